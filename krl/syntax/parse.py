@@ -1,0 +1,193 @@
+"""Parsing KRL text with the generated ANTLR parser.
+
+Two stages, the standard ANTLR strategy: SLL prediction with a bail-out error strategy
+first (fast, and enough for almost every valid file), then full LL with a line-oriented
+error recovery only when the first stage fails. The second stage reports every syntax
+error with its line, column, offending token, the expected tokens and the rule stack.
+
+The parser classes come from a `ParserBundle`, so that `krl growth` can load the parsers
+generated from older versions of grammar/KRL.g4.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import sys
+from dataclasses import dataclass, field
+from pathlib import Path
+from types import ModuleType
+
+from antlr4 import CommonTokenStream, InputStream, Token
+from antlr4.atn.PredictionMode import PredictionMode
+from antlr4.error.ErrorStrategy import BailErrorStrategy
+from antlr4.error.Errors import ParseCancellationException
+
+from krl.syntax.errors import CollectingErrorListener, LineErrorStrategy
+from krl.syntax.source import SourceText, read_source
+
+GENERATED_DIR = Path(__file__).parent / "generated"
+
+
+@dataclass(slots=True)
+class SyntaxIssue:
+    """One syntax or lexer error at line:column (1-based line, 0-based column as ANTLR)."""
+
+    line: int
+    column: int
+    message: str
+    offending: str
+    expected: list[str]
+    rule_stack: list[str]
+    kind: str = "syntax"          # "syntax" or "lexer"
+    offending_type: str = ""      # symbolic token name, "<EOF>" or "" for lexer errors
+    line_shape: list[str] = field(default_factory=list)  # tokens of the line up to the offending one
+    line_text: str = ""
+    cascade: bool = False          # a follow-on error of an earlier one (not a construct of its own)
+
+    def as_json(self) -> dict:
+        return {"line": self.line, "column": self.column, "message": self.message,
+                "offending": self.offending, "expected": self.expected,
+                "rule_stack": self.rule_stack, "kind": self.kind, "cascade": self.cascade}
+
+
+@dataclass(slots=True)
+class ParseResult:
+    path: str
+    ok: bool
+    encoding: str
+    status: str = "ok"            # "ok", "syntax_error", or a SourceText classification
+    errors: list[SyntaxIssue] = field(default_factory=list)
+    tree: object | None = None
+    stage: str = "sll"            # which stage produced the result: "sll" or "ll"
+    size: int = 0
+
+    def as_json(self) -> dict:
+        return {"path": self.path, "ok": self.ok, "encoding": self.encoding,
+                "errors": [e.as_json() for e in self.errors]}
+
+
+class ParserBundle:
+    """The lexer and parser classes generated from one version of KRL.g4."""
+
+    def __init__(self, lexer_cls: type, parser_cls: type):
+        self.lexer_cls = lexer_cls
+        self.parser_cls = parser_cls
+        self.symbolic = list(parser_cls.symbolicNames)
+        self.literal = list(parser_cls.literalNames)
+
+    @classmethod
+    def from_directory(cls, directory: str | Path, tag: str = "") -> "ParserBundle":
+        """Load KRLLexer.py and KRLParser.py from a directory of generated code."""
+        directory = Path(directory)
+        mods: dict[str, ModuleType] = {}
+        for name in ("KRLLexer", "KRLParser"):
+            modname = f"_krl_gen_{tag or abs(hash(str(directory)))}_{name}"
+            spec = importlib.util.spec_from_file_location(modname, directory / f"{name}.py")
+            if spec is None or spec.loader is None:
+                raise ImportError(f"no generated {name} in {directory}")
+            mod = importlib.util.module_from_spec(spec)
+            sys.modules[modname] = mod
+            spec.loader.exec_module(mod)
+            mods[name] = mod
+        return cls(mods["KRLLexer"].KRLLexer, mods["KRLParser"].KRLParser)
+
+    def token_name(self, ttype: int) -> str:
+        if ttype == Token.EOF:
+            return "<EOF>"
+        if 0 < ttype < len(self.symbolic) and self.symbolic[ttype] != "<INVALID>":
+            return self.symbolic[ttype]
+        if 0 < ttype < len(self.literal):
+            return self.literal[ttype]
+        return str(ttype)
+
+    def display_name(self, ttype: int) -> str:
+        """A token type as a user reads it: the literal ('THEN', ':') where there is one."""
+        if ttype == Token.EOF:
+            return "<EOF>"
+        if ttype == -2:  # Token.EPSILON
+            return "<end of rule>"
+        if 0 < ttype < len(self.literal) and self.literal[ttype] != "<INVALID>":
+            return self.literal[ttype].strip("'")
+        return self.token_name(ttype)
+
+
+_default_bundle: ParserBundle | None = None
+
+
+def default_bundle() -> ParserBundle:
+    """The parser generated from the working tree's grammar/KRL.g4 (by `make parser`)."""
+    global _default_bundle
+    if _default_bundle is None:
+        if not (GENERATED_DIR / "KRLParser.py").exists():
+            raise RuntimeError("the generated parser is missing: run `make parser` "
+                               "(it generates krl/syntax/generated from grammar/KRL.g4)")
+        from krl.syntax.generated.KRLLexer import KRLLexer  # noqa: PLC0415
+        from krl.syntax.generated.KRLParser import KRLParser  # noqa: PLC0415
+        _default_bundle = ParserBundle(KRLLexer, KRLParser)
+    return _default_bundle
+
+
+def _prepare(text: str) -> str:
+    # A newline ends every statement; give an unterminated last line its newline.
+    if text and not text.endswith(("\n", "\r")):
+        text += "\n"
+    return text
+
+
+def parse_text(text: str, path: str = "<string>", bundle: ParserBundle | None = None,
+               keep_tree: bool = True, encoding: str = "") -> ParseResult:
+    """Parse KRL text with the start rule `module`.
+
+    Returns a ParseResult; ok is True when there is no lexer or syntax error.
+    Never raises for bad input.
+    """
+    bundle = bundle or default_bundle()
+    text = _prepare(text)
+
+    # Stage 1: SLL with bail-out. Lexer errors are collected here too.
+    lex_listener = CollectingErrorListener(bundle, kind="lexer")
+    lexer = bundle.lexer_cls(InputStream(text))
+    lexer.removeErrorListeners()
+    lexer.addErrorListener(lex_listener)
+    tokens = CommonTokenStream(lexer)
+    tokens.fill()
+    parser = bundle.parser_cls(tokens)
+    parser.removeErrorListeners()
+    parser._interp.predictionMode = PredictionMode.SLL
+    parser._errHandler = BailErrorStrategy()
+    try:
+        tree = parser.module()
+        if not lex_listener.issues:
+            return ParseResult(path, True, encoding, "ok", [], tree if keep_tree else None, "sll")
+    except ParseCancellationException:
+        pass
+
+    # Stage 2: full LL with line-oriented recovery, collecting every error.
+    tokens.seek(0)
+    parser = bundle.parser_cls(tokens)
+    parser.removeErrorListeners()
+    listener = CollectingErrorListener(bundle, kind="syntax", tokens=tokens, text=text)
+    parser.addErrorListener(listener)
+    parser._interp.predictionMode = PredictionMode.LL
+    parser._errHandler = LineErrorStrategy()
+    tree = parser.module()
+    lex_issues = lex_listener.finish_lexer(text)
+    issues = sorted(lex_issues + listener.issues, key=lambda i: (i.line, i.column))
+    listener.mark_cascades(issues)
+    ok = not issues
+    return ParseResult(path, ok, encoding, "ok" if ok else "syntax_error", issues,
+                       tree if keep_tree else None, "ll")
+
+
+def parse_source(source: SourceText, bundle: ParserBundle | None = None,
+                 keep_tree: bool = True) -> ParseResult:
+    """Parse a decoded file; classified bad input (binary, empty, ...) is not parsed."""
+    if source.status != "ok":
+        return ParseResult(source.path, False, source.encoding, source.status, [], None, "", source.size)
+    result = parse_text(source.text, source.path, bundle, keep_tree, source.encoding)
+    result.size = source.size
+    return result
+
+
+def parse_file(path: str | Path, bundle: ParserBundle | None = None, keep_tree: bool = True) -> ParseResult:
+    return parse_source(read_source(path), bundle, keep_tree)
