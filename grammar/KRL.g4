@@ -1,0 +1,556 @@
+/*
+ * KRL.g4 -- grammar of the KUKA Robot Language (KSS 8.x), recovered from real code.
+ *
+ * This grammar starts deliberately restrictive: it encodes the documented syntax of
+ * ../shared/docs/krl-reference.md sections 1-6.1 and, wherever the reference is vague,
+ * takes the most restrictive reading.  It grows one validated construct per commit
+ * (see grammar/CHANGES.md); `krl growth` replays its git history over a corpus.
+ *
+ * Conventions
+ *  - One combined grammar, case-insensitive, line-oriented: NEWLINE ends a statement.
+ *  - ';' comments and ';FOLD' / ';ENDFOLD' lines are on the hidden channel.
+ *  - The start rule is `module` in every version (the growth replay relies on it).
+ *  - The parse front end appends a final newline to a file that lacks one.
+ */
+grammar KRL;
+
+options { caseInsensitive = true; }
+
+// ======================================================================== parser
+
+// A .src, .sub or .dat file (reference 2.1, 2.2, 2.5).
+module
+    : headerLine* NEWLINE* (dataList | routine (NEWLINE* routine)*) NEWLINE* EOF
+    ;
+
+// &ACCESS, &REL, &PARAM, &COMMENT lines at the top of a file (reference 1.3).
+headerLine
+    : HEADER NEWLINE+
+    ;
+
+// ------------------------------------------------------------------ routines (2.2-2.4)
+
+routine
+    : procedureDefinition
+    | functionDefinition
+    ;
+
+procedureDefinition
+    : GLOBAL? DEF name '(' parameterList? ')' NEWLINE routineBody END NEWLINE
+    ;
+
+functionDefinition
+    : GLOBAL? DEFFCT typeRef name '(' parameterList? ')' NEWLINE routineBody ENDFCT NEWLINE
+    ;
+
+parameterList
+    : parameter (',' parameter)*
+    ;
+
+parameter
+    : name (':' (IN | OUT))?
+    ;
+
+// Declarations precede statements (2.2): a DECL after the first statement is a syntax error.
+routineBody
+    : declarationLine* statementList
+    ;
+
+declarationLine
+    : declaration? NEWLINE
+    ;
+
+statementList
+    : statementLine*
+    ;
+
+statementLine
+    : (statement | label)? NEWLINE
+    ;
+
+label
+    : name ':'
+    ;
+
+// ------------------------------------------------------------------ data lists (2.5)
+
+dataList
+    : DEFDAT name PUBLIC? NEWLINE dataItemLine* ENDDAT NEWLINE
+    ;
+
+dataItemLine
+    : dataItem? NEWLINE
+    ;
+
+dataItem
+    : dataVariableDeclaration
+    | arrayElementInitialisation
+    | structureDeclaration
+    | enumDeclaration
+    | signalDeclaration
+    | externalDeclaration
+    | importDeclaration
+    | channelDeclaration
+    ;
+
+// DECL is optional only before the simple types; user and predefined structure types need it (2.5).
+dataVariableDeclaration
+    : DECL GLOBAL? CONST? typeName variableName ('=' constantValue)?
+    | GLOBAL? CONST? simpleType variableName ('=' constantValue)?
+    ;
+
+arrayElementInitialisation
+    : name '[' constantIndex (',' constantIndex?)* ']' '=' constantValue
+    ;
+
+constantIndex
+    : INTLITERAL
+    ;
+
+// Only literals (with a leading sign) and literal aggregates initialise data-list variables (1.5).
+constantValue
+    : sign=('-' | '+')? (INTLITERAL | REALLITERAL)
+    | HEXLITERAL
+    | BINLITERAL
+    | TRUE
+    | FALSE
+    | STRINGLITERAL
+    | ENUMLITERAL
+    | constantAggregate
+    ;
+
+constantAggregate
+    : '{' (typeName ':')? constantComponent (',' constantComponent)* '}'
+    ;
+
+constantComponent
+    : name ('[' ']')? constantValue
+    ;
+
+channelDeclaration
+    : CHANNEL ':' name ':' name name
+    ;
+
+importDeclaration
+    : IMPORT typeName name IS '/' name '/' name '..' name
+    ;
+
+// ------------------------------------------------------------------ declarations (3)
+
+declaration
+    : variableDeclaration
+    | structureDeclaration
+    | enumDeclaration
+    | signalDeclaration
+    | externalDeclaration
+    | importDeclaration
+    ;
+
+// In a routine: no initial values, no CONST (2.2, 2.5).
+variableDeclaration
+    : DECL typeName variableName (',' variableName)*
+    | simpleType variableName (',' variableName)*
+    ;
+
+variableName
+    : name arrayDimensions?
+    ;
+
+arrayDimensions
+    : '[' INTLITERAL (',' INTLITERAL (',' INTLITERAL)?)? ']'
+    ;
+
+structureDeclaration
+    : GLOBAL? STRUC name typeName structureComponent (',' typeName? structureComponent)*
+    ;
+
+structureComponent
+    : name arrayDimensions?
+    ;
+
+enumDeclaration
+    : GLOBAL? ENUM name name (',' name)*
+    ;
+
+signalDeclaration
+    : GLOBAL? SIGNAL name signalReference (TO signalReference)?
+    ;
+
+signalReference
+    : SYSNAME '[' INTLITERAL ']'
+    ;
+
+// EXT/EXTP procedure and EXTFCT/EXTFCTP function signatures (2.6).
+externalDeclaration
+    : (EXT | EXTP) name '(' externalParameterList? ')'
+    | (EXTFCT | EXTFCTP) typeRef name '(' externalParameterList? ')'
+    ;
+
+externalParameterList
+    : externalParameter (',' externalParameter)*
+    ;
+
+externalParameter
+    : typeName ('[' INTLITERAL? ']')? (name ('[' INTLITERAL? ']')?)? (':' (IN | OUT))?
+    ;
+
+typeRef
+    : typeName ('[' INTLITERAL? ']')?
+    ;
+
+typeName
+    : simpleType
+    | IDENTIFIER
+    ;
+
+simpleType
+    : INT
+    | REAL
+    | BOOL
+    | CHAR
+    ;
+
+// ------------------------------------------------------------------ statements (5)
+
+statement
+    : assignment                                                    # assignmentStatement
+    | call                                                          # callStatement
+    | IF expression THEN NEWLINE statementList
+      (ELSE NEWLINE statementList)? ENDIF                           # ifStatement
+    | SWITCH expression NEWLINE+ switchCase+ switchDefault? ENDSWITCH # switchStatement
+    | FOR name '=' expression TO expression (STEP expression)?
+      NEWLINE statementList ENDFOR                                  # forStatement
+    | WHILE expression NEWLINE statementList ENDWHILE               # whileStatement
+    | REPEAT NEWLINE statementList UNTIL expression                 # repeatStatement
+    | LOOP NEWLINE statementList ENDLOOP                            # loopStatement
+    | EXIT                                                          # exitStatement
+    | GOTO name                                                     # gotoStatement
+    | HALT                                                          # haltStatement
+    | WAIT FOR expression                                           # waitForStatement
+    | WAIT SEC expression                                           # waitSecStatement
+    | CONTINUE                                                      # continueStatement
+    | RETURN expression?                                            # returnStatement
+    | ON_ERROR_PROCEED                                              # onErrorProceedStatement
+    | GLOBAL? INTERRUPT DECL priority WHEN expression DO call       # interruptDeclaration
+    | INTERRUPT action=(ON | OFF | ENABLE | DISABLE) priority?      # interruptControl
+    | BRAKE                                                         # brakeStatement
+    | BRAKE_F                                                       # brakeFStatement
+    | RESUME                                                        # resumeStatement
+    | triggerStatement                                              # triggerStatementAlt
+    | ANIN ON variable '=' expression                               # aninOnStatement
+    | ANIN OFF name                                                 # aninOffStatement
+    | ANOUT ON name '=' expression (DELAY '=' expression)?
+      (MINIMUM '=' expression)? (MAXIMUM '=' expression)?           # anoutOnStatement
+    | ANOUT OFF name                                                # anoutOffStatement
+    | motion                                                        # motionStatement
+    ;
+
+assignment
+    : variable '=' expression
+    ;
+
+call
+    : name '(' argumentList? ')'
+    ;
+
+// Omitted arguments leave an empty slot: F(a, , c) (2.3).
+argumentList
+    : argument (',' argument?)*
+    | (',' argument?)+
+    ;
+
+argument
+    : expression
+    ;
+
+switchCase
+    : CASE expression (',' expression)* NEWLINE statementList
+    ;
+
+switchDefault
+    : DEFAULT NEWLINE statementList
+    ;
+
+priority
+    : INTLITERAL
+    | name
+    ;
+
+// Path-synchronous actions (5.18).
+triggerStatement
+    : TRIGGER WHEN DISTANCE '=' INTLITERAL DELAY '=' expression DO triggerAction
+      (PRIO '=' expression)?
+    | TRIGGER WHEN PATH '=' expression ONSTART? DELAY '=' expression DO triggerAction
+      (PRIO '=' expression)?
+    ;
+
+triggerAction
+    : assignment
+    | call
+    ;
+
+// ------------------------------------------------------------------ motions (6.1)
+
+motion
+    : PTP expression approximation? approximation?                                   # ptpMotion
+    | PTP_REL expression approximation? approximation? ENUMLITERAL?                  # ptpRelMotion
+    | LIN expression approximation? approximation?                                   # linMotion
+    | LIN_REL expression approximation? approximation? ENUMLITERAL?                  # linRelMotion
+    | CIRC expression ',' expression (',' CA expression)? approximation? approximation? # circMotion
+    | CIRC_REL expression ',' expression (',' CA expression)? approximation?
+      ENUMLITERAL?                                                                   # circRelMotion
+    | SPTP expression withClause? splineApproximation?                               # sptpMotion
+    | SLIN expression withClause? splineApproximation?                               # slinMotion
+    | SCIRC expression ',' expression (',' CA expression)? withClause? C_SPL?        # scircMotion
+    | SPTP_REL expression withClause? splineApproximation? ENUMLITERAL?              # sptpRelMotion
+    | SLIN_REL expression withClause? splineApproximation? ENUMLITERAL?              # slinRelMotion
+    | SCIRC_REL expression ',' expression (',' CA expression)? withClause? C_SPL?
+      ENUMLITERAL?                                                                   # scircRelMotion
+    ;
+
+approximation
+    : C_PTP
+    | C_DIS
+    | C_VEL
+    | C_ORI
+    ;
+
+splineApproximation
+    : C_SPL
+    | C_DIS
+    | C_PTP
+    ;
+
+withClause
+    : WITH withAssignment (',' withAssignment)*
+    ;
+
+withAssignment
+    : systemVariable '=' expression
+    ;
+
+systemVariable
+    : SYSNAME selector*
+    ;
+
+// ------------------------------------------------------------------ expressions (4)
+
+// Alternatives are listed from the highest to the lowest priority (reference 4.1);
+// comparisons bind weaker than AND/OR.
+expression
+    : primary                                                     # primaryExpression
+    | op=('-' | '+' | NOT | B_NOT) expression                     # unaryExpression
+    | expression ':' expression                                   # geometricExpression
+    | expression op=('*' | '/') expression                        # multiplicativeExpression
+    | expression op=('+' | '-') expression                        # additiveExpression
+    | expression op=(AND | B_AND) expression                      # andExpression
+    | expression op=(EXOR | B_EXOR) expression                    # exorExpression
+    | expression op=(OR | B_OR) expression                        # orExpression
+    | expression op=('==' | '<>' | '<' | '>' | '<=' | '>=') expression # relationalExpression
+    ;
+
+primary
+    : literal                                                     # literalPrimary
+    | aggregate                                                   # aggregatePrimary
+    | call                                                        # callPrimary
+    | variable                                                    # variablePrimary
+    | '(' expression ')'                                          # parenthesisedPrimary
+    ;
+
+variable
+    : name selector*
+    ;
+
+// a[i], m[i,j], names[2,] (row of a CHAR array), s[] (whole CHAR array), p.X
+selector
+    : '[' expression? (',' expression?)* ']'
+    | '.' name
+    ;
+
+aggregate
+    : '{' (typeName ':')? aggregateComponent (',' aggregateComponent)* '}'
+    ;
+
+aggregateComponent
+    : name ('[' ']')? expression
+    ;
+
+literal
+    : INTLITERAL
+    | REALLITERAL
+    | HEXLITERAL
+    | BINLITERAL
+    | TRUE
+    | FALSE
+    | STRINGLITERAL
+    | ENUMLITERAL
+    ;
+
+name
+    : IDENTIFIER
+    | SYSNAME
+    ;
+
+// ======================================================================== lexer
+
+// Header lines (1.3): only the four documented kinds.
+HEADER : '&' ('ACCESS' | 'REL' | 'PARAM' | 'COMMENT') ~[\r\n]* ;
+
+// Folds and comments (1.3): structural comments on the hidden channel.
+FOLD    : ';' [ \t]* 'FOLD' ~[\r\n]*    -> channel(HIDDEN) ;
+ENDFOLD : ';' [ \t]* 'ENDFOLD' ~[\r\n]* -> channel(HIDDEN) ;
+COMMENT : ';' ~[\r\n]*                  -> channel(HIDDEN) ;
+
+NEWLINE : '\r'? '\n' | '\r' ;
+WS      : [ \t\f]+ -> skip ;
+
+// Keywords (1.6).
+AND : 'AND' ;
+ANIN : 'ANIN' ;
+ANOUT : 'ANOUT' ;
+ASYCANCEL : 'ASYCANCEL' ;
+ASYCONT : 'ASYCONT' ;
+ASYPTP : 'ASYPTP' ;
+ASYSTOP : 'ASYSTOP' ;
+B_AND : 'B_AND' ;
+B_EXOR : 'B_EXOR' ;
+B_NOT : 'B_NOT' ;
+B_OR : 'B_OR' ;
+BOOL : 'BOOL' ;
+BRAKE_F : 'BRAKE' [ \t]+ 'F' ;
+BRAKE : 'BRAKE' ;
+C_DIS : 'C_DIS' ;
+C_ORI : 'C_ORI' ;
+C_PTP : 'C_PTP' ;
+C_SPL : 'C_SPL' ;
+C_VEL : 'C_VEL' ;
+CA : 'CA' ;
+CASE : 'CASE' ;
+CHANNEL : 'CHANNEL' ;
+CHAR : 'CHAR' ;
+CIRC : 'CIRC' ;
+CIRC_REL : 'CIRC_REL' ;
+CONST : 'CONST' ;
+CONST_VEL : 'CONST_VEL' ;
+CONTINUE : 'CONTINUE' ;
+DECL : 'DECL' ;
+DEF : 'DEF' ;
+DEFAULT : 'DEFAULT' ;
+DEFDAT : 'DEFDAT' ;
+DEFFCT : 'DEFFCT' ;
+DELAY : 'DELAY' ;
+DIGIN : 'DIGIN' ;
+DISABLE : 'DISABLE' ;
+DISTANCE : 'DISTANCE' ;
+DO : 'DO' ;
+ELSE : 'ELSE' ;
+ENABLE : 'ENABLE' ;
+END : 'END' ;
+ENDDAT : 'ENDDAT' ;
+ENDFCT : 'ENDFCT' ;
+ENDFOR : 'ENDFOR' ;
+ENDIF : 'ENDIF' ;
+ENDLOOP : 'ENDLOOP' ;
+ENDSPLINE : 'ENDSPLINE' ;
+ENDSWITCH : 'ENDSWITCH' ;
+ENDWHILE : 'ENDWHILE' ;
+ENUM : 'ENUM' ;
+EXIT : 'EXIT' ;
+EXOR : 'EXOR' ;
+EXT : 'EXT' ;
+EXTFCT : 'EXTFCT' ;
+EXTFCTP : 'EXTFCTP' ;
+EXTP : 'EXTP' ;
+FALSE : 'FALSE' ;
+FOR : 'FOR' ;
+GLOBAL : 'GLOBAL' ;
+GOTO : 'GOTO' ;
+HALT : 'HALT' ;
+IF : 'IF' ;
+IMPORT : 'IMPORT' ;
+IN : 'IN' ;
+INT : 'INT' ;
+INTERRUPT : 'INTERRUPT' ;
+IS : 'IS' ;
+LIN : 'LIN' ;
+LIN_REL : 'LIN_REL' ;
+LOOP : 'LOOP' ;
+MAXIMUM : 'MAXIMUM' ;
+MINIMUM : 'MINIMUM' ;
+MOVE_EMI : 'MOVE_EMI' ;
+NOT : 'NOT' ;
+OFF : 'OFF' ;
+ON : 'ON' ;
+ON_ERROR_PROCEED : 'ON_ERROR_PROCEED' ;
+ONSTART : 'ONSTART' ;
+OR : 'OR' ;
+OUT : 'OUT' ;
+PATH : 'PATH' ;
+PRIO : 'PRIO' ;
+PTP : 'PTP' ;
+PTP_REL : 'PTP_REL' ;
+PTP_SPLINE : 'PTP_SPLINE' ;
+PUBLIC : 'PUBLIC' ;
+REAL : 'REAL' ;
+REPEAT : 'REPEAT' ;
+RESUME : 'RESUME' ;
+RETURN : 'RETURN' ;
+SCIRC : 'SCIRC' ;
+SCIRC_REL : 'SCIRC_REL' ;
+SEC : 'SEC' ;
+SIGNAL : 'SIGNAL' ;
+SLIN : 'SLIN' ;
+SLIN_REL : 'SLIN_REL' ;
+SPL : 'SPL' ;
+SPLINE : 'SPLINE' ;
+SPTP : 'SPTP' ;
+SPTP_REL : 'SPTP_REL' ;
+STEP : 'STEP' ;
+STRUC : 'STRUC' ;
+SWITCH : 'SWITCH' ;
+THEN : 'THEN' ;
+TIME_BLOCK : 'TIME_BLOCK' ;
+TO : 'TO' ;
+TRIGGER : 'TRIGGER' ;
+TRUE : 'TRUE' ;
+UNTIL : 'UNTIL' ;
+WAIT : 'WAIT' ;
+WHEN : 'WHEN' ;
+WHILE : 'WHILE' ;
+WITH : 'WITH' ;
+
+// Literals (1.5).
+HEXLITERAL    : '\'' 'H' [0-9A-F]+ '\'' ;
+BINLITERAL    : '\'' 'B' [01]+ '\'' ;
+REALLITERAL   : [0-9]+ '.' [0-9]* EXPONENT? | '.' [0-9]+ EXPONENT? | [0-9]+ EXPONENT ;
+INTLITERAL    : [0-9]+ ;
+STRINGLITERAL : '"' ~["\r\n]* '"' ;
+ENUMLITERAL   : '#' [A-Z_] [A-Z0-9_]* ;
+fragment EXPONENT : 'E' [+-]? [0-9]+ ;
+
+// Names (1.2): system names start with '$'.
+SYSNAME    : '$' [A-Z0-9_$]* ;
+IDENTIFIER : [A-Z_] [A-Z0-9_$]* ;
+
+// Operators and punctuation.
+EQ     : '==' ;
+NE     : '<>' ;
+LE     : '<=' ;
+GE     : '>=' ;
+LT     : '<' ;
+GT     : '>' ;
+ASSIGN : '=' ;
+PLUS   : '+' ;
+MINUS  : '-' ;
+STAR   : '*' ;
+SLASH  : '/' ;
+COLON  : ':' ;
+COMMA  : ',' ;
+DOTDOT : '..' ;
+DOT    : '.' ;
+LPAREN : '(' ;
+RPAREN : ')' ;
+LBRACK : '[' ;
+RBRACK : ']' ;
+LBRACE : '{' ;
+RBRACE : '}' ;
