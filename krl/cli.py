@@ -24,13 +24,18 @@ def main() -> None:
 @main.command()
 @click.argument("files", nargs=-1, required=True, type=click.Path(path_type=Path))
 @click.option("--json", "as_json", is_flag=True, help="One JSON object per file.")
-def parse(files: tuple[Path, ...], as_json: bool) -> None:
+@click.option("--outline", is_flag=True, help="Print the tree outline of each file that parses.")
+def parse(files: tuple[Path, ...], as_json: bool, outline: bool) -> None:
     """Parse FILES; exit 0 when every file parses."""
+    from krl.syntax.outline import outline as tree_outline  # noqa: PLC0415
     from krl.syntax.parse import parse_file  # noqa: PLC0415
 
     all_ok = True
     for path in files:
-        result = parse_file(path, keep_tree=False)
+        result = parse_file(path, keep_tree=outline)
+        if outline and result.ok:
+            for entry in tree_outline(result.tree):
+                click.echo(f"{path}:{entry}")
         all_ok &= result.ok
         if as_json:
             obj = result.as_json()
