@@ -54,16 +54,30 @@ def parse(files: tuple[Path, ...], as_json: bool, outline: bool) -> None:
     sys.exit(0 if all_ok else 1)
 
 
+# Each pipeline stage contributes its subcommands from its own package: a module listed
+# here exposes `commands`, a list of click commands.
+SUBCOMMAND_MODULES = (
+    "recovery.cli",        # recover, growth, validate
+    "krl.semantics.cli",   # check
+    "robot.cli",           # plot
+    "interp.cli",          # run, asm
+    "krl.bench",           # bench
+    "conformance.cli",     # conformance
+)
+
+
 def _register_subcommands() -> None:
-    """Subcommands that live in their own packages register here."""
-    from recovery.cli import growth, recover, validate  # noqa: PLC0415
+    import importlib  # noqa: PLC0415
 
-    main.add_command(recover)
-    main.add_command(growth)
-    main.add_command(validate)
+    for module_name in SUBCOMMAND_MODULES:
+        try:
+            module = importlib.import_module(module_name)
+        except ModuleNotFoundError as exc:
+            if exc.name and (module_name + ".").startswith(exc.name + "."):
+                continue  # that stage (or its package) is not built yet
+            raise
+        for command in module.commands:
+            main.add_command(command)
 
 
-try:
-    _register_subcommands()
-except ImportError:  # pragma: no cover - during bootstrap a package may be missing
-    pass
+_register_subcommands()
