@@ -1,0 +1,102 @@
+"""Clustering parse failures into missing constructs.
+
+A cluster is a construct the grammar lacks, not a file. Its signature is built from the
+first syntax error of each statement (follow-on errors are marked by the parser and left
+out): the parser rule at the error, the offending token type, and the shape of the line up
+to the offending token, with keywords kept and names, numbers, strings and system variables
+normalised. Lexer errors (unknown characters) form clusters of their own. Clusters are
+ranked by the number of files they affect, then by occurrences.
+"""
+
+from __future__ import annotations
+
+import hashlib
+from collections import defaultdict
+from dataclasses import dataclass, field
+
+from recovery.scan import FileResult, IssueRecord
+
+MAX_SHAPE = 8
+EXAMPLES = 3
+
+
+@dataclass(slots=True)
+class Cluster:
+    id: str
+    signature: str
+    files: int = 0
+    occurrences: int = 0
+    leading_keyword: str = ""
+    expected: list[str] = field(default_factory=list)
+    examples: list[dict] = field(default_factory=list)
+    paths: list[str] = field(default_factory=list)
+
+    def to_json(self) -> dict:
+        return {"id": self.id, "signature": self.signature, "files": self.files,
+                "occurrences": self.occurrences, "leading_keyword": self.leading_keyword,
+                "expected": self.expected, "examples": self.examples}
+
+
+def compact_shape(shape: list[str]) -> list[str]:
+    """Keep the start of the line and the tokens just before the error."""
+    if len(shape) <= MAX_SHAPE:
+        return list(shape)
+    return shape[:3] + ["…"] + shape[-(MAX_SHAPE - 4):]
+
+
+def signature(issue: IssueRecord) -> str:
+    if issue.kind == "lexer":
+        return "lexer | " + " ".join(issue.shape)
+    if issue.kind == "internal":
+        return "internal | parser failure"
+    context = issue.rule_stack[-1] if issue.rule_stack else "?"
+    return f"{context} | {issue.offending_type} | {' '.join(compact_shape(issue.shape))}"
+
+
+def cluster_id(sig: str) -> str:
+    return "C" + hashlib.sha1(sig.encode("utf-8")).hexdigest()[:7]
+
+
+def _leading_keyword(issue: IssueRecord) -> str:
+    if issue.kind == "lexer":
+        return "(lexer)"
+    first = issue.shape[0] if issue.shape else ""
+    return first
+
+
+def counted_issues(result: FileResult) -> list[IssueRecord]:
+    """The issues of a file that define constructs: not follow-on errors."""
+    return [i for i in result.issues if not i.cascade]
+
+
+def cluster_results(results: list[FileResult]) -> list[Cluster]:
+    """Group the counted issues of all files into ranked clusters."""
+    by_sig: dict[str, Cluster] = {}
+    files_of: dict[str, set[str]] = defaultdict(set)
+    for res in results:
+        for issue in counted_issues(res):
+            sig = signature(issue)
+            cl = by_sig.get(sig)
+            if cl is None:
+                cl = by_sig[sig] = Cluster(cluster_id(sig), sig, leading_keyword=_leading_keyword(issue),
+                                           expected=list(issue.expected))
+            cl.occurrences += 1
+            if res.path not in files_of[sig]:
+                files_of[sig].add(res.path)
+                if len(cl.examples) < EXAMPLES:
+                    cl.examples.append({"path": res.path, "line": issue.line,
+                                        "text": issue.line_text.strip()[:200]})
+    for sig, cl in by_sig.items():
+        cl.files = len(files_of[sig])
+        cl.paths = sorted(files_of[sig])
+    return sorted(by_sig.values(), key=lambda c: (-c.files, -c.occurrences, c.signature))
+
+
+def clusters_of_file(result: FileResult) -> list[str]:
+    """Cluster ids of one file, in order of first appearance."""
+    seen: list[str] = []
+    for issue in counted_issues(result):
+        cid = cluster_id(signature(issue))
+        if cid not in seen:
+            seen.append(cid)
+    return seen
