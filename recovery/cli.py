@@ -37,4 +37,46 @@ def recover(corpus: Path, out: Path, jobs: int | None, no_cache: bool) -> None:
     sys.exit(0 if summary.files_ok == summary.files else 1)
 
 
-commands = [recover]
+@click.command()
+@click.argument("corpus", type=click.Path(path_type=Path))
+@click.option("--out", default="reports/growth", type=click.Path(path_type=Path))
+@click.option("--jobs", type=int, default=None)
+@click.option("--no-cache", is_flag=True)
+def growth(corpus: Path, out: Path, jobs: int | None, no_cache: bool) -> None:
+    """Replay every committed version of grammar/KRL.g4 over CORPUS: growth.csv and growth.png."""
+    from recovery.grammar_versions import GrammarToolError  # noqa: PLC0415
+    from recovery.growth import growth_rows, write_growth  # noqa: PLC0415
+
+    if not corpus.is_dir():
+        click.echo(f"error: corpus directory not found: {corpus}", err=True)
+        sys.exit(2)
+    try:
+        rows = growth_rows(corpus, jobs=jobs, use_cache=not no_cache)
+    except GrammarToolError as exc:
+        click.echo(f"error: {exc}", err=True)
+        sys.exit(2)
+    write_growth(out, rows)
+    for i, r in enumerate(rows):
+        click.echo(f"{i:3d} {r['commit']} {r['files_ok']:4d}/{r['files']} files "
+                   f"{r['clusters']:4d} clusters  {r['subject']}")
+    click.echo(f"-> {out}/growth.csv, {out}/growth.png")
+
+
+@click.command()
+@click.argument("names", nargs=-1)
+@click.option("--corpus", type=click.Path(path_type=Path), default=None,
+              help="Also report the corpus clusters each construct closed (default: "
+                   "../shared/krl-corpus when present).")
+@click.option("--no-corpus", is_flag=True, help="Only run the examples.")
+def validate(names: tuple[str, ...], corpus: Path | None, no_corpus: bool) -> None:
+    """Run every grammar construct's positive and negative examples (or only NAMES)."""
+    from recovery.validate import DEFAULT_CORPUS, print_validation, validate_constructs  # noqa: PLC0415
+
+    if corpus is None and not no_corpus and DEFAULT_CORPUS.is_dir():
+        corpus = DEFAULT_CORPUS
+    reports = validate_constructs(list(names), corpus=None if no_corpus else corpus)
+    ok = print_validation(reports)
+    sys.exit(0 if ok else 1)
+
+
+commands = [recover, growth, validate]

@@ -1,0 +1,159 @@
+"""`krl validate`: check each grammar construct's examples and its effect on the corpus.
+
+grammar/constructs/<name>/ holds, per construct:
+- ok_*.src|.dat|.sub: positive examples that must parse; a sibling ok_*.expect lists
+  outline entries (see krl.syntax.outline) that must appear in the example's tree;
+- bad_*.src|.dat|.sub: negative near-misses that must be rejected.
+
+With a corpus, validate also reports which corpus clusters the construct closed: it scans
+the corpus with the grammar before and after the commit that introduced the construct
+(parsers and results come from the growth cache).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import click
+
+from krl.syntax.outline import outline
+from krl.syntax.parse import parse_file
+from krl.syntax.source import is_krl_file
+from recovery.cluster import cluster_results
+from recovery.grammar_versions import GrammarToolError, _git, parser_dir_for
+from recovery.scan import grammar_sha, scan
+
+REPO_ROOT = Path(__file__).resolve().parents[1]
+CONSTRUCTS = REPO_ROOT / "grammar" / "constructs"
+DEFAULT_CORPUS = REPO_ROOT.parent / "shared" / "krl-corpus"
+
+
+@dataclass(slots=True)
+class ExampleResult:
+    path: str
+    kind: str          # "ok" or "bad"
+    passed: bool
+    detail: str = ""
+
+
+@dataclass(slots=True)
+class ConstructReport:
+    name: str
+    examples: list[ExampleResult] = field(default_factory=list)
+    commit: str = ""
+    grammar_changed: bool = False
+    closed: list[dict] = field(default_factory=list)
+    files_before: int | None = None
+    files_after: int | None = None
+    note: str = ""
+
+    @property
+    def passed(self) -> bool:
+        return bool(self.examples) and all(e.passed for e in self.examples) and any(
+            e.kind == "ok" for e in self.examples) and any(e.kind == "bad" for e in self.examples)
+
+
+def expected_entries(expect_file: Path) -> list[str]:
+    if not expect_file.exists():
+        return []
+    return [ln.strip() for ln in expect_file.read_text(encoding="utf-8").splitlines()
+            if ln.strip() and not ln.lstrip().startswith("#")]
+
+
+def check_example(path: Path) -> ExampleResult:
+    kind = "ok" if path.name.startswith("ok_") else "bad"
+    result = parse_file(path, keep_tree=(kind == "ok"))
+    rel = path.relative_to(REPO_ROOT).as_posix()
+    if kind == "bad":
+        return ExampleResult(rel, kind, not result.ok, "" if not result.ok else "accepted")
+    if not result.ok:
+        first = next((e for e in result.errors if not e.cascade), None)
+        where = f"{first.line}:{first.column + 1} {first.message}" if first else result.status
+        return ExampleResult(rel, kind, False, f"rejected: {where}")
+    entries = set(outline(result.tree))
+    missing = [e for e in expected_entries(path.with_suffix(".expect")) if e not in entries]
+    if missing:
+        return ExampleResult(rel, kind, False, "tree differs; missing " + "; ".join(missing[:3]))
+    return ExampleResult(rel, kind, True)
+
+
+def _introducing_commit(directory: Path) -> str:
+    rel = directory.relative_to(REPO_ROOT).as_posix()
+    out = _git("log", "--diff-filter=A", "--format=%H", "--", rel).split()
+    return out[-1] if out else ""
+
+
+def _corpus_effect(report: ConstructReport, directory: Path, corpus: Path) -> None:
+    try:
+        commit = _introducing_commit(directory)
+    except GrammarToolError as exc:
+        report.note = str(exc)
+        return
+    if not commit:
+        report.note = "not committed yet"
+        return
+    report.commit = commit[:10]
+    changed = _git("diff-tree", "--no-commit-id", "--name-only", "-r", commit).split()
+    report.grammar_changed = "grammar/KRL.g4" in changed
+    if not report.grammar_changed:
+        report.note = "covered by the grammar already (examples only)"
+        return
+    try:
+        before = _git("show", f"{commit}^:grammar/KRL.g4")
+    except GrammarToolError:
+        report.note = "introduced with the first grammar"
+        return
+    after = _git("show", f"{commit}:grammar/KRL.g4")
+    scans = []
+    for text in (before, after):
+        pdir = parser_dir_for(text)
+        scans.append(scan(corpus, grammar_sha(text), parser_dir=str(pdir), progress=False))
+    clusters_before = {c.signature: c for c in cluster_results(scans[0])}
+    after_sigs = {c.signature for c in cluster_results(scans[1])}
+    report.closed = [{"id": c.id, "files": c.files, "signature": c.signature}
+                     for sig, c in clusters_before.items() if sig not in after_sigs]
+    report.files_before = sum(r.ok for r in scans[0])
+    report.files_after = sum(r.ok for r in scans[1])
+
+
+def validate_constructs(names: list[str], corpus: Path | None = None) -> list[ConstructReport]:
+    """Validate the named constructs (all when names is empty)."""
+    dirs = sorted(d for d in CONSTRUCTS.iterdir() if d.is_dir()) if CONSTRUCTS.is_dir() else []
+    if names:
+        unknown = set(names) - {d.name for d in dirs}
+        if unknown:
+            raise click.UsageError(f"unknown construct(s): {', '.join(sorted(unknown))}")
+        dirs = [d for d in dirs if d.name in names]
+    reports = []
+    for d in dirs:
+        rep = ConstructReport(d.name)
+        for f in sorted(d.iterdir()):
+            if is_krl_file(f) and f.name.startswith(("ok_", "bad_")):
+                rep.examples.append(check_example(f))
+        if corpus is not None:
+            _corpus_effect(rep, d, corpus)
+        reports.append(rep)
+    return reports
+
+
+def print_validation(reports: list[ConstructReport]) -> bool:
+    all_ok = True
+    for rep in reports:
+        n_ok = sum(e.kind == "ok" for e in rep.examples)
+        n_bad = sum(e.kind == "bad" for e in rep.examples)
+        status = "PASS" if rep.passed else "FAIL"
+        all_ok &= rep.passed
+        click.echo(f"{status} {rep.name}: {n_ok} positive, {n_bad} negative examples")
+        for e in rep.examples:
+            if not e.passed:
+                click.echo(f"    {e.path}: {e.detail}")
+        if not n_ok or not n_bad:
+            click.echo("    needs at least one positive and one negative example")
+        if rep.files_before is not None:
+            click.echo(f"    corpus: {rep.files_before} -> {rep.files_after} files parse; closed "
+                       + (", ".join(f"{c['id']} ({c['files']} files)" for c in rep.closed) or "no cluster"))
+        elif rep.note:
+            click.echo(f"    corpus: {rep.note}")
+    click.echo(f"{sum(r.passed for r in reports)}/{len(reports)} constructs pass")
+    return all_ok
