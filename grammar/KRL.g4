@@ -93,10 +93,12 @@ dataItem
     | channelDeclaration
     ;
 
-// DECL is optional only before the simple types; user and predefined structure types need it (2.5).
+// DECL is optional before the simple types and the predefined geometric structure types (2.5);
+// user-defined types need it.
 dataVariableDeclaration
     : DECL GLOBAL? CONST? typeName variableName ('=' constantValue)?
     | GLOBAL? CONST? simpleType variableName ('=' constantValue)?
+    | GLOBAL? CONST? geometricType variableName ('=' constantValue)?
     ;
 
 arrayElementInitialisation
@@ -150,6 +152,7 @@ declaration
 variableDeclaration
     : DECL typeName variableName (',' variableName)*
     | simpleType variableName (',' variableName)*
+    | geometricType variableName (',' variableName)*
     ;
 
 variableName
@@ -200,6 +203,7 @@ typeRef
 
 typeName
     : simpleType
+    | geometricType
     | IDENTIFIER
     ;
 
@@ -208,6 +212,18 @@ simpleType
     | REAL
     | BOOL
     | CHAR
+    ;
+
+// The predefined geometric structures (3.7), the only structure types written without DECL
+// in real code (`FRAME f`, `E6POS XP1={...}`, `E6AXIS XHOME={...}`; 2.5).
+geometricType
+    : AXIS
+    | E3AXIS
+    | E6AXIS
+    | FRAME
+    | POS
+    | E3POS
+    | E6POS
     ;
 
 // ------------------------------------------------------------------ statements (5)
@@ -518,6 +534,15 @@ WAIT : 'WAIT' ;
 WHEN : 'WHEN' ;
 WHILE : 'WHILE' ;
 WITH : 'WITH' ;
+
+// Predefined geometric structure types (3.7): type names, not usable as variable names.
+AXIS : 'AXIS' ;
+E3AXIS : 'E3AXIS' ;
+E6AXIS : 'E6AXIS' ;
+FRAME : 'FRAME' ;
+POS : 'POS' ;
+E3POS : 'E3POS' ;
+E6POS : 'E6POS' ;
 
 // Literals (1.5).
 HEXLITERAL    : '\'' 'H' [0-9A-F]+ '\'' ;
