@@ -85,6 +85,7 @@ dataItemLine
 dataItem
     : dataVariableDeclaration
     | arrayElementInitialisation
+    | stringInitialisation
     | structureDeclaration
     | enumDeclaration
     | signalDeclaration
@@ -107,6 +108,11 @@ arrayElementInitialisation
 
 constantIndex
     : INTLITERAL
+    ;
+
+// A whole CHAR array (string) initialised after its declaration: NAME[]="text" (2.5, 3.4).
+stringInitialisation
+    : name '[' ']' '=' STRINGLITERAL
     ;
 
 // Only literals (with a leading sign) and literal aggregates initialise data-list variables (1.5).
