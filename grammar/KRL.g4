@@ -47,8 +47,13 @@ parameterList
     : parameter (',' parameter)*
     ;
 
+// An array parameter carries empty brackets, one comma per extra dimension: A[], M[,] (2.3).
 parameter
-    : name (':' (IN | OUT))?
+    : name openDimensions? (':' (IN | OUT))?
+    ;
+
+openDimensions
+    : '[' (',' ','?)? ']'
     ;
 
 // Declarations precede statements (2.2): a DECL after the first statement is a syntax error.
