@@ -44,12 +44,30 @@ def compact_shape(shape: list[str]) -> list[str]:
     return shape[:3] + ["…"] + shape[-(MAX_SHAPE - 4):]
 
 
+# A line that cannot even start fails in whichever list rule happens to be reading lines
+# (the routine's declaration part, a statement list, ...). Those are one position.
+_LINE_LISTS = {"routineBody": "line-start", "statementList": "line-start", "statementLine": "line-start",
+               "declarationLine": "line-start", "dataList": "data-line-start",
+               "dataItemLine": "data-line-start", "module": "file-line-start"}
+
+
+def error_context(issue: IssueRecord) -> str:
+    """The parser rule at the error; at the start of a line, the kind of line list."""
+    if not issue.rule_stack:
+        return "?"
+    if len(issue.shape) == 1:
+        for rule in reversed(issue.rule_stack):
+            if rule in _LINE_LISTS:
+                return _LINE_LISTS[rule]
+    return issue.rule_stack[-1]
+
+
 def signature(issue: IssueRecord) -> str:
     if issue.kind == "lexer":
         return "lexer | " + " ".join(issue.shape)
     if issue.kind == "internal":
         return "internal | parser failure"
-    context = issue.rule_stack[-1] if issue.rule_stack else "?"
+    context = error_context(issue)
     return f"{context} | {issue.offending_type} | {' '.join(compact_shape(issue.shape))}"
 
 
