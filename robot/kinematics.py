@@ -1,0 +1,335 @@
+"""Forward and inverse kinematics of the KR 6 R900 sixx in KUKA's conventions.
+
+Sources: robot-model.md §2-§4 (chain, OPW parameters), §7 (frame chain),
+§8 (status S and turn T), reference §6.4-§6.5 and §8.2 (errors).
+
+Units: mm and degrees everywhere (axis values A1..A6 in deg, frames as 4x4
+homogeneous transforms in mm). The FLANGE frame is KUKA's flange (= URDF
+``tool0``: +Z out of the flange), expressed in ``$ROBROOT``.
+
+Forward kinematics walks the URDF chain of the yaml (joint origins and axes,
+``q_urdf = radians(A_i)``, robot-model.md §3). Inverse kinematics is the analytic
+OPW solution (Brandstötter et al. 2014) with the yaml ``opw`` parameters; it
+returns up to 8 solutions, one per status S (bits 0..2).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from .errors import SoftLimitError, WorkspaceError
+from .frames import as_matrix, inv_pos
+from .machine import MachineData, load_machine
+
+#: Values closer than this to a status/turn switching point count as "on" it (deg, mm).
+BOUNDARY_EPS = 1e-9
+#: |A5| (deg) below which the wrist is treated as singular (A4 + A6 only defined).
+WRIST_SINGULAR_DEG = 1e-6
+#: Wrist point distance from the A1 axis (mm) below which A1 is undefined.
+OVERHEAD_SINGULAR_MM = 1e-6
+#: Tolerance of the reachability test on the cosine-law arguments.
+_ACOS_TOL = 1e-9
+#: Tolerance of the soft-limit test (deg), absorbs floating-point noise.
+LIMIT_EPS_DEG = 1e-9
+
+
+def _wrap180(v: np.ndarray) -> np.ndarray:
+    """Wrap angles (deg) to (-180, 180]."""
+    return -((-np.asarray(v, dtype=float) + 180.0) % 360.0) + 180.0
+
+
+class Kinematics:
+    """Kinematics of one robot, built from :class:`~robot.machine.MachineData`.
+
+    Public methods: :meth:`forward`, :meth:`solutions`, :meth:`inverse`,
+    :meth:`status_turn`, :meth:`check_soft_limits`, :meth:`tcp_pose`,
+    :meth:`flange_target`, :meth:`wrist_point_x`.
+    """
+
+    def __init__(self, machine: MachineData | None = None) -> None:
+        self.machine = machine if machine is not None else load_machine()
+        m = self.machine
+        self._origins = np.array([j.origin_mm for j in m.joints], dtype=float)  # (6, 3) mm
+        axes = np.array([j.joint_axis for j in m.joints], dtype=float)
+        self._axes = axes / np.linalg.norm(axes, axis=1)[:, None]
+        self._R_flange = Rotation.from_euler("xyz", m.flange_rpy_rad).as_matrix()  # link_6 -> flange
+        self._lo = np.array([j.limit_deg[0] for j in m.joints], dtype=float)
+        self._hi = np.array([j.limit_deg[1] for j in m.joints], dtype=float)
+        o = m.opw
+        self._opw = o
+        self._sign = np.array(o.sign_corrections, dtype=float)
+        self._off = np.radians(np.array(o.offsets_deg, dtype=float))
+        self._home = np.array(m.home_deg, dtype=float)
+        self.phi_deg = float(m.status_phi_deg)
+
+    # ------------------------------------------------------------------ FK
+    def forward(self, axes_deg: Sequence[float]) -> np.ndarray:
+        """FLANGE(A1..A6): KUKA flange frame in ``$ROBROOT`` (robot-model.md §2-§3).
+
+        Args:
+            axes_deg: A1..A6 in degrees (6 values).
+        Returns:
+            4x4 homogeneous transform, translation in mm.
+        """
+        q = np.radians(np.asarray(axes_deg, dtype=float)[:6])
+        Rj = Rotation.from_rotvec(self._axes * q[:, None]).as_matrix()  # (6, 3, 3)
+        R = np.eye(3)
+        p = np.zeros(3)
+        for i in range(6):
+            p = p + R @ self._origins[i]
+            R = R @ Rj[i]
+        T = np.eye(4)
+        T[:3, :3] = R @ self._R_flange
+        T[:3, 3] = p
+        return T
+
+    # ------------------------------------------------------------------ S/T
+    def wrist_point_x(self, axes_deg: Sequence[float]) -> float:
+        """x of the wrist point in the A1 frame, mm (robot-model.md §4.4; S bit 0)."""
+        q = np.asarray(axes_deg, dtype=float)
+        o = self._opw
+        t2 = math.radians(self._sign[1] * q[1]) - self._off[1]
+        t3 = math.radians(self._sign[2] * q[2]) - self._off[2]
+        return float(o.a1 + o.c2 * math.sin(t2) + o.c3 * math.sin(t2 + t3)
+                     + o.a2 * math.cos(t2 + t3))
+
+    def status_turn(self, axes_deg: Sequence[float]) -> tuple[int, int]:
+        """Status S and turn T of an axis configuration (robot-model.md §8, reference §6.5).
+
+        S bit 0 = 1 if the wrist point is behind the A1 axis (overhead area);
+        bit 1 = 1 if A3 >= phi (4.764°); bit 2 = 1 if A5 < 0 (A5 = 0 counts as
+        0, matching the HOME test vector S = 2).
+        T bit i = 1 if A(i+1) < 0 (0 counts as positive).
+        Values within 1e-9 deg/mm of a switching point count as on its
+        non-negative side (floating-point noise).
+
+        Returns:
+            (S, T) as ints.
+        """
+        q = np.asarray(axes_deg, dtype=float)[:6]
+        s = 0
+        if self.wrist_point_x(q) < -BOUNDARY_EPS:
+            s |= 1
+        if q[2] >= self.phi_deg - BOUNDARY_EPS:
+            s |= 2
+        if q[4] < -BOUNDARY_EPS:
+            s |= 4
+        t = 0
+        for i in range(6):
+            if q[i] < -BOUNDARY_EPS:
+                t |= 1 << i
+        return s, t
+
+    def _status_and_ambiguity(self, q: np.ndarray) -> tuple[int, int]:
+        """S of q plus a bit mask of the S bits that sit on their switching point."""
+        s, _ = self.status_turn(q)
+        amb = 0
+        if abs(self.wrist_point_x(q)) < OVERHEAD_SINGULAR_MM:
+            amb |= 1
+        if abs(q[2] - self.phi_deg) < 1e-7:
+            amb |= 2
+        if abs(q[4]) < WRIST_SINGULAR_DEG:
+            amb |= 4
+        return s, amb
+
+    # ------------------------------------------------------------------ limits
+    def check_soft_limits(self, axes_deg: Sequence[float]) -> None:
+        """Raise :class:`~robot.errors.SoftLimitError` for the first axis outside
+        ``$SOFTN_END``/``$SOFTP_END`` (reference §8.2): message
+        ``"software limit switch +A1"`` / ``"... -A2"``. Returns None otherwise."""
+        q = np.asarray(axes_deg, dtype=float)[:6]
+        for i in range(6):
+            if q[i] < self._lo[i] - LIMIT_EPS_DEG:
+                raise SoftLimitError(i + 1, float(q[i]), positive=False)
+            if q[i] > self._hi[i] + LIMIT_EPS_DEG:
+                raise SoftLimitError(i + 1, float(q[i]), positive=True)
+
+    def within_limits(self, axes_deg: Sequence[float]) -> bool:
+        """True if every axis lies within its soft limits."""
+        q = np.asarray(axes_deg, dtype=float)[:6]
+        return bool(np.all(q >= self._lo - LIMIT_EPS_DEG) and np.all(q <= self._hi + LIMIT_EPS_DEG))
+
+    # ------------------------------------------------------------------ IK
+    def _opw_solve(self, flange_T: np.ndarray, ref_deg: np.ndarray | None) -> np.ndarray:
+        """OPW closed form: (n, 6) array of KUKA axis values (deg, wrapped to (-180, 180]).
+
+        With ``ref_deg`` the free angle at a singularity is taken from it:
+        A1 when the wrist point is on the A1 axis, A4 when A5 = 0.
+        """
+        o = self._opw
+        T = np.asarray(flange_T, dtype=float)
+        R = T[:3, :3]
+        c = T[:3, 3] - o.c4 * R[:, 2]  # wrist point
+        cx, cy, cz = c
+        rho2 = cx * cx + cy * cy - o.b * o.b
+        if rho2 < 0.0:
+            return np.empty((0, 6))
+        nx1 = math.sqrt(rho2) - o.a1
+        if math.sqrt(cx * cx + cy * cy) < OVERHEAD_SINGULAR_MM and ref_deg is not None:
+            tmp1 = math.radians(self._sign[0] * ref_deg[0]) - self._off[0]
+        else:
+            tmp1 = math.atan2(cy, cx)
+        tmp2 = math.atan2(o.b, nx1 + o.a1)
+        th1_i = tmp1 - tmp2
+        th1_ii = tmp1 + tmp2 - math.pi
+        tmp3 = cz - o.c1
+        s1_2 = nx1 * nx1 + tmp3 * tmp3
+        tmp4 = nx1 + 2.0 * o.a1
+        s2_2 = tmp4 * tmp4 + tmp3 * tmp3
+        kappa_2 = o.a2 * o.a2 + o.c3 * o.c3
+        c2_2 = o.c2 * o.c2
+        s1 = math.sqrt(s1_2)
+        s2 = math.sqrt(s2_2)
+        k = math.sqrt(kappa_2)
+        at23 = math.atan2(o.a2, o.c3)
+
+        arms = []  # (th1, th2, th3)
+        for th1, s_, s_2, base2 in ((th1_i, s1, s1_2, math.atan2(nx1, tmp3)),
+                                    (th1_ii, s2, s2_2, -math.atan2(tmp4, tmp3))):
+            if s_ < 1e-12:
+                continue
+            arg2 = (s_2 + c2_2 - kappa_2) / (2.0 * s_ * o.c2)
+            arg3 = (s_2 - c2_2 - kappa_2) / (2.0 * o.c2 * k)
+            if abs(arg2) > 1.0 + _ACOS_TOL or abs(arg3) > 1.0 + _ACOS_TOL:
+                continue
+            a2c = math.acos(min(1.0, max(-1.0, arg2)))
+            a3c = math.acos(min(1.0, max(-1.0, arg3)))
+            arms.append((th1, -a2c + base2, a3c - at23))
+            arms.append((th1, a2c + base2, -a3c - at23))
+        if not arms:
+            return np.empty((0, 6))
+
+        sols = []
+        for th1, th2, th3 in arms:
+            sn1, cs1 = math.sin(th1), math.cos(th1)
+            s23, c23 = math.sin(th2 + th3), math.cos(th2 + th3)
+            mm = R[0, 2] * s23 * cs1 + R[1, 2] * s23 * sn1 + R[2, 2] * c23
+            th5 = math.atan2(math.sqrt(max(0.0, 1.0 - mm * mm)), mm)
+            th4 = math.atan2(R[1, 2] * cs1 - R[0, 2] * sn1,
+                             R[0, 2] * c23 * cs1 + R[1, 2] * c23 * sn1 - R[2, 2] * s23)
+            th6 = math.atan2(R[0, 1] * s23 * cs1 + R[1, 1] * s23 * sn1 + R[2, 1] * c23,
+                             -R[0, 0] * s23 * cs1 - R[1, 0] * s23 * sn1 - R[2, 0] * c23)
+            if ref_deg is not None and abs(math.degrees(th5)) < WRIST_SINGULAR_DEG:
+                # Wrist singularity: only th4 + th6 is defined; keep A4 of the reference.
+                total = th4 + th6
+                th4 = math.radians(self._sign[3] * ref_deg[3]) - self._off[3]
+                th6 = total - th4
+            sols.append((th1, th2, th3, th4, th5, th6))
+            sols.append((th1, th2, th3, th4 + math.pi, -th5, th6 - math.pi))
+        opw = np.array(sols)
+        q = np.degrees((opw + self._off) * self._sign)
+        return _wrap180(q)
+
+    def solutions(self, flange_T: np.ndarray) -> list[np.ndarray]:
+        """All analytic OPW solutions for a flange pose (robot-model.md §4.2, §8).
+
+        Args:
+            flange_T: 4x4 flange frame in ``$ROBROOT``, mm.
+        Returns:
+            list of up to 8 arrays of shape (6,), A1..A6 in deg wrapped to
+            (-180, 180], any order, before soft-limit filtering and without the
+            ±360° variants. Empty if the pose is out of reach. At a singularity
+            the split of the free angles is arbitrary.
+        """
+        return [row.copy() for row in self._opw_solve(flange_T, None)]
+
+    def inverse(self, flange_T: np.ndarray, status: int | None = None, turn: int | None = None,
+                reference_deg: Sequence[float] | None = None) -> np.ndarray:
+        """Axis values for a flange pose, selected by status and turn (robot-model.md §8,
+        reference §6.5).
+
+        Args:
+            flange_T: 4x4 flange frame in ``$ROBROOT``, mm.
+            status: S; bits 0..2 select the IK branch (masked with 7). None: keep
+                the status of ``reference_deg``.
+            turn: T; bit i = 1 means A(i+1) < 0, selecting the ±360° variant of
+                each axis. None: each axis takes the value nearest to
+                ``reference_deg`` (shortest axis motion).
+            reference_deg: current axes A1..A6 (deg); default HOME. Also supplies
+                the free angle at singularities (A4 when A5 = 0, A1 when the wrist
+                point is on the A1 axis).
+        Returns:
+            array (6,) A1..A6 in deg.
+        Raises:
+            WorkspaceError: no solution (out of reach) or none with the requested S.
+            SoftLimitError: the solution(s) with the requested S/T violate
+                ``$SOFTN_END``/``$SOFTP_END``.
+        """
+        ref = self._home.copy() if reference_deg is None else np.asarray(reference_deg, dtype=float)[:6]
+        sols = self._opw_solve(flange_T, ref)
+        if len(sols) == 0:
+            raise WorkspaceError("workspace error: target not reachable")
+        s_target = (int(status) & 7) if status is not None else self.status_turn(ref)[0]
+
+        matching = []
+        for b in sols:
+            s, amb = self._status_and_ambiguity(b)
+            if (s ^ s_target) & ~amb & 7 == 0:
+                matching.append(b)
+        if not matching:
+            raise WorkspaceError(f"workspace error: target not reachable with status S={s_target}")
+
+        best_ok: tuple[float, np.ndarray] | None = None
+        best_bad: tuple[float, np.ndarray, int] | None = None
+        ks = np.arange(-2, 3) * 360.0
+        for b in matching:
+            q = np.empty(6)
+            bad_axis = -1
+            for i in range(6):
+                cands = b[i] + ks
+                if turn is not None:
+                    neg = bool((int(turn) >> i) & 1)
+                    sign_ok = (cands < 0) == neg
+                    sign_ok |= np.abs(cands) < BOUNDARY_EPS * 1e3
+                    cands = cands[sign_ok]
+                inlim = cands[(cands >= self._lo[i] - LIMIT_EPS_DEG) & (cands <= self._hi[i] + LIMIT_EPS_DEG)]
+                if len(inlim):
+                    q[i] = inlim[np.argmin(np.abs(inlim - ref[i]))]
+                else:
+                    # nearest-to-the-limits variant, for the error message
+                    dist = np.maximum(self._lo[i] - cands, cands - self._hi[i])
+                    q[i] = cands[np.argmin(dist)]
+                    if bad_axis < 0:
+                        bad_axis = i
+            cost = float(np.sum(np.abs(q - ref)))
+            if bad_axis < 0:
+                if best_ok is None or cost < best_ok[0]:
+                    best_ok = (cost, q)
+            elif best_bad is None or cost < best_bad[0]:
+                best_bad = (cost, q, bad_axis)
+        if best_ok is not None:
+            return best_ok[1]
+        assert best_bad is not None
+        _, q, i = best_bad
+        raise SoftLimitError(i + 1, float(q[i]), positive=bool(q[i] > self._hi[i]))
+
+    # ------------------------------------------------------------------ frame chain
+    def tcp_pose(self, axes_deg: Sequence[float], tool: Any = None, base: Any = None,
+                 robroot: Any = None) -> np.ndarray:
+        """``$POS_ACT`` as a matrix: TCP in ``$BASE`` for ``$IPO_MODE=#BASE``.
+
+        ``INV_POS($BASE) : $ROBROOT : FLANGE(q) : $TOOL`` (robot-model.md §7,
+        reference §6.4). ``tool``, ``base``, ``robroot``: 4x4 arrays, 6-tuples
+        (X, Y, Z, A, B, C) or None (= ``$NULLFRAME``). Returns 4x4, mm.
+        """
+        return inv_pos(as_matrix(base)) @ as_matrix(robroot) @ self.forward(axes_deg) @ as_matrix(tool)
+
+    def flange_target(self, tcp_in_base: Any, tool: Any = None, base: Any = None,
+                      robroot: Any = None) -> np.ndarray:
+        """Flange frame in ``$ROBROOT`` that puts the TCP at ``tcp_in_base``
+        (a Cartesian KRL target in ``$BASE``): the inverse of :meth:`tcp_pose`,
+        ``INV_POS($ROBROOT) : $BASE : P : INV_POS($TOOL)`` (robot-model.md §7).
+        Arguments as in :meth:`tcp_pose`; returns 4x4, mm."""
+        return inv_pos(as_matrix(robroot)) @ as_matrix(base) @ as_matrix(tcp_in_base) @ inv_pos(as_matrix(tool))
+
+    def inverse_tcp(self, tcp_in_base: Any, status: int | None = None, turn: int | None = None,
+                    reference_deg: Sequence[float] | None = None, tool: Any = None,
+                    base: Any = None, robroot: Any = None) -> np.ndarray:
+        """Convenience: :meth:`inverse` of :meth:`flange_target`. Same errors."""
+        return self.inverse(self.flange_target(tcp_in_base, tool, base, robroot),
+                            status, turn, reference_deg)

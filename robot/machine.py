@@ -1,0 +1,265 @@
+"""Machine data of the simulated robot, read from ``robot/data/kr6_r900.yaml``.
+
+The yaml file is a copy of ``shared/robots/kr6_r900.yaml`` (robot-model.md §1-§5,
+§10); every number used by the kinematics, the MJCF builder and the planner comes
+from it, nothing is hard-coded a second time in the code.
+
+Units: lengths in mm (the yaml geometry is in metres and is converted here),
+angles in degrees unless a name says otherwise.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, NamedTuple
+
+import yaml
+
+DEFAULT_MACHINE_FILE = Path(__file__).with_name("data") / "kr6_r900.yaml"
+
+
+@dataclass(frozen=True)
+class JointData:
+    """One robot axis (robot-model.md §2, §5).
+
+    Attributes:
+        name: URDF joint name, e.g. ``"joint_a1"``.
+        axis: KUKA axis number 1..6.
+        limit_deg: ``($SOFTN_END, $SOFTP_END)`` in degrees.
+        max_speed_deg_s: axis maximum speed in deg/s, computed like the controller
+            does from ``$VEL_AXIS_MA`` [rpm] / |``$RAT_MOT_AX``| * 6 (robot-model.md §5;
+            e.g. 381.18 for A4; the URDF rounds it to 381).
+        max_acc_deg_s2: simulation default axis acceleration in deg/s^2 (kroshu
+            worst-case value, robot-model.md §5 [uncertain]).
+        max_jerk_deg_s3: ``$AXIS_JERK`` in deg/s^3.
+        origin_mm: URDF joint origin relative to the parent link, mm.
+        joint_axis: URDF joint axis unit vector (KUKA directions built in, §3).
+        urdf_max_speed_deg_s: the URDF velocity limit (deg/s), for reference.
+    """
+
+    name: str
+    axis: int
+    limit_deg: tuple[float, float]
+    max_speed_deg_s: float
+    max_acc_deg_s2: float
+    max_jerk_deg_s3: float
+    origin_mm: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    joint_axis: tuple[float, float, float] = (0.0, 0.0, 1.0)
+    urdf_max_speed_deg_s: float = 0.0
+    parent: str = ""
+    child: str = ""
+
+    @property
+    def softn_end(self) -> float:
+        """``$SOFTN_END`` of this axis, deg."""
+        return self.limit_deg[0]
+
+    @property
+    def softp_end(self) -> float:
+        """``$SOFTP_END`` of this axis, deg."""
+        return self.limit_deg[1]
+
+
+class CartLimits(NamedTuple):
+    """A KRL ``CP`` structure (``$VEL_MA``, ``$ACC_MA``, ...): ``cp`` in m/s (or m/s^2),
+    ``ori1``/``ori2`` in deg/s (or deg/s^2). Also indexable by name
+    (``lim["cp"]``, ``lim["ori1"]``) or position."""
+
+    cp: float
+    ori1: float
+    ori2: float
+
+    def __getitem__(self, key):  # type: ignore[override]
+        if isinstance(key, str):
+            k = key.lower().split("_")[0]
+            return getattr(self, k)
+        return tuple.__getitem__(self, key)
+
+
+@dataclass(frozen=True)
+class OPWParams:
+    """OPW kinematic parameters (robot-model.md §4.2), lengths in **mm**.
+
+    ``offsets_deg`` and ``sign_corrections`` follow the OPW convention
+    ``q_opw = sign * A - offset``.
+    """
+
+    a1: float
+    a2: float
+    b: float
+    c1: float
+    c2: float
+    c3: float
+    c4: float
+    offsets_deg: tuple[float, ...]
+    sign_corrections: tuple[int, ...]
+
+
+@dataclass(frozen=True)
+class MachineData:
+    """All machine data of the robot (robot-model.md; loaded by :func:`load_machine`).
+
+    Attributes:
+        name: robot name, ``"KR 6 R900 sixx"``.
+        joints: six :class:`JointData`, A1..A6.
+        home_deg: ``$AXIS_HOME[1]`` / XHOME, deg.
+        mastering_deg: ``$MAMES``, deg.
+        opw: :class:`OPWParams` (mm).
+        flange_quat_wxyz: rotation link_6 -> KUKA flange (URDF ``tool0``), (w, x, y, z).
+        flange_rpy_rad: the same rotation as URDF rpy.
+        robroot_frame: ``$ROBROOT`` as (X, Y, Z, A, B, C) mm/deg.
+        default_tool_frame: ``TOOL_DATA[1]`` as (X, Y, Z, A, B, C) mm/deg (bas.src INITMOV).
+        status_phi_deg: S bit 1 switching angle of A3 (robot-model.md §8).
+        vel_ma: ``$VEL_MA`` (cp m/s, ori1/ori2 deg/s).
+        acc_ma: ``$ACC_MA`` (cp m/s^2, ori1/ori2 deg/s^2).
+        acc_ov: ``$ACC_OV``.
+        apo_dis_ptp_deg: ``$APO_DIS_PTP[1..6]``, deg.
+        in_pos_ma_deg, in_pos_car_mm, in_pos_ori_deg: ``$IN_POS_*``.
+        def_flt_ptp, def_flt_cp: ``$DEF_FLT_PTP``/``$DEF_FLT_CP``.
+        ipo_cycle_s: interpolation cycle, 0.012 s.
+        motion_defaults: the yaml ``motion_defaults`` mapping ($config.dat / bas.src).
+        default_load: the yaml ``default_load`` mapping ($robcor.dat).
+        reach_wrist_point_mm: derived reach, mm.
+        raw: the whole parsed yaml document.
+    """
+
+    name: str
+    joints: tuple[JointData, ...]
+    home_deg: tuple[float, ...]
+    mastering_deg: tuple[float, ...]
+    opw: OPWParams
+    flange_quat_wxyz: tuple[float, float, float, float]
+    flange_rpy_rad: tuple[float, float, float]
+    robroot_frame: tuple[float, ...]
+    default_tool_frame: tuple[float, ...]
+    status_phi_deg: float
+    vel_ma: CartLimits
+    acc_ma: CartLimits
+    acc_ov: CartLimits
+    apo_dis_ptp_deg: tuple[float, ...]
+    in_pos_ma_deg: tuple[float, ...]
+    in_pos_car_mm: float
+    in_pos_ori_deg: float
+    def_flt_ptp: int
+    def_flt_cp: int
+    ipo_cycle_s: float
+    motion_defaults: dict[str, Any] = field(compare=False)
+    default_load: dict[str, Any] = field(compare=False)
+    reach_wrist_point_mm: float = field()
+    home_flange_pose: tuple[float, ...] = field()
+    source: str = ""
+    raw: dict[str, Any] = field(default_factory=dict, repr=False, compare=False)
+
+    @property
+    def limits_deg(self) -> tuple[tuple[float, float], ...]:
+        """(``$SOFTN_END``, ``$SOFTP_END``) per axis, deg."""
+        return tuple(j.limit_deg for j in self.joints)
+
+    @property
+    def softn_end(self) -> tuple[float, ...]:
+        return tuple(j.limit_deg[0] for j in self.joints)
+
+    @property
+    def softp_end(self) -> tuple[float, ...]:
+        return tuple(j.limit_deg[1] for j in self.joints)
+
+    @property
+    def max_speed_deg_s(self) -> tuple[float, ...]:
+        return tuple(j.max_speed_deg_s for j in self.joints)
+
+    @property
+    def max_acc_deg_s2(self) -> tuple[float, ...]:
+        return tuple(j.max_acc_deg_s2 for j in self.joints)
+
+    @property
+    def max_jerk_deg_s3(self) -> tuple[float, ...]:
+        return tuple(j.max_jerk_deg_s3 for j in self.joints)
+
+
+def _floats(seq) -> tuple[float, ...]:
+    return tuple(float(v) for v in seq)
+
+
+def _cart(d: dict[str, Any]) -> CartLimits:
+    def pick(prefix: str) -> float:
+        for k, v in d.items():
+            if k.split("_")[0] == prefix:
+                return float(v)
+        raise KeyError(prefix)
+
+    return CartLimits(pick("cp"), pick("ori1"), pick("ori2"))
+
+
+def load_machine(path: str | Path | None = None) -> MachineData:
+    """Read the machine data yaml (default: ``robot/data/kr6_r900.yaml``).
+
+    Returns a frozen :class:`MachineData`; geometry converted to mm, accelerations
+    to deg/s^2. Raises ``FileNotFoundError``/``KeyError`` for a missing file or key.
+    """
+    p = Path(path) if path is not None else DEFAULT_MACHINE_FILE
+    doc = yaml.safe_load(p.read_text(encoding="utf-8"))
+    md = doc["machine_data_kinematics"]
+    rpm = md.get("vel_axis_ma_rpm")
+    ratios = md.get("rat_mot_ax_n_d")
+
+    joints = []
+    for i, j in enumerate(doc["joints"]):
+        if rpm is not None and ratios is not None:
+            n, d = ratios[i]
+            vmax = float(rpm[i]) / abs(float(n) / float(d)) * 6.0  # robot-model.md §5
+        else:
+            vmax = float(j["max_speed_deg_s"])
+        joints.append(JointData(
+            name=j["name"],
+            axis=int(str(j.get("kuka_axis", f"A{i + 1}")).lstrip("Aa")),
+            limit_deg=(float(j["limit_deg"][0]), float(j["limit_deg"][1])),
+            max_speed_deg_s=vmax,
+            max_acc_deg_s2=math.degrees(float(j["max_acc_rad_s2"])),
+            max_jerk_deg_s3=float(j["max_jerk_deg_s3"]),
+            origin_mm=tuple(1000.0 * float(v) for v in j["origin_xyz_m"]),  # type: ignore[arg-type]
+            joint_axis=_floats(j["axis"]),  # type: ignore[arg-type]
+            urdf_max_speed_deg_s=float(j["max_speed_deg_s"]),
+            parent=j.get("parent", ""),
+            child=j.get("child", ""),
+        ))
+
+    frames = {f["name"]: f for f in doc["fixed_frames"]}
+    tool0 = frames["tool0"]
+    o = doc["opw"]
+    opw = OPWParams(
+        a1=1000.0 * o["a1"], a2=1000.0 * o["a2"], b=1000.0 * o["b"],
+        c1=1000.0 * o["c1"], c2=1000.0 * o["c2"], c3=1000.0 * o["c3"], c4=1000.0 * o["c4"],
+        offsets_deg=tuple(math.degrees(v) for v in o["offsets_rad"]),
+        sign_corrections=tuple(int(s) for s in o["sign_corrections"]),
+    )
+    mdf = doc.get("motion_defaults", {})
+    return MachineData(
+        name=str(doc["robot"]),
+        joints=tuple(joints),
+        home_deg=_floats(doc["home_deg"]),
+        mastering_deg=_floats(doc.get("mastering_mames_deg", doc["home_deg"])),
+        opw=opw,
+        flange_quat_wxyz=_floats(tool0["mujoco_site_quat_wxyz"]),  # type: ignore[arg-type]
+        flange_rpy_rad=_floats(tool0["origin_rpy_rad"]),  # type: ignore[arg-type]
+        robroot_frame=_floats(doc.get("robroot_mm_deg", [0.0] * 6)),
+        default_tool_frame=_floats(mdf.get("tool_data_1_mm_deg", [0.0] * 6)),
+        status_phi_deg=float(doc["status_bit1_phi_deg"]),
+        vel_ma=_cart(md["vel_ma"]),
+        acc_ma=_cart(md["acc_ma"]),
+        acc_ov=_cart(md["acc_ov"]),
+        apo_dis_ptp_deg=_floats(md["apo_dis_ptp_deg"]),
+        in_pos_ma_deg=_floats(md["in_pos_ma_deg"]),
+        in_pos_car_mm=float(md["in_pos_car_mm"]),
+        in_pos_ori_deg=float(md["in_pos_ori_deg"]),
+        def_flt_ptp=int(md["def_flt_ptp"]),
+        def_flt_cp=int(md["def_flt_cp"]),
+        ipo_cycle_s=float(doc.get("ipo_cycle_s", 0.012)),
+        motion_defaults=dict(mdf),
+        default_load=dict(doc.get("default_load", {})),
+        reach_wrist_point_mm=float(doc["reach_wrist_point_mm"]),
+        home_flange_pose=_floats(doc["home_flange_pose_mm_deg"]),
+        source=str(p),
+        raw=doc,
+    )
