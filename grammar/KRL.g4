@@ -160,10 +160,15 @@ declaration
     ;
 
 // In a routine: no initial values, no CONST (2.2, 2.5).
+// Array parameters are declared with open dimensions, DECL CHAR buf[] (2.3): routines only.
 variableDeclaration
-    : DECL typeName variableName (',' variableName)*
-    | simpleType variableName (',' variableName)*
-    | geometricType variableName (',' variableName)*
+    : DECL typeName (variableName | openArrayName) (',' (variableName | openArrayName))*
+    | simpleType (variableName | openArrayName) (',' (variableName | openArrayName))*
+    | geometricType (variableName | openArrayName) (',' (variableName | openArrayName))*
+    ;
+
+openArrayName
+    : name openDimensions
     ;
 
 variableName
