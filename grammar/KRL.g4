@@ -137,7 +137,7 @@ constantAggregate
     ;
 
 constantComponent
-    : name ('[' ']')? constantValue
+    : (name | contextKeyword) ('[' ']')? constantValue
     ;
 
 channelDeclaration
@@ -184,11 +184,11 @@ structureDeclaration
     ;
 
 structureComponent
-    : name arrayDimensions?
+    : (name | contextKeyword) arrayDimensions?
     ;
 
 enumDeclaration
-    : GLOBAL? ENUM name name (',' name)*
+    : GLOBAL? ENUM name (name | contextKeyword) (',' (name | contextKeyword))*
     ;
 
 signalDeclaration
@@ -396,7 +396,7 @@ variable
 // a[i], m[i,j], names[2,] (row of a CHAR array), s[] (whole CHAR array), p.X
 selector
     : '[' expression? (',' expression?)* ']'
-    | '.' name
+    | '.' (name | contextKeyword)
     ;
 
 aggregate
@@ -404,7 +404,7 @@ aggregate
     ;
 
 aggregateComponent
-    : name ('[' ']')? expression
+    : (name | contextKeyword) ('[' ']')? expression
     ;
 
 literal
@@ -421,6 +421,20 @@ literal
 name
     : IDENTIFIER
     | SYSNAME
+    ;
+
+// Keywords that KUKA's own data lists use as structure components and enum values
+// (`STRUC DATE INT CSEC,SEC,...`, `ENUM SW_ONOFF ON,OFF`, `P[1].OUT`; IN/OUT are keywords
+// only after ':', 1.6). Accepted only in component and enum-value positions.
+contextKeyword
+    : IN
+    | OUT
+    | ON
+    | OFF
+    | PATH
+    | STEP
+    | SEC
+    | DISTANCE
     ;
 
 // ======================================================================== lexer
