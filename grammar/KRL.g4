@@ -247,6 +247,7 @@ geometricType
 statement
     : assignment                                                    # assignmentStatement
     | call                                                          # callStatement
+    | IDENTIFIER                                                    # parameterlessCallStatement
     | IF expression THEN NEWLINE statementList
       (ELSE NEWLINE statementList)? ENDIF                           # ifStatement
     | SWITCH expression NEWLINE+ switchCase+ switchDefault? ENDSWITCH # switchStatement
