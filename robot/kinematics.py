@@ -57,7 +57,12 @@ class Kinematics:
         self._origins = np.array([j.origin_mm for j in m.joints], dtype=float)  # (6, 3) mm
         axes = np.array([j.joint_axis for j in m.joints], dtype=float)
         self._axes = axes / np.linalg.norm(axes, axis=1)[:, None]
-        self._R_flange = Rotation.from_euler("xyz", m.flange_rpy_rad).as_matrix()  # link_6 -> flange
+        self._kuka_sign = np.array([j.kuka_sign for j in m.joints], dtype=float)  # q_urdf = sign * A
+        self._R_origin = Rotation.from_euler("xyz", [j.origin_rpy_rad for j in m.joints]).as_matrix()
+        self._origin_rot = any(np.any(r) for r in (j.origin_rpy_rad for j in m.joints))
+        w, x, y, z = m.flange_quat_wxyz
+        self._R_flange = Rotation.from_quat([x, y, z, w]).as_matrix()  # link_6 -> KUKA flange
+        self._p_flange = np.array(m.flange_pos_mm, dtype=float)
         self._lo = np.array([j.limit_deg[0] for j in m.joints], dtype=float)
         self._hi = np.array([j.limit_deg[1] for j in m.joints], dtype=float)
         o = m.opw
@@ -66,6 +71,8 @@ class Kinematics:
         self._off = np.radians(np.array(o.offsets_deg, dtype=float))
         self._home = np.array(m.home_deg, dtype=float)
         self.phi_deg = float(m.status_phi_deg)
+        self._ks = np.arange(-2, 3) * 360.0
+        self._rows = np.arange(6)
 
     # ------------------------------------------------------------------ FK
     def forward(self, axes_deg: Sequence[float]) -> np.ndarray:
@@ -76,16 +83,18 @@ class Kinematics:
         Returns:
             4x4 homogeneous transform, translation in mm.
         """
-        q = np.radians(np.asarray(axes_deg, dtype=float)[:6])
+        q = self._kuka_sign * np.radians(np.asarray(axes_deg, dtype=float)[:6])
         Rj = Rotation.from_rotvec(self._axes * q[:, None]).as_matrix()  # (6, 3, 3)
         R = np.eye(3)
         p = np.zeros(3)
         for i in range(6):
             p = p + R @ self._origins[i]
+            if self._origin_rot:
+                R = R @ self._R_origin[i]
             R = R @ Rj[i]
         T = np.eye(4)
         T[:3, :3] = R @ self._R_flange
-        T[:3, 3] = p
+        T[:3, 3] = p + R @ self._p_flange
         return T
 
     # ------------------------------------------------------------------ S/T
@@ -125,16 +134,19 @@ class Kinematics:
                 t |= 1 << i
         return s, t
 
-    def _status_and_ambiguity(self, q: np.ndarray) -> tuple[int, int]:
-        """S of q plus a bit mask of the S bits that sit on their switching point."""
-        s, _ = self.status_turn(q)
-        amb = 0
-        if abs(self.wrist_point_x(q)) < OVERHEAD_SINGULAR_MM:
-            amb |= 1
-        if abs(q[2] - self.phi_deg) < 1e-7:
-            amb |= 2
-        if abs(q[4]) < WRIST_SINGULAR_DEG:
-            amb |= 4
+    def _status_bits(self, Q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Vectorised S of the rows of Q (n, 6), plus a mask of the S bits that sit
+        on their switching point (wrist point on the A1 axis, A3 = phi, A5 = 0)."""
+        o = self._opw
+        t2 = np.radians(self._sign[1] * Q[:, 1]) - self._off[1]
+        t23 = t2 + np.radians(self._sign[2] * Q[:, 2]) - self._off[2]
+        xw = o.a1 + o.c2 * np.sin(t2) + o.c3 * np.sin(t23) + o.a2 * np.cos(t23)
+        s = ((xw < -BOUNDARY_EPS).astype(int)
+             | ((Q[:, 2] >= self.phi_deg - BOUNDARY_EPS).astype(int) << 1)
+             | ((Q[:, 4] < -BOUNDARY_EPS).astype(int) << 2))
+        amb = ((np.abs(xw) < OVERHEAD_SINGULAR_MM).astype(int)
+               | ((np.abs(Q[:, 2] - self.phi_deg) < 1e-7).astype(int) << 1)
+               | ((np.abs(Q[:, 4]) < WRIST_SINGULAR_DEG).astype(int) << 2))
         return s, amb
 
     # ------------------------------------------------------------------ limits
@@ -266,42 +278,37 @@ class Kinematics:
             raise WorkspaceError("workspace error: target not reachable")
         s_target = (int(status) & 7) if status is not None else self.status_turn(ref)[0]
 
-        matching = []
-        for b in sols:
-            s, amb = self._status_and_ambiguity(b)
-            if (s ^ s_target) & ~amb & 7 == 0:
-                matching.append(b)
-        if not matching:
+        s_all, amb = self._status_bits(sols)
+        matching = sols[((s_all ^ s_target) & ~amb & 7) == 0]
+        if len(matching) == 0:
             raise WorkspaceError(f"workspace error: target not reachable with status S={s_target}")
 
+        if turn is not None:
+            neg = ((int(turn) >> np.arange(6)) & 1).astype(bool)[:, None]  # (6, 1)
         best_ok: tuple[float, np.ndarray] | None = None
         best_bad: tuple[float, np.ndarray, int] | None = None
-        ks = np.arange(-2, 3) * 360.0
         for b in matching:
-            q = np.empty(6)
-            bad_axis = -1
-            for i in range(6):
-                cands = b[i] + ks
-                if turn is not None:
-                    neg = bool((int(turn) >> i) & 1)
-                    sign_ok = (cands < 0) == neg
-                    sign_ok |= np.abs(cands) < BOUNDARY_EPS * 1e3
-                    cands = cands[sign_ok]
-                inlim = cands[(cands >= self._lo[i] - LIMIT_EPS_DEG) & (cands <= self._hi[i] + LIMIT_EPS_DEG)]
-                if len(inlim):
-                    q[i] = inlim[np.argmin(np.abs(inlim - ref[i]))]
-                else:
-                    # nearest-to-the-limits variant, for the error message
-                    dist = np.maximum(self._lo[i] - cands, cands - self._hi[i])
-                    q[i] = cands[np.argmin(dist)]
-                    if bad_axis < 0:
-                        bad_axis = i
-            cost = float(np.sum(np.abs(q - ref)))
-            if bad_axis < 0:
+            cands = b[:, None] + self._ks[None, :]  # (6, 5): the ±360° variants per axis
+            ok = np.ones(cands.shape, dtype=bool)
+            if turn is not None:
+                ok = ((cands < 0) == neg) | (np.abs(cands) < 1e-6)
+            inlim = ok & (cands >= self._lo[:, None] - LIMIT_EPS_DEG) & (cands <= self._hi[:, None] + LIMIT_EPS_DEG)
+            dist = np.where(inlim, np.abs(cands - ref[:, None]), np.inf)
+            pick = np.argmin(dist, axis=1)
+            q = cands[self._rows, pick]
+            axis_bad = ~inlim.any(axis=1)
+            if not axis_bad.any():
+                cost = float(np.sum(np.abs(q - ref)))
                 if best_ok is None or cost < best_ok[0]:
                     best_ok = (cost, q)
-            elif best_bad is None or cost < best_bad[0]:
-                best_bad = (cost, q, bad_axis)
+                continue
+            # for the error: the allowed (turn) variant nearest to the limits
+            over = np.maximum(self._lo[:, None] - cands, cands - self._hi[:, None])
+            over = np.where(ok, over, np.inf)
+            q_bad = np.where(axis_bad, cands[self._rows, np.argmin(over, axis=1)], q)
+            cost = float(np.sum(np.abs(q_bad - ref)))
+            if best_bad is None or cost < best_bad[0]:
+                best_bad = (cost, q_bad, int(np.argmax(axis_bad)))
         if best_ok is not None:
             return best_ok[1]
         assert best_bad is not None

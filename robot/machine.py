@@ -11,11 +11,14 @@ angles in degrees unless a name says otherwise.
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, NamedTuple
 
+import numpy as np
 import yaml
+from scipy.spatial.transform import Rotation
 
 DEFAULT_MACHINE_FILE = Path(__file__).with_name("data") / "kr6_r900.yaml"
 
@@ -37,6 +40,9 @@ class JointData:
         origin_mm: URDF joint origin relative to the parent link, mm.
         joint_axis: URDF joint axis unit vector (KUKA directions built in, §3).
         urdf_max_speed_deg_s: the URDF velocity limit (deg/s), for reference.
+        parent, child: URDF link names.
+        origin_rpy_rad: URDF joint origin rotation (roll, pitch, yaw), rad.
+        kuka_sign: ``q_urdf_rad = kuka_sign * radians(A_i)`` (yaml ``angle_mapping``, +1 here).
     """
 
     name: str
@@ -50,6 +56,8 @@ class JointData:
     urdf_max_speed_deg_s: float = 0.0
     parent: str = ""
     child: str = ""
+    kuka_sign: int = 1
+    origin_rpy_rad: tuple[float, float, float] = (0.0, 0.0, 0.0)
 
     @property
     def softn_end(self) -> float:
@@ -107,8 +115,10 @@ class MachineData:
         home_deg: ``$AXIS_HOME[1]`` / XHOME, deg.
         mastering_deg: ``$MAMES``, deg.
         opw: :class:`OPWParams` (mm).
-        flange_quat_wxyz: rotation link_6 -> KUKA flange (URDF ``tool0``), (w, x, y, z).
+        flange_quat_wxyz: rotation link_6 -> KUKA flange (URDF ``tool0``), (w, x, y, z),
+            composed from the yaml ``fixed_frames`` chain link_6 -> flange -> tool0.
         flange_rpy_rad: the same rotation as URDF rpy.
+        flange_pos_mm: position of the KUKA flange in link_6, mm.
         robroot_frame: ``$ROBROOT`` as (X, Y, Z, A, B, C) mm/deg.
         default_tool_frame: ``TOOL_DATA[1]`` as (X, Y, Z, A, B, C) mm/deg (bas.src INITMOV).
         status_phi_deg: S bit 1 switching angle of A3 (robot-model.md §8).
@@ -132,6 +142,7 @@ class MachineData:
     opw: OPWParams
     flange_quat_wxyz: tuple[float, float, float, float]
     flange_rpy_rad: tuple[float, float, float]
+    flange_pos_mm: tuple[float, float, float]
     robroot_frame: tuple[float, ...]
     default_tool_frame: tuple[float, ...]
     status_phi_deg: float
@@ -223,10 +234,26 @@ def load_machine(path: str | Path | None = None) -> MachineData:
             urdf_max_speed_deg_s=float(j["max_speed_deg_s"]),
             parent=j.get("parent", ""),
             child=j.get("child", ""),
+            kuka_sign=int(j.get("kuka_sign", 1)),
+            origin_rpy_rad=_floats(j.get("origin_rpy_rad", [0.0, 0.0, 0.0])),  # type: ignore[arg-type]
         ))
 
     frames = {f["name"]: f for f in doc["fixed_frames"]}
-    tool0 = frames["tool0"]
+    # link_6 -> KUKA flange (URDF tool0) = (link_6 -> flange) * (flange -> tool0)
+    fl_pos = np.zeros(3)
+    fl_rot = Rotation.identity()
+    chain = []
+    name = "tool0"
+    while name in frames:
+        chain.append(frames[name])
+        name = frames[name].get("parent", "")
+    for f in reversed(chain):
+        fl_pos = fl_pos + fl_rot.apply(1000.0 * np.asarray(f["origin_xyz_m"], dtype=float))
+        fl_rot = fl_rot * Rotation.from_euler("xyz", f["origin_rpy_rad"])
+    x, y, z, w = fl_rot.as_quat()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", UserWarning)  # pitch = 90 deg: gimbal lock, any split is fine
+        fl_rpy = fl_rot.as_euler("xyz")
     o = doc["opw"]
     opw = OPWParams(
         a1=1000.0 * o["a1"], a2=1000.0 * o["a2"], b=1000.0 * o["b"],
@@ -241,8 +268,9 @@ def load_machine(path: str | Path | None = None) -> MachineData:
         home_deg=_floats(doc["home_deg"]),
         mastering_deg=_floats(doc.get("mastering_mames_deg", doc["home_deg"])),
         opw=opw,
-        flange_quat_wxyz=_floats(tool0["mujoco_site_quat_wxyz"]),  # type: ignore[arg-type]
-        flange_rpy_rad=_floats(tool0["origin_rpy_rad"]),  # type: ignore[arg-type]
+        flange_quat_wxyz=(float(w), float(x), float(y), float(z)),
+        flange_rpy_rad=_floats(fl_rpy),  # type: ignore[arg-type]
+        flange_pos_mm=_floats(fl_pos),  # type: ignore[arg-type]
         robroot_frame=_floats(doc.get("robroot_mm_deg", [0.0] * 6)),
         default_tool_frame=_floats(mdf.get("tool_data_1_mm_deg", [0.0] * 6)),
         status_phi_deg=float(doc["status_bit1_phi_deg"]),

@@ -1,0 +1,206 @@
+"""MuJoCo model of the KR 6 R900 sixx, generated from the machine-data yaml
+(robot-model.md §2, §11).
+
+The body tree mirrors the URDF chain exactly (joint origins, axes, ranges), so
+``qpos = kuka_sign * radians(A_i)`` (= radians(A_i) here, robot-model.md §3) and
+the site ``tool0`` on ``link_6`` is KUKA's flange frame (+Z out of the flange).
+Geometry is capsules only; masses come from the geometry (density 1000 kg/m^3,
+invented, robot-model.md §11: link masses are not published).
+
+Two modes (argument ``actuated``):
+  * replay (default): no actuators; :meth:`ArmModel.set_axes` writes ``qpos``
+    and runs ``mj_kinematics`` (kinematic playback, exact).
+  * actuated: per joint a ``position`` actuator (kp) and a separate ``velocity``
+    actuator (kv), gravity-compensated links, stepped with
+    :meth:`ArmModel.step_actuated` (robot-model.md §11, "Driving along a
+    precomputed KRL joint trajectory").
+
+Units at this interface: degrees and mm (MuJoCo itself uses rad and m).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from xml.sax.saxutils import quoteattr
+
+import numpy as np
+
+from .machine import MachineData, load_machine
+
+#: Servo gains of the actuated mode (robot-model.md §11: kp 2e4 + kv 400 -> 0.175 deg max error).
+DEFAULT_KP = 20000.0
+DEFAULT_KV = 400.0
+DEFAULT_TIMESTEP_S = 0.001
+
+
+def _f(v: float) -> str:
+    return repr(float(v))
+
+
+def _vec(v: Sequence[float]) -> str:
+    return " ".join(_f(x) for x in v)
+
+
+def build_mjcf(machine: MachineData | None = None, actuated: bool = False, *,
+               kp: float = DEFAULT_KP, kv: float = DEFAULT_KV,
+               timestep: float = DEFAULT_TIMESTEP_S) -> str:
+    """MJCF XML (str) of the arm from the machine data (robot-model.md §2, §11).
+
+    Bodies ``base_link``, ``link_1`` .. ``link_6``; joints named as in the yaml
+    (``joint_a1`` ..); site ``robroot`` at ``$ROBROOT`` (world origin) and site
+    ``tool0`` (KUKA flange) on ``link_6``; keyframe ``home``.
+
+    Args:
+        machine: machine data; default :func:`~robot.machine.load_machine`.
+        actuated: False = kinematic replay model (no actuators); True = adds a
+            ``position`` actuator ``a<i>`` (kp) and a ``velocity`` actuator
+            ``v<i>`` (kv) per joint, with ``gravcomp`` on the links.
+        kp, kv: servo gains (N·m/rad, N·m·s/rad) for the actuated mode.
+        timestep: simulation time step, s.
+    """
+    m = machine if machine is not None else load_machine()
+    joints = m.joints
+    gravcomp = ' gravcomp="1"' if actuated else ""
+    lines = [
+        f"<mujoco model={quoteattr(m.name)}>",
+        '  <compiler angle="radian" autolimits="true"/>',
+        f'  <option timestep="{_f(timestep)}" integrator="implicitfast"/>',
+        "  <default>",
+        '    <geom contype="0" conaffinity="0" rgba="1 0.45 0 1" density="1000"/>',
+        '    <joint damping="0" armature="0.01"/>',
+        "  </default>",
+        "  <worldbody>",
+        '    <site name="robroot" pos="0 0 0" size="0.01" rgba="0 0 1 1"/>',
+        '    <body name="base_link">',
+    ]
+    # base column up to the A1 joint origin
+    o1 = np.array(joints[0].origin_mm) / 1000.0
+    lines.append(f'      <geom name="base_geom" type="capsule" size="0.07" fromto="0 0 0 {_vec(o1)}" rgba="0.2 0.2 0.2 1"/>')
+    indent = "      "
+    for i, j in enumerate(joints):
+        pos = np.array(j.origin_mm) / 1000.0
+        quat = ""
+        if any(j.origin_rpy_rad):
+            from scipy.spatial.transform import Rotation
+
+            x, y, z, w = Rotation.from_euler("xyz", j.origin_rpy_rad).as_quat()
+            quat = f' quat="{_vec((w, x, y, z))}"'
+        lo, hi = (math.radians(v) for v in j.limit_deg)
+        if j.kuka_sign < 0:
+            lo, hi = -hi, -lo
+        lines.append(f'{indent}<body name="{j.child or f"link_{i + 1}"}" pos="{_vec(pos)}"{quat}{gravcomp}>')
+        indent += "  "
+        lines.append(f'{indent}<joint name="{j.name}" type="hinge" axis="{_vec(j.joint_axis)}" range="{_f(lo)} {_f(hi)}"/>')
+        # link geometry: capsule from this joint to the next joint origin (or to the flange)
+        nxt = np.array(joints[i + 1].origin_mm) / 1000.0 if i + 1 < len(joints) else None
+        radius = 0.06 if i < 3 else 0.045
+        if nxt is not None and np.linalg.norm(nxt) > 1e-6:
+            lines.append(f'{indent}<geom name="link_{i + 1}_geom" type="capsule" size="{_f(radius)}" fromto="0 0 0 {_vec(nxt)}"/>')
+        else:
+            lines.append(f'{indent}<geom name="link_{i + 1}_geom" type="sphere" size="{_f(radius)}"/>')
+    # KUKA flange frame (URDF tool0) on link_6
+    fpos = np.array(m.flange_pos_mm) / 1000.0
+    lines.append(f'{indent}<site name="tool0" pos="{_vec(fpos)}" quat="{_vec(m.flange_quat_wxyz)}" size="0.01" rgba="0 1 0 1"/>')
+    for _ in joints:
+        indent = indent[:-2]
+        lines.append(f"{indent}</body>")
+    lines.append("    </body>")
+    lines.append("  </worldbody>")
+    if actuated:
+        lines.append("  <actuator>")
+        for i, j in enumerate(joints):
+            lines.append(f'    <position name="a{i + 1}" joint="{j.name}" kp="{_f(kp)}" inheritrange="1"/>')
+        for i, j in enumerate(joints):
+            lines.append(f'    <velocity name="v{i + 1}" joint="{j.name}" kv="{_f(kv)}"/>')
+        lines.append("  </actuator>")
+    home = [j.kuka_sign * math.radians(a) for j, a in zip(joints, m.home_deg)]
+    lines.append("  <keyframe>")
+    ctrl = ""
+    if actuated:
+        ctrl = f' ctrl="{_vec(home + [0.0] * len(joints))}"'
+    lines.append(f'    <key name="home" qpos="{_vec(home)}"{ctrl}/>')
+    lines.append("  </keyframe>")
+    lines.append("</mujoco>")
+    return "\n".join(lines) + "\n"
+
+
+class ArmModel:
+    """The MuJoCo arm, driven in KUKA axis values (deg) and read back in mm.
+
+    Attributes:
+        machine, model (``mujoco.MjModel``), data (``mujoco.MjData``), xml, actuated.
+    """
+
+    def __init__(self, machine: MachineData | None = None, actuated: bool = False, **kw) -> None:
+        import mujoco
+
+        self._mj = mujoco
+        self.machine = machine if machine is not None else load_machine()
+        self.actuated = actuated
+        self.xml = build_mjcf(self.machine, actuated, **kw)
+        self.model = mujoco.MjModel.from_xml_string(self.xml)
+        self.data = mujoco.MjData(self.model)
+        self._qadr = np.array([self.model.joint(j.name).qposadr[0] for j in self.machine.joints])
+        self._dadr = np.array([self.model.joint(j.name).dofadr[0] for j in self.machine.joints])
+        self._sign = np.array([j.kuka_sign for j in self.machine.joints], dtype=float)
+        self._site = self.model.site("tool0").id
+        self.set_axes(self.machine.home_deg)
+
+    # ------------------------------------------------------------------ replay
+    def set_axes(self, axes_deg: Sequence[float], vel_deg_s: Sequence[float] | None = None,
+                 full: bool = False) -> None:
+        """Kinematic playback: write ``qpos`` (and ``qvel``) from A1..A6 in deg (deg/s)
+        and run ``mj_kinematics`` (``mj_forward`` with ``full=True``)."""
+        d = self.data
+        d.qpos[self._qadr] = self._sign * np.radians(np.asarray(axes_deg, dtype=float)[:6])
+        if vel_deg_s is not None:
+            d.qvel[self._dadr] = self._sign * np.radians(np.asarray(vel_deg_s, dtype=float)[:6])
+        if full:
+            self._mj.mj_forward(self.model, d)
+        else:
+            self._mj.mj_kinematics(self.model, d)
+
+    def axes_deg(self) -> np.ndarray:
+        """Current A1..A6 (deg) read back from ``qpos``; shape (6,)."""
+        return np.degrees(self._sign * self.data.qpos[self._qadr])
+
+    def axes_vel_deg_s(self) -> np.ndarray:
+        """Current axis speeds (deg/s) from ``qvel``; shape (6,)."""
+        return np.degrees(self._sign * self.data.qvel[self._dadr])
+
+    def flange_pose(self) -> np.ndarray:
+        """KUKA flange frame (site ``tool0``) in ``$ROBROOT`` (= MuJoCo world), 4x4, mm."""
+        T = np.eye(4)
+        T[:3, :3] = self.data.site_xmat[self._site].reshape(3, 3)
+        T[:3, 3] = 1000.0 * self.data.site_xpos[self._site]
+        return T
+
+    # ------------------------------------------------------------------ actuated
+    def step_actuated(self, targets_deg: Sequence[float], dt: float,
+                      target_vel_deg_s: Sequence[float] | None = None) -> None:
+        """Actuated mode only: hold ``ctrl`` = target axes (deg) and target speeds (deg/s,
+        default 0) and advance the simulation by ``dt`` seconds (rounded to whole
+        time steps, at least one). Raises RuntimeError in replay mode."""
+        if not self.actuated:
+            raise RuntimeError("step_actuated needs ArmModel(actuated=True)")
+        n = len(self._qadr)
+        d = self.data
+        d.ctrl[:n] = self._sign * np.radians(np.asarray(targets_deg, dtype=float)[:6])
+        if target_vel_deg_s is None:
+            d.ctrl[n:2 * n] = 0.0
+        else:
+            d.ctrl[n:2 * n] = self._sign * np.radians(np.asarray(target_vel_deg_s, dtype=float)[:6])
+        steps = max(1, int(round(dt / self.model.opt.timestep)))
+        for _ in range(steps):
+            self._mj.mj_step(self.model, d)
+
+    def reset(self, axes_deg: Sequence[float] | None = None) -> None:
+        """Reset the simulation state to ``axes_deg`` (default HOME), zero speed;
+        in actuated mode the servo targets are set there too."""
+        self._mj.mj_resetData(self.model, self.data)
+        q = self.machine.home_deg if axes_deg is None else axes_deg
+        if self.actuated:
+            n = len(self._qadr)
+            self.data.ctrl[:n] = self._sign * np.radians(np.asarray(q, dtype=float)[:6])
+        self.set_axes(q, full=True)
