@@ -97,6 +97,24 @@ class Kinematics:
         T[:3, 3] = p + R @ self._p_flange
         return T
 
+    def forward_many(self, axes_deg: np.ndarray) -> np.ndarray:
+        """Vectorised :meth:`forward`: axes (n, 6) in deg -> flange frames (n, 4, 4), mm."""
+        Q = self._kuka_sign * np.radians(np.atleast_2d(np.asarray(axes_deg, dtype=float))[:, :6])
+        n = Q.shape[0]
+        Rj = Rotation.from_rotvec((self._axes[None, :, :] * Q[:, :, None]).reshape(-1, 3)).as_matrix()
+        Rj = Rj.reshape(n, 6, 3, 3)
+        R = np.broadcast_to(np.eye(3), (n, 3, 3)).copy()
+        p = np.zeros((n, 3))
+        for i in range(6):
+            p = p + R @ self._origins[i]
+            if self._origin_rot:
+                R = R @ self._R_origin[i]
+            R = R @ Rj[:, i]
+        T = np.broadcast_to(np.eye(4), (n, 4, 4)).copy()
+        T[:, :3, :3] = R @ self._R_flange
+        T[:, :3, 3] = p + R @ self._p_flange
+        return T
+
     # ------------------------------------------------------------------ S/T
     def wrist_point_x(self, axes_deg: Sequence[float]) -> float:
         """x of the wrist point in the A1 frame, mm (robot-model.md §4.4; S bit 0)."""
@@ -258,7 +276,8 @@ class Kinematics:
         Args:
             flange_T: 4x4 flange frame in ``$ROBROOT``, mm.
             status: S; bits 0..2 select the IK branch (masked with 7). None: keep
-                the status of ``reference_deg``.
+                the status of ``reference_deg`` (a bit whose switching point the
+                reference sits on, e.g. A5 = 0 for bit 2, is left free).
             turn: T; bit i = 1 means A(i+1) < 0, selecting the ±360° variant of
                 each axis. None: each axis takes the value nearest to
                 ``reference_deg`` (shortest axis motion).
@@ -276,10 +295,16 @@ class Kinematics:
         sols = self._opw_solve(flange_T, ref)
         if len(sols) == 0:
             raise WorkspaceError("workspace error: target not reachable")
-        s_target = (int(status) & 7) if status is not None else self.status_turn(ref)[0]
+        if status is not None:
+            s_target, free = int(status) & 7, 0
+        else:
+            # keep the reference's status; bits the reference sits exactly on
+            # (A5 = 0, A3 = phi, wrist point on the A1 axis) are free
+            s_ref, free_ref = self._status_bits(ref[None, :])
+            s_target, free = int(s_ref[0]), int(free_ref[0])
 
         s_all, amb = self._status_bits(sols)
-        matching = sols[((s_all ^ s_target) & ~amb & 7) == 0]
+        matching = sols[((s_all ^ s_target) & ~(amb | free) & 7) == 0]
         if len(matching) == 0:
             raise WorkspaceError(f"workspace error: target not reachable with status S={s_target}")
 
@@ -333,6 +358,17 @@ class Kinematics:
         ``INV_POS($ROBROOT) : $BASE : P : INV_POS($TOOL)`` (robot-model.md §7).
         Arguments as in :meth:`tcp_pose`; returns 4x4, mm."""
         return inv_pos(as_matrix(robroot)) @ as_matrix(base) @ as_matrix(tcp_in_base) @ inv_pos(as_matrix(tool))
+
+    def pos_act(self, axes_deg: Sequence[float], tool: Any = None, base: Any = None,
+                robroot: Any = None) -> tuple[float, float, float, float, float, float, int, int]:
+        """``$POS_ACT`` as an E6POS-like tuple (X, Y, Z, A, B, C, S, T): TCP of
+        :meth:`tcp_pose` in mm/deg (ABC as in :func:`~robot.frames.matrix_to_frame`)
+        with the status and turn of the axes (robot-model.md §7-§8)."""
+        from .frames import matrix_to_frame
+
+        x, y, z, a, b, c = matrix_to_frame(self.tcp_pose(axes_deg, tool, base, robroot))
+        s, t = self.status_turn(axes_deg)
+        return (x, y, z, a, b, c, s, t)
 
     def inverse_tcp(self, tcp_in_base: Any, status: int | None = None, turn: int | None = None,
                     reference_deg: Sequence[float] | None = None, tool: Any = None,

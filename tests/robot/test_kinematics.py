@@ -316,3 +316,28 @@ def test_inverse_speed(kin):
     for _ in range(200):
         kin.inverse(F, 6, 18)
     assert (time.perf_counter() - t0) / 200 < 2e-3
+
+
+def test_status_none_from_singular_reference_is_free(kin):
+    # the reference sits on A5 = 0 (S bit 2 undetermined): the nearby flipped wrist is taken,
+    # not the A4 + 180 solution that S = 2 would force
+    F = kin.forward((0, -90, 90, 0, -5, 0))
+    np.testing.assert_allclose(kin.inverse(F, reference_deg=(0, -90, 90, 0, 0, 0)), (0, -90, 90, 0, -5, 0),
+                               atol=1e-6)
+    q = kin.inverse(F, 2, reference_deg=(0, -90, 90, 0, 0, 0))
+    assert q[4] == pytest.approx(5, abs=1e-6) and abs(q[3]) == pytest.approx(180, abs=1e-6)
+
+
+def test_forward_many_and_pos_act(kin):
+    rng = np.random.default_rng(25)
+    Q = random_axes(rng, 50)
+    T = kin.forward_many(Q)
+    assert T.shape == (50, 4, 4)
+    for q, t in zip(Q, T):
+        np.testing.assert_allclose(t, dh_forward(q), atol=1e-9)
+    # robot-model.md §7 worked example as an E6POS tuple
+    x, y, z, a, b, c, s, t = kin.pos_act((0, -90, 90, 0, 90, 0), tool=(0, 0, 225, 0, 0, 0),
+                                         base=(500, 0, 0, 90, 0, 0))
+    assert (x, y, z) == pytest.approx((0, 55, 585), abs=1e-9)
+    assert rot_angle_deg(abc_matrix(a, b, c), abc_matrix(90, 0, 180)) < 1e-9
+    assert (s, t) == (2, 2)
