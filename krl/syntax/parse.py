@@ -157,7 +157,7 @@ def parse_text(text: str, path: str = "<string>", bundle: ParserBundle | None = 
     parser._errHandler = BailErrorStrategy()
     try:
         tree = parser.module()
-        if not lex_listener.issues:
+        if not lex_listener.issues and not lex_listener._lexer_raw:
             return ParseResult(path, True, encoding, "ok", [], tree if keep_tree else None, "sll")
     except ParseCancellationException:
         pass
