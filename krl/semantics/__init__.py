@@ -1,0 +1,1 @@
+"""Semantic analysis: built-in data, types, symbol tables, the type checker and diagnostics."""
