@@ -1,0 +1,301 @@
+"""AST -> KRL text (pretty-printer).
+
+``print_module(module)`` returns KRL source such that parsing it and building the AST
+again gives an equal AST (spans and annotations excluded). Comments and folds are not
+in the AST and are not printed. Parentheses are inserted from operator precedence
+(reference 4.1): unary > ':' > '*' '/' > '+' '-' > AND > EXOR > OR > comparisons; binary
+operators associate to the left.
+"""
+
+from __future__ import annotations
+
+from krl.ast import nodes as N
+
+PREC = {
+    "==": 1, "<>": 1, "<": 1, ">": 1, "<=": 1, ">=": 1,
+    "OR": 2, "B_OR": 2,
+    "EXOR": 3, "B_EXOR": 3,
+    "AND": 4, "B_AND": 4,
+    "+": 5, "-": 5,
+    "*": 6, "/": 6,
+    ":": 7,
+}
+UNARY_PREC = 8
+ATOM_PREC = 9
+INDENT = "  "
+
+
+def _prec(e: N.Expr) -> int:
+    if isinstance(e, N.Binary):
+        return PREC.get(e.op, 0)
+    if isinstance(e, N.Unary):
+        return UNARY_PREC
+    return ATOM_PREC
+
+
+def fmt_real(value: float) -> str:
+    text = repr(float(value))
+    if text in ("inf", "-inf", "nan"):
+        return "0.0"
+    return text.upper() if "e" in text else text
+
+
+def expr(e: N.Expr | None) -> str:
+    """One expression as KRL text."""
+    if e is None:
+        return ""
+    if isinstance(e, N.IntLit):
+        if e.base == 16:
+            return f"'H{e.value:X}'"
+        if e.base == 2:
+            return f"'B{e.value:b}'"
+        return str(e.value)
+    if isinstance(e, N.RealLit):
+        return fmt_real(e.value)
+    if isinstance(e, N.BoolLit):
+        return "TRUE" if e.value else "FALSE"
+    if isinstance(e, N.StrLit):
+        return f'"{e.value}"'
+    if isinstance(e, N.EnumLit):
+        return f"#{e.name}"
+    if isinstance(e, N.Name):
+        return e.name
+    if isinstance(e, N.Index):
+        return f"{expr(e.base)}[{','.join(expr(i) for i in e.indices)}]"
+    if isinstance(e, N.Field):
+        return f"{expr(e.base)}.{e.name}"
+    if isinstance(e, N.Call):
+        return f"{e.name}({', '.join(expr(a) for a in e.args)})".replace(", )", ",)") \
+            if e.args else f"{e.name}()"
+    if isinstance(e, N.Aggregate):
+        head = f"{e.type_name}: " if e.type_name else ""
+        items = ", ".join(f"{i.name}{'[]' if i.array else ''} {expr(i.value)}" for i in e.items)
+        return "{" + head + items + "}"
+    if isinstance(e, N.Unary):
+        inner = expr(e.operand)
+        if _prec(e.operand) < UNARY_PREC:
+            inner = f"({inner})"
+        if e.op in ("NOT", "B_NOT"):
+            return f"{e.op} {inner}"
+        return f"{e.op}{inner}"
+    if isinstance(e, N.Binary):
+        p = PREC.get(e.op, 0)
+        left, right = expr(e.left), expr(e.right)
+        if _prec(e.left) < p:
+            left = f"({left})"
+        if _prec(e.right) <= p:
+            right = f"({right})"
+        return f"{left} {e.op} {right}"
+    raise TypeError(f"not an expression: {type(e).__name__}")
+
+
+def _with(items: list[N.WithAssign]) -> str:
+    if not items:
+        return ""
+    return " WITH " + ", ".join(f"{expr(w.target)} = {expr(w.value)}" for w in items)
+
+
+def _dims(dims: list[int]) -> str:
+    return f"[{','.join(str(d) if d else '' for d in dims)}]" if dims else ""
+
+
+def _size(size: int | None) -> str:
+    if size is None:
+        return ""
+    return "[]" if size == 0 else f"[{size}]"
+
+
+def decl(d: N.Decl) -> str:
+    """One declaration line (without newline)."""
+    if isinstance(d, N.VarDecl):
+        parts = []
+        if d.decl_keyword:
+            parts.append("DECL")
+        if d.is_global:
+            parts.append("GLOBAL")
+        if d.is_const:
+            parts.append("CONST")
+        parts.append(d.type.name)
+        parts.append(", ".join(v.name + _dims(v.dims) for v in d.names))
+        text = " ".join(parts)
+        if d.init is not None:
+            text += " = " + expr(d.init)
+        return text
+    if isinstance(d, N.ArrayInit):
+        idx = ",".join("" if i is None else str(i) for i in d.indices)
+        return f"{d.name}[{idx}] = {expr(d.value)}"
+    if isinstance(d, N.StrucDecl):
+        comps = []
+        prev = None
+        for c in d.components:
+            comps.append((f"{c.type_name} " if c.type_name != prev else "") + c.name + _dims(c.dims))
+            prev = c.type_name
+        return ("GLOBAL " if d.is_global else "") + f"STRUC {d.name} " + ", ".join(comps)
+    if isinstance(d, N.EnumDecl):
+        return ("GLOBAL " if d.is_global else "") + f"ENUM {d.name} " + ", ".join(d.values)
+    if isinstance(d, N.SignalDecl):
+        text = ("GLOBAL " if d.is_global else "") + f"SIGNAL {d.name} {d.start.sysvar}[{d.start.index}]"
+        if d.end is not None:
+            text += f" TO {d.end.sysvar}[{d.end.index}]"
+        return text
+    if isinstance(d, N.ExtDecl):
+        ps = []
+        for p in d.params:
+            t = p.type_name + _size(p.type_size)
+            if p.name:
+                t += f" {p.name}{_size(p.name_size)}"
+            if p.mode:
+                t += f" :{p.mode}"
+            ps.append(t)
+        rt = f"{d.return_type.name}{_size(d.return_type.size)} " if d.return_type else ""
+        return f"{d.kind} {rt}{d.name}({', '.join(ps)})"
+    if isinstance(d, N.ImportDecl):
+        parts = list(d.path) + ["", "", ""]
+        return f"IMPORT {d.type_name} {d.name} IS /{parts[0]}/{parts[1]}..{parts[2]}"
+    if isinstance(d, N.ChannelDecl):
+        return f"CHANNEL :{d.name} :{d.device} {d.param}"
+    raise TypeError(f"not a declaration: {type(d).__name__}")
+
+
+def _motion(m: N.Motion) -> str:
+    text = m.kind + " "
+    if m.aux is not None:
+        text += expr(m.aux) + ", "
+    text += expr(m.target)
+    if m.ca is not None:
+        text += ", CA " + expr(m.ca)
+    text += _with(m.with_)
+    if m.approx:
+        text += " " + " ".join(m.approx)
+    if m.frame:
+        text += " " + m.frame
+    return text
+
+
+def _trigger_action(s: N.Stmt) -> str:
+    if isinstance(s, N.Assign):
+        return f"{expr(s.target)} = {expr(s.value)}"
+    if isinstance(s, N.CallStmt):
+        return expr(s.call)
+    return "".join(stmt(s, 0))
+
+
+def stmt(s: N.Stmt, level: int = 1) -> list[str]:
+    """A statement as indented lines."""
+    ind = INDENT * level
+    if isinstance(s, N.Assign):
+        return [f"{ind}{expr(s.target)} = {expr(s.value)}"]
+    if isinstance(s, N.CallStmt):
+        return [ind + expr(s.call)]
+    if isinstance(s, N.If):
+        out = [f"{ind}IF {expr(s.cond)} THEN"] + block(s.then, level + 1)
+        if s.orelse is not None:
+            out += [f"{ind}ELSE"] + block(s.orelse, level + 1)
+        return out + [f"{ind}ENDIF"]
+    if isinstance(s, N.Switch):
+        out = [f"{ind}SWITCH {expr(s.selector)}"]
+        for c in s.cases:
+            out += [f"{ind}CASE {', '.join(expr(v) for v in c.values)}"] + block(c.body, level + 1)
+        if s.default is not None:
+            out += [f"{ind}DEFAULT"] + block(s.default, level + 1)
+        return out + [f"{ind}ENDSWITCH"]
+    if isinstance(s, N.For):
+        step = f" STEP {expr(s.step)}" if s.step is not None else ""
+        return ([f"{ind}FOR {s.var.name} = {expr(s.start)} TO {expr(s.end)}{step}"]
+                + block(s.body, level + 1) + [f"{ind}ENDFOR"])
+    if isinstance(s, N.While):
+        return [f"{ind}WHILE {expr(s.cond)}"] + block(s.body, level + 1) + [f"{ind}ENDWHILE"]
+    if isinstance(s, N.Repeat):
+        return [f"{ind}REPEAT"] + block(s.body, level + 1) + [f"{ind}UNTIL {expr(s.cond)}"]
+    if isinstance(s, N.Loop):
+        return [f"{ind}LOOP"] + block(s.body, level + 1) + [f"{ind}ENDLOOP"]
+    if isinstance(s, N.Exit):
+        return [ind + "EXIT"]
+    if isinstance(s, N.Goto):
+        return [f"{ind}GOTO {s.label}"]
+    if isinstance(s, N.Label):
+        return [f"{ind}{s.name}:"]
+    if isinstance(s, N.Halt):
+        return [ind + "HALT"]
+    if isinstance(s, N.WaitFor):
+        return [f"{ind}WAIT FOR {expr(s.cond)}"]
+    if isinstance(s, N.WaitSec):
+        return [f"{ind}WAIT SEC {expr(s.time)}"]
+    if isinstance(s, N.Continue):
+        return [ind + "CONTINUE"]
+    if isinstance(s, N.Return):
+        return [ind + "RETURN" + (f" {expr(s.value)}" if s.value is not None else "")]
+    if isinstance(s, N.OnErrorProceed):
+        return [ind + "ON_ERROR_PROCEED"]
+    if isinstance(s, N.InterruptDecl):
+        g = "GLOBAL " if s.is_global else ""
+        return [f"{ind}{g}INTERRUPT DECL {expr(s.prio)} WHEN {expr(s.when)} DO {expr(s.call)}"]
+    if isinstance(s, N.InterruptCtl):
+        return [f"{ind}INTERRUPT {s.action}" + (f" {expr(s.prio)}" if s.prio is not None else "")]
+    if isinstance(s, N.Brake):
+        return [ind + ("BRAKE F" if s.fast else "BRAKE")]
+    if isinstance(s, N.Resume):
+        return [ind + "RESUME"]
+    if isinstance(s, N.Trigger):
+        at = f"{s.kind} = {expr(s.at)}" + (" ONSTART" if s.onstart else "")
+        text = f"{ind}TRIGGER WHEN {at} DELAY = {expr(s.delay)} DO {_trigger_action(s.action)}"
+        if s.prio is not None:
+            text += f" PRIO = {expr(s.prio)}"
+        return [text]
+    if isinstance(s, N.AninOn):
+        return [f"{ind}ANIN ON {expr(s.target)} = {expr(s.value)}"]
+    if isinstance(s, N.AninOff):
+        return [f"{ind}ANIN OFF {s.name}"]
+    if isinstance(s, N.AnoutOn):
+        text = f"{ind}ANOUT ON {s.name} = {expr(s.value)}"
+        for key, v in (("DELAY", s.delay), ("MINIMUM", s.minimum), ("MAXIMUM", s.maximum)):
+            if v is not None:
+                text += f" {key} = {expr(v)}"
+        return [text]
+    if isinstance(s, N.AnoutOff):
+        return [f"{ind}ANOUT OFF {s.name}"]
+    if isinstance(s, N.Motion):
+        return [ind + _motion(s)]
+    if isinstance(s, N.SplineBlock):
+        out = [f"{ind}{s.kind}{_with(s.with_)}"] + block(s.body, level + 1)
+        return out + [f"{ind}ENDSPLINE" + (f" {s.approx}" if s.approx else "")]
+    if isinstance(s, N.DeclStmt):
+        return [ind + decl(s.decl)]
+    if isinstance(s, N.Unsupported):
+        return [ind + line for line in s.text.splitlines()] or [ind]
+    raise TypeError(f"not a statement: {type(s).__name__}")
+
+
+def block(stmts: list[N.Stmt], level: int) -> list[str]:
+    out: list[str] = []
+    for s in stmts:
+        out.extend(stmt(s, level))
+    return out
+
+
+def routine(r: N.Routine) -> list[str]:
+    params = ", ".join(p.name + (f"[{',' * (p.dims - 1)}]" if p.dims else "")
+                       + (f" :{p.mode}" if p.mode else "") for p in r.params)
+    g = "GLOBAL " if r.is_global else ""
+    if r.kind == "DEFFCT":
+        rt = r.return_type.name + _size(r.return_type.size) if r.return_type else "INT"
+        head = f"{g}DEFFCT {rt} {r.name}({params})"
+        end = "ENDFCT"
+    else:
+        head = f"{g}DEF {r.name}({params})"
+        end = "END"
+    return [head] + [INDENT + decl(d) for d in r.decls] + block(r.body, 1) + [end]
+
+
+def print_module(m: N.Module) -> str:
+    """The whole file as KRL text, lines ending in '\\n'."""
+    lines = list(m.headers)
+    if m.data is not None:
+        lines.append(f"DEFDAT {m.data.name}" + (" PUBLIC" if m.data.public else ""))
+        lines += [INDENT + decl(d) for d in m.data.items]
+        lines.append("ENDDAT")
+    for i, r in enumerate(m.routines):
+        if i:
+            lines.append("")
+        lines += routine(r)
+    return "\n".join(lines) + "\n"
