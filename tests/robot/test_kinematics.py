@@ -341,3 +341,34 @@ def test_forward_many_and_pos_act(kin):
     assert (x, y, z) == pytest.approx((0, 55, 585), abs=1e-9)
     assert rot_angle_deg(abc_matrix(a, b, c), abc_matrix(90, 0, 180)) < 1e-9
     assert (s, t) == (2, 2)
+
+
+def test_yaml_copy_matches_shared_file():
+    """robot/data/kr6_r900.yaml is the shared machine data plus the two [added] keys."""
+    from pathlib import Path
+
+    import yaml
+
+    shared = Path(__file__).resolve().parents[3] / "shared" / "robots" / "kr6_r900.yaml"
+    if not shared.exists():
+        pytest.skip("../shared/robots/kr6_r900.yaml is not present")
+    ours = yaml.safe_load((Path(__file__).resolve().parents[2] / "robot" / "data" / "kr6_r900.yaml").read_text())
+    theirs = yaml.safe_load(shared.read_text())
+    assert set(ours) - set(theirs) == {"robroot_mm_deg", "ipo_cycle_s"}
+    assert {k: ours[k] for k in theirs} == theirs
+
+
+from hypothesis import assume, given  # noqa: E402
+from hypothesis import strategies as st  # noqa: E402
+
+_KIN = Kinematics(load_machine())  # hypothesis tests cannot use function-scoped fixtures
+
+
+@given(st.tuples(*[st.floats(lo, hi, allow_nan=False) for lo, hi in LIMITS]))
+def test_ik_round_trip_property(q):
+    kin = _KIN
+    q = np.array(q)
+    # stay away from the switching points (there S is ambiguous by definition)
+    assume(abs(q[4]) > 1e-3 and abs(q[2] - 4.763641690726179) > 1e-3 and abs(kin.wrist_point_x(q)) > 1e-3)
+    s, t = kin.status_turn(q)
+    np.testing.assert_allclose(kin.inverse(kin.forward(q), s, t), q, atol=1e-6)
