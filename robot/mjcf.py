@@ -25,7 +25,9 @@ from collections.abc import Sequence
 from xml.sax.saxutils import quoteattr
 
 import numpy as np
+from scipy.spatial.transform import Rotation
 
+from .frames import as_matrix, frame_to_matrix, inv_pos
 from .machine import MachineData, load_machine
 
 #: Servo gains of the actuated mode (robot-model.md §11: kp 2e4 + kv 400 -> 0.175 deg max error).
@@ -48,8 +50,9 @@ def build_mjcf(machine: MachineData | None = None, actuated: bool = False, *,
     """MJCF XML (str) of the arm from the machine data (robot-model.md §2, §11).
 
     Bodies ``base_link``, ``link_1`` .. ``link_6``; joints named as in the yaml
-    (``joint_a1`` ..); site ``robroot`` at ``$ROBROOT`` (world origin) and site
-    ``tool0`` (KUKA flange) on ``link_6``; keyframe ``home``.
+    (``joint_a1`` ..); MuJoCo's world frame is ``$WORLD``: ``base_link`` and the
+    site ``robroot`` sit at the machine data's ``$ROBROOT``; site ``tool0`` (KUKA
+    flange) on ``link_6``; keyframe ``home``.
 
     Args:
         machine: machine data; default :func:`~robot.machine.load_machine`.
@@ -71,9 +74,13 @@ def build_mjcf(machine: MachineData | None = None, actuated: bool = False, *,
         '    <joint damping="0" armature="0.01"/>',
         "  </default>",
         "  <worldbody>",
-        '    <site name="robroot" pos="0 0 0" size="0.01" rgba="0 0 1 1"/>',
-        '    <body name="base_link">',
     ]
+    # $ROBROOT in $WORLD (machine data; $NULLFRAME here): MuJoCo's world frame is $WORLD
+    rr = frame_to_matrix(m.robroot_frame)
+    rx, ry, rz, rw = Rotation.from_matrix(rr[:3, :3]).as_quat()
+    rr_attr = f'pos="{_vec(rr[:3, 3] / 1000.0)}" quat="{_vec((rw, rx, ry, rz))}"'
+    lines.append(f'    <site name="robroot" {rr_attr} size="0.01" rgba="0 0 1 1"/>')
+    lines.append(f'    <body name="base_link" {rr_attr}>')
     # base column up to the A1 joint origin
     o1 = np.array(joints[0].origin_mm) / 1000.0
     lines.append(f'      <geom name="base_geom" type="capsule" size="0.07" fromto="0 0 0 {_vec(o1)}" rgba="0.2 0.2 0.2 1"/>')
@@ -82,8 +89,6 @@ def build_mjcf(machine: MachineData | None = None, actuated: bool = False, *,
         pos = np.array(j.origin_mm) / 1000.0
         quat = ""
         if any(j.origin_rpy_rad):
-            from scipy.spatial.transform import Rotation
-
             x, y, z, w = Rotation.from_euler("xyz", j.origin_rpy_rad).as_quat()
             quat = f' quat="{_vec((w, x, y, z))}"'
         lo, hi = (math.radians(v) for v in j.limit_deg)
@@ -145,6 +150,9 @@ class ArmModel:
         self._dadr = np.array([self.model.joint(j.name).dofadr[0] for j in self.machine.joints])
         self._sign = np.array([j.kuka_sign for j in self.machine.joints], dtype=float)
         self._site = self.model.site("tool0").id
+        self._robroot = frame_to_matrix(self.machine.robroot_frame)
+        self._robroot_inv = inv_pos(self._robroot)
+        self._robroot_null = bool(np.allclose(self._robroot, np.eye(4)))
         self.set_axes(self.machine.home_deg)
 
     # ------------------------------------------------------------------ replay
@@ -169,12 +177,24 @@ class ArmModel:
         """Current axis speeds (deg/s) from ``qvel``; shape (6,)."""
         return np.degrees(self._sign * self.data.qvel[self._dadr])
 
-    def flange_pose(self) -> np.ndarray:
-        """KUKA flange frame (site ``tool0``) in ``$ROBROOT`` (= MuJoCo world), 4x4, mm."""
+    def flange_pose_world(self) -> np.ndarray:
+        """KUKA flange frame (site ``tool0``) in ``$WORLD`` (MuJoCo world), 4x4, mm."""
         T = np.eye(4)
         T[:3, :3] = self.data.site_xmat[self._site].reshape(3, 3)
         T[:3, 3] = 1000.0 * self.data.site_xpos[self._site]
         return T
+
+    def flange_pose(self) -> np.ndarray:
+        """KUKA flange frame (site ``tool0``) in ``$ROBROOT``, 4x4, mm; equals
+        :meth:`robot.kinematics.Kinematics.forward` of :meth:`axes_deg`."""
+        T = self.flange_pose_world()
+        return T if self._robroot_null else self._robroot_inv @ T
+
+    def tcp_pose(self, tool=None, base=None) -> np.ndarray:
+        """``$POS_ACT`` read back from the simulation (``$IPO_MODE=#BASE``):
+        ``INV_POS($BASE) : FLANGE_in_WORLD : $TOOL`` (robot-model.md §7), 4x4, mm.
+        ``tool``/``base``: 4x4, (X, Y, Z, A, B, C) or None (= ``$NULLFRAME``)."""
+        return inv_pos(as_matrix(base)) @ self.flange_pose_world() @ as_matrix(tool)
 
     # ------------------------------------------------------------------ actuated
     def step_actuated(self, targets_deg: Sequence[float], dt: float,

@@ -95,3 +95,23 @@ def test_actuated_mode_tracks_a_ptp_like_move():
 def test_step_actuated_needs_actuated_model(arm):
     with pytest.raises(RuntimeError):
         arm.step_actuated((0, -90, 90, 0, 0, 0), 0.012)
+
+
+def test_tcp_pose_read_back_worked_example(arm):
+    # robot-model.md §7: tool-down pose, $TOOL {Z 225}, $BASE {X 500, A 90} -> {X 0, Y 55, Z 585, A 90, B 0, C 180}
+    arm.set_axes((0, -90, 90, 0, 90, 0))
+    P = arm.tcp_pose(tool=(0, 0, 225, 0, 0, 0), base=(500, 0, 0, 90, 0, 0))
+    np.testing.assert_allclose(P[:3, 3], [0, 55, 585], atol=1e-9)
+    np.testing.assert_allclose(P[:3, :3], [[0, 1, 0], [1, 0, 0], [0, 0, -1]], atol=1e-12)
+
+
+def test_robroot_places_the_base():
+    import dataclasses
+
+    m = dataclasses.replace(load_machine(), robroot_frame=(1000.0, 200.0, 0.0, 90.0, 0.0, 0.0))
+    arm = ArmModel(m)
+    kin = Kinematics(m)
+    q = (10, -80, 95, 5, 30, -20)
+    arm.set_axes(q)
+    np.testing.assert_allclose(arm.flange_pose(), kin.forward(q), atol=1e-6)
+    np.testing.assert_allclose(arm.tcp_pose(), kin.tcp_pose(q, robroot=m.robroot_frame), atol=1e-6)
