@@ -1,0 +1,175 @@
+"""Approximate positioning (blending) between two planned segments (reference §6.8).
+
+Model (documented in docs/robot.md, "Motion"):
+
+* **Where the blend starts** — on the approximated segment, from the keyword valid for it:
+
+  - ``C_DIS`` (CP): where the remaining path length to the programmed point equals
+    ``d = min($APO.CDIS, L/2, L_next/2)``; the remaining straight-line distance is then at
+    most ``d`` too.
+  - ``C_ORI`` (CP): where the remaining orientation change equals ``min($APO.CORI, θ/2)``.
+  - ``C_VEL`` (CP): in the deceleration phase, where the path speed falls to
+    ``$APO.CVEL`` % of the programmed speed (not before the middle of the segment).
+  - ``C_PTP`` (PTP): per axis ``d_i = min($APO.CPTP% · $APO_DIS_PTP[i], |Δq_i|/2,
+    |Δq_next_i|/2)``; the blend starts when every axis is within its ``d_i``.
+  - ``C_DIS`` on PTP (KSS 8 inline forms): where the TCP gets within ``$APO.CDIS`` of the
+    point (found on the sampled TCP path, not before the middle).
+  - ``C_SPL`` = ``C_PTP`` for SPTP, ``C_DIS`` otherwise; ``C_PTP`` on a CP motion is read as
+    ``C_DIS``; ``C_VEL``/``C_ORI`` on a PTP as ``C_PTP``. ``PTP P C_PTP C_DIS``: the second
+    keyword applies when the next motion is a CP motion.
+
+* **Where it ends** — on the next segment, at the point whose distance from the start of
+  that segment equals the blend-start distance (capped at half the next segment), or, for
+  PTP→PTP with ``C_PTP``, with the per-axis rule and the ``$APO.CPTP`` of the *next* motion
+  (KSS 8 per-point rule, reference §6.8).
+
+* **Contour** — the next segment starts (its own time law, from rest) at the blend start;
+  during the blend window the setpoint is the convex combination
+  ``x = (1-w)·x_prev(t) + w·x_next(t)`` with ``w`` = smoothstep over the window. ``x_prev``
+  only moves from the blend start to the programmed point and ``x_next`` only from the
+  programmed point to the blend end, so every blended setpoint lies in the convex hull of
+  points within the zone: **the contour stays inside the approximation sphere** (CP-CP,
+  Cartesian combination, orientation by slerp) or inside the axis-space box (blends with a
+  PTP side are combined in axis space). Position and velocity are continuous at both ends.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from .planner import CartSegment, JointSegment, Segment
+from .profiles import smoothstep
+
+
+def effective_keyword(prev: Segment, nxt: Segment | None) -> str | None:
+    """The approximation keyword that governs the blend ``prev`` -> ``nxt``."""
+    k = prev.req.approx
+    if k is None:
+        return None
+    if not prev.cart and nxt is not None and nxt.cart and prev.req.approx2:
+        k = prev.req.approx2
+    if k == "C_SPL":
+        k = "C_DIS" if prev.cart else "C_PTP"
+    if prev.cart and k == "C_PTP":
+        k = "C_DIS"
+    if not prev.cart and k in ("C_VEL", "C_ORI"):
+        k = "C_PTP"
+    return k
+
+
+def _ptp_fraction(seg: JointSegment, other: Segment | None, cptp: float) -> float:
+    """min over moving axes of d_i/|Δq_i| (C_PTP per-axis rule); 0 if nothing moves."""
+    dq = np.abs(seg.dq)
+    moving = dq > 1e-9
+    if not moving.any():
+        return 0.0
+    d = np.minimum(cptp / 100.0 * seg.model.apo_dis_ptp, dq / 2.0)
+    if isinstance(other, JointSegment):
+        odq = np.abs(other.dq)
+        d = np.where(odq > 1e-9, np.minimum(d, odq / 2.0), d)
+    return float(np.min(d[moving] / dq[moving]))
+
+
+def blend_start_tau(prev: Segment, nxt: Segment | None, keyword: str) -> float | None:
+    """Local time on ``prev`` (s) at which its approximation starts, or None when the
+    segment cannot be approximated (zero duration). ``nxt`` may be None (not yet known):
+    then the half-segment cap of the next motion is not applied."""
+    if prev.T <= 0.0:
+        return None
+    prof = prev.profile
+    if keyword == "C_PTP":
+        assert isinstance(prev, JointSegment)
+        frac = _ptp_fraction(prev, nxt, prev.req.params.apo_cptp)
+        return prof.t_of_u(1.0 - frac)
+    if keyword == "C_VEL":
+        t = prof.t_of_speed_in_decel(prev.req.params.apo_cvel / 100.0, prev.v_prog)
+        return max(t, prof.t_of_u(0.5))
+    if keyword == "C_ORI" and isinstance(prev, CartSegment):
+        theta = prev.ori_angle
+        if theta <= 1e-9:
+            return prof.t_of_u(0.5)
+        dth = min(prev.req.params.apo_cori, theta / 2.0)
+        lo, hi = 0.5, 1.0  # smallest u with remaining angle <= dth
+        for _ in range(40):
+            mid = 0.5 * (lo + hi)
+            if prev.ori_angle_to_end(mid) <= dth:
+                hi = mid
+            else:
+                lo = mid
+        return prof.t_of_u(hi)
+    # C_DIS
+    d = prev.req.params.apo_cdis
+    if isinstance(prev, CartSegment):
+        L = prev.path_length
+        d = min(d, L / 2.0)
+        if nxt is not None:
+            d = min(d, nxt.path_length / 2.0)
+        if L <= 0.0:
+            return prof.t_of_u(0.5)
+        return prof.t_of_u(prev.u_of_path(L - d))
+    assert isinstance(prev, JointSegment)
+    if nxt is not None:
+        d = min(d, nxt.path_length / 2.0)
+    us = np.linspace(0.5, 1.0, 33)
+    dist = [prev.tcp_dist_to_end(float(u)) for u in us]
+    k = len(us) - 1
+    while k > 0 and dist[k - 1] <= d:
+        k -= 1
+    if k == 0:
+        return prof.t_of_u(0.5)
+    lo, hi = float(us[k - 1]), float(us[k])  # dist(lo) > d >= dist(hi)
+    for _ in range(30):
+        mid = 0.5 * (lo + hi)
+        if prev.tcp_dist_to_end(mid) <= d:
+            hi = mid
+        else:
+            lo = mid
+    return prof.t_of_u(hi)
+
+
+def blend_end_tau(prev: Segment, nxt: Segment, keyword: str, tau_start: float) -> float:
+    """Local time on ``nxt`` (s) at which the blend that started at ``tau_start`` on
+    ``prev`` ends (see the module docstring)."""
+    if nxt.T <= 0.0:
+        return 0.0
+    if keyword == "C_PTP" and isinstance(prev, JointSegment) and isinstance(nxt, JointSegment):
+        frac = _ptp_fraction(nxt, prev, nxt.req.params.apo_cptp)
+        return nxt.profile.t_of_u(frac)
+    u_a = prev.profile.u(tau_start)
+    d_start = prev.tcp_dist_to_end(u_a)
+    L = nxt.path_length
+    if L <= 1e-9:
+        return nxt.profile.t_of_u(min(1.0 - u_a, 0.5))
+    return nxt.profile.t_of_u(nxt.u_of_path(min(d_start, L / 2.0)))
+
+
+def blend_space(prev: Segment, nxt: Segment) -> str:
+    """``"cart"`` when both segments are CP motions (combined in Cartesian space with the
+    same $TOOL/$BASE), else ``"joint"``."""
+    if prev.cart and nxt.cart and np.allclose(prev.tool_T, nxt.tool_T) and \
+            np.allclose(prev.base_T, nxt.base_T):
+        return "cart"
+    return "joint"
+
+
+def weight(x: float) -> float:
+    """Blend weight of the next segment at window fraction x in [0, 1]."""
+    return smoothstep(x)
+
+
+def combine_pose(p0: np.ndarray, R0: Rotation, p1: np.ndarray, R1: Rotation,
+                 w: float) -> tuple[np.ndarray, Rotation]:
+    """Convex combination of two TCP poses: positions linearly, orientations by slerp."""
+    p = (1.0 - w) * p0 + w * p1
+    rel = (R0.inv() * R1).as_rotvec()
+    return p, R0 * Rotation.from_rotvec(w * rel)
+
+
+def combine_axes(q0: np.ndarray, q1: np.ndarray, w: float) -> np.ndarray:
+    """Convex combination of two axis vectors (deg)."""
+    return (1.0 - w) * q0 + w * q1
+
+
+__all__ = ["effective_keyword", "blend_start_tau", "blend_end_tau", "blend_space", "weight",
+           "combine_pose", "combine_axes"]

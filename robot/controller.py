@@ -1,0 +1,730 @@
+"""The simulated KR C4 main run: motion queue, 12 ms IPO cycle, triggers, BRAKE, I/O
+(reference §5.8, §5.12-§5.18, §6, §7; issue 5).
+
+The interpreters are the advance run; they drive a :class:`Controller` through a small
+protocol (docs/architecture.md, "Robot interface")::
+
+    ctl = Controller(trace=TraceWriter("run.jsonl"))
+    while not ctl.can_enqueue():          # $ADVANCE: a full queue blocks the advance run
+        handle(ctl.step())
+    ctl.enqueue(MotionRequest("LIN", {"X": 500}, params, approx="C_DIS", triggers=...))
+    while not ctl.is_idle():              # an advance-run stop (WAIT, $OUT write, ...)
+        handle(ctl.step())
+
+:meth:`Controller.step` runs one IPO cycle (12 ms of simulated time) and returns the events
+of that cycle (:class:`MotionEvent`, :class:`TriggerEvent`, :class:`IoEvent`,
+:class:`MessageEvent`, :class:`ErrorEvent`). Interrupt conditions are the interpreter's:
+it evaluates them after every step.
+
+Time: the clock is the integer IPO cycle count ``k``; ``time = k · 0.012`` s. Motion timing
+uses a *path time* that equals the clock except while BRAKE ramps the path speed down (the
+robot then stays on its path, because every setpoint is a function of path time).
+"""
+
+from __future__ import annotations
+
+import math
+from collections import deque
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from . import blending
+from .errors import RobotError
+from .frames import frame_to_matrix, inv_pos, matrix_to_frame
+from .io import IOImage, parse_signal
+from .machine import MachineData, load_machine
+from .motion import MotionRequest, Trigger
+from .planner import RobotModel, Segment, TriggerPlan, plan, resolved_target
+from .stimuli import Stimulus, load_stimuli, parse_stimuli
+from .trace import TraceWriter
+
+EPS = 1e-9
+MSG_APPROX_IMPOSSIBLE = "approximation not possible"
+
+
+# ----------------------------------------------------------------------------- events
+@dataclass(frozen=True)
+class MotionEvent:
+    """A motion reached a phase: ``start``, ``blend_start``, ``blend_end`` or ``end``."""
+
+    t: float
+    id: int
+    phase: str
+    request: MotionRequest = field(repr=False, compare=False)
+    kind: str = "motion"
+
+
+@dataclass(frozen=True)
+class TriggerEvent:
+    """A TRIGGER's switching point was reached: the interpreter runs ``trigger.action``
+    now, as a short interrupt-like context (no motion statements)."""
+
+    t: float
+    id: int
+    index: int
+    trigger: Trigger
+    kind: str = "trigger"
+
+
+@dataclass(frozen=True)
+class IoEvent:
+    """A signal changed (``source``: program, trigger, pulse, stimulus)."""
+
+    t: float
+    signal: str
+    value: Any
+    source: str
+    kind: str = "io"
+
+
+@dataclass(frozen=True)
+class MessageEvent:
+    """A controller message (e.g. "approximation not possible")."""
+
+    t: float
+    text: str
+    id: int | None = None
+    kind: str = "message"
+
+
+@dataclass(frozen=True)
+class ErrorEvent:
+    """A motion error in the main run (workspace error, software limit switch, ...): the
+    robot stopped, the motion queue was discarded. The interpreter raises ``error``."""
+
+    t: float
+    error: RobotError
+    id: int | None = None
+    kind: str = "error"
+
+
+Event = MotionEvent | TriggerEvent | IoEvent | MessageEvent | ErrorEvent
+
+
+# ----------------------------------------------------------------------------- main run
+@dataclass
+class _Run:
+    """A segment being executed by the main run."""
+
+    seg: Segment
+    t0: float                     # path time of local time 0
+    blend_in_end: float | None = None   # path time where the blend into it ended/ends
+    blend_mid: float | None = None      # path time of the middle of its outgoing blend
+    planned_mid: float | None = None    # expected blend middle (for DISTANCE=1 early)
+    decided: bool = False               # approximation decided (blend or exact stop)
+    fired: set[int] = field(default_factory=set)
+    tau_cache: tuple[int | None, float | None] | None = None
+
+    def shift(self, d: float) -> None:
+        self.t0 += d
+        for name in ("blend_in_end", "blend_mid", "planned_mid"):
+            v = getattr(self, name)
+            if v is not None:
+                setattr(self, name, v + d)
+
+    def trigger_time(self, tp: TriggerPlan) -> float:
+        """Path time at which trigger ``tp`` switches (reference §5.18; see docs)."""
+        seg = self.seg
+        if tp.u_ref is not None:
+            ref = self.t0 + seg.profile.t_of_u(tp.u_ref)
+        elif tp.kind == "start":
+            ref = self.blend_in_end if self.blend_in_end is not None else self.t0
+        else:  # end
+            if self.blend_mid is not None:
+                ref = self.blend_mid
+            elif self.planned_mid is not None and not self.decided:
+                ref = self.planned_mid
+            else:
+                ref = self.t0 + seg.T
+        return max(self.t0, ref + tp.trigger.delay_ms / 1000.0)
+
+    @property
+    def pending_triggers(self) -> bool:
+        return len(self.fired) < len(self.seg.triggers)
+
+
+@dataclass
+class _Blend:
+    prev: _Run
+    nxt: _Run
+    pa: float
+    pb: float
+    space: str
+    keyword: str
+
+
+@dataclass
+class _Held:
+    """Main-run state suspended by BRAKE (restored by :meth:`Controller.release`)."""
+
+    runs: list[_Run]
+    blend: _Blend | None
+    pending: deque
+    tracked: list[_Run]
+    pt: float
+    q: np.ndarray
+    tool_T: np.ndarray
+    base_T: np.ndarray
+
+
+class Controller:
+    """The simulated controller (main run). See the module docstring for the protocol.
+
+    Args:
+        machine: machine data (default :func:`robot.machine.load_machine`).
+        trace: a :class:`~robot.trace.TraceWriter` or None.
+        stimuli: list of :class:`~robot.stimuli.Stimulus`, a YAML path, or None.
+        start_axes: initial axes A1..A6 (deg), default HOME.
+        actuated: drive MuJoCo with position/velocity actuators instead of qpos replay.
+        strict_bco: the first motion needs a complete PTP/LIN target (reference §6.3).
+        mujoco: False to skip MuJoCo entirely (axis_act then returns the setpoint).
+
+    Attributes:
+        advance: ``$ADVANCE`` (0..5), set by the interpreter; default 3.
+        io: the :class:`~robot.io.IOImage`.
+        dt: IPO cycle in s (0.012).
+        last_error: the last :class:`RobotError` of the main run, or None.
+    """
+
+    def __init__(self, machine: MachineData | None = None, *, trace: TraceWriter | None = None,
+                 stimuli: list[Stimulus] | str | None = None,
+                 start_axes: Any = None, actuated: bool = False, strict_bco: bool = True,
+                 mujoco: bool = True) -> None:
+        self.machine = machine if machine is not None else load_machine()
+        self.model = RobotModel(self.machine)
+        self.dt = float(self.machine.ipo_cycle_s)
+        self._dt_ms = int(round(self.dt * 1000))
+        self.trace = trace
+        self.advance = int(self.machine.motion_defaults.get("def_advance", 3))
+        self.strict_bco = strict_bco
+        self._bco_done = False
+        self.io = IOImage(on_change=self._on_io)
+        if isinstance(stimuli, str):
+            stimuli = load_stimuli(stimuli, self.machine.in_pos_car_mm)
+        self.stimuli: list[Stimulus] = list(stimuli or [])
+        q = np.array(self.machine.home_deg if start_axes is None else start_axes, dtype=float)
+        self.model.kin.check_soft_limits(q)
+        self._arm = None
+        self.actuated = actuated
+        if mujoco:
+            from .mjcf import ArmModel
+            self._arm = ArmModel(self.machine, actuated=actuated)
+            self._arm.reset(q)
+        self._k = 0
+        self._pt = 0.0
+        self._scale = 1.0
+        self._scale_rate = 0.0
+        self._braking = False
+        self._brake_T = 0.0
+        self._held: _Held | None = None
+        self._moved_while_held = False
+        self._q = q.copy()
+        self._q_prev = q.copy()
+        self._plan_q = q.copy()        # end point of the last planned motion
+        self._pending: deque[Segment] = deque()
+        self._runs: list[_Run] = []
+        self._blend: _Blend | None = None
+        self._tracked: list[_Run] = []  # runs with unfired triggers
+        self._next_id = 1
+        self._events: list[Event] = []
+        self._pulses: list[tuple[float, int, bool]] = []
+        self._cyclic: dict[int, Callable[["Controller"], None]] = {}
+        self._cyclic_next = 1
+        self._tool_T = np.eye(4)
+        self._base_T = np.eye(4)
+        self._base_inv_T = np.eye(4)
+        self._tcp_T = self.model.tcp(self._q, self._tool_T, self._base_inv_T)
+        self._tcp_prev = self._tcp_T[:3, 3].copy()
+        self.last_error: RobotError | None = None
+        self._ended = False
+
+    # ================================================================= clock
+    @property
+    def time(self) -> float:
+        """Simulated time in s (IPO cycles · 0.012)."""
+        return self._k * self.dt
+
+    @property
+    def cycle(self) -> int:
+        """Number of IPO cycles run so far."""
+        return self._k
+
+    def cycles_for(self, seconds: float) -> int:
+        """IPO cycles a ``WAIT SEC seconds`` takes: rounded up, 0 for ``WAIT SEC 0``
+        (reference §5.8: WAIT SEC 0.012 waits one cycle)."""
+        if seconds <= 0:
+            return 0
+        return int(math.ceil(seconds / self.dt - 1e-9))
+
+    # ================================================================= advance-run side
+    def can_enqueue(self) -> bool:
+        """True if the advance run may plan another motion now: fewer than ``$ADVANCE``
+        motions wait in the queue (with ``$ADVANCE = 0``: only when the robot is idle)."""
+        if self.advance <= 0:
+            return self.is_idle()
+        return len(self._pending) < self.advance
+
+    def enqueue(self, req: MotionRequest) -> int:
+        """Plan ``req`` from the end point of the previously planned motion and queue it.
+
+        Returns the motion id (1, 2, ... in enqueue order). Raises
+        :class:`~robot.errors.RobotError` (WorkspaceError, SoftLimitError, BCO errors) when
+        the motion cannot be planned; nothing is queued then. It does not wait for queue
+        space: check :meth:`can_enqueue` first.
+        """
+        req.id = self._next_id
+        seg = plan(req, self._plan_q, self.model, first=self.strict_bco and not self._bco_done)
+        self._next_id += 1
+        self._bco_done = True
+        self._pending.append(seg)
+        self._plan_q = seg.q1.copy()
+        if self._held is not None:
+            self._moved_while_held = True
+        return req.id
+
+    def is_idle(self) -> bool:
+        """True when the main run has caught up: no motion executing or queued, no
+        pending trigger, not braking (the condition an advance-run stop waits for).
+        After BRAKE the suspended motion does not count (interrupt level)."""
+        return (not self._runs and self._blend is None and not self._pending
+                and not self._tracked and not self._braking)
+
+    def is_moving(self) -> bool:
+        """True while a motion is being executed."""
+        return bool(self._runs) or self._blend is not None
+
+    def queue_length(self) -> int:
+        """Motions planned but not yet started by the main run."""
+        return len(self._pending)
+
+    def step_until(self, predicate: Callable[[], bool], max_cycles: int = 10_000_000) -> list[Event]:
+        """Step until ``predicate()`` is true (checked before each cycle); returns all
+        events. Interpreters that evaluate interrupts should call :meth:`step` themselves."""
+        out: list[Event] = []
+        n = 0
+        while not predicate() and n < max_cycles:
+            out.extend(self.step())
+            n += 1
+        return out
+
+    def wait_idle(self) -> list[Event]:
+        """Step until :meth:`is_idle`."""
+        return self.step_until(self.is_idle)
+
+    def wait_sec(self, seconds: float) -> list[Event]:
+        """Step for ``WAIT SEC seconds`` (see :meth:`cycles_for`)."""
+        out: list[Event] = []
+        for _ in range(self.cycles_for(seconds)):
+            out.extend(self.step())
+        return out
+
+    # ================================================================= BRAKE / RESUME
+    def brake(self, fast: bool = False) -> None:
+        """Start ``BRAKE`` (``fast=False``) or ``BRAKE F`` (``fast=True``): the path speed
+        ramps down linearly to zero, the robot stays on its path (reference §5.17).
+
+        Ramp time ``T = max_i |q̇_i| / (f · a_max_i)`` with f = 0.5 (BRAKE) or 1.0 (BRAKE F)
+        of the machine acceleration. The interpreter steps until :meth:`is_braking` is False.
+        """
+        if not self.is_moving() or self._braking:
+            return
+        qd = np.abs(self._q - self._q_prev) / self.dt
+        f = 1.0 if fast else 0.5
+        T = max(self.dt, float(np.max(qd / (f * self.model.a_max))))
+        self._brake_T = T
+        self._scale_rate = -self._scale / T
+        self._braking = True
+
+    def is_braking(self) -> bool:
+        """True while a BRAKE ramp is running."""
+        return self._braking
+
+    def release(self) -> None:
+        """Return from an interrupt routine without RESUME: the motion suspended by BRAKE
+        continues. If the routine moved the robot, the suspended motions are re-planned from
+        the current position (the braked motion as a PTP/LIN to its end point)."""
+        h = self._held
+        if h is None:
+            return
+        self._held = None
+        if not self._moved_while_held and self.is_idle():
+            d = self._pt - h.pt
+            objs = list(h.runs) + list(h.tracked)
+            if h.blend is not None:
+                objs += [h.blend.prev, h.blend.nxt]
+                h.blend.pa += d
+                h.blend.pb += d
+            seen: set[int] = set()
+            for r in objs:
+                if id(r) not in seen:
+                    seen.add(id(r))
+                    r.shift(d)
+            self._runs, self._blend, self._pending = h.runs, h.blend, h.pending
+            self._tracked = list(dict.fromkeys(h.tracked))
+            self._tool_T, self._base_T = h.tool_T, h.base_T
+            self._base_inv_T = inv_pos(h.base_T)
+            self._scale = 0.0
+            self._scale_rate = 1.0 / max(self._brake_T, self.dt)
+            return
+        # re-plan from where the planning chain ends now
+        segs = []
+        cur = h.blend.nxt if h.blend is not None else (h.runs[-1] if h.runs else None)
+        if cur is not None:
+            req = resolved_target(cur.seg)
+            left = tuple(tp.trigger for tp in cur.seg.triggers if tp.index not in cur.fired)
+            req.triggers = left
+            req.segments = ()
+            segs.append(req)
+        segs.extend(s.req for s in h.pending)
+        for req in segs:
+            seg = plan(req, self._plan_q, self.model)
+            self._pending.append(seg)
+            self._plan_q = seg.q1.copy()
+        self._moved_while_held = False
+
+    def cancel_pending(self) -> None:
+        """``RESUME``: discard the motion suspended by BRAKE and every planned motion; the
+        next motion starts from the current position (reference §5.17). Called while the
+        robot moves (no BRAKE before), it stops at the current setpoint."""
+        self._held = None
+        self._moved_while_held = False
+        self._pending.clear()
+        self._runs = []
+        self._blend = None
+        self._tracked = []
+        self._braking = False
+        self._scale, self._scale_rate = 1.0, 0.0
+        self._plan_q = self._q.copy()
+
+    # ================================================================= I/O
+    def _on_io(self, t: float, name: str, value: Any, source: str) -> None:
+        self._events.append(IoEvent(t, name, value, source))
+        if self.trace is not None:
+            self.trace.write("io", t, signal=name, value=value, source=source)
+
+    def set_out(self, n: int, value: bool, source: str = "program") -> None:
+        """``$OUT[n] = value`` (logged as an io event)."""
+        self.io.now = self.time
+        self.io.set_out(n, value, source)
+
+    def get_in(self, n: int) -> bool:
+        """``$IN[n]``."""
+        return self.io.get_in(n)
+
+    def pulse(self, n: int, level: bool, duration_s: float, source: str = "program") -> None:
+        """``PULSE($OUT[n], level, duration)``: set now, set to ``NOT level`` after
+        ``duration_s`` (at the first IPO cycle at or after it; reference §5.12)."""
+        self.set_out(n, level, source)
+        self._pulses.append((self.time + float(duration_s), int(n), not level))
+
+    def add_cyclic(self, fn: Callable[["Controller"], None]) -> int:
+        """Call ``fn(controller)`` once per IPO cycle after the setpoint is computed
+        (ANOUT ON, ANIN ON, $CYCFLAG). Returns a handle for :meth:`remove_cyclic`."""
+        h = self._cyclic_next
+        self._cyclic_next += 1
+        self._cyclic[h] = fn
+        return h
+
+    def remove_cyclic(self, handle: int) -> None:
+        self._cyclic.pop(handle, None)
+
+    # ================================================================= read-back
+    def axis_act(self) -> np.ndarray:
+        """``$AXIS_ACT``: A1..A6 (deg) read back from the MuJoCo model, shape (6,)."""
+        if self._arm is not None:
+            return self._arm.axes_deg()
+        return self._q.copy()
+
+    def axis_setpoint(self) -> np.ndarray:
+        """The current IPO setpoint A1..A6 (deg)."""
+        return self._q.copy()
+
+    def pos_act(self, tool: Any = None, base: Any = None) -> dict[str, float]:
+        """``$POS_ACT`` as an E6POS dict {X, Y, Z, A, B, C, S, T} (mm, deg): the TCP of
+        :meth:`axis_act` in ``base`` for ``tool`` (6-tuples or 4x4; default: the $BASE/$TOOL
+        of the motion the main run executes, ``$BASE_C``/``$TOOL_C``)."""
+        q = self.axis_act()
+        tool_T = self._tool_T if tool is None else _as4(tool)
+        base_inv = self._base_inv_T if base is None else inv_pos(_as4(base))
+        T = self.model.tcp(q, tool_T, base_inv)
+        x, y, z, a, b, c = matrix_to_frame(T)
+        s, t = self.model.status_turn(q)
+        return {"X": x, "Y": y, "Z": z, "A": a, "B": b, "C": c, "S": s, "T": t}
+
+    def vel_act(self) -> float:
+        """``$VEL_ACT``: TCP speed in m/s over the last IPO cycle."""
+        return float(np.linalg.norm(self._tcp_T[:3, 3] - self._tcp_prev)) / self.dt / 1000.0
+
+    def planned_axes(self) -> np.ndarray:
+        """End point (deg) of the last planned motion (the start of the next one)."""
+        return self._plan_q.copy()
+
+    # ================================================================= trace helpers
+    def message(self, text: str, motion_id: int | None = None, number: int | None = None) -> None:
+        """Log a controller message (event + trace)."""
+        self._events.append(MessageEvent(self.time, text, motion_id))
+        if self.trace is not None:
+            self.trace.write("message", self.time, text=text, id=motion_id, number=number)
+
+    def finish(self, reason: str = "program_end") -> None:
+        """Write the ``end`` trace event (once)."""
+        if not self._ended and self.trace is not None:
+            self.trace.write("end", self.time, reason=reason)
+        self._ended = True
+
+    def _motion_event(self, seg: Segment, phase: str) -> None:
+        req = seg.req
+        self._events.append(MotionEvent(self.time, req.id, phase, req))
+        if self.trace is not None:
+            self.trace.write("motion", self.time, id=req.id, type=req.type_name,
+                             target=dict(req.target), approximation=req.approx,
+                             phase=phase, line=req.line, file=req.file)
+        for st in self.stimuli:
+            if (not st.fired and st.due is None and st.phase == phase
+                    and st.matches_motion(req.id, req.line)):
+                st.due = self.time + st.delay
+
+    # ================================================================= the IPO cycle
+    def step(self) -> list[Event]:
+        """Run one IPO cycle (12 ms): I/O timers, pulses and stimuli, the main-run setpoint
+        (motion start, approximation, blend, end), triggers, MuJoCo, the pose trace event.
+
+        Returns the events of this cycle, in order.
+        """
+        self._events = []
+        self._k += 1
+        t = self.time
+        self.io.now = t
+        self.io.tick_timers(self._dt_ms)
+        if self._pulses:
+            keep = []
+            for (te, n, lvl) in self._pulses:
+                if t >= te - EPS:
+                    self.io.set_out(n, lvl, "pulse")
+                else:
+                    keep.append((te, n, lvl))
+            self._pulses = keep
+        self._apply_stimuli(t)
+
+        # path time (BRAKE ramps scale the path speed)
+        s_old = self._scale
+        if self._scale_rate != 0.0:
+            self._scale = min(1.0, max(0.0, self._scale + self._scale_rate * self.dt))
+            if self._scale in (0.0, 1.0):
+                self._scale_rate = 0.0
+        self._pt += self.dt * 0.5 * (s_old + self._scale)
+        self._q_prev = self._q
+        try:
+            q = self._main_run(self._pt)
+        except RobotError as err:
+            q = self._fault(err)
+        if self._braking and self._scale <= 0.0:
+            self._hold()
+        self._fire_triggers(self._pt)
+        self._q = np.asarray(q, dtype=float)
+        if self._arm is not None:
+            if self.actuated:
+                self._arm.step_actuated(self._q, self.dt, (self._q - self._q_prev) / self.dt)
+            else:
+                self._arm.set_axes(self._q)
+        qa = self.axis_act()
+        self._tcp_prev = self._tcp_T[:3, 3].copy()
+        self._tcp_T = self.model.tcp(qa, self._tool_T, self._base_inv_T)
+        for fn in list(self._cyclic.values()):
+            fn(self)
+        self._reach_stimuli()
+        if self.trace is not None:
+            self.trace.write("pose", t, axes=[float(v) for v in qa],
+                             tcp=list(matrix_to_frame(self._tcp_T)))
+        return self._events
+
+    # ----------------------------------------------------------------- main run
+    def _start(self, seg: Segment, pt: float) -> _Run:
+        run = _Run(seg, pt)
+        self._tool_T, self._base_T = seg.tool_T, seg.base_T
+        self._base_inv_T = seg.base_inv_T
+        self._motion_event(seg, "start")
+        if seg.triggers:
+            self._tracked.append(run)
+        # expected blend (for DISTANCE=1 triggers with a negative DELAY)
+        if seg.req.approx is not None and self._pending and seg.triggers:
+            nxt = self._pending[0]
+            kw = blending.effective_keyword(seg, nxt)
+            ta = blending.blend_start_tau(seg, nxt, kw) if kw else None
+            if ta is not None:
+                te = blending.blend_end_tau(seg, nxt, kw, ta)
+                run.planned_mid = pt + ta + 0.5 * te
+        return run
+
+    def _main_run(self, pt: float) -> np.ndarray:
+        if self._blend is not None:
+            b = self._blend
+            if pt < b.pb - EPS:
+                return self._blend_setpoint(b, pt)
+            self._end_blend(b)
+        if not self._runs:
+            if self._pending:
+                seg = self._pending.popleft()
+                self._runs = [self._start(seg, pt)]
+            else:
+                return self._q
+        r = self._runs[0]
+        seg = r.seg
+        tau = pt - r.t0
+        if seg.req.approx is not None and not r.decided:
+            nxt = self._pending[0] if self._pending else None
+            key = nxt.id if nxt is not None else None
+            if r.tau_cache is None or r.tau_cache[0] != key:
+                kw = blending.effective_keyword(seg, nxt)
+                r.tau_cache = (key, blending.blend_start_tau(seg, nxt, kw) if kw else None)
+            tau_a = r.tau_cache[1]
+            if tau_a is None:
+                r.decided = True
+            elif tau >= tau_a - EPS:
+                r.decided = True
+                if nxt is not None:
+                    return self._begin_blend(r, pt)
+                self.message(MSG_APPROX_IMPOSSIBLE, seg.id)
+        if tau >= seg.T - EPS:
+            self._runs = []
+            r.decided = True
+            self._motion_event(seg, "end")
+            seg._last_q = seg.q1.copy()
+            return seg.q1.copy()
+        return seg.axes(tau)
+
+    def _begin_blend(self, r: _Run, pt: float) -> np.ndarray:
+        nseg = self._pending.popleft()
+        kw = blending.effective_keyword(r.seg, nseg) or "C_DIS"
+        tau_e = blending.blend_end_tau(r.seg, nseg, kw, pt - r.t0)
+        self._motion_event(r.seg, "blend_start")
+        nr = self._start(nseg, pt)
+        nr.blend_in_end = pt + tau_e
+        r.blend_mid = pt + 0.5 * tau_e
+        b = _Blend(r, nr, pt, pt + tau_e, blending.blend_space(r.seg, nseg), kw)
+        self._runs = [nr]
+        self._blend = b
+        if tau_e <= EPS:
+            self._end_blend(b)
+            return nr.seg.axes(pt - nr.t0)
+        return self._blend_setpoint(b, pt)
+
+    def _end_blend(self, b: _Blend) -> None:
+        self._blend = None
+        self._motion_event(b.prev.seg, "blend_end")
+        self._motion_event(b.prev.seg, "end")
+        b.nxt.seg._last_q = self._q.copy()
+
+    def _blend_setpoint(self, b: _Blend, pt: float) -> np.ndarray:
+        w = blending.weight((pt - b.pa) / (b.pb - b.pa))
+        t_prev = min(pt - b.prev.t0, b.prev.seg.T)
+        t_next = pt - b.nxt.t0
+        if b.space == "cart":
+            p0, R0 = b.prev.seg.pose(t_prev)
+            p1, R1 = b.nxt.seg.pose(t_next)
+            p, R = blending.combine_pose(p0, R0, p1, R1, w)
+            q = b.nxt.seg.ik(p, R, self._q)  # type: ignore[attr-defined]
+            return q
+        q0 = b.prev.seg.axes(t_prev)
+        q1 = b.nxt.seg.axes(t_next)
+        q = blending.combine_axes(q0, q1, w)
+        self.model.kin.check_soft_limits(q)
+        return q
+
+    def _fault(self, err: RobotError) -> np.ndarray:
+        mid = self._runs[0].seg.id if self._runs else None
+        self.last_error = err
+        self._events.append(ErrorEvent(self.time, err, mid))
+        if self.trace is not None:
+            line = self._runs[0].seg.req.line if self._runs else None
+            self.trace.write("error", self.time, text=err.message, number=err.number,
+                             id=mid, line=line)
+        q = self._q.copy()
+        self._runs = []
+        self._blend = None
+        self._pending.clear()
+        self._tracked = []
+        self._held = None
+        self._braking = False
+        self._scale, self._scale_rate = 1.0, 0.0
+        self._plan_q = q.copy()
+        return q
+
+    def _hold(self) -> None:
+        """BRAKE finished: suspend the main run (interrupt level starts empty)."""
+        self._braking = False
+        self._held = _Held(self._runs, self._blend, self._pending, self._tracked, self._pt,
+                           self._q.copy(), self._tool_T, self._base_T)
+        self._runs, self._blend, self._pending, self._tracked = [], None, deque(), []
+        self._scale, self._scale_rate = 1.0, 0.0
+        self._moved_while_held = False
+        self._plan_q = self._q.copy()
+
+    # ----------------------------------------------------------------- triggers
+    def _fire_triggers(self, pt: float) -> None:
+        if not self._tracked:
+            return
+        still = []
+        for run in self._tracked:
+            due = []
+            for tp in run.seg.triggers:
+                if tp.index in run.fired:
+                    continue
+                tf = run.trigger_time(tp)
+                if pt >= tf - EPS:
+                    due.append((tf, tp.index, tp))
+            for _, _, tp in sorted(due, key=lambda x: (x[0], x[1])):
+                run.fired.add(tp.index)
+                ev = TriggerEvent(self.time, run.seg.id, tp.index, tp.trigger)
+                self._events.append(ev)
+                if self.trace is not None:
+                    self.trace.write("trigger", self.time, id=run.seg.id, index=tp.index,
+                                     line=tp.trigger.line)
+            if run.pending_triggers:
+                still.append(run)
+        self._tracked = still
+
+    # ----------------------------------------------------------------- stimuli
+    def _apply_stimuli(self, t: float) -> None:
+        for st in self.stimuli:
+            if st.fired:
+                continue
+            due = st.at if st.at is not None else st.due
+            if due is not None and t >= due - EPS:
+                st.fired = True
+                for name, v in st.set.items():
+                    self.io.set_signal(name, v, "stimulus")
+
+    def _reach_stimuli(self) -> None:
+        if not self.stimuli or not self._runs:
+            return
+        active = [r.seg for r in self._runs]
+        if self._blend is not None:
+            active.append(self._blend.prev.seg)
+        for st in self.stimuli:
+            if st.fired or st.due is not None or st.reached_mm is None:
+                continue
+            for seg in active:
+                if st.matches_motion(seg.id, seg.req.line):
+                    p_end = seg.model.tcp(seg.q1, seg.tool_T, seg.base_inv_T)[:3, 3]
+                    here = self.model.tcp(self._q, seg.tool_T, seg.base_inv_T)[:3, 3]
+                    if float(np.linalg.norm(here - p_end)) <= st.reached_mm + 1e-9:
+                        st.due = self.time + st.delay
+                        if st.delay <= 0:
+                            st.fired = True
+                            for name, v in st.set.items():
+                                self.io.set_signal(name, v, "stimulus")
+
+
+def _as4(F: Any) -> np.ndarray:
+    arr = np.asarray(F, dtype=float)
+    if arr.shape == (4, 4):
+        return arr
+    return frame_to_matrix(*arr)
+
+
+__all__ = ["Controller", "MotionEvent", "TriggerEvent", "IoEvent", "MessageEvent",
+           "ErrorEvent", "Event", "MSG_APPROX_IMPOSSIBLE", "parse_signal", "parse_stimuli"]

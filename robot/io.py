@@ -1,0 +1,176 @@
+"""Digital and analog I/O, timers and the I/O event log of the simulated controller
+(reference §5.12-§5.15, §7.1).
+
+* ``$IN[1..8192]`` (read-only for programs; ``$IN[1025]`` is always TRUE), ``$OUT[1..8192]``;
+* ``$ANIN[1..32]``, ``$ANOUT[1..32]``, values clamped to -1.0 .. +1.0;
+* ``$TIMER[1..64]`` in ms, counting up by one IPO cycle (12 ms) per cycle while
+  ``$TIMER_STOP[n]`` is FALSE (boot: all stopped); ``$TIMER_FLAG[n]`` = ``$TIMER[n] >= 0``.
+
+Every change of a signal is appended to :attr:`IOImage.log` as ``(t, signal, value, source)``
+and reported to the optional ``on_change`` callback (the controller writes it to the trace
+as an ``io`` event). Writing the value a signal already has is not an event.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+N_DIGITAL = 8192
+N_ANALOG = 32
+N_TIMERS = 64
+ALWAYS_TRUE_INPUT = 1025
+
+
+class IOError_(ValueError):
+    """Bad signal index or a write to a read-only signal (reference §5.13)."""
+
+
+@dataclass
+class IOImage:
+    """The I/O image. Indices are 1-based as in KRL.
+
+    Attributes:
+        log: list of ``(t_s, signal_name, value, source)`` for every change.
+        on_change: called as ``on_change(t_s, signal_name, value, source)`` on every change.
+        now: current simulated time in s (kept up to date by the controller).
+    """
+
+    on_change: Callable[[float, str, object, str], None] | None = None
+    now: float = 0.0
+    log: list[tuple[float, str, object, str]] = field(default_factory=list)
+
+    def __post_init__(self) -> None:
+        self._in = bytearray(N_DIGITAL + 1)
+        self._in[ALWAYS_TRUE_INPUT] = 1
+        self._out = bytearray(N_DIGITAL + 1)
+        self._anin = [0.0] * (N_ANALOG + 1)
+        self._anout = [0.0] * (N_ANALOG + 1)
+        self.timer_ms = [0] * (N_TIMERS + 1)
+        self.timer_stop = [True] * (N_TIMERS + 1)
+
+    # -- helpers ---------------------------------------------------------------------------
+    @staticmethod
+    def _check(n: int, hi: int, name: str) -> int:
+        n = int(n)
+        if not 1 <= n <= hi:
+            raise IOError_(f"{name}[{n}]: index outside 1..{hi}")
+        return n
+
+    def _changed(self, name: str, value: object, source: str) -> None:
+        self.log.append((self.now, name, value, source))
+        if self.on_change is not None:
+            self.on_change(self.now, name, value, source)
+
+    # -- digital ---------------------------------------------------------------------------
+    def get_in(self, n: int) -> bool:
+        """``$IN[n]``."""
+        return bool(self._in[self._check(n, N_DIGITAL, "$IN")])
+
+    def set_in(self, n: int, value: bool, source: str = "stimulus") -> None:
+        """Set a simulated input (environment side; programs cannot write inputs)."""
+        n = self._check(n, N_DIGITAL, "$IN")
+        if n == ALWAYS_TRUE_INPUT:
+            return
+        v = 1 if value else 0
+        if self._in[n] != v:
+            self._in[n] = v
+            self._changed(f"$IN[{n}]", bool(v), source)
+
+    def get_out(self, n: int) -> bool:
+        """``$OUT[n]``."""
+        return bool(self._out[self._check(n, N_DIGITAL, "$OUT")])
+
+    def set_out(self, n: int, value: bool, source: str = "program") -> None:
+        """``$OUT[n] = value``."""
+        n = self._check(n, N_DIGITAL, "$OUT")
+        v = 1 if value else 0
+        if self._out[n] != v:
+            self._out[n] = v
+            self._changed(f"$OUT[{n}]", bool(v), source)
+
+    # -- analog ----------------------------------------------------------------------------
+    def get_anin(self, n: int) -> float:
+        """``$ANIN[n]`` (-1.0 .. 1.0)."""
+        return self._anin[self._check(n, N_ANALOG, "$ANIN")]
+
+    def set_anin(self, n: int, value: float, source: str = "stimulus") -> None:
+        n = self._check(n, N_ANALOG, "$ANIN")
+        v = max(-1.0, min(1.0, float(value)))
+        if self._anin[n] != v:
+            self._anin[n] = v
+            self._changed(f"$ANIN[{n}]", v, source)
+
+    def get_anout(self, n: int) -> float:
+        """``$ANOUT[n]`` (-1.0 .. 1.0)."""
+        return self._anout[self._check(n, N_ANALOG, "$ANOUT")]
+
+    def set_anout(self, n: int, value: float, source: str = "program") -> None:
+        """``$ANOUT[n] = value``; the value is clamped to -1.0 .. 1.0."""
+        n = self._check(n, N_ANALOG, "$ANOUT")
+        v = max(-1.0, min(1.0, float(value)))
+        if self._anout[n] != v:
+            self._anout[n] = v
+            self._changed(f"$ANOUT[{n}]", v, source)
+
+    # -- by name ---------------------------------------------------------------------------
+    def set_signal(self, name: str, value: object, source: str = "stimulus") -> None:
+        """Set ``$IN[n]``, ``$ANIN[n]``, ``$OUT[n]`` or ``$ANOUT[n]`` given as text."""
+        base, n = parse_signal(name)
+        if base == "$IN":
+            self.set_in(n, bool(value), source)
+        elif base == "$ANIN":
+            self.set_anin(n, float(value), source)  # type: ignore[arg-type]
+        elif base == "$OUT":
+            self.set_out(n, bool(value), source)
+        elif base == "$ANOUT":
+            self.set_anout(n, float(value), source)  # type: ignore[arg-type]
+        else:  # pragma: no cover - parse_signal guards this
+            raise IOError_(f"unknown signal {name}")
+
+    def get_signal(self, name: str) -> object:
+        base, n = parse_signal(name)
+        return {"$IN": self.get_in, "$OUT": self.get_out, "$ANIN": self.get_anin,
+                "$ANOUT": self.get_anout}[base](n)
+
+    # -- timers ----------------------------------------------------------------------------
+    def tick_timers(self, dt_ms: int) -> None:
+        """Advance every running ``$TIMER`` by ``dt_ms`` (called once per IPO cycle)."""
+        tm, st = self.timer_ms, self.timer_stop
+        for i in range(1, N_TIMERS + 1):
+            if not st[i]:
+                tm[i] += dt_ms
+
+    def get_timer(self, n: int) -> int:
+        """``$TIMER[n]`` in ms."""
+        return self.timer_ms[self._check(n, N_TIMERS, "$TIMER")]
+
+    def set_timer(self, n: int, ms: int) -> None:
+        """Preset ``$TIMER[n]`` (ms)."""
+        self.timer_ms[self._check(n, N_TIMERS, "$TIMER")] = int(ms)
+
+    def get_timer_stop(self, n: int) -> bool:
+        return self.timer_stop[self._check(n, N_TIMERS, "$TIMER_STOP")]
+
+    def set_timer_stop(self, n: int, stopped: bool) -> None:
+        """``$TIMER_STOP[n] = stopped``."""
+        self.timer_stop[self._check(n, N_TIMERS, "$TIMER_STOP")] = bool(stopped)
+
+    def get_timer_flag(self, n: int) -> bool:
+        """``$TIMER_FLAG[n]`` = ``$TIMER[n] >= 0``."""
+        return self.get_timer(n) >= 0
+
+
+def parse_signal(name: str) -> tuple[str, int]:
+    """``"$IN[3]"`` -> ``("$IN", 3)``; accepts $IN, $OUT, $ANIN, $ANOUT (case-insensitive).
+    Raises IOError_ for anything else."""
+    s = name.strip().upper().replace(" ", "")
+    if "[" not in s or not s.endswith("]"):
+        raise IOError_(f"not a signal: {name!r}")
+    base, idx = s[:-1].split("[", 1)
+    if base not in ("$IN", "$OUT", "$ANIN", "$ANOUT"):
+        raise IOError_(f"not a signal: {name!r}")
+    try:
+        return base, int(idx)
+    except ValueError:
+        raise IOError_(f"not a signal: {name!r}") from None

@@ -1,0 +1,208 @@
+"""The trace: JSON Lines, one event per line — the single source of truth for its schema.
+
+Every event is a JSON object with ``t`` (simulated time in seconds, rounded to the µs) and
+``kind``; the other fields depend on the kind and are listed in :data:`SCHEMA`. The
+controller (``robot/controller.py``) writes ``motion``, ``io``, ``pose``, ``trigger``,
+``message``, ``error`` and ``end``; the interpreters write ``stmt``, ``call``, ``return``
+and ``interrupt`` through the same :class:`TraceWriter`.
+
+Determinism: fields are written in the order of :data:`SCHEMA`, floats are rounded (time
+to 1e-6 s, poses to 1e-6 mm/deg) and ``-0.0`` is written as ``0.0``, so the same program
+gives the same bytes.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Iterator
+from pathlib import Path
+from typing import IO, Any
+
+#: kind -> ordered list of (field, description). Fields marked "optional" may be absent.
+SCHEMA: dict[str, list[tuple[str, str]]] = {
+    "motion": [
+        ("id", "int: motion id given by Controller.enqueue"),
+        ("type", "str: PTP, LIN, CIRC, PTP_REL, LIN_REL, CIRC_REL, SPTP, SLIN, SCIRC, SPLINE"),
+        ("target", "dict: programmed target components as given (name -> number)"),
+        ("approximation", "str or null: C_PTP, C_DIS, C_VEL, C_ORI, C_SPL or null (exact stop)"),
+        ("phase", "str: start | blend_start | blend_end | end"),
+        ("line", "optional int: source line of the motion statement"),
+        ("file", "optional str: source file of the motion statement"),
+    ],
+    "io": [
+        ("signal", "str: e.g. $OUT[3], $IN[5], $ANOUT[1], $ANIN[2]"),
+        ("value", "bool or float: the new value"),
+        ("source", "optional str: program | trigger | pulse | stimulus"),
+    ],
+    "pose": [
+        ("axes", "list[6] float: A1..A6 in deg (setpoint read back from MuJoCo)"),
+        ("tcp", "list[6] float: X, Y, Z mm and A, B, C deg of the TCP in $BASE (main-run $TOOL/$BASE)"),
+    ],
+    "trigger": [
+        ("id", "int: motion id the TRIGGER belongs to"),
+        ("index", "int: position of the trigger among that motion's triggers (0-based)"),
+        ("line", "optional int: source line of the TRIGGER statement"),
+    ],
+    "message": [
+        ("text", "str: controller message, e.g. 'approximation not possible'"),
+        ("id", "optional int: motion id the message refers to"),
+        ("number", "optional int: KSS message number"),
+    ],
+    "error": [
+        ("text", "str: error message"),
+        ("number", "optional int: KSS message number"),
+        ("id", "optional int: motion id"),
+        ("line", "optional int: source line"),
+        ("file", "optional str: source file"),
+    ],
+    "end": [
+        ("reason", "str: e.g. program_end, error, reset, max_time"),
+    ],
+    # written by the interpreters (same writer)
+    "stmt": [
+        ("file", "str: source file"),
+        ("line", "int: source line"),
+        ("text", "optional str: statement summary"),
+    ],
+    "call": [("name", "str: routine name"), ("line", "optional int")],
+    "return": [("name", "str: routine name"), ("line", "optional int")],
+    "interrupt": [
+        ("prio", "int: interrupt number / priority"),
+        ("name", "str: handler routine"),
+        ("line", "optional int"),
+    ],
+}
+
+KINDS = tuple(SCHEMA)
+_REQUIRED = {k: tuple(f for f, d in v if not d.startswith("optional")) for k, v in SCHEMA.items()}
+_ORDER = {k: tuple(f for f, _ in v) for k, v in SCHEMA.items()}
+
+
+def round_time(t: float) -> float:
+    """Simulated time rounded to the µs (s)."""
+    r = round(float(t), 6)
+    return 0.0 if r == 0.0 else r
+
+
+def _clean(v: Any, nd: int = 6) -> Any:
+    if isinstance(v, bool) or v is None or isinstance(v, str) or isinstance(v, int):
+        return v
+    if isinstance(v, float):
+        r = round(v, nd)
+        return 0.0 if r == 0.0 else r
+    if isinstance(v, dict):
+        return {str(k): _clean(x, nd) for k, x in v.items()}
+    if isinstance(v, (list, tuple)):
+        return [_clean(x, nd) for x in v]
+    try:  # numpy scalars
+        return _clean(v.item(), nd)
+    except AttributeError:
+        return str(v)
+
+
+def make_event(kind: str, t: float, **fields: Any) -> dict[str, Any]:
+    """Build a schema-checked event dict (fields ordered as in :data:`SCHEMA`).
+
+    Raises ValueError for an unknown kind, a missing required field or an unknown field.
+    """
+    if kind not in SCHEMA:
+        raise ValueError(f"unknown trace event kind {kind!r}")
+    missing = [f for f in _REQUIRED[kind] if f not in fields]
+    if missing:
+        raise ValueError(f"trace event {kind!r} lacks {missing}")
+    extra = [f for f in fields if f not in _ORDER[kind]]
+    if extra:
+        raise ValueError(f"trace event {kind!r} has unknown fields {extra}")
+    ev: dict[str, Any] = {"t": round_time(t), "kind": kind}
+    for f in _ORDER[kind]:
+        if f in fields and fields[f] is not None or (f in fields and f in _REQUIRED[kind]):
+            ev[f] = _clean(fields[f])
+    return ev
+
+
+class TraceWriter:
+    """Writes trace events as JSON Lines.
+
+    ``TraceWriter(path)`` writes to a file, ``TraceWriter(stream)`` to an open text stream,
+    ``TraceWriter()`` keeps the lines in memory only (see :attr:`lines`). With
+    ``keep=True`` the events are also kept as dicts in :attr:`events`.
+    ``pose_every`` > 1 thins the per-IPO-cycle pose events (1 = every cycle).
+    """
+
+    def __init__(self, target: str | Path | IO[str] | None = None, *, keep: bool = False,
+                 pose_every: int = 1) -> None:
+        self._own = False
+        if target is None:
+            self._fh: IO[str] | None = None
+        elif isinstance(target, (str, Path)):
+            self._fh = open(target, "w", encoding="utf-8", newline="\n")
+            self._own = True
+        else:
+            self._fh = target
+        self.keep = keep
+        self.events: list[dict[str, Any]] = []
+        self.lines: list[str] = []
+        self._memory = target is None
+        self.pose_every = max(1, int(pose_every))
+        self._pose_count = 0
+        self.closed = False
+
+    def write(self, kind: str, t: float, **fields: Any) -> dict[str, Any]:
+        """Validate, serialise and write one event; returns the event dict."""
+        ev = make_event(kind, t, **fields)
+        self.write_event(ev)
+        return ev
+
+    def write_event(self, ev: dict[str, Any]) -> None:
+        """Write an already built event dict (from :func:`make_event`)."""
+        if ev["kind"] == "pose":
+            self._pose_count += 1
+            if (self._pose_count - 1) % self.pose_every:
+                return
+        line = json.dumps(ev, separators=(",", ":"), ensure_ascii=True)
+        if self.keep:
+            self.events.append(ev)
+        if self._memory:
+            self.lines.append(line)
+        elif self._fh is not None:
+            self._fh.write(line)
+            self._fh.write("\n")
+
+    def text(self) -> str:
+        """The in-memory trace as one string (memory mode only)."""
+        return "".join(line + "\n" for line in self.lines)
+
+    def close(self) -> None:
+        if self._own and self._fh is not None and not self.closed:
+            self._fh.close()
+        self.closed = True
+
+    def __enter__(self) -> "TraceWriter":
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+
+def read_trace(source: str | Path | IO[str]) -> Iterator[dict[str, Any]]:
+    """Yield the events of a JSON Lines trace (a path, or a text stream)."""
+    if isinstance(source, (str, Path)):
+        with open(source, encoding="utf-8") as fh:
+            yield from read_trace(fh)
+        return
+    for line in source:
+        line = line.strip()
+        if line:
+            yield json.loads(line)
+
+
+def validate_event(ev: dict[str, Any]) -> None:
+    """Raise ValueError if ``ev`` does not follow :data:`SCHEMA`."""
+    if "t" not in ev or "kind" not in ev:
+        raise ValueError("event lacks t or kind")
+    fields = {k: v for k, v in ev.items() if k not in ("t", "kind")}
+    make_event(ev["kind"], ev["t"], **fields)
+
+
+__all__ = ["SCHEMA", "KINDS", "TraceWriter", "make_event", "read_trace", "validate_event",
+           "round_time"]
