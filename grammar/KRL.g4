@@ -101,10 +101,19 @@ dataItem
 
 // DECL is optional before the simple types and the predefined geometric structure types (2.5);
 // user-defined types need it.
+// A CONST must be initialised on the same line (2.5), except a CONST array, whose elements
+// are initialised on the following lines (ARR[1]=...).
 dataVariableDeclaration
-    : DECL GLOBAL? CONST? typeName variableName ('=' constantValue)?
-    | GLOBAL? CONST? simpleType variableName ('=' constantValue)?
-    | GLOBAL? CONST? geometricType variableName ('=' constantValue)?
+    : DECL GLOBAL? typeName variableName ('=' constantValue)?
+    | DECL GLOBAL? CONST typeName (variableName '=' constantValue | constantArrayName)
+    | GLOBAL? simpleType variableName ('=' constantValue)?
+    | GLOBAL? CONST simpleType (variableName '=' constantValue | constantArrayName)
+    | GLOBAL? geometricType variableName ('=' constantValue)?
+    | GLOBAL? CONST geometricType (variableName '=' constantValue | constantArrayName)
+    ;
+
+constantArrayName
+    : name arrayDimensions
     ;
 
 arrayElementInitialisation
@@ -440,8 +449,8 @@ contextKeyword
 
 // ======================================================================== lexer
 
-// Header lines (1.3): only the four documented kinds.
-HEADER : '&' ('ACCESS' | 'REL' | 'PARAM' | 'COMMENT') ~[\r\n]* ;
+// Header lines (1.3): the four documented kinds and &USER (owner tag of technology packages).
+HEADER : '&' ('ACCESS' | 'REL' | 'PARAM' | 'COMMENT' | 'USER') ~[\r\n]* ;
 
 // Folds and comments (1.3): structural comments on the hidden channel.
 FOLD    : ';' [ \t]* 'FOLD' ~[\r\n]*    -> channel(HIDDEN) ;
