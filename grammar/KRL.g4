@@ -318,9 +318,10 @@ priority
     | name
     ;
 
-// Path-synchronous actions (5.18).
+// Path-synchronous actions (5.18): DISTANCE is the start (0) or end (1) point of the motion.
 triggerStatement
-    : TRIGGER WHEN DISTANCE '=' INTLITERAL DELAY '=' expression DO triggerAction
+    : TRIGGER WHEN DISTANCE '=' point=INTLITERAL {$point.text in ("0", "1")}?<fail={"TRIGGER WHEN DISTANCE takes 0 or 1"}>
+      DELAY '=' expression DO triggerAction
       (PRIO '=' expression)?
     | TRIGGER WHEN PATH '=' expression ONSTART? DELAY '=' expression DO triggerAction
       (PRIO '=' expression)?
