@@ -336,19 +336,24 @@ triggerAction
 
 motion
     : PTP expression approximation? approximation?                                   # ptpMotion
-    | PTP_REL expression approximation? approximation? ENUMLITERAL?                  # ptpRelMotion
+    | PTP_REL expression approximation? approximation? relativeFrame?                # ptpRelMotion
     | LIN expression approximation? approximation?                                   # linMotion
-    | LIN_REL expression approximation? approximation? ENUMLITERAL?                  # linRelMotion
+    | LIN_REL expression approximation? approximation? relativeFrame?                # linRelMotion
     | CIRC expression ',' expression (',' CA expression)? approximation? approximation? # circMotion
     | CIRC_REL expression ',' expression (',' CA expression)? approximation?
-      ENUMLITERAL?                                                                   # circRelMotion
+      relativeFrame?                                                                 # circRelMotion
     | SPTP expression withClause? splineApproximation?                               # sptpMotion
     | SLIN expression withClause? splineApproximation?                               # slinMotion
     | SCIRC expression ',' expression (',' CA expression)? withClause? C_SPL?        # scircMotion
-    | SPTP_REL expression withClause? splineApproximation? ENUMLITERAL?              # sptpRelMotion
-    | SLIN_REL expression withClause? splineApproximation? ENUMLITERAL?              # slinRelMotion
+    | SPTP_REL expression withClause? splineApproximation? relativeFrame?            # sptpRelMotion
+    | SLIN_REL expression withClause? splineApproximation? relativeFrame?            # slinRelMotion
     | SCIRC_REL expression ',' expression (',' CA expression)? withClause? C_SPL?
-      ENUMLITERAL?                                                                   # scircRelMotion
+      relativeFrame?                                                                 # scircRelMotion
+    ;
+
+// The reference frame of a relative motion: #BASE (default) or #TOOL (6.1, 6.3).
+relativeFrame
+    : frame=ENUMLITERAL {$frame.text.upper() in ("#BASE", "#TOOL")}?<fail={"a relative motion takes #BASE or #TOOL"}>
     ;
 
 approximation
