@@ -200,8 +200,11 @@ enumDeclaration
     : GLOBAL? ENUM name (name | contextKeyword) (',' (name | contextKeyword))*
     ;
 
+// A system signal that is not wired is declared FALSE in KUKA's machine data
+// ($machine.dat: SIGNAL $MODE_TEST FALSE).
 signalDeclaration
     : GLOBAL? SIGNAL name signalReference (TO signalReference)?
+    | SIGNAL SYSNAME FALSE
     ;
 
 signalReference
