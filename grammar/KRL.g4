@@ -276,6 +276,7 @@ statement
     | CONTINUE                                                      # continueStatement
     | RETURN expression?                                            # returnStatement
     | ON_ERROR_PROCEED                                              # onErrorProceedStatement
+    | CONFIRM expression                                            # confirmStatement
     | GLOBAL? INTERRUPT DECL priority WHEN expression DO call       # interruptDeclaration
     | INTERRUPT action=(ON | OFF | ENABLE | DISABLE) priority?      # interruptControl
     | BRAKE                                                         # brakeStatement
@@ -495,6 +496,7 @@ CHANNEL : 'CHANNEL' ;
 CHAR : 'CHAR' ;
 CIRC : 'CIRC' ;
 CIRC_REL : 'CIRC_REL' ;
+CONFIRM : 'CONFIRM' ;
 CONST : 'CONST' ;
 CONST_VEL : 'CONST_VEL' ;
 CONTINUE : 'CONTINUE' ;
