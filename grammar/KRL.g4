@@ -103,12 +103,13 @@ dataItem
 // user-defined types need it.
 // A CONST must be initialised on the same line (2.5), except a CONST array, whose elements
 // are initialised on the following lines (ARR[1]=...).
+// Several names on one line only without initial values (3.2).
 dataVariableDeclaration
-    : DECL GLOBAL? typeName variableName ('=' constantValue)?
+    : DECL GLOBAL? typeName variableName ('=' constantValue | (',' variableName)*)
     | DECL GLOBAL? CONST typeName (variableName '=' constantValue | constantArrayName)
-    | GLOBAL? simpleType variableName ('=' constantValue)?
+    | GLOBAL? simpleType variableName ('=' constantValue | (',' variableName)*)
     | GLOBAL? CONST simpleType (variableName '=' constantValue | constantArrayName)
-    | GLOBAL? geometricType variableName ('=' constantValue)?
+    | GLOBAL? geometricType variableName ('=' constantValue | (',' variableName)*)
     | GLOBAL? CONST geometricType (variableName '=' constantValue | constantArrayName)
     ;
 
