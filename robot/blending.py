@@ -158,12 +158,13 @@ def weight(x: float) -> float:
     return smoothstep(x)
 
 
-def combine_pose(p0: np.ndarray, R0: Rotation, p1: np.ndarray, R1: Rotation,
-                 w: float) -> tuple[np.ndarray, Rotation]:
-    """Convex combination of two TCP poses: positions linearly, orientations by slerp."""
+def combine_pose(p0: np.ndarray, R0: np.ndarray, p1: np.ndarray, R1: np.ndarray,
+                 w: float) -> tuple[np.ndarray, np.ndarray]:
+    """Convex combination of two TCP poses (mm, 3x3 rotation matrices): positions
+    linearly, orientations by slerp ``R0 · exp(w · log(R0ᵀ R1))``."""
     p = (1.0 - w) * p0 + w * p1
-    rel = (R0.inv() * R1).as_rotvec()
-    return p, R0 * Rotation.from_rotvec(w * rel)
+    rel = Rotation.from_matrix(R0.T @ R1).as_rotvec()
+    return p, R0 @ Rotation.from_rotvec(w * rel).as_matrix()
 
 
 def combine_axes(q0: np.ndarray, q1: np.ndarray, w: float) -> np.ndarray:

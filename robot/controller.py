@@ -481,7 +481,7 @@ class Controller:
         if self.trace is not None:
             self.trace.write("motion", self.time, id=req.id, type=req.type_name,
                              target=dict(req.target), approximation=req.approx,
-                             phase=phase, line=req.line, file=req.file)
+                             phase=phase, point=seg.end_frame, line=req.line, file=req.file)
         for st in self.stimuli:
             if (not st.fired and st.due is None and st.phase == phase
                     and st.matches_motion(req.id, req.line)):
@@ -537,8 +537,7 @@ class Controller:
             fn(self)
         self._reach_stimuli()
         if self.trace is not None:
-            self.trace.write("pose", t, axes=[float(v) for v in qa],
-                             tcp=list(matrix_to_frame(self._tcp_T)))
+            self.trace.write_pose(t, qa, self._tcp_T)
         return self._events
 
     # ----------------------------------------------------------------- main run

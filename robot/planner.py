@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from scipy.spatial.transform import Rotation, Slerp
+from scipy.spatial.transform import Rotation
 
 from .errors import RobotError
 from .frames import frame_to_matrix, inv_pos, matrix_to_frame
@@ -198,6 +198,7 @@ class Segment:
         self.status = model.status_turn(q0)[0]
         self.triggers: list[TriggerPlan] = []
         self._last_q = q0.copy()
+        self._end_frame: list[float] | None = None
 
     def u(self, tau: float) -> float:
         return self.profile.u(tau)
@@ -206,17 +207,26 @@ class Segment:
     def axes(self, tau: float) -> np.ndarray:
         raise NotImplementedError
 
-    def pose(self, tau: float) -> tuple[np.ndarray, Rotation]:
-        """TCP position (mm) and orientation in $BASE at local time tau."""
+    def pose(self, tau: float) -> tuple[np.ndarray, np.ndarray]:
+        """TCP position (mm, (3,)) and rotation matrix (3, 3) in $BASE at local time tau."""
         raise NotImplementedError
 
-    def end_pose(self) -> tuple[np.ndarray, Rotation]:
-        T = self.model.tcp(self.q1, self.tool_T, self.base_inv_T)
-        return T[:3, 3].copy(), Rotation.from_matrix(T[:3, :3])
+    @property
+    def end_frame(self) -> list[float]:
+        """Programmed end point as (X, Y, Z, A, B, C) of the TCP in $BASE (mm, deg)."""
+        if self._end_frame is None:
+            self._end_frame = list(matrix_to_frame(self.model.tcp(self.q1, self.tool_T,
+                                                                  self.base_inv_T)))
+        return self._end_frame
 
-    def start_pose(self) -> tuple[np.ndarray, Rotation]:
+    def end_pose(self) -> tuple[np.ndarray, np.ndarray]:
+        """Programmed end point: TCP position (mm) and 3x3 rotation in $BASE."""
+        T = self.model.tcp(self.q1, self.tool_T, self.base_inv_T)
+        return T[:3, 3].copy(), T[:3, :3].copy()
+
+    def start_pose(self) -> tuple[np.ndarray, np.ndarray]:
         T = self.model.tcp(self.q0, self.tool_T, self.base_inv_T)
-        return T[:3, 3].copy(), Rotation.from_matrix(T[:3, :3])
+        return T[:3, 3].copy(), T[:3, :3].copy()
 
     def tcp_dist_to_end(self, u: float) -> float:
         """Euclidean TCP distance (mm) from the point at parameter u to the end point."""
@@ -247,11 +257,11 @@ class JointSegment(Segment):
     def axes(self, tau: float) -> np.ndarray:
         return self.axes_u(self.profile.u(tau))
 
-    def pose_u(self, u: float) -> tuple[np.ndarray, Rotation]:
+    def pose_u(self, u: float) -> tuple[np.ndarray, np.ndarray]:
         T = self.model.tcp(self.axes_u(u), self.tool_T, self.base_inv_T)
-        return T[:3, 3].copy(), Rotation.from_matrix(T[:3, :3])
+        return T[:3, 3].copy(), T[:3, :3].copy()
 
-    def pose(self, tau: float) -> tuple[np.ndarray, Rotation]:
+    def pose(self, tau: float) -> tuple[np.ndarray, np.ndarray]:
         return self.pose_u(self.profile.u(tau))
 
     def _table(self) -> tuple[np.ndarray, np.ndarray]:
@@ -301,12 +311,9 @@ class CartSegment(Segment):
         self.u_bounds = cw / W if W > 0 else np.linspace(0.0, 1.0, len(pieces) + 1)
         self.lengths = np.array([p.length for p in pieces])
         self.s_bounds = np.concatenate([[0.0], np.cumsum(self.lengths)])
-        self._slerps = []
-        for k, p in enumerate(pieces):
-            if ori[k] == "VAR":
-                self._slerps.append(Slerp([0.0, 1.0], Rotation.concatenate([rots[k], rots[k + 1]])))
-            else:
-                self._slerps.append(None)
+        # orientation of piece k at fraction f: R_k · exp(f · r_k) (= slerp, reference §6.7)
+        self._R = [r.as_matrix() for r in rots]
+        self._rv = [(rots[k].inv() * rots[k + 1]).as_rotvec() for k in range(len(pieces))]
 
     @property
     def path_length(self) -> float:
@@ -324,28 +331,34 @@ class CartSegment(Segment):
         du = ub[k + 1] - ub[k]
         return k, (u - ub[k]) / du if du > 0 else 1.0
 
-    def pose_u(self, u: float) -> tuple[np.ndarray, Rotation]:
+    def pose_u(self, u: float) -> tuple[np.ndarray, np.ndarray]:
+        """TCP position (mm, (3,)) and rotation matrix (3, 3) in $BASE at parameter u."""
         k, f = self._locate(u)
         piece = self.pieces[k]
         p = piece.pos(f * piece.length)
         mode = self.ori[k]
         if mode == "VAR":
-            R = self._slerps[k]([f])[0]
+            if f <= 0.0:
+                R = self._R[k]
+            elif f >= 1.0:
+                R = self._R[k + 1]
+            else:
+                R = self._R[k] @ Rotation.from_rotvec(f * self._rv[k]).as_matrix()
         elif mode == "PATH":
             assert isinstance(piece, ArcPiece)
-            R = Rotation.from_rotvec(piece.n * piece.phi(f * piece.length)) * self.rots[k]
+            R = Rotation.from_rotvec(piece.n * piece.phi(f * piece.length)).as_matrix() @ self._R[k]
         else:  # CONSTANT
-            R = self.rots[k]
+            R = self._R[k]
         return p, R
 
-    def pose(self, tau: float) -> tuple[np.ndarray, Rotation]:
+    def pose(self, tau: float) -> tuple[np.ndarray, np.ndarray]:
         return self.pose_u(self.profile.u(tau))
 
-    def ik(self, p: np.ndarray, R: Rotation, ref: np.ndarray) -> np.ndarray:
-        """Axes for a TCP pose in this segment's $BASE/$TOOL, start status S, turn nearest
-        to ``ref``. Raises WorkspaceError/SoftLimitError."""
+    def ik(self, p: np.ndarray, R: np.ndarray, ref: np.ndarray) -> np.ndarray:
+        """Axes for a TCP pose (position mm, 3x3 rotation) in this segment's $BASE/$TOOL,
+        start status S, turn nearest to ``ref``. Raises WorkspaceError/SoftLimitError."""
         T = np.eye(4)
-        T[:3, :3] = R.as_matrix()
+        T[:3, :3] = R
         T[:3, 3] = p
         return self.model.ik(T, self.tool_inv_T, self.base_T, self.status, None, ref)
 
@@ -379,7 +392,7 @@ class CartSegment(Segment):
     def ori_angle_to_end(self, u: float) -> float:
         """Remaining orientation change (deg) from parameter u to the end."""
         R = self.pose_u(u)[1]
-        return float(np.degrees((R.inv() * self.pose_u(1.0)[1]).magnitude()))
+        return float(np.degrees(Rotation.from_matrix(R.T @ self.pose_u(1.0)[1]).magnitude()))
 
     @property
     def ori_angle(self) -> float:

@@ -26,6 +26,7 @@ SCHEMA: dict[str, list[tuple[str, str]]] = {
         ("target", "dict: programmed target components as given (name -> number)"),
         ("approximation", "str or null: C_PTP, C_DIS, C_VEL, C_ORI, C_SPL or null (exact stop)"),
         ("phase", "str: start | blend_start | blend_end | end"),
+        ("point", "optional list[6] float: programmed end point, TCP X,Y,Z mm, A,B,C deg in $BASE"),
         ("line", "optional int: source line of the motion statement"),
         ("file", "optional str: source file of the motion statement"),
     ],
@@ -140,12 +141,25 @@ class TraceWriter:
         else:
             self._fh = target
         self.keep = keep
-        self.events: list[dict[str, Any]] = []
-        self.lines: list[str] = []
+        self._events: list[dict[str, Any]] = []
+        self._lines: list[str] = []
+        self._poses: list[tuple[float, Any, Any]] = []
         self._memory = target is None
         self.pose_every = max(1, int(pose_every))
         self._pose_count = 0
         self.closed = False
+
+    @property
+    def events(self) -> list[dict[str, Any]]:
+        """Events written so far (only with ``keep=True``)."""
+        self.flush()
+        return self._events
+
+    @property
+    def lines(self) -> list[str]:
+        """JSON lines written so far (memory mode only)."""
+        self.flush()
+        return self._lines
 
     def write(self, kind: str, t: float, **fields: Any) -> dict[str, Any]:
         """Validate, serialise and write one event; returns the event dict."""
@@ -153,17 +167,43 @@ class TraceWriter:
         self.write_event(ev)
         return ev
 
+    def write_pose(self, t: float, axes: Any, tcp_T: Any) -> None:
+        """Queue a ``pose`` event from axes (6, deg) and a 4x4 TCP matrix (mm). Poses are
+        converted to X, Y, Z, A, B, C in batches (vectorised, same numbers as
+        :func:`robot.frames.matrix_to_frame`) and written before the next other event."""
+        self._pose_count += 1
+        if (self._pose_count - 1) % self.pose_every:
+            return
+        self._poses.append((t, axes, tcp_T))
+        if len(self._poses) >= 512:
+            self.flush()
+
+    def flush(self) -> None:
+        """Write the queued pose events."""
+        if not self._poses:
+            return
+        poses, self._poses = self._poses, []
+        frames = _frames_of([T for _, _, T in poses])
+        for (t, axes, _), fr in zip(poses, frames):
+            self._emit({"t": round_time(t), "kind": "pose", "axes": _clean([float(v) for v in axes]),
+                        "tcp": _clean(fr)})
+
     def write_event(self, ev: dict[str, Any]) -> None:
         """Write an already built event dict (from :func:`make_event`)."""
+        if self._poses:
+            self.flush()
         if ev["kind"] == "pose":
             self._pose_count += 1
             if (self._pose_count - 1) % self.pose_every:
                 return
+        self._emit(ev)
+
+    def _emit(self, ev: dict[str, Any]) -> None:
         line = json.dumps(ev, separators=(",", ":"), ensure_ascii=True)
         if self.keep:
-            self.events.append(ev)
+            self._events.append(ev)
         if self._memory:
-            self.lines.append(line)
+            self._lines.append(line)
         elif self._fh is not None:
             self._fh.write(line)
             self._fh.write("\n")
@@ -173,6 +213,7 @@ class TraceWriter:
         return "".join(line + "\n" for line in self.lines)
 
     def close(self) -> None:
+        self.flush()
         if self._own and self._fh is not None and not self.closed:
             self._fh.close()
         self.closed = True
@@ -182,6 +223,39 @@ class TraceWriter:
 
     def __exit__(self, *exc: object) -> None:
         self.close()
+
+
+def _wrap180(v: Any) -> Any:
+    import numpy as np
+
+    w = -((-np.asarray(v, dtype=float) + 180.0) % 360.0) + 180.0
+    return np.where(np.abs(w) < 1e-12, 0.0, w)
+
+
+def _frames_of(Ts: list[Any]) -> list[list[float]]:
+    """Vectorised :func:`robot.frames.matrix_to_frame` for a list of 4x4 matrices."""
+    import warnings
+
+    import numpy as np
+    from scipy.spatial.transform import Rotation
+
+    from .frames import GIMBAL_TOL_DEG, matrix_to_frame
+
+    M = np.asarray(Ts, dtype=float)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", UserWarning)
+        abc = Rotation.from_matrix(M[:, :3, :3]).as_euler("ZYX", degrees=True)
+    a = _wrap180(abc[:, 0])
+    c = _wrap180(abc[:, 2])
+    out = []
+    for i in range(len(M)):
+        b = float(abc[i, 1])
+        if abs(abs(b) - 90.0) < GIMBAL_TOL_DEG:
+            out.append(list(matrix_to_frame(M[i])))
+        else:
+            out.append([float(M[i, 0, 3]), float(M[i, 1, 3]), float(M[i, 2, 3]),
+                        float(a[i]), b, float(c[i])])
+    return out
 
 
 def read_trace(source: str | Path | IO[str]) -> Iterator[dict[str, Any]]:
