@@ -290,6 +290,7 @@ statement
       (MINIMUM '=' expression)? (MAXIMUM '=' expression)?           # anoutOnStatement
     | ANOUT OFF name                                                # anoutOffStatement
     | motion                                                        # motionStatement
+    | MOVE_EMI variable STRINGLITERAL (name expression)?            # moveEmiStatement
     ;
 
 assignment
