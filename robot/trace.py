@@ -57,13 +57,20 @@ SCHEMA: dict[str, list[tuple[str, str]]] = {
         ("file", "optional str: source file"),
     ],
     "end": [
-        ("reason", "str: e.g. program_end, error, reset, max_time"),
+        ("reason", "str: e.g. program_end, error, reset, max_time; interpreters: completed, "
+                   "halt, error, deadlock, max_steps, max_sim_time"),
+        ("text", "optional str: detail (error message, the condition waited for)"),
+        ("number", "optional int: KSS message number of an error"),
+        ("file", "optional str: source file where the run ended"),
+        ("line", "optional int: source line where the run ended"),
+        ("context", "optional str: main | interrupt | trigger | submit"),
     ],
     # written by the interpreters (same writer)
     "stmt": [
         ("file", "str: source file"),
         ("line", "int: source line"),
         ("text", "optional str: statement summary"),
+        ("context", "optional str: main | interrupt | trigger | submit"),
     ],
     "call": [("name", "str: routine name"), ("line", "optional int")],
     "return": [("name", "str: routine name"), ("line", "optional int")],
@@ -71,6 +78,7 @@ SCHEMA: dict[str, list[tuple[str, str]]] = {
         ("prio", "int: interrupt number / priority"),
         ("name", "str: handler routine"),
         ("line", "optional int"),
+        ("phase", "optional str: entry | exit"),
     ],
 }
 
