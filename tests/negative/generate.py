@@ -462,7 +462,7 @@ MUTATIONS: list[Mutation] = [
     M("irq_decl_no_when", "INTERRUPT DECL without WHEN", "5.16", "irq", ("DECL 21 WHEN $IN[12]", "DECL 21 $IN[12]")),
     M("irq_decl_no_do", "INTERRUPT DECL without DO", "5.16", "irq", ("$IN[12] DO Touch( )", "$IN[12] Touch( )")),
     M("irq_decl_no_prio", "INTERRUPT DECL without a priority", "5.16", "irq", ("DECL 21 WHEN", "DECL WHEN")),
-    M("irq_no_parens", "interrupt routine called without parentheses", "5.16", "irq", ("DO Touch( )", "DO Touch")),
+    M("irq_then_not_do", "INTERRUPT DECL ... THEN instead of DO", "5.16", "irq", ("$IN[12] DO Touch( )", "$IN[12] THEN Touch( )")),
     M("irq_decl_assign", "INTERRUPT DECL with an assignment as handler", "5.16", "irq", ("DO Touch( )", "DO $OUT[3] = TRUE")),
     M("irq_bad_action", "INTERRUPT START (unknown action)", "5.16", "irq", ("  INTERRUPT ON 21\n", "  INTERRUPT START 21\n")),
     M("irq_two_numbers", "INTERRUPT ON with two numbers", "5.16", "irq", ("  INTERRUPT ON 21\n", "  INTERRUPT ON 21 22\n")),
