@@ -1,0 +1,286 @@
+"""The controller protocol: advance run queue, triggers, BRAKE, WAIT, I/O, stimuli, errors
+(reference §5.8, §5.12-§5.18, §6.10)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from robot.bench import run_motions
+from robot.controller import Controller, ErrorEvent, TriggerEvent
+from robot.errors import RobotError, WorkspaceError
+from robot.motion import MotionParams, MotionRequest, Trigger
+from robot.stimuli import parse_stimuli
+from robot.trace import TraceWriter
+
+DT = 0.012
+TOOL_DOWN = {"A1": 0, "A2": -90, "A3": 90, "A4": 0, "A5": 90, "A6": 0}
+HOME = {"A1": 0, "A2": -90, "A3": 90, "A4": 0, "A5": 0, "A6": 0}
+
+
+def _ctl(**kw):
+    tw = TraceWriter(keep=True)
+    return Controller(trace=tw, mujoco=False, **kw), tw
+
+
+def _phases(events, mid):
+    return {e["phase"]: e["t"] for e in events if e["kind"] == "motion" and e["id"] == mid}
+
+
+def _trig_times(events):
+    return [(e["id"], e["index"], e["t"]) for e in events if e["kind"] == "trigger"]
+
+
+# ------------------------------------------------------------------ advance run
+def test_queue_blocks_at_advance():
+    ctl, _ = _ctl()
+    ctl.advance = 2
+    P = MotionParams()
+    ctl.enqueue(MotionRequest("PTP", HOME, P))
+    assert ctl.can_enqueue()
+    ctl.enqueue(MotionRequest("PTP", {"A1": 30}, P))
+    assert not ctl.can_enqueue()  # two motions wait: the advance run blocks
+    ctl.step()  # the main run takes motion 1
+    assert ctl.can_enqueue()
+    ctl.enqueue(MotionRequest("PTP", {"A1": -30}, P))
+    assert not ctl.can_enqueue()
+    assert not ctl.is_idle()
+    ctl.wait_idle()
+    assert ctl.is_idle() and ctl.can_enqueue()
+
+
+def test_advance_zero_only_when_idle():
+    ctl, _ = _ctl()
+    ctl.advance = 0
+    ctl.enqueue(MotionRequest("PTP", HOME, MotionParams()))
+    assert not ctl.can_enqueue()
+    ctl.wait_idle()
+    assert ctl.can_enqueue()
+
+
+def test_wait_sec_runs_on_simulated_time():
+    ctl, _ = _ctl()
+    assert ctl.cycles_for(0.012) == 1
+    assert ctl.cycles_for(0) == 0
+    ctl.wait_sec(0.5)
+    assert ctl.cycle == 42  # ceil(0.5 / 0.012)
+    assert ctl.time == pytest.approx(0.504)
+
+
+# ------------------------------------------------------------------ triggers
+def _lin_with(triggers, v=0.25, approx=None, extra=()):
+    P = MotionParams().with_(vel_cp=v)
+    return [MotionRequest("PTP", TOOL_DOWN, P),
+            MotionRequest("LIN", {"X": 445, "Y": 300, "Z": 810}, P, approx=approx,
+                          triggers=tuple(triggers)), *extra]
+
+
+def test_trigger_distance0_delay20_fires_20ms_after_start():
+    ctl, tw = _ctl()
+    events = run_motions(ctl, _lin_with([Trigger(distance=0, delay_ms=20, action="A")]))
+    ph = _phases(tw.events, 2)
+    (mid, idx, t), = _trig_times(tw.events)
+    assert mid == 2 and idx == 0
+    assert abs((t - ph["start"]) - 0.020) <= DT + 1e-9
+    te = [e for e in events if isinstance(e, TriggerEvent)]
+    assert te[0].trigger.action == "A"
+
+
+def test_trigger_distance1_at_end_and_negative_delay():
+    ctl, tw = _ctl()
+    run_motions(ctl, _lin_with([Trigger(distance=1, delay_ms=0),
+                                Trigger(distance=1, delay_ms=-100)]))
+    ph = _phases(tw.events, 2)
+    times = {idx: t for _, idx, t in _trig_times(tw.events)}
+    assert times[0] == pytest.approx(ph["end"], abs=1e-9)
+    assert abs((ph["end"] - times[1]) - 0.100) <= DT + 1e-9
+
+
+def test_trigger_distance1_in_blend_middle():
+    P = MotionParams().with_(vel_cp=0.25, apo_cdis=30.0)
+    nxt = (MotionRequest("LIN", {"X": 600, "Y": 300, "Z": 810}, P),)
+    ctl, tw = _ctl()
+    run_motions(ctl, _lin_with([Trigger(distance=1, delay_ms=0)], approx="C_DIS", extra=nxt))
+    ph = _phases(tw.events, 2)
+    (_, _, t), = _trig_times(tw.events)
+    mid = 0.5 * (ph["blend_start"] + ph["blend_end"])
+    assert abs(t - mid) <= DT + 1e-9
+
+
+def test_trigger_path_before_end_and_onstart():
+    """PATH=-50: 50 mm before the end point; PATH=30 ONSTART: 30 mm after the start."""
+    ctl, tw = _ctl()
+    run_motions(ctl, _lin_with([Trigger(path_mm=-50.0), Trigger(path_mm=30.0, onstart=True)]))
+    times = {idx: t for _, idx, t in _trig_times(tw.events)}
+    poses = {round(e["t"], 6): e["tcp"] for e in tw.events if e["kind"] == "pose"}
+    step = 0.25 * 1000 * DT  # 3 mm per cycle at cruise speed
+    y_end = poses[round(times[0], 6)][1]
+    assert 250.0 <= y_end <= 250.0 + step + 1e-6
+    y_start = poses[round(times[1], 6)][1]
+    assert 30.0 <= y_start <= 30.0 + step + 1e-6
+
+
+def test_trigger_path_not_for_ptp():
+    ctl, _ = _ctl()
+    ctl.enqueue(MotionRequest("PTP", HOME, MotionParams()))
+    with pytest.raises(RobotError):
+        ctl.enqueue(MotionRequest("PTP", {"A1": 10}, MotionParams(),
+                                  triggers=(Trigger(path_mm=-5.0),)))
+
+
+def test_pending_trigger_keeps_controller_busy():
+    """A positive DELAY after an exact stop still fires; is_idle waits for it."""
+    ctl, tw = _ctl()
+    run_motions(ctl, _lin_with([Trigger(distance=1, delay_ms=200)]))
+    ph = _phases(tw.events, 2)
+    (_, _, t), = _trig_times(tw.events)
+    assert abs(t - ph["end"] - 0.2) <= DT + 1e-9
+
+
+# ------------------------------------------------------------------ BRAKE
+def _brake_run(fast):
+    P = MotionParams().with_(vel_cp=1.0)
+    ctl, tw = _ctl()
+    ctl.enqueue(MotionRequest("PTP", TOOL_DOWN, P))
+    ctl.enqueue(MotionRequest("LIN", {"X": 445, "Y": 400, "Z": 600}, P))
+    while not ctl.time >= 1.0:
+        ctl.step()
+    p0 = ctl.pos_act()
+    t0 = ctl.time
+    ctl.brake(fast)
+    ctl.step_until(lambda: not ctl.is_braking())
+    p1 = ctl.pos_act()
+    return ctl, tw, t0, p0, p1
+
+
+def test_brake_f_stops_harder_than_brake_and_on_path():
+    c1, tw1, t01, a1, b1 = _brake_run(False)
+    c2, tw2, t02, a2, b2 = _brake_run(True)
+    d_normal = np.hypot(b1["Y"] - a1["Y"], b1["Z"] - a1["Z"])
+    d_fast = np.hypot(b2["Y"] - a2["Y"], b2["Z"] - a2["Z"])
+    assert d_fast < d_normal
+    assert (c2.time - t02) < (c1.time - t01)
+    # stands still and stays on the straight line (445, 0, 810) -> (445, 400, 600)
+    for tw in (tw1, tw2):
+        a, b = np.array([445.0, 0, 810]), np.array([445.0, 400, 600])
+        d = (b - a) / np.linalg.norm(b - a)
+        for e in tw.events:
+            if e["kind"] == "pose" and e["t"] > 0.3:
+                v = np.array(e["tcp"][:3]) - a
+                assert np.linalg.norm(v - (v @ d) * d) < 0.01
+    assert c1.is_idle()  # the braked motion is suspended (interrupt level)
+
+
+def test_brake_then_release_continues_to_the_end():
+    ctl, tw, *_ = _brake_run(False)
+    ctl.wait_sec(0.1)
+    ctl.release()
+    assert not ctl.is_idle()
+    ctl.wait_idle()
+    p = ctl.pos_act()
+    assert (p["X"], p["Y"], p["Z"]) == pytest.approx((445, 400, 600), abs=1e-6)
+    assert [e["phase"] for e in tw.events if e["kind"] == "motion" and e["id"] == 2][-1] == "end"
+
+
+def test_brake_then_resume_discards_motions():
+    ctl, tw, _, _, stop = _brake_run(True)
+    ctl.cancel_pending()
+    assert ctl.is_idle()
+    ctl.enqueue(MotionRequest("LIN_REL", {"Z": 50}, MotionParams()))
+    ctl.wait_idle()
+    p = ctl.pos_act()
+    assert p["Z"] == pytest.approx(stop["Z"] + 50, abs=1e-6)
+    assert p["Y"] == pytest.approx(stop["Y"], abs=1e-6)
+
+
+def test_motion_in_interrupt_after_brake_then_release_replans():
+    ctl, tw, _, _, stop = _brake_run(False)
+    ctl.enqueue(MotionRequest("LIN_REL", {"X": 30}, MotionParams()))
+    ctl.wait_idle()
+    ctl.release()
+    ctl.wait_idle()
+    p = ctl.pos_act()
+    assert (p["X"], p["Y"], p["Z"]) == pytest.approx((445, 400, 600), abs=1e-6)
+
+
+# ------------------------------------------------------------------ I/O
+def test_outputs_pulse_and_timers_logged():
+    ctl, tw = _ctl()
+    ctl.set_out(3, True)
+    ctl.set_out(3, True)  # no change, no event
+    ctl.pulse(4, True, 0.1)
+    ctl.io.set_timer_stop(1, False)
+    ctl.wait_sec(0.2)
+    ios = [(e["signal"], e["value"]) for e in tw.events if e["kind"] == "io"]
+    assert ios == [("$OUT[3]", True), ("$OUT[4]", True), ("$OUT[4]", False)]
+    off = [e["t"] for e in tw.events if e["kind"] == "io" and e["value"] is False][0]
+    assert off == pytest.approx(0.108)  # first IPO cycle at or after 0.1 s
+    assert ctl.io.get_timer(1) == 17 * 12
+    assert ctl.get_in(1025) is True
+
+
+def test_stimuli_at_time_and_on_motion():
+    stim = parse_stimuli({"stimuli": [
+        {"at": 0.05, "set": {"$IN[3]": True}},
+        {"when": {"motion": 2, "phase": "start"}, "set": {"$IN[4]": True}, "delay": 0.024},
+        {"when": {"motion": 2, "reached": 5.0}, "set": {"$ANIN[1]": 0.5}},
+    ]})
+    tw = TraceWriter(keep=True)
+    ctl = Controller(trace=tw, mujoco=False, stimuli=stim)
+    run_motions(ctl, _lin_with([]))
+    ev = {e["signal"]: e["t"] for e in tw.events if e["kind"] == "io"}
+    assert ev["$IN[3]"] == pytest.approx(0.06)
+    ph = _phases(tw.events, 2)
+    assert ev["$IN[4]"] == pytest.approx(ph["start"] + 0.024)
+    assert ph["start"] < ev["$ANIN[1]"] <= ph["end"]
+    assert ctl.io.get_anin(1) == 0.5
+    y_at = [e["tcp"][1] for e in tw.events if e["kind"] == "pose" and abs(e["t"] - ev["$ANIN[1]"]) < 1e-9][0]
+    assert y_at >= 295.0
+
+
+def test_stimuli_from_yaml_file(tmp_path):
+    f = tmp_path / "s.yaml"
+    f.write_text("stimuli:\n  - at: 0.024\n    set: {\"$IN[7]\": true}\n")
+    ctl = Controller(mujoco=False, stimuli=str(f))
+    ctl.step()
+    assert not ctl.get_in(7)
+    ctl.step()
+    assert ctl.get_in(7)
+
+
+# ------------------------------------------------------------------ errors, read-back
+def test_error_in_main_run_stops_and_reports(monkeypatch):
+    ctl, tw = _ctl()
+    P = MotionParams().with_(vel_cp=0.5)
+    ctl.enqueue(MotionRequest("PTP", TOOL_DOWN, P))
+    ctl.enqueue(MotionRequest("LIN", {"Y": 200}, P))
+    ctl.enqueue(MotionRequest("LIN", {"Y": 0}, P))
+    seg = ctl._pending[1]
+    calls = {"n": 0}
+    orig = seg.ik
+
+    def failing(p, R, ref):
+        calls["n"] += 1
+        if calls["n"] > 10:
+            raise WorkspaceError("workspace error: target not reachable")
+        return orig(p, R, ref)
+
+    monkeypatch.setattr(seg, "ik", failing)
+    events = ctl.wait_idle()
+    errs = [e for e in events if isinstance(e, ErrorEvent)]
+    assert len(errs) == 1 and errs[0].id == 2
+    assert ctl.is_idle() and ctl.queue_length() == 0
+    assert [e["text"] for e in tw.events if e["kind"] == "error"] == ["workspace error: target not reachable"]
+
+
+def test_axis_act_and_pos_act_from_mujoco():
+    ctl = Controller()
+    run_motions(ctl, [MotionRequest("PTP", TOOL_DOWN, MotionParams())])
+    assert list(ctl.axis_act()) == pytest.approx([0, -90, 90, 0, 90, 0], abs=1e-9)
+    p = ctl.pos_act()
+    assert (p["X"], p["Y"], p["Z"]) == pytest.approx((445, 0, 810), abs=1e-6)
+    p_tool = ctl.pos_act(tool=(0, 0, 225, 0, 0, 0), base=(500, 0, 0, 90, 0, 0))
+    # robot-model.md §7 worked example: {X 0, Y 55, Z 585, A 90, B 0, C 180}
+    assert (p_tool["X"], p_tool["Y"], p_tool["Z"]) == pytest.approx((0, 55, 585), abs=1e-6)
+    ctl.step()  # one cycle at rest
+    assert ctl.vel_act() == pytest.approx(0.0, abs=1e-9)

@@ -1,0 +1,89 @@
+"""The JSON Lines trace: schema, rounding, determinism (issue 5, "Trace")."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from robot.bench import bench_program, run_motions
+from robot.controller import Controller
+from robot.motion import MotionParams, MotionRequest, Trigger
+from robot.stimuli import parse_stimuli
+from robot.trace import KINDS, SCHEMA, TraceWriter, make_event, read_trace, validate_event
+
+
+def test_schema_has_the_issue_kinds():
+    for k in ("motion", "io", "pose", "message", "error", "end", "stmt", "call", "return",
+              "interrupt"):
+        assert k in KINDS
+    assert [f for f, _ in SCHEMA["motion"]][:5] == ["id", "type", "target", "approximation", "phase"]
+
+
+def test_make_event_checks_fields_and_rounds():
+    ev = make_event("io", 1.0000004, signal="$OUT[1]", value=True)
+    assert ev == {"t": 1.0, "kind": "io", "signal": "$OUT[1]", "value": True}
+    assert make_event("end", -0.0000001, reason="x")["t"] == 0.0
+    with pytest.raises(ValueError):
+        make_event("nope", 0.0)
+    with pytest.raises(ValueError):
+        make_event("io", 0.0, signal="$OUT[1]")
+    with pytest.raises(ValueError):
+        make_event("end", 0.0, reason="x", extra=1)
+    ev = make_event("pose", 0.012, axes=[-0.0, 1e-9, 1.23456789, 0, 0, 0], tcp=[0.0] * 6)
+    assert ev["axes"][:3] == [0.0, 0.0, 1.234568]
+
+
+def _program_trace(path=None):
+    tw = TraceWriter(path) if path else TraceWriter()
+    stim = parse_stimuli([{"at": 0.5, "set": {"$IN[2]": True}}])
+    ctl = Controller(trace=tw, stimuli=stim)
+    reqs = bench_program(ctl.machine)[:5]
+    reqs[1].triggers = (Trigger(distance=0, delay_ms=20),)
+    for ev in run_motions(ctl, reqs):
+        if ev.kind == "trigger":
+            ctl.set_out(5, True, "trigger")
+    ctl.finish()
+    tw.close()
+    return tw
+
+
+def test_deterministic_bit_for_bit(tmp_path):
+    a = _program_trace().text()
+    b = _program_trace().text()
+    assert a == b
+    _program_trace(tmp_path / "t.jsonl")
+    assert (tmp_path / "t.jsonl").read_text() == a
+
+
+def test_trace_events_valid_and_ordered(tmp_path):
+    p = tmp_path / "t.jsonl"
+    _program_trace(p)
+    events = list(read_trace(p))
+    kinds = {e["kind"] for e in events}
+    assert {"motion", "pose", "io", "trigger", "end"} <= kinds
+    for e in events:
+        validate_event(e)
+    ts = [e["t"] for e in events]
+    assert ts == sorted(ts)
+    assert events[-1]["kind"] == "end" and events[-1]["reason"] == "program_end"
+    # one pose per IPO cycle
+    poses = [e["t"] for e in events if e["kind"] == "pose"]
+    assert all(abs((b - a) - 0.012) < 1e-9 for a, b in zip(poses, poses[1:]))
+    # times are rounded to the µs
+    for line in p.read_text().splitlines():
+        t = json.loads(line)["t"]
+        assert round(t, 6) == t
+
+
+def test_interpreter_events_through_same_writer():
+    tw = TraceWriter(keep=True)
+    ctl = Controller(trace=tw, mujoco=False)
+    tw.write("stmt", ctl.time, file="a.src", line=3)
+    ctl.enqueue(MotionRequest("PTP", {"A1": 0, "A2": -90, "A3": 90, "A4": 0, "A5": 0, "A6": 0},
+                              MotionParams(), line=3, file="a.src"))
+    ctl.step()
+    tw.write("call", ctl.time, name="FOO")
+    kinds = [e["kind"] for e in tw.events]
+    # a zero-length PTP starts and ends in the same IPO cycle
+    assert kinds == ["stmt", "motion", "motion", "pose", "call"]
