@@ -290,6 +290,7 @@ statement
       (MINIMUM '=' expression)? (MAXIMUM '=' expression)?           # anoutOnStatement
     | ANOUT OFF name                                                # anoutOffStatement
     | motion                                                        # motionStatement
+    | splineBlock                                                   # splineBlockStatement
     | MOVE_EMI variable STRINGLITERAL (name expression)?            # moveEmiStatement
     ;
 
@@ -360,6 +361,31 @@ motion
 // The reference frame of a relative motion: #BASE (default) or #TOOL (6.1, 6.3).
 relativeFrame
     : frame=ENUMLITERAL {$frame.text.upper() in ("#BASE", "#TOOL")}?<fail={"a relative motion takes #BASE or #TOOL"}>
+    ;
+
+// Spline blocks (6.2): one motion through all segments; inside only segments, TRIGGERs,
+// blank and comment lines.
+splineBlock
+    : SPLINE withClause? NEWLINE splineBlockLine* ENDSPLINE C_SPL?          # cartesianSplineBlock
+    | PTP_SPLINE withClause? NEWLINE ptpSplineBlockLine* ENDSPLINE C_SPL?   # ptpSplineBlock
+    ;
+
+splineBlockLine
+    : (splineSegment | triggerStatement)? NEWLINE
+    ;
+
+splineSegment
+    : SPL expression withClause?                                            # splSegment
+    | SLIN expression withClause?                                           # slinSegment
+    | SCIRC expression ',' expression (',' CA expression)? withClause?      # scircSegment
+    ;
+
+ptpSplineBlockLine
+    : (ptpSplineSegment | triggerStatement)? NEWLINE
+    ;
+
+ptpSplineSegment
+    : SPTP expression withClause?
     ;
 
 approximation
