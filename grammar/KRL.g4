@@ -291,6 +291,7 @@ statement
     | ANOUT OFF name                                                # anoutOffStatement
     | motion                                                        # motionStatement
     | splineBlock                                                   # splineBlockStatement
+    | ASYPTP expression                                             # asyptpStatement
     | MOVE_EMI variable STRINGLITERAL (name expression)?            # moveEmiStatement
     ;
 
