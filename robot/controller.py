@@ -458,6 +458,11 @@ class Controller:
         """``$VEL_ACT``: TCP speed in m/s over the last IPO cycle."""
         return float(np.linalg.norm(self._tcp_T[:3, 3] - self._tcp_prev)) / self.dt / 1000.0
 
+    def current_request(self) -> MotionRequest | None:
+        """The motion the main run executes now (the newer one during a blend), or None:
+        the source of the ``_C`` variables (``$VEL_C``, ``$TOOL_C``, ...) and ``$POS_FOR``."""
+        return self._runs[-1].seg.req if self._runs else None
+
     def planned_axes(self) -> np.ndarray:
         """End point (deg) of the last planned motion (the start of the next one)."""
         return self._plan_q.copy()
