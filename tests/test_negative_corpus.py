@@ -17,20 +17,6 @@ NEGATIVE_DIR = Path(__file__).resolve().parent / "negative"
 NEGATIVE_FILES = sorted(p for p in NEGATIVE_DIR.iterdir()
                         if p.name.startswith("neg_") and p.suffix.lower() in (".src", ".dat", ".sub"))
 
-# Invalid programs that the grammar wrongly accepts: grammar bugs, reported and awaiting a grammar
-# fix. They are xfail (not strict, because the grammar is edited concurrently); once the grammar
-# rejects one of them, remove it from this list so that it is enforced again.
-KNOWN_GRAMMAR_BUGS: dict[str, str] = {
-    # "neg_NNN_name.src": "why it is invalid (reference section)",
-}
-
-
-def _param(path: Path):
-    reason = KNOWN_GRAMMAR_BUGS.get(path.name)
-    marks = [pytest.mark.xfail(reason=f"grammar bug: {reason}", strict=False)] if reason else []
-    return pytest.param(path, id=path.name, marks=marks)
-
-
 def test_at_least_150_negative_programs():
     assert len(NEGATIVE_FILES) >= 150
 
@@ -53,7 +39,7 @@ def test_generated_files_are_up_to_date():
         assert (NEGATIVE_DIR / name).read_text(encoding="utf-8") == text, name
 
 
-@pytest.mark.parametrize("path", [_param(p) for p in NEGATIVE_FILES])
+@pytest.mark.parametrize("path", NEGATIVE_FILES, ids=[p.name for p in NEGATIVE_FILES])
 def test_negative_program_is_rejected(path: Path):
     result = parse_file(path, keep_tree=False)
     assert result.ok is False, f"{path.name}: invalid program accepted by the grammar"
