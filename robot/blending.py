@@ -146,9 +146,10 @@ def blend_end_tau(prev: Segment, nxt: Segment, keyword: str, tau_start: float) -
 
 def blend_space(prev: Segment, nxt: Segment) -> str:
     """``"cart"`` when both segments are CP motions (combined in Cartesian space with the
-    same $TOOL/$BASE), else ``"joint"``."""
+    same $TOOL/$BASE, neither with ``$ORI_TYPE #JOINT``), else ``"joint"``."""
     if prev.cart and nxt.cart and np.allclose(prev.tool_T, nxt.tool_T) and \
-            np.allclose(prev.base_T, nxt.base_T):
+            np.allclose(prev.base_T, nxt.base_T) and \
+            not getattr(prev, "joint_ori", False) and not getattr(nxt, "joint_ori", False):
         return "cart"
     return "joint"
 

@@ -24,7 +24,7 @@ from typing import Any
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from .errors import RobotError
+from .errors import RobotError, WorkspaceError
 from .frames import frame_to_matrix, inv_pos, matrix_to_frame
 from .kinematics import Kinematics
 from .motion import AXIS_KEYS, CART_KEYS, MotionParams, MotionRequest, SplineSegment, Trigger
@@ -65,6 +65,40 @@ class RobotModel:
 
     def status_turn(self, q: np.ndarray) -> tuple[int, int]:
         return self.kin.status_turn(q)
+
+    def tcp_pos_many(self, Q: np.ndarray, tool_T: np.ndarray, base_inv_T: np.ndarray) -> np.ndarray:
+        """TCP positions (n, 3) in $BASE for axis rows Q (n, 6)."""
+        F = self.kin.forward_many(Q)
+        if not self._robroot_is_null:
+            F = self.robroot_T @ F
+        T = base_inv_T @ F @ tool_T
+        return T[:, :3, 3]
+
+    def solve_position(self, p: np.ndarray, wrist: np.ndarray, ref: np.ndarray,
+                       tool_T: np.ndarray, base_inv_T: np.ndarray) -> np.ndarray:
+        """Axes whose TCP is at ``p`` (mm, in $BASE) with the wrist axes A4..A6 fixed to
+        ``wrist`` (deg): Newton iteration on A1..A3 from ``ref`` (``$ORI_TYPE #JOINT``).
+        Raises WorkspaceError when it does not converge, SoftLimitError outside the limits."""
+        q = np.array(ref, dtype=float)
+        q[3:6] = wrist
+        h = 1e-5
+        for _ in range(20):
+            Q = np.repeat(q[None, :], 4, axis=0)
+            Q[1, 0] += h
+            Q[2, 1] += h
+            Q[3, 2] += h
+            P = self.tcp_pos_many(Q, tool_T, base_inv_T)
+            r = P[0] - p
+            if float(np.linalg.norm(r)) < 1e-7:
+                self.kin.check_soft_limits(q)
+                return q
+            J = (P[1:] - P[0]).T / h
+            try:
+                dx = np.linalg.solve(J, -r)
+            except np.linalg.LinAlgError:
+                break
+            q[:3] += np.clip(dx, -20.0, 20.0)
+        raise WorkspaceError("workspace error: target not reachable ($ORI_TYPE #JOINT)")
 
 
 # ------------------------------------------------------------------------- path pieces
@@ -307,6 +341,7 @@ class CartSegment(Segment):
         self.ori = ori
         W = float(sum(weights))
         self.W = W
+        self.joint_ori = req.params.ori_type == "JOINT" and req.kind != "SPLINE"
         cw = np.concatenate([[0.0], np.cumsum(weights)])
         self.u_bounds = cw / W if W > 0 else np.linspace(0.0, 1.0, len(pieces) + 1)
         self.lengths = np.array([p.length for p in pieces])
@@ -366,6 +401,14 @@ class CartSegment(Segment):
         if tau >= self.T:
             self._last_q = self.q1.copy()
             return self.q1.copy()
+        if self.joint_ori:
+            # $ORI_TYPE #JOINT: wrist axes linear in u, TCP on the path (reference §6.7)
+            u = self.profile.u(tau)
+            p = self.pose_u(u)[0]
+            wrist = self.q0[3:6] + u * (self.q1[3:6] - self.q0[3:6])
+            q = self.model.solve_position(p, wrist, self._last_q, self.tool_T, self.base_inv_T)
+            self._last_q = q
+            return q
         p, R = self.pose(tau)
         q = self.ik(p, R, self._last_q)
         self._last_q = q
@@ -513,7 +556,7 @@ def _orientation_modes(p: MotionParams, kind: str) -> str:
         return "CONSTANT"
     if kind in ("CIRC", "SCIRC") and p.circ_type == "PATH":
         return "PATH"
-    return "VAR"  # #JOINT is planned like #VAR (documented simplification)
+    return "VAR"  # #JOINT: pose_u interpolates like #VAR; axes() moves the wrist axes linearly
 
 
 def _plan_cart(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_T: np.ndarray,

@@ -160,3 +160,22 @@ def test_lin_to_ptp_mixed_blend_runs():
         assert {"start", "blend_start", "blend_end", "end"} <= set(_phases(ev, mid))
     assert not [e for e in ev if e["kind"] in ("message", "error")]
     assert ctl.pos_act()["X"] == pytest.approx(400, abs=1e-6)
+
+
+def test_c_ori_blend_starts_at_remaining_orientation():
+    """C_ORI 10°: the blend starts when the remaining orientation change is 10° or less."""
+    from robot.frames import frame_to_matrix, rotation_angle_deg
+
+    P = MotionParams().with_(vel_cp=0.5, apo_cori=10.0)
+    goal = (180.0 - 60.0, 0.0, 180.0)  # 60° about Z from the tool-down orientation
+    ctl, ev = _run([MotionRequest("PTP", TOOL_DOWN, P),
+                    MotionRequest("LIN", dict(zip("XYZABC", P1 + goal)), P, approx="C_ORI"),
+                    MotionRequest("LIN", dict(zip("XYZ", P2)), P)])
+    ph = _phases(ev, 2)
+    R_goal = frame_to_matrix(0, 0, 0, *goal)
+
+    def remaining(t):
+        return rotation_angle_deg(frame_to_matrix(0, 0, 0, *_pose_at(ev, t)["tcp"][3:]), R_goal)
+
+    assert remaining(ph["blend_start"]) <= 10.0 + 1e-6
+    assert remaining(ph["blend_start"] - DT) > 10.0

@@ -189,3 +189,25 @@ def test_rotation_helper_consistency():
     R1 = Rotation.from_matrix(frame_to_matrix(0, 0, 0, 120, 20, 160)[:3, :3])
     mid = Slerp([0, 1], Rotation.concatenate([R0, R1]))([0.5])[0].as_matrix()
     assert np.allclose(seg.pose_u(0.5)[1], mid, atol=1e-12)
+
+
+def test_lin_ori_joint_moves_wrist_axes_linearly_on_a_straight_path():
+    P = MotionParams().with_(vel_cp=0.5, ori_type="#JOINT")
+    start = (445.0, 0.0, 810.0)
+    end = (550.0, 150.0, 650.0)
+    ctl, ev = _run([MotionRequest("PTP", TOOL_DOWN, P),
+                    MotionRequest("LIN", {"X": end[0], "Y": end[1], "Z": end[2], "A": 140,
+                                          "B": 15, "C": 165}, P)])
+    ph = _phases(ev, 2)
+    poses = _poses(ev, ph["start"], ph["end"])
+    assert max(_dist_to_line(e["tcp"][:3], start, end) for e in poses) < 0.01
+    q0 = np.array(poses[0]["axes"])
+    q1 = np.array(poses[-1]["axes"])
+    L = np.linalg.norm(np.subtract(end, start))
+    for e in poses:
+        s = np.linalg.norm(np.subtract(e["tcp"][:3], start)) / L  # path fraction
+        for i in (3, 4, 5):
+            if abs(q1[i] - q0[i]) > 1.0:
+                assert (e["axes"][i] - q0[i]) / (q1[i] - q0[i]) == pytest.approx(s, abs=1e-6)
+    R = frame_to_matrix(*poses[-1]["tcp"])[:3, :3]
+    assert np.allclose(R, frame_to_matrix(0, 0, 0, 140, 15, 165)[:3, :3], atol=1e-9)
