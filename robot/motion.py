@@ -109,6 +109,52 @@ class MotionParams:
             tool=tool if tool is not None else NULLFRAME,
         )
 
+    @staticmethod
+    def from_sysvars(values: Any, default: "MotionParams | None" = None) -> "MotionParams":
+        """Build a snapshot from KRL system-variable values (reference §6.10, §7.3).
+
+        ``values`` maps names (case-insensitive, ``$`` optional) to values: ``$VEL`` and
+        ``$ACC`` as mappings with CP/ORI1/ORI2, ``$VEL_AXIS``/``$ACC_AXIS`` as 6-sequences
+        (or mappings 1..6), ``$APO`` as a mapping with CVEL/CPTP/CDIS/CORI, ``$TOOL``/
+        ``$BASE`` as mappings X..C or 6-sequences, ``$ORI_TYPE``/``$CIRC_TYPE``/``$IPO_MODE``
+        as enum names, ``$OV_PRO`` as a number. Missing names (or missing components) keep
+        the values of ``default`` (INITMOV values if None)."""
+        d = default or MotionParams()
+        v = {str(k).upper().lstrip("$"): x for k, x in dict(values).items()}
+
+        def comp(m: Any, key: str, old: float) -> float:
+            if m is None:
+                return old
+            m = {str(k).upper(): x for k, x in dict(m).items()}
+            return float(m[key]) if m.get(key) is not None else old
+
+        def six(x: Any, old: tuple[float, ...], keys: tuple[str, ...]) -> tuple[float, ...]:
+            if x is None:
+                return old
+            if hasattr(x, "items"):
+                m = {str(k).upper(): y for k, y in x.items()}
+                return tuple(float(m[k]) if m.get(k) is not None else old[i]
+                             for i, k in enumerate(keys))
+            return tuple(float(y) for y in list(x)[:6])
+
+        vel, acc, apo = v.get("VEL"), v.get("ACC"), v.get("APO")
+        return MotionParams(
+            vel_cp=comp(vel, "CP", d.vel_cp), vel_ori1=comp(vel, "ORI1", d.vel_ori1),
+            vel_ori2=comp(vel, "ORI2", d.vel_ori2),
+            acc_cp=comp(acc, "CP", d.acc_cp), acc_ori1=comp(acc, "ORI1", d.acc_ori1),
+            acc_ori2=comp(acc, "ORI2", d.acc_ori2),
+            vel_axis=six(v.get("VEL_AXIS"), d.vel_axis, ("1", "2", "3", "4", "5", "6")),
+            acc_axis=six(v.get("ACC_AXIS"), d.acc_axis, ("1", "2", "3", "4", "5", "6")),
+            apo_cptp=comp(apo, "CPTP", d.apo_cptp), apo_cdis=comp(apo, "CDIS", d.apo_cdis),
+            apo_cvel=comp(apo, "CVEL", d.apo_cvel), apo_cori=comp(apo, "CORI", d.apo_cori),
+            tool=six(v.get("TOOL"), d.tool, ("X", "Y", "Z", "A", "B", "C")),  # type: ignore[arg-type]
+            base=six(v.get("BASE"), d.base, ("X", "Y", "Z", "A", "B", "C")),  # type: ignore[arg-type]
+            ori_type=str(v.get("ORI_TYPE") or d.ori_type),
+            circ_type=str(v.get("CIRC_TYPE") or d.circ_type),
+            ov_pro=float(v["OV_PRO"]) if v.get("OV_PRO") is not None else d.ov_pro,
+            ipo_mode=str(v.get("IPO_MODE") or d.ipo_mode),
+        )
+
     def with_(self, **changes: Any) -> "MotionParams":
         """A copy with some fields changed (e.g. for a spline ``WITH`` clause)."""
         return replace(self, **changes)

@@ -284,3 +284,31 @@ def test_axis_act_and_pos_act_from_mujoco():
     assert (p_tool["X"], p_tool["Y"], p_tool["Z"]) == pytest.approx((0, 55, 585), abs=1e-6)
     ctl.step()  # one cycle at rest
     assert ctl.vel_act() == pytest.approx(0.0, abs=1e-9)
+
+
+def test_triggers_inside_spline_block_refer_to_their_segment():
+    from robot.motion import SplineSegment
+
+    P = MotionParams().with_(vel_cp=0.5)
+    segs = (SplineSegment("SLIN", {"X": 445, "Y": 100, "Z": 810}),
+            SplineSegment("SLIN", {"X": 545, "Y": 100, "Z": 810},
+                          triggers=(Trigger(distance=0, delay_ms=0, line=7),
+                                    Trigger(path_mm=-20.0, line=8))),
+            SplineSegment("SPL", {"X": 600, "Y": 0, "Z": 760}))
+    ctl, tw = _ctl()
+    run_motions(ctl, [MotionRequest("PTP", TOOL_DOWN, P),
+                      MotionRequest("SPLINE", {}, P, segments=segs)])
+    poses = {round(e["t"], 6): e["tcp"] for e in tw.events if e["kind"] == "pose"}
+    fired = {e["line"]: e["t"] for e in tw.events if e["kind"] == "trigger"}
+    step = 0.5 * 1000 * DT
+    x7 = poses[round(fired[7], 6)]
+    assert x7[1] == pytest.approx(100.0, abs=1e-6) and 445.0 <= x7[0] <= 445.0 + step
+    x8 = poses[round(fired[8], 6)]
+    assert 525.0 <= x8[0] <= 525.0 + step
+
+
+def test_actuated_mode_follows_setpoints():
+    ctl = Controller(actuated=True)
+    run_motions(ctl, [MotionRequest("PTP", TOOL_DOWN, MotionParams().with_(vel_axis=(50.0,) * 6))])
+    ctl.wait_sec(0.2)
+    assert np.max(np.abs(ctl.axis_act() - ctl.axis_setpoint())) < 0.5

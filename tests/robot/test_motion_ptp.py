@@ -148,3 +148,15 @@ def test_first_motion_must_be_complete():
     ctl = Controller(mujoco=False)
     with pytest.raises(RobotError):
         ctl.enqueue(MotionRequest("PTP", {"A1": 10}, MotionParams()))
+
+
+def test_motion_params_from_sysvars():
+    p = MotionParams.from_sysvars({
+        "$VEL": {"CP": 0.3, "ORI1": 150}, "$acc_axis": [50] * 6,
+        "$APO": {"CDIS": 12.5, "CPTP": 20}, "$TOOL": {"X": 0, "Y": 0, "Z": 225, "A": 0, "B": 0, "C": 0},
+        "$ORI_TYPE": "#CONSTANT", "$OV_PRO": 75})
+    assert (p.vel_cp, p.vel_ori1, p.vel_ori2) == (0.3, 150.0, 200.0)
+    assert p.acc_axis == (50.0,) * 6 and p.vel_axis == (100.0,) * 6
+    assert (p.apo_cdis, p.apo_cptp, p.apo_cvel) == (12.5, 20.0, 100.0)
+    assert p.tool == (0.0, 0.0, 225.0, 0.0, 0.0, 0.0)
+    assert p.ori_type == "CONSTANT" and p.ov_pro == 75.0
