@@ -19,8 +19,9 @@ options { caseInsensitive = true; }
 // ======================================================================== parser
 
 // A .src, .sub or .dat file (reference 2.1, 2.2, 2.5).
+// Blank and comment lines are allowed everywhere (1.4), also before the header lines.
 module
-    : headerLine* NEWLINE* (dataList | routine (NEWLINE* routine)*) NEWLINE* EOF
+    : NEWLINE* headerLine* NEWLINE* (dataList | routine (NEWLINE* routine)*) NEWLINE* EOF
     ;
 
 // &ACCESS, &REL, &PARAM, &COMMENT lines at the top of a file (reference 1.3).
