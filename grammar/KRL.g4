@@ -118,8 +118,9 @@ constantArrayName
     : name arrayDimensions
     ;
 
+// Arrays have 1 to 3 dimensions (3.3); an empty last index selects a CHAR-array row: N[3,]="x".
 arrayElementInitialisation
-    : name '[' constantIndex (',' constantIndex?)* ']' '=' constantValue
+    : name '[' constantIndex (',' (constantIndex (',' constantIndex?)?)?)? ']' '=' constantValue
     ;
 
 constantIndex
