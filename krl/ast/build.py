@@ -386,6 +386,13 @@ class Builder:
 
     def signal_decl(self, ctx) -> N.SignalDecl:
         syms = [s for s, _, _ in self.toks(ctx)]
+        if not self.rules(ctx, "signalReference"):
+            tk = self.toks(ctx)
+            sysname = next((t for s, t, _ in tk if s in ("SYSNAME", "IDENTIFIER")), None)
+            nm = self.rule(ctx, "name", required=False)
+            if "FALSE" in [s for s, _, _ in tk] and (sysname or nm is not None):
+                return N.SignalDecl(sysname or self.name(nm), None, None, "GLOBAL" in syms,
+                                    span=self.span(ctx))
         name = self.name(self.rule(ctx, "name"))
         refs = []
         for r in self.rules(ctx, "signalReference"):
@@ -533,6 +540,14 @@ class Builder:
         if not inner and len(tk) == 1 and tk[0][0] == "IDENTIFIER":
             # a parameterless call without parentheses (`Name`), however the grammar labels it
             return N.CallStmt(N.Call(tk[0][1], [], span=sp), span=sp)
+        if own == "moveEmiStatement" or first == "MOVE_EMI":
+            return self.move_emi(ctx, sp)
+        if tk and tk[0][2] is (ctx.children or [None])[0] and all(
+                _names(c)[1] == "expression" for c in inner) and all(
+                s not in ("ASSIGN", "COMMA") and t not in ("=", ",") for s, t, _ in tk):
+            # KEYWORD [KEYWORD...] expression...: CONFIRM n, ASYPTP {E1 90}, ...
+            words = [t.upper() for s, t, _ in tk]
+            return N.KeywordStmt(words, [self.expr(c) for c in inner], span=sp)
         if len(inner) == 1 and not tk:
             # a wrapper alternative (e.g. `splineBlock # splineStatement`): unwrap it
             return self.statement(inner[0])
@@ -540,6 +555,14 @@ class Builder:
             return N.DeclStmt(self.declaration(ctx), span=sp)
         self.unknown(ctx, "statement")
         return N.Unsupported(own, self.source_text(ctx), span=sp)
+
+    def move_emi(self, ctx, sp) -> N.MoveEmi:
+        target = self.variable(self.rule(ctx, "variable"))
+        text = next(t for s, t, _ in self.toks(ctx) if s == "STRINGLITERAL")[1:-1]
+        key = self.rule(ctx, "name", required=False)
+        value = self.rule(ctx, "expression", required=False)
+        return N.MoveEmi(target, text, self.name(key) if key is not None else None,
+                         self.expr(value) if value is not None else None, span=sp)
 
     def s_assign(self, ctx, sp):
         a = self.rule(ctx, "assignment")
@@ -788,9 +811,8 @@ class Builder:
                 own, b = _names(ch)
                 if b == "withClause" and not body and not seen_end:
                     with_.extend(self.with_clause(ch))
-                elif b in ("motion", "triggerStatement") or own.endswith("Motion") \
-                        or own.startswith(("spl", "spline")) and self.first_tok(ch) in (
-                            "SPL", "SLIN", "SCIRC", "SPTP"):
+                elif b in ("motion", "triggerStatement") or own.endswith(("Motion", "Segment")) \
+                        or b.endswith("Segment"):
                     if b == "triggerStatement":
                         st = self.guarded(self.trigger, ch)
                     else:

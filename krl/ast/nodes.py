@@ -26,6 +26,7 @@ Shapes (reference sections in brackets):
   :class:`Return`, :class:`OnErrorProceed`, :class:`InterruptDecl`, :class:`InterruptCtl`,
   :class:`Brake`, :class:`Resume`, :class:`Trigger`, :class:`AninOn`, :class:`AninOff`,
   :class:`AnoutOn`, :class:`AnoutOff`, :class:`Motion`, :class:`SplineBlock`,
+  :class:`KeywordStmt` (CONFIRM, ASYPTP, ...), :class:`MoveEmi`,
   :class:`DeclStmt` (a declaration found among statements), :class:`Unsupported`
   (a construct the builder does not know; carries the source text) [5, 6].
 * expressions: :class:`IntLit`, :class:`RealLit`, :class:`BoolLit`, :class:`StrLit`,
@@ -270,9 +271,10 @@ class SignalRef(Node):
 
 @dataclass(slots=True)
 class SignalDecl(Decl):
-    """``[GLOBAL] SIGNAL NAME $OUT[n] [TO $OUT[m]]`` (3.8)."""
+    """``[GLOBAL] SIGNAL NAME $OUT[n] [TO $OUT[m]]`` (3.8); start None for a system signal
+    declared ``SIGNAL $NAME FALSE`` (not wired)."""
     name: str
-    start: SignalRef
+    start: SignalRef | None
     end: SignalRef | None = None
     is_global: bool = False
 
@@ -524,6 +526,23 @@ class SplineBlock(Stmt):
 
 
 @dataclass(slots=True)
+class KeywordStmt(Stmt):
+    """A statement made of keywords followed by expressions, e.g. ``CONFIRM n``,
+    ``ASYPTP {E1 90}`` (5.20); ``words`` are the upper-case keywords."""
+    words: list[str]
+    args: list[Expr] = field(default_factory=list)
+
+
+@dataclass(slots=True)
+class MoveEmi(Stmt):
+    """``MOVE_EMI device[] "file.emily" [KEY value]`` (5.20)."""
+    target: Expr
+    file: str
+    key: str | None = None
+    value: Expr | None = None
+
+
+@dataclass(slots=True)
 class DeclStmt(Stmt):
     """A declaration that appears after the first statement (a checker error, 2.2)."""
     decl: Decl
@@ -570,8 +589,9 @@ class DataList(Node):
 
 @dataclass(slots=True)
 class Module(Node):
-    """One file. kind is 'src' (also .sub) or 'dat'; headers are the '&' lines verbatim."""
-    path: str
+    """One file. kind is 'src' (also .sub) or 'dat'; headers are the '&' lines verbatim.
+    ``path`` is not part of equality (like spans)."""
+    path: str = field(compare=False)
     kind: str
     headers: list[str] = field(default_factory=list)
     routines: list[Routine] = field(default_factory=list)

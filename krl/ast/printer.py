@@ -133,6 +133,8 @@ def decl(d: N.Decl) -> str:
         return ("GLOBAL " if d.is_global else "") + f"STRUC {d.name} " + ", ".join(comps)
     if isinstance(d, N.EnumDecl):
         return ("GLOBAL " if d.is_global else "") + f"ENUM {d.name} " + ", ".join(d.values)
+    if isinstance(d, N.SignalDecl) and d.start is None:
+        return ("GLOBAL " if d.is_global else "") + f"SIGNAL {d.name} FALSE"
     if isinstance(d, N.SignalDecl):
         text = ("GLOBAL " if d.is_global else "") + f"SIGNAL {d.name} {d.start.sysvar}[{d.start.index}]"
         if d.end is not None:
@@ -259,6 +261,11 @@ def stmt(s: N.Stmt, level: int = 1) -> list[str]:
     if isinstance(s, N.SplineBlock):
         out = [f"{ind}{s.kind}{_with(s.with_)}"] + block(s.body, level + 1)
         return out + [f"{ind}ENDSPLINE" + (f" {s.approx}" if s.approx else "")]
+    if isinstance(s, N.KeywordStmt):
+        return [ind + " ".join(s.words + ([", ".join(expr(a) for a in s.args)] if s.args else []))]
+    if isinstance(s, N.MoveEmi):
+        tail = f" {s.key} {expr(s.value)}" if s.key is not None else ""
+        return [f'{ind}MOVE_EMI {expr(s.target)} "{s.file}"{tail}']
     if isinstance(s, N.DeclStmt):
         return [ind + decl(s.decl)]
     if isinstance(s, N.Unsupported):

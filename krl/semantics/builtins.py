@@ -1,0 +1,149 @@
+"""Built-in types, system variables and routines, loaded from the data tables in
+``krl/semantics/data`` (types.yaml, sysvars.yaml, functions.yaml). Data, not code:
+this module only reads the tables into plain records, once per process.
+
+Reference: 3.7 (predefined structures and enums), 4.5-4.8 (functions and procedures),
+6.10 and 7 (system variables, access, advance-run stops).
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field
+from functools import lru_cache
+from pathlib import Path
+
+import yaml
+
+DATA_DIR = Path(__file__).parent / "data"
+
+try:  # the C loader is much faster where libyaml is present
+    _Loader = yaml.CSafeLoader
+except AttributeError:  # pragma: no cover
+    _Loader = yaml.SafeLoader
+
+
+@dataclass(slots=True)
+class SysVarInfo:
+    """A system variable: type name, array sizes, access ('RW' or 'RO'), advance-run stops."""
+    name: str
+    type_name: str
+    dims: tuple[int, ...] = ()
+    access: str = "RW"
+    stop_read: bool = False
+    stop_write: bool = False
+
+
+@dataclass(slots=True)
+class ParamInfo:
+    """A parameter of a built-in: type name, array sizes (0 = open), mode 'IN'/'OUT'."""
+    name: str
+    type_name: str
+    dims: tuple[int, ...] = ()
+    mode: str = "IN"
+
+
+@dataclass(slots=True)
+class SignatureInfo:
+    """A built-in routine; returns is None for a procedure; varargs for '...' lists."""
+    name: str
+    returns: str | None
+    params: list[ParamInfo] = field(default_factory=list)
+    varargs: bool = False
+
+
+@dataclass(slots=True)
+class Builtins:
+    simple: list[str]
+    cartesian: list[str]
+    axis: list[str]
+    structs: dict[str, str]                 # name -> component list text (STRUC syntax)
+    enums: dict[str, list[str]]
+    basis_structs: dict[str, str]
+    basis_enums: dict[str, list[str]]
+    basis_variables: dict[str, tuple[str, tuple[int, ...]]]
+    sysvars: dict[str, SysVarInfo]          # UPPER name -> info
+    routines: dict[str, SignatureInfo]      # UPPER name -> signature
+
+
+_NAME_DIMS = re.compile(r"^\s*(\$?[A-Za-z_][\w$]*)\s*(?:\[([\d,\s]*)\])?\s*$")
+_SIG = re.compile(r"^\s*(?:([A-Za-z_]\w*)(?:\[(\d*)\])?\s+)?(\$?[A-Za-z_]\w*)\s*\((.*)\)\s*$")
+_PARAM = re.compile(r"^\s*([A-Za-z_]\w*)\s+([A-Za-z_]\w*)\s*(?:\[([\d,\s]*)\])?\s*(?::\s*(IN|OUT))?\s*$")
+
+
+def _dims(text: str | None) -> tuple[int, ...]:
+    if text is None:
+        return ()
+    return tuple(int(x) if x.strip() else 0 for x in text.split(","))
+
+
+def split_name(key: str) -> tuple[str, tuple[int, ...]]:
+    """'$IN[8192]' -> ('$IN', (8192,)); 'TOOL_NAME[16,24]' -> ('TOOL_NAME', (16, 24))."""
+    m = _NAME_DIMS.match(key)
+    if not m:
+        raise ValueError(f"bad name in data table: {key!r}")
+    return m.group(1), _dims(m.group(2))
+
+
+def parse_signature(text: str, is_function: bool) -> SignatureInfo:
+    """'REAL ABS(REAL X :IN)' -> SignatureInfo; raises ValueError for a malformed entry."""
+    m = _SIG.match(text)
+    if not m:
+        raise ValueError(f"bad signature: {text!r}")
+    rtype, _rsize, name, params_text = m.groups()
+    if is_function and not rtype:
+        raise ValueError(f"function without return type: {text!r}")
+    sig = SignatureInfo(name.upper(), rtype if is_function else None)
+    for part in [p for p in params_text.split(",") if p.strip()]:
+        if part.strip() == "...":
+            sig.varargs = True
+            continue
+        pm = _PARAM.match(part)
+        if not pm:
+            raise ValueError(f"bad parameter {part!r} in {text!r}")
+        ptype, pname, pdims, mode = pm.groups()
+        sig.params.append(ParamInfo(pname, ptype, _dims(pdims), mode or "IN"))
+    return sig
+
+
+def _read(name: str) -> dict:
+    with open(DATA_DIR / name, encoding="utf-8") as fh:
+        return yaml.load(fh, Loader=_Loader) or {}
+
+
+@lru_cache(maxsize=1)
+def load_builtins() -> Builtins:
+    """Read the three data tables (cached). Raises ValueError for a malformed table."""
+    types = _read("types.yaml")
+    sysv = _read("sysvars.yaml")
+    funcs = _read("functions.yaml")
+    basis = types.get("basis", {})
+    sysvars: dict[str, SysVarInfo] = {}
+    for key, info in sysv.items():
+        name, dims = split_name(key)
+        stops = info.get("stop", []) or []
+        sysvars[name.upper()] = SysVarInfo(name, info["type"], dims, info.get("access", "RW"),
+                                           "read" in stops, "write" in stops)
+    routines: dict[str, SignatureInfo] = {}
+    for text in funcs.get("functions", []):
+        sig = parse_signature(text, True)
+        routines[sig.name] = sig
+    for text in funcs.get("procedures", []):
+        sig = parse_signature(text, False)
+        routines[sig.name] = sig
+    bvars = {}
+    for key, tname in (basis.get("variables") or {}).items():
+        name, dims = split_name(key)
+        bvars[name] = (tname, dims)
+    return Builtins(
+        simple=list(types.get("simple", [])),
+        cartesian=list(types.get("geometric", {}).get("cartesian", [])),
+        axis=list(types.get("geometric", {}).get("axis", [])),
+        structs=dict(types.get("structs", {})),
+        enums={k: list(v) for k, v in (types.get("enums") or {}).items()},
+        basis_structs=dict(basis.get("structs", {})),
+        basis_enums={k: list(v) for k, v in (basis.get("enums") or {}).items()},
+        basis_variables=bvars,
+        sysvars=sysvars,
+        routines=routines,
+    )

@@ -1,0 +1,811 @@
+"""The static type checker (reference 2-6, 8.1 "compile errors").
+
+Two jobs:
+
+* :class:`Declarer` enters declarations into scopes (types first, then structure components,
+  then variables, signals, external and routine signatures), reporting duplicates (E102),
+  over-long identifiers (E103) and unknown types (E105).
+* :class:`Checker` walks every routine and data list, gives every expression a type
+  (``expr.ann.type``), resolves every name and call (``node.ann.symbol``) and reports the
+  rules of the issue: assignment compatibility (3.9, E201/W202), aggregates field by field
+  (E206), calls (arity E301, :OUT needs a variable E302, argument types E303), ENUM literals
+  (E205), declarations before statements (E104), GOTO targets (E401/E402), EXIT outside
+  loops (E403), RETURN (E404), undeclared names (E101/E106), write-protected system
+  variables and constants (E501/E502), conditions (E204), SWITCH (E207), FOR (E208),
+  motion targets (E209), operators (E203).
+
+When the workspace is incomplete (a file of it has syntax errors, so declarations may be
+missing), "not found" findings are warnings (W101/W105/W106) instead of errors.
+"""
+
+from __future__ import annotations
+
+from krl.ast import nodes as N
+from krl.semantics import types as T
+from krl.semantics.diagnostics import DiagnosticSink
+from krl.semantics.symbols import ParamSig, RoutineSig, Scope, Symbol, make_array
+
+MAX_IDENT = 24
+ARITH = {"+", "-", "*", "/"}
+LOGIC = {"AND", "OR", "EXOR"}
+BITS = {"B_AND", "B_OR", "B_EXOR"}
+EQUALITY = {"==", "<>"}
+ORDER = {"<", ">", "<=", ">="}
+
+
+def _is_system_datalist(name: str) -> bool:
+    return name.startswith("$")
+
+
+class Declarer:
+    """Enters declarations into scopes. One instance per workspace."""
+
+    def __init__(self, sink: DiagnosticSink, incomplete: bool = False):
+        self.sink = sink
+        self.incomplete = incomplete
+        # unknown types are only warnings in system data lists: they use types of
+        # $operate.dat, which lives on the controller and is not part of a backup
+        self.soft_types = False
+
+    def ident(self, name: str, span: N.Span) -> None:
+        if len(name) > MAX_IDENT:
+            self.sink.at(span, "E103", f"identifier '{name}' has {len(name)} characters (at most {MAX_IDENT})")
+
+    def duplicate(self, name: str, span: N.Span, old: Symbol | T.KrlType | None) -> None:
+        where = ""
+        decl = getattr(old, "decl", None)
+        if decl is not None and getattr(decl, "span", None) is not None and decl.span.line:
+            where = f" (first declared at {decl.span})"
+        self.sink.at(span, "E102", f"'{name}' is declared more than once{where}")
+
+    def resolve_type(self, scope: Scope, tref: N.TypeRef | str, span: N.Span, dims=()) -> T.KrlType:
+        name = tref.name if isinstance(tref, N.TypeRef) else tref
+        typ = scope.lookup_type(name)
+        if typ is None:
+            if self.incomplete or self.soft_types or scope.is_incomplete():
+                self.sink.at(span, "W105", f"unknown type '{name}'")
+            else:
+                self.sink.at(span, "E105", f"unknown type '{name}'")
+            typ = T.UNKNOWN
+        if isinstance(tref, N.TypeRef) and tref.size is not None:
+            typ = T.Array(typ, (tref.size,))
+        return make_array(typ, dims)
+
+    # -- phase 1: type names
+    def declare_types(self, scope: Scope, items: list[N.Decl]) -> None:
+        for d in items:
+            if isinstance(d, N.StrucDecl):
+                self.ident(d.name, d.span)
+                if scope.define_type(d.name, T.Struc(d.name)) is not None and scope.kind != "global":
+                    self.duplicate(d.name, d.span, None)
+            elif isinstance(d, N.EnumDecl):
+                self.ident(d.name, d.span)
+                if scope.define_type(d.name, T.Enum(d.name, frozenset(v.upper() for v in d.values))) is not None \
+                        and scope.kind != "global":
+                    self.duplicate(d.name, d.span, None)
+
+    # -- phase 2: structure components
+    def fill_types(self, scope: Scope, items: list[N.Decl]) -> None:
+        for d in items:
+            if isinstance(d, N.StrucDecl):
+                st = scope.types.get(d.name.upper())
+                if not isinstance(st, T.Struc) or st.fields:
+                    continue
+                for c in d.components:
+                    self.ident(c.name, c.span)
+                    ct = self.resolve_type(scope, c.type_name, c.span, c.dims)
+                    if c.name.upper() in st.fields:
+                        self.sink.at(c.span, "E102", f"component '{c.name}' appears twice in {d.name}")
+                    st.fields[c.name.upper()] = (c.name, ct)
+
+    # -- phase 3: values and routines
+    def declare_values(self, scope: Scope, items: list[N.Decl], module: str, path: str,
+                       kind: str = "var") -> None:
+        for d in items:
+            if isinstance(d, N.VarDecl):
+                for v in d.names:
+                    self.ident(v.name, v.span)
+                    typ = self.resolve_type(scope, d.type, d.type.span, v.dims)
+                    sym = Symbol(v.name, "const" if d.is_const else kind, typ, scope.kind, d,
+                                 "RO" if d.is_const else "RW", module=module, path=path)
+                    self._define(scope, sym, v.span)
+            elif isinstance(d, N.SignalDecl):
+                self.ident(d.name, d.span)
+                src = d.start.sysvar.upper() if d.start is not None else "$FALSE"
+                if src in ("$ANIN", "$ANOUT"):
+                    typ = T.REAL
+                elif d.end is not None:
+                    typ = T.INT
+                else:
+                    typ = T.BOOL
+                access = "RO" if src in ("$IN", "$ANIN") else "RW"
+                sym = Symbol(d.name, "signal", typ, scope.kind, d, access, module=module, path=path,
+                             stop_read=src in ("$IN", "$ANIN"), stop_write=src in ("$OUT", "$ANOUT"))
+                self._define(scope, sym, d.span)
+            elif isinstance(d, N.ImportDecl):
+                self.ident(d.name, d.span)
+                typ = self.resolve_type(scope, d.type_name, d.span)
+                self._define(scope, Symbol(d.name, "var", typ, scope.kind, d, module=module, path=path), d.span)
+            elif isinstance(d, N.ExtDecl):
+                self.ident(d.name, d.span)
+                sig = self.ext_signature(scope, d)
+                sym = Symbol(d.name, "routine", sig.returns or T.VOID, scope.kind, d, "RO",
+                             signature=sig, module=module, path=path)
+                # an EXT declaration may repeat a routine's signature: not a duplicate
+                scope.routines.setdefault(d.name.upper(), sym)
+
+    def _define(self, scope: Scope, sym: Symbol, span: N.Span) -> None:
+        old = scope.define("values", sym)
+        if old is not None and old.decl is not sym.decl:
+            if scope.kind in ("global",) and (old.path != sym.path):
+                # the same global declared by two data lists: a link error (2.7)
+                self.duplicate(sym.name, span, old)
+            elif scope.kind != "global":
+                self.duplicate(sym.name, span, old)
+
+    def ext_signature(self, scope: Scope, d: N.ExtDecl) -> RoutineSig:
+        ret = self.resolve_type(scope, d.return_type, d.span) if d.return_type is not None else None
+        params = []
+        for i, p in enumerate(d.params):
+            size = p.name_size if p.name_size is not None else p.type_size
+            typ = self.resolve_type(scope, p.type_name, p.span, (size,) if size is not None else ())
+            params.append(ParamSig(p.name or f"P{i + 1}", typ, p.mode))
+        return RoutineSig(d.name, ret, params)
+
+    def routine_symbol(self, r: N.Routine, module: str, path: str, scope: Scope) -> Symbol:
+        """A routine's symbol; its signature is completed by :meth:`complete_signature`."""
+        ret = None
+        if r.kind == "DEFFCT":
+            ret = self.resolve_type(scope, r.return_type, r.span) if r.return_type else T.UNKNOWN
+        sig = RoutineSig(r.name, ret, [ParamSig(p.name, T.UNKNOWN, p.mode) for p in r.params])
+        return Symbol(r.name, "routine", ret or T.VOID, scope.kind, r, "RO", signature=sig,
+                      module=module, path=path)
+
+    def complete_signature(self, sym: Symbol, local: Scope) -> None:
+        """Fill parameter types from the routine's local declarations."""
+        sig = sym.signature
+        for p in sig.params:
+            s = local.values.get(p.name.upper())
+            if s is not None:
+                p.type = s.type
+
+
+class _Ctx:
+    """Per-routine state of the checker."""
+
+    def __init__(self, routine: N.Routine | None, scope: Scope):
+        self.routine = routine
+        self.scope = scope
+        self.loops = 0
+        self.labels: dict[str, tuple[N.Label, tuple[int, ...]]] = {}
+        self.gotos: list[tuple[N.Goto, tuple[int, ...]]] = []
+        self.block_path: list[int] = []
+        self.next_block = 0
+
+
+class Checker:
+    """Types and checks statements and expressions. Never raises out of :meth:`check_routine`
+    or :meth:`check_datalist` (an internal failure becomes E901)."""
+
+    def __init__(self, sink: DiagnosticSink, declarer: Declarer, incomplete: bool = False):
+        self.sink = sink
+        self.decl = declarer
+        self.incomplete = incomplete
+        # set while checking KUKA system files (R1/System, TP, Mada, STEU): they use
+        # declarations of $operate.dat, which is not part of a backup
+        self.system_file = False
+
+    def _soft(self, sc: Scope) -> bool:
+        return self.incomplete or self.system_file or sc.is_incomplete()
+
+    # ---------------------------------------------------------------- entry points
+
+    def check_datalist(self, dl: N.DataList, scope: Scope) -> None:
+        try:
+            for d in dl.items:
+                if isinstance(d, N.VarDecl) and d.init is not None:
+                    sym = scope.lookup(d.names[0].name)
+                    target = sym.type if sym is not None else T.UNKNOWN
+                    self.check_value(target, d.init, scope, d.init.span)
+                elif isinstance(d, N.ArrayInit):
+                    self.check_array_init(d, scope)
+        except Exception as exc:  # noqa: BLE001
+            self.sink.at(dl.span, "E901", f"internal checker error in data list: {type(exc).__name__}: {exc}")
+
+    def check_array_init(self, d: N.ArrayInit, scope: Scope) -> None:
+        sym = scope.lookup(d.name)
+        if sym is None:
+            self.not_found(d.span, d.name, scope)
+            return
+        t = sym.type
+        if not isinstance(t, T.Array):
+            if t is not T.UNKNOWN:
+                self.sink.at(d.span, "E109", f"'{d.name}' is not an array")
+            return
+        if len(d.indices) != len(t.dims):
+            self.sink.at(d.span, "E109", f"'{d.name}' has {len(t.dims)} dimension(s), {len(d.indices)} given")
+            return
+        for i, (idx, size) in enumerate(zip(d.indices, t.dims)):
+            if idx is not None and size and not 1 <= idx <= size:
+                self.sink.at(d.span, "E110", f"index {idx} of '{d.name}' is outside 1..{size}")
+        if d.indices and d.indices[-1] is None:
+            elem: T.KrlType = T.Array(t.elem, (t.dims[-1],))
+        else:
+            elem = t.elem
+        self.check_value(elem, d.value, scope, d.span)
+
+    def check_routine(self, r: N.Routine, local: Scope, module_path: str) -> None:
+        try:
+            ctx = _Ctx(r, local)
+            self._routine(r, ctx)
+        except RecursionError:
+            self.sink.at(r.span, "E901", "routine nested too deeply to check")
+        except Exception as exc:  # noqa: BLE001
+            self.sink.at(r.span, "E901", f"internal checker error: {type(exc).__name__}: {exc}")
+
+    def _routine(self, r: N.Routine, ctx: _Ctx) -> None:
+        local = ctx.scope
+        declared = {k for k in local.values}
+        for p in r.params:
+            self.decl.ident(p.name, p.span)
+            if p.name.upper() not in declared:
+                self.sink.at(p.span, "E101", f"parameter '{p.name}' of {r.name} has no declaration")
+            else:
+                sym = local.values[p.name.upper()]
+                sym.kind = "param"
+                sym.mode = p.mode
+        self.block(r.body, ctx)
+        for g, path in ctx.gotos:
+            got = ctx.labels.get(g.label.upper())
+            if got is None:
+                self.sink.at(g.span, "E401", f"GOTO target '{g.label}' is not a label of {r.name}")
+                continue
+            label, lpath = got
+            g.annotate().extra["label"] = label
+            if tuple(path[:len(lpath)]) != lpath:
+                self.sink.at(g.span, "E402", f"GOTO {g.label} jumps into a block")
+
+    # ---------------------------------------------------------------- statements
+
+    def block(self, stmts: list[N.Stmt], ctx: _Ctx, new_block: bool = False) -> None:
+        if new_block:
+            ctx.next_block += 1
+            ctx.block_path.append(ctx.next_block)
+        try:
+            for s in stmts:
+                self.stmt(s, ctx)
+        finally:
+            if new_block:
+                ctx.block_path.pop()
+
+    def stmt(self, s: N.Stmt, ctx: _Ctx) -> None:
+        sc = ctx.scope
+        if isinstance(s, N.Assign):
+            self.assign(s.target, s.value, sc, s.span)
+        elif isinstance(s, N.CallStmt):
+            self.call(s.call, sc, statement=True)
+        elif isinstance(s, N.If):
+            self.cond(s.cond, sc, "IF")
+            self.block(s.then, ctx, True)
+            if s.orelse is not None:
+                self.block(s.orelse, ctx, True)
+        elif isinstance(s, N.Switch):
+            self.switch(s, ctx)
+        elif isinstance(s, N.For):
+            self.for_(s, ctx)
+        elif isinstance(s, N.While):
+            self.cond(s.cond, sc, "WHILE")
+            self.loop_body(s.body, ctx)
+        elif isinstance(s, N.Repeat):
+            self.loop_body(s.body, ctx)
+            self.cond(s.cond, sc, "UNTIL")
+        elif isinstance(s, N.Loop):
+            self.loop_body(s.body, ctx)
+        elif isinstance(s, N.Exit):
+            if ctx.loops == 0:
+                self.sink.at(s.span, "E403", "EXIT outside a loop")
+        elif isinstance(s, N.Goto):
+            ctx.gotos.append((s, tuple(ctx.block_path)))
+        elif isinstance(s, N.Label):
+            self.decl.ident(s.name, s.span)
+            key = s.name.upper()
+            if key in ctx.labels:
+                self.sink.at(s.span, "E405", f"label '{s.name}' is defined more than once")
+            else:
+                ctx.labels[key] = (s, tuple(ctx.block_path))
+        elif isinstance(s, N.WaitFor):
+            self.cond(s.cond, sc, "WAIT FOR")
+        elif isinstance(s, N.WaitSec):
+            self.numeric(s.time, sc, "WAIT SEC")
+        elif isinstance(s, N.Return):
+            self.return_(s, ctx)
+        elif isinstance(s, N.InterruptDecl):
+            self.int_expr(s.prio, sc, "interrupt number")
+            self.cond(s.when, sc, "WHEN")
+            self.call(s.call, sc, statement=True)
+        elif isinstance(s, N.InterruptCtl):
+            if s.prio is not None:
+                self.int_expr(s.prio, sc, "interrupt number")
+        elif isinstance(s, N.Trigger):
+            self.numeric(s.at, sc, s.kind)
+            self.numeric(s.delay, sc, "DELAY")
+            if s.prio is not None:
+                self.int_expr(s.prio, sc, "PRIO")
+            self.stmt(s.action, ctx)
+        elif isinstance(s, N.Motion):
+            self.motion(s, sc)
+        elif isinstance(s, N.SplineBlock):
+            for w in s.with_:
+                self.with_assign(w, sc)
+            for inner in s.body:
+                self.stmt(inner, ctx)
+        elif isinstance(s, N.AninOn):
+            self.assign_target(s.target, sc, s.span)
+            self.expr(s.value, sc)
+        elif isinstance(s, N.AnoutOn):
+            self.signal_name(s.name, s.span, sc)
+            self.numeric(s.value, sc, "ANOUT")
+            for e in (s.delay, s.minimum, s.maximum):
+                if e is not None:
+                    self.numeric(e, sc, "ANOUT")
+        elif isinstance(s, (N.AninOff, N.AnoutOff)):
+            self.signal_name(s.name, s.span, sc)
+        elif isinstance(s, N.KeywordStmt):
+            for a in s.args:
+                if isinstance(a, N.Aggregate):
+                    self.aggregate(a, sc, T.UNKNOWN)
+                else:
+                    self.expr(a, sc)
+        elif isinstance(s, N.MoveEmi):
+            self.expr(s.target, sc)
+            if s.value is not None:
+                self.expr(s.value, sc)
+        elif isinstance(s, N.DeclStmt):
+            self.sink.at(s.span, "E104", "declaration after the first statement of the routine")
+        # Halt, Continue, OnErrorProceed, Brake, Resume, Unsupported: nothing to check
+
+    def loop_body(self, body: list[N.Stmt], ctx: _Ctx) -> None:
+        ctx.loops += 1
+        try:
+            self.block(body, ctx, True)
+        finally:
+            ctx.loops -= 1
+
+    def signal_name(self, name: str, span: N.Span, sc: Scope) -> None:
+        if sc.lookup(name) is None:
+            self.not_found(span, name, sc)
+
+    def switch(self, s: N.Switch, ctx: _Ctx) -> None:
+        sc = ctx.scope
+        st = self.expr(s.selector, sc)
+        if not (st in (T.INT, T.CHAR) or isinstance(st, T.Enum) or st is T.UNKNOWN):
+            self.sink.at(s.selector.span, "E207", f"SWITCH selector must be INT, CHAR or ENUM, not {st}")
+            st = T.UNKNOWN
+        for c in s.cases:
+            for v in c.values:
+                vt = self.expr(v, sc, expected=st)
+                if st is T.UNKNOWN or vt is T.UNKNOWN:
+                    continue
+                if isinstance(st, T.Enum):
+                    if not isinstance(vt, (T.EnumLitType, T.Enum)) or isinstance(vt, T.Enum) and vt != st:
+                        self.sink.at(v.span, "E207", f"CASE value of type {vt} for a {st} selector")
+                elif not T.assignable(st, vt).ok or isinstance(vt, T.EnumLitType):
+                    self.sink.at(v.span, "E207", f"CASE value of type {vt} for a {st} selector")
+            self.block(c.body, ctx, True)
+        if s.default is not None:
+            self.block(s.default, ctx, True)
+
+    def for_(self, s: N.For, ctx: _Ctx) -> None:
+        sc = ctx.scope
+        sym = sc.lookup(s.var.name)
+        if sym is None:
+            self.not_found(s.var.span, s.var.name, sc)
+        else:
+            s.var.annotate().symbol = sym
+            s.var.ann.type = sym.type
+            if sym.type not in (T.INT, T.UNKNOWN):
+                self.sink.at(s.var.span, "E208", f"FOR counter '{s.var.name}' is {sym.type}, not INT")
+            elif sym.kind in ("const", "routine"):
+                self.sink.at(s.var.span, "E208", f"FOR counter '{s.var.name}' is not a variable")
+        for e in (s.start, s.end, s.step):
+            if e is not None:
+                self.int_expr(e, sc, "FOR bound", lossy_ok=True)
+        self.loop_body(s.body, ctx)
+
+    def return_(self, s: N.Return, ctx: _Ctx) -> None:
+        r = ctx.routine
+        sc = ctx.scope
+        if r is None:
+            return
+        if r.kind == "DEFFCT":
+            if s.value is None:
+                self.sink.at(s.span, "E404", f"RETURN in function {r.name} needs a value")
+                return
+            sym = sc.lookup_routine(r.name)
+            rt = sym.signature.returns if sym is not None and sym.signature else T.UNKNOWN
+            self.check_value(rt or T.UNKNOWN, s.value, sc, s.value.span, what="RETURN value")
+        elif s.value is not None:
+            self.expr(s.value, sc)
+            self.sink.at(s.span, "E404", f"RETURN with a value in procedure {r.name}")
+
+    def motion(self, m: N.Motion, sc: Scope) -> None:
+        for e in (m.aux, m.target):
+            if e is not None:
+                self.motion_target(e, sc, relative=m.kind.endswith("_REL"))
+        if m.ca is not None:
+            self.numeric(m.ca, sc, "CA")
+        for w in m.with_:
+            self.with_assign(w, sc)
+
+    def motion_target(self, e: N.Expr, sc: Scope, relative: bool) -> None:
+        if isinstance(e, N.Aggregate) and e.type_name is None:
+            names = {i.name.upper() for i in e.items}
+            cart = sc.lookup_type("E6POS")
+            axes = sc.lookup_type("E6AXIS")
+            if isinstance(cart, T.Struc) and isinstance(axes, T.Struc):
+                if names <= set(cart.fields):
+                    target: T.KrlType = cart
+                elif names <= set(axes.fields):
+                    target = axes
+                else:
+                    self.sink.at(e.span, "E209", "aggregate target mixes or misses axis and Cartesian components")
+                    target = T.UNKNOWN
+                self.check_value(target, e, sc, e.span)
+                return
+        t = self.expr(e, sc)
+        if t is T.UNKNOWN:
+            return
+        if T.geometric_family(t) is None:
+            self.sink.at(e.span, "E209", f"motion target of type {t}; expected a position or axis type")
+
+    def with_assign(self, w: N.WithAssign, sc: Scope) -> None:
+        self.assign(w.target, w.value, sc, w.span)
+
+    # ---------------------------------------------------------------- assignments
+
+    def assign(self, target: N.Expr, value: N.Expr, sc: Scope, span: N.Span) -> None:
+        tt = self.assign_target(target, sc, span)
+        self.check_value(tt, value, sc, value.span)
+
+    def assign_target(self, target: N.Expr, sc: Scope, span: N.Span) -> T.KrlType:
+        tt = self.expr(target, sc, lvalue=True)
+        root = N.root_name(target)
+        if root is None:
+            self.sink.at(target.span, "E503", "the left side of an assignment must be a variable")
+            return T.UNKNOWN
+        sym = N.symbol_of(root)
+        if isinstance(sym, Symbol):
+            if sym.kind == "const":
+                self.sink.at(target.span, "E502", f"'{sym.name}' is a constant")
+            elif sym.kind == "routine":
+                self.sink.at(target.span, "E503", f"'{sym.name}' is a routine, not a variable")
+            elif sym.access == "RO" and (sym.name.upper() in ("$IN", "$ANIN") or sym.kind == "signal"):
+                # real code writes input signals (possible with simulated I/O): a warning
+                self.sink.at(target.span, "W501", f"'{sym.name}' is an input; programs can only write simulated inputs")
+            elif sym.access == "RO":
+                self.sink.at(target.span, "E501", f"'{sym.name}' is write-protected")
+        return tt
+
+    def check_value(self, target: T.KrlType, value: N.Expr, sc: Scope, span: N.Span,
+                    what: str = "assignment") -> None:
+        """Type `value` against `target` (3.9), aggregates component by component."""
+        if isinstance(value, N.Aggregate):
+            self.aggregate(value, sc, target)
+            return
+        vt = self.expr(value, sc, expected=target)
+        if vt is T.VOID:
+            return
+        got = T.assignable(target, vt)
+        if not got.ok:
+            code = "E205" if isinstance(vt, T.EnumLitType) else "E201"
+            if code == "E205" and getattr(target, "soft", False):
+                code = "W205"
+            self.sink.at(span, code, f"{what}: {got.reason}")
+        elif got.lossy:
+            code = "W210" if isinstance(vt, T.StrType) else "W202"
+            self.sink.at(span, code, f"{what}: {got.reason}")
+            value.annotate().extra["conversion"] = f"{vt}->{target}"
+        elif vt != target and vt is not T.UNKNOWN and target is not T.UNKNOWN:
+            value.annotate().extra["conversion"] = f"{vt}->{target}"
+
+    def aggregate(self, agg: N.Aggregate, sc: Scope, expected: T.KrlType) -> T.KrlType:
+        """Check an aggregate against a structure type, component by component (1.5, 3.9)."""
+        target = expected
+        if agg.type_name is not None:
+            named = sc.lookup_type(agg.type_name)
+            if named is None:
+                self.not_found_type(agg.span, agg.type_name, sc)
+                named = T.UNKNOWN
+            if expected is not T.UNKNOWN and named is not T.UNKNOWN:
+                got = T.assignable(expected, named)
+                if not got.ok:
+                    self.sink.at(agg.span, "E201", got.reason)
+            target = named
+        agg.annotate().type = target
+        seen: set[str] = set()
+        for item in agg.items:
+            key = item.name.upper()
+            if key in seen:
+                self.sink.at(item.span, "E206", f"component '{item.name}' given twice")
+            seen.add(key)
+            if isinstance(target, T.Struc) and target.fields:
+                ft = target.field_type(item.name)
+                if ft is None:
+                    self.sink.at(item.span, "W206" if target.soft else "E206",
+                                 f"{target.name} has no component '{item.name}'")
+                    self.expr(item.value, sc) if not isinstance(item.value, N.Aggregate) else None
+                    continue
+                self.check_value(ft, item.value, sc, item.value.span, what=f"component {item.name}")
+            elif target is T.UNKNOWN:
+                if isinstance(item.value, N.Aggregate):
+                    self.aggregate(item.value, sc, T.UNKNOWN)
+                else:
+                    self.expr(item.value, sc)
+            else:
+                self.sink.at(agg.span, "W201" if getattr(target, "soft", False) else "E201",
+                             f"an aggregate cannot be assigned to {target}")
+                return target
+        return target
+
+    # ---------------------------------------------------------------- expressions
+
+    def cond(self, e: N.Expr, sc: Scope, what: str) -> None:
+        t = self.expr(e, sc, expected=T.BOOL)
+        if t not in (T.BOOL, T.UNKNOWN):
+            self.sink.at(e.span, "E204", f"{what} condition is {t}, not BOOL")
+
+    def numeric(self, e: N.Expr, sc: Scope, what: str) -> None:
+        t = self.expr(e, sc)
+        if not T.is_numeric(t):
+            self.sink.at(e.span, "E203", f"{what} needs a number, not {t}")
+
+    def int_expr(self, e: N.Expr, sc: Scope, what: str, lossy_ok: bool = False) -> None:
+        t = self.expr(e, sc)
+        if t in (T.INT, T.UNKNOWN, T.CHAR) or lossy_ok and t == T.REAL:
+            return
+        self.sink.at(e.span, "E203", f"{what} must be INT, not {t}")
+
+    def set_type(self, e: N.Expr, t: T.KrlType) -> T.KrlType:
+        ann = e.ann
+        if ann is None:
+            e.ann = ann = N.Annotation()
+        ann.type = t
+        return t
+
+    def expr(self, e: N.Expr, sc: Scope, expected: T.KrlType | None = None,
+             lvalue: bool = False) -> T.KrlType:
+        """Type `e` (annotating it) and report errors; never raises for a valid AST."""
+        if isinstance(e, N.IntLit):
+            return self.set_type(e, T.INT)
+        if isinstance(e, N.RealLit):
+            return self.set_type(e, T.REAL)
+        if isinstance(e, N.BoolLit):
+            return self.set_type(e, T.BOOL)
+        if isinstance(e, N.StrLit):
+            return self.set_type(e, T.StrType(len(e.value)))
+        if isinstance(e, N.EnumLit):
+            if isinstance(expected, T.Enum):
+                if expected.values and e.name.upper() not in expected.values:
+                    self.sink.at(e.span, "W205" if expected.soft else "E205",
+                                 f"#{e.name} is not a value of {expected.name}")
+                    return self.set_type(e, T.UNKNOWN)
+                return self.set_type(e, expected)
+            return self.set_type(e, T.EnumLitType(e.name))
+        if isinstance(e, N.Name):
+            return self.name(e, sc)
+        if isinstance(e, N.Index):
+            return self.index(e, sc)
+        if isinstance(e, N.Field):
+            bt = self.expr(e.base, sc)
+            if bt is T.UNKNOWN:
+                return self.set_type(e, T.UNKNOWN)
+            if isinstance(bt, T.Struc):
+                ft = bt.field_type(e.name)
+                if ft is None:
+                    if bt.fields:
+                        self.sink.at(e.span, "W108" if bt.soft else "E108",
+                                     f"{bt.name} has no component '{e.name}'")
+                    return self.set_type(e, T.UNKNOWN)
+                return self.set_type(e, ft)
+            self.sink.at(e.span, "E108", f"'.{e.name}' applied to {bt}, which is not a structure")
+            return self.set_type(e, T.UNKNOWN)
+        if isinstance(e, N.Call):
+            return self.set_type(e, self.call(e, sc, statement=False))
+        if isinstance(e, N.Aggregate):
+            return self.set_type(e, self.aggregate(e, sc, expected or T.UNKNOWN))
+        if isinstance(e, N.Unary):
+            return self.set_type(e, self.unary(e, sc))
+        if isinstance(e, N.Binary):
+            return self.set_type(e, self.binary(e, sc))
+        return T.UNKNOWN
+
+    def name(self, e: N.Name, sc: Scope) -> T.KrlType:
+        sym = sc.lookup(e.name)
+        if sym is None:
+            rsym = sc.lookup_routine(e.name)
+            if rsym is not None:
+                # a parameterless function called without parentheses
+                e.annotate().symbol = rsym
+                return self.set_type(e, rsym.type if rsym.type is not T.VOID else T.UNKNOWN)
+            self.not_found(e.span, e.name, sc)
+            return self.set_type(e, T.UNKNOWN)
+        e.annotate().symbol = sym
+        return self.set_type(e, sym.type)
+
+    def index(self, e: N.Index, sc: Scope) -> T.KrlType:
+        bt = self.expr(e.base, sc)
+        for i in e.indices:
+            if i is None:
+                continue
+            it = self.expr(i, sc)
+            if it is T.UNKNOWN or it in (T.INT, T.CHAR):
+                continue
+            if it == T.REAL:
+                continue  # converted like an assignment to INT
+            self.sink.at(i.span, "E211", f"array index of type {it}; indices are INT")
+        if bt is T.UNKNOWN:
+            return self.set_type(e, T.UNKNOWN)
+        if not isinstance(bt, T.Array):
+            self.sink.at(e.span, "E109", f"'{_show(e.base)}' is {bt}, not an array")
+            return self.set_type(e, T.UNKNOWN)
+        n = len(bt.dims)
+        if all(i is None for i in e.indices) and (len(e.indices) == n or e.indices == [None]):
+            e.annotate().extra["whole_array"] = True
+            return self.set_type(e, bt)
+        if len(e.indices) != n:
+            self.sink.at(e.span, "E109", f"'{_show(e.base)}' has {n} dimension(s), {len(e.indices)} given")
+            return self.set_type(e, T.UNKNOWN)
+        for i, size in zip(e.indices, bt.dims):
+            if isinstance(i, N.IntLit) and size and not 1 <= i.value <= size:
+                self.sink.at(i.span, "E110", f"index {i.value} is outside 1..{size}")
+        if e.indices[-1] is None and all(i is not None for i in e.indices[:-1]):
+            e.annotate().extra["row"] = True
+            return self.set_type(e, T.Array(bt.elem, (bt.dims[-1],)))
+        if any(i is None for i in e.indices):
+            self.sink.at(e.span, "E109", "only the last index may be left out")
+            return self.set_type(e, T.UNKNOWN)
+        return self.set_type(e, bt.elem)
+
+    def unary(self, e: N.Unary, sc: Scope) -> T.KrlType:
+        t = self.expr(e.operand, sc)
+        if t is T.UNKNOWN:
+            return T.UNKNOWN
+        if e.op in ("-", "+"):
+            if t in (T.INT, T.REAL):
+                return t
+            if t == T.CHAR:
+                return T.INT
+        elif e.op == "NOT":
+            if t == T.BOOL:
+                return T.BOOL
+        elif e.op == "B_NOT":
+            if t in (T.INT, T.CHAR):
+                return T.INT
+        self.sink.at(e.span, "E203", f"{e.op} cannot be applied to {t}")
+        return T.UNKNOWN
+
+    def binary(self, e: N.Binary, sc: Scope) -> T.KrlType:
+        op = e.op
+        if op == ":":
+            lt = self.geo_operand(e.left, sc)
+            rt = self.geo_operand(e.right, sc)
+            for side, t in ((e.left, lt), (e.right, rt)):
+                if t is not T.UNKNOWN and T.geometric_family(t) != "cartesian":
+                    self.sink.at(side.span, "E203", f"':' needs FRAME, POS or E6POS operands, not {t}")
+                    return T.UNKNOWN
+            return rt
+        if op in EQUALITY:
+            lt = self.expr(e.left, sc)
+            rt = self.expr(e.right, sc, expected=lt if isinstance(lt, T.Enum) else None)
+            if isinstance(rt, T.Enum) and isinstance(e.left, N.EnumLit):
+                lt = self.expr(e.left, sc, expected=rt)
+        else:
+            lt = self.expr(e.left, sc)
+            rt = self.expr(e.right, sc)
+        if lt is T.UNKNOWN or rt is T.UNKNOWN:
+            return T.BOOL if op in EQUALITY | ORDER else T.UNKNOWN
+        num = (T.INT, T.REAL, T.CHAR)
+        if op in ARITH:
+            if lt in num and rt in num:
+                return T.REAL if T.REAL in (lt, rt) else T.INT
+        elif op in LOGIC:
+            if lt == T.BOOL and rt == T.BOOL:
+                return T.BOOL
+        elif op in BITS:
+            if lt in (T.INT, T.CHAR) and rt in (T.INT, T.CHAR):
+                return T.INT
+        elif op in EQUALITY:
+            if self.comparable(lt, rt):
+                return T.BOOL
+        elif op in ORDER:
+            if lt in num and rt in num or _char_like(lt) and _char_like(rt):
+                return T.BOOL
+        self.sink.at(e.span, "E203", f"'{op}' cannot be applied to {lt} and {rt}")
+        return T.BOOL if op in EQUALITY | ORDER else T.UNKNOWN
+
+    def comparable(self, a: T.KrlType, b: T.KrlType) -> bool:
+        num = (T.INT, T.REAL, T.CHAR)
+        if a in num and b in num:
+            return True
+        if _char_like(a) and _char_like(b):
+            return True
+        if a == T.BOOL and b == T.BOOL:
+            return True
+        if isinstance(a, T.Enum) and isinstance(b, T.Enum):
+            return a == b
+        if isinstance(a, (T.Enum, T.EnumLitType)) and isinstance(b, (T.Enum, T.EnumLitType)):
+            return True
+        return False
+
+    def geo_operand(self, e: N.Expr, sc: Scope) -> T.KrlType:
+        if isinstance(e, N.Aggregate) and e.type_name is None:
+            frame = sc.lookup_type("E6POS")
+            return self.aggregate(e, sc, frame if frame is not None else T.UNKNOWN)
+        return self.expr(e, sc)
+
+    # ---------------------------------------------------------------- calls
+
+    def call(self, c: N.Call, sc: Scope, statement: bool) -> T.KrlType:
+        sym = sc.lookup_routine(c.name)
+        if sym is None:
+            for a in c.args:
+                if a is not None:
+                    self.expr(a, sc)
+            code = "W106" if self._soft(sc) else "E106"
+            self.sink.at(c.span, code, f"routine '{c.name}' is not declared")
+            return T.UNKNOWN
+        c.annotate().symbol = sym
+        sig = sym.signature
+        if sig is None:
+            return T.UNKNOWN
+        if not statement and not sig.is_function:
+            self.sink.at(c.span, "E304", f"procedure '{c.name}' has no value")
+        if len(c.args) > len(sig.params) and not sig.varargs:
+            self.sink.at(c.span, "E301", f"'{c.name}' takes {len(sig.params)} argument(s), {len(c.args)} given")
+        for i, a in enumerate(c.args):
+            if a is None:
+                continue
+            p = sig.params[i] if i < len(sig.params) else None
+            if p is None:
+                self.expr(a, sc)
+                continue
+            if p.mode == "OUT":
+                if not N.is_lvalue(a):
+                    self.expr(a, sc, expected=p.type)
+                    self.sink.at(a.span, "E302", f"argument {i + 1} of '{c.name}' is :OUT and must be a variable")
+                    continue
+            if isinstance(a, N.Aggregate):
+                self.aggregate(a, sc, p.type)
+                continue
+            at = self.expr(a, sc, expected=p.type)
+            got = T.param_compatible(p.type, at, p.mode or "IN")
+            if not got.ok:
+                self.sink.at(a.span, "E303", f"argument {i + 1} of '{c.name}': {got.reason}")
+        return sig.returns if sig.returns is not None else T.VOID
+
+    # ---------------------------------------------------------------- helpers
+
+    def not_found(self, span: N.Span, name: str, sc: Scope) -> None:
+        if name.startswith("$"):
+            self.sink.at(span, "W107", f"unknown system variable '{name}'")
+        elif self._soft(sc):
+            why = "system file" if self.system_file else "the workspace has files with syntax errors"
+            self.sink.at(span, "W101", f"'{name}' is not declared ({why})")
+        else:
+            self.sink.at(span, "E101", f"'{name}' is not declared")
+
+    def not_found_type(self, span: N.Span, name: str, sc: Scope) -> None:
+        code = "W105" if self._soft(sc) else "E105"
+        self.sink.at(span, code, f"unknown type '{name}'")
+
+
+def _char_like(t: T.KrlType) -> bool:
+    return t == T.CHAR or isinstance(t, T.StrType) and t.length == 1
+
+
+def _show(e: N.Expr) -> str:
+    from krl.ast.printer import expr  # noqa: PLC0415 - only for messages
+    try:
+        return expr(e)
+    except Exception:  # noqa: BLE001
+        return "?"

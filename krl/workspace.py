@@ -1,0 +1,335 @@
+"""A KRL program as a set of files (reference 2.1, 2.5, 2.7).
+
+A :class:`Workspace` holds parsed files (:class:`SourceFile`, each with its AST), the scope
+hierarchy of :mod:`krl.semantics.symbols` and the diagnostics. Pairing and visibility:
+
+* ``NAME.src`` (or ``.sub``) and ``NAME.dat`` in the same folder form one module: the data
+  list is the module scope of the routines;
+* ``$config.dat`` and the system data lists (any ``DEFDAT $NAME``: ``$machine.dat``,
+  ``$custom.dat``, ``$option.dat``, ``$robcor.dat``, ``$operate.dat``) are global;
+* ``DEFDAT X PUBLIC`` exports its ``GLOBAL`` declarations; the main routine (first routine)
+  of every module and every ``GLOBAL DEF/DEFFCT`` are global routines;
+* ``IMPORT`` declarations bring another module's data under a local name.
+
+A KRC backup folder (``KRC/R1/Program``, ``R1/System`` with ``bas.src`` and ``$config.dat``,
+``R1/Mada``, ``R1/TP``, ``STEU/Mada``; any letter case) loads as one workspace:
+:func:`find_backups` finds them, :func:`load_workspace` loads files or folders.
+Files are read with krl.syntax.source.read_source and parsed with parse_source only.
+
+Usage::
+
+    ws = load_workspace([Path("KRC")])
+    ws.check()                      # runs the checker, fills ws.diagnostics
+    ws.modules["DEMO"].routines     # AST; expression types in node.ann.type
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from krl.ast import nodes as N
+from krl.ast.build import build_module
+from krl.semantics.checker import Checker, Declarer, _is_system_datalist
+from krl.semantics.diagnostics import Diagnostic, DiagnosticSink
+from krl.semantics.symbols import Scope, Symbol, system_scopes
+from krl.syntax.parse import parse_source
+from krl.syntax.source import is_krl_file, read_source
+
+
+@dataclass(slots=True)
+class SourceFile:
+    """One file of the workspace: its AST, whether it parsed, and its module scope."""
+    path: str
+    module: N.Module
+    ok: bool
+    status: str = "ok"
+    scope: Scope | None = None
+    parse_seconds: float = 0.0
+
+
+@dataclass(slots=True)
+class ModuleUnit:
+    """A module: its .src/.sub file and/or its .dat file, sharing one module scope."""
+    name: str
+    src: SourceFile | None = None
+    dat: SourceFile | None = None
+    scope: Scope | None = None
+
+    @property
+    def routines(self) -> list[N.Routine]:
+        return self.src.module.routines if self.src is not None else []
+
+
+@dataclass
+class Workspace:
+    """Files, scopes and diagnostics of one program (see the module docstring)."""
+    root: str
+    files: list[SourceFile] = field(default_factory=list)
+    units: list[ModuleUnit] = field(default_factory=list)
+    global_scope: Scope | None = None
+    sink: DiagnosticSink = field(default_factory=DiagnosticSink)
+    routine_scopes: dict[int, Scope] = field(default_factory=dict)
+    parse_seconds: float = 0.0
+    check_seconds: float = 0.0
+    checked: bool = False
+
+    @property
+    def diagnostics(self) -> list[Diagnostic]:
+        return self.sink.sorted()
+
+    @property
+    def modules(self) -> dict[str, ModuleUnit]:
+        return {u.name.upper(): u for u in self.units}
+
+    @property
+    def incomplete(self) -> bool:
+        return any(not f.ok for f in self.files)
+
+    def routine_scope(self, routine: N.Routine) -> Scope | None:
+        """The scope of a routine's parameters and locals (after :meth:`check`)."""
+        return self.routine_scopes.get(id(routine))
+
+    def add_file(self, path: str | Path) -> SourceFile:
+        """Read, parse and build one file (never raises for bad content)."""
+        t = time.perf_counter()
+        src = read_source(path)
+        result = parse_source(src)
+        elapsed = time.perf_counter() - t
+        self.parse_seconds += elapsed
+        path_s = str(path)
+        if result.status not in ("ok", "syntax_error"):
+            self.sink.add(path_s, 1, 1, "E001", f"file not checked: {result.status}"
+                          + (f" ({src.detail})" if src.detail else ""))
+        for err in result.errors:
+            if not err.cascade:
+                self.sink.add(path_s, err.line, err.column + 1, "E002", err.message)
+        t = time.perf_counter()
+        module = build_module(result, self.sink)
+        self.check_seconds += time.perf_counter() - t
+        sf = SourceFile(path_s, module, result.ok, result.status, parse_seconds=elapsed)
+        self.files.append(sf)
+        return sf
+
+    # ------------------------------------------------------------------ linking
+
+    def _pair(self) -> None:
+        by_key: dict[tuple[str, str], ModuleUnit] = {}
+        for f in self.files:
+            p = Path(f.path)
+            key = (str(p.parent).lower(), p.stem.lower())
+            unit = by_key.get(key)
+            if unit is None:
+                unit = ModuleUnit(p.stem)
+                by_key[key] = unit
+                self.units.append(unit)
+            if f.module.kind == "dat" or p.suffix.lower() == ".dat":
+                if unit.dat is None:
+                    unit.dat = f
+            elif unit.src is None:
+                unit.src = f
+            else:  # two code files with one stem (e.g. x.src and x.sub): keep both as units
+                other = ModuleUnit(p.stem, src=f)
+                self.units.append(other)
+
+    def check(self) -> list[Diagnostic]:
+        """Link the files into scopes and run the checker; returns the sorted diagnostics."""
+        if self.checked:
+            return self.diagnostics
+        t = time.perf_counter()
+        self.checked = True
+        try:
+            self._check()
+        except Exception as exc:  # noqa: BLE001 - never a traceback for bad input
+            self.sink.add(self.root, 1, 1, "E901", f"internal checker error: {type(exc).__name__}: {exc}")
+        self.check_seconds += time.perf_counter() - t
+        return self.diagnostics
+
+    def _check(self) -> None:
+        _system, basis = system_scopes()
+        incomplete = self.incomplete
+        sink = self.sink
+        declarer = Declarer(sink, incomplete)
+        checker = Checker(sink, declarer, incomplete)
+        glob = Scope("global", "$GLOBAL", basis)
+        glob.incomplete = incomplete
+        self.global_scope = glob
+        self._pair()
+
+        # which scope each data list's declarations go to
+        def targets(unit: ModuleUnit) -> list[tuple[Scope, list[N.Decl], str]]:
+            out = []
+            if unit.dat is not None and unit.dat.module.data is not None:
+                dl = unit.dat.module.data
+                if _is_system_datalist(dl.name):
+                    out.append((glob, dl.items, dl.name))
+                else:
+                    exported = [d for d in dl.items if getattr(d, "is_global", False)]
+                    local = [d for d in dl.items if not getattr(d, "is_global", False)]
+                    if exported:
+                        out.append((glob, exported, dl.name))
+                    out.append((unit.scope, local, dl.name))
+            return out
+
+        for unit in self.units:
+            unit.scope = Scope("module", unit.name, glob)
+            for f in (unit.src, unit.dat):
+                if f is not None:
+                    f.scope = unit.scope
+        plan = [(u, targets(u)) for u in self.units]
+        for _u, tg in plan:
+            for scope, items, _name in tg:
+                declarer.declare_types(scope, items)
+        for u, tg in plan:
+            for scope, items, name in tg:
+                declarer.soft_types = _is_system_datalist(name) or is_system_path(u.dat.path)
+                declarer.fill_types(scope, items)
+        declarer.soft_types = False
+        # system data lists first, so that user globals that repeat them are the duplicates
+        order = sorted(plan, key=lambda p: 0 if any(_is_system_datalist(n) for _, _, n in p[1]) else 1)
+        for u, tg in order:
+            for scope, items, name in tg:
+                path = u.dat.path if u.dat is not None else ""
+                if scope is glob and _is_system_datalist(name):
+                    # several system data lists may repeat a declaration: first one wins
+                    tmp = Scope("global-sys", name, glob)
+                    declarer.soft_types = True  # they refer to $operate.dat, never in a backup
+                    try:
+                        declarer.declare_values(tmp, items, name, path)
+                    finally:
+                        declarer.soft_types = False
+                    for k, v in tmp.values.items():
+                        glob.values.setdefault(k, v)
+                    for k, v in tmp.routines.items():
+                        glob.routines.setdefault(k, v)
+                else:
+                    declarer.soft_types = is_system_path(path)
+                    declarer.declare_values(scope, items, name, path)
+                    declarer.soft_types = False
+
+        # routines: main routines and GLOBAL ones are global, others module-local
+        routine_syms: list[tuple[N.Routine, Symbol, ModuleUnit]] = []
+        for u in self.units:
+            if u.src is None:
+                continue
+            declarer.soft_types = is_system_path(u.src.path)
+            for i, r in enumerate(u.src.module.routines):
+                declarer.ident(r.name, r.span)
+                is_global = i == 0 or r.is_global
+                scope = glob if is_global else u.scope
+                sym = declarer.routine_symbol(r, u.name, u.src.path, u.scope)
+                old = scope.routines.get(r.name.upper())
+                if old is not None and isinstance(old.decl, N.Routine):
+                    declarer.duplicate(r.name, r.span, old)
+                else:
+                    scope.routines[r.name.upper()] = sym  # a routine replaces its EXT signature
+                if is_global and scope is glob:
+                    u.scope.routines.setdefault(r.name.upper(), sym)
+                routine_syms.append((r, sym, u))
+            declarer.soft_types = False
+            if u.src.module.routines:
+                main = u.src.module.routines[0]
+                if main.name.upper() != u.name.upper() and not u.src.path.lower().endswith(".sub"):
+                    sink.at(main.span, "W111", f"main routine '{main.name}' differs from the file name '{u.name}'")
+
+        # routine scopes (parameters and locals), then signatures, then bodies
+        for r, sym, u in routine_syms:
+            declarer.soft_types = is_system_path(u.src.path)
+            local = Scope("routine", r.name, u.scope)
+            declarer.declare_types(local, r.decls)
+            declarer.fill_types(local, r.decls)
+            declarer.declare_values(local, r.decls, u.name, u.src.path if u.src else "")
+            declarer.complete_signature(sym, local)
+            self.routine_scopes[id(r)] = local
+        declarer.soft_types = False
+        for u in self.units:
+            if u.dat is not None and u.dat.module.data is not None and u.dat.ok:
+                checker.system_file = declarer.soft_types = is_system_path(u.dat.path)
+                checker.check_datalist(u.dat.module.data, u.scope)
+        for r, _sym, u in routine_syms:
+            if u.src is None or not u.src.ok:
+                continue  # a file with syntax errors: its AST may miss tokens; E002 says why
+            checker.system_file = declarer.soft_types = is_system_path(u.src.path)
+            checker.check_routine(r, self.routine_scopes[id(r)], u.src.path)
+        checker.system_file = declarer.soft_types = False
+
+
+SYSTEM_DIRS = ("system", "tp", "mada", "steu")
+
+
+def is_system_path(path: str) -> bool:
+    """True for KUKA system files of a backup (folders System, TP, Mada, STEU, or a $-file):
+    they rely on $operate.dat declarations that a backup never contains (see W101/W105/W106)."""
+    parts = Path(path).parts
+    return Path(path).name.startswith("$") or any(p.lower() in SYSTEM_DIRS for p in parts[:-1])
+
+
+def _casefold_child(folder: Path, name: str) -> Path | None:
+    try:
+        for c in folder.iterdir():
+            if c.name.lower() == name.lower():
+                return c
+    except OSError:
+        return None
+    return None
+
+
+def find_backups(root: str | Path) -> list[Path]:
+    """Backup roots below `root`: folders with R1/System/$config.dat (the root is the folder
+    holding R1, e.g. KRC) or System/$config.dat (a flat R1 export). Any letter case; sorted."""
+    root = Path(root)
+    found: set[Path] = set()
+    for cfg in root.rglob("*"):
+        if cfg.name.lower() != "$config.dat" or not cfg.is_file():
+            continue
+        system = cfg.parent
+        if system.name.lower() != "system":
+            continue
+        base = system.parent
+        found.add(base.parent if base.name.lower() == "r1" else base)
+    roots = sorted(found)
+    # a backup inside another one is part of it
+    return [r for r in roots if not any(o != r and o in r.parents for o in roots)]
+
+
+def collect_files(path: Path) -> list[Path]:
+    """KRL files (.src, .dat, .sub in any case) of a file or folder, sorted."""
+    if path.is_file():
+        return [path]
+    try:
+        return sorted(p for p in path.rglob("*") if p.is_file() and is_krl_file(p))
+    except OSError:
+        return []
+
+
+def load_workspace(paths: list[str | Path], root: str = "") -> Workspace:
+    """One workspace from files and/or folders (all files of the folders). Never raises for
+    bad content; a path that does not exist gives an E001 diagnostic."""
+    ws = Workspace(root or (str(paths[0]) if paths else ""))
+    for p in paths:
+        p = Path(p)
+        if not p.exists():
+            ws.sink.add(str(p), 1, 1, "E001", "no such file or folder")
+            continue
+        for f in collect_files(p):
+            ws.add_file(f)
+    return ws
+
+
+def workspaces_for(path: str | Path) -> list[Workspace]:
+    """The workspaces to check for a command-line PATH: a file -> itself with the .dat/.src
+    of its module; a folder holding backups -> one workspace per backup; another folder ->
+    one workspace of all its files."""
+    p = Path(path)
+    if p.is_file():
+        files = [p]
+        for sib in (p.parent.iterdir() if p.parent.exists() else []):
+            if sib != p and sib.stem.lower() == p.stem.lower() and is_krl_file(sib):
+                files.append(sib)
+        return [load_workspace(files, str(p))]
+    if p.is_dir():
+        backups = find_backups(p)
+        if backups:
+            return [load_workspace([b], str(b)) for b in backups]
+    return [load_workspace([p], str(p))]
