@@ -23,8 +23,12 @@ Model (documented in docs/robot.md, "Motion"):
   PTP→PTP with ``C_PTP``, with the per-axis rule and the ``$APO.CPTP`` of the *next* motion
   (KSS 8 per-point rule, reference §6.8).
 
-* **Contour** — the next segment starts (its own time law, from rest) at the blend start;
-  during the blend window the setpoint is the convex combination
+* **Contour** — the next segment starts (its own time law, from rest) at the blend start.
+  Preferred: the *overlap of the velocity profiles* ``x = x_prev(t) + (x_next(t) - P)``
+  (axis values for blends with a PTP side), used when :func:`overlap_ok` proves it stays
+  in the zone; the blend then ends when the approximated motion reaches its point and the
+  speed never exceeds the sum of the two profiles (no overshoot for equal accelerations).
+  Otherwise, during the blend window the setpoint is the convex combination
   ``x = (1-w)·x_prev(t) + w·x_next(t)`` with ``w`` = smoothstep over the window. ``x_prev``
   only moves from the blend start to the programmed point and ``x_next`` only from the
   programmed point to the blend end, so every blended setpoint lies in the convex hull of
@@ -34,6 +38,8 @@ Model (documented in docs/robot.md, "Motion"):
 """
 
 from __future__ import annotations
+
+import math
 
 import numpy as np
 from scipy.spatial.transform import Rotation
@@ -144,6 +150,57 @@ def blend_end_tau(prev: Segment, nxt: Segment, keyword: str, tau_start: float) -
     return nxt.profile.t_of_u(nxt.u_of_path(min(d_start, L / 2.0)))
 
 
+def _remaining_norm(seg: Segment, u: float, u_a: float) -> float:
+    """Remaining part of ``seg`` after parameter u, relative to the part left at the blend
+    start u_a (1 at the blend start, 0 at the programmed point): path length for CP, the
+    parameter (= every axis' share) for PTP."""
+    if isinstance(seg, CartSegment):
+        L = seg.path_length
+        den = L - seg.s_of_u(u_a)
+        return (L - seg.s_of_u(u)) / den if den > 0 else 0.0
+    return (1.0 - u) / (1.0 - u_a) if u_a < 1.0 else 0.0
+
+
+def _progress_norm(seg: Segment, u: float, u_e: float) -> float:
+    """Progress of ``seg`` up to parameter u relative to the blend-end parameter u_e."""
+    if isinstance(seg, CartSegment):
+        den = seg.s_of_u(u_e)
+        return seg.s_of_u(u) / den if den > 0 else (0.0 if u <= 0 else 2.0)
+    return u / u_e if u_e > 0 else (0.0 if u <= 0 else 2.0)
+
+
+def overlap_ok(prev: Segment, nxt: Segment, tau_a: float, tau_e: float, h: float) -> bool:
+    """Can the blend be the *overlap of the two velocity profiles* (superposition
+    ``x = x_prev(t) + (x_next(t) - P)``) without leaving the zone?
+
+    With ``ρ`` the normalised remaining part of ``prev`` and ``π`` the normalised progress
+    of ``nxt`` (relative to the blend start and blend end distances), ``|x - P| <= ρ·d_s +
+    π·d_e <= max(d_s, d_e)`` whenever ``ρ + π <= 1``. Checked on a grid of step ``h`` (s)
+    from the blend start until ``prev`` reaches its point; ``nxt`` must not progress past
+    the blend end before that either. True in the usual case (blend in the deceleration
+    phase, similar accelerations); otherwise the convex combination is used."""
+    T = prev.T
+    if T - tau_a <= 0 or tau_e <= 0:
+        return False
+    u_a = prev.profile.u(tau_a)
+    u_e = nxt.profile.u(tau_e)
+    n = int(math.ceil((T - tau_a) / h))
+    for j in range(1, n + 1):
+        t = min(tau_a + j * h, T)
+        rho = _remaining_norm(prev, prev.profile.u(t), u_a)
+        pi = _progress_norm(nxt, nxt.profile.u(t - tau_a), u_e)
+        if rho + pi > 1.0 + 1e-9:
+            return False
+    return True
+
+
+def superpose_pose(p0: np.ndarray, R0: np.ndarray, p1: np.ndarray, R1: np.ndarray,
+                   pc: np.ndarray, Rc: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Profile overlap in Cartesian space: ``p = p_prev + (p_next - P)``,
+    ``R = (R_next · R_Pᵀ) · R_prev`` (the next motion's change applied on top)."""
+    return p0 + (p1 - pc), (R1 @ Rc.T) @ R0
+
+
 def blend_space(prev: Segment, nxt: Segment) -> str:
     """``"cart"`` when both segments are CP motions (combined in Cartesian space with the
     same $TOOL/$BASE, neither with ``$ORI_TYPE #JOINT``), else ``"joint"``."""
@@ -174,4 +231,4 @@ def combine_axes(q0: np.ndarray, q1: np.ndarray, w: float) -> np.ndarray:
 
 
 __all__ = ["effective_keyword", "blend_start_tau", "blend_end_tau", "blend_space", "weight",
-           "combine_pose", "combine_axes"]
+           "combine_pose", "combine_axes", "overlap_ok", "superpose_pose"]

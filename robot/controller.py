@@ -154,6 +154,7 @@ class _Blend:
     pb: float
     space: str
     keyword: str
+    overlap: bool = False
 
 
 @dataclass
@@ -329,7 +330,11 @@ class Controller:
         Ramp time ``T = max_i |q̇_i| / (f · a_max_i)`` with f = 0.5 (BRAKE) or 1.0 (BRAKE F)
         of the machine acceleration. The interpreter steps until :meth:`is_braking` is False.
         """
-        if not self.is_moving() or self._braking:
+        if self._braking:
+            return
+        if not self.is_moving():
+            if self._pending:  # at rest between motions: hold the queued ones
+                self._hold()
             return
         qd = np.abs(self._q - self._q_prev) / self.dt
         f = 1.0 if fast else 0.5
@@ -449,10 +454,17 @@ class Controller:
         q = self.axis_act()
         tool_T = self._tool_T if tool is None else _as4(tool)
         base_inv = self._base_inv_T if base is None else inv_pos(_as4(base))
-        T = self.model.tcp(q, tool_T, base_inv)
+        T = self._tcp_read_back(q, tool_T, base_inv)
         x, y, z, a, b, c = matrix_to_frame(T)
         s, t = self.model.status_turn(q)
         return {"X": x, "Y": y, "Z": z, "A": a, "B": b, "C": c, "S": s, "T": t}
+
+    def _tcp_read_back(self, q: np.ndarray, tool_T: np.ndarray, base_inv_T: np.ndarray) -> np.ndarray:
+        """TCP in $BASE from the MuJoCo flange site (``INV_POS($BASE) : FLANGE_world : $TOOL``),
+        or from the forward kinematics of ``q`` without MuJoCo."""
+        if self._arm is not None:
+            return base_inv_T @ self._arm.flange_pose_world() @ tool_T
+        return self.model.tcp(q, tool_T, base_inv_T)
 
     def vel_act(self) -> float:
         """``$VEL_ACT``: TCP speed in m/s over the last IPO cycle."""
@@ -537,7 +549,7 @@ class Controller:
                 self._arm.set_axes(self._q)
         qa = self.axis_act()
         self._tcp_prev = self._tcp_T[:3, 3].copy()
-        self._tcp_T = self.model.tcp(qa, self._tool_T, self._base_inv_T)
+        self._tcp_T = self._tcp_read_back(qa, self._tool_T, self._base_inv_T)
         for fn in list(self._cyclic.values()):
             fn(self)
         self._reach_stimuli()
@@ -603,12 +615,16 @@ class Controller:
     def _begin_blend(self, r: _Run, pt: float) -> np.ndarray:
         nseg = self._pending.popleft()
         kw = blending.effective_keyword(r.seg, nseg) or "C_DIS"
-        tau_e = blending.blend_end_tau(r.seg, nseg, kw, pt - r.t0)
+        tau_a = pt - r.t0
+        tau_e = blending.blend_end_tau(r.seg, nseg, kw, tau_a)
+        overlap = blending.overlap_ok(r.seg, nseg, tau_a, tau_e, self.dt / 4.0)
+        if overlap:
+            tau_e = r.seg.T - tau_a  # the blend ends when the approximated motion ends
         self._motion_event(r.seg, "blend_start")
         nr = self._start(nseg, pt)
         nr.blend_in_end = pt + tau_e
         r.blend_mid = pt + 0.5 * tau_e
-        b = _Blend(r, nr, pt, pt + tau_e, blending.blend_space(r.seg, nseg), kw)
+        b = _Blend(r, nr, pt, pt + tau_e, blending.blend_space(r.seg, nseg), kw, overlap)
         self._runs = [nr]
         self._blend = b
         if tau_e <= EPS:
@@ -626,6 +642,16 @@ class Controller:
         w = blending.weight((pt - b.pa) / (b.pb - b.pa))
         t_prev = min(pt - b.prev.t0, b.prev.seg.T)
         t_next = pt - b.nxt.t0
+        if b.overlap:
+            if b.space == "cart":
+                p0, R0 = b.prev.seg.pose(t_prev)
+                p1, R1 = b.nxt.seg.pose(t_next)
+                pc, Rc = b.nxt.seg.pose(0.0)
+                p, R = blending.superpose_pose(p0, R0, p1, R1, pc, Rc)
+                return b.nxt.seg.ik(p, R, self._q)  # type: ignore[attr-defined]
+            q = b.prev.seg.axes(t_prev) + (b.nxt.seg.axes(t_next) - b.nxt.seg.q0)
+            self.model.kin.check_soft_limits(q)
+            return q
         if b.space == "cart":
             p0, R0 = b.prev.seg.pose(t_prev)
             p1, R1 = b.nxt.seg.pose(t_next)

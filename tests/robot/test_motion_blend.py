@@ -179,3 +179,18 @@ def test_c_ori_blend_starts_at_remaining_orientation():
 
     assert remaining(ph["blend_start"]) <= 10.0 + 1e-6
     assert remaining(ph["blend_start"] - DT) > 10.0
+
+
+def test_blend_overlaps_profiles_without_overspeed():
+    """Equal accelerations: the overlapped profiles never exceed $VEL.CP (500 mm/s) and the
+    blend ends when the approximated motion reaches its point."""
+    ctl, ev = _run(_corner_program(cdis=30.0, v=0.5))
+    ph2, ph3 = _phases(ev, 2), _phases(ev, 3)
+    poses = [e for e in ev if e["kind"] == "pose" and ph2["start"] <= e["t"] <= ph3["end"]]
+    P = np.array([e["tcp"][:3] for e in poses])
+    speed = np.linalg.norm(np.diff(P, axis=0), axis=1) / DT
+    assert speed.max() <= 500.0 * (1 + 1e-6)
+    # the robot never stops in between
+    inner = [e for e in poses if ph2["blend_start"] <= e["t"] <= ph2["blend_end"]]
+    Pi = np.array([e["tcp"][:3] for e in inner])
+    assert (np.linalg.norm(np.diff(Pi, axis=0), axis=1) / DT).min() > 100.0
