@@ -571,7 +571,7 @@ class Controller:
             kw = blending.effective_keyword(seg, nxt)
             ta = blending.blend_start_tau(seg, nxt, kw) if kw else None
             if ta is not None:
-                te = blending.blend_end_tau(seg, nxt, kw, ta)
+                te, _ = self._blend_window(seg, nxt, kw, ta)
                 run.planned_mid = pt + ta + 0.5 * te
         return run
 
@@ -616,10 +616,7 @@ class Controller:
         nseg = self._pending.popleft()
         kw = blending.effective_keyword(r.seg, nseg) or "C_DIS"
         tau_a = pt - r.t0
-        tau_e = blending.blend_end_tau(r.seg, nseg, kw, tau_a)
-        overlap = blending.overlap_ok(r.seg, nseg, tau_a, tau_e, self.dt / 4.0)
-        if overlap:
-            tau_e = r.seg.T - tau_a  # the blend ends when the approximated motion ends
+        tau_e, overlap = self._blend_window(r.seg, nseg, kw, tau_a)
         self._motion_event(r.seg, "blend_start")
         nr = self._start(nseg, pt)
         nr.blend_in_end = pt + tau_e
@@ -631,6 +628,14 @@ class Controller:
             self._end_blend(b)
             return nr.seg.axes(pt - nr.t0)
         return self._blend_setpoint(b, pt)
+
+    def _blend_window(self, seg: Segment, nxt: Segment, kw: str, tau_a: float) -> tuple[float, bool]:
+        """Length (s) of the blend that starts at local time ``tau_a`` of ``seg``, and
+        whether it is a profile overlap (see robot/blending.py)."""
+        tau_e = blending.blend_end_tau(seg, nxt, kw, tau_a)
+        if blending.overlap_ok(seg, nxt, tau_a, tau_e, self.dt / 4.0):
+            return seg.T - tau_a, True  # the blend ends when the approximated motion ends
+        return tau_e, False
 
     def _end_blend(self, b: _Blend) -> None:
         self._blend = None

@@ -312,3 +312,14 @@ def test_actuated_mode_follows_setpoints():
     run_motions(ctl, [MotionRequest("PTP", TOOL_DOWN, MotionParams().with_(vel_axis=(50.0,) * 6))])
     ctl.wait_sec(0.2)
     assert np.max(np.abs(ctl.axis_act() - ctl.axis_setpoint())) < 0.5
+
+
+def test_trigger_distance1_negative_delay_before_blend_middle():
+    P = MotionParams().with_(vel_cp=0.25, apo_cdis=30.0)
+    nxt = (MotionRequest("LIN", {"X": 600, "Y": 300, "Z": 810}, P),)
+    ctl, tw = _ctl()
+    run_motions(ctl, _lin_with([Trigger(distance=1, delay_ms=-50)], approx="C_DIS", extra=nxt))
+    ph = _phases(tw.events, 2)
+    (_, _, t), = _trig_times(tw.events)
+    mid = 0.5 * (ph["blend_start"] + ph["blend_end"])
+    assert abs((mid - t) - 0.050) <= DT + 1e-9
