@@ -34,11 +34,11 @@ import numpy as np
 from . import blending
 from .errors import RobotError
 from .frames import frame_to_matrix, inv_pos, matrix_to_frame
-from .io import IOImage, parse_signal
+from .io import IOImage
 from .machine import MachineData, load_machine
 from .motion import MotionRequest, Trigger
 from .planner import RobotModel, Segment, TriggerPlan, plan, resolved_target
-from .stimuli import Stimulus, load_stimuli, parse_stimuli
+from .stimuli import Stimulus, load_stimuli
 from .trace import TraceWriter
 
 EPS = 1e-9
@@ -762,4 +762,4 @@ def _as4(F: Any) -> np.ndarray:
 
 
 __all__ = ["Controller", "MotionEvent", "TriggerEvent", "IoEvent", "MessageEvent",
-           "ErrorEvent", "Event", "MSG_APPROX_IMPOSSIBLE", "parse_signal", "parse_stimuli"]
+           "ErrorEvent", "Event", "MSG_APPROX_IMPOSSIBLE"]

@@ -18,7 +18,7 @@ violation of a target raises :class:`~robot.errors.RobotError` at the motion sta
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -27,7 +27,7 @@ from scipy.spatial.transform import Rotation
 from .errors import RobotError, WorkspaceError
 from .frames import frame_to_matrix, inv_pos, matrix_to_frame
 from .kinematics import Kinematics
-from .motion import AXIS_KEYS, CART_KEYS, MotionParams, MotionRequest, SplineSegment, Trigger
+from .motion import AXIS_KEYS, CART_KEYS, MotionParams, MotionRequest, Trigger
 from .profiles import Trapezoid
 
 
@@ -443,10 +443,6 @@ class CartSegment(Segment):
 
 
 # ------------------------------------------------------------------------- planning
-def _frame(T: np.ndarray) -> tuple[np.ndarray, Rotation]:
-    return T[:3, 3].copy(), Rotation.from_matrix(T[:3, :3])
-
-
 def _apply_partial(start6: tuple[float, ...], tgt: dict[str, float]) -> list[float]:
     return [float(tgt[k]) if k in tgt else float(start6[i]) for i, k in enumerate(CART_KEYS)]
 
@@ -725,4 +721,4 @@ def resolved_target(seg: Segment) -> MotionRequest:
 
 
 __all__ = ["RobotModel", "Segment", "JointSegment", "CartSegment", "TriggerPlan", "plan",
-           "resolved_target", "LinePiece", "ArcPiece", "CatmullRomPiece", "SplineSegment"]
+           "resolved_target", "LinePiece", "ArcPiece", "CatmullRomPiece"]
