@@ -1,0 +1,60 @@
+"""`krl run`: run a KRL program on the simulated controller (issue 6).
+
+Exit codes: 0 completed; 3 stopped (HALT, --max-steps, --max-sim-time, deadlocked WAIT);
+1 KRL run-time error; 2 usage or internal error (also `--interp vm` until the VM exists).
+"""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import click
+
+
+@click.command("run")
+@click.argument("program", type=click.Path(path_type=Path))
+@click.option("--interp", "interp_kind", type=click.Choice(["tree", "vm"]), default="tree",
+              show_default=True, help="Interpreter.")
+@click.option("--workspace", type=click.Path(path_type=Path), default=None,
+              help="Folder of the program's modules (default: the program's folder; a KRC backup is detected).")
+@click.option("--inputs", type=click.Path(path_type=Path), default=None, help="Stimuli YAML (robot/stimuli.py).")
+@click.option("--trace", "trace_path", type=click.Path(path_type=Path), default=None, help="Write the JSONL trace here.")
+@click.option("--max-sim-time", type=float, default=600.0, show_default=True, help="Simulated-time limit (s).")
+@click.option("--max-steps", type=int, default=10_000_000, show_default=True,
+              help="Limit of executed statements and loop iterations.")
+@click.option("--submit", "submit", type=click.Path(path_type=Path), multiple=True,
+              help="A submit program (.sub) to run beside the robot program (repeatable).")
+def run(program: Path, interp_kind: str, workspace, inputs, trace_path, max_sim_time, max_steps, submit) -> None:
+    """Run PROGRAM (.src) on the simulated KR C4; print where and why it ended."""
+    if interp_kind == "vm":
+        click.echo("error: --interp vm: the bytecode VM is not built yet (issue 7); use --interp tree", err=True)
+        sys.exit(2)
+    if not program.exists():
+        click.echo(f"error: {program}: no such file", err=True)
+        sys.exit(2)
+    from interp.run import run_program  # noqa: PLC0415
+    from robot.trace import TraceWriter  # noqa: PLC0415
+
+    trace = TraceWriter(trace_path) if trace_path else None
+    try:
+        res = run_program(program, workspace=workspace, inputs=inputs, trace=trace,
+                          max_sim_time=max_sim_time, max_steps=max_steps, submit=list(submit))
+    except Exception as exc:  # noqa: BLE001
+        click.echo(f"internal error: {type(exc).__name__}: {exc}", err=True)
+        sys.exit(2)
+    finally:
+        if trace is not None:
+            trace.close()
+    where = f"{res.file}:{res.line}" if res.line else ""
+    if res.reason == "completed":
+        click.echo(f"completed at t={res.sim_time:.3f} s ({res.steps} steps)")
+    elif res.reason == "error":
+        num = f" ({res.error.number})" if res.error is not None and res.error.number else ""
+        click.echo(f"error at {where}: {res.text}{num} (t={res.sim_time:.3f} s)")
+    else:
+        click.echo(f"stopped ({res.reason}) at {where}: {res.text} (t={res.sim_time:.3f} s)".replace(": ()", ""))
+    sys.exit(res.exit_code)
+
+
+commands = [run]

@@ -1,0 +1,698 @@
+"""Built-in functions and procedures (reference §4.5-§4.8, §5.12, §5.19).
+
+:func:`call_builtin` is the single entry: ``args`` is a list of references
+(:class:`memory.Ref`; an expression argument is wrapped in :class:`ValueRef`, an omitted
+one is None). :IN arguments are read with ``get()``, :OUT arguments written with ``set()``.
+:data:`NATIVES` lists what is implemented; signatures are the front end's data table
+(krl/semantics/data/functions.yaml). BASIS routines (BAS, SVEL_JOINT, ...) are KRL in
+interp/basis/bas.src (or the backup's), not natives.
+
+SWRITE/SREAD use a printf/scanf-style format engine written here (no eval): ``%[flags]
+[width][.precision]conv`` with flags ``-+ 0#``, conversions ``d i x X o f F e E g G c s``
+and ``%%``. Unsupported: CAST_TO/CAST_FROM, CREAD/COPEN/CCLOSE/CIOCTL, channels other
+than $CMD — a clear "not supported" run-time error.
+"""
+
+from __future__ import annotations
+
+import math
+import random
+
+from krl.semantics import types as T
+
+from .convert import convert_scalar, frame_tuple, inv_pos, num, real_to_int, to_bool
+from .errors import KrlRuntimeError, value_invalid
+from .memory import Ref
+from .values import UNSET, Arr, EnumValue, Struct, is_char_array, make_value
+
+
+class ValueRef(Ref):
+    """An rvalue passed where a reference is expected (an :IN expression argument)."""
+
+    __slots__ = ("v", "type", "name")
+
+    def __init__(self, v, name: str = "argument") -> None:
+        self.v = v
+        self.type = None
+        self.name = name
+
+    def peek(self):
+        return self.v
+
+    def set(self, v) -> None:
+        self.v = v
+
+
+def _text(ref: Ref | None, what: str) -> str:
+    if ref is None:
+        raise value_invalid(what)
+    v = ref.get()
+    if isinstance(v, str):
+        return v
+    if isinstance(v, Arr) and v.type.elem == T.CHAR:
+        return v.text()
+    raise KrlRuntimeError(f"{what} is not a string")
+
+
+def _real(ref, what="argument") -> float:
+    if ref is None:
+        raise value_invalid(what)
+    return float(num(ref.get(), what))
+
+
+def _int(ref, what="argument") -> int:
+    if ref is None:
+        raise value_invalid(what)
+    v = num(ref.get(), what)
+    return v if v.__class__ is int else real_to_int(v)
+
+
+def _chars(ref, what) -> Arr:
+    if ref is None:
+        raise value_invalid(what)
+    v = ref.peek()
+    if not is_char_array(v):
+        raise KrlRuntimeError(f"{what} is not a CHAR array")
+    return v
+
+
+def _put_text(arr: Arr, text: str) -> int:
+    n = len(arr.data)
+    text = text[:n]
+    for i, ch in enumerate(text):
+        arr.data[i] = ch
+    for i in range(len(text), n):
+        arr.data[i] = "\0"
+    return len(text)
+
+
+def _mode_sens(ref) -> bool:
+    if ref is None:
+        return True
+    v = ref.get()
+    return not (isinstance(v, EnumValue) and v.name == "NOT_CASE_SENS")
+
+
+# ------------------------------------------------------------------ math (§4.5)
+
+def _abs(rt, a):
+    return abs(_real(a[0]))
+
+
+def _sqrt(rt, a):
+    x = _real(a[0])
+    if x < 0:
+        raise KrlRuntimeError(f"SQRT of a negative number ({x})")
+    return math.sqrt(x)
+
+
+def _trig(fn):
+    return lambda rt, a: fn(math.radians(_real(a[0])))
+
+
+def _tan(rt, a):
+    x = _real(a[0])
+    if abs(math.cos(math.radians(x))) < 1e-12:
+        raise KrlRuntimeError(f"TAN({x}) is undefined")
+    return math.tan(math.radians(x))
+
+
+def _acos(rt, a):
+    x = _real(a[0])
+    if not -1.0 <= x <= 1.0:
+        raise KrlRuntimeError(f"ACOS argument {x} outside -1..1")
+    return math.degrees(math.acos(x))
+
+
+def _atan2(rt, a):
+    y, x = _real(a[0]), _real(a[1])
+    if x == 0 and y == 0:
+        return 0.0
+    return math.degrees(math.atan2(y, x))
+
+
+def _frand(rt, a):
+    lo, hi = _real(a[0]), _real(a[1])
+    return rt.random.uniform(lo, hi)
+
+
+def _inv_pos(rt, a):
+    return inv_pos(a[0].get())
+
+
+def _forward(rt, a):
+    from .sysvars import pos_struct  # noqa: PLC0415
+
+    ax = a[0].get()
+    q = [_real_leaf(ax, k) for k in ("A1", "A2", "A3", "A4", "A5", "A6")]
+    ctl = rt.controller
+    store = rt.sysvars.store
+    d = ctl.pos_act(tool=frame_tuple(store["$TOOL"]), base=frame_tuple(store["$BASE"])) if False else None
+    kin = ctl.model.kin
+    import numpy as np  # noqa: PLC0415
+
+    from robot.frames import frame_to_matrix, inv_pos as _ip, matrix_to_frame  # noqa: PLC0415
+
+    tool = frame_to_matrix(*frame_tuple(store["$TOOL"]))
+    base = frame_to_matrix(*frame_tuple(store["$BASE"]))
+    Tm = ctl.model.tcp(np.array(q, dtype=float), tool, _ip(base))
+    x, y, z, aa, bb, cc = matrix_to_frame(Tm)
+    s, t = kin.status_turn(np.array(q, dtype=float))
+    d = {"X": x, "Y": y, "Z": z, "A": aa, "B": bb, "C": cc, "S": s, "T": t}
+    if len(a) > 1 and a[1] is not None:
+        a[1].set(0)
+    return pos_struct(d)
+
+
+def _inverse(rt, a):
+    raise KrlRuntimeError("INVERSE is not supported by this simulator")
+
+
+def _real_leaf(s, k):
+    v = s.f.get(k, 0.0) if isinstance(s, Struct) else UNSET
+    if v is UNSET:
+        raise value_invalid(k)
+    return float(num(v))
+
+
+# ------------------------------------------------------------------ VARSTATE (§4.5)
+
+def _varstate(rt, a):
+    name = _text(a[0], "VARSTATE argument")
+    try:
+        ref = rt.ref_from_text(name)
+    except KrlRuntimeError:
+        return EnumValue("UNKNOWN")
+    if ref is None:
+        return EnumValue("UNKNOWN")
+    try:
+        v = ref.peek()
+    except KrlRuntimeError:
+        return EnumValue("DECLARED")
+    from .values import is_initialised  # noqa: PLC0415
+
+    return EnumValue("INITIALIZED" if is_initialised(v) else "DECLARED")
+
+
+def _vartype(rt, a):
+    name = _text(a[0], "VARTYPE argument")
+    ref = rt.ref_from_text(name)
+    if ref is None:
+        return EnumValue("TYP_UNKNOWN")
+    t = ref.type
+    if t in (T.INT, T.REAL, T.BOOL, T.CHAR):
+        return EnumValue("TYP_" + t.name)
+    if isinstance(t, T.Enum):
+        return EnumValue("TYP_ENUM")
+    if isinstance(t, T.Struc):
+        n = t.name.upper()
+        return EnumValue("TYP_" + n if n in ("FRAME", "POS", "E3POS", "E6POS", "AXIS", "E3AXIS", "E6AXIS") else "TYP_STRUC")
+    return EnumValue("TYP_UNKNOWN")
+
+
+# ------------------------------------------------------------------ strings (§4.6)
+
+def _strlen(rt, a):
+    return len(_text(a[0], "STRLEN argument"))
+
+
+def _strdecllen(rt, a):
+    v = a[0].peek() if a[0] is not None else UNSET
+    if isinstance(v, Arr):
+        return len(v.data)
+    if isinstance(v, str):
+        return len(v)
+    raise KrlRuntimeError("STRDECLLEN needs a CHAR array")
+
+
+def _strclear(rt, a):
+    _put_text(_chars(a[0], "STRCLEAR argument"), "")
+    return True
+
+
+def _stradd(rt, a):
+    dest = _chars(a[0], "STRADD destination")
+    return _put_text(dest, dest.text() + _text(a[1], "STRADD argument"))
+
+
+def _strcopy(rt, a):
+    dest = _chars(a[0], "STRCOPY destination")
+    src = _text(a[1], "STRCOPY source")
+    _put_text(dest, src)
+    return len(src) <= len(dest.data)
+
+
+def _strcomp(rt, a):
+    s1, s2 = _text(a[0], "STRCOMP argument 1"), _text(a[1], "STRCOMP argument 2")
+    if not _mode_sens(a[2] if len(a) > 2 else None):
+        return s1.upper() == s2.upper()
+    return s1 == s2
+
+
+def _strfind(rt, a):
+    start = _int(a[0])
+    s, sub = _text(a[1], "STRFIND string"), _text(a[2], "STRFIND pattern")
+    if not _mode_sens(a[3] if len(a) > 3 else None):
+        s, sub = s.upper(), sub.upper()
+    if start < 1:
+        start = 1
+    pos = s.find(sub, start - 1)
+    return pos + 1 if pos >= 0 and sub else 0
+
+
+def _strto(conv):
+    def fn(rt, a):
+        s = _text(a[0], "string").strip()
+        try:
+            v = conv(s)
+        except (ValueError, KrlRuntimeError):
+            return False
+        a[1].set(v)
+        return True
+    return fn
+
+
+def _to_int(s: str) -> int:
+    return int(s, 10)
+
+
+def _to_bool(s: str) -> bool:
+    u = s.upper()
+    if u in ("TRUE", "1"):
+        return True
+    if u in ("FALSE", "0"):
+        return False
+    raise ValueError(s)
+
+
+def _strtostring(rt, a):
+    dest = _chars(a[1], "STRTOSTRING destination")
+    _put_text(dest, _text(a[0], "string"))
+    return True
+
+
+def _strto_struct(tname):
+    def fn(rt, a):
+        text = _text(a[0], "string").strip()
+        if not (text.startswith("{") and text.endswith("}")):
+            return False
+        body = text[1:-1]
+        if ":" in body.split(",")[0]:
+            body = body.split(":", 1)[1]
+        vals = {}
+        for part in body.split(","):
+            w = part.split()
+            if len(w) != 2:
+                return False
+            try:
+                vals[w[0].upper()] = float(w[1]) if w[0].upper() not in ("S", "T") else int(w[1])
+            except ValueError:
+                return False
+        from .sysvars import sys_type  # noqa: PLC0415
+
+        s = Struct(sys_type(tname), vals)
+        a[1].set(s)
+        return True
+    return fn
+
+
+# ------------------------------------------------------------------ errors (§5.19, §8.3)
+
+def _err_clear(rt, a):
+    e = a[0].peek()
+    rt.clear_err(e)
+
+
+def _err_raise(rt, a):
+    e = a[0].peek()
+    n = e.f.get("NUMBER", 0)
+    if n in (UNSET, 0):
+        return None
+    msg = rt.err_message(e)
+    raise KrlRuntimeError(msg, n)
+
+
+# ------------------------------------------------------------------ I/O (§5.12)
+
+def _pulse(rt, a):
+    sig, level, dur = a[0], a[1], a[2]
+    lvl = to_bool(level.get(), "PULSE level")
+    d = _real(dur, "PULSE duration")
+    rt.pulse(sig, lvl, d)
+
+
+def _set_krlmsg(rt, a):
+    msg = a[1].peek() if len(a) > 1 and a[1] is not None else None
+    text = ""
+    if isinstance(msg, Struct):
+        t = msg.f.get("MSG_TXT")
+        text = t.text() if isinstance(t, Arr) else ""
+    rt.message(f"KRL message: {text}")
+    rt.msg_handle += 1
+    return rt.msg_handle
+
+
+def _exists_krlmsg(rt, a):
+    return False
+
+
+def _clear_krlmsg(rt, a):
+    return True
+
+
+def _set_krldlg(rt, a):
+    rt.message("KRL dialog (answered with the first softkey)")
+    rt.msg_handle += 1
+    return rt.msg_handle
+
+
+def _exists_krldlg(rt, a):
+    if len(a) > 1 and a[1] is not None:
+        a[1].set(1)
+    return False
+
+
+def _cwrite(rt, a):
+    ch = _int(a[0], "channel")
+    cmd = rt.sysvars.store.get("$CMD")
+    fmt = _text(a[3], "CWRITE format") if len(a) > 3 else ""
+    if ch != cmd:
+        raise KrlRuntimeError("CWRITE: only the $CMD channel is supported by this simulator")
+    rt.message(f"CWRITE $CMD: {fmt}")
+    st = a[1].peek() if a[1] is not None else None
+    if isinstance(st, Struct) and "RET1" in st.f:
+        st.f["RET1"] = EnumValue("CMD_OK")
+
+
+def _unsupported(name):
+    def fn(rt, a):
+        raise KrlRuntimeError(f"{name} is not supported by this simulator")
+    return fn
+
+
+# ------------------------------------------------------------------ SWRITE / SREAD (§4.7)
+
+_FLAGS = "-+ 0#"
+
+
+def parse_format(fmt: str) -> list:
+    """Split a format into literal strings and (flags, width, precision, conv) tuples."""
+    out: list = []
+    i, n = 0, len(fmt)
+    lit = []
+    while i < n:
+        ch = fmt[i]
+        if ch != "%":
+            lit.append(ch)
+            i += 1
+            continue
+        if i + 1 < n and fmt[i + 1] == "%":
+            lit.append("%")
+            i += 2
+            continue
+        if lit:
+            out.append("".join(lit))
+            lit = []
+        j = i + 1
+        flags = ""
+        while j < n and fmt[j] in _FLAGS:
+            flags += fmt[j]
+            j += 1
+        w = ""
+        while j < n and fmt[j].isdigit():
+            w += fmt[j]
+            j += 1
+        prec = None
+        if j < n and fmt[j] == ".":
+            j += 1
+            p = ""
+            while j < n and fmt[j].isdigit():
+                p += fmt[j]
+                j += 1
+            prec = int(p) if p else 0
+        while j < n and fmt[j] in "lhL":
+            j += 1
+        if j >= n:
+            raise KrlRuntimeError(f"format error in {fmt!r}")
+        conv = fmt[j]
+        if conv not in "dixXofFeEgGcs":
+            raise KrlRuntimeError(f"format error: %{conv} in {fmt!r}")
+        out.append((flags, int(w) if w else None, prec, conv))
+        i = j + 1
+    if lit:
+        out.append("".join(lit))
+    return out
+
+
+def _pad(body: str, sign: str, flags: str, width: int | None, numeric: bool) -> str:
+    s = sign + body
+    if width is None or len(s) >= width:
+        return s
+    if "-" in flags:
+        return s + " " * (width - len(s))
+    if "0" in flags and numeric:
+        return sign + "0" * (width - len(s)) + body
+    return " " * (width - len(s)) + s
+
+
+def format_one(spec, v) -> str:
+    flags, width, prec, conv = spec
+    if conv == "s":
+        if isinstance(v, Arr):
+            s = v.text()
+        elif isinstance(v, str):
+            s = v
+        elif isinstance(v, bool):
+            s = "TRUE" if v else "FALSE"
+        elif isinstance(v, EnumValue):
+            s = v.name
+        else:
+            s = str(v)
+        if prec is not None:
+            s = s[:prec]
+        return _pad(s, "", flags, width, False)
+    if conv == "c":
+        if isinstance(v, str):
+            s = v[:1]
+        else:
+            s = chr(int(num(v)) & 0xFF)
+        return _pad(s, "", flags, width, False)
+    if isinstance(v, bool):
+        v = 1 if v else 0
+    x = num(v)
+    if conv in "dixXo":
+        x = x if x.__class__ is int else real_to_int(x)
+        mag = abs(x)
+        if conv in "di":
+            body = str(mag)
+        elif conv == "o":
+            body = format(mag, "o")
+        else:
+            body = format(x & 0xFFFFFFFF if x < 0 else x, "x")
+            if conv == "X":
+                body = body.upper()
+        if prec is not None and len(body) < prec:
+            body = "0" * (prec - len(body)) + body
+        sign = "-" if x < 0 and conv in "di" else ("+" if "+" in flags else (" " if " " in flags else ""))
+        return _pad(body, sign, flags if prec is None else flags.replace("0", ""), width, True)
+    x = float(x)
+    p = 6 if prec is None else prec
+    code = {"f": "f", "F": "f", "e": "e", "E": "E", "g": "g", "G": "G"}[conv]
+    body = format(abs(x), f"{'#' if '#' in flags else ''}.{p}{code}")
+    neg = x < 0 or (x == 0 and math.copysign(1, x) < 0 and body.strip("0.") != "")
+    sign = "-" if neg else ("+" if "+" in flags else (" " if " " in flags else ""))
+    return _pad(body, sign, flags, width, True)
+
+
+def swrite_text(fmt: str, values: list) -> tuple[str, int]:
+    """(formatted text, number of converted values)."""
+    parts = parse_format(fmt)
+    out = []
+    k = 0
+    for p in parts:
+        if isinstance(p, str):
+            out.append(p)
+            continue
+        if k >= len(values):
+            break
+        out.append(format_one(p, values[k]))
+        k += 1
+    return "".join(out), k
+
+
+def _state(ref, ok: bool, hits: int, length: int) -> None:
+    if ref is None:
+        return
+    st = ref.peek()
+    if isinstance(st, Struct):
+        st.f["RET1"] = EnumValue("CMD_OK" if ok else "FMT_ERR")
+        if "HITS" in st.f:
+            st.f["HITS"] = hits
+        if "LENGTH" in st.f:
+            st.f["LENGTH"] = length
+        if "MSG_NO" in st.f:
+            st.f["MSG_NO"] = 0
+
+
+def _swrite(rt, a):
+    dest = _chars(a[0], "SWRITE destination")
+    off_ref = a[2]
+    off = _int(off_ref, "SWRITE offset") if off_ref is not None else 0
+    fmt = _text(a[3], "SWRITE format")
+    vals = [r.get() if r is not None else UNSET for r in a[4:]]
+    if any(v is UNSET for v in vals):
+        raise value_invalid("SWRITE argument")
+    text, hits = swrite_text(fmt, vals)
+    n = len(dest.data)
+    cur = dest.text()
+    if off < 0:
+        off = 0
+    base = (cur + "\0" * n)[:off].replace("\0", " ")
+    new = (base + text)[:n]
+    for i, ch in enumerate(new):
+        dest.data[i] = ch
+    for i in range(len(new), n):
+        dest.data[i] = "\0"
+    if off_ref is not None:
+        off_ref.set(len(new))
+    _state(a[1], True, hits, len(new) - off)
+
+
+def sread_values(src: str, fmt: str, start: int = 0) -> tuple[list, int]:
+    """scanf: (list of (spec, python value), position after the last match)."""
+    parts = parse_format(fmt)
+    pos = start
+    out = []
+    n = len(src)
+    for p in parts:
+        if isinstance(p, str):
+            for ch in p:
+                if ch.isspace():
+                    while pos < n and src[pos].isspace():
+                        pos += 1
+                elif pos < n and src[pos] == ch:
+                    pos += 1
+                else:
+                    return out, pos
+            continue
+        flags, width, prec, conv = p
+        if conv != "c":
+            while pos < n and src[pos].isspace():
+                pos += 1
+        lim = n if width is None else min(n, pos + width)
+        if conv == "c":
+            if pos >= n:
+                break
+            out.append((p, src[pos]))
+            pos += 1
+            continue
+        if conv == "s":
+            j = pos
+            while j < lim and not src[j].isspace():
+                j += 1
+            if j == pos:
+                break
+            out.append((p, src[pos:j]))
+            pos = j
+            continue
+        j = pos
+        if conv in "di":
+            if j < lim and src[j] in "+-":
+                j += 1
+            k = j
+            while j < lim and src[j].isdigit():
+                j += 1
+            if j == k:
+                break
+            out.append((p, int(src[pos:j])))
+        elif conv in "xX":
+            while j < lim and src[j] in "0123456789abcdefABCDEF":
+                j += 1
+            if j == pos:
+                break
+            out.append((p, int(src[pos:j], 16)))
+        elif conv == "o":
+            while j < lim and src[j] in "01234567":
+                j += 1
+            if j == pos:
+                break
+            out.append((p, int(src[pos:j], 8)))
+        else:
+            if j < lim and src[j] in "+-":
+                j += 1
+            k = j
+            while j < lim and (src[j].isdigit() or src[j] == "."):
+                j += 1
+            if j < lim and src[j] in "eE":
+                m = j + 1
+                if m < lim and src[m] in "+-":
+                    m += 1
+                if m < lim and src[m].isdigit():
+                    j = m
+                    while j < lim and src[j].isdigit():
+                        j += 1
+            try:
+                out.append((p, float(src[pos:j])))
+            except ValueError:
+                break
+            if j == k:
+                break
+        pos = j
+    return out, pos
+
+
+def _sread(rt, a):
+    src = _text(a[0], "SREAD source")
+    off_ref = a[2]
+    off = _int(off_ref, "SREAD offset") if off_ref is not None else 0
+    fmt = _text(a[3], "SREAD format")
+    got, pos = sread_values(src, fmt, max(0, off))
+    targets = a[4:]
+    hits = 0
+    for (spec, v), ref in zip(got, targets):
+        if ref is None:
+            continue
+        if isinstance(ref.peek(), Arr):
+            _put_text(ref.peek(), str(v))
+        else:
+            ref.set(v)
+        hits += 1
+    if off_ref is not None:
+        off_ref.set(pos)
+    _state(a[1], hits == len([t for t in targets if t is not None]), hits, pos - off)
+
+
+NATIVES: dict = {
+    "ABS": _abs, "SQRT": _sqrt, "SIN": _trig(math.sin), "COS": _trig(math.cos), "TAN": _tan,
+    "ACOS": _acos, "ATAN2": _atan2, "FRAND": _frand, "INV_POS": _inv_pos,
+    "FORWARD": _forward, "INVERSE": _inverse,
+    "VARSTATE": _varstate, "VARTYPE": _vartype,
+    "STRLEN": _strlen, "STRDECLLEN": _strdecllen, "STRCLEAR": _strclear, "STRADD": _stradd,
+    "STRCOPY": _strcopy, "STRCOMP": _strcomp, "STRFIND": _strfind,
+    "STRTOINT": _strto(_to_int), "STRTOREAL": _strto(float), "STRTOBOOL": _strto(_to_bool),
+    "STRTOSTRING": _strtostring,
+    "STRTOFRAME": _strto_struct("FRAME"), "STRTOPOS": _strto_struct("POS"),
+    "STRTOE3POS": _strto_struct("E3POS"), "STRTOE6POS": _strto_struct("E6POS"),
+    "STRTOAXIS": _strto_struct("AXIS"), "STRTOE3AXIS": _strto_struct("E3AXIS"),
+    "STRTOE6AXIS": _strto_struct("E6AXIS"),
+    "ERR_CLEAR": _err_clear, "ERR_RAISE": _err_raise, "PULSE": _pulse,
+    "SWRITE": _swrite, "SREAD": _sread, "CWRITE": _cwrite,
+    "SET_KRLMSG": _set_krlmsg, "EXISTS_KRLMSG": _exists_krlmsg, "CLEAR_KRLMSG": _clear_krlmsg,
+    "SET_KRLDLG": _set_krldlg, "EXISTS_KRLDLG": _exists_krldlg,
+    "CAST_TO": _unsupported("CAST_TO"), "CAST_FROM": _unsupported("CAST_FROM"),
+    "CREAD": _unsupported("CREAD"), "COPEN": _unsupported("COPEN"),
+    "CCLOSE": _unsupported("CCLOSE"), "CIOCTL": _unsupported("CIOCTL"),
+    "GET_SIG_INF": _unsupported("GET_SIG_INF"), "GETSYSSTATE": _unsupported("GETSYSSTATE"),
+}
+
+# built-ins whose result type is needed to convert a native Python result
+FUNCTION_RESULT = {"ABS", "SQRT", "SIN", "COS", "TAN", "ACOS", "ATAN2", "FRAND"}
+
+
+def call_builtin(rt, name: str, args: list):
+    """Call native ``name`` (UPPER) with reference arguments; returns the value (None for
+    procedures). Raises KeyError if ``name`` is not a native."""
+    return NATIVES[name](rt, args)
+
+
+__all__ = ["NATIVES", "ValueRef", "call_builtin", "swrite_text", "sread_values", "parse_format"]

@@ -1,0 +1,123 @@
+"""Execution contexts and interrupts (reference §5.16-§5.18, §10.4).
+
+Each task (robot program, submit program) has a stack of :class:`Context` objects: the
+bottom one is ``main`` (robot) or ``submit``; an interrupt routine runs in an
+``interrupt`` context pushed on top of the interrupted one, a TRIGGER action in a
+``trigger`` context. No threads: a handler runs nested on the Python stack of the task it
+interrupts (its greenlet), at a statement boundary or at an IPO cycle.
+
+:class:`InterruptTable` holds a task's declarations, one :class:`Irq` per number:
+
+* DECL declares (state ``off``); re-declaring a number replaces it;
+* ON arms edge detection (the condition's current value is the reference: a condition
+  already TRUE does not fire until it has been FALSE); OFF disarms and drops a pending
+  event; DISABLE keeps detecting but defers handling (events are buffered); ENABLE
+  releases them;
+* a rising edge (FALSE -> TRUE) of an armed condition makes the interrupt *pending*; a
+  pending, enabled interrupt runs when its number is smaller (= higher priority) than
+  the priority of the running context (main: 129, so every interrupt can run there);
+  the smallest number runs first; equal or lower priorities wait;
+* a non-GLOBAL declaration is removed when the routine that declared it returns;
+  ON/OFF/ENABLE/DISABLE of an undeclared number is error 1430.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from .errors import INTERRUPT_NOT_DECLARED, KrlRuntimeError
+
+MAIN_PRIO = 129
+
+
+@dataclass
+class Context:
+    kind: str                     # main | interrupt | trigger | submit
+    prio: int = MAIN_PRIO
+    number: int | None = None     # interrupt number
+    pos_int: dict | None = None   # $POS_INT of an interrupt context
+    axis_int: object = None       # $AXIS_INT
+    frame: object = None          # declaring frame of the running interrupt (RESUME)
+
+
+@dataclass
+class Irq:
+    number: int
+    cond: object                  # zero-argument callable -> bool
+    handler: object               # zero-argument callable: runs the handler
+    name: str                     # handler routine name (trace)
+    frame: object                 # the declaring frame (RESUME target, lifetime)
+    is_global: bool = False
+    line: int | None = None
+    on: bool = False
+    enabled: bool = True
+    last: bool = False
+    pending: bool = False
+
+
+@dataclass
+class InterruptTable:
+    irqs: dict = field(default_factory=dict)
+    armed: int = 0                # number of interrupts switched on (fast test)
+
+    def declare(self, irq: Irq) -> None:
+        if not 1 <= irq.number <= 128:
+            raise KrlRuntimeError(f"interrupt priority {irq.number} outside 1..128")
+        old = self.irqs.get(irq.number)
+        if old is not None and old.on:
+            self.armed -= 1
+        self.irqs[irq.number] = irq
+
+    def _targets(self, number: int | None) -> list[Irq]:
+        if number is None:
+            return list(self.irqs.values())
+        irq = self.irqs.get(number)
+        if irq is None:
+            raise KrlRuntimeError(f"interrupt {number} not declared", INTERRUPT_NOT_DECLARED)
+        return [irq]
+
+    def control(self, action: str, number: int | None) -> None:
+        for irq in self._targets(number):
+            if action == "ON":
+                if not irq.on:
+                    self.armed += 1
+                irq.on = True
+                irq.last = bool(irq.cond())
+                irq.pending = False
+            elif action == "OFF":
+                if irq.on:
+                    self.armed -= 1
+                irq.on = False
+                irq.pending = False
+            elif action == "DISABLE":
+                irq.enabled = False
+            elif action == "ENABLE":
+                irq.enabled = True
+            else:
+                raise KrlRuntimeError(f"unknown INTERRUPT action {action}")
+
+    def poll(self) -> None:
+        """Evaluate the armed conditions; a rising edge makes the interrupt pending."""
+        for irq in list(self.irqs.values()):
+            if not irq.on:
+                continue
+            cur = bool(irq.cond())
+            if cur and not irq.last:
+                irq.pending = True
+            irq.last = cur
+
+    def next_ready(self, running_prio: int) -> Irq | None:
+        best = None
+        for irq in self.irqs.values():
+            if irq.pending and irq.on and irq.enabled and irq.number < running_prio:
+                if best is None or irq.number < best.number:
+                    best = irq
+        return best
+
+    def remove_frame(self, frame) -> None:
+        """The routine ``frame`` returned: drop its non-GLOBAL declarations."""
+        for n, irq in list(self.irqs.items()):
+            if irq.frame is frame and not irq.is_global:
+                if irq.on:
+                    self.armed -= 1
+                del self.irqs[n]

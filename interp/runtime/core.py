@@ -1,0 +1,759 @@
+"""The runtime facade: one :class:`Runtime` per run, used by the tree interpreter and
+(later) the VM. Its methods are the interface an interpreter calls; they hold all the
+semantics (docs/architecture.md, "Interpreters", lists the contracts).
+"""
+
+from __future__ import annotations
+
+import random
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+
+from krl.ast import nodes as N
+from krl.semantics import types as T
+from krl.semantics.symbols import Scope, fill_struc, make_array
+
+from . import advance
+from .builtins import NATIVES, ValueRef, call_builtin
+from .contexts import Context, Irq
+from .convert import assign_into, binary_op, convert_scalar, to_bool, unary_op
+from .errors import (HaltSignal, KrlRuntimeError, ResumeSignal, StopRun)
+from .memory import Frame, ProxyRef, Ref, SignalRef, Slot, field_ref, index_ref
+from .motion import params_from, request, segment, target_of
+from .program import Program
+from .scheduler import Scheduler, Task
+from .sysvars import SysVars, struct_of
+from .values import UNSET, Arr, EnumValue, Struct, copy_value, make_value
+
+MAX_CALL_DEPTH = 100
+
+EXIT_CODES = {"completed": 0, "halt": 3, "deadlock": 3, "max_steps": 3, "max_sim_time": 3,
+              "error": 1, "internal": 2}
+
+
+@dataclass
+class RunResult:
+    reason: str                 # completed | halt | error | deadlock | max_steps | max_sim_time
+    error: KrlRuntimeError | None = None
+    file: str | None = None
+    line: int | None = None
+    context: str | None = None
+    text: str = ""
+    sim_time: float = 0.0
+    steps: int = 0
+
+    @property
+    def exit_code(self) -> int:
+        return EXIT_CODES.get(self.reason, 2)
+
+
+class Runtime:
+    """Shared runtime of one run.
+
+    Args: main program path; ``workspace`` (folder of the program's modules; default the
+    program's folder; a KRC backup is detected automatically); ``controller`` (a
+    robot.controller.Controller; default a new one with ``trace``/``stimuli``);
+    ``max_sim_time`` (s), ``max_steps`` (statements + loop iterations, all tasks).
+    """
+
+    def __init__(self, main_path, *, workspace=None, controller=None, trace=None, stimuli=None,
+                 max_sim_time: float | None = None, max_steps: int | None = None,
+                 mujoco: bool = True, robot_budget: int | None = None) -> None:
+        if controller is None:
+            from robot.controller import Controller  # noqa: PLC0415
+
+            controller = Controller(trace=trace, stimuli=stimuli, mujoco=mujoco)
+        self.controller = controller
+        self.trace = trace if trace is not None else controller.trace
+        self.current_task: Task | None = None
+        self.random = random.Random(0)
+        self.mode_op = "T1"
+        self.msg_handle = 0
+        self.steps = 0
+        self.max_steps = max_steps
+        self.robot_budget = robot_budget
+        self.sysvars = SysVars(self)
+        self.program = Program(self, main_path, workspace)
+        self.scheduler = Scheduler(self, max_sim_time, max_steps)
+        self.robot: Task | None = None
+        self.result: RunResult | None = None
+        self._stop_cache: dict = {}
+
+    # ================================================================== tasks and run
+    def add_task(self, kind: str, name: str, body) -> Task:
+        """Register a task; ``body()`` runs the program (the first task is the robot)."""
+        task = Task(kind, name, body, self.robot_budget if kind == "robot" else None)
+        if kind == "robot":
+            self.robot = task
+        self.scheduler.add(task)
+        return task
+
+    def task_main(self, task: Task) -> None:
+        """Greenlet body of a task: run it and record its outcome."""
+        self.current_task = task
+        try:
+            task.body()
+            if task.kind == "robot":
+                self.wait_main_run(task)      # END: the main run finishes its motions
+            task.outcome = ("completed", None)
+        except HaltSignal:
+            task.outcome = ("halt", None)
+        except StopRun as s:
+            task.outcome = (s.reason, s.text)
+        except KrlRuntimeError as e:
+            e.at(task.file, task.line)
+            task.outcome = ("error", e)
+        except ResumeSignal:
+            task.outcome = ("error", KrlRuntimeError(
+                "RESUME not possible: the advance run is in the routine that declared the interrupt",
+                None, task.file, task.line))
+        except RecursionError:
+            task.outcome = ("error", KrlRuntimeError("stack overflow", None, task.file, task.line))
+        finally:
+            task.done = True
+        reason = task.outcome[0]
+        if task.kind == "robot" or reason in ("max_steps", "max_sim_time"):
+            if self.scheduler.stop is None and (task.kind == "robot" and reason != "completed" or task.kind != "robot"):
+                self.scheduler.stop = (reason, task.outcome[1], task)
+
+    def submit_finished(self, task: Task) -> None:
+        reason, err = task.outcome
+        if reason == "error" and err is not None and self.trace is not None:
+            self.trace.write("error", self.controller.time, text=f"submit {task.name}: {err.message}",
+                             number=err.number, line=err.line, file=err.file)
+
+    def run(self) -> RunResult:
+        """Run all tasks to the end; writes the ``end`` trace event; returns the result."""
+        old = sys.getrecursionlimit()
+        sys.setrecursionlimit(max(old, 20000))
+        try:
+            self.scheduler.run()
+        finally:
+            sys.setrecursionlimit(old)
+        robot = self.robot
+        stop = self.scheduler.stop
+        if stop is not None:
+            reason, detail, task = stop
+        else:
+            reason, detail, task = robot.outcome[0], robot.outcome[1], robot
+        err = detail if isinstance(detail, KrlRuntimeError) else None
+        text = err.message if err is not None else (detail or "")
+        file = (err.file if err is not None else None) or task.file
+        line = (err.line if err is not None else None) or task.line
+        ctx = task.context.kind if task.contexts else None
+        if reason == "completed":
+            file, line, ctx = robot.file, robot.line, "main"
+        self.result = RunResult(reason, err, file, line, ctx, text, self.controller.time, self.steps)
+        if self.trace is not None:
+            self.trace.write("end", self.controller.time, reason=reason, text=text or None,
+                             number=err.number if err is not None else None,
+                             file=file, line=line, context=ctx)
+            self.controller._ended = True  # noqa: SLF001 - the interpreter wrote the end event
+        return self.result
+
+    def interpreter_active(self, robot: bool) -> bool:
+        if robot:
+            return self.robot is not None and not self.robot.done
+        return any(not t.done for t in self.scheduler.tasks[1:])
+
+    def current_task_kind(self) -> str:
+        return self.current_task.kind if self.current_task is not None else "robot"
+
+    def current_context(self) -> Context | None:
+        t = self.current_task
+        if t is None:
+            return None
+        for c in reversed(t.contexts):
+            if c.kind == "interrupt":
+                return c
+        return None
+
+    def io_source(self) -> str:
+        t = self.current_task
+        return "trigger" if t is not None and t.context.kind == "trigger" else "program"
+
+    # ================================================================== time
+    def yield_cycle(self, task: Task) -> None:
+        """Give the rest of this IPO cycle back; on return run :meth:`service`."""
+        self.scheduler.yield_cycle()
+        self.service(task)
+
+    def service(self, task: Task) -> None:
+        """First act of a resumed task: main-run errors, TRIGGER actions, interrupts."""
+        if task.pending_error is not None:
+            e, task.pending_error = task.pending_error, None
+            raise KrlRuntimeError(e.message, e.number)
+        while task.pending_triggers:
+            self.run_trigger(task, task.pending_triggers.pop(0))
+        if task.irqs.armed:
+            self.check_interrupts(task)
+
+    def before_statement(self, info: advance.StmtInfo) -> None:
+        """Called by an interpreter before every statement: counts the step (limits,
+        time slice), checks interrupts, applies CONTINUE and the advance-run stop, writes
+        the ``stmt`` trace event."""
+        task = self.current_task
+        task.file = info.file
+        task.line = info.line
+        self.steps += 1
+        if self.max_steps is not None and self.steps > self.max_steps:
+            raise StopRun("max_steps", f"step limit {self.max_steps} reached")
+        task.count += 1
+        if task.count >= task.budget:
+            self.yield_cycle(task)
+        elif task.irqs.armed:
+            self.check_interrupts(task)
+        cont = False
+        if task.continue_line is not None:
+            cf, cl = task.continue_line
+            cont = cf == info.file and info.line == cl + 1
+            task.continue_line = None
+        if info.stops and not cont and task.kind == "robot" and task.context.kind != "trigger":
+            self.wait_main_run(task)
+        if self.trace is not None:
+            self.trace.write("stmt", self.controller.time, file=info.file, line=info.line,
+                             context=task.context.kind)
+
+    def loop_tick(self, info: advance.StmtInfo) -> None:
+        """Called once per loop iteration (WHILE/REPEAT/LOOP/FOR): counts a step, may end
+        the time slice, applies a loop condition's advance-run stop. No trace event."""
+        task = self.current_task
+        self.steps += 1
+        if self.max_steps is not None and self.steps > self.max_steps:
+            raise StopRun("max_steps", f"step limit {self.max_steps} reached")
+        task.count += 1
+        if task.count >= task.budget:
+            self.yield_cycle(task)
+        elif task.irqs.armed:
+            self.check_interrupts(task)
+        if info.cond_stops and task.kind == "robot" and task.context.kind != "trigger":
+            self.wait_main_run(task)
+
+    def set_continue(self, info: advance.StmtInfo) -> None:
+        """CONTINUE: the next line does not stop the advance run."""
+        self.current_task.continue_line = (info.file, info.line)
+
+    def wait_main_run(self, task: Task) -> None:
+        """Advance-run stop: wait until the main run is idle (robot at rest)."""
+        ctl = self.controller
+        while not ctl.is_idle():
+            self.yield_cycle(task)
+
+    def wait_for(self, cond_fn, text: str = "WAIT FOR") -> None:
+        """WAIT FOR: ``cond_fn()`` is evaluated now and once per IPO cycle."""
+        task = self.current_task
+        if to_bool(cond_fn(), "WAIT FOR condition"):
+            return
+        task.waiting = f"{text} at {task.file}:{task.line}" if task.kind == "robot" else None
+        try:
+            while True:
+                self.yield_cycle(task)
+                if to_bool(cond_fn(), "WAIT FOR condition"):
+                    return
+        finally:
+            task.waiting = None
+
+    def wait_sec(self, seconds) -> None:
+        """WAIT SEC t: t seconds of simulated time (rounded up to IPO cycles)."""
+        from .convert import num  # noqa: PLC0415
+
+        t = float(num(seconds, "WAIT SEC time"))
+        if t < 0:
+            raise KrlRuntimeError(f"WAIT SEC with a negative time ({t})")
+        task = self.current_task
+        ctl = self.controller
+        end = ctl.cycle + ctl.cycles_for(t)
+        while ctl.cycle < end:
+            self.yield_cycle(task)
+
+    def halt(self) -> None:
+        raise HaltSignal()
+
+    # ================================================================== memory
+    def lookup(self, name: str, frame: Frame) -> Ref:
+        """The reference a name denotes in ``frame`` (§2.7)."""
+        key = name.upper()
+        r = frame.vars.get(key)
+        if r is not None:
+            return r
+        m = frame.module
+        if m is not None:
+            r = m.data.get(key)
+            if r is not None:
+                return r
+        prog = self.program
+        if key[:1] == "$":
+            r = self.sysvars.lookup(key)
+            if r is not None:
+                return r
+        r = prog.globals.get(key)
+        if r is not None:
+            return r
+        r = prog.lookup_global(key)
+        if r is not None:
+            return r
+        raise KrlRuntimeError(f"unknown name {name}")
+
+    def index(self, base: Ref, idx: list, name: str) -> Ref:
+        return index_ref(base, idx, name)
+
+    def field(self, base: Ref, comp: str, name: str) -> Ref:
+        return field_ref(base, comp, name)
+
+    def assign(self, ref: Ref, value) -> None:
+        """``target = value`` (§5.1, conversions §3.9)."""
+        ref.set(value)
+
+    def read(self, ref: Ref):
+        return ref.get()
+
+    binary_op = staticmethod(binary_op)
+    unary_op = staticmethod(unary_op)
+    to_bool = staticmethod(to_bool)
+
+    def aggregate(self, type_name: str | None, items: list, module) -> Struct:
+        """Value of ``{[TYPE:] NAME value, ...}``: a partial Struct."""
+        st = None
+        if type_name:
+            st = self.type_named(type_name, module)
+        return Struct(st if isinstance(st, T.Struc) else None, dict(items))
+
+    def type_named(self, name: str, module):
+        scope = module.types if module is not None else self.program.types
+        return scope.lookup_type(name)
+
+    def stop_of(self, name: str, mode: str, frame: Frame) -> bool:
+        """Does reading/writing ``name`` in ``frame`` stop the advance run?"""
+        key = name.upper()
+        if key in frame.vars:
+            return False
+        m = frame.module
+        ref = m.data.get(key) if m is not None else None
+        if ref is None and key[:1] != "$":
+            ref = self.program.globals.get(key)
+        if isinstance(ref, SignalRef):
+            base = ref.proxy.name.upper()
+            r, w = self.sysvars.stops(base)
+            return r if mode == "r" else w
+        if ref is not None:
+            return False
+        if key[:1] == "$":
+            r, w = self.sysvars.stops(key)
+            return r if mode == "r" else w
+        return False
+
+    def stmt_info(self, stmt, frame: Frame) -> advance.StmtInfo:
+        """The (cached) StmtInfo of a statement, resolved in ``frame``'s module."""
+        k = (id(stmt), frame.module.name if frame.module is not None else "")
+        got = self._stop_cache.get(k)
+        if got is None:
+            got = advance.analyse(stmt, lambda n, mode: self.stop_of(n, mode, frame))
+            self._stop_cache[k] = got
+        return got
+
+    # ================================================================== routines
+    def find_routine(self, name: str, module):
+        return self.program.find_routine(name, module)
+
+    def is_native(self, name: str) -> bool:
+        return name.upper() in NATIVES
+
+    def call_builtin(self, name: str, args: list):
+        return call_builtin(self, name.upper(), args)
+
+    def stub_call(self, name: str, is_function: bool):
+        """The stub policy for a routine that is not found (a technology package absent from
+        the backup): in a backup a procedure call is skipped and logged as a ``message``
+        event; anything else is the run-time error "routine not found"."""
+        key = name.upper()
+        if self.program.backup and not is_function:
+            if key not in self.program.stubs:
+                self.program.stubs.add(key)
+            self.message(f"stub: {name} (routine not in the backup; technology package not simulated)")
+            return None
+        raise KrlRuntimeError(f"routine {name} not found")
+
+    def enter_routine(self, module, routine: N.Routine, args: list, caller: Frame | None) -> Frame:
+        """Create the frame of a call (§2.3): :IN parameters get converted copies, :OUT
+        (and unmarked) parameters are bound to the caller's reference; omitted arguments
+        stay declared-but-unset; locals are declared unset."""
+        task = self.current_task
+        depth = caller.depth + 1 if caller is not None else 0
+        if depth > MAX_CALL_DEPTH:
+            raise KrlRuntimeError(f"stack overflow: more than {MAX_CALL_DEPTH} nested calls")
+        frame = Frame(routine, module, caller, task)
+        ptypes = {}
+        pnames = {p.name.upper() for p in routine.params}
+        scope = module.types if module is not None else self.program.types
+        local_types = None
+        for d in routine.decls:
+            if isinstance(d, (N.StrucDecl, N.EnumDecl)):
+                if local_types is None:
+                    local_types = Scope("routine", routine.name, scope)
+                if isinstance(d, N.StrucDecl):
+                    st = T.Struc(d.name)
+                    local_types.types[d.name.upper()] = st
+                    fill_struc(local_types, st, [(c.type_name, c.name, tuple(c.dims)) for c in d.components])
+                else:
+                    local_types.types[d.name.upper()] = T.Enum(d.name, frozenset(v.upper() for v in d.values))
+        if local_types is not None:
+            scope = local_types
+        frame.extra = scope
+        for d in routine.decls:
+            if isinstance(d, N.VarDecl):
+                t0 = self.program.resolve_type(d.type, scope)
+                for vn in d.names:
+                    t = make_array(t0, vn.dims) if vn.dims else t0
+                    key = vn.name.upper()
+                    if key in pnames:
+                        ptypes[key] = t
+                    else:
+                        frame.declare(vn.name, t)
+            elif isinstance(d, N.SignalDecl):
+                ref = self.program.signal_ref(d)
+                if ref is not None:
+                    frame.bind(d.name, ref)
+        for i, p in enumerate(routine.params):
+            key = p.name.upper()
+            t = ptypes.get(key)
+            a = args[i] if i < len(args) else None
+            if a is None:
+                if t is None or (isinstance(t, T.Array) and 0 in t.dims):
+                    frame.store[key] = UNSET
+                    frame.vars[key] = Slot(frame.store, key, None, p.name)
+                else:
+                    frame.declare(p.name, t)
+                continue
+            if p.mode == "IN" or isinstance(a, ValueRef):
+                v = a.peek()
+                frame.store[key] = self._param_copy(v, t, p.name)
+                frame.vars[key] = Slot(frame.store, key, self._slot_type(t, frame.store[key]), p.name)
+            else:
+                frame.vars[key] = a
+        if self.trace is not None:
+            self.trace.write("call", self.controller.time, name=routine.name,
+                             line=caller.line if caller is not None else None)
+        return frame
+
+    @staticmethod
+    def _slot_type(t, v):
+        if isinstance(t, T.Array) and 0 in t.dims and isinstance(v, Arr):
+            return v.type
+        return t
+
+    def _param_copy(self, v, t, name: str):
+        if v is UNSET:
+            return make_value(t) if t is not None and not (isinstance(t, T.Array) and 0 in t.dims) else UNSET
+        if t is None:
+            return copy_value(v)
+        if isinstance(t, T.Array):
+            if 0 in t.dims:
+                if isinstance(v, str):
+                    arr = make_value(T.Array(T.CHAR, (max(len(v), 1),)))
+                    assign_into(arr, v)
+                    return arr
+                return copy_value(v)
+            dest = make_value(t)
+            assign_into(dest, v)
+            return dest
+        if isinstance(t, T.Struc):
+            dest = make_value(t)
+            assign_into(dest, v)
+            return dest
+        return convert_scalar(v, t)
+
+    def leave_routine(self, frame: Frame) -> None:
+        task = self.current_task
+        if frame.interrupts:
+            task.irqs.remove_frame(frame)
+        if self.trace is not None:
+            self.trace.write("return", self.controller.time, name=frame.name)
+
+    def return_value(self, routine: N.Routine, value, module):
+        """``RETURN expr`` of a function: converted to the return type (§2.4)."""
+        if routine.return_type is None:
+            return value
+        scope = module.types if module is not None else self.program.types
+        t = self.program.resolve_type(routine.return_type, scope)
+        if isinstance(t, T.Array) and isinstance(value, str):
+            arr = make_value(t)
+            assign_into(arr, value)
+            return arr
+        return convert_scalar(value, t)
+
+    def ref_from_text(self, text: str):
+        """The reference named by a string such as ``"P[2].X"`` (VARSTATE), or None."""
+        import re  # noqa: PLC0415
+
+        task = self.current_task
+        frame = getattr(task, "frame", None)
+        m = re.match(r"\s*(\$?[A-Za-z_][\w$]*)(.*)$", text)
+        if not m or frame is None:
+            return None
+        try:
+            ref = self.lookup(m.group(1), frame)
+        except KrlRuntimeError:
+            return None
+        rest = m.group(2).strip()
+        name = m.group(1)
+        while rest:
+            if rest.startswith("["):
+                j = rest.index("]")
+                idx = [int(x) if x.strip() else None for x in rest[1:j].split(",")]
+                ref = index_ref(ref, idx, name)
+                rest = rest[j + 1:].strip()
+            elif rest.startswith("."):
+                mm = re.match(r"\.\s*([A-Za-z_][\w$]*)", rest)
+                ref = field_ref(ref, mm.group(1), name)
+                rest = rest[mm.end():].strip()
+            else:
+                return None
+        return ref
+
+    # ================================================================== errors ($ERR)
+    def current_err(self) -> Struct:
+        task = self.current_task or self.robot
+        if task.err is None:
+            task.err = struct_of("ERROR_T", {})
+            self.clear_err(task.err)
+        return task.err
+
+    def clear_err(self, e: Struct) -> None:
+        for k, v in list(e.f.items()):
+            if isinstance(v, Arr):
+                v.data[:] = ["\0"] * len(v.data)
+            elif k in ("NUMBER", "INT_PRIO", "LINE_NR"):
+                e.f[k] = 0
+        e.f["INTERPRETER"] = EnumValue("R_INT")
+        e.f["INT_TYPE"] = EnumValue("INT_NONE")
+        e.f["TRIGGER_TYPE"] = EnumValue("NONE")
+        if self.current_task is not None:
+            self.current_task.err_text = ""
+
+    def take_error_proceed(self) -> bool:
+        """True (and reset) if ON_ERROR_PROCEED preceded the statement about to run."""
+        task = self.current_task
+        p = task.error_proceed
+        task.error_proceed = False
+        return p
+
+    def on_error_proceed(self) -> None:
+        self.current_task.error_proceed = True
+
+    def record_error(self, err: KrlRuntimeError, frame: Frame | None) -> None:
+        """A statement under ON_ERROR_PROCEED failed: fill $ERR and go on (§5.19)."""
+        task = self.current_task
+        e = self.current_err()
+        e.f["NUMBER"] = err.number if err.number is not None else 1
+        e.f["LINE_NR"] = err.line or task.line or 0
+        e.f["INTERPRETER"] = EnumValue("R_INT" if task.kind == "robot" else "S_INT")
+        ctx = task.context
+        e.f["INT_TYPE"] = EnumValue("INT_IR" if ctx.kind == "interrupt" else "INT_NONE")
+        e.f["INT_PRIO"] = ctx.number or 0
+        for key, text in (("MODULE", frame.module.name if frame and frame.module else ""),
+                          ("UP_NAME", frame.name if frame else "")):
+            arr = e.f.get(key)
+            if isinstance(arr, Arr):
+                assign_into(arr, text[: len(arr.data)])
+        task.err_text = err.message
+
+    def err_message(self, e: Struct) -> str:
+        task = self.current_task
+        return getattr(task, "err_text", "") or f"error {e.f.get('NUMBER')}"
+
+    # ================================================================== I/O, messages
+    def pulse(self, ref: Ref, level: bool, duration: float) -> None:
+        """PULSE(signal, level, duration) on an output (§5.12)."""
+        if isinstance(ref, ProxyRef) and ref.proxy.name.upper() == "$OUT":
+            n = ref.index
+        elif isinstance(ref, SignalRef) and ref.b is None and ref.proxy.name.upper() == "$OUT":
+            n = ref.a
+        else:
+            raise KrlRuntimeError("PULSE needs an output ($OUT[n] or an output SIGNAL)")
+        self.controller.pulse(n, level, duration, self.io_source())
+
+    def message(self, text: str) -> None:
+        self.controller.message(text)
+
+    # ================================================================== motion
+    def _params(self, with_: list):
+        store = self.sysvars.store
+        saved = []
+        for ref, value in with_:
+            old = copy_value(ref.peek())
+            saved.append((ref, old))
+            ref.set(value)
+        try:
+            return params_from(store)
+        finally:
+            for ref, old in reversed(saved):
+                if isinstance(ref, Slot):
+                    cur = ref.c[ref.k]
+                    if isinstance(cur, (Struct, Arr)):
+                        assign_into(cur, old)
+                    else:
+                        ref.c[ref.k] = old
+
+    def motion(self, kind: str, target, approx: list, aux=None, ca=None, frame: str | None = None,
+               with_: list = (), file: str | None = None, line: int | None = None) -> int:
+        """Plan a motion statement and queue it (waits while the queue holds $ADVANCE
+        motions). ``target``/``aux`` are evaluated values; ``with_`` (ref, value) pairs of a
+        WITH clause, valid for this motion only. Returns the motion id."""
+        task = self._robot_only(kind)
+        tgt = target_of(target)
+        aux_d = target_of(aux, "auxiliary point") if aux is not None else None
+        params = self._params(list(with_))
+        trig, task.next_triggers = task.next_triggers, []
+        from .convert import num  # noqa: PLC0415
+
+        req = request(kind, tgt, params, list(approx), aux_d,
+                      float(num(ca)) if ca is not None else None, frame, trig, file, line)
+        return self._enqueue(task, req)
+
+    def spline(self, kind: str, segments: list, approx: str | None, with_: list = (),
+               file: str | None = None, line: int | None = None) -> int:
+        """A SPLINE / PTP_SPLINE block. ``segments``: list of dicts with kind, target, aux,
+        ca, with_ (ref, value pairs), triggers (robot.motion.Trigger list), line."""
+        task = self._robot_only(kind)
+        if kind.upper() == "PTP_SPLINE":
+            last = None
+            for i, s in enumerate(segments):
+                task.next_triggers = list(s.get("triggers", ()))
+                ap = ["C_SPL"] if i < len(segments) - 1 else ([approx] if approx else [])
+                last = self.motion("SPTP", s["target"], ap, with_=list(with_) + list(s.get("with_", ())),
+                                   file=file, line=s.get("line"))
+            return last or 0
+        block_params = self._params(list(with_))
+        segs = []
+        for s in segments:
+            p = self._params(list(with_) + list(s["with_"])) if s.get("with_") else None
+            segs.append(segment(s["kind"], target_of(s["target"]),
+                                target_of(s["aux"], "auxiliary point") if s.get("aux") is not None else None,
+                                s.get("ca"), p, s.get("triggers", ()), s.get("line")))
+        from robot.motion import MotionRequest  # noqa: PLC0415
+
+        req = MotionRequest("SPLINE", segs[-1].target if segs else {}, block_params,
+                            approx=approx, segments=tuple(segs), file=file, line=line)
+        return self._enqueue(task, req)
+
+    def _robot_only(self, what: str) -> Task:
+        task = self.current_task
+        if task.kind != "robot":
+            raise KrlRuntimeError(f"{what}: motion statements are not allowed in the submit interpreter")
+        if task.context.kind == "trigger":
+            raise KrlRuntimeError(f"{what}: no motion statements in a TRIGGER action")
+        return task
+
+    def _enqueue(self, task: Task, req) -> int:
+        from robot.errors import RobotError  # noqa: PLC0415
+
+        ctl = self.controller
+        adv = self.sysvars.store.get("$ADVANCE")
+        ctl.advance = int(adv) if isinstance(adv, int) else 3
+        while not ctl.can_enqueue():
+            self.yield_cycle(task)
+        try:
+            return ctl.enqueue(req)
+        except RobotError as e:
+            raise KrlRuntimeError(e.message, e.number) from None
+
+    def trigger(self, action, *, distance: int | None = None, path: float | None = None,
+                onstart: bool = False, delay_ms: float = 0.0, prio: int | None = None,
+                line: int | None = None) -> None:
+        """TRIGGER: ``action`` (a zero-argument callable; call arguments already
+        evaluated) runs when the next motion's switching point is reached."""
+        from robot.motion import Trigger  # noqa: PLC0415
+
+        task = self._robot_only("TRIGGER")
+        task.next_triggers.append(Trigger(distance=distance, path_mm=path, onstart=onstart,
+                                          delay_ms=float(delay_ms), action=action, prio=prio, line=line))
+
+    def run_trigger(self, task: Task, ev) -> None:
+        action = ev.trigger.action
+        task.contexts.append(Context("trigger", prio=ev.trigger.prio if ev.trigger.prio and ev.trigger.prio > 0 else 129))
+        try:
+            action()
+        finally:
+            task.contexts.pop()
+
+    # ================================================================== interrupts
+    def interrupt_decl(self, number, cond_fn, handler_fn, name: str, frame: Frame,
+                       is_global: bool = False, line: int | None = None) -> None:
+        from .convert import num  # noqa: PLC0415
+
+        task = self.current_task
+        n = int(num(number, "interrupt number"))
+        task.irqs.declare(Irq(n, cond_fn, handler_fn, name, frame, is_global, line))
+        frame.interrupts.append(n)
+
+    def interrupt_ctl(self, action: str, number=None) -> None:
+        from .convert import num  # noqa: PLC0415
+
+        task = self.current_task
+        n = int(num(number, "interrupt number")) if number is not None else None
+        task.irqs.control(action.upper(), n)
+        if action.upper() in ("ENABLE", "ON") and task.irqs.armed:
+            self.check_interrupts(task)
+
+    def check_interrupts(self, task: Task) -> None:
+        if task.in_poll:
+            return
+        task.in_poll = True
+        try:
+            task.irqs.poll()
+        finally:
+            task.in_poll = False
+        while True:
+            irq = task.irqs.next_ready(task.context.prio)
+            if irq is None:
+                return
+            irq.pending = False
+            self.fire(task, irq)
+
+    def fire(self, task: Task, irq: Irq) -> None:
+        ctl = self.controller
+        ctx = Context("interrupt", prio=irq.number, number=irq.number)
+        if task.kind == "robot":
+            ctx.pos_int = ctl.pos_act()
+            ctx.axis_int = ctl.axis_act()
+        ctx.frame = irq.frame
+        task.contexts.append(ctx)
+        if self.trace is not None:
+            self.trace.write("interrupt", ctl.time, prio=irq.number, name=irq.name, line=task.line,
+                             phase="entry")
+        ok = False
+        try:
+            irq.handler()
+            ok = True
+        finally:
+            task.contexts.pop()
+            if self.trace is not None:
+                self.trace.write("interrupt", ctl.time, prio=irq.number, name=irq.name,
+                                 line=task.line, phase="exit")
+        if ok and task.kind == "robot":
+            ctl.release()
+
+    def brake(self, fast: bool = False) -> None:
+        """BRAKE / BRAKE F: ramp the path speed down and wait until the robot stands."""
+        task = self.current_task
+        if task.kind != "robot":
+            raise KrlRuntimeError("BRAKE is not allowed in the submit interpreter")
+        ctl = self.controller
+        ctl.brake(fast)
+        while ctl.is_braking():
+            self.yield_cycle(task)
+
+    def resume(self) -> None:
+        """RESUME: discard the planned motions and unwind to the declaring routine."""
+        task = self.current_task
+        ctx = None
+        for c in reversed(task.contexts):
+            if c.kind == "interrupt":
+                ctx = c
+                break
+        if ctx is None:
+            raise KrlRuntimeError("RESUME outside an interrupt routine")
+        if task.kind == "robot":
+            self.controller.cancel_pending()
+        raise ResumeSignal(ctx.frame)

@@ -1,0 +1,84 @@
+"""Run-time errors of KRL programs (reference §8).
+
+:class:`KrlRuntimeError` carries the KRL message, the KSS message number where the
+reference gives one (1422 "value invalid", 1430 "interrupt not declared") and the place
+(file, line) — filled in by :meth:`KrlRuntimeError.at` when the error crosses a statement.
+
+The control-flow signals (:class:`GotoSignal`, :class:`ExitSignal`, :class:`ReturnSignal`,
+:class:`ResumeSignal`, :class:`HaltSignal`, :class:`StopRun`) are exceptions too: the tree
+interpreter unwinds with them, as the paper describes; the VM uses the last three.
+"""
+
+from __future__ import annotations
+
+VALUE_INVALID = 1422
+INTERRUPT_NOT_DECLARED = 1430
+
+
+class KrlRuntimeError(Exception):
+    """A KRL run-time error: ``message``, ``number`` (or None), ``file``, ``line``."""
+
+    def __init__(self, message: str, number: int | None = None, file: str | None = None,
+                 line: int | None = None) -> None:
+        super().__init__(message)
+        self.message = message
+        self.number = number
+        self.file = file
+        self.line = line
+
+    def at(self, file: str | None, line: int | None) -> "KrlRuntimeError":
+        """Set the place if it is not set yet (the innermost statement wins); returns self."""
+        if self.line is None:
+            self.file, self.line = file, line
+        return self
+
+    def __str__(self) -> str:
+        where = f"{self.file}:{self.line}: " if self.line is not None else ""
+        num = f" ({self.number})" if self.number is not None else ""
+        return f"{where}{self.message}{num}"
+
+
+def value_invalid(what: str = "") -> KrlRuntimeError:
+    return KrlRuntimeError(f"value invalid{': ' + what if what else ''}", VALUE_INVALID)
+
+
+class ControlSignal(Exception):
+    """Base of the unwinding signals (never shown to users)."""
+
+
+class GotoSignal(ControlSignal):
+    def __init__(self, label: str) -> None:
+        super().__init__(label)
+        self.label = label.upper()
+
+
+class ExitSignal(ControlSignal):
+    pass
+
+
+class ReturnSignal(ControlSignal):
+    def __init__(self, value=None) -> None:
+        super().__init__()
+        self.value = value
+
+
+class ResumeSignal(ControlSignal):
+    """RESUME: unwinds to the call in progress in ``frame`` (the declaring routine)."""
+
+    def __init__(self, frame) -> None:
+        super().__init__()
+        self.frame = frame
+
+
+class HaltSignal(ControlSignal):
+    """HALT in a program: the run stops here (the simulation has no operator to restart it)."""
+
+
+class StopRun(ControlSignal):
+    """The scheduler ends the run (limit, deadlock, end of the robot program); raised inside
+    a task to unwind it. ``reason`` as in the ``end`` trace event."""
+
+    def __init__(self, reason: str, text: str = "") -> None:
+        super().__init__(reason)
+        self.reason = reason
+        self.text = text

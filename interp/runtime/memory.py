@@ -1,0 +1,278 @@
+"""Memory: storage locations (references) and call frames (reference §2.3, §2.5, §2.7).
+
+A *reference* is what a name, an array element or a structure component denotes. Every
+reference has ``type``, ``name`` (for messages), ``get()`` (the value; a Struct/Arr is
+returned without copying; an unset leaf raises 1422), ``peek()`` (the raw value, possibly
+UNSET) and ``set(value)`` (converts as an assignment, §3.9; structures and arrays are
+written in place so that :OUT aliases stay valid).
+
+* :class:`Slot` — a key in a dict (variables) or a position in a list (array elements) or
+  a component dict (structure fields). :OUT parameters bind the callee's name to the
+  caller's Slot, so writes go straight to the caller's variable, element or component.
+* :class:`ProxyRef` — an element of a live system array ($IN, $OUT, $TIMER, ...).
+* :class:`ComputedRef` — a live system variable ($POS_ACT, $AXIS_ACT, $DATE, ...).
+* :class:`SignalRef` — a SIGNAL name: one bit (BOOL) or a group of bits (INT, LSB first).
+* :class:`RowRef` — a row ``t[i,]`` of a 2-D CHAR array.
+
+:class:`Frame` is one activation of a routine: its bindings (name -> reference), the
+module it belongs to, its caller, and the interrupts it declared (removed on return).
+"""
+
+from __future__ import annotations
+
+from krl.semantics import types as T
+
+from .convert import assign_into, convert_scalar
+from .errors import KrlRuntimeError, value_invalid
+from .values import UNSET, Arr, Struct, make_value
+
+
+class Ref:
+    __slots__ = ()
+    type = None
+    name = "?"
+    readonly = False
+
+    def get(self):
+        v = self.peek()
+        if v is UNSET:
+            raise value_invalid(self.name)
+        return v
+
+    def peek(self):  # pragma: no cover - abstract
+        raise NotImplementedError
+
+    def set(self, v) -> None:  # pragma: no cover - abstract
+        raise NotImplementedError
+
+
+class Slot(Ref):
+    __slots__ = ("c", "k", "type", "name", "readonly", "on_write")
+
+    def __init__(self, container, key, type_, name: str, readonly: bool = False, on_write=None) -> None:
+        self.c = container
+        self.k = key
+        self.type = type_
+        self.name = name
+        self.readonly = readonly
+        self.on_write = on_write
+
+    def get(self):
+        v = self.c[self.k]
+        if v is UNSET:
+            raise value_invalid(self.name)
+        return v
+
+    def peek(self):
+        return self.c[self.k]
+
+    def set(self, v) -> None:
+        if self.readonly:
+            raise KrlRuntimeError(f"{self.name} is write-protected")
+        cur = self.c[self.k]
+        if isinstance(cur, (Struct, Arr)):
+            if cur is not v:
+                assign_into(cur, v)
+        elif self.type is not None:
+            self.c[self.k] = convert_scalar(v, self.type)
+        else:
+            self.c[self.k] = v
+        if self.on_write is not None:
+            self.on_write(self)
+
+
+class ProxyRef(Ref):
+    """Element ``index`` of a live array (see :class:`sysvars.LiveArray`)."""
+
+    __slots__ = ("proxy", "index", "type", "name")
+
+    def __init__(self, proxy, index: int, type_, name: str) -> None:
+        self.proxy = proxy
+        self.index = index
+        self.type = type_
+        self.name = name
+
+    @property
+    def readonly(self):
+        return self.proxy.setter is None
+
+    def peek(self):
+        return self.proxy.get(self.index)
+
+    def set(self, v) -> None:
+        if self.proxy.setter is None:
+            raise KrlRuntimeError(f"{self.name} is write-protected")
+        self.proxy.set(self.index, convert_scalar(v, self.type))
+
+
+class ComputedRef(Ref):
+    __slots__ = ("getter", "setter", "type", "name")
+
+    def __init__(self, getter, type_, name: str, setter=None) -> None:
+        self.getter = getter
+        self.setter = setter
+        self.type = type_
+        self.name = name
+
+    @property
+    def readonly(self):
+        return self.setter is None
+
+    def peek(self):
+        return self.getter()
+
+    def set(self, v) -> None:
+        if self.setter is None:
+            raise KrlRuntimeError(f"{self.name} is write-protected")
+        self.setter(v)
+
+
+class SignalRef(Ref):
+    """``SIGNAL name $OUT[a] [TO $OUT[b]]``: BOOL for one bit, unsigned INT for a group."""
+
+    __slots__ = ("proxy", "a", "b", "type", "name")
+
+    def __init__(self, proxy, a: int, b: int | None, name: str) -> None:
+        self.proxy = proxy
+        self.a = a
+        self.b = b
+        self.name = name
+        if proxy.type is T.REAL:
+            self.type = T.REAL
+        else:
+            self.type = T.BOOL if b is None else T.INT
+
+    @property
+    def readonly(self):
+        return self.proxy.setter is None
+
+    def peek(self):
+        if self.b is None:
+            return self.proxy.get(self.a)
+        v = 0
+        for bit, n in enumerate(range(self.a, self.b + 1)):
+            if self.proxy.get(n):
+                v |= 1 << bit
+        return v
+
+    def set(self, v) -> None:
+        if self.proxy.setter is None:
+            raise KrlRuntimeError(f"{self.name} is write-protected")
+        if self.b is None:
+            self.proxy.set(self.a, convert_scalar(v, self.type))
+            return
+        v = convert_scalar(v, T.INT)
+        for bit, n in enumerate(range(self.a, self.b + 1)):
+            self.proxy.set(n, bool((v >> bit) & 1))
+
+
+class RowRef(Ref):
+    """Row ``i`` of a 2-D CHAR array (``NAMES[2,]``)."""
+
+    __slots__ = ("arr", "row", "type", "name")
+
+    def __init__(self, arr: Arr, row: int, name: str) -> None:
+        if not 1 <= row <= arr.dims[0]:
+            raise KrlRuntimeError(f"array index {row} outside 1..{arr.dims[0]} ({name})")
+        self.arr = arr
+        self.row = row
+        self.name = name
+        self.type = T.Array(T.CHAR, (arr.dims[1],))
+
+    def _view(self) -> Arr:
+        n = self.arr.dims[1]
+        s = (self.row - 1) * n
+        return Arr(self.type, (n,), self.arr.data[s:s + n])
+
+    def peek(self):
+        return self._view()
+
+    def set(self, v) -> None:
+        view = self._view()
+        assign_into(view, v)
+        n = self.arr.dims[1]
+        s = (self.row - 1) * n
+        self.arr.data[s:s + n] = view.data
+
+
+def index_ref(base: Ref, idx: list, name: str) -> Ref:
+    """The reference of ``base[idx]`` (``idx``: 1-based INTs; a trailing None selects a
+    CHAR row, all None the whole array)."""
+    if all(i is None for i in idx):
+        return base
+    v = base.peek()
+    proxy = getattr(v, "is_live_array", False)
+    if proxy:
+        if len(idx) != 1 or idx[0] is None:
+            raise KrlRuntimeError(f"{name}: one index expected")
+        i = idx[0]
+        if not 1 <= i <= v.size:
+            raise KrlRuntimeError(f"array index {i} outside 1..{v.size} ({name})")
+        return ProxyRef(v, i, v.type, f"{name}[{i}]")
+    if not isinstance(v, Arr):
+        if v is UNSET:
+            raise value_invalid(base.name)
+        raise KrlRuntimeError(f"{base.name} is not an array")
+    if idx[-1] is None and len(idx) == 2 and len(v.dims) == 2:
+        return RowRef(v, idx[0], f"{name}[{idx[0]},]")
+    try:
+        pos = v.flat(idx)
+    except IndexError as exc:
+        raise KrlRuntimeError(f"array index inadmissible: {name}[{','.join(map(str, idx))}] ({exc})") from None
+    return Slot(v.data, pos, v.type.elem, f"{name}[{','.join(map(str, idx))}]",
+                base.readonly if isinstance(base, Slot) else False)
+
+
+def field_ref(base: Ref, comp: str, name: str) -> Ref:
+    v = base.peek()
+    key = comp.upper()
+    if not isinstance(v, Struct):
+        if v is UNSET:
+            raise value_invalid(base.name)
+        raise KrlRuntimeError(f"{base.name} is not a structure")
+    if key not in v.f:
+        if v.type is not None and key in v.type.fields:
+            v.f[key] = make_value(v.type.fields[key][1])
+        else:
+            raise KrlRuntimeError(f"{base.name} has no component {comp}")
+    ft = v.type.fields[key][1] if v.type is not None and key in v.type.fields else None
+    ro = base.readonly if isinstance(base, (Slot, ComputedRef)) else False
+    return Slot(v.f, key, ft, f"{name}.{comp}", ro)
+
+
+class Frame:
+    """One activation of a routine (or of a module's data list initialisation).
+
+    Attributes: routine (AST Routine or None), module (:class:`program.ModuleRT`),
+    vars (UPPER name -> Ref), caller (Frame or None), depth, interrupts (numbers
+    declared here, removed on return), task (the owning task), line (current line).
+    """
+
+    __slots__ = ("routine", "module", "vars", "caller", "depth", "interrupts", "task", "line",
+                 "store", "extra")
+
+    def __init__(self, routine, module, caller: "Frame | None", task=None) -> None:
+        self.routine = routine
+        self.module = module
+        self.vars: dict[str, Ref] = {}
+        self.store: dict = {}
+        self.caller = caller
+        self.depth = caller.depth + 1 if caller is not None else 0
+        self.interrupts: list[int] = []
+        self.task = task
+        self.line = 0
+        self.extra = None
+
+    def declare(self, name: str, type_, value=None) -> Slot:
+        key = name.upper()
+        self.store[key] = make_value(type_) if value is None else value
+        ref = Slot(self.store, key, type_, name)
+        self.vars[key] = ref
+        return ref
+
+    def bind(self, name: str, ref: Ref) -> None:
+        self.vars[name.upper()] = ref
+
+    @property
+    def name(self) -> str:
+        return self.routine.name if self.routine is not None else "?"

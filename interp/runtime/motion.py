@@ -1,0 +1,86 @@
+"""Motion statements -> robot.motion.MotionRequest (reference §6.1-§6.3, §6.10).
+
+* :func:`params_from` snapshots the motion system variables ($VEL, $ACC, $VEL_AXIS,
+  $ACC_AXIS, $APO, $TOOL, $BASE, $ORI_TYPE, $CIRC_TYPE, $IPO_MODE, $OV_PRO) at planning
+  time (advance run);
+* :func:`target_of` turns an evaluated target (a Struct: variable, aggregate, ``:`` chain,
+  function result) into the request's component dict. Components that are not given —
+  absent from a partial aggregate, or never assigned in a variable — are left out, so
+  the controller takes them from the start position (absolute motions) or uses 0
+  (``_REL``). A target with no component at all is "value invalid" (1422).
+"""
+
+from __future__ import annotations
+
+from robot.motion import MotionParams, MotionRequest, SplineSegment
+
+from .convert import num
+from .errors import KrlRuntimeError, value_invalid
+from .values import UNSET, Struct
+
+TARGET_KEYS = ("X", "Y", "Z", "A", "B", "C", "S", "T", "A1", "A2", "A3", "A4", "A5", "A6",
+               "E1", "E2", "E3", "E4", "E5", "E6")
+
+
+def _enum_name(v, default: str) -> str:
+    return getattr(v, "name", default) if v is not UNSET else default
+
+
+def _f(v, default: float) -> float:
+    return float(num(v)) if v is not UNSET else default
+
+
+def _frame(s: Struct) -> tuple:
+    return tuple(_f(s.f.get(k, 0.0), 0.0) for k in ("X", "Y", "Z", "A", "B", "C"))
+
+
+def params_from(store: dict) -> MotionParams:
+    """A MotionParams snapshot of the system-variable store (unset values: INITMOV defaults)."""
+    d = MotionParams()
+    vel, acc, apo = store["$VEL"], store["$ACC"], store["$APO"]
+    va, aa = store["$VEL_AXIS"].data, store["$ACC_AXIS"].data
+    return MotionParams(
+        vel_cp=_f(vel.f["CP"], d.vel_cp), vel_ori1=_f(vel.f["ORI1"], d.vel_ori1),
+        vel_ori2=_f(vel.f["ORI2"], d.vel_ori2),
+        acc_cp=_f(acc.f["CP"], d.acc_cp), acc_ori1=_f(acc.f["ORI1"], d.acc_ori1),
+        acc_ori2=_f(acc.f["ORI2"], d.acc_ori2),
+        vel_axis=tuple(_f(v, 100.0) for v in va[:6]),
+        acc_axis=tuple(_f(v, 100.0) for v in aa[:6]),
+        apo_cptp=_f(apo.f["CPTP"], d.apo_cptp), apo_cdis=_f(apo.f["CDIS"], d.apo_cdis),
+        apo_cvel=_f(apo.f["CVEL"], d.apo_cvel), apo_cori=_f(apo.f["CORI"], d.apo_cori),
+        tool=_frame(store["$TOOL"]), base=_frame(store["$BASE"]),
+        ori_type=_enum_name(store["$ORI_TYPE"], "VAR"),
+        circ_type=_enum_name(store["$CIRC_TYPE"], "BASE"),
+        ov_pro=_f(store["$OV_PRO"], 100.0),
+        ipo_mode=_enum_name(store["$IPO_MODE"], "BASE"),
+    )
+
+
+def target_of(v, what: str = "motion target") -> dict:
+    """Component dict of a motion target value (see the module docstring)."""
+    if not isinstance(v, Struct):
+        if v is UNSET:
+            raise value_invalid(what)
+        raise KrlRuntimeError(f"{what} is not a position: {v!r}")
+    out = {}
+    for k, x in v.f.items():
+        if k not in TARGET_KEYS or x is UNSET:
+            continue
+        out[k] = int(num(x)) if k in ("S", "T") else float(num(x))
+    if not out:
+        raise value_invalid(what)
+    return out
+
+
+def request(kind: str, target: dict, params: MotionParams, approx: list, aux=None, ca=None,
+            frame: str | None = None, triggers=(), file=None, line=None) -> MotionRequest:
+    """Build the MotionRequest of one motion statement."""
+    a1 = approx[0] if approx else None
+    a2 = approx[1] if len(approx) > 1 else None
+    rel_frame = (frame or "#BASE").lstrip("#")
+    return MotionRequest(kind, target, params, approx=a1, approx2=a2, aux=aux, ca=ca,
+                         rel_frame=rel_frame, triggers=tuple(triggers), file=file, line=line)
+
+
+def segment(kind: str, target: dict, aux=None, ca=None, params=None, triggers=(), line=None) -> SplineSegment:
+    return SplineSegment(kind, target, aux, ca, params, tuple(triggers), line)

@@ -1,0 +1,346 @@
+"""Loading a program and its environment; name resolution (reference §2.1-§2.7).
+
+:class:`Program` indexes the files of the workspace (module name = file stem), parses
+them lazily (each file once) and builds the run-time module objects
+(:class:`ModuleRT`): routines, data-list store (initialised from the DECL values, kept
+for the whole run, so .dat state persists across calls), types (STRUC/ENUM).
+
+Environment:
+
+* outside a KRC backup the project's BASIS (interp/basis: ``$config.dat``, ``bas.src``,
+  ``ir_stopm.src``) is the system folder;
+* inside a backup (a folder with ``R1/System``, or a flat export with a ``System`` folder
+  holding ``$config.dat``) the backup's own System folder is used, and the whole ``R1``
+  tree is the workspace; the backup's ``Mada`` data lists (``$machine.dat``, ...)
+  declare further system variables. Files are read in place, never copied.
+
+Resolution order for a name (§2.7): locals/parameters -> the module's data list ->
+globals (``$config.dat``, GLOBAL names of PUBLIC data lists, system data lists) ->
+system variables. Routines: the module's own routines -> GLOBAL routines and module main
+routines -> built-in natives -> the stub policy (see :meth:`Program.find_routine`).
+
+This is the runtime's own small resolver; when the front end's checker has annotated a
+node (``node.ann.symbol``), the interpreters may use that instead (docs/architecture.md).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from krl.ast import nodes as N
+from krl.semantics import types as T
+from krl.semantics.symbols import Scope, fill_struc, make_array, system_scopes
+
+from .convert import assign_into, convert_scalar
+from .errors import KrlRuntimeError
+from .memory import Slot, SignalRef
+from .values import UNSET, EnumValue, Struct, make_value
+
+BASIS_DIR = Path(__file__).resolve().parent.parent / "basis"
+KRL_SUFFIXES = {".src": "src", ".dat": "dat", ".sub": "sub"}
+
+_PARSE_CACHE: dict = {}
+
+
+def parse_module(path: str):
+    """(Module AST, list of syntax error strings) of one file, cached per process."""
+    key = str(path)
+    got = _PARSE_CACHE.get(key)
+    if got is not None:
+        return got
+    from krl.ast.build import build_module  # noqa: PLC0415
+    from krl.semantics.diagnostics import DiagnosticSink  # noqa: PLC0415
+    from krl.syntax.parse import parse_file  # noqa: PLC0415
+
+    res = parse_file(path)
+    mod = build_module(res, DiagnosticSink())
+    errs = [f"{path}:{e.line}:{e.column + 1}: {e.message}" for e in res.errors if not e.cascade]
+    if not res.ok and not res.errors:
+        errs.append(f"{path}: {res.status}")
+    got = (mod, errs)
+    _PARSE_CACHE[key] = got
+    return got
+
+
+def find_backup_root(path: Path) -> tuple[Path, Path] | None:
+    """(workspace root, System folder) if ``path`` lies inside a KRC backup."""
+    for d in [path.parent, *path.parent.parents]:
+        if (d / "R1" / "System").is_dir() and ((d / "R1" / "System" / "$config.dat").exists()
+                                               or (d / "R1" / "System" / "$CONFIG.DAT").exists()):
+            return d / "R1", d / "R1" / "System"
+        if d.name.upper() == "R1" and (d / "System").is_dir():
+            return d, d / "System"
+        if (d / "System").is_dir() and any((d / "System" / n).exists() for n in ("$config.dat", "$CONFIG.DAT")):
+            return d, d / "System"
+    return None
+
+
+class ModuleRT:
+    """A module at run time: routines, data list store and types."""
+
+    def __init__(self, name: str, program: "Program") -> None:
+        self.name = name
+        self.program = program
+        self.files: dict[str, Path] = {}
+        self.routines: dict[str, N.Routine] = {}
+        self.main: N.Routine | None = None
+        self.data: dict = {}            # UPPER -> Ref (data-list variables, signals)
+        self.store: dict = {}
+        self.types = Scope("module", name, program.types)
+        self.loaded = False
+        self.errors: list[str] = []
+        self.path = ""
+
+
+class Program:
+    def __init__(self, rt, main_path: str | Path, workspace: str | Path | None = None) -> None:
+        self.rt = rt
+        self.main_path = Path(main_path).resolve()
+        found = find_backup_root(self.main_path)
+        self.backup = found is not None
+        if found is not None:
+            self.workspace, self.system_dir = found
+        else:
+            self.workspace = Path(workspace).resolve() if workspace else self.main_path.parent
+            self.system_dir = BASIS_DIR
+        system, basis = system_scopes()
+        self.types = Scope("global", "$CONFIG", basis)
+        self.globals: dict = {}
+        self.global_routines: dict = {}
+        self.modules: dict[str, ModuleRT] = {}
+        self.index: dict[str, dict[str, Path]] = {}
+        self.stubs: set[str] = set()
+        self._scanned_all = False
+        self._index_files()
+        self._load_system()
+
+    # ------------------------------------------------------------------ files
+    def _add_file(self, p: Path, system: bool = False) -> None:
+        kind = KRL_SUFFIXES.get(p.suffix.lower())
+        if kind is None:
+            return
+        name = p.stem.upper()
+        entry = self.index.setdefault(name, {})
+        if kind not in entry or system:
+            entry[kind] = p
+
+    def _index_files(self) -> None:
+        if self.backup:
+            for p in sorted(self.workspace.rglob("*")):
+                if p.is_file():
+                    self._add_file(p)
+        else:
+            for p in sorted(self.workspace.iterdir()):
+                if p.is_file():
+                    self._add_file(p)
+            for p in sorted(self.system_dir.iterdir()):
+                if p.is_file() and p.stem.upper() not in self.index:
+                    self._add_file(p, system=True)
+        self._add_file(self.main_path)
+
+    def _load_system(self) -> None:
+        cfg = self.index.get("$CONFIG", {}).get("dat")
+        if cfg is None:
+            cfg = next((p for p in self.system_dir.iterdir() if p.name.upper() == "$CONFIG.DAT"), None)
+        if cfg is not None:
+            m = self.module("$CONFIG")
+            for k, ref in m.data.items():
+                self.globals.setdefault(k, ref)
+        if self.backup:
+            mada = [p for p in self.workspace.rglob("*.dat") if p.parent.name.upper() == "MADA"]
+            for p in sorted(mada):
+                try:
+                    self._load_sysdata(p)
+                except KrlRuntimeError:
+                    continue
+
+    def _load_sysdata(self, p: Path) -> None:
+        mod, errs = parse_module(str(p))
+        if mod.data is None:
+            return
+        m = ModuleRT(p.stem.upper(), self)
+        m.types = self.types
+        self._load_data(m, mod.data, all_global=True)
+
+    # ------------------------------------------------------------------ modules
+    def module(self, name: str) -> ModuleRT | None:
+        key = name.upper()
+        m = self.modules.get(key)
+        if m is not None:
+            return m
+        files = self.index.get(key)
+        if not files:
+            return None
+        m = ModuleRT(key, self)
+        self.modules[key] = m
+        m.files = files
+        is_config = key == "$CONFIG"
+        if is_config:
+            m.types = self.types
+        dat = files.get("dat")
+        if dat is not None:
+            mod, errs = parse_module(str(dat))
+            m.errors += errs
+            if mod.data is not None:
+                self._load_data(m, mod.data, all_global=is_config)
+        src = files.get("src") or files.get("sub")
+        if src is not None:
+            mod, errs = parse_module(str(src))
+            m.errors += errs
+            m.path = str(src)
+            for i, r in enumerate(mod.routines):
+                m.routines.setdefault(r.name.upper(), r)
+                if i == 0:
+                    m.main = r
+                if r.is_global or i == 0:
+                    self.global_routines.setdefault(r.name.upper(), (m, r))
+        m.loaded = True
+        return m
+
+    def _load_data(self, m: ModuleRT, data: N.DataList, all_global: bool) -> None:
+        """Declare and initialise a data list's variables in ``m`` (§2.5)."""
+        for item in data.items:
+            is_glob = all_global or (data.public and getattr(item, "is_global", False))
+            if isinstance(item, N.StrucDecl):
+                st = T.Struc(item.name)
+                scope = self.types if (item.is_global or all_global) else m.types
+                scope.types[item.name.upper()] = st
+                fill_struc(scope, st, [(c.type_name, c.name, tuple(c.dims)) for c in item.components])
+            elif isinstance(item, N.EnumDecl):
+                en = T.Enum(item.name, frozenset(v.upper() for v in item.values))
+                scope = self.types if (item.is_global or all_global) else m.types
+                scope.types[item.name.upper()] = en
+            elif isinstance(item, N.VarDecl):
+                t0 = self.resolve_type(item.type, m.types)
+                for vn in item.names:
+                    t = make_array(t0, vn.dims) if vn.dims else t0
+                    key = vn.name.upper()
+                    m.store[key] = make_value(t)
+                    ref = Slot(m.store, key, t, vn.name, readonly=item.is_const)
+                    if item.init is not None:
+                        try:
+                            v = self.literal(item.init, t, m)
+                            cur = m.store[key]
+                            if isinstance(cur, (Struct,)) or hasattr(cur, "dims"):
+                                assign_into(cur, v)
+                            else:
+                                m.store[key] = convert_scalar(v, t)
+                        except KrlRuntimeError as exc:
+                            m.errors.append(f"{vn.name}: {exc.message}")
+                    m.data[key] = ref
+                    if is_glob:
+                        self.globals[key] = ref
+            elif isinstance(item, N.ArrayInit):
+                ref = m.data.get(item.name.upper())
+                if ref is None:
+                    continue
+                try:
+                    from .memory import index_ref  # noqa: PLC0415
+
+                    target = index_ref(ref, list(item.indices), item.name)
+                    target.set(self.literal(item.value, target.type, m)) if not isinstance(
+                        target.peek(), Struct) else assign_into(target.peek(), self.literal(item.value, target.type, m))
+                except KrlRuntimeError as exc:
+                    m.errors.append(f"{item.name}: {exc.message}")
+            elif isinstance(item, N.SignalDecl):
+                ref = self.signal_ref(item)
+                if ref is not None:
+                    m.data[item.name.upper()] = ref
+                    if is_glob:
+                        self.globals[item.name.upper()] = ref
+
+    def signal_ref(self, item: N.SignalDecl):
+        sv = self.rt.sysvars.lookup(item.start.sysvar.upper())
+        if sv is None:
+            return None
+        arr = sv.peek()
+        if not getattr(arr, "is_live_array", False):
+            return None
+        end = item.end.index if item.end is not None else None
+        return SignalRef(arr, item.start.index, end, item.name)
+
+    # ------------------------------------------------------------------ types and literals
+    def resolve_type(self, tref, scope: Scope):
+        name = tref.name if isinstance(tref, N.TypeRef) else str(tref)
+        t = scope.lookup_type(name)
+        if t is None:
+            raise KrlRuntimeError(f"unknown type {name}")
+        size = tref.size if isinstance(tref, N.TypeRef) else None
+        if size:
+            t = T.Array(t, (size,))
+        return t
+
+    def literal(self, e, t, m: ModuleRT):
+        """Value of a data-list initialiser (literals, aggregates, leading minus, constants)."""
+        if isinstance(e, N.IntLit):
+            return e.value
+        if isinstance(e, N.RealLit):
+            return e.value
+        if isinstance(e, N.BoolLit):
+            return e.value
+        if isinstance(e, N.StrLit):
+            return e.value
+        if isinstance(e, N.EnumLit):
+            return EnumValue(e.name)
+        if isinstance(e, N.Unary) and e.op in ("-", "+"):
+            v = self.literal(e.operand, t, m)
+            return -v if e.op == "-" else v
+        if isinstance(e, N.Aggregate):
+            st = None
+            if e.type_name:
+                st = m.types.lookup_type(e.type_name)
+            out = Struct(st if isinstance(st, T.Struc) else None, {})
+            ft = t if isinstance(t, T.Struc) else st
+            for it in e.items:
+                sub_t = ft.fields.get(it.name.upper(), (None, None))[1] if isinstance(ft, T.Struc) else None
+                out.f[it.name.upper()] = self.literal(it.value, sub_t, m)
+            return out
+        if isinstance(e, N.Name):
+            ref = m.data.get(e.name.upper()) or self.globals.get(e.name.upper())
+            if ref is not None:
+                return ref.get()
+            raise KrlRuntimeError(f"unknown name {e.name} in a data list initialisation")
+        raise KrlRuntimeError("only literal values are allowed in a data list")
+
+    # ------------------------------------------------------------------ resolution
+    def scan_all(self) -> None:
+        """Load every module of the workspace once (to find GLOBAL routines and data)."""
+        if self._scanned_all:
+            return
+        self._scanned_all = True
+        for name in list(self.index):
+            try:
+                self.module(name)
+            except KrlRuntimeError:
+                continue
+            except RecursionError:
+                continue
+
+    def lookup_global(self, name: str):
+        key = name.upper()
+        ref = self.globals.get(key)
+        if ref is None and not self._scanned_all:
+            self.scan_all()
+            ref = self.globals.get(key)
+        return ref
+
+    def find_routine(self, name: str, module: ModuleRT | None):
+        """(ModuleRT, Routine) for a call of ``name`` from ``module``, or None."""
+        key = name.upper()
+        if module is not None:
+            r = module.routines.get(key)
+            if r is not None:
+                return module, r
+        got = self.global_routines.get(key)
+        if got is not None:
+            return got
+        m = self.module(key)
+        if m is not None and m.main is not None and m.main.name.upper() == key:
+            return m, m.main
+        if not self._scanned_all:
+            self.scan_all()
+            return self.global_routines.get(key)
+        return None
+
+
+UNSET_ = UNSET

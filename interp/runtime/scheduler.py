@@ -1,0 +1,137 @@
+"""Simulated time and the cooperative tasks (reference §6.10, §9; docs/architecture.md
+"Interpreters").
+
+No threads. The :class:`Scheduler` owns simulated time: the robot controller's 12 ms IPO
+clock. The robot program and every submit program run as :class:`Task` objects, each in
+its own greenlet. Per IPO cycle the scheduler
+
+1. resumes every live task once (robot first, then the submit tasks in start order); a
+   task runs until it must wait — queue full at ``$ADVANCE``, an advance-run stop waiting
+   for the main run, ``WAIT SEC``/``WAIT FOR`` not yet satisfied, ``BRAKE`` ramping — or
+   until it has used its statement budget for this cycle (:data:`ROBOT_BUDGET` statements
+   or loop iterations for the robot program, :data:`SUBMIT_BUDGET` for a submit program),
+   so endless loops advance simulated time;
+2. checks the end conditions: robot program finished (``completed``), HALT (``halt``),
+   error (``error``), ``--max-steps`` (``max_steps``), ``--max-sim-time``
+   (``max_sim_time``), deadlock (``deadlock``: the robot program waits in WAIT FOR while
+   nothing can change any more — no motion, no stimulus or pulse pending, no running
+   timer, no submit program, no armed interrupt);
+3. runs one ``controller.step()`` and hands its events to the robot task: TRIGGER actions
+   and main-run errors are picked up when the robot task resumes (its first act after a
+   switch is :meth:`core.Runtime.service`: triggers, then interrupt conditions).
+"""
+
+from __future__ import annotations
+
+from greenlet import greenlet
+
+from .contexts import Context, InterruptTable
+
+ROBOT_BUDGET = 1000
+SUBMIT_BUDGET = 100
+
+
+class Task:
+    """One interpreter: ``kind`` 'robot' or 'submit'."""
+
+    def __init__(self, kind: str, name: str, body, budget: int | None = None) -> None:
+        self.kind = kind
+        self.name = name
+        self.body = body
+        self.budget = budget if budget is not None else (ROBOT_BUDGET if kind == "robot" else SUBMIT_BUDGET)
+        self.count = 0
+        self.contexts = [Context("main" if kind == "robot" else "submit")]
+        self.irqs = InterruptTable()
+        self.err = None                 # $ERR of this interpreter (Struct ERROR_T)
+        self.continue_line = None       # (file, line) of a CONTINUE
+        self.error_proceed = False      # ON_ERROR_PROCEED seen
+        self.pending_triggers: list = []
+        self.pending_error = None
+        self.next_triggers: list = []   # TRIGGERs waiting for the next motion
+        self.waiting: str | None = None
+        self.file: str | None = None
+        self.line: int | None = None
+        self.done = False
+        self.outcome = None             # (reason, error or None)
+        self.in_poll = False
+        self.glet: greenlet | None = None
+        self.frame = None               # innermost frame (VARSTATE)
+        self.err_text = ""
+
+    @property
+    def context(self) -> Context:
+        return self.contexts[-1]
+
+
+class Scheduler:
+    def __init__(self, rt, max_sim_time: float | None = None, max_steps: int | None = None) -> None:
+        self.rt = rt
+        self.max_sim_time = max_sim_time
+        self.max_steps = max_steps
+        self.tasks: list[Task] = []
+        self.stop: tuple | None = None      # (reason, text, task)
+        self.main = greenlet.getcurrent()
+
+    def add(self, task: Task) -> None:
+        task.glet = greenlet(lambda: self.rt.task_main(task), parent=self.main)
+        self.tasks.append(task)
+
+    def yield_cycle(self) -> None:
+        """Called inside a task: give the IPO cycle back to the scheduler."""
+        self.main.switch()
+
+    def _resume(self, task: Task) -> None:
+        self.rt.current_task = task
+        task.count = 0
+        try:
+            task.glet.switch()
+        finally:
+            self.rt.current_task = None
+
+    def run(self) -> None:
+        rt = self.rt
+        ctl = rt.controller
+        robot = self.tasks[0]
+        while True:
+            for task in list(self.tasks):
+                if not task.done and self.stop is None:
+                    self._resume(task)
+                    if task.done and task is not robot:
+                        rt.submit_finished(task)
+            if robot.done or self.stop is not None:
+                break
+            if self.max_sim_time is not None and ctl.time >= self.max_sim_time - 1e-9:
+                self.stop = ("max_sim_time", f"simulated time limit {self.max_sim_time} s reached", robot)
+                break
+            if robot.waiting and self.deadlocked():
+                self.stop = ("deadlock", f"deadlocked {robot.waiting}", robot)
+                break
+            events = ctl.step()
+            for ev in events:
+                k = ev.kind
+                if k == "trigger":
+                    robot.pending_triggers.append(ev)
+                elif k == "error":
+                    robot.pending_error = ev.error
+        for task in self.tasks:
+            if not task.done and task.glet is not None and not task.glet.dead:
+                task.glet = None  # abandoned: never resumed again
+
+    def deadlocked(self) -> bool:
+        rt = self.rt
+        ctl = rt.controller
+        if not ctl.is_idle() or ctl._held is not None:  # noqa: SLF001
+            return False
+        if any(not t.done for t in self.tasks[1:]):
+            return False
+        if any(not st.fired for st in ctl.stimuli):
+            return False
+        if ctl._pulses or ctl._cyclic:  # noqa: SLF001
+            return False
+        io = ctl.io
+        if any(not s for s in io.timer_stop[1:]):
+            return False
+        robot = self.tasks[0]
+        if robot.irqs.armed or robot.pending_triggers:
+            return False
+        return True

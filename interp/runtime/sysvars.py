@@ -1,0 +1,311 @@
+"""System variables wired to the simulated controller (reference §6.10, §7).
+
+The table of names, types, access (RO/RW) and advance-run stop flags is the front end's
+``krl/semantics/data/sysvars.yaml`` (read through :func:`krl.semantics.builtins.load_builtins`);
+this module adds only *where the value lives*:
+
+* live arrays on the controller's I/O image: ``$IN`` (RO), ``$OUT``, ``$ANIN`` (RO),
+  ``$ANOUT``, ``$TIMER``, ``$TIMER_STOP``, ``$TIMER_FLAG`` (RO);
+* computed values: ``$POS_ACT``, ``$AXIS_ACT`` (read back from the arm), ``$POS_INT`` /
+  ``$AXIS_INT`` (captured when the running interrupt fired; "value invalid" elsewhere),
+  ``$VEL_ACT``, ``$DATE``, ``$PRO_STATE*``, ``$PRO_MOVE``, ``$STOPMESS``, ``$MODE_OP``,
+  ``$INTERPRETER``, ``$ERR`` (one per interpreter), ``$NULLFRAME``, ``$NUM_AX``, ...;
+* everything else is stored (``store``), booting with the INITMOV values ("friendly mode",
+  reference §7.3): the motion variables are read from there when a motion is planned.
+"""
+
+from __future__ import annotations
+
+from krl.semantics import types as T
+from krl.semantics.builtins import load_builtins
+from krl.semantics.symbols import make_array, system_scopes
+
+from .errors import KrlRuntimeError, value_invalid
+from .memory import ComputedRef, Slot
+from .values import UNSET, EnumValue, Struct, make_value
+
+
+class LiveArray:
+    """A 1-D system array whose elements live elsewhere (I/O image)."""
+
+    is_live_array = True
+
+    def __init__(self, name: str, size: int, type_, getter, setter=None) -> None:
+        self.name = name
+        self.size = size
+        self.type = type_
+        self.getter = getter
+        self.setter = setter
+
+    def get(self, i: int):
+        return self.getter(i)
+
+    def set(self, i: int, v) -> None:
+        self.setter(i, v)
+
+
+def sys_type(name: str):
+    system, basis = system_scopes()
+    return basis.lookup_type(name)
+
+
+def struct_of(type_name: str, values: dict) -> Struct:
+    s = make_value(sys_type(type_name))
+    for k, v in values.items():
+        s.f[k.upper()] = v
+    return s
+
+
+E6AXIS_KEYS = ("A1", "A2", "A3", "A4", "A5", "A6", "E1", "E2", "E3", "E4", "E5", "E6")
+
+
+def axis_struct(q) -> Struct:
+    vals = {k: 0.0 for k in E6AXIS_KEYS}
+    for i, v in enumerate(list(q)[:6]):
+        vals[E6AXIS_KEYS[i]] = float(v)
+    return struct_of("E6AXIS", vals)
+
+
+def pos_struct(d: dict) -> Struct:
+    vals = {k: float(d[k]) for k in ("X", "Y", "Z", "A", "B", "C")}
+    vals["S"] = int(d.get("S", 0))
+    vals["T"] = int(d.get("T", 0))
+    for e in ("E1", "E2", "E3", "E4", "E5", "E6"):
+        vals[e] = 0.0
+    return struct_of("E6POS", vals)
+
+
+class SysVars:
+    """The system variables of one run. ``rt`` is the :class:`core.Runtime` (for the
+    controller, the current task and the current context)."""
+
+    def __init__(self, rt) -> None:
+        self.rt = rt
+        self.info = load_builtins().sysvars
+        self.store: dict = {}
+        self.refs: dict = {}
+        self._boot()
+
+    # ------------------------------------------------------------------ boot values
+    def _boot(self) -> None:
+        from robot.motion import MotionParams  # noqa: PLC0415
+
+        ctl = self.rt.controller
+        p = MotionParams.initmov(ctl.machine)
+        m = ctl.machine
+        boot = {
+            "$VEL": {"CP": p.vel_cp, "ORI1": p.vel_ori1, "ORI2": p.vel_ori2},
+            "$ACC": {"CP": p.acc_cp, "ORI1": p.acc_ori1, "ORI2": p.acc_ori2},
+            "$APO": {"CPTP": int(p.apo_cptp), "CDIS": p.apo_cdis, "CVEL": int(p.apo_cvel), "CORI": p.apo_cori},
+            "$BASE": dict(zip("XYZABC", [0.0] * 6)),
+            "$TOOL": dict(zip("XYZABC", [0.0] * 6)),
+            "$WORLD": dict(zip("XYZABC", [0.0] * 6)),
+            "$ROBROOT": dict(zip("XYZABC", [float(x) for x in m.robroot_frame])),
+            "$VEL_MA": {"CP": 3.0, "ORI1": 400.0, "ORI2": 400.0},
+            "$ACC_MA": {"CP": 10.0, "ORI1": 1000.0, "ORI2": 1000.0},
+            "$LOAD": {"M": -1.0},
+        }
+        for key, info in self.info.items():
+            if key in _LIVE:
+                continue
+            t = make_array(sys_type(info.type_name) or T.UNKNOWN, info.dims)
+            v = make_value(t)
+            if key in boot and isinstance(v, Struct):
+                for k, x in boot[key].items():
+                    if k in v.f:
+                        v.f[k] = x
+            self.store[key] = v
+        s = self.store
+        for i in range(12):
+            s["$VEL_AXIS"].data[i] = float(p.vel_axis[0]) if i < 6 else 100.0
+            s["$ACC_AXIS"].data[i] = float(p.acc_axis[0]) if i < 6 else 100.0
+        for key in ("$FLAG", "$CYCFLAG"):
+            a = s[key]
+            a.data[:] = [False] * len(a.data)
+        for i, j in enumerate(m.joints[:6] if hasattr(m, "joints") else []):
+            s["$SOFTN_END"].data[i] = float(j.limit_deg[0])
+            s["$SOFTP_END"].data[i] = float(j.limit_deg[1])
+        s["$ADVANCE"] = int(ctl.advance)
+        s["$OV_PRO"] = 100
+        s["$ORI_TYPE"] = EnumValue("VAR")
+        s["$CIRC_TYPE"] = EnumValue("BASE")
+        s["$IPO_MODE"] = EnumValue("BASE")
+        s["$ACT_TOOL"] = -1
+        s["$ACT_BASE"] = -1
+        s["$ACT_EX_AX"] = -1
+        s["$BWDSTART"] = False
+        s["$TCP_IPO"] = False
+        s["$ADAP_ACC"] = EnumValue("STEP2")
+        s["$I_O_ACT"] = True
+        s["$MOVE_ENABLE"] = True
+        s["$USER_SAF"] = True
+        s["$DRIVES_ON"] = False
+        s["$DRIVES_OFF"] = False
+        s["$CMD"] = 1
+        s["$FCT_CALL"] = 2
+        s["$FILTER"] = 0
+        s["$EX_AX_IGNORE"] = 0
+        s["$H_POS"] = axis_struct(m.home_deg)
+        for i in range(5):
+            s["$AXIS_HOME"].data[i] = axis_struct(m.home_deg)
+
+    # ------------------------------------------------------------------ lookup
+    def lookup(self, name: str):
+        """The reference of system variable ``name`` (upper-case), or None if unknown."""
+        ref = self.refs.get(name)
+        if ref is not None:
+            return ref
+        info = self.info.get(name)
+        if info is None:
+            return None
+        t = make_array(sys_type(info.type_name) or T.UNKNOWN, info.dims)
+        live = _LIVE.get(name)
+        if live is not None:
+            ref = live(self, t, name)
+        else:
+            on_write = self._on_write.get(name)
+            ref = Slot(self.store, name, t, name, readonly=info.access == "RO", on_write=on_write)
+        self.refs[name] = ref
+        return ref
+
+    def stops(self, name: str) -> tuple[bool, bool]:
+        """(stops on read, stops on write) for system variable ``name``."""
+        info = self.info.get(name)
+        return (info.stop_read, info.stop_write) if info is not None else (False, False)
+
+    # ------------------------------------------------------------------ helpers for motion
+    def value(self, name: str):
+        return self.store[name]
+
+    _on_write: dict = {}
+
+
+# ---------------------------------------------------------------------- live variables
+
+def _io(kind: str):
+    def make(sv: SysVars, t, name):
+        io = sv.rt.controller.io
+        ctl = sv.rt.controller
+        if kind == "$IN":
+            arr = LiveArray(name, 8192, T.BOOL, io.get_in)
+        elif kind == "$OUT":
+            arr = LiveArray(name, 8192, T.BOOL, io.get_out,
+                            lambda i, v: ctl.set_out(i, v, sv.rt.io_source()))
+        elif kind == "$ANIN":
+            arr = LiveArray(name, 32, T.REAL, io.get_anin)
+        elif kind == "$ANOUT":
+            arr = LiveArray(name, 32, T.REAL, io.get_anout,
+                            lambda i, v: _set_anout(sv, i, v))
+        elif kind == "$TIMER":
+            arr = LiveArray(name, 64, T.INT, io.get_timer, io.set_timer)
+        elif kind == "$TIMER_STOP":
+            arr = LiveArray(name, 64, T.BOOL, io.get_timer_stop, io.set_timer_stop)
+        else:  # $TIMER_FLAG
+            arr = LiveArray(name, 64, T.BOOL, io.get_timer_flag)
+        return ComputedRef(lambda: arr, t, name)
+    return make
+
+
+def _set_anout(sv: SysVars, i: int, v) -> None:
+    io = sv.rt.controller.io
+    io.now = sv.rt.controller.time
+    io.set_anout(i, v, sv.rt.io_source())
+
+
+def _computed(fn, setter=None):
+    def make(sv: SysVars, t, name):
+        return ComputedRef(lambda: fn(sv), t, name, setter)
+    return make
+
+
+def _pos_int(sv: SysVars):
+    ctx = sv.rt.current_context()
+    if ctx is None or ctx.pos_int is None:
+        raise value_invalid("$POS_INT outside an interrupt routine")
+    return pos_struct(ctx.pos_int)
+
+
+def _axis_int(sv: SysVars):
+    ctx = sv.rt.current_context()
+    if ctx is None or ctx.axis_int is None:
+        raise value_invalid("$AXIS_INT outside an interrupt routine")
+    return axis_struct(ctx.axis_int)
+
+
+def _date(sv: SysVars):
+    t = sv.rt.controller.time
+    cs = int(round(t * 100))
+    s = cs // 100
+    return struct_of("DATE", {"CSEC": cs % 100, "SEC": s % 60, "MIN": (s // 60) % 60,
+                              "HOUR": (s // 3600) % 24, "DAY": 1, "MONTH": 1, "YEAR": 2026})
+
+
+def _pro_state(robot: bool):
+    def fn(sv: SysVars):
+        return EnumValue("P_ACTIVE" if sv.rt.interpreter_active(robot) else "P_FREE")
+    return fn
+
+
+def _pro_state_self(sv: SysVars):
+    return EnumValue("P_ACTIVE")
+
+
+def _err(sv: SysVars):
+    return sv.rt.current_err()
+
+
+def _nullframe(sv: SysVars):
+    return struct_of("FRAME", dict(zip("XYZABC", [0.0] * 6)))
+
+
+def _ro_const(v):
+    return lambda sv: v
+
+
+_LIVE = {
+    "$IN": _io("$IN"), "$OUT": _io("$OUT"), "$ANIN": _io("$ANIN"), "$ANOUT": _io("$ANOUT"),
+    "$TIMER": _io("$TIMER"), "$TIMER_STOP": _io("$TIMER_STOP"), "$TIMER_FLAG": _io("$TIMER_FLAG"),
+    "$POS_ACT": _computed(lambda sv: pos_struct(sv.rt.controller.pos_act())),
+    "$POS_ACT_MES": _computed(lambda sv: pos_struct(sv.rt.controller.pos_act())),
+    "$AXIS_ACT": _computed(lambda sv: axis_struct(sv.rt.controller.axis_act())),
+    "$AXIS_ACT_MEAS": _computed(lambda sv: axis_struct(sv.rt.controller.axis_act())),
+    "$POS_INT": _computed(_pos_int),
+    "$AXIS_INT": _computed(_axis_int),
+    "$VEL_ACT": _computed(lambda sv: float(sv.rt.controller.vel_act())),
+    "$DATE": _computed(_date),
+    "$PRO_STATE": _computed(_pro_state_self),
+    "$PRO_STATE0": _computed(_pro_state(False)),
+    "$PRO_STATE1": _computed(_pro_state(True)),
+    "$PRO_MOVE": _computed(lambda sv: bool(sv.rt.controller.is_moving())),
+    "$STOPMESS": _computed(_ro_const(False)),
+    "$POWER_FAIL": _computed(_ro_const(False)),
+    "$ALARM_STOP": _computed(_ro_const(False)),
+    "$ON_PATH": _computed(_ro_const(True)),
+    "$MODE_OP": _computed(lambda sv: EnumValue(sv.rt.mode_op)),
+    "$T1": _computed(lambda sv: sv.rt.mode_op == "T1"),
+    "$T2": _computed(lambda sv: sv.rt.mode_op == "T2"),
+    "$AUT": _computed(lambda sv: sv.rt.mode_op == "AUT"),
+    "$EXT": _computed(lambda sv: sv.rt.mode_op == "EX"),
+    "$INTERPRETER": _computed(lambda sv: 1 if sv.rt.current_task_kind() == "robot" else 0),
+    "$ERR": _computed(_err),
+    "$NULLFRAME": _computed(_nullframe),
+    "$NUM_AX": _computed(_ro_const(6)),
+    "$EX_AX_NUM": _computed(_ro_const(0)),
+    "$PERI_RDY": _computed(_ro_const(True)),
+    "$ROB_CAL": _computed(_ro_const(True)),
+    "$IN_HOME": _computed(_ro_const(False)),
+    "$IN_HOME1": _computed(_ro_const(False)),
+    "$NEAR_POSRET": _computed(_ro_const(False)),
+    "$ROBRUNTIME": _computed(lambda sv: int(sv.rt.controller.time / 60)),
+}
+
+
+def _sync_advance(ref) -> None:
+    """``$ADVANCE = n`` (0..5) goes to the controller's motion queue at once."""
+    v = ref.c[ref.k]
+    if not 0 <= v <= 5:
+        raise KrlRuntimeError(f"$ADVANCE {v} outside 0..5")
+
+
+SysVars._on_write = {"$ADVANCE": _sync_advance}
+UNSET_ = UNSET

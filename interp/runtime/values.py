@@ -1,0 +1,170 @@
+"""KRL values (reference §3).
+
+Representation (shared by both interpreters):
+
+* INT -> ``int`` (32-bit range enforced by :mod:`convert`), REAL -> ``float``,
+  BOOL -> ``bool``, CHAR -> a one-character ``str`` (code 0..255; arithmetic uses the code);
+* a string literal -> ``str``;
+* ENUM -> :class:`EnumValue` (compared by value name; the enum type comes from the context);
+* STRUC -> :class:`Struct`: ``type`` (a :class:`krl.semantics.types.Struc`, or None for an
+  untyped aggregate) and ``f``, a dict UPPER component name -> value. An aggregate
+  evaluates to a Struct holding only the components it names (a *partial* value,
+  reference §3.9): assignment copies exactly the components present;
+* arrays -> :class:`Arr` (1-based, row-major flat ``data``);
+* :data:`UNSET` marks a leaf that was declared but never assigned: reading it is error
+  1422 "value invalid" (reference §10.2).
+
+Types are the front end's :mod:`krl.semantics.types` classes (Simple, Array, Struc, Enum).
+"""
+
+from __future__ import annotations
+
+from krl.semantics import types as T
+
+
+class _Unset:
+    __slots__ = ()
+
+    def __repr__(self) -> str:
+        return "UNSET"
+
+    def __bool__(self) -> bool:  # never used as a truth value by accident
+        raise TypeError("UNSET has no truth value")
+
+
+UNSET = _Unset()
+
+
+class EnumValue:
+    """``#NAME``: an enum value (name upper-case; ``type`` the Enum type if known)."""
+
+    __slots__ = ("name", "type")
+
+    def __init__(self, name: str, type_=None) -> None:
+        self.name = name.upper()
+        self.type = type_
+
+    def __eq__(self, other: object) -> bool:
+        return isinstance(other, EnumValue) and other.name == self.name
+
+    def __hash__(self) -> int:
+        return hash(("#", self.name))
+
+    def __repr__(self) -> str:
+        return f"#{self.name}"
+
+
+class Struct:
+    """A structure value; ``f`` maps UPPER component names to values (see module doc)."""
+
+    __slots__ = ("type", "f")
+
+    def __init__(self, type_, f: dict | None = None) -> None:
+        self.type = type_
+        self.f = f if f is not None else {}
+
+    def __repr__(self) -> str:
+        name = self.type.name if self.type is not None else ""
+        return "{" + (name + ": " if name else "") + ", ".join(f"{k} {v!r}" for k, v in self.f.items()) + "}"
+
+    def __eq__(self, other: object) -> bool:
+        return isinstance(other, Struct) and self.f == other.f
+
+
+class Arr:
+    """An array: ``type`` (T.Array), ``dims`` (sizes), ``data`` (flat, row-major)."""
+
+    __slots__ = ("type", "dims", "data")
+
+    def __init__(self, type_, dims: tuple, data: list) -> None:
+        self.type = type_
+        self.dims = dims
+        self.data = data
+
+    @property
+    def elem(self):
+        return self.type.elem
+
+    def flat(self, idx: list[int]) -> int:
+        """Flat position of 1-based indices ``idx``; raises IndexError when out of range."""
+        if len(idx) != len(self.dims):
+            raise IndexError(f"{len(idx)} indices for {len(self.dims)} dimensions")
+        pos = 0
+        for i, n in zip(idx, self.dims):
+            if not 1 <= i <= n:
+                raise IndexError(f"index {i} outside 1..{n}")
+            pos = pos * n + (i - 1)
+        return pos
+
+    def text(self) -> str:
+        """A CHAR array as a Python string: up to the first NUL or unset element."""
+        out = []
+        for c in self.data:
+            if c is UNSET or c == "\0":
+                break
+            out.append(c)
+        return "".join(out)
+
+    def __repr__(self) -> str:
+        if self.type.elem == T.CHAR:
+            return repr(self.text())
+        return f"Arr{self.dims}{self.data!r}"
+
+
+def is_char_array(v) -> bool:
+    return isinstance(v, Arr) and v.type.elem == T.CHAR and len(v.dims) == 1
+
+
+def make_value(t):
+    """A fresh, uninitialised value of type ``t`` (UNSET leaves)."""
+    if isinstance(t, T.Struc):
+        return Struct(t, {k: make_value(ft) for k, (_, ft) in t.fields.items()})
+    if isinstance(t, T.Array):
+        n = 1
+        for d in t.dims:
+            n *= d
+        if isinstance(t.elem, (T.Struc, T.Array)):
+            return Arr(t, t.dims, [make_value(t.elem) for _ in range(n)])
+        return Arr(t, t.dims, [UNSET] * n)
+    return UNSET
+
+
+def copy_value(v):
+    """A deep copy (for :IN parameters and whole-value reads)."""
+    if isinstance(v, Struct):
+        return Struct(v.type, {k: copy_value(x) for k, x in v.f.items()})
+    if isinstance(v, Arr):
+        if v.data and isinstance(v.data[0], (Struct, Arr)):
+            return Arr(v.type, v.dims, [copy_value(x) for x in v.data])
+        return Arr(v.type, v.dims, list(v.data))
+    return v
+
+
+def is_initialised(v) -> bool:
+    """True if ``v`` is set (a Struct/Arr counts as set when one leaf is set)."""
+    if v is UNSET:
+        return False
+    if isinstance(v, Struct):
+        return any(is_initialised(x) for x in v.f.values())
+    if isinstance(v, Arr):
+        return any(is_initialised(x) for x in v.data)
+    return True
+
+
+def type_name_of(v) -> str:
+    """KRL type name of a value, for messages and VARTYPE."""
+    if isinstance(v, bool):
+        return "BOOL"
+    if isinstance(v, int):
+        return "INT"
+    if isinstance(v, float):
+        return "REAL"
+    if isinstance(v, str):
+        return "CHAR" if len(v) == 1 else "string"
+    if isinstance(v, EnumValue):
+        return v.type.name if v.type is not None else "ENUM"
+    if isinstance(v, Struct):
+        return v.type.name if v.type is not None else "aggregate"
+    if isinstance(v, Arr):
+        return str(v.type)
+    return "?"

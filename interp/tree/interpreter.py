@@ -1,0 +1,498 @@
+"""The tree interpreter (paper §VI): a visitor over the AST.
+
+It decides only *how to step*: statement by statement, expressions recursively. Every
+semantic decision (values, conversions, operators, memory, calls, built-ins, system
+variables, advance run, motion, interrupts, triggers, time) is a call into
+:class:`interp.runtime.core.Runtime`. GOTO, EXIT and RETURN unwind with Python exceptions
+(:mod:`interp.runtime.errors`); a block that holds the GOTO's label catches it and
+continues there.
+
+Names: resolved at run time by the runtime's resolver (``Runtime.lookup``), which follows
+the reference's order (§2.7); the checker's annotations are not required.
+"""
+
+from __future__ import annotations
+
+from krl.ast import nodes as N
+
+from interp.runtime.builtins import ValueRef
+from interp.runtime.convert import num
+from interp.runtime.errors import (ExitSignal, GotoSignal, KrlRuntimeError, ResumeSignal,
+                                   ReturnSignal)
+from interp.runtime.values import EnumValue, Struct, copy_value
+
+
+class TreeInterpreter:
+    def __init__(self, rt) -> None:
+        self.rt = rt
+        self._labels: dict = {}
+        self.stmt_dispatch = {
+            N.Assign: self.s_assign, N.CallStmt: self.s_call, N.If: self.s_if,
+            N.Switch: self.s_switch, N.For: self.s_for, N.While: self.s_while,
+            N.Repeat: self.s_repeat, N.Loop: self.s_loop, N.Exit: self.s_exit,
+            N.Goto: self.s_goto, N.Label: self.s_label, N.Halt: self.s_halt,
+            N.WaitFor: self.s_wait_for, N.WaitSec: self.s_wait_sec, N.Continue: self.s_continue,
+            N.Return: self.s_return, N.OnErrorProceed: self.s_on_error_proceed,
+            N.InterruptDecl: self.s_int_decl, N.InterruptCtl: self.s_int_ctl,
+            N.Brake: self.s_brake, N.Resume: self.s_resume, N.Trigger: self.s_trigger,
+            N.Motion: self.s_motion, N.SplineBlock: self.s_spline,
+            N.AninOn: self.s_unsupported, N.AninOff: self.s_unsupported,
+            N.AnoutOn: self.s_unsupported, N.AnoutOff: self.s_unsupported,
+            N.DeclStmt: self.s_declstmt, N.Unsupported: self.s_unsupported_text,
+        }
+        self.expr_dispatch = {
+            N.IntLit: self.e_lit, N.RealLit: self.e_lit, N.BoolLit: self.e_lit,
+            N.StrLit: self.e_lit, N.EnumLit: self.e_enum, N.Aggregate: self.e_aggregate,
+            N.Name: self.e_var, N.Index: self.e_var, N.Field: self.e_var,
+            N.Call: self.e_call, N.Unary: self.e_unary, N.Binary: self.e_binary,
+        }
+
+    # ------------------------------------------------------------------ entry points
+    def run_program(self, module_name: str | None = None) -> None:
+        """Body of the robot (or a submit) task: call the main routine of the module."""
+        rt = self.rt
+        prog = rt.program
+        name = module_name or prog.main_path.stem
+        m = prog.module(name)
+        if m is None or m.main is None:
+            raise KrlRuntimeError(f"no main routine in {name}")
+        if m.errors and not m.main.body:
+            raise KrlRuntimeError("program has syntax errors: " + "; ".join(m.errors[:3]))
+        self.invoke((m, m.main), [], None)
+
+    # ------------------------------------------------------------------ statements
+    def exec_block(self, stmts: list, frame) -> None:
+        i = 0
+        n = len(stmts)
+        dispatch = self.stmt_dispatch
+        while i < n:
+            st = stmts[i]
+            try:
+                dispatch[st.__class__](st, frame)
+                i += 1
+            except GotoSignal as g:
+                pos = self._label_pos(stmts, g.label)
+                if pos is None:
+                    raise
+                i = pos
+
+    def _label_pos(self, stmts: list, label: str):
+        key = id(stmts)
+        table = self._labels.get(key)
+        if table is None:
+            table = {s.name.upper(): i for i, s in enumerate(stmts) if isinstance(s, N.Label)}
+            self._labels[key] = (table, stmts)
+        else:
+            table = table[0]
+        return table.get(label)
+
+    def begin(self, st, frame):
+        """Common statement prologue: runtime bookkeeping; returns the StmtInfo."""
+        rt = self.rt
+        info = rt.stmt_info(st, frame)
+        frame.line = info.line
+        rt.before_statement(info)
+        return info
+
+    def guarded(self, fn, st, frame) -> None:
+        """Run a statement body under ON_ERROR_PROCEED semantics and place errors."""
+        rt = self.rt
+        proceed = rt.take_error_proceed()
+        try:
+            fn()
+        except KrlRuntimeError as e:
+            e.at(st.span.file, st.span.line)
+            if not proceed:
+                raise
+            rt.record_error(e, frame)
+
+    def s_assign(self, st, frame) -> None:
+        self.begin(st, frame)
+
+        def do():
+            value = self.eval(st.value, frame)
+            ref = self.ref(st.target, frame)
+            self.rt.assign(ref, value)
+        self.guarded(do, st, frame)
+
+    def s_call(self, st, frame) -> None:
+        self.begin(st, frame)
+        self.guarded(lambda: self.call(st.call, frame, statement=True), st, frame)
+
+    def s_if(self, st, frame) -> None:
+        self.begin(st, frame)
+        cond = []
+        self.guarded(lambda: cond.append(self.rt.to_bool(self.eval(st.cond, frame))), st, frame)
+        if not cond:
+            return
+        if cond[0]:
+            self.exec_block(st.then, frame)
+        elif st.orelse:
+            self.exec_block(st.orelse, frame)
+
+    def s_switch(self, st, frame) -> None:
+        self.begin(st, frame)
+        sel = []
+        self.guarded(lambda: sel.append(self.eval(st.selector, frame)), st, frame)
+        if not sel:
+            return
+        v = sel[0]
+        for case in st.cases:
+            for ce in case.values:
+                if self.rt.binary_op("==", v, self.eval(ce, frame)):
+                    self.exec_block(case.body, frame)
+                    return
+        if st.default is not None:
+            self.exec_block(st.default, frame)
+
+    def s_for(self, st, frame) -> None:
+        info = self.begin(st, frame)
+        rt = self.rt
+        try:
+            ref = self.ref(st.var, frame)
+            start = self.eval(st.start, frame)
+            end = num(self.eval(st.end, frame))
+            step = num(self.eval(st.step, frame)) if st.step is not None else 1
+        except KrlRuntimeError as e:
+            raise e.at(st.span.file, st.span.line)
+        if step == 0:
+            raise KrlRuntimeError("FOR with STEP 0", None, st.span.file, st.span.line)
+        rt.assign(ref, start)
+        try:
+            while True:
+                c = ref.get()
+                if (step > 0 and c > end) or (step < 0 and c < end):
+                    break
+                rt.loop_tick(info)
+                self.exec_block(st.body, frame)
+                rt.assign(ref, rt.binary_op("+", ref.get(), step))
+        except ExitSignal:
+            pass
+
+    def s_while(self, st, frame) -> None:
+        info = self.begin(st, frame)
+        rt = self.rt
+        try:
+            while True:
+                rt.loop_tick(info)
+                if not rt.to_bool(self.eval_at(st.cond, frame, st)):
+                    break
+                self.exec_block(st.body, frame)
+        except ExitSignal:
+            pass
+
+    def s_repeat(self, st, frame) -> None:
+        info = self.begin(st, frame)
+        rt = self.rt
+        try:
+            while True:
+                self.exec_block(st.body, frame)
+                rt.loop_tick(info)
+                if rt.to_bool(self.eval_at(st.cond, frame, st)):
+                    break
+        except ExitSignal:
+            pass
+
+    def s_loop(self, st, frame) -> None:
+        info = self.begin(st, frame)
+        rt = self.rt
+        try:
+            while True:
+                rt.loop_tick(info)
+                self.exec_block(st.body, frame)
+        except ExitSignal:
+            pass
+
+    def s_exit(self, st, frame) -> None:
+        self.begin(st, frame)
+        raise ExitSignal()
+
+    def s_goto(self, st, frame) -> None:
+        self.begin(st, frame)
+        raise GotoSignal(st.label)
+
+    def s_label(self, st, frame) -> None:
+        pass
+
+    def s_halt(self, st, frame) -> None:
+        self.begin(st, frame)
+        self.rt.halt()
+
+    def s_wait_for(self, st, frame) -> None:
+        self.begin(st, frame)
+        self.guarded(lambda: self.rt.wait_for(lambda: self.eval(st.cond, frame)), st, frame)
+
+    def s_wait_sec(self, st, frame) -> None:
+        self.begin(st, frame)
+        self.guarded(lambda: self.rt.wait_sec(self.eval(st.time, frame)), st, frame)
+
+    def s_continue(self, st, frame) -> None:
+        info = self.begin(st, frame)
+        self.rt.set_continue(info)
+
+    def s_return(self, st, frame) -> None:
+        self.begin(st, frame)
+        value = None
+        if st.value is not None:
+            value = self.eval_at(st.value, frame, st)
+        raise ReturnSignal(value)
+
+    def s_on_error_proceed(self, st, frame) -> None:
+        self.begin(st, frame)
+        self.rt.on_error_proceed()
+
+    def s_declstmt(self, st, frame) -> None:
+        raise KrlRuntimeError("declaration after the first statement", None, st.span.file, st.span.line)
+
+    def s_unsupported(self, st, frame) -> None:
+        self.begin(st, frame)
+        raise KrlRuntimeError(f"{type(st).__name__} is not supported by this simulator", None,
+                              st.span.file, st.span.line)
+
+    def s_unsupported_text(self, st, frame) -> None:
+        raise KrlRuntimeError(f"unsupported statement: {st.text.strip()[:60]}", None,
+                              st.span.file, st.span.line)
+
+    # interrupts, triggers, brake ------------------------------------------------------
+    def s_int_decl(self, st, frame) -> None:
+        self.begin(st, frame)
+        rt = self.rt
+        call = st.call
+        cond_expr = st.when
+
+        def cond():
+            return rt.to_bool(self.eval(cond_expr, frame), "interrupt condition")
+
+        if call.name.upper() in ("BRAKE", "BRAKE_F") and not call.args:
+            fast = call.name.upper() == "BRAKE_F"
+
+            def handler():
+                rt.brake(fast)
+        else:
+            def handler():
+                self.call(call, frame, statement=True, catch_resume=False)
+
+        def do():
+            rt.interrupt_decl(self.eval(st.prio, frame), cond, handler, call.name, frame,
+                              st.is_global, st.span.line)
+        self.guarded(do, st, frame)
+
+    def s_int_ctl(self, st, frame) -> None:
+        self.begin(st, frame)
+        self.guarded(lambda: self.rt.interrupt_ctl(
+            st.action, self.eval(st.prio, frame) if st.prio is not None else None), st, frame)
+
+    def s_brake(self, st, frame) -> None:
+        self.begin(st, frame)
+        self.rt.brake(st.fast)
+
+    def s_resume(self, st, frame) -> None:
+        self.begin(st, frame)
+        self.rt.resume()
+
+    def s_trigger(self, st, frame) -> None:
+        self.begin(st, frame)
+        rt = self.rt
+        act = st.action
+
+        def do():
+            if isinstance(act, N.CallStmt):
+                call = act.call
+                target = rt.find_routine(call.name, frame.module)
+                if target is not None:
+                    args = self.args_for(call, frame)   # evaluated now (advance run)
+
+                    def action():
+                        self.exec_trigger_stmt(act, frame, lambda: self.invoke(target, args, frame))
+                else:
+                    def action():
+                        self.exec_trigger_stmt(act, frame, lambda: self.call(call, frame, statement=True))
+            else:
+                def action():
+                    self.exec_trigger_stmt(act, frame, lambda: rt.assign(
+                        self.ref(act.target, frame), self.eval(act.value, frame)))
+            at = num(self.eval(st.at, frame))
+            delay = num(self.eval(st.delay, frame))
+            prio = int(num(self.eval(st.prio, frame))) if st.prio is not None else None
+            if st.kind == "PATH":
+                rt.trigger(action, path=float(at), onstart=st.onstart, delay_ms=delay, prio=prio,
+                           line=st.span.line)
+            else:
+                rt.trigger(action, distance=int(at), delay_ms=delay, prio=prio, line=st.span.line)
+        self.guarded(do, st, frame)
+
+    def exec_trigger_stmt(self, act, frame, fn) -> None:
+        info = self.rt.stmt_info(act, frame)
+        self.rt.before_statement(info)
+        try:
+            fn()
+        except KrlRuntimeError as e:
+            raise e.at(act.span.file, act.span.line)
+
+    # motion ---------------------------------------------------------------------------
+    def with_pairs(self, with_, frame) -> list:
+        return [(self.ref(w.target, frame), self.eval(w.value, frame)) for w in with_]
+
+    def s_motion(self, st, frame) -> None:
+        self.begin(st, frame)
+        rt = self.rt
+
+        def do():
+            target = self.eval(st.target, frame)
+            aux = self.eval(st.aux, frame) if st.aux is not None else None
+            ca = self.eval(st.ca, frame) if st.ca is not None else None
+            rt.motion(st.kind, target, st.approx, aux, ca, st.frame, self.with_pairs(st.with_, frame),
+                      st.span.file, st.span.line)
+        self.guarded(do, st, frame)
+
+    def s_spline(self, st, frame) -> None:
+        self.begin(st, frame)
+        rt = self.rt
+        task = rt.current_task
+
+        def do():
+            segs = []
+            pending = []
+            for s in st.body:
+                if isinstance(s, N.Trigger):
+                    saved = task.next_triggers
+                    task.next_triggers = []
+                    self.s_trigger(s, frame)
+                    pending += task.next_triggers
+                    task.next_triggers = saved
+                elif isinstance(s, N.Motion):
+                    segs.append({"kind": s.kind, "target": self.eval(s.target, frame),
+                                 "aux": self.eval(s.aux, frame) if s.aux is not None else None,
+                                 "ca": float(num(self.eval(s.ca, frame))) if s.ca is not None else None,
+                                 "with_": self.with_pairs(s.with_, frame), "triggers": pending,
+                                 "line": s.span.line})
+                    pending = []
+            rt.spline(st.kind, segs, st.approx, self.with_pairs(st.with_, frame), st.span.file, st.span.line)
+        self.guarded(do, st, frame)
+
+    # ------------------------------------------------------------------ calls
+    def args_for(self, call: N.Call, frame) -> list:
+        """Arguments as references: lvalues by reference, expressions as values, omitted None."""
+        out = []
+        for a in call.args:
+            if a is None:
+                out.append(None)
+            elif isinstance(a, (N.Name, N.Index, N.Field)):
+                out.append(self.ref(a, frame))
+            else:
+                out.append(ValueRef(self.eval(a, frame)))
+        return out
+
+    def call(self, call: N.Call, frame, statement: bool = False, catch_resume: bool = True):
+        rt = self.rt
+        target = rt.find_routine(call.name, frame.module)
+        if target is None:
+            if rt.is_native(call.name):
+                return rt.call_builtin(call.name, self.args_for(call, frame))
+            return rt.stub_call(call.name, not statement)
+        return self.invoke(target, self.args_for(call, frame), frame, catch_resume)
+
+    def invoke(self, target, args: list, caller, catch_resume: bool = True):
+        """Run routine ``target`` = (module, Routine) with reference ``args``."""
+        rt = self.rt
+        module, routine = target
+        frame = rt.enter_routine(module, routine, args, caller)
+        task = rt.current_task
+        prev = task.frame
+        task.frame = frame
+        try:
+            self.exec_block(routine.body, frame)
+            if routine.kind == "DEFFCT":
+                raise KrlRuntimeError(f"function {routine.name} ended without RETURN", None,
+                                      routine.span.file, frame.line or routine.span.line)
+            return None
+        except ReturnSignal as r:
+            if routine.kind == "DEFFCT":
+                if r.value is None:
+                    raise KrlRuntimeError(f"RETURN without a value in function {routine.name}", None,
+                                          routine.span.file, frame.line) from None
+                return rt.return_value(routine, r.value, module)
+            return None
+        except GotoSignal as g:
+            raise KrlRuntimeError(f"GOTO {g.label}: label not found", None, routine.span.file, frame.line) from None
+        except ResumeSignal as r:
+            if catch_resume and r.frame is caller and caller is not None:
+                return None
+            raise
+        finally:
+            task.frame = prev
+            rt.leave_routine(frame)
+
+    # ------------------------------------------------------------------ expressions
+    def eval(self, e, frame):
+        return self.expr_dispatch[e.__class__](e, frame)
+
+    def eval_at(self, e, frame, st):
+        try:
+            return self.eval(e, frame)
+        except KrlRuntimeError as exc:
+            raise exc.at(st.span.file, st.span.line)
+
+    def e_lit(self, e, frame):
+        return e.value
+
+    def e_enum(self, e, frame):
+        return EnumValue(e.name)
+
+    def e_aggregate(self, e, frame):
+        items = []
+        for it in e.items:
+            items.append((it.name.upper(), self.eval(it.value, frame)))
+        return self.rt.aggregate(e.type_name, items, frame.module)
+
+    def e_var(self, e, frame):
+        v = self.ref(e, frame).get()
+        if isinstance(v, Struct) or hasattr(v, "dims"):
+            return copy_value(v)
+        return v
+
+    def e_call(self, e, frame):
+        v = self.call(e, frame)
+        if v is None:
+            raise KrlRuntimeError(f"{e.name} does not return a value")
+        return v
+
+    def e_unary(self, e, frame):
+        return self.rt.unary_op(e.op, self.eval(e.operand, frame))
+
+    def e_binary(self, e, frame):
+        a = self.eval(e.left, frame)
+        b = self.eval(e.right, frame)
+        return self.rt.binary_op(e.op, a, b)
+
+    def ref(self, e, frame):
+        """The reference of an lvalue expression (Name / Index / Field chain)."""
+        rt = self.rt
+        if isinstance(e, N.Name):
+            return rt.lookup(e.name, frame)
+        if isinstance(e, N.Index):
+            base = self.ref(e.base, frame)
+            idx = []
+            for i in e.indices:
+                if i is None:
+                    idx.append(None)
+                else:
+                    v = num(self.eval(i, frame), "array index")
+                    if v.__class__ is not int:
+                        raise KrlRuntimeError("array index is not an INT")
+                    idx.append(v)
+            return rt.index(base, idx, _name_of(e.base))
+        if isinstance(e, N.Field):
+            base = self.ref(e.base, frame)
+            return rt.field(base, e.name, _name_of(e.base))
+        raise KrlRuntimeError("not a variable")
+
+
+def _name_of(e) -> str:
+    if isinstance(e, N.Name):
+        return e.name
+    if isinstance(e, N.Index):
+        return _name_of(e.base) + "[..]"
+    if isinstance(e, N.Field):
+        return _name_of(e.base) + "." + e.name
+    return "?"
