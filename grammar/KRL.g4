@@ -344,26 +344,27 @@ triggerAction
 
 // ------------------------------------------------------------------ motions (6.1)
 
+// A relative motion may name its reference frame, #BASE (default) or #TOOL (6.1, 6.3); the
+// check is a validating predicate on the enum literal, so the tree keeps the bare token.
 motion
     : PTP expression approximation? approximation?                                   # ptpMotion
-    | PTP_REL expression approximation? approximation? relativeFrame?                # ptpRelMotion
+    | PTP_REL expression approximation? approximation?
+      (frame=ENUMLITERAL {$frame.text.upper() in ("#BASE", "#TOOL")}?<fail={"a relative motion takes #BASE or #TOOL"}>)? # ptpRelMotion
     | LIN expression approximation? approximation?                                   # linMotion
-    | LIN_REL expression approximation? approximation? relativeFrame?                # linRelMotion
+    | LIN_REL expression approximation? approximation?
+      (frame=ENUMLITERAL {$frame.text.upper() in ("#BASE", "#TOOL")}?<fail={"a relative motion takes #BASE or #TOOL"}>)? # linRelMotion
     | CIRC expression ',' expression (',' CA expression)? approximation? approximation? # circMotion
     | CIRC_REL expression ',' expression (',' CA expression)? approximation?
-      relativeFrame?                                                                 # circRelMotion
+      (frame=ENUMLITERAL {$frame.text.upper() in ("#BASE", "#TOOL")}?<fail={"a relative motion takes #BASE or #TOOL"}>)? # circRelMotion
     | SPTP expression withClause? splineApproximation?                               # sptpMotion
     | SLIN expression withClause? splineApproximation?                               # slinMotion
     | SCIRC expression ',' expression (',' CA expression)? withClause? C_SPL?        # scircMotion
-    | SPTP_REL expression withClause? splineApproximation? relativeFrame?            # sptpRelMotion
-    | SLIN_REL expression withClause? splineApproximation? relativeFrame?            # slinRelMotion
+    | SPTP_REL expression withClause? splineApproximation?
+      (frame=ENUMLITERAL {$frame.text.upper() in ("#BASE", "#TOOL")}?<fail={"a relative motion takes #BASE or #TOOL"}>)? # sptpRelMotion
+    | SLIN_REL expression withClause? splineApproximation?
+      (frame=ENUMLITERAL {$frame.text.upper() in ("#BASE", "#TOOL")}?<fail={"a relative motion takes #BASE or #TOOL"}>)? # slinRelMotion
     | SCIRC_REL expression ',' expression (',' CA expression)? withClause? C_SPL?
-      relativeFrame?                                                                 # scircRelMotion
-    ;
-
-// The reference frame of a relative motion: #BASE (default) or #TOOL (6.1, 6.3).
-relativeFrame
-    : frame=ENUMLITERAL {$frame.text.upper() in ("#BASE", "#TOOL")}?<fail={"a relative motion takes #BASE or #TOOL"}>
+      (frame=ENUMLITERAL {$frame.text.upper() in ("#BASE", "#TOOL")}?<fail={"a relative motion takes #BASE or #TOOL"}>)? # scircRelMotion
     ;
 
 // Spline blocks (6.2): one motion through all segments; inside only segments, TRIGGERs,
