@@ -111,10 +111,12 @@ def blend_start_tau(prev: Segment, nxt: Segment | None, keyword: str) -> float |
         d = min(d, L / 2.0)
         if nxt is not None:
             d = min(d, nxt.path_length / 2.0)
-        if L <= 0.0:
-            return prof.t_of_u(0.5)
+        if L <= 1e-9:  # no path, only reorientation: nothing to approximate before the end
+            return prof.t_total
         return prof.t_of_u(prev.u_of_path(L - d))
     assert isinstance(prev, JointSegment)
+    if prev.path_length <= 1e-9:  # the TCP does not move (wrist-only PTP)
+        return prof.t_total
     if nxt is not None:
         d = min(d, nxt.path_length / 2.0)
     us = np.linspace(0.5, 1.0, 33)
@@ -145,7 +147,8 @@ def blend_end_tau(prev: Segment, nxt: Segment, keyword: str, tau_start: float) -
     u_a = prev.profile.u(tau_start)
     d_start = prev.tcp_dist_to_end(u_a)
     L = nxt.path_length
-    if L <= 1e-9:
+    if L <= 1e-9 or (d_start <= 1e-9 and u_a < 1.0):
+        # no TCP distance to measure with: the same fraction as left on the approximated motion
         return nxt.profile.t_of_u(min(1.0 - u_a, 0.5))
     return nxt.profile.t_of_u(nxt.u_of_path(min(d_start, L / 2.0)))
 
