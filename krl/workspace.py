@@ -112,6 +112,21 @@ class Workspace:
         self.files.append(sf)
         return sf
 
+    def add_text(self, text: str, path: str = "<string>.src") -> SourceFile:
+        """Parse and build KRL text as if it were the file `path` (tests, editors, REPLs)."""
+        from krl.syntax.parse import parse_text  # noqa: PLC0415
+
+        t = time.perf_counter()
+        result = parse_text(text, path)
+        self.parse_seconds += time.perf_counter() - t
+        for err in result.errors:
+            if not err.cascade:
+                self.sink.add(path, err.line, err.column + 1, "E002", err.message)
+        module = build_module(result, self.sink)
+        sf = SourceFile(path, module, result.ok, result.status)
+        self.files.append(sf)
+        return sf
+
     # ------------------------------------------------------------------ linking
 
     def _pair(self) -> None:
@@ -314,6 +329,15 @@ def load_workspace(paths: list[str | Path], root: str = "") -> Workspace:
             continue
         for f in collect_files(p):
             ws.add_file(f)
+    return ws
+
+
+def check_texts(files: dict[str, str]) -> Workspace:
+    """A checked workspace from {path: KRL text}; e.g. ``check_texts({"a.src": "DEF a()..."})``."""
+    ws = Workspace(next(iter(files), ""))
+    for path, text in files.items():
+        ws.add_text(text, path)
+    ws.check()
     return ws
 
 

@@ -530,6 +530,12 @@ class Builder:
         method = _STATEMENTS.get(own)
         if method is not None:
             return method(self, ctx, sp)
+        if base == "assignment":
+            return self.assignment(ctx)
+        if base == "call":
+            return N.CallStmt(self.call(ctx), span=sp)
+        if base == "triggerStatement":
+            return self.trigger(ctx)
         inner = self.rules(ctx)
         first = self.first_tok(ctx)
         if first in ("SPLINE", "PTP_SPLINE"):
@@ -776,6 +782,13 @@ class Builder:
                 with_.extend(self.with_clause(c))
             elif b == "motion":
                 return self.motion(c, sp)
+            else:
+                # e.g. relativeFrame: an enum literal naming the frame; C_SPL-like tokens
+                for s2, t2, _ in self.toks(c):
+                    if s2 == "ENUMLITERAL":
+                        frame = t2
+                    elif s2 in ("C_PTP", "C_DIS", "C_VEL", "C_ORI", "C_SPL"):
+                        approx.append(s2)
         if not exprs:
             raise BuildError("motion without target")
         aux = exprs[0] if len(exprs) > 1 else None

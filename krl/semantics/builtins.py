@@ -64,6 +64,7 @@ class Builtins:
     basis_variables: dict[str, tuple[str, tuple[int, ...]]]
     sysvars: dict[str, SysVarInfo]          # UPPER name -> info
     routines: dict[str, SignatureInfo]      # UPPER name -> signature
+    exact: frozenset[str] = frozenset()     # UPPER names of complete type definitions
 
 
 _NAME_DIMS = re.compile(r"^\s*(\$?[A-Za-z_][\w$]*)\s*(?:\[([\d,\s]*)\])?\s*$")
@@ -146,4 +147,5 @@ def load_builtins() -> Builtins:
         basis_variables=bvars,
         sysvars=sysvars,
         routines=routines,
+        exact=frozenset(str(n).upper() for n in types.get("exact", [])),
     )

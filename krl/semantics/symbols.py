@@ -172,8 +172,8 @@ def system_scopes() -> tuple[Scope, Scope]:
     for n in b.simple:
         system.define_type(n, T.SIMPLE[n])
     for name, values in b.enums.items():
-        system.define_type(name, T.Enum(name, frozenset(str(v).upper() for v in values), soft=True))
-    strucs = {name: T.Struc(name, soft=True) for name in b.structs}
+        system.define_type(name, T.Enum(name, frozenset(str(v).upper() for v in values), soft=name.upper() not in b.exact))
+    strucs = {name: T.Struc(name, soft=name.upper() not in b.exact) for name in b.structs}
     for name, s in strucs.items():
         system.define_type(name, s)
     for name, text in b.structs.items():
@@ -184,8 +184,8 @@ def system_scopes() -> tuple[Scope, Scope]:
                                        stop_read=info.stop_read, stop_write=info.stop_write))
     basis = Scope("basis", "$BASIS", system)
     for name, values in b.basis_enums.items():
-        basis.define_type(name, T.Enum(name, frozenset(str(v).upper() for v in values), soft=True))
-    bstrucs = {name: T.Struc(name, soft=True) for name in b.basis_structs}
+        basis.define_type(name, T.Enum(name, frozenset(str(v).upper() for v in values), soft=name.upper() not in b.exact))
+    bstrucs = {name: T.Struc(name, soft=name.upper() not in b.exact) for name in b.basis_structs}
     for name, s in bstrucs.items():
         basis.define_type(name, s)
     for name, text in b.basis_structs.items():

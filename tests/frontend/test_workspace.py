@@ -1,0 +1,75 @@
+"""Workspaces: file pairing, backup discovery (any case), global visibility, CLI, report."""
+
+from __future__ import annotations
+
+import json
+
+from click.testing import CliRunner
+
+from krl.semantics.cli import check as check_cmd
+from krl.semantics.report import check_report
+from krl.workspace import find_backups, is_system_path, workspaces_for
+
+
+def make_backup(root, r1="R1", system="System", program="Program"):
+    (root / "KRC" / r1 / system).mkdir(parents=True)
+    (root / "KRC" / r1 / program / "Cell").mkdir(parents=True)
+    (root / "KRC" / r1 / system / "$config.dat").write_text(
+        "DEFDAT $CONFIG\n  INT gCount = 0\n  DECL E6AXIS XHOME = {A1 0, A2 -90, A3 90, A4 0, A5 0, A6 0}\n"
+        "  EXT BAS(BAS_COMMAND :IN, REAL :IN)\nENDDAT\n")
+    (root / "KRC" / r1 / program / "Cell" / "Job.src").write_text(
+        "DEF Job()\n  BAS(#INITMOV, 0)\n  PTP XHOME\n  gCount = gCount + Lib(2)\n  PTP XP1\nEND\n")
+    (root / "KRC" / r1 / program / "Cell" / "JOB.DAT").write_text(
+        "DEFDAT Job\n  DECL E6POS XP1 = {X 10, Y 0, Z 500, A 0, B 90, C 0, S 2, T 35}\nENDDAT\n")
+    (root / "KRC" / r1 / program / "lib.src").write_text(
+        "DEFFCT INT Lib(n :IN)\n  INT n\n  RETURN n * 2\nENDFCT\n")
+    return root / "KRC"
+
+
+def test_backup_discovery_any_case(tmp_path):
+    a = make_backup(tmp_path / "a")
+    b = make_backup(tmp_path / "b", r1="r1", system="SYSTEM", program="program")
+    assert find_backups(tmp_path) == sorted([a, b])
+
+
+def test_backup_checks_clean_and_pairs_dat(tmp_path):
+    root = make_backup(tmp_path)
+    [ws] = workspaces_for(tmp_path)
+    diags = ws.check()
+    assert not diags, [str(d) for d in diags]
+    units = ws.modules
+    assert units["JOB"].src is not None and units["JOB"].dat is not None
+    assert ws.global_scope.lookup("gcount").module == "$CONFIG"
+    assert is_system_path(str(root / "R1" / "System" / "$config.dat"))
+
+
+def test_single_file_takes_its_dat(tmp_path):
+    root = make_backup(tmp_path)
+    [ws] = workspaces_for(root / "R1" / "Program" / "Cell" / "Job.src")
+    assert len(ws.files) == 2
+    codes = {d.code for d in ws.check()}
+    # XHOME and BAS come from the built-in BASIS data; gCount ($config.dat) and Lib
+    # (another module) are not part of this workspace
+    assert codes == {"E101", "E106"}
+
+
+def test_cli_text_json_and_exit_codes(tmp_path):
+    make_backup(tmp_path)
+    runner = CliRunner()
+    ok = runner.invoke(check_cmd, [str(tmp_path)])
+    assert ok.exit_code == 0, ok.output
+    bad = tmp_path / "bad.src"
+    bad.write_text("DEF bad()\n  INT i\n  i = TRUE\nEND\n")
+    res = runner.invoke(check_cmd, [str(bad)])
+    assert res.exit_code == 1 and ":3:7: error E201 " in res.output
+    res = runner.invoke(check_cmd, [str(bad), "--json"])
+    obj = json.loads(res.output.splitlines()[0])
+    assert obj["errors"] == 1 and obj["diagnostics"][0]["code"] == "E201"
+
+
+def test_report_on_small_backup(tmp_path):
+    make_backup(tmp_path / "corpus")
+    data, md = check_report(tmp_path / "corpus", tmp_path / "out")
+    assert data["total"]["files"] == 4 and data["total"]["files_clean"] == 4
+    assert json.loads((tmp_path / "out" / "check_report.json").read_text())["total"]["errors"] == 0
+    assert "| backup |" in md
