@@ -194,3 +194,26 @@ def test_blend_overlaps_profiles_without_overspeed():
     inner = [e for e in poses if ph2["blend_start"] <= e["t"] <= ph2["blend_end"]]
     Pi = np.array([e["tcp"][:3] for e in inner])
     assert (np.linalg.norm(np.diff(Pi, axis=0), axis=1) / DT).min() > 100.0
+
+
+def test_no_setpoint_jumps_through_mixed_blends():
+    """Blends of every kind, including motions without TCP path: the axes never move more
+    per IPO cycle than the axis maximum speed allows (+10 %)."""
+    from robot.motion import SplineSegment
+
+    P = MotionParams().with_(vel_cp=0.5, apo_cdis=20.0)
+    ctl, ev = _run([MotionRequest("PTP", TOOL_DOWN, P),
+                    MotionRequest("LIN", {"A": 150}, P, approx="C_DIS"),
+                    MotionRequest("LIN", {"X": 500, "Y": 100}, P, approx="C_DIS"),
+                    MotionRequest("PTP", {"A6": 30}, P, approx="C_DIS"),
+                    MotionRequest("PTP", {"A6": 60, "A1": -10}, P, approx="C_PTP"),
+                    MotionRequest("CIRC", {"X": 500, "Y": -100}, P, aux={"X": 600, "Y": 0},
+                                  approx="C_DIS"),
+                    MotionRequest("SPLINE", {}, P, approx="C_SPL", segments=(
+                        SplineSegment("SPL", {"X": 450, "Y": -50}),
+                        SplineSegment("SPL", {"X": 420, "Y": 50, "Z": 700}))),
+                    MotionRequest("SPTP", TOOL_DOWN, P)])
+    assert not [e for e in ev if e["kind"] in ("error", "message")]
+    ax = np.array([e["axes"] for e in ev if e["kind"] == "pose"])
+    vmax = np.array(ctl.machine.max_speed_deg_s)
+    assert np.all(np.abs(np.diff(ax, axis=0)).max(axis=0) <= 1.1 * vmax * DT)
