@@ -44,7 +44,12 @@ _PARSE_CACHE: dict = {}
 
 def parse_module(path: str):
     """(Module AST, list of syntax error strings) of one file, cached per process."""
-    key = str(path)
+    import hashlib  # noqa: PLC0415
+
+    try:
+        key = (str(path), hashlib.sha1(Path(path).read_bytes()).hexdigest())
+    except OSError:
+        key = (str(path), "")
     got = _PARSE_CACHE.get(key)
     if got is not None:
         return got
@@ -88,7 +93,8 @@ class ModuleRT:
         self.store: dict = {}
         self.types = Scope("module", name, program.types)
         self.loaded = False
-        self.errors: list[str] = []
+        self.errors: list[str] = []         # data-list initialisation problems
+        self.syntax_errors: list[str] = []  # syntax errors of its files (cannot run)
         self.path = ""
 
 
@@ -180,13 +186,13 @@ class Program:
         dat = files.get("dat")
         if dat is not None:
             mod, errs = parse_module(str(dat))
-            m.errors += errs
+            m.syntax_errors += errs
             if mod.data is not None:
                 self._load_data(m, mod.data, all_global=is_config)
         src = files.get("src") or files.get("sub")
         if src is not None:
             mod, errs = parse_module(str(src))
-            m.errors += errs
+            m.syntax_errors += errs
             m.path = str(src)
             for i, r in enumerate(mod.routines):
                 m.routines.setdefault(r.name.upper(), r)

@@ -56,8 +56,9 @@ class TreeInterpreter:
         m = prog.module(name)
         if m is None or m.main is None:
             raise KrlRuntimeError(f"no main routine in {name}")
-        if m.errors and not m.main.body:
-            raise KrlRuntimeError("program has syntax errors: " + "; ".join(m.errors[:3]))
+        if m.syntax_errors:
+            raise KrlRuntimeError("the program has syntax errors and cannot start: " + m.syntax_errors[0],
+                                  None, m.path, 0)
         self.invoke((m, m.main), [], None)
 
     # ------------------------------------------------------------------ statements
