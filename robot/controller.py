@@ -240,6 +240,7 @@ class Controller:
         self._tcp_T = self.model.tcp(self._q, self._tool_T, self._base_inv_T)
         self._tcp_prev = self._tcp_T[:3, 3].copy()
         self.last_error: RobotError | None = None
+        self._ret_q: np.ndarray | None = None
         self._ended = False
 
     # ================================================================= clock
@@ -391,10 +392,17 @@ class Controller:
         self._moved_while_held = False
 
     def cancel_pending(self) -> None:
-        """``RESUME``: discard the motion suspended by BRAKE and every planned motion; the
-        next motion starts from the current position (reference §5.17). Called while the
-        robot moves (no BRAKE before), it stops at the current setpoint."""
-        self._held = None
+        """``RESUME``: discard the motions suspended by BRAKE (the braked one and everything
+        planned after it, reference §5.17). Motions the interrupt routine itself planned
+        after the BRAKE are kept and run; the next motion starts where they end, or from the
+        current position. Called while the robot moves without a BRAKE before, it discards
+        everything and the robot stops at the current setpoint."""
+        if self._held is not None:
+            self._held = None
+            self._moved_while_held = False
+            if not self.is_moving() and not self._pending:
+                self._plan_q = self._q.copy()
+            return
         self._moved_while_held = False
         self._pending.clear()
         self._runs = []
@@ -403,6 +411,11 @@ class Controller:
         self._braking = False
         self._scale, self._scale_rate = 1.0, 0.0
         self._plan_q = self._q.copy()
+
+    def axis_ret(self) -> np.ndarray | None:
+        """``$AXIS_RET``: the axes where BRAKE (or an error) made the robot leave its path,
+        or None if that never happened (deg, shape (6,))."""
+        return None if self._ret_q is None else self._ret_q.copy()
 
     # ================================================================= I/O
     def _on_io(self, t: float, name: str, value: Any, source: str) -> None:
@@ -538,10 +551,10 @@ class Controller:
             q = self._main_run(self._pt)
         except RobotError as err:
             q = self._fault(err)
+        self._q = np.asarray(q, dtype=float)
         if self._braking and self._scale <= 0.0:
             self._hold()
         self._fire_triggers(self._pt)
-        self._q = np.asarray(q, dtype=float)
         if self._arm is not None:
             if self.actuated:
                 self._arm.step_actuated(self._q, self.dt, (self._q - self._q_prev) / self.dt)
@@ -678,6 +691,7 @@ class Controller:
             self.trace.write("error", self.time, text=err.message, number=err.number,
                              id=mid, line=line)
         q = self._q.copy()
+        self._ret_q = q.copy()
         self._runs = []
         self._blend = None
         self._pending.clear()
@@ -693,6 +707,7 @@ class Controller:
         self._braking = False
         self._held = _Held(self._runs, self._blend, self._pending, self._tracked, self._pt,
                            self._q.copy(), self._tool_T, self._base_T)
+        self._ret_q = self._q.copy()
         self._runs, self._blend, self._pending, self._tracked = [], None, deque(), []
         self._scale, self._scale_rate = 1.0, 0.0
         self._moved_while_held = False

@@ -323,3 +323,18 @@ def test_trigger_distance1_negative_delay_before_blend_middle():
     (_, _, t), = _trig_times(tw.events)
     mid = 0.5 * (ph["blend_start"] + ph["blend_end"])
     assert abs((mid - t) - 0.050) <= DT + 1e-9
+
+
+def test_resume_keeps_motions_of_the_interrupt_routine():
+    """BRAKE; LIN_REL (in the routine); RESUME: the routine's motion still runs, the
+    interrupted ones are gone."""
+    ctl, tw, _, _, stop = _brake_run(True)
+    assert ctl.axis_ret() is not None
+    ctl.enqueue(MotionRequest("LIN_REL", {"Z": 40}, MotionParams()))
+    ctl.cancel_pending()
+    ctl.wait_idle()
+    p = ctl.pos_act()
+    assert (p["Y"], p["Z"]) == pytest.approx((stop["Y"], stop["Z"] + 40), abs=1e-6)
+    ctl.enqueue(MotionRequest("LIN_REL", {"Z": 10}, MotionParams()))
+    ctl.wait_idle()
+    assert ctl.pos_act()["Z"] == pytest.approx(stop["Z"] + 50, abs=1e-6)
