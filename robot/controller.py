@@ -37,7 +37,7 @@ from .frames import frame_to_matrix, inv_pos, matrix_to_frame
 from .io import IOImage
 from .machine import MachineData, load_machine
 from .motion import MotionRequest, Trigger
-from .planner import RobotModel, Segment, TriggerPlan, plan, resolved_target
+from .planner import CP_SPEED_LIMIT_FACTOR, RobotModel, Segment, TriggerPlan, plan, resolved_target
 from .stimuli import Stimulus, load_stimuli
 from .trace import TraceWriter
 
@@ -549,6 +549,7 @@ class Controller:
         self._q_prev = self._q
         try:
             q = self._main_run(self._pt)
+            self._check_speed(q)
         except RobotError as err:
             q = self._fault(err)
         self._q = np.asarray(q, dtype=float)
@@ -681,6 +682,15 @@ class Controller:
         q = blending.combine_axes(q0, q1, w)
         self.model.kin.check_soft_limits(q)
         return q
+
+    def _check_speed(self, q: np.ndarray) -> None:
+        """Reject a setpoint that would move an axis faster than
+        ``CP_SPEED_LIMIT_FACTOR`` x its maximum speed (a CP path through a singularity)."""
+        step = np.abs(np.asarray(q) - self._q_prev)
+        lim = CP_SPEED_LIMIT_FACTOR * self.model.v_max * self.dt + 1e-9
+        if np.any(step > lim):
+            i = int(np.argmax(step / lim))
+            raise RobotError(f"speed limit exceeded A{i + 1}: CP path through a singularity")
 
     def _fault(self, err: RobotError) -> np.ndarray:
         mid = self._runs[0].seg.id if self._runs else None

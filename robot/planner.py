@@ -31,6 +31,13 @@ from .motion import AXIS_KEYS, CART_KEYS, MotionParams, MotionRequest, Trigger
 from .profiles import Trapezoid
 
 
+#: An axis jump (deg) between neighbouring planning samples of a CP path that means the
+#: path crosses a singularity (the IK had to flip the wrist to keep the status).
+SINGULAR_JUMP_DEG = 90.0
+#: Factor on the axis maximum speed above which an interpolated CP setpoint is rejected.
+CP_SPEED_LIMIT_FACTOR = 1.5
+
+
 class RobotModel:
     """Adapter between the planner and the kinematics module (mm, deg, 4x4 frames).
 
@@ -663,7 +670,13 @@ def _plan_cart(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_T: 
     n_chk = max(2, min(64, int(seg.path_length / 50.0) + 2 + int(seg.ori_angle / 10.0)))
     for u in np.linspace(0.0, 1.0, n_chk)[1:]:
         pu, Ru = seg.pose_u(float(u))
-        ref = seg.ik(pu, Ru, ref)
+        q = seg.ik(pu, Ru, ref)
+        jump = np.abs(q - ref)
+        if float(jump.max()) > SINGULAR_JUMP_DEG:
+            i = int(np.argmax(jump))
+            raise RobotError(f"CP path through a singularity: A{i + 1} would turn "
+                             f"{jump[i]:.0f} deg at once (keep the status on CP paths)")
+        ref = q
     seg.q1 = ref
     seg.status = status
     return seg

@@ -211,3 +211,18 @@ def test_lin_ori_joint_moves_wrist_axes_linearly_on_a_straight_path():
                 assert (e["axes"][i] - q0[i]) / (q1[i] - q0[i]) == pytest.approx(s, abs=1e-6)
     R = frame_to_matrix(*poses[-1]["tcp"])[:3, :3]
     assert np.allclose(R, frame_to_matrix(0, 0, 0, 140, 15, 165)[:3, :3], atol=1e-9)
+
+
+def test_lin_through_wrist_singularity_is_an_error():
+    """A LIN from A5 = +20° to the mirrored pose with A5 = -20° needs a status change
+    (wrist flip): a CP motion may not do that (reference §6.5, §8.2)."""
+    from robot.errors import RobotError
+    from robot.frames import matrix_to_frame
+
+    P = MotionParams().with_(vel_cp=0.3)
+    ctl = Controller(mujoco=False)
+    run_motions(ctl, [MotionRequest("PTP", {"A1": 0, "A2": -90, "A3": 90, "A4": 30, "A5": 20,
+                                            "A6": 0}, P)])
+    f = matrix_to_frame(ctl.model.kin.forward([0, -90, 90, 30, -20, 0]))
+    with pytest.raises(RobotError, match="singularity"):
+        ctl.enqueue(MotionRequest("LIN", dict(zip("XYZABC", f)), P))
