@@ -132,8 +132,12 @@ def load_builtins() -> Builtins:
     for text in funcs.get("procedures", []):
         sig = parse_signature(text, False)
         routines[sig.name] = sig
+    for names in (funcs.get("lenient") or {}).values():
+        for name in names:
+            routines.setdefault(str(name).upper(), SignatureInfo(str(name).upper(), "ANY", [], True))
+    options = types.get("options", {}) or {}
     bvars = {}
-    for key, tname in (basis.get("variables") or {}).items():
+    for key, tname in list((basis.get("variables") or {}).items()) + list((options.get("variables") or {}).items()):
         name, dims = split_name(key)
         bvars[name] = (tname, dims)
     return Builtins(
@@ -142,8 +146,9 @@ def load_builtins() -> Builtins:
         axis=list(types.get("geometric", {}).get("axis", [])),
         structs=dict(types.get("structs", {})),
         enums={k: list(v) for k, v in (types.get("enums") or {}).items()},
-        basis_structs=dict(basis.get("structs", {})),
-        basis_enums={k: list(v) for k, v in (basis.get("enums") or {}).items()},
+        basis_structs={**dict(basis.get("structs", {})), **dict(options.get("structs", {}) or {})},
+        basis_enums={k: list(v) for k, v in {**(basis.get("enums") or {}),
+                                              **(options.get("enums") or {})}.items()},
         basis_variables=bvars,
         sysvars=sysvars,
         routines=routines,
