@@ -262,7 +262,6 @@ geometricType
 statement
     : assignment                                                    # assignmentStatement
     | call                                                          # callStatement
-    | IDENTIFIER                                                    # parameterlessCallStatement
     | IF expression THEN NEWLINE statementList
       (ELSE NEWLINE statementList)? ENDIF                           # ifStatement
     | SWITCH expression NEWLINE+ switchCase+ switchDefault? ENDSWITCH # switchStatement
