@@ -20,7 +20,10 @@ from dataclasses import dataclass
 
 from krl.ast import nodes as N
 
-STOP_STATEMENTS = (N.WaitFor, N.WaitSec, N.Halt, N.AninOn, N.AninOff, N.AnoutOn, N.AnoutOff)
+# INTERRUPT ON/OFF/ENABLE/DISABLE stop it too (reference §6.10 [U]): otherwise the
+# `INTERRUPT OFF` after the interruptible motion of §5.17 would run before the motion.
+STOP_STATEMENTS = (N.WaitFor, N.WaitSec, N.Halt, N.AninOn, N.AninOff, N.AnoutOn, N.AnoutOff,
+                   N.InterruptCtl)
 STOP_ROUTINES = frozenset({"PULSE"})
 
 

@@ -209,8 +209,8 @@ class Runtime:
             cf, cl = task.continue_line
             cont = cf == info.file and info.line == cl + 1
             task.continue_line = None
-        if info.stops and not cont and task.kind == "robot" and task.context.kind != "trigger":
-            self.wait_main_run(task)
+        if info.stops and not cont and task.kind == "robot":
+            self.advance_stop(task)
         if self.trace is not None:
             self.trace.write("stmt", self.controller.time, file=info.file, line=info.line,
                              context=task.context.kind)
@@ -227,12 +227,21 @@ class Runtime:
             self.yield_cycle(task)
         elif task.irqs.armed:
             self.check_interrupts(task)
-        if info.cond_stops and task.kind == "robot" and task.context.kind != "trigger":
-            self.wait_main_run(task)
+        if info.cond_stops and task.kind == "robot":
+            self.advance_stop(task)
 
     def set_continue(self, info: advance.StmtInfo) -> None:
         """CONTINUE: the next line does not stop the advance run."""
         self.current_task.continue_line = (info.file, info.line)
+
+    def advance_stop(self, task: Task) -> None:
+        """The advance-run stop of a statement. Main context: wait for the main run. An
+        interrupt routine waits only for the motions of its own level (after BRAKE: the
+        interrupted motion is suspended and not counted); before BRAKE the planned motions
+        keep running and the routine does not wait for them. A TRIGGER action never waits."""
+        kind = task.context.kind
+        if kind == "main" or (kind == "interrupt" and self.controller._held is not None):  # noqa: SLF001
+            self.wait_main_run(task)
 
     def wait_main_run(self, task: Task) -> None:
         """Advance-run stop: wait until the main run is idle (robot at rest)."""
