@@ -294,6 +294,18 @@ class Controller:
         return (not self._runs and self._blend is None and not self._pending
                 and not self._tracked and not self._braking)
 
+    def is_suspended(self) -> bool:
+        """True while motions are suspended by a finished BRAKE (until :meth:`release` or
+        :meth:`cancel_pending`)."""
+        return self._held is not None
+
+    def io_may_change(self) -> bool:
+        """True if an input or output can still change without the program doing anything:
+        a stimulus not yet applied, a PULSE not yet reset, a cyclic hook, a running timer
+        (for deadlock detection of WAIT FOR)."""
+        return (any(not st.fired for st in self.stimuli) or bool(self._pulses)
+                or bool(self._cyclic) or not all(self.io.timer_stop[1:]))
+
     def is_moving(self) -> bool:
         """True while a motion is being executed."""
         return bool(self._runs) or self._blend is not None

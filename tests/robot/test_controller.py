@@ -338,3 +338,18 @@ def test_resume_keeps_motions_of_the_interrupt_routine():
     ctl.enqueue(MotionRequest("LIN_REL", {"Z": 10}, MotionParams()))
     ctl.wait_idle()
     assert ctl.pos_act()["Z"] == pytest.approx(stop["Z"] + 50, abs=1e-6)
+
+
+def test_public_state_queries():
+    ctl, _ = _ctl()
+    assert not ctl.io_may_change()
+    ctl.pulse(2, True, 0.05)
+    assert ctl.io_may_change()
+    ctl.wait_sec(0.06)
+    assert not ctl.io_may_change()
+    ctl.io.set_timer_stop(3, False)
+    assert ctl.io_may_change()
+    c2, _, *_ = _brake_run(False)
+    assert c2.is_suspended()
+    c2.cancel_pending()
+    assert not c2.is_suspended()
