@@ -164,6 +164,7 @@ importDeclaration
 
 declaration
     : variableDeclaration
+    | constantDeclaration
     | structureDeclaration
     | enumDeclaration
     | signalDeclaration
@@ -171,7 +172,16 @@ declaration
     | importDeclaration
     ;
 
-// In a routine: no initial values, no CONST (2.2, 2.5).
+// A local constant: DECL CONST with its literal value on the same line. The reference keeps
+// CONST to data lists (2.5); the project's requirements (issue 3) ask for constants in a
+// routine's declaration section too, which is how KSS 8 code declares local limits.
+// Only scalars: a constant array would need element assignments, which are statements.
+constantDeclaration
+    : DECL CONST typeName variableName '=' constantValue
+    | CONST (simpleType | geometricType) variableName '=' constantValue
+    ;
+
+// In a routine: no initial values (2.2).
 // Array parameters are declared with open dimensions, DECL CHAR buf[] (2.3): routines only.
 variableDeclaration
     : DECL typeName (variableName | openArrayName) (',' (variableName | openArrayName))*
