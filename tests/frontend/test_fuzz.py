@@ -9,6 +9,8 @@ from hypothesis import given, strategies as st
 from krl.semantics.cli import run_check
 from krl.workspace import check_texts, load_workspace
 
+from .strategies import modules
+
 SEED = """&ACCESS RVP
 DEF seed(p :IN, q :OUT)
   DECL INT p, i, a[4]
@@ -46,6 +48,9 @@ def _safe_check_text(text: str, dat: str | None = None):
     ws = check_texts(files)   # must not raise
     for d in ws.diagnostics:
         assert d.line >= 0 and d.code[0] in "EW"
+        assert d.code != "E901", str(d)          # an internal checker error is a bug
+        if all(f.ok for f in ws.files):
+            assert d.code != "W003", str(d)      # a tree that parsed must build completely
     return ws
 
 
@@ -117,3 +122,9 @@ def test_unreadable_inputs(tmp_path):
     diags = ws.check()
     assert {d.code for d in diags} == {"E001"}
     assert run_check([str(tmp_path / "nothing-here")], echo=lambda s: None) == 1
+
+
+@given(modules)
+def test_generated_programs_check_without_internal_errors(module):
+    from krl.ast.printer import print_module
+    _safe_check_text(print_module(module))
