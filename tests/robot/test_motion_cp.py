@@ -226,3 +226,27 @@ def test_lin_through_wrist_singularity_is_an_error():
     f = matrix_to_frame(ctl.model.kin.forward([0, -90, 90, 30, -20, 0]))
     with pytest.raises(RobotError, match="singularity"):
         ctl.enqueue(MotionRequest("LIN", dict(zip("XYZABC", f)), P))
+
+
+def test_circ_type_path_turns_the_tool_with_the_tangent():
+    """$CIRC_TYPE #PATH: the orientation relative to the circle's tangent stays constant."""
+    P = MotionParams().with_(vel_cp=0.5, circ_type="#PATH")
+    ctl, ev = _run([MotionRequest("PTP", TOOL_DOWN, P),
+                    MotionRequest("LIN", {"X": 500, "Y": 100, "Z": 600}, P),
+                    MotionRequest("CIRC", {"X": 500, "Y": -100, "Z": 600}, P,
+                                  aux={"X": 600, "Y": 0, "Z": 600})])
+    ph = _phases(ev, 3)
+    poses = _poses(ev, ph["start"], ph["end"])
+    # centre (500, 0): the tool's x axis, expressed in the rotating radial frame, is constant
+    rel = []
+    for e in poses:
+        R = frame_to_matrix(*e["tcp"])[:3, :3]
+        phi = math.atan2(e["tcp"][1], e["tcp"][0] - 500.0)
+        Rz = Rotation.from_euler("z", phi).as_matrix()
+        rel.append(Rz.T @ R)
+    for M in rel:
+        assert np.allclose(M, rel[0], atol=1e-6)
+    # the tool turned by the swept angle (180°) about the circle normal
+    R0 = frame_to_matrix(*poses[0]["tcp"])[:3, :3]
+    R1 = frame_to_matrix(*poses[-1]["tcp"])[:3, :3]
+    assert np.degrees(Rotation.from_matrix(R0.T @ R1).magnitude()) == pytest.approx(180.0, abs=1e-6)

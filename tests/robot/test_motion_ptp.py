@@ -160,3 +160,18 @@ def test_motion_params_from_sysvars():
     assert (p.apo_cdis, p.apo_cptp, p.apo_cvel) == (12.5, 20.0, 100.0)
     assert p.tool == (0.0, 0.0, 225.0, 0.0, 0.0, 0.0)
     assert p.ori_type == "CONSTANT" and p.ov_pro == 75.0
+
+
+def test_ptp_status_and_turn_select_the_configuration():
+    """PTP to an E6POS with S/T: the configuration the bits name (reference §6.5)."""
+    ctl = Controller(mujoco=False)
+    goal = [20.0, -80.0, 100.0, 40.0, -30.0, -120.0]  # A5 < 0: S bit 2; A6 < 0: T bit 5
+    from robot.frames import matrix_to_frame
+
+    x, y, z, a, b, c = matrix_to_frame(ctl.model.kin.forward(goal))
+    s, t = ctl.model.kin.status_turn(goal)
+    assert s & 4 and t & 32
+    run_motions(ctl, [MotionRequest("PTP", dict(HOME, A5=30), MotionParams()),
+                      MotionRequest("PTP", {"X": x, "Y": y, "Z": z, "A": a, "B": b, "C": c,
+                                            "S": s, "T": t}, MotionParams())])
+    assert list(ctl.axis_act()) == pytest.approx(goal, abs=1e-6)
