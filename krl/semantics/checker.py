@@ -246,6 +246,10 @@ class Checker:
     def _routine(self, r: N.Routine, ctx: _Ctx) -> None:
         local = ctx.scope
         declared = {k for k in local.values}
+        for d in r.decls:
+            if isinstance(d, N.VarDecl) and d.init is not None:   # DECL CONST ... = value
+                sym = local.values.get(d.names[0].name.upper())
+                self.check_value(sym.type if sym is not None else T.UNKNOWN, d.init, local, d.init.span)
         for p in r.params:
             self.decl.ident(p.name, p.span)
             if p.name.upper() not in declared:

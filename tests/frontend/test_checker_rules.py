@@ -76,6 +76,8 @@ CASES = [
     ("E501", prog("", "$MODE_OP = #T1"), prog("BOOL b", "b = $MODE_OP == #T1")),
     ("W501", prog("", "$IN[3] = TRUE"), prog("", "$OUT[3] = TRUE")),
     ("E503", prog("INT i", "t = 1"), prog("INT i", "i = 1")),
+    ("E502", prog("DECL CONST INT k = 3\nINT i", "k = 1"), prog("DECL CONST INT k = 3\nINT i", "i = k")),
+    ("E201", prog("DECL CONST INT k = TRUE", ""), prog("DECL CONST INT k = 3", "")),
 ]
 
 
