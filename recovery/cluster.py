@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 
 from recovery.scan import FileResult, IssueRecord
 
-MAX_SHAPE = 8
+WINDOW = 2
 EXAMPLES = 3
 
 
@@ -37,11 +37,14 @@ class Cluster:
                 "expected": self.expected, "examples": self.examples}
 
 
-def compact_shape(shape: list[str]) -> list[str]:
-    """Keep the start of the line and the tokens just before the error."""
-    if len(shape) <= MAX_SHAPE:
-        return list(shape)
-    return shape[:3] + ["…"] + shape[-(MAX_SHAPE - 4):]
+def local_shape(shape: list[str]) -> list[str]:
+    """The offending token and the token before it.
+
+    The rule at the error already says which construct the parser was in; the whole line
+    would split one construct by what precedes it (`DEF` or `GLOBAL DEF`, the first or the
+    second parameter).
+    """
+    return list(shape[-WINDOW:])
 
 
 # A line that cannot even start fails in whichever list rule happens to be reading lines
@@ -68,7 +71,7 @@ def signature(issue: IssueRecord) -> str:
     if issue.kind == "internal":
         return "internal | parser failure"
     context = error_context(issue)
-    return f"{context} | {issue.offending_type} | {' '.join(compact_shape(issue.shape))}"
+    return f"{context} | {issue.offending_type} | {' '.join(local_shape(issue.shape))}"
 
 
 def cluster_id(sig: str) -> str:

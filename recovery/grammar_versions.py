@@ -11,6 +11,7 @@ import re
 import shutil
 import subprocess
 import sys
+import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -70,17 +71,22 @@ def parser_dir_for(text: str) -> Path:
     target = cache_dir() / "parsers" / gsha[:32]
     if (target / "KRLParser.py").exists():
         return target
-    tmp = target.with_name(target.name + ".tmp")
-    shutil.rmtree(tmp, ignore_errors=True)
-    tmp.mkdir(parents=True)
-    (tmp / "KRL.g4").write_text(text, encoding="utf-8")
-    cmd = _antlr_tool() + ["-Dlanguage=Python3", "-visitor", "-no-listener", "-Xexact-output-dir",
-                           "-o", str(tmp), str(tmp / "KRL.g4")]
-    run = subprocess.run(cmd, capture_output=True, text=True, check=False)
-    if run.returncode != 0 or not (tmp / "KRLParser.py").exists():
-        raise GrammarToolError(f"ANTLR failed for grammar {gsha[:12]}: {run.stderr.strip()[:500]}")
-    shutil.rmtree(target, ignore_errors=True)
-    tmp.rename(target)
+    target.parent.mkdir(parents=True, exist_ok=True)
+    tmp = Path(tempfile.mkdtemp(prefix=target.name + ".", dir=target.parent))
+    try:
+        (tmp / "KRL.g4").write_text(text, encoding="utf-8")
+        cmd = _antlr_tool() + ["-Dlanguage=Python3", "-visitor", "-no-listener", "-Xexact-output-dir",
+                               "-o", str(tmp), str(tmp / "KRL.g4")]
+        run = subprocess.run(cmd, capture_output=True, text=True, check=False)
+        if run.returncode != 0 or not (tmp / "KRLParser.py").exists():
+            raise GrammarToolError(f"ANTLR failed for grammar {gsha[:12]}: {run.stderr.strip()[:500]}")
+        try:
+            tmp.rename(target)
+        except OSError:
+            if not (target / "KRLParser.py").exists():  # not a concurrent generation of the same grammar
+                raise
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
     return target
 
 

@@ -91,6 +91,20 @@ def grammar_sha(text: str) -> str:
     return hashlib.sha256(text.encode("utf-8")).hexdigest()
 
 
+def front_end_sha() -> str:
+    """Hash of the parse front end (krl/syntax/*.py except generated code).
+
+    A cached result depends on the grammar, the file and how errors are recovered and
+    recorded, so a change of the front end invalidates the cache too.
+    """
+    h = hashlib.sha256(CACHE_VERSION.encode())
+    syntax_dir = Path(__file__).resolve().parents[1] / "krl" / "syntax"
+    for p in sorted(syntax_dir.glob("*.py")):
+        h.update(p.name.encode())
+        h.update(p.read_bytes())
+    return h.hexdigest()
+
+
 # ----------------------------------------------------------------------- worker side
 
 _BUNDLE = None
@@ -161,7 +175,7 @@ class ResultCache:
 
     def __init__(self, gsha: str, enabled: bool = True):
         self.enabled = enabled
-        self.path = cache_dir() / "results" / f"v{CACHE_VERSION}-{gsha[:32]}.json"
+        self.path = cache_dir() / "results" / f"{front_end_sha()[:12]}-{gsha[:32]}.json"
         self.data: dict[str, dict] = {}
         if enabled and self.path.exists():
             try:
