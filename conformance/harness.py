@@ -809,6 +809,9 @@ def _c_duration(spec, mid, mt, ps):
     if frm not in d or to not in d:
         return False, f"phases {frm}/{to} missing: {d}"
     dur = d[to] - d[frm]
+    if "min_seconds" in spec:
+        return dur >= float(spec["min_seconds"]) - TIME_TOL, \
+            f"{frm}->{to} took {dur:.3f} s, expected at least {spec['min_seconds']}"
     tol = float(spec.get("tol", TIME_TOL))
     return abs(dur - float(spec["seconds"])) <= tol, \
         f"{frm}->{to} took {dur:.3f} s, expected {spec['seconds']} ±{tol:.3f}"
@@ -850,14 +853,12 @@ def _c_passes(spec, mid, mt, ps):
 
 
 def _c_stops_before(spec, mid, mt, ps):
-    """The robot stands still before the motion's point (BRAKE): the last pose of the motion is
-    farther than min_mm from the point and the TCP does not move in the last cycles."""
-    d = mt[mid]
-    t_last = max(t for t, _ in ps)
-    after = [p for t, p in ps if t >= d.get("start", 0)]
-    end_p = after[-1][:3]
-    dd = _norm(_sub(end_p, d["point"][:3]))
-    return dd >= float(spec.get("min_mm", 1.0)), f"robot stopped {dd:.3f} mm from the point (t={t_last})"
+    """The robot never gets closer than ``min_mm`` to the programmed point of motion ``id``
+    (it was braked and the motion abandoned)."""
+    target = mt[mid]["point"][:3]
+    closest = min((_norm(_sub(p[:3], target)) for _, p in ps), default=math.inf)
+    return closest >= float(spec.get("min_mm", 1.0)), \
+        f"closest approach to the point of motion {mid}: {closest:.3f} mm (must stay >= {spec.get('min_mm', 1.0)})"
 
 
 _MOTION_CHECKS = {
