@@ -194,8 +194,8 @@ class Workspace:
                     f.scope = unit.scope
         plan = [(u, targets(u)) for u in self.units]
         for _u, tg in plan:
-            for scope, items, _name in tg:
-                declarer.declare_types(scope, items)
+            for scope, items, name in tg:
+                declarer.declare_types(scope, items, system=_is_system_datalist(name))
         for u, tg in plan:
             for scope, items, name in tg:
                 declarer.soft_types = _is_system_datalist(name) or is_system_path(u.dat.path)

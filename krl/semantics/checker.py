@@ -46,6 +46,7 @@ class Declarer:
         # unknown types are only warnings in system data lists: they use types of
         # $operate.dat, which lives on the controller and is not part of a backup
         self.soft_types = False
+        self._type_decls: dict[tuple[int, str], tuple[N.Decl, bool]] = {}
 
     def ident(self, name: str, span: N.Span) -> None:
         if len(name) > MAX_IDENT:
@@ -72,17 +73,27 @@ class Declarer:
         return make_array(typ, dims)
 
     # -- phase 1: type names
-    def declare_types(self, scope: Scope, items: list[N.Decl]) -> None:
+    def declare_types(self, scope: Scope, items: list[N.Decl], system: bool = False) -> None:
+        """Enter STRUC and ENUM names. A second declaration of a name in the same scope is
+        E102, except between system data lists ($config.dat, $machine.dat, ...), which may
+        repeat each other's declarations (the first one wins)."""
         for d in items:
             if isinstance(d, N.StrucDecl):
-                self.ident(d.name, d.span)
-                if scope.define_type(d.name, T.Struc(d.name)) is not None and scope.kind != "global":
-                    self.duplicate(d.name, d.span, None)
+                typ: T.KrlType = T.Struc(d.name)
             elif isinstance(d, N.EnumDecl):
-                self.ident(d.name, d.span)
-                if scope.define_type(d.name, T.Enum(d.name, frozenset(v.upper() for v in d.values))) is not None \
-                        and scope.kind != "global":
-                    self.duplicate(d.name, d.span, None)
+                typ = T.Enum(d.name, frozenset(v.upper() for v in d.values))
+                for v in d.values:
+                    self.ident(v, d.span)
+            else:
+                continue
+            self.ident(d.name, d.span)
+            key = (id(scope), d.name.upper())
+            if scope.define_type(d.name, typ) is None:
+                self._type_decls[key] = (d, system)
+                continue
+            first, first_system = self._type_decls.get(key, (None, True))
+            if not (system and first_system) and first is not d:
+                self.duplicate(d.name, d.span, _DeclRef(first))
 
     # -- phase 2: structure components
     def fill_types(self, scope: Scope, items: list[N.Decl]) -> None:
@@ -168,6 +179,13 @@ class Declarer:
             s = local.values.get(p.name.upper())
             if s is not None:
                 p.type = s.type
+
+
+class _DeclRef:
+    """Adapter so that Declarer.duplicate can name the first declaration of a type."""
+
+    def __init__(self, decl):
+        self.decl = decl
 
 
 class _Ctx:

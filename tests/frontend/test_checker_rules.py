@@ -24,6 +24,7 @@ CASES = [
     ("E106", prog("", "Foo(1)"), prog("", "t()")),
     # duplicate declarations (E102) and identifier length (E103, 1.2)
     ("E102", prog("INT i\nREAL i", "i = 1"), prog("INT i\nREAL j", "i = 1")),
+    ("E102", prog("ENUM E a, b\nSTRUC E INT n", ""), prog("ENUM E a, b\nSTRUC F INT n", "")),
     ("E103", prog("INT abcdefghijklmnopqrstuvwxy", ""), prog("INT abcdefghijklmnopqrstuvwx", "")),
     # unknown type (E105)
     ("E105", prog("DECL NOSUCH x", ""), prog("DECL FRAME x", "")),
@@ -166,3 +167,15 @@ def test_system_variables_have_types_and_stops():
     sym = N.symbol_of(p_assign.value)
     assert sym.kind == "sysvar" and sym.access == "RO" and sym.stop_read
     assert N.type_of(ws.units[0].routines[0].body[1].target) == T.REAL
+
+
+def test_duplicate_global_types_across_data_lists():
+    """2.7: two PUBLIC data lists exporting the same GLOBAL ENUM is a link error;
+    system data lists may repeat each other."""
+    from krl.workspace import check_texts
+    a = "DEFDAT a PUBLIC\n  GLOBAL ENUM CMD_T X, Y\nENDDAT\n"
+    b = "DEFDAT b PUBLIC\n  GLOBAL ENUM CMD_T X, Y, Z\nENDDAT\n"
+    assert [d.code for d in check_texts({"a.dat": a, "b.dat": b}).diagnostics] == ["E102"]
+    m1 = "DEFDAT $MACHINE PUBLIC\n  ENUM KIN_T A, B\nENDDAT\n"
+    m2 = "DEFDAT $MACHINE PUBLIC\n  ENUM KIN_T A, B\nENDDAT\n"
+    assert check_texts({"R1/Mada/$machine.dat": m1, "STEU/Mada/$machine.dat": m2}).diagnostics == []
