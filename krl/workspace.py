@@ -266,8 +266,9 @@ class Workspace:
             if u.src is None or not u.src.ok:
                 continue  # a file with syntax errors: its AST may miss tokens; E002 says why
             checker.system_file = declarer.soft_types = is_system_path(u.src.path)
+            checker.submit = u.src.path.lower().endswith(".sub")
             checker.check_routine(r, self.routine_scopes[id(r)], u.src.path)
-        checker.system_file = declarer.soft_types = False
+        checker.system_file = declarer.soft_types = checker.submit = False
 
 
 SYSTEM_DIRS = ("system", "tp", "mada", "steu")

@@ -212,6 +212,8 @@ class Checker:
         # set while checking KUKA system files (R1/System, TP, Mada, STEU): they use
         # declarations of $operate.dat, which is not part of a backup
         self.system_file = False
+        # set while checking a .sub file: the submit interpreter has no motion (9, 8.2)
+        self.submit = False
 
     def _soft(self, sc: Scope) -> bool:
         return self.incomplete or self.system_file or sc.is_incomplete()
@@ -349,14 +351,17 @@ class Checker:
             if s.prio is not None:
                 self.int_expr(s.prio, sc, "interrupt number")
         elif isinstance(s, N.Trigger):
+            self.no_motion_in_submit(s, "TRIGGER")
             self.numeric(s.at, sc, s.kind)
             self.numeric(s.delay, sc, "DELAY")
             if s.prio is not None:
                 self.int_expr(s.prio, sc, "PRIO")
             self.stmt(s.action, ctx)
         elif isinstance(s, N.Motion):
+            self.no_motion_in_submit(s, s.kind)
             self.motion(s, sc)
         elif isinstance(s, N.SplineBlock):
+            self.no_motion_in_submit(s, s.kind)
             for w in s.with_:
                 self.with_assign(w, sc)
             for inner in s.body:
@@ -384,7 +389,13 @@ class Checker:
                 self.expr(s.value, sc)
         elif isinstance(s, N.DeclStmt):
             self.sink.at(s.span, "E104", "declaration after the first statement of the routine")
-        # Halt, Continue, OnErrorProceed, Brake, Resume, Unsupported: nothing to check
+        elif isinstance(s, (N.Brake, N.Resume)):
+            self.no_motion_in_submit(s, "BRAKE" if isinstance(s, N.Brake) else "RESUME")
+        # Halt, Continue, OnErrorProceed, Unsupported: nothing to check
+
+    def no_motion_in_submit(self, s: N.Stmt, what: str) -> None:
+        if self.submit:
+            self.sink.at(s.span, "E406", f"{what} in a submit program (.sub): the submit interpreter has no motion")
 
     def loop_body(self, body: list[N.Stmt], ctx: _Ctx) -> None:
         ctx.loops += 1

@@ -56,6 +56,7 @@ CODES: dict[str, tuple[str, str]] = {
     "E403": ("error", "EXIT outside a loop"),
     "E404": ("error", "RETURN value mismatch"),
     "E405": ("error", "duplicate label"),
+    "E406": ("error", "motion statement in a submit program"),
     "E501": ("error", "write to a write-protected variable"),
     "W501": ("warning", "write to an input"),
     "E502": ("error", "assignment to a constant"),

@@ -169,6 +169,15 @@ def test_system_variables_have_types_and_stops():
     assert N.type_of(ws.units[0].routines[0].body[1].target) == T.REAL
 
 
+def test_no_motion_in_submit_programs():
+    """9, 8.2: the submit interpreter has no motion statements."""
+    from krl.workspace import check_texts
+    bad = check_texts({"sps.sub": "DEF sps()\n  LOOP\n    PTP XHOME\n  ENDLOOP\nEND\n"})
+    assert [d.code for d in bad.diagnostics] == ["E406"]
+    ok = check_texts({"sps.sub": "DEF sps()\n  LOOP\n    $OUT[1] = $IN[2]\n  ENDLOOP\nEND\n"})
+    assert ok.diagnostics == []
+
+
 def test_duplicate_global_types_across_data_lists():
     """2.7: two PUBLIC data lists exporting the same GLOBAL ENUM is a link error;
     system data lists may repeat each other."""
