@@ -91,10 +91,13 @@ class Case:
     def files(self) -> list[Path]:
         return sorted(p for p in self.path.iterdir() if p.suffix.lower() in (".src", ".sub", ".dat"))
 
-    def routines(self) -> set[str]:
-        """Upper-case names of the routines defined in the case's own files."""
+    def routines(self, suffix: str | None = None) -> set[str]:
+        """Upper-case names of the routines defined in the case's own files (only in files
+        with the given suffix, if one is given)."""
         names: set[str] = set()
         for p in self.files():
+            if suffix is not None and p.suffix.lower() != suffix:
+                continue
             for m in re.finditer(r"^\s*(?:GLOBAL\s+)?DEF(?:FCT\s+\w+(?:\[\])?)?\s+(\w+)\s*\(",
                                  p.read_text(encoding="utf-8", errors="replace"), re.I | re.M):
                 names.add(m.group(1).upper())
@@ -309,7 +312,9 @@ def run_program(program: Path, interp: str, *, stimuli: Path | None = None,
                         except json.JSONDecodeError:
                             crash = crash or f"trace line is not JSON: {line[:120]}"
         elif crash is None:
-            crash = f"no trace written (exit code {code})"
+            crash = f"no trace written (exit code {code}): {output.strip()[-500:]}"
+        if crash is None and code == 2:
+            crash = f"exit code 2 (usage or internal error): {output.strip()[-1500:]}"
     return RunResult(interp, events, code, output, crash, time.monotonic() - t0)
 
 
@@ -330,12 +335,14 @@ def flow_tokens(events: list[dict[str, Any]], case: Case | None = None, *,
     out: list[str] = []
     leaves: dict[str, set[int]] = {}
     routines: set[str] = set()
+    sub_routines: set[str] = set()
     if case is not None:
         types = _user_types(case)
         for p in case.files():
             if p.suffix.lower() != ".dat":
                 leaves[p.name.lower()] = leaf_lines(p, types)
-        routines = case.routines()
+        routines = case.routines() - {"PROGRAM"}   # the run's own top-level call is implied
+        sub_routines = case.routines(suffix=".sub")
     pending_handler: str | None = None
     for ev in events:
         k = ev.get("kind")
@@ -357,7 +364,8 @@ def flow_tokens(events: list[dict[str, Any]], case: Case | None = None, *,
         elif k in ("call", "return"):
             name = str(ev.get("name", "")).upper()
             if case is not None:
-                if name not in routines or submit:
+                # call events carry no context: a routine of a .sub file belongs to the submit side
+                if name not in routines or (name in sub_routines) != submit:
                     continue
                 # the handler call that an interrupt entry implies is not a separate token
                 if k == "call" and pending_handler == name:
@@ -552,8 +560,8 @@ def check_flow(case: Case, events: list[dict[str, Any]]) -> list[Check]:
         act = flow_tokens(events, case, submit=submit)
         ignore = [str(x).lower() for x in case.expect.get("flow_ignore", [])]
         if ignore:
-            exp = [t for t in exp if not any(fnmatch.fnmatchcase(t, g) for g in ignore)]
-            act = [t for t in act if not any(fnmatch.fnmatchcase(t, g) for g in ignore)]
+            exp = [t for t in exp if not any(fnmatch.fnmatchcase(t.lower(), g) for g in ignore)]
+            act = [t for t in act if not any(fnmatch.fnmatchcase(t.lower(), g) for g in ignore)]
         if key == "flow_submit" and case.expect.get("flow_submit_prefix", True):
             act = act[:len(exp)]  # the submit program loops until the robot program ends
         out.append(Check(key, exp == act, "" if exp == act else _diff(exp, act, key)))
@@ -564,10 +572,8 @@ def check_io(case: Case, events: list[dict[str, Any]]) -> list[Check]:
     if "io" not in case.expect:
         return []
     spec = case.expect["io"]
-    signals = case.expect.get("io_signals")
-    if signals is None:
-        signals = sorted({str(e["signal"]).upper().replace(" ", "") for e in spec}) or ["$OUT[*"]
-        signals = signals if spec else ["$OUT*", "$ANOUT*"]
+    # default: every output the program (or a trigger, a pulse) changes - an unexpected write fails
+    signals = case.expect.get("io_signals") or ["$OUT*", "$ANOUT*"]
     act = io_events(events, signals)
     mt = motion_times(events)
     exp_tok = [f"{str(e['signal']).upper().replace(' ', '')}={_fmt(e['value'])}" for e in spec]
@@ -587,7 +593,11 @@ def check_io(case: Case, events: list[dict[str, Any]]) -> list[Check]:
             continue
         if "t" not in e and "dt" not in e:
             continue
-        base = _anchor_time(e, mt)
+        if isinstance(e.get("after"), dict) and "io" in e["after"]:
+            k = int(e["after"]["io"])
+            base = act[k]["t"] if 0 <= k < len(act) else None
+        else:
+            base = _anchor_time(e, mt)
         if base is None:
             bad.append(f"#{i} {exp_tok[i]}: anchor {e.get('after')} not in the trace")
             continue
@@ -671,6 +681,8 @@ def _window(mt, mid, which="body"):
     if "blend_end" not in prev:
         t0 = d.get("start")
     t1 = d.get("blend_start", d.get("end"))
+    if t1 is None:  # abandoned (RESUME) or cut by an error: up to the next motion / the trace end
+        t1 = mt.get(mid + 1, {}).get("start", math.inf)
     return t0, t1
 
 
