@@ -56,3 +56,20 @@ bench: $(PARSER)
 
 clean:
 	rm -rf $(VENV) $(GEN_DIR) reports/recovery reports/growth
+
+# Conformance suites (issue 8): hand-written cases, differential fuzzing, corpus programs.
+CONF_OUT  ?= reports/conformance
+CONF_FUZZ ?= 200
+conformance: $(PARSER)
+	$(BIN)/krl conformance --out $(CONF_OUT) --fuzz $(CONF_FUZZ)
+
+# Long nightly run, in order: recovery over the shared corpus, growth, conformance; dated
+# reports under reports/nightly/<date>/ and an index page. Not part of `make test`.
+NIGHTLY_FUZZ ?= 2000
+nightly: $(PARSER)
+	@d=reports/nightly/$$(date -u +%Y-%m-%d); mkdir -p $$d; \
+	$(BIN)/krl recover $(SHARED_CORPUS) --out $$d/recovery; s=$$?; [ $$s -le 1 ] || exit $$s; \
+	$(BIN)/krl growth $(SHARED_CORPUS) --out $$d/growth || exit $$?; \
+	$(BIN)/krl conformance --out $$d/conformance --fuzz $(NIGHTLY_FUZZ); c=$$?; \
+	$(BIN)/python -m conformance.nightly reports/nightly; \
+	echo "nightly reports: $$d (index: reports/nightly/index.html)"; exit $$c

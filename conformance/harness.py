@@ -187,29 +187,36 @@ def _interp_run_command():
     return None
 
 
-def interpreter_status() -> dict[str, str | None]:
-    """name -> None if available, else the reason why not."""
+_STATUS: dict[str, str | None] | None = None
+
+
+def _probe(interp: str) -> str | None:
+    """Run a two-line program with ``krl run --interp INTERP``; None if it works, else why not."""
+    with tempfile.TemporaryDirectory(prefix="krl-probe-") as tmp:
+        prog = Path(tmp) / "program.src"
+        prog.write_text("DEF program()\n  $OUT[1] = TRUE\nEND\n", encoding="utf-8")
+        res = run_program(prog, interp, max_sim_time=1.0, wall_timeout=60.0)
+    if res.crash is None and res.exit_code == 0 and any(e.get("kind") == "end" for e in res.events):
+        return None
+    why = (res.crash or res.output or f"exit code {res.exit_code}").strip().splitlines()
+    return "not available: " + (why[0] if why else "krl run failed")[:200]
+
+
+def interpreter_status(refresh: bool = False) -> dict[str, str | None]:
+    """name -> None if available, else the reason why not. An interpreter is available when
+    ``krl run --interp NAME`` runs a trivial program to completion (probed once)."""
+    global _STATUS
+    if _STATUS is not None and not refresh:
+        return dict(_STATUS)
     out: dict[str, str | None] = {}
-    cmd = _interp_run_command()
-    if cmd is None:
-        out["tree"] = "not available: interp.cli has no `run` command yet (issue 6 in progress)"
-    else:
-        out["tree"] = None
-    vm_spec = None
-    for name in ("interp.vm", "interp.vm.machine", "interp.bytecode"):
-        try:
-            vm_spec = importlib.util.find_spec(name)
-        except (ImportError, ValueError):
-            vm_spec = None
-        if vm_spec is not None:
-            break
-    if cmd is None:
+    if _interp_run_command() is None:
+        out["tree"] = "not available: interp.cli has no `run` command yet (issue 6)"
         out["vm"] = "not available: no `krl run`"
-    elif vm_spec is None:
-        out["vm"] = "not available: no interp.vm package yet (issue 7)"
     else:
-        out["vm"] = None
-    return out
+        out["tree"] = _probe("tree")
+        out["vm"] = _probe("vm")
+    _STATUS = out
+    return dict(out)
 
 
 def available_interpreters() -> list[str]:
@@ -250,9 +257,11 @@ def _wall_limit(seconds: float):
 
 def run_args(program: Path, interp: str, trace: Path, *, stimuli: Path | None = None,
              submit: Path | None = None, max_sim_time: float = 10.0,
-             workspace: Path | None = None) -> list[str]:
+             workspace: Path | None = None, max_steps: int | None = None) -> list[str]:
     args = [str(program), "--interp", interp, "--trace", str(trace),
             "--max-sim-time", str(max_sim_time)]
+    if max_steps is not None:
+        args += ["--max-steps", str(max_steps)]
     if workspace is not None:
         args += ["--workspace", str(workspace)]
     if stimuli is not None:
@@ -265,13 +274,13 @@ def run_args(program: Path, interp: str, trace: Path, *, stimuli: Path | None = 
 def run_program(program: Path, interp: str, *, stimuli: Path | None = None,
                 submit: Path | None = None, max_sim_time: float = 10.0,
                 workspace: Path | None = None, wall_timeout: float = 120.0,
-                subprocess_mode: bool = False) -> RunResult:
+                subprocess_mode: bool = False, max_steps: int | None = 1_000_000) -> RunResult:
     """Run one program with ``krl run`` and read its trace back."""
     t0 = time.monotonic()
     with tempfile.TemporaryDirectory(prefix="krl-conf-") as tmp:
         trace = Path(tmp) / "trace.jsonl"
         args = run_args(program, interp, trace, stimuli=stimuli, submit=submit,
-                        max_sim_time=max_sim_time, workspace=workspace)
+                        max_sim_time=max_sim_time, workspace=workspace, max_steps=max_steps)
         code: int | None = None
         output = ""
         crash = None
@@ -316,6 +325,19 @@ def run_program(program: Path, interp: str, *, stimuli: Path | None = None,
         if crash is None and code == 2:
             crash = f"exit code 2 (usage or internal error): {output.strip()[-1500:]}"
     return RunResult(interp, events, code, output, crash, time.monotonic() - t0)
+
+
+def clean_run_problem(res: RunResult) -> str | None:
+    """Why a run counts as an internal failure of the interpreter (crash, exit code 2, no
+    ``end`` event), or None. Run-time errors of the KRL program (exit 1) and stops (exit 3)
+    are clean outcomes."""
+    if res.crash:
+        return res.crash
+    if res.exit_code not in (0, 1, 3):
+        return f"exit code {res.exit_code}"
+    if not any(e.get("kind") == "end" for e in res.events):
+        return "no end event"
+    return None
 
 
 def run_case(case: Case, interp: str, **kw: Any) -> RunResult:
@@ -886,6 +908,11 @@ def check_case(case: Case, res: RunResult) -> CaseResult:
     if res.crash is not None:
         return cr
     ev = res.events
+    if case.expect.get("fuzz"):
+        # a program saved by the fuzzer: it must run without an internal error (tree == vm is
+        # checked by compare_runs when both interpreters exist)
+        prob = clean_run_problem(res)
+        cr.checks.append(Check("runs_cleanly", prob is None, prob or ""))
     cr.checks += check_end(case, ev)
     cr.checks += check_flow(case, ev)
     cr.checks += check_io(case, ev)

@@ -1,0 +1,40 @@
+"""`krl conformance`: run the conformance suites and write the report (issue 8)."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import click
+
+
+@click.command("conformance")
+@click.option("--out", "out", type=click.Path(path_type=Path), default=Path("reports/conformance"),
+              show_default=True, help="Report directory.")
+@click.option("--fuzz", "fuzz_n", type=int, default=200, show_default=True,
+              help="Number of generated programs for the differential fuzzer (0: no fuzzing).")
+@click.option("--no-real", is_flag=True, help="Skip the real programs of ../shared/krl-corpus.")
+@click.option("--corpus", type=click.Path(path_type=Path), default=None,
+              help="Corpus of KRC backups (default ../shared/krl-corpus).")
+@click.option("--real-limit", type=int, default=None, help="Run at most N real programs.")
+def conformance(out: Path, fuzz_n: int, no_real: bool, corpus: Path | None, real_limit: int | None) -> None:
+    """Run the hand-written cases on every available interpreter, the differential fuzzer and
+    the corpus programs; write summary.json, report.md and report.html to --out.
+
+    Exit code 0 when every case that is not marked pending passes and the interpreters agree,
+    1 otherwise."""
+    from conformance.report import DEFAULT_CORPUS, run_all  # noqa: PLC0415
+
+    s = run_all(out, fuzz_n=fuzz_n, real=not no_real, corpus=corpus or DEFAULT_CORPUS,
+                real_limit=real_limit, echo=click.echo)
+    click.echo(f"cases {s['passed']}/{s['cases']} pass; pending: {len(s['pending'])}; "
+               f"tree = vm: {s['tree_vm_agree'] if s['tree_vm_agree'] is not None else 'n/a (' + s['vm'] + ')'}")
+    bad = bool(s["failed_not_pending"])
+    if s["tree_vm_agree"] is not None and s["tree_vm_agree"] < s["cases"]:
+        bad = True
+    if s.get("fuzz_tree_ok") is not None and s["fuzz_tree_ok"] < s["fuzz_programs"]:
+        bad = True
+    sys.exit(1 if bad else 0)
+
+
+commands = [conformance]

@@ -1,0 +1,363 @@
+"""Run the conformance suites and write ``reports/conformance/`` (issue 8).
+
+* the hand-written cases (``conformance/cases``) on every available interpreter, each against
+  its expectations, and tree vs VM when both exist;
+* the differential fuzzer (``conformance/fuzz.py``);
+* the runnable programs of the KRC backups in ``../shared/krl-corpus`` (tree vs VM).
+
+Outputs: ``summary.json`` (``cases, passed, tree_vm_agree, fuzz_programs, fuzz_agree,
+real_programs, real_agree`` plus explanatory keys), ``report.md``, ``report.html`` (jinja2) and
+one PNG per case with motion (programmed points, approximation zones, the interpreters' TCP
+paths; matplotlib Agg). Without a VM the agreement fields are ``null`` and ``vm`` says why.
+"""
+
+from __future__ import annotations
+
+import html
+import json
+import math
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from . import harness as H
+
+REPO = H.REPO
+DEFAULT_CORPUS = REPO.parent / "shared" / "krl-corpus"
+
+
+# ============================================================================ cases
+@dataclass
+class CaseOutcome:
+    case: H.Case
+    results: dict[str, H.CaseResult] = field(default_factory=dict)
+    runs: dict[str, H.RunResult] = field(default_factory=dict)
+    tree_vm: list[H.Check] | None = None
+    plot: str | None = None
+
+    @property
+    def passed(self) -> bool:
+        return bool(self.results) and all(r.passed for r in self.results.values())
+
+    @property
+    def agree(self) -> bool | None:
+        if self.tree_vm is None:
+            return None
+        return all(c.ok for c in self.tree_vm)
+
+
+def run_cases(cases: list[H.Case] | None = None, interps: list[str] | None = None,
+              *, progress=None) -> list[CaseOutcome]:
+    cases = H.load_cases() if cases is None else cases
+    interps = H.available_interpreters() if interps is None else interps
+    out = []
+    for case in cases:
+        co = CaseOutcome(case)
+        for it in interps:
+            res = H.run_case(case, it)
+            co.runs[it] = res
+            co.results[it] = H.check_case(case, res)
+        if "tree" in co.runs and "vm" in co.runs:
+            co.tree_vm = H.compare_runs(co.runs["tree"], co.runs["vm"])
+        out.append(co)
+        if progress:
+            progress(co)
+    return out
+
+
+# ============================================================================ real programs
+@dataclass
+class RealOutcome:
+    program: str
+    reasons: dict[str, str] = field(default_factory=dict)   # interp -> end reason / crash
+    crash: dict[str, str] = field(default_factory=dict)
+    tree_vm: list[H.Check] | None = None
+
+    @property
+    def agree(self) -> bool | None:
+        if self.tree_vm is None:
+            return None
+        return all(c.ok for c in self.tree_vm)
+
+
+def real_programs(corpus: Path = DEFAULT_CORPUS) -> list[tuple[Path, Path]]:
+    """(program, backup root) for every runnable program of the corpus backups (the
+    definition of issue 6: ``interp.realprograms``). Empty when the corpus is absent."""
+    if not corpus.is_dir():
+        return []
+    from interp import realprograms as R  # noqa: PLC0415
+
+    out = []
+    for root in R.find_backups(corpus):
+        for prog in R.programs_of(root):
+            out.append((prog, root))
+    return out
+
+
+def run_real(corpus: Path = DEFAULT_CORPUS, interps: list[str] | None = None, *, limit: int | None = None,
+             max_sim_time: float = 30.0, max_steps: int = 300_000, progress=None) -> list[RealOutcome]:
+    interps = H.available_interpreters() if interps is None else interps
+    progs = real_programs(corpus)
+    if limit is not None:
+        progs = progs[:limit]
+    out = []
+    from interp import realprograms as R  # noqa: PLC0415
+
+    for prog, root in progs:
+        ro = RealOutcome(str(prog.relative_to(corpus)) if prog.is_relative_to(corpus) else str(prog))
+        runs = {}
+        subs = []
+        try:
+            subs = list(R.submit_of(prog))
+        except Exception:  # noqa: BLE001 - no submit program then
+            subs = []
+        for it in interps:
+            res = H.run_program(prog, it, workspace=None, max_sim_time=max_sim_time,
+                                max_steps=max_steps, submit=subs[0] if subs else None,
+                                wall_timeout=300.0)
+            runs[it] = res
+            if res.crash:
+                ro.crash[it] = res.crash.splitlines()[0][:300]
+                ro.reasons[it] = "crash"
+            else:
+                ends = [e for e in res.events if e.get("kind") == "end"]
+                ro.reasons[it] = ends[-1].get("reason", "?") if ends else "no end event"
+        if "tree" in runs and "vm" in runs:
+            ro.tree_vm = H.compare_runs(runs["tree"], runs["vm"], path_tol_mm=1e-6)
+        out.append(ro)
+        if progress:
+            progress(ro)
+    return out
+
+
+# ============================================================================ plots
+def plot_case(co: CaseOutcome, png: Path) -> bool:
+    """TCP paths (top view X-Y and side view X-Z): programmed points, approximation zones,
+    each interpreter's path. Returns False when the case has no motion."""
+    runs = {k: r for k, r in co.runs.items() if r.events and any(e.get("kind") == "motion" for e in r.events)}
+    if not runs:
+        return False
+    import matplotlib  # noqa: PLC0415
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt  # noqa: PLC0415
+    from matplotlib.patches import Circle  # noqa: PLC0415
+
+    first = next(iter(runs.values()))
+    mt = H.motion_times(first.events)
+    zones = {}
+    for spec in co.case.expect.get("motion") or []:
+        if spec.get("check") == "blend":
+            mid = int(spec["id"])
+            if "zone_mm" in spec:
+                zones[mid] = float(spec["zone_mm"])
+    for mid, d in mt.items():
+        if "blend_start" in d and mid not in zones:
+            p = H._pose_at(H.poses(first.events), d["blend_start"])
+            zones[mid] = H._norm(H._sub(p, d["point"][:3]))
+    fig, axes = plt.subplots(1, 2, figsize=(10, 4.6))
+    styles = {"tree": dict(color="tab:blue", lw=1.6, ls="-"), "vm": dict(color="tab:orange", lw=1.2, ls="--")}
+    for ax, (i, j, lab) in zip(axes, ((0, 1, "top view: X-Y"), (0, 2, "side view: X-Z"))):
+        for name, r in runs.items():
+            ps = [p for _, p in H.poses(r.events)]
+            ax.plot([p[i] for p in ps], [p[j] for p in ps], label=f"{name} TCP path", **styles.get(name, {}))
+        pts = [(mid, d["point"]) for mid, d in sorted(mt.items()) if "point" in d]
+        ax.plot([p[i] for _, p in pts], [p[j] for _, p in pts], "k+", ms=9, mew=1.5, label="programmed points")
+        for mid, p in pts:
+            ax.annotate(str(mid), (p[i], p[j]), textcoords="offset points", xytext=(4, 4), fontsize=8)
+            if mid in zones:
+                ax.add_patch(Circle((p[i], p[j]), zones[mid], fill=False, ls=":", color="tab:red",
+                                    label="approximation zone" if mid == min(zones) else None))
+        ax.set_aspect("equal", adjustable="datalim")
+        ax.set_title(lab, fontsize=9)
+        ax.set_xlabel("X mm" if i == 0 else "")
+        ax.set_ylabel("Y mm" if j == 1 else "Z mm")
+        ax.grid(alpha=0.3)
+    axes[0].legend(fontsize=7, loc="best")
+    fig.suptitle(co.case.name, fontsize=10)
+    fig.tight_layout()
+    png.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(png, dpi=90)
+    plt.close(fig)
+    return True
+
+
+# ============================================================================ report
+def summary(outcomes: list[CaseOutcome], fuzz: dict[str, Any] | None, real: list[RealOutcome] | None,
+            status: dict[str, str | None]) -> dict[str, Any]:
+    vm_ok = status.get("vm") is None and status.get("tree") is None
+    s: dict[str, Any] = {
+        "cases": len(outcomes),
+        "passed": sum(1 for o in outcomes if o.passed),
+        "tree_vm_agree": sum(1 for o in outcomes if o.agree) if vm_ok else None,
+        "fuzz_programs": (fuzz or {}).get("programs", 0),
+        "fuzz_agree": (fuzz or {}).get("agree") if vm_ok else None,
+        "real_programs": len(real or []),
+        "real_agree": sum(1 for r in (real or []) if r.agree) if vm_ok else None,
+    }
+    s["pending"] = sorted(o.case.name for o in outcomes if o.case.pending)
+    s["pending_passing"] = sorted(o.case.name for o in outcomes if o.case.pending and o.passed)
+    s["failed_not_pending"] = sorted(o.case.name for o in outcomes if not o.passed and not o.case.pending)
+    s["interpreters"] = {k: ("available" if v is None else v) for k, v in status.items()}
+    s["vm"] = "available" if vm_ok else (status.get("vm") or "not available")
+    if fuzz:
+        s["fuzz_tree_ok"] = fuzz.get("tree_ok")
+        s["fuzz_mode"] = fuzz.get("mode")
+    if real is not None:
+        s["real_tree_crashes"] = sum(1 for r in real if "tree" in r.crash)
+        s["real_tree_reasons"] = _count(r.reasons.get("tree", "-") for r in real)
+    return s
+
+
+def _count(items) -> dict[str, int]:
+    out: dict[str, int] = {}
+    for x in items:
+        out[x] = out.get(x, 0) + 1
+    return dict(sorted(out.items()))
+
+
+def _row(o: CaseOutcome) -> dict[str, Any]:
+    per = {k: ("pass" if r.passed else "FAIL") for k, r in o.results.items()}
+    return {"name": o.case.name, "title": o.case.expect.get("title", ""),
+            "covers": ", ".join(o.case.expect.get("covers", [])),
+            "per": per, "agree": {None: "n/a", True: "yes", False: "NO"}[o.agree],
+            "pending": o.case.pending or "", "plot": o.plot,
+            "status": "pass" if o.passed else ("pending" if o.case.pending else "FAIL"),
+            "diffs": {k: r.diff_text() for k, r in o.results.items() if not r.passed},
+            "tree_vm_diff": "\n".join(f"[{c.name}] {c.detail}" for c in (o.tree_vm or []) if not c.ok)}
+
+
+def write_report(out: Path, outcomes: list[CaseOutcome], fuzz: dict[str, Any] | None = None,
+                 real: list[RealOutcome] | None = None, *, plots: bool = True) -> dict[str, Any]:
+    out.mkdir(parents=True, exist_ok=True)
+    status = H.interpreter_status()
+    if plots:
+        for o in outcomes:
+            png = out / "plots" / f"{o.case.name}.png"
+            try:
+                if plot_case(o, png):
+                    o.plot = f"plots/{png.name}"
+            except Exception as exc:  # noqa: BLE001 - a broken plot must not lose the report
+                o.plot = None
+                print(f"plot {o.case.name}: {exc}")
+    s = summary(outcomes, fuzz, real, status)
+    (out / "summary.json").write_text(json.dumps(s, indent=2) + "\n", encoding="utf-8")
+    rows = [_row(o) for o in outcomes]
+    interps = sorted({k for o in outcomes for k in o.results})
+    (out / "report.md").write_text(_markdown(s, rows, interps, fuzz, real), encoding="utf-8")
+    (out / "report.html").write_text(_html(s, rows, interps, fuzz, real), encoding="utf-8")
+    return s
+
+
+def _markdown(s, rows, interps, fuzz, real) -> str:
+    L = ["# Conformance report", "",
+         f"Generated {time.strftime('%Y-%m-%d %H:%M:%S UTC', time.gmtime())}.", "",
+         "| metric | value |", "|---|---|"]
+    for k in ("cases", "passed", "tree_vm_agree", "fuzz_programs", "fuzz_agree", "real_programs", "real_agree", "vm"):
+        L.append(f"| {k} | {s.get(k) if s.get(k) is not None else 'n/a (no VM)'} |")
+    L += ["", "## Cases", "", "| case | " + " | ".join(interps) + " | tree = vm | status | covers |",
+          "|---|" + "---|" * len(interps) + "---|---|---|"]
+    for r in rows:
+        L.append(f"| {r['name']} | " + " | ".join(r["per"].get(i, "-") for i in interps)
+                 + f" | {r['agree']} | {r['status']} | {r['covers']} |")
+    pend = [r for r in rows if r["pending"]]
+    if pend:
+        L += ["", "## Pending cases", ""]
+        L += [f"- **{r['name']}** ({r['status']}): {r['pending']}" for r in pend]
+    fails = [r for r in rows if r["diffs"] or r["tree_vm_diff"]]
+    if fails:
+        L += ["", "## Differences", ""]
+        for r in fails:
+            L += [f"### {r['name']}" + (" (pending)" if r["pending"] else ""), ""]
+            for k, d in r["diffs"].items():
+                L += [f"{k}:", "", "```", d, "```", ""]
+            if r["tree_vm_diff"]:
+                L += ["tree vs vm:", "", "```", r["tree_vm_diff"], "```", ""]
+    if fuzz:
+        L += ["", "## Differential fuzzing", "", f"mode: {fuzz.get('mode')}; programs: {fuzz.get('programs')}; "
+              f"tree ran cleanly: {fuzz.get('tree_ok')}; tree = vm: {fuzz.get('agree')}"]
+        for f in fuzz.get("failures", [])[:20]:
+            L += ["", "```", str(f)[:2000], "```"]
+    if real is not None:
+        L += ["", "## Real programs (../shared/krl-corpus)", "",
+              f"{len(real)} runnable programs; end reasons on the tree interpreter: {s.get('real_tree_reasons')}", ""]
+        bad = [r for r in real if r.crash or r.agree is False]
+        for r in bad[:50]:
+            L.append(f"- {r.program}: {r.crash or ''} {'' if r.agree is not False else 'tree != vm'}")
+    return "\n".join(L) + "\n"
+
+
+_HTML = """<!doctype html>
+<html><head><meta charset="utf-8"><title>Conformance report</title>
+<style>body{font-family:sans-serif;margin:1.5em}table{border-collapse:collapse}td,th{border:1px solid #ccc;padding:2px 6px;font-size:13px}
+.pass{background:#e6ffe6}.FAIL{background:#ffe0e0}.pending{background:#fff4d6}pre{background:#f6f6f6;padding:6px;font-size:12px;overflow-x:auto}
+img{max-width:900px;border:1px solid #ddd}</style></head><body>
+<h1>Conformance report</h1>
+<p>Generated {{ when }}.</p>
+<table>{% for k, v in summary_rows %}<tr><th>{{ k }}</th><td>{{ v }}</td></tr>{% endfor %}</table>
+<h2>Cases</h2>
+<table><tr><th>case</th>{% for i in interps %}<th>{{ i }}</th>{% endfor %}<th>tree = vm</th><th>status</th><th>covers</th><th>plot</th></tr>
+{% for r in rows %}<tr class="{{ r.status }}"><td><a href="#{{ r.name }}">{{ r.name }}</a><br><small>{{ r.title }}</small></td>
+{% for i in interps %}<td>{{ r.per.get(i, '-') }}</td>{% endfor %}<td>{{ r.agree }}</td><td>{{ r.status }}</td><td><small>{{ r.covers }}</small></td>
+<td>{% if r.plot %}<a href="{{ r.plot }}">png</a>{% endif %}</td></tr>{% endfor %}</table>
+{% if pending %}<h2>Pending cases</h2><ul>{% for r in pending %}<li><b>{{ r.name }}</b> ({{ r.status }}): {{ r.pending }}</li>{% endfor %}</ul>{% endif %}
+<h2>Details</h2>
+{% for r in rows %}{% if r.diffs or r.tree_vm_diff or r.plot %}<h3 id="{{ r.name }}">{{ r.name }} <small>{{ r.status }}</small></h3>
+{% for k, d in r.diffs.items() %}<p>{{ k }}:</p><pre>{{ d }}</pre>{% endfor %}
+{% if r.tree_vm_diff %}<p>tree vs vm:</p><pre>{{ r.tree_vm_diff }}</pre>{% endif %}
+{% if r.plot %}<img src="{{ r.plot }}" alt="paths of {{ r.name }}">{% endif %}{% endif %}{% endfor %}
+{% if fuzz %}<h2>Differential fuzzing</h2><p>mode: {{ fuzz.mode }}; programs: {{ fuzz.programs }}; tree ran cleanly: {{ fuzz.tree_ok }}; tree = vm: {{ fuzz.agree }}</p>
+{% for f in fuzz.failures[:20] %}<pre>{{ f }}</pre>{% endfor %}{% endif %}
+{% if real is not none %}<h2>Real programs</h2><p>{{ real|length }} runnable programs; end reasons (tree): {{ real_reasons }}</p>
+<ul>{% for r in real %}{% if r.crash or r.agree == False %}<li>{{ r.program }}: {{ r.crash }}</li>{% endif %}{% endfor %}</ul>{% endif %}
+</body></html>
+"""
+
+
+def _html(s, rows, interps, fuzz, real) -> str:
+    import jinja2  # noqa: PLC0415
+
+    env = jinja2.Environment(autoescape=True)
+    t = env.from_string(_HTML)
+    keys = ("cases", "passed", "tree_vm_agree", "fuzz_programs", "fuzz_agree", "real_programs", "real_agree", "vm")
+    return t.render(when=time.strftime("%Y-%m-%d %H:%M:%S UTC", time.gmtime()),
+                    summary_rows=[(k, s.get(k) if s.get(k) is not None else "n/a (no VM)") for k in keys],
+                    rows=rows, interps=interps, pending=[r for r in rows if r["pending"]],
+                    fuzz=fuzz, real=real, real_reasons=s.get("real_tree_reasons"))
+
+
+def run_all(out: Path, *, fuzz_n: int = 200, real: bool = True, corpus: Path = DEFAULT_CORPUS,
+            real_limit: int | None = None, echo=print) -> dict[str, Any]:
+    """Everything `krl conformance` / `make conformance` does."""
+    status = H.interpreter_status()
+    for k, v in status.items():
+        echo(f"{k}: {'available' if v is None else v}")
+    t0 = time.monotonic()
+
+    def prog(co):
+        st = "pass" if co.passed else ("pending" if co.case.pending else "FAIL")
+        echo(f"  {st:7s} {co.case.name}")
+    outcomes = run_cases(progress=prog)
+    echo(f"cases: {sum(o.passed for o in outcomes)}/{len(outcomes)} pass ({time.monotonic() - t0:.0f} s)")
+    fz = None
+    if fuzz_n > 0:
+        from . import fuzz as F  # noqa: PLC0415
+
+        fz = F.run_fuzz(fuzz_n, save_failures=out / "fuzz_failures")
+        echo(f"fuzz: {fz['programs']} programs, mode {fz['mode']}, tree clean {fz['tree_ok']}, agree {fz['agree']}")
+    rl = None
+    if real:
+        if corpus.is_dir():
+            rl = run_real(corpus, limit=real_limit,
+                          progress=lambda r: echo(f"  real {r.reasons} {r.program}"))
+            echo(f"real programs: {len(rl)}")
+        else:
+            echo(f"real programs: skipped ({corpus} not found)")
+    s = write_report(out, outcomes, fz, rl)
+    echo(f"report: {out / 'report.md'}")
+    return s
+
+
+__all__ = ["run_cases", "run_real", "write_report", "run_all", "plot_case", "summary", "CaseOutcome",
+           "RealOutcome", "real_programs"]
