@@ -433,6 +433,7 @@ class Checker:
         sym = sc.lookup(s.var.name)
         if sym is None:
             self.not_found(s.var.span, s.var.name, sc)
+            self.set_type(s.var, T.UNKNOWN)
         else:
             s.var.annotate().symbol = sym
             s.var.ann.type = sym.type
@@ -566,19 +567,25 @@ class Checker:
                 if ft is None:
                     self.sink.at(item.span, "W206" if target.soft else "E206",
                                  f"{target.name} has no component '{item.name}'")
-                    self.expr(item.value, sc) if not isinstance(item.value, N.Aggregate) else None
+                    self.loose(item.value, sc)
                     continue
                 self.check_value(ft, item.value, sc, item.value.span, what=f"component {item.name}")
             elif target is T.UNKNOWN:
-                if isinstance(item.value, N.Aggregate):
-                    self.aggregate(item.value, sc, T.UNKNOWN)
-                else:
-                    self.expr(item.value, sc)
+                self.loose(item.value, sc)
             else:
                 self.sink.at(agg.span, "W201" if getattr(target, "soft", False) else "E201",
                              f"an aggregate cannot be assigned to {target}")
+                for rest in agg.items:   # still type every component value
+                    self.loose(rest.value, sc)
                 return target
         return target
+
+    def loose(self, value: N.Expr, sc: Scope) -> None:
+        """Type a value without an expected type (after an error), aggregates included."""
+        if isinstance(value, N.Aggregate):
+            self.aggregate(value, sc, T.UNKNOWN)
+        else:
+            self.expr(value, sc)
 
     # ---------------------------------------------------------------- expressions
 
@@ -643,7 +650,7 @@ class Checker:
             self.sink.at(e.span, "E108", f"'.{e.name}' applied to {bt}, which is not a structure")
             return self.set_type(e, T.UNKNOWN)
         if isinstance(e, N.Call):
-            return self.set_type(e, self.call(e, sc, statement=False))
+            return self.call(e, sc, statement=False)
         if isinstance(e, N.Aggregate):
             return self.set_type(e, self.aggregate(e, sc, expected or T.UNKNOWN))
         if isinstance(e, N.Unary):
@@ -779,6 +786,11 @@ class Checker:
     # ---------------------------------------------------------------- calls
 
     def call(self, c: N.Call, sc: Scope, statement: bool) -> T.KrlType:
+        """Check a call; returns (and records in c.ann.type) its result type, VOID for a
+        procedure, UNKNOWN for an unknown routine."""
+        return self.set_type(c, self._call(c, sc, statement))
+
+    def _call(self, c: N.Call, sc: Scope, statement: bool) -> T.KrlType:
         sym = sc.lookup_routine(c.name)
         if sym is None:
             for a in c.args:

@@ -100,3 +100,17 @@ def test_checking_costs_no_more_than_parsing(checked):
     assert check <= parse, (check, parse)
 
 
+
+
+@pytest.mark.corpus
+def test_every_expression_is_typed(checked):
+    """The interpreters rely on ann.type for every expression of a checked file."""
+    from krl.ast import nodes as N
+    untyped = []
+    for ws in checked:
+        for f in ws.files:
+            if not f.ok:
+                continue
+            untyped += [f"{f.path}:{n.span.line} {type(n).__name__}" for n in f.module.walk()
+                        if isinstance(n, N.Expr) and N.type_of(n) is None]
+    assert not untyped, untyped[:20]

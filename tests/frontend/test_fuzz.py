@@ -126,5 +126,8 @@ def test_unreadable_inputs(tmp_path):
 
 @given(modules)
 def test_generated_programs_check_without_internal_errors(module):
+    from krl.ast import nodes as N
     from krl.ast.printer import print_module
-    _safe_check_text(print_module(module))
+    ws = _safe_check_text(print_module(module))
+    for f in ws.files:
+        assert all(N.type_of(n) is not None for n in f.module.walk() if isinstance(n, N.Expr))
