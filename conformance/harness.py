@@ -242,6 +242,10 @@ def _wall_limit(seconds: float):
     if seconds <= 0 or not hasattr(signal, "SIGALRM"):
         yield
         return
+    if signal.getsignal(signal.SIGALRM) not in (signal.SIG_DFL, signal.SIG_IGN, None):
+        # someone else (pytest-timeout) owns SIGALRM: leave it to them
+        yield
+        return
     try:
         old = signal.signal(signal.SIGALRM, lambda *_: (_ for _ in ()).throw(_Timeout()))
     except ValueError:  # not in the main thread
