@@ -345,6 +345,8 @@ class Checker:
             self.return_(s, ctx)
         elif isinstance(s, N.InterruptDecl):
             self.int_expr(s.prio, sc, "interrupt number")
+            if isinstance(s.prio, N.IntLit) and not 1 <= s.prio.value <= 128:
+                self.sink.at(s.prio.span, "E408", f"interrupt priority {s.prio.value} is outside 1..128")
             self.cond(s.when, sc, "WHEN")
             self.call(s.call, sc, statement=True)
         elif isinstance(s, N.InterruptCtl):
@@ -356,6 +358,8 @@ class Checker:
             self.numeric(s.delay, sc, "DELAY")
             if s.prio is not None:
                 self.int_expr(s.prio, sc, "PRIO")
+            elif isinstance(s.action, N.CallStmt):
+                self.sink.at(s.span, "E409", "a TRIGGER that calls a routine needs PRIO (-1 lets the system choose)")
             self.stmt(s.action, ctx)
         elif isinstance(s, N.Motion):
             self.no_motion_in_submit(s, s.kind)

@@ -57,6 +57,8 @@ CODES: dict[str, tuple[str, str]] = {
     "E404": ("error", "RETURN value mismatch"),
     "E405": ("error", "duplicate label"),
     "E406": ("error", "motion statement in a submit program"),
+    "E408": ("error", "interrupt priority outside 1..128"),
+    "E409": ("error", "TRIGGER calling a routine without PRIO"),
     "E501": ("error", "write to a write-protected variable"),
     "W501": ("warning", "write to an input"),
     "E502": ("error", "assignment to a constant"),

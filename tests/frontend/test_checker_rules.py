@@ -72,6 +72,10 @@ CASES = [
     ("E403", prog("", "EXIT"), prog("", "LOOP\n  EXIT\nENDLOOP")),
     ("E404", prog("", "RETURN 1"), prog("", "RETURN")),
     ("E405", prog("", "m:\nm:"), prog("", "m:\nn:")),
+    # interrupts and triggers (5.16, 5.18)
+    ("E408", prog("", "INTERRUPT DECL 129 WHEN $IN[1] DO t()"), prog("", "INTERRUPT DECL 128 WHEN $IN[1] DO t()")),
+    ("E409", prog("", "TRIGGER WHEN DISTANCE=1 DELAY=0 DO t()\nPTP $POS_ACT"),
+     prog("", "TRIGGER WHEN DISTANCE=1 DELAY=0 DO t() PRIO=-1\nPTP $POS_ACT")),
     # write protection (5.1, 7) and constants (2.5)
     ("E501", prog("", "$POS_ACT = $POS_ACT"), prog("", "$BASE = $NULLFRAME")),
     ("E501", prog("", "$MODE_OP = #T1"), prog("BOOL b", "b = $MODE_OP == #T1")),
