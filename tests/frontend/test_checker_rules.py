@@ -192,3 +192,14 @@ def test_duplicate_global_types_across_data_lists():
     m1 = "DEFDAT $MACHINE PUBLIC\n  ENUM KIN_T A, B\nENDDAT\n"
     m2 = "DEFDAT $MACHINE PUBLIC\n  ENUM KIN_T A, B\nENDDAT\n"
     assert check_texts({"R1/Mada/$machine.dat": m1, "STEU/Mada/$machine.dat": m2}).diagnostics == []
+
+
+def test_advance_run_stop_annotations():
+    """6.10 and 5.9: statements that stop the advance run are marked, CONTINUE noted."""
+    ws = check("DEF t()\n  DECL E6POS p\n  BOOL b\n  INT a[3]\n  p = $POS_ACT\n  CONTINUE\n  $OUT[1] = TRUE\n"
+               "  b = $IN[2]\n  $VEL.CP = 1\n  WAIT SEC 0\n  PULSE($OUT[2], TRUE, 0.5)\n  a[$TIMER[1]] = 1\nEND\n")
+    assert not ws.diagnostics, [str(d) for d in ws.diagnostics]
+    marks = [(s.ann.extra.get("advance_stop"), s.ann.extra.get("continued")) if s.ann else (None, None)
+             for s in ws.units[0].routines[0].body]
+    assert marks == [("reads $POS_ACT", None), (None, None), ("writes $OUT", True), ("reads $IN", None),
+                     (None, None), ("WAIT SEC", None), ("PULSE", None), ("reads $TIMER", None)]
