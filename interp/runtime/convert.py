@@ -20,7 +20,7 @@ import math
 from krl.semantics import types as T
 
 from .errors import KrlRuntimeError, value_invalid
-from .values import UNSET, Arr, EnumValue, Struct, copy_value, make_value
+from .values import NEUTRAL, UNSET, Arr, EnumValue, Struct, copy_value, make_value
 
 INT_MIN = -(2 ** 31)
 INT_MAX = 2 ** 31 - 1
@@ -51,6 +51,8 @@ def num(v, what: str = "operand"):
         return ord(v)
     if v is UNSET:
         raise value_invalid()
+    if v is NEUTRAL:
+        return 0
     if isinstance(v, bool):
         raise KrlRuntimeError(f"BOOL {what} where a number is needed")
     raise KrlRuntimeError(f"{what} is not a number: {v!r}")
@@ -59,6 +61,8 @@ def num(v, what: str = "operand"):
 def to_bool(v, what: str = "condition") -> bool:
     if v is True or v is False:
         return v
+    if v is NEUTRAL:
+        return False
     if v is UNSET:
         raise value_invalid()
     raise KrlRuntimeError(f"{what} is not BOOL: {v!r}")
@@ -68,6 +72,10 @@ def convert_scalar(v, t):
     """Convert ``v`` for storage in a leaf of simple/enum type ``t`` (assignment, §3.9)."""
     if v is UNSET:
         raise value_invalid()
+    if v is NEUTRAL:
+        if isinstance(t, (T.Struc, T.Array)):
+            return make_value(t)
+        v = False if t is T.BOOL else 0
     if t is T.INT:
         c = v.__class__
         if c is int:
@@ -114,7 +122,7 @@ def convert_scalar(v, t):
         dest = make_value(t)
         assign_into(dest, v)
         return dest
-    return v  # unknown type: store as is
+    return copy_value(v)  # unknown type: store a copy as is
 
 
 def assign_chars(dest: Arr, v) -> None:
@@ -137,6 +145,8 @@ def assign_into(dest, v) -> None:
     """Assign ``v`` into the existing Struct/Arr ``dest`` in place (so that :OUT
     references and component views stay valid). Structures copy the components present
     in ``v`` that exist in ``dest`` (partial aggregates, geometric relatives, §3.9)."""
+    if v is NEUTRAL:
+        return  # undeclared machine data: leaves the destination as it is
     if isinstance(dest, Struct):
         if not isinstance(v, Struct):
             if v is UNSET:
@@ -240,6 +250,10 @@ def binary_op(op: str, a, b):
 def compare(op: str, a, b) -> bool:
     if a is UNSET or b is UNSET:
         raise value_invalid()
+    if a is NEUTRAL:
+        a = False if (b is True or b is False) else 0
+    if b is NEUTRAL:
+        b = False if (a is True or a is False) else 0
     if isinstance(a, EnumValue) or isinstance(b, EnumValue):
         if op == "==":
             return a == b

@@ -142,6 +142,8 @@ class Runtime:
         file = (err.file if err is not None else None) or task.file
         line = (err.line if err is not None else None) or task.line
         ctx = task.context.kind if task.contexts else None
+        if reason in ("max_sim_time", "max_steps") and robot.waiting:
+            text = f"{text} while the robot program waits: {robot.waiting}"
         if reason == "completed":
             file, line, ctx = robot.file, robot.line, "main"
         self.result = RunResult(reason, err, file, line, ctx, text, self.controller.time, self.steps)
@@ -150,6 +152,7 @@ class Runtime:
                              number=err.number if err is not None else None,
                              file=file, line=line, context=ctx)
             self.controller._ended = True  # noqa: SLF001 - the interpreter wrote the end event
+        self.trace = None       # abandoned tasks may unwind later: nothing more is traced
         return self.result
 
     def interpreter_active(self, robot: bool) -> bool:
@@ -302,6 +305,8 @@ class Runtime:
         r = prog.lookup_global(key)
         if r is not None:
             return r
+        if key[:1] == "$" and prog.backup:
+            return self.sysvars.auto(key)
         raise KrlRuntimeError(f"unknown name {name}")
 
     def index(self, base: Ref, idx: list, name: str) -> Ref:
@@ -428,7 +433,11 @@ class Runtime:
             t = ptypes.get(key)
             a = args[i] if i < len(args) else None
             if a is None:
-                if t is None or (isinstance(t, T.Array) and 0 in t.dims):
+                if isinstance(t, T.Array) and t.elem == T.CHAR and t.dims == (0,):
+                    # an omitted string parameter: declared, no characters (KUKA's MsgLib
+                    # calls STRLEN on it without ON_ERROR_PROCEED); VARSTATE says #DECLARED
+                    frame.declare(p.name, t, Arr(t, (0,), []))
+                elif t is None or (isinstance(t, T.Array) and 0 in t.dims):
                     frame.store[key] = UNSET
                     frame.vars[key] = Slot(frame.store, key, None, p.name)
                 else:

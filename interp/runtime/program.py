@@ -154,6 +154,9 @@ class Program:
                 self.globals.setdefault(k, ref)
         if self.backup:
             mada = [p for p in self.workspace.rglob("*.dat") if p.parent.name.upper() == "MADA"]
+            steu = self.workspace.parent / "STEU" / "Mada"
+            if steu.is_dir():
+                mada += [p for p in steu.iterdir() if p.suffix.lower() == ".dat"]
             for p in sorted(mada):
                 try:
                     self._load_sysdata(p)
@@ -166,7 +169,22 @@ class Program:
             return
         m = ModuleRT(p.stem.upper(), self)
         m.types = self.types
-        self._load_data(m, mod.data, all_global=True)
+        self._load_data(m, mod.data, all_global=False)
+        sv = self.rt.sysvars
+        for key, ref in m.data.items():
+            if key in sv.store:
+                # machine data for a system variable of the table: take the backup's value
+                try:
+                    v = ref.peek()
+                    cur = sv.store[key]
+                    if isinstance(cur, Struct) or hasattr(cur, "dims"):
+                        assign_into(cur, v)
+                    elif v is not UNSET:
+                        sv.store[key] = v
+                except KrlRuntimeError:
+                    pass
+            elif key not in sv.info:
+                self.globals.setdefault(key, ref)
 
     # ------------------------------------------------------------------ modules
     def module(self, name: str) -> ModuleRT | None:
@@ -204,8 +222,16 @@ class Program:
         return m
 
     def _load_data(self, m: ModuleRT, data: N.DataList, all_global: bool) -> None:
-        """Declare and initialise a data list's variables in ``m`` (§2.5)."""
+        """Declare and initialise a data list's variables in ``m`` (§2.5). A declaration that
+        fails (unknown type, bad initialiser) is recorded in ``m.errors`` and skipped."""
         for item in data.items:
+            try:
+                self._load_item(m, data, item, all_global)
+            except KrlRuntimeError as exc:
+                m.errors.append(f"line {item.span.line}: {exc.message}")
+
+    def _load_item(self, m: ModuleRT, data: N.DataList, item, all_global: bool) -> None:
+        if True:
             is_glob = all_global or (data.public and getattr(item, "is_global", False))
             if isinstance(item, N.StrucDecl):
                 st = T.Struc(item.name)
@@ -239,7 +265,7 @@ class Program:
             elif isinstance(item, N.ArrayInit):
                 ref = m.data.get(item.name.upper())
                 if ref is None:
-                    continue
+                    return
                 try:
                     from .memory import index_ref  # noqa: PLC0415
 
@@ -256,6 +282,8 @@ class Program:
                         self.globals[item.name.upper()] = ref
 
     def signal_ref(self, item: N.SignalDecl):
+        if item.start is None:   # `SIGNAL $NAME FALSE`: a signal permanently FALSE
+            return Slot({"V": False}, "V", T.BOOL, item.name, readonly=True)
         sv = self.rt.sysvars.lookup(item.start.sysvar.upper())
         if sv is None:
             return None
@@ -266,11 +294,47 @@ class Program:
         return SignalRef(arr, item.start.index, end, item.name)
 
     # ------------------------------------------------------------------ types and literals
+    def scan_types(self) -> None:
+        """Register the GLOBAL STRUC/ENUM types of every data list of the workspace (once):
+        all types first, then the structure components (types may refer to each other)."""
+        if getattr(self, "_types_scanned", False):
+            return
+        self._types_scanned = True
+        pending = []
+        for name, files in list(self.index.items()):
+            dat = files.get("dat")
+            if dat is None:
+                continue
+            mod, _ = parse_module(str(dat))
+            if mod.data is None:
+                continue
+            for item in mod.data.items:
+                if isinstance(item, N.StrucDecl) and item.is_global:
+                    if item.name.upper() not in self.types.types:
+                        st = T.Struc(item.name)
+                        self.types.types[item.name.upper()] = st
+                        pending.append((st, item))
+                elif isinstance(item, N.EnumDecl) and item.is_global:
+                    self.types.types.setdefault(item.name.upper(), T.Enum(
+                        item.name, frozenset(v.upper() for v in item.values)))
+        for st, item in pending:
+            fill_struc(self.types, st, [(c.type_name, c.name, tuple(c.dims)) for c in item.components])
+
     def resolve_type(self, tref, scope: Scope):
         name = tref.name if isinstance(tref, N.TypeRef) else str(tref)
         t = scope.lookup_type(name)
         if t is None:
-            raise KrlRuntimeError(f"unknown type {name}")
+            self.scan_types()
+            t = scope.lookup_type(name)
+        if t is None:
+            if not self.backup:
+                raise KrlRuntimeError(f"unknown type {name}")
+            # a type of the controller's system data lists that the backup does not hold
+            # (e.g. ESYS of $operate.dat): untyped, logged once
+            if name.upper() not in self.stubs:
+                self.stubs.add(name.upper())
+                self.rt.message(f"not simulated: type {name} (undeclared; values are untyped)")
+            t = T.UNKNOWN
         size = tref.size if isinstance(tref, N.TypeRef) else None
         if size:
             t = T.Array(t, (size,))

@@ -113,9 +113,8 @@ class Scheduler:
                     robot.pending_triggers.append(ev)
                 elif k == "error":
                     robot.pending_error = ev.error
-        for task in self.tasks:
-            if not task.done and task.glet is not None and not task.glet.dead:
-                task.glet = None  # abandoned: never resumed again
+        # tasks still suspended are abandoned: never resumed; they stay referenced until the
+        # runtime is dropped (the runtime has stopped tracing by then)
 
     def deadlocked(self) -> bool:
         rt = self.rt

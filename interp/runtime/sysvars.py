@@ -21,7 +21,7 @@ from krl.semantics.builtins import load_builtins
 from krl.semantics.symbols import make_array, system_scopes
 
 from .errors import KrlRuntimeError, value_invalid
-from .memory import ComputedRef, Slot
+from .memory import AutoSlot, ComputedRef, Slot
 from .values import UNSET, EnumValue, Struct, make_value
 
 
@@ -144,6 +144,23 @@ class SysVars:
         s["$CMD"] = 1
         s["$FCT_CALL"] = 2
         s["$FILTER"] = 0
+        s["$KINCLASS"] = EnumValue("STANDARD")
+        for k in ("$PRO_MODE", "$PRO_MODE0", "$PRO_MODE1"):
+            s[k] = EnumValue("GO")
+        s["$DEF_FLT_PTP"] = 16        # machine data (filter lengths), boot values
+        s["$DEF_FLT_CP"] = 16
+        s["$ACT_GROUP"] = 1
+        s["$OV_PRO"] = 100
+        s["$PAL_MODE"] = False
+        s["$SINGUL_POS"].data[:] = [0, 0, 0]
+        s["$ORI_CHECK"] = 0
+        s["$CP_VEL_TYPE"] = 0
+        s["$SPL_VEL_MODE"] = 0
+        s["$TOOL_DIRECTION"] = 0
+        s["$EMSTOP_TIME"] = 0
+        s["$CONF_MESS"] = False
+        s["$EXT_START"] = False
+        s["$CHCK_MOVENA"] = False
         s["$EX_AX_IGNORE"] = 0
         s["$H_POS"] = axis_struct(m.home_deg)
         for i in range(5):
@@ -166,6 +183,19 @@ class SysVars:
             on_write = self._on_write.get(name)
             ref = Slot(self.store, name, t, name, readonly=info.access == "RO", on_write=on_write)
         self.refs[name] = ref
+        return ref
+
+    def auto(self, name: str):
+        """Policy for a system variable that neither the table nor a data list of the
+        backup declares (e.g. ``$LOAD_A1`` of operate_r1.dat): created on first use as an
+        untyped variable, logged once as a ``message`` event; a part never written reads
+        as 0 (machine data such as ``$TORQMON_DEF[i]`` that the backup lacks)."""
+        ref = self.refs.get(name)
+        if ref is None:
+            self.store[name] = Struct(None, {})
+            ref = AutoSlot(self.store, name, None, name)
+            self.refs[name] = ref
+            self.rt.message(f"not simulated: system variable {name} (undeclared; created on first use)")
         return ref
 
     def stops(self, name: str) -> tuple[bool, bool]:

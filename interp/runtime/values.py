@@ -35,6 +35,19 @@ class _Unset:
 UNSET = _Unset()
 
 
+class _Neutral:
+    """The value of undeclared machine data (see ``sysvars.SysVars.auto``): 0 where a number
+    is needed, FALSE where a BOOL is needed."""
+
+    __slots__ = ()
+
+    def __repr__(self) -> str:
+        return "NEUTRAL"
+
+
+NEUTRAL = _Neutral()
+
+
 class EnumValue:
     """``#NAME``: an enum value (name upper-case; ``type`` the Enum type if known)."""
 

@@ -1,0 +1,166 @@
+"""Run the programs of the KRC backups in ../shared/krl-corpus and report how they end
+(issue 6, "Real programs").
+
+A *backup* is a folder with ``R1/System`` (or a flat export with ``System/$config.dat``); its
+*programs* are the ``.src`` files under its Program folders (and ``cell.src``) whose main
+routine takes no parameters. Each runs on the tree interpreter with the backup's own
+System folder (BASIS, ``$config.dat``), no stimuli, ``--max-sim-time`` 60 s and 300 000
+steps. Outcomes:
+
+* ``completed``;
+* a *legitimate stop*: ``deadlock`` (a WAIT FOR on an input no stimulus sets), ``halt``,
+  ``max_sim_time``/``max_steps`` (cell programs loop forever waiting for a program number);
+* ``error``: grouped by message (numbers and names normalised), each either a true program
+  error (e.g. a target the KR 6 R900 cannot reach) or a simulator limitation.
+
+Routines of technology packages absent from the backup are stubbed (a ``message`` event
+"stub: NAME"), and the report lists the stubs.
+
+Usage: ``python -m interp.realprograms [CORPUS] [--json OUT] [--limit N]``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import re
+import sys
+import time
+from collections import Counter
+from pathlib import Path
+
+DEFAULT_CORPUS = Path(__file__).resolve().parents[2] / "shared" / "krl-corpus"
+LEGITIMATE = ("deadlock", "halt", "max_sim_time", "max_steps")
+
+
+def find_backups(corpus: Path) -> list[Path]:
+    """Backup roots (the folder holding R1, or a flat export's folder)."""
+    out = []
+    for sysdir in sorted(corpus.rglob("System")):
+        if not sysdir.is_dir():
+            continue
+        if not any(p.name.upper() == "$CONFIG.DAT" for p in sysdir.iterdir()):
+            continue
+        root = sysdir.parent
+        out.append(root)
+    return out
+
+
+def programs_of(root: Path) -> list[Path]:
+    from interp.runtime.program import parse_module  # noqa: PLC0415
+
+    cands = []
+    for p in sorted(root.rglob("*")):
+        if p.suffix.lower() != ".src" or not p.is_file():
+            continue
+        parts = [x.upper() for x in p.relative_to(root).parts]
+        if "SYSTEM" in parts or "TP" in parts or "MADA" in parts:
+            continue
+        if "PROGRAM" in parts or p.stem.upper() == "CELL" or p.parent == root:
+            cands.append(p)
+    out = []
+    for p in cands:
+        mod, errs = parse_module(str(p))
+        if mod.routines and not mod.routines[0].params and mod.routines[0].kind == "DEF":
+            out.append(p)
+    return out
+
+
+def normalise(text: str) -> str:
+    t = re.sub(r"-?\d+(\.\d+)?", "N", text or "")
+    t = re.sub(r"/\S+", "PATH", t)
+    return t[:90]
+
+
+def submit_of(path: Path) -> list[Path]:
+    """The backup's SPS.SUB (R1/SPS.SUB or System/sps.sub): started beside the program as
+    the controller does at boot (reference §9)."""
+    from interp.runtime.program import find_backup_root  # noqa: PLC0415
+
+    found = find_backup_root(path.resolve())
+    if found is None:
+        return []
+    ws, sysdir = found
+    for d in (ws, sysdir):
+        for p in d.iterdir():
+            if p.name.upper() == "SPS.SUB":
+                return [p]
+    return []
+
+
+def run_one(path: Path, max_sim_time: float, max_steps: int) -> dict:
+    from interp.run import make_runtime  # noqa: PLC0415
+    from robot.trace import TraceWriter  # noqa: PLC0415
+
+    t0 = time.time()
+    tw = TraceWriter(keep=False)
+    try:
+        rt, _ = make_runtime(path, trace=None, mujoco=False, max_sim_time=max_sim_time, max_steps=max_steps,
+                             submit=submit_of(path))
+        res = rt.run()
+        stubs = sorted(rt.program.stubs)
+    except Exception as exc:  # noqa: BLE001 - an internal error is a bug to report
+        return {"program": str(path), "reason": "internal", "text": f"{type(exc).__name__}: {exc}",
+                "seconds": round(time.time() - t0, 2)}
+    del tw
+    return {"program": str(path), "reason": res.reason, "text": res.text,
+            "number": res.error.number if res.error is not None else None,
+            "file": res.file, "line": res.line, "sim_time": round(res.sim_time, 3),
+            "steps": res.steps, "stubs": stubs, "seconds": round(time.time() - t0, 2)}
+
+
+def report(rows: list[dict]) -> str:
+    n = len(rows)
+    by = Counter(r["reason"] for r in rows)
+    ok = by["completed"]
+    legit = sum(by[k] for k in LEGITIMATE)
+    waits = sum(1 for r in rows if r["reason"] in ("max_sim_time", "max_steps") and "waits: WAIT FOR" in r["text"])
+    lines = [f"{n} programs: {ok} completed, {legit} legitimate stops "
+             f"({', '.join(f'{k} {by[k]}' for k in LEGITIMATE if by[k])}), "
+             f"{by['error']} errors, {by['internal']} internal errors",
+             f"  ({waits} of the limit stops wait in WAIT FOR for an input that no stimulus sets; "
+             f"the others loop, e.g. re-issuing a message while the cell inputs are absent)", ""]
+    errs = Counter(normalise(r["text"]) for r in rows if r["reason"] in ("error", "internal"))
+    if errs:
+        lines.append("Failures by message:")
+        for msg, c in errs.most_common():
+            lines.append(f"  {c:4d}  {msg}")
+    stubs = Counter(s for r in rows for s in r.get("stubs", []))
+    if stubs:
+        lines.append("")
+        lines.append("Stubs (routines of absent technology packages; types of absent system data lists): " +
+                     ", ".join(f"{s} ({c})" for s, c in stubs.most_common()))
+    return "\n".join(lines)
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("corpus", nargs="?", default=str(DEFAULT_CORPUS))
+    ap.add_argument("--json", default=None, help="write one JSON object per program")
+    ap.add_argument("--limit", type=int, default=0)
+    ap.add_argument("--max-sim-time", type=float, default=60.0)
+    ap.add_argument("--max-steps", type=int, default=300_000)
+    a = ap.parse_args(argv)
+    corpus = Path(a.corpus)
+    if not corpus.is_dir():
+        print(f"no corpus at {corpus}; nothing to do")
+        return 0
+    rows = []
+    for root in find_backups(corpus):
+        for p in programs_of(root):
+            rows.append(run_one(p, a.max_sim_time, a.max_steps))
+            r = rows[-1]
+            print(f"{r['reason']:13s} {r.get('seconds', 0):6.1f}s {p.relative_to(corpus)}  {r['text'][:80]}",
+                  file=sys.stderr)
+            if a.limit and len(rows) >= a.limit:
+                break
+    if a.json:
+        with open(a.json, "w", encoding="utf-8") as fh:
+            for r in rows:
+                fh.write(json.dumps(r) + "\n")
+    print(report(rows))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,603 @@
+"""The bytecode compiler: a routine's AST -> readable assembly text (interp/vm/assembler.py).
+
+It mirrors the tree interpreter statement by statement (interp/tree/interpreter.py), so
+that the VM makes the same runtime calls in the same order; only the stepping differs:
+
+* names are resolved at compile time to *frame slots* (parameters and locals, in
+  ``.locals`` order), *module slots* (the data list of the routine's module) and *global
+  slots* (globals, system variables; bound on first use, as the runtime resolver would);
+* structured statements become jumps; GOTO jumps to the label of the nearest enclosing
+  block that holds it (the tree interpreter's rule), EXIT to the end of the innermost loop;
+* constant operands are folded with the runtime's own operator (Runtime.binary_op /
+  unary_op); an expression whose folding raises is left for run time;
+* conditions that are evaluated later (WAIT FOR, interrupt conditions and handlers,
+  TRIGGER actions) are compiled as *thunks* after the routine's END;
+* each statement gets its StmtInfo (advance-run stop flags) from Runtime.stmt_info, the
+  same analysis the tree interpreter uses, and an error region (``.at``) that places
+  run-time errors on the line the tree interpreter would name.
+"""
+
+from __future__ import annotations
+
+from krl.ast import nodes as N
+
+from interp.runtime.errors import KrlRuntimeError
+from interp.runtime.memory import Frame
+from interp.runtime.values import EnumValue
+
+from .assembler import Listing, Region, format_listing
+
+
+def name_of(e) -> str:
+    """The name of an lvalue for messages (as the tree interpreter's ``_name_of``)."""
+    if isinstance(e, N.Name):
+        return e.name
+    if isinstance(e, N.Index):
+        return name_of(e.base) + "[..]"
+    if isinstance(e, N.Field):
+        return name_of(e.base) + "." + e.name
+    return "?"
+
+
+_FAST_BINOPS = {"+": "ADD", "-": "SUB", "*": "MUL", "<": "LT", "==": "EQ"}
+_FOLDABLE = (int, float, bool, str, EnumValue)
+
+
+def local_names(routine: N.Routine) -> list[str]:
+    """Frame slots of a routine: its parameters, then its variables (declaration order)."""
+    out = []
+    seen = set()
+    for p in routine.params:
+        if p.name.upper() not in seen:
+            seen.add(p.name.upper())
+            out.append(p.name)
+    for d in routine.decls:
+        if isinstance(d, N.VarDecl):
+            for vn in d.names:
+                if vn.name.upper() not in seen:
+                    seen.add(vn.name.upper())
+                    out.append(vn.name)
+    return out
+
+
+def static_frame(rt, module, routine) -> Frame:
+    """A frame with the routine's names bound (for the advance-run analysis when the
+    routine is compiled without being called, e.g. by `krl asm`)."""
+    f = Frame(routine, module, None)
+    for n in local_names(routine):
+        f.vars[n.upper()] = None
+    for d in routine.decls:
+        if isinstance(d, N.SignalDecl):
+            f.vars[d.name.upper()] = None
+    return f
+
+
+class Compiler:
+    def __init__(self, rt, module, routine: N.Routine, frame: Frame | None = None) -> None:
+        self.rt = rt
+        self.module = module
+        self.routine = routine
+        self.frame = frame if frame is not None else static_frame(rt, module, routine)
+        self.locals = local_names(routine)
+        self.local_set = {n.upper() for n in self.locals}
+        self.data = module.data if module is not None else {}
+        self.lst = Listing(routine.name, routine.kind, routine.span.file, self.locals, 0)
+        self.region: Region | None = None
+        self.nlabels = 0
+        self.blocks: list[dict] = []      # label tables of the enclosing statement lists
+        self.loops: list[str] = []        # exit labels of the enclosing loops
+        self.thunks: list = []            # (label, emitter) compiled after END
+
+    # ------------------------------------------------------------------ emitting
+    def emit(self, name: str, *ops) -> None:
+        self.lst.instrs.append((name, list(ops), self.region))
+
+    def new_label(self) -> str:
+        self.nlabels += 1
+        return f"_{self.nlabels}"
+
+    def place(self, label: str) -> None:
+        self.lst.labels[label] = len(self.lst.instrs)
+
+    def temp(self) -> int:
+        t = self.lst.ntemps
+        self.lst.ntemps += 1
+        return t
+
+    def info(self, st) -> tuple:
+        si = self.rt.stmt_info(st, self.frame)
+        return (si.line, ("S" if si.stops else "") + ("C" if si.cond_stops else ""))
+
+    def guarded(self, st) -> str:
+        """STMT_G and a guarded region up to the returned end label."""
+        self.region = None
+        self.emit("STMT_G", self.info(st))
+        end = self.new_label()
+        self.region = Region("G", st.span.line, end)
+        return end
+
+    def stmt(self, st) -> None:
+        self.region = None
+        self.emit("STMT", self.info(st))
+
+    # ------------------------------------------------------------------ routine
+    def compile(self) -> str:
+        self.block(self.routine.body)
+        self.region = None
+        self.emit("END")
+        while self.thunks:
+            label, fn = self.thunks.pop(0)
+            self.place(label)
+            fn()
+            self.emit("END_THUNK")
+        return format_listing(self.lst)
+
+    def thunk(self, fn) -> str:
+        label = self.new_label()
+        self.thunks.append((label, fn))
+        return label
+
+    def block(self, stmts: list) -> None:
+        labels = {s.name.upper(): self.new_label() for s in stmts if isinstance(s, N.Label)}
+        self.blocks.append(labels)
+        try:
+            for st in stmts:
+                fn = getattr(self, "s_" + type(st).__name__, None)
+                if fn is None:
+                    self.region = None
+                    self.emit("RAISE", f"{type(st).__name__} is not supported by this simulator", st.span.line)
+                else:
+                    fn(st)
+        finally:
+            self.blocks.pop()
+
+    # ------------------------------------------------------------------ statements
+    def s_Assign(self, st) -> None:
+        end = self.guarded(st)
+        self.expr(st.value)
+        self.store(st.target)
+        self.place(end)
+
+    def s_CallStmt(self, st) -> None:
+        end = self.guarded(st)
+        self.call(st.call, "S")
+        self.place(end)
+
+    def s_If(self, st) -> None:
+        end = self.guarded(st)
+        other = self.new_label()
+        self.expr(st.cond)
+        self.emit("JUMP_IF_FALSE", other)
+        self.block(st.then)
+        if st.orelse:
+            self.region = None
+            self.emit("JUMP", end)
+            self.place(other)
+            self.block(st.orelse)
+        else:
+            self.place(other)
+        self.place(end)
+
+    def s_Switch(self, st) -> None:
+        end = self.guarded(st)
+        t = self.temp()
+        self.expr(st.selector)
+        self.emit("STORE_TEMP", t)
+        self.region = None
+        bodies = []
+        for case in st.cases:
+            lab = self.new_label()
+            bodies.append((lab, case.body))
+            for ce in case.values:
+                self.emit("LOAD_TEMP", t)
+                self.expr(ce)
+                self.emit("EQ")
+                self.emit("JUMP_IF_TRUE", lab)
+        if st.default is not None:
+            self.block(st.default)
+        self.region = None
+        self.emit("JUMP", end)
+        for lab, body in bodies:
+            self.place(lab)
+            self.block(body)
+            self.region = None
+            self.emit("JUMP", end)
+        self.place(end)
+
+    def s_For(self, st) -> None:
+        info = self.info(st)
+        self.stmt(st)
+        t = self.temp()
+        self.temp()
+        self.temp()
+        self.region = Region("A", st.span.line)
+        self.ref(st.var)
+        self.expr(st.start)
+        self.expr(st.end)
+        if st.step is not None:
+            self.expr(st.step)
+        else:
+            self.emit("CONST", 1)
+        self.emit("FOR_PREP", t)
+        self.region = None
+        self.emit("FOR_INIT", t)
+        test, end = self.new_label(), self.new_label()
+        self.place(test)
+        self.emit("FOR_TEST", t, end)
+        self.emit("TICK", info)
+        self.loop_body(st.body, end)
+        self.region = None
+        self.emit("FOR_NEXT", t, test)
+        self.place(end)
+
+    def loop_body(self, body, end) -> None:
+        self.loops.append(end)
+        try:
+            self.block(body)
+        finally:
+            self.loops.pop()
+
+    def s_While(self, st) -> None:
+        info = self.info(st)
+        self.stmt(st)
+        top, end = self.new_label(), self.new_label()
+        self.place(top)
+        self.emit("TICK", info)
+        self.region = Region("A", st.span.line)
+        self.expr(st.cond)
+        self.region = None
+        self.emit("JUMP_IF_FALSE", end)
+        self.loop_body(st.body, end)
+        self.region = None
+        self.emit("JUMP", top)
+        self.place(end)
+
+    def s_Repeat(self, st) -> None:
+        info = self.info(st)
+        self.stmt(st)
+        top, end = self.new_label(), self.new_label()
+        self.place(top)
+        self.loop_body(st.body, end)
+        self.region = None
+        self.emit("TICK", info)
+        self.region = Region("A", st.span.line)
+        self.expr(st.cond)
+        self.region = None
+        self.emit("JUMP_IF_FALSE", top)
+        self.place(end)
+
+    def s_Loop(self, st) -> None:
+        info = self.info(st)
+        self.stmt(st)
+        top, end = self.new_label(), self.new_label()
+        self.place(top)
+        self.emit("TICK", info)
+        self.loop_body(st.body, end)
+        self.region = None
+        self.emit("JUMP", top)
+        self.place(end)
+
+    def s_Exit(self, st) -> None:
+        self.stmt(st)
+        if self.loops:
+            self.emit("JUMP", self.loops[-1])
+        else:
+            self.emit("EXIT_SIGNAL")
+
+    def s_Goto(self, st) -> None:
+        self.stmt(st)
+        key = st.label.upper()
+        for labels in reversed(self.blocks):
+            if key in labels:
+                self.emit("JUMP", labels[key])
+                return
+        self.emit("GOTO_FAIL", key)
+
+    def s_Label(self, st) -> None:
+        self.place(self.blocks[-1][st.name.upper()])
+
+    def s_Halt(self, st) -> None:
+        self.stmt(st)
+        self.emit("HALT")
+
+    def s_WaitFor(self, st) -> None:
+        end = self.guarded(st)
+        region = self.region
+
+        def cond():
+            self.region = region
+            self.expr(st.cond)
+        self.emit("WAIT_FOR", self.thunk(cond))
+        self.place(end)
+
+    def s_WaitSec(self, st) -> None:
+        end = self.guarded(st)
+        self.expr(st.time)
+        self.emit("WAIT_SEC")
+        self.place(end)
+
+    def s_Continue(self, st) -> None:
+        self.stmt(st)
+        self.emit("CONTINUE", self.info(st))
+
+    def s_Return(self, st) -> None:
+        self.stmt(st)
+        if st.value is None:
+            self.emit("RETURN")
+            return
+        self.region = Region("A", st.span.line)
+        self.expr(st.value)
+        self.region = None
+        self.emit("RETURN_VAL")
+
+    def s_OnErrorProceed(self, st) -> None:
+        self.stmt(st)
+        self.emit("ON_ERROR_PROCEED")
+
+    def s_DeclStmt(self, st) -> None:
+        self.region = None
+        self.emit("RAISE", "declaration after the first statement", st.span.line)
+
+    def s_Unsupported(self, st) -> None:
+        self.region = None
+        self.emit("RAISE", f"unsupported statement: {st.text.strip()[:60]}", st.span.line)
+
+    def _unsupported(self, st) -> None:
+        self.stmt(st)
+        self.emit("RAISE", f"{type(st).__name__} is not supported by this simulator", st.span.line)
+
+    s_AninOn = s_AninOff = s_AnoutOn = s_AnoutOff = _unsupported
+
+    # interrupts, triggers, brake ------------------------------------------------------
+    def s_InterruptDecl(self, st) -> None:
+        end = self.guarded(st)
+        call = st.call
+
+        def cond():
+            self.region = None
+            self.expr(st.when)
+
+        if call.name.upper() in ("BRAKE", "BRAKE_F") and not call.args:
+            fast = "F" if call.name.upper() == "BRAKE_F" else ""
+
+            def handler():
+                self.region = None
+                self.emit("BRAKE", fast)
+        else:
+            def handler():
+                self.region = None
+                self.call(call, "SN")
+        lc, lh = self.thunk(cond), self.thunk(handler)
+        self.expr(st.prio)
+        self.emit("INT_DECL", lc, lh, call.name, "G" if st.is_global else "", st.span.line)
+        self.place(end)
+
+    def s_InterruptCtl(self, st) -> None:
+        end = self.guarded(st)
+        if st.prio is not None:
+            self.expr(st.prio)
+        self.emit("INT_CTL", st.action, "P" if st.prio is not None else "")
+        self.place(end)
+
+    def s_Brake(self, st) -> None:
+        self.stmt(st)
+        self.emit("BRAKE", "F" if st.fast else "")
+
+    def s_Resume(self, st) -> None:
+        self.stmt(st)
+        self.emit("RESUME")
+
+    def s_Trigger(self, st) -> None:
+        end = self.guarded(st)
+        act = st.action
+        region = self.region
+        if isinstance(act, N.CallStmt):
+            nf = self.new_label()
+            self.emit("TRIG_FIND", act.call.name, nf)
+            self.args(act.call)
+            self.emit("TRIG_PACK", len(act.call.args))
+            self.place(nf)
+            self.region = region
+        else:
+            self.emit("NONE")
+        info = self.info(act)
+
+        def action():
+            self.region = None
+            self.emit("STMT", info)
+            self.region = Region("A", act.span.line)
+            if isinstance(act, N.CallStmt):
+                slow, done = self.new_label(), self.new_label()
+                self.emit("JUMP_IF_NONE", slow)
+                self.emit("TRIG_INVOKE")
+                self.emit("JUMP", done)
+                self.place(slow)
+                self.call(act.call, "S")
+                self.place(done)
+            else:
+                self.emit("POP")
+                self.expr(act.value)
+                self.store(act.target)
+        self.expr(st.at)
+        self.expr(st.delay)
+        if st.prio is not None:
+            self.expr(st.prio)
+        flags = ("O" if st.onstart else "") + ("P" if st.prio is not None else "")
+        self.emit("TRIGGER", st.kind, flags, st.span.line, self.thunk(action))
+        self.place(end)
+
+    # motion ---------------------------------------------------------------------------
+    def with_pairs(self, with_) -> None:
+        for w in with_:
+            self.ref(w.target)
+            self.expr(w.value)
+
+    def s_Motion(self, st) -> None:
+        end = self.guarded(st)
+        self.expr(st.target)
+        flags = ""
+        if st.aux is not None:
+            self.expr(st.aux)
+            flags += "A"
+        if st.ca is not None:
+            self.expr(st.ca)
+            flags += "C"
+        self.with_pairs(st.with_)
+        self.emit("MOTION", st.kind, ",".join(st.approx), st.frame, flags, len(st.with_), st.span.line)
+        self.place(end)
+
+    def s_SplineBlock(self, st) -> None:
+        end = self.guarded(st)
+        region = self.region
+        t = self.temp()
+        self.emit("SPL_BEGIN", t)
+        for s in st.body:
+            if isinstance(s, N.Trigger):
+                self.emit("SPL_TRIG_BEGIN", t)
+                self.s_Trigger(s)
+                self.region = region
+                self.emit("SPL_TRIG_END", t)
+            elif isinstance(s, N.Motion):
+                self.expr(s.target)
+                flags = ""
+                if s.aux is not None:
+                    self.expr(s.aux)
+                    flags += "A"
+                if s.ca is not None:
+                    self.expr(s.ca)
+                    flags += "C"
+                self.with_pairs(s.with_)
+                self.emit("SPL_SEG", s.kind, flags, len(s.with_), s.span.line, t)
+        self.with_pairs(st.with_)
+        self.emit("SPLINE", st.kind, st.approx, len(st.with_), st.span.line, t)
+        self.place(end)
+
+    # ------------------------------------------------------------------ calls
+    def args(self, call: N.Call) -> None:
+        for a in call.args:
+            if a is None:
+                self.emit("NONE")
+            elif isinstance(a, (N.Name, N.Index, N.Field)):
+                self.ref(a)
+            else:
+                self.expr(a)
+                self.emit("VALARG")
+
+    def call(self, call: N.Call, flags: str) -> None:
+        self.args(call)
+        self.emit("CALL", call.name, len(call.args), flags)
+
+    # ------------------------------------------------------------------ names
+    def kind_of(self, name: str) -> str:
+        key = name.upper()
+        if key in self.local_set:
+            return "LOCAL"
+        if key in self.data:
+            return "MOD"
+        return "GLOBAL"
+
+    def ref(self, e) -> None:
+        if isinstance(e, N.Name):
+            self.emit("REF_" + self.kind_of(e.name), e.name)
+        elif isinstance(e, N.Index):
+            self.ref(e.base)
+            self.indices(e)
+            self.emit("INDEX", len(e.indices), name_of(e.base))
+        elif isinstance(e, N.Field):
+            self.ref(e.base)
+            self.emit("FIELD", e.name, name_of(e.base))
+        else:
+            self.emit("RAISE", "not a variable", 0)
+
+    def indices(self, e: N.Index) -> None:
+        for i in e.indices:
+            if i is None:
+                self.emit("NONE")
+            else:
+                self.expr(i)
+
+    def store(self, target) -> None:
+        if isinstance(target, N.Name):
+            self.emit("STORE_" + self.kind_of(target.name), target.name)
+        else:
+            self.ref(target)
+            self.emit("ASSIGN")
+
+    # ------------------------------------------------------------------ expressions
+    def fold(self, e):
+        """(True, value) if ``e`` is a constant the runtime's operators can fold."""
+        if isinstance(e, (N.IntLit, N.RealLit, N.BoolLit, N.StrLit)):
+            return True, e.value
+        if isinstance(e, N.EnumLit):
+            return True, EnumValue(e.name)
+        try:
+            if isinstance(e, N.Unary):
+                ok, a = self.fold(e.operand)
+                if ok:
+                    v = self.rt.unary_op(e.op, a)
+                    return isinstance(v, _FOLDABLE), v
+            elif isinstance(e, N.Binary) and e.op != ":":
+                ok, a = self.fold(e.left)
+                if ok:
+                    ok, b = self.fold(e.right)
+                    if ok:
+                        v = self.rt.binary_op(e.op, a, b)
+                        return isinstance(v, _FOLDABLE), v
+        except KrlRuntimeError:
+            pass
+        return False, None
+
+    def expr(self, e) -> None:
+        if isinstance(e, (N.Unary, N.Binary)):
+            ok, v = self.fold(e)
+            if ok:
+                self.emit("CONST", v)
+                return
+        if isinstance(e, (N.IntLit, N.RealLit, N.BoolLit, N.StrLit)):
+            self.emit("CONST", e.value)
+        elif isinstance(e, N.EnumLit):
+            self.emit("CONST", EnumValue(e.name))
+        elif isinstance(e, N.Name):
+            self.emit("LOAD_" + self.kind_of(e.name), e.name)
+        elif isinstance(e, N.Index):
+            self.ref(e.base)
+            self.indices(e)
+            self.emit("LOAD_INDEX", len(e.indices), name_of(e.base))
+        elif isinstance(e, N.Field):
+            self.ref(e.base)
+            self.emit("LOAD_FIELD", e.name, name_of(e.base))
+        elif isinstance(e, N.Call):
+            self.call(e, "E")
+        elif isinstance(e, N.Unary):
+            self.expr(e.operand)
+            self.emit("UNOP", e.op)
+        elif isinstance(e, N.Binary):
+            self.expr(e.left)
+            self.expr(e.right)
+            fast = _FAST_BINOPS.get(e.op)
+            if fast is not None:
+                self.emit(fast)
+            else:
+                self.emit("BINOP", e.op)
+        elif isinstance(e, N.Aggregate):
+            for it in e.items:
+                self.expr(it.value)
+            self.emit("AGG", e.type_name, ",".join(it.name.upper() for it in e.items))
+        else:
+            self.emit("RAISE", f"cannot evaluate {type(e).__name__}", 0)
+
+
+def compile_routine(rt, module, routine: N.Routine, frame: Frame | None = None) -> str:
+    """The assembly text of ``routine`` (of ``module``, a runtime ModuleRT)."""
+    return Compiler(rt, module, routine, frame).compile()
+
+
+def compile_module(rt, module) -> str:
+    """The assembly text of every routine of ``module``, main routine first."""
+    parts = []
+    seen = set()
+    for r in module.routines.values():
+        if id(r) not in seen:
+            seen.add(id(r))
+            parts.append(compile_routine(rt, module, r))
+    return "\n".join(parts)

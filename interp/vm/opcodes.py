@@ -1,0 +1,134 @@
+"""THE opcode table of the KRL VM (one source of truth, like CPython's ``opcode`` module).
+
+Each opcode is defined once, here: its name, number, stack effect and operand kinds. The
+compiler writes instructions by name, the assembler encodes them from this table, the
+disassembler decodes them with it, and the VM dispatches on the numbers bound below.
+
+Operand kinds (how an operand is written in the assembly text / stored in the code):
+
+====  ==========================================  =====================================
+kind  text                                        code
+====  ==========================================  =====================================
+i     an integer                                  the integer
+c     a literal: 12, -3, 2.5, "text", TRUE,       index into the constant pool
+      #ENUM_VALUE, NONE
+n     a name or word (``X``, ``$OV_PRO``, ``+``,  index into the constant pool (a str)
+      ``C_DIS,C_PTP``; JSON-quoted if it is not
+      a plain word)
+l     a label ``L3``                              the instruction address
+s     a local (frame slot) by name                the slot number (``.locals`` order)
+m     a module (data list) variable by name       index into the code's module slots
+g     a global / system variable by name          index into the code's global slots
+t     a temporary slot number                     the number
+f     a flag word (``-`` = none)                  index into the constant pool (a str)
+x     a statement: ``LINE`` or ``LINE/FLAGS``      index into the code's statement table
+      (S: stops the advance run, C: its loop      (advance.StmtInfo objects)
+      condition stops it)
+====  ==========================================  =====================================
+
+Stack effect: the net change of the operand-stack depth; ``None`` where it depends on an
+operand (documented per opcode).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+
+@dataclass(frozen=True, slots=True)
+class OpInfo:
+    name: str
+    number: int
+    effect: int | None
+    operands: str            # operand kinds, one letter each
+    doc: str
+
+
+_TABLE = [
+    # name            effect operands doc
+    # -- statements and lines
+    ("STMT",          0,  "x", "statement boundary: Runtime.before_statement (trace, limits, interrupts, advance-run stop)"),
+    ("STMT_G",        0,  "x",  "STMT of a guarded statement: also takes the ON_ERROR_PROCEED flag"),
+    ("TICK",          0,  "x",  "one loop iteration: Runtime.loop_tick"),
+    # -- values
+    ("CONST",         1,  "c",  "push a constant"),
+    ("NONE",          1,  "",   "push None (an omitted index or argument)"),
+    ("POP",          -1,  "",   "drop the top of the stack"),
+    ("LOAD_LOCAL",    1,  "s",  "push the value of a frame slot (aggregates are copied)"),
+    ("LOAD_MOD",      1,  "m",  "push the value of a module slot"),
+    ("LOAD_GLOBAL",   1,  "g",  "push the value of a global slot (resolved on first use)"),
+    ("REF_LOCAL",     1,  "s",  "push the reference of a frame slot"),
+    ("REF_MOD",       1,  "m",  "push the reference of a module slot"),
+    ("REF_GLOBAL",    1,  "g",  "push the reference of a global slot"),
+    ("INDEX",      None,  "in", "pop i indices and a reference, push the element reference (effect -i); n: name for messages"),
+    ("FIELD",         0,  "nn", "replace a reference by its component reference; n: component, n: name for messages"),
+    ("LOAD_INDEX", None,  "in", "INDEX, then the element's value (effect -i)"),
+    ("LOAD_FIELD",    0,  "nn", "FIELD, then the component's value"),
+    ("DEREF",         0,  "",   "replace a reference by its value"),
+    ("ASSIGN",       -2,  "",   "pop a reference and a value: Runtime.assign"),
+    ("STORE_LOCAL",  -1,  "s",  "pop a value into a frame slot (Runtime.assign)"),
+    ("STORE_MOD",    -1,  "m",  "pop a value into a module slot"),
+    ("STORE_GLOBAL", -1,  "g",  "pop a value into a global slot"),
+    ("LOAD_TEMP",     1,  "t",  "push a temporary"),
+    ("STORE_TEMP",   -1,  "t",  "pop into a temporary"),
+    ("VALARG",        0,  "",   "wrap a value as an :IN argument (ValueRef)"),
+    ("AGG",        None,  "nn", "pop k values, push an aggregate; n: type name or -, n: component names (effect 1-k)"),
+    # -- operators
+    ("BINOP",        -1,  "n",  "Runtime.binary_op"),
+    ("UNOP",          0,  "n",  "Runtime.unary_op"),
+    ("ADD",          -1,  "",   "binary +  (Runtime fast path, same meaning as BINOP +)"),
+    ("SUB",          -1,  "",   "binary -"),
+    ("MUL",          -1,  "",   "binary *"),
+    ("LT",           -1,  "",   "binary <"),
+    ("EQ",           -1,  "",   "binary =="),
+    # -- jumps
+    ("JUMP",          0,  "l",  "jump"),
+    ("JUMP_IF_FALSE",-1,  "l",  "pop a condition (Runtime.to_bool); jump if FALSE"),
+    ("JUMP_IF_TRUE", -1,  "l",  "pop a condition; jump if TRUE"),
+    ("JUMP_IF_NONE",  0,  "l",  "if the top is None: pop it and jump"),
+    ("FOR_PREP",     -3,  "t",  "pop step, end, start and the counter reference into temps t..t+2, push start"),
+    ("FOR_INIT",     -1,  "t",  "pop start: assign it to the counter"),
+    ("FOR_TEST",      0,  "tl", "jump when the counter is past the end"),
+    ("FOR_NEXT",      0,  "tl", "counter = counter + step; jump"),
+    # -- calls
+    ("CALL",       None,  "nif","pop i arguments, call routine n (effect -i, +1 for a function call); f: S statement, E expression, N no RESUME catch"),
+    ("RETURN",        0,  "",   "return from the routine (no value)"),
+    ("RETURN_VAL",   -1,  "",   "return the top of the stack"),
+    ("END",           0,  "",   "end of the routine body"),
+    ("END_THUNK",     0,  "",   "end of a thunk (condition, handler, trigger action): return the top or None"),
+    # -- statements with runtime calls
+    ("HALT",          0,  "",   "Runtime.halt"),
+    ("WAIT_FOR",      0,  "l",  "Runtime.wait_for with the condition thunk at l"),
+    ("WAIT_SEC",     -1,  "",   "Runtime.wait_sec"),
+    ("CONTINUE",      0,  "x",  "Runtime.set_continue"),
+    ("ON_ERROR_PROCEED", 0, "", "Runtime.on_error_proceed"),
+    ("EXIT_SIGNAL",   0,  "",   "EXIT outside a loop: raise ExitSignal"),
+    ("GOTO_FAIL",     0,  "n",  "GOTO to a label that is not in an enclosing block"),
+    ("RAISE",         0,  "ni", "raise a run-time error n at line i"),
+    ("INT_DECL",     -1,  "llnfi", "pop the number: Runtime.interrupt_decl(cond thunk, handler thunk, name, GLOBAL?, line)"),
+    ("INT_CTL",    None,  "nf", "Runtime.interrupt_ctl(action[, popped number]); f: P if a number is given"),
+    ("BRAKE",         0,  "f",  "Runtime.brake (f: F for BRAKE F)"),
+    ("RESUME",        0,  "",   "Runtime.resume"),
+    ("TRIG_FIND",     1,  "nl", "push the routine target of a TRIGGER action call, or None and jump"),
+    ("TRIG_PACK",  None,  "i",  "pop i arguments and the target, push the packed call (effect -i)"),
+    ("TRIGGER",    None,  "nffil", "pop [prio,] delay, at and the packed call: Runtime.trigger; f: kind, f: O onstart / P prio; i: line; l: action thunk"),
+    ("TRIG_INVOKE",  -1,  "",   "in an action thunk: invoke the packed call"),
+    ("MOTION",     None,  "nnnfii", "pop [with pairs,] [ca,] [aux,] target: Runtime.motion; n kind, n approx, n frame, f A/C, i #with, i line"),
+    ("SPL_BEGIN",     0,  "t",  "start collecting spline segments in temp t"),
+    ("SPL_TRIG_BEGIN",0,  "t",  "a TRIGGER inside a SPLINE block: set the trigger list aside"),
+    ("SPL_TRIG_END",  0,  "t",  "collect the TRIGGER's entry for the next segment"),
+    ("SPL_SEG",    None,  "nfiit", "pop a segment (target, aux?, ca?, with pairs) into temp t; n kind, f A/C, i #with, i line"),
+    ("SPLINE",     None,  "nniit", "pop the block's with pairs: Runtime.spline; n kind, n approx, i #with, i line"),
+]
+
+OPS: list[OpInfo] = [OpInfo(name, i, eff, ops, doc) for i, (name, eff, ops, doc) in enumerate(_TABLE)]
+BY_NAME: dict[str, OpInfo] = {o.name: o for o in OPS}
+OPERAND_KINDS = "icnlsmgtfx"
+
+# bind the numbers as module constants (STMT, CONST, ...) for the compiler and the VM
+globals().update({o.name: o.number for o in OPS})
+
+
+def size(op: int) -> int:
+    """Length of an instruction in code words (the opcode and its operands)."""
+    return 1 + len(OPS[op].operands)
