@@ -344,8 +344,9 @@ def check_texts(files: dict[str, str]) -> Workspace:
 
 def workspaces_for(path: str | Path) -> list[Workspace]:
     """The workspaces to check for a command-line PATH: a file -> itself with the .dat/.src
-    of its module; a folder holding backups -> one workspace per backup; another folder ->
-    one workspace of all its files."""
+    of its module; a folder holding backups -> one workspace per backup, plus one per
+    top-level subfolder for the files outside the backups; another folder -> one
+    workspace of all its files."""
     p = Path(path)
     if p.is_file():
         files = [p]
@@ -356,5 +357,15 @@ def workspaces_for(path: str | Path) -> list[Workspace]:
     if p.is_dir():
         backups = find_backups(p)
         if backups:
-            return [load_workspace([b], str(b)) for b in backups]
+            out = [load_workspace([b], str(b)) for b in backups]
+            # files outside every backup: one workspace per top-level folder of `path`
+            rest: dict[str, list[Path]] = {}
+            for f in collect_files(p):
+                if any(b == f or b in f.parents for b in backups):
+                    continue
+                rel = f.relative_to(p)
+                key = str(p / rel.parts[0]) if len(rel.parts) > 1 else str(p)
+                rest.setdefault(key, []).append(f)
+            out += [load_workspace(files, key) for key, files in sorted(rest.items())]
+            return out
     return [load_workspace([p], str(p))]

@@ -73,3 +73,12 @@ def test_report_on_small_backup(tmp_path):
     assert data["total"]["files"] == 4 and data["total"]["files_clean"] == 4
     assert json.loads((tmp_path / "out" / "check_report.json").read_text())["total"]["errors"] == 0
     assert "| backup |" in md
+
+
+def test_folder_with_backups_and_loose_files(tmp_path):
+    make_backup(tmp_path / "a")
+    (tmp_path / "loose").mkdir()
+    (tmp_path / "loose" / "x.src").write_text("DEF x()\nEND\n")
+    (tmp_path / "top.src").write_text("DEF top()\nEND\n")
+    roots = sorted(ws.root for ws in workspaces_for(tmp_path))
+    assert roots == sorted([str(tmp_path / "a" / "KRC"), str(tmp_path / "loose"), str(tmp_path)])
