@@ -10,8 +10,9 @@ from interp.runtime.core import RunResult, Runtime
 
 def make_runtime(program, *, workspace=None, inputs=None, trace=None, max_sim_time=None,
                  max_steps=None, submit=None, mujoco: bool = True, controller=None,
-                 robot_budget=None) -> tuple[Runtime, object]:
-    """Build the runtime and the tree interpreter for ``program`` (not started yet)."""
+                 robot_budget=None, interp: str = "tree") -> tuple[Runtime, object]:
+    """Build the runtime and the interpreter (``interp``: tree or vm) for ``program``
+    (not started yet)."""
     from interp.tree import TreeInterpreter  # noqa: PLC0415
 
     if controller is None:
@@ -20,7 +21,12 @@ def make_runtime(program, *, workspace=None, inputs=None, trace=None, max_sim_ti
         controller = Controller(trace=trace, stimuli=str(inputs) if inputs else None, mujoco=mujoco)
     rt = Runtime(program, workspace=workspace, controller=controller, trace=trace,
                  max_sim_time=max_sim_time, max_steps=max_steps, robot_budget=robot_budget)
-    interp = TreeInterpreter(rt)
+    if interp == "vm":
+        from interp.vm import VM  # noqa: PLC0415
+
+        interp = VM(rt)
+    else:
+        interp = TreeInterpreter(rt)
     rt.add_task("robot", Path(program).stem, lambda: interp.run_program())
     for sub in submit or ():
         sp = Path(sub).resolve()

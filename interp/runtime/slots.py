@@ -107,11 +107,11 @@ def eq(a, b):
 
 
 # ------------------------------------------------------------------ TRIGGER arguments
-def trigger_args(kind: str, at, delay, prio) -> dict:
+def trigger_args(kind: str, at, delay, prio, onstart: bool = False) -> dict:
     """Keyword arguments of Runtime.trigger from the evaluated TRIGGER operands."""
     at = num(at)
     delay = num(delay)
     p = int(num(prio)) if prio is not None else None
     if kind == "PATH":
-        return {"path": float(at), "delay_ms": delay, "prio": p}
+        return {"path": float(at), "onstart": onstart, "delay_ms": delay, "prio": p}
     return {"distance": int(at), "delay_ms": delay, "prio": p}

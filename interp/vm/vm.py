@@ -1,0 +1,489 @@
+"""The VM: runs assembled code (interp/vm/assembler.py) on the shared runtime.
+
+One dispatch loop (:meth:`VM.run`) with the instruction pointer, the operand stack and
+the frame slots in locals, one dispatch point, and every semantic operation a call into
+:class:`interp.runtime.core.Runtime` (or its fast paths in interp/runtime/slots.py), the
+same calls the tree interpreter makes. A KRL call runs a nested :meth:`run` (one Python
+level per KRL call, as the tree interpreter's ``invoke``), so interrupt handlers, TRIGGER
+actions and WAIT FOR conditions, which the runtime calls back at a statement boundary or
+an IPO cycle, run as *thunks* of the declaring routine's code on top of the interrupted
+context.
+
+Errors: the assembler's regions (``.at``) are the line table. A KrlRuntimeError raised by
+an instruction is placed on its region's line; in a guarded region after ON_ERROR_PROCEED
+it is recorded ($ERR) and execution goes on after the statement, as in the tree
+interpreter.
+
+Routines are compiled on their first call (the compiler needs the module's data list and
+the runtime's resolver) and kept per routine.
+"""
+
+from __future__ import annotations
+
+import inspect
+import re
+
+from interp.runtime.builtins import ValueRef
+from interp.runtime.convert import num
+from interp.runtime.errors import ExitSignal, KrlRuntimeError, ResumeSignal
+from interp.runtime.slots import (add, array_index, element, eq, for_done, for_limits, lt, mul,
+                                  read_value, sub, trigger_args)
+
+from . import opcodes as OP
+from .assembler import Code, assemble
+from .compiler import compile_routine
+
+
+def _specialize(fn):
+    """Replace ``OP.NAME`` by the opcode's number in ``fn``'s source (the dispatch loop
+    compares against literals instead of looking up module attributes). Line numbers
+    stay those of this file."""
+    lines, first = inspect.getsourcelines(fn)
+    indent = len(lines[0]) - len(lines[0].lstrip())
+    body = []
+    for ln in lines:
+        if ln.lstrip().startswith("@_specialize"):
+            body.append("\n")
+            continue
+        body.append(ln[indent:] if len(ln) > indent else ln.lstrip(" "))
+    src = "\n" * (first - 1) + "".join(body)
+    src = re.sub(r"\bOP\.([A-Z_]+)\b", lambda m: str(OP.BY_NAME[m.group(1)].number), src)
+    ns: dict = {}
+    exec(compile(src, inspect.getsourcefile(fn), "exec"), fn.__globals__, ns)  # noqa: S102
+    return ns[fn.__name__]
+
+
+class Act:
+    """One activation: the runtime frame, its slots (references, in ``.locals`` order) and
+    the temporaries."""
+
+    __slots__ = ("frame", "refs", "temps")
+
+    def __init__(self, frame, refs: list, temps: list) -> None:
+        self.frame = frame
+        self.refs = refs
+        self.temps = temps
+
+
+class VM:
+    def __init__(self, rt) -> None:
+        self.rt = rt
+        self.codes: dict = {}          # id(routine) -> Code
+
+    # ------------------------------------------------------------------ entry points
+    def run_program(self, module_name: str | None = None) -> None:
+        """Body of the robot (or a submit) task: call the main routine of the module."""
+        rt = self.rt
+        prog = rt.program
+        name = module_name or prog.main_path.stem
+        m = prog.module(name)
+        if m is None or m.main is None:
+            raise KrlRuntimeError(f"no main routine in {name}")
+        if m.syntax_errors:
+            raise KrlRuntimeError("the program has syntax errors and cannot start: " + m.syntax_errors[0],
+                                  None, m.path, 0)
+        self.invoke((m, m.main), [], None)
+
+    def code_for(self, module, routine, frame=None) -> Code:
+        code = self.codes.get(id(routine))
+        if code is None:
+            code = assemble(compile_routine(self.rt, module, routine, frame))[0]
+            code.routine = routine
+            code.module = module
+            data = module.data if module is not None else {}
+            code.mrefs = [data.get(n.upper()) for n in code.mnames]
+            code.grefs = [None] * len(code.gnames)
+            code.lkeys = [n.upper() for n in code.lnames]
+            self.codes[id(routine)] = code
+        return code
+
+    # ------------------------------------------------------------------ calls
+    def invoke(self, target, args: list, caller, catch_resume: bool = True):
+        """Run routine ``target`` = (module, Routine) with reference ``args``."""
+        rt = self.rt
+        module, routine = target
+        frame = rt.enter_routine(module, routine, args, caller)
+        code = self.codes.get(id(routine)) or self.code_for(module, routine, frame)
+        task = rt.current_task
+        prev = task.frame
+        task.frame = frame
+        try:
+            v = frame.vars
+            act = Act(frame, [v[k] for k in code.lkeys], [None] * code.ntemps)
+            value = self.run(code, act, 0, [])
+            if code.kind == "DEFFCT":
+                return rt.return_value(routine, value, module)
+            return None
+        except ResumeSignal as r:
+            if catch_resume and r.frame is caller and caller is not None:
+                return None
+            raise
+        finally:
+            task.frame = prev
+            rt.leave_routine(frame)
+
+    def call(self, code: Code, ip: int, name: str, args: list, frame, flags: str):
+        rt = self.rt
+        target = code.callsites.get(ip)
+        if target is None:
+            target = rt.find_routine(name, frame.module)
+            if target is None:
+                if rt.is_native(name):
+                    return rt.call_builtin(name, args)
+                return rt.stub_call(name, flags == "E")
+            code.callsites[ip] = target
+        return self.invoke(target, args, frame, "N" not in flags)
+
+    def thunk(self, code: Code, act: Act, ip: int, stack: list | None = None):
+        """A callable that runs the thunk at ``ip`` of ``code`` in ``act``."""
+        return lambda: self.run(code, act, ip, list(stack) if stack else [], True)
+
+    # ------------------------------------------------------------------ the loop
+    @_specialize
+    def run(self, code: Code, act: Act, ip: int, stack: list, thunk: bool = False):
+        """Run ``code`` from ``ip`` in activation ``act``; returns the value of RETURN,
+        or of the thunk at END_THUNK."""
+        rt = self.rt
+        words = code.words
+        consts = code.consts
+        infos = code.infos
+        mrefs = code.mrefs
+        grefs = code.grefs
+        refs = act.refs
+        temps = act.temps
+        frame = act.frame
+        push = stack.append
+        pop = stack.pop
+        before = rt.before_statement
+        tick = rt.loop_tick
+        assign = rt.assign
+        proceed = False
+        while True:
+            try:
+                while True:
+                    op = words[ip]
+                    if op == OP.LOAD_LOCAL:
+                        push(read_value(refs[words[ip + 1]]))
+                        ip += 2
+                    elif op == OP.CONST:
+                        push(consts[words[ip + 1]])
+                        ip += 2
+                    elif op == OP.STMT_G:
+                        info = infos[words[ip + 1]]
+                        if not thunk:
+                            frame.line = info.line
+                        before(info)
+                        proceed = rt.take_error_proceed()
+                        ip += 2
+                    elif op == OP.STORE_LOCAL:
+                        assign(refs[words[ip + 1]], pop())
+                        ip += 2
+                    elif op == OP.ADD:
+                        b = pop()
+                        stack[-1] = add(stack[-1], b)
+                        ip += 1
+                    elif op == OP.LOAD_INDEX:
+                        n = words[ip + 1]
+                        if n == 1 and stack[-1] is not None:
+                            i = pop()
+                            stack[-1] = element(stack[-1], i, consts[words[ip + 2]])
+                        else:
+                            idx = [None if x is None else array_index(x) for x in stack[-n:]]
+                            del stack[-n:]
+                            stack[-1] = read_value(rt.index(stack[-1], idx, consts[words[ip + 2]]))
+                        ip += 3
+                    elif op == OP.MUL:
+                        b = pop()
+                        stack[-1] = mul(stack[-1], b)
+                        ip += 1
+                    elif op == OP.SUB:
+                        b = pop()
+                        stack[-1] = sub(stack[-1], b)
+                        ip += 1
+                    elif op == OP.FOR_TEST:
+                        t = words[ip + 1]
+                        if for_done(temps[t].get(), temps[t + 1], temps[t + 2]):
+                            ip = words[ip + 2]
+                        else:
+                            ip += 3
+                    elif op == OP.TICK:
+                        tick(infos[words[ip + 1]])
+                        ip += 2
+                    elif op == OP.FOR_NEXT:
+                        t = words[ip + 1]
+                        ref = temps[t]
+                        assign(ref, add(ref.get(), temps[t + 2]))
+                        ip = words[ip + 2]
+                    elif op == OP.LOAD_MOD:
+                        push(read_value(mrefs[words[ip + 1]]))
+                        ip += 2
+                    elif op == OP.STORE_MOD:
+                        assign(mrefs[words[ip + 1]], pop())
+                        ip += 2
+                    elif op == OP.REF_LOCAL:
+                        push(refs[words[ip + 1]])
+                        ip += 2
+                    elif op == OP.INDEX:
+                        n = words[ip + 1]
+                        idx = [None if x is None else array_index(x) for x in stack[-n:]]
+                        del stack[-n:]
+                        stack[-1] = rt.index(stack[-1], idx, consts[words[ip + 2]])
+                        ip += 3
+                    elif op == OP.ASSIGN:
+                        ref = pop()
+                        assign(ref, pop())
+                        ip += 1
+                    elif op == OP.JUMP_IF_FALSE:
+                        if rt.to_bool(pop()):
+                            ip += 2
+                        else:
+                            ip = words[ip + 1]
+                    elif op == OP.JUMP:
+                        ip = words[ip + 1]
+                    elif op == OP.LT:
+                        b = pop()
+                        stack[-1] = lt(stack[-1], b)
+                        ip += 1
+                    elif op == OP.EQ:
+                        b = pop()
+                        stack[-1] = eq(stack[-1], b)
+                        ip += 1
+                    elif op == OP.BINOP:
+                        b = pop()
+                        stack[-1] = rt.binary_op(consts[words[ip + 1]], stack[-1], b)
+                        ip += 2
+                    elif op == OP.UNOP:
+                        stack[-1] = rt.unary_op(consts[words[ip + 1]], stack[-1])
+                        ip += 2
+                    elif op == OP.STMT:
+                        info = infos[words[ip + 1]]
+                        if not thunk:
+                            frame.line = info.line
+                        before(info)
+                        ip += 2
+                    elif op == OP.CALL:
+                        argc = words[ip + 2]
+                        if argc:
+                            args = stack[-argc:]
+                            del stack[-argc:]
+                        else:
+                            args = []
+                        name = consts[words[ip + 1]]
+                        flags = consts[words[ip + 3]]
+                        v = self.call(code, ip, name, args, frame, flags)
+                        if flags == "E":
+                            if v is None:
+                                raise KrlRuntimeError(f"{name} does not return a value")
+                            push(v)
+                        ip += 4
+                    elif op == OP.VALARG:
+                        stack[-1] = ValueRef(stack[-1])
+                        ip += 1
+                    elif op == OP.REF_MOD:
+                        push(mrefs[words[ip + 1]])
+                        ip += 2
+                    elif op == OP.LOAD_GLOBAL or op == OP.REF_GLOBAL or op == OP.STORE_GLOBAL:
+                        g = words[ip + 1]
+                        ref = grefs[g]
+                        if ref is None:
+                            ref = rt.lookup(code.gnames[g], frame)
+                            grefs[g] = ref
+                        if op == OP.LOAD_GLOBAL:
+                            push(read_value(ref))
+                        elif op == OP.REF_GLOBAL:
+                            push(ref)
+                        else:
+                            assign(ref, pop())
+                        ip += 2
+                    elif op == OP.FIELD:
+                        stack[-1] = rt.field(stack[-1], consts[words[ip + 1]], consts[words[ip + 2]])
+                        ip += 3
+                    elif op == OP.LOAD_FIELD:
+                        stack[-1] = read_value(rt.field(stack[-1], consts[words[ip + 1]], consts[words[ip + 2]]))
+                        ip += 3
+                    elif op == OP.RETURN_VAL:
+                        v = pop()
+                        return v if code.kind == "DEFFCT" else None
+                    elif op == OP.RETURN:
+                        if code.kind == "DEFFCT":
+                            raise KrlRuntimeError(f"RETURN without a value in function {code.routine.name}", None,
+                                                  code.routine.span.file, frame.line)
+                        return None
+                    elif op == OP.END:
+                        if code.kind == "DEFFCT":
+                            r = code.routine
+                            raise KrlRuntimeError(f"function {r.name} ended without RETURN", None,
+                                                  r.span.file, frame.line or r.span.line)
+                        return None
+                    elif op == OP.END_THUNK:
+                        return stack[-1] if stack else None
+                    elif op == OP.LOAD_TEMP:
+                        push(temps[words[ip + 1]])
+                        ip += 2
+                    elif op == OP.STORE_TEMP:
+                        temps[words[ip + 1]] = pop()
+                        ip += 2
+                    elif op == OP.JUMP_IF_TRUE:
+                        if rt.to_bool(pop()):
+                            ip = words[ip + 1]
+                        else:
+                            ip += 2
+                    elif op == OP.NONE:
+                        push(None)
+                        ip += 1
+                    elif op == OP.POP:
+                        pop()
+                        ip += 1
+                    elif op == OP.DEREF:
+                        stack[-1] = read_value(stack[-1])
+                        ip += 1
+                    elif op == OP.FOR_PREP:
+                        t = words[ip + 1]
+                        step = pop()
+                        end = pop()
+                        start = pop()
+                        temps[t] = pop()
+                        temps[t + 1], temps[t + 2] = for_limits(end, step)
+                        push(start)
+                        ip += 2
+                    elif op == OP.FOR_INIT:
+                        assign(temps[words[ip + 1]], pop())
+                        ip += 2
+                    elif op == OP.AGG:
+                        names = consts[words[ip + 2]]
+                        keys = names.split(",") if names else []
+                        k = len(keys)
+                        vals = stack[len(stack) - k:]
+                        del stack[len(stack) - k:]
+                        push(rt.aggregate(consts[words[ip + 1]], list(zip(keys, vals)), frame.module))
+                        ip += 3
+                    elif op == OP.JUMP_IF_NONE:
+                        if stack[-1] is None:
+                            pop()
+                            ip = words[ip + 1]
+                        else:
+                            ip += 2
+                    elif op == OP.HALT:
+                        rt.halt()
+                        ip += 1
+                    elif op == OP.WAIT_FOR:
+                        rt.wait_for(self.thunk(code, act, words[ip + 1]))
+                        ip += 2
+                    elif op == OP.WAIT_SEC:
+                        rt.wait_sec(pop())
+                        ip += 1
+                    elif op == OP.CONTINUE:
+                        rt.set_continue(infos[words[ip + 1]])
+                        ip += 2
+                    elif op == OP.ON_ERROR_PROCEED:
+                        rt.on_error_proceed()
+                        ip += 1
+                    elif op == OP.EXIT_SIGNAL:
+                        raise ExitSignal()
+                    elif op == OP.GOTO_FAIL:
+                        raise KrlRuntimeError(f"GOTO {consts[words[ip + 1]]}: label not found", None,
+                                              code.routine.span.file, frame.line)
+                    elif op == OP.RAISE:
+                        line = words[ip + 2]
+                        raise KrlRuntimeError(consts[words[ip + 1]], None, code.file if line else None, line or None)
+                    elif op == OP.INT_DECL:
+                        cond = self.thunk(code, act, words[ip + 1])
+                        rt.interrupt_decl(pop(), lambda c=cond: rt.to_bool(c(), "interrupt condition"),
+                                          self.thunk(code, act, words[ip + 2]), consts[words[ip + 3]], frame,
+                                          consts[words[ip + 4]] == "G", words[ip + 5])
+                        ip += 6
+                    elif op == OP.INT_CTL:
+                        n = pop() if consts[words[ip + 2]] == "P" else None
+                        rt.interrupt_ctl(consts[words[ip + 1]], n)
+                        ip += 3
+                    elif op == OP.BRAKE:
+                        rt.brake(consts[words[ip + 1]] == "F")
+                        ip += 2
+                    elif op == OP.RESUME:
+                        rt.resume()
+                        ip += 1
+                    elif op == OP.TRIG_FIND:
+                        target = rt.find_routine(consts[words[ip + 1]], frame.module)
+                        push(target)
+                        ip = words[ip + 2] if target is None else ip + 3
+                    elif op == OP.TRIG_PACK:
+                        argc = words[ip + 1]
+                        args = stack[len(stack) - argc:]
+                        del stack[len(stack) - argc:]
+                        stack[-1] = (stack[-1], args)
+                        ip += 2
+                    elif op == OP.TRIGGER:
+                        flags = consts[words[ip + 2]]
+                        prio = pop() if "P" in flags else None
+                        delay = pop()
+                        at = pop()
+                        action = self.thunk(code, act, words[ip + 4], [pop()])
+                        rt.trigger(action, line=words[ip + 3],
+                                   **trigger_args(consts[words[ip + 1]], at, delay, prio, "O" in flags))
+                        ip += 5
+                    elif op == OP.TRIG_INVOKE:
+                        target, args = pop()
+                        self.invoke(target, args, frame)
+                        ip += 1
+                    elif op == OP.MOTION:
+                        nwith = words[ip + 5]
+                        pairs = self.pairs(stack, nwith)
+                        flags = consts[words[ip + 4]]
+                        ca = pop() if "C" in flags else None
+                        aux = pop() if "A" in flags else None
+                        approx = consts[words[ip + 2]]
+                        rt.motion(consts[words[ip + 1]], pop(), approx.split(",") if approx else [], aux, ca,
+                                  consts[words[ip + 3]], pairs, code.file, words[ip + 6])
+                        ip += 7
+                    elif op == OP.SPL_BEGIN:
+                        temps[words[ip + 1]] = [[], [], None]     # segments, pending triggers, saved
+                        ip += 2
+                    elif op == OP.SPL_TRIG_BEGIN:
+                        sp = temps[words[ip + 1]]
+                        task = rt.current_task
+                        sp[2] = task.next_triggers
+                        task.next_triggers = []
+                        ip += 2
+                    elif op == OP.SPL_TRIG_END:
+                        sp = temps[words[ip + 1]]
+                        task = rt.current_task
+                        sp[1] += task.next_triggers
+                        task.next_triggers = sp[2]
+                        ip += 2
+                    elif op == OP.SPL_SEG:
+                        pairs = self.pairs(stack, words[ip + 3])
+                        flags = consts[words[ip + 2]]
+                        ca = float(num(pop())) if "C" in flags else None
+                        aux = pop() if "A" in flags else None
+                        sp = temps[words[ip + 5]]
+                        sp[0].append({"kind": consts[words[ip + 1]], "target": pop(), "aux": aux, "ca": ca,
+                                      "with_": pairs, "triggers": sp[1], "line": words[ip + 4]})
+                        sp[1] = []
+                        ip += 6
+                    elif op == OP.SPLINE:
+                        pairs = self.pairs(stack, words[ip + 3])
+                        rt.spline(consts[words[ip + 1]], temps[words[ip + 5]][0], consts[words[ip + 2]], pairs,
+                                  code.file, words[ip + 4])
+                        ip += 6
+                    else:
+                        raise RuntimeError(f"bad opcode {op} at {ip} in {code.name}")
+            except KrlRuntimeError as e:
+                reg = code.regions[ip]
+                if reg is None:
+                    raise
+                e.at(code.file, reg.line)
+                if reg.kind != "G" or thunk or not proceed:
+                    raise
+                proceed = False
+                rt.record_error(e, frame)
+                del stack[:]
+                ip = reg.end
+
+    @staticmethod
+    def pairs(stack: list, n: int) -> list:
+        """Pop ``n`` WITH (reference, value) pairs."""
+        if not n:
+            return []
+        items = stack[len(stack) - 2 * n:]
+        del stack[len(stack) - 2 * n:]
+        return [(items[2 * i], items[2 * i + 1]) for i in range(n)]
