@@ -54,6 +54,9 @@ class TreeInterpreter:
         prog = rt.program
         name = module_name or prog.main_path.stem
         m = prog.module(name)
+        if m is not None and m.syntax_errors:
+            raise KrlRuntimeError("the program has syntax errors and cannot start: " + m.syntax_errors[0],
+                                  None, m.path, 0)
         if m is None or m.main is None:
             raise KrlRuntimeError(f"no main routine in {name}")
         if m.syntax_errors:

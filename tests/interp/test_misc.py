@@ -1,0 +1,135 @@
+"""Signals, VARSTATE, $ADVANCE, spline blocks, CIRC, _REL, WITH, the CLI and the trace."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from .helpers import run_krl, write
+
+DAT = """
+DEFDAT prog
+  DECL INT N1, N2
+  DECL BOOL B1
+  DECL VAR_STATE VS1, VS2
+  SIGNAL GripClose $OUT[17]
+  SIGNAL ProgNo $IN[33] TO $IN[36]
+ENDDAT
+"""
+
+HOME = "PTP {A1 0, A2 -90, A3 90, A4 0, A5 30, A6 0}"   # A5 = 0 would be the wrist singularity
+
+
+def test_signals_bit_and_group(tmp_path):
+    r = run_krl(tmp_path, """
+    DEF prog()
+      GripClose = TRUE
+      WAIT SEC 0.05
+      N1 = ProgNo
+    END
+    """, DAT, stimuli='stimuli:\n  - at: 0.0\n    set: {"$IN[33]": true, "$IN[35]": true}\n')
+    assert r.io("$OUT[17]")[0][1] is True
+    assert r.var("prog", "N1") == 5          # bits 1 and 3 (LSB first)
+
+
+def test_varstate(tmp_path):
+    r = run_krl(tmp_path, """
+    DEF prog()
+      DECL INT k
+      VS1 = VARSTATE("k")
+      k = 3
+      VS2 = VARSTATE("k")
+      B1 = VARSTATE("nothing") == #UNKNOWN
+    END
+    """, DAT)
+    assert r.var("prog", "VS1").name == "DECLARED"
+    assert r.var("prog", "VS2").name == "INITIALIZED"
+    assert r.var("prog", "B1") is True
+
+
+def test_advance_limits_planning(tmp_path):
+    src = f"""
+    DEF prog()
+      $ADVANCE = {{ADV}}
+      {HOME}
+      PTP {{A1 20}}
+      PTP {{A1 40}}
+      PTP {{A1 60}}
+      PTP {{A1 80}}
+      N1 = 1
+    END
+    """
+    r1 = run_krl(tmp_path, src.replace("{ADV}", "1"), DAT)
+    r3 = run_krl(tmp_path, src.replace("{ADV}", "3"), DAT)
+
+    def t_of_n1(r):
+        return [e["t"] for e in r.events if e["kind"] == "stmt" and e["line"] == 8][0]
+    # N1 = 1 runs when the last motion is planned: with $ADVANCE 1 only one motion may wait
+    # in the queue, so the advance run reaches line 8 later than with $ADVANCE 3
+    assert t_of_n1(r1) > t_of_n1(r3)
+
+
+def test_lin_rel_circ_and_spline(tmp_path):
+    r = run_krl(tmp_path, f"""
+    DEF prog()
+      {HOME}
+      LIN_REL {{Z -50}}
+      LIN_REL {{X 20}} #TOOL
+      CIRC {{X 480, Y 30, Z 790}}, {{X 460, Y 0, Z 790}}
+      SPLINE
+        SPL {{X 460, Y 30, Z 780}}
+        SLIN {{X 480, Y 30, Z 770}}
+      ENDSPLINE
+      SLIN {{X 500, Y 0, Z 790}} WITH $VEL = {{CP 0.2, ORI1 100, ORI2 100}}
+    END
+    """)
+    assert r.result.reason == "completed", r.result
+    types = [e["type"] for e in r.kinds("motion") if e["phase"] == "start"]
+    assert types == ["PTP", "LIN_REL", "LIN_REL", "CIRC", "SPLINE", "SLIN"]
+
+
+def test_trace_is_deterministic_and_valid(tmp_path):
+    from robot.trace import validate_event
+
+    src = """
+    DEF prog()
+      DECL INT i
+      FOR i = 1 TO 3
+        $OUT[i] = TRUE
+      ENDFOR
+      WAIT SEC 0.05
+    END
+    """
+    a = run_krl(tmp_path, src)
+    b = run_krl(tmp_path, src)
+    assert a.trace.lines == b.trace.lines
+    for ev in a.events:
+        validate_event(ev)
+    assert a.events[-1]["kind"] == "end" and a.events[-1]["reason"] == "completed"
+    assert {"call", "return", "stmt"} <= {e["kind"] for e in a.events}
+
+
+def _krl(*args, cwd=None):
+    exe = Path(sys.executable).with_name("krl")
+    return subprocess.run([str(exe), *map(str, args)], capture_output=True, text=True, cwd=cwd, timeout=120)
+
+
+def test_cli_exit_codes_and_trace(tmp_path):
+    ok = write(tmp_path, "ok.src", "DEF ok()\n  $OUT[1] = TRUE\nEND\n")
+    bad = write(tmp_path, "bad.src", "DEF bad()\n  DECL INT u\n  u = u + 1\nEND\n")
+    halt = write(tmp_path, "stop1.src", "DEF stop1()\n  HALT\nEND\n")
+    out = tmp_path / "t.jsonl"
+    p = _krl("run", ok, "--trace", out)
+    assert p.returncode == 0, p.stderr
+    events = [json.loads(x) for x in out.read_text().splitlines()]
+    assert events[-1]["kind"] == "end" and events[-1]["reason"] == "completed"
+    p = _krl("run", bad)
+    assert p.returncode == 1 and "value invalid" in p.stdout and "bad.src:3" in p.stdout
+    p = _krl("run", halt)
+    assert p.returncode == 3 and "halt" in p.stdout
+    p = _krl("run", ok, "--interp", "vm")
+    assert p.returncode == 2 and "not built yet" in p.stderr
