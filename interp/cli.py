@@ -1,7 +1,7 @@
 """`krl run`: run a KRL program on the simulated controller (issue 6).
 
 Exit codes: 0 completed; 3 stopped (HALT, --max-steps, --max-sim-time, deadlocked WAIT);
-1 KRL run-time error; 2 usage or internal error (also `--interp vm` until the VM exists).
+1 KRL run-time error; 2 usage or internal error.
 """
 
 from __future__ import annotations
@@ -27,9 +27,6 @@ import click
               help="A submit program (.sub) to run beside the robot program (repeatable).")
 def run(program: Path, interp_kind: str, workspace, inputs, trace_path, max_sim_time, max_steps, submit) -> None:
     """Run PROGRAM (.src) on the simulated KR C4; print where and why it ended."""
-    if interp_kind == "vm":
-        click.echo("error: --interp vm: the bytecode VM is not built yet (issue 7); use --interp tree", err=True)
-        sys.exit(2)
     if not program.exists():
         click.echo(f"error: {program}: no such file", err=True)
         sys.exit(2)
@@ -39,7 +36,8 @@ def run(program: Path, interp_kind: str, workspace, inputs, trace_path, max_sim_
     trace = TraceWriter(trace_path) if trace_path else None
     try:
         res = run_program(program, workspace=workspace, inputs=inputs, trace=trace,
-                          max_sim_time=max_sim_time, max_steps=max_steps, submit=list(submit))
+                          max_sim_time=max_sim_time, max_steps=max_steps, submit=list(submit),
+                          interp=interp_kind)
     except Exception as exc:  # noqa: BLE001
         click.echo(f"internal error: {type(exc).__name__}: {exc}", err=True)
         sys.exit(2)
@@ -57,4 +55,6 @@ def run(program: Path, interp_kind: str, workspace, inputs, trace_path, max_sim_
     sys.exit(res.exit_code)
 
 
-commands = [run]
+from interp.vm.cli import asm  # noqa: E402
+
+commands = [run, asm]

@@ -26,6 +26,7 @@ from interp.runtime.memory import Frame
 from interp.runtime.values import EnumValue
 
 from .assembler import Listing, Region, format_listing
+from .opcodes import BY_NAME as OPS
 
 
 def name_of(e) -> str:
@@ -90,6 +91,7 @@ class Compiler:
 
     # ------------------------------------------------------------------ emitting
     def emit(self, name: str, *ops) -> None:
+        assert len(ops) == len(OPS[name].operands), (name, ops)
         self.lst.instrs.append((name, list(ops), self.region))
 
     def new_label(self) -> str:

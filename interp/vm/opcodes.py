@@ -111,7 +111,7 @@ _TABLE = [
     ("RESUME",        0,  "",   "Runtime.resume"),
     ("TRIG_FIND",     1,  "nl", "push the routine target of a TRIGGER action call, or None and jump"),
     ("TRIG_PACK",  None,  "i",  "pop i arguments and the target, push the packed call (effect -i)"),
-    ("TRIGGER",    None,  "nffil", "pop [prio,] delay, at and the packed call: Runtime.trigger; f: kind, f: O onstart / P prio; i: line; l: action thunk"),
+    ("TRIGGER",    None,  "nfil", "pop [prio,] delay, at and the packed call: Runtime.trigger; n: kind, f: O onstart / P prio; i: line; l: action thunk"),
     ("TRIG_INVOKE",  -1,  "",   "in an action thunk: invoke the packed call"),
     ("MOTION",     None,  "nnnfii", "pop [with pairs,] [ca,] [aux,] target: Runtime.motion; n kind, n approx, n frame, f A/C, i #with, i line"),
     ("SPL_BEGIN",     0,  "t",  "start collecting spline segments in temp t"),

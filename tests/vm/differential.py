@@ -1,0 +1,61 @@
+"""Run a program on both interpreters and compare the traces event for event."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import yaml
+
+from interp.run import make_runtime
+from robot.trace import TraceWriter
+
+REPO = Path(__file__).resolve().parents[2]
+PAPER = REPO.parent / "shared" / "examples" / "paper_fig1.src"
+CORPUS = sorted((REPO / "corpus" / "programs").glob("*.src"))
+CASES = sorted((REPO / "conformance" / "cases").glob("*/program.src"))
+
+
+def run_trace(program: Path, interp: str, *, inputs=None, submit=(), before=None, max_sim_time=30.0,
+              max_steps=2_000_000):
+    tw = TraceWriter(keep=True)
+    rt, _ = make_runtime(program, inputs=inputs, trace=tw, max_sim_time=max_sim_time, max_steps=max_steps,
+                         mujoco=False, submit=list(submit), interp=interp)
+    if before is not None:
+        before(rt)
+    res = rt.run()
+    tw.close()
+    return res, tw.events
+
+
+def case_options(program: Path) -> dict:
+    d = program.parent
+    kw: dict = {}
+    exp = d / "expect.yaml"
+    if exp.exists():
+        e = yaml.safe_load(exp.read_text()) or {}
+        if e.get("submit"):
+            kw["submit"] = [d / e["submit"]]
+        if e.get("max_sim_time"):
+            kw["max_sim_time"] = float(e["max_sim_time"])
+        else:
+            kw["max_sim_time"] = 10.0
+    if (d / "stimuli.yaml").exists():
+        kw["inputs"] = d / "stimuli.yaml"
+    return kw
+
+
+def first_difference(a: list, b: list):
+    """None if the event lists are equal, else (index, event a, event b)."""
+    for i, (x, y) in enumerate(zip(a, b)):
+        if x != y:
+            return i, x, y
+    if len(a) != len(b):
+        i = min(len(a), len(b))
+        return i, a[i] if i < len(a) else None, b[i] if i < len(b) else None
+    return None
+
+
+def compare(program: Path, **kw):
+    rt_res, tree_ev = run_trace(program, "tree", **kw)
+    vm_res, vm_ev = run_trace(program, "vm", **kw)
+    return (rt_res, vm_res), first_difference(tree_ev, vm_ev), len(tree_ev)
