@@ -141,27 +141,24 @@ def _inv_pos(rt, a):
 
 
 def _forward(rt, a):
-    from .sysvars import pos_struct  # noqa: PLC0415
-
-    ax = a[0].get()
-    q = [_real_leaf(ax, k) for k in ("A1", "A2", "A3", "A4", "A5", "A6")]
-    ctl = rt.controller
-    store = rt.sysvars.store
-    d = ctl.pos_act(tool=frame_tuple(store["$TOOL"]), base=frame_tuple(store["$BASE"])) if False else None
-    kin = ctl.model.kin
+    """FORWARD(axes, status): the TCP for ``axes`` with the current $TOOL/$BASE (E6POS)."""
     import numpy as np  # noqa: PLC0415
 
     from robot.frames import frame_to_matrix, inv_pos as _ip, matrix_to_frame  # noqa: PLC0415
 
+    from .sysvars import pos_struct  # noqa: PLC0415
+
+    ax = a[0].get()
+    q = np.array([_real_leaf(ax, k) for k in ("A1", "A2", "A3", "A4", "A5", "A6")], dtype=float)
+    ctl = rt.controller
+    store = rt.sysvars.store
     tool = frame_to_matrix(*frame_tuple(store["$TOOL"]))
     base = frame_to_matrix(*frame_tuple(store["$BASE"]))
-    Tm = ctl.model.tcp(np.array(q, dtype=float), tool, _ip(base))
-    x, y, z, aa, bb, cc = matrix_to_frame(Tm)
-    s, t = kin.status_turn(np.array(q, dtype=float))
-    d = {"X": x, "Y": y, "Z": z, "A": aa, "B": bb, "C": cc, "S": s, "T": t}
+    x, y, z, aa, bb, cc = matrix_to_frame(ctl.model.tcp(q, tool, _ip(base)))
+    s, t = ctl.model.kin.status_turn(q)
     if len(a) > 1 and a[1] is not None:
         a[1].set(0)
-    return pos_struct(d)
+    return pos_struct({"X": x, "Y": y, "Z": z, "A": aa, "B": bb, "C": cc, "S": s, "T": t})
 
 
 def _inverse(rt, a):
