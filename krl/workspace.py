@@ -87,6 +87,11 @@ class Workspace:
     def incomplete(self) -> bool:
         return any(not f.ok for f in self.files)
 
+    def lookup_routine(self, name: str) -> Symbol | None:
+        """A global routine (main routine of a module, GLOBAL routine or built-in) by name;
+        ``sym.decl`` is its Routine node for routines of the workspace."""
+        return self.global_scope.lookup_routine(name) if self.global_scope is not None else None
+
     def routine_scope(self, routine: N.Routine) -> Scope | None:
         """The scope of a routine's parameters and locals (after :meth:`check`)."""
         return self.routine_scopes.get(id(routine))

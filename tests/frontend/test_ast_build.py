@@ -162,3 +162,24 @@ def test_build_module_without_tree():
     class R:  # a ParseResult-like object that lost its tree
         path, ok, tree = "x.src", False, None
     assert build_module(R()) == N.Module("x.src", "src")
+
+
+def test_newer_grammar_constructs():
+    """Constructs added while the grammar grew: routine constants, CONFIRM, ASYPTP, MOVE_EMI,
+    unwired system signals."""
+    r = ast_of("DEF t()\n  DECL CONST INT MAX = 12\n  CONFIRM 3\n  ASYPTP {E1 90}\n"
+               "  MOVE_EMI dev[] \"a.emily\" FLT 0\nEND\n").routines[0]
+    assert r.decls == [N.VarDecl(N.TypeRef("INT"), [N.VarName("MAX")], N.IntLit(12), is_const=True)]
+    assert r.body[0] == N.KeywordStmt(["CONFIRM"], [N.IntLit(3)])
+    assert r.body[1].words == ["ASYPTP"] and isinstance(r.body[1].args[0], N.Aggregate)
+    assert r.body[2] == N.MoveEmi(N.Index(N.Name("dev"), [None]), "a.emily", "FLT", N.IntLit(0))
+    m = ast_of("DEFDAT $MACHINE PUBLIC\n  SIGNAL $MODE_TEST FALSE\nENDDAT\n", "m.dat")
+    assert m.data.items == [N.SignalDecl("$MODE_TEST", None)]
+
+
+def test_workspace_routine_lookup():
+    from krl.workspace import check_texts
+    ws = check_texts({"a.src": "DEF a()\n  b()\nEND\nDEF b()\nEND\n"})
+    sym = ws.lookup_routine("A")
+    assert sym.decl is ws.units[0].routines[0] and ws.lookup_routine("b") is None
+    assert ws.lookup_routine("SQRT").signature.returns is not None
