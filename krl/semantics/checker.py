@@ -119,6 +119,8 @@ class Declarer:
                     typ = self.resolve_type(scope, d.type, d.type.span, v.dims)
                     sym = Symbol(v.name, "const" if d.is_const else kind, typ, scope.kind, d,
                                  "RO" if d.is_const else "RW", module=module, path=path)
+                    ann = v.annotate()
+                    ann.symbol, ann.type = sym, typ
                     self._define(scope, sym, v.span)
             elif isinstance(d, N.SignalDecl):
                 self.ident(d.name, d.span)

@@ -203,3 +203,9 @@ def test_advance_run_stop_annotations():
              for s in ws.units[0].routines[0].body]
     assert marks == [("reads $POS_ACT", None), (None, None), ("writes $OUT", True), ("reads $IN", None),
                      (None, None), ("WAIT SEC", None), ("PULSE", None), ("reads $TIMER", None)]
+
+
+def test_declared_names_carry_their_symbols():
+    ws = check("DEF t()\n  DECL REAL m[3,4]\nEND\n")
+    vn = ws.units[0].routines[0].decls[0].names[0]
+    assert N.symbol_of(vn).kind == "var" and N.type_of(vn) == T.Array(T.REAL, (3, 4))
