@@ -149,12 +149,9 @@ class Declarer:
 
     def _define(self, scope: Scope, sym: Symbol, span: N.Span) -> None:
         old = scope.define("values", sym)
-        if old is not None and old.decl is not sym.decl:
-            if scope.kind in ("global",) and (old.path != sym.path):
-                # the same global declared by two data lists: a link error (2.7)
-                self.duplicate(sym.name, span, old)
-            elif scope.kind != "global":
-                self.duplicate(sym.name, span, old)
+        if old is not None:
+            # in one scope, or the same global from two data lists (a link error, 2.7)
+            self.duplicate(sym.name, span, old)
 
     def ext_signature(self, scope: Scope, d: N.ExtDecl) -> RoutineSig:
         ret = self.resolve_type(scope, d.return_type, d.span) if d.return_type is not None else None

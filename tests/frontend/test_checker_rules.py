@@ -25,6 +25,7 @@ CASES = [
     # duplicate declarations (E102) and identifier length (E103, 1.2)
     ("E102", prog("INT i\nREAL i", "i = 1"), prog("INT i\nREAL j", "i = 1")),
     ("E102", prog("ENUM E a, b\nSTRUC E INT n", ""), prog("ENUM E a, b\nSTRUC F INT n", "")),
+    ("E102", prog("INT i, i", ""), prog("INT i, j", "")),
     ("E103", prog("INT abcdefghijklmnopqrstuvwxy", ""), prog("INT abcdefghijklmnopqrstuvwx", "")),
     # unknown type (E105)
     ("E105", prog("DECL NOSUCH x", ""), prog("DECL FRAME x", "")),
