@@ -70,6 +70,6 @@ nightly: $(PARSER)
 	@d=reports/nightly/$$(date -u +%Y-%m-%d); mkdir -p $$d; \
 	$(BIN)/krl recover $(SHARED_CORPUS) --out $$d/recovery; s=$$?; [ $$s -le 1 ] || exit $$s; \
 	$(BIN)/krl growth $(SHARED_CORPUS) --out $$d/growth || exit $$?; \
-	$(BIN)/krl conformance --out $$d/conformance --fuzz $(NIGHTLY_FUZZ); c=$$?; \
+	$(BIN)/krl conformance --out $$d/conformance --fuzz $(NIGHTLY_FUZZ) --fuzz-random; c=$$?; \
 	$(BIN)/python -m conformance.nightly reports/nightly; \
 	echo "nightly reports: $$d (index: reports/nightly/index.html)"; exit $$c

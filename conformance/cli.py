@@ -17,7 +17,10 @@ import click
 @click.option("--corpus", type=click.Path(path_type=Path), default=None,
               help="Corpus of KRC backups (default ../shared/krl-corpus).")
 @click.option("--real-limit", type=int, default=None, help="Run at most N real programs.")
-def conformance(out: Path, fuzz_n: int, no_real: bool, corpus: Path | None, real_limit: int | None) -> None:
+@click.option("--fuzz-random", is_flag=True,
+              help="Fresh random programs (default: the same reproducible set every run).")
+def conformance(out: Path, fuzz_n: int, no_real: bool, corpus: Path | None, real_limit: int | None,
+                fuzz_random: bool) -> None:
     """Run the hand-written cases on every available interpreter, the differential fuzzer and
     the corpus programs; write summary.json, report.md and report.html to --out.
 
@@ -26,7 +29,7 @@ def conformance(out: Path, fuzz_n: int, no_real: bool, corpus: Path | None, real
     from conformance.report import DEFAULT_CORPUS, run_all  # noqa: PLC0415
 
     s = run_all(out, fuzz_n=fuzz_n, real=not no_real, corpus=corpus or DEFAULT_CORPUS,
-                real_limit=real_limit, echo=click.echo)
+                real_limit=real_limit, fuzz_random=fuzz_random, echo=click.echo)
     click.echo(f"cases {s['passed']}/{s['cases']} pass; pending: {len(s['pending'])}; "
                f"tree = vm: {s['tree_vm_agree'] if s['tree_vm_agree'] is not None else 'n/a (' + s['vm'] + ')'}")
     bad = bool(s["failed_not_pending"])

@@ -339,10 +339,12 @@ def save_case(src: str, stim: str | None, problem: str, root: Path = H.CASES_DIR
     return d
 
 
-def run_fuzz(n: int = 200, *, seed: int | None = 0, interps: list[str] | None = None,
+def run_fuzz(n: int = 200, *, reproducible: bool = True, interps: list[str] | None = None,
              save_failures: Path | None = None, save_cases: bool = True) -> dict[str, Any]:
-    """Run ``n`` generated programs. Returns ``{"programs", "mode", "tree_ok", "agree",
-    "failures": [...], "saved": [...]}``."""
+    """Run ``n`` generated programs (the same ones every time with ``reproducible``; fresh
+    ones otherwise, as in the nightly run). Returns ``{"programs", "mode", "tree_ok", "agree",
+    "failures": [...], "saved": [...]}``; ``programs`` counts every run of the property,
+    including hypothesis' shrinking runs after a failure."""
     interps = H.available_interpreters() if interps is None else interps
     mode = "tree == vm" if ("tree" in interps and "vm" in interps) else (
         "tree smoke test (no VM): runs without internal errors" if "tree" in interps else "no interpreter")
@@ -352,7 +354,7 @@ def run_fuzz(n: int = 200, *, seed: int | None = 0, interps: list[str] | None = 
         return stats
     last: dict[str, Any] = {}
 
-    @settings(max_examples=n, deadline=None, database=None, derandomize=seed is not None,
+    @settings(max_examples=n, deadline=None, database=None, derandomize=reproducible,
               suppress_health_check=list(HealthCheck),
               phases=[Phase.generate, Phase.shrink] if n > 0 else [Phase.generate])
     @given(programs())

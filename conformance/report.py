@@ -328,7 +328,7 @@ def _html(s, rows, interps, fuzz, real) -> str:
 
 
 def run_all(out: Path, *, fuzz_n: int = 200, real: bool = True, corpus: Path = DEFAULT_CORPUS,
-            real_limit: int | None = None, echo=print) -> dict[str, Any]:
+            real_limit: int | None = None, fuzz_random: bool = False, echo=print) -> dict[str, Any]:
     """Everything `krl conformance` / `make conformance` does."""
     status = H.interpreter_status()
     for k, v in status.items():
@@ -344,7 +344,7 @@ def run_all(out: Path, *, fuzz_n: int = 200, real: bool = True, corpus: Path = D
     if fuzz_n > 0:
         from . import fuzz as F  # noqa: PLC0415
 
-        fz = F.run_fuzz(fuzz_n, save_failures=out / "fuzz_failures")
+        fz = F.run_fuzz(fuzz_n, reproducible=not fuzz_random, save_failures=out / "fuzz_failures")
         echo(f"fuzz: {fz['programs']} programs, mode {fz['mode']}, tree clean {fz['tree_ok']}, agree {fz['agree']}")
     rl = None
     if real:
