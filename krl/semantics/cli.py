@@ -19,8 +19,20 @@ import click
 @click.argument("paths", nargs=-1, required=True)
 @click.option("--json", "as_json", is_flag=True, help="One JSON object per workspace.")
 @click.option("--no-warnings", is_flag=True, help="Print errors only.")
-def check(paths: tuple[str, ...], as_json: bool, no_warnings: bool) -> None:
+@click.option("--report", "report_dir", default=None,
+              help="Instead: write check_report.md/.json for the KRC backups below PATH into this folder.")
+def check(paths: tuple[str, ...], as_json: bool, no_warnings: bool, report_dir: str | None) -> None:
     """Type-check KRL files or KRC backups; exit 1 when there are errors."""
+    if report_dir is not None:
+        from krl.semantics.report import check_report  # noqa: PLC0415
+        try:
+            for path in paths:
+                _data, md = check_report(path, report_dir)
+                click.echo(md)
+        except Exception as exc:  # noqa: BLE001
+            click.echo(f"krl check: internal error: {type(exc).__name__}: {exc}")
+            sys.exit(2)
+        sys.exit(0)
     status = run_check(list(paths), as_json, no_warnings, click.echo)
     sys.exit(status)
 

@@ -82,3 +82,10 @@ def test_folder_with_backups_and_loose_files(tmp_path):
     (tmp_path / "top.src").write_text("DEF top()\nEND\n")
     roots = sorted(ws.root for ws in workspaces_for(tmp_path))
     assert roots == sorted([str(tmp_path / "a" / "KRC"), str(tmp_path / "loose"), str(tmp_path)])
+
+
+def test_cli_report_option(tmp_path):
+    make_backup(tmp_path / "corpus")
+    res = CliRunner().invoke(check_cmd, [str(tmp_path / "corpus"), "--report", str(tmp_path / "out")])
+    assert res.exit_code == 0 and "| backup |" in res.output
+    assert (tmp_path / "out" / "check_report.md").exists()
