@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import json
 
-from hypothesis import given, strategies as st
+import pytest
+from hypothesis import given, settings, strategies as st
 
 from krl.semantics.cli import run_check
 from krl.workspace import check_texts, load_workspace
@@ -131,3 +132,29 @@ def test_generated_programs_check_without_internal_errors(module):
     ws = _safe_check_text(print_module(module))
     for f in ws.files:
         assert all(N.type_of(n) is not None for n in f.module.walk() if isinstance(n, N.Expr))
+
+
+@pytest.mark.corpus
+@settings(max_examples=15)
+@given(st.data())
+def test_mutated_corpus_files(corpus, data):
+    """Mutations of real backup files: still no exception and no internal error."""
+    files = _sample_files(corpus)
+    path = data.draw(st.sampled_from(files))
+    text = path.read_bytes().decode("utf-8", errors="replace")
+    muts = data.draw(_MUTATIONS)
+    suffix = path.suffix.lower()
+    ws = check_texts({f"m{suffix}": _mutate(text, muts)})
+    assert not [d for d in ws.diagnostics if d.code == "E901"]
+
+
+_SAMPLE: list = []
+
+
+def _sample_files(corpus):
+    if not _SAMPLE:
+        from krl.syntax.source import is_krl_file
+        files = sorted(p for p in corpus.rglob("*") if p.is_file() and is_krl_file(p)
+                       and p.stat().st_size < 20_000)
+        _SAMPLE.extend(files[:: max(1, len(files) // 40)])
+    return _SAMPLE
