@@ -134,6 +134,30 @@ class Workspace:
 
     # ------------------------------------------------------------------ linking
 
+    def _link_imports(self, checker: Checker) -> None:
+        """IMPORT type name IS /R1/module..var (2.5): point the local name at the module's
+        data-list variable (Symbol.alias, Symbol.module); report a missing target."""
+        by_name: dict[str, ModuleUnit] = {}
+        for u in self.units:
+            for n in _unit_names(u):
+                by_name.setdefault(n, u)
+        for u in self.units:
+            if u.scope is None:
+                continue
+            for sym in u.scope.values.values():
+                d = sym.decl
+                if not isinstance(d, N.ImportDecl) or len(d.path) < 3:
+                    continue
+                target_unit = by_name.get(d.path[1].upper())
+                target = target_unit.scope.values.get(d.path[2].upper()) if target_unit and target_unit.scope else None
+                if target is None and target_unit is not None and self.global_scope is not None:
+                    g = self.global_scope.values.get(d.path[2].upper())
+                    target = g if g is not None and g.module.upper() in _unit_names(target_unit) else None
+                if target is None:
+                    checker.not_found(d.span, f"{d.path[1]}..{d.path[2]}", u.scope)
+                    continue
+                sym.alias, sym.module = target, target.module
+
     def _pair(self) -> None:
         by_key: dict[tuple[str, str], ModuleUnit] = {}
         for f in self.files:
@@ -228,6 +252,8 @@ class Workspace:
                     declarer.declare_values(scope, items, name, path)
                     declarer.soft_types = False
 
+        self._link_imports(checker)
+
         # routines: main routines and GLOBAL ones are global, others module-local
         routine_syms: list[tuple[N.Routine, Symbol, ModuleUnit]] = []
         for u in self.units:
@@ -284,6 +310,13 @@ def is_system_path(path: str) -> bool:
     they rely on $operate.dat declarations that a backup never contains (see W101/W105/W106)."""
     parts = Path(path).parts
     return Path(path).name.startswith("$") or any(p.lower() in SYSTEM_DIRS for p in parts[:-1])
+
+
+def _unit_names(u: "ModuleUnit") -> set[str]:
+    names = {u.name.upper()}
+    if u.dat is not None and u.dat.module.data is not None:
+        names.add(u.dat.module.data.name.upper())
+    return names
 
 
 def _casefold_child(folder: Path, name: str) -> Path | None:

@@ -15,7 +15,8 @@ A :class:`Symbol` is what the checker attaches to a Name/Call (``node.ann.symbol
 ``type`` is its KrlType; ``scope`` the scope kind where it was declared; ``decl`` the
 declaring AST node (None for built-ins); ``access`` 'RW' or 'RO'; ``mode`` the parameter mode;
 ``signature`` a :class:`RoutineSig` for routines; ``module`` the module name for module/global
-data (the interpreters key persistent data-list storage on it).
+data (the interpreters key persistent data-list storage on it); ``alias`` for an IMPORT
+name, the imported data-list variable's symbol.
 """
 
 from __future__ import annotations
@@ -61,6 +62,7 @@ class Symbol:
     stop_read: bool = False
     stop_write: bool = False
     path: str = ""
+    alias: "Symbol | None" = None    # IMPORT: the data-list variable this name stands for
 
     def __repr__(self) -> str:
         return f"Symbol({self.name!r}, {self.kind}, {self.type}, scope={self.scope})"

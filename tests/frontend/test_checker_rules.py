@@ -210,3 +210,17 @@ def test_declared_names_carry_their_symbols():
     ws = check("DEF t()\n  DECL REAL m[3,4]\nEND\n")
     vn = ws.units[0].routines[0].decls[0].names[0]
     assert N.symbol_of(vn).kind == "var" and N.type_of(vn) == T.Array(T.REAL, (3, 4))
+
+
+def test_import_links_to_the_data_list_variable():
+    """2.5: IMPORT type name IS /R1/module..var."""
+    from krl.workspace import check_texts
+    files = {"other.dat": "DEFDAT other\n  INT counter = 0\nENDDAT\n",
+             "t.src": "DEF t()\n  n = n + 1\nEND\n",
+             "t.dat": "DEFDAT t\n  IMPORT INT n IS /R1/other..counter\nENDDAT\n"}
+    ws = check_texts(files)
+    assert not ws.diagnostics, [str(d) for d in ws.diagnostics]
+    sym = N.symbol_of(ws.modules["T"].routines[0].body[0].target)
+    assert sym.alias is not None and sym.alias.name == "counter" and sym.module == "other"
+    files["t.dat"] = "DEFDAT t\n  IMPORT INT n IS /R1/other..nothing\nENDDAT\n"
+    assert [d.code for d in check_texts(files).diagnostics] == ["E101"]
