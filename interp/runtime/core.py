@@ -79,6 +79,7 @@ class Runtime:
         self.robot: Task | None = None
         self.result: RunResult | None = None
         self._stop_cache: dict = {}
+        self._cyclic: dict = {}
 
     # ================================================================== tasks and run
     def add_task(self, kind: str, name: str, body) -> Task:
@@ -423,11 +424,21 @@ class Runtime:
                     if key in pnames:
                         ptypes[key] = t
                     else:
-                        frame.declare(vn.name, t)
+                        ref = frame.declare(vn.name, t)
+                        if d.init is not None:      # DECL CONST INT OFFS = 10 (KSS 8)
+                            v = self.program.literal(d.init, t, module)
+                            cur = ref.peek()
+                            if isinstance(cur, (Struct, Arr)):
+                                assign_into(cur, v)
+                            else:
+                                frame.store[key] = convert_scalar(v, t)
+                            ref.readonly = d.is_const
             elif isinstance(d, N.SignalDecl):
                 ref = self.program.signal_ref(d)
                 if ref is not None:
                     frame.bind(d.name, ref)
+            elif isinstance(d, N.ImportDecl):
+                frame.bind(d.name, self.program.import_ref(d))
         for i, p in enumerate(routine.params):
             key = p.name.upper()
             t = ptypes.get(key)
@@ -481,11 +492,13 @@ class Runtime:
             return dest
         return convert_scalar(v, t)
 
-    def leave_routine(self, frame: Frame) -> None:
+    def leave_routine(self, frame: Frame, returned: bool = True) -> None:
+        """The routine of ``frame`` ends; ``returned`` False when it is abandoned (run-time
+        error, RESUME, end of the run): then no ``return`` event is written."""
         task = self.current_task
         if frame.interrupts:
             task.irqs.remove_frame(frame)
-        if self.trace is not None:
+        if returned and self.trace is not None:
             self.trace.write("return", self.controller.time, name=frame.name)
 
     def return_value(self, routine: N.Routine, value, module):
@@ -593,6 +606,38 @@ class Runtime:
 
     def message(self, text: str) -> None:
         self.controller.message(text)
+
+    # ================================================================== cyclic evaluation
+    def cyclic_on(self, key, fn) -> None:
+        """Evaluate ``fn()`` once per IPO cycle until :meth:`cyclic_off` (``ANOUT ON``,
+        ``ANIN ON``, ``$CYCFLAG[n] = expr``; §5.14, §5.15). An error in ``fn`` becomes a
+        run-time error of the robot program at its next resumption."""
+        self.cyclic_off(key)
+        robot = self.robot
+
+        def tick(ctl):
+            try:
+                fn()
+            except KrlRuntimeError as e:
+                self.cyclic_off(key)
+                if robot is not None and robot.pending_error is None:
+                    from robot.errors import RobotError  # noqa: PLC0415
+
+                    robot.pending_error = RobotError(e.message, e.number)
+        self._cyclic[key] = self.controller.add_cyclic(tick)
+
+    def cyclic_off(self, key) -> None:
+        h = self._cyclic.pop(key, None)
+        if h is not None:
+            self.controller.remove_cyclic(h)
+
+    def stub_statement(self, what: str) -> None:
+        """A statement of §5.20 that is recognised and not simulated (CONFIRM, ASYPTP,
+        MOVE_EMI, ...): logged once as a ``message`` event, no effect."""
+        key = "STMT " + what.upper()
+        if key not in self.program.stubs:
+            self.program.stubs.add(key)
+            self.message(f"stub: {what} (statement not simulated)")
 
     # ================================================================== motion
     def _params(self, with_: list):

@@ -274,12 +274,26 @@ class Program:
                         target.peek(), Struct) else assign_into(target.peek(), self.literal(item.value, target.type, m))
                 except KrlRuntimeError as exc:
                     m.errors.append(f"{item.name}: {exc.message}")
+            elif isinstance(item, N.ImportDecl):
+                ref = self.import_ref(item)
+                m.data[item.name.upper()] = ref
             elif isinstance(item, N.SignalDecl):
                 ref = self.signal_ref(item)
                 if ref is not None:
                     m.data[item.name.upper()] = ref
                     if is_glob:
                         self.globals[item.name.upper()] = ref
+
+    def import_ref(self, item: N.ImportDecl):
+        """``IMPORT type name IS /R1/module..var``: the other data list's variable (§2.5)."""
+        path = [p for p in item.path if p]
+        if len(path) < 2:
+            raise KrlRuntimeError(f"IMPORT {item.name}: bad path")
+        mod = self.module(path[-2])
+        ref = mod.data.get(path[-1].upper()) if mod is not None else None
+        if ref is None:
+            raise KrlRuntimeError(f"IMPORT {item.name}: {'/'.join(path)} not found")
+        return ref
 
     def signal_ref(self, item: N.SignalDecl):
         if item.start is None:   # `SIGNAL $NAME FALSE`: a signal permanently FALSE

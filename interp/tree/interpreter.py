@@ -40,6 +40,14 @@ class TreeInterpreter:
             N.AnoutOn: self.s_unsupported, N.AnoutOff: self.s_unsupported,
             N.DeclStmt: self.s_declstmt, N.Unsupported: self.s_unsupported_text,
         }
+        for cls_name in ("KeywordStmt", "MoveEmi"):
+            cls = getattr(N, cls_name, None)
+            if cls is not None:
+                self.stmt_dispatch[cls] = self.s_stub
+        self.stmt_dispatch[N.AninOn] = self.s_anin_on
+        self.stmt_dispatch[N.AninOff] = self.s_anin_off
+        self.stmt_dispatch[N.AnoutOn] = self.s_anout_on
+        self.stmt_dispatch[N.AnoutOff] = self.s_anout_off
         self.expr_dispatch = {
             N.IntLit: self.e_lit, N.RealLit: self.e_lit, N.BoolLit: self.e_lit,
             N.StrLit: self.e_lit, N.EnumLit: self.e_enum, N.Aggregate: self.e_aggregate,
@@ -117,6 +125,10 @@ class TreeInterpreter:
             value = self.eval(st.value, frame)
             ref = self.ref(st.target, frame)
             self.rt.assign(ref, value)
+            t = st.target
+            if isinstance(t, N.Index) and isinstance(t.base, N.Name) and t.base.name.upper() == "$CYCFLAG":
+                # a cyclic flag: re-evaluated every IPO cycle until assigned again (§5.15)
+                self.rt.cyclic_on(("CYCFLAG", ref.name), lambda: self.rt.assign(ref, self.eval(st.value, frame)))
         self.guarded(do, st, frame)
 
     def s_call(self, st, frame) -> None:
@@ -248,6 +260,53 @@ class TreeInterpreter:
     def s_declstmt(self, st, frame) -> None:
         raise KrlRuntimeError("declaration after the first statement", None, st.span.file, st.span.line)
 
+    def s_stub(self, st, frame) -> None:
+        """CONFIRM, ASYPTP, MOVE_EMI, ... (§5.20): recognised, not simulated."""
+        self.begin(st, frame)
+        words = getattr(st, "words", None)
+        self.rt.stub_statement(" ".join(words) if words else type(st).__name__.upper())
+
+    # analog I/O (§5.14) --------------------------------------------------------------
+    def s_anout_on(self, st, frame) -> None:
+        self.begin(st, frame)
+        rt = self.rt
+
+        def do():
+            ref = rt.lookup(st.name, frame)
+            lo = float(num(self.eval(st.minimum, frame))) if st.minimum is not None else -1.0
+            hi = float(num(self.eval(st.maximum, frame))) if st.maximum is not None else 1.0
+
+            def tick():
+                v = float(num(self.eval(st.value, frame)))
+                ref.set(min(hi, max(lo, v)))
+            tick()
+            rt.cyclic_on(("ANOUT", st.name.upper()), tick)
+        self.guarded(do, st, frame)
+
+    def s_anout_off(self, st, frame) -> None:
+        self.begin(st, frame)
+        self.rt.cyclic_off(("ANOUT", st.name.upper()))
+
+    def s_anin_on(self, st, frame) -> None:
+        self.begin(st, frame)
+        rt = self.rt
+        names = [n.name.upper() for n in st.value.walk() if isinstance(n, N.Name)]
+
+        def do():
+            ref = self.ref(st.target, frame)
+
+            def tick():
+                rt.assign(ref, self.eval(st.value, frame))
+            tick()
+            for name in names:
+                rt.cyclic_on(("ANIN", name), tick)
+                break
+        self.guarded(do, st, frame)
+
+    def s_anin_off(self, st, frame) -> None:
+        self.begin(st, frame)
+        self.rt.cyclic_off(("ANIN", st.name.upper()))
+
     def s_unsupported(self, st, frame) -> None:
         self.begin(st, frame)
         raise KrlRuntimeError(f"{type(st).__name__} is not supported by this simulator", None,
@@ -304,7 +363,9 @@ class TreeInterpreter:
                 call = act.call
                 target = rt.find_routine(call.name, frame.module)
                 if target is not None:
-                    args = self.args_for(call, frame)   # evaluated now (advance run)
+                    # the arguments are evaluated now, in the advance run (§5.18)
+                    args = [None if a is None else ValueRef(copy_value(self.eval(a, frame)))
+                            for a in call.args]
 
                     def action():
                         self.exec_trigger_stmt(act, frame, lambda: self.invoke(target, args, frame))
@@ -404,18 +465,23 @@ class TreeInterpreter:
         task = rt.current_task
         prev = task.frame
         task.frame = frame
+        returned = False
         try:
             self.exec_block(routine.body, frame)
             if routine.kind == "DEFFCT":
                 raise KrlRuntimeError(f"function {routine.name} ended without RETURN", None,
                                       routine.span.file, frame.line or routine.span.line)
+            returned = True
             return None
         except ReturnSignal as r:
             if routine.kind == "DEFFCT":
                 if r.value is None:
                     raise KrlRuntimeError(f"RETURN without a value in function {routine.name}", None,
                                           routine.span.file, frame.line) from None
-                return rt.return_value(routine, r.value, module)
+                value = rt.return_value(routine, r.value, module)
+                returned = True
+                return value
+            returned = True
             return None
         except GotoSignal as g:
             raise KrlRuntimeError(f"GOTO {g.label}: label not found", None, routine.span.file, frame.line) from None
@@ -425,7 +491,7 @@ class TreeInterpreter:
             raise
         finally:
             task.frame = prev
-            rt.leave_routine(frame)
+            rt.leave_routine(frame, returned)
 
     # ------------------------------------------------------------------ expressions
     def eval(self, e, frame):

@@ -131,5 +131,87 @@ def test_cli_exit_codes_and_trace(tmp_path):
     assert p.returncode == 1 and "value invalid" in p.stdout and "bad.src:3" in p.stdout
     p = _krl("run", halt)
     assert p.returncode == 3 and "halt" in p.stdout
-    p = _krl("run", ok, "--interp", "vm")
-    assert p.returncode == 2 and "not built yet" in p.stderr
+
+
+def test_cycflag_is_reevaluated_and_fires_an_interrupt(tmp_path):
+    r = run_krl(tmp_path, """
+    DEF prog()
+      $CYCFLAG[2] = $IN[4] AND $IN[5]
+      INTERRUPT DECL 10 WHEN $CYCFLAG[2] DO Found()
+      INTERRUPT ON 10
+      WAIT SEC 0.5
+    END
+    DEF Found()
+      $OUT[1] = TRUE
+    END
+    """, stimuli='stimuli:\n  - at: 0.1\n    set: {"$IN[4]": true}\n  - at: 0.2\n    set: {"$IN[5]": true}\n')
+    assert r.io("$OUT[1]")[0][0] == pytest.approx(0.204, abs=0.013)
+
+
+def test_anout_anin_on_off(tmp_path):
+    r = run_krl(tmp_path, """
+    DEF prog()
+      SIGNAL SpeedOut $ANOUT[1]
+      SIGNAL SensIn $ANIN[2]
+      DECL REAL v
+      ANOUT ON SpeedOut = 0.5 * SensIn
+      ANIN ON v = 1.0 * SensIn
+      WAIT SEC 0.3
+      ANOUT OFF SpeedOut
+      ANIN OFF SensIn
+      $OUT[1] = ABS(v - 0.8) < 0.0001
+      $ANOUT[1] = 0.1
+    END
+    """, stimuli='stimuli:\n  - at: 0.1\n    set: {"$ANIN[2]": 0.8}\n')
+    assert r.result.reason == "completed"
+    assert [v for _, v in r.io("$ANOUT[1]")] == [pytest.approx(0.4), pytest.approx(0.1)]
+    assert r.io("$OUT[1]")[0][1] is True
+
+
+def test_stub_statements_import_and_routine_const(tmp_path):
+    r = run_krl(tmp_path, """
+    DEF prog()
+      DECL CONST INT OFFS = 10
+      DECL INT handle
+      IMPORT INT parts IS /R1/cell..PartCount
+      handle = 0
+      CONFIRM handle
+      ASYPTP {E1 90}
+      parts = parts + OFFS
+    END
+    """, files={"cell.dat": "DEFDAT cell\n  DECL INT PartCount = 7\nENDDAT\n"})
+    assert r.result.reason == "completed", r.result
+    assert r.var("cell", "PartCount") == 17
+    assert any("stub: CONFIRM" in e.get("text", "") for e in r.kinds("message"))
+
+
+def test_trigger_call_arguments_are_evaluated_in_the_advance_run(tmp_path):
+    r = run_krl(tmp_path, f"""
+    DEF prog()
+      DECL INT n
+      {HOME}
+      n = 3
+      TRIGGER WHEN DISTANCE=1 DELAY=0 DO Mark(n) PRIO=-1
+      PTP {{A1 20}}
+      n = 5
+    END
+    DEF Mark(k :IN)
+      DECL INT k
+      $OUT[k] = TRUE
+    END
+    """)
+    assert r.io("$OUT[3]") and not r.io("$OUT[5]")
+
+
+def test_no_return_event_after_an_error(tmp_path):
+    r = run_krl(tmp_path, """
+    DEF prog()
+      Fail()
+    END
+    DEF Fail()
+      DECL INT u
+      u = u + 1
+    END
+    """)
+    assert r.result.reason == "error"
+    assert not [e for e in r.kinds("return") if e["name"] == "Fail"]
