@@ -25,6 +25,7 @@ Usage::
 
 from __future__ import annotations
 
+import re
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -74,6 +75,21 @@ class Workspace:
     parse_seconds: float = 0.0
     check_seconds: float = 0.0
     checked: bool = False
+    # words of files that did not parse: a name among them may be declared there
+    failed_words: set = field(default_factory=set)
+    unreadable: bool = False
+
+    def maybe_declared(self, name: str) -> bool:
+        """True when a file that could not be parsed (or read) may declare `name`."""
+        return self.unreadable or name.upper() in self.failed_words
+
+    def _note_failed(self, result, text: str) -> None:
+        if result.ok:
+            return
+        if result.status in ("binary", "too_large", "unreadable"):
+            self.unreadable = True
+        elif text:
+            self.failed_words.update(w.upper() for w in _WORD.findall(text))
 
     @property
     def diagnostics(self) -> list[Diagnostic]:
@@ -111,6 +127,7 @@ class Workspace:
             if not err.cascade:
                 self.sink.add(path_s, err.line, err.column + 1, "E002", err.message)
         t = time.perf_counter()
+        self._note_failed(result, src.text)
         module = build_module(result, self.sink)
         self.check_seconds += time.perf_counter() - t
         sf = SourceFile(path_s, module, result.ok, result.status, parse_seconds=elapsed)
@@ -127,6 +144,7 @@ class Workspace:
         for err in result.errors:
             if not err.cascade:
                 self.sink.add(path, err.line, err.column + 1, "E002", err.message)
+        self._note_failed(result, text)
         module = build_module(result, self.sink)
         sf = SourceFile(path, module, result.ok, result.status)
         self.files.append(sf)
@@ -194,10 +212,9 @@ class Workspace:
         _system, basis = system_scopes()
         incomplete = self.incomplete
         sink = self.sink
-        declarer = Declarer(sink, incomplete)
+        declarer = Declarer(sink, incomplete, self.maybe_declared)
         checker = Checker(sink, declarer, incomplete)
         glob = Scope("global", "$GLOBAL", basis)
-        glob.incomplete = incomplete
         self.global_scope = glob
         self._pair()
 
@@ -303,6 +320,7 @@ class Workspace:
 
 
 SYSTEM_DIRS = ("system", "tp", "mada", "steu")
+_WORD = re.compile(r"[A-Za-z_$][A-Za-z0-9_$]*")
 
 
 def is_system_path(path: str) -> bool:

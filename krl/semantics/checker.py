@@ -14,8 +14,10 @@ Two jobs:
   variables and constants (E501/E502), conditions (E204), SWITCH (E207), FOR (E208),
   motion targets (E209), operators (E203).
 
-When the workspace is incomplete (a file of it has syntax errors, so declarations may be
-missing), "not found" findings are warnings (W101/W105/W106) instead of errors.
+When a name is not found but may be declared in a part of the workspace that could not be
+read (a file with syntax errors whose text contains the name), or in a KUKA system file
+(which relies on $operate.dat, never part of a backup), the finding is a warning
+(W101/W105/W106) instead of an error.
 """
 
 from __future__ import annotations
@@ -40,9 +42,11 @@ def _is_system_datalist(name: str) -> bool:
 class Declarer:
     """Enters declarations into scopes. One instance per workspace."""
 
-    def __init__(self, sink: DiagnosticSink, incomplete: bool = False):
+    def __init__(self, sink: DiagnosticSink, incomplete: bool = False, maybe_declared=None):
         self.sink = sink
         self.incomplete = incomplete
+        # maybe_declared(name) -> True when an unreadable part of the workspace may declare it
+        self.maybe_declared = maybe_declared or (lambda _name: incomplete)
         # unknown types are only warnings in system data lists: they use types of
         # $operate.dat, which lives on the controller and is not part of a backup
         self.soft_types = False
@@ -63,7 +67,7 @@ class Declarer:
         name = tref.name if isinstance(tref, N.TypeRef) else tref
         typ = scope.lookup_type(name)
         if typ is None:
-            if self.incomplete or self.soft_types or scope.is_incomplete():
+            if self.soft_types or self.maybe_declared(name):
                 self.sink.at(span, "W105", f"unknown type '{name}'")
             else:
                 self.sink.at(span, "E105", f"unknown type '{name}'")
@@ -214,8 +218,8 @@ class Checker:
         # set while checking a .sub file: the submit interpreter has no motion (9, 8.2)
         self.submit = False
 
-    def _soft(self, sc: Scope) -> bool:
-        return self.incomplete or self.system_file or sc.is_incomplete()
+    def _soft(self, sc: Scope, name: str) -> bool:
+        return self.system_file or self.decl.maybe_declared(name)
 
     # ---------------------------------------------------------------- entry points
 
@@ -807,7 +811,7 @@ class Checker:
             for a in c.args:
                 if a is not None:
                     self.expr(a, sc)
-            code = "W106" if self._soft(sc) else "E106"
+            code = "W106" if self._soft(sc, c.name) else "E106"
             self.sink.at(c.span, code, f"routine '{c.name}' is not declared")
             return T.UNKNOWN
         c.annotate().symbol = sym
@@ -844,14 +848,14 @@ class Checker:
     def not_found(self, span: N.Span, name: str, sc: Scope) -> None:
         if name.startswith("$"):
             self.sink.at(span, "W107", f"unknown system variable '{name}'")
-        elif self._soft(sc):
-            why = "system file" if self.system_file else "the workspace has files with syntax errors"
+        elif self._soft(sc, name):
+            why = "system file" if self.system_file else "a file with syntax errors mentions it"
             self.sink.at(span, "W101", f"'{name}' is not declared ({why})")
         else:
             self.sink.at(span, "E101", f"'{name}' is not declared")
 
     def not_found_type(self, span: N.Span, name: str, sc: Scope) -> None:
-        code = "W105" if self._soft(sc) else "E105"
+        code = "W105" if self._soft(sc, name) else "E105"
         self.sink.at(span, code, f"unknown type '{name}'")
 
 

@@ -224,3 +224,12 @@ def test_import_links_to_the_data_list_variable():
     assert sym.alias is not None and sym.alias.name == "counter" and sym.module == "other"
     files["t.dat"] = "DEFDAT t\n  IMPORT INT n IS /R1/other..nothing\nENDDAT\n"
     assert [d.code for d in check_texts(files).diagnostics] == ["E101"]
+
+
+def test_names_from_unparsable_files_are_warnings_only():
+    """A name that a file with syntax errors mentions may be declared there: W101, not E101."""
+    from krl.workspace import check_texts
+    ws = check_texts({"broken.dat": "DEFDAT broken PUBLIC\n  DECL GLOBAL INT foo = = 1\nENDDAT\n",
+                      "t.src": "DEF t()\n  foo = 1\n  bar = 2\nEND\n"})
+    got = sorted((d.code, d.message.split("'")[1]) for d in ws.diagnostics if d.code != "E002")
+    assert got == [("E101", "bar"), ("W101", "foo")]

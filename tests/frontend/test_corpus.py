@@ -42,6 +42,20 @@ TRUE_ERRORS = [
      "an enum literal is passed to the REAL parameter rCutRefX (stale call, see E301)"),
     (r"rawpython__kukaKRLmagic/R1/Program/sample_program_with_globals.src", "E103", r"27 characters",
      "the routine name has 27 characters; KRL names have at most 24 (1.2)"),
+    (r"HugoDanielson__ChinaMilling/KRC/R1/Program/KukaMiling/IO/(Inputs|Outputs).src", "E101",
+     r"'(IN|OUT)_\w+' is not declared",
+     "the I/O signals IN_Tool_InHolder_1.., IN_WorkPiece*, OUT_LightGreen, OUT_RobotUnknowPos are declared "
+     "in no file of the backup (no SIGNAL line anywhere)"),
+    (r"HugoDanielson__ChinaMilling/KRC/R1/Program/KukaMiling/Main_2.src", "E101", r"'(IN_StopRobot|OUT_LightBuzz)'",
+     "declared in no file of the backup; the other uses (Buttons.src) are commented out"),
+    (r"HugoDanielson__ChinaMilling/KRC/R1/Program/KukaMiling/Jobs/St2", "E106",
+     r"'(SpindleRelease|SpindleClamp|SpindleClampWithTool)'",
+     "these routines are commented out in Jobs/Spindle.src (`;GLOBAL DEF SpindleRelease()`)"),
+    (r"HugoDanielson__ChinaMilling/KRC/R1/Program/KukaMiling/Moves/FromSt1/st1_st4.src", "E101",
+     r"'(xST1_St4_1|FST1_St4_1|xST1_ST4_10)'",
+     "inline-form points of module st1_st4, whose st1_st4.dat is missing from the backup"),
+    (r"HugoDanielson__ChinaMilling/KRC/R1/Program/millingcn.src", "E101", r"'t_vel'",
+     "declared nowhere (sps.sub mentions t_vel only in comments)"),
 ]
 
 
