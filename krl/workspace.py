@@ -352,9 +352,11 @@ def find_backups(root: str | Path) -> list[Path]:
     holding R1, e.g. KRC) or System/$config.dat (a flat R1 export). Any letter case; sorted."""
     root = Path(root)
     found: set[Path] = set()
-    for cfg in root.rglob("*"):
-        if cfg.name.lower() != "$config.dat" or not cfg.is_file():
-            continue
+    try:
+        candidates = [p for p in root.rglob("*") if p.name.lower() == "$config.dat" and p.is_file()]
+    except OSError:
+        candidates = []
+    for cfg in candidates:
         system = cfg.parent
         if system.name.lower() != "system":
             continue
