@@ -65,8 +65,7 @@ def expr(e: N.Expr | None) -> str:
     if isinstance(e, N.Field):
         return f"{expr(e.base)}.{e.name}"
     if isinstance(e, N.Call):
-        return f"{e.name}({', '.join(expr(a) for a in e.args)})".replace(", )", ",)") \
-            if e.args else f"{e.name}()"
+        return f"{e.name}({', '.join(expr(a) for a in e.args)})"
     if isinstance(e, N.Aggregate):
         head = f"{e.type_name}: " if e.type_name else ""
         items = ", ".join(f"{i.name}{'[]' if i.array else ''} {expr(i.value)}" for i in e.items)
