@@ -10,10 +10,14 @@ function's. tests/vm/test_slots.py checks the fast paths against the general fun
 
 from __future__ import annotations
 
+from krl.semantics import types as T
+
 from .convert import INT_MAX, INT_MIN, binary_op, num
 from .errors import KrlRuntimeError
-from .memory import Slot, index_ref
+from .memory import Slot, field_ref, index_ref
 from .values import Arr, Struct, copy_value
+
+INT, REAL, BOOL = T.INT, T.REAL, T.BOOL
 
 
 # ------------------------------------------------------------------ reading
@@ -34,16 +38,131 @@ def array_index(v) -> int:
     return v
 
 
-def element(base, i, name: str):
-    """Value of ``base[i]`` (one index). Fast path: a Slot holding a 1-D array of scalars
-    and an index in range; everything else through memory.index_ref."""
+def load(ref):
+    """:func:`read_value` (fast path: an INT/REAL/BOOL value in a Slot)."""
+    if ref.__class__ is Slot:
+        v = ref.c[ref.k]
+        c = v.__class__
+        if c is int or c is float or c is bool:
+            return v
+    return read_value(ref)
+
+
+def _store_fast(c, k, t, v) -> bool:
+    """Store scalar ``v`` into ``c[k]`` of type ``t`` when no conversion is involved."""
+    vc = v.__class__
+    if t is INT:
+        if vc is int and INT_MIN <= v <= INT_MAX:
+            c[k] = v
+            return True
+    elif t is REAL:
+        if vc is float:
+            c[k] = v
+            return True
+    elif t is BOOL:
+        if vc is bool:
+            c[k] = v
+            return True
+    return False
+
+
+def store(ref, v) -> None:
+    """Runtime.assign (``ref.set``), fast path: a writable Slot of type INT/REAL/BOOL
+    without write hook and a value of that very type."""
+    if ref.__class__ is Slot and not ref.readonly and ref.on_write is None \
+            and _store_fast(ref.c, ref.k, ref.type, v):
+        return
+    ref.set(v)
+
+
+def _flat(base, idx):
+    """(array, flat position) for a plain Slot holding an array of scalars and INT
+    indices in range, else None."""
+    if base.__class__ is not Slot:
+        return None
+    a = base.c[base.k]
+    if a.__class__ is not Arr:
+        return None
+    dims = a.dims
+    if len(idx) != len(dims):
+        return None
+    pos = 0
+    for i, n in zip(idx, dims):
+        if i.__class__ is not int or not 1 <= i <= n:
+            return None
+        pos = pos * n + (i - 1)
+    return a, pos
+
+
+def element(base, idx: list, name: str):
+    """Value of ``base[idx]`` (``idx``: the evaluated index values, none omitted)."""
+    got = _flat(base, idx)
+    if got is not None:
+        x = got[0].data[got[1]]
+        c = x.__class__
+        if c is int or c is float or c is bool:
+            return x
+    return read_value(index_ref(base, [array_index(i) for i in idx], name))
+
+
+def element1(base, i, name: str):
+    """:func:`element` with one index (no list built on the fast path)."""
     if base.__class__ is Slot and i.__class__ is int:
-        v = base.c[base.k]
-        if v.__class__ is Arr and len(v.dims) == 1 and 1 <= i <= v.dims[0]:
-            x = v.data[i - 1]
-            if x.__class__ is int or x.__class__ is float:
+        a = base.c[base.k]
+        if a.__class__ is Arr and len(a.dims) == 1 and 1 <= i <= a.dims[0]:
+            x = a.data[i - 1]
+            c = x.__class__
+            if c is int or c is float or c is bool:
                 return x
-    return read_value(index_ref(base, [array_index(i)], name))
+    return element(base, [i], name)
+
+
+def element2(base, i, j, name: str):
+    """:func:`element` with two indices."""
+    if base.__class__ is Slot and i.__class__ is int and j.__class__ is int:
+        a = base.c[base.k]
+        if a.__class__ is Arr and len(a.dims) == 2:
+            n, m = a.dims
+            if 1 <= i <= n and 1 <= j <= m:
+                x = a.data[(i - 1) * m + j - 1]
+                c = x.__class__
+                if c is int or c is float or c is bool:
+                    return x
+    return element(base, [i, j], name)
+
+
+def set_element(base, idx: list, v, name: str) -> None:
+    """``base[idx] = v`` (Runtime.index + Runtime.assign)."""
+    got = _flat(base, idx)
+    if got is not None and not base.readonly:
+        a, pos = got
+        if _store_fast(a.data, pos, a.type.elem, v):
+            return
+    index_ref(base, [array_index(i) for i in idx], name).set(v)
+
+
+def component(base, comp: str, name: str):
+    """Value of ``base.comp`` (Runtime.field, then read)."""
+    if base.__class__ is Slot:
+        s = base.c[base.k]
+        if s.__class__ is Struct:
+            x = s.f.get(comp.upper())
+            c = x.__class__
+            if c is int or c is float or c is bool:
+                return x
+    return read_value(field_ref(base, comp, name))
+
+
+def set_component(base, comp: str, v, name: str) -> None:
+    """``base.comp = v`` (Runtime.field + Runtime.assign)."""
+    if base.__class__ is Slot and not base.readonly:
+        s = base.c[base.k]
+        if s.__class__ is Struct and s.type is not None:
+            key = comp.upper()
+            ft = s.type.fields.get(key)
+            if ft is not None and key in s.f and _store_fast(s.f, key, ft[1], v):
+                return
+    field_ref(base, comp, name).set(v)
 
 
 # ------------------------------------------------------------------ FOR (reference §5.4)
@@ -62,48 +181,73 @@ def for_done(c, end, step) -> bool:
 
 
 # ------------------------------------------------------------------ operators (fast paths of convert.binary_op)
+# Numbers only (``__class__`` is int or float: BOOL, CHAR, ENUM and UNSET take the general
+# path). INT op INT stays INT unless it leaves the 32-bit range; with a REAL operand the
+# result is REAL, as in binary_op.
 def add(a, b):
-    if a.__class__ is int and b.__class__ is int:
+    ca = a.__class__
+    cb = b.__class__
+    if ca is int and cb is int:
         r = a + b
         if INT_MIN <= r <= INT_MAX:
             return r
-    elif a.__class__ is float and b.__class__ is float:
-        return a + b
+    elif (ca is float or ca is int) and (cb is float or cb is int):
+        return float(a + b)
     return binary_op("+", a, b)
 
 
 def sub(a, b):
-    if a.__class__ is int and b.__class__ is int:
+    ca = a.__class__
+    cb = b.__class__
+    if ca is int and cb is int:
         r = a - b
         if INT_MIN <= r <= INT_MAX:
             return r
-    elif a.__class__ is float and b.__class__ is float:
-        return a - b
+    elif (ca is float or ca is int) and (cb is float or cb is int):
+        return float(a - b)
     return binary_op("-", a, b)
 
 
 def mul(a, b):
-    if a.__class__ is int and b.__class__ is int:
+    ca = a.__class__
+    cb = b.__class__
+    if ca is int and cb is int:
         r = a * b
         if INT_MIN <= r <= INT_MAX:
             return r
-    elif a.__class__ is float and b.__class__ is float:
-        return a * b
+    elif (ca is float or ca is int) and (cb is float or cb is int):
+        return float(a * b)
     return binary_op("*", a, b)
 
 
-def lt(a, b):
+def _numbers(a, b) -> bool:
     ca = a.__class__
-    if (ca is int or ca is float) and (b.__class__ is int or b.__class__ is float):
-        return a < b
-    return binary_op("<", a, b)
+    cb = b.__class__
+    return (ca is int or ca is float) and (cb is int or cb is float)
+
+
+def lt(a, b):
+    return a < b if _numbers(a, b) else binary_op("<", a, b)
+
+
+def le(a, b):
+    return a <= b if _numbers(a, b) else binary_op("<=", a, b)
+
+
+def gt(a, b):
+    return a > b if _numbers(a, b) else binary_op(">", a, b)
+
+
+def ge(a, b):
+    return a >= b if _numbers(a, b) else binary_op(">=", a, b)
 
 
 def eq(a, b):
-    ca = a.__class__
-    if (ca is int or ca is float) and (b.__class__ is int or b.__class__ is float):
-        return a == b
-    return binary_op("==", a, b)
+    return a == b if _numbers(a, b) else binary_op("==", a, b)
+
+
+def ne(a, b):
+    return a != b if _numbers(a, b) else binary_op("<>", a, b)
 
 
 # ------------------------------------------------------------------ TRIGGER arguments
@@ -115,3 +259,14 @@ def trigger_args(kind: str, at, delay, prio, onstart: bool = False) -> dict:
     if kind == "PATH":
         return {"path": float(at), "onstart": onstart, "delay_ms": delay, "prio": p}
     return {"distance": int(at), "delay_ms": delay, "prio": p}
+
+
+# ------------------------------------------------------------------ ANOUT ON (reference §5.14)
+def anout_limits(lo, hi) -> tuple:
+    """(minimum, maximum) of ANOUT ON: the given values as REAL, default -1.0 and 1.0."""
+    return (float(num(lo)) if lo is not None else -1.0, float(num(hi)) if hi is not None else 1.0)
+
+
+def anout_value(v, lo: float, hi: float) -> float:
+    """The analog output value: REAL, clamped to [minimum, maximum]."""
+    return min(hi, max(lo, float(num(v))))

@@ -40,7 +40,8 @@ def name_of(e) -> str:
     return "?"
 
 
-_FAST_BINOPS = {"+": "ADD", "-": "SUB", "*": "MUL", "<": "LT", "==": "EQ"}
+_FAST_BINOPS = {"+": "ADD", "-": "SUB", "*": "MUL", "<": "LT", "<=": "LE", ">": "GT", ">=": "GE",
+                "==": "EQ", "<>": "NE"}
 _FOLDABLE = (int, float, bool, str, EnumValue)
 
 
@@ -132,6 +133,8 @@ class Compiler:
             self.place(label)
             fn()
             self.emit("END_THUNK")
+        peephole(self.lst)
+        peephole(self.lst)
         return format_listing(self.lst)
 
     def thunk(self, fn) -> str:
@@ -157,7 +160,16 @@ class Compiler:
     def s_Assign(self, st) -> None:
         end = self.guarded(st)
         self.expr(st.value)
-        self.store(st.target)
+        t = st.target
+        if isinstance(t, N.Index) and isinstance(t.base, N.Name) and t.base.name.upper() == "$CYCFLAG":
+            # a cyclic flag: re-evaluated every IPO cycle until assigned again (§5.15)
+            def value():
+                self.region = None
+                self.expr(st.value)
+            self.ref(t)
+            self.emit("CYCFLAG", self.thunk(value))
+        else:
+            self.store(t)
         self.place(end)
 
     def s_CallStmt(self, st) -> None:
@@ -223,13 +235,13 @@ class Compiler:
         self.emit("FOR_PREP", t)
         self.region = None
         self.emit("FOR_INIT", t)
-        test, end = self.new_label(), self.new_label()
-        self.place(test)
+        body, end = self.new_label(), self.new_label()
         self.emit("FOR_TEST", t, end)
         self.emit("TICK", info)
+        self.place(body)
         self.loop_body(st.body, end)
         self.region = None
-        self.emit("FOR_NEXT", t, test)
+        self.emit("FOR_NEXT", t, info, body)
         self.place(end)
 
     def loop_body(self, body, end) -> None:
@@ -344,11 +356,51 @@ class Compiler:
         self.region = None
         self.emit("RAISE", f"unsupported statement: {st.text.strip()[:60]}", st.span.line)
 
-    def _unsupported(self, st) -> None:
+    def _stub(self, st) -> None:
         self.stmt(st)
-        self.emit("RAISE", f"{type(st).__name__} is not supported by this simulator", st.span.line)
+        words = getattr(st, "words", None)
+        self.emit("STUB", " ".join(words) if words else type(st).__name__.upper())
 
-    s_AninOn = s_AninOff = s_AnoutOn = s_AnoutOff = _unsupported
+    s_KeywordStmt = s_MoveEmi = _stub
+
+    # analog I/O (§5.14) -----------------------------------------------------------------
+    def s_AnoutOn(self, st) -> None:
+        end = self.guarded(st)
+        region = self.region
+
+        def value():
+            self.region = None
+            self.expr(st.value)
+        self.emit("REF_" + self.kind_of(st.name), st.name)
+        flags = ""
+        if st.minimum is not None:
+            self.expr(st.minimum)
+            flags += "L"
+        if st.maximum is not None:
+            self.expr(st.maximum)
+            flags += "H"
+        self.region = region
+        self.emit("ANOUT_ON", st.name.upper(), flags, self.thunk(value))
+        self.place(end)
+
+    def s_AnoutOff(self, st) -> None:
+        self.stmt(st)
+        self.emit("CYCLIC_OFF", "ANOUT", st.name.upper())
+
+    def s_AninOn(self, st) -> None:
+        end = self.guarded(st)
+        names = [n.name.upper() for n in st.value.walk() if isinstance(n, N.Name)]
+
+        def value():
+            self.region = None
+            self.expr(st.value)
+        self.ref(st.target)
+        self.emit("ANIN_ON", names[0] if names else None, self.thunk(value))
+        self.place(end)
+
+    def s_AninOff(self, st) -> None:
+        self.stmt(st)
+        self.emit("CYCLIC_OFF", "ANIN", st.name.upper())
 
     # interrupts, triggers, brake ------------------------------------------------------
     def s_InterruptDecl(self, st) -> None:
@@ -396,7 +448,12 @@ class Compiler:
         if isinstance(act, N.CallStmt):
             nf = self.new_label()
             self.emit("TRIG_FIND", act.call.name, nf)
-            self.args(act.call)
+            for a in act.call.args:      # evaluated now, in the advance run, by value (§5.18)
+                if a is None:
+                    self.emit("NONE")
+                else:
+                    self.expr(a)
+                    self.emit("VALARG")
             self.emit("TRIG_PACK", len(act.call.args))
             self.place(nf)
             self.region = region
@@ -521,6 +578,13 @@ class Compiler:
     def store(self, target) -> None:
         if isinstance(target, N.Name):
             self.emit("STORE_" + self.kind_of(target.name), target.name)
+        elif isinstance(target, N.Index) and None not in target.indices:
+            self.ref(target.base)
+            self.indices(target)
+            self.emit("STORE_INDEX", len(target.indices), name_of(target.base))
+        elif isinstance(target, N.Field):
+            self.ref(target.base)
+            self.emit("STORE_FIELD", target.name, name_of(target.base))
         else:
             self.ref(target)
             self.emit("ASSIGN")
@@ -564,7 +628,11 @@ class Compiler:
         elif isinstance(e, N.Index):
             self.ref(e.base)
             self.indices(e)
-            self.emit("LOAD_INDEX", len(e.indices), name_of(e.base))
+            if None in e.indices:
+                self.emit("INDEX", len(e.indices), name_of(e.base))
+                self.emit("DEREF")
+            else:
+                self.emit("LOAD_INDEX", len(e.indices), name_of(e.base))
         elif isinstance(e, N.Field):
             self.ref(e.base)
             self.emit("LOAD_FIELD", e.name, name_of(e.base))
@@ -587,6 +655,70 @@ class Compiler:
             self.emit("AGG", e.type_name, ",".join(it.name.upper() for it in e.items))
         else:
             self.emit("RAISE", f"cannot evaluate {type(e).__name__}", 0)
+
+
+_CMP_JUMPS = {"LT": "IF_NOT_LT", "LE": "IF_NOT_LE", "GT": "IF_NOT_GT", "GE": "IF_NOT_GE",
+              "EQ": "IF_NOT_EQ", "NE": "IF_NOT_NE"}
+_CONST_OPS = {"ADD": "ADD_CONST", "SUB": "SUB_CONST", "MUL": "MUL_CONST"}
+
+
+def _fuse(group: list):
+    """The superinstruction for a group of instructions, or None."""
+    names = [g[0] for g in group]
+    ops = [g[1] for g in group]
+    if len(group) == 3 and names == ["REF_LOCAL", "LOAD_LOCAL2", "LOAD_INDEX"] and ops[2][0] == 2:
+        return ("LOAD_ELEM2_LLL", [ops[0][0], ops[1][0], ops[1][1], ops[2][1]])
+    if len(group) == 3 and names[:2] == ["REF_LOCAL", "LOAD_LOCAL"] and names[2] in ("LOAD_INDEX", "STORE_INDEX") \
+            and ops[2][0] == 1:
+        return ("LOAD_ELEM_LL" if names[2] == "LOAD_INDEX" else "STORE_ELEM_LL", [ops[0][0], ops[1][0], ops[2][1]])
+    if len(group) == 2:
+        if names[1] == "JUMP_IF_FALSE" and names[0] in _CMP_JUMPS:
+            return (_CMP_JUMPS[names[0]], [ops[1][0]])
+        if names[0] == "CONST" and names[1] in _CONST_OPS:
+            return (_CONST_OPS[names[1]], [ops[0][0]])
+        if names == ["LOAD_LOCAL", "LOAD_LOCAL"]:
+            return ("LOAD_LOCAL2", [ops[0][0], ops[1][0]])
+    return None
+
+
+def peephole(lst: Listing) -> None:
+    """Replace common instruction sequences by superinstructions (opcodes.py). A sequence
+    is fused only when no label points inside it and all of it lies in one error region;
+    the fused instruction keeps the region of the sequence's first instruction, except a
+    compare-and-jump, whose only possible error is the comparison's."""
+    old = lst.instrs
+    targets = set(lst.labels.values())
+    new: list = []
+    where: dict = {}
+    i = 0
+    while i < len(old):
+        done = False
+        for n in (3, 2):
+            group = old[i:i + n]
+            if len(group) < n or any(i + k in targets for k in range(1, n)):
+                continue
+            fused = _fuse(group)
+            if fused is None:
+                continue
+            regions = [g[2] for g in group]
+            if fused[0] in _CMP_JUMPS.values():
+                region = regions[0]
+            elif all(r is regions[0] for r in regions):
+                region = regions[0]
+            else:
+                continue
+            where[i] = len(new)
+            new.append((fused[0], fused[1], region))
+            i += n
+            done = True
+            break
+        if not done:
+            where[i] = len(new)
+            new.append(old[i])
+            i += 1
+    where[len(old)] = len(new)
+    lst.instrs = new
+    lst.labels = {k: where[v] for k, v in lst.labels.items()}
 
 
 def compile_routine(rt, module, routine: N.Routine, frame: Frame | None = None) -> str:

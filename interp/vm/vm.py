@@ -26,8 +26,9 @@ import re
 from interp.runtime.builtins import ValueRef
 from interp.runtime.convert import num
 from interp.runtime.errors import ExitSignal, KrlRuntimeError, ResumeSignal
-from interp.runtime.slots import (add, array_index, element, eq, for_done, for_limits, lt, mul,
-                                  read_value, sub, trigger_args)
+from interp.runtime.slots import (add, anout_limits, anout_value, array_index, component, element, element1,
+                                  element2, eq, for_done, for_limits, ge, gt, le, load, lt, mul, ne, read_value,
+                                  set_component, set_element, store, sub, trigger_args)
 
 from . import opcodes as OP
 from .assembler import Code, assemble
@@ -77,6 +78,9 @@ class VM:
         prog = rt.program
         name = module_name or prog.main_path.stem
         m = prog.module(name)
+        if m is not None and m.syntax_errors:
+            raise KrlRuntimeError("the program has syntax errors and cannot start: " + m.syntax_errors[0],
+                                  None, m.path, 0)
         if m is None or m.main is None:
             raise KrlRuntimeError(f"no main routine in {name}")
         if m.syntax_errors:
@@ -107,20 +111,22 @@ class VM:
         task = rt.current_task
         prev = task.frame
         task.frame = frame
+        returned = False
         try:
             v = frame.vars
             act = Act(frame, [v[k] for k in code.lkeys], [None] * code.ntemps)
             value = self.run(code, act, 0, [])
             if code.kind == "DEFFCT":
-                return rt.return_value(routine, value, module)
-            return None
+                value = rt.return_value(routine, value, module)
+            returned = True
+            return value
         except ResumeSignal as r:
             if catch_resume and r.frame is caller and caller is not None:
                 return None
             raise
         finally:
             task.frame = prev
-            rt.leave_routine(frame)
+            rt.leave_routine(frame, returned)
 
     def call(self, code: Code, ip: int, name: str, args: list, frame, flags: str):
         rt = self.rt
@@ -156,73 +162,158 @@ class VM:
         pop = stack.pop
         before = rt.before_statement
         tick = rt.loop_tick
-        assign = rt.assign
+        take_error_proceed = rt.take_error_proceed
         proceed = False
         while True:
             try:
                 while True:
                     op = words[ip]
+                    # the hottest opcodes first (measured on the benchmark)
                     if op == OP.LOAD_LOCAL:
-                        push(read_value(refs[words[ip + 1]]))
-                        ip += 2
-                    elif op == OP.CONST:
-                        push(consts[words[ip + 1]])
+                        push(load(refs[words[ip + 1]]))
                         ip += 2
                     elif op == OP.STMT_G:
                         info = infos[words[ip + 1]]
                         if not thunk:
                             frame.line = info.line
                         before(info)
-                        proceed = rt.take_error_proceed()
+                        proceed = take_error_proceed()
+                        ip += 2
+                    elif op == OP.LOAD_ELEM_LL:
+                        push(element1(refs[words[ip + 1]], load(refs[words[ip + 2]]), consts[words[ip + 3]]))
+                        ip += 4
+                    elif op == OP.CONST:
+                        push(consts[words[ip + 1]])
                         ip += 2
                     elif op == OP.STORE_LOCAL:
-                        assign(refs[words[ip + 1]], pop())
+                        store(refs[words[ip + 1]], pop())
+                        ip += 2
+                    elif op == OP.TICK:
+                        tick(infos[words[ip + 1]])
                         ip += 2
                     elif op == OP.ADD:
                         b = pop()
                         stack[-1] = add(stack[-1], b)
                         ip += 1
-                    elif op == OP.LOAD_INDEX:
-                        n = words[ip + 1]
-                        if n == 1 and stack[-1] is not None:
-                            i = pop()
-                            stack[-1] = element(stack[-1], i, consts[words[ip + 2]])
+                    elif op == OP.STORE_ELEM_LL:
+                        set_element(refs[words[ip + 1]], [load(refs[words[ip + 2]])], pop(), consts[words[ip + 3]])
+                        ip += 4
+                    elif op == OP.IF_NOT_LE:
+                        b = pop()
+                        if le(pop(), b):
+                            ip += 2
                         else:
-                            idx = [None if x is None else array_index(x) for x in stack[-n:]]
-                            del stack[-n:]
-                            stack[-1] = read_value(rt.index(stack[-1], idx, consts[words[ip + 2]]))
-                        ip += 3
-                    elif op == OP.MUL:
-                        b = pop()
-                        stack[-1] = mul(stack[-1], b)
-                        ip += 1
-                    elif op == OP.SUB:
-                        b = pop()
-                        stack[-1] = sub(stack[-1], b)
-                        ip += 1
+                            ip = words[ip + 1]
+                    elif op == OP.JUMP:
+                        ip = words[ip + 1]
                     elif op == OP.FOR_TEST:
                         t = words[ip + 1]
                         if for_done(temps[t].get(), temps[t + 1], temps[t + 2]):
                             ip = words[ip + 2]
                         else:
                             ip += 3
-                    elif op == OP.TICK:
-                        tick(infos[words[ip + 1]])
-                        ip += 2
                     elif op == OP.FOR_NEXT:
                         t = words[ip + 1]
                         ref = temps[t]
-                        assign(ref, add(ref.get(), temps[t + 2]))
-                        ip = words[ip + 2]
-                    elif op == OP.LOAD_MOD:
-                        push(read_value(mrefs[words[ip + 1]]))
+                        step = temps[t + 2]
+                        store(ref, add(ref.get(), step))
+                        if for_done(ref.get(), temps[t + 1], step):
+                            ip += 4
+                        else:
+                            tick(infos[words[ip + 2]])
+                            ip = words[ip + 3]
+                    elif op == OP.LOAD_ELEM2_LLL:
+                        push(element2(refs[words[ip + 1]], load(refs[words[ip + 2]]), load(refs[words[ip + 3]]),
+                                      consts[words[ip + 4]]))
+                        ip += 5
+                    elif op == OP.LOAD_LOCAL2:
+                        push(load(refs[words[ip + 1]]))
+                        push(load(refs[words[ip + 2]]))
+                        ip += 3
+                    elif op == OP.ADD_CONST:
+                        stack[-1] = add(stack[-1], consts[words[ip + 1]])
                         ip += 2
-                    elif op == OP.STORE_MOD:
-                        assign(mrefs[words[ip + 1]], pop())
+                    elif op == OP.SUB_CONST:
+                        stack[-1] = sub(stack[-1], consts[words[ip + 1]])
                         ip += 2
+                    elif op == OP.IF_NOT_LT:
+                        b = pop()
+                        if lt(pop(), b):
+                            ip += 2
+                        else:
+                            ip = words[ip + 1]
                     elif op == OP.REF_LOCAL:
                         push(refs[words[ip + 1]])
                         ip += 2
+                    elif op == OP.JUMP_IF_FALSE:
+                        if rt.to_bool(pop()):
+                            ip += 2
+                        else:
+                            ip = words[ip + 1]
+                    elif op == OP.SUB:
+                        b = pop()
+                        stack[-1] = sub(stack[-1], b)
+                        ip += 1
+                    elif op == OP.MUL:
+                        b = pop()
+                        stack[-1] = mul(stack[-1], b)
+                        ip += 1
+                    elif op == OP.MUL_CONST:
+                        stack[-1] = mul(stack[-1], consts[words[ip + 1]])
+                        ip += 2
+                    elif op == OP.LOAD_INDEX:
+                        n = words[ip + 1]
+                        idx = stack[-n:]
+                        del stack[-n:]
+                        stack[-1] = element(stack[-1], idx, consts[words[ip + 2]])
+                        ip += 3
+                    elif op == OP.STORE_INDEX:
+                        n = words[ip + 1]
+                        idx = stack[-n:]
+                        del stack[-n:]
+                        base = pop()
+                        set_element(base, idx, pop(), consts[words[ip + 2]])
+                        ip += 3
+                    elif op == OP.LOAD_FIELD:
+                        stack[-1] = component(stack[-1], consts[words[ip + 1]], consts[words[ip + 2]])
+                        ip += 3
+                    elif op == OP.STORE_FIELD:
+                        base = pop()
+                        set_component(base, consts[words[ip + 1]], pop(), consts[words[ip + 2]])
+                        ip += 3
+                    elif op == OP.UNOP:
+                        stack[-1] = rt.unary_op(consts[words[ip + 1]], stack[-1])
+                        ip += 2
+                    elif op == OP.LOAD_MOD:
+                        push(load(mrefs[words[ip + 1]]))
+                        ip += 2
+                    elif op == OP.STORE_MOD:
+                        store(mrefs[words[ip + 1]], pop())
+                        ip += 2
+                    elif op == OP.IF_NOT_GT:
+                        b = pop()
+                        if gt(pop(), b):
+                            ip += 2
+                        else:
+                            ip = words[ip + 1]
+                    elif op == OP.IF_NOT_GE:
+                        b = pop()
+                        if ge(pop(), b):
+                            ip += 2
+                        else:
+                            ip = words[ip + 1]
+                    elif op == OP.IF_NOT_EQ:
+                        b = pop()
+                        if eq(pop(), b):
+                            ip += 2
+                        else:
+                            ip = words[ip + 1]
+                    elif op == OP.IF_NOT_NE:
+                        b = pop()
+                        if ne(pop(), b):
+                            ip += 2
+                        else:
+                            ip = words[ip + 1]
                     elif op == OP.INDEX:
                         n = words[ip + 1]
                         idx = [None if x is None else array_index(x) for x in stack[-n:]]
@@ -231,29 +322,35 @@ class VM:
                         ip += 3
                     elif op == OP.ASSIGN:
                         ref = pop()
-                        assign(ref, pop())
+                        store(ref, pop())
                         ip += 1
-                    elif op == OP.JUMP_IF_FALSE:
-                        if rt.to_bool(pop()):
-                            ip += 2
-                        else:
-                            ip = words[ip + 1]
-                    elif op == OP.JUMP:
-                        ip = words[ip + 1]
                     elif op == OP.LT:
                         b = pop()
                         stack[-1] = lt(stack[-1], b)
+                        ip += 1
+                    elif op == OP.LE:
+                        b = pop()
+                        stack[-1] = le(stack[-1], b)
+                        ip += 1
+                    elif op == OP.GT:
+                        b = pop()
+                        stack[-1] = gt(stack[-1], b)
+                        ip += 1
+                    elif op == OP.GE:
+                        b = pop()
+                        stack[-1] = ge(stack[-1], b)
                         ip += 1
                     elif op == OP.EQ:
                         b = pop()
                         stack[-1] = eq(stack[-1], b)
                         ip += 1
+                    elif op == OP.NE:
+                        b = pop()
+                        stack[-1] = ne(stack[-1], b)
+                        ip += 1
                     elif op == OP.BINOP:
                         b = pop()
                         stack[-1] = rt.binary_op(consts[words[ip + 1]], stack[-1], b)
-                        ip += 2
-                    elif op == OP.UNOP:
-                        stack[-1] = rt.unary_op(consts[words[ip + 1]], stack[-1])
                         ip += 2
                     elif op == OP.STMT:
                         info = infos[words[ip + 1]]
@@ -289,17 +386,14 @@ class VM:
                             ref = rt.lookup(code.gnames[g], frame)
                             grefs[g] = ref
                         if op == OP.LOAD_GLOBAL:
-                            push(read_value(ref))
+                            push(load(ref))
                         elif op == OP.REF_GLOBAL:
                             push(ref)
                         else:
-                            assign(ref, pop())
+                            store(ref, pop())
                         ip += 2
                     elif op == OP.FIELD:
                         stack[-1] = rt.field(stack[-1], consts[words[ip + 1]], consts[words[ip + 2]])
-                        ip += 3
-                    elif op == OP.LOAD_FIELD:
-                        stack[-1] = read_value(rt.field(stack[-1], consts[words[ip + 1]], consts[words[ip + 2]]))
                         ip += 3
                     elif op == OP.RETURN_VAL:
                         v = pop()
@@ -347,7 +441,7 @@ class VM:
                         push(start)
                         ip += 2
                     elif op == OP.FOR_INIT:
-                        assign(temps[words[ip + 1]], pop())
+                        store(temps[words[ip + 1]], pop())
                         ip += 2
                     elif op == OP.AGG:
                         names = consts[words[ip + 2]]
@@ -399,6 +493,42 @@ class VM:
                     elif op == OP.BRAKE:
                         rt.brake(consts[words[ip + 1]] == "F")
                         ip += 2
+                    elif op == OP.STUB:
+                        rt.stub_statement(consts[words[ip + 1]])
+                        ip += 2
+                    elif op == OP.CYCFLAG:
+                        ref = pop()
+                        store(ref, pop())
+                        value = self.thunk(code, act, words[ip + 1])
+                        rt.cyclic_on(("CYCFLAG", ref.name), lambda r=ref, f=value: rt.assign(r, f()))
+                        ip += 2
+                    elif op == OP.ANOUT_ON:
+                        flags = consts[words[ip + 2]]
+                        hi = pop() if "H" in flags else None
+                        lo = pop() if "L" in flags else None
+                        ref = pop()
+                        lo, hi = anout_limits(lo, hi)
+                        value = self.thunk(code, act, words[ip + 3])
+
+                        def anout(ref=ref, value=value, lo=lo, hi=hi):
+                            ref.set(anout_value(value(), lo, hi))
+                        anout()
+                        rt.cyclic_on(("ANOUT", consts[words[ip + 1]]), anout)
+                        ip += 4
+                    elif op == OP.ANIN_ON:
+                        ref = pop()
+                        value = self.thunk(code, act, words[ip + 2])
+
+                        def anin(ref=ref, value=value):
+                            rt.assign(ref, value())
+                        anin()
+                        key = consts[words[ip + 1]]
+                        if key is not None:
+                            rt.cyclic_on(("ANIN", key), anin)
+                        ip += 3
+                    elif op == OP.CYCLIC_OFF:
+                        rt.cyclic_off((consts[words[ip + 1]], consts[words[ip + 2]]))
+                        ip += 3
                     elif op == OP.RESUME:
                         rt.resume()
                         ip += 1
