@@ -49,6 +49,8 @@ CASES = [
      prog("ENUM COLOR red, green\nDECL COLOR c\nBOOL b", "b = c == #RED")),
     # aggregates field by field, partial aggregates allowed (1.5, 3.9)
     ("E206", prog("DECL FRAME f", "f = {X 1, W 2}"), prog("DECL FRAME f", "f = {X 1, Z 2}")),
+    ("E206", prog("", "$LOAD = {M 5, CM {X 1, Q 2}}"), prog("", "$LOAD = {M 5, CM {X 1, Z 2}}")),
+    ("E201", prog("", "$LOAD = {M 5, CM {X TRUE}}"), prog("", "$LOAD = {M 5.5, J {X 1}}")),
     ("E201", prog("STRUC S INT n, BOOL ok\nDECL S s", "s = {n 1, ok 3}"),
      prog("STRUC S INT n, BOOL ok\nDECL S s", "s = {ok TRUE}")),
     # SWITCH (5.3) and FOR (5.4)
