@@ -18,7 +18,8 @@ settings.register_profile("nightly", max_examples=500, deadline=None,
                           suppress_health_check=[HealthCheck.too_slow])
 settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "ci"))
 
-CORPUS = Path(__file__).resolve().parents[2].parent / "shared" / "krl-corpus"
+CORPUS = Path(os.environ.get("KRL_CORPUS",
+                             Path(__file__).resolve().parents[2].parent / "shared" / "krl-corpus"))
 
 
 @pytest.fixture(scope="session")
