@@ -1,5 +1,9 @@
 """`krl bench`: benchmarks that print ratios and rates measured in the same run.
 
+`krl bench` runs the compute benchmark (interp/vm/bench) on the tree interpreter, on the
+VM and as hand-written Python; `krl bench --json` prints one JSON line with every figure
+(compute ratio and rates, simulator real-time factor, parser KB/s), measured in one process.
+
 `krl bench parse [CORPUS]` measures the parser in KB/s over a corpus, cold (a fresh
 parser whose ANTLR prediction cache is empty) and warm (the same files again in the same
 process), single process, so the figure does not depend on the number of cores.
@@ -41,12 +45,56 @@ def parse_rate(corpus: Path, limit_bytes: int | None = None) -> dict:
             "cold_kb_per_s": round(rates["cold"], 1), "warm_kb_per_s": round(rates["warm"], 1)}
 
 
+EMBEDDED_CORPUS = Path(__file__).resolve().parents[1] / "corpus"
+
+
+def all_figures(repeat: int = 3, sim_seconds: float = 60.0, parse_kb: int = 512) -> dict:
+    """Every figure of `krl bench --json`, measured in this process: the compute benchmark
+    on both interpreters and in Python (interp/vm/bench), the simulator's real-time factor
+    (robot.bench) and the parser's warm rate over ``parse_kb`` KB of the shared corpus (the
+    embedded corpus when the shared one is absent)."""
+    from interp.vm.bench import compute  # noqa: PLC0415
+    from robot.bench import run_bench  # noqa: PLC0415
+
+    c = compute(repeat)
+    sim = run_bench(min_motion_s=sim_seconds)
+    corpus = DEFAULT_CORPUS if DEFAULT_CORPUS.is_dir() else EMBEDDED_CORPUS
+    parse = parse_rate(corpus, limit_bytes=parse_kb * 1024)
+    return {
+        "vm_vs_tree": round(c["vm_vs_tree"], 2),
+        "tree_stmts_per_s": round(c["tree_stmts_per_s"]),
+        "vm_stmts_per_s": round(c["vm_stmts_per_s"]),
+        "sim_realtime_factor": sim["sim_realtime_factor"],
+        "parse_kb_per_s": parse["warm_kb_per_s"],
+        "python_stmts_per_s": round(c["python_stmts_per_s"]),
+    }
+
+
 @click.group(invoke_without_command=True)
+@click.option("--json", "as_json", is_flag=True, help="Print one JSON line with every figure.")
+@click.option("--repeat", type=int, default=3, show_default=True, help="Runs of the compute benchmark (best counts).")
+@click.option("--sim-seconds", type=float, default=60.0, show_default=True,
+              help="Simulated seconds of the simulator benchmark (with --json).")
+@click.option("--parse-kb", type=int, default=512, show_default=True,
+              help="KB of the corpus for the parser rate (with --json).")
 @click.pass_context
-def bench(ctx: click.Context) -> None:
-    """Benchmarks (ratios measured in one run)."""
-    if ctx.invoked_subcommand is None:
-        click.echo(ctx.get_help())
+def bench(ctx: click.Context, as_json: bool, repeat: int, sim_seconds: float, parse_kb: int) -> None:
+    """Benchmarks (ratios measured in one run). Without a subcommand: the compute benchmark
+    (interp/vm/bench/bench.src) on the tree interpreter, the VM and in Python."""
+    if ctx.invoked_subcommand is not None:
+        return
+    if as_json:
+        click.echo(json.dumps(all_figures(repeat, sim_seconds, parse_kb)))
+        return
+    from interp.vm.bench import compute  # noqa: PLC0415
+
+    c = compute(repeat)
+    click.echo(f"compute benchmark, {c['steps']} statements and loop iterations, best of {repeat}:")
+    click.echo(f"  tree interpreter {c['tree_s']:.3f} s  {c['tree_stmts_per_s']:>12,.0f} stmts/s")
+    click.echo(f"  VM               {c['vm_s']:.3f} s  {c['vm_stmts_per_s']:>12,.0f} stmts/s"
+               f"  ({c['vm_vs_tree']:.2f}x the tree interpreter)")
+    click.echo(f"  Python           {c['python_s']:.4f} s  {c['python_stmts_per_s']:>12,.0f} stmts/s"
+               f"  ({c['python_vs_vm']:.0f}x the VM)")
 
 
 @bench.command("parse")
