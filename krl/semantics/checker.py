@@ -459,7 +459,24 @@ class Checker:
         for e in (s.start, s.end, s.step):
             if e is not None:
                 self.int_expr(e, sc, "FOR bound", lossy_ok=True)
+        if s.step is not None:
+            self.for_step(s.step)
         self.loop_body(s.body, ctx)
+
+    def for_step(self, step: N.Expr) -> None:
+        """5.4: the increment is an INT constant (literal or CONST), not 0."""
+        e, value = step, None
+        if isinstance(e, N.Unary) and e.op in ("-", "+") and isinstance(e.operand, N.IntLit):
+            value = -e.operand.value if e.op == "-" else e.operand.value
+        elif isinstance(e, N.IntLit):
+            value = e.value
+        elif isinstance(e, N.Name) and isinstance(N.symbol_of(e), Symbol) and N.symbol_of(e).kind == "const":
+            return
+        if value is None:
+            if N.type_of(e) is not T.UNKNOWN:
+                self.sink.at(e.span, "E212", "FOR STEP must be an INT constant (a literal or a CONST)")
+        elif value == 0:
+            self.sink.at(e.span, "E212", "FOR STEP must not be 0")
 
     def return_(self, s: N.Return, ctx: _Ctx) -> None:
         r = ctx.routine

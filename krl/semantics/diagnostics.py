@@ -47,6 +47,7 @@ CODES: dict[str, tuple[str, str]] = {
     "E209": ("error", "invalid motion target"),
     "W210": ("warning", "string longer than the CHAR array"),
     "E211": ("error", "invalid array index type"),
+    "E212": ("error", "FOR STEP is not a non-zero INT constant"),
     "E301": ("error", "too many arguments"),
     "E302": ("error", ":OUT argument is not a variable"),
     "E303": ("error", "argument type mismatch"),

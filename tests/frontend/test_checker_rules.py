@@ -56,6 +56,9 @@ CASES = [
     # SWITCH (5.3) and FOR (5.4)
     ("E207", prog("REAL r", "SWITCH r\nCASE 1\nENDSWITCH"), prog("INT n", "SWITCH n\nCASE 1, 2\nENDSWITCH")),
     ("E208", prog("REAL r", "FOR r = 1 TO 3\nENDFOR"), prog("INT n", "FOR n = 1 TO 3\nENDFOR")),
+    ("E212", prog("INT n, c", "FOR n = 1 TO 9 STEP c\nENDFOR"), prog("INT n", "FOR n = 9 TO 1 STEP -2\nENDFOR")),
+    ("E212", prog("INT n", "FOR n = 1 TO 9 STEP 0\nENDFOR"),
+     prog("INT n\nDECL CONST INT c = 3", "FOR n = 1 TO 9 STEP c\nENDFOR")),
     # motion targets (6.1)
     ("E209", prog("INT i", "PTP i"), prog("DECL E6AXIS ax", "PTP ax")),
     ("E209", prog("", "LIN {X 1, A1 2}"), prog("", "LIN {X 1, Z 2}")),
