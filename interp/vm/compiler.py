@@ -82,6 +82,7 @@ class Compiler:
         self.frame = frame if frame is not None else static_frame(rt, module, routine)
         self.locals = local_names(routine)
         self.local_set = {n.upper() for n in self.locals}
+        self.spelling = {n.upper(): n for n in self.locals}
         self.data = module.data if module is not None else {}
         self.lst = Listing(routine.name, routine.kind, routine.span.file, self.locals, 0)
         self.region: Region | None = None
@@ -371,7 +372,7 @@ class Compiler:
         def value():
             self.region = None
             self.expr(st.value)
-        self.emit("REF_" + self.kind_of(st.name), st.name)
+        self.emit("REF_" + self.kind_of(st.name), self.spelled(st.name))
         flags = ""
         if st.minimum is not None:
             self.expr(st.minimum)
@@ -547,6 +548,15 @@ class Compiler:
         self.emit("CALL", call.name, len(call.args), flags)
 
     # ------------------------------------------------------------------ names
+    def spelled(self, name: str) -> str:
+        """One spelling per name in a routine's text (KRL names ignore case): the
+        declaration's for locals, else the first one used."""
+        key = name.upper()
+        got = self.spelling.get(key)
+        if got is None:
+            got = self.spelling[key] = name
+        return got
+
     def kind_of(self, name: str) -> str:
         key = name.upper()
         if key in self.local_set:
@@ -557,7 +567,7 @@ class Compiler:
 
     def ref(self, e) -> None:
         if isinstance(e, N.Name):
-            self.emit("REF_" + self.kind_of(e.name), e.name)
+            self.emit("REF_" + self.kind_of(e.name), self.spelled(e.name))
         elif isinstance(e, N.Index):
             self.ref(e.base)
             self.indices(e)
@@ -577,7 +587,7 @@ class Compiler:
 
     def store(self, target) -> None:
         if isinstance(target, N.Name):
-            self.emit("STORE_" + self.kind_of(target.name), target.name)
+            self.emit("STORE_" + self.kind_of(target.name), self.spelled(target.name))
         elif isinstance(target, N.Index) and None not in target.indices:
             self.ref(target.base)
             self.indices(target)
@@ -624,7 +634,7 @@ class Compiler:
         elif isinstance(e, N.EnumLit):
             self.emit("CONST", EnumValue(e.name))
         elif isinstance(e, N.Name):
-            self.emit("LOAD_" + self.kind_of(e.name), e.name)
+            self.emit("LOAD_" + self.kind_of(e.name), self.spelled(e.name))
         elif isinstance(e, N.Index):
             self.ref(e.base)
             self.indices(e)

@@ -1,0 +1,80 @@
+"""Assembler and disassembler: text -> code -> text is the identity."""
+
+from __future__ import annotations
+
+import pytest
+
+from interp.vm.assembler import AsmError, assemble, disassemble, parse_const, fmt_const
+from interp.vm.cli import program_assembly
+from interp.runtime.values import EnumValue
+
+from .differential import CASES, CORPUS
+
+PROGRAMS = CORPUS + CASES[::4]
+
+
+@pytest.mark.parametrize("program", PROGRAMS, ids=lambda p: p.parent.name if p.name == "program.src" else p.name)
+def test_round_trip(program):
+    text = program_assembly(program, all_modules=False)
+    blocks = [line for line in text.splitlines() if line.startswith(".routine ")]
+    codes = assemble(text)
+    assert codes or "syntax errors" in text
+    again = "".join(disassemble(c) for c in codes)
+    body = "".join(line + "\n" for line in text.splitlines() if not line.startswith("; module") and line)
+    assert again.replace("\n\n", "\n") == body.replace("\n\n", "\n")
+    assert len(codes) == len(blocks)
+
+
+HAND = """\
+.routine DEMO DEF
+.file ""
+.locals I
+.temps 3
+    .at -
+    ; 3
+    STMT 3/S
+    .at 3 G L2
+    CONST 0
+    STORE_LOCAL I
+L1:
+    .at -
+    LOAD_LOCAL I
+    ADD_CONST 1
+    STORE_LOCAL I
+    LOAD_MOD N
+    LOAD_GLOBAL $OV_PRO
+    BINOP :
+    CONST "a \\"quoted\\" text"
+    CONST #ENUM_V
+    CONST 2.5
+    CONST NONE
+    CONST TRUE
+    IF_NOT_LT L1
+L2:
+    END
+.end
+"""
+
+
+def test_hand_written_text_round_trips():
+    (code,) = assemble(HAND)
+    assert disassemble(code) == HAND
+    assert code.lnames == ["I"] and code.mnames == ["N"] and code.gnames == ["$OV_PRO"]
+    assert code.infos[0].line == 3 and code.infos[0].stops and not code.infos[0].cond_stops
+    assert len(code.regions) == len(code.words)
+
+
+@pytest.mark.parametrize("bad", ["FOO 1", "CONST", "JUMP L9", "STORE_LOCAL X", "CONST 1x"])
+def test_bad_text_is_an_error(bad):
+    with pytest.raises(AsmError):
+        assemble(".routine X DEF\n.file \"\"\n.locals I\n    " + bad + "\n    END\n.end\n")
+
+
+@pytest.mark.parametrize("v", [0, -7, 2147483647, 1.5, -0.25, 1e30, "", "x y", '"', True, False, None])
+def test_constants(v):
+    assert parse_const(fmt_const(v)) == v
+    assert type(parse_const(fmt_const(v))) is type(v)
+
+
+def test_enum_constant():
+    assert parse_const(fmt_const(EnumValue("c_dis"))) == EnumValue("C_DIS")

@@ -1,0 +1,38 @@
+"""`krl run --interp vm` writes the same trace as `--interp tree`, event for event: the
+embedded corpus programs, the conformance cases and the paper's example."""
+
+from __future__ import annotations
+
+import pytest
+
+from .differential import CASES, CORPUS, PAPER, case_options, compare
+
+
+def _check(program, **kw):
+    (tree, vm), diff, n = compare(program, **kw)
+    assert diff is None, f"first difference at event {diff[0]}:\n tree {diff[1]}\n vm   {diff[2]}"
+    assert (tree.reason, tree.text, tree.file, tree.line, tree.context) == \
+        (vm.reason, vm.text, vm.file, vm.line, vm.context)
+    assert n > 1
+
+
+@pytest.mark.parametrize("program", CORPUS, ids=lambda p: p.name)
+def test_corpus_program(program):
+    _check(program)
+
+
+@pytest.mark.parametrize("program", CASES, ids=lambda p: p.parent.name)
+def test_conformance_case(program):
+    _check(program, **case_options(program))
+
+
+@pytest.mark.skipif(not PAPER.exists(), reason="../shared/examples absent")
+@pytest.mark.parametrize("brake_at", [None, 1.0])
+def test_paper_example(tmp_path, brake_at):
+    from tests.interp.test_paper import STIMULI, _shift_base, _variant
+
+    stim = STIMULI + (f"  - at: {brake_at}\n    set: {{\"$IN[2]\": false}}\n" if brake_at else "")
+    inputs = tmp_path / "stimuli.yaml"
+    inputs.write_text(stim)
+    _check(_variant(tmp_path), inputs=inputs, before=_shift_base, max_sim_time=60)
+    _check(PAPER, inputs=inputs, before=_shift_base, max_sim_time=60)
