@@ -290,6 +290,8 @@ def unary_op(op: str, a):
     if op == "NOT":
         if a is True or a is False:
             return not a
+        if a is NEUTRAL:
+            return True
         if a.__class__ is int:
             return _wrap32(~a)
         raise KrlRuntimeError("NOT needs a BOOL operand")
