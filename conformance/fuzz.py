@@ -287,7 +287,11 @@ def programs(draw, max_depth: int = 2):
 
 
 # ----------------------------------------------------------------------------- running
-def run_text(src: str, stim: str | None, interp: str, *, max_sim_time: float = 20.0) -> H.RunResult:
+def run_text(src: str, stim: str | None, interp: str | list[str], *,
+             max_sim_time: float = 20.0) -> H.RunResult | dict[str, H.RunResult]:
+    """Run the program on one interpreter (a RunResult) or on several, in the same folder
+    (a dict interp -> RunResult)."""
+    many = not isinstance(interp, str)
     with tempfile.TemporaryDirectory(prefix="krl-fuzz-") as tmp:
         d = Path(tmp)
         (d / "program.src").write_text(src, encoding="utf-8")
@@ -296,8 +300,10 @@ def run_text(src: str, stim: str | None, interp: str, *, max_sim_time: float = 2
         if stim:
             stim_path = d / "stimuli.yaml"
             stim_path.write_text(stim, encoding="utf-8")
-        return H.run_program(d / "program.src", interp, stimuli=stim_path, workspace=d,
-                             max_sim_time=max_sim_time, max_steps=200_000, wall_timeout=60.0)
+        out = {it: H.run_program(d / "program.src", it, stimuli=stim_path, workspace=d,
+                                 max_sim_time=max_sim_time, max_steps=200_000, wall_timeout=60.0)
+               for it in ([interp] if not many else interp)}
+    return out if many else out[interp]
 
 
 clean_run_problem = H.clean_run_problem
@@ -305,7 +311,7 @@ clean_run_problem = H.clean_run_problem
 
 def check_program(src: str, stim: str | None, interps: list[str]) -> str | None:
     """None if the program passes the fuzz property, else a description."""
-    runs = {it: run_text(src, stim, it) for it in interps}
+    runs = run_text(src, stim, list(interps))
     for it, r in runs.items():
         prob = clean_run_problem(r)
         if prob:

@@ -79,10 +79,22 @@ class Case:
 
     @property
     def pending(self) -> str | None:
-        """The reason if the case is marked ``status: pending``, else None."""
+        """The reason if the case is marked ``status: pending`` (for any interpreter), else None."""
         if str(self.expect.get("status", "ok")).lower() == "pending":
             return str(self.expect.get("reason") or "pending (no reason given)")
         return None
+
+    @property
+    def pending_on(self) -> tuple[str, ...]:
+        """The interpreters the pending mark applies to (``pending_on``, default both); the
+        tree-vs-VM comparison counts as "vm"."""
+        if self.pending is None:
+            return ()
+        on = self.expect.get("pending_on") or list(INTERPRETERS)
+        return tuple(str(x).lower() for x in (on if isinstance(on, list) else [on]))
+
+    def pending_for(self, interp: str) -> str | None:
+        return self.pending if interp in self.pending_on else None
 
     @property
     def max_sim_time(self) -> float:
@@ -908,7 +920,8 @@ _MOTION_CHECKS = {
 
 
 def check_case(case: Case, res: RunResult) -> CaseResult:
-    cr = CaseResult(case.name, res.interp, crash=res.crash, pending=case.pending, wall_s=res.wall_s)
+    cr = CaseResult(case.name, res.interp, crash=res.crash, pending=case.pending_for(res.interp),
+                    wall_s=res.wall_s)
     if res.crash is not None:
         return cr
     ev = res.events
@@ -948,8 +961,8 @@ def compare_runs(a: RunResult, b: RunResult, path_tol_mm: float = 1e-6) -> list[
     checks.append(Check("tree_vm.io", ia == ib, "" if ia == ib else _diff(ia, ib, "io")))
 
     def other(evs):
-        return [json.dumps({k: v for k, v in e.items()}, sort_keys=True) for e in evs
-                if e.get("kind") in ("motion", "message", "error", "end", "trigger")]
+        return [json.dumps({k: (Path(str(v)).name if k == "file" else v) for k, v in e.items()}, sort_keys=True)
+                for e in evs if e.get("kind") in ("motion", "message", "error", "end", "trigger")]
     oa, ob = other(a.events), other(b.events)
     checks.append(Check("tree_vm.events", oa == ob, "" if oa == ob else _diff(oa, ob, "motion/message/error/end")))
     pa = [p[:3] for _, p in poses(a.events)]

@@ -23,7 +23,7 @@ REPO = Path(__file__).resolve().parents[2]
 
 KNOWN_KEYS = {"title", "reference", "covers", "notes", "flow_note", "end", "flow", "flow_submit",
               "flow_submit_prefix", "flow_ignore", "io", "io_signals", "errors", "messages", "motion",
-              "exit_code", "status", "reason", "max_sim_time", "submit", "fuzz"}
+              "exit_code", "status", "reason", "pending_on", "max_sim_time", "submit", "fuzz"}
 MOTION_CHECKS = set(H._MOTION_CHECKS)
 
 
@@ -64,7 +64,7 @@ def test_case_tree(case: H.Case, request) -> None:
     why = _status()["tree"]
     if why is not None:
         pytest.xfail(f"tree interpreter {why}")
-    if case.pending is not None:
+    if case.pending_for("tree") is not None:
         request.node.add_marker(pytest.mark.xfail(reason=f"pending: {case.pending}", strict=False))
     res = H.run_case(case, "tree")
     cr = H.check_case(case, res)
@@ -76,7 +76,7 @@ def test_case_vm_and_tree_vm(case: H.Case, request) -> None:
     st = _status()
     if st["vm"] is not None or st["tree"] is not None:
         pytest.skip(f"vm: {st['vm'] or 'available'}; tree: {st['tree'] or 'available'} - tree vs vm not compared")
-    if case.pending is not None:
+    if case.pending_for("vm") is not None:
         request.node.add_marker(pytest.mark.xfail(reason=f"pending: {case.pending}", strict=False))
     vm = H.run_case(case, "vm")
     cr = H.check_case(case, vm)

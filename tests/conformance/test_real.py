@@ -15,9 +15,15 @@ from conformance import report as R
 PROGRAMS = R.real_programs()
 SAMPLE = PROGRAMS[:: max(1, len(PROGRAMS) // 8)][:8]
 
+# Known disagreements, listed like the pending cases (xfail, strict=False): the VM is not
+# finished. Keep the reason precise; remove the entry when it passes.
+KNOWN: dict[str, str] = {}
 
-def _check(prog):
+
+def _check(prog, request=None):
     st = H.interpreter_status()
+    if request is not None and prog.stem in KNOWN and st["vm"] is None:
+        request.node.add_marker(pytest.mark.xfail(reason=f"known: {KNOWN[prog.stem]}", strict=False))
     if st["tree"] is not None:
         pytest.xfail(f"tree interpreter {st['tree']}")
     interps = H.available_interpreters()
@@ -33,12 +39,12 @@ def _check(prog):
 
 @pytest.mark.corpus
 @pytest.mark.parametrize("prog", [p for p, _ in SAMPLE], ids=lambda p: p.stem)
-def test_real_program_sample(shared_corpus, prog):
-    _check(prog)
+def test_real_program_sample(shared_corpus, prog, request):
+    _check(prog, request)
 
 
 @pytest.mark.corpus
 @pytest.mark.slow
 @pytest.mark.parametrize("prog", [p for p, _ in PROGRAMS], ids=lambda p: p.stem)
-def test_real_program_all(shared_corpus, prog):
-    _check(prog)
+def test_real_program_all(shared_corpus, prog, request):
+    _check(prog, request)
