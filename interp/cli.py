@@ -25,11 +25,22 @@ import click
               help="Limit of executed statements and loop iterations.")
 @click.option("--submit", "submit", type=click.Path(path_type=Path), multiple=True,
               help="A submit program (.sub) to run beside the robot program (repeatable).")
-def run(program: Path, interp_kind: str, workspace, inputs, trace_path, max_sim_time, max_steps, submit) -> None:
+@click.option("--check", "check", is_flag=True,
+              help="Run the front end's checker first; like the controller, refuse to start a "
+                   "program whose files have errors (exit 1).")
+def run(program: Path, interp_kind: str, workspace, inputs, trace_path, max_sim_time, max_steps, submit,
+        check) -> None:
     """Run PROGRAM (.src) on the simulated KR C4; print where and why it ended."""
     if not program.exists():
         click.echo(f"error: {program}: no such file", err=True)
         sys.exit(2)
+    if check:
+        errors = check_errors(program, workspace)
+        if errors:
+            for d in errors[:20]:
+                click.echo(str(d))
+            click.echo(f"not started: {len(errors)} error(s) found by the checker")
+            sys.exit(1)
     from interp.run import run_program  # noqa: PLC0415
     from robot.trace import TraceWriter  # noqa: PLC0415
 
@@ -56,5 +67,23 @@ def run(program: Path, interp_kind: str, workspace, inputs, trace_path, max_sim_
 
 
 from interp.vm.cli import asm  # noqa: E402
+
+def check_errors(program: Path, workspace=None) -> list:
+    """Errors the front end's checker finds in the program's own module (its .src/.dat)
+    when the whole environment of the run (workspace, BASIS or the backup) is checked."""
+    from interp.runtime.program import BASIS_DIR, find_backup_root  # noqa: PLC0415
+    from krl.workspace import load_workspace  # noqa: PLC0415
+
+    prog = program.resolve()
+    found = find_backup_root(prog)
+    if found is not None:
+        paths = [found[0]]
+    else:
+        paths = [Path(workspace).resolve() if workspace else prog.parent, BASIS_DIR]
+    ws = load_workspace(paths, str(prog))
+    ws.check()
+    stem = prog.stem.upper()
+    return [d for d in ws.diagnostics if d.is_error and Path(d.path).stem.upper() == stem]
+
 
 commands = [run, asm]

@@ -215,3 +215,9 @@ def test_no_return_event_after_an_error(tmp_path):
     """)
     assert r.result.reason == "error"
     assert not [e for e in r.kinds("return") if e["name"] == "Fail"]
+
+
+def test_cli_check_refuses_a_program_with_errors(tmp_path):
+    bad = write(tmp_path, "chk.src", "DEF chk()\n  DECL INT i\n  i = TRUE\nEND\n")
+    p = _krl("run", bad, "--check")
+    assert p.returncode == 1 and "E201" in p.stdout and "not started" in p.stdout
