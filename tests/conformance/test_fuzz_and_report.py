@@ -49,16 +49,24 @@ def test_fuzz_failure_is_saved_as_a_case(tmp_path):
 def test_report_files(tmp_path):
     if H.interpreter_status()["tree"] is not None:
         pytest.xfail("tree interpreter not available")
-    cases = [H.load_case(H.CASES_DIR / n) for n in ("001_assign_arith", "057_lin_c_dis", "085_trigger_call_args")]
+    import shutil
+
+    pend_dir = tmp_path / "cases" / "999_pending_copy"
+    shutil.copytree(H.CASES_DIR / "002_if_else", pend_dir)
+    with open(pend_dir / "expect.yaml", "a", encoding="utf-8") as fh:
+        fh.write('status: pending\nreason: "a copy marked pending for this test"\n')
+    cases = [H.load_case(H.CASES_DIR / n) for n in ("001_assign_arith", "057_lin_c_dis")] + [H.load_case(pend_dir)]
     outcomes = R.run_cases(cases)
+    tmp_path = tmp_path / "out"
     s = R.write_report(tmp_path, outcomes, {"programs": 3, "tree_ok": 3, "agree": None, "mode": "x",
                                             "failures": []}, [])
     j = json.loads((tmp_path / "summary.json").read_text())
     for k in ("cases", "passed", "tree_vm_agree", "fuzz_programs", "fuzz_agree", "real_programs", "real_agree"):
         assert k in j
-    assert j["cases"] == 3 and s["pending"] == ["085_trigger_call_args"]
+    assert j["cases"] == 3 and s["pending"] == ["999_pending_copy"]
+    assert s["pending_passing"] == ["999_pending_copy"]
     md = (tmp_path / "report.md").read_text()
     html = (tmp_path / "report.html").read_text()
-    assert "057_lin_c_dis" in md and "085_trigger_call_args" in html
+    assert "057_lin_c_dis" in md and "999_pending_copy" in html and "a copy marked pending" in md
     assert (tmp_path / "plots" / "057_lin_c_dis.png").stat().st_size > 1000
     assert not (tmp_path / "plots" / "001_assign_arith.png").exists()
