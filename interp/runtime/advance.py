@@ -34,7 +34,6 @@ class StmtInfo:
     line: int
     stops: bool = False           # stops the advance run before it executes
     cond_stops: bool = False      # a loop condition that stops on each evaluation
-    context_free: bool = False    # reserved
 
 
 def _reads(expr, acc: list) -> None:

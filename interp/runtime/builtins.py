@@ -16,14 +16,13 @@ than $CMD — a clear "not supported" run-time error.
 from __future__ import annotations
 
 import math
-import random
 
 from krl.semantics import types as T
 
-from .convert import convert_scalar, frame_tuple, inv_pos, num, real_to_int, to_bool
+from .convert import frame_tuple, inv_pos, num, real_to_int, to_bool
 from .errors import KrlRuntimeError, value_invalid
 from .memory import Ref
-from .values import UNSET, Arr, EnumValue, Struct, is_char_array, make_value
+from .values import UNSET, Arr, EnumValue, Struct, is_char_array
 
 
 class ValueRef(Ref):

@@ -8,7 +8,6 @@ from __future__ import annotations
 import random
 import sys
 from dataclasses import dataclass
-from pathlib import Path
 
 from krl.ast import nodes as N
 from krl.semantics import types as T

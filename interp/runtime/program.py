@@ -427,4 +427,3 @@ class Program:
         return None
 
 
-UNSET_ = UNSET

@@ -22,7 +22,7 @@ from krl.semantics.symbols import make_array, system_scopes
 
 from .errors import KrlRuntimeError, value_invalid
 from .memory import AutoSlot, ComputedRef, Slot
-from .values import UNSET, EnumValue, Struct, make_value
+from .values import EnumValue, Struct, make_value
 
 
 class LiveArray:
@@ -338,4 +338,3 @@ def _sync_advance(ref) -> None:
 
 
 SysVars._on_write = {"$ADVANCE": _sync_advance}
-UNSET_ = UNSET
