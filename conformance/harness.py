@@ -5,8 +5,8 @@ A case is a directory ``conformance/cases/NNN_name/`` with
 * ``program.src`` (main routine ``DEF program()``), optionally ``program.dat`` and other
   ``.src``/``.sub`` modules;
 * optionally ``stimuli.yaml`` (format of :mod:`robot.stimuli`);
-* ``expect.yaml``: the expectations, written by hand from the reference (see
-  ``conformance/README.md`` for the format).
+* ``expect.yaml``: the expectations, written by hand from the reference (format:
+  docs/architecture.md, "Conformance").
 
 Each case is run through the ``krl run`` contract of issue 6 (``--interp tree|vm``,
 ``--trace OUT.jsonl``, ``--inputs``, ``--submit``, ``--max-sim-time``); the trace
