@@ -1,0 +1,36 @@
+"""`krl bench` smoke test: it runs and prints the JSON keys (no timing assertions)."""
+
+from __future__ import annotations
+
+import json
+
+from click.testing import CliRunner
+
+from interp.vm.bench import run_krl, run_python
+from krl.bench import bench
+
+KEYS = {"vm_vs_tree", "tree_stmts_per_s", "vm_stmts_per_s", "sim_realtime_factor", "parse_kb_per_s"}
+
+
+def test_benchmark_gives_the_same_result_everywhere():
+    _, steps_t, tree = run_krl("tree")
+    _, steps_v, vm = run_krl("vm")
+    _, py = run_python(1)
+    assert tree == vm == py
+    assert steps_t == steps_v > 0
+
+
+def test_bench_json_line():
+    res = CliRunner().invoke(bench, ["--json", "--repeat", "1", "--sim-seconds", "1", "--parse-kb", "20"])
+    assert res.exit_code == 0, res.output
+    lines = [ln for ln in res.output.splitlines() if ln.strip()]
+    assert len(lines) == 1
+    data = json.loads(lines[0])
+    assert KEYS <= set(data)
+    assert all(isinstance(data[k], (int, float)) and data[k] > 0 for k in KEYS)
+
+
+def test_bench_text():
+    res = CliRunner().invoke(bench, ["--repeat", "1"])
+    assert res.exit_code == 0, res.output
+    assert "VM" in res.output and "Python" in res.output

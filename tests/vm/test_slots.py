@@ -1,0 +1,82 @@
+"""The runtime's fast paths (interp/runtime/slots.py) agree with the general functions."""
+
+from __future__ import annotations
+
+import itertools
+
+import pytest
+
+from interp.runtime.convert import binary_op
+from interp.runtime.errors import KrlRuntimeError
+from interp.runtime.memory import Slot, field_ref, index_ref
+from interp.runtime.slots import (add, array_index, component, element, element1, element2, eq, ge, gt, le, load, lt, mul,
+                                  ne, read_value, set_component, set_element, store, sub)
+from interp.runtime.values import UNSET, EnumValue, make_value
+from krl.semantics import types as T
+
+VALUES = [0, 1, -7, 2147483647, -2147483648, 2.5, -0.0, 1e300, True, False, "A", EnumValue("X"), UNSET]
+FAST = {"+": add, "-": sub, "*": mul, "<": lt, "<=": le, ">": gt, ">=": ge, "==": eq, "<>": ne}
+
+
+def outcome(fn, *args):
+    try:
+        v = fn(*args)
+        return ("ok", type(v), v)
+    except KrlRuntimeError as e:
+        return ("error", e.message, e.number)
+
+
+@pytest.mark.parametrize("op", list(FAST))
+def test_operators(op):
+    for a, b in itertools.product(VALUES, VALUES):
+        assert outcome(FAST[op], a, b) == outcome(binary_op, op, a, b), (op, a, b)
+
+
+def _array(t, dims, values):
+    a = make_value(T.Array(t, dims))
+    for i, v in enumerate(values):
+        a.data[i] = v
+    return Slot({"A": a}, "A", a.type, "A")
+
+
+def test_elements_and_stores():
+    for t, vals, new in ((T.INT, [1, UNSET, 3, 4], [5, 2.6, True, 2 ** 40]),
+                         (T.REAL, [1.0, UNSET, 3.0, 4.0], [5, 2.6, True]),
+                         (T.BOOL, [True, UNSET, False, True], [False, 1])):
+        for idx in ([1], [2], [4], [5], [0], [1.5], [True]):
+            fast = _array(t, (4,), vals)
+            slow = _array(t, (4,), vals)
+            assert outcome(element, fast, idx, "A") == \
+                outcome(lambda: read_value(index_ref(slow, [array_index(i) for i in idx], "A")))
+            if len(idx) == 1:
+                assert outcome(element1, fast, idx[0], "A") == outcome(element, slow, idx, "A")
+            for v in new:
+                r1 = outcome(set_element, fast, idx, v, "A")
+                r2 = outcome(lambda: index_ref(slow, [array_index(i) for i in idx], "A").set(v))
+                assert r1 == r2
+                assert fast.c["A"].data == slow.c["A"].data
+        m1 = _array(t, (2, 2), vals)
+        for i, j in itertools.product([0, 1, 2, 3], repeat=2):
+            assert outcome(element2, m1, i, j, "M") == outcome(lambda: read_value(index_ref(m1, [i, j], "M")))
+
+
+def test_load_store_components():
+    st = T.Struc("PAIR")
+    st.fields["A"] = ("A", T.INT)
+    st.fields["B"] = ("B", T.REAL)
+    for v in (1, 2.5, True, 2 ** 40, "x"):
+        for comp in ("A", "b", "C"):
+            s1 = Slot({"P": make_value(st)}, "P", st, "P")
+            s2 = Slot({"P": make_value(st)}, "P", st, "P")
+            assert outcome(set_component, s1, comp, v, "P") == outcome(lambda: field_ref(s2, comp, "P").set(v))
+            assert s1.c["P"].f == s2.c["P"].f
+            assert outcome(component, s1, comp, "P") == outcome(lambda: read_value(field_ref(s2, comp, "P")))
+    for t, v in ((T.INT, 3), (T.INT, 3.7), (T.REAL, 2), (T.BOOL, 1), (T.INT, 2 ** 33)):
+        a = Slot({"X": UNSET}, "X", t, "X")
+        b = Slot({"X": UNSET}, "X", t, "X")
+        assert outcome(load, a) == outcome(read_value, b)
+        assert outcome(store, a, v) == outcome(b.set, v)
+        assert a.c == b.c
+        assert outcome(load, a) == outcome(read_value, b)
+    ro = Slot({"X": 1}, "X", T.INT, "X", readonly=True)
+    assert outcome(store, ro, 2)[0] == "error"
