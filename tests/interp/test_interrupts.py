@@ -150,3 +150,36 @@ def test_interrupt_brake_without_resume_continues(tmp_path):
     """, DAT, stimuli="stimuli:\n  - at: 0.2\n    set: {\"$IN[12]\": true}\n")
     assert r.result.reason == "completed"
     assert any(e["id"] == 2 and e["phase"] == "end" for e in r.kinds("motion"))
+
+
+def test_global_declaration_survives_the_return(tmp_path):
+    r = run_krl(tmp_path, """
+    DEF prog()
+      MkIrq()
+      INTERRUPT ON 41
+      GO = TRUE
+      WAIT SEC 0.05
+    END
+    DEF MkIrq()
+      GLOBAL INTERRUPT DECL 41 WHEN GO DO Hit()
+    END
+    DEF Hit()
+      N1 = N1 + 1
+    END
+    """, DAT)
+    assert r.result.reason == "completed" and r.var("prog", "N1") == 1
+
+
+def test_err_raise_reissues_the_stored_error(tmp_path):
+    r = run_krl(tmp_path, """
+    DEF prog()
+      DECL INT u
+      ON_ERROR_PROCEED
+      N1 = u
+      SEQ = $ERR.NUMBER
+      ERR_RAISE($ERR)
+      N1 = 5
+    END
+    """, DAT)
+    assert r.var("prog", "SEQ") == 1422
+    assert r.result.reason == "error" and r.result.error.number == 1422 and r.result.line == 6
