@@ -55,7 +55,7 @@ def run(program: Path, interp_kind: str, workspace, inputs, trace_path, max_sim_
     finally:
         if trace is not None:
             trace.close()
-    where = f"{res.file}:{res.line}" if res.line else ""
+    where = f"{res.file}:{res.line}" if res.line else (res.file or "")
     if res.reason == "completed":
         click.echo(f"completed at t={res.sim_time:.3f} s ({res.steps} steps)")
     elif res.reason == "error":
