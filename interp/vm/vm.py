@@ -31,7 +31,7 @@ from interp.runtime.slots import (add, anout_limits, anout_value, array_index, c
                                   set_component, set_element, store, sub, trigger_args)
 
 from . import opcodes as OP
-from .assembler import Code, assemble
+from .assembler import Code, Region, assemble
 from .compiler import compile_routine
 
 
@@ -52,6 +52,40 @@ def _specialize(fn):
     ns: dict = {}
     exec(compile(src, inspect.getsourcefile(fn), "exec"), fn.__globals__, ns)  # noqa: S102
     return ns[fn.__name__]
+
+
+def decode(code: Code) -> tuple[list, list]:
+    """The VM's form of assembled code: one tuple ``(opcode, operand, ...)`` per
+    instruction, with constants, names and statement infos resolved and jump targets as
+    instruction numbers; and the error region of each instruction."""
+    words = code.words
+    starts = []
+    pc = 0
+    while pc < len(words):
+        starts.append(pc)
+        pc += OP.size(words[pc])
+    index = {a: i for i, a in enumerate(starts)}
+    index[len(words)] = len(starts)
+    prog = []
+    regions = []
+    for a in starts:
+        info = OP.OPS[words[a]]
+        ins = [info.number]
+        for j, k in enumerate(info.operands):
+            w = words[a + 1 + j]
+            if k in "cnf":
+                w = code.consts[w]
+            elif k == "x":
+                w = code.infos[w]
+            elif k == "l":
+                w = index[w]
+            ins.append(w)
+        prog.append(tuple(ins))
+        r = code.regions[a]
+        if r is not None and r.kind == "G":
+            r = Region("G", r.line, index[r.end])
+        regions.append(r)
+    return prog, regions
 
 
 class Act:
@@ -98,6 +132,7 @@ class VM:
             code.mrefs = [data.get(n.upper()) for n in code.mnames]
             code.grefs = [None] * len(code.gnames)
             code.lkeys = [n.upper() for n in code.lnames]
+            code.prog, code.iregions = decode(code)
             self.codes[id(routine)] = code
         return code
 
@@ -150,9 +185,7 @@ class VM:
         """Run ``code`` from ``ip`` in activation ``act``; returns the value of RETURN,
         or of the thunk at END_THUNK."""
         rt = self.rt
-        words = code.words
-        consts = code.consts
-        infos = code.infos
+        prog = code.prog
         mrefs = code.mrefs
         grefs = code.grefs
         refs = act.refs
@@ -167,89 +200,90 @@ class VM:
         while True:
             try:
                 while True:
-                    op = words[ip]
+                    ins = prog[ip]
+                    op = ins[0]
                     # the hottest opcodes first (measured on the benchmark)
                     if op == OP.LOAD_LOCAL:
-                        push(load(refs[words[ip + 1]]))
-                        ip += 2
+                        push(load(refs[ins[1]]))
+                        ip += 1
                     elif op == OP.STMT_G:
-                        info = infos[words[ip + 1]]
+                        info = ins[1]
                         if not thunk:
                             frame.line = info.line
                         before(info)
                         proceed = take_error_proceed()
-                        ip += 2
+                        ip += 1
                     elif op == OP.LOAD_ELEM_LL:
-                        push(element1(refs[words[ip + 1]], load(refs[words[ip + 2]]), consts[words[ip + 3]]))
-                        ip += 4
+                        push(element1(refs[ins[1]], load(refs[ins[2]]), ins[3]))
+                        ip += 1
                     elif op == OP.CONST:
-                        push(consts[words[ip + 1]])
-                        ip += 2
+                        push(ins[1])
+                        ip += 1
                     elif op == OP.STORE_LOCAL:
-                        store(refs[words[ip + 1]], pop())
-                        ip += 2
+                        store(refs[ins[1]], pop())
+                        ip += 1
                     elif op == OP.TICK:
-                        tick(infos[words[ip + 1]])
-                        ip += 2
+                        tick(ins[1])
+                        ip += 1
                     elif op == OP.ADD:
                         b = pop()
                         stack[-1] = add(stack[-1], b)
                         ip += 1
                     elif op == OP.STORE_ELEM_LL:
-                        set_element(refs[words[ip + 1]], [load(refs[words[ip + 2]])], pop(), consts[words[ip + 3]])
-                        ip += 4
+                        set_element(refs[ins[1]], [load(refs[ins[2]])], pop(), ins[3])
+                        ip += 1
                     elif op == OP.IF_NOT_LE:
                         b = pop()
                         if le(pop(), b):
-                            ip += 2
+                            ip += 1
                         else:
-                            ip = words[ip + 1]
+                            ip = ins[1]
                     elif op == OP.JUMP:
-                        ip = words[ip + 1]
+                        ip = ins[1]
                     elif op == OP.FOR_TEST:
-                        t = words[ip + 1]
+                        t = ins[1]
                         if for_done(temps[t].get(), temps[t + 1], temps[t + 2]):
-                            ip = words[ip + 2]
+                            ip = ins[2]
                         else:
-                            ip += 3
+                            ip += 1
                     elif op == OP.FOR_NEXT:
-                        t = words[ip + 1]
+                        t = ins[1]
                         ref = temps[t]
                         step = temps[t + 2]
                         store(ref, add(ref.get(), step))
                         if for_done(ref.get(), temps[t + 1], step):
-                            ip += 4
+                            ip += 1
                         else:
-                            tick(infos[words[ip + 2]])
-                            ip = words[ip + 3]
+                            tick(ins[2])
+                            ip = ins[3]
                     elif op == OP.LOAD_ELEM2_LLL:
-                        push(element2(refs[words[ip + 1]], load(refs[words[ip + 2]]), load(refs[words[ip + 3]]),
-                                      consts[words[ip + 4]]))
-                        ip += 5
+                        push(element2(refs[ins[1]], load(refs[ins[2]]), load(refs[ins[3]]),
+                                      ins[4]))
+                        ip += 1
                     elif op == OP.LOAD_LOCAL2:
-                        push(load(refs[words[ip + 1]]))
-                        push(load(refs[words[ip + 2]]))
-                        ip += 3
+                        push(load(refs[ins[1]]))
+                        push(load(refs[ins[2]]))
+                        ip += 1
                     elif op == OP.ADD_CONST:
-                        stack[-1] = add(stack[-1], consts[words[ip + 1]])
-                        ip += 2
+                        stack[-1] = add(stack[-1], ins[1])
+                        ip += 1
                     elif op == OP.SUB_CONST:
-                        stack[-1] = sub(stack[-1], consts[words[ip + 1]])
-                        ip += 2
+                        stack[-1] = sub(stack[-1], ins[1])
+                        ip += 1
                     elif op == OP.IF_NOT_LT:
                         b = pop()
                         if lt(pop(), b):
-                            ip += 2
+                            ip += 1
                         else:
-                            ip = words[ip + 1]
+                            ip = ins[1]
                     elif op == OP.REF_LOCAL:
-                        push(refs[words[ip + 1]])
-                        ip += 2
+                        push(refs[ins[1]])
+                        ip += 1
                     elif op == OP.JUMP_IF_FALSE:
                         if rt.to_bool(pop()):
-                            ip += 2
+                            ip += 1
                         else:
-                            ip = words[ip + 1]
+                            ip = ins[1]
                     elif op == OP.SUB:
                         b = pop()
                         stack[-1] = sub(stack[-1], b)
@@ -259,67 +293,67 @@ class VM:
                         stack[-1] = mul(stack[-1], b)
                         ip += 1
                     elif op == OP.MUL_CONST:
-                        stack[-1] = mul(stack[-1], consts[words[ip + 1]])
-                        ip += 2
+                        stack[-1] = mul(stack[-1], ins[1])
+                        ip += 1
                     elif op == OP.LOAD_INDEX:
-                        n = words[ip + 1]
+                        n = ins[1]
                         idx = stack[-n:]
                         del stack[-n:]
-                        stack[-1] = element(stack[-1], idx, consts[words[ip + 2]])
-                        ip += 3
+                        stack[-1] = element(stack[-1], idx, ins[2])
+                        ip += 1
                     elif op == OP.STORE_INDEX:
-                        n = words[ip + 1]
+                        n = ins[1]
                         idx = stack[-n:]
                         del stack[-n:]
                         base = pop()
-                        set_element(base, idx, pop(), consts[words[ip + 2]])
-                        ip += 3
+                        set_element(base, idx, pop(), ins[2])
+                        ip += 1
                     elif op == OP.LOAD_FIELD:
-                        stack[-1] = component(stack[-1], consts[words[ip + 1]], consts[words[ip + 2]])
-                        ip += 3
+                        stack[-1] = component(stack[-1], ins[1], ins[2])
+                        ip += 1
                     elif op == OP.STORE_FIELD:
                         base = pop()
-                        set_component(base, consts[words[ip + 1]], pop(), consts[words[ip + 2]])
-                        ip += 3
+                        set_component(base, ins[1], pop(), ins[2])
+                        ip += 1
                     elif op == OP.UNOP:
-                        stack[-1] = rt.unary_op(consts[words[ip + 1]], stack[-1])
-                        ip += 2
+                        stack[-1] = rt.unary_op(ins[1], stack[-1])
+                        ip += 1
                     elif op == OP.LOAD_MOD:
-                        push(load(mrefs[words[ip + 1]]))
-                        ip += 2
+                        push(load(mrefs[ins[1]]))
+                        ip += 1
                     elif op == OP.STORE_MOD:
-                        store(mrefs[words[ip + 1]], pop())
-                        ip += 2
+                        store(mrefs[ins[1]], pop())
+                        ip += 1
                     elif op == OP.IF_NOT_GT:
                         b = pop()
                         if gt(pop(), b):
-                            ip += 2
+                            ip += 1
                         else:
-                            ip = words[ip + 1]
+                            ip = ins[1]
                     elif op == OP.IF_NOT_GE:
                         b = pop()
                         if ge(pop(), b):
-                            ip += 2
+                            ip += 1
                         else:
-                            ip = words[ip + 1]
+                            ip = ins[1]
                     elif op == OP.IF_NOT_EQ:
                         b = pop()
                         if eq(pop(), b):
-                            ip += 2
+                            ip += 1
                         else:
-                            ip = words[ip + 1]
+                            ip = ins[1]
                     elif op == OP.IF_NOT_NE:
                         b = pop()
                         if ne(pop(), b):
-                            ip += 2
+                            ip += 1
                         else:
-                            ip = words[ip + 1]
+                            ip = ins[1]
                     elif op == OP.INDEX:
-                        n = words[ip + 1]
+                        n = ins[1]
                         idx = [None if x is None else array_index(x) for x in stack[-n:]]
                         del stack[-n:]
-                        stack[-1] = rt.index(stack[-1], idx, consts[words[ip + 2]])
-                        ip += 3
+                        stack[-1] = rt.index(stack[-1], idx, ins[2])
+                        ip += 1
                     elif op == OP.ASSIGN:
                         ref = pop()
                         store(ref, pop())
@@ -350,37 +384,37 @@ class VM:
                         ip += 1
                     elif op == OP.BINOP:
                         b = pop()
-                        stack[-1] = rt.binary_op(consts[words[ip + 1]], stack[-1], b)
-                        ip += 2
+                        stack[-1] = rt.binary_op(ins[1], stack[-1], b)
+                        ip += 1
                     elif op == OP.STMT:
-                        info = infos[words[ip + 1]]
+                        info = ins[1]
                         if not thunk:
                             frame.line = info.line
                         before(info)
-                        ip += 2
+                        ip += 1
                     elif op == OP.CALL:
-                        argc = words[ip + 2]
+                        argc = ins[2]
                         if argc:
                             args = stack[-argc:]
                             del stack[-argc:]
                         else:
                             args = []
-                        name = consts[words[ip + 1]]
-                        flags = consts[words[ip + 3]]
+                        name = ins[1]
+                        flags = ins[3]
                         v = self.call(code, ip, name, args, frame, flags)
                         if flags == "E":
                             if v is None:
                                 raise KrlRuntimeError(f"{name} does not return a value")
                             push(v)
-                        ip += 4
+                        ip += 1
                     elif op == OP.VALARG:
                         stack[-1] = ValueRef(stack[-1])
                         ip += 1
                     elif op == OP.REF_MOD:
-                        push(mrefs[words[ip + 1]])
-                        ip += 2
+                        push(mrefs[ins[1]])
+                        ip += 1
                     elif op == OP.LOAD_GLOBAL or op == OP.REF_GLOBAL or op == OP.STORE_GLOBAL:
-                        g = words[ip + 1]
+                        g = ins[1]
                         ref = grefs[g]
                         if ref is None:
                             ref = rt.lookup(code.gnames[g], frame)
@@ -391,10 +425,10 @@ class VM:
                             push(ref)
                         else:
                             store(ref, pop())
-                        ip += 2
+                        ip += 1
                     elif op == OP.FIELD:
-                        stack[-1] = rt.field(stack[-1], consts[words[ip + 1]], consts[words[ip + 2]])
-                        ip += 3
+                        stack[-1] = rt.field(stack[-1], ins[1], ins[2])
+                        ip += 1
                     elif op == OP.RETURN_VAL:
                         v = pop()
                         return v if code.kind == "DEFFCT" else None
@@ -412,16 +446,16 @@ class VM:
                     elif op == OP.END_THUNK:
                         return stack[-1] if stack else None
                     elif op == OP.LOAD_TEMP:
-                        push(temps[words[ip + 1]])
-                        ip += 2
+                        push(temps[ins[1]])
+                        ip += 1
                     elif op == OP.STORE_TEMP:
-                        temps[words[ip + 1]] = pop()
-                        ip += 2
+                        temps[ins[1]] = pop()
+                        ip += 1
                     elif op == OP.JUMP_IF_TRUE:
                         if rt.to_bool(pop()):
-                            ip = words[ip + 1]
+                            ip = ins[1]
                         else:
-                            ip += 2
+                            ip += 1
                     elif op == OP.NONE:
                         push(None)
                         ip += 1
@@ -432,173 +466,173 @@ class VM:
                         stack[-1] = read_value(stack[-1])
                         ip += 1
                     elif op == OP.FOR_PREP:
-                        t = words[ip + 1]
+                        t = ins[1]
                         step = pop()
                         end = pop()
                         start = pop()
                         temps[t] = pop()
                         temps[t + 1], temps[t + 2] = for_limits(end, step)
                         push(start)
-                        ip += 2
+                        ip += 1
                     elif op == OP.FOR_INIT:
-                        store(temps[words[ip + 1]], pop())
-                        ip += 2
+                        store(temps[ins[1]], pop())
+                        ip += 1
                     elif op == OP.AGG:
-                        names = consts[words[ip + 2]]
+                        names = ins[2]
                         keys = names.split(",") if names else []
                         k = len(keys)
                         vals = stack[len(stack) - k:]
                         del stack[len(stack) - k:]
-                        push(rt.aggregate(consts[words[ip + 1]], list(zip(keys, vals)), frame.module))
-                        ip += 3
+                        push(rt.aggregate(ins[1], list(zip(keys, vals)), frame.module))
+                        ip += 1
                     elif op == OP.JUMP_IF_NONE:
                         if stack[-1] is None:
                             pop()
-                            ip = words[ip + 1]
+                            ip = ins[1]
                         else:
-                            ip += 2
+                            ip += 1
                     elif op == OP.HALT:
                         rt.halt()
                         ip += 1
                     elif op == OP.WAIT_FOR:
-                        rt.wait_for(self.thunk(code, act, words[ip + 1]))
-                        ip += 2
+                        rt.wait_for(self.thunk(code, act, ins[1]))
+                        ip += 1
                     elif op == OP.WAIT_SEC:
                         rt.wait_sec(pop())
                         ip += 1
                     elif op == OP.CONTINUE:
-                        rt.set_continue(infos[words[ip + 1]])
-                        ip += 2
+                        rt.set_continue(ins[1])
+                        ip += 1
                     elif op == OP.ON_ERROR_PROCEED:
                         rt.on_error_proceed()
                         ip += 1
                     elif op == OP.EXIT_SIGNAL:
                         raise ExitSignal()
                     elif op == OP.GOTO_FAIL:
-                        raise KrlRuntimeError(f"GOTO {consts[words[ip + 1]]}: label not found", None,
+                        raise KrlRuntimeError(f"GOTO {ins[1]}: label not found", None,
                                               code.routine.span.file, frame.line)
                     elif op == OP.RAISE:
-                        line = words[ip + 2]
-                        raise KrlRuntimeError(consts[words[ip + 1]], None, code.file if line else None, line or None)
+                        line = ins[2]
+                        raise KrlRuntimeError(ins[1], None, code.file if line else None, line or None)
                     elif op == OP.INT_DECL:
-                        cond = self.thunk(code, act, words[ip + 1])
+                        cond = self.thunk(code, act, ins[1])
                         rt.interrupt_decl(pop(), lambda c=cond: rt.to_bool(c(), "interrupt condition"),
-                                          self.thunk(code, act, words[ip + 2]), consts[words[ip + 3]], frame,
-                                          consts[words[ip + 4]] == "G", words[ip + 5])
-                        ip += 6
+                                          self.thunk(code, act, ins[2]), ins[3], frame,
+                                          ins[4] == "G", ins[5])
+                        ip += 1
                     elif op == OP.INT_CTL:
-                        n = pop() if consts[words[ip + 2]] == "P" else None
-                        rt.interrupt_ctl(consts[words[ip + 1]], n)
-                        ip += 3
+                        n = pop() if ins[2] == "P" else None
+                        rt.interrupt_ctl(ins[1], n)
+                        ip += 1
                     elif op == OP.BRAKE:
-                        rt.brake(consts[words[ip + 1]] == "F")
-                        ip += 2
+                        rt.brake(ins[1] == "F")
+                        ip += 1
                     elif op == OP.STUB:
-                        rt.stub_statement(consts[words[ip + 1]])
-                        ip += 2
+                        rt.stub_statement(ins[1])
+                        ip += 1
                     elif op == OP.CYCFLAG:
                         ref = pop()
                         store(ref, pop())
-                        value = self.thunk(code, act, words[ip + 1])
+                        value = self.thunk(code, act, ins[1])
                         rt.cyclic_on(("CYCFLAG", ref.name), lambda r=ref, f=value: rt.assign(r, f()))
-                        ip += 2
+                        ip += 1
                     elif op == OP.ANOUT_ON:
-                        flags = consts[words[ip + 2]]
+                        flags = ins[2]
                         hi = pop() if "H" in flags else None
                         lo = pop() if "L" in flags else None
                         ref = pop()
                         lo, hi = anout_limits(lo, hi)
-                        value = self.thunk(code, act, words[ip + 3])
+                        value = self.thunk(code, act, ins[3])
 
                         def anout(ref=ref, value=value, lo=lo, hi=hi):
                             ref.set(anout_value(value(), lo, hi))
                         anout()
-                        rt.cyclic_on(("ANOUT", consts[words[ip + 1]]), anout)
-                        ip += 4
+                        rt.cyclic_on(("ANOUT", ins[1]), anout)
+                        ip += 1
                     elif op == OP.ANIN_ON:
                         ref = pop()
-                        value = self.thunk(code, act, words[ip + 2])
+                        value = self.thunk(code, act, ins[2])
 
                         def anin(ref=ref, value=value):
                             rt.assign(ref, value())
                         anin()
-                        key = consts[words[ip + 1]]
+                        key = ins[1]
                         if key is not None:
                             rt.cyclic_on(("ANIN", key), anin)
-                        ip += 3
+                        ip += 1
                     elif op == OP.CYCLIC_OFF:
-                        rt.cyclic_off((consts[words[ip + 1]], consts[words[ip + 2]]))
-                        ip += 3
+                        rt.cyclic_off((ins[1], ins[2]))
+                        ip += 1
                     elif op == OP.RESUME:
                         rt.resume()
                         ip += 1
                     elif op == OP.TRIG_FIND:
-                        target = rt.find_routine(consts[words[ip + 1]], frame.module)
+                        target = rt.find_routine(ins[1], frame.module)
                         push(target)
-                        ip = words[ip + 2] if target is None else ip + 3
+                        ip = ins[2] if target is None else ip + 1
                     elif op == OP.TRIG_PACK:
-                        argc = words[ip + 1]
+                        argc = ins[1]
                         args = stack[len(stack) - argc:]
                         del stack[len(stack) - argc:]
                         stack[-1] = (stack[-1], args)
-                        ip += 2
+                        ip += 1
                     elif op == OP.TRIGGER:
-                        flags = consts[words[ip + 2]]
+                        flags = ins[2]
                         prio = pop() if "P" in flags else None
                         delay = pop()
                         at = pop()
-                        action = self.thunk(code, act, words[ip + 4], [pop()])
-                        rt.trigger(action, line=words[ip + 3],
-                                   **trigger_args(consts[words[ip + 1]], at, delay, prio, "O" in flags))
-                        ip += 5
+                        action = self.thunk(code, act, ins[4], [pop()])
+                        rt.trigger(action, line=ins[3],
+                                   **trigger_args(ins[1], at, delay, prio, "O" in flags))
+                        ip += 1
                     elif op == OP.TRIG_INVOKE:
                         target, args = pop()
                         self.invoke(target, args, frame)
                         ip += 1
                     elif op == OP.MOTION:
-                        nwith = words[ip + 5]
+                        nwith = ins[5]
                         pairs = self.pairs(stack, nwith)
-                        flags = consts[words[ip + 4]]
+                        flags = ins[4]
                         ca = pop() if "C" in flags else None
                         aux = pop() if "A" in flags else None
-                        approx = consts[words[ip + 2]]
-                        rt.motion(consts[words[ip + 1]], pop(), approx.split(",") if approx else [], aux, ca,
-                                  consts[words[ip + 3]], pairs, code.file, words[ip + 6])
-                        ip += 7
+                        approx = ins[2]
+                        rt.motion(ins[1], pop(), approx.split(",") if approx else [], aux, ca,
+                                  ins[3], pairs, code.file, ins[6])
+                        ip += 1
                     elif op == OP.SPL_BEGIN:
-                        temps[words[ip + 1]] = [[], [], None]     # segments, pending triggers, saved
-                        ip += 2
+                        temps[ins[1]] = [[], [], None]     # segments, pending triggers, saved
+                        ip += 1
                     elif op == OP.SPL_TRIG_BEGIN:
-                        sp = temps[words[ip + 1]]
+                        sp = temps[ins[1]]
                         task = rt.current_task
                         sp[2] = task.next_triggers
                         task.next_triggers = []
-                        ip += 2
+                        ip += 1
                     elif op == OP.SPL_TRIG_END:
-                        sp = temps[words[ip + 1]]
+                        sp = temps[ins[1]]
                         task = rt.current_task
                         sp[1] += task.next_triggers
                         task.next_triggers = sp[2]
-                        ip += 2
+                        ip += 1
                     elif op == OP.SPL_SEG:
-                        pairs = self.pairs(stack, words[ip + 3])
-                        flags = consts[words[ip + 2]]
+                        pairs = self.pairs(stack, ins[3])
+                        flags = ins[2]
                         ca = float(num(pop())) if "C" in flags else None
                         aux = pop() if "A" in flags else None
-                        sp = temps[words[ip + 5]]
-                        sp[0].append({"kind": consts[words[ip + 1]], "target": pop(), "aux": aux, "ca": ca,
-                                      "with_": pairs, "triggers": sp[1], "line": words[ip + 4]})
+                        sp = temps[ins[5]]
+                        sp[0].append({"kind": ins[1], "target": pop(), "aux": aux, "ca": ca,
+                                      "with_": pairs, "triggers": sp[1], "line": ins[4]})
                         sp[1] = []
-                        ip += 6
+                        ip += 1
                     elif op == OP.SPLINE:
-                        pairs = self.pairs(stack, words[ip + 3])
-                        rt.spline(consts[words[ip + 1]], temps[words[ip + 5]][0], consts[words[ip + 2]], pairs,
-                                  code.file, words[ip + 4])
-                        ip += 6
+                        pairs = self.pairs(stack, ins[3])
+                        rt.spline(ins[1], temps[ins[5]][0], ins[2], pairs,
+                                  code.file, ins[4])
+                        ip += 1
                     else:
                         raise RuntimeError(f"bad opcode {op} at {ip} in {code.name}")
             except KrlRuntimeError as e:
-                reg = code.regions[ip]
+                reg = code.iregions[ip]
                 if reg is None:
                     raise
                 e.at(code.file, reg.line)
