@@ -256,15 +256,15 @@ class Compiler:
         info = self.info(st)
         self.stmt(st)
         top, end = self.new_label(), self.new_label()
-        self.place(top)
         self.emit("TICK", info)
+        self.place(top)
         self.region = Region("A", st.span.line)
         self.expr(st.cond)
         self.region = None
         self.emit("JUMP_IF_FALSE", end)
         self.loop_body(st.body, end)
         self.region = None
-        self.emit("JUMP", top)
+        self.emit("JUMP_TICK", info, top)
         self.place(end)
 
     def s_Repeat(self, st) -> None:
@@ -285,11 +285,11 @@ class Compiler:
         info = self.info(st)
         self.stmt(st)
         top, end = self.new_label(), self.new_label()
-        self.place(top)
         self.emit("TICK", info)
+        self.place(top)
         self.loop_body(st.body, end)
         self.region = None
-        self.emit("JUMP", top)
+        self.emit("JUMP_TICK", info, top)
         self.place(end)
 
     def s_Exit(self, st) -> None:
@@ -686,6 +686,8 @@ def _fuse(group: list):
             return (_CMP_JUMPS[names[0]], [ops[1][0]])
         if names[0] == "CONST" and names[1] in _CONST_OPS:
             return (_CONST_OPS[names[1]], [ops[0][0]])
+        if names[0] == "LOAD_LOCAL" and names[1] in ("ADD_CONST", "SUB_CONST"):
+            return ("LOCAL_" + names[1], [ops[0][0], ops[1][0]])
         if names == ["LOAD_LOCAL", "LOAD_LOCAL"]:
             return ("LOAD_LOCAL2", [ops[0][0], ops[1][0]])
     return None

@@ -240,6 +240,15 @@ class VM:
                             ip = ins[1]
                     elif op == OP.JUMP:
                         ip = ins[1]
+                    elif op == OP.JUMP_TICK:
+                        tick(ins[1])
+                        ip = ins[2]
+                    elif op == OP.LOCAL_ADD_CONST:
+                        push(add(load(refs[ins[1]]), ins[2]))
+                        ip += 1
+                    elif op == OP.LOCAL_SUB_CONST:
+                        push(sub(load(refs[ins[1]]), ins[2]))
+                        ip += 1
                     elif op == OP.FOR_TEST:
                         t = ins[1]
                         if for_done(temps[t].get(), temps[t + 1], temps[t + 2]):
