@@ -289,7 +289,8 @@ statement
     | RETURN expression?                                            # returnStatement
     | ON_ERROR_PROCEED                                              # onErrorProceedStatement
     | CONFIRM expression                                            # confirmStatement
-    | GLOBAL? INTERRUPT DECL priority WHEN expression DO call       # interruptDeclaration
+    | GLOBAL? INTERRUPT DECL priority WHEN expression DO
+      (call | BRAKE | BRAKE_F)                                      # interruptDeclaration
     | INTERRUPT action=(ON | OFF | ENABLE | DISABLE) priority?      # interruptControl
     | BRAKE                                                         # brakeStatement
     | BRAKE_F                                                       # brakeFStatement
