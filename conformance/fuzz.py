@@ -5,8 +5,9 @@ array (all initialised first), assignments with arithmetic and comparisons, IF/E
 with value lists and DEFAULT, FOR (with STEP), WHILE/REPEAT/LOOP bounded by counters, EXIT,
 forward GOTOs, calls of a procedure with :IN/:OUT parameters and of a function, $OUT writes
 (with and without CONTINUE), PULSE, WAIT SEC, PTP/LIN/CIRC motions with C_PTP/C_DIS/C_VEL
-approximation between reachable points near the start pose, TRIGGERs and an interrupt on an
-input driven by generated stimuli.
+approximation between reachable points near the start pose, TRIGGERs, an interrupt on an
+input driven by generated stimuli, REAL<->INT conversions and statements that may fail at run
+time (division by a variable, array index from a variable), sometimes after ON_ERROR_PROCEED.
 
 Property:
 * with the VM available: ``tree == vm`` (trace flow, I/O with times, motion/end events, TCP
@@ -155,7 +156,7 @@ def _ax(q):
 @st.composite
 def statement(draw, depth: int, ctx: dict[str, Any]):
     kinds = ["assign_int", "assign_real", "assign_bool", "assign_arr", "out", "call", "motion",
-             "motion", "wait", "trigger"]
+             "motion", "wait", "trigger", "convert", "risky"]
     if depth > 0:
         kinds += ["if", "switch", "for", "while", "repeat", "loop", "goto"]
     k = draw(st.sampled_from(kinds))
@@ -166,6 +167,18 @@ def statement(draw, depth: int, ctx: dict[str, Any]):
         return [f"{ind}{draw(st.sampled_from(REAL_VARS))} = {draw(real_expr())}"]
     if k == "assign_bool":
         return [f"{ind}{draw(st.sampled_from(BOOL_VARS))} = {draw(bool_expr())}"]
+    if k == "convert":  # REAL -> INT (rounding), INT -> REAL
+        if draw(st.booleans()):
+            return [f"{ind}{draw(st.sampled_from(INT_VARS))} = {draw(real_expr(1))}"]
+        return [f"{ind}{draw(st.sampled_from(REAL_VARS))} = {draw(int_expr(1))} / 4"]
+    if k == "risky":  # may raise a run-time error (division by zero, index out of range)
+        v = draw(st.sampled_from(INT_VARS))
+        stmt = draw(st.sampled_from([f"{v} = {draw(int_expr(1))} / {draw(st.sampled_from(INT_VARS))}",
+                                     f"{v} = arr[{draw(st.sampled_from(INT_VARS))}]",
+                                     f"arr[{draw(st.sampled_from(INT_VARS))}] = {draw(int_expr(1))}"]))
+        if draw(st.booleans()):
+            return [f"{ind}ON_ERROR_PROCEED", f"{ind}{stmt}"]
+        return [f"{ind}{stmt}"]
     if k == "assign_arr":
         return [f"{ind}arr[{draw(st.integers(1, 5))}] = {draw(int_expr(1))}"]
     if k == "out":
