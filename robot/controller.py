@@ -511,10 +511,11 @@ class Controller:
         if self.trace is not None:
             self.trace.write("message", self.time, text=text, id=motion_id, number=number)
 
-    def finish(self, reason: str = "program_end") -> None:
-        """Write the ``end`` trace event (once)."""
+    def finish(self, reason: str = "program_end", **fields: Any) -> None:
+        """Write the ``end`` trace event (once); ``fields`` add where and why (the
+        interpreters pass text, number, file, line and context)."""
         if not self._ended and self.trace is not None:
-            self.trace.write("end", self.time, reason=reason)
+            self.trace.write("end", self.time, reason=reason, **fields)
         self._ended = True
 
     def _motion_event(self, seg: Segment, phase: str) -> None:

@@ -148,10 +148,9 @@ class Runtime:
             file, line, ctx = robot.file, robot.line, "main"
         self.result = RunResult(reason, err, file, line, ctx, text, self.controller.time, self.steps)
         if self.trace is not None:
-            self.trace.write("end", self.controller.time, reason=reason, text=text or None,
-                             number=err.number if err is not None else None,
-                             file=file, line=line, context=ctx)
-            self.controller._ended = True  # noqa: SLF001 - the interpreter wrote the end event
+            self.controller.finish(reason, text=text or None,
+                                   number=err.number if err is not None else None,
+                                   file=file, line=line, context=ctx)
         self.trace = None       # abandoned tasks may unwind later: nothing more is traced
         return self.result
 
@@ -243,7 +242,7 @@ class Runtime:
         interrupted motion is suspended and not counted); before BRAKE the planned motions
         keep running and the routine does not wait for them. A TRIGGER action never waits."""
         kind = task.context.kind
-        if kind == "main" or (kind == "interrupt" and self.controller._held is not None):  # noqa: SLF001
+        if kind == "main" or (kind == "interrupt" and self.controller.is_suspended()):
             self.wait_main_run(task)
 
     def wait_main_run(self, task: Task) -> None:

@@ -119,16 +119,11 @@ class Scheduler:
     def deadlocked(self) -> bool:
         rt = self.rt
         ctl = rt.controller
-        if not ctl.is_idle() or ctl._held is not None:  # noqa: SLF001
+        if not ctl.is_idle() or ctl.is_suspended():
             return False
         if any(not t.done for t in self.tasks[1:]):
             return False
-        if any(not st.fired for st in ctl.stimuli):
-            return False
-        if ctl._pulses or ctl._cyclic:  # noqa: SLF001
-            return False
-        io = ctl.io
-        if any(not s for s in io.timer_stop[1:]):
+        if ctl.io_may_change():   # a stimulus, a PULSE, a cyclic hook or a running timer
             return False
         robot = self.tasks[0]
         if robot.irqs.armed or robot.pending_triggers:
