@@ -659,8 +659,15 @@ class Builder:
             when = self.expr(exprs[0])
         else:
             prio, when = self.expr(exprs[0]), self.expr(exprs[1])
-        return N.InterruptDecl(prio, when, self.call(self.rule(ctx, "call")),
-                               self.has(ctx, "GLOBAL"), span=sp)
+        call_ctx = self.rule(ctx, "call", required=False)
+        if call_ctx is not None:
+            return N.InterruptDecl(prio, when, self.call(call_ctx), self.has(ctx, "GLOBAL"), span=sp)
+        syms = [s for s, _, _ in self.toks(ctx)]
+        after_do = syms[syms.index("DO") + 1:] if "DO" in syms else []
+        if "BRAKE_F" in after_do or "BRAKE" in after_do:
+            brake = N.Brake("BRAKE_F" in after_do, span=sp)
+            return N.InterruptDecl(prio, when, None, self.has(ctx, "GLOBAL"), brake, span=sp)
+        raise BuildError("interrupt declaration without action")
 
     def s_int_ctl(self, ctx, sp):
         action = next(s for s, _, _ in self.toks(ctx) if s in ("ON", "OFF", "ENABLE", "DISABLE"))

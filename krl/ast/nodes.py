@@ -426,11 +426,13 @@ class OnErrorProceed(Stmt):
 
 @dataclass(slots=True)
 class InterruptDecl(Stmt):
-    """``[GLOBAL] INTERRUPT DECL prio WHEN cond DO call`` (5.16)."""
+    """``[GLOBAL] INTERRUPT DECL prio WHEN cond DO call`` (5.16); ``DO BRAKE`` / ``DO BRAKE F``
+    gives call None and brake a Brake node."""
     prio: Expr
     when: Expr
-    call: Call
+    call: Call | None
     is_global: bool = False
+    brake: "Brake | None" = None
 
 
 @dataclass(slots=True)

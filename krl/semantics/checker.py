@@ -359,7 +359,8 @@ class Checker:
             if isinstance(s.prio, N.IntLit) and not 1 <= s.prio.value <= 128:
                 self.sink.at(s.prio.span, "E408", f"interrupt priority {s.prio.value} is outside 1..128")
             self.cond(s.when, sc, "WHEN")
-            self.call(s.call, sc, statement=True)
+            if s.call is not None:
+                self.call(s.call, sc, statement=True)
         elif isinstance(s, N.InterruptCtl):
             if s.prio is not None:
                 self.int_expr(s.prio, sc, "interrupt number")

@@ -84,6 +84,8 @@ simple_stmts = st.one_of(
     st.builds(N.Return, st.one_of(st.none(), exprs)),
     st.builds(N.Goto, names), st.builds(N.Label, names),
     st.builds(N.InterruptDecl, st.one_of(dec_ints, st.builds(N.Name, names)), exprs, calls, st.booleans()),
+    st.builds(N.InterruptDecl, st.one_of(dec_ints, st.builds(N.Name, names)), exprs, st.none(), st.booleans(),
+              st.builds(N.Brake, st.booleans())),
     st.builds(N.InterruptCtl, st.sampled_from(["ON", "OFF", "ENABLE", "DISABLE"]),
               st.one_of(st.none(), dec_ints, st.builds(N.Name, names))),
     st.builds(N.Trigger, st.just("DISTANCE"), st.builds(N.IntLit, st.integers(0, 1)), exprs,
