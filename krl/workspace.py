@@ -93,14 +93,17 @@ class Workspace:
 
     @property
     def diagnostics(self) -> list[Diagnostic]:
+        """All diagnostics so far, sorted by path, line, column."""
         return self.sink.sorted()
 
     @property
     def modules(self) -> dict[str, ModuleUnit]:
+        """Module units by upper-case name."""
         return {u.name.upper(): u for u in self.units}
 
     @property
     def incomplete(self) -> bool:
+        """True when a file of the workspace did not parse."""
         return any(not f.ok for f in self.files)
 
     def lookup_routine(self, name: str) -> Symbol | None:

@@ -274,6 +274,7 @@ def stmt(s: N.Stmt, level: int = 1) -> list[str]:
 
 
 def block(stmts: list[N.Stmt], level: int) -> list[str]:
+    """Statements as lines indented to `level`."""
     out: list[str] = []
     for s in stmts:
         out.extend(stmt(s, level))
@@ -281,6 +282,7 @@ def block(stmts: list[N.Stmt], level: int) -> list[str]:
 
 
 def routine(r: N.Routine) -> list[str]:
+    """A routine as lines, from its DEF/DEFFCT header to END/ENDFCT (2.2-2.4)."""
     params = ", ".join(p.name + (f"[{',' * (p.dims - 1)}]" if p.dims else "")
                        + (f" :{p.mode}" if p.mode else "") for p in r.params)
     g = "GLOBAL " if r.is_global else ""

@@ -64,6 +64,7 @@ class Declarer:
         self.sink.at(span, "E102", f"'{name}' is declared more than once{where}")
 
     def resolve_type(self, scope: Scope, tref: N.TypeRef | str, span: N.Span, dims=()) -> T.KrlType:
+        """A type by name (E105/W105 and UNKNOWN when it does not exist), with array dims."""
         name = tref.name if isinstance(tref, N.TypeRef) else tref
         typ = scope.lookup_type(name)
         if typ is None:
@@ -224,6 +225,7 @@ class Checker:
     # ---------------------------------------------------------------- entry points
 
     def check_datalist(self, dl: N.DataList, scope: Scope) -> None:
+        """Check the initial values of a data list against the declared types (2.5, 3.9)."""
         try:
             for d in dl.items:
                 if isinstance(d, N.VarDecl) and d.init is not None:
@@ -258,6 +260,7 @@ class Checker:
         self.check_value(elem, d.value, scope, d.span)
 
     def check_routine(self, r: N.Routine, local: Scope, module_path: str) -> None:
+        """Check and annotate one routine whose scope `local` holds its parameters and locals."""
         try:
             ctx = _Ctx(r, local)
             self._routine(r, ctx)

@@ -92,11 +92,13 @@ class Diagnostic:
         return CODES.get(self.code, ("", self.code))[1]
 
     def format(self) -> str:
+        """`path:line:col: severity CODE message`."""
         return f"{self.path}:{self.line}:{self.column}: {self.severity} {self.code} {self.message}"
 
     __str__ = format
 
     def as_json(self) -> dict:
+        """The JSON form: path, line, column, severity, code, message."""
         return {"path": self.path, "line": self.line, "column": self.column,
                 "severity": self.severity, "code": self.code, "message": self.message}
 
@@ -110,6 +112,7 @@ class DiagnosticSink:
 
     def add(self, path: str, line: int, column: int, code: str, message: str,
             severity: str = "") -> None:
+        """Add one diagnostic (exact duplicates are dropped)."""
         key = (path, line, column, code, message)
         if key in self._seen:
             return

@@ -30,6 +30,7 @@ from krl.semantics.builtins import load_builtins
 
 @dataclass(slots=True)
 class ParamSig:
+    """A routine parameter in a signature: name, type and mode ('IN', 'OUT' or None)."""
     name: str
     type: T.KrlType
     mode: str | None          # 'IN', 'OUT' or None (not written)
@@ -50,6 +51,7 @@ class RoutineSig:
 
 @dataclass(slots=True, eq=False)
 class Symbol:
+    """A declared name (see the module docstring for the fields)."""
     name: str
     kind: str
     type: T.KrlType
@@ -94,6 +96,7 @@ class Scope:
         return None
 
     def define_type(self, name: str, typ: T.KrlType) -> T.KrlType | None:
+        """Add a type name; return the existing type of that name in this scope (a duplicate), else None."""
         key = name.upper()
         old = self.types.get(key)
         if old is not None:
@@ -102,6 +105,7 @@ class Scope:
         return None
 
     def lookup(self, name: str) -> Symbol | None:
+        """A variable, constant, parameter, signal or system variable, searched up the parents (2.7)."""
         key = name.upper()
         s: Scope | None = self
         while s is not None:
@@ -112,6 +116,7 @@ class Scope:
         return None
 
     def lookup_routine(self, name: str) -> Symbol | None:
+        """A routine (user, EXT-declared or built-in), searched up the parents."""
         key = name.upper()
         s: Scope | None = self
         while s is not None:
@@ -122,6 +127,7 @@ class Scope:
         return None
 
     def lookup_type(self, name: str) -> T.KrlType | None:
+        """A type by name, searched up the parents."""
         key = name.upper()
         s: Scope | None = self
         while s is not None:
@@ -141,6 +147,7 @@ class Scope:
 
 
 def make_array(elem: T.KrlType, dims) -> T.KrlType:
+    """`elem` itself for no dimensions, else Array(elem, dims) (3.3)."""
     dims = tuple(dims or ())
     return T.Array(elem, dims) if dims else elem
 

@@ -35,6 +35,7 @@ class KrlType:
 
 @dataclass(frozen=True, slots=True)
 class Simple(KrlType):
+    """INT, REAL, BOOL or CHAR (3.1)."""
     name: str
 
     def __str__(self) -> str:
@@ -50,6 +51,7 @@ SIMPLE = {"INT": INT, "REAL": REAL, "BOOL": BOOL, "CHAR": CHAR}
 
 @dataclass(frozen=True, slots=True)
 class Array(KrlType):
+    """An array of 1-3 dimensions; a size of 0 is an open dimension of an array parameter (2.3, 3.3)."""
     elem: KrlType
     dims: tuple[int, ...]
 
@@ -144,10 +146,12 @@ GEOMETRIC = CARTESIAN | AXES
 
 
 def is_numeric(t: KrlType) -> bool:
+    """INT, REAL (or UNKNOWN, which is compatible with everything)."""
     return t in (INT, REAL) or t is UNKNOWN
 
 
 def is_char_array(t: KrlType) -> bool:
+    """A one-dimensional CHAR array: a string variable (3.4)."""
     return isinstance(t, Array) and t.elem == CHAR and len(t.dims) == 1
 
 
@@ -157,6 +161,7 @@ def is_stringish(t: KrlType) -> bool:
 
 
 def geometric_family(t: KrlType) -> str | None:
+    """'cartesian' for FRAME/POS/E3POS/E6POS, 'axis' for AXIS/E3AXIS/E6AXIS, else None (3.9)."""
     if isinstance(t, Struc):
         n = t.name.upper()
         if n in CARTESIAN:
