@@ -929,7 +929,23 @@ def _c_stops_before(spec, mid, mt, ps):
         f"closest approach to the point of motion {mid}: {closest:.3f} mm (must stay >= {spec.get('min_mm', 1.0)})"
 
 
+def _c_standstill(spec, mid, mt, ps):
+    """The robot stands still during motion ``id`` (BRAKE without RESUME) at least
+    ``min_mm`` away from both its start and its end point, and the motion then goes on."""
+    d = mt[mid]
+    a, b = _start_point(mt, ps, mid), d["point"][:3]
+    t0, t1 = d["start"], d.get("end", math.inf)
+    seg = [(t, p[:3]) for t, p in ps if t0 <= t <= t1]
+    far = float(spec.get("min_mm", 5.0))
+    still = [seg[k][0] for k in range(1, len(seg))
+             if _norm(_sub(seg[k][1], seg[k - 1][1])) < 1e-6
+             and _norm(_sub(seg[k][1], a)) > far and _norm(_sub(seg[k][1], b)) > far]
+    return bool(still), (f"standing still at t={still[0]:.3f}..{still[-1]:.3f} s" if still
+                         else f"no standstill inside motion {mid} (more than {far} mm from its ends)")
+
+
 _MOTION_CHECKS = {
+    "standstill": _c_standstill,
     "count": _c_count, "straight": _c_straight, "circle": _c_circle, "reaches": _c_reaches,
     "exact_stop": _c_exact, "blend": _c_blend, "duration": _c_duration, "gap": _c_gap,
     "approximation": _c_approx, "point": _c_point, "passes": _c_passes,
