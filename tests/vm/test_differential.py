@@ -36,3 +36,25 @@ def test_paper_example(tmp_path, brake_at):
     inputs.write_text(stim)
     _check(_variant(tmp_path), inputs=inputs, before=_shift_base, max_sim_time=60)
     _check(PAPER, inputs=inputs, before=_shift_base, max_sim_time=60)
+
+
+def _real_programs():
+    try:
+        from interp.realprograms import DEFAULT_CORPUS, find_backups, programs_of
+    except ImportError:     # pragma: no cover
+        return []
+    if not DEFAULT_CORPUS.is_dir():
+        return []
+    out = []
+    for b in find_backups(DEFAULT_CORPUS):
+        out += programs_of(b)
+    return out
+
+
+REAL = _real_programs()
+
+
+@pytest.mark.skipif(not REAL, reason="../shared/krl-corpus absent")
+@pytest.mark.parametrize("program", REAL, ids=lambda p: "/".join(p.parts[-3:]))
+def test_real_program(program):
+    _check(program, max_sim_time=20, max_steps=100_000)
