@@ -665,8 +665,10 @@ class Builder:
         syms = [s for s, _, _ in self.toks(ctx)]
         after_do = syms[syms.index("DO") + 1:] if "DO" in syms else []
         if "BRAKE_F" in after_do or "BRAKE" in after_do:
-            brake = N.Brake("BRAKE_F" in after_do, span=sp)
-            return N.InterruptDecl(prio, when, None, self.has(ctx, "GLOBAL"), brake, span=sp)
+            fast = "BRAKE_F" in after_do
+            brake = N.Brake(fast, span=sp)
+            call = N.Call("BRAKE_F" if fast else "BRAKE", [], span=sp)
+            return N.InterruptDecl(prio, when, call, self.has(ctx, "GLOBAL"), brake, span=sp)
         raise BuildError("interrupt declaration without action")
 
     def s_int_ctl(self, ctx, sp):

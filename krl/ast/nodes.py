@@ -426,11 +426,12 @@ class OnErrorProceed(Stmt):
 
 @dataclass(slots=True)
 class InterruptDecl(Stmt):
-    """``[GLOBAL] INTERRUPT DECL prio WHEN cond DO call`` (5.16); ``DO BRAKE`` / ``DO BRAKE F``
-    gives call None and brake a Brake node."""
+    """``[GLOBAL] INTERRUPT DECL prio WHEN cond DO call`` (5.16). For ``DO BRAKE`` /
+    ``DO BRAKE F``, ``brake`` is the Brake node and ``call`` is ``Call('BRAKE', [])`` /
+    ``Call('BRAKE_F', [])`` (the form the interpreters dispatch on)."""
     prio: Expr
     when: Expr
-    call: Call | None
+    call: Call
     is_global: bool = False
     brake: "Brake | None" = None
 

@@ -230,7 +230,7 @@ def stmt(s: N.Stmt, level: int = 1) -> list[str]:
         return [ind + "ON_ERROR_PROCEED"]
     if isinstance(s, N.InterruptDecl):
         g = "GLOBAL " if s.is_global else ""
-        action = expr(s.call) if s.call is not None else ("BRAKE F" if s.brake and s.brake.fast else "BRAKE")
+        action = ("BRAKE F" if s.brake.fast else "BRAKE") if s.brake is not None else expr(s.call)
         return [f"{ind}{g}INTERRUPT DECL {expr(s.prio)} WHEN {expr(s.when)} DO {action}"]
     if isinstance(s, N.InterruptCtl):
         return [f"{ind}INTERRUPT {s.action}" + (f" {expr(s.prio)}" if s.prio is not None else "")]

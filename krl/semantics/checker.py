@@ -362,8 +362,10 @@ class Checker:
             if isinstance(s.prio, N.IntLit) and not 1 <= s.prio.value <= 128:
                 self.sink.at(s.prio.span, "E408", f"interrupt priority {s.prio.value} is outside 1..128")
             self.cond(s.when, sc, "WHEN")
-            if s.call is not None:
+            if s.brake is None:
                 self.call(s.call, sc, statement=True)
+            else:
+                self.set_type(s.call, T.VOID)
         elif isinstance(s, N.InterruptCtl):
             if s.prio is not None:
                 self.int_expr(s.prio, sc, "interrupt number")

@@ -179,8 +179,9 @@ def test_newer_grammar_constructs():
 
 def test_interrupt_brake_action():
     a, b = body_of("INTERRUPT DECL 5 WHEN $IN[1] DO BRAKE\nGLOBAL INTERRUPT DECL 6 WHEN $IN[2] DO BRAKE F")
-    assert a == N.InterruptDecl(N.IntLit(5), N.Index(N.Name("$IN"), [N.IntLit(1)]), None, False, N.Brake(False))
-    assert b.brake == N.Brake(True) and b.is_global and b.call is None
+    assert a == N.InterruptDecl(N.IntLit(5), N.Index(N.Name("$IN"), [N.IntLit(1)]), N.Call("BRAKE", []),
+                                False, N.Brake(False))
+    assert b.brake == N.Brake(True) and b.is_global and b.call == N.Call("BRAKE_F", [])
 
 
 def test_workspace_routine_lookup():
