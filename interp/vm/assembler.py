@@ -64,12 +64,15 @@ class Code:
     gnames: list = field(default_factory=list)    # global slots
     ntemps: int = 0
     regions: list = field(default_factory=list)   # per word: Region or None
-    # linked at run time (interp/vm/vm.py)
-    routine: object = None
-    module: object = None
-    mrefs: list | None = None
-    grefs: list | None = None
-    callsites: dict = field(default_factory=dict)
+    # linked when the routine is first called (interp/vm/vm.py, VM.code_for)
+    routine: object = None                        # the AST Routine
+    module: object = None                         # its runtime ModuleRT
+    mrefs: list | None = None                     # module slots -> data-list references
+    grefs: list | None = None                     # global slots -> references (bound on first use)
+    lkeys: list | None = None                     # frame slots -> Frame.vars keys
+    prog: list | None = None                      # decoded instructions (vm.decode)
+    iregions: list | None = None                  # error region per decoded instruction
+    callsites: dict = field(default_factory=dict)  # instruction -> (module, routine) of a CALL
 
     @property
     def is_function(self) -> bool:
