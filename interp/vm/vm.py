@@ -203,15 +203,15 @@ class VM:
                     ins = prog[ip]
                     op = ins[0]
                     # the hottest opcodes first (measured on the benchmark)
-                    if op == OP.LOAD_LOCAL:
-                        push(load(refs[ins[1]]))
-                        ip += 1
-                    elif op == OP.STMT_G:
+                    if op == OP.STMT_G:
                         info = ins[1]
                         if not thunk:
                             frame.line = info.line
                         before(info)
                         proceed = take_error_proceed()
+                        ip += 1
+                    elif op == OP.LOAD_LOCAL:
+                        push(load(refs[ins[1]]))
                         ip += 1
                     elif op == OP.LOAD_ELEM_LL:
                         push(element1(refs[ins[1]], load(refs[ins[2]]), ins[3]))
@@ -222,15 +222,8 @@ class VM:
                     elif op == OP.STORE_LOCAL:
                         store(refs[ins[1]], pop())
                         ip += 1
-                    elif op == OP.TICK:
-                        tick(ins[1])
-                        ip += 1
-                    elif op == OP.ADD:
-                        b = pop()
-                        stack[-1] = add(stack[-1], b)
-                        ip += 1
-                    elif op == OP.STORE_ELEM_LL:
-                        set_element(refs[ins[1]], [load(refs[ins[2]])], pop(), ins[3])
+                    elif op == OP.REF_LOCAL:
+                        push(refs[ins[1]])
                         ip += 1
                     elif op == OP.IF_NOT_LE:
                         b = pop()
@@ -238,23 +231,16 @@ class VM:
                             ip += 1
                         else:
                             ip = ins[1]
-                    elif op == OP.JUMP:
-                        ip = ins[1]
                     elif op == OP.JUMP_TICK:
                         tick(ins[1])
                         ip = ins[2]
-                    elif op == OP.LOCAL_ADD_CONST:
-                        push(add(load(refs[ins[1]]), ins[2]))
+                    elif op == OP.LOAD_LOCAL2:
+                        push(load(refs[ins[1]]))
+                        push(load(refs[ins[2]]))
                         ip += 1
-                    elif op == OP.LOCAL_SUB_CONST:
-                        push(sub(load(refs[ins[1]]), ins[2]))
+                    elif op == OP.TICK:
+                        tick(ins[1])
                         ip += 1
-                    elif op == OP.FOR_TEST:
-                        t = ins[1]
-                        if for_done(temps[t].get(), temps[t + 1], temps[t + 2]):
-                            ip = ins[2]
-                        else:
-                            ip += 1
                     elif op == OP.FOR_NEXT:
                         t = ins[1]
                         ref = temps[t]
@@ -265,19 +251,19 @@ class VM:
                         else:
                             tick(ins[2])
                             ip = ins[3]
-                    elif op == OP.LOAD_ELEM2_LLL:
-                        push(element2(refs[ins[1]], load(refs[ins[2]]), load(refs[ins[3]]),
-                                      ins[4]))
+                    elif op == OP.ADD:
+                        b = pop()
+                        stack[-1] = add(stack[-1], b)
                         ip += 1
-                    elif op == OP.LOAD_LOCAL2:
-                        push(load(refs[ins[1]]))
-                        push(load(refs[ins[2]]))
+                    elif op == OP.LOCAL_ADD_CONST:
+                        push(add(load(refs[ins[1]]), ins[2]))
                         ip += 1
-                    elif op == OP.ADD_CONST:
-                        stack[-1] = add(stack[-1], ins[1])
-                        ip += 1
-                    elif op == OP.SUB_CONST:
-                        stack[-1] = sub(stack[-1], ins[1])
+                    elif op == OP.STORE_INDEX:
+                        n = ins[1]
+                        idx = stack[-n:]
+                        del stack[-n:]
+                        base = pop()
+                        set_element(base, idx, pop(), ins[2])
                         ip += 1
                     elif op == OP.IF_NOT_LT:
                         b = pop()
@@ -285,21 +271,48 @@ class VM:
                             ip += 1
                         else:
                             ip = ins[1]
-                    elif op == OP.REF_LOCAL:
-                        push(refs[ins[1]])
+                    elif op == OP.STORE_ELEM_LL:
+                        set_element(refs[ins[1]], [load(refs[ins[2]])], pop(), ins[3])
+                        ip += 1
+                    elif op == OP.LOCAL_SUB_CONST:
+                        push(sub(load(refs[ins[1]]), ins[2]))
+                        ip += 1
+                    elif op == OP.MUL:
+                        b = pop()
+                        stack[-1] = mul(stack[-1], b)
+                        ip += 1
+                    elif op == OP.LOAD_FIELD:
+                        stack[-1] = component(stack[-1], ins[1], ins[2])
+                        ip += 1
+                    elif op == OP.LOAD_ELEM2_LLL:
+                        push(element2(refs[ins[1]], load(refs[ins[2]]), load(refs[ins[3]]),
+                                      ins[4]))
+                        ip += 1
+                    elif op == OP.UNOP:
+                        stack[-1] = rt.unary_op(ins[1], stack[-1])
                         ip += 1
                     elif op == OP.JUMP_IF_FALSE:
                         if rt.to_bool(pop()):
                             ip += 1
                         else:
                             ip = ins[1]
+                    elif op == OP.JUMP:
+                        ip = ins[1]
+                    elif op == OP.FOR_TEST:
+                        t = ins[1]
+                        if for_done(temps[t].get(), temps[t + 1], temps[t + 2]):
+                            ip = ins[2]
+                        else:
+                            ip += 1
+                    elif op == OP.ADD_CONST:
+                        stack[-1] = add(stack[-1], ins[1])
+                        ip += 1
+                    elif op == OP.SUB_CONST:
+                        stack[-1] = sub(stack[-1], ins[1])
+                        ip += 1
                     elif op == OP.SUB:
                         b = pop()
                         stack[-1] = sub(stack[-1], b)
-                        ip += 1
-                    elif op == OP.MUL:
-                        b = pop()
-                        stack[-1] = mul(stack[-1], b)
                         ip += 1
                     elif op == OP.MUL_CONST:
                         stack[-1] = mul(stack[-1], ins[1])
@@ -310,22 +323,9 @@ class VM:
                         del stack[-n:]
                         stack[-1] = element(stack[-1], idx, ins[2])
                         ip += 1
-                    elif op == OP.STORE_INDEX:
-                        n = ins[1]
-                        idx = stack[-n:]
-                        del stack[-n:]
-                        base = pop()
-                        set_element(base, idx, pop(), ins[2])
-                        ip += 1
-                    elif op == OP.LOAD_FIELD:
-                        stack[-1] = component(stack[-1], ins[1], ins[2])
-                        ip += 1
                     elif op == OP.STORE_FIELD:
                         base = pop()
                         set_component(base, ins[1], pop(), ins[2])
-                        ip += 1
-                    elif op == OP.UNOP:
-                        stack[-1] = rt.unary_op(ins[1], stack[-1])
                         ip += 1
                     elif op == OP.LOAD_MOD:
                         push(load(mrefs[ins[1]]))
