@@ -375,7 +375,8 @@ class Checker:
             self.numeric(s.delay, sc, "DELAY")
             if s.prio is not None:
                 self.int_expr(s.prio, sc, "PRIO")
-            elif isinstance(s.action, N.CallStmt):
+            elif isinstance(s.action, N.CallStmt) and s.action.call.name.upper() != "PULSE":
+                # PULSE is a statement of its own, not a subprogram call (5.12, 5.18)
                 self.sink.at(s.span, "E409", "a TRIGGER that calls a routine needs PRIO (-1 lets the system choose)")
             self.stmt(s.action, ctx)
         elif isinstance(s, N.Motion):

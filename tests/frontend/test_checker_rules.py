@@ -82,6 +82,8 @@ CASES = [
     ("E408", prog("", "INTERRUPT DECL 129 WHEN $IN[1] DO t()"), prog("", "INTERRUPT DECL 128 WHEN $IN[1] DO t()")),
     ("E409", prog("", "TRIGGER WHEN DISTANCE=1 DELAY=0 DO t()\nPTP $POS_ACT"),
      prog("", "TRIGGER WHEN DISTANCE=1 DELAY=0 DO t() PRIO=-1\nPTP $POS_ACT")),
+    ("E409", prog("", "TRIGGER WHEN DISTANCE=0 DELAY=9 DO t()\nPTP $POS_ACT"),
+     prog("", "TRIGGER WHEN DISTANCE=0 DELAY=9 DO PULSE($OUT[4], TRUE, 0.1)\nPTP $POS_ACT")),
     # write protection (5.1, 7) and constants (2.5)
     ("E501", prog("", "$POS_ACT = $POS_ACT"), prog("", "$BASE = $NULLFRAME")),
     ("E501", prog("", "$MODE_OP = #T1"), prog("BOOL b", "b = $MODE_OP == #T1")),
