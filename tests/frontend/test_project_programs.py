@@ -1,0 +1,37 @@
+"""The project's own KRL (the interpreters' BASIS, the conformance cases) checks without
+false errors: the interpreters refuse to run a program with checker errors."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from krl.workspace import load_workspace
+
+ROOT = Path(__file__).resolve().parents[2]
+BASIS = ROOT / "interp" / "basis"
+CASES = ROOT / "conformance" / "cases"
+
+
+@pytest.mark.skipif(not BASIS.is_dir(), reason="interp/basis not present")
+def test_basis_checks_clean():
+    ws = load_workspace([BASIS])
+    assert not [str(d) for d in ws.check() if d.is_error]
+
+
+def _cases():
+    if not CASES.is_dir():
+        return []
+    return sorted(p for p in CASES.iterdir() if (p / "program.src").is_file())
+
+
+@pytest.mark.skipif(not _cases(), reason="no conformance cases")
+def test_conformance_cases_have_no_internal_or_unmapped_findings():
+    """Cases may hold deliberate errors; internal errors and unmapped constructs never."""
+    bad = []
+    for case in _cases():
+        paths = [case] + ([BASIS] if BASIS.is_dir() else [])
+        ws = load_workspace(paths, str(case))
+        bad += [str(d) for d in ws.check() if d.code in ("E901", "W003")]
+    assert not bad, bad[:10]
