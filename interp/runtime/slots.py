@@ -68,10 +68,14 @@ def _store_fast(c, k, t, v) -> bool:
 
 def store(ref, v) -> None:
     """Runtime.assign (``ref.set``), fast path: a writable Slot of type INT/REAL/BOOL
-    without write hook and a value of that very type."""
-    if ref.__class__ is Slot and not ref.readonly and ref.on_write is None \
-            and _store_fast(ref.c, ref.k, ref.type, v):
-        return
+    without write hook and a value of that very type (INT: in range)."""
+    if ref.__class__ is Slot and not ref.readonly and ref.on_write is None:
+        t = ref.type
+        vc = v.__class__
+        if (t is INT and vc is int and INT_MIN <= v <= INT_MAX) or (t is REAL and vc is float) \
+                or (t is BOOL and vc is bool):
+            ref.c[ref.k] = v
+            return
     ref.set(v)
 
 
@@ -129,6 +133,16 @@ def element2(base, i, j, name: str):
                 if c is int or c is float or c is bool:
                     return x
     return element(base, [i, j], name)
+
+
+def set_element1(base, i, v, name: str) -> None:
+    """:func:`set_element` with one index."""
+    if base.__class__ is Slot and i.__class__ is int and not base.readonly:
+        a = base.c[base.k]
+        if a.__class__ is Arr and len(a.dims) == 1 and 1 <= i <= a.dims[0] \
+                and _store_fast(a.data, i - 1, a.type.elem, v):
+            return
+    set_element(base, [i], v, name)
 
 
 def set_element(base, idx: list, v, name: str) -> None:

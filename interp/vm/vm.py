@@ -28,7 +28,7 @@ from interp.runtime.convert import num
 from interp.runtime.errors import ExitSignal, KrlRuntimeError, ResumeSignal
 from interp.runtime.slots import (add, anout_limits, anout_value, array_index, component, element, element1,
                                   element2, eq, for_done, for_limits, ge, gt, le, load, lt, mul, ne, read_value,
-                                  set_component, set_element, store, sub, trigger_args)
+                                  set_component, set_element, set_element1, store, sub, trigger_args)
 
 from . import opcodes as OP
 from .assembler import Code, Region, assemble
@@ -260,10 +260,15 @@ class VM:
                         ip += 1
                     elif op == OP.STORE_INDEX:
                         n = ins[1]
-                        idx = stack[-n:]
-                        del stack[-n:]
-                        base = pop()
-                        set_element(base, idx, pop(), ins[2])
+                        if n == 1:
+                            i = pop()
+                            base = pop()
+                            set_element1(base, i, pop(), ins[2])
+                        else:
+                            idx = stack[-n:]
+                            del stack[-n:]
+                            base = pop()
+                            set_element(base, idx, pop(), ins[2])
                         ip += 1
                     elif op == OP.IF_NOT_LT:
                         b = pop()
@@ -272,7 +277,7 @@ class VM:
                         else:
                             ip = ins[1]
                     elif op == OP.STORE_ELEM_LL:
-                        set_element(refs[ins[1]], [load(refs[ins[2]])], pop(), ins[3])
+                        set_element1(refs[ins[1]], load(refs[ins[2]]), pop(), ins[3])
                         ip += 1
                     elif op == OP.LOCAL_SUB_CONST:
                         push(sub(load(refs[ins[1]]), ins[2]))

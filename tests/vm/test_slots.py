@@ -10,7 +10,7 @@ from interp.runtime.convert import binary_op
 from interp.runtime.errors import KrlRuntimeError
 from interp.runtime.memory import Slot, field_ref, index_ref
 from interp.runtime.slots import (add, array_index, component, element, element1, element2, eq, ge, gt, le, load, lt, mul,
-                                  ne, read_value, set_component, set_element, store, sub)
+                                  ne, read_value, set_component, set_element, set_element1, store, sub)
 from interp.runtime.values import UNSET, EnumValue, make_value
 from krl.semantics import types as T
 
@@ -50,6 +50,10 @@ def test_elements_and_stores():
                 outcome(lambda: read_value(index_ref(slow, [array_index(i) for i in idx], "A")))
             if len(idx) == 1:
                 assert outcome(element1, fast, idx[0], "A") == outcome(element, slow, idx, "A")
+                f1 = _array(t, (4,), vals)
+                for v in new:
+                    assert outcome(set_element1, f1, idx[0], v, "A") == outcome(set_element, fast, idx, v, "A")
+                    assert f1.c["A"].data == fast.c["A"].data
             for v in new:
                 r1 = outcome(set_element, fast, idx, v, "A")
                 r2 = outcome(lambda: index_ref(slow, [array_index(i) for i in idx], "A").set(v))
