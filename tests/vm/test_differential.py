@@ -3,6 +3,8 @@ embedded corpus programs, the conformance cases and the paper's example."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import pytest
 
 from .differential import CASES, CORPUS, PAPER, case_options, compare
@@ -58,3 +60,11 @@ REAL = _real_programs()
 @pytest.mark.parametrize("program", REAL, ids=lambda p: "/".join(p.parts[-3:]))
 def test_real_program(program):
     _check(program, max_sim_time=20, max_steps=100_000)
+
+
+def test_mixed_program():
+    """GOTO out of nested FOR, SWITCH on CHAR and ENUM, functions returning structures,
+    recursion, whole-array copy, SWRITE, REPEAT/EXIT, RETURN inside FOR, interrupts with
+    DISABLE/ENABLE and :OUT handler arguments, ON_ERROR_PROCEED, a FOR counter overflow."""
+    here = Path(__file__).parent / "programs"
+    _check(here / "mixed.src", inputs=here / "mixed.yaml")
