@@ -194,6 +194,13 @@ def for_done(c, end, step) -> bool:
     return (step > 0 and c > end) or (step < 0 and c < end)
 
 
+def for_next(ref, end, step) -> bool:
+    """End of a FOR iteration: counter = counter + step (Runtime.assign, binary_op);
+    True while the loop goes on."""
+    store(ref, add(ref.get(), step))
+    return not for_done(ref.get(), end, step)
+
+
 # ------------------------------------------------------------------ operators (fast paths of convert.binary_op)
 # Numbers only (``__class__`` is int or float: BOOL, CHAR, ENUM and UNSET take the general
 # path). INT op INT stays INT unless it leaves the 32-bit range; with a REAL operand the

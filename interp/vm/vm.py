@@ -27,7 +27,7 @@ from interp.runtime.builtins import ValueRef
 from interp.runtime.convert import num
 from interp.runtime.errors import ExitSignal, KrlRuntimeError, ResumeSignal
 from interp.runtime.slots import (add, anout_limits, anout_value, array_index, component, element, element1,
-                                  element2, eq, for_done, for_limits, ge, gt, le, load, lt, mul, ne, read_value,
+                                  element2, eq, for_done, for_limits, for_next, ge, gt, le, load, lt, mul, ne, read_value,
                                   set_component, set_element, set_element1, store, sub, trigger_args)
 
 from . import opcodes as OP
@@ -243,14 +243,11 @@ class VM:
                         ip += 1
                     elif op == OP.FOR_NEXT:
                         t = ins[1]
-                        ref = temps[t]
-                        step = temps[t + 2]
-                        store(ref, add(ref.get(), step))
-                        if for_done(ref.get(), temps[t + 1], step):
-                            ip += 1
-                        else:
+                        if for_next(temps[t], temps[t + 1], temps[t + 2]):
                             tick(ins[2])
                             ip = ins[3]
+                        else:
+                            ip += 1
                     elif op == OP.ADD:
                         b = pop()
                         stack[-1] = add(stack[-1], b)
