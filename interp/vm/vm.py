@@ -196,6 +196,29 @@ class VM:
         before = rt.before_statement
         tick = rt.loop_tick
         take_error_proceed = rt.take_error_proceed
+        # the runtime helpers as locals (no global lookups in the loop)
+        _load = load
+        _store = store
+        _element = element
+        _element1 = element1
+        _element2 = element2
+        _set_element = set_element
+        _set_element1 = set_element1
+        _component = component
+        _set_component = set_component
+        _add = add
+        _sub = sub
+        _mul = mul
+        _lt = lt
+        _le = le
+        _gt = gt
+        _ge = ge
+        _eq = eq
+        _ne = ne
+        _for_next = for_next
+        _for_limits = for_limits
+        _read_value = read_value
+        _array_index = array_index
         proceed = False
         while True:
             try:
@@ -211,23 +234,23 @@ class VM:
                         proceed = take_error_proceed()
                         ip += 1
                     elif op == OP.LOAD_LOCAL:
-                        push(load(refs[ins[1]]))
+                        push(_load(refs[ins[1]]))
                         ip += 1
                     elif op == OP.LOAD_ELEM_LL:
-                        push(element1(refs[ins[1]], load(refs[ins[2]]), ins[3]))
+                        push(_element1(refs[ins[1]], _load(refs[ins[2]]), ins[3]))
                         ip += 1
                     elif op == OP.CONST:
                         push(ins[1])
                         ip += 1
                     elif op == OP.STORE_LOCAL:
-                        store(refs[ins[1]], pop())
+                        _store(refs[ins[1]], pop())
                         ip += 1
                     elif op == OP.REF_LOCAL:
                         push(refs[ins[1]])
                         ip += 1
                     elif op == OP.IF_NOT_LE:
                         b = pop()
-                        if le(pop(), b):
+                        if _le(pop(), b):
                             ip += 1
                         else:
                             ip = ins[1]
@@ -235,59 +258,59 @@ class VM:
                         tick(ins[1])
                         ip = ins[2]
                     elif op == OP.LOAD_LOCAL2:
-                        push(load(refs[ins[1]]))
-                        push(load(refs[ins[2]]))
+                        push(_load(refs[ins[1]]))
+                        push(_load(refs[ins[2]]))
                         ip += 1
                     elif op == OP.TICK:
                         tick(ins[1])
                         ip += 1
                     elif op == OP.FOR_NEXT:
                         t = ins[1]
-                        if for_next(temps[t], temps[t + 1], temps[t + 2]):
+                        if _for_next(temps[t], temps[t + 1], temps[t + 2]):
                             tick(ins[2])
                             ip = ins[3]
                         else:
                             ip += 1
                     elif op == OP.ADD:
                         b = pop()
-                        stack[-1] = add(stack[-1], b)
+                        stack[-1] = _add(stack[-1], b)
                         ip += 1
                     elif op == OP.LOCAL_ADD_CONST:
-                        push(add(load(refs[ins[1]]), ins[2]))
+                        push(_add(_load(refs[ins[1]]), ins[2]))
                         ip += 1
                     elif op == OP.STORE_INDEX:
                         n = ins[1]
                         if n == 1:
                             i = pop()
                             base = pop()
-                            set_element1(base, i, pop(), ins[2])
+                            _set_element1(base, i, pop(), ins[2])
                         else:
                             idx = stack[-n:]
                             del stack[-n:]
                             base = pop()
-                            set_element(base, idx, pop(), ins[2])
+                            _set_element(base, idx, pop(), ins[2])
                         ip += 1
                     elif op == OP.IF_NOT_LT:
                         b = pop()
-                        if lt(pop(), b):
+                        if _lt(pop(), b):
                             ip += 1
                         else:
                             ip = ins[1]
                     elif op == OP.STORE_ELEM_LL:
-                        set_element1(refs[ins[1]], load(refs[ins[2]]), pop(), ins[3])
+                        _set_element1(refs[ins[1]], _load(refs[ins[2]]), pop(), ins[3])
                         ip += 1
                     elif op == OP.LOCAL_SUB_CONST:
-                        push(sub(load(refs[ins[1]]), ins[2]))
+                        push(_sub(_load(refs[ins[1]]), ins[2]))
                         ip += 1
                     elif op == OP.MUL:
                         b = pop()
-                        stack[-1] = mul(stack[-1], b)
+                        stack[-1] = _mul(stack[-1], b)
                         ip += 1
                     elif op == OP.LOAD_FIELD:
-                        stack[-1] = component(stack[-1], ins[1], ins[2])
+                        stack[-1] = _component(stack[-1], ins[1], ins[2])
                         ip += 1
                     elif op == OP.LOAD_ELEM2_LLL:
-                        push(element2(refs[ins[1]], load(refs[ins[2]]), load(refs[ins[3]]),
+                        push(_element2(refs[ins[1]], _load(refs[ins[2]]), _load(refs[ins[3]]),
                                       ins[4]))
                         ip += 1
                     elif op == OP.UNOP:
@@ -307,91 +330,91 @@ class VM:
                         else:
                             ip += 1
                     elif op == OP.ADD_CONST:
-                        stack[-1] = add(stack[-1], ins[1])
+                        stack[-1] = _add(stack[-1], ins[1])
                         ip += 1
                     elif op == OP.SUB_CONST:
-                        stack[-1] = sub(stack[-1], ins[1])
+                        stack[-1] = _sub(stack[-1], ins[1])
                         ip += 1
                     elif op == OP.SUB:
                         b = pop()
-                        stack[-1] = sub(stack[-1], b)
+                        stack[-1] = _sub(stack[-1], b)
                         ip += 1
                     elif op == OP.MUL_CONST:
-                        stack[-1] = mul(stack[-1], ins[1])
+                        stack[-1] = _mul(stack[-1], ins[1])
                         ip += 1
                     elif op == OP.LOAD_INDEX:
                         n = ins[1]
                         idx = stack[-n:]
                         del stack[-n:]
-                        stack[-1] = element(stack[-1], idx, ins[2])
+                        stack[-1] = _element(stack[-1], idx, ins[2])
                         ip += 1
                     elif op == OP.STORE_FIELD:
                         base = pop()
-                        set_component(base, ins[1], pop(), ins[2])
+                        _set_component(base, ins[1], pop(), ins[2])
                         ip += 1
                     elif op == OP.LOAD_MOD:
-                        push(load(mrefs[ins[1]]))
+                        push(_load(mrefs[ins[1]]))
                         ip += 1
                     elif op == OP.STORE_MOD:
-                        store(mrefs[ins[1]], pop())
+                        _store(mrefs[ins[1]], pop())
                         ip += 1
                     elif op == OP.IF_NOT_GT:
                         b = pop()
-                        if gt(pop(), b):
+                        if _gt(pop(), b):
                             ip += 1
                         else:
                             ip = ins[1]
                     elif op == OP.IF_NOT_GE:
                         b = pop()
-                        if ge(pop(), b):
+                        if _ge(pop(), b):
                             ip += 1
                         else:
                             ip = ins[1]
                     elif op == OP.IF_NOT_EQ:
                         b = pop()
-                        if eq(pop(), b):
+                        if _eq(pop(), b):
                             ip += 1
                         else:
                             ip = ins[1]
                     elif op == OP.IF_NOT_NE:
                         b = pop()
-                        if ne(pop(), b):
+                        if _ne(pop(), b):
                             ip += 1
                         else:
                             ip = ins[1]
                     elif op == OP.INDEX:
                         n = ins[1]
-                        idx = [None if x is None else array_index(x) for x in stack[-n:]]
+                        idx = [None if x is None else _array_index(x) for x in stack[-n:]]
                         del stack[-n:]
                         stack[-1] = rt.index(stack[-1], idx, ins[2])
                         ip += 1
                     elif op == OP.ASSIGN:
                         ref = pop()
-                        store(ref, pop())
+                        _store(ref, pop())
                         ip += 1
                     elif op == OP.LT:
                         b = pop()
-                        stack[-1] = lt(stack[-1], b)
+                        stack[-1] = _lt(stack[-1], b)
                         ip += 1
                     elif op == OP.LE:
                         b = pop()
-                        stack[-1] = le(stack[-1], b)
+                        stack[-1] = _le(stack[-1], b)
                         ip += 1
                     elif op == OP.GT:
                         b = pop()
-                        stack[-1] = gt(stack[-1], b)
+                        stack[-1] = _gt(stack[-1], b)
                         ip += 1
                     elif op == OP.GE:
                         b = pop()
-                        stack[-1] = ge(stack[-1], b)
+                        stack[-1] = _ge(stack[-1], b)
                         ip += 1
                     elif op == OP.EQ:
                         b = pop()
-                        stack[-1] = eq(stack[-1], b)
+                        stack[-1] = _eq(stack[-1], b)
                         ip += 1
                     elif op == OP.NE:
                         b = pop()
-                        stack[-1] = ne(stack[-1], b)
+                        stack[-1] = _ne(stack[-1], b)
                         ip += 1
                     elif op == OP.BINOP:
                         b = pop()
@@ -431,11 +454,11 @@ class VM:
                             ref = rt.lookup(code.gnames[g], frame)
                             grefs[g] = ref
                         if op == OP.LOAD_GLOBAL:
-                            push(load(ref))
+                            push(_load(ref))
                         elif op == OP.REF_GLOBAL:
                             push(ref)
                         else:
-                            store(ref, pop())
+                            _store(ref, pop())
                         ip += 1
                     elif op == OP.FIELD:
                         stack[-1] = rt.field(stack[-1], ins[1], ins[2])
@@ -474,7 +497,7 @@ class VM:
                         pop()
                         ip += 1
                     elif op == OP.DEREF:
-                        stack[-1] = read_value(stack[-1])
+                        stack[-1] = _read_value(stack[-1])
                         ip += 1
                     elif op == OP.FOR_PREP:
                         t = ins[1]
@@ -482,11 +505,11 @@ class VM:
                         end = pop()
                         start = pop()
                         temps[t] = pop()
-                        temps[t + 1], temps[t + 2] = for_limits(end, step)
+                        temps[t + 1], temps[t + 2] = _for_limits(end, step)
                         push(start)
                         ip += 1
                     elif op == OP.FOR_INIT:
-                        store(temps[ins[1]], pop())
+                        _store(temps[ins[1]], pop())
                         ip += 1
                     elif op == OP.AGG:
                         names = ins[2]
@@ -543,7 +566,7 @@ class VM:
                         ip += 1
                     elif op == OP.CYCFLAG:
                         ref = pop()
-                        store(ref, pop())
+                        _store(ref, pop())
                         value = self.thunk(code, act, ins[1])
                         rt.cyclic_on(("CYCFLAG", ref.name), lambda r=ref, f=value: rt.assign(r, f()))
                         ip += 1
