@@ -53,13 +53,19 @@ def _real_programs():
     return out
 
 
+def _submit_of(program):
+    from interp.realprograms import submit_of
+
+    return submit_of(program)
+
+
 REAL = _real_programs()
 
 
 @pytest.mark.skipif(not REAL, reason="../shared/krl-corpus absent")
 @pytest.mark.parametrize("program", REAL, ids=lambda p: "/".join(p.parts[-3:]))
 def test_real_program(program):
-    _check(program, max_sim_time=20, max_steps=100_000)
+    _check(program, max_sim_time=20, max_steps=100_000, submit=_submit_of(program))
 
 
 def test_mixed_program():
