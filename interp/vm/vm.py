@@ -148,8 +148,7 @@ class VM:
         task.frame = frame
         returned = False
         try:
-            v = frame.vars
-            act = Act(frame, [v[k] for k in code.lkeys], [None] * code.ntemps)
+            act = Act(frame, list(map(frame.vars.__getitem__, code.lkeys)), [None] * code.ntemps)
             value = self.run(code, act, 0, [])
             if code.kind == "DEFFCT":
                 value = rt.return_value(routine, value, module)
@@ -352,11 +351,49 @@ class VM:
                         base = pop()
                         _set_component(base, ins[1], pop(), ins[2])
                         ip += 1
+                    elif op == OP.CALL:
+                        argc = ins[2]
+                        if argc:
+                            args = stack[-argc:]
+                            del stack[-argc:]
+                        else:
+                            args = []
+                        name = ins[1]
+                        flags = ins[3]
+                        v = self.call(code, ip, name, args, frame, flags)
+                        if flags == "E":
+                            if v is None:
+                                raise KrlRuntimeError(f"{name} does not return a value")
+                            push(v)
+                        ip += 1
+                    elif op == OP.VALARG:
+                        stack[-1] = ValueRef(stack[-1])
+                        ip += 1
+                    elif op == OP.RETURN_VAL:
+                        v = pop()
+                        return v if code.kind == "DEFFCT" else None
+                    elif op == OP.RETURN:
+                        if code.kind == "DEFFCT":
+                            raise KrlRuntimeError(f"RETURN without a value in function {code.routine.name}", None,
+                                                  code.routine.span.file, frame.line)
+                        return None
+                    elif op == OP.END:
+                        if code.kind == "DEFFCT":
+                            r = code.routine
+                            raise KrlRuntimeError(f"function {r.name} ended without RETURN", None,
+                                                  r.span.file, frame.line or r.span.line)
+                        return None
                     elif op == OP.LOAD_MOD:
                         push(_load(mrefs[ins[1]]))
                         ip += 1
                     elif op == OP.STORE_MOD:
                         _store(mrefs[ins[1]], pop())
+                        ip += 1
+                    elif op == OP.STMT:
+                        info = ins[1]
+                        if not thunk:
+                            frame.line = info.line
+                        before(info)
                         ip += 1
                     elif op == OP.IF_NOT_GT:
                         b = pop()
@@ -420,30 +457,6 @@ class VM:
                         b = pop()
                         stack[-1] = rt.binary_op(ins[1], stack[-1], b)
                         ip += 1
-                    elif op == OP.STMT:
-                        info = ins[1]
-                        if not thunk:
-                            frame.line = info.line
-                        before(info)
-                        ip += 1
-                    elif op == OP.CALL:
-                        argc = ins[2]
-                        if argc:
-                            args = stack[-argc:]
-                            del stack[-argc:]
-                        else:
-                            args = []
-                        name = ins[1]
-                        flags = ins[3]
-                        v = self.call(code, ip, name, args, frame, flags)
-                        if flags == "E":
-                            if v is None:
-                                raise KrlRuntimeError(f"{name} does not return a value")
-                            push(v)
-                        ip += 1
-                    elif op == OP.VALARG:
-                        stack[-1] = ValueRef(stack[-1])
-                        ip += 1
                     elif op == OP.REF_MOD:
                         push(mrefs[ins[1]])
                         ip += 1
@@ -463,20 +476,6 @@ class VM:
                     elif op == OP.FIELD:
                         stack[-1] = rt.field(stack[-1], ins[1], ins[2])
                         ip += 1
-                    elif op == OP.RETURN_VAL:
-                        v = pop()
-                        return v if code.kind == "DEFFCT" else None
-                    elif op == OP.RETURN:
-                        if code.kind == "DEFFCT":
-                            raise KrlRuntimeError(f"RETURN without a value in function {code.routine.name}", None,
-                                                  code.routine.span.file, frame.line)
-                        return None
-                    elif op == OP.END:
-                        if code.kind == "DEFFCT":
-                            r = code.routine
-                            raise KrlRuntimeError(f"function {r.name} ended without RETURN", None,
-                                                  r.span.file, frame.line or r.span.line)
-                        return None
                     elif op == OP.END_THUNK:
                         return stack[-1] if stack else None
                     elif op == OP.LOAD_TEMP:
