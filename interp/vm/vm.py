@@ -180,9 +180,15 @@ class VM:
 
     # ------------------------------------------------------------------ the loop
     @_specialize
-    def run(self, code: Code, act: Act, ip: int, stack: list, thunk: bool = False):
+    def run(self, code: Code, act: Act, ip: int, stack: list, thunk: bool = False, *,
+            _load=load, _store=store, _element=element, _element1=element1, _element2=element2,
+            _set_element=set_element, _set_element1=set_element1, _component=component,
+            _set_component=set_component, _add=add, _sub=sub, _mul=mul, _lt=lt, _le=le, _gt=gt, _ge=ge,
+            _eq=eq, _ne=ne, _for_next=for_next, _for_limits=for_limits, _read_value=read_value,
+            _array_index=array_index):
         """Run ``code`` from ``ip`` in activation ``act``; returns the value of RETURN,
-        or of the thunk at END_THUNK."""
+        or of the thunk at END_THUNK. (The keyword defaults bind the runtime helpers as
+        locals of the loop, at no cost per call.)"""
         rt = self.rt
         prog = code.prog
         mrefs = code.mrefs
@@ -195,29 +201,6 @@ class VM:
         before = rt.before_statement
         tick = rt.loop_tick
         take_error_proceed = rt.take_error_proceed
-        # the runtime helpers as locals (no global lookups in the loop)
-        _load = load
-        _store = store
-        _element = element
-        _element1 = element1
-        _element2 = element2
-        _set_element = set_element
-        _set_element1 = set_element1
-        _component = component
-        _set_component = set_component
-        _add = add
-        _sub = sub
-        _mul = mul
-        _lt = lt
-        _le = le
-        _gt = gt
-        _ge = ge
-        _eq = eq
-        _ne = ne
-        _for_next = for_next
-        _for_limits = for_limits
-        _read_value = read_value
-        _array_index = array_index
         proceed = False
         while True:
             try:
