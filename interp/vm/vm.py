@@ -35,10 +35,18 @@ from .assembler import Code, Region, assemble
 from .compiler import compile_routine
 
 
+# runtime functions the loop calls as ``_name`` (closure variables: no global lookup, no
+# per-call binding)
+HELPERS = ("load", "store", "element", "element1", "element2", "set_element", "set_element1", "component",
+           "set_component", "add", "sub", "mul", "lt", "le", "gt", "ge", "eq", "ne", "for_next", "for_limits",
+           "read_value", "array_index")
+
+
 def _specialize(fn):
     """Replace ``OP.NAME`` by the opcode's number in ``fn``'s source (the dispatch loop
-    compares against literals instead of looking up module attributes). Line numbers
-    stay those of this file."""
+    compares against literals instead of looking up module attributes) and make the
+    :data:`HELPERS` closure variables ``_name`` of it. Line numbers stay those of this
+    file."""
     lines, first = inspect.getsourcelines(fn)
     indent = len(lines[0]) - len(lines[0].lstrip())
     body = []
@@ -46,12 +54,14 @@ def _specialize(fn):
         if ln.lstrip().startswith("@_specialize"):
             body.append("\n")
             continue
-        body.append(ln[indent:] if len(ln) > indent else ln.lstrip(" "))
-    src = "\n" * (first - 1) + "".join(body)
+        body.append("    " + (ln[indent:] if len(ln) > indent else ln.lstrip(" ")))
+    pre = ["def _factory():"] + [f"    _{n} = {n}" for n in HELPERS]
+    assert len(pre) < first - 1
+    src = "\n".join(pre) + "\n" * (first - len(pre)) + "".join(body) + f"    return {fn.__name__}\n"
     src = re.sub(r"\bOP\.([A-Z_]+)\b", lambda m: str(OP.BY_NAME[m.group(1)].number), src)
     ns: dict = {}
     exec(compile(src, inspect.getsourcefile(fn), "exec"), fn.__globals__, ns)  # noqa: S102
-    return ns[fn.__name__]
+    return ns["_factory"]()
 
 
 def decode(code: Code) -> tuple[list, list]:
@@ -180,15 +190,10 @@ class VM:
 
     # ------------------------------------------------------------------ the loop
     @_specialize
-    def run(self, code: Code, act: Act, ip: int, stack: list, thunk: bool = False, *,
-            _load=load, _store=store, _element=element, _element1=element1, _element2=element2,
-            _set_element=set_element, _set_element1=set_element1, _component=component,
-            _set_component=set_component, _add=add, _sub=sub, _mul=mul, _lt=lt, _le=le, _gt=gt, _ge=ge,
-            _eq=eq, _ne=ne, _for_next=for_next, _for_limits=for_limits, _read_value=read_value,
-            _array_index=array_index):
+    def run(self, code: Code, act: Act, ip: int, stack: list, thunk: bool = False):
         """Run ``code`` from ``ip`` in activation ``act``; returns the value of RETURN,
-        or of the thunk at END_THUNK. (The keyword defaults bind the runtime helpers as
-        locals of the loop, at no cost per call.)"""
+        or of the thunk at END_THUNK. The ``_name`` helpers are the runtime functions of
+        :data:`HELPERS`, closure variables of the loop (see :func:`_specialize`)."""
         rt = self.rt
         prog = code.prog
         mrefs = code.mrefs
