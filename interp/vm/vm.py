@@ -78,6 +78,7 @@ def decode(code: Code) -> tuple[list, list]:
     index[len(words)] = len(starts)
     prog = []
     regions = []
+    moved: dict = {}     # guarded regions with their end as an instruction number
     for a in starts:
         info = OP.OPS[words[a]]
         ins = [info.number]
@@ -93,7 +94,10 @@ def decode(code: Code) -> tuple[list, list]:
         prog.append(tuple(ins))
         r = code.regions[a]
         if r is not None and r.kind == "G":
-            r = Region("G", r.line, index[r.end])
+            got = moved.get(id(r))
+            if got is None:
+                got = moved[id(r)] = Region("G", r.line, index[r.end])
+            r = got
         regions.append(r)
     return prog, regions
 
