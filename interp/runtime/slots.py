@@ -291,3 +291,24 @@ def anout_limits(lo, hi) -> tuple:
 def anout_value(v, lo: float, hi: float) -> float:
     """The analog output value: REAL, clamped to [minimum, maximum]."""
     return min(hi, max(lo, float(num(v))))
+
+
+# ------------------------------------------------------------------ calls and jumps (the tree interpreter's messages)
+def function_result(name: str, v):
+    """The value of a function call in an expression; a procedure has none."""
+    if v is None:
+        raise KrlRuntimeError(f"{name} does not return a value")
+    return v
+
+
+def ended_without_return(routine, line) -> KrlRuntimeError:
+    return KrlRuntimeError(f"function {routine.name} ended without RETURN", None, routine.span.file,
+                           line or routine.span.line)
+
+
+def return_without_value(routine, line) -> KrlRuntimeError:
+    return KrlRuntimeError(f"RETURN without a value in function {routine.name}", None, routine.span.file, line)
+
+
+def label_not_found(label: str, routine, line) -> KrlRuntimeError:
+    return KrlRuntimeError(f"GOTO {label}: label not found", None, routine.span.file, line)

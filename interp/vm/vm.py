@@ -27,6 +27,7 @@ from interp.runtime.builtins import ValueRef
 from interp.runtime.convert import num
 from interp.runtime.errors import ExitSignal, KrlRuntimeError, ResumeSignal
 from interp.runtime.slots import (add, anout_limits, anout_value, array_index, component, element, element1,
+                                  ended_without_return, function_result, label_not_found, return_without_value,
                                   element2, eq, for_done, for_limits, for_next, ge, gt, le, load, lt, mul, ne, read_value,
                                   set_component, set_element, set_element1, store, sub, trigger_args)
 
@@ -354,9 +355,7 @@ class VM:
                         flags = ins[3]
                         v = self.call(code, ip, name, args, frame, flags)
                         if flags == "E":
-                            if v is None:
-                                raise KrlRuntimeError(f"{name} does not return a value")
-                            push(v)
+                            push(function_result(name, v))
                         ip += 1
                     elif op == OP.VALARG:
                         stack[-1] = ValueRef(stack[-1])
@@ -366,14 +365,11 @@ class VM:
                         return v if code.kind == "DEFFCT" else None
                     elif op == OP.RETURN:
                         if code.kind == "DEFFCT":
-                            raise KrlRuntimeError(f"RETURN without a value in function {code.routine.name}", None,
-                                                  code.routine.span.file, frame.line)
+                            raise return_without_value(code.routine, frame.line)
                         return None
                     elif op == OP.END:
                         if code.kind == "DEFFCT":
-                            r = code.routine
-                            raise KrlRuntimeError(f"function {r.name} ended without RETURN", None,
-                                                  r.span.file, frame.line or r.span.line)
+                            raise ended_without_return(code.routine, frame.line)
                         return None
                     elif op == OP.LOAD_MOD:
                         push(_load(mrefs[ins[1]]))
@@ -534,8 +530,7 @@ class VM:
                     elif op == OP.EXIT_SIGNAL:
                         raise ExitSignal()
                     elif op == OP.GOTO_FAIL:
-                        raise KrlRuntimeError(f"GOTO {ins[1]}: label not found", None,
-                                              code.routine.span.file, frame.line)
+                        raise label_not_found(ins[1], code.routine, frame.line)
                     elif op == OP.RAISE:
                         line = ins[2]
                         raise KrlRuntimeError(ins[1], None, code.file if line else None, line or None)

@@ -17,6 +17,10 @@ DEFFCT INT NORET()
   N1 = 1
 ENDFCT
 
+DEFFCT INT BARE()
+  RETURN
+ENDFCT
+
 DEF DEEP(n:IN)
   DECL INT n
   IF n > 0 THEN
@@ -43,6 +47,9 @@ PROGRAMS = {
     "write_protected": "$POS_ACT = {X 1}",
     "stack_overflow": "DEEP(200)",
     "interrupt_not_declared": "INTERRUPT ON 7",
+    "goto_into_a_block": "N1 = 0\n  GOTO inside\n  IF N1 == 0 THEN\n  inside:\n    N2 = 1\n  ENDIF",
+    "return_without_value": "N1 = BARE()",
+    "procedure_in_expression": "N1 = DEEP(0) + 1",
 }
 
 
