@@ -26,10 +26,11 @@ import re
 from interp.runtime.builtins import ValueRef
 from interp.runtime.convert import num
 from interp.runtime.errors import ExitSignal, KrlRuntimeError, ResumeSignal
-from interp.runtime.slots import (add, anout_limits, anout_value, array_index, component, element, element1,
-                                  ended_without_return, function_result, label_not_found, return_without_value,
-                                  element2, eq, for_done, for_limits, for_next, ge, gt, le, load, lt, mul, ne, read_value,
-                                  set_component, set_element, set_element1, store, sub, trigger_args)
+from interp.runtime.slots import (add, anout_limits, anout_value, array_index, component, element,
+                                  element1, element2, ended_without_return, eq, for_done, for_limits,
+                                  for_next, function_result, ge, gt, label_not_found, le, load, lt, mul,
+                                  ne, read_value, return_without_value, set_component, set_element,
+                                  set_element1, store, sub, trigger_args)
 
 from . import opcodes as OP
 from .assembler import Code, Region, assemble
