@@ -78,3 +78,27 @@ def test_constants(v):
 
 def test_enum_constant():
     assert parse_const(fmt_const(EnumValue("c_dis"))) == EnumValue("C_DIS")
+
+
+def test_every_routine_of_the_shared_corpus_compiles_and_round_trips():
+    from interp.realprograms import DEFAULT_CORPUS, find_backups, programs_of
+    from interp.run import make_runtime
+    from interp.vm.compiler import compile_module
+
+    if not DEFAULT_CORPUS.is_dir():
+        pytest.skip("../shared/krl-corpus absent")
+    n = 0
+    for b in find_backups(DEFAULT_CORPUS):
+        progs = programs_of(b)
+        if not progs:
+            continue
+        rt, _ = make_runtime(progs[0], mujoco=False, interp="vm")
+        rt.program.scan_all()
+        for m in list(rt.program.modules.values()):
+            if m.syntax_errors or not m.routines:
+                continue
+            text = compile_module(rt, m)
+            codes = assemble(text)
+            assert "\n".join(disassemble(c) for c in codes) == text, m.name
+            n += len(codes)
+    assert n > 0
