@@ -796,7 +796,12 @@ class Runtime:
             ctl.release()
 
     def brake(self, fast: bool = False) -> None:
-        """BRAKE / BRAKE F: ramp the path speed down and wait until the robot stands."""
+        """BRAKE / BRAKE F: ramp the path speed down and wait until the robot stands (5.17).
+
+        Standstill is confirmed one IPO cycle after the path speed has reached zero (the
+        controller sees two equal setpoints), so even `DO BRAKE`, whose interrupt ends with
+        the brake, leaves the robot at rest for at least one cycle before it goes on.
+        """
         task = self.current_task
         if task.kind != "robot":
             raise KrlRuntimeError("BRAKE is not allowed in the submit interpreter")
@@ -804,6 +809,7 @@ class Runtime:
         ctl.brake(fast)
         while ctl.is_braking():
             self.yield_cycle(task)
+        self.yield_cycle(task)
 
     def resume(self) -> None:
         """RESUME: discard the planned motions and unwind to the declaring routine."""
