@@ -3,12 +3,14 @@
 from __future__ import annotations
 
 import csv
+import hashlib
+import json
 import time
 from pathlib import Path
 
 from recovery.cluster import cluster_results
 from recovery.report import Summary, summarise, write_report
-from recovery.scan import FileResult, grammar_sha, scan
+from recovery.scan import FileResult, cache_dir, grammar_sha, scan
 
 REPO_ROOT = Path(__file__).resolve().parents[1]
 GRAMMAR = REPO_ROOT / "grammar" / "KRL.g4"
@@ -47,6 +49,42 @@ def known_invalid_figures(results: list[FileResult]) -> dict | None:
             "now_parsing": [r.path for r in present if r.ok]}
 
 
+def _front_end_code_sha() -> str:
+    h = hashlib.sha256()
+    for p in sorted((REPO_ROOT / "krl").rglob("*")):
+        if p.is_file() and "generated" not in p.parts and p.suffix in (".py", ".yaml"):
+            h.update(p.as_posix().encode())
+            h.update(p.read_bytes())
+    return h.hexdigest()
+
+
+def static_check_figures(corpus: Path, results: list[FileResult], gsha: str,
+                         use_cache: bool) -> dict | None:
+    """`krl check` over the KRC backups of the corpus (issue 4's report), cached by the
+    grammar, the front end's code and the corpus files."""
+    from krl.workspace import find_backups  # noqa: PLC0415
+
+    if not find_backups(corpus):
+        return None
+    key = hashlib.sha256("|".join([gsha, _front_end_code_sha()] +
+                                  sorted(f"{r.path}:{r.sha}" for r in results)).encode()).hexdigest()
+    path = cache_dir() / "check" / f"{key[:32]}.json"
+    if use_cache and path.exists():
+        try:
+            return json.loads(path.read_text())
+        except ValueError:
+            pass
+    from krl.semantics.report import check_report  # noqa: PLC0415
+
+    data, markdown = check_report(corpus)
+    figures = {"files": data["total"]["files"], "files_clean": data["total"]["files_clean"],
+               "errors": data["total"]["errors"], "warnings": data["total"]["warnings"],
+               "top_kinds": data["top_kinds"], "markdown": markdown}
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(json.dumps(figures))
+    return figures
+
+
 def run_recovery(corpus: Path, out: Path, jobs: int | None = None, use_cache: bool = True) -> Summary:
     start = time.perf_counter()
     gsha = current_grammar_sha()
@@ -57,6 +95,9 @@ def run_recovery(corpus: Path, out: Path, jobs: int | None = None, use_cache: bo
     ki = known_invalid_figures(results)
     if ki:
         summary.extra["known_invalid"] = ki
+    check = static_check_figures(Path(corpus), results, gsha, use_cache)
+    if check:
+        summary.extra["check"] = check
     summary.seconds = time.perf_counter() - start
     write_report(out, summary, results)
     return summary

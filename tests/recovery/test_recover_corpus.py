@@ -46,6 +46,11 @@ def test_recover_shared_corpus(shared_corpus: Path, tmp_path: Path) -> None:
     check_consistency(summary, rows, tmp_path)
     assert code == (0 if summary["files_ok"] == summary["files"] else 1)
     assert summary["files"] >= 500
+    # Known-invalid files keep failing, and the static check of the KRC backups is included.
+    assert summary["known_invalid"]["still_failing"] == summary["known_invalid"]["present"]
+    assert summary["check"]["files"] > 0
+    assert 0 < summary["check"]["files_clean"] <= summary["check"]["files"]
+    assert "krl check" in (tmp_path / "report.md").read_text()
 
 
 def test_recover_embedded_corpus(tmp_path: Path) -> None:
