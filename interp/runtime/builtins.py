@@ -9,7 +9,7 @@ interp/basis/bas.src (or the backup's), not natives.
 
 SWRITE/SREAD use a printf/scanf-style format engine written here (no eval): ``%[flags]
 [width][.precision]conv`` with flags ``-+ 0#``, conversions ``d i x X o f F e E g G c s``
-and ``%%``. Unsupported: CAST_TO/CAST_FROM, CREAD/COPEN/CCLOSE/CIOCTL, channels other
+and ``%%``. CAST_TO/CAST_FROM are in cast.py. Unsupported: CREAD/COPEN/CCLOSE/CIOCTL, channels other
 than $CMD — a clear "not supported" run-time error.
 """
 
@@ -19,6 +19,7 @@ import math
 
 from krl.semantics import types as T
 
+from .cast import cast_from, cast_to
 from .convert import frame_tuple, inv_pos, num, real_to_int, to_bool
 from .errors import KrlRuntimeError, value_invalid
 from .memory import Ref
@@ -675,7 +676,7 @@ NATIVES: dict = {
     "SWRITE": _swrite, "SREAD": _sread, "CWRITE": _cwrite,
     "SET_KRLMSG": _set_krlmsg, "EXISTS_KRLMSG": _exists_krlmsg, "CLEAR_KRLMSG": _clear_krlmsg,
     "SET_KRLDLG": _set_krldlg, "EXISTS_KRLDLG": _exists_krldlg,
-    "CAST_TO": _unsupported("CAST_TO"), "CAST_FROM": _unsupported("CAST_FROM"),
+    "CAST_TO": cast_to, "CAST_FROM": cast_from,
     "CREAD": _unsupported("CREAD"), "COPEN": _unsupported("COPEN"),
     "CCLOSE": _unsupported("CCLOSE"), "CIOCTL": _unsupported("CIOCTL"),
     "GET_SIG_INF": _unsupported("GET_SIG_INF"), "GETSYSSTATE": _unsupported("GETSYSSTATE"),

@@ -1,0 +1,122 @@
+"""CAST_TO / CAST_FROM: raw byte copies between variables and a CHAR buffer (reference §4.8).
+
+    CAST_TO(buffer[], offset, var1, var2, ...)     ; writes the bytes of var1.. at offset
+    CAST_FROM(buffer[], offset, var1, var2, ...)   ; reads var1.. back from offset
+
+``offset`` (INT, in/out) counts the bytes before the first one written or read and advances
+past them. The byte layout is a project decision (the reference gives none): little-endian,
+INT 4 bytes two's complement, REAL 4 bytes IEEE single (so a REAL round trip rounds to
+single precision), BOOL 4 bytes 0/1, CHAR 1 byte; arrays element by element in row-major
+order, structures component by component in declaration order. ENUM values have no
+documented code and are refused. Errors: a buffer too small, an unset value (1422).
+"""
+
+from __future__ import annotations
+
+import struct
+
+from krl.semantics import types as T
+
+from .errors import KrlRuntimeError, value_invalid
+from .values import UNSET, Arr, Struct
+
+_SCALAR = {"INT": "<i", "REAL": "<f", "BOOL": "<i"}
+
+
+def _type_of(ref, value):
+    t = getattr(ref, "type", None)
+    if t is not None:
+        return t
+    if isinstance(value, (Arr, Struct)):
+        return value.type
+    if isinstance(value, bool):
+        return T.BOOL
+    if isinstance(value, int):
+        return T.INT
+    if isinstance(value, float):
+        return T.REAL
+    if isinstance(value, str) and len(value) == 1:
+        return T.CHAR
+    raise KrlRuntimeError("CAST: a variable of this type cannot be copied")
+
+
+def encode(value, type_) -> bytes:
+    """The bytes of one KRL value of type ``type_``."""
+    if value is UNSET:
+        raise value_invalid("CAST_TO argument")
+    if isinstance(type_, T.Array):
+        return b"".join(encode(v, type_.elem) for v in value.data)
+    if isinstance(type_, T.Struc):
+        return b"".join(encode(value.f.get(key, UNSET), ftype) for key, (_, ftype) in type_.fields.items())
+    name = getattr(type_, "name", "")
+    if name == "CHAR":
+        return bytes([ord(value) & 0xFF])
+    if name in _SCALAR:
+        return struct.pack(_SCALAR[name], int(value) if name != "REAL" else float(value))
+    raise KrlRuntimeError(f"CAST: values of type {type_} cannot be copied")
+
+
+def decode(data: bytes, pos: int, type_, old=None):
+    """(value, next position) of one value of ``type_`` read at ``pos``."""
+    if isinstance(type_, T.Array):
+        items = []
+        for k in range(len(old.data)):
+            v, pos = decode(data, pos, type_.elem, old.data[k])
+            items.append(v)
+        old.data[:] = items
+        return old, pos
+    if isinstance(type_, T.Struc):
+        out = old if isinstance(old, Struct) else Struct(type_)
+        for key, (_, ftype) in type_.fields.items():
+            out.f[key], pos = decode(data, pos, ftype, out.f.get(key))
+        return out, pos
+    name = getattr(type_, "name", "")
+    if name == "CHAR":
+        _need(data, pos, 1)
+        return chr(data[pos]), pos + 1
+    if name in _SCALAR:
+        _need(data, pos, 4)
+        (v,) = struct.unpack_from(_SCALAR[name], data, pos)
+        if name == "BOOL":
+            v = v != 0
+        return v, pos + 4
+    raise KrlRuntimeError(f"CAST: values of type {type_} cannot be copied")
+
+
+def _need(data: bytes, pos: int, n: int) -> None:
+    if pos + n > len(data):
+        raise KrlRuntimeError("CAST_FROM: the buffer ends before the variable")
+
+
+def _buffer(ref, what: str) -> Arr:
+    v = ref.peek() if ref is not None else UNSET
+    if not (isinstance(v, Arr) and v.type.elem == T.CHAR):
+        raise KrlRuntimeError(f"{what}: the buffer is not a CHAR array")
+    return v
+
+
+def cast_to(rt, a) -> None:  # noqa: ARG001 - the built-ins' calling convention
+    buf = _buffer(a[0], "CAST_TO")
+    off = int(a[1].get()) if a[1] is not None else 0
+    data = b"".join(encode(r.get() if r is not None else UNSET, _type_of(r, r.peek() if r else UNSET))
+                    for r in a[2:])
+    if off < 0 or off + len(data) > len(buf.data):
+        raise KrlRuntimeError("CAST_TO: the buffer is too small")
+    for k, byte in enumerate(data):
+        buf.data[off + k] = chr(byte)
+    if a[1] is not None:
+        a[1].set(off + len(data))
+
+
+def cast_from(rt, a) -> None:  # noqa: ARG001
+    buf = _buffer(a[0], "CAST_FROM")
+    raw = bytes(0 if c is UNSET else ord(c) & 0xFF for c in buf.data)
+    pos = int(a[1].get()) if a[1] is not None else 0
+    for r in a[2:]:
+        if r is None:
+            continue
+        old = r.peek()
+        value, pos = decode(raw, pos, _type_of(r, old), old)
+        r.set(value)
+    if a[1] is not None:
+        a[1].set(pos)
