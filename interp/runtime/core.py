@@ -366,6 +366,18 @@ class Runtime:
         return got
 
     # ================================================================== routines
+    def main_routine(self, module_name: str | None = None):
+        """(module, main routine) a robot or submit task starts with (the program's module by
+        default); raises KrlRuntimeError when the module has syntax errors or no main routine."""
+        name = module_name or self.program.main_path.stem
+        m = self.program.module(name)
+        if m is not None and m.syntax_errors:
+            raise KrlRuntimeError("the program has syntax errors and cannot start: " + m.syntax_errors[0],
+                                  None, m.path, 0)
+        if m is None or m.main is None:
+            raise KrlRuntimeError(f"no main routine in {name}")
+        return m, m.main
+
     def find_routine(self, name: str, module):
         return self.program.find_routine(name, module)
 

@@ -124,19 +124,7 @@ class VM:
     # ------------------------------------------------------------------ entry points
     def run_program(self, module_name: str | None = None) -> None:
         """Body of the robot (or a submit) task: call the main routine of the module."""
-        rt = self.rt
-        prog = rt.program
-        name = module_name or prog.main_path.stem
-        m = prog.module(name)
-        if m is not None and m.syntax_errors:
-            raise KrlRuntimeError("the program has syntax errors and cannot start: " + m.syntax_errors[0],
-                                  None, m.path, 0)
-        if m is None or m.main is None:
-            raise KrlRuntimeError(f"no main routine in {name}")
-        if m.syntax_errors:
-            raise KrlRuntimeError("the program has syntax errors and cannot start: " + m.syntax_errors[0],
-                                  None, m.path, 0)
-        self.invoke((m, m.main), [], None)
+        self.invoke(self.rt.main_routine(module_name), [], None)
 
     def code_for(self, module, routine, frame=None) -> Code:
         code = self.codes.get(id(routine))
