@@ -198,14 +198,7 @@ class Runtime:
         task = self.current_task
         task.file = info.file
         task.line = info.line
-        self.steps += 1
-        if self.max_steps is not None and self.steps > self.max_steps:
-            raise StopRun("max_steps", f"step limit {self.max_steps} reached")
-        task.count += 1
-        if task.count >= task.budget:
-            self.yield_cycle(task)
-        elif task.irqs.armed:
-            self.check_interrupts(task)
+        self._count_step(task)
         cont = False
         if task.continue_line is not None:
             cf, cl = task.continue_line
@@ -217,10 +210,8 @@ class Runtime:
             self.trace.write("stmt", self.controller.time, file=info.file, line=info.line,
                              context=task.context.kind)
 
-    def loop_tick(self, info: advance.StmtInfo) -> None:
-        """Called once per loop iteration (WHILE/REPEAT/LOOP/FOR): counts a step, may end
-        the time slice, applies a loop condition's advance-run stop. No trace event."""
-        task = self.current_task
+    def _count_step(self, task: Task) -> None:
+        """One step of a task: the step limit, the end of its time slice, interrupts."""
         self.steps += 1
         if self.max_steps is not None and self.steps > self.max_steps:
             raise StopRun("max_steps", f"step limit {self.max_steps} reached")
@@ -229,6 +220,12 @@ class Runtime:
             self.yield_cycle(task)
         elif task.irqs.armed:
             self.check_interrupts(task)
+
+    def loop_tick(self, info: advance.StmtInfo) -> None:
+        """Called once per loop iteration (WHILE/REPEAT/LOOP/FOR): counts a step, may end
+        the time slice, applies a loop condition's advance-run stop. No trace event."""
+        task = self.current_task
+        self._count_step(task)
         if info.cond_stops and task.kind == "robot":
             self.advance_stop(task)
 

@@ -82,3 +82,17 @@ class StopRun(ControlSignal):
         super().__init__(reason)
         self.reason = reason
         self.text = text
+
+
+def lvalue_name(e) -> str:
+    """The name of an lvalue expression (krl.ast nodes) as run-time messages show it:
+    ``p``, ``a[..]``, ``p.X``."""
+    from krl.ast import nodes as N  # noqa: PLC0415
+
+    if isinstance(e, N.Name):
+        return e.name
+    if isinstance(e, N.Index):
+        return lvalue_name(e.base) + "[..]"
+    if isinstance(e, N.Field):
+        return lvalue_name(e.base) + "." + e.name
+    return "?"

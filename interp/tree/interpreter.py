@@ -17,7 +17,7 @@ from krl.ast import nodes as N
 
 from interp.runtime.builtins import ValueRef
 from interp.runtime.convert import num
-from interp.runtime.errors import (ExitSignal, GotoSignal, KrlRuntimeError, ResumeSignal,
+from interp.runtime.errors import (lvalue_name, ExitSignal, GotoSignal, KrlRuntimeError, ResumeSignal,
                                    ReturnSignal)
 from interp.runtime.values import EnumValue, Struct, copy_value
 
@@ -546,11 +546,4 @@ class TreeInterpreter:
         raise KrlRuntimeError("not a variable")
 
 
-def _name_of(e) -> str:
-    if isinstance(e, N.Name):
-        return e.name
-    if isinstance(e, N.Index):
-        return _name_of(e.base) + "[..]"
-    if isinstance(e, N.Field):
-        return _name_of(e.base) + "." + e.name
-    return "?"
+_name_of = lvalue_name

@@ -25,19 +25,13 @@ from interp.runtime.errors import KrlRuntimeError
 from interp.runtime.memory import Frame
 from interp.runtime.values import EnumValue
 
+from interp.runtime.errors import lvalue_name
+
 from .assembler import Listing, Region, format_listing
 from .opcodes import BY_NAME as OPS
 
 
-def name_of(e) -> str:
-    """The name of an lvalue for messages (as the tree interpreter's ``_name_of``)."""
-    if isinstance(e, N.Name):
-        return e.name
-    if isinstance(e, N.Index):
-        return name_of(e.base) + "[..]"
-    if isinstance(e, N.Field):
-        return name_of(e.base) + "." + e.name
-    return "?"
+name_of = lvalue_name   # the shared runtime's helper, so both interpreters name lvalues alike
 
 
 _FAST_BINOPS = {"+": "ADD", "-": "SUB", "*": "MUL", "<": "LT", "<=": "LE", ">": "GT", ">=": "GE",
