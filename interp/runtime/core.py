@@ -78,6 +78,7 @@ class Runtime:
         self.robot: Task | None = None
         self.result: RunResult | None = None
         self._stop_cache: dict = {}
+        self._plans: dict = {}          # id(routine) -> Runtime._frame_plan
         self._cyclic: dict = {}
 
     # ================================================================== tasks and run
@@ -196,8 +197,7 @@ class Runtime:
         time slice), checks interrupts, applies CONTINUE and the advance-run stop, writes
         the ``stmt`` trace event."""
         task = self.current_task
-        task.file = info.file
-        task.line = info.line
+        task.at = info
         self._count_step(task)
         cont = False
         if task.continue_line is not None:
@@ -215,11 +215,32 @@ class Runtime:
         self.steps += 1
         if self.max_steps is not None and self.steps > self.max_steps:
             raise StopRun("max_steps", f"step limit {self.max_steps} reached")
-        task.count += 1
-        if task.count >= task.budget:
+        if self.steps >= task.slice_end:
             self.yield_cycle(task)
         elif task.irqs.armed:
             self.check_interrupts(task)
+
+    def quiet_limit(self, task: Task) -> int:
+        """The *quiet-step limit* of ``task`` (the VM's fast path; docs/architecture.md,
+        "Bytecode VM"): while ``self.steps`` is below it, a statement whose StmtInfo does
+        not stop the advance run (or a loop iteration whose condition does not) has no
+        effect of :meth:`before_statement` / :meth:`loop_tick` but ``steps += 1`` and
+        ``task.at = info``: no trace, no step limit or end of the time slice
+        reached, no armed interrupt, no pending CONTINUE or ON_ERROR_PROCEED. 0 when a
+        step needs the full hook. An interpreter that takes the fast path stores the
+        limit in ``task.quiet`` after each full hook; :meth:`_break` (a task switch,
+        CONTINUE, ON_ERROR_PROCEED, an interrupt declared or switched) resets it."""
+        if self.trace is not None or task.irqs.armed or task.continue_line is not None or task.error_proceed:
+            return 0
+        lim = task.slice_end - 1
+        if self.max_steps is not None and self.max_steps < lim:
+            return self.max_steps
+        return lim
+
+    @staticmethod
+    def _break(task: Task) -> None:
+        """The next step of ``task`` takes the full hook (see :meth:`quiet_limit`)."""
+        task.quiet = 0
 
     def loop_tick(self, info: advance.StmtInfo) -> None:
         """Called once per loop iteration (WHILE/REPEAT/LOOP/FOR): counts a step, may end
@@ -231,7 +252,9 @@ class Runtime:
 
     def set_continue(self, info: advance.StmtInfo) -> None:
         """CONTINUE: the next line does not stop the advance run."""
-        self.current_task.continue_line = (info.file, info.line)
+        task = self.current_task
+        task.continue_line = (info.file, info.line)
+        self._break(task)
 
     def advance_stop(self, task: Task) -> None:
         """The advance-run stop of a statement. Main context: wait for the main run. An
@@ -399,13 +422,66 @@ class Runtime:
     def enter_routine(self, module, routine: N.Routine, args: list, caller: Frame | None) -> Frame:
         """Create the frame of a call (§2.3): :IN parameters get converted copies, :OUT
         (and unmarked) parameters are bound to the caller's reference; omitted arguments
-        stay declared-but-unset; locals are declared unset."""
+        stay declared-but-unset; locals are declared unset. The routine's declarations are
+        resolved once (:meth:`_frame_plan`)."""
         task = self.current_task
         depth = caller.depth + 1 if caller is not None else 0
         if depth > MAX_CALL_DEPTH:
             raise KrlRuntimeError(f"stack overflow: more than {MAX_CALL_DEPTH} nested calls")
+        plan = self._plans.get(id(routine))
+        if plan is None or plan[0] is not module:
+            plan = self._plans[id(routine)] = self._frame_plan(module, routine)
+        _, scope, decls, params = plan
         frame = Frame(routine, module, caller, task)
-        ptypes = {}
+        frame.extra = scope
+        store = frame.store
+        fvars = frame.vars
+        for name, key, t, d in decls:
+            if t is not None:
+                store[key] = make_value(t)
+                ref = fvars[key] = Slot(store, key, t, name)
+                if d is not None:      # DECL CONST INT OFFS = 10 (KSS 8)
+                    v = self.program.literal(d.init, t, module)
+                    cur = store[key]
+                    if isinstance(cur, (Struct, Arr)):
+                        assign_into(cur, v)
+                    else:
+                        store[key] = convert_scalar(v, t)
+                    ref.readonly = d.is_const
+            elif isinstance(d, N.SignalDecl):
+                ref = self.program.signal_ref(d)
+                if ref is not None:
+                    frame.bind(d.name, ref)
+            else:
+                frame.bind(d.name, self.program.import_ref(d))
+        for i, (name, key, mode, t) in enumerate(params):
+            a = args[i] if i < len(args) else None
+            if a is None:
+                if isinstance(t, T.Array) and t.elem == T.CHAR and t.dims == (0,):
+                    # an omitted string parameter: declared, no characters (KUKA's MsgLib
+                    # calls STRLEN on it without ON_ERROR_PROCEED); VARSTATE says #DECLARED
+                    frame.declare(name, t, Arr(t, (0,), []))
+                elif t is None or (isinstance(t, T.Array) and 0 in t.dims):
+                    store[key] = UNSET
+                    fvars[key] = Slot(store, key, None, name)
+                else:
+                    frame.declare(name, t)
+                continue
+            if mode == "IN" or a.__class__ is ValueRef:
+                v = store[key] = self._param_copy(a.peek(), t, name)
+                fvars[key] = Slot(store, key, self._slot_type(t, v), name)
+            else:
+                fvars[key] = a
+        if self.trace is not None:
+            self.trace.write("call", self.controller.time, name=routine.name,
+                             line=caller.line if caller is not None else None)
+        return frame
+
+    def _frame_plan(self, module, routine: N.Routine) -> tuple:
+        """The declarations of ``routine`` resolved for :meth:`enter_routine`: (module,
+        type scope, [(name, KEY, type, VarDecl with an initial value or None) for each
+        local variable, or (name, KEY, None, SignalDecl/ImportDecl)], [(name, KEY, mode,
+        type or None) for each parameter]). Raises KrlRuntimeError for an unknown type."""
         pnames = {p.name.upper() for p in routine.params}
         scope = module.types if module is not None else self.program.types
         local_types = None
@@ -421,7 +497,8 @@ class Runtime:
                     local_types.types[d.name.upper()] = T.Enum(d.name, frozenset(v.upper() for v in d.values))
         if local_types is not None:
             scope = local_types
-        frame.extra = scope
+        ptypes = {}
+        decls = []
         for d in routine.decls:
             if isinstance(d, N.VarDecl):
                 t0 = self.program.resolve_type(d.type, scope)
@@ -431,46 +508,11 @@ class Runtime:
                     if key in pnames:
                         ptypes[key] = t
                     else:
-                        ref = frame.declare(vn.name, t)
-                        if d.init is not None:      # DECL CONST INT OFFS = 10 (KSS 8)
-                            v = self.program.literal(d.init, t, module)
-                            cur = ref.peek()
-                            if isinstance(cur, (Struct, Arr)):
-                                assign_into(cur, v)
-                            else:
-                                frame.store[key] = convert_scalar(v, t)
-                            ref.readonly = d.is_const
-            elif isinstance(d, N.SignalDecl):
-                ref = self.program.signal_ref(d)
-                if ref is not None:
-                    frame.bind(d.name, ref)
-            elif isinstance(d, N.ImportDecl):
-                frame.bind(d.name, self.program.import_ref(d))
-        for i, p in enumerate(routine.params):
-            key = p.name.upper()
-            t = ptypes.get(key)
-            a = args[i] if i < len(args) else None
-            if a is None:
-                if isinstance(t, T.Array) and t.elem == T.CHAR and t.dims == (0,):
-                    # an omitted string parameter: declared, no characters (KUKA's MsgLib
-                    # calls STRLEN on it without ON_ERROR_PROCEED); VARSTATE says #DECLARED
-                    frame.declare(p.name, t, Arr(t, (0,), []))
-                elif t is None or (isinstance(t, T.Array) and 0 in t.dims):
-                    frame.store[key] = UNSET
-                    frame.vars[key] = Slot(frame.store, key, None, p.name)
-                else:
-                    frame.declare(p.name, t)
-                continue
-            if p.mode == "IN" or isinstance(a, ValueRef):
-                v = a.peek()
-                frame.store[key] = self._param_copy(v, t, p.name)
-                frame.vars[key] = Slot(frame.store, key, self._slot_type(t, frame.store[key]), p.name)
-            else:
-                frame.vars[key] = a
-        if self.trace is not None:
-            self.trace.write("call", self.controller.time, name=routine.name,
-                             line=caller.line if caller is not None else None)
-        return frame
+                        decls.append((vn.name, key, t, d if d.init is not None else None))
+            elif isinstance(d, (N.SignalDecl, N.ImportDecl)):
+                decls.append((d.name, d.name.upper(), None, d))
+        params = [(p.name, p.name.upper(), p.mode, ptypes.get(p.name.upper())) for p in routine.params]
+        return module, scope, decls, params
 
     @staticmethod
     def _slot_type(t, v):
@@ -577,7 +619,9 @@ class Runtime:
         return p
 
     def on_error_proceed(self) -> None:
-        self.current_task.error_proceed = True
+        task = self.current_task
+        task.error_proceed = True
+        self._break(task)
 
     def record_error(self, err: KrlRuntimeError, frame: Frame | None) -> None:
         """A statement under ON_ERROR_PROCEED failed: fill $ERR and go on (§5.19)."""
@@ -756,6 +800,7 @@ class Runtime:
         n = int(num(number, "interrupt number"))
         task.irqs.declare(Irq(n, cond_fn, handler_fn, name, frame, is_global, line))
         frame.interrupts.append(n)
+        self._break(task)
 
     def interrupt_ctl(self, action: str, number=None) -> None:
         from .convert import num  # noqa: PLC0415
@@ -763,6 +808,7 @@ class Runtime:
         task = self.current_task
         n = int(num(number, "interrupt number")) if number is not None else None
         task.irqs.control(action.upper(), n)
+        self._break(task)
         if action.upper() in ("ENABLE", "ON") and task.irqs.armed:
             self.check_interrupts(task)
 

@@ -39,7 +39,8 @@ class Task:
         self.name = name
         self.body = body
         self.budget = budget if budget is not None else (ROBOT_BUDGET if kind == "robot" else SUBMIT_BUDGET)
-        self.count = 0
+        self.slice_end = 0              # value of Runtime.steps that ends this IPO cycle's time slice
+        self.quiet = 0                  # quiet-step limit (Runtime.quiet_limit)
         self.contexts = [Context("main" if kind == "robot" else "submit")]
         self.irqs = InterruptTable()
         self.err = None                 # $ERR of this interpreter (Struct ERROR_T)
@@ -49,14 +50,23 @@ class Task:
         self.pending_error = None
         self.next_triggers: list = []   # TRIGGERs waiting for the next motion
         self.waiting: str | None = None
-        self.file: str | None = None
-        self.line: int | None = None
+        self.at = None                  # StmtInfo of the statement that ran last (file, line)
         self.done = False
         self.outcome = None             # (reason, error or None)
         self.in_poll = False
         self.glet: greenlet | None = None
         self.frame = None               # innermost frame (VARSTATE)
         self.err_text = ""
+
+    @property
+    def file(self) -> str | None:
+        """File of the statement that ran last."""
+        return self.at.file if self.at is not None else None
+
+    @property
+    def line(self) -> int | None:
+        """Line of the statement that ran last."""
+        return self.at.line if self.at is not None else None
 
     @property
     def context(self) -> Context:
@@ -82,7 +92,8 @@ class Scheduler:
 
     def _resume(self, task: Task) -> None:
         self.rt.current_task = task
-        task.count = 0
+        task.slice_end = self.rt.steps + task.budget
+        task.quiet = 0
         try:
             task.glet.switch()
         finally:

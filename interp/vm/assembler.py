@@ -202,7 +202,7 @@ def format_listing(lst: Listing) -> str:
                 parts.append(lab[v])
             elif k == "c":
                 parts.append(fmt_const(v))
-            elif k in "nsmg":
+            elif k in "nsmgvyo":
                 parts.append(fmt_name(v))
             elif k == "f":
                 parts.append(fmt_flags(v))
@@ -265,7 +265,7 @@ def parse_listings(text: str) -> list[Listing]:
                 for k, t in zip(info.operands, args):
                     if k == "c":
                         ops.append(parse_const(t))
-                    elif k in "nsmg":
+                    elif k in "nsmgvyo":
                         ops.append(parse_name(t))
                     elif k == "f":
                         ops.append("" if t == "-" else t)
@@ -324,11 +324,11 @@ def encode(lst: Listing) -> Code:
         words.append(info.number)
         regions.append(r)
         for k, v in zip(info.operands, ops):
-            if k == "c" or k == "n" or k == "f":
+            if k == "c" or k == "n" or k == "f" or k == "y" or k == "o":
                 w = const(v)
             elif k == "l":
                 w = label(v)
-            elif k == "s":
+            elif k == "s" or k == "v":
                 w = lix.get(v.upper())
                 if w is None:
                     raise AsmError(f"{v} is not in .locals")
@@ -373,13 +373,13 @@ def to_listing(code: Code) -> Listing:
         ops = []
         for j, k in enumerate(info.operands):
             w = words[a + 1 + j]
-            if k in "cnf":
+            if k in "cnfyo":
                 ops.append(code.consts[w])
             elif k == "l":
                 name = f"@{w}"
                 lst.labels[name] = index_of[w]
                 ops.append(name)
-            elif k == "s":
+            elif k == "s" or k == "v":
                 ops.append(code.lnames[w])
             elif k == "m":
                 ops.append(code.mnames[w])

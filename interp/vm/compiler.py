@@ -56,6 +56,34 @@ def local_names(routine: N.Routine) -> list[str]:
     return out
 
 
+_LETTERS = {"INT": "I", "REAL": "R", "BOOL": "B", "CHAR": "C"}
+
+
+def store_variables(routine: N.Routine) -> dict:
+    """The routine's *store variables* (operand kind ``v``, interp/vm/opcodes.py): UPPER
+    name -> (type letter I/R/B/C, number of array dimensions, 0 for a scalar) for each
+    variable the frame holds in its own store (Runtime.enter_routine: a local, or an :IN
+    parameter) whose declared type is INT, REAL, BOOL or CHAR, scalar or an array of 1 or
+    2 fixed dimensions; not CONST, not an :OUT parameter (an alias of the caller's
+    variable)."""
+    modes = {p.name.upper(): p.mode for p in routine.params}
+    out: dict = {}
+    for d in routine.decls:
+        if not isinstance(d, N.VarDecl) or d.is_const or d.init is not None:
+            continue
+        letter = _LETTERS.get(d.type.name.upper()) if d.type.size is None else None
+        if letter is None:
+            continue
+        for vn in d.names:
+            key = vn.name.upper()
+            if key in out or (key in modes and modes[key] != "IN"):
+                continue
+            if len(vn.dims) > 2 or 0 in vn.dims:
+                continue
+            out[key] = (letter, len(vn.dims))
+    return out
+
+
 def static_frame(rt, module, routine) -> Frame:
     """A frame with the routine's names bound (for the advance-run analysis when the
     routine is compiled without being called, e.g. by `krl asm`)."""
@@ -76,6 +104,7 @@ class Compiler:
         self.frame = frame if frame is not None else static_frame(rt, module, routine)
         self.locals = local_names(routine)
         self.local_set = {n.upper() for n in self.locals}
+        self.fast = store_variables(routine)
         self.spelling = {n.upper(): n for n in self.locals}
         self.data = module.data if module is not None else {}
         self.lst = Listing(routine.name, routine.kind, routine.span.file, self.locals, 0)
@@ -128,8 +157,8 @@ class Compiler:
             self.place(label)
             fn()
             self.emit("END_THUNK")
-        peephole(self.lst)
-        peephole(self.lst)
+        while peephole(self.lst):
+            pass
         return format_listing(self.lst)
 
     def thunk(self, fn) -> str:
@@ -236,7 +265,10 @@ class Compiler:
         self.place(body)
         self.loop_body(st.body, end)
         self.region = None
-        self.emit("FOR_NEXT", t, info, body)
+        if self.fast_scalar(st.var) == "I":
+            self.emit("FOR_NEXT_FAST", self.spelled(st.var.name), t, info, body)
+        else:
+            self.emit("FOR_NEXT", t, info, body)
         self.place(end)
 
     def loop_body(self, body, end) -> None:
@@ -559,6 +591,23 @@ class Compiler:
             return "MOD"
         return "GLOBAL"
 
+    def fast_scalar(self, e) -> str | None:
+        """The type letter of ``e`` if it is a scalar store variable, else None."""
+        if isinstance(e, N.Name):
+            got = self.fast.get(e.name.upper())
+            if got is not None and got[1] == 0:
+                return got[0]
+        return None
+
+    def fast_array(self, e) -> str | None:
+        """The element type letter of ``e`` if it is ``store array[i]`` or ``[i, j]`` with
+        every index given and as many as the array's dimensions, else None."""
+        if isinstance(e, N.Index) and isinstance(e.base, N.Name) and None not in e.indices:
+            got = self.fast.get(e.base.name.upper())
+            if got is not None and got[1] == len(e.indices):
+                return got[0]
+        return None
+
     def ref(self, e) -> None:
         if isinstance(e, N.Name):
             self.emit("REF_" + self.kind_of(e.name), self.spelled(e.name))
@@ -580,6 +629,16 @@ class Compiler:
                 self.expr(i)
 
     def store(self, target) -> None:
+        letter = self.fast_scalar(target)
+        if letter is not None and letter in "IRB":
+            self.emit("STORE_FAST", self.spelled(target.name), letter)
+            return
+        letter = self.fast_array(target)
+        if letter is not None:
+            self.indices(target)
+            self.emit(f"STORE_ELEM{len(target.indices)}", self.spelled(target.base.name), name_of(target.base),
+                      letter)
+            return
         if isinstance(target, N.Name):
             self.emit("STORE_" + self.kind_of(target.name), self.spelled(target.name))
         elif isinstance(target, N.Index) and None not in target.indices:
@@ -627,8 +686,13 @@ class Compiler:
             self.emit("CONST", e.value)
         elif isinstance(e, N.EnumLit):
             self.emit("CONST", EnumValue(e.name))
+        elif self.fast_scalar(e) is not None:
+            self.emit("LOAD_FAST", self.spelled(e.name))
         elif isinstance(e, N.Name):
             self.emit("LOAD_" + self.kind_of(e.name), self.spelled(e.name))
+        elif self.fast_array(e) is not None:
+            self.indices(e)
+            self.emit(f"LOAD_ELEM{len(e.indices)}", self.spelled(e.base.name), name_of(e.base))
         elif isinstance(e, N.Index):
             self.ref(e.base)
             self.indices(e)
@@ -664,6 +728,8 @@ class Compiler:
 _CMP_JUMPS = {"LT": "IF_NOT_LT", "LE": "IF_NOT_LE", "GT": "IF_NOT_GT", "GE": "IF_NOT_GE",
               "EQ": "IF_NOT_EQ", "NE": "IF_NOT_NE"}
 _CONST_OPS = {"ADD": "ADD_CONST", "SUB": "SUB_CONST", "MUL": "MUL_CONST"}
+_CMP_SYMBOLS = {"IF_NOT_LT": "<", "IF_NOT_LE": "<=", "IF_NOT_GT": ">", "IF_NOT_GE": ">=", "IF_NOT_EQ": "==",
+                "IF_NOT_NE": "<>"}
 
 
 def _fuse(group: list):
@@ -675,6 +741,23 @@ def _fuse(group: list):
     if len(group) == 3 and names[:2] == ["REF_LOCAL", "LOAD_LOCAL"] and names[2] in ("LOAD_INDEX", "STORE_INDEX") \
             and ops[2][0] == 1:
         return ("LOAD_ELEM_LL" if names[2] == "LOAD_INDEX" else "STORE_ELEM_LL", [ops[0][0], ops[1][0], ops[2][1]])
+    if len(group) == 3 and names == ["LOAD_FAST", "LOAD_FAST", "LOAD_ELEM2"]:
+        return ("LOAD_ELEM2_VV", [ops[2][0], ops[0][0], ops[1][0], ops[2][1]])
+    if len(group) == 2 and names[0] in ("FAST_ADD_CONST", "FAST_SUB_CONST") and names[1] == "STORE_FAST":
+        return (names[0][5:8] + "C_FAST", [ops[0][0], ops[0][1], ops[1][0], ops[1][1]])
+    if len(group) == 2 and names[0] == "LOAD_FAST2" and names[1] in _CMP_SYMBOLS:
+        return ("IF_NOT_VV", [ops[0][0], ops[0][1], _CMP_SYMBOLS[names[1]], ops[1][0]])
+    if len(group) == 3 and names[:2] == ["LOAD_FAST", "CONST"] and names[2] in _CMP_SYMBOLS:
+        return ("IF_NOT_VC", [ops[0][0], ops[1][0], _CMP_SYMBOLS[names[2]], ops[2][0]])
+    if len(group) == 2 and names[0] == "LOAD_FAST":
+        if names[1] == "LOAD_ELEM1":
+            return ("LOAD_ELEM1_V", [ops[1][0], ops[0][0], ops[1][1]])
+        if names[1] == "STORE_ELEM1":
+            return ("STORE_ELEM1_V", [ops[1][0], ops[0][0], ops[1][1], ops[1][2]])
+        if names[1] == "LOAD_FAST":
+            return ("LOAD_FAST2", [ops[0][0], ops[1][0]])
+        if names[1] in ("ADD_CONST", "SUB_CONST"):
+            return ("FAST_" + names[1], [ops[0][0], ops[1][0]])
     if len(group) == 2:
         if names[1] == "JUMP_IF_FALSE" and names[0] in _CMP_JUMPS:
             return (_CMP_JUMPS[names[0]], [ops[1][0]])
@@ -687,8 +770,9 @@ def _fuse(group: list):
     return None
 
 
-def peephole(lst: Listing) -> None:
-    """Replace common instruction sequences by superinstructions (opcodes.py). A sequence
+def peephole(lst: Listing) -> bool:
+    """Replace common instruction sequences by superinstructions (opcodes.py); True if it
+    replaced any (a fused instruction may fuse again in the next pass). A sequence
     is fused only when no label points inside it and all of it lies in one error region;
     the fused instruction keeps the region of the sequence's first instruction, except a
     compare-and-jump, whose only possible error is the comparison's."""
@@ -725,6 +809,7 @@ def peephole(lst: Listing) -> None:
     where[len(old)] = len(new)
     lst.instrs = new
     lst.labels = {k: where[v] for k, v in lst.labels.items()}
+    return len(new) < len(old)
 
 
 def compile_routine(rt, module, routine: N.Routine, frame: Frame | None = None) -> str:

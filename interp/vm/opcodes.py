@@ -17,10 +17,20 @@ n     a name or word (``X``, ``$OV_PRO``, ``+``,  index into the constant pool (
       a plain word)
 l     a label ``L3``                              the instruction address
 s     a local (frame slot) by name                the slot number (``.locals`` order)
+v     a *store variable* by name: a local or      the slot number; the VM's form is the
+      :IN parameter the frame holds in its own    key of ``Frame.store``
+      store (never an alias of the caller's)
 m     a module (data list) variable by name       index into the code's module slots
 g     a global / system variable by name          index into the code's global slots
 t     a temporary slot number                     the number
 f     a flag word (``-`` = none)                  index into the constant pool (a str)
+y     a value type: I, R, B or C (INT, REAL,      index into the constant pool (a str);
+      BOOL, CHAR)                                 the VM's form is the Python class of
+                                                  that type's values (None for C: every
+                                                  CHAR store takes the general path)
+o     a comparison: ``<``, ``<=``, ``>``, ``>=``,   index into the constant pool (a str);
+      ``==``, ``<>``                              the VM's form is (the comparison on two
+                                                  numbers, its runtime function)
 x     a statement: ``LINE`` or ``LINE/FLAGS``      index into the code's statement table
       (S: stops the advance run, C: its loop      (advance.StmtInfo objects)
       condition stops it)
@@ -104,6 +114,29 @@ _TABLE = [
     ("IF_NOT_GE",    -2,  "l",  "GE, JUMP_IF_FALSE l"),
     ("IF_NOT_EQ",    -2,  "l",  "EQ, JUMP_IF_FALSE l"),
     ("IF_NOT_NE",    -2,  "l",  "NE, JUMP_IF_FALSE l"),
+    # -- store variables (operand kind v): a routine's own scalar variables and arrays of
+    #    scalars, read and written in ``Frame.store`` directly. Each has an inline fast path
+    #    for the common case and hands every other case (UNSET, a conversion, an index out
+    #    of range) to the same runtime function as the general opcode, so values and error
+    #    messages are the general opcode's. The compiler emits them only for variables
+    #    declared INT, REAL, BOOL, CHAR or ENUM (arrays: of INT, REAL, BOOL, CHAR), not CONST.
+    ("LOAD_FAST",     1,  "v",  "push a store variable (LOAD_LOCAL)"),
+    ("LOAD_FAST2",    2,  "vv", "push two store variables"),
+    ("FAST_ADD_CONST", 1, "vc", "LOAD_FAST v, ADD_CONST c"),
+    ("FAST_SUB_CONST", 1, "vc", "LOAD_FAST v, SUB_CONST c"),
+    ("STORE_FAST",   -1,  "vy", "pop a value into a store variable (STORE_LOCAL); y: its type"),
+    ("LOAD_ELEM1",    0,  "vn", "pop an index, push store array v [index] (LOAD_INDEX 1); n: name for messages"),
+    ("LOAD_ELEM2",   -1,  "vn", "pop two indices, push store array v [i, j] (LOAD_INDEX 2)"),
+    ("STORE_ELEM1",  -2,  "vny","pop an index and a value: store array v [index] = value (STORE_INDEX 1); n: name, y: element type"),
+    ("STORE_ELEM2",  -3,  "vny","pop two indices and a value: store array v [i, j] = value (STORE_INDEX 2)"),
+    ("LOAD_ELEM1_V",  1,  "vvn", "push store array v1 [store variable v2]"),
+    ("STORE_ELEM1_V",-1,  "vvny", "pop a value into store array v1 [store variable v2]"),
+    ("LOAD_ELEM2_VV", 1,  "vvvn", "push store array v1 [v2, v3]"),
+    ("FOR_NEXT_FAST", 0,  "vtxl", "FOR_NEXT with an INT store variable v as the counter"),
+    ("ADDC_FAST",     0,  "vcvy", "v2 = v1 + c (FAST_ADD_CONST v1 c, STORE_FAST v2 y)"),
+    ("SUBC_FAST",     0,  "vcvy", "v2 = v1 - c (FAST_SUB_CONST v1 c, STORE_FAST v2 y)"),
+    ("IF_NOT_VV",     0,  "vvol", "jump to l unless v1 o v2 (LOAD_FAST2 v1 v2, IF_NOT_<o> l)"),
+    ("IF_NOT_VC",     0,  "vcol", "jump to l unless v o c (LOAD_FAST v, CONST c, IF_NOT_<o> l)"),
     # -- jumps
     ("JUMP",          0,  "l",  "jump"),
     ("JUMP_IF_FALSE",-1,  "l",  "pop a condition (Runtime.to_bool); jump if FALSE"),
@@ -151,7 +184,7 @@ _TABLE = [
 
 OPS: list[OpInfo] = [OpInfo(name, i, eff, ops, doc) for i, (name, eff, ops, doc) in enumerate(_TABLE)]
 BY_NAME: dict[str, OpInfo] = {o.name: o for o in OPS}
-OPERAND_KINDS = "icnlsmgtfx"
+OPERAND_KINDS = "icnlsmgtfxvyo"
 
 # bind the numbers as module constants (STMT, CONST, ...) for the compiler and the VM
 globals().update({o.name: o.number for o in OPS})

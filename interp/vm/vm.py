@@ -20,12 +20,18 @@ the runtime's resolver) and kept per routine.
 
 from __future__ import annotations
 
+import ast
+import copy
+import heapq
 import inspect
-import re
+import itertools
+import operator
+import textwrap
 
 from interp.runtime.builtins import ValueRef
-from interp.runtime.convert import num
+from interp.runtime.convert import INT_MAX, INT_MIN, num
 from interp.runtime.errors import ExitSignal, KrlRuntimeError, ResumeSignal
+from interp.runtime.values import UNSET
 from interp.runtime.slots import (add, anout_limits, anout_value, array_index, component, element,
                                   element1, element2, ended_without_return, eq, for_done, for_limits,
                                   for_next, function_result, ge, gt, label_not_found, le, load, lt, mul,
@@ -45,31 +51,148 @@ HELPERS = ("load", "store", "element", "element1", "element2", "set_element", "s
 
 
 def _specialize(fn):
-    """Replace ``OP.NAME`` by the opcode's number in ``fn``'s source (the dispatch loop
-    compares against literals instead of looking up module attributes) and make the
-    :data:`HELPERS` closure variables ``_name`` of it. Line numbers stay those of this
-    file."""
+    """Compile the dispatch loop ``fn`` for speed, from its own source, with line numbers
+    kept (tracebacks and coverage point into this file):
+
+    * the :data:`HELPERS` become closure variables ``_name``;
+    * the chain ``if op == <opcode>: ... elif op == <opcode>: ...``, hottest first, becomes
+      a binary search, ``if op < k:``, shaped as a Huffman tree over the opcodes with
+      Zipf weights by rank in the chain (weight 1/rank): the hottest opcode is found after
+      two tests, the tenth after about five, a rare one after about ten, where the chain
+      needs one test per opcode ahead of it. The loop therefore dispatches on its own
+      numbering of the opcodes, the leaves of that tree from left to right;
+      ``fn.dispatch[opcode number]`` is that number (:func:`decode` writes it), and every
+      ``OP.NAME`` in ``fn`` becomes it.
+    """
     lines, first = inspect.getsourcelines(fn)
-    indent = len(lines[0]) - len(lines[0].lstrip())
-    body = []
-    for ln in lines:
-        if ln.lstrip().startswith("@_specialize"):
-            body.append("\n")
+    src = textwrap.dedent("".join(ln for ln in lines if not ln.lstrip().startswith("@_specialize")))
+    tree = ast.parse(src)
+    ast.increment_lineno(tree, first)
+    func = tree.body[0]
+    chain = next(n for n in ast.walk(func) if isinstance(n, ast.If) and _chain_ops(n.test))
+    branches = []
+    node = chain
+    while True:
+        branches.append((_chain_ops(node.test), node.body))
+        if len(node.orelse) == 1 and isinstance(node.orelse[0], ast.If) and _chain_ops(node.orelse[0].test):
+            node = node.orelse[0]
             continue
-        body.append("    " + (ln[indent:] if len(ln) > indent else ln.lstrip(" ")))
-    pre = ["def _factory():"] + [f"    _{n} = {n}" for n in HELPERS]
-    assert len(pre) < first - 1
-    src = "\n".join(pre) + "\n" * (first - len(pre)) + "".join(body) + f"    return {fn.__name__}\n"
-    src = re.sub(r"\bOP\.([A-Z_]+)\b", lambda m: str(OP.BY_NAME[m.group(1)].number), src)
+        break
+    body_of, weight = {}, {}
+    for rank, (names, body) in enumerate(branches, 1):
+        for name in names:
+            body_of.setdefault(name, body)
+            weight.setdefault(name, 1.0 / rank / len(names))
+    missing = set(OP.BY_NAME) - set(body_of)
+    if missing:
+        raise AssertionError(f"opcodes without a branch in the dispatch loop: {sorted(missing)}")
+    root = _huffman(weight)
+    order: list = []
+    _leaves(root, order)
+    number = {name: i for i, name in enumerate(order)}
+    search = _search(root, body_of, number)
+    _replace(func, chain, search if isinstance(search, ast.If) else search[0])
+    func = _OpNumbers(number).visit(func)
+    factory = ast.FunctionDef(
+        "_factory", ast.arguments([], [], None, [], [], None, []),
+        [ast.Assign([ast.Name(f"_{n}", ast.Store())], ast.Name(n, ast.Load())) for n in HELPERS]
+        + [func, ast.Return(ast.Name(fn.__name__, ast.Load()))], [], None)
+    mod = ast.Module([factory], [])
+    _locate(mod, chain)
     ns: dict = {}
-    exec(compile(src, inspect.getsourcefile(fn), "exec"), fn.__globals__, ns)  # noqa: S102
-    return ns["_factory"]()
+    exec(compile(mod, inspect.getsourcefile(fn), "exec"), fn.__globals__, ns)  # noqa: S102
+    out = ns["_factory"]()
+    out.dispatch = [number[o.name] for o in OP.OPS]
+    return out
+
+
+class _OpNumbers(ast.NodeTransformer):
+    """``OP.NAME`` -> the loop's number of the opcode."""
+
+    def __init__(self, number: dict) -> None:
+        self.number = number
+
+    def visit_Attribute(self, node):
+        if isinstance(node.value, ast.Name) and node.value.id == "OP" and node.attr in self.number:
+            return ast.copy_location(ast.Constant(self.number[node.attr]), node)
+        return self.generic_visit(node)
+
+
+def _chain_ops(test) -> list | None:
+    """The opcode names of a dispatch test ``op == <opcode> [or op == <opcode> ...]``, else None."""
+    parts = test.values if isinstance(test, ast.BoolOp) and isinstance(test.op, ast.Or) else [test]
+    out = []
+    for p in parts:
+        if not (isinstance(p, ast.Compare) and isinstance(p.left, ast.Name) and p.left.id == "op"
+                and len(p.ops) == 1 and isinstance(p.ops[0], ast.Eq)):
+            return None
+        c = p.comparators[0]
+        if not (isinstance(c, ast.Attribute) and isinstance(c.value, ast.Name) and c.value.id == "OP"):
+            return None
+        out.append(c.attr)
+    return out
+
+
+def _huffman(weight: dict):
+    """A Huffman tree over the opcode names: a name (leaf) or a pair (left, right)."""
+    tie = itertools.count()
+    heap = [(w, next(tie), name) for name, w in sorted(weight.items())]
+    heapq.heapify(heap)
+    while len(heap) > 1:
+        wa, _, a = heapq.heappop(heap)
+        wb, _, b = heapq.heappop(heap)
+        heapq.heappush(heap, (wa + wb, next(tie), (a, b)))
+    return heap[0][2]
+
+
+def _leaves(node, out: list) -> None:
+    if isinstance(node, tuple):
+        _leaves(node[0], out)
+        _leaves(node[1], out)
+    else:
+        out.append(node)
+
+
+def _search(node, body_of: dict, number: dict):
+    """The statements that dispatch ``op`` within the subtree ``node``."""
+    if not isinstance(node, tuple):
+        return copy.deepcopy(body_of[node])
+    right = []
+    _leaves(node[1], right)
+    lo = _search(node[0], body_of, number)
+    hi = _search(node[1], body_of, number)
+    test = ast.Compare(ast.Name("op", ast.Load()), [ast.Lt()], [ast.Constant(number[right[0]])])
+    return [ast.If(test, lo, hi)]
+
+
+def _replace(tree, old, new) -> None:
+    for parent in ast.walk(tree):
+        for _, value in ast.iter_fields(parent):
+            if isinstance(value, list) and old in value:
+                value[value.index(old)] = new
+                return
+    raise AssertionError("dispatch chain not found")
+
+
+def _locate(tree, where) -> None:
+    """Give the new dispatch tests the line of the chain's first test."""
+    for node in ast.walk(tree):
+        if isinstance(node, (ast.stmt, ast.expr)) and not hasattr(node, "lineno"):
+            ast.copy_location(node, where)
+    ast.fix_missing_locations(tree)
+
+
+# the VM's forms of operand kinds y and o (opcodes.py)
+_VALUE_CLASS = {"I": int, "R": float, "B": bool}
+_COMPARE = {"<": (operator.lt, lt), "<=": (operator.le, le), ">": (operator.gt, gt), ">=": (operator.ge, ge),
+            "==": (operator.eq, eq), "<>": (operator.ne, ne)}
 
 
 def decode(code: Code) -> tuple[list, list]:
     """The VM's form of assembled code: one tuple ``(opcode, operand, ...)`` per
     instruction, with constants, names and statement infos resolved and jump targets as
     instruction numbers; and the error region of each instruction."""
+    dispatch = VM.run.dispatch
     words = code.words
     starts = []
     pc = 0
@@ -83,7 +206,7 @@ def decode(code: Code) -> tuple[list, list]:
     moved: dict = {}     # guarded regions with their end as an instruction number
     for a in starts:
         info = OP.OPS[words[a]]
-        ins = [info.number]
+        ins = [dispatch[info.number]]
         for j, k in enumerate(info.operands):
             w = words[a + 1 + j]
             if k in "cnf":
@@ -92,6 +215,12 @@ def decode(code: Code) -> tuple[list, list]:
                 w = code.infos[w]
             elif k == "l":
                 w = index[w]
+            elif k == "v":
+                w = code.lkeys[w]
+            elif k == "y":
+                w = _VALUE_CLASS.get(code.consts[w])
+            elif k == "o":
+                w = _COMPARE[code.consts[w]]
             ins.append(w)
         prog.append(tuple(ins))
         r = code.regions[a]
@@ -195,11 +324,15 @@ class VM:
         refs = act.refs
         temps = act.temps
         frame = act.frame
+        store = frame.store          # store variables (operand kind v): Frame.store keys
+        fvars = frame.vars
         push = stack.append
         pop = stack.pop
         before = rt.before_statement
         tick = rt.loop_tick
         take_error_proceed = rt.take_error_proceed
+        quiet_limit = rt.quiet_limit
+        task = rt.current_task
         proceed = False
         while True:
             try:
@@ -211,88 +344,197 @@ class VM:
                         info = ins[1]
                         if not thunk:
                             frame.line = info.line
-                        before(info)
-                        proceed = take_error_proceed()
+                        n = rt.steps
+                        if n < task.quiet and not info.stops:     # a quiet step (Runtime.quiet_limit)
+                            rt.steps = n + 1
+                            task.at = info
+                            proceed = False
+                        else:
+                            before(info)
+                            proceed = take_error_proceed()
+                            task.quiet = quiet_limit(task)
                         ip += 1
-                    elif op == OP.LOAD_LOCAL:
-                        push(_load(refs[ins[1]]))
+                    elif op == OP.LOAD_FAST:
+                        v = store[ins[1]]
+                        push(v if v is not UNSET else _load(fvars[ins[1]]))
                         ip += 1
-                    elif op == OP.LOAD_ELEM_LL:
-                        push(_element1(refs[ins[1]], _load(refs[ins[2]]), ins[3]))
+                    elif op == OP.LOAD_ELEM1_V:
+                        a = store[ins[1]]
+                        i = store[ins[2]]
+                        if i.__class__ is int and 0 < i <= a.dims[0] and (v := a.data[i - 1]) is not UNSET:
+                            push(v)
+                        else:
+                            push(_element1(fvars[ins[1]], _load(fvars[ins[2]]), ins[3]))
                         ip += 1
                     elif op == OP.CONST:
                         push(ins[1])
                         ip += 1
-                    elif op == OP.STORE_LOCAL:
-                        _store(refs[ins[1]], pop())
+                    elif op == OP.STORE_FAST:
+                        v = pop()
+                        t = ins[2]
+                        if v.__class__ is t and (t is not int or INT_MIN <= v <= INT_MAX):
+                            store[ins[1]] = v
+                        else:
+                            _store(fvars[ins[1]], v)
+                        ip += 1
+                    elif op == OP.LOAD_FAST2:
+                        v = store[ins[1]]
+                        push(v if v is not UNSET else _load(fvars[ins[1]]))
+                        v = store[ins[2]]
+                        push(v if v is not UNSET else _load(fvars[ins[2]]))
+                        ip += 1
+                    elif op == OP.IF_NOT_VV:
+                        a = store[ins[1]]
+                        b = store[ins[2]]
+                        ca = a.__class__
+                        cb = b.__class__
+                        f = ins[3]
+                        if (f[0](a, b) if (ca is int or ca is float) and (cb is int or cb is float)
+                                else f[1](a if a is not UNSET else _load(fvars[ins[1]]), b if b is not UNSET else _load(fvars[ins[2]]))):
+                            ip += 1
+                        else:
+                            ip = ins[4]
+                    elif op == OP.JUMP_TICK:
+                        n = rt.steps
+                        if n < task.quiet and not ins[1].cond_stops:
+                            rt.steps = n + 1
+                        else:
+                            tick(ins[1])
+                            task.quiet = quiet_limit(task)
+                        ip = ins[2]
+                    elif op == OP.FOR_NEXT_FAST:
+                        t = ins[2]
+                        c = store[ins[1]]
+                        step = temps[t + 2]
+                        if c.__class__ is int and step.__class__ is int and INT_MIN <= (c := c + step) <= INT_MAX:
+                            store[ins[1]] = c
+                            go = c <= temps[t + 1] if step > 0 else c >= temps[t + 1]
+                        else:
+                            go = _for_next(temps[t], temps[t + 1], step)
+                        if go:
+                            n = rt.steps
+                            if n < task.quiet and not ins[3].cond_stops:
+                                rt.steps = n + 1
+                            else:
+                                tick(ins[3])
+                                task.quiet = quiet_limit(task)
+                            ip = ins[4]
+                        else:
+                            ip += 1
+                    elif op == OP.IF_NOT_VC:
+                        a = store[ins[1]]
+                        b = ins[2]
+                        ca = a.__class__
+                        cb = b.__class__
+                        f = ins[3]
+                        if (f[0](a, b) if (ca is int or ca is float) and (cb is int or cb is float)
+                                else f[1](a if a is not UNSET else _load(fvars[ins[1]]), b)):
+                            ip += 1
+                        else:
+                            ip = ins[4]
+                    elif op == OP.ADDC_FAST:
+                        a = store[ins[1]]
+                        b = ins[2]
+                        t = ins[4]
+                        ca = a.__class__
+                        if ca is b.__class__ and ca is t and (ca is float or (ca is int and INT_MIN <= (v := a + b) <= INT_MAX)):
+                            store[ins[3]] = a + b if ca is float else v
+                        else:
+                            _store(fvars[ins[3]], _add(a if a is not UNSET else _load(fvars[ins[1]]), b))
+                        ip += 1
+                    elif op == OP.SUBC_FAST:
+                        a = store[ins[1]]
+                        b = ins[2]
+                        t = ins[4]
+                        ca = a.__class__
+                        if ca is b.__class__ and ca is t and (ca is float or (ca is int and INT_MIN <= (v := a - b) <= INT_MAX)):
+                            store[ins[3]] = a - b if ca is float else v
+                        else:
+                            _store(fvars[ins[3]], _sub(a if a is not UNSET else _load(fvars[ins[1]]), b))
+                        ip += 1
+                    elif op == OP.ADD:
+                        b = pop()
+                        a = stack[-1]
+                        if a.__class__ is float and b.__class__ is float:
+                            stack[-1] = a + b
+                        elif a.__class__ is int and b.__class__ is int and INT_MIN <= (v := a + b) <= INT_MAX:
+                            stack[-1] = v
+                        else:
+                            stack[-1] = _add(a, b)
+                        ip += 1
+                    elif op == OP.IF_NOT_LE:
+                        b = pop()
+                        a = pop()
+                        ca = a.__class__
+                        cb = b.__class__
+                        if (a <= b) if (ca is int or ca is float) and (cb is int or cb is float) else _le(a, b):
+                            ip += 1
+                        else:
+                            ip = ins[1]
+                    elif op == OP.IF_NOT_LT:
+                        b = pop()
+                        a = pop()
+                        ca = a.__class__
+                        cb = b.__class__
+                        if (a < b) if (ca is int or ca is float) and (cb is int or cb is float) else _lt(a, b):
+                            ip += 1
+                        else:
+                            ip = ins[1]
+                    elif op == OP.FAST_ADD_CONST:
+                        a = store[ins[1]]
+                        b = ins[2]
+                        if a.__class__ is int and b.__class__ is int and INT_MIN <= (v := a + b) <= INT_MAX:
+                            push(v)
+                        elif a.__class__ is float and b.__class__ is float:
+                            push(a + b)
+                        else:
+                            push(_add(a if a is not UNSET else _load(fvars[ins[1]]), b))
+                        ip += 1
+                    elif op == OP.STORE_ELEM1:
+                        i = pop()
+                        v = pop()
+                        a = store[ins[1]]
+                        t = ins[3]
+                        if i.__class__ is int and 0 < i <= a.dims[0] and v.__class__ is t and (t is not int or INT_MIN <= v <= INT_MAX):
+                            a.data[i - 1] = v
+                        else:
+                            _set_element1(fvars[ins[1]], i, v, ins[2])
+                        ip += 1
+                    elif op == OP.FAST_SUB_CONST:
+                        a = store[ins[1]]
+                        b = ins[2]
+                        if a.__class__ is int and b.__class__ is int and INT_MIN <= (v := a - b) <= INT_MAX:
+                            push(v)
+                        elif a.__class__ is float and b.__class__ is float:
+                            push(a - b)
+                        else:
+                            push(_sub(a if a is not UNSET else _load(fvars[ins[1]]), b))
+                        ip += 1
+                    elif op == OP.STORE_ELEM1_V:
+                        a = store[ins[1]]
+                        i = store[ins[2]]
+                        v = pop()
+                        t = ins[4]
+                        if i.__class__ is int and 0 < i <= a.dims[0] and v.__class__ is t and (t is not int or INT_MIN <= v <= INT_MAX):
+                            a.data[i - 1] = v
+                        else:
+                            _set_element1(fvars[ins[1]], _load(fvars[ins[2]]), v, ins[3])
                         ip += 1
                     elif op == OP.REF_LOCAL:
                         push(refs[ins[1]])
                         ip += 1
-                    elif op == OP.IF_NOT_LE:
-                        b = pop()
-                        if _le(pop(), b):
-                            ip += 1
-                        else:
-                            ip = ins[1]
-                    elif op == OP.JUMP_TICK:
-                        tick(ins[1])
-                        ip = ins[2]
-                    elif op == OP.LOAD_LOCAL2:
-                        push(_load(refs[ins[1]]))
-                        push(_load(refs[ins[2]]))
-                        ip += 1
-                    elif op == OP.TICK:
-                        tick(ins[1])
-                        ip += 1
-                    elif op == OP.FOR_NEXT:
-                        t = ins[1]
-                        if _for_next(temps[t], temps[t + 1], temps[t + 2]):
-                            tick(ins[2])
-                            ip = ins[3]
-                        else:
-                            ip += 1
-                    elif op == OP.ADD:
-                        b = pop()
-                        stack[-1] = _add(stack[-1], b)
-                        ip += 1
-                    elif op == OP.LOCAL_ADD_CONST:
-                        push(_add(_load(refs[ins[1]]), ins[2]))
-                        ip += 1
-                    elif op == OP.STORE_INDEX:
-                        n = ins[1]
-                        if n == 1:
-                            i = pop()
-                            base = pop()
-                            _set_element1(base, i, pop(), ins[2])
-                        else:
-                            idx = stack[-n:]
-                            del stack[-n:]
-                            base = pop()
-                            _set_element(base, idx, pop(), ins[2])
-                        ip += 1
-                    elif op == OP.IF_NOT_LT:
-                        b = pop()
-                        if _lt(pop(), b):
-                            ip += 1
-                        else:
-                            ip = ins[1]
-                    elif op == OP.STORE_ELEM_LL:
-                        _set_element1(refs[ins[1]], _load(refs[ins[2]]), pop(), ins[3])
-                        ip += 1
-                    elif op == OP.LOCAL_SUB_CONST:
-                        push(_sub(_load(refs[ins[1]]), ins[2]))
-                        ip += 1
                     elif op == OP.MUL:
                         b = pop()
-                        stack[-1] = _mul(stack[-1], b)
+                        a = stack[-1]
+                        if a.__class__ is float and b.__class__ is float:
+                            stack[-1] = a * b
+                        elif a.__class__ is int and b.__class__ is int and INT_MIN <= (v := a * b) <= INT_MAX:
+                            stack[-1] = v
+                        else:
+                            stack[-1] = _mul(a, b)
                         ip += 1
                     elif op == OP.LOAD_FIELD:
                         stack[-1] = _component(stack[-1], ins[1], ins[2])
-                        ip += 1
-                    elif op == OP.LOAD_ELEM2_LLL:
-                        push(_element2(refs[ins[1]], _load(refs[ins[2]]), _load(refs[ins[3]]),
-                                      ins[4]))
                         ip += 1
                     elif op == OP.UNOP:
                         stack[-1] = rt.unary_op(ins[1], stack[-1])
@@ -302,36 +544,151 @@ class VM:
                             ip += 1
                         else:
                             ip = ins[1]
-                    elif op == OP.JUMP:
-                        ip = ins[1]
-                    elif op == OP.FOR_TEST:
-                        t = ins[1]
-                        if for_done(temps[t].get(), temps[t + 1], temps[t + 2]):
-                            ip = ins[2]
+                    elif op == OP.LOAD_ELEM2:
+                        j = pop()
+                        i = stack[-1]
+                        a = store[ins[1]]
+                        n, m = a.dims
+                        if i.__class__ is int and j.__class__ is int and 0 < i <= n and 0 < j <= m \
+                                and (v := a.data[(i - 1) * m + j - 1]) is not UNSET:
+                            stack[-1] = v
                         else:
-                            ip += 1
-                    elif op == OP.ADD_CONST:
-                        stack[-1] = _add(stack[-1], ins[1])
+                            stack[-1] = _element2(fvars[ins[1]], i, j, ins[2])
                         ip += 1
-                    elif op == OP.SUB_CONST:
-                        stack[-1] = _sub(stack[-1], ins[1])
+                    elif op == OP.LOAD_ELEM2_VV:
+                        a = store[ins[1]]
+                        i = store[ins[2]]
+                        j = store[ins[3]]
+                        n, m = a.dims
+                        if i.__class__ is int and j.__class__ is int and 0 < i <= n and 0 < j <= m \
+                                and (v := a.data[(i - 1) * m + j - 1]) is not UNSET:
+                            push(v)
+                        else:
+                            push(_element2(fvars[ins[1]], _load(fvars[ins[2]]), _load(fvars[ins[3]]), ins[4]))
                         ip += 1
-                    elif op == OP.SUB:
-                        b = pop()
-                        stack[-1] = _sub(stack[-1], b)
-                        ip += 1
-                    elif op == OP.MUL_CONST:
-                        stack[-1] = _mul(stack[-1], ins[1])
-                        ip += 1
-                    elif op == OP.LOAD_INDEX:
-                        n = ins[1]
-                        idx = stack[-n:]
-                        del stack[-n:]
-                        stack[-1] = _element(stack[-1], idx, ins[2])
+                    elif op == OP.STMT:
+                        info = ins[1]
+                        if not thunk:
+                            frame.line = info.line
+                        n = rt.steps
+                        if n < task.quiet and not info.stops:
+                            rt.steps = n + 1
+                            task.at = info
+                        else:
+                            before(info)
+                            task.quiet = quiet_limit(task)
                         ip += 1
                     elif op == OP.STORE_FIELD:
                         base = pop()
                         _set_component(base, ins[1], pop(), ins[2])
+                        ip += 1
+                    elif op == OP.TICK:
+                        n = rt.steps
+                        if n < task.quiet and not ins[1].cond_stops:
+                            rt.steps = n + 1
+                        else:
+                            tick(ins[1])
+                            task.quiet = quiet_limit(task)
+                        ip += 1
+                    elif op == OP.LOAD_MOD:
+                        push(_load(mrefs[ins[1]]))
+                        ip += 1
+                    elif op == OP.STORE_MOD:
+                        _store(mrefs[ins[1]], pop())
+                        ip += 1
+                    elif op == OP.LOAD_LOCAL:
+                        push(_load(refs[ins[1]]))
+                        ip += 1
+                    elif op == OP.STORE_LOCAL:
+                        _store(refs[ins[1]], pop())
+                        ip += 1
+                    elif op == OP.SUB:
+                        b = pop()
+                        a = stack[-1]
+                        if a.__class__ is float and b.__class__ is float:
+                            stack[-1] = a - b
+                        elif a.__class__ is int and b.__class__ is int and INT_MIN <= (v := a - b) <= INT_MAX:
+                            stack[-1] = v
+                        else:
+                            stack[-1] = _sub(a, b)
+                        ip += 1
+                    elif op == OP.MUL_CONST:
+                        b = ins[1]
+                        a = stack[-1]
+                        if a.__class__ is float and b.__class__ is float:
+                            stack[-1] = a * b
+                        elif a.__class__ is int and b.__class__ is int and INT_MIN <= (v := a * b) <= INT_MAX:
+                            stack[-1] = v
+                        else:
+                            stack[-1] = _mul(a, b)
+                        ip += 1
+                    elif op == OP.ADD_CONST:
+                        b = ins[1]
+                        a = stack[-1]
+                        if a.__class__ is float and b.__class__ is float:
+                            stack[-1] = a + b
+                        elif a.__class__ is int and b.__class__ is int and INT_MIN <= (v := a + b) <= INT_MAX:
+                            stack[-1] = v
+                        else:
+                            stack[-1] = _add(a, b)
+                        ip += 1
+                    elif op == OP.SUB_CONST:
+                        b = ins[1]
+                        a = stack[-1]
+                        if a.__class__ is float and b.__class__ is float:
+                            stack[-1] = a - b
+                        elif a.__class__ is int and b.__class__ is int and INT_MIN <= (v := a - b) <= INT_MAX:
+                            stack[-1] = v
+                        else:
+                            stack[-1] = _sub(a, b)
+                        ip += 1
+                    elif op == OP.IF_NOT_GT:
+                        b = pop()
+                        a = pop()
+                        ca = a.__class__
+                        cb = b.__class__
+                        if (a > b) if (ca is int or ca is float) and (cb is int or cb is float) else _gt(a, b):
+                            ip += 1
+                        else:
+                            ip = ins[1]
+                    elif op == OP.IF_NOT_GE:
+                        b = pop()
+                        a = pop()
+                        ca = a.__class__
+                        cb = b.__class__
+                        if (a >= b) if (ca is int or ca is float) and (cb is int or cb is float) else _ge(a, b):
+                            ip += 1
+                        else:
+                            ip = ins[1]
+                    elif op == OP.IF_NOT_EQ:
+                        b = pop()
+                        a = pop()
+                        ca = a.__class__
+                        cb = b.__class__
+                        if (a == b) if (ca is int or ca is float) and (cb is int or cb is float) else _eq(a, b):
+                            ip += 1
+                        else:
+                            ip = ins[1]
+                    elif op == OP.IF_NOT_NE:
+                        b = pop()
+                        a = pop()
+                        ca = a.__class__
+                        cb = b.__class__
+                        if (a != b) if (ca is int or ca is float) and (cb is int or cb is float) else _ne(a, b):
+                            ip += 1
+                        else:
+                            ip = ins[1]
+                    elif op == OP.STORE_ELEM2:
+                        j = pop()
+                        i = pop()
+                        v = pop()
+                        a = store[ins[1]]
+                        n, m = a.dims
+                        t = ins[3]
+                        if i.__class__ is int and j.__class__ is int and 0 < i <= n and 0 < j <= m and v.__class__ is t and (t is not int or INT_MIN <= v <= INT_MAX):
+                            a.data[(i - 1) * m + j - 1] = v
+                        else:
+                            _set_element(fvars[ins[1]], [i, j], v, ins[2])
                         ip += 1
                     elif op == OP.CALL:
                         argc = ins[2]
@@ -360,42 +717,72 @@ class VM:
                         if code.kind == "DEFFCT":
                             raise ended_without_return(code.routine, frame.line)
                         return None
-                    elif op == OP.LOAD_MOD:
-                        push(_load(mrefs[ins[1]]))
+                    elif op == OP.JUMP:
+                        ip = ins[1]
+                    elif op == OP.LOAD_ELEM1:
+                        a = store[ins[1]]
+                        i = stack[-1]
+                        if i.__class__ is int and 0 < i <= a.dims[0] and (v := a.data[i - 1]) is not UNSET:
+                            stack[-1] = v
+                        else:
+                            stack[-1] = _element1(fvars[ins[1]], i, ins[2])
                         ip += 1
-                    elif op == OP.STORE_MOD:
-                        _store(mrefs[ins[1]], pop())
+                    elif op == OP.LOAD_ELEM_LL:
+                        push(_element1(refs[ins[1]], _load(refs[ins[2]]), ins[3]))
                         ip += 1
-                    elif op == OP.STMT:
-                        info = ins[1]
-                        if not thunk:
-                            frame.line = info.line
-                        before(info)
+                    elif op == OP.LOAD_LOCAL2:
+                        push(_load(refs[ins[1]]))
+                        push(_load(refs[ins[2]]))
                         ip += 1
-                    elif op == OP.IF_NOT_GT:
-                        b = pop()
-                        if _gt(pop(), b):
-                            ip += 1
+                    elif op == OP.FOR_NEXT:
+                        t = ins[1]
+                        if _for_next(temps[t], temps[t + 1], temps[t + 2]):
+                            n = rt.steps
+                            if n < task.quiet and not ins[2].cond_stops:
+                                rt.steps = n + 1
+                            else:
+                                tick(ins[2])
+                                task.quiet = quiet_limit(task)
+                            ip = ins[3]
                         else:
-                            ip = ins[1]
-                    elif op == OP.IF_NOT_GE:
-                        b = pop()
-                        if _ge(pop(), b):
                             ip += 1
+                    elif op == OP.LOCAL_ADD_CONST:
+                        push(_add(_load(refs[ins[1]]), ins[2]))
+                        ip += 1
+                    elif op == OP.STORE_INDEX:
+                        n = ins[1]
+                        if n == 1:
+                            i = pop()
+                            base = pop()
+                            _set_element1(base, i, pop(), ins[2])
                         else:
-                            ip = ins[1]
-                    elif op == OP.IF_NOT_EQ:
-                        b = pop()
-                        if _eq(pop(), b):
+                            idx = stack[-n:]
+                            del stack[-n:]
+                            base = pop()
+                            _set_element(base, idx, pop(), ins[2])
+                        ip += 1
+                    elif op == OP.STORE_ELEM_LL:
+                        _set_element1(refs[ins[1]], _load(refs[ins[2]]), pop(), ins[3])
+                        ip += 1
+                    elif op == OP.LOCAL_SUB_CONST:
+                        push(_sub(_load(refs[ins[1]]), ins[2]))
+                        ip += 1
+                    elif op == OP.LOAD_ELEM2_LLL:
+                        push(_element2(refs[ins[1]], _load(refs[ins[2]]), _load(refs[ins[3]]),
+                                      ins[4]))
+                        ip += 1
+                    elif op == OP.FOR_TEST:
+                        t = ins[1]
+                        if for_done(temps[t].get(), temps[t + 1], temps[t + 2]):
+                            ip = ins[2]
+                        else:
                             ip += 1
-                        else:
-                            ip = ins[1]
-                    elif op == OP.IF_NOT_NE:
-                        b = pop()
-                        if _ne(pop(), b):
-                            ip += 1
-                        else:
-                            ip = ins[1]
+                    elif op == OP.LOAD_INDEX:
+                        n = ins[1]
+                        idx = stack[-n:]
+                        del stack[-n:]
+                        stack[-1] = _element(stack[-1], idx, ins[2])
+                        ip += 1
                     elif op == OP.INDEX:
                         n = ins[1]
                         idx = [None if x is None else _array_index(x) for x in stack[-n:]]
