@@ -9,11 +9,20 @@ figure is that count divided by the Python time.
 
 from __future__ import annotations
 
+import re
 import time
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 PROGRAM = HERE / "bench.src"
+
+
+def rounds(program: Path = PROGRAM) -> int:
+    """The benchmark's ``ROUNDS`` (its data list, bench.dat), for the Python version."""
+    m = re.search(r"DECL\s+INT\s+ROUNDS\s*=\s*(\d+)", program.with_suffix(".dat").read_text(), re.I)
+    if m is None:
+        raise RuntimeError(f"no DECL INT ROUNDS = n in {program.with_suffix('.dat')}")
+    return int(m.group(1))
 
 
 def run_krl(interp: str, program: Path = PROGRAM):
@@ -35,9 +44,10 @@ def run_python(loops: int = 20):
     run, result)."""
     from . import bench as py  # noqa: PLC0415
 
+    n = rounds()
     t0 = time.perf_counter()
     for _ in range(loops):
-        got = py.bench()
+        got = py.bench(n)
     return (time.perf_counter() - t0) / loops, got
 
 
