@@ -79,6 +79,7 @@ class Runtime:
         self.result: RunResult | None = None
         self._stop_cache: dict = {}
         self._plans: dict = {}          # id(routine) -> Runtime._frame_plan
+        self._return_types: dict = {}   # id(routine) -> resolved return type of a function
         self._cyclic: dict = {}
 
     # ================================================================== tasks and run
@@ -554,8 +555,10 @@ class Runtime:
         """``RETURN expr`` of a function: converted to the return type (§2.4)."""
         if routine.return_type is None:
             return value
-        scope = module.types if module is not None else self.program.types
-        t = self.program.resolve_type(routine.return_type, scope)
+        t = self._return_types.get(id(routine))
+        if t is None:
+            scope = module.types if module is not None else self.program.types
+            t = self._return_types[id(routine)] = self.program.resolve_type(routine.return_type, scope)
         if isinstance(t, T.Array) and isinstance(value, str):
             arr = make_value(t)
             assign_into(arr, value)

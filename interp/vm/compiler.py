@@ -248,6 +248,7 @@ class Compiler:
         t = self.temp()
         self.temp()
         self.temp()
+        self.temp()
         self.region = Region("A", st.span.line)
         self.ref(st.var)
         self.expr(st.start)
@@ -265,7 +266,7 @@ class Compiler:
         self.place(body)
         self.loop_body(st.body, end)
         self.region = None
-        if self.fast_scalar(st.var) == "I":
+        if self.fast_scalar(st.var) == "I" and "C" not in info[1]:
             self.emit("FOR_NEXT_FAST", self.spelled(st.var.name), t, info, body)
         else:
             self.emit("FOR_NEXT", t, info, body)

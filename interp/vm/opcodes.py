@@ -16,7 +16,8 @@ n     a name or word (``X``, ``$OV_PRO``, ``+``,  index into the constant pool (
       ``C_DIS,C_PTP``; JSON-quoted if it is not
       a plain word)
 l     a label ``L3``                              the instruction address
-s     a local (frame slot) by name                the slot number (``.locals`` order)
+s     a local (frame slot) by name                the slot number (``.locals`` order);
+                                                  the VM's form is the key of ``Frame.vars``
 v     a *store variable* by name: a local or      the slot number; the VM's form is the
       :IN parameter the frame holds in its own    key of ``Frame.store``
       store (never an alias of the caller's)
@@ -132,7 +133,7 @@ _TABLE = [
     ("LOAD_ELEM1_V",  1,  "vvn", "push store array v1 [store variable v2]"),
     ("STORE_ELEM1_V",-1,  "vvny", "pop a value into store array v1 [store variable v2]"),
     ("LOAD_ELEM2_VV", 1,  "vvvn", "push store array v1 [v2, v3]"),
-    ("FOR_NEXT_FAST", 0,  "vtxl", "FOR_NEXT with an INT store variable v as the counter"),
+    ("FOR_NEXT_FAST", 0,  "vtxl", "FOR_NEXT with an INT store variable v as the counter, a loop condition that does not stop the advance run"),
     ("ADDC_FAST",     0,  "vcvy", "v2 = v1 + c (FAST_ADD_CONST v1 c, STORE_FAST v2 y)"),
     ("SUBC_FAST",     0,  "vcvy", "v2 = v1 - c (FAST_SUB_CONST v1 c, STORE_FAST v2 y)"),
     ("IF_NOT_VV",     0,  "vvol", "jump to l unless v1 o v2 (LOAD_FAST2 v1 v2, IF_NOT_<o> l)"),
@@ -142,7 +143,7 @@ _TABLE = [
     ("JUMP_IF_FALSE",-1,  "l",  "pop a condition (Runtime.to_bool); jump if FALSE"),
     ("JUMP_IF_TRUE", -1,  "l",  "pop a condition; jump if TRUE"),
     ("JUMP_IF_NONE",  0,  "l",  "if the top is None: pop it and jump"),
-    ("FOR_PREP",     -3,  "t",  "pop step, end, start and the counter reference into temps t..t+2, push start"),
+    ("FOR_PREP",     -3,  "t",  "pop step, end, start and the counter reference into temps t..t+2, push start; t+3: the last counter value FOR_NEXT_FAST may reach without a test (min(end, INT max) for an INT step > 0, else -inf)"),
     ("FOR_INIT",     -1,  "t",  "pop start: assign it to the counter"),
     ("FOR_TEST",      0,  "tl", "jump when the counter is past the end"),
     ("FOR_NEXT",      0,  "txl", "counter = counter + step; unless it is past the end: TICK x and jump to l"),

@@ -25,6 +25,7 @@ import copy
 import heapq
 import inspect
 import itertools
+import math
 import operator
 import textwrap
 
@@ -215,7 +216,7 @@ def decode(code: Code) -> tuple[list, list]:
                 w = code.infos[w]
             elif k == "l":
                 w = index[w]
-            elif k == "v":
+            elif k == "s" or k == "v":
                 w = code.lkeys[w]
             elif k == "y":
                 w = _VALUE_CLASS.get(code.consts[w])
@@ -234,14 +235,12 @@ def decode(code: Code) -> tuple[list, list]:
 
 
 class Act:
-    """One activation: the runtime frame, its slots (references, in ``.locals`` order) and
-    the temporaries."""
+    """One activation: the runtime frame and the temporaries."""
 
-    __slots__ = ("frame", "refs", "temps")
+    __slots__ = ("frame", "temps")
 
-    def __init__(self, frame, refs: list, temps: list) -> None:
+    def __init__(self, frame, temps: list) -> None:
         self.frame = frame
-        self.refs = refs
         self.temps = temps
 
 
@@ -281,7 +280,7 @@ class VM:
         task.frame = frame
         returned = False
         try:
-            act = Act(frame, list(map(frame.vars.__getitem__, code.lkeys)), [None] * code.ntemps)
+            act = Act(frame, [None] * code.ntemps)
             value = self.run(code, act, 0, [])
             if code.kind == "DEFFCT":
                 value = rt.return_value(routine, value, module)
@@ -321,7 +320,6 @@ class VM:
         prog = code.prog
         mrefs = code.mrefs
         grefs = code.grefs
-        refs = act.refs
         temps = act.temps
         frame = act.frame
         store = frame.store          # store variables (operand kind v): Frame.store keys
@@ -405,15 +403,14 @@ class VM:
                     elif op == OP.FOR_NEXT_FAST:
                         t = ins[2]
                         c = store[ins[1]]
-                        step = temps[t + 2]
-                        if c.__class__ is int and step.__class__ is int and INT_MIN <= (c := c + step) <= INT_MAX:
+                        if c.__class__ is int and (c := c + temps[t + 2]) <= temps[t + 3]:
                             store[ins[1]] = c
-                            go = c <= temps[t + 1] if step > 0 else c >= temps[t + 1]
+                            go = True
                         else:
-                            go = _for_next(temps[t], temps[t + 1], step)
+                            go = _for_next(temps[t], temps[t + 1], temps[t + 2])
                         if go:
                             n = rt.steps
-                            if n < task.quiet and not ins[3].cond_stops:
+                            if n < task.quiet:
                                 rt.steps = n + 1
                             else:
                                 tick(ins[3])
@@ -521,7 +518,7 @@ class VM:
                             _set_element1(fvars[ins[1]], _load(fvars[ins[2]]), v, ins[3])
                         ip += 1
                     elif op == OP.REF_LOCAL:
-                        push(refs[ins[1]])
+                        push(fvars[ins[1]])
                         ip += 1
                     elif op == OP.MUL:
                         b = pop()
@@ -597,10 +594,10 @@ class VM:
                         _store(mrefs[ins[1]], pop())
                         ip += 1
                     elif op == OP.LOAD_LOCAL:
-                        push(_load(refs[ins[1]]))
+                        push(_load(fvars[ins[1]]))
                         ip += 1
                     elif op == OP.STORE_LOCAL:
-                        _store(refs[ins[1]], pop())
+                        _store(fvars[ins[1]], pop())
                         ip += 1
                     elif op == OP.SUB:
                         b = pop()
@@ -728,11 +725,11 @@ class VM:
                             stack[-1] = _element1(fvars[ins[1]], i, ins[2])
                         ip += 1
                     elif op == OP.LOAD_ELEM_LL:
-                        push(_element1(refs[ins[1]], _load(refs[ins[2]]), ins[3]))
+                        push(_element1(fvars[ins[1]], _load(fvars[ins[2]]), ins[3]))
                         ip += 1
                     elif op == OP.LOAD_LOCAL2:
-                        push(_load(refs[ins[1]]))
-                        push(_load(refs[ins[2]]))
+                        push(_load(fvars[ins[1]]))
+                        push(_load(fvars[ins[2]]))
                         ip += 1
                     elif op == OP.FOR_NEXT:
                         t = ins[1]
@@ -747,7 +744,7 @@ class VM:
                         else:
                             ip += 1
                     elif op == OP.LOCAL_ADD_CONST:
-                        push(_add(_load(refs[ins[1]]), ins[2]))
+                        push(_add(_load(fvars[ins[1]]), ins[2]))
                         ip += 1
                     elif op == OP.STORE_INDEX:
                         n = ins[1]
@@ -762,13 +759,13 @@ class VM:
                             _set_element(base, idx, pop(), ins[2])
                         ip += 1
                     elif op == OP.STORE_ELEM_LL:
-                        _set_element1(refs[ins[1]], _load(refs[ins[2]]), pop(), ins[3])
+                        _set_element1(fvars[ins[1]], _load(fvars[ins[2]]), pop(), ins[3])
                         ip += 1
                     elif op == OP.LOCAL_SUB_CONST:
-                        push(_sub(_load(refs[ins[1]]), ins[2]))
+                        push(_sub(_load(fvars[ins[1]]), ins[2]))
                         ip += 1
                     elif op == OP.LOAD_ELEM2_LLL:
-                        push(_element2(refs[ins[1]], _load(refs[ins[2]]), _load(refs[ins[3]]),
+                        push(_element2(fvars[ins[1]], _load(fvars[ins[2]]), _load(fvars[ins[3]]),
                                       ins[4]))
                         ip += 1
                     elif op == OP.FOR_TEST:
@@ -868,7 +865,8 @@ class VM:
                         end = pop()
                         start = pop()
                         temps[t] = pop()
-                        temps[t + 1], temps[t + 2] = _for_limits(end, step)
+                        temps[t + 1], temps[t + 2] = end, step = _for_limits(end, step)
+                        temps[t + 3] = min(end, INT_MAX) if step.__class__ is int and step > 0 else -math.inf
                         push(start)
                         ip += 1
                     elif op == OP.FOR_INIT:
