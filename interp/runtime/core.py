@@ -47,6 +47,12 @@ class RunResult:
         return EXIT_CODES.get(self.reason, 2)
 
 
+def _scalar(t) -> bool:
+    """A type of single values: INT, REAL, BOOL, CHAR or an ENUM (not an array, a STRUC or
+    an unresolved type)."""
+    return isinstance(t, (T.Simple, T.Enum)) and t is not T.UNKNOWN
+
+
 class Runtime:
     """Shared runtime of one run.
 
@@ -437,9 +443,9 @@ class Runtime:
         frame.extra = scope
         store = frame.store
         fvars = frame.vars
-        for name, key, t, d in decls:
+        for name, key, t, d, scalar in decls:
             if t is not None:
-                store[key] = make_value(t)
+                store[key] = UNSET if scalar else make_value(t)
                 ref = fvars[key] = Slot(store, key, t, name)
                 if d is not None:      # DECL CONST INT OFFS = 10 (KSS 8)
                     v = self.program.literal(d.init, t, module)
@@ -455,7 +461,7 @@ class Runtime:
                     frame.bind(d.name, ref)
             else:
                 frame.bind(d.name, self.program.import_ref(d))
-        for i, (name, key, mode, t) in enumerate(params):
+        for i, (name, key, mode, t, scalar) in enumerate(params):
             a = args[i] if i < len(args) else None
             if a is None:
                 if isinstance(t, T.Array) and t.elem == T.CHAR and t.dims == (0,):
@@ -469,6 +475,11 @@ class Runtime:
                     frame.declare(name, t)
                 continue
             if mode == "IN" or a.__class__ is ValueRef:
+                if scalar:      # (the scalar case of _param_copy and _slot_type)
+                    v = a.peek()
+                    store[key] = v if v is UNSET else convert_scalar(v, t)
+                    fvars[key] = Slot(store, key, t, name)
+                    continue
                 v = store[key] = self._param_copy(a.peek(), t, name)
                 fvars[key] = Slot(store, key, self._slot_type(t, v), name)
             else:
@@ -480,9 +491,11 @@ class Runtime:
 
     def _frame_plan(self, module, routine: N.Routine) -> tuple:
         """The declarations of ``routine`` resolved for :meth:`enter_routine`: (module,
-        type scope, [(name, KEY, type, VarDecl with an initial value or None) for each
-        local variable, or (name, KEY, None, SignalDecl/ImportDecl)], [(name, KEY, mode,
-        type or None) for each parameter]). Raises KrlRuntimeError for an unknown type."""
+        type scope, [(name, KEY, type, VarDecl with an initial value or None, scalar?) for
+        each local variable, or (name, KEY, None, SignalDecl/ImportDecl, False)], [(name,
+        KEY, mode, type or None, scalar?) for each parameter]); *scalar*: a type whose fresh
+        value is UNSET and whose values are converted by convert_scalar (INT, REAL, BOOL,
+        CHAR, ENUM). Raises KrlRuntimeError for an unknown type."""
         pnames = {p.name.upper() for p in routine.params}
         scope = module.types if module is not None else self.program.types
         local_types = None
@@ -509,10 +522,11 @@ class Runtime:
                     if key in pnames:
                         ptypes[key] = t
                     else:
-                        decls.append((vn.name, key, t, d if d.init is not None else None))
+                        decls.append((vn.name, key, t, d if d.init is not None else None, _scalar(t)))
             elif isinstance(d, (N.SignalDecl, N.ImportDecl)):
-                decls.append((d.name, d.name.upper(), None, d))
-        params = [(p.name, p.name.upper(), p.mode, ptypes.get(p.name.upper())) for p in routine.params]
+                decls.append((d.name, d.name.upper(), None, d, False))
+        params = [(p.name, p.name.upper(), p.mode, ptypes.get(p.name.upper()), _scalar(ptypes.get(p.name.upper())))
+                  for p in routine.params]
         return module, scope, decls, params
 
     @staticmethod

@@ -113,6 +113,7 @@ class Compiler:
         self.blocks: list[dict] = []      # label tables of the enclosing statement lists
         self.loops: list[str] = []        # exit labels of the enclosing loops
         self.thunks: list = []            # (label, emitter) compiled after END
+        self.in_thunk = False
 
     # ------------------------------------------------------------------ emitting
     def emit(self, name: str, *ops) -> None:
@@ -137,6 +138,7 @@ class Compiler:
 
     def guarded(self, st) -> str:
         """STMT_G and a guarded region up to the returned end label."""
+        assert not self.in_thunk, "STMT_G in a thunk (the VM sets frame.line for it)"
         self.region = None
         self.emit("STMT_G", self.info(st))
         end = self.new_label()
@@ -152,6 +154,7 @@ class Compiler:
         self.block(self.routine.body)
         self.region = None
         self.emit("END")
+        self.in_thunk = True
         while self.thunks:
             label, fn = self.thunks.pop(0)
             self.place(label)

@@ -248,6 +248,8 @@ class VM:
     def __init__(self, rt) -> None:
         self.rt = rt
         self.codes: dict = {}          # id(routine) -> Code
+        # the runtime's statement hooks, bound once (the loop takes them at each call)
+        self.hooks = (rt.before_statement, rt.loop_tick, rt.take_error_proceed, rt.quiet_limit)
 
     # ------------------------------------------------------------------ entry points
     def run_program(self, module_name: str | None = None) -> None:
@@ -326,10 +328,7 @@ class VM:
         fvars = frame.vars
         push = stack.append
         pop = stack.pop
-        before = rt.before_statement
-        tick = rt.loop_tick
-        take_error_proceed = rt.take_error_proceed
-        quiet_limit = rt.quiet_limit
+        before, tick, take_error_proceed, quiet_limit = self.hooks
         task = rt.current_task
         proceed = False
         while True:
@@ -340,8 +339,7 @@ class VM:
                     # the hottest opcodes first (measured on the benchmark)
                     if op == OP.STMT_G:
                         info = ins[1]
-                        if not thunk:
-                            frame.line = info.line
+                        frame.line = info.line
                         n = rt.steps
                         if n < task.quiet and not info.stops:     # a quiet step (Runtime.quiet_limit)
                             rt.steps = n + 1
@@ -352,10 +350,6 @@ class VM:
                             proceed = take_error_proceed()
                             task.quiet = quiet_limit(task)
                         ip += 1
-                    elif op == OP.LOAD_FAST:
-                        v = store[ins[1]]
-                        push(v if v is not UNSET else _load(fvars[ins[1]]))
-                        ip += 1
                     elif op == OP.LOAD_ELEM1_V:
                         a = store[ins[1]]
                         i = store[ins[2]]
@@ -364,34 +358,10 @@ class VM:
                         else:
                             push(_element1(fvars[ins[1]], _load(fvars[ins[2]]), ins[3]))
                         ip += 1
-                    elif op == OP.CONST:
-                        push(ins[1])
-                        ip += 1
-                    elif op == OP.STORE_FAST:
-                        v = pop()
-                        t = ins[2]
-                        if v.__class__ is t and (t is not int or INT_MIN <= v <= INT_MAX):
-                            store[ins[1]] = v
-                        else:
-                            _store(fvars[ins[1]], v)
-                        ip += 1
-                    elif op == OP.LOAD_FAST2:
+                    elif op == OP.LOAD_FAST:
                         v = store[ins[1]]
                         push(v if v is not UNSET else _load(fvars[ins[1]]))
-                        v = store[ins[2]]
-                        push(v if v is not UNSET else _load(fvars[ins[2]]))
                         ip += 1
-                    elif op == OP.IF_NOT_VV:
-                        a = store[ins[1]]
-                        b = store[ins[2]]
-                        ca = a.__class__
-                        cb = b.__class__
-                        f = ins[3]
-                        if (f[0](a, b) if (ca is int or ca is float) and (cb is int or cb is float)
-                                else f[1](a if a is not UNSET else _load(fvars[ins[1]]), b if b is not UNSET else _load(fvars[ins[2]]))):
-                            ip += 1
-                        else:
-                            ip = ins[4]
                     elif op == OP.JUMP_TICK:
                         n = rt.steps
                         if n < task.quiet and not ins[1].cond_stops:
@@ -400,6 +370,9 @@ class VM:
                             tick(ins[1])
                             task.quiet = quiet_limit(task)
                         ip = ins[2]
+                    elif op == OP.CONST:
+                        push(ins[1])
+                        ip += 1
                     elif op == OP.FOR_NEXT_FAST:
                         t = ins[2]
                         c = store[ins[1]]
@@ -418,36 +391,11 @@ class VM:
                             ip = ins[4]
                         else:
                             ip += 1
-                    elif op == OP.IF_NOT_VC:
-                        a = store[ins[1]]
-                        b = ins[2]
-                        ca = a.__class__
-                        cb = b.__class__
-                        f = ins[3]
-                        if (f[0](a, b) if (ca is int or ca is float) and (cb is int or cb is float)
-                                else f[1](a if a is not UNSET else _load(fvars[ins[1]]), b)):
-                            ip += 1
-                        else:
-                            ip = ins[4]
-                    elif op == OP.ADDC_FAST:
-                        a = store[ins[1]]
-                        b = ins[2]
-                        t = ins[4]
-                        ca = a.__class__
-                        if ca is b.__class__ and ca is t and (ca is float or (ca is int and INT_MIN <= (v := a + b) <= INT_MAX)):
-                            store[ins[3]] = a + b if ca is float else v
-                        else:
-                            _store(fvars[ins[3]], _add(a if a is not UNSET else _load(fvars[ins[1]]), b))
-                        ip += 1
-                    elif op == OP.SUBC_FAST:
-                        a = store[ins[1]]
-                        b = ins[2]
-                        t = ins[4]
-                        ca = a.__class__
-                        if ca is b.__class__ and ca is t and (ca is float or (ca is int and INT_MIN <= (v := a - b) <= INT_MAX)):
-                            store[ins[3]] = a - b if ca is float else v
-                        else:
-                            _store(fvars[ins[3]], _sub(a if a is not UNSET else _load(fvars[ins[1]]), b))
+                    elif op == OP.LOAD_FAST2:
+                        v = store[ins[1]]
+                        push(v if v is not UNSET else _load(fvars[ins[1]]))
+                        v = store[ins[2]]
+                        push(v if v is not UNSET else _load(fvars[ins[2]]))
                         ip += 1
                     elif op == OP.ADD:
                         b = pop()
@@ -459,33 +407,13 @@ class VM:
                         else:
                             stack[-1] = _add(a, b)
                         ip += 1
-                    elif op == OP.IF_NOT_LE:
-                        b = pop()
-                        a = pop()
-                        ca = a.__class__
-                        cb = b.__class__
-                        if (a <= b) if (ca is int or ca is float) and (cb is int or cb is float) else _le(a, b):
-                            ip += 1
+                    elif op == OP.STORE_FAST:
+                        v = pop()
+                        t = ins[2]
+                        if v.__class__ is t and (t is not int or INT_MIN <= v <= INT_MAX):
+                            store[ins[1]] = v
                         else:
-                            ip = ins[1]
-                    elif op == OP.IF_NOT_LT:
-                        b = pop()
-                        a = pop()
-                        ca = a.__class__
-                        cb = b.__class__
-                        if (a < b) if (ca is int or ca is float) and (cb is int or cb is float) else _lt(a, b):
-                            ip += 1
-                        else:
-                            ip = ins[1]
-                    elif op == OP.FAST_ADD_CONST:
-                        a = store[ins[1]]
-                        b = ins[2]
-                        if a.__class__ is int and b.__class__ is int and INT_MIN <= (v := a + b) <= INT_MAX:
-                            push(v)
-                        elif a.__class__ is float and b.__class__ is float:
-                            push(a + b)
-                        else:
-                            push(_add(a if a is not UNSET else _load(fvars[ins[1]]), b))
+                            _store(fvars[ins[1]], v)
                         ip += 1
                     elif op == OP.STORE_ELEM1:
                         i = pop()
@@ -497,16 +425,36 @@ class VM:
                         else:
                             _set_element1(fvars[ins[1]], i, v, ins[2])
                         ip += 1
-                    elif op == OP.FAST_SUB_CONST:
+                    elif op == OP.SUBC_FAST:
                         a = store[ins[1]]
                         b = ins[2]
-                        if a.__class__ is int and b.__class__ is int and INT_MIN <= (v := a - b) <= INT_MAX:
-                            push(v)
-                        elif a.__class__ is float and b.__class__ is float:
-                            push(a - b)
+                        t = ins[4]
+                        ca = a.__class__
+                        if ca is b.__class__ and ca is t and (ca is float or (ca is int and INT_MIN <= (v := a - b) <= INT_MAX)):
+                            store[ins[3]] = a - b if ca is float else v
                         else:
-                            push(_sub(a if a is not UNSET else _load(fvars[ins[1]]), b))
+                            _store(fvars[ins[3]], _sub(a if a is not UNSET else _load(fvars[ins[1]]), b))
                         ip += 1
+                    elif op == OP.IF_NOT_VC:
+                        a = store[ins[1]]
+                        b = ins[2]
+                        ca = a.__class__
+                        cb = b.__class__
+                        f = ins[3]
+                        if (f[0](a, b) if (ca is int or ca is float) and (cb is int or cb is float)
+                                else f[1](a if a is not UNSET else _load(fvars[ins[1]]), b)):
+                            ip += 1
+                        else:
+                            ip = ins[4]
+                    elif op == OP.IF_NOT_LE:
+                        b = pop()
+                        a = pop()
+                        ca = a.__class__
+                        cb = b.__class__
+                        if (a <= b) if (ca is int or ca is float) and (cb is int or cb is float) else _le(a, b):
+                            ip += 1
+                        else:
+                            ip = ins[1]
                     elif op == OP.STORE_ELEM1_V:
                         a = store[ins[1]]
                         i = store[ins[2]]
@@ -517,9 +465,30 @@ class VM:
                         else:
                             _set_element1(fvars[ins[1]], _load(fvars[ins[2]]), v, ins[3])
                         ip += 1
+                    elif op == OP.FAST_ADD_CONST:
+                        a = store[ins[1]]
+                        b = ins[2]
+                        if a.__class__ is int and b.__class__ is int and INT_MIN <= (v := a + b) <= INT_MAX:
+                            push(v)
+                        elif a.__class__ is float and b.__class__ is float:
+                            push(a + b)
+                        else:
+                            push(_add(a if a is not UNSET else _load(fvars[ins[1]]), b))
+                        ip += 1
                     elif op == OP.REF_LOCAL:
                         push(fvars[ins[1]])
                         ip += 1
+                    elif op == OP.IF_NOT_VV:
+                        a = store[ins[1]]
+                        b = store[ins[2]]
+                        ca = a.__class__
+                        cb = b.__class__
+                        f = ins[3]
+                        if (f[0](a, b) if (ca is int or ca is float) and (cb is int or cb is float)
+                                else f[1](a if a is not UNSET else _load(fvars[ins[1]]), b if b is not UNSET else _load(fvars[ins[2]]))):
+                            ip += 1
+                        else:
+                            ip = ins[4]
                     elif op == OP.MUL:
                         b = pop()
                         a = stack[-1]
@@ -587,17 +556,15 @@ class VM:
                             tick(ins[1])
                             task.quiet = quiet_limit(task)
                         ip += 1
-                    elif op == OP.LOAD_MOD:
-                        push(_load(mrefs[ins[1]]))
-                        ip += 1
-                    elif op == OP.STORE_MOD:
-                        _store(mrefs[ins[1]], pop())
-                        ip += 1
-                    elif op == OP.LOAD_LOCAL:
-                        push(_load(fvars[ins[1]]))
-                        ip += 1
-                    elif op == OP.STORE_LOCAL:
-                        _store(fvars[ins[1]], pop())
+                    elif op == OP.MUL_CONST:
+                        b = ins[1]
+                        a = stack[-1]
+                        if a.__class__ is float and b.__class__ is float:
+                            stack[-1] = a * b
+                        elif a.__class__ is int and b.__class__ is int and INT_MIN <= (v := a * b) <= INT_MAX:
+                            stack[-1] = v
+                        else:
+                            stack[-1] = _mul(a, b)
                         ip += 1
                     elif op == OP.SUB:
                         b = pop()
@@ -609,16 +576,6 @@ class VM:
                         else:
                             stack[-1] = _sub(a, b)
                         ip += 1
-                    elif op == OP.MUL_CONST:
-                        b = ins[1]
-                        a = stack[-1]
-                        if a.__class__ is float and b.__class__ is float:
-                            stack[-1] = a * b
-                        elif a.__class__ is int and b.__class__ is int and INT_MIN <= (v := a * b) <= INT_MAX:
-                            stack[-1] = v
-                        else:
-                            stack[-1] = _mul(a, b)
-                        ip += 1
                     elif op == OP.ADD_CONST:
                         b = ins[1]
                         a = stack[-1]
@@ -628,6 +585,87 @@ class VM:
                             stack[-1] = v
                         else:
                             stack[-1] = _add(a, b)
+                        ip += 1
+                    elif op == OP.CALL:
+                        argc = ins[2]
+                        if argc:
+                            args = stack[-argc:]
+                            del stack[-argc:]
+                        else:
+                            args = []
+                        flags = ins[3]
+                        target = code.callsites.get(ip)
+                        if target is not None:
+                            v = self.invoke(target, args, frame, "N" not in flags)
+                        else:
+                            v = self.call(code, ip, ins[1], args, frame, flags)
+                        if flags == "E":
+                            push(v if v is not None else function_result(ins[1], v))
+                        ip += 1
+                    elif op == OP.STORE_ELEM2:
+                        j = pop()
+                        i = pop()
+                        v = pop()
+                        a = store[ins[1]]
+                        n, m = a.dims
+                        t = ins[3]
+                        if i.__class__ is int and j.__class__ is int and 0 < i <= n and 0 < j <= m and v.__class__ is t and (t is not int or INT_MIN <= v <= INT_MAX):
+                            a.data[(i - 1) * m + j - 1] = v
+                        else:
+                            _set_element(fvars[ins[1]], [i, j], v, ins[2])
+                        ip += 1
+                    elif op == OP.ADDC_FAST:
+                        a = store[ins[1]]
+                        b = ins[2]
+                        t = ins[4]
+                        ca = a.__class__
+                        if ca is b.__class__ and ca is t and (ca is float or (ca is int and INT_MIN <= (v := a + b) <= INT_MAX)):
+                            store[ins[3]] = a + b if ca is float else v
+                        else:
+                            _store(fvars[ins[3]], _add(a if a is not UNSET else _load(fvars[ins[1]]), b))
+                        ip += 1
+                    elif op == OP.LOAD_MOD:
+                        push(_load(mrefs[ins[1]]))
+                        ip += 1
+                    elif op == OP.STORE_MOD:
+                        _store(mrefs[ins[1]], pop())
+                        ip += 1
+                    elif op == OP.VALARG:
+                        stack[-1] = ValueRef(stack[-1])
+                        ip += 1
+                    elif op == OP.RETURN_VAL:
+                        v = pop()
+                        return v if code.kind == "DEFFCT" else None
+                    elif op == OP.END:
+                        if code.kind == "DEFFCT":
+                            raise ended_without_return(code.routine, frame.line)
+                        return None
+                    elif op == OP.IF_NOT_LT:
+                        b = pop()
+                        a = pop()
+                        ca = a.__class__
+                        cb = b.__class__
+                        if (a < b) if (ca is int or ca is float) and (cb is int or cb is float) else _lt(a, b):
+                            ip += 1
+                        else:
+                            ip = ins[1]
+                    elif op == OP.JUMP:
+                        ip = ins[1]
+                    elif op == OP.LOAD_LOCAL:
+                        push(_load(fvars[ins[1]]))
+                        ip += 1
+                    elif op == OP.STORE_LOCAL:
+                        _store(fvars[ins[1]], pop())
+                        ip += 1
+                    elif op == OP.FAST_SUB_CONST:
+                        a = store[ins[1]]
+                        b = ins[2]
+                        if a.__class__ is int and b.__class__ is int and INT_MIN <= (v := a - b) <= INT_MAX:
+                            push(v)
+                        elif a.__class__ is float and b.__class__ is float:
+                            push(a - b)
+                        else:
+                            push(_sub(a if a is not UNSET else _load(fvars[ins[1]]), b))
                         ip += 1
                     elif op == OP.SUB_CONST:
                         b = ins[1]
@@ -675,47 +713,10 @@ class VM:
                             ip += 1
                         else:
                             ip = ins[1]
-                    elif op == OP.STORE_ELEM2:
-                        j = pop()
-                        i = pop()
-                        v = pop()
-                        a = store[ins[1]]
-                        n, m = a.dims
-                        t = ins[3]
-                        if i.__class__ is int and j.__class__ is int and 0 < i <= n and 0 < j <= m and v.__class__ is t and (t is not int or INT_MIN <= v <= INT_MAX):
-                            a.data[(i - 1) * m + j - 1] = v
-                        else:
-                            _set_element(fvars[ins[1]], [i, j], v, ins[2])
-                        ip += 1
-                    elif op == OP.CALL:
-                        argc = ins[2]
-                        if argc:
-                            args = stack[-argc:]
-                            del stack[-argc:]
-                        else:
-                            args = []
-                        name = ins[1]
-                        flags = ins[3]
-                        v = self.call(code, ip, name, args, frame, flags)
-                        if flags == "E":
-                            push(function_result(name, v))
-                        ip += 1
-                    elif op == OP.VALARG:
-                        stack[-1] = ValueRef(stack[-1])
-                        ip += 1
-                    elif op == OP.RETURN_VAL:
-                        v = pop()
-                        return v if code.kind == "DEFFCT" else None
                     elif op == OP.RETURN:
                         if code.kind == "DEFFCT":
                             raise return_without_value(code.routine, frame.line)
                         return None
-                    elif op == OP.END:
-                        if code.kind == "DEFFCT":
-                            raise ended_without_return(code.routine, frame.line)
-                        return None
-                    elif op == OP.JUMP:
-                        ip = ins[1]
                     elif op == OP.LOAD_ELEM1:
                         a = store[ins[1]]
                         i = stack[-1]
