@@ -1,11 +1,13 @@
 """Slot-based access and operator entry points for interpreters that resolve names and
 operators at compile time (the bytecode VM, interp/vm).
 
-Nothing here has a meaning of its own. Each function is either a statement of a rule the
-tree interpreter applies inline (so that both interpreters can share it), or a *fast
-path*: it handles the common case of a general runtime function directly and hands every
-other case to that function, so the result, and every error message, is the general
-function's. tests/vm/test_slots.py checks the fast paths against the general functions.
+Nothing here has a meaning of its own. Each function is either a rule both interpreters
+apply (array index, FOR limits and test, TRIGGER arguments, ANOUT limits: written once,
+here), or a *fast path*: it handles the common case of a general runtime function directly
+and hands every other case to that function, so the result, and every error message, is
+the general function's. tests/vm/test_slots.py checks the fast paths against the general
+functions. The VM's loop (interp/vm/vm.py) inlines the common case of some of them and
+calls them for every other case.
 """
 
 from __future__ import annotations

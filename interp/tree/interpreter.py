@@ -17,6 +17,8 @@ from krl.ast import nodes as N
 
 from interp.runtime.builtins import ValueRef
 from interp.runtime.convert import num
+from interp.runtime.slots import (anout_limits, anout_value, array_index, for_done, for_limits, for_next,
+                                 trigger_args)
 from interp.runtime.errors import (lvalue_name, ExitSignal, GotoSignal, KrlRuntimeError, ResumeSignal,
                                    ReturnSignal)
 from interp.runtime.values import EnumValue, Struct, copy_value
@@ -155,21 +157,19 @@ class TreeInterpreter:
         try:
             ref = self.ref(st.var, frame)
             start = self.eval(st.start, frame)
-            end = num(self.eval(st.end, frame))
-            step = num(self.eval(st.step, frame)) if st.step is not None else 1
+            end, step = for_limits(self.eval(st.end, frame),
+                                   self.eval(st.step, frame) if st.step is not None else 1)
         except KrlRuntimeError as e:
             raise e.at(st.span.file, st.span.line)
-        if step == 0:
-            raise KrlRuntimeError("FOR with STEP 0", None, st.span.file, st.span.line)
         rt.assign(ref, start)
+        if for_done(ref.get(), end, step):
+            return
         try:
             while True:
-                c = ref.get()
-                if (step > 0 and c > end) or (step < 0 and c < end):
-                    break
                 rt.loop_tick(info)
                 self.exec_block(st.body, frame)
-                rt.assign(ref, rt.binary_op("+", ref.get(), step))
+                if not for_next(ref, end, step):
+                    break
         except ExitSignal:
             pass
 
@@ -261,12 +261,11 @@ class TreeInterpreter:
 
         def do():
             ref = rt.lookup(st.name, frame)
-            lo = float(num(self.eval(st.minimum, frame))) if st.minimum is not None else -1.0
-            hi = float(num(self.eval(st.maximum, frame))) if st.maximum is not None else 1.0
+            lo, hi = anout_limits(self.eval(st.minimum, frame) if st.minimum is not None else None,
+                                  self.eval(st.maximum, frame) if st.maximum is not None else None)
 
             def tick():
-                v = float(num(self.eval(st.value, frame)))
-                ref.set(min(hi, max(lo, v)))
+                ref.set(anout_value(self.eval(st.value, frame), lo, hi))
             tick()
             rt.cyclic_on(("ANOUT", st.name.upper()), tick)
         self.guarded(do, st, frame)
@@ -364,14 +363,10 @@ class TreeInterpreter:
                 def action():
                     self.exec_trigger_stmt(act, frame, lambda: rt.assign(
                         self.ref(act.target, frame), self.eval(act.value, frame)))
-            at = num(self.eval(st.at, frame))
-            delay = num(self.eval(st.delay, frame))
-            prio = int(num(self.eval(st.prio, frame))) if st.prio is not None else None
-            if st.kind == "PATH":
-                rt.trigger(action, path=float(at), onstart=st.onstart, delay_ms=delay, prio=prio,
-                           line=st.span.line)
-            else:
-                rt.trigger(action, distance=int(at), delay_ms=delay, prio=prio, line=st.span.line)
+            at = self.eval(st.at, frame)
+            delay = self.eval(st.delay, frame)
+            prio = self.eval(st.prio, frame) if st.prio is not None else None
+            rt.trigger(action, line=st.span.line, **trigger_args(st.kind, at, delay, prio, st.onstart))
         self.guarded(do, st, frame)
 
     def exec_trigger_stmt(self, act, frame, fn) -> None:
@@ -535,10 +530,7 @@ class TreeInterpreter:
                 if i is None:
                     idx.append(None)
                 else:
-                    v = num(self.eval(i, frame), "array index")
-                    if v.__class__ is not int:
-                        raise KrlRuntimeError("array index is not an INT")
-                    idx.append(v)
+                    idx.append(array_index(self.eval(i, frame)))
             return rt.index(base, idx, _name_of(e.base))
         if isinstance(e, N.Field):
             base = self.ref(e.base, frame)
