@@ -202,7 +202,7 @@ def format_listing(lst: Listing) -> str:
                 parts.append(lab[v])
             elif k == "c":
                 parts.append(fmt_const(v))
-            elif k in "nsmgvyo":
+            elif k in "nsmgvyok":
                 parts.append(fmt_name(v))
             elif k == "f":
                 parts.append(fmt_flags(v))
@@ -265,7 +265,7 @@ def parse_listings(text: str) -> list[Listing]:
                 for k, t in zip(info.operands, args):
                     if k == "c":
                         ops.append(parse_const(t))
-                    elif k in "nsmgvyo":
+                    elif k in "nsmgvyok":
                         ops.append(parse_name(t))
                     elif k == "f":
                         ops.append("" if t == "-" else t)
@@ -324,7 +324,7 @@ def encode(lst: Listing) -> Code:
         words.append(info.number)
         regions.append(r)
         for k, v in zip(info.operands, ops):
-            if k == "c" or k == "n" or k == "f" or k == "y" or k == "o":
+            if k in "cnfyok":
                 w = const(v)
             elif k == "l":
                 w = label(v)
@@ -373,7 +373,7 @@ def to_listing(code: Code) -> Listing:
         ops = []
         for j, k in enumerate(info.operands):
             w = words[a + 1 + j]
-            if k in "cnfyo":
+            if k in "cnfyok":
                 ops.append(code.consts[w])
             elif k == "l":
                 name = f"@{w}"

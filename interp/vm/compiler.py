@@ -753,6 +753,8 @@ def _fuse(group: list):
         return ("IF_NOT_VV", [ops[0][0], ops[0][1], _CMP_SYMBOLS[names[1]], ops[1][0]])
     if len(group) == 3 and names[:2] == ["LOAD_FAST", "CONST"] and names[2] in _CMP_SYMBOLS:
         return ("IF_NOT_VC", [ops[0][0], ops[1][0], _CMP_SYMBOLS[names[2]], ops[2][0]])
+    if len(group) == 2 and names[0] == "REF_LOCAL" and names[1] in ("LOAD_FIELD", "STORE_FIELD"):
+        return (names[1] + "_L", [ops[0][0], ops[1][0], ops[1][1]])
     if len(group) == 2 and names[0] == "LOAD_FAST":
         if names[1] == "LOAD_ELEM1":
             return ("LOAD_ELEM1_V", [ops[1][0], ops[0][0], ops[1][1]])

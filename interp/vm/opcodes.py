@@ -32,6 +32,8 @@ y     a value type: I, R, B or C (INT, REAL,      index into the constant pool (
 o     a comparison: ``<``, ``<=``, ``>``, ``>=``,   index into the constant pool (a str);
       ``==``, ``<>``                              the VM's form is (the comparison on two
                                                   numbers, its runtime function)
+k     a structure component by name              index into the constant pool (a str);
+                                                  the VM's form is (the name, its UPPER key)
 x     a statement: ``LINE`` or ``LINE/FLAGS``      index into the code's statement table
       (S: stops the advance run, C: its loop      (advance.StmtInfo objects)
       condition stops it)
@@ -75,8 +77,8 @@ _TABLE = [
     ("FIELD",         0,  "nn", "replace a reference by its component reference; n: component, n: name for messages"),
     ("LOAD_INDEX", None,  "in", "pop i indices (none omitted) and a reference, push the element's value (effect -i)"),
     ("STORE_INDEX",None,  "in", "pop i indices, a reference and a value: element = value (effect -i-2)"),
-    ("LOAD_FIELD",    0,  "nn", "FIELD, then the component's value"),
-    ("STORE_FIELD",  -2,  "nn", "pop a reference and a value: component = value"),
+    ("LOAD_FIELD",    0,  "kn", "FIELD, then the component's value"),
+    ("STORE_FIELD",  -2,  "kn", "pop a reference and a value: component = value"),
     ("DEREF",         0,  "",   "replace a reference by its value"),
     ("ASSIGN",       -2,  "",   "pop a reference and a value: Runtime.assign"),
     ("STORE_LOCAL",  -1,  "s",  "pop a value into a frame slot (Runtime.assign)"),
@@ -133,6 +135,8 @@ _TABLE = [
     ("LOAD_ELEM1_V",  1,  "vvn", "push store array v1 [store variable v2]"),
     ("STORE_ELEM1_V",-1,  "vvny", "pop a value into store array v1 [store variable v2]"),
     ("LOAD_ELEM2_VV", 1,  "vvvn", "push store array v1 [v2, v3]"),
+    ("LOAD_FIELD_L",  1,  "skn", "push local s . component (REF_LOCAL, LOAD_FIELD)"),
+    ("STORE_FIELD_L",-1,  "skn", "pop a value into local s . component (REF_LOCAL, STORE_FIELD)"),
     ("FOR_NEXT_FAST", 0,  "vtxl", "FOR_NEXT with an INT store variable v as the counter, a loop condition that does not stop the advance run"),
     ("ADDC_FAST",     0,  "vcvy", "v2 = v1 + c (FAST_ADD_CONST v1 c, STORE_FAST v2 y)"),
     ("SUBC_FAST",     0,  "vcvy", "v2 = v1 - c (FAST_SUB_CONST v1 c, STORE_FAST v2 y)"),
@@ -185,7 +189,7 @@ _TABLE = [
 
 OPS: list[OpInfo] = [OpInfo(name, i, eff, ops, doc) for i, (name, eff, ops, doc) in enumerate(_TABLE)]
 BY_NAME: dict[str, OpInfo] = {o.name: o for o in OPS}
-OPERAND_KINDS = "icnlsmgtfxvyo"
+OPERAND_KINDS = "icnlsmgtfxvyok"
 
 # bind the numbers as module constants (STMT, CONST, ...) for the compiler and the VM
 globals().update({o.name: o.number for o in OPS})

@@ -32,7 +32,8 @@ import textwrap
 from interp.runtime.builtins import ValueRef
 from interp.runtime.convert import INT_MAX, INT_MIN, num
 from interp.runtime.errors import ExitSignal, KrlRuntimeError, ResumeSignal
-from interp.runtime.values import UNSET
+from interp.runtime.memory import Slot
+from interp.runtime.values import UNSET, Struct
 from interp.runtime.slots import (add, anout_limits, anout_value, array_index, component, element,
                                   element1, element2, ended_without_return, eq, for_done, for_limits,
                                   for_next, function_result, ge, gt, label_not_found, le, load, lt, mul,
@@ -222,6 +223,9 @@ def decode(code: Code) -> tuple[list, list]:
                 w = _VALUE_CLASS.get(code.consts[w])
             elif k == "o":
                 w = _COMPARE[code.consts[w]]
+            elif k == "k":
+                w = code.consts[w]
+                w = (w, w.upper())
             ins.append(w)
         prog.append(tuple(ins))
         r = code.regions[a]
@@ -500,7 +504,25 @@ class VM:
                             stack[-1] = _mul(a, b)
                         ip += 1
                     elif op == OP.LOAD_FIELD:
-                        stack[-1] = _component(stack[-1], ins[1], ins[2])
+                        base = stack[-1]
+                        if base.__class__ is Slot and (x := base.c[base.k]).__class__ is Struct and (
+                                (x := x.f.get(ins[1][1])).__class__ is float or x.__class__ is int
+                                or x.__class__ is bool):
+                            stack[-1] = x
+                        else:
+                            stack[-1] = _component(base, ins[1][0], ins[2])
+                        ip += 1
+                    elif op == OP.LOAD_FIELD_L:
+                        base = fvars[ins[1]]
+                        if base.__class__ is Slot and (x := base.c[base.k]).__class__ is Struct and (
+                                (x := x.f.get(ins[2][1])).__class__ is float or x.__class__ is int
+                                or x.__class__ is bool):
+                            push(x)
+                        else:
+                            push(_component(base, ins[2][0], ins[3]))
+                        ip += 1
+                    elif op == OP.STORE_FIELD_L:
+                        _set_component(fvars[ins[1]], ins[2][0], pop(), ins[3])
                         ip += 1
                     elif op == OP.UNOP:
                         stack[-1] = rt.unary_op(ins[1], stack[-1])
@@ -546,7 +568,7 @@ class VM:
                         ip += 1
                     elif op == OP.STORE_FIELD:
                         base = pop()
-                        _set_component(base, ins[1], pop(), ins[2])
+                        _set_component(base, ins[1][0], pop(), ins[2])
                         ip += 1
                     elif op == OP.TICK:
                         n = rt.steps
