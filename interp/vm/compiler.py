@@ -786,23 +786,30 @@ def peephole(lst: Listing) -> bool:
     targets = set(lst.labels.values())
     new: list = []
     where: dict = {}
+
+    def fusion(i: int, n: int):
+        """(fused instruction, region) for old[i:i+n], or None."""
+        group = old[i:i + n]
+        if len(group) < n or any(i + k in targets for k in range(1, n)):
+            return None
+        fused = _fuse(group)
+        if fused is None:
+            return None
+        regions = [g[2] for g in group]
+        if fused[0] in _CMP_JUMPS.values() or all(r is regions[0] for r in regions):
+            return fused, regions[0]
+        return None
+
     i = 0
     while i < len(old):
         done = False
         for n in (3, 2):
-            group = old[i:i + n]
-            if len(group) < n or any(i + k in targets for k in range(1, n)):
+            got = fusion(i, n)
+            if got is None:
                 continue
-            fused = _fuse(group)
-            if fused is None:
-                continue
-            regions = [g[2] for g in group]
-            if fused[0] in _CMP_JUMPS.values():
-                region = regions[0]
-            elif all(r is regions[0] for r in regions):
-                region = regions[0]
-            else:
-                continue
+            if n == 2 and i + 1 not in targets and fusion(i + 1, 3) is not None:
+                continue      # leave old[i + 1] to the longer sequence it starts
+            fused, region = got
             where[i] = len(new)
             new.append((fused[0], fused[1], region))
             i += n
