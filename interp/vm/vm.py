@@ -238,16 +238,6 @@ def decode(code: Code) -> tuple[list, list]:
     return prog, regions
 
 
-class Act:
-    """One activation: the runtime frame and the temporaries."""
-
-    __slots__ = ("frame", "temps")
-
-    def __init__(self, frame, temps: list) -> None:
-        self.frame = frame
-        self.temps = temps
-
-
 class VM:
     def __init__(self, rt) -> None:
         self.rt = rt
@@ -286,8 +276,7 @@ class VM:
         task.frame = frame
         returned = False
         try:
-            act = Act(frame, [None] * code.ntemps)
-            value = self.run(code, act, 0, [])
+            value = self.run(code, frame, [None] * code.ntemps, 0, [])
             if code.kind == "DEFFCT":
                 value = rt.return_value(routine, value, module)
             returned = True
@@ -312,22 +301,22 @@ class VM:
             code.callsites[ip] = target
         return self.invoke(target, args, frame, "N" not in flags)
 
-    def thunk(self, code: Code, act: Act, ip: int, stack: list | None = None):
-        """A callable that runs the thunk at ``ip`` of ``code`` in ``act``."""
-        return lambda: self.run(code, act, ip, list(stack) if stack else [], True)
+    def thunk(self, code: Code, frame, temps: list, ip: int, stack: list | None = None):
+        """A callable that runs the thunk at ``ip`` of ``code`` in the activation (``frame``,
+        ``temps``) that declared it."""
+        return lambda: self.run(code, frame, temps, ip, list(stack) if stack else [], True)
 
     # ------------------------------------------------------------------ the loop
     @_specialize
-    def run(self, code: Code, act: Act, ip: int, stack: list, thunk: bool = False):
-        """Run ``code`` from ``ip`` in activation ``act``; returns the value of RETURN,
+    def run(self, code: Code, frame, temps: list, ip: int, stack: list, thunk: bool = False):
+        """Run ``code`` from ``ip`` in the activation of ``frame`` (its runtime Frame) with
+        the temporaries ``temps``; returns the value of RETURN,
         or of the thunk at END_THUNK. The ``_name`` helpers are the runtime functions of
         :data:`HELPERS`, closure variables of the loop (see :func:`_specialize`)."""
         rt = self.rt
         prog = code.prog
         mrefs = code.mrefs
         grefs = code.grefs
-        temps = act.temps
-        frame = act.frame
         store = frame.store          # store variables (operand kind v): Frame.store keys
         fvars = frame.vars
         push = stack.append
@@ -913,7 +902,7 @@ class VM:
                         rt.halt()
                         ip += 1
                     elif op == OP.WAIT_FOR:
-                        rt.wait_for(self.thunk(code, act, ins[1]))
+                        rt.wait_for(self.thunk(code, frame, temps, ins[1]))
                         ip += 1
                     elif op == OP.WAIT_SEC:
                         rt.wait_sec(pop())
@@ -932,9 +921,9 @@ class VM:
                         line = ins[2]
                         raise KrlRuntimeError(ins[1], None, code.file if line else None, line or None)
                     elif op == OP.INT_DECL:
-                        cond = self.thunk(code, act, ins[1])
+                        cond = self.thunk(code, frame, temps, ins[1])
                         rt.interrupt_decl(pop(), lambda c=cond: rt.to_bool(c(), "interrupt condition"),
-                                          self.thunk(code, act, ins[2]), ins[3], frame,
+                                          self.thunk(code, frame, temps, ins[2]), ins[3], frame,
                                           ins[4] == "G", ins[5])
                         ip += 1
                     elif op == OP.INT_CTL:
@@ -950,7 +939,7 @@ class VM:
                     elif op == OP.CYCFLAG:
                         ref = pop()
                         _store(ref, pop())
-                        value = self.thunk(code, act, ins[1])
+                        value = self.thunk(code, frame, temps, ins[1])
                         rt.cyclic_on(("CYCFLAG", ref.name), lambda r=ref, f=value: rt.assign(r, f()))
                         ip += 1
                     elif op == OP.ANOUT_ON:
@@ -959,7 +948,7 @@ class VM:
                         lo = pop() if "L" in flags else None
                         ref = pop()
                         lo, hi = anout_limits(lo, hi)
-                        value = self.thunk(code, act, ins[3])
+                        value = self.thunk(code, frame, temps, ins[3])
 
                         def anout(ref=ref, value=value, lo=lo, hi=hi):
                             ref.set(anout_value(value(), lo, hi))
@@ -968,7 +957,7 @@ class VM:
                         ip += 1
                     elif op == OP.ANIN_ON:
                         ref = pop()
-                        value = self.thunk(code, act, ins[2])
+                        value = self.thunk(code, frame, temps, ins[2])
 
                         def anin(ref=ref, value=value):
                             rt.assign(ref, value())
@@ -998,7 +987,7 @@ class VM:
                         prio = pop() if "P" in flags else None
                         delay = pop()
                         at = pop()
-                        action = self.thunk(code, act, ins[4], [pop()])
+                        action = self.thunk(code, frame, temps, ins[4], [pop()])
                         rt.trigger(action, line=ins[3],
                                    **trigger_args(ins[1], at, delay, prio, "O" in flags))
                         ip += 1
