@@ -27,7 +27,6 @@ import inspect
 import itertools
 import math
 import operator
-import textwrap
 
 from interp.runtime.builtins import ValueRef
 from interp.runtime.convert import INT_MAX, INT_MIN, num
@@ -66,11 +65,12 @@ def _specialize(fn):
       ``fn.dispatch[opcode number]`` is that number (:func:`decode` writes it), and every
       ``OP.NAME`` in ``fn`` becomes it.
     """
-    lines, first = inspect.getsourcelines(fn)
-    src = textwrap.dedent("".join(ln for ln in lines if not ln.lstrip().startswith("@_specialize")))
-    tree = ast.parse(src)
-    ast.increment_lineno(tree, first)
-    func = tree.body[0]
+    path = inspect.getsourcefile(fn)
+    with open(path, encoding="utf-8") as f:
+        module = ast.parse(f.read(), path)
+    func = next(n for n in ast.walk(module) if isinstance(n, ast.FunctionDef) and n.name == fn.__name__
+                and any(isinstance(d, ast.Name) and d.id == "_specialize" for d in n.decorator_list))
+    func.decorator_list = []
     chain = next(n for n in ast.walk(func) if isinstance(n, ast.If) and _chain_ops(n.test))
     branches = []
     node = chain
@@ -92,7 +92,7 @@ def _specialize(fn):
     order: list = []
     _leaves(root, order)
     number = {name: i for i, name in enumerate(order)}
-    search = _search(root, body_of, number)
+    search = _search(root, body_of, number, set())
     _replace(func, chain, search if isinstance(search, ast.If) else search[0])
     func = _OpNumbers(number).visit(func)
     factory = ast.FunctionDef(
@@ -155,14 +155,19 @@ def _leaves(node, out: list) -> None:
         out.append(node)
 
 
-def _search(node, body_of: dict, number: dict):
-    """The statements that dispatch ``op`` within the subtree ``node``."""
+def _search(node, body_of: dict, number: dict, used: set):
+    """The statements that dispatch ``op`` within the subtree ``node`` (``used``: the
+    branch bodies already placed)."""
     if not isinstance(node, tuple):
-        return copy.deepcopy(body_of[node])
+        body = body_of[node]
+        if id(body) in used:           # a branch of several opcodes: one copy per leaf
+            return copy.deepcopy(body)
+        used.add(id(body))
+        return body
     right = []
     _leaves(node[1], right)
-    lo = _search(node[0], body_of, number)
-    hi = _search(node[1], body_of, number)
+    lo = _search(node[0], body_of, number, used)
+    hi = _search(node[1], body_of, number, used)
     test = ast.Compare(ast.Name("op", ast.Load()), [ast.Lt()], [ast.Constant(number[right[0]])])
     return [ast.If(test, lo, hi)]
 
