@@ -18,7 +18,6 @@ CONTINUE, §5.16 interrupts, §5.19 ON_ERROR_PROCEED, §8.2 errors), not copied 
 
 from __future__ import annotations
 
-import inspect
 import math
 import re
 import traceback
@@ -505,10 +504,17 @@ def test_decoded_code_uses_the_loop_numbering():
 
 
 def _vm_run_lines():
+    """(path of interp/vm/vm.py, first line, last line) of ``VM.run`` in its source."""
+    import ast
+
     from interp.vm import vm as vmmod
 
-    src, first = inspect.getsourcelines(vmmod.VM.run)
-    return Path(vmmod.__file__).resolve(), first, first + len(src) - 1
+    path = Path(vmmod.__file__).resolve()
+    tree = ast.parse(path.read_text())
+    cls = next(n for n in tree.body if isinstance(n, ast.ClassDef) and n.name == "VM")
+    run = next(n for n in cls.body if isinstance(n, ast.FunctionDef) and n.name == "run")
+    first = min([run.lineno] + [d.lineno for d in run.decorator_list])
+    return path, first, run.end_lineno
 
 
 def test_error_traceback_points_into_vm_run():
@@ -529,6 +535,9 @@ def test_error_traceback_points_into_vm_run():
     for f in inside:
         assert lo <= f.lineno <= hi, (f.lineno, lo, hi)
         assert f.line and f.line.strip(), f     # a real source line of the loop
+    # the innermost frame of the loop is the line of ADDC_FAST's slow path, which calls
+    # the runtime's add (the overflow is raised there)
+    assert "_add(" in inside[-1].line, inside[-1].line
 
 
 def test_dispatch_tests_keep_the_loop_lines():
@@ -540,3 +549,41 @@ def test_dispatch_tests_keep_the_loop_lines():
     assert Path(code.co_filename).resolve() == path
     lines = {ln for _, _, ln in code.co_lines() if ln is not None}
     assert lines and min(lines) >= lo and max(lines) <= hi
+
+
+def test_trigger_and_brake_resume_during_a_compute_loop():
+    out = run_all(FAST / "fp_trigger.src", max_sim_time=30.0)
+    assert out.reason == "completed"
+    d = out.data
+    # the TRIGGER action (start of the PTP + 20 ms) runs once while the advance run is in
+    # the loop (CONTINUE before INTERRUPT ON: no advance-run stop); the loop sees it,
+    # sets $FLAG[9]; interrupt 9 fires at the next statement of the same pass, BRAKE,
+    # RESUME ends worker() (§5.17): the main routine goes on with CUR unchanged
+    assert d["TRIG_N"] == 1
+    assert 1 < d["TRIG_AT"] < 30000
+    assert d["IRQ_AT"] == d["TRIG_AT"] == d["AFTER_RESUME"] == d["CUR"]
+
+
+@pytest.mark.parametrize("traced", [False, True])
+def test_quiet_path_is_taken_only_without_a_trace(traced):
+    """The sweeps above compare something: untraced, most steps skip the statement hooks
+    (one full hook per time slice here); traced, every step takes them."""
+    tw = TraceWriter(keep=True) if traced else None
+    rt, vm = make_runtime(MAXSTEPS, trace=tw, mujoco=False, interp="vm", max_steps=20_000, max_sim_time=600.0)
+    rt.program.module("fp_maxsteps").data["SEL"].set(2)
+    calls = [0]
+    before, tick, take, quiet = vm.hooks
+
+    def counted(fn):
+        def hook(*a):
+            calls[0] += 1
+            return fn(*a)
+        return hook
+
+    vm.hooks = (counted(before), counted(tick), take, quiet)
+    res = rt.run()
+    assert res.reason == "max_steps" and res.steps == 20_001
+    if traced:
+        assert calls[0] == res.steps
+    else:
+        assert calls[0] < res.steps // 100, calls[0]
