@@ -587,3 +587,100 @@ def test_quiet_path_is_taken_only_without_a_trace(traced):
         assert calls[0] == res.steps
     else:
         assert calls[0] < res.steps // 100, calls[0]
+
+
+# ---------------------------------------------------------------------------- random programs
+# Straight-line code over store variables (INT, REAL, BOOL, CHAR scalars, 1-D and 2-D
+# arrays, some elements unset) mixing types, out-of-range and REAL indices, overflowing
+# constants; most statements under ON_ERROR_PROCEED so one run passes many slow paths.
+_NAMES = {"I": ["i", "j", "k"], "R": ["x", "y"], "B": ["b"], "C": ["c"]}
+_CONSTS = ["0", "1", "2", "-1", "3", "2147483647", "-2147483647", "1.5", "2.5", "-0.5", "TRUE", "FALSE",
+           '"A"', '"z"']
+
+
+class _Gen:
+    def __init__(self, seed: int) -> None:
+        import random
+
+        self.r = random.Random(seed)
+
+    def scalar(self) -> str:
+        return self.r.choice(sum(_NAMES.values(), []))
+
+    def index(self, extra) -> str:
+        return self.r.choice(_NAMES["I"] + extra)
+
+    def atom(self) -> str:
+        p = self.r.random()
+        if p < 0.45:
+            return self.scalar()
+        if p < 0.65:
+            return self.r.choice(["a", "a", "ra", "s"]) + f"[{self.index(['1', '2', '3', '4', '0', 'x'])}]"
+        if p < 0.75:
+            return f"m[{self.index(['1', '2'])}, {self.index(['1', '3', '4'])}]"
+        return self.r.choice(_CONSTS)
+
+    def expr(self, depth: int = 0) -> str:
+        if depth > 1 or self.r.random() < 0.4:
+            return self.atom()
+        return f"{self.expr(depth + 1)} {self.r.choice('+-*+-')} {self.expr(depth + 1)}"
+
+    def cond(self) -> str:
+        return f"{self.expr(1)} {self.r.choice(['<', '<=', '>', '>=', '==', '<>'])} {self.expr(1)}"
+
+    def target(self) -> str:
+        p = self.r.random()
+        if p < 0.6:
+            return self.scalar()
+        if p < 0.85:
+            return self.r.choice(["a", "ra", "s"]) + f"[{self.index(['1', '2', '3', '4'])}]"
+        return f"m[{self.index(['1', '2'])}, {self.index(['1', '3'])}]"
+
+    def block(self, n: int, depth: int = 0) -> list:
+        out = []
+        ind = "  " * (depth + 1)
+        for _ in range(n):
+            p = self.r.random()
+            if p < 0.05 and depth < 2:
+                out += [f"{ind}IF {self.cond()} THEN", *self.block(2, depth + 1), f"{ind}ENDIF"]
+            elif p < 0.1 and depth < 2:
+                v = self.r.choice(_NAMES["I"])
+                start = self.r.choice(["1", "3", "-2", "2147483645"])
+                end = self.r.choice(["3", "1", "2147483647", "5"])
+                step = self.r.choice(["1", "2", "-1", "-2"])
+                out += [f"{ind}FOR {v} = {start} TO {end} STEP {step}", *self.block(2, depth + 1), f"{ind}ENDFOR"]
+            elif p < 0.97:
+                out += [f"{ind}ON_ERROR_PROCEED", f"{ind}{self.target()} = {self.expr()}",
+                        f"{ind}ERRS = ERRS + $ERR.NUMBER", f"{ind}ERR_CLEAR($ERR)"]
+            else:
+                out.append(f"{ind}{self.target()} = {self.expr()}")
+        return out
+
+
+def _random_program(tmp: Path, seed: int) -> Path:
+    g = _Gen(seed)
+    init = ["i = 1", "j = 2", "x = 0.5", "b = TRUE", 'c = "B"', "k = 3", "y = -1.5", "a[1] = 5", "a[2] = -7",
+            "ra[1] = 0.25", "ra[3] = 4.0", 's[1] = "q"', 's[2] = "R"', "m[1, 1] = 1", "m[2, 3] = 9", "m[1, 3] = 4"]
+    outs = ["OI = i", "OJ = j", "OK = k", "OX = x", "OY = y", "OB = b", "OC = c"]
+    src = ["DEF fz()", "  DECL INT i, j, k, a[3], m[2,3]", "  DECL REAL x, y, ra[3]", "  DECL BOOL b",
+           "  DECL CHAR c, s[4]"]
+    src += ["  " + s for s in init] + g.block(40)
+    for s in outs:
+        src += ["  ON_ERROR_PROCEED", "  " + s]
+    src += ["  FOR i = 1 TO 3", "    ON_ERROR_PROCEED", "    OA[i] = a[i]", "    ON_ERROR_PROCEED",
+            "    ORA[i] = ra[i]", "  ENDFOR", "END"]
+    (tmp / "fz.src").write_text("\n".join(src) + "\n")
+    (tmp / "fz.dat").write_text("DEFDAT fz\n  DECL INT ERRS = 0\n  DECL INT OI, OJ, OK, OA[3]\n"
+                                "  DECL REAL OX, OY, ORA[3]\n  DECL BOOL OB\n  DECL CHAR OC\nENDDAT\n")
+    return tmp / "fz.src"
+
+
+@pytest.mark.parametrize("seed", range(12))
+def test_random_programs(tmp_path, seed):
+    run_all(_random_program(tmp_path, seed), max_steps=5000, max_sim_time=5.0)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("seed", range(12, 400))
+def test_random_programs_many(tmp_path, seed):
+    run_all(_random_program(tmp_path, seed), max_steps=5000, max_sim_time=5.0)
