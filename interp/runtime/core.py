@@ -237,7 +237,8 @@ class Runtime:
         step needs the full hook. An interpreter that takes the fast path stores the
         limit in ``task.quiet`` after each full hook; :meth:`_break` (a task switch,
         CONTINUE, ON_ERROR_PROCEED, an interrupt declared or switched) resets it."""
-        if self.trace is not None or task.irqs.armed or task.continue_line is not None or task.error_proceed:
+        if self.trace is not None or task.irqs.armed or task.continue_line is not None \
+                or any(c.error_proceed for c in task.contexts):
             return 0
         lim = task.slice_end - 1
         if self.max_steps is not None and self.max_steps < lim:
@@ -629,15 +630,19 @@ class Runtime:
             self.current_task.err_text = ""
 
     def take_error_proceed(self) -> bool:
-        """True (and reset) if ON_ERROR_PROCEED preceded the statement about to run."""
-        task = self.current_task
-        p = task.error_proceed
-        task.error_proceed = False
+        """True (and reset) if ON_ERROR_PROCEED preceded the statement about to run. Every
+        statement takes it, whether or not it can fail (§5.19: it covers the *next*
+        statement only); the flag belongs to the running context, so an interrupt routine
+        or a TRIGGER action that runs before that statement neither takes nor sees it
+        (docs/architecture.md, "Choices on the reference's open points")."""
+        ctx = self.current_task.contexts[-1]
+        p = ctx.error_proceed
+        ctx.error_proceed = False
         return p
 
     def on_error_proceed(self) -> None:
         task = self.current_task
-        task.error_proceed = True
+        task.contexts[-1].error_proceed = True
         self._break(task)
 
     def record_error(self, err: KrlRuntimeError, frame: Frame | None) -> None:

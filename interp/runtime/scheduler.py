@@ -45,7 +45,6 @@ class Task:
         self.irqs = InterruptTable()
         self.err = None                 # $ERR of this interpreter (Struct ERROR_T)
         self.continue_line = None       # (file, line) of a CONTINUE
-        self.error_proceed = False      # ON_ERROR_PROCEED seen
         self.pending_triggers: list = []
         self.pending_error = None
         self.next_triggers: list = []   # TRIGGERs waiting for the next motion

@@ -96,10 +96,20 @@ class TreeInterpreter:
         rt.before_statement(info)
         return info
 
-    def guarded(self, fn, st, frame) -> None:
-        """Run a statement body under ON_ERROR_PROCEED semantics and place errors."""
+    def plain(self, st, frame):
+        """Prologue of a statement that ON_ERROR_PROCEED does not cover: it takes the flag
+        all the same (§5.19: the flag is for the next statement only)."""
+        info = self.begin(st, frame)
+        self.rt.take_error_proceed()
+        return info
+
+    def guarded(self, fn, st, frame, proceed: bool | None = None) -> bool:
+        """Run a statement body under ON_ERROR_PROCEED semantics and place errors; False
+        if it failed and the error was recorded (``proceed``: the flag, if the statement
+        took it already)."""
         rt = self.rt
-        proceed = rt.take_error_proceed()
+        if proceed is None:
+            proceed = rt.take_error_proceed()
         try:
             fn()
         except KrlRuntimeError as e:
@@ -107,6 +117,8 @@ class TreeInterpreter:
             if not proceed:
                 raise
             rt.record_error(e, frame)
+            return False
+        return True
 
     def s_assign(self, st, frame) -> None:
         self.begin(st, frame)
@@ -154,14 +166,18 @@ class TreeInterpreter:
     def s_for(self, st, frame) -> None:
         info = self.begin(st, frame)
         rt = self.rt
-        try:
+        head = []
+
+        def header():        # ON_ERROR_PROCEED covers it: an error skips the whole loop
             ref = self.ref(st.var, frame)
             start = self.eval(st.start, frame)
             end, step = for_limits(self.eval(st.end, frame),
                                    self.eval(st.step, frame) if st.step is not None else 1)
-        except KrlRuntimeError as e:
-            raise e.at(st.span.file, st.span.line)
-        rt.assign(ref, start)
+            rt.assign(ref, start)
+            head.extend((ref, end, step))
+        if not self.guarded(header, st, frame):
+            return
+        ref, end, step = head
         if for_done(ref.get(), end, step):
             return
         try:
@@ -176,17 +192,24 @@ class TreeInterpreter:
     def s_while(self, st, frame) -> None:
         info = self.begin(st, frame)
         rt = self.rt
+        proceed = rt.take_error_proceed()
+        first = []
+        rt.loop_tick(info)
+        # ON_ERROR_PROCEED covers the first evaluation of the condition: an error skips the loop
+        if not self.guarded(lambda: first.append(rt.to_bool(self.eval(st.cond, frame))), st, frame, proceed) \
+                or not first[0]:
+            return
         try:
             while True:
+                self.exec_block(st.body, frame)
                 rt.loop_tick(info)
                 if not rt.to_bool(self.eval_at(st.cond, frame, st)):
                     break
-                self.exec_block(st.body, frame)
         except ExitSignal:
             pass
 
     def s_repeat(self, st, frame) -> None:
-        info = self.begin(st, frame)
+        info = self.plain(st, frame)
         rt = self.rt
         try:
             while True:
@@ -198,7 +221,7 @@ class TreeInterpreter:
             pass
 
     def s_loop(self, st, frame) -> None:
-        info = self.begin(st, frame)
+        info = self.plain(st, frame)
         rt = self.rt
         try:
             while True:
@@ -208,18 +231,18 @@ class TreeInterpreter:
             pass
 
     def s_exit(self, st, frame) -> None:
-        self.begin(st, frame)
+        self.plain(st, frame)
         raise ExitSignal()
 
     def s_goto(self, st, frame) -> None:
-        self.begin(st, frame)
+        self.plain(st, frame)
         raise GotoSignal(st.label)
 
     def s_label(self, st, frame) -> None:
         pass
 
     def s_halt(self, st, frame) -> None:
-        self.begin(st, frame)
+        self.plain(st, frame)
         self.rt.halt()
 
     def s_wait_for(self, st, frame) -> None:
@@ -231,18 +254,19 @@ class TreeInterpreter:
         self.guarded(lambda: self.rt.wait_sec(self.eval(st.time, frame)), st, frame)
 
     def s_continue(self, st, frame) -> None:
-        info = self.begin(st, frame)
+        info = self.plain(st, frame)
         self.rt.set_continue(info)
 
     def s_return(self, st, frame) -> None:
         self.begin(st, frame)
-        value = None
-        if st.value is not None:
-            value = self.eval_at(st.value, frame, st)
-        raise ReturnSignal(value)
+        value = []
+        # ON_ERROR_PROCEED covers the value: after an error the next statement runs
+        if self.guarded(lambda: value.append(self.eval(st.value, frame) if st.value is not None else None),
+                        st, frame):
+            raise ReturnSignal(value[0])
 
     def s_on_error_proceed(self, st, frame) -> None:
-        self.begin(st, frame)
+        self.plain(st, frame)
         self.rt.on_error_proceed()
 
     def s_declstmt(self, st, frame) -> None:
@@ -250,7 +274,7 @@ class TreeInterpreter:
 
     def s_stub(self, st, frame) -> None:
         """CONFIRM, ASYPTP, MOVE_EMI, ... (§5.20): recognised, not simulated."""
-        self.begin(st, frame)
+        self.plain(st, frame)
         words = getattr(st, "words", None)
         self.rt.stub_statement(" ".join(words) if words else type(st).__name__.upper())
 
@@ -271,7 +295,7 @@ class TreeInterpreter:
         self.guarded(do, st, frame)
 
     def s_anout_off(self, st, frame) -> None:
-        self.begin(st, frame)
+        self.plain(st, frame)
         self.rt.cyclic_off(("ANOUT", st.name.upper()))
 
     def s_anin_on(self, st, frame) -> None:
@@ -291,11 +315,11 @@ class TreeInterpreter:
         self.guarded(do, st, frame)
 
     def s_anin_off(self, st, frame) -> None:
-        self.begin(st, frame)
+        self.plain(st, frame)
         self.rt.cyclic_off(("ANIN", st.name.upper()))
 
     def s_unsupported(self, st, frame) -> None:
-        self.begin(st, frame)
+        self.plain(st, frame)
         raise KrlRuntimeError(f"{type(st).__name__} is not supported by this simulator", None,
                               st.span.file, st.span.line)
 
@@ -333,11 +357,11 @@ class TreeInterpreter:
             st.action, self.eval(st.prio, frame) if st.prio is not None else None), st, frame)
 
     def s_brake(self, st, frame) -> None:
-        self.begin(st, frame)
+        self.plain(st, frame)
         self.rt.brake(st.fast)
 
     def s_resume(self, st, frame) -> None:
-        self.begin(st, frame)
+        self.plain(st, frame)
         self.rt.resume()
 
     def s_trigger(self, st, frame) -> None:

@@ -146,8 +146,11 @@ class Compiler:
         return end
 
     def stmt(self, st) -> None:
+        """A statement ON_ERROR_PROCEED does not cover: STMT_G all the same, which takes the
+        flag (it is for the next statement only; the tree interpreter's ``plain``)."""
+        assert not self.in_thunk, "STMT_G in a thunk (the VM sets frame.line for it)"
         self.region = None
-        self.emit("STMT", self.info(st))
+        self.emit("STMT_G", self.info(st))
 
     # ------------------------------------------------------------------ routine
     def compile(self) -> str:
@@ -247,12 +250,11 @@ class Compiler:
 
     def s_For(self, st) -> None:
         info = self.info(st)
-        self.stmt(st)
+        end = self.guarded(st)        # the header: an error under ON_ERROR_PROCEED skips the loop
         t = self.temp()
         self.temp()
         self.temp()
         self.temp()
-        self.region = Region("A", st.span.line)
         self.ref(st.var)
         self.expr(st.start)
         self.expr(st.end)
@@ -261,9 +263,9 @@ class Compiler:
         else:
             self.emit("CONST", 1)
         self.emit("FOR_PREP", t)
-        self.region = None
         self.emit("FOR_INIT", t)
-        body, end = self.new_label(), self.new_label()
+        self.region = None
+        body = self.new_label()
         self.emit("FOR_TEST", t, end)
         self.emit("TICK", info)
         self.place(body)
@@ -284,14 +286,24 @@ class Compiler:
 
     def s_While(self, st) -> None:
         info = self.info(st)
-        self.stmt(st)
-        top, end = self.new_label(), self.new_label()
+        end = self.guarded(st)
+        region = self.region
+        top, body = self.new_label(), self.new_label()
+        self.region = None
         self.emit("TICK", info)
+        # the first evaluation of the condition: ON_ERROR_PROCEED covers it (an error skips
+        # the loop); the later ones are placed on the WHILE line only
+        self.region = region
+        self.expr(st.cond)
+        self.emit("JUMP_IF_FALSE", end)
+        self.region = None
+        self.emit("JUMP", body)
         self.place(top)
         self.region = Region("A", st.span.line)
         self.expr(st.cond)
         self.region = None
         self.emit("JUMP_IF_FALSE", end)
+        self.place(body)
         self.loop_body(st.body, end)
         self.region = None
         self.emit("JUMP_TICK", info, top)
@@ -366,14 +378,15 @@ class Compiler:
         self.emit("CONTINUE", self.info(st))
 
     def s_Return(self, st) -> None:
-        self.stmt(st)
         if st.value is None:
+            self.stmt(st)
             self.emit("RETURN")
             return
-        self.region = Region("A", st.span.line)
+        end = self.guarded(st)        # the value: after an error under ON_ERROR_PROCEED, go on
         self.expr(st.value)
         self.region = None
         self.emit("RETURN_VAL")
+        self.place(end)
 
     def s_OnErrorProceed(self, st) -> None:
         self.stmt(st)

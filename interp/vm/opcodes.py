@@ -60,8 +60,8 @@ class OpInfo:
 _TABLE = [
     # name            effect operands doc
     # -- statements and lines
-    ("STMT",          0,  "x", "statement boundary: Runtime.before_statement (trace, limits, interrupts, advance-run stop)"),
-    ("STMT_G",        0,  "x",  "STMT of a guarded statement: also takes the ON_ERROR_PROCEED flag"),
+    ("STMT",          0,  "x", "statement boundary in a thunk (a TRIGGER action): Runtime.before_statement (trace, limits, interrupts, advance-run stop)"),
+    ("STMT_G",        0,  "x",  "statement boundary in a routine: Runtime.before_statement, then take the ON_ERROR_PROCEED flag (every statement takes it)"),
     ("TICK",          0,  "x",  "one loop iteration: Runtime.loop_tick"),
     # -- values
     ("CONST",         1,  "c",  "push a constant"),

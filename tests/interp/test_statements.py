@@ -246,6 +246,26 @@ def test_on_error_proceed_and_err(tmp_path):
     assert (r.var("prog", "N2"), r.var("prog", "N3")) == (1422, 0)
 
 
+def test_on_error_proceed_flag_belongs_to_the_running_context(tmp_path):
+    """An interrupt routine (or TRIGGER action) that runs before the statement after
+    ON_ERROR_PROCEED neither takes nor sees the flag: it is the interrupted flow's."""
+    from interp.runtime.contexts import Context
+
+    r = run_krl(tmp_path, """
+    DEF prog()
+    END
+    """, DAT)
+    rt = r.rt
+    task = rt.robot
+    rt.current_task = task
+    rt.on_error_proceed()
+    task.contexts.append(Context("interrupt", prio=3, number=3))
+    assert rt.take_error_proceed() is False
+    task.contexts.pop()
+    assert rt.take_error_proceed() is True
+    assert rt.take_error_proceed() is False
+
+
 def test_swrite_sread_and_string_functions(tmp_path):
     r = run_krl(tmp_path, """
     DEF prog()
