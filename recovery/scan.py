@@ -117,8 +117,9 @@ def _init_worker(parser_dir: str | None) -> None:
     _BUNDLE = ParserBundle.from_directory(parser_dir, tag="scan") if parser_dir else default_bundle()
 
 
-class _Timeout(Exception):
-    pass
+class _Timeout(BaseException):
+    """The parse timeout (SIGALRM). A BaseException, so that no ``except Exception`` on the
+    way (a handler in the parser, its error listener) can swallow it."""
 
 
 def _on_alarm(signum, frame):  # noqa: ARG001

@@ -63,7 +63,7 @@ def test_timeout_is_a_row_not_a_hang(tmp_path: Path) -> None:
 
     scan_mod._init_worker(None)
     row = scan_one((str(p), "slow.src", "sha", 1))
-    assert row.status == "timeout"
+    assert row.status == "timeout", (row.status, row.seconds, row.issues[:1])
 
 
 def test_parse_json_output_and_exit_codes(tmp_path: Path) -> None:
