@@ -27,6 +27,20 @@ def run_trace(program: Path, interp: str, *, inputs=None, submit=(), before=None
     return res, tw.events
 
 
+def real_programs() -> list:
+    """The main programs of the KRC backups in ../shared/krl-corpus ([] when it is absent)."""
+    try:
+        from interp.realprograms import DEFAULT_CORPUS, find_backups, programs_of
+    except ImportError:     # pragma: no cover
+        return []
+    if not DEFAULT_CORPUS.is_dir():
+        return []
+    out = []
+    for b in find_backups(DEFAULT_CORPUS):
+        out += programs_of(b)
+    return out
+
+
 def case_options(program: Path) -> dict:
     d = program.parent
     kw: dict = {}

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 
-from .differential import CASES, CORPUS, PAPER, case_options, compare
+from .differential import CASES, CORPUS, PAPER, case_options, compare, real_programs
 
 
 def _check(program, **kw):
@@ -40,26 +40,13 @@ def test_paper_example(tmp_path, brake_at):
     _check(PAPER, inputs=inputs, before=_shift_base, max_sim_time=60)
 
 
-def _real_programs():
-    try:
-        from interp.realprograms import DEFAULT_CORPUS, find_backups, programs_of
-    except ImportError:     # pragma: no cover
-        return []
-    if not DEFAULT_CORPUS.is_dir():
-        return []
-    out = []
-    for b in find_backups(DEFAULT_CORPUS):
-        out += programs_of(b)
-    return out
-
-
 def _submit_of(program):
     from interp.realprograms import submit_of
 
     return submit_of(program)
 
 
-REAL = _real_programs()
+REAL = real_programs()
 
 
 @pytest.mark.skipif(not REAL, reason="../shared/krl-corpus absent")

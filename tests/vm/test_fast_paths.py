@@ -30,7 +30,7 @@ from interp.run import make_runtime
 from interp.runtime.values import UNSET, Arr, EnumValue, Struct
 from robot.trace import TraceWriter
 
-from .differential import CASES, CORPUS, case_options
+from .differential import CASES, CORPUS, case_options, real_programs
 
 HERE = Path(__file__).parent / "programs"
 FAST = HERE / "fast"
@@ -366,21 +366,8 @@ def test_quiet_steps_sweep(program, options):
     run_all(program, runs=QUIET_RUNS, **kw)
 
 
-def _real_programs():
-    try:
-        from interp.realprograms import DEFAULT_CORPUS, find_backups, programs_of
-    except ImportError:     # pragma: no cover
-        return []
-    if not DEFAULT_CORPUS.is_dir():
-        return []
-    out = []
-    for b in find_backups(DEFAULT_CORPUS):
-        out += programs_of(b)
-    return out
-
-
 @pytest.mark.slow
-@pytest.mark.parametrize("program", _real_programs(), ids=lambda p: "/".join(p.parts[-3:]))
+@pytest.mark.parametrize("program", real_programs(), ids=lambda p: "/".join(p.parts[-3:]))
 def test_quiet_steps_real_programs(program):
     from interp.realprograms import submit_of
 
