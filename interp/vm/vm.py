@@ -1,9 +1,12 @@
 """The VM: runs assembled code (interp/vm/assembler.py) on the shared runtime.
 
 One dispatch loop (:meth:`VM.run`) with the instruction pointer, the operand stack and
-the frame slots in locals, one dispatch point, and every semantic operation a call into
+the frame's store in locals, one dispatch point, and every semantic operation a call into
 :class:`interp.runtime.core.Runtime` (or its fast paths in interp/runtime/slots.py), the
-same calls the tree interpreter makes. A KRL call runs a nested :meth:`run` (one Python
+same calls the tree interpreter makes. Hot opcodes inline the common case of such a call
+(a number in a store variable, an in-range index, int/float arithmetic, a quiet step:
+docs/architecture.md, "Bytecode VM") and make the call for every other case, so values
+and error messages stay the runtime's. A KRL call runs a nested :meth:`run` (one Python
 level per KRL call, as the tree interpreter's ``invoke``), so interrupt handlers, TRIGGER
 actions and WAIT FOR conditions, which the runtime calls back at a statement boundary or
 an IPO cycle, run as *thunks* of the declaring routine's code on top of the interrupted
@@ -334,7 +337,8 @@ class VM:
                 while True:
                     ins = prog[ip]
                     op = ins[0]
-                    # the hottest opcodes first (measured on the benchmark)
+                    # hottest first (measured on the benchmark): the rank weights the search
+                    # tree _specialize makes of this chain
                     if op == OP.STMT_G:
                         info = ins[1]
                         frame.line = info.line
