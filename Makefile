@@ -63,13 +63,17 @@ CONF_FUZZ ?= 200
 conformance: $(PARSER)
 	$(BIN)/krl conformance --out $(CONF_OUT) --fuzz $(CONF_FUZZ)
 
-# Long nightly run, in order: recovery over the shared corpus, growth, conformance; dated
-# reports under reports/nightly/<date>/ and an index page. Not part of `make test`.
+# Long nightly run, in order: recovery over the shared corpus, growth, conformance, the
+# tests marked slow (long sweeps; hypothesis with the nightly profile); dated reports under
+# reports/nightly/<date>/ and an index page. Not part of `make test`.
 NIGHTLY_FUZZ ?= 2000
 nightly: $(PARSER)
 	@d=reports/nightly/$$(date -u +%Y-%m-%d); mkdir -p $$d; \
 	$(BIN)/krl recover $(SHARED_CORPUS) --out $$d/recovery; s=$$?; [ $$s -le 1 ] || exit $$s; \
 	$(BIN)/krl growth $(SHARED_CORPUS) --out $$d/growth || exit $$?; \
 	$(BIN)/krl conformance --out $$d/conformance --fuzz $(NIGHTLY_FUZZ) --fuzz-random; c=$$?; \
+	HYPOTHESIS_PROFILE=nightly $(BIN)/python -m pytest -q -n 2 -p no:cacheprovider -m slow \
+	  > $$d/slow-tests.log 2>&1; t=$$?; tail -1 $$d/slow-tests.log; \
 	$(BIN)/python -m conformance.nightly reports/nightly; \
-	echo "nightly reports: $$d (index: reports/nightly/index.html)"; exit $$c
+	echo "nightly reports: $$d (index: reports/nightly/index.html; slow tests: $$d/slow-tests.log)"; \
+	[ $$c -eq 0 ] && exit $$t; exit $$c
