@@ -62,7 +62,7 @@ def _specialize(fn):
     * the chain ``if op == <opcode>: ... elif op == <opcode>: ...``, hottest first, becomes
       a binary search, ``if op < k:``, shaped as a Huffman tree over the opcodes with
       Zipf weights by rank in the chain (weight 1/rank): the hottest opcode is found after
-      two tests, the tenth after about five, a rare one after about ten, where the chain
+      two tests, the tenth after six, the 100th after nine (at most ten), where the chain
       needs one test per opcode ahead of it. The loop therefore dispatches on its own
       numbering of the opcodes, the leaves of that tree from left to right;
       ``fn.dispatch[opcode number]`` is that number (:func:`decode` writes it), and every
