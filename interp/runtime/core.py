@@ -557,6 +557,34 @@ class Runtime:
             return dest
         return convert_scalar(v, t)
 
+    def run_routine(self, target, args: list, caller: Frame | None, body, catch_resume: bool = True):
+        """The call protocol of both interpreters (§2.3, §5.17): :meth:`enter_routine`,
+        the task's innermost frame (VARSTATE), ``body(frame)`` — the interpreter runs the
+        routine and returns the value of its RETURN (None for a DEF) —, the value converted
+        to a function's return type (:meth:`return_value`), RESUME caught at the caller
+        that declared the interrupt (unless ``catch_resume`` is False: an interrupt
+        handler's own call), :meth:`leave_routine` (``returned`` False when the routine is
+        abandoned by an error or RESUME). ``target``: (module, Routine)."""
+        module, routine = target
+        frame = self.enter_routine(module, routine, args, caller)
+        task = self.current_task
+        prev = task.frame
+        task.frame = frame
+        returned = False
+        try:
+            value = body(frame)
+            if routine.kind == "DEFFCT":
+                value = self.return_value(routine, value, module)
+            returned = True
+            return value
+        except ResumeSignal as r:
+            if catch_resume and r.frame is caller and caller is not None:
+                return None
+            raise
+        finally:
+            task.frame = prev
+            self.leave_routine(frame, returned)
+
     def leave_routine(self, frame: Frame, returned: bool = True) -> None:
         """The routine of ``frame`` ends; ``returned`` False when it is abandoned (run-time
         error, RESUME, end of the run): then no ``return`` event is written."""

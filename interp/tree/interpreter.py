@@ -17,10 +17,9 @@ from krl.ast import nodes as N
 
 from interp.runtime.builtins import ValueRef
 from interp.runtime.convert import num
-from interp.runtime.slots import (anout_limits, anout_value, array_index, for_done, for_limits, for_next,
-                                 trigger_args)
-from interp.runtime.errors import (lvalue_name, ExitSignal, GotoSignal, KrlRuntimeError, ResumeSignal,
-                                   ReturnSignal)
+from interp.runtime.slots import (anout_limits, anout_value, array_index, ended_without_return, for_done,
+                                 for_limits, for_next, label_not_found, return_without_value, trigger_args)
+from interp.runtime.errors import lvalue_name, ExitSignal, GotoSignal, KrlRuntimeError, ReturnSignal
 from interp.runtime.values import EnumValue, Struct, copy_value
 
 
@@ -465,40 +464,25 @@ class TreeInterpreter:
         return self.invoke(target, self.args_for(call, frame), frame, catch_resume)
 
     def invoke(self, target, args: list, caller, catch_resume: bool = True):
-        """Run routine ``target`` = (module, Routine) with reference ``args``."""
-        rt = self.rt
-        module, routine = target
-        frame = rt.enter_routine(module, routine, args, caller)
-        task = rt.current_task
-        prev = task.frame
-        task.frame = frame
-        returned = False
+        """Run routine ``target`` = (module, Routine) with reference ``args`` (the
+        runtime's call protocol, Runtime.run_routine)."""
+        return self.rt.run_routine(target, args, caller, self.exec_routine, catch_resume)
+
+    def exec_routine(self, frame):
+        """The body of the routine of ``frame``; the value of its RETURN (None for a DEF).
+        RETURN and GOTO unwind as exceptions to here."""
+        routine = frame.routine
         try:
             self.exec_block(routine.body, frame)
-            if routine.kind == "DEFFCT":
-                raise KrlRuntimeError(f"function {routine.name} ended without RETURN", None,
-                                      routine.span.file, frame.line or routine.span.line)
-            returned = True
-            return None
         except ReturnSignal as r:
-            if routine.kind == "DEFFCT":
-                if r.value is None:
-                    raise KrlRuntimeError(f"RETURN without a value in function {routine.name}", None,
-                                          routine.span.file, frame.line) from None
-                value = rt.return_value(routine, r.value, module)
-                returned = True
-                return value
-            returned = True
-            return None
+            if routine.kind == "DEFFCT" and r.value is None:
+                raise return_without_value(routine, frame.line) from None
+            return r.value if routine.kind == "DEFFCT" else None
         except GotoSignal as g:
-            raise KrlRuntimeError(f"GOTO {g.label}: label not found", None, routine.span.file, frame.line) from None
-        except ResumeSignal as r:
-            if catch_resume and r.frame is caller and caller is not None:
-                return None
-            raise
-        finally:
-            task.frame = prev
-            rt.leave_routine(frame, returned)
+            raise label_not_found(g.label, routine, frame.line) from None
+        if routine.kind == "DEFFCT":
+            raise ended_without_return(routine, frame.line)
+        return None
 
     # ------------------------------------------------------------------ expressions
     def eval(self, e, frame):

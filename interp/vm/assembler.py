@@ -361,11 +361,7 @@ def assemble(text: str) -> list[Code]:
 def to_listing(code: Code) -> Listing:
     lst = Listing(code.name, code.kind, code.file, list(code.lnames), code.ntemps)
     words = code.words
-    starts = []
-    pc = 0
-    while pc < len(words):
-        starts.append(pc)
-        pc += O.size(words[pc])
+    starts = O.instruction_starts(words)
     index_of = {a: i for i, a in enumerate(starts)}
     index_of[len(words)] = len(starts)
     for a in starts:

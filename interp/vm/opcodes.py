@@ -198,3 +198,13 @@ globals().update({o.name: o.number for o in OPS})
 def size(op: int) -> int:
     """Length of an instruction in code words (the opcode and its operands)."""
     return 1 + len(OPS[op].operands)
+
+
+def instruction_starts(words: list) -> list[int]:
+    """The address of each instruction in the code words, in order."""
+    starts = []
+    pc = 0
+    while pc < len(words):
+        starts.append(pc)
+        pc += size(words[pc])
+    return starts

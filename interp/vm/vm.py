@@ -33,7 +33,7 @@ import operator
 
 from interp.runtime.builtins import ValueRef
 from interp.runtime.convert import INT_MAX, INT_MIN, num
-from interp.runtime.errors import ExitSignal, KrlRuntimeError, ResumeSignal
+from interp.runtime.errors import ExitSignal, KrlRuntimeError
 from interp.runtime.memory import Slot
 from interp.runtime.values import UNSET, Struct
 from interp.runtime.slots import (add, anout_limits, anout_value, array_index, component, element,
@@ -204,11 +204,7 @@ def decode(code: Code) -> tuple[list, list]:
     instruction numbers; and the error region of each instruction."""
     dispatch = VM.run.dispatch
     words = code.words
-    starts = []
-    pc = 0
-    while pc < len(words):
-        starts.append(pc)
-        pc += OP.size(words[pc])
+    starts = OP.instruction_starts(words)
     index = {a: i for i, a in enumerate(starts)}
     index[len(words)] = len(starts)
     prog = []
@@ -274,39 +270,27 @@ class VM:
 
     # ------------------------------------------------------------------ calls
     def invoke(self, target, args: list, caller, catch_resume: bool = True):
-        """Run routine ``target`` = (module, Routine) with reference ``args``."""
-        rt = self.rt
-        module, routine = target
-        frame = rt.enter_routine(module, routine, args, caller)
-        code = self.codes.get(id(routine)) or self.code_for(module, routine, frame)
-        task = rt.current_task
-        prev = task.frame
-        task.frame = frame
-        returned = False
-        try:
-            value = self.run(code, frame, [None] * code.ntemps, 0, [])
-            if code.kind == "DEFFCT":
-                value = rt.return_value(routine, value, module)
-            returned = True
-            return value
-        except ResumeSignal as r:
-            if catch_resume and r.frame is caller and caller is not None:
-                return None
-            raise
-        finally:
-            task.frame = prev
-            rt.leave_routine(frame, returned)
+        """Run routine ``target`` = (module, Routine) with reference ``args`` (the
+        runtime's call protocol, Runtime.run_routine)."""
+        return self.rt.run_routine(target, args, caller, self.exec_routine, catch_resume)
+
+    def exec_routine(self, frame):
+        """Run the code of the routine of ``frame`` (compiled on its first call); the value
+        of its RETURN (None for a DEF)."""
+        routine = frame.routine
+        code = self.codes.get(id(routine)) or self.code_for(frame.module, routine, frame)
+        return self.run(code, frame, [None] * code.ntemps, 0, [])
 
     def call(self, code: Code, ip: int, name: str, args: list, frame, flags: str):
+        """A CALL whose routine is not known yet (the loop calls a known one itself):
+        a built-in, a stub, or a routine found now and kept for this call site."""
         rt = self.rt
-        target = code.callsites.get(ip)
+        target = rt.find_routine(name, frame.module)
         if target is None:
-            target = rt.find_routine(name, frame.module)
-            if target is None:
-                if rt.is_native(name):
-                    return rt.call_builtin(name, args)
-                return rt.stub_call(name, flags == "E")
-            code.callsites[ip] = target
+            if rt.is_native(name):
+                return rt.call_builtin(name, args)
+            return rt.stub_call(name, flags == "E")
+        code.callsites[ip] = target
         return self.invoke(target, args, frame, "N" not in flags)
 
     def thunk(self, code: Code, frame, temps: list, ip: int, stack: list | None = None):
