@@ -159,7 +159,8 @@ class Runtime:
             self.controller.finish(reason, text=text or None,
                                    number=err.number if err is not None else None,
                                    file=file, line=line, context=ctx)
-        self.trace = None       # abandoned tasks may unwind later: nothing more is traced
+        self.trace = None       # the suspended tasks unwind now: nothing more is traced
+        self.scheduler.close()
         return self.result
 
     def interpreter_active(self, robot: bool) -> bool:

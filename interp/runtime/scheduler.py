@@ -23,7 +23,7 @@ its own greenlet. Per IPO cycle the scheduler
 
 from __future__ import annotations
 
-from greenlet import greenlet
+from greenlet import GreenletExit, greenlet
 
 from .contexts import Context, InterruptTable
 
@@ -123,8 +123,22 @@ class Scheduler:
                     robot.pending_triggers.append(ev)
                 elif k == "error":
                     robot.pending_error = ev.error
-        # tasks still suspended are abandoned: never resumed; they stay referenced until the
-        # runtime is dropped (the runtime has stopped tracing by then)
+        # tasks still suspended stay so until close()
+
+    def close(self) -> None:
+        """End the tasks still suspended (the run stopped: a limit, an error, HALT, the
+        robot program's end): each unwinds now, with GreenletExit, in the run that owns
+        it. Left to the garbage collector, a suspended task would unwind at any later
+        moment, inside unrelated code (a signal handler's exception could be raised in
+        it and lost)."""
+        for task in self.tasks:
+            g = task.glet
+            if g is not None and g and not g.dead:
+                self.rt.current_task = task
+                try:
+                    g.throw(GreenletExit)
+                finally:
+                    self.rt.current_task = None
 
     def deadlocked(self) -> bool:
         rt = self.rt
