@@ -25,7 +25,7 @@ check-java:
 	  echo "       On Debian/Ubuntu: sudo apt-get install -y openjdk-17-jre-headless"; exit 2; }
 	@java -version 2>&1 | awk -F'"' '/version/ { split($$2, v, "."); if ((v[1] == 1 ? v[2] : v[1]) + 0 < 11) { print "error: Java 11 or later is needed, found " $$2; exit 2 } }'
 
-$(BIN)/.installed: pyproject.toml | check-python
+$(BIN)/.installed: pyproject.toml constraints.txt | check-python
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/pip install --quiet --upgrade pip
 	$(BIN)/pip install --quiet -e '.[dev]'
