@@ -11,7 +11,9 @@ from dataclasses import dataclass
 from pathlib import Path
 import codecs
 
-MAX_BYTES = 10 * 1024 * 1024
+from krl.limits import MAX_FILE_BYTES
+
+MAX_BYTES = MAX_FILE_BYTES   # krl/limits.py
 KRL_SUFFIXES = (".src", ".dat", ".sub")
 
 

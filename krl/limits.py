@@ -1,0 +1,19 @@
+"""Every size and depth limit on untrusted input, in one place (docs/security.md lists them).
+
+Each limit is a named constant; going past one is a normal error with a message and a place
+(file:line:col), never a crash. Commands and both interpreters read the limits from here, so one
+number holds everywhere. Add a limit here, with its unit and the reason for its value, and a row in
+docs/security.md.
+"""
+
+from __future__ import annotations
+
+# The nesting budget, shared by every command and both interpreters: the deepest nesting of
+# blocks (IF, FOR, WHILE, LOOP, REPEAT, SWITCH, SPLINE, ...) and brackets in expressions, counted
+# together, in levels. Real KRL nests a few levels (the corpus's deepest file is far below this);
+# C requires compilers to accept 127 nested blocks and 63 nested parentheses, which is the order
+# of magnitude chosen here. Past it: "nesting too deep" at the opener that went past it.
+MAX_NESTING = 100
+
+# The largest source file read, in bytes (krl/syntax/source.py).
+MAX_FILE_BYTES = 10 * 1024 * 1024
