@@ -42,9 +42,13 @@ def run_check(paths: list[str], as_json: bool = False, no_warnings: bool = False
     from krl.workspace import workspaces_for  # noqa: PLC0415
 
     any_error = False
+    seen: set = set()      # files already checked: `krl check A.src A.dat` checks module A once
     try:
         for path in paths:
+            if _resolved(path) in seen:
+                continue
             for ws in workspaces_for(path):
+                seen.update(_resolved(f.path) for f in ws.files)
                 diags = ws.check()
                 any_error |= any(d.is_error for d in diags)
                 shown = [d for d in diags if d.is_error or not no_warnings]
@@ -63,6 +67,14 @@ def run_check(paths: list[str], as_json: bool = False, no_warnings: bool = False
         echo(f"krl check: internal error: {type(exc).__name__}: {exc}")
         return 2
     return 1 if any_error else 0
+
+
+def _resolved(path) -> str:
+    from pathlib import Path  # noqa: PLC0415
+    try:
+        return str(Path(path).resolve())
+    except OSError:
+        return str(path)
 
 
 commands = [check]

@@ -104,7 +104,10 @@ class Diagnostic:
 
 
 class DiagnosticSink:
-    """Collects diagnostics, dropping exact duplicates."""
+    """Collects diagnostics, one per (path, line, code, message): the message names the
+    symbol, so a name that is wrong several times on one line (an unknown type in each
+    parameter of an EXT declaration) is reported once. Syntax diagnostics (E0xx) keep
+    their column in the key: two syntax errors on one line are two findings."""
 
     def __init__(self) -> None:
         self.items: list[Diagnostic] = []
@@ -112,8 +115,8 @@ class DiagnosticSink:
 
     def add(self, path: str, line: int, column: int, code: str, message: str,
             severity: str = "") -> None:
-        """Add one diagnostic (exact duplicates are dropped)."""
-        key = (path, line, column, code, message)
+        """Add one diagnostic (a repeat of (path, line, code, message) is dropped)."""
+        key = (path, line, column if code.startswith("E0") else 0, code, message)
         if key in self._seen:
             return
         self._seen.add(key)

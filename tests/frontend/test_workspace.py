@@ -89,3 +89,22 @@ def test_cli_report_option(tmp_path):
     res = CliRunner().invoke(check_cmd, [str(tmp_path / "corpus"), "--report", str(tmp_path / "out")])
     assert res.exit_code == 0 and "| backup |" in res.output
     assert (tmp_path / "out" / "check_report.md").exists()
+
+
+def test_module_given_as_src_and_dat_is_checked_once(tmp_path):
+    """`krl check A.src A.dat`: module A is one workspace, each diagnostic printed once."""
+    (tmp_path / "a.src").write_text("DEF a()\n  i = 1\nEND\n")
+    (tmp_path / "a.dat").write_text("DEFDAT a\n  DECL INT n = TRUE\nENDDAT\n")
+    res = CliRunner().invoke(check_cmd, [str(tmp_path / "a.src"), str(tmp_path / "a.dat")])
+    lines = [ln for ln in res.output.splitlines() if ": error " in ln]
+    assert len(lines) == 2, res.output                      # E101 in a.src, E201 in a.dat
+    assert sorted(ln.split(": error ")[1][:4] for ln in lines) == ["E101", "E201"]
+
+
+def test_one_diagnostic_per_code_name_and_line():
+    """An unknown type in every parameter of one EXT line is one E105, not one per use."""
+    from krl.workspace import check_texts
+    ws = check_texts({"m.src": "DEF m()\nEND\n",
+                      "m.dat": "DEFDAT m\n  EXT Foo(NOTYPE :IN, NOTYPE :IN, NOTYPE :OUT)\nENDDAT\n"})
+    found = [(d.line, d.code) for d in ws.diagnostics if "NOTYPE" in d.message]
+    assert found == [(2, "E105")], found
