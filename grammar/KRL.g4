@@ -340,7 +340,7 @@ priority
 
 // Path-synchronous actions (5.18): DISTANCE is the start (0) or end (1) point of the motion.
 triggerStatement
-    : TRIGGER WHEN DISTANCE '=' point=INTLITERAL {$point.text in ("0", "1")}?<fail={"TRIGGER WHEN DISTANCE takes 0 or 1"}>
+    : TRIGGER WHEN DISTANCE '=' point=INTLITERAL  // 0 or 1: checked after the parse (krl/syntax/checks.py)
       DELAY '=' expression DO triggerAction
       (PRIO '=' expression)?
     | TRIGGER WHEN PATH '=' expression ONSTART? DELAY '=' expression DO triggerAction

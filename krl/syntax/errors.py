@@ -119,6 +119,17 @@ class CollectingErrorListener(ErrorListener):
                             line_text=self._line_text(line))
         self.issues.append(issue)
 
+    def check_issue(self, failure) -> object:
+        """A SyntaxIssue for a failed post-parse token check (krl.syntax.checks)."""
+        from krl.syntax.parse import SyntaxIssue  # noqa: PLC0415
+
+        token, check = failure.token, failure.check
+        return SyntaxIssue(line=token.line, column=token.column,
+                           message=f"{check.message}, not {token.text}", offending=token.text or "",
+                           expected=list(check.allowed), rule_stack=list(failure.rule_stack),
+                           kind="syntax", offending_type=self.bundle.token_name(token.type),
+                           line_shape=self._shape(token), line_text=self._line_text(token.line))
+
     def finish_lexer(self, text: str) -> list:
         """Turn the collected lexer errors into SyntaxIssue records."""
         from krl.syntax.parse import SyntaxIssue  # noqa: PLC0415

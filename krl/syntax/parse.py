@@ -22,6 +22,7 @@ from antlr4.atn.PredictionMode import PredictionMode
 from antlr4.error.ErrorStrategy import BailErrorStrategy
 from antlr4.error.Errors import ParseCancellationException
 
+from krl.syntax.checks import may_fail, run_checks
 from krl.syntax.errors import CollectingErrorListener, LineErrorStrategy
 from krl.syntax.source import SourceText, read_source
 
@@ -158,7 +159,14 @@ def parse_text(text: str, path: str = "<string>", bundle: ParserBundle | None = 
     try:
         tree = parser.module()
         if not lex_listener.issues and not lex_listener._lexer_raw:
-            return ParseResult(path, True, encoding, "ok", [], tree if keep_tree else None, "sll")
+            failures = run_checks(tree, bundle.parser_cls) if may_fail(text) else []
+            if not failures:
+                return ParseResult(path, True, encoding, "ok", [], tree if keep_tree else None, "sll")
+            listener = CollectingErrorListener(bundle, kind="syntax", tokens=tokens, text=text)
+            issues = [listener.check_issue(f) for f in failures]
+            listener.mark_cascades(issues)
+            return ParseResult(path, False, encoding, "syntax_error", issues,
+                               tree if keep_tree else None, "sll")
     except ParseCancellationException:
         pass
 
@@ -172,7 +180,9 @@ def parse_text(text: str, path: str = "<string>", bundle: ParserBundle | None = 
     parser._errHandler = LineErrorStrategy()
     tree = parser.module()
     lex_issues = lex_listener.finish_lexer(text)
-    issues = sorted(lex_issues + listener.issues, key=lambda i: (i.line, i.column))
+    check_issues = ([listener.check_issue(f) for f in run_checks(tree, bundle.parser_cls)]
+                    if may_fail(text) else [])
+    issues = sorted(lex_issues + listener.issues + check_issues, key=lambda i: (i.line, i.column))
     listener.mark_cascades(issues)
     ok = not issues
     return ParseResult(path, ok, encoding, "ok" if ok else "syntax_error", issues,
