@@ -355,26 +355,27 @@ triggerAction
 // ------------------------------------------------------------------ motions (6.1)
 
 // A relative motion may name its reference frame, #BASE (default) or #TOOL (6.1, 6.3); the
-// check is a validating predicate on the enum literal, so the tree keeps the bare token.
+// grammar takes any enum literal under the label frame=, checked after the parse
+// (krl/syntax/checks.py), so that every ANTLR target runs this grammar.
 motion
     : PTP expression approximation? approximation?                                   # ptpMotion
     | PTP_REL expression approximation? approximation?
-      (frame=ENUMLITERAL {$frame.text.upper() in ("#BASE", "#TOOL")}?<fail={"a relative motion takes #BASE or #TOOL"}>)? # ptpRelMotion
+      (frame=ENUMLITERAL)? # ptpRelMotion
     | LIN expression approximation? approximation?                                   # linMotion
     | LIN_REL expression approximation? approximation?
-      (frame=ENUMLITERAL {$frame.text.upper() in ("#BASE", "#TOOL")}?<fail={"a relative motion takes #BASE or #TOOL"}>)? # linRelMotion
+      (frame=ENUMLITERAL)? # linRelMotion
     | CIRC expression ',' expression (',' CA expression)? approximation? approximation? # circMotion
     | CIRC_REL expression ',' expression (',' CA expression)? approximation?
-      (frame=ENUMLITERAL {$frame.text.upper() in ("#BASE", "#TOOL")}?<fail={"a relative motion takes #BASE or #TOOL"}>)? # circRelMotion
+      (frame=ENUMLITERAL)? # circRelMotion
     | SPTP expression withClause? splineApproximation?                               # sptpMotion
     | SLIN expression withClause? splineApproximation?                               # slinMotion
     | SCIRC expression ',' expression (',' CA expression)? withClause? C_SPL?        # scircMotion
     | SPTP_REL expression withClause? splineApproximation?
-      (frame=ENUMLITERAL {$frame.text.upper() in ("#BASE", "#TOOL")}?<fail={"a relative motion takes #BASE or #TOOL"}>)? # sptpRelMotion
+      (frame=ENUMLITERAL)? # sptpRelMotion
     | SLIN_REL expression withClause? splineApproximation?
-      (frame=ENUMLITERAL {$frame.text.upper() in ("#BASE", "#TOOL")}?<fail={"a relative motion takes #BASE or #TOOL"}>)? # slinRelMotion
+      (frame=ENUMLITERAL)? # slinRelMotion
     | SCIRC_REL expression ',' expression (',' CA expression)? withClause? C_SPL?
-      (frame=ENUMLITERAL {$frame.text.upper() in ("#BASE", "#TOOL")}?<fail={"a relative motion takes #BASE or #TOOL"}>)? # scircRelMotion
+      (frame=ENUMLITERAL)? # scircRelMotion
     ;
 
 // Spline blocks (6.2): one motion through all segments; inside only segments, TRIGGERs,

@@ -56,3 +56,25 @@ def test_check_error_beside_a_grammar_error():
 ])
 def test_may_fail_prefilter(text, expected):
     assert may_fail(text) is expected
+
+
+@pytest.mark.parametrize("line", [
+    "LIN_REL {X 10} #BASE", "PTP_REL {A1 5} C_PTP #TOOL", "slin_rel {z 1} #tool",
+    "CIRC_REL {X 1}, {X 2} #BASE", "SPTP_REL {A1 5}", "SCIRC_REL {X 1}, {X 2} #Tool",
+])
+def test_relative_motion_frames_accepted(line):
+    res = parse_text(routine(line))
+    assert res.ok, [e.message for e in res.errors]
+
+
+@pytest.mark.parametrize("line, column, frame", [
+    ("LIN_REL {Z 10.0} #WORLD", 17, "#WORLD"),
+    ("PTP_REL {A1 5} C_PTP #ROBROOT", 21, "#ROBROOT"),
+    ("SLIN_REL {X 1} #base1", 15, "#base1"),
+])
+def test_relative_motion_other_frames_rejected_at_the_frame(line, column, frame):
+    res = parse_text(routine(line))
+    [err] = res.errors
+    assert (err.line, err.column, err.offending) == (2, column, frame)
+    assert err.message == f"a relative motion takes #BASE or #TOOL, not {frame}"
+    assert err.rule_stack[-2:] == ["statement", "motion"]
