@@ -1,5 +1,7 @@
 """Built-in types, system variables and routines, loaded from the data tables in
-``krl/semantics/data`` (types.yaml, sysvars.yaml, functions.yaml). Data, not code:
+``krl/semantics/data`` (types.yaml, sysvars.yaml, functions.yaml from the reference; kss.yaml
+derived from KUKA system files by krl/semantics/derive_tables.py, each entry with its
+source). Data, not code:
 this module only reads the tables into plain records, once per process.
 
 Reference: 3.7 (predefined structures and enums), 4.5-4.8 (functions and procedures),
@@ -65,6 +67,13 @@ class Builtins:
     sysvars: dict[str, SysVarInfo]          # UPPER name -> info
     routines: dict[str, SignatureInfo]      # UPPER name -> signature
     exact: frozenset[str] = frozenset()     # UPPER names of complete type definitions
+    # kss.yaml (derived, lower precedence than the hand-written tables above):
+    kss_structs: dict[str, str] = field(default_factory=dict)
+    # the checker knows these names; the interpreters simulate only `sysvars`
+    kss_variables: dict[str, SysVarInfo] = field(default_factory=dict)
+    kss_enums: dict[str, list[str]] = field(default_factory=dict)
+    sources: dict[str, str] = field(default_factory=dict)      # UPPER name -> "path:line"
+    packages: dict[str, tuple[str, str]] = field(default_factory=dict)  # UPPER name -> (package, source)
 
 
 _NAME_DIMS = re.compile(r"^\s*(\$?[A-Za-z_][\w$]*)\s*(?:\[([\d,\s]*)\])?\s*$")
@@ -135,6 +144,29 @@ def load_builtins() -> Builtins:
     for names in (funcs.get("lenient") or {}).values():
         for name in names:
             routines.setdefault(str(name).upper(), SignatureInfo(str(name).upper(), "ANY", [], True))
+    kss = _read("kss.yaml")
+    sources: dict[str, str] = {}
+    kss_structs: dict[str, str] = {}
+    kss_enums: dict[str, list[str]] = {}
+    for key, info in (kss.get("types") or {}).items():
+        if "struc" in info:
+            kss_structs[info["name"]] = info["struc"]
+        else:
+            kss_enums[info["name"]] = [str(v) for v in info["enum"]]
+        sources[key] = info["source"]
+    kss_variables: dict[str, SysVarInfo] = {}
+    for key, info in (kss.get("variables") or {}).items():
+        name, dims = split_name(info["name"])
+        if name.upper() not in sysvars:
+            tname, tdims = split_name(info["type"])
+            kss_variables[name.upper()] = SysVarInfo(name, tname, dims + tdims,
+                                                     "RO" if info.get("const") else "RW")
+            sources.setdefault(key, info["source"])
+    for key, info in (kss.get("routines") or {}).items():
+        if key not in routines:
+            routines[key] = parse_signature(info["signature"], bool(info["function"]))
+            sources.setdefault(key, info["source"])
+    packages = {k: (v["package"], v["source"]) for k, v in (kss.get("packages") or {}).items()}
     options = types.get("options", {}) or {}
     bvars = {}
     for key, tname in list((basis.get("variables") or {}).items()) + list((options.get("variables") or {}).items()):
@@ -153,4 +185,9 @@ def load_builtins() -> Builtins:
         sysvars=sysvars,
         routines=routines,
         exact=frozenset(str(n).upper() for n in types.get("exact", [])),
+        kss_structs=kss_structs,
+        kss_variables=kss_variables,
+        kss_enums=kss_enums,
+        sources=sources,
+        packages=packages,
     )

@@ -187,7 +187,16 @@ def system_scopes() -> tuple[Scope, Scope]:
         system.define_type(name, s)
     for name, text in b.structs.items():
         fill_struc(system, strucs[name], T.parse_component_list(text))
-    for info in b.sysvars.values():
+    # types of KUKA's system data lists (kss.yaml): only names the reference tables lack
+    for name, values in b.kss_enums.items():
+        if system.lookup_type(name) is None:
+            system.define_type(name, T.Enum(name, frozenset(v.upper() for v in values), soft=True))
+    kss = {name: T.Struc(name, soft=True) for name in b.kss_structs if system.lookup_type(name) is None}
+    for name, s in kss.items():
+        system.define_type(name, s)
+    for name, s in kss.items():
+        fill_struc(system, s, T.parse_component_list(b.kss_structs[name]))
+    for info in list(b.sysvars.values()) + list(b.kss_variables.values()):
         typ = make_array(system.lookup_type(info.type_name) or T.UNKNOWN, info.dims)
         system.define("values", Symbol(info.name, "sysvar", typ, "system", None, info.access,
                                        stop_read=info.stop_read, stop_write=info.stop_write))

@@ -1,0 +1,177 @@
+"""Derive the KSS platform table (krl/semantics/data/kss.yaml) from system files of a corpus.
+
+Facts, not files: from every KUKA system data list of the corpus (``DEFDAT $OPERATE``,
+``$OPERATE_R1``, ``$MACHINE``, ``$ROBCOR``, ``$CUSTOM``, ``$OPTION``; ``$CONFIG`` is left out:
+its user part belongs to one robot cell, and its BASIS part is the ``basis`` table of
+types.yaml) the names of the declared types, variables and routine signatures are read,
+each with the ``path:line`` it came from. From the files of technology packages
+(``R1/TP/<package>/``) the GLOBAL names are read with the package that declares them.
+
+Usage (the corpus is read in place, never copied)::
+
+    python -m krl.semantics.derive_tables ../shared/krl-corpus > krl/semantics/data/kss.yaml
+
+tests/frontend/test_kss_tables.py checks that the committed table equals a fresh derivation
+when the corpus is present. The first declaration of a name (in the order of
+:func:`system_files`) wins; the hand-written tables (types.yaml, sysvars.yaml,
+functions.yaml, from the reference) win over this one, and a backup's own declarations win
+over all tables (they live in its global scope, above the system scope).
+"""
+
+from __future__ import annotations
+
+import csv
+import re
+import sys
+from pathlib import Path
+
+import yaml
+
+from krl.ast import nodes as N
+from krl.ast.build import build_module
+from krl.syntax.parse import parse_source
+from krl.syntax.source import read_source
+
+# system data lists whose declarations are platform facts, in the order in which they win
+SYSTEM_DATALISTS = ("$OPERATE", "$OPERATE_R1", "$MACHINE", "$ROBCOR", "$CUSTOM", "$OPTION")
+_SYSTEM_DEFDAT = re.compile(r"^\s*DEFDAT\s+\$", re.IGNORECASE | re.MULTILINE)
+
+
+def _known_invalid(corpus: Path) -> set[str]:
+    listing = Path(__file__).resolve().parents[2] / "corpus" / "known-invalid.csv"
+    try:
+        with open(listing, encoding="utf-8") as fh:
+            return {row["path"] for row in csv.DictReader(fh)}
+    except OSError:
+        return set()
+
+
+def _modules(corpus: Path):
+    """(relative path, Module) of every .dat file of the corpus that parses, sorted."""
+    invalid = _known_invalid(corpus)
+    for p in sorted(corpus.rglob("*")):
+        if not p.is_file() or p.suffix.lower() != ".dat":
+            continue
+        rel = p.relative_to(corpus).as_posix()
+        if rel in invalid:
+            continue
+        in_tp = "tp" in [q.lower() for q in p.relative_to(corpus).parts[:-1]]
+        try:
+            head = p.read_bytes()[:4096].decode("latin-1")
+        except OSError:
+            continue
+        if not in_tp and not _SYSTEM_DEFDAT.search(head):
+            continue            # only system data lists and technology-package files are read
+        result = parse_source(read_source(p))
+        if not result.ok:
+            continue
+        module = build_module(result)
+        if module.data is not None:
+            yield rel, module
+
+
+def _dims(dims) -> str:
+    return f"[{','.join(str(d) for d in dims)}]" if dims else ""
+
+
+def _components(d: N.StrucDecl) -> str:
+    out, cur = [], None
+    for c in d.components:
+        head = f"{c.type_name} " if c.type_name.upper() != cur else ""
+        cur = c.type_name.upper()
+        out.append(f"{head}{c.name}{_dims(c.dims)}")
+    return ", ".join(out)
+
+
+def _signature(d: N.ExtDecl) -> str:
+    params = []
+    for i, p in enumerate(d.params):
+        size = p.name_size if p.name_size is not None else p.type_size
+        dims = "" if size is None else f"[{size or ''}]"
+        mode = f" :{p.mode.upper()}" if p.mode else ""
+        params.append(f"{p.type_name} {p.name or f'P{i + 1}'}{dims}{mode}")
+    ret = f"{d.return_type.name} " if d.return_type is not None else ""
+    return f"{ret}{d.name}({', '.join(params)})"
+
+
+def derive(corpus: str | Path) -> dict:
+    """The table as a dict (see the module docstring); empty sections when nothing is found."""
+    corpus = Path(corpus)
+    types: dict[str, dict] = {}
+    variables: dict[str, dict] = {}
+    routines: dict[str, dict] = {}
+    packages: dict[str, dict] = {}
+    files = list(_modules(corpus))
+    rank = {n: i for i, n in enumerate(SYSTEM_DATALISTS)}
+    system = sorted(((rel, m) for rel, m in files if m.data.name.upper() in rank),
+                    key=lambda rm: (rank[rm[1].data.name.upper()], rm[0]))
+    for rel, module in system:
+        for d in module.data.items:
+            where = f"{rel}:{d.span.line}"
+            if isinstance(d, N.StrucDecl):
+                types.setdefault(d.name.upper(), {"name": d.name, "struc": _components(d), "source": where})
+            elif isinstance(d, N.EnumDecl):
+                types.setdefault(d.name.upper(), {"name": d.name, "enum": list(d.values), "source": where})
+            elif isinstance(d, N.VarDecl):
+                for v in d.names:
+                    entry = {"type": d.type.name + (f"[{d.type.size}]" if d.type.size else ""),
+                             "source": where}
+                    if d.is_const:
+                        entry["const"] = True
+                    variables.setdefault(v.name.upper(), {"name": v.name + _dims(v.dims), **entry})
+            elif isinstance(d, N.SignalDecl):
+                typ = "INT" if d.end is not None else "BOOL"
+                variables.setdefault(d.name.upper(), {"name": d.name, "type": typ, "source": where,
+                                                      "signal": True})
+            elif isinstance(d, N.ExtDecl):
+                routines.setdefault(d.name.upper(), {"signature": _signature(d),
+                                                     "function": d.return_type is not None,
+                                                     "source": where})
+    # technology packages: GLOBAL names of the data lists in R1/TP/<package>/
+    for rel, module in files:
+        parts = rel.split("/")
+        low = [p.lower() for p in parts]
+        if "tp" not in low[:-1] or low.index("tp") + 2 >= len(parts):
+            continue
+        package = parts[low.index("tp") + 1]
+        for d in module.data.items:
+            if not getattr(d, "is_global", False):
+                continue
+            names = [v.name for v in d.names] if isinstance(d, N.VarDecl) else [getattr(d, "name", "")]
+            for n in names:
+                if n:
+                    packages.setdefault(n.upper(), {"package": package, "source": f"{rel}:{d.span.line}"})
+    return {"types": dict(sorted(types.items())),
+            "variables": dict(sorted(variables.items())),
+            "routines": dict(sorted(routines.items())),
+            "packages": dict(sorted(packages.items()))}
+
+
+HEADER = """\
+# KSS platform facts derived from the system files of the corpus (read in place):
+# types, variables and routine signatures of KUKA's system data lists ($OPERATE,
+# $OPERATE_R1, $MACHINE, $ROBCOR, $CUSTOM, $OPTION) and the GLOBAL names of technology
+# packages (R1/TP/<package>/). Each entry names its source file and line (paths relative
+# to ../shared/krl-corpus; MANIFEST.csv there gives repository and commit).
+# Generated by: python -m krl.semantics.derive_tables ../shared/krl-corpus
+# Do not edit by hand; the hand-written tables (types.yaml, sysvars.yaml, functions.yaml)
+# win over this one, and a backup's own declarations win over every table.
+"""
+
+
+def render(table: dict) -> str:
+    """The YAML text of a derived table (stable: sorted keys, one entry per line)."""
+    return HEADER + yaml.safe_dump(table, sort_keys=True, allow_unicode=True, width=200,
+                                   default_flow_style=None)
+
+
+def main(argv: list[str]) -> int:
+    if len(argv) != 1 or not Path(argv[0]).is_dir():
+        print("usage: python -m krl.semantics.derive_tables CORPUS_FOLDER", file=sys.stderr)
+        return 2
+    sys.stdout.write(render(derive(argv[0])))
+    return 0
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main(sys.argv[1:]))
