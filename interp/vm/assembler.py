@@ -33,6 +33,8 @@ import linecache
 import re
 from dataclasses import dataclass, field
 
+from krl.terminal import printable
+
 from interp.runtime.advance import StmtInfo
 from interp.runtime.values import EnumValue
 
@@ -147,7 +149,8 @@ def const_key(v):
 
 
 def source_comment(file: str, line: int) -> str:
-    text = linecache.getline(file, line).strip() if file else ""
+    # printable: a form feed, U+0085, U+2028... in the line stays on the comment's line
+    text = printable(linecache.getline(file, line).strip()) if file else ""
     return f"; {line}: {text}" if text else f"; {line}"
 
 

@@ -13,6 +13,8 @@ def program_assembly(program: Path, workspace: Path | None = None, all_modules: 
     workspace that has routines), compiled as the VM would compile it."""
     from interp.run import make_runtime  # noqa: PLC0415
 
+    from krl.terminal import printable  # noqa: PLC0415
+
     from .compiler import compile_module  # noqa: PLC0415
 
     rt, _ = make_runtime(program, workspace=workspace, mujoco=False, interp="vm")
@@ -27,9 +29,9 @@ def program_assembly(program: Path, workspace: Path | None = None, all_modules: 
         if m is None:
             continue
         if m.syntax_errors:
-            out.append(f"; module {m.name}: syntax errors, not compiled: {m.syntax_errors[0]}\n")
+            out.append(f"; module {printable(m.name)}: syntax errors, not compiled: {printable(m.syntax_errors[0])}\n")
             continue
-        out.append(f"; module {m.name}\n" + compile_module(rt, m))
+        out.append(f"; module {printable(m.name)}\n" + compile_module(rt, m))
     return "\n".join(out)
 
 

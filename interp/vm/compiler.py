@@ -1,4 +1,9 @@
-"""The bytecode compiler: a routine's AST -> readable assembly text (interp/vm/assembler.py).
+"""The bytecode compiler: a routine's AST -> its instruction listing (interp/vm/assembler.py).
+
+The VM encodes the listing directly (assembler.encode); no text is produced or parsed on
+the way to running code, so no KRL text (a comment, a string) can ever be read back as an
+instruction. The readable assembly (assembler.format_listing) is written only for
+`krl asm` and the assembler's round-trip tests.
 
 It mirrors the tree interpreter statement by statement (interp/tree/interpreter.py), so
 that the VM makes the same runtime calls in the same order; only the stepping differs:
@@ -153,7 +158,7 @@ class Compiler:
         self.emit("STMT_G", self.info(st))
 
     # ------------------------------------------------------------------ routine
-    def compile(self) -> str:
+    def compile(self) -> Listing:
         self.block(self.routine.body)
         self.region = None
         self.emit("END")
@@ -165,7 +170,7 @@ class Compiler:
             self.emit("END_THUNK")
         while peephole(self.lst):
             pass
-        return format_listing(self.lst)
+        return self.lst
 
     def thunk(self, fn) -> str:
         label = self.new_label()
@@ -838,17 +843,19 @@ def peephole(lst: Listing) -> bool:
     return len(new) < len(old)
 
 
-def compile_routine(rt, module, routine: N.Routine, frame: Frame | None = None) -> str:
-    """The assembly text of ``routine`` (of ``module``, a runtime ModuleRT)."""
+def compile_routine(rt, module, routine: N.Routine, frame: Frame | None = None) -> Listing:
+    """The instruction listing of ``routine`` (of ``module``, a runtime ModuleRT), for
+    assembler.encode (the VM) or assembler.format_listing (`krl asm`)."""
     return Compiler(rt, module, routine, frame).compile()
 
 
 def compile_module(rt, module) -> str:
-    """The assembly text of every routine of ``module``, main routine first."""
+    """The readable assembly text of every routine of ``module``, main routine first
+    (`krl asm` and the round-trip tests; the VM never reads it)."""
     parts = []
     seen = set()
     for r in module.routines.values():
         if id(r) not in seen:
             seen.add(id(r))
-            parts.append(compile_routine(rt, module, r))
+            parts.append(format_listing(compile_routine(rt, module, r)))
     return "\n".join(parts)

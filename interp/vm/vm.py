@@ -1,4 +1,4 @@
-"""The VM: runs assembled code (interp/vm/assembler.py) on the shared runtime.
+"""The VM: runs encoded code (interp/vm/assembler.py) on the shared runtime.
 
 One dispatch loop (:meth:`VM.run`) with the instruction pointer, the operand stack and
 the frame's store in locals, one dispatch point, and every semantic operation a call into
@@ -43,7 +43,7 @@ from interp.runtime.slots import (add, anout_limits, anout_value, array_index, c
                                   set_element1, store, sub, trigger_args)
 
 from . import opcodes as OP
-from .assembler import Code, Region, assemble
+from .assembler import Code, Region, encode
 from .compiler import compile_routine
 
 
@@ -257,7 +257,7 @@ class VM:
     def code_for(self, module, routine, frame=None) -> Code:
         code = self.codes.get(id(routine))
         if code is None:
-            code = assemble(compile_routine(self.rt, module, routine, frame))[0]
+            code = encode(compile_routine(self.rt, module, routine, frame))   # no text on the way
             code.routine = routine
             code.module = module
             data = module.data if module is not None else {}
