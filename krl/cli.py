@@ -6,7 +6,6 @@ internal error.
 
 from __future__ import annotations
 
-import json
 import sys
 from pathlib import Path
 
@@ -23,35 +22,16 @@ def main() -> None:
 
 @main.command()
 @click.argument("files", nargs=-1, required=True, type=click.Path(path_type=Path))
-@click.option("--json", "as_json", is_flag=True, help="One JSON object per file.")
-@click.option("--outline", is_flag=True, help="Print the tree outline of each file that parses.")
-def parse(files: tuple[Path, ...], as_json: bool, outline: bool) -> None:
-    """Parse FILES; exit 0 when every file parses."""
-    from krl.syntax.outline import outline as tree_outline  # noqa: PLC0415
-    from krl.syntax.parse import parse_file  # noqa: PLC0415
+@click.option("--format", "fmt", type=click.Choice(["text", "json", "sarif"]), default="text",
+              show_default=True, help="text: compiler style; json: one object per file; sarif: SARIF 2.1.0.")
+@click.option("--json", "as_json", is_flag=True, help="Same as --format json.")
+@click.option("--outline", is_flag=True, help="Print the routines and declarations of each file that parses.")
+@click.option("--tree", is_flag=True, help="Print the grammar-rule outline of each file that parses.")
+def parse(files: tuple[Path, ...], fmt: str, as_json: bool, outline: bool, tree: bool) -> None:
+    """Parse FILES; exit 0 when every file parses (krl/syntax/cli.py)."""
+    from krl.syntax.cli import main_status  # noqa: PLC0415
 
-    all_ok = True
-    for path in files:
-        result = parse_file(path, keep_tree=outline)
-        if outline and result.ok:
-            for entry in tree_outline(result.tree):
-                click.echo(f"{path}:{entry}")
-        all_ok &= result.ok
-        if as_json:
-            obj = result.as_json()
-            if result.status not in ("ok", "syntax_error"):
-                obj["status"] = result.status
-            click.echo(json.dumps(obj))
-        elif result.ok:
-            click.echo(f"{path}: ok")
-        elif not result.errors:
-            click.echo(f"{path}: {result.status}", err=False)
-        else:
-            for err in result.errors:
-                if err.cascade:
-                    continue
-                click.echo(f"{path}:{err.line}:{err.column + 1}: error: {err.message}")
-    sys.exit(0 if all_ok else 1)
+    sys.exit(main_status(files, fmt, as_json, outline, tree))
 
 
 # Each pipeline stage contributes its subcommands from its own package: a module listed

@@ -17,3 +17,10 @@ MAX_NESTING = 100
 
 # The largest source file read, in bytes (krl/syntax/source.py).
 MAX_FILE_BYTES = 10 * 1024 * 1024
+
+# The most operands (terms) in one statement's expressions, counted on its line: `a + b * c` has
+# 3. Real KRL stays far below (long conditions have a few dozen terms); the limit keeps the parse
+# tree, the AST and the recursive evaluation of both interpreters bounded, since a chain of
+# binary operators nests one level per operator. Past it: error E019 "expression too long" at
+# the statement's line (the file does not parse; the program does not start).
+MAX_EXPRESSION_TERMS = 500

@@ -35,6 +35,7 @@ from krl.ast.build import build_module
 from krl.semantics.checker import Checker, Declarer, _is_system_datalist
 from krl.semantics.diagnostics import Diagnostic, DiagnosticSink
 from krl.semantics.symbols import Scope, Symbol, system_scopes
+from krl.syntax.messages import syntax_diagnostics
 from krl.syntax.parse import parse_source
 from krl.syntax.source import is_krl_file, read_source
 
@@ -123,12 +124,10 @@ class Workspace:
         elapsed = time.perf_counter() - t
         self.parse_seconds += elapsed
         path_s = str(path)
-        if result.status not in ("ok", "syntax_error"):
+        if result.status not in ("ok", "syntax_error") and not result.errors:
             self.sink.add(path_s, 1, 1, "E001", f"file not checked: {result.status}"
                           + (f" ({src.detail})" if src.detail else ""))
-        for err in result.errors:
-            if not err.cascade:
-                self.sink.add(path_s, err.line, err.column + 1, "E002", err.message)
+        self.sink.extend(syntax_diagnostics(result, src.text))
         t = time.perf_counter()
         self._note_failed(result, src.text)
         module = build_module(result, self.sink)
@@ -144,9 +143,7 @@ class Workspace:
         t = time.perf_counter()
         result = parse_text(text, path)
         self.parse_seconds += time.perf_counter() - t
-        for err in result.errors:
-            if not err.cascade:
-                self.sink.add(path, err.line, err.column + 1, "E002", err.message)
+        self.sink.extend(syntax_diagnostics(result, text))
         self._note_failed(result, text)
         module = build_module(result, self.sink)
         sf = SourceFile(path, module, result.ok, result.status)

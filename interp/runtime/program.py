@@ -55,11 +55,16 @@ def parse_module(path: str):
         return got
     from krl.ast.build import build_module  # noqa: PLC0415
     from krl.semantics.diagnostics import DiagnosticSink  # noqa: PLC0415
-    from krl.syntax.parse import parse_file  # noqa: PLC0415
+    from krl.syntax.parse import parse_source  # noqa: PLC0415
+    from krl.syntax.messages import syntax_diagnostics  # noqa: PLC0415
+    from krl.syntax.source import read_source  # noqa: PLC0415
 
-    res = parse_file(path)
-    mod = build_module(res, DiagnosticSink())
-    errs = [f"{path}:{e.line}:{e.column + 1}: {e.message}" for e in res.errors if not e.cascade]
+    src = read_source(path)
+    res = parse_source(src)
+    sink = DiagnosticSink()
+    mod = build_module(res, sink)  # E003: a construct that cannot be built stops the start too
+    errs = [f"{d.path}:{d.line}:{d.column}: {d.message}"
+            for d in syntax_diagnostics(res, src.text) + sink.errors]
     if not res.ok and not res.errors:
         errs.append(f"{path}: {res.status}")
     got = (mod, errs)

@@ -140,12 +140,12 @@ class Builder:
             return fn(ctx)
         except RecursionError:
             sp = self.span(ctx)
-            self.sink.add(self.path, sp.line, sp.column, "W003", "construct nested too deeply")
+            self.sink.add(self.path, sp.line, sp.column, "E003", "construct nested too deeply to build")
             return default
         except Exception as exc:  # noqa: BLE001 - the builder must never raise
             if not self.recovered:
                 sp = self.span(ctx)
-                self.sink.add(self.path, sp.line, sp.column, "W003",
+                self.sink.add(self.path, sp.line, sp.column, "E003",
                               f"cannot build '{_names(ctx)[0]}': {exc}")
             return default
 
@@ -1061,7 +1061,8 @@ def build_module(result, sink: DiagnosticSink | None = None) -> N.Module:
 
     `result` is a krl.syntax.parse.ParseResult (its `.tree` must be kept). Returns a
     Module (possibly empty, for a file that was not parsed or lost its tree). Never raises;
-    problems go to `sink` as W003 diagnostics. Reference: sections 2-6 for the shapes.
+    a construct that cannot be built is an E003 error (the program does not start), one the
+    builder does not map yet a W003 warning (it is kept as an Unsupported statement). Reference: sections 2-6 for the shapes.
     """
     sink = sink if sink is not None else DiagnosticSink()
     path = result.path
@@ -1074,5 +1075,5 @@ def build_module(result, sink: DiagnosticSink | None = None) -> N.Module:
         b = Builder(path, sink, symbolic, recovered=not result.ok)
         return b.module(tree)
     except Exception as exc:  # noqa: BLE001 - never raise on any parse tree
-        sink.add(path, 1, 1, "W003", f"AST builder failed: {type(exc).__name__}: {exc}")
+        sink.add(path, 1, 1, "E003", f"AST builder failed: {type(exc).__name__}: {exc}")
         return N.Module(path, "src", span=N.Span(path, 1, 1))

@@ -2,9 +2,11 @@
 
 PATH is a file (checked with the .src/.dat of its module), a KRC backup folder (one
 workspace), or a folder holding backups (one workspace per backup) or plain files (one
-workspace). Output: one ``path:line:col: error|warning CODE message`` line per diagnostic,
-or with --json one JSON object per workspace. Exit 1 when there are errors, 0 otherwise,
-2 for an internal failure; never a Python traceback for bad input.
+workspace). Output (``--format``): compiler-style text (``path:line:col: error[CODE]: message``,
+the source line and a caret, krl/semantics/render.py, then a count line), one JSON object per
+workspace, or SARIF 2.1.0. ``--ignore CODE`` and the workspace's ``krl.toml`` select codes and
+severities (krl/semantics/config.py). Exit 1 when there are errors, 0 otherwise, 2 for a bad
+configuration or an internal failure; never a Python traceback for bad input.
 """
 
 from __future__ import annotations
@@ -17,11 +19,16 @@ import click
 
 @click.command()
 @click.argument("paths", nargs=-1, required=True)
-@click.option("--json", "as_json", is_flag=True, help="One JSON object per workspace.")
+@click.option("--format", "fmt", type=click.Choice(["text", "json", "sarif"]), default="text", show_default=True,
+              help="text: compiler style; json: one object per workspace; sarif: SARIF 2.1.0.")
+@click.option("--json", "as_json", is_flag=True, help="Same as --format json.")
 @click.option("--no-warnings", is_flag=True, help="Print errors only.")
+@click.option("--ignore", "ignore", multiple=True, metavar="CODE",
+              help="Do not report CODE (or a prefix: W1); repeatable, or comma-separated. Adds to krl.toml.")
 @click.option("--report", "report_dir", default=None,
               help="Instead: write check_report.md/.json for the KRC backups below PATH into this folder.")
-def check(paths: tuple[str, ...], as_json: bool, no_warnings: bool, report_dir: str | None) -> None:
+def check(paths: tuple[str, ...], fmt: str, as_json: bool, no_warnings: bool, ignore: tuple[str, ...],
+          report_dir: str | None) -> None:
     """Type-check KRL files or KRC backups; exit 1 when there are errors."""
     if report_dir is not None:
         from krl.semantics.report import check_report  # noqa: PLC0415
@@ -33,26 +40,45 @@ def check(paths: tuple[str, ...], as_json: bool, no_warnings: bool, report_dir: 
             click.echo(f"krl check: internal error: {type(exc).__name__}: {exc}")
             sys.exit(2)
         sys.exit(0)
-    status = run_check(list(paths), as_json, no_warnings, click.echo)
+    from krl.semantics.render import use_colour  # noqa: PLC0415
+
+    fmt = "json" if as_json else fmt
+    status = run_check(list(paths), no_warnings=no_warnings, echo=click.echo, fmt=fmt,
+                       ignore=[c for v in ignore for c in v.split(",") if c.strip()],
+                       colour=fmt == "text" and use_colour(sys.stdout))
     sys.exit(status)
 
 
-def run_check(paths: list[str], as_json: bool = False, no_warnings: bool = False, echo=print) -> int:
-    """Check `paths` and print the diagnostics; returns the exit status (0, 1 or 2)."""
+def run_check(paths: list[str], as_json: bool = False, no_warnings: bool = False, echo=print,
+              fmt: str = "text", ignore=(), colour: bool = False) -> int:
+    """Check `paths` and print the diagnostics in `fmt` ("text", "json", "sarif"; `as_json` is
+    the old spelling of "json"); `ignore`: codes not to report (with the krl.toml of each
+    workspace, krl/semantics/config.py). Returns the exit status: 0, 1 (errors), 2 (bad
+    configuration or internal failure)."""
+    from krl.semantics.config import ConfigError, Selection, config_for, parse_codes  # noqa: PLC0415
+    from krl.semantics.render import Renderer  # noqa: PLC0415
+    from krl.terminal import printable  # noqa: PLC0415
     from krl.workspace import workspaces_for  # noqa: PLC0415
 
+    fmt = "json" if as_json else fmt
+    renderer = Renderer(echo, colour)
+    all_shown = []
+    files = 0
     any_error = False
     seen: set = set()      # files already checked: `krl check A.src A.dat` checks module A once
     try:
+        cli_sel = Selection(ignore=parse_codes(ignore, "--ignore"))
         for path in paths:
             if _resolved(path) in seen:
                 continue
             for ws in workspaces_for(path):
                 seen.update(_resolved(f.path) for f in ws.files)
-                diags = ws.check()
+                sel = config_for(ws.root, path).merged(cli_sel)
+                diags = sel.apply(ws.check())
+                files += len(ws.files)
                 any_error |= any(d.is_error for d in diags)
                 shown = [d for d in diags if d.is_error or not no_warnings]
-                if as_json:
+                if fmt == "json":
                     echo(json.dumps({
                         "workspace": ws.root,
                         "files": len(ws.files),
@@ -60,12 +86,21 @@ def run_check(paths: list[str], as_json: bool = False, no_warnings: bool = False
                         "warnings": sum(not d.is_error for d in diags),
                         "diagnostics": [d.as_json() for d in shown],
                     }))
+                elif fmt == "sarif":
+                    all_shown += shown
                 else:
-                    for d in shown:
-                        echo(d.format())
-    except Exception as exc:  # noqa: BLE001 - a last line of defence: no traceback
-        echo(f"krl check: internal error: {type(exc).__name__}: {exc}")
+                    renderer.emit(shown)
+    except ConfigError as exc:
+        echo(f"krl check: {printable(exc)}")
         return 2
+    except Exception as exc:  # noqa: BLE001 - a last line of defence: no traceback
+        echo(f"krl check: internal error: {type(exc).__name__}: {printable(exc)}")
+        return 2
+    if fmt == "sarif":
+        from krl.semantics.sarif import to_sarif  # noqa: PLC0415
+        echo(json.dumps(to_sarif(all_shown), indent=2))
+    elif fmt == "text":
+        echo(renderer.summary(files))
     return 1 if any_error else 0
 
 

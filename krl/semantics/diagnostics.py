@@ -1,9 +1,12 @@
-"""Compiler-style diagnostics with stable codes.
+"""Compiler-style diagnostics with stable codes: the one model that `krl parse`, `krl check`,
+the language server and SARIF output share.
 
-Text form: ``path:line:col: error|warning CODE message`` (1-based line and column).
-JSON form: ``{"path", "line", "column", "severity", "code", "message"}``.
+Text form (krl/semantics/render.py): ``path:line:col: error[CODE]: message``, then the source line
+and a caret under the span. JSON form: :meth:`Diagnostic.as_json`. Lines and columns are 1-based
+everywhere (columns count characters, a tab is one column).
 
-Codes are stable: tests, reports and users refer to them. Groups:
+Codes are stable: tests, reports, ``krl.toml`` and users refer to them, and every code has a
+section in docs/diagnostics.md. Groups:
 E0xx input and syntax, E1xx names and declarations, E2xx types, E3xx calls,
 E4xx control flow, E5xx system variables / write protection, E9xx internal.
 Warnings use the same number with a W prefix where the same rule has a soft form.
@@ -11,13 +14,25 @@ Warnings use the same number with a W prefix where the same rule has a soft form
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 # code -> (severity, short kind name used in reports)
 CODES: dict[str, tuple[str, str]] = {
     "E001": ("error", "unreadable or binary input"),
     "E002": ("error", "syntax error"),
     "W003": ("warning", "construct not understood by the AST builder"),
+    "E003": ("error", "construct that cannot be built (too large or malformed)"),
+    "E010": ("error", "block not closed"),
+    "E011": ("error", "block closer without its opener"),
+    "E012": ("error", "statement missing a keyword or a part"),
+    "E013": ("error", "`==` where an assignment `=` is meant"),
+    "E014": ("error", "declaration after the first statement (syntax)"),
+    "E015": ("error", "bracket or string not closed"),
+    "E016": ("error", "unexpected text after a complete statement"),
+    "E017": ("error", "character that is not KRL"),
+    "E018": ("error", "nesting too deep"),
+    "E019": ("error", "expression too long"),
+    "E020": ("error", "unexpected end of file"),
     "E101": ("error", "undeclared name"),
     "W101": ("warning", "name not found (may be declared in an unparsable or controller-side file)"),
     "E102": ("error", "duplicate declaration"),
@@ -67,10 +82,31 @@ CODES: dict[str, tuple[str, str]] = {
     "E901": ("error", "internal checker error"),
 }
 
+# The codes of syntax errors (the file does not parse; krl/syntax/messages.py); E001 and E003 are
+# input and build errors of the same group.
+SYNTAX_CODES = frozenset({"E002", *(f"E0{n}" for n in range(10, 21))})
+
+
+@dataclass(slots=True)
+class Note:
+    """A related place of a diagnostic ("the IF opened here"), 1-based."""
+
+    path: str
+    line: int
+    column: int
+    message: str
+
+    def as_json(self) -> dict:
+        return {"path": self.path, "line": self.line, "column": self.column, "message": self.message}
+
 
 @dataclass(slots=True)
 class Diagnostic:
-    """One finding at path:line:col (1-based). severity is 'error' or 'warning'."""
+    """One finding at path:line:col, 1-based; severity is 'error' or 'warning'.
+
+    The span runs from (line, column) to (end_line, end_column), end exclusive; 0 means "one
+    character" (see :attr:`span_end`). `notes` point at related places, `help` says how to fix.
+    """
 
     path: str
     line: int
@@ -78,10 +114,26 @@ class Diagnostic:
     code: str
     message: str
     severity: str = ""
+    end_line: int = 0
+    end_column: int = 0
+    notes: list[Note] = field(default_factory=list)
+    help: str = ""
 
     def __post_init__(self) -> None:
         if not self.severity:
             self.severity = CODES.get(self.code, ("error" if self.code.startswith("E") else "warning",))[0]
+
+    @property
+    def file(self) -> str:
+        """The file's path (the name editors and SARIF use)."""
+        return self.path
+
+    @property
+    def span_end(self) -> tuple[int, int]:
+        """(end_line, end_column), 1-based, exclusive; one character when not given."""
+        if self.end_line <= 0:
+            return self.line, self.column + 1
+        return self.end_line, max(self.end_column, 1)
 
     @property
     def is_error(self) -> bool:
@@ -92,15 +144,24 @@ class Diagnostic:
         return CODES.get(self.code, ("", self.code))[1]
 
     def format(self) -> str:
-        """`path:line:col: severity CODE message`."""
-        return f"{self.path}:{self.line}:{self.column}: {self.severity} {self.code} {self.message}"
+        """The first line of the text form: `path:line:col: severity[CODE]: message` (raw text;
+        krl/semantics/render.py makes it safe for a terminal)."""
+        return f"{self.path}:{self.line}:{self.column}: {self.severity}[{self.code}]: {self.message}"
 
     __str__ = format
 
     def as_json(self) -> dict:
-        """The JSON form: path, line, column, severity, code, message."""
-        return {"path": self.path, "line": self.line, "column": self.column,
-                "severity": self.severity, "code": self.code, "message": self.message}
+        """The JSON form: path, line, column, end_line, end_column (1-based, end exclusive),
+        severity, code, message, and notes/help when present."""
+        end_line, end_column = self.span_end
+        out = {"path": self.path, "line": self.line, "column": self.column,
+               "end_line": end_line, "end_column": end_column,
+               "severity": self.severity, "code": self.code, "message": self.message}
+        if self.notes:
+            out["notes"] = [n.as_json() for n in self.notes]
+        if self.help:
+            out["help"] = self.help
+        return out
 
 
 class DiagnosticSink:
@@ -114,13 +175,21 @@ class DiagnosticSink:
         self._seen: set[tuple] = set()
 
     def add(self, path: str, line: int, column: int, code: str, message: str,
-            severity: str = "") -> None:
-        """Add one diagnostic (a repeat of (path, line, code, message) is dropped)."""
+            severity: str = "", **extra) -> None:
+        """Add one diagnostic (a repeat of (path, line, code, message) is dropped); `extra`:
+        end_line, end_column, notes, help (see :class:`Diagnostic`)."""
         key = (path, line, column if code.startswith("E0") else 0, code, message)
         if key in self._seen:
             return
         self._seen.add(key)
-        self.items.append(Diagnostic(path, line, column, code, message, severity))
+        self.items.append(Diagnostic(path, line, column, code, message, severity, **extra))
+
+    def add_diagnostic(self, d: Diagnostic) -> None:
+        """Add a finished Diagnostic (repeats are dropped as in :meth:`add`)."""
+        key = (d.path, d.line, d.column if d.code.startswith("E0") else 0, d.code, d.message)
+        if key not in self._seen:
+            self._seen.add(key)
+            self.items.append(d)
 
     def at(self, span, code: str, message: str, severity: str = "") -> None:
         """Add a diagnostic at a krl.ast.nodes.Span."""
@@ -128,7 +197,7 @@ class DiagnosticSink:
 
     def extend(self, diags) -> None:
         for d in diags:
-            self.add(d.path, d.line, d.column, d.code, d.message, d.severity)
+            self.add_diagnostic(d)
 
     @property
     def errors(self) -> list[Diagnostic]:

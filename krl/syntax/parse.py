@@ -23,6 +23,7 @@ from antlr4.error.ErrorStrategy import BailErrorStrategy
 from antlr4.error.Errors import ParseCancellationException
 
 from krl.syntax.checks import may_fail, run_checks
+from krl.syntax.blocks import first_past_limit
 from krl.syntax.errors import CollectingErrorListener, LineErrorStrategy
 from krl.syntax.source import SourceText, read_source
 
@@ -152,6 +153,9 @@ def parse_text(text: str, path: str = "<string>", bundle: ParserBundle | None = 
     lexer.addErrorListener(lex_listener)
     tokens = CommonTokenStream(lexer)
     tokens.fill()
+    past = first_past_limit(tokens.tokens, bundle)  # nesting budget, expression size (krl/limits.py)
+    if past is not None:
+        return _past_limit(path, encoding, past)
     parser = bundle.parser_cls(tokens)
     parser.removeErrorListeners()
     parser._interp.predictionMode = PredictionMode.SLL
@@ -187,6 +191,15 @@ def parse_text(text: str, path: str = "<string>", bundle: ParserBundle | None = 
     ok = not issues
     return ParseResult(path, ok, encoding, "ok" if ok else "syntax_error", issues,
                        tree if keep_tree else None, "ll")
+
+
+def _past_limit(path: str, encoding: str, past) -> ParseResult:
+    """A file past a limit of krl/limits.py: not parsed; status "too_deep" (nesting) or
+    "too_long" (expression size), with one issue (kind "limit") at the place."""
+    status = "too_deep" if past.code == "E018" else "too_long"
+    issue = SyntaxIssue(line=past.line, column=past.column - 1, message=past.message, offending="",
+                        expected=[], rule_stack=[], kind="limit", offending_type=past.code)
+    return ParseResult(path, False, encoding, status, [issue], None, "limit")
 
 
 def parse_source(source: SourceText, bundle: ParserBundle | None = None,

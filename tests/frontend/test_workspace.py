@@ -61,10 +61,16 @@ def test_cli_text_json_and_exit_codes(tmp_path):
     bad = tmp_path / "bad.src"
     bad.write_text("DEF bad()\n  INT i\n  i = TRUE\nEND\n")
     res = runner.invoke(check_cmd, [str(bad)])
-    assert res.exit_code == 1 and ":3:7: error E201 " in res.output
+    assert res.exit_code == 1
+    assert res.output.splitlines() == [
+        f"{bad}:3:7: error[E201]: assignment: BOOL is not assignable to INT",
+        " 3 |   i = TRUE",
+        "   |       ^~~~",
+        "1 error in 1 file"]
     res = runner.invoke(check_cmd, [str(bad), "--json"])
     obj = json.loads(res.output.splitlines()[0])
     assert obj["errors"] == 1 and obj["diagnostics"][0]["code"] == "E201"
+    assert (obj["diagnostics"][0]["line"], obj["diagnostics"][0]["column"]) == (3, 7)
 
 
 def test_report_on_small_backup(tmp_path):
