@@ -102,9 +102,9 @@ def test_module_given_as_src_and_dat_is_checked_once(tmp_path):
     (tmp_path / "a.src").write_text("DEF a()\n  i = 1\nEND\n")
     (tmp_path / "a.dat").write_text("DEFDAT a\n  DECL INT n = TRUE\nENDDAT\n")
     res = CliRunner().invoke(check_cmd, [str(tmp_path / "a.src"), str(tmp_path / "a.dat")])
-    lines = [ln for ln in res.output.splitlines() if ": error " in ln]
+    lines = [ln for ln in res.output.splitlines() if ": error[" in ln]
     assert len(lines) == 2, res.output                      # E101 in a.src, E201 in a.dat
-    assert sorted(ln.split(": error ")[1][:4] for ln in lines) == ["E101", "E201"]
+    assert sorted(ln.split(": error[")[1][:4] for ln in lines) == ["E101", "E201"]
 
 
 def test_one_diagnostic_per_code_name_and_line():
