@@ -1,8 +1,10 @@
 """`krl validate`: check each grammar construct's examples and its effect on the corpus.
 
 grammar/constructs/<name>/ holds, per construct:
-- ok_*.src|.dat|.sub: positive examples that must parse; a sibling ok_*.expect lists
-  outline entries (see krl.syntax.outline) that must appear in the example's tree;
+- ok_*.src|.dat|.sub: positive examples that must parse; a sibling ok_*.expect lists, one
+  per line as ``LINE KIND``, every header, declaration and statement the example must build
+  to, in order, in KRL words (krl/ast/kinds.py). The lists are written by hand from the
+  reference, not copied from the parser's output;
 - bad_*.src|.dat|.sub: negative near-misses that must be rejected.
 
 With a corpus, validate also reports which corpus clusters the construct closed: it scans
@@ -17,7 +19,6 @@ from pathlib import Path
 
 import click
 
-from krl.syntax.outline import outline
 from krl.syntax.parse import parse_file
 from krl.syntax.source import is_krl_file
 from recovery.cluster import cluster_results
@@ -54,11 +55,26 @@ class ConstructReport:
             e.kind == "ok" for e in self.examples) and any(e.kind == "bad" for e in self.examples)
 
 
-def expected_entries(expect_file: Path) -> list[str]:
+def expected_kinds(expect_file: Path) -> list[tuple[int, str]] | None:
+    """The ``LINE KIND`` lines of an .expect file (None when there is none); ``#`` comments."""
     if not expect_file.exists():
-        return []
-    return [ln.strip() for ln in expect_file.read_text(encoding="utf-8").splitlines()
-            if ln.strip() and not ln.lstrip().startswith("#")]
+        return None
+    out = []
+    for ln in expect_file.read_text(encoding="utf-8").splitlines():
+        ln = ln.strip()
+        if ln and not ln.startswith("#"):
+            line, _, kind = ln.partition(" ")
+            out.append((int(line), kind.strip()))
+    return out
+
+
+def built_kinds(result) -> list[tuple[int, str]]:
+    """(line, kind) of the module the AST builder makes of a parse result."""
+    from krl.ast.build import build_module  # noqa: PLC0415
+    from krl.ast.kinds import statement_kinds  # noqa: PLC0415
+    from krl.semantics.diagnostics import DiagnosticSink  # noqa: PLC0415
+
+    return statement_kinds(build_module(result, DiagnosticSink()))
 
 
 def check_example(path: Path) -> ExampleResult:
@@ -71,10 +87,14 @@ def check_example(path: Path) -> ExampleResult:
         first = next((e for e in result.errors if not e.cascade), None)
         where = f"{first.line}:{first.column + 1} {first.message}" if first else result.status
         return ExampleResult(rel, kind, False, f"rejected: {where}")
-    entries = set(outline(result.tree))
-    missing = [e for e in expected_entries(path.with_suffix(".expect")) if e not in entries]
-    if missing:
-        return ExampleResult(rel, kind, False, "tree differs; missing " + "; ".join(missing[:3]))
+    expected = expected_kinds(path.with_suffix(".expect"))
+    if expected is not None:
+        got = built_kinds(result)
+        if got != expected:
+            diff = next((f"line {e[0]}: expected {e[1]!r}, built {g[1]!r} (line {g[0]})"
+                         for e, g in zip(expected, got) if e != g),
+                        f"{len(expected)} entries expected, {len(got)} built")
+            return ExampleResult(rel, kind, False, "statement kinds differ: " + diff)
     return ExampleResult(rel, kind, True)
 
 

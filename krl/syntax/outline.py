@@ -6,10 +6,6 @@ entry `LINE: sexpr`, where sexpr lists rule names only (tokens are left out), wi
 of single-child rules joined by `/`:
 
     7: statement/motionStatement/motion/sptpMotion(expression/primaryExpression/... withClause(...))
-
-Grammar construct examples (grammar/constructs/*/ok_*.expect) list entries that must
-appear in the outline of their example file, so a construct is checked by its tree, not
-only by the absence of syntax errors.
 """
 
 from __future__ import annotations
