@@ -7,6 +7,8 @@ import json
 import pytest
 from hypothesis import given, settings, strategies as st
 
+from tests.budget import examples
+
 from krl.semantics.cli import run_check
 from krl.workspace import check_texts, load_workspace
 
@@ -135,7 +137,7 @@ def test_generated_programs_check_without_internal_errors(module):
 
 
 @pytest.mark.corpus
-@settings(max_examples=15)
+@settings(max_examples=examples(15))
 @given(st.data())
 def test_mutated_corpus_files(corpus, data):
     """Mutations of real backup files: still no exception and no internal error."""
