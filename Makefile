@@ -49,7 +49,7 @@ validate: $(PARSER)
 	$(BIN)/krl validate
 
 test: $(PARSER)
-	$(BIN)/python -m pytest -q -n 2 -p no:cacheprovider
+	$(BIN)/python -m pytest -q -n 2 -p no:cacheprovider -r fEsxX
 
 bench: $(PARSER)
 	$(BIN)/krl bench

@@ -3,10 +3,13 @@
 * every case is well formed: its files parse, its expectations use known keys, the lines of
   its expected control flow are executable statements of the program;
 * every case passes on the tree interpreter - unless it is marked ``status: pending`` in its
-  expect.yaml, then the test is an xfail(strict=False) carrying the pending reason;
-* when the VM exists, every case passes on it too and its trace equals the tree
-  interpreter's (flow, I/O with times, motion/end events, TCP path). Until then the VM test
-  is skipped with the reason the probe gave ("vm: not available ...").
+  expect.yaml, then the test is a strict xfail carrying the pending reason (the bug it stands
+  for): a pending case that starts to pass fails the suite until its mark is removed;
+* every case passes on the VM too and its trace equals the tree interpreter's (flow, I/O with
+  times, motion/end events, TCP path).
+
+Both interpreters exist: when the interpreter probe fails, every case fails loudly with the
+probe's reason (it used to turn every case into a skip or xfail and leave the run green).
 """
 
 from __future__ import annotations
@@ -27,8 +30,10 @@ KNOWN_KEYS = {"title", "reference", "covers", "notes", "flow_note", "end", "flow
 MOTION_CHECKS = set(H._MOTION_CHECKS)
 
 
-def _status():
-    return H.interpreter_status()
+def _require_interpreters() -> None:
+    st = H.interpreter_status()
+    broken = {k: v for k, v in st.items() if v is not None}
+    assert not broken, f"interpreter probe failed: {broken}"
 
 
 @pytest.mark.parametrize("case", CASES, ids=IDS)
@@ -61,11 +66,9 @@ def test_case_is_well_formed(case: H.Case) -> None:
 
 @pytest.mark.parametrize("case", CASES, ids=IDS)
 def test_case_tree(case: H.Case, request) -> None:
-    why = _status()["tree"]
-    if why is not None:
-        pytest.xfail(f"tree interpreter {why}")
+    _require_interpreters()
     if case.pending_for("tree") is not None:
-        request.node.add_marker(pytest.mark.xfail(reason=f"pending: {case.pending}", strict=False))
+        request.node.add_marker(pytest.mark.xfail(reason=f"pending: {case.pending}", strict=True))
     res = H.run_case(case, "tree")
     cr = H.check_case(case, res)
     assert cr.passed, f"{case.name} on the tree interpreter:\n{cr.diff_text()}"
@@ -73,11 +76,9 @@ def test_case_tree(case: H.Case, request) -> None:
 
 @pytest.mark.parametrize("case", CASES, ids=IDS)
 def test_case_vm_and_tree_vm(case: H.Case, request) -> None:
-    st = _status()
-    if st["vm"] is not None or st["tree"] is not None:
-        pytest.skip(f"vm: {st['vm'] or 'available'}; tree: {st['tree'] or 'available'} - tree vs vm not compared")
+    _require_interpreters()
     if case.pending_for("vm") is not None:
-        request.node.add_marker(pytest.mark.xfail(reason=f"pending: {case.pending}", strict=False))
+        request.node.add_marker(pytest.mark.xfail(reason=f"pending: {case.pending}", strict=True))
     vm = H.run_case(case, "vm")
     cr = H.check_case(case, vm)
     tree = H.run_case(case, "tree")

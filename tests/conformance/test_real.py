@@ -15,17 +15,17 @@ from conformance import report as R
 PROGRAMS = R.real_programs()
 SAMPLE = PROGRAMS[:: max(1, len(PROGRAMS) // 8)][:8]
 
-# Known disagreements, listed like the pending cases (xfail, strict=False): the VM is not
-# finished. Keep the reason precise; remove the entry when it passes.
+# Known disagreements, listed like the pending cases (strict xfail naming the bug). Keep the
+# reason precise; remove the entry when it passes (a strict xfail that passes fails the suite).
 KNOWN: dict[str, str] = {}
 
 
 def _check(prog, request=None):
     st = H.interpreter_status()
-    if request is not None and prog.stem in KNOWN and st["vm"] is None:
-        request.node.add_marker(pytest.mark.xfail(reason=f"known: {KNOWN[prog.stem]}", strict=False))
-    if st["tree"] is not None:
-        pytest.xfail(f"tree interpreter {st['tree']}")
+    broken = {k: v for k, v in st.items() if v is not None}
+    assert not broken, f"interpreter probe failed: {broken}"
+    if request is not None and prog.stem in KNOWN:
+        request.node.add_marker(pytest.mark.xfail(reason=f"known: {KNOWN[prog.stem]}", strict=True))
     interps = H.available_interpreters()
     runs = {it: H.run_program(prog, it, max_sim_time=10.0, max_steps=100_000, wall_timeout=120.0)
             for it in interps}
