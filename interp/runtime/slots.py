@@ -304,8 +304,9 @@ def function_result(name: str, v):
 
 
 def ended_without_return(routine, line) -> KrlRuntimeError:
+    """Reaching ENDFCT without RETURN is a run-time error at ENDFCT (reference 2.3, table 8)."""
     return KrlRuntimeError(f"function {routine.name} ended without RETURN", None, routine.span.file,
-                           line or routine.span.line)
+                           routine.end_line or line or routine.span.line)
 
 
 def return_without_value(routine, line) -> KrlRuntimeError:

@@ -210,7 +210,9 @@ class Builder:
         rbody = self.rule(ctx, "routineBody", required=False)
         if rbody is not None:
             self.body_items(rbody, decls, body)
-        return N.Routine(kind, name, params, decls, body, rtype, "GLOBAL" in syms, span=self.span(ctx))
+        stop = getattr(ctx, "stop", None)
+        return N.Routine(kind, name, params, decls, body, rtype, "GLOBAL" in syms, span=self.span(ctx),
+                         end_line=stop.line if stop is not None else 0)
 
     def body_items(self, ctx, decls: list, body: list) -> None:
         """Fill decls/body from a routine body; declarations after a statement become DeclStmt."""

@@ -580,6 +580,7 @@ class Routine(Node):
     body: list[Stmt]
     return_type: TypeRef | None = None
     is_global: bool = False
+    end_line: int = field(default=0, compare=False, repr=False, kw_only=True)   # END/ENDFCT line
 
 
 @dataclass(slots=True)

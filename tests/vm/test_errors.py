@@ -1,7 +1,11 @@
 """Run-time errors: the VM names the same message, number and source line as the tree
-interpreter (the assembler's regions are the line table)."""
+interpreter (the assembler's regions are the line table), and that error is the one the case
+is about: its kind (a message pattern) and its line, worked out by hand from the program (line 1
+is ``DEF prog()``, the body starts on line 2; EXTRA's routines follow END on line 3 + body)."""
 
 from __future__ import annotations
+
+import re
 
 import pytest
 
@@ -29,33 +33,49 @@ DEF DEEP(n:IN)
     N1 = ARR[n]
   ENDIF
 END
-"""
 
+DEF NOP()
+  N2 = 2
+END
+"""
+# EXTRA's line numbers, counted from its first routine: DIV's RETURN is its line 4, NORET's
+# ENDFCT its line 9, BARE's RETURN its line 12, DEEP's `N1 = ARR[n]` its line 20.
+EXTRA_LINE = {"div_return": 4, "noret_end": 9, "bare_return": 12, "deep_index": 20}
+
+# name -> (program body, message pattern, line within the body (1 = first body line) or
+#          ("extra", key) for a line of EXTRA)
 PROGRAMS = {
-    "division_by_zero_in_function": "N1 = DIV(1, 0)",
-    "function_without_return": "N2 = NORET()",
-    "error_deep_in_calls": "DEEP(3)",
-    "unknown_routine": "NOSUCH(1)",
-    "unknown_name": "N1 = NOSUCHVAR + 1",
-    "unset_value": "N1 = N3 + 1",
-    "index_out_of_range": "ARR[6] = 1",
-    "real_index": "ARR[1.5] = 1",
-    "bool_condition": "IF N1 THEN\n    N2 = 1\n  ENDIF",
-    "for_step_zero": "FOR N1 = 1 TO 3 STEP 0\n  ENDFOR",
-    "while_condition": "WHILE N3 > 0\n  ENDWHILE",
-    "on_error_proceed": "ON_ERROR_PROCEED\n  N1 = N3\n  N2 = $ERR.NUMBER\n  N1 = N3",
-    "write_protected": "$POS_ACT = {X 1}",
-    "stack_overflow": "DEEP(200)",
-    "interrupt_not_declared": "INTERRUPT ON 7",
-    "goto_into_a_block": "N1 = 0\n  GOTO inside\n  IF N1 == 0 THEN\n  inside:\n    N2 = 1\n  ENDIF",
-    "return_without_value": "N1 = BARE()",
-    "procedure_in_expression": "N1 = DEEP(0) + 1",
+    "division_by_zero_in_function": ("N1 = DIV(1, 0)", r"division by zero", ("extra", "div_return")),
+    "function_without_return": ("N2 = NORET()", r"NORET ended without RETURN", ("extra", "noret_end")),
+    "error_deep_in_calls": ("DEEP(3)", r"array index inadmissible: ARR\[0\]", ("extra", "deep_index")),
+    "unknown_routine": ("NOSUCH(1)", r"routine NOSUCH not found", 1),
+    "unknown_name": ("N1 = NOSUCHVAR + 1", r"unknown name NOSUCHVAR", 1),
+    "unset_value": ("N1 = N3 + 1", r"value invalid: N3", 1),
+    "index_out_of_range": ("ARR[6] = 1", r"array index inadmissible: ARR\[6\]", 1),
+    "real_index": ("ARR[1.5] = 1", r"array index is not an INT", 1),
+    "bool_condition": ("N1 = 1\n  IF N1 THEN\n    N2 = 1\n  ENDIF", r"condition is not BOOL", 2),
+    "for_step_zero": ("FOR N1 = 1 TO 3 STEP 0\n  ENDFOR", r"FOR with STEP 0", 1),
+    "while_condition": ("WHILE N3 > 0\n  ENDWHILE", r"value invalid: N3", 1),
+    "on_error_proceed": ("ON_ERROR_PROCEED\n  N1 = N3\n  N2 = $ERR.NUMBER\n  N1 = N3", r"value invalid: N3", 4),
+    "write_protected": ("$POS_ACT = {X 1}", r"\$POS_ACT is write-protected", 1),
+    "stack_overflow": ("DEEP(200)", r"stack overflow", ("extra", "deep_recursion")),
+    "interrupt_not_declared": ("INTERRUPT ON 7", r"interrupt 7 not declared", 1),
+    "goto_into_a_block": ("N1 = 0\n  GOTO inside\n  IF N1 == 0 THEN\n  inside:\n    N2 = 1\n  ENDIF",
+                          r"GOTO INSIDE: label not found", 2),
+    "return_without_value": ("N1 = BARE()", r"RETURN without a value in function BARE", ("extra", "bare_return")),
+    "procedure_in_expression": ("N1 = NOP() + 1", r"NOP does not return a value", 1),
 }
+EXTRA_LINE["deep_recursion"] = 18      # DEEP's recursive call `DEEP(n - 1)`
 
 
 @pytest.mark.parametrize("name", list(PROGRAMS))
 def test_same_error(tmp_path, name):
-    res, ev, _ = both(tmp_path, PROGRAMS[name], extra=EXTRA)
-    assert res.reason == "error"
+    body, pattern, where = PROGRAMS[name]
+    res, ev, _ = both(tmp_path, body, extra=EXTRA)
+    assert res.reason == "error", (res.reason, res.text)
+    assert re.search(pattern, res.text), f"{name}: stopped on {res.text!r} (line {res.line})"
+    end_of_prog = 3 + body.count("\n")            # the END line of prog
+    line = end_of_prog + EXTRA_LINE[where[1]] if isinstance(where, tuple) else 1 + where
+    assert res.line == line, f"{name}: error at line {res.line}, expected {line}: {res.text}"
     end = ev[-1]
-    assert end["kind"] == "end" and end["text"] and end["line"]
+    assert end["kind"] == "end" and end["line"] == line and re.search(pattern, end["text"])

@@ -251,7 +251,12 @@ def test_spline_block(tmp_path):
 
 
 def test_submit_interpreter(tmp_path):
-    both(tmp_path, """
+    """The submit program toggles $OUT[7] while the robot program waits 0.5 s. Expected from
+    the reference (WAIT SEC in the submit interpreter, 12 ms IPO cycle) and docs/architecture.md
+    (a wait ends on the 12 ms grid: 0.1 s -> 9 cycles = 0.108 s): toggles at 0, 0.108, 0.216,
+    0.324, 0.432 s, TRUE first; the robot program completes at 0.504 s with N1 = N2 = 5."""
+    res, ev, var = both(tmp_path, """
+      N2 = 5
       WAIT SEC 0.5
       N1 = N2
     """, submit="""
@@ -262,17 +267,37 @@ def test_submit_interpreter(tmp_path):
       ENDLOOP
     END
     """, max_sim_time=2.0)
+    assert res.reason == "completed", (res.reason, res.text, res.line)
+    assert var("N1") == 5
+    toggles = [e for e in ev if e["kind"] == "io" and e["signal"] == "$OUT[7]"]
+    assert [e["value"] for e in toggles] == [True, False, True, False, True]
+    assert [e["t"] for e in toggles] == pytest.approx([0.0, 0.108, 0.216, 0.324, 0.432], abs=1e-9)
+    assert ev[-1]["kind"] == "end" and ev[-1]["t"] == pytest.approx(0.504, abs=1e-9)
 
 
 def test_analog_and_stub_statements(tmp_path):
-    both(tmp_path, """
-      ANOUT ON $ANOUT[1] = 0.5 * R1 MINIMUM=0.1 MAXIMUM=0.9
-      R1 = 1.0
+    """ANOUT ON recomputes the output every IPO cycle, clamped to MINIMUM/MAXIMUM, until
+    ANOUT OFF (reference 5.x analog I/O): 0.5 * 0.4 = 0.2 at once; after R1 = 4.0 the next
+    cycle writes min(2.0, 0.9) = 0.9; after ANOUT OFF, R1 = 0 changes nothing. $CYCFLAG and
+    CONFIRM run to completion."""
+    res, ev, var = both(tmp_path, """
+      SIGNAL AOUT1 $ANOUT[1]
+      R1 = 0.4
+      ANOUT ON AOUT1 = 0.5 * R1 MINIMUM=0.1 MAXIMUM=0.9
       WAIT SEC 0.1
-      ANOUT OFF $ANOUT[1]
+      R1 = 4.0
+      WAIT SEC 0.1
+      ANOUT OFF AOUT1
+      R1 = 0.0
+      WAIT SEC 0.1
       $CYCFLAG[1] = $IN[3]
+      N1 = 1
       CONFIRM N1
     """)
+    assert res.reason == "completed", (res.reason, res.text, res.line)
+    out = [e for e in ev if e["kind"] == "io" and e["signal"] == "$ANOUT[1]"]
+    assert [e["value"] for e in out] == pytest.approx([0.2, 0.9])
+    assert out[0]["t"] == 0.0 and 0.108 <= out[1]["t"] <= 0.108 + 0.012 + 1e-9
 
 
 @pytest.mark.parametrize("program", ["N1 = 1\n  N1 = N1 + 2147483647", "N1 = ARR[0]", "N1 = N3"])
