@@ -1,9 +1,10 @@
 """Real programs of the KRC backups in ../shared/krl-corpus (skipped cleanly when absent).
 
-With the VM: tree == vm for each program. Until then: the tree interpreter runs each program
-to an `end` event without an internal error (a KRL run-time error or a legitimate stop is a
-clean outcome; the corpus report of issue 6 classifies those). CI runs an evenly spaced sample
-of 8 programs; the whole corpus runs in the `slow` sweep (make nightly / krl conformance)."""
+tree == vm for each program, each run ends with an `end` event and no internal error (a KRL
+run-time error or a legitimate stop is a clean outcome; the corpus report of issue 6 classifies
+those), and each program of the CI sample really runs statements. CI runs an evenly spaced
+sample of 8 programs among those not listed in corpus/known-invalid.csv (those cannot start:
+their files have syntax errors); the whole corpus runs in the `slow` sweep."""
 
 from __future__ import annotations
 
@@ -13,14 +14,36 @@ from conformance import harness as H
 from conformance import report as R
 
 PROGRAMS = R.real_programs()
-SAMPLE = PROGRAMS[:: max(1, len(PROGRAMS) // 8)][:8]
+
+
+def _has_statements(program) -> bool:
+    """The program's main routine (its first) has at least one statement."""
+    from interp.runtime.program import parse_module
+
+    module, errors = parse_module(str(program))
+    return not errors and bool(module.routines) and bool(module.routines[0].body)
+
+
+def _startable(programs):
+    """Programs that can start and have something to run: not in corpus/known-invalid.csv (their
+    files have syntax errors) and with a non-empty main routine (a backup may hold an empty
+    template, such as CollDetect_UserAction.src)."""
+    from recovery.pipeline import load_known_invalid
+
+    invalid = set(load_known_invalid())
+    return [(p, root) for p, root in programs
+            if p.relative_to(R.DEFAULT_CORPUS).as_posix() not in invalid and _has_statements(p)]
+
+
+STARTABLE = _startable(PROGRAMS) if PROGRAMS else []
+SAMPLE = STARTABLE[:: max(1, len(STARTABLE) // 8)][:8]
 
 # Known disagreements, listed like the pending cases (strict xfail naming the bug). Keep the
 # reason precise; remove the entry when it passes (a strict xfail that passes fails the suite).
 KNOWN: dict[str, str] = {}
 
 
-def _check(prog, request=None):
+def _check(prog, request=None, must_run: bool = False):
     st = H.interpreter_status()
     broken = {k: v for k, v in st.items() if v is not None}
     assert not broken, f"interpreter probe failed: {broken}"
@@ -32,6 +55,10 @@ def _check(prog, request=None):
     for it, r in runs.items():
         prob = H.clean_run_problem(r)
         assert prob is None, f"{prog} on {it}: {prob}"
+    if must_run:
+        for it, r in runs.items():
+            stmts = [e for e in r.events if e.get("kind") == "stmt"]
+            assert stmts, f"{prog} on {it} ran no statement: {[e for e in r.events if e.get('kind') == 'end']}"
     if "vm" in runs:
         bad = [c for c in H.compare_runs(runs["tree"], runs["vm"]) if not c.ok]
         assert not bad, "\n".join(f"[{c.name}] {c.detail}" for c in bad)
@@ -40,7 +67,7 @@ def _check(prog, request=None):
 @pytest.mark.corpus
 @pytest.mark.parametrize("prog", [p for p, _ in SAMPLE], ids=lambda p: p.stem)
 def test_real_program_sample(shared_corpus, prog, request):
-    _check(prog, request)
+    _check(prog, request, must_run=True)
 
 
 @pytest.mark.corpus
