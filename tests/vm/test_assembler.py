@@ -80,6 +80,7 @@ def test_enum_constant():
     assert parse_const(fmt_const(EnumValue("c_dis"))) == EnumValue("C_DIS")
 
 
+@pytest.mark.corpus
 def test_every_routine_of_the_shared_corpus_compiles_and_round_trips():
     from interp.realprograms import DEFAULT_CORPUS, find_backups, programs_of
     from interp.run import make_runtime

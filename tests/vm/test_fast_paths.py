@@ -367,6 +367,7 @@ def test_quiet_steps_sweep(program, options):
 
 
 @pytest.mark.slow
+@pytest.mark.corpus
 @pytest.mark.parametrize("program", real_programs(), ids=lambda p: "/".join(p.parts[-3:]))
 def test_quiet_steps_real_programs(program):
     from interp.realprograms import submit_of
