@@ -21,12 +21,12 @@ options { caseInsensitive = true; }
 // A .src, .sub or .dat file (reference 2.1, 2.2, 2.5).
 // Blank and comment lines are allowed everywhere (1.4), also before the header lines.
 module
-    : NEWLINE* headerLine* NEWLINE* (dataList | routine (NEWLINE* routine)*) NEWLINE* EOF
+    : NEWLINE* (headerLine NEWLINE*)* (dataList | routine (NEWLINE* routine)*) NEWLINE* EOF
     ;
 
 // &ACCESS, &REL, &PARAM, &COMMENT lines at the top of a file (reference 1.3).
 headerLine
-    : HEADER NEWLINE+
+    : HEADER NEWLINE
     ;
 
 // ------------------------------------------------------------------ routines (2.2-2.4)
@@ -58,12 +58,16 @@ openDimensions
     ;
 
 // Declarations precede statements (2.2): a DECL after the first statement is a syntax error.
+// Blank and comment lines before and between declarations belong to routineBody itself, and
+// those after the last one to the statement list: every blank line has one owner, so the
+// parser decides declaration-or-statement once per run of blank lines, not once per line
+// (a run of n blank lines used to cost n lookaheads of n tokens each, quadratic).
 routineBody
-    : declarationLine* statementList
+    : (NEWLINE* declarationLine)* statementList
     ;
 
 declarationLine
-    : declaration? NEWLINE
+    : declaration NEWLINE
     ;
 
 statementList
