@@ -10,17 +10,29 @@ from interp.runtime.core import RunResult, Runtime
 
 def make_runtime(program, *, workspace=None, inputs=None, trace=None, max_sim_time=None,
                  max_steps=None, submit=None, mujoco: bool = True, controller=None,
-                 robot_budget=None, interp: str = "tree") -> tuple[Runtime, object]:
+                 robot_budget=None, interp: str = "tree", observer=None) -> tuple[Runtime, object]:
     """Build the runtime and the interpreter (``interp``: tree or vm) for ``program``
-    (not started yet)."""
+    (not started yet). `observer` (an :class:`interp.summary.RunObserver`) sees the
+    controller's events on their way to `trace`; it is not used with a given `controller`."""
     from interp.tree import TreeInterpreter  # noqa: PLC0415
 
     if controller is None:
         from robot.controller import Controller  # noqa: PLC0415
 
-        controller = Controller(trace=trace, stimuli=str(inputs) if inputs else None, mujoco=mujoco)
+        if observer is not None:
+            observer.inner = trace
+        controller = Controller(trace=observer if observer is not None else trace,
+                                stimuli=str(inputs) if inputs else None, mujoco=mujoco)
     rt = Runtime(program, workspace=workspace, controller=controller, trace=trace,
                  max_sim_time=max_sim_time, max_steps=max_steps, robot_budget=robot_budget)
+    if observer is not None:
+        # The interpreters trace into the user's trace only: without one the VM keeps its
+        # quiet fast path (Runtime.quiet_limit); the observer needs the controller's events.
+        rt.trace = trace
+    if controller.stimuli:
+        from robot.stimuli import resolve_signals  # noqa: PLC0415
+
+        resolve_signals(controller.stimuli, lambda name: signal_of(rt, Path(program).stem, name))
     if interp == "vm":
         from interp.vm import VM  # noqa: PLC0415
 
@@ -34,6 +46,21 @@ def make_runtime(program, *, workspace=None, inputs=None, trace=None, max_sim_ti
             rt.program._add_file(sp)  # noqa: SLF001
         rt.add_task("submit", sp.stem, lambda name=sp.stem: interp.run_program(name))
     return rt, interp
+
+
+def signal_of(rt: Runtime, main: str, name: str) -> tuple[str, int, int | None] | None:
+    """``(base, first, last)`` of the SIGNAL `name` seen by the program `main`: its data list,
+    then $config.dat and the other global declarations. None if there is no such SIGNAL."""
+    from interp.runtime.memory import SignalRef  # noqa: PLC0415
+
+    key = name.upper()
+    module = rt.program.module(main)
+    ref = module.data.get(key) if module is not None else None
+    if ref is None:
+        ref = rt.program.globals.get(key)
+    if not isinstance(ref, SignalRef):
+        return None
+    return ref.proxy.name.upper(), ref.a, ref.b
 
 
 def run_program(program, **kw) -> RunResult:

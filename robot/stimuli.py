@@ -11,6 +11,16 @@ Format (a list, or a mapping with a ``stimuli`` list)::
       - when: {line: 12, reached: 2.0}  # ... or the motion statement on source line 12;
         set: {"$ANIN[1]": 0.5}          # reached: TCP within 2 mm of its programmed point
 
+A signal is ``$IN[n]`` or ``$ANIN[n]``, or the name of a ``SIGNAL`` declared on them in
+``$config.dat`` or the program's data list (``SIGNAL PART_OK $IN[3]``; a group ``SIGNAL CODE
+$IN[1] TO $IN[4]`` takes an INT, bit 0 on the first input). The run resolves the names before
+it starts (:func:`resolve_signals`).
+
+The file is validated against this schema: a top-level mapping holds only ``stimuli``; a
+stimulus only ``at``, ``when``, ``set``, ``delay``; ``when`` only ``motion``, ``line``,
+``phase``, ``reached``. Anything else is a :class:`StimulusError` that names the key and the
+place (``file:line``). Limits: at most :data:`MAX_STIMULI` stimuli, :data:`MAX_FILE_BYTES` bytes.
+
 ``phase`` is one of start, blend_start, blend_end, end. ``reached`` (mm) fires in the
 first IPO cycle in which that motion is being executed and the TCP is within the given
 distance of the motion's programmed end point (default ``$IN_POS_CAR`` = 0.1 mm when
@@ -19,19 +29,28 @@ distance of the motion's programmed end point (default ``$IN_POS_CAR`` = 0.1 mm 
 
 from __future__ import annotations
 
+import math
+import re
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import yaml
 
-from .io import parse_signal
+from .io import IOError_, parse_signal
 
 PHASES = ("start", "blend_start", "blend_end", "end")
+TOP_KEYS = ("stimuli",)
+STIMULUS_KEYS = ("at", "when", "set", "delay")
+WHEN_KEYS = ("motion", "line", "phase", "reached")
+MAX_STIMULI = 100_000          # stimuli in one file
+MAX_FILE_BYTES = 4 * 1024 * 1024
+_NAME = re.compile(r"[A-Za-z_$][A-Za-z0-9_$]{0,23}\Z")   # a KRL name (reference §2: 24 characters)
 
 
 class StimulusError(ValueError):
-    """Malformed stimuli file."""
+    """Malformed stimuli file; the message names the file:line and the key when known."""
 
 
 @dataclass
@@ -39,11 +58,13 @@ class Stimulus:
     """One input change. Exactly one of ``at`` or a motion condition is set.
 
     Attributes:
-        set: signal name -> value.
+        set: signal name -> value (``$IN[n]``/``$ANIN[n]``, or a SIGNAL name until
+            :func:`resolve_signals` replaces it).
         at: time in s, or None.
         motion: motion id (n-th enqueued motion), or None. line: source line, or None.
         phase: motion phase, or None. reached_mm: distance for "TCP reaches the point".
         delay: extra delay in s after the condition holds.
+        where: ``file:line`` of the stimulus in its file ("" when built from data).
     """
 
     set: dict[str, Any]
@@ -55,6 +76,7 @@ class Stimulus:
     delay: float = 0.0
     fired: bool = False
     due: float | None = field(default=None, repr=False)
+    where: str = field(default="", repr=False)
 
     def matches_motion(self, motion_id: int, line: int | None) -> bool:
         if self.motion is not None:
@@ -62,49 +84,217 @@ class Stimulus:
         return self.line is not None and line is not None and self.line == line
 
 
-def parse_stimuli(doc: Any, default_reach_mm: float = 0.1) -> list[Stimulus]:
-    """Build stimuli from a parsed YAML document. Raises StimulusError."""
+# ------------------------------------------------------------------ YAML with line numbers
+class _Map(dict):
+    """A YAML mapping that remembers its line and the line of each key (1-based)."""
+
+    line: int = 0
+    key_lines: dict
+
+
+class _Loader(yaml.SafeLoader):
+    pass
+
+
+def _construct_map(loader: _Loader, node: yaml.MappingNode):
+    data = _Map()
+    data.line = node.start_mark.line + 1
+    data.key_lines = {}
+    yield data
+    data.update(loader.construct_mapping(node))
+    for key_node, _ in node.value:
+        try:
+            data.key_lines[loader.construct_object(key_node)] = key_node.start_mark.line + 1
+        except TypeError:   # an unhashable key: construct_mapping has complained already
+            pass
+
+
+_Loader.add_constructor("tag:yaml.org,2002:map", _construct_map)
+
+
+class _Where:
+    def __init__(self, source: str) -> None:
+        self.source = source
+
+    def __call__(self, obj: Any = None, key: Any = None) -> str:
+        line = 0
+        if isinstance(obj, _Map):
+            line = obj.key_lines.get(key, obj.line) if key is not None else obj.line
+        if self.source and line:
+            return f"{self.source}:{line}"
+        return self.source or "stimuli"
+
+
+def _number(value: Any, what: str, where: str, *, integer: bool = False) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise StimulusError(f"{where}: {what} must be a number, not {value!r}")
+    if integer and not isinstance(value, int):
+        raise StimulusError(f"{where}: {what} must be a whole number, not {value!r}")
+    if not math.isfinite(value):
+        raise StimulusError(f"{where}: {what} must be finite, not {value!r}")
+    return value
+
+
+def _unknown(obj: dict, allowed: tuple[str, ...], what: str, where: _Where) -> None:
+    for key in obj:
+        if key not in allowed:
+            raise StimulusError(f"{where(obj, key)}: unknown {what} {key!r} "
+                                f"(allowed: {', '.join(allowed)})")
+
+
+def _signal_name(name: Any, where: str) -> str:
+    """``$IN[n]``/``$ANIN[n]`` in canonical form, or a SIGNAL name (upper case)."""
+    if not isinstance(name, str):
+        raise StimulusError(f"{where}: signal name must be text, not {name!r}")
+    s = name.strip().upper().replace(" ", "")
+    if "[" in s:
+        try:
+            base, n = parse_signal(s)
+        except IOError_:
+            raise StimulusError(f"{where}: not a signal: {name!r}") from None
+        if base not in ("$IN", "$ANIN"):
+            raise StimulusError(f"{where}: only $IN/$ANIN can be stimulated, not {name}")
+        return f"{base}[{n}]"
+    if not _NAME.match(s):
+        raise StimulusError(f"{where}: not a signal name: {name!r}")
+    return s
+
+
+def parse_stimuli(doc: Any, default_reach_mm: float = 0.1, source: str = "") -> list[Stimulus]:
+    """Build stimuli from a parsed YAML document (a list, or a mapping with ``stimuli``).
+
+    `source` is the file name used in messages. Raises :class:`StimulusError` for a key
+    outside the schema, a missing ``stimuli``/``set``/``at``-or-``when``, a value of the wrong
+    type, or more than :data:`MAX_STIMULI` stimuli.
+    """
+    where = _Where(source)
     if doc is None:
         return []
     if isinstance(doc, dict):
-        doc = doc.get("stimuli", [])
+        _unknown(doc, TOP_KEYS, "top-level key", where)
+        if "stimuli" not in doc:
+            raise StimulusError(f"{where(doc)}: the mapping needs a 'stimuli' list")
+        doc = doc["stimuli"]
+        if doc is None:
+            return []
     if not isinstance(doc, list):
-        raise StimulusError("stimuli: expected a list")
+        raise StimulusError(f"{where()}: 'stimuli' must be a list of stimuli")
+    if len(doc) > MAX_STIMULI:
+        raise StimulusError(f"{where()}: {len(doc)} stimuli, more than the limit of {MAX_STIMULI}")
     out: list[Stimulus] = []
     for i, item in enumerate(doc):
-        if not isinstance(item, dict) or "set" not in item or not isinstance(item["set"], dict):
-            raise StimulusError(f"stimulus {i + 1}: needs a 'set' mapping")
-        sets = {}
+        if not isinstance(item, dict):
+            raise StimulusError(f"{where()}: stimulus {i + 1} must be a mapping with 'set'")
+        here = where(item)
+        _unknown(item, STIMULUS_KEYS, f"field of stimulus {i + 1}:", where)
+        if not isinstance(item.get("set"), dict) or not item["set"]:
+            raise StimulusError(f"{here}: stimulus {i + 1} needs a 'set' mapping of signals")
+        sets: dict[str, Any] = {}
         for name, v in item["set"].items():
-            base, _ = parse_signal(str(name))
-            if base not in ("$IN", "$ANIN"):
-                raise StimulusError(f"stimulus {i + 1}: only $IN/$ANIN can be stimulated, not {name}")
-            sets[str(name).upper().replace(" ", "")] = v
-        st = Stimulus(set=sets, delay=float(item.get("delay", 0.0)))
+            at = where(item["set"], name)
+            key = _signal_name(name, at)
+            if isinstance(v, bool) or key.startswith("$ANIN"):
+                if key.startswith("$ANIN"):
+                    v = _number(v, f"value of {key}", at)
+            else:
+                v = int(_number(v, f"value of {key}", at, integer=True))
+            sets[key] = v
+        st = Stimulus(set=sets, delay=float(_number(item.get("delay", 0.0), "delay", where(item, "delay"))),
+                      where=here)
+        if st.delay < 0:
+            raise StimulusError(f"{where(item, 'delay')}: delay must not be negative")
+        if "at" in item and "when" in item:
+            raise StimulusError(f"{here}: stimulus {i + 1} has both 'at' and 'when'; give one")
         if "at" in item:
-            st.at = float(item["at"])
-        elif "when" in item and isinstance(item["when"], dict):
+            st.at = float(_number(item["at"], "at", where(item, "at")))
+        elif "when" in item:
             w = item["when"]
-            st.motion = int(w["motion"]) if "motion" in w else None
-            st.line = int(w["line"]) if "line" in w else None
+            if not isinstance(w, dict):
+                raise StimulusError(f"{where(item, 'when')}: 'when' must be a mapping "
+                                    f"({', '.join(WHEN_KEYS)})")
+            _unknown(w, WHEN_KEYS, "field of 'when':", where)
+            st.motion = int(_number(w["motion"], "motion", where(w, "motion"), integer=True)) \
+                if "motion" in w else None
+            st.line = int(_number(w["line"], "line", where(w, "line"), integer=True)) if "line" in w else None
             if st.motion is None and st.line is None:
-                raise StimulusError(f"stimulus {i + 1}: 'when' needs motion or line")
+                raise StimulusError(f"{where(w)}: 'when' needs motion or line")
             if "phase" in w:
                 if w["phase"] not in PHASES:
-                    raise StimulusError(f"stimulus {i + 1}: phase must be one of {PHASES}")
+                    raise StimulusError(f"{where(w, 'phase')}: phase must be one of {', '.join(PHASES)}")
                 st.phase = str(w["phase"])
             if "reached" in w:
                 r = w["reached"]
-                st.reached_mm = default_reach_mm if r is True else float(r)
+                st.reached_mm = default_reach_mm if r is True else float(_number(r, "reached", where(w, "reached")))
             if st.phase is None and st.reached_mm is None:
                 st.phase = "end"
         else:
-            raise StimulusError(f"stimulus {i + 1}: needs 'at' or 'when'")
+            raise StimulusError(f"{here}: stimulus {i + 1} needs 'at' or 'when'")
         out.append(st)
     return out
 
 
 def load_stimuli(path: str | Path, default_reach_mm: float = 0.1) -> list[Stimulus]:
-    """Read a stimuli YAML file (see the module docstring)."""
-    text = Path(path).read_text(encoding="utf-8")
-    return parse_stimuli(yaml.safe_load(text), default_reach_mm)
+    """Read and validate a stimuli YAML file (see the module docstring).
+
+    Raises :class:`StimulusError` (with ``file:line``) for an unreadable, oversized or
+    malformed file."""
+    p = Path(path)
+    try:
+        if p.stat().st_size > MAX_FILE_BYTES:
+            raise StimulusError(f"{p}: larger than the limit of {MAX_FILE_BYTES} bytes")
+        if not p.is_file():
+            raise StimulusError(f"{p}: not a regular file")
+        text = p.read_bytes().decode("utf-8")
+    except OSError as exc:
+        raise StimulusError(f"{p}: cannot read: {exc.strerror or exc}") from None
+    except UnicodeDecodeError as exc:
+        raise StimulusError(f"{p}: not UTF-8 text (byte {exc.start})") from None
+    try:
+        doc = yaml.load(text, Loader=_Loader)  # noqa: S506 - a SafeLoader subclass
+    except yaml.MarkedYAMLError as exc:
+        mark = exc.problem_mark or exc.context_mark
+        line = f":{mark.line + 1}" if mark is not None else ""
+        raise StimulusError(f"{p}{line}: not valid YAML: {exc.problem or exc.context}") from None
+    except yaml.YAMLError as exc:
+        raise StimulusError(f"{p}: not valid YAML: {exc}") from None
+    except TypeError as exc:   # an unhashable mapping key
+        raise StimulusError(f"{p}: not a valid stimuli file: {exc}") from None
+    return parse_stimuli(doc, default_reach_mm, source=str(p))
+
+
+def resolve_signals(stimuli: list[Stimulus],
+                    lookup: Callable[[str], tuple[str, int, int | None] | None]) -> None:
+    """Replace SIGNAL names in the stimuli by the inputs they stand for, in place.
+
+    `lookup(NAME)` gives ``(base, first, last)`` for a SIGNAL declared on ``base``
+    (``"$IN"``, ``"$ANIN"``, ...) from input ``first`` to ``last`` (None for one input), or
+    None for an unknown name. A group takes an INT (bit 0 on ``first``), one ``$IN`` a BOOL.
+    Raises :class:`StimulusError` (with the stimulus's ``file:line``) for an unknown name, a
+    signal on an output, or a value that does not fit.
+    """
+    for st in stimuli:
+        resolved: dict[str, Any] = {}
+        for name, value in st.set.items():
+            if name.startswith("$"):
+                resolved[name] = value
+                continue
+            where = st.where or "stimuli"
+            found = lookup(name)
+            if found is None:
+                raise StimulusError(f"{where}: unknown signal {name} (neither $IN[n]/$ANIN[n] nor a "
+                                    f"SIGNAL declared in $config.dat or the program's data list)")
+            base, first, last = found
+            if base not in ("$IN", "$ANIN"):
+                raise StimulusError(f"{where}: {name} is a SIGNAL on {base}; only $IN/$ANIN can be stimulated")
+            if base == "$ANIN" or last is None:
+                if base == "$IN" and not isinstance(value, bool):
+                    raise StimulusError(f"{where}: {name} is one input ($IN[{first}]): give true or false")
+                resolved[f"{base}[{first}]"] = value
+                continue
+            width = last - first + 1
+            if isinstance(value, bool) or not isinstance(value, int) or not 0 <= value < (1 << width):
+                raise StimulusError(f"{where}: {name} is the group $IN[{first}] TO $IN[{last}]: "
+                                    f"give a whole number 0..{(1 << width) - 1}")
+            for bit, n in enumerate(range(first, last + 1)):
+                resolved[f"$IN[{n}]"] = bool((value >> bit) & 1)
+        st.set = resolved
