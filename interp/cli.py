@@ -41,28 +41,38 @@ def run(program: Path, interp_kind: str, workspace, inputs, trace_path, max_sim_
                 click.echo(str(d))
             click.echo(f"not started: {len(errors)} error(s) found by the checker")
             sys.exit(1)
-    from interp.run import run_program  # noqa: PLC0415
+    from interp.run import make_runtime  # noqa: PLC0415
+    from interp.summary import RunObserver, summary_lines  # noqa: PLC0415
+    from krl.terminal import printable  # noqa: PLC0415
+    from robot.stimuli import StimulusError  # noqa: PLC0415
     from robot.trace import TraceWriter  # noqa: PLC0415
 
     trace = TraceWriter(trace_path) if trace_path else None
+    observer = RunObserver()
     try:
-        res = run_program(program, workspace=workspace, inputs=inputs, trace=trace,
-                          max_sim_time=max_sim_time, max_steps=max_steps, submit=list(submit),
-                          interp=interp_kind)
+        rt, _ = make_runtime(program, workspace=workspace, inputs=inputs, trace=trace,
+                             max_sim_time=max_sim_time, max_steps=max_steps, submit=list(submit),
+                             interp=interp_kind, observer=observer)
+        res = rt.run()
+    except StimulusError as exc:
+        click.echo(f"error: {printable(exc)}", err=True)
+        sys.exit(2)
     except Exception as exc:  # noqa: BLE001
-        click.echo(f"internal error: {type(exc).__name__}: {exc}", err=True)
+        click.echo(f"internal error: {type(exc).__name__}: {printable(exc)}", err=True)
         sys.exit(2)
     finally:
         if trace is not None:
             trace.close()
-    where = f"{res.file}:{res.line}" if res.line else (res.file or "")
-    if res.reason == "completed":
-        click.echo(f"completed at t={res.sim_time:.3f} s ({res.steps} steps)")
-    elif res.reason == "error":
-        num = f" ({res.error.number})" if res.error is not None and res.error.number else ""
-        click.echo(f"error at {where}: {res.text}{num} (t={res.sim_time:.3f} s)")
-    else:
-        click.echo(f"stopped ({res.reason}) at {where}: {res.text} (t={res.sim_time:.3f} s)".replace(": ()", ""))
+    prog = rt.program
+    ws_note = None
+    if prog.backup:
+        ws_note = f"{prog.workspace} (KRC backup{' found above the program' if workspace is None else ''})"
+    elif workspace is not None:
+        ws_note = str(prog.workspace)
+    for line in summary_lines(res, observer, program=str(program), interp=interp_kind,
+                              submits=[t for t in rt.scheduler.tasks if t.kind == "submit"],
+                              workspace=ws_note):
+        click.echo(line)
     sys.exit(res.exit_code)
 
 
@@ -75,7 +85,7 @@ def check_errors(program: Path, workspace=None) -> list:
     from krl.workspace import load_workspace  # noqa: PLC0415
 
     prog = program.resolve()
-    found = find_backup_root(prog)
+    found = find_backup_root(prog, Path(workspace).resolve() if workspace else None)
     if found is not None:
         paths = [found[0]]
     else:

@@ -72,9 +72,16 @@ def parse_module(path: str):
     return got
 
 
-def find_backup_root(path: Path) -> tuple[Path, Path] | None:
-    """(workspace root, System folder) if ``path`` lies inside a KRC backup."""
-    for d in [path.parent, *path.parent.parents]:
+def find_backup_root(path: Path, within: Path | None = None) -> tuple[Path, Path] | None:
+    """(workspace root, System folder) if ``path`` lies inside a KRC backup.
+
+    With `within` (the ``--workspace`` folder) only folders inside it, itself included, are
+    looked at: a folder above the workspace that happens to hold ``System/$config.dat`` is
+    never adopted (issue 12)."""
+    ancestors = [path.parent, *path.parent.parents]
+    if within is not None:
+        ancestors = [d for d in ancestors if d == within or within in d.parents]
+    for d in ancestors:
         if (d / "R1" / "System").is_dir() and ((d / "R1" / "System" / "$config.dat").exists()
                                                or (d / "R1" / "System" / "$CONFIG.DAT").exists()):
             return d / "R1", d / "R1" / "System"
@@ -107,7 +114,7 @@ class Program:
     def __init__(self, rt, main_path: str | Path, workspace: str | Path | None = None) -> None:
         self.rt = rt
         self.main_path = Path(main_path).resolve()
-        found = find_backup_root(self.main_path)
+        found = find_backup_root(self.main_path, Path(workspace).resolve() if workspace else None)
         self.backup = found is not None
         if found is not None:
             self.workspace, self.system_dir = found

@@ -130,7 +130,7 @@ def test_cli_exit_codes_and_trace(tmp_path):
     p = _krl("run", bad)
     assert p.returncode == 1 and "value invalid" in p.stdout and "bad.src:3" in p.stdout
     p = _krl("run", halt)
-    assert p.returncode == 3 and "halt" in p.stdout
+    assert p.returncode == 3 and "stopped by HALT" in p.stdout and "stop1.src:2" in p.stdout
 
 
 def test_cycflag_is_reevaluated_and_fires_an_interrupt(tmp_path):
