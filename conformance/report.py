@@ -13,7 +13,6 @@ paths; matplotlib Agg). Without a VM the agreement fields are ``null`` and ``vm`
 
 from __future__ import annotations
 
-import html
 import json
 import math
 import time
@@ -262,6 +261,8 @@ def write_report(out: Path, outcomes: list[CaseOutcome], fuzz: dict[str, Any] | 
 
 
 def _markdown(s, rows, interps, fuzz, real) -> str:
+    from krl.render import markdown_code as md  # noqa: PLC0415
+
     L = ["# Conformance report", "",
          f"Generated {time.strftime('%Y-%m-%d %H:%M:%S UTC', time.gmtime())}.", "",
          "| metric | value |", "|---|---|"]
@@ -291,51 +292,32 @@ def _markdown(s, rows, interps, fuzz, real) -> str:
         for f in fuzz.get("failures", [])[:20]:
             L += ["", "```", str(f)[:2000], "```"]
     if real is not None:
-        L += ["", "## Real programs (../shared/krl-corpus)", "",
-              f"{len(real)} runnable programs; end reasons on the tree interpreter: {s.get('real_tree_reasons')}", ""]
-        bad = [r for r in real if r.crash or r.agree is False]
-        for r in bad[:50]:
-            L.append(f"- {r.program}: {r.crash or ''} {'' if r.agree is not False else 'tree != vm'}")
+        L += ["", "## Real programs (../shared/krl-corpus)", "", f"{len(real)} runnable programs of the KRC backups.", ""]
+        reasons = s.get("real_tree_reasons") or {}
+        if reasons:
+            L += ["| end reason (tree) | programs |", "|---|---:|"]
+            L += [f"| {md(k)} | {v} |" for k, v in reasons.items()]
+        its = sorted({k for r in real for k in r.reasons})
+        if real:
+            L += ["", "| program | " + " | ".join(its) + " | tree = vm | crash |",
+                  "|---|" + "---|" * len(its) + "---|---|"]
+            for r in real:
+                agree = {None: "n/a", True: "yes", False: "NO"}[r.agree]
+                crash = "; ".join(r.crash.values())
+                L.append(f"| {md(r.program)} | " + " | ".join(md(r.reasons.get(i, "-")) for i in its)
+                         + f" | {agree} | {md(crash) if crash else ''} |")
     return "\n".join(L) + "\n"
 
 
-_HTML = """<!doctype html>
-<html><head><meta charset="utf-8"><title>Conformance report</title>
-<style>body{font-family:sans-serif;margin:1.5em}table{border-collapse:collapse}td,th{border:1px solid #ccc;padding:2px 6px;font-size:13px}
-.pass{background:#e6ffe6}.FAIL{background:#ffe0e0}.pending{background:#fff4d6}pre{background:#f6f6f6;padding:6px;font-size:12px;overflow-x:auto}
-img{max-width:900px;border:1px solid #ddd}</style></head><body>
-<h1>Conformance report</h1>
-<p>Generated {{ when }}.</p>
-<table>{% for k, v in summary_rows %}<tr><th>{{ k }}</th><td>{{ v }}</td></tr>{% endfor %}</table>
-<h2>Cases</h2>
-<table><tr><th>case</th>{% for i in interps %}<th>{{ i }}</th>{% endfor %}<th>tree = vm</th><th>status</th><th>covers</th><th>plot</th></tr>
-{% for r in rows %}<tr class="{{ r.status }}"><td><a href="#{{ r.name }}">{{ r.name }}</a><br><small>{{ r.title }}</small></td>
-{% for i in interps %}<td>{{ r.per.get(i, '-') }}</td>{% endfor %}<td>{{ r.agree }}</td><td>{{ r.status }}</td><td><small>{{ r.covers }}</small></td>
-<td>{% if r.plot %}<a href="{{ r.plot }}">png</a>{% endif %}</td></tr>{% endfor %}</table>
-{% if pending %}<h2>Pending cases</h2><ul>{% for r in pending %}<li><b>{{ r.name }}</b> ({{ r.status }}): {{ r.pending }}</li>{% endfor %}</ul>{% endif %}
-<h2>Details</h2>
-{% for r in rows %}{% if r.diffs or r.tree_vm_diff or r.plot %}<h3 id="{{ r.name }}">{{ r.name }} <small>{{ r.status }}</small></h3>
-{% for k, d in r.diffs.items() %}<p>{{ k }}:</p><pre>{{ d }}</pre>{% endfor %}
-{% if r.tree_vm_diff %}<p>tree vs vm:</p><pre>{{ r.tree_vm_diff }}</pre>{% endif %}
-{% if r.plot %}<img src="{{ r.plot }}" alt="paths of {{ r.name }}">{% endif %}{% endif %}{% endfor %}
-{% if fuzz %}<h2>Differential fuzzing</h2><p>mode: {{ fuzz.mode }}; programs: {{ fuzz.programs }}; tree ran cleanly: {{ fuzz.tree_ok }}; tree = vm: {{ fuzz.agree }}</p>
-{% for f in fuzz.failures[:20] %}<pre>{{ f }}</pre>{% endfor %}{% endif %}
-{% if real is not none %}<h2>Real programs</h2><p>{{ real|length }} runnable programs; end reasons (tree): {{ real_reasons }}</p>
-<ul>{% for r in real %}{% if r.crash or r.agree == False %}<li>{{ r.program }}: {{ r.crash }}</li>{% endif %}{% endfor %}</ul>{% endif %}
-</body></html>
-"""
-
-
 def _html(s, rows, interps, fuzz, real) -> str:
-    import jinja2  # noqa: PLC0415
+    from krl.render import render_html  # noqa: PLC0415
 
-    env = jinja2.Environment(autoescape=True)
-    t = env.from_string(_HTML)
     keys = ("cases", "passed", "tree_vm_agree", "fuzz_programs", "fuzz_agree", "real_programs", "real_agree", "vm")
-    return t.render(when=time.strftime("%Y-%m-%d %H:%M:%S UTC", time.gmtime()),
-                    summary_rows=[(k, s.get(k) if s.get(k) is not None else "n/a (no VM)") for k in keys],
-                    rows=rows, interps=interps, pending=[r for r in rows if r["pending"]],
-                    fuzz=fuzz, real=real, real_reasons=s.get("real_tree_reasons"))
+    return render_html("conformance.html.j2", when=time.strftime("%Y-%m-%d %H:%M:%S UTC", time.gmtime()),
+                       summary_rows=[(k, s.get(k) if s.get(k) is not None else "n/a (no VM)") for k in keys],
+                       rows=rows, interps=interps, pending=[r for r in rows if r["pending"]],
+                       fuzz=fuzz, real=real, real_reasons=s.get("real_tree_reasons") or {},
+                       real_interps=sorted({k for r in (real or []) for k in r.reasons}))
 
 
 def run_all(out: Path, *, fuzz_n: int = 200, real: bool = True, corpus: Path = DEFAULT_CORPUS,

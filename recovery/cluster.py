@@ -11,6 +11,7 @@ ranked by the number of files they affect, then by occurrences.
 from __future__ import annotations
 
 import hashlib
+import re
 from collections import defaultdict
 from dataclasses import dataclass, field
 
@@ -30,10 +31,38 @@ class Cluster:
     expected: list[str] = field(default_factory=list)
     examples: list[dict] = field(default_factory=list)
     paths: list[str] = field(default_factory=list)
+    shape: list[str] = field(default_factory=list)   # the line up to the offending token (first example)
+
+    @property
+    def line_shape(self) -> str:
+        """The line's shape in KRL words: ``IF ‹name› = ‹number›``."""
+        return shape_words(self.shape)
+
+    @property
+    def keyword(self) -> str:
+        """The leading keyword in KRL words (a name stands as ‹name›)."""
+        if self.leading_keyword == "(lexer)":
+            return shape_words(self.shape) or "a character"
+        return shape_words([self.leading_keyword]) if self.leading_keyword else "?"
+
+    @property
+    def is_lexer(self) -> bool:
+        return self.signature.startswith("lexer |")
+
+    @property
+    def where(self) -> str:
+        """Where in the grammar the line fails, in KRL words."""
+        return context_words(self.signature)
+
+    @property
+    def stopped_at(self) -> str:
+        """The token the parser could not take (the last of the shape), in KRL words."""
+        return shape_words(self.shape[-1:]) if self.shape else ""
 
     def to_json(self) -> dict:
         return {"id": self.id, "signature": self.signature, "files": self.files,
                 "occurrences": self.occurrences, "leading_keyword": self.leading_keyword,
+                "line_shape": self.line_shape, "where": self.where,
                 "expected": self.expected, "examples": self.examples}
 
 
@@ -74,6 +103,51 @@ def signature(issue: IssueRecord) -> str:
     return f"{context} | {issue.offending_type} | {' '.join(local_shape(issue.shape))}"
 
 
+# ---------------------------------------------------------------- KRL words for a cluster
+_PLACEHOLDERS = {"id": "‹name›", "$sys": "‹system variable›", "num": "‹number›", "str": "‹string›",
+                 "#enum": "‹#enum value›", "<EOL>": "‹end of line›", "<EOF>": "‹end of file›"}
+_CONTEXTS = {"line-start": "a statement or declaration line cannot start like this",
+             "data-line-start": "a data-list line cannot start like this",
+             "file-line-start": "a module line (outside DEF/DEFDAT) cannot start like this",
+             "?": "(no parser rule recorded)"}
+_KEYWORD_WORDS = {"if", "for", "while", "loop", "repeat", "switch", "interrupt", "trigger", "spline", "ptp",
+                  "lin", "circ", "def", "deffct", "defdat", "signal", "struc", "enum", "decl", "wait",
+                  "goto", "halt", "brake", "const", "import", "ext", "extfct"}
+
+
+def shape_words(shape: list[str]) -> str:
+    """Normalised shape tokens in KRL words: ``["IF", "id", "=", "num"]`` ->
+    ``IF ‹name› = ‹number›``; a lexer shape names the character class."""
+    words = []
+    for tok in shape:
+        if tok.startswith("lexer:"):
+            cls = tok[len("lexer:"):]
+            words.append({"eol": "‹end of line›", "space": "‹white space›",
+                          "non-ascii": "‹a non-ASCII character›"}.get(cls, f"the character {cls}"))
+        else:
+            words.append(_PLACEHOLDERS.get(tok, tok))
+    return " ".join(words)
+
+
+def rule_words(rule: str) -> str:
+    """A grammar rule name in words: ``ifStatement`` -> ``IF statement``,
+    ``withClause`` -> ``with clause``."""
+    parts = re.findall(r"[A-Z]?[a-z0-9]+|[A-Z]+(?![a-z])", rule)
+    return " ".join(w.upper() if w.lower() in _KEYWORD_WORDS else w.lower() for w in parts) or rule
+
+
+def context_words(sig: str) -> str:
+    """The first part of a cluster signature in words."""
+    head = sig.split(" | ", 1)[0]
+    if head == "lexer":
+        return "a character the KRL lexer does not accept"
+    if head == "internal":
+        return "the parser failed (internal error)"
+    if head in _CONTEXTS:
+        return _CONTEXTS[head]
+    return f"in the {rule_words(head)}"
+
+
 def cluster_id(sig: str) -> str:
     return "C" + hashlib.sha1(sig.encode("utf-8")).hexdigest()[:7]
 
@@ -100,7 +174,7 @@ def cluster_results(results: list[FileResult]) -> list[Cluster]:
             cl = by_sig.get(sig)
             if cl is None:
                 cl = by_sig[sig] = Cluster(cluster_id(sig), sig, leading_keyword=_leading_keyword(issue),
-                                           expected=list(issue.expected))
+                                           expected=list(issue.expected), shape=list(issue.shape))
             cl.occurrences += 1
             if res.path not in files_of[sig]:
                 files_of[sig].add(res.path)

@@ -8,7 +8,6 @@ import json
 import time
 from pathlib import Path
 
-from recovery.cluster import cluster_results
 from recovery.report import Summary, summarise, write_report
 from recovery.scan import FileResult, cache_dir, grammar_sha, scan
 
@@ -89,8 +88,7 @@ def run_recovery(corpus: Path, out: Path, jobs: int | None = None, use_cache: bo
     start = time.perf_counter()
     gsha = current_grammar_sha()
     results = scan(corpus, gsha, jobs=jobs, use_cache=use_cache)
-    clusters = cluster_results(results)
-    summary = summarise(results, clusters, gsha, str(corpus), 0.0)
+    summary = summarise(results, gsha, str(corpus), 0.0, known_invalid=load_known_invalid())
     summary.negative = negative_figures(gsha, jobs, use_cache)
     ki = known_invalid_figures(results)
     if ki:

@@ -1,0 +1,93 @@
+"""report.html rendered in headless Chromium (issue 13): it loads without console errors, its key
+elements are there, and markup from the corpus stays inert (issue 12)."""
+
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+import tempfile
+from pathlib import Path
+
+import pytest
+
+from recovery.report import summarise, write_report
+from tests.report.test_recovery_report import corpus_results
+
+CHROMIUM = "/usr/bin/chromium"
+FLAGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
+         "--disable-background-networking", "--disable-component-update", "--disable-sync"]
+PWNED = "<script>window.pwned=1</script>"
+
+
+@pytest.fixture(scope="module")
+def chromium() -> str:
+    """The Debian chromium; installed with apt-get when missing and running as root."""
+    if not Path(CHROMIUM).exists():
+        if os.geteuid() != 0 or shutil.which("apt-get") is None:
+            pytest.skip("chromium is not installed and cannot be installed (not root or no apt-get)")
+        env = dict(os.environ, DEBIAN_FRONTEND="noninteractive")
+        try:
+            subprocess.run(["apt-get", "install", "-y", "-q", "chromium"], env=env, capture_output=True,
+                           timeout=900, check=False)
+            if not Path(CHROMIUM).exists():
+                subprocess.run(["apt-get", "update", "-q"], env=env, capture_output=True, timeout=600)
+                subprocess.run(["apt-get", "install", "-y", "-q", "chromium"], env=env, capture_output=True,
+                               timeout=900, check=False)
+        except (OSError, subprocess.TimeoutExpired) as exc:
+            pytest.skip(f"chromium could not be installed: {exc}")
+        if not Path(CHROMIUM).exists():
+            pytest.skip("chromium could not be installed with apt-get (no network or no package?)")
+    return CHROMIUM
+
+
+@pytest.fixture(scope="module")
+def report(tmp_path_factory) -> Path:
+    out = tmp_path_factory.mktemp("report")
+    results = corpus_results()
+    # markup in a KRL line and in a file name
+    results[1].issues[0].line_text = f"IF nCount = 2 THEN ; {PWNED}"
+    results[1].path = f"prog/{PWNED}.src"
+    s = summarise(results, "g" * 64, str(out / "corpus"), 1.0, known_invalid={"tmpl/k.src"})
+    s.extra["check"] = {"markdown": f"## Front end: `krl check`\n\n| backup | errors |\n|---|---:|\n| {PWNED} | 3 |\n"}
+    write_report(out, s, results)
+    return out / "report.html"
+
+
+def test_report_renders_in_headless_chromium(chromium, report):
+    playwright = pytest.importorskip("playwright.sync_api")
+    with playwright.sync_playwright() as pw, tempfile.TemporaryDirectory() as profile:
+        ctx = pw.chromium.launch_persistent_context(profile, executable_path=chromium, headless=True,
+                                                    args=FLAGS[1:])
+        try:
+            page = ctx.new_page()
+            problems: list[str] = []
+            page.on("console", lambda m: problems.append(f"{m.type}: {m.text}") if m.type in ("error", "warning") else None)
+            page.on("pageerror", lambda e: problems.append(f"page error: {e}"))
+            page.on("requestfailed", lambda r: problems.append(f"request failed: {r.url}"))
+            page.goto(report.as_uri())
+            page.wait_for_load_state("load")
+            assert problems == []
+            assert page.title() == "KRL grammar recovery report"
+            assert page.locator("h1").inner_text() == "Grammar recovery report"
+            assert page.locator("table#summary tr").count() == 3
+            # one ranked construct (IF, 2 files), shown with its line shape and example links
+            cards = page.locator("#missing ~ section.cluster")
+            assert page.locator("section.cluster").count() == 2          # IF ranked + TODO known-invalid
+            first = cards.first.inner_text()
+            assert "IF — 2 files, 2 occurrences" in first and "Line shape: IF ‹name› =" in first
+            assert page.locator("a.example").count() == 3
+            # the chart loaded and has a size
+            assert page.evaluate("document.getElementById('chart').naturalWidth") > 500
+            assert page.locator("#known-invalid").count() == 1 and page.locator("#internal").count() == 1
+            assert "deep/i.src" in page.locator("#internal ~ table").first.inner_text()
+            # the static-check Markdown is a real table
+            assert page.locator("#static-check table tr").count() == 2
+            # markup from the corpus is text: no script element, nothing ran
+            assert page.evaluate("document.querySelectorAll('script').length") == 0
+            assert page.evaluate("window.pwned === undefined")
+            assert PWNED in page.locator("#missing ~ section.cluster").first.inner_text()
+            page.screenshot(path=str(report.with_name("report.png")), full_page=True)
+        finally:
+            ctx.close()
+    assert report.with_name("report.png").stat().st_size > 10_000
