@@ -84,6 +84,8 @@ def pytest_make_collect_report(collector):
 
 def pytest_terminal_summary(terminalreporter, exitstatus, config) -> None:
     """Close with the counts, so a log shows at a glance what really ran."""
+    if config.option.collectonly:
+        return
     stats = terminalreporter.stats
     counts = {k: len(stats.get(k, [])) for k in ("passed", "failed", "error", "skipped", "xfailed", "xpassed")}
     terminalreporter.write_line(
