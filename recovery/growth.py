@@ -21,11 +21,16 @@ COLUMNS = ["commit", "date", "subject", "parser_rules", "lexer_rules", "alternat
 
 def growth_rows(corpus: Path, jobs: int | None = None, use_cache: bool = True,
                 progress: bool = True) -> list[dict]:
+    from recovery.progress import steps  # noqa: PLC0415
+
     rows = []
-    for version in committed_versions():
+    versions = committed_versions()
+    shown = steps(versions, "replaying grammar versions", lambda v: f"{v.commit[:10]} {v.subject[:40]}") \
+        if progress else versions
+    for version in shown:
         pdir = parser_dir_for(version.text)
         results = scan(corpus, version.sha, parser_dir=str(pdir), jobs=jobs, use_cache=use_cache,
-                       progress=progress)
+                       progress=False)
         row = {"commit": version.commit[:10], "date": version.date, "subject": version.subject}
         row.update(grammar_metrics(version.text))
         row.update({"files_ok": sum(r.ok for r in results),

@@ -145,8 +145,10 @@ def validate_constructs(names: list[str], corpus: Path | None = None) -> list[Co
         if unknown:
             raise click.UsageError(f"unknown construct(s): {', '.join(sorted(unknown))}")
         dirs = [d for d in dirs if d.name in names]
+    from recovery.progress import steps  # noqa: PLC0415
+
     reports = []
-    for d in dirs:
+    for d in steps(dirs, "validating constructs", lambda d: d.name):
         rep = ConstructReport(d.name)
         for f in sorted(d.iterdir()):
             if is_krl_file(f) and f.name.startswith(("ok_", "bad_")):

@@ -1,0 +1,49 @@
+"""Progress of the long recovery commands (`krl validate`, `krl growth`) with rich.
+
+Shown on standard error only when it is a terminal; piped or redirected, the commands stay
+quiet (no bar, no control sequences in logs). The bar is transient: what the command prints
+afterwards is the same with or without it.
+"""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Iterable, Iterator
+from typing import TypeVar
+
+T = TypeVar("T")
+
+
+def shown(stream=None) -> bool:
+    """True when a progress bar goes to `stream` (default stderr): a terminal, and TERM is not dumb."""
+    import os  # noqa: PLC0415
+
+    stream = sys.stderr if stream is None else stream
+    try:
+        tty = stream.isatty()
+    except (AttributeError, ValueError):
+        return False
+    return tty and os.environ.get("TERM", "") != "dumb"
+
+
+def steps(items: list[T], what: str, label=str) -> Iterator[T]:
+    """Yield `items`, showing "`what` i/n: label(item)" and a bar on a terminal."""
+    if not shown() or not items:
+        yield from items
+        return
+    from rich.console import Console  # noqa: PLC0415
+    from rich.markup import escape  # noqa: PLC0415
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn  # noqa: PLC0415
+
+    columns = (TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn())
+    with Progress(*columns, console=Console(stderr=True), transient=True) as bar:
+        task = bar.add_task(escape(what), total=len(items))
+        for item in items:
+            bar.update(task, description=escape(f"{what}: {label(item)}"))
+            yield item
+            bar.advance(task)
+
+
+def iterate(items: Iterable[T], what: str, label=str) -> Iterator[T]:
+    """:func:`steps` over any iterable (materialised first to know the total)."""
+    return steps(list(items), what, label)
