@@ -1,0 +1,93 @@
+"""Position-free comparison of ASTs (krl/ast/nodes.py).
+
+Node ``==`` already ignores ``span`` and ``ann``; :func:`same_tree` adds two things a
+formatter check needs:
+
+* with ``fold_keywords=True``, a string field that spells a reserved word (a type name such
+  as ``int``/``INT``, an approximation ``c_ptp``) compares case-insensitively, since KRL is
+  case-insensitive (reference 1.1) and the formatter may change keyword case. Names of
+  variables, routines, components and string contents still compare exactly: identifiers
+  cannot spell a reserved word, and :class:`~krl.ast.nodes.StrLit` values are never folded;
+* :func:`first_difference` names the path of the first differing field, for test messages.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+from krl.ast import nodes as N
+
+__all__ = ["same_tree", "first_difference", "structure"]
+
+
+def _keywords() -> frozenset[str]:
+    from krl.syntax.parse import default_bundle  # noqa: PLC0415
+
+    from krl.fmt.core import keyword_types  # noqa: PLC0415
+
+    bundle = default_bundle()
+    return frozenset(bundle.symbolic[t].replace("_F", " F") if bundle.symbolic[t] == "BRAKE_F"
+                     else bundle.symbolic[t] for t in keyword_types(bundle))
+
+
+_KW: frozenset[str] | None = None
+
+
+def structure(node, fold_keywords: bool = False):
+    """A nested tuple of the node's compared fields (no spans, no annotations); iterative,
+    so deep trees do not hit the recursion limit."""
+    global _KW
+    if fold_keywords and _KW is None:
+        _KW = _keywords()
+    kw = _KW or frozenset()
+    # post-order build with an explicit stack
+    out_stack: list = []
+    work: list = [(node, False, None)]
+    while work:
+        item, done, meta = work.pop()
+        if done:
+            kind, n = meta
+            vals = [out_stack.pop() for _ in range(n)][::-1]
+            out_stack.append((kind, *vals) if kind is not None else tuple(vals))
+            continue
+        if isinstance(item, N.Node):
+            fields = [f for f in dataclasses.fields(item) if f.compare]
+            work.append((None, True, (type(item).__name__, len(fields))))
+            fold = fold_keywords and not isinstance(item, N.StrLit)
+            for f in reversed(fields):
+                v = getattr(item, f.name)
+                if fold and isinstance(v, str) and v.upper() in kw:
+                    v = v.upper()
+                work.append((v, False, None))
+        elif isinstance(item, (list, tuple)):
+            work.append((None, True, (None, len(item))))
+            for v in reversed(item):
+                work.append((v, False, None))
+        else:
+            out_stack.append(item)
+    return out_stack[0]
+
+
+def same_tree(a, b, fold_keywords: bool = False) -> bool:
+    """True when the two ASTs are equal without positions (and, with `fold_keywords`, up to
+    the case of reserved words)."""
+    if not fold_keywords:
+        return a == b
+    return structure(a, True) == structure(b, True)
+
+
+def first_difference(a, b, fold_keywords: bool = False) -> str | None:
+    """The first differing position as a readable path, or None when equal."""
+    sa, sb = structure(a, fold_keywords), structure(b, fold_keywords)
+    path: list[str] = []
+    work = [(sa, sb, "")]
+    while work:
+        x, y, where = work.pop(0)
+        if x == y:
+            continue
+        if isinstance(x, tuple) and isinstance(y, tuple) and len(x) == len(y):
+            work = [(xi, yi, f"{where}/{i}") for i, (xi, yi) in enumerate(zip(x, y))] + work
+            continue
+        path.append(f"{where}: {x!r:.200} != {y!r:.200}")
+        break
+    return path[0] if path else None

@@ -1,0 +1,481 @@
+"""`krl fmt`: the KRL formatter, working on the ANTLR token stream and parse tree.
+
+What it changes, line by line (reference 1.1-1.6 for the lexical rules it relies on):
+
+* **Indentation** of code lines: one level (``FormatOptions.indent``, default two spaces) per
+  enclosing block -- DEF/DEFFCT bodies, DEFDAT contents, IF/ELSE/ENDIF, FOR, WHILE, LOOP,
+  REPEAT/UNTIL, SWITCH (CASE/DEFAULT one level in, their statements two), SPLINE/PTP_SPLINE.
+  ELSE, CASE and DEFAULT sit at their block's level; labels at the level of the statements.
+* **Keyword case** (``keyword_case``: ``"upper"``, KUKA's spelling and the default; ``"lower"``;
+  ``"keep"``). Only reserved words change; names (identifiers, $system names, #enum literals,
+  and keywords used as structure components or enum values: ``ON``, ``OFF``, ``IN`` ...) keep
+  the case their author wrote, since KRL names are case-insensitive (1.1) and the case is a
+  person's choice.
+* **Spacing** between the tokens of a code line: one space around binary operators,
+  assignment ``=`` and the geometric operator ``:``; none after a unary ``-``/``+``; none inside
+  ``()``, ``[]`` and ``{}``; none before ``,`` and one after; ``{X 10, Y 20}`` in aggregates; no
+  space between a name and its ``(`` or ``[``; a single space elsewhere. Trailing blanks of code
+  lines and whitespace-only lines are removed. Places whose style the corpus does not settle
+  (``a :IN`` parameter modes, CHANNEL and IMPORT declarations) keep the author's choice,
+  collapsed to one space or none.
+
+What it never changes: comments (also their position after code: the blank run before a
+trailing comment is kept), full comment lines, ``;FOLD`` / ``;ENDFOLD`` lines, every line of a
+folded inline form (a FOLD whose line carries a ``%{...}`` marker, e.g.
+``;FOLD PTP P1 ...;%{PE}%R 8.3.31,%MKUKATPBASIS,...``, down to its ENDFOLD, nested folds
+included: the smartPAD regenerates those lines and expects their exact text), ``&`` header
+lines, blank lines (their number), string literals, literals' spelling, line ends (CRLF, LF
+and CR per line), a leading byte order mark and a missing final line end.
+
+A file that does not parse is never formatted: :func:`format_text` raises
+:class:`FormatSyntaxError`. After formatting, the result is lexed again and its token stream
+must equal the input's (keyword case aside); a difference raises :class:`FormatSafetyError`
+instead of returning changed meaning.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Literal
+
+from antlr4 import InputStream, ParserRuleContext
+from antlr4.Token import Token
+from antlr4.tree.Tree import TerminalNode
+
+from krl.syntax.parse import ParseResult, ParserBundle, default_bundle, parse_text
+
+__all__ = ["FormatOptions", "FormatError", "FormatSyntaxError", "FormatSafetyError", "format_text",
+           "format_parsed"]
+
+KeywordCase = Literal["upper", "lower", "keep"]
+
+
+@dataclass(frozen=True, slots=True)
+class FormatOptions:
+    """How :func:`format_text` formats.
+
+    keyword_case: "upper" (default, KUKA's spelling), "lower" or "keep".
+    indent: the text of one indentation level (default three spaces, the corpus' most common
+        step; a tab is allowed).
+    indent_case: CASE/DEFAULT one level inside SWITCH (default True, the corpus' majority).
+    indent_data: indent the contents of a DEFDAT (default False: KUKA's data lists start every
+        line in column 1).
+    """
+
+    keyword_case: KeywordCase = "upper"
+    indent: str = "   "
+    indent_case: bool = True
+    indent_data: bool = False
+
+    def __post_init__(self) -> None:
+        if self.keyword_case not in ("upper", "lower", "keep"):
+            raise ValueError(f"keyword_case must be upper, lower or keep, not {self.keyword_case!r}")
+        if self.indent.strip(" \t") != "":
+            raise ValueError("indent must be spaces or tabs")
+
+
+class FormatError(Exception):
+    """Base class of the formatter's errors; the text is left unformatted."""
+
+
+@dataclass
+class SyntaxProblem:
+    """One reason a text does not parse: 1-based line and column, a message."""
+
+    line: int
+    column: int
+    message: str
+    code: str = "E002"
+
+
+class FormatSyntaxError(FormatError):
+    """The text does not parse (syntax or lexer error, or past a limit of krl/limits.py);
+    `problems` lists them (1-based line and column) and `result` is the ParseResult."""
+
+    def __init__(self, problems: list[SyntaxProblem], result: ParseResult | None = None):
+        self.problems = problems
+        self.result = result
+        first = problems[0] if problems else SyntaxProblem(1, 1, "does not parse")
+        super().__init__(f"{first.line}:{first.column}: {first.message}")
+
+
+class FormatSafetyError(FormatError):
+    """The formatted text would not lex to the same tokens (a formatter bug); nothing is
+    returned rather than a changed program."""
+
+
+# ---------------------------------------------------------------------------- token roles
+
+# Roles of default-channel tokens, decided from the parse tree.
+BINOP = "binop"          # binary operator, relational operator, AND/OR/...
+GEO = "geo"              # the geometric operator ':'
+UNARY = "unary"          # unary - + NOT B_NOT, the sign of a data-list constant
+ASSIGN = "assign"        # '=' of an assignment, FOR, WITH, DELAY=, an initial value
+NAME = "name"            # a keyword used as a name (structure component, enum value)
+CALL_OPEN = "call("      # '(' after a routine name (call, DEF, DEFFCT, EXT)
+KEEP = "keep"            # spacing kept as written (collapsed to one space or none)
+TIGHT = "tight"          # no spaces around (open dimensions [,])
+COMP_NAME = "comp"       # the component name of an aggregate item
+AGG_COLON = "aggcolon"   # '{E6POS: X 1}' type colon
+LABEL_COLON = "labelcolon"
+AGG_COMMA = "aggcomma"   # ',' between aggregate components
+_OPS = frozenset((BINOP, GEO, ASSIGN))
+
+_BINARY_LABELS = frozenset(("multiplicativeExpression", "additiveExpression", "andExpression",
+                            "exorExpression", "orExpression", "relationalExpression"))
+_KEEP_RULES = frozenset(("channelDeclaration", "importDeclaration", "parameter", "externalParameter"))
+
+_OPENERS = frozenset(("IF", "FOR", "WHILE", "LOOP", "REPEAT", "SWITCH", "SPLINE", "PTP_SPLINE",
+                      "DEF", "DEFFCT", "DEFDAT"))
+_CLOSERS = {"ENDIF": "IF", "ENDFOR": "FOR", "ENDWHILE": "WHILE", "ENDLOOP": "LOOP", "UNTIL": "REPEAT",
+            "ENDSWITCH": "SWITCH", "ENDSPLINE": "SPLINE", "END": "DEF", "ENDFCT": "DEFFCT",
+            "ENDDAT": "DEFDAT"}
+
+_WORDISH = frozenset("ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789_$#'\"")
+_OPCHARS = frozenset("<>=")
+
+
+def _rule_name(ctx) -> str:
+    name = type(ctx).__name__
+    if name.endswith("Context"):
+        name = name[:-7]
+    return name[:1].lower() + name[1:]
+
+
+def _keyword_types(bundle: ParserBundle) -> frozenset[int]:
+    """Token types of reserved words: those whose lexer rule is a word literal ('IF', 'E6POS')."""
+    out = set()
+    for ttype, sym in enumerate(bundle.symbolic):
+        if ttype == 0 or sym in ("<INVALID>", "HEADER", "FOLD", "ENDFOLD", "COMMENT", "NEWLINE", "WS",
+                                 "IDENTIFIER", "SYSNAME") or sym.endswith("LITERAL"):
+            continue
+        if sym.replace("_", "").isalnum() and sym[:1].isalpha():
+            out.add(ttype)
+    return frozenset(out)
+
+
+_KW_CACHE: dict[int, frozenset[int]] = {}
+
+
+def keyword_types(bundle: ParserBundle) -> frozenset[int]:
+    got = _KW_CACHE.get(id(bundle))
+    if got is None:
+        got = _KW_CACHE[id(bundle)] = _keyword_types(bundle)
+    return got
+
+
+def _roles(tree) -> dict[int, str]:
+    """token index -> role, for the tokens whose spacing depends on their place in the tree."""
+    roles: dict[int, str] = {}
+    stack = [tree]
+    while stack:
+        ctx = stack.pop()
+        rule = _rule_name(ctx)
+        kids = ctx.children or ()
+        for i, c in enumerate(kids):
+            if isinstance(c, ParserRuleContext):
+                stack.append(c)
+                continue
+            if not isinstance(c, TerminalNode):
+                continue
+            tok = c.symbol
+            text = tok.text
+            role = None
+            if rule in _BINARY_LABELS and i == 1:
+                role = BINOP
+            elif rule == "geometricExpression" and i == 1:
+                role = GEO
+            elif rule == "unaryExpression" and i == 0:
+                role = UNARY
+            elif rule == "constantValue" and text in ("-", "+"):
+                role = UNARY
+            elif text == "=":
+                role = ASSIGN
+            elif rule == "contextKeyword":
+                role = NAME
+            elif rule in _KEEP_RULES and text != "(" and text != ")" and text != ",":
+                role = KEEP if text in (":", "/", "..", "[", "]") else None
+            elif rule == "openDimensions":
+                role = TIGHT
+            elif text == "(" and rule in ("call", "procedureDefinition", "functionDefinition",
+                                          "externalDeclaration"):
+                role = CALL_OPEN
+            elif text == ":" and rule in ("aggregate", "constantAggregate"):
+                role = AGG_COLON
+            elif text == "," and rule in ("aggregate", "constantAggregate"):
+                role = AGG_COMMA
+            elif text == ":" and rule == "label":
+                role = LABEL_COLON
+            elif rule == "channelDeclaration":
+                role = KEEP
+            if role is not None:
+                roles[tok.tokenIndex] = role
+        if rule in ("aggregateComponent", "constantComponent") and kids:
+            first = kids[0]
+            tok = first.symbol if isinstance(first, TerminalNode) else first.start
+            if tok is not None:
+                roles[tok.tokenIndex] = COMP_NAME
+    return roles
+
+
+# ---------------------------------------------------------------------------- spacing
+
+
+def _gap(a, b, ra: str | None, rb: str | None, original: str, data: bool) -> str:
+    """The blank between two adjacent default-channel tokens a, b of one code line; `data`:
+    the line is in a data list (DEFDAT), written compact as KUKA writes data lists."""
+    ta, tb = a.text, b.text
+    if ra == KEEP or rb == KEEP:
+        want = " " if original else ""
+    elif ra == TIGHT or rb == TIGHT:
+        want = ""
+    elif ra in _OPS or rb in _OPS:
+        op = ta if ra in _OPS else tb
+        if op[:1].isalpha():
+            want = " "                                    # AND, OR, EXOR, B_AND, ...
+        elif GEO in (ra, rb):
+            want = ""                                     # p1:p2
+        else:
+            want = "" if data else " "                    # a = b + 1; DECL INT n=3
+    elif ra == UNARY:
+        want = " " if ta[:1].isalpha() else ""            # NOT x, B_NOT x; -x
+    elif ra == AGG_COMMA:
+        want = "" if data else " "                        # {X 10, Y 20}; {X 10,Y 20}
+    elif tb in (",", ")", "]", "}") or ta in ("(", "[", "{", ","):
+        want = ""                                         # f(a,b), a[i,j], (x)
+    elif ta == "." or tb == "." or tb == "[" or rb in (CALL_OPEN, AGG_COLON, LABEL_COLON):
+        want = ""                                         # p.x, a[1], f(, {E6POS: ...}, L1:
+    else:
+        want = " "
+    if want == "" and _would_merge(ta, tb):
+        want = " "
+    return want
+
+
+def _would_merge(ta: str, tb: str) -> bool:
+    """True when writing `ta` and `tb` without a blank could lex differently."""
+    la, fb = ta[-1:], tb[:1]
+    if la in _WORDISH and fb in _WORDISH:
+        return True
+    if la in _OPCHARS and fb in _OPCHARS:
+        return True
+    if la == "." and (fb == "." or fb.isdigit()):
+        return True                                       # '..', '.5'
+    return la.isdigit() and fb == "."                     # '1.'
+
+
+# ---------------------------------------------------------------------------- formatting
+
+
+def _problems(result: ParseResult) -> list[SyntaxProblem]:
+    out = []
+    for e in result.errors:
+        code = e.offending_type if e.kind == "limit" else ("E001" if e.kind == "lexer" else "E002")
+        out.append(SyntaxProblem(e.line, e.column + 1, e.message, code))
+    if not out:
+        out.append(SyntaxProblem(1, 1, f"file not parsed: {result.status}", "E001"))
+    return out
+
+
+def format_text(text: str, options: FormatOptions | None = None) -> str:
+    """Format KRL source text (one .src/.sub/.dat file) and return the new text.
+
+    `text` is the decoded file (krl.syntax.source.decode_bytes); a leading U+FEFF (BOM) is
+    kept. Returns `text` itself when nothing changes. Idempotent:
+    ``format_text(format_text(t)) == format_text(t)``.
+
+    Raises FormatSyntaxError when the text does not parse (nothing is formatted), and
+    FormatSafetyError if the result would not lex to the same tokens (a formatter bug).
+    """
+    options = options or FormatOptions()
+    bom = ""
+    body = text
+    if body.startswith("\ufeff"):
+        bom, body = "\ufeff", body[1:]
+    added_newline = bool(body) and not body.endswith(("\n", "\r"))
+    prepared = body + "\n" if added_newline else body
+    result = parse_text(prepared, "<fmt>")
+    if not result.ok or result.tree is None:
+        raise FormatSyntaxError(_problems(result), result)
+    out = format_parsed(prepared, result, options)
+    if added_newline and out.endswith("\n"):
+        out = out[:-1]
+    new = bom + out
+    return text if new == text else new
+
+
+def format_parsed(text: str, result: ParseResult, options: FormatOptions) -> str:
+    """Format `text` given its successful ParseResult (the tree kept); see :func:`format_text`."""
+    tree = result.tree
+    parser = tree.parser
+    bundle = default_bundle()
+    tokens = parser.getTokenStream().tokens
+    kw = keyword_types(bundle)
+    roles = _roles(tree)
+    sym = bundle.symbolic
+    NL = bundle.lexer_cls.NEWLINE
+    FOLD, ENDFOLD, HEADER = bundle.lexer_cls.FOLD, bundle.lexer_cls.ENDFOLD, bundle.lexer_cls.HEADER
+
+    def case(tok) -> str:
+        if options.keyword_case == "keep" or tok.type not in kw or roles.get(tok.tokenIndex) == NAME:
+            return tok.text
+        return tok.text.upper() if options.keyword_case == "upper" else tok.text.lower()
+
+    out: list[str] = []
+    blocks: list[str] = []       # open blocks, innermost last ("IF", "SWITCH", "CASE", ...)
+    fold_depth = 0               # FOLD nesting
+    verbatim_from = 0            # 0: not in an inline form; else the fold depth that opened one
+    line_start = 0               # char index where the current line starts
+    line: list = []              # tokens of the current line (all channels, no NEWLINE)
+
+    def depth() -> int:
+        return sum(1 for b in blocks if b != "SWITCH0")
+
+    def emit(line_tokens: list, nl_tok) -> None:
+        nonlocal fold_depth, verbatim_from, line_start
+        end = nl_tok.start if nl_tok is not None else len(text)
+        raw = text[line_start:end]
+        newline = nl_tok.text if nl_tok is not None else ""
+        code = [t for t in line_tokens if t.channel == Token.DEFAULT_CHANNEL]
+        hidden = [t for t in line_tokens if t.channel != Token.DEFAULT_CHANNEL]
+        verbatim = verbatim_from > 0
+        # block structure, from the line's first word (the file parses, so this is exact)
+        first = sym[code[0].type] if code else ""
+        if first == "GLOBAL" and len(code) > 1:
+            first = sym[code[1].type]
+        level = depth()
+        if first in _CLOSERS:
+            want = _CLOSERS[first]
+            if want == "SWITCH" and blocks and blocks[-1] == "CASE":
+                blocks.pop()
+            if want == "SWITCH" and blocks and blocks[-1] == "SWITCH0":
+                want = "SWITCH0"
+            if want == "SPLINE" and blocks and blocks[-1] == "PTP_SPLINE":
+                want = "PTP_SPLINE"
+            if want == "DEF" and blocks and blocks[-1] == "DEFFCT":
+                want = "DEFFCT"
+            if blocks and blocks[-1] == want:
+                blocks.pop()
+            level = depth()
+        elif first == "ELSE":
+            level = depth() - 1
+        elif first in ("CASE", "DEFAULT"):
+            if blocks and blocks[-1] == "CASE":
+                blocks.pop()
+            level = depth()
+            blocks.append("CASE")
+        if first in _OPENERS:
+            blocks.append("SWITCH0" if first == "SWITCH" and not options.indent_case else first)
+        # folds: a FOLD line with a %{..} marker opens an inline form, kept verbatim to its ENDFOLD
+        for t in hidden:
+            if t.type == FOLD:
+                fold_depth += 1
+                if verbatim_from == 0 and "%{" in t.text:
+                    verbatim_from = fold_depth
+                    verbatim = True
+            elif t.type == ENDFOLD:
+                if verbatim_from and fold_depth == verbatim_from:
+                    verbatim_from = 0
+                    verbatim = True
+                fold_depth = max(0, fold_depth - 1)
+        data = "DEFDAT" in blocks
+        if data and not options.indent_data:
+            level -= 1
+        indent_ws = raw[:len(raw) - len(raw.lstrip(" \t\f"))]
+        if not line_tokens:
+            out.append(["keep", (raw if verbatim else "") + newline, None, ""])
+        elif verbatim or line_tokens[0].type in (HEADER, FOLD, ENDFOLD):
+            out.append(["keep", raw + newline, None, ""])
+        elif not code:
+            # a full comment line: its text as written; its indentation follows the code line
+            # it was aligned with (decided in the second pass), otherwise stays as it is
+            out.append(["comment", raw[len(indent_ws):] + newline, indent_ws, None])
+        else:
+            parts = [case(code[0])]
+            for a, b in zip(code, code[1:]):
+                original = text[a.stop + 1:b.start]
+                parts.append(_gap(a, b, roles.get(a.tokenIndex), roles.get(b.tokenIndex), original, data))
+                parts.append(case(b))
+            if hidden:
+                # a trailing comment: the blank run before it as written
+                c0 = hidden[0]
+                parts.append(text[code[-1].stop + 1:c0.start])
+                parts.append(text[c0.start:end])
+            out.append(["code", "".join(parts) + newline, indent_ws, options.indent * max(level, 0)])
+        line_start = nl_tok.stop + 1 if nl_tok is not None else len(text)
+
+    for tok in tokens:
+        if tok.type == Token.EOF:
+            break
+        if tok.type == NL:
+            emit(line, tok)
+            line = []
+        else:
+            line.append(tok)
+    if line or line_start < len(text):
+        emit(line, None)
+    formatted = "".join(_place_comments(out))
+    _verify(text, formatted, bundle, options)
+    return formatted
+
+
+def _place_comments(lines: list[list]) -> list[str]:
+    """Second pass: the text of each line. A full comment line indented exactly like the next
+    code line (or else the previous one) moves with it; any other comment line (column 1,
+    aligned with something else) keeps its indentation. Blank and comment lines between are
+    skipped when looking for that code line; a kept line (fold, header, inline form) stops it."""
+    n = len(lines)
+    nxt: list[int | None] = [None] * n
+    prv: list[int | None] = [None] * n
+    last = None
+    for i in range(n):
+        prv[i] = last
+        kind = lines[i][0]
+        if kind == "code":
+            last = i
+        elif kind == "keep" and lines[i][1].strip():
+            last = None
+    last = None
+    for i in range(n - 1, -1, -1):
+        nxt[i] = last
+        kind = lines[i][0]
+        if kind == "code":
+            last = i
+        elif kind == "keep" and lines[i][1].strip():
+            last = None
+    out = []
+    for i, (kind, body, old, new) in enumerate(lines):
+        if kind == "keep":
+            out.append(body)
+        elif kind == "code":
+            out.append(new + body)
+        else:
+            indent = old
+            for j in (nxt[i], prv[i]):
+                if j is not None and lines[j][2] == old:
+                    indent = lines[j][3]
+                    break
+            out.append(indent + body)
+    return out
+
+
+def _signature(text: str, bundle: ParserBundle, fold_case: bool) -> list[tuple[int, str]]:
+    lexer = bundle.lexer_cls(InputStream(text))
+    lexer.removeErrorListeners()
+    kw = keyword_types(bundle)
+    out = []
+    for tok in lexer.getAllTokens():
+        if tok.type in kw and fold_case:
+            out.append((tok.type, tok.text.upper()))
+        else:
+            out.append((tok.type, tok.text))
+    return out
+
+
+def _verify(before: str, after: str, bundle: ParserBundle, options: FormatOptions) -> None:
+    """The formatted text lexes to the same tokens, each with the same text (keywords up to
+    case when the case changes): comments, strings, literals and names are untouched."""
+    if before == after:
+        return
+    if _signature(before, bundle, True) != _signature(after, bundle, True):
+        raise FormatSafetyError("formatting would change the token stream; the text is left as it is")
