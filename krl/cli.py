@@ -43,6 +43,7 @@ SUBCOMMAND_MODULES = (
     "interp.cli",          # run, asm
     "krl.bench",           # bench
     "conformance.cli",     # conformance
+    "krl.fmt.cli",         # fmt
 )
 
 

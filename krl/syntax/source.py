@@ -24,6 +24,16 @@ def _latin1_fallback(err: UnicodeDecodeError) -> tuple[str, int]:
 codecs.register_error("krl-latin1", _latin1_fallback)
 
 
+def _latin1_encode_fallback(err: UnicodeEncodeError) -> tuple[bytes, int]:
+    chunk = err.object[err.start:err.end]
+    if all(ord(ch) <= 0xFF for ch in chunk):
+        return chunk.encode("latin-1"), err.end
+    raise err
+
+
+codecs.register_error("krl-latin1-encode", _latin1_encode_fallback)
+
+
 @dataclass(slots=True)
 class SourceText:
     """A decoded source file.
@@ -54,6 +64,18 @@ def decode_bytes(data: bytes) -> tuple[str, str]:
         pass
     # cp1252 leaves 0x81, 0x8D, 0x8F, 0x90, 0x9D undefined; those decode as Latin-1.
     return data.decode("cp1252", errors="krl-latin1"), "cp1252"
+
+
+def encode_text(text: str, encoding: str) -> bytes:
+    """The inverse of :func:`decode_bytes` for the encoding it reported: ``encode_text(t, e)``
+    gives back the original bytes for ``(t, e) = decode_bytes(data)`` ("utf-8-sig" restores the
+    BOM; "cp1252" writes the five undefined bytes, decoded as Latin-1, back as themselves).
+    Raises UnicodeEncodeError for a character the encoding cannot hold."""
+    if encoding == "utf-8-sig":
+        return b"\xef\xbb\xbf" + text.encode("utf-8")
+    if encoding in ("ascii", "utf-8"):
+        return text.encode("utf-8")
+    return text.encode("cp1252", errors="krl-latin1-encode")
 
 
 def read_source(path: str | Path, max_bytes: int = MAX_BYTES) -> SourceText:

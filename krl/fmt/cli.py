@@ -1,0 +1,198 @@
+"""`krl fmt [--check] [--diff] [--keyword-case upper|lower|keep] [--indent N] PATHS...`
+(registered by krl/cli.py).
+
+PATHS are KRL files (.src, .dat, .sub) or folders (searched for KRL files, symbolic links not
+followed). By default each file that would change is rewritten in place, atomically (a
+temporary file in the same folder, then a rename), in the encoding it was read in
+(krl/syntax/source.py: UTF-8 with or without BOM, or Windows-1252, byte for byte outside the
+changed whitespace and keyword case). ``--check`` and ``--diff`` write nothing: they print a
+unified diff of each file that would change (KRL text shown through krl/terminal.py
+``printable``); ``--check`` also exits 1 when any file would change.
+
+A file that does not parse is never formatted: its syntax errors are printed in the compiler
+form of ``krl parse`` (krl/semantics/render.py, ``file:line:col: error[E0xx]: ...``) on stderr,
+the file is left untouched, and the exit status is 2. Exit status: 0 nothing to do or
+everything formatted; 1 (``--check`` only) some file would change; 2 some file did not parse
+or could not be read or written (this wins over 1). A count line closes the run on stderr.
+"""
+
+from __future__ import annotations
+
+import difflib
+import os
+import re
+import sys
+import tempfile
+from pathlib import Path
+
+import click
+
+from krl.fmt.core import FormatError, FormatOptions, FormatSyntaxError, format_text
+
+_LINE_END = re.compile(r"\r\n|\n|\r")
+
+
+def krl_files(paths) -> list[Path]:
+    """The KRL files named by `paths`: files as given, folders walked iteratively (sorted,
+    symbolic links inside folders not followed). A missing path is returned as is (and
+    reported as unreadable)."""
+    from krl.syntax.source import is_krl_file  # noqa: PLC0415
+
+    out: list[Path] = []
+    for raw in paths:
+        p = Path(raw)
+        if not p.is_dir():
+            out.append(p)
+            continue
+        found: list[Path] = []
+        stack = [p]
+        while stack:
+            d = stack.pop()
+            try:
+                entries = list(os.scandir(d))
+            except OSError:
+                continue
+            for e in entries:
+                try:
+                    if e.is_symlink():
+                        continue
+                    if e.is_dir(follow_symlinks=False):
+                        stack.append(Path(e.path))
+                    elif e.is_file(follow_symlinks=False) and is_krl_file(Path(e.name)):
+                        found.append(Path(e.path))
+                except OSError:
+                    continue
+        out.extend(sorted(found))
+    return out
+
+
+def _lines(text: str) -> list[str]:
+    return _LINE_END.split(text)
+
+
+def unified_diff(path: str, before: str, after: str) -> list[str]:
+    """A unified diff of two versions of a file, as printable lines (line ends are never changed
+    by the formatter, so lines are compared without them; control characters escaped)."""
+    from krl.terminal import printable, printable_path  # noqa: PLC0415
+
+    name = printable_path(path)
+    diff = difflib.unified_diff(_lines(before), _lines(after), f"{name} (original)", f"{name} (formatted)",
+                                lineterm="")
+    return [printable(line) for line in diff]
+
+
+def write_atomically(path: Path, data: bytes) -> None:
+    """Replace the file's content: write a temporary file next to it, then rename it over the
+    file (the target of a symbolic link is replaced, the link kept); the file's mode is kept.
+    Raises OSError."""
+    target = Path(os.path.realpath(path))
+    mode = target.stat().st_mode & 0o7777
+    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".krlfmt", dir=target.parent)
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(data)
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.chmod(tmp, mode)
+        os.replace(tmp, target)
+    except BaseException:
+        try:
+            os.unlink(tmp)
+        except OSError:
+            pass
+        raise
+
+
+def run_fmt(paths, check: bool = False, diff: bool = False, options: FormatOptions | None = None,
+            out=None, err=None, colour: bool = False) -> int:
+    """The command's body; `out`/`err` are line writers (diffs / diagnostics and the count line).
+    Returns the exit status (0, 1 or 2). Never raises for bad input."""
+    from krl.semantics.diagnostics import Diagnostic  # noqa: PLC0415
+    from krl.semantics.render import Renderer, SourceLines  # noqa: PLC0415
+    from krl.syntax.cli import file_diagnostics  # noqa: PLC0415
+    from krl.syntax.source import encode_text, read_source  # noqa: PLC0415
+    from krl.terminal import printable, printable_path  # noqa: PLC0415
+
+    out = out or click.echo
+    err = err or (lambda line: click.echo(line, err=True))
+    options = options or FormatOptions()
+    sources = SourceLines()
+    renderer = Renderer(err, colour, sources)
+    files = krl_files(paths)
+    changed = unchanged = failed = 0
+    for path in files:
+        src = read_source(path)
+        if src.status == "empty":
+            unchanged += 1
+            continue
+        problem: list[Diagnostic] = []
+        new = None
+        if src.status == "ok":
+            try:
+                new = format_text(src.text, options)
+            except FormatSyntaxError:
+                _result, text, problem = file_diagnostics(path)
+                sources.add(str(path), text)
+            except FormatError as exc:
+                err(f"{printable_path(path)}: not formatted: {printable(exc)}")
+                failed += 1
+                continue
+        else:
+            _result, text, problem = file_diagnostics(path)
+        if new is None:
+            renderer.emit(problem or [Diagnostic(str(path), 1, 1, "E001", f"file not parsed: {src.status}")])
+            failed += 1
+            continue
+        if new == src.text:
+            unchanged += 1
+            continue
+        changed += 1
+        if check or diff:
+            for line in unified_diff(str(path), src.text, new):
+                out(line)
+            continue
+        try:
+            original = encode_text(src.text, src.encoding)
+            data = encode_text(new, src.encoding)
+            if original != Path(path).read_bytes():
+                raise OSError("the file changed while it was formatted, or its bytes do not round-trip")
+            write_atomically(Path(path), data)
+        except (OSError, UnicodeError) as exc:
+            err(f"{printable_path(path)}: not written: {printable(exc)}")
+            changed -= 1
+            failed += 1
+    verb = "would be reformatted" if (check or diff) else "reformatted"
+    summary = f"{changed} {'file' if changed == 1 else 'files'} {verb}, {unchanged} unchanged"
+    if failed:
+        summary += f", {failed} not formatted (syntax errors or unreadable)"
+    err(summary)
+    if failed:
+        return 2
+    return 1 if (check and changed) else 0
+
+
+@click.command("fmt")
+@click.argument("paths", nargs=-1, required=True)
+@click.option("--check", is_flag=True, help="Write nothing; print a diff and exit 1 when a file would change.")
+@click.option("--diff", is_flag=True, help="Write nothing; print a unified diff of each file that would change.")
+@click.option("--keyword-case", type=click.Choice(["upper", "lower", "keep"]), default="upper", show_default=True,
+              help="Case of reserved words (names always keep theirs).")
+@click.option("--indent", type=click.IntRange(1, 16), default=3, show_default=True,
+              help="Spaces per block level.")
+def fmt(paths: tuple[str, ...], check: bool, diff: bool, keyword_case: str, indent: int) -> None:
+    """Format KRL files in place (indentation, keyword case, spacing); comments, folds,
+    inline forms, header lines and line ends are kept. Exit 1 with --check when a file would
+    change, 2 when a file does not parse."""
+    from krl.semantics.render import use_colour  # noqa: PLC0415
+
+    options = FormatOptions(keyword_case=keyword_case, indent=" " * indent)  # type: ignore[arg-type]
+    try:
+        status = run_fmt(paths, check, diff, options, colour=use_colour(sys.stderr))
+    except Exception as exc:  # noqa: BLE001 - a last line of defence: no traceback
+        from krl.terminal import printable  # noqa: PLC0415
+        click.echo(f"krl fmt: internal error: {type(exc).__name__}: {printable(exc)}", err=True)
+        status = 2
+    sys.exit(status)
+
+
+commands = [fmt]
