@@ -1,0 +1,100 @@
+"""`krl fmt` on files: in-place rewrite in the file's own encoding, --check / --diff exit codes
+and output, unparsable files reported (file:line:col) and left untouched."""
+
+from __future__ import annotations
+
+import os
+import stat
+
+from click.testing import CliRunner
+
+from krl.cli import main
+
+MESSY = b"DEF t( )\r\nx=1 ; caf\xe9 = \x81 kept\r\nEND\r\n"          # cp1252, with an undefined byte
+TIDY = b"DEF t()\r\n   x = 1 ; caf\xe9 = \x81 kept\r\nEND\r\n"
+BROKEN = b"DEF u()\nIF a THEN\nx=1\nEND\n"
+
+
+def run(*args):
+    return CliRunner().invoke(main, ["fmt", *map(str, args)])
+
+
+def test_rewrites_in_place_in_the_same_encoding(tmp_path):
+    f = tmp_path / "t.src"
+    f.write_bytes(MESSY)
+    os.chmod(f, 0o640)
+    res = run(f)
+    assert res.exit_code == 0, res.output
+    assert f.read_bytes() == TIDY
+    assert stat.S_IMODE(f.stat().st_mode) == 0o640
+    assert "1 file reformatted" in res.stderr
+    assert [p.name for p in tmp_path.iterdir()] == ["t.src"]          # no temporary file left
+
+
+def test_utf8_bom_is_written_back(tmp_path):
+    f = tmp_path / "t.src"
+    f.write_bytes(b"\xef\xbb\xbfDEF t()\nx=\"\xc3\xa4\"\nEND\n")
+    assert run(f).exit_code == 0
+    assert f.read_bytes() == b"\xef\xbb\xbfDEF t()\n   x = \"\xc3\xa4\"\nEND\n"
+
+
+def test_check_exits_1_with_a_diff_and_writes_nothing(tmp_path):
+    f = tmp_path / "t.src"
+    f.write_bytes(MESSY)
+    res = run("--check", f)
+    assert res.exit_code == 1
+    assert f.read_bytes() == MESSY
+    out = res.stdout.splitlines()
+    assert out[0] == f"--- {f} (original)"
+    assert out[1] == f"+++ {f} (formatted)"
+    assert "-DEF t( )" in out and "+DEF t()" in out
+    assert "-x=1 ; caf\xe9 = \\x81 kept" in out          # the C1 control is shown escaped
+    assert "+   x = 1 ; caf\xe9 = \\x81 kept" in out
+    assert " END" in out
+    assert "1 file would be reformatted" in res.stderr
+
+
+def test_check_exits_0_when_formatted(tmp_path):
+    f = tmp_path / "t.src"
+    f.write_bytes(TIDY)
+    res = run("--check", f)
+    assert res.exit_code == 0
+    assert res.stdout == ""
+
+
+def test_diff_writes_nothing_and_exits_0(tmp_path):
+    f = tmp_path / "t.src"
+    f.write_bytes(MESSY)
+    res = run("--diff", f)
+    assert res.exit_code == 0
+    assert "+DEF t()" in res.stdout.splitlines()
+    assert f.read_bytes() == MESSY
+
+
+def test_unparsable_file_is_reported_and_untouched_exit_2(tmp_path):
+    bad, good = tmp_path / "u.src", tmp_path / "t.src"
+    bad.write_bytes(BROKEN)
+    good.write_bytes(MESSY)
+    res = run(tmp_path)                          # a folder: both files
+    assert res.exit_code == 2
+    assert bad.read_bytes() == BROKEN
+    assert good.read_bytes() == TIDY             # the good one is still formatted
+    assert f"{bad}:2:1: error[E010]" in res.stderr
+    res = run("--check", bad, good)
+    assert res.exit_code == 2                    # 2 wins over "would change"
+
+
+def test_keyword_case_and_indent_options(tmp_path):
+    f = tmp_path / "t.src"
+    f.write_bytes(b"DEF t()\nIF a THEN\nhalt\nENDIF\nEND\n")
+    assert run("--keyword-case", "lower", "--indent", "2", f).exit_code == 0
+    assert f.read_bytes() == b"def t()\n  if a then\n    halt\n  endif\nend\n"
+
+
+def test_missing_file_and_binary_file_are_errors(tmp_path):
+    b = tmp_path / "b.src"
+    b.write_bytes(b"DEF\x00")
+    res = run(tmp_path / "nope.src", b)
+    assert res.exit_code == 2
+    assert "E001" in res.stderr
+    assert "Traceback" not in res.output

@@ -1,0 +1,90 @@
+"""krl fmt over generated programs: the printed AST (tests/frontend/strategies.py), scrambled
+(random blanks between tokens, random keyword case, indentation, trailing comments, blank
+lines, CRLF), must format to text that parses to the same AST and formats to itself."""
+
+from __future__ import annotations
+
+import random
+
+from antlr4 import InputStream
+from hypothesis import assume, given, settings, strategies as st
+
+from krl.ast.build import build_module
+from krl.ast.compare import first_difference, same_tree
+from krl.ast.printer import print_module
+from krl.fmt import FormatOptions, format_text
+from krl.fmt.core import keyword_types
+from krl.syntax.parse import default_bundle, parse_text
+from tests.budget import examples
+from tests.frontend.strategies import modules
+
+GAPS = ["", " ", "  ", "\t", " \t "]
+
+
+def tokens(text: str):
+    bundle = default_bundle()
+    lexer = bundle.lexer_cls(InputStream(text))
+    lexer.removeErrorListeners()
+    return [(t.type, t.text.upper()) for t in lexer.getAllTokens()]
+
+
+def code(text: str):
+    """The program's tokens without comments and line ends, keywords upper-case."""
+    bundle = default_bundle()
+    return [t for t in tokens(text) if t[0] not in (bundle.lexer_cls.NEWLINE, bundle.lexer_cls.COMMENT)]
+
+
+_GLUE = set("ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789_$#'\"<>=.")
+
+
+def scramble(text: str, seed: int) -> str:
+    """The same program with other blanks, keyword case, comments and line ends."""
+    rnd = random.Random(seed)
+    bundle = default_bundle()
+    kw = keyword_types(bundle)
+    lexer = bundle.lexer_cls(InputStream(text))
+    lexer.removeErrorListeners()
+    out: list[str] = []
+    at_line_start = True
+    prev = ""
+    nl = "\r\n" if rnd.random() < 0.5 else "\n"
+    for tok in lexer.getAllTokens():
+        if tok.type == bundle.lexer_cls.NEWLINE:
+            if rnd.random() < 0.2:
+                out.append(" " * rnd.randint(0, 3) + "; note = 1 ;" + rnd.choice(["", "  x  "]))
+            out.append(nl)
+            if rnd.random() < 0.1:
+                out.append(" " * rnd.randint(0, 4) + nl)
+            at_line_start = True
+            continue
+        word = tok.text
+        if tok.type in kw:
+            word = "".join(c.upper() if rnd.random() < 0.5 else c.lower() for c in word)
+        if at_line_start:
+            out.append(" " * rnd.randint(0, 6))
+        else:
+            glue = prev[-1:] in _GLUE and word[:1] in _GLUE
+            out.append(rnd.choice(GAPS[1:] if glue else GAPS))
+        out.append(word)
+        prev = word
+        at_line_start = False
+    return "".join(out)
+
+
+@settings(max_examples=examples(40))
+@given(modules, st.integers(0, 2**32 - 1), st.sampled_from(["upper", "lower", "keep"]))
+def test_format_keeps_the_ast_and_is_idempotent(module, seed, case):
+    printed = print_module(module)
+    messy = scramble(printed, seed)
+    assume(code(messy) == code(printed))   # no two tokens glued into one by a removed blank
+    before = parse_text(messy, "gen.src")
+    assert before.ok, messy
+    opts = FormatOptions(keyword_case=case)
+    once = format_text(messy, opts)
+    after = parse_text(once, "gen.src")
+    assert after.ok, once
+    a, b = build_module(before), build_module(after)
+    assert same_tree(a, b, fold_keywords=True), (first_difference(a, b, True), messy, once)
+    assert format_text(once, opts) == once, once
+    # line ends are kept line by line
+    assert once.count("\r\n") == messy.count("\r\n")
