@@ -56,7 +56,7 @@ def test_nested_fold_inside_an_inline_form_is_kept_to_the_outer_endfold():
 
 def test_plain_fold_lines_are_kept_and_their_content_formatted():
     src = "\n".join(["DEF t()", "  ;FOLD my section  ", "x=1", " ;ENDFOLD  (my section)", "END", ""])
-    want = "\n".join(["DEF t()", "  ;FOLD my section  ", "   x = 1", " ;ENDFOLD  (my section)", "END", ""])
+    want = "\n".join(["DEF t()", "  ;FOLD my section  ", "      x = 1", " ;ENDFOLD  (my section)", "END", ""])
     assert format_text(src) == want
 
 

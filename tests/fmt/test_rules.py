@@ -81,6 +81,24 @@ def test_label_sits_with_the_statements():
     assert fmt(src) == want
 
 
+def test_plain_folds_in_a_routine_indent_their_statements():
+    src = lines("DEF t()", "   ;FOLD INI", "x = 1", "   ;ENDFOLD", "y = 2", "END")
+    want = lines("DEF t()", "   ;FOLD INI", "      x = 1", "   ;ENDFOLD", "   y = 2", "END")
+    assert fmt(src) == want
+    assert fmt(src, indent_folds=False) == lines("DEF t()", "   ;FOLD INI", "   x = 1", "   ;ENDFOLD",
+                                                 "   y = 2", "END")
+
+
+def test_folds_around_routines_do_not_indent_them():
+    # KUKA's system files: a fold opened in one routine closes after its END; a fold around a
+    # whole DEF opens outside any routine
+    src = lines("DEF a()", ";FOLD A ()", "x = 1", "END", ";ENDFOLD A ()", ";FOLD B ()", "DEF b()",
+                "y = 2", "END", ";ENDFOLD B ()")
+    want = lines("DEF a()", ";FOLD A ()", "      x = 1", "END", ";ENDFOLD A ()", ";FOLD B ()", "DEF b()",
+                 "   y = 2", "END", ";ENDFOLD B ()")
+    assert fmt(src) == want
+
+
 # ------------------------------------------------------------------ keyword case
 
 def test_keywords_upper_names_kept():
