@@ -4,9 +4,12 @@ line ends, a BOM, a missing final line end, string contents, names' case; and th
 
 from __future__ import annotations
 
+import pytest
+
+import krl.fmt.core as core
 from krl.ast.build import build_module
 from krl.ast.compare import first_difference, same_tree
-from krl.fmt import format_text
+from krl.fmt import FormatSafetyError, format_text
 from krl.syntax.parse import parse_text
 
 INLINE_FORM = [
@@ -94,3 +97,12 @@ def test_keyword_case_is_the_only_ast_difference_that_is_folded():
     assert not same_tree(a, c, fold_keywords=True)
     # string contents are never folded
     assert not same_tree(ast('DEF t()\nx[]="int"\nEND\n'), ast('DEF t()\nx[]="INT"\nEND\n'), fold_keywords=True)
+
+
+def test_the_token_check_refuses_a_result_that_lexes_differently(monkeypatch):
+    # a spacing rule that glued two words would turn `a AND b` into the one name `aANDb`:
+    # the final re-lex must catch it instead of returning another program
+    monkeypatch.setattr(core, "_would_merge", lambda ta, tb: False)
+    monkeypatch.setattr(core, "_gap", lambda *args: "")
+    with pytest.raises(FormatSafetyError):
+        format_text("DEF t()\nx = a AND b\nEND\n")
