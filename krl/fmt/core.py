@@ -437,7 +437,7 @@ def format_parsed(text: str, result: ParseResult, options: FormatOptions) -> str
     if line or line_start < len(text):
         emit(line, None)
     formatted = "".join(_place_comments(out))
-    _verify(text, formatted, bundle, options)
+    _verify(tokens, text, formatted, bundle)
     return formatted
 
 
@@ -481,23 +481,23 @@ def _place_comments(lines: list[list]) -> list[str]:
     return out
 
 
-def _signature(text: str, bundle: ParserBundle, fold_case: bool) -> list[tuple[int, str]]:
-    lexer = bundle.lexer_cls(InputStream(text))
-    lexer.removeErrorListeners()
-    kw = keyword_types(bundle)
+def _signature(tokens, kw: frozenset[int]) -> list[tuple[int, str]]:
     out = []
-    for tok in lexer.getAllTokens():
-        if tok.type in kw and fold_case:
-            out.append((tok.type, tok.text.upper()))
-        else:
-            out.append((tok.type, tok.text))
+    for tok in tokens:
+        if tok.type == Token.EOF:
+            break
+        out.append((tok.type, tok.text.upper() if tok.type in kw else tok.text))
     return out
 
 
-def _verify(before: str, after: str, bundle: ParserBundle, options: FormatOptions) -> None:
-    """The formatted text lexes to the same tokens, each with the same text (keywords up to
-    case when the case changes): comments, strings, literals and names are untouched."""
+def _verify(tokens, before: str, after: str, bundle: ParserBundle) -> None:
+    """The formatted text lexes to the same tokens as the input (`tokens`, its lexed stream),
+    each with the same text (keywords up to case): comments, strings, literals and names are
+    untouched, and no two tokens were glued or split."""
     if before == after:
         return
-    if _signature(before, bundle, True) != _signature(after, bundle, True):
+    kw = keyword_types(bundle)
+    lexer = bundle.lexer_cls(InputStream(after))
+    lexer.removeErrorListeners()
+    if _signature(tokens, kw) != _signature(lexer.getAllTokens(), kw):
         raise FormatSafetyError("formatting would change the token stream; the text is left as it is")
