@@ -43,7 +43,7 @@ instead of returning changed meaning.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Literal
 
 from antlr4 import InputStream, ParserRuleContext
@@ -126,7 +126,6 @@ NAME = "name"            # a keyword used as a name (structure component, enum v
 CALL_OPEN = "call("      # '(' after a routine name (call, DEF, DEFFCT, EXT)
 KEEP = "keep"            # spacing kept as written (collapsed to one space or none)
 TIGHT = "tight"          # no spaces around (open dimensions [,])
-COMP_NAME = "comp"       # the component name of an aggregate item
 AGG_COLON = "aggcolon"   # '{E6POS: X 1}' type colon
 LABEL_COLON = "labelcolon"
 AGG_COMMA = "aggcomma"   # ',' between aggregate components
@@ -221,11 +220,6 @@ def _roles(tree) -> dict[int, str]:
                 role = KEEP
             if role is not None:
                 roles[tok.tokenIndex] = role
-        if rule in ("aggregateComponent", "constantComponent") and kids:
-            first = kids[0]
-            tok = first.symbol if isinstance(first, TerminalNode) else first.start
-            if tok is not None:
-                roles[tok.tokenIndex] = COMP_NAME
     return roles
 
 

@@ -121,8 +121,8 @@ def test_keywords_used_as_names_keep_their_case_and_enum_literals_too():
     src = lines("DEFDAT t", "enum sw_onoff on,off", "struc pt int in,out", "ENDDAT")
     want = lines("DEFDAT t", "ENUM sw_onoff on,off", "STRUC pt INT in,out", "ENDDAT")
     assert fmt(src) == want
-    src = lines("DEF t()", "lin_rel {x 10} #tool", "x = p.in", "END")
-    assert fmt(src) == lines("DEF t()", "   LIN_REL {x 10} #tool", "   x = p.in", "END")
+    src = lines("DEF t()", "lin_rel {x 10} #tool", "x = p.in", "y = {in 1, out 2}", "END")
+    assert fmt(src) == lines("DEF t()", "   LIN_REL {x 10} #tool", "   x = p.in", "   y = {in 1, out 2}", "END")
 
 
 # ------------------------------------------------------------------ spacing
