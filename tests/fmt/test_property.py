@@ -55,6 +55,8 @@ def scramble(text: str, seed: int) -> str:
             out.append(nl)
             if rnd.random() < 0.1:
                 out.append(" " * rnd.randint(0, 4) + nl)
+            if rnd.random() < 0.15:
+                out.append(" " * rnd.randint(0, 6) + ";full line  comment" + nl)
             at_line_start = True
             continue
         word = tok.text
