@@ -2,7 +2,7 @@
 (registered by krl/cli.py).
 
 PATHS are KRL files (.src, .dat, .sub) or folders (searched for KRL files, symbolic links not
-followed). By default each file that would change is rewritten in place, atomically (a
+followed); ``-`` alone formats standard input to standard output (for editors and hooks). By default each file that would change is rewritten in place, atomically (a
 temporary file in the same folder, then a rename), in the encoding it was read in
 (krl/syntax/source.py: UTF-8 with or without BOM, or Windows-1252, byte for byte outside the
 changed whitespace and keyword case). ``--check`` and ``--diff`` write nothing: they print a
@@ -171,6 +171,55 @@ def run_fmt(paths, check: bool = False, diff: bool = False, options: FormatOptio
     return 1 if (check and changed) else 0
 
 
+def run_stdin(data: bytes, check: bool = False, diff: bool = False, options: FormatOptions | None = None,
+              write=None, out=None, err=None, colour: bool = False, terminal: bool = False) -> int:
+    """`krl fmt -`: format the bytes of standard input. The formatted file goes to `write`
+    (bytes, in the input's encoding; through ``printable`` when `terminal`); with --check or
+    --diff only the diff is printed. Exit status as :func:`run_fmt`; on a syntax error nothing
+    is written to `write` (an editor keeps its buffer) and the diagnostics name ``<stdin>``."""
+    from krl.limits import MAX_FILE_BYTES  # noqa: PLC0415
+    from krl.semantics.diagnostics import Diagnostic  # noqa: PLC0415
+    from krl.semantics.render import Renderer, SourceLines  # noqa: PLC0415
+    from krl.syntax.messages import syntax_diagnostics  # noqa: PLC0415
+    from krl.syntax.parse import parse_text  # noqa: PLC0415
+    from krl.syntax.source import decode_bytes, encode_text  # noqa: PLC0415
+    from krl.terminal import printable  # noqa: PLC0415
+
+    out = out or click.echo
+    err = err or (lambda line: click.echo(line, err=True))
+    write = write or sys.stdout.buffer.write
+    options = options or FormatOptions()
+    name = "<stdin>"
+    if len(data) > MAX_FILE_BYTES:
+        Renderer(err, colour).emit([Diagnostic(name, 1, 1, "E001", f"file not parsed: too_large "
+                                               f"({len(data)} bytes > {MAX_FILE_BYTES})")])
+        return 2
+    if b"\x00" in data:
+        Renderer(err, colour).emit([Diagnostic(name, 1, 1, "E001", "file not parsed: binary (NUL bytes)")])
+        return 2
+    text, encoding = decode_bytes(data)
+    try:
+        new = format_text(text, options) if text.strip(" \t\r\n\x1a") else text
+    except FormatSyntaxError:
+        diags = syntax_diagnostics(parse_text(text, name), text)
+        Renderer(err, colour, SourceLines({name: text})).emit(
+            diags or [Diagnostic(name, 1, 1, "E001", "file not parsed")])
+        return 2
+    except FormatError as exc:
+        err(f"{name}: not formatted: {printable(exc)}")
+        return 2
+    if check or diff:
+        if new != text:
+            for line in unified_diff(name, text, new):
+                out(line)
+        return 1 if (check and new != text) else 0
+    if terminal:
+        out(printable(new, keep_newlines=True))
+    else:
+        write(encode_text(new, encoding))
+    return 0
+
+
 @click.command("fmt")
 @click.argument("paths", nargs=-1, required=True)
 @click.option("--check", is_flag=True, help="Write nothing; print a diff and exit 1 when a file would change.")
@@ -187,7 +236,15 @@ def fmt(paths: tuple[str, ...], check: bool, diff: bool, keyword_case: str, inde
 
     options = FormatOptions(keyword_case=keyword_case, indent=" " * indent)  # type: ignore[arg-type]
     try:
-        status = run_fmt(paths, check, diff, options, colour=use_colour(sys.stderr))
+        if paths == ("-",):
+            stdin = sys.stdin.buffer
+            from krl.limits import MAX_FILE_BYTES  # noqa: PLC0415
+            data = stdin.read(MAX_FILE_BYTES + 1)
+            stdout = sys.stdout.buffer
+            status = run_stdin(data, check, diff, options, write=stdout.write, colour=use_colour(sys.stderr),
+                               terminal=stdout.isatty())
+        else:
+            status = run_fmt(paths, check, diff, options, colour=use_colour(sys.stderr))
     except Exception as exc:  # noqa: BLE001 - a last line of defence: no traceback
         from krl.terminal import printable  # noqa: PLC0415
         click.echo(f"krl fmt: internal error: {type(exc).__name__}: {printable(exc)}", err=True)

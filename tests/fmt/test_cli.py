@@ -98,3 +98,23 @@ def test_missing_file_and_binary_file_are_errors(tmp_path):
     assert res.exit_code == 2
     assert "E001" in res.stderr
     assert "Traceback" not in res.output
+
+
+def test_stdin_to_stdout_in_the_same_encoding():
+    res = CliRunner().invoke(main, ["fmt", "-"], input=MESSY)
+    assert res.exit_code == 0, res.output
+    assert res.stdout_bytes == TIDY
+
+
+def test_stdin_syntax_error_writes_nothing_and_exits_2():
+    res = CliRunner().invoke(main, ["fmt", "-"], input=BROKEN)
+    assert res.exit_code == 2
+    assert res.stdout_bytes == b""
+    assert "<stdin>:2:1: error[E010]" in res.stderr
+
+
+def test_stdin_check():
+    assert CliRunner().invoke(main, ["fmt", "--check", "-"], input=TIDY).exit_code == 0
+    res = CliRunner().invoke(main, ["fmt", "--check", "-"], input=MESSY)
+    assert res.exit_code == 1
+    assert "+DEF t()" in res.stdout.splitlines()
