@@ -1,4 +1,4 @@
-"""`krl fmt [--check] [--diff] [--keyword-case upper|lower|keep] [--indent N] PATHS...`
+"""`krl fmt [--check] [--diff] [--keyword-case upper|lower|keep] [--indent N|tab] PATHS...`
 (registered by krl/cli.py).
 
 PATHS are KRL files (.src, .dat, .sub) or folders (searched for KRL files, symbolic links not
@@ -226,15 +226,21 @@ def run_stdin(data: bytes, check: bool = False, diff: bool = False, options: For
 @click.option("--diff", is_flag=True, help="Write nothing; print a unified diff of each file that would change.")
 @click.option("--keyword-case", type=click.Choice(["upper", "lower", "keep"]), default="upper", show_default=True,
               help="Case of reserved words (names always keep theirs).")
-@click.option("--indent", type=click.IntRange(1, 16), default=3, show_default=True,
-              help="Spaces per block level.")
-def fmt(paths: tuple[str, ...], check: bool, diff: bool, keyword_case: str, indent: int) -> None:
+@click.option("--indent", default="3", show_default=True, metavar="N|tab",
+              help="One block level: N spaces (1-16) or a tab.")
+def fmt(paths: tuple[str, ...], check: bool, diff: bool, keyword_case: str, indent: str) -> None:
     """Format KRL files in place (indentation, keyword case, spacing); comments, folds,
     inline forms, header lines and line ends are kept. Exit 1 with --check when a file would
     change, 2 when a file does not parse."""
     from krl.semantics.render import use_colour  # noqa: PLC0415
 
-    options = FormatOptions(keyword_case=keyword_case, indent=" " * indent)  # type: ignore[arg-type]
+    if indent.lower() == "tab":
+        unit = "\t"
+    elif indent.isdigit() and 1 <= int(indent) <= 16:
+        unit = " " * int(indent)
+    else:
+        raise click.BadParameter("N spaces (1-16) or tab", param_hint="--indent")
+    options = FormatOptions(keyword_case=keyword_case, indent=unit)  # type: ignore[arg-type]
     try:
         if paths == ("-",):
             stdin = sys.stdin.buffer

@@ -91,6 +91,15 @@ def test_keyword_case_and_indent_options(tmp_path):
     assert f.read_bytes() == b"def t()\n  if a then\n    halt\n  endif\nend\n"
 
 
+def test_indent_tab_and_a_bad_indent(tmp_path):
+    f = tmp_path / "t.src"
+    f.write_bytes(b"DEF t()\nhalt\nEND\n")
+    assert run("--indent", "x", f).exit_code == 2          # click's usage error
+    assert f.read_bytes() == b"DEF t()\nhalt\nEND\n"
+    assert run("--indent", "tab", f).exit_code == 0
+    assert f.read_bytes() == b"DEF t()\n\tHALT\nEND\n"
+
+
 def test_missing_file_and_binary_file_are_errors(tmp_path):
     b = tmp_path / "b.src"
     b.write_bytes(b"DEF\x00")
