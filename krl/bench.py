@@ -45,6 +45,38 @@ def parse_rate(corpus: Path, limit_bytes: int | None = None) -> dict:
             "cold_kb_per_s": round(rates["cold"], 1), "warm_kb_per_s": round(rates["warm"], 1)}
 
 
+def fmt_rate(corpus: Path, limit_bytes: int | None = None) -> dict:
+    """Parse, then format, every KRL file under corpus that parses (a warm-up parse first);
+    returns KB/s of both and the ratio of the times, all measured in this process."""
+    from krl.fmt import format_text  # noqa: PLC0415
+    from krl.syntax.parse import parse_source  # noqa: PLC0415
+    from krl.syntax.source import read_source  # noqa: PLC0415
+    from recovery.scan import discover  # noqa: PLC0415
+
+    sources = []
+    total = 0
+    for p in discover(corpus):
+        src = read_source(p)
+        if src.status == "ok" and parse_source(src, keep_tree=False).ok:   # also warms the parser
+            sources.append(src)
+            total += src.size
+            if limit_bytes and total >= limit_bytes:
+                break
+    start = time.perf_counter()
+    for src in sources:
+        parse_source(src)
+    parse_s = time.perf_counter() - start
+    changed = 0
+    start = time.perf_counter()
+    for src in sources:
+        changed += format_text(src.text) != src.text
+    fmt_s = time.perf_counter() - start
+    kb = total / 1024
+    return {"files": len(sources), "changed": changed, "kb": round(kb, 1),
+            "parse_kb_per_s": round(kb / parse_s, 1), "fmt_kb_per_s": round(kb / fmt_s, 1),
+            "fmt_vs_parse": round(fmt_s / parse_s, 2)}
+
+
 EMBEDDED_CORPUS = Path(__file__).resolve().parents[1] / "corpus"
 
 
@@ -111,6 +143,24 @@ def bench_parse(corpus: Path | None, as_json: bool) -> None:
     else:
         click.echo(f"{res['files']} files, {res['kb']} KB: cold {res['cold_kb_per_s']} KB/s, "
                    f"warm {res['warm_kb_per_s']} KB/s (one process)")
+
+
+@bench.command("fmt")
+@click.argument("corpus", required=False, type=click.Path(path_type=Path))
+@click.option("--kb", type=int, default=1024, show_default=True, help="KB of the corpus to format.")
+@click.option("--json", "as_json", is_flag=True)
+def bench_fmt(corpus: Path | None, kb: int, as_json: bool) -> None:
+    """Formatter speed over CORPUS (default ../shared/krl-corpus) against the parser, warm."""
+    corpus = corpus or DEFAULT_CORPUS
+    if not corpus.is_dir():
+        raise click.UsageError(f"corpus not found: {corpus}")
+    res = fmt_rate(corpus, limit_bytes=kb * 1024)
+    if as_json:
+        click.echo(json.dumps(res))
+    else:
+        click.echo(f"{res['files']} files, {res['kb']} KB ({res['changed']} would change): parse "
+                   f"{res['parse_kb_per_s']} KB/s, format {res['fmt_kb_per_s']} KB/s; format takes "
+                   f"{res['fmt_vs_parse']}x the parse time (one process)")
 
 
 commands = [bench]
