@@ -44,12 +44,12 @@ _PARSE_CACHE: dict = {}
 
 def parse_module(path: str):
     """(Module AST, list of syntax error strings) of one file, cached per process."""
-    import hashlib  # noqa: PLC0415
+    from krl.syntax.source import read_source  # noqa: PLC0415
 
-    try:
-        key = (str(path), hashlib.sha1(Path(path).read_bytes()).hexdigest())
-    except OSError:
-        key = (str(path), "")
+    # read once (a FIFO or device is classified, never opened); the key is the hash of the
+    # very bytes that are parsed
+    src = read_source(path)
+    key = (str(path), src.sha or src.status)
     got = _PARSE_CACHE.get(key)
     if got is not None:
         return got
@@ -57,16 +57,14 @@ def parse_module(path: str):
     from krl.semantics.diagnostics import DiagnosticSink  # noqa: PLC0415
     from krl.syntax.parse import parse_source  # noqa: PLC0415
     from krl.syntax.messages import syntax_diagnostics  # noqa: PLC0415
-    from krl.syntax.source import read_source  # noqa: PLC0415
 
-    src = read_source(path)
     res = parse_source(src)
     sink = DiagnosticSink()
     mod = build_module(res, sink)  # E003: a construct that cannot be built stops the start too
     errs = [f"{d.path}:{d.line}:{d.column}: {d.message}"
             for d in syntax_diagnostics(res, src.text) + sink.errors]
     if not res.ok and not res.errors:
-        errs.append(f"{path}: {res.status}")
+        errs.append(f"{path}: file not read: {res.status}" + (f" ({src.detail})" if src.detail else ""))
     got = (mod, errs)
     _PARSE_CACHE[key] = got
     return got
@@ -145,7 +143,7 @@ class Program:
     def _index_files(self) -> None:
         if self.backup:
             for p in sorted(self.workspace.rglob("*")):
-                if p.is_file():
+                if p.is_file() and not p.is_symlink():
                     self._add_file(p)
         else:
             for p in sorted(self.workspace.iterdir()):
