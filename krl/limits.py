@@ -24,3 +24,14 @@ MAX_FILE_BYTES = 10 * 1024 * 1024
 # binary operators nests one level per operator. Past it: error E019 "expression too long" at
 # the statement's line (the file does not parse; the program does not start).
 MAX_EXPRESSION_TERMS = 500
+
+# The deepest folder a walk of a corpus or a KRC backup enters (krl/files.py), in folder levels
+# below the root. Real backups are about 6 levels deep (KRC/R1/Program/<cell>/<folder>); the walk is
+# iterative, so the limit keeps paths and report rows readable, not the stack safe. Past it: the
+# folder is listed as a row / warning "too_deep" and not entered.
+MAX_FOLDER_DEPTH = 100
+
+# The time one file may take to parse (krl recover, krl parse, krl check), in seconds of wall time
+# in a worker process; past it the worker is killed and the file gets a "timeout" row / error.
+# The largest corpus file (about 150 KB) parses in about a second; a 9.5 MB file took over 300 s.
+PARSE_TIMEOUT_S = 30

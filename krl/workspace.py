@@ -87,7 +87,7 @@ class Workspace:
     def _note_failed(self, result, text: str) -> None:
         if result.ok:
             return
-        if result.status in ("binary", "too_large", "unreadable"):
+        if result.status in ("binary", "too_large", "unreadable", "not_regular"):
             self.unreadable = True
         elif text:
             self.failed_words.update(w.upper() for w in _WORD.findall(text))
@@ -349,13 +349,15 @@ def _casefold_child(folder: Path, name: str) -> Path | None:
 
 def find_backups(root: str | Path) -> list[Path]:
     """Backup roots below `root`: folders with R1/System/$config.dat (the root is the folder
-    holding R1, e.g. KRC) or System/$config.dat (a flat R1 export). Any letter case; sorted."""
+    holding R1, e.g. KRC) or System/$config.dat (a flat R1 export). Any letter case; sorted.
+    The walk is krl.files.walk: iterative, links never followed."""
+    from krl.files import walk  # noqa: PLC0415
+
     root = Path(root)
     found: set[Path] = set()
-    try:
-        candidates = [p for p in root.rglob("*") if p.name.lower() == "$config.dat" and p.is_file()]
-    except OSError:
-        candidates = []
+    if not root.is_dir():
+        return []
+    candidates = [e.path for e in walk(root, match=lambda n: n.lower() == "$config.dat") if e.kind == "file"]
     for cfg in candidates:
         system = cfg.parent
         if system.name.lower() != "system":
@@ -367,27 +369,45 @@ def find_backups(root: str | Path) -> list[Path]:
     return [r for r in roots if not any(o != r and o in r.parents for o in roots)]
 
 
+def collect_entries(path: Path) -> list:
+    """The KRL entries (:class:`krl.files.Entry`) of a file or folder, in walk order: a folder is
+    walked (krl/files.py: links and FIFOs listed, never read; unreadable or too deep folders
+    listed); anything else that exists is one ``file`` entry, classified when it is read."""
+    from krl.files import Entry, walk  # noqa: PLC0415
+
+    if path.is_dir() and not path.is_symlink():
+        return list(walk(path))
+    if path.is_symlink() and path.is_dir():
+        return [Entry(path, path.name, "symlink")]
+    return [Entry(path, path.name, "file")]
+
+
 def collect_files(path: Path) -> list[Path]:
-    """KRL files (.src, .dat, .sub in any case) of a file or folder, sorted."""
-    if path.is_file():
-        return [path]
-    try:
-        return sorted(p for p in path.rglob("*") if p.is_file() and is_krl_file(p))
-    except OSError:
-        return []
+    """KRL files (.src, .dat, .sub in any case) of a file or folder, in walk order (regular
+    files only; see :func:`collect_entries` for the rest)."""
+    return [e.path for e in collect_entries(path) if e.kind == "file"]
+
+
+def _add_entries(ws: "Workspace", entries) -> None:
+    for e in entries:
+        if e.kind == "file":
+            ws.add_file(e.path)
+        else:
+            ws.sink.add(str(e.path), 1, 1, "W002", f"not read: {e.message}")
+            ws.unreadable = True   # it may declare what the other files use
 
 
 def load_workspace(paths: list[str | Path], root: str = "") -> Workspace:
     """One workspace from files and/or folders (all files of the folders). Never raises for
-    bad content; a path that does not exist gives an E001 diagnostic."""
+    bad content; a path that does not exist gives an E001 diagnostic; a link, FIFO, unreadable
+    or too deep folder met in a folder gives a W002 warning and is not read."""
     ws = Workspace(root or (str(paths[0]) if paths else ""))
     for p in paths:
         p = Path(p)
-        if not p.exists():
+        if not p.exists() and not p.is_symlink():
             ws.sink.add(str(p), 1, 1, "E001", "no such file or folder")
             continue
-        for f in collect_files(p):
-            ws.add_file(f)
+        _add_entries(ws, collect_entries(p))
     return ws
 
 
@@ -406,24 +426,31 @@ def workspaces_for(path: str | Path) -> list[Workspace]:
     top-level subfolder for the files outside the backups; another folder -> one
     workspace of all its files."""
     p = Path(path)
-    if p.is_file():
+    if p.exists() and not p.is_dir():
         files = [p]
-        for sib in (p.parent.iterdir() if p.parent.exists() else []):
-            if sib != p and sib.stem.lower() == p.stem.lower() and is_krl_file(sib):
+        try:
+            siblings = sorted(p.parent.iterdir()) if p.parent.is_dir() else []
+        except OSError:
+            siblings = []
+        for sib in siblings:
+            if sib != p and sib.stem.lower() == p.stem.lower() and is_krl_file(sib) and not sib.is_symlink():
                 files.append(sib)
         return [load_workspace(files, str(p))]
-    if p.is_dir():
+    if p.is_dir() and not p.is_symlink():
         backups = find_backups(p)
         if backups:
             out = [load_workspace([b], str(b)) for b in backups]
-            # files outside every backup: one workspace per top-level folder of `path`
-            rest: dict[str, list[Path]] = {}
-            for f in collect_files(p):
-                if any(b == f or b in f.parents for b in backups):
+            # entries outside every backup: one workspace per top-level folder of `path`
+            rest: dict[str, list] = {}
+            for e in collect_entries(p):
+                if any(b == e.path or b in e.path.parents for b in backups):
                     continue
-                rel = f.relative_to(p)
-                key = str(p / rel.parts[0]) if len(rel.parts) > 1 else str(p)
-                rest.setdefault(key, []).append(f)
-            out += [load_workspace(files, key) for key, files in sorted(rest.items())]
+                parts = e.rel.split("/")
+                key = str(p / parts[0]) if len(parts) > 1 else str(p)
+                rest.setdefault(key, []).append(e)
+            for key, entries in sorted(rest.items()):
+                ws = Workspace(key)
+                _add_entries(ws, entries)
+                out.append(ws)
             return out
     return [load_workspace([p], str(p))]

@@ -19,6 +19,7 @@ from dataclasses import dataclass, field
 # code -> (severity, short kind name used in reports)
 CODES: dict[str, tuple[str, str]] = {
     "E001": ("error", "unreadable or binary input"),
+    "W002": ("warning", "entry of a folder not read (symbolic link, FIFO/socket/device, folder unreadable or too deep)"),
     "E002": ("error", "syntax error"),
     "W003": ("warning", "construct not understood by the AST builder"),
     "E003": ("error", "construct that cannot be built (too large or malformed)"),
