@@ -8,6 +8,7 @@ from pathlib import Path
 
 import click
 
+from krl.limits import PARSE_TIMEOUT_S
 
 
 @click.command()
@@ -15,22 +16,30 @@ import click
 @click.option("--out", default="reports/recovery", type=click.Path(path_type=Path),
               help="Report directory.")
 @click.option("--jobs", type=int, default=None, help="Worker processes (default: the number of cores).")
-@click.option("--no-cache", is_flag=True, help="Parse every file again.")
-def recover(corpus: Path, out: Path, jobs: int | None, no_cache: bool) -> None:
+@click.option("--no-cache", is_flag=True, help="Parse every file again (the cache folder is not touched).")
+@click.option("--timeout", type=click.FloatRange(min=0, min_open=True), default=PARSE_TIMEOUT_S,
+              show_default=True, help="Seconds one file may parse; past it its worker is killed (row `timeout`).")
+def recover(corpus: Path, out: Path, jobs: int | None, no_cache: bool, timeout: float) -> None:
     """Parse every KRL file under CORPUS, cluster the failures, write the report to --out.
 
     Exit code: 0 when every file parses, 1 when some do not, 2 on a usage or internal error.
     """
+    from krl.terminal import printable_path  # noqa: PLC0415
     from recovery.pipeline import run_recovery  # noqa: PLC0415
+    from recovery.report import ReportError  # noqa: PLC0415
 
     if not corpus.is_dir():
-        click.echo(f"error: corpus directory not found: {corpus}", err=True)
+        click.echo(f"error: corpus directory not found: {printable_path(corpus)}", err=True)
         sys.exit(2)
     start = time.perf_counter()
-    summary = run_recovery(corpus, out, jobs=jobs, use_cache=not no_cache)
+    try:
+        summary = run_recovery(corpus, out, jobs=jobs, use_cache=not no_cache, timeout=timeout)
+    except ReportError as exc:
+        click.echo(f"error: {printable_path(exc)}", err=True)
+        sys.exit(2)
     click.echo(f"{summary.files_ok}/{summary.files} files parse "
                f"({summary.bytes_ok}/{summary.bytes} bytes), {len(summary.clusters)} clusters, "
-               f"{time.perf_counter() - start:.1f} s -> {out}/report.md")
+               f"{time.perf_counter() - start:.1f} s -> {printable_path(out)}/report.md")
     if summary.negative:
         click.echo(f"negative corpus: rejected {summary.negative['rejected']} of "
                    f"{summary.negative['programs']} invalid programs")

@@ -5,11 +5,13 @@ from __future__ import annotations
 import csv
 import hashlib
 import json
+import os
 import time
 from pathlib import Path
 
+from krl.limits import PARSE_TIMEOUT_S
 from recovery.report import Summary, summarise, write_report
-from recovery.scan import FileResult, cache_dir, grammar_sha, scan
+from recovery.scan import FileResult, cache_dir, grammar_sha, scan, warn
 
 REPO_ROOT = Path(__file__).resolve().parents[1]
 GRAMMAR = REPO_ROOT / "grammar" / "KRL.g4"
@@ -67,27 +69,53 @@ def static_check_figures(corpus: Path, results: list[FileResult], gsha: str,
         return None
     key = hashlib.sha256("|".join([gsha, _front_end_code_sha()] +
                                   sorted(f"{r.path}:{r.sha}" for r in results)).encode()).hexdigest()
-    path = cache_dir() / "check" / f"{key[:32]}.json"
-    if use_cache and path.exists():
+    path = None
+    if use_cache:       # --no-cache never touches the cache folder
         try:
-            return json.loads(path.read_text())
-        except ValueError:
+            path = cache_dir() / "check" / f"{key[:32]}.json"
+        except OSError:
+            path = None  # the scan has already warned that the cache folder is not usable
+    if path is not None and path.exists():
+        try:
+            cached = json.loads(path.read_text(encoding="utf-8"))
+            if _valid_check_figures(cached):
+                return cached
+        except (OSError, ValueError, RecursionError):
             pass
+        warn(f"cache file {path} is corrupt; ignored and rebuilt")
     from krl.semantics.report import check_report  # noqa: PLC0415
 
     data, markdown = check_report(corpus)
     figures = {"files": data["total"]["files"], "files_clean": data["total"]["files_clean"],
                "errors": data["total"]["errors"], "warnings": data["total"]["warnings"],
                "top_kinds": data["top_kinds"], "markdown": markdown}
-    path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(json.dumps(figures))
+    if path is not None:
+        tmp = path.with_name(f"{path.name}.{os.getpid()}.tmp")
+        try:
+            path.parent.mkdir(parents=True, exist_ok=True)
+            tmp.write_text(json.dumps(figures), encoding="utf-8")
+            tmp.replace(path)
+        except OSError as exc:
+            warn(f"cache file {path} not written ({exc.strerror or exc})")
     return figures
 
 
-def run_recovery(corpus: Path, out: Path, jobs: int | None = None, use_cache: bool = True) -> Summary:
+def _valid_check_figures(obj: object) -> bool:
+    types = {"files": int, "files_clean": int, "errors": int, "warnings": int, "top_kinds": list,
+             "markdown": str}
+    return (isinstance(obj, dict) and set(obj) == set(types)
+            and all(isinstance(obj[k], t) for k, t in types.items())
+            and all(isinstance(k, dict) for k in obj["top_kinds"]))
+
+
+def run_recovery(corpus: Path, out: Path, jobs: int | None = None, use_cache: bool = True,
+                 timeout: float = PARSE_TIMEOUT_S) -> Summary:
+    """Scan `corpus`, cluster, add the negative-corpus and static-check figures and write the
+    report to `out` (atomically, recovery/report.py). Raises ReportError when `out` holds
+    files that are not a report."""
     start = time.perf_counter()
     gsha = current_grammar_sha()
-    results = scan(corpus, gsha, jobs=jobs, use_cache=use_cache)
+    results = scan(corpus, gsha, jobs=jobs, use_cache=use_cache, timeout=timeout)
     summary = summarise(results, gsha, str(corpus), 0.0, known_invalid=load_known_invalid())
     summary.negative = negative_figures(gsha, jobs, use_cache)
     ki = known_invalid_figures(results)

@@ -18,6 +18,8 @@ from __future__ import annotations
 import csv
 import json
 import os
+import shutil
+import tempfile
 from collections.abc import Collection
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -64,7 +66,7 @@ class Summary:
 
 def _without_internal(r: FileResult) -> FileResult:
     return FileResult(r.path, r.bytes, r.sha, r.encoding, r.status, r.ok, r.seconds,
-                      [i for i in r.issues if i.kind != "internal"])
+                      [i for i in r.issues if i.kind != "internal"], r.detail)
 
 
 def summarise(results: list[FileResult], gsha: str, corpus: str, seconds: float,
@@ -88,20 +90,39 @@ def summarise(results: list[FileResult], gsha: str, corpus: str, seconds: float,
                    internal_failures=internal)
 
 
+_FORMULA_START = ("=", "+", "-", "@", "\t", "\r")
+
+
+def csv_cell(value: object) -> object:
+    """A CSV cell that a spreadsheet cannot take for a formula (the OWASP rule for CSV
+    injection): a text starting with ``= + - @``, TAB or CR gets a leading apostrophe.
+    Numbers are left as they are. ``csv_cell("=1+1") == "'=1+1"``."""
+    if isinstance(value, str) and value.startswith(_FORMULA_START):
+        return "'" + value
+    return value
+
+
+def _writerow(w, cells) -> None:
+    w.writerow([csv_cell(c) for c in cells])
+
+
 def write_files_csv(path: Path, results: list[FileResult]) -> None:
+    """One row per corpus entry; ``encoding`` is the decoding used (krl/syntax/source.py),
+    ``detail`` says why a file was not parsed. Every text cell through :func:`csv_cell`."""
     with path.open("w", newline="", encoding="utf-8") as fh:
         w = csv.writer(fh)
-        w.writerow(["path", "bytes", "encoding", "status", "ok", "line", "column", "clusters"])
+        w.writerow(["path", "bytes", "encoding", "status", "ok", "line", "column", "clusters", "detail"])
         for r in results:
             first = next((i for i in r.issues if not i.cascade), None)
-            w.writerow([r.path, r.bytes, r.encoding, r.status, int(r.ok),
-                        first.line if first else "", first.column + 1 if first else "",
-                        " ".join(clusters_of_file(r))])
+            _writerow(w, [r.path, r.bytes, r.encoding, r.status, int(r.ok),
+                          first.line if first else "", first.column + 1 if first else "",
+                          " ".join(clusters_of_file(r)), r.detail])
 
 
 def write_clusters_csv(path: Path, clusters: list[Cluster], known_invalid: list[Cluster] = ()) -> None:
     """One row per cluster: the ranked missing constructs (``group`` missing, ranked 1..n),
-    then the clusters of known-invalid files (``group`` known_invalid, no rank)."""
+    then the clusters of known-invalid files (``group`` known_invalid, no rank). Every text
+    cell through :func:`csv_cell`."""
     with path.open("w", newline="", encoding="utf-8") as fh:
         w = csv.writer(fh)
         w.writerow(["rank", "id", "files", "occurrences", "leading_keyword", "signature",
@@ -110,8 +131,8 @@ def write_clusters_csv(path: Path, clusters: list[Cluster], known_invalid: list[
         rows += [("", c, "known_invalid") for c in known_invalid]
         for rank, c, group in rows:
             ex = c.examples[0] if c.examples else {"path": "", "line": "", "text": ""}
-            w.writerow([rank, c.id, c.files, c.occurrences, c.leading_keyword, c.signature,
-                        " ".join(c.expected[:12]), ex["path"], ex["line"], ex["text"], group, c.line_shape])
+            _writerow(w, [rank, c.id, c.files, c.occurrences, c.leading_keyword, c.signature,
+                          " ".join(c.expected[:12]), ex["path"], ex["line"], ex["text"], group, c.line_shape])
 
 
 def chart_label(c: Cluster, width: int = 48) -> str:
@@ -166,23 +187,69 @@ def source_link(corpus: str, path: str, out: Path) -> str:
     return quote(os.fsencode(target).replace(os.sep.encode(), b"/"))
 
 
+REPORT_FILES = frozenset({"summary.json", "files.csv", "clusters.csv", "clusters.png", "report.md",
+                          "report.html", ".krl-report"})
+
+
+class ReportError(Exception):
+    """The report folder cannot be replaced (it holds files that are not a report)."""
+
+
+def _replaceable(out: Path) -> bool:
+    """True when `out` may be replaced as a whole: missing, empty, or a report folder (it holds
+    the marker ``.krl-report`` or only report files)."""
+    if not out.exists() and not out.is_symlink():
+        return True
+    if out.is_symlink() or not out.is_dir():
+        return False
+    names = {p.name for p in out.iterdir()}
+    return ".krl-report" in names or names <= REPORT_FILES
+
+
 def write_report(out: Path, summary: Summary, results: list[FileResult]) -> None:
-    """Write every report file into `out` (created if needed)."""
+    """Write every report file into the folder `out`, atomically: everything is rendered into a
+    temporary folder next to `out`, which then replaces `out` by renames. A failure while
+    rendering leaves the previous report untouched (and no temporary folder). Raises
+    :class:`ReportError` when `out` exists and holds files that are not a report (nothing is
+    written or removed then)."""
+    out = Path(out)
+    if not _replaceable(out):
+        raise ReportError(f"{out} holds files that are not a recovery report; choose an empty or "
+                          "new folder for --out")
+    out.parent.mkdir(parents=True, exist_ok=True)
+    tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.new-", dir=out.parent))
+    try:
+        render_report(tmp, summary, results, link_from=out)
+        (tmp / ".krl-report").write_text("a krl recover report; replaced as a whole by the next run\n")
+        os.chmod(tmp, 0o755)   # mkdtemp makes it private
+        if out.exists():
+            old = Path(tempfile.mkdtemp(prefix=f".{out.name}.old-", dir=out.parent))
+            os.replace(out, old / out.name)
+            os.replace(tmp, out)
+            shutil.rmtree(old, ignore_errors=True)
+        else:
+            os.replace(tmp, out)
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+
+
+def render_report(out: Path, summary: Summary, results: list[FileResult], link_from: Path | None = None) -> None:
+    """Render every report file into the existing folder `out`; links to corpus files are
+    relative to `link_from` (default `out`), the folder the report will be read from."""
     from krl.render import render_html  # noqa: PLC0415
 
-    out.mkdir(parents=True, exist_ok=True)
-    (out / "summary.json").write_text(json.dumps(summary.to_json(), indent=1) + "\n")
+    link_from = link_from or out
+    (out / "summary.json").write_text(json.dumps(summary.to_json(), indent=1) + "\n", encoding="utf-8")
     write_files_csv(out / "files.csv", results)
     write_clusters_csv(out / "clusters.csv", summary.clusters, summary.known_invalid_clusters)
     chart = write_chart(out / "clusters.png", summary.clusters)
-    if not chart and (out / "clusters.png").exists():
-        (out / "clusters.png").unlink()
     links = {}
     for c in summary.clusters[:TOP_REPORT] + summary.known_invalid_clusters:
         for e in c.examples:
-            links[e["path"]] = source_link(summary.corpus, e["path"], out)
+            links[e["path"]] = source_link(summary.corpus, e["path"], link_from)
     for f in summary.internal_failures:
-        links[f["path"]] = source_link(summary.corpus, f["path"], out)
+        links[f["path"]] = source_link(summary.corpus, f["path"], link_from)
     context = {"s": summary, "clusters": summary.clusters[:TOP_REPORT],
                "known_clusters": summary.known_invalid_clusters,
                "internal": summary.internal_failures, "chart": chart, "links": links,
