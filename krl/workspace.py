@@ -36,7 +36,7 @@ from krl.semantics.checker import Checker, Declarer, _is_system_datalist
 from krl.semantics.diagnostics import Diagnostic, DiagnosticSink
 from krl.semantics.symbols import Scope, Symbol, system_scopes
 from krl.syntax.messages import syntax_diagnostics
-from krl.syntax.parse import parse_source
+from krl.syntax.parse import ParseResult, parse_source
 from krl.syntax.source import is_krl_file, read_source
 
 
@@ -49,6 +49,47 @@ class SourceFile:
     status: str = "ok"
     scope: Scope | None = None
     parse_seconds: float = 0.0
+
+
+@dataclass(slots=True)
+class LoadedFile:
+    """One file read, parsed and built, apart from any workspace (picklable: it may come from
+    a worker process): its AST, its diagnostics (input, syntax, build) and what a failed
+    parse leaves for name lookup."""
+    path: str
+    module: N.Module
+    ok: bool
+    status: str
+    parse_seconds: float
+    build_seconds: float
+    diagnostics: list
+    unreadable: bool = False
+    failed_words: set = field(default_factory=set)
+
+
+def load_file(path: str | Path) -> LoadedFile:
+    """Read (krl.syntax.source.read_source), parse and build one file; never raises for bad
+    content."""
+    t = time.perf_counter()
+    src = read_source(path)
+    result = parse_source(src)
+    elapsed = time.perf_counter() - t
+    path_s = str(path)
+    sink = DiagnosticSink()
+    if result.status not in ("ok", "syntax_error") and not result.errors:
+        sink.add(path_s, 1, 1, "E001", f"file not checked: {result.status}"
+                 + (f" ({src.detail})" if src.detail else ""))
+    sink.extend(syntax_diagnostics(result, src.text))
+    t = time.perf_counter()
+    unreadable, words = False, set()
+    if not result.ok:
+        if result.status in ("binary", "too_large", "unreadable", "not_regular"):
+            unreadable = True
+        elif src.text:
+            words = {w.upper() for w in _WORD.findall(src.text)}
+    module = build_module(result, sink)
+    return LoadedFile(path_s, module, result.ok, result.status, elapsed, time.perf_counter() - t,
+                      sink.items, unreadable, words)
 
 
 @dataclass(slots=True)
@@ -118,21 +159,46 @@ class Workspace:
 
     def add_file(self, path: str | Path) -> SourceFile:
         """Read, parse and build one file (never raises for bad content)."""
-        t = time.perf_counter()
-        src = read_source(path)
-        result = parse_source(src)
-        elapsed = time.perf_counter() - t
-        self.parse_seconds += elapsed
-        path_s = str(path)
-        if result.status not in ("ok", "syntax_error") and not result.errors:
-            self.sink.add(path_s, 1, 1, "E001", f"file not checked: {result.status}"
-                          + (f" ({src.detail})" if src.detail else ""))
-        self.sink.extend(syntax_diagnostics(result, src.text))
-        t = time.perf_counter()
-        self._note_failed(result, src.text)
-        module = build_module(result, self.sink)
-        self.check_seconds += time.perf_counter() - t
-        sf = SourceFile(path_s, module, result.ok, result.status, parse_seconds=elapsed)
+        return self._add_loaded(load_file(path))
+
+    def add_files(self, paths, timeout: float | None = None, jobs: int | None = None) -> None:
+        """:meth:`add_file` for each of `paths`, in order. With `timeout` (seconds per file) each
+        file is read, parsed and built in a worker process (krl/pool.py) that is killed past the
+        timeout: the file gets error E004 and the other files are still checked. A worker that
+        dies (a crash of the parser) gives error E001 for its file."""
+        paths = list(paths)
+        if timeout is None or not paths:
+            for p in paths:
+                self.add_file(p)
+            return
+        from krl.pool import run_tasks  # noqa: PLC0415
+
+        from krl.syntax.parse import default_bundle  # noqa: PLC0415
+
+        default_bundle()    # imported once here, inherited by the forked workers
+        done = {o.key: o for o in run_tasks(load_file, ((i, (p,)) for i, p in enumerate(paths)),
+                                            jobs=jobs, timeout=timeout)}
+        for i, p in enumerate(paths):
+            o = done[i]
+            if o.status == "done":
+                self._add_loaded(o.value)
+                continue
+            if o.status == "timeout":
+                self.sink.add(str(p), 1, 1, "E004", f"file not checked: not parsed within {timeout:g} s "
+                              "(--timeout; the parse was stopped)")
+            else:
+                self.sink.add(str(p), 1, 1, "E001", f"file not checked: {o.detail}")
+            self.unreadable = True
+            module = build_module(ParseResult(str(p), False, "", o.status), DiagnosticSink())
+            self.files.append(SourceFile(str(p), module, False, o.status))
+
+    def _add_loaded(self, lf: "LoadedFile") -> SourceFile:
+        self.parse_seconds += lf.parse_seconds
+        self.check_seconds += lf.build_seconds
+        self.sink.extend(lf.diagnostics)
+        self.unreadable |= lf.unreadable
+        self.failed_words |= lf.failed_words
+        sf = SourceFile(lf.path, lf.module, lf.ok, lf.status, parse_seconds=lf.parse_seconds)
         self.files.append(sf)
         return sf
 
@@ -388,26 +454,29 @@ def collect_files(path: Path) -> list[Path]:
     return [e.path for e in collect_entries(path) if e.kind == "file"]
 
 
-def _add_entries(ws: "Workspace", entries) -> None:
+def _add_entries(ws: "Workspace", entries, timeout: float | None = None, jobs: int | None = None) -> None:
+    ws.add_files([e.path for e in entries if e.kind == "file"], timeout=timeout, jobs=jobs)
     for e in entries:
-        if e.kind == "file":
-            ws.add_file(e.path)
-        else:
+        if e.kind != "file":
             ws.sink.add(str(e.path), 1, 1, "W002", f"not read: {e.message}")
             ws.unreadable = True   # it may declare what the other files use
 
 
-def load_workspace(paths: list[str | Path], root: str = "") -> Workspace:
+def load_workspace(paths: list[str | Path], root: str = "", timeout: float | None = None,
+                   jobs: int | None = None) -> Workspace:
     """One workspace from files and/or folders (all files of the folders). Never raises for
     bad content; a path that does not exist gives an E001 diagnostic; a link, FIFO, unreadable
-    or too deep folder met in a folder gives a W002 warning and is not read."""
+    or too deep folder met in a folder gives a W002 warning and is not read. With `timeout`
+    (seconds per file) files are parsed in worker processes (:meth:`Workspace.add_files`)."""
     ws = Workspace(root or (str(paths[0]) if paths else ""))
+    entries = []
     for p in paths:
         p = Path(p)
         if not p.exists() and not p.is_symlink():
             ws.sink.add(str(p), 1, 1, "E001", "no such file or folder")
             continue
-        _add_entries(ws, collect_entries(p))
+        entries += collect_entries(p)
+    _add_entries(ws, entries, timeout, jobs)
     return ws
 
 
@@ -420,11 +489,11 @@ def check_texts(files: dict[str, str]) -> Workspace:
     return ws
 
 
-def workspaces_for(path: str | Path) -> list[Workspace]:
+def workspaces_for(path: str | Path, timeout: float | None = None, jobs: int | None = None) -> list[Workspace]:
     """The workspaces to check for a command-line PATH: a file -> itself with the .dat/.src
     of its module; a folder holding backups -> one workspace per backup, plus one per
     top-level subfolder for the files outside the backups; another folder -> one
-    workspace of all its files."""
+    workspace of all its files. `timeout`, `jobs`: see :func:`load_workspace`."""
     p = Path(path)
     if p.exists() and not p.is_dir():
         files = [p]
@@ -435,11 +504,11 @@ def workspaces_for(path: str | Path) -> list[Workspace]:
         for sib in siblings:
             if sib != p and sib.stem.lower() == p.stem.lower() and is_krl_file(sib) and not sib.is_symlink():
                 files.append(sib)
-        return [load_workspace(files, str(p))]
+        return [load_workspace(files, str(p), timeout, jobs)]
     if p.is_dir() and not p.is_symlink():
         backups = find_backups(p)
         if backups:
-            out = [load_workspace([b], str(b)) for b in backups]
+            out = [load_workspace([b], str(b), timeout, jobs) for b in backups]
             # entries outside every backup: one workspace per top-level folder of `path`
             rest: dict[str, list] = {}
             for e in collect_entries(p):
@@ -450,7 +519,7 @@ def workspaces_for(path: str | Path) -> list[Workspace]:
                 rest.setdefault(key, []).append(e)
             for key, entries in sorted(rest.items()):
                 ws = Workspace(key)
-                _add_entries(ws, entries)
+                _add_entries(ws, entries, timeout, jobs)
                 out.append(ws)
             return out
-    return [load_workspace([p], str(p))]
+    return [load_workspace([p], str(p), timeout, jobs)]

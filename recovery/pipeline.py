@@ -60,9 +60,11 @@ def _front_end_code_sha() -> str:
 
 
 def static_check_figures(corpus: Path, results: list[FileResult], gsha: str,
-                         use_cache: bool) -> dict | None:
+                         use_cache: bool, jobs: int | None = None,
+                         timeout: float | None = PARSE_TIMEOUT_S) -> dict | None:
     """`krl check` over the KRC backups of the corpus (issue 4's report), cached by the
-    grammar, the front end's code and the corpus files."""
+    grammar, the front end's code and the corpus files. Files are parsed and built in `jobs`
+    worker processes (the scan's pool, krl/pool.py), each stopped past `timeout` seconds."""
     from krl.workspace import find_backups  # noqa: PLC0415
 
     if not find_backups(corpus):
@@ -85,7 +87,7 @@ def static_check_figures(corpus: Path, results: list[FileResult], gsha: str,
         warn(f"cache file {path} is corrupt; ignored and rebuilt")
     from krl.semantics.report import check_report  # noqa: PLC0415
 
-    data, markdown = check_report(corpus)
+    data, markdown = check_report(corpus, timeout=timeout, jobs=jobs)
     figures = {"files": data["total"]["files"], "files_clean": data["total"]["files_clean"],
                "errors": data["total"]["errors"], "warnings": data["total"]["warnings"],
                "top_kinds": data["top_kinds"], "markdown": markdown}
@@ -121,7 +123,7 @@ def run_recovery(corpus: Path, out: Path, jobs: int | None = None, use_cache: bo
     ki = known_invalid_figures(results)
     if ki:
         summary.extra["known_invalid"] = ki
-    check = static_check_figures(Path(corpus), results, gsha, use_cache)
+    check = static_check_figures(Path(corpus), results, gsha, use_cache, jobs=jobs, timeout=timeout)
     if check:
         summary.extra["check"] = check
     summary.seconds = time.perf_counter() - start

@@ -21,6 +21,7 @@ CODES: dict[str, tuple[str, str]] = {
     "E001": ("error", "unreadable or binary input"),
     "W002": ("warning", "entry of a folder not read (symbolic link, FIFO/socket/device, folder unreadable or too deep)"),
     "E002": ("error", "syntax error"),
+    "E004": ("error", "file not parsed within the time limit (--timeout)"),
     "W003": ("warning", "construct not understood by the AST builder"),
     "E003": ("error", "construct that cannot be built (too large or malformed)"),
     "E010": ("error", "block not closed"),
