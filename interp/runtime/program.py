@@ -28,6 +28,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from krl.ast import nodes as N
+from krl.files import walk   # the one folder walk: iterative, links never followed
 from krl.semantics import types as T
 from krl.semantics.symbols import Scope, fill_struc, make_array, system_scopes
 
@@ -142,9 +143,8 @@ class Program:
 
     def _index_files(self) -> None:
         if self.backup:
-            for p in sorted(self.workspace.rglob("*")):
-                if p.is_file() and not p.is_symlink():
-                    self._add_file(p)
+            for p in sorted(e.path for e in walk(self.workspace) if e.kind == "file"):
+                self._add_file(p)
         else:
             for p in sorted(self.workspace.iterdir()):
                 if p.is_file():
@@ -163,7 +163,8 @@ class Program:
             for k, ref in m.data.items():
                 self.globals.setdefault(k, ref)
         if self.backup:
-            mada = [p for p in self.workspace.rglob("*.dat") if p.parent.name.upper() == "MADA"]
+            mada = [e.path for e in walk(self.workspace)
+                    if e.kind == "file" and e.path.suffix.lower() == ".dat" and e.path.parent.name.upper() == "MADA"]
             steu = self.workspace.parent / "STEU" / "Mada"
             if steu.is_dir():
                 mada += [p for p in steu.iterdir() if p.suffix.lower() == ".dat"]
