@@ -112,3 +112,23 @@ def _links_to_folder(e: os.DirEntry) -> bool:
         return e.is_dir(follow_symlinks=True)
     except OSError:
         return False
+
+
+def write_text_atomic(path: str | Path, text: str) -> None:
+    """Write `text` (UTF-8) to `path` atomically: into a temporary file in the same folder,
+    then renamed over `path`, so a reader (or a crash) never sees half a file."""
+    import tempfile  # noqa: PLC0415
+
+    path = Path(path)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as fh:
+            fh.write(text)
+        os.chmod(tmp, 0o644)
+        os.replace(tmp, path)
+    except BaseException:
+        try:
+            os.unlink(tmp)
+        except OSError:
+            pass
+        raise

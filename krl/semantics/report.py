@@ -54,10 +54,12 @@ def check_report(corpus: str | Path, out_dir: str | Path | None = None, top: int
     data = {"corpus": str(corpus), "backups": rows, "total": total, "top_kinds": top_kinds}
     md = render_markdown(data)
     if out_dir is not None:
+        from krl.files import write_text_atomic  # noqa: PLC0415
+
         out = Path(out_dir)
         out.mkdir(parents=True, exist_ok=True)
-        (out / "check_report.json").write_text(json.dumps(data, indent=2), encoding="utf-8")
-        (out / "check_report.md").write_text(md, encoding="utf-8")
+        write_text_atomic(out / "check_report.json", json.dumps(data, indent=2))
+        write_text_atomic(out / "check_report.md", md)
     return data, md
 
 

@@ -40,9 +40,9 @@ def test_parse_timeout_stops_one_file_and_parses_the_others(tmp_path: Path, monk
     monkeypatch.setattr(syntax_cli, "file_diagnostics", file_diagnostics)
     files = _files(tmp_path)
     lines: list[str] = []
-    assert run_parse(files, echo=lines.append, timeout=1, jobs=2) == 1
+    assert run_parse(files, echo=lines.append, timeout=4, jobs=2) == 1
     located = [ln for ln in lines if ": error[" in ln]
-    assert located[0] == f"{files[0]}:1:1: error[E004]: file not parsed within 1 s (--timeout; the parse was stopped)"
+    assert located[0] == f"{files[0]}:1:1: error[E004]: file not parsed within 4 s (--timeout; the parse was stopped)"
     assert len(located) == 2 and located[1].startswith(f"{files[2]}:")     # bad.src, in file order
     assert lines[-1] == "2 errors in 3 files"
 
@@ -58,9 +58,9 @@ def test_check_timeout_stops_one_file_and_checks_the_others(tmp_path: Path, monk
     monkeypatch.setattr(workspace_mod, "parse_source", parse_source)
     _files(tmp_path)
     lines: list[str] = []
-    assert run_check([str(tmp_path)], echo=lines.append, timeout=1, jobs=2) == 1
+    assert run_check([str(tmp_path)], echo=lines.append, timeout=4, jobs=2) == 1
     errors = [ln for ln in lines if ": error[" in ln]
-    assert f"{tmp_path / 'stuck.src'}:1:1: error[E004]: file not checked: not parsed within 1 s " \
+    assert f"{tmp_path / 'stuck.src'}:1:1: error[E004]: file not checked: not parsed within 4 s " \
            "(--timeout; the parse was stopped)" in errors
     assert any(ln.startswith(f"{tmp_path / 'bad.src'}:") for ln in errors)
     assert not any("good.src" in ln for ln in errors)
