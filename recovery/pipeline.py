@@ -10,7 +10,7 @@ import time
 from pathlib import Path
 
 from krl.limits import PARSE_TIMEOUT_S
-from recovery.report import Summary, summarise, write_report
+from recovery.report import ReportStream, Summary, SummaryBuilder
 from recovery.scan import FileResult, cache_dir, grammar_sha, scan, warn
 
 REPO_ROOT = Path(__file__).resolve().parents[1]
@@ -41,13 +41,16 @@ def load_known_invalid(path: Path = KNOWN_INVALID) -> dict[str, str]:
 
 
 def known_invalid_figures(results: list[FileResult]) -> dict | None:
-    known = load_known_invalid()
-    present = [r for r in results if r.path in known]
+    return _known_invalid_figures({r.path: r.ok for r in results if r.path in load_known_invalid()})
+
+
+def _known_invalid_figures(present: dict[str, bool]) -> dict | None:
+    """Figures of the known-invalid files present: `present` maps their paths to whether they parse."""
     if not present:
         return None
-    return {"listed": len(known), "present": len(present),
-            "still_failing": sum(not r.ok for r in present),
-            "now_parsing": [r.path for r in present if r.ok]}
+    return {"listed": len(load_known_invalid()), "present": len(present),
+            "still_failing": sum(not ok for ok in present.values()),
+            "now_parsing": sorted(p for p, ok in present.items() if ok)}
 
 
 def _front_end_code_sha() -> str:
@@ -59,18 +62,19 @@ def _front_end_code_sha() -> str:
     return h.hexdigest()
 
 
-def static_check_figures(corpus: Path, results: list[FileResult], gsha: str,
+def static_check_figures(corpus: Path, fingerprints: list[str], gsha: str,
                          use_cache: bool, jobs: int | None = None,
                          timeout: float | None = PARSE_TIMEOUT_S) -> dict | None:
     """`krl check` over the KRC backups of the corpus (issue 4's report), cached by the
-    grammar, the front end's code and the corpus files. Files are parsed and built in `jobs`
+    grammar, the front end's code and the corpus files (`fingerprints`: "path:sha" of every
+    scanned file). Files are parsed and built in `jobs`
     worker processes (the scan's pool, krl/pool.py), each stopped past `timeout` seconds."""
     from krl.workspace import find_backups  # noqa: PLC0415
 
     if not find_backups(corpus):
         return None
     key = hashlib.sha256("|".join([gsha, _front_end_code_sha()] +
-                                  sorted(f"{r.path}:{r.sha}" for r in results)).encode()).hexdigest()
+                                  sorted(fingerprints)).encode()).hexdigest()
     path = None
     if use_cache:       # --no-cache never touches the cache folder
         try:
@@ -113,19 +117,29 @@ def _valid_check_figures(obj: object) -> bool:
 def run_recovery(corpus: Path, out: Path, jobs: int | None = None, use_cache: bool = True,
                  timeout: float = PARSE_TIMEOUT_S) -> Summary:
     """Scan `corpus`, cluster, add the negative-corpus and static-check figures and write the
-    report to `out` (atomically, recovery/report.py). Raises ReportError when `out` holds
-    files that are not a report."""
+    report to `out`. Rows stream to ``files.csv`` (in a temporary folder next to `out`) as files
+    finish and only counts and clusters are kept, so memory stays flat with the corpus size;
+    the folder replaces `out` atomically at the end (recovery/report.py). Raises ReportError
+    when `out` holds files that are not a report."""
     start = time.perf_counter()
     gsha = current_grammar_sha()
-    results = scan(corpus, gsha, jobs=jobs, use_cache=use_cache, timeout=timeout)
-    summary = summarise(results, gsha, str(corpus), 0.0, known_invalid=load_known_invalid())
-    summary.negative = negative_figures(gsha, jobs, use_cache)
-    ki = known_invalid_figures(results)
-    if ki:
-        summary.extra["known_invalid"] = ki
-    check = static_check_figures(Path(corpus), results, gsha, use_cache, jobs=jobs, timeout=timeout)
-    if check:
-        summary.extra["check"] = check
-    summary.seconds = time.perf_counter() - start
-    write_report(out, summary, results)
+    known = load_known_invalid()
+    builder = SummaryBuilder(known)
+    with ReportStream(Path(out)) as stream:
+        def on_row(index: int, row: FileResult) -> None:
+            builder.add(index, row)
+            stream.add(index, row)
+
+        scan(corpus, gsha, jobs=jobs, use_cache=use_cache, timeout=timeout, on_row=on_row, keep=False)
+        summary = builder.summary(gsha, str(corpus), 0.0)
+        summary.negative = negative_figures(gsha, jobs, use_cache)
+        ki = _known_invalid_figures(builder.known_ok)
+        if ki:
+            summary.extra["known_invalid"] = ki
+        check = static_check_figures(Path(corpus), builder.fingerprints, gsha, use_cache, jobs=jobs,
+                                     timeout=timeout)
+        if check:
+            summary.extra["check"] = check
+        summary.seconds = time.perf_counter() - start
+        stream.commit(summary, builder.bad_input)
     return summary

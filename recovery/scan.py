@@ -309,22 +309,24 @@ class ResultCache:
 
 def scan(corpus: Path, gsha: str, parser_dir: str | None = None, jobs: int | None = None,
          use_cache: bool = True, progress: bool = True, timeout: float | None = PARSE_TIMEOUT_S,
-         in_process: bool = False, on_row: Callable[[FileResult], None] | None = None,
-         warn: Callable[[str], None] = warn) -> list[FileResult]:
+         in_process: bool = False, on_row: Callable[[int, FileResult], None] | None = None,
+         keep: bool = True, warn: Callable[[str], None] = warn) -> list[FileResult]:
     """Classify and parse every KRL entry under corpus; one FileResult per entry, in walk order.
 
     parser_dir: a directory of generated parser code (None: the working tree's parser).
     jobs: worker processes (default: the number of cores); timeout: seconds per file, after
     which its worker is killed (row ``timeout``); in_process: parse here, without workers and
-    without a timeout (only for callers that already run in a worker). on_row: called with each
-    row as it is known (cache hits and classified entries first, then parsed files as they
-    finish). Never raises for what it finds in the corpus.
+    without a timeout (only for callers that already run in a worker). on_row: called with the
+    walk index and the row of each entry as it is known (classified entries and cache hits
+    first, parsed files as they finish, so in any order). keep=False: the rows are only given
+    to on_row and the scan returns [] (memory stays flat whatever the corpus size; the cache,
+    when used, still holds one entry per file). Never raises for what it finds in the corpus.
     """
     from rich.progress import Progress  # noqa: PLC0415
 
     corpus = Path(corpus)
     entries = list(walk(corpus))
-    rows: list[FileResult | None] = [None] * len(entries)
+    rows: list[FileResult | None] = [None] * len(entries) if keep else []
     cache = ResultCache(gsha, enabled=use_cache, warn=warn)
     files = [idx for idx, e in enumerate(entries) if e.kind == "file"]
     # Big files first, so that the pool's tail is short.
@@ -333,11 +335,12 @@ def scan(corpus: Path, gsha: str, parser_dir: str | None = None, jobs: int | Non
     bar_task = bar.add_task("parsing", total=len(files))
 
     def record(idx: int, row: FileResult) -> None:
-        rows[idx] = row
+        if keep:
+            rows[idx] = row
         if entries[idx].kind == "file":
             bar.advance(bar_task)
         if on_row is not None:
-            on_row(row)
+            on_row(idx, row)
 
     for idx, e in enumerate(entries):
         if e.kind != "file":

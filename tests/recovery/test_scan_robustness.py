@@ -235,3 +235,52 @@ def test_files_and_clusters_csv_hold_no_formula(tmp_path: Path) -> None:
     with (tmp_path / "files.csv").open(newline="", encoding="utf-8") as fh:
         first = next(csv.DictReader(fh))
     assert first["path"] == "'=cmd|' /C calc'!A0.src" and first["bytes"] == "10"
+
+
+# ----------------------------------------------------------------------- streaming (issue 17)
+
+def test_streamed_report_equals_the_report_of_the_whole_list(tmp_path: Path) -> None:
+    # Rows arrive in any order in a parallel scan; the streamed report (rows written as files
+    # finish, only counts and clusters kept) must equal the report built from the full list.
+    import random
+
+    from recovery.report import ReportStream, SummaryBuilder
+
+    corpus = tmp_path / "corpus"
+    (corpus / "sub").mkdir(parents=True)
+    for i in range(6):
+        (corpus / f"b{i}.src").write_text(BROKEN.replace("x", f"v{i}"))
+        (corpus / "sub" / f"c{i}.src").write_text(f"DEF c{i}()\n  x = 1 ? 2\nEND\n")
+        (corpus / f"ok{i}.src").write_text(VALID)
+    (corpus / "empty.dat").write_text("")
+    (corpus / "known.src").write_text("DEF k()\n  FOR\nEND\n")
+    os.mkfifo(corpus / "fifo.src")
+    results = scan(corpus, "g", jobs=1, use_cache=False, progress=False)
+    known = ["known.src"]
+    write_report(tmp_path / "list", summarise(results, "g", str(corpus), 1.0, known), results)
+
+    order = list(range(len(results)))
+    random.Random(4711).shuffle(order)
+    builder = SummaryBuilder(known)
+    with ReportStream(tmp_path / "stream") as stream:
+        for index in order:
+            builder.add(index, results[index])
+            stream.add(index, results[index])
+        stream.commit(builder.summary("g", str(corpus), 1.0), builder.bad_input)
+    for name in ("files.csv", "clusters.csv", "summary.json", "report.md", "report.html"):
+        assert (tmp_path / "stream" / name).read_bytes() == (tmp_path / "list" / name).read_bytes(), name
+    summary = json.loads((tmp_path / "list" / "summary.json").read_text())
+    assert summary["files"] == 21 and summary["statuses"]["not_regular"] == 1
+    assert [c["files"] for c in summary["clusters"]] == [6, 6]
+
+
+def test_scan_without_keeping_rows_reports_each_entry_once(tmp_path: Path) -> None:
+    for i in range(5):
+        (tmp_path / f"a{i}.src").write_text(VALID if i % 2 else BROKEN)
+    (tmp_path / "link.src").symlink_to(tmp_path / "a0.src")
+    seen: list[tuple[int, str]] = []
+    got = scan(tmp_path, "g", jobs=2, use_cache=False, progress=False, keep=False,
+               on_row=lambda index, row: seen.append((index, row.path)))
+    assert got == []
+    assert sorted(seen) == [(0, "a0.src"), (1, "a1.src"), (2, "a2.src"), (3, "a3.src"), (4, "a4.src"),
+                            (5, "link.src")]
