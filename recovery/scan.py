@@ -143,13 +143,20 @@ def front_end_sha() -> str:
 # ----------------------------------------------------------------------- worker side
 
 _BUNDLE = None
+_BUNDLE_DIR: tuple[str | None] | None = None
 
 
 def _init_worker(parser_dir: str | None) -> None:
-    global _BUNDLE
+    """Load the parser of `parser_dir` (None: the working tree's). The scan calls it in the
+    main process first, so that a missing parser is one clear error there and the forked
+    workers inherit the loaded parser (then this is a no-op in them)."""
+    global _BUNDLE, _BUNDLE_DIR
+    if _BUNDLE_DIR == (parser_dir,):
+        return
     from krl.syntax.parse import ParserBundle, default_bundle  # noqa: PLC0415
 
     _BUNDLE = ParserBundle.from_directory(parser_dir, tag="scan") if parser_dir else default_bundle()
+    _BUNDLE_DIR = (parser_dir,)
 
 
 def parse_row(rel_path: str, data: bytes, sha: str) -> FileResult:
@@ -325,6 +332,7 @@ def scan(corpus: Path, gsha: str, parser_dir: str | None = None, jobs: int | Non
     from rich.progress import Progress  # noqa: PLC0415
 
     corpus = Path(corpus)
+    _init_worker(parser_dir)      # here first: a missing parser fails once, with its own message
     entries = list(walk(corpus))
     rows: list[FileResult | None] = [None] * len(entries) if keep else []
     cache = ResultCache(gsha, enabled=use_cache, warn=warn)
