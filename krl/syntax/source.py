@@ -18,6 +18,7 @@ from __future__ import annotations
 import codecs
 import hashlib
 import os
+import re
 import stat
 from dataclasses import dataclass
 from pathlib import Path
@@ -71,17 +72,32 @@ class SourceText:
     sha: str = ""
 
 
-def _letters(text: str) -> int:
-    return sum(ch.isalpha() for ch in text if ord(ch) > 0x7F)
+_WORDS = re.compile(r"[^\W\d_]+(?:[^\w\s][^\W\d_]+)*")
+
+
+def _suspicious(text: str) -> int:
+    """How unlikely `text` is as a decoding: C1 controls (bytes the page leaves undefined),
+    symbols inside a word (``Nieprawid³owy``: cp1252 for cp1250 text) and, counted twice,
+    words mixing ASCII letters with Cyrillic or Greek ones (``cafй``: cp1251 for cp1252 text)."""
+    score = sum(0x80 <= ord(ch) <= 0x9F for ch in text)
+    for word in _WORDS.findall(text):
+        if word.isascii():
+            continue
+        score += sum(1 for ch in word if ord(ch) > 0x7F and not ch.isalpha())
+        if any(ch.isascii() and ch.isalpha() for ch in word) and any(0x370 <= ord(ch) <= 0x52F for ch in word):
+            score += 2
+    return score
 
 
 def _code_page(body: bytes) -> str:
     """The most plausible of :data:`KRL_CODE_PAGES` for bytes that are not UTF-8.
 
-    charset-normalizer ranks the pages on the lines holding non-ASCII bytes (comments and
-    strings, in KRL); among its candidates the page that decodes more of those bytes as letters
-    wins (``ł`` rather than ``³`` in Polish text), then charset-normalizer's order. When cp1252
-    gives the same text as the winner (German umlauts are the same in cp1250), cp1252 is named.
+    The candidates are the pages charset-normalizer finds plausible for the lines holding
+    non-ASCII bytes (comments and strings, in KRL), in its order, and cp1252 (the default of
+    reference 1.1) in any case; the candidate whose decoding is least :func:`_suspicious`
+    wins, then charset-normalizer's order (its language model tells Cyrillic from Latin-1
+    letters). When cp1252 gives the same text as the winner (German umlauts are the same bytes
+    in cp1250), cp1252 is named.
     """
     import charset_normalizer  # noqa: PLC0415
 
@@ -90,13 +106,11 @@ def _code_page(body: bytes) -> str:
         matches = list(charset_normalizer.from_bytes(sample, cp_isolation=list(KRL_CODE_PAGES)))
     except Exception:  # noqa: BLE001 - detection is a guess; a failure means the default page
         matches = []
-    names = [codecs.lookup(m.encoding).name for m in matches]
-    names = [n for n in names if n in KRL_CODE_PAGES]
-    if not names:
-        return "cp1252"
+    names = [n for n in (codecs.lookup(m.encoding).name for m in matches) if n in KRL_CODE_PAGES]
+    names = list(dict.fromkeys(names + ["cp1252"]))
     decoded = {n: sample.decode(n, errors="krl-latin1") for n in names}
-    best = max(names, key=lambda n: (_letters(decoded[n]), -names.index(n)))
-    if best != "cp1252" and sample.decode("cp1252", errors="krl-latin1") == decoded[best]:
+    best = min(names, key=lambda n: (_suspicious(decoded[n]), names.index(n)))
+    if best != "cp1252" and decoded["cp1252"] == decoded[best]:
         return "cp1252"
     return best
 

@@ -8,6 +8,8 @@ import sys
 import time
 from pathlib import Path
 
+import pytest
+
 from krl.syntax.parse import parse_text
 from krl.syntax.source import read_source
 from recovery.scan import scan
@@ -108,10 +110,14 @@ def test_bom_followed_by_cp1252_is_not_rejected(tmp_path: Path) -> None:
     # A UTF-8 BOM, then cp1252 text (an editor added the BOM to an old file): the BOM goes,
     # the rest decodes as cp1252; before, the BOM became "ï»¿" and the file failed at 1:1.
     p = tmp_path / "a.src"
-    p.write_bytes(b"\xef\xbb\xbf" + VALID.encode("cp1252"))
+    data = b"\xef\xbb\xbf" + VALID.encode("cp1252")
+    p.write_bytes(data)
     src = read_source(p)
-    assert (src.encoding, src.text) == ("cp1252", VALID)
+    assert (src.encoding, src.text) == ("cp1252+bom", VALID)
     assert parse_text(src.text).ok
+    from krl.syntax.source import encode_text  # noqa: PLC0415 - krl fmt writes the same bytes back
+
+    assert encode_text(src.text, src.encoding) == data
 
 
 def test_central_european_code_page_is_detected(tmp_path: Path) -> None:
@@ -122,6 +128,9 @@ def test_central_european_code_page_is_detected(tmp_path: Path) -> None:
     p.write_bytes(text.encode("cp1250"))
     src = read_source(p)
     assert (src.encoding, src.text) == ("cp1250", text)
+    from krl.syntax.source import encode_text  # noqa: PLC0415
+
+    assert encode_text(src.text, src.encoding) == text.encode("cp1250")
     # German umlauts are the same bytes in cp1250 and cp1252: named cp1252, the KRL default
     de = tmp_path / "de.src"
     de.write_bytes(VALID.encode("cp1252"))
@@ -143,5 +152,26 @@ def test_files_csv_records_the_encoding(tmp_path: Path) -> None:
 
     with (tmp_path / "out" / "files.csv").open(newline="", encoding="utf-8") as fh:
         got = {r["path"]: (r["encoding"], r["status"]) for r in csv.DictReader(fh)}
-    assert got == {"bom.src": ("utf-8-sig", "ok"), "bom1252.src": ("cp1252", "ok"),
+    assert got == {"bom.src": ("utf-8-sig", "ok"), "bom1252.src": ("cp1252+bom", "ok"),
                    "pl.src": ("cp1250", "ok"), "plain.src": ("ascii", "ok")}
+
+
+@pytest.mark.parametrize(("text", "page"), [
+    ("; Grüße, Maß; ausgeführt", "cp1252"),
+    ("; élève à côté", "cp1252"),
+    ("; Nieprawidłowy stan czujnika", "cp1250"),      # 0xB3: ł in cp1250, ³ in cp1252
+    ("; Dvořák žluťoučký kůň", "cp1250"),
+    ("; Привет мир, как дела", "cp1251"),
+])
+def test_code_page_of_a_comment(text: str, page: str) -> None:
+    from krl.syntax.source import decode_bytes  # noqa: PLC0415
+
+    data = f"DEF t()\r\n  x = 1 {text}\r\nEND\r\n".encode(page)
+    assert decode_bytes(data) == (data.decode(page), page)
+
+
+def test_a_byte_undefined_in_cp1252_does_not_switch_to_cyrillic() -> None:
+    # 0x81 is undefined in cp1252 and "Ѓ" in cp1251; "café" must stay café, not "cafй".
+    from krl.syntax.source import decode_bytes  # noqa: PLC0415
+
+    assert decode_bytes(b"x=1 ; caf\xe9 = \x81 kept\n") == ("x=1 ; café = \x81 kept\n", "cp1252")
