@@ -35,6 +35,7 @@ from krl.ast.build import build_module
 from krl.semantics.checker import Checker, Declarer, _is_system_datalist
 from krl.semantics.diagnostics import Diagnostic, DiagnosticSink
 from krl.semantics.symbols import Scope, Symbol, system_scopes
+from krl.syntax.folds import fold_diagnostics
 from krl.syntax.messages import syntax_diagnostics
 from krl.syntax.parse import parse_source
 from krl.syntax.source import is_krl_file, read_source
@@ -128,6 +129,7 @@ class Workspace:
             self.sink.add(path_s, 1, 1, "E001", f"file not checked: {result.status}"
                           + (f" ({src.detail})" if src.detail else ""))
         self.sink.extend(syntax_diagnostics(result, src.text))
+        self.sink.extend(fold_diagnostics(path_s, src.text))
         t = time.perf_counter()
         self._note_failed(result, src.text)
         module = build_module(result, self.sink)
@@ -144,6 +146,7 @@ class Workspace:
         result = parse_text(text, path)
         self.parse_seconds += time.perf_counter() - t
         self.sink.extend(syntax_diagnostics(result, text))
+        self.sink.extend(fold_diagnostics(path, text))
         self._note_failed(result, text)
         module = build_module(result, self.sink)
         sf = SourceFile(path, module, result.ok, result.status)

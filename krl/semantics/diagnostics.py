@@ -33,6 +33,7 @@ CODES: dict[str, tuple[str, str]] = {
     "E018": ("error", "nesting too deep"),
     "E019": ("error", "expression too long"),
     "E020": ("error", "unexpected end of file"),
+    "W021": ("warning", "unbalanced ;FOLD / ;ENDFOLD"),
     "E101": ("error", "undeclared name"),
     "W101": ("warning", "name not found (may be declared in an unparsable or controller-side file)"),
     "E102": ("error", "duplicate declaration"),
