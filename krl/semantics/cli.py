@@ -1,8 +1,9 @@
 """`krl check PATH... [--json]`: the front end's command (registered by krl/cli.py).
 
 PATH is a file (checked with the .src/.dat of its module), a KRC backup folder (one
-workspace), or a folder holding backups (one workspace per backup) or plain files (one
-workspace). Output (``--format``): compiler-style text (``path:line:col: error[CODE]: message``,
+workspace), a folder holding backups (one workspace per backup) or plain files (one
+workspace), or a backup archive (.zip, checked as the folder it holds: krl/archive.py; a
+refused archive is error E004; paths are shown as ``backup.zip/KRC/R1/...``). Output (``--format``): compiler-style text (``path:line:col: error[CODE]: message``,
 the source line and a caret, krl/semantics/render.py, then a count line), one JSON object per
 workspace, or SARIF 2.1.0. ``--ignore CODE`` and the workspace's ``krl.toml`` select codes and
 severities (krl/semantics/config.py). Exit 1 when there are errors, 0 otherwise, 2 for a bad
@@ -55,7 +56,10 @@ def run_check(paths: list[str], as_json: bool = False, no_warnings: bool = False
     the old spelling of "json"); `ignore`: codes not to report (with the krl.toml of each
     workspace, krl/semantics/config.py). Returns the exit status: 0, 1 (errors), 2 (bad
     configuration or internal failure)."""
+    from krl.archive import ArchiveError, backup_source  # noqa: PLC0415
     from krl.semantics.config import ConfigError, Selection, config_for, parse_codes  # noqa: PLC0415
+    from krl.semantics.diagnostics import Diagnostic  # noqa: PLC0415
+    from krl.syntax.source import read_source  # noqa: PLC0415
     from krl.semantics.render import Renderer  # noqa: PLC0415
     from krl.terminal import printable  # noqa: PLC0415
     from krl.workspace import workspaces_for  # noqa: PLC0415
@@ -66,30 +70,44 @@ def run_check(paths: list[str], as_json: bool = False, no_warnings: bool = False
     files = 0
     any_error = False
     seen: set = set()      # files already checked: `krl check A.src A.dat` checks module A once
+
+    def report(root: str, n_files: int, diags: list) -> None:
+        shown = [d for d in diags if d.is_error or not no_warnings]
+        if fmt == "json":
+            echo(json.dumps({
+                "workspace": root,
+                "files": n_files,
+                "errors": sum(d.is_error for d in diags),
+                "warnings": sum(not d.is_error for d in diags),
+                "diagnostics": [d.as_json() for d in shown],
+            }))
+        elif fmt == "sarif":
+            all_shown.extend(shown)
+        else:
+            renderer.emit(shown)
+
     try:
         cli_sel = Selection(ignore=parse_codes(ignore, "--ignore"))
         for path in paths:
             if _resolved(path) in seen:
                 continue
-            for ws in workspaces_for(path):
-                seen.update(_resolved(f.path) for f in ws.files)
-                sel = config_for(ws.root, path).merged(cli_sel)
-                diags = sel.apply(ws.check())
-                files += len(ws.files)
-                any_error |= any(d.is_error for d in diags)
-                shown = [d for d in diags if d.is_error or not no_warnings]
-                if fmt == "json":
-                    echo(json.dumps({
-                        "workspace": ws.root,
-                        "files": len(ws.files),
-                        "errors": sum(d.is_error for d in diags),
-                        "warnings": sum(not d.is_error for d in diags),
-                        "diagnostics": [d.as_json() for d in shown],
-                    }))
-                elif fmt == "sarif":
-                    all_shown += shown
-                else:
-                    renderer.emit(shown)
+            try:
+                with backup_source(path) as (folder, as_shown):
+                    for ws in workspaces_for(folder if as_shown.archive else path):
+                        seen.update(_resolved(f.path) for f in ws.files)
+                        sel = config_for(ws.root, folder if as_shown.archive else path).merged(cli_sel)
+                        diags = sel.apply(ws.check())
+                        files += len(ws.files)
+                        if as_shown.archive:
+                            for real in {d.path for d in diags}:
+                                renderer.sources.add(as_shown(real), read_source(real).text or "")
+                            diags = [as_shown.diagnostic(d) for d in diags]
+                        any_error |= any(d.is_error for d in diags)
+                        report(as_shown(ws.root), len(ws.files), diags)
+            except ArchiveError as exc:
+                any_error = True
+                message = str(exc).removeprefix(f"{path}: ")
+                report(str(path), 0, [Diagnostic(str(path), 1, 1, "E004", message)])
     except ConfigError as exc:
         echo(f"krl check: {printable(exc)}")
         return 2

@@ -22,6 +22,7 @@ CODES: dict[str, tuple[str, str]] = {
     "E002": ("error", "syntax error"),
     "W003": ("warning", "construct not understood by the AST builder"),
     "E003": ("error", "construct that cannot be built (too large or malformed)"),
+    "E004": ("error", "backup archive refused (unsafe entry or past a limit)"),
     "E010": ("error", "block not closed"),
     "E011": ("error", "block closer without its opener"),
     "E012": ("error", "statement missing a keyword or a part"),
