@@ -17,17 +17,27 @@ import click
 @click.option("--jobs", type=int, default=None, help="Worker processes (default: the number of cores).")
 @click.option("--no-cache", is_flag=True, help="Parse every file again.")
 def recover(corpus: Path, out: Path, jobs: int | None, no_cache: bool) -> None:
-    """Parse every KRL file under CORPUS, cluster the failures, write the report to --out.
+    """Parse every KRL file under CORPUS (a folder or a KRC backup .zip), cluster the failures,
+    write the report to --out.
 
-    Exit code: 0 when every file parses, 1 when some do not, 2 on a usage or internal error.
+    Exit code: 0 when every file parses, 1 when some do not, 2 on a usage or internal error
+    (or an archive refused by the limits of krl/limits.py).
     """
+    from krl.archive import ArchiveError, backup_source, is_archive  # noqa: PLC0415
+    from krl.terminal import printable  # noqa: PLC0415
     from recovery.pipeline import run_recovery  # noqa: PLC0415
 
-    if not corpus.is_dir():
-        click.echo(f"error: corpus directory not found: {corpus}", err=True)
+    if not corpus.is_dir() and not is_archive(corpus):
+        click.echo(f"error: corpus folder or .zip archive not found: {printable(corpus)}", err=True)
         sys.exit(2)
     start = time.perf_counter()
-    summary = run_recovery(corpus, out, jobs=jobs, use_cache=not no_cache)
+    try:
+        with backup_source(corpus) as (folder, shown):
+            summary = run_recovery(folder, out, jobs=jobs, use_cache=not no_cache,
+                                   label=str(corpus) if shown.archive else None)
+    except ArchiveError as exc:
+        click.echo(f"error: {printable(exc)}", err=True)
+        sys.exit(2)
     click.echo(f"{summary.files_ok}/{summary.files} files parse "
                f"({summary.bytes_ok}/{summary.bytes} bytes), {len(summary.clusters)} clusters, "
                f"{time.perf_counter() - start:.1f} s -> {out}/report.md")

@@ -84,11 +84,15 @@ def static_check_figures(corpus: Path, results: list[FileResult], gsha: str,
     return figures
 
 
-def run_recovery(corpus: Path, out: Path, jobs: int | None = None, use_cache: bool = True) -> Summary:
+def run_recovery(corpus: Path, out: Path, jobs: int | None = None, use_cache: bool = True,
+                 label: str | None = None) -> Summary:
+    """Scan `corpus`, cluster, write the report into `out`. `label`: how the report names the
+    corpus when it is not the folder itself (a backup .zip extracted to a temporary folder:
+    the report then names the archive and does not link to the vanished files)."""
     start = time.perf_counter()
     gsha = current_grammar_sha()
     results = scan(corpus, gsha, jobs=jobs, use_cache=use_cache)
-    summary = summarise(results, gsha, str(corpus), 0.0, known_invalid=load_known_invalid())
+    summary = summarise(results, gsha, label or str(corpus), 0.0, known_invalid=load_known_invalid())
     summary.negative = negative_figures(gsha, jobs, use_cache)
     ki = known_invalid_figures(results)
     if ki:

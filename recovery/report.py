@@ -178,11 +178,13 @@ def write_report(out: Path, summary: Summary, results: list[FileResult]) -> None
     if not chart and (out / "clusters.png").exists():
         (out / "clusters.png").unlink()
     links = {}
+    # a corpus read from an archive has no files left to link to: the examples are plain text
+    linkable = not summary.corpus.lower().endswith(".zip")
     for c in summary.clusters[:TOP_REPORT] + summary.known_invalid_clusters:
         for e in c.examples:
-            links[e["path"]] = source_link(summary.corpus, e["path"], out)
+            links[e["path"]] = source_link(summary.corpus, e["path"], out) if linkable else ""
     for f in summary.internal_failures:
-        links[f["path"]] = source_link(summary.corpus, f["path"], out)
+        links[f["path"]] = source_link(summary.corpus, f["path"], out) if linkable else ""
     context = {"s": summary, "clusters": summary.clusters[:TOP_REPORT],
                "known_clusters": summary.known_invalid_clusters,
                "internal": summary.internal_failures, "chart": chart, "links": links,
