@@ -28,7 +28,7 @@ check-java:
 $(BIN)/.installed: pyproject.toml constraints.txt | check-python
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/pip install --quiet --upgrade pip
-	$(BIN)/pip install --quiet -e '.[dev]'
+	$(BIN)/pip install --quiet -c constraints.txt -e '.[dev]'
 	@touch $@
 
 $(PARSER): grammar/KRL.g4 $(BIN)/.installed | check-java

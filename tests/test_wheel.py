@@ -105,3 +105,27 @@ def test_installed_wheel_checks_a_backup_without_java(wheel, tmp_path):
     where, tool = res.stdout.splitlines()[-2:]
     assert Path(where).is_relative_to(site), where
     assert tool == "[]"
+
+
+def test_constraints_pin_installed_versions_and_every_dependency():
+    """constraints.txt (which make installs with: `pip install -c constraints.txt`) pins only
+    packages that are installed, at their installed versions (a stale pin such as a dropped
+    dependency fails here), and pins every direct dependency of krl-tools, dev extras included."""
+    import re
+    from importlib import metadata
+
+    def norm(name: str) -> str:
+        return re.sub(r"[-_.]+", "-", name).lower()
+
+    pins = {}
+    for line in (REPO / "constraints.txt").read_text().splitlines():
+        line = line.split("#")[0].strip()
+        if line:
+            name, _, version = line.partition("==")
+            pins[norm(name)] = version
+    installed = {norm(d.metadata["Name"]): d.version for d in metadata.distributions() if d.metadata["Name"]}
+    assert {n: installed.get(n) for n in pins} == pins
+    requires = metadata.requires("krl-tools") or []
+    direct = {norm(re.match(r"[A-Za-z0-9_.-]+", r).group(0)) for r in requires}
+    assert direct - set(pins) == set()
+    assert "-c constraints.txt" in (REPO / "Makefile").read_text()
