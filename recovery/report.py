@@ -166,6 +166,14 @@ def source_link(corpus: str, path: str, out: Path) -> str:
     return quote(os.fsencode(target).replace(os.sep.encode(), b"/"))
 
 
+def _expected_words(expected: list[str]) -> str:
+    """The tokens expected at a cluster's error in KRL words: at most six grouped alternatives
+    ("a statement, ELSE, ENDIF or end of line"), as in the compiler-style messages."""
+    from krl.syntax.messages import expected_phrase  # noqa: PLC0415
+
+    return expected_phrase(list(expected)).replace("`", "")
+
+
 def write_report(out: Path, summary: Summary, results: list[FileResult]) -> None:
     """Write every report file into `out` (created if needed)."""
     from krl.render import render_html  # noqa: PLC0415
@@ -188,6 +196,7 @@ def write_report(out: Path, summary: Summary, results: list[FileResult]) -> None
     context = {"s": summary, "clusters": summary.clusters[:TOP_REPORT],
                "known_clusters": summary.known_invalid_clusters,
                "internal": summary.internal_failures, "chart": chart, "links": links,
+               "expected_words": _expected_words,
                "more": max(0, len(summary.clusters) - TOP_REPORT),
                "pct": (100.0 * summary.files_ok / summary.files) if summary.files else 0.0,
                "bytes_pct": (100.0 * summary.bytes_ok / summary.bytes) if summary.bytes else 0.0,
