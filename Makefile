@@ -40,7 +40,7 @@ parser: $(PARSER)
 
 recover: $(PARSER)
 	$(BIN)/krl recover $(CORPUS) --out $(OUT); status=$$?; \
-	  if [ $$status -le 1 ]; then echo "report: $(OUT)/report.md"; exit 0; else exit $$status; fi
+	  if [ $$status -le 1 ]; then echo "report: $(OUT)/report.html (open it in a browser; Markdown: $(OUT)/report.md)"; exit 0; else exit $$status; fi
 
 growth: $(PARSER)
 	$(BIN)/krl growth $(SHARED_CORPUS) --out reports/growth
