@@ -27,6 +27,9 @@ from __future__ import annotations
 
 import re
 import time
+from collections.abc import Callable
+from contextlib import contextmanager
+from contextvars import ContextVar
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -130,6 +133,9 @@ class Workspace:
                           + (f" ({src.detail})" if src.detail else ""))
         self.sink.extend(syntax_diagnostics(result, src.text))
         self.sink.extend(fold_diagnostics(path_s, src.text))
+        hook = _ON_FILE.get()
+        if hook is not None:
+            hook(path_s)
         t = time.perf_counter()
         self._note_failed(result, src.text)
         module = build_module(result, self.sink)
@@ -320,6 +326,20 @@ class Workspace:
             checker.submit = u.src.path.lower().endswith(".sub")
             checker.check_routine(r, self.routine_scopes[id(r)], u.src.path)
         checker.system_file = declarer.soft_types = checker.submit = False
+
+
+_ON_FILE: ContextVar[Callable[[str], None] | None] = ContextVar("krl_workspace_on_file", default=None)
+
+
+@contextmanager
+def on_each_file(callback: Callable[[str], None]):
+    """``with on_each_file(cb):`` calls ``cb(path)`` after each file that a workspace reads and
+    parses (progress display of `krl check`); the hook ends with the block."""
+    token = _ON_FILE.set(callback)
+    try:
+        yield
+    finally:
+        _ON_FILE.reset(token)
 
 
 SYSTEM_DIRS = ("system", "tp", "mada", "steu")

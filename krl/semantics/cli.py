@@ -62,7 +62,6 @@ def run_check(paths: list[str], as_json: bool = False, no_warnings: bool = False
     from krl.syntax.source import read_source  # noqa: PLC0415
     from krl.semantics.render import Renderer  # noqa: PLC0415
     from krl.terminal import printable  # noqa: PLC0415
-    from krl.workspace import workspaces_for  # noqa: PLC0415
 
     fmt = "json" if as_json else fmt
     renderer = Renderer(echo, colour)
@@ -93,7 +92,7 @@ def run_check(paths: list[str], as_json: bool = False, no_warnings: bool = False
                 continue
             try:
                 with backup_source(path) as (folder, as_shown):
-                    for ws in workspaces_for(folder if as_shown.archive else path):
+                    for ws in _loaded(folder if as_shown.archive else path):
                         seen.update(_resolved(f.path) for f in ws.files)
                         sel = config_for(ws.root, folder if as_shown.archive else path).merged(cli_sel)
                         diags = sel.apply(ws.check())
@@ -120,6 +119,41 @@ def run_check(paths: list[str], as_json: bool = False, no_warnings: bool = False
     elif fmt == "text":
         echo(renderer.summary(files))
     return 1 if any_error else 0
+
+
+def _loaded(path) -> list:
+    """workspaces_for(path), with a transient progress bar on standard error when it is a
+    terminal (a KRC backup of a few hundred files takes tens of seconds to parse); piped or
+    redirected, nothing is shown, so the output is the same either way."""
+    from pathlib import Path  # noqa: PLC0415
+
+    from krl.workspace import collect_files, on_each_file, workspaces_for  # noqa: PLC0415
+
+    if not _progress_shown():
+        return workspaces_for(path)
+    from rich.console import Console  # noqa: PLC0415
+    from rich.markup import escape  # noqa: PLC0415
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn  # noqa: PLC0415
+
+    p = Path(path)
+    total = len(collect_files(p)) if p.is_dir() else None
+    columns = (TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn())
+    with Progress(*columns, console=Console(stderr=True), transient=True) as bar:
+        task = bar.add_task("parsing", total=total)
+
+        def advance(file: str) -> None:
+            bar.update(task, advance=1, description=escape(f"parsing {Path(file).name}"))
+        with on_each_file(advance):
+            return workspaces_for(path)
+
+
+def _progress_shown() -> bool:
+    import os  # noqa: PLC0415
+
+    try:
+        return sys.stderr.isatty() and os.environ.get("TERM", "") != "dumb"
+    except (AttributeError, ValueError):
+        return False
 
 
 def _resolved(path) -> str:

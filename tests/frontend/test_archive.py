@@ -220,3 +220,15 @@ def test_krl_recover_reads_the_archive(tmp_path, own_tmp):
     evil = write_zip(tmp_path / "evil.zip", [("../x.src", "DEF x()\nEND\n")])
     res = CliRunner().invoke(recover, [str(evil), "--out", str(tmp_path / "rep2")])
     assert res.exit_code == 2 and "entry '../x.src' leaves the archive folder" in res.output
+
+
+def test_each_file_read_is_reported_to_the_progress_hook(tmp_path):
+    from krl.workspace import on_each_file, workspaces_for
+
+    folder = make_backup(tmp_path / "src")
+    seen: list[str] = []
+    with on_each_file(seen.append):
+        workspaces_for(folder)
+    assert sorted(Path(p).name for p in seen) == ["$config.dat", "demo.src", "done.src"]
+    workspaces_for(folder)                      # outside the block: no more calls
+    assert len(seen) == 3
