@@ -94,7 +94,11 @@ def run_check(paths: list[str], as_json: bool = False, no_warnings: bool = False
                 with backup_source(path) as (folder, as_shown):
                     for ws in _loaded(folder if as_shown.archive else path):
                         seen.update(_resolved(f.path) for f in ws.files)
-                        sel = config_for(ws.root, folder if as_shown.archive else path).merged(cli_sel)
+                        try:
+                            sel = config_for(ws.root, folder if as_shown.archive else path).merged(cli_sel)
+                        except ConfigError as exc:   # name the krl.toml as the user sees it
+                            raise ConfigError(str(exc).replace(str(folder), str(path))
+                                              if as_shown.archive else str(exc)) from None
                         diags = sel.apply(ws.check())
                         files += len(ws.files)
                         if as_shown.archive:
