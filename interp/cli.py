@@ -32,9 +32,9 @@ def run(program: Path, interp_kind: str, workspace, inputs, trace_path, max_sim_
         check) -> None:
     """Run PROGRAM (.src) on the simulated KR C4; print where and why it ended.
 
-    With ``--workspace BACKUP.zip`` (a KRC backup archive) PROGRAM is a path inside the archive
-    (``KRC/R1/Program/demo.src``) or a module name (``demo``); the archive is checked and
-    extracted to a temporary folder (krl/archive.py) that is removed after the run.
+    With --workspace BACKUP.zip (a KRC backup archive) PROGRAM is a path inside the archive
+    (KRC/R1/Program/demo.src) or a module name (demo); the archive is checked and extracted
+    to a temporary folder (krl/archive.py) that is removed after the run.
     """
     from krl.archive import ArchiveError, backup_source, is_archive  # noqa: PLC0415
     from krl.terminal import printable  # noqa: PLC0415

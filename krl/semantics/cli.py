@@ -30,7 +30,8 @@ import click
               help="Instead: write check_report.md/.json for the KRC backups below PATH into this folder.")
 def check(paths: tuple[str, ...], fmt: str, as_json: bool, no_warnings: bool, ignore: tuple[str, ...],
           report_dir: str | None) -> None:
-    """Type-check KRL files or KRC backups; exit 1 when there are errors."""
+    """Type-check KRL files, KRC backup folders or backup .zip archives; exit 1 when there are
+    errors. Every code is explained in docs/diagnostics.md."""
     if report_dir is not None:
         from krl.semantics.report import check_report  # noqa: PLC0415
         try:
