@@ -84,9 +84,13 @@ def test_json_columns_are_one_based_in_parse_and_check(t_src):
     assert _places(json.loads(out[0])["diagnostics"]) == EXPECTED
 
 
-def test_sarif_regions_are_one_based(t_src):
+@pytest.mark.parametrize("command", ["parse", "check"])
+def test_sarif_regions_are_one_based(t_src, command):
     out: list[str] = []
-    run_check([str(t_src)], fmt="sarif", echo=out.append)
+    if command == "parse":
+        run_parse([t_src], fmt="sarif", echo=out.append)
+    else:
+        run_check([str(t_src)], fmt="sarif", echo=out.append)
     log = json.loads("\n".join(out))
     assert log["version"] == "2.1.0"
     results = log["runs"][0]["results"]
