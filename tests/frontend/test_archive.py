@@ -232,3 +232,14 @@ def test_each_file_read_is_reported_to_the_progress_hook(tmp_path):
     assert sorted(Path(p).name for p in seen) == ["$config.dat", "demo.src", "done.src"]
     workspaces_for(folder)                      # outside the block: no more calls
     assert len(seen) == 3
+
+
+def test_windows_separators_and_letter_case(tmp_path):
+    """Archives made on Windows may use backslashes; KRL files in any letter case are kept."""
+    archive = write_zip(tmp_path / "win.zip", [("KRC\\R1\\Program\\Demo.SRC", DONE),
+                                               ("KRC\\R1\\System\\$CONFIG.DAT", CONFIG)])
+    dest = tmp_path / "out"
+    dest.mkdir()
+    assert extract_backup(archive, dest) == 2
+    assert sorted(p.relative_to(dest).as_posix() for p in dest.rglob("*") if p.is_file()) == [
+        "KRC/R1/Program/Demo.SRC", "KRC/R1/System/$CONFIG.DAT"]
