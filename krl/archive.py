@@ -63,7 +63,7 @@ def _entry_parts(archive: str, name: str) -> list[str]:
     if ".." in parts:
         raise ArchiveError(f"{archive}: entry '{shown}' leaves the archive folder ('..')")
     if len(parts) > limits.MAX_ARCHIVE_DEPTH:
-        raise ArchiveError(f"{archive}: entry '{shown}' is {len(parts)} folders deep "
+        raise ArchiveError(f"{archive}: entry '{shown}' has {len(parts)} path levels "
                            f"(limit MAX_ARCHIVE_DEPTH = {limits.MAX_ARCHIVE_DEPTH})")
     return parts
 

@@ -39,5 +39,5 @@ MAX_ARCHIVE_BYTES = 512 * 1024 * 1024
 # tiny file of blanks compresses well and can do no harm).
 MAX_ARCHIVE_RATIO = 200
 MAX_ARCHIVE_RATIO_FLOOR = 4096
-# Folder levels of an entry's path (KRC/R1/Program/... is 4-6 deep).
+# Levels of an entry's path, file name included (KRC/R1/Program/x.src has 4).
 MAX_ARCHIVE_DEPTH = 32

@@ -243,3 +243,9 @@ def test_windows_separators_and_letter_case(tmp_path):
     assert extract_backup(archive, dest) == 2
     assert sorted(p.relative_to(dest).as_posix() for p in dest.rglob("*") if p.is_file()) == [
         "KRC/R1/Program/Demo.SRC", "KRC/R1/System/$CONFIG.DAT"]
+
+
+def test_depth_limit(tmp_path, own_tmp, monkeypatch):
+    monkeypatch.setattr(limits, "MAX_ARCHIVE_DEPTH", 4)
+    archive = write_zip(tmp_path / "deep.zip", [("a/b/c/d/e.src", "DEF e()\nEND\n")])
+    assert refused(archive) == "entry 'a/b/c/d/e.src' has 5 path levels (limit MAX_ARCHIVE_DEPTH = 4)"
