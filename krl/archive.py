@@ -7,7 +7,7 @@ removes it afterwards whatever happens. The archive is untrusted (docs/security.
 refused whole, with an :class:`ArchiveError` naming the archive and the entry, when
 
 * an entry's path is absolute (``/x``, ``\\x``, ``C:x``), has a ``..`` component or a NUL, or is
-  deeper than ``MAX_ARCHIVE_DEPTH`` folders;
+  more than ``MAX_ARCHIVE_DEPTH`` path levels deep;
 * an entry is a symbolic link, a device, a FIFO or a socket (only files and folders), or is
   encrypted;
 * there are more than ``MAX_ARCHIVE_ENTRIES`` entries, or their declared sizes add up to more
