@@ -107,11 +107,11 @@ def fold_diagnostics(path: str, text: str) -> list[Diagnostic]:
     for o_line, o_col, o_end, o_ctx in stack:
         end = routine_end(o_ctx)
         if end is not None:
-            message = f"`;FOLD` not closed before the end of {end[0]} (line {end[1]})"
+            message = f"`;FOLD` never closed (it opens in {end[0]}, which ends at line {end[1]})"
             note = Note(path, end[1], 1, f"{end[0]} ends here")
             help_ = f"add `;ENDFOLD` before line {end[1]}"
         else:
-            message = f"`;FOLD` not closed before the end of the file (line {last})"
+            message = f"`;FOLD` never closed before the end of the file (line {last})"
             note = Note(path, last, 1, "the file ends here")
             help_ = "add the missing `;ENDFOLD`"
         out.append(Diagnostic(path, o_line, o_col, "W021", message, end_line=o_line, end_column=o_end,
