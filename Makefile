@@ -28,7 +28,7 @@ check-java:
 $(BIN)/.installed: pyproject.toml constraints.txt | check-python
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/pip install --quiet --upgrade pip
-	$(BIN)/pip install --quiet -e '.[dev]'
+	$(BIN)/pip install --quiet -c constraints.txt -e '.[dev]'
 	@touch $@
 
 $(PARSER): grammar/KRL.g4 $(BIN)/.installed | check-java
@@ -40,7 +40,7 @@ parser: $(PARSER)
 
 recover: $(PARSER)
 	$(BIN)/krl recover $(CORPUS) --out $(OUT); status=$$?; \
-	  if [ $$status -le 1 ]; then echo "report: $(OUT)/report.md"; exit 0; else exit $$status; fi
+	  if [ $$status -le 1 ]; then echo "report: $(OUT)/report.html (open it in a browser; Markdown: $(OUT)/report.md)"; exit 0; else exit $$status; fi
 
 growth: $(PARSER)
 	$(BIN)/krl growth $(SHARED_CORPUS) --out reports/growth

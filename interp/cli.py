@@ -17,7 +17,7 @@ import click
 @click.option("--interp", "interp_kind", type=click.Choice(["tree", "vm"]), default="tree",
               show_default=True, help="Interpreter.")
 @click.option("--workspace", type=click.Path(path_type=Path), default=None,
-              help="Folder of the program's modules (default: the program's folder; a KRC backup is detected).")
+              help="Folder of the program's modules, or a KRC backup .zip (default: the program's folder; a KRC backup is detected).")
 @click.option("--inputs", type=click.Path(path_type=Path), default=None, help="Stimuli YAML (robot/stimuli.py).")
 @click.option("--trace", "trace_path", type=click.Path(path_type=Path), default=None, help="Write the JSONL trace here.")
 @click.option("--max-sim-time", type=float, default=600.0, show_default=True, help="Simulated-time limit (s).")
@@ -30,7 +30,54 @@ import click
                    "program whose files have errors (exit 1).")
 def run(program: Path, interp_kind: str, workspace, inputs, trace_path, max_sim_time, max_steps, submit,
         check) -> None:
-    """Run PROGRAM (.src) on the simulated KR C4; print where and why it ended."""
+    """Run PROGRAM (.src) on the simulated KR C4; print where and why it ended.
+
+    With --workspace BACKUP.zip (a KRC backup archive) PROGRAM is a path inside the archive
+    (KRC/R1/Program/demo.src) or a module name (demo); the archive is checked and extracted
+    to a temporary folder (krl/archive.py) that is removed after the run.
+    """
+    from krl.archive import ArchiveError, backup_source, is_archive  # noqa: PLC0415
+    from krl.terminal import printable  # noqa: PLC0415
+
+    if is_archive(program):
+        click.echo(f"error: {printable(program)} is a backup archive; name the program to run in it: "
+                   f"krl run --workspace {printable(program)} PROGRAM", err=True)
+        sys.exit(2)
+    if workspace is not None and is_archive(workspace):
+        try:
+            with backup_source(workspace) as (folder, shown):
+                found = program_in(folder, program)
+                if found is None:
+                    click.echo(f"error: no program {printable(program)} in {printable(workspace)}", err=True)
+                    sys.exit(2)
+                _run(found, folder, inputs, trace_path, max_sim_time, max_steps, submit, check, interp_kind,
+                     shown=lambda text: text.replace(str(folder), str(workspace)))
+        except ArchiveError as exc:
+            click.echo(f"error: {printable(exc)}", err=True)
+            sys.exit(2)
+        return
+    _run(program, workspace, inputs, trace_path, max_sim_time, max_steps, submit, check, interp_kind)
+
+
+def program_in(folder: Path, program: Path) -> Path | None:
+    """PROGRAM inside an extracted archive: its relative path (any letter case of the file
+    name), else the .src (then .sub) file whose stem is its name; None when there is none."""
+    from krl.syntax.source import is_krl_file  # noqa: PLC0415
+
+    direct = folder / program
+    if not program.is_absolute() and ".." not in program.parts and direct.is_file():
+        return direct
+    stem = program.stem.lower()
+    candidates = sorted(p for p in folder.rglob("*") if p.is_file() and is_krl_file(p) and p.stem.lower() == stem)
+    for suffix in (".src", ".sub"):
+        for p in candidates:
+            if p.suffix.lower() == suffix:
+                return p
+    return None
+
+
+def _run(program: Path, workspace, inputs, trace_path, max_sim_time, max_steps, submit, check, interp_kind,
+         shown=lambda text: text) -> None:
     if not program.exists():
         click.echo(f"error: {program}: no such file", err=True)
         sys.exit(2)
@@ -38,7 +85,7 @@ def run(program: Path, interp_kind: str, workspace, inputs, trace_path, max_sim_
         errors = check_errors(program, workspace)
         if errors:
             for d in errors[:20]:
-                click.echo(str(d))
+                click.echo(shown(str(d)))
             click.echo(f"not started: {len(errors)} error(s) found by the checker")
             sys.exit(1)
     from interp.run import make_runtime  # noqa: PLC0415
@@ -55,10 +102,10 @@ def run(program: Path, interp_kind: str, workspace, inputs, trace_path, max_sim_
                              interp=interp_kind, observer=observer)
         res = rt.run()
     except StimulusError as exc:
-        click.echo(f"error: {printable(exc)}", err=True)
+        click.echo(f"error: {shown(printable(exc))}", err=True)
         sys.exit(2)
     except Exception as exc:  # noqa: BLE001
-        click.echo(f"internal error: {type(exc).__name__}: {printable(exc)}", err=True)
+        click.echo(f"internal error: {type(exc).__name__}: {shown(printable(exc))}", err=True)
         sys.exit(2)
     finally:
         if trace is not None:
@@ -72,7 +119,7 @@ def run(program: Path, interp_kind: str, workspace, inputs, trace_path, max_sim_
     for line in summary_lines(res, observer, program=str(program), interp=interp_kind,
                               submits=[t for t in rt.scheduler.tasks if t.kind == "submit"],
                               workspace=ws_note):
-        click.echo(line)
+        click.echo(shown(line))
     sys.exit(res.exit_code)
 
 

@@ -118,8 +118,13 @@ def summary_lines(result: Any, observer: RunObserver, *, program: str, interp: s
             num = f" [{result.error.number}]"
         ctx = f" ({result.context})" if result.context and result.context != "main" else ""
         out.append(f"  ended      {ending} at t={result.sim_time:.3f} s")
+        if where and detail.endswith(f" at {where}"):
+            detail = detail[:-len(f" at {where}")]      # the place is already in front
         if where or detail:
             out.append(f"             {where}{ctx}{': ' if where and detail else ''}{detail}{num}")
+        if result.reason in ("max_sim_time", "max_steps", "deadlock") and "WAIT FOR" in (result.text or ""):
+            out.append("  hint       nothing set the inputs that WAIT FOR reads: give them with "
+                       "--inputs STIMULI.yaml (- at: 1.0 / set: {\"$IN[n]\": true}; robot/stimuli.py)")
     for task in submits:
         reason, err = getattr(task, "outcome", (None, None)) or (None, None)
         if reason == "error" and err is not None:

@@ -29,7 +29,7 @@ def main() -> None:
 @click.option("--outline", is_flag=True, help="Print the routines and declarations of each file that parses.")
 @click.option("--tree", is_flag=True, help="Print the grammar-rule outline of each file that parses.")
 @click.option("--timeout", type=click.FloatRange(min=0, min_open=True), default=PARSE_TIMEOUT_S,
-              show_default=True, help="Seconds one file may parse; past it the parse is stopped (error E004).")
+              show_default=True, help="Seconds one file may parse; past it the parse is stopped (error E005).")
 @click.option("--jobs", type=click.IntRange(min=1), default=None,
               help="Worker processes (default: the number of cores).")
 def parse(files: tuple[Path, ...], fmt: str, as_json: bool, outline: bool, tree: bool, timeout: float,

@@ -35,3 +35,20 @@ MAX_FOLDER_DEPTH = 100
 # in a worker process; past it the worker is killed and the file gets a "timeout" row / error.
 # The largest corpus file (about 150 KB) parses in about a second; a 9.5 MB file took over 300 s.
 PARSE_TIMEOUT_S = 30
+
+# KRC backup archives (.zip) given to `krl check`, `krl recover` and `krl run` (krl/archive.py).
+# Every entry is inspected before anything is written; past a limit the archive is refused with
+# an error naming it and the entry (code E004), and nothing of it is read.
+# Entries (files and folders) in one archive: a KRC 4 backup holds a few thousand.
+MAX_ARCHIVE_ENTRIES = 20_000
+# Total uncompressed size declared by the entries, in bytes: a backup is tens of MiB; the real
+# corpus of 596 files is 4.8 MB.
+MAX_ARCHIVE_BYTES = 512 * 1024 * 1024
+# Uncompressed / compressed size of one entry: KRL text compresses 3-67x (measured over the
+# real corpus with deflate level 9; the maximum is a point list of repeated lines); a zip bomb
+# expands 1000x and more. Checked for entries larger than MAX_ARCHIVE_RATIO_FLOOR bytes (a
+# tiny file of blanks compresses well and can do no harm).
+MAX_ARCHIVE_RATIO = 200
+MAX_ARCHIVE_RATIO_FLOOR = 4096
+# Levels of an entry's path, file name included (KRC/R1/Program/x.src has 4).
+MAX_ARCHIVE_DEPTH = 32

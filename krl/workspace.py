@@ -27,6 +27,9 @@ from __future__ import annotations
 
 import re
 import time
+from collections.abc import Callable
+from contextlib import contextmanager
+from contextvars import ContextVar
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -35,6 +38,7 @@ from krl.ast.build import build_module
 from krl.semantics.checker import Checker, Declarer, _is_system_datalist
 from krl.semantics.diagnostics import Diagnostic, DiagnosticSink
 from krl.semantics.symbols import Scope, Symbol, system_scopes
+from krl.syntax.folds import fold_diagnostics
 from krl.syntax.messages import syntax_diagnostics
 from krl.syntax.parse import ParseResult, parse_source
 from krl.syntax.source import is_krl_file, read_source
@@ -80,6 +84,7 @@ def load_file(path: str | Path) -> LoadedFile:
         sink.add(path_s, 1, 1, "E001", f"file not checked: {result.status}"
                  + (f" ({src.detail})" if src.detail else ""))
     sink.extend(syntax_diagnostics(result, src.text))
+    sink.extend(fold_diagnostics(path_s, src.text))
     t = time.perf_counter()
     unreadable, words = False, set()
     if not result.ok:
@@ -164,7 +169,7 @@ class Workspace:
     def add_files(self, paths, timeout: float | None = None, jobs: int | None = None) -> None:
         """:meth:`add_file` for each of `paths`, in order. With `timeout` (seconds per file) each
         file is read, parsed and built in a worker process (krl/pool.py) that is killed past the
-        timeout: the file gets error E004 and the other files are still checked. A worker that
+        timeout: the file gets error E005 and the other files are still checked. A worker that
         dies (a crash of the parser) gives error E001 for its file."""
         paths = list(paths)
         if timeout is None or not paths:
@@ -176,15 +181,19 @@ class Workspace:
         from krl.syntax.parse import default_bundle  # noqa: PLC0415
 
         default_bundle()    # imported once here, inherited by the forked workers
-        done = {o.key: o for o in run_tasks(load_file, ((i, (p,)) for i, p in enumerate(paths)),
-                                            jobs=jobs, timeout=timeout)}
+        hook = _ON_FILE.get()
+        done = {}
+        for o in run_tasks(load_file, ((i, (p,)) for i, p in enumerate(paths)), jobs=jobs, timeout=timeout):
+            done[o.key] = o
+            if hook is not None:
+                hook(str(paths[o.key]))      # progress as files finish, in any order
         for i, p in enumerate(paths):
             o = done[i]
             if o.status == "done":
-                self._add_loaded(o.value)
+                self._add_loaded(o.value, notify=False)
                 continue
             if o.status == "timeout":
-                self.sink.add(str(p), 1, 1, "E004", f"file not checked: not parsed within {timeout:g} s "
+                self.sink.add(str(p), 1, 1, "E005", f"file not checked: not parsed within {timeout:g} s "
                               "(--timeout; the parse was stopped)")
             else:
                 self.sink.add(str(p), 1, 1, "E001", f"file not checked: {o.detail}")
@@ -192,12 +201,15 @@ class Workspace:
             module = build_module(ParseResult(str(p), False, "", o.status), DiagnosticSink())
             self.files.append(SourceFile(str(p), module, False, o.status))
 
-    def _add_loaded(self, lf: "LoadedFile") -> SourceFile:
+    def _add_loaded(self, lf: "LoadedFile", notify: bool = True) -> SourceFile:
         self.parse_seconds += lf.parse_seconds
         self.check_seconds += lf.build_seconds
         self.sink.extend(lf.diagnostics)
         self.unreadable |= lf.unreadable
         self.failed_words |= lf.failed_words
+        hook = _ON_FILE.get() if notify else None
+        if hook is not None:
+            hook(lf.path)
         sf = SourceFile(lf.path, lf.module, lf.ok, lf.status, parse_seconds=lf.parse_seconds)
         self.files.append(sf)
         return sf
@@ -210,6 +222,7 @@ class Workspace:
         result = parse_text(text, path)
         self.parse_seconds += time.perf_counter() - t
         self.sink.extend(syntax_diagnostics(result, text))
+        self.sink.extend(fold_diagnostics(path, text))
         self._note_failed(result, text)
         module = build_module(result, self.sink)
         sf = SourceFile(path, module, result.ok, result.status)
@@ -383,6 +396,20 @@ class Workspace:
             checker.submit = u.src.path.lower().endswith(".sub")
             checker.check_routine(r, self.routine_scopes[id(r)], u.src.path)
         checker.system_file = declarer.soft_types = checker.submit = False
+
+
+_ON_FILE: ContextVar[Callable[[str], None] | None] = ContextVar("krl_workspace_on_file", default=None)
+
+
+@contextmanager
+def on_each_file(callback: Callable[[str], None]):
+    """``with on_each_file(cb):`` calls ``cb(path)`` after each file that a workspace reads and
+    parses (progress display of `krl check`); the hook ends with the block."""
+    token = _ON_FILE.set(callback)
+    try:
+        yield
+    finally:
+        _ON_FILE.reset(token)
 
 
 SYSTEM_DIRS = ("system", "tp", "mada", "steu")

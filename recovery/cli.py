@@ -20,21 +20,26 @@ from krl.limits import PARSE_TIMEOUT_S
 @click.option("--timeout", type=click.FloatRange(min=0, min_open=True), default=PARSE_TIMEOUT_S,
               show_default=True, help="Seconds one file may parse; past it its worker is killed (row `timeout`).")
 def recover(corpus: Path, out: Path, jobs: int | None, no_cache: bool, timeout: float) -> None:
-    """Parse every KRL file under CORPUS, cluster the failures, write the report to --out.
+    """Parse every KRL file under CORPUS (a folder or a KRC backup .zip), cluster the failures,
+    write the report to --out.
 
-    Exit code: 0 when every file parses, 1 when some do not, 2 on a usage or internal error.
+    Exit code: 0 when every file parses, 1 when some do not, 2 on a usage or internal error
+    (or an archive refused by the limits of krl/limits.py).
     """
+    from krl.archive import ArchiveError, backup_source, is_archive  # noqa: PLC0415
     from krl.terminal import printable_path  # noqa: PLC0415
     from recovery.pipeline import run_recovery  # noqa: PLC0415
     from recovery.report import ReportError  # noqa: PLC0415
 
-    if not corpus.is_dir():
-        click.echo(f"error: corpus directory not found: {printable_path(corpus)}", err=True)
+    if not corpus.is_dir() and not is_archive(corpus):
+        click.echo(f"error: corpus folder or .zip archive not found: {printable_path(corpus)}", err=True)
         sys.exit(2)
     start = time.perf_counter()
     try:
-        summary = run_recovery(corpus, out, jobs=jobs, use_cache=not no_cache, timeout=timeout)
-    except ReportError as exc:
+        with backup_source(corpus) as (folder, shown):
+            summary = run_recovery(folder, out, jobs=jobs, use_cache=not no_cache, timeout=timeout,
+                                   label=str(corpus) if shown.archive else None)
+    except (ArchiveError, ReportError) as exc:
         click.echo(f"error: {printable_path(exc)}", err=True)
         sys.exit(2)
     click.echo(f"{summary.files_ok}/{summary.files} files parse "

@@ -115,9 +115,11 @@ def _valid_check_figures(obj: object) -> bool:
 
 
 def run_recovery(corpus: Path, out: Path, jobs: int | None = None, use_cache: bool = True,
-                 timeout: float = PARSE_TIMEOUT_S) -> Summary:
+                 timeout: float = PARSE_TIMEOUT_S, label: str | None = None) -> Summary:
     """Scan `corpus`, cluster, add the negative-corpus and static-check figures and write the
-    report to `out`. Rows stream to ``files.csv`` (in a temporary folder next to `out`) as files
+    report to `out`. `label`: how the report names the corpus when it is not the folder itself
+    (a backup .zip extracted to a temporary folder: the report then names the archive and does
+    not link to the vanished files). Rows stream to ``files.csv`` (in a temporary folder next to `out`) as files
     finish and only counts and clusters are kept, so memory stays flat with the corpus size;
     the folder replaces `out` atomically at the end (recovery/report.py). Raises ReportError
     when `out` holds files that are not a report."""
@@ -131,7 +133,7 @@ def run_recovery(corpus: Path, out: Path, jobs: int | None = None, use_cache: bo
             stream.add(index, row)
 
         scan(corpus, gsha, jobs=jobs, use_cache=use_cache, timeout=timeout, on_row=on_row, keep=False)
-        summary = builder.summary(gsha, str(corpus), 0.0)
+        summary = builder.summary(gsha, label or str(corpus), 0.0)
         summary.negative = negative_figures(gsha, jobs, use_cache)
         ki = _known_invalid_figures(builder.known_ok)
         if ki:

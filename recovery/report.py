@@ -234,6 +234,14 @@ def source_link(corpus: str, path: str, out: Path) -> str:
     return quote(os.fsencode(target).replace(os.sep.encode(), b"/"))
 
 
+def _expected_words(expected: list[str]) -> str:
+    """The tokens expected at a cluster's error in KRL words: at most six grouped alternatives
+    ("a statement, ELSE, ENDIF or end of line"), as in the compiler-style messages."""
+    from krl.syntax.messages import expected_phrase  # noqa: PLC0415
+
+    return expected_phrase(list(expected)).replace("`", "")
+
+
 REPORT_FILES = frozenset({"summary.json", "files.csv", "clusters.csv", "clusters.png", "report.md",
                           "report.html", ".krl-report"})
 
@@ -344,14 +352,17 @@ def render_report(out: Path, summary: Summary, bad_input: list[FileResult], link
     write_clusters_csv(out / "clusters.csv", summary.clusters, summary.known_invalid_clusters)
     chart = write_chart(out / "clusters.png", summary.clusters)
     links = {}
+    # a corpus read from an archive has no files left to link to: the examples are plain text
+    linkable = not summary.corpus.lower().endswith(".zip")
     for c in summary.clusters[:TOP_REPORT] + summary.known_invalid_clusters:
         for e in c.examples:
-            links[e["path"]] = source_link(summary.corpus, e["path"], link_from)
+            links[e["path"]] = source_link(summary.corpus, e["path"], link_from) if linkable else ""
     for f in summary.internal_failures:
-        links[f["path"]] = source_link(summary.corpus, f["path"], link_from)
+        links[f["path"]] = source_link(summary.corpus, f["path"], link_from) if linkable else ""
     context = {"s": summary, "clusters": summary.clusters[:TOP_REPORT],
                "known_clusters": summary.known_invalid_clusters,
                "internal": summary.internal_failures, "chart": chart, "links": links,
+               "expected_words": _expected_words,
                "more": max(0, len(summary.clusters) - TOP_REPORT),
                "pct": (100.0 * summary.files_ok / summary.files) if summary.files else 0.0,
                "bytes_pct": (100.0 * summary.bytes_ok / summary.bytes) if summary.bytes else 0.0,

@@ -155,6 +155,11 @@ class Runtime:
         if reason == "completed":
             file, line, ctx = robot.file, robot.line, "main"
         self.result = RunResult(reason, err, file, line, ctx, text, self.controller.time, self.steps)
+        if self.trace is not None and reason == "error" and err is not None:
+            # the robot program's run-time error, before the `end` event (robot/trace.py);
+            # a submit program's error was written when that task ended (submit_finished)
+            self.trace.write("error", self.controller.time, text=err.message, number=err.number,
+                             line=line, file=file)
         if self.trace is not None:
             self.controller.finish(reason, text=text or None,
                                    number=err.number if err is not None else None,

@@ -1,8 +1,9 @@
 """`krl check PATH... [--json]`: the front end's command (registered by krl/cli.py).
 
 PATH is a file (checked with the .src/.dat of its module), a KRC backup folder (one
-workspace), or a folder holding backups (one workspace per backup) or plain files (one
-workspace). Output (``--format``): compiler-style text (``path:line:col: error[CODE]: message``,
+workspace), a folder holding backups (one workspace per backup) or plain files (one
+workspace), or a backup archive (.zip, checked as the folder it holds: krl/archive.py; a
+refused archive is error E004; paths are shown as ``backup.zip/KRC/R1/...``). Output (``--format``): compiler-style text (``path:line:col: error[CODE]: message``,
 the source line and a caret, krl/semantics/render.py, then a count line), one JSON object per
 workspace, or SARIF 2.1.0. ``--ignore CODE`` and the workspace's ``krl.toml`` select codes and
 severities (krl/semantics/config.py). Exit 1 when there are errors, 0 otherwise, 2 for a bad
@@ -29,12 +30,13 @@ from krl.limits import PARSE_TIMEOUT_S
 @click.option("--report", "report_dir", default=None,
               help="Instead: write check_report.md/.json for the KRC backups below PATH into this folder.")
 @click.option("--timeout", type=click.FloatRange(min=0, min_open=True), default=PARSE_TIMEOUT_S,
-              show_default=True, help="Seconds one file may parse; past it the parse is stopped (error E004).")
+              show_default=True, help="Seconds one file may parse; past it the parse is stopped (error E005).")
 @click.option("--jobs", type=click.IntRange(min=1), default=None,
               help="Worker processes that parse the files (default: the number of cores).")
 def check(paths: tuple[str, ...], fmt: str, as_json: bool, no_warnings: bool, ignore: tuple[str, ...],
           report_dir: str | None, timeout: float, jobs: int | None) -> None:
-    """Type-check KRL files or KRC backups; exit 1 when there are errors."""
+    """Type-check KRL files, KRC backup folders or backup .zip archives; exit 1 when there are
+    errors. Every code is explained in docs/diagnostics.md."""
     if report_dir is not None:
         from krl.semantics.report import check_report  # noqa: PLC0415
         try:
@@ -61,12 +63,14 @@ def run_check(paths: list[str], as_json: bool = False, no_warnings: bool = False
     the old spelling of "json"); `ignore`: codes not to report (with the krl.toml of each
     workspace, krl/semantics/config.py). `timeout`: seconds per file, files parsed in worker
     processes that are killed past it (None: parse here, without a limit; the command passes
-    krl.limits.PARSE_TIMEOUT_S). Returns the exit status: 0, 1 (errors), 2 (bad configuration
-    or internal failure)."""
+    krl.limits.PARSE_TIMEOUT_S); `jobs`: worker processes. Returns the exit status: 0, 1
+    (errors), 2 (bad configuration or internal failure)."""
+    from krl.archive import ArchiveError, backup_source  # noqa: PLC0415
     from krl.semantics.config import ConfigError, Selection, config_for, parse_codes  # noqa: PLC0415
+    from krl.semantics.diagnostics import Diagnostic  # noqa: PLC0415
+    from krl.syntax.source import read_source  # noqa: PLC0415
     from krl.semantics.render import Renderer  # noqa: PLC0415
     from krl.terminal import printable  # noqa: PLC0415
-    from krl.workspace import workspaces_for  # noqa: PLC0415
 
     fmt = "json" if as_json else fmt
     renderer = Renderer(echo, colour)
@@ -74,30 +78,48 @@ def run_check(paths: list[str], as_json: bool = False, no_warnings: bool = False
     files = 0
     any_error = False
     seen: set = set()      # files already checked: `krl check A.src A.dat` checks module A once
+
+    def report(root: str, n_files: int, diags: list) -> None:
+        shown = [d for d in diags if d.is_error or not no_warnings]
+        if fmt == "json":
+            echo(json.dumps({
+                "workspace": root,
+                "files": n_files,
+                "errors": sum(d.is_error for d in diags),
+                "warnings": sum(not d.is_error for d in diags),
+                "diagnostics": [d.as_json() for d in shown],
+            }))
+        elif fmt == "sarif":
+            all_shown.extend(shown)
+        else:
+            renderer.emit(shown)
+
     try:
         cli_sel = Selection(ignore=parse_codes(ignore, "--ignore"))
         for path in paths:
             if _resolved(path) in seen:
                 continue
-            for ws in workspaces_for(path, timeout=timeout, jobs=jobs):
-                seen.update(_resolved(f.path) for f in ws.files)
-                sel = config_for(ws.root, path).merged(cli_sel)
-                diags = sel.apply(ws.check())
-                files += len(ws.files)
-                any_error |= any(d.is_error for d in diags)
-                shown = [d for d in diags if d.is_error or not no_warnings]
-                if fmt == "json":
-                    echo(json.dumps({
-                        "workspace": ws.root,
-                        "files": len(ws.files),
-                        "errors": sum(d.is_error for d in diags),
-                        "warnings": sum(not d.is_error for d in diags),
-                        "diagnostics": [d.as_json() for d in shown],
-                    }))
-                elif fmt == "sarif":
-                    all_shown += shown
-                else:
-                    renderer.emit(shown)
+            try:
+                with backup_source(path) as (folder, as_shown):
+                    for ws in _loaded(folder if as_shown.archive else path, timeout, jobs):
+                        seen.update(_resolved(f.path) for f in ws.files)
+                        try:
+                            sel = config_for(ws.root, folder if as_shown.archive else path).merged(cli_sel)
+                        except ConfigError as exc:   # name the krl.toml as the user sees it
+                            raise ConfigError(str(exc).replace(str(folder), str(path))
+                                              if as_shown.archive else str(exc)) from None
+                        diags = sel.apply(ws.check())
+                        files += len(ws.files)
+                        if as_shown.archive:
+                            for real in {d.path for d in diags}:
+                                renderer.sources.add(as_shown(real), read_source(real).text or "")
+                            diags = [as_shown.diagnostic(d) for d in diags]
+                        any_error |= any(d.is_error for d in diags)
+                        report(as_shown(ws.root), len(ws.files), diags)
+            except ArchiveError as exc:
+                any_error = True
+                message = str(exc).removeprefix(f"{path}: ")
+                report(str(path), 0, [Diagnostic(str(path), 1, 1, "E004", message)])
     except ConfigError as exc:
         echo(f"krl check: {printable(exc)}")
         return 2
@@ -110,6 +132,41 @@ def run_check(paths: list[str], as_json: bool = False, no_warnings: bool = False
     elif fmt == "text":
         echo(renderer.summary(files))
     return 1 if any_error else 0
+
+
+def _loaded(path, timeout: float | None = None, jobs: int | None = None) -> list:
+    """workspaces_for(path), with a transient progress bar on standard error when it is a
+    terminal (a KRC backup of a few hundred files takes tens of seconds to parse); piped or
+    redirected, nothing is shown, so the output is the same either way."""
+    from pathlib import Path  # noqa: PLC0415
+
+    from krl.workspace import collect_files, on_each_file, workspaces_for  # noqa: PLC0415
+
+    if not _progress_shown():
+        return workspaces_for(path, timeout=timeout, jobs=jobs)
+    from rich.console import Console  # noqa: PLC0415
+    from rich.markup import escape  # noqa: PLC0415
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn  # noqa: PLC0415
+
+    p = Path(path)
+    total = len(collect_files(p)) if p.is_dir() else None
+    columns = (TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn())
+    with Progress(*columns, console=Console(stderr=True), transient=True) as bar:
+        task = bar.add_task("parsing", total=total)
+
+        def advance(file: str) -> None:
+            bar.update(task, advance=1, description=escape(f"parsing {Path(file).name}"))
+        with on_each_file(advance):
+            return workspaces_for(path, timeout=timeout, jobs=jobs)
+
+
+def _progress_shown() -> bool:
+    import os  # noqa: PLC0415
+
+    try:
+        return sys.stderr.isatty() and os.environ.get("TERM", "") != "dumb"
+    except (AttributeError, ValueError):
+        return False
 
 
 def _resolved(path) -> str:

@@ -73,7 +73,7 @@ def _jobs_in_order(files, outline: bool, tree: bool, timeout: float | None, jobs
             if o.status == "done":
                 yield path, o.value, None
             elif o.status == "timeout":
-                yield path, None, Diagnostic(str(path), 1, 1, "E004",
+                yield path, None, Diagnostic(str(path), 1, 1, "E005",
                                              f"file not parsed within {timeout:g} s (--timeout; the parse was stopped)")
             else:
                 yield path, None, Diagnostic(str(path), 1, 1, "E001", f"file not parsed: {o.detail}")
@@ -84,7 +84,7 @@ def run_parse(files, fmt: str = "text", outline: bool = False, tree: bool = Fals
     """Parse `files` and print the result in `fmt`; returns the exit status (0 or 1).
 
     timeout: seconds per file; each file is then parsed in a worker process (krl/pool.py)
-    that is killed past it, and the file gets error E004 while the others are still parsed
+    that is killed past it, and the file gets error E005 while the others are still parsed
     (None: parse here, without a limit; the command passes krl.limits.PARSE_TIMEOUT_S).
     """
     from krl.semantics.render import Renderer, SourceLines  # noqa: PLC0415
@@ -101,7 +101,7 @@ def run_parse(files, fmt: str = "text", outline: bool = False, tree: bool = Fals
             all_diags.append(failure)
             if fmt == "json":
                 echo(json.dumps({"path": str(path), "ok": False, "encoding": "",
-                                 "status": "timeout" if failure.code == "E004" else "internal_error",
+                                 "status": "timeout" if failure.code == "E005" else "internal_error",
                                  "diagnostics": [failure.as_json()], "errors": []}))
             elif fmt == "text":
                 renderer.emit([failure])

@@ -285,6 +285,24 @@ def _describe(path: str, e, f: _File | None) -> Diagnostic:
         if kw in _BARE and len(shape) >= 2 and shape[0] == kw:
             return diag("E016", f"{_shown_token(e)} after {kw}: {kw} stands alone on its line")
         return diag("E016", f"{_shown_token(e)} after the end of the statement; KRL has one statement per line")
+    # two words written as one: INTERRUPT5, GLOBALSTRUC (the lexer reads one name)
+    if line is not None and line.toks and line.toks[0].word == "IDENTIFIER" and e.line == line.toks[0].line:
+        glued = _glued(line.toks[0].text)
+        if glued is not None:
+            t = line.toks[0]
+            return Diagnostic(path, e.line, t.column, "E002",
+                              _clip(f"{q(t.text)} is read as one name; write {q(glued[0] + ' ' + glued[1])}"),
+                              end_line=e.line, end_column=t.column + len(t.text),
+                              help=f"KRL needs a space after {glued[0]}")
+    # a bare name on its own line: a call without parentheses (withdrawn, grammar/CHANGES.md) or
+    # a placeholder such as TODO
+    if (tok == "<EOL>" and line is not None and len(line.toks) == 1 and shape[:1] == ["id"]
+            and line.toks[0].word == "IDENTIFIER"):
+        t = line.toks[0]
+        return Diagnostic(path, e.line, t.column, "E012",
+                          _clip(f"{q(t.text)} alone is not a statement; to call the routine write {q(t.text + '()')}"),
+                          end_line=e.line, end_column=t.column + len(t.text),
+                          help=f"if it is a note (like TODO), make it a comment: `;{t.text}`")
     # a missing expression
     phrase = expected_phrase(e.expected)
     if tok == "<EOL>":
@@ -299,6 +317,20 @@ def _describe(path: str, e, f: _File | None) -> Diagnostic:
     if len(shape) >= 2 and shape[-2] not in ("id", "num", "str", "$sys", "#enum") and "…" not in shape[-2]:
         after = f" after {q(shape[-2])}"
     return diag("E002", f"unexpected {_shown_token(e)}{after}" + (f"; expected {phrase}" if phrase else ""))
+
+
+_GLUE_KEYWORDS = sorted(_STATEMENT | _DECL | {"DEF", "DEFFCT", "DEFDAT", "DECL"}, key=len, reverse=True)
+
+
+def _glued(text: str) -> tuple[str, str] | None:
+    """(keyword, rest) when `text` is a keyword glued to a number or to another keyword
+    (``INTERRUPT5`` -> INTERRUPT 5, ``GLOBALSTRUC`` -> GLOBAL STRUC), else None."""
+    upper = text.upper()
+    for k in _GLUE_KEYWORDS:
+        rest = upper[len(k):]
+        if upper.startswith(k) and rest and (rest.isdigit() or rest in _STATEMENT or rest in _DECL):
+            return text[:len(k)], text[len(k):]
+    return None
 
 
 def _bracket_problem(line, e) -> Diagnostic | None:

@@ -1,5 +1,5 @@
 """`krl parse` and `krl check` stop a file that parses too long (issue 12): the worker that
-parses it is killed after --timeout, the file gets error E004 and the other files are still
+parses it is killed after --timeout, the file gets error E005 and the other files are still
 parsed and checked. The stuck parse below swallows every exception, as a parser stuck in a C
 extension (or a SIGALRM raised inside a garbage-collector callback) would."""
 
@@ -42,7 +42,7 @@ def test_parse_timeout_stops_one_file_and_parses_the_others(tmp_path: Path, monk
     lines: list[str] = []
     assert run_parse(files, echo=lines.append, timeout=4, jobs=2) == 1
     located = [ln for ln in lines if ": error[" in ln]
-    assert located[0] == f"{files[0]}:1:1: error[E004]: file not parsed within 4 s (--timeout; the parse was stopped)"
+    assert located[0] == f"{files[0]}:1:1: error[E005]: file not parsed within 4 s (--timeout; the parse was stopped)"
     assert len(located) == 2 and located[1].startswith(f"{files[2]}:")     # bad.src, in file order
     assert lines[-1] == "2 errors in 3 files"
 
@@ -60,7 +60,7 @@ def test_check_timeout_stops_one_file_and_checks_the_others(tmp_path: Path, monk
     lines: list[str] = []
     assert run_check([str(tmp_path)], echo=lines.append, timeout=4, jobs=2) == 1
     errors = [ln for ln in lines if ": error[" in ln]
-    assert f"{tmp_path / 'stuck.src'}:1:1: error[E004]: file not checked: not parsed within 4 s " \
+    assert f"{tmp_path / 'stuck.src'}:1:1: error[E005]: file not checked: not parsed within 4 s " \
            "(--timeout; the parse was stopped)" in errors
     assert any(ln.startswith(f"{tmp_path / 'bad.src'}:") for ln in errors)
     assert not any("good.src" in ln for ln in errors)

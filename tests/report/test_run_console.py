@@ -180,3 +180,28 @@ def test_stimulus_by_signal_name(tmp_path):
     assert code == 0, out
     # PART_OK -> $IN[3]; CODE 5 = 0b0101 -> $IN[10] and $IN[12] rise ($IN[11], $IN[13] stay FALSE)
     assert "  I/O        4 change(s) ($IN by stimulus 3, $OUT 1)" in out
+
+
+def test_a_wait_for_an_input_nobody_sets_gets_a_hint(tmp_path):
+    """The program waits for $IN[5] and nothing can set it (no stimulus, no interrupt, no
+    submit program): the run ends deadlocked at line 3, then a hint names --inputs."""
+    prog = write(tmp_path / "cell.src", """
+        DEF cell()
+          $OUT[1] = TRUE
+          WAIT FOR $IN[5]
+        END
+        """)
+    code, out = run(str(prog), "--max-sim-time", "0.5")
+    assert code == 3, out
+    lines = out.splitlines()
+    assert lines[2] == f"             {prog}:3: deadlocked WAIT FOR"
+    assert lines[3].startswith("  hint       nothing set the inputs that WAIT FOR reads: give them with "
+                               "--inputs STIMULI.yaml")
+    stim = write(tmp_path / "stim.yaml", """
+        stimuli:
+          - at: 0.1
+            set: {"$IN[5]": true}
+        """)
+    code, out = run(str(prog), "--max-sim-time", "0.5", "--inputs", str(stim))
+    assert code == 0, out
+    assert "hint" not in out

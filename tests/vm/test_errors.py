@@ -79,3 +79,34 @@ def test_same_error(tmp_path, name):
     assert res.line == line, f"{name}: error at line {res.line}, expected {line}: {res.text}"
     end = ev[-1]
     assert end["kind"] == "end" and end["line"] == line and re.search(pattern, end["text"])
+    # the run-time error is an `error` event right before `end` (robot/trace.py), with the
+    # same place, text and KSS number (1422 "value invalid" where the reference gives it)
+    error = ev[-2]
+    assert error["kind"] == "error", ev[-3:]
+    assert (error["line"], error["text"], error.get("number")) == (line, end["text"], end.get("number"))
+    assert error["file"].endswith("prog.src")
+    if pattern.startswith("value invalid"):
+        assert error["number"] == 1422
+    assert sum(e["kind"] == "error" for e in ev) == 1
+
+
+def test_error_event_trace_files_are_byte_identical(tmp_path):
+    """`krl run --trace` of a program stopped by a run-time error: both interpreters write the
+    same bytes, the error event (line 4, division by zero) right before the end event."""
+    import json
+
+    from click.testing import CliRunner
+
+    from interp.cli import run
+
+    (tmp_path / "prog.src").write_text("DEF prog()\n  INT i, n\n  n = 0\n  i = 1 / n\nEND\n")
+    traces = {}
+    for kind in ("tree", "vm"):
+        out = tmp_path / f"{kind}.jsonl"
+        res = CliRunner().invoke(run, [str(tmp_path / "prog.src"), "--interp", kind, "--trace", str(out)])
+        assert res.exit_code == 1, res.output
+        traces[kind] = out.read_bytes()
+    assert traces["tree"] == traces["vm"]
+    events = [json.loads(x) for x in traces["vm"].splitlines()]
+    assert [e["kind"] for e in events[-2:]] == ["error", "end"]
+    assert (events[-2]["line"], events[-2]["text"]) == (4, "division by zero")

