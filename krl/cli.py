@@ -50,6 +50,7 @@ SUBCOMMAND_MODULES = (
     "krl.bench",           # bench
     "conformance.cli",     # conformance
     "krl.fmt.cli",         # fmt
+    "krl.lsp.cli",         # lsp
 )
 
 

@@ -52,3 +52,9 @@ MAX_ARCHIVE_RATIO = 200
 MAX_ARCHIVE_RATIO_FLOOR = 4096
 # Levels of an entry's path, file name included (KRC/R1/Program/x.src has 4).
 MAX_ARCHIVE_DEPTH = 32
+
+# The most KRL files `krl lsp` reads for one workspace (a KRC backup or a folder the editor
+# opened), in files. A real backup holds a few hundred to a few thousand; an editor opened on a
+# home folder must not make the server read the whole disk. Past it: the first files (sorted)
+# are read, the rest are not part of the workspace (their names stay unresolved).
+MAX_LSP_WORKSPACE_FILES = 5000

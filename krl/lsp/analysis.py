@@ -1,0 +1,155 @@
+"""A checked workspace and the look-ups every editor feature shares.
+
+An :class:`Analysis` is a :class:`krl.workspace.Workspace` after ``check()`` plus, per file, its
+text and lines. The scopes are the front end's (krl/semantics/symbols.py): a position's scope is
+the routine scope of the routine around it (``Workspace.routine_scope``), else the module scope
+of its file, else the global scope. Routines of files with syntax errors are not checked by
+``krl check``; here they are typed with a checker whose findings are dropped, so that names in a
+partial tree still resolve (:meth:`Analysis.annotate_partial`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from krl.ast import nodes as N
+from krl.lsp.parsing import Parsed
+from krl.semantics import types as T
+from krl.semantics.checker import Checker, Declarer, _is_system_datalist
+from krl.semantics.diagnostics import Diagnostic, DiagnosticSink
+from krl.semantics.symbols import Scope
+from krl.workspace import SourceFile, Workspace
+
+
+@dataclass
+class FileInfo:
+    """One file of an analysis: the parse, the workspace's SourceFile, the lines of its text."""
+    path: str
+    parsed: Parsed
+    source: SourceFile
+    lines: list[str]
+    _by_line: dict[int, list[N.Node]] | None = None
+
+    def nodes_on(self, line: int) -> list[N.Node]:
+        """AST nodes whose first token is on `line` (1-based)."""
+        if self._by_line is None:
+            idx: dict[int, list[N.Node]] = {}
+            for n in self.source.module.walk():
+                idx.setdefault(n.span.line, []).append(n)
+            self._by_line = idx
+        return self._by_line.get(line, [])
+
+
+@dataclass
+class Analysis:
+    """A checked workspace (see the module docstring); `files` by path."""
+    root: str
+    ws: Workspace
+    files: dict[str, FileInfo] = field(default_factory=dict)
+    _types: dict[int, tuple[N.Decl, str]] | None = None
+    _routine_path: dict[int, str] | None = None
+
+    # ------------------------------------------------------------------ places
+
+    def routine_at(self, path: str, line: int) -> N.Routine | None:
+        """The routine whose DEF..END lines hold `line`, else None."""
+        fi = self.files.get(path)
+        if fi is None:
+            return None
+        routines = fi.source.module.routines
+        for i, r in enumerate(routines):
+            end = r.end_line or (routines[i + 1].span.line - 1 if i + 1 < len(routines) else len(fi.lines))
+            if r.span.line <= line <= end:
+                return r
+        return None
+
+    def scope_at(self, path: str, line: int) -> Scope | None:
+        """The innermost scope at a line: routine, module or global."""
+        r = self.routine_at(path, line)
+        if r is not None:
+            sc = self.ws.routine_scope(r)
+            if sc is not None:
+                return sc
+        fi = self.files.get(path)
+        if fi is not None and fi.source.scope is not None:
+            return fi.source.scope
+        return self.ws.global_scope
+
+    def routine_path(self, routine: N.Routine) -> str:
+        if self._routine_path is None:
+            self._routine_path = {id(r): f.path for f in self.ws.files for r in f.module.routines}
+        return self._routine_path.get(id(routine), "")
+
+    def type_decl(self, typ: T.KrlType) -> tuple[N.Decl, str] | None:
+        """The STRUC/ENUM declaration (and its file) of a user type, else None (built-in)."""
+        if self._types is None:
+            self._types = {}
+            glob = self.ws.global_scope
+            for u in self.ws.units:
+                if u.dat is not None and u.dat.module.data is not None and u.scope is not None:
+                    dl = u.dat.module.data
+                    for d in dl.items:
+                        if isinstance(d, (N.StrucDecl, N.EnumDecl)):
+                            glob_decl = _is_system_datalist(dl.name) or d.is_global
+                            sc = glob if glob_decl else u.scope
+                            self._remember(sc, d, u.dat.path)
+                if u.src is not None:
+                    for r in u.src.module.routines:
+                        sc = self.ws.routine_scope(r)
+                        for d in r.decls:
+                            if isinstance(d, (N.StrucDecl, N.EnumDecl)) and sc is not None:
+                                self._remember(sc, d, u.src.path)
+        return self._types.get(id(typ))
+
+    def _remember(self, sc: Scope | None, d: N.Decl, path: str) -> None:
+        t = sc.types.get(d.name.upper()) if sc is not None else None
+        if t is not None:
+            self._types.setdefault(id(t), (d, path))
+
+    # ------------------------------------------------------------------ set-up
+
+    def annotate_partial(self) -> None:
+        """Type the routines of files that did not parse (their findings are not reported:
+        ``krl check`` reports only the syntax errors of such files)."""
+        if self.ws.global_scope is None:
+            return
+        sink = DiagnosticSink()
+        checker = Checker(sink, Declarer(sink, True), True)
+        for f in self.ws.files:
+            if f.ok:
+                continue
+            for r in f.module.routines:
+                sc = self.ws.routine_scope(r)
+                if sc is not None:
+                    checker.check_routine(r, sc, f.path)
+        for f in self.ws.files:
+            if not f.ok and f.module.data is not None and f.scope is not None:
+                checker.check_datalist(f.module.data, f.scope)
+
+    def diagnostics_for(self, path: str) -> list[Diagnostic]:
+        """The workspace's diagnostics of one file, with the root's krl.toml applied."""
+        diags = [d for d in self.ws.diagnostics if d.path == path]
+        try:
+            from krl.semantics.config import config_for  # noqa: PLC0415
+            return config_for(self.root, path).apply(diags)
+        except Exception:  # noqa: BLE001 - a bad krl.toml: `krl check` says why; here all are shown
+            return diags
+
+
+def build_analysis(root: str, parsed: list[Parsed]) -> Analysis:
+    """Link and check parsed files as one workspace (krl/workspace.py ``Workspace.check``)."""
+    ws = Workspace(root)
+    an = Analysis(root, ws)
+    from krl.lsp.text import split_lines  # noqa: PLC0415
+    for p in parsed:
+        sf = SourceFile(p.path, p.module, p.ok, p.status)
+        ws.files.append(sf)
+        ws.sink.extend(p.diagnostics)
+        if not p.ok:
+            if p.unreadable:
+                ws.unreadable = True
+            ws.failed_words.update(p.failed_words)
+        an.files[p.path] = FileInfo(p.path, p, sf, split_lines(p.text))
+    ws.check()
+    an.annotate_partial()
+    return an

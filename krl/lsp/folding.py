@@ -1,0 +1,50 @@
+"""Folding ranges: ``;FOLD`` ... ``;ENDFOLD`` sections and blocks (routines, IF, FOR, WHILE,
+LOOP, REPEAT, SWITCH, SPLINE, data lists). Blocks come from the block scan of the syntax layer
+(krl/syntax/blocks.py ``scan``: each closer matched with its opener), which works on files with
+syntax errors too. A block's range ends on the line before its closer, so ENDIF stays visible; a
+FOLD section's range ends on its ``;ENDFOLD`` line (the section folds away as on the KUKA pendant)."""
+
+from __future__ import annotations
+
+import re
+
+from lsprotocol import types as L
+
+from krl.syntax.blocks import Line, scan
+from krl.lsp.text import line_tokens
+
+FOLD = re.compile(r"^\s*;\s*FOLD\b(.*)", re.IGNORECASE)
+ENDFOLD = re.compile(r"^\s*;\s*ENDFOLD\b", re.IGNORECASE)
+
+
+def fold_sections(lines: list[str]) -> list[tuple[int, int, str]]:
+    """(first line, ENDFOLD line, title) of every FOLD section, 1-based, nested ones included."""
+    out: list[tuple[int, int, str]] = []
+    stack: list[tuple[int, str]] = []
+    for n, text in enumerate(lines, start=1):
+        m = FOLD.match(text)
+        if m:
+            title = m.group(1).split(";%", 1)[0].strip() or "FOLD"
+            stack.append((n, title))
+        elif ENDFOLD.match(text) and stack:
+            start, title = stack.pop()
+            out.append((start, n, title))
+    return out
+
+
+def block_pairs(lines: list[str]) -> list[tuple[int, int]]:
+    """(opener line, closer line), 1-based, of the matched blocks."""
+    toks = [Line(n, t) for n, text in enumerate(lines, start=1) if (t := line_tokens(text, n))]
+    res = scan(toks)
+    return sorted((opener, closer) for closer, opener in res.matched.items())
+
+
+def folding_ranges(lines: list[str]) -> list[L.FoldingRange]:
+    out = []
+    for start, end, _title in fold_sections(lines):
+        if end > start:
+            out.append(L.FoldingRange(start_line=start - 1, end_line=end - 1, kind=L.FoldingRangeKind.Region))
+    for opener, closer in block_pairs(lines):
+        if closer - 1 > opener:
+            out.append(L.FoldingRange(start_line=opener - 1, end_line=closer - 2))
+    return out

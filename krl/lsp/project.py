@@ -1,0 +1,124 @@
+"""Open buffers over disk files, and one checked analysis per workspace root.
+
+The text of an open buffer wins over the file on disk (unsaved changes are what the user sees).
+Files that are not open are read with krl.syntax.source.read_source (the project's one decoding
+function: UTF-8 with or without BOM, else cp1252) and re-read when their size or modification
+time changes (a file changed by another program, a ``git checkout``). Every analysis re-checks
+the whole workspace from the cached parses; only changed buffers and files are parsed again.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import time
+from pathlib import Path
+
+from krl.lsp.analysis import Analysis, build_analysis
+from krl.lsp.parsing import ParseCache, Parsed, parse_disk
+from krl.lsp.roots import workspace_of
+from krl.syntax.source import read_source
+
+_SCHEME = re.compile(r"^[A-Za-z][A-Za-z0-9+.-]+:")
+ROOTS_TTL_S = 2.0        # seconds a workspace's file list is trusted before it is listed again
+
+
+def norm(path: str | Path) -> str:
+    """One spelling per file: absolute, normalised (symbolic links kept). A document that is
+    not a file (``untitled:...``) keeps its URI as its name."""
+    p = str(path)
+    if is_uri(p):
+        return p
+    return os.path.normpath(os.path.abspath(p))
+
+
+def is_uri(name: str) -> bool:
+    """True for a document name that is a URI, not a file path (``untitled:Untitled-1``)."""
+    return bool(_SCHEME.match(name)) and not os.path.isabs(name)
+
+
+class Project:
+    """Documents and analyses of one editor session."""
+
+    def __init__(self) -> None:
+        self.docs: dict[str, str] = {}          # open buffers: path -> text
+        self.folders: list[Path] = []           # the editor's workspace folders
+        self.parser = ParseCache()
+        self._buffers: dict[str, tuple[str, Parsed]] = {}
+        self._disk: dict[str, tuple[int, int, Parsed]] = {}
+        self._roots: dict[str, tuple[float, str, list[str]]] = {}
+        self.analyses: dict[str, Analysis] = {}  # root -> latest analysis
+        self._root_of: dict[str, str] = {}       # path -> root of its latest analysis
+
+    # ------------------------------------------------------------------ documents
+
+    def open(self, path: str, text: str) -> None:
+        self.docs[norm(path)] = text
+
+    def change(self, path: str, text: str) -> None:
+        self.docs[norm(path)] = text
+
+    def close(self, path: str) -> None:
+        p = norm(path)
+        self.docs.pop(p, None)
+        self._buffers.pop(p, None)
+
+    def files_changed(self) -> None:
+        """Files were created or deleted on disk: list the workspaces again."""
+        self._roots.clear()
+
+    # ------------------------------------------------------------------ analysis
+
+    def workspace_files(self, path: str, docs: dict[str, str] | None = None) -> tuple[str, list[str]]:
+        p = norm(path)
+        if is_uri(p):
+            return p, [p]       # not a file: checked on its own
+        got = self._roots.get(p)
+        now = time.monotonic()
+        if got is None or now - got[0] > ROOTS_TTL_S:
+            root, files = workspace_of(Path(p), self.folders)
+            got = (now, norm(root), [norm(f) for f in files])
+            self._roots[p] = got
+        root, files = got[1], list(got[2])
+        seen = set(files)
+        for d in (docs if docs is not None else self.docs):      # open buffers not (yet) on disk that belong to this workspace
+            if d not in seen and (d == root or d.startswith(root.rstrip(os.sep) + os.sep)) and \
+                    Path(root).is_dir() and d.lower().endswith((".src", ".dat", ".sub")):
+                files.append(d)
+        return root, sorted(set(files))
+
+    def parsed(self, path: str, docs: dict[str, str] | None = None) -> Parsed:
+        """The parse of one file: its open buffer, else its disk content (cached)."""
+        text = (docs if docs is not None else self.docs).get(path)
+        if text is not None:
+            got = self._buffers.get(path)
+            if got is None or got[0] is not text and got[0] != text:
+                got = (text, self.parser.parse(path, text))
+                self._buffers[path] = got
+            return got[1]
+        try:
+            st = os.stat(path)
+            stamp = (st.st_mtime_ns, st.st_size)
+        except OSError:
+            stamp = (-1, -1)
+        got = self._disk.get(path)
+        if got is None or (got[0], got[1]) != stamp:
+            got = (*stamp, parse_disk(read_source(path)))
+            self._disk[path] = got
+        return got[2]
+
+    def analyze(self, path: str, docs: dict[str, str] | None = None) -> Analysis:
+        """Check the workspace of `path` with the buffers `docs` (default: the open ones); the
+        result is remembered as the latest analysis of that workspace."""
+        docs = dict(self.docs) if docs is None else docs
+        root, files = self.workspace_files(path, docs)
+        an = build_analysis(root, [self.parsed(f, docs) for f in files])
+        self.analyses[root] = an
+        for f in files:
+            self._root_of[f] = root
+        return an
+
+    def latest(self, path: str) -> Analysis | None:
+        """The latest analysis holding `path`, or None."""
+        root = self._root_of.get(norm(path))
+        return self.analyses.get(root) if root is not None else None

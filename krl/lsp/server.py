@@ -1,0 +1,338 @@
+"""The pygls language server: handlers for the LSP requests and notifications.
+
+Analysis (parse, link, check: krl/lsp/project.py) runs in one worker thread, debounced after
+each change (:data:`DEBOUNCE_S`); requests wait for the analysis of their file when it is out of
+date. An exception in a handler is logged (stderr and ``window/logMessage``) and answered with an
+empty result: it never ends the server.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import functools
+import importlib.util
+import logging
+import os
+from concurrent.futures import ThreadPoolExecutor
+
+from lsprotocol import types as L
+from pygls.lsp.server import LanguageServer
+from pygls.uris import from_fs_path, to_fs_path
+
+from krl import __version__
+from krl.lsp import complete as _complete
+from krl.lsp import folding as _folding
+from krl.lsp import hover as _hover
+from krl.lsp import navigate as _nav
+from krl.lsp import outline as _outline
+from krl.lsp.analysis import Analysis
+from krl.lsp.convert import lsp_diagnostic
+from krl.lsp.project import Project, norm
+from krl.lsp.text import from_position, to_range
+
+log = logging.getLogger("krl.lsp")
+DEBOUNCE_S = 0.05          # seconds after the last change before the analysis starts
+
+
+def path_of(uri: str) -> str:
+    """The file path of a ``file:`` URI; other URIs (``untitled:``) name themselves."""
+    if uri.startswith("file:"):
+        p = to_fs_path(uri)
+        if p:
+            return norm(p)
+    return uri
+
+
+def uri_of(path: str) -> str:
+    return from_fs_path(path) if os.path.isabs(path) else path
+
+
+def formatter():
+    """krl.fmt.format_text when the formatter is installed, else None (imported lazily)."""
+    try:
+        if importlib.util.find_spec("krl.fmt") is None:
+            return None
+        from krl.fmt import format_text  # noqa: PLC0415
+        return format_text
+    except Exception:  # noqa: BLE001 - a formatter that cannot be imported is not offered
+        return None
+
+
+class KrlLanguageServer(LanguageServer):
+    """pygls server with the project state (see the module docstring)."""
+
+    def __init__(self) -> None:
+        super().__init__("krl-lsp", __version__)
+        self.project = Project()
+        self.debounce_s = DEBOUNCE_S
+        self._executor = ThreadPoolExecutor(max_workers=1, thread_name_prefix="krl-analysis")
+        self._lock: asyncio.Lock | None = None
+        self._pending: dict[str, asyncio.Task] = {}
+        self._dirty: set[str] = set()
+        self._versions: dict[str, int | None] = {}
+
+    @property
+    def lock(self) -> asyncio.Lock:
+        if self._lock is None:
+            self._lock = asyncio.Lock()
+        return self._lock
+
+    def codec(self):
+        try:
+            return self.workspace.position_codec
+        except Exception:  # noqa: BLE001 - before initialize
+            return None
+
+    def folders(self) -> list:
+        from pathlib import Path  # noqa: PLC0415
+        out = []
+        try:
+            for f in self.workspace.folders.values():
+                p = to_fs_path(f.uri)
+                if p:
+                    out.append(Path(norm(p)))
+            if not out and self.workspace.root_path:
+                out.append(Path(norm(self.workspace.root_path)))
+        except Exception:  # noqa: BLE001
+            pass
+        return out
+
+    # ------------------------------------------------------------------ analysis
+
+    async def _analyze(self, path: str) -> Analysis | None:
+        async with self.lock:
+            self._dirty.discard(path)
+            self.project.folders = self.folders()
+            docs = dict(self.project.docs)
+            loop = asyncio.get_running_loop()
+            try:
+                an = await loop.run_in_executor(self._executor, self.project.analyze, path, docs)
+            except Exception as exc:  # noqa: BLE001
+                log.exception("analysis of %s failed", path)
+                self._report(f"krl lsp: analysis of {path} failed: {type(exc).__name__}: {exc}")
+                return None
+            self.publish(an)
+            return an
+
+    def publish(self, an: Analysis) -> None:
+        codec = self.codec()
+        for path, fi in an.files.items():
+            if path not in self.project.docs:
+                continue
+            diags = [lsp_diagnostic(d, fi.lines, codec, uri_of) for d in an.diagnostics_for(path)]
+            self.text_document_publish_diagnostics(L.PublishDiagnosticsParams(
+                uri=uri_of(path), diagnostics=diags, version=self._versions.get(path)))
+
+    def schedule(self, path: str, delay: float | None = None) -> None:
+        """Analyse the workspace of `path` after the debounce delay (a newer change restarts it)."""
+        self._dirty.add(path)
+        old = self._pending.pop(path, None)
+        if old is not None and not old.done():
+            old.cancel()
+
+        async def later() -> None:
+            try:
+                await asyncio.sleep(self.debounce_s if delay is None else delay)
+            except asyncio.CancelledError:
+                return
+            self._pending.pop(path, None)
+            await self._analyze(path)
+
+        self._pending[path] = asyncio.ensure_future(later())
+
+    async def fresh(self, path: str) -> Analysis | None:
+        """The analysis holding `path`, brought up to date with the buffers first."""
+        if path in self._dirty or self.project.latest(path) is None:
+            task = self._pending.pop(path, None)
+            if task is not None:
+                task.cancel()
+            return await self._analyze(path)
+        return self.project.latest(path)
+
+    def _report(self, message: str) -> None:
+        try:
+            self.window_log_message(L.LogMessageParams(type=L.MessageType.Error, message=message))
+        except Exception:  # noqa: BLE001
+            pass
+
+
+def guarded(empty=None):
+    """Run a handler; an exception is logged and answered with `empty`."""
+    def wrap(fn):
+        @functools.wraps(fn)
+        async def run(ls: KrlLanguageServer, params):
+            try:
+                return await fn(ls, params)
+            except Exception as exc:  # noqa: BLE001
+                log.exception("handler %s failed", fn.__name__)
+                ls._report(f"krl lsp: {fn.__name__} failed: {type(exc).__name__}: {exc}")
+                return empty() if callable(empty) else empty
+        return run
+    return wrap
+
+
+def create_server() -> KrlLanguageServer:
+    """A server with every feature registered (formatting only when krl.fmt is installed)."""
+    server = KrlLanguageServer()
+
+    @server.feature(L.INITIALIZED)
+    @guarded()
+    async def initialized(ls: KrlLanguageServer, params: L.InitializedParams):
+        caps = ls.client_capabilities
+        dyn = getattr(getattr(getattr(caps, "workspace", None), "did_change_watched_files", None),
+                      "dynamic_registration", False)
+        if dyn:
+            watchers = [L.FileSystemWatcher(glob_pattern=g) for g in ("**/*.src", "**/*.dat", "**/*.sub",
+                                                                       "**/*.SRC", "**/*.DAT", "**/*.SUB")]
+            await ls.client_register_capability_async(L.RegistrationParams(registrations=[L.Registration(
+                id="krl-watch", method=L.WORKSPACE_DID_CHANGE_WATCHED_FILES,
+                register_options=L.DidChangeWatchedFilesRegistrationOptions(watchers=watchers))]))
+
+    @server.feature(L.TEXT_DOCUMENT_DID_OPEN)
+    @guarded()
+    async def did_open(ls: KrlLanguageServer, params: L.DidOpenTextDocumentParams):
+        path = path_of(params.text_document.uri)
+        ls.project.open(path, params.text_document.text)
+        ls._versions[path] = params.text_document.version
+        ls.schedule(path, 0.0)
+
+    @server.feature(L.TEXT_DOCUMENT_DID_CHANGE)
+    @guarded()
+    async def did_change(ls: KrlLanguageServer, params: L.DidChangeTextDocumentParams):
+        path = path_of(params.text_document.uri)
+        doc = ls.workspace.get_text_document(params.text_document.uri)
+        ls.project.change(path, doc.source)
+        ls._versions[path] = params.text_document.version
+        ls.schedule(path)
+
+    @server.feature(L.TEXT_DOCUMENT_DID_SAVE)
+    @guarded()
+    async def did_save(ls: KrlLanguageServer, params: L.DidSaveTextDocumentParams):
+        ls.project.files_changed()
+        ls.schedule(path_of(params.text_document.uri))
+
+    @server.feature(L.TEXT_DOCUMENT_DID_CLOSE)
+    @guarded()
+    async def did_close(ls: KrlLanguageServer, params: L.DidCloseTextDocumentParams):
+        path = path_of(params.text_document.uri)
+        ls.project.close(path)
+        ls._versions.pop(path, None)
+        task = ls._pending.pop(path, None)
+        if task is not None:
+            task.cancel()
+        ls.text_document_publish_diagnostics(L.PublishDiagnosticsParams(uri=params.text_document.uri, diagnostics=[]))
+        for other in list(ls.project.docs):     # the others now see the file on disk again
+            ls.schedule(other)
+            break
+
+    @server.feature(L.WORKSPACE_DID_CHANGE_WATCHED_FILES)
+    @guarded()
+    async def watched(ls: KrlLanguageServer, params: L.DidChangeWatchedFilesParams):
+        ls.project.files_changed()
+        for path in list(ls.project.docs):
+            ls.schedule(path)
+
+    async def place(ls: KrlLanguageServer, td, pos: L.Position):
+        path = path_of(td.uri)
+        an = await ls.fresh(path)
+        if an is None or path not in an.files:
+            return None, None, 0, 0
+        line, col = from_position(an.files[path].lines, pos, ls.codec())
+        return an, path, line, col
+
+    def location(ls: KrlLanguageServer, an: Analysis, p: _nav.Place) -> L.Location:
+        return L.Location(uri=uri_of(p.path), range=to_range(an.files[p.path].lines, p.line, p.column, p.length, ls.codec()))
+
+    @server.feature(L.TEXT_DOCUMENT_DEFINITION)
+    @guarded()
+    async def definition(ls: KrlLanguageServer, params: L.DefinitionParams):
+        an, path, line, col = await place(ls, params.text_document, params.position)
+        if an is None:
+            return None
+        t = _nav.resolve(an, path, line, col)
+        p = _nav.definition(an, t) if t is not None else None
+        return [location(ls, an, p)] if p is not None else None
+
+    @server.feature(L.TEXT_DOCUMENT_REFERENCES)
+    @guarded(list)
+    async def references(ls: KrlLanguageServer, params: L.ReferenceParams):
+        an, path, line, col = await place(ls, params.text_document, params.position)
+        if an is None:
+            return []
+        t = _nav.resolve(an, path, line, col)
+        if t is None:
+            return []
+        include = params.context.include_declaration if params.context is not None else True
+        return [location(ls, an, p) for p in _nav.references(an, t, include)]
+
+    @server.feature(L.TEXT_DOCUMENT_HOVER)
+    @guarded()
+    async def hover(ls: KrlLanguageServer, params: L.HoverParams):
+        an, path, line, col = await place(ls, params.text_document, params.position)
+        if an is None:
+            return None
+        t = _nav.resolve(an, path, line, col)
+        if t is None:
+            return None
+        text = _hover.hover_text(an, t)
+        return L.Hover(contents=L.MarkupContent(kind=L.MarkupKind.Markdown, value=text)) if text else None
+
+    @server.feature(L.TEXT_DOCUMENT_DOCUMENT_SYMBOL)
+    @guarded(list)
+    async def document_symbol(ls: KrlLanguageServer, params: L.DocumentSymbolParams):
+        path = path_of(params.text_document.uri)
+        an = await ls.fresh(path)
+        if an is None or path not in an.files:
+            return []
+        return _outline.document_symbols(an, path, ls.codec())
+
+    @server.feature(L.WORKSPACE_SYMBOL)
+    @guarded(list)
+    async def workspace_symbol(ls: KrlLanguageServer, params: L.WorkspaceSymbolParams):
+        for path in list(ls._dirty):
+            await ls.fresh(path)
+        return _outline.workspace_symbols(list(ls.project.analyses.values()), params.query or "", uri_of, ls.codec())
+
+    @server.feature(L.TEXT_DOCUMENT_FOLDING_RANGE)
+    @guarded(list)
+    async def folding_range(ls: KrlLanguageServer, params: L.FoldingRangeParams):
+        path = path_of(params.text_document.uri)
+        an = await ls.fresh(path)
+        if an is None or path not in an.files:
+            return []
+        return _folding.folding_ranges(an.files[path].lines)
+
+    @server.feature(L.TEXT_DOCUMENT_COMPLETION, L.CompletionOptions(trigger_characters=[".", "$"]))
+    @guarded()
+    async def completion(ls: KrlLanguageServer, params: L.CompletionParams):
+        an, path, line, col = await place(ls, params.text_document, params.position)
+        if an is None:
+            return None
+        return L.CompletionList(is_incomplete=False, items=_complete.complete(an, path, line, col))
+
+    fmt = formatter()
+    if fmt is not None:
+        @server.feature(L.TEXT_DOCUMENT_FORMATTING)
+        @guarded()
+        async def formatting(ls: KrlLanguageServer, params: L.DocumentFormattingParams):
+            doc = ls.workspace.get_text_document(params.text_document.uri)
+            text = doc.source
+            try:
+                new = fmt(text)
+            except Exception as exc:  # noqa: BLE001 - unparsable input: no edit, say why
+                ls._report(f"krl lsp: not formatted: {type(exc).__name__}: {exc}")
+                return None
+            if new == text:
+                return []
+            lines = text.split("\n")
+            end = L.Position(line=len(lines) - 1, character=len(lines[-1].encode("utf-16-le")) // 2)
+            return [L.TextEdit(range=L.Range(start=L.Position(line=0, character=0), end=end), new_text=new)]
+
+    return server
+
+
+def serve(log_file: str | None = None) -> None:
+    """Run the server on stdin/stdout until the client says exit."""
+    logging.basicConfig(filename=log_file, level=logging.INFO if log_file else logging.WARNING,
+                        format="%(asctime)s %(name)s %(levelname)s %(message)s")
+    create_server().start_io()
