@@ -62,6 +62,13 @@ class Project:
         p = norm(path)
         self.docs.pop(p, None)
         self._buffers.pop(p, None)
+        # a workspace without open documents is forgotten (workspace symbols, memory)
+        for root, an in list(self.analyses.items()):
+            if not any(d in an.files for d in self.docs):
+                del self.analyses[root]
+                for f in an.files:
+                    if self._root_of.get(f) == root:
+                        del self._root_of[f]
 
     def files_changed(self) -> None:
         """Files were created or deleted on disk: list the workspaces again."""

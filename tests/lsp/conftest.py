@@ -1,0 +1,101 @@
+"""A pytest-lsp client driving `python -m krl.lsp` over stdio, and helpers to open files and
+wait for their diagnostics. The fixture backup (fixtures/backup: R1/Program, R1/System/$config.dat)
+is small enough that every expected position in the tests is counted by hand from its text."""
+
+from __future__ import annotations
+
+import asyncio
+import shutil
+import sys
+from pathlib import Path
+
+import pytest
+import pytest_lsp
+from lsprotocol import types as L
+from pytest_lsp import ClientServerConfig, LanguageClient
+
+FIXTURES = Path(__file__).parent / "fixtures"
+BACKUP = FIXTURES / "backup"
+PROGRAM = BACKUP / "R1" / "Program"
+SYSTEM = BACKUP / "R1" / "System"
+WAIT_S = 60.0          # generous: the machine is shared; no test measures time
+
+
+def server_config() -> ClientServerConfig:
+    return ClientServerConfig(server_command=[sys.executable, "-m", "krl.lsp"])
+
+
+def init_params(root: Path) -> L.InitializeParams:
+    caps = L.ClientCapabilities(
+        workspace=L.WorkspaceClientCapabilities(
+            did_change_watched_files=L.DidChangeWatchedFilesClientCapabilities(dynamic_registration=False),
+            workspace_folders=True),
+        text_document=L.TextDocumentClientCapabilities(
+            document_symbol=L.DocumentSymbolClientCapabilities(hierarchical_document_symbol_support=True),
+            publish_diagnostics=L.PublishDiagnosticsClientCapabilities(related_information=True)))
+    return L.InitializeParams(capabilities=caps, root_uri=root.as_uri(),
+                              workspace_folders=[L.WorkspaceFolder(uri=root.as_uri(), name=root.name)])
+
+
+@pytest_lsp.fixture(scope="module", config=server_config())
+async def client(lsp_client: LanguageClient):
+    lsp_client.init_result = await lsp_client.initialize_session(init_params(BACKUP))
+    yield
+    await lsp_client.shutdown_session()
+
+
+async def wait_diagnostics(client: LanguageClient, uri: str) -> list[L.Diagnostic]:
+    """The next diagnostics published for `uri` (call after clearing client.diagnostics[uri])."""
+    async def loop():
+        while uri not in client.diagnostics:
+            await client.wait_for_notification(L.TEXT_DOCUMENT_PUBLISH_DIAGNOSTICS)
+        return list(client.diagnostics[uri])
+    return await asyncio.wait_for(loop(), WAIT_S)
+
+
+async def open_doc(client: LanguageClient, path: Path, text: str | None = None, version: int = 1) -> list[L.Diagnostic]:
+    """Open `path` (with `text` as the unsaved buffer, else its content) and return its first diagnostics."""
+    uri = path.as_uri()
+    client.diagnostics.pop(uri, None)
+    if text is None:
+        text = path.read_bytes().decode("utf-8", errors="replace")
+    client.text_document_did_open(L.DidOpenTextDocumentParams(
+        text_document=L.TextDocumentItem(uri=uri, language_id="krl", version=version, text=text)))
+    return await wait_diagnostics(client, uri)
+
+
+async def change_doc(client: LanguageClient, path: Path, text: str, version: int) -> list[L.Diagnostic]:
+    uri = path.as_uri()
+    client.diagnostics.pop(uri, None)
+    client.text_document_did_change(L.DidChangeTextDocumentParams(
+        text_document=L.VersionedTextDocumentIdentifier(uri=uri, version=version),
+        content_changes=[L.TextDocumentContentChangeWholeDocument(text=text)]))
+    return await wait_diagnostics(client, uri)
+
+
+def close_doc(client: LanguageClient, path: Path) -> None:
+    client.text_document_did_close(L.DidCloseTextDocumentParams(text_document=L.TextDocumentIdentifier(uri=path.as_uri())))
+
+
+def summary(diags) -> list[tuple[str, int, int, str]]:
+    """(code, 0-based line, 0-based character, message), sorted."""
+    return sorted((str(d.code), d.range.start.line, d.range.start.character, d.message) for d in diags)
+
+
+def pos(line: int, character: int) -> L.Position:
+    return L.Position(line=line, character=character)
+
+
+def where(loc) -> tuple[str, int, int, int, int]:
+    """(file name, start line, start char, end line, end char) of a Location."""
+    from urllib.parse import unquote, urlparse  # noqa: PLC0415
+    r = loc.range
+    return (Path(unquote(urlparse(loc.uri).path)).name, r.start.line, r.start.character, r.end.line, r.end.character)
+
+
+@pytest.fixture
+def backup_copy(tmp_path: Path) -> Path:
+    """A writable copy of the fixture backup."""
+    dst = tmp_path / "KRC"
+    shutil.copytree(BACKUP, dst)
+    return dst

@@ -1,0 +1,191 @@
+"""krl lsp driven over stdio by pytest-lsp: one test (at least) per feature. Every expected
+position is counted by hand from the fixture backup (fixtures/backup), 0-based as LSP counts:
+main.src line 11 is ``    p.x = gripper.mass`` (p at 4, x at 6, gripper at 10, mass at 18), and so on."""
+
+from __future__ import annotations
+
+import importlib.util
+import json
+import subprocess
+import sys
+
+import pytest
+from lsprotocol import types as L
+
+from tests.lsp.conftest import (BACKUP, PROGRAM, SYSTEM, change_doc, close_doc, open_doc, pos, summary,
+                                wait_diagnostics, where)
+
+pytestmark = pytest.mark.asyncio(loop_scope="module")
+
+MAIN = PROGRAM / "main.src"
+MAIN_TEXT = MAIN.read_text()
+
+
+def td(path) -> L.TextDocumentIdentifier:
+    return L.TextDocumentIdentifier(uri=path.as_uri())
+
+
+async def definition(client, path, line, char):
+    got = await client.text_document_definition_async(L.DefinitionParams(text_document=td(path), position=pos(line, char)))
+    return [where(x) for x in (got or [])]
+
+
+async def references(client, path, line, char, decl=True):
+    got = await client.text_document_references_async(L.ReferenceParams(
+        text_document=td(path), position=pos(line, char), context=L.ReferenceContext(include_declaration=decl)))
+    return sorted(where(x) for x in (got or []))
+
+
+async def test_diagnostics_resolve_config_and_globals(client):
+    # main.src uses counter/gripper/run_mode ($config.dat), pose_t and helper (GLOBAL in tools.*),
+    # local_count (main.dat): with the backup root found, nothing is undeclared.
+    diags = await open_doc(client, MAIN)
+    assert summary(diags) == []
+
+
+async def test_diagnostics_unsaved_buffer_on_change_same_as_krl_check(client, backup_copy):
+    path = backup_copy / "R1" / "Program" / "main.src"
+    broken = MAIN_TEXT.replace("  counter = 0\n", "  countr = 0\n")
+    diags = await open_doc(client, path, broken)          # the disk file is unchanged: the buffer wins
+    assert summary(diags) == [("E101", 8, 2, "'countr' is not declared")]
+    assert diags[0].range.end == pos(8, 8)                # the whole name
+    assert diags[0].severity == L.DiagnosticSeverity.Error
+    # the same text checked by `krl check`: same codes, places and messages
+    path.write_text(broken)
+    out = subprocess.run([sys.executable, "-m", "krl.cli", "check", "--format", "json", str(backup_copy)],
+                         capture_output=True, text=True, check=False)
+    cli = [d for ws in map(json.loads, out.stdout.splitlines()) for d in ws["diagnostics"] if d["path"].endswith("main.src")]
+    assert sorted((d["code"], d["line"] - 1, d["column"] - 1, d["message"]) for d in cli) == summary(diags)
+    # on change: fixed, then a syntax error (IF without THEN on line 13)
+    assert summary(await change_doc(client, path, MAIN_TEXT, 2)) == []
+    no_then = MAIN_TEXT.replace("IF run_mode == #auto THEN", "IF run_mode == #auto")
+    diags = await change_doc(client, path, no_then, 3)
+    assert [(str(d.code), d.range.start.line) for d in diags] == [("E012", 13)]
+    path.write_text(no_then)
+    out = subprocess.run([sys.executable, "-m", "krl.cli", "check", "--format", "json", str(backup_copy)],
+                         capture_output=True, text=True, check=False)
+    cli = [d for ws in map(json.loads, out.stdout.splitlines()) for d in ws["diagnostics"] if d["path"].endswith("main.src")]
+    assert [(d["code"], d["line"] - 1, d["message"]) for d in cli] == [(str(d.code), d.range.start.line, d.message) for d in diags]
+    close_doc(client, path)
+
+
+async def test_definition_routine_across_files_global_and_ext(client):
+    await open_doc(client, MAIN)
+    # helper(local_count) on line 14 -> GLOBAL DEF helper in tools.src line 3, chars 11..17
+    assert await definition(client, MAIN, 14, 5) == [("tools.src", 3, 11, 3, 17)]
+    # the EXT declaration in main.dat (line 1, `  EXT helper(INT :IN)`) -> the same routine
+    assert await definition(client, PROGRAM / "main.dat", 1, 7) == [("tools.src", 3, 11, 3, 17)]
+
+
+async def test_definition_variables_local_module_config(client):
+    await open_doc(client, MAIN)
+    assert await definition(client, MAIN, 10, 24) == [("main.src", 2, 11, 2, 12)]          # i: local
+    assert await definition(client, MAIN, 14, 12) == [("main.dat", 2, 11, 2, 22)]         # local_count: module .dat
+    assert await definition(client, MAIN, 8, 2) == [("$config.dat", 1, 11, 1, 18)]        # counter: $config.dat
+
+
+async def test_definition_types_components_enum(client):
+    await open_doc(client, MAIN)
+    assert await definition(client, MAIN, 3, 8) == [("tools.dat", 1, 15, 1, 21)]          # pose_t
+    assert await definition(client, MAIN, 11, 6) == [("tools.dat", 1, 27, 1, 28)]         # p.x -> component x
+    assert await definition(client, MAIN, 11, 19) == [("$config.dat", 2, 20, 2, 24)]      # gripper.mass
+    assert await definition(client, MAIN, 13, 19) == [("$config.dat", 3, 14, 3, 18)]      # #auto of mode_t
+
+
+async def test_definition_label_and_interrupt_handler(client):
+    await open_doc(client, MAIN)
+    assert await definition(client, MAIN, 16, 8) == [("main.src", 17, 2, 17, 6)]          # GOTO done
+    assert await definition(client, MAIN, 5, 36) == [("main.src", 21, 4, 21, 11)]         # DO on_stop( )
+
+
+async def test_references_variable_and_routine(client):
+    await open_doc(client, MAIN)
+    assert await references(client, MAIN, 8, 3) == sorted([
+        ("$config.dat", 1, 11, 1, 18), ("main.src", 8, 2, 8, 9), ("main.src", 10, 4, 10, 11), ("main.src", 10, 14, 10, 21)])
+    assert await references(client, MAIN, 8, 3, decl=False) == sorted([
+        ("main.src", 8, 2, 8, 9), ("main.src", 10, 4, 10, 11), ("main.src", 10, 14, 10, 21)])
+    assert await references(client, MAIN, 14, 4) == sorted([
+        ("main.dat", 1, 6, 1, 12), ("main.src", 14, 4, 14, 10), ("tools.src", 3, 11, 3, 17)])
+    # a component: x of pose_t, declared in tools.dat, used in main.src
+    assert await references(client, MAIN, 11, 6) == sorted([("main.src", 11, 6, 11, 7), ("tools.dat", 1, 27, 1, 28)])
+
+
+async def test_hover_variable_and_system_variable(client):
+    await open_doc(client, MAIN)
+    h = await client.text_document_hover_async(L.HoverParams(text_document=td(MAIN), position=pos(8, 4)))
+    assert "DECL INT counter" in h.contents.value and "$config.dat" in h.contents.value
+    # $OUT (line 18): BOOL[8192]; sysvars.yaml says writing it stops the advance run
+    h = await client.text_document_hover_async(L.HoverParams(text_document=td(MAIN), position=pos(18, 3)))
+    assert "BOOL" in h.contents.value and "8192" in h.contents.value
+    assert "writing it stops the advance run" in h.contents.value
+    # a component: its type and its structure
+    h = await client.text_document_hover_async(L.HoverParams(text_document=td(MAIN), position=pos(11, 19)))
+    assert "REAL mass" in h.contents.value and "tool_t" in h.contents.value
+
+
+async def test_document_symbols_hierarchical(client):
+    await open_doc(client, MAIN)
+    syms = await client.text_document_document_symbol_async(L.DocumentSymbolParams(text_document=td(MAIN)))
+    shape = [(s.name, s.kind, s.range.start.line, s.range.end.line,
+              [(c.name, c.kind, c.range.start.line, c.range.end.line) for c in s.children or []]) for s in syms]
+    assert shape == [
+        ("main", L.SymbolKind.Function, 1, 19, [("i", L.SymbolKind.Variable, 2, 2), ("p", L.SymbolKind.Variable, 3, 3),
+                                                ("INIT", L.SymbolKind.Namespace, 4, 7)]),
+        ("on_stop", L.SymbolKind.Function, 21, 23, []),
+    ]
+    assert syms[0].selection_range.start == pos(1, 4)
+
+
+async def test_workspace_symbols(client):
+    await open_doc(client, MAIN)
+    got = await client.workspace_symbol_async(L.WorkspaceSymbolParams(query="help"))
+    assert sorted((s.name, where(s.location)) for s in got) == [
+        ("helper", ("main.dat", 1, 6, 1, 12)), ("helper", ("tools.src", 3, 11, 3, 17))]
+
+
+async def test_folding_ranges(client):
+    await open_doc(client, MAIN)
+    got = await client.text_document_folding_range_async(L.FoldingRangeParams(text_document=td(MAIN)))
+    assert sorted((f.start_line, f.end_line, f.kind) for f in got) == sorted([
+        (4, 7, L.FoldingRangeKind.Region),      # ;FOLD INIT .. ;ENDFOLD
+        (1, 18, None),                          # DEF main .. (END on 19)
+        (9, 11, None),                          # FOR .. (ENDFOR on 12)
+        (13, 14, None),                         # IF .. (ENDIF on 15)
+        (21, 22, None),                         # DEF on_stop .. (END on 23)
+    ])
+
+
+async def complete(client, path, line, char):
+    got = await client.text_document_completion_async(L.CompletionParams(text_document=td(path), position=pos(line, char)))
+    items = got.items if isinstance(got, L.CompletionList) else got or []
+    return {i.label for i in items}
+
+
+async def test_completion_components_after_dot(client):
+    await open_doc(client, MAIN)
+    assert await complete(client, MAIN, 11, 6) == {"x", "y"}            # after `p.` (pose_t)
+    assert await complete(client, MAIN, 11, 18) == {"mass", "id"}       # after `gripper.` (tool_t)
+
+
+async def test_completion_names_keywords_system_variables(client, backup_copy):
+    path = backup_copy / "R1" / "Program" / "main.src"
+    text = MAIN_TEXT.replace("  counter = 0\n", "  cou\n  ENDI\n  $POS_AC\n")
+    await open_doc(client, path, text)
+    assert "counter" in await complete(client, path, 8, 5)               # global from $config.dat
+    assert "ENDIF" in await complete(client, path, 9, 6)                 # keyword
+    sysvars = await complete(client, path, 10, 9)
+    assert "$POS_ACT" in sysvars and all(s.upper().startswith("$POS_AC") for s in sysvars)
+    assert "i" in await complete(client, path, 8, 2)                     # local, empty prefix
+    close_doc(client, path)
+
+
+async def test_formatting_offered_exactly_when_krl_fmt_is_installed(client):
+    has_fmt = importlib.util.find_spec("krl.fmt") is not None
+    assert bool(client.init_result.capabilities.document_formatting_provider) == has_fmt
+    await open_doc(client, MAIN)
+    edits = await client.text_document_formatting_async(L.DocumentFormattingParams(
+        text_document=td(MAIN), options=L.FormattingOptions(tab_size=2, insert_spaces=True))) if has_fmt else None
+    if has_fmt:
+        from krl.fmt import format_text
+        expected = format_text(MAIN_TEXT)
+        assert (edits or []) == [] if expected == MAIN_TEXT else edits[0].new_text == expected
