@@ -2,12 +2,16 @@
 with a cache per routine so that a change re-parses only the routine it touches.
 
 A .src/.sub file is cut before every line that starts a routine (``[GLOBAL] DEF``/``DEFFCT``)
-after the first one; each piece is parsed on its own, preceded by as many empty lines as come
-before it in the file, so its spans and messages carry the file's own line numbers. When every
+after the first one; each piece is parsed on its own, its lexer counting lines from the piece's
+first line, so that its spans carry the file's own line numbers (a piece with a syntax error is
+parsed again preceded by as many empty lines as come before it, so that its messages, which
+quote line numbers, are the file's). When every
 piece parses, the routines of the pieces form the file's Module (the grammar's ``module`` rule is
 a sequence of routines, so the AST is the one of the whole file). When a piece has a syntax
-error the whole file is parsed in one go, so that the messages are exactly those of
-``krl check``. Data lists (.dat) and small files are parsed whole.
+error, its messages are those of the whole file only when the error stays inside the routine:
+when it is the only piece with an error and the block scan of the piece (krl/syntax/blocks.py)
+finds every block closed, END included, the piece's diagnostics are used; otherwise the whole file is parsed in one go, so that the
+messages are exactly those of ``krl check``. Data lists (.dat) and small files are parsed whole.
 """
 
 from __future__ import annotations
@@ -104,6 +108,7 @@ class ParseCache:
         cuts = [0] + starts[1:] + [len(lines)]
         modules: list[N.Module] = []
         diags: list[Diagnostic] = []
+        ok = True
         for a, b in zip(cuts, cuts[1:]):
             piece = "\n".join(lines[a:b])
             if b < len(lines):
@@ -111,12 +116,18 @@ class ParseCache:
             key = (path, a, piece)
             got = self._pieces.get(key)
             if got is None:
-                result = parse_text("\n" * a + piece, path)
+                # the lexer counts lines from the piece's first line: spans are the file's
+                result = parse_text(piece, path, first_line=a + 1)
                 self.pieces_parsed += 1
-                if not result.ok:
-                    return None
                 sink = DiagnosticSink()
-                got = (build_module(result, sink), sink.items)
+                if not result.ok:
+                    # messages quote line numbers and lines: parse the piece at its place
+                    padded = "\n" * a + piece
+                    result = parse_text(padded, path)
+                    if result.status != "syntax_error" or not _closed(lines[a:b], a):
+                        return None
+                    sink.extend(syntax_diagnostics(result, padded))
+                got = (build_module(result, sink), sink.items, result.ok)
                 self._pieces[key] = got
                 while len(self._pieces) > CACHE_PIECES:
                     self._pieces.popitem(last=False)
@@ -124,7 +135,27 @@ class ParseCache:
                 self._pieces.move_to_end(key)
             modules.append(got[0])
             diags.extend(got[1])
+            if not got[2]:
+                if not ok:
+                    return None     # errors in two routines: the whole file says which ones count
+                ok = False
         first = modules[0]
         module = N.Module(path, first.kind, list(first.headers),
                           [r for m in modules for r in m.routines], None, span=first.span)
-        return Parsed(path, text, module, True, "ok", diags)
+        words, _ = _failed("syntax_error", ok, text)
+        sink = DiagnosticSink()
+        sink.extend(diags)
+        return Parsed(path, text, module, ok, "ok" if ok else "syntax_error", sink.items, words)
+
+
+def _closed(lines: list[str], offset: int) -> bool:
+    """True when the block scan of a piece finds no block finding: every block it opens,
+    its routine included, is closed inside it."""
+    from krl.lsp.text import line_tokens  # noqa: PLC0415
+    from krl.syntax.blocks import Line, scan  # noqa: PLC0415
+
+    if any(len(t) > 4096 for t in lines):
+        return False            # line_tokens reads 4 KiB of a line: let the whole file be parsed
+    toks = [Line(offset + n, t) for n, text in enumerate(lines, start=1) if (t := line_tokens(text, offset + n))]
+    res = scan(toks)
+    return res.limit is None and not res.blocks and bool(res.matched)

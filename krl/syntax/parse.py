@@ -137,11 +137,12 @@ def _prepare(text: str) -> str:
 
 
 def parse_text(text: str, path: str = "<string>", bundle: ParserBundle | None = None,
-               keep_tree: bool = True, encoding: str = "") -> ParseResult:
+               keep_tree: bool = True, encoding: str = "", first_line: int = 1) -> ParseResult:
     """Parse KRL text with the start rule `module`.
 
     Returns a ParseResult; ok is True when there is no lexer or syntax error.
-    Never raises for bad input.
+    Never raises for bad input. `first_line`: the line number of the text's first line (a
+    piece of a file, krl/lsp/parsing.py); the lines of tokens and spans count from it.
     """
     bundle = bundle or default_bundle()
     text = _prepare(text)
@@ -149,6 +150,8 @@ def parse_text(text: str, path: str = "<string>", bundle: ParserBundle | None = 
     # Stage 1: SLL with bail-out. Lexer errors are collected here too.
     lex_listener = CollectingErrorListener(bundle, kind="lexer")
     lexer = bundle.lexer_cls(InputStream(text))
+    if first_line != 1:
+        lexer.line = first_line
     lexer.removeErrorListeners()
     lexer.addErrorListener(lex_listener)
     tokens = CommonTokenStream(lexer)

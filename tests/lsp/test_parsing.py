@@ -1,0 +1,81 @@
+"""The per-routine parse cache (krl/lsp/parsing.py) gives exactly the diagnostics and the AST of
+a whole-file parse (what `krl check` reports), on valid files and after edits that break one
+routine, two routines, or a routine's END."""
+
+from __future__ import annotations
+
+import random
+from pathlib import Path
+
+import pytest
+
+from krl.lsp.bench import generate
+from krl.lsp.parsing import MIN_CHUNKED_LINES, ParseCache, parse_disk
+from krl.syntax.source import SourceText, read_source
+
+
+def whole(path: str, text: str):
+    return parse_disk(SourceText(path, text, "utf-8", len(text.encode())))
+
+
+def same(path: str, text: str, cache: ParseCache) -> None:
+    a, b = whole(path, text), cache.parse(path, text)
+    assert [d.as_json() for d in b.diagnostics] == [d.as_json() for d in a.diagnostics]
+    assert (b.ok, b.status) == (a.ok, a.status)
+    assert b.module == a.module            # AST equality (spans and annotations aside)
+    spans = lambda m: [(type(n).__name__, n.span.line, n.span.column, getattr(n, "end_line", 0)) for n in m.walk()]  # noqa: E731
+    assert spans(b.module) == spans(a.module)
+
+
+EDITS = [
+    ("  WAIT SEC 0.3", "  WAIT SEC 0.7"),                 # valid edit
+    ("  WAIT SEC 0.3", "  WAIT SEC"),                     # E0xx inside one routine
+    ("    IF d > 10.0 THEN", "    IF d > 10.0"),          # IF without THEN
+    ("    ENDIF", ""),                                    # a block left open
+    ("END", ""),                                          # a routine without END
+    ("  p = $POS_ACT", "  p = = $POS_ACT"),
+]
+
+
+@pytest.mark.parametrize("old,new", EDITS)
+def test_pieces_match_the_whole_file(old, new):
+    text = generate(700)
+    lines = text.split("\r\n")
+    cache = ParseCache()
+    same("/w/bench.src", text, cache)
+    before = cache.pieces_parsed
+    hits = [i for i, ln in enumerate(lines) if ln == old]
+    lines[hits[len(hits) // 2]] = new
+    same("/w/bench.src", "\r\n".join(lines), cache)
+    # a valid edit or an error inside one routine re-parses one piece only
+    if new.startswith("  WAIT SEC 0.7"):
+        assert cache.pieces_parsed == before + 1
+
+
+def test_errors_in_two_routines_match_the_whole_file():
+    lines = generate(700).split("\r\n")
+    hits = [i for i, ln in enumerate(lines) if ln == "  WAIT SEC 0.3"]
+    lines[hits[0]] = "  WAIT SEC"
+    lines[hits[-1]] = "  x = = 1"
+    same("/w/bench.src", "\r\n".join(lines), ParseCache())
+
+
+@pytest.mark.slow
+def test_pieces_match_the_whole_file_on_the_corpus(shared_corpus: Path):
+    rng = random.Random(7)
+    mutations = [lambda s: s.replace("THEN", ""), lambda s: "", lambda s: s + " = = 1", lambda s: "IF x THEN",
+                 lambda s: s.replace("(", ""), lambda s: "ENDFOR", lambda s: "END", lambda s: "DEF"]
+    checked = 0
+    for p in sorted(shared_corpus.rglob("*.src")):
+        src = read_source(p)
+        lines = src.text.split("\n")
+        if src.status != "ok" or not MIN_CHUNKED_LINES <= len(lines) <= 3000:
+            continue
+        cache = ParseCache()
+        for _ in range(2):
+            ls = list(lines)
+            i = rng.randrange(len(ls))
+            ls[i] = rng.choice(mutations)(ls[i])
+            same(str(p), "\n".join(ls), cache)
+        checked += 1
+    assert checked > 10
