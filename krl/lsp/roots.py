@@ -47,6 +47,10 @@ def backup_root(path: Path) -> Path | None:
     for d in path.parents:
         if _is_backup_base(d):
             found = d.parent if d.name.lower() == "r1" else d
+        else:
+            r1 = _child(d, "r1")       # a file beside R1 (STEU/, KRC/): the backup holding R1
+            if r1 is not None and r1.is_dir() and _is_backup_base(r1):
+                found = d
     return found
 
 
