@@ -70,6 +70,7 @@ class KrlLanguageServer(LanguageServer):
         self._pending: dict[str, asyncio.Task] = {}
         self._dirty: set[str] = set()
         self._versions: dict[str, int | None] = {}
+        self._gen: dict[str, int] = {}          # path -> count of changes (stale-analysis check)
 
     @property
     def lock(self) -> asyncio.Lock:
@@ -101,31 +102,45 @@ class KrlLanguageServer(LanguageServer):
 
     async def _analyze(self, path: str) -> Analysis | None:
         async with self.lock:
-            self._dirty.discard(path)
+            if path not in self._dirty and self.project.latest(path) is not None:
+                return self.project.latest(path)     # an analysis of its workspace ran meanwhile
             self.project.folders = self.folders()
             docs = dict(self.project.docs)
+            versions = dict(self._versions)
+            gens = dict(self._gen)
             loop = asyncio.get_running_loop()
             try:
                 an = await loop.run_in_executor(self._executor, self.project.analyze, path, docs)
             except Exception as exc:  # noqa: BLE001
                 log.exception("analysis of %s failed", path)
                 self._report(f"krl lsp: analysis of {path} failed: {type(exc).__name__}: {exc}")
+                self._dirty.discard(path)
                 return None
-            self.publish(an)
+            for f in an.files:          # up to date unless changed while the analysis ran
+                if self._gen.get(f) == gens.get(f):
+                    self._dirty.discard(f)
+            if path not in an.files and self._gen.get(path) == gens.get(path):
+                self._dirty.discard(path)
+            try:
+                self.publish(an, docs, versions)
+            except Exception:  # noqa: BLE001 - e.g. the client went away
+                log.exception("publishing diagnostics failed")
             return an
 
-    def publish(self, an: Analysis) -> None:
+    def publish(self, an: Analysis, docs: dict[str, str], versions: dict[str, int | None]) -> None:
+        """Diagnostics of the open documents of an analysis, with the versions it saw."""
         codec = self.codec()
         for path, fi in an.files.items():
-            if path not in self.project.docs:
+            if path not in docs or path not in self.project.docs:
                 continue
             diags = [lsp_diagnostic(d, fi.lines, codec, uri_of) for d in an.diagnostics_for(path)]
             self.text_document_publish_diagnostics(L.PublishDiagnosticsParams(
-                uri=uri_of(path), diagnostics=diags, version=self._versions.get(path)))
+                uri=uri_of(path), diagnostics=diags, version=versions.get(path)))
 
     def schedule(self, path: str, delay: float | None = None) -> None:
         """Analyse the workspace of `path` after the debounce delay (a newer change restarts it)."""
         self._dirty.add(path)
+        self._gen[path] = self._gen.get(path, 0) + 1
         old = self._pending.pop(path, None)
         if old is not None and not old.done():
             old.cancel()
@@ -223,7 +238,6 @@ def create_server() -> KrlLanguageServer:
         ls.text_document_publish_diagnostics(L.PublishDiagnosticsParams(uri=params.text_document.uri, diagnostics=[]))
         for other in list(ls.project.docs):     # the others now see the file on disk again
             ls.schedule(other)
-            break
 
     @server.feature(L.WORKSPACE_DID_CHANGE_WATCHED_FILES)
     @guarded()

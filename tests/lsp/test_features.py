@@ -189,3 +189,29 @@ async def test_formatting_offered_exactly_when_krl_fmt_is_installed(client):
         from krl.fmt import format_text
         expected = format_text(MAIN_TEXT)
         assert (edits or []) == [] if expected == MAIN_TEXT else edits[0].new_text == expected
+
+
+async def test_unsaved_buffer_of_another_file_is_seen(client, backup_copy):
+    main = backup_copy / "R1" / "Program" / "main.src"
+    tools = backup_copy / "R1" / "Program" / "tools.dat"
+    assert summary(await open_doc(client, main)) == []
+    # tools.dat edited in the editor, not saved: pose_t is gone -> main.src line 3 `  DECL pose_t p`
+    client.diagnostics.pop(main.as_uri(), None)
+    await open_doc(client, tools, "DEFDAT tools PUBLIC\n  DECL GLOBAL INT shared = 0\nENDDAT\n")
+    assert summary(await wait_diagnostics(client, main.as_uri())) == [("E105", 3, 7, "unknown type 'pose_t'")]
+    # closed without saving: the file on disk counts again
+    client.diagnostics.pop(main.as_uri(), None)
+    close_doc(client, tools)
+    assert summary(await wait_diagnostics(client, main.as_uri())) == []
+    close_doc(client, main)
+
+
+async def test_untitled_buffer(client):
+    uri = "untitled:Untitled-1"
+    client.diagnostics.pop(uri, None)
+    client.text_document_did_open(L.DidOpenTextDocumentParams(text_document=L.TextDocumentItem(
+        uri=uri, language_id="krl", version=1, text="DEF x( )\n  DECL INT n\n  n = m\nEND\n")))
+    assert summary(await wait_diagnostics(client, uri)) == [("E101", 2, 6, "'m' is not declared")]
+    got = await client.text_document_definition_async(L.DefinitionParams(
+        text_document=L.TextDocumentIdentifier(uri=uri), position=pos(2, 2)))
+    assert [(x.uri, x.range.start.line, x.range.start.character) for x in got] == [(uri, 1, 11)]
