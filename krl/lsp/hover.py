@@ -4,6 +4,7 @@ and what the built-in tables (krl/semantics/data: sysvars.yaml, kss.yaml) say ab
 from __future__ import annotations
 
 import os
+from functools import lru_cache
 
 from krl.ast import nodes as N
 from krl.lsp.analysis import Analysis
@@ -57,14 +58,32 @@ def _decl_of(sym) -> str:
     return f"{words} {typ} {sym.name}{dims}"
 
 
+@lru_cache(maxsize=1)
+def meanings() -> dict[str, tuple[str, str]]:
+    """UPPER name -> (meaning, reference section) from krl/semantics/data/sysvar_meanings.yaml."""
+    import yaml  # noqa: PLC0415
+
+    from krl.semantics.builtins import DATA_DIR  # noqa: PLC0415
+    try:
+        data = yaml.safe_load((DATA_DIR / "sysvar_meanings.yaml").read_text(encoding="utf-8")) or {}
+    except (OSError, yaml.YAMLError):
+        return {}
+    return {str(k).upper(): (str(v.get("meaning", "")), str(v.get("ref", ""))) for k, v in data.items()
+            if isinstance(v, dict)}
+
+
 def sysvar_text(name: str) -> list[str]:
-    """What the tables say about a system variable: access, advance-run stops, source."""
+    """What the tables say about a system variable: meaning, access, advance-run stops, source."""
     b = load_builtins()
     key = name.upper()
     info = b.sysvars.get(key) or b.kss_variables.get(key)
     if info is None:
         return []
-    out = ["write-protected (read only)" if info.access == "RO" else "read and write"]
+    out = []
+    meaning, ref = meanings().get(key, ("", ""))
+    if meaning:
+        out.append(meaning + (f" (reference {ref})" if ref else ""))
+    out.append("write-protected (read only)" if info.access == "RO" else "read and write")
     stops = [w for w, on in (("reading", info.stop_read), ("writing", info.stop_write)) if on]
     if stops:
         out.append(" and ".join(stops) + " it stops the advance run")

@@ -118,6 +118,7 @@ async def test_hover_variable_and_system_variable(client):
     h = await client.text_document_hover_async(L.HoverParams(text_document=td(MAIN), position=pos(18, 3)))
     assert "BOOL" in h.contents.value and "8192" in h.contents.value
     assert "writing it stops the advance run" in h.contents.value
+    assert "digital outputs (reference 7.1)" in h.contents.value          # sysvar_meanings.yaml
     # a component: its type and its structure
     h = await client.text_document_hover_async(L.HoverParams(text_document=td(MAIN), position=pos(11, 19)))
     assert "REAL mass" in h.contents.value and "tool_t" in h.contents.value
