@@ -13,6 +13,7 @@ import functools
 import importlib.util
 import logging
 import os
+import sys
 from concurrent.futures import ThreadPoolExecutor
 
 from lsprotocol import types as L
@@ -305,6 +306,12 @@ def create_server() -> KrlLanguageServer:
     async def workspace_symbol(ls: KrlLanguageServer, params: L.WorkspaceSymbolParams):
         for path in list(ls._dirty):
             await ls.fresh(path)
+        if not ls.project.analyses:         # nothing open yet: the folders the editor opened
+            from krl.lsp.roots import list_krl_files  # noqa: PLC0415
+            for folder in ls.folders():
+                first = list_krl_files(folder, limit=1)
+                if first:
+                    await ls.fresh(norm(first[0]))
         return _outline.workspace_symbols(list(ls.project.analyses.values()), params.query or "", uri_of, ls.codec())
 
     @server.feature(L.TEXT_DOCUMENT_FOLDING_RANGE)
@@ -349,4 +356,15 @@ def serve(log_file: str | None = None) -> None:
     """Run the server on stdin/stdout until the client says exit."""
     logging.basicConfig(filename=log_file, level=logging.INFO if log_file else logging.WARNING,
                         format="%(asctime)s %(name)s %(levelname)s %(message)s")
-    create_server().start_io()
+    server = create_server()
+    server.start_io()
+    # exit now, even when an analysis of a large file is still running in the worker thread;
+    # exit code 0 after a `shutdown` request, else 1 (the LSP rule)
+    code = 0 if getattr(server.protocol, "_shutdown", False) else 1
+    logging.shutdown()
+    try:
+        sys.stdout.flush()
+        sys.stderr.flush()
+    except (OSError, ValueError):
+        pass
+    os._exit(code)
