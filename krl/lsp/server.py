@@ -157,13 +157,16 @@ class KrlLanguageServer(LanguageServer):
         self._pending[path] = asyncio.ensure_future(later())
 
     async def fresh(self, path: str) -> Analysis | None:
-        """The analysis holding `path`, brought up to date with the buffers first."""
+        """The analysis holding `path`, brought up to date with the buffers first. Returns
+        when no analysis is running: the caller reads the annotated trees without awaiting
+        anything, so no analysis re-annotates them meanwhile."""
         if path in self._dirty or self.project.latest(path) is None:
             task = self._pending.pop(path, None)
             if task is not None:
                 task.cancel()
             return await self._analyze(path)
-        return self.project.latest(path)
+        async with self.lock:
+            return self.project.latest(path)
 
     def _report(self, message: str) -> None:
         try:
