@@ -12,7 +12,7 @@ import sys
 import pytest
 from lsprotocol import types as L
 
-from tests.lsp.conftest import (BACKUP, PROGRAM, SYSTEM, change_doc, close_doc, open_doc, pos, summary,
+from tests.lsp.conftest import (PROGRAM, change_doc, close_doc, open_doc, pos, summary,
                                 wait_diagnostics, where)
 
 pytestmark = pytest.mark.asyncio(loop_scope="module")
