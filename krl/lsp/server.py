@@ -30,8 +30,10 @@ from krl.lsp.analysis import Analysis
 from krl.lsp.convert import lsp_diagnostic
 from krl.lsp.project import Project, norm
 from krl.lsp.text import from_position, to_range
+from krl.terminal import printable, printable_path
 
-log = logging.getLogger("krl.lsp")
+log = logging.getLogger("krl.lsp")       # file names and messages in it pass krl.terminal.printable
+TRACEBACKS = {"on": False}                # Python tracebacks only into a --log-file, never to stderr
 DEBOUNCE_S = 0.05          # seconds after the last change before the analysis starts
 
 
@@ -113,8 +115,8 @@ class KrlLanguageServer(LanguageServer):
             try:
                 an = await loop.run_in_executor(self._executor, self.project.analyze, path, docs)
             except Exception as exc:  # noqa: BLE001
-                log.exception("analysis of %s failed", path)
-                self._report(f"krl lsp: analysis of {path} failed: {type(exc).__name__}: {exc}")
+                log.error("analysis of %s failed: %s", printable_path(path), printable(exc), exc_info=TRACEBACKS["on"])
+                self._report(f"krl lsp: analysis of {printable_path(path)} failed: {type(exc).__name__}: {printable(exc)}")
                 self._dirty.discard(path)
                 return None
             for f in an.files:          # up to date unless changed while the analysis ran
@@ -125,7 +127,7 @@ class KrlLanguageServer(LanguageServer):
             try:
                 self.publish(an, docs, versions)
             except Exception:  # noqa: BLE001 - e.g. the client went away
-                log.exception("publishing diagnostics failed")
+                log.error("publishing diagnostics failed", exc_info=TRACEBACKS["on"])
             return an
 
     def publish(self, an: Analysis, docs: dict[str, str], versions: dict[str, int | None]) -> None:
@@ -183,8 +185,8 @@ def guarded(empty=None):
             try:
                 return await fn(ls, params)
             except Exception as exc:  # noqa: BLE001
-                log.exception("handler %s failed", fn.__name__)
-                ls._report(f"krl lsp: {fn.__name__} failed: {type(exc).__name__}: {exc}")
+                log.error("handler %s failed: %s", fn.__name__, printable(exc), exc_info=TRACEBACKS["on"])
+                ls._report(f"krl lsp: {fn.__name__} failed: {type(exc).__name__}: {printable(exc)}")
                 return empty() if callable(empty) else empty
         return run
     return wrap
@@ -344,7 +346,7 @@ def create_server() -> KrlLanguageServer:
             try:
                 new = fmt(text)
             except Exception as exc:  # noqa: BLE001 - unparsable input: no edit, say why
-                ls._report(f"krl lsp: not formatted: {type(exc).__name__}: {exc}")
+                ls._report(f"krl lsp: not formatted: {type(exc).__name__}: {printable(exc)}")
                 return None
             if new == text:
                 return []
@@ -359,6 +361,7 @@ def serve(log_file: str | None = None) -> None:
     """Run the server on stdin/stdout until the client says exit."""
     logging.basicConfig(filename=log_file, level=logging.INFO if log_file else logging.WARNING,
                         format="%(asctime)s %(name)s %(levelname)s %(message)s")
+    TRACEBACKS["on"] = log_file is not None
     server = create_server()
     server.start_io()
     # exit now, even when an analysis of a large file is still running in the worker thread;
