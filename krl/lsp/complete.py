@@ -1,5 +1,5 @@
 """Completion: STRUC components after ``.`` (the type of the expression before it, from the
-symbol tables), system variables after ``$``, otherwise the grammar's keywords and the names in
+symbol tables), system variables after ``$``, ENUM values after ``#``, otherwise the grammar's keywords and the names in
 scope at the cursor (locals, the module's data list, globals, built-in routines and types)."""
 
 from __future__ import annotations
@@ -56,6 +56,23 @@ def _scope_names(scope: Scope, dollar: bool) -> list[L.CompletionItem]:
     return out
 
 
+def _enum_values(scope: Scope, word: str) -> list[L.CompletionItem]:
+    """ENUM values after ``#``: the values of every ENUM type in scope, inner scopes first."""
+    out: list[L.CompletionItem] = []
+    seen: set[str] = set()
+    s: Scope | None = scope
+    up = word.upper()
+    while s is not None and len(out) < MAX_ITEMS:
+        for typ in s.types.values():
+            if isinstance(typ, T.Enum):
+                for v in sorted(typ.values):
+                    if v.startswith(up) and v not in seen:
+                        seen.add(v)
+                        out.append(L.CompletionItem(label=v, kind=CK.EnumMember, detail=typ.name))
+        s = s.parent
+    return out[:MAX_ITEMS]
+
+
 def complete(an: Analysis, path: str, line: int, column: int) -> list[L.CompletionItem]:
     """Completion items at 1-based (line, column) of `path` (the cursor is before `column`)."""
     fi = an.files.get(path)
@@ -83,6 +100,8 @@ def complete(an: Analysis, path: str, line: int, column: int) -> list[L.Completi
         code_end = toks[-1].column + len(toks[-1].text) - 1 if toks else 0
         if ";" in prefix[code_end:]:
             return []           # the cursor is in a comment
+    if before.endswith("#"):
+        return _enum_values(scope, word)
     items = _scope_names(scope, word.startswith("$"))
     if not word.startswith("$"):
         items += [L.CompletionItem(label=k, kind=CK.Keyword) for k in keywords()]

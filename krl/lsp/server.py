@@ -328,7 +328,7 @@ def create_server() -> KrlLanguageServer:
             return []
         return _folding.folding_ranges(an.files[path].lines)
 
-    @server.feature(L.TEXT_DOCUMENT_COMPLETION, L.CompletionOptions(trigger_characters=[".", "$"]))
+    @server.feature(L.TEXT_DOCUMENT_COMPLETION, L.CompletionOptions(trigger_characters=[".", "$", "#"]))
     @guarded()
     async def completion(ls: KrlLanguageServer, params: L.CompletionParams):
         an, path, line, col = await place(ls, params.text_document, params.position)

@@ -170,13 +170,14 @@ async def test_completion_components_after_dot(client):
 
 async def test_completion_names_keywords_system_variables(client, backup_copy):
     path = backup_copy / "R1" / "Program" / "main.src"
-    text = MAIN_TEXT.replace("  counter = 0\n", "  cou\n  ENDI\n  $POS_AC\n")
+    text = MAIN_TEXT.replace("  counter = 0\n", "  cou\n  ENDI\n  $POS_AC\n  run_mode = #ma\n")
     await open_doc(client, path, text)
     assert "counter" in await complete(client, path, 8, 5)               # global from $config.dat
     assert "ENDIF" in await complete(client, path, 9, 6)                 # keyword
     sysvars = await complete(client, path, 10, 9)
     assert "$POS_ACT" in sysvars and all(s.upper().startswith("$POS_AC") for s in sysvars)
     assert "i" in await complete(client, path, 8, 2)                     # local, empty prefix
+    assert "MANUAL" in await complete(client, path, 11, 16)             # `#ma`: mode_t's value manual
     close_doc(client, path)
 
 
