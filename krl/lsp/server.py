@@ -170,9 +170,9 @@ class KrlLanguageServer(LanguageServer):
         async with self.lock:
             return self.project.latest(path)
 
-    def _report(self, message: str) -> None:
+    def _report(self, message: str, kind: L.MessageType = L.MessageType.Error) -> None:
         try:
-            self.window_log_message(L.LogMessageParams(type=L.MessageType.Error, message=message))
+            self.window_log_message(L.LogMessageParams(type=kind, message=message))
         except Exception:  # noqa: BLE001
             pass
 
@@ -346,7 +346,7 @@ def create_server() -> KrlLanguageServer:
             try:
                 new = fmt(text)
             except Exception as exc:  # noqa: BLE001 - unparsable input: no edit, say why
-                ls._report(f"krl lsp: not formatted: {type(exc).__name__}: {printable(exc)}")
+                ls._report(f"krl lsp: not formatted: {type(exc).__name__}: {printable(exc)}", L.MessageType.Warning)
                 return None
             if new == text:
                 return []

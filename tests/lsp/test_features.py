@@ -191,6 +191,12 @@ async def test_formatting_offered_exactly_when_krl_fmt_is_installed(client):
         from krl.fmt import format_text
         expected = format_text(MAIN_TEXT)
         assert (edits or []) == [] if expected == MAIN_TEXT else edits[0].new_text == expected
+        # text that does not parse: no edit
+        path = PROGRAM / "main.src"
+        await change_doc(client, path, MAIN_TEXT.replace("IF run_mode == #auto THEN", "IF run_mode == #auto"), 50)
+        assert not await client.text_document_formatting_async(L.DocumentFormattingParams(
+            text_document=td(MAIN), options=L.FormattingOptions(tab_size=2, insert_spaces=True)))
+        await change_doc(client, path, MAIN_TEXT, 51)
 
 
 async def test_unsaved_buffer_of_another_file_is_seen(client, backup_copy):
