@@ -6,8 +6,6 @@ from __future__ import annotations
 
 import importlib.util
 import json
-import subprocess
-import sys
 
 import pytest
 from lsprotocol import types as L
@@ -36,6 +34,15 @@ async def references(client, path, line, char, decl=True):
     return sorted(where(x) for x in (got or []))
 
 
+def krl_check_json(folder) -> list[dict]:
+    """The diagnostics of main.src as `krl check --format json FOLDER` prints them."""
+    from krl.semantics.cli import run_check
+
+    lines: list[str] = []
+    run_check([str(folder)], fmt="json", echo=lines.append)
+    return [d for ws in map(json.loads, lines) for d in ws["diagnostics"] if d["path"].endswith("main.src")]
+
+
 async def test_diagnostics_resolve_config_and_globals(client):
     # main.src uses counter/gripper/run_mode ($config.dat), pose_t and helper (GLOBAL in tools.*),
     # local_count (main.dat): with the backup root found, nothing is undeclared.
@@ -52,9 +59,7 @@ async def test_diagnostics_unsaved_buffer_on_change_same_as_krl_check(client, ba
     assert diags[0].severity == L.DiagnosticSeverity.Error
     # the same text checked by `krl check`: same codes, places and messages
     path.write_text(broken)
-    out = subprocess.run([sys.executable, "-m", "krl.cli", "check", "--format", "json", str(backup_copy)],
-                         capture_output=True, text=True, check=False)
-    cli = [d for ws in map(json.loads, out.stdout.splitlines()) for d in ws["diagnostics"] if d["path"].endswith("main.src")]
+    cli = krl_check_json(backup_copy)
     assert sorted((d["code"], d["line"] - 1, d["column"] - 1, d["message"]) for d in cli) == summary(diags)
     # on change: fixed, then a syntax error (IF without THEN on line 13)
     assert summary(await change_doc(client, path, MAIN_TEXT, 2)) == []
@@ -62,9 +67,7 @@ async def test_diagnostics_unsaved_buffer_on_change_same_as_krl_check(client, ba
     diags = await change_doc(client, path, no_then, 3)
     assert [(str(d.code), d.range.start.line) for d in diags] == [("E012", 13)]
     path.write_text(no_then)
-    out = subprocess.run([sys.executable, "-m", "krl.cli", "check", "--format", "json", str(backup_copy)],
-                         capture_output=True, text=True, check=False)
-    cli = [d for ws in map(json.loads, out.stdout.splitlines()) for d in ws["diagnostics"] if d["path"].endswith("main.src")]
+    cli = krl_check_json(backup_copy)
     assert [(d["code"], d["line"] - 1, d["message"]) for d in cli] == [(str(d.code), d.range.start.line, d.message) for d in diags]
     close_doc(client, path)
 

@@ -39,7 +39,7 @@ EDITS = [
 
 @pytest.mark.parametrize("old,new", EDITS)
 def test_pieces_match_the_whole_file(old, new):
-    text = generate(700)
+    text = generate(350)
     lines = text.split("\r\n")
     cache = ParseCache()
     same("/w/bench.src", text, cache)
@@ -53,7 +53,7 @@ def test_pieces_match_the_whole_file(old, new):
 
 
 def test_errors_in_two_routines_match_the_whole_file():
-    lines = generate(700).split("\r\n")
+    lines = generate(350).split("\r\n")
     hits = [i for i, ln in enumerate(lines) if ln == "  WAIT SEC 0.3"]
     lines[hits[0]] = "  WAIT SEC"
     lines[hits[-1]] = "  x = = 1"
