@@ -1,5 +1,6 @@
-"""Parsing for the editor: the same results as ``krl check`` (krl/workspace.py ``add_file``),
-with a cache per routine so that a change re-parses only the routine it touches.
+"""Parsing for the editor: the same results as ``krl check`` (krl/workspace.py ``add_file``:
+syntax diagnostics, FOLD balance, the AST and its build diagnostics), with a cache per routine so
+that a change re-parses only the routine it touches. tests/lsp/test_parsing.py compares the two.
 
 A .src/.sub file is cut before every line that starts a routine (``[GLOBAL] DEF``/``DEFFCT``)
 after the first one; each piece is parsed on its own, its lexer counting lines from the piece's
@@ -24,6 +25,7 @@ from krl.ast import nodes as N
 from krl.ast.build import build_module
 from krl.limits import MAX_FILE_BYTES
 from krl.semantics.diagnostics import Diagnostic, DiagnosticSink
+from krl.syntax.folds import fold_diagnostics
 from krl.syntax.messages import syntax_diagnostics
 from krl.syntax.parse import parse_source, parse_text
 from krl.syntax.source import SourceText
@@ -63,6 +65,7 @@ def parse_disk(source: SourceText) -> Parsed:
         sink.add(source.path, 1, 1, "E001", f"file not checked: {result.status}"
                  + (f" ({source.detail})" if source.detail else ""))
     sink.extend(syntax_diagnostics(result, source.text))
+    sink.extend(fold_diagnostics(source.path, source.text))
     module = build_module(result, sink)
     words, unreadable = _failed(result.status, result.ok, source.text)
     return Parsed(source.path, source.text, module, result.ok, result.status, sink.items, words, unreadable)
@@ -94,6 +97,7 @@ class ParseCache:
         sink = DiagnosticSink()
         result = parse_text(text, path)
         sink.extend(syntax_diagnostics(result, text))
+        sink.extend(fold_diagnostics(path, text))
         module = build_module(result, sink)
         words, unreadable = _failed(result.status, result.ok, text)
         return Parsed(path, text, module, result.ok, result.status, sink.items, words, unreadable)
@@ -145,6 +149,7 @@ class ParseCache:
         words, _ = _failed("syntax_error", ok, text)
         sink = DiagnosticSink()
         sink.extend(diags)
+        sink.extend(fold_diagnostics(path, text))
         return Parsed(path, text, module, ok, "ok" if ok else "syntax_error", sink.items, words)
 
 

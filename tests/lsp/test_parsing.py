@@ -1,6 +1,7 @@
 """The per-routine parse cache (krl/lsp/parsing.py) gives exactly the diagnostics and the AST of
-a whole-file parse (what `krl check` reports), on valid files and after edits that break one
-routine, two routines, or a routine's END."""
+`krl check`'s own pipeline (krl/workspace.py Workspace.add_text / add_file), on valid files and
+after edits that break one routine, two routines, or a routine's END; and a whole backup analysed
+by the server has exactly the diagnostics `krl check` gives it."""
 
 from __future__ import annotations
 
@@ -10,17 +11,19 @@ from pathlib import Path
 import pytest
 
 from krl.lsp.bench import generate
-from krl.lsp.parsing import MIN_CHUNKED_LINES, ParseCache, parse_disk
-from krl.syntax.source import SourceText, read_source
-
-
-def whole(path: str, text: str):
-    return parse_disk(SourceText(path, text, "utf-8", len(text.encode())))
+from krl.lsp.parsing import MIN_CHUNKED_LINES, ParseCache
+from krl.lsp.project import Project, norm
+from krl.syntax.source import read_source
+from krl.workspace import Workspace, find_backups, load_workspace
 
 
 def same(path: str, text: str, cache: ParseCache) -> None:
-    a, b = whole(path, text), cache.parse(path, text)
-    assert [d.as_json() for d in b.diagnostics] == [d.as_json() for d in a.diagnostics]
+    ws = Workspace(path)
+    a = ws.add_text(text, path)
+    b = cache.parse(path, text)
+    key = lambda d: (d.line, d.column, d.code, d.message)  # noqa: E731
+    assert sorted((d.as_json() for d in b.diagnostics), key=lambda j: (j["line"], j["column"], j["code"], j["message"])) \
+        == [d.as_json() for d in sorted(ws.sink.items, key=key)]
     assert (b.ok, b.status) == (a.ok, a.status)
     assert b.module == a.module            # AST equality (spans and annotations aside)
     spans = lambda m: [(type(n).__name__, n.span.line, n.span.column, getattr(n, "end_line", 0)) for n in m.walk()]  # noqa: E731
@@ -58,6 +61,27 @@ def test_errors_in_two_routines_match_the_whole_file():
     lines[hits[0]] = "  WAIT SEC"
     lines[hits[-1]] = "  x = = 1"
     same("/w/bench.src", "\r\n".join(lines), ParseCache())
+
+
+def check_backup(backup: Path) -> None:
+    files = sorted(f for f in backup.rglob("*") if f.suffix.lower() in (".src", ".dat", ".sub") and f.is_file())
+    an = Project().analyze(norm(files[0]))
+    ws = load_workspace([backup], str(backup))
+    ws.check()
+    shown = lambda d: (norm(d.path), d.line, d.column, d.code, d.message)  # noqa: E731
+    assert sorted(map(shown, an.ws.diagnostics)) == sorted(map(shown, ws.diagnostics))
+    assert len(an.files) == len(ws.files)
+
+
+def test_a_backup_has_the_diagnostics_of_krl_check(shared_corpus: Path):
+    backups = find_backups(shared_corpus)
+    check_backup(min(backups, key=lambda b: sum(1 for _ in b.rglob("*"))))      # the smallest one
+
+
+@pytest.mark.slow
+def test_every_backup_has_the_diagnostics_of_krl_check(shared_corpus: Path):
+    for b in find_backups(shared_corpus):
+        check_backup(b)
 
 
 @pytest.mark.slow
