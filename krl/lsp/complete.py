@@ -5,6 +5,7 @@ scope at the cursor (locals, the module's data list, globals, built-in routines 
 from __future__ import annotations
 
 import re
+from functools import lru_cache
 
 from lsprotocol import types as L
 
@@ -19,7 +20,8 @@ _WORD_BEFORE = re.compile(r"[\w$]*$")
 CK = L.CompletionItemKind
 
 
-def keywords() -> list[str]:
+@lru_cache(maxsize=1)
+def keywords() -> tuple[str, ...]:
     """The grammar's keywords (the lexer's literal tokens that are words)."""
     from krl.syntax.parse import default_bundle  # noqa: PLC0415
     out = []
@@ -27,7 +29,7 @@ def keywords() -> list[str]:
         w = lit.strip("'")
         if w and (w[0].isalpha() or w[0] == "_") and w != "<INVALID>":
             out.append(w)
-    return sorted(set(out))
+    return tuple(sorted(set(out)))
 
 
 def _scope_names(scope: Scope, dollar: bool) -> list[L.CompletionItem]:
