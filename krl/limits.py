@@ -58,3 +58,7 @@ MAX_ARCHIVE_DEPTH = 32
 # home folder must not make the server read the whole disk. Past it: the first files (sorted)
 # are read, the rest are not part of the workspace (their names stay unresolved).
 MAX_LSP_WORKSPACE_FILES = 5000
+# The most directory entries (files and folders) `krl lsp` looks at while listing one workspace
+# folder, in entries: a backup has a few thousand; a home folder opened by mistake may have
+# millions. Past it the listing stops there (as for MAX_LSP_WORKSPACE_FILES).
+MAX_LSP_SCAN_ENTRIES = 200_000

@@ -8,8 +8,9 @@
   FOLDER`` groups the files outside backups;
 * else the file with the .src/.dat/.sub of its module (``krl check FILE``).
 
-A folder is listed up to :data:`krl.limits.MAX_LSP_WORKSPACE_FILES` KRL files (an editor opened
-on a home folder must not read the whole disk).
+A folder is listed up to :data:`krl.limits.MAX_LSP_WORKSPACE_FILES` KRL files and
+:data:`krl.limits.MAX_LSP_SCAN_ENTRIES` directory entries (an editor opened on a home folder must
+not read the whole disk).
 """
 
 from __future__ import annotations
@@ -17,7 +18,7 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from krl.limits import MAX_LSP_WORKSPACE_FILES
+from krl.limits import MAX_LSP_SCAN_ENTRIES, MAX_LSP_WORKSPACE_FILES
 from krl.syntax.source import is_krl_file
 
 
@@ -54,17 +55,21 @@ def backup_root(path: Path) -> Path | None:
     return found
 
 
-def list_krl_files(folder: Path, limit: int = MAX_LSP_WORKSPACE_FILES) -> list[Path]:
-    """KRL files below `folder`, sorted, at most `limit` (symbolic links to folders not followed)."""
+def list_krl_files(folder: Path, limit: int = MAX_LSP_WORKSPACE_FILES,
+                   max_entries: int = MAX_LSP_SCAN_ENTRIES) -> list[Path]:
+    """KRL files below `folder`, sorted, at most `limit`, looking at no more than `max_entries`
+    directory entries (symbolic links to folders not followed)."""
     out: list[Path] = []
     stack = [folder]
-    while stack and len(out) < limit:
+    seen = 0
+    while stack and len(out) < limit and seen < max_entries:
         d = stack.pop()
         try:
             with os.scandir(d) as it:
                 entries = sorted(it, key=lambda e: e.name)
         except OSError:
             continue
+        seen += len(entries)
         for e in entries:
             try:
                 if e.is_dir(follow_symlinks=False):

@@ -50,3 +50,14 @@ def test_every_corpus_backup_file_finds_its_backup(shared_corpus: Path):
         for f in b.rglob("*"):
             if f.suffix.lower() in (".src", ".dat", ".sub") and f.is_file():
                 assert backup_root(f) == b, f
+
+
+def test_listing_stops_at_its_limits(tmp_path: Path):
+    from krl.lsp.roots import list_krl_files
+
+    for i in range(5):
+        touch(tmp_path / f"d{i}" / f"f{i}.src")
+    assert len(list_krl_files(tmp_path)) == 5
+    assert len(list_krl_files(tmp_path, limit=3)) == 3
+    # the root's 5 folders are 5 entries: the walk stops before it enters them
+    assert list_krl_files(tmp_path, max_entries=5) == []
