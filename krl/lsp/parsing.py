@@ -121,7 +121,7 @@ class ParseCache:
             got = self._pieces.get(key)
             if got is None:
                 # the lexer counts lines from the piece's first line: spans are the file's
-                result = parse_text(piece, path, first_line=a + 1)
+                result = parse_text(piece, path, first_line=a + 1, recover=False)
                 self.pieces_parsed += 1
                 sink = DiagnosticSink()
                 if not result.ok:

@@ -137,12 +137,15 @@ def _prepare(text: str) -> str:
 
 
 def parse_text(text: str, path: str = "<string>", bundle: ParserBundle | None = None,
-               keep_tree: bool = True, encoding: str = "", first_line: int = 1) -> ParseResult:
+               keep_tree: bool = True, encoding: str = "", first_line: int = 1,
+               recover: bool = True) -> ParseResult:
     """Parse KRL text with the start rule `module`.
 
     Returns a ParseResult; ok is True when there is no lexer or syntax error.
     Never raises for bad input. `first_line`: the line number of the text's first line (a
     piece of a file, krl/lsp/parsing.py); the lines of tokens and spans count from it.
+    `recover=False`: when the fast stage fails, return a not-ok result at once, without the
+    errors (the caller only needs to know that the text does not parse).
     """
     bundle = bundle or default_bundle()
     text = _prepare(text)
@@ -175,7 +178,8 @@ def parse_text(text: str, path: str = "<string>", bundle: ParserBundle | None = 
             return ParseResult(path, False, encoding, "syntax_error", issues,
                                tree if keep_tree else None, "sll")
     except ParseCancellationException:
-        pass
+        if not recover:
+            return ParseResult(path, False, encoding, "syntax_error", [], None, "sll")
 
     # Stage 2: full LL with line-oriented recovery, collecting every error.
     tokens.seek(0)
