@@ -139,8 +139,9 @@ class Analysis:
             return diags
 
 
-def build_analysis(root: str, parsed: list[Parsed]) -> Analysis:
-    """Link and check parsed files as one workspace (krl/workspace.py ``Workspace.check``)."""
+def build_analysis(root: str, parsed: list[Parsed], skipped=()) -> Analysis:
+    """Link and check parsed files as one workspace (krl/workspace.py ``Workspace.check``);
+    `skipped`: the krl.files entries not read (links, FIFOs, ...), W002 as in ``krl check``."""
     ws = Workspace(root)
     an = Analysis(root, ws)
     from krl.lsp.text import split_lines  # noqa: PLC0415
@@ -153,6 +154,9 @@ def build_analysis(root: str, parsed: list[Parsed]) -> Analysis:
                 ws.unreadable = True
             ws.failed_words.update(p.failed_words)
         an.files[p.path] = FileInfo(p.path, p, sf, split_lines(p.text))
+    for e in skipped:
+        ws.sink.add(str(e.path), 1, 1, "W002", f"not read: {e.message}")
+        ws.unreadable = True
     ws.check()
     an.annotate_partial()
     return an

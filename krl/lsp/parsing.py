@@ -57,18 +57,30 @@ def _failed(status: str, ok: bool, text: str) -> tuple[frozenset, bool]:
     return frozenset(w.upper() for w in _WORD.findall(text)), False
 
 
-def parse_disk(source: SourceText) -> Parsed:
-    """A file read with krl.syntax.source.read_source, exactly as Workspace.add_file does."""
+def parse_disk(path: str) -> Parsed:
+    """A file on disk, read, parsed and built by krl/workspace.py ``load_file`` (what
+    ``krl check`` does for each file)."""
+    from krl.workspace import load_file  # noqa: PLC0415
+
+    lf = load_file(path)
+    return Parsed(lf.path, _text_of(lf), lf.module, lf.ok, lf.status, list(lf.diagnostics),
+                  frozenset(lf.failed_words), lf.unreadable)
+
+
+def _text_of(lf) -> str:
+    """The decoded text the editor features work on (load_file keeps only the AST)."""
+    from krl.syntax.source import read_source  # noqa: PLC0415
+    src = read_source(lf.path)
+    return src.text if src.status == "ok" else ""
+
+
+def _not_parsed(path: str, size: int, status: str, detail: str) -> Parsed:
+    """A buffer that is not parsed (empty, binary, too large): E001 as for a file."""
     sink = DiagnosticSink()
-    result = parse_source(source)
-    if result.status not in ("ok", "syntax_error") and not result.errors:
-        sink.add(source.path, 1, 1, "E001", f"file not checked: {result.status}"
-                 + (f" ({source.detail})" if source.detail else ""))
-    sink.extend(syntax_diagnostics(result, source.text))
-    sink.extend(fold_diagnostics(source.path, source.text))
+    result = parse_source(SourceText(path, "", "", size, status, detail))
+    sink.add(path, 1, 1, "E001", f"file not checked: {status}" + (f" ({detail})" if detail else ""))
     module = build_module(result, sink)
-    words, unreadable = _failed(result.status, result.ok, source.text)
-    return Parsed(source.path, source.text, module, result.ok, result.status, sink.items, words, unreadable)
+    return Parsed(path, "", module, False, status, sink.items, frozenset(), status != "empty")
 
 
 class ParseCache:
@@ -82,11 +94,11 @@ class ParseCache:
         """Parse a buffer as if it were the file `path` (never raises for bad content)."""
         size = len(text.encode("utf-8", "surrogatepass"))
         if size > MAX_FILE_BYTES:
-            return parse_disk(SourceText(path, "", "", size, "too_large", f"{size} bytes > {MAX_FILE_BYTES}"))
+            return _not_parsed(path, size, "too_large", f"{size} bytes > {MAX_FILE_BYTES}")
         if not text.strip(" \t\r\n\x1a"):
-            return parse_disk(SourceText(path, "", "", size, "empty", "no content"))
+            return _not_parsed(path, size, "empty", "no content")
         if "\x00" in text:
-            return parse_disk(SourceText(path, "", "", size, "binary", "NUL bytes"))
+            return _not_parsed(path, size, "binary", "NUL bytes")
         if not path.lower().endswith(".dat"):
             got = self._parse_pieces(path, text)
             if got is not None:

@@ -17,7 +17,6 @@ from pathlib import Path
 from krl.lsp.analysis import Analysis, build_analysis
 from krl.lsp.parsing import ParseCache, Parsed, parse_disk
 from krl.lsp.roots import workspace_of
-from krl.syntax.source import read_source
 
 _SCHEME = re.compile(r"^[A-Za-z][A-Za-z0-9+.-]+:")
 ROOTS_TTL_S = 2.0        # seconds a workspace's file list is trusted before it is listed again
@@ -46,7 +45,7 @@ class Project:
         self.parser = ParseCache()
         self._buffers: dict[str, tuple[str, Parsed]] = {}
         self._disk: dict[str, tuple[int, int, Parsed]] = {}
-        self._roots: dict[str, tuple[float, str, list[str]]] = {}
+        self._roots: dict[str, tuple[float, str, list[str], list]] = {}
         self.analyses: dict[str, Analysis] = {}  # root -> latest analysis
         self._root_of: dict[str, str] = {}       # path -> root of its latest analysis
 
@@ -76,23 +75,24 @@ class Project:
 
     # ------------------------------------------------------------------ analysis
 
-    def workspace_files(self, path: str, docs: dict[str, str] | None = None) -> tuple[str, list[str]]:
+    def workspace_files(self, path: str, docs: dict[str, str] | None = None) -> tuple[str, list[str], list]:
+        """(root, files in krl check's order, entries not read) of the workspace of `path`."""
         p = norm(path)
         if is_uri(p):
-            return p, [p]       # not a file: checked on its own
+            return p, [p], []       # not a file: checked on its own
         got = self._roots.get(p)
         now = time.monotonic()
         if got is None or now - got[0] > ROOTS_TTL_S:
-            root, files = workspace_of(Path(p), self.folders)
-            got = (now, norm(root), [norm(f) for f in files])
+            root, files, skipped = workspace_of(Path(p), self.folders)
+            got = (now, norm(root), [norm(f) for f in files], skipped)
             self._roots[p] = got
-        root, files = got[1], list(got[2])
+        root, files = got[1], list(dict.fromkeys(got[2]))
         seen = set(files)
         for d in (docs if docs is not None else self.docs):      # open buffers not (yet) on disk that belong to this workspace
             if d not in seen and (d == root or d.startswith(root.rstrip(os.sep) + os.sep)) and \
                     Path(root).is_dir() and d.lower().endswith((".src", ".dat", ".sub")):
                 files.append(d)
-        return root, sorted(set(files))
+        return root, files, got[3]
 
     def parsed(self, path: str, docs: dict[str, str] | None = None) -> Parsed:
         """The parse of one file: its open buffer, else its disk content (cached)."""
@@ -110,7 +110,7 @@ class Project:
             stamp = (-1, -1)
         got = self._disk.get(path)
         if got is None or (got[0], got[1]) != stamp:
-            got = (*stamp, parse_disk(read_source(path)))
+            got = (*stamp, parse_disk(path))
             self._disk[path] = got
         return got[2]
 
@@ -118,8 +118,8 @@ class Project:
         """Check the workspace of `path` with the buffers `docs` (default: the open ones); the
         result is remembered as the latest analysis of that workspace."""
         docs = dict(self.docs) if docs is None else docs
-        root, files = self.workspace_files(path, docs)
-        an = build_analysis(root, [self.parsed(f, docs) for f in files])
+        root, files, skipped = self.workspace_files(path, docs)
+        an = build_analysis(root, [self.parsed(f, docs) for f in files], skipped)
         self.analyses[root] = an
         for f in files:
             self._root_of[f] = root

@@ -64,7 +64,8 @@ def test_errors_in_two_routines_match_the_whole_file():
 
 
 def check_backup(backup: Path) -> None:
-    files = sorted(f for f in backup.rglob("*") if f.suffix.lower() in (".src", ".dat", ".sub") and f.is_file())
+    files = sorted(f for f in backup.rglob("*")
+                   if f.suffix.lower() in (".src", ".dat", ".sub") and f.is_file() and not f.is_symlink())
     an = Project().analyze(norm(files[0]))
     ws = load_workspace([backup], str(backup))
     ws.check()
@@ -103,3 +104,18 @@ def test_pieces_match_the_whole_file_on_the_corpus(shared_corpus: Path):
             same(str(p), "\n".join(ls), cache)
         checked += 1
     assert checked > 10
+
+
+def test_links_and_fifos_in_a_backup_are_reported_as_krl_check_does(tmp_path: Path):
+    import os
+    import shutil
+
+    from tests.lsp.conftest import BACKUP
+
+    b = tmp_path / "KRC"
+    shutil.copytree(BACKUP, b)
+    (b / "R1" / "Program" / "link.src").symlink_to(b / "R1" / "Program" / "tools.src")
+    os.mkfifo(b / "R1" / "Program" / "pipe.src")
+    check_backup(b)           # W002 for both, in the same order, nothing read from them
+    an = Project().analyze(norm(b / "R1" / "Program" / "main.src"))
+    assert sorted(d.code for d in an.ws.diagnostics) == ["W002", "W002"]

@@ -25,7 +25,7 @@ def test_backup_layouts(tmp_path: Path):
     touch(flat / "System" / "$config.dat")
     assert backup_root(touch(flat / "Program" / "x.src")) == flat
     assert backup_root(touch(tmp_path / "loose" / "y.src")) is None
-    root, files = workspace_of(prog, [])
+    root, files, _ = workspace_of(prog, [])
     assert root == krc and sorted(f.name for f in files) == ["$CONFIG.DAT", "$machine.dat", "b.src"]
 
 
@@ -34,12 +34,12 @@ def test_file_outside_backups_takes_its_module_or_its_folder(tmp_path: Path):
     touch(tmp_path / "proj" / "sub" / "A.DAT")
     touch(tmp_path / "proj" / "sub" / "other.src")
     touch(tmp_path / "proj" / "top.src")
-    root, files = workspace_of(a, [])                           # no folder open: the module
+    root, files, _ = workspace_of(a, [])                           # no folder open: the module
     assert root == a and sorted(f.name for f in files) == ["A.DAT", "a.src"]
-    root, files = workspace_of(a, [tmp_path / "proj"])          # the opened folder, no backup in it
+    root, files, _ = workspace_of(a, [tmp_path / "proj"])          # the opened folder, no backup in it
     assert root == tmp_path / "proj" and sorted(f.name for f in files) == ["A.DAT", "a.src", "other.src", "top.src"]
     touch(tmp_path / "proj" / "KRC" / "R1" / "System" / "$config.dat")
-    root, files = workspace_of(a, [tmp_path / "proj"])          # a backup in it: by top-level folder
+    root, files, _ = workspace_of(a, [tmp_path / "proj"])          # a backup in it: by top-level folder
     assert root == tmp_path / "proj" / "sub" and sorted(f.name for f in files) == ["A.DAT", "a.src", "other.src"]
 
 
@@ -59,5 +59,4 @@ def test_listing_stops_at_its_limits(tmp_path: Path):
         touch(tmp_path / f"d{i}" / f"f{i}.src")
     assert len(list_krl_files(tmp_path)) == 5
     assert len(list_krl_files(tmp_path, limit=3)) == 3
-    # the root's 5 folders are 5 entries: the walk stops before it enters them
-    assert list_krl_files(tmp_path, max_entries=5) == []
+    assert len(list_krl_files(tmp_path, max_entries=3)) == 3     # files looked at
