@@ -134,7 +134,7 @@ class Analysis:
             diags = [d for d in diags if d.code != "W111"]
         try:
             from krl.semantics.config import config_for  # noqa: PLC0415
-            return config_for(self.root, path).apply(diags)
+            return config_for(self.root).apply(diags)     # the workspace root only, as krl check
         except Exception:  # noqa: BLE001 - a bad krl.toml: `krl check` says why; here all are shown
             return diags
 

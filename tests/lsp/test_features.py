@@ -226,3 +226,13 @@ async def test_untitled_buffer(client):
     got = await client.text_document_definition_async(L.DefinitionParams(
         text_document=L.TextDocumentIdentifier(uri=uri), position=pos(2, 2)))
     assert [(x.uri, x.range.start.line, x.range.start.character) for x in got] == [(uri, 1, 11)]
+
+
+async def test_krl_toml_of_the_backup_applies(client, backup_copy):
+    (backup_copy / "krl.toml").write_text('[check]\nignore = ["E101"]\n[check.severity]\nE106 = "warning"\n')
+    path = backup_copy / "R1" / "Program" / "main.src"
+    text = MAIN_TEXT.replace("  counter = 0\n", "  countr = 0\n  nowhere( )\n")
+    diags = await open_doc(client, path, text)
+    # E101 (countr) ignored; E106 (nowhere) reported as a warning
+    assert [(str(d.code), d.range.start.line, d.severity) for d in diags] == [("E106", 9, L.DiagnosticSeverity.Warning)]
+    close_doc(client, path)
