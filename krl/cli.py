@@ -27,11 +27,14 @@ def main() -> None:
 @click.option("--json", "as_json", is_flag=True, help="Same as --format json.")
 @click.option("--outline", is_flag=True, help="Print the routines and declarations of each file that parses.")
 @click.option("--tree", is_flag=True, help="Print the grammar-rule outline of each file that parses.")
-def parse(files: tuple[Path, ...], fmt: str, as_json: bool, outline: bool, tree: bool) -> None:
+@click.option("--engine", type=click.Choice(["auto", "python", "java"]), default="auto", show_default=True,
+              help="Parse engine: java (fast; needs a JDK), python (reference; builds trees), auto: "
+                   "java when available. --outline/--tree always use python.")
+def parse(files: tuple[Path, ...], fmt: str, as_json: bool, outline: bool, tree: bool, engine: str) -> None:
     """Parse FILES; exit 0 when every file parses (krl/syntax/cli.py)."""
     from krl.syntax.cli import main_status  # noqa: PLC0415
 
-    sys.exit(main_status(files, fmt, as_json, outline, tree))
+    sys.exit(main_status(files, fmt, as_json, outline, tree, engine))
 
 
 # Each pipeline stage contributes its subcommands from its own package: a module listed

@@ -16,7 +16,9 @@ import click
               help="Report directory.")
 @click.option("--jobs", type=int, default=None, help="Worker processes (default: the number of cores).")
 @click.option("--no-cache", is_flag=True, help="Parse every file again.")
-def recover(corpus: Path, out: Path, jobs: int | None, no_cache: bool) -> None:
+@click.option("--engine", type=click.Choice(["auto", "python", "java"]), default="auto", show_default=True,
+              help="Parse engine: java (fast; needs a JDK), python (the reference), auto: java when available.")
+def recover(corpus: Path, out: Path, jobs: int | None, no_cache: bool, engine: str) -> None:
     """Parse every KRL file under CORPUS (a folder or a KRC backup .zip), cluster the failures,
     write the report to --out.
 
@@ -26,7 +28,9 @@ def recover(corpus: Path, out: Path, jobs: int | None, no_cache: bool) -> None:
     from krl.archive import ArchiveError, backup_source, is_archive  # noqa: PLC0415
     from krl.terminal import printable  # noqa: PLC0415
     from recovery.pipeline import run_recovery  # noqa: PLC0415
+    from krl.syntax.engines import use_engine  # noqa: PLC0415
 
+    use_engine(engine)
     if not corpus.is_dir() and not is_archive(corpus):
         click.echo(f"error: corpus folder or .zip archive not found: {printable(corpus)}", err=True)
         sys.exit(2)

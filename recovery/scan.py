@@ -130,7 +130,7 @@ def scan_one(args: tuple[str, str, str, int]) -> FileResult:
     """Parse one file in a worker. Never raises: failures become classified rows."""
     import time  # noqa: PLC0415
 
-    from krl.syntax.parse import parse_source  # noqa: PLC0415
+    from krl.syntax.engines import parse_source  # noqa: PLC0415  (KRL_ENGINE: python, java, auto)
 
     abs_path, rel_path, sha, timeout = args
     start = time.perf_counter()
