@@ -54,13 +54,17 @@ def recover(corpus: Path, out: Path, jobs: int | None, no_cache: bool, engine: s
 @click.command()
 @click.argument("corpus", type=click.Path(path_type=Path))
 @click.option("--out", default="reports/growth", type=click.Path(path_type=Path))
-@click.option("--jobs", type=int, default=None)
+@click.option("--jobs", type=int, default=None, help="Grammar versions scanned at a time (default: the number of cores).")
 @click.option("--no-cache", is_flag=True)
-def growth(corpus: Path, out: Path, jobs: int | None, no_cache: bool) -> None:
+@click.option("--engine", type=click.Choice(["auto", "python", "java"]), default="auto", show_default=True,
+              help="Parse engine (java: fast, needs a JDK; python: the reference).")
+def growth(corpus: Path, out: Path, jobs: int | None, no_cache: bool, engine: str) -> None:
     """Replay every committed version of grammar/KRL.g4 over CORPUS: growth.csv and growth.png."""
+    from krl.syntax.engines import use_engine  # noqa: PLC0415
     from recovery.grammar_versions import GrammarToolError  # noqa: PLC0415
     from recovery.growth import growth_rows, write_growth  # noqa: PLC0415
 
+    use_engine(engine)
     if not corpus.is_dir():
         click.echo(f"error: corpus directory not found: {corpus}", err=True)
         sys.exit(2)
@@ -82,13 +86,23 @@ def growth(corpus: Path, out: Path, jobs: int | None, no_cache: bool) -> None:
               help="Also report the corpus clusters each construct closed (default: "
                    "../shared/krl-corpus when present).")
 @click.option("--no-corpus", is_flag=True, help="Only run the examples.")
-def validate(names: tuple[str, ...], corpus: Path | None, no_corpus: bool) -> None:
+@click.option("--jobs", type=int, default=None, help="Grammar versions scanned at a time (default: the number of cores).")
+@click.option("--engine", type=click.Choice(["auto", "python", "java"]), default="auto", show_default=True,
+              help="Parse engine for the corpus scans (java: fast, needs a JDK; python: the reference).")
+def validate(names: tuple[str, ...], corpus: Path | None, no_corpus: bool, jobs: int | None, engine: str) -> None:
     """Run every grammar construct's positive and negative examples (or only NAMES)."""
+    from krl.syntax.engines import use_engine  # noqa: PLC0415
+    from recovery.grammar_versions import GrammarToolError  # noqa: PLC0415
     from recovery.validate import DEFAULT_CORPUS, print_validation, validate_constructs  # noqa: PLC0415
 
+    use_engine(engine)
     if corpus is None and not no_corpus and DEFAULT_CORPUS.is_dir():
         corpus = DEFAULT_CORPUS
-    reports = validate_constructs(list(names), corpus=None if no_corpus else corpus)
+    try:
+        reports = validate_constructs(list(names), corpus=None if no_corpus else corpus, jobs=jobs)
+    except GrammarToolError as exc:
+        click.echo(f"error: {exc}", err=True)
+        sys.exit(2)
     ok = print_validation(reports)
     sys.exit(0 if ok else 1)
 

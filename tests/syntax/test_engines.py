@@ -179,3 +179,26 @@ def test_parse_file_takes_bytes_text_and_source():
         assert res.ok and res.status == "ok"
     assert parse_file(b"", "e.src", engine="python").status == "empty"
     assert parse_file(b"DEF\x00", "b.src", engine="python").status == "binary"
+
+
+@needs_java
+def test_engines_agree_on_a_grammar_version_with_python_predicates():
+    """Older grammar versions state two checks as Python predicates; the Java build removes
+    them (java_grammar) and may_fail routes every file where one could fail to Python. The
+    engines agree on tests/negative/ with such a version, and the files that exercise the
+    predicates (DISTANCE, #WORLD) are among those parsed."""
+    _java_or_skip()
+    from recovery.grammar_versions import _git, parser_dir_for  # noqa: PLC0415
+    from krl.syntax.parse import ParserBundle  # noqa: PLC0415
+
+    commits = _git("log", "--format=%H", "--", "grammar/KRL.g4").split()
+    text = next((t for t in (_git("show", f"{c}:grammar/KRL.g4") for c in commits) if "}?<fail=" in t), None)
+    assert text is not None, "no grammar version with predicates in the history"
+    assert "}?" not in java_engine.java_grammar(text)
+    bundle = ParserBundle.from_directory(parser_dir_for(text), tag="predicates")
+    sources = [read_source(p) for p in discover(REPO / "tests" / "negative")]
+    sources.append(SourceText("pred.src", CHECKED, "ascii", len(CHECKED)))
+    py = list(parse_sources(sources, "python", bundle))
+    jv = list(parse_sources(sources, "java", bundle))
+    assert [_record(r) for r in jv] == [_record(r) for r in py]
+    assert not py[-1].ok and [e.line for e in py[-1].errors if not e.cascade] == [2, 3]

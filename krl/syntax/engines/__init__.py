@@ -80,10 +80,17 @@ def resolve(name: str | None = None) -> str:
     return "python"
 
 
+_GRAMMARS: dict[str, str] = {}
+
+
 def _grammar_text(bundle: ParserBundle) -> str:
+    """The grammar a bundle was generated from (its directory's KRL.g4; the working tree's)."""
     directory = bundle.directory
     g4 = Path(directory) / "KRL.g4" if directory is not None else REPO_GRAMMAR
-    return g4.read_text(encoding="utf-8")
+    key = str(g4)
+    if key not in _GRAMMARS:
+        _GRAMMARS[key] = g4.read_text(encoding="utf-8")
+    return _GRAMMARS[key]
 
 
 def _needs_python(text: str) -> bool:
@@ -109,7 +116,12 @@ def parse_sources(sources: Iterable[SourceText], engine: str | None = None,
         return
     from krl.syntax.engines.java import worker_for  # noqa: PLC0415
 
-    worker = worker_for(_grammar_text(bundle), threads)
+    try:
+        worker = worker_for(_grammar_text(bundle), threads)
+    except EngineUnavailable:   # this grammar version does not build for Java: the reference
+        for src in sources:
+            yield _py_parse_source(src, bundle, keep_tree=False)
+        return
     results: list[ParseResult | None] = [None] * len(sources)
     texts: list[str] = []
     where: list[int] = []

@@ -19,6 +19,7 @@ import atexit
 import hashlib
 import json
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -105,33 +106,117 @@ def _build_once(target: Path, make) -> Path:
     return target
 
 
+WORKER_SOURCES = (WORKER_SOURCE, WORKER_SOURCE.parent / "KrlBuild.java")
+
+
 def worker_classes() -> Path:
-    """The compiled KrlWorker (built once per source hash)."""
+    """The compiled KrlWorker and KrlBuild (built once per hash of their sources)."""
     reason = unavailable_reason()
     if reason:
         raise EngineUnavailable(reason)
-    source = WORKER_SOURCE.read_bytes()
-    target = build_root() / f"worker-{_sha(source)[:16]}"
+    digest = _sha(b"".join(p.read_bytes() for p in WORKER_SOURCES))
+    target = build_root() / f"worker-{digest[:16]}"
 
     def make(tmp: Path) -> None:
         _run(["javac", "-nowarn", "-encoding", "UTF-8", "-cp", str(antlr_jar()), "-d", str(tmp),
-              str(WORKER_SOURCE)], "javac (KrlWorker.java)")
+              *map(str, WORKER_SOURCES)], "javac (worker)")
 
     return _build_once(target, make)
 
 
+def java_target(grammar_text: str) -> Path:
+    return build_root() / _sha(grammar_text.encode("utf-8"))[:32]
+
+
+def build_many(tasks: list[tuple[str, str, Path]], jobs: int = 1) -> dict[Path, str]:
+    """Generate many parsers in `jobs` JVMs (KrlBuild): tasks are (language "python" or "java",
+    grammar text, target directory); a target that exists is skipped. The python layout is
+    recovery/grammar_versions.py's (KRL.g4 and the generated modules); the java one is
+    :func:`grammar_classes`'. Returns {target: reason} of the builds that failed (a java failure
+    is also remembered on disk, so that no process tries that grammar again)."""
+    todo = [(lang, text, Path(target)) for lang, text, target in tasks
+            if not Path(target).is_dir() and not _failed_marker(Path(target)).exists()]
+    if not todo:
+        return {}
+    worker = worker_classes()
+    tmps: dict[str, tuple[Path, Path, str]] = {}
+    argv: list[list[str]] = [[] for _ in range(max(1, min(jobs, len(todo))))]
+    for k, (lang, text, target) in enumerate(todo):
+        target.parent.mkdir(parents=True, exist_ok=True)
+        tmp = Path(tempfile.mkdtemp(prefix=target.name + ".", dir=target.parent))
+        if lang == "java":
+            (tmp / "gen").mkdir()
+            g4 = tmp / "gen" / "KRL.g4"
+            g4.write_text(java_grammar(text), encoding="utf-8")
+        else:
+            g4 = tmp / "KRL.g4"
+            g4.write_text(text, encoding="utf-8")
+        tmps[str(tmp)] = (tmp, target, lang)
+        argv[k % len(argv)] += [lang, str(g4), str(tmp)]
+    cp = os.pathsep.join([str(antlr_jar()), str(worker)])
+    procs = [subprocess.Popen(["java", "-cp", cp, "KrlBuild", *args], stdout=subprocess.PIPE,
+                              stderr=subprocess.DEVNULL, text=True) for args in argv if args]
+    failed: dict[Path, str] = {}
+    answered: set[str] = set()
+    for proc in procs:
+        out, _ = proc.communicate()
+        for line in out.splitlines():
+            status, _, rest = line.partition(" ")
+            path, _, reason = rest.partition(" ") if status == "fail" else (rest, "", "")
+            if path not in tmps:
+                continue
+            answered.add(path)
+            tmp, target, lang = tmps[path]
+            if status == "ok":
+                try:
+                    tmp.rename(target)
+                except OSError:
+                    if not target.is_dir():
+                        failed[target] = "could not move the build into place"
+            else:
+                failed[target] = reason
+                if lang == "java":
+                    _failed_marker(target).write_text(reason, encoding="utf-8")
+    for path, (tmp, target, _lang) in tmps.items():
+        if path not in answered:
+            failed[target] = "the build JVM stopped early"
+        shutil.rmtree(tmp, ignore_errors=True)
+    return failed
+
+
+def _failed_marker(target: Path) -> Path:
+    return target.with_name(target.name + ".failed")
+
+
+# A semantic predicate with its fail option, as older grammar versions wrote them (in Python):
+# `{$point.text in ("0", "1")}?<fail={"..."}>`.
+_PREDICATE = re.compile(r"\{[^{}]*\}\?(?:<fail=\{[^{}]*\}>)?")
+
+
+def java_grammar(grammar_text: str) -> str:
+    """The grammar for the Java target: semantic predicates (Python code, in grammar versions
+    before they became post-parse checks) removed. Their conditions are exactly the token checks
+    of krl/syntax/checks.py, and a file on which one could fail (``may_fail``) is parsed by the
+    Python engine, so the removal changes no result."""
+    return _PREDICATE.sub("", grammar_text)
+
+
 def grammar_classes(grammar_text: str) -> Path:
-    """The Java lexer and parser generated from grammar text and compiled (once per sha)."""
+    """The Java lexer and parser generated from grammar text and compiled (once per sha of
+    the text)."""
     reason = unavailable_reason()
     if reason:
         raise EngineUnavailable(reason)
     gsha = _sha(grammar_text.encode("utf-8"))
     target = build_root() / gsha[:32]
+    if _failed_marker(target).exists():
+        raise EngineUnavailable(f"grammar {gsha[:12]} does not build for Java: "
+                                + _failed_marker(target).read_text(encoding="utf-8")[:300])
 
     def make(tmp: Path) -> None:
         gen = tmp / "gen"
         gen.mkdir()
-        (gen / "KRL.g4").write_text(grammar_text, encoding="utf-8")
+        (gen / "KRL.g4").write_text(java_grammar(grammar_text), encoding="utf-8")
         _run(["java", "-cp", str(antlr_jar()), "org.antlr.v4.Tool", "-Dlanguage=Java", "-no-listener",
               "-no-visitor", "-Xexact-output-dir", "-o", str(gen), str(gen / "KRL.g4")],
              f"the ANTLR tool (grammar {gsha[:12]})")
@@ -238,15 +323,22 @@ class JavaWorker:
 
 _WORKERS: dict[tuple[str, int], JavaWorker] = {}
 _WORKERS_LOCK = threading.Lock()
+_FAILED: dict[str, str] = {}
 
 
 def worker_for(grammar_text: str, threads: int = 1) -> JavaWorker:
     """The (cached) worker of a grammar version; started on first use."""
     key = (_sha(grammar_text.encode("utf-8")), threads)
     with _WORKERS_LOCK:
+        if key[0] in _FAILED:       # a failed build is not retried in this process
+            raise EngineUnavailable(_FAILED[key[0]])
         w = _WORKERS.get(key)
         if w is None:
-            w = _WORKERS[key] = JavaWorker(grammar_text, threads)
+            try:
+                w = _WORKERS[key] = JavaWorker(grammar_text, threads)
+            except EngineUnavailable as exc:
+                _FAILED[key[0]] = str(exc)
+                raise
         return w
 
 
