@@ -93,11 +93,22 @@ def _grammar_text(bundle: ParserBundle) -> str:
     return _GRAMMARS[key]
 
 
+_NEEDS: dict[tuple[int, int], bool] = {}
+
+
 def _needs_python(text: str) -> bool:
+    """True when a Python-only check could change the result of `text` (grammar-independent,
+    so remembered per text for the many grammar versions of `krl growth`)."""
     from krl.syntax.blocks import may_pass_limit  # noqa: PLC0415
     from krl.syntax.checks import may_fail  # noqa: PLC0415
 
-    return may_fail(text) or may_pass_limit(text)
+    key = (hash(text), len(text))
+    found = _NEEDS.get(key)
+    if found is None:
+        if len(_NEEDS) > 100_000:
+            _NEEDS.clear()
+        found = _NEEDS[key] = may_fail(text) or may_pass_limit(text)
+    return found
 
 
 def parse_sources(sources: Iterable[SourceText], engine: str | None = None,
