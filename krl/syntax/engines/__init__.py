@@ -146,8 +146,11 @@ def parse_sources(sources: Iterable[SourceText], engine: str | None = None,
         texts.append(text)
         where.append(i)
     answers: dict[int, dict] = {}
-    for k, raw in worker.parse_raw(texts):
-        answers[k] = raw
+    try:
+        for k, raw in worker.parse_raw(texts):
+            answers[k] = raw
+    except WorkerError:
+        pass    # the worker died (it is restarted next time): the rest goes to the Python engine
     for k, i in enumerate(where):
         raw = answers.get(k)
         if raw is not None and "fail" not in raw:
