@@ -27,10 +27,10 @@ def main() -> None:
 @click.option("--json", "as_json", is_flag=True, help="Same as --format json.")
 @click.option("--outline", is_flag=True, help="Print the routines and declarations of each file that parses.")
 @click.option("--tree", is_flag=True, help="Print the grammar-rule outline of each file that parses.")
-@click.option("--engine", type=click.Choice(["auto", "python", "java"]), default="auto", show_default=True,
+@click.option("--engine", type=click.Choice(["auto", "python", "java"]), default=None,
               help="Parse engine: java (fast; needs a JDK), python (reference; builds trees), auto: "
-                   "java when available. --outline/--tree always use python.")
-def parse(files: tuple[Path, ...], fmt: str, as_json: bool, outline: bool, tree: bool, engine: str) -> None:
+                   "java when available (default: $KRL_ENGINE, else auto). --outline/--tree use python.")
+def parse(files: tuple[Path, ...], fmt: str, as_json: bool, outline: bool, tree: bool, engine: str | None) -> None:
     """Parse FILES; exit 0 when every file parses (krl/syntax/cli.py)."""
     from krl.syntax.cli import main_status  # noqa: PLC0415
 

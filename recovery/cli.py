@@ -16,9 +16,10 @@ import click
               help="Report directory.")
 @click.option("--jobs", type=int, default=None, help="Worker processes (default: the number of cores).")
 @click.option("--no-cache", is_flag=True, help="Parse every file again.")
-@click.option("--engine", type=click.Choice(["auto", "python", "java"]), default="auto", show_default=True,
-              help="Parse engine: java (fast; needs a JDK), python (the reference), auto: java when available.")
-def recover(corpus: Path, out: Path, jobs: int | None, no_cache: bool, engine: str) -> None:
+@click.option("--engine", type=click.Choice(["auto", "python", "java"]), default=None,
+              help="Parse engine: java (fast; needs a JDK), python (the reference), auto: java when available "
+                   "(default: $KRL_ENGINE, else auto).")
+def recover(corpus: Path, out: Path, jobs: int | None, no_cache: bool, engine: str | None) -> None:
     """Parse every KRL file under CORPUS (a folder or a KRC backup .zip), cluster the failures,
     write the report to --out.
 
@@ -56,9 +57,9 @@ def recover(corpus: Path, out: Path, jobs: int | None, no_cache: bool, engine: s
 @click.option("--out", default="reports/growth", type=click.Path(path_type=Path))
 @click.option("--jobs", type=int, default=None, help="Grammar versions scanned at a time (default: the number of cores).")
 @click.option("--no-cache", is_flag=True)
-@click.option("--engine", type=click.Choice(["auto", "python", "java"]), default="auto", show_default=True,
-              help="Parse engine (java: fast, needs a JDK; python: the reference).")
-def growth(corpus: Path, out: Path, jobs: int | None, no_cache: bool, engine: str) -> None:
+@click.option("--engine", type=click.Choice(["auto", "python", "java"]), default=None,
+              help="Parse engine (java: fast, needs a JDK; python: the reference; default: $KRL_ENGINE, else auto).")
+def growth(corpus: Path, out: Path, jobs: int | None, no_cache: bool, engine: str | None) -> None:
     """Replay every committed version of grammar/KRL.g4 over CORPUS: growth.csv and growth.png."""
     from krl.syntax.engines import use_engine  # noqa: PLC0415
     from recovery.grammar_versions import GrammarToolError  # noqa: PLC0415
@@ -87,9 +88,11 @@ def growth(corpus: Path, out: Path, jobs: int | None, no_cache: bool, engine: st
                    "../shared/krl-corpus when present).")
 @click.option("--no-corpus", is_flag=True, help="Only run the examples.")
 @click.option("--jobs", type=int, default=None, help="Grammar versions scanned at a time (default: the number of cores).")
-@click.option("--engine", type=click.Choice(["auto", "python", "java"]), default="auto", show_default=True,
-              help="Parse engine for the corpus scans (java: fast, needs a JDK; python: the reference).")
-def validate(names: tuple[str, ...], corpus: Path | None, no_corpus: bool, jobs: int | None, engine: str) -> None:
+@click.option("--engine", type=click.Choice(["auto", "python", "java"]), default=None,
+              help="Parse engine for the corpus scans (java: fast, needs a JDK; python: the reference; "
+                   "default: $KRL_ENGINE, else auto).")
+def validate(names: tuple[str, ...], corpus: Path | None, no_corpus: bool, jobs: int | None,
+             engine: str | None) -> None:
     """Run every grammar construct's positive and negative examples (or only NAMES)."""
     from krl.syntax.engines import use_engine  # noqa: PLC0415
     from recovery.grammar_versions import GrammarToolError  # noqa: PLC0415

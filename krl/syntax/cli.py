@@ -74,7 +74,7 @@ def run_parse(files, fmt: str = "text", outline: bool = False, tree: bool = Fals
     return 0 if all_ok else 1
 
 
-def main_status(files, fmt, as_json, outline, tree, engine: str = "auto") -> int:
+def main_status(files, fmt, as_json, outline, tree, engine: str | None = None) -> int:
     """The `parse` command's body (krl/cli.py keeps only the options)."""
     from krl.syntax.engines import use_engine  # noqa: PLC0415
 

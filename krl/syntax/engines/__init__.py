@@ -43,10 +43,11 @@ def set_default(name: str) -> None:
     os.environ["KRL_ENGINE"] = name
 
 
-def use_engine(name: str) -> str:
-    """For the --engine options: resolve `name`, make it the default of this process and its
-    children, and return the engine that will run. An unavailable "java" is a message on
-    stderr and exit status 2, never a traceback."""
+def use_engine(name: str | None) -> str:
+    """For the --engine options: resolve `name` (None: KRL_ENGINE, else auto), make it the
+    default of this process and its children, and return the engine that will run. An
+    unavailable "java" is a message on stderr and exit status 2, never a traceback."""
+    name = name or os.environ.get("KRL_ENGINE") or "auto"
     try:
         chosen = resolve(name)
     except EngineUnavailable as exc:
