@@ -422,3 +422,26 @@ def test_any_lexer_string_through_swrite_and_messages_leaves_tree_equal_vm(tmp_p
         shown = text.split("\0")[0]
         assert messages[0] == f"KRL message: <{shown}>"
         assert len(messages) == 2
+
+
+# ---------------------------------------------------------------- the console of `krl run`
+@pytest.mark.parametrize("interp", ["tree", "vm"])
+@pytest.mark.parametrize("case, src, dat, shown", [
+    ("nesting", nested_ifs(MAX_NESTING + 1), None, f"prog.src:{3 + MAX_NESTING + 1}:1: nesting too deep"),
+    ("memory", "DEF prog()\n  a[1] = 1\nEND\n", "DEFDAT prog\n  DECL INT a[100000000]\nENDDAT\n",
+     "prog.dat:2: data memory exhausted"),
+    ("cast", "DEF prog()\n  p = -4\n  CAST_FROM(buf[], p, x)\nEND\n", CAST_DAT, "prog.src:3: CAST_FROM: offset -4"),
+])
+def test_krl_run_shows_the_limit_with_its_place(tmp_path, interp, case, src, dat, shown):
+    """`krl run`: exit 1 (a KRL run-time error), the message with file:line, no internal error."""
+    from click.testing import CliRunner
+
+    from krl.cli import main
+
+    (tmp_path / "prog.src").write_text(src)
+    if dat is not None:
+        (tmp_path / "prog.dat").write_text(dat)
+    res = CliRunner().invoke(main, ["run", "--interp", interp, str(tmp_path / "prog.src")])
+    assert res.exit_code == 1, res.output
+    assert shown in res.output
+    assert "internal error" not in res.output and "Traceback" not in res.output
