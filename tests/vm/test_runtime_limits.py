@@ -445,3 +445,12 @@ def test_krl_run_shows_the_limit_with_its_place(tmp_path, interp, case, src, dat
     assert res.exit_code == 1, res.output
     assert shown in res.output
     assert "internal error" not in res.output and "Traceback" not in res.output
+
+
+def test_a_construct_that_cannot_be_built_stops_the_start(tmp_path):
+    """E003: an INT literal of 5000 digits cannot become a value; the program does not start
+    on either interpreter and the error names its line (3)."""
+    src = "DEF prog()\n  DECL INT i\n  i = " + "9" * 5000 + "\n  i = 0\nEND\n"
+    res, ev, _ = run_both(tmp_path, src)
+    assert_error(res, r"cannot start: .*prog\.src:3:3: cannot build", 3)
+    assert [e["kind"] for e in ev] == ["end"]
