@@ -454,3 +454,33 @@ def test_a_construct_that_cannot_be_built_stops_the_start(tmp_path):
     res, ev, _ = run_both(tmp_path, src)
     assert_error(res, r"cannot start: .*prog\.src:3:3: cannot build", 3)
     assert [e["kind"] for e in ev] == ["end"]
+
+
+# ---------------------------------------------------------------- the format engine on any format
+_FORMAT_CHARS = "%%%-+ 0#.0123456789\u00b2\u0663dixXofFeEgGcsqlhL;ab"
+_VALUES = st.lists(st.one_of(st.integers(-2**31, 2**31 - 1), st.floats(allow_nan=True, allow_infinity=True),
+                             st.booleans(), st.text(max_size=3)), max_size=4)
+
+
+@settings(max_examples=examples(200))
+@given(fmt=st.text(alphabet=_FORMAT_CHARS, max_size=16), values=_VALUES, room=st.integers(0, 30),
+       src=st.text(alphabet="0123456789 +-.eE\u00b2xf", max_size=12))
+def test_any_format_is_text_a_format_error_or_a_krl_error(fmt, values, room, src):
+    """SWRITE/SREAD on any format and values: a text that fits, a format error, or a KRL
+    run-time error (a value that does not suit its conversion), never a Python exception."""
+    from interp.runtime.builtins import sread_values, swrite_text
+    from interp.runtime.errors import KrlRuntimeError
+
+    try:
+        text, hits, error = swrite_text(fmt, values, room)
+    except KrlRuntimeError:
+        pass
+    else:
+        assert len(text) <= room and 0 <= hits <= len(values)
+        assert error is None or error.startswith("format error")
+    try:
+        got, pos, error = sread_values(src, fmt)
+    except KrlRuntimeError:
+        pass
+    else:
+        assert 0 <= pos <= len(src) and (error is None or error.startswith("format error"))
