@@ -86,6 +86,22 @@ def test_huge_data_list_array_is_an_error_at_its_dat_line(tmp_path):
     assert_error(res, rf"data memory exhausted: a needs {HUGE}", 3, "prog.dat")
 
 
+def test_data_list_of_a_module_loaded_during_the_run(tmp_path):
+    """OTHER's data list is loaded when OTHER is first called (line 3): its DECL is the error."""
+    (tmp_path / "other.src").write_text("DEF other()\n  big[1] = 1\nEND\n")
+    (tmp_path / "other.dat").write_text("DEFDAT other\n  DECL INT big[2000000]\nENDDAT\n")
+    res, _, _ = run_both(tmp_path, "DEF prog()\n  n = 1\n  OTHER()\nEND\n", "DEFDAT prog\n  DECL INT n\nENDDAT\n")
+    assert_error(res, r"data memory exhausted: big needs 2000000", 2, "other.dat")
+
+
+def test_config_dat_past_the_limit_stops_the_start(tmp_path):
+    """$config.dat is loaded before the run: the program does not start; the error is its DECL."""
+    (tmp_path / "$config.dat").write_text("DEFDAT $CONFIG\n  DECL GLOBAL INT n\n  DECL GLOBAL INT big[3000000]\nENDDAT\n")
+    res, ev, _ = run_both(tmp_path, "DEF prog()\n  n = 1\nEND\n")
+    assert_error(res, r"data memory exhausted: big needs 3000000", 3, "$config.dat")
+    assert [e["kind"] for e in ev] == ["end"]
+
+
 def test_nested_struc_arrays_count_every_element(tmp_path):
     # 100 000 x (1 structure + 1000 INT + 1 REAL) = 100 200 000 elements
     dat = "DEFDAT prog\n  STRUC SS INT A[1000], REAL B\nENDDAT\n"
