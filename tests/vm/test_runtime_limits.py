@@ -99,7 +99,7 @@ def test_config_dat_past_the_limit_stops_the_start(tmp_path):
     (tmp_path / "$config.dat").write_text("DEFDAT $CONFIG\n  DECL GLOBAL INT n\n  DECL GLOBAL INT big[3000000]\nENDDAT\n")
     res, ev, _ = run_both(tmp_path, "DEF prog()\n  n = 1\nEND\n")
     assert_error(res, r"data memory exhausted: big needs 3000000", 3, "$config.dat")
-    assert [e["kind"] for e in ev] == ["end"]
+    assert [e["kind"] for e in ev] == ["error", "end"]
 
 
 def test_nested_struc_arrays_count_every_element(tmp_path):
@@ -312,7 +312,7 @@ def test_nesting_past_the_budget_stops_the_start(tmp_path):
     interpreter; the error names the IF that went past it (line 3 + its depth)."""
     res, ev, _ = run_both(tmp_path, nested_ifs(MAX_NESTING + 1))
     assert_error(res, rf"cannot start: .*prog\.src:{3 + MAX_NESTING + 1}:1: nesting too deep", 3 + MAX_NESTING + 1)
-    assert [e["kind"] for e in ev] == ["end"]      # not one statement ran
+    assert [e["kind"] for e in ev] == ["error", "end"]      # not one statement ran
 
 
 def test_deep_recursion_is_a_stack_overflow_at_the_call(tmp_path):
@@ -327,7 +327,7 @@ def test_too_long_expression_stops_the_start(tmp_path, terms):
     src = "DEF prog()\n  DECL INT i\n  i = " + " + ".join(["1"] * terms) + "\n  i = 0\nEND\n"
     res, ev, _ = run_both(tmp_path, src)
     assert_error(res, rf"cannot start: .*prog\.src:3:3: expression too long: more than {MAX_EXPRESSION_TERMS} terms", 3)
-    assert [e["kind"] for e in ev] == ["end"]
+    assert [e["kind"] for e in ev] == ["error", "end"]
 
 
 def test_longest_expression_runs_alike(tmp_path):
@@ -469,7 +469,7 @@ def test_a_construct_that_cannot_be_built_stops_the_start(tmp_path):
     src = "DEF prog()\n  DECL INT i\n  i = " + "9" * 5000 + "\n  i = 0\nEND\n"
     res, ev, _ = run_both(tmp_path, src)
     assert_error(res, r"cannot start: .*prog\.src:3:3: cannot build", 3)
-    assert [e["kind"] for e in ev] == ["end"]
+    assert [e["kind"] for e in ev] == ["error", "end"]
 
 
 # ---------------------------------------------------------------- the format engine on any format
