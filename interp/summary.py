@@ -112,7 +112,9 @@ def summary_lines(result: Any, observer: RunObserver, *, program: str, interp: s
     if result.reason == "completed":
         out.append(f"  ended      {ending} at t={result.sim_time:.3f} s")
     else:
-        detail = _clip(result.text) if result.text else ""
+        # how the run ended is the one message the user came for: shown whole (printable), never
+        # clipped like the list of KRL messages below
+        detail = printable(result.text) if result.text else ""
         num = ""
         if result.error is not None and getattr(result.error, "number", None):
             num = f" [{result.error.number}]"

@@ -12,6 +12,7 @@ from pathlib import Path
 import click
 
 from krl import __version__
+from krl.limits import PARSE_TIMEOUT_S
 
 
 @click.group(context_settings={"help_option_names": ["-h", "--help"]})
@@ -30,11 +31,16 @@ def main() -> None:
 @click.option("--engine", type=click.Choice(["auto", "python", "java"]), default=None,
               help="Parse engine: java (fast; needs a JDK), python (reference; builds trees), auto: "
                    "java when available (default: $KRL_ENGINE, else auto). --outline/--tree use python.")
-def parse(files: tuple[Path, ...], fmt: str, as_json: bool, outline: bool, tree: bool, engine: str | None) -> None:
+@click.option("--timeout", type=click.FloatRange(min=0, min_open=True), default=PARSE_TIMEOUT_S,
+              show_default=True, help="Seconds one file may parse; past it the parse is stopped (error E005).")
+@click.option("--jobs", type=click.IntRange(min=1), default=None,
+              help="Worker processes (default: the number of cores).")
+def parse(files: tuple[Path, ...], fmt: str, as_json: bool, outline: bool, tree: bool, timeout: float,
+          jobs: int | None, engine: str | None) -> None:
     """Parse FILES; exit 0 when every file parses (krl/syntax/cli.py)."""
     from krl.syntax.cli import main_status  # noqa: PLC0415
 
-    sys.exit(main_status(files, fmt, as_json, outline, tree, engine))
+    sys.exit(main_status(files, fmt, as_json, outline, tree, timeout, jobs, engine))
 
 
 # Each pipeline stage contributes its subcommands from its own package: a module listed

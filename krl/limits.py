@@ -15,6 +15,12 @@ from __future__ import annotations
 # of magnitude chosen here. Past it: "nesting too deep" at the opener that went past it.
 MAX_NESTING = 100
 
+# The deepest nesting of KRL routine calls at run time (both interpreters, interrupt routines
+# included). The reference (§8.2) leaves the limit open and suggests about 100 levels; real
+# programs call a few levels deep. Past it: the run-time error "stack overflow: more than 100
+# nested calls" at the call (interp/runtime/core.py).
+MAX_CALL_DEPTH = 100
+
 # The largest source file read, in bytes (krl/syntax/source.py).
 MAX_FILE_BYTES = 10 * 1024 * 1024
 
@@ -24,6 +30,17 @@ MAX_FILE_BYTES = 10 * 1024 * 1024
 # binary operators nests one level per operator. Past it: error E019 "expression too long" at
 # the statement's line (the file does not parse; the program does not start).
 MAX_EXPRESSION_TERMS = 500
+
+# The deepest folder a walk of a corpus or a KRC backup enters (krl/files.py), in folder levels
+# below the root. Real backups are about 6 levels deep (KRC/R1/Program/<cell>/<folder>); the walk is
+# iterative, so the limit keeps paths and report rows readable, not the stack safe. Past it: the
+# folder is listed as a row / warning "too_deep" and not entered.
+MAX_FOLDER_DEPTH = 100
+
+# The time one file may take to parse (krl recover, krl parse, krl check), in seconds of wall time
+# in a worker process; past it the worker is killed and the file gets a "timeout" row / error.
+# The largest corpus file (about 150 KB) parses in about a second; a 9.5 MB file took over 300 s.
+PARSE_TIMEOUT_S = 30
 
 # KRC backup archives (.zip) given to `krl check`, `krl recover` and `krl run` (krl/archive.py).
 # Every entry is inspected before anything is written; past a limit the archive is refused with
@@ -41,3 +58,13 @@ MAX_ARCHIVE_RATIO = 200
 MAX_ARCHIVE_RATIO_FLOOR = 4096
 # Levels of an entry's path, file name included (KRC/R1/Program/x.src has 4).
 MAX_ARCHIVE_DEPTH = 32
+
+# The run's data memory, in data elements: every scalar value (INT, REAL, BOOL, CHAR, ENUM) and
+# every structure value held by a declared variable counts one (an array of n elements counts n
+# times its element; `DECL E6POS P[10]` is 10 x 13 = 130). Data lists (.dat, $config.dat), the
+# locals of every active routine call and the copies of :IN parameters are counted together;
+# a routine's share is given back when it returns. 2^20 elements is about 4 MiB of controller
+# data at 4 bytes an element, far above the largest real data list (the corpus's biggest array
+# has 8192 elements) and a few hundred MB of Python at most. Past it: the run-time error "data
+# memory exhausted" at the DECL line, before anything is allocated (interp/runtime/memory.py).
+MAX_DATA_ELEMENTS = 1 << 20

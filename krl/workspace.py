@@ -40,7 +40,7 @@ from krl.semantics.diagnostics import Diagnostic, DiagnosticSink
 from krl.semantics.symbols import Scope, Symbol, system_scopes
 from krl.syntax.folds import fold_diagnostics
 from krl.syntax.messages import syntax_diagnostics
-from krl.syntax.parse import parse_source
+from krl.syntax.parse import ParseResult, parse_source
 from krl.syntax.source import is_krl_file, read_source
 
 
@@ -53,6 +53,48 @@ class SourceFile:
     status: str = "ok"
     scope: Scope | None = None
     parse_seconds: float = 0.0
+
+
+@dataclass(slots=True)
+class LoadedFile:
+    """One file read, parsed and built, apart from any workspace (picklable: it may come from
+    a worker process): its AST, its diagnostics (input, syntax, build) and what a failed
+    parse leaves for name lookup."""
+    path: str
+    module: N.Module
+    ok: bool
+    status: str
+    parse_seconds: float
+    build_seconds: float
+    diagnostics: list
+    unreadable: bool = False
+    failed_words: set = field(default_factory=set)
+
+
+def load_file(path: str | Path) -> LoadedFile:
+    """Read (krl.syntax.source.read_source), parse and build one file; never raises for bad
+    content."""
+    t = time.perf_counter()
+    src = read_source(path)
+    result = parse_source(src)
+    elapsed = time.perf_counter() - t
+    path_s = str(path)
+    sink = DiagnosticSink()
+    if result.status not in ("ok", "syntax_error") and not result.errors:
+        sink.add(path_s, 1, 1, "E001", f"file not checked: {result.status}"
+                 + (f" ({src.detail})" if src.detail else ""))
+    sink.extend(syntax_diagnostics(result, src.text))
+    sink.extend(fold_diagnostics(path_s, src.text))
+    t = time.perf_counter()
+    unreadable, words = False, set()
+    if not result.ok:
+        if result.status in ("binary", "too_large", "unreadable", "not_regular"):
+            unreadable = True
+        elif src.text:
+            words = {w.upper() for w in _WORD.findall(src.text)}
+    module = build_module(result, sink)
+    return LoadedFile(path_s, module, result.ok, result.status, elapsed, time.perf_counter() - t,
+                      sink.items, unreadable, words)
 
 
 @dataclass(slots=True)
@@ -91,7 +133,7 @@ class Workspace:
     def _note_failed(self, result, text: str) -> None:
         if result.ok:
             return
-        if result.status in ("binary", "too_large", "unreadable"):
+        if result.status in ("binary", "too_large", "unreadable", "not_regular"):
             self.unreadable = True
         elif text:
             self.failed_words.update(w.upper() for w in _WORD.findall(text))
@@ -122,25 +164,53 @@ class Workspace:
 
     def add_file(self, path: str | Path) -> SourceFile:
         """Read, parse and build one file (never raises for bad content)."""
-        t = time.perf_counter()
-        src = read_source(path)
-        result = parse_source(src)
-        elapsed = time.perf_counter() - t
-        self.parse_seconds += elapsed
-        path_s = str(path)
-        if result.status not in ("ok", "syntax_error") and not result.errors:
-            self.sink.add(path_s, 1, 1, "E001", f"file not checked: {result.status}"
-                          + (f" ({src.detail})" if src.detail else ""))
-        self.sink.extend(syntax_diagnostics(result, src.text))
-        self.sink.extend(fold_diagnostics(path_s, src.text))
+        return self._add_loaded(load_file(path))
+
+    def add_files(self, paths, timeout: float | None = None, jobs: int | None = None) -> None:
+        """:meth:`add_file` for each of `paths`, in order. With `timeout` (seconds per file) each
+        file is read, parsed and built in a worker process (krl/pool.py) that is killed past the
+        timeout: the file gets error E005 and the other files are still checked. A worker that
+        dies (a crash of the parser) gives error E001 for its file."""
+        paths = list(paths)
+        if timeout is None or not paths:
+            for p in paths:
+                self.add_file(p)
+            return
+        from krl.pool import run_tasks  # noqa: PLC0415
+
+        from krl.syntax.parse import default_bundle  # noqa: PLC0415
+
+        default_bundle()    # imported once here, inherited by the forked workers
         hook = _ON_FILE.get()
+        done = {}
+        for o in run_tasks(load_file, ((i, (p,)) for i, p in enumerate(paths)), jobs=jobs, timeout=timeout):
+            done[o.key] = o
+            if hook is not None:
+                hook(str(paths[o.key]))      # progress as files finish, in any order
+        for i, p in enumerate(paths):
+            o = done[i]
+            if o.status == "done":
+                self._add_loaded(o.value, notify=False)
+                continue
+            if o.status == "timeout":
+                self.sink.add(str(p), 1, 1, "E005", f"file not checked: not parsed within {timeout:g} s "
+                              "(--timeout; the parse was stopped)")
+            else:
+                self.sink.add(str(p), 1, 1, "E001", f"file not checked: {o.detail}")
+            self.unreadable = True
+            module = build_module(ParseResult(str(p), False, "", o.status), DiagnosticSink())
+            self.files.append(SourceFile(str(p), module, False, o.status))
+
+    def _add_loaded(self, lf: "LoadedFile", notify: bool = True) -> SourceFile:
+        self.parse_seconds += lf.parse_seconds
+        self.check_seconds += lf.build_seconds
+        self.sink.extend(lf.diagnostics)
+        self.unreadable |= lf.unreadable
+        self.failed_words |= lf.failed_words
+        hook = _ON_FILE.get() if notify else None
         if hook is not None:
-            hook(path_s)
-        t = time.perf_counter()
-        self._note_failed(result, src.text)
-        module = build_module(result, self.sink)
-        self.check_seconds += time.perf_counter() - t
-        sf = SourceFile(path_s, module, result.ok, result.status, parse_seconds=elapsed)
+            hook(lf.path)
+        sf = SourceFile(lf.path, lf.module, lf.ok, lf.status, parse_seconds=lf.parse_seconds)
         self.files.append(sf)
         return sf
 
@@ -372,13 +442,15 @@ def _casefold_child(folder: Path, name: str) -> Path | None:
 
 def find_backups(root: str | Path) -> list[Path]:
     """Backup roots below `root`: folders with R1/System/$config.dat (the root is the folder
-    holding R1, e.g. KRC) or System/$config.dat (a flat R1 export). Any letter case; sorted."""
+    holding R1, e.g. KRC) or System/$config.dat (a flat R1 export). Any letter case; sorted.
+    The walk is krl.files.walk: iterative, links never followed."""
+    from krl.files import walk  # noqa: PLC0415
+
     root = Path(root)
     found: set[Path] = set()
-    try:
-        candidates = [p for p in root.rglob("*") if p.name.lower() == "$config.dat" and p.is_file()]
-    except OSError:
-        candidates = []
+    if not root.is_dir():
+        return []
+    candidates = [e.path for e in walk(root, match=lambda n: n.lower() == "$config.dat") if e.kind == "file"]
     for cfg in candidates:
         system = cfg.parent
         if system.name.lower() != "system":
@@ -390,27 +462,48 @@ def find_backups(root: str | Path) -> list[Path]:
     return [r for r in roots if not any(o != r and o in r.parents for o in roots)]
 
 
+def collect_entries(path: Path) -> list:
+    """The KRL entries (:class:`krl.files.Entry`) of a file or folder, in walk order: a folder is
+    walked (krl/files.py: links and FIFOs listed, never read; unreadable or too deep folders
+    listed); anything else that exists is one ``file`` entry, classified when it is read."""
+    from krl.files import Entry, walk  # noqa: PLC0415
+
+    if path.is_dir() and not path.is_symlink():
+        return list(walk(path))
+    if path.is_symlink() and path.is_dir():
+        return [Entry(path, path.name, "symlink")]
+    return [Entry(path, path.name, "file")]
+
+
 def collect_files(path: Path) -> list[Path]:
-    """KRL files (.src, .dat, .sub in any case) of a file or folder, sorted."""
-    if path.is_file():
-        return [path]
-    try:
-        return sorted(p for p in path.rglob("*") if p.is_file() and is_krl_file(p))
-    except OSError:
-        return []
+    """KRL files (.src, .dat, .sub in any case) of a file or folder, in walk order (regular
+    files only; see :func:`collect_entries` for the rest)."""
+    return [e.path for e in collect_entries(path) if e.kind == "file"]
 
 
-def load_workspace(paths: list[str | Path], root: str = "") -> Workspace:
+def _add_entries(ws: "Workspace", entries, timeout: float | None = None, jobs: int | None = None) -> None:
+    ws.add_files([e.path for e in entries if e.kind == "file"], timeout=timeout, jobs=jobs)
+    for e in entries:
+        if e.kind != "file":
+            ws.sink.add(str(e.path), 1, 1, "W002", f"not read: {e.message}")
+            ws.unreadable = True   # it may declare what the other files use
+
+
+def load_workspace(paths: list[str | Path], root: str = "", timeout: float | None = None,
+                   jobs: int | None = None) -> Workspace:
     """One workspace from files and/or folders (all files of the folders). Never raises for
-    bad content; a path that does not exist gives an E001 diagnostic."""
+    bad content; a path that does not exist gives an E001 diagnostic; a link, FIFO, unreadable
+    or too deep folder met in a folder gives a W002 warning and is not read. With `timeout`
+    (seconds per file) files are parsed in worker processes (:meth:`Workspace.add_files`)."""
     ws = Workspace(root or (str(paths[0]) if paths else ""))
+    entries = []
     for p in paths:
         p = Path(p)
-        if not p.exists():
+        if not p.exists() and not p.is_symlink():
             ws.sink.add(str(p), 1, 1, "E001", "no such file or folder")
             continue
-        for f in collect_files(p):
-            ws.add_file(f)
+        entries += collect_entries(p)
+    _add_entries(ws, entries, timeout, jobs)
     return ws
 
 
@@ -423,30 +516,37 @@ def check_texts(files: dict[str, str]) -> Workspace:
     return ws
 
 
-def workspaces_for(path: str | Path) -> list[Workspace]:
+def workspaces_for(path: str | Path, timeout: float | None = None, jobs: int | None = None) -> list[Workspace]:
     """The workspaces to check for a command-line PATH: a file -> itself with the .dat/.src
     of its module; a folder holding backups -> one workspace per backup, plus one per
     top-level subfolder for the files outside the backups; another folder -> one
-    workspace of all its files."""
+    workspace of all its files. `timeout`, `jobs`: see :func:`load_workspace`."""
     p = Path(path)
-    if p.is_file():
+    if p.exists() and not p.is_dir():
         files = [p]
-        for sib in (p.parent.iterdir() if p.parent.exists() else []):
-            if sib != p and sib.stem.lower() == p.stem.lower() and is_krl_file(sib):
+        try:
+            siblings = sorted(p.parent.iterdir()) if p.parent.is_dir() else []
+        except OSError:
+            siblings = []
+        for sib in siblings:
+            if sib != p and sib.stem.lower() == p.stem.lower() and is_krl_file(sib) and not sib.is_symlink():
                 files.append(sib)
-        return [load_workspace(files, str(p))]
-    if p.is_dir():
+        return [load_workspace(files, str(p), timeout, jobs)]
+    if p.is_dir() and not p.is_symlink():
         backups = find_backups(p)
         if backups:
-            out = [load_workspace([b], str(b)) for b in backups]
-            # files outside every backup: one workspace per top-level folder of `path`
-            rest: dict[str, list[Path]] = {}
-            for f in collect_files(p):
-                if any(b == f or b in f.parents for b in backups):
+            out = [load_workspace([b], str(b), timeout, jobs) for b in backups]
+            # entries outside every backup: one workspace per top-level folder of `path`
+            rest: dict[str, list] = {}
+            for e in collect_entries(p):
+                if any(b == e.path or b in e.path.parents for b in backups):
                     continue
-                rel = f.relative_to(p)
-                key = str(p / rel.parts[0]) if len(rel.parts) > 1 else str(p)
-                rest.setdefault(key, []).append(f)
-            out += [load_workspace(files, key) for key, files in sorted(rest.items())]
+                parts = e.rel.split("/")
+                key = str(p / parts[0]) if len(parts) > 1 else str(p)
+                rest.setdefault(key, []).append(e)
+            for key, entries in sorted(rest.items()):
+                ws = Workspace(key)
+                _add_entries(ws, entries, timeout, jobs)
+                out.append(ws)
             return out
-    return [load_workspace([p], str(p))]
+    return [load_workspace([p], str(p), timeout, jobs)]

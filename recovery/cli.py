@@ -8,6 +8,7 @@ from pathlib import Path
 
 import click
 
+from krl.limits import PARSE_TIMEOUT_S
 
 
 @click.command()
@@ -15,11 +16,13 @@ import click
 @click.option("--out", default="reports/recovery", type=click.Path(path_type=Path),
               help="Report directory.")
 @click.option("--jobs", type=int, default=None, help="Worker processes (default: the number of cores).")
-@click.option("--no-cache", is_flag=True, help="Parse every file again.")
+@click.option("--no-cache", is_flag=True, help="Parse every file again (the cache folder is not touched).")
+@click.option("--timeout", type=click.FloatRange(min=0, min_open=True), default=PARSE_TIMEOUT_S,
+              show_default=True, help="Seconds one file may parse; past it its worker is killed (row `timeout`).")
 @click.option("--engine", type=click.Choice(["auto", "python", "java"]), default=None,
               help="Parse engine: java (fast; needs a JDK), python (the reference), auto: java when available "
                    "(default: $KRL_ENGINE, else auto).")
-def recover(corpus: Path, out: Path, jobs: int | None, no_cache: bool, engine: str | None) -> None:
+def recover(corpus: Path, out: Path, jobs: int | None, no_cache: bool, timeout: float, engine: str | None) -> None:
     """Parse every KRL file under CORPUS (a folder or a KRC backup .zip), cluster the failures,
     write the report to --out.
 
@@ -27,25 +30,26 @@ def recover(corpus: Path, out: Path, jobs: int | None, no_cache: bool, engine: s
     (or an archive refused by the limits of krl/limits.py).
     """
     from krl.archive import ArchiveError, backup_source, is_archive  # noqa: PLC0415
-    from krl.terminal import printable  # noqa: PLC0415
+    from krl.terminal import printable_path  # noqa: PLC0415
     from recovery.pipeline import run_recovery  # noqa: PLC0415
     from krl.syntax.engines import use_engine  # noqa: PLC0415
+    from recovery.report import ReportError  # noqa: PLC0415
 
     use_engine(engine)
     if not corpus.is_dir() and not is_archive(corpus):
-        click.echo(f"error: corpus folder or .zip archive not found: {printable(corpus)}", err=True)
+        click.echo(f"error: corpus folder or .zip archive not found: {printable_path(corpus)}", err=True)
         sys.exit(2)
     start = time.perf_counter()
     try:
         with backup_source(corpus) as (folder, shown):
-            summary = run_recovery(folder, out, jobs=jobs, use_cache=not no_cache,
+            summary = run_recovery(folder, out, jobs=jobs, use_cache=not no_cache, timeout=timeout,
                                    label=str(corpus) if shown.archive else None)
-    except ArchiveError as exc:
-        click.echo(f"error: {printable(exc)}", err=True)
+    except (ArchiveError, ReportError) as exc:
+        click.echo(f"error: {printable_path(exc)}", err=True)
         sys.exit(2)
     click.echo(f"{summary.files_ok}/{summary.files} files parse "
                f"({summary.bytes_ok}/{summary.bytes} bytes), {len(summary.clusters)} clusters, "
-               f"{time.perf_counter() - start:.1f} s -> {out}/report.md")
+               f"{time.perf_counter() - start:.1f} s -> {printable_path(out)}/report.md")
     if summary.negative:
         click.echo(f"negative corpus: rejected {summary.negative['rejected']} of "
                    f"{summary.negative['programs']} invalid programs")

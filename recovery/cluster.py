@@ -164,27 +164,56 @@ def counted_issues(result: FileResult) -> list[IssueRecord]:
     return [i for i in result.issues if not i.cascade]
 
 
-def cluster_results(results: list[FileResult]) -> list[Cluster]:
-    """Group the counted issues of all files into ranked clusters."""
-    by_sig: dict[str, Cluster] = {}
-    files_of: dict[str, set[str]] = defaultdict(set)
-    for res in results:
-        for issue in counted_issues(res):
+class ClusterBuilder:
+    """Clusters built one file at a time, in any order (files finish in any order in a
+    parallel scan): each file comes with its index in the corpus walk, and every choice that
+    depends on order (the first example, the expected tokens, the leading keyword and the line
+    shape shown for a cluster, its three examples) is made by the smallest walk index. So the
+    clusters are the same whatever order the files arrive in; only paths and counts are kept
+    per file, not the files' issues."""
+
+    def __init__(self) -> None:
+        self._by_sig: dict[str, Cluster] = {}
+        self._first: dict[str, tuple] = {}              # sig -> (index, position) of the representative
+        self._files: dict[str, set[str]] = defaultdict(set)
+        self._examples: dict[str, list[tuple]] = defaultdict(list)   # sig -> [(index, example)]
+
+    def add(self, index: int, res: FileResult) -> None:
+        """Add the counted issues of one file, `index` its place in the corpus walk."""
+        for pos, issue in enumerate(counted_issues(res)):
             sig = signature(issue)
-            cl = by_sig.get(sig)
+            cl = self._by_sig.get(sig)
             if cl is None:
-                cl = by_sig[sig] = Cluster(cluster_id(sig), sig, leading_keyword=_leading_keyword(issue),
-                                           expected=list(issue.expected), shape=list(issue.shape))
+                cl = self._by_sig[sig] = Cluster(cluster_id(sig), sig)
+            if sig not in self._first or (index, pos) < self._first[sig]:
+                self._first[sig] = (index, pos)
+                cl.leading_keyword = _leading_keyword(issue)
+                cl.expected = list(issue.expected)
+                cl.shape = list(issue.shape)
             cl.occurrences += 1
-            if res.path not in files_of[sig]:
-                files_of[sig].add(res.path)
-                if len(cl.examples) < EXAMPLES:
-                    cl.examples.append({"path": res.path, "line": issue.line,
-                                        "text": issue.line_text.strip()[:200]})
-    for sig, cl in by_sig.items():
-        cl.files = len(files_of[sig])
-        cl.paths = sorted(files_of[sig])
-    return sorted(by_sig.values(), key=lambda c: (-c.files, -c.occurrences, c.signature))
+            if res.path not in self._files[sig]:
+                self._files[sig].add(res.path)
+                ex = self._examples[sig]
+                ex.append((index, {"path": res.path, "line": issue.line,
+                                   "text": issue.line_text.strip()[:200]}))
+                ex.sort(key=lambda item: item[0])
+                del ex[EXAMPLES:]
+
+    def clusters(self) -> list[Cluster]:
+        """The clusters so far, ranked by files, then occurrences."""
+        for sig, cl in self._by_sig.items():
+            cl.files = len(self._files[sig])
+            cl.paths = sorted(self._files[sig])
+            cl.examples = [e for _, e in self._examples[sig]]
+        return sorted(self._by_sig.values(), key=lambda c: (-c.files, -c.occurrences, c.signature))
+
+
+def cluster_results(results: list[FileResult]) -> list[Cluster]:
+    """Group the counted issues of all files (in walk order) into ranked clusters."""
+    builder = ClusterBuilder()
+    for index, res in enumerate(results):
+        builder.add(index, res)
+    return builder.clusters()
 
 
 def clusters_of_file(result: FileResult) -> list[str]:

@@ -5,11 +5,13 @@ from __future__ import annotations
 import csv
 import hashlib
 import json
+import os
 import time
 from pathlib import Path
 
-from recovery.report import Summary, summarise, write_report
-from recovery.scan import FileResult, cache_dir, grammar_sha, scan
+from krl.limits import PARSE_TIMEOUT_S
+from recovery.report import ReportStream, Summary, SummaryBuilder
+from recovery.scan import FileResult, cache_dir, grammar_sha, scan, warn
 
 REPO_ROOT = Path(__file__).resolve().parents[1]
 GRAMMAR = REPO_ROOT / "grammar" / "KRL.g4"
@@ -39,13 +41,16 @@ def load_known_invalid(path: Path = KNOWN_INVALID) -> dict[str, str]:
 
 
 def known_invalid_figures(results: list[FileResult]) -> dict | None:
-    known = load_known_invalid()
-    present = [r for r in results if r.path in known]
+    return _known_invalid_figures({r.path: r.ok for r in results if r.path in load_known_invalid()})
+
+
+def _known_invalid_figures(present: dict[str, bool]) -> dict | None:
+    """Figures of the known-invalid files present: `present` maps their paths to whether they parse."""
     if not present:
         return None
-    return {"listed": len(known), "present": len(present),
-            "still_failing": sum(not r.ok for r in present),
-            "now_parsing": [r.path for r in present if r.ok]}
+    return {"listed": len(load_known_invalid()), "present": len(present),
+            "still_failing": sum(not ok for ok in present.values()),
+            "now_parsing": sorted(p for p, ok in present.items() if ok)}
 
 
 def _front_end_code_sha() -> str:
@@ -57,49 +62,86 @@ def _front_end_code_sha() -> str:
     return h.hexdigest()
 
 
-def static_check_figures(corpus: Path, results: list[FileResult], gsha: str,
-                         use_cache: bool) -> dict | None:
+def static_check_figures(corpus: Path, fingerprints: list[str], gsha: str,
+                         use_cache: bool, jobs: int | None = None,
+                         timeout: float | None = PARSE_TIMEOUT_S) -> dict | None:
     """`krl check` over the KRC backups of the corpus (issue 4's report), cached by the
-    grammar, the front end's code and the corpus files."""
+    grammar, the front end's code and the corpus files (`fingerprints`: "path:sha" of every
+    scanned file). Files are parsed and built in `jobs`
+    worker processes (the scan's pool, krl/pool.py), each stopped past `timeout` seconds."""
     from krl.workspace import find_backups  # noqa: PLC0415
 
     if not find_backups(corpus):
         return None
     key = hashlib.sha256("|".join([gsha, _front_end_code_sha()] +
-                                  sorted(f"{r.path}:{r.sha}" for r in results)).encode()).hexdigest()
-    path = cache_dir() / "check" / f"{key[:32]}.json"
-    if use_cache and path.exists():
+                                  sorted(fingerprints)).encode()).hexdigest()
+    path = None
+    if use_cache:       # --no-cache never touches the cache folder
         try:
-            return json.loads(path.read_text())
-        except ValueError:
+            path = cache_dir() / "check" / f"{key[:32]}.json"
+        except OSError:
+            path = None  # the scan has already warned that the cache folder is not usable
+    if path is not None and path.exists():
+        try:
+            cached = json.loads(path.read_text(encoding="utf-8"))
+            if _valid_check_figures(cached):
+                return cached
+        except (OSError, ValueError, RecursionError):
             pass
+        warn(f"cache file {path} is corrupt; ignored and rebuilt")
     from krl.semantics.report import check_report  # noqa: PLC0415
 
-    data, markdown = check_report(corpus)
+    data, markdown = check_report(corpus, timeout=timeout, jobs=jobs)
     figures = {"files": data["total"]["files"], "files_clean": data["total"]["files_clean"],
                "errors": data["total"]["errors"], "warnings": data["total"]["warnings"],
                "top_kinds": data["top_kinds"], "markdown": markdown}
-    path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(json.dumps(figures))
+    if path is not None:
+        tmp = path.with_name(f"{path.name}.{os.getpid()}.tmp")
+        try:
+            path.parent.mkdir(parents=True, exist_ok=True)
+            tmp.write_text(json.dumps(figures), encoding="utf-8")
+            tmp.replace(path)
+        except OSError as exc:
+            warn(f"cache file {path} not written ({exc.strerror or exc})")
     return figures
 
 
+def _valid_check_figures(obj: object) -> bool:
+    types = {"files": int, "files_clean": int, "errors": int, "warnings": int, "top_kinds": list,
+             "markdown": str}
+    return (isinstance(obj, dict) and set(obj) == set(types)
+            and all(isinstance(obj[k], t) for k, t in types.items())
+            and all(isinstance(k, dict) for k in obj["top_kinds"]))
+
+
 def run_recovery(corpus: Path, out: Path, jobs: int | None = None, use_cache: bool = True,
-                 label: str | None = None) -> Summary:
-    """Scan `corpus`, cluster, write the report into `out`. `label`: how the report names the
-    corpus when it is not the folder itself (a backup .zip extracted to a temporary folder:
-    the report then names the archive and does not link to the vanished files)."""
+                 timeout: float = PARSE_TIMEOUT_S, label: str | None = None) -> Summary:
+    """Scan `corpus`, cluster, add the negative-corpus and static-check figures and write the
+    report to `out`. `label`: how the report names the corpus when it is not the folder itself
+    (a backup .zip extracted to a temporary folder: the report then names the archive and does
+    not link to the vanished files). Rows stream to ``files.csv`` (in a temporary folder next to `out`) as files
+    finish and only counts and clusters are kept, so memory stays flat with the corpus size;
+    the folder replaces `out` atomically at the end (recovery/report.py). Raises ReportError
+    when `out` holds files that are not a report."""
     start = time.perf_counter()
     gsha = current_grammar_sha()
-    results = scan(corpus, gsha, jobs=jobs, use_cache=use_cache)
-    summary = summarise(results, gsha, label or str(corpus), 0.0, known_invalid=load_known_invalid())
-    summary.negative = negative_figures(gsha, jobs, use_cache)
-    ki = known_invalid_figures(results)
-    if ki:
-        summary.extra["known_invalid"] = ki
-    check = static_check_figures(Path(corpus), results, gsha, use_cache)
-    if check:
-        summary.extra["check"] = check
-    summary.seconds = time.perf_counter() - start
-    write_report(out, summary, results)
+    known = load_known_invalid()
+    builder = SummaryBuilder(known)
+    with ReportStream(Path(out)) as stream:
+        def on_row(index: int, row: FileResult) -> None:
+            builder.add(index, row)
+            stream.add(index, row)
+
+        scan(corpus, gsha, jobs=jobs, use_cache=use_cache, timeout=timeout, on_row=on_row, keep=False)
+        summary = builder.summary(gsha, label or str(corpus), 0.0)
+        summary.negative = negative_figures(gsha, jobs, use_cache)
+        ki = _known_invalid_figures(builder.known_ok)
+        if ki:
+            summary.extra["known_invalid"] = ki
+        check = static_check_figures(Path(corpus), builder.fingerprints, gsha, use_cache, jobs=jobs,
+                                     timeout=timeout)
+        if check:
+            summary.extra["check"] = check
+        summary.seconds = time.perf_counter() - start
+        stream.commit(summary, builder.bad_input)
     return summary

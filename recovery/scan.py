@@ -1,9 +1,23 @@
-"""Scanning a corpus: parse every KRL file with one grammar version, in a process pool.
+"""Scanning a corpus: parse every KRL file with one grammar version, in worker processes.
 
-A scan never dies on one file: each file gets a classified row (ok, syntax_error, empty,
-binary, too_large, timeout, unreadable, internal_error). Results are cached per
-(grammar sha, file sha) in the user cache directory, so a repeated scan with an unchanged
-grammar only hashes files.
+A scan never hangs, never dies on one file and never lies about one: every entry of the corpus
+gets a classified row. A parsed file is ``ok`` or ``syntax_error`` (or ``too_deep``/``too_long``
+past a limit of krl/limits.py); a file that is not parsed is ``empty``, ``binary``,
+``too_large``, ``unreadable``, ``not_regular`` (a FIFO, socket or device: never opened),
+``symlink`` (never followed), ``timeout`` (the worker was killed after ``--timeout``) or
+``internal_error`` (the parser raised, or its worker died); a folder that cannot be listed is an
+``unreadable_folder`` row and one past :data:`krl.limits.MAX_FOLDER_DEPTH` a ``too_deep`` row.
+
+Each file is read once in the main process (:func:`krl.syntax.source.read_limited`, no FIFO is
+ever opened); the SHA-256 of those bytes keys the result cache, and the same bytes are what a
+worker decodes and parses (:func:`parse_row`, the scan's one call into the parser). Workers are
+a killable pool (krl/pool.py, pebble): a timeout kills the worker, whatever the parser is doing.
+
+Results are cached per (front end, grammar sha, file sha) in the user cache directory, so a
+repeated scan with an unchanged grammar only reads and hashes files. Cache entries are validated
+when read: a corrupt or foreign file is ignored (one warning) and rebuilt; a cache folder that
+cannot be written means a scan without cache (one warning). With ``use_cache=False`` the cache
+folder is never touched.
 """
 
 from __future__ import annotations
@@ -11,17 +25,26 @@ from __future__ import annotations
 import hashlib
 import json
 import os
-import signal
-from concurrent.futures import ProcessPoolExecutor
+import sys
+import time
+from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
 import platformdirs
 
-from krl.syntax.source import is_krl_file, read_source
+from krl.files import display_path, walk
+from krl.limits import PARSE_TIMEOUT_S
+from krl.pool import default_jobs, run_tasks
+from krl.syntax.source import read_limited, source_from_bytes
 
-PARSE_TIMEOUT_S = 30
-CACHE_VERSION = "1"
+CACHE_VERSION = "3"
+CACHE_SCHEMA = "krl-scan-results"
+
+# Rows that say nothing about (grammar, file): never cached, retried next time.
+NOT_CACHED = frozenset({"timeout", "internal_error", "unreadable", "not_regular", "symlink",
+                        "unreadable_folder", "too_deep_folder"})
+STATUSES = frozenset({"ok", "syntax_error", "too_deep", "too_long", "empty", "binary", "too_large"}) | NOT_CACHED
 
 
 @dataclass(slots=True)
@@ -41,9 +64,14 @@ class IssueRecord:
     cascade: bool
 
 
+_ISSUE_TYPES = {"line": int, "column": int, "kind": str, "message": str, "offending": str,
+                "offending_type": str, "expected": list, "rule_stack": list, "shape": list,
+                "line_text": str, "cascade": bool}
+
+
 @dataclass(slots=True)
 class FileResult:
-    path: str                 # relative to the corpus root, with '/' separators
+    path: str                 # relative to the corpus root, '/' separators, undecodable bytes as \xNN
     bytes: int
     sha: str
     encoding: str = ""
@@ -51,6 +79,7 @@ class FileResult:
     ok: bool = False
     seconds: float = 0.0
     issues: list[IssueRecord] = field(default_factory=list)
+    detail: str = ""          # why a file was not parsed ("a FIFO (never opened)", "killed after 30 s")
 
     @property
     def first_error(self) -> IssueRecord | None:
@@ -66,25 +95,31 @@ class FileResult:
         return cls(**obj)
 
 
+_ROW_TYPES = {"path": str, "bytes": int, "sha": str, "encoding": str, "status": str, "ok": bool,
+              "seconds": (int, float), "issues": list, "detail": str}
+
+
+def valid_row(obj: object, sha: str) -> bool:
+    """True when `obj` is a cached row of this schema for the file hashed `sha`: exactly the
+    fields of :class:`FileResult` (and of :class:`IssueRecord` for each issue), each of its type."""
+    def fits(o: object, types: dict) -> bool:
+        return (isinstance(o, dict) and set(o) == set(types)
+                and all(isinstance(o[k], t) for k, t in types.items()))
+
+    if not fits(obj, _ROW_TYPES) or obj["sha"] != sha or obj["status"] not in STATUSES:
+        return False
+    for issue in obj["issues"]:
+        if not fits(issue, _ISSUE_TYPES):
+            return False
+        if not all(isinstance(x, str) for k in ("expected", "rule_stack", "shape") for x in issue[k]):
+            return False
+    return True
+
+
 def discover(corpus: Path) -> list[Path]:
-    """All .src/.dat/.sub files under corpus (any letter case), sorted; symlinks not followed."""
-    found = []
-    for root, dirs, files in os.walk(corpus):
-        dirs.sort()
-        for name in sorted(files):
-            p = Path(root) / name
-            if is_krl_file(p) and not p.is_symlink():
-                found.append(p)
-    return found
-
-
-def file_sha(path: Path) -> str:
-    h = hashlib.sha256()
-    try:
-        h.update(path.read_bytes())
-    except OSError:
-        return "unreadable"
-    return h.hexdigest()
+    """The regular .src/.dat/.sub files under corpus (any letter case), in walk order
+    (krl/files.py: iterative, links never followed)."""
+    return [e.path for e in walk(corpus) if e.kind == "file"]
 
 
 def grammar_sha(text: str) -> str:
@@ -108,82 +143,140 @@ def front_end_sha() -> str:
 # ----------------------------------------------------------------------- worker side
 
 _BUNDLE = None
+_BUNDLE_DIR: tuple[str | None] | None = None
 
 
 def _init_worker(parser_dir: str | None) -> None:
-    global _BUNDLE
+    """Load the parser of `parser_dir` (None: the working tree's). The scan calls it in the
+    main process first, so that a missing parser is one clear error there and the forked
+    workers inherit the loaded parser (then this is a no-op in them)."""
+    global _BUNDLE, _BUNDLE_DIR
+    if _BUNDLE_DIR == (parser_dir,):
+        return
     from krl.syntax.parse import ParserBundle, default_bundle  # noqa: PLC0415
 
     _BUNDLE = ParserBundle.from_directory(parser_dir, tag="scan") if parser_dir else default_bundle()
+    _BUNDLE_DIR = (parser_dir,)
 
 
-class _Timeout(BaseException):
-    """The parse timeout (SIGALRM). A BaseException, so that no ``except Exception`` on the
-    way (a handler in the parser, its error listener) can swallow it."""
+def parse_row(rel_path: str, data: bytes, sha: str) -> FileResult:
+    """Decode and parse the bytes of one file: the scan's one call into the parser."""
+    from krl.syntax.engines import parse_source  # noqa: PLC0415  (KRL_ENGINE: python, java, auto)
+
+    source = source_from_bytes(rel_path, data, sha)
+    row = FileResult(rel_path, source.size, sha, source.encoding, source.status, detail=source.detail)
+    if source.status != "ok":
+        return row
+    result = parse_source(source, _BUNDLE, keep_tree=False)
+    row.ok = result.ok
+    row.status = result.status
+    row.issues = [IssueRecord(i.line, i.column, i.kind, i.message, i.offending, i.offending_type,
+                              i.expected, i.rule_stack, i.line_shape, i.line_text[:300], i.cascade)
+                  for i in result.errors]
+    return row
 
 
-def _on_alarm(signum, frame):  # noqa: ARG001
-    raise _Timeout()
+def scan_bytes(rel_path: str, data: bytes, sha: str) -> FileResult:
+    """Parse one file in a worker. Never raises: an exception becomes an internal_error row."""
+    start = time.perf_counter()
+    try:
+        row = parse_row(rel_path, data, sha)
+    except Exception as exc:  # noqa: BLE001 - one bad file never stops a scan
+        row = failed_row(rel_path, len(data), sha, "internal_error", f"{type(exc).__name__}: {exc}")
+    row.seconds = round(time.perf_counter() - start, 4)
+    return row
+
+
+def failed_row(rel_path: str, size: int, sha: str, status: str, detail: str) -> FileResult:
+    """The row of a file whose parse did not end normally (timeout, internal error): one issue
+    of kind "internal", which reports list by file and never cluster."""
+    return FileResult(rel_path, size, sha, "", status, False, 0.0,
+                      [IssueRecord(0, 0, "internal", detail, "", "", [], [], ["internal"], "", False)],
+                      detail)
 
 
 def scan_one(args: tuple[str, str, str, int]) -> FileResult:
-    """Parse one file in a worker. Never raises: failures become classified rows."""
-    import time  # noqa: PLC0415
-
-    from krl.syntax.engines import parse_source  # noqa: PLC0415  (KRL_ENGINE: python, java, auto)
-
-    abs_path, rel_path, sha, timeout = args
-    start = time.perf_counter()
-    source = read_source(abs_path)
-    row = FileResult(rel_path, source.size, sha, source.encoding, source.status)
-    if source.status != "ok":
-        return row
-    old = signal.signal(signal.SIGALRM, _on_alarm) if timeout else None
-    if timeout:
-        signal.alarm(timeout)
-    try:
-        result = parse_source(source, _BUNDLE, keep_tree=False)
-        row.ok = result.ok
-        row.status = result.status
-        row.issues = [IssueRecord(i.line, i.column, i.kind, i.message, i.offending, i.offending_type,
-                                  i.expected, i.rule_stack, i.line_shape, i.line_text[:300], i.cascade)
-                      for i in result.errors]
-    except _Timeout:
-        row.status = "timeout"
-    except Exception as exc:  # noqa: BLE001 - one bad file never stops a scan
-        row.status = "internal_error"
-        row.issues = [IssueRecord(0, 0, "internal", f"{type(exc).__name__}: {exc}", "", "", [], [],
-                                  ["internal"], "", False)]
-    finally:
-        if timeout:
-            signal.alarm(0)
-            signal.signal(signal.SIGALRM, old)
-    row.seconds = round(time.perf_counter() - start, 4)
-    return row
+    """Read and parse one file in this process (no timeout): ``(path, rel_path, sha, timeout)``;
+    sha and timeout are ignored (kept for old callers). The scan itself uses workers."""
+    path, rel_path = args[0], args[1]
+    data, status, detail, size = read_limited(path)
+    if data is None:
+        return FileResult(rel_path, size, "", "", status, detail=detail)
+    return scan_bytes(rel_path, data, hashlib.sha256(data).hexdigest())
 
 
 # ----------------------------------------------------------------------- cache
 
 def cache_dir() -> Path:
-    """The user cache directory (never inside the repository)."""
+    """The user cache directory (never inside the repository); created here. Raises OSError
+    when it cannot be created."""
     d = Path(os.environ.get("KRL_CACHE_DIR") or platformdirs.user_cache_dir("krl-tools"))
     d.mkdir(parents=True, exist_ok=True)
     return d
 
 
-class ResultCache:
-    """Per-file results keyed by (grammar sha, file sha), one JSON file per grammar."""
+_WARNED: set[str] = set()
 
-    def __init__(self, gsha: str, enabled: bool = True):
+
+def warn(message: str) -> None:
+    """A warning of the scan on stderr, once per message and process (never one per file)."""
+    from krl.terminal import printable  # noqa: PLC0415
+
+    if message not in _WARNED:
+        _WARNED.add(message)
+        print(f"warning: {printable(message)}", file=sys.stderr)
+
+
+class ResultCache:
+    """Per-file results keyed by (grammar sha, file sha), one JSON file per grammar and front end:
+    ``{"schema": CACHE_SCHEMA, "version": CACHE_VERSION, "results": {sha: row}}``."""
+
+    def __init__(self, gsha: str, enabled: bool = True, warn: Callable[[str], None] = warn):
         self.enabled = enabled
-        self.path = cache_dir() / "results" / f"{front_end_sha()[:12]}-{gsha[:32]}.json"
+        self.warn = warn
         self.data: dict[str, dict] = {}
-        if enabled and self.path.exists():
-            try:
-                self.data = json.loads(self.path.read_text())
-            except (OSError, ValueError):
-                self.data = {}
         self.dirty = False
+        self.path: Path | None = None
+        if not enabled:
+            return      # --no-cache: the cache folder is never touched
+        try:
+            self.path = cache_dir() / "results" / f"{front_end_sha()[:12]}-{gsha[:32]}.json"
+        except OSError as exc:
+            self._disable(f"cache folder not usable ({exc.strerror or exc}); running without a cache")
+            return
+        self.data = self._load()
+
+    def _disable(self, why: str) -> None:
+        self.enabled = False
+        self.data = {}
+        self.warn(why)
+
+    def _load(self) -> dict[str, dict]:
+        assert self.path is not None
+        try:
+            raw = self.path.read_bytes()
+        except FileNotFoundError:
+            return {}
+        except OSError as exc:
+            self.warn(f"cache file {self.path} not readable ({exc.strerror or exc}); rebuilding it")
+            self.dirty = True
+            return {}
+        try:
+            obj = json.loads(raw)
+        except (ValueError, RecursionError):
+            obj = None
+        if not (isinstance(obj, dict) and obj.get("schema") == CACHE_SCHEMA
+                and obj.get("version") == CACHE_VERSION and isinstance(obj.get("results"), dict)):
+            self.warn(f"cache file {self.path} is corrupt or of another version; ignored and rebuilt")
+            self.dirty = True
+            return {}
+        results = obj["results"]
+        good = {sha: row for sha, row in results.items() if valid_row(row, sha)}
+        if len(good) != len(results):
+            self.warn(f"{len(results) - len(good)} corrupt entries in cache file {self.path}; "
+                      "ignored, their files are parsed again")
+            self.dirty = True
+        return good
 
     def get(self, sha: str, rel_path: str) -> FileResult | None:
         if not self.enabled:
@@ -196,69 +289,96 @@ class ResultCache:
         return res
 
     def put(self, res: FileResult) -> None:
-        if res.status in ("timeout", "internal_error", "unreadable"):
+        if not self.enabled or res.status in NOT_CACHED or not res.sha:
             return  # not a property of (grammar, file): retry next time
         self.data[res.sha] = res.to_json()
         self.dirty = True
 
     def save(self) -> None:
-        if self.enabled and self.dirty:
+        if not (self.enabled and self.dirty and self.path is not None):
+            return
+        tmp = self.path.with_name(f"{self.path.name}.{os.getpid()}.tmp")
+        try:
             self.path.parent.mkdir(parents=True, exist_ok=True)
-            tmp = self.path.with_suffix(".tmp")
-            tmp.write_text(json.dumps(self.data))
+            tmp.write_text(json.dumps({"schema": CACHE_SCHEMA, "version": CACHE_VERSION,
+                                       "results": self.data}))
             tmp.replace(self.path)
+        except OSError as exc:
+            self.warn(f"cache file {self.path} not written ({exc.strerror or exc}); the next scan parses again")
+            try:
+                tmp.unlink()
+            except OSError:
+                pass
+        self.dirty = False
 
+
+# ----------------------------------------------------------------------- the scan
 
 def scan(corpus: Path, gsha: str, parser_dir: str | None = None, jobs: int | None = None,
-         use_cache: bool = True, progress: bool = True,
-         timeout: int = PARSE_TIMEOUT_S) -> list[FileResult]:
-    """Parse every KRL file under corpus; returns one FileResult per file, in path order.
+         use_cache: bool = True, progress: bool = True, timeout: float | None = PARSE_TIMEOUT_S,
+         in_process: bool = False, on_row: Callable[[int, FileResult], None] | None = None,
+         keep: bool = True, warn: Callable[[str], None] = warn) -> list[FileResult]:
+    """Classify and parse every KRL entry under corpus; one FileResult per entry, in walk order.
 
     parser_dir: a directory of generated parser code (None: the working tree's parser).
+    jobs: worker processes (default: the number of cores); timeout: seconds per file, after
+    which its worker is killed (row ``timeout``); in_process: parse here, without workers and
+    without a timeout (only for callers that already run in a worker). on_row: called with the
+    walk index and the row of each entry as it is known (classified entries and cache hits
+    first, parsed files as they finish, so in any order). keep=False: the rows are only given
+    to on_row and the scan returns [] (memory stays flat whatever the corpus size; the cache,
+    when used, still holds one entry per file). Never raises for what it finds in the corpus.
     """
-    corpus = Path(corpus)
-    paths = discover(corpus)
-    cache = ResultCache(gsha, enabled=use_cache)
-    results: dict[int, FileResult] = {}
-    todo: list[tuple[int, tuple[str, str, str, int]]] = []
-    for idx, p in enumerate(paths):
-        rel = p.relative_to(corpus).as_posix()
-        sha = file_sha(p)
-        hit = cache.get(sha, rel)
-        if hit is not None:
-            results[idx] = hit
-        else:
-            todo.append((idx, (str(p), rel, sha, timeout)))
-    if todo:
-        jobs = jobs or os.cpu_count() or 1
-        # Big files first, so that the pool's tail is short.
-        todo.sort(key=lambda item: -_size(item[1][0]))
-        if jobs == 1:
-            _init_worker(parser_dir)
-            iterator = ((idx, scan_one(args)) for idx, args in todo)
-            _collect(iterator, results, cache, len(todo), progress)
-        else:
-            with ProcessPoolExecutor(max_workers=jobs, initializer=_init_worker,
-                                     initargs=(parser_dir,)) as pool:
-                futures = pool.map(scan_one, [a for _, a in todo], chunksize=4)
-                _collect(zip((i for i, _ in todo), futures), results, cache, len(todo), progress)
-        cache.save()
-    return [results[i] for i in range(len(paths))]
-
-
-def _size(path: str) -> int:
-    try:
-        return os.path.getsize(path)
-    except OSError:
-        return 0
-
-
-def _collect(pairs, results, cache, total, progress) -> None:
     from rich.progress import Progress  # noqa: PLC0415
 
-    with Progress(transient=True, disable=not progress or total < 50) as bar:
-        task = bar.add_task("parsing", total=total)
-        for idx, res in pairs:
-            results[idx] = res
-            cache.put(res)
-            bar.advance(task)
+    corpus = Path(corpus)
+    _init_worker(parser_dir)      # here first: a missing parser fails once, with its own message
+    entries = list(walk(corpus))
+    rows: list[FileResult | None] = [None] * len(entries) if keep else []
+    cache = ResultCache(gsha, enabled=use_cache, warn=warn)
+    files = [idx for idx, e in enumerate(entries) if e.kind == "file"]
+    # Big files first, so that the pool's tail is short.
+    files.sort(key=lambda i: -entries[i].size)
+    bar = Progress(transient=True, disable=not progress or len(files) < 50)
+    bar_task = bar.add_task("parsing", total=len(files))
+
+    def record(idx: int, row: FileResult) -> None:
+        if keep:
+            rows[idx] = row
+        if entries[idx].kind == "file":
+            bar.advance(bar_task)
+        if on_row is not None:
+            on_row(idx, row)
+
+    for idx, e in enumerate(entries):
+        if e.kind != "file":
+            status = "too_deep_folder" if e.kind == "too_deep" else e.kind
+            record(idx, FileResult(display_path(e.rel), e.size, "", "", status, detail=e.message))
+
+    pending: dict[int, tuple[str, int, str]] = {}
+
+    def tasks():
+        for idx in files:
+            e = entries[idx]
+            rel = display_path(e.rel)
+            data, status, detail, size = read_limited(e.path, follow_symlinks=False)
+            if data is None:
+                record(idx, FileResult(rel, size, "", "", status, detail=detail))
+                continue
+            sha = hashlib.sha256(data).hexdigest()
+            hit = cache.get(sha, rel)
+            if hit is not None:
+                record(idx, hit)
+                continue
+            pending[idx] = (rel, len(data), sha)
+            yield idx, (rel, data, sha)
+
+    with bar:
+        for out in run_tasks(scan_bytes, tasks(), jobs=jobs or default_jobs(), timeout=timeout,
+                             initializer=_init_worker, initargs=(parser_dir,), in_process=in_process):
+            rel, size, sha = pending.pop(out.key)
+            row = out.value if out.status == "done" else failed_row(rel, size, sha, out.status, out.detail)
+            cache.put(row)
+            record(out.key, row)
+    cache.save()
+    return [r for r in rows if r is not None]

@@ -17,6 +17,7 @@ import sys
 
 import click
 
+from krl.limits import PARSE_TIMEOUT_S
 
 @click.command()
 @click.argument("paths", nargs=-1, required=True)
@@ -28,15 +29,19 @@ import click
               help="Do not report CODE (or a prefix: W1); repeatable, or comma-separated. Adds to krl.toml.")
 @click.option("--report", "report_dir", default=None,
               help="Instead: write check_report.md/.json for the KRC backups below PATH into this folder.")
+@click.option("--timeout", type=click.FloatRange(min=0, min_open=True), default=PARSE_TIMEOUT_S,
+              show_default=True, help="Seconds one file may parse; past it the parse is stopped (error E005).")
+@click.option("--jobs", type=click.IntRange(min=1), default=None,
+              help="Worker processes that parse the files (default: the number of cores).")
 def check(paths: tuple[str, ...], fmt: str, as_json: bool, no_warnings: bool, ignore: tuple[str, ...],
-          report_dir: str | None) -> None:
+          report_dir: str | None, timeout: float, jobs: int | None) -> None:
     """Type-check KRL files, KRC backup folders or backup .zip archives; exit 1 when there are
     errors. Every code is explained in docs/diagnostics.md."""
     if report_dir is not None:
         from krl.semantics.report import check_report  # noqa: PLC0415
         try:
             for path in paths:
-                _data, md = check_report(path, report_dir)
+                _data, md = check_report(path, report_dir, timeout=timeout, jobs=jobs)
                 click.echo(md)
         except Exception as exc:  # noqa: BLE001
             click.echo(f"krl check: internal error: {type(exc).__name__}: {exc}")
@@ -47,16 +52,19 @@ def check(paths: tuple[str, ...], fmt: str, as_json: bool, no_warnings: bool, ig
     fmt = "json" if as_json else fmt
     status = run_check(list(paths), no_warnings=no_warnings, echo=click.echo, fmt=fmt,
                        ignore=[c for v in ignore for c in v.split(",") if c.strip()],
-                       colour=fmt == "text" and use_colour(sys.stdout))
+                       colour=fmt == "text" and use_colour(sys.stdout), timeout=timeout, jobs=jobs)
     sys.exit(status)
 
 
 def run_check(paths: list[str], as_json: bool = False, no_warnings: bool = False, echo=print,
-              fmt: str = "text", ignore=(), colour: bool = False) -> int:
+              fmt: str = "text", ignore=(), colour: bool = False, timeout: float | None = None,
+              jobs: int | None = None) -> int:
     """Check `paths` and print the diagnostics in `fmt` ("text", "json", "sarif"; `as_json` is
     the old spelling of "json"); `ignore`: codes not to report (with the krl.toml of each
-    workspace, krl/semantics/config.py). Returns the exit status: 0, 1 (errors), 2 (bad
-    configuration or internal failure)."""
+    workspace, krl/semantics/config.py). `timeout`: seconds per file, files parsed in worker
+    processes that are killed past it (None: parse here, without a limit; the command passes
+    krl.limits.PARSE_TIMEOUT_S); `jobs`: worker processes. Returns the exit status: 0, 1
+    (errors), 2 (bad configuration or internal failure)."""
     from krl.archive import ArchiveError, backup_source  # noqa: PLC0415
     from krl.semantics.config import ConfigError, Selection, config_for, parse_codes  # noqa: PLC0415
     from krl.semantics.diagnostics import Diagnostic  # noqa: PLC0415
@@ -93,7 +101,7 @@ def run_check(paths: list[str], as_json: bool = False, no_warnings: bool = False
                 continue
             try:
                 with backup_source(path) as (folder, as_shown):
-                    for ws in _loaded(folder if as_shown.archive else path):
+                    for ws in _loaded(folder if as_shown.archive else path, timeout, jobs):
                         seen.update(_resolved(f.path) for f in ws.files)
                         try:
                             sel = config_for(ws.root, folder if as_shown.archive else path).merged(cli_sel)
@@ -126,7 +134,7 @@ def run_check(paths: list[str], as_json: bool = False, no_warnings: bool = False
     return 1 if any_error else 0
 
 
-def _loaded(path) -> list:
+def _loaded(path, timeout: float | None = None, jobs: int | None = None) -> list:
     """workspaces_for(path), with a transient progress bar on standard error when it is a
     terminal (a KRC backup of a few hundred files takes tens of seconds to parse); piped or
     redirected, nothing is shown, so the output is the same either way."""
@@ -135,7 +143,7 @@ def _loaded(path) -> list:
     from krl.workspace import collect_files, on_each_file, workspaces_for  # noqa: PLC0415
 
     if not _progress_shown():
-        return workspaces_for(path)
+        return workspaces_for(path, timeout=timeout, jobs=jobs)
     from rich.console import Console  # noqa: PLC0415
     from rich.markup import escape  # noqa: PLC0415
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn  # noqa: PLC0415
@@ -149,7 +157,7 @@ def _loaded(path) -> list:
         def advance(file: str) -> None:
             bar.update(task, advance=1, description=escape(f"parsing {Path(file).name}"))
         with on_each_file(advance):
-            return workspaces_for(path)
+            return workspaces_for(path, timeout=timeout, jobs=jobs)
 
 
 def _progress_shown() -> bool:

@@ -19,10 +19,12 @@ from dataclasses import dataclass, field
 # code -> (severity, short kind name used in reports)
 CODES: dict[str, tuple[str, str]] = {
     "E001": ("error", "unreadable or binary input"),
+    "W002": ("warning", "entry of a folder not read (symbolic link, FIFO/socket/device, folder unreadable or too deep)"),
     "E002": ("error", "syntax error"),
     "W003": ("warning", "construct not understood by the AST builder"),
     "E003": ("error", "construct that cannot be built (too large or malformed)"),
     "E004": ("error", "backup archive refused (unsafe entry or past a limit)"),
+    "E005": ("error", "file not parsed within the time limit (--timeout)"),
     "E010": ("error", "block not closed"),
     "E011": ("error", "block closer without its opener"),
     "E012": ("error", "statement missing a keyword or a part"),

@@ -76,9 +76,8 @@ class SourceLines:
     def _read(path: str) -> list[str] | None:
         from krl.syntax.source import read_source  # noqa: PLC0415
 
-        if not Path(path).is_file():
-            return None
-        src = read_source(path)
+        # never through a link (a linked file is not quoted) and never a FIFO/device (not opened)
+        src = read_source(path, follow_symlinks=False)
         return split_lines(src.text) if src.status == "ok" else None
 
 

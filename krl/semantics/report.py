@@ -16,9 +16,12 @@ from pathlib import Path
 from krl.semantics.diagnostics import CODES
 
 
-def check_report(corpus: str | Path, out_dir: str | Path | None = None, top: int = 15) -> tuple[dict, str]:
+def check_report(corpus: str | Path, out_dir: str | Path | None = None, top: int = 15,
+                 timeout: float | None = None, jobs: int | None = None) -> tuple[dict, str]:
     """Check every backup below `corpus`; returns (data, markdown). With `out_dir`, also
-    writes check_report.json and check_report.md there. Never raises for bad input files."""
+    writes check_report.json and check_report.md there. `timeout`, `jobs`: files are parsed
+    in that many worker processes, each file stopped past `timeout` seconds (see
+    krl.workspace.load_workspace; None: in this process). Never raises for bad input files."""
     from krl.workspace import find_backups, load_workspace  # noqa: PLC0415
 
     corpus = Path(corpus)
@@ -26,7 +29,7 @@ def check_report(corpus: str | Path, out_dir: str | Path | None = None, top: int
     rows = []
     kinds: Counter = Counter()
     for b in backups:
-        ws = load_workspace([b], str(b))
+        ws = load_workspace([b], str(b), timeout=timeout, jobs=jobs)
         diags = ws.check()
         err_files = {d.path for d in diags if d.is_error}
         codes = Counter(d.code for d in diags)
@@ -51,10 +54,12 @@ def check_report(corpus: str | Path, out_dir: str | Path | None = None, top: int
     data = {"corpus": str(corpus), "backups": rows, "total": total, "top_kinds": top_kinds}
     md = render_markdown(data)
     if out_dir is not None:
+        from krl.files import write_text_atomic  # noqa: PLC0415
+
         out = Path(out_dir)
         out.mkdir(parents=True, exist_ok=True)
-        (out / "check_report.json").write_text(json.dumps(data, indent=2), encoding="utf-8")
-        (out / "check_report.md").write_text(md, encoding="utf-8")
+        write_text_atomic(out / "check_report.json", json.dumps(data, indent=2))
+        write_text_atomic(out / "check_report.md", md)
     return data, md
 
 

@@ -33,21 +33,85 @@ def file_diagnostics(path: Path, keep_tree: bool = True):
     return result, src.text, diags
 
 
+def parse_job(path: str, outline: bool, tree: bool):
+    """One file of `krl parse`, as a worker runs it: (ParseResult without its tree, text,
+    diagnostics, outline lines). Everything returned is picklable."""
+    result, text, diags = file_diagnostics(Path(path), keep_tree=outline or tree)
+    entries: list[str] = []
+    if result.ok and (outline or tree):
+        if tree:
+            from krl.syntax.outline import outline as tree_outline  # noqa: PLC0415
+            entries = list(tree_outline(result.tree))
+        else:
+            from krl.ast.build import build_module  # noqa: PLC0415
+            from krl.syntax.outline import symbol_outline  # noqa: PLC0415
+            entries = list(symbol_outline(build_module(result)))
+    result.tree = None
+    return result, text, diags, entries
+
+
+def _jobs_in_order(files, outline: bool, tree: bool, timeout: float | None, jobs: int | None):
+    """(path, job result or None, failure Diagnostic or None) per file, in the order of
+    `files`. With `timeout`, each file is parsed in a worker process killed past it."""
+    from krl.pool import run_tasks  # noqa: PLC0415
+
+    if timeout is None:
+        for path in files:
+            yield path, parse_job(str(path), outline, tree), None
+        return
+    from krl.syntax.parse import default_bundle  # noqa: PLC0415
+
+    default_bundle()   # imported once here, inherited by the forked workers
+    waiting: dict[int, object] = {}
+    nxt = 0
+    tasks = ((i, (str(p), outline, tree)) for i, p in enumerate(files))
+    for o in run_tasks(parse_job, tasks, jobs=jobs, timeout=timeout):
+        waiting[o.key] = o
+        while nxt in waiting:
+            o = waiting.pop(nxt)
+            path = files[nxt]
+            nxt += 1
+            if o.status == "done":
+                yield path, o.value, None
+            elif o.status == "timeout":
+                yield path, None, Diagnostic(str(path), 1, 1, "E005",
+                                             f"file not parsed within {timeout:g} s (--timeout; the parse was stopped)")
+            else:
+                yield path, None, Diagnostic(str(path), 1, 1, "E001", f"file not parsed: {o.detail}")
+
+
 def run_parse(files, fmt: str = "text", outline: bool = False, tree: bool = False, echo=print,
-              colour: bool = False) -> int:
-    """Parse `files` and print the result in `fmt`; returns the exit status (0 or 1)."""
+              colour: bool = False, timeout: float | None = None, jobs: int | None = None) -> int:
+    """Parse `files` and print the result in `fmt`; returns the exit status (0 or 1).
+
+    timeout: seconds per file; each file is then parsed in a worker process (krl/pool.py)
+    that is killed past it, and the file gets error E005 while the others are still parsed
+    (None: parse here, without a limit; the command passes krl.limits.PARSE_TIMEOUT_S).
+    """
     from krl.semantics.render import Renderer, SourceLines  # noqa: PLC0415
     from krl.terminal import printable, printable_path  # noqa: PLC0415
 
+    files = list(files)
     sources = SourceLines()
     renderer = Renderer(echo, colour, sources)
     all_diags: list[Diagnostic] = []
     all_ok = True
-    for path in files:
-        result, text, diags = file_diagnostics(Path(path), keep_tree=(outline or tree) and fmt == "text")
+    for path, job, failure in _jobs_in_order(files, outline, tree, timeout, jobs):
+        if job is None:
+            all_ok = False
+            all_diags.append(failure)
+            if fmt == "json":
+                echo(json.dumps({"path": str(path), "ok": False, "encoding": "",
+                                 "status": "timeout" if failure.code == "E005" else "internal_error",
+                                 "diagnostics": [failure.as_json()], "errors": []}))
+            elif fmt == "text":
+                renderer.emit([failure])
+            continue
+        result, text, diags, entries = job
         all_ok &= result.ok
         all_diags += diags
-        sources.add(str(path), text)
+        if text or result.ok:
+            sources.add(str(path), text)
         if fmt == "json":
             obj = {"path": str(path), "ok": result.ok, "encoding": result.encoding, "status": result.status,
                    "diagnostics": [d.as_json() for d in diags],
@@ -57,13 +121,6 @@ def run_parse(files, fmt: str = "text", outline: bool = False, tree: bool = Fals
         if fmt == "text":
             renderer.emit(diags)
         if result.ok and (outline or tree) and fmt == "text":
-            if tree:
-                from krl.syntax.outline import outline as tree_outline  # noqa: PLC0415
-                entries = tree_outline(result.tree)
-            else:
-                from krl.ast.build import build_module  # noqa: PLC0415
-                from krl.syntax.outline import symbol_outline  # noqa: PLC0415
-                entries = symbol_outline(build_module(result))
             for entry in entries:
                 echo(f"{printable_path(path)}:{printable(entry)}")
     if fmt == "sarif":
@@ -74,7 +131,7 @@ def run_parse(files, fmt: str = "text", outline: bool = False, tree: bool = Fals
     return 0 if all_ok else 1
 
 
-def main_status(files, fmt, as_json, outline, tree, engine: str | None = None) -> int:
+def main_status(files, fmt, as_json, outline, tree, timeout=None, jobs=None, engine: str | None = None) -> int:
     """The `parse` command's body (krl/cli.py keeps only the options)."""
     from krl.syntax.engines import use_engine  # noqa: PLC0415
 
@@ -84,4 +141,5 @@ def main_status(files, fmt, as_json, outline, tree, engine: str | None = None) -
     import click  # noqa: PLC0415
 
     fmt = "json" if as_json else fmt
-    return run_parse(files, fmt, outline, tree, click.echo, use_colour(sys.stdout) and fmt == "text")
+    return run_parse(files, fmt, outline, tree, click.echo, use_colour(sys.stdout) and fmt == "text",
+                     timeout=timeout, jobs=jobs)

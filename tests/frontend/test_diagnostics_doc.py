@@ -5,13 +5,14 @@ section in docs/diagnostics.md and the doc has no section for a code that does n
 ``krl`` blocks of a section form one small program (the info string names the file); the
 checker run on exactly those files must report the section's code. Codes whose trigger is not
 a small text (a binary file, a generated 101-level nesting, a zip archive) are produced here by
-a generator instead; four codes have no trigger (toolkit bugs, or a tree the grammar never builds), and the doc says so.
+a generator instead (W002 a symbolic link, E005 a parse that never ends); four codes have no trigger (toolkit bugs, or a tree the grammar never builds), and the doc says so.
 """
 
 from __future__ import annotations
 
 import json
 import re
+import time
 import zipfile
 from pathlib import Path
 
@@ -71,6 +72,26 @@ def _generated(code: str, tmp: Path) -> set[str]:
         out: list[str] = []
         assert run_check([str(z)], fmt="json", echo=out.append) == 1
         return {d["code"] for line in out for d in json.loads(line)["diagnostics"]}
+    if code == "W002":
+        (tmp / "a.src").write_text("DEF a()\nEND\n")
+        (tmp / "link.src").symlink_to(tmp / "a.src")
+        out = []
+        run_check([str(tmp)], fmt="json", echo=out.append)
+        return {d["code"] for line in out for d in json.loads(line)["diagnostics"]}
+    if code == "E005":
+        # a parse that never ends: the worker is killed after the timeout
+        import krl.workspace as workspace_mod  # noqa: PLC0415
+        from unittest import mock  # noqa: PLC0415
+
+        def stuck(src, *a, **kw):
+            while True:
+                time.sleep(3600)
+
+        (tmp / "slow.src").write_text("DEF slow()\nEND\n")
+        out = []
+        with mock.patch.object(workspace_mod, "parse_source", stuck):
+            assert run_check([str(tmp)], fmt="json", echo=out.append, timeout=1, jobs=1) == 1
+        return {d["code"] for line in out for d in json.loads(line)["diagnostics"]}
     raise AssertionError(f"no generator for {code}")
 
 
@@ -82,7 +103,7 @@ def test_every_code_has_a_section_and_every_section_a_code():
 
 def test_sections_without_example_are_exactly_the_generated_and_untriggerable_ones():
     without = {c for c, body in sections().items() if not examples(body)}
-    assert without == NO_TRIGGER | {"E001", "E004", "E018", "E019"}
+    assert without == NO_TRIGGER | {"E001", "W002", "E004", "E005", "E018", "E019"}
     for code in NO_TRIGGER:
         assert "Example: none" in sections()[code]
 

@@ -1,0 +1,134 @@
+"""Walking an untrusted folder (a corpus, a KRC backup): iterative, never following a link.
+
+:func:`walk` is the one folder walk of ``krl recover`` and ``krl check`` (and of finding KRC
+backups). It never recurses (an explicit stack: a tree 1,000 levels deep costs a list, not the
+Python stack), never follows a symbolic link (a link is listed, never read, so nothing outside
+the root is reached or quoted), and never opens a file: it only lists folders and ``lstat``\\ s
+their entries. Every entry that is not a plain file of interest is reported, not dropped:
+
+========================  ==========================================================
+kind                      meaning
+========================  ==========================================================
+``file``                  a regular file whose name matches (``.src``/``.dat``/``.sub``)
+``symlink``               a symbolic link named like a KRL file, or linking to a folder
+``not_regular``           a FIFO, socket or device named like a KRL file (never opened)
+``unreadable_folder``     a folder that cannot be listed (permissions, I/O error)
+``too_deep``              a folder past :data:`krl.limits.MAX_FOLDER_DEPTH`, not entered
+========================  ==========================================================
+
+Order: within a folder, entries sorted by name; the files of a folder come before its
+sub-folders (the order of ``os.walk`` with sorted names).
+"""
+
+from __future__ import annotations
+
+import os
+import stat
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass
+from pathlib import Path
+
+from krl.limits import MAX_FOLDER_DEPTH
+from krl.syntax.source import file_kind, is_krl_file
+
+WARNING_KINDS = ("symlink", "not_regular", "unreadable_folder", "too_deep")
+
+
+@dataclass(slots=True)
+class Entry:
+    """One listed entry. ``rel``: the path relative to the root, '/'-separated, as the file
+    system spells it (an undecodable byte stays a surrogate escape; show it with
+    :func:`display_path`). ``size``: bytes, by lstat (0 for anything but a file)."""
+
+    path: Path
+    rel: str
+    kind: str
+    detail: str = ""
+    size: int = 0
+
+    @property
+    def message(self) -> str:
+        """Why the entry is not read, in words (for a diagnostic or a report row)."""
+        return {"symlink": "a symbolic link (never followed)",
+                "not_regular": f"{self.detail or 'not a regular file'} (never opened)",
+                "unreadable_folder": f"folder cannot be read: {self.detail}",
+                "too_deep": f"folder more than {MAX_FOLDER_DEPTH} levels deep (not entered)",
+                }.get(self.kind, self.detail)
+
+
+def display_path(path: str) -> str:
+    """A path for reports (CSV, JSON, Markdown, HTML): undecodable bytes of a file name (held
+    by Python as surrogate escapes ``\\udcXX``) shown as ``\\xNN``; every other character kept.
+    ``display_path(os.fsdecode(b"Pr\\xfcfung.src")) == "Pr\\\\xfcfung.src"``."""
+    if not any("\udc80" <= ch <= "\udcff" for ch in path):
+        return path
+    return "".join(f"\\x{ord(ch) - 0xDC00:02x}" if "\udc80" <= ch <= "\udcff" else ch for ch in path)
+
+
+def walk(root: str | Path, match: Callable[[str], bool] | None = None,
+         max_depth: int = MAX_FOLDER_DEPTH) -> Iterator[Entry]:
+    """Entries below the folder `root` (see the module docstring). `match(name)` selects the
+    files of interest (default: KRL files); a symbolic link or a non-regular file is listed
+    when its name matches (a link to a folder always). Never raises for what it finds."""
+    root = Path(root)
+    match = match or (lambda name: is_krl_file(Path(name)))
+    stack: list[tuple[Path, str, int]] = [(root, "", 0)]
+    while stack:
+        folder, rel, depth = stack.pop()
+        if depth > max_depth:
+            yield Entry(folder, rel, "too_deep")
+            continue
+        try:
+            with os.scandir(folder) as it:
+                listed = sorted(it, key=lambda e: e.name)
+        except OSError as exc:
+            yield Entry(folder, rel or ".", "unreadable_folder", exc.strerror or str(exc))
+            continue
+        subfolders = []
+        for e in listed:
+            sub = f"{rel}/{e.name}" if rel else e.name
+            try:
+                st = e.stat(follow_symlinks=False)
+                mode, size = st.st_mode, st.st_size
+            except OSError as exc:
+                if match(e.name):
+                    yield Entry(Path(e.path), sub, "unreadable", exc.strerror or str(exc))
+                continue
+            if stat.S_ISLNK(mode):
+                if match(e.name) or _links_to_folder(e):
+                    yield Entry(Path(e.path), sub, "symlink")
+            elif stat.S_ISDIR(mode):
+                subfolders.append((Path(e.path), sub))
+            elif stat.S_ISREG(mode):
+                if match(e.name):
+                    yield Entry(Path(e.path), sub, "file", size=size)
+            elif match(e.name):
+                yield Entry(Path(e.path), sub, "not_regular", file_kind(mode))
+        stack.extend((path, sub, depth + 1) for path, sub in reversed(subfolders))
+
+
+def _links_to_folder(e: os.DirEntry) -> bool:
+    try:
+        return e.is_dir(follow_symlinks=True)
+    except OSError:
+        return False
+
+
+def write_text_atomic(path: str | Path, text: str) -> None:
+    """Write `text` (UTF-8) to `path` atomically: into a temporary file in the same folder,
+    then renamed over `path`, so a reader (or a crash) never sees half a file."""
+    import tempfile  # noqa: PLC0415
+
+    path = Path(path)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as fh:
+            fh.write(text)
+        os.chmod(tmp, 0o644)
+        os.replace(tmp, path)
+    except BaseException:
+        try:
+            os.unlink(tmp)
+        except OSError:
+            pass
+        raise

@@ -1,0 +1,115 @@
+"""Running per-file work in worker processes that can be killed (pebble).
+
+A parse of untrusted text may take too long, exhaust memory or crash the interpreter (a C
+extension, a signal). None of that may stop a scan or hang a command, and a timeout must not
+depend on the parsed code cooperating (a SIGALRM is lost when it fires inside a garbage-collector
+callback). So each task runs in a worker process of a :class:`pebble.ProcessPool`: past its
+timeout the worker is killed and replaced, and a worker that dies (killed, segfault, ``os._exit``)
+fails only its own task. :func:`run_tasks` turns every task into one :class:`Outcome`, in
+completion order, and keeps a bounded number of tasks in flight, so the arguments (file bytes)
+of a large corpus are never all in memory at once.
+
+Workers are forked from the calling process (the default start method on Linux): a function
+patched in the parent before the pool starts is the function the workers run (the tests'
+crash hooks rely on it).
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+from collections.abc import Callable, Iterable, Iterator
+from concurrent.futures import FIRST_COMPLETED, wait
+from concurrent.futures import TimeoutError as FutureTimeout
+from dataclasses import dataclass
+from typing import Any, Hashable
+
+
+@dataclass(slots=True)
+class Outcome:
+    """The end of one task: ``status`` is "done" (``value`` is the function's result),
+    "timeout" (the worker was killed after the timeout) or "internal_error" (the worker died,
+    or the function raised: ``detail`` says how)."""
+
+    key: Hashable
+    status: str
+    value: Any = None
+    detail: str = ""
+
+
+def default_jobs() -> int:
+    """The number of cores this process may run on."""
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except (AttributeError, OSError):
+        return os.cpu_count() or 1
+
+
+def _death(exitcode: int | None) -> str:
+    if exitcode is not None and exitcode < 0:
+        try:
+            return f"the worker process died ({signal.Signals(-exitcode).name})"
+        except ValueError:
+            return f"the worker process died (signal {-exitcode})"
+    return f"the worker process died (exit status {exitcode})"
+
+
+def run_tasks(fn: Callable[..., Any], tasks: Iterable[tuple[Hashable, tuple]], *, jobs: int | None = None,
+              timeout: float | None = None, initializer: Callable | None = None, initargs: tuple = (),
+              in_process: bool = False) -> Iterator[Outcome]:
+    """Run ``fn(*args)`` for every ``(key, args)`` of `tasks`; yield one :class:`Outcome` per
+    task as tasks finish.
+
+    jobs: worker processes (default: :func:`default_jobs`). timeout: seconds of wall time per
+    task, counted from when a worker starts it (None: no limit). in_process: run in this
+    process, one after the other, with no timeout and no protection from a crash (for callers
+    that already run inside a worker, and for tests of the function itself).
+    Tasks are taken from `tasks` lazily, at most ``2 * jobs`` ahead of the results.
+    """
+    if in_process:
+        if initializer is not None:
+            initializer(*initargs)
+        for key, args in tasks:
+            try:
+                yield Outcome(key, "done", fn(*args))
+            except Exception as exc:  # noqa: BLE001 - one task never stops the others
+                yield Outcome(key, "internal_error", None, f"{type(exc).__name__}: {exc}")
+        return
+    from pebble import ProcessExpired, ProcessPool  # noqa: PLC0415
+
+    jobs = max(1, jobs or default_jobs())
+    window = 2 * jobs
+    pool = ProcessPool(max_workers=jobs, initializer=initializer, initargs=initargs)
+    finished = False
+    try:
+        inflight: dict = {}
+        source = iter(tasks)
+        exhausted = False
+        while True:
+            while not exhausted and len(inflight) < window:
+                try:
+                    key, args = next(source)
+                except StopIteration:
+                    exhausted = True
+                    break
+                inflight[pool.schedule(fn, args=args, timeout=timeout)] = key
+            if not inflight:
+                break
+            done, _ = wait(list(inflight), return_when=FIRST_COMPLETED)
+            for fut in done:
+                key = inflight.pop(fut)
+                try:
+                    yield Outcome(key, "done", fut.result())
+                except FutureTimeout:
+                    yield Outcome(key, "timeout", None, f"killed after {timeout:g} s")
+                except ProcessExpired as exc:
+                    yield Outcome(key, "internal_error", None, _death(exc.exitcode))
+                except Exception as exc:  # noqa: BLE001 - raised in the worker, or unpicklable
+                    yield Outcome(key, "internal_error", None, f"{type(exc).__name__}: {exc}")
+        finished = True
+    finally:
+        if finished:
+            pool.close()
+        else:
+            pool.stop()   # interrupted or abandoned: kill the workers, do not wait for them
+        pool.join()
