@@ -11,7 +11,7 @@ GEN_DIR := krl/syntax/generated
 PARSER  := $(GEN_DIR)/KRLParser.py
 SHARED_CORPUS ?= ../shared/krl-corpus
 
-.PHONY: all recover test validate growth conformance nightly bench parser clean check-python check-java
+.PHONY: all recover test validate growth conformance nightly bench parser java-parser clean check-python check-java
 
 all: test
 
@@ -36,38 +36,48 @@ $(PARSER): grammar/KRL.g4 $(BIN)/.installed | check-java
 	$(BIN)/antlr4 -Dlanguage=Python3 -visitor -no-listener -Xexact-output-dir -o $(GEN_DIR) grammar/KRL.g4
 	@touch $(GEN_DIR)/__init__.py $@
 
-parser: $(PARSER)
+parser: $(PARSER) java-parser
 
-recover: $(PARSER)
+# The Java parse engine (krl/syntax/engines/java.py): the Java parser generated from
+# grammar/KRL.g4 and compiled, cached by the grammar's sha under build/java/ (not committed).
+# Without a JDK it says so and the Python engine is used.
+JAVA_STAMP := build/java/.built-$(shell sha256sum grammar/KRL.g4 krl/syntax/engines/worker/KrlWorker.java 2>/dev/null | sha256sum | cut -c1-16)
+$(JAVA_STAMP): $(PARSER)
+	@$(BIN)/python -c 'import sys; from krl.syntax.engines.java import main; sys.exit(main(["build"]))'
+	@mkdir -p build/java && touch $@
+
+java-parser: $(JAVA_STAMP)
+
+recover: $(PARSER) java-parser
 	$(BIN)/krl recover $(CORPUS) --out $(OUT); status=$$?; \
 	  if [ $$status -le 1 ]; then echo "report: $(OUT)/report.html (open it in a browser; Markdown: $(OUT)/report.md)"; exit 0; else exit $$status; fi
 
-growth: $(PARSER)
+growth: $(PARSER) java-parser
 	$(BIN)/krl growth $(SHARED_CORPUS) --out reports/growth
 
-validate: $(PARSER)
+validate: $(PARSER) java-parser
 	$(BIN)/krl validate
 
-test: $(PARSER)
+test: $(PARSER) java-parser
 	$(BIN)/python -m pytest -q -n 2 -p no:cacheprovider -r fEsxX
 
-bench: $(PARSER)
+bench: $(PARSER) java-parser
 	$(BIN)/krl bench
 
 clean:
-	rm -rf $(VENV) $(GEN_DIR) reports/recovery reports/growth
+	rm -rf $(VENV) $(GEN_DIR) build/java reports/recovery reports/growth
 
 # Conformance suites (issue 8): hand-written cases, differential fuzzing, corpus programs.
 CONF_OUT  ?= reports/conformance
 CONF_FUZZ ?= 200
-conformance: $(PARSER)
+conformance: $(PARSER) java-parser
 	$(BIN)/krl conformance --out $(CONF_OUT) --fuzz $(CONF_FUZZ)
 
 # Long nightly run, in order: recovery over the shared corpus, growth, conformance, the
 # tests marked slow (long sweeps; hypothesis with the nightly profile); dated reports under
 # reports/nightly/<date>/ and an index page. Not part of `make test`.
 NIGHTLY_FUZZ ?= 2000
-nightly: $(PARSER)
+nightly: $(PARSER) java-parser
 	@d=reports/nightly/$$(date -u +%Y-%m-%d); mkdir -p $$d; \
 	$(BIN)/krl recover $(SHARED_CORPUS) --out $$d/recovery; s=$$?; [ $$s -le 1 ] || exit $$s; \
 	$(BIN)/krl growth $(SHARED_CORPUS) --out $$d/growth || exit $$?; \

@@ -6,6 +6,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from interp.runtime.core import RunResult, Runtime
+from interp.runtime.errors import ResourceError
 
 
 def make_runtime(program, *, workspace=None, inputs=None, trace=None, max_sim_time=None,
@@ -32,7 +33,10 @@ def make_runtime(program, *, workspace=None, inputs=None, trace=None, max_sim_ti
     if controller.stimuli:
         from robot.stimuli import resolve_signals  # noqa: PLC0415
 
-        resolve_signals(controller.stimuli, lambda name: signal_of(rt, Path(program).stem, name))
+        try:
+            resolve_signals(controller.stimuli, lambda name: signal_of(rt, Path(program).stem, name))
+        except ResourceError:
+            pass    # a data list past a limit: the program does not start (Runtime.main_routine says why)
     if interp == "vm":
         from interp.vm import VM  # noqa: PLC0415
 

@@ -28,16 +28,19 @@ def main() -> None:
 @click.option("--json", "as_json", is_flag=True, help="Same as --format json.")
 @click.option("--outline", is_flag=True, help="Print the routines and declarations of each file that parses.")
 @click.option("--tree", is_flag=True, help="Print the grammar-rule outline of each file that parses.")
+@click.option("--engine", type=click.Choice(["auto", "python", "java"]), default=None,
+              help="Parse engine: java (fast; needs a JDK), python (reference; builds trees), auto: "
+                   "java when available (default: $KRL_ENGINE, else auto). --outline/--tree use python.")
 @click.option("--timeout", type=click.FloatRange(min=0, min_open=True), default=PARSE_TIMEOUT_S,
               show_default=True, help="Seconds one file may parse; past it the parse is stopped (error E005).")
 @click.option("--jobs", type=click.IntRange(min=1), default=None,
               help="Worker processes (default: the number of cores).")
 def parse(files: tuple[Path, ...], fmt: str, as_json: bool, outline: bool, tree: bool, timeout: float,
-          jobs: int | None) -> None:
+          jobs: int | None, engine: str | None) -> None:
     """Parse FILES; exit 0 when every file parses (krl/syntax/cli.py)."""
     from krl.syntax.cli import main_status  # noqa: PLC0415
 
-    sys.exit(main_status(files, fmt, as_json, outline, tree, timeout, jobs))
+    sys.exit(main_status(files, fmt, as_json, outline, tree, timeout, jobs, engine))
 
 
 # Each pipeline stage contributes its subcommands from its own package: a module listed

@@ -15,6 +15,12 @@ from __future__ import annotations
 # of magnitude chosen here. Past it: "nesting too deep" at the opener that went past it.
 MAX_NESTING = 100
 
+# The deepest nesting of KRL routine calls at run time (both interpreters, interrupt routines
+# included). The reference (§8.2) leaves the limit open and suggests about 100 levels; real
+# programs call a few levels deep. Past it: the run-time error "stack overflow: more than 100
+# nested calls" at the call (interp/runtime/core.py).
+MAX_CALL_DEPTH = 100
+
 # The largest source file read, in bytes (krl/syntax/source.py).
 MAX_FILE_BYTES = 10 * 1024 * 1024
 
@@ -62,3 +68,13 @@ MAX_LSP_WORKSPACE_FILES = 5000
 # folder, in entries: a backup has a few thousand; a home folder opened by mistake may have
 # millions. Past it the listing stops there (as for MAX_LSP_WORKSPACE_FILES).
 MAX_LSP_SCAN_ENTRIES = 200_000
+
+# The run's data memory, in data elements: every scalar value (INT, REAL, BOOL, CHAR, ENUM) and
+# every structure value held by a declared variable counts one (an array of n elements counts n
+# times its element; `DECL E6POS P[10]` is 10 x 13 = 130). Data lists (.dat, $config.dat), the
+# locals of every active routine call and the copies of :IN parameters are counted together;
+# a routine's share is given back when it returns. 2^20 elements is about 4 MiB of controller
+# data at 4 bytes an element, far above the largest real data list (the corpus's biggest array
+# has 8192 elements) and a few hundred MB of Python at most. Past it: the run-time error "data
+# memory exhausted" at the DECL line, before anything is allocated (interp/runtime/memory.py).
+MAX_DATA_ELEMENTS = 1 << 20

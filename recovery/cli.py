@@ -19,7 +19,10 @@ from krl.limits import PARSE_TIMEOUT_S
 @click.option("--no-cache", is_flag=True, help="Parse every file again (the cache folder is not touched).")
 @click.option("--timeout", type=click.FloatRange(min=0, min_open=True), default=PARSE_TIMEOUT_S,
               show_default=True, help="Seconds one file may parse; past it its worker is killed (row `timeout`).")
-def recover(corpus: Path, out: Path, jobs: int | None, no_cache: bool, timeout: float) -> None:
+@click.option("--engine", type=click.Choice(["auto", "python", "java"]), default=None,
+              help="Parse engine: java (fast; needs a JDK), python (the reference), auto: java when available "
+                   "(default: $KRL_ENGINE, else auto).")
+def recover(corpus: Path, out: Path, jobs: int | None, no_cache: bool, timeout: float, engine: str | None) -> None:
     """Parse every KRL file under CORPUS (a folder or a KRC backup .zip), cluster the failures,
     write the report to --out.
 
@@ -29,8 +32,10 @@ def recover(corpus: Path, out: Path, jobs: int | None, no_cache: bool, timeout: 
     from krl.archive import ArchiveError, backup_source, is_archive  # noqa: PLC0415
     from krl.terminal import printable_path  # noqa: PLC0415
     from recovery.pipeline import run_recovery  # noqa: PLC0415
+    from krl.syntax.engines import use_engine  # noqa: PLC0415
     from recovery.report import ReportError  # noqa: PLC0415
 
+    use_engine(engine)
     if not corpus.is_dir() and not is_archive(corpus):
         click.echo(f"error: corpus folder or .zip archive not found: {printable_path(corpus)}", err=True)
         sys.exit(2)
@@ -54,13 +59,17 @@ def recover(corpus: Path, out: Path, jobs: int | None, no_cache: bool, timeout: 
 @click.command()
 @click.argument("corpus", type=click.Path(path_type=Path))
 @click.option("--out", default="reports/growth", type=click.Path(path_type=Path))
-@click.option("--jobs", type=int, default=None)
+@click.option("--jobs", type=int, default=None, help="Grammar versions scanned at a time (default: the number of cores).")
 @click.option("--no-cache", is_flag=True)
-def growth(corpus: Path, out: Path, jobs: int | None, no_cache: bool) -> None:
+@click.option("--engine", type=click.Choice(["auto", "python", "java"]), default=None,
+              help="Parse engine (java: fast, needs a JDK; python: the reference; default: $KRL_ENGINE, else auto).")
+def growth(corpus: Path, out: Path, jobs: int | None, no_cache: bool, engine: str | None) -> None:
     """Replay every committed version of grammar/KRL.g4 over CORPUS: growth.csv and growth.png."""
+    from krl.syntax.engines import use_engine  # noqa: PLC0415
     from recovery.grammar_versions import GrammarToolError  # noqa: PLC0415
     from recovery.growth import growth_rows, write_growth  # noqa: PLC0415
 
+    use_engine(engine)
     if not corpus.is_dir():
         click.echo(f"error: corpus directory not found: {corpus}", err=True)
         sys.exit(2)
@@ -82,13 +91,25 @@ def growth(corpus: Path, out: Path, jobs: int | None, no_cache: bool) -> None:
               help="Also report the corpus clusters each construct closed (default: "
                    "../shared/krl-corpus when present).")
 @click.option("--no-corpus", is_flag=True, help="Only run the examples.")
-def validate(names: tuple[str, ...], corpus: Path | None, no_corpus: bool) -> None:
+@click.option("--jobs", type=int, default=None, help="Grammar versions scanned at a time (default: the number of cores).")
+@click.option("--engine", type=click.Choice(["auto", "python", "java"]), default=None,
+              help="Parse engine for the corpus scans (java: fast, needs a JDK; python: the reference; "
+                   "default: $KRL_ENGINE, else auto).")
+def validate(names: tuple[str, ...], corpus: Path | None, no_corpus: bool, jobs: int | None,
+             engine: str | None) -> None:
     """Run every grammar construct's positive and negative examples (or only NAMES)."""
+    from krl.syntax.engines import use_engine  # noqa: PLC0415
+    from recovery.grammar_versions import GrammarToolError  # noqa: PLC0415
     from recovery.validate import DEFAULT_CORPUS, print_validation, validate_constructs  # noqa: PLC0415
 
+    use_engine(engine)
     if corpus is None and not no_corpus and DEFAULT_CORPUS.is_dir():
         corpus = DEFAULT_CORPUS
-    reports = validate_constructs(list(names), corpus=None if no_corpus else corpus)
+    try:
+        reports = validate_constructs(list(names), corpus=None if no_corpus else corpus, jobs=jobs)
+    except GrammarToolError as exc:
+        click.echo(f"error: {exc}", err=True)
+        sys.exit(2)
     ok = print_validation(reports)
     sys.exit(0 if ok else 1)
 

@@ -65,10 +65,15 @@ def _antlr_tool() -> list[str]:
     return [exe]
 
 
+def python_target(text: str) -> Path:
+    """Where the Python parser of a grammar text is generated (the user cache, by sha)."""
+    return cache_dir() / "parsers" / grammar_sha(text)[:32]
+
+
 def parser_dir_for(text: str) -> Path:
     """Generate (once) the Python parser for grammar text; returns its directory."""
     gsha = grammar_sha(text)
-    target = cache_dir() / "parsers" / gsha[:32]
+    target = python_target(text)
     if (target / "KRLParser.py").exists():
         return target
     target.parent.mkdir(parents=True, exist_ok=True)

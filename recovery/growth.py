@@ -2,41 +2,100 @@
 
 Writes growth.csv (one row per version: commit, date, subject, parser_rules, lexer_rules,
 alternatives, files_ok, bytes_ok, clusters, files, bytes) and growth.png (files and bytes
-parsed against grammar version). Parsers and per-file results are cached by (grammar sha,
-file sha), so a replay only parses what changed.
+parsed against grammar version). Parsers (Python and Java) are generated once per grammar sha,
+in parallel; versions are scanned in parallel (--jobs), each with the fast parse engine when it
+can run; per-file results are cached by (grammar sha, file sha), so a replay only parses what
+changed.
 """
 
 from __future__ import annotations
 
 import csv
+import os
 from pathlib import Path
 
 from recovery.cluster import cluster_results
 from recovery.grammar_versions import committed_versions, grammar_metrics, parser_dir_for
-from recovery.scan import scan
+from recovery.scan import grammar_sha, scan
 
 COLUMNS = ["commit", "date", "subject", "parser_rules", "lexer_rules", "alternatives",
            "files_ok", "bytes_ok", "clusters", "files", "bytes"]
 
 
-def growth_rows(corpus: Path, jobs: int | None = None, use_cache: bool = True,
-                progress: bool = True) -> list[dict]:
+def _summary(results) -> dict:
+    return {"files_ok": sum(r.ok for r in results),
+            "bytes_ok": sum(r.bytes for r in results if r.ok),
+            "clusters": len(cluster_results(results)),
+            "files": len(results), "bytes": sum(r.bytes for r in results)}
+
+
+def _scan_version(args: tuple[str, str, str, bool]) -> dict:
+    """Scan the corpus with one grammar version in this process (a pool worker); its Java
+    worker (if any) is stopped afterwards, so that versions do not pile up JVMs."""
+    from krl.syntax.engines.java import close_all  # noqa: PLC0415
+
+    corpus, sha, pdir, use_cache = args
+    try:
+        return _summary(scan(Path(corpus), sha, parser_dir=pdir, jobs=1, use_cache=use_cache,
+                             progress=False))
+    finally:
+        close_all()
+
+
+def build_parsers(texts: list[str], jobs: int) -> list[Path]:
+    """The Python parser directory of each grammar text, and its Java parser when the Java
+    engine can run, generated once per sha: all missing ones in `jobs` JVMs (KrlBuild), so the
+    JVM start and warm-up are paid once, not per version."""
+    from krl.syntax.engines import resolve  # noqa: PLC0415
+    from krl.syntax.engines.java import build_many, java_target  # noqa: PLC0415
+    from recovery.grammar_versions import python_target  # noqa: PLC0415
+
+    tasks = [("python", t, python_target(t)) for t in texts]
+    if resolve() == "java":
+        tasks += [("java", t, java_target(t)) for t in texts]
+        build_many(tasks, jobs)   # a failed build is done again below, one by one, to say why
+    return [parser_dir_for(t) for t in texts]
+
+
+def scan_versions(corpus: Path, texts: list[str], jobs: int | None = None, use_cache: bool = True,
+                  labels: list[str] | None = None, progress: bool = True) -> list[dict]:
+    """Scan `corpus` with each grammar text, `jobs` versions at a time (one process and one
+    parse engine worker each); returns each version's summary (files_ok, bytes_ok, clusters,
+    files, bytes), in order. Per-file results land in the result cache (recovery/scan.py)."""
+    from concurrent.futures import ProcessPoolExecutor  # noqa: PLC0415
+
     from recovery.progress import steps  # noqa: PLC0415
 
-    rows = []
+    jobs = jobs or os.cpu_count() or 1
+    pdirs = build_parsers(texts, jobs)
+    args = [(str(corpus), grammar_sha(t), str(d), use_cache) for t, d in zip(texts, pdirs)]
+    labels = labels or [grammar_sha(t)[:10] for t in texts]
+    order = list(range(len(texts)))
+    shown = (lambda items: steps(items, "replaying grammar versions", lambda i: labels[i])) if progress \
+        else (lambda items: items)
+    out: list[dict] = []
+    if jobs == 1 or len(texts) == 1:
+        for i in shown(order):
+            out.append(_scan_version(args[i]))
+        return out
+    with ProcessPoolExecutor(max_workers=min(jobs, len(texts))) as pool:
+        ordered = pool.map(_scan_version, args)
+        for _ in shown(order):
+            out.append(next(ordered))
+    return out
+
+
+def growth_rows(corpus: Path, jobs: int | None = None, use_cache: bool = True,
+                progress: bool = True) -> list[dict]:
+    """One row per committed grammar version (COLUMNS); versions scanned in parallel."""
     versions = committed_versions()
-    shown = steps(versions, "replaying grammar versions", lambda v: f"{v.commit[:10]} {v.subject[:40]}") \
-        if progress else versions
-    for version in shown:
-        pdir = parser_dir_for(version.text)
-        results = scan(corpus, version.sha, parser_dir=str(pdir), jobs=jobs, use_cache=use_cache,
-                       progress=False)
+    summaries = scan_versions(corpus, [v.text for v in versions], jobs, use_cache,
+                              [f"{v.commit[:10]} {v.subject[:40]}" for v in versions], progress)
+    rows = []
+    for version, summary in zip(versions, summaries):
         row = {"commit": version.commit[:10], "date": version.date, "subject": version.subject}
         row.update(grammar_metrics(version.text))
-        row.update({"files_ok": sum(r.ok for r in results),
-                    "bytes_ok": sum(r.bytes for r in results if r.ok),
-                    "clusters": len(cluster_results(results)),
-                    "files": len(results), "bytes": sum(r.bytes for r in results)})
+        row.update(summary)
         rows.append(row)
     return rows
 

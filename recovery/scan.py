@@ -161,7 +161,7 @@ def _init_worker(parser_dir: str | None) -> None:
 
 def parse_row(rel_path: str, data: bytes, sha: str) -> FileResult:
     """Decode and parse the bytes of one file: the scan's one call into the parser."""
-    from krl.syntax.parse import parse_source  # noqa: PLC0415
+    from krl.syntax.engines import parse_source  # noqa: PLC0415  (KRL_ENGINE: python, java, auto)
 
     source = source_from_bytes(rel_path, data, sha)
     row = FileResult(rel_path, source.size, sha, source.encoding, source.status, detail=source.detail)

@@ -9,7 +9,8 @@ grammar/constructs/<name>/ holds, per construct:
 
 With a corpus, validate also reports which corpus clusters the construct closed: it scans
 the corpus with the grammar before and after the commit that introduced the construct
-(parsers and results come from the growth cache).
+(parsers and results come from the growth cache; the versions are scanned in parallel, with
+the fast parse engine when it can run: krl/syntax/engines).
 """
 
 from __future__ import annotations
@@ -20,7 +21,7 @@ from pathlib import Path
 import click
 
 from krl.syntax.parse import parse_file
-from krl.syntax.source import is_krl_file
+from krl.syntax.source import is_krl_file, read_source
 from recovery.cluster import cluster_results
 from recovery.grammar_versions import GrammarToolError, _git, parser_dir_for
 from recovery.scan import grammar_sha, scan
@@ -79,7 +80,12 @@ def built_kinds(result) -> list[tuple[int, str]]:
 
 def check_example(path: Path) -> ExampleResult:
     kind = "ok" if path.name.startswith("ok_") else "bad"
-    result = parse_file(path, keep_tree=(kind == "ok"))
+    if kind == "ok":   # the statement kinds need the tree: the Python engine
+        result = parse_file(path, keep_tree=True)
+    else:
+        from krl.syntax.engines import parse_source  # noqa: PLC0415
+
+        result = parse_source(read_source(path))
     rel = path.relative_to(REPO_ROOT).as_posix()
     if kind == "bad":
         return ExampleResult(rel, kind, not result.ok, "" if not result.ok else "accepted")
@@ -104,29 +110,34 @@ def _introducing_commit(directory: Path) -> str:
     return out[-1] if out else ""
 
 
-def _corpus_effect(report: ConstructReport, directory: Path, corpus: Path) -> None:
+def _grammar_change(report: ConstructReport, directory: Path) -> tuple[str, str] | None:
+    """The grammar before and after the commit that introduced the construct, or None (with
+    report.note saying why) when there is no corpus effect to measure."""
     try:
         commit = _introducing_commit(directory)
     except GrammarToolError as exc:
         report.note = str(exc)
-        return
+        return None
     if not commit:
         report.note = "not committed yet"
-        return
+        return None
     report.commit = commit[:10]
     changed = _git("diff-tree", "--no-commit-id", "--name-only", "-r", commit).split()
     report.grammar_changed = "grammar/KRL.g4" in changed
     if not report.grammar_changed:
         report.note = "covered by the grammar already (examples only)"
-        return
+        return None
     try:
         before = _git("show", f"{commit}^:grammar/KRL.g4")
     except GrammarToolError:
         report.note = "introduced with the first grammar"
-        return
-    after = _git("show", f"{commit}:grammar/KRL.g4")
+        return None
+    return before, _git("show", f"{commit}:grammar/KRL.g4")
+
+
+def _corpus_effect(report: ConstructReport, pair: tuple[str, str], corpus: Path) -> None:
     scans = []
-    for text in (before, after):
+    for text in pair:
         pdir = parser_dir_for(text)
         scans.append(scan(corpus, grammar_sha(text), parser_dir=str(pdir), progress=False))
     clusters_before = {c.signature: c for c in cluster_results(scans[0])}
@@ -137,25 +148,33 @@ def _corpus_effect(report: ConstructReport, directory: Path, corpus: Path) -> No
     report.files_after = sum(r.ok for r in scans[1])
 
 
-def validate_constructs(names: list[str], corpus: Path | None = None) -> list[ConstructReport]:
-    """Validate the named constructs (all when names is empty)."""
+def validate_constructs(names: list[str], corpus: Path | None = None,
+                        jobs: int | None = None) -> list[ConstructReport]:
+    """Validate the named constructs (all when names is empty).
+
+    With a corpus, the grammar versions before and after each construct are scanned first, in
+    parallel (`jobs` versions at a time, recovery/growth.py), into the result cache."""
     dirs = sorted(d for d in CONSTRUCTS.iterdir() if d.is_dir()) if CONSTRUCTS.is_dir() else []
     if names:
         unknown = set(names) - {d.name for d in dirs}
         if unknown:
             raise click.UsageError(f"unknown construct(s): {', '.join(sorted(unknown))}")
         dirs = [d for d in dirs if d.name in names]
-    from recovery.progress import steps  # noqa: PLC0415
+    from recovery.growth import scan_versions  # noqa: PLC0415
+    from recovery.progress import shown, steps  # noqa: PLC0415
 
-    reports = []
-    for d in steps(dirs, "validating constructs", lambda d: d.name):
-        rep = ConstructReport(d.name)
+    reports = [ConstructReport(d.name) for d in dirs]
+    pairs = [_grammar_change(rep, d) if corpus is not None else None for rep, d in zip(reports, dirs)]
+    if corpus is not None:
+        texts = list(dict.fromkeys(t for pair in pairs if pair for t in pair))
+        if texts:
+            scan_versions(corpus, texts, jobs, progress=shown())
+    for rep, d, pair in steps(list(zip(reports, dirs, pairs)), "validating constructs", lambda x: x[1].name):
         for f in sorted(d.iterdir()):
             if is_krl_file(f) and f.name.startswith(("ok_", "bad_")):
                 rep.examples.append(check_example(f))
-        if corpus is not None:
-            _corpus_effect(rep, d, corpus)
-        reports.append(rep)
+        if pair is not None:
+            _corpus_effect(rep, pair, corpus)
     return reports
 
 

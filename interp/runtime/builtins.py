@@ -9,18 +9,25 @@ interp/basis/bas.src (or the backup's), not natives.
 
 SWRITE/SREAD use a printf/scanf-style format engine written here (no eval): ``%[flags]
 [width][.precision]conv`` with flags ``-+ 0#``, conversions ``d i x X o f F e E g G c s``
-and ``%%``. CAST_TO/CAST_FROM are in cast.py. Unsupported: CREAD/COPEN/CCLOSE/CIOCTL, channels other
-than $CMD — a clear "not supported" run-time error.
+and ``%%``. Width and precision are ASCII digits no larger than the length of the CHAR
+buffer written or read. A bad specification (unknown conversion, width or precision past the
+buffer, a non-ASCII digit) is a format error, as on the controller: the text up to it is
+written, ``state.RET1`` = #FMT_ERR and ``state.HITS`` counts the values converted before it;
+the program goes on (without a STATE_T variable it is a run-time error). StrToInt/StrToReal
+accept KRL literal syntax only (reference §1.5). CAST_TO/CAST_FROM are in cast.py.
+Unsupported: CREAD/COPEN/CCLOSE/CIOCTL, channels other than $CMD — a clear "not supported"
+run-time error.
 """
 
 from __future__ import annotations
 
 import math
+import re
 
 from krl.semantics import types as T
 
 from .cast import cast_from, cast_to
-from .convert import frame_tuple, inv_pos, num, real_to_int, to_bool
+from .convert import INT_MAX, INT_MIN, frame_tuple, inv_pos, num, real_to_int, to_bool, trunc_int
 from .errors import KrlRuntimeError, value_invalid
 from .memory import Ref
 from .values import UNSET, Arr, EnumValue, Struct, is_char_array
@@ -259,7 +266,7 @@ def _strfind(rt, a):
 
 def _strto(conv):
     def fn(rt, a):
-        s = _text(a[0], "string").strip()
+        s = _text(a[0], "string")
         try:
             v = conv(s)
         except (ValueError, KrlRuntimeError):
@@ -269,12 +276,51 @@ def _strto(conv):
     return fn
 
 
+# The number syntax of StrToInt/StrToReal is KRL's literal syntax (reference §1.5,
+# grammar/KRL.g4 INTLITERAL, HEXLITERAL, BINLITERAL, REALLITERAL) with the sign a data-list
+# initial value may carry: ASCII digits only, no blanks, no '_', no 'nan'/'inf', no '0x'.
+_INT_SYNTAX = re.compile(r"[+-]?[0-9]+")
+_HEX_SYNTAX = re.compile(r"'[Hh]([0-9A-Fa-f]+)'")
+_BIN_SYNTAX = re.compile(r"'[Bb]([01]+)'")
+_REAL_SYNTAX = re.compile(r"[+-]?(?:[0-9]+\.[0-9]*(?:[Ee][+-]?[0-9]+)?|\.[0-9]+(?:[Ee][+-]?[0-9]+)?"
+                          r"|[0-9]+(?:[Ee][+-]?[0-9]+)?)")
+
+
 def _to_int(s: str) -> int:
-    return int(s, 10)
+    """A KRL INT literal (decimal with an optional sign, 'H..' or 'B..') in -2^31..2^31-1;
+    raises ValueError otherwise."""
+    if _INT_SYNTAX.fullmatch(s):
+        if len(s.lstrip("+-").lstrip("0")) > 10:
+            raise ValueError(s)
+        v = int(s, 10)
+    elif m := _HEX_SYNTAX.fullmatch(s):
+        if len(m.group(1).lstrip("0")) > 8:
+            raise ValueError(s)
+        v = int(m.group(1), 16)
+    elif m := _BIN_SYNTAX.fullmatch(s):
+        if len(m.group(1).lstrip("0")) > 32:
+            raise ValueError(s)
+        v = int(m.group(1), 2)
+    else:
+        raise ValueError(s)
+    if not INT_MIN <= v <= INT_MAX:
+        raise ValueError(s)
+    return v
+
+
+def _to_real(s: str) -> float:
+    """A KRL REAL or decimal INT literal with an optional sign; raises ValueError
+    otherwise or when it is too large for any float (1E999)."""
+    if not _REAL_SYNTAX.fullmatch(s):
+        raise ValueError(s)
+    v = float(s)
+    if not math.isfinite(v):
+        raise ValueError(s)
+    return v
 
 
 def _to_bool(s: str) -> bool:
-    u = s.upper()
+    u = s.strip().upper()
     if u in ("TRUE", "1"):
         return True
     if u in ("FALSE", "0"):
@@ -302,7 +348,7 @@ def _strto_struct(tname):
             if len(w) != 2:
                 return False
             try:
-                vals[w[0].upper()] = float(w[1]) if w[0].upper() not in ("S", "T") else int(w[1])
+                vals[w[0].upper()] = _to_real(w[1]) if w[0].upper() not in ("S", "T") else _to_int(w[1])
             except ValueError:
                 return False
         from .sysvars import sys_type  # noqa: PLC0415
@@ -390,55 +436,82 @@ def _unsupported(name):
 # ------------------------------------------------------------------ SWRITE / SREAD (§4.7)
 
 _FLAGS = "-+ 0#"
+_DIGITS = "0123456789"     # ASCII only: str.isdigit() also takes '²', '٣', ...
 
 
-def parse_format(fmt: str) -> list:
-    """Split a format into literal strings and (flags, width, precision, conv) tuples."""
+class FormatError(Exception):
+    """A format that SWRITE/SREAD cannot use: the state's RET1 becomes #FMT_ERR."""
+
+
+def _ascii_digits(text: str, j: int) -> int:
+    """The end of the run of ASCII digits starting at ``text[j]``."""
+    n = len(text)
+    while j < n and text[j] in _DIGITS:
+        j += 1
+    return j
+
+
+def _bounded(digits: str, limit: int, what: str, fmt: str) -> int:
+    """``digits`` as a width or precision no larger than ``limit`` (the buffer's length);
+    compared as text first, so that a 20-digit number is never turned into an int."""
+    significant = digits.lstrip("0") or "0"
+    if len(significant) > len(str(limit)) or int(significant) > limit:
+        raise FormatError(f"format error: {what} {digits[:12]}{'...' if len(digits) > 12 else ''} "
+                          f"larger than the buffer ({limit} characters) in {fmt[:40]!r}")
+    return int(significant)
+
+
+def parse_format(fmt: str, limit: int) -> tuple[list, str | None]:
+    """Split a format into literal strings and (flags, width, precision, conv) tuples.
+
+    Returns (parts, error): ``parts`` the format up to the first bad specification,
+    ``error`` its message (None when the whole format is good). Width and precision are
+    ASCII digits and bounded by ``limit``, the length of the CHAR buffer written (SWRITE)
+    or read (SREAD): a larger one is a format error, as is an unknown conversion."""
     out: list = []
     i, n = 0, len(fmt)
     lit = []
-    while i < n:
-        ch = fmt[i]
-        if ch != "%":
-            lit.append(ch)
-            i += 1
-            continue
-        if i + 1 < n and fmt[i + 1] == "%":
-            lit.append("%")
-            i += 2
-            continue
-        if lit:
-            out.append("".join(lit))
-            lit = []
-        j = i + 1
-        flags = ""
-        while j < n and fmt[j] in _FLAGS:
-            flags += fmt[j]
-            j += 1
-        w = ""
-        while j < n and fmt[j].isdigit():
-            w += fmt[j]
-            j += 1
-        prec = None
-        if j < n and fmt[j] == ".":
-            j += 1
-            p = ""
-            while j < n and fmt[j].isdigit():
-                p += fmt[j]
+    try:
+        while i < n:
+            ch = fmt[i]
+            if ch != "%":
+                lit.append(ch)
+                i += 1
+                continue
+            if i + 1 < n and fmt[i + 1] == "%":
+                lit.append("%")
+                i += 2
+                continue
+            if lit:
+                out.append("".join(lit))
+                lit = []
+            j = i + 1
+            flags = ""
+            while j < n and fmt[j] in _FLAGS:
+                flags += fmt[j]
                 j += 1
-            prec = int(p) if p else 0
-        while j < n and fmt[j] in "lhL":
-            j += 1
-        if j >= n:
-            raise KrlRuntimeError(f"format error in {fmt!r}")
-        conv = fmt[j]
-        if conv not in "dixXofFeEgGcs":
-            raise KrlRuntimeError(f"format error: %{conv} in {fmt!r}")
-        out.append((flags, int(w) if w else None, prec, conv))
-        i = j + 1
+            k = _ascii_digits(fmt, j)
+            width = _bounded(fmt[j:k], limit, "width", fmt) if k > j else None
+            j = k
+            prec = None
+            if j < n and fmt[j] == ".":
+                k = _ascii_digits(fmt, j + 1)
+                prec = _bounded(fmt[j + 1:k], limit, "precision", fmt) if k > j + 1 else 0
+                j = k
+            while j < n and fmt[j] in "lhL":
+                j += 1
+            if j >= n:
+                raise FormatError(f"format error: incomplete specification at the end of {fmt[:40]!r}")
+            conv = fmt[j]
+            if conv not in "dixXofFeEgGcs":
+                raise FormatError(f"format error: %{conv} in {fmt[:40]!r}")
+            out.append((flags, width, prec, conv))
+            i = j + 1
+    except FormatError as exc:
+        return out, str(exc)
     if lit:
         out.append("".join(lit))
-    return out
+    return out, None
 
 
 def _pad(body: str, sign: str, flags: str, width: int | None, numeric: bool) -> str:
@@ -472,7 +545,7 @@ def format_one(spec, v) -> str:
         if isinstance(v, str):
             s = v[:1]
         else:
-            s = chr(int(num(v)) & 0xFF)
+            s = chr(trunc_int(v, "%c argument") & 0xFF)
         return _pad(s, "", flags, width, False)
     if isinstance(v, bool):
         v = 1 if v else 0
@@ -501,20 +574,30 @@ def format_one(spec, v) -> str:
     return _pad(body, sign, flags, width, True)
 
 
-def swrite_text(fmt: str, values: list) -> tuple[str, int]:
-    """(formatted text, number of converted values)."""
-    parts = parse_format(fmt)
+def swrite_text(fmt: str, values: list, room: int, limit: int | None = None) -> tuple[str, int, str | None]:
+    """(formatted text, number of converted values, format error or None): the text of
+    ``fmt`` with ``values``, at most ``room`` characters (the rest of the destination;
+    the values past it are still converted and counted); it stops at a bad specification
+    (:func:`parse_format`; widths and precisions bounded by ``limit``, the destination's
+    length, default ``room``)."""
+    parts, error = parse_format(fmt, room if limit is None else limit)
     out = []
+    size = 0
     k = 0
     for p in parts:
-        if isinstance(p, str):
-            out.append(p)
-            continue
-        if k >= len(values):
+        if k >= len(values) and not isinstance(p, str):
             break
-        out.append(format_one(p, values[k]))
-        k += 1
-    return "".join(out), k
+        if isinstance(p, str):
+            piece = p
+        else:
+            if size >= room:        # converted but not shown: no width, no precision to build
+                p = (p[0], None, None, p[3])
+            piece = format_one(p, values[k])
+            k += 1
+        if size < room:
+            out.append(piece[:room - size])
+            size += len(out[-1])
+    return "".join(out), k, error
 
 
 def _state(ref, ok: bool, hits: int, length: int) -> None:
@@ -531,6 +614,12 @@ def _state(ref, ok: bool, hits: int, length: int) -> None:
             st.f["MSG_NO"] = 0
 
 
+def _format_error(state_ref, error: str) -> None:
+    """A bad format with no STATE_T variable to report it in is a run-time error."""
+    if state_ref is None or not isinstance(state_ref.peek(), Struct):
+        raise KrlRuntimeError(error)
+
+
 def _swrite(rt, a):
     dest = _chars(a[0], "SWRITE destination")
     off_ref = a[2]
@@ -539,11 +628,12 @@ def _swrite(rt, a):
     vals = [r.get() if r is not None else UNSET for r in a[4:]]
     if any(v is UNSET for v in vals):
         raise value_invalid("SWRITE argument")
-    text, hits = swrite_text(fmt, vals)
     n = len(dest.data)
     cur = dest.text()
-    if off < 0:
-        off = 0
+    off = min(max(off, 0), n)
+    text, hits, error = swrite_text(fmt, vals, n - off, n)
+    if error is not None:
+        _format_error(a[1], error)
     base = (cur + "\0" * n)[:off].replace("\0", " ")
     new = (base + text)[:n]
     for i, ch in enumerate(new):
@@ -552,12 +642,23 @@ def _swrite(rt, a):
         dest.data[i] = "\0"
     if off_ref is not None:
         off_ref.set(len(new))
-    _state(a[1], True, hits, len(new) - off)
+    _state(a[1], error is None, hits, len(new) - off)
 
 
-def sread_values(src: str, fmt: str, start: int = 0) -> tuple[list, int]:
-    """scanf: (list of (spec, python value), position after the last match)."""
-    parts = parse_format(fmt)
+def _scan_int(text: str, base: int) -> int:
+    """A scanned integer; more digits than any INT has is INT overflow (never a Python
+    int of thousands of digits)."""
+    digits = text.lstrip("+-").lstrip("0")
+    if len(digits) > 40:
+        raise KrlRuntimeError(f"INT overflow ({text[:12]}... outside -2147483648..2147483647)")
+    return int(text, base)
+
+
+def sread_values(src: str, fmt: str, start: int = 0, limit: int | None = None) -> tuple[list, int, str | None]:
+    """scanf: (list of (spec, python value), position after the last match, format error
+    or None). Widths are bounded by ``limit`` (the source buffer's length; default
+    ``len(src)``); numbers are ASCII digits only."""
+    parts, error = parse_format(fmt, len(src) if limit is None else limit)
     pos = start
     out = []
     n = len(src)
@@ -570,7 +671,7 @@ def sread_values(src: str, fmt: str, start: int = 0) -> tuple[list, int]:
                 elif pos < n and src[pos] == ch:
                     pos += 1
                 else:
-                    return out, pos
+                    return out, pos, error
             continue
         flags, width, prec, conv = p
         if conv != "c":
@@ -597,45 +698,45 @@ def sread_values(src: str, fmt: str, start: int = 0) -> tuple[list, int]:
             if j < lim and src[j] in "+-":
                 j += 1
             k = j
-            while j < lim and src[j].isdigit():
+            while j < lim and src[j] in _DIGITS:
                 j += 1
             if j == k:
                 break
-            out.append((p, int(src[pos:j])))
+            out.append((p, _scan_int(src[pos:j], 10)))
         elif conv in "xX":
             while j < lim and src[j] in "0123456789abcdefABCDEF":
                 j += 1
             if j == pos:
                 break
-            out.append((p, int(src[pos:j], 16)))
+            out.append((p, _scan_int(src[pos:j], 16)))
         elif conv == "o":
             while j < lim and src[j] in "01234567":
                 j += 1
             if j == pos:
                 break
-            out.append((p, int(src[pos:j], 8)))
+            out.append((p, _scan_int(src[pos:j], 8)))
         else:
             if j < lim and src[j] in "+-":
                 j += 1
             k = j
-            while j < lim and (src[j].isdigit() or src[j] == "."):
+            while j < lim and (src[j] in _DIGITS or src[j] == "."):
                 j += 1
             if j < lim and src[j] in "eE":
                 m = j + 1
                 if m < lim and src[m] in "+-":
                     m += 1
-                if m < lim and src[m].isdigit():
+                if m < lim and src[m] in _DIGITS:
                     j = m
-                    while j < lim and src[j].isdigit():
+                    while j < lim and src[j] in _DIGITS:
                         j += 1
+            if j == k:
+                break
             try:
                 out.append((p, float(src[pos:j])))
             except ValueError:
                 break
-            if j == k:
-                break
         pos = j
-    return out, pos
+    return out, pos, error
 
 
 def _sread(rt, a):
@@ -643,7 +744,10 @@ def _sread(rt, a):
     off_ref = a[2]
     off = _int(off_ref, "SREAD offset") if off_ref is not None else 0
     fmt = _text(a[3], "SREAD format")
-    got, pos = sread_values(src, fmt, max(0, off))
+    buf = a[0].peek()
+    got, pos, error = sread_values(src, fmt, max(0, off), len(buf.data) if isinstance(buf, Arr) else len(src))
+    if error is not None:
+        _format_error(a[1], error)
     targets = a[4:]
     hits = 0
     for (spec, v), ref in zip(got, targets):
@@ -656,7 +760,7 @@ def _sread(rt, a):
         hits += 1
     if off_ref is not None:
         off_ref.set(pos)
-    _state(a[1], hits == len([t for t in targets if t is not None]), hits, pos - off)
+    _state(a[1], error is None and hits == len([t for t in targets if t is not None]), hits, pos - off)
 
 
 NATIVES: dict = {
@@ -666,7 +770,7 @@ NATIVES: dict = {
     "VARSTATE": _varstate, "VARTYPE": _vartype,
     "STRLEN": _strlen, "STRDECLLEN": _strdecllen, "STRCLEAR": _strclear, "STRADD": _stradd,
     "STRCOPY": _strcopy, "STRCOMP": _strcomp, "STRFIND": _strfind,
-    "STRTOINT": _strto(_to_int), "STRTOREAL": _strto(float), "STRTOBOOL": _strto(_to_bool),
+    "STRTOINT": _strto(_to_int), "STRTOREAL": _strto(_to_real), "STRTOBOOL": _strto(_to_bool),
     "STRTOSTRING": _strtostring,
     "STRTOFRAME": _strto_struct("FRAME"), "STRTOPOS": _strto_struct("POS"),
     "STRTOE3POS": _strto_struct("E3POS"), "STRTOE6POS": _strto_struct("E6POS"),

@@ -8,7 +8,9 @@ past them. The byte layout is a project decision (the reference gives none): lit
 INT 4 bytes two's complement, REAL 4 bytes IEEE single (so a REAL round trip rounds to
 single precision), BOOL 4 bytes 0/1, CHAR 1 byte; arrays element by element in row-major
 order, structures component by component in declaration order. ENUM values have no
-documented code and are refused. Errors: a buffer too small, an unset value (1422).
+documented code and are refused. Errors: an offset outside 0..the buffer's length (a
+negative offset never reads from the end of the buffer), a buffer too small, an unset value
+(1422).
 """
 
 from __future__ import annotations
@@ -17,6 +19,7 @@ import struct
 
 from krl.semantics import types as T
 
+from .convert import num, real_to_int
 from .errors import KrlRuntimeError, value_invalid
 from .values import UNSET, Arr, Struct
 
@@ -84,7 +87,7 @@ def decode(data: bytes, pos: int, type_, old=None):
 
 
 def _need(data: bytes, pos: int, n: int) -> None:
-    if pos + n > len(data):
+    if pos < 0 or pos + n > len(data):
         raise KrlRuntimeError("CAST_FROM: the buffer ends before the variable")
 
 
@@ -95,12 +98,24 @@ def _buffer(ref, what: str) -> Arr:
     return v
 
 
+def _offset(ref, what: str, buf: Arr) -> int:
+    """The offset argument: an INT from 0 to the buffer's length (a REAL is rounded as on
+    assignment); anything else is a run-time error, never a Python index from the end."""
+    if ref is None:
+        return 0
+    v = num(ref.get(), f"{what} offset")
+    off = v if v.__class__ is int else real_to_int(v)
+    if not 0 <= off <= len(buf.data):
+        raise KrlRuntimeError(f"{what}: offset {off} outside 0..{len(buf.data)} (the buffer's length)")
+    return off
+
+
 def cast_to(rt, a) -> None:  # noqa: ARG001 - the built-ins' calling convention
     buf = _buffer(a[0], "CAST_TO")
-    off = int(a[1].get()) if a[1] is not None else 0
+    off = _offset(a[1], "CAST_TO", buf)
     data = b"".join(encode(r.get() if r is not None else UNSET, _type_of(r, r.peek() if r else UNSET))
                     for r in a[2:])
-    if off < 0 or off + len(data) > len(buf.data):
+    if off + len(data) > len(buf.data):
         raise KrlRuntimeError("CAST_TO: the buffer is too small")
     for k, byte in enumerate(data):
         buf.data[off + k] = chr(byte)
@@ -110,8 +125,8 @@ def cast_to(rt, a) -> None:  # noqa: ARG001 - the built-ins' calling convention
 
 def cast_from(rt, a) -> None:  # noqa: ARG001
     buf = _buffer(a[0], "CAST_FROM")
+    pos = _offset(a[1], "CAST_FROM", buf)
     raw = bytes(0 if c is UNSET else ord(c) & 0xFF for c in buf.data)
-    pos = int(a[1].get()) if a[1] is not None else 0
     for r in a[2:]:
         if r is None:
             continue

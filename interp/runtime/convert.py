@@ -29,7 +29,8 @@ ROUNDING = "half_away"   # or "trunc" (reference §3.9 [U])
 
 def check_int(v: int) -> int:
     if v < INT_MIN or v > INT_MAX:
-        raise KrlRuntimeError(f"INT overflow ({v} outside -2147483648..2147483647)")
+        shown = v if v.bit_length() <= 128 else ("a huge negative number" if v < 0 else "a huge number")
+        raise KrlRuntimeError(f"INT overflow ({shown} outside -2147483648..2147483647)")
     return v
 
 
@@ -41,6 +42,16 @@ def real_to_int(x: float) -> int:
         return check_int(int(x))
     r = math.floor(abs(x) + 0.5)
     return check_int(int(r if x >= 0 else -r))
+
+
+def trunc_int(v, what: str = "operand") -> int:
+    """``int(num(v))``: a REAL truncated toward zero, as interrupt numbers, S/T, TRIGGER
+    DISTANCE/PRIO and SWRITE's %c take it; a NaN or infinite REAL is the run-time error
+    "REAL value cannot be converted to INT", never a Python exception."""
+    x = num(v, what)
+    if x.__class__ is float and (x != x or x in (math.inf, -math.inf)):
+        raise KrlRuntimeError(f"{what}: REAL value cannot be converted to INT")
+    return int(x)
 
 
 def num(v, what: str = "operand"):

@@ -10,22 +10,22 @@ import sys
 from dataclasses import dataclass
 
 from krl.ast import nodes as N
+from krl.limits import MAX_CALL_DEPTH
 from krl.semantics import types as T
 from krl.semantics.symbols import Scope, fill_struc, make_array
 
 from . import advance
 from .builtins import NATIVES, ValueRef, call_builtin
 from .contexts import Context, Irq
-from .convert import assign_into, binary_op, convert_scalar, to_bool, unary_op
+from .convert import assign_into, binary_op, convert_scalar, to_bool, trunc_int, unary_op
 from .errors import (HaltSignal, KrlRuntimeError, ResumeSignal, StopRun)
-from .memory import Frame, ProxyRef, Ref, SignalRef, Slot, field_ref, index_ref
+from .memory import DataMemory, Frame, ProxyRef, Ref, SignalRef, Slot, field_ref, index_ref
 from .motion import params_from, request, segment, target_of
 from .program import Program
 from .scheduler import Scheduler, Task
 from .sysvars import SysVars, struct_of
-from .values import UNSET, Arr, EnumValue, Struct, copy_value, make_value
+from .values import UNSET, Arr, EnumValue, Struct, copy_value, make_value, value_size
 
-MAX_CALL_DEPTH = 100
 
 EXIT_CODES = {"completed": 0, "halt": 3, "deadlock": 3, "max_steps": 3, "max_sim_time": 3,
               "error": 1, "internal": 2}
@@ -79,6 +79,7 @@ class Runtime:
         self.max_steps = max_steps
         self.robot_budget = robot_budget
         self.sysvars = SysVars(self)
+        self.memory = DataMemory()
         self.program = Program(self, main_path, workspace)
         self.scheduler = Scheduler(self, max_sim_time, max_steps)
         self.robot: Task | None = None
@@ -304,6 +305,8 @@ class Runtime:
         from .convert import num  # noqa: PLC0415
 
         t = float(num(seconds, "WAIT SEC time"))
+        if t != t or t in (float("inf"), float("-inf")):
+            raise KrlRuntimeError(f"WAIT SEC with an invalid time ({t})")
         if t < 0:
             raise KrlRuntimeError(f"WAIT SEC with a negative time ({t})")
         task = self.current_task
@@ -406,8 +409,11 @@ class Runtime:
         name = module_name or self.program.main_path.stem
         m = self.program.module(name)
         if m is not None and m.syntax_errors:
-            raise KrlRuntimeError("the program has syntax errors and cannot start: " + m.syntax_errors[0],
-                                  None, m.path, 0)
+            first = m.syntax_errors[0]
+            raise KrlRuntimeError("the program has syntax errors and cannot start: " + first, None,
+                                  getattr(first, "file", None) or m.path, getattr(first, "line", None) or 0)
+        if self.program.fatal is not None:
+            raise self.program.fatal
         if m is None or m.main is None:
             raise KrlRuntimeError(f"no main routine in {name}")
         return m, m.main
@@ -445,8 +451,37 @@ class Runtime:
         plan = self._plans.get(id(routine))
         if plan is None or plan[0] is not module:
             plan = self._plans[id(routine)] = self._frame_plan(module, routine)
-        _, scope, decls, params = plan
+        _, scope, decls, params, local_elements, local_sizes = plan
+        mem = self.memory
+        if mem.used + local_elements > mem.limit:
+            self._locals_do_not_fit(local_sizes)
+        mem.used += local_elements
         frame = Frame(routine, module, caller, task)
+        frame.data = local_elements
+        try:
+            self._fill_frame(frame, module, scope, decls, params, args)
+        except BaseException:
+            mem.give(frame.data)
+            raise
+        if self.trace is not None:
+            self.trace.write("call", self.controller.time, name=routine.name,
+                             line=caller.line if caller is not None else None)
+        return frame
+
+    def _locals_do_not_fit(self, local_sizes) -> None:
+        """Raise "data memory exhausted" at the first local DECL that does not fit."""
+        mem = self.memory
+        used = mem.used
+        try:
+            for n, vn, d in local_sizes:
+                self.program.take_memory_n(n, vn, d)
+        finally:
+            mem.used = used
+
+    def _fill_frame(self, frame: Frame, module, scope, decls, params, args) -> None:
+        """Declare the locals and bind the parameters of a new frame (:meth:`enter_routine`);
+        the data memory of :IN copies and omitted aggregate parameters is added to
+        ``frame.data``."""
         frame.extra = scope
         store = frame.store
         fvars = frame.vars
@@ -468,7 +503,7 @@ class Runtime:
                     frame.bind(d.name, ref)
             else:
                 frame.bind(d.name, self.program.import_ref(d))
-        for i, (name, key, mode, t, scalar) in enumerate(params):
+        for i, (name, key, mode, t, scalar, size) in enumerate(params):
             a = args[i] if i < len(args) else None
             if a is None:
                 if isinstance(t, T.Array) and t.elem == T.CHAR and t.dims == (0,):
@@ -479,6 +514,7 @@ class Runtime:
                     store[key] = UNSET
                     fvars[key] = Slot(store, key, None, name)
                 else:
+                    frame.data += self.memory.take(size, f"parameter {name}")
                     frame.declare(name, t)
                 continue
             if mode == "IN" or a.__class__ is ValueRef:
@@ -487,22 +523,23 @@ class Runtime:
                     store[key] = v if v is UNSET else convert_scalar(v, t)
                     fvars[key] = Slot(store, key, t, name)
                     continue
-                v = store[key] = self._param_copy(a.peek(), t, name)
+                v = a.peek()
+                frame.data += self.memory.take(value_size(v) if isinstance(v, (Struct, Arr)) else size,
+                                               f"a copy of :IN parameter {name}")
+                v = store[key] = self._param_copy(v, t, name)
                 fvars[key] = Slot(store, key, self._slot_type(t, v), name)
             else:
                 fvars[key] = a
-        if self.trace is not None:
-            self.trace.write("call", self.controller.time, name=routine.name,
-                             line=caller.line if caller is not None else None)
-        return frame
 
     def _frame_plan(self, module, routine: N.Routine) -> tuple:
         """The declarations of ``routine`` resolved for :meth:`enter_routine`: (module,
         type scope, [(name, KEY, type, VarDecl with an initial value or None, scalar?) for
         each local variable, or (name, KEY, None, SignalDecl/ImportDecl, False)], [(name,
-        KEY, mode, type or None, scalar?) for each parameter]); *scalar*: a type whose fresh
-        value is UNSET and whose values are converted by convert_scalar (INT, REAL, BOOL,
-        CHAR, ENUM). Raises KrlRuntimeError for an unknown type."""
+        KEY, mode, type or None, scalar?, data elements) for each parameter], data elements
+        of the locals, [(data elements, VarName, VarDecl) for each local]); *scalar*: a type
+        whose fresh value is UNSET and whose values are converted by convert_scalar (INT,
+        REAL, BOOL, CHAR, ENUM). Raises KrlRuntimeError for an unknown type, ResourceError
+        for a type that nests too deep (values.data_size)."""
         pnames = {p.name.upper() for p in routine.params}
         scope = module.types if module is not None else self.program.types
         local_types = None
@@ -519,22 +556,27 @@ class Runtime:
         if local_types is not None:
             scope = local_types
         ptypes = {}
+        psizes = {}
         decls = []
+        sizes = []
         for d in routine.decls:
             if isinstance(d, N.VarDecl):
                 t0 = self.program.resolve_type(d.type, scope)
                 for vn in d.names:
                     t = make_array(t0, vn.dims) if vn.dims else t0
                     key = vn.name.upper()
+                    n = self.program.data_elements(t, vn, d)
                     if key in pnames:
                         ptypes[key] = t
+                        psizes[key] = n
                     else:
                         decls.append((vn.name, key, t, d if d.init is not None else None, _scalar(t)))
+                        sizes.append((n, vn, d))
             elif isinstance(d, (N.SignalDecl, N.ImportDecl)):
                 decls.append((d.name, d.name.upper(), None, d, False))
-        params = [(p.name, p.name.upper(), p.mode, ptypes.get(p.name.upper()), _scalar(ptypes.get(p.name.upper())))
-                  for p in routine.params]
-        return module, scope, decls, params
+        params = [(p.name, p.name.upper(), p.mode, ptypes.get(p.name.upper()), _scalar(ptypes.get(p.name.upper())),
+                   psizes.get(p.name.upper(), 1)) for p in routine.params]
+        return module, scope, decls, params, sum(n for n, _, _ in sizes), sizes
 
     @staticmethod
     def _slot_type(t, v):
@@ -595,6 +637,8 @@ class Runtime:
         """The routine of ``frame`` ends; ``returned`` False when it is abandoned (run-time
         error, RESUME, end of the run): then no ``return`` event is written."""
         task = self.current_task
+        self.memory.used -= frame.data      # DataMemory.give, inlined: once per call
+        frame.data = 0
         if frame.interrupts:
             task.irqs.remove_frame(frame)
         if returned and self.trace is not None:
@@ -631,12 +675,16 @@ class Runtime:
         name = m.group(1)
         while rest:
             if rest.startswith("["):
-                j = rest.index("]")
-                idx = [int(x) if x.strip() else None for x in rest[1:j].split(",")]
-                ref = index_ref(ref, idx, name)
+                j = rest.find("]")
+                parts = [x.strip() for x in rest[1:j].split(",")] if j > 0 else None
+                if parts is None or not all(x == "" or re.fullmatch(r"-?[0-9]{1,10}", x) for x in parts):
+                    return None     # no closing bracket, or an index that is not an INT literal
+                ref = index_ref(ref, [int(x) if x else None for x in parts], name)
                 rest = rest[j + 1:].strip()
             elif rest.startswith("."):
-                mm = re.match(r"\.\s*([A-Za-z_][\w$]*)", rest)
+                mm = re.match(r"\.\s*([A-Za-z_][A-Za-z0-9_$]*)", rest)
+                if mm is None:
+                    return None
                 ref = field_ref(ref, mm.group(1), name)
                 rest = rest[mm.end():].strip()
             else:
@@ -850,19 +898,15 @@ class Runtime:
     # ================================================================== interrupts
     def interrupt_decl(self, number, cond_fn, handler_fn, name: str, frame: Frame,
                        is_global: bool = False, line: int | None = None) -> None:
-        from .convert import num  # noqa: PLC0415
-
         task = self.current_task
-        n = int(num(number, "interrupt number"))
+        n = trunc_int(number, "interrupt number")
         task.irqs.declare(Irq(n, cond_fn, handler_fn, name, frame, is_global, line))
         frame.interrupts.append(n)
         self._break(task)
 
     def interrupt_ctl(self, action: str, number=None) -> None:
-        from .convert import num  # noqa: PLC0415
-
         task = self.current_task
-        n = int(num(number, "interrupt number")) if number is not None else None
+        n = trunc_int(number, "interrupt number") if number is not None else None
         task.irqs.control(action.upper(), n)
         self._break(task)
         if action.upper() in ("ENABLE", "ON") and task.irqs.armed:

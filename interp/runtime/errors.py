@@ -38,6 +38,11 @@ class KrlRuntimeError(Exception):
         return f"{where}{self.message}{num}"
 
 
+class ResourceError(KrlRuntimeError):
+    """A run-time error for a resource limit of krl/limits.py (data memory, type nesting):
+    loading a data list never skips it as it skips a bad initial value; it stops the run."""
+
+
 def value_invalid(what: str = "") -> KrlRuntimeError:
     return KrlRuntimeError(f"value invalid{': ' + what if what else ''}", VALUE_INVALID)
 

@@ -23,7 +23,7 @@ from __future__ import annotations
 from krl.semantics import types as T
 
 from .convert import assign_into, convert_scalar
-from .errors import KrlRuntimeError, value_invalid
+from .errors import KrlRuntimeError, ResourceError, value_invalid
 from .values import NEUTRAL, UNSET, Arr, Struct, make_value
 
 
@@ -278,11 +278,12 @@ class Frame:
 
     Attributes: routine (AST Routine or None), module (:class:`program.ModuleRT`),
     vars (UPPER name -> Ref), caller (Frame or None), depth, interrupts (numbers
-    declared here, removed on return), task (the owning task), line (current line).
+    declared here, removed on return), task (the owning task), line (current line), data
+    (the elements of the run's data memory it holds, given back on return).
     """
 
     __slots__ = ("routine", "module", "vars", "caller", "depth", "interrupts", "task", "line",
-                 "store", "extra")
+                 "store", "extra", "data")
 
     def __init__(self, routine, module, caller: "Frame | None", task=None) -> None:
         self.routine = routine
@@ -295,6 +296,7 @@ class Frame:
         self.task = task
         self.line = 0
         self.extra = None
+        self.data = 0       # elements of the run's data memory this activation holds (DataMemory)
 
     def declare(self, name: str, type_, value=None) -> Slot:
         key = name.upper()
@@ -309,3 +311,31 @@ class Frame:
     @property
     def name(self) -> str:
         return self.routine.name if self.routine is not None else "?"
+
+
+class DataMemory:
+    """The run's data memory (krl/limits.py MAX_DATA_ELEMENTS, counted by
+    :func:`values.data_size`): data lists take their share when they are loaded, a routine
+    call takes its locals and :IN copies when it is entered and gives them back when it
+    returns. :meth:`take` checks before anything is allocated."""
+
+    __slots__ = ("limit", "used")
+
+    def __init__(self, limit: int | None = None) -> None:
+        from krl.limits import MAX_DATA_ELEMENTS  # noqa: PLC0415
+
+        self.limit = MAX_DATA_ELEMENTS if limit is None else limit
+        self.used = 0
+
+    def take(self, n: int, name: str, file: str | None = None, line: int | None = None) -> int:
+        """Reserve ``n`` elements for ``name``; returns ``n``. Raises ResourceError "data
+        memory exhausted" (at ``file``:``line`` when given) when they do not fit."""
+        if self.used + n > self.limit:
+            free = self.limit - self.used
+            raise ResourceError(f"data memory exhausted: {name} needs {n} data elements, "
+                                f"{free} of {self.limit} are free", None, file, line)
+        self.used += n
+        return n
+
+    def give(self, n: int) -> None:
+        self.used -= n

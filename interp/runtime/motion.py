@@ -14,7 +14,7 @@ from __future__ import annotations
 
 from robot.motion import MotionParams, MotionRequest, SplineSegment
 
-from .convert import num
+from .convert import num, trunc_int
 from .errors import KrlRuntimeError, value_invalid
 from .values import UNSET, Struct
 
@@ -66,7 +66,7 @@ def target_of(v, what: str = "motion target") -> dict:
     for k, x in v.f.items():
         if k not in TARGET_KEYS or x is UNSET:
             continue
-        out[k] = int(num(x)) if k in ("S", "T") else float(num(x))
+        out[k] = trunc_int(x, k) if k in ("S", "T") else float(num(x))
     if not out:
         raise value_invalid(what)
     return out

@@ -33,14 +33,25 @@ from krl.semantics import types as T
 from krl.semantics.symbols import Scope, fill_struc, make_array, system_scopes
 
 from .convert import assign_into, convert_scalar
-from .errors import KrlRuntimeError
+from .errors import KrlRuntimeError, ResourceError
 from .memory import Slot, SignalRef
-from .values import UNSET, EnumValue, Struct, make_value
+from .values import UNSET, EnumValue, Struct, data_size, make_value
 
 BASIS_DIR = Path(__file__).resolve().parent.parent / "basis"
 KRL_SUFFIXES = {".src": "src", ".dat": "dat", ".sub": "sub"}
 
 _PARSE_CACHE: dict = {}
+
+
+class SyntaxProblem(str):
+    """A syntax error of a file as text (``file:line:col: message``) that keeps its place
+    (``file``, ``line``) for the run-time error that stops the program from starting."""
+
+    def __new__(cls, text: str, file: str | None = None, line: int | None = None) -> "SyntaxProblem":
+        self = super().__new__(cls, text)
+        self.file = file
+        self.line = line
+        return self
 
 
 def parse_module(path: str):
@@ -62,7 +73,7 @@ def parse_module(path: str):
     res = parse_source(src)
     sink = DiagnosticSink()
     mod = build_module(res, sink)  # E003: a construct that cannot be built stops the start too
-    errs = [f"{d.path}:{d.line}:{d.column}: {d.message}"
+    errs = [SyntaxProblem(f"{d.path}:{d.line}:{d.column}: {d.message}", d.path, d.line)
             for d in syntax_diagnostics(res, src.text) + sink.errors]
     if not res.ok and not res.errors:
         errs.append(f"{path}: file not read: {res.status}" + (f" ({src.detail})" if src.detail else ""))
@@ -128,6 +139,7 @@ class Program:
         self.index: dict[str, dict[str, Path]] = {}
         self.stubs: set[str] = set()
         self._scanned_all = False
+        self.fatal: ResourceError | None = None   # a data list past a limit: the program cannot start
         self._index_files()
         self._load_system()
 
@@ -155,6 +167,12 @@ class Program:
         self._add_file(self.main_path)
 
     def _load_system(self) -> None:
+        try:
+            self._load_system_data()
+        except ResourceError as exc:     # the program cannot start (Runtime.main_routine)
+            self.fatal = self.fatal or exc
+
+    def _load_system_data(self) -> None:
         cfg = self.index.get("$CONFIG", {}).get("dat")
         if cfg is None:
             cfg = next((p for p in self.system_dir.iterdir() if p.name.upper() == "$CONFIG.DAT"), None)
@@ -171,6 +189,8 @@ class Program:
             for p in sorted(mada):
                 try:
                     self._load_sysdata(p)
+                except ResourceError:
+                    raise
                 except KrlRuntimeError:
                     continue
 
@@ -217,7 +237,11 @@ class Program:
             mod, errs = parse_module(str(dat))
             m.syntax_errors += errs
             if mod.data is not None:
-                self._load_data(m, mod.data, all_global=is_config)
+                try:
+                    self._load_data(m, mod.data, all_global=is_config)
+                except ResourceError as exc:
+                    self.fatal = self.fatal or exc
+                    raise
         src = files.get("src") or files.get("sub")
         if src is not None:
             mod, errs = parse_module(str(src))
@@ -238,8 +262,35 @@ class Program:
         for item in data.items:
             try:
                 self._load_item(m, data, item, all_global)
+            except ResourceError:
+                raise
             except KrlRuntimeError as exc:
                 m.errors.append(f"line {item.span.line}: {exc.message}")
+
+    @staticmethod
+    def _decl_span(vn: N.VarName, decl) -> N.Span:
+        return vn.span if vn.span.line else decl.span
+
+    def data_elements(self, t, vn: N.VarName, decl) -> int:
+        """The data elements of variable ``vn`` of type ``t`` declared by ``decl``
+        (values.data_size); a STRUC that contains itself or nests too deep is a
+        ResourceError at the DECL's file:line."""
+        try:
+            return data_size(t)
+        except KrlRuntimeError as exc:
+            span = self._decl_span(vn, decl)
+            raise ResourceError(exc.message, None, span.file, span.line) from None
+
+    def take_memory_n(self, n: int, vn: N.VarName, decl) -> int:
+        """Reserve ``n`` elements of the run's data memory for ``vn``; returns ``n``.
+        Raises ResourceError "data memory exhausted" at the DECL's file:line."""
+        span = self._decl_span(vn, decl)
+        return self.rt.memory.take(n, vn.name, span.file, span.line)
+
+    def take_memory(self, t, vn: N.VarName, decl) -> int:
+        """Reserve the run's data memory for variable ``vn`` of type ``t`` (a data-list or
+        routine DECL, ``decl``) before anything is allocated; returns the elements taken."""
+        return self.take_memory_n(self.data_elements(t, vn, decl), vn, decl)
 
     def _load_item(self, m: ModuleRT, data: N.DataList, item, all_global: bool) -> None:
         if True:
@@ -258,6 +309,7 @@ class Program:
                 for vn in item.names:
                     t = make_array(t0, vn.dims) if vn.dims else t0
                     key = vn.name.upper()
+                    self.take_memory(t, vn, item)
                     m.store[key] = make_value(t)
                     ref = Slot(m.store, key, t, vn.name, readonly=item.is_const)
                     if item.init is not None:
@@ -406,6 +458,8 @@ class Program:
         for name in list(self.index):
             try:
                 self.module(name)
+            except ResourceError:
+                raise
             except KrlRuntimeError:
                 continue
             except RecursionError:

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 from krl.semantics import types as T
 
-from .convert import INT_MAX, INT_MIN, binary_op, num
+from .convert import INT_MAX, INT_MIN, binary_op, num, trunc_int
 from .errors import KrlRuntimeError
 from .memory import Slot, field_ref, index_ref
 from .values import Arr, Struct, copy_value
@@ -196,10 +196,16 @@ def for_done(c, end, step) -> bool:
     return (step > 0 and c > end) or (step < 0 and c < end)
 
 
-def for_next(ref, end, step) -> bool:
+def for_next(ref, end, step, info=None) -> bool:
     """End of a FOR iteration: counter = counter + step (Runtime.assign, binary_op);
-    True while the loop goes on."""
-    store(ref, add(ref.get(), step))
+    True while the loop goes on. An error of the step (INT overflow past 2^31-1) is placed
+    on the FOR statement (``info``: its StmtInfo), not on the body's last line."""
+    try:
+        store(ref, add(ref.get(), step))
+    except KrlRuntimeError as exc:
+        if info is not None:
+            exc.at(info.file, info.line)
+        raise
     return not for_done(ref.get(), end, step)
 
 
@@ -278,10 +284,10 @@ def trigger_args(kind: str, at, delay, prio, onstart: bool = False) -> dict:
     """Keyword arguments of Runtime.trigger from the evaluated TRIGGER operands."""
     at = num(at)
     delay = num(delay)
-    p = int(num(prio)) if prio is not None else None
+    p = trunc_int(prio, "TRIGGER PRIO") if prio is not None else None
     if kind == "PATH":
         return {"path": float(at), "onstart": onstart, "delay_ms": delay, "prio": p}
-    return {"distance": int(at), "delay_ms": delay, "prio": p}
+    return {"distance": trunc_int(at, "TRIGGER DISTANCE"), "delay_ms": delay, "prio": p}
 
 
 # ------------------------------------------------------------------ ANOUT ON (reference §5.14)

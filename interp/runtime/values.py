@@ -128,6 +128,64 @@ def is_char_array(v) -> bool:
     return isinstance(v, Arr) and v.type.elem == T.CHAR and len(v.dims) == 1
 
 
+def data_size(t) -> int:
+    """The number of data elements (krl/limits.py MAX_DATA_ELEMENTS) a fresh value of type
+    ``t`` holds, computed from the type without building the value: a scalar or an unknown
+    type 1, a structure 1 plus its components, an array its element count times its
+    element. Raises :class:`errors.KrlRuntimeError` for a STRUC that contains itself or
+    types nested deeper than krl/limits.py MAX_NESTING (the caller adds the place)."""
+    from krl.limits import MAX_NESTING  # noqa: PLC0415
+
+    from .errors import KrlRuntimeError  # noqa: PLC0415
+
+    memo: dict = {}     # id(Struc) -> (elements, levels of STRUC nesting below and with it)
+    busy: set = set()
+
+    def size(t) -> tuple[int, int]:
+        if isinstance(t, T.Array):
+            n = 1
+            for d in t.dims:
+                n *= d
+            got, levels = size(t.elem)
+            return n * got, levels
+        if not isinstance(t, T.Struc):
+            return 1, 0
+        got = memo.get(id(t))
+        if got is not None:
+            return got
+        if id(t) in busy:
+            raise KrlRuntimeError(f"STRUC {t.name} contains itself")
+        if len(busy) >= MAX_NESTING:
+            raise KrlRuntimeError(f"nesting too deep: more than {MAX_NESTING} levels of STRUC in {t.name}")
+        busy.add(id(t))
+        n, levels = 1, 0
+        for _, ft in t.fields.values():
+            k, lv = size(ft)
+            n += k
+            levels = max(levels, lv)
+        busy.discard(id(t))
+        got = memo[id(t)] = (n, levels + 1)
+        return got
+
+    n, levels = size(t)
+    if levels > MAX_NESTING:
+        raise KrlRuntimeError(f"nesting too deep: more than {MAX_NESTING} levels of STRUC in {t}")
+    return n
+
+
+def value_size(v) -> int:
+    """The data elements of an existing value (as :func:`data_size` counts them; an open
+    array parameter's copy is sized by its value, not its type)."""
+    if isinstance(v, Arr):
+        if not v.data:
+            return 0
+        first = v.data[0]
+        return len(v.data) * (value_size(first) if isinstance(first, (Struct, Arr)) else 1)
+    if isinstance(v, Struct):
+        return data_size(v.type) if v.type is not None else 1 + len(v.f)
+    return 1
+
+
 def make_value(t):
     """A fresh, uninitialised value of type ``t`` (UNSET leaves)."""
     if isinstance(t, T.Struc):

@@ -183,7 +183,7 @@ class TreeInterpreter:
             while True:
                 rt.loop_tick(info)
                 self.exec_block(st.body, frame)
-                if not for_next(ref, end, step):
+                if not for_next(ref, end, step, info):
                     break
         except ExitSignal:
             pass

@@ -366,7 +366,7 @@ class VM:
                             store[ins[1]] = c
                             go = True
                         else:
-                            go = _for_next(temps[t], temps[t + 1], temps[t + 2])
+                            go = _for_next(temps[t], temps[t + 1], temps[t + 2], ins[3])
                         if go:
                             n = rt.steps
                             if n < task.quiet:
@@ -738,7 +738,7 @@ class VM:
                         ip += 1
                     elif op == OP.FOR_NEXT:
                         t = ins[1]
-                        if _for_next(temps[t], temps[t + 1], temps[t + 2]):
+                        if _for_next(temps[t], temps[t + 1], temps[t + 2], ins[2]):
                             n = rt.steps
                             if n < task.quiet and not ins[2].cond_stops:
                                 rt.steps = n + 1

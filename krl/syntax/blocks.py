@@ -17,6 +17,8 @@ Depth counts blocks (IF, FOR, WHILE, REPEAT, LOOP, SWITCH, SPLINE) and, inside a
 
 from __future__ import annotations
 
+import bisect
+import re
 from dataclasses import dataclass, field
 
 from krl.limits import MAX_EXPRESSION_TERMS, MAX_NESTING
@@ -266,3 +268,56 @@ def first_past_limit(tokens, bundle) -> Finding | None:
     """The first place where the token stream goes past MAX_NESTING or MAX_EXPRESSION_TERMS,
     or None; for the parser's pre-pass (cheap: one walk over the tokens, no recursion)."""
     return scan(lines_of(tokens, bundle), limits_only=True).limit
+
+
+# ----------------------------------------------------------------------- text pre-filter
+
+_W = r"(?![A-Z0-9_$])"
+# A line whose first token may be a block opener: any characters that are no token of their
+# own (blanks, characters the lexer rejects) may come before it, so this over-matches.
+_LINE_EVENTS = re.compile(
+    r"^(?P<routine>[ \t\f]*(?:GLOBAL[ \t\f]+)?(?:DEFFCT|DEFDAT|DEF)" + _W + ")"
+    r"|^(?P<closer>[ \t\f]*(?:ENDIF|ENDFOR|ENDWHILE|UNTIL|ENDLOOP|ENDSWITCH|ENDSPLINE|ENDFCT|ENDDAT|END)" + _W + ")"
+    r"|^(?P<opener>[^A-Z0-9_$;\n]*(?:GLOBAL[^A-Z0-9_$;\n]*)?(?:IF|FOR|WHILE|REPEAT|LOOP|SWITCH|PTP_SPLINE|SPLINE)" + _W + ")",
+    re.IGNORECASE | re.ASCII | re.MULTILINE)
+_NEST_CHARS = re.compile(r"[(\[{+\-]|NOT", re.IGNORECASE | re.ASCII)
+_TERM_CHARS = re.compile(r"[+\-*/<>=:]|AND|OR", re.IGNORECASE | re.ASCII)
+
+
+def may_pass_limit(text: str) -> bool:
+    """True when `text` might go past MAX_NESTING or MAX_EXPRESSION_TERMS in :func:`scan`
+    (a conservative bound from the text alone: False means it cannot).
+
+    A parse engine that runs no token pass of its own (krl/syntax/engines) hands such a file to
+    the Python engine. The bound: the block depth at a line is at most the number of opener lines
+    since the last routine line, minus one per certain closer line (a closer pops at least one
+    open block, a routine line clears them); a line adds at most one level per bracket, sign or
+    NOT, and one term per operator character or AND/OR (tests/syntax/test_engines.py checks it
+    against :func:`scan` on generated and real files)."""
+    t = text.replace("\r\n", "\n").replace("\r", "\n")
+    depth = top = 0
+    depth_at: list[tuple[int, int]] = []   # (offset of a line, block depth after that line)
+    for m in _LINE_EVENTS.finditer(t):
+        kind = m.lastgroup
+        if kind == "routine":
+            depth = 0
+        elif kind == "closer":
+            depth = max(0, depth - 1)
+        else:
+            depth += 1
+            top = max(top, depth)
+        depth_at.append((m.start(), depth))
+    if top > MAX_NESTING:
+        return True
+    # Only a line longer than the room left can go past a limit: one level or term per character.
+    room = min(MAX_NESTING - top, MAX_EXPRESSION_TERMS - 1)
+    positions = [p for p, _ in depth_at]
+    for m in re.finditer(r"^[^\n]{%d,}" % (room + 1), t, re.MULTILINE):
+        line = m.group()
+        k = bisect.bisect_right(positions, m.start()) - 1
+        block = depth_at[k][1] if k >= 0 else 0
+        if block + len(_NEST_CHARS.findall(line)) > MAX_NESTING:
+            return True
+        if len(line) >= MAX_EXPRESSION_TERMS and 1 + len(_TERM_CHARS.findall(line)) > MAX_EXPRESSION_TERMS:
+            return True
+    return False

@@ -17,14 +17,15 @@ from pathlib import Path
 from krl.semantics.diagnostics import Diagnostic
 
 
-def file_diagnostics(path: Path):
-    """(ParseResult, decoded text, diagnostics) of one file; never raises for bad content."""
+def file_diagnostics(path: Path, keep_tree: bool = True):
+    """(ParseResult, decoded text, diagnostics) of one file; never raises for bad content.
+    Without keep_tree the default parse engine (krl/syntax/engines) parses it, with no tree."""
+    from krl.syntax.engines import parse_source  # noqa: PLC0415
     from krl.syntax.messages import syntax_diagnostics  # noqa: PLC0415
-    from krl.syntax.parse import parse_source  # noqa: PLC0415
     from krl.syntax.source import read_source  # noqa: PLC0415
 
     src = read_source(path)
-    result = parse_source(src, keep_tree=True)
+    result = parse_source(src, keep_tree=keep_tree)
     diags = syntax_diagnostics(result, src.text)
     if not result.ok and not diags:
         detail = f" ({src.detail})" if src.detail else ""
@@ -35,7 +36,7 @@ def file_diagnostics(path: Path):
 def parse_job(path: str, outline: bool, tree: bool):
     """One file of `krl parse`, as a worker runs it: (ParseResult without its tree, text,
     diagnostics, outline lines). Everything returned is picklable."""
-    result, text, diags = file_diagnostics(Path(path))
+    result, text, diags = file_diagnostics(Path(path), keep_tree=outline or tree)
     entries: list[str] = []
     if result.ok and (outline or tree):
         if tree:
@@ -130,8 +131,11 @@ def run_parse(files, fmt: str = "text", outline: bool = False, tree: bool = Fals
     return 0 if all_ok else 1
 
 
-def main_status(files, fmt, as_json, outline, tree, timeout=None, jobs=None) -> int:
+def main_status(files, fmt, as_json, outline, tree, timeout=None, jobs=None, engine: str | None = None) -> int:
     """The `parse` command's body (krl/cli.py keeps only the options)."""
+    from krl.syntax.engines import use_engine  # noqa: PLC0415
+
+    use_engine(engine)
     from krl.semantics.render import use_colour  # noqa: PLC0415
 
     import click  # noqa: PLC0415

