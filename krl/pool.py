@@ -9,9 +9,9 @@ fails only its own task. :func:`run_tasks` turns every task into one :class:`Out
 completion order, and keeps a bounded number of tasks in flight, so the arguments (file bytes)
 of a large corpus are never all in memory at once.
 
-Workers are forked from the calling process (the default start method on Linux): a function
-patched in the parent before the pool starts is the function the workers run (the tests'
-crash hooks rely on it).
+Workers are forked from the calling process (explicitly, where the platform can fork): they
+start with the parser the caller has loaded, and a function patched in the parent before the
+pool starts is the function the workers run (the tests' crash hooks rely on it).
 """
 
 from __future__ import annotations
@@ -79,7 +79,12 @@ def run_tasks(fn: Callable[..., Any], tasks: Iterable[tuple[Hashable, tuple]], *
 
     jobs = max(1, jobs or default_jobs())
     window = 2 * jobs
-    pool = ProcessPool(max_workers=jobs, initializer=initializer, initargs=initargs)
+    import multiprocessing  # noqa: PLC0415
+
+    # fork, explicitly (Python 3.14 changes the default): workers start with what this process
+    # has loaded (the parser) and with what a test patched in it
+    context = multiprocessing.get_context("fork" if "fork" in multiprocessing.get_all_start_methods() else None)
+    pool = ProcessPool(max_workers=jobs, initializer=initializer, initargs=initargs, context=context)
     finished = False
     try:
         inflight: dict = {}
