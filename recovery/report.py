@@ -270,18 +270,38 @@ def _new_report_folder(out: Path) -> Path:
     return Path(tempfile.mkdtemp(prefix=f".{out.name}.new-", dir=out.parent))
 
 
+def _exchange(a: Path, b: Path) -> bool:
+    """Swap the folders `a` and `b` in one atomic step (Linux renameat2 RENAME_EXCHANGE);
+    False when the system or the file system cannot (then nothing has changed)."""
+    import ctypes  # noqa: PLC0415
+    import sys  # noqa: PLC0415
+
+    if not sys.platform.startswith("linux"):
+        return False
+    try:
+        libc = ctypes.CDLL(None, use_errno=True)
+        renameat2 = libc.renameat2
+    except (OSError, AttributeError):
+        return False
+    at_fdcwd, rename_exchange = -100, 2
+    return renameat2(at_fdcwd, os.fsencode(a), at_fdcwd, os.fsencode(b), rename_exchange) == 0
+
+
 def _put_in_place(tmp: Path, out: Path) -> None:
-    """Replace the folder `out` by the finished folder `tmp` (two renames; the old report
-    stays whole until the first, the new one is whole from the second)."""
+    """Replace the folder `out` by the finished folder `tmp`: one atomic exchange where the
+    system has it (a reader sees the old report or the new one, never none); else two renames
+    (the old report stays whole until the first, the new one is whole from the second)."""
     (tmp / ".krl-report").write_text("a krl recover report; replaced as a whole by the next run\n")
     os.chmod(tmp, 0o755)   # mkdtemp makes it private
-    if out.exists():
+    if not out.exists():
+        os.replace(tmp, out)
+    elif _exchange(tmp, out):
+        shutil.rmtree(tmp, ignore_errors=True)      # now holds the old report
+    else:
         old = Path(tempfile.mkdtemp(prefix=f".{out.name}.old-", dir=out.parent))
         os.replace(out, old / out.name)
         os.replace(tmp, out)
         shutil.rmtree(old, ignore_errors=True)
-    else:
-        os.replace(tmp, out)
 
 
 def write_report(out: Path, summary: Summary, results: list[FileResult]) -> None:

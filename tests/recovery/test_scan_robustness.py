@@ -200,6 +200,20 @@ def test_report_is_replaced_atomically(tmp_path: Path, monkeypatch) -> None:
     assert sorted(p.name for p in out.parent.iterdir()) == ["recovery"]
 
 
+@pytest.mark.parametrize("exchange", ["atomic exchange", "two renames"])
+def test_report_replacement_by_exchange_or_renames(tmp_path: Path, monkeypatch, exchange: str) -> None:
+    # Both ways of putting the new report in place give the new report and leave nothing behind.
+    if exchange == "two renames":
+        monkeypatch.setattr(report_mod, "_exchange", lambda a, b: False)
+    (tmp_path / "a.src").write_text(BROKEN)
+    out = tmp_path / "reports" / "recovery"
+    results = _results(tmp_path)
+    for gsha in ("old", "new"):
+        write_report(out, summarise(results, gsha, str(tmp_path), 0.0), results)
+    assert json.loads((out / "summary.json").read_text())["grammar_sha"] == "new"
+    assert sorted(p.name for p in out.parent.iterdir()) == ["recovery"]
+
+
 def test_report_never_replaces_a_folder_of_other_files(tmp_path: Path) -> None:
     (tmp_path / "a.src").write_text(VALID)
     out = tmp_path / "home"
