@@ -35,8 +35,10 @@ from pathlib import Path
 
 from krl.ast import nodes as N
 from krl.ast.build import build_module
+from krl.semantics.builtins import load_builtins
 from krl.semantics.checker import Checker, Declarer, _is_system_datalist
 from krl.semantics.diagnostics import Diagnostic, DiagnosticSink
+from krl.semantics.outside import Unresolved, template_lines
 from krl.semantics.symbols import Scope, Symbol, system_scopes
 from krl.syntax.folds import fold_diagnostics
 from krl.syntax.messages import syntax_diagnostics
@@ -69,6 +71,8 @@ class LoadedFile:
     diagnostics: list
     unreadable: bool = False
     failed_words: set = field(default_factory=set)
+    # (INI-fold lines, inline-form lines) of KUKA's templates (krl/semantics/outside.py)
+    template: tuple = (frozenset(), frozenset())
 
 
 def load_file(path: str | Path) -> LoadedFile:
@@ -94,7 +98,7 @@ def load_file(path: str | Path) -> LoadedFile:
             words = {w.upper() for w in _WORD.findall(src.text)}
     module = build_module(result, sink)
     return LoadedFile(path_s, module, result.ok, result.status, elapsed, time.perf_counter() - t,
-                      sink.items, unreadable, words)
+                      sink.items, unreadable, words, template_lines(src.text or ""))
 
 
 @dataclass(slots=True)
@@ -125,10 +129,22 @@ class Workspace:
     # words of files that did not parse: a name among them may be declared there
     failed_words: set = field(default_factory=set)
     unreadable: bool = False
+    # path -> (INI-fold lines, inline-form lines) of KUKA's templates (krl/semantics/outside.py)
+    template: dict = field(default_factory=dict)
 
     def maybe_declared(self, name: str) -> bool:
         """True when a file that could not be parsed (or read) may declare `name`."""
         return self.unreadable or name.upper() in self.failed_words
+
+    def evidence(self, path: str, line: int, kind: str) -> str:
+        """Why a use at path:line says installed software declares the name, or "" (the
+        template's INI fold; a KUKA inline form, for routines and types)."""
+        ini, inline = self.template.get(path, (frozenset(), frozenset()))
+        if line in ini:
+            return "the template's INI fold uses it (KUKA's template and technology packages write that fold)"
+        if line in inline and kind in ("routine", "type"):
+            return "a KUKA inline form (;FOLD ... ;%{PE}) uses it"
+        return ""
 
     def _note_failed(self, result, text: str) -> None:
         if result.ok:
@@ -210,6 +226,7 @@ class Workspace:
         hook = _ON_FILE.get() if notify else None
         if hook is not None:
             hook(lf.path)
+        self.template[lf.path] = lf.template
         sf = SourceFile(lf.path, lf.module, lf.ok, lf.status, parse_seconds=lf.parse_seconds)
         self.files.append(sf)
         return sf
@@ -224,6 +241,7 @@ class Workspace:
         self.sink.extend(syntax_diagnostics(result, text))
         self.sink.extend(fold_diagnostics(path, text))
         self._note_failed(result, text)
+        self.template[path] = template_lines(text)
         module = build_module(result, self.sink)
         sf = SourceFile(path, module, result.ok, result.status)
         self.files.append(sf)
@@ -292,6 +310,8 @@ class Workspace:
         incomplete = self.incomplete
         sink = self.sink
         declarer = Declarer(sink, incomplete, self.maybe_declared)
+        declarer.unresolved = Unresolved(load_builtins().packages, self.maybe_declared)
+        declarer.evidence = self.evidence
         checker = Checker(sink, declarer, incomplete)
         glob = Scope("global", "$GLOBAL", basis)
         self.global_scope = glob
@@ -396,6 +416,12 @@ class Workspace:
             checker.submit = u.src.path.lower().endswith(".sub")
             checker.check_routine(r, self.routine_scopes[id(r)], u.src.path)
         checker.system_file = declarer.soft_types = checker.submit = False
+        declarer.unresolved.finish(sink)
+        # advisory warnings are for code its maintainer can change: not for KUKA's own files
+        kuka = {f.path for f in self.files if is_system_path(f.path)} | {
+            u.dat.path for u in self.units
+            if u.dat is not None and u.dat.module.data is not None and _is_system_datalist(u.dat.module.data.name)}
+        sink.items = [d for d in sink.items if not (d.code in ADVISORY and d.path in kuka)]
 
 
 _ON_FILE: ContextVar[Callable[[str], None] | None] = ContextVar("krl_workspace_on_file", default=None)
@@ -413,6 +439,8 @@ def on_each_file(callback: Callable[[str], None]):
 
 
 SYSTEM_DIRS = ("system", "tp", "mada", "steu")
+# warnings that advise a change of the code (docs/diagnostics.md): not reported in KUKA's files
+ADVISORY = frozenset({"W108", "W111", "W201", "W202", "W205", "W206", "W210", "W501"})
 _WORD = re.compile(r"[A-Za-z_$][A-Za-z0-9_$]*")
 
 
