@@ -131,6 +131,9 @@ class Workspace:
     unreadable: bool = False
     # path -> (INI-fold lines, inline-form lines) of KUKA's templates (krl/semantics/outside.py)
     template: dict = field(default_factory=dict)
+    # when set: only these paths' routine bodies and data-list values are checked (the other
+    # files still declare their names); one file in the context of its backup
+    check_only: set | None = None
 
     def maybe_declared(self, name: str) -> bool:
         """True when a file that could not be parsed (or read) may declare `name`."""
@@ -368,6 +371,9 @@ class Workspace:
                     declarer.declare_values(scope, items, name, path)
                     declarer.soft_types = False
 
+        for u in self.units:
+            if u.dat is not None and u.dat.module.data is not None and not _is_system_datalist(u.dat.module.data.name):
+                _global_and_local_twice(u.dat.module.data, declarer)
         self._link_imports(checker)
 
         # routines: main routines and GLOBAL ones are global, others module-local
@@ -407,11 +413,15 @@ class Workspace:
         declarer.soft_types = False
         for u in self.units:
             if u.dat is not None and u.dat.module.data is not None and u.dat.ok:
+                if self.check_only is not None and u.dat.path not in self.check_only:
+                    continue
                 checker.system_file = declarer.soft_types = is_system_path(u.dat.path)
                 checker.check_datalist(u.dat.module.data, u.scope)
         for r, _sym, u in routine_syms:
             if u.src is None or not u.src.ok:
                 continue  # a file with syntax errors: its AST may miss tokens; E002 says why
+            if self.check_only is not None and u.src.path not in self.check_only:
+                continue
             checker.system_file = declarer.soft_types = is_system_path(u.src.path)
             checker.submit = u.src.path.lower().endswith(".sub")
             checker.check_routine(r, self.routine_scopes[id(r)], u.src.path)
@@ -449,6 +459,31 @@ def is_system_path(path: str) -> bool:
     they rely on $operate.dat declarations that a backup never contains (see W101/W105/W106)."""
     parts = Path(path).parts
     return Path(path).name.startswith("$") or any(p.lower() in SYSTEM_DIRS for p in parts[:-1])
+
+
+def _global_and_local_twice(dl: N.DataList, declarer: Declarer) -> None:
+    """E102 for a name that one data list declares both GLOBAL and not (2.5, 2.7): the two go
+    to different scopes (global and module), so the scopes alone do not see the repeat."""
+    first: dict[str, tuple[object, bool]] = {}
+    for d in dl.items:
+        is_global = bool(getattr(d, "is_global", False))
+        if isinstance(d, N.VarDecl):
+            named = [(v.name, v.span, v) for v in d.names]
+        elif isinstance(d, (N.SignalDecl, N.ImportDecl)):
+            named = [(d.name, d.span, d)]
+        else:
+            continue
+        for name, span, node in named:
+            got = first.get(name.upper())
+            if got is None:
+                first[name.upper()] = (node, is_global)
+            elif got[1] != is_global:
+                declarer.duplicate(name, span, _Decl(got[0]))
+
+
+class _Decl:
+    def __init__(self, node):
+        self.decl = node
 
 
 def _unit_names(u: "ModuleUnit") -> set[str]:

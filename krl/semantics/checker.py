@@ -868,6 +868,10 @@ class Checker:
             return T.UNKNOWN
         if not statement and not sig.is_function:
             self.sink.at(c.span, "E304", f"procedure '{c.name}' has no value")
+        elif statement and sig.is_function and sig.returns is not T.UNKNOWN:
+            # 2.4: a function is called only inside an expression
+            self.sink.at(c.span, "E304", f"function '{c.name}' called as a statement; use its value "
+                         f"(x = {c.name}(...))")
         if len(c.args) > len(sig.params) and not sig.varargs:
             self.sink.at(c.span, "E301", f"'{c.name}' takes {len(sig.params)} argument(s), {len(c.args)} given")
         for i, a in enumerate(c.args):
