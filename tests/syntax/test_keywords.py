@@ -105,3 +105,12 @@ def test_no_valid_file_declares_a_keyword(shared_corpus):
                     (in_invalid if rel in invalid else found).append(f"{rel}:{no} {n}")
     assert found == []
     assert in_invalid, "the known-invalid file with `step` as a name was not seen"
+
+
+@pytest.mark.parametrize("word", ["AXIS", "E3AXIS", "E6AXIS", "FRAME", "POS", "E3POS", "E6POS"])
+def test_geometric_type_names_are_names(word):
+    """1.6: FRAME, E6POS, ... are "ordinary type identifiers, not keywords": a variable, a
+    parameter, a component and an assignment target may carry the name."""
+    assert parses(f"DEF t({word} :IN)\n  DECL FRAME {word}\n  DECL REAL r\n  r = {word}.X\nEND\n"), word
+    assert parses(f"DEFDAT d\n  STRUC S_T REAL {word}\n  DECL INT {word} = 1\nENDDAT\n", "d.dat"), word
+    assert not parses(f"DEF t()\n  DECL {word} {word} x\nEND\n"), word
