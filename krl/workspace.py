@@ -346,7 +346,7 @@ class Workspace:
                 declarer.declare_types(scope, items, system=_is_system_datalist(name))
         for u, tg in plan:
             for scope, items, name in tg:
-                declarer.soft_types = _is_system_datalist(name) or is_system_path(u.dat.path)
+                declarer.soft_types = _is_system_datalist(name) or is_kuka_file(u.dat.path)
                 declarer.fill_types(scope, items)
         declarer.soft_types = False
         # system data lists first, so that user globals that repeat them are the duplicates
@@ -367,7 +367,7 @@ class Workspace:
                     for k, v in tmp.routines.items():
                         glob.routines.setdefault(k, v)
                 else:
-                    declarer.soft_types = is_system_path(path)
+                    declarer.soft_types = is_kuka_file(path)
                     declarer.declare_values(scope, items, name, path)
                     declarer.soft_types = False
 
@@ -381,7 +381,7 @@ class Workspace:
         for u in self.units:
             if u.src is None:
                 continue
-            declarer.soft_types = is_system_path(u.src.path)
+            declarer.soft_types = is_kuka_file(u.src.path)
             for i, r in enumerate(u.src.module.routines):
                 declarer.ident(r.name, r.span)
                 is_global = i == 0 or r.is_global
@@ -403,7 +403,7 @@ class Workspace:
 
         # routine scopes (parameters and locals), then signatures, then bodies
         for r, sym, u in routine_syms:
-            declarer.soft_types = is_system_path(u.src.path)
+            declarer.soft_types = is_kuka_file(u.src.path)
             local = Scope("routine", r.name, u.scope)
             declarer.declare_types(local, r.decls)
             declarer.fill_types(local, r.decls)
@@ -415,20 +415,20 @@ class Workspace:
             if u.dat is not None and u.dat.module.data is not None and u.dat.ok:
                 if self.check_only is not None and u.dat.path not in self.check_only:
                     continue
-                checker.system_file = declarer.soft_types = is_system_path(u.dat.path)
+                checker.system_file = declarer.soft_types = is_kuka_file(u.dat.path)
                 checker.check_datalist(u.dat.module.data, u.scope)
         for r, _sym, u in routine_syms:
             if u.src is None or not u.src.ok:
                 continue  # a file with syntax errors: its AST may miss tokens; E002 says why
             if self.check_only is not None and u.src.path not in self.check_only:
                 continue
-            checker.system_file = declarer.soft_types = is_system_path(u.src.path)
+            checker.system_file = declarer.soft_types = is_kuka_file(u.src.path)
             checker.submit = u.src.path.lower().endswith(".sub")
             checker.check_routine(r, self.routine_scopes[id(r)], u.src.path)
         checker.system_file = declarer.soft_types = checker.submit = False
         declarer.unresolved.finish(sink)
         # advisory warnings are for code its maintainer can change: not for KUKA's own files
-        kuka = {f.path for f in self.files if is_system_path(f.path)} | {
+        kuka = {f.path for f in self.files if is_kuka_file(f.path)} | {
             u.dat.path for u in self.units
             if u.dat is not None and u.dat.module.data is not None and _is_system_datalist(u.dat.module.data.name)}
         sink.items = [d for d in sink.items if not (d.code in ADVISORY and d.path in kuka)]
@@ -484,6 +484,17 @@ def _global_and_local_twice(dl: N.DataList, declarer: Declarer) -> None:
 class _Decl:
     def __init__(self, node):
         self.decl = node
+
+
+def is_kuka_file(path: str) -> bool:
+    """A file KUKA's software wrote: a system file (:func:`is_system_path`) or one of KUKA's
+    hook programs under R1/Program (kss.yaml ``programs``: masref_user.src,
+    CollDetect_UserAction.src; KUKA's system files call their routines)."""
+    if is_system_path(path):
+        return True
+    p = Path(path)
+    return (p.name.upper() in load_builtins().programs
+            and "program" in [q.lower() for q in p.parts[:-1]])
 
 
 def _unit_names(u: "ModuleUnit") -> set[str]:

@@ -6,7 +6,8 @@ The checker does not report an unresolved name at once. It records every use her
 whole workspace has been checked:
 
 * a name is **outside the backup** when there is evidence that installed software declares it:
-  the platform tables name the technology package that declares it (kss.yaml ``packages``),
+  the platform tables name the technology package or KUKA hook program that declares it
+  (kss.yaml ``packages``),
   or one of its uses is a line that KUKA's software wrote (a KUKA system file: R1/System,
   R1/TP, R1/Mada, STEU or a ``$`` file; the template's INI fold of a program, not its
   USER INI fold; for a routine or a type, a KUKA inline form ``;FOLD ... ;%{PE}``), or it is
@@ -75,6 +76,22 @@ def template_lines(text: str) -> tuple[frozenset[int], frozenset[int]]:
     return frozenset(ini), frozenset(inline)
 
 
+def user_fold_lines(text: str) -> frozenset[int]:
+    """Lines inside a fold titled ``USER ...`` (``;FOLD USER INI``, ``;FOLD USER PLC``): the
+    programmer's part of a template or of a KUKA system file such as sps.sub."""
+    out: set[int] = set()
+    stack: list[bool] = []
+    for no, line in enumerate(text.splitlines(), 1):
+        m = _FOLD.match(line)
+        if m:
+            stack.append(m.group(1).split(";", 1)[0].strip().upper().startswith("USER"))
+        if any(stack):
+            out.add(no)
+        if not m and _ENDFOLD.match(line) and stack:
+            stack.pop()
+    return frozenset(out)
+
+
 def _innermost(stack: list[str]) -> str:
     for kind in reversed(stack):
         if kind == "user":
@@ -115,6 +132,9 @@ class Unresolved:
         got = self.packages.get(name.upper())
         if got is not None:
             package, source = got
+            if package.startswith("KSS hook program "):
+                return (f"declared by KUKA's hook program {package[17:]} ({source}), which KUKA's system "
+                        f"files call and this backup does not contain")
             return f"declared by technology package {package} ({source}), which this backup does not contain"
         for u in uses:
             if u.evidence:

@@ -152,3 +152,17 @@ def test_template_lines():
     assert {lines[i - 1].strip() for i in ini} >= {"BAS (#INITMOV,0 )", "ArcInit(ARC_DEFAULT)"}
     assert "x = 1" not in {lines[i - 1].strip() for i in ini}
     assert "y = 2" not in {lines[i - 1].strip() for i in ini | inline}
+
+
+def test_hook_program_routine_names_its_program(tmp_path):
+    """A backup whose masref_user.src is missing: the system file's calls of MasRefStartG1 are one
+    W106 naming KUKA's hook program; inside a hook program under R1/Program an unknown routine is
+    KUKA's too, in a user program of the same name elsewhere it is an error."""
+    root = backup(tmp_path, {"System/masref_main.src": "DEF masref_main()\n  MasRefStartG1()\nEND\n",
+                             "Program/CollDetect_UserAction.src": "DEF CollDetect_UserAction()\n  HookHelper()\nEND\n",
+                             "Program/Cell/mine.src": "DEF mine()\n  OtherHelper()\nEND\n"})
+    got = diags(root)
+    assert [(p, ln, c) for p, ln, c, _m in got] == [
+        ("Program/Cell/mine.src", 2, "E106"), ("Program/CollDetect_UserAction.src", 2, "W106"),
+        ("System/masref_main.src", 2, "W106")], got
+    assert "hook program masref_user.src" in got[2][3]
