@@ -868,8 +868,11 @@ class Checker:
             return T.UNKNOWN
         if not statement and not sig.is_function:
             self.sink.at(c.span, "E304", f"procedure '{c.name}' has no value")
-        elif statement and sig.is_function and sig.returns is not T.UNKNOWN:
-            # 2.4: a function is called only inside an expression
+        elif (statement and sig.is_function and sig.returns is not T.UNKNOWN
+              and isinstance(sym.decl, (N.Routine, N.ExtDecl))):
+            # 2.4: a function is called only inside an expression. Only for functions the
+            # program declares: KUKA documents built-ins such as CAST_TO as statements, which
+            # the tables give a BOOL value
             self.sink.at(c.span, "E304", f"function '{c.name}' called as a statement; use its value "
                          f"(x = {c.name}(...))")
         if len(c.args) > len(sig.params) and not sig.varargs:

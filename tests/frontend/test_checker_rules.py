@@ -72,7 +72,8 @@ CASES = [
     ("E303", prog("REAL r\nBOOL b", "r = SQRT(b)"), prog("REAL r\nINT i", "r = SQRT(i)")),
     ("E304", prog("INT i", "i = BAS(#INITMOV, 0)"), prog("", "BAS(#INITMOV, 0)")),
     # 2.4: a function is called only inside an expression (found by the seeded-error suite)
-    ("E304", prog("REAL r", "SQRT(2.0)"), prog("REAL r", "r = SQRT(2.0)")),
+    ("E304", "DEF t()\n  REAL r\n  Half(2.0)\nEND\nDEFFCT REAL Half(x :IN)\n  REAL x\n  RETURN x / 2\nENDFCT\n",
+     "DEF t()\n  REAL r\n  r = Half(2.0)\nEND\nDEFFCT REAL Half(x :IN)\n  REAL x\n  RETURN x / 2\nENDFCT\n"),
     # control flow (5.5, 5.6, 5.10)
     ("E401", prog("", "GOTO nowhere"), prog("", "GOTO here\nhere:")),
     ("E402", prog("BOOL b", "GOTO inner\nIF b THEN\n  inner:\nENDIF"),
