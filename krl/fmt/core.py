@@ -122,7 +122,7 @@ BINOP = "binop"          # binary operator, relational operator, AND/OR/...
 GEO = "geo"              # the geometric operator ':'
 UNARY = "unary"          # unary - + NOT B_NOT, the sign of a data-list constant
 ASSIGN = "assign"        # '=' of an assignment, FOR, WITH, DELAY=, an initial value
-NAME = "name"            # a keyword used as a name (structure component, enum value)
+NAME = "name"            # a keyword used as a name (structure component, enum value, FRAME as a variable)
 CALL_OPEN = "call("      # '(' after a routine name (call, DEF, DEFFCT, EXT)
 KEEP = "keep"            # spacing kept as written (collapsed to one space or none)
 TIGHT = "tight"          # no spaces around (open dimensions [,])
@@ -201,8 +201,8 @@ def _roles(tree) -> dict[int, str]:
                 role = UNARY
             elif text == "=":
                 role = ASSIGN
-            elif rule == "contextKeyword":
-                role = NAME
+            elif rule in ("contextKeyword", "name"):
+                role = NAME       # a keyword token standing as a name (FRAME as a variable, 1.6)
             elif rule in _KEEP_RULES and text != "(" and text != ")" and text != ",":
                 role = KEEP if text in (":", "/", "..", "[", "]") else None
             elif rule == "openDimensions":

@@ -125,6 +125,13 @@ def test_keywords_used_as_names_keep_their_case_and_enum_literals_too():
     assert fmt(src) == lines("DEF t()", "   LIN_REL {x 10} #tool", "   x = p.in", "   y = {in 1, out 2}", "END")
 
 
+def test_geometric_type_names_used_as_names_keep_their_case():
+    """FRAME, POS ... are type names, not keywords (1.6): as a variable they keep their case,
+    as the type of a declaration they are upper-cased like INT."""
+    src = lines("DEF t(frame :IN)", "decl frame frame", "frame pos", "pos = frame", "END")
+    assert fmt(src) == lines("DEF t(frame :IN)", "   DECL FRAME frame", "   FRAME pos", "   pos = frame", "END")
+
+
 # ------------------------------------------------------------------ spacing
 
 def test_operators_are_spaced_unary_minus_is_not():
