@@ -485,9 +485,18 @@ literal
     | ENUMLITERAL
     ;
 
+// The predefined geometric type names are tokens (for DECL-less declarations, 2.5) but not
+// keywords: "ordinary type identifiers" (1.6), so they are names wherever a name may stand.
 name
     : IDENTIFIER
     | SYSNAME
+    | AXIS
+    | E3AXIS
+    | E6AXIS
+    | FRAME
+    | POS
+    | E3POS
+    | E6POS
     ;
 
 // Keywords that KUKA's own data lists use as structure components and enum values

@@ -35,8 +35,10 @@ from pathlib import Path
 
 from krl.ast import nodes as N
 from krl.ast.build import build_module
+from krl.semantics.builtins import load_builtins
 from krl.semantics.checker import Checker, Declarer, _is_system_datalist
 from krl.semantics.diagnostics import Diagnostic, DiagnosticSink
+from krl.semantics.outside import Unresolved, template_lines
 from krl.semantics.symbols import Scope, Symbol, system_scopes
 from krl.syntax.folds import fold_diagnostics
 from krl.syntax.messages import syntax_diagnostics
@@ -69,6 +71,8 @@ class LoadedFile:
     diagnostics: list
     unreadable: bool = False
     failed_words: set = field(default_factory=set)
+    # (INI-fold lines, inline-form lines) of KUKA's templates (krl/semantics/outside.py)
+    template: tuple = (frozenset(), frozenset())
 
 
 def load_file(path: str | Path) -> LoadedFile:
@@ -94,7 +98,7 @@ def load_file(path: str | Path) -> LoadedFile:
             words = {w.upper() for w in _WORD.findall(src.text)}
     module = build_module(result, sink)
     return LoadedFile(path_s, module, result.ok, result.status, elapsed, time.perf_counter() - t,
-                      sink.items, unreadable, words)
+                      sink.items, unreadable, words, template_lines(src.text or ""))
 
 
 @dataclass(slots=True)
@@ -125,10 +129,25 @@ class Workspace:
     # words of files that did not parse: a name among them may be declared there
     failed_words: set = field(default_factory=set)
     unreadable: bool = False
+    # path -> (INI-fold lines, inline-form lines) of KUKA's templates (krl/semantics/outside.py)
+    template: dict = field(default_factory=dict)
+    # when set: only these paths' routine bodies and data-list values are checked (the other
+    # files still declare their names); one file in the context of its backup
+    check_only: set | None = None
 
     def maybe_declared(self, name: str) -> bool:
         """True when a file that could not be parsed (or read) may declare `name`."""
         return self.unreadable or name.upper() in self.failed_words
+
+    def evidence(self, path: str, line: int, kind: str) -> str:
+        """Why a use at path:line says installed software declares the name, or "" (the
+        template's INI fold; a KUKA inline form, for routines and types)."""
+        ini, inline = self.template.get(path, (frozenset(), frozenset()))
+        if line in ini:
+            return "the template's INI fold uses it (KUKA's template and technology packages write that fold)"
+        if line in inline and kind in ("routine", "type"):
+            return "a KUKA inline form (;FOLD ... ;%{PE}) uses it"
+        return ""
 
     def _note_failed(self, result, text: str) -> None:
         if result.ok:
@@ -210,6 +229,7 @@ class Workspace:
         hook = _ON_FILE.get() if notify else None
         if hook is not None:
             hook(lf.path)
+        self.template[lf.path] = lf.template
         sf = SourceFile(lf.path, lf.module, lf.ok, lf.status, parse_seconds=lf.parse_seconds)
         self.files.append(sf)
         return sf
@@ -224,6 +244,7 @@ class Workspace:
         self.sink.extend(syntax_diagnostics(result, text))
         self.sink.extend(fold_diagnostics(path, text))
         self._note_failed(result, text)
+        self.template[path] = template_lines(text)
         module = build_module(result, self.sink)
         sf = SourceFile(path, module, result.ok, result.status)
         self.files.append(sf)
@@ -292,6 +313,8 @@ class Workspace:
         incomplete = self.incomplete
         sink = self.sink
         declarer = Declarer(sink, incomplete, self.maybe_declared)
+        declarer.unresolved = Unresolved(load_builtins().packages, self.maybe_declared)
+        declarer.evidence = self.evidence
         checker = Checker(sink, declarer, incomplete)
         glob = Scope("global", "$GLOBAL", basis)
         self.global_scope = glob
@@ -323,7 +346,7 @@ class Workspace:
                 declarer.declare_types(scope, items, system=_is_system_datalist(name))
         for u, tg in plan:
             for scope, items, name in tg:
-                declarer.soft_types = _is_system_datalist(name) or is_system_path(u.dat.path)
+                declarer.soft_types = _is_system_datalist(name) or is_kuka_file(u.dat.path)
                 declarer.fill_types(scope, items)
         declarer.soft_types = False
         # system data lists first, so that user globals that repeat them are the duplicates
@@ -344,10 +367,13 @@ class Workspace:
                     for k, v in tmp.routines.items():
                         glob.routines.setdefault(k, v)
                 else:
-                    declarer.soft_types = is_system_path(path)
+                    declarer.soft_types = is_kuka_file(path)
                     declarer.declare_values(scope, items, name, path)
                     declarer.soft_types = False
 
+        for u in self.units:
+            if u.dat is not None and u.dat.module.data is not None and not _is_system_datalist(u.dat.module.data.name):
+                _global_and_local_twice(u.dat.module.data, declarer)
         self._link_imports(checker)
 
         # routines: main routines and GLOBAL ones are global, others module-local
@@ -355,7 +381,7 @@ class Workspace:
         for u in self.units:
             if u.src is None:
                 continue
-            declarer.soft_types = is_system_path(u.src.path)
+            declarer.soft_types = is_kuka_file(u.src.path)
             for i, r in enumerate(u.src.module.routines):
                 declarer.ident(r.name, r.span)
                 is_global = i == 0 or r.is_global
@@ -377,7 +403,7 @@ class Workspace:
 
         # routine scopes (parameters and locals), then signatures, then bodies
         for r, sym, u in routine_syms:
-            declarer.soft_types = is_system_path(u.src.path)
+            declarer.soft_types = is_kuka_file(u.src.path)
             local = Scope("routine", r.name, u.scope)
             declarer.declare_types(local, r.decls)
             declarer.fill_types(local, r.decls)
@@ -387,15 +413,25 @@ class Workspace:
         declarer.soft_types = False
         for u in self.units:
             if u.dat is not None and u.dat.module.data is not None and u.dat.ok:
-                checker.system_file = declarer.soft_types = is_system_path(u.dat.path)
+                if self.check_only is not None and u.dat.path not in self.check_only:
+                    continue
+                checker.system_file = declarer.soft_types = is_kuka_file(u.dat.path)
                 checker.check_datalist(u.dat.module.data, u.scope)
         for r, _sym, u in routine_syms:
             if u.src is None or not u.src.ok:
                 continue  # a file with syntax errors: its AST may miss tokens; E002 says why
-            checker.system_file = declarer.soft_types = is_system_path(u.src.path)
+            if self.check_only is not None and u.src.path not in self.check_only:
+                continue
+            checker.system_file = declarer.soft_types = is_kuka_file(u.src.path)
             checker.submit = u.src.path.lower().endswith(".sub")
             checker.check_routine(r, self.routine_scopes[id(r)], u.src.path)
         checker.system_file = declarer.soft_types = checker.submit = False
+        declarer.unresolved.finish(sink)
+        # advisory warnings are for code its maintainer can change: not for KUKA's own files
+        kuka = {f.path for f in self.files if is_kuka_file(f.path)} | {
+            u.dat.path for u in self.units
+            if u.dat is not None and u.dat.module.data is not None and _is_system_datalist(u.dat.module.data.name)}
+        sink.items = [d for d in sink.items if not (d.code in ADVISORY and d.path in kuka)]
 
 
 _ON_FILE: ContextVar[Callable[[str], None] | None] = ContextVar("krl_workspace_on_file", default=None)
@@ -413,6 +449,8 @@ def on_each_file(callback: Callable[[str], None]):
 
 
 SYSTEM_DIRS = ("system", "tp", "mada", "steu")
+# warnings that advise a change of the code (docs/diagnostics.md): not reported in KUKA's files
+ADVISORY = frozenset({"W108", "W111", "W201", "W202", "W205", "W206", "W210", "W501"})
 _WORD = re.compile(r"[A-Za-z_$][A-Za-z0-9_$]*")
 
 
@@ -421,6 +459,42 @@ def is_system_path(path: str) -> bool:
     they rely on $operate.dat declarations that a backup never contains (see W101/W105/W106)."""
     parts = Path(path).parts
     return Path(path).name.startswith("$") or any(p.lower() in SYSTEM_DIRS for p in parts[:-1])
+
+
+def _global_and_local_twice(dl: N.DataList, declarer: Declarer) -> None:
+    """E102 for a name that one data list declares both GLOBAL and not (2.5, 2.7): the two go
+    to different scopes (global and module), so the scopes alone do not see the repeat."""
+    first: dict[str, tuple[object, bool]] = {}
+    for d in dl.items:
+        is_global = bool(getattr(d, "is_global", False))
+        if isinstance(d, N.VarDecl):
+            named = [(v.name, v.span, v) for v in d.names]
+        elif isinstance(d, (N.SignalDecl, N.ImportDecl)):
+            named = [(d.name, d.span, d)]
+        else:
+            continue
+        for name, span, node in named:
+            got = first.get(name.upper())
+            if got is None:
+                first[name.upper()] = (node, is_global)
+            elif got[1] != is_global:
+                declarer.duplicate(name, span, _Decl(got[0]))
+
+
+class _Decl:
+    def __init__(self, node):
+        self.decl = node
+
+
+def is_kuka_file(path: str) -> bool:
+    """A file KUKA's software wrote: a system file (:func:`is_system_path`) or one of KUKA's
+    hook programs under R1/Program (kss.yaml ``programs``: masref_user.src,
+    CollDetect_UserAction.src; KUKA's system files call their routines)."""
+    if is_system_path(path):
+        return True
+    p = Path(path)
+    return (p.name.upper() in load_builtins().programs
+            and "program" in [q.lower() for q in p.parts[:-1]])
 
 
 def _unit_names(u: "ModuleUnit") -> set[str]:

@@ -22,7 +22,11 @@ from krl.limits import PARSE_TIMEOUT_S
 @click.option("--engine", type=click.Choice(["auto", "python", "java"]), default=None,
               help="Parse engine: java (fast; needs a JDK), python (the reference), auto: java when available "
                    "(default: $KRL_ENGINE, else auto).")
-def recover(corpus: Path, out: Path, jobs: int | None, no_cache: bool, timeout: float, engine: str | None) -> None:
+@click.option("--scheduler", default=None, metavar="tcp://HOST:PORT",
+              help="Parse the files on this Dask distributed scheduler's cluster (in batches); "
+                   "default: local worker processes.")
+def recover(corpus: Path, out: Path, jobs: int | None, no_cache: bool, timeout: float, engine: str | None,
+            scheduler: str | None) -> None:
     """Parse every KRL file under CORPUS (a folder or a KRC backup .zip), cluster the failures,
     write the report to --out.
 
@@ -33,6 +37,7 @@ def recover(corpus: Path, out: Path, jobs: int | None, no_cache: bool, timeout: 
     from krl.terminal import printable_path  # noqa: PLC0415
     from recovery.pipeline import run_recovery  # noqa: PLC0415
     from krl.syntax.engines import use_engine  # noqa: PLC0415
+    from recovery.distributed import SchedulerError  # noqa: PLC0415
     from recovery.report import ReportError  # noqa: PLC0415
 
     use_engine(engine)
@@ -43,8 +48,8 @@ def recover(corpus: Path, out: Path, jobs: int | None, no_cache: bool, timeout: 
     try:
         with backup_source(corpus) as (folder, shown):
             summary = run_recovery(folder, out, jobs=jobs, use_cache=not no_cache, timeout=timeout,
-                                   label=str(corpus) if shown.archive else None)
-    except (ArchiveError, ReportError) as exc:
+                                   label=str(corpus) if shown.archive else None, scheduler=scheduler)
+    except (ArchiveError, ReportError, SchedulerError) as exc:
         click.echo(f"error: {printable_path(exc)}", err=True)
         sys.exit(2)
     click.echo(f"{summary.files_ok}/{summary.files} files parse "

@@ -115,7 +115,8 @@ def _valid_check_figures(obj: object) -> bool:
 
 
 def run_recovery(corpus: Path, out: Path, jobs: int | None = None, use_cache: bool = True,
-                 timeout: float = PARSE_TIMEOUT_S, label: str | None = None) -> Summary:
+                 timeout: float = PARSE_TIMEOUT_S, label: str | None = None,
+                 scheduler: str | None = None) -> Summary:
     """Scan `corpus`, cluster, add the negative-corpus and static-check figures and write the
     report to `out`. `label`: how the report names the corpus when it is not the folder itself
     (a backup .zip extracted to a temporary folder: the report then names the archive and does
@@ -132,7 +133,8 @@ def run_recovery(corpus: Path, out: Path, jobs: int | None = None, use_cache: bo
             builder.add(index, row)
             stream.add(index, row)
 
-        scan(corpus, gsha, jobs=jobs, use_cache=use_cache, timeout=timeout, on_row=on_row, keep=False)
+        scan(corpus, gsha, jobs=jobs, use_cache=use_cache, timeout=timeout, on_row=on_row, keep=False,
+             scheduler=scheduler)
         summary = builder.summary(gsha, label or str(corpus), 0.0)
         summary.negative = negative_figures(gsha, jobs, use_cache)
         ki = _known_invalid_figures(builder.known_ok)

@@ -317,7 +317,8 @@ class ResultCache:
 def scan(corpus: Path, gsha: str, parser_dir: str | None = None, jobs: int | None = None,
          use_cache: bool = True, progress: bool = True, timeout: float | None = PARSE_TIMEOUT_S,
          in_process: bool = False, on_row: Callable[[int, FileResult], None] | None = None,
-         keep: bool = True, warn: Callable[[str], None] = warn) -> list[FileResult]:
+         keep: bool = True, warn: Callable[[str], None] = warn,
+         scheduler: str | None = None) -> list[FileResult]:
     """Classify and parse every KRL entry under corpus; one FileResult per entry, in walk order.
 
     parser_dir: a directory of generated parser code (None: the working tree's parser).
@@ -327,7 +328,10 @@ def scan(corpus: Path, gsha: str, parser_dir: str | None = None, jobs: int | Non
     walk index and the row of each entry as it is known (classified entries and cache hits
     first, parsed files as they finish, so in any order). keep=False: the rows are only given
     to on_row and the scan returns [] (memory stays flat whatever the corpus size; the cache,
-    when used, still holds one entry per file). Never raises for what it finds in the corpus.
+    when used, still holds one entry per file). scheduler: the address of a Dask scheduler
+    (``tcp://HOST:8786``): the files are parsed on its cluster, in batches, with the same rows
+    (recovery/distributed.py; raises SchedulerError when it cannot be reached). Never raises
+    for what it finds in the corpus.
     """
     from rich.progress import Progress  # noqa: PLC0415
 
@@ -374,8 +378,15 @@ def scan(corpus: Path, gsha: str, parser_dir: str | None = None, jobs: int | Non
             yield idx, (rel, data, sha)
 
     with bar:
-        for out in run_tasks(scan_bytes, tasks(), jobs=jobs or default_jobs(), timeout=timeout,
-                             initializer=_init_worker, initargs=(parser_dir,), in_process=in_process):
+        if scheduler is not None:
+            from recovery.distributed import run_batches  # noqa: PLC0415
+
+            outcomes = run_batches(scheduler, scan_bytes, tasks(), timeout=timeout,
+                                   initializer=_init_worker, initargs=(parser_dir,))
+        else:
+            outcomes = run_tasks(scan_bytes, tasks(), jobs=jobs or default_jobs(), timeout=timeout,
+                                 initializer=_init_worker, initargs=(parser_dir,), in_process=in_process)
+        for out in outcomes:
             rel, size, sha = pending.pop(out.key)
             row = out.value if out.status == "done" else failed_row(rel, size, sha, out.status, out.detail)
             cache.put(row)

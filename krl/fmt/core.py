@@ -122,7 +122,7 @@ BINOP = "binop"          # binary operator, relational operator, AND/OR/...
 GEO = "geo"              # the geometric operator ':'
 UNARY = "unary"          # unary - + NOT B_NOT, the sign of a data-list constant
 ASSIGN = "assign"        # '=' of an assignment, FOR, WITH, DELAY=, an initial value
-NAME = "name"            # a keyword used as a name (structure component, enum value)
+NAME = "name"            # a keyword used as a name (structure component, enum value, FRAME as a variable)
 CALL_OPEN = "call("      # '(' after a routine name (call, DEF, DEFFCT, EXT)
 KEEP = "keep"            # spacing kept as written (collapsed to one space or none)
 TIGHT = "tight"          # no spaces around (open dimensions [,])
@@ -201,8 +201,8 @@ def _roles(tree) -> dict[int, str]:
                 role = UNARY
             elif text == "=":
                 role = ASSIGN
-            elif rule == "contextKeyword":
-                role = NAME
+            elif rule in ("contextKeyword", "name"):
+                role = NAME       # a keyword token standing as a name (FRAME as a variable, 1.6)
             elif rule in _KEEP_RULES and text != "(" and text != ")" and text != ",":
                 role = KEEP if text in (":", "/", "..", "[", "]") else None
             elif rule == "openDimensions":
@@ -272,11 +272,13 @@ def _would_merge(ta: str, tb: str) -> bool:
 # ---------------------------------------------------------------------------- formatting
 
 
-def _problems(result: ParseResult) -> list[SyntaxProblem]:
-    out = []
-    for e in result.errors:
-        code = e.offending_type if e.kind == "limit" else ("E001" if e.kind == "lexer" else "E002")
-        out.append(SyntaxProblem(e.line, e.column + 1, e.message, code))
+def _problems(result: ParseResult, text: str) -> list[SyntaxProblem]:
+    """The syntax errors as `krl parse` words them (krl/syntax/messages.py: codes E0xx)."""
+    from krl.syntax.messages import syntax_diagnostics  # noqa: PLC0415
+
+    out = [SyntaxProblem(d.line, d.column, d.message, d.code) for d in syntax_diagnostics(result, text)]
+    if not out:
+        out = [SyntaxProblem(e.line, e.column + 1, e.message, "E002") for e in result.errors]
     if not out:
         out.append(SyntaxProblem(1, 1, f"file not parsed: {result.status}", "E001"))
     return out
@@ -301,7 +303,7 @@ def format_text(text: str, options: FormatOptions | None = None) -> str:
     prepared = body + "\n" if added_newline else body
     result = parse_text(prepared, "<fmt>")
     if not result.ok or result.tree is None:
-        raise FormatSyntaxError(_problems(result), result)
+        raise FormatSyntaxError(_problems(result, prepared), result)
     out = format_parsed(prepared, result, options)
     if added_newline and out.endswith("\n"):
         out = out[:-1]

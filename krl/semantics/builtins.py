@@ -74,6 +74,7 @@ class Builtins:
     kss_enums: dict[str, list[str]] = field(default_factory=dict)
     sources: dict[str, str] = field(default_factory=dict)      # UPPER name -> "path:line"
     packages: dict[str, tuple[str, str]] = field(default_factory=dict)  # UPPER name -> (package, source)
+    programs: dict[str, str] = field(default_factory=dict)    # UPPER file name of a KUKA hook program -> source
 
 
 _NAME_DIMS = re.compile(r"^\s*(\$?[A-Za-z_][\w$]*)\s*(?:\[([\d,\s]*)\])?\s*$")
@@ -167,6 +168,7 @@ def load_builtins() -> Builtins:
             routines[key] = parse_signature(info["signature"], bool(info["function"]))
             sources.setdefault(key, info["source"])
     packages = {k: (v["package"], v["source"]) for k, v in (kss.get("packages") or {}).items()}
+    programs = {k: v["source"] for k, v in (kss.get("programs") or {}).items()}
     options = types.get("options", {}) or {}
     bvars = {}
     for key, tname in list((basis.get("variables") or {}).items()) + list((options.get("variables") or {}).items()):
@@ -190,4 +192,5 @@ def load_builtins() -> Builtins:
         kss_enums=kss_enums,
         sources=sources,
         packages=packages,
+        programs=programs,
     )

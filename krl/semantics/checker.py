@@ -14,10 +14,9 @@ Two jobs:
   variables and constants (E501/E502), conditions (E204), SWITCH (E207), FOR (E208),
   motion targets (E209), operators (E203).
 
-When a name is not found but may be declared in a part of the workspace that could not be
-read (a file with syntax errors whose text contains the name), or in a KUKA system file
-(which relies on $operate.dat, never part of a backup), the finding is a warning
-(W101/W105/W106) instead of an error.
+A name that is not found is recorded, not reported at once: krl/semantics/outside.py decides,
+for the whole backup, whether installed software the backup lacks declares it (one warning
+W101/W105/W106/W107 per name) or it is the program's error (E101/E105/E106 at each use).
 """
 
 from __future__ import annotations
@@ -50,7 +49,32 @@ class Declarer:
         # unknown types are only warnings in system data lists: they use types of
         # $operate.dat, which lives on the controller and is not part of a backup
         self.soft_types = False
+        # set while declaring the types of an EXT/EXTFCT declaration
+        self.in_ext = False
+        # the workspace's record of unresolved names (krl/semantics/outside.py); None: report at once
+        self.unresolved = None
+        # evidence(path, line, kind) -> why installed software declares a name used there, or ""
+        self.evidence = lambda _path, _line, _kind: ""
         self._type_decls: dict[tuple[int, str], tuple[N.Decl, bool]] = {}
+
+    def unknown(self, kind: str, name: str, span: N.Span, evidence: str = "") -> None:
+        """An unresolved name of `kind` ('name', 'type', 'routine', 'sysvar') used at `span`:
+        recorded for the workspace's decision (krl/semantics/outside.py), or reported at once
+        when the declarer works without a workspace."""
+        if not evidence:
+            if self.soft_types:
+                evidence = "KUKA's system files use it"
+            else:
+                evidence = self.evidence(span.file, span.line, kind)
+        if self.unresolved is not None:
+            self.unresolved.use(kind, name, span.file, span.line, span.column, evidence)
+            return
+        from krl.semantics.outside import KINDS  # noqa: PLC0415
+        err, warn, _noun = KINDS[kind]
+        soft = evidence or kind == "sysvar" or self.maybe_declared(name)
+        msg = {"type": f"unknown type '{name}'", "routine": f"routine '{name}' is not declared",
+               "sysvar": f"unknown system variable '{name}'"}.get(kind, f"'{name}' is not declared")
+        self.sink.at(span, warn if soft else err, msg)
 
     def ident(self, name: str, span: N.Span) -> None:
         if len(name) > MAX_IDENT:
@@ -68,10 +92,8 @@ class Declarer:
         name = tref.name if isinstance(tref, N.TypeRef) else tref
         typ = scope.lookup_type(name)
         if typ is None:
-            if self.soft_types or self.maybe_declared(name):
-                self.sink.at(span, "W105", f"unknown type '{name}'")
-            else:
-                self.sink.at(span, "E105", f"unknown type '{name}'")
+            self.unknown("type", name, span, "an EXT declaration names it: the software that provides "
+                         "the external routine declares its types" if self.in_ext else "")
             typ = T.UNKNOWN
         if isinstance(tref, N.TypeRef) and tref.size is not None:
             typ = T.Array(typ, (tref.size,))
@@ -159,12 +181,16 @@ class Declarer:
             self.duplicate(sym.name, span, old)
 
     def ext_signature(self, scope: Scope, d: N.ExtDecl) -> RoutineSig:
-        ret = self.resolve_type(scope, d.return_type, d.span) if d.return_type is not None else None
-        params = []
-        for i, p in enumerate(d.params):
-            size = p.name_size if p.name_size is not None else p.type_size
-            typ = self.resolve_type(scope, p.type_name, p.span, (size,) if size is not None else ())
-            params.append(ParamSig(p.name or f"P{i + 1}", typ, p.mode))
+        self.in_ext = True
+        try:
+            ret = self.resolve_type(scope, d.return_type, d.span) if d.return_type is not None else None
+            params = []
+            for i, p in enumerate(d.params):
+                size = p.name_size if p.name_size is not None else p.type_size
+                typ = self.resolve_type(scope, p.type_name, p.span, (size,) if size is not None else ())
+                params.append(ParamSig(p.name or f"P{i + 1}", typ, p.mode))
+        finally:
+            self.in_ext = False
         return RoutineSig(d.name, ret, params)
 
     def routine_symbol(self, r: N.Routine, module: str, path: str, scope: Scope) -> Symbol:
@@ -218,9 +244,6 @@ class Checker:
         self.system_file = False
         # set while checking a .sub file: the submit interpreter has no motion (9, 8.2)
         self.submit = False
-
-    def _soft(self, sc: Scope, name: str) -> bool:
-        return self.system_file or self.decl.maybe_declared(name)
 
     # ---------------------------------------------------------------- entry points
 
@@ -552,8 +575,10 @@ class Checker:
                 self.sink.at(target.span, "E502", f"'{sym.name}' is a constant")
             elif sym.kind == "routine":
                 self.sink.at(target.span, "E503", f"'{sym.name}' is a routine, not a variable")
-            elif sym.access == "RO" and (sym.name.upper() in ("$IN", "$ANIN") or sym.kind == "signal"):
-                # real code writes input signals (possible with simulated I/O): a warning
+            elif sym.access == "RO" and sym.name.upper() in ("$IN", "$ANIN"):
+                self.sink.at(target.span, "E501", f"'{sym.name}' is an input; programs cannot write inputs (5.13)")
+            elif sym.access == "RO" and sym.kind == "signal":
+                # KUKA's own technology packages write SIGNAL names of inputs (simulated I/O): a warning
                 self.sink.at(target.span, "W501", f"'{sym.name}' is an input; programs can only write simulated inputs")
             elif sym.access == "RO":
                 self.sink.at(target.span, "E501", f"'{sym.name}' is write-protected")
@@ -835,8 +860,7 @@ class Checker:
             for a in c.args:
                 if a is not None:
                     self.expr(a, sc)
-            code = "W106" if self._soft(sc, c.name) else "E106"
-            self.sink.at(c.span, code, f"routine '{c.name}' is not declared")
+            self.unknown("routine", c.name, c.span)
             return T.UNKNOWN
         c.annotate().symbol = sym
         sig = sym.signature
@@ -844,6 +868,13 @@ class Checker:
             return T.UNKNOWN
         if not statement and not sig.is_function:
             self.sink.at(c.span, "E304", f"procedure '{c.name}' has no value")
+        elif (statement and sig.is_function and sig.returns is not T.UNKNOWN
+              and isinstance(sym.decl, (N.Routine, N.ExtDecl))):
+            # 2.4: a function is called only inside an expression. Only for functions the
+            # program declares: KUKA documents built-ins such as CAST_TO as statements, which
+            # the tables give a BOOL value
+            self.sink.at(c.span, "E304", f"function '{c.name}' called as a statement; use its value "
+                         f"(x = {c.name}(...))")
         if len(c.args) > len(sig.params) and not sig.varargs:
             self.sink.at(c.span, "E301", f"'{c.name}' takes {len(sig.params)} argument(s), {len(c.args)} given")
         for i, a in enumerate(c.args):
@@ -869,18 +900,15 @@ class Checker:
 
     # ---------------------------------------------------------------- helpers
 
+    def unknown(self, kind: str, name: str, span: N.Span) -> None:
+        """Record an unresolved name (krl/semantics/outside.py decides error or warning)."""
+        self.decl.unknown(kind, name, span, "KUKA's system files use it" if self.system_file else "")
+
     def not_found(self, span: N.Span, name: str, sc: Scope) -> None:
-        if name.startswith("$"):
-            self.sink.at(span, "W107", f"unknown system variable '{name}'")
-        elif self._soft(sc, name):
-            why = "system file" if self.system_file else "a file with syntax errors mentions it"
-            self.sink.at(span, "W101", f"'{name}' is not declared ({why})")
-        else:
-            self.sink.at(span, "E101", f"'{name}' is not declared")
+        self.unknown("sysvar" if name.startswith("$") else "name", name, span)
 
     def not_found_type(self, span: N.Span, name: str, sc: Scope) -> None:
-        code = "W105" if self._soft(sc, name) else "E105"
-        self.sink.at(span, code, f"unknown type '{name}'")
+        self.unknown("type", name, span)
 
 
 def _reads(e: N.Node | None) -> str | None:

@@ -80,3 +80,64 @@ def render_markdown(data: dict) -> str:
     for k in data["top_kinds"]:
         lines.append(f"| {k['code']} | {k['severity']} | {k['kind']} | {k['count']} |")
     return "\n".join(lines) + "\n"
+
+
+def known_invalid(repo_root: str | Path | None = None) -> set[str]:
+    """Corpus-relative paths listed in corpus/known-invalid.csv (files that are not valid KRL)."""
+    import csv  # noqa: PLC0415
+    root = Path(repo_root) if repo_root is not None else Path(__file__).resolve().parents[2]
+    try:
+        with open(root / "corpus" / "known-invalid.csv", encoding="utf-8") as fh:
+            return {row["path"] for row in csv.DictReader(fh)}
+    except OSError:
+        return set()
+
+
+def measure(corpus: str | Path) -> dict:
+    """`krl check` over every KRC backup below `corpus`, split by file validity: errors and
+    warnings by code on files that are not in corpus/known-invalid.csv ("valid") and on the
+    listed ones ("known_invalid"), and the error lines on valid files (path:line CODE message,
+    paths relative to `corpus`). The figure of issue 14; reproducible with
+    ``python -m krl.semantics.report ../shared/krl-corpus``."""
+    from krl.workspace import find_backups, load_workspace  # noqa: PLC0415
+
+    corpus = Path(corpus).resolve()
+    invalid = known_invalid()
+    out = {"backups": 0, "valid": {"errors": Counter(), "warnings": Counter()},
+           "known_invalid": {"errors": Counter(), "warnings": Counter()}, "valid_errors": []}
+    for b in find_backups(corpus):
+        out["backups"] += 1
+        for d in load_workspace([b], str(b)).check():
+            try:
+                rel = Path(d.path).resolve().relative_to(corpus).as_posix()
+            except ValueError:
+                rel = d.path
+            part = out["known_invalid" if rel in invalid else "valid"]
+            part["errors" if d.is_error else "warnings"][d.code] += 1
+            if d.is_error and rel not in invalid:
+                out["valid_errors"].append(f"{rel}:{d.line} {d.code} {d.message}")
+    return out
+
+
+def main(argv: list[str]) -> int:
+    import sys  # noqa: PLC0415
+    from krl.terminal import printable  # noqa: PLC0415
+
+    if len(argv) != 1 or not Path(argv[0]).is_dir():
+        print("usage: python -m krl.semantics.report CORPUS_FOLDER", file=sys.stderr)
+        return 2
+    m = measure(argv[0])
+    print(f"{m['backups']} KRC backups")
+    for part in ("valid", "known_invalid"):
+        for sev in ("errors", "warnings"):
+            c = m[part][sev]
+            codes = ", ".join(f"{k} {v}" for k, v in sorted(c.items()))
+            print(f"{part} files: {sum(c.values())} {sev}" + (f" ({codes})" if codes else ""))
+    for line in m["valid_errors"]:
+        print("  " + printable(line))
+    return 0
+
+
+if __name__ == "__main__":  # pragma: no cover
+    import sys
+    sys.exit(main(sys.argv[1:]))

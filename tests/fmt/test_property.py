@@ -1,6 +1,8 @@
 """krl fmt over generated programs: the printed AST (tests/frontend/strategies.py), scrambled
 (random blanks between tokens, random keyword case, indentation, trailing comments, blank
-lines, CRLF), must format to text that parses to the same AST and formats to itself."""
+lines, CRLF), must format to text that parses to the same AST and formats to itself. Data lists
+are generated as text (values, aggregates, signs, comments, inline-form folds) for the same
+properties, plus: compact KUKA style and the inline form's lines kept."""
 
 from __future__ import annotations
 
@@ -90,3 +92,75 @@ def test_format_keeps_the_ast_and_is_idempotent(module, seed, case):
     assert format_text(once, opts) == once, once
     # line ends are kept line by line
     assert once.count("\r\n") == messy.count("\r\n")
+
+
+# ------------------------------------------------------------------ data lists, written as text
+
+_SP = st.sampled_from(["", " ", "  ", "\t"])
+_SP1 = st.sampled_from([" ", "  ", "\t"])
+
+
+@st.composite
+def _number(draw):
+    sign = draw(st.sampled_from(["", "-", "+"]))
+    if draw(st.booleans()):
+        return sign + str(draw(st.integers(0, 99999)))
+    return sign + f"{draw(st.floats(0, 1e4, allow_nan=False)):.3f}"
+
+
+@st.composite
+def _value(draw):
+    kind = draw(st.sampled_from(["num", "agg", "bool", "str", "enum"]))
+    if kind == "num":
+        return draw(_number())
+    if kind == "bool":
+        return draw(st.sampled_from(["TRUE", "false"]))
+    if kind == "str":
+        return '"' + draw(st.text(st.characters(min_codepoint=32, max_codepoint=126,
+                                                blacklist_characters='"'), max_size=6)) + '"'
+    if kind == "enum":
+        return "#" + draw(st.sampled_from(["base", "TOOL", "x_1"]))
+    comps = draw(st.lists(st.sampled_from(["X", "y", "Z", "A", "S", "t"]), min_size=1, max_size=4, unique=True))
+    head = draw(st.sampled_from(["", "E6POS:", "FRAME :"]))
+    items = [c + draw(_SP1) + draw(_number()) for c in comps]
+    sep = draw(_SP) + "," + draw(_SP)
+    return "{" + draw(_SP) + head + draw(_SP) + sep.join(items) + draw(_SP) + "}"
+
+
+@st.composite
+def _data_line(draw):
+    kind = draw(st.sampled_from(["decl", "plain", "comment", "fold", "blank"]))
+    lead = draw(st.sampled_from(["", "  ", "   ", "\t"]))
+    name = draw(st.sampled_from(["xp1", "Counter", "gVal", "P_HOME"]))
+    if kind == "decl":
+        typ = draw(st.sampled_from(["E6POS", "frame", "INT", "MyStruc", "real"]))
+        glob = draw(st.sampled_from(["", "GLOBAL "]))
+        return f"{lead}DECL {glob}{typ} {name}{draw(_SP)}={draw(_SP)}{draw(_value())}"
+    if kind == "plain":
+        return f"{lead}int {name}{draw(_SP)}={draw(_SP)}{draw(_number())}"
+    if kind == "comment":
+        return f"{lead};  a  = {{X 1}} comment"
+    if kind == "fold":
+        return f"{lead};FOLD section;%{{PE}}\n DECL  INT   kept={draw(_number())}\n;ENDFOLD"
+    return lead
+
+
+@settings(max_examples=examples(40))
+@given(st.lists(_data_line(), max_size=8), st.sampled_from(["\n", "\r\n"]))
+def test_data_lists_keep_the_ast_and_are_idempotent(body, nl):
+    text = "\n".join(["DEFDAT  gen PUBLIC", *body, "ENDDAT", ""]).replace("\n", nl)
+    before = parse_text(text, "gen.dat")
+    assert before.ok, (text, [e.message for e in before.errors])
+    once = format_text(text)
+    after = parse_text(once, "gen.dat")
+    assert after.ok, once
+    a, b = build_module(before), build_module(after)
+    assert same_tree(a, b, fold_keywords=True), (first_difference(a, b, True), text, once)
+    assert format_text(once) == once, once
+    assert once.count("\r\n") == text.count("\r\n")
+    for ln in once.splitlines():
+        if ln.startswith("DECL") and "{" in ln:
+            code = ln.split('"')[0]
+            assert ", " not in code and " = " not in code    # data lists are written compact
+    kept = [ln for ln in text.split(nl) if "kept=" in ln]
+    assert all(ln in once.split(nl) for ln in kept)               # inline-form payload verbatim

@@ -125,6 +125,13 @@ def test_keywords_used_as_names_keep_their_case_and_enum_literals_too():
     assert fmt(src) == lines("DEF t()", "   LIN_REL {x 10} #tool", "   x = p.in", "   y = {in 1, out 2}", "END")
 
 
+def test_geometric_type_names_used_as_names_keep_their_case():
+    """FRAME, POS ... are type names, not keywords (1.6): as a variable they keep their case,
+    as the type of a declaration they are upper-cased like INT."""
+    src = lines("DEF t(frame :IN)", "decl frame frame", "frame pos", "pos = frame", "END")
+    assert fmt(src) == lines("DEF t(frame :IN)", "   DECL FRAME frame", "   FRAME pos", "   pos = frame", "END")
+
+
 # ------------------------------------------------------------------ spacing
 
 def test_operators_are_spaced_unary_minus_is_not():
@@ -182,8 +189,10 @@ def test_already_formatted_text_is_returned_unchanged():
 def test_unparsable_text_raises_with_a_place():
     with pytest.raises(FormatSyntaxError) as info:
         fmt(lines("DEF t()", "IF a THEN", "x = 1", "END"))
-    assert info.value.problems and info.value.problems[0].line >= 2
-    assert info.value.problems[0].code.startswith("E")
+    # the IF of line 2 is never closed: krl parse's E010 at the IF (docs/diagnostics.md)
+    first = info.value.problems[0]
+    assert (first.line, first.column, first.code) == (2, 1, "E010")
+    assert str(info.value).startswith("2:1: ")
 
 
 def test_bad_options_are_refused():

@@ -71,6 +71,9 @@ CASES = [
     ("E302", prog("BOOL ok", "ok = STRCLEAR(\"x\")"), prog("BOOL ok\nCHAR s[5]", "ok = STRCLEAR(s[])")),
     ("E303", prog("REAL r\nBOOL b", "r = SQRT(b)"), prog("REAL r\nINT i", "r = SQRT(i)")),
     ("E304", prog("INT i", "i = BAS(#INITMOV, 0)"), prog("", "BAS(#INITMOV, 0)")),
+    # 2.4: a function is called only inside an expression (found by the seeded-error suite)
+    ("E304", "DEF t()\n  REAL r\n  Half(2.0)\nEND\nDEFFCT REAL Half(x :IN)\n  REAL x\n  RETURN x / 2\nENDFCT\n",
+     "DEF t()\n  REAL r\n  r = Half(2.0)\nEND\nDEFFCT REAL Half(x :IN)\n  REAL x\n  RETURN x / 2\nENDFCT\n"),
     # control flow (5.5, 5.6, 5.10)
     ("E401", prog("", "GOTO nowhere"), prog("", "GOTO here\nhere:")),
     ("E402", prog("BOOL b", "GOTO inner\nIF b THEN\n  inner:\nENDIF"),
@@ -87,7 +90,10 @@ CASES = [
     # write protection (5.1, 7) and constants (2.5)
     ("E501", prog("", "$POS_ACT = $POS_ACT"), prog("", "$BASE = $NULLFRAME")),
     ("E501", prog("", "$MODE_OP = #T1"), prog("BOOL b", "b = $MODE_OP == #T1")),
-    ("W501", prog("", "$IN[3] = TRUE"), prog("", "$OUT[3] = TRUE")),
+    # inputs cannot be written by programs (5.1, 5.13): an error; a SIGNAL name of an input is
+    # written by KUKA's own technology packages (simulated I/O): a warning in user code
+    ("E501", prog("", "$IN[3] = TRUE"), prog("", "$OUT[3] = TRUE")),
+    ("E501", prog("REAL r", "$ANIN[1] = 0.5"), prog("REAL r", "r = $ANIN[1]")),
     ("E503", prog("INT i", "t = 1"), prog("INT i", "i = 1")),
     ("E502", prog("DECL CONST INT k = 3\nINT i", "k = 1"), prog("DECL CONST INT k = 3\nINT i", "i = k")),
     ("E201", prog("DECL CONST INT k = TRUE", ""), prog("DECL CONST INT k = 3", "")),

@@ -20,10 +20,10 @@ TABLE = yaml.safe_load((DATA_DIR / "kss.yaml").read_text(encoding="utf-8"))
 
 
 def test_every_entry_names_its_source():
-    for section in ("types", "variables", "routines", "packages"):
+    for section in ("types", "variables", "routines", "packages", "programs"):
         assert TABLE[section], section
         for key, info in TABLE[section].items():
-            assert re.fullmatch(r"[^:]+\.dat:\d+", info["source"], re.IGNORECASE), (section, key, info)
+            assert re.fullmatch(r"[^:]+\.(dat|src):\d+", info["source"], re.IGNORECASE), (section, key, info)
 
 
 @pytest.mark.corpus
@@ -58,3 +58,16 @@ def test_backup_declaration_wins_over_the_table():
     ws = check_texts({"$operate.dat": "DEFDAT $OPERATE PUBLIC\n  DECL BOOL $TORQ_DIFF2\nENDDAT\n",
                       "t.src": "DEF t()\n  REAL r\n  r = $TORQ_DIFF2[1]\nEND\n"})
     assert [d.code for d in ws.diagnostics] == ["E109"]   # BOOL there, not an array
+
+
+def test_hook_programs_are_kuka_files_and_their_routines_known():
+    """masref_user.src under R1/Program is KUKA's hook program: System/masref_main.src calls its
+    GLOBAL routines. The table records the file and the routines, each with its source."""
+    from krl.workspace import is_kuka_file
+    b = load_builtins()
+    assert b.packages["MASREFSTARTG1"][0] == "KSS hook program masref_user.src"
+    assert "masref_user.src:8" in b.packages["MASREFSTARTG1"][1]
+    assert "masref_main.src" in TABLE["programs"]["MASREF_USER.SRC"]["called_from"]
+    assert is_kuka_file("KRC/R1/Program/masref_user.src")
+    assert not is_kuka_file("KRC/R1/Program/my_masref_user.src")
+    assert not is_kuka_file("KRC/R1/masref_user.src")

@@ -108,9 +108,17 @@ def test_module_given_as_src_and_dat_is_checked_once(tmp_path):
 
 
 def test_one_diagnostic_per_code_name_and_line():
-    """An unknown type in every parameter of one EXT line is one E105, not one per use."""
+    """An unknown type for every name of one DECL line is one E105, not one per name; in
+    every parameter of EXT lines of several files it is one W105 for the backup (the
+    software that provides the external routine declares its types)."""
     from krl.workspace import check_texts
     ws = check_texts({"m.src": "DEF m()\nEND\n",
-                      "m.dat": "DEFDAT m\n  EXT Foo(NOTYPE :IN, NOTYPE :IN, NOTYPE :OUT)\nENDDAT\n"})
+                      "m.dat": "DEFDAT m\n  DECL NOTYPE a, b, c\nENDDAT\n"})
     found = [(d.line, d.code) for d in ws.diagnostics if "NOTYPE" in d.message]
     assert found == [(2, "E105")], found
+    ext = "  EXT Foo(PKGTYPE :IN, PKGTYPE :IN, PKGTYPE :OUT)\n"
+    ws = check_texts({"m.src": "DEF m()\nEND\n", "m.dat": f"DEFDAT m\n{ext}ENDDAT\n",
+                      "n.src": "DEF n()\nEND\n", "n.dat": f"DEFDAT n\n\n{ext}ENDDAT\n"})
+    found = [(d.path, d.line, d.code) for d in ws.diagnostics if "PKGTYPE" in d.message]
+    assert found == [("m.dat", 2, "W105")], found
+    assert "used 6 times in 2 files" in ws.diagnostics[0].message

@@ -1,0 +1,144 @@
+"""Running the scan on a Dask distributed cluster (``krl recover CORPUS --scheduler tcp://HOST:8786``).
+
+The scan is the same wherever it runs. The client walks the corpus and reads each file once
+(recovery/scan.py); this module ships batches of ``(relative path, bytes, sha)`` to the
+cluster's workers, which parse them with the same function as the local pool
+(:func:`recovery.scan.scan_bytes`) and send back picklable rows. Workers need the project
+installed (the same version, with its generated parser) but no access to the corpus folder:
+nothing on a worker opens a path named by the corpus.
+
+:func:`run_batches` keeps the contract of :func:`krl.pool.run_tasks`: one
+:class:`krl.pool.Outcome` per task, in completion order, with a bounded number of batches in
+flight (so the bytes of a large corpus are never all in memory at once). The per-file timeout
+becomes a per-batch deadline (``timeout`` x files in the batch, plus the transfer allowance):
+a batch past it gives each of its files a ``timeout`` row; its worker thread cannot be killed
+from here, which is why the local pool (killable processes) stays the default.
+
+Dask is imported only when a scheduler address is given.
+
+Errors: :class:`SchedulerError` when the scheduler cannot be reached (within Dask's connect
+timeout, 30 s by default) or the address is malformed: a clear message naming the address,
+never a traceback from the command.
+"""
+
+from __future__ import annotations
+
+import uuid
+from collections.abc import Callable, Hashable, Iterable, Iterator
+from typing import Any
+
+from krl.pool import Outcome
+
+#: Files per task sent to a worker: big enough that the scheduler's per-task cost (about a
+#: millisecond) is small against the parses, small enough that a slow batch does not hold the tail.
+DEFAULT_BATCH_FILES = 16
+#: Batches in flight per worker thread of the cluster (bounds the client's memory).
+IN_FLIGHT_PER_THREAD = 4
+#: Seconds added to each batch's deadline for transfer and scheduling.
+TRANSFER_ALLOWANCE_S = 60.0
+
+
+class SchedulerError(RuntimeError):
+    """The Dask scheduler could not be used (address unreachable, cluster without workers)."""
+
+
+def _run_batch(fn: Callable[..., Any], batch: list[tuple[Hashable, tuple]],
+               init: Callable[..., None] | None, initargs: tuple) -> list[tuple[Hashable, str, Any, str]]:
+    """On a worker: ``fn(*args)`` for each task of the batch; an exception fails only its task."""
+    if init is not None:
+        init(*initargs)
+    out = []
+    for key, args in batch:
+        try:
+            out.append((key, "done", fn(*args), ""))
+        except Exception as exc:  # noqa: BLE001 - one bad file never fails its batch
+            out.append((key, "internal_error", None, f"{type(exc).__name__}: {exc}"))
+    return out
+
+
+def _batches(tasks: Iterable[tuple[Hashable, tuple]], size: int) -> Iterator[list[tuple[Hashable, tuple]]]:
+    batch: list = []
+    for task in tasks:
+        batch.append(task)
+        if len(batch) >= size:
+            yield batch
+            batch = []
+    if batch:
+        yield batch
+
+
+def run_batches(address: str, fn: Callable[..., Any], tasks: Iterable[tuple[Hashable, tuple]], *,
+                timeout: float | None = None, initializer: Callable[..., None] | None = None,
+                initargs: tuple = (), batch_files: int = DEFAULT_BATCH_FILES,
+                connect_s: float | None = None) -> Iterator[Outcome]:
+    """Run ``fn(*args)`` for every ``(key, args)`` of `tasks` on the cluster at `address`
+    (``tcp://HOST:PORT``), in batches of `batch_files`; yield one Outcome per task as batches
+    finish. `fn` and `initializer` must be importable module-level functions on the workers.
+    `timeout`: seconds per file (None: no deadline). `connect_s`: seconds to reach the
+    scheduler (None: Dask's ``distributed.comm.timeouts.connect``, 30 s unless configured).
+    Raises SchedulerError."""
+    try:
+        from distributed import Client, wait  # noqa: PLC0415
+    except ImportError as exc:  # pragma: no cover - dask.distributed is a dependency
+        raise SchedulerError(f"dask.distributed is not installed: {exc}") from exc
+    if batch_files < 1:
+        raise ValueError("batch_files must be at least 1")
+    try:
+        kw = {} if connect_s is None else {"timeout": connect_s}
+        client = Client(address, set_as_default=False, **kw)
+    except (OSError, TimeoutError, ValueError) as exc:
+        raise SchedulerError(f"cannot reach the Dask scheduler at {address}: {exc}") from exc
+    run = uuid.uuid4().hex[:12]
+    try:
+        threads = sum(client.nthreads().values())
+        if threads == 0:
+            raise SchedulerError(f"the Dask cluster at {address} has no workers")
+        limit = max(2, threads * IN_FLIGHT_PER_THREAD)
+        in_flight: dict[Any, list[tuple[Hashable, tuple]]] = {}
+        source = _batches(tasks, batch_files)
+        n = 0
+
+        def submit() -> bool:
+            nonlocal n
+            batch = next(source, None)
+            if batch is None:
+                return False
+            fut = client.submit(_run_batch, fn, batch, initializer, initargs, pure=False,
+                                key=f"krl-scan-{run}-{n}")
+            n += 1
+            in_flight[fut] = batch
+            return True
+
+        while len(in_flight) < limit and submit():
+            pass
+        while in_flight:
+            deadline = None if timeout is None else timeout * batch_files + TRANSFER_ALLOWANCE_S
+            try:
+                with client.as_current():
+                    done, _ = wait(list(in_flight), timeout=deadline, return_when="FIRST_COMPLETED")
+            except TimeoutError:
+                done = set()
+            if not done:   # nothing finished within a whole batch's deadline: give up on them
+                for fut, batch in in_flight.items():
+                    fut.cancel()
+                    for key, _args in batch:
+                        yield Outcome(key, "timeout", detail=f"the batch on the Dask cluster took longer "
+                                                             f"than {deadline:g} s")
+                in_flight.clear()
+                while len(in_flight) < limit and submit():
+                    pass
+                continue
+            for fut in done:
+                batch = in_flight.pop(fut)
+                if fut.status == "finished":
+                    for key, status, value, detail in fut.result():
+                        yield Outcome(key, status, value, detail)
+                else:
+                    detail = f"the Dask worker failed: {fut.exception()!r}" if fut.status == "error" \
+                        else f"the Dask task ended as {fut.status}"
+                    for key, _args in batch:
+                        yield Outcome(key, "internal_error", detail=detail)
+            while len(in_flight) < limit and submit():
+                pass
+    finally:
+        client.close()

@@ -1,0 +1,168 @@
+"""Names the backup cannot know (krl/semantics/outside.py, docs/diagnostics.md).
+
+Small synthetic KRC backups (R1/System/$config.dat, R1/Program/...) written to tmp_path: a name
+that only installed software can declare is one warning per backup, saying where it is first
+used and how often; a name that nothing explains stays an error at every line that uses it.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from krl.semantics.outside import template_lines
+from krl.workspace import find_backups, load_workspace
+
+CONFIG = "DEFDAT $CONFIG\n  DECL INT CELL_NO = 1\nENDDAT\n"
+
+# KUKA's program template with a technology package's INI fold (as the spot template writes it)
+TEMPLATE = """\
+&ACCESS RVP
+DEF {name}( )
+;FOLD INI;%{{PE}}
+  ;FOLD BASISTECH INI
+    BAS (#INITMOV,0 )
+  ;ENDFOLD (BASISTECH INI)
+  ;FOLD ARCTECH INI
+    ARC_INIT_DONE = FALSE
+    ArcInit(ARC_DEFAULT)
+  ;ENDFOLD (ARCTECH INI)
+  ;FOLD USER INI
+    ;Make your modifications here
+{user_ini}
+  ;ENDFOLD (USER INI)
+;ENDFOLD (INI)
+{body}
+END
+"""
+
+
+def backup(tmp_path: Path, files: dict[str, str]) -> Path:
+    root = tmp_path / "KRC"
+    (root / "R1" / "System").mkdir(parents=True)
+    (root / "R1" / "Program").mkdir(parents=True)
+    (root / "R1" / "System" / "$config.dat").write_text(CONFIG)
+    for rel, text in files.items():
+        p = root / "R1" / rel
+        p.parent.mkdir(parents=True, exist_ok=True)
+        p.write_text(text.replace("\n", "\r\n"))
+    assert find_backups(tmp_path) == [root]
+    return root
+
+
+def diags(root: Path):
+    ws = load_workspace([root], str(root))
+    return [(Path(d.path).relative_to(root / "R1").as_posix(), d.line, d.code, d.message) for d in ws.check()]
+
+
+def test_template_fold_name_is_one_warning_for_the_backup(tmp_path):
+    """ARC_INIT_DONE and ArcInit are used in the ARCTECH INI fold of two programs and once more
+    in user code: one W101 and one W106 for the backup, at the first use, with the counts."""
+    root = backup(tmp_path, {
+        "Program/a.src": TEMPLATE.format(name="a", user_ini="", body="  IF ARC_INIT_DONE THEN\n  ENDIF"),
+        "Program/b.src": TEMPLATE.format(name="b", user_ini="", body=""),
+    })
+    got = diags(root)
+    assert [(p, ln, c) for p, ln, c, _m in got] == [
+        ("Program/a.src", 8, "W101"), ("Program/a.src", 9, "W106"), ("Program/a.src", 9, "W101")], got
+    by_code = {c: m for _p, _ln, c, m in got if c == "W106"}
+    assert "ArcInit" in by_code["W106"] and "used 2 times in 2 files" in by_code["W106"]
+    w101 = [m for _p, _ln, c, m in got if c == "W101" and "ARC_INIT_DONE" in m]
+    assert len(w101) == 1 and "used 3 times in 2 files" in w101[0] and "INI fold" in w101[0]
+
+
+def test_misspelled_variable_in_user_code_is_an_error_at_its_line(tmp_path):
+    """The same template, a user variable declared in the data list and misspelled in the
+    USER INI fold and in the body: E101 at both lines, no warning."""
+    root = backup(tmp_path, {
+        "Program/a.src": TEMPLATE.format(name="a", user_ini="    nCount = 0",
+                                         body="  nCuont = nCount + 1"),
+        "Program/a.dat": "DEFDAT a\n  DECL INT nCount = 0\n  DECL BOOL ARC_INIT_DONE\n"
+                         "  EXT ArcInit(INT :IN)\n  DECL INT ARC_DEFAULT = 1\nENDDAT\n",
+    })
+    got = diags(root)
+    assert [(p, ln, c) for p, ln, c, _m in got] == [("Program/a.src", 16, "E101")], got
+    assert "'nCuont' is not declared" in got[0][3]
+    root2 = backup(tmp_path / "second", {
+        "Program/a.src": TEMPLATE.format(name="a", user_ini="    nCuont = 0", body="  nCuont = 1"),
+        "Program/a.dat": "DEFDAT a\n  DECL BOOL ARC_INIT_DONE\n  EXT ArcInit(INT :IN)\n"
+                         "  DECL INT ARC_DEFAULT = 1\nENDDAT\n",
+    })
+    got = diags(root2)
+    assert [(p, ln, c) for p, ln, c, _m in got] == [("Program/a.src", 13, "E101"), ("Program/a.src", 16, "E101")]
+
+
+def test_package_name_from_the_table_names_its_package(tmp_path):
+    """DI_gbSpindleClamp is a GLOBAL signal of KUKA's milling package (kss.yaml packages,
+    R2M_SpindleVariables.dat:152). A backup without the package's files uses it in user code:
+    one warning naming the package and its source."""
+    root = backup(tmp_path, {"Program/m.src": "DEF m()\n  BOOL b\n  b = DI_gbSpindleClamp\n"
+                                              "  WAIT FOR DI_gbSpindleClamp\nEND\n"})
+    got = diags(root)
+    assert [(p, ln, c) for p, ln, c, _m in got] == [("Program/m.src", 3, "W101")], got
+    assert "Milling" in got[0][3] and "R2M_SpindleVariables.dat:152" in got[0][3]
+    assert "used 2 times;" in got[0][3]
+
+
+def test_system_file_routine_once_per_name(tmp_path):
+    """A routine called from KUKA's system files (masref_main.src calls MasRefStartG1 of
+    masref_user.src, which the backup lacks): one W106, however often it is called."""
+    calls = "\n".join(["  MasRefStartG1()"] * 3)
+    root = backup(tmp_path, {"System/masref_main.src": f"DEF masref_main()\n{calls}\nEND\n"})
+    got = diags(root)
+    assert [(p, ln, c) for p, ln, c, _m in got] == [("System/masref_main.src", 2, "W106")], got
+    assert "used 3 times;" in got[0][3]
+
+
+def test_unknown_type_has_one_severity_in_user_and_system_files(tmp_path):
+    """A type that KUKA's system files use without declaring (controller-side) has the
+    same severity in a user program: one W105 for the backup, not E105 here and W105 there."""
+    root = backup(tmp_path, {
+        "System/tech.src": "DEF tech()\n  DECL TECH_STATE_T s\nEND\n",
+        "Program/p.src": "DEF p()\n  DECL TECH_STATE_T mine\nEND\n",
+    })
+    got = diags(root)
+    assert [(p, ln, c) for p, ln, c, _m in got] == [("Program/p.src", 2, "W105")], got
+    assert "used 2 times in 2 files" in got[0][3]
+    # and with no system file using it, it is the program's error in user code
+    root2 = backup(tmp_path / "second", {"Program/p.src": "DEF p()\n  DECL TECH_STATE_T mine\nEND\n"})
+    assert [(p, ln, c) for p, ln, c, _m in diags(root2)] == [("Program/p.src", 2, "E105")]
+
+
+def test_unknown_system_variable_is_one_warning_per_backup(tmp_path):
+    body = "\n".join([f"  r = $NO_SUCH_SYSVAR + {i}" for i in range(4)])
+    root = backup(tmp_path, {"Program/p.src": f"DEF p()\n  REAL r\n{body}\nEND\n"})
+    got = diags(root)
+    assert [(p, ln, c) for p, ln, c, _m in got] == [("Program/p.src", 3, "W107")], got
+
+
+def test_inline_form_routine_is_outside_but_not_its_points(tmp_path):
+    """A KUKA inline form (;FOLD ... ;%{PE}) calls a package routine: a warning. The point it
+    moves to belongs to the program's data list: missing, it is an error."""
+    src = ("DEF p()\n;FOLD SPINDLE ON ;%{PE}%MKUKATPUSER\n  SpindleOn(#CW)\n;ENDFOLD\n"
+           ";FOLD PTP P1 Vel=100 % PDAT1 ;%{PE}\n  PTP XP1\n;ENDFOLD\nEND\n")
+    root = backup(tmp_path, {"Program/p.src": src})
+    got = diags(root)
+    assert [(p, ln, c) for p, ln, c, _m in got] == [("Program/p.src", 3, "W106"), ("Program/p.src", 6, "E101")]
+
+
+def test_template_lines():
+    text = TEMPLATE.format(name="a", user_ini="    x = 1", body="  y = 2")
+    ini, inline = template_lines(text)
+    lines = text.splitlines()
+    assert {lines[i - 1].strip() for i in ini} >= {"BAS (#INITMOV,0 )", "ArcInit(ARC_DEFAULT)"}
+    assert "x = 1" not in {lines[i - 1].strip() for i in ini}
+    assert "y = 2" not in {lines[i - 1].strip() for i in ini | inline}
+
+
+def test_hook_program_routine_names_its_program(tmp_path):
+    """A backup whose masref_user.src is missing: the system file's calls of MasRefStartG1 are one
+    W106 naming KUKA's hook program; inside a hook program under R1/Program an unknown routine is
+    KUKA's too, in a user program of the same name elsewhere it is an error."""
+    root = backup(tmp_path, {"System/masref_main.src": "DEF masref_main()\n  MasRefStartG1()\nEND\n",
+                             "Program/CollDetect_UserAction.src": "DEF CollDetect_UserAction()\n  HookHelper()\nEND\n",
+                             "Program/Cell/mine.src": "DEF mine()\n  OtherHelper()\nEND\n"})
+    got = diags(root)
+    assert [(p, ln, c) for p, ln, c, _m in got] == [
+        ("Program/Cell/mine.src", 2, "E106"), ("Program/CollDetect_UserAction.src", 2, "W106"),
+        ("System/masref_main.src", 2, "W106")], got
+    assert "hook program masref_user.src" in got[2][3]
