@@ -29,6 +29,11 @@ SCHEMA: dict[str, list[tuple[str, str]]] = {
         ("point", "optional list[6] float: programmed end point, TCP X,Y,Z mm, A,B,C deg in $BASE"),
         ("line", "optional int: source line of the motion statement"),
         ("file", "optional str: source file of the motion statement"),
+        ("reason", "optional str: on phase end: abort (the motion was abandoned: RESUME, "
+                   "an error or a reset discarded it before its end point)"),
+        ("limits", "optional dict on phase start: the limits the motion is planned within "
+                   "(robot/limits.py): path (TCP mm/s or null), axes (6 deg/s), flange (mm/s "
+                   "or null, T1), tool and base (X..C mm/deg)"),
     ],
     "io": [
         ("signal", "str: e.g. $OUT[3], $IN[5], $ANOUT[1], $ANIN[2]"),

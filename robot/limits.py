@@ -1,0 +1,306 @@
+"""The limits a motion must respect, and a checker that measures them on a trace (issue 15).
+
+Two halves that share one definition:
+
+* :func:`motion_limits` — the programmed and machine limits of one motion (reference §6.6,
+  §6.7, §7.5; robot-model.md §5, §10): TCP path speed ``$VEL.CP · $OV_PRO%`` for CP motions
+  (the largest ``WITH $VEL.CP`` of a SPLINE block), axis speeds ``$VEL_AXIS[i]% · $OV_PRO% ·
+  v_max_i`` for PTP/SPTP and ``v_max_i`` for CP motions, axis accelerations ``a_max_i``; in
+  T1 additionally TCP and flange ≤ 250 mm/s and PTP axis speeds ``· $RED_T1%``. The planner
+  plans within these numbers; the controller writes them into the ``start`` event of every
+  motion (trace field ``limits``).
+* :func:`check_trace` — measures the ``pose`` events of a trace by finite differences (TCP
+  path speed from the axes through the forward kinematics with the motion's ``$TOOL`` and
+  ``$BASE``; flange speed in T1; axis speeds; axis accelerations by the second difference)
+  and returns every sample above its limit by more than the tolerance (3 % for speeds, 10 %
+  for accelerations, issue 15). In an approximation window the larger limit of the two
+  motions applies. Stops that are not planned (a motion error, RESUME without BRAKE) are
+  excluded from the acceleration check: they are fault stops, not planned motion.
+
+Units: mm, deg, s (speeds mm/s and deg/s, accelerations deg/s²).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+#: T1 speed limit of the TCP and the flange (reference §6.7 [C], §7.5), mm/s.
+T1_SPEED_MM_S = 250.0
+#: ``$RED_T1`` (%) when the machine data do not give it (robot-model.md §10, KR6 $machine.dat).
+RED_T1_DEFAULT_PCT = 7.0
+#: Operating modes (enum MODE_OP, reference §7.5); the CLI spells ``#EX`` as ``EXT``.
+MODES = ("T1", "T2", "AUT", "EX")
+#: The mode of the unattended virtual controller (docs/robot.md, "Operating modes").
+DEFAULT_MODE = "AUT"
+#: Tolerances of the checker (issue 15): speeds 3 %, accelerations estimated by finite
+#: differences 10 %.
+TOL_SPEED = 0.03
+TOL_ACC = 0.10
+
+
+def normalise_mode(mode: str | None) -> str:
+    """``T1``/``T2``/``AUT``/``EX`` from a CLI or enum spelling (``EXT``, ``#ex``, ...).
+    None gives :data:`DEFAULT_MODE`. Raises ValueError for anything else."""
+    if mode is None:
+        return DEFAULT_MODE
+    m = str(mode).strip().lstrip("#").upper()
+    if m == "EXT":
+        m = "EX"
+    if m not in MODES:
+        raise ValueError(f"unknown operating mode {mode!r} (T1, T2, AUT or EXT)")
+    return m
+
+
+def red_t1_pct(machine: Any) -> float:
+    """``$RED_T1`` in % from the machine data yaml (key ``machine_data_kinematics.red_t1_pct``),
+    else robot-model.md's KR6 value 7 %."""
+    raw = getattr(machine, "raw", None) or {}
+    v = (raw.get("machine_data_kinematics") or {}).get("red_t1_pct")
+    return float(v) if v is not None else RED_T1_DEFAULT_PCT
+
+
+@dataclass(frozen=True)
+class MotionLimits:
+    """Limits of one motion.
+
+    Attributes:
+        path: TCP path speed limit (mm/s) or None (PTP outside T1).
+        axes: axis speed limits A1..A6 (deg/s).
+        flange: flange speed limit (mm/s) or None (only T1 has one).
+        tool, base: the motion's ``$TOOL``/``$BASE`` (X, Y, Z, A, B, C), mm/deg, the frames
+            the path speed is measured in.
+    """
+
+    path: float | None
+    axes: tuple[float, ...]
+    flange: float | None = None
+    tool: tuple[float, ...] = (0.0,) * 6
+    base: tuple[float, ...] = (0.0,) * 6
+
+    def as_trace(self) -> dict[str, Any]:
+        """The ``limits`` field of a motion ``start`` trace event."""
+        return {"path": self.path, "axes": list(self.axes), "flange": self.flange,
+                "tool": list(self.tool), "base": list(self.base)}
+
+    @staticmethod
+    def from_trace(d: dict[str, Any]) -> "MotionLimits":
+        return MotionLimits(d.get("path"), tuple(float(v) for v in d["axes"]), d.get("flange"),
+                            tuple(float(v) for v in d.get("tool") or (0.0,) * 6),
+                            tuple(float(v) for v in d.get("base") or (0.0,) * 6))
+
+
+def motion_limits(req: Any, machine: Any, mode: str = DEFAULT_MODE) -> MotionLimits:
+    """The limits of a :class:`~robot.motion.MotionRequest` (see the module docstring).
+
+    PTP/SPTP: axes ``v_max_i · $VEL_AXIS[i]% · $OV_PRO%`` (``· $RED_T1%`` in T1), no path
+    limit outside T1. CP: path ``$VEL.CP · 1000 · $OV_PRO%`` mm/s (a SPLINE block: the largest
+    over its segments), axes ``v_max_i``. T1: path and flange ``<= 250 mm/s``."""
+    p = req.params
+    v_max = np.asarray(machine.max_speed_deg_s, dtype=float)
+    if req.kind in ("PTP", "SPTP"):
+        axes = v_max * np.asarray(p.vel_axis, dtype=float) / 100.0 * p.ov_pro / 100.0
+        if mode == "T1":
+            axes = axes * red_t1_pct(machine) / 100.0
+        path: float | None = None
+    else:
+        vs = [p.vel_cp] + [s.params.vel_cp for s in getattr(req, "segments", ()) if s.params]
+        ovs = [p.ov_pro] + [s.params.ov_pro for s in getattr(req, "segments", ()) if s.params]
+        path = max(v * 1000.0 * o / 100.0 for v, o in zip(vs, ovs))
+        axes = v_max
+    flange = None
+    if mode == "T1":
+        path = T1_SPEED_MM_S if path is None else min(path, T1_SPEED_MM_S)
+        flange = T1_SPEED_MM_S
+    return MotionLimits(path, tuple(float(v) for v in axes), flange,
+                        tuple(float(v) for v in p.tool), tuple(float(v) for v in p.base))
+
+
+# ----------------------------------------------------------------------------- checker
+@dataclass(frozen=True)
+class Violation:
+    """One sample above its limit: ``what`` is ``path`` (TCP mm/s), ``flange`` (mm/s),
+    ``axis_speed`` (deg/s) or ``axis_acc`` (deg/s²); ``axis`` 1..6 for the axis checks;
+    ``t`` the time (s) of the later pose of the sample; ``motion`` the newest active id."""
+
+    what: str
+    t: float
+    value: float
+    limit: float
+    axis: int | None = None
+    motion: int | None = None
+
+    @property
+    def ratio(self) -> float:
+        return self.value / self.limit if self.limit > 0 else math.inf
+
+    def __str__(self) -> str:
+        ax = f" A{self.axis}" if self.axis else ""
+        return (f"t={self.t:.3f} s motion {self.motion}: {self.what}{ax} {self.value:.1f} > "
+                f"{self.limit:.1f} ({100 * self.ratio:.0f} %)")
+
+
+@dataclass
+class LimitReport:
+    """Result of :func:`check_trace`: the violations and the largest ratios measured
+    (value / limit) for path speed, flange speed, axis speed and axis acceleration."""
+
+    violations: list[Violation] = field(default_factory=list)
+    path_ratio: float = 0.0
+    flange_ratio: float = 0.0
+    axis_speed_ratio: float = 0.0
+    axis_acc_ratio: float = 0.0
+    samples: int = 0
+
+    @property
+    def ok(self) -> bool:
+        return not self.violations
+
+    def summary(self) -> str:
+        return (f"path {100 * self.path_ratio:.1f} %, axis speed {100 * self.axis_speed_ratio:.1f} %, "
+                f"axis acc {100 * self.axis_acc_ratio:.1f} %, flange {100 * self.flange_ratio:.1f} % "
+                f"of the limits over {self.samples} poses; {len(self.violations)} violations")
+
+
+def _frame(f: Iterable[float]) -> np.ndarray:
+    from .frames import frame_to_matrix
+    return frame_to_matrix(*[float(v) for v in f])
+
+
+def check_trace(events: Iterable[dict[str, Any]], machine: Any = None, *,
+                limits: dict[int, MotionLimits] | None = None,
+                tol_speed: float = TOL_SPEED, tol_acc: float = TOL_ACC,
+                max_violations: int = 50) -> LimitReport:
+    """Check the ``pose`` events of a trace against the motions' limits.
+
+    Args:
+        events: trace event dicts (:func:`robot.trace.read_trace`).
+        machine: machine data (default :func:`robot.machine.load_machine`): axis maxima,
+            kinematics for the TCP/flange speed.
+        limits: motion id -> :class:`MotionLimits`; default: the ``limits`` fields of the
+            trace's motion ``start`` events (motions without one are checked against the
+            machine axis maxima only).
+        tol_speed, tol_acc: relative tolerances (3 %, 10 %).
+        max_violations: at most this many violations are listed (the ratios cover all).
+
+    Returns a :class:`LimitReport`. Speeds of a sample (k-1, k] are checked against the
+    largest limit of the motions active in it (both motions of an approximation window);
+    accelerations over (k-2, k] against ``a_max_i``, except across a fault stop (an
+    ``error`` event or a motion ended with ``reason`` ``abort``)."""
+    from .kinematics import Kinematics
+    from .machine import load_machine
+
+    machine = machine if machine is not None else load_machine()
+    v_max = np.asarray(machine.max_speed_deg_s, dtype=float)
+    a_max = np.asarray(machine.max_acc_deg_s2, dtype=float)
+    lim: dict[int, MotionLimits] = dict(limits or {})
+    ts: list[float] = []
+    qs: list[list[float]] = []
+    span: dict[int, list[float]] = {}       # id -> [start, end]
+    faults: list[float] = []
+    for ev in events:
+        k = ev.get("kind")
+        if k == "pose":
+            ts.append(float(ev["t"]))
+            qs.append(ev["axes"])
+        elif k == "motion":
+            mid = int(ev["id"])
+            ph = ev.get("phase")
+            if ph == "start":
+                span[mid] = [float(ev["t"]), math.inf]
+                if mid not in lim and ev.get("limits"):
+                    lim[mid] = MotionLimits.from_trace(ev["limits"])
+            elif ph == "end" and mid in span:
+                span[mid][1] = float(ev["t"])
+                if ev.get("reason") == "abort":
+                    faults.append(float(ev["t"]))
+        elif k == "error":
+            faults.append(float(ev["t"]))
+            for s in span.values():
+                if s[1] == math.inf:
+                    s[1] = float(ev["t"])
+    rep = LimitReport(samples=len(ts))
+    n = len(ts)
+    if n < 2:
+        return rep
+    T = np.asarray(ts)
+    Q = np.asarray(qs, dtype=float)
+    kin = Kinematics(machine)
+    F = kin.forward_many(Q)
+    from .frames import frame_to_matrix, inv_pos
+    robroot = frame_to_matrix(*machine.robroot_frame)
+    F = robroot @ F
+    ids = sorted(span, key=lambda m: (span[m][0], m))
+    starts = np.array([span[m][0] for m in ids]) if ids else np.zeros(0)
+    ends = np.array([span[m][1] for m in ids]) if ids else np.zeros(0)
+    frames_cache: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+
+    def frames_of(mid: int) -> tuple[np.ndarray, np.ndarray]:
+        if mid not in frames_cache:
+            ml = lim.get(mid)
+            tool = _frame(ml.tool) if ml else np.eye(4)
+            base = _frame(ml.base) if ml else np.eye(4)
+            frames_cache[mid] = (tool, inv_pos(base))
+        return frames_cache[mid]
+
+    def add(v: Violation) -> None:
+        if len(rep.violations) < max_violations:
+            rep.violations.append(v)
+
+    fault_arr = np.asarray(sorted(faults))
+    prev_v: np.ndarray | None = None
+    for k in range(1, n):
+        dt = T[k] - T[k - 1]
+        if dt <= 0:
+            prev_v = None
+            continue
+        t0, t1 = T[k - 1], T[k]
+        act = [ids[j] for j in np.nonzero((starts <= t1 + 1e-9) & (ends >= t0 - 1e-9))[0]] \
+            if ids else []
+        newest = act[-1] if act else None
+        ax_lim = np.max([lim[m].axes for m in act if m in lim], axis=0) \
+            if any(m in lim for m in act) else v_max
+        v = (Q[k] - Q[k - 1]) / dt
+        r = np.abs(v) / ax_lim
+        rep.axis_speed_ratio = max(rep.axis_speed_ratio, float(r.max()))
+        if r.max() > 1.0 + tol_speed:
+            i = int(np.argmax(r))
+            add(Violation("axis_speed", float(t1), float(abs(v[i])), float(ax_lim[i]), i + 1, newest))
+        if newest is not None and any(m in lim for m in act):
+            paths = [lim[m].path for m in act if m in lim]
+            p_lim = None if any(p is None for p in paths) else max(paths)  # type: ignore[type-var]
+            fl = [lim[m].flange for m in act if m in lim]
+            f_lim = None if any(f is None for f in fl) else max(fl)  # type: ignore[type-var]
+            if p_lim is not None:
+                tool, binv = frames_of(newest)
+                a = (binv @ F[k - 1] @ tool)[:3, 3]
+                b = (binv @ F[k] @ tool)[:3, 3]
+                sp = float(np.linalg.norm(b - a)) / dt
+                rep.path_ratio = max(rep.path_ratio, sp / p_lim)
+                if sp > p_lim * (1.0 + tol_speed):
+                    add(Violation("path", float(t1), sp, float(p_lim), None, newest))
+            if f_lim is not None:
+                sp = float(np.linalg.norm(F[k][:3, 3] - F[k - 1][:3, 3])) / dt
+                rep.flange_ratio = max(rep.flange_ratio, sp / f_lim)
+                if sp > f_lim * (1.0 + tol_speed):
+                    add(Violation("flange", float(t1), sp, float(f_lim), None, newest))
+        if prev_v is not None and k >= 2:
+            fault = fault_arr.size and bool(np.any((fault_arr > T[k - 2] - 1e-9) & (fault_arr <= t1 + 1e-9)))
+            if not fault:
+                acc = (v - prev_v) / (0.5 * (T[k] - T[k - 2]))
+                ra = np.abs(acc) / a_max
+                rep.axis_acc_ratio = max(rep.axis_acc_ratio, float(ra.max()))
+                if ra.max() > 1.0 + tol_acc:
+                    i = int(np.argmax(ra))
+                    add(Violation("axis_acc", float(t1), float(abs(acc[i])), float(a_max[i]), i + 1, newest))
+        prev_v = v
+    return rep
+
+
+__all__ = ["MotionLimits", "motion_limits", "check_trace", "LimitReport", "Violation",
+           "normalise_mode", "red_t1_pct", "T1_SPEED_MM_S", "MODES", "DEFAULT_MODE",
+           "TOL_SPEED", "TOL_ACC"]
