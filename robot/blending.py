@@ -40,12 +40,14 @@ Model (documented in docs/robot.md, "Motion"):
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from scipy.spatial.transform import Rotation
 
 from .planner import CartSegment, JointSegment, Segment
-from .profiles import smoothstep
+from .profiles import BrakeProfile, RampProfile, smoothstep
 
 
 def effective_keyword(prev: Segment, nxt: Segment | None) -> str | None:
@@ -79,10 +81,18 @@ def _ptp_fraction(seg: JointSegment, other: Segment | None, cptp: float) -> floa
 
 def blend_start_tau(prev: Segment, nxt: Segment | None, keyword: str) -> float | None:
     """Local time on ``prev`` (s) at which its approximation starts, or None when the
-    segment cannot be approximated (zero duration). ``nxt`` may be None (not yet known):
-    then the half-segment cap of the next motion is not applied."""
+    segment cannot be approximated (zero duration, no TCP path for C_DIS, or a next motion
+    of zero length). ``nxt`` may be None (not yet known): then the half-segment cap of the
+    next motion is not applied."""
     if prev.T <= 0.0:
         return None
+    if nxt is not None and nxt.T <= 0.0:
+        return None  # a zero-length motion is never part of an approximation
+    return _zone_start_tau(prev, nxt, keyword)
+
+
+def _zone_start_tau(prev: Segment, nxt: Segment | None, keyword: str) -> float | None:
+    """The earliest blend start (s) by the keyword's zone rule (module docstring)."""
     prof = prev.profile
     if keyword == "C_PTP":
         assert isinstance(prev, JointSegment)
@@ -111,8 +121,8 @@ def blend_start_tau(prev: Segment, nxt: Segment | None, keyword: str) -> float |
         d = min(d, L / 2.0)
         if nxt is not None:
             d = min(d, nxt.path_length / 2.0)
-        if L <= 1e-9:  # no path, only reorientation: nothing to approximate before the end
-            return prof.t_total
+        if L <= 1e-9:  # no TCP path: a zero-length LIN/CIRC is never approximated
+            return None
         return prof.t_of_u(prev.u_of_path(L - d))
     assert isinstance(prev, JointSegment)
     if prev.path_length <= 1e-9:  # the TCP does not move (wrist-only PTP)
@@ -172,6 +182,68 @@ def _progress_norm(seg: Segment, u: float, u_e: float) -> float:
     return u / u_e if u_e > 0 else (0.0 if u <= 0 else 2.0)
 
 
+@dataclass
+class BlendPlan:
+    """How a blend runs (issue 15), from :func:`plan_blend`: the new time laws of the two
+    motions (``prev_profile`` brakes uniformly from the blend start to the point,
+    ``next_profile`` ramps up to the blend end) and the blend length ``window`` (s)."""
+
+    prev_profile: Any
+    next_profile: Any
+    window: float
+
+
+def plan_blend(prev: Segment, nxt: Segment, keyword: str, tau_a: float) -> BlendPlan | None:
+    """Time laws of a blend that starts at local time ``tau_a`` of ``prev`` (issue 15).
+
+    The contour is the overlap of the two profiles (module docstring), but with profiles
+    made for it: ``prev`` brakes uniformly over the whole rest of the zone
+    (:class:`~robot.profiles.BrakeProfile`) and ``nxt`` accelerates uniformly to its blend
+    end point (:class:`~robot.profiles.RampProfile`), timed so that it arrives there when
+    ``prev`` reaches its point (started later if it cannot take that long). Both speeds are
+    then linear in time over the window, so ``|v_prev + v_next| <= max(v_prev, v_next)``:
+    the path never runs faster than the faster of the two programmed motions, and no
+    acceleration exceeds what either motion was planned with. With equal speeds the blend
+    ends as far after the point as it started before it, and ``ρ + π = (1-x)² + x² <= 1``
+    keeps the contour in the zone.
+
+    Returns None when an axis reverses between the two motions and the two accelerations
+    would add up beyond ``a_max``: the blend then has to wait until ``prev`` reaches its point
+    (call again with ``tau_a = prev.T``, which always succeeds)."""
+    bp = BrakeProfile(prev.profile, tau_a)
+    tau_p = bp.t_total - tau_a if bp.tau > 0 else 0.0
+    if tau_p <= 0.0 or nxt.T <= 0.0:
+        return BlendPlan(bp, RampProfile(nxt.profile, 0.0), 0.0)
+    base = nxt.profile
+    u_max = base.u(blend_end_tau(prev, nxt, keyword, tau_a))
+    u_max = min(u_max, base.u(max(0.0, base.t_total - getattr(base, "t_brake", base.t_acc))))
+
+    def ramp_time(u: float) -> float:
+        if u <= 0:
+            return 0.0
+        v = base.du(base.t_of_u(u))
+        return 2.0 * u / v if v > 0 else math.inf
+
+    if u_max <= 0.0:
+        rp = RampProfile(base, 0.0, tau_p)
+    elif ramp_time(u_max) <= tau_p:
+        rp = RampProfile(base, u_max, tau_p - ramp_time(u_max))
+    else:
+        lo, hi = 0.0, u_max
+        for _ in range(40):
+            mid = 0.5 * (lo + hi)
+            if ramp_time(mid) <= tau_p:
+                lo = mid
+            else:
+                hi = mid
+        rp = RampProfile(base, lo, tau_p - ramp_time(lo))
+    rev = (prev.qd_end * nxt.qd_start) < 0
+    a_sum = np.abs(prev.qd_end) * bp.a_b + np.abs(nxt.qd_start) * rp.a_r
+    if np.any(rev & (a_sum > prev.model.a_max * (1.0 + 1e-6))):
+        return None
+    return BlendPlan(bp, rp, tau_p)
+
+
 def overlap_ok(prev: Segment, nxt: Segment, tau_a: float, tau_e: float, h: float) -> bool:
     """Can the blend be the *overlap of the two velocity profiles* (superposition
     ``x = x_prev(t) + (x_next(t) - P)``) without leaving the zone?
@@ -183,7 +255,9 @@ def overlap_ok(prev: Segment, nxt: Segment, tau_a: float, tau_e: float, h: float
     the blend end before that either. True in the usual case (blend in the deceleration
     phase, similar accelerations); otherwise the convex combination is used."""
     T = prev.T
-    if T - tau_a <= 0 or tau_e <= 0:
+    if T - tau_a <= 1e-12:
+        return True  # the approximated motion is at its point: the next one simply runs
+    if tau_e <= 0:
         return False
     u_a = prev.profile.u(tau_a)
     u_e = nxt.profile.u(tau_e)
@@ -234,4 +308,4 @@ def combine_axes(q0: np.ndarray, q1: np.ndarray, w: float) -> np.ndarray:
 
 
 __all__ = ["effective_keyword", "blend_start_tau", "blend_end_tau", "blend_space", "weight",
-           "combine_pose", "combine_axes", "overlap_ok", "superpose_pose"]
+           "combine_pose", "combine_axes", "overlap_ok", "superpose_pose", "plan_blend", "BlendPlan"]

@@ -35,6 +35,7 @@ from . import blending
 from .errors import RobotError
 from .frames import frame_to_matrix, inv_pos, matrix_to_frame
 from .io import IOImage
+from .limits import normalise_mode
 from .machine import MachineData, load_machine
 from .motion import MotionRequest, Trigger
 from .planner import CP_SPEED_LIMIT_FACTOR, RobotModel, Segment, TriggerPlan, plan, resolved_target
@@ -182,6 +183,8 @@ class Controller:
         actuated: drive MuJoCo with position/velocity actuators instead of qpos replay.
         strict_bco: the first motion needs a complete PTP/LIN target (reference §6.3).
         mujoco: False to skip MuJoCo entirely (axis_act then returns the setpoint).
+        mode_op: operating mode ``T1``, ``T2``, ``AUT`` or ``EX`` (``EXT``); default AUT
+            (reference §7.5; T1 limits TCP and flange to 250 mm/s, PTP to ``$RED_T1``).
 
     Attributes:
         advance: ``$ADVANCE`` (0..5), set by the interpreter; default 3.
@@ -193,9 +196,10 @@ class Controller:
     def __init__(self, machine: MachineData | None = None, *, trace: TraceWriter | None = None,
                  stimuli: list[Stimulus] | str | None = None,
                  start_axes: Any = None, actuated: bool = False, strict_bco: bool = True,
-                 mujoco: bool = True) -> None:
+                 mujoco: bool = True, mode_op: str | None = None) -> None:
         self.machine = machine if machine is not None else load_machine()
-        self.model = RobotModel(self.machine)
+        self.mode_op = normalise_mode(mode_op)
+        self.model = RobotModel(self.machine, mode=self.mode_op)
         self.dt = float(self.machine.ipo_cycle_s)
         self._dt_ms = int(round(self.dt * 1000))
         self.trace = trace
@@ -410,12 +414,15 @@ class Controller:
         current position. Called while the robot moves without a BRAKE before, it discards
         everything and the robot stops at the current setpoint."""
         if self._held is not None:
+            h = self._held
+            self._abort(h.runs, h.blend)
             self._held = None
             self._moved_while_held = False
             if not self.is_moving() and not self._pending:
                 self._plan_q = self._q.copy()
             return
         self._moved_while_held = False
+        self._abort(self._runs, self._blend)
         self._pending.clear()
         self._runs = []
         self._blend = None
@@ -423,6 +430,16 @@ class Controller:
         self._braking = False
         self._scale, self._scale_rate = 1.0, 0.0
         self._plan_q = self._q.copy()
+
+    def _abort(self, runs: list[_Run], blend: _Blend | None) -> None:
+        """Log ``end`` with ``reason: abort`` for started motions that are abandoned before
+        their end point (RESUME, a main-run error)."""
+        segs = ([blend.prev.seg] if blend is not None else []) + [r.seg for r in runs]
+        seen: set[int] = set()
+        for seg in segs:
+            if seg.id not in seen:
+                seen.add(seg.id)
+                self._motion_event(seg, "end", reason="abort")
 
     def axis_ret(self) -> np.ndarray | None:
         """``$AXIS_RET``: the axes where BRAKE (or an error) made the robot leave its path,
@@ -518,13 +535,15 @@ class Controller:
             self.trace.write("end", self.time, reason=reason, **fields)
         self._ended = True
 
-    def _motion_event(self, seg: Segment, phase: str) -> None:
+    def _motion_event(self, seg: Segment, phase: str, reason: str | None = None) -> None:
         req = seg.req
         self._events.append(MotionEvent(self.time, req.id, phase, req))
         if self.trace is not None:
+            limits = seg.limits.as_trace() if phase == "start" else None
             self.trace.write("motion", self.time, id=req.id, type=req.type_name,
                              target=dict(req.target), approximation=req.approx,
-                             phase=phase, point=seg.end_frame, line=req.line, file=req.file)
+                             phase=phase, point=seg.end_frame, line=req.line, file=req.file,
+                             reason=reason, limits=limits)
         for st in self.stimuli:
             if (not st.fired and st.due is None and st.phase == phase
                     and st.matches_motion(req.id, req.line)):
@@ -628,9 +647,19 @@ class Controller:
             if tau_a is None:
                 r.decided = True
             elif tau >= tau_a - EPS:
-                r.decided = True
                 if nxt is not None:
-                    return self._begin_blend(r, pt)
+                    kw = blending.effective_keyword(seg, nxt) or "C_DIS"
+                    bp = blending.plan_blend(seg, nxt, kw, tau)
+                    if bp is None:
+                        # an axis would reverse with both accelerations added: the blend
+                        # waits until the approximated motion reaches its point
+                        bp = blending.plan_blend(seg, nxt, kw, max(tau, seg.T))
+                        if tau < seg.T - EPS:
+                            r.tau_cache = (key, seg.T)
+                            return seg.axes(tau)
+                    r.decided = True
+                    return self._begin_blend(r, pt, bp)
+                r.decided = True
                 self.message(MSG_APPROX_IMPOSSIBLE, seg.id)
         if tau >= seg.T - EPS:
             self._runs = []
@@ -640,11 +669,14 @@ class Controller:
             return seg.q1.copy()
         return seg.axes(tau)
 
-    def _begin_blend(self, r: _Run, pt: float) -> np.ndarray:
+    def _begin_blend(self, r: _Run, pt: float, bp: "blending.BlendPlan") -> np.ndarray:
         nseg = self._pending.popleft()
         kw = blending.effective_keyword(r.seg, nseg) or "C_DIS"
-        tau_a = pt - r.t0
-        tau_e, overlap = self._blend_window(r.seg, nseg, kw, tau_a)
+        # the blend's own time laws (robot/blending.py plan_blend): prev brakes through the
+        # zone, the next motion ramps up to the blend end
+        r.seg.profile, r.seg.T = bp.prev_profile, bp.prev_profile.t_total
+        nseg.profile, nseg.T = bp.next_profile, bp.next_profile.t_total
+        tau_e, overlap = bp.window, True
         self._motion_event(r.seg, "blend_start")
         nr = self._start(nseg, pt)
         nr.blend_in_end = pt + tau_e
@@ -658,12 +690,11 @@ class Controller:
         return self._blend_setpoint(b, pt)
 
     def _blend_window(self, seg: Segment, nxt: Segment, kw: str, tau_a: float) -> tuple[float, bool]:
-        """Length (s) of the blend that starts at local time ``tau_a`` of ``seg``, and
-        whether it is a profile overlap (see robot/blending.py)."""
-        tau_e = blending.blend_end_tau(seg, nxt, kw, tau_a)
-        if blending.overlap_ok(seg, nxt, tau_a, tau_e, self.dt / 4.0):
-            return seg.T - tau_a, True  # the blend ends when the approximated motion ends
-        return tau_e, False
+        """Length (s) of the blend that starts at local time ``tau_a`` of ``seg`` (it ends
+        when ``seg`` reaches its point), and whether it is a profile overlap (always)."""
+        bp = blending.plan_blend(seg, nxt, kw, tau_a) or blending.plan_blend(seg, nxt, kw, seg.T)
+        assert bp is not None
+        return bp.window, True
 
     def _end_blend(self, b: _Blend) -> None:
         self._blend = None
@@ -716,6 +747,9 @@ class Controller:
                              id=mid, line=line)
         q = self._q.copy()
         self._ret_q = q.copy()
+        self._abort(self._runs, self._blend)
+        if self._held is not None:
+            self._abort(self._held.runs, self._held.blend)
         self._runs = []
         self._blend = None
         self._pending.clear()

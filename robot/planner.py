@@ -28,7 +28,8 @@ from .errors import RobotError, WorkspaceError
 from .frames import frame_to_matrix, inv_pos, matrix_to_frame
 from .kinematics import Kinematics
 from .motion import AXIS_KEYS, CART_KEYS, MotionParams, MotionRequest, Trigger
-from .profiles import Trapezoid
+from .limits import DEFAULT_MODE, T1_SPEED_MM_S, motion_limits, red_t1_pct
+from .profiles import PiecewiseProfile, Trapezoid
 
 
 #: An axis jump (deg) between neighbouring planning samples of a CP path that means the
@@ -36,6 +37,8 @@ from .profiles import Trapezoid
 SINGULAR_JUMP_DEG = 90.0
 #: Factor on the axis maximum speed above which an interpolated CP setpoint is rejected.
 CP_SPEED_LIMIT_FACTOR = 1.5
+#: Safety factor on the sampled TCP/flange speed of a path in T1 (sampling between points).
+T1_MARGIN = 1.02
 
 
 class RobotModel:
@@ -45,8 +48,9 @@ class RobotModel:
     ref)`` -> axes (6,) raising WorkspaceError/SoftLimitError; ``status_turn(q)``.
     """
 
-    def __init__(self, machine: Any, kin: Kinematics | None = None) -> None:
+    def __init__(self, machine: Any, kin: Kinematics | None = None, mode: str = DEFAULT_MODE) -> None:
         self.machine = machine
+        self.mode = mode
         self.kin = kin if kin is not None else Kinematics(machine)
         self.robroot_T = frame_to_matrix(*machine.robroot_frame)
         self._robroot_is_null = bool(np.allclose(self.robroot_T, np.eye(4)))
@@ -129,6 +133,12 @@ class LinePiece(_Piece):
     def pos(self, s: float) -> np.ndarray:
         return self.p0 + self.dir * s
 
+    def tangent(self, s: float) -> np.ndarray:
+        """Unit tangent at arc length s."""
+        return self.dir
+
+    min_radius = math.inf
+
 
 class ArcPiece(_Piece):
     """Circular arc: centre c, radius r, in-plane unit vectors e1 (to the start) and e2,
@@ -166,6 +176,15 @@ class ArcPiece(_Piece):
         ph = self.phi(s)
         return self.c + self.r * (math.cos(ph) * self.e1 + math.sin(ph) * self.e2)
 
+    def tangent(self, s: float) -> np.ndarray:
+        ph = self.phi(s)
+        sg = 1.0 if self.angle >= 0 else -1.0
+        return sg * (-math.sin(ph) * self.e1 + math.cos(ph) * self.e2)
+
+    @property
+    def min_radius(self) -> float:
+        return self.r
+
 
 class CatmullRomPiece(_Piece):
     """Uniform Catmull-Rom curve from P1 to P2 (neighbours P0, P3), re-parametrised by arc
@@ -173,18 +192,40 @@ class CatmullRomPiece(_Piece):
 
     N = 48
 
-    def __init__(self, P0: np.ndarray, P1: np.ndarray, P2: np.ndarray, P3: np.ndarray) -> None:
+    def __init__(self, P0: np.ndarray, P1: np.ndarray, P2: np.ndarray, P3: np.ndarray,
+                 m1: np.ndarray | None = None, m2: np.ndarray | None = None) -> None:
+        """Hermite form: end tangents ``m1 = (P2-P0)/2``, ``m2 = (P3-P1)/2`` (Catmull-Rom)
+        unless given (a SPL point next to an SLIN/SCIRC takes that piece's direction, so
+        the junction has no kink)."""
         P0, P1, P2, P3 = (np.asarray(v, dtype=float) for v in (P0, P1, P2, P3))
+        m1 = 0.5 * (P2 - P0) if m1 is None else np.asarray(m1, dtype=float)
+        m2 = 0.5 * (P3 - P1) if m2 is None else np.asarray(m2, dtype=float)
+        if float(np.linalg.norm(P2 - P1)) <= 1e-9:
+            m1 = m2 = np.zeros(3)
         self.c0 = P1
-        self.c1 = 0.5 * (P2 - P0)
-        self.c2 = 0.5 * (2 * P0 - 5 * P1 + 4 * P2 - P3)
-        self.c3 = 0.5 * (-P0 + 3 * P1 - 3 * P2 + P3)
+        self.c1 = m1
+        self.c2 = 3.0 * (P2 - P1) - 2.0 * m1 - m2
+        self.c3 = 2.0 * (P1 - P2) + m1 + m2
         ts = np.linspace(0.0, 1.0, self.N + 1)
-        pts = np.array([self._at(t) for t in ts])
+        pts = self.c0 + ts[:, None] * (self.c1 + ts[:, None] * (self.c2 + ts[:, None] * self.c3))
         seg = np.linalg.norm(np.diff(pts, axis=0), axis=1)
         self._s = np.concatenate([[0.0], np.cumsum(seg)])
         self._t = ts
         self.length = float(self._s[-1])
+        d1 = self.c1 + ts[:, None] * (2.0 * self.c2 + 3.0 * ts[:, None] * self.c3)
+        d2 = 2.0 * self.c2 + 6.0 * ts[:, None] * self.c3
+        n1 = np.linalg.norm(d1, axis=1)
+        cr = np.linalg.norm(np.cross(d1, d2), axis=1)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            kappa = np.where(n1 > 1e-9, cr / np.maximum(n1, 1e-12) ** 3, 0.0)
+        km = float(np.max(kappa)) if len(kappa) else 0.0
+        self.min_radius = 1.0 / km if km > 1e-12 else math.inf
+
+    def tangent(self, s: float) -> np.ndarray:
+        t = float(np.interp(s, self._s, self._t)) if self.length > 0 else 0.0
+        d = self.c1 + t * (2.0 * self.c2 + 3.0 * t * self.c3)
+        n = float(np.linalg.norm(d))
+        return d / n if n > 1e-12 else np.zeros(3)
 
     def _at(self, t: float) -> np.ndarray:
         return self.c0 + t * (self.c1 + t * (self.c2 + t * self.c3))
@@ -238,6 +279,11 @@ class Segment:
         self.model = model
         self.status = model.status_turn(q0)[0]
         self.triggers: list[TriggerPlan] = []
+        self.limits: Any = None            # robot.limits.MotionLimits, set by plan()
+        self.vel_peak = np.zeros(6)        # highest planned axis speeds (deg/s)
+        self.acc_peak = np.zeros(6)        # highest planned axis accelerations (deg/s²)
+        self.qd_start = q1 - q0            # dq/du at the start and at the end (deg)
+        self.qd_end = q1 - q0
         self._last_q = q0.copy()
         self._end_frame: list[float] | None = None
 
@@ -519,6 +565,7 @@ def plan(req: MotionRequest, q_start: np.ndarray, model: RobotModel, *,
     else:
         seg = _plan_cart(req, q0, start_T, tool_T, base_T, model)
     _plan_triggers(seg)
+    seg.limits = motion_limits(req, model.machine, model.mode)
     return seg
 
 
@@ -542,16 +589,35 @@ def _plan_joint(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_T:
     if not moving.any():
         prof = Trapezoid.plan(math.inf, math.inf)
         v_prog = math.inf
+        V = A = 0.0
     else:
         v_axis = model.v_max * np.array(p.vel_axis) / 100.0 * p.ov_pro / 100.0
+        if model.mode == "T1":
+            v_axis = v_axis * red_t1_pct(model.machine) / 100.0  # $RED_T1 (issue 15)
         a_axis = model.a_max * np.array(p.acc_axis) / 100.0
         if np.any(v_axis[moving] <= 0) or np.any(a_axis[moving] <= 0):
             raise RobotError("PTP: $VEL_AXIS, $ACC_AXIS and $OV_PRO must be positive")
         V = float(np.min(v_axis[moving] / dq[moving]))
         A = float(np.min(a_axis[moving] / dq[moving]))
+        if model.mode == "T1":
+            # TCP and flange <= 250 mm/s (reference §6.7 [C]): the largest |dp/du| on the path
+            us = np.linspace(0.0, 1.0, 33)
+            Q = q0[None, :] + us[:, None] * (q1 - q0)[None, :]
+            F = model.kin.forward_many(Q)
+            if not model._robroot_is_null:
+                F = model.robroot_T @ F
+            tcp = (inv_pos(base_T) @ F @ tool_T)[:, :3, 3]
+            dp = max(float(np.max(np.linalg.norm(np.diff(tcp, axis=0), axis=1))),
+                     float(np.max(np.linalg.norm(np.diff(F[:, :3, 3], axis=0), axis=1))))
+            dp *= (len(us) - 1) * T1_MARGIN
+            if dp > 0:
+                V = min(V, T1_SPEED_MM_S / dp)
         prof = Trapezoid.plan(V, A)
         v_prog = V
-    return JointSegment(req, q0, q1, prof, v_prog, tool_T, base_T, model)
+    seg = JointSegment(req, q0, q1, prof, v_prog, tool_T, base_T, model)
+    seg.vel_peak = dq * prof.v
+    seg.acc_peak = dq * prof.a
+    return seg
 
 
 def _orientation_modes(p: MotionParams, kind: str) -> str:
@@ -560,6 +626,20 @@ def _orientation_modes(p: MotionParams, kind: str) -> str:
     if kind in ("CIRC", "SCIRC") and p.circ_type == "PATH":
         return "PATH"
     return "VAR"  # #JOINT: pose_u interpolates like #VAR; axes() moves the wrist axes linearly
+
+
+def _cp_speeds(prm: MotionParams, mode: str) -> tuple[float, float, float, float]:
+    """(v_cp mm/s, v_ori deg/s, a_cp mm/s², a_ori deg/s²) of a CP piece: ``$VEL.CP``
+    · ``$OV_PRO``% (T1: at most 250 mm/s), the smaller ORI value (reference §6.7)."""
+    v_cp = prm.vel_cp * 1000.0 * prm.ov_pro / 100.0
+    if mode == "T1":
+        v_cp = min(v_cp, T1_SPEED_MM_S)
+    v_ori = min(prm.vel_ori1, prm.vel_ori2) * prm.ov_pro / 100.0
+    a_cp = prm.acc_cp * 1000.0
+    a_ori = min(prm.acc_ori1, prm.acc_ori2)
+    if min(v_cp, v_ori, a_cp, a_ori) <= 0:
+        raise RobotError("CP motion: $VEL, $ACC and $OV_PRO must be positive")
+    return v_cp, v_ori, a_cp, a_ori
 
 
 def _plan_cart(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_T: np.ndarray,
@@ -599,28 +679,46 @@ def _plan_cart(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_T: 
         cur_T = T1
 
     pts = [T[:3, 3].copy() for T in pts_T]
-    pieces: list[_Piece] = []
-    rots: list[Rotation] = [Rotation.from_matrix(start_T[:3, :3])]
-    ori: list[str] = []
-    weights: list[float] = []
-    v_lims: list[tuple[float, float, float, float]] = []
+    n = len(geo)
+    built: list[_Piece | None] = [None] * n
+    # lines and arcs first (CA moves an end point), then the SPL curves, whose end
+    # tangents follow a neighbouring SLIN/SCIRC (no kink at such a junction)
     for k, (g, data) in enumerate(geo):
-        prm = items[k][4]
         a, b = pts[k], pts[k + 1]
         if g == "ARC":
-            piece: _Piece = ArcPiece(a, data[0], b, data[1])
+            arc = ArcPiece(a, data[0], b, data[1])
             if data[1] is not None:  # CA moves the end point onto the circle
-                b = piece.pos(piece.length)
+                b = arc.pos(arc.length)
                 pts[k + 1] = b
                 pts_T[k + 1] = pts_T[k + 1].copy()
                 pts_T[k + 1][:3, 3] = b
-        elif g == "SPL":
-            P0 = pts[k - 1] if k >= 1 else 2 * a - b
-            P3 = pts[k + 2] if k + 2 < len(pts) else 2 * b - a
-            piece = CatmullRomPiece(P0, a, b, P3)
-        else:
-            piece = LinePiece(a, b)
-        pieces.append(piece)
+            built[k] = arc
+        elif g == "SLIN":
+            built[k] = LinePiece(a, b)
+    for k, (g, _) in enumerate(geo):
+        if g != "SPL":
+            continue
+        a, b = pts[k], pts[k + 1]
+        chord = float(np.linalg.norm(b - a))
+        P0 = pts[k - 1] if k >= 1 else 2 * a - b
+        P3 = pts[k + 2] if k + 2 < len(pts) else 2 * b - a
+        m1 = m2 = None
+        prev_p = built[k - 1] if k >= 1 and geo[k - 1][0] != "SPL" else None
+        next_p = built[k + 1] if k + 1 < n and geo[k + 1][0] != "SPL" else None
+        if prev_p is not None and prev_p.length > 0:
+            m1 = prev_p.tangent(prev_p.length) * chord
+        if next_p is not None and next_p.length > 0:
+            m2 = next_p.tangent(0.0) * chord
+        built[k] = CatmullRomPiece(P0, a, b, P3, m1, m2)
+    pieces: list[_Piece] = [pc for pc in built if pc is not None]
+
+    rots: list[Rotation] = [Rotation.from_matrix(start_T[:3, :3])]
+    ori: list[str] = []
+    thetas: list[float] = []
+    speeds: list[tuple[float, float, float, float]] = []
+    for k, (g, data) in enumerate(geo):
+        prm = items[k][4]
+        piece = pieces[k]
         mode = _orientation_modes(prm, "SCIRC" if g == "ARC" else "SLIN")
         if mode == "CONSTANT":
             R1 = rots[k]
@@ -631,52 +729,131 @@ def _plan_cart(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_T: 
             R1 = Rotation.from_matrix(pts_T[k + 1][:3, :3])
         rots.append(R1)
         ori.append(mode)
-        theta = float(np.degrees((rots[k].inv() * R1).magnitude()))
-        v_cp = prm.vel_cp * 1000.0 * prm.ov_pro / 100.0
-        v_ori = min(prm.vel_ori1, prm.vel_ori2) * prm.ov_pro / 100.0
-        a_cp = prm.acc_cp * 1000.0
-        a_ori = min(prm.acc_ori1, prm.acc_ori2)
-        if min(v_cp, v_ori, a_cp, a_ori) <= 0:
-            raise RobotError("CP motion: $VEL, $ACC and $OV_PRO must be positive")
-        weights.append(_time_weight(piece.length, theta, v_cp, v_ori))
-        v_lims.append((piece.length, theta, a_cp, a_ori))
+        thetas.append(float(np.degrees((rots[k].inv() * R1).magnitude())))
+        speeds.append(_cp_speeds(prm, model.mode))
 
+    # parameter u: proportional to max(L_k, θ_k·c) with one scale c (mm/deg) for the block,
+    # so the path speed is continuous where pieces meet (= the old time weights when all
+    # pieces share $VEL/$ACC)
+    v_cp0, v_ori0, _, _ = _cp_speeds(p, model.mode)
+    c = v_cp0 / v_ori0
+    weights = [max(pc.length, th * c) for pc, th in zip(pieces, thetas)]
     W = float(sum(weights))
-    if W <= 0:
-        prof = Trapezoid.plan(math.inf, math.inf)
-        v_prog = math.inf
-    else:
-        # per piece: speed L_k·W/w_k·du/dt <= v_cp (holds by construction of w) and
-        # acceleration L_k·W/w_k·A <= a_cp, θ_k·W/w_k·A <= a_ori
-        A = math.inf
-        for (L, th, a_cp, a_ori), w in zip(v_lims, weights):
-            if w <= 0:
-                continue
-            if L > 0:
-                A = min(A, a_cp * w / (L * W))
-            if th > 0:
-                A = min(A, a_ori * w / (th * W))
-        prof = Trapezoid.plan(1.0 / W, A)
-        v_prog = 1.0 / W
-    # end axes: IK of the final pose with the start status (CP keeps S, reference §6.5)
-    T_end = np.eye(4)
-    T_end[:3, :3] = rots[-1].as_matrix()
-    T_end[:3, 3] = pts[-1]
+    seg = CartSegment(req, q0, q0.copy(), Trapezoid.plan(math.inf, math.inf), math.inf,
+                      tool_T, base_T, model, pieces, rots, weights, ori)
+    seg.vel_peak = np.zeros(6)
+    seg.acc_peak = np.zeros(6)
+    if W <= 1e-6:  # nothing to move (a zero-length LIN): zero duration, never approximated
+        seg.q1 = q0.copy()
+        return seg
+
+    m = len(pieces)
+    dt = model.machine.ipo_cycle_s
+    vmax: list[float] = []
+    amax: list[float] = []
+    vprog: list[float] = []
+    for k in range(m):
+        L, th, w = pieces[k].length, thetas[k], weights[k]
+        v_cp, v_ori, a_cp, a_ori = speeds[k]
+        lk = L * W / w if w > 0 else 0.0       # mm per unit u
+        ok = th * W / w if w > 0 else 0.0      # deg per unit u
+        # curvature: the centripetal acceleration v²/r stays within $ACC.CP
+        v_curve = math.sqrt(a_cp * pieces[k].min_radius) if L > 0 else math.inf
+        v = min(v_cp / lk if lk > 0 else math.inf, v_ori / ok if ok > 0 else math.inf)
+        vprog.append(v)
+        v = min(v, v_curve / lk if lk > 0 else math.inf)
+        a = min(a_cp / lk if lk > 0 else math.inf, a_ori / ok if ok > 0 else math.inf)
+        vmax.append(v if v < math.inf else 1e12)
+        amax.append(a if a < math.inf else 1e12)
+    # corners between pieces: the velocity turns within one IPO cycle, so the corner speed
+    # keeps |Δv|/Δt within $ACC.CP (reference §6.2: the spline is slowed at corners)
+    vnode = [0.0] * (m + 1)
+    for k in range(1, m):
+        vnode[k] = math.inf
+        A_, B_ = pieces[k - 1], pieces[k]
+        if A_.length <= 0 or B_.length <= 0:
+            vnode[k] = 0.0
+            continue
+        cosang = float(np.clip(A_.tangent(A_.length) @ B_.tangent(0.0), -1.0, 1.0))
+        ang = math.acos(cosang)
+        if ang > 1e-3:
+            a_c = min(speeds[k - 1][2], speeds[k][2])
+            v_c = a_c * dt / (2.0 * math.sin(ang / 2.0))
+            lk0 = A_.length * W / weights[k - 1]
+            lk1 = B_.length * W / weights[k]
+            vnode[k] = min(v_c / lk0, v_c / lk1)
+
+    # walk the path per piece: IK (start status S, continuous turn), singularities, and the
+    # axis speeds/accelerations the path needs (the path is slowed so that the axes stay
+    # within machine data: |q'|·du/dt <= v_max, |q''|·(du/dt)² + |q'|·d²u/dt² <= a_max)
     status = model.status_turn(q0)[0]
-    # walk the path coarsely so the end turn follows continuously from the start
-    seg = CartSegment(req, q0, q0.copy(), prof, v_prog, tool_T, base_T, model,
-                      pieces, rots, weights, ori)
     ref = q0.copy()
-    n_chk = max(2, min(64, int(seg.path_length / 50.0) + 2 + int(seg.ori_angle / 10.0)))
-    for u in np.linspace(0.0, 1.0, n_chk)[1:]:
-        pu, Ru = seg.pose_u(float(u))
-        q = seg.ik(pu, Ru, ref)
-        jump = np.abs(q - ref)
-        if float(jump.max()) > SINGULAR_JUMP_DEG:
-            i = int(np.argmax(jump))
-            raise RobotError(f"CP path through a singularity: A{i + 1} would turn "
-                             f"{jump[i]:.0f} deg at once (keep the status on CP paths)")
-        ref = q
+    ub = seg.u_bounds
+    v_ax = model.v_max
+    a_ax = model.a_max
+    junction_q: list[np.ndarray] = []
+    for k in range(m):
+        L, th = pieces[k].length, thetas[k]
+        nk = max(4, min(48, int(L / 25.0) + int(th / 5.0) + 4))
+        us = np.linspace(float(ub[k]), float(ub[k + 1]), nk + 1)
+        Q = np.empty((nk + 1, 6))
+        Q[0] = ref
+        for j in range(1, nk + 1):
+            pu, Ru = seg.pose_u(float(us[j]))
+            q = seg.ik(pu, Ru, ref)
+            jump = np.abs(q - ref)
+            if float(jump.max()) > SINGULAR_JUMP_DEG:
+                i = int(np.argmax(jump))
+                raise RobotError(f"CP path through a singularity: A{i + 1} would turn "
+                                 f"{jump[i]:.0f} deg at once (keep the status on CP paths)")
+            Q[j] = q
+            ref = q
+        h = float(us[1] - us[0])
+        if h <= 0:
+            junction_q.append(Q[0].copy())
+            continue
+        d1 = np.gradient(Q, h, axis=0, edge_order=2)
+        d2 = np.gradient(d1, h, axis=0, edge_order=2)
+        qd = np.max(np.abs(d1), axis=0)
+        qdd = np.max(np.abs(d2), axis=0)
+        junction_q.append(Q[0].copy())
+        if k == 0:
+            seg.qd_start = d1[0].copy()
+        if k == m - 1:
+            seg.qd_end = d1[-1].copy()
+        with np.errstate(divide="ignore"):
+            V = float(np.min(np.where(qd > 1e-9, v_ax / qd, np.inf)))
+            V = min(V, float(np.min(np.where(qdd > 1e-9, np.sqrt(0.5 * a_ax / qdd), np.inf))))
+        if model.mode == "T1":
+            F = model.kin.forward_many(Q)
+            dpf = float(np.max(np.linalg.norm(np.diff(F[:, :3, 3], axis=0), axis=1))) / h
+            lk = L * W / weights[k] if weights[k] > 0 else 0.0
+            if dpf > lk * (1.0 + 1e-6):  # the flange moves faster than the TCP (tool, rotation)
+                V = min(V, T1_SPEED_MM_S / (dpf * T1_MARGIN))
+        vmax[k] = min(vmax[k], V)
+        with np.errstate(divide="ignore"):
+            Aax = float(np.min(np.where(qd > 1e-9, (a_ax - qdd * vmax[k] ** 2) / qd, np.inf)))
+        amax[k] = min(amax[k], max(Aax, 1e-9))
+        seg.vel_peak = np.maximum(seg.vel_peak, qd * vmax[k])
+        seg.acc_peak = np.maximum(seg.acc_peak, qdd * vmax[k] ** 2 + qd * amax[k])
+    for k in range(1, m):  # axis-velocity jumps where pieces meet (one-sided derivatives)
+        if vnode[k] <= 0.0:
+            continue
+        uk, du_ = float(ub[k]), 1e-5
+        qj = seg.ik(*seg.pose_u(uk), junction_q[k])
+        qL = seg.ik(*seg.pose_u(uk - du_), qj)
+        qR = seg.ik(*seg.pose_u(uk + du_), qj)
+        jump = np.abs((qR - qj) - (qj - qL)) / du_
+        with np.errstate(divide="ignore"):
+            vj = float(np.min(np.where(jump > 1e-6, 0.5 * a_ax * dt / jump, np.inf)))
+        vnode[k] = min(vnode[k], vj)
+    if m == 1:
+        prof: Any = Trapezoid.plan(vmax[0], amax[0])
+    else:
+        prof = PiecewiseProfile([float(x) for x in ub], vmax, amax, vnode)
+    seg.profile = prof
+    seg.T = prof.t_total
+    seg.v_prog = vprog[-1]
     seg.q1 = ref
     seg.status = status
     return seg

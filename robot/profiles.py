@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 
 @dataclass(frozen=True)
@@ -68,6 +69,11 @@ class Trapezoid:
     def t_dec(self) -> float:
         """Time at which deceleration begins, s."""
         return self.t_total - self.t_acc
+
+    @property
+    def t_brake(self) -> float:
+        """Duration of the final braking phase, s (= ``t_acc``)."""
+        return self.t_acc
 
     def u(self, t: float) -> float:
         """Path parameter at time ``t`` (clamped to [0, T])."""
@@ -128,3 +134,249 @@ def smoothstep(x: float) -> float:
     if x >= 1.0:
         return 1.0
     return x * x * (3.0 - 2.0 * x)
+
+
+class PiecewiseProfile:
+    """Normalised time law u(t) over sections with their own limits (issue 15: spline
+    blocks slowed at corners, CP paths slowed for the axes).
+
+    Section ``j`` covers ``u`` in ``[bounds[j], bounds[j+1]]`` with speed limit ``vmax[j]``
+    (1/s) and acceleration limit ``amax[j]`` (1/s²); ``vnode[j]`` limits du/dt at the
+    junction ``bounds[j]`` (0 at both ends). A forward and a backward pass make the junction
+    speeds reachable; every section is then a trapezoid from its entry to its exit speed
+    (accelerate, cruise, decelerate), so the speed is continuous and the acceleration of
+    each section stays within its limit. With one section this is :class:`Trapezoid`.
+
+    Same interface as :class:`Trapezoid`: ``u``, ``du``, ``t_of_u``,
+    ``t_of_speed_in_decel``, ``t_total``, ``t_acc`` (first acceleration phase, s),
+    ``t_brake`` (final braking phase, s), ``v`` (peak speed), ``a`` (final braking
+    acceleration). Raises ValueError for non-positive limits.
+    """
+
+    def __init__(self, bounds: list[float], vmax: list[float], amax: list[float],
+                 vnode: list[float] | None = None) -> None:
+        m = len(vmax)
+        if len(bounds) != m + 1 or len(amax) != m:
+            raise ValueError("profile: bounds must have one more entry than vmax/amax")
+        if any(not (v > 0 and a > 0) for v, a in zip(vmax, amax)):
+            raise ValueError("profile limits must be positive")
+        L = [max(0.0, bounds[j + 1] - bounds[j]) for j in range(m)]
+        vn = [0.0] + [math.inf] * (m - 1) + [0.0]
+        if vnode is not None:
+            for j in range(1, m):
+                vn[j] = max(0.0, float(vnode[j]))
+        for j in range(1, m):
+            vn[j] = min(vn[j], vmax[j - 1], vmax[j])
+        for j in range(m):  # forward
+            reach = 2.0 * amax[j] * L[j] if L[j] > 0 else 0.0
+            vn[j + 1] = min(vn[j + 1], math.sqrt(vn[j] ** 2 + reach))
+        for j in range(m - 1, -1, -1):  # backward
+            reach = 2.0 * amax[j] * L[j] if L[j] > 0 else 0.0
+            vn[j] = min(vn[j], math.sqrt(vn[j + 1] ** 2 + reach))
+        t0: list[float] = []
+        u0: list[float] = []
+        v0: list[float] = []
+        acc: list[float] = []
+        dur: list[float] = []
+        t = 0.0
+        peak = 0.0
+
+        def add(du_: float, vs: float, a_: float, d_: float) -> None:
+            nonlocal t
+            if d_ <= 0.0:
+                return
+            t0.append(t)
+            u0.append(du_)
+            v0.append(vs)
+            acc.append(a_)
+            dur.append(d_)
+            t += d_
+
+        for j in range(m):
+            if L[j] <= 0.0:
+                continue
+            a, vi, vo = amax[j], vn[j], vn[j + 1]
+            vp = min(vmax[j], math.sqrt(max(0.0, (2.0 * a * L[j] + vi * vi + vo * vo) / 2.0)))
+            vp = max(vp, vi, vo)
+            d1 = (vp * vp - vi * vi) / (2.0 * a)
+            d3 = (vp * vp - vo * vo) / (2.0 * a)
+            d2 = max(0.0, L[j] - d1 - d3)
+            u = bounds[j]
+            add(u, vi, a, (vp - vi) / a)
+            u += d1
+            add(u, vp, 0.0, d2 / vp if vp > 0 else 0.0)
+            u += d2
+            add(u, vp, -a, (vp - vo) / a)
+            peak = max(peak, vp)
+        self._t0, self._u0, self._v0, self._acc, self._dur = t0, u0, v0, acc, dur
+        self._end = float(bounds[-1])
+        self.t_total = t
+        self.v = peak
+        self.t_acc = dur[0] if acc and acc[0] > 0 and v0[0] == 0.0 else 0.0
+        self.t_brake = dur[-1] if acc and acc[-1] < 0 else 0.0
+        self.a = -acc[-1] if acc and acc[-1] < 0 else (acc[0] if acc else 0.0)
+        self.a_start = acc[0] if acc and acc[0] > 0 else self.a
+        self.t_dec = t - self.t_brake
+        self.vnode = vn
+
+    def _phase(self, t: float) -> int:
+        from bisect import bisect_right
+        return max(0, bisect_right(self._t0, t) - 1)
+
+    def u(self, t: float) -> float:
+        if self.t_total == 0.0 or t >= self.t_total:
+            return 1.0
+        if t <= 0.0:
+            return 0.0
+        k = self._phase(t)
+        tau = min(t - self._t0[k], self._dur[k])
+        return min(1.0, self._u0[k] + self._v0[k] * tau + 0.5 * self._acc[k] * tau * tau)
+
+    def du(self, t: float) -> float:
+        if t <= 0.0 or t >= self.t_total:
+            return 0.0
+        k = self._phase(t)
+        tau = min(t - self._t0[k], self._dur[k])
+        return max(0.0, self._v0[k] + self._acc[k] * tau)
+
+    def t_of_u(self, u: float) -> float:
+        from bisect import bisect_right
+        if u <= 0.0 or self.t_total == 0.0:
+            return 0.0
+        if u >= 1.0:
+            return self.t_total
+        k = max(0, bisect_right(self._u0, u) - 1)
+        d = u - self._u0[k]
+        v0, a = self._v0[k], self._acc[k]
+        disc = max(0.0, v0 * v0 + 2.0 * a * d)
+        den = v0 + math.sqrt(disc)
+        tau = 2.0 * d / den if den > 0 else self._dur[k]
+        return self._t0[k] + min(tau, self._dur[k])
+
+    def t_of_speed_in_decel(self, fraction_of_v: float, v_ref: float) -> float:
+        """First time in the final braking phase at which du/dt <= ``fraction_of_v·v_ref``."""
+        target = fraction_of_v * v_ref
+        if not self._acc or self._acc[-1] >= 0:
+            return self.t_total
+        if target >= self._v0[-1]:
+            return self._t0[-1]
+        return self.t_total - target / self.a
+
+
+class BrakeProfile:
+    """The approximated motion of a blend (issue 15): ``base`` until ``t_a``, then a uniform
+    deceleration from the state there ``(u_a, v_a)`` to rest at ``u = 1``.
+
+    Braking over the whole remaining zone instead of at full ``A`` at its end: the
+    deceleration ``v_a²/(2(1-u_a))`` is never larger than the base profile's (the base could
+    stop in that distance), and it lasts ``2(1-u_a)/v_a`` s. Same interface as
+    :class:`Trapezoid`."""
+
+    def __init__(self, base: Any, t_a: float) -> None:
+        self.base = base
+        self.t_a = t_a
+        self.u_a = base.u(t_a)
+        self.v_a = base.du(t_a)
+        rem = 1.0 - self.u_a
+        if self.v_a <= 1e-12 or rem <= 1e-12:
+            self.a_b, self.tau = 0.0, 0.0
+        else:
+            self.a_b = self.v_a * self.v_a / (2.0 * rem)
+            self.tau = 2.0 * rem / self.v_a
+        self.t_total = t_a + self.tau if self.tau > 0 else max(t_a, 0.0)
+        if self.tau <= 0 and self.u_a < 1.0:
+            self.t_total = base.t_total
+        self.v = base.v
+        self.a = self.a_b if self.tau > 0 else base.a
+        self.a_start = getattr(base, "a_start", base.a)
+        self.t_acc = base.t_acc
+        self.t_brake = self.tau if self.tau > 0 else getattr(base, "t_brake", base.t_acc)
+        self.t_dec = self.t_total - self.t_brake
+
+    def u(self, t: float) -> float:
+        if self.tau <= 0:
+            return self.base.u(t)
+        if t <= self.t_a:
+            return self.base.u(t)
+        if t >= self.t_total:
+            return 1.0
+        s = t - self.t_a
+        return min(1.0, self.u_a + self.v_a * s - 0.5 * self.a_b * s * s)
+
+    def du(self, t: float) -> float:
+        if self.tau <= 0 or t <= self.t_a:
+            return self.base.du(t)
+        if t >= self.t_total:
+            return 0.0
+        return max(0.0, self.v_a - self.a_b * (t - self.t_a))
+
+    def t_of_u(self, u: float) -> float:
+        if self.tau <= 0 or u <= self.u_a:
+            return self.base.t_of_u(u)
+        if u >= 1.0:
+            return self.t_total
+        d = u - self.u_a
+        den = self.v_a + math.sqrt(max(0.0, self.v_a * self.v_a - 2.0 * self.a_b * d))
+        return self.t_a + (2.0 * d / den if den > 0 else self.tau)
+
+    def t_of_speed_in_decel(self, fraction_of_v: float, v_ref: float) -> float:
+        if self.tau <= 0:
+            return self.base.t_of_speed_in_decel(fraction_of_v, v_ref)
+        target = fraction_of_v * v_ref
+        if target >= self.v_a:
+            return self.t_a
+        return self.t_total - target / self.a_b
+
+
+class RampProfile:
+    """The next motion of a blend (issue 15): at rest for ``delay`` s, then a uniform
+    acceleration from rest to ``u_e``, arriving with the speed ``base`` has at ``u_e``, then
+    ``base`` (shifted in time). The acceleration ``v_b²/(2·u_e)`` is never larger than the
+    base profile's when ``u_e`` lies at or after the end of its acceleration phase. Same
+    interface as :class:`Trapezoid`."""
+
+    def __init__(self, base: Any, u_e: float, delay: float = 0.0) -> None:
+        self.base = base
+        self.delay = max(0.0, delay)
+        t_b = base.t_of_u(u_e) if u_e > 0 else 0.0
+        v_b = base.du(t_b) if u_e > 0 else 0.0
+        if u_e <= 1e-12 or v_b <= 1e-12:
+            self.u_e, self.tau, self.a_r = 0.0, 0.0, 0.0
+            self.shift = self.delay
+        else:
+            self.u_e = u_e
+            self.tau = 2.0 * u_e / v_b
+            self.a_r = v_b / self.tau
+            self.shift = self.delay + self.tau - t_b
+        self.t_total = base.t_total + self.shift
+        self.v = base.v
+        self.a = base.a
+        self.a_start = self.a_r if self.tau > 0 else getattr(base, "a_start", base.a)
+        self.t_acc = self.delay + (self.tau if self.tau > 0 else base.t_acc)
+        self.t_brake = getattr(base, "t_brake", base.t_acc)
+        self.t_dec = self.t_total - self.t_brake
+
+    def u(self, t: float) -> float:
+        if t <= self.delay:
+            return 0.0 if self.t_total > 0 else 1.0
+        if self.tau > 0 and t < self.delay + self.tau:
+            s = t - self.delay
+            return 0.5 * self.a_r * s * s
+        return self.base.u(t - self.shift)
+
+    def du(self, t: float) -> float:
+        if t <= self.delay:
+            return 0.0
+        if self.tau > 0 and t < self.delay + self.tau:
+            return self.a_r * (t - self.delay)
+        return self.base.du(t - self.shift)
+
+    def t_of_u(self, u: float) -> float:
+        if u <= 0.0:
+            return 0.0
+        if self.tau > 0 and u < self.u_e:
+            return self.delay + math.sqrt(2.0 * u / self.a_r)
+        return self.base.t_of_u(u) + self.shift
+
+    def t_of_speed_in_decel(self, fraction_of_v: float, v_ref: float) -> float:
+        return self.base.t_of_speed_in_decel(fraction_of_v, v_ref) + self.shift

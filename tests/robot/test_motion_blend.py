@@ -119,12 +119,13 @@ def test_advance_zero_prevents_approximation():
 
 def test_c_ptp_blend_per_axis_distance():
     """PTP (A1 0->60, A2 -90->-70) C_PTP with CPTP 20 % of $APO_DIS_PTP 90° = 18°, then
-    A2 -70->-110: the blend starts when every axis is within its distance."""
+    A2 -70->-50, A3 90->110: the blend starts when every axis is within its distance.
+    (No axis reverses; the reversing case is the next test.)"""
     P = MotionParams().with_(apo_cptp=20.0)
     home = {"A1": 0, "A2": -90, "A3": 90, "A4": 0, "A5": 0, "A6": 0}
     ctl, ev = _run([MotionRequest("PTP", home, P),
                     MotionRequest("PTP", dict(home, A1=60, A2=-70), P, approx="C_PTP"),
-                    MotionRequest("PTP", dict(home, A1=60, A2=-110), P)])
+                    MotionRequest("PTP", dict(home, A1=60, A2=-50, A3=110), P)])
     ph = _phases(ev, 2)
     a_bs = _pose_at(ev, ph["blend_start"])["axes"]
     a_prev = _pose_at(ev, ph["blend_start"] - DT)["axes"]
@@ -134,7 +135,27 @@ def test_c_ptp_blend_per_axis_distance():
     assert 60 - a_prev[0] > 18.0
     inside = [e["axes"] for e in ev if e["kind"] == "pose" and ph["blend_start"] <= e["t"] < ph["blend_end"]]
     assert max(abs(a[0] - 60) for a in inside) <= 18 + 1e-9
-    assert max(a[1] for a in inside) < -70.0 - 1.0  # the corner is cut: A2 never reaches -70
+    # the corner is cut: A3 moves while A1 is still short of 60
+    assert any(a[0] < 59.0 and a[2] > 91.0 for a in inside)
+
+
+def test_c_ptp_blend_with_a_reversing_axis_keeps_the_acceleration_limit():
+    """A2 -90->-70 then -70->-110 (A2 reverses): both PTPs accelerate A2 with its maximum
+    394.7 deg/s² (A2 leads: 394.7/20 < 1241.4/60), overlapping them would need 2x that, so
+    the next motion starts when the approximated one reaches its point (issue 15)."""
+    from robot.limits import check_trace
+
+    P = MotionParams().with_(apo_cptp=20.0)
+    home = {"A1": 0, "A2": -90, "A3": 90, "A4": 0, "A5": 0, "A6": 0}
+    ctl, ev = _run([MotionRequest("PTP", home, P),
+                    MotionRequest("PTP", dict(home, A1=60, A2=-70), P, approx="C_PTP"),
+                    MotionRequest("PTP", dict(home, A1=60, A2=-110), P)])
+    ph = _phases(ev, 2)
+    assert {"blend_start", "blend_end", "end"} <= set(ph)
+    a2 = [e["axes"][1] for e in ev if e["kind"] == "pose"]
+    assert max(a2) == pytest.approx(-70.0, abs=1e-6)
+    rep = check_trace(ev, ctl.machine)
+    assert rep.ok, [str(v) for v in rep.violations]
 
 
 def test_c_vel_blend_starts_in_deceleration():
