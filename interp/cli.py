@@ -25,11 +25,15 @@ import click
               help="Limit of executed statements and loop iterations.")
 @click.option("--submit", "submit", type=click.Path(path_type=Path), multiple=True,
               help="A submit program (.sub) to run beside the robot program (repeatable).")
+@click.option("--mode", "mode", type=click.Choice(["T1", "T2", "AUT", "EXT"], case_sensitive=False),
+              default="AUT", show_default=True,
+              help="Operating mode ($MODE_OP): T1 limits TCP and flange to 250 mm/s and PTP to "
+                   "$RED_T1; AUT is the unattended virtual controller (docs/robot.md).")
 @click.option("--check", "check", is_flag=True,
               help="Run the front end's checker first; like the controller, refuse to start a "
                    "program whose files have errors (exit 1).")
 def run(program: Path, interp_kind: str, workspace, inputs, trace_path, max_sim_time, max_steps, submit,
-        check) -> None:
+        mode, check) -> None:
     """Run PROGRAM (.src) on the simulated KR C4; print where and why it ended.
 
     With --workspace BACKUP.zip (a KRC backup archive) PROGRAM is a path inside the archive
@@ -51,12 +55,12 @@ def run(program: Path, interp_kind: str, workspace, inputs, trace_path, max_sim_
                     click.echo(f"error: no program {printable(program)} in {printable(workspace)}", err=True)
                     sys.exit(2)
                 _run(found, folder, inputs, trace_path, max_sim_time, max_steps, submit, check, interp_kind,
-                     shown=lambda text: text.replace(str(folder), str(workspace)))
+                     mode=mode, shown=lambda text: text.replace(str(folder), str(workspace)))
         except ArchiveError as exc:
             click.echo(f"error: {printable(exc)}", err=True)
             sys.exit(2)
         return
-    _run(program, workspace, inputs, trace_path, max_sim_time, max_steps, submit, check, interp_kind)
+    _run(program, workspace, inputs, trace_path, max_sim_time, max_steps, submit, check, interp_kind, mode=mode)
 
 
 def program_in(folder: Path, program: Path) -> Path | None:
@@ -77,7 +81,7 @@ def program_in(folder: Path, program: Path) -> Path | None:
 
 
 def _run(program: Path, workspace, inputs, trace_path, max_sim_time, max_steps, submit, check, interp_kind,
-         shown=lambda text: text) -> None:
+         mode=None, shown=lambda text: text) -> None:
     if not program.exists():
         click.echo(f"error: {program}: no such file", err=True)
         sys.exit(2)
@@ -99,7 +103,7 @@ def _run(program: Path, workspace, inputs, trace_path, max_sim_time, max_steps, 
     try:
         rt, _ = make_runtime(program, workspace=workspace, inputs=inputs, trace=trace,
                              max_sim_time=max_sim_time, max_steps=max_steps, submit=list(submit),
-                             interp=interp_kind, observer=observer)
+                             interp=interp_kind, observer=observer, mode=mode)
         res = rt.run()
     except StimulusError as exc:
         click.echo(f"error: {shown(printable(exc))}", err=True)

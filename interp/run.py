@@ -11,10 +11,13 @@ from interp.runtime.errors import ResourceError
 
 def make_runtime(program, *, workspace=None, inputs=None, trace=None, max_sim_time=None,
                  max_steps=None, submit=None, mujoco: bool = True, controller=None,
-                 robot_budget=None, interp: str = "tree", observer=None) -> tuple[Runtime, object]:
+                 robot_budget=None, interp: str = "tree", observer=None,
+                 mode: str | None = None) -> tuple[Runtime, object]:
     """Build the runtime and the interpreter (``interp``: tree or vm) for ``program``
     (not started yet). `observer` (an :class:`interp.summary.RunObserver`) sees the
-    controller's events on their way to `trace`; it is not used with a given `controller`."""
+    controller's events on their way to `trace`; it is not used with a given `controller`.
+    ``mode``: operating mode T1/T2/AUT/EXT (``$MODE_OP``; default AUT, robot/limits.py);
+    ignored with a given `controller` (it has its own)."""
     from interp.tree import TreeInterpreter  # noqa: PLC0415
 
     if controller is None:
@@ -23,7 +26,8 @@ def make_runtime(program, *, workspace=None, inputs=None, trace=None, max_sim_ti
         if observer is not None:
             observer.inner = trace
         controller = Controller(trace=observer if observer is not None else trace,
-                                stimuli=str(inputs) if inputs else None, mujoco=mujoco)
+                                stimuli=str(inputs) if inputs else None, mujoco=mujoco,
+                                mode_op=mode)
     rt = Runtime(program, workspace=workspace, controller=controller, trace=trace,
                  max_sim_time=max_sim_time, max_steps=max_steps, robot_budget=robot_budget)
     if observer is not None:

@@ -73,7 +73,7 @@ class Runtime:
         self.trace = trace if trace is not None else controller.trace
         self.current_task: Task | None = None
         self.random = random.Random(0)
-        self.mode_op = "T1"
+        self.mode_op = getattr(controller, "mode_op", "AUT")  # $MODE_OP (robot/limits.py)
         self.msg_handle = 0
         self.steps = 0
         self.max_steps = max_steps

@@ -126,8 +126,10 @@ def test_brake_and_resume(tmp_path):
     assert r.var("prog", "N1") == 7           # RESUME skipped the rest of SearchMove
     assert r.var("prog", "SEQ") == 1
     motions = r.kinds("motion")
-    # motion 2 (A1 170) never ended; motion 3 (A1 -170) was discarded; the next one is PTP {A1 0}
-    assert not any(e["id"] == 2 and e["phase"] == "end" for e in motions)
+    # motion 2 (A1 170) never reached its end: RESUME abandons it with an end/abort event
+    # (issue 15); motion 3 (A1 -170) was discarded; the next one is PTP {A1 0}
+    ends2 = [e for e in motions if e["id"] == 2 and e["phase"] == "end"]
+    assert [e.get("reason") for e in ends2] == ["abort"]
     assert not any(e["id"] == 3 and e["phase"] == "start" for e in motions)
     last = [e for e in motions if e["phase"] == "end"][-1]
     assert last["target"] == {"A1": 0.0}
