@@ -20,7 +20,8 @@ Each case is run through the ``krl run`` contract of issue 6 (``--interp tree|vm
   within one IPO cycle (12 ms) of the expectation (absolute, or relative to a motion event);
 * **paths** - properties of the TCP polyline (``pose`` events): straightness of LIN
   segments, circles, blend zone radius and where a blend starts and ends, exact stops,
-  durations (trapezoid profile by hand), reached points; controller messages; the ``end``.
+  durations (trapezoid profile by hand), reached points; controller messages; the ``end``;
+* **limits** - every case's trace keeps the motion limits (:func:`check_limits`, issue 15).
 
 Between the tree interpreter and the VM the whole trace is compared: the statement/call/
 interrupt sequence and the I/O events exactly (times included), and the TCP polylines by
@@ -953,6 +954,19 @@ _MOTION_CHECKS = {
 }
 
 
+def check_limits(events: list[dict[str, Any]]) -> list[Check]:
+    """The motion-limits property of issue 15 on a trace (robot/limits.py ``check_trace``):
+    path speed <= $VEL.CP·$OV_PRO, axes <= their programmed/machine speed (3 %), axis
+    accelerations <= machine data (10 %, finite differences), T1 250 mm/s."""
+    if not any(e.get("kind") == "pose" for e in events):
+        return []
+    from robot.limits import check_trace  # noqa: PLC0415
+
+    rep = check_trace(events)
+    return [Check("limits", rep.ok, "" if rep.ok else rep.summary() + ": "
+                  + "; ".join(str(v) for v in rep.violations[:5]))]
+
+
 def check_case(case: Case, res: RunResult) -> CaseResult:
     cr = CaseResult(case.name, res.interp, crash=res.crash, pending=case.pending_for(res.interp),
                     wall_s=res.wall_s)
@@ -970,6 +984,7 @@ def check_case(case: Case, res: RunResult) -> CaseResult:
     cr.checks += check_errors(case, ev)
     cr.checks += check_messages(case, ev)
     cr.checks += check_motion(case, ev)
+    cr.checks += check_limits(ev)
     if "exit_code" in case.expect:
         want = case.expect["exit_code"]
         cr.checks.append(Check("exit_code", res.exit_code == want,

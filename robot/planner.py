@@ -37,6 +37,9 @@ from .profiles import PiecewiseProfile, Trapezoid
 SINGULAR_JUMP_DEG = 90.0
 #: Factor on the axis maximum speed above which an interpolated CP setpoint is rejected.
 CP_SPEED_LIMIT_FACTOR = 1.5
+#: Largest axis step (deg) between the planning samples of a CP path (axis speed and
+#: acceleration are estimated from them).
+CP_SAMPLE_STEP_DEG = 1.0
 #: Safety factor on the sampled TCP/flange speed of a path in T1 (sampling between points).
 T1_MARGIN = 1.02
 
@@ -188,9 +191,9 @@ class ArcPiece(_Piece):
 
 class CatmullRomPiece(_Piece):
     """Uniform Catmull-Rom curve from P1 to P2 (neighbours P0, P3), re-parametrised by arc
-    length through a 48-point table (SPL points of a SPLINE block, reference §6.2 [U])."""
+    length through a 256-point table (SPL points of a SPLINE block, reference §6.2 [U])."""
 
-    N = 48
+    N = 256
 
     def __init__(self, P0: np.ndarray, P1: np.ndarray, P2: np.ndarray, P3: np.ndarray,
                  m1: np.ndarray | None = None, m2: np.ndarray | None = None) -> None:
@@ -768,6 +771,7 @@ def _plan_cart(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_T: 
     # corners between pieces: the velocity turns within one IPO cycle, so the corner speed
     # keeps |Δv|/Δt within $ACC.CP (reference §6.2: the spline is slowed at corners)
     vnode = [0.0] * (m + 1)
+    kink = [False] * (m + 1)
     for k in range(1, m):
         vnode[k] = math.inf
         A_, B_ = pieces[k - 1], pieces[k]
@@ -777,6 +781,7 @@ def _plan_cart(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_T: 
         cosang = float(np.clip(A_.tangent(A_.length) @ B_.tangent(0.0), -1.0, 1.0))
         ang = math.acos(cosang)
         if ang > 1e-3:
+            kink[k] = True
             a_c = min(speeds[k - 1][2], speeds[k][2])
             v_c = a_c * dt / (2.0 * math.sin(ang / 2.0))
             lk0 = A_.length * W / weights[k - 1]
@@ -795,19 +800,28 @@ def _plan_cart(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_T: 
     for k in range(m):
         L, th = pieces[k].length, thetas[k]
         nk = max(4, min(48, int(L / 25.0) + int(th / 5.0) + 4))
-        us = np.linspace(float(ub[k]), float(ub[k + 1]), nk + 1)
-        Q = np.empty((nk + 1, 6))
-        Q[0] = ref
-        for j in range(1, nk + 1):
-            pu, Ru = seg.pose_u(float(us[j]))
-            q = seg.ik(pu, Ru, ref)
-            jump = np.abs(q - ref)
-            if float(jump.max()) > SINGULAR_JUMP_DEG:
-                i = int(np.argmax(jump))
-                raise RobotError(f"CP path through a singularity: A{i + 1} would turn "
-                                 f"{jump[i]:.0f} deg at once (keep the status on CP paths)")
-            Q[j] = q
-            ref = q
+        start = ref
+        while True:
+            us = np.linspace(float(ub[k]), float(ub[k + 1]), nk + 1)
+            Q = np.empty((nk + 1, 6))
+            Q[0] = start
+            ref = start
+            for j in range(1, nk + 1):
+                pu, Ru = seg.pose_u(float(us[j]))
+                q = seg.ik(pu, Ru, ref)
+                jump = np.abs(q - ref)
+                if float(jump.max()) > SINGULAR_JUMP_DEG:
+                    i = int(np.argmax(jump))
+                    raise RobotError(f"CP path through a singularity: A{i + 1} would turn "
+                                     f"{jump[i]:.0f} deg at once (keep the status on CP paths)")
+                Q[j] = q
+                ref = q
+            # resolution: at most ~1° of any axis between samples (near a wrist singularity
+            # A4/A6 turn fast on a short piece of path), up to 256 samples per piece
+            step = float(np.max(np.abs(np.diff(Q, axis=0)))) if nk > 0 else 0.0
+            if step <= CP_SAMPLE_STEP_DEG or nk >= 256:
+                break
+            nk = min(256, int(nk * step / CP_SAMPLE_STEP_DEG) + 1)
         h = float(us[1] - us[0])
         if h <= 0:
             junction_q.append(Q[0].copy())
@@ -821,9 +835,12 @@ def _plan_cart(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_T: 
             seg.qd_start = d1[0].copy()
         if k == m - 1:
             seg.qd_end = d1[-1].copy()
+        # next to a corner the axis velocity turns within one IPO cycle (up to half of a_max,
+        # junction rule below) while the path brakes: the piece keeps the other half
+        budget = 0.5 if (kink[k] or kink[k + 1]) else 1.0
         with np.errstate(divide="ignore"):
             V = float(np.min(np.where(qd > 1e-9, v_ax / qd, np.inf)))
-            V = min(V, float(np.min(np.where(qdd > 1e-9, np.sqrt(0.5 * a_ax / qdd), np.inf))))
+            V = min(V, float(np.min(np.where(qdd > 1e-9, np.sqrt(0.5 * budget * a_ax / qdd), np.inf))))
         if model.mode == "T1":
             F = model.kin.forward_many(Q)
             dpf = float(np.max(np.linalg.norm(np.diff(F[:, :3, 3], axis=0), axis=1))) / h
@@ -832,7 +849,7 @@ def _plan_cart(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_T: 
                 V = min(V, T1_SPEED_MM_S / (dpf * T1_MARGIN))
         vmax[k] = min(vmax[k], V)
         with np.errstate(divide="ignore"):
-            Aax = float(np.min(np.where(qd > 1e-9, (a_ax - qdd * vmax[k] ** 2) / qd, np.inf)))
+            Aax = float(np.min(np.where(qd > 1e-9, (budget * a_ax - qdd * vmax[k] ** 2) / qd, np.inf)))
         amax[k] = min(amax[k], max(Aax, 1e-9))
         seg.vel_peak = np.maximum(seg.vel_peak, qd * vmax[k])
         seg.acc_peak = np.maximum(seg.acc_peak, qdd * vmax[k] ** 2 + qd * amax[k])

@@ -2,7 +2,7 @@
 
 tree == vm for each program, each run ends with an `end` event and no internal error (a KRL
 run-time error or a legitimate stop is a clean outcome; the corpus report of issue 6 classifies
-those), and each program of the CI sample really runs statements. CI runs an evenly spaced
+those), each trace keeps the motion limits (issue 15), and each program of the CI sample really runs statements. CI runs an evenly spaced
 sample of 8 programs among those not listed in corpus/known-invalid.csv (those cannot start:
 their files have syntax errors); the whole corpus runs in the `slow` sweep."""
 
@@ -55,6 +55,8 @@ def _check(prog, request=None, must_run: bool = False):
     for it, r in runs.items():
         prob = H.clean_run_problem(r)
         assert prob is None, f"{prog} on {it}: {prob}"
+        bad = [c for c in H.check_limits(r.events) if not c.ok]  # issue 15
+        assert not bad, f"{prog} on {it}: {bad[0].detail}"
     if must_run:
         for it, r in runs.items():
             stmts = [e for e in r.events if e.get("kind") == "stmt"]

@@ -1,0 +1,130 @@
+"""Property (issue 15): whatever motion sequence a program asks for — PTP, LIN, CIRC, SPTP,
+SPLINE blocks with SPL/SLIN/SCIRC, every approximation kind, random targets within reach,
+random $VEL/$OV_PRO/$APO, T1 or AUT — the trace keeps the limits: path speed <= $VEL.CP ·
+$OV_PRO (3 %), PTP axes <= $VEL_AXIS · v_max (3 %), every axis <= machine speed (3 %) and
+acceleration (10 %, finite differences), TCP/flange <= 250 mm/s in T1. Checked from the pose
+events with robot/limits.py. Motions the planner refuses (unreachable, singular) are left
+out, as an advance run would stop there."""
+
+from __future__ import annotations
+
+import numpy as np
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from robot.controller import Controller
+from robot.errors import RobotError
+from robot.frames import matrix_to_frame
+from robot.kinematics import Kinematics
+from robot.limits import check_trace
+from robot.machine import load_machine
+from robot.motion import MotionParams, MotionRequest, SplineSegment
+from robot.trace import TraceWriter
+from tests.budget import examples
+
+M = load_machine()
+KIN = Kinematics(M)
+HOME = (0.0, -90.0, 90.0, 0.0, 60.0, 0.0)
+# a comfortable part of the workspace: wrist away from A5 = 0, arm not stretched
+RANGES = ((-70, 70), (-115, -55), (60, 125), (-60, 60), (25, 105), (-90, 90))
+
+axes_st = st.tuples(*[st.floats(lo, hi, allow_nan=False) for lo, hi in RANGES])
+approx_st = st.sampled_from([None, "C_PTP", "C_DIS", "C_VEL", "C_ORI", "C_SPL"])
+
+
+@st.composite
+def params_st(draw):
+    return MotionParams().with_(
+        vel_cp=draw(st.floats(0.1, 2.0)), ov_pro=draw(st.sampled_from([30.0, 100.0])),
+        vel_axis=(draw(st.floats(10.0, 100.0)),) * 6,
+        apo_cdis=draw(st.floats(1.0, 120.0)), apo_cptp=draw(st.floats(1.0, 100.0)),
+        apo_cvel=draw(st.floats(10.0, 100.0)), apo_cori=draw(st.floats(1.0, 30.0)),
+        ori_type=draw(st.sampled_from(["VAR", "VAR", "CONSTANT"])))
+
+
+@st.composite
+def step_st(draw):
+    kind = draw(st.sampled_from(["PTP", "SPTP", "LIN", "CIRC", "SPLINE"]))
+    step = {"kind": kind, "q": draw(axes_st), "approx": draw(approx_st), "params": draw(params_st()),
+            "bulge": draw(st.floats(-120.0, 120.0))}
+    if kind == "SPLINE":
+        step["segs"] = draw(st.lists(st.tuples(st.sampled_from(["SPL", "SLIN", "SCIRC"]), axes_st,
+                                               st.floats(-80.0, 80.0)), min_size=2, max_size=5))
+    return step
+
+
+def _pose(q):
+    return matrix_to_frame(KIN.forward(np.asarray(q, dtype=float)))
+
+
+def _cart(q):
+    return dict(zip("XYZABC", _pose(q)))
+
+
+def _aux(p0, p1, bulge):
+    """An auxiliary point: the chord's midpoint pushed sideways by ``bulge`` mm (horizontal)."""
+    a, b = np.asarray(p0[:3]), np.asarray(p1[:3])
+    d = b - a
+    n = np.array([-d[1], d[0], 0.0])
+    if np.linalg.norm(n) < 1e-3 or np.linalg.norm(d) < 5.0:
+        return None
+    m = 0.5 * (a + b) + bulge * n / np.linalg.norm(n)
+    return {"X": float(m[0]), "Y": float(m[1]), "Z": float(m[2])}
+
+
+def _requests(steps):
+    cur = _pose(HOME)
+    out = [MotionRequest("PTP", dict(zip(("A1", "A2", "A3", "A4", "A5", "A6"), HOME)), MotionParams())]
+    for s in steps:
+        P, q, k = s["params"], s["q"], s["kind"]
+        ax = s["approx"]
+        if k in ("PTP", "SPTP"):
+            out.append(MotionRequest(k, dict(zip(("A1", "A2", "A3", "A4", "A5", "A6"), q)), P, approx=ax,
+                                     approx2=ax and "C_DIS"))
+            cur = _pose(q)
+        elif k == "LIN":
+            out.append(MotionRequest("LIN", _cart(q), P, approx=ax))
+            cur = _pose(q)
+        elif k == "CIRC":
+            end = _pose(q)
+            aux = _aux(cur, end, s["bulge"])
+            if aux is None:
+                continue
+            out.append(MotionRequest("CIRC", _cart(q), P, approx=ax, aux=aux))
+            cur = end
+        else:
+            segs = []
+            for kind, qs, bulge in s["segs"]:
+                end = _pose(qs)
+                if kind == "SCIRC":
+                    aux = _aux(cur, end, bulge)
+                    if aux is None:
+                        kind, aux = "SLIN", None
+                    segs.append(SplineSegment(kind, _cart(qs), aux=aux))
+                else:
+                    segs.append(SplineSegment(kind, _cart(qs)))
+                cur = end
+            out.append(MotionRequest("SPLINE", {}, P, approx=ax, segments=tuple(segs)))
+    return out
+
+
+@settings(max_examples=examples(10), deadline=None,
+          suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+@given(steps=st.lists(step_st(), min_size=1, max_size=5), mode=st.sampled_from(["AUT", "AUT", "T1"]))
+def test_every_trace_keeps_the_limits(steps, mode):
+    tw = TraceWriter(keep=True)
+    ctl = Controller(trace=tw, mujoco=False, mode_op=mode)
+    planned = 0
+    for req in _requests(steps):
+        while not ctl.can_enqueue():
+            ctl.step()
+        try:
+            ctl.enqueue(req)
+            planned += 1
+        except RobotError:
+            continue  # the advance run would stop at this motion
+        if ctl.time > 120.0:
+            break
+    ctl.step_until(ctl.is_idle, max_cycles=200_000)
+    rep = check_trace(tw.events, M)
+    assert rep.ok, f"{rep.summary()}\n" + "\n".join(str(v) for v in rep.violations[:10])
