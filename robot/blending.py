@@ -23,7 +23,12 @@ Model (documented in docs/robot.md, "Motion"):
   PTP→PTP with ``C_PTP``, with the per-axis rule and the ``$APO.CPTP`` of the *next* motion
   (KSS 8 per-point rule, reference §6.8).
 
-* **Contour** — the next segment starts (its own time law, from rest) at the blend start.
+* **Contour (issue 15)** — :func:`plan_blend`: from the blend start the approximated motion
+  brakes uniformly through the rest of the zone and the next one ramps up uniformly to its
+  blend end, both over the same window, and the two are overlapped (below), so the path
+  speed never exceeds the faster programmed speed. The text below describes the original
+  overlap (next segment from rest with its own time law) and the convex combination, which
+  the controller no longer uses.
   Preferred: the *overlap of the velocity profiles* ``x = x_prev(t) + (x_next(t) - P)``
   (axis values for blends with a PTP side), used when :func:`overlap_ok` proves it stays
   in the zone; the blend then ends when the approximated motion reaches its point and the

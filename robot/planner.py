@@ -1,8 +1,9 @@
 """Motion planning: a :class:`~robot.motion.MotionRequest` becomes a :class:`Segment` that
 the main run samples every IPO cycle (reference §6.3-§6.7, robot-model.md §7-§8).
 
-A segment is a geometric path plus one normalised trapezoidal time law
-(:mod:`robot.profiles`):
+A segment is a geometric path plus one normalised time law (:mod:`robot.profiles`: a
+trapezoid, or a piecewise profile for a SPLINE block; CP paths are slowed so the axes keep
+machine data, issue 15):
 
 * :class:`JointSegment` (PTP, SPTP): ``q(u) = q0 + u·(q1 - q0)``, synchronised axes.
 * :class:`CartSegment` (LIN, CIRC, SLIN, SCIRC, SPLINE): the TCP moves in ``$BASE`` along
@@ -113,6 +114,21 @@ class RobotModel:
                 break
             q[:3] += np.clip(dx, -20.0, 20.0)
         raise WorkspaceError("workspace error: target not reachable ($ORI_TYPE #JOINT)")
+
+
+def rotvec_matrix(v: np.ndarray) -> np.ndarray:
+    """Rotation matrix of a rotation vector (rad), Rodrigues' formula (the same matrix as
+    scipy's ``Rotation.from_rotvec(v).as_matrix()`` to rounding, without its overhead)."""
+    x, y, z = float(v[0]), float(v[1]), float(v[2])
+    th = math.sqrt(x * x + y * y + z * z)
+    if th < 1e-12:
+        return np.eye(3)
+    s, c = math.sin(th), math.cos(th)
+    x, y, z = x / th, y / th, z / th
+    C = 1.0 - c
+    return np.array([[c + x * x * C, x * y * C - z * s, x * z * C + y * s],
+                     [y * x * C + z * s, c + y * y * C, y * z * C - x * s],
+                     [z * x * C - y * s, z * y * C + x * s, c + z * z * C]])
 
 
 # ------------------------------------------------------------------------- path pieces
@@ -434,10 +450,10 @@ class CartSegment(Segment):
             elif f >= 1.0:
                 R = self._R[k + 1]
             else:
-                R = self._R[k] @ Rotation.from_rotvec(f * self._rv[k]).as_matrix()
+                R = self._R[k] @ rotvec_matrix(f * self._rv[k])
         elif mode == "PATH":
             assert isinstance(piece, ArcPiece)
-            R = Rotation.from_rotvec(piece.n * piece.phi(f * piece.length)).as_matrix() @ self._R[k]
+            R = rotvec_matrix(piece.n * piece.phi(f * piece.length)) @ self._R[k]
         else:  # CONSTANT
             R = self._R[k]
         return p, R
@@ -799,7 +815,7 @@ def _plan_cart(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_T: 
     junction_q: list[np.ndarray] = []
     for k in range(m):
         L, th = pieces[k].length, thetas[k]
-        nk = max(4, min(48, int(L / 25.0) + int(th / 5.0) + 4))
+        nk = max(4, min(48, int(L / 50.0) + int(th / 10.0) + 4))
         start = ref
         while True:
             us = np.linspace(float(ub[k]), float(ub[k + 1]), nk + 1)
