@@ -187,6 +187,22 @@ def _progress_norm(seg: Segment, u: float, u_e: float) -> float:
     return u / u_e if u_e > 0 else (0.0 if u <= 0 else 2.0)
 
 
+def _below(v_of_u: Any, base: Any, u0: float, u1: float) -> bool:
+    """Is the speed law ``v_of_u`` (du/dt as a function of u) at or below the planned
+    profile ``base`` on [u0, u1]? Checked on 24 points plus the base's section bounds."""
+    if u1 <= u0:
+        return True
+    us = list(np.linspace(u0, u1, 26)[1:-1])
+    us += [b for b in getattr(base, "bounds", ()) if u0 < b < u1]
+    for u in us:
+        vb = base.du(base.t_of_u(float(u)))
+        if v_of_u(float(u)) > vb * (1.0 + 1e-6) + 1e-12:
+            # at a section bound the planned speed is the junction speed: compare with the
+            # smaller of the speeds just before and after
+            return False
+    return True
+
+
 @dataclass
 class BlendPlan:
     """How a blend runs (issue 15), from :func:`plan_blend`: the new time laws of the two
@@ -219,6 +235,11 @@ def plan_blend(prev: Segment, nxt: Segment, keyword: str, tau_a: float) -> Blend
     tau_p = bp.t_total - tau_a if bp.tau > 0 else 0.0
     if tau_p <= 0.0 or nxt.T <= 0.0:
         return BlendPlan(bp, RampProfile(nxt.profile, 0.0), 0.0)
+    # the uniform braking must stay below the planned speed everywhere (a spline block's
+    # corners and curves have lower speeds than the blend start): else no blend before the point
+    if not _below(lambda u: math.sqrt(max(0.0, bp.v_a ** 2 - 2.0 * bp.a_b * (u - bp.u_a))),
+                  prev.profile, bp.u_a, 1.0):
+        return None
     base = nxt.profile
     u_max = base.u(blend_end_tau(prev, nxt, keyword, tau_a))
     u_max = min(u_max, base.u(max(0.0, base.t_total - getattr(base, "t_brake", base.t_acc))))
@@ -242,6 +263,17 @@ def plan_blend(prev: Segment, nxt: Segment, keyword: str, tau_a: float) -> Blend
             else:
                 hi = mid
         rp = RampProfile(base, lo, tau_p - ramp_time(lo))
+    if rp.tau > 0 and not _below(lambda u: math.sqrt(2.0 * rp.a_r * u), base, 0.0, rp.u_e):
+        lo, hi = 0.0, rp.u_e  # a shorter ramp (at its shortest it is the planned acceleration)
+        for _ in range(30):
+            mid = 0.5 * (lo + hi)
+            t_m = ramp_time(mid)
+            cand = RampProfile(base, mid, max(0.0, tau_p - t_m))
+            if cand.tau <= 0 or _below(lambda u, c=cand: math.sqrt(2.0 * c.a_r * u), base, 0.0, mid):
+                lo = mid
+            else:
+                hi = mid
+        rp = RampProfile(base, lo, max(0.0, tau_p - ramp_time(lo)))
     rev = (prev.qd_end * nxt.qd_start) < 0
     a_sum = np.abs(prev.qd_end) * bp.a_b + np.abs(nxt.qd_start) * rp.a_r
     if np.any(rev & (a_sum > prev.model.a_max * (1.0 + 1e-6))):

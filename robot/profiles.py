@@ -218,6 +218,7 @@ class PiecewiseProfile:
         self.a_start = acc[0] if acc and acc[0] > 0 else self.a
         self.t_dec = t - self.t_brake
         self.vnode = vn
+        self.bounds = [float(b) for b in bounds]
 
     def _phase(self, t: float) -> int:
         from bisect import bisect_right
@@ -292,6 +293,7 @@ class BrakeProfile:
         self.t_acc = base.t_acc
         self.t_brake = self.tau if self.tau > 0 else getattr(base, "t_brake", base.t_acc)
         self.t_dec = self.t_total - self.t_brake
+        self.bounds = getattr(base, "bounds", [0.0, 1.0])
 
     def u(self, t: float) -> float:
         if self.tau <= 0:
@@ -355,6 +357,7 @@ class RampProfile:
         self.t_acc = self.delay + (self.tau if self.tau > 0 else base.t_acc)
         self.t_brake = getattr(base, "t_brake", base.t_acc)
         self.t_dec = self.t_total - self.t_brake
+        self.bounds = getattr(base, "bounds", [0.0, 1.0])
 
     def u(self, t: float) -> float:
         if t <= self.delay:
