@@ -813,6 +813,7 @@ def _plan_cart(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_T: 
     v_ax = model.v_max
     a_ax = model.a_max
     junction_q: list[np.ndarray] = []
+    sec_d: list[tuple[np.ndarray, np.ndarray, float]] = []
     for k in range(m):
         L, th = pieces[k].length, thetas[k]
         nk = max(4, min(48, int(L / 50.0) + int(th / 10.0) + 4))
@@ -841,6 +842,7 @@ def _plan_cart(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_T: 
         h = float(us[1] - us[0])
         if h <= 0:
             junction_q.append(Q[0].copy())
+            sec_d.append((np.zeros(6), np.zeros(6), 1.0))
             continue
         d1 = np.gradient(Q, h, axis=0, edge_order=2)
         d2 = np.gradient(d1, h, axis=0, edge_order=2)
@@ -867,8 +869,19 @@ def _plan_cart(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_T: 
         with np.errstate(divide="ignore"):
             Aax = float(np.min(np.where(qd > 1e-9, (budget * a_ax - qdd * vmax[k] ** 2) / qd, np.inf)))
         amax[k] = min(amax[k], max(Aax, 1e-9))
-        seg.vel_peak = np.maximum(seg.vel_peak, qd * vmax[k])
-        seg.acc_peak = np.maximum(seg.acc_peak, qdd * vmax[k] ** 2 + qd * amax[k])
+        sec_d.append((qd, qdd, budget))
+
+    def rebudget(k: int) -> None:
+        """Half the axis acceleration for piece k (a junction turns the axis velocities)."""
+        qd, qdd, b = sec_d[k]
+        if b <= 0.5:
+            return
+        sec_d[k] = (qd, qdd, 0.5)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            vmax[k] = min(vmax[k], float(np.min(np.where(qdd > 1e-9, np.sqrt(0.25 * a_ax / qdd), np.inf))))
+            Aax = float(np.min(np.where(qd > 1e-9, (0.5 * a_ax - qdd * vmax[k] ** 2) / qd, np.inf)))
+        amax[k] = min(amax[k], max(Aax, 1e-9))
+
     for k in range(1, m):  # axis-velocity jumps where pieces meet (one-sided derivatives)
         if vnode[k] <= 0.0:
             continue
@@ -877,9 +890,19 @@ def _plan_cart(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_T: 
         qL = seg.ik(*seg.pose_u(uk - du_), qj)
         qR = seg.ik(*seg.pose_u(uk + du_), qj)
         jump = np.abs((qR - qj) - (qj - qL)) / du_
-        with np.errstate(divide="ignore"):
-            vj = float(np.min(np.where(jump > 1e-6, 0.5 * a_ax * dt / jump, np.inf)))
-        vnode[k] = min(vnode[k], vj)
+        # a jump that matters at full speed (> 5 % of a_max within one cycle; e.g. the
+        # orientation rate changing between pieces) is a corner for the axes
+        v_full = min(vmax[k - 1], vmax[k])
+        if np.any(jump * v_full > 0.05 * a_ax * dt):
+            rebudget(k - 1)
+            rebudget(k)
+            with np.errstate(divide="ignore"):
+                vj = float(np.min(np.where(jump > 1e-9, 0.5 * a_ax * dt / jump, np.inf)))
+            vnode[k] = min(vnode[k], vj)
+    for k in range(m):
+        qd, qdd, _ = sec_d[k]
+        seg.vel_peak = np.maximum(seg.vel_peak, qd * vmax[k])
+        seg.acc_peak = np.maximum(seg.acc_peak, qdd * vmax[k] ** 2 + qd * amax[k])
     if m == 1:
         prof: Any = Trapezoid.plan(vmax[0], amax[0])
     else:
