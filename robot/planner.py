@@ -219,13 +219,28 @@ class CatmullRomPiece(_Piece):
         P0, P1, P2, P3 = (np.asarray(v, dtype=float) for v in (P0, P1, P2, P3))
         m1 = 0.5 * (P2 - P0) if m1 is None else np.asarray(m1, dtype=float)
         m2 = 0.5 * (P3 - P1) if m2 is None else np.asarray(m2, dtype=float)
-        if float(np.linalg.norm(P2 - P1)) <= 1e-9:
+        chord = P2 - P1
+        if float(np.linalg.norm(chord)) <= 1e-9:
             m1 = m2 = np.zeros(3)
+        ts = np.linspace(0.0, 1.0, self.N + 1)
+        # no cusp or loop: the curve must keep moving towards P2 (tangent · chord > 0); else
+        # the end tangents are shortened (halved up to 4 times, then zero: a straight piece
+        # whose junctions are corners)
+        for attempt in range(6):
+            c1 = m1
+            c2 = 3.0 * chord - 2.0 * m1 - m2
+            c3 = -2.0 * chord + m1 + m2
+            d = c1 + ts[1:-1, None] * (2.0 * c2 + 3.0 * ts[1:-1, None] * c3)
+            if float(np.linalg.norm(chord)) <= 1e-9 or float(np.min(d @ chord)) > 0.0:
+                break
+            if attempt >= 4:
+                m1 = m2 = np.zeros(3)
+            else:
+                m1, m2 = 0.5 * m1, 0.5 * m2
         self.c0 = P1
         self.c1 = m1
-        self.c2 = 3.0 * (P2 - P1) - 2.0 * m1 - m2
-        self.c3 = 2.0 * (P1 - P2) + m1 + m2
-        ts = np.linspace(0.0, 1.0, self.N + 1)
+        self.c2 = 3.0 * chord - 2.0 * m1 - m2
+        self.c3 = -2.0 * chord + m1 + m2
         pts = self.c0 + ts[:, None] * (self.c1 + ts[:, None] * (self.c2 + ts[:, None] * self.c3))
         seg = np.linalg.norm(np.diff(pts, axis=0), axis=1)
         self._s = np.concatenate([[0.0], np.cumsum(seg)])
@@ -244,7 +259,11 @@ class CatmullRomPiece(_Piece):
         t = float(np.interp(s, self._s, self._t)) if self.length > 0 else 0.0
         d = self.c1 + t * (2.0 * self.c2 + 3.0 * t * self.c3)
         n = float(np.linalg.norm(d))
-        return d / n if n > 1e-12 else np.zeros(3)
+        if n > 1e-9:
+            return d / n
+        c = 3.0 * (self.c0 + self.c1 + self.c2 + self.c3 - self.c0)  # zero end tangent: the
+        nc = float(np.linalg.norm(c))                                  # curve leaves along the chord
+        return c / nc if nc > 1e-12 else np.zeros(3)
 
     def _at(self, t: float) -> np.ndarray:
         return self.c0 + t * (self.c1 + t * (self.c2 + t * self.c3))
