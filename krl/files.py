@@ -114,17 +114,22 @@ def _links_to_folder(e: os.DirEntry) -> bool:
         return False
 
 
-def write_text_atomic(path: str | Path, text: str) -> None:
-    """Write `text` (UTF-8) to `path` atomically: into a temporary file in the same folder,
-    then renamed over `path`, so a reader (or a crash) never sees half a file."""
+def write_bytes_atomic(path: str | Path, data: bytes, mode: int | None = 0o644) -> None:
+    """Write `data` to `path` atomically: into a temporary file in the same folder, flushed to
+    disk, then renamed over `path`, so a reader (or a crash) never sees half a file.
+    mode: the new file's permission bits (None: keep those of the existing file). Raises OSError."""
     import tempfile  # noqa: PLC0415
 
     path = Path(path)
+    if mode is None:
+        mode = path.stat().st_mode & 0o7777
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
     try:
-        with os.fdopen(fd, "w", encoding="utf-8") as fh:
-            fh.write(text)
-        os.chmod(tmp, 0o644)
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(data)
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.chmod(tmp, mode)
         os.replace(tmp, path)
     except BaseException:
         try:
@@ -132,3 +137,8 @@ def write_text_atomic(path: str | Path, text: str) -> None:
         except OSError:
             pass
         raise
+
+
+def write_text_atomic(path: str | Path, text: str) -> None:
+    """:func:`write_bytes_atomic` of `text` in UTF-8, mode 0644."""
+    write_bytes_atomic(path, text.encode("utf-8"))

@@ -22,7 +22,6 @@ import difflib
 import os
 import re
 import sys
-import tempfile
 from pathlib import Path
 
 import click
@@ -82,25 +81,11 @@ def unified_diff(path: str, before: str, after: str) -> list[str]:
 
 
 def write_atomically(path: Path, data: bytes) -> None:
-    """Replace the file's content: write a temporary file next to it, then rename it over the
-    file (the target of a symbolic link is replaced, the link kept); the file's mode is kept.
-    Raises OSError."""
-    target = Path(os.path.realpath(path))
-    mode = target.stat().st_mode & 0o7777
-    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".krlfmt", dir=target.parent)
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(data)
-            fh.flush()
-            os.fsync(fh.fileno())
-        os.chmod(tmp, mode)
-        os.replace(tmp, target)
-    except BaseException:
-        try:
-            os.unlink(tmp)
-        except OSError:
-            pass
-        raise
+    """Replace the file's content atomically (krl/files.py), keeping its mode; the target of a
+    symbolic link is replaced, the link kept. Raises OSError."""
+    from krl.files import write_bytes_atomic  # noqa: PLC0415
+
+    write_bytes_atomic(Path(os.path.realpath(path)), data, mode=None)
 
 
 def run_fmt(paths, check: bool = False, diff: bool = False, options: FormatOptions | None = None,
