@@ -40,13 +40,9 @@ end })
 
 def neovim() -> str | None:
     """nvim, installed with apt-get when missing (as the test set-up); None if that fails."""
-    found = shutil.which("nvim")
-    if found:
-        return found
-    if shutil.which("apt-get") is None or os.geteuid() != 0:
-        return None
-    subprocess.run(["apt-get", "install", "-y", "neovim"], capture_output=True, timeout=600, check=False)
-    return shutil.which("nvim")
+    from tests.apt import apt_install  # noqa: PLC0415
+
+    return apt_install("neovim", "nvim")
 
 
 @pytest.mark.may_skip("Neovim is not installed and cannot be installed here (no apt-get, not root, or no package source)")

@@ -1,0 +1,30 @@
+"""Installing a Debian package a test needs (chromium, neovim) as the test set-up does on a fresh
+machine: `apt-get install`, then `apt-get update` and install again when the package lists are
+stale. Used only by tests marked may_skip: if the package cannot be installed (not root, no
+apt-get, no network), the caller skips with a clear reason."""
+
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+
+
+def apt_install(package: str, binary: str) -> str | None:
+    """The path of `binary`, installing `package` first when it is missing; None if it cannot be
+    installed. Never raises."""
+    found = shutil.which(binary)
+    if found:
+        return found
+    if shutil.which("apt-get") is None or os.geteuid() != 0:
+        return None
+    env = dict(os.environ, DEBIAN_FRONTEND="noninteractive")
+    try:
+        for step in (["install"], ["update"], ["install"]):
+            args = ["apt-get", *step, "-y", "-q"] + ([package] if step == ["install"] else [])
+            subprocess.run(args, env=env, capture_output=True, timeout=900, check=False)
+            if shutil.which(binary):
+                return shutil.which(binary)
+    except (OSError, subprocess.TimeoutExpired):
+        return None
+    return shutil.which(binary)
