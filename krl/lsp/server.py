@@ -260,26 +260,28 @@ def create_server() -> KrlLanguageServer:
         line, col = from_position(an.files[path].lines, pos, ls.codec())
         return an, path, line, col
 
+    async def target(ls: KrlLanguageServer, td, pos: L.Position):
+        """(analysis, the name under the cursor) or (None, None) when there is none."""
+        an, path, line, col = await place(ls, td, pos)
+        if an is None:
+            return None, None
+        t = _nav.resolve(an, path, line, col)
+        return (an, t) if t is not None else (None, None)
+
     def location(ls: KrlLanguageServer, an: Analysis, p: _nav.Place) -> L.Location:
         return L.Location(uri=uri_of(p.path), range=to_range(an.files[p.path].lines, p.line, p.column, p.length, ls.codec()))
 
     @server.feature(L.TEXT_DOCUMENT_DEFINITION)
     @guarded()
     async def definition(ls: KrlLanguageServer, params: L.DefinitionParams):
-        an, path, line, col = await place(ls, params.text_document, params.position)
-        if an is None:
-            return None
-        t = _nav.resolve(an, path, line, col)
+        an, t = await target(ls, params.text_document, params.position)
         p = _nav.definition(an, t) if t is not None else None
         return [location(ls, an, p)] if p is not None else None
 
     @server.feature(L.TEXT_DOCUMENT_REFERENCES)
     @guarded(list)
     async def references(ls: KrlLanguageServer, params: L.ReferenceParams):
-        an, path, line, col = await place(ls, params.text_document, params.position)
-        if an is None:
-            return []
-        t = _nav.resolve(an, path, line, col)
+        an, t = await target(ls, params.text_document, params.position)
         if t is None:
             return []
         include = params.context.include_declaration if params.context is not None else True
@@ -288,10 +290,7 @@ def create_server() -> KrlLanguageServer:
     @server.feature(L.TEXT_DOCUMENT_HOVER)
     @guarded()
     async def hover(ls: KrlLanguageServer, params: L.HoverParams):
-        an, path, line, col = await place(ls, params.text_document, params.position)
-        if an is None:
-            return None
-        t = _nav.resolve(an, path, line, col)
+        an, t = await target(ls, params.text_document, params.position)
         if t is None:
             return None
         text = _hover.hover_text(an, t)
