@@ -437,30 +437,29 @@ def format_parsed(text: str, result: ParseResult, options: FormatOptions) -> str
     return formatted
 
 
+def _nearest_code(lines: list[list], order) -> list[int | None]:
+    """For each line, walking `order`, the index of the last code line seen before it (None
+    after a kept non-blank line: a fold, header or inline form stops the search)."""
+    found: list[int | None] = [None] * len(lines)
+    last = None
+    for i in order:
+        found[i] = last
+        kind = lines[i][0]
+        if kind == "code":
+            last = i
+        elif kind == "keep" and lines[i][1].strip():
+            last = None
+    return found
+
+
 def _place_comments(lines: list[list]) -> list[str]:
     """Second pass: the text of each line. A full comment line indented exactly like the next
     code line (or else the previous one) moves with it; any other comment line (column 1,
     aligned with something else) keeps its indentation. Blank and comment lines between are
     skipped when looking for that code line; a kept line (fold, header, inline form) stops it."""
     n = len(lines)
-    nxt: list[int | None] = [None] * n
-    prv: list[int | None] = [None] * n
-    last = None
-    for i in range(n):
-        prv[i] = last
-        kind = lines[i][0]
-        if kind == "code":
-            last = i
-        elif kind == "keep" and lines[i][1].strip():
-            last = None
-    last = None
-    for i in range(n - 1, -1, -1):
-        nxt[i] = last
-        kind = lines[i][0]
-        if kind == "code":
-            last = i
-        elif kind == "keep" and lines[i][1].strip():
-            last = None
+    prv = _nearest_code(lines, range(n))
+    nxt = _nearest_code(lines, range(n - 1, -1, -1))
     out = []
     for i, (kind, body, old, new) in enumerate(lines):
         if kind == "keep":
