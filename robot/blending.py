@@ -26,20 +26,9 @@ Model (documented in docs/robot.md, "Motion"):
 * **Contour (issue 15)** — :func:`plan_blend`: from the blend start the approximated motion
   brakes uniformly through the rest of the zone and the next one ramps up uniformly to its
   blend end, both over the same window, and the two are overlapped (below), so the path
-  speed never exceeds the faster programmed speed. The text below describes the original
-  overlap (next segment from rest with its own time law) and the convex combination, which
-  the controller no longer uses.
-  Preferred: the *overlap of the velocity profiles* ``x = x_prev(t) + (x_next(t) - P)``
-  (axis values for blends with a PTP side), used when :func:`overlap_ok` proves it stays
-  in the zone; the blend then ends when the approximated motion reaches its point and the
-  speed never exceeds the sum of the two profiles (no overshoot for equal accelerations).
-  Otherwise, during the blend window the setpoint is the convex combination
-  ``x = (1-w)·x_prev(t) + w·x_next(t)`` with ``w`` = smoothstep over the window. ``x_prev``
-  only moves from the blend start to the programmed point and ``x_next`` only from the
-  programmed point to the blend end, so every blended setpoint lies in the convex hull of
-  points within the zone: **the contour stays inside the approximation sphere** (CP-CP,
-  Cartesian combination, orientation by slerp) or inside the axis-space box (blends with a
-  PTP side are combined in axis space). Position and velocity are continuous at both ends.
+  speed never exceeds the faster programmed speed. The setpoint is the *overlap of the
+  velocity profiles* ``x = x_prev(t) + (x_next(t) - P)`` (:func:`superpose_pose`; axis values
+  for blends with a PTP side); the blend ends when the approximated motion reaches its point.
 """
 
 from __future__ import annotations
@@ -49,10 +38,9 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from .planner import CartSegment, JointSegment, Segment
-from .profiles import BrakeProfile, RampProfile, smoothstep
+from .profiles import BrakeProfile, RampProfile
 
 
 def effective_keyword(prev: Segment, nxt: Segment | None) -> str | None:
@@ -168,25 +156,6 @@ def blend_end_tau(prev: Segment, nxt: Segment, keyword: str, tau_start: float) -
     return nxt.profile.t_of_u(nxt.u_of_path(min(d_start, L / 2.0)))
 
 
-def _remaining_norm(seg: Segment, u: float, u_a: float) -> float:
-    """Remaining part of ``seg`` after parameter u, relative to the part left at the blend
-    start u_a (1 at the blend start, 0 at the programmed point): path length for CP, the
-    parameter (= every axis' share) for PTP."""
-    if isinstance(seg, CartSegment):
-        L = seg.path_length
-        den = L - seg.s_of_u(u_a)
-        return (L - seg.s_of_u(u)) / den if den > 0 else 0.0
-    return (1.0 - u) / (1.0 - u_a) if u_a < 1.0 else 0.0
-
-
-def _progress_norm(seg: Segment, u: float, u_e: float) -> float:
-    """Progress of ``seg`` up to parameter u relative to the blend-end parameter u_e."""
-    if isinstance(seg, CartSegment):
-        den = seg.s_of_u(u_e)
-        return seg.s_of_u(u) / den if den > 0 else (0.0 if u <= 0 else 2.0)
-    return u / u_e if u_e > 0 else (0.0 if u <= 0 else 2.0)
-
-
 def _below(v_of_u: Any, base: Any, u0: float, u1: float) -> bool:
     """Is the speed law ``v_of_u`` (du/dt as a function of u) at or below the planned
     profile ``base`` on [u0, u1]? Checked on 24 points plus the base's section bounds."""
@@ -281,33 +250,6 @@ def plan_blend(prev: Segment, nxt: Segment, keyword: str, tau_a: float) -> Blend
     return BlendPlan(bp, rp, tau_p)
 
 
-def overlap_ok(prev: Segment, nxt: Segment, tau_a: float, tau_e: float, h: float) -> bool:
-    """Can the blend be the *overlap of the two velocity profiles* (superposition
-    ``x = x_prev(t) + (x_next(t) - P)``) without leaving the zone?
-
-    With ``ρ`` the normalised remaining part of ``prev`` and ``π`` the normalised progress
-    of ``nxt`` (relative to the blend start and blend end distances), ``|x - P| <= ρ·d_s +
-    π·d_e <= max(d_s, d_e)`` whenever ``ρ + π <= 1``. Checked on a grid of step ``h`` (s)
-    from the blend start until ``prev`` reaches its point; ``nxt`` must not progress past
-    the blend end before that either. True in the usual case (blend in the deceleration
-    phase, similar accelerations); otherwise the convex combination is used."""
-    T = prev.T
-    if T - tau_a <= 1e-12:
-        return True  # the approximated motion is at its point: the next one simply runs
-    if tau_e <= 0:
-        return False
-    u_a = prev.profile.u(tau_a)
-    u_e = nxt.profile.u(tau_e)
-    n = int(math.ceil((T - tau_a) / h))
-    for j in range(1, n + 1):
-        t = min(tau_a + j * h, T)
-        rho = _remaining_norm(prev, prev.profile.u(t), u_a)
-        pi = _progress_norm(nxt, nxt.profile.u(t - tau_a), u_e)
-        if rho + pi > 1.0 + 1e-9:
-            return False
-    return True
-
-
 def superpose_pose(p0: np.ndarray, R0: np.ndarray, p1: np.ndarray, R1: np.ndarray,
                    pc: np.ndarray, Rc: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Profile overlap in Cartesian space: ``p = p_prev + (p_next - P)``,
@@ -325,24 +267,5 @@ def blend_space(prev: Segment, nxt: Segment) -> str:
     return "joint"
 
 
-def weight(x: float) -> float:
-    """Blend weight of the next segment at window fraction x in [0, 1]."""
-    return smoothstep(x)
-
-
-def combine_pose(p0: np.ndarray, R0: np.ndarray, p1: np.ndarray, R1: np.ndarray,
-                 w: float) -> tuple[np.ndarray, np.ndarray]:
-    """Convex combination of two TCP poses (mm, 3x3 rotation matrices): positions
-    linearly, orientations by slerp ``R0 · exp(w · log(R0ᵀ R1))``."""
-    p = (1.0 - w) * p0 + w * p1
-    rel = Rotation.from_matrix(R0.T @ R1).as_rotvec()
-    return p, R0 @ Rotation.from_rotvec(w * rel).as_matrix()
-
-
-def combine_axes(q0: np.ndarray, q1: np.ndarray, w: float) -> np.ndarray:
-    """Convex combination of two axis vectors (deg)."""
-    return (1.0 - w) * q0 + w * q1
-
-
-__all__ = ["effective_keyword", "blend_start_tau", "blend_end_tau", "blend_space", "weight",
-           "combine_pose", "combine_axes", "overlap_ok", "superpose_pose", "plan_blend", "BlendPlan"]
+__all__ = ["effective_keyword", "blend_start_tau", "blend_end_tau", "blend_space", "superpose_pose",
+           "plan_blend", "BlendPlan"]

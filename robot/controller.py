@@ -155,7 +155,6 @@ class _Blend:
     pb: float
     space: str
     keyword: str
-    overlap: bool = False
 
 
 @dataclass
@@ -581,8 +580,7 @@ class Controller:
         self._q_prev = self._q
         try:
             q = self._main_run(self._pt)
-            if self._blend is None or self._blend.overlap:  # convex blends may overshoot a bit
-                self._check_speed(q)
+            self._check_speed(q)
         except RobotError as err:
             q = self._fault(err)
         self._q = np.asarray(q, dtype=float)
@@ -618,7 +616,7 @@ class Controller:
             kw = blending.effective_keyword(seg, nxt)
             ta = blending.blend_start_tau(seg, nxt, kw) if kw else None
             if ta is not None:
-                te, _ = self._blend_window(seg, nxt, kw, ta)
+                te = self._blend_window(seg, nxt, kw, ta)
                 run.planned_mid = pt + ta + 0.5 * te
         return run
 
@@ -676,12 +674,12 @@ class Controller:
         # zone, the next motion ramps up to the blend end
         r.seg.profile, r.seg.T = bp.prev_profile, bp.prev_profile.t_total
         nseg.profile, nseg.T = bp.next_profile, bp.next_profile.t_total
-        tau_e, overlap = bp.window, True
+        tau_e = bp.window
         self._motion_event(r.seg, "blend_start")
         nr = self._start(nseg, pt)
         nr.blend_in_end = pt + tau_e
         r.blend_mid = pt + 0.5 * tau_e
-        b = _Blend(r, nr, pt, pt + tau_e, blending.blend_space(r.seg, nseg), kw, overlap)
+        b = _Blend(r, nr, pt, pt + tau_e, blending.blend_space(r.seg, nseg), kw)
         self._runs = [nr]
         self._blend = b
         if tau_e <= EPS:
@@ -689,12 +687,12 @@ class Controller:
             return nr.seg.axes(pt - nr.t0)
         return self._blend_setpoint(b, pt)
 
-    def _blend_window(self, seg: Segment, nxt: Segment, kw: str, tau_a: float) -> tuple[float, bool]:
+    def _blend_window(self, seg: Segment, nxt: Segment, kw: str, tau_a: float) -> float:
         """Length (s) of the blend that starts at local time ``tau_a`` of ``seg`` (it ends
-        when ``seg`` reaches its point), and whether it is a profile overlap (always)."""
+        when ``seg`` reaches its point)."""
         bp = blending.plan_blend(seg, nxt, kw, tau_a) or blending.plan_blend(seg, nxt, kw, seg.T)
         assert bp is not None
-        return bp.window, True
+        return bp.window
 
     def _end_blend(self, b: _Blend) -> None:
         self._blend = None
@@ -703,28 +701,17 @@ class Controller:
         b.nxt.seg._last_q = self._q.copy()
 
     def _blend_setpoint(self, b: _Blend, pt: float) -> np.ndarray:
-        w = blending.weight((pt - b.pa) / (b.pb - b.pa))
+        """The blend's setpoint: the overlap of the two velocity profiles (robot/blending.py),
+        in Cartesian space or in axis space."""
         t_prev = min(pt - b.prev.t0, b.prev.seg.T)
         t_next = pt - b.nxt.t0
-        if b.overlap:
-            if b.space == "cart":
-                p0, R0 = b.prev.seg.pose(t_prev)
-                p1, R1 = b.nxt.seg.pose(t_next)
-                pc, Rc = b.nxt.seg.pose(0.0)
-                p, R = blending.superpose_pose(p0, R0, p1, R1, pc, Rc)
-                return b.nxt.seg.ik(p, R, self._q)  # type: ignore[attr-defined]
-            q = b.prev.seg.axes(t_prev) + (b.nxt.seg.axes(t_next) - b.nxt.seg.q0)
-            self.model.kin.check_soft_limits(q)
-            return q
         if b.space == "cart":
             p0, R0 = b.prev.seg.pose(t_prev)
             p1, R1 = b.nxt.seg.pose(t_next)
-            p, R = blending.combine_pose(p0, R0, p1, R1, w)
-            q = b.nxt.seg.ik(p, R, self._q)  # type: ignore[attr-defined]
-            return q
-        q0 = b.prev.seg.axes(t_prev)
-        q1 = b.nxt.seg.axes(t_next)
-        q = blending.combine_axes(q0, q1, w)
+            pc, Rc = b.nxt.seg.pose(0.0)
+            p, R = blending.superpose_pose(p0, R0, p1, R1, pc, Rc)
+            return b.nxt.seg.ik(p, R, self._q)  # type: ignore[attr-defined]
+        q = b.prev.seg.axes(t_prev) + (b.nxt.seg.axes(t_next) - b.nxt.seg.q0)
         self.model.kin.check_soft_limits(q)
         return q
 

@@ -575,10 +575,6 @@ def _check_complete(req: MotionRequest) -> None:
         raise RobotError("BCO run: the first motion needs a complete target (no partial aggregate)")
 
 
-def _time_weight(L: float, theta: float, v_cp: float, v_ori: float) -> float:
-    return max(L / v_cp if L > 0 else 0.0, theta / v_ori if theta > 0 else 0.0)
-
-
 def plan(req: MotionRequest, q_start: np.ndarray, model: RobotModel, *,
          first: bool = False) -> Segment:
     """Plan one motion from the axes ``q_start`` (the previous programmed end point).

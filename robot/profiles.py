@@ -127,15 +127,6 @@ class Trapezoid:
         return self.t_total - target / self.a if self.a > 0 else self.t_total
 
 
-def smoothstep(x: float) -> float:
-    """C1 blend weight 3x² - 2x³ on [0, 1] (clamped); zero slope at both ends."""
-    if x <= 0.0:
-        return 0.0
-    if x >= 1.0:
-        return 1.0
-    return x * x * (3.0 - 2.0 * x)
-
-
 class PiecewiseProfile:
     """Normalised time law u(t) over sections with their own limits (issue 15: spline
     blocks slowed at corners, CP paths slowed for the axes).
