@@ -149,8 +149,12 @@ def encode_text(text: str, encoding: str) -> bytes:
 
 
 def source_from_bytes(path: str, data: bytes, sha: str | None = None) -> SourceText:
-    """Classify and decode the bytes of one file (never raises)."""
+    """Classify and decode the bytes of one file (never raises): too_large past MAX_BYTES
+    (krl/limits.py MAX_FILE_BYTES, whoever read the bytes: a file, an editor buffer), empty,
+    binary, or ok with the decoded text."""
     sha = sha if sha is not None else hashlib.sha256(data).hexdigest()
+    if len(data) > MAX_BYTES:
+        return SourceText(path, "", "", len(data), "too_large", f"{len(data)} bytes > {MAX_BYTES}", sha)
     if not data.strip(b" \t\r\n\x1a"):
         return SourceText(path, "", "", len(data), "empty", "no content", sha)
     if b"\x00" in data:

@@ -175,3 +175,16 @@ def test_a_byte_undefined_in_cp1252_does_not_switch_to_cyrillic() -> None:
     from krl.syntax.source import decode_bytes  # noqa: PLC0415
 
     assert decode_bytes(b"x=1 ; caf\xe9 = \x81 kept\n") == ("x=1 ; café = \x81 kept\n", "cp1252")
+
+
+def test_bytes_past_the_file_limit_are_too_large_whoever_read_them() -> None:
+    """source_from_bytes is the one classifier: bytes from an editor buffer or parse_file get the
+    same size limit as a file read from disk (krl/limits.py MAX_FILE_BYTES)."""
+    from krl.limits import MAX_FILE_BYTES
+    from krl.syntax.engines import parse_file
+    from krl.syntax.source import source_from_bytes
+
+    big = b"DEF a()\nEND\n" + b";" * MAX_FILE_BYTES
+    assert source_from_bytes("big.src", big).status == "too_large"
+    assert parse_file(big, "big.src", "python").status == "too_large"
+    assert source_from_bytes("ok.src", b"DEF a()\nEND\n").status == "ok"

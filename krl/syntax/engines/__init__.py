@@ -25,7 +25,7 @@ from pathlib import Path
 
 from krl.syntax.parse import (ParseResult, ParserBundle, default_bundle, parse_source as _py_parse_source,
                               prepare_text, result_from_raw)
-from krl.syntax.source import SourceText, decode_bytes
+from krl.syntax.source import SourceText
 
 ENGINES = ("auto", "python", "java")
 REPO_GRAMMAR = Path(__file__).resolve().parents[3] / "grammar" / "KRL.g4"
@@ -179,23 +179,9 @@ def parse_file(data: bytes | str | SourceText, path: str = "<string>", engine: s
     if isinstance(data, SourceText):
         source = data
     elif isinstance(data, bytes):
-        source = _source_from_bytes(path, data)
+        from krl.syntax.source import source_from_bytes  # noqa: PLC0415
+
+        source = source_from_bytes(path, data)
     else:
         source = SourceText(path, data, "", len(data.encode("utf-8", "surrogatepass")))
     return parse_source(source, bundle, keep_tree, engine)
-
-
-def _source_from_bytes(path: str, data: bytes) -> SourceText:
-    from krl.syntax import source as src_mod  # noqa: PLC0415
-
-    make = getattr(src_mod, "source_from_bytes", None)
-    if make is not None:
-        return make(path, data)
-    if len(data) > src_mod.MAX_BYTES:
-        return SourceText(path, "", "", len(data), "too_large", f"{len(data)} bytes > {src_mod.MAX_BYTES}")
-    if not data.strip(b" \t\r\n\x1a"):
-        return SourceText(path, "", "", len(data), "empty", "no content")
-    if b"\x00" in data:
-        return SourceText(path, "", "", len(data), "binary", "NUL bytes")
-    text, encoding = decode_bytes(data)
-    return SourceText(path, text, encoding, len(data))
