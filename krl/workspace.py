@@ -504,15 +504,6 @@ def _unit_names(u: "ModuleUnit") -> set[str]:
     return names
 
 
-def _casefold_child(folder: Path, name: str) -> Path | None:
-    try:
-        for c in folder.iterdir():
-            if c.name.lower() == name.lower():
-                return c
-    except OSError:
-        return None
-    return None
-
 
 def find_backups(root: str | Path) -> list[Path]:
     """Backup roots below `root`: folders with R1/System/$config.dat (the root is the folder

@@ -5,7 +5,6 @@ from __future__ import annotations
 import csv
 import hashlib
 import json
-import os
 import time
 from pathlib import Path
 
@@ -96,11 +95,11 @@ def static_check_figures(corpus: Path, fingerprints: list[str], gsha: str,
                "errors": data["total"]["errors"], "warnings": data["total"]["warnings"],
                "top_kinds": data["top_kinds"], "markdown": markdown}
     if path is not None:
-        tmp = path.with_name(f"{path.name}.{os.getpid()}.tmp")
+        from krl.files import write_text_atomic  # noqa: PLC0415
+
         try:
             path.parent.mkdir(parents=True, exist_ok=True)
-            tmp.write_text(json.dumps(figures), encoding="utf-8")
-            tmp.replace(path)
+            write_text_atomic(path, json.dumps(figures))
         except OSError as exc:
             warn(f"cache file {path} not written ({exc.strerror or exc})")
     return figures

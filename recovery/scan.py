@@ -195,16 +195,6 @@ def failed_row(rel_path: str, size: int, sha: str, status: str, detail: str) -> 
                       detail)
 
 
-def scan_one(args: tuple[str, str, str, int]) -> FileResult:
-    """Read and parse one file in this process (no timeout): ``(path, rel_path, sha, timeout)``;
-    sha and timeout are ignored (kept for old callers). The scan itself uses workers."""
-    path, rel_path = args[0], args[1]
-    data, status, detail, size = read_limited(path)
-    if data is None:
-        return FileResult(rel_path, size, "", "", status, detail=detail)
-    return scan_bytes(rel_path, data, hashlib.sha256(data).hexdigest())
-
-
 # ----------------------------------------------------------------------- cache
 
 def cache_dir() -> Path:
@@ -297,18 +287,14 @@ class ResultCache:
     def save(self) -> None:
         if not (self.enabled and self.dirty and self.path is not None):
             return
-        tmp = self.path.with_name(f"{self.path.name}.{os.getpid()}.tmp")
+        from krl.files import write_text_atomic  # noqa: PLC0415
+
         try:
             self.path.parent.mkdir(parents=True, exist_ok=True)
-            tmp.write_text(json.dumps({"schema": CACHE_SCHEMA, "version": CACHE_VERSION,
-                                       "results": self.data}))
-            tmp.replace(self.path)
+            write_text_atomic(self.path, json.dumps({"schema": CACHE_SCHEMA, "version": CACHE_VERSION,
+                                                     "results": self.data}))
         except OSError as exc:
             self.warn(f"cache file {self.path} not written ({exc.strerror or exc}); the next scan parses again")
-            try:
-                tmp.unlink()
-            except OSError:
-                pass
         self.dirty = False
 
 
