@@ -156,7 +156,7 @@ class Runtime:
         if reason == "completed":
             file, line, ctx = robot.file, robot.line, "main"
         self.result = RunResult(reason, err, file, line, ctx, text, self.controller.time, self.steps)
-        if self.trace is not None and reason == "error" and err is not None:
+        if self.trace is not None and reason == "error" and err is not None and not err.traced:
             # the robot program's run-time error, before the `end` event (robot/trace.py);
             # a submit program's error was written when that task ended (submit_finished)
             self.trace.write("error", self.controller.time, text=err.message, number=err.number,
@@ -200,7 +200,9 @@ class Runtime:
         """First act of a resumed task: main-run errors, TRIGGER actions, interrupts."""
         if task.pending_error is not None:
             e, task.pending_error = task.pending_error, None
-            raise KrlRuntimeError(e.message, e.number)
+            err = KrlRuntimeError(e.message, e.number)
+            err.traced = True          # robot/controller.py wrote its error event
+            raise err
         while task.pending_triggers:
             self.run_trigger(task, task.pending_triggers.pop(0))
         if task.irqs.armed:

@@ -25,6 +25,9 @@ class KrlRuntimeError(Exception):
         self.number = number
         self.file = file
         self.line = line
+        # True when the trace already holds this error's `error` event (a main-run fault,
+        # written by the controller with its motion id): the run does not write it again
+        self.traced = False
 
     def at(self, file: str | None, line: int | None) -> "KrlRuntimeError":
         """Set the place if it is not set yet (the innermost statement wins); returns self."""

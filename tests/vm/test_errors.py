@@ -110,3 +110,30 @@ def test_error_event_trace_files_are_byte_identical(tmp_path):
     events = [json.loads(x) for x in traces["vm"].splitlines()]
     assert [e["kind"] for e in events[-2:]] == ["error", "end"]
     assert (events[-2]["line"], events[-2]["text"]) == (4, "division by zero")
+
+
+def test_a_main_run_fault_is_one_error_event(tmp_path, monkeypatch):
+    """A fault of the main run (here forced in the controller's speed check while the LIN of
+    line 4 moves) is written once, by the controller, with the motion's id and line; the
+    program then stops with that error and the interpreter does not write it a second time."""
+    from robot.controller import Controller
+    from robot.errors import RobotError
+
+    real = Controller._check_speed
+
+    def check(self, q):
+        if self.time > 0.5:
+            raise RobotError("forced main-run fault")
+        return real(self, q)
+
+    monkeypatch.setattr(Controller, "_check_speed", check)
+    body = ("PTP {A1 0, A2 -90, A3 90, A4 0, A5 45, A6 0}\n"
+            "LIN_REL {Z -100}\n"
+            "LIN_REL {Y 100}\n"
+            "N1 = 1")
+    res, ev, _ = both(tmp_path, body)
+    assert res.reason == "error" and res.text == "forced main-run fault"
+    errors = [e for e in ev if e["kind"] == "error"]
+    assert len(errors) == 1, errors
+    assert errors[0]["text"] == "forced main-run fault" and errors[0].get("id") is not None
+    assert ev[-1]["kind"] == "end"
