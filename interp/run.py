@@ -58,14 +58,15 @@ def make_runtime(program, *, workspace=None, inputs=None, trace=None, max_sim_ti
 
 def signal_of(rt: Runtime, main: str, name: str) -> tuple[str, int, int | None] | None:
     """``(base, first, last)`` of the SIGNAL `name` seen by the program `main`: its data list,
-    then $config.dat and the other global declarations. None if there is no such SIGNAL."""
+    then the global declarations of every module ($config.dat, public data lists loaded on
+    demand, as the program's own name lookup does). None if there is no such SIGNAL."""
     from interp.runtime.memory import SignalRef  # noqa: PLC0415
 
     key = name.upper()
     module = rt.program.module(main)
     ref = module.data.get(key) if module is not None else None
     if ref is None:
-        ref = rt.program.globals.get(key)
+        ref = rt.program.lookup_global(key)
     if not isinstance(ref, SignalRef):
         return None
     return ref.proxy.name.upper(), ref.a, ref.b

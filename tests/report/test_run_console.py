@@ -205,3 +205,27 @@ def test_a_wait_for_an_input_nobody_sets_gets_a_hint(tmp_path):
     code, out = run(str(prog), "--max-sim-time", "0.5", "--inputs", str(stim))
     assert code == 0, out
     assert "hint" not in out
+
+
+def test_stimulus_by_a_global_signal_of_another_module(tmp_path):
+    """A GLOBAL SIGNAL declared in another module's public data list is seen by the program
+    (the run loads that list on demand), so the stimuli may name it too."""
+    prog = write(tmp_path / "p.src", """
+        DEF p()
+          WAIT FOR DOOR_OK
+          $OUT[1] = TRUE
+        END
+        """)
+    write(tmp_path / "cell.dat", """
+        DEFDAT cell PUBLIC
+          GLOBAL SIGNAL DOOR_OK $IN[7]
+        ENDDAT
+        """)
+    stim = write(tmp_path / "s.yaml", """
+        stimuli:
+          - at: 0.1
+            set: {DOOR_OK: true}
+        """)
+    code, out = run(str(prog), "--inputs", str(stim), "--max-sim-time", "2")
+    assert code == 0, out
+    assert "  I/O        2 change(s) ($IN by stimulus 1, $OUT 1)" in out
