@@ -47,11 +47,12 @@ def real_to_int(x: float) -> int:
 def trunc_int(v, what: str = "operand") -> int:
     """``int(num(v))``: a REAL truncated toward zero, as interrupt numbers, S/T, TRIGGER
     DISTANCE/PRIO and SWRITE's %c take it; a NaN or infinite REAL is the run-time error
-    "REAL value cannot be converted to INT", never a Python exception."""
+    "REAL value cannot be converted to INT", a REAL past the INT range "INT overflow", never a
+    Python exception or a huge Python int."""
     x = num(v, what)
-    if x.__class__ is float and (x != x or x in (math.inf, -math.inf)):
+    if x.__class__ is float and not math.isfinite(x):
         raise KrlRuntimeError(f"{what}: REAL value cannot be converted to INT")
-    return int(x)
+    return check_int(int(x))
 
 
 def num(v, what: str = "operand"):

@@ -500,3 +500,16 @@ def test_any_format_is_text_a_format_error_or_a_krl_error(fmt, values, room, src
         pass
     else:
         assert 0 <= pos <= len(src) and (error is None or error.startswith("format error"))
+
+
+def test_a_huge_real_taken_as_an_int_is_int_overflow():
+    """trunc_int (interrupt numbers, S/T, TRIGGER DISTANCE/PRIO, %c) checks the INT range
+    like every other REAL -> INT conversion: 1E30 is INT overflow, 2147483647.9 truncates."""
+    from interp.runtime.convert import trunc_int
+    from interp.runtime.errors import KrlRuntimeError
+
+    with pytest.raises(KrlRuntimeError, match="INT overflow"):
+        trunc_int(1e30, "interrupt number")
+    with pytest.raises(KrlRuntimeError, match="INT overflow"):
+        trunc_int(-2147483649.0)
+    assert trunc_int(2147483647.9) == 2147483647 and trunc_int(-7.9) == -7
