@@ -45,7 +45,7 @@ def report(tmp_path_factory) -> Path:
 
 @pytest.mark.may_skip("chromium is missing and cannot be installed (not root, or apt-get has no network)")
 def test_report_renders_in_headless_chromium(chromium, report):
-    playwright = pytest.importorskip("playwright.sync_api")
+    import playwright.sync_api as playwright  # a dev dependency: missing is a failure, not a skip
     with playwright.sync_playwright() as pw, tempfile.TemporaryDirectory() as profile:
         ctx = pw.chromium.launch_persistent_context(profile, executable_path=chromium, headless=True,
                                                     args=FLAGS[1:])
