@@ -144,7 +144,7 @@ def build_analysis(root: str, parsed: list[Parsed], skipped=()) -> Analysis:
     `skipped`: the krl.files entries not read (links, FIFOs, ...), W002 as in ``krl check``."""
     ws = Workspace(root)
     an = Analysis(root, ws)
-    from krl.lsp.text import split_lines  # noqa: PLC0415
+    from krl.semantics.render import split_lines  # noqa: PLC0415
     for p in parsed:
         sf = SourceFile(p.path, p.module, p.ok, p.status)
         ws.files.append(sf)

@@ -29,7 +29,7 @@ from krl.lsp import outline as _outline
 from krl.lsp.analysis import Analysis
 from krl.lsp.convert import lsp_diagnostic
 from krl.lsp.project import Project, norm
-from krl.lsp.text import from_position, to_range
+from krl.lsp.text import from_position, to_range, units
 from krl.terminal import printable, printable_path
 
 log = logging.getLogger("krl.lsp")       # file names and messages in it pass krl.terminal.printable
@@ -350,7 +350,7 @@ def create_server() -> KrlLanguageServer:
             if new == text:
                 return []
             lines = text.split("\n")
-            end = L.Position(line=len(lines) - 1, character=len(lines[-1].encode("utf-16-le")) // 2)
+            end = L.Position(line=len(lines) - 1, character=units(ls.codec(), lines[-1]))
             return [L.TextEdit(range=L.Range(start=L.Position(line=0, character=0), end=end), new_text=new)]
 
     return server

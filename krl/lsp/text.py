@@ -19,11 +19,6 @@ from krl.syntax.blocks import Tok, lines_of
 NAME_WORDS = ("IDENTIFIER", "SYSNAME")
 
 
-def split_lines(text: str) -> list[str]:
-    """The lines of `text` as the KRL lexer counts them (a line ends at LF; CR is dropped)."""
-    return [ln[:-1] if ln.endswith("\r") else ln for ln in text.split("\n")]
-
-
 def units(codec, s: str) -> int:
     return codec.client_num_units(s) if codec is not None else len(s)
 

@@ -236,3 +236,17 @@ async def test_krl_toml_of_the_backup_applies(client, backup_copy):
     # E101 (countr) ignored; E106 (nowhere) reported as a warning
     assert [(str(d.code), d.range.start.line, d.severity) for d in diags] == [("E106", 9, L.DiagnosticSeverity.Warning)]
     close_doc(client, path)
+
+
+async def test_formatting_replaces_up_to_the_real_end_of_the_document(client, tmp_path):
+    """The edit's end is the end of the last line in the client's position units (UTF-16 by
+    default): '; Grüße 😀' is 10 units (the emoji is a surrogate pair), not 9 characters."""
+    path = tmp_path / "fmt_end.src"
+    text = "def t()\nend\n; Grüße 😀"
+    await open_doc(client, path, text)
+    edits = await client.text_document_formatting_async(L.DocumentFormattingParams(
+        text_document=td(path), options=L.FormattingOptions(tab_size=2, insert_spaces=True)))
+    assert len(edits) == 1 and edits[0].new_text.startswith("DEF t()\nEND\n")
+    assert (edits[0].range.start.line, edits[0].range.start.character) == (0, 0)
+    assert (edits[0].range.end.line, edits[0].range.end.character) == (2, 10)
+    close_doc(client, path)
