@@ -42,8 +42,9 @@ from krl.semantics.outside import Unresolved, template_lines
 from krl.semantics.symbols import Scope, Symbol, system_scopes
 from krl.syntax.folds import fold_diagnostics
 from krl.syntax.messages import syntax_diagnostics
-from krl.syntax.parse import ParseResult, parse_source
-from krl.syntax.source import is_krl_file, read_source
+from krl.syntax.engines import parse_source
+from krl.syntax.parse import ParseResult
+from krl.syntax.source import SourceText, is_krl_file, read_source
 
 
 @dataclass(slots=True)
@@ -75,14 +76,34 @@ class LoadedFile:
     template: tuple = (frozenset(), frozenset())
 
 
+# Below this many bytes a batch of files is parsed by the Python engine: starting the Java
+# engine's worker costs more than it saves (measured: docs/architecture.md, "Parse engines").
+JAVA_BATCH_BYTES = 256 * 1024
+
+
 def load_file(path: str | Path) -> LoadedFile:
-    """Read (krl.syntax.source.read_source), parse and build one file; never raises for bad
-    content."""
+    """Read (krl.syntax.source.read_source), parse (the Python engine) and build one file;
+    never raises for bad content."""
     t = time.perf_counter()
     src = read_source(path)
-    result = parse_source(src)
-    elapsed = time.perf_counter() - t
-    path_s = str(path)
+    return _loaded(src, parse_source(src, keep_tree=True, engine="python"), t)
+
+
+def load_parsed(src: SourceText, raw: bytes | None = None) -> LoadedFile:
+    """Build one read file from the Java engine's answer `raw` (its parse tree is rebuilt,
+    krl/syntax/engines/tree.py), or parse it with the Python engine when raw is None;
+    never raises for bad content."""
+    from krl.syntax.engines import result_from_answer  # noqa: PLC0415
+
+    t = time.perf_counter()
+    if raw is None:
+        return _loaded(src, parse_source(src, keep_tree=True, engine="python"), t)
+    return _loaded(src, result_from_answer(src, raw, keep_tree=True), t)
+
+
+def _loaded(src: SourceText, result: ParseResult, started: float) -> LoadedFile:
+    elapsed = time.perf_counter() - started
+    path_s = src.path
     sink = DiagnosticSink()
     if result.status not in ("ok", "syntax_error") and not result.errors:
         sink.add(path_s, 1, 1, "E001", f"file not checked: {result.status}"
@@ -99,6 +120,49 @@ def load_file(path: str | Path) -> LoadedFile:
     module = build_module(result, sink)
     return LoadedFile(path_s, module, result.ok, result.status, elapsed, time.perf_counter() - t,
                       sink.items, unreadable, words, template_lines(src.text or ""))
+
+
+def load_batch(paths: list, timeout: float, jobs: int | None = None) -> list:
+    """Read `paths` here, parse and build them in `jobs` worker processes (krl/pool.py), each
+    file stopped past `timeout` seconds; returns one krl.pool.Outcome per path, in order (value:
+    a LoadedFile). A batch of at least JAVA_BATCH_BYTES is parsed by the Java engine
+    (:func:`_parse_tasks`): the same trees. Progress: the :func:`on_each_file` callback, as
+    files finish."""
+    from krl.pool import run_tasks  # noqa: PLC0415
+    from krl.syntax.parse import default_bundle  # noqa: PLC0415
+
+    default_bundle()    # imported once here, inherited by the forked workers
+    hook = _ON_FILE.get()
+    sources = [read_source(p) for p in paths]
+    done: list = [None] * len(paths)
+    for o in run_tasks(load_parsed, _parse_tasks(sources, jobs, timeout), jobs=jobs, timeout=timeout):
+        done[o.key] = o
+        sources[o.key] = None
+        if hook is not None:
+            hook(str(paths[o.key]))      # progress as files finish, in any order
+    return done
+
+
+def _parse_tasks(sources: list[SourceText], jobs: int | None, stall: float):
+    """(index, (source, raw)) for :func:`load_parsed` in worker processes: one Java worker
+    with `jobs` threads parses a batch of at least JAVA_BATCH_BYTES here, with trees, while
+    the workers rebuild and build what it has answered (raw None: the Python engine)."""
+    from krl.pool import default_jobs  # noqa: PLC0415
+    from krl.syntax.engines import EngineUnavailable, java_answers, resolve  # noqa: PLC0415
+
+    try:
+        engine = resolve()
+    except EngineUnavailable:
+        engine = "python"
+    # big files first, so that the workers' tail is short
+    order = sorted(range(len(sources)), key=lambda i: -sources[i].size)
+    if engine != "java" or sum(s.size for s in sources) < JAVA_BATCH_BYTES:
+        for i in order:
+            yield i, (sources[i], None)
+        return
+    for i, src, raw in java_answers(((i, sources[i]) for i in order), threads=jobs or default_jobs(),
+                                    trees=True, stall=stall, decode=False):
+        yield i, (src, raw)
 
 
 @dataclass(slots=True)
@@ -186,39 +250,30 @@ class Workspace:
         return self._add_loaded(load_file(path))
 
     def add_files(self, paths, timeout: float | None = None, jobs: int | None = None) -> None:
-        """:meth:`add_file` for each of `paths`, in order. With `timeout` (seconds per file) each
-        file is read, parsed and built in a worker process (krl/pool.py) that is killed past the
-        timeout: the file gets error E005 and the other files are still checked. A worker that
-        dies (a crash of the parser) gives error E001 for its file."""
+        """:meth:`add_file` for each of `paths`, in order. With `timeout` (seconds per file) the
+        files are read here and parsed and built in worker processes (:func:`load_batch`)."""
         paths = list(paths)
         if timeout is None or not paths:
             for p in paths:
                 self.add_file(p)
             return
-        from krl.pool import run_tasks  # noqa: PLC0415
+        for p, outcome in zip(paths, load_batch(paths, timeout, jobs)):
+            self.add_outcome(p, outcome, timeout)
 
-        from krl.syntax.parse import default_bundle  # noqa: PLC0415
-
-        default_bundle()    # imported once here, inherited by the forked workers
-        hook = _ON_FILE.get()
-        done = {}
-        for o in run_tasks(load_file, ((i, (p,)) for i, p in enumerate(paths)), jobs=jobs, timeout=timeout):
-            done[o.key] = o
-            if hook is not None:
-                hook(str(paths[o.key]))      # progress as files finish, in any order
-        for i, p in enumerate(paths):
-            o = done[i]
-            if o.status == "done":
-                self._add_loaded(o.value, notify=False)
-                continue
-            if o.status == "timeout":
-                self.sink.add(str(p), 1, 1, "E005", f"file not checked: not parsed within {timeout:g} s "
-                              "(--timeout; the parse was stopped)")
-            else:
-                self.sink.add(str(p), 1, 1, "E001", f"file not checked: {o.detail}")
-            self.unreadable = True
-            module = build_module(ParseResult(str(p), False, "", o.status), DiagnosticSink())
-            self.files.append(SourceFile(str(p), module, False, o.status))
+    def add_outcome(self, path, o, timeout: float) -> None:
+        """Add one file of :func:`load_batch`: its LoadedFile, or E005 (stopped past `timeout`
+        seconds) or E001 (its worker died) and an empty module."""
+        if o.status == "done":
+            self._add_loaded(o.value, notify=False)
+            return
+        if o.status == "timeout":
+            self.sink.add(str(path), 1, 1, "E005", f"file not checked: not parsed within {timeout:g} s "
+                          "(--timeout; the parse was stopped)")
+        else:
+            self.sink.add(str(path), 1, 1, "E001", f"file not checked: {o.detail}")
+        self.unreadable = True
+        module = build_module(ParseResult(str(path), False, "", o.status), DiagnosticSink())
+        self.files.append(SourceFile(str(path), module, False, o.status))
 
     def _add_loaded(self, lf: "LoadedFile", notify: bool = True) -> SourceFile:
         self.parse_seconds += lf.parse_seconds
@@ -548,6 +603,27 @@ def collect_files(path: Path) -> list[Path]:
 
 def _add_entries(ws: "Workspace", entries, timeout: float | None = None, jobs: int | None = None) -> None:
     ws.add_files([e.path for e in entries if e.kind == "file"], timeout=timeout, jobs=jobs)
+    _note_unread(ws, entries)
+
+
+def load_workspaces(groups: list[tuple[str, list]], timeout: float | None = None,
+                    jobs: int | None = None) -> list[Workspace]:
+    """One workspace per (root, entries) group (entries: :func:`collect_entries`), the files of
+    all groups loaded in one batch (:func:`load_batch`; with `timeout`, else here one by one)."""
+    out = [Workspace(root) for root, _ in groups]
+    files = [(k, e.path) for k, (_, entries) in enumerate(groups) for e in entries if e.kind == "file"]
+    if timeout is None:
+        for k, path in files:
+            out[k].add_file(path)
+    else:
+        for (k, path), outcome in zip(files, load_batch([p for _, p in files], timeout, jobs)):
+            out[k].add_outcome(path, outcome, timeout)
+    for ws, (_, entries) in zip(out, groups):
+        _note_unread(ws, entries)
+    return out
+
+
+def _note_unread(ws: "Workspace", entries) -> None:
     for e in entries:
         if e.kind != "file":
             ws.sink.add(str(e.path), 1, 1, "W002", f"not read: {e.message}")
@@ -600,7 +676,7 @@ def workspaces_for(path: str | Path, timeout: float | None = None, jobs: int | N
     if p.is_dir() and not p.is_symlink():
         backups = find_backups(p)
         if backups:
-            out = [load_workspace([b], str(b), timeout, jobs) for b in backups]
+            groups = [(str(b), collect_entries(b)) for b in backups]
             # entries outside every backup: one workspace per top-level folder of `path`
             rest: dict[str, list] = {}
             for e in collect_entries(p):
@@ -609,9 +685,5 @@ def workspaces_for(path: str | Path, timeout: float | None = None, jobs: int | N
                 parts = e.rel.split("/")
                 key = str(p / parts[0]) if len(parts) > 1 else str(p)
                 rest.setdefault(key, []).append(e)
-            for key, entries in sorted(rest.items()):
-                ws = Workspace(key)
-                _add_entries(ws, entries, timeout, jobs)
-                out.append(ws)
-            return out
+            return load_workspaces(groups + sorted(rest.items()), timeout, jobs)
     return [load_workspace([p], str(p), timeout, jobs)]

@@ -1,13 +1,23 @@
 """Simulated KR 6 R900 sixx controller: machine data, frames, kinematics (and MuJoCo model
 in robot.mjcf, imported lazily because it needs mujoco)."""
 
-from .errors import RobotError, SoftLimitError, WorkspaceError
-from .frames import compose, frame_to_matrix, inv_pos, matrix_to_frame
-from .kinematics import Kinematics
-from .machine import JointData, MachineData, load_machine
+import importlib
 
-__all__ = [
-    "RobotError", "SoftLimitError", "WorkspaceError",
-    "compose", "frame_to_matrix", "inv_pos", "matrix_to_frame",
-    "Kinematics", "JointData", "MachineData", "load_machine",
-]
+# The names below load their module on first use (PEP 562): `krl` commands that do not move
+# the arm (parse, check, recover) never import numpy and scipy.
+_EXPORTS = {
+    "RobotError": ".errors", "SoftLimitError": ".errors", "WorkspaceError": ".errors",
+    "compose": ".frames", "frame_to_matrix": ".frames", "inv_pos": ".frames", "matrix_to_frame": ".frames",
+    "Kinematics": ".kinematics", "JointData": ".machine", "MachineData": ".machine", "load_machine": ".machine",
+}
+
+__all__ = list(_EXPORTS)
+
+
+def __getattr__(name: str):
+    module = _EXPORTS.get(name)
+    if module is None:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    value = getattr(importlib.import_module(module, __name__), name)
+    globals()[name] = value
+    return value

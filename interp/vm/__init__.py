@@ -6,6 +6,13 @@ the readable text for `krl asm` and its round trip, never read at run time) -> `
 interp/runtime). ``cli.py`` is `krl asm`; ``bench/`` the compute benchmark of `krl bench`.
 """
 
-from .vm import VM
-
 __all__ = ["VM"]
+
+
+def __getattr__(name: str):
+    # loaded on first use (PEP 562), so that `krl` commands that run no program stay quick
+    if name == "VM":
+        from .vm import VM  # noqa: PLC0415
+
+        return VM
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -22,14 +22,13 @@ def check_report(corpus: str | Path, out_dir: str | Path | None = None, top: int
     writes check_report.json and check_report.md there. `timeout`, `jobs`: files are parsed
     in that many worker processes, each file stopped past `timeout` seconds (see
     krl.workspace.load_workspace; None: in this process). Never raises for bad input files."""
-    from krl.workspace import find_backups, load_workspace  # noqa: PLC0415
+    from krl.workspace import find_backups  # noqa: PLC0415
 
     corpus = Path(corpus)
     backups = find_backups(corpus) if corpus.exists() else []
     rows = []
     kinds: Counter = Counter()
-    for b in backups:
-        ws = load_workspace([b], str(b), timeout=timeout, jobs=jobs)
+    for b, ws in _loaded_backups(backups, timeout, jobs):
         diags = ws.check()
         err_files = {d.path for d in diags if d.is_error}
         codes = Counter(d.code for d in diags)
@@ -61,6 +60,28 @@ def check_report(corpus: str | Path, out_dir: str | Path | None = None, top: int
         write_text_atomic(out / "check_report.json", json.dumps(data, indent=2))
         write_text_atomic(out / "check_report.md", md)
     return data, md
+
+
+# Backups are loaded in batches of about this many bytes of KRL: one pool of workers (and the
+# Java engine) for many small backups, while memory holds one batch of ASTs at a time.
+BATCH_BYTES = 4 * 1024 * 1024
+
+
+def _loaded_backups(backups: list[Path], timeout: float | None, jobs: int | None):
+    """(backup, its loaded Workspace) for each backup, in order, loaded in batches."""
+    from krl.workspace import collect_entries, load_workspaces  # noqa: PLC0415
+
+    batch: list[tuple[Path, list]] = []
+    size = 0
+    for k, b in enumerate(backups):
+        entries = collect_entries(b)
+        batch.append((b, entries))
+        size += sum(e.size for e in entries if e.kind == "file")
+        if size >= BATCH_BYTES or k == len(backups) - 1:
+            spaces = load_workspaces([(str(bb), ee) for bb, ee in batch], timeout=timeout, jobs=jobs)
+            for (bb, _), ws in zip(batch, spaces):
+                yield bb, ws
+            batch, size, spaces = [], 0, None
 
 
 def render_markdown(data: dict) -> str:

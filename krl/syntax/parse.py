@@ -214,20 +214,21 @@ class _RawToken:
 
 
 def result_from_raw(raw: dict, text: str, path: str, encoding: str,
-                    bundle: ParserBundle | None = None) -> ParseResult:
+                    bundle: ParserBundle | None = None, tree: object | None = None) -> ParseResult:
     """The ParseResult of a parse engine's raw record (krl/syntax/engines): the same records,
     shapes and cascade marks as :func:`parse_text` makes, from the same code. `text` is the
-    text the engine parsed (after :func:`prepare_text`). No tree."""
+    text the engine parsed (after :func:`prepare_text`); `tree`: the parse tree rebuilt from
+    the record (krl/syntax/engines/tree.py), or None."""
     bundle = bundle or default_bundle()
     if raw["stage"] == "sll":
-        return ParseResult(path, True, encoding, "ok", [], None, "sll")
+        return ParseResult(path, True, encoding, "ok", [], tree, "sll")
     lex_listener = CollectingErrorListener(bundle, kind="lexer")
     lex_listener._lexer_raw = [tuple(e) for e in raw["lex"]]
     listener = CollectingErrorListener(bundle, kind="syntax", text=text)
     for e in raw["syn"]:
         listener.add_raw(e["line"], e["column"], e["msg"], e["type"], e["text"], e["expected"],
                          e["stack"][::-1], [_RawToken(t, x) for t, x in e["line_tokens"]])
-    return _finish(path, encoding, text, lex_listener, listener, [], None, "ll")
+    return _finish(path, encoding, text, lex_listener, listener, [], tree, "ll")
 
 
 def _past_limit(path: str, encoding: str, past) -> ParseResult:

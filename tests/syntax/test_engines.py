@@ -5,7 +5,8 @@ line's tokens); everything else is shared Python code applied to its raw records
 hold the ports to the originals on every file of ../shared/krl-corpus, tests/negative/ and
 grammar/constructs/: the same status and the same error records (line, column, message,
 offending token and its type, expected tokens, rule stack, line shape, line text, cascade
-mark), hence the same clusters. The Python side runs once per file.
+mark), hence the same clusters, and the same parse trees node by node (the Java engine's
+rebuilt by krl/syntax/engines/tree.py). The Python side runs once per file.
 """
 
 from __future__ import annotations
@@ -17,12 +18,14 @@ import sys
 from pathlib import Path
 
 import pytest
+from antlr4.tree.Tree import ErrorNode
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from krl.syntax import blocks
 from krl.syntax.engines import EngineUnavailable, parse_file, parse_sources, resolve
 from krl.syntax.engines import java as java_engine
+from krl.syntax.engines.tree import RebuiltToken
 from krl.syntax.parse import default_bundle, prepare_text
 from krl.syntax.source import SourceText, read_source
 from recovery.scan import discover
@@ -51,6 +54,37 @@ def _record(result) -> tuple:
          i.line_shape, i.line_text, i.cascade) for i in result.errors])
 
 
+def _token(t) -> tuple | None:
+    return None if t is None else (t.tokenIndex, t.type, t.channel, t.start, t.stop, t.line, t.column, t.text)
+
+
+def tree_shape(tree) -> list[tuple]:
+    """Every node of a parse tree in preorder, with what a consumer can read of it: context
+    class, start and stop tokens (all their fields), invoking state, whether the rule recorded
+    an exception, children (count or None), label fields and the parent's class; terminals and
+    error nodes with their token."""
+    from antlr4 import ParserRuleContext  # noqa: PLC0415
+    from antlr4.tree.Tree import ErrorNode, TerminalNode  # noqa: PLC0415
+
+    if tree is None:
+        return []
+    out, stack = [], [tree]
+    while stack:
+        n = stack.pop()
+        parent = type(n.parentCtx).__name__
+        if isinstance(n, TerminalNode):
+            out.append(("error" if isinstance(n, ErrorNode) else "terminal", _token(n.symbol), parent))
+            continue
+        labels = sorted((k, _token(v) if not isinstance(v, (list, ParserRuleContext)) else
+                         (n.children.index(v) if isinstance(v, ParserRuleContext) else
+                          [_token(x) for x in v])) for k, v in getattr(n, "__dict__", {}).items())
+        out.append((type(n).__name__, _token(n.start), _token(n.stop), n.invokingState, n.exception is not None,
+                    None if n.children is None else len(n.children), labels, parent,
+                    type(n.parser).__name__ if n.parser is not None else None))
+        stack.extend(reversed(n.children or ()))
+    return out
+
+
 def _files(shared_corpus: Path) -> list[Path]:
     return (discover(shared_corpus) + discover(REPO / "tests" / "negative")
             + discover(REPO / "grammar" / "constructs"))
@@ -62,16 +96,30 @@ def test_engines_agree_on_every_file(shared_corpus, shard):
     _java_or_skip()
     paths = [p for i, p in enumerate(_files(shared_corpus)) if i % SHARDS == shard]
     sources = [read_source(p) for p in paths]
-    py = list(parse_sources(sources, "python"))
-    jv = list(parse_sources(sources, "java"))
+    py = list(parse_sources(sources, "python", keep_tree=True))
+    jv = list(parse_sources(sources, "java", keep_tree=True))
     assert len(py) == len(jv) == len(paths)
     differ = [str(p) for p, a, b in zip(paths, py, jv) if _record(a) != _record(b)]
     assert differ == []
-    # Not vacuous: the Java worker really parsed files of this shard, failing ones among them.
+    # The parse trees too (krl/syntax/engines/tree.py rebuilds the Java engine's), node by node.
+    differ = [str(p) for p, a, b in zip(paths, py, jv) if tree_shape(a.tree) != tree_shape(b.tree)]
+    assert differ == []
+    # Not vacuous: the Java worker really parsed files of this shard, failing ones among them,
+    # and its trees were rebuilt (their tokens are RebuiltTokens).
     worker_parsed = [b for s, b in zip(sources, jv)
-                     if s.status == "ok" and b.stage in ("sll", "ll") and b.tree is None]
+                     if s.status == "ok" and b.stage in ("sll", "ll") and isinstance(b.tree.start, RebuiltToken)]
     assert any(r.ok for r in worker_parsed)
     assert any(not r.ok and r.stage == "ll" for r in worker_parsed)
+    assert any(any(isinstance(x, ErrorNode) for x in _nodes(r.tree)) for r in worker_parsed)
+    assert all(not isinstance(r.tree.start, RebuiltToken) for r in py if r.tree is not None)
+
+
+def _nodes(tree):
+    stack = [tree]
+    while stack:
+        n = stack.pop()
+        yield n
+        stack.extend(getattr(n, "children", None) or ())
 
 
 DEEP = "DEF deep()\n" + "IF a THEN\n" * 101 + "ENDIF\n" * 101 + "END\n"

@@ -1,17 +1,17 @@
 """Parse engines behind one interface (docs/architecture.md, "Parse engines").
 
 - ``python``: krl/syntax/parse.py on the ANTLR Python runtime; the reference and the fallback.
-  It alone builds parse trees.
 - ``java``: the same grammar, generated for the ANTLR 4.13.2 Java runtime and run in a
   long-lived worker process (krl/syntax/engines/java.py); 10-30 times faster. It returns the
-  same ParseResult without a tree.
+  same ParseResult, and on request the same parse tree (sent as data and rebuilt into the
+  Python runtime's objects, krl/syntax/engines/tree.py).
 - ``auto`` (the default): java when it can run here (java, javac and the ANTLR jar present),
   else python.
 
 Whatever the engine, a file goes to the Python engine when a check that the fast engine does
 not run could fire: a post-parse token check (krl/syntax/checks.py ``may_fail``), a nesting or
-expression-size limit (krl/syntax/blocks.py ``may_pass_limit``), or when a tree is wanted. So
-the result is always the Python engine's result (tests/syntax/test_engines.py).
+expression-size limit (krl/syntax/blocks.py ``may_pass_limit``). So the result is always the
+Python engine's result, tree included (tests/syntax/test_engines.py).
 
 `KRL_ENGINE` (python|java|auto) sets the default for this process and its children
 (:func:`set_default`, used by the ``--engine`` options).
@@ -30,8 +30,8 @@ from krl.syntax.source import SourceText
 ENGINES = ("auto", "python", "java")
 REPO_GRAMMAR = Path(__file__).resolve().parents[3] / "grammar" / "KRL.g4"
 
-__all__ = ["ENGINES", "EngineUnavailable", "available", "resolve", "set_default", "use_engine", "parse_file",
-           "parse_source", "parse_sources", "unavailable_reason"]
+__all__ = ["ENGINES", "EngineUnavailable", "available", "java_answers", "resolve", "result_from_answer",
+           "set_default", "use_engine", "parse_file", "parse_source", "parse_sources", "unavailable_reason"]
 
 from krl.syntax.engines.java import EngineUnavailable, WorkerError, unavailable_reason  # noqa: E402
 
@@ -113,69 +113,111 @@ def _needs_python(text: str) -> bool:
 
 
 def parse_sources(sources: Iterable[SourceText], engine: str | None = None,
-                  bundle: ParserBundle | None = None, threads: int = 1) -> Iterator[ParseResult]:
+                  bundle: ParserBundle | None = None, threads: int = 1,
+                  keep_tree: bool = False) -> Iterator[ParseResult]:
     """Parse decoded files with one engine; yields one ParseResult per source, in order.
 
     The java engine pipelines the files through one worker (`threads` parse threads); a file
     the worker cannot parse (it failed inside) and every file that needs a Python-only check
-    is parsed by the Python engine. Never raises for bad input; EngineUnavailable when "java"
-    was asked for and cannot run."""
+    is parsed by the Python engine. `keep_tree`: the results carry parse trees (the java
+    engine's are rebuilt from its data, krl/syntax/engines/tree.py). Never raises for bad
+    input; EngineUnavailable when "java" was asked for and cannot run."""
     bundle = bundle or default_bundle()
     sources = list(sources)
     if resolve(engine) == "python":
         for src in sources:
-            yield _py_parse_source(src, bundle, keep_tree=False)
-        return
-    from krl.syntax.engines.java import worker_for  # noqa: PLC0415
-
-    try:
-        worker = worker_for(_grammar_text(bundle), threads)
-    except EngineUnavailable:   # this grammar version does not build for Java: the reference
-        for src in sources:
-            yield _py_parse_source(src, bundle, keep_tree=False)
+            yield _py_parse_source(src, bundle, keep_tree=keep_tree)
         return
     results: list[ParseResult | None] = [None] * len(sources)
-    texts: list[str] = []
-    where: list[int] = []
-    for i, src in enumerate(sources):
-        if src.status != "ok":
-            results[i] = _py_parse_source(src, bundle, keep_tree=False)
-            continue
-        text = prepare_text(src.text)
-        if _needs_python(text):
-            continue
-        texts.append(text)
-        where.append(i)
-    answers: dict[int, dict] = {}
+    for i, src, raw in java_answers(enumerate(sources), bundle, threads, keep_tree):
+        results[i] = result_from_answer(src, raw, bundle, keep_tree)
+    yield from results
+
+
+def java_answers(items: Iterable[tuple[object, SourceText]], bundle: ParserBundle | None = None,
+                 threads: int = 1, trees: bool = False, stall: float | None = None,
+                 decode: bool = True) -> Iterator[tuple[object, SourceText, dict | bytes | None]]:
+    """The java engine's answers for (key, source) items, as they come: (key, source, raw).
+
+    raw is None for a source the Python engine must parse (not decoded text, a Python-only
+    check could fire, the grammar does not build for Java, the worker failed or went `stall`
+    seconds without answering); such sources come first, or last when the worker gave up.
+    `decode=False`: raw is the answer's JSON line (bytes), for :func:`result_from_answer` in
+    another process. Never raises for bad input."""
+    from krl.syntax.engines.java import worker_for  # noqa: PLC0415
+
+    bundle = bundle or default_bundle()
+    items = list(items)
     try:
-        for k, raw in worker.parse_raw(texts):
-            answers[k] = raw
-    except WorkerError:
-        pass    # the worker died (it is restarted next time): the rest goes to the Python engine
-    for k, i in enumerate(where):
-        raw = answers.get(k)
-        if raw is not None and "fail" not in raw:
-            src = sources[i]
-            res = result_from_raw(raw, texts[k], src.path, src.encoding, bundle)
-            res.size = src.size
-            results[i] = res
-    for i, src in enumerate(sources):
-        yield results[i] if results[i] is not None else _py_parse_source(src, bundle, keep_tree=False)
+        worker = worker_for(_grammar_text(bundle), threads)
+    except EngineUnavailable:   # no JDK, or this grammar version does not build for Java
+        worker = None
+    to_java: list[int] = []
+    texts: list[str] = []
+    if worker is not None:
+        for i, (_key, src) in enumerate(items):
+            if src.status == "ok":
+                text = prepare_text(src.text)
+                if not _needs_python(text):
+                    to_java.append(i)
+                    texts.append(text)
+    answered = [False] * len(items)
+    for i in sorted(set(range(len(items))) - set(to_java)):
+        answered[i] = True
+        yield (*items[i], None)
+    if texts:
+        try:
+            for k, raw in worker.parse_raw(texts, trees=trees, stall=stall, decode=decode):
+                i = to_java[k]
+                answered[i] = True
+                yield (*items[i], raw)
+        except WorkerError:
+            pass    # the worker died or stalled (it is restarted next time): the Python engine
+    for i, done in enumerate(answered):
+        if not done:
+            yield (*items[i], None)
+
+
+def result_from_answer(source: SourceText, raw: dict | bytes | None, bundle: ParserBundle | None = None,
+                       keep_tree: bool = False) -> ParseResult:
+    """The ParseResult of one :func:`java_answers` item (its parse tree rebuilt when
+    `keep_tree`); the Python engine's result when raw is None or unusable."""
+    bundle = bundle or default_bundle()
+    if raw is not None:
+        if isinstance(raw, bytes):
+            import json  # noqa: PLC0415
+
+            try:
+                raw = json.loads(raw)
+            except ValueError:
+                raw = None
+    if raw is None or "fail" in raw:
+        return _py_parse_source(source, bundle, keep_tree=keep_tree)
+    text = prepare_text(source.text)
+    tree = None
+    if keep_tree:
+        from krl.syntax.engines.tree import TreeDataError, tree_from_raw  # noqa: PLC0415
+
+        try:
+            tree = tree_from_raw(raw, text, bundle)
+        except TreeDataError:
+            return _py_parse_source(source, bundle, keep_tree=True)
+    res = result_from_raw(raw, text, source.path, source.encoding, bundle, tree)
+    res.size = source.size
+    return res
 
 
 def parse_source(source: SourceText, bundle: ParserBundle | None = None, keep_tree: bool = False,
                  engine: str | None = None) -> ParseResult:
-    """One decoded file with the chosen engine (keep_tree: always the Python engine)."""
-    if keep_tree:
-        return _py_parse_source(source, bundle, keep_tree=True)
-    return next(parse_sources([source], engine, bundle))
+    """One decoded file with the chosen engine."""
+    return next(parse_sources([source], engine, bundle, keep_tree=keep_tree))
 
 
 def parse_file(data: bytes | str | SourceText, path: str = "<string>", engine: str | None = None,
                bundle: ParserBundle | None = None, keep_tree: bool = False) -> ParseResult:
     """Parse one file's bytes (decoded as krl/syntax/source.py does), text or SourceText with the
     chosen engine ("python", "java", "auto"; None: KRL_ENGINE or auto). Returns the same
-    ParseResult whatever the engine (tree only with keep_tree, which uses the Python engine)."""
+    ParseResult whatever the engine (with its parse tree when `keep_tree`)."""
     if isinstance(data, SourceText):
         source = data
     elif isinstance(data, bytes):

@@ -19,6 +19,7 @@ import atexit
 import hashlib
 import json
 import os
+import queue
 import re
 import shutil
 import subprocess
@@ -263,8 +264,14 @@ class JavaWorker:
             proc.kill()
             proc.wait()
 
-    def parse_raw(self, texts: Iterable[str]) -> Iterator[tuple[int, dict]]:
-        """Send every text; yield (index in `texts`, raw record) in completion order.
+    def parse_raw(self, texts: Iterable[str], trees: bool = False, stall: float | None = None,
+                  decode: bool = True) -> Iterator[tuple[int, dict | bytes]]:
+        """Send every text; yield (index in `texts`, raw record) in completion order. `trees`:
+        the records carry the parse trees as data (worker/KrlWorker.java's header;
+        krl/syntax/engines/tree.py rebuilds them). `decode=False`: the records as the JSON
+        line the worker wrote (bytes), for a process that decodes them elsewhere.
+        `stall`: seconds the worker may go without answering while requests are pending;
+        past them it is killed and WorkerError raised.
 
         An exception (or an interrupt such as a parse timeout) while waiting kills the worker,
         so that no late answer is ever read as the answer to a later request."""
@@ -275,6 +282,7 @@ class JavaWorker:
             window = threading.Semaphore(IN_FLIGHT)
             failure: list[BaseException] = []
             done = threading.Event()
+            flag = b" t" if trees else b""
 
             def write() -> None:
                 try:
@@ -283,7 +291,7 @@ class JavaWorker:
                         window.acquire()
                         if done.is_set():
                             return
-                        proc.stdin.write(b"%d %d\n" % (first + sent[0], len(data)))
+                        proc.stdin.write(b"%d %d%s\n" % (first + sent[0], len(data), flag))
                         proc.stdin.write(data)
                         proc.stdin.flush()
                         sent[0] += 1
@@ -303,19 +311,23 @@ class JavaWorker:
                 writer.start()
             received = 0
             barrier = False
+            readline = proc.stdout.readline if stall is None else _stalling_reader(proc.stdout, stall, first - 1, sent)
             try:
                 while not (barrier and received >= sent[0]):
-                    line = proc.stdout.readline()
+                    line = readline()
                     if not line:
                         raise WorkerError("the Java worker exited"
                                           + (f" ({failure[0]})" if failure else ""))
-                    raw = json.loads(line)
-                    if raw["id"] == first - 1:
+                    found = _ID.match(line)
+                    if found is None:
+                        raise WorkerError(f"the Java worker answered {line[:80]!r}")
+                    ident = int(found.group(1))
+                    if ident == first - 1:
                         barrier = True
                         continue
                     received += 1
                     window.release()
-                    yield raw["id"] - first, raw
+                    yield ident - first, (json.loads(line) if decode else line)
                 if writer is not None:
                     writer.join()
                 self.next_id = first + sent[0] + 1
@@ -325,6 +337,43 @@ class JavaWorker:
                 self.kill()
                 self.next_id = first + sent[0] + 2
                 raise
+
+
+_ID = re.compile(rb'\{"id":(\d+)[,}]')
+
+
+def _stalling_reader(stream, stall: float, last: int, sent: list[int]):
+    """A readline for `stream` that raises WorkerError when no line comes for `stall` seconds.
+    A thread reads the batch's lines: up to its barrier (the answer with id `last`) and the
+    answers to all `sent[0]` requests (final once the barrier was written), so that the next
+    batch reads the stream itself; or to the end of the stream."""
+    lines: queue.Queue = queue.Queue()
+    barrier = b'{"id":%d,' % last
+
+    def pump() -> None:
+        seen, answers = False, 0
+        try:
+            for line in iter(stream.readline, b""):
+                lines.put(line)
+                if line.startswith(barrier):
+                    seen = True
+                else:
+                    answers += 1
+                if seen and answers >= sent[0]:
+                    return
+        except (OSError, ValueError):
+            pass
+        lines.put(b"")
+
+    threading.Thread(target=pump, daemon=True).start()
+
+    def readline() -> bytes:
+        try:
+            return lines.get(timeout=stall)
+        except queue.Empty:
+            raise WorkerError(f"the Java worker gave no answer for {stall:g} s") from None
+
+    return readline
 
 
 _WORKERS: dict[tuple[str, int], JavaWorker] = {}

@@ -13,11 +13,26 @@
 // records, so it exists once. The two ports (LineErrorStrategy, lineTokens) are tested
 // against the Python originals on every file of the corpora (tests/syntax/test_engines.py).
 //
-// Protocol: requests on stdin, "<id> <n>\n" followed by n bytes of UTF-8 KRL text (already
-// decoded and given its final newline by Python); one JSON line per request on stdout,
-// {"id": .., "stage": "sll"|"ll", "lex": [[line, column, msg], ..], "syn": [{..}, ..]} or
-// {"id": .., "fail": "<exception>"}. Requests are parsed on a thread pool; answers come in
-// completion order. "0 -1\n" (or end of input) stops the worker.
+// Protocol: requests on stdin, "<id> <n>\n" (or "<id> <n> t\n": with the parse tree) followed
+// by n bytes of UTF-8 KRL text (already decoded and given its final newline by Python); one
+// JSON line per request on stdout, {"id": .., "stage": "sll"|"ll", "lex": [[line, column, msg],
+// ..], "syn": [{..}, ..]} or {"id": .., "fail": "<exception>"}. Requests are parsed on a thread
+// pool; answers come in completion order. "0 -1\n" (or end of input) stops the worker.
+//
+// With "t" the answer also carries the parse tree that the stage's parser built, as data
+// (krl/syntax/engines/tree.py rebuilds the Python runtime's objects from it; nothing is
+// re-parsed):
+//   "tokens": every token of the stream, 6 integers each: type, channel, start and stop (code
+//             point offsets in the text), line, column; a token's index is its tokenIndex;
+//   "names":  the context class names the tree uses (the generated Java and Python parsers
+//             name them alike, e.g. "UnaryExpressionContext");
+//   "tree":   the nodes in preorder, integers: a rule context is
+//             name index, start token, stop token (-1: none), invoking state, 1 when the rule
+//             recorded a recognition exception else 0, number of children, then its children;
+//             a terminal is -1, token index; an error node -2, token index;
+//   "labels": [[context's preorder number among contexts, field, kind, value], ..] for every
+//             label field (`op=`, `frame=` ..) of the contexts: kind "t" a token index (-1:
+//             null), "c" the index of a child (-1: null), "T"/"C" lists of those.
 
 import java.io.BufferedOutputStream;
 import java.io.DataInputStream;
@@ -28,8 +43,14 @@ import java.io.PrintStream;
 import java.lang.reflect.Constructor;
 import java.lang.reflect.Method;
 import java.nio.charset.StandardCharsets;
+import java.lang.reflect.Field;
+import java.lang.reflect.Modifier;
+import java.util.ArrayDeque;
 import java.util.ArrayList;
+import java.util.HashMap;
 import java.util.List;
+import java.util.Map;
+import java.util.concurrent.ConcurrentHashMap;
 import java.util.concurrent.ExecutorService;
 import java.util.concurrent.Executors;
 import java.util.concurrent.ThreadFactory;
@@ -43,6 +64,7 @@ import org.antlr.v4.runtime.DefaultErrorStrategy;
 import org.antlr.v4.runtime.InputMismatchException;
 import org.antlr.v4.runtime.Lexer;
 import org.antlr.v4.runtime.Parser;
+import org.antlr.v4.runtime.ParserRuleContext;
 import org.antlr.v4.runtime.RecognitionException;
 import org.antlr.v4.runtime.Recognizer;
 import org.antlr.v4.runtime.Token;
@@ -51,6 +73,9 @@ import org.antlr.v4.runtime.atn.ATNState;
 import org.antlr.v4.runtime.atn.PredictionMode;
 import org.antlr.v4.runtime.misc.IntervalSet;
 import org.antlr.v4.runtime.misc.ParseCancellationException;
+import org.antlr.v4.runtime.tree.ErrorNode;
+import org.antlr.v4.runtime.tree.ParseTree;
+import org.antlr.v4.runtime.tree.TerminalNode;
 
 public final class KrlWorker {
 
@@ -58,6 +83,7 @@ public final class KrlWorker {
     static Constructor<?> parserNew;
     static Method startRule;
     static int newlineType;
+    static String parserClassName;
 
     /** krl/syntax/errors.py LineErrorStrategy: report, then resynchronise at the end of the line. */
     static final class LineErrorStrategy extends DefaultErrorStrategy {
@@ -253,7 +279,7 @@ public final class KrlWorker {
         return i > 0 && Character.isHighSurrogate(s.charAt(i - 1));
     }
 
-    static String parse(long id, String text) throws Exception {
+    static String parse(long id, String text, boolean wantTree) throws Exception {
         Lexer lexer = (Lexer) lexerNew.newInstance(CharStreams.fromString(text));
         lexer.removeErrorListeners();
         LexerErrors lexErrors = new LexerErrors();
@@ -266,9 +292,10 @@ public final class KrlWorker {
         parser.removeErrorListeners();
         parser.getInterpreter().setPredictionMode(PredictionMode.SLL);
         parser.setErrorHandler(new BailErrorStrategy());
+        ParserRuleContext tree = null;
         boolean sllOk;
         try {
-            startRule.invoke(parser);
+            tree = (ParserRuleContext) startRule.invoke(parser);
             sllOk = true;
         } catch (java.lang.reflect.InvocationTargetException ex) {
             if (!(ex.getCause() instanceof ParseCancellationException)) {
@@ -277,7 +304,11 @@ public final class KrlWorker {
             sllOk = false;
         }
         if (sllOk && lexErrors.count == 0) {
-            return "{\"id\":" + id + ",\"stage\":\"sll\",\"lex\":[],\"syn\":[]}";
+            StringBuilder b = new StringBuilder("{\"id\":").append(id).append(",\"stage\":\"sll\",\"lex\":[],\"syn\":[]");
+            if (wantTree) {
+                treeData(b, tokens, tree);
+            }
+            return b.append('}').toString();
         }
 
         // Stage 2: full LL with line-oriented recovery, collecting every error.
@@ -288,8 +319,140 @@ public final class KrlWorker {
         parser.addErrorListener(synErrors);
         parser.getInterpreter().setPredictionMode(PredictionMode.LL);
         parser.setErrorHandler(new LineErrorStrategy());
-        startRule.invoke(parser);
-        return "{\"id\":" + id + ",\"stage\":\"ll\",\"lex\":[" + lexErrors.out + "],\"syn\":[" + synErrors.out + "]}";
+        tree = (ParserRuleContext) startRule.invoke(parser);
+        StringBuilder b = new StringBuilder("{\"id\":").append(id).append(",\"stage\":\"ll\",\"lex\":[")
+                .append(lexErrors.out).append("],\"syn\":[").append(synErrors.out).append(']');
+        if (wantTree) {
+            treeData(b, tokens, tree);
+        }
+        return b.append('}').toString();
+    }
+
+    /** The label fields (`op=`, `frame=`, `x+=`) the generated code declares on a context class. */
+    static final Map<Class<?>, Field[]> LABELS = new ConcurrentHashMap<>();
+
+    static Field[] labelFields(Class<?> cls) {
+        return LABELS.computeIfAbsent(cls, c -> {
+            List<Field> out = new ArrayList<>();
+            for (Field f : c.getFields()) {
+                if (Modifier.isStatic(f.getModifiers())
+                        || !f.getDeclaringClass().getName().startsWith(parserClassName + "$")) {
+                    continue;
+                }
+                out.add(f);
+            }
+            out.sort((a, b) -> a.getName().compareTo(b.getName()));
+            return out.toArray(new Field[0]);
+        });
+    }
+
+    /** ",\"tokens\":[..],\"names\":[..],\"tree\":[..],\"labels\":[..]" (see the header). */
+    static void treeData(StringBuilder b, CommonTokenStream tokens, ParserRuleContext root) throws IllegalAccessException {
+        b.append(",\"tokens\":[");
+        List<Token> all = tokens.getTokens();
+        for (int i = 0; i < all.size(); i++) {
+            Token t = all.get(i);
+            if (t.getTokenIndex() != i) {
+                throw new IllegalStateException("token index " + t.getTokenIndex() + " at " + i);
+            }
+            b.append(i == 0 ? "" : ",").append(t.getType()).append(',').append(t.getChannel()).append(',')
+                    .append(t.getStartIndex()).append(',').append(t.getStopIndex()).append(',')
+                    .append(t.getLine()).append(',').append(t.getCharPositionInLine());
+        }
+        Map<Class<?>, Integer> names = new HashMap<>();
+        List<String> nameList = new ArrayList<>();
+        StringBuilder tree = new StringBuilder();
+        StringBuilder labels = new StringBuilder();
+        int contexts = 0;
+        ArrayDeque<ParseTree> stack = new ArrayDeque<>();
+        stack.push(root);
+        while (!stack.isEmpty()) {
+            ParseTree node = stack.pop();
+            if (tree.length() > 0) {
+                tree.append(',');
+            }
+            if (node instanceof TerminalNode) {
+                Token sym = ((TerminalNode) node).getSymbol();
+                if (sym.getTokenIndex() < 0) {
+                    throw new IllegalStateException("a token the parser made up");
+                }
+                tree.append(node instanceof ErrorNode ? -2 : -1).append(',').append(sym.getTokenIndex());
+                continue;
+            }
+            ParserRuleContext ctx = (ParserRuleContext) node;
+            Integer k = names.get(ctx.getClass());
+            if (k == null) {
+                k = nameList.size();
+                names.put(ctx.getClass(), k);
+                nameList.add(ctx.getClass().getSimpleName());
+            }
+            int n = ctx.getChildCount();
+            tree.append(k).append(',').append(index(ctx.getStart())).append(',').append(stopIndex(all, ctx.getStop()))
+                    .append(',').append(ctx.invokingState).append(',').append(ctx.exception != null ? 1 : 0)
+                    .append(',').append(n);
+            for (Field f : labelFields(ctx.getClass())) {
+                labels.append(labels.length() == 0 ? "[" : ",[").append(contexts).append(',');
+                str(labels, f.getName());
+                Object v = f.get(ctx);
+                if (v instanceof List) {
+                    boolean tokensList = f.getGenericType().getTypeName().contains("Token");
+                    labels.append(tokensList ? ",\"T\",[" : ",\"C\",[");
+                    List<?> list = (List<?>) v;
+                    for (int i = 0; i < list.size(); i++) {
+                        labels.append(i == 0 ? "" : ",").append(tokensList ? index((Token) list.get(i)) : child(ctx, list.get(i)));
+                    }
+                    labels.append("]]");
+                } else if (Token.class.isAssignableFrom(f.getType())) {
+                    labels.append(",\"t\",").append(index((Token) v)).append(']');
+                } else {
+                    labels.append(",\"c\",").append(child(ctx, v)).append(']');
+                }
+            }
+            contexts++;
+            for (int i = n - 1; i >= 0; i--) {
+                stack.push(ctx.getChild(i));
+            }
+        }
+        b.append("],\"names\":[");
+        for (int i = 0; i < nameList.size(); i++) {
+            if (i > 0) {
+                b.append(',');
+            }
+            str(b, nameList.get(i));
+        }
+        b.append("],\"tree\":[").append(tree).append("],\"labels\":[").append(labels).append(']');
+    }
+
+    /** A context's stop token as the Python runtime records it: Java's exitRule takes the EOF
+     *  token once EOF was matched (LT(1)), Python's always LT(-1), the last token on the
+     *  default channel before it. */
+    static int stopIndex(List<Token> all, Token stop) {
+        if (stop == null || stop.getType() != Token.EOF) {
+            return index(stop);
+        }
+        for (int i = stop.getTokenIndex() - 1; i >= 0; i--) {
+            if (all.get(i).getChannel() == Token.DEFAULT_CHANNEL) {
+                return i;
+            }
+        }
+        return -1;
+    }
+
+    static int index(Token t) {
+        return t == null ? -1 : t.getTokenIndex();
+    }
+
+    /** The index of a labelled context among ctx's children (-1: null or not a child). */
+    static int child(ParserRuleContext ctx, Object v) {
+        if (v == null || ctx.children == null) {
+            return -1;
+        }
+        for (int i = 0; i < ctx.children.size(); i++) {
+            if (ctx.children.get(i) == v) {
+                return i;
+            }
+        }
+        return -1;
     }
 
     static String readLine(InputStream in) throws IOException {
@@ -308,6 +471,7 @@ public final class KrlWorker {
         parserNew = parserCls.getConstructor(TokenStream.class);
         startRule = parserCls.getMethod(args.length > 1 ? args[1] : "module");
         newlineType = (int) parserCls.getField("NEWLINE").get(null);
+        parserClassName = parserCls.getName();
         int threads = args.length > 0 ? Integer.parseInt(args[0]) : 1;
 
         PrintStream out = new PrintStream(new BufferedOutputStream(System.out, 1 << 16), false, StandardCharsets.UTF_8);
@@ -319,6 +483,7 @@ public final class KrlWorker {
             String[] parts = header.trim().split(" ");
             long id = Long.parseLong(parts[0]);
             int n = Integer.parseInt(parts[1]);
+            boolean wantTree = parts.length > 2 && parts[2].equals("t");
             if (n < 0) {
                 break;
             }
@@ -328,7 +493,7 @@ public final class KrlWorker {
             pool.execute(() -> {
                 String answer;
                 try {
-                    answer = parse(id, text);
+                    answer = parse(id, text, wantTree);
                 } catch (Throwable ex) {  // one bad file never stops the worker
                     Throwable cause = ex instanceof java.lang.reflect.InvocationTargetException ? ex.getCause() : ex;
                     StringBuilder b = new StringBuilder("{\"id\":").append(id).append(",\"fail\":");

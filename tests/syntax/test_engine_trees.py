@@ -1,0 +1,137 @@
+"""Parse trees from the Java engine (krl/syntax/engines/tree.py) and the batch path that uses
+them (krl/workspace.py ``load_batch``): bad tree data, a worker that stops answering and a
+whole backup checked through either engine.
+
+The node-by-node equality of the rebuilt trees with the Python engine's, on every file of
+the corpora, is in tests/syntax/test_engines.py.
+"""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+import time
+
+import pytest
+
+import krl.workspace as workspace_mod
+from krl.syntax.engines import java as java_engine
+from krl.syntax.engines import java_answers, parse_file, result_from_answer
+from krl.syntax.engines.tree import RebuiltToken, TreeDataError, tree_from_raw
+from krl.syntax.parse import default_bundle, prepare_text
+from krl.syntax.source import SourceText
+from tests.syntax.test_engines import _java_or_skip, _record, needs_java, tree_shape
+
+TEXT = "DEF a()\nDECL INT x\nx = -(1 + 2) * 3\nIF x > 1 THEN\nx = x - 1\nENDIF\nEND\n"
+BROKEN = "DEF b()\nx = = 1\nIF THEN\nEND\n"
+
+
+def _raw(text: str) -> dict:
+    worker = java_engine.worker_for(java_engine.REPO_ROOT.joinpath("grammar", "KRL.g4").read_text(encoding="utf-8"))
+    return dict(worker.parse_raw([prepare_text(text)], trees=True))[0]
+
+
+@needs_java
+@pytest.mark.parametrize("text", [TEXT, BROKEN])
+def test_a_rebuilt_tree_is_the_python_engines_tree(text):
+    _java_or_skip()
+    py = parse_file(text, "a.src", engine="python", keep_tree=True)
+    jv = parse_file(text, "a.src", engine="java", keep_tree=True)
+    assert isinstance(jv.tree.start, RebuiltToken)
+    assert tree_shape(jv.tree) == tree_shape(py.tree)
+    assert _record(jv) == _record(py)
+    assert jv.tree.getText() == py.tree.getText()
+
+
+@needs_java
+@pytest.mark.parametrize("damage", [
+    lambda r: r.update(tree=r["tree"][:-1]),                       # ends inside a context
+    lambda r: r.update(tree=r["tree"] + [-1, 0]),                   # a node after the root
+    lambda r: r.update(tree=[-7] + r["tree"][1:]),                  # an unknown node kind
+    lambda r: r.update(names=["NoSuchContext"] * len(r["names"])),  # a class the parser lacks
+    lambda r: r.update(names=["__class__"] * len(r["names"])),      # not a context class
+    lambda r: r.update(tokens=r["tokens"][:-1]),                    # not 6 integers per token
+    lambda r: r.update(tree=[0, 10 ** 9, 0, 0, 0, 0]),              # a token that does not exist
+    lambda r: r.update(labels=[[0, "op", "x", 1]]),                 # an unknown label kind
+    lambda r: r.pop("tree"),
+])
+def test_bad_tree_data_is_an_error_and_the_python_engine_parses(damage):
+    _java_or_skip()
+    raw = _raw(TEXT)
+    damage(raw)
+    with pytest.raises(TreeDataError):
+        tree_from_raw(raw, prepare_text(TEXT), default_bundle())
+    src = SourceText("a.src", TEXT, "ascii", len(TEXT))
+    res = result_from_answer(src, json.dumps(raw).encode(), keep_tree=True)
+    assert res.ok and not isinstance(res.tree.start, RebuiltToken)
+    assert tree_shape(res.tree) == tree_shape(parse_file(TEXT, "a.src", engine="python", keep_tree=True).tree)
+
+
+def test_a_worker_that_stops_answering_is_killed_after_the_stall(monkeypatch):
+    """parse_raw(stall=...) gives up on a worker that reads its requests and never answers:
+    WorkerError after about `stall` seconds, the process killed."""
+    worker = java_engine.JavaWorker.__new__(java_engine.JavaWorker)
+    worker.proc, worker.lock, worker.next_id, worker.threads = None, java_engine.threading.Lock(), 1, 1
+    silent = [sys.executable, "-c", "import sys, time\nsys.stdin.buffer.read()\ntime.sleep(600)"]
+    monkeypatch.setattr(worker, "_start", lambda: worker.proc or setattr(worker, "proc", subprocess.Popen(
+        silent, stdin=subprocess.PIPE, stdout=subprocess.PIPE)) or worker.proc)
+    proc = worker._start()
+    start = time.monotonic()
+    with pytest.raises(java_engine.WorkerError, match="no answer for 1 s"):
+        list(worker.parse_raw(["DEF a()\nEND\n"] * 3, stall=1))
+    assert 0.9 < time.monotonic() - start < 30
+    assert proc.wait(timeout=10) != 0 and worker.proc is None
+
+
+def test_java_answers_hands_every_unanswered_file_to_python(monkeypatch):
+    """A worker that dies after two answers: those two come with their records, every other
+    source with None (the Python engine parses it), none lost or repeated."""
+    class Dying:
+        def parse_raw(self, texts, **kw):
+            for k in range(2):
+                yield k, {"id": k, "stage": "sll", "lex": [], "syn": []}
+            raise java_engine.WorkerError("the Java worker exited")
+
+    monkeypatch.setattr(java_engine, "worker_for", lambda *a, **k: Dying())
+    sources = [SourceText(f"f{i}.src", "DEF f()\nEND\n", "ascii", 12) for i in range(6)]
+    sources.append(SourceText("bin.src", "", "", 3, "binary"))
+    got = list(java_answers(enumerate(sources)))
+    assert sorted(k for k, _, _ in got) == list(range(7))
+    assert [k for k, _, raw in got if raw is not None] == [0, 1]
+    assert got[0][0] == 6           # the source the worker never sees comes first
+
+
+@needs_java
+def test_a_backup_checks_the_same_through_either_engine(shared_corpus, monkeypatch):
+    """krl check of a backup (load_batch, worker processes): the Java engine's batch path gives
+    the same diagnostics and the same ASTs as the Python engine, and it really ran."""
+    _java_or_skip()
+    backup = shared_corpus / "rawpython__kukaKRLmagic"
+    entries = workspace_mod.collect_entries(backup)
+
+    def load(engine: str):
+        monkeypatch.setenv("KRL_ENGINE", engine)
+        [ws] = workspace_mod.load_workspaces([(str(backup), entries)], timeout=60, jobs=2)
+        return ws, list(ws.check())
+
+    monkeypatch.setattr(workspace_mod, "JAVA_BATCH_BYTES", 0)
+    answered = []
+    real = workspace_mod._parse_tasks
+
+    def counting(*a, **kw):
+        for key, (src, raw) in real(*a, **kw):
+            answered.append(raw is not None)
+            yield key, (src, raw)
+
+    monkeypatch.setattr(workspace_mod, "_parse_tasks", counting)
+    ws_py, diags_py = load("python")
+    assert not any(answered)
+    answered.clear()
+    ws_jv, diags_jv = load("java")
+    assert sum(answered) >= 30                     # of 34 files; the rest need a Python-only check
+    assert diags_jv == diags_py and len(diags_py) > 0
+    assert [f.path for f in ws_jv.files] == [f.path for f in ws_py.files]
+    assert [f.module for f in ws_jv.files] == [f.module for f in ws_py.files]
+    assert [[n.span for n in f.module.walk()] for f in ws_jv.files] == \
+           [[n.span for n in f.module.walk()] for f in ws_py.files]
