@@ -9,6 +9,7 @@ includes it.
 
 from __future__ import annotations
 
+import gc
 import json
 from collections import Counter
 from pathlib import Path
@@ -44,6 +45,7 @@ def check_report(corpus: str | Path, out_dir: str | Path | None = None, top: int
             "check_seconds": round(ws.check_seconds, 3),
             "codes": dict(codes.most_common()),
         })
+        ws = diags = None    # not held while the next batch loads
     total = {k: sum(r[k] for r in rows) for k in
              ("files", "files_parsed", "files_clean", "errors", "warnings")}
     total["parse_seconds"] = round(sum(r["parse_seconds"] for r in rows), 3)
@@ -62,9 +64,9 @@ def check_report(corpus: str | Path, out_dir: str | Path | None = None, top: int
     return data, md
 
 
-# Backups are loaded in batches of about this many bytes of KRL: one pool of workers (and the
+# Backups are loaded in batches of about this many bytes of KRL (and one more backup): one pool of workers (and the
 # Java engine) for many small backups, while memory holds one batch of ASTs at a time.
-BATCH_BYTES = 4 * 1024 * 1024
+BATCH_BYTES = 512 * 1024
 
 
 def _loaded_backups(backups: list[Path], timeout: float | None, jobs: int | None):
@@ -81,7 +83,30 @@ def _loaded_backups(backups: list[Path], timeout: float | None, jobs: int | None
             spaces = load_workspaces([(str(bb), ee) for bb, ee in batch], timeout=timeout, jobs=jobs)
             for (bb, _), ws in zip(batch, spaces):
                 yield bb, ws
-            batch, size, spaces = [], 0, None
+            batch, size, spaces, ws = [], 0, None, None
+            # the batch's ASTs and scopes hold reference cycles: free them before the next batch
+            # is loaded, so that memory holds one batch, not two
+            gc.collect()
+            _trim()
+
+
+def _trim() -> None:
+    """Give the C heap's free pages back to the system (glibc ``malloc_trim``; elsewhere
+    nothing): the results of a batch are unpickled on a thread of the worker pool, whose malloc
+    arena otherwise keeps the memory of the largest batch for every later one."""
+    global _MALLOC_TRIM
+    if _MALLOC_TRIM is None:
+        try:
+            import ctypes  # noqa: PLC0415
+
+            _MALLOC_TRIM = ctypes.CDLL("libc.so.6").malloc_trim
+        except (OSError, AttributeError):
+            _MALLOC_TRIM = False
+    if _MALLOC_TRIM:
+        _MALLOC_TRIM(0)
+
+
+_MALLOC_TRIM = None
 
 
 def render_markdown(data: dict) -> str:
