@@ -29,8 +29,8 @@ def main() -> None:
 @click.option("--outline", is_flag=True, help="Print the routines and declarations of each file that parses.")
 @click.option("--tree", is_flag=True, help="Print the grammar-rule outline of each file that parses.")
 @click.option("--engine", type=click.Choice(["auto", "python", "java"]), default=None,
-              help="Parse engine: java (fast; needs a JDK), python (reference; builds trees), auto: "
-                   "java when available (default: $KRL_ENGINE, else auto). --outline/--tree use python.")
+              help="Parse engine: java (fast; needs a JDK), python (the reference), auto: "
+                   "java when available (default: $KRL_ENGINE, else auto).")
 @click.option("--timeout", type=click.FloatRange(min=0, min_open=True), default=PARSE_TIMEOUT_S,
               show_default=True, help="Seconds one file may parse; past it the parse is stopped (error E005).")
 @click.option("--jobs", type=click.IntRange(min=1), default=None,

@@ -25,7 +25,9 @@ from __future__ import annotations
 import hashlib
 import json
 import os
+import sqlite3
 import sys
+import threading
 import time
 from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
@@ -218,84 +220,143 @@ def warn(message: str) -> None:
 
 
 class ResultCache:
-    """Per-file results keyed by (grammar sha, file sha), one JSON file per grammar and front end:
-    ``{"schema": CACHE_SCHEMA, "version": CACHE_VERSION, "results": {sha: row}}``."""
+    """Per-file results keyed by (grammar sha, file sha): one SQLite database per grammar and
+    front end, ``results/<front end>-<grammar>.sqlite``, with a ``meta`` table (schema, version)
+    and a ``results`` table (sha -> the row as JSON). Rows are read when a file is met and
+    written in transactions, so the cache costs no memory per file whatever the corpus size
+    (issue 17; it was one JSON document held whole).
+
+    Never raises: a database of another schema or version, or one that is not a database, is
+    ignored and rebuilt with one warning; entries that fail validation (:func:`valid_row`) are
+    parsed again and counted in one warning; a cache folder or database that cannot be used
+    means a scan without cache, with one warning. Several scans may share a cache (SQLite's
+    locking; a writer waits up to LOCK_WAIT_S, and writes COMMIT_EVERY rows at a time in one
+    short transaction)."""
+
+    LOCK_WAIT_S = 30.0
+    COMMIT_EVERY = 500
 
     def __init__(self, gsha: str, enabled: bool = True, warn: Callable[[str], None] = warn):
         self.enabled = enabled
         self.warn = warn
-        self.data: dict[str, dict] = {}
-        self.dirty = False
+        self.db: sqlite3.Connection | None = None
         self.path: Path | None = None
+        self.pending: dict[str, str] = {}     # sha -> row JSON, written COMMIT_EVERY at a time
+        self.corrupt = 0
+        self.lock = threading.Lock()
         if not enabled:
             return      # --no-cache: the cache folder is never touched
         try:
-            self.path = cache_dir() / "results" / f"{front_end_sha()[:12]}-{gsha[:32]}.json"
+            self.path = cache_dir() / "results" / f"{front_end_sha()[:12]}-{gsha[:32]}.sqlite"
+            self.path.parent.mkdir(parents=True, exist_ok=True)
         except OSError as exc:
             self._disable(f"cache folder not usable ({exc.strerror or exc}); running without a cache")
             return
-        self.data = self._load()
+        self._open()
 
     def _disable(self, why: str) -> None:
         self.enabled = False
-        self.data = {}
+        if self.db is not None:
+            try:
+                self.db.close()
+            except sqlite3.Error:
+                pass
+        self.db = None
         self.warn(why)
 
-    def _load(self) -> dict[str, dict]:
+    def _connect(self) -> sqlite3.Connection:
+        assert self.path is not None
+        db = sqlite3.connect(self.path, timeout=self.LOCK_WAIT_S, check_same_thread=False)
+        db.execute("CREATE TABLE IF NOT EXISTS meta (key TEXT PRIMARY KEY, value TEXT NOT NULL)")
+        db.execute("CREATE TABLE IF NOT EXISTS results (sha TEXT PRIMARY KEY, row TEXT NOT NULL)")
+        db.execute("INSERT OR IGNORE INTO meta VALUES ('schema', ?), ('version', ?)", (CACHE_SCHEMA, CACHE_VERSION))
+        db.commit()
+        meta = dict(db.execute("SELECT key, value FROM meta").fetchall())
+        if meta != {"schema": CACHE_SCHEMA, "version": CACHE_VERSION}:
+            db.close()
+            raise sqlite3.DatabaseError("of another schema or version")
+        return db
+
+    def _open(self) -> None:
         assert self.path is not None
         try:
-            raw = self.path.read_bytes()
-        except FileNotFoundError:
-            return {}
-        except OSError as exc:
-            self.warn(f"cache file {self.path} not readable ({exc.strerror or exc}); rebuilding it")
-            self.dirty = True
-            return {}
-        try:
-            obj = json.loads(raw)
-        except (ValueError, RecursionError):
-            obj = None
-        if not (isinstance(obj, dict) and obj.get("schema") == CACHE_SCHEMA
-                and obj.get("version") == CACHE_VERSION and isinstance(obj.get("results"), dict)):
+            self.db = self._connect()
+            return
+        except sqlite3.OperationalError as exc:     # locked past LOCK_WAIT_S, cannot open, disk full
+            self._disable(f"cache file {self.path} not usable ({exc}); running without a cache")
+            return
+        except sqlite3.DatabaseError:               # not a database, or another schema or version
             self.warn(f"cache file {self.path} is corrupt or of another version; ignored and rebuilt")
-            self.dirty = True
-            return {}
-        results = obj["results"]
-        good = {sha: row for sha, row in results.items() if valid_row(row, sha)}
-        if len(good) != len(results):
-            self.warn(f"{len(results) - len(good)} corrupt entries in cache file {self.path}; "
-                      "ignored, their files are parsed again")
-            self.dirty = True
-        return good
+        except (sqlite3.Error, OSError) as exc:
+            self._disable(f"cache file {self.path} not usable ({exc}); running without a cache")
+            return
+        try:
+            self.path.unlink(missing_ok=True)
+            self.db = self._connect()
+        except (sqlite3.Error, OSError) as exc:
+            self._disable(f"cache file {self.path} not usable ({exc}); running without a cache")
 
     def get(self, sha: str, rel_path: str) -> FileResult | None:
-        if not self.enabled:
+        if not self.enabled or self.db is None:
             return None
-        obj = self.data.get(sha)
-        if obj is None:
+        with self.lock:
+            found = self.pending.get(sha)
+            if found is None:
+                try:
+                    row = self.db.execute("SELECT row FROM results WHERE sha = ?", (sha,)).fetchone()
+                except sqlite3.Error as exc:
+                    self._disable(f"cache file {self.path} not readable ({exc}); running without a cache")
+                    return None
+                found = row[0] if row is not None else None
+        if found is None:
             return None
+        try:
+            obj = json.loads(found)
+        except (ValueError, RecursionError, TypeError):
+            obj = None
+        if not valid_row(obj, sha):
+            self.corrupt += 1
+            return None     # parsed again; its new row replaces the entry
         res = FileResult.from_json(obj)
         res.path = rel_path
         return res
 
     def put(self, res: FileResult) -> None:
-        if not self.enabled or res.status in NOT_CACHED or not res.sha:
+        if not self.enabled or self.db is None or res.status in NOT_CACHED or not res.sha:
             return  # not a property of (grammar, file): retry next time
-        self.data[res.sha] = res.to_json()
-        self.dirty = True
+        with self.lock:
+            self.pending[res.sha] = json.dumps(res.to_json())
+            if len(self.pending) >= self.COMMIT_EVERY:
+                self._flush()
+
+    def _flush(self) -> None:
+        """Write the pending rows in one short transaction (the write lock is never held while
+        files are parsed, so concurrent scans wait for each other only that long)."""
+        if not self.pending or self.db is None:
+            return
+        try:
+            with self.db:
+                self.db.executemany("INSERT OR REPLACE INTO results VALUES (?, ?)", self.pending.items())
+        except sqlite3.Error as exc:
+            self._disable(f"cache file {self.path} not written ({exc}); the next scan parses again")
+        self.pending = {}
 
     def save(self) -> None:
-        if not (self.enabled and self.dirty and self.path is not None):
+        """Commit and close; the one warning about corrupt entries met."""
+        if self.corrupt:
+            self.warn(f"{self.corrupt} corrupt entries in cache file {self.path}; "
+                      "ignored, their files were parsed again")
+            self.corrupt = 0
+        if not self.enabled or self.db is None:
             return
-        from krl.files import write_text_atomic  # noqa: PLC0415
-
-        try:
-            self.path.parent.mkdir(parents=True, exist_ok=True)
-            write_text_atomic(self.path, json.dumps({"schema": CACHE_SCHEMA, "version": CACHE_VERSION,
-                                                     "results": self.data}))
-        except OSError as exc:
-            self.warn(f"cache file {self.path} not written ({exc.strerror or exc}); the next scan parses again")
-        self.dirty = False
+        with self.lock:
+            self._flush()
+            if self.db is not None:
+                try:
+                    self.db.close()
+                except sqlite3.Error:
+                    pass
+            self.db = None
 
 
 # ----------------------------------------------------------------------- the scan

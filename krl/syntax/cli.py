@@ -19,7 +19,8 @@ from krl.semantics.diagnostics import Diagnostic
 
 def file_diagnostics(path: Path, keep_tree: bool = True):
     """(ParseResult, decoded text, diagnostics) of one file; never raises for bad content.
-    Without keep_tree the default parse engine (krl/syntax/engines) parses it, with no tree."""
+    The default parse engine (krl/syntax/engines) parses it; with keep_tree the result has its
+    parse tree (the java engine's is rebuilt from its data, the same tree)."""
     from krl.syntax.engines import parse_source  # noqa: PLC0415
     from krl.syntax.messages import syntax_diagnostics  # noqa: PLC0415
     from krl.syntax.source import read_source  # noqa: PLC0415

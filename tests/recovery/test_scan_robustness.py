@@ -3,6 +3,7 @@ reports and spreadsheet-safe CSV."""
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import ctypes
 import faulthandler
@@ -10,6 +11,7 @@ import hashlib
 import json
 import os
 import signal
+import sqlite3
 import subprocess
 import sys
 import time
@@ -84,7 +86,12 @@ def _facts(rows: dict) -> dict:
 
 
 def _cache_files(cache: Path) -> list[Path]:
-    return sorted((cache / "results").glob("*.json"))
+    return sorted((cache / "results").glob("*.sqlite"))
+
+
+def _cached_rows(cfile: Path) -> dict[str, dict]:
+    with contextlib.closing(sqlite3.connect(cfile)) as db:
+        return {sha: json.loads(row) for sha, row in db.execute("SELECT sha, row FROM results")}
 
 
 def test_corrupt_cache_entries_are_ignored_and_rebuilt_with_one_warning(tmp_path: Path, monkeypatch) -> None:
@@ -96,26 +103,60 @@ def test_corrupt_cache_entries_are_ignored_and_rebuilt_with_one_warning(tmp_path
     (corpus / "b.src").write_text(BROKEN)
     first = {r.path: r for r in scan(corpus, "g", jobs=1, progress=False)}
     [cfile] = _cache_files(cache)
-    obj = json.loads(cfile.read_text())
+    rows = _cached_rows(cfile)
     sha_a = hashlib.sha256(VALID.encode()).hexdigest()
     sha_b = hashlib.sha256(BROKEN.encode()).hexdigest()
-    assert set(obj["results"]) == {sha_a, sha_b}
+    assert set(rows) == {sha_a, sha_b}
     # a poisoned entry: the broken file claimed to parse, with a field of the wrong type
-    obj["results"][sha_b]["ok"] = "yes"
-    obj["results"][sha_b]["status"] = "ok"
-    cfile.write_text(json.dumps(obj))
+    rows[sha_b]["ok"] = "yes"
+    rows[sha_b]["status"] = "ok"
+    with contextlib.closing(sqlite3.connect(cfile)) as db:
+        db.execute("UPDATE results SET row = ? WHERE sha = ?", (json.dumps(rows[sha_b]), sha_b))
+        db.execute("UPDATE results SET row = ? WHERE sha = ?", ("{not json", sha_a))
+        db.commit()
     warnings: list[str] = []
     second = {r.path: r for r in scan(corpus, "g", jobs=1, progress=False, warn=warnings.append)}
-    assert len(warnings) == 1 and "1 corrupt" in warnings[0]
+    assert len(warnings) == 1 and "2 corrupt" in warnings[0]
     assert second["b.src"].status == "syntax_error" and _facts(second) == _facts(first)
-    assert json.loads(cfile.read_text())["results"][sha_b]["ok"] is False   # rebuilt
-    # a file that is not JSON at all: one warning, everything parsed again, file rewritten
-    cfile.write_bytes(b"\x00garbage{")
+    assert _cached_rows(cfile)[sha_b]["ok"] is False   # rebuilt
+    # a file that is not a database at all: one warning, everything parsed again, file rewritten
+    cfile.write_bytes(b"\x00garbage{" * 100)
     warnings.clear()
     third = {r.path: r for r in scan(corpus, "g", jobs=1, progress=False, warn=warnings.append)}
     assert len(warnings) == 1 and "corrupt" in warnings[0]
     assert _facts(third) == _facts(first)
-    assert set(json.loads(cfile.read_text())["results"]) == {sha_a, sha_b}
+    assert set(_cached_rows(cfile)) == {sha_a, sha_b}
+    # a database of another version: the same
+    with contextlib.closing(sqlite3.connect(cfile)) as db:
+        db.execute("UPDATE meta SET value = 'old' WHERE key = 'version'")
+        db.commit()
+    warnings.clear()
+    fourth = {r.path: r for r in scan(corpus, "g", jobs=1, progress=False, warn=warnings.append)}
+    assert len(warnings) == 1 and "another version" in warnings[0]
+    assert _facts(fourth) == _facts(first) and set(_cached_rows(cfile)) == {sha_a, sha_b}
+
+
+def test_a_locked_cache_means_no_cache_and_one_warning_never_a_lost_cache(tmp_path: Path, monkeypatch) -> None:
+    """Another scan holding the database's write lock past the wait: this scan runs without
+    the cache (one warning) and leaves the other's database alone."""
+    monkeypatch.setenv("KRL_CACHE_DIR", str(tmp_path / "cache"))
+    monkeypatch.setattr(scan_mod.ResultCache, "LOCK_WAIT_S", 0.2)
+    corpus = tmp_path / "corpus"
+    corpus.mkdir()
+    (corpus / "a.src").write_text(VALID)
+    first = scan(corpus, "g", jobs=1, progress=False)
+    [cfile] = _cache_files(tmp_path / "cache")
+    holder = sqlite3.connect(cfile)
+    holder.execute("BEGIN EXCLUSIVE")
+    try:
+        warnings: list[str] = []
+        again = scan(corpus, "g", jobs=1, progress=False, warn=warnings.append)
+    finally:
+        holder.rollback()
+        holder.close()
+    assert _facts({r.path: r for r in again}) == _facts({r.path: r for r in first})
+    assert len(warnings) == 1 and "running without a cache" in warnings[0]
+    assert set(_cached_rows(cfile)) == {hashlib.sha256(VALID.encode()).hexdigest()}
 
 
 def test_unwritable_cache_folder_means_no_cache_and_one_warning(tmp_path: Path, monkeypatch) -> None:
@@ -166,7 +207,7 @@ def test_cache_holds_the_hash_of_the_bytes_parsed(tmp_path: Path, monkeypatch) -
     [row] = scan(corpus, "g", jobs=1, progress=False)
     assert row.sha == hashlib.sha256(VALID.encode()).hexdigest() and row.ok
     [cfile] = _cache_files(tmp_path / "cache")
-    assert json.loads(cfile.read_text())["results"][row.sha]["ok"] is True
+    assert _cached_rows(cfile)[row.sha]["ok"] is True
 
 
 # ----------------------------------------------------------------------- reports
