@@ -672,8 +672,8 @@ class Controller:
         kw = blending.effective_keyword(r.seg, nseg) or "C_DIS"
         # the blend's own time laws (robot/blending.py plan_blend): prev brakes through the
         # zone, the next motion ramps up to the blend end
-        r.seg.profile, r.seg.T = bp.prev_profile, bp.prev_profile.t_total
-        nseg.profile, nseg.T = bp.next_profile, bp.next_profile.t_total
+        r.seg.profile = bp.prev_profile
+        nseg.profile = bp.next_profile
         tau_e = bp.window
         self._motion_event(r.seg, "blend_start")
         nr = self._start(nseg, pt)

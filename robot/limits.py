@@ -94,6 +94,25 @@ class MotionLimits:
                             tuple(float(v) for v in d.get("base") or (0.0,) * 6))
 
 
+def ptp_axis_speeds(params: Any, machine: Any, mode: str = DEFAULT_MODE) -> np.ndarray:
+    """The programmed axis speeds of a PTP/SPTP motion, deg/s per axis (shape (6,)):
+    ``v_max_i · $VEL_AXIS[i]% · $OV_PRO%``, ``· $RED_T1%`` in T1 (reference §6.7, robot-model.md
+    §10). The one formula: the planner plans with it, :func:`motion_limits` checks with it."""
+    v_max = np.asarray(machine.max_speed_deg_s, dtype=float)
+    axes = v_max * np.asarray(params.vel_axis, dtype=float) / 100.0 * params.ov_pro / 100.0
+    if mode == "T1":
+        axes = axes * red_t1_pct(machine) / 100.0
+    return axes
+
+
+def cp_path_speed(params: Any, mode: str = DEFAULT_MODE) -> float:
+    """The programmed path speed of a CP motion piece, mm/s: ``$VEL.CP`` (m/s) ``· 1000 ·
+    $OV_PRO%``, at most 250 mm/s in T1 (reference §6.7). The one formula, as
+    :func:`ptp_axis_speeds`."""
+    v = params.vel_cp * 1000.0 * params.ov_pro / 100.0
+    return min(v, T1_SPEED_MM_S) if mode == "T1" else v
+
+
 def motion_limits(req: Any, machine: Any, mode: str = DEFAULT_MODE) -> MotionLimits:
     """The limits of a :class:`~robot.motion.MotionRequest` (see the module docstring).
 
@@ -101,21 +120,14 @@ def motion_limits(req: Any, machine: Any, mode: str = DEFAULT_MODE) -> MotionLim
     limit outside T1. CP: path ``$VEL.CP · 1000 · $OV_PRO%`` mm/s (a SPLINE block: the largest
     over its segments), axes ``v_max_i``. T1: path and flange ``<= 250 mm/s``."""
     p = req.params
-    v_max = np.asarray(machine.max_speed_deg_s, dtype=float)
     if req.kind in ("PTP", "SPTP"):
-        axes = v_max * np.asarray(p.vel_axis, dtype=float) / 100.0 * p.ov_pro / 100.0
-        if mode == "T1":
-            axes = axes * red_t1_pct(machine) / 100.0
-        path: float | None = None
+        axes = ptp_axis_speeds(p, machine, mode)
+        path: float | None = T1_SPEED_MM_S if mode == "T1" else None
     else:
-        vs = [p.vel_cp] + [s.params.vel_cp for s in getattr(req, "segments", ()) if s.params]
-        ovs = [p.ov_pro] + [s.params.ov_pro for s in getattr(req, "segments", ()) if s.params]
-        path = max(v * 1000.0 * o / 100.0 for v, o in zip(vs, ovs))
-        axes = v_max
-    flange = None
-    if mode == "T1":
-        path = T1_SPEED_MM_S if path is None else min(path, T1_SPEED_MM_S)
-        flange = T1_SPEED_MM_S
+        pieces = [p] + [s.params for s in getattr(req, "segments", ()) if s.params]
+        path = max(cp_path_speed(q, mode) for q in pieces)
+        axes = np.asarray(machine.max_speed_deg_s, dtype=float)
+    flange = T1_SPEED_MM_S if mode == "T1" else None
     return MotionLimits(path, tuple(float(v) for v in axes), flange,
                         tuple(float(v) for v in p.tool), tuple(float(v) for v in p.base))
 
@@ -302,5 +314,5 @@ def check_trace(events: Iterable[dict[str, Any]], machine: Any = None, *,
 
 
 __all__ = ["MotionLimits", "motion_limits", "check_trace", "LimitReport", "Violation",
-           "normalise_mode", "red_t1_pct", "T1_SPEED_MM_S", "MODES", "DEFAULT_MODE",
+           "normalise_mode", "red_t1_pct", "ptp_axis_speeds", "cp_path_speed", "T1_SPEED_MM_S", "MODES", "DEFAULT_MODE",
            "TOL_SPEED", "TOL_ACC"]

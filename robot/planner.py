@@ -29,7 +29,7 @@ from .errors import RobotError, WorkspaceError
 from .frames import frame_to_matrix, inv_pos, matrix_to_frame
 from .kinematics import Kinematics
 from .motion import AXIS_KEYS, CART_KEYS, MotionParams, MotionRequest, Trigger
-from .limits import DEFAULT_MODE, T1_SPEED_MM_S, motion_limits, red_t1_pct
+from .limits import DEFAULT_MODE, T1_SPEED_MM_S, cp_path_speed, motion_limits, ptp_axis_speeds
 from .profiles import PiecewiseProfile, Trapezoid
 
 
@@ -293,7 +293,7 @@ class Segment:
     Attributes:
         req: the request; id: its id.
         q0, q1: start and end axes (deg), shape (6,).
-        profile: :class:`~robot.profiles.Trapezoid`; T: duration (s).
+        profile: :class:`~robot.profiles.Trapezoid`; T: its duration (s), ``profile.t_total``.
         v_prog: the requested normalised speed (1/s) (for C_VEL).
         tool_T, base_T: the motion's $TOOL and $BASE (4x4); status: start S.
         triggers: :class:`TriggerPlan` list.
@@ -308,7 +308,6 @@ class Segment:
         self.q0 = q0
         self.q1 = q1
         self.profile = profile
-        self.T = profile.t_total
         self.v_prog = v_prog
         self.tool_T = tool_T
         self.base_T = base_T
@@ -324,6 +323,11 @@ class Segment:
         self.qd_end = q1 - q0
         self._last_q = q0.copy()
         self._end_frame: list[float] | None = None
+
+    @property
+    def T(self) -> float:  # noqa: N802 - the duration's symbol in the planner's formulas
+        """Duration (s): the profile's (one fact; a blend that replaces the profile changes it)."""
+        return self.profile.t_total
 
     def u(self, tau: float) -> float:
         return self.profile.u(tau)
@@ -625,9 +629,7 @@ def _plan_joint(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_T:
         v_prog = math.inf
         V = A = 0.0
     else:
-        v_axis = model.v_max * np.array(p.vel_axis) / 100.0 * p.ov_pro / 100.0
-        if model.mode == "T1":
-            v_axis = v_axis * red_t1_pct(model.machine) / 100.0  # $RED_T1 (issue 15)
+        v_axis = ptp_axis_speeds(p, model.machine, model.mode)     # $RED_T1 in T1 (issue 15)
         a_axis = model.a_max * np.array(p.acc_axis) / 100.0
         if np.any(v_axis[moving] <= 0) or np.any(a_axis[moving] <= 0):
             raise RobotError("PTP: $VEL_AXIS, $ACC_AXIS and $OV_PRO must be positive")
@@ -665,9 +667,7 @@ def _orientation_modes(p: MotionParams, kind: str) -> str:
 def _cp_speeds(prm: MotionParams, mode: str) -> tuple[float, float, float, float]:
     """(v_cp mm/s, v_ori deg/s, a_cp mm/s², a_ori deg/s²) of a CP piece: ``$VEL.CP``
     · ``$OV_PRO``% (T1: at most 250 mm/s), the smaller ORI value (reference §6.7)."""
-    v_cp = prm.vel_cp * 1000.0 * prm.ov_pro / 100.0
-    if mode == "T1":
-        v_cp = min(v_cp, T1_SPEED_MM_S)
+    v_cp = cp_path_speed(prm, mode)
     v_ori = min(prm.vel_ori1, prm.vel_ori2) * prm.ov_pro / 100.0
     a_cp = prm.acc_cp * 1000.0
     a_ori = min(prm.acc_ori1, prm.acc_ori2)
@@ -923,7 +923,6 @@ def _plan_cart(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_T: 
     else:
         prof = PiecewiseProfile([float(x) for x in ub], vmax, amax, vnode)
     seg.profile = prof
-    seg.T = prof.t_total
     seg.v_prog = vprog[-1]
     seg.q1 = ref
     seg.status = status
