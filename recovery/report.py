@@ -156,16 +156,6 @@ def files_csv_row(r: FileResult) -> list:
             first.column + 1 if first else "", " ".join(clusters_of_file(r)), r.detail]
 
 
-def write_files_csv(path: Path, results: list[FileResult]) -> None:
-    """One row per corpus entry; ``encoding`` is the decoding used (krl/syntax/source.py),
-    ``detail`` says why a file was not parsed. Every text cell through :func:`csv_cell`."""
-    with path.open("w", newline="", encoding="utf-8") as fh:
-        w = csv.writer(fh)
-        w.writerow(FILES_CSV_HEADER)
-        for r in results:
-            _writerow(w, files_csv_row(r))
-
-
 def write_clusters_csv(path: Path, clusters: list[Cluster], known_invalid: list[Cluster] = ()) -> None:
     """One row per cluster: the ranked missing constructs (``group`` missing, ranked 1..n),
     then the clusters of known-invalid files (``group`` known_invalid, no rank). Every text
@@ -310,16 +300,10 @@ def write_report(out: Path, summary: Summary, results: list[FileResult]) -> None
     rendering leaves the previous report untouched (and no temporary folder). Raises
     :class:`ReportError` when `out` exists and holds files that are not a report (nothing is
     written or removed then)."""
-    out = Path(out)
-    tmp = _new_report_folder(out)
-    try:
-        write_files_csv(tmp / "files.csv", results)
-        render_report(tmp, summary, [r for r in results if r.status not in ("ok", "syntax_error")],
-                      link_from=out)
-        _put_in_place(tmp, out)
-    except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise
+    with ReportStream(Path(out)) as stream:     # the one writer of files.csv
+        for index, r in enumerate(results):
+            stream.add(index, r)
+        stream.commit(summary, [r for r in results if r.status not in ("ok", "syntax_error")])
 
 
 class ReportStream:
@@ -331,6 +315,9 @@ class ReportStream:
     untouched and removes the temporary folder."""
 
     def __init__(self, out: Path):
+        """files.csv: one row per corpus entry; ``encoding`` is the decoding used
+        (krl/syntax/source.py), ``detail`` says why a file was not parsed; every text cell
+        through :func:`csv_cell`."""
         self.out = Path(out)
         self.tmp = _new_report_folder(self.out)
         self._fh = (self.tmp / "files.csv").open("w", newline="", encoding="utf-8")

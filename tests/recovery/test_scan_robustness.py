@@ -22,7 +22,7 @@ import pytest
 from recovery import report as report_mod
 from recovery import scan as scan_mod
 from recovery.cluster import Cluster
-from recovery.report import summarise, write_clusters_csv, write_files_csv, write_report
+from recovery.report import summarise, write_clusters_csv, write_report
 from recovery.scan import FileResult, scan
 
 REPO_ROOT = Path(__file__).resolve().parents[2]
@@ -283,7 +283,7 @@ def test_files_and_clusters_csv_hold_no_formula(tmp_path: Path) -> None:
                FileResult("@SUM(1).src", 10, "s", "ascii", "binary", False, detail="-NUL bytes")]
     cluster = Cluster(id="c1", signature="+x | y", files=1, occurrences=1, leading_keyword="=IF",
                       expected=["-a"], examples=[{"path": "=a.src", "line": 3, "text": "@x = 1"}])
-    write_files_csv(tmp_path / "files.csv", results)
+    write_report(tmp_path, summarise(results, "g", "corpus", 0.0), results)    # files.csv among them
     write_clusters_csv(tmp_path / "clusters.csv", [cluster])
     for name in ("files.csv", "clusters.csv"):
         with (tmp_path / name).open(newline="", encoding="utf-8") as fh:
