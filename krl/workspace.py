@@ -25,6 +25,7 @@ Usage::
 
 from __future__ import annotations
 
+import gc
 import re
 import time
 from collections.abc import Callable
@@ -135,11 +136,22 @@ def load_batch(paths: list, timeout: float, jobs: int | None = None) -> list:
     hook = _ON_FILE.get()
     sources = [read_source(p) for p in paths]
     done: list = [None] * len(paths)
-    for o in run_tasks(load_parsed, _parse_tasks(sources, jobs, timeout), jobs=jobs, timeout=timeout):
-        done[o.key] = o
-        sources[o.key] = None
-        if hook is not None:
-            hook(str(paths[o.key]))      # progress as files finish, in any order
+    # The ASTs arriving here are millions of new objects and next to no garbage: the cyclic
+    # collector's passes over the growing heap cost more than the unpickling (main-process CPU
+    # for the whole corpus 6.4 s with them, 2.7 s without); it runs once the batch is in.
+    enabled = gc.isenabled()
+    gc.disable()
+    try:
+        # (the workers, forked from here, collect as usual: their parse trees are cyclic garbage)
+        for o in run_tasks(load_parsed, _parse_tasks(sources, jobs, timeout), jobs=jobs, timeout=timeout,
+                           initializer=gc.enable):
+            done[o.key] = o
+            sources[o.key] = None
+            if hook is not None:
+                hook(str(paths[o.key]))      # progress as files finish, in any order
+    finally:
+        if enabled:
+            gc.enable()
     return done
 
 

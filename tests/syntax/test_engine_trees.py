@@ -135,3 +135,27 @@ def test_a_backup_checks_the_same_through_either_engine(shared_corpus, monkeypat
     assert [f.module for f in ws_jv.files] == [f.module for f in ws_py.files]
     assert [[n.span for n in f.module.walk()] for f in ws_jv.files] == \
            [[n.span for n in f.module.walk()] for f in ws_py.files]
+
+
+def _collector_state(src, raw=None):
+    import gc  # noqa: PLC0415
+
+    return gc.isenabled()
+
+
+def test_load_batch_pauses_the_collector_here_but_never_in_the_workers(tmp_path, monkeypatch):
+    """The main process pauses the cyclic collector while a batch's ASTs arrive (and restores
+    it after); the worker processes, forked meanwhile, must collect as usual: their parse
+    trees are cyclic garbage, file after file."""
+    import gc
+
+    paths = []
+    for i in range(4):
+        (tmp_path / f"f{i}.src").write_text("DEF f()\nEND\n")
+        paths.append(tmp_path / f"f{i}.src")
+    monkeypatch.setattr(workspace_mod, "load_parsed", _collector_state)
+    assert gc.isenabled()
+    outcomes = workspace_mod.load_batch(paths, timeout=60, jobs=2)
+    assert [o.status for o in outcomes] == ["done"] * 4
+    assert [o.value for o in outcomes] == [True] * 4
+    assert gc.isenabled()
