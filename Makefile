@@ -73,7 +73,8 @@ CONF_FUZZ ?= 200
 conformance: $(PARSER) java-parser
 	$(BIN)/krl conformance --out $(CONF_OUT) --fuzz $(CONF_FUZZ)
 
-# Long nightly run, in order: recovery over the shared corpus, growth, conformance, the
+# Long nightly run, in order: recovery over the shared corpus, growth, the 16-copies scaling
+# figures (scale.json), conformance, the
 # tests marked slow (long sweeps; hypothesis with the nightly profile); dated reports under
 # reports/nightly/<date>/ and an index page. Not part of `make test`.
 NIGHTLY_FUZZ ?= 2000
@@ -81,6 +82,7 @@ nightly: $(PARSER) java-parser
 	@d=reports/nightly/$$(date -u +%Y-%m-%d); mkdir -p $$d; \
 	$(BIN)/krl recover $(SHARED_CORPUS) --out $$d/recovery; s=$$?; [ $$s -le 1 ] || exit $$s; \
 	$(BIN)/krl growth $(SHARED_CORPUS) --out $$d/growth || exit $$?; \
+	$(BIN)/python -m recovery.scale_bench $(SHARED_CORPUS) --json > $$d/scale.json || exit $$?; \
 	$(BIN)/krl conformance --out $$d/conformance --fuzz $(NIGHTLY_FUZZ) --fuzz-random; c=$$?; \
 	HYPOTHESIS_PROFILE=nightly $(BIN)/python -m pytest -q -n 2 -p no:cacheprovider -m "slow or not slow" \
 	  > $$d/slow-tests.log 2>&1; t=$$?; tail -1 $$d/slow-tests.log; \

@@ -25,9 +25,6 @@ from pathlib import Path
 
 import click
 
-REPO = Path(__file__).resolve().parents[1]
-
-
 def _link_tree(src: Path, dst: Path) -> None:
     try:
         shutil.copytree(src, dst, copy_function=os.link, symlinks=True)
@@ -91,13 +88,13 @@ def scale(corpus: Path, copies: int = 16) -> dict:
 @click.option("--copies", type=click.IntRange(2, 64), default=16, show_default=True)
 @click.option("--json", "as_json", is_flag=True, help="One JSON object.")
 def main(corpus: Path | None, copies: int, as_json: bool) -> None:
-    corpus = corpus or REPO.parent / "shared" / "krl-corpus"
-    if not corpus.is_dir():
-        raise click.UsageError(f"no corpus at {corpus}")
-    figures = scale(corpus, copies)
+    from krl.bench import DEFAULT_CORPUS  # noqa: PLC0415
+
+    if corpus is None and not DEFAULT_CORPUS.is_dir():
+        raise click.UsageError(f"no corpus at {DEFAULT_CORPUS}; name one")
+    figures = scale(corpus or DEFAULT_CORPUS, copies)
     if as_json:
-        click.echo(json.dumps(figures))
-        return
+        return click.echo(json.dumps(figures))
     one, many = figures["one"], figures["many"]
     click.echo(f"one copy: {one['seconds']} s, peak {one['peak_mb']}")
     click.echo(f"{copies} copies: {many['seconds']} s, peak {many['peak_mb']}")

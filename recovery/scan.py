@@ -256,13 +256,16 @@ class ResultCache:
 
     def _disable(self, why: str) -> None:
         self.enabled = False
+        self._close()
+        self.warn(why)
+
+    def _close(self) -> None:
         if self.db is not None:
             try:
                 self.db.close()
             except sqlite3.Error:
                 pass
         self.db = None
-        self.warn(why)
 
     def _connect(self) -> sqlite3.Connection:
         assert self.path is not None
@@ -351,12 +354,7 @@ class ResultCache:
             return
         with self.lock:
             self._flush()
-            if self.db is not None:
-                try:
-                    self.db.close()
-                except sqlite3.Error:
-                    pass
-            self.db = None
+            self._close()
 
 
 # ----------------------------------------------------------------------- the scan
