@@ -1,19 +1,25 @@
 """`krl fmt [--check] [--diff] [--keyword-case upper|lower|keep] [--indent N|tab] PATHS...`
 (registered by krl/cli.py).
 
-PATHS are KRL files (.src, .dat, .sub) or folders (searched for KRL files, symbolic links not
-followed); ``-`` alone formats standard input to standard output (for editors and hooks). By default each file that would change is rewritten in place, atomically (a
-temporary file in the same folder, then a rename), in the encoding it was read in
-(krl/syntax/source.py: UTF-8 with or without BOM, or Windows-1252, byte for byte outside the
-changed whitespace and keyword case). ``--check`` and ``--diff`` write nothing: they print a
-unified diff of each file that would change (KRL text shown through krl/terminal.py
-``printable``); ``--check`` also exits 1 when any file would change.
+PATHS are KRL files (.src, .dat, .sub) or folders, walked by krl/files.py ``walk`` as
+``krl check`` walks them: a symbolic link, FIFO, socket or device named like a KRL file and a
+folder more than ``MAX_FOLDER_DEPTH`` levels deep are never read nor written; each is reported
+on stderr as a W002 warning naming it (``path:1:1: warning[W002]: not read: a symbolic link
+(never followed)``), as is a folder that cannot be listed. ``-`` alone formats standard input
+to standard output (for editors and hooks). By default each file that would change is
+rewritten in place, atomically (a temporary file in the same folder, then a rename), in the
+encoding it was read in (krl/syntax/source.py: UTF-8 with or without BOM, or Windows-1252,
+byte for byte outside the changed whitespace and keyword case). ``--check`` and ``--diff``
+write nothing: they print a unified diff of each file that would change (KRL text shown
+through krl/terminal.py ``printable``); ``--check`` also exits 1 when any file would change.
 
 A file that does not parse is never formatted: its syntax errors are printed in the compiler
 form of ``krl parse`` (krl/semantics/render.py, ``file:line:col: error[E0xx]: ...``) on stderr,
 the file is left untouched, and the exit status is 2. Exit status: 0 nothing to do or
 everything formatted; 1 (``--check`` only) some file would change; 2 some file did not parse
-or could not be read or written (this wins over 1). A count line closes the run on stderr.
+or could not be read or written, or a folder could not be listed (this wins over 1). Links,
+FIFOs and too deep folders met in a folder are skipped on purpose and do not change the exit
+status. A count line closes the run on stderr.
 """
 
 from __future__ import annotations
@@ -22,47 +28,40 @@ import difflib
 import os
 import re
 import sys
+from collections.abc import Iterator
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import click
 
 from krl.fmt.core import FormatError, FormatOptions, FormatSyntaxError, format_text
 
+if TYPE_CHECKING:
+    from krl.files import Entry
+
 _LINE_END = re.compile(r"\r\n|\n|\r")
 
 
-def krl_files(paths) -> list[Path]:
-    """The KRL files named by `paths`: files as given, folders walked iteratively (sorted,
-    symbolic links inside folders not followed). A missing path is returned as is (and
-    reported as unreadable)."""
-    from krl.syntax.source import is_krl_file  # noqa: PLC0415
+# entries of a walk that could not be read (exit status 2); the other kinds are skipped on purpose
+_UNREADABLE = ("unreadable_folder", "unreadable")
 
-    out: list[Path] = []
+
+def fmt_entries(paths) -> Iterator[tuple[Entry, bool]]:
+    """What `krl fmt PATHS` works on, in order: (krl/files.py entry, named). A path that is
+    not a folder is one ``file`` entry, named (a named link is followed; a missing path is
+    reported unreadable when read). A folder (also one named through a link) is walked by
+    :func:`krl.files.walk`, the one folder walk of the project: iterative, links inside never
+    followed, every link, FIFO/socket/device, unreadable or too deep folder (past
+    krl/limits.py ``MAX_FOLDER_DEPTH``) listed as an entry that is not read."""
+    from krl.files import Entry, walk  # noqa: PLC0415
+
     for raw in paths:
         p = Path(raw)
-        if not p.is_dir():
-            out.append(p)
-            continue
-        found: list[Path] = []
-        stack = [p]
-        while stack:
-            d = stack.pop()
-            try:
-                entries = list(os.scandir(d))
-            except OSError:
-                continue
-            for e in entries:
-                try:
-                    if e.is_symlink():
-                        continue
-                    if e.is_dir(follow_symlinks=False):
-                        stack.append(Path(e.path))
-                    elif e.is_file(follow_symlinks=False) and is_krl_file(Path(e.name)):
-                        found.append(Path(e.path))
-                except OSError:
-                    continue
-        out.extend(sorted(found))
-    return out
+        if p.is_dir():
+            for e in walk(p):
+                yield e, False
+        else:
+            yield Entry(p, str(p), "file"), True
 
 
 def _lines(text: str) -> list[str]:
@@ -80,12 +79,14 @@ def unified_diff(path: str, before: str, after: str) -> list[str]:
     return [printable(line) for line in diff]
 
 
-def write_atomically(path: Path, data: bytes) -> None:
-    """Replace the file's content atomically (krl/files.py), keeping its mode; the target of a
-    symbolic link is replaced, the link kept. Raises OSError."""
+def write_atomically(path: Path, data: bytes, follow_symlinks: bool = True) -> None:
+    """Replace the file's content atomically (krl/files.py), keeping its mode. A named file
+    (`follow_symlinks`): the target of a symbolic link is replaced, the link kept; a file found
+    in a folder: the path itself is replaced (a link swapped in meanwhile is replaced, its
+    target never written). Raises OSError."""
     from krl.files import write_bytes_atomic  # noqa: PLC0415
 
-    write_bytes_atomic(Path(os.path.realpath(path)), data, mode=None)
+    write_bytes_atomic(Path(os.path.realpath(path)) if follow_symlinks else Path(path), data, mode=None)
 
 
 def run_fmt(paths, check: bool = False, diff: bool = False, options: FormatOptions | None = None,
@@ -95,7 +96,7 @@ def run_fmt(paths, check: bool = False, diff: bool = False, options: FormatOptio
     from krl.semantics.diagnostics import Diagnostic  # noqa: PLC0415
     from krl.semantics.render import Renderer, SourceLines  # noqa: PLC0415
     from krl.syntax.cli import file_diagnostics  # noqa: PLC0415
-    from krl.syntax.source import encode_text, read_source  # noqa: PLC0415
+    from krl.syntax.source import encode_text, read_limited, read_source  # noqa: PLC0415
     from krl.terminal import printable, printable_path  # noqa: PLC0415
 
     out = out or click.echo
@@ -103,10 +104,18 @@ def run_fmt(paths, check: bool = False, diff: bool = False, options: FormatOptio
     options = options or FormatOptions()
     sources = SourceLines()
     renderer = Renderer(err, colour, sources)
-    files = krl_files(paths)
-    changed = unchanged = failed = 0
-    for path in files:
-        src = read_source(path)
+    changed = unchanged = failed = skipped = 0
+    for entry, named in fmt_entries(paths):
+        path = entry.path
+        if entry.kind != "file":
+            # never read nor written: a W002 warning as `krl check` gives it
+            renderer.emit([Diagnostic(str(path), 1, 1, "W002", f"not read: {entry.message}")])
+            if entry.kind in _UNREADABLE:
+                failed += 1
+            else:
+                skipped += 1
+            continue
+        src = read_source(path, follow_symlinks=named)   # a link swapped in after the walk: not read
         if src.status == "empty":
             unchanged += 1
             continue
@@ -139,9 +148,12 @@ def run_fmt(paths, check: bool = False, diff: bool = False, options: FormatOptio
         try:
             original = encode_text(src.text, src.encoding)
             data = encode_text(new, src.encoding)
-            if original != Path(path).read_bytes():
+            now, status, detail, _size = read_limited(path, follow_symlinks=named)
+            if status != "ok":
+                raise OSError(f"the file changed while it was formatted ({status}{': ' + detail if detail else ''})")
+            if original != now:
                 raise OSError("the file changed while it was formatted, or its bytes do not round-trip")
-            write_atomically(Path(path), data)
+            write_atomically(Path(path), data, follow_symlinks=named)
         except (OSError, UnicodeError) as exc:
             err(f"{printable_path(path)}: not written: {printable(exc)}")
             changed -= 1
@@ -150,6 +162,8 @@ def run_fmt(paths, check: bool = False, diff: bool = False, options: FormatOptio
     summary = f"{changed} {'file' if changed == 1 else 'files'} {verb}, {unchanged} unchanged"
     if failed:
         summary += f", {failed} not formatted (syntax errors or unreadable)"
+    if skipped:
+        summary += f", {skipped} not read (links, FIFOs, devices, too deep folders)"
     err(summary)
     if failed:
         return 2
@@ -215,8 +229,9 @@ def run_stdin(data: bytes, check: bool = False, diff: bool = False, options: For
               help="One block level: N spaces (1-16) or a tab.")
 def fmt(paths: tuple[str, ...], check: bool, diff: bool, keyword_case: str, indent: str) -> None:
     """Format KRL files in place (indentation, keyword case, spacing); comments, folds,
-    inline forms, header lines and line ends are kept. Exit 1 with --check when a file would
-    change, 2 when a file does not parse."""
+    inline forms, header lines and line ends are kept. Folders are searched; links, FIFOs and
+    folders too deep met there are never read (a W002 warning each). Exit 1 with --check when
+    a file would change, 2 when a file does not parse or cannot be read."""
     from krl.semantics.render import use_colour  # noqa: PLC0415
 
     if indent.lower() == "tab":

@@ -127,3 +127,79 @@ def test_stdin_check():
     res = CliRunner().invoke(main, ["fmt", "--check", "-"], input=MESSY)
     assert res.exit_code == 1
     assert "+DEF t()" in res.stdout.splitlines()
+
+
+def _warning(path, why):
+    return f"{path}:1:1: warning[W002]: not read: {why}"
+
+
+def test_folder_links_and_fifos_are_reported_never_read_nor_written(tmp_path):
+    outside = tmp_path / "outside.src"
+    outside.write_bytes(MESSY)
+    tree = tmp_path / "tree"
+    tree.mkdir()
+    good = tree / "good.src"
+    good.write_bytes(MESSY)
+    link = tree / "link.src"
+    link.symlink_to(outside)
+    fifo = tree / "x.src"
+    os.mkfifo(fifo)
+    shown = tree / "l\x1b[2J.src"                 # a name with a terminal control sequence
+    shown.symlink_to(outside)
+
+    res = run("--check", tree)
+    assert res.exit_code == 1                    # good.src would change; skipped entries do not count
+    assert f"--- {good} (original)" in res.stdout.splitlines()
+    assert str(link) not in res.stdout and str(fifo) not in res.stdout
+
+    res = run(tree)
+    assert res.exit_code == 0, res.output        # documented: links and FIFOs do not change the status
+    assert good.read_bytes() == TIDY             # only the normal file is formatted
+    assert outside.read_bytes() == MESSY         # the link's target outside the folder is untouched
+    assert link.is_symlink() and os.readlink(link) == str(outside)
+    assert stat.S_ISFIFO(os.lstat(fifo).st_mode)
+    err = res.stderr.splitlines()
+    assert _warning(link, "a symbolic link (never followed)") in err
+    assert _warning(fifo, "a FIFO (never opened)") in err
+    assert _warning(tree / "l\\x1b[2J.src", "a symbolic link (never followed)") in err
+    assert "\x1b" not in res.stderr
+    assert err[-1] == "1 file reformatted, 0 unchanged, 3 not read (links, FIFOs, devices, too deep folders)"
+
+
+def test_a_named_link_is_still_followed(tmp_path):
+    target = tmp_path / "target.src"
+    target.write_bytes(MESSY)
+    link = tmp_path / "named.src"
+    link.symlink_to(target)
+    assert run(link).exit_code == 0
+    assert target.read_bytes() == TIDY and link.is_symlink()     # as docs/security.md says
+
+
+def test_a_folder_too_deep_is_reported_and_not_entered(tmp_path):
+    from krl.limits import MAX_FOLDER_DEPTH
+
+    root = tmp_path / "deep"
+    shallow = root / "a.src"
+    folders = [root]
+    for _ in range(MAX_FOLDER_DEPTH + 1):        # the last folder is MAX_FOLDER_DEPTH + 1 levels below root
+        folders.append(folders[-1] / "d")
+    try:
+        folders[-1].mkdir(parents=True)
+        shallow.write_bytes(MESSY)
+        deepest = folders[-1] / "z.src"
+        deepest.write_bytes(MESSY)
+        fine = folders[-2] / "y.src"             # MAX_FOLDER_DEPTH levels down: still entered
+        fine.write_bytes(MESSY)
+        res = run(root)
+        assert res.exit_code == 0, res.output
+        assert shallow.read_bytes() == TIDY and fine.read_bytes() == TIDY
+        assert deepest.read_bytes() == MESSY
+        assert _warning(folders[-1], f"folder more than {MAX_FOLDER_DEPTH} levels deep (not entered)") \
+            in res.stderr.splitlines()
+    finally:
+        for folder in reversed(folders):        # iteratively, deepest first
+            if folder.exists():
+                for f in folder.iterdir():
+                    if not f.is_dir():
+                        f.unlink()
+                folder.rmdir()
