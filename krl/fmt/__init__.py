@@ -2,9 +2,11 @@
 
 Public API, also used by the language server for document formatting::
 
-    format_text(text: str, options: FormatOptions | None = None) -> str
+    format_text(text: str, options: FormatOptions | None = None, path: str = "<fmt>") -> str
 
-Raises :class:`FormatSyntaxError` (a :class:`FormatError`) for text that does not parse.
+Raises :class:`FormatSyntaxError` (a :class:`FormatError`) for text that does not parse; it
+carries the parse result (``result``) and its syntax errors as `krl parse` words them
+(``diagnostics``, named by `path`), so nothing is parsed twice.
 """
 
 from krl.fmt.core import (FormatError, FormatOptions, FormatSafetyError, FormatSyntaxError, SyntaxProblem,

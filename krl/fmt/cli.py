@@ -95,7 +95,8 @@ def run_fmt(paths, check: bool = False, diff: bool = False, options: FormatOptio
     Returns the exit status (0, 1 or 2). Never raises for bad input."""
     from krl.semantics.diagnostics import Diagnostic  # noqa: PLC0415
     from krl.semantics.render import Renderer, SourceLines  # noqa: PLC0415
-    from krl.syntax.cli import file_diagnostics  # noqa: PLC0415
+    from krl.syntax.cli import source_diagnostics  # noqa: PLC0415
+    from krl.syntax.parse import parse_source  # noqa: PLC0415
     from krl.syntax.source import encode_text, read_limited, read_source  # noqa: PLC0415
     from krl.terminal import printable, printable_path  # noqa: PLC0415
 
@@ -119,22 +120,22 @@ def run_fmt(paths, check: bool = False, diff: bool = False, options: FormatOptio
         if src.status == "empty":
             unchanged += 1
             continue
-        problem: list[Diagnostic] = []
         new = None
         if src.status == "ok":
+            # one read, one parse: the formatter's parse result carries the syntax errors
             try:
-                new = format_text(src.text, options)
-            except FormatSyntaxError:
-                _result, text, problem = file_diagnostics(path)
-                sources.add(str(path), text)
+                new = format_text(src.text, options, src.path)
+            except FormatSyntaxError as exc:
+                sources.add(src.path, src.text)
+                renderer.emit(source_diagnostics(src, exc.result, exc.diagnostics))
+                failed += 1
+                continue
             except FormatError as exc:
                 err(f"{printable_path(path)}: not formatted: {printable(exc)}")
                 failed += 1
                 continue
         else:
-            _result, text, problem = file_diagnostics(path)
-        if new is None:
-            renderer.emit(problem or [Diagnostic(str(path), 1, 1, "E001", f"file not parsed: {src.status}")])
+            renderer.emit(source_diagnostics(src, parse_source(src)))     # not parsed: E001 says why
             failed += 1
             continue
         if new == src.text:
@@ -179,9 +180,8 @@ def run_stdin(data: bytes, check: bool = False, diff: bool = False, options: For
     from krl.limits import MAX_FILE_BYTES  # noqa: PLC0415
     from krl.semantics.diagnostics import Diagnostic  # noqa: PLC0415
     from krl.semantics.render import Renderer, SourceLines  # noqa: PLC0415
-    from krl.syntax.messages import syntax_diagnostics  # noqa: PLC0415
-    from krl.syntax.parse import parse_text  # noqa: PLC0415
-    from krl.syntax.source import decode_bytes, encode_text  # noqa: PLC0415
+    from krl.syntax.cli import source_diagnostics  # noqa: PLC0415
+    from krl.syntax.source import SourceText, decode_bytes, encode_text  # noqa: PLC0415
     from krl.terminal import printable  # noqa: PLC0415
 
     out = out or click.echo
@@ -198,11 +198,10 @@ def run_stdin(data: bytes, check: bool = False, diff: bool = False, options: For
         return 2
     text, encoding = decode_bytes(data)
     try:
-        new = format_text(text, options) if text.strip(" \t\r\n\x1a") else text
-    except FormatSyntaxError:
-        diags = syntax_diagnostics(parse_text(text, name), text)
-        Renderer(err, colour, SourceLines({name: text})).emit(
-            diags or [Diagnostic(name, 1, 1, "E001", "file not parsed")])
+        new = format_text(text, options, name) if text.strip(" \t\r\n\x1a") else text
+    except FormatSyntaxError as exc:
+        src = SourceText(name, text, encoding, len(data))
+        Renderer(err, colour, SourceLines({name: text})).emit(source_diagnostics(src, exc.result, exc.diagnostics))
         return 2
     except FormatError as exc:
         err(f"{name}: not formatted: {printable(exc)}")

@@ -101,11 +101,16 @@ class SyntaxProblem:
 
 class FormatSyntaxError(FormatError):
     """The text does not parse (syntax or lexer error, or past a limit of krl/limits.py);
-    `problems` lists them (1-based line and column) and `result` is the ParseResult."""
+    `problems` lists them (1-based line and column), `result` is the ParseResult and
+    `diagnostics` its syntax errors as `krl parse` words them (krl/syntax/messages.py
+    ``syntax_diagnostics``, named by the `path` given to :func:`format_text`; empty when none
+    could be worded), so that a caller prints them without parsing the text again."""
 
-    def __init__(self, problems: list[SyntaxProblem], result: ParseResult | None = None):
+    def __init__(self, problems: list[SyntaxProblem], result: ParseResult | None = None,
+                 diagnostics: list | None = None):
         self.problems = problems
         self.result = result
+        self.diagnostics = diagnostics if diagnostics is not None else []
         first = problems[0] if problems else SyntaxProblem(1, 1, "does not parse")
         super().__init__(f"{first.line}:{first.column}: {first.message}")
 
@@ -272,27 +277,31 @@ def _would_merge(ta: str, tb: str) -> bool:
 # ---------------------------------------------------------------------------- formatting
 
 
-def _problems(result: ParseResult, text: str) -> list[SyntaxProblem]:
-    """The syntax errors as `krl parse` words them (krl/syntax/messages.py: codes E0xx)."""
+def _syntax_error(result: ParseResult, text: str) -> FormatSyntaxError:
+    """The error for a text that does not parse: its syntax errors as `krl parse` words them
+    (krl/syntax/messages.py: codes E0xx), worded once."""
     from krl.syntax.messages import syntax_diagnostics  # noqa: PLC0415
 
-    out = [SyntaxProblem(d.line, d.column, d.message, d.code) for d in syntax_diagnostics(result, text)]
+    diags = syntax_diagnostics(result, text)
+    out = [SyntaxProblem(d.line, d.column, d.message, d.code) for d in diags]
     if not out:
         out = [SyntaxProblem(e.line, e.column + 1, e.message, "E002") for e in result.errors]
     if not out:
         out.append(SyntaxProblem(1, 1, f"file not parsed: {result.status}", "E001"))
-    return out
+    return FormatSyntaxError(out, result, diags)
 
 
-def format_text(text: str, options: FormatOptions | None = None) -> str:
+def format_text(text: str, options: FormatOptions | None = None, path: str = "<fmt>") -> str:
     """Format KRL source text (one .src/.sub/.dat file) and return the new text.
 
     `text` is the decoded file (krl.syntax.source.decode_bytes); a leading U+FEFF (BOM) is
-    kept. Returns `text` itself when nothing changes. Idempotent:
-    ``format_text(format_text(t)) == format_text(t)``.
+    kept. `path` names the file in the diagnostics of a FormatSyntaxError. Returns `text`
+    itself when nothing changes. Idempotent: ``format_text(format_text(t)) == format_text(t)``.
+    The text is parsed once.
 
-    Raises FormatSyntaxError when the text does not parse (nothing is formatted), and
-    FormatSafetyError if the result would not lex to the same tokens (a formatter bug).
+    Raises FormatSyntaxError when the text does not parse (nothing is formatted; it carries
+    the parse result and its diagnostics), and FormatSafetyError if the result would not lex
+    to the same tokens (a formatter bug).
     """
     options = options or FormatOptions()
     bom = ""
@@ -301,9 +310,9 @@ def format_text(text: str, options: FormatOptions | None = None) -> str:
         bom, body = "\ufeff", body[1:]
     added_newline = bool(body) and not body.endswith(("\n", "\r"))
     prepared = body + "\n" if added_newline else body
-    result = parse_text(prepared, "<fmt>")
+    result = parse_text(prepared, path)
     if not result.ok or result.tree is None:
-        raise FormatSyntaxError(_problems(result, prepared), result)
+        raise _syntax_error(result, prepared)
     out = format_parsed(prepared, result, options)
     if added_newline and out.endswith("\n"):
         out = out[:-1]

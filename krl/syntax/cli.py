@@ -22,16 +22,25 @@ def file_diagnostics(path: Path, keep_tree: bool = True):
     The default parse engine (krl/syntax/engines) parses it; with keep_tree the result has its
     parse tree (the java engine's is rebuilt from its data, the same tree)."""
     from krl.syntax.engines import parse_source  # noqa: PLC0415
-    from krl.syntax.messages import syntax_diagnostics  # noqa: PLC0415
     from krl.syntax.source import read_source  # noqa: PLC0415
 
     src = read_source(path)
     result = parse_source(src, keep_tree=keep_tree)
-    diags = syntax_diagnostics(result, src.text)
+    return result, src.text, source_diagnostics(src, result)
+
+
+def source_diagnostics(src, result, worded: list[Diagnostic] | None = None) -> list[Diagnostic]:
+    """The diagnostics `krl parse` prints for a decoded file (SourceText) and its ParseResult:
+    the syntax errors in KRL words (krl/syntax/messages.py; `worded` when the caller already
+    has them for this result), else, when the file was not parsed, one E001 naming why
+    (``file not parsed: binary``, ``... too_large (N bytes > M)``). Never raises."""
+    from krl.syntax.messages import syntax_diagnostics  # noqa: PLC0415
+
+    diags = worded if worded is not None else syntax_diagnostics(result, src.text)
     if not result.ok and not diags:
         detail = f" ({src.detail})" if src.detail else ""
-        diags = [Diagnostic(str(path), 1, 1, "E001", f"file not parsed: {result.status}{detail}")]
-    return result, src.text, diags
+        diags = [Diagnostic(src.path, 1, 1, "E001", f"file not parsed: {result.status}{detail}")]
+    return diags
 
 
 def parse_job(path: str, outline: bool, tree: bool):

@@ -203,3 +203,63 @@ def test_a_folder_too_deep_is_reported_and_not_entered(tmp_path):
                     if not f.is_dir():
                         f.unlink()
                 folder.rmdir()
+
+
+NO_THEN = b"DEF v()\nIF a\n  x=1\nENDIF\nEND\n"
+
+
+def _count_parses_and_reads(monkeypatch) -> dict:
+    """Wrap every way a file is parsed (the Python parser, the engine entry point) or read."""
+    import krl.fmt.core
+    import krl.syntax.engines
+    import krl.syntax.parse
+    import krl.syntax.source
+
+    counts = {"parse": 0, "read": 0}
+
+    def counting(fn, key):
+        def wrapper(*args, **kwargs):
+            counts[key] += 1
+            return fn(*args, **kwargs)
+        return wrapper
+
+    parse_text = counting(krl.syntax.parse.parse_text, "parse")
+    monkeypatch.setattr(krl.syntax.parse, "parse_text", parse_text)
+    monkeypatch.setattr(krl.fmt.core, "parse_text", parse_text)
+    monkeypatch.setattr(krl.syntax.engines, "parse_sources", counting(krl.syntax.engines.parse_sources, "parse"))
+    monkeypatch.setattr(krl.syntax.source, "read_limited", counting(krl.syntax.source.read_limited, "read"))
+    return counts
+
+
+def _located(stderr: str, path) -> list[str]:
+    return [line for line in stderr.splitlines() if line.startswith(f"{path}:")]
+
+
+def test_a_syntax_error_is_read_and_parsed_once_and_printed_as_krl_parse_prints_it(tmp_path, monkeypatch):
+    bad, worse = tmp_path / "u.src", tmp_path / "v.src"
+    bad.write_bytes(BROKEN)
+    worse.write_bytes(NO_THEN)
+    expected = {
+        # counted by hand: the IF on line 2 is never closed; END (line 4) is where it shows
+        bad: [f"{bad}:2:1: error[E010]: missing ENDIF for the IF at line 2",
+              f"{bad}:4:1: note: END reached here while the IF is open"],
+        # the line `IF a` ends (column 5) where THEN must come
+        worse: [f"{worse}:2:5: error[E012]: IF needs THEN after the condition"],
+    }
+    parsed = {f: _located(CliRunner().invoke(main, ["parse", str(f)]).output, f) for f in (bad, worse)}
+    for f in (bad, worse):
+        counts = _count_parses_and_reads(monkeypatch)
+        res = run(f)
+        monkeypatch.undo()
+        assert res.exit_code == 2
+        assert counts == {"parse": 1, "read": 1}, f
+        assert _located(res.stderr, f) == parsed[f] == expected[f]
+        assert f.read_bytes() in (BROKEN, NO_THEN)
+
+
+def test_stdin_syntax_error_is_parsed_once(monkeypatch):
+    counts = _count_parses_and_reads(monkeypatch)
+    res = CliRunner().invoke(main, ["fmt", "-"], input=NO_THEN)
+    assert res.exit_code == 2
+    assert counts["parse"] == 1
+    assert _located(res.stderr, "<stdin>") == ["<stdin>:2:5: error[E012]: IF needs THEN after the condition"]
