@@ -1,35 +1,24 @@
 """Folding ranges: ``;FOLD`` ... ``;ENDFOLD`` sections and blocks (routines, IF, FOR, WHILE,
 LOOP, REPEAT, SWITCH, SPLINE, data lists). Blocks come from the block scan of the syntax layer
 (krl/syntax/blocks.py ``scan``: each closer matched with its opener), which works on files with
-syntax errors too. A block's range ends on the line before its closer, so ENDIF stays visible; a
-FOLD section's range ends on its ``;ENDFOLD`` line (the section folds away as on the KUKA pendant)."""
+syntax errors too. FOLD sections are the pairs of krl/syntax/folds.py, the scan behind
+``krl check``'s W021, so the server folds exactly the pairs the checker finds balanced. A
+block's range ends on the line before its closer, so ENDIF stays visible; a FOLD section's
+range ends on its ``;ENDFOLD`` line (the section folds away as on the KUKA pendant)."""
 
 from __future__ import annotations
-
-import re
 
 from lsprotocol import types as L
 
 from krl.syntax.blocks import Line, scan
+from krl.syntax.folds import scan_fold_lines
 from krl.lsp.text import line_tokens
-
-FOLD = re.compile(r"^\s*;\s*FOLD\b(.*)", re.IGNORECASE)
-ENDFOLD = re.compile(r"^\s*;\s*ENDFOLD\b", re.IGNORECASE)
 
 
 def fold_sections(lines: list[str]) -> list[tuple[int, int, str]]:
-    """(first line, ENDFOLD line, title) of every FOLD section, 1-based, nested ones included."""
-    out: list[tuple[int, int, str]] = []
-    stack: list[tuple[int, str]] = []
-    for n, text in enumerate(lines, start=1):
-        m = FOLD.match(text)
-        if m:
-            title = m.group(1).split(";%", 1)[0].strip() or "FOLD"
-            stack.append((n, title))
-        elif ENDFOLD.match(text) and stack:
-            start, title = stack.pop()
-            out.append((start, n, title))
-    return out
+    """(first line, ENDFOLD line, title) of every FOLD section, 1-based, nested ones included
+    (krl/syntax/folds.py pairs; the title is the fold's text, "FOLD" when it has none)."""
+    return [(f.line, f.end_line, f.text or "FOLD") for f in scan_fold_lines(lines).pairs]
 
 
 def block_pairs(lines: list[str]) -> list[tuple[int, int]]:

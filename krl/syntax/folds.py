@@ -17,23 +17,62 @@ close it after END, and sps.sub hides its later routines in a ``;FOLD ;%{H}`` op
 END. A pair with one end outside every routine is therefore not a mismatch. Over the 596 files
 of the real corpus the scan reports 7 warnings in 6 files, each a genuinely unbalanced fold.
 
-The scan works on the text alone, line by line with the lexer's line ends (``\\r\\n``, ``\\n``,
-``\\r``): a comment starts at the first ``;`` outside a string; a marker is the comment's first
-word, in any letter case (``;FOLD``, ``; fold``, ``;EndFold (BASISTECH INI)``). Routines are the
-lines between DEF/DEFFCT/DEFDAT (optionally GLOBAL) and END/ENDFCT/ENDDAT. A file that does not
-parse is scanned all the same.
+The scan works on the text alone, statement by statement with the lexer's line ends (``\\r\\n``,
+``\\n``, ``\\r``): a comment starts at the first ``;`` outside a string; a marker is the comment's
+first word, in any letter case (``;FOLD``, ``; fold``, ``;EndFold (BASISTECH INI)``), also after
+code on its line (``x = 1 ;FOLD``). Routines are the lines between DEF/DEFFCT/DEFDAT (optionally
+GLOBAL) and END/ENDFCT/ENDDAT. A file that does not parse is scanned all the same. Lines and
+columns are numbered as the parser numbers them (and krl/semantics/render.py ``split_lines``):
+a new line after each LF only, so a lone CR ends a comment but not the line's number.
+
+:func:`scan_folds` is the one recogniser of fold markers outside the lexer: ``krl check``'s
+W021 (:func:`fold_diagnostics`) and the language server's folding ranges and document symbols
+(:func:`fold_pairs`, krl/lsp/folding.py and outline.py) read the same scan.
 """
 
 from __future__ import annotations
 
 import re
+from dataclasses import dataclass, field
 
 from krl.semantics.diagnostics import Diagnostic, Note
 
-_LINES = re.compile(r"\r\n|\n|\r")
 _MARKER = re.compile(r";[ \t]*(END)?FOLD(?![A-Za-z0-9_$])", re.I)
 _OPEN = re.compile(r"[ \t\f]*(?:GLOBAL[ \t]+)?(DEF|DEFFCT|DEFDAT)[ \t]+([A-Za-z_$][A-Za-z0-9_$]*)", re.I)
 _CLOSE = re.compile(r"[ \t\f]*(END|ENDFCT|ENDDAT)(?![A-Za-z0-9_$])", re.I)
+
+
+@dataclass(frozen=True, slots=True)
+class Fold:
+    """One ``;FOLD`` ... ``;ENDFOLD`` pair. `line`, `column`: the FOLD marker's ``;`` (1-based);
+    `end_line`, `end_column`: the ENDFOLD marker's ``;``; `text`: the fold's text as the KUKA
+    editor shows it folded, the comment after ``FOLD`` up to an inline form's ``;%{...}``
+    parameters, blanks stripped ("" for a bare ``;FOLD``); `marker_end`: the column just after
+    the word FOLD (the span of a diagnostic at the FOLD)."""
+
+    line: int
+    column: int
+    end_line: int
+    end_column: int
+    text: str
+    marker_end: int = 0
+
+
+@dataclass(slots=True)
+class FoldScan:
+    """The markers of one text (see the module docstring). `pairs`: matched folds, in the order
+    their ENDFOLDs come; `unclosed`: FOLDs never closed, (line, column, marker end column,
+    routine index); `stray`: ENDFOLDs without an open FOLD, (line, column, marker end column);
+    `crossing`: pairs whose FOLD opens in one routine and closes in another, as (the pair, the
+    FOLD's routine index); `routines`: (name, first line, END line) in order; `last`: the
+    number of the last line."""
+
+    pairs: list[Fold] = field(default_factory=list)
+    unclosed: list[tuple[int, int, int, int | None]] = field(default_factory=list)
+    stray: list[tuple[int, int, int]] = field(default_factory=list)
+    crossing: list[tuple[Fold, int]] = field(default_factory=list)
+    routines: list[tuple[str, int, int]] = field(default_factory=list)
+    last: int = 0
 
 
 def _comment_start(line: str) -> int:
@@ -47,53 +86,89 @@ def _comment_start(line: str) -> int:
     return -1
 
 
+def _lines(text: str) -> list[str]:
+    from krl.semantics.render import split_lines  # noqa: PLC0415
+
+    return split_lines(text)
+
+
+def scan_folds(text: str) -> FoldScan:
+    """Scan `text` (a whole file) for FOLD markers and routines; never raises."""
+    return scan_fold_lines(_lines(text))
+
+
+def scan_fold_lines(lines: list[str]) -> FoldScan:
+    """:func:`scan_folds` of a text already split as krl/semantics/render.py ``split_lines``
+    splits it (the language server's lines)."""
+    out = FoldScan()
+    routines = out.routines
+    stack: list[tuple[int, int, int, int | None, str]] = []   # open FOLDs: line, column, end column, routine, text
+    current: int | None = None                                 # index into routines, None outside
+    out.last = len(lines) - (1 if len(lines) > 1 and lines[-1] == "" else 0)
+    for number, whole in enumerate(lines, start=1):
+        offset = 0
+        for line in whole.split("\r"):           # a lone CR ends a statement and its comment
+            semi = _comment_start(line)
+            code = line if semi < 0 else line[:semi]
+            if current is None:
+                m = _OPEN.match(code)
+                if m:
+                    routines.append((m.group(2), number, 0))
+                    current = len(routines) - 1
+            marker = _MARKER.match(line, semi) if semi >= 0 else None
+            if marker is not None:
+                col = offset + semi + 1
+                end_col = col + marker.end() - marker.start()
+                if marker.group(1) is None:
+                    title = line[marker.end():].split(";%", 1)[0].strip()
+                    stack.append((number, col, end_col, current, title))
+                elif not stack:
+                    out.stray.append((number, col, end_col))
+                else:
+                    o_line, o_col, o_end, o_ctx, title = stack.pop()
+                    fold = Fold(o_line, o_col, number, col, title, o_end)
+                    out.pairs.append(fold)
+                    if o_ctx is not None and current is not None and o_ctx != current:
+                        out.crossing.append((fold, o_ctx))
+            if current is not None and _CLOSE.match(code):
+                name, first, _ = routines[current]
+                routines[current] = (name, first, number)
+                current = None
+            offset += len(line) + 1
+    if current is not None:
+        name, first, _ = routines[current]
+        routines[current] = (name, first, out.last)
+    out.unclosed = [(ln, col, end, ctx) for ln, col, end, ctx, _title in stack]
+    return out
+
+
+def fold_pairs(text: str) -> list[Fold]:
+    """The matched ``;FOLD`` ... ``;ENDFOLD`` pairs of `text`, nested ones included, ordered by
+    their ENDFOLD (an inner fold before the one around it). Unbalanced markers pair as the KUKA
+    editor nests them: an ENDFOLD closes the innermost open FOLD, a stray ENDFOLD and a FOLD
+    never closed give no pair (W021 reports them)."""
+    return scan_folds(text).pairs
+
+
 def fold_diagnostics(path: str, text: str) -> list[Diagnostic]:
     """W021 warnings for the unbalanced FOLD markers of `text` (the file `path`), by line."""
+    found = scan_folds(text)
     out: list[Diagnostic] = []
-    stack: list[tuple[int, int, int, int | None]] = []  # (line, column, end column, routine) of open FOLDs
-    routines: list[tuple[str, int, int]] = []         # (name, first line, END line) in order
-    current: int | None = None                        # index into routines, None outside
-    lines = _LINES.split(text)
-    last = len(lines) - (1 if len(lines) > 1 and lines[-1] == "" else 0)
+    last = found.last
 
     def routine_end(idx: int | None) -> tuple[str, int] | None:
         if idx is None:
             return None
-        name, _first, end = routines[idx]
+        name, _first, end = found.routines[idx]
         return name, end
 
-    pending_cross: list[tuple[int, int, int, int | None, int, int]] = []  # FOLD line/col/end/ctx, ENDFOLD line/col
-    for number, line in enumerate(lines, start=1):
-        semi = _comment_start(line)
-        code = line if semi < 0 else line[:semi]
-        if current is None:
-            m = _OPEN.match(code)
-            if m:
-                routines.append((m.group(2), number, 0))
-                current = len(routines) - 1
-        marker = _MARKER.match(line, semi) if semi >= 0 else None
-        if marker is not None:
-            col = semi + 1
-            end_col = col + marker.end() - marker.start()
-            if marker.group(1) is None:
-                stack.append((number, col, end_col, current))
-            elif not stack:
-                out.append(Diagnostic(path, number, col, "W021", "`;ENDFOLD` without an open `;FOLD`",
-                                      end_line=number, end_column=end_col,
-                                      help="remove it, or add the `;FOLD` it closes"))
-            else:
-                o_line, o_col, o_end, o_ctx = stack.pop()
-                if o_ctx is not None and current is not None and o_ctx != current:
-                    pending_cross.append((o_line, o_col, o_end, o_ctx, number, col))
-        if current is not None and _CLOSE.match(code):
-            name, first, _ = routines[current]
-            routines[current] = (name, first, number)
-            current = None
-    if current is not None:
-        name, first, _ = routines[current]
-        routines[current] = (name, first, last)
-    for o_line, o_col, o_end, o_ctx, c_line, c_col in pending_cross:
+    for number, col, end_col in found.stray:
+        out.append(Diagnostic(path, number, col, "W021", "`;ENDFOLD` without an open `;FOLD`",
+                              end_line=number, end_column=end_col,
+                              help="remove it, or add the `;FOLD` it closes"))
+    for fold, o_ctx in found.crossing:
         end = routine_end(o_ctx)
+        c_line, c_col = fold.end_line, fold.end_column
         notes = []
         if end is not None:
             what = f"{end[0]} ends here"
@@ -102,9 +177,9 @@ def fold_diagnostics(path: str, text: str) -> list[Diagnostic]:
         else:
             message = f"`;FOLD` outside any routine closed by the `;ENDFOLD` at line {c_line}, inside a routine"
         notes.append(Note(path, c_line, c_col, "the `;ENDFOLD` that closes it"))
-        out.append(Diagnostic(path, o_line, o_col, "W021", message, end_line=o_line, end_column=o_end,
-                              notes=notes, help="keep each fold inside one routine"))
-    for o_line, o_col, o_end, o_ctx in stack:
+        out.append(Diagnostic(path, fold.line, fold.column, "W021", message, end_line=fold.line,
+                              end_column=fold.marker_end, notes=notes, help="keep each fold inside one routine"))
+    for o_line, o_col, o_end, o_ctx in found.unclosed:
         end = routine_end(o_ctx)
         if end is not None:
             message = f"`;FOLD` never closed (it opens in {end[0]}, which ends at line {end[1]})"

@@ -80,10 +80,24 @@ def test_markers_inside_strings_and_other_words_do_not_count():
     assert found(text) == []
 
 
-@pytest.mark.parametrize("eol", ["\r\n", "\r"])
-def test_line_ends_are_the_lexers(eol):
+@pytest.mark.parametrize("eol, expected", [
+    ("\r\n", [(3, 3, [4])]),
+    # a lone CR ends the statement and the comment (a NEWLINE token) but, as in the parser and
+    # every other diagnostic, not the line number: all is line 1; ';' is character 19
+    ("\r", [(1, 19, [1])]),
+])
+def test_line_ends_are_the_lexers(eol, expected):
     text = eol.join(["DEF t()", "  INT i", "  ;FOLD x", "END", ""])
-    assert found(text) == [(3, 3, [4])]
+    assert found(text) == expected
+
+
+def test_fold_lines_are_the_parsers_lines():
+    from krl.syntax.parse import parse_text
+
+    text = "DEF t()\r\n  x = 1\r  ;FOLD a\n  y = 2\rEND\n"
+    fold_tokens = [t for t in parse_text(text).tree.parser.getTokenStream().tokens if t.text.startswith(";FOLD")]
+    assert [(t.line, t.column + 1) for t in fold_tokens] == [(2, 11)]   # "  x = 1" CR "  ;": 11th
+    assert found(text) == [(2, 11, [3])]          # the END is on the parser's line 3
 
 
 def test_check_reports_the_warning_and_it_does_not_stop_the_file():
