@@ -410,9 +410,9 @@ class Workspace:
                 if f is not None:
                     f.scope = unit.scope
         plan = [(u, targets(u)) for u in self.units]
-        for _u, tg in plan:
+        for u, tg in plan:
             for scope, items, name in tg:
-                declarer.declare_types(scope, items, system=_is_system_datalist(name))
+                declarer.declare_types(scope, items, system=_is_system_datalist(name), path=u.dat.path, module=name)
         for u, tg in plan:
             for scope, items, name in tg:
                 declarer.soft_types = _is_system_datalist(name) or is_kuka_file(u.dat.path)
@@ -474,7 +474,7 @@ class Workspace:
         for r, sym, u in routine_syms:
             declarer.soft_types = is_kuka_file(u.src.path)
             local = Scope("routine", r.name, u.scope)
-            declarer.declare_types(local, r.decls)
+            declarer.declare_types(local, r.decls, path=u.src.path, module=u.name)
             declarer.fill_types(local, r.decls)
             declarer.declare_values(local, r.decls, u.name, u.src.path if u.src else "")
             declarer.complete_signature(sym, local)

@@ -15,9 +15,9 @@ from dataclasses import dataclass, field
 from krl.ast import nodes as N
 from krl.lsp.parsing import Parsed
 from krl.semantics import types as T
-from krl.semantics.checker import Checker, Declarer, _is_system_datalist
+from krl.semantics.checker import Checker, Declarer
 from krl.semantics.diagnostics import Diagnostic, DiagnosticSink
-from krl.semantics.symbols import Scope
+from krl.semantics.symbols import Scope, Symbol
 from krl.workspace import SourceFile, Workspace
 
 
@@ -46,7 +46,8 @@ class Analysis:
     root: str
     ws: Workspace
     files: dict[str, FileInfo] = field(default_factory=dict)
-    _types: dict[int, tuple[N.Decl, str]] | None = None
+    _types: dict[int, Symbol] | None = None
+    _type_of_decl: dict[int, Symbol] | None = None
     _routine_path: dict[int, str] | None = None
 
     # ------------------------------------------------------------------ places
@@ -80,31 +81,35 @@ class Analysis:
             self._routine_path = {id(r): f.path for f in self.ws.files for r in f.module.routines}
         return self._routine_path.get(id(routine), "")
 
-    def type_decl(self, typ: T.KrlType) -> tuple[N.Decl, str] | None:
-        """The STRUC/ENUM declaration (and its file) of a user type, else None (built-in)."""
+    def type_symbol(self, typ: T.KrlType) -> Symbol | None:
+        """Where the checker's Declarer entered a user STRUC/ENUM type (krl/semantics/checker.py
+        ``Declarer.declare_types``: the Symbol of kind 'type' in its scope's ``type_symbols``,
+        with the declaration, file and scope kind), else None (a built-in type)."""
         if self._types is None:
-            self._types = {}
-            glob = self.ws.global_scope
-            for u in self.ws.units:
-                if u.dat is not None and u.dat.module.data is not None and u.scope is not None:
-                    dl = u.dat.module.data
-                    for d in dl.items:
-                        if isinstance(d, (N.StrucDecl, N.EnumDecl)):
-                            glob_decl = _is_system_datalist(dl.name) or d.is_global
-                            sc = glob if glob_decl else u.scope
-                            self._remember(sc, d, u.dat.path)
-                if u.src is not None:
-                    for r in u.src.module.routines:
-                        sc = self.ws.routine_scope(r)
-                        for d in r.decls:
-                            if isinstance(d, (N.StrucDecl, N.EnumDecl)) and sc is not None:
-                                self._remember(sc, d, u.src.path)
+            self._index_types()
         return self._types.get(id(typ))
 
-    def _remember(self, sc: Scope | None, d: N.Decl, path: str) -> None:
-        t = sc.types.get(d.name.upper()) if sc is not None else None
-        if t is not None:
-            self._types.setdefault(id(t), (d, path))
+    def type_decl(self, typ: T.KrlType) -> tuple[N.Decl, str] | None:
+        """The STRUC/ENUM declaration (and its file) of a user type, else None (built-in)."""
+        sym = self.type_symbol(typ)
+        return (sym.decl, sym.path) if sym is not None else None
+
+    def declared_type(self, decl: N.Decl) -> T.KrlType | None:
+        """The type a STRUC/ENUM declaration entered, None when it entered none (a duplicate)."""
+        if self._type_of_decl is None:
+            self._index_types()
+        sym = self._type_of_decl.get(id(decl))
+        return sym.type if sym is not None else None
+
+    def _index_types(self) -> None:
+        self._types, self._type_of_decl = {}, {}
+        scopes = [self.ws.global_scope, *(u.scope for u in self.ws.units), *self.ws.routine_scopes.values()]
+        for sc in scopes:
+            if sc is None:
+                continue
+            for sym in sc.type_symbols.values():
+                self._types.setdefault(id(sym.type), sym)
+                self._type_of_decl.setdefault(id(sym.decl), sym)
 
     # ------------------------------------------------------------------ set-up
 

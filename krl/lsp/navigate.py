@@ -212,20 +212,15 @@ def resolve(an: Analysis, path: str, line: int, column: int) -> Target | None:
 
 
 def _decl_type(an: Analysis, path: str, line: int, name: str, scope: Scope) -> T.KrlType | None:
-    """The type a STRUC/ENUM declaration on `line` entered (global or in the scope at hand)."""
+    """The type a STRUC/ENUM declaration on `line` entered, as the checker's Declarer recorded
+    it (:meth:`Analysis.declared_type`); for a declaration that entered none (a duplicate),
+    the type the name means at that place."""
     fi = an.files[path]
     for d in fi.nodes_on(line):
         if isinstance(d, (N.StrucDecl, N.EnumDecl)) and d.name.upper() == name.upper():
-            s: Scope | None = scope
-            while s is not None:
-                t = s.types.get(name.upper())
-                if t is not None:
-                    got = an.type_decl(t)
-                    if got is None or got[0] is d:
-                        return t
-                s = s.parent
-            if an.ws.global_scope is not None:
-                return an.ws.global_scope.types.get(name.upper())
+            t = an.declared_type(d)
+            if t is not None:
+                return t
     return scope.lookup_type(name)
 
 

@@ -55,7 +55,8 @@ class Declarer:
         self.unresolved = None
         # evidence(path, line, kind) -> why installed software declares a name used there, or ""
         self.evidence = lambda _path, _line, _kind: ""
-        self._type_decls: dict[tuple[int, str], tuple[N.Decl, bool]] = {}
+        # (id(scope), UPPER name) of the types a system data list declared first (they may repeat)
+        self._system_types: set[tuple[int, str]] = set()
 
     def unknown(self, kind: str, name: str, span: N.Span, evidence: str = "") -> None:
         """An unresolved name of `kind` ('name', 'type', 'routine', 'sysvar') used at `span`:
@@ -100,10 +101,19 @@ class Declarer:
         return make_array(typ, dims)
 
     # -- phase 1: type names
-    def declare_types(self, scope: Scope, items: list[N.Decl], system: bool = False) -> None:
+    def declare_types(self, scope: Scope, items: list[N.Decl], system: bool = False, path: str = "",
+                      module: str = "") -> None:
         """Enter STRUC and ENUM names. A second declaration of a name in the same scope is
         E102, except between system data lists ($config.dat, $machine.dat, ...), which may
-        repeat each other's declarations (the first one wins)."""
+        repeat each other's declarations (the first one wins).
+
+        Where each type is declared is recorded here, once: ``scope.type_symbols[NAME]`` is a
+        Symbol of kind 'type' with the type, the scope kind it was entered in ('routine' for a
+        routine's local type, 'module' for one of the module's data list, 'global' for a
+        GLOBAL one of a data list or one of $config.dat and the other system data lists), the
+        declaring StrucDecl/EnumDecl (the first one), the file `path` and the `module` (the
+        data list's or the module's name). The language server reads it (go to definition,
+        hover)."""
         for d in items:
             if isinstance(d, N.StrucDecl):
                 typ: T.KrlType = T.Struc(d.name)
@@ -114,13 +124,16 @@ class Declarer:
             else:
                 continue
             self.ident(d.name, d.span)
-            key = (id(scope), d.name.upper())
+            key = d.name.upper()
             if scope.define_type(d.name, typ) is None:
-                self._type_decls[key] = (d, system)
+                scope.type_symbols[key] = Symbol(d.name, "type", typ, scope.kind, d, "RO", module=module, path=path)
+                if system:
+                    self._system_types.add((id(scope), key))
                 continue
-            first, first_system = self._type_decls.get(key, (None, True))
-            if not (system and first_system) and first is not d:
-                self.duplicate(d.name, d.span, _DeclRef(first))
+            first = scope.type_symbols.get(key)
+            first_system = first is None or (id(scope), key) in self._system_types
+            if not (system and first_system) and (first is None or first.decl is not d):
+                self.duplicate(d.name, d.span, first)
 
     # -- phase 2: structure components
     def fill_types(self, scope: Scope, items: list[N.Decl]) -> None:
@@ -209,13 +222,6 @@ class Declarer:
             s = local.values.get(p.name.upper())
             if s is not None:
                 p.type = s.type
-
-
-class _DeclRef:
-    """Adapter so that Declarer.duplicate can name the first declaration of a type."""
-
-    def __init__(self, decl):
-        self.decl = decl
 
 
 class _Ctx:

@@ -8,7 +8,9 @@
             -> routine (parameters and local declarations)
 
 Each :class:`Scope` has three namespaces (values, types, routines); lookups walk up the
-parents. Names are case-insensitive (1.1): keys are upper-case.
+parents. Names are case-insensitive (1.1): keys are upper-case. ``type_symbols`` records, for
+each STRUC/ENUM a program declares in the scope, where the checker's Declarer entered it (a
+Symbol of kind 'type': ``decl``, ``path``, ``module``, ``scope``); built-in types have none.
 
 A :class:`Symbol` is what the checker attaches to a Name/Call (``node.ann.symbol``):
 ``kind`` is one of 'var', 'const', 'param', 'signal', 'sysvar', 'routine', 'type', 'label';
@@ -73,7 +75,7 @@ class Symbol:
 class Scope:
     """One level of the hierarchy; kind is 'system', 'basis', 'global', 'module' or 'routine'."""
 
-    __slots__ = ("kind", "name", "parent", "values", "types", "routines", "incomplete")
+    __slots__ = ("kind", "name", "parent", "values", "types", "routines", "incomplete", "type_symbols")
 
     def __init__(self, kind: str, name: str = "", parent: "Scope | None" = None):
         self.kind = kind
@@ -83,6 +85,7 @@ class Scope:
         self.types: dict[str, T.KrlType] = {}
         self.routines: dict[str, Symbol] = {}
         self.incomplete = False
+        self.type_symbols: dict[str, Symbol] = {}   # UPPER name -> where a declared type was entered
 
     def define(self, table: str, sym: Symbol) -> Symbol | None:
         """Add `sym` to namespace `table` ('values' or 'routines'); return the previous

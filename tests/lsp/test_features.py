@@ -250,3 +250,44 @@ async def test_formatting_replaces_up_to_the_real_end_of_the_document(client, tm
     assert (edits[0].range.start.line, edits[0].range.start.character) == (0, 0)
     assert (edits[0].range.end.line, edits[0].range.end.character) == (2, 10)
     close_doc(client, path)
+
+
+SHAPES = ("DEF shapes( )\n"                 # 0
+          "  STRUC local_t INT a, b\n"       # 1  local_t at 8..15, a at 20, b at 23
+          "  DECL local_t loc\n"             # 2  local_t at 7..14
+          "  DECL pose_t p\n"                # 3  pose_t at 7..13: GLOBAL in tools.dat
+          "  DECL tool_t t\n"                # 4  tool_t at 7..13: $config.dat
+          "  loc.b = 1\n"                    # 5  b at 6
+          "END\n")
+
+
+async def hover(client, path, line, char) -> str:
+    h = await client.text_document_hover_async(L.HoverParams(text_document=td(path), position=pos(line, char)))
+    return h.contents.value if h is not None else ""
+
+
+async def test_types_where_the_checker_declared_them(client, backup_copy):
+    """A STRUC local to a routine, one GLOBAL in a .dat and one of $config.dat: go to definition
+    and hover read the placement the checker's Declarer recorded (Scope.type_symbols)."""
+    program, system = backup_copy / "R1" / "Program", backup_copy / "R1" / "System"
+    shapes = program / "shapes.src"
+    shapes.write_text(SHAPES)
+    assert summary(await open_doc(client, shapes)) == []
+    # uses -> declarations; tools.dat line 1 `  GLOBAL STRUC pose_t REAL x, y` (pose_t 15..21),
+    # $config.dat line 2 `  STRUC tool_t REAL mass, INT id` (tool_t 8..14)
+    assert await definition(client, shapes, 2, 9) == [("shapes.src", 1, 8, 1, 15)]
+    assert await definition(client, shapes, 3, 8) == [("tools.dat", 1, 15, 1, 21)]
+    assert await definition(client, shapes, 4, 10) == [("$config.dat", 2, 8, 2, 14)]
+    assert await definition(client, shapes, 5, 6) == [("shapes.src", 1, 23, 1, 24)]     # loc.b -> component b
+    # a declaration's own name is the type it entered
+    assert await definition(client, shapes, 1, 12) == [("shapes.src", 1, 8, 1, 15)]
+    assert await definition(client, program / "tools.dat", 1, 17) == [("tools.dat", 1, 15, 1, 21)]
+    assert await definition(client, system / "$config.dat", 2, 8) == [("$config.dat", 2, 8, 2, 14)]
+    # hover: the structure and where it is declared (1-based lines)
+    assert await hover(client, shapes, 2, 9) == \
+        "```krl\nSTRUC local_t INT a, INT b\n```\n\ndeclared in `R1/Program/shapes.src` line 2"
+    assert await hover(client, shapes, 3, 8) == \
+        "```krl\nSTRUC pose_t REAL x, REAL y\n```\n\ndeclared in `R1/Program/tools.dat` line 2"
+    assert await hover(client, shapes, 4, 10) == \
+        "```krl\nSTRUC tool_t REAL mass, INT id\n```\n\ndeclared in `R1/System/$config.dat` line 3"
+    close_doc(client, shapes)
