@@ -26,10 +26,22 @@ MAX_FILE_BYTES = 10 * 1024 * 1024
 
 # The most operands (terms) in one statement's expressions, counted on its line: `a + b * c` has
 # 3. Real KRL stays far below (long conditions have a few dozen terms); the limit keeps the parse
-# tree, the AST and the recursive evaluation of both interpreters bounded, since a chain of
-# binary operators nests one level per operator. Past it: error E019 "expression too long" at
-# the statement's line (the file does not parse; the program does not start).
+# tree and the AST bounded: a chain of binary operators nests one level per operator (in
+# Binary.left), and every stage walks such a chain in a loop (krl.ast.nodes.left_chain: the
+# builder, the checker, the printer, pickling, both interpreters), so its length costs no stack.
+# Past it: error E019 "expression too long" at the statement's line (the file does not parse;
+# the program does not start).
 MAX_EXPRESSION_TERMS = 500
+
+# The Python stack that parsing, building and checking one file within the limits above may
+# take, in frames above the caller. Only MAX_NESTING levels recurse (blocks, brackets, prefix
+# operators; never the terms of a chain): measured at most 5.25 frames per level (100 nested IFs
+# take 525 frames, 100 brackets around 499 terms 325), so 600 leaves a margin, and Python's
+# default recursion limit of 1000 frames leaves 400 to the caller (the command line, the
+# language server). tests/frontend/test_long_expressions.py checks the deepest legal files
+# within it. The parser's limits keep every file below it; were it ever passed, the routine gets
+# E901 "routine nested too deeply to check" (the builder E003), never a crash.
+MAX_CHECK_FRAMES = 600
 
 # The deepest folder a walk of a corpus or a KRC backup enters (krl/files.py), in folder levels
 # below the root. Real backups are about 6 levels deep (KRC/R1/Program/<cell>/<folder>); the walk is

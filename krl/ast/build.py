@@ -884,11 +884,43 @@ class Builder:
         return lit
 
     def expr(self, ctx) -> N.Expr:
-        if ctx is None:
-            raise BuildError("missing expression")
-        if getattr(ctx, "exception", None) is not None:
-            raise BuildError("recovered expression")
-        own, base = _names(ctx)
+        """The AST of an expression context. A left-nested chain of binary operators (one
+        parse-tree level per operator, up to krl.limits.MAX_EXPRESSION_TERMS terms) is walked
+        in a loop, not recursively; recursion is left for brackets and prefix operators, which
+        krl.limits.MAX_NESTING bounds. Left before right, as the operators associate."""
+        links: list[tuple[str, object, N.Span]] = []   # (op, right context, span), outermost first
+        while True:
+            if ctx is None:
+                raise BuildError("missing expression")
+            if getattr(ctx, "exception", None) is not None:
+                raise BuildError("recovered expression")
+            own, base = _names(ctx)
+            if base in ("primary", "literal", "variable", "call", "aggregate", "constantAggregate"):
+                break
+            kids = ctx.children or []
+            rule_kids = [c for c in kids if isinstance(c, ParserRuleContext)]
+            term_kids = [c for c in kids if isinstance(c, TerminalNode)]
+            if any(isinstance(c, ErrorNode) for c in term_kids):
+                raise BuildError("error node in expression")
+            if len(rule_kids) == 1 and not term_kids:
+                ctx = rule_kids[0]
+            elif len(rule_kids) == 1 and len(term_kids) == 1 and kids[0] is term_kids[0]:
+                break
+            elif len(rule_kids) == 2 and len(term_kids) == 1 and kids[1] is term_kids[0]:
+                links.append((term_kids[0].getText().upper(), rule_kids[1], self.span(term_kids[0])))
+                ctx = rule_kids[0]
+            elif len(rule_kids) == 1 and [t.getText() for t in term_kids] == ["(", ")"]:
+                ctx = rule_kids[0]
+            else:
+                raise BuildError(f"unknown expression form {own}")
+        node = self._operand(ctx, base)
+        for op, right, span in reversed(links):
+            node = N.Binary(op, node, self.expr(right), span=span)
+        return node
+
+    def _operand(self, ctx, base: str) -> N.Expr:
+        """An expression context that is no binary operator: a primary, literal, variable,
+        call, aggregate or prefix operator."""
         if base == "primary":
             return self.primary(ctx)
         if base in ("literal",):
@@ -900,20 +932,8 @@ class Builder:
         if base in ("aggregate", "constantAggregate"):
             return self.aggregate(ctx)
         kids = ctx.children or []
-        rule_kids = [c for c in kids if isinstance(c, ParserRuleContext)]
-        term_kids = [c for c in kids if isinstance(c, TerminalNode)]
-        if any(isinstance(c, ErrorNode) for c in term_kids):
-            raise BuildError("error node in expression")
-        if len(rule_kids) == 1 and not term_kids:
-            return self.expr(rule_kids[0])
-        if len(rule_kids) == 1 and len(term_kids) == 1 and kids[0] is term_kids[0]:
-            return N.Unary(term_kids[0].getText().upper(), self.expr(rule_kids[0]), span=self.span(ctx))
-        if len(rule_kids) == 2 and len(term_kids) == 1 and kids[1] is term_kids[0]:
-            return N.Binary(term_kids[0].getText().upper(), self.expr(rule_kids[0]),
-                            self.expr(rule_kids[1]), span=self.span(term_kids[0]))
-        if len(rule_kids) == 1 and [t.getText() for t in term_kids] == ["(", ")"]:
-            return self.expr(rule_kids[0])
-        raise BuildError(f"unknown expression form {own}")
+        term = kids[0]
+        return N.Unary(term.getText().upper(), self.expr(kids[1]), span=self.span(ctx))
 
     def primary(self, ctx) -> N.Expr:
         inner = self.rules(ctx)

@@ -192,10 +192,49 @@ class Unary(Expr):
 @dataclass(slots=True)
 class Binary(Expr):
     """op is ':', '*', '/', '+', '-', 'AND', 'B_AND', 'EXOR', 'B_EXOR', 'OR', 'B_OR',
-    '==', '<>', '<', '>', '<=', '>=' (4.1)."""
+    '==', '<>', '<', '>', '<=', '>=' (4.1).
+
+    Binary operators associate to the left, so ``1 + 1 + ... + 1`` (up to
+    krl.limits.MAX_EXPRESSION_TERMS terms) is a chain nested one level per operator in
+    ``left``. Code that descends into ``left`` walks such a chain with :func:`left_chain`
+    instead of recursing, and pickling (worker processes) and copying store it flat."""
     op: str
     left: Expr
     right: Expr
+
+    def __eq__(self, other):
+        if other.__class__ is not self.__class__:
+            return NotImplemented
+        a, b = self, other
+        while a.op == b.op and a.right == b.right:
+            a, b = a.left, b.left
+            if a.__class__ is not Binary or b.__class__ is not Binary:
+                return a == b
+        return False
+
+    def __reduce__(self):
+        leftmost, chain = left_chain(self)
+        return _rebuild_chain, (leftmost, [(b.op, b.right, b.span, b.ann) for b in chain])
+
+
+def left_chain(e: Binary) -> tuple[Expr, list[Binary]]:
+    """``(leftmost, chain)`` of a left-nested chain of binary operators, without recursion:
+    ``chain`` is the Binary nodes from the innermost (whose ``left`` is ``leftmost``, not a
+    Binary) out to `e` itself. ``a - b + c`` -> ``(a, [a - b, (a - b) + c])``."""
+    chain = []
+    node: Expr = e
+    while isinstance(node, Binary):
+        chain.append(node)
+        node = node.left
+    chain.reverse()
+    return node, chain
+
+
+def _rebuild_chain(leftmost: Expr, links: list) -> Binary:
+    node = leftmost
+    for op, right, span, ann in links:
+        node = Binary(op, node, right, span=span, ann=ann)
+    return node
 
 
 # ------------------------------------------------------------------ declarations (2.5, 2.6, 3)

@@ -78,13 +78,18 @@ def expr(e: N.Expr | None) -> str:
             return f"{e.op} {inner}"
         return f"{e.op}{inner}"
     if isinstance(e, N.Binary):
-        p = PREC.get(e.op, 0)
-        left, right = expr(e.left), expr(e.right)
-        if _prec(e.left) < p:
-            left = f"({left})"
-        if _prec(e.right) <= p:
-            right = f"({right})"
-        return f"{left} {e.op} {right}"
+        # a left-associative chain (up to MAX_EXPRESSION_TERMS terms) in a loop, not recursively
+        left, chain = N.left_chain(e)
+        text, inner = expr(left), left
+        for b in chain:
+            p = PREC.get(b.op, 0)
+            right = expr(b.right)
+            if _prec(inner) < p:
+                text = f"({text})"
+            if _prec(b.right) <= p:
+                right = f"({right})"
+            text, inner = f"{text} {b.op} {right}", b
+        return text
     raise TypeError(f"not an expression: {type(e).__name__}")
 
 

@@ -795,9 +795,19 @@ class Checker:
         return T.UNKNOWN
 
     def binary(self, e: N.Binary, sc: Scope) -> T.KrlType:
+        """Type a binary operator and the left-nested chain below it (``1 + 1 + ... + 1``, up
+        to krl.limits.MAX_EXPRESSION_TERMS terms) in a loop, innermost first: left before
+        right, as the operators associate; only brackets and prefix operators recurse."""
+        leftmost, chain = N.left_chain(e)
+        lt = self.geo_operand(leftmost, sc) if chain[0].op == ":" else self.expr(leftmost, sc)
+        for b in chain:
+            lt = self.set_type(b, self._binary(b, lt, sc))
+        return lt
+
+    def _binary(self, e: N.Binary, lt: T.KrlType, sc: Scope) -> T.KrlType:
+        """The type of `e` whose left operand has been typed `lt`."""
         op = e.op
         if op == ":":
-            lt = self.geo_operand(e.left, sc)
             rt = self.geo_operand(e.right, sc)
             for side, t in ((e.left, lt), (e.right, rt)):
                 if t is not T.UNKNOWN and T.geometric_family(t) != "cartesian":
@@ -805,12 +815,10 @@ class Checker:
                     return T.UNKNOWN
             return rt
         if op in EQUALITY:
-            lt = self.expr(e.left, sc)
             rt = self.expr(e.right, sc, expected=lt if isinstance(lt, T.Enum) else None)
             if isinstance(rt, T.Enum) and isinstance(e.left, N.EnumLit):
                 lt = self.expr(e.left, sc, expected=rt)
         else:
-            lt = self.expr(e.left, sc)
             rt = self.expr(e.right, sc)
         if lt is T.UNKNOWN or rt is T.UNKNOWN:
             return T.BOOL if op in EQUALITY | ORDER else T.UNKNOWN
