@@ -522,9 +522,12 @@ class TreeInterpreter:
         return self.rt.unary_op(e.op, self.eval(e.operand, frame))
 
     def e_binary(self, e, frame):
-        a = self.eval(e.left, frame)
-        b = self.eval(e.right, frame)
-        return self.rt.binary_op(e.op, a, b)
+        # a left-nested chain (up to MAX_EXPRESSION_TERMS terms) in a loop: left before right
+        left, chain = N.left_chain(e)
+        a = self.eval(left, frame)
+        for b in chain:
+            a = self.rt.binary_op(b.op, a, self.eval(b.right, frame))
+        return a
 
     def ref(self, e, frame):
         """The reference of an lvalue expression (Name / Index / Field chain)."""

@@ -687,16 +687,36 @@ class Compiler:
                 if ok:
                     v = self.rt.unary_op(e.op, a)
                     return isinstance(v, _FOLDABLE), v
-            elif isinstance(e, N.Binary) and e.op != ":":
-                ok, a = self.fold(e.left)
-                if ok:
-                    ok, b = self.fold(e.right)
-                    if ok:
-                        v = self.rt.binary_op(e.op, a, b)
-                        return isinstance(v, _FOLDABLE), v
+            elif isinstance(e, N.Binary):
+                left, chain = N.left_chain(e)
+                n, v = self.fold_chain(left, chain)
+                return n == len(chain), v
         except KrlRuntimeError:
             pass
         return False, None
+
+    def fold_chain(self, left, chain):
+        """How far a left-nested chain of binary operators (``chain`` innermost first, as
+        krl.ast.nodes.left_chain gives it) folds, in a loop: (n, value) when ``left`` and the
+        first n operators of the chain are constants (n = 0: ``left`` alone, if it folds);
+        (0, None) when nothing folds. An operator folds when :meth:`fold` would fold it."""
+        ok, a = self.fold(left)
+        if not ok:
+            return 0, None
+        for n, b in enumerate(chain):
+            if b.op == ":":
+                return n, a
+            try:
+                ok, r = self.fold(b.right)
+                if not ok:
+                    return n, a
+                v = self.rt.binary_op(b.op, a, r)
+            except KrlRuntimeError:
+                return n, a
+            if not isinstance(v, _FOLDABLE):
+                return n, a
+            a = v
+        return len(chain), a
 
     def expr(self, e) -> None:
         if isinstance(e, (N.Unary, N.Binary)):
@@ -732,13 +752,21 @@ class Compiler:
             self.expr(e.operand)
             self.emit("UNOP", e.op)
         elif isinstance(e, N.Binary):
-            self.expr(e.left)
-            self.expr(e.right)
-            fast = _FAST_BINOPS.get(e.op)
-            if fast is not None:
-                self.emit(fast)
+            # a left-nested chain (up to MAX_EXPRESSION_TERMS terms) in a loop: the longest
+            # constant start of the chain is one CONST, as recursing would fold it
+            left, chain = N.left_chain(e)
+            n, v = self.fold_chain(left, chain)
+            if n:
+                self.emit("CONST", v)
             else:
-                self.emit("BINOP", e.op)
+                self.expr(left)
+            for b in chain[n:]:
+                self.expr(b.right)
+                fast = _FAST_BINOPS.get(b.op)
+                if fast is not None:
+                    self.emit(fast)
+                else:
+                    self.emit("BINOP", b.op)
         elif isinstance(e, N.Aggregate):
             for it in e.items:
                 self.expr(it.value)
