@@ -14,6 +14,7 @@ kind                      meaning
 ``not_regular``           a FIFO, socket or device named like a KRL file (never opened)
 ``unreadable_folder``     a folder that cannot be listed (permissions, I/O error)
 ``too_deep``              a folder past :data:`krl.limits.MAX_FOLDER_DEPTH`, not entered
+``folder``                a folder entered (only when asked for: ``walk(..., folders=True)``)
 ========================  ==========================================================
 
 Order: within a folder, entries sorted by name; the files of a folder come before its
@@ -66,10 +67,13 @@ def display_path(path: str) -> str:
 
 
 def walk(root: str | Path, match: Callable[[str], bool] | None = None,
-         max_depth: int = MAX_FOLDER_DEPTH) -> Iterator[Entry]:
+         max_depth: int = MAX_FOLDER_DEPTH, folders: bool = False) -> Iterator[Entry]:
     """Entries below the folder `root` (see the module docstring). `match(name)` selects the
     files of interest (default: KRL files); a symbolic link or a non-regular file is listed
-    when its name matches (a link to a folder always). Never raises for what it finds."""
+    when its name matches (a link to a folder always). With `folders`, every folder entered
+    (the root too, rel "") is also listed, as kind ``folder``, before anything in it (a caller
+    that splits one walk into several roots applies their own depth limits with it,
+    krl/workspace.py). Never raises for what it finds."""
     root = Path(root)
     match = match or (lambda name: is_krl_file(Path(name)))
     stack: list[tuple[Path, str, int]] = [(root, "", 0)]
@@ -78,6 +82,8 @@ def walk(root: str | Path, match: Callable[[str], bool] | None = None,
         if depth > max_depth:
             yield Entry(folder, rel, "too_deep")
             continue
+        if folders:
+            yield Entry(folder, rel, "folder")
         try:
             with os.scandir(folder) as it:
                 listed = sorted(it, key=lambda e: e.name)

@@ -36,6 +36,7 @@ from pathlib import Path
 
 from krl.ast import nodes as N
 from krl.ast.build import build_module
+from krl.limits import MAX_FOLDER_DEPTH
 from krl.semantics.builtins import load_builtins
 from krl.semantics.checker import Checker, Declarer, _is_system_datalist
 from krl.semantics.diagnostics import Diagnostic, DiagnosticSink
@@ -581,12 +582,19 @@ def find_backups(root: str | Path) -> list[Path]:
     from krl.files import walk  # noqa: PLC0415
 
     root = Path(root)
-    found: set[Path] = set()
     if not root.is_dir():
         return []
-    candidates = [e.path for e in walk(root, match=lambda n: n.lower() == "$config.dat") if e.kind == "file"]
-    for cfg in candidates:
-        system = cfg.parent
+    return _backups_in(walk(root, match=lambda n: n.lower() == "$config.dat"))
+
+
+def _backups_in(entries) -> list[Path]:
+    """:func:`find_backups` from the entries of a walk (krl.files.walk) of the folder: its
+    regular files named $config.dat in folders at most MAX_FOLDER_DEPTH levels deep."""
+    found: set[Path] = set()
+    for e in entries:
+        if e.kind != "file" or e.path.name.lower() != "$config.dat" or _levels(e.rel) - 1 > MAX_FOLDER_DEPTH:
+            continue
+        system = e.path.parent
         if system.name.lower() != "system":
             continue
         base = system.parent
@@ -594,6 +602,74 @@ def find_backups(root: str | Path) -> list[Path]:
     roots = sorted(found)
     # a backup inside another one is part of it
     return [r for r in roots if not any(o != r and o in r.parents for o in roots)]
+
+
+def _levels(rel: str) -> int:
+    """Folder levels of a walk entry's `rel` below the walk's root ("" and "." are the root)."""
+    return 0 if rel in ("", ".") else rel.count("/") + 1
+
+
+def folder_groups(path: str | Path) -> list[tuple[str, list]] | None:
+    """What `krl check FOLDER` loads, from one walk of the folder (krl.files.walk): the
+    (root, entries) groups of :func:`workspaces_for` -- one per backup
+    (:func:`find_backups`), then one per top-level folder for the entries outside every
+    backup, sorted; a folder without backups is one group. The entries are those that
+    :func:`collect_entries` of each root gives (each root's own MAX_FOLDER_DEPTH, its own
+    ``rel``). None when `path` is not a folder (or is a link)."""
+    from krl.files import walk  # noqa: PLC0415
+
+    p = Path(path)
+    if not p.is_dir() or p.is_symlink():
+        return None
+    # deep enough for every root's own limit: a backup root is at most MAX_FOLDER_DEPTH levels
+    # down; folder events are kept only where some root's limit may cut (past MAX_FOLDER_DEPTH)
+    entries = [e for e in walk(p, max_depth=2 * MAX_FOLDER_DEPTH + 1, folders=True)
+               if e.kind != "folder" or _levels(e.rel) > MAX_FOLDER_DEPTH]
+    backups = _backups_in(entries)
+    whole = _as_walk_of(entries, "")
+    if not backups:
+        return [(str(p), whole)]
+    groups = []
+    prefixes = []
+    for b in backups:
+        rel = b.relative_to(p).as_posix()
+        rel = "" if rel == "." else rel
+        prefixes.append(rel)
+        groups.append((str(b), _as_walk_of(
+            [e for e in entries if not rel or e.rel == rel or e.rel.startswith(rel + "/")], rel)))
+    # entries outside every backup: one workspace per top-level folder of `path`
+    rest: dict[str, list] = {}
+    for e in whole:
+        if any(not r or e.rel == r or e.rel.startswith(r + "/") for r in prefixes):
+            continue
+        parts = e.rel.split("/")
+        key = str(p / parts[0]) if len(parts) > 1 else str(p)
+        rest.setdefault(key, []).append(e)
+    return groups + sorted(rest.items())
+
+
+def _as_walk_of(entries: list, rel: str) -> list:
+    """The entries a walk of the folder `rel` (of a deeper walk with folder events) would have
+    given: ``rel`` relative to it, folders past MAX_FOLDER_DEPTH below it ``too_deep`` and not
+    entered, folder events dropped."""
+    from krl.files import Entry  # noqa: PLC0415
+
+    base = _levels(rel)
+    cut = len(rel) + 1 if rel else 0
+    out = []
+    pruned = None
+    for e in entries:
+        if pruned is not None and (e.path == pruned or pruned in e.path.parents):
+            continue
+        pruned = None
+        own = e.rel[cut:] if cut and e.rel != rel else (e.rel if not cut else ".")
+        if e.kind == "folder":
+            if _levels(e.rel) - base > MAX_FOLDER_DEPTH:
+                out.append(Entry(e.path, own, "too_deep"))
+                pruned = e.path
+            continue
+        out.append(e if not cut else Entry(e.path, own, e.kind, e.detail, e.size))
+    return out
 
 
 def collect_entries(path: Path) -> list:
@@ -671,11 +747,14 @@ def check_texts(files: dict[str, str]) -> Workspace:
     return ws
 
 
-def workspaces_for(path: str | Path, timeout: float | None = None, jobs: int | None = None) -> list[Workspace]:
+def workspaces_for(path: str | Path, timeout: float | None = None, jobs: int | None = None,
+                   groups: list | None = None) -> list[Workspace]:
     """The workspaces to check for a command-line PATH: a file -> itself with the .dat/.src
     of its module; a folder holding backups -> one workspace per backup, plus one per
     top-level subfolder for the files outside the backups; another folder -> one
-    workspace of all its files. `timeout`, `jobs`: see :func:`load_workspace`."""
+    workspace of all its files. A folder is walked once (:func:`folder_groups`; pass its
+    result as `groups` when the caller has it already). `timeout`, `jobs`: see
+    :func:`load_workspace`."""
     p = Path(path)
     if p.exists() and not p.is_dir():
         files = [p]
@@ -687,17 +766,11 @@ def workspaces_for(path: str | Path, timeout: float | None = None, jobs: int | N
             if sib != p and sib.stem.lower() == p.stem.lower() and is_krl_file(sib) and not sib.is_symlink():
                 files.append(sib)
         return [load_workspace(files, str(p), timeout, jobs)]
-    if p.is_dir() and not p.is_symlink():
-        backups = find_backups(p)
-        if backups:
-            groups = [(str(b), collect_entries(b)) for b in backups]
-            # entries outside every backup: one workspace per top-level folder of `path`
-            rest: dict[str, list] = {}
-            for e in collect_entries(p):
-                if any(b == e.path or b in e.path.parents for b in backups):
-                    continue
-                parts = e.rel.split("/")
-                key = str(p / parts[0]) if len(parts) > 1 else str(p)
-                rest.setdefault(key, []).append(e)
-            return load_workspaces(groups + sorted(rest.items()), timeout, jobs)
+    groups = folder_groups(p) if groups is None else groups
+    if groups is not None and (len(groups) > 1 or groups[0][0] != str(p)):
+        return load_workspaces(groups, timeout, jobs)
+    if groups is not None:          # a folder without backups: one workspace of all its files
+        ws = Workspace(str(p))
+        _add_entries(ws, groups[0][1], timeout, jobs)
+        return [ws]
     return [load_workspace([p], str(p), timeout, jobs)]

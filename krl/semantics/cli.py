@@ -140,7 +140,7 @@ def _loaded(path, timeout: float | None = None, jobs: int | None = None) -> list
     redirected, nothing is shown, so the output is the same either way."""
     from pathlib import Path  # noqa: PLC0415
 
-    from krl.workspace import collect_files, on_each_file, workspaces_for  # noqa: PLC0415
+    from krl.workspace import folder_groups, on_each_file, workspaces_for  # noqa: PLC0415
 
     if not _progress_shown():
         return workspaces_for(path, timeout=timeout, jobs=jobs)
@@ -149,7 +149,8 @@ def _loaded(path, timeout: float | None = None, jobs: int | None = None) -> list
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn  # noqa: PLC0415
 
     p = Path(path)
-    total = len(collect_files(p)) if p.is_dir() else None
+    groups = folder_groups(p)       # the one walk of the folder; its entries are loaded below
+    total = sum(e.kind == "file" for _, entries in groups or () for e in entries) if p.is_dir() else None
     columns = (TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn())
     with Progress(*columns, console=Console(stderr=True), transient=True) as bar:
         task = bar.add_task("parsing", total=total)
@@ -157,7 +158,7 @@ def _loaded(path, timeout: float | None = None, jobs: int | None = None) -> list
         def advance(file: str) -> None:
             bar.update(task, advance=1, description=escape(f"parsing {Path(file).name}"))
         with on_each_file(advance):
-            return workspaces_for(path, timeout=timeout, jobs=jobs)
+            return workspaces_for(path, timeout=timeout, jobs=jobs, groups=groups)
 
 
 def _progress_shown() -> bool:
