@@ -18,6 +18,7 @@ import krl.files
 from krl.limits import MAX_FOLDER_DEPTH
 from krl.semantics import cli
 from krl.semantics.cli import run_check
+from tests.deep import deep_chain, remove_bottom_up
 
 CONFIG = "DEFDAT $CONFIG\n  INT gCount = 0\nENDDAT\n"
 CLEAN = "DEF {name}()\n  gCount = 1\nEND\n"
@@ -100,24 +101,6 @@ def test_folder_without_backups_is_walked_once(tmp_path, monkeypatch):
     assert status == 1
 
 
-def _chain(root: Path, levels: int, made: list[Path]) -> Path:
-    """`levels` folders d/d/... below `root`, each appended to `made` (deepest last)."""
-    p = root
-    for _ in range(levels):
-        p = p / "d"
-        p.mkdir()
-        made.append(p)
-    return p
-
-
-def _remove_bottom_up(folders: list[Path]) -> None:
-    for folder in reversed(folders):
-        for f in folder.iterdir():
-            if not f.is_dir() or f.is_symlink():
-                f.unlink()
-        folder.rmdir()
-
-
 def test_each_root_keeps_its_own_depth_limit(tmp_path):
     # A backup 3 levels down (x/y/KRC): the depth limit counts from the backup, as when the
     # backup was walked on its own; the loose folders count from the checked folder.
@@ -128,11 +111,11 @@ def test_each_root_keeps_its_own_depth_limit(tmp_path):
     (top / "loose").mkdir()
     made: list[Path] = []
     try:
-        inside = _chain(program, MAX_FOLDER_DEPTH - 2, made)        # 100 levels below KRC
+        inside = deep_chain(program, MAX_FOLDER_DEPTH - 2, made)        # 100 levels below KRC
         (inside / "deep.src").write_text("DEF deep()\nEND\n")
-        past = _chain(program / "e", MAX_FOLDER_DEPTH - 2, made)    # 101 levels below KRC
+        past = deep_chain(program / "e", MAX_FOLDER_DEPTH - 2, made)    # 101 levels below KRC
         (past / "deeper.src").write_text("DEF deeper()\nEND\n")
-        loose = _chain(top / "loose", MAX_FOLDER_DEPTH, made)      # 101 levels below top
+        loose = deep_chain(top / "loose", MAX_FOLDER_DEPTH, made)      # 101 levels below top
         (loose / "far.src").write_text("DEF far()\nEND\n")
         _status, got = checked(top)
         assert got == {
@@ -145,4 +128,4 @@ def test_each_root_keeps_its_own_depth_limit(tmp_path):
         too_deep = f"not read: folder more than {MAX_FOLDER_DEPTH} levels deep (not entered)"
         assert {d["message"] for line in out for d in json.loads(line)["diagnostics"]} == {too_deep}
     finally:
-        _remove_bottom_up(made)
+        remove_bottom_up(made)

@@ -19,6 +19,7 @@ from krl import limits
 from krl.syntax.source import read_source
 from recovery.report import summarise, write_report
 from recovery.scan import scan
+from tests.deep import deep_chain, remove_bottom_up
 
 REPO_ROOT = Path(__file__).resolve().parents[2]
 KRL = [sys.executable, "-m", "krl.cli"]
@@ -148,29 +149,13 @@ def test_unreadable_folder_is_reported(tmp_path: Path, monkeypatch) -> None:
     assert any("W002" in ln and "locked" in ln and "Permission denied" in ln for ln in lines), lines
 
 
-def _deep_tree(root: Path, depth: int) -> list[Path]:
-    folders, p = [], root
-    for _ in range(depth):
-        p = p / "d"
-        p.mkdir()
-        folders.append(p)
-    return folders
-
-
-def _remove_bottom_up(folders: list[Path]) -> None:
-    for folder in reversed(folders):
-        for f in folder.iterdir():
-            if not f.is_dir() or f.is_symlink():
-                f.unlink()
-        folder.rmdir()
-
-
 def test_thousand_levels_deep_tree_does_not_crash_recover_or_check(tmp_path: Path) -> None:
     MAX_FOLDER_DEPTH = getattr(limits, "MAX_FOLDER_DEPTH", 100)  # noqa: N806
     corpus = tmp_path / "corpus"
     corpus.mkdir()
     (corpus / "top.src").write_text("DEF top()\nEND\n")
-    folders = _deep_tree(corpus, 1000)
+    folders: list[Path] = []
+    deep_chain(corpus, 1000, folders)
     try:
         (folders[MAX_FOLDER_DEPTH - 2] / "shallow.src").write_text("DEF shallow()\nEND\n")
         (folders[-1] / "bottom.src").write_text("DEF bottom()\n  IF\nEND\n")
@@ -186,4 +171,4 @@ def test_thousand_levels_deep_tree_does_not_crash_recover_or_check(tmp_path: Pat
         assert any("W002" in ln and "levels deep" in ln for ln in lines)
         assert lines[-1] == "1 warning in 2 files"
     finally:
-        _remove_bottom_up(folders)
+        remove_bottom_up(folders)
