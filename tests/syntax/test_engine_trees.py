@@ -27,6 +27,16 @@ TEXT = "DEF a()\nDECL INT x\nx = -(1 + 2) * 3\nIF x > 1 THEN\nx = x - 1\nENDIF\n
 BROKEN = "DEF b()\nx = = 1\nIF THEN\nEND\n"
 
 
+def _first_terminal(tree: list[int], token: int) -> list[int]:
+    """The tree data with its first terminal's token index replaced (preorder integers: a
+    context takes 6, a terminal 2)."""
+    tree, pos = list(tree), 0
+    while tree[pos] >= 0:
+        pos += 6
+    tree[pos + 1] = token
+    return tree
+
+
 def _raw(text: str) -> dict:
     worker = java_engine.worker_for(java_engine.REPO_ROOT.joinpath("grammar", "KRL.g4").read_text(encoding="utf-8"))
     return dict(worker.parse_raw([prepare_text(text)], trees=True))[0]
@@ -53,6 +63,7 @@ def test_a_rebuilt_tree_is_the_python_engines_tree(text):
     lambda r: r.update(names=["__class__"] * len(r["names"])),      # not a context class
     lambda r: r.update(tokens=r["tokens"][:-1]),                    # not 6 integers per token
     lambda r: r.update(tree=[0, 10 ** 9, 0, 0, 0, 0]),              # a token that does not exist
+    lambda r: r.update(tree=_first_terminal(r["tree"], -1)),         # a terminal with no token
     lambda r: r.update(labels=[[0, "op", "x", 1]]),                 # an unknown label kind
     lambda r: r.pop("tree"),
 ])

@@ -160,12 +160,9 @@ def _build(tk: list[int], names: list[str], data: list[int], labels: list, text:
     while pos < end:
         kind = data[pos]
         if kind < 0:
-            i = data[pos + 1]
-            t = made[i]
+            t = token(data[pos + 1])
             if t is None:
-                t = made[i] = _new(RebuiltToken)
-                t._data = shared
-                t._k = 6 * i
+                raise TreeDataError("a terminal without a token")
             if kind == -1:
                 node = _new(terminal)
             elif kind == -2:
