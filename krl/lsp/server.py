@@ -252,10 +252,16 @@ def create_server() -> KrlLanguageServer:
         for path in list(ls.project.docs):
             ls.schedule(path)
 
-    async def place(ls: KrlLanguageServer, td, pos: L.Position):
+    async def holding(ls: KrlLanguageServer, td):
+        """(analysis, path) of the document, its analysis fresh; (None, path) when no analysis
+        holds it."""
         path = path_of(td.uri)
         an = await ls.fresh(path)
-        if an is None or path not in an.files:
+        return (an, path) if an is not None and path in an.files else (None, path)
+
+    async def place(ls: KrlLanguageServer, td, pos: L.Position):
+        an, path = await holding(ls, td)
+        if an is None:
             return None, None, 0, 0
         line, col = from_position(an.files[path].lines, pos, ls.codec())
         return an, path, line, col
@@ -299,11 +305,8 @@ def create_server() -> KrlLanguageServer:
     @server.feature(L.TEXT_DOCUMENT_DOCUMENT_SYMBOL)
     @guarded(list)
     async def document_symbol(ls: KrlLanguageServer, params: L.DocumentSymbolParams):
-        path = path_of(params.text_document.uri)
-        an = await ls.fresh(path)
-        if an is None or path not in an.files:
-            return []
-        return _outline.document_symbols(an, path, ls.codec())
+        an, path = await holding(ls, params.text_document)
+        return _outline.document_symbols(an, path, ls.codec()) if an is not None else []
 
     @server.feature(L.WORKSPACE_SYMBOL)
     @guarded(list)
@@ -321,11 +324,8 @@ def create_server() -> KrlLanguageServer:
     @server.feature(L.TEXT_DOCUMENT_FOLDING_RANGE)
     @guarded(list)
     async def folding_range(ls: KrlLanguageServer, params: L.FoldingRangeParams):
-        path = path_of(params.text_document.uri)
-        an = await ls.fresh(path)
-        if an is None or path not in an.files:
-            return []
-        return _folding.folding_ranges(an.files[path].lines)
+        an, path = await holding(ls, params.text_document)
+        return _folding.folding_ranges(an.files[path].lines) if an is not None else []
 
     @server.feature(L.TEXT_DOCUMENT_COMPLETION, L.CompletionOptions(trigger_characters=[".", "$", "#"]))
     @guarded()
