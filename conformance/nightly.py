@@ -19,7 +19,7 @@ PARTS = (("recovery", ("report.html", "report.md")), ("growth", ("growth.png", "
 def write_index(root: Path) -> Path:
     root.mkdir(parents=True, exist_ok=True)
     days = sorted((p for p in root.iterdir() if p.is_dir()), reverse=True)
-    rows, rows_md = [], []   # rows: for krl/templates/nightly.html.j2
+    rows, rows_md = [], []   # rows: for conformance/templates/nightly.html.j2
     for d in days:
         links = []
         for part, names in PARTS:
@@ -40,7 +40,7 @@ def write_index(root: Path) -> Path:
         rows_md.append(f"| {d.name} | " + " ".join(f"[{t}]({h})" for t, h in links) + f" | {summ} |")
     from krl.render import render_html  # noqa: PLC0415
 
-    (root / "index.html").write_text(render_html("nightly.html.j2", days=rows), encoding="utf-8")
+    (root / "index.html").write_text(render_html("conformance", "nightly.html.j2", days=rows), encoding="utf-8")
     (root / "index.md").write_text("# Nightly reports\n\n| date | reports | conformance |\n|---|---|---|\n"
                                    + "\n".join(rows_md) + "\n", encoding="utf-8")
     return root / "index.html"

@@ -20,10 +20,11 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from krl.files import SHARED_CORPUS as DEFAULT_CORPUS
+
 from . import harness as H
 
 REPO = H.REPO
-DEFAULT_CORPUS = REPO.parent / "shared" / "krl-corpus"
 
 
 # ============================================================================ cases
@@ -313,7 +314,7 @@ def _html(s, rows, interps, fuzz, real) -> str:
     from krl.render import render_html  # noqa: PLC0415
 
     keys = ("cases", "passed", "tree_vm_agree", "fuzz_programs", "fuzz_agree", "real_programs", "real_agree", "vm")
-    return render_html("conformance.html.j2", when=time.strftime("%Y-%m-%d %H:%M:%S UTC", time.gmtime()),
+    return render_html("conformance", "conformance.html.j2", when=time.strftime("%Y-%m-%d %H:%M:%S UTC", time.gmtime()),
                        summary_rows=[(k, s.get(k) if s.get(k) is not None else "n/a (no VM)") for k in keys],
                        rows=rows, interps=interps, pending=[r for r in rows if r["pending"]],
                        fuzz=fuzz, real=real, real_reasons=s.get("real_tree_reasons") or {},

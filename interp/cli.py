@@ -66,7 +66,7 @@ def run(program: Path, interp_kind: str, workspace, inputs, trace_path, max_sim_
 def program_in(folder: Path, program: Path) -> Path | None:
     """PROGRAM inside an extracted archive: its relative path (any letter case of the file
     name), else the .src (then .sub) file whose stem is its name; None when there is none."""
-    from krl.syntax.source import is_krl_file  # noqa: PLC0415
+    from krl.source import is_krl_file  # noqa: PLC0415
 
     direct = folder / program
     if not program.is_absolute() and ".." not in program.parts and direct.is_file():
@@ -127,21 +127,21 @@ def _run(program: Path, workspace, inputs, trace_path, max_sim_time, max_steps, 
     sys.exit(res.exit_code)
 
 
-from interp.vm.cli import asm  # noqa: E402
+from interp.asm import asm  # noqa: E402
+
 
 def check_errors(program: Path, workspace=None) -> list:
     """Errors the front end's checker finds in the program's own module (its .src/.dat)
-    when the whole environment of the run (workspace, BASIS or the backup) is checked."""
-    from interp.runtime.program import BASIS_DIR, find_backup_root  # noqa: PLC0415
-    from krl.workspace import load_workspace  # noqa: PLC0415
+    when the program's files (krl.project.project_of, the rule of the run) are checked
+    together, with the project's BASIS outside a backup."""
+    from interp.runtime.program import BASIS_DIR  # noqa: PLC0415
+    from krl.project import project_of  # noqa: PLC0415
+    from krl.workspace import load_project  # noqa: PLC0415
 
     prog = program.resolve()
-    found = find_backup_root(prog, Path(workspace).resolve() if workspace else None)
-    if found is not None:
-        paths = [found[0]]
-    else:
-        paths = [Path(workspace).resolve() if workspace else prog.parent, BASIS_DIR]
-    ws = load_workspace(paths, str(prog))
+    project = project_of(prog, Path(workspace).resolve() if workspace else None)
+    extra = [] if project.backup else sorted(p for p in BASIS_DIR.iterdir() if p.is_file())
+    ws = load_project(project, str(prog), extra=extra)
     ws.check()
     stem = prog.stem.upper()
     return [d for d in ws.diagnostics if d.is_error and Path(d.path).stem.upper() == stem]

@@ -29,26 +29,20 @@ import time
 from collections import Counter
 from pathlib import Path
 
-DEFAULT_CORPUS = Path(__file__).resolve().parents[2] / "shared" / "krl-corpus"
+from krl.files import SHARED_CORPUS as DEFAULT_CORPUS
+from krl.project import backup_of, find_backups, system_folder
+
 LEGITIMATE = ("deadlock", "halt", "max_sim_time", "max_steps")
 
 
-def find_backups(corpus: Path) -> list[Path]:
-    """Backup roots (the folder holding R1, or a flat export's folder)."""
-    out = []
-    for sysdir in sorted(corpus.rglob("System")):
-        if not sysdir.is_dir():
-            continue
-        if not any(p.name.upper() == "$CONFIG.DAT" for p in sysdir.iterdir()):
-            continue
-        root = sysdir.parent
-        out.append(root)
-    return out
-
-
 def programs_of(root: Path) -> list[Path]:
+    """The robot programs of the backup rooted at `root` (krl/project.py): the .src files
+    under the robot's folder (R1, or a flat export's root) in a Program folder, named CELL,
+    or at that folder's top, whose first routine is a DEF without parameters."""
     from interp.runtime.program import parse_module  # noqa: PLC0415
 
+    system = system_folder(root)
+    root = system.parent if system is not None else root
     cands = []
     for p in sorted(root.rglob("*")):
         if p.suffix.lower() != ".src" or not p.is_file():
@@ -75,13 +69,11 @@ def normalise(text: str) -> str:
 def submit_of(path: Path) -> list[Path]:
     """The backup's SPS.SUB (R1/SPS.SUB or System/sps.sub): started beside the program as
     the controller does at boot (reference §9)."""
-    from interp.runtime.program import find_backup_root  # noqa: PLC0415
-
-    found = find_backup_root(path.resolve())
-    if found is None:
+    root = backup_of(path.resolve())
+    sysdir = system_folder(root) if root is not None else None
+    if sysdir is None:
         return []
-    ws, sysdir = found
-    for d in (ws, sysdir):
+    for d in (sysdir.parent, sysdir):
         for p in d.iterdir():
             if p.name.upper() == "SPS.SUB":
                 return [p]

@@ -17,12 +17,10 @@ from collections import Counter
 from dataclasses import dataclass, field
 from typing import Any
 
-from krl.terminal import printable, printable_path
+from krl.terminal import clip, printable, printable_path
 
 #: messages shown on the console; the rest are counted ("... N more").
 MAX_MESSAGES = 8
-#: characters of one message shown.
-MAX_MESSAGE_CHARS = 160
 
 #: controller messages that are notes of the simulator, not of the program: counted apart.
 SIMULATOR_NOTES = ("not simulated:", "stub:")
@@ -92,8 +90,7 @@ def _where(file: str | None, line: int | None) -> str:
 
 
 def _clip(text: str) -> str:
-    text = printable(text)
-    return text if len(text) <= MAX_MESSAGE_CHARS else text[:MAX_MESSAGE_CHARS - 1] + "…"
+    return clip(printable(text))
 
 
 def summary_lines(result: Any, observer: RunObserver, *, program: str, interp: str,

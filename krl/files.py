@@ -30,9 +30,14 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from krl.limits import MAX_FOLDER_DEPTH
-from krl.syntax.source import file_kind, is_krl_file
+from krl.source import file_kind, is_krl_file
 
 WARNING_KINDS = ("symlink", "not_regular", "unreadable_folder", "too_deep")
+
+# The shared corpus of real KRL (docs: README "Quick start"), read in place beside the repository
+# (../shared/krl-corpus): the default corpus of the benchmarks, the real-program runs and the
+# conformance suite. Absent on a machine without it; every user checks is_dir().
+SHARED_CORPUS = Path(__file__).resolve().parents[1].parent / "shared" / "krl-corpus"
 
 
 @dataclass(slots=True)

@@ -21,8 +21,14 @@ MAX_NESTING = 100
 # nested calls" at the call (interp/runtime/core.py).
 MAX_CALL_DEPTH = 100
 
-# The largest source file read, in bytes (krl/syntax/source.py).
+# The largest source file read, in bytes (krl/source.py).
 MAX_FILE_BYTES = 10 * 1024 * 1024
+
+# The longest message printed, in characters: a diagnostic's message (krl parse, krl check, the
+# language server), a line of the run summary (krl run), and the part of a source line shown
+# around a caret. Untrusted text (a 10 MB line, a string SWRITE built) never floods a terminal or
+# a report; longer text is cut by krl.terminal.clip, ending in "…".
+MAX_MESSAGE_CHARS = 160
 
 # The most operands (terms) in one statement's expressions, counted on its line: `a + b * c` has
 # 3. Real KRL stays far below (long conditions have a few dozen terms); the limit keeps the parse
@@ -80,6 +86,21 @@ MAX_LSP_WORKSPACE_FILES = 5000
 # folder, in entries: a backup has a few thousand; a home folder opened by mistake may have
 # millions. Past it the listing stops there (as for MAX_LSP_WORKSPACE_FILES).
 MAX_LSP_SCAN_ENTRIES = 200_000
+
+# The most entries `krl lsp` answers with: workspace symbols for one query, completion items for
+# one request. A backup declares tens of thousands of names; an editor shows a few dozen.
+MAX_LSP_SYMBOLS = 500
+MAX_LSP_COMPLETIONS = 1000
+
+# A `krl.toml` (the diagnostic configuration of a workspace), in bytes: a few lines in practice.
+# Past it: the configuration error names the file (krl check exits 2).
+MAX_CONFIG_BYTES = 64 * 1024
+
+# Stimuli files (`krl run --inputs`, robot/stimuli.py): the largest file read, in bytes (a YAML
+# document; real cells script a few hundred stimuli), and the most stimuli in one file. Past
+# either: an error naming the file; the run does not start.
+MAX_STIMULI_BYTES = 4 * 1024 * 1024
+MAX_STIMULI = 100_000
 
 # The run's data memory, in data elements: every scalar value (INT, REAL, BOOL, CHAR, ENUM) and
 # every structure value held by a declared variable counts one (an array of n elements counts n

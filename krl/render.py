@@ -3,8 +3,10 @@
 Reports show text taken from untrusted input — KRL lines, file names from a corpus or a
 backup, run-time messages — so every HTML output goes through the single Jinja environment
 of :func:`html_env`, with autoescape on for every template whatever its name (docs/security.md).
-The templates live in ``krl/templates``: ``recovery.html.j2`` (``krl recover``),
-``conformance.html.j2`` (``krl conformance``), ``nightly.html.j2`` (the nightly index).
+Each package keeps its own report templates in its ``templates`` folder (``recovery.html.j2`` in
+recovery/, ``conformance.html.j2`` and ``nightly.html.j2`` in conformance/); they extend
+``_base.html.j2``, the shared page of ``krl/templates``. This module imports nothing of the
+project: the packages above it name themselves when they render.
 
 Markdown produced by the project (e.g. the static-check section of the recovery report) is
 turned into HTML by markdown-it-py with raw HTML disabled (:func:`markdown_html`), never by
@@ -16,7 +18,7 @@ from __future__ import annotations
 from functools import lru_cache
 from typing import Any
 
-from jinja2 import Environment, PackageLoader, StrictUndefined
+from jinja2 import ChoiceLoader, Environment, PackageLoader, StrictUndefined
 from markupsafe import Markup
 
 __all__ = ["html_env", "markdown_code", "markdown_html", "render_html"]
@@ -50,17 +52,19 @@ def markdown_code(text: object) -> str:
     return f"{fence}{pad}{s}{pad}{fence}"
 
 
-@lru_cache(maxsize=1)
-def html_env() -> Environment:
-    """The Jinja environment of every HTML output: autoescape on for all templates (not
-    chosen by file name), undefined names are errors, filter ``markdown`` (:func:`markdown_html`)."""
-    env = Environment(loader=PackageLoader("krl", "templates"), autoescape=True,
+@lru_cache(maxsize=None)
+def html_env(package: str) -> Environment:
+    """The Jinja environment of `package`'s HTML output: its ``templates`` folder, then
+    ``krl/templates`` (the shared base page); autoescape on for all templates (not chosen by
+    file name), undefined names are errors, filter ``markdown`` (:func:`markdown_html`)."""
+    loader = ChoiceLoader([PackageLoader(package, "templates"), PackageLoader("krl", "templates")])
+    env = Environment(loader=loader, autoescape=True,
                       undefined=StrictUndefined, trim_blocks=True, lstrip_blocks=True)
     env.filters["markdown"] = markdown_html
     return env
 
 
-def render_html(template: str, **context: Any) -> str:
-    """Render ``krl/templates/<template>`` with `context`; every value is escaped unless it is
-    already :class:`markupsafe.Markup`."""
-    return html_env().get_template(template).render(**context)
+def render_html(package: str, template: str, **context: Any) -> str:
+    """Render ``<package>/templates/<template>`` with `context`; every value is escaped unless it
+    is already :class:`markupsafe.Markup`."""
+    return html_env(package).get_template(template).render(**context)

@@ -21,7 +21,9 @@ from __future__ import annotations
 
 import re
 
-__all__ = ["printable", "printable_path"]
+from krl.limits import MAX_MESSAGE_CHARS
+
+__all__ = ["clip", "printable", "printable_path"]
 
 _UNSAFE = re.compile("[\x00-\x08\x0a-\x1f\x7f-\x9f\u2028\u2029\u200e\u200f\u202a-\u202e\u2066-\u2069]")
 _UNSAFE_KEEP_NL = re.compile("[\x00-\x08\x0b-\x1f\x7f-\x9f\u2028\u2029\u200e\u200f\u202a-\u202e\u2066-\u2069]")
@@ -51,3 +53,9 @@ def printable_path(path: object) -> str:
     if any("\udc80" <= ch <= "\udcff" for ch in s):
         s = "".join(f"\\x{ord(ch) - 0xDC00:02x}" if "\udc80" <= ch <= "\udcff" else ch for ch in s)
     return printable(s)
+
+
+def clip(text: str, limit: int = MAX_MESSAGE_CHARS) -> str:
+    """`text` cut to at most `limit` characters (default :data:`krl.limits.MAX_MESSAGE_CHARS`),
+    the last one an ellipsis "…" when it was cut."""
+    return text if len(text) <= limit else text[:limit - 1] + "…"

@@ -13,8 +13,9 @@ hierarchy of :mod:`krl.semantics.symbols` and the diagnostics. Pairing and visib
 
 A KRC backup folder (``KRC/R1/Program``, ``R1/System`` with ``bas.src`` and ``$config.dat``,
 ``R1/Mada``, ``R1/TP``, ``STEU/Mada``; any letter case) loads as one workspace:
-:func:`find_backups` finds them, :func:`load_workspace` loads files or folders.
-Files are read with krl.syntax.source.read_source and parsed with parse_source only.
+krl/project.py says which files form a program (:func:`krl.project.project_of`, one rule for
+every command); :func:`load_project` and :func:`load_workspace` load them.
+Files are read with krl.source.read_source and parsed with parse_source only.
 
 Usage::
 
@@ -36,17 +37,18 @@ from pathlib import Path
 
 from krl.ast import nodes as N
 from krl.ast.build import build_module
-from krl.limits import MAX_FOLDER_DEPTH
+from krl.files import Entry
+from krl.project import Project, collect_entries, folder_groups, is_system_path, project_of
 from krl.semantics.builtins import load_builtins
 from krl.semantics.checker import Checker, Declarer, _is_system_datalist
-from krl.semantics.diagnostics import Diagnostic, DiagnosticSink
+from krl.diagnostics import Diagnostic, DiagnosticSink
 from krl.semantics.outside import Unresolved, template_lines
 from krl.semantics.symbols import Scope, Symbol, system_scopes
 from krl.syntax.folds import fold_diagnostics
 from krl.syntax.messages import syntax_diagnostics
 from krl.syntax.engines import parse_source
 from krl.syntax.parse import ParseResult
-from krl.syntax.source import SourceText, is_krl_file, read_source
+from krl.source import SourceText, is_krl_file, read_source
 
 
 @dataclass(slots=True)
@@ -86,7 +88,7 @@ JAVA_BATCH_BYTES = 64 * 1024
 
 
 def load_file(path: str | Path) -> LoadedFile:
-    """Read (krl.syntax.source.read_source), parse (the Python engine) and build one file;
+    """Read (krl.source.read_source), parse (the Python engine) and build one file;
     never raises for bad content."""
     t = time.perf_counter()
     src = read_source(path)
@@ -238,8 +240,12 @@ class Workspace:
 
     @property
     def diagnostics(self) -> list[Diagnostic]:
-        """All diagnostics so far, sorted by path, line, column."""
-        return self.sink.sorted()
+        """All diagnostics so far, sorted by path, line, column; with :attr:`check_only`, those
+        of the files checked."""
+        out = self.sink.sorted()
+        if self.check_only is not None:
+            out = [d for d in out if d.path in self.check_only]
+        return out
 
     @property
     def modules(self) -> dict[str, ModuleUnit]:
@@ -518,17 +524,9 @@ def on_each_file(callback: Callable[[str], None]):
         _ON_FILE.reset(token)
 
 
-SYSTEM_DIRS = ("system", "tp", "mada", "steu")
 # warnings that advise a change of the code (docs/diagnostics.md): not reported in KUKA's files
 ADVISORY = frozenset({"W108", "W111", "W201", "W202", "W205", "W206", "W210", "W501"})
 _WORD = re.compile(r"[A-Za-z_$][A-Za-z0-9_$]*")
-
-
-def is_system_path(path: str) -> bool:
-    """True for KUKA system files of a backup (folders System, TP, Mada, STEU, or a $-file):
-    they rely on $operate.dat declarations that a backup never contains (see W101/W105/W106)."""
-    parts = Path(path).parts
-    return Path(path).name.startswith("$") or any(p.lower() in SYSTEM_DIRS for p in parts[:-1])
 
 
 def _global_and_local_twice(dl: N.DataList, declarer: Declarer) -> None:
@@ -573,122 +571,6 @@ def _unit_names(u: "ModuleUnit") -> set[str]:
         names.add(u.dat.module.data.name.upper())
     return names
 
-
-
-def find_backups(root: str | Path) -> list[Path]:
-    """Backup roots below `root`: folders with R1/System/$config.dat (the root is the folder
-    holding R1, e.g. KRC) or System/$config.dat (a flat R1 export). Any letter case; sorted.
-    The walk is krl.files.walk: iterative, links never followed."""
-    from krl.files import walk  # noqa: PLC0415
-
-    root = Path(root)
-    if not root.is_dir():
-        return []
-    return _backups_in(walk(root, match=lambda n: n.lower() == "$config.dat"))
-
-
-def _backups_in(entries) -> list[Path]:
-    """:func:`find_backups` from the entries of a walk (krl.files.walk) of the folder: its
-    regular files named $config.dat in folders at most MAX_FOLDER_DEPTH levels deep."""
-    found: set[Path] = set()
-    for e in entries:
-        if e.kind != "file" or e.path.name.lower() != "$config.dat" or _levels(e.rel) - 1 > MAX_FOLDER_DEPTH:
-            continue
-        system = e.path.parent
-        if system.name.lower() != "system":
-            continue
-        base = system.parent
-        found.add(base.parent if base.name.lower() == "r1" else base)
-    roots = sorted(found)
-    # a backup inside another one is part of it
-    return [r for r in roots if not any(o != r and o in r.parents for o in roots)]
-
-
-def _levels(rel: str) -> int:
-    """Folder levels of a walk entry's `rel` below the walk's root ("" and "." are the root)."""
-    return 0 if rel in ("", ".") else rel.count("/") + 1
-
-
-def folder_groups(path: str | Path) -> list[tuple[str, list]] | None:
-    """What `krl check FOLDER` loads, from one walk of the folder (krl.files.walk): the
-    (root, entries) groups of :func:`workspaces_for` -- one per backup
-    (:func:`find_backups`), then one per top-level folder for the entries outside every
-    backup, sorted; a folder without backups is one group. The entries are those that
-    :func:`collect_entries` of each root gives (each root's own MAX_FOLDER_DEPTH, its own
-    ``rel``). None when `path` is not a folder (or is a link)."""
-    from krl.files import walk  # noqa: PLC0415
-
-    p = Path(path)
-    if not p.is_dir() or p.is_symlink():
-        return None
-    # deep enough for every root's own limit: a backup root is at most MAX_FOLDER_DEPTH levels
-    # down; folder events are kept only where some root's limit may cut (past MAX_FOLDER_DEPTH)
-    entries = [e for e in walk(p, max_depth=2 * MAX_FOLDER_DEPTH + 1, folders=True)
-               if e.kind != "folder" or _levels(e.rel) > MAX_FOLDER_DEPTH]
-    backups = _backups_in(entries)
-    whole = _as_walk_of(entries, "")
-    if not backups:
-        return [(str(p), whole)]
-    groups = []
-    prefixes = []
-    for b in backups:
-        rel = b.relative_to(p).as_posix()
-        rel = "" if rel == "." else rel
-        prefixes.append(rel)
-        groups.append((str(b), _as_walk_of(
-            [e for e in entries if not rel or e.rel == rel or e.rel.startswith(rel + "/")], rel)))
-    # entries outside every backup: one workspace per top-level folder of `path`
-    rest: dict[str, list] = {}
-    for e in whole:
-        if any(not r or e.rel == r or e.rel.startswith(r + "/") for r in prefixes):
-            continue
-        parts = e.rel.split("/")
-        key = str(p / parts[0]) if len(parts) > 1 else str(p)
-        rest.setdefault(key, []).append(e)
-    return groups + sorted(rest.items())
-
-
-def _as_walk_of(entries: list, rel: str) -> list:
-    """The entries a walk of the folder `rel` (of a deeper walk with folder events) would have
-    given: ``rel`` relative to it, folders past MAX_FOLDER_DEPTH below it ``too_deep`` and not
-    entered, folder events dropped."""
-    from krl.files import Entry  # noqa: PLC0415
-
-    base = _levels(rel)
-    cut = len(rel) + 1 if rel else 0
-    out = []
-    pruned = None
-    for e in entries:
-        if pruned is not None and (e.path == pruned or pruned in e.path.parents):
-            continue
-        pruned = None
-        own = e.rel[cut:] if cut and e.rel != rel else (e.rel if not cut else ".")
-        if e.kind == "folder":
-            if _levels(e.rel) - base > MAX_FOLDER_DEPTH:
-                out.append(Entry(e.path, own, "too_deep"))
-                pruned = e.path
-            continue
-        out.append(e if not cut else Entry(e.path, own, e.kind, e.detail, e.size))
-    return out
-
-
-def collect_entries(path: Path) -> list:
-    """The KRL entries (:class:`krl.files.Entry`) of a file or folder, in walk order: a folder is
-    walked (krl/files.py: links and FIFOs listed, never read; unreadable or too deep folders
-    listed); anything else that exists is one ``file`` entry, classified when it is read."""
-    from krl.files import Entry, walk  # noqa: PLC0415
-
-    if path.is_dir() and not path.is_symlink():
-        return list(walk(path))
-    if path.is_symlink() and path.is_dir():
-        return [Entry(path, path.name, "symlink")]
-    return [Entry(path, path.name, "file")]
-
-
-def collect_files(path: Path) -> list[Path]:
-    """KRL files (.src, .dat, .sub in any case) of a file or folder, in walk order (regular
-    files only; see :func:`collect_entries` for the rest)."""
-    return [e.path for e in collect_entries(path) if e.kind == "file"]
 
 
 def _add_entries(ws: "Workspace", entries, timeout: float | None = None, jobs: int | None = None) -> None:
@@ -747,25 +629,47 @@ def check_texts(files: dict[str, str]) -> Workspace:
     return ws
 
 
+def module_files(path: Path) -> list[Path]:
+    """`path` and the other KRL files of its module: the .src/.dat/.sub beside it with the
+    same name (any case; links not followed)."""
+    files = [path]
+    try:
+        siblings = sorted(path.parent.iterdir()) if path.parent.is_dir() else []
+    except OSError:
+        siblings = []
+    for sib in siblings:
+        if sib != path and sib.stem.lower() == path.stem.lower() and is_krl_file(sib) and not sib.is_symlink():
+            files.append(sib)
+    return files
+
+
+def load_project(project: Project, root: str = "", timeout: float | None = None, jobs: int | None = None,
+                 extra: list[Path] = ()) -> Workspace:
+    """The workspace of `project` (krl.project.project_of): its files in walk order, then
+    `extra` files (a run's BASIS, a submit program outside the project); the entries not read
+    are W002 warnings."""
+    ws = Workspace(root or str(project.root))
+    files = project.files
+    known = {f.stem.lower() for f in files}
+    more = [f for f in extra if f.stem.lower() not in known and f not in files]
+    _add_entries(ws, project.entries + [Entry(f, f.name, "file") for f in more], timeout, jobs)
+    return ws
+
+
 def workspaces_for(path: str | Path, timeout: float | None = None, jobs: int | None = None,
                    groups: list | None = None) -> list[Workspace]:
-    """The workspaces to check for a command-line PATH: a file -> itself with the .dat/.src
-    of its module; a folder holding backups -> one workspace per backup, plus one per
-    top-level subfolder for the files outside the backups; another folder -> one
-    workspace of all its files. A folder is walked once (:func:`folder_groups`; pass its
-    result as `groups` when the caller has it already). `timeout`, `jobs`: see
+    """The workspaces to check for a command-line PATH (krl/project.py): a file -> its program
+    (the backup holding it, else every KRL file of its folder), checked and reported for the
+    file's own module only (its .src/.dat); a folder holding backups -> one workspace per
+    backup, plus one per top-level subfolder for the files outside the backups; another
+    folder -> one workspace of all its files. A folder is walked once (:func:`folder_groups`;
+    pass its result as `groups` when the caller has it already). `timeout`, `jobs`: see
     :func:`load_workspace`."""
     p = Path(path)
     if p.exists() and not p.is_dir():
-        files = [p]
-        try:
-            siblings = sorted(p.parent.iterdir()) if p.parent.is_dir() else []
-        except OSError:
-            siblings = []
-        for sib in siblings:
-            if sib != p and sib.stem.lower() == p.stem.lower() and is_krl_file(sib) and not sib.is_symlink():
-                files.append(sib)
-        return [load_workspace(files, str(p), timeout, jobs)]
+        ws = load_project(project_of(p), str(p), timeout, jobs)
+        ws.check_only = {str(f) for f in module_files(p)}
+        return [ws]
     groups = folder_groups(p) if groups is None else groups
     if groups is not None and (len(groups) > 1 or groups[0][0] != str(p)):
         return load_workspaces(groups, timeout, jobs)

@@ -68,7 +68,7 @@ def static_check_figures(corpus: Path, fingerprints: list[str], gsha: str,
     grammar, the front end's code and the corpus files (`fingerprints`: "path:sha" of every
     scanned file). Files are parsed and built in `jobs`
     worker processes (the scan's pool, krl/pool.py), each stopped past `timeout` seconds."""
-    from krl.workspace import find_backups  # noqa: PLC0415
+    from krl.project import find_backups  # noqa: PLC0415
 
     if not find_backups(corpus):
         return None
@@ -88,7 +88,7 @@ def static_check_figures(corpus: Path, fingerprints: list[str], gsha: str,
         except (OSError, ValueError, RecursionError):
             pass
         warn(f"cache file {path} is corrupt; ignored and rebuilt")
-    from krl.semantics.report import check_report  # noqa: PLC0415
+    from krl.survey.report import check_report  # noqa: PLC0415
 
     data, markdown = check_report(corpus, timeout=timeout, jobs=jobs)
     figures = {"files": data["total"]["files"], "files_clean": data["total"]["files_clean"],

@@ -316,7 +316,7 @@ class ReportStream:
 
     def __init__(self, out: Path):
         """files.csv: one row per corpus entry; ``encoding`` is the decoding used
-        (krl/syntax/source.py), ``detail`` says why a file was not parsed; every text cell
+        (krl/source.py), ``detail`` says why a file was not parsed; every text cell
         through :func:`csv_cell`."""
         self.out = Path(out)
         self.tmp = _new_report_folder(self.out)
@@ -376,4 +376,4 @@ def render_report(out: Path, summary: Summary, bad_input: list[FileResult], link
                "bad_input": bad_input}
     (out / "report.md").write_text(_markdown_env().get_template("report.md.j2").render(**context),
                                    encoding="utf-8")
-    (out / "report.html").write_text(render_html("recovery.html.j2", **context), encoding="utf-8")
+    (out / "report.html").write_text(render_html("recovery", "recovery.html.j2", **context), encoding="utf-8")

@@ -88,7 +88,7 @@ def scale(corpus: Path, copies: int = 16) -> dict:
 @click.option("--copies", type=click.IntRange(2, 64), default=16, show_default=True)
 @click.option("--json", "as_json", is_flag=True, help="One JSON object.")
 def main(corpus: Path | None, copies: int, as_json: bool) -> None:
-    from krl.bench import DEFAULT_CORPUS  # noqa: PLC0415
+    from krl.files import SHARED_CORPUS as DEFAULT_CORPUS  # noqa: PLC0415
 
     if corpus is None and not DEFAULT_CORPUS.is_dir():
         raise click.UsageError(f"no corpus at {DEFAULT_CORPUS}; name one")

@@ -8,7 +8,7 @@ past a limit of krl/limits.py); a file that is not parsed is ``empty``, ``binary
 ``internal_error`` (the parser raised, or its worker died); a folder that cannot be listed is an
 ``unreadable_folder`` row and one past :data:`krl.limits.MAX_FOLDER_DEPTH` a ``too_deep`` row.
 
-Each file is read once in the main process (:func:`krl.syntax.source.read_limited`, no FIFO is
+Each file is read once in the main process (:func:`krl.source.read_limited`, no FIFO is
 ever opened); the SHA-256 of those bytes keys the result cache, and the same bytes are what a
 worker decodes and parses (:func:`parse_row`, the scan's one call into the parser). Workers are
 a killable pool (krl/pool.py, pebble): a timeout kills the worker, whatever the parser is doing.
@@ -38,7 +38,7 @@ import platformdirs
 from krl.files import display_path, walk
 from krl.limits import PARSE_TIMEOUT_S
 from krl.pool import default_jobs, run_tasks
-from krl.syntax.source import read_limited, source_from_bytes
+from krl.source import read_limited, source_from_bytes
 
 CACHE_VERSION = "3"
 CACHE_SCHEMA = "krl-scan-results"

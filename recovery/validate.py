@@ -20,15 +20,15 @@ from pathlib import Path
 
 import click
 
+from krl.files import SHARED_CORPUS as DEFAULT_CORPUS
 from krl.syntax.parse import parse_file
-from krl.syntax.source import is_krl_file, read_source
+from krl.source import is_krl_file, read_source
 from recovery.cluster import cluster_results
 from recovery.grammar_versions import GrammarToolError, _git, parser_dir_for
 from recovery.scan import grammar_sha, scan
 
 REPO_ROOT = Path(__file__).resolve().parents[1]
 CONSTRUCTS = REPO_ROOT / "grammar" / "constructs"
-DEFAULT_CORPUS = REPO_ROOT.parent / "shared" / "krl-corpus"
 
 
 @dataclass(slots=True)
@@ -73,7 +73,7 @@ def built_kinds(result) -> list[tuple[int, str]]:
     """(line, kind) of the module the AST builder makes of a parse result."""
     from krl.ast.build import build_module  # noqa: PLC0415
     from krl.ast.kinds import statement_kinds  # noqa: PLC0415
-    from krl.semantics.diagnostics import DiagnosticSink  # noqa: PLC0415
+    from krl.diagnostics import DiagnosticSink  # noqa: PLC0415
 
     return statement_kinds(build_module(result, DiagnosticSink()))
 

@@ -1,4 +1,4 @@
-"""``krl plot``: the robot package's subcommand (registered by krl/cli.py)."""
+"""``krl plot``: the robot package's subcommand (registered by krl/cli/__init__.py)."""
 
 from __future__ import annotations
 

@@ -19,7 +19,7 @@ it starts (:func:`resolve_signals`).
 The file is validated against this schema: a top-level mapping holds only ``stimuli``; a
 stimulus only ``at``, ``when``, ``set``, ``delay``; ``when`` only ``motion``, ``line``,
 ``phase``, ``reached``. Anything else is a :class:`StimulusError` that names the key and the
-place (``file:line``). Limits: at most :data:`MAX_STIMULI` stimuli, :data:`MAX_FILE_BYTES` bytes.
+place (``file:line``). Limits: at most :data:`MAX_STIMULI` stimuli, :data:`MAX_STIMULI_BYTES` bytes.
 
 ``phase`` is one of start, blend_start, blend_end, end. ``reached`` (mm) fires in the
 first IPO cycle in which that motion is being executed and the TCP is within the given
@@ -38,14 +38,14 @@ from typing import Any
 
 import yaml
 
+from krl.limits import MAX_STIMULI, MAX_STIMULI_BYTES
+
 from .io import IOError_, parse_signal
 
 PHASES = ("start", "blend_start", "blend_end", "end")
 TOP_KEYS = ("stimuli",)
 STIMULUS_KEYS = ("at", "when", "set", "delay")
 WHEN_KEYS = ("motion", "line", "phase", "reached")
-MAX_STIMULI = 100_000          # stimuli in one file
-MAX_FILE_BYTES = 4 * 1024 * 1024
 _NAME = re.compile(r"[A-Za-z_$][A-Za-z0-9_$]{0,23}\Z")   # a KRL name (reference §2: 24 characters)
 
 
@@ -240,8 +240,8 @@ def load_stimuli(path: str | Path, default_reach_mm: float = 0.1) -> list[Stimul
     malformed file."""
     p = Path(path)
     try:
-        if p.stat().st_size > MAX_FILE_BYTES:
-            raise StimulusError(f"{p}: larger than the limit of {MAX_FILE_BYTES} bytes")
+        if p.stat().st_size > MAX_STIMULI_BYTES:
+            raise StimulusError(f"{p}: larger than the limit of {MAX_STIMULI_BYTES} bytes")
         if not p.is_file():
             raise StimulusError(f"{p}: not a regular file")
         text = p.read_bytes().decode("utf-8")

@@ -53,7 +53,8 @@ def wheel(tmp_path_factory) -> Path:
 def test_wheel_ships_the_generated_parser_and_the_data(wheel):
     names = set(zipfile.ZipFile(wheel).namelist())
     for needed in ("krl/syntax/generated/KRLParser.py", "krl/syntax/generated/KRLLexer.py",
-                   "krl/syntax/generated/__init__.py", "krl/templates/recovery.html.j2",
+                   "krl/syntax/generated/__init__.py", "krl/templates/_base.html.j2",
+                   "recovery/templates/recovery.html.j2", "conformance/templates/conformance.html.j2",
                    "krl/semantics/data/sysvars.yaml", "interp/basis/bas.src", "robot/data/kr6_r900.yaml"):
         assert needed in names, needed
     assert not any(n.startswith("tests/") for n in names)

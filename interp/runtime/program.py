@@ -7,12 +7,13 @@ for the whole run, so .dat state persists across calls), types (STRUC/ENUM).
 
 Environment:
 
+* the program's files are those of krl.project.project_of (one rule for every command): the
+  KRC backup holding the program (its whole root, ``R1`` and ``STEU``), else every KRL file
+  below the program's folder (or ``--workspace``);
 * outside a KRC backup the project's BASIS (interp/basis: ``$config.dat``, ``bas.src``,
-  ``ir_stopm.src``) is the system folder;
-* inside a backup (a folder with ``R1/System``, or a flat export with a ``System`` folder
-  holding ``$config.dat``) the backup's own System folder is used, and the whole ``R1``
-  tree is the workspace; the backup's ``Mada`` data lists (``$machine.dat``, ...)
-  declare further system variables. Files are read in place, never copied.
+  ``ir_stopm.src``) is the system folder; inside a backup its own System folder is used, and
+  the backup's ``Mada`` data lists (``$machine.dat``, ...) declare further system variables.
+  Files are read in place, never copied.
 
 Resolution order for a name (§2.7): locals/parameters -> the module's data list ->
 globals (``$config.dat``, GLOBAL names of PUBLIC data lists, system data lists) ->
@@ -28,7 +29,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from krl.ast import nodes as N
-from krl.files import walk   # the one folder walk: iterative, links never followed
+from krl.project import project_of   # which files make the program: one rule
 from krl.semantics import types as T
 from krl.semantics.symbols import Scope, fill_struc, make_array, system_scopes
 
@@ -56,7 +57,7 @@ class SyntaxProblem(str):
 
 def parse_module(path: str):
     """(Module AST, list of syntax error strings) of one file, cached per process."""
-    from krl.syntax.source import read_source  # noqa: PLC0415
+    from krl.source import read_source  # noqa: PLC0415
 
     # read once (a FIFO or device is classified, never opened); the key is the hash of the
     # very bytes that are parsed
@@ -66,7 +67,7 @@ def parse_module(path: str):
     if got is not None:
         return got
     from krl.ast.build import build_module  # noqa: PLC0415
-    from krl.semantics.diagnostics import DiagnosticSink  # noqa: PLC0415
+    from krl.diagnostics import DiagnosticSink  # noqa: PLC0415
     from krl.syntax.parse import parse_source  # noqa: PLC0415
     from krl.syntax.messages import syntax_diagnostics  # noqa: PLC0415
 
@@ -80,26 +81,6 @@ def parse_module(path: str):
     got = (mod, errs)
     _PARSE_CACHE[key] = got
     return got
-
-
-def find_backup_root(path: Path, within: Path | None = None) -> tuple[Path, Path] | None:
-    """(workspace root, System folder) if ``path`` lies inside a KRC backup.
-
-    With `within` (the ``--workspace`` folder) only folders inside it, itself included, are
-    looked at: a folder above the workspace that happens to hold ``System/$config.dat`` is
-    never adopted (issue 12)."""
-    ancestors = [path.parent, *path.parent.parents]
-    if within is not None:
-        ancestors = [d for d in ancestors if d == within or within in d.parents]
-    for d in ancestors:
-        if (d / "R1" / "System").is_dir() and ((d / "R1" / "System" / "$config.dat").exists()
-                                               or (d / "R1" / "System" / "$CONFIG.DAT").exists()):
-            return d / "R1", d / "R1" / "System"
-        if d.name.upper() == "R1" and (d / "System").is_dir():
-            return d, d / "System"
-        if (d / "System").is_dir() and any((d / "System" / n).exists() for n in ("$config.dat", "$CONFIG.DAT")):
-            return d, d / "System"
-    return None
 
 
 class ModuleRT:
@@ -124,13 +105,10 @@ class Program:
     def __init__(self, rt, main_path: str | Path, workspace: str | Path | None = None) -> None:
         self.rt = rt
         self.main_path = Path(main_path).resolve()
-        found = find_backup_root(self.main_path, Path(workspace).resolve() if workspace else None)
-        self.backup = found is not None
-        if found is not None:
-            self.workspace, self.system_dir = found
-        else:
-            self.workspace = Path(workspace).resolve() if workspace else self.main_path.parent
-            self.system_dir = BASIS_DIR
+        self.project = project_of(self.main_path, Path(workspace).resolve() if workspace else None)
+        self.backup = self.project.backup
+        self.workspace = self.project.root
+        self.system_dir = self.project.system if self.backup and self.project.system else BASIS_DIR
         system, basis = system_scopes()
         self.types = Scope("global", "$CONFIG", basis)
         self.globals: dict = {}
@@ -154,13 +132,11 @@ class Program:
             entry[kind] = p
 
     def _index_files(self) -> None:
-        if self.backup:
-            for p in sorted(e.path for e in walk(self.workspace) if e.kind == "file"):
-                self._add_file(p)
-        else:
-            for p in sorted(self.workspace.iterdir()):
-                if p.is_file():
-                    self._add_file(p)
+        """The program's files (krl.project.project_of, in walk order; the first file of a
+        module name and kind counts), then, outside a backup, the project's BASIS."""
+        for p in self.project.files:
+            self._add_file(p)
+        if not self.backup:
             for p in sorted(self.system_dir.iterdir()):
                 if p.is_file() and p.stem.upper() not in self.index:
                     self._add_file(p, system=True)
@@ -181,11 +157,9 @@ class Program:
             for k, ref in m.data.items():
                 self.globals.setdefault(k, ref)
         if self.backup:
-            mada = [e.path for e in walk(self.workspace)
-                    if e.kind == "file" and e.path.suffix.lower() == ".dat" and e.path.parent.name.upper() == "MADA"]
-            steu = self.workspace.parent / "STEU" / "Mada"
-            if steu.is_dir():
-                mada += [p for p in steu.iterdir() if p.suffix.lower() == ".dat"]
+            # the machine data lists of the backup (R1/Mada, STEU/Mada): system variables
+            mada = [p for p in self.project.files
+                    if p.suffix.lower() == ".dat" and p.parent.name.upper() == "MADA"]
             for p in sorted(mada):
                 try:
                     self._load_sysdata(p)

@@ -19,7 +19,7 @@ from antlr4 import ParserRuleContext
 from antlr4.tree.Tree import ErrorNode, TerminalNode
 
 from krl.ast import nodes as N
-from krl.semantics.diagnostics import DiagnosticSink
+from krl.diagnostics import DiagnosticSink
 
 _RULE_CACHE: dict[type, tuple[str, str]] = {}
 

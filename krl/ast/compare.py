@@ -21,9 +21,7 @@ __all__ = ["same_tree", "first_difference", "structure"]
 
 
 def _keywords() -> frozenset[str]:
-    from krl.syntax.parse import default_bundle  # noqa: PLC0415
-
-    from krl.fmt.core import keyword_types  # noqa: PLC0415
+    from krl.syntax.parse import default_bundle, keyword_types  # noqa: PLC0415
 
     bundle = default_bundle()
     return frozenset(bundle.symbolic[t].replace("_F", " F") if bundle.symbolic[t] == "BRAKE_F"

@@ -1,5 +1,5 @@
 """`krl fmt [--check] [--diff] [--keyword-case upper|lower|keep] [--indent N|tab] PATHS...`
-(registered by krl/cli.py).
+(registered by krl/cli/__init__.py).
 
 PATHS are KRL files (.src, .dat, .sub) or folders, walked by krl/files.py ``walk`` as
 ``krl check`` walks them: a symbolic link, FIFO, socket or device named like a KRL file and a
@@ -8,13 +8,13 @@ on stderr as a W002 warning naming it (``path:1:1: warning[W002]: not read: a sy
 (never followed)``), as is a folder that cannot be listed. ``-`` alone formats standard input
 to standard output (for editors and hooks). By default each file that would change is
 rewritten in place, atomically (a temporary file in the same folder, then a rename), in the
-encoding it was read in (krl/syntax/source.py: UTF-8 with or without BOM, or Windows-1252,
+encoding it was read in (krl/source.py: UTF-8 with or without BOM, or Windows-1252,
 byte for byte outside the changed whitespace and keyword case). ``--check`` and ``--diff``
 write nothing: they print a unified diff of each file that would change (KRL text shown
 through krl/terminal.py ``printable``); ``--check`` also exits 1 when any file would change.
 
 A file that does not parse is never formatted: its syntax errors are printed in the compiler
-form of ``krl parse`` (krl/semantics/render.py, ``file:line:col: error[E0xx]: ...``) on stderr,
+form of ``krl parse`` (krl/diagnostics/render.py, ``file:line:col: error[E0xx]: ...``) on stderr,
 the file is left untouched, and the exit status is 2. Exit status: 0 nothing to do or
 everything formatted; 1 (``--check`` only) some file would change; 2 some file did not parse
 or could not be read or written, or a folder could not be listed (this wins over 1). Links,
@@ -93,11 +93,11 @@ def run_fmt(paths, check: bool = False, diff: bool = False, options: FormatOptio
             out=None, err=None, colour: bool = False) -> int:
     """The command's body; `out`/`err` are line writers (diffs / diagnostics and the count line).
     Returns the exit status (0, 1 or 2). Never raises for bad input."""
-    from krl.semantics.diagnostics import Diagnostic  # noqa: PLC0415
-    from krl.semantics.render import Renderer, SourceLines  # noqa: PLC0415
-    from krl.syntax.cli import source_diagnostics  # noqa: PLC0415
+    from krl.diagnostics import Diagnostic  # noqa: PLC0415
+    from krl.diagnostics.render import Renderer, SourceLines  # noqa: PLC0415
+    from krl.syntax.messages import source_diagnostics  # noqa: PLC0415
     from krl.syntax.parse import parse_source  # noqa: PLC0415
-    from krl.syntax.source import encode_text, read_limited, read_source  # noqa: PLC0415
+    from krl.source import encode_text, read_limited, read_source  # noqa: PLC0415
     from krl.terminal import printable, printable_path  # noqa: PLC0415
 
     out = out or click.echo
@@ -178,10 +178,10 @@ def run_stdin(data: bytes, check: bool = False, diff: bool = False, options: For
     --diff only the diff is printed. Exit status as :func:`run_fmt`; on a syntax error nothing
     is written to `write` (an editor keeps its buffer) and the diagnostics name ``<stdin>``."""
     from krl.limits import MAX_FILE_BYTES  # noqa: PLC0415
-    from krl.semantics.diagnostics import Diagnostic  # noqa: PLC0415
-    from krl.semantics.render import Renderer, SourceLines  # noqa: PLC0415
-    from krl.syntax.cli import source_diagnostics  # noqa: PLC0415
-    from krl.syntax.source import SourceText, decode_bytes, encode_text  # noqa: PLC0415
+    from krl.diagnostics import Diagnostic  # noqa: PLC0415
+    from krl.diagnostics.render import Renderer, SourceLines  # noqa: PLC0415
+    from krl.syntax.messages import source_diagnostics  # noqa: PLC0415
+    from krl.source import SourceText, decode_bytes, encode_text  # noqa: PLC0415
     from krl.terminal import printable  # noqa: PLC0415
 
     out = out or click.echo
@@ -231,7 +231,7 @@ def fmt(paths: tuple[str, ...], check: bool, diff: bool, keyword_case: str, inde
     inline forms, header lines and line ends are kept. Folders are searched; links, FIFOs and
     folders too deep met there are never read (a W002 warning each). Exit 1 with --check when
     a file would change, 2 when a file does not parse or cannot be read."""
-    from krl.semantics.render import use_colour  # noqa: PLC0415
+    from krl.diagnostics.render import use_colour  # noqa: PLC0415
 
     if indent.lower() == "tab":
         unit = "\t"

@@ -50,7 +50,7 @@ from antlr4 import InputStream, ParserRuleContext
 from antlr4.Token import Token
 from antlr4.tree.Tree import TerminalNode
 
-from krl.syntax.parse import ParseResult, ParserBundle, default_bundle, parse_text
+from krl.syntax.parse import ParseResult, ParserBundle, default_bundle, keyword_types, parse_text
 
 __all__ = ["FormatOptions", "FormatError", "FormatSyntaxError", "FormatSafetyError", "format_text",
            "format_parsed"]
@@ -155,28 +155,6 @@ def _rule_name(ctx) -> str:
     if name.endswith("Context"):
         name = name[:-7]
     return name[:1].lower() + name[1:]
-
-
-def _keyword_types(bundle: ParserBundle) -> frozenset[int]:
-    """Token types of reserved words: those whose lexer rule is a word literal ('IF', 'E6POS')."""
-    out = set()
-    for ttype, sym in enumerate(bundle.symbolic):
-        if ttype == 0 or sym in ("<INVALID>", "HEADER", "FOLD", "ENDFOLD", "COMMENT", "NEWLINE", "WS",
-                                 "IDENTIFIER", "SYSNAME") or sym.endswith("LITERAL"):
-            continue
-        if sym.replace("_", "").isalnum() and sym[:1].isalpha():
-            out.add(ttype)
-    return frozenset(out)
-
-
-_KW_CACHE: dict[int, frozenset[int]] = {}
-
-
-def keyword_types(bundle: ParserBundle) -> frozenset[int]:
-    got = _KW_CACHE.get(id(bundle))
-    if got is None:
-        got = _KW_CACHE[id(bundle)] = _keyword_types(bundle)
-    return got
 
 
 def _roles(tree) -> dict[int, str]:
@@ -294,7 +272,7 @@ def _syntax_error(result: ParseResult, text: str) -> FormatSyntaxError:
 def format_text(text: str, options: FormatOptions | None = None, path: str = "<fmt>") -> str:
     """Format KRL source text (one .src/.sub/.dat file) and return the new text.
 
-    `text` is the decoded file (krl.syntax.source.decode_bytes); a leading U+FEFF (BOM) is
+    `text` is the decoded file (krl.source.decode_bytes); a leading U+FEFF (BOM) is
     kept. `path` names the file in the diagnostics of a FormatSyntaxError. Returns `text`
     itself when nothing changes. Idempotent: ``format_text(format_text(t)) == format_text(t)``.
     The text is parsed once.

@@ -16,7 +16,7 @@ from krl.ast import nodes as N
 from krl.lsp.parsing import Parsed
 from krl.semantics import types as T
 from krl.semantics.checker import Checker, Declarer
-from krl.semantics.diagnostics import Diagnostic, DiagnosticSink
+from krl.diagnostics import Diagnostic, DiagnosticSink
 from krl.semantics.symbols import Scope, Symbol
 from krl.workspace import SourceFile, Workspace
 
@@ -149,7 +149,7 @@ def build_analysis(root: str, parsed: list[Parsed], skipped=()) -> Analysis:
     `skipped`: the krl.files entries not read (links, FIFOs, ...), W002 as in ``krl check``."""
     ws = Workspace(root)
     an = Analysis(root, ws)
-    from krl.semantics.render import split_lines  # noqa: PLC0415
+    from krl.diagnostics.render import split_lines  # noqa: PLC0415
     for p in parsed:
         sf = SourceFile(p.path, p.module, p.ok, p.status)
         ws.files.append(sf)

@@ -9,13 +9,13 @@ from functools import lru_cache
 
 from lsprotocol import types as L
 
+from krl.limits import MAX_LSP_COMPLETIONS
 from krl.lsp.analysis import Analysis
 from krl.lsp.navigate import chain_type
 from krl.lsp.text import line_tokens
 from krl.semantics import types as T
 from krl.semantics.symbols import Scope
 
-MAX_ITEMS = 1000
 _WORD_BEFORE = re.compile(r"[\w$]*$")
 CK = L.CompletionItemKind
 
@@ -64,7 +64,7 @@ def _enum_values(scope: Scope, word: str) -> list[L.CompletionItem]:
     seen: set[str] = set()
     s: Scope | None = scope
     up = word.upper()
-    while s is not None and len(out) < MAX_ITEMS:
+    while s is not None and len(out) < MAX_LSP_COMPLETIONS:
         for typ in s.types.values():
             if isinstance(typ, T.Enum):
                 for v in sorted(typ.values):
@@ -72,7 +72,7 @@ def _enum_values(scope: Scope, word: str) -> list[L.CompletionItem]:
                         seen.add(v)
                         out.append(L.CompletionItem(label=v, kind=CK.EnumMember, detail=typ.name))
         s = s.parent
-    return out[:MAX_ITEMS]
+    return out[:MAX_LSP_COMPLETIONS]
 
 
 def complete(an: Analysis, path: str, line: int, column: int) -> list[L.CompletionItem]:
@@ -109,4 +109,4 @@ def complete(an: Analysis, path: str, line: int, column: int) -> list[L.Completi
         items += [L.CompletionItem(label=k, kind=CK.Keyword) for k in keywords()]
     up = word.upper()
     items = [i for i in items if i.label.upper().startswith(up)]
-    return items[:MAX_ITEMS]
+    return items[:MAX_LSP_COMPLETIONS]

@@ -1,4 +1,4 @@
-"""krl diagnostics (krl/semantics/diagnostics.py, 1-based, characters) as LSP diagnostics
+"""krl diagnostics (krl/diagnostics/__init__.py, 1-based, characters) as LSP diagnostics
 (0-based, code units): same code, same message, severity error/warning, notes as related
 information. A one-character span on a name is widened to the whole name."""
 
@@ -9,7 +9,7 @@ import re
 from lsprotocol import types as L
 
 from krl.lsp.text import to_position
-from krl.semantics.diagnostics import Diagnostic
+from krl.diagnostics import Diagnostic
 
 _NAME = re.compile(r"[\w$#]+")
 

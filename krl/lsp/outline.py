@@ -8,12 +8,12 @@ from dataclasses import dataclass, field
 from lsprotocol import types as L
 
 from krl.ast import nodes as N
+from krl.limits import MAX_LSP_SYMBOLS
 from krl.lsp.analysis import Analysis
 from krl.lsp.folding import fold_sections
 from krl.lsp.text import find_name, to_position, to_range
 
 SK = L.SymbolKind
-MAX_WORKSPACE_SYMBOLS = 500
 
 
 @dataclass
@@ -98,7 +98,7 @@ def document_symbols(an: Analysis, path: str, codec=None) -> list[L.DocumentSymb
 
 def workspace_symbols(analyses: list[Analysis], query: str, uri_of, codec=None) -> list[L.WorkspaceSymbol]:
     """Routines, data-list declarations and FOLD-free top-level names whose name contains
-    `query` (any case); at most MAX_WORKSPACE_SYMBOLS."""
+    `query` (any case); at most MAX_LSP_SYMBOLS."""
     q = query.upper()
     out: list[L.WorkspaceSymbol] = []
     seen: set = set()
@@ -114,6 +114,6 @@ def workspace_symbols(analyses: list[Analysis], query: str, uri_of, codec=None) 
                 loc = L.Location(uri=uri_of(path), range=to_range(fi.lines, it.sel_line, it.sel_col, it.sel_len, codec))
                 out.append(L.WorkspaceSymbol(name=it.name, kind=it.kind, location=loc,
                                              container_name=fi.source.module.name))
-                if len(out) >= MAX_WORKSPACE_SYMBOLS:
+                if len(out) >= MAX_LSP_SYMBOLS:
                     return out
     return out

@@ -24,11 +24,11 @@ from dataclasses import dataclass, field
 from krl.ast import nodes as N
 from krl.ast.build import build_module
 from krl.limits import MAX_FILE_BYTES
-from krl.semantics.diagnostics import Diagnostic, DiagnosticSink
+from krl.diagnostics import Diagnostic, DiagnosticSink
 from krl.syntax.folds import fold_diagnostics
 from krl.syntax.messages import syntax_diagnostics
 from krl.syntax.parse import parse_source, parse_text
-from krl.syntax.source import SourceText
+from krl.source import SourceText
 
 _ROUTINE_START = re.compile(r"^[ \t]*(?:GLOBAL[ \t]+)?DEF(?:FCT)?\b", re.IGNORECASE)
 _WORD = re.compile(r"[A-Za-z_$][A-Za-z0-9_$]*")
@@ -69,7 +69,7 @@ def parse_disk(path: str) -> Parsed:
 
 def _text_of(lf) -> str:
     """The decoded text the editor features work on (load_file keeps only the AST)."""
-    from krl.syntax.source import read_source  # noqa: PLC0415
+    from krl.source import read_source  # noqa: PLC0415
     src = read_source(lf.path)
     return src.text if src.status == "ok" else ""
 

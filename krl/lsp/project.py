@@ -1,7 +1,7 @@
 """Open buffers over disk files, and one checked analysis per workspace root.
 
 The text of an open buffer wins over the file on disk (unsaved changes are what the user sees).
-Files that are not open are read with krl.syntax.source.read_source (the project's one decoding
+Files that are not open are read with krl.source.read_source (the project's one decoding
 function: UTF-8 with or without BOM, else cp1252) and re-read when their size or modification
 time changes (a file changed by another program, a ``git checkout``). Every analysis re-checks
 the whole workspace from the cached parses; only changed buffers and files are parsed again.

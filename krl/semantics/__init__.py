@@ -7,5 +7,5 @@ Entry points (see docs/architecture.md, "Front end"):
   AST annotated.
 * ``krl.ast.nodes.type_of(expr)`` -> :class:`krl.semantics.types.KrlType`;
   ``krl.ast.nodes.symbol_of(name_or_call)`` -> :class:`krl.semantics.symbols.Symbol`.
-* ``krl.semantics.report.check_report(corpus, out_dir)`` -> (data, markdown) for KRC backups.
+* ``krl.survey.report.check_report(corpus, out_dir)`` -> (data, markdown) for KRC backups.
 """

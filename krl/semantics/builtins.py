@@ -1,6 +1,6 @@
 """Built-in types, system variables and routines, loaded from the data tables in
 ``krl/semantics/data`` (types.yaml, sysvars.yaml, functions.yaml from the reference; kss.yaml
-derived from KUKA system files by krl/semantics/derive_tables.py, each entry with its
+derived from KUKA system files by krl/survey/derive_tables.py, each entry with its
 source). Data, not code:
 this module only reads the tables into plain records, once per process.
 

@@ -23,7 +23,7 @@ from __future__ import annotations
 
 from krl.ast import nodes as N
 from krl.semantics import types as T
-from krl.semantics.diagnostics import DiagnosticSink
+from krl.diagnostics import DiagnosticSink
 from krl.semantics.symbols import ParamSig, RoutineSig, Scope, Symbol, make_array
 
 MAX_IDENT = 24

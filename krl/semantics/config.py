@@ -22,10 +22,10 @@ import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from krl.semantics.diagnostics import CODES, Diagnostic
+from krl.diagnostics import CODES, Diagnostic
+from krl.limits import MAX_CONFIG_BYTES
 
 CONFIG_NAME = "krl.toml"
-MAX_CONFIG_BYTES = 64 * 1024
 SEVERITIES = ("error", "warning", "off")
 
 

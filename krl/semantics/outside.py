@@ -27,7 +27,7 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass, field
 
-from krl.semantics.diagnostics import DiagnosticSink, Note
+from krl.diagnostics import DiagnosticSink, Note
 
 # kind -> (error code, warning code, noun)
 KINDS = {

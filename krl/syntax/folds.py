@@ -22,7 +22,7 @@ The scan works on the text alone, statement by statement with the lexer's line e
 first word, in any letter case (``;FOLD``, ``; fold``, ``;EndFold (BASISTECH INI)``), also after
 code on its line (``x = 1 ;FOLD``). Routines are the lines between DEF/DEFFCT/DEFDAT (optionally
 GLOBAL) and END/ENDFCT/ENDDAT. A file that does not parse is scanned all the same. Lines and
-columns are numbered as the parser numbers them (and krl/semantics/render.py ``split_lines``):
+columns are numbered as the parser numbers them (and krl/diagnostics/render.py ``split_lines``):
 a new line after each LF only, so a lone CR ends a comment but not the line's number.
 
 :func:`scan_folds` is the one recogniser of fold markers outside the lexer: ``krl check``'s
@@ -35,7 +35,7 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass, field
 
-from krl.semantics.diagnostics import Diagnostic, Note
+from krl.diagnostics import Diagnostic, Note
 
 _MARKER = re.compile(r";[ \t]*(END)?FOLD(?![A-Za-z0-9_$])", re.I)
 _OPEN = re.compile(r"[ \t\f]*(?:GLOBAL[ \t]+)?(DEF|DEFFCT|DEFDAT)[ \t]+([A-Za-z_$][A-Za-z0-9_$]*)", re.I)
@@ -87,7 +87,7 @@ def _comment_start(line: str) -> int:
 
 
 def _lines(text: str) -> list[str]:
-    from krl.semantics.render import split_lines  # noqa: PLC0415
+    from krl.diagnostics.render import split_lines  # noqa: PLC0415
 
     return split_lines(text)
 
@@ -98,7 +98,7 @@ def scan_folds(text: str) -> FoldScan:
 
 
 def scan_fold_lines(lines: list[str]) -> FoldScan:
-    """:func:`scan_folds` of a text already split as krl/semantics/render.py ``split_lines``
+    """:func:`scan_folds` of a text already split as krl/diagnostics/render.py ``split_lines``
     splits it (the language server's lines)."""
     out = FoldScan()
     routines = out.routines

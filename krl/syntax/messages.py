@@ -20,15 +20,17 @@ E002        any other: ``unexpected `X`; expected a statement, ENDIF or end of l
 
 Lists of alternatives are grouped ("a statement", "an expression", "a name") and hold at most
 six entries; tokens are quoted one by one (never glued as ANTLR's "no viable alternative at
-input 'INTERRUPT5'"). Every message is shorter than :data:`MAX_MESSAGE` characters.
+input 'INTERRUPT5'"). Every message is at most :data:`krl.limits.MAX_MESSAGE_CHARS` characters long.
 """
 
 from __future__ import annotations
 
-from krl.semantics.diagnostics import Diagnostic, Note
+from pathlib import Path
+
+from krl.diagnostics import Diagnostic, Note
+from krl.terminal import clip
 from krl.syntax.blocks import CLOSER, OPENER_OF, MIDDLE, BlockScan, lines_of, scan
 
-MAX_MESSAGE = 160
 MAX_ALTERNATIVES = 6
 
 _STATEMENT = {"ANIN", "ANOUT", "ASYPTP", "BRAKE", "BRAKE_F", "CIRC", "CIRC_REL", "CONFIRM", "CONTINUE",
@@ -141,10 +143,6 @@ def expected_phrase(expected: list[str]) -> str:
     return ", ".join(groups[:-1]) + " or " + groups[-1]
 
 
-def _clip(message: str) -> str:
-    return message if len(message) < MAX_MESSAGE else message[:MAX_MESSAGE - 4] + "..."
-
-
 class _File:
     """The line tokens and block scan of one file, made only when it has syntax errors."""
 
@@ -185,7 +183,7 @@ def syntax_diagnostics(result, text: str, bundle=None) -> list[Diagnostic]:
     if f is not None:
         for b in f.scan.blocks:
             notes = [Note(path, b.note[0], b.note[1], b.note[2])] if b.note else []
-            out.append(Diagnostic(path, b.line, b.column, b.code, _clip(b.message),
+            out.append(Diagnostic(path, b.line, b.column, b.code, clip(b.message),
                                   end_line=b.line if b.end_column else 0, end_column=b.end_column,
                                   notes=notes, help=b.help))
             taken_lines.add(b.closer_line)
@@ -197,7 +195,7 @@ def syntax_diagnostics(result, text: str, bundle=None) -> list[Diagnostic]:
         try:
             d = _describe(path, e, f)
         except Exception:  # noqa: BLE001
-            d = Diagnostic(path, e.line, e.column + 1, "E002", _clip(e.message))
+            d = Diagnostic(path, e.line, e.column + 1, "E002", clip(e.message))
         out.append(d)
     out.sort(key=lambda d: (d.line, d.column))
     return out
@@ -220,7 +218,7 @@ def _describe(path: str, e, f: _File | None) -> Diagnostic:
     end = col + len(tok) if tok not in ("<EOL>", "<EOF>", "") else col + 1
 
     def diag(code: str, message: str, column: int = col, end_column: int = end, help: str = "") -> Diagnostic:
-        return Diagnostic(path, e.line, column, code, _clip(message), end_line=e.line,
+        return Diagnostic(path, e.line, column, code, clip(message), end_line=e.line,
                           end_column=end_column, help=help)
 
     if e.kind == "lexer":
@@ -291,7 +289,7 @@ def _describe(path: str, e, f: _File | None) -> Diagnostic:
         if glued is not None:
             t = line.toks[0]
             return Diagnostic(path, e.line, t.column, "E002",
-                              _clip(f"{q(t.text)} is read as one name; write {q(glued[0] + ' ' + glued[1])}"),
+                              clip(f"{q(t.text)} is read as one name; write {q(glued[0] + ' ' + glued[1])}"),
                               end_line=e.line, end_column=t.column + len(t.text),
                               help=f"KRL needs a space after {glued[0]}")
     # a bare name on its own line: a call without parentheses (withdrawn, grammar/CHANGES.md) or
@@ -300,7 +298,7 @@ def _describe(path: str, e, f: _File | None) -> Diagnostic:
             and line.toks[0].word == "IDENTIFIER"):
         t = line.toks[0]
         return Diagnostic(path, e.line, t.column, "E012",
-                          _clip(f"{q(t.text)} alone is not a statement; to call the routine write {q(t.text + '()')}"),
+                          clip(f"{q(t.text)} alone is not a statement; to call the routine write {q(t.text + '()')}"),
                           end_line=e.line, end_column=t.column + len(t.text),
                           help=f"if it is a note (like TODO), make it a comment: `;{t.text}`")
     # a missing expression
@@ -361,3 +359,27 @@ def _bracket_problem(line, e) -> Diagnostic | None:
         return Diagnostic("", t.line, t.column, "E015",
                           f"this {q(t.text)} is not closed; expected {q(pairs[t.word])} before {_shown_token(e)}")
     return None
+
+
+def file_diagnostics(path: Path, keep_tree: bool = True):
+    """(ParseResult, decoded text, diagnostics) of one file; never raises for bad content.
+    The default parse engine (krl/syntax/engines) parses it; with keep_tree the result has its
+    parse tree (the java engine's is rebuilt from its data, the same tree)."""
+    from krl.syntax.engines import parse_source  # noqa: PLC0415
+    from krl.source import read_source  # noqa: PLC0415
+
+    src = read_source(path)
+    result = parse_source(src, keep_tree=keep_tree)
+    return result, src.text, source_diagnostics(src, result)
+
+
+def source_diagnostics(src, result, worded: list[Diagnostic] | None = None) -> list[Diagnostic]:
+    """The diagnostics `krl parse` prints for a decoded file (SourceText) and its ParseResult:
+    the syntax errors in KRL words (krl/syntax/messages.py; `worded` when the caller already
+    has them for this result), else, when the file was not parsed, one E001 naming why
+    (``file not parsed: binary``, ``... too_large (N bytes > M)``). Never raises."""
+    diags = worded if worded is not None else syntax_diagnostics(result, src.text)
+    if not result.ok and not diags:
+        detail = f" ({src.detail})" if src.detail else ""
+        diags = [Diagnostic(src.path, 1, 1, "E001", f"file not parsed: {result.status}{detail}")]
+    return diags

@@ -25,7 +25,7 @@ from antlr4.error.Errors import ParseCancellationException
 from krl.syntax.checks import may_fail, run_checks
 from krl.syntax.blocks import first_past_limit
 from krl.syntax.errors import CollectingErrorListener, LineErrorStrategy
-from krl.syntax.source import SourceText, read_source
+from krl.source import SourceText, read_source
 
 GENERATED_DIR = Path(__file__).parent / "generated"
 
@@ -128,6 +128,29 @@ def default_bundle() -> ParserBundle:
         from krl.syntax.generated.KRLParser import KRLParser  # noqa: PLC0415
         _default_bundle = ParserBundle(KRLLexer, KRLParser)
     return _default_bundle
+
+
+def _keyword_types(bundle: ParserBundle) -> frozenset[int]:
+    """Token types of reserved words: those whose lexer rule is a word literal ('IF', 'E6POS')."""
+    out = set()
+    for ttype, sym in enumerate(bundle.symbolic):
+        if ttype == 0 or sym in ("<INVALID>", "HEADER", "FOLD", "ENDFOLD", "COMMENT", "NEWLINE", "WS",
+                                 "IDENTIFIER", "SYSNAME") or sym.endswith("LITERAL"):
+            continue
+        if sym.replace("_", "").isalnum() and sym[:1].isalpha():
+            out.add(ttype)
+    return frozenset(out)
+
+
+_KW_CACHE: dict[int, frozenset[int]] = {}
+
+
+def keyword_types(bundle: ParserBundle) -> frozenset[int]:
+    """Token types of the reserved words of `bundle`'s grammar (cached per bundle)."""
+    got = _KW_CACHE.get(id(bundle))
+    if got is None:
+        got = _KW_CACHE[id(bundle)] = _keyword_types(bundle)
+    return got
 
 
 def prepare_text(text: str) -> str:

@@ -213,7 +213,7 @@ def _count_parses_and_reads(monkeypatch) -> dict:
     import krl.fmt.core
     import krl.syntax.engines
     import krl.syntax.parse
-    import krl.syntax.source
+    import krl.source
 
     counts = {"parse": 0, "read": 0}
 
@@ -227,7 +227,7 @@ def _count_parses_and_reads(monkeypatch) -> dict:
     monkeypatch.setattr(krl.syntax.parse, "parse_text", parse_text)
     monkeypatch.setattr(krl.fmt.core, "parse_text", parse_text)
     monkeypatch.setattr(krl.syntax.engines, "parse_sources", counting(krl.syntax.engines.parse_sources, "parse"))
-    monkeypatch.setattr(krl.syntax.source, "read_limited", counting(krl.syntax.source.read_limited, "read"))
+    monkeypatch.setattr(krl.source, "read_limited", counting(krl.source.read_limited, "read"))
     return counts
 
 

@@ -12,9 +12,9 @@ import pytest
 from krl.ast.build import build_module
 from krl.ast.compare import first_difference, same_tree
 from krl.fmt import format_text
-from krl.semantics.diagnostics import DiagnosticSink
+from krl.diagnostics import DiagnosticSink
 from krl.syntax.parse import parse_source, parse_text
-from krl.syntax.source import is_krl_file, read_source
+from krl.source import is_krl_file, read_source
 
 STRIDE = 8
 

@@ -15,8 +15,7 @@ from krl.ast.build import build_module
 from krl.ast.compare import first_difference, same_tree
 from krl.ast.printer import print_module
 from krl.fmt import FormatOptions, format_text
-from krl.fmt.core import keyword_types
-from krl.syntax.parse import default_bundle, parse_text
+from krl.syntax.parse import default_bundle, keyword_types, parse_text
 from tests.budget import examples
 from tests.frontend.strategies import modules
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from krl.ast.build import build_module
 from krl.ast.nodes import Module
-from krl.semantics.diagnostics import DiagnosticSink
+from krl.diagnostics import DiagnosticSink
 from krl.syntax.parse import parse_text
 from krl.workspace import Workspace, check_texts
 

@@ -17,7 +17,7 @@ from click.testing import CliRunner
 
 from krl import limits
 from krl.archive import ArchiveError, backup_source, extract_backup
-from krl.semantics.cli import run_check
+from krl.cli.check import run_check
 
 CONFIG = "DEFDAT $CONFIG\n  DECL INT counter = 0\nENDDAT\n"
 DEMO = ("DEF demo()\n"                    # 1

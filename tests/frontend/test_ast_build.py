@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from krl.ast import nodes as N
 from krl.ast.build import build_module
-from krl.semantics.diagnostics import DiagnosticSink
+from krl.diagnostics import DiagnosticSink
 from krl.syntax.parse import parse_text
 
 from .helpers import ast_of, body_of

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from krl.semantics.cli import run_check
+from krl.cli.check import run_check
 
 DEMO = ("DEF demo()\n"
         "  INT i\n"

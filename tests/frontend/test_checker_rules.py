@@ -113,7 +113,7 @@ def test_declaration_after_statement_E104():
     """2.2: all declarations precede the first statement. The grammar rejects this form
     itself today; the checker also reports E104 for a DeclStmt that a grammar lets through."""
     from krl.semantics.checker import Checker, Declarer, _Ctx
-    from krl.semantics.diagnostics import DiagnosticSink
+    from krl.diagnostics import DiagnosticSink
     from krl.semantics.symbols import Scope, system_scopes
 
     sink = DiagnosticSink()

@@ -14,9 +14,10 @@ from pathlib import Path
 
 import pytest
 
-from krl.semantics.diagnostics import SYNTAX_CODES
-from krl.semantics.report import check_report
-from krl.workspace import find_backups, load_workspace
+from krl.diagnostics import SYNTAX_CODES
+from krl.survey.report import check_report
+from krl.workspace import load_workspace
+from krl.project import find_backups
 
 # (path pattern, code, message pattern, why it is a true error, the lines: file name:line)
 TRUE_ERRORS = [
@@ -120,7 +121,7 @@ def test_no_false_errors(checked, corpus):
     assert used, "no documented true error was found at all"
 
 
-# The cost of checking against parsing is a benchmark, not a test: python -m krl.semantics.bench
+# The cost of checking against parsing is a benchmark, not a test: python -m krl.survey.bench
 
 
 @pytest.mark.corpus

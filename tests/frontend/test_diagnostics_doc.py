@@ -1,6 +1,6 @@
 """docs/diagnostics.md documents every diagnostic code, and its examples are true.
 
-The codes are defined once, in krl/semantics/diagnostics.py (CODES). Each has a ``## CODE``
+The codes are defined once, in krl/diagnostics/__init__.py (CODES). Each has a ``## CODE``
 section in docs/diagnostics.md and the doc has no section for a code that does not exist. The
 ``krl`` blocks of a section form one small program (the info string names the file); the
 checker run on exactly those files must report the section's code. Codes whose trigger is not
@@ -18,8 +18,8 @@ from pathlib import Path
 
 import pytest
 
-from krl.semantics.diagnostics import CODES
-from krl.semantics.cli import run_check
+from krl.diagnostics import CODES
+from krl.cli.check import run_check
 from krl.workspace import check_texts, load_workspace
 
 DOC = Path(__file__).resolve().parents[2] / "docs" / "diagnostics.md"

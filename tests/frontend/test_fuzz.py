@@ -9,7 +9,7 @@ from hypothesis import given, settings, strategies as st
 
 from tests.budget import examples
 
-from krl.semantics.cli import run_check
+from krl.cli.check import run_check
 from krl.workspace import check_texts, load_workspace
 
 from .strategies import modules
@@ -155,7 +155,7 @@ _SAMPLE: list = []
 
 def _sample_files(corpus):
     if not _SAMPLE:
-        from krl.syntax.source import is_krl_file
+        from krl.source import is_krl_file
         files = sorted(p for p in corpus.rglob("*") if p.is_file() and is_krl_file(p)
                        and p.stat().st_size < 20_000)
         _SAMPLE.extend(files[:: max(1, len(files) // 40)])

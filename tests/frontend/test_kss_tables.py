@@ -1,6 +1,6 @@
 """The KSS platform table (krl/semantics/data/kss.yaml): facts with their sources.
 
-The table is derived from KUKA system files of the corpus by krl/semantics/derive_tables.py;
+The table is derived from KUKA system files of the corpus by krl/survey/derive_tables.py;
 these tests check it against the files it names (read in place) and that the checker
 uses it: a backup without $operate.dat still knows KSS system variables and types.
 """
@@ -39,7 +39,7 @@ def test_sources_declare_what_the_table_says(corpus):
 
 @pytest.mark.corpus
 def test_table_is_the_derivation_of_the_corpus(corpus):
-    from krl.semantics.derive_tables import derive, render
+    from krl.survey.derive_tables import derive, render
     assert render(derive(corpus)) == (DATA_DIR / "kss.yaml").read_text(encoding="utf-8")
 
 

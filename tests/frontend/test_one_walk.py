@@ -1,6 +1,6 @@
 """`krl check FOLDER` walks the folder once (krl/files.py `walk`, the one walker) and loads
 what that walk found: backups, the entries of each backup, the files outside the backups and
-the progress bar's count (krl/workspace.py `folder_groups`).
+the progress bar's count (krl/project.py `folder_groups`).
 
 The expected workspaces and diagnostics are derived from the fixtures built here: which
 files each workspace holds (reference 2.7: a backup is one workspace; the files outside are one
@@ -16,8 +16,8 @@ import pytest
 
 import krl.files
 from krl.limits import MAX_FOLDER_DEPTH
-from krl.semantics import cli
-from krl.semantics.cli import run_check
+from krl.cli import check as cli
+from krl.cli.check import run_check
 from tests.deep import deep_chain, remove_bottom_up
 
 CONFIG = "DEFDAT $CONFIG\n  INT gCount = 0\nENDDAT\n"

@@ -10,7 +10,8 @@ from __future__ import annotations
 from pathlib import Path
 
 from krl.semantics.outside import template_lines
-from krl.workspace import find_backups, load_workspace
+from krl.workspace import load_workspace
+from krl.project import find_backups
 
 CONFIG = "DEFDAT $CONFIG\n  DECL INT CELL_NO = 1\nENDDAT\n"
 

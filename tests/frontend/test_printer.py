@@ -8,9 +8,9 @@ from hypothesis import given
 from krl.ast import nodes as N
 from krl.ast.build import build_module
 from krl.ast.printer import expr, print_module
-from krl.semantics.diagnostics import DiagnosticSink
+from krl.diagnostics import DiagnosticSink
 from krl.syntax.parse import parse_text
-from krl.syntax.source import is_krl_file, read_source
+from krl.source import is_krl_file, read_source
 from krl.syntax.parse import parse_source
 
 from .strategies import exprs, modules

@@ -1,6 +1,6 @@
 """Recall of `krl check`: seeded semantic errors in valid programs of the corpus's backups.
 
-krl/semantics/mutants.py inserts one error line into a copy of a valid user program (17 kinds:
+krl/survey/mutants.py inserts one error line into a copy of a valid user program (17 kinds:
 misspelled variable, wrong argument count, REAL into an ENUM, write to $IN, undeclared routine,
 type mismatch in an aggregate, assignment to a CONST, non-BOOL IF/WAIT FOR condition, GOTO to
 a missing label, duplicate declaration, EXIT outside a loop, RETURN value in a procedure,
@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import pytest
 
-from krl.semantics.mutants import EXPECTED, load_programs, mutants
+from krl.survey.mutants import EXPECTED, load_programs, mutants
 
 
 @pytest.fixture(scope="module")

@@ -6,9 +6,10 @@ import json
 
 from click.testing import CliRunner
 
-from krl.semantics.cli import check as check_cmd
-from krl.semantics.report import check_report
-from krl.workspace import find_backups, is_system_path, workspaces_for
+from krl.cli.check import check as check_cmd
+from krl.survey.report import check_report
+from krl.workspace import workspaces_for
+from krl.project import find_backups, is_system_path
 
 
 def make_backup(root, r1="R1", system="System", program="Program"):
@@ -43,14 +44,18 @@ def test_backup_checks_clean_and_pairs_dat(tmp_path):
     assert is_system_path(str(root / "R1" / "System" / "$config.dat"))
 
 
-def test_single_file_takes_its_dat(tmp_path):
+def test_single_file_is_checked_in_its_backup(tmp_path):
+    """krl/project.py rule 3: a file is checked as part of its program (the backup holding it),
+    as krl run runs it; only its own module's diagnostics are reported."""
     root = make_backup(tmp_path)
-    [ws] = workspaces_for(root / "R1" / "Program" / "Cell" / "Job.src")
-    assert len(ws.files) == 2
-    codes = {d.code for d in ws.check()}
-    # XHOME and BAS come from the built-in BASIS data; gCount ($config.dat) and Lib
-    # (another module) are not part of this workspace
-    assert codes == {"E101", "E106"}
+    job = root / "R1" / "Program" / "Cell" / "Job.src"
+    (root / "R1" / "Program" / "broken.src").write_text("DEF broken()\n  x = \nEND\n")
+    [ws] = workspaces_for(job)
+    assert len(ws.files) == 5           # $config.dat, Job.src, JOB.DAT, lib.src, broken.src
+    # gCount ($config.dat) and Lib (another module) are found; broken.src's error is not Job's
+    assert ws.check() == []
+    [ws] = workspaces_for(root / "R1" / "Program" / "broken.src")
+    assert {d.code for d in ws.check()} == {"E012"}     # statement missing a part
 
 
 def test_cli_text_json_and_exit_codes(tmp_path):

@@ -36,7 +36,7 @@ async def references(client, path, line, char, decl=True):
 
 def krl_check_json(folder) -> list[dict]:
     """The diagnostics of main.src as `krl check --format json FOLDER` prints them."""
-    from krl.semantics.cli import run_check
+    from krl.cli.check import run_check
 
     lines: list[str] = []
     run_check([str(folder)], fmt="json", echo=lines.append)

@@ -4,7 +4,7 @@ line before its closer, a FOLD section up to its ;ENDFOLD line)."""
 from __future__ import annotations
 
 from krl.lsp.folding import folding_ranges
-from krl.semantics.render import split_lines
+from krl.diagnostics.render import split_lines
 
 PROGRAM = """DEF blocks( )
   DECL INT i

@@ -13,8 +13,9 @@ import pytest
 from krl.lsp.bench import generate
 from krl.lsp.parsing import MIN_CHUNKED_LINES, ParseCache
 from krl.lsp.project import Project, norm
-from krl.syntax.source import read_source
-from krl.workspace import Workspace, find_backups, load_workspace
+from krl.source import read_source
+from krl.workspace import Workspace, load_workspace
+from krl.project import find_backups
 
 
 def same(path: str, text: str, cache: ParseCache) -> None:

@@ -5,8 +5,9 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from krl.lsp.roots import backup_root, workspace_of
-from krl.workspace import find_backups
+from krl.lsp.roots import workspace_of
+from krl.project import backup_of as backup_root
+from krl.project import find_backups
 
 
 def touch(path: Path, text: str = "") -> Path:
@@ -29,13 +30,15 @@ def test_backup_layouts(tmp_path: Path):
     assert root == krc and sorted(f.name for f in files) == ["$CONFIG.DAT", "$machine.dat", "b.src"]
 
 
-def test_file_outside_backups_takes_its_module_or_its_folder(tmp_path: Path):
+def test_file_outside_backups_takes_its_folder(tmp_path: Path):
+    """krl/project.py rule 3: outside a backup, the files of the program's folder (the
+    editor's folder when one is open), as krl run and krl check FILE read them."""
     a = touch(tmp_path / "proj" / "sub" / "a.src")
     touch(tmp_path / "proj" / "sub" / "A.DAT")
     touch(tmp_path / "proj" / "sub" / "other.src")
     touch(tmp_path / "proj" / "top.src")
-    root, files, _ = workspace_of(a, [])                           # no folder open: the module
-    assert root == a and sorted(f.name for f in files) == ["A.DAT", "a.src"]
+    root, files, _ = workspace_of(a, [])                           # no folder open: its folder
+    assert root == a.parent and sorted(f.name for f in files) == ["A.DAT", "a.src", "other.src"]
     root, files, _ = workspace_of(a, [tmp_path / "proj"])          # the opened folder, no backup in it
     assert root == tmp_path / "proj" and sorted(f.name for f in files) == ["A.DAT", "a.src", "other.src", "top.src"]
     touch(tmp_path / "proj" / "KRC" / "R1" / "System" / "$config.dat")

@@ -11,7 +11,7 @@ from pathlib import Path
 import pytest
 
 from krl.syntax.parse import parse_text
-from krl.syntax.source import read_source
+from krl.source import read_source
 from recovery.scan import scan
 
 VALID = "DEF t()\n  ; Grüße, Maß\n  x = 1\nEND\n"
@@ -115,7 +115,7 @@ def test_bom_followed_by_cp1252_is_not_rejected(tmp_path: Path) -> None:
     src = read_source(p)
     assert (src.encoding, src.text) == ("cp1252+bom", VALID)
     assert parse_text(src.text).ok
-    from krl.syntax.source import encode_text  # noqa: PLC0415 - krl fmt writes the same bytes back
+    from krl.source import encode_text  # noqa: PLC0415 - krl fmt writes the same bytes back
 
     assert encode_text(src.text, src.encoding) == data
 
@@ -128,7 +128,7 @@ def test_central_european_code_page_is_detected(tmp_path: Path) -> None:
     p.write_bytes(text.encode("cp1250"))
     src = read_source(p)
     assert (src.encoding, src.text) == ("cp1250", text)
-    from krl.syntax.source import encode_text  # noqa: PLC0415
+    from krl.source import encode_text  # noqa: PLC0415
 
     assert encode_text(src.text, src.encoding) == text.encode("cp1250")
     # German umlauts are the same bytes in cp1250 and cp1252: named cp1252, the KRL default
@@ -164,7 +164,7 @@ def test_files_csv_records_the_encoding(tmp_path: Path) -> None:
     ("; Привет мир, как дела", "cp1251"),
 ])
 def test_code_page_of_a_comment(text: str, page: str) -> None:
-    from krl.syntax.source import decode_bytes  # noqa: PLC0415
+    from krl.source import decode_bytes  # noqa: PLC0415
 
     data = f"DEF t()\r\n  x = 1 {text}\r\nEND\r\n".encode(page)
     assert decode_bytes(data) == (data.decode(page), page)
@@ -172,7 +172,7 @@ def test_code_page_of_a_comment(text: str, page: str) -> None:
 
 def test_a_byte_undefined_in_cp1252_does_not_switch_to_cyrillic() -> None:
     # 0x81 is undefined in cp1252 and "Ѓ" in cp1251; "café" must stay café, not "cafй".
-    from krl.syntax.source import decode_bytes  # noqa: PLC0415
+    from krl.source import decode_bytes  # noqa: PLC0415
 
     assert decode_bytes(b"x=1 ; caf\xe9 = \x81 kept\n") == ("x=1 ; café = \x81 kept\n", "cp1252")
 
@@ -182,7 +182,7 @@ def test_bytes_past_the_file_limit_are_too_large_whoever_read_them() -> None:
     same size limit as a file read from disk (krl/limits.py MAX_FILE_BYTES)."""
     from krl.limits import MAX_FILE_BYTES
     from krl.syntax.engines import parse_file
-    from krl.syntax.source import source_from_bytes
+    from krl.source import source_from_bytes
 
     big = b"DEF a()\nEND\n" + b";" * MAX_FILE_BYTES
     assert source_from_bytes("big.src", big).status == "too_large"

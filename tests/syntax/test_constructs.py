@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pytest
 
-from krl.syntax.source import is_krl_file
+from krl.source import is_krl_file
 from recovery.validate import CONSTRUCTS, check_example
 
 EXAMPLES = sorted(p for d in CONSTRUCTS.iterdir() if d.is_dir() for p in d.iterdir()

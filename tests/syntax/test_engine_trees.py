@@ -20,7 +20,7 @@ from krl.syntax.engines import java as java_engine
 from krl.syntax.engines import java_answers, parse_file, result_from_answer
 from krl.syntax.engines.tree import RebuiltToken, TreeDataError, tree_from_raw
 from krl.syntax.parse import default_bundle, prepare_text
-from krl.syntax.source import SourceText
+from krl.source import SourceText
 from tests.syntax.test_engines import _java_or_skip, _record, needs_java, tree_shape
 
 TEXT = "DEF a()\nDECL INT x\nx = -(1 + 2) * 3\nIF x > 1 THEN\nx = x - 1\nENDIF\nEND\n"
@@ -119,7 +119,9 @@ def test_a_backup_checks_the_same_through_either_engine(shared_corpus, monkeypat
     the same diagnostics and the same ASTs as the Python engine, and it really ran."""
     _java_or_skip()
     backup = shared_corpus / "rawpython__kukaKRLmagic"
-    entries = workspace_mod.collect_entries(backup)
+    from krl.project import collect_entries  # noqa: PLC0415
+
+    entries = collect_entries(backup)
 
     def load(engine: str):
         monkeypatch.setenv("KRL_ENGINE", engine)

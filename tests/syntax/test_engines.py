@@ -27,7 +27,7 @@ from krl.syntax.engines import EngineUnavailable, parse_file, parse_sources, res
 from krl.syntax.engines import java as java_engine
 from krl.syntax.engines.tree import RebuiltToken
 from krl.syntax.parse import default_bundle, prepare_text
-from krl.syntax.source import SourceText, read_source
+from krl.source import SourceText, read_source
 from recovery.scan import discover
 from tests.budget import examples
 

@@ -108,7 +108,7 @@ def test_check_reports_the_warning_and_it_does_not_stop_the_file():
 
 @pytest.mark.corpus
 def test_real_corpus_fires_only_on_unbalanced_files(shared_corpus):
-    from krl.syntax.source import is_krl_file, read_source
+    from krl.source import is_krl_file, read_source
 
     hits = {}
     for p in sorted(shared_corpus.rglob("*")):

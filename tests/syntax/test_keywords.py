@@ -80,7 +80,7 @@ def test_pulse_is_a_routine_name():
 def test_no_valid_file_declares_a_keyword(shared_corpus):
     """The evidence for the split: no file outside corpus/known-invalid.csv declares a listed
     word (other than PULSE) as a variable or parameter name."""
-    from krl.semantics.report import known_invalid
+    from krl.survey.report import known_invalid
     invalid = known_invalid()
     words = set(KEYWORDS) - {"PULSE"}
     header = re.compile(r"^\s*(?:GLOBAL\s+)?DEF(?:FCT\s+\S+)?\s+\w+\s*\((.*)\)", re.IGNORECASE)

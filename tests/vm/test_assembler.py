@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 
 from interp.vm.assembler import AsmError, assemble, disassemble, parse_const, fmt_const
-from interp.vm.cli import program_assembly
+from interp.asm import program_assembly
 from interp.runtime.values import EnumValue
 
 from .differential import CASES, CORPUS
@@ -108,7 +108,7 @@ def test_every_routine_of_the_shared_corpus_compiles_and_round_trips():
 def test_benchmark_round_trips_with_its_superinstructions():
     """The compute benchmark uses the store-variable and register-style opcodes (operand
     kinds v, y, o, k); its assembly round-trips like any other."""
-    from interp.vm.bench import PROGRAM
+    from interp.bench import PROGRAM
 
     text = program_assembly(PROGRAM, all_modules=False)
     codes = assemble(text)

@@ -6,8 +6,8 @@ import json
 
 from click.testing import CliRunner
 
-from interp.vm.bench import run_krl, run_python
-from krl.bench import bench
+from interp.bench import run_krl, run_python
+from krl.cli.bench import bench
 
 KEYS = {"vm_vs_tree", "tree_stmts_per_s", "vm_stmts_per_s", "sim_realtime_factor", "parse_kb_per_s"}
 

@@ -107,7 +107,7 @@ def run_all(program: Path, runs=RUNS, **kw) -> Outcome:
 
 
 def opcodes_of(program: Path) -> set:
-    from interp.vm.cli import program_assembly
+    from interp.asm import program_assembly
 
     ops = set()
     for ln in program_assembly(program).splitlines():
@@ -335,7 +335,7 @@ def test_programs_use_the_fast_opcodes():
 def test_krl_asm_command_lists_fast_opcodes():
     from click.testing import CliRunner
 
-    from interp.vm.cli import asm
+    from interp.asm import asm
 
     res = CliRunner().invoke(asm, [str(VALUES)])
     assert res.exit_code == 0, res.output

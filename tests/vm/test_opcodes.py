@@ -128,7 +128,7 @@ def check_stack(lst) -> None:
 
 def test_stack_effects_of_compiled_programs():
     from interp.vm.assembler import parse_listings
-    from interp.vm.cli import program_assembly
+    from interp.asm import program_assembly
 
     from .differential import CASES, CORPUS
 

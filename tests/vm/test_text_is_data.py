@@ -94,7 +94,7 @@ def test_the_vm_never_parses_text(tmp_path, monkeypatch):
 def test_krl_asm_round_trips_and_escapes_source_lines(tmp_path, c):
     """`krl asm`: the source line in a comment is shown escaped, on one line, and the text
     assembles back to the same code."""
-    from interp.vm.cli import program_assembly
+    from interp.asm import program_assembly
 
     prog = tmp_path / "prog.src"
     prog.write_bytes(program(c).encode("utf-8"))

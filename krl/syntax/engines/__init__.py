@@ -25,7 +25,7 @@ from pathlib import Path
 
 from krl.syntax.parse import (ParseResult, ParserBundle, default_bundle, parse_source as _py_parse_source,
                               prepare_text, result_from_raw)
-from krl.syntax.source import SourceText
+from krl.source import SourceText
 
 ENGINES = ("auto", "python", "java")
 REPO_GRAMMAR = Path(__file__).resolve().parents[3] / "grammar" / "KRL.g4"
@@ -215,13 +215,13 @@ def parse_source(source: SourceText, bundle: ParserBundle | None = None, keep_tr
 
 def parse_file(data: bytes | str | SourceText, path: str = "<string>", engine: str | None = None,
                bundle: ParserBundle | None = None, keep_tree: bool = False) -> ParseResult:
-    """Parse one file's bytes (decoded as krl/syntax/source.py does), text or SourceText with the
+    """Parse one file's bytes (decoded as krl/source.py does), text or SourceText with the
     chosen engine ("python", "java", "auto"; None: KRL_ENGINE or auto). Returns the same
     ParseResult whatever the engine (with its parse tree when `keep_tree`)."""
     if isinstance(data, SourceText):
         source = data
     elif isinstance(data, bytes):
-        from krl.syntax.source import source_from_bytes  # noqa: PLC0415
+        from krl.source import source_from_bytes  # noqa: PLC0415
 
         source = source_from_bytes(path, data)
     else:

@@ -1,6 +1,6 @@
 """`krl bench`: benchmarks that print ratios and rates measured in the same run.
 
-`krl bench` runs the compute benchmark (interp/vm/bench) on the tree interpreter, on the
+`krl bench` runs the compute benchmark (interp/bench) on the tree interpreter, on the
 VM and as hand-written Python; `krl bench --json` prints one JSON line with every figure
 (compute ratio and rates, simulator real-time factor, parser KB/s), measured in one process.
 
@@ -17,13 +17,13 @@ from pathlib import Path
 
 import click
 
-DEFAULT_CORPUS = Path(__file__).resolve().parents[1].parent / "shared" / "krl-corpus"
+from krl.files import SHARED_CORPUS as DEFAULT_CORPUS
 
 
 def parse_rate(corpus: Path, limit_bytes: int | None = None) -> dict:
     """Parse every KRL file under corpus twice in this process; returns KB/s cold and warm."""
     from krl.syntax.parse import parse_source  # noqa: PLC0415
-    from krl.syntax.source import read_source  # noqa: PLC0415
+    from krl.source import read_source  # noqa: PLC0415
     from recovery.scan import discover  # noqa: PLC0415
 
     sources = []
@@ -50,7 +50,7 @@ def fmt_rate(corpus: Path, limit_bytes: int | None = None) -> dict:
     returns KB/s of both and the ratio of the times, all measured in this process."""
     from krl.fmt import format_text  # noqa: PLC0415
     from krl.syntax.parse import parse_source  # noqa: PLC0415
-    from krl.syntax.source import read_source  # noqa: PLC0415
+    from krl.source import read_source  # noqa: PLC0415
     from recovery.scan import discover  # noqa: PLC0415
 
     sources = []
@@ -77,15 +77,15 @@ def fmt_rate(corpus: Path, limit_bytes: int | None = None) -> dict:
             "fmt_vs_parse": round(fmt_s / parse_s, 2)}
 
 
-EMBEDDED_CORPUS = Path(__file__).resolve().parents[1] / "corpus"
+EMBEDDED_CORPUS = Path(__file__).resolve().parents[2] / "corpus"
 
 
 def all_figures(repeat: int = 3, sim_seconds: float = 60.0, parse_kb: int = 512) -> dict:
     """Every figure of `krl bench --json`, measured in this process: the compute benchmark
-    on both interpreters and in Python (interp/vm/bench), the simulator's real-time factor
+    on both interpreters and in Python (interp/bench), the simulator's real-time factor
     (robot.bench) and the parser's warm rate over ``parse_kb`` KB of the shared corpus (the
     embedded corpus when the shared one is absent)."""
-    from interp.vm.bench import compute  # noqa: PLC0415
+    from interp.bench import compute  # noqa: PLC0415
     from robot.bench import run_bench  # noqa: PLC0415
 
     c = compute(repeat)
@@ -112,13 +112,13 @@ def all_figures(repeat: int = 3, sim_seconds: float = 60.0, parse_kb: int = 512)
 @click.pass_context
 def bench(ctx: click.Context, as_json: bool, repeat: int, sim_seconds: float, parse_kb: int) -> None:
     """Benchmarks (ratios measured in one run). Without a subcommand: the compute benchmark
-    (interp/vm/bench/bench.src) on the tree interpreter, the VM and in Python."""
+    (interp/bench/bench.src) on the tree interpreter, the VM and in Python."""
     if ctx.invoked_subcommand is not None:
         return
     if as_json:
         click.echo(json.dumps(all_figures(repeat, sim_seconds, parse_kb)))
         return
-    from interp.vm.bench import compute  # noqa: PLC0415
+    from interp.bench import compute  # noqa: PLC0415
 
     c = compute(repeat)
     click.echo(f"compute benchmark, {c['steps']} statements and loop iterations, best of {repeat}:")
@@ -134,7 +134,7 @@ def engine_rates(corpus: Path, repeat: int = 3, engines: list[str] | None = None
     interleaved (python, java, python, java, ...), best of `repeat`; one thread each, results
     built in full (the java figure includes the Python side: pre-filters, records, fallbacks)."""
     from krl.syntax.engines import available, parse_sources  # noqa: PLC0415
-    from krl.syntax.source import read_source  # noqa: PLC0415
+    from krl.source import read_source  # noqa: PLC0415
     from recovery.scan import discover  # noqa: PLC0415
 
     sources = [s for s in (read_source(p) for p in discover(corpus)) if s.status == "ok"]

@@ -1,6 +1,6 @@
 """Checking cost against parsing cost over the KRC backups of a corpus, measured in one run.
 
-``python -m krl.semantics.bench [CORPUS]`` loads and checks every backup of CORPUS (default
+``python -m krl.survey.bench [CORPUS]`` loads and checks every backup of CORPUS (default
 ../shared/krl-corpus) in this process and prints one JSON line:
 ``{"backups": n, "parse_s": ..., "check_s": ..., "check_vs_parse": check_s / parse_s}``.
 The goal is ``check_vs_parse`` well under 1 (checking costs less than parsing). A benchmark,
@@ -13,12 +13,13 @@ import json
 import sys
 from pathlib import Path
 
-DEFAULT_CORPUS = Path(__file__).resolve().parents[2].parent / "shared" / "krl-corpus"
+from krl.files import SHARED_CORPUS as DEFAULT_CORPUS
 
 
 def measure(corpus: Path) -> dict:
     """Parse and check every backup of ``corpus``; seconds of each phase and their ratio."""
-    from krl.workspace import find_backups, load_workspace  # noqa: PLC0415
+    from krl.workspace import load_workspace  # noqa: PLC0415
+    from krl.project import find_backups  # noqa: PLC0415
 
     parse_s = check_s = 0.0
     backups = find_backups(corpus)

@@ -15,7 +15,7 @@ def program_assembly(program: Path, workspace: Path | None = None, all_modules: 
 
     from krl.terminal import printable  # noqa: PLC0415
 
-    from .compiler import compile_module  # noqa: PLC0415
+    from interp.vm.compiler import compile_module  # noqa: PLC0415
 
     rt, _ = make_runtime(program, workspace=workspace, mujoco=False, interp="vm")
     prog = rt.program

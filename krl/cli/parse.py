@@ -1,9 +1,9 @@
-"""`krl parse FILE...`: syntax-check files and print their syntax errors (registered by krl/cli.py).
+"""`krl parse FILE...`: syntax-check files and print their syntax errors (registered by krl/cli/__init__.py).
 
-Formats (``--format``): ``text`` (compiler style, krl/semantics/render.py: location, code, message,
+Formats (``--format``): ``text`` (compiler style, krl/diagnostics/render.py: location, code, message,
 source line, caret; a closing count line), ``json`` (one object per file: path, ok, encoding,
 status, ``diagnostics`` in the shared model and the parser's raw ``errors`` with 1-based columns,
-for grammar work) and ``sarif`` (SARIF 2.1.0, krl/semantics/sarif.py). ``--outline`` prints the
+for grammar work) and ``sarif`` (SARIF 2.1.0, krl/diagnostics/sarif.py). ``--outline`` prints the
 symbols (routines, declarations) of each file that parses; ``--tree`` the grammar-rule outline.
 Exit 0 when every file parses, 1 otherwise; never a traceback for bad input.
 """
@@ -14,33 +14,11 @@ import json
 import sys
 from pathlib import Path
 
-from krl.semantics.diagnostics import Diagnostic
+import click
 
-
-def file_diagnostics(path: Path, keep_tree: bool = True):
-    """(ParseResult, decoded text, diagnostics) of one file; never raises for bad content.
-    The default parse engine (krl/syntax/engines) parses it; with keep_tree the result has its
-    parse tree (the java engine's is rebuilt from its data, the same tree)."""
-    from krl.syntax.engines import parse_source  # noqa: PLC0415
-    from krl.syntax.source import read_source  # noqa: PLC0415
-
-    src = read_source(path)
-    result = parse_source(src, keep_tree=keep_tree)
-    return result, src.text, source_diagnostics(src, result)
-
-
-def source_diagnostics(src, result, worded: list[Diagnostic] | None = None) -> list[Diagnostic]:
-    """The diagnostics `krl parse` prints for a decoded file (SourceText) and its ParseResult:
-    the syntax errors in KRL words (krl/syntax/messages.py; `worded` when the caller already
-    has them for this result), else, when the file was not parsed, one E001 naming why
-    (``file not parsed: binary``, ``... too_large (N bytes > M)``). Never raises."""
-    from krl.syntax.messages import syntax_diagnostics  # noqa: PLC0415
-
-    diags = worded if worded is not None else syntax_diagnostics(result, src.text)
-    if not result.ok and not diags:
-        detail = f" ({src.detail})" if src.detail else ""
-        diags = [Diagnostic(src.path, 1, 1, "E001", f"file not parsed: {result.status}{detail}")]
-    return diags
+from krl.diagnostics import Diagnostic
+from krl.limits import PARSE_TIMEOUT_S
+from krl.syntax.messages import file_diagnostics
 
 
 def parse_job(path: str, outline: bool, tree: bool):
@@ -54,7 +32,7 @@ def parse_job(path: str, outline: bool, tree: bool):
             entries = list(tree_outline(result.tree))
         else:
             from krl.ast.build import build_module  # noqa: PLC0415
-            from krl.syntax.outline import symbol_outline  # noqa: PLC0415
+            from krl.ast.outline import symbol_outline  # noqa: PLC0415
             entries = list(symbol_outline(build_module(result)))
     result.tree = None
     return result, text, diags, entries
@@ -98,7 +76,7 @@ def run_parse(files, fmt: str = "text", outline: bool = False, tree: bool = Fals
     that is killed past it, and the file gets error E005 while the others are still parsed
     (None: parse here, without a limit; the command passes krl.limits.PARSE_TIMEOUT_S).
     """
-    from krl.semantics.render import Renderer, SourceLines  # noqa: PLC0415
+    from krl.diagnostics.render import Renderer, SourceLines  # noqa: PLC0415
     from krl.terminal import printable, printable_path  # noqa: PLC0415
 
     files = list(files)
@@ -134,7 +112,7 @@ def run_parse(files, fmt: str = "text", outline: bool = False, tree: bool = Fals
             for entry in entries:
                 echo(f"{printable_path(path)}:{printable(entry)}")
     if fmt == "sarif":
-        from krl.semantics.sarif import to_sarif  # noqa: PLC0415
+        from krl.diagnostics.sarif import to_sarif  # noqa: PLC0415
         echo(json.dumps(to_sarif(all_diags), indent=2))
     elif fmt == "text":
         echo(renderer.summary(len(files)))
@@ -142,14 +120,35 @@ def run_parse(files, fmt: str = "text", outline: bool = False, tree: bool = Fals
 
 
 def main_status(files, fmt, as_json, outline, tree, timeout=None, jobs=None, engine: str | None = None) -> int:
-    """The `parse` command's body (krl/cli.py keeps only the options)."""
+    """The `parse` command's body (krl/cli/__init__.py keeps only the options)."""
     from krl.syntax.engines import use_engine  # noqa: PLC0415
 
     use_engine(engine)
-    from krl.semantics.render import use_colour  # noqa: PLC0415
-
-    import click  # noqa: PLC0415
+    from krl.diagnostics.render import use_colour  # noqa: PLC0415
 
     fmt = "json" if as_json else fmt
     return run_parse(files, fmt, outline, tree, click.echo, use_colour(sys.stdout) and fmt == "text",
                      timeout=timeout, jobs=jobs)
+
+
+@click.command()
+@click.argument("files", nargs=-1, required=True, type=click.Path(path_type=Path))
+@click.option("--format", "fmt", type=click.Choice(["text", "json", "sarif"]), default="text",
+              show_default=True, help="text: compiler style; json: one object per file; sarif: SARIF 2.1.0.")
+@click.option("--json", "as_json", is_flag=True, help="Same as --format json.")
+@click.option("--outline", is_flag=True, help="Print the routines and declarations of each file that parses.")
+@click.option("--tree", is_flag=True, help="Print the grammar-rule outline of each file that parses.")
+@click.option("--engine", type=click.Choice(["auto", "python", "java"]), default=None,
+              help="Parse engine: java (fast; needs a JDK), python (the reference), auto: "
+                   "java when available (default: $KRL_ENGINE, else auto).")
+@click.option("--timeout", type=click.FloatRange(min=0, min_open=True), default=PARSE_TIMEOUT_S,
+              show_default=True, help="Seconds one file may parse; past it the parse is stopped (error E005).")
+@click.option("--jobs", type=click.IntRange(min=1), default=None,
+              help="Worker processes (default: the number of cores).")
+def parse(files: tuple[Path, ...], fmt: str, as_json: bool, outline: bool, tree: bool, timeout: float,
+          jobs: int | None, engine: str | None) -> None:
+    """Parse FILES; exit 0 when every file parses."""
+    sys.exit(main_status(files, fmt, as_json, outline, tree, timeout, jobs, engine))
+
+
+commands = [parse]

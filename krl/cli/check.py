@@ -1,10 +1,10 @@
-"""`krl check PATH... [--json]`: the front end's command (registered by krl/cli.py).
+"""`krl check PATH... [--json]`: the front end's command (registered by krl/cli/__init__.py).
 
 PATH is a file (checked with the .src/.dat of its module), a KRC backup folder (one
 workspace), a folder holding backups (one workspace per backup) or plain files (one
 workspace), or a backup archive (.zip, checked as the folder it holds: krl/archive.py; a
 refused archive is error E004; paths are shown as ``backup.zip/KRC/R1/...``). Output (``--format``): compiler-style text (``path:line:col: error[CODE]: message``,
-the source line and a caret, krl/semantics/render.py, then a count line), one JSON object per
+the source line and a caret, krl/diagnostics/render.py, then a count line), one JSON object per
 workspace, or SARIF 2.1.0. ``--ignore CODE`` and the workspace's ``krl.toml`` select codes and
 severities (krl/semantics/config.py). Exit 1 when there are errors, 0 otherwise, 2 for a bad
 configuration or an internal failure; never a Python traceback for bad input.
@@ -38,7 +38,7 @@ def check(paths: tuple[str, ...], fmt: str, as_json: bool, no_warnings: bool, ig
     """Type-check KRL files, KRC backup folders or backup .zip archives; exit 1 when there are
     errors. Every code is explained in docs/diagnostics.md."""
     if report_dir is not None:
-        from krl.semantics.report import check_report  # noqa: PLC0415
+        from krl.survey.report import check_report  # noqa: PLC0415
         try:
             for path in paths:
                 _data, md = check_report(path, report_dir, timeout=timeout, jobs=jobs)
@@ -47,7 +47,7 @@ def check(paths: tuple[str, ...], fmt: str, as_json: bool, no_warnings: bool, ig
             click.echo(f"krl check: internal error: {type(exc).__name__}: {exc}")
             sys.exit(2)
         sys.exit(0)
-    from krl.semantics.render import use_colour  # noqa: PLC0415
+    from krl.diagnostics.render import use_colour  # noqa: PLC0415
 
     fmt = "json" if as_json else fmt
     status = run_check(list(paths), no_warnings=no_warnings, echo=click.echo, fmt=fmt,
@@ -67,9 +67,9 @@ def run_check(paths: list[str], as_json: bool = False, no_warnings: bool = False
     (errors), 2 (bad configuration or internal failure)."""
     from krl.archive import ArchiveError, backup_source  # noqa: PLC0415
     from krl.semantics.config import ConfigError, Selection, config_for, parse_codes  # noqa: PLC0415
-    from krl.semantics.diagnostics import Diagnostic  # noqa: PLC0415
-    from krl.syntax.source import read_source  # noqa: PLC0415
-    from krl.semantics.render import Renderer  # noqa: PLC0415
+    from krl.diagnostics import Diagnostic  # noqa: PLC0415
+    from krl.source import read_source  # noqa: PLC0415
+    from krl.diagnostics.render import Renderer  # noqa: PLC0415
     from krl.terminal import printable  # noqa: PLC0415
 
     fmt = "json" if as_json else fmt
@@ -127,7 +127,7 @@ def run_check(paths: list[str], as_json: bool = False, no_warnings: bool = False
         echo(f"krl check: internal error: {type(exc).__name__}: {printable(exc)}")
         return 2
     if fmt == "sarif":
-        from krl.semantics.sarif import to_sarif  # noqa: PLC0415
+        from krl.diagnostics.sarif import to_sarif  # noqa: PLC0415
         echo(json.dumps(to_sarif(all_shown), indent=2))
     elif fmt == "text":
         echo(renderer.summary(files))
@@ -140,7 +140,8 @@ def _loaded(path, timeout: float | None = None, jobs: int | None = None) -> list
     redirected, nothing is shown, so the output is the same either way."""
     from pathlib import Path  # noqa: PLC0415
 
-    from krl.workspace import folder_groups, on_each_file, workspaces_for  # noqa: PLC0415
+    from krl.workspace import on_each_file, workspaces_for  # noqa: PLC0415
+    from krl.project import folder_groups  # noqa: PLC0415
 
     if not _progress_shown():
         return workspaces_for(path, timeout=timeout, jobs=jobs)

@@ -14,7 +14,7 @@ import json
 from collections import Counter
 from pathlib import Path
 
-from krl.semantics.diagnostics import CODES
+from krl.diagnostics import CODES
 
 
 def check_report(corpus: str | Path, out_dir: str | Path | None = None, top: int = 15,
@@ -23,7 +23,7 @@ def check_report(corpus: str | Path, out_dir: str | Path | None = None, top: int
     writes check_report.json and check_report.md there. `timeout`, `jobs`: files are parsed
     in that many worker processes, each file stopped past `timeout` seconds (see
     krl.workspace.load_workspace; None: in this process). Never raises for bad input files."""
-    from krl.workspace import find_backups  # noqa: PLC0415
+    from krl.project import find_backups  # noqa: PLC0415
 
     corpus = Path(corpus)
     backups = find_backups(corpus) if corpus.exists() else []
@@ -71,7 +71,8 @@ BATCH_BYTES = 512 * 1024
 
 def _loaded_backups(backups: list[Path], timeout: float | None, jobs: int | None):
     """(backup, its loaded Workspace) for each backup, in order, loaded in batches."""
-    from krl.workspace import collect_entries, load_workspaces  # noqa: PLC0415
+    from krl.workspace import load_workspaces  # noqa: PLC0415
+    from krl.project import collect_entries  # noqa: PLC0415
 
     batch: list[tuple[Path, list]] = []
     size = 0
@@ -144,8 +145,9 @@ def measure(corpus: str | Path) -> dict:
     warnings by code on files that are not in corpus/known-invalid.csv ("valid") and on the
     listed ones ("known_invalid"), and the error lines on valid files (path:line CODE message,
     paths relative to `corpus`). The figure of issue 14; reproducible with
-    ``python -m krl.semantics.report ../shared/krl-corpus``."""
-    from krl.workspace import find_backups, load_workspace  # noqa: PLC0415
+    ``python -m krl.survey.report ../shared/krl-corpus``."""
+    from krl.workspace import load_workspace  # noqa: PLC0415
+    from krl.project import find_backups  # noqa: PLC0415
 
     corpus = Path(corpus).resolve()
     invalid = known_invalid()
@@ -170,7 +172,7 @@ def main(argv: list[str]) -> int:
     from krl.terminal import printable  # noqa: PLC0415
 
     if len(argv) != 1 or not Path(argv[0]).is_dir():
-        print("usage: python -m krl.semantics.report CORPUS_FOLDER", file=sys.stderr)
+        print("usage: python -m krl.survey.report CORPUS_FOLDER", file=sys.stderr)
         return 2
     m = measure(argv[0])
     print(f"{m['backups']} KRC backups")

@@ -14,7 +14,7 @@ from pathlib import Path, PurePath
 from urllib.parse import quote
 
 from krl import __version__
-from krl.semantics.diagnostics import CODES, Diagnostic
+from krl.diagnostics import CODES, Diagnostic
 
 SCHEMA = "https://json.schemastore.org/sarif-2.1.0.json"
 DOCS = "docs/diagnostics.md"

@@ -37,7 +37,7 @@ are presumed declared by installed software). Every choice comes from ``random.R
 over sorted candidates: the same corpus and seed give the same mutants.
 
 A mutant is **found** when the checker reports an error with the expected code at the
-inserted line of the mutated file. ``python -m krl.semantics.mutants ../shared/krl-corpus``
+inserted line of the mutated file. ``python -m krl.survey.mutants ../shared/krl-corpus``
 prints the recall; tests/frontend/test_seeded_errors.py requires every mutant to be found.
 """
 
@@ -52,10 +52,11 @@ from krl.ast import nodes as N
 from krl.semantics import types as T
 from krl.semantics.builtins import load_builtins
 from krl.semantics.outside import template_lines
-from krl.semantics.report import known_invalid
+from krl.survey.report import known_invalid
 from krl.semantics.symbols import Symbol
-from krl.syntax.source import read_source
-from krl.workspace import SourceFile, Workspace, find_backups, is_system_path, load_workspace
+from krl.source import read_source
+from krl.workspace import SourceFile, Workspace, load_workspace
+from krl.project import find_backups, is_system_path
 
 KINDS = ("misspelled_variable", "wrong_argument_count", "real_into_enum", "write_to_input",
          "undeclared_routine", "aggregate_type_mismatch", "assignment_to_const",
@@ -380,7 +381,7 @@ def judge(m: Mutant, p: _Program) -> None:
 def main(argv: list[str]) -> int:
     from krl.terminal import printable  # noqa: PLC0415
     if not argv or not Path(argv[0]).is_dir():
-        print("usage: python -m krl.semantics.mutants CORPUS_FOLDER [PER_KIND]", file=sys.stderr)
+        print("usage: python -m krl.survey.mutants CORPUS_FOLDER [PER_KIND]", file=sys.stderr)
         return 2
     ms = mutants(argv[0], int(argv[1]) if len(argv) > 1 else 6)
     found = sum(m.found for m in ms)

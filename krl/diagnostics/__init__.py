@@ -1,7 +1,7 @@
 """Compiler-style diagnostics with stable codes: the one model that `krl parse`, `krl check`,
 the language server and SARIF output share.
 
-Text form (krl/semantics/render.py): ``path:line:col: error[CODE]: message``, then the source line
+Text form (krl/diagnostics/render.py): ``path:line:col: error[CODE]: message``, then the source line
 and a caret under the span. JSON form: :meth:`Diagnostic.as_json`. Lines and columns are 1-based
 everywhere (columns count characters, a tab is one column).
 
@@ -149,7 +149,7 @@ class Diagnostic:
 
     def format(self) -> str:
         """The first line of the text form: `path:line:col: severity[CODE]: message` (raw text;
-        krl/semantics/render.py makes it safe for a terminal)."""
+        krl/diagnostics/render.py makes it safe for a terminal)."""
         return f"{self.path}:{self.line}:{self.column}: {self.severity}[{self.code}]: {self.message}"
 
     __str__ = format

@@ -27,11 +27,10 @@ import re
 from collections.abc import Callable, Iterable
 from pathlib import Path
 
-from krl.semantics.diagnostics import Diagnostic
+from krl.diagnostics import Diagnostic
+from krl.limits import MAX_MESSAGE_CHARS
 from krl.terminal import printable, printable_path
 
-# The widest part of a source line shown around the caret, in characters.
-MAX_SHOWN = 160
 TAB = "    "
 
 _WORD = re.compile(r"[A-Za-z0-9_$#]+|\S")
@@ -74,7 +73,7 @@ class SourceLines:
 
     @staticmethod
     def _read(path: str) -> list[str] | None:
-        from krl.syntax.source import read_source  # noqa: PLC0415
+        from krl.source import read_source  # noqa: PLC0415
 
         # never through a link (a linked file is not quoted) and never a FIFO/device (not opened)
         src = read_source(path, follow_symlinks=False)
@@ -102,14 +101,14 @@ def snippet(line_text: str, column: int, end_column: int | None) -> tuple[str, s
     end_column = min(end_column, max(len(line_text) + 1, col + 1))
     before, span, after = line_text[:col - 1], line_text[col - 1:end_column - 1], line_text[end_column - 1:]
     lead = ""
-    if len(before) > MAX_SHOWN // 2:
-        before, lead = before[-(MAX_SHOWN // 2):], "..."
-    if len(span) > MAX_SHOWN:
-        span = span[:MAX_SHOWN]
+    if len(before) > MAX_MESSAGE_CHARS // 2:
+        before, lead = before[-(MAX_MESSAGE_CHARS // 2):], "..."
+    if len(span) > MAX_MESSAGE_CHARS:
+        span = span[:MAX_MESSAGE_CHARS]
         after = ""
     tail = ""
-    if len(after) > MAX_SHOWN // 2:
-        after, tail = after[:MAX_SHOWN // 2], "..."
+    if len(after) > MAX_MESSAGE_CHARS // 2:
+        after, tail = after[:MAX_MESSAGE_CHARS // 2], "..."
     b, s = lead + _shown(before), _shown(span) or " "
     return b + s + _shown(after) + tail, " " * len(b) + "^" + "~" * (len(s) - 1)
 

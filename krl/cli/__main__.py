@@ -1,0 +1,5 @@
+"""`python -m krl.cli`: the `krl` command."""
+
+from krl.cli import main
+
+main()

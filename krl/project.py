@@ -1,0 +1,290 @@
+"""The project model: which KRC backup a path belongs to, and which files make a program.
+
+One rule, used by ``krl check``, ``krl run``, ``krl asm``, ``krl lsp``, ``krl fmt`` and the
+static check of ``krl recover`` (docs/architecture.md, "Project model"):
+
+1. **A backup.** A folder *B* is the *base* of a KRC backup when ``B/System/$config.dat`` is a
+   regular file (folder and file names in any letter case; links are never followed). The
+   backup's *root* is the folder holding *B* when *B* is named ``R1`` (``KRC/R1/System``: the
+   root is ``KRC``, so ``KRC/STEU`` belongs to it), else *B* itself (a flat export of R1).
+2. **The backup of a path** is the *outermost* backup root among the path's folders: a backup
+   inside another one is part of it. With ``within`` (``krl run --workspace DIR``), only folders
+   inside ``DIR`` (``DIR`` included) count, so a folder above it is never adopted.
+3. **A program's files** (:func:`project_of`): in a backup, every KRL file (``.src``, ``.dat``,
+   ``.sub``, any case) below its root; outside one, every KRL file below the program's folder
+   (``within``, else the folder holding the program). Folders are walked by
+   :func:`krl.files.walk` (iterative; links, FIFOs, unreadable and too deep folders are listed,
+   never read: warning W002), in its order (the files of a folder before its sub-folders,
+   names sorted), which decides which of two declarations comes first. A run outside a backup
+   adds the project's own BASIS (``interp/basis``) after them, as its System folder.
+4. **A folder given to ``krl check`` or ``krl recover``** (:func:`folder_groups`) is split by
+   the same rule, from one walk: one program per backup below it, then one per top-level folder
+   for the files outside every backup (a folder without backups is one program).
+
+:func:`find_backups` lists the backup roots below a folder; :func:`backup_of` answers rule 2.
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from krl import files as _files   # the one folder walk (called through the module: tests count its calls)
+from krl.files import Entry
+from krl.limits import MAX_FOLDER_DEPTH
+from krl.source import is_krl_file
+
+__all__ = ["Project", "backup_of", "collect_entries", "collect_files", "find_backups",
+           "folder_groups", "is_system_path", "project_of", "system_folder"]
+
+SYSTEM_DIRS = ("system", "tp", "mada", "steu")
+
+
+@dataclass
+class Project:
+    """The files of one program (rule 3). ``root``: the backup root or the folder; ``backup``:
+    True inside a KRC backup; ``system``: the backup's System folder (None outside a backup);
+    ``entries``: the walk of ``root`` (:class:`krl.files.Entry`: files, and the entries not read)."""
+    root: Path
+    backup: bool
+    system: Path | None
+    entries: list[Entry] = field(default_factory=list)
+
+    @property
+    def files(self) -> list[Path]:
+        """The regular KRL files, in walk order."""
+        return [e.path for e in self.entries if e.kind == "file"]
+
+
+def _child(folder: Path, name: str) -> Path | None:
+    """The entry of `folder` named `name` in any letter case (not followed if a link)."""
+    try:
+        with os.scandir(folder) as it:
+            for e in it:
+                if e.name.lower() == name:
+                    return Path(e.path)
+    except OSError:
+        return None
+    return None
+
+
+def _is_base(folder: Path) -> bool:
+    """Rule 1: `folder` holds ``System/$config.dat`` (any case, no links)."""
+    system = _child(folder, "system")
+    if system is None or system.is_symlink() or not system.is_dir():
+        return False
+    config = _child(system, "$config.dat")
+    return config is not None and not config.is_symlink() and config.is_file()
+
+
+def _root_of_base(base: Path) -> Path:
+    return base.parent if base.name.lower() == "r1" else base
+
+
+def backup_of(path: str | Path, within: str | Path | None = None) -> Path | None:
+    """Rule 2: the root of the outermost KRC backup holding `path` (a file or folder), else
+    None. With `within`, only folders inside it (itself included) are looked at."""
+    path = Path(path)
+    folders = [path, *path.parents] if path.is_dir() and not path.is_symlink() else list(path.parents)
+    if within is not None:
+        w = Path(within)
+        folders = [d for d in folders if d == w or w in d.parents]
+    found = None
+    for d in folders:
+        if _is_base(d):
+            root = _root_of_base(d)
+            if within is None or root == Path(within) or Path(within) in root.parents:
+                found = root
+            else:
+                found = d
+        else:
+            r1 = _child(d, "r1")       # a file beside R1 (STEU/, KRC/): the backup holding R1
+            if r1 is not None and r1.is_dir() and not r1.is_symlink() and _is_base(r1):
+                found = d
+    return found
+
+
+def system_folder(root: Path) -> Path | None:
+    """The System folder of the backup rooted at `root` (``R1/System`` or ``System``)."""
+    r1 = _child(root, "r1")
+    for base in ([r1] if r1 is not None else []) + [root]:
+        if _is_base(base):
+            return _child(base, "system")
+    return None
+
+
+def project_of(path: str | Path, within: str | Path | None = None, limit: int | None = None,
+               max_entries: int | None = None) -> Project:
+    """Rule 3: the program of the file `path` (``krl run``, ``krl check FILE``, the language
+    server's open file). `within`: the folder the caller names (``--workspace``, the editor's
+    folder). `limit`, `max_entries`: stop the walk after that many KRL files / entries looked
+    at (the language server's bounds, krl.limits.MAX_LSP_*). `path` itself is always among
+    the files (it may be an unsaved editor buffer)."""
+    path = Path(path)
+    root = backup_of(path, within)
+    if root is not None:
+        project = Project(root, True, system_folder(root))
+    else:
+        folder = Path(within) if within is not None else path.parent
+        project = Project(folder, False, None)
+    entries = list_entries(project.root, limit, max_entries)
+    if root is None and any(e.kind == "file" and e.path.name.lower() == "$config.dat"
+                            and e.path.parent.name.lower() == "system" for e in entries):
+        # rule 4: the folder holds backups; a file outside them belongs to its top-level group
+        try:
+            rel = path.relative_to(project.root)
+        except ValueError:
+            rel = Path(path.name)
+        if len(rel.parts) > 1:
+            project.root = project.root / rel.parts[0]
+            entries = [e for e in entries if e.rel.split("/")[0] == rel.parts[0] and "/" in e.rel]
+        else:
+            entries = [e for e in entries if "/" not in e.rel]
+    project.entries = entries
+    if path not in project.files:
+        project.entries.append(Entry(path, path.name, "file"))
+    return project
+
+
+class _Budget(Exception):
+    """The walk looked at `max_entries` entries."""
+
+
+def list_entries(folder: Path, limit: int | None = None, max_entries: int | None = None) -> list[Entry]:
+    """The KRL entries below `folder` in walk order (krl.files.walk), up to `limit` KRL files,
+    looking at no more than `max_entries` entries (None: no bound)."""
+    if limit is None and max_entries is None:
+        return collect_entries(folder)
+    seen = 0
+
+    def match(name: str) -> bool:
+        nonlocal seen
+        seen += 1
+        if max_entries is not None and seen > max_entries:
+            raise _Budget
+        return is_krl_file(Path(name))
+
+    out: list[Entry] = []
+    files = 0
+    try:
+        for e in _files.walk(folder, match=match):
+            out.append(e)
+            files += e.kind == "file"
+            if limit is not None and files >= limit:
+                break
+    except _Budget:
+        pass
+    return out
+
+
+def is_system_path(path: str) -> bool:
+    """True for KUKA system files of a backup (folders System, TP, Mada, STEU, or a $-file):
+    they rely on $operate.dat declarations that a backup never contains (see W101/W105/W106)."""
+    parts = Path(path).parts
+    return Path(path).name.startswith("$") or any(p.lower() in SYSTEM_DIRS for p in parts[:-1])
+
+
+def find_backups(root: str | Path) -> list[Path]:
+    """The backup roots below `root` (rule 1 and 2: a backup inside another is part of it),
+    sorted. The walk is krl.files.walk: iterative, links never followed."""
+    root = Path(root)
+    if not root.is_dir():
+        return []
+    return _backups_in(_files.walk(root, match=lambda n: n.lower() == "$config.dat"))
+
+
+def _backups_in(entries) -> list[Path]:
+    """:func:`find_backups` from the entries of a walk (krl.files.walk) of the folder: its
+    regular files named $config.dat in folders at most MAX_FOLDER_DEPTH levels deep."""
+    found: set[Path] = set()
+    for e in entries:
+        if e.kind != "file" or e.path.name.lower() != "$config.dat" or _levels(e.rel) - 1 > MAX_FOLDER_DEPTH:
+            continue
+        system = e.path.parent
+        if system.name.lower() != "system":
+            continue
+        found.add(_root_of_base(system.parent))
+    roots = sorted(found)
+    return [r for r in roots if not any(o != r and o in r.parents for o in roots)]
+
+
+def _levels(rel: str) -> int:
+    """Folder levels of a walk entry's `rel` below the walk's root ("" and "." are the root)."""
+    return 0 if rel in ("", ".") else rel.count("/") + 1
+
+
+def folder_groups(path: str | Path) -> list[tuple[str, list]] | None:
+    """Rule 4, from one walk of the folder (krl.files.walk): the (root, entries) groups -- one
+    per backup (:func:`find_backups`), then one per top-level folder for the entries outside
+    every backup, sorted; a folder without backups is one group. The entries are those that
+    :func:`collect_entries` of each root gives (each root's own MAX_FOLDER_DEPTH, its own
+    ``rel``). None when `path` is not a folder (or is a link)."""
+    p = Path(path)
+    if not p.is_dir() or p.is_symlink():
+        return None
+    # deep enough for every root's own limit: a backup root is at most MAX_FOLDER_DEPTH levels
+    # down; folder events are kept only where some root's limit may cut (past MAX_FOLDER_DEPTH)
+    entries = [e for e in _files.walk(p, max_depth=2 * MAX_FOLDER_DEPTH + 1, folders=True)
+               if e.kind != "folder" or _levels(e.rel) > MAX_FOLDER_DEPTH]
+    backups = _backups_in(entries)
+    whole = _as_walk_of(entries, "")
+    if not backups:
+        return [(str(p), whole)]
+    groups = []
+    prefixes = []
+    for b in backups:
+        rel = b.relative_to(p).as_posix()
+        rel = "" if rel == "." else rel
+        prefixes.append(rel)
+        groups.append((str(b), _as_walk_of(
+            [e for e in entries if not rel or e.rel == rel or e.rel.startswith(rel + "/")], rel)))
+    # entries outside every backup: one program per top-level folder of `path`
+    rest: dict[str, list] = {}
+    for e in whole:
+        if any(not r or e.rel == r or e.rel.startswith(r + "/") for r in prefixes):
+            continue
+        parts = e.rel.split("/")
+        key = str(p / parts[0]) if len(parts) > 1 else str(p)
+        rest.setdefault(key, []).append(e)
+    return groups + sorted(rest.items())
+
+
+def _as_walk_of(entries: list, rel: str) -> list:
+    """The entries a walk of the folder `rel` (of a deeper walk with folder events) would have
+    given: ``rel`` relative to it, folders past MAX_FOLDER_DEPTH below it ``too_deep`` and not
+    entered, folder events dropped."""
+    base = _levels(rel)
+    cut = len(rel) + 1 if rel else 0
+    out = []
+    pruned = None
+    for e in entries:
+        if pruned is not None and (e.path == pruned or pruned in e.path.parents):
+            continue
+        pruned = None
+        own = e.rel[cut:] if cut and e.rel != rel else (e.rel if not cut else ".")
+        if e.kind == "folder":
+            if _levels(e.rel) - base > MAX_FOLDER_DEPTH:
+                out.append(Entry(e.path, own, "too_deep"))
+                pruned = e.path
+            continue
+        out.append(e if not cut else Entry(e.path, own, e.kind, e.detail, e.size))
+    return out
+
+
+def collect_entries(path: Path) -> list:
+    """The KRL entries (:class:`krl.files.Entry`) of a file or folder, in walk order: a folder is
+    walked (krl/files.py: links and FIFOs listed, never read; unreadable or too deep folders
+    listed); anything else that exists is one ``file`` entry, classified when it is read."""
+    path = Path(path)
+    if path.is_dir() and not path.is_symlink():
+        return list(_files.walk(path))
+    if path.is_symlink() and path.is_dir():
+        return [Entry(path, path.name, "symlink")]
+    return [Entry(path, path.name, "file")]
+
+
+def collect_files(path: Path) -> list[Path]:
+    """KRL files (.src, .dat, .sub in any case) of a file or folder, in walk order (regular
+    files only; see :func:`collect_entries` for the rest)."""
+    return [e.path for e in collect_entries(path) if e.kind == "file"]
