@@ -17,13 +17,12 @@ def program_assembly(program: Path, workspace: Path | None = None, all_modules: 
 
     from interp.vm.compiler import compile_module  # noqa: PLC0415
 
-    rt, _ = make_runtime(program, workspace=workspace, mujoco=False, interp="vm")
+    rt, _ = make_runtime(program, workspace=workspace, mujoco=False, interp="vm", check=False)
     prog = rt.program
-    main = prog.module(Path(program).stem)
+    main = prog.module_of(prog.main_path)
     mods = [main]
     if all_modules:
-        prog.scan_all()
-        mods += [m for m in prog.modules.values() if m is not main and m.routines]
+        mods += [m for m in prog.modules if m is not main and m.routines]
     out = []
     for m in mods:
         if m is None:

@@ -29,11 +29,12 @@ import click
               default="AUT", show_default=True,
               help="Operating mode ($MODE_OP): T1 limits TCP and flange to 250 mm/s and PTP to "
                    "$RED_T1; AUT is the unattended virtual controller (docs/robot.md).")
-@click.option("--check", "check", is_flag=True,
-              help="Run the front end's checker first; like the controller, refuse to start a "
-                   "program whose files have errors (exit 1).")
+@click.option("--no-check", "no_check", is_flag=True,
+              help="Start the program even when the front end's checker finds errors in its own "
+                   "module (by default, like the controller, such a program does not start: exit 1). "
+                   "A name nothing declares is then a run-time error where it is evaluated.")
 def run(program: Path, interp_kind: str, workspace, inputs, trace_path, max_sim_time, max_steps, submit,
-        mode, check) -> None:
+        mode, no_check) -> None:
     """Run PROGRAM (.src) on the simulated KR C4; print where and why it ended.
 
     With --workspace BACKUP.zip (a KRC backup archive) PROGRAM is a path inside the archive
@@ -54,13 +55,14 @@ def run(program: Path, interp_kind: str, workspace, inputs, trace_path, max_sim_
                 if found is None:
                     click.echo(f"error: no program {printable(program)} in {printable(workspace)}", err=True)
                     sys.exit(2)
-                _run(found, folder, inputs, trace_path, max_sim_time, max_steps, submit, check, interp_kind,
-                     mode=mode, shown=lambda text: text.replace(str(folder), str(workspace)))
+                _run(found, folder, inputs, trace_path, max_sim_time, max_steps, submit, interp_kind,
+                     mode=mode, shown=lambda text: text.replace(str(folder), str(workspace)), check=not no_check)
         except ArchiveError as exc:
             click.echo(f"error: {printable(exc)}", err=True)
             sys.exit(2)
         return
-    _run(program, workspace, inputs, trace_path, max_sim_time, max_steps, submit, check, interp_kind, mode=mode)
+    _run(program, workspace, inputs, trace_path, max_sim_time, max_steps, submit, interp_kind, mode=mode,
+         check=not no_check)
 
 
 def program_in(folder: Path, program: Path) -> Path | None:
@@ -80,18 +82,11 @@ def program_in(folder: Path, program: Path) -> Path | None:
     return None
 
 
-def _run(program: Path, workspace, inputs, trace_path, max_sim_time, max_steps, submit, check, interp_kind,
-         mode=None, shown=lambda text: text) -> None:
+def _run(program: Path, workspace, inputs, trace_path, max_sim_time, max_steps, submit, interp_kind,
+         mode=None, shown=lambda text: text, check: bool = True) -> None:
     if not program.exists():
         click.echo(f"error: {program}: no such file", err=True)
         sys.exit(2)
-    if check:
-        errors = check_errors(program, workspace)
-        if errors:
-            for d in errors[:20]:
-                click.echo(shown(str(d)))
-            click.echo(f"not started: {len(errors)} error(s) found by the checker")
-            sys.exit(1)
     from interp.run import make_runtime  # noqa: PLC0415
     from interp.summary import RunObserver, summary_lines  # noqa: PLC0415
     from krl.terminal import printable  # noqa: PLC0415
@@ -103,7 +98,14 @@ def _run(program: Path, workspace, inputs, trace_path, max_sim_time, max_steps, 
     try:
         rt, _ = make_runtime(program, workspace=workspace, inputs=inputs, trace=trace,
                              max_sim_time=max_sim_time, max_steps=max_steps, submit=list(submit),
-                             interp=interp_kind, observer=observer, mode=mode)
+                             interp=interp_kind, observer=observer, mode=mode, check=check)
+        errors = rt.program.errors_of(rt.program.module_of(rt.program.main_path))
+        if errors:
+            # the checker rejects the program's own module: like the controller, it does not start
+            for d in errors[:20]:
+                click.echo(shown(printable(str(d))))
+            click.echo(f"not started: {len(errors)} error(s) found by the checker (--no-check runs it anyway)")
+            sys.exit(1)
         res = rt.run()
     except StimulusError as exc:
         click.echo(f"error: {shown(printable(exc))}", err=True)
@@ -128,23 +130,6 @@ def _run(program: Path, workspace, inputs, trace_path, max_sim_time, max_steps, 
 
 
 from interp.asm import asm  # noqa: E402
-
-
-def check_errors(program: Path, workspace=None) -> list:
-    """Errors the front end's checker finds in the program's own module (its .src/.dat)
-    when the program's files (krl.project.project_of, the rule of the run) are checked
-    together, with the project's BASIS outside a backup."""
-    from interp.runtime.program import BASIS_DIR  # noqa: PLC0415
-    from krl.project import project_of  # noqa: PLC0415
-    from krl.workspace import load_project  # noqa: PLC0415
-
-    prog = program.resolve()
-    project = project_of(prog, Path(workspace).resolve() if workspace else None)
-    extra = [] if project.backup else sorted(p for p in BASIS_DIR.iterdir() if p.is_file())
-    ws = load_project(project, str(prog), extra=extra)
-    ws.check()
-    stem = prog.stem.upper()
-    return [d for d in ws.diagnostics if d.is_error and Path(d.path).stem.upper() == stem]
 
 
 commands = [run, asm]

@@ -6,15 +6,18 @@ from __future__ import annotations
 from pathlib import Path
 
 from interp.runtime.core import RunResult, Runtime
-from interp.runtime.errors import ResourceError
+from interp.runtime.errors import KrlRuntimeError, ResourceError
 
 
 def make_runtime(program, *, workspace=None, inputs=None, trace=None, max_sim_time=None,
                  max_steps=None, submit=None, mujoco: bool = True, controller=None,
                  robot_budget=None, interp: str = "tree", observer=None,
-                 mode: str | None = None) -> tuple[Runtime, object]:
+                 mode: str | None = None, check: bool = True) -> tuple[Runtime, object]:
     """Build the runtime and the interpreter (``interp``: tree or vm) for ``program``
-    (not started yet). `observer` (an :class:`interp.summary.RunObserver`) sees the
+    (not started yet). Its files (krl.project.project_of, with the `submit` programs) are
+    loaded, checked and resolved first; with `check` (``krl run`` without ``--no-check``) a
+    program whose own module the checker rejects does not start (its run ends with that
+    error). `observer` (an :class:`interp.summary.RunObserver`) sees the
     controller's events on their way to `trace`; it is not used with a given `controller`.
     ``mode``: operating mode T1/T2/AUT/EXT (``$MODE_OP``; default AUT, robot/limits.py);
     ignored with a given `controller` (it has its own)."""
@@ -29,7 +32,8 @@ def make_runtime(program, *, workspace=None, inputs=None, trace=None, max_sim_ti
                                 stimuli=str(inputs) if inputs else None, mujoco=mujoco,
                                 mode_op=mode)
     rt = Runtime(program, workspace=workspace, controller=controller, trace=trace,
-                 max_sim_time=max_sim_time, max_steps=max_steps, robot_budget=robot_budget)
+                 max_sim_time=max_sim_time, max_steps=max_steps, robot_budget=robot_budget,
+                 submits=list(submit or ()), check=check)
     if observer is not None:
         # The interpreters trace into the user's trace only: without one the VM keeps its
         # quiet fast path (Runtime.quiet_limit); the observer needs the controller's events.
@@ -50,9 +54,7 @@ def make_runtime(program, *, workspace=None, inputs=None, trace=None, max_sim_ti
     rt.add_task("robot", Path(program).stem, lambda: interp.run_program())
     for sub in submit or ():
         sp = Path(sub).resolve()
-        if sp.stem.upper() not in rt.program.index:
-            rt.program._add_file(sp)  # noqa: SLF001
-        rt.add_task("submit", sp.stem, lambda name=sp.stem: interp.run_program(name))
+        rt.add_task("submit", sp.stem, lambda name=sp: interp.run_program(name))
     return rt, interp
 
 
@@ -62,11 +64,16 @@ def signal_of(rt: Runtime, main: str, name: str) -> tuple[str, int, int | None] 
     demand, as the program's own name lookup does). None if there is no such SIGNAL."""
     from interp.runtime.memory import SignalRef  # noqa: PLC0415
 
-    key = name.upper()
-    module = rt.program.module(main)
-    ref = module.data.get(key) if module is not None else None
-    if ref is None:
-        ref = rt.program.lookup_global(key)
+    prog = rt.program
+    module = prog.module_of(prog.main_path) if main.upper() == prog.main_path.stem.upper() else prog.module(main)
+    scope = prog.ws.units[module.index].scope if module is not None else prog.ws.global_scope
+    sym = scope.lookup(name) if scope is not None else None
+    if sym is None or sym.kind != "signal":
+        return None
+    try:
+        ref = rt.storage_ref(prog.ws.resolver.storage(name, sym, None, module.index if module else -1), None)
+    except KrlRuntimeError:
+        return None
     if not isinstance(ref, SignalRef):
         return None
     return ref.proxy.name.upper(), ref.a, ref.b

@@ -43,6 +43,7 @@ from krl.semantics.builtins import load_builtins
 from krl.semantics.checker import Checker, Declarer, _is_system_datalist
 from krl.diagnostics import Diagnostic, DiagnosticSink
 from krl.semantics.outside import Unresolved, template_lines
+from krl.semantics.resolve import resolve_workspace
 from krl.semantics.symbols import Scope, Symbol, system_scopes
 from krl.syntax.folds import fold_diagnostics
 from krl.syntax.messages import syntax_diagnostics
@@ -215,6 +216,10 @@ class Workspace:
     # when set: only these paths' routine bodies and data-list values are checked (the other
     # files still declare their names); one file in the context of its backup
     check_only: set | None = None
+    # the system variables the program uses, by Storage.slot, and the resolver that placed
+    # every name (krl/semantics/resolve.py)
+    system_names: list = field(default_factory=list)
+    resolver: object = None
 
     def maybe_declared(self, name: str) -> bool:
         """True when a file that could not be parsed (or read) may declare `name`."""
@@ -508,6 +513,9 @@ class Workspace:
             u.dat.path for u in self.units
             if u.dat is not None and u.dat.module.data is not None and _is_system_datalist(u.dat.module.data.name)}
         sink.items = [d for d in sink.items if not (d.code in ADVISORY and d.path in kuka)]
+        # every use gets its storage and every statement its advance-run facts, once, for the
+        # interpreters (krl/semantics/resolve.py)
+        resolve_workspace(self)
 
 
 _ON_FILE: ContextVar[Callable[[str], None] | None] = ContextVar("krl_workspace_on_file", default=None)

@@ -7,14 +7,15 @@ from __future__ import annotations
 
 import random
 import sys
+from pathlib import Path
 from dataclasses import dataclass
 
 from krl.ast import nodes as N
 from krl.limits import MAX_CALL_DEPTH
 from krl.semantics import types as T
-from krl.semantics.symbols import Scope, fill_struc, make_array
+from krl.semantics.advance import StmtInfo
+from krl.semantics.resolve import Callee, Storage
 
-from . import advance
 from .builtins import NATIVES, ValueRef, call_builtin
 from .contexts import Context, Irq
 from .convert import assign_into, binary_op, convert_scalar, to_bool, trunc_int, unary_op
@@ -64,7 +65,8 @@ class Runtime:
 
     def __init__(self, main_path, *, workspace=None, controller=None, trace=None, stimuli=None,
                  max_sim_time: float | None = None, max_steps: int | None = None,
-                 mujoco: bool = True, robot_budget: int | None = None) -> None:
+                 mujoco: bool = True, robot_budget: int | None = None, submits: list = (),
+                 check: bool = True) -> None:
         if controller is None:
             from robot.controller import Controller  # noqa: PLC0415
 
@@ -80,13 +82,12 @@ class Runtime:
         self.robot_budget = robot_budget
         self.sysvars = SysVars(self)
         self.memory = DataMemory()
-        self.program = Program(self, main_path, workspace)
+        self.program = Program(self, main_path, workspace, submits, check)
+        self.modules = self.program.modules       # by Storage.owner / Callee.owner
         self.scheduler = Scheduler(self, max_sim_time, max_steps)
         self.robot: Task | None = None
         self.result: RunResult | None = None
-        self._stop_cache: dict = {}
         self._plans: dict = {}          # id(routine) -> Runtime._frame_plan
-        self._return_types: dict = {}   # id(routine) -> resolved return type of a function
         self._cyclic: dict = {}
 
     # ================================================================== tasks and run
@@ -208,7 +209,7 @@ class Runtime:
         if task.irqs.armed:
             self.check_interrupts(task)
 
-    def before_statement(self, info: advance.StmtInfo) -> None:
+    def before_statement(self, info: StmtInfo) -> None:
         """Called by an interpreter before every statement: counts the step (limits,
         time slice), checks interrupts, applies CONTINUE and the advance-run stop, writes
         the ``stmt`` trace event."""
@@ -259,7 +260,7 @@ class Runtime:
         """The next step of ``task`` takes the full hook (see :meth:`quiet_limit`)."""
         task.quiet = 0
 
-    def loop_tick(self, info: advance.StmtInfo) -> None:
+    def loop_tick(self, info: StmtInfo) -> None:
         """Called once per loop iteration (WHILE/REPEAT/LOOP/FOR): counts a step, may end
         the time slice, applies a loop condition's advance-run stop. No trace event."""
         task = self.current_task
@@ -267,7 +268,7 @@ class Runtime:
         if info.cond_stops and task.kind == "robot":
             self.advance_stop(task)
 
-    def set_continue(self, info: advance.StmtInfo) -> None:
+    def set_continue(self, info: StmtInfo) -> None:
         """CONTINUE: the next line does not stop the advance run."""
         task = self.current_task
         task.continue_line = (info.file, info.line)
@@ -321,30 +322,43 @@ class Runtime:
         raise HaltSignal()
 
     # ================================================================== memory
-    def lookup(self, name: str, frame: Frame) -> Ref:
-        """The reference a name denotes in ``frame`` (§2.7)."""
+    def sysref(self, st: Storage) -> Ref:
+        """The reference of a system variable the tables declare (storage class SYSTEM; its
+        storage is allocated on first use and kept)."""
+        refs = self.program.sysrefs
+        ref = refs[st.slot]
+        if ref is None:
+            ref = self.sysvars.lookup(st.name)
+            if ref is None:
+                ref = self.lookup(st.name)
+            refs[st.slot] = ref
+        return ref
+
+    def storage_ref(self, st: Storage, frame: Frame | None) -> Ref:
+        """The reference a resolved name denotes (krl/semantics/resolve.py): a frame slot, a
+        data-list slot, a system variable, or the fallback for what nothing declares."""
+        k = st.kind
+        if k == 0:                   # LOCAL
+            return frame.vars[st.slot]
+        if k <= 2:                   # MODULE, GLOBAL
+            return self.modules[st.owner].refs[st.slot] or self.program.data_ref(st)
+        if k == 3:                   # SYSTEM
+            return self.program.sysrefs[st.slot] or self.sysref(st)
+        return self.lookup(st.name)
+
+    def lookup(self, name: str) -> Ref:
+        """The one run-time name lookup, for a name nothing declares (storage class
+        UNRESOLVED; docs/architecture.md, "One program model"): a ``$`` name is a system
+        variable the simulator knows without a table entry, or, in a KRC backup, an
+        undeclared one created on first use that reads 0 (``SysVars.auto``); any other name
+        is the run-time error "unknown name"."""
         key = name.upper()
-        r = frame.vars.get(key)
-        if r is not None:
-            return r
-        m = frame.module
-        if m is not None:
-            r = m.data.get(key)
-            if r is not None:
-                return r
-        prog = self.program
         if key[:1] == "$":
             r = self.sysvars.lookup(key)
             if r is not None:
                 return r
-        r = prog.globals.get(key)
-        if r is not None:
-            return r
-        r = prog.lookup_global(key)
-        if r is not None:
-            return r
-        if key[:1] == "$" and prog.backup:
-            return self.sysvars.auto(key)
+            if self.program.backup:
+                return self.sysvars.auto(key)
         raise KrlRuntimeError(f"unknown name {name}")
 
     def index(self, base: Ref, idx: list, name: str) -> Ref:
@@ -364,66 +378,49 @@ class Runtime:
     unary_op = staticmethod(unary_op)
     to_bool = staticmethod(to_bool)
 
-    def aggregate(self, type_name: str | None, items: list, module) -> Struct:
-        """Value of ``{[TYPE:] NAME value, ...}``: a partial Struct."""
-        st = None
-        if type_name:
-            st = self.type_named(type_name, module)
-        return Struct(st if isinstance(st, T.Struc) else None, dict(items))
-
-    def type_named(self, name: str, module):
-        scope = module.types if module is not None else self.program.types
-        return scope.lookup_type(name)
-
-    def stop_of(self, name: str, mode: str, frame: Frame) -> bool:
-        """Does reading/writing ``name`` in ``frame`` stop the advance run?"""
-        key = name.upper()
-        if key in frame.vars:
-            return False
-        m = frame.module
-        ref = m.data.get(key) if m is not None else None
-        if ref is None and key[:1] != "$":
-            ref = self.program.globals.get(key)
-        if isinstance(ref, SignalRef):
-            base = ref.proxy.name.upper()
-            r, w = self.sysvars.stops(base)
-            return r if mode == "r" else w
-        if ref is not None:
-            return False
-        if key[:1] == "$":
-            r, w = self.sysvars.stops(key)
-            return r if mode == "r" else w
-        return False
-
-    def stmt_info(self, stmt, frame: Frame) -> advance.StmtInfo:
-        """The (cached) StmtInfo of a statement, resolved in ``frame``'s module."""
-        k = (id(stmt), frame.module.name if frame.module is not None else "")
-        got = self._stop_cache.get(k)
-        if got is None:
-            got = advance.analyse(stmt, lambda n, mode: self.stop_of(n, mode, frame))
-            self._stop_cache[k] = got
-        return got
+    @staticmethod
+    def aggregate(struc, items: list) -> Struct:
+        """Value of ``{[TYPE:] NAME value, ...}``: a partial Struct; ``struc``: the resolved
+        STRUC of the TYPE prefix (the resolver's, ``Aggregate.ann.storage``), else None."""
+        return Struct(struc if isinstance(struc, T.Struc) else None, dict(items))
 
     # ================================================================== routines
     def main_routine(self, module_name: str | None = None):
-        """(module, main routine) a robot or submit task starts with (the program's module by
-        default); raises KrlRuntimeError when the module has syntax errors or no main routine."""
-        name = module_name or self.program.main_path.stem
-        m = self.program.module(name)
+        """(module, main routine) a robot or submit task starts with (the program's module, or
+        the module of a submit program's file ``module_name``); raises KrlRuntimeError when the
+        module's files have syntax errors, when the checker rejected them (unless the run does
+        not check: ``krl run --no-check``) or when there is no main routine."""
+        prog = self.program
+        if module_name is None:
+            m = prog.module_of(prog.main_path)
+            name = prog.main_path.stem
+        else:
+            m = prog.module_of(module_name) or prog.module(str(module_name))
+            name = module_name
         if m is not None and m.syntax_errors:
             first = m.syntax_errors[0]
             raise KrlRuntimeError("the program has syntax errors and cannot start: " + first, None,
                                   getattr(first, "file", None) or m.path, getattr(first, "line", None) or 0)
-        if self.program.fatal is not None:
-            raise self.program.fatal
+        errors = prog.errors_of(m)
+        if errors:
+            d = errors[0]
+            more = f" (and {len(errors) - 1} more)" if len(errors) > 1 else ""
+            raise KrlRuntimeError(f"the program has errors and cannot start: {d.path}:{d.line}:{d.column}: "
+                                  f"error[{d.code}]: {d.message}{more}", None, d.path, d.line)
+        if prog.fatal is not None:
+            raise prog.fatal
         if m is None or m.main is None:
-            raise KrlRuntimeError(f"no main routine in {name}")
+            raise KrlRuntimeError(f"no main routine in {Path(str(name)).stem}")
         return m, m.main
 
-    def find_routine(self, name: str, module):
-        return self.program.find_routine(name, module)
+    def callee(self, c: Callee):
+        """(module, Routine) of a resolved call, or None (a built-in or nothing declares it)."""
+        if c.routine is None:
+            return None
+        return self.modules[c.owner], c.routine
 
-    def is_native(self, name: str) -> bool:
+    @staticmethod
+    def is_native(name: str) -> bool:
         return name.upper() in NATIVES
 
     def call_builtin(self, name: str, args: list):
@@ -444,24 +441,24 @@ class Runtime:
     def enter_routine(self, module, routine: N.Routine, args: list, caller: Frame | None) -> Frame:
         """Create the frame of a call (§2.3): :IN parameters get converted copies, :OUT
         (and unmarked) parameters are bound to the caller's reference; omitted arguments
-        stay declared-but-unset; locals are declared unset. The routine's declarations are
-        resolved once (:meth:`_frame_plan`)."""
+        stay declared-but-unset; locals are declared unset. The routine's slots are its
+        Layout (krl/semantics/resolve.py), planned once (:meth:`_frame_plan`)."""
         task = self.current_task
         depth = caller.depth + 1 if caller is not None else 0
         if depth > MAX_CALL_DEPTH:
             raise KrlRuntimeError(f"stack overflow: more than {MAX_CALL_DEPTH} nested calls")
         plan = self._plans.get(id(routine))
-        if plan is None or plan[0] is not module:
+        if plan is None:
             plan = self._plans[id(routine)] = self._frame_plan(module, routine)
-        _, scope, decls, params, local_elements, local_sizes = plan
+        layout, decls, params, local_elements, local_sizes = plan
         mem = self.memory
         if mem.used + local_elements > mem.limit:
             self._locals_do_not_fit(local_sizes)
         mem.used += local_elements
-        frame = Frame(routine, module, caller, task)
+        frame = Frame(routine, module, caller, task, layout)
         frame.data = local_elements
         try:
-            self._fill_frame(frame, module, scope, decls, params, args)
+            self._fill_frame(frame, decls, params, args)
         except BaseException:
             mem.give(frame.data)
             raise
@@ -480,105 +477,84 @@ class Runtime:
         finally:
             mem.used = used
 
-    def _fill_frame(self, frame: Frame, module, scope, decls, params, args) -> None:
+    def _fill_frame(self, frame: Frame, decls, params, args) -> None:
         """Declare the locals and bind the parameters of a new frame (:meth:`enter_routine`);
         the data memory of :IN copies and omitted aggregate parameters is added to
         ``frame.data``."""
-        frame.extra = scope
         store = frame.store
         fvars = frame.vars
-        for name, key, t, d, scalar in decls:
+        for k, name, t, d, scalar in decls:
             if t is not None:
-                store[key] = UNSET if scalar else make_value(t)
-                ref = fvars[key] = Slot(store, key, t, name)
+                store[k] = UNSET if scalar else make_value(t)
+                ref = fvars[k] = Slot(store, k, t, name)
                 if d is not None:      # DECL CONST INT OFFS = 10 (KSS 8)
-                    v = self.program.literal(d.init, t, module)
-                    cur = store[key]
+                    v = self.program.literal(d.init, t)
+                    cur = store[k]
                     if isinstance(cur, (Struct, Arr)):
                         assign_into(cur, v)
                     else:
-                        store[key] = convert_scalar(v, t)
+                        store[k] = convert_scalar(v, t)
                     ref.readonly = d.is_const
-            elif isinstance(d, N.SignalDecl):
-                ref = self.program.signal_ref(d)
-                if ref is not None:
-                    frame.bind(d.name, ref)
-            else:
-                frame.bind(d.name, self.program.import_ref(d))
-        for i, (name, key, mode, t, scalar, size) in enumerate(params):
-            a = args[i] if i < len(args) else None
+            else:                      # a SIGNAL of the routine
+                fvars[k] = self.program.signal_ref(d)
+        for k, name, mode, t, scalar, size in params:
+            a = args[k] if k < len(args) else None
             if a is None:
                 if isinstance(t, T.Array) and t.elem == T.CHAR and t.dims == (0,):
                     # an omitted string parameter: declared, no characters (KUKA's MsgLib
                     # calls STRLEN on it without ON_ERROR_PROCEED); VARSTATE says #DECLARED
-                    frame.declare(name, t, Arr(t, (0,), []))
+                    store[k] = Arr(t, (0,), [])
+                    fvars[k] = Slot(store, k, t, name)
                 elif t is None or (isinstance(t, T.Array) and 0 in t.dims):
-                    store[key] = UNSET
-                    fvars[key] = Slot(store, key, None, name)
+                    store[k] = UNSET
+                    fvars[k] = Slot(store, k, None, name)
                 else:
                     frame.data += self.memory.take(size, f"parameter {name}")
-                    frame.declare(name, t)
+                    store[k] = make_value(t)
+                    fvars[k] = Slot(store, k, t, name)
                 continue
             if mode == "IN" or a.__class__ is ValueRef:
                 if scalar:      # (the scalar case of _param_copy and _slot_type)
                     v = a.peek()
-                    store[key] = v if v is UNSET else convert_scalar(v, t)
-                    fvars[key] = Slot(store, key, t, name)
+                    store[k] = v if v is UNSET else convert_scalar(v, t)
+                    fvars[k] = Slot(store, k, t, name)
                     continue
                 v = a.peek()
                 frame.data += self.memory.take(value_size(v) if isinstance(v, (Struct, Arr)) else size,
                                                f"a copy of :IN parameter {name}")
-                v = store[key] = self._param_copy(v, t, name)
-                fvars[key] = Slot(store, key, self._slot_type(t, v), name)
+                v = store[k] = self._param_copy(v, t, name)
+                fvars[k] = Slot(store, k, self._slot_type(t, v), name)
             else:
-                fvars[key] = a
+                fvars[k] = a
 
     def _frame_plan(self, module, routine: N.Routine) -> tuple:
-        """The declarations of ``routine`` resolved for :meth:`enter_routine`: (module,
-        type scope, [(name, KEY, type, VarDecl with an initial value or None, scalar?) for
-        each local variable, or (name, KEY, None, SignalDecl/ImportDecl, False)], [(name,
-        KEY, mode, type or None, scalar?, data elements) for each parameter], data elements
-        of the locals, [(data elements, VarName, VarDecl) for each local]); *scalar*: a type
-        whose fresh value is UNSET and whose values are converted by convert_scalar (INT,
-        REAL, BOOL, CHAR, ENUM). Raises KrlRuntimeError for an unknown type, ResourceError
-        for a type that nests too deep (values.data_size)."""
-        pnames = {p.name.upper() for p in routine.params}
-        scope = module.types if module is not None else self.program.types
-        local_types = None
-        for d in routine.decls:
-            if isinstance(d, (N.StrucDecl, N.EnumDecl)):
-                if local_types is None:
-                    local_types = Scope("routine", routine.name, scope)
-                if isinstance(d, N.StrucDecl):
-                    st = T.Struc(d.name)
-                    local_types.types[d.name.upper()] = st
-                    fill_struc(local_types, st, [(c.type_name, c.name, tuple(c.dims)) for c in d.components])
-                else:
-                    local_types.types[d.name.upper()] = T.Enum(d.name, frozenset(v.upper() for v in d.values))
-        if local_types is not None:
-            scope = local_types
-        ptypes = {}
-        psizes = {}
-        decls = []
-        sizes = []
-        for d in routine.decls:
-            if isinstance(d, N.VarDecl):
-                t0 = self.program.resolve_type(d.type, scope)
-                for vn in d.names:
-                    t = make_array(t0, vn.dims) if vn.dims else t0
-                    key = vn.name.upper()
-                    n = self.program.data_elements(t, vn, d)
-                    if key in pnames:
-                        ptypes[key] = t
-                        psizes[key] = n
-                    else:
-                        decls.append((vn.name, key, t, d if d.init is not None else None, _scalar(t)))
-                        sizes.append((n, vn, d))
-            elif isinstance(d, (N.SignalDecl, N.ImportDecl)):
-                decls.append((d.name, d.name.upper(), None, d, False))
-        params = [(p.name, p.name.upper(), p.mode, ptypes.get(p.name.upper()), _scalar(ptypes.get(p.name.upper())),
-                   psizes.get(p.name.upper(), 1)) for p in routine.params]
-        return module, scope, decls, params, sum(n for n, _, _ in sizes), sizes
+        """The routine's Layout made ready for :meth:`enter_routine`: (layout, [(slot, name,
+        type, VarDecl with an initial value or None, scalar?) for each local variable, or
+        (slot, name, None, SignalDecl, False)], [(slot, name, mode, type or None, scalar?, data
+        elements) for each parameter], data elements of the locals, [(data elements,
+        VarName, VarDecl) for each local]); *scalar*: a type whose fresh value is UNSET and
+        whose values are converted by convert_scalar (INT, REAL, BOOL, CHAR, ENUM). Types are
+        the checker's; raises KrlRuntimeError for a type nothing declares (outside a backup),
+        ResourceError for a type that nests too deep (values.data_size)."""
+        layout = routine.ann.storage
+        prog = self.program
+        decls, params, sizes = [], [], []
+        for k, s in enumerate(layout.slots):
+            if k < layout.nparams:
+                if s.var is not None:            # the parameter's declaration (a VarDecl)
+                    t = prog.declared_type(s.type, s.decl.type)
+                    n = prog.data_elements(t, s.var, s.decl)
+                else:                            # no declaration (E101): untyped
+                    t, n = None, 1
+                params.append((k, s.name, s.mode, t, _scalar(t), n))
+            elif isinstance(s.decl, N.VarDecl):
+                t = prog.declared_type(s.type, s.decl.type)
+                n = prog.data_elements(t, s.var, s.decl)
+                decls.append((k, s.name, t, s.decl if s.decl.init is not None else None, _scalar(t)))
+                sizes.append((n, s.var, s.decl))
+            else:
+                decls.append((k, s.name, None, s.decl, False))
+        return layout, decls, params, sum(n for n, _, _ in sizes), sizes
 
     @staticmethod
     def _slot_type(t, v):
@@ -647,13 +623,11 @@ class Runtime:
             self.trace.write("return", self.controller.time, name=frame.name)
 
     def return_value(self, routine: N.Routine, value, module):
-        """``RETURN expr`` of a function: converted to the return type (§2.4)."""
+        """``RETURN expr`` of a function: converted to the return type (§2.4; the checker's,
+        ``Layout.returns``)."""
         if routine.return_type is None:
             return value
-        t = self._return_types.get(id(routine))
-        if t is None:
-            scope = module.types if module is not None else self.program.types
-            t = self._return_types[id(routine)] = self.program.resolve_type(routine.return_type, scope)
+        t = self.program.declared_type(routine.ann.storage.returns, routine.return_type)
         if isinstance(t, T.Array) and isinstance(value, str):
             arr = make_value(t)
             assign_into(arr, value)
@@ -661,20 +635,28 @@ class Runtime:
         return convert_scalar(value, t)
 
     def ref_from_text(self, text: str):
-        """The reference named by a string such as ``"P[2].X"`` (VARSTATE), or None."""
+        """The reference named by a string such as ``"P[2].X"`` (VARSTATE), or None. The
+        name is looked up in the scopes the front end built for the running routine
+        (``Layout.scope``, the checker's), and placed by the resolver's rules: the text is a
+        run-time value, so this is the one lookup that happens while the program runs,
+        besides the ``$``-name fallback."""
         import re  # noqa: PLC0415
 
         task = self.current_task
         frame = getattr(task, "frame", None)
         m = re.match(r"\s*(\$?[A-Za-z_][\w$]*)(.*)$", text)
-        if not m or frame is None:
+        if not m or frame is None or frame.layout is None:
             return None
+        name = m.group(1)
+        layout = frame.layout
+        resolver = self.program.ws.resolver
+        sym = layout.scope.lookup(name) if layout.scope is not None else None
+        local = {id(s.symbol) if s.symbol is not None else s.name.upper(): k for k, s in enumerate(layout.slots)}
         try:
-            ref = self.lookup(m.group(1), frame)
+            ref = self.storage_ref(resolver.storage(name, sym, local, layout.owner), frame)
         except KrlRuntimeError:
             return None
         rest = m.group(2).strip()
-        name = m.group(1)
         while rest:
             if rest.startswith("["):
                 j = rest.find("]")

@@ -274,39 +274,38 @@ def field_ref(base: Ref, comp: str, name: str) -> Ref:
 
 
 class Frame:
-    """One activation of a routine (or of a module's data list initialisation).
+    """One activation of a routine.
 
-    Attributes: routine (AST Routine or None), module (:class:`program.ModuleRT`),
-    vars (UPPER name -> Ref), caller (Frame or None), depth, interrupts (numbers
-    declared here, removed on return), task (the owning task), line (current line), data
-    (the elements of the run's data memory it holds, given back on return).
+    Attributes: routine (AST Routine), module (:class:`program.ModuleRT`), vars (frame slot ->
+    Ref: the slots of the routine's Layout, krl/semantics/resolve.py: parameters, then
+    locals), store (frame slot -> the value of a variable the frame holds itself: a local or an
+    :IN copy), layout, caller (Frame or None), depth, interrupts (numbers declared here,
+    removed on return), task (the owning task), line (current line), data (the elements of
+    the run's data memory it holds, given back on return).
     """
 
     __slots__ = ("routine", "module", "vars", "caller", "depth", "interrupts", "task", "line",
-                 "store", "extra", "data")
+                 "store", "layout", "data")
 
-    def __init__(self, routine, module, caller: "Frame | None", task=None) -> None:
+    def __init__(self, routine, module, caller: "Frame | None", task=None, layout=None) -> None:
         self.routine = routine
         self.module = module
-        self.vars: dict[str, Ref] = {}
-        self.store: dict = {}
+        n = len(layout.slots) if layout is not None else 0
+        self.layout = layout
+        self.vars: list = [None] * n
+        self.store: list = [UNSET] * n
         self.caller = caller
         self.depth = caller.depth + 1 if caller is not None else 0
         self.interrupts: list[int] = []
         self.task = task
         self.line = 0
-        self.extra = None
         self.data = 0       # elements of the run's data memory this activation holds (DataMemory)
 
-    def declare(self, name: str, type_, value=None) -> Slot:
-        key = name.upper()
-        self.store[key] = make_value(type_) if value is None else value
-        ref = Slot(self.store, key, type_, name)
-        self.vars[key] = ref
-        return ref
-
-    def bind(self, name: str, ref: Ref) -> None:
-        self.vars[name.upper()] = ref
+    def ref(self, name: str) -> Ref | None:
+        """The reference of the parameter or local `name` (any case), else None: for tools
+        (VARSTATE's text, a debugger); the interpreters use each use's Storage slot."""
+        k = self.layout.index(name) if self.layout is not None else None
+        return self.vars[k] if k is not None else None
 
     @property
     def name(self) -> str:

@@ -1,47 +1,53 @@
-"""Loading a program and its environment; name resolution (reference §2.1-§2.7).
+"""Loading a program: storage for what the front end resolved (reference §2.1-§2.7).
 
-:class:`Program` indexes the files of the workspace (module name = file stem), parses
-them lazily (each file once) and builds the run-time module objects
-(:class:`ModuleRT`): routines, data-list store (initialised from the DECL values, kept
-for the whole run, so .dat state persists across calls), types (STRUC/ENUM).
+:class:`Program` is the run-time side of one program model:
 
-Environment:
+* the program's files are those of :func:`krl.project.project_of` (one rule for every
+  command): the KRC backup holding the program (its whole root, ``R1`` and ``STEU``), else
+  every KRL file below the program's folder (or ``--workspace``); outside a backup the
+  project's BASIS (interp/basis: ``$config.dat``, ``bas.src``, ``ir_stopm.src``) is added as
+  the System folder, inside one the backup's own System folder is used;
+* they are loaded, checked and resolved together by the front end
+  (:func:`krl.workspace.load_project`, ``Workspace.check``; krl/semantics/resolve.py gives
+  every use its storage class and slot, every call its routine, every statement its
+  advance-run facts), once per process for the same files (:func:`checked_workspace`);
+* this module only *allocates* storage for those symbols: one :class:`ModuleRT` per module of
+  the workspace (``Workspace.units``, same order: a Storage's ``owner`` is its index) holds
+  its data list's references by slot (``refs``), initialised from the DECL values when the
+  program is loaded and kept for the whole run; the machine data lists of a backup
+  (``Mada``) initialise the system variables they declare. Nothing here looks a name up:
+  a data-list initialiser's names carry their Storage like any other use.
 
-* the program's files are those of krl.project.project_of (one rule for every command): the
-  KRC backup holding the program (its whole root, ``R1`` and ``STEU``), else every KRL file
-  below the program's folder (or ``--workspace``);
-* outside a KRC backup the project's BASIS (interp/basis: ``$config.dat``, ``bas.src``,
-  ``ir_stopm.src``) is the system folder; inside a backup its own System folder is used, and
-  the backup's ``Mada`` data lists (``$machine.dat``, ...) declare further system variables.
-  Files are read in place, never copied.
-
-Resolution order for a name (§2.7): locals/parameters -> the module's data list ->
-globals (``$config.dat``, GLOBAL names of PUBLIC data lists, system data lists) ->
-system variables. Routines: the module's own routines -> GLOBAL routines and module main
-routines -> built-in natives -> the stub policy (see :meth:`Program.find_routine`).
-
-This is the runtime's own small resolver; when the front end's checker has annotated a
-node (``node.ann.symbol``), the interpreters may use that instead (docs/architecture.md).
+``Module.data`` (upper-case name -> reference) is kept for tools and tests that read a data
+list by name (the benchmark's result, a debugger); the interpreters use ``refs``.
 """
 
 from __future__ import annotations
 
+import os
+from collections import OrderedDict
 from pathlib import Path
 
 from krl.ast import nodes as N
+from krl.diagnostics import SYNTAX_CODES
 from krl.project import project_of   # which files make the program: one rule
 from krl.semantics import types as T
-from krl.semantics.symbols import Scope, fill_struc, make_array, system_scopes
+from krl.semantics.resolve import GLOBAL, LOCAL, MODULE, SYSTEM, Storage
 
 from .convert import assign_into, convert_scalar
 from .errors import KrlRuntimeError, ResourceError
-from .memory import Slot, SignalRef
+from .memory import Slot, SignalRef, index_ref
 from .values import UNSET, EnumValue, Struct, data_size, make_value
 
 BASIS_DIR = Path(__file__).resolve().parent.parent / "basis"
-KRL_SUFFIXES = {".src": "src", ".dat": "dat", ".sub": "sub"}
 
-_PARSE_CACHE: dict = {}
+# the files a program's own module cannot have for it to start: input errors (E001, E005),
+# syntax errors and constructs the builder cannot build (E003)
+_START_CODES = SYNTAX_CODES | {"E001", "E003", "E005"}
+# files above this size in total are parsed in worker processes (the Java engine when present)
+_BATCH_BYTES = 256 * 1024
+_CACHE: OrderedDict = OrderedDict()
+_CACHE_SIZE = 8
 
 
 class SyntaxProblem(str):
@@ -56,186 +62,179 @@ class SyntaxProblem(str):
 
 
 def parse_module(path: str):
-    """(Module AST, list of syntax error strings) of one file, cached per process."""
-    from krl.source import read_source  # noqa: PLC0415
+    """(Module AST, syntax error strings) of one file on its own (tools and tests; a run
+    loads its files through :func:`checked_workspace`)."""
+    from krl.workspace import load_file  # noqa: PLC0415
 
-    # read once (a FIFO or device is classified, never opened); the key is the hash of the
-    # very bytes that are parsed
-    src = read_source(path)
-    key = (str(path), src.sha or src.status)
-    got = _PARSE_CACHE.get(key)
-    if got is not None:
-        return got
-    from krl.ast.build import build_module  # noqa: PLC0415
-    from krl.diagnostics import DiagnosticSink  # noqa: PLC0415
-    from krl.syntax.parse import parse_source  # noqa: PLC0415
-    from krl.syntax.messages import syntax_diagnostics  # noqa: PLC0415
-
-    res = parse_source(src)
-    sink = DiagnosticSink()
-    mod = build_module(res, sink)  # E003: a construct that cannot be built stops the start too
+    lf = load_file(path)
     errs = [SyntaxProblem(f"{d.path}:{d.line}:{d.column}: {d.message}", d.path, d.line)
-            for d in syntax_diagnostics(res, src.text) + sink.errors]
-    if not res.ok and not res.errors:
-        errs.append(f"{path}: file not read: {res.status}" + (f" ({src.detail})" if src.detail else ""))
-    got = (mod, errs)
-    _PARSE_CACHE[key] = got
-    return got
+            for d in lf.diagnostics if d.is_error and d.code in _START_CODES]
+    return lf.module, errs
+
+
+def checked_workspace(project, extra: list[Path] = ()):
+    """The loaded, checked and resolved workspace of `project` and the `extra` files (a run's
+    BASIS, a submit program outside the project): cached per process for the same files
+    (path, size, modification time), so the two interpreters of a conformance run, or the
+    programs of one backup, load and check their files once. Never raises for bad input."""
+    from krl.limits import PARSE_TIMEOUT_S  # noqa: PLC0415
+    from krl.workspace import load_project  # noqa: PLC0415
+
+    paths = [*project.files, *extra]
+    key = [str(project.root), project.backup]
+    size = 0
+    for p in paths:
+        try:
+            st = os.stat(p, follow_symlinks=False)
+            key.append((str(p), st.st_size, st.st_mtime_ns))
+            size += st.st_size
+        except OSError:
+            key.append((str(p), -1, -1))
+    key.extend(e.kind + str(e.path) for e in project.entries if e.kind != "file")
+    key = tuple(key)
+    ws = _CACHE.get(key)
+    if ws is not None:
+        _CACHE.move_to_end(key)
+        return ws
+    ws = load_project(project, str(project.root), PARSE_TIMEOUT_S if size > _BATCH_BYTES else None,
+                      extra=list(extra))
+    ws.check()
+    _CACHE[key] = ws
+    while len(_CACHE) > _CACHE_SIZE:
+        _CACHE.popitem(last=False)
+    return ws
 
 
 class ModuleRT:
-    """A module at run time: routines, data list store and types."""
+    """A module at run time: its routines, and the storage of its data list by slot."""
 
-    def __init__(self, name: str, program: "Program") -> None:
-        self.name = name
+    def __init__(self, program: "Program", index: int, unit) -> None:
         self.program = program
+        self.index = index
+        self.unit = unit
+        self.name = unit.name.upper()
         self.files: dict[str, Path] = {}
+        for f, kind in ((unit.src, None), (unit.dat, "dat")):
+            if f is not None:
+                self.files[kind or Path(f.path).suffix.lower().lstrip(".")] = Path(f.path)
+        routines = unit.routines
         self.routines: dict[str, N.Routine] = {}
-        self.main: N.Routine | None = None
-        self.data: dict = {}            # UPPER -> Ref (data-list variables, signals)
-        self.store: dict = {}
-        self.types = Scope("module", name, program.types)
-        self.loaded = False
-        self.errors: list[str] = []         # data-list initialisation problems
+        for r in routines:
+            self.routines.setdefault(r.name.upper(), r)
+        self.main: N.Routine | None = routines[0] if routines else None
+        self.path = unit.src.path if unit.src is not None else (unit.dat.path if unit.dat is not None else "")
+        dl = unit.dat.module.data if unit.dat is not None else None
+        self.datalist: N.DataList | None = dl
+        self.layout = dl.ann.storage if dl is not None and dl.ann is not None else None
+        n = len(self.layout.slots) if self.layout is not None else 0
+        self.refs: list = [None] * n       # slot -> reference (the interpreters' storage)
+        self.store: list = [UNSET] * n     # slot -> value of a variable
+        self.data: dict = {}               # UPPER name -> reference (tools and tests)
+        self.errors: list[str] = []        # data-list initialisation problems
         self.syntax_errors: list[str] = []  # syntax errors of its files (cannot run)
-        self.path = ""
+        self.loaded = False
+        self.loading = False
 
 
 class Program:
-    def __init__(self, rt, main_path: str | Path, workspace: str | Path | None = None) -> None:
+    """The program of one run (module docstring). ``modules``: one ModuleRT per unit of the
+    workspace, by index; ``errors``: the checker's errors in the program's own module (its
+    .src/.dat), which keep it from starting unless the run was asked not to check."""
+
+    def __init__(self, rt, main_path: str | Path, workspace: str | Path | None = None,
+                 submits: list = (), check: bool = True) -> None:
         self.rt = rt
         self.main_path = Path(main_path).resolve()
         self.project = project_of(self.main_path, Path(workspace).resolve() if workspace else None)
         self.backup = self.project.backup
         self.workspace = self.project.root
         self.system_dir = self.project.system if self.backup and self.project.system else BASIS_DIR
-        system, basis = system_scopes()
-        self.types = Scope("global", "$CONFIG", basis)
-        self.globals: dict = {}
-        self.global_routines: dict = {}
-        self.modules: dict[str, ModuleRT] = {}
-        self.index: dict[str, dict[str, Path]] = {}
+        extra = [] if self.backup else sorted(p for p in BASIS_DIR.iterdir() if p.is_file())
+        extra += [Path(s).resolve() for s in submits if Path(s).resolve() not in self.project.files]
+        self.ws = ws = checked_workspace(self.project, extra)
+        self.check = check
+        self.modules: list[ModuleRT] = [ModuleRT(self, i, u) for i, u in enumerate(ws.units)]
+        self.by_name: dict[str, ModuleRT] = {}
+        self.by_path: dict[str, ModuleRT] = {}
+        for m in self.modules:
+            self.by_name.setdefault(m.name, m)
+            for p in m.files.values():
+                self.by_path[str(p)] = m
+        self.sysrefs: list = [None] * len(ws.system_names)
         self.stubs: set[str] = set()
-        self._scanned_all = False
         self.fatal: ResourceError | None = None   # a data list past a limit: the program cannot start
-        self._index_files()
-        self._load_system()
-
-    # ------------------------------------------------------------------ files
-    def _add_file(self, p: Path, system: bool = False) -> None:
-        kind = KRL_SUFFIXES.get(p.suffix.lower())
-        if kind is None:
-            return
-        name = p.stem.upper()
-        entry = self.index.setdefault(name, {})
-        if kind not in entry or system:
-            entry[kind] = p
-
-    def _index_files(self) -> None:
-        """The program's files (krl.project.project_of, in walk order; the first file of a
-        module name and kind counts), then, outside a backup, the project's BASIS."""
-        for p in self.project.files:
-            self._add_file(p)
-        if not self.backup:
-            for p in sorted(self.system_dir.iterdir()):
-                if p.is_file() and p.stem.upper() not in self.index:
-                    self._add_file(p, system=True)
-        self._add_file(self.main_path)
-
-    def _load_system(self) -> None:
-        try:
-            self._load_system_data()
-        except ResourceError as exc:     # the program cannot start (Runtime.main_routine)
-            self.fatal = self.fatal or exc
-
-    def _load_system_data(self) -> None:
-        cfg = self.index.get("$CONFIG", {}).get("dat")
-        if cfg is None:
-            cfg = next((p for p in self.system_dir.iterdir() if p.name.upper() == "$CONFIG.DAT"), None)
-        if cfg is not None:
-            m = self.module("$CONFIG")
-            for k, ref in m.data.items():
-                self.globals.setdefault(k, ref)
-        if self.backup:
-            # the machine data lists of the backup (R1/Mada, STEU/Mada): system variables
-            mada = [p for p in self.project.files
-                    if p.suffix.lower() == ".dat" and p.parent.name.upper() == "MADA"]
-            for p in sorted(mada):
-                try:
-                    self._load_sysdata(p)
-                except ResourceError:
-                    raise
-                except KrlRuntimeError:
-                    continue
-
-    def _load_sysdata(self, p: Path) -> None:
-        mod, errs = parse_module(str(p))
-        if mod.data is None:
-            return
-        m = ModuleRT(p.stem.upper(), self)
-        m.types = self.types
-        self._load_data(m, mod.data, all_global=False)
-        sv = self.rt.sysvars
-        for key, ref in m.data.items():
-            if key in sv.store:
-                # machine data for a system variable of the table: take the backup's value
-                try:
-                    v = ref.peek()
-                    cur = sv.store[key]
-                    if isinstance(cur, Struct) or hasattr(cur, "dims"):
-                        assign_into(cur, v)
-                    elif v is not UNSET:
-                        sv.store[key] = v
-                except KrlRuntimeError:
-                    pass
-            elif key not in sv.info:
-                self.globals.setdefault(key, ref)
+        self._syntax_errors()
+        self._load_all()
 
     # ------------------------------------------------------------------ modules
     def module(self, name: str) -> ModuleRT | None:
-        key = name.upper()
-        m = self.modules.get(key)
-        if m is not None:
+        """The first module named `name` (any case), in the order of the program's files
+        (tools and tests; the interpreters use each call's resolved module)."""
+        return self.by_name.get(name.upper())
+
+    def module_of(self, path: str | Path) -> ModuleRT | None:
+        """The module of the file `path` (the program's main file, a submit program)."""
+        return self.by_path.get(str(Path(path).resolve())) or self.by_path.get(str(path))
+
+    def errors_of(self, m: ModuleRT | None) -> list:
+        """The checker's errors in module `m`'s files (none when the run does not check)."""
+        if m is None or not self.check:
+            return []
+        paths = {str(p) for p in m.files.values()}
+        return [d for d in self.ws.sink.sorted() if d.is_error and d.path in paths]
+
+    def _syntax_errors(self) -> None:
+        by_path: dict[str, list] = {}
+        for d in self.ws.sink.sorted():
+            if d.is_error and d.code in _START_CODES:
+                by_path.setdefault(d.path, []).append(
+                    SyntaxProblem(f"{d.path}:{d.line}:{d.column}: {d.message}", d.path, d.line))
+        for f in self.ws.files:
+            if not f.ok and f.path not in by_path:
+                by_path[f.path] = [SyntaxProblem(f"{f.path}: file not read: {f.status}", f.path, 1)]
+        for m in self.modules:
+            for kind in ("dat", "src", "sub"):
+                p = m.files.get(kind)
+                if p is not None:
+                    m.syntax_errors += by_path.get(str(p), [])
+
+    def _load_all(self) -> None:
+        """Initialise every data list (§2.5): the system data lists first ($config.dat, ...),
+        then the machine data (Mada: the system variables it declares take its values), then
+        the others in the order of the program's files; an initialiser that names another
+        data list's variable loads that list first."""
+        def rank(m: ModuleRT) -> int:
+            if m.datalist is None:
+                return 3
+            if m.datalist.name[:1] != "$":
+                return 2
+            return 1 if _in_mada(m) else 0
+        try:
+            for m in sorted(self.modules, key=rank):
+                self.ensure_loaded(m)
+        except ResourceError as exc:     # the program cannot start (Runtime.main_routine)
+            self.fatal = self.fatal or exc
+
+    def ensure_loaded(self, m: ModuleRT) -> ModuleRT:
+        if m.loaded or m.loading:
             return m
-        files = self.index.get(key)
-        if not files:
-            return None
-        m = ModuleRT(key, self)
-        self.modules[key] = m
-        m.files = files
-        is_config = key == "$CONFIG"
-        if is_config:
-            m.types = self.types
-        dat = files.get("dat")
-        if dat is not None:
-            mod, errs = parse_module(str(dat))
-            m.syntax_errors += errs
-            if mod.data is not None:
-                try:
-                    self._load_data(m, mod.data, all_global=is_config)
-                except ResourceError as exc:
-                    self.fatal = self.fatal or exc
-                    raise
-        src = files.get("src") or files.get("sub")
-        if src is not None:
-            mod, errs = parse_module(str(src))
-            m.syntax_errors += errs
-            m.path = str(src)
-            for i, r in enumerate(mod.routines):
-                m.routines.setdefault(r.name.upper(), r)
-                if i == 0:
-                    m.main = r
-                if r.is_global or i == 0:
-                    self.global_routines.setdefault(r.name.upper(), (m, r))
-        m.loaded = True
+        m.loading = True
+        try:
+            if m.datalist is not None and m.layout is not None:
+                self._load_data(m)
+        finally:
+            m.loading = False
+            m.loaded = True
         return m
 
-    def _load_data(self, m: ModuleRT, data: N.DataList, all_global: bool) -> None:
+    def _load_data(self, m: ModuleRT) -> None:
         """Declare and initialise a data list's variables in ``m`` (§2.5). A declaration that
         fails (unknown type, bad initialiser) is recorded in ``m.errors`` and skipped."""
-        for item in data.items:
+        slot_of = {id(s.decl) if s.var is None else id(s.var): k for k, s in enumerate(m.layout.slots)}
+        mada = self.backup and _in_mada(m)
+        for item in m.datalist.items:
             try:
-                self._load_item(m, data, item, all_global)
+                self._load_item(m, item, slot_of, mada)
             except ResourceError:
                 raise
             except KrlRuntimeError as exc:
@@ -266,71 +265,80 @@ class Program:
         routine DECL, ``decl``) before anything is allocated; returns the elements taken."""
         return self.take_memory_n(self.data_elements(t, vn, decl), vn, decl)
 
-    def _load_item(self, m: ModuleRT, data: N.DataList, item, all_global: bool) -> None:
-        if True:
-            is_glob = all_global or (data.public and getattr(item, "is_global", False))
-            if isinstance(item, N.StrucDecl):
-                st = T.Struc(item.name)
-                scope = self.types if (item.is_global or all_global) else m.types
-                scope.types[item.name.upper()] = st
-                fill_struc(scope, st, [(c.type_name, c.name, tuple(c.dims)) for c in item.components])
-            elif isinstance(item, N.EnumDecl):
-                en = T.Enum(item.name, frozenset(v.upper() for v in item.values))
-                scope = self.types if (item.is_global or all_global) else m.types
-                scope.types[item.name.upper()] = en
-            elif isinstance(item, N.VarDecl):
-                t0 = self.resolve_type(item.type, m.types)
-                for vn in item.names:
-                    t = make_array(t0, vn.dims) if vn.dims else t0
-                    key = vn.name.upper()
-                    self.take_memory(t, vn, item)
-                    m.store[key] = make_value(t)
-                    ref = Slot(m.store, key, t, vn.name, readonly=item.is_const)
-                    if item.init is not None:
-                        try:
-                            v = self.literal(item.init, t, m)
-                            cur = m.store[key]
-                            if isinstance(cur, (Struct,)) or hasattr(cur, "dims"):
-                                assign_into(cur, v)
-                            else:
-                                m.store[key] = convert_scalar(v, t)
-                        except KrlRuntimeError as exc:
-                            m.errors.append(f"{vn.name}: {exc.message}")
-                    m.data[key] = ref
-                    if is_glob:
-                        self.globals[key] = ref
-            elif isinstance(item, N.ArrayInit):
-                ref = m.data.get(item.name.upper())
-                if ref is None:
-                    return
-                try:
-                    from .memory import index_ref  # noqa: PLC0415
+    def declared_type(self, t, tref) -> T.KrlType:
+        """The type the checker gave a declaration; a type nothing declares is an error
+        outside a backup and, in a backup (a type of the controller's system data lists it
+        does not hold, e.g. ESYS of $operate.dat), untyped and logged once."""
+        if t is not None and t is not T.UNKNOWN and not _has_unknown(t):
+            return t
+        name = tref.name if isinstance(tref, N.TypeRef) else str(tref)
+        if not self.backup:
+            raise KrlRuntimeError(f"unknown type {name}")
+        if name.upper() not in self.stubs:
+            self.stubs.add(name.upper())
+            self.rt.message(f"not simulated: type {name} (undeclared; values are untyped)")
+        return T.UNKNOWN
 
-                    target = index_ref(ref, list(item.indices), item.name)
-                    target.set(self.literal(item.value, target.type, m)) if not isinstance(
-                        target.peek(), Struct) else assign_into(target.peek(), self.literal(item.value, target.type, m))
-                except KrlRuntimeError as exc:
-                    m.errors.append(f"{item.name}: {exc.message}")
-            elif isinstance(item, N.ImportDecl):
-                ref = self.import_ref(item)
+    def _load_item(self, m: ModuleRT, item, slot_of: dict, mada: bool) -> None:
+        if isinstance(item, N.VarDecl):
+            for vn in item.names:
+                k = slot_of.get(id(vn))
+                if k is None:
+                    continue             # a repeated name (E102): the first declaration holds it
+                t = self.declared_type(N.type_of(vn), item.type)
+                self.take_memory(t, vn, item)
+                m.store[k] = make_value(t)
+                ref = Slot(m.store, k, t, vn.name, readonly=item.is_const)
+                if item.init is not None:
+                    try:
+                        v = self.literal(item.init, t)
+                        cur = m.store[k]
+                        if isinstance(cur, Struct) or hasattr(cur, "dims"):
+                            assign_into(cur, v)
+                        else:
+                            m.store[k] = convert_scalar(v, t)
+                    except KrlRuntimeError as exc:
+                        m.errors.append(f"{vn.name}: {exc.message}")
+                m.refs[k] = ref
+                m.data[vn.name.upper()] = ref
+                if mada:
+                    self._machine_data(vn.name.upper(), ref)
+        elif isinstance(item, N.ArrayInit):
+            st = item.ann.storage if item.ann is not None else None
+            ref = m.refs[st.slot] if st is not None else None
+            if ref is None:
+                return
+            try:
+                target = index_ref(ref, list(item.indices), item.name)
+                value = self.literal(item.value, target.type)
+                if isinstance(target.peek(), Struct):
+                    assign_into(target.peek(), value)
+                else:
+                    target.set(value)
+            except KrlRuntimeError as exc:
+                m.errors.append(f"{item.name}: {exc.message}")
+        elif isinstance(item, N.SignalDecl):
+            k = slot_of.get(id(item))
+            ref = self.signal_ref(item)
+            if ref is not None and k is not None:
+                m.refs[k] = ref
                 m.data[item.name.upper()] = ref
-            elif isinstance(item, N.SignalDecl):
-                ref = self.signal_ref(item)
-                if ref is not None:
-                    m.data[item.name.upper()] = ref
-                    if is_glob:
-                        self.globals[item.name.upper()] = ref
 
-    def import_ref(self, item: N.ImportDecl):
-        """``IMPORT type name IS /R1/module..var``: the other data list's variable (§2.5)."""
-        path = [p for p in item.path if p]
-        if len(path) < 2:
-            raise KrlRuntimeError(f"IMPORT {item.name}: bad path")
-        mod = self.module(path[-2])
-        ref = mod.data.get(path[-1].upper()) if mod is not None else None
-        if ref is None:
-            raise KrlRuntimeError(f"IMPORT {item.name}: {'/'.join(path)} not found")
-        return ref
+    def _machine_data(self, key: str, ref) -> None:
+        """A machine data list (Mada) declares a system variable of the tables: the system
+        variable takes its value (the data list only initialises it)."""
+        sv = self.rt.sysvars
+        if key not in sv.store:
+            return
+        try:
+            v = ref.peek()
+            cur = sv.store[key]
+            if isinstance(cur, Struct) or hasattr(cur, "dims"):
+                assign_into(cur, v)
+            elif v is not UNSET:
+                sv.store[key] = v
+        except KrlRuntimeError:
+            pass
 
     def signal_ref(self, item: N.SignalDecl):
         if item.start is None:   # `SIGNAL $NAME FALSE`: a signal permanently FALSE
@@ -344,125 +352,54 @@ class Program:
         end = item.end.index if item.end is not None else None
         return SignalRef(arr, item.start.index, end, item.name)
 
-    # ------------------------------------------------------------------ types and literals
-    def scan_types(self) -> None:
-        """Register the GLOBAL STRUC/ENUM types of every data list of the workspace (once):
-        all types first, then the structure components (types may refer to each other)."""
-        if getattr(self, "_types_scanned", False):
-            return
-        self._types_scanned = True
-        pending = []
-        for name, files in list(self.index.items()):
-            dat = files.get("dat")
-            if dat is None:
-                continue
-            mod, _ = parse_module(str(dat))
-            if mod.data is None:
-                continue
-            for item in mod.data.items:
-                if isinstance(item, N.StrucDecl) and item.is_global:
-                    if item.name.upper() not in self.types.types:
-                        st = T.Struc(item.name)
-                        self.types.types[item.name.upper()] = st
-                        pending.append((st, item))
-                elif isinstance(item, N.EnumDecl) and item.is_global:
-                    self.types.types.setdefault(item.name.upper(), T.Enum(
-                        item.name, frozenset(v.upper() for v in item.values)))
-        for st, item in pending:
-            fill_struc(self.types, st, [(c.type_name, c.name, tuple(c.dims)) for c in item.components])
+    # ------------------------------------------------------------------ storage
+    def data_ref(self, st: Storage):
+        """The reference of a MODULE or GLOBAL storage (its data list loaded on demand, for an
+        initialiser that names another list's variable)."""
+        m = self.modules[st.owner]
+        ref = m.refs[st.slot]
+        if ref is None and not m.loaded:
+            self.ensure_loaded(m)
+            ref = m.refs[st.slot]
+        if ref is None:
+            raise KrlRuntimeError(f"unknown name {st.name}")
+        return ref
 
-    def resolve_type(self, tref, scope: Scope):
-        name = tref.name if isinstance(tref, N.TypeRef) else str(tref)
-        t = scope.lookup_type(name)
-        if t is None:
-            self.scan_types()
-            t = scope.lookup_type(name)
-        if t is None:
-            if not self.backup:
-                raise KrlRuntimeError(f"unknown type {name}")
-            # a type of the controller's system data lists that the backup does not hold
-            # (e.g. ESYS of $operate.dat): untyped, logged once
-            if name.upper() not in self.stubs:
-                self.stubs.add(name.upper())
-                self.rt.message(f"not simulated: type {name} (undeclared; values are untyped)")
-            t = T.UNKNOWN
-        size = tref.size if isinstance(tref, N.TypeRef) else None
-        if size:
-            t = T.Array(t, (size,))
-        return t
-
-    def literal(self, e, t, m: ModuleRT):
-        """Value of a data-list initialiser (literals, aggregates, leading minus, constants)."""
-        if isinstance(e, N.IntLit):
-            return e.value
-        if isinstance(e, N.RealLit):
-            return e.value
-        if isinstance(e, N.BoolLit):
-            return e.value
-        if isinstance(e, N.StrLit):
+    def literal(self, e, t):
+        """Value of a data-list or CONST initialiser (literals, aggregates, a leading sign,
+        constants: a name's resolved storage)."""
+        if isinstance(e, (N.IntLit, N.RealLit, N.BoolLit, N.StrLit)):
             return e.value
         if isinstance(e, N.EnumLit):
             return EnumValue(e.name)
         if isinstance(e, N.Unary) and e.op in ("-", "+"):
-            v = self.literal(e.operand, t, m)
+            v = self.literal(e.operand, t)
             return -v if e.op == "-" else v
         if isinstance(e, N.Aggregate):
-            st = None
-            if e.type_name:
-                st = m.types.lookup_type(e.type_name)
+            st = e.ann.storage if e.ann is not None else None
             out = Struct(st if isinstance(st, T.Struc) else None, {})
             ft = t if isinstance(t, T.Struc) else st
             for it in e.items:
                 sub_t = ft.fields.get(it.name.upper(), (None, None))[1] if isinstance(ft, T.Struc) else None
-                out.f[it.name.upper()] = self.literal(it.value, sub_t, m)
+                out.f[it.name.upper()] = self.literal(it.value, sub_t)
             return out
         if isinstance(e, N.Name):
-            ref = m.data.get(e.name.upper()) or self.globals.get(e.name.upper())
-            if ref is not None:
-                return ref.get()
+            st = e.ann.storage if e.ann is not None else None
+            if isinstance(st, Storage) and st.kind in (MODULE, GLOBAL):
+                return self.data_ref(st).get()
+            if isinstance(st, Storage) and st.kind == SYSTEM:
+                return self.rt.sysref(st).get()
             raise KrlRuntimeError(f"unknown name {e.name} in a data list initialisation")
         raise KrlRuntimeError("only literal values are allowed in a data list")
 
-    # ------------------------------------------------------------------ resolution
-    def scan_all(self) -> None:
-        """Load every module of the workspace once (to find GLOBAL routines and data)."""
-        if self._scanned_all:
-            return
-        self._scanned_all = True
-        for name in list(self.index):
-            try:
-                self.module(name)
-            except ResourceError:
-                raise
-            except KrlRuntimeError:
-                continue
-            except RecursionError:
-                continue
 
-    def lookup_global(self, name: str):
-        key = name.upper()
-        ref = self.globals.get(key)
-        if ref is None and not self._scanned_all:
-            self.scan_all()
-            ref = self.globals.get(key)
-        return ref
-
-    def find_routine(self, name: str, module: ModuleRT | None):
-        """(ModuleRT, Routine) for a call of ``name`` from ``module``, or None."""
-        key = name.upper()
-        if module is not None:
-            r = module.routines.get(key)
-            if r is not None:
-                return module, r
-        got = self.global_routines.get(key)
-        if got is not None:
-            return got
-        m = self.module(key)
-        if m is not None and m.main is not None and m.main.name.upper() == key:
-            return m, m.main
-        if not self._scanned_all:
-            self.scan_all()
-            return self.global_routines.get(key)
-        return None
+def _has_unknown(t) -> bool:
+    return isinstance(t, T.Array) and t.elem is T.UNKNOWN
 
 
+def _in_mada(m: ModuleRT) -> bool:
+    p = m.files.get("dat")
+    return p is not None and p.parent.name.upper() == "MADA"
+
+
+__all__ = ["BASIS_DIR", "LOCAL", "ModuleRT", "Program", "SyntaxProblem", "checked_workspace", "parse_module"]

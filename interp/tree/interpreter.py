@@ -7,8 +7,10 @@ variables, advance run, motion, interrupts, triggers, time) is a call into
 (:mod:`interp.runtime.errors`); a block that holds the GOTO's label catches it and
 continues there.
 
-Names: resolved at run time by the runtime's resolver (``Runtime.lookup``), which follows
-the reference's order (§2.7); the checker's annotations are not required.
+Names: the front end resolved them (krl/semantics/resolve.py): each Name carries its
+Storage (a frame slot, a data-list slot, a system variable), each Call its Callee and each
+statement its StmtInfo (advance-run stops); the interpreter reads them and never looks a name
+up (``Runtime.storage_ref``).
 """
 
 from __future__ import annotations
@@ -20,6 +22,7 @@ from interp.runtime.convert import num
 from interp.runtime.slots import (anout_limits, anout_value, array_index, ended_without_return, for_done,
                                  for_limits, for_next, label_not_found, return_without_value, trigger_args)
 from interp.runtime.errors import lvalue_name, ExitSignal, GotoSignal, KrlRuntimeError, ReturnSignal
+from krl.semantics.resolve import LOCAL, SYSTEM
 from interp.runtime.values import EnumValue, Struct, copy_value
 
 
@@ -89,10 +92,9 @@ class TreeInterpreter:
 
     def begin(self, st, frame):
         """Common statement prologue: runtime bookkeeping; returns the StmtInfo."""
-        rt = self.rt
-        info = rt.stmt_info(st, frame)
+        info = st.ann.info
         frame.line = info.line
-        rt.before_statement(info)
+        self.rt.before_statement(info)
         return info
 
     def plain(self, st, frame):
@@ -283,7 +285,7 @@ class TreeInterpreter:
         rt = self.rt
 
         def do():
-            ref = rt.lookup(st.name, frame)
+            ref = rt.storage_ref(st.ann.storage, frame)
             lo, hi = anout_limits(self.eval(st.minimum, frame) if st.minimum is not None else None,
                                   self.eval(st.maximum, frame) if st.maximum is not None else None)
 
@@ -371,7 +373,7 @@ class TreeInterpreter:
         def do():
             if isinstance(act, N.CallStmt):
                 call = act.call
-                target = rt.find_routine(call.name, frame.module)
+                target = rt.callee(call.ann.storage)
                 if target is not None:
                     # the arguments are evaluated now, in the advance run (§5.18)
                     args = [None if a is None else ValueRef(copy_value(self.eval(a, frame)))
@@ -393,8 +395,7 @@ class TreeInterpreter:
         self.guarded(do, st, frame)
 
     def exec_trigger_stmt(self, act, frame, fn) -> None:
-        info = self.rt.stmt_info(act, frame)
-        self.rt.before_statement(info)
+        self.rt.before_statement(act.ann.info)
         try:
             fn()
         except KrlRuntimeError as e:
@@ -456,7 +457,7 @@ class TreeInterpreter:
 
     def call(self, call: N.Call, frame, statement: bool = False, catch_resume: bool = True):
         rt = self.rt
-        target = rt.find_routine(call.name, frame.module)
+        target = rt.callee(call.ann.storage)
         if target is None:
             if rt.is_native(call.name):
                 return rt.call_builtin(call.name, self.args_for(call, frame))
@@ -504,7 +505,7 @@ class TreeInterpreter:
         items = []
         for it in e.items:
             items.append((it.name.upper(), self.eval(it.value, frame)))
-        return self.rt.aggregate(e.type_name, items, frame.module)
+        return self.rt.aggregate(e.ann.storage if e.type_name else None, items)
 
     def e_var(self, e, frame):
         v = self.ref(e, frame).get()
@@ -532,8 +533,14 @@ class TreeInterpreter:
     def ref(self, e, frame):
         """The reference of an lvalue expression (Name / Index / Field chain)."""
         rt = self.rt
-        if isinstance(e, N.Name):
-            return rt.lookup(e.name, frame)
+        if e.__class__ is N.Name:
+            st = e.ann.storage
+            k = st.kind
+            if k == LOCAL:
+                return frame.vars[st.slot]
+            if k < SYSTEM:
+                return rt.modules[st.owner].refs[st.slot] or rt.storage_ref(st, frame)
+            return rt.storage_ref(st, frame)
         if isinstance(e, N.Index):
             base = self.ref(e.base, frame)
             idx = []

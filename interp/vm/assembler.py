@@ -35,7 +35,7 @@ from dataclasses import dataclass, field
 
 from krl.terminal import printable
 
-from interp.runtime.advance import StmtInfo
+from krl.semantics.advance import StmtInfo
 from interp.runtime.values import EnumValue
 
 from . import opcodes as O

@@ -8,18 +8,21 @@ instruction. The readable assembly (assembler.format_listing) is written only fo
 It mirrors the tree interpreter statement by statement (interp/tree/interpreter.py), so
 that the VM makes the same runtime calls in the same order; only the stepping differs:
 
-* names are resolved at compile time to *frame slots* (parameters and locals, in
-  ``.locals`` order), *module slots* (the data list of the routine's module) and *global
-  slots* (globals, system variables; bound on first use, as the runtime resolver would);
+* names come resolved from the front end (krl/semantics/resolve.py): a LOCAL storage is a
+  *frame slot* (parameters and locals, in ``.locals`` order, the routine's Layout), a
+  MODULE storage a *module slot* (the data list of the routine's module), anything else a
+  *global slot* (another data list, a system variable, the ``$``-name fallback; its
+  reference is taken on first use from the storage, Runtime.storage_ref); calls carry their
+  Callee, aggregates their STRUC;
 * structured statements become jumps; GOTO jumps to the label of the nearest enclosing
   block that holds it (the tree interpreter's rule), EXIT to the end of the innermost loop;
 * constant operands are folded with the runtime's own operator (Runtime.binary_op /
   unary_op); an expression whose folding raises is left for run time;
 * conditions that are evaluated later (WAIT FOR, interrupt conditions and handlers,
   TRIGGER actions) are compiled as *thunks* after the routine's END;
-* each statement gets its StmtInfo (advance-run stop flags) from Runtime.stmt_info, the
-  same analysis the tree interpreter uses, and an error region (``.at``) that places
-  run-time errors on the line the tree interpreter would name.
+* each statement's StmtInfo (advance-run stop flags) is the front end's (``stmt.ann.info``,
+  krl/semantics/advance.py), the one the tree interpreter reads, and its error region
+  (``.at``) places run-time errors on the line the tree interpreter would name.
 """
 
 from __future__ import annotations
@@ -29,6 +32,8 @@ from krl.ast import nodes as N
 from interp.runtime.errors import KrlRuntimeError
 from interp.runtime.memory import Frame
 from interp.runtime.values import EnumValue
+from krl.semantics import types as T
+from krl.semantics.resolve import LOCAL, MODULE
 
 from interp.runtime.errors import lvalue_name
 
@@ -45,60 +50,40 @@ _FOLDABLE = (int, float, bool, str, EnumValue)
 
 
 def local_names(routine: N.Routine) -> list[str]:
-    """Frame slots of a routine: its parameters, then its variables (declaration order)."""
-    out = []
-    seen = set()
-    for p in routine.params:
-        if p.name.upper() not in seen:
-            seen.add(p.name.upper())
-            out.append(p.name)
-    for d in routine.decls:
-        if isinstance(d, N.VarDecl):
-            for vn in d.names:
-                if vn.name.upper() not in seen:
-                    seen.add(vn.name.upper())
-                    out.append(vn.name)
-    return out
+    """Frame slots of a routine (its Layout, krl/semantics/resolve.py): its parameters, then
+    its variables and SIGNALs (declaration order)."""
+    return [s.name for s in routine.ann.storage.slots]
 
 
-_LETTERS = {"INT": "I", "REAL": "R", "BOOL": "B", "CHAR": "C"}
+_LETTERS = {T.INT: "I", T.REAL: "R", T.BOOL: "B", T.CHAR: "C"}
 
 
 def store_variables(routine: N.Routine) -> dict:
     """The routine's *store variables* (operand kind ``v``, interp/vm/opcodes.py): UPPER
     name -> (type letter I/R/B/C, number of array dimensions, 0 for a scalar) for each
     variable the frame holds in its own store (Runtime.enter_routine: a local, or an :IN
-    parameter) whose declared type is INT, REAL, BOOL or CHAR, scalar or an array of 1 or
-    2 fixed dimensions; not CONST, not an :OUT parameter (an alias of the caller's
-    variable)."""
-    modes = {p.name.upper(): p.mode for p in routine.params}
+    parameter) whose type (the checker's, from the routine's Layout) is INT, REAL, BOOL or
+    CHAR, scalar or an array of 1 or 2 fixed dimensions; not CONST, not an :OUT parameter
+    (an alias of the caller's variable)."""
+    layout = routine.ann.storage
     out: dict = {}
-    for d in routine.decls:
+    for k, s in enumerate(layout.slots):
+        d = s.decl
         if not isinstance(d, N.VarDecl) or d.is_const or d.init is not None:
             continue
-        letter = _LETTERS.get(d.type.name.upper()) if d.type.size is None else None
-        if letter is None:
+        if k < layout.nparams and s.mode != "IN":
             continue
-        for vn in d.names:
-            key = vn.name.upper()
-            if key in out or (key in modes and modes[key] != "IN"):
+        t = s.type
+        dims = 0
+        if isinstance(t, T.Array):
+            if len(t.dims) > 2 or 0 in t.dims:
                 continue
-            if len(vn.dims) > 2 or 0 in vn.dims:
-                continue
-            out[key] = (letter, len(vn.dims))
+            dims = len(t.dims)
+            t = t.elem
+        letter = _LETTERS.get(t)
+        if letter is not None:
+            out[s.name.upper()] = (letter, dims)
     return out
-
-
-def static_frame(rt, module, routine) -> Frame:
-    """A frame with the routine's names bound (for the advance-run analysis when the
-    routine is compiled without being called, e.g. by `krl asm`)."""
-    f = Frame(routine, module, None)
-    for n in local_names(routine):
-        f.vars[n.upper()] = None
-    for d in routine.decls:
-        if isinstance(d, N.SignalDecl):
-            f.vars[d.name.upper()] = None
-    return f
 
 
 class Compiler:
@@ -106,13 +91,16 @@ class Compiler:
         self.rt = rt
         self.module = module
         self.routine = routine
-        self.frame = frame if frame is not None else static_frame(rt, module, routine)
         self.locals = local_names(routine)
         self.local_set = {n.upper() for n in self.locals}
         self.fast = store_variables(routine)
         self.spelling = {n.upper(): n for n in self.locals}
-        self.data = module.data if module is not None else {}
         self.lst = Listing(routine.name, routine.kind, routine.span.file, self.locals, 0)
+        # what the front end resolved, for the names this code uses (by upper-case spelling:
+        # one routine's text resolves a spelling one way): the VM binds them (VM.code_for)
+        self.lst.storages = {}
+        self.lst.callees = {}
+        self.lst.types = {}
         self.region: Region | None = None
         self.nlabels = 0
         self.blocks: list[dict] = []      # label tables of the enclosing statement lists
@@ -138,7 +126,7 @@ class Compiler:
         return t
 
     def info(self, st) -> tuple:
-        si = self.rt.stmt_info(st, self.frame)
+        si = st.ann.info
         return (si.line, ("S" if si.stops else "") + ("C" if si.cond_stops else ""))
 
     def guarded(self, st) -> str:
@@ -420,7 +408,7 @@ class Compiler:
         def value():
             self.region = None
             self.expr(st.value)
-        self.emit("REF_" + self.kind_of(st.name), self.spelled(st.name))
+        self.emit("REF_" + self.kind_of(st.name, st.ann.storage), self.spelled(st.name))
         flags = ""
         if st.minimum is not None:
             self.expr(st.minimum)
@@ -496,6 +484,7 @@ class Compiler:
         region = self.region
         if isinstance(act, N.CallStmt):
             nf = self.new_label()
+            self.callee(act.call)
             self.emit("TRIG_FIND", act.call.name, nf)
             for a in act.call.args:      # evaluated now, in the advance run, by value (§5.18)
                 if a is None:
@@ -591,8 +580,12 @@ class Compiler:
                 self.expr(a)
                 self.emit("VALARG")
 
+    def callee(self, call: N.Call) -> None:
+        self.lst.callees[call.name.upper()] = call.ann.storage
+
     def call(self, call: N.Call, flags: str) -> None:
         self.args(call)
+        self.callee(call)
         self.emit("CALL", call.name, len(call.args), flags)
 
     # ------------------------------------------------------------------ names
@@ -605,17 +598,16 @@ class Compiler:
             got = self.spelling[key] = name
         return got
 
-    def kind_of(self, name: str) -> str:
-        key = name.upper()
-        if key in self.local_set:
+    def kind_of(self, name: str, st) -> str:
+        """The operand class of a resolved name (its Storage): LOCAL, MOD or GLOBAL."""
+        if st.kind == LOCAL:
             return "LOCAL"
-        if key in self.data:
-            return "MOD"
-        return "GLOBAL"
+        self.lst.storages[name.upper()] = st
+        return "MOD" if st.kind == MODULE else "GLOBAL"
 
     def fast_scalar(self, e) -> str | None:
         """The type letter of ``e`` if it is a scalar store variable, else None."""
-        if isinstance(e, N.Name):
+        if isinstance(e, N.Name) and e.ann.storage.kind == LOCAL:
             got = self.fast.get(e.name.upper())
             if got is not None and got[1] == 0:
                 return got[0]
@@ -624,7 +616,8 @@ class Compiler:
     def fast_array(self, e) -> str | None:
         """The element type letter of ``e`` if it is ``store array[i]`` or ``[i, j]`` with
         every index given and as many as the array's dimensions, else None."""
-        if isinstance(e, N.Index) and isinstance(e.base, N.Name) and None not in e.indices:
+        if isinstance(e, N.Index) and isinstance(e.base, N.Name) and None not in e.indices \
+                and e.base.ann.storage.kind == LOCAL:
             got = self.fast.get(e.base.name.upper())
             if got is not None and got[1] == len(e.indices):
                 return got[0]
@@ -632,7 +625,7 @@ class Compiler:
 
     def ref(self, e) -> None:
         if isinstance(e, N.Name):
-            self.emit("REF_" + self.kind_of(e.name), self.spelled(e.name))
+            self.emit("REF_" + self.kind_of(e.name, e.ann.storage), self.spelled(e.name))
         elif isinstance(e, N.Index):
             self.ref(e.base)
             self.indices(e)
@@ -662,7 +655,7 @@ class Compiler:
                       letter)
             return
         if isinstance(target, N.Name):
-            self.emit("STORE_" + self.kind_of(target.name), self.spelled(target.name))
+            self.emit("STORE_" + self.kind_of(target.name, target.ann.storage), self.spelled(target.name))
         elif isinstance(target, N.Index) and None not in target.indices:
             self.ref(target.base)
             self.indices(target)
@@ -731,7 +724,7 @@ class Compiler:
         elif self.fast_scalar(e) is not None:
             self.emit("LOAD_FAST", self.spelled(e.name))
         elif isinstance(e, N.Name):
-            self.emit("LOAD_" + self.kind_of(e.name), self.spelled(e.name))
+            self.emit("LOAD_" + self.kind_of(e.name, e.ann.storage), self.spelled(e.name))
         elif self.fast_array(e) is not None:
             self.indices(e)
             self.emit(f"LOAD_ELEM{len(e.indices)}", self.spelled(e.base.name), name_of(e.base))
@@ -770,6 +763,8 @@ class Compiler:
         elif isinstance(e, N.Aggregate):
             for it in e.items:
                 self.expr(it.value)
+            if e.type_name:
+                self.lst.types[e.type_name.upper()] = e.ann.storage
             self.emit("AGG", e.type_name, ",".join(it.name.upper() for it in e.items))
         else:
             self.emit("RAISE", f"cannot evaluate {type(e).__name__}", 0)

@@ -257,13 +257,19 @@ class VM:
     def code_for(self, module, routine, frame=None) -> Code:
         code = self.codes.get(id(routine))
         if code is None:
-            code = encode(compile_routine(self.rt, module, routine, frame))   # no text on the way
+            lst = compile_routine(self.rt, module, routine, frame)
+            code = encode(lst)   # no text on the way
             code.routine = routine
             code.module = module
-            data = module.data if module is not None else {}
-            code.mrefs = [data.get(n.upper()) for n in code.mnames]
+            rt = self.rt
+            # the storage the front end resolved: module slots bound now (the data lists are
+            # loaded), global slots on first use (Runtime.storage_ref), frame slots by number
+            code.mrefs = [rt.storage_ref(lst.storages[n.upper()], None) for n in code.mnames]
+            code.gstorage = [lst.storages[n.upper()] for n in code.gnames]
             code.grefs = [None] * len(code.gnames)
-            code.lkeys = [n.upper() for n in code.lnames]
+            code.lkeys = list(range(len(code.lnames)))
+            code.callees = lst.callees
+            code.types = lst.types
             code.prog, code.iregions = decode(code)
             self.codes[id(routine)] = code
         return code
@@ -285,7 +291,7 @@ class VM:
         """A CALL whose routine is not known yet (the loop calls a known one itself):
         a built-in, a stub, or a routine found now and kept for this call site."""
         rt = self.rt
-        target = rt.find_routine(name, frame.module)
+        target = rt.callee(code.callees[name.upper()])
         if target is None:
             if rt.is_native(name):
                 return rt.call_builtin(name, args)
@@ -830,7 +836,7 @@ class VM:
                         g = ins[1]
                         ref = grefs[g]
                         if ref is None:
-                            ref = rt.lookup(code.gnames[g], frame)
+                            ref = rt.storage_ref(code.gstorage[g], frame)
                             grefs[g] = ref
                         if op == OP.LOAD_GLOBAL:
                             push(_load(ref))
@@ -883,7 +889,8 @@ class VM:
                         k = len(keys)
                         vals = stack[len(stack) - k:]
                         del stack[len(stack) - k:]
-                        push(rt.aggregate(ins[1], list(zip(keys, vals)), frame.module))
+                        push(rt.aggregate(code.types.get(ins[1].upper()) if ins[1] else None,
+                                          list(zip(keys, vals))))
                         ip += 1
                     elif op == OP.JUMP_IF_NONE:
                         if stack[-1] is None:
@@ -966,7 +973,7 @@ class VM:
                         rt.resume()
                         ip += 1
                     elif op == OP.TRIG_FIND:
-                        target = rt.find_routine(ins[1], frame.module)
+                        target = rt.callee(code.callees[ins[1].upper()])
                         push(target)
                         ip = ins[2] if target is None else ip + 1
                     elif op == OP.TRIG_PACK:

@@ -59,14 +59,20 @@ NO_SPAN = Span()
 class Annotation:
     """The checker's results for one node.
 
-    type:   static type of an expression (krl.semantics.types.KrlType) or None;
-    symbol: resolved symbol of a Name/Call/For variable/Goto (krl.semantics.symbols.Symbol);
-    extra:  free-form notes (e.g. ``{"whole_array": True}``, ``{"conversion": "REAL->INT"}``).
+    type:    static type of an expression (krl.semantics.types.KrlType) or None;
+    symbol:  resolved symbol of a Name/Call/For variable/Goto (krl.semantics.symbols.Symbol);
+    extra:   free-form notes (e.g. ``{"whole_array": True}``, ``{"conversion": "REAL->INT"}``);
+    storage: where a Name's variable lives, or which routine a Call runs (the resolver,
+             krl/semantics/resolve.py: ``Storage``, ``Callee``); a Routine's or DataList's
+             slot layout (``Layout``);
+    info:    a statement's place and advance-run stops (krl/semantics/advance.py ``StmtInfo``).
     """
 
     type: Any = None
     symbol: Any = None
     extra: dict = field(default_factory=dict)
+    storage: Any = None
+    info: Any = None
 
 
 @dataclass(slots=True)

@@ -331,16 +331,8 @@ class Checker:
             ctx.next_block += 1
             ctx.block_path.append(ctx.next_block)
         try:
-            after_continue = False
             for s in stmts:
                 self.stmt(s, ctx)
-                reason = advance_stop(s)
-                if reason:
-                    extra = s.annotate().extra
-                    extra["advance_stop"] = reason
-                    if after_continue:
-                        extra["continued"] = True
-                after_continue = isinstance(s, N.Continue)
         finally:
             if new_block:
                 ctx.block_path.pop()
@@ -923,60 +915,6 @@ class Checker:
 
     def not_found_type(self, span: N.Span, name: str, sc: Scope) -> None:
         self.unknown("type", name, span)
-
-
-def _reads(e: N.Node | None) -> str | None:
-    """The first name read in `e` whose symbol stops the advance run when read, else None."""
-    if e is None:
-        return None
-    for n in e.walk():
-        if isinstance(n, N.Name):
-            sym = N.symbol_of(n)
-            if isinstance(sym, Symbol) and sym.stop_read:
-                return f"reads {sym.name}"
-    return None
-
-
-def advance_stop(s: N.Stmt) -> str | None:
-    """Why statement `s` stops the advance run (reference 6.10), or None.
-
-    The checker stores the reason in ``s.ann.extra["advance_stop"]`` and marks statements
-    right after CONTINUE with ``s.ann.extra["continued"] = True`` (5.9); the interpreters
-    decide what to do with it. Only the statement's own expressions count (for IF/WHILE/
-    SWITCH the condition), not nested blocks.
-    """
-    if isinstance(s, (N.WaitFor, N.WaitSec, N.Halt)):
-        return {"WaitFor": "WAIT FOR", "WaitSec": "WAIT SEC", "Halt": "HALT"}[type(s).__name__]
-    if isinstance(s, (N.AninOn, N.AninOff, N.AnoutOn, N.AnoutOff)):
-        return "analog I/O"
-    if isinstance(s, N.Assign):
-        root = N.root_name(s.target)
-        sym = N.symbol_of(root) if root is not None else None
-        if isinstance(sym, Symbol) and sym.stop_write:
-            return f"writes {sym.name}"
-        index_reads = None
-        node = s.target
-        while isinstance(node, (N.Index, N.Field)):          # a[$IN[1]] = ... reads too
-            if isinstance(node, N.Index):
-                for i in node.indices:
-                    index_reads = index_reads or _reads(i)
-            node = node.base
-        return _reads(s.value) or index_reads
-    if isinstance(s, N.CallStmt):
-        if s.call.name.upper() == "PULSE":
-            return "PULSE"
-        return _reads(s.call)
-    if isinstance(s, (N.If, N.While, N.Repeat)):
-        return _reads(s.cond)
-    if isinstance(s, N.Switch):
-        return _reads(s.selector)
-    if isinstance(s, N.For):
-        return _reads(s.start) or _reads(s.end)
-    if isinstance(s, N.Motion):
-        return _reads(s.target) or _reads(s.aux)
-    if isinstance(s, N.Return):
-        return _reads(s.value)
-    return None
 
 
 def _char_like(t: T.KrlType) -> bool:

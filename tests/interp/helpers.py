@@ -46,7 +46,8 @@ def run_krl(tmp: Path, src: str, dat: str | None = None, name: str = "prog", *, 
         inputs = write(tmp, "stimuli.yaml", stimuli)
     tw = TraceWriter(keep=True) if trace else None
     rt, _ = make_runtime(prog, inputs=inputs, trace=tw, max_sim_time=max_sim_time, max_steps=max_steps,
-                         mujoco=False, submit=[tmp / s for s in (submit or [])])
+                         mujoco=False, submit=[tmp / s for s in (submit or [])],
+                         check=False)   # run-time semantics, errors included (krl run --no-check)
     if before is not None:
         before(rt)
     res = rt.run()

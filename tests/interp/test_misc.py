@@ -217,7 +217,12 @@ def test_no_return_event_after_an_error(tmp_path):
     assert not [e for e in r.kinds("return") if e["name"] == "Fail"]
 
 
-def test_cli_check_refuses_a_program_with_errors(tmp_path):
-    bad = write(tmp_path, "chk.src", "DEF chk()\n  DECL INT i\n  i = TRUE\nEND\n")
-    p = _krl("run", bad, "--check")
-    assert p.returncode == 1 and "E201" in p.stdout and "not started" in p.stdout
+def test_cli_refuses_a_program_with_errors_unless_no_check(tmp_path):
+    """A program the checker rejects does not run (exit 1, the errors and "not started"),
+    unless --no-check: then it runs and stops on the run-time error at that line."""
+    bad = write(tmp_path, "chk.src", "DEF chk()\n  DECL INT i\n  $OUT[1] = TRUE\n  i = Nowhere()\nEND\n")
+    p = _krl("run", bad)
+    assert p.returncode == 1 and "E106" in p.stdout and "not started" in p.stdout
+    p = _krl("run", bad, "--no-check")
+    assert p.returncode == 1 and "not started" not in p.stdout
+    assert "chk.src:4" in p.stdout and "routine Nowhere not found" in p.stdout

@@ -1,0 +1,377 @@
+"""The resolver: after checking, every use of a name gets its storage, as clox's resolver does.
+
+The checker (krl/semantics/checker.py) gives each Name and Call its :class:`Symbol`. This pass
+(:func:`resolve_workspace`, run by ``Workspace.check``) turns symbols into places, once, ahead
+of any run; the interpreters (interp/) allocate storage for them and never look a name up:
+
+* every Routine gets a :class:`Layout` (``routine.ann.storage``): its frame slots — the
+  parameters in order, then its local variables, SIGNALs and IMPORTs in declaration order;
+* every DataList gets a :class:`Layout` of its data-list slots (variables and SIGNALs);
+* every Name (an expression, an assignment target, a FOR variable, a WITH target) gets a
+  :class:`Storage` (``name.ann.storage``): its *storage class* and *slot*:
+
+  ========== ============================================================================
+  class      where the variable lives
+  ========== ============================================================================
+  LOCAL      a slot of the routine's frame: a local, or a parameter (an :IN copy, or the
+             caller's reference for :OUT); ``slot`` is the frame slot
+  MODULE     a slot of the data list of the routine's own module (``owner``: the module's
+             index in ``Workspace.units``, ``slot`` its data-list slot)
+  GLOBAL     a slot of another data list: ``$config.dat``, a system data list
+             (``$machine.dat``, ...), a GLOBAL declaration of a PUBLIC data list
+  SYSTEM     a system variable of the tables (krl/semantics/data), ``slot`` its index in
+             ``Workspace.system_names``; machine data a backup declares for it (Mada)
+             initialises it
+  UNRESOLVED nothing declares the name: a ``$`` name goes to the runtime's documented
+             fallback (``Runtime.lookup``: the simulated system variables, and in a backup
+             an undeclared one that reads 0); any other name is the run-time error
+             "unknown name" where it is evaluated
+  ========== ============================================================================
+
+  An IMPORT name stands for the imported data-list variable (its storage). A name inside a
+  routine whose file does not parse (the checker does not check such bodies) is resolved
+  with the same scopes (``Scope.lookup``).
+* every Call gets a :class:`Callee` (``call.ann.storage``): the module and Routine it runs,
+  or a built-in routine (``native``), or none (the stub policy decides at run time);
+* every statement gets its :class:`krl.semantics.advance.StmtInfo` (``stmt.ann.info``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from krl.ast import nodes as N
+from krl.semantics import types as T
+from krl.semantics.advance import analyse
+from krl.semantics.symbols import Scope, Symbol, system_scopes
+
+LOCAL, MODULE, GLOBAL, SYSTEM, UNRESOLVED = range(5)
+CLASS_NAMES = ("local", "module", "global", "system", "unresolved")
+
+
+@dataclass(slots=True, eq=False)
+class Storage:
+    """Where a name's variable lives: ``kind`` (LOCAL, MODULE, GLOBAL, SYSTEM, UNRESOLVED),
+    ``slot`` (frame slot, data-list slot, or index in ``Workspace.system_names``), ``owner``
+    (the data list's module index in ``Workspace.units``; -1 otherwise), ``name`` (the
+    declared spelling; the upper-case key for SYSTEM; the use's spelling for UNRESOLVED,
+    for its run-time error) and ``symbol``."""
+    kind: int
+    slot: int = -1
+    owner: int = -1
+    name: str = ""
+    symbol: Symbol | None = None
+
+    def __repr__(self) -> str:
+        where = f"{self.owner}:{self.slot}" if self.owner >= 0 else str(self.slot)
+        return f"Storage({CLASS_NAMES[self.kind]} {self.name} @{where})"
+
+
+@dataclass(slots=True, eq=False)
+class Callee:
+    """What a call runs: ``routine`` (a Routine of the program) in module ``owner`` (index in
+    ``Workspace.units``), or ``native`` True (a built-in routine of the tables), or neither
+    (nothing declares it: the run-time stub policy); ``name`` as called."""
+    name: str
+    owner: int = -1
+    routine: N.Routine | None = None
+    native: bool = False
+
+
+@dataclass(slots=True, eq=False)
+class Slot:
+    """One slot of a Layout: the declared spelling, the symbol, its declaration node (VarDecl,
+    SignalDecl or Param), the VarName for a variable, its type and the parameter mode."""
+    name: str
+    symbol: Symbol | None
+    decl: object
+    var: N.VarName | None = None
+    type: T.KrlType | None = None
+    mode: str | None = None
+
+
+@dataclass(slots=True, eq=False)
+class Layout:
+    """The slots of a routine's frame (parameters first: ``nparams``) or of a data list,
+    and the scope the names were resolved in (VARSTATE's text and tools use it)."""
+    slots: list[Slot] = field(default_factory=list)
+    nparams: int = 0
+    scope: Scope | None = None
+    owner: int = -1
+    returns: T.KrlType | None = None       # a function's return type (None for a DEF)
+
+    def index(self, name: str) -> int | None:
+        """The slot of `name` (any case), else None: for tools (debugger, VARSTATE), not for
+        the interpreters, which read each use's Storage."""
+        key = name.upper()
+        for i, s in enumerate(self.slots):
+            if s.name.upper() == key:
+                return i
+        return None
+
+
+def _data_layout(dl: N.DataList, owner: int) -> Layout:
+    lay = Layout(owner=owner)
+    seen: set = set()
+    for d in dl.items:
+        if isinstance(d, N.VarDecl):
+            for v in d.names:
+                if v.name.upper() in seen:
+                    continue
+                seen.add(v.name.upper())
+                lay.slots.append(Slot(v.name, N.symbol_of(v), d, v, N.type_of(v)))
+        elif isinstance(d, N.SignalDecl) and d.name.upper() not in seen:
+            seen.add(d.name.upper())
+            lay.slots.append(Slot(d.name, None, d))
+    return lay
+
+
+def _routine_layout(r: N.Routine, scope: Scope | None, owner: int) -> Layout:
+    lay = Layout(scope=scope, owner=owner)
+    values = scope.values if scope is not None else {}
+    seen: set = set()
+    modes = {}
+    for p in r.params:
+        key = p.name.upper()
+        modes[key] = p.mode
+        if key in seen:
+            continue
+        seen.add(key)
+        sym = values.get(key)
+        lay.slots.append(Slot(p.name, sym, p, type=sym.type if sym is not None else None, mode=p.mode))
+    lay.nparams = len(lay.slots)
+    for d in r.decls:
+        if isinstance(d, N.VarDecl):
+            for v in d.names:
+                key = v.name.upper()
+                if key in seen:
+                    if key in modes:     # the declaration of a parameter: its type and VarName
+                        i = next(i for i, s in enumerate(lay.slots) if s.name.upper() == key)
+                        lay.slots[i].var = v
+                        lay.slots[i].decl = d
+                        lay.slots[i].type = N.type_of(v)
+                    continue
+                seen.add(key)
+                lay.slots.append(Slot(v.name, values.get(key), d, v, N.type_of(v)))
+        elif isinstance(d, N.SignalDecl) and d.name.upper() not in seen:
+            seen.add(d.name.upper())
+            lay.slots.append(Slot(d.name, values.get(d.name.upper()), d))
+    return lay
+
+
+class Resolver:
+    """One pass over a checked workspace (see the module docstring)."""
+
+    def __init__(self, ws) -> None:
+        self.ws = ws
+        self.system, _ = system_scopes()
+        self.places: dict[int, tuple[int, int, int]] = {}   # id(Symbol) -> (kind, owner, slot)
+        self.system_index: dict[str, int] = {}
+        self.unit_of: dict[int, int] = {}                    # id(Routine) -> unit index
+        self.native_names = set(self.system.routines)
+
+    # ------------------------------------------------------------------ layouts
+    def run(self) -> None:
+        ws = self.ws
+        ws.system_names = []
+        ws.resolver = self
+        returns: dict[int, T.KrlType | None] = {}
+        for scope in [ws.global_scope] + [u.scope for u in ws.units]:
+            for sym in (scope.routines.values() if scope is not None else ()):
+                if isinstance(sym.decl, N.Routine) and sym.signature is not None:
+                    returns.setdefault(id(sym.decl), sym.signature.returns)
+        for i, u in enumerate(ws.units):
+            if u.src is not None:
+                for r in u.src.module.routines:
+                    self.unit_of[id(r)] = i
+            if u.dat is not None and u.dat.module.data is not None:
+                lay = _data_layout(u.dat.module.data, i)
+                u.dat.module.data.annotate().storage = lay
+                for k, s in enumerate(lay.slots):
+                    sym = s.symbol if s.symbol is not None else (u.scope.values.get(s.name.upper())
+                                                                 if u.scope is not None else None)
+                    if sym is None and ws.global_scope is not None:
+                        sym = ws.global_scope.values.get(s.name.upper())
+                        if sym is not None and sym.decl is not s.decl:
+                            sym = None
+                    if sym is not None:
+                        s.symbol = sym
+                        self.places.setdefault(id(sym), (MODULE, i, k))
+        for i, u in enumerate(ws.units):
+            if u.dat is not None and u.dat.module.data is not None:
+                dl = u.dat.module.data
+                scope = u.scope if u.scope is not None else ws.global_scope
+                for d in dl.items:
+                    if isinstance(d, N.VarDecl) and d.init is not None:
+                        self.expr(d.init, scope, None, i)
+                    elif isinstance(d, N.ArrayInit):
+                        # `NAME[i] = value`: an element of this data list's own variable
+                        k = u.dat.module.data.ann.storage.index(d.name)
+                        d.annotate().storage = Storage(MODULE, k, i, d.name) if k is not None else None
+                        for e in (*d.indices, d.value):
+                            self.expr(e, scope, None, i)
+            if u.src is None:
+                continue
+            for r in u.src.module.routines:
+                scope = ws.routine_scope(r) or u.scope
+                lay = _routine_layout(r, ws.routine_scope(r), i)
+                lay.returns = returns.get(id(r)) if r.kind == "DEFFCT" else None
+                r.annotate().storage = lay
+                local = {id(s.symbol) if s.symbol is not None else s.name.upper(): k
+                         for k, s in enumerate(lay.slots)}
+                for d in r.decls:
+                    if isinstance(d, N.VarDecl) and d.init is not None:
+                        self.expr(d.init, scope, local, i)
+                self.block(r.body, scope, local, i)
+
+    # ------------------------------------------------------------------ names
+    def import_target(self, d: N.ImportDecl) -> Symbol | None:
+        """The data-list variable ``IMPORT type name IS /R1/module..var`` names (2.5): the
+        module's own or exported declaration of that name (as Workspace._link_imports links
+        the data lists' IMPORTs; this also serves a routine's)."""
+        path = [p for p in d.path if p]
+        if len(path) < 2:
+            return None
+        mod, var = path[-2].upper(), path[-1].upper()
+        for u in self.ws.units:
+            names = {u.name.upper()}
+            if u.dat is not None and u.dat.module.data is not None:
+                names.add(u.dat.module.data.name.upper())
+            if mod not in names:
+                continue
+            got = u.scope.values.get(var) if u.scope is not None else None
+            if got is None and self.ws.global_scope is not None:
+                g = self.ws.global_scope.values.get(var)
+                got = g if g is not None and g.module.upper() in names else None
+            if got is not None:
+                return got
+        return None
+
+    def storage(self, name: str, sym: Symbol | None, local: dict | None, unit: int) -> Storage:
+        hops = 0
+        while sym is not None and (sym.alias is not None or isinstance(sym.decl, N.ImportDecl)):
+            # IMPORT: the imported variable (an IMPORT of an IMPORT is followed a few times)
+            hops += 1
+            sym = (sym.alias if sym.alias is not None else self.import_target(sym.decl)) if hops < 8 else None
+        if sym is None and local is not None and name.upper() in local:
+            # a parameter without a declaration (E101): the caller's argument all the same
+            return Storage(LOCAL, local[name.upper()], -1, name)
+        if sym is None or sym.kind in ("routine", "type", "label"):
+            return Storage(UNRESOLVED, name=name)
+        if local is not None:
+            k = local.get(id(sym))
+            if k is not None:
+                return Storage(LOCAL, k, -1, sym.name, sym)
+        place = self.places.get(id(sym))
+        if place is not None:
+            key = name.upper()
+            if key[:1] == "$" and key in self.system.values and sym.scope != "routine" and \
+                    sym.module[:1] == "$":
+                # machine data (a system data list) for a system variable of the tables: the
+                # variable is the system's; the data list only initialises it
+                return self.system_storage(self.system.values[key])
+            _, owner, slot = place
+            return Storage(MODULE if owner == unit else GLOBAL, slot, owner, sym.name, sym)
+        if sym.scope in ("system", "basis") or sym.kind == "sysvar":
+            if name[:1] == "$":
+                return self.system_storage(sym)
+            return Storage(UNRESOLVED, name=name, symbol=sym)
+        return Storage(UNRESOLVED, name=name, symbol=sym)
+
+    def system_storage(self, sym: Symbol) -> Storage:
+        key = sym.name.upper()
+        k = self.system_index.get(key)
+        if k is None:
+            k = self.system_index[key] = len(self.ws.system_names)
+            self.ws.system_names.append(key)
+        return Storage(SYSTEM, k, -1, key, sym)
+
+    def name(self, e: N.Name, scope: Scope | None, local, unit: int) -> None:
+        sym = N.symbol_of(e)
+        if not isinstance(sym, Symbol) and scope is not None:
+            sym = scope.lookup(e.name)
+        e.annotate().storage = self.storage(e.name, sym, local, unit)
+
+    def call(self, c: N.Call, scope: Scope | None, unit: int) -> None:
+        sym = N.symbol_of(c)
+        if not isinstance(sym, Symbol) and scope is not None:
+            sym = scope.lookup_routine(c.name)
+        callee = Callee(c.name)
+        if isinstance(sym, Symbol):
+            if isinstance(sym.decl, N.Routine):
+                callee.routine = sym.decl
+                callee.owner = self.unit_of.get(id(sym.decl), -1)
+            elif sym.scope == "system" or (sym.decl is None and c.name.upper() in self.native_names):
+                callee.native = True
+        c.annotate().storage = callee
+
+    def expr(self, e, scope, local, unit: int) -> None:
+        """Resolve every Name and Call of expression `e` (iteratively: a 500-term chain costs
+        no stack)."""
+        stack = [e]
+        while stack:
+            n = stack.pop()
+            if not isinstance(n, N.Node):
+                continue
+            if isinstance(n, N.Name):
+                self.name(n, scope, local, unit)
+                continue
+            if isinstance(n, N.Call):
+                self.call(n, scope, unit)
+            elif isinstance(n, N.Aggregate) and n.type_name and scope is not None:
+                t = N.type_of(n)
+                n.annotate().storage = t if isinstance(t, T.Struc) else scope.lookup_type(n.type_name)
+            stack.extend(n.children())
+
+    # ------------------------------------------------------------------ statements
+    def block(self, stmts, scope, local, unit: int) -> None:
+        after_continue = False
+        for s in stmts:
+            self.stmt(s, scope, local, unit)
+            info = s.annotate().info = analyse(s, _symbol_of)
+            if info.reason is not None:
+                s.ann.extra["advance_stop"] = info.reason
+                if after_continue:
+                    s.ann.extra["continued"] = True
+            after_continue = isinstance(s, N.Continue)
+
+    def stmt(self, s, scope, local, unit: int) -> None:
+        blocks = []
+        for f in s.__dataclass_fields__:
+            v = getattr(s, f)
+            if isinstance(v, list):
+                if v and isinstance(v[0], N.Stmt):
+                    blocks.append(v)
+                else:
+                    for x in v:
+                        if isinstance(x, N.Case):
+                            self.exprs(x.values, scope, local, unit)
+                            blocks.append(x.body)
+                        elif isinstance(x, N.Node):
+                            self.expr(x, scope, local, unit)
+            elif isinstance(v, N.Stmt):
+                self.stmt(v, scope, local, unit)          # a TRIGGER's action
+                v.annotate().info = analyse(v, _symbol_of)
+            elif isinstance(v, N.Node):
+                self.expr(v, scope, local, unit)
+        if isinstance(s, (N.AnoutOn, N.AnoutOff, N.AninOff)) and scope is not None:
+            # the analog channel is named by a plain word in these statements
+            s.annotate().storage = self.storage(s.name, scope.lookup(s.name), local, unit)
+        for b in blocks:
+            self.block(b, scope, local, unit)
+
+    def exprs(self, es, scope, local, unit) -> None:
+        for e in es:
+            self.expr(e, scope, local, unit)
+
+
+def _symbol_of(node) -> Symbol | None:
+    st = node.ann.storage if node.ann is not None else None
+    sym = st.symbol if isinstance(st, Storage) else None
+    return sym if sym is not None else N.symbol_of(node)
+
+
+def resolve_workspace(ws) -> None:
+    """Give every routine and data list of the checked workspace `ws` its Layout, every Name
+    its Storage, every Call its Callee and every statement its StmtInfo (module docstring)."""
+    Resolver(ws).run()
