@@ -9,28 +9,31 @@ import click
 
 
 def program_assembly(program: Path, workspace: Path | None = None, all_modules: bool = False) -> str:
-    """The assembly text of PROGRAM's module (with ``all_modules``: of every module of the
-    workspace that has routines), compiled as the VM would compile it."""
-    from interp.run import make_runtime  # noqa: PLC0415
-
+    """The assembly text of PROGRAM's module (with ``all_modules``: of every module of its
+    program that has routines): the listings the VM links and runs, compiled from the
+    checked, resolved program (krl/project.py, krl/semantics/resolve.py) with no runtime."""
+    from interp.runtime.program import BASIS_DIR, checked_workspace  # noqa: PLC0415
+    from interp.vm.compiler import compile_module  # noqa: PLC0415
+    from krl.project import project_of  # noqa: PLC0415
     from krl.terminal import printable  # noqa: PLC0415
 
-    from interp.vm.compiler import compile_module  # noqa: PLC0415
-
-    rt, _ = make_runtime(program, workspace=workspace, mujoco=False, interp="vm", check=False)
-    prog = rt.program
-    main = prog.module_of(prog.main_path)
-    mods = [main]
+    main_path = Path(program).resolve()
+    project = project_of(main_path, Path(workspace).resolve() if workspace else None)
+    extra = [] if project.backup else sorted(p for p in BASIS_DIR.iterdir() if p.is_file())
+    ws = checked_workspace(project, extra)
+    units = [u for u in ws.units if any(f is not None and Path(f.path) == main_path for f in (u.src, u.dat))]
     if all_modules:
-        mods += [m for m in prog.modules if m is not main and m.routines]
+        units += [u for u in ws.units if u not in units and u.routines]
     out = []
-    for m in mods:
-        if m is None:
+    for u in units:
+        name = u.name.upper()
+        bad = [f for f in (u.src, u.dat) if f is not None and not f.ok]
+        if bad:
+            first = next((d for d in ws.sink.sorted() if d.path == bad[0].path and d.is_error), None)
+            why = f"{first.path}:{first.line}:{first.column}: {first.message}" if first else bad[0].status
+            out.append(f"; module {printable(name)}: syntax errors, not compiled: {printable(why)}\n")
             continue
-        if m.syntax_errors:
-            out.append(f"; module {printable(m.name)}: syntax errors, not compiled: {printable(m.syntax_errors[0])}\n")
-            continue
-        out.append(f"; module {printable(m.name)}\n" + compile_module(rt, m))
+        out.append(f"; module {printable(name)}\n" + compile_module(u.routines))
     return "\n".join(out)
 
 

@@ -12,12 +12,14 @@ from interp.runtime.errors import KrlRuntimeError, ResourceError
 def make_runtime(program, *, workspace=None, inputs=None, trace=None, max_sim_time=None,
                  max_steps=None, submit=None, mujoco: bool = True, controller=None,
                  robot_budget=None, interp: str = "tree", observer=None,
-                 mode: str | None = None, check: bool = True) -> tuple[Runtime, object]:
+                 mode: str | None = None, check: bool = True,
+                 vm_loop: str = "generated") -> tuple[Runtime, object]:
     """Build the runtime and the interpreter (``interp``: tree or vm) for ``program``
     (not started yet). Its files (krl.project.project_of, with the `submit` programs) are
     loaded, checked and resolved first; with `check` (``krl run`` without ``--no-check``) a
     program whose own module the checker rejects does not start (its run ends with that
-    error). `observer` (an :class:`interp.summary.RunObserver`) sees the
+    error). `vm_loop`: the VM's dispatch loop, "generated" (interp/vm/loop.py) or "source"
+    (VM.run as written; tests compare the two). `observer` (an :class:`interp.summary.RunObserver`) sees the
     controller's events on their way to `trace`; it is not used with a given `controller`.
     ``mode``: operating mode T1/T2/AUT/EXT (``$MODE_OP``; default AUT, robot/limits.py);
     ignored with a given `controller` (it has its own)."""
@@ -48,7 +50,7 @@ def make_runtime(program, *, workspace=None, inputs=None, trace=None, max_sim_ti
     if interp == "vm":
         from interp.vm import VM  # noqa: PLC0415
 
-        interp = VM(rt)
+        interp = VM(rt, loop=vm_loop)
     else:
         interp = TreeInterpreter(rt)
     rt.add_task("robot", Path(program).stem, lambda: interp.run_program())

@@ -51,9 +51,75 @@ def run_python(loops: int = 20):
     return (time.perf_counter() - t0) / loops, got
 
 
-def compute(repeat: int = 3) -> dict:
-    """Best-of-``repeat`` times of tree, VM and Python; ratios and statement rates."""
-    best = {"tree": None, "vm": None, "python": None}
+# the starting commit of issue 23: the tree interpreter must stay at least as fast as there
+BASELINE_REV = "89ac166"
+
+_BASELINE_SNIPPET = """
+import json
+try:
+    from interp.bench import run_krl            # the layout since issue 23
+except ImportError:
+    from interp.vm.bench import run_krl         # before it
+dt, steps, check = run_krl("tree")
+print(json.dumps([dt, steps, [check[0], check[1]]]))
+"""
+
+
+class Baseline:
+    """The tree interpreter of another revision of this repository (``rev``), run side by
+    side with this one: a temporary ``git worktree`` of ``rev`` (with this checkout's
+    generated parser: the grammar is the same), each run a fresh process whose Python path
+    is that worktree; the time is measured inside it, as :func:`run_krl` measures. Use as a
+    context manager; the worktree is removed afterwards."""
+
+    def __init__(self, rev: str = BASELINE_REV) -> None:
+        self.rev = rev
+        self.dir = None
+
+    def __enter__(self) -> "Baseline":
+        import shutil  # noqa: PLC0415
+        import subprocess  # noqa: PLC0415
+        import tempfile  # noqa: PLC0415
+
+        repo = HERE.parents[1]
+        self.dir = Path(tempfile.mkdtemp(prefix="krl-baseline-")) / "tree"
+        subprocess.run(["git", "-C", str(repo), "worktree", "add", "--detach", str(self.dir), self.rev],
+                       check=True, capture_output=True, text=True)
+        gen = repo / "krl" / "syntax" / "generated"
+        shutil.copytree(gen, self.dir / "krl" / "syntax" / "generated", dirs_exist_ok=True,
+                        ignore=shutil.ignore_patterns("__pycache__"))
+        return self
+
+    def __exit__(self, *exc) -> None:
+        import shutil  # noqa: PLC0415
+        import subprocess  # noqa: PLC0415
+
+        repo = HERE.parents[1]
+        subprocess.run(["git", "-C", str(repo), "worktree", "remove", "--force", str(self.dir)],
+                       capture_output=True, text=True)
+        shutil.rmtree(self.dir.parent, ignore_errors=True)
+
+    def run_tree(self):
+        """One run of the benchmark on that revision's tree interpreter: (seconds, steps,
+        (CHECK_I, CHECK_R))."""
+        import json  # noqa: PLC0415
+        import os  # noqa: PLC0415
+        import subprocess  # noqa: PLC0415
+        import sys  # noqa: PLC0415
+
+        env = dict(os.environ, PYTHONPATH=str(self.dir))
+        p = subprocess.run([sys.executable, "-c", _BASELINE_SNIPPET], cwd=self.dir, env=env,
+                           capture_output=True, text=True, timeout=3600)
+        if p.returncode != 0:
+            raise RuntimeError(f"baseline {self.rev} failed: {p.stderr[-2000:]}")
+        dt, steps, check = json.loads(p.stdout.strip().splitlines()[-1])
+        return dt, steps, tuple(check)
+
+
+def compute(repeat: int = 3, baseline: Baseline | None = None) -> dict:
+    """Best-of-``repeat`` times of tree, VM and Python (and, with `baseline`, the tree
+    interpreter of another revision), interleaved in this run; ratios and statement rates."""
+    best = {"tree": None, "vm": None, "python": None, "baseline": None}
     steps = None
     checks = {}
     for _ in range(repeat):
@@ -65,9 +131,15 @@ def compute(repeat: int = 3) -> dict:
         dt, check = run_python()
         checks["python"] = check
         best["python"] = dt if best["python"] is None else min(best["python"], dt)
-    if not (checks["tree"] == checks["vm"] == checks["python"]):
+        if baseline is not None:
+            dt, n, check = baseline.run_tree()
+            if n != steps:
+                raise RuntimeError(f"baseline {baseline.rev} counts {n} steps, this tree {steps}")
+            checks["baseline"] = check
+            best["baseline"] = dt if best["baseline"] is None else min(best["baseline"], dt)
+    if not (checks["tree"] == checks["vm"] == checks["python"] == checks.get("baseline", checks["tree"])):
         raise RuntimeError(f"benchmark results differ: {checks}")
-    return {
+    out = {
         "steps": steps,
         "tree_s": best["tree"], "vm_s": best["vm"], "python_s": best["python"],
         "vm_vs_tree": best["tree"] / best["vm"],
@@ -76,3 +148,7 @@ def compute(repeat: int = 3) -> dict:
         "python_stmts_per_s": steps / best["python"],
         "python_vs_vm": best["vm"] / best["python"],
     }
+    if baseline is not None:
+        out.update({"baseline_rev": baseline.rev, "baseline_tree_s": best["baseline"],
+                    "tree_vs_baseline": best["baseline"] / best["tree"]})
+    return out

@@ -29,8 +29,8 @@ from __future__ import annotations
 
 from krl.ast import nodes as N
 
+from interp.runtime.convert import binary_op, unary_op
 from interp.runtime.errors import KrlRuntimeError
-from interp.runtime.memory import Frame
 from interp.runtime.values import EnumValue
 from krl.semantics import types as T
 from krl.semantics.resolve import LOCAL, MODULE
@@ -87,9 +87,7 @@ def store_variables(routine: N.Routine) -> dict:
 
 
 class Compiler:
-    def __init__(self, rt, module, routine: N.Routine, frame: Frame | None = None) -> None:
-        self.rt = rt
-        self.module = module
+    def __init__(self, routine: N.Routine) -> None:
         self.routine = routine
         self.locals = local_names(routine)
         self.local_set = {n.upper() for n in self.locals}
@@ -678,7 +676,7 @@ class Compiler:
             if isinstance(e, N.Unary):
                 ok, a = self.fold(e.operand)
                 if ok:
-                    v = self.rt.unary_op(e.op, a)
+                    v = unary_op(e.op, a)
                     return isinstance(v, _FOLDABLE), v
             elif isinstance(e, N.Binary):
                 left, chain = N.left_chain(e)
@@ -703,7 +701,7 @@ class Compiler:
                 ok, r = self.fold(b.right)
                 if not ok:
                     return n, a
-                v = self.rt.binary_op(b.op, a, r)
+                v = binary_op(b.op, a, r)
             except KrlRuntimeError:
                 return n, a
             if not isinstance(v, _FOLDABLE):
@@ -866,19 +864,25 @@ def peephole(lst: Listing) -> bool:
     return len(new) < len(old)
 
 
-def compile_routine(rt, module, routine: N.Routine, frame: Frame | None = None) -> Listing:
-    """The instruction listing of ``routine`` (of ``module``, a runtime ModuleRT), for
-    assembler.encode (the VM) or assembler.format_listing (`krl asm`)."""
-    return Compiler(rt, module, routine, frame).compile()
+def compile_routine(routine: N.Routine) -> Listing:
+    """The instruction listing of ``routine``, from its annotated AST alone (the front end's
+    resolution, krl/semantics/resolve.py; no runtime): for assembler.link (the VM's executed
+    form) and assembler.format_listing (`krl asm`). Kept on the routine (``ann.extra``), so
+    a routine is compiled once per process whatever the runs."""
+    extra = routine.ann.extra
+    lst = extra.get("vm_listing")
+    if lst is None:
+        lst = extra["vm_listing"] = Compiler(routine).compile()
+    return lst
 
 
-def compile_module(rt, module) -> str:
-    """The readable assembly text of every routine of ``module``, main routine first
-    (`krl asm` and the round-trip tests; the VM never reads it)."""
+def compile_module(routines) -> str:
+    """The readable assembly text of ``routines`` (a module's, main routine first): what
+    the VM runs (`krl asm` and the round-trip tests; the VM never reads text)."""
     parts = []
     seen = set()
-    for r in module.routines.values():
+    for r in routines:
         if id(r) not in seen:
             seen.add(id(r))
-            parts.append(format_listing(compile_routine(rt, module, r)))
+            parts.append(format_listing(compile_routine(r)))
     return "\n".join(parts)

@@ -17,17 +17,19 @@ an instruction is placed on its region's line; in a guarded region after ON_ERRO
 it is recorded ($ERR) and execution goes on after the statement, as in the tree
 interpreter.
 
-Routines are compiled on their first call (the compiler needs the module's data list and
-the runtime's resolver) and kept per routine.
+Code: the compiler makes a routine's listing from its annotated AST alone (no runtime;
+kept on the routine), :func:`link` turns the listing into the executed form (one tuple per
+listing instruction: `krl asm` prints exactly what runs), and :class:`Bound` binds it to a
+run's storage when the routine is first called. Dispatch: :meth:`VM.run` is the source of
+every opcode's handler, a chain in frequency order; interp/vm/loop.py, generated from it by
+interp/vm/gen_loop.py and checked in, is the same loop with a Huffman-shaped binary search
+for the dispatch, and is what runs by default (``VM(rt, loop="source")`` runs the source).
+The cold opcodes (motion, interrupts, triggers, analog I/O, waits, ...) are methods
+``_cold_NAME`` the loop calls, so that the loop is the hot path.
 """
 
 from __future__ import annotations
 
-import ast
-import copy
-import heapq
-import inspect
-import itertools
 import math
 import operator
 
@@ -43,7 +45,9 @@ from interp.runtime.slots import (add, anout_limits, anout_value, array_index, c
                                   set_element1, store, sub, trigger_args)
 
 from . import opcodes as OP
-from .assembler import Code, Region, encode
+from krl.semantics.advance import StmtInfo
+
+from .assembler import Region
 from .compiler import compile_routine
 
 
@@ -52,144 +56,11 @@ from .compiler import compile_routine
 HELPERS = ("load", "store", "element", "element1", "element2", "set_element", "set_element1", "component",
            "set_component", "add", "sub", "mul", "lt", "le", "gt", "ge", "eq", "ne", "for_next", "for_limits",
            "read_value", "array_index")
-
-
-def _specialize(fn):
-    """Compile the dispatch loop ``fn`` for speed, from its own source, with line numbers
-    kept (tracebacks and coverage point into this file):
-
-    * the :data:`HELPERS` become closure variables ``_name``;
-    * the chain ``if op == <opcode>: ... elif op == <opcode>: ...``, hottest first, becomes
-      a binary search, ``if op < k:``, shaped as a Huffman tree over the opcodes with
-      Zipf weights by rank in the chain (weight 1/rank): the hottest opcode is found after
-      two tests, the tenth after six, the 100th after nine (at most ten), where the chain
-      needs one test per opcode ahead of it. The loop therefore dispatches on its own
-      numbering of the opcodes, the leaves of that tree from left to right;
-      ``fn.dispatch[opcode number]`` is that number (:func:`decode` writes it), and every
-      ``OP.NAME`` in ``fn`` becomes it.
-    """
-    path = inspect.getsourcefile(fn)
-    with open(path, encoding="utf-8") as f:
-        module = ast.parse(f.read(), path)
-    func = next(n for n in ast.walk(module) if isinstance(n, ast.FunctionDef) and n.name == fn.__name__
-                and any(isinstance(d, ast.Name) and d.id == "_specialize" for d in n.decorator_list))
-    func.decorator_list = []
-    chain = next(n for n in ast.walk(func) if isinstance(n, ast.If) and _chain_ops(n.test))
-    branches = []
-    node = chain
-    while True:
-        branches.append((_chain_ops(node.test), node.body))
-        if len(node.orelse) == 1 and isinstance(node.orelse[0], ast.If) and _chain_ops(node.orelse[0].test):
-            node = node.orelse[0]
-            continue
-        break
-    body_of, weight = {}, {}
-    for rank, (names, body) in enumerate(branches, 1):
-        for name in names:
-            body_of.setdefault(name, body)
-            weight.setdefault(name, 1.0 / rank / len(names))
-    missing = set(OP.BY_NAME) - set(body_of)
-    if missing:
-        raise AssertionError(f"opcodes without a branch in the dispatch loop: {sorted(missing)}")
-    root = _huffman(weight)
-    order: list = []
-    _leaves(root, order)
-    number = {name: i for i, name in enumerate(order)}
-    search = _search(root, body_of, number, set())
-    _replace(func, chain, search if isinstance(search, ast.If) else search[0])
-    func = _OpNumbers(number).visit(func)
-    factory = ast.FunctionDef(
-        "_factory", ast.arguments([], [], None, [], [], None, []),
-        [ast.Assign([ast.Name(f"_{n}", ast.Store())], ast.Name(n, ast.Load())) for n in HELPERS]
-        + [func, ast.Return(ast.Name(fn.__name__, ast.Load()))], [], None)
-    mod = ast.Module([factory], [])
-    _locate(mod, chain)
-    ns: dict = {}
-    exec(compile(mod, inspect.getsourcefile(fn), "exec"), fn.__globals__, ns)  # noqa: S102
-    out = ns["_factory"]()
-    out.dispatch = [number[o.name] for o in OP.OPS]
-    return out
-
-
-class _OpNumbers(ast.NodeTransformer):
-    """``OP.NAME`` -> the loop's number of the opcode."""
-
-    def __init__(self, number: dict) -> None:
-        self.number = number
-
-    def visit_Attribute(self, node):
-        if isinstance(node.value, ast.Name) and node.value.id == "OP" and node.attr in self.number:
-            return ast.copy_location(ast.Constant(self.number[node.attr]), node)
-        return self.generic_visit(node)
-
-
-def _chain_ops(test) -> list | None:
-    """The opcode names of a dispatch test ``op == <opcode> [or op == <opcode> ...]``, else None."""
-    parts = test.values if isinstance(test, ast.BoolOp) and isinstance(test.op, ast.Or) else [test]
-    out = []
-    for p in parts:
-        if not (isinstance(p, ast.Compare) and isinstance(p.left, ast.Name) and p.left.id == "op"
-                and len(p.ops) == 1 and isinstance(p.ops[0], ast.Eq)):
-            return None
-        c = p.comparators[0]
-        if not (isinstance(c, ast.Attribute) and isinstance(c.value, ast.Name) and c.value.id == "OP"):
-            return None
-        out.append(c.attr)
-    return out
-
-
-def _huffman(weight: dict):
-    """A Huffman tree over the opcode names: a name (leaf) or a pair (left, right)."""
-    tie = itertools.count()
-    heap = [(w, next(tie), name) for name, w in sorted(weight.items())]
-    heapq.heapify(heap)
-    while len(heap) > 1:
-        wa, _, a = heapq.heappop(heap)
-        wb, _, b = heapq.heappop(heap)
-        heapq.heappush(heap, (wa + wb, next(tie), (a, b)))
-    return heap[0][2]
-
-
-def _leaves(node, out: list) -> None:
-    if isinstance(node, tuple):
-        _leaves(node[0], out)
-        _leaves(node[1], out)
-    else:
-        out.append(node)
-
-
-def _search(node, body_of: dict, number: dict, used: set):
-    """The statements that dispatch ``op`` within the subtree ``node`` (``used``: the
-    branch bodies already placed)."""
-    if not isinstance(node, tuple):
-        body = body_of[node]
-        if id(body) in used:           # a branch of several opcodes: one copy per leaf
-            return copy.deepcopy(body)
-        used.add(id(body))
-        return body
-    right = []
-    _leaves(node[1], right)
-    lo = _search(node[0], body_of, number, used)
-    hi = _search(node[1], body_of, number, used)
-    test = ast.Compare(ast.Name("op", ast.Load()), [ast.Lt()], [ast.Constant(number[right[0]])])
-    return [ast.If(test, lo, hi)]
-
-
-def _replace(tree, old, new) -> None:
-    for parent in ast.walk(tree):
-        for _, value in ast.iter_fields(parent):
-            if isinstance(value, list) and old in value:
-                value[value.index(old)] = new
-                return
-    raise AssertionError("dispatch chain not found")
-
-
-def _locate(tree, where) -> None:
-    """Give the new dispatch tests the line of the chain's first test."""
-    for node in ast.walk(tree):
-        if isinstance(node, (ast.stmt, ast.expr)) and not hasattr(node, "lineno"):
-            ast.copy_location(node, where)
-    ast.fix_missing_locations(tree)
+(_load, _store, _element, _element1, _element2, _set_element, _set_element1, _component,
+ _set_component, _add, _sub, _mul, _lt, _le, _gt, _ge, _eq, _ne, _for_next, _for_limits,
+ _read_value, _array_index) = (load, store, element, element1, element2, set_element, set_element1,
+                               component, set_component, add, sub, mul, lt, le, gt, ge, eq, ne, for_next,
+                               for_limits, read_value, array_index)
 
 
 # the VM's forms of operand kinds y and o (opcodes.py)
@@ -198,54 +69,110 @@ _COMPARE = {"<": (operator.lt, lt), "<=": (operator.le, le), ">": (operator.gt, 
             "==": (operator.eq, eq), "<>": (operator.ne, ne)}
 
 
-def decode(code: Code) -> tuple[list, list]:
-    """The VM's form of assembled code: one tuple ``(opcode, operand, ...)`` per
-    instruction, with constants, names and statement infos resolved and jump targets as
-    instruction numbers; and the error region of each instruction."""
-    dispatch = VM.run.dispatch
-    words = code.words
-    starts = OP.instruction_starts(words)
-    index = {a: i for i, a in enumerate(starts)}
-    index[len(words)] = len(starts)
+class Linked:
+    """The VM's executed form of one routine, made from its listing (interp/vm/compiler.py)
+    by :func:`link`: one tuple ``(opcode, operand, ...)`` per instruction of the listing, in
+    the listing's order (so `krl asm`, which prints the listing, shows exactly what runs),
+    constants and statement infos in place, jump targets as instruction numbers, frame slots
+    as slot numbers, module and global slots as indexes into ``mstorage`` / ``gstorage``
+    (the front end's Storage, bound per run by :class:`Bound`); and the error region of
+    each instruction. It holds nothing of a run and is kept per routine and loop."""
+
+    __slots__ = ("name", "kind", "file", "routine", "prog", "iregions", "lnames", "ntemps",
+                 "mnames", "mstorage", "gnames", "gstorage", "callees", "types")
+
+
+def link(lst, dispatch) -> Linked:
+    """The executed form of listing `lst` for the loop whose opcode numbering is
+    `dispatch` (opcode number -> the loop's number)."""
+    out = Linked()
+    out.name, out.kind, out.file, out.ntemps = lst.name, lst.kind, lst.file, lst.ntemps
+    out.lnames = list(lst.lnames)
+    lix = {n.upper(): i for i, n in enumerate(out.lnames)}
+    out.mnames, out.gnames = [], []
+    mix: dict = {}
+    gix: dict = {}
+    labels = lst.labels
     prog = []
     regions = []
     moved: dict = {}     # guarded regions with their end as an instruction number
-    for a in starts:
-        info = OP.OPS[words[a]]
+    for name, ops, reg in lst.instrs:
+        info = OP.BY_NAME[name]
         ins = [dispatch[info.number]]
-        for j, k in enumerate(info.operands):
-            w = words[a + 1 + j]
-            if k in "cnf":
-                w = code.consts[w]
-            elif k == "x":
-                w = code.infos[w]
+        for k, v in zip(info.operands, ops):
+            if k == "x":
+                v = StmtInfo(lst.file, v[0], "S" in v[1], "C" in v[1])
             elif k == "l":
-                w = index[w]
+                v = labels[v]
             elif k == "s" or k == "v":
-                w = code.lkeys[w]
+                v = lix[v.upper()]
+            elif k == "m":
+                name_ = v
+                v = mix.setdefault(name_.upper(), len(mix))
+                if v == len(out.mnames):
+                    out.mnames.append(name_)
+            elif k == "g":
+                name_ = v
+                v = gix.setdefault(name_.upper(), len(gix))
+                if v == len(out.gnames):
+                    out.gnames.append(name_)
             elif k == "y":
-                w = _VALUE_CLASS.get(code.consts[w])
+                v = _VALUE_CLASS.get(v)
             elif k == "o":
-                w = _COMPARE[code.consts[w]]
+                v = _COMPARE[v]
             elif k == "k":
-                w = code.consts[w]
-                w = (w, w.upper())
-            ins.append(w)
+                v = (v, v.upper())
+            ins.append(v)
         prog.append(tuple(ins))
-        r = code.regions[a]
-        if r is not None and r.kind == "G":
-            got = moved.get(id(r))
+        if reg is not None and reg.kind == "G":
+            got = moved.get(id(reg))
             if got is None:
-                got = moved[id(r)] = Region("G", r.line, index[r.end])
-            r = got
-        regions.append(r)
-    return prog, regions
+                got = moved[id(reg)] = Region("G", reg.line, labels[reg.end])
+            reg = got
+        elif reg is not None:
+            reg = Region(reg.kind, reg.line, -1)
+        regions.append(reg)
+    out.prog, out.iregions = prog, regions
+    out.mstorage = [lst.storages[n.upper()] for n in out.mnames]
+    out.gstorage = [lst.storages[n.upper()] for n in out.gnames]
+    out.callees, out.types = lst.callees, lst.types
+    out.routine = None
+    return out
+
+
+class Bound:
+    """One run's view of a routine's code: the Linked form (shared) and this run's bindings
+    of its module slots (``mrefs``, bound when first called: the data lists are loaded),
+    global slots (``grefs``, bound on first use) and call sites (``callsites``)."""
+
+    __slots__ = ("name", "kind", "file", "routine", "prog", "iregions", "ntemps", "gstorage", "callees",
+                 "types", "mrefs", "grefs", "callsites", "gnames")
+
+    def __init__(self, linked: Linked, routine, rt) -> None:
+        self.name, self.kind, self.file, self.routine = linked.name, linked.kind, linked.file, routine
+        self.prog, self.iregions, self.ntemps = linked.prog, linked.iregions, linked.ntemps
+        self.gstorage, self.gnames = linked.gstorage, linked.gnames
+        self.callees, self.types = linked.callees, linked.types
+        self.mrefs = [rt.storage_ref(st, None) for st in linked.mstorage]
+        self.grefs = [None] * len(linked.gstorage)
+        self.callsites: dict = {}
 
 
 class VM:
-    def __init__(self, rt) -> None:
+    def __init__(self, rt, loop: str = "generated") -> None:
+        """`loop`: "generated" (interp/vm/loop.py, the dispatch loop generated from
+        :meth:`run`, the default) or "source" (:meth:`run` itself, the handlers' source,
+        kept runnable and tested: tests/vm/test_generated_loop.py)."""
         self.rt = rt
-        self.codes: dict = {}          # id(routine) -> Code
+        self.loop = _generated_run if loop == "generated" else VM.run
+        self.dispatch = GENERATED_DISPATCH if loop == "generated" else SOURCE_DISPATCH
+        self.codes: dict = {}          # id(routine) -> Bound
+        # the cold opcodes' handlers by the loop's number of the opcode
+        self.cold = [None] * len(OP.OPS)
+        for o in OP.OPS:
+            handler = getattr(self, "_cold_" + o.name, None)
+            if handler is not None:
+                self.cold[self.dispatch[o.number]] = handler
         # the runtime's statement hooks, bound once (the loop takes them at each call)
         self.hooks = (rt.before_statement, rt.loop_tick, rt.take_error_proceed, rt.quiet_limit)
 
@@ -254,24 +181,18 @@ class VM:
         """Body of the robot (or a submit) task: call the main routine of the module."""
         self.invoke(self.rt.main_routine(module_name), [], None)
 
-    def code_for(self, module, routine, frame=None) -> Code:
+    def code_for(self, routine) -> Bound:
+        """This run's code of `routine`: compiled from its annotated AST (once per process,
+        interp/vm/compiler.py), linked for this VM's loop (once per process), bound to this
+        run's storage (once per run)."""
         code = self.codes.get(id(routine))
         if code is None:
-            lst = compile_routine(self.rt, module, routine, frame)
-            code = encode(lst)   # no text on the way
-            code.routine = routine
-            code.module = module
-            rt = self.rt
-            # the storage the front end resolved: module slots bound now (the data lists are
-            # loaded), global slots on first use (Runtime.storage_ref), frame slots by number
-            code.mrefs = [rt.storage_ref(lst.storages[n.upper()], None) for n in code.mnames]
-            code.gstorage = [lst.storages[n.upper()] for n in code.gnames]
-            code.grefs = [None] * len(code.gnames)
-            code.lkeys = list(range(len(code.lnames)))
-            code.callees = lst.callees
-            code.types = lst.types
-            code.prog, code.iregions = decode(code)
-            self.codes[id(routine)] = code
+            extra = routine.ann.extra
+            key = "vm_linked" if self.loop is _generated_run else "vm_linked_source"
+            linked = extra.get(key)
+            if linked is None:
+                linked = extra[key] = link(compile_routine(routine), self.dispatch)
+            code = self.codes[id(routine)] = Bound(linked, routine, self.rt)
         return code
 
     # ------------------------------------------------------------------ calls
@@ -284,10 +205,10 @@ class VM:
         """Run the code of the routine of ``frame`` (compiled on its first call); the value
         of its RETURN (None for a DEF)."""
         routine = frame.routine
-        code = self.codes.get(id(routine)) or self.code_for(frame.module, routine, frame)
-        return self.run(code, frame, [None] * code.ntemps, 0, [])
+        code = self.codes.get(id(routine)) or self.code_for(routine)
+        return self.loop(self, code, frame, [None] * code.ntemps, 0, [])
 
-    def call(self, code: Code, ip: int, name: str, args: list, frame, flags: str):
+    def call(self, code, ip: int, name: str, args: list, frame, flags: str):
         """A CALL whose routine is not known yet (the loop calls a known one itself):
         a built-in, a stub, or a routine found now and kept for this call site."""
         rt = self.rt
@@ -299,14 +220,230 @@ class VM:
         code.callsites[ip] = target
         return self.invoke(target, args, frame, "N" not in flags)
 
-    def thunk(self, code: Code, frame, temps: list, ip: int, stack: list | None = None):
+    def thunk(self, code, frame, temps: list, ip: int, stack: list | None = None):
         """A callable that runs the thunk at ``ip`` of ``code`` in the activation (``frame``,
         ``temps``) that declared it."""
-        return lambda: self.run(code, frame, temps, ip, list(stack) if stack else [], True)
+        loop = self.loop
+        return lambda: loop(self, code, frame, temps, ip, list(stack) if stack else [], True)
+
+    # ------------------------------------------------------------------ cold opcodes
+    def _cold_AGG(self, ins, code, frame, temps, stack, ip):
+        rt = self.rt
+        push = stack.append
+        names = ins[2]
+        keys = names.split(",") if names else []
+        k = len(keys)
+        vals = stack[len(stack) - k:]
+        del stack[len(stack) - k:]
+        push(rt.aggregate(code.types.get(ins[1].upper()) if ins[1] else None,
+                          list(zip(keys, vals))))
+        return ip + 1
+
+    def _cold_JUMP_IF_NONE(self, ins, code, frame, temps, stack, ip):
+        pop = stack.pop
+        if stack[-1] is None:
+            pop()
+            return ins[1]
+        else:
+            return ip + 1
+
+    def _cold_HALT(self, ins, code, frame, temps, stack, ip):
+        rt = self.rt
+        rt.halt()
+        return ip + 1
+
+    def _cold_WAIT_FOR(self, ins, code, frame, temps, stack, ip):
+        rt = self.rt
+        rt.wait_for(self.thunk(code, frame, temps, ins[1]))
+        return ip + 1
+
+    def _cold_WAIT_SEC(self, ins, code, frame, temps, stack, ip):
+        rt = self.rt
+        pop = stack.pop
+        rt.wait_sec(pop())
+        return ip + 1
+
+    def _cold_CONTINUE(self, ins, code, frame, temps, stack, ip):
+        rt = self.rt
+        rt.set_continue(ins[1])
+        return ip + 1
+
+    def _cold_ON_ERROR_PROCEED(self, ins, code, frame, temps, stack, ip):
+        rt = self.rt
+        rt.on_error_proceed()
+        return ip + 1
+
+    def _cold_EXIT_SIGNAL(self, ins, code, frame, temps, stack, ip):
+        raise ExitSignal()
+
+    def _cold_GOTO_FAIL(self, ins, code, frame, temps, stack, ip):
+        raise label_not_found(ins[1], code.routine, frame.line)
+
+    def _cold_RAISE(self, ins, code, frame, temps, stack, ip):
+        line = ins[2]
+        raise KrlRuntimeError(ins[1], None, code.file if line else None, line or None)
+
+    def _cold_INT_DECL(self, ins, code, frame, temps, stack, ip):
+        rt = self.rt
+        pop = stack.pop
+        cond = self.thunk(code, frame, temps, ins[1])
+        rt.interrupt_decl(pop(), lambda c=cond: rt.to_bool(c(), "interrupt condition"),
+                          self.thunk(code, frame, temps, ins[2]), ins[3], frame,
+                          ins[4] == "G", ins[5])
+        return ip + 1
+
+    def _cold_INT_CTL(self, ins, code, frame, temps, stack, ip):
+        rt = self.rt
+        pop = stack.pop
+        n = pop() if ins[2] == "P" else None
+        rt.interrupt_ctl(ins[1], n)
+        return ip + 1
+
+    def _cold_BRAKE(self, ins, code, frame, temps, stack, ip):
+        rt = self.rt
+        rt.brake(ins[1] == "F")
+        return ip + 1
+
+    def _cold_STUB(self, ins, code, frame, temps, stack, ip):
+        rt = self.rt
+        rt.stub_statement(ins[1])
+        return ip + 1
+
+    def _cold_CYCFLAG(self, ins, code, frame, temps, stack, ip):
+        rt = self.rt
+        pop = stack.pop
+        ref = pop()
+        _store(ref, pop())
+        value = self.thunk(code, frame, temps, ins[1])
+        rt.cyclic_on(("CYCFLAG", ref.name), lambda r=ref, f=value: rt.assign(r, f()))
+        return ip + 1
+
+    def _cold_ANOUT_ON(self, ins, code, frame, temps, stack, ip):
+        rt = self.rt
+        pop = stack.pop
+        flags = ins[2]
+        hi = pop() if "H" in flags else None
+        lo = pop() if "L" in flags else None
+        ref = pop()
+        lo, hi = anout_limits(lo, hi)
+        value = self.thunk(code, frame, temps, ins[3])
+
+        def anout(ref=ref, value=value, lo=lo, hi=hi):
+            ref.set(anout_value(value(), lo, hi))
+        anout()
+        rt.cyclic_on(("ANOUT", ins[1]), anout)
+        return ip + 1
+
+    def _cold_ANIN_ON(self, ins, code, frame, temps, stack, ip):
+        rt = self.rt
+        pop = stack.pop
+        ref = pop()
+        value = self.thunk(code, frame, temps, ins[2])
+
+        def anin(ref=ref, value=value):
+            rt.assign(ref, value())
+        anin()
+        key = ins[1]
+        if key is not None:
+            rt.cyclic_on(("ANIN", key), anin)
+        return ip + 1
+
+    def _cold_CYCLIC_OFF(self, ins, code, frame, temps, stack, ip):
+        rt = self.rt
+        rt.cyclic_off((ins[1], ins[2]))
+        return ip + 1
+
+    def _cold_RESUME(self, ins, code, frame, temps, stack, ip):
+        rt = self.rt
+        rt.resume()
+        return ip + 1
+
+    def _cold_TRIG_FIND(self, ins, code, frame, temps, stack, ip):
+        rt = self.rt
+        push = stack.append
+        target = rt.callee(code.callees[ins[1].upper()])
+        push(target)
+        return ins[2] if target is None else ip + 1
+
+    def _cold_TRIG_PACK(self, ins, code, frame, temps, stack, ip):
+        argc = ins[1]
+        args = stack[len(stack) - argc:]
+        del stack[len(stack) - argc:]
+        stack[-1] = (stack[-1], args)
+        return ip + 1
+
+    def _cold_TRIGGER(self, ins, code, frame, temps, stack, ip):
+        rt = self.rt
+        pop = stack.pop
+        flags = ins[2]
+        prio = pop() if "P" in flags else None
+        delay = pop()
+        at = pop()
+        action = self.thunk(code, frame, temps, ins[4], [pop()])
+        rt.trigger(action, line=ins[3],
+                   **trigger_args(ins[1], at, delay, prio, "O" in flags))
+        return ip + 1
+
+    def _cold_TRIG_INVOKE(self, ins, code, frame, temps, stack, ip):
+        pop = stack.pop
+        target, args = pop()
+        self.invoke(target, args, frame)
+        return ip + 1
+
+    def _cold_MOTION(self, ins, code, frame, temps, stack, ip):
+        rt = self.rt
+        pop = stack.pop
+        nwith = ins[5]
+        pairs = self.pairs(stack, nwith)
+        flags = ins[4]
+        ca = pop() if "C" in flags else None
+        aux = pop() if "A" in flags else None
+        approx = ins[2]
+        rt.motion(ins[1], pop(), approx.split(",") if approx else [], aux, ca,
+                  ins[3], pairs, code.file, ins[6])
+        return ip + 1
+
+    def _cold_SPL_BEGIN(self, ins, code, frame, temps, stack, ip):
+        temps[ins[1]] = [[], [], None]     # segments, pending triggers, saved
+        return ip + 1
+
+    def _cold_SPL_TRIG_BEGIN(self, ins, code, frame, temps, stack, ip):
+        rt = self.rt
+        sp = temps[ins[1]]
+        task = rt.current_task
+        sp[2] = task.next_triggers
+        task.next_triggers = []
+        return ip + 1
+
+    def _cold_SPL_TRIG_END(self, ins, code, frame, temps, stack, ip):
+        rt = self.rt
+        sp = temps[ins[1]]
+        task = rt.current_task
+        sp[1] += task.next_triggers
+        task.next_triggers = sp[2]
+        return ip + 1
+
+    def _cold_SPL_SEG(self, ins, code, frame, temps, stack, ip):
+        pop = stack.pop
+        pairs = self.pairs(stack, ins[3])
+        flags = ins[2]
+        ca = float(num(pop())) if "C" in flags else None
+        aux = pop() if "A" in flags else None
+        sp = temps[ins[5]]
+        sp[0].append({"kind": ins[1], "target": pop(), "aux": aux, "ca": ca,
+                      "with_": pairs, "triggers": sp[1], "line": ins[4]})
+        sp[1] = []
+        return ip + 1
+
+    def _cold_SPLINE(self, ins, code, frame, temps, stack, ip):
+        rt = self.rt
+        pairs = self.pairs(stack, ins[3])
+        rt.spline(ins[1], temps[ins[5]][0], ins[2], pairs,
+                  code.file, ins[4])
+        return ip + 1
 
     # ------------------------------------------------------------------ the loop
-    @_specialize
-    def run(self, code: Code, frame, temps: list, ip: int, stack: list, thunk: bool = False):
+    def run(self, code, frame, temps: list, ip: int, stack: list, thunk: bool = False):
         """Run ``code`` from ``ip`` in the activation of ``frame`` (its runtime Frame) with
         the temporaries ``temps``; returns the value of RETURN,
         or of the thunk at END_THUNK. The ``_name`` helpers are the runtime functions of
@@ -320,6 +457,7 @@ class VM:
         push = stack.append
         pop = stack.pop
         before, tick, take_error_proceed, quiet_limit = self.hooks
+        cold = self.cold
         task = rt.current_task
         proceed = False
         while True:
@@ -883,158 +1021,18 @@ class VM:
                     elif op == OP.FOR_INIT:
                         _store(temps[ins[1]], pop())
                         ip += 1
-                    elif op == OP.AGG:
-                        names = ins[2]
-                        keys = names.split(",") if names else []
-                        k = len(keys)
-                        vals = stack[len(stack) - k:]
-                        del stack[len(stack) - k:]
-                        push(rt.aggregate(code.types.get(ins[1].upper()) if ins[1] else None,
-                                          list(zip(keys, vals))))
-                        ip += 1
-                    elif op == OP.JUMP_IF_NONE:
-                        if stack[-1] is None:
-                            pop()
-                            ip = ins[1]
-                        else:
-                            ip += 1
-                    elif op == OP.HALT:
-                        rt.halt()
-                        ip += 1
-                    elif op == OP.WAIT_FOR:
-                        rt.wait_for(self.thunk(code, frame, temps, ins[1]))
-                        ip += 1
-                    elif op == OP.WAIT_SEC:
-                        rt.wait_sec(pop())
-                        ip += 1
-                    elif op == OP.CONTINUE:
-                        rt.set_continue(ins[1])
-                        ip += 1
-                    elif op == OP.ON_ERROR_PROCEED:
-                        rt.on_error_proceed()
-                        ip += 1
-                    elif op == OP.EXIT_SIGNAL:
-                        raise ExitSignal()
-                    elif op == OP.GOTO_FAIL:
-                        raise label_not_found(ins[1], code.routine, frame.line)
-                    elif op == OP.RAISE:
-                        line = ins[2]
-                        raise KrlRuntimeError(ins[1], None, code.file if line else None, line or None)
-                    elif op == OP.INT_DECL:
-                        cond = self.thunk(code, frame, temps, ins[1])
-                        rt.interrupt_decl(pop(), lambda c=cond: rt.to_bool(c(), "interrupt condition"),
-                                          self.thunk(code, frame, temps, ins[2]), ins[3], frame,
-                                          ins[4] == "G", ins[5])
-                        ip += 1
-                    elif op == OP.INT_CTL:
-                        n = pop() if ins[2] == "P" else None
-                        rt.interrupt_ctl(ins[1], n)
-                        ip += 1
-                    elif op == OP.BRAKE:
-                        rt.brake(ins[1] == "F")
-                        ip += 1
-                    elif op == OP.STUB:
-                        rt.stub_statement(ins[1])
-                        ip += 1
-                    elif op == OP.CYCFLAG:
-                        ref = pop()
-                        _store(ref, pop())
-                        value = self.thunk(code, frame, temps, ins[1])
-                        rt.cyclic_on(("CYCFLAG", ref.name), lambda r=ref, f=value: rt.assign(r, f()))
-                        ip += 1
-                    elif op == OP.ANOUT_ON:
-                        flags = ins[2]
-                        hi = pop() if "H" in flags else None
-                        lo = pop() if "L" in flags else None
-                        ref = pop()
-                        lo, hi = anout_limits(lo, hi)
-                        value = self.thunk(code, frame, temps, ins[3])
-
-                        def anout(ref=ref, value=value, lo=lo, hi=hi):
-                            ref.set(anout_value(value(), lo, hi))
-                        anout()
-                        rt.cyclic_on(("ANOUT", ins[1]), anout)
-                        ip += 1
-                    elif op == OP.ANIN_ON:
-                        ref = pop()
-                        value = self.thunk(code, frame, temps, ins[2])
-
-                        def anin(ref=ref, value=value):
-                            rt.assign(ref, value())
-                        anin()
-                        key = ins[1]
-                        if key is not None:
-                            rt.cyclic_on(("ANIN", key), anin)
-                        ip += 1
-                    elif op == OP.CYCLIC_OFF:
-                        rt.cyclic_off((ins[1], ins[2]))
-                        ip += 1
-                    elif op == OP.RESUME:
-                        rt.resume()
-                        ip += 1
-                    elif op == OP.TRIG_FIND:
-                        target = rt.callee(code.callees[ins[1].upper()])
-                        push(target)
-                        ip = ins[2] if target is None else ip + 1
-                    elif op == OP.TRIG_PACK:
-                        argc = ins[1]
-                        args = stack[len(stack) - argc:]
-                        del stack[len(stack) - argc:]
-                        stack[-1] = (stack[-1], args)
-                        ip += 1
-                    elif op == OP.TRIGGER:
-                        flags = ins[2]
-                        prio = pop() if "P" in flags else None
-                        delay = pop()
-                        at = pop()
-                        action = self.thunk(code, frame, temps, ins[4], [pop()])
-                        rt.trigger(action, line=ins[3],
-                                   **trigger_args(ins[1], at, delay, prio, "O" in flags))
-                        ip += 1
-                    elif op == OP.TRIG_INVOKE:
-                        target, args = pop()
-                        self.invoke(target, args, frame)
-                        ip += 1
-                    elif op == OP.MOTION:
-                        nwith = ins[5]
-                        pairs = self.pairs(stack, nwith)
-                        flags = ins[4]
-                        ca = pop() if "C" in flags else None
-                        aux = pop() if "A" in flags else None
-                        approx = ins[2]
-                        rt.motion(ins[1], pop(), approx.split(",") if approx else [], aux, ca,
-                                  ins[3], pairs, code.file, ins[6])
-                        ip += 1
-                    elif op == OP.SPL_BEGIN:
-                        temps[ins[1]] = [[], [], None]     # segments, pending triggers, saved
-                        ip += 1
-                    elif op == OP.SPL_TRIG_BEGIN:
-                        sp = temps[ins[1]]
-                        task = rt.current_task
-                        sp[2] = task.next_triggers
-                        task.next_triggers = []
-                        ip += 1
-                    elif op == OP.SPL_TRIG_END:
-                        sp = temps[ins[1]]
-                        task = rt.current_task
-                        sp[1] += task.next_triggers
-                        task.next_triggers = sp[2]
-                        ip += 1
-                    elif op == OP.SPL_SEG:
-                        pairs = self.pairs(stack, ins[3])
-                        flags = ins[2]
-                        ca = float(num(pop())) if "C" in flags else None
-                        aux = pop() if "A" in flags else None
-                        sp = temps[ins[5]]
-                        sp[0].append({"kind": ins[1], "target": pop(), "aux": aux, "ca": ca,
-                                      "with_": pairs, "triggers": sp[1], "line": ins[4]})
-                        sp[1] = []
-                        ip += 1
-                    elif op == OP.SPLINE:
-                        pairs = self.pairs(stack, ins[3])
-                        rt.spline(ins[1], temps[ins[5]][0], ins[2], pairs,
-                                  code.file, ins[4])
-                        ip += 1
+                    elif (op == OP.AGG or op == OP.JUMP_IF_NONE or op == OP.HALT or op == OP.WAIT_FOR or
+                          op == OP.WAIT_SEC or op == OP.CONTINUE or op == OP.ON_ERROR_PROCEED or
+                          op == OP.EXIT_SIGNAL or op == OP.GOTO_FAIL or op == OP.RAISE or
+                          op == OP.INT_DECL or op == OP.INT_CTL or op == OP.BRAKE or op == OP.STUB or
+                          op == OP.CYCFLAG or op == OP.ANOUT_ON or op == OP.ANIN_ON or op == OP.CYCLIC_OFF or
+                          op == OP.RESUME or op == OP.TRIG_FIND or op == OP.TRIG_PACK or op == OP.TRIGGER or
+                          op == OP.TRIG_INVOKE or op == OP.MOTION or op == OP.SPL_BEGIN or
+                          op == OP.SPL_TRIG_BEGIN or op == OP.SPL_TRIG_END or op == OP.SPL_SEG or
+                          op == OP.SPLINE):
+                        # the cold opcodes (statements of motion, interrupts, I/O, ...): one
+                        # method each (VM._cold_NAME), so the loop stays the hot path
+                        ip = cold[op](ins, code, frame, temps, stack, ip)
                     else:
                         raise RuntimeError(f"bad opcode {op} at {ip} in {code.name}")
             except KrlRuntimeError as e:
@@ -1057,3 +1055,10 @@ class VM:
         items = stack[len(stack) - 2 * n:]
         del stack[len(stack) - 2 * n:]
         return [(items[2 * i], items[2 * i + 1]) for i in range(n)]
+
+
+# The loops: VM.run above is the source of every handler (runnable: VM(rt, loop="source"),
+# dispatching on the opcode numbers themselves); interp/vm/loop.py is generated from it
+# (python -m interp.vm.gen_loop) and dispatches on its own numbering.
+SOURCE_DISPATCH = [o.number for o in OP.OPS]
+from .loop import DISPATCH as GENERATED_DISPATCH, run as _generated_run  # noqa: E402

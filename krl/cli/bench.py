@@ -118,15 +118,43 @@ def bench(ctx: click.Context, as_json: bool, repeat: int, sim_seconds: float, pa
     if as_json:
         click.echo(json.dumps(all_figures(repeat, sim_seconds, parse_kb)))
         return
-    from interp.bench import compute  # noqa: PLC0415
+    _print_compute(repeat, None)
 
-    c = compute(repeat)
+
+def _print_compute(repeat: int, baseline_rev: str | None, as_json: bool = False) -> None:
+    from interp.bench import Baseline, compute  # noqa: PLC0415
+
+    if baseline_rev:
+        with Baseline(baseline_rev) as base:
+            c = compute(repeat, base)
+    else:
+        c = compute(repeat)
+    if as_json:
+        click.echo(json.dumps(c))
+        return
     click.echo(f"compute benchmark, {c['steps']} statements and loop iterations, best of {repeat}:")
     click.echo(f"  tree interpreter {c['tree_s']:.3f} s  {c['tree_stmts_per_s']:>12,.0f} stmts/s")
     click.echo(f"  VM               {c['vm_s']:.3f} s  {c['vm_stmts_per_s']:>12,.0f} stmts/s"
                f"  ({c['vm_vs_tree']:.2f}x the tree interpreter)")
     click.echo(f"  Python           {c['python_s']:.4f} s  {c['python_stmts_per_s']:>12,.0f} stmts/s"
                f"  ({c['python_vs_vm']:.0f}x the VM)")
+    if baseline_rev:
+        click.echo(f"  tree at {c['baseline_rev']:7s} {c['baseline_tree_s']:.3f} s  "
+                   f"{c['steps'] / c['baseline_tree_s']:>12,.0f} stmts/s  (this tree interpreter: "
+                   f"{c['tree_vs_baseline']:.2f}x its speed)")
+
+
+@bench.command("vm")
+@click.option("--repeat", type=int, default=3, show_default=True, help="Runs of each (best counts).")
+@click.option("--baseline", "baseline_rev", default=None, metavar="REV",
+              help="Also run the tree interpreter of git revision REV (e.g. 89ac166, the starting "
+                   "commit of issue 23) side by side, from a temporary git worktree.")
+@click.option("--json", "as_json", is_flag=True, help="One JSON object.")
+def bench_vm(repeat: int, baseline_rev: str | None, as_json: bool) -> None:
+    """The compute benchmark (interp/bench/bench.src) on the tree interpreter, the VM and in
+    Python, interleaved in this run; with --baseline, the tree interpreter of another
+    revision too (this tree interpreter must stay at least as fast)."""
+    _print_compute(repeat, baseline_rev, as_json)
 
 
 def engine_rates(corpus: Path, repeat: int = 3, engines: list[str] | None = None) -> dict:

@@ -464,53 +464,52 @@ def test_step_limit_inside_a_loop(sel, max_steps):
 # ---------------------------------------------------------------------------- d. dispatch
 def test_dispatch_is_a_permutation():
     from interp.vm import opcodes as OP
-    from interp.vm.vm import VM
+    from interp.vm.vm import GENERATED_DISPATCH
 
-    d = VM.run.dispatch
+    d = GENERATED_DISPATCH
     assert sorted(d) == list(range(len(OP.OPS)))
     assert len(d) == len(OP.OPS)
 
 
-def test_decoded_code_uses_the_loop_numbering():
+def test_linked_code_uses_the_loop_numbering():
+    """The executed form is the listing, instruction for instruction, each opcode in the
+    loop's numbering (what `krl asm` prints is what runs)."""
     from interp.vm import opcodes as OP
-    from interp.vm.vm import VM
+    from interp.vm.compiler import compile_routine
+    from interp.vm.vm import GENERATED_DISPATCH
 
     rt, vm = make_runtime(VALUES, mujoco=False, interp="vm")
     rt.run()
-    d = VM.run.dispatch
-    inverse = {n: i for i, n in enumerate(d)}
+    d = GENERATED_DISPATCH
     seen = set()
     for code in vm.codes.values():
-        pc = 0
-        for ins in code.prog:
-            number = code.words[pc]
-            assert ins[0] == d[number]
-            assert inverse[ins[0]] == number
-            seen.add(OP.OPS[number].name)
-            pc += OP.size(number)
+        lst = compile_routine(code.routine)
+        assert len(code.prog) == len(lst.instrs)
+        for ins, (name, _ops, _reg) in zip(code.prog, lst.instrs):
+            assert ins[0] == d[OP.BY_NAME[name].number]
+            seen.add(name)
     assert FAST_OPS - {"FAST_ADD_CONST", "FAST_SUB_CONST"} <= seen
 
 
-def _vm_run_lines():
-    """(path of interp/vm/vm.py, first line, last line) of ``VM.run`` in its source."""
+def _loop_lines():
+    """(path of interp/vm/loop.py, first line, last line) of the generated ``run``."""
     import ast
 
-    from interp.vm import vm as vmmod
+    from interp.vm import loop as loopmod
 
-    path = Path(vmmod.__file__).resolve()
+    path = Path(loopmod.__file__).resolve()
     tree = ast.parse(path.read_text())
-    cls = next(n for n in tree.body if isinstance(n, ast.ClassDef) and n.name == "VM")
-    run = next(n for n in cls.body if isinstance(n, ast.FunctionDef) and n.name == "run")
-    first = min([run.lineno] + [d.lineno for d in run.decorator_list])
-    return path, first, run.end_lineno
+    factory = next(n for n in tree.body if isinstance(n, ast.FunctionDef) and n.name == "_factory")
+    run = next(n for n in factory.body if isinstance(n, ast.FunctionDef) and n.name == "run")
+    return path, run.lineno, run.end_lineno
 
 
-def test_error_traceback_points_into_vm_run():
+def test_error_traceback_points_into_the_loop():
     """A run-time error raised by a slow path inside the loop: its traceback has a frame
-    in interp/vm/vm.py on a line of VM.run's source."""
+    in interp/vm/loop.py on a line of the generated loop, a real source line."""
     from interp.runtime.errors import KrlRuntimeError
 
-    path, lo, hi = _vm_run_lines()
+    path, lo, hi = _loop_lines()
     rt, _ = make_runtime(ERRORS, mujoco=False, interp="vm", max_steps=10_000)
     rt.program.module("fp_errors").data["SEL"].set(6)      # k = big + 1: INT overflow
     res = rt.run()
@@ -526,17 +525,6 @@ def test_error_traceback_points_into_vm_run():
     # the innermost frame of the loop is the line of ADDC_FAST's slow path, which calls
     # the runtime's add (the overflow is raised there)
     assert "_add(" in inside[-1].line, inside[-1].line
-
-
-def test_dispatch_tests_keep_the_loop_lines():
-    """Every line of the specialised loop lies in VM.run's source."""
-    from interp.vm.vm import VM
-
-    path, lo, hi = _vm_run_lines()
-    code = VM.run.__code__
-    assert Path(code.co_filename).resolve() == path
-    lines = {ln for _, _, ln in code.co_lines() if ln is not None}
-    assert lines and min(lines) >= lo and max(lines) <= hi
 
 
 def test_trigger_and_brake_resume_during_a_compute_loop():
