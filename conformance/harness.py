@@ -274,9 +274,11 @@ def _wall_limit(seconds: float):
 
 def run_args(program: Path, interp: str, trace: Path, *, stimuli: Path | None = None,
              submit: Path | None = None, max_sim_time: float = 10.0,
-             workspace: Path | None = None, max_steps: int | None = None) -> list[str]:
+             workspace: Path | None = None, max_steps: int | None = None, check: bool = True) -> list[str]:
     args = [str(program), "--interp", interp, "--trace", str(trace),
             "--max-sim-time", str(max_sim_time)]
+    if not check:
+        args.append("--no-check")
     if max_steps is not None:
         args += ["--max-steps", str(max_steps)]
     if workspace is not None:
@@ -291,13 +293,15 @@ def run_args(program: Path, interp: str, trace: Path, *, stimuli: Path | None = 
 def run_program(program: Path, interp: str, *, stimuli: Path | None = None,
                 submit: Path | None = None, max_sim_time: float = 10.0,
                 workspace: Path | None = None, wall_timeout: float = 120.0,
-                subprocess_mode: bool = False, max_steps: int | None = 1_000_000) -> RunResult:
-    """Run one program with ``krl run`` and read its trace back."""
+                subprocess_mode: bool = False, max_steps: int | None = 1_000_000,
+                check: bool = True) -> RunResult:
+    """Run one program with ``krl run`` and read its trace back. ``check`` False: ``--no-check``
+    (the real programs: the interpreters are compared on the code the checker rejects too)."""
     t0 = time.monotonic()
     with tempfile.TemporaryDirectory(prefix="krl-conf-") as tmp:
         trace = Path(tmp) / "trace.jsonl"
         args = run_args(program, interp, trace, stimuli=stimuli, submit=submit,
-                        max_sim_time=max_sim_time, workspace=workspace, max_steps=max_steps)
+                        max_sim_time=max_sim_time, workspace=workspace, max_steps=max_steps, check=check)
         code: int | None = None
         output = ""
         crash = None

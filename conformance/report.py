@@ -124,7 +124,7 @@ def run_real(corpus: Path = DEFAULT_CORPUS, interps: list[str] | None = None, *,
         for it in interps:
             res = H.run_program(prog, it, workspace=None, max_sim_time=max_sim_time,
                                 max_steps=max_steps, submit=subs[0] if subs else None,
-                                wall_timeout=300.0)
+                                wall_timeout=300.0, check=False)
             runs[it] = res
             if res.crash:
                 ro.crash[it] = res.crash.splitlines()[0][:300]

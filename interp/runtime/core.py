@@ -88,6 +88,7 @@ class Runtime:
         self.robot: Task | None = None
         self.result: RunResult | None = None
         self._plans: dict = {}          # id(routine) -> Runtime._frame_plan
+        self._return_types: dict = {}   # id(routine) -> the checker's return type, checked once
         self._cyclic: dict = {}
 
     # ================================================================== tasks and run
@@ -627,7 +628,10 @@ class Runtime:
         ``Layout.returns``)."""
         if routine.return_type is None:
             return value
-        t = self.program.declared_type(routine.ann.storage.returns, routine.return_type)
+        t = self._return_types.get(id(routine))
+        if t is None:
+            t = self._return_types[id(routine)] = self.program.declared_type(routine.ann.storage.returns,
+                                                                              routine.return_type)
         if isinstance(t, T.Array) and isinstance(value, str):
             arr = make_value(t)
             assign_into(arr, value)
