@@ -325,17 +325,23 @@ class Resolver:
 
     # ------------------------------------------------------------------ statements
     def block(self, stmts, scope, local, unit: int) -> None:
-        after_continue = False
-        for s in stmts:
-            self.stmt(s, scope, local, unit)
-            info = s.annotate().info = analyse(s, _symbol_of)
-            if info.reason is not None:
-                s.ann.extra["advance_stop"] = info.reason
-                if after_continue:
-                    s.ann.extra["continued"] = True
-            after_continue = isinstance(s, N.Continue)
+        """Resolve a statement list and the blocks nested in it, with a work list (nesting costs
+        no stack: the deepest legal file checks within krl.limits.MAX_CHECK_FRAMES)."""
+        work = [stmts]
+        while work:
+            after_continue = False
+            for s in work.pop():
+                work.extend(self.stmt(s, scope, local, unit))
+                info = s.annotate().info = analyse(s, _symbol_of)
+                if info.reason is not None:
+                    s.ann.extra["advance_stop"] = info.reason
+                    if after_continue:
+                        s.ann.extra["continued"] = True
+                after_continue = isinstance(s, N.Continue)
 
-    def stmt(self, s, scope, local, unit: int) -> None:
+    def stmt(self, s, scope, local, unit: int) -> list:
+        """Resolve the statement's own expressions (a TRIGGER's action, an interrupt's BRAKE
+        included); returns the statement lists nested in it."""
         blocks = []
         for f in s.__dataclass_fields__:
             v = getattr(s, f)
@@ -350,15 +356,14 @@ class Resolver:
                         elif isinstance(x, N.Node):
                             self.expr(x, scope, local, unit)
             elif isinstance(v, N.Stmt):
-                self.stmt(v, scope, local, unit)          # a TRIGGER's action
+                blocks += self.stmt(v, scope, local, unit)          # a TRIGGER's action
                 v.annotate().info = analyse(v, _symbol_of)
             elif isinstance(v, N.Node):
                 self.expr(v, scope, local, unit)
         if isinstance(s, (N.AnoutOn, N.AnoutOff, N.AninOff)) and scope is not None:
             # the analog channel is named by a plain word in these statements
             s.annotate().storage = self.storage(s.name, scope.lookup(s.name), local, unit)
-        for b in blocks:
-            self.block(b, scope, local, unit)
+        return blocks
 
     def exprs(self, es, scope, local, unit) -> None:
         for e in es:

@@ -478,7 +478,7 @@ def test_linked_code_uses_the_loop_numbering():
     from interp.vm.compiler import compile_routine
     from interp.vm.vm import GENERATED_DISPATCH
 
-    rt, vm = make_runtime(VALUES, mujoco=False, interp="vm")
+    rt, vm = make_runtime(VALUES, mujoco=False, interp="vm", check=False)
     rt.run()
     d = GENERATED_DISPATCH
     seen = set()
@@ -510,7 +510,7 @@ def test_error_traceback_points_into_the_loop():
     from interp.runtime.errors import KrlRuntimeError
 
     path, lo, hi = _loop_lines()
-    rt, _ = make_runtime(ERRORS, mujoco=False, interp="vm", max_steps=10_000)
+    rt, _ = make_runtime(ERRORS, mujoco=False, interp="vm", max_steps=10_000, check=False)
     rt.program.module("fp_errors").data["SEL"].set(6)      # k = big + 1: INT overflow
     res = rt.run()
     assert res.reason == "error"
@@ -545,7 +545,8 @@ def test_quiet_path_is_taken_only_without_a_trace(traced):
     """The sweeps above compare something: untraced, most steps skip the statement hooks
     (one full hook per time slice here); traced, every step takes them."""
     tw = TraceWriter(keep=True) if traced else None
-    rt, vm = make_runtime(MAXSTEPS, trace=tw, mujoco=False, interp="vm", max_steps=20_000, max_sim_time=600.0)
+    rt, vm = make_runtime(MAXSTEPS, trace=tw, mujoco=False, interp="vm", max_steps=20_000, max_sim_time=600.0,
+                          check=False)
     rt.program.module("fp_maxsteps").data["SEL"].set(2)
     calls = [0]
     before, tick, take, quiet = vm.hooks
