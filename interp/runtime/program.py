@@ -177,11 +177,13 @@ class Program:
         return self.by_path.get(str(Path(path).resolve())) or self.by_path.get(str(path))
 
     def errors_of(self, m: ModuleRT | None) -> list:
-        """The checker's errors in module `m`'s files (none when the run does not check)."""
-        if m is None or not self.check:
+        """The checker's errors in module `m`'s files (none when the run does not check); input
+        and syntax errors are not among them: those keep any run from starting, --no-check or
+        not, and the run says so itself ("the program has syntax errors and cannot start")."""
+        if m is None or not self.check or m.syntax_errors:
             return []
         paths = {str(p) for p in m.files.values()}
-        return [d for d in self.ws.sink.sorted() if d.is_error and d.path in paths]
+        return [d for d in self.ws.sink.sorted() if d.is_error and d.path in paths and d.code not in _START_CODES]
 
     def _syntax_errors(self) -> None:
         by_path: dict[str, list] = {}
