@@ -134,8 +134,12 @@ def test_workspace_always_wins_over_an_ancestor_backup(tmp_path):
           helper()
         END
         """)
-    # --workspace: the ancestor is not adopted, so helper does not exist.
+    # --workspace: the ancestor is not adopted, so helper does not exist: the checker
+    # refuses to start the program, and with --no-check the run stops at the call.
     code, out = run(str(prog), "--workspace", str(ws))
+    assert code == 1, out
+    assert f"{prog}:2:3: error[E106]: routine 'helper' is not declared" in out.splitlines()
+    code, out = run(str(prog), "--workspace", str(ws), "--no-check")
     assert code == 1, out
     assert f"             {prog}:2: routine helper not found" in out.splitlines()
     assert "$OUT" not in out
