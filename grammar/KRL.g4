@@ -487,6 +487,11 @@ literal
 
 // The predefined geometric type names are tokens (for DECL-less declarations, 2.5) but not
 // keywords: "ordinary type identifiers" (1.6), so they are names wherever a name may stand.
+// The attribute words of interrupt, trigger and analog-output statements are names too
+// (grammar/CHANGES.md, "attribute keywords as names"): each stands only right after its own
+// statement's keyword or as `WORD=` inside it, never at a statement's start or between an
+// expression and an operator, so a name spelled alike is never ambiguous, and real backups
+// name parameters and variables so (`DEF SetGripper(ENABLE :IN)`).
 name
     : IDENTIFIER
     | SYSNAME
@@ -497,6 +502,17 @@ name
     | POS
     | E3POS
     | E6POS
+    | attributeKeyword
+    ;
+
+attributeKeyword
+    : ENABLE
+    | DISABLE
+    | ONSTART
+    | DELAY
+    | PRIO
+    | MINIMUM
+    | MAXIMUM
     ;
 
 // Keywords that KUKA's own data lists use as structure components and enum values

@@ -36,7 +36,10 @@ NOT AND OR EXOR B_NOT B_AND B_OR B_EXOR TRUE FALSE""".split()
 SOFT_COMPONENT = {"IN", "OUT", "ON", "OFF", "PATH", "STEP", "SEC", "DISTANCE"}
 # listed, but a name: "PULSE is a built-in procedure name" (1.6)
 NOT_RESERVED = {"PULSE"}
-RESERVED = [k for k in KEYWORDS if k not in SOFT_COMPONENT | NOT_RESERVED]
+# attribute words of INTERRUPT / TRIGGER / ANOUT statements: names wherever a name may stand
+# (grammar/CHANGES.md, "attribute keywords as names"; real backups name parameters `ENABLE`)
+ATTRIBUTE_NAMES = {"ENABLE", "DISABLE", "ONSTART", "DELAY", "PRIO", "MINIMUM", "MAXIMUM"}
+RESERVED = [k for k in KEYWORDS if k not in SOFT_COMPONENT | NOT_RESERVED | ATTRIBUTE_NAMES]
 
 
 def parses(text: str, path: str = "t.src") -> bool:
@@ -72,6 +75,27 @@ def test_soft_keyword_is_a_component_but_no_variable(word):
     assert not parses(f"DEF t({word} :IN)\n  DECL INT n\nEND\n"), word
 
 
+@pytest.mark.parametrize("word", sorted(ATTRIBUTE_NAMES))
+def test_attribute_word_is_a_name(word):
+    """An attribute word is a variable, a parameter, a component, a routine and a data-list
+    name, in any letter case, and the statements that use it as a keyword still parse."""
+    low = word.lower()
+    assert parses(f"DEF t({word} :IN)\n  DECL INT {word}\n  DECL INT n\n  n = {low} + 1\n  {low} = n\nEND\n"), word
+    assert parses(f"DEF {word}()\nEND\nDEF t()\n  {low}()\nEND\n"), word
+    assert parses(f"DEFDAT d\n  STRUC S_T INT A, {word}\n  DECL S_T s = {{A 1, {word} 2}}\n"
+                  f"  DECL INT {word} = 3\nENDDAT\n", "d.dat"), word
+    assert parses(f"DEF t()\n  DECL INT {low}\n  INTERRUPT DECL 3 WHEN $IN[1] DO t()\n  INTERRUPT ENABLE {low}\n"
+                  f"  INTERRUPT DISABLE 3\n  TRIGGER WHEN PATH={low} ONSTART DELAY={low} DO $OUT[1]=TRUE PRIO={low}\n"
+                  f"  LIN {{X 1}}\nEND\n"), word
+
+
+def test_attribute_words_stay_keywords_where_they_are_keywords():
+    """A name spelled like an attribute word does not replace the keyword: DELAY is still
+    required after TRIGGER WHEN DISTANCE, and ENABLE after INTERRUPT is the action."""
+    assert not parses("DEF t()\n  DECL INT delay\n  TRIGGER WHEN DISTANCE=0 delay DO $OUT[1]=TRUE\n  LIN {X 1}\nEND\n")
+    assert not parses("DEF t()\n  DECL INT enable\n  INTERRUPT 3 enable\nEND\n")
+
+
 def test_pulse_is_a_routine_name():
     assert parses("DEF t()\n  PULSE($OUT[1], TRUE, 0.5)\nEND\n")
 
@@ -79,10 +103,10 @@ def test_pulse_is_a_routine_name():
 @pytest.mark.corpus
 def test_no_valid_file_declares_a_keyword(shared_corpus):
     """The evidence for the split: no file outside corpus/known-invalid.csv declares a listed
-    word (other than PULSE) as a variable or parameter name."""
+    word (other than PULSE and the attribute words) as a variable or parameter name."""
     from krl.survey.report import known_invalid
     invalid = known_invalid()
-    words = set(KEYWORDS) - {"PULSE"}
+    words = set(KEYWORDS) - NOT_RESERVED - ATTRIBUTE_NAMES
     header = re.compile(r"^\s*(?:GLOBAL\s+)?DEF(?:FCT\s+\S+)?\s+\w+\s*\((.*)\)", re.IGNORECASE)
     decl = re.compile(r"^\s*DECL\s+(?:GLOBAL\s+)?(?:CONST\s+)?\w+\s+(.*)$", re.IGNORECASE)
     found, in_invalid = [], []
