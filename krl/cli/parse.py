@@ -2,8 +2,9 @@
 
 Formats (``--format``): ``text`` (compiler style, krl/diagnostics/render.py: location, code, message,
 source line, caret; a closing count line), ``json`` (one object per file: path, ok, encoding,
-status, ``diagnostics`` in the shared model and the parser's raw ``errors`` with 1-based columns,
-for grammar work) and ``sarif`` (SARIF 2.1.0, krl/diagnostics/sarif.py). ``--outline`` prints the
+status, ``diagnostics`` in the shared model, the one truth; ``--antlr-errors`` adds ANTLR's raw
+``antlr_errors``, debugging data for grammar work: the token where the parser stopped, which may
+lie lines after the error the diagnostic names; schema: docs/schemas/parse.schema.json) and ``sarif`` (SARIF 2.1.0, krl/diagnostics/sarif.py). ``--outline`` prints the
 symbols (routines, declarations) of each file that parses; ``--tree`` the grammar-rule outline.
 Exit 0 when every file parses, 1 otherwise; never a traceback for bad input.
 """
@@ -69,12 +70,14 @@ def _jobs_in_order(files, outline: bool, tree: bool, timeout: float | None, jobs
 
 
 def run_parse(files, fmt: str = "text", outline: bool = False, tree: bool = False, echo=print,
-              colour: bool = False, timeout: float | None = None, jobs: int | None = None) -> int:
+              colour: bool = False, timeout: float | None = None, jobs: int | None = None,
+              antlr_errors: bool = False) -> int:
     """Parse `files` and print the result in `fmt`; returns the exit status (0 or 1).
 
     timeout: seconds per file; each file is then parsed in a worker process (krl/pool.py)
     that is killed past it, and the file gets error E005 while the others are still parsed
     (None: parse here, without a limit; the command passes krl.limits.PARSE_TIMEOUT_S).
+    antlr_errors: with fmt "json", add the parser's raw errors as ``antlr_errors`` (1-based columns).
     """
     from krl.diagnostics.render import Renderer, SourceLines  # noqa: PLC0415
     from krl.terminal import printable, printable_path  # noqa: PLC0415
@@ -89,9 +92,12 @@ def run_parse(files, fmt: str = "text", outline: bool = False, tree: bool = Fals
             all_ok = False
             all_diags.append(failure)
             if fmt == "json":
-                echo(json.dumps({"path": str(path), "ok": False, "encoding": "",
-                                 "status": "timeout" if failure.code == "E005" else "internal_error",
-                                 "diagnostics": [failure.as_json()], "errors": []}))
+                obj = {"path": str(path), "ok": False, "encoding": "",
+                       "status": "timeout" if failure.code == "E005" else "internal_error",
+                       "diagnostics": [failure.as_json()]}
+                if antlr_errors:
+                    obj["antlr_errors"] = []
+                echo(json.dumps(obj))
             elif fmt == "text":
                 renderer.emit([failure])
             continue
@@ -102,8 +108,9 @@ def run_parse(files, fmt: str = "text", outline: bool = False, tree: bool = Fals
             sources.add(str(path), text)
         if fmt == "json":
             obj = {"path": str(path), "ok": result.ok, "encoding": result.encoding, "status": result.status,
-                   "diagnostics": [d.as_json() for d in diags],
-                   "errors": [dict(e.as_json(), column=e.column + 1) for e in result.errors]}
+                   "diagnostics": [d.as_json() for d in diags]}
+            if antlr_errors:
+                obj["antlr_errors"] = [dict(e.as_json(), column=e.column + 1) for e in result.errors]
             echo(json.dumps(obj))
             continue
         if fmt == "text":
@@ -119,7 +126,8 @@ def run_parse(files, fmt: str = "text", outline: bool = False, tree: bool = Fals
     return 0 if all_ok else 1
 
 
-def main_status(files, fmt, as_json, outline, tree, timeout=None, jobs=None, engine: str | None = None) -> int:
+def main_status(files, fmt, as_json, outline, tree, timeout=None, jobs=None, engine: str | None = None,
+                antlr_errors: bool = False) -> int:
     """The `parse` command's body (krl/cli/__init__.py keeps only the options)."""
     from krl.syntax.engines import use_engine  # noqa: PLC0415
 
@@ -128,7 +136,7 @@ def main_status(files, fmt, as_json, outline, tree, timeout=None, jobs=None, eng
 
     fmt = "json" if as_json else fmt
     return run_parse(files, fmt, outline, tree, click.echo, use_colour(sys.stdout) and fmt == "text",
-                     timeout=timeout, jobs=jobs)
+                     timeout=timeout, jobs=jobs, antlr_errors=antlr_errors)
 
 
 @click.command()
@@ -136,6 +144,8 @@ def main_status(files, fmt, as_json, outline, tree, timeout=None, jobs=None, eng
 @click.option("--format", "fmt", type=click.Choice(["text", "json", "sarif"]), default="text",
               show_default=True, help="text: compiler style; json: one object per file; sarif: SARIF 2.1.0.")
 @click.option("--json", "as_json", is_flag=True, help="Same as --format json.")
+@click.option("--antlr-errors", is_flag=True,
+              help="With --format json: add the parser's raw errors (antlr_errors), debugging data for grammar work.")
 @click.option("--outline", is_flag=True, help="Print the routines and declarations of each file that parses.")
 @click.option("--tree", is_flag=True, help="Print the grammar-rule outline of each file that parses.")
 @click.option("--engine", type=click.Choice(["auto", "python", "java"]), default=None,
@@ -146,9 +156,9 @@ def main_status(files, fmt, as_json, outline, tree, timeout=None, jobs=None, eng
 @click.option("--jobs", type=click.IntRange(min=1), default=None,
               help="Worker processes (default: the number of cores).")
 def parse(files: tuple[Path, ...], fmt: str, as_json: bool, outline: bool, tree: bool, timeout: float,
-          jobs: int | None, engine: str | None) -> None:
+          jobs: int | None, engine: str | None, antlr_errors: bool) -> None:
     """Parse FILES; exit 0 when every file parses."""
-    sys.exit(main_status(files, fmt, as_json, outline, tree, timeout, jobs, engine))
+    sys.exit(main_status(files, fmt, as_json, outline, tree, timeout, jobs, engine, antlr_errors))
 
 
 commands = [parse]

@@ -100,7 +100,11 @@ def test_parse_json_output_and_exit_codes(tmp_path: Path) -> None:
     assert out.returncode == 1
     objs = [json.loads(line) for line in out.stdout.splitlines()]
     assert [o["ok"] for o in objs] == [True, False]
-    err = objs[1]["errors"][0]
+    # the one truth: the missing ENDIF is named at the IF (line 2), and no raw list beside it
+    assert [(d["code"], d["line"]) for d in objs[1]["diagnostics"]][:1] == [("E010", 2)]
+    assert "errors" not in objs[1] and "antlr_errors" not in objs[1]
+    out = subprocess.run([*krl, "parse", "--json", "--antlr-errors", str(bad)], capture_output=True, text=True)
+    err = json.loads(out.stdout.splitlines()[0])["antlr_errors"][0]
     assert set(err) >= {"line", "column", "message", "offending", "expected", "rule_stack"}
     assert err["line"] == 3 and "ENDIF" in err["expected"]
     assert err["rule_stack"][0] == "module"
