@@ -74,18 +74,26 @@ conformance: $(PARSER) java-parser
 	$(BIN)/krl conformance --out $(CONF_OUT) --fuzz $(CONF_FUZZ)
 
 # Long nightly run, in order: recovery over the shared corpus, growth, the 16-copies scaling
-# figures (scale.json), conformance, the
-# tests marked slow (long sweeps; hypothesis with the nightly profile); dated reports under
-# reports/nightly/<date>/ and an index page. Not part of `make test`.
+# figures (scale.json), the static check of the corpus backups (check/), conformance, the
+# benchmarks (bench.json, bench-parse.json, limits.jsonl), the fuzzers for their nightly budget
+# (fuzz/), the tests marked slow (long sweeps; hypothesis with the nightly profile); dated
+# reports under reports/nightly/<date>/, then the history (reports/nightly/history.sqlite) and
+# the index with charts and the changes since the night before. Not part of `make test`.
 NIGHTLY_FUZZ ?= 2000
+FUZZ_SECONDS ?= 120
 nightly: $(PARSER) java-parser
 	@d=reports/nightly/$$(date -u +%Y-%m-%d); mkdir -p $$d; \
 	$(BIN)/krl recover $(SHARED_CORPUS) --out $$d/recovery; s=$$?; [ $$s -le 1 ] || exit $$s; \
 	$(BIN)/krl growth $(SHARED_CORPUS) --out $$d/growth || exit $$?; \
 	$(BIN)/python -m recovery.scale_bench $(SHARED_CORPUS) --json > $$d/scale.json || exit $$?; \
+	$(BIN)/krl check --report $$d/check $(SHARED_CORPUS) > $$d/check.log 2>&1; \
 	$(BIN)/krl conformance --out $$d/conformance --fuzz $(NIGHTLY_FUZZ) --fuzz-random; c=$$?; \
+	$(BIN)/krl bench --json > $$d/bench.json 2> $$d/bench.log; \
+	$(BIN)/krl bench parse --json > $$d/bench-parse.json 2>> $$d/bench.log; \
+	$(BIN)/python -m robot.limits_bench > $$d/limits.jsonl 2>> $$d/bench.log; \
+	$(BIN)/python -m tests.fuzz.run --seconds $(FUZZ_SECONDS) --out $$d/fuzz; f=$$?; \
 	HYPOTHESIS_PROFILE=nightly $(BIN)/python -m pytest -q -n 2 -p no:cacheprovider -m "slow or not slow" \
 	  > $$d/slow-tests.log 2>&1; t=$$?; tail -1 $$d/slow-tests.log; \
-	$(BIN)/python -m conformance.nightly reports/nightly; \
+	$(BIN)/python -m conformance.nightly reports/nightly || exit $$?; \
 	echo "nightly reports: $$d (index: reports/nightly/index.html; slow tests: $$d/slow-tests.log)"; \
-	[ $$c -eq 0 ] && exit $$t; exit $$c
+	[ $$c -eq 0 ] || exit $$c; [ $$f -eq 0 ] || exit $$f; exit $$t

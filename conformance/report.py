@@ -6,7 +6,8 @@
 * the runnable programs of the KRC backups in ``../shared/krl-corpus`` (tree vs VM).
 
 Outputs: ``summary.json`` (``cases, passed, tree_vm_agree, fuzz_programs, fuzz_agree,
-real_programs, real_agree`` plus explanatory keys), ``report.md``, ``report.html`` (jinja2) and
+real_programs, real_agree`` plus explanatory keys, ``case_status`` case -> pass/pending/FAIL and
+``real_status`` program -> how the tree run ended, which the nightly history compares), ``report.md``, ``report.html`` (jinja2) and
 one PNG per case with motion (programmed points, approximation zones, the interpreters' TCP
 paths; matplotlib Agg). Without a VM the agreement fields are ``null`` and ``vm`` says why.
 """
@@ -217,7 +218,14 @@ def summary(outcomes: list[CaseOutcome], fuzz: dict[str, Any] | None, real: list
     if real is not None:
         s["real_tree_crashes"] = sum(1 for r in real if "tree" in r.crash)
         s["real_tree_reasons"] = _count(r.reasons.get("tree", "-") for r in real)
+        s["real_status"] = {r.program: r.reasons.get("tree", "-") for r in real}
+    s["case_status"] = {o.case.name: _status(o) for o in outcomes}
     return s
+
+
+def _status(o: CaseOutcome) -> str:
+    """pass, pending or FAIL: a case's one status in the report and the nightly history."""
+    return "pass" if o.passed and o.agree is not False else ("pending" if o.ok_or_pending else "FAIL")
 
 
 def _count(items) -> dict[str, int]:
@@ -233,8 +241,7 @@ def _row(o: CaseOutcome) -> dict[str, Any]:
             "covers": ", ".join(o.case.expect.get("covers", [])),
             "per": per, "agree": {None: "n/a", True: "yes", False: "NO"}[o.agree],
             "pending": o.case.pending or "", "plot": o.plot,
-            "status": ("pass" if o.passed and o.agree is not False
-                       else ("pending" if o.ok_or_pending else "FAIL")),
+            "status": _status(o),
             "diffs": {k: r.diff_text() for k, r in o.results.items() if not r.passed},
             "tree_vm_diff": "\n".join(f"[{c.name}] {c.detail}" for c in (o.tree_vm or []) if not c.ok)}
 
