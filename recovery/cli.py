@@ -119,4 +119,37 @@ def validate(names: tuple[str, ...], corpus: Path | None, no_corpus: bool, jobs:
     sys.exit(0 if ok else 1)
 
 
-commands = [recover, growth, validate]
+@click.group()
+def construct() -> None:
+    """Grammar constructs: start a new one from a cluster of the recovery report."""
+
+
+@construct.command("new")
+@click.argument("name")
+@click.option("--from", "cluster_id", required=True, metavar="CLUSTER", help="Cluster id of the report (e.g. C680b7aa).")
+@click.option("--report", default="reports/recovery", type=click.Path(path_type=Path), show_default=True,
+              help="The recovery report folder (krl recover --out).")
+@click.option("--corpus", default=None, type=click.Path(path_type=Path),
+              help="The corpus the report was made from (default: the one the report names).")
+@click.option("--root", default=None, type=click.Path(path_type=Path),
+              help="The project folder to write into (default: this checkout).")
+def construct_new(name: str, cluster_id: str, report: Path, corpus: Path | None, root: Path | None) -> None:
+    """Create grammar/constructs/NAME/ from CLUSTER: positive examples cut from the corpus (the
+    smallest module that still shows the construct, each with its origin), a negative-example
+    template, the grammar/CHANGES.md row and a conformance-case stub."""
+    from krl.terminal import printable  # noqa: PLC0415
+    from recovery.construct import REPO_ROOT, ConstructError, new_construct  # noqa: PLC0415
+
+    base = root or REPO_ROOT
+    try:
+        written = new_construct(name, cluster_id, report, corpus, base)
+    except ConstructError as exc:
+        click.echo(f"error: {printable(str(exc))}", err=True)
+        sys.exit(2)
+    for p in written:
+        click.echo(f"wrote {printable(str(p.relative_to(base)))}")
+    click.echo(f"next: write the rule in grammar/KRL.g4, fill in the .expect files and a bad_ example, "
+               f"then krl validate {name}")
+
+
+commands = [recover, growth, validate, construct]

@@ -8,7 +8,9 @@ grammar/constructs/<name>/ holds, per construct:
 - bad_*.src|.dat|.sub: negative near-misses that must be rejected.
 
 With a corpus, validate also reports which corpus clusters the construct closed: it scans
-the corpus with the grammar before and after the commit that introduced the construct
+the corpus with the grammar before and after the commit that introduced the construct (for a
+construct not committed yet, `krl construct new`'s folder: HEAD's grammar against the working
+tree's, so a maintainer sees the clusters closed and files gained before committing)
 (parsers and results come from the growth cache; the versions are scanned in parallel, with
 the fast parse engine when it can run: krl/syntax/engines).
 """
@@ -118,9 +120,19 @@ def _grammar_change(report: ConstructReport, directory: Path) -> tuple[str, str]
     except GrammarToolError as exc:
         report.note = str(exc)
         return None
-    if not commit:
-        report.note = "not committed yet"
-        return None
+    if not commit:      # a construct in the making: HEAD's grammar against the working tree's
+        try:
+            before = _git("show", "HEAD:grammar/KRL.g4")
+        except GrammarToolError as exc:
+            report.note = f"not committed yet ({exc})"
+            return None
+        after = (REPO_ROOT / "grammar" / "KRL.g4").read_text(encoding="utf-8")
+        if after == before:
+            report.note = "not committed yet; grammar/KRL.g4 is unchanged in the working tree"
+            return None
+        report.commit = "working tree"
+        report.grammar_changed = True
+        return before, after
     report.commit = commit[:10]
     changed = _git("diff-tree", "--no-commit-id", "--name-only", "-r", commit).split()
     report.grammar_changed = "grammar/KRL.g4" in changed
@@ -192,7 +204,8 @@ def print_validation(reports: list[ConstructReport]) -> bool:
         if not n_ok or not n_bad:
             click.echo("    needs at least one positive and one negative example")
         if rep.files_before is not None:
-            click.echo(f"    corpus: {rep.files_before} -> {rep.files_after} files parse; closed "
+            where = " (HEAD -> working tree)" if rep.commit == "working tree" else ""
+            click.echo(f"    corpus{where}: {rep.files_before} -> {rep.files_after} files parse; closed "
                        + (", ".join(f"{c['id']} ({c['files']} files)" for c in rep.closed) or "no cluster"))
         elif rep.note:
             click.echo(f"    corpus: {rep.note}")
