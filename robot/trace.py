@@ -291,5 +291,44 @@ def validate_event(ev: dict[str, Any]) -> None:
     make_event(ev["kind"], ev["t"], **fields)
 
 
-__all__ = ["SCHEMA", "KINDS", "TraceWriter", "make_event", "read_trace", "validate_event",
+#: the leading words of a field description -> its JSON Schema type
+_JSON_TYPES = (("list[6] float", {"type": "array", "items": {"type": "number"}, "minItems": 6, "maxItems": 6}),
+               ("bool or float", {"type": ["boolean", "number"]}), ("str or null", {"type": ["string", "null"]}),
+               ("dict", {"type": "object"}), ("int", {"type": "integer"}), ("str", {"type": "string"}),
+               ("float", {"type": "number"}), ("bool", {"type": "boolean"}), ("list", {"type": "array"}))
+
+
+def _field_type(description: str) -> dict[str, Any]:
+    words = description.removeprefix("optional").strip()
+    for prefix, schema in _JSON_TYPES:
+        if words.startswith(prefix):
+            return dict(schema, description=description)
+    return {"description": description}
+
+
+def json_schema() -> dict[str, Any]:
+    """The trace's JSON Schema (draft 2020-12), built from :data:`SCHEMA`: one event per line,
+    one branch per kind with its required and optional fields. docs/schemas/trace.schema.json
+    is this, written by ``python -m robot.trace --schema`` (a test keeps the file current)."""
+    branches = []
+    for kind, fields in SCHEMA.items():
+        props: dict[str, Any] = {"t": {"type": "number", "minimum": 0, "description": "simulated time (s)"},
+                                 "kind": {"const": kind}}
+        props.update({name: _field_type(desc) for name, desc in fields})
+        branches.append({"type": "object", "properties": props, "additionalProperties": False,
+                         "required": ["t", "kind", *_REQUIRED[kind]]})
+    return {"$schema": "https://json-schema.org/draft/2020-12/schema", "$id": "trace.schema.json",
+            "title": "krl run --trace: one event per line (JSON Lines), robot/trace.py SCHEMA",
+            "oneOf": branches}
+
+
+__all__ = ["SCHEMA", "KINDS", "TraceWriter", "json_schema", "make_event", "read_trace", "validate_event",
            "round_time"]
+
+
+if __name__ == "__main__":
+    import sys
+
+    if sys.argv[1:] != ["--schema"]:
+        sys.exit("usage: python -m robot.trace --schema")
+    print(json.dumps(json_schema(), indent=2))

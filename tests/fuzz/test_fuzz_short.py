@@ -6,12 +6,11 @@ from __future__ import annotations
 import json
 import subprocess
 import sys
-from pathlib import Path
-
 import pytest
 
 from tests.fuzz.run import REPO
 from tests.fuzz.targets import TARGETS
+from tests.test_json_schemas import validate
 
 
 @pytest.mark.parametrize("target", sorted(TARGETS))
@@ -21,6 +20,7 @@ def test_short_fuzz_run(target, tmp_path):
                           "--runs", str(runs), "--out", str(tmp_path)], cwd=REPO, capture_output=True, text=True,
                          timeout=600, check=False)
     summary = json.loads((tmp_path / "summary.json").read_text())
+    validate("fuzz-summary", summary)
     entry = summary["targets"][target]
     log = (tmp_path / target / "fuzz.log").read_text()
     assert res.returncode == 0, res.stdout + res.stderr + log[-3000:]

@@ -1,0 +1,119 @@
+"""Every JSON output of the project has a documented schema (docs/schemas/, listed in
+docs/json.md), and each output, made here by the real command on small inputs, validates
+against it (issue 27: "JSON output with one truth")."""
+
+from __future__ import annotations
+
+import json
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+from jsonschema import Draft202012Validator
+from referencing import Registry, Resource
+
+REPO = Path(__file__).resolve().parents[1]
+SCHEMAS = REPO / "docs" / "schemas"
+KRL = [sys.executable, "-m", "krl.cli"]
+GOOD = "DEF good()\n  DECL INT n\n  n = 1\nEND\n"
+BAD = "DEF bad()\n  IF x THEN\nEND\n"
+
+
+def _registry() -> Registry:
+    res = [Resource.from_contents(json.loads(p.read_text())) for p in sorted(SCHEMAS.glob("*.schema.json"))]
+    return Registry().with_resources((r.contents["$id"], r) for r in res)
+
+
+def validate(name: str, instance) -> None:
+    schema = json.loads((SCHEMAS / f"{name}.schema.json").read_text())
+    Draft202012Validator(schema, registry=_registry()).validate(instance)
+
+
+def test_every_schema_is_valid_and_documented():
+    doc = (REPO / "docs" / "json.md").read_text(encoding="utf-8")
+    for p in sorted(SCHEMAS.glob("*.schema.json")):
+        schema = json.loads(p.read_text())
+        Draft202012Validator.check_schema(schema)
+        assert schema["$id"] == p.name
+        assert f"schemas/{p.name}" in doc, f"{p.name} is not described in docs/json.md"
+
+
+def test_trace_schema_file_is_current():
+    from robot.trace import json_schema
+
+    assert json.loads((SCHEMAS / "trace.schema.json").read_text()) == json_schema(), \
+        "run: python -m robot.trace --schema > docs/schemas/trace.schema.json"
+
+
+def test_parse_and_check_json(tmp_path):
+    (tmp_path / "good.src").write_text(GOOD)
+    (tmp_path / "bad.src").write_text(BAD)
+    for extra in ([], ["--antlr-errors"]):
+        out = subprocess.run([*KRL, "parse", "--format", "json", *extra, str(tmp_path / "good.src"),
+                              str(tmp_path / "bad.src")], capture_output=True, text=True, check=False)
+        objs = [json.loads(line) for line in out.stdout.splitlines()]
+        assert len(objs) == 2
+        for obj in objs:
+            validate("parse", obj)
+        assert ("antlr_errors" in objs[1]) == bool(extra)
+    with pytest.raises(Exception, match="errors"):           # the old raw list is not allowed back
+        validate("parse", dict(objs[1], errors=[]))
+    out = subprocess.run([*KRL, "check", "--format", "json", str(tmp_path / "bad.src")], capture_output=True,
+                         text=True, check=False)
+    (obj,) = [json.loads(line) for line in out.stdout.splitlines()]
+    validate("check", obj)
+    assert obj["errors"] == 1
+
+
+def test_recovery_summary_and_check_report(tmp_path):
+    from recovery.pipeline import run_recovery
+
+    corpus = tmp_path / "corpus"
+    corpus.mkdir()
+    (corpus / "good.src").write_text(GOOD)
+    (corpus / "bad.src").write_text(BAD)
+    run_recovery(corpus, tmp_path / "rec", jobs=1, use_cache=False)
+    validate("recovery-summary", json.loads((tmp_path / "rec" / "summary.json").read_text()))
+    backup = tmp_path / "backups" / "b"
+    shutil.copytree(REPO / "tests" / "lsp" / "fixtures" / "backup", backup)
+    res = subprocess.run([*KRL, "check", "--report", str(tmp_path / "report"), str(tmp_path / "backups")],
+                         capture_output=True, text=True, check=False)
+    report = json.loads((tmp_path / "report" / "check_report.json").read_text())
+    validate("check-report", report)
+    assert report["backups"], res.stdout + res.stderr
+
+
+def test_conformance_summary_and_trace(tmp_path):
+    from conformance import harness as H
+    from conformance.report import run_cases, write_report
+    from robot.trace import read_trace
+
+    case = H.load_case(REPO / "conformance" / "cases" / "053_lin_straight")
+    write_report(tmp_path / "conf", run_cases([case], ["tree"]), plots=False)
+    validate("conformance-summary", json.loads((tmp_path / "conf" / "summary.json").read_text()))
+    trace = tmp_path / "run.jsonl"
+    subprocess.run([*KRL, "run", str(case.path / "program.src"), "--trace", str(trace)], capture_output=True,
+                   check=False)
+    events = list(read_trace(trace))
+    assert {e["kind"] for e in events} >= {"motion", "stmt", "end"}
+    for ev in events:
+        validate("trace", ev)
+
+
+def test_bench_outputs(tmp_path):
+    from krl.cli.bench import all_figures, engine_rates
+
+    validate("bench", all_figures(repeat=1, sim_seconds=0.5, parse_kb=4))
+
+    corpus = tmp_path / "c"
+    corpus.mkdir()
+    (corpus / "a.src").write_text(GOOD * 20)
+    validate("bench-parse", engine_rates(corpus, repeat=1))
+    out = subprocess.run([sys.executable, "-m", "robot.limits_bench"], capture_output=True, text=True,
+                         check=False, cwd=REPO)
+    rows = [json.loads(line) for line in out.stdout.splitlines()]
+    assert len(rows) >= 5
+    for row in rows:
+        validate("limits", row)
