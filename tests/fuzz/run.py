@@ -75,7 +75,10 @@ def run_target(target: str, seconds: int, out: Path, keep: bool = False, seeds: 
                              timeout=seconds + 600, check=False)
     # atheris prints an uncaught exception's traceback on stdout, libFuzzer its report on stderr
     (art / "fuzz.log").write_text((res.stdout[-100_000:] + res.stderr[-200_000:]), encoding="utf-8")
-    findings = sorted(p for p in art.iterdir() if p.name.startswith(("crash-", "timeout-", "oom-", "slow-unit-")))
+    # libFuzzer's slow-unit files (an input over 10 s) are load on a shared machine, not a finding;
+    # a timeout (-timeout=60), a crash and an out-of-memory are
+    findings = sorted(p for p in art.iterdir() if p.name.startswith(("crash-", "timeout-", "oom-")))
+    slow = sorted(p.name for p in art.iterdir() if p.name.startswith("slow-unit-"))
     kept = []
     for p in findings:
         small = p.with_name("min-" + p.name)
@@ -90,7 +93,7 @@ def run_target(target: str, seconds: int, out: Path, keep: bool = False, seeds: 
             kept.append(str(dest.relative_to(REPO)))
     status = res.returncode if not findings else 1
     return {"seconds": seconds, "runs": _stats(res.stderr), "findings": len(findings),
-            "files": [p.name for p in findings], "kept": kept, "exit": status}
+            "files": [p.name for p in findings], "slow": slow, "kept": kept, "exit": status}
 
 
 def main(argv: list[str] | None = None) -> int:
