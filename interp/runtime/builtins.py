@@ -15,8 +15,9 @@ buffer, a non-ASCII digit) is a format error, as on the controller: the text up 
 written, ``state.RET1`` = #FMT_ERR and ``state.HITS`` counts the values converted before it;
 the program goes on (without a STATE_T variable it is a run-time error). StrToInt/StrToReal
 accept KRL literal syntax only (reference §1.5). CAST_TO/CAST_FROM are in cast.py.
-Unsupported: CREAD/COPEN/CCLOSE/CIOCTL, channels other than $CMD — a clear "not supported"
-run-time error.
+GETSYSSTATE answers "STOPBITS" (no stop reaction active; :func:`_getsysstate`).
+Unsupported: CREAD/COPEN/CCLOSE/CIOCTL, GET_SIG_INF, INVERSE, channels other than $CMD — a
+clear "not supported" run-time error.
 """
 
 from __future__ import annotations
@@ -427,6 +428,34 @@ def _cwrite(rt, a):
         st.f["RET1"] = EnumValue("CMD_OK")
 
 
+# ------------------------------------------------------------------ system state (§4.8)
+
+GETSYSSTATE_COMMANDS = ("STOPBITS",)
+"""The GETSYSSTATE commands the simulator answers (the only one the corpus uses)."""
+
+
+def _getsysstate(rt, a):
+    """``BOOL GETSYSSTATE(CHAR CMD[64] :IN, INT IPAR :OUT, REAL RPAR :OUT)`` (KSS
+    ``$OPERATE`` EXTFCTP, operate.dat; reference §4.8 names it, KUKA does not document it).
+    ``"STOPBITS"`` (KUKA's torque monitoring, tm_bib.src, asks it before it changes its
+    limits): TRUE, IPAR = the stop reactions active on the controller as bits, 0 = none, and
+    RPAR = 0.0. The simulated controller never holds the robot in a stop reaction that a
+    program goes on past (a stop ends the run), so IPAR is always 0: the simulated answer.
+    Any other command: FALSE, IPAR and RPAR unchanged, one ``message`` event per command."""
+    cmd = _text(a[0], "GETSYSSTATE command").strip().upper()
+    if cmd not in GETSYSSTATE_COMMANDS:
+        key = "GETSYSSTATE " + cmd[:64]
+        if key not in rt.noted:
+            rt.noted.add(key)
+            rt.message(f"not simulated: GETSYSSTATE(\"{cmd[:64]}\") answers FALSE")
+        return False
+    if len(a) > 1 and a[1] is not None:
+        a[1].set(0)
+    if len(a) > 2 and a[2] is not None:
+        a[2].set(0.0)
+    return True
+
+
 def _unsupported(name):
     def fn(rt, a):
         raise KrlRuntimeError(f"{name} is not supported by this simulator")
@@ -783,7 +812,7 @@ NATIVES: dict = {
     "CAST_TO": cast_to, "CAST_FROM": cast_from,
     "CREAD": _unsupported("CREAD"), "COPEN": _unsupported("COPEN"),
     "CCLOSE": _unsupported("CCLOSE"), "CIOCTL": _unsupported("CIOCTL"),
-    "GET_SIG_INF": _unsupported("GET_SIG_INF"), "GETSYSSTATE": _unsupported("GETSYSSTATE"),
+    "GET_SIG_INF": _unsupported("GET_SIG_INF"), "GETSYSSTATE": _getsysstate,
 }
 
 # built-ins whose result type is needed to convert a native Python result

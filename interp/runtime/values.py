@@ -35,17 +35,6 @@ class _Unset:
 UNSET = _Unset()
 
 
-class _Neutral:
-    """The value of undeclared machine data (see ``sysvars.SysVars.auto``): 0 where a number
-    is needed, FALSE where a BOOL is needed."""
-
-    __slots__ = ()
-
-    def __repr__(self) -> str:
-        return "NEUTRAL"
-
-
-NEUTRAL = _Neutral()
 
 
 class EnumValue:
@@ -197,6 +186,28 @@ def make_value(t):
         if isinstance(t.elem, (T.Struc, T.Array)):
             return Arr(t, t.dims, [make_value(t.elem) for _ in range(n)])
         return Arr(t, t.dims, [UNSET] * n)
+    return UNSET
+
+
+def zero_value(t):
+    """A value of type ``t`` whose INT leaves are 0, REAL 0.0, BOOL FALSE, CHAR NUL; ENUM
+    leaves stay UNSET (no value is neutral). For system variables the simulator does not
+    model and nothing gives a value (sysvars.SysVars)."""
+    if isinstance(t, T.Struc):
+        return Struct(t, {k: zero_value(ft) for k, (_, ft) in t.fields.items()})
+    if isinstance(t, T.Array):
+        n = 1
+        for d in t.dims:
+            n *= d
+        return Arr(t, t.dims, [zero_value(t.elem) for _ in range(n)])
+    if t == T.INT:
+        return 0
+    if t == T.REAL:
+        return 0.0
+    if t == T.BOOL:
+        return False
+    if t == T.CHAR:
+        return "\0"
     return UNSET
 
 
