@@ -20,6 +20,7 @@ from krl.semantics import types as T
 from krl.semantics.builtins import load_builtins
 from krl.semantics.symbols import make_array, system_scopes
 
+from .convert import frame_tuple
 from .errors import KrlRuntimeError, value_invalid
 from .memory import ComputedRef, Slot
 from .values import EnumValue, Struct, make_value, zero_value
@@ -286,6 +287,18 @@ def _computed(fn, setter=None):
     return make
 
 
+def _pos_act(sv: SysVars):
+    """``$POS_ACT``: the robot's pose in the current ``$TOOL``/``$BASE`` (reference §6.4,
+    table §10: "current TCP pose in current $BASE/$TOOL"), the values the program set last,
+    so that ``$TOOL = TOOL_DATA[2]`` then ``PTP $POS_ACT`` does not move the robot (the read
+    stops the advance run: the robot stands still). ``$IPO_MODE = #TCP``: the fixed tool in
+    the workpiece frame (robot/external_tcp.py)."""
+    s = sv.store
+    mode = s["$IPO_MODE"]
+    return pos_struct(sv.rt.controller.pos_act(frame_tuple(s["$TOOL"], "$TOOL"), frame_tuple(s["$BASE"], "$BASE"),
+                                               ipo_mode=mode.name if isinstance(mode, EnumValue) else "BASE"))
+
+
 def _pos_int(sv: SysVars):
     ctx = sv.rt.current_context()
     if ctx is None or ctx.pos_int is None:
@@ -333,8 +346,8 @@ def _ro_const(v):
 _LIVE = {
     "$IN": _io("$IN"), "$OUT": _io("$OUT"), "$ANIN": _io("$ANIN"), "$ANOUT": _io("$ANOUT"),
     "$TIMER": _io("$TIMER"), "$TIMER_STOP": _io("$TIMER_STOP"), "$TIMER_FLAG": _io("$TIMER_FLAG"),
-    "$POS_ACT": _computed(lambda sv: pos_struct(sv.rt.controller.pos_act())),
-    "$POS_ACT_MES": _computed(lambda sv: pos_struct(sv.rt.controller.pos_act())),
+    "$POS_ACT": _computed(lambda sv: _pos_act(sv)),
+    "$POS_ACT_MES": _computed(lambda sv: _pos_act(sv)),
     "$AXIS_ACT": _computed(lambda sv: axis_struct(sv.rt.controller.axis_act())),
     "$AXIS_ACT_MEAS": _computed(lambda sv: axis_struct(sv.rt.controller.axis_act())),
     "$POS_INT": _computed(_pos_int),

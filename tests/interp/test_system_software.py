@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from interp import realprograms as rp
@@ -219,3 +220,71 @@ def test_submit_errors_are_in_the_real_programs_row_and_report(tmp_path):
             {"program": "b", "reason": "completed", "text": "", "submit": []}]
     text = rp.report(rows)
     assert "Submit-interpreter errors: 1 of 2 runs:" in text
+
+
+# ------------------------------------------------------------------ $POS_ACT and $IPO_MODE = #TCP
+
+FRAMES_DAT = """
+DEFDAT prog
+  DECL E6POS p
+  DECL E6POS q
+  DECL E6POS r
+  DECL E6AXIS ax
+ENDDAT
+"""
+
+# The tool-down pose of robot-model.md §7's worked example: the flange at {X 445, Y 0, Z 810}
+# with the rotation diag(-1, 1, -1) (A 180, B 0, C 180).
+FRAMES_SRC = """
+DEF prog()
+  PTP {A1 0, A2 -90, A3 90, A4 0, A5 90, A6 0, E1 0, E2 0, E3 0, E4 0, E5 0, E6 0}
+  $TOOL = {X 0, Y 0, Z 225, A 0, B 0, C 0}
+  $BASE = {X 500, Y 0, Z 0, A 90, B 0, C 0}
+  p = $POS_ACT
+  PTP $POS_ACT
+  ax = $AXIS_ACT
+  $IPO_MODE = #TCP
+  q = $POS_ACT
+  q.Z = q.Z - 50
+  LIN q
+  r = $POS_ACT
+END
+"""
+
+
+def _pose(v) -> list[float]:
+    return [v.f[k] for k in ("X", "Y", "Z", "A", "B", "C")]
+
+
+def test_pos_act_is_in_the_frames_just_set_and_ptp_pos_act_does_not_move(tmp_path):
+    for run in both(tmp_path, FRAMES_SRC, FRAMES_DAT):
+        assert run.result.reason == "completed", run.result.text
+        # TCP in WORLD (445, 0, 810 - 225 = 585); in $BASE (origin (500, 0, 0), x = world +Y,
+        # y = world -X): (0, 55, 585); rotation Rz(-90)·diag(-1, 1, -1) = A 90, B 0, C 180
+        assert _pose(run.var("prog", "p")) == pytest.approx([0.0, 55.0, 585.0, 90.0, 0.0, 180.0], abs=1e-6)
+        ax = run.var("prog", "ax")
+        assert [ax.f[k] for k in ("A1", "A2", "A3", "A4", "A5", "A6")] == \
+            pytest.approx([0.0, -90.0, 90.0, 0.0, 90.0, 0.0], abs=1e-6)
+
+
+def test_external_tcp_pose_and_linear_motion(tmp_path):
+    for run in both(tmp_path, FRAMES_SRC, FRAMES_DAT):
+        # #TCP: $TOOL = workpiece on the flange, $BASE = fixed tool in WORLD;
+        # P = INV_POS(FLANGE : $TOOL) : $BASE. FLANGE : $TOOL = (445, 0, 585), R_w = diag(-1, 1, -1);
+        # R_w^T ((500, 0, 0) - (445, 0, 585)) = (-55, 0, 585); R_w^T Rz(90) = A 90, B 0, C 180
+        assert _pose(run.var("prog", "r"))[:3] == pytest.approx([-55.0, 0.0, 535.0], abs=1e-4)
+        assert _pose(run.var("prog", "r"))[3:] == pytest.approx([90.0, 0.0, 180.0], abs=1e-4)
+        # FLANGE = $BASE : INV_POS(P2) : INV_POS($TOOL): (500,0,0) + Rz(90)(0, 55, 535) = (445, 0, 535),
+        # then 225 mm up along -z of diag(-1, 1, -1): the flange at (445, 0, 760), 50 mm lower
+        q = run.rt.controller.axis_act()
+        F = run.rt.controller.model.tcp(q, np.eye(4), np.eye(4))
+        assert F[:3, 3] == pytest.approx([445.0, 0.0, 760.0], abs=1e-4)
+        assert F[:3, :3] == pytest.approx(np.diag([-1.0, 1.0, -1.0]), abs=1e-6)
+        # P moves on a straight line with a constant rotation, so the flange does too: from
+        # (445, 0, 810) straight down to (445, 0, 760), passing through every IPO cycle's pose
+        [t0] = [e["t"] for e in run.events if e["kind"] == "motion" and e["type"] == "LIN" and e["phase"] == "start"]
+        path = [run.rt.controller.model.tcp(np.array(e["axes"]), np.eye(4), np.eye(4))[:3, 3]
+                for e in run.events if e["kind"] == "pose" and e["t"] >= t0]
+        assert len(path) > 10
+        for xyz in path:
+            assert xyz[:2] == pytest.approx([445.0, 0.0], abs=1e-3) and 760.0 - 1e-3 <= xyz[2] <= 810.0 + 1e-3
