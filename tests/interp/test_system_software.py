@@ -288,3 +288,40 @@ def test_external_tcp_pose_and_linear_motion(tmp_path):
         assert len(path) > 10
         for xyz in path:
             assert xyz[:2] == pytest.approx([445.0, 0.0], abs=1e-3) and 760.0 - 1e-3 <= xyz[2] <= 810.0 + 1e-3
+
+
+def test_inverse_gives_the_axes_of_a_pose_and_a_status_when_out_of_reach(tmp_path):
+    dat = """
+    DEFDAT prog
+      DECL E6AXIS ax
+      DECL E6AXIS far
+      DECL INT st1
+      DECL INT st2
+    ENDDAT
+    """
+    src = """
+    DEF prog()
+      DECL E6AXIS start
+      DECL E6POS p
+      start = {A1 10, A2 -80, A3 80, A4 0, A5 80, A6 0, E1 0, E2 0, E3 0, E4 0, E5 0, E6 0}
+      $TOOL = {X 0, Y 0, Z 225, A 0, B 0, C 0}
+      $BASE = {X 500, Y 0, Z 0, A 90, B 0, C 0}
+      p = {X 0, Y 55, Z 585, A 90, B 0, C 180}
+      st1 = -1
+      ax = INVERSE(p, start, st1)
+      p.X = 5000
+      st2 = -1
+      far = INVERSE(p, start, st2)
+    END
+    """
+    for run in both(tmp_path, src, dat):
+        assert run.result.reason == "completed", run.result.text
+        # robot-model.md §7: this pose in these frames is the tool-down pose {0, -90, 90, 0, 90, 0}
+        ax = run.var("prog", "ax")
+        assert [ax.f[k] for k in ("A1", "A2", "A3", "A4", "A5", "A6")] == \
+            pytest.approx([0.0, -90.0, 90.0, 0.0, 90.0, 0.0], abs=1e-6)
+        assert run.var("prog", "st1") == 0
+        # 5 m away: not reachable, STATUS 3, the result is START_AXIS
+        far = run.var("prog", "far")
+        assert run.var("prog", "st2") == 3
+        assert [far.f[k] for k in ("A1", "A2", "A3")] == [10.0, -80.0, 80.0]
