@@ -193,22 +193,25 @@ def zero_value(t):
     """A value of type ``t`` whose INT leaves are 0, REAL 0.0, BOOL FALSE, CHAR NUL; ENUM
     leaves stay UNSET (no value is neutral). For system variables the simulator does not
     model and nothing gives a value (sysvars.SysVars)."""
-    if isinstance(t, T.Struc):
-        return Struct(t, {k: zero_value(ft) for k, (_, ft) in t.fields.items()})
-    if isinstance(t, T.Array):
-        n = 1
-        for d in t.dims:
-            n *= d
-        return Arr(t, t.dims, [zero_value(t.elem) for _ in range(n)])
-    if t == T.INT:
-        return 0
-    if t == T.REAL:
-        return 0.0
-    if t == T.BOOL:
-        return False
-    if t == T.CHAR:
-        return "\0"
-    return UNSET
+    return _zeroed(make_value(t), t)
+
+
+def _zeroed(v, t):
+    """``v`` (a fresh :func:`make_value` of ``t``) with its UNSET leaves set to zero."""
+    if isinstance(v, Struct):
+        for k, (_, ft) in t.fields.items():
+            v.f[k] = _zeroed(v.f[k], ft)
+    elif isinstance(v, Arr):
+        v.data[:] = [_zeroed(x, t.elem) for x in v.data]
+    elif t == T.INT:
+        v = 0
+    elif t == T.REAL:
+        v = 0.0
+    elif t == T.BOOL:
+        v = False
+    elif t == T.CHAR:
+        v = "\0"
+    return v
 
 
 def copy_value(v):
