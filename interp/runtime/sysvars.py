@@ -11,7 +11,11 @@ this module adds only *where the value lives*:
   ``$VEL_ACT``, ``$DATE``, ``$PRO_STATE*``, ``$PRO_MOVE``, ``$STOPMESS``, ``$MODE_OP``,
   ``$INTERPRETER``, ``$ERR`` (one per interpreter), ``$NULLFRAME``, ``$NUM_AX``, ...;
 * everything else is stored (``store``), booting with the INITMOV values ("friendly mode",
-  reference §7.3): the motion variables are read from there when a motion is planned.
+  reference §7.3): the motion variables are read from there when a motion is planned;
+* a system variable the table lacks: the value a KSS system data list of the program's files
+  declares (``declare``), or, when only KSS's own files declare it (kss.yaml), its type with
+  zero values; one ``message`` event per variable (:meth:`SysVars._unsimulated`). A ``$``
+  name nothing declares is not created: the caller's run-time error "unknown name".
 """
 
 from __future__ import annotations
