@@ -13,6 +13,9 @@ steps. Outcomes:
 * ``error``: grouped by message (numbers and names normalised), each either a true program
   error (e.g. a target the KR 6 R900 cannot reach) or a simulator limitation.
 
+A run-time error of the backup's submit program (SPS.SUB) does not end the run: each row's
+``submit`` lists those errors and the report counts them.
+
 Routines of technology packages absent from the backup are stubbed (a ``message`` event
 "stub: NAME"), and the report lists the stubs.
 
@@ -99,7 +102,19 @@ def run_one(path: Path, max_sim_time: float, max_steps: int) -> dict:
     return {"program": str(path), "reason": res.reason, "text": res.text,
             "number": res.error.number if res.error is not None else None,
             "file": res.file, "line": res.line, "sim_time": round(res.sim_time, 3),
-            "steps": res.steps, "stubs": stubs, "seconds": round(time.time() - t0, 2)}
+            "steps": res.steps, "stubs": stubs, "submit": submit_errors(rt),
+            "seconds": round(time.time() - t0, 2)}
+
+
+def submit_errors(rt) -> list[str]:
+    """The run-time errors that stopped the run's submit programs, ``NAME: message at
+    file:line`` each (the robot program runs on; the run summary shows them the same way)."""
+    out = []
+    for task in rt.scheduler.tasks:
+        reason, err = task.outcome or (None, None)
+        if task.kind == "submit" and reason == "error" and err is not None:
+            out.append(f"{task.name}: {err.message} at {err.file or task.file}:{err.line or task.line}")
+    return out
 
 
 def report(rows: list[dict]) -> str:
@@ -118,6 +133,12 @@ def report(rows: list[dict]) -> str:
         lines.append("Failures by message:")
         for msg, c in errs.most_common():
             lines.append(f"  {c:4d}  {msg}")
+    subs = Counter(normalise(s.split(": ", 1)[-1]) for r in rows for s in r.get("submit", []))
+    n_sub = sum(1 for r in rows if r.get("submit"))
+    lines.append("")
+    lines.append(f"Submit-interpreter errors: {n_sub} of {n} runs" + (":" if subs else ""))
+    for msg, c in subs.most_common():
+        lines.append(f"  {c:4d}  {msg}")
     stubs = Counter(s for r in rows for s in r.get("stubs", []))
     if stubs:
         lines.append("")
@@ -143,7 +164,8 @@ def main(argv: list[str] | None = None) -> int:
         for p in programs_of(root):
             rows.append(run_one(p, a.max_sim_time, a.max_steps))
             r = rows[-1]
-            print(f"{r['reason']:13s} {r.get('seconds', 0):6.1f}s {p.relative_to(corpus)}  {r['text'][:80]}",
+            sub = f"  [submit: {r['submit'][0][:60]}]" if r.get("submit") else ""
+            print(f"{r['reason']:13s} {r.get('seconds', 0):6.1f}s {p.relative_to(corpus)}  {r['text'][:80]}{sub}",
                   file=sys.stderr)
             if a.limit and len(rows) >= a.limit:
                 break

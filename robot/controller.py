@@ -488,14 +488,19 @@ class Controller:
         """The current IPO setpoint A1..A6 (deg)."""
         return self._q.copy()
 
-    def pos_act(self, tool: Any = None, base: Any = None) -> dict[str, float]:
+    def pos_act(self, tool: Any = None, base: Any = None, ipo_mode: str = "BASE") -> dict[str, float]:
         """``$POS_ACT`` as an E6POS dict {X, Y, Z, A, B, C, S, T} (mm, deg): the TCP of
         :meth:`axis_act` in ``base`` for ``tool`` (6-tuples or 4x4; default: the $BASE/$TOOL
-        of the motion the main run executes, ``$BASE_C``/``$TOOL_C``)."""
+        of the motion the main run executes, ``$BASE_C``/``$TOOL_C``). ``ipo_mode`` "TCP"
+        (external TCP, reference §6.4): ``tool`` is the workpiece on the flange, ``base`` the
+        fixed tool in WORLD, and the pose is the fixed tool in the workpiece frame,
+        ``INV_POS($ROBROOT : FLANGE(q) : $TOOL) : $BASE`` (robot/external_tcp.py)."""
         q = self.axis_act()
         tool_T = self._tool_T if tool is None else _as4(tool)
         base_inv = self._base_inv_T if base is None else inv_pos(_as4(base))
         T = self._tcp_read_back(q, tool_T, base_inv)
+        if ipo_mode == "TCP":
+            T = inv_pos(T)
         x, y, z, a, b, c = matrix_to_frame(T)
         s, t = self.model.status_turn(q)
         return {"X": x, "Y": y, "Z": z, "A": a, "B": b, "C": c, "S": s, "T": t}
@@ -805,7 +810,7 @@ class Controller:
             for seg in active:
                 if st.matches_motion(seg.id, seg.req.line):
                     p_end = seg.model.tcp(seg.q1, seg.tool_T, seg.base_inv_T)[:3, 3]
-                    here = self.model.tcp(self._q, seg.tool_T, seg.base_inv_T)[:3, 3]
+                    here = seg.model.tcp(self._q, seg.tool_T, seg.base_inv_T)[:3, 3]
                     if float(np.linalg.norm(here - p_end)) <= st.reached_mm + 1e-9:
                         st.due = self.time + st.delay
                         if st.delay <= 0:

@@ -54,7 +54,7 @@ class MotionParams:
         ori_type: ``VAR``, ``CONSTANT`` or ``JOINT`` (``$ORI_TYPE``, '#' optional).
         circ_type: ``BASE`` or ``PATH`` (``$CIRC_TYPE``).
         ov_pro: ``$OV_PRO`` %.
-        ipo_mode: ``BASE`` (only this is supported; ``TCP`` raises at planning).
+        ipo_mode: ``BASE`` or ``TCP`` (external TCP, robot/external_tcp.py).
     """
 
     vel_cp: float = 2.0

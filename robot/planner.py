@@ -584,14 +584,18 @@ def plan(req: MotionRequest, q_start: np.ndarray, model: RobotModel, *,
     """Plan one motion from the axes ``q_start`` (the previous programmed end point).
 
     Raises:
-        RobotError: incomplete first motion (BCO), PATH trigger on PTP, unsupported
-            ``$IPO_MODE``; WorkspaceError / SoftLimitError (subclasses) when the
+        RobotError: incomplete first motion (BCO), PATH trigger on PTP, a ``$IPO_MODE``
+            other than #BASE and #TCP (robot/external_tcp.py); WorkspaceError / SoftLimitError (subclasses) when the
             target (or a SPLINE/CIRC point) is unreachable or outside the soft limits.
     """
     p: MotionParams = req.params
     if first:
         _check_complete(req)
-    if p.ipo_mode != "BASE":
+    if p.ipo_mode == "TCP":
+        from .external_tcp import external_tcp  # noqa: PLC0415
+
+        model = external_tcp(model)      # the fixed tool in the workpiece frame
+    elif p.ipo_mode != "BASE":
         raise RobotError(f"$IPO_MODE=#{p.ipo_mode} is not supported by the simulator")
     q0 = np.asarray(q_start, dtype=float).copy()
     tool_T = frame_to_matrix(*p.tool)

@@ -15,8 +15,10 @@ buffer, a non-ASCII digit) is a format error, as on the controller: the text up 
 written, ``state.RET1`` = #FMT_ERR and ``state.HITS`` counts the values converted before it;
 the program goes on (without a STATE_T variable it is a run-time error). StrToInt/StrToReal
 accept KRL literal syntax only (reference §1.5). CAST_TO/CAST_FROM are in cast.py.
-Unsupported: CREAD/COPEN/CCLOSE/CIOCTL, channels other than $CMD — a clear "not supported"
-run-time error.
+GETSYSSTATE answers "STOPBITS" (no stop reaction active; :func:`_getsysstate`); INVERSE
+solves the inverse kinematics of the simulated robot (:func:`_inverse`).
+Unsupported: CREAD/COPEN/CCLOSE/CIOCTL, GET_SIG_INF, channels other than $CMD — a clear
+"not supported" run-time error.
 """
 
 from __future__ import annotations
@@ -168,8 +170,50 @@ def _forward(rt, a):
     return pos_struct({"X": x, "Y": y, "Z": z, "A": aa, "B": bb, "C": cc, "S": s, "T": t})
 
 
+INVERSE_NOT_REACHABLE = 3
+"""INVERSE's STATUS for a position the robot cannot reach (KSS reports "3": its value in
+KUKA's field reports; KUKA does not document the codes). 0 is success."""
+INVERSE_SOFT_LIMIT = 2
+"""INVERSE's STATUS for a position reachable only outside the software limit switches
+(a simulated code: KUKA's BASIS treats 2 and 3 alike, bas.src CheckERRStatus)."""
+
+
 def _inverse(rt, a):
-    raise KrlRuntimeError("INVERSE is not supported by this simulator")
+    """``E6AXIS INVERSE(E6POS TOOLPOS :IN, E6AXIS START_AXIS :IN, INT STATUS :OUT)``
+    (reference §4.8; KSS operate.dat): the axes that put the TCP at TOOLPOS in the current
+    $TOOL/$BASE (as FORWARD and the motions do), with TOOLPOS's S and T where it has them and
+    otherwise the solution nearest START_AXIS. STATUS 0; a position out of reach: STATUS
+    :data:`INVERSE_NOT_REACHABLE` (outside the software limits: :data:`INVERSE_SOFT_LIMIT`)
+    and the result is START_AXIS (the program is expected to test STATUS)."""
+    import numpy as np  # noqa: PLC0415
+
+    from robot.errors import SoftLimitError, WorkspaceError  # noqa: PLC0415
+    from robot.frames import frame_to_matrix  # noqa: PLC0415
+
+    from .sysvars import axis_struct  # noqa: PLC0415
+
+    pos = a[0].get()
+    start = a[1].get() if len(a) > 1 and a[1] is not None else None
+    ctl = rt.controller
+    ref = (np.array([_real_leaf(start, k) for k in ("A1", "A2", "A3", "A4", "A5", "A6")], dtype=float)
+           if start is not None else np.array(ctl.axis_act(), dtype=float)[:6])
+    store = rt.sysvars.store
+    tool = frame_to_matrix(*frame_tuple(store["$TOOL"]))
+    base = frame_to_matrix(*frame_tuple(store["$BASE"]))
+    target = frame_to_matrix(*frame_tuple(pos, "INVERSE position"))
+    st = pos.f.get("S", UNSET) if isinstance(pos, Struct) else UNSET
+    tu = pos.f.get("T", UNSET) if isinstance(pos, Struct) else UNSET
+    code = 0
+    try:
+        q = ctl.model.ik(target, np.linalg.inv(tool), base, None if st is UNSET else int(num(st)),
+                         None if tu is UNSET else int(num(tu)), ref)
+    except SoftLimitError:
+        q, code = ref, INVERSE_SOFT_LIMIT
+    except WorkspaceError:
+        q, code = ref, INVERSE_NOT_REACHABLE
+    if len(a) > 2 and a[2] is not None:
+        a[2].set(code)
+    return axis_struct(q)
 
 
 def _real_leaf(s, k):
@@ -425,6 +469,34 @@ def _cwrite(rt, a):
     st = a[1].peek() if a[1] is not None else None
     if isinstance(st, Struct) and "RET1" in st.f:
         st.f["RET1"] = EnumValue("CMD_OK")
+
+
+# ------------------------------------------------------------------ system state (§4.8)
+
+GETSYSSTATE_COMMANDS = ("STOPBITS",)
+"""The GETSYSSTATE commands the simulator answers (the only one the corpus uses)."""
+
+
+def _getsysstate(rt, a):
+    """``BOOL GETSYSSTATE(CHAR CMD[64] :IN, INT IPAR :OUT, REAL RPAR :OUT)`` (KSS
+    ``$OPERATE`` EXTFCTP, operate.dat; reference §4.8 names it, KUKA does not document it).
+    ``"STOPBITS"`` (KUKA's torque monitoring, tm_bib.src, asks it before it changes its
+    limits): TRUE, IPAR = the stop reactions active on the controller as bits, 0 = none, and
+    RPAR = 0.0. The simulated controller never holds the robot in a stop reaction that a
+    program goes on past (a stop ends the run), so IPAR is always 0: the simulated answer.
+    Any other command: FALSE, IPAR and RPAR unchanged, one ``message`` event per command."""
+    cmd = _text(a[0], "GETSYSSTATE command").strip().upper()
+    if cmd not in GETSYSSTATE_COMMANDS:
+        key = "GETSYSSTATE " + cmd[:64]
+        if key not in rt.noted:
+            rt.noted.add(key)
+            rt.message(f"not simulated: GETSYSSTATE(\"{cmd[:64]}\") answers FALSE")
+        return False
+    if len(a) > 1 and a[1] is not None:
+        a[1].set(0)
+    if len(a) > 2 and a[2] is not None:
+        a[2].set(0.0)
+    return True
 
 
 def _unsupported(name):
@@ -783,7 +855,7 @@ NATIVES: dict = {
     "CAST_TO": cast_to, "CAST_FROM": cast_from,
     "CREAD": _unsupported("CREAD"), "COPEN": _unsupported("COPEN"),
     "CCLOSE": _unsupported("CCLOSE"), "CIOCTL": _unsupported("CIOCTL"),
-    "GET_SIG_INF": _unsupported("GET_SIG_INF"), "GETSYSSTATE": _unsupported("GETSYSSTATE"),
+    "GET_SIG_INF": _unsupported("GET_SIG_INF"), "GETSYSSTATE": _getsysstate,
 }
 
 # built-ins whose result type is needed to convert a native Python result

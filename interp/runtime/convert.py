@@ -20,7 +20,7 @@ import math
 from krl.semantics import types as T
 
 from .errors import KrlRuntimeError, value_invalid
-from .values import NEUTRAL, UNSET, Arr, EnumValue, Struct, copy_value, make_value
+from .values import UNSET, Arr, EnumValue, Struct, copy_value, make_value
 
 INT_MIN = -(2 ** 31)
 INT_MAX = 2 ** 31 - 1
@@ -63,8 +63,6 @@ def num(v, what: str = "operand"):
         return ord(v)
     if v is UNSET:
         raise value_invalid()
-    if v is NEUTRAL:
-        return 0
     if isinstance(v, bool):
         raise KrlRuntimeError(f"BOOL {what} where a number is needed")
     raise KrlRuntimeError(f"{what} is not a number: {v!r}")
@@ -73,8 +71,6 @@ def num(v, what: str = "operand"):
 def to_bool(v, what: str = "condition") -> bool:
     if v is True or v is False:
         return v
-    if v is NEUTRAL:
-        return False
     if v is UNSET:
         raise value_invalid()
     raise KrlRuntimeError(f"{what} is not BOOL: {v!r}")
@@ -84,10 +80,6 @@ def convert_scalar(v, t):
     """Convert ``v`` for storage in a leaf of simple/enum type ``t`` (assignment, §3.9)."""
     if v is UNSET:
         raise value_invalid()
-    if v is NEUTRAL:
-        if isinstance(t, (T.Struc, T.Array)):
-            return make_value(t)
-        v = False if t is T.BOOL else 0
     if t is T.INT:
         c = v.__class__
         if c is int:
@@ -157,8 +149,6 @@ def assign_into(dest, v) -> None:
     """Assign ``v`` into the existing Struct/Arr ``dest`` in place (so that :OUT
     references and component views stay valid). Structures copy the components present
     in ``v`` that exist in ``dest`` (partial aggregates, geometric relatives, §3.9)."""
-    if v is NEUTRAL:
-        return  # undeclared machine data: leaves the destination as it is
     if isinstance(dest, Struct):
         if not isinstance(v, Struct):
             if v is UNSET:
@@ -262,10 +252,6 @@ def binary_op(op: str, a, b):
 def compare(op: str, a, b) -> bool:
     if a is UNSET or b is UNSET:
         raise value_invalid()
-    if a is NEUTRAL:
-        a = False if (b is True or b is False) else 0
-    if b is NEUTRAL:
-        b = False if (a is True or a is False) else 0
     if isinstance(a, EnumValue) or isinstance(b, EnumValue):
         if op == "==":
             return a == b
@@ -302,8 +288,6 @@ def unary_op(op: str, a):
     if op == "NOT":
         if a is True or a is False:
             return not a
-        if a is NEUTRAL:
-            return True
         if a.__class__ is int:
             return _wrap32(~a)
         raise KrlRuntimeError("NOT needs a BOOL operand")

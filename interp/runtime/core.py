@@ -77,6 +77,7 @@ class Runtime:
         self.random = random.Random(0)
         self.mode_op = getattr(controller, "mode_op", "AUT")  # $MODE_OP (robot/limits.py)
         self.msg_handle = 0
+        self.noted: set[str] = set()    # simulator notes given once per run (builtins)
         self.steps = 0
         self.max_steps = max_steps
         self.robot_budget = robot_budget
@@ -350,16 +351,14 @@ class Runtime:
     def lookup(self, name: str) -> Ref:
         """The one run-time name lookup, for a name nothing declares (storage class
         UNRESOLVED; docs/architecture.md, "One program model"): a ``$`` name is a system
-        variable the simulator knows without a table entry, or, in a KRC backup, an
-        undeclared one created on first use that reads 0 (``SysVars.auto``); any other name
-        is the run-time error "unknown name"."""
+        variable the simulator knows, or one that a system data list or KSS's system files
+        declare (``SysVars.lookup``); any other name, an undeclared ``$`` name included, is the
+        run-time error "unknown name", as on the controller."""
         key = name.upper()
         if key[:1] == "$":
             r = self.sysvars.lookup(key)
             if r is not None:
                 return r
-            if self.program.backup:
-                return self.sysvars.auto(key)
         raise KrlRuntimeError(f"unknown name {name}")
 
     def index(self, base: Ref, idx: list, name: str) -> Ref:

@@ -24,7 +24,7 @@ from krl.semantics import types as T
 
 from .convert import assign_into, convert_scalar
 from .errors import KrlRuntimeError, ResourceError, value_invalid
-from .values import NEUTRAL, UNSET, Arr, Struct, make_value
+from .values import UNSET, Arr, Struct, make_value
 
 
 class Ref:
@@ -79,27 +79,6 @@ class Slot(Ref):
             self.c[self.k] = v
         if self.on_write is not None:
             self.on_write(self)
-
-
-class AutoSlot(Slot):
-    """An undeclared system variable (see ``sysvars.SysVars.auto``): takes any value."""
-
-    __slots__ = ()
-
-    def get(self):
-        v = self.c[self.k]
-        if v is UNSET or (isinstance(v, Struct) and v.type is None and not v.f):
-            return NEUTRAL   # machine data the backup does not declare: 0 / FALSE (documented policy)
-        return v
-
-    def set(self, v) -> None:
-        from .values import copy_value  # noqa: PLC0415
-
-        cur = self.c[self.k]
-        if isinstance(cur, Struct) and isinstance(v, Struct):
-            assign_into(cur, v)
-        else:
-            self.c[self.k] = copy_value(v)
 
 
 class ProxyRef(Ref):
@@ -221,14 +200,6 @@ def index_ref(base: Ref, idx: list, name: str) -> Ref:
     CHAR row, all None the whole array)."""
     if all(i is None for i in idx):
         return base
-    if isinstance(base, AutoSlot):       # an undeclared system variable used as an array
-        v = base.peek()
-        if not isinstance(v, Struct):
-            v = Struct(None, {})
-            base.c[base.k] = v
-        key = "[" + ",".join("" if i is None else str(i) for i in idx) + "]"
-        v.f.setdefault(key, Struct(None, {}))
-        return AutoSlot(v.f, key, None, f"{name}{key}")
     v = base.peek()
     proxy = getattr(v, "is_live_array", False)
     if proxy:
@@ -262,12 +233,8 @@ def field_ref(base: Ref, comp: str, name: str) -> Ref:
     if key not in v.f:
         if v.type is not None and key in v.type.fields:
             v.f[key] = make_value(v.type.fields[key][1])
-        elif v.type is None and isinstance(base, AutoSlot):
-            v.f[key] = Struct(None, {})   # an undeclared system variable grows its components
         else:
             raise KrlRuntimeError(f"{base.name} has no component {comp}")
-    if v.type is None and isinstance(base, AutoSlot):
-        return AutoSlot(v.f, key, None, f"{name}.{comp}")
     ft = v.type.fields[key][1] if v.type is not None and key in v.type.fields else None
     ro = base.readonly if isinstance(base, (Slot, ComputedRef)) else False
     return Slot(v.f, key, ft, f"{name}.{comp}", ro)

@@ -282,6 +282,9 @@ class Program:
         return T.UNKNOWN
 
     def _load_item(self, m: ModuleRT, item, slot_of: dict, mada: bool) -> None:
+        # a KSS system data list ($OPERATE, $MACHINE, $OPTION, ...: DEFDAT $NAME) declares the
+        # system variables the simulator does not model (SysVars.declare)
+        system_list = m.datalist.name[:1] == "$"
         if isinstance(item, N.VarDecl):
             for vn in item.names:
                 k = slot_of.get(id(vn))
@@ -305,11 +308,17 @@ class Program:
                 m.data[vn.name.upper()] = ref
                 if mada:
                     self._machine_data(vn.name.upper(), ref)
+                if system_list and vn.name[:1] == "$":
+                    self.rt.sysvars.declare(vn.name.upper(), ref, self._decl_span(vn, item))
         elif isinstance(item, N.ArrayInit):
             st = item.ann.storage if item.ann is not None else None
             ref = m.refs[st.slot] if st is not None else None
             if ref is None:
                 return
+            if isinstance(ref, Slot) and ref.readonly:
+                # a CONST array initialised element by element in its data list (reference
+                # §2.5 array_elem_init): the data list writes it; the program cannot
+                ref = Slot(ref.c, ref.k, ref.type, ref.name)
             try:
                 target = index_ref(ref, list(item.indices), item.name)
                 value = self.literal(item.value, target.type)
@@ -325,6 +334,8 @@ class Program:
             if ref is not None and k is not None:
                 m.refs[k] = ref
                 m.data[item.name.upper()] = ref
+                if system_list and item.name[:1] == "$":
+                    self.rt.sysvars.declare(item.name.upper(), ref, item.span)
 
     def _machine_data(self, key: str, ref) -> None:
         """A machine data list (Mada) declares a system variable of the tables: the system

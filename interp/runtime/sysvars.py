@@ -11,7 +11,11 @@ this module adds only *where the value lives*:
   ``$VEL_ACT``, ``$DATE``, ``$PRO_STATE*``, ``$PRO_MOVE``, ``$STOPMESS``, ``$MODE_OP``,
   ``$INTERPRETER``, ``$ERR`` (one per interpreter), ``$NULLFRAME``, ``$NUM_AX``, ...;
 * everything else is stored (``store``), booting with the INITMOV values ("friendly mode",
-  reference §7.3): the motion variables are read from there when a motion is planned.
+  reference §7.3): the motion variables are read from there when a motion is planned;
+* a system variable the table lacks: the value a KSS system data list of the program's files
+  declares (``declare``), or, when only KSS's own files declare it (kss.yaml), its type with
+  zero values; one ``message`` event per variable (:meth:`SysVars._unsimulated`). A ``$``
+  name nothing declares is not created: the caller's run-time error "unknown name".
 """
 
 from __future__ import annotations
@@ -20,9 +24,10 @@ from krl.semantics import types as T
 from krl.semantics.builtins import load_builtins
 from krl.semantics.symbols import make_array, system_scopes
 
+from .convert import frame_tuple
 from .errors import KrlRuntimeError, value_invalid
-from .memory import AutoSlot, ComputedRef, Slot
-from .values import EnumValue, Struct, make_value
+from .memory import ComputedRef, Slot
+from .values import EnumValue, Struct, make_value, zero_value
 
 
 class LiveArray:
@@ -84,6 +89,7 @@ class SysVars:
         self.info = load_builtins().sysvars
         self.store: dict = {}
         self.refs: dict = {}
+        self.declared: dict = {}      # UPPER name -> (data-list reference, Span): declare()
         self._boot()
 
     # ------------------------------------------------------------------ boot values
@@ -174,7 +180,7 @@ class SysVars:
             return ref
         info = self.info.get(name)
         if info is None:
-            return None
+            return self._unsimulated(name)
         t = make_array(sys_type(info.type_name) or T.UNKNOWN, info.dims)
         live = _LIVE.get(name)
         if live is not None:
@@ -185,17 +191,39 @@ class SysVars:
         self.refs[name] = ref
         return ref
 
-    def auto(self, name: str):
-        """Policy for a system variable that neither the table nor a data list of the
-        backup declares (e.g. ``$LOAD_A1`` of operate_r1.dat): created on first use as an
-        untyped variable, logged once as a ``message`` event; a part never written reads
-        as 0 (machine data such as ``$TORQMON_DEF[i]`` that the backup lacks)."""
-        ref = self.refs.get(name)
-        if ref is None:
-            self.store[name] = Struct(None, {})
-            ref = AutoSlot(self.store, name, None, name)
-            self.refs[name] = ref
-            self.rt.message(f"not simulated: system variable {name} (undeclared; created on first use)")
+    def declare(self, name: str, ref, span) -> None:
+        """A KSS system data list of the program's files (``DEFDAT $MACHINE``, ``$ROBCOR``,
+        ``$CUSTOM``, ``$OPTION``, ``$OPERATE``, ...; reference §2.5) declares system variable
+        ``name`` (upper-case) as ``ref`` at ``span``: if the simulator does not model it, a
+        read gives the value declared there (:meth:`lookup`). The first declaration holds."""
+        if name not in self.info and name not in _LIVE:
+            self.declared.setdefault(name, (ref, span))
+
+    def _unsimulated(self, name: str):
+        """The reference of a system variable the simulator does not model, or None if
+        nothing declares it (the caller's run-time error "unknown name", as the controller
+        gives for an undeclared ``$`` name). Declared by a system data list of the backup
+        (:meth:`declare`): that variable, with its declared value. Declared only by KSS's own
+        system files (krl/semantics/data/kss.yaml, e.g. ``$TORQMON`` of operate.dat in a flat
+        export without them): a variable of the declared type whose numbers read 0, BOOLs
+        FALSE, CHARs NUL (KSS's files give these no initial value; the simulated answer,
+        docs/architecture.md "Environment"). Either way one ``message`` event per variable
+        and run says so."""
+        d = self.declared.get(name)
+        if d is not None:
+            ref, span = d
+            where = _where(self.rt, span)
+            self.rt.message(f"not simulated: system variable {name} reads its value declared at {where}")
+        else:
+            kss = load_builtins().kss_variables.get(name)
+            if kss is None:
+                return None
+            t = make_array(sys_type(kss.type_name) or T.UNKNOWN, kss.dims)
+            self.store[name] = zero_value(t)
+            ref = Slot(self.store, name, t, name, readonly=kss.access == "RO")
+            self.rt.message(f"not simulated: system variable {name} (declared by KSS's system files, "
+                            f"not by this program's): reads 0/FALSE")
+        self.refs[name] = ref
         return ref
 
     def stops(self, name: str) -> tuple[bool, bool]:
@@ -208,6 +236,21 @@ class SysVars:
         return self.store[name]
 
     _on_write: dict = {}
+
+
+def _where(rt, span) -> str:
+    """``file:line`` of a declaration, the file relative to the program's workspace when it
+    lies inside it (traces do not depend on where the backup is unpacked)."""
+    from pathlib import Path  # noqa: PLC0415
+
+    p = Path(span.file)
+    root = getattr(getattr(rt, "program", None), "workspace", None)
+    if root is not None:
+        try:
+            p = p.resolve().relative_to(Path(root).resolve())
+        except ValueError:
+            pass
+    return f"{p.as_posix()}:{span.line}"
 
 
 # ---------------------------------------------------------------------- live variables
@@ -246,6 +289,18 @@ def _computed(fn, setter=None):
     def make(sv: SysVars, t, name):
         return ComputedRef(lambda: fn(sv), t, name, setter)
     return make
+
+
+def _pos_act(sv: SysVars):
+    """``$POS_ACT``: the robot's pose in the current ``$TOOL``/``$BASE`` (reference §6.4,
+    table §10: "current TCP pose in current $BASE/$TOOL"), the values the program set last,
+    so that ``$TOOL = TOOL_DATA[2]`` then ``PTP $POS_ACT`` does not move the robot (the read
+    stops the advance run: the robot stands still). ``$IPO_MODE = #TCP``: the fixed tool in
+    the workpiece frame (robot/external_tcp.py)."""
+    s = sv.store
+    mode = s["$IPO_MODE"]
+    return pos_struct(sv.rt.controller.pos_act(frame_tuple(s["$TOOL"], "$TOOL"), frame_tuple(s["$BASE"], "$BASE"),
+                                               ipo_mode=mode.name if isinstance(mode, EnumValue) else "BASE"))
 
 
 def _pos_int(sv: SysVars):
@@ -295,8 +350,8 @@ def _ro_const(v):
 _LIVE = {
     "$IN": _io("$IN"), "$OUT": _io("$OUT"), "$ANIN": _io("$ANIN"), "$ANOUT": _io("$ANOUT"),
     "$TIMER": _io("$TIMER"), "$TIMER_STOP": _io("$TIMER_STOP"), "$TIMER_FLAG": _io("$TIMER_FLAG"),
-    "$POS_ACT": _computed(lambda sv: pos_struct(sv.rt.controller.pos_act())),
-    "$POS_ACT_MES": _computed(lambda sv: pos_struct(sv.rt.controller.pos_act())),
+    "$POS_ACT": _computed(lambda sv: _pos_act(sv)),
+    "$POS_ACT_MES": _computed(lambda sv: _pos_act(sv)),
     "$AXIS_ACT": _computed(lambda sv: axis_struct(sv.rt.controller.axis_act())),
     "$AXIS_ACT_MEAS": _computed(lambda sv: axis_struct(sv.rt.controller.axis_act())),
     "$POS_INT": _computed(_pos_int),

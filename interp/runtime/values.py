@@ -35,17 +35,6 @@ class _Unset:
 UNSET = _Unset()
 
 
-class _Neutral:
-    """The value of undeclared machine data (see ``sysvars.SysVars.auto``): 0 where a number
-    is needed, FALSE where a BOOL is needed."""
-
-    __slots__ = ()
-
-    def __repr__(self) -> str:
-        return "NEUTRAL"
-
-
-NEUTRAL = _Neutral()
 
 
 class EnumValue:
@@ -198,6 +187,31 @@ def make_value(t):
             return Arr(t, t.dims, [make_value(t.elem) for _ in range(n)])
         return Arr(t, t.dims, [UNSET] * n)
     return UNSET
+
+
+def zero_value(t):
+    """A value of type ``t`` whose INT leaves are 0, REAL 0.0, BOOL FALSE, CHAR NUL; ENUM
+    leaves stay UNSET (no value is neutral). For system variables the simulator does not
+    model and nothing gives a value (sysvars.SysVars)."""
+    return _zeroed(make_value(t), t)
+
+
+def _zeroed(v, t):
+    """``v`` (a fresh :func:`make_value` of ``t``) with its UNSET leaves set to zero."""
+    if isinstance(v, Struct):
+        for k, (_, ft) in t.fields.items():
+            v.f[k] = _zeroed(v.f[k], ft)
+    elif isinstance(v, Arr):
+        v.data[:] = [_zeroed(x, t.elem) for x in v.data]
+    elif t == T.INT:
+        v = 0
+    elif t == T.REAL:
+        v = 0.0
+    elif t == T.BOOL:
+        v = False
+    elif t == T.CHAR:
+        v = "\0"
+    return v
 
 
 def copy_value(v):

@@ -34,8 +34,9 @@ def write(tmp: Path, name: str, text: str) -> Path:
 
 def run_krl(tmp: Path, src: str, dat: str | None = None, name: str = "prog", *, files: dict | None = None,
             stimuli: str | None = None, max_sim_time: float = 60.0, max_steps: int = 2_000_000,
-            submit: list | None = None, before=None, trace: bool = True) -> Run:
-    """Write ``name``.src (and .dat) into ``tmp``, run it on the tree interpreter."""
+            submit: list | None = None, before=None, trace: bool = True, interp: str = "tree") -> Run:
+    """Write ``name``.src (and .dat) into ``tmp``, run it on the tree interpreter (or
+    ``interp="vm"``)."""
     prog = write(tmp, f"{name}.src", src)
     if dat is not None:
         write(tmp, f"{name}.dat", dat)
@@ -47,7 +48,7 @@ def run_krl(tmp: Path, src: str, dat: str | None = None, name: str = "prog", *, 
     tw = TraceWriter(keep=True) if trace else None
     rt, _ = make_runtime(prog, inputs=inputs, trace=tw, max_sim_time=max_sim_time, max_steps=max_steps,
                          mujoco=False, submit=[tmp / s for s in (submit or [])],
-                         check=False)   # run-time semantics, errors included (krl run --no-check)
+                         check=False, interp=interp)   # run-time semantics, errors included (krl run --no-check)
     if before is not None:
         before(rt)
     res = rt.run()
