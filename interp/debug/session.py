@@ -121,6 +121,7 @@ class DebugSession:
         self.step: tuple | None = None         # (kind, task, depth)
         self.resume: tuple | None = None
         self.stop_n = 0
+        self.stop_mid = False                  # stopped inside a statement (step stop, error)
         self.stop_task = None
         self.stop_error = None
         self.handles: list = []
@@ -349,12 +350,13 @@ class DebugSession:
     def req_stepBack(self, req, args) -> None:  # noqa: N802
         self._need_stopped()
         self.respond(req)
-        self.resume = ("restart", Restart(max(1, self.stop_n - 1), "step"))
+        # a stop inside statement n (a step stop, an error) goes back to n's start, else to n - 1
+        self.resume = ("restart", Restart(max(1, self.stop_n - (0 if self.stop_mid else 1)), "step"))
 
     def req_reverseContinue(self, req, args) -> None:  # noqa: N802
         self._need_stopped()
         self.respond(req)
-        self.resume = ("restart", Restart(0, "breakpoint", scan=self.stop_n))
+        self.resume = ("restart", Restart(0, "breakpoint", scan=self.stop_n + (1 if self.stop_mid else 0)))
 
     # ------------------------------------------------------------------ requests: inspection
     def req_stackTrace(self, req, args) -> None:  # noqa: N802
@@ -666,13 +668,13 @@ class DebugSession:
             return
         what = {"MSTEP": "MSTEP: the motion has ended", "ISTEP": "ISTEP: before the next statement",
                 "BSTEP": "BSTEP: the backward motion has ended"}.get(mode, mode)
-        self.stop(task, "step", description=text or what)
+        self.stop(task, "step", description=text or what, mid=True)
 
     def on_error(self, task, frame, err) -> None:
         if self.busy or self.target is not None or self.scan is not None:
             return
         num = f" ({err.number})" if err.number is not None else ""
-        self.stop(task, "exception", description=f"run-time error{num}", text=err.message, error=err)
+        self.stop(task, "exception", description=f"run-time error{num}", text=err.message, error=err, mid=True)
 
     def _breakpoint(self, task, info):
         """(bp, is_function, description) when a breakpoint stops here (its hit counted), else None."""
@@ -733,9 +735,10 @@ class DebugSession:
             self.dispatch(msg)
 
     def stop(self, task, reason: str, description: str | None = None, text: str | None = None,
-             bp=None, error=None) -> None:
+             bp=None, error=None, mid: bool = False) -> None:
         """Stop every thread here and serve requests until one resumes."""
         self.state = "stopped"
+        self.stop_mid = mid
         self.stop_task = task
         self.stop_n = self.n
         self.stop_error = error
