@@ -822,10 +822,13 @@ class DebugSession:
         return out
 
     def _thread_of(self, task) -> int:
+        """The thread a stop of ``task`` belongs to: its innermost running interrupt's, else
+        its own."""
+        last = ROBOT_THREAD
         for tid, _n, t, _f in self.thread_list():
             if t is task:
                 last = tid
-        return last if task is not None else ROBOT_THREAD
+        return last
 
     def _task_of_thread(self, tid):
         for t, _n, task, _f in self.thread_list():

@@ -201,3 +201,19 @@ def test_launch_refuses_bad_arguments(tmp_path):
             c.request("launch", {"program": str(tmp_path / "none.src")})
         with pytest.raises(DapError, match="mode"):
             c.request("launch", {"program": str(CALL), "mode": "T3"})
+
+
+def test_submit_interpreter_is_a_thread():
+    # 100_submit_io: the robot program waits at WAIT FOR $OUT[5] (l.2); sps.sub sets $OUT[5]
+    # (l.4) once the stimulus has set $IN[2] at t = 0.2 s
+    case = CASES / "100_submit_io"
+    with DapClient() as c:
+        st = c.start(case / "program.src", inputs=str(case / "stimuli.yaml"), submit=[str(case / "sps.sub")],
+                     breakpoints={case / "sps.sub": [4]})
+        assert st["body"]["reason"] == "breakpoint" and st["body"]["threadId"] == 2
+        threads = {t["id"]: t["name"] for t in c.request("threads")["body"]["threads"]}
+        assert threads == {1: "robot program program", 2: "submit interpreter sps"}
+        assert frames(c, 2) == [("sps()", 4)]
+        assert frames(c, 1) == [("program()", 2)]
+        assert c.value("$IN[2]") == "TRUE" and c.value("$OUT[5]") == "FALSE"
+        assert c.request("krl/pointers")["body"]["time"] >= 0.2
