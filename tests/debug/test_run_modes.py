@@ -61,8 +61,9 @@ def test_mstep_stops_at_each_motion_end_exactly(interp):
     assert np.allclose(pose_at(ev, ends[2])["tcp"][:3], [605, 0, 810], atol=1e-3)
 
 
-def test_istep_stops_before_each_statement_with_the_robot_at_rest():
-    _, res, ev = run(CIRC, "ISTEP")
+@pytest.mark.parametrize("interp", ["tree", "vm"])
+def test_istep_stops_before_each_statement_with_the_robot_at_rest(interp):
+    _, res, ev = run(CIRC, "ISTEP", interp=interp)
     assert res.reason == "completed"
     stops = kinds(ev, "step_stop")
     main = [s for s in stops if s["file"].endswith("program.src")]
