@@ -599,6 +599,7 @@ class DebugSession:
             rt.stmt_hook = self.on_statement
             rt.step_hook = self.on_step_stop
             rt.error_hook = self.on_error
+            rt.cycle_hook = self.on_cycle
             self.n = 0
             self.target, self.target_reason, self.scan, self.scan_last = target, reason, scan, 0
             self.step = None
@@ -660,6 +661,15 @@ class DebugSession:
         self.prev_frame[task] = task.frame
         if reason is not None:
             self.stop(task, reason, description=desc, bp=hit[0] if hit else None)
+
+    def on_cycle(self, task) -> None:
+        """A task resumes in a new IPO cycle (it waits: WAIT FOR, WAIT SEC, the advance-run
+        stop, a full motion queue): a pause requested meanwhile stops it there."""
+        if self.busy or self.target is not None or self.scan is not None:
+            return
+        self.pump()
+        if self.pause_req:
+            self.stop(task, "pause", description="paused while waiting", mid=True)
 
     def on_step_stop(self, task, mode: str, text: str | None) -> None:
         if text:

@@ -97,6 +97,7 @@ class Runtime:
         self.stmt_hook = None           # debugger: stmt_hook(task, info) before every statement
         self.step_hook = None           # debugger: step_hook(task, mode, text) at a step stop
         self.error_hook = None          # debugger: error_hook(task, frame, err) where an error leaves a routine
+        self.cycle_hook = None          # debugger: cycle_hook(task) when a waiting task resumes (pause in a WAIT)
 
     # ================================================================== tasks and run
     def add_task(self, kind: str, name: str, body) -> Task:
@@ -206,6 +207,8 @@ class Runtime:
         """Give the rest of this IPO cycle back; on return run :meth:`service`."""
         self.scheduler.yield_cycle()
         self.service(task)
+        if self.cycle_hook is not None:
+            self.cycle_hook(task)
 
     def service(self, task: Task) -> None:
         """First act of a resumed task: main-run errors, TRIGGER actions, interrupts."""

@@ -217,3 +217,28 @@ def test_submit_interpreter_is_a_thread():
         assert frames(c, 1) == [("program()", 2)]
         assert c.value("$IN[2]") == "TRUE" and c.value("$OUT[5]") == "FALSE"
         assert c.request("krl/pointers")["body"]["time"] >= 0.2
+
+
+def test_pause_while_waiting_and_step_back_from_there(tmp_path):
+    # WAIT SEC 1000 (l.4): pause stops the program inside the wait
+    prog = tmp_path / "waits.src"
+    prog.write_text("DEF waits()\n  DECL INT n\n  n = 5\n  WAIT SEC 1000\n  n = 6\nEND\n")
+    with DapClient() as c:
+        c.initialize()
+        c.request("launch", {"program": str(prog), "maxSimTime": 100000})
+        c.request("configurationDone")
+        c.request("pause", {"threadId": 1})
+        st = c.wait_event("stopped")
+        for _ in range(3):                                  # paused at a statement, before the wait: go on
+            if st["body"].get("description") == "paused while waiting":
+                break
+            c.request("continue", {"threadId": 1})
+            c.request("pause", {"threadId": 1})
+            st = c.wait_event("stopped")
+        assert st["body"]["reason"] == "pause" and st["body"]["description"] == "paused while waiting"
+        assert frames(c) == [("waits()", 4)] and c.value("n") == "5"
+        t = c.request("krl/pointers")["body"]["time"]
+        assert 0 < t < 1000
+        c.request("stepBack", {"threadId": 1})              # back to the start of line 4, t = 0
+        c.wait_event("stopped")
+        assert frames(c) == [("waits()", 4)] and c.request("krl/pointers")["body"]["time"] == 0.0
