@@ -130,6 +130,7 @@ class DebugSession:
         self.prev_frame: dict = {}             # task -> frame seen at its previous statement
         self.done = False
         self.last_refusal: str | None = None
+        self.break_on_errors = True
         self._stop_thread = ROBOT_THREAD
 
     # ------------------------------------------------------------------ wire
@@ -188,7 +189,9 @@ class DebugSession:
 
     def dispatch(self, msg: dict) -> None:
         if msg.get("type") == "_protocol_error":
-            sys.stderr.write(f"krl debug: protocol error: {msg['text']}\n")
+            from krl.terminal import printable  # noqa: PLC0415
+
+            sys.stderr.write(f"krl debug: protocol error: {printable(msg['text'])}\n")
             self.done = True
             raise Terminate()
         if msg.get("type") != "request":
@@ -300,7 +303,10 @@ class DebugSession:
         self.respond(req, {"breakpoints": out})
 
     def req_setExceptionBreakpoints(self, req, args) -> None:  # noqa: N802
-        self.respond(req, {"breakpoints": []})
+        """The filter ``runtime_error`` (on by default): stop where a run-time error occurs."""
+        filters = args.get("filters") or []
+        self.break_on_errors = "runtime_error" in filters
+        self.respond(req, {"breakpoints": [{"verified": True} for _ in filters]})
 
     def req_threads(self, req, args) -> None:
         threads = []
@@ -681,7 +687,7 @@ class DebugSession:
         self.stop(task, "step", description=text or what, mid=True)
 
     def on_error(self, task, frame, err) -> None:
-        if self.busy or self.target is not None or self.scan is not None:
+        if self.busy or self.target is not None or self.scan is not None or not self.break_on_errors:
             return
         num = f" ({err.number})" if err.number is not None else ""
         self.stop(task, "exception", description=f"run-time error{num}", text=err.message, error=err, mid=True)

@@ -139,6 +139,13 @@ def test_runtime_error_stop():
         assert c.request("exceptionInfo", {"threadId": 1})["body"]["description"] == "division by zero"
         c.request("continue", {"threadId": 1})
         assert c.wait_event("exited")["body"]["exitCode"] == 1
+    with DapClient() as c:                                  # the filter off: the run just ends
+        c.initialize()
+        c.request("launch", {"program": str(DIV0)})
+        c.request("setExceptionBreakpoints", {"filters": []})
+        c.request("configurationDone")
+        assert c.wait_event("exited")["body"]["exitCode"] == 1
+        assert "division by zero" in c.wait_event("output")["body"]["output"]
 
 
 def state(c):
@@ -242,3 +249,16 @@ def test_pause_while_waiting_and_step_back_from_there(tmp_path):
         c.request("stepBack", {"threadId": 1})              # back to the start of line 4, t = 0
         c.wait_event("stopped")
         assert frames(c) == [("waits()", 4)] and c.request("krl/pointers")["body"]["time"] == 0.0
+
+
+def test_a_malformed_message_ends_the_session_without_a_traceback():
+    c = DapClient()
+    try:
+        c.proc.stdin.write(b"Content-Length: 12x\r\n\r\n{}")
+        c.proc.stdin.flush()
+        c.proc.stdin.close()
+        assert c.proc.wait(timeout=60) == 0
+        err = c.proc.stderr.read().decode()
+        assert "krl debug: protocol error: bad Content-Length '12x'" in err and "Traceback" not in err
+    finally:
+        c.close()
