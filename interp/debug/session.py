@@ -636,9 +636,9 @@ class DebugSession:
 
     # ------------------------------------------------------------------ hooks
     def on_statement(self, task, info) -> None:
-        self.n += 1
-        if self.busy:
+        if self.busy:       # a function called by a watch, a backward motion: not counted
             return
+        self.n += 1
         if self.n > MAX_DAP_REPLAY_STEPS:
             return
         hit = self._breakpoint(task, info)
@@ -664,7 +664,6 @@ class DebugSession:
             reason = "step"
         if hit is not None:
             reason, desc = reason or ("function breakpoint" if hit[1] else "breakpoint"), hit[2]
-        self.prev_frame[task] = task.frame
         if reason is not None:
             self.stop(task, reason, description=desc, bp=hit[0] if hit else None)
 
@@ -696,8 +695,10 @@ class DebugSession:
         """(bp, is_function, description) when a breakpoint stops here (its hit counted), else None."""
         frame = task.frame
         fb = None
+        prev = self.prev_frame.get(task)
+        self.prev_frame[task] = frame
         if self.func_bps and frame is not None:
-            prev = self.prev_frame.get(task)
+            # a routine's first statement: its frame is new, deeper than the last one seen
             if prev is not frame and (prev is None or frame.caller is prev or frame.depth > prev.depth):
                 fb = self.func_bps.get(frame.name.upper())
         real = self.realpaths.get(info.file)
