@@ -25,6 +25,7 @@ starts at the beginning (at most krl.limits.MAX_DAP_REPLAY_STEPS statements).
 
 from __future__ import annotations
 
+import contextlib
 import os
 import queue
 import sys
@@ -131,6 +132,7 @@ class DebugSession:
         self.done = False
         self.last_refusal: str | None = None
         self.break_on_errors = True
+        self.cleanup = contextlib.ExitStack()  # an extracted backup, removed when the session ends
         self._stop_thread = ROBOT_THREAD
 
     # ------------------------------------------------------------------ wire
@@ -185,6 +187,8 @@ class DebugSession:
                     self.run_loop()
         except Terminate:
             pass
+        finally:
+            self.cleanup.close()
         return 0
 
     def dispatch(self, msg: dict) -> None:
@@ -231,6 +235,22 @@ class DebugSession:
         program = args.get("program")
         if not isinstance(program, str) or not program:
             raise _Refused("launch needs 'program': the path of a .src file")
+        workspace = args.get("workspace")
+        from krl.archive import ArchiveError, backup_source, is_archive  # noqa: PLC0415
+
+        if workspace is not None and is_archive(Path(str(workspace))):
+            # a KRC backup .zip: checked and extracted for the session (krl run --workspace BACKUP.zip)
+            from interp.cli import program_in  # noqa: PLC0415
+
+            try:
+                folder, _shown = self.cleanup.enter_context(backup_source(str(workspace)))
+            except ArchiveError as exc:
+                raise _Refused(str(exc)) from None
+            found = program_in(folder, Path(program))
+            if found is None:
+                raise _Refused(f"no program {program} in {workspace}")
+            program, workspace = str(found), str(folder)
+            args = {**args, "workspace": workspace}
         if not Path(program).is_file():
             raise _Refused(f"no such program: {program}")
         mode = str(args.get("mode") or "T1").upper()
@@ -245,7 +265,7 @@ class DebugSession:
         for key in ("workspace", "inputs"):
             if args.get(key) is not None and not Path(str(args[key])).exists():
                 raise _Refused(f"{key}: no such file or folder: {args[key]}")
-        self.launch_args = {"program": program, "workspace": args.get("workspace"), "inputs": args.get("inputs"),
+        self.launch_args = {"program": program, "workspace": workspace, "inputs": args.get("inputs"),
                             "mode": mode, "run_mode": run_mode, "interp": interp,
                             "stop_on_entry": bool(args.get("stopOnEntry", False)),
                             "max_sim_time": float(args.get("maxSimTime", 600.0)),

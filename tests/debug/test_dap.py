@@ -262,3 +262,17 @@ def test_a_malformed_message_ends_the_session_without_a_traceback():
         assert "krl debug: protocol error: bad Content-Length '12x'" in err and "Traceback" not in err
     finally:
         c.close()
+
+
+def test_a_krc_backup_zip_as_workspace(tmp_path):
+    import zipfile
+
+    backup = tmp_path / "backup.zip"
+    with zipfile.ZipFile(backup, "w") as zf:
+        zf.writestr("KRC/R1/Program/prog.src", "DEF prog()\n  DECL INT n\n  n = 41\n  n = n + 1\nEND\n")
+    with DapClient() as c:
+        st = c.start("prog", workspace=str(backup), stopOnEntry=True)     # a module name, as krl run takes it
+        assert st["body"]["reason"] == "entry" and frames(c) == [("prog()", 3)]
+        assert c.stack()[0]["source"]["path"].endswith("KRC/R1/Program/prog.src")
+        c.step("next")
+        assert c.value("n") == "41"
