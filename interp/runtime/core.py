@@ -848,6 +848,8 @@ class Runtime:
         """A SPLINE / PTP_SPLINE block. ``segments``: list of dicts with kind, target, aux,
         ca, with_ (ref, value pairs), triggers (robot.motion.Trigger list), line."""
         task = self._robot_only(kind)
+        if self.run_mode in STEP_MODES:
+            approx = None   # no advance run: the block ends exactly (docs/robot.md, run modes)
         if kind.upper() == "PTP_SPLINE":
             last = None
             for i, s in enumerate(segments):

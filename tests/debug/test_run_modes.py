@@ -145,3 +145,10 @@ def test_krl_run_run_mode_option(tmp_path):
     r = CliRunner().invoke(main, ["run", str(CIRC), "--run-mode", "mstep", "--trace", str(out)])
     assert r.exit_code == 0, r.output
     assert out.read_text().count('"kind":"step_stop"') == 3
+
+
+def test_mstep_stops_once_after_a_spline_block():
+    _, res, ev = run(SPLINE, "MSTEP")
+    # 065: PTP (l.4), SPLINE ... ENDSPLINE (l.6-10): two motions, two stops
+    assert [(s["mode"], s["id"]) for s in kinds(ev, "step_stop")] == [("MSTEP", 1), ("MSTEP", 2)]
+    assert all(e["approximation"] is None for e in kinds(ev, "motion"))
