@@ -29,12 +29,18 @@ import click
               default="AUT", show_default=True,
               help="Operating mode ($MODE_OP): T1 limits TCP and flange to 250 mm/s and PTP to "
                    "$RED_T1; AUT is the unattended virtual controller (docs/robot.md).")
+@click.option("--run-mode", "run_mode", type=click.Choice(["GO", "MSTEP", "ISTEP", "BSTEP"], case_sensitive=False),
+              default="GO", show_default=True,
+              help="Program run mode ($PRO_MODE): MSTEP stops after each motion, ISTEP after each "
+                   "statement (no advance run, no approximation); BSTEP runs forward as MSTEP, then "
+                   "retraces the motions backward (T1/T2 only). Each stop is a step_stop trace event "
+                   "and the run goes on, as if Start were pressed again (docs/robot.md).")
 @click.option("--no-check", "no_check", is_flag=True,
               help="Start the program even when the front end's checker finds errors in its own "
                    "module (by default, like the controller, such a program does not start: exit 1). "
                    "A name nothing declares is then a run-time error where it is evaluated.")
 def run(program: Path, interp_kind: str, workspace, inputs, trace_path, max_sim_time, max_steps, submit,
-        mode, no_check) -> None:
+        mode, run_mode, no_check) -> None:
     """Run PROGRAM (.src) on the simulated KR C4; print where and why it ended.
 
     With --workspace BACKUP.zip (a KRC backup archive) PROGRAM is a path inside the archive
@@ -56,13 +62,14 @@ def run(program: Path, interp_kind: str, workspace, inputs, trace_path, max_sim_
                     click.echo(f"error: no program {printable(program)} in {printable(workspace)}", err=True)
                     sys.exit(2)
                 _run(found, folder, inputs, trace_path, max_sim_time, max_steps, submit, interp_kind,
-                     mode=mode, shown=lambda text: text.replace(str(folder), str(workspace)), check=not no_check)
+                     mode=mode, shown=lambda text: text.replace(str(folder), str(workspace)), check=not no_check,
+                     run_mode=run_mode)
         except ArchiveError as exc:
             click.echo(f"error: {printable(exc)}", err=True)
             sys.exit(2)
         return
     _run(program, workspace, inputs, trace_path, max_sim_time, max_steps, submit, interp_kind, mode=mode,
-         check=not no_check)
+         check=not no_check, run_mode=run_mode)
 
 
 def program_in(folder: Path, program: Path) -> Path | None:
@@ -83,7 +90,7 @@ def program_in(folder: Path, program: Path) -> Path | None:
 
 
 def _run(program: Path, workspace, inputs, trace_path, max_sim_time, max_steps, submit, interp_kind,
-         mode=None, shown=lambda text: text, check: bool = True) -> None:
+         mode=None, shown=lambda text: text, check: bool = True, run_mode: str = "GO") -> None:
     if not program.exists():
         click.echo(f"error: {program}: no such file", err=True)
         sys.exit(2)
@@ -98,7 +105,8 @@ def _run(program: Path, workspace, inputs, trace_path, max_sim_time, max_steps, 
     try:
         rt, _ = make_runtime(program, workspace=workspace, inputs=inputs, trace=trace,
                              max_sim_time=max_sim_time, max_steps=max_steps, submit=list(submit),
-                             interp=interp_kind, observer=observer, mode=mode, check=check)
+                             interp=interp_kind, observer=observer, mode=mode, check=check,
+                             run_mode=run_mode.upper())
         errors = rt.program.errors_of(rt.program.module_of(rt.program.main_path))
         if errors:
             # the checker rejects the program's own module: like the controller, it does not start

@@ -13,7 +13,7 @@ def make_runtime(program, *, workspace=None, inputs=None, trace=None, max_sim_ti
                  max_steps=None, submit=None, mujoco: bool = True, controller=None,
                  robot_budget=None, interp: str = "tree", observer=None,
                  mode: str | None = None, check: bool = True,
-                 vm_loop: str = "generated") -> tuple[Runtime, object]:
+                 vm_loop: str = "generated", run_mode: str | None = None) -> tuple[Runtime, object]:
     """Build the runtime and the interpreter (``interp``: tree or vm) for ``program``
     (not started yet). Its files (krl.project.project_of, with the `submit` programs) are
     loaded, checked and resolved first; with `check` (``krl run`` without ``--no-check``) a
@@ -22,7 +22,8 @@ def make_runtime(program, *, workspace=None, inputs=None, trace=None, max_sim_ti
     (VM.run as written; tests compare the two). `observer` (an :class:`interp.summary.RunObserver`) sees the
     controller's events on their way to `trace`; it is not used with a given `controller`.
     ``mode``: operating mode T1/T2/AUT/EXT (``$MODE_OP``; default AUT, robot/limits.py);
-    ignored with a given `controller` (it has its own)."""
+    ignored with a given `controller` (it has its own). ``run_mode``: ``$PRO_MODE`` at the
+    start (GO, MSTEP, ISTEP, BSTEP; interp/runtime/runmode.py; default GO)."""
     from interp.tree import TreeInterpreter  # noqa: PLC0415
 
     if controller is None:
@@ -36,6 +37,8 @@ def make_runtime(program, *, workspace=None, inputs=None, trace=None, max_sim_ti
     rt = Runtime(program, workspace=workspace, controller=controller, trace=trace,
                  max_sim_time=max_sim_time, max_steps=max_steps, robot_budget=robot_budget,
                  submits=list(submit or ()), check=check)
+    if run_mode is not None:
+        rt.set_run_mode(run_mode)
     if observer is not None:
         # The interpreters trace into the user's trace only: without one the VM keeps its
         # quiet fast path (Runtime.quiet_limit); the observer needs the controller's events.

@@ -111,3 +111,15 @@ MAX_STIMULI = 100_000
 # has 8192 elements) and a few hundred MB of Python at most. Past it: the run-time error "data
 # memory exhausted" at the DECL line, before anything is allocated (interp/runtime/memory.py).
 MAX_DATA_ELEMENTS = 1 << 20
+
+# Backward motion (interp/runtime/runmode.py): the executed motions the robot interpreter keeps
+# for #BSTEP, newest last; past it the oldest is dropped (backward motion then ends there with
+# "no executed motion left to retrace"). A real cycle has tens to a few hundred motions.
+MAX_MOTION_HISTORY = 10_000
+
+# The DAP server (interp/debug): the largest message body it reads (a longer Content-Length is
+# a protocol error that ends the session), the breakpoints of one source file, and the
+# statements a reverse step replays (stepBack re-runs the program from its start).
+MAX_DAP_MESSAGE_BYTES = 1024 * 1024
+MAX_DAP_BREAKPOINTS = 1000
+MAX_DAP_REPLAY_STEPS = 10_000_000

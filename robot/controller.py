@@ -290,6 +290,11 @@ class Controller:
             self._moved_while_held = True
         return req.id
 
+    def last_planned(self):
+        """The Segment (robot.planner) that :meth:`enqueue` planned last (for the motion
+        history of backward motion, interp/runtime/runmode.py)."""
+        return self._pending[-1]
+
     def is_idle(self) -> bool:
         """True when the main run has caught up: no motion executing or queued, no
         pending trigger, not braking (the condition an advance-run stop waits for).

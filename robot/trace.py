@@ -77,6 +77,14 @@ SCHEMA: dict[str, list[tuple[str, str]]] = {
         ("text", "optional str: statement summary"),
         ("context", "optional str: main | interrupt | trigger | submit"),
     ],
+    "step_stop": [
+        ("mode", "str: the run mode that stops: MSTEP (a motion ended), ISTEP (before the next "
+                 "statement), BSTEP (a backward motion ended, or was refused: then text)"),
+        ("file", "optional str: source file of the statement"),
+        ("line", "optional int: source line of the statement (of the motion, for MSTEP and BSTEP)"),
+        ("id", "optional int: motion id (MSTEP, BSTEP)"),
+        ("text", "optional str: why backward motion was refused"),
+    ],
     "call": [("name", "str: routine name"), ("line", "optional int")],
     "return": [("name", "str: routine name"), ("line", "optional int")],
     "interrupt": [

@@ -38,6 +38,7 @@ class Context:
     pos_int: dict | None = None   # $POS_INT of an interrupt context
     axis_int: object = None       # $AXIS_INT
     frame: object = None          # declaring frame of the running interrupt (RESUME)
+    interrupted: object = None    # innermost frame of the interrupted level (a debugger's stacks)
     error_proceed: bool = False   # ON_ERROR_PROCEED seen; the next statement of this context takes it
 
 

@@ -21,8 +21,9 @@ from .contexts import Context, Irq
 from .convert import assign_into, binary_op, convert_scalar, to_bool, trunc_int, unary_op
 from .errors import (HaltSignal, KrlRuntimeError, ResumeSignal, StopRun)
 from .memory import DataMemory, Frame, ProxyRef, Ref, SignalRef, Slot, field_ref, index_ref
-from .motion import params_from, request, segment, target_of
+from .motion import frame_of, params_from, request, segment, target_of
 from .program import Program
+from .runmode import STEP_MODES, BackwardRefused, MotionHistory, mode_name
 from .scheduler import Scheduler, Task
 from .sysvars import SysVars, struct_of
 from .values import UNSET, Arr, EnumValue, Struct, copy_value, make_value, value_size
@@ -91,6 +92,13 @@ class Runtime:
         self._plans: dict = {}          # id(routine) -> Runtime._frame_plan
         self._return_types: dict = {}   # id(routine) -> the checker's return type, checked once
         self._cyclic: dict = {}
+        # run modes and debugging (interp/runtime/runmode.py, interp/debug)
+        self.run_mode = "GO"            # $PRO_MODE of the robot interpreter
+        self.history = MotionHistory()  # executed motions, for backward motion
+        self.stmt_hook = None           # debugger: stmt_hook(task, info) before every statement
+        self.step_hook = None           # debugger: step_hook(task, mode, text) at a step stop
+        self.error_hook = None          # debugger: error_hook(task, frame, err) where an error leaves a routine
+        self.cycle_hook = None          # debugger: cycle_hook(task) when a waiting task resumes (pause in a WAIT)
 
     # ================================================================== tasks and run
     def add_task(self, kind: str, name: str, body) -> Task:
@@ -108,6 +116,8 @@ class Runtime:
             task.body()
             if task.kind == "robot":
                 self.wait_main_run(task)      # END: the main run finishes its motions
+                if self.run_mode == "BSTEP":
+                    self.retrace(task)
             task.outcome = ("completed", None)
         except HaltSignal:
             task.outcome = ("halt", None)
@@ -198,6 +208,8 @@ class Runtime:
         """Give the rest of this IPO cycle back; on return run :meth:`service`."""
         self.scheduler.yield_cycle()
         self.service(task)
+        if self.cycle_hook is not None:
+            self.cycle_hook(task)
 
     def service(self, task: Task) -> None:
         """First act of a resumed task: main-run errors, TRIGGER actions, interrupts."""
@@ -225,9 +237,15 @@ class Runtime:
             task.continue_line = None
         if info.stops and not cont and task.kind == "robot":
             self.advance_stop(task)
+        if self.run_mode == "ISTEP" and task.kind == "robot" and task.context.kind != "trigger":
+            # ISTEP: a stop after each statement, reached with the main run caught up
+            self.wait_main_run(task)
+            self.step_stop(task, "ISTEP")
         if self.trace is not None:
             self.trace.write("stmt", self.controller.time, file=info.file, line=info.line,
                              context=task.context.kind)
+        if self.stmt_hook is not None:
+            self.stmt_hook(task, info)
 
     def _count_step(self, task: Task) -> None:
         """One step of a task: the step limit, the end of its time slice, interrupts."""
@@ -250,6 +268,7 @@ class Runtime:
         limit in ``task.quiet`` after each full hook; :meth:`_break` (a task switch,
         CONTINUE, ON_ERROR_PROCEED, an interrupt declared or switched) resets it."""
         if self.trace is not None or task.irqs.armed or task.continue_line is not None \
+                or self.stmt_hook is not None or self.run_mode == "ISTEP" \
                 or any(c.error_proceed for c in task.contexts):
             return 0
         lim = task.slice_end - 1
@@ -607,6 +626,11 @@ class Runtime:
             if catch_resume and r.frame is caller and caller is not None:
                 return None
             raise
+        except KrlRuntimeError as e:
+            if self.error_hook is not None and not e.debug_seen:
+                e.debug_seen = True     # the debugger stops once, in the innermost frame
+                self.error_hook(task, frame, e)
+            raise
         finally:
             task.frame = prev
             self.leave_routine(frame, returned)
@@ -812,6 +836,8 @@ class Runtime:
         trig, task.next_triggers = task.next_triggers, []
         from .convert import num  # noqa: PLC0415
 
+        if self.run_mode in STEP_MODES:
+            approx = []     # no advance run: exact positioning (docs/robot.md, run modes)
         req = request(kind, tgt, params, list(approx), aux_d,
                       float(num(ca)) if ca is not None else None, frame, trig, file, line)
         return self._enqueue(task, req)
@@ -821,6 +847,8 @@ class Runtime:
         """A SPLINE / PTP_SPLINE block. ``segments``: list of dicts with kind, target, aux,
         ca, with_ (ref, value pairs), triggers (robot.motion.Trigger list), line."""
         task = self._robot_only(kind)
+        if self.run_mode in STEP_MODES:
+            approx = None   # no advance run: the block ends exactly (docs/robot.md, run modes)
         if kind.upper() == "PTP_SPLINE":
             last = None
             for i, s in enumerate(segments):
@@ -859,9 +887,76 @@ class Runtime:
         while not ctl.can_enqueue():
             self.yield_cycle(task)
         try:
-            return ctl.enqueue(req)
+            mid = ctl.enqueue(req)
         except RobotError as e:
             raise KrlRuntimeError(e.message, e.number) from None
+        self.history.record(req, ctl.last_planned())
+        if self.run_mode in STEP_MODES:
+            # the advance run does not pass the motion: the next statement is read when it ends
+            self.wait_main_run(task)
+            if self.run_mode != "ISTEP":
+                self.step_stop(task, "MSTEP", motion=mid)
+        return mid
+
+    # ================================================================== run modes
+    def set_run_mode(self, mode) -> None:
+        """``$PRO_MODE`` of the robot interpreter (``#GO``, ``#MSTEP``, ``#ISTEP``,
+        ``#BSTEP``; interp/runtime/runmode.py). ValueError for another mode."""
+        name = mode_name(mode)
+        self.sysvars.store["$PRO_MODE"] = EnumValue(name)
+        self.run_mode_changed()
+
+    def run_mode_changed(self) -> None:
+        """``$PRO_MODE`` was written: the new mode applies from the next statement."""
+        v = self.sysvars.store.get("$PRO_MODE")
+        try:
+            self.run_mode = mode_name(v)
+        except ValueError:
+            self.run_mode = "GO"
+            self.message(f"run mode {getattr(v, 'name', v)} is not simulated: #GO")
+        if self.current_task is not None:
+            self._break(self.current_task)
+
+    def step_stop(self, task: Task, mode: str, motion: int | None = None, text: str | None = None,
+                  at: tuple | None = None) -> None:
+        """A step stop (the operator presses Start again): a ``step_stop`` trace event; the
+        debugger's ``step_hook`` stops there, ``krl run`` goes on at once."""
+        if self.trace is not None:
+            file, line = at if at is not None else (task.file, task.line)
+            self.trace.write("step_stop", self.controller.time, mode=mode, file=file, line=line,
+                             id=motion, text=text)
+        if self.step_hook is not None:
+            self.step_hook(task, mode, text)
+
+    def backward_step(self, task: Task) -> bool:
+        """One backward motion (#BSTEP): the newest executed motion not yet retraced, back
+        to its start point, as exact positioning with its own speed, frames and the
+        operating mode's limits; no statement runs. False (and a ``step_stop`` event whose
+        text is the reason) when it is refused (interp/runtime/runmode.py)."""
+        from robot.errors import RobotError  # noqa: PLC0415
+
+        store = self.sysvars.store
+        try:
+            req, rec = self.history.next_backward(self.mode_op, frame_of(store["$TOOL"]),
+                                                  frame_of(store["$BASE"]))
+        except BackwardRefused as r:
+            self.message(r.reason)
+            self.step_stop(task, "BSTEP", text=r.reason)
+            return False
+        ctl = self.controller
+        self.wait_main_run(task)
+        try:
+            mid = ctl.enqueue(req)
+        except RobotError as e:
+            raise KrlRuntimeError(e.message, e.number) from None
+        self.wait_main_run(task)
+        self.step_stop(task, "BSTEP", motion=mid, at=(rec.file, rec.line))
+        return True
+
+    def retrace(self, task: Task) -> None:
+        """#BSTEP at the end of the program: backward motions until one is refused."""
+        while self.backward_step(task):
+            pass
 
     def trigger(self, action, *, distance: int | None = None, path: float | None = None,
                 onstart: bool = False, delay_ms: float = 0.0, prio: int | None = None,
@@ -921,6 +1016,7 @@ class Runtime:
             ctx.pos_int = ctl.pos_act()
             ctx.axis_int = ctl.axis_act()
         ctx.frame = irq.frame
+        ctx.interrupted = task.frame
         task.contexts.append(ctx)
         if self.trace is not None:
             self.trace.write("interrupt", ctl.time, prio=irq.number, name=irq.name, line=task.line,

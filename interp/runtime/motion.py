@@ -34,6 +34,9 @@ def _frame(s: Struct) -> tuple:
     return tuple(_f(s.f.get(k, 0.0), 0.0) for k in ("X", "Y", "Z", "A", "B", "C"))
 
 
+frame_of = _frame     # a FRAME value as (X, Y, Z, A, B, C) mm/deg ($TOOL, $BASE)
+
+
 def params_from(store: dict) -> MotionParams:
     """A MotionParams snapshot of the system-variable store (unset values: INITMOV defaults)."""
     d = MotionParams()

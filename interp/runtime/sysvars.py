@@ -20,6 +20,8 @@ this module adds only *where the value lives*:
 
 from __future__ import annotations
 
+from functools import partial
+
 from krl.semantics import types as T
 from krl.semantics.builtins import load_builtins
 from krl.semantics.symbols import make_array, system_scopes
@@ -187,6 +189,8 @@ class SysVars:
             ref = live(self, t, name)
         else:
             on_write = self._on_write.get(name)
+            if on_write is not None:
+                on_write = partial(on_write, self)
             ref = Slot(self.store, name, t, name, readonly=info.access == "RO", on_write=on_write)
         self.refs[name] = ref
         return ref
@@ -385,11 +389,17 @@ _LIVE = {
 }
 
 
-def _sync_advance(ref) -> None:
+def _sync_advance(sv: SysVars, ref) -> None:
     """``$ADVANCE = n`` (0..5) goes to the controller's motion queue at once."""
     v = ref.c[ref.k]
     if not 0 <= v <= 5:
         raise KrlRuntimeError(f"$ADVANCE {v} outside 0..5")
 
 
-SysVars._on_write = {"$ADVANCE": _sync_advance}
+def _pro_mode_written(sv: SysVars, ref) -> None:
+    """``$PRO_MODE = #MSTEP`` (any run mode): the next statement takes the full hook, so the
+    new mode applies from there in both interpreters (interp/runtime/runmode.py)."""
+    sv.rt.run_mode_changed()
+
+
+SysVars._on_write = {"$ADVANCE": _sync_advance, "$PRO_MODE": _pro_mode_written}
