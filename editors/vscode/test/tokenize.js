@@ -1,6 +1,7 @@
 // Tokenizes KRL lines with VS Code's own TextMate engine (vscode-textmate + vscode-oniguruma, the
-// engine vscode-tmgrammar-test uses) and the extension's grammar; prints one JSON array per run:
-// for each input line, its tokens as {text, scopes}. Input: a JSON array of lines on stdin.
+// engine vscode-tmgrammar-test uses) and the extension's grammar (or the grammar file given as the
+// first argument); prints one JSON array per run: for each input line, its tokens as
+// {text, scopes}. Input: a JSON array of lines on stdin.
 // Used by tests/editors/test_vscode_grammar.py (every lexer keyword gets a keyword scope).
 'use strict';
 
@@ -19,7 +20,7 @@ async function main() {
     }),
     loadGrammar: async (scopeName) => {
       if (scopeName !== 'source.krl') return null;
-      const file = path.join(__dirname, '..', 'syntaxes', 'krl.tmLanguage.json');
+      const file = process.argv[2] || path.join(__dirname, '..', 'syntaxes', 'krl.tmLanguage.json');
       return textmate.parseRawGrammar(fs.readFileSync(file, 'utf8'), file);
     },
   });
