@@ -28,3 +28,31 @@ def apt_install(package: str, binary: str) -> str | None:
     except (OSError, subprocess.TimeoutExpired):
         return None
     return shutil.which(binary)
+
+
+def apt_install_packages(packages: list[str]) -> bool:
+    """Installs the Debian packages that dpkg does not list as installed (libraries and headers
+    have no binary to look for), as apt_install does; True when all are installed. Never raises."""
+    def missing() -> list[str]:
+        try:
+            out = subprocess.run(["dpkg-query", "-W", "-f=${Package} ${Status}\n", *packages],
+                                 capture_output=True, text=True, timeout=60, check=False).stdout
+        except (OSError, subprocess.TimeoutExpired):
+            return list(packages)
+        ok = {line.split()[0] for line in out.splitlines() if line.endswith(" installed")}
+        return [p for p in packages if p not in ok]
+
+    if not missing():
+        return True
+    if shutil.which("apt-get") is None or os.geteuid() != 0:
+        return False
+    env = dict(os.environ, DEBIAN_FRONTEND="noninteractive")
+    try:
+        for step in (["install"], ["update"], ["install"]):
+            args = ["apt-get", *step, "-y", "-q"] + (missing() if step == ["install"] else [])
+            subprocess.run(args, env=env, capture_output=True, timeout=900, check=False)
+            if not missing():
+                return True
+    except (OSError, subprocess.TimeoutExpired):
+        return False
+    return not missing()

@@ -19,12 +19,12 @@ import pytest
 from tests.apt import apt_install
 
 EXTENSION = Path(__file__).resolve().parents[2] / "editors" / "vscode"
-STAMP = EXTENSION / "node_modules" / ".installed"
 NPM_CI_TIMEOUT_S = 900     # a cold `npm ci` on the shared 2-core machine; cached runs take none
+PACKAGE_TIMEOUT_S = 300
 
 
-def _lock_sha() -> str:
-    return hashlib.sha256((EXTENSION / "package-lock.json").read_bytes()).hexdigest()
+def _lock_sha(folder: Path) -> str:
+    return hashlib.sha256((folder / "package-lock.json").read_bytes()).hexdigest()
 
 
 def node_or_fail() -> tuple[str, str]:
@@ -40,19 +40,31 @@ def node_or_fail() -> tuple[str, str]:
     pytest.skip(why)
 
 
-def npm_ci() -> Path:
-    """editors/vscode with its node_modules installed from package-lock.json (cached); the path."""
+def npm_ci(folder: Path = EXTENSION, env: dict[str, str] | None = None, timeout: float = NPM_CI_TIMEOUT_S) -> Path:
+    """folder (default: editors/vscode) with its node_modules installed from its package-lock.json,
+    cached by the lock file's sha256 in node_modules/.installed; returns folder."""
     node_or_fail()
-    sha = _lock_sha()
+    sha = _lock_sha(folder)
+    stamp = folder / "node_modules" / ".installed"
     # one installer at a time (pytest -n 2 runs the grammar and client tests in two workers)
-    with open(EXTENSION / ".npm-ci.lock", "w") as lock:
+    with open(folder / ".npm-ci.lock", "w") as lock:
         fcntl.flock(lock, fcntl.LOCK_EX)
-        if not (STAMP.exists() and STAMP.read_text().strip() == sha):
-            run = subprocess.run(["npm", "ci", "--no-audit", "--no-fund"], cwd=EXTENSION,
-                                 capture_output=True, text=True, timeout=NPM_CI_TIMEOUT_S, check=False)
-            assert run.returncode == 0, f"npm ci failed in {EXTENSION}:\n{run.stdout[-3000:]}\n{run.stderr[-3000:]}"
-            STAMP.write_text(sha + "\n")
-    return EXTENSION
+        if not (stamp.exists() and stamp.read_text().strip() == sha):
+            run = subprocess.run(["npm", "ci", "--no-audit", "--no-fund"], cwd=folder, capture_output=True,
+                                 text=True, timeout=timeout, check=False, env=env)
+            assert run.returncode == 0, f"npm ci failed in {folder}:\n{run.stdout[-3000:]}\n{run.stderr[-3000:]}"
+            stamp.write_text(sha + "\n")
+    return folder
+
+
+def build_vsix(out: Path) -> Path:
+    """The extension packaged by @vscode/vsce as `make vsix` does, written to out."""
+    npm_ci()
+    run = subprocess.run([str(node_bin("vsce")), "package", "--allow-missing-repository", "--skip-license",
+                          "--out", str(out)], cwd=EXTENSION, capture_output=True, text=True,
+                         timeout=PACKAGE_TIMEOUT_S, check=False)
+    assert run.returncode == 0, run.stdout[-3000:] + run.stderr[-3000:]
+    return out
 
 
 def node_bin(name: str) -> Path:

@@ -5,22 +5,14 @@ settings; the client with its run-time node packages) and none of the tests."""
 from __future__ import annotations
 
 import json
-import subprocess
 import zipfile
 from pathlib import Path
 
-from tests.editors.npm import node_bin, npm_ci
-
-PACKAGE_TIMEOUT_S = 300
+from tests.editors.npm import build_vsix
 
 
 def test_vsce_packages_the_extension(tmp_path: Path):
-    ext = npm_ci()
-    vsix = tmp_path / "krl.vsix"
-    run = subprocess.run([str(node_bin("vsce")), "package", "--allow-missing-repository", "--skip-license",
-                          "--out", str(vsix)], cwd=ext, capture_output=True, text=True,
-                         timeout=PACKAGE_TIMEOUT_S, check=False)
-    assert run.returncode == 0, run.stdout[-3000:] + run.stderr[-3000:]
+    vsix = build_vsix(tmp_path / "krl.vsix")
     with zipfile.ZipFile(vsix) as z:
         names = set(z.namelist())
         manifest = json.loads(z.read("extension/package.json"))
