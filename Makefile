@@ -11,7 +11,7 @@ GEN_DIR := krl/syntax/generated
 PARSER  := $(GEN_DIR)/KRLParser.py
 SHARED_CORPUS ?= ../shared/krl-corpus
 
-.PHONY: all recover test validate growth conformance nightly bench parser java-parser clean check-python check-java
+.PHONY: all recover test validate growth conformance nightly bench parser java-parser clean check-python check-java vsix check-node
 
 all: test
 
@@ -97,3 +97,28 @@ nightly: $(PARSER) java-parser
 	$(BIN)/python -m conformance.nightly reports/nightly || exit $$?; \
 	echo "nightly reports: $$d (index: reports/nightly/index.html; slow tests: $$d/slow-tests.log)"; \
 	[ $$c -eq 0 ] || exit $$c; [ $$f -eq 0 ] || exit $$f; exit $$t
+
+# The VS Code extension (editors/vscode, issue 25): `make vsix` writes editors/vscode/krl.vsix
+# (install: code --install-extension editors/vscode/krl.vsix). Node.js and npm come from PATH,
+# else from Debian's packages (nodejs, npm) when run as root; the node packages from
+# package-lock.json with `npm ci` (again only when the lock file changes). @vscode/vsce needs
+# Node.js 20 or later.
+VSCODE_EXT := editors/vscode
+check-node:
+	@command -v node >/dev/null 2>&1 && command -v npm >/dev/null 2>&1 || { \
+	  if [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then \
+	    DEBIAN_FRONTEND=noninteractive apt-get install -y -q nodejs npm >/dev/null 2>&1 || \
+	    { apt-get update -q >/dev/null && DEBIAN_FRONTEND=noninteractive apt-get install -y -q nodejs npm >/dev/null; }; \
+	  fi; }
+	@command -v node >/dev/null 2>&1 && command -v npm >/dev/null 2>&1 || { \
+	  echo "error: node and npm were not found. On Debian/Ubuntu: sudo apt-get install -y nodejs npm"; exit 2; }
+
+$(VSCODE_EXT)/node_modules/.installed: $(VSCODE_EXT)/package-lock.json | check-node
+	cd $(VSCODE_EXT) && npm ci --no-audit --no-fund
+	@sha256sum $(VSCODE_EXT)/package-lock.json | cut -c1-64 > $@
+
+vsix: $(VSCODE_EXT)/node_modules/.installed
+	@node -e 'process.exit(+process.versions.node.split(".")[0] >= 20 ? 0 : 1)' || { \
+	  echo "error: @vscode/vsce needs Node.js 20 or later (found $$(node --version))"; exit 2; }
+	cd $(VSCODE_EXT) && node_modules/.bin/vsce package --allow-missing-repository --skip-license --out krl.vsix
+	@echo "extension: $(VSCODE_EXT)/krl.vsix (install: code --install-extension $(VSCODE_EXT)/krl.vsix)"
