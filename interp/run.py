@@ -40,11 +40,12 @@ def make_runtime(program, *, workspace=None, inputs=None, trace=None, max_sim_ti
         # The interpreters trace into the user's trace only: without one the VM keeps its
         # quiet fast path (Runtime.quiet_limit); the observer needs the controller's events.
         rt.trace = trace
-    if controller.stimuli:
+    if controller.stimuli or controller.rules:
         from robot.stimuli import resolve_signals  # noqa: PLC0415
 
         try:
-            resolve_signals(controller.stimuli, lambda name: signal_of(rt, Path(program).stem, name))
+            resolve_signals(controller.stimuli, lambda name: signal_of(rt, Path(program).stem, name),
+                            controller.rules)
         except ResourceError:
             pass    # a data list past a limit: the program does not start (Runtime.main_routine says why)
     if interp == "vm":

@@ -111,3 +111,11 @@ MAX_STIMULI = 100_000
 # has 8192 elements) and a few hundred MB of Python at most. Past it: the run-time error "data
 # memory exhausted" at the DECL line, before anything is allocated (interp/runtime/memory.py).
 MAX_DATA_ELEMENTS = 1 << 20
+
+# Reactive rules of a cell file (`rules:` in a stimuli file, robot/cellrules.py): the most rules
+# in one file (a PLC program answering a cell has tens of handshakes, a few hundred at most) and
+# the most tokens in one rule's `when` expression (one line of KRL; real conditions have under
+# 20 tokens; the bound also bounds the bracket depth of the parse). Past either: an error naming
+# the file:line of the rule; the run does not start.
+MAX_CELL_RULES = 1000
+MAX_RULE_TOKENS = 200
