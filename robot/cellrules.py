@@ -252,6 +252,7 @@ class Rule:
     last: bool = field(default=False, repr=False)
     due: list[float] = field(default_factory=list, repr=False)
     fired: int = field(default=0, repr=False)
+    last_fired: float | None = field(default=None, repr=False)   # s, the last answer written
 
     def holds(self, io: IOImage) -> bool:
         """The condition's value now (False before the run resolved it)."""
@@ -267,6 +268,7 @@ def step_rules(rules: list[Rule], io: IOImage, t: float, dt: float) -> None:
         while r.due and t >= r.due[0] - eps:
             r.due.pop(0)
             r.fired += 1
+            r.last_fired = t
             for name, v in r.set.items():
                 io.set_signal(name, v, r.source)
     for r in rules:

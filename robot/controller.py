@@ -200,6 +200,13 @@ class Controller:
                  start_axes: Any = None, actuated: bool = False, strict_bco: bool = True,
                  mujoco: bool = True, mode_op: str | None = None) -> None:
         self.machine = machine if machine is not None else load_machine()
+        self.rules: list[Rule] = []
+        self.pgno: int | None = None      # the cell file's pgno preset (interp/run.py builds its rules)
+        if isinstance(stimuli, str):
+            cell = load_cell(stimuli, self.machine.in_pos_car_mm)
+            stimuli, self.rules, self.pgno = cell.stimuli, cell.rules, cell.pgno
+            if cell.autoext and mode_op is None:
+                mode_op = "EX"            # Automatic External (robot/cellpresets.py)
         self.mode_op = normalise_mode(mode_op)
         self.model = RobotModel(self.machine, mode=self.mode_op)
         self.dt = float(self.machine.ipo_cycle_s)
@@ -209,10 +216,6 @@ class Controller:
         self.strict_bco = strict_bco
         self._bco_done = False
         self.io = IOImage(on_change=self._on_io)
-        self.rules: list[Rule] = []
-        if isinstance(stimuli, str):
-            cell = load_cell(stimuli, self.machine.in_pos_car_mm)
-            stimuli, self.rules = cell.stimuli, cell.rules
         self.rules += list(rules or [])
         self.stimuli: list[Stimulus] = list(stimuli or [])
         q = np.array(self.machine.home_deg if start_axes is None else start_axes, dtype=float)

@@ -44,7 +44,8 @@ from .cellrules import ConditionError, Rule, compile_condition, parse_condition
 from .io import IOError_, parse_signal
 
 PHASES = ("start", "blend_start", "blend_end", "end")
-TOP_KEYS = ("stimuli", "rules")
+TOP_KEYS = ("stimuli", "rules", "presets")
+PRESET_KEYS = ("pgno", "autoext")
 RULE_KEYS = ("when", "after", "set")
 STIMULUS_KEYS = ("at", "when", "set", "delay")
 WHEN_KEYS = ("motion", "line", "phase", "reached")
@@ -184,6 +185,8 @@ class Cell:
 
     stimuli: list[Stimulus] = field(default_factory=list)
     rules: list[Rule] = field(default_factory=list)
+    pgno: int | None = None        # presets: the program number the PLC answers (robot/cellpresets.py)
+    autoext: bool = False          # presets: Automatic External (operating mode EXT)
 
 
 def _parse_rules(doc: Any, where: _Where, key_where: str) -> list[Rule]:
@@ -236,13 +239,31 @@ def parse_cell(doc: Any, default_reach_mm: float = 0.1, source: str = "") -> Cel
     rules: list[Rule] = []
     if isinstance(doc, dict):
         _unknown(doc, TOP_KEYS, "top-level key", where)
-        if "stimuli" not in doc and "rules" not in doc:
-            raise StimulusError(f"{where(doc)}: the mapping needs a 'stimuli' or a 'rules' list")
-        rules = _parse_rules(doc.get("rules"), where, where(doc, "rules"))
-        doc = doc.get("stimuli")
-        if doc is None:
-            return Cell([], rules)
-    return Cell(_parse_stimuli(doc, default_reach_mm, where), rules)
+        if "stimuli" not in doc and "rules" not in doc and "presets" not in doc:
+            raise StimulusError(f"{where(doc)}: the mapping needs 'stimuli', 'rules' or 'presets'")
+        cell = Cell([], _parse_rules(doc.get("rules"), where, where(doc, "rules")))
+        _parse_presets(doc.get("presets"), cell, where, where(doc, "presets"))
+        if doc.get("stimuli") is not None:
+            cell.stimuli = _parse_stimuli(doc["stimuli"], default_reach_mm, where)
+        return cell
+    return Cell(_parse_stimuli(doc, default_reach_mm, where))
+
+
+def _parse_presets(doc: Any, cell: Cell, where: _Where, key_where: str) -> None:
+    if doc is None:
+        return
+    if not isinstance(doc, dict):
+        raise StimulusError(f"{key_where}: 'presets' must be a mapping ({', '.join(PRESET_KEYS)})")
+    _unknown(doc, PRESET_KEYS, "preset", where)
+    if "pgno" in doc and doc["pgno"] is not None:
+        n = int(_number(doc["pgno"], "pgno", where(doc, "pgno"), integer=True))
+        if not 0 < n < 1 << 16:
+            raise StimulusError(f"{where(doc, 'pgno')}: pgno must be 1..65535")
+        cell.pgno = n
+    if "autoext" in doc:
+        if not isinstance(doc["autoext"], bool):
+            raise StimulusError(f"{where(doc, 'autoext')}: autoext must be true or false")
+        cell.autoext = doc["autoext"]
 
 
 def parse_stimuli(doc: Any, default_reach_mm: float = 0.1, source: str = "") -> list[Stimulus]:
