@@ -15,8 +15,9 @@ Every stop gets one *cause* (:func:`cause_of`, issue 22 "Every stop explained"):
   of the run: the cycle was still running);
 * ``program error``: a KRL run-time error of the program, at its file:line;
 * ``interpreter gap``: an error that is the simulator's (:data:`GAP_MESSAGES`: a feature not
-  simulated; a target or a CP path the simulated KR 6 R900 cannot follow — the backup's own robot
-  is another),
+  simulated; a target, a CP path or an axis range the simulated KR 6 R900 cannot follow — the
+  backup's own robot is another; an element of a CONST array a data list sets line by line, which
+  the runtime leaves unset, :func:`const_array_gap`),
   or an internal error;
 * ``limit``: the time or step limit (or a deadlock) with no cell answering: the program starves
   for an input (named by the stop text, "waits: WAIT FOR ...") or loops on its own.
@@ -46,7 +47,8 @@ LEGITIMATE = ("deadlock", "halt", "max_sim_time", "max_steps")
 CAUSES = ("completed", "intended end", "program error", "interpreter gap", "limit")
 
 #: parts of a run-time error message that make it the simulator's gap, not the program's error
-GAP_MESSAGES = ("target not reachable", "through a singularity", "not supported", "unsupported", "not simulated",
+GAP_MESSAGES = ("target not reachable", "through a singularity", "software limit switch",
+                "CONST array element", "not supported", "unsupported", "not simulated",
                 "not implemented", "internal error")
 
 #: the committed cell files of the corpus backups (issue 22)
@@ -67,6 +69,19 @@ def cell_of(path: Path, corpus: Path = DEFAULT_CORPUS, cells: Path = CELLS) -> P
     return None
 
 
+def const_array_gap(rt, res) -> bool:
+    """True when the run stopped on "value invalid" reading an element of a ``DECL CONST``
+    array (the checker's symbol of the name, in the module of the stop): the reference lets a
+    data list initialise it element by element; the runtime does not yet (issue 22)."""
+    m = re.match(r"value invalid: ([A-Za-z_$][A-Za-z0-9_$]*)\[", res.text or "")
+    if res.reason != "error" or m is None or not res.file:
+        return False
+    module = rt.program.module_of(res.file)
+    scope = rt.program.ws.units[module.index].scope if module is not None else None
+    sym = scope.lookup(m.group(1)) if scope is not None else None
+    return sym is not None and sym.kind == "const"
+
+
 def cause_of(row: dict) -> str:
     """The one cause of a run's stop (see the module docstring): a row of :func:`run_one`."""
     reason = row.get("reason")
@@ -78,7 +93,7 @@ def cause_of(row: dict) -> str:
         return "interpreter gap"
     if reason == "error":
         text = (row.get("text") or "").lower()
-        return "interpreter gap" if any(g in text for g in GAP_MESSAGES) else "program error"
+        return "interpreter gap" if any(g.lower() in text for g in GAP_MESSAGES) else "program error"
     last = row.get("cell_last")
     t = row.get("sim_time") or 0.0
     if row.get("cell_answers") and last is not None and last >= 0.75 * t:
@@ -151,7 +166,10 @@ def run_one(path: Path, max_sim_time: float, max_steps: int, cell: Path | None =
         row["cause"] = cause_of(row)
         return row
     del tw
-    row = {"program": str(path), "reason": res.reason, "text": res.text,
+    text = res.text
+    if const_array_gap(rt, res):
+        text = f"{text} (a CONST array element set line by line in its data list)"
+    row = {"program": str(path), "reason": res.reason, "text": text,
            "number": res.error.number if res.error is not None else None,
            "file": res.file, "line": res.line, "sim_time": round(res.sim_time, 3),
            "steps": res.steps, "stubs": stubs, "seconds": round(time.time() - t0, 2),
