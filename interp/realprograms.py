@@ -82,6 +82,32 @@ def const_array_gap(rt, res) -> bool:
     return sym is not None and sym.kind == "const"
 
 
+def row_from_trace(program: Path, events: list[dict]) -> dict:
+    """A row as :func:`run_one` gives it, from the trace of a run of `program` with its cell
+    (the conformance report runs programs through ``krl run``): the ``end`` event, the cell's
+    answers (``io`` events whose source is ``cell``/``cell:...``), and the cause."""
+    ends = [e for e in events if e.get("kind") == "end"]
+    end = ends[-1] if ends else {}
+    cell = [e["t"] for e in events if e.get("kind") == "io" and str(e.get("source", "")).startswith("cell")]
+    row = {"program": str(program), "reason": end.get("reason", "internal"), "text": end.get("text") or "",
+           "file": end.get("file"), "line": end.get("line"), "sim_time": end.get("t", 0.0),
+           "cell_answers": len(cell), "cell_last": max(cell) if cell else None}
+    if row["reason"] == "program_end":
+        row["reason"] = "completed"
+    if row["reason"] == "error" and row["text"].startswith("value invalid:"):
+        from interp.run import make_runtime  # noqa: PLC0415
+        from interp.runtime.core import RunResult  # noqa: PLC0415
+
+        try:
+            rt, _ = make_runtime(program, mujoco=False, check=False)
+            if const_array_gap(rt, RunResult("error", None, row["file"], row["line"], None, row["text"])):
+                row["text"] += " (a CONST array element set line by line in its data list)"
+        except Exception:  # noqa: BLE001 - the cause stays a program error
+            pass
+    row["cause"] = cause_of(row)
+    return row
+
+
 def cause_of(row: dict) -> str:
     """The one cause of a run's stop (see the module docstring): a row of :func:`run_one`."""
     reason = row.get("reason")
