@@ -16,10 +16,20 @@ A signal is ``$IN[n]`` or ``$ANIN[n]``, or the name of a ``SIGNAL`` declared on 
 $IN[1] TO $IN[4]`` takes an INT, bit 0 on the first input). The run resolves the names before
 it starts (:func:`resolve_signals`).
 
-The file is validated against this schema: a top-level mapping holds only ``stimuli``; a
-stimulus only ``at``, ``when``, ``set``, ``delay``; ``when`` only ``motion``, ``line``,
-``phase``, ``reached``. Anything else is a :class:`StimulusError` that names the key and the
-place (``file:line``). Limits: at most :data:`MAX_STIMULI` stimuli, :data:`MAX_STIMULI_BYTES` bytes.
+A *cell file* is a stimuli file with reactive rules and presets beside (issue 22)::
+
+    presets: {autoext: true, pgno: 2}    # robot/cellpresets.py
+    rules:                               # robot/cellrules.py: rising edge, `after` s later
+      - when: "$OUT[3] AND NOT PART_OK"
+        after: 0.2
+        set: {PART_OK: true}
+
+The file is validated against this schema: a top-level mapping holds only ``stimuli``,
+``rules``, ``presets``; a stimulus only ``at``, ``when``, ``set``, ``delay``; ``when`` only
+``motion``, ``line``, ``phase``, ``reached``; a rule only ``when`` (KRL text), ``after``, ``set``;
+``presets`` only ``pgno``, ``autoext``. Anything else is a :class:`StimulusError` that names the
+key and the place (``file:line``). Limits: at most :data:`MAX_STIMULI` stimuli,
+:data:`MAX_CELL_RULES` rules, :data:`MAX_STIMULI_BYTES` bytes.
 
 ``phase`` is one of start, blend_start, blend_end, end. ``reached`` (mm) fires in the
 first IPO cycle in which that motion is being executed and the TCP is within the given
