@@ -57,7 +57,7 @@ def test_rule_fires_once_per_rising_edge_not_while_true(tmp_path):
       WAIT SEC 0.06
     END
     """
-    # an $ANIN value shows each answer (it only changes when written with a new value)
+    # $IN[7] shows each answer: set by the first rule, reset by the second
     r = run_krl(tmp_path, src, stimuli="""
         rules:
           - when: "$OUT[1]"
