@@ -161,8 +161,12 @@ def cell_init(root: Path, programs: list[Path]) -> str:
     from interp.run import make_runtime  # noqa: PLC0415
 
     found: dict[str, InputUse] = {}
+    covered: set[str] = set()
     for prog in programs:
+        if str(prog.resolve()) in covered:
+            continue        # its module was loaded with an earlier program's files (one backup)
         rt, _ = make_runtime(prog, mujoco=False, check=False)
+        covered |= {str(Path(m.unit.src.path).resolve()) for m in rt.program.modules if m.unit.src is not None}
         for u in inputs_read(rt, root):
             have = found.setdefault(u.name, u)
             if have is not u:
