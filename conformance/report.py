@@ -83,6 +83,9 @@ class RealOutcome:
     reasons: dict[str, str] = field(default_factory=dict)   # interp -> end reason / crash
     crash: dict[str, str] = field(default_factory=dict)
     tree_vm: list[H.Check] | None = None
+    cause: str = ""          # the one cause of the tree run's stop (interp/realprograms.py cause_of)
+    where: str = ""          # file:line of the stop (file name only)
+    cell: str = ""           # the committed cell file used (corpus/cells), or ""
 
     @property
     def agree(self) -> bool | None:
@@ -116,6 +119,8 @@ def run_real(corpus: Path = DEFAULT_CORPUS, interps: list[str] | None = None, *,
 
     for prog, root in progs:
         ro = RealOutcome(str(prog.relative_to(corpus)) if prog.is_relative_to(corpus) else str(prog))
+        cell = R.cell_of(prog, corpus)
+        ro.cell = str(cell.relative_to(R.CELLS.parent.parent)) if cell is not None else ""
         runs = {}
         subs = []
         try:
@@ -123,7 +128,7 @@ def run_real(corpus: Path = DEFAULT_CORPUS, interps: list[str] | None = None, *,
         except Exception:  # noqa: BLE001 - no submit program then
             subs = []
         for it in interps:
-            res = H.run_program(prog, it, workspace=None, max_sim_time=max_sim_time,
+            res = H.run_program(prog, it, workspace=None, max_sim_time=max_sim_time, stimuli=cell,
                                 max_steps=max_steps, submit=subs[0] if subs else None,
                                 wall_timeout=300.0, check=False)
             runs[it] = res
@@ -135,6 +140,14 @@ def run_real(corpus: Path = DEFAULT_CORPUS, interps: list[str] | None = None, *,
                 ro.reasons[it] = ends[-1].get("reason", "?") if ends else "no end event"
         if "tree" in runs and "vm" in runs:
             ro.tree_vm = H.compare_runs(runs["tree"], runs["vm"], path_tol_mm=1e-6)
+        first = runs.get("tree") or next(iter(runs.values()), None)
+        if first is not None:
+            if first.crash:
+                ro.cause = "interpreter gap"
+            else:
+                row = R.row_from_trace(prog, first.events)
+                ro.cause = row["cause"]
+                ro.where = f"{Path(row['file']).name}:{row['line']}" if row.get("file") and row.get("line") else ""
         out.append(ro)
         if progress:
             progress(ro)
@@ -218,7 +231,9 @@ def summary(outcomes: list[CaseOutcome], fuzz: dict[str, Any] | None, real: list
     if real is not None:
         s["real_tree_crashes"] = sum(1 for r in real if "tree" in r.crash)
         s["real_tree_reasons"] = _count(r.reasons.get("tree", "-") for r in real)
-        s["real_status"] = {r.program: r.reasons.get("tree", "-") for r in real}
+        s["real_causes"] = _count(r.cause or "-" for r in real)
+        s["real_completed_or_intended"] = sum(1 for r in real if r.cause in ("completed", "intended end"))
+        s["real_status"] = {r.program: (r.cause or r.reasons.get("tree", "-")) for r in real}
     s["case_status"] = {o.case.name: _status(o) for o in outcomes}
     return s
 
@@ -301,18 +316,28 @@ def _markdown(s, rows, interps, fuzz, real) -> str:
             L += ["", "```", str(f)[:2000], "```"]
     if real is not None:
         L += ["", "## Real programs (../shared/krl-corpus)", "", f"{len(real)} runnable programs of the KRC backups.", ""]
+        causes = s.get("real_causes") or {}
+        if causes:
+            L += ["Every stop explained (interp/realprograms.py `cause_of`): completed; intended end (the "
+                  "program's own HALT, or a cycle loop stopped by the limit with its cell answering); "
+                  "program error (at its file:line); interpreter gap; limit. Cell files: corpus/cells.", "",
+                  "| cause | programs |", "|---|---:|"]
+            L += [f"| {md(k)} | {v} |" for k, v in causes.items()]
+            L += ["", f"Completed or intended end: {s.get('real_completed_or_intended')} of {len(real)}.", ""]
         reasons = s.get("real_tree_reasons") or {}
         if reasons:
             L += ["| end reason (tree) | programs |", "|---|---:|"]
             L += [f"| {md(k)} | {v} |" for k, v in reasons.items()]
         its = sorted({k for r in real for k in r.reasons})
         if real:
-            L += ["", "| program | " + " | ".join(its) + " | tree = vm | crash |",
-                  "|---|" + "---|" * len(its) + "---|---|"]
+            L += ["", "| program | cause | stop at | cell | " + " | ".join(its) + " | tree = vm | crash |",
+                  "|---|---|---|---|" + "---|" * len(its) + "---|---|"]
             for r in real:
                 agree = {None: "n/a", True: "yes", False: "NO"}[r.agree]
                 crash = "; ".join(r.crash.values())
-                L.append(f"| {md(r.program)} | " + " | ".join(md(r.reasons.get(i, "-")) for i in its)
+                L.append(f"| {md(r.program)} | {md(r.cause) if r.cause else ''} | {md(r.where) if r.where else ''} | "
+                         f"{md(r.cell) if r.cell else ''} | "
+                         + " | ".join(md(r.reasons.get(i, "-")) for i in its)
                          + f" | {agree} | {md(crash) if crash else ''} |")
     return "\n".join(L) + "\n"
 
@@ -325,6 +350,8 @@ def _html(s, rows, interps, fuzz, real) -> str:
                        summary_rows=[(k, s.get(k) if s.get(k) is not None else "n/a (no VM)") for k in keys],
                        rows=rows, interps=interps, pending=[r for r in rows if r["pending"]],
                        fuzz=fuzz, real=real, real_reasons=s.get("real_tree_reasons") or {},
+                       real_causes=s.get("real_causes") or {},
+                       real_good=s.get("real_completed_or_intended"),
                        real_interps=sorted({k for r in (real or []) for k in r.reasons}))
 
 

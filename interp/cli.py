@@ -26,21 +26,25 @@ import click
 @click.option("--submit", "submit", type=click.Path(path_type=Path), multiple=True,
               help="A submit program (.sub) to run beside the robot program (repeatable).")
 @click.option("--mode", "mode", type=click.Choice(["T1", "T2", "AUT", "EXT"], case_sensitive=False),
-              default="AUT", show_default=True,
+              default=None,
               help="Operating mode ($MODE_OP): T1 limits TCP and flange to 250 mm/s and PTP to "
-                   "$RED_T1; AUT is the unattended virtual controller (docs/robot.md).")
+                   "$RED_T1; AUT is the unattended virtual controller (docs/robot.md). Default AUT, "
+                   "or EXT when the --inputs cell file has the autoext preset.")
 @click.option("--run-mode", "run_mode", type=click.Choice(["GO", "MSTEP", "ISTEP", "BSTEP"], case_sensitive=False),
               default="GO", show_default=True,
               help="Program run mode ($PRO_MODE): MSTEP stops after each motion, ISTEP after each "
                    "statement (no advance run, no approximation); BSTEP runs forward as MSTEP, then "
                    "retraces the motions backward (T1/T2 only). Each stop is a step_stop trace event "
                    "and the run goes on, as if Start were pressed again (docs/robot.md).")
+@click.option("--pgno", "pgno", type=click.IntRange(1, 65535), default=None,
+              help="Program number the cell's PLC answers in P00's handshake (PGNO_* of the "
+                   "backup's $config.dat; robot/cellpresets.py, docs/robot.md).")
 @click.option("--no-check", "no_check", is_flag=True,
               help="Start the program even when the front end's checker finds errors in its own "
                    "module (by default, like the controller, such a program does not start: exit 1). "
                    "A name nothing declares is then a run-time error where it is evaluated.")
 def run(program: Path, interp_kind: str, workspace, inputs, trace_path, max_sim_time, max_steps, submit,
-        mode, run_mode, no_check) -> None:
+        mode, run_mode, pgno, no_check) -> None:
     """Run PROGRAM (.src) on the simulated KR C4; print where and why it ended.
 
     With --workspace BACKUP.zip (a KRC backup archive) PROGRAM is a path inside the archive
@@ -63,13 +67,13 @@ def run(program: Path, interp_kind: str, workspace, inputs, trace_path, max_sim_
                     sys.exit(2)
                 _run(found, folder, inputs, trace_path, max_sim_time, max_steps, submit, interp_kind,
                      mode=mode, shown=lambda text: text.replace(str(folder), str(workspace)), check=not no_check,
-                     run_mode=run_mode)
+                     run_mode=run_mode, pgno=pgno)
         except ArchiveError as exc:
             click.echo(f"error: {printable(exc)}", err=True)
             sys.exit(2)
         return
     _run(program, workspace, inputs, trace_path, max_sim_time, max_steps, submit, interp_kind, mode=mode,
-         check=not no_check, run_mode=run_mode)
+         check=not no_check, run_mode=run_mode, pgno=pgno)
 
 
 def program_in(folder: Path, program: Path) -> Path | None:
@@ -90,12 +94,13 @@ def program_in(folder: Path, program: Path) -> Path | None:
 
 
 def _run(program: Path, workspace, inputs, trace_path, max_sim_time, max_steps, submit, interp_kind,
-         mode=None, shown=lambda text: text, check: bool = True, run_mode: str = "GO") -> None:
+         mode=None, shown=lambda text: text, check: bool = True, run_mode: str = "GO",
+         pgno: int | None = None) -> None:
     if not program.exists():
         click.echo(f"error: {program}: no such file", err=True)
         sys.exit(2)
     from interp.run import make_runtime  # noqa: PLC0415
-    from interp.summary import RunObserver, summary_lines  # noqa: PLC0415
+    from interp.summary import RunObserver, starvation_lines, summary_lines  # noqa: PLC0415
     from krl.terminal import printable  # noqa: PLC0415
     from robot.stimuli import StimulusError  # noqa: PLC0415
     from robot.trace import TraceWriter  # noqa: PLC0415
@@ -106,7 +111,7 @@ def _run(program: Path, workspace, inputs, trace_path, max_sim_time, max_steps, 
         rt, _ = make_runtime(program, workspace=workspace, inputs=inputs, trace=trace,
                              max_sim_time=max_sim_time, max_steps=max_steps, submit=list(submit),
                              interp=interp_kind, observer=observer, mode=mode, check=check,
-                             run_mode=run_mode.upper())
+                             run_mode=run_mode.upper(), pgno=pgno)
         errors = rt.program.errors_of(rt.program.module_of(rt.program.main_path))
         if errors:
             # the checker rejects the program's own module: like the controller, it does not start
@@ -132,12 +137,54 @@ def _run(program: Path, workspace, inputs, trace_path, max_sim_time, max_steps, 
         ws_note = str(prog.workspace)
     for line in summary_lines(res, observer, program=str(program), interp=interp_kind,
                               submits=[t for t in rt.scheduler.tasks if t.kind == "submit"],
-                              workspace=ws_note):
+                              workspace=ws_note, starving=starvation_lines(rt)):
         click.echo(shown(line))
     sys.exit(res.exit_code)
+
+
+@click.group("cell")
+def cell() -> None:
+    """The cell of a backup: the PLC's answers as reactive rules (robot/cellrules.py)."""
+
+
+@cell.command("init")
+@click.argument("backup", type=click.Path(path_type=Path))
+@click.argument("program", required=False, type=click.Path(path_type=Path))
+@click.option("-o", "--output", type=click.Path(path_type=Path), default=None,
+              help="Write the starter file here (default: print it).")
+def cell_init_cmd(backup: Path, program: Path | None, output: Path | None) -> None:
+    """Write a starter cell file for PROGRAM (a path or a module name in BACKUP), or for every
+    program of BACKUP: each input the programs read, with a rule to fill in."""
+    from interp.cellinit import cell_init  # noqa: PLC0415
+    from interp.realprograms import programs_of  # noqa: PLC0415
+    from krl.project import backup_of  # noqa: PLC0415
+    from krl.terminal import printable  # noqa: PLC0415
+
+    if not backup.is_dir():
+        click.echo(f"error: {printable(backup)}: not a folder", err=True)
+        sys.exit(2)
+    root = backup_of(backup.resolve()) or backup.resolve()
+    if program is not None:
+        found = program if program.is_file() else program_in(root, program)
+        if found is None:
+            click.echo(f"error: no program {printable(program)} in {printable(backup)}", err=True)
+            sys.exit(2)
+        programs = [found]
+    else:
+        programs = programs_of(root)
+    try:
+        text = cell_init(root, programs)
+    except Exception as exc:  # noqa: BLE001 - never a traceback for input
+        click.echo(f"error: {printable(exc)}", err=True)
+        sys.exit(2)
+    if output is None:
+        click.echo(text, nl=False)
+    else:
+        output.write_text(text, encoding="utf-8")
+        click.echo(f"wrote {printable(output)}")
 
 
 from interp.asm import asm  # noqa: E402
 
 
-commands = [run, asm]
+commands = [run, asm, cell]

@@ -4,14 +4,23 @@
 A *backup* is a folder with ``R1/System`` (or a flat export with ``System/$config.dat``); its
 *programs* are the ``.src`` files under its Program folders (and ``cell.src``) whose main
 routine takes no parameters. Each runs on the tree interpreter with the backup's own
-System folder (BASIS, ``$config.dat``), no stimuli, ``--max-sim-time`` 60 s and 300 000
-steps. Outcomes:
+System folder (BASIS, ``$config.dat``), its cell file (:func:`cell_of`: the committed
+``corpus/cells``; ``--no-cells`` runs without), ``--max-sim-time`` 60 s and 300 000 steps.
+
+Every stop gets one *cause* (:func:`cause_of`, issue 22 "Every stop explained"):
 
 * ``completed``;
-* a *legitimate stop*: ``deadlock`` (a WAIT FOR on an input no stimulus sets), ``halt``,
-  ``max_sim_time``/``max_steps`` (cell programs loop forever waiting for a program number);
-* ``error``: grouped by message (numbers and names normalised), each either a true program
-  error (e.g. a target the KR 6 R900 cannot reach) or a simulator limitation.
+* ``intended end``: the program's own ``HALT``, or a cycle loop stopped by the time or step
+  limit while the cell answers it (a rule of the cell file wrote an input in the last quarter
+  of the run: the cycle was still running);
+* ``program error``: a KRL run-time error of the program, at its file:line;
+* ``interpreter gap``: an error that is the simulator's (:data:`GAP_MESSAGES`: a feature not
+  simulated; a target, a CP path or an axis range the simulated KR 6 R900 cannot follow — the
+  backup's own robot is another; an element of a CONST array a data list sets line by line, which
+  the runtime leaves unset, :func:`const_array_gap`),
+  or an internal error;
+* ``limit``: the time or step limit (or a deadlock) with no cell answering: the program starves
+  for an input (named by the stop text, "waits: WAIT FOR ...") or loops on its own.
 
 A run-time error of the backup's submit program (SPS.SUB) does not end the run: each row's
 ``submit`` lists those errors and the report counts them.
@@ -36,6 +45,89 @@ from krl.files import SHARED_CORPUS as DEFAULT_CORPUS
 from krl.project import backup_of, find_backups, system_folder
 
 LEGITIMATE = ("deadlock", "halt", "max_sim_time", "max_steps")
+
+#: the causes of a stop, in report order
+CAUSES = ("completed", "intended end", "program error", "interpreter gap", "limit")
+
+#: parts of a run-time error message that make it the simulator's gap, not the program's error
+GAP_MESSAGES = ("target not reachable", "through a singularity", "software limit switch",
+                "CONST array element", "not supported", "unsupported", "not simulated",
+                "not implemented", "internal error")
+
+#: the committed cell files of the corpus backups (issue 22)
+CELLS = Path(__file__).resolve().parent.parent / "corpus" / "cells"
+
+
+def cell_of(path: Path, corpus: Path = DEFAULT_CORPUS, cells: Path = CELLS) -> Path | None:
+    """The committed cell file of a corpus program: ``corpus/cells/REPO/STEM.yaml`` (one
+    program, lower-case stem), else ``corpus/cells/REPO.yaml`` (the backup), where REPO is the
+    program's first folder under the corpus. None when there is none."""
+    try:
+        repo = path.resolve().relative_to(corpus.resolve()).parts[0]
+    except (ValueError, IndexError):
+        return None
+    for cand in (cells / repo / f"{path.stem.lower()}.yaml", cells / f"{repo}.yaml"):
+        if cand.is_file():
+            return cand
+    return None
+
+
+def const_array_gap(rt, res) -> bool:
+    """True when the run stopped on "value invalid" reading an element of a ``DECL CONST``
+    array (the checker's symbol of the name, in the module of the stop): the reference lets a
+    data list initialise it element by element; the runtime does not yet (issue 22)."""
+    m = re.match(r"value invalid: ([A-Za-z_$][A-Za-z0-9_$]*)\[", res.text or "")
+    if res.reason != "error" or m is None or not res.file:
+        return False
+    module = rt.program.module_of(res.file)
+    scope = rt.program.ws.units[module.index].scope if module is not None else None
+    sym = scope.lookup(m.group(1)) if scope is not None else None
+    return sym is not None and sym.kind == "const"
+
+
+def row_from_trace(program: Path, events: list[dict]) -> dict:
+    """A row as :func:`run_one` gives it, from the trace of a run of `program` with its cell
+    (the conformance report runs programs through ``krl run``): the ``end`` event, the cell's
+    answers (``io`` events whose source is ``cell``/``cell:...``), and the cause."""
+    ends = [e for e in events if e.get("kind") == "end"]
+    end = ends[-1] if ends else {}
+    cell = [e["t"] for e in events if e.get("kind") == "io" and str(e.get("source", "")).startswith("cell")]
+    row = {"program": str(program), "reason": end.get("reason", "internal"), "text": end.get("text") or "",
+           "file": end.get("file"), "line": end.get("line"), "sim_time": end.get("t", 0.0),
+           "cell_answers": len(cell), "cell_last": max(cell) if cell else None}
+    if row["reason"] == "program_end":
+        row["reason"] = "completed"
+    if row["reason"] == "error" and row["text"].startswith("value invalid:"):
+        from interp.run import make_runtime  # noqa: PLC0415
+        from interp.runtime.core import RunResult  # noqa: PLC0415
+
+        try:
+            rt, _ = make_runtime(program, mujoco=False, check=False)
+            if const_array_gap(rt, RunResult("error", None, row["file"], row["line"], None, row["text"])):
+                row["text"] += " (a CONST array element set line by line in its data list)"
+        except Exception:  # noqa: BLE001 - the cause stays a program error
+            pass
+    row["cause"] = cause_of(row)
+    return row
+
+
+def cause_of(row: dict) -> str:
+    """The one cause of a run's stop (see the module docstring): a row of :func:`run_one`."""
+    reason = row.get("reason")
+    if reason == "completed":
+        return "completed"
+    if reason == "halt":
+        return "intended end"
+    if reason == "internal":
+        return "interpreter gap"
+    if reason == "error":
+        text = (row.get("text") or "").lower()
+        return "interpreter gap" if any(g.lower() in text for g in GAP_MESSAGES) else "program error"
+    last = row.get("cell_last")
+    t = row.get("sim_time") or 0.0
+    if row.get("cell_answers") and last is not None and last >= 0.75 * t:
+        return "intended end"
+    return "limit"
 
 
 def programs_of(root: Path) -> list[Path]:
@@ -83,7 +175,7 @@ def submit_of(path: Path) -> list[Path]:
     return []
 
 
-def run_one(path: Path, max_sim_time: float, max_steps: int) -> dict:
+def run_one(path: Path, max_sim_time: float, max_steps: int, cell: Path | None = None) -> dict:
     from interp.run import make_runtime  # noqa: PLC0415
     from robot.trace import TraceWriter  # noqa: PLC0415
 
@@ -92,18 +184,29 @@ def run_one(path: Path, max_sim_time: float, max_steps: int) -> dict:
     try:
         # --no-check: the report says how each real program runs, also those the checker rejects
         rt, _ = make_runtime(path, trace=None, mujoco=False, max_sim_time=max_sim_time, max_steps=max_steps,
-                             submit=submit_of(path), check=False)
+                             submit=submit_of(path), check=False, inputs=cell)
         res = rt.run()
         stubs = sorted(rt.program.stubs)
+        rules = rt.controller.rules
+        fired = [r.last_fired for r in rules if r.last_fired is not None]
     except Exception as exc:  # noqa: BLE001 - an internal error is a bug to report
-        return {"program": str(path), "reason": "internal", "text": f"{type(exc).__name__}: {exc}",
-                "seconds": round(time.time() - t0, 2)}
+        row = {"program": str(path), "reason": "internal", "text": f"{type(exc).__name__}: {exc}",
+               "seconds": round(time.time() - t0, 2), "cell": str(cell) if cell else None}
+        row["cause"] = cause_of(row)
+        return row
     del tw
-    return {"program": str(path), "reason": res.reason, "text": res.text,
-            "number": res.error.number if res.error is not None else None,
-            "file": res.file, "line": res.line, "sim_time": round(res.sim_time, 3),
-            "steps": res.steps, "stubs": stubs, "submit": submit_errors(rt),
-            "seconds": round(time.time() - t0, 2)}
+    text = res.text
+    if const_array_gap(rt, res):
+        text = f"{text} (a CONST array element set line by line in its data list)"
+    row = {"program": str(path), "reason": res.reason, "text": text,
+           "number": res.error.number if res.error is not None else None,
+           "file": res.file, "line": res.line, "sim_time": round(res.sim_time, 3),
+           "steps": res.steps, "stubs": stubs, "submit": submit_errors(rt),
+           "seconds": round(time.time() - t0, 2),
+           "cell": str(cell) if cell else None, "cell_answers": sum(r.fired for r in rules),
+           "cell_last": round(max(fired), 3) if fired else None}
+    row["cause"] = cause_of(row)
+    return row
 
 
 def submit_errors(rt) -> list[str]:
@@ -117,8 +220,17 @@ def submit_errors(rt) -> list[str]:
     return out
 
 
+def causes(rows: list[dict]) -> Counter:
+    """Programs by cause, in :data:`CAUSES` order."""
+    by = Counter(r.get("cause") or cause_of(r) for r in rows)
+    return Counter({k: by[k] for k in CAUSES if by[k]})
+
+
 def report(rows: list[dict]) -> str:
     n = len(rows)
+    by_cause = causes(rows)
+    head = [f"{n} programs by cause: " + ", ".join(f"{k} {v}" for k, v in by_cause.items()),
+            f"  completed or intended end: {by_cause['completed'] + by_cause['intended end']}"]
     by = Counter(r["reason"] for r in rows)
     ok = by["completed"]
     legit = sum(by[k] for k in LEGITIMATE)
@@ -128,6 +240,13 @@ def report(rows: list[dict]) -> str:
              f"{by['error']} errors, {by['internal']} internal errors",
              f"  ({waits} of the limit stops wait in WAIT FOR for an input that no stimulus sets; "
              f"the others loop, e.g. re-issuing a message while the cell inputs are absent)", ""]
+    lines = head + [""] + lines
+    lines.append("By program (cause, where):")
+    for r in rows:
+        where = f"{Path(r['file']).name}:{r['line']}" if r.get("file") and r.get("line") else ""
+        lines.append(f"  {r.get('cause') or cause_of(r):15s} {Path(r['program']).name:28s} {where:26s} "
+                     f"{(r.get('text') or '')[:70]}")
+    lines.append("")
     errs = Counter(normalise(r["text"]) for r in rows if r["reason"] in ("error", "internal"))
     if errs:
         lines.append("Failures by message:")
@@ -154,6 +273,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--limit", type=int, default=0)
     ap.add_argument("--max-sim-time", type=float, default=60.0)
     ap.add_argument("--max-steps", type=int, default=300_000)
+    ap.add_argument("--no-cells", action="store_true", help="run without the committed cell files")
     a = ap.parse_args(argv)
     corpus = Path(a.corpus)
     if not corpus.is_dir():
@@ -162,10 +282,10 @@ def main(argv: list[str] | None = None) -> int:
     rows = []
     for root in find_backups(corpus):
         for p in programs_of(root):
-            rows.append(run_one(p, a.max_sim_time, a.max_steps))
+            rows.append(run_one(p, a.max_sim_time, a.max_steps, None if a.no_cells else cell_of(p, corpus)))
             r = rows[-1]
             sub = f"  [submit: {r['submit'][0][:60]}]" if r.get("submit") else ""
-            print(f"{r['reason']:13s} {r.get('seconds', 0):6.1f}s {p.relative_to(corpus)}  {r['text'][:80]}{sub}",
+            print(f"{r['cause']:15s} {r['reason']:13s} {r.get('seconds', 0):6.1f}s {p.relative_to(corpus)}  {r['text'][:80]}{sub}",
                   file=sys.stderr)
             if a.limit and len(rows) >= a.limit:
                 break

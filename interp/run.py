@@ -13,7 +13,8 @@ def make_runtime(program, *, workspace=None, inputs=None, trace=None, max_sim_ti
                  max_steps=None, submit=None, mujoco: bool = True, controller=None,
                  robot_budget=None, interp: str = "tree", observer=None,
                  mode: str | None = None, check: bool = True,
-                 vm_loop: str = "generated", run_mode: str | None = None) -> tuple[Runtime, object]:
+                 vm_loop: str = "generated", run_mode: str | None = None,
+                 pgno: int | None = None) -> tuple[Runtime, object]:
     """Build the runtime and the interpreter (``interp``: tree or vm) for ``program``
     (not started yet). Its files (krl.project.project_of, with the `submit` programs) are
     loaded, checked and resolved first; with `check` (``krl run`` without ``--no-check``) a
@@ -22,8 +23,12 @@ def make_runtime(program, *, workspace=None, inputs=None, trace=None, max_sim_ti
     (VM.run as written; tests compare the two). `observer` (an :class:`interp.summary.RunObserver`) sees the
     controller's events on their way to `trace`; it is not used with a given `controller`.
     ``mode``: operating mode T1/T2/AUT/EXT (``$MODE_OP``; default AUT, robot/limits.py);
-    ignored with a given `controller` (it has its own). ``run_mode``: ``$PRO_MODE`` at the
-    start (GO, MSTEP, ISTEP, BSTEP; interp/runtime/runmode.py; default GO)."""
+    ignored with a given `controller` (it has its own); None: AUT, or EXT when the cell file
+    (`inputs`) has the ``autoext`` preset. ``pgno``: the program number the cell's PLC answers
+    in P00's handshake (robot/cellpresets.py; overrides the cell file's ``pgno`` preset).
+    ``run_mode``: ``$PRO_MODE`` at the start (GO, MSTEP, ISTEP, BSTEP; interp/runtime/runmode.py;
+    default GO). Raises :class:`robot.stimuli.StimulusError` for a bad cell file or a preset the
+    backup's ``$config.dat`` does not allow."""
     from interp.tree import TreeInterpreter  # noqa: PLC0415
 
     if controller is None:
@@ -43,11 +48,15 @@ def make_runtime(program, *, workspace=None, inputs=None, trace=None, max_sim_ti
         # The interpreters trace into the user's trace only: without one the VM keeps its
         # quiet fast path (Runtime.quiet_limit); the observer needs the controller's events.
         rt.trace = trace
-    if controller.stimuli:
+    number = pgno if pgno is not None else getattr(controller, "pgno", None)
+    if number is not None:
+        controller.rules += _pgno_rules(rt, Path(program).stem, number)
+    if controller.stimuli or controller.rules:
         from robot.stimuli import resolve_signals  # noqa: PLC0415
 
         try:
-            resolve_signals(controller.stimuli, lambda name: signal_of(rt, Path(program).stem, name))
+            resolve_signals(controller.stimuli, lambda name: signal_of(rt, Path(program).stem, name),
+                            controller.rules)
         except ResourceError:
             pass    # a data list past a limit: the program does not start (Runtime.main_routine says why)
     if interp == "vm":
@@ -61,6 +70,38 @@ def make_runtime(program, *, workspace=None, inputs=None, trace=None, max_sim_ti
         sp = Path(sub).resolve()
         rt.add_task("submit", sp.stem, lambda name=sp: interp.run_program(name))
     return rt, interp
+
+
+def _pgno_rules(rt: Runtime, main: str, number: int) -> list:
+    """The PLC's rules of P00's program-number handshake answering `number`, with the
+    ``PGNO_*`` parameters the program sees ($config.dat)."""
+    from robot.cellpresets import PGNO_PARAMETERS, PresetError, pgno_rules  # noqa: PLC0415
+    from robot.stimuli import StimulusError  # noqa: PLC0415
+
+    params = {}
+    for name in PGNO_PARAMETERS:
+        value = global_value(rt, main, name)
+        if isinstance(value, int) and not isinstance(value, bool):
+            params[name] = value
+    try:
+        return pgno_rules(params, number)
+    except PresetError as exc:
+        raise StimulusError(f"--pgno {number}: {exc}") from None
+
+
+def global_value(rt: Runtime, main: str, name: str):
+    """The value of the variable `name` as the program `main` sees it (its data list, then the
+    global declarations: $config.dat), or None when there is none or it has no value."""
+    prog = rt.program
+    module = prog.module_of(prog.main_path) if main.upper() == prog.main_path.stem.upper() else prog.module(main)
+    scope = prog.ws.units[module.index].scope if module is not None else prog.ws.global_scope
+    sym = scope.lookup(name) if scope is not None else None
+    if sym is None or sym.kind not in ("var", "const"):
+        return None
+    try:
+        return rt.storage_ref(prog.ws.resolver.storage(name, sym, None, module.index if module else -1), None).get()
+    except KrlRuntimeError:
+        return None
 
 
 def signal_of(rt: Runtime, main: str, name: str) -> tuple[str, int, int | None] | None:
@@ -77,7 +118,7 @@ def signal_of(rt: Runtime, main: str, name: str) -> tuple[str, int, int | None] 
         return None
     try:
         ref = rt.storage_ref(prog.ws.resolver.storage(name, sym, None, module.index if module else -1), None)
-    except KrlRuntimeError:
+    except (KrlRuntimeError, IndexError):   # IndexError: a system signal ($EXT_START) the table types
         return None
     if not isinstance(ref, SignalRef):
         return None

@@ -94,12 +94,14 @@ def _clip(text: str) -> str:
 
 
 def summary_lines(result: Any, observer: RunObserver, *, program: str, interp: str,
-                  submits: list[Any] = (), workspace: str | None = None) -> list[str]:
+                  submits: list[Any] = (), workspace: str | None = None,
+                  starving: list[str] = ()) -> list[str]:
     """The console summary of one run, about a screen (at most ~20 lines).
 
     `result` is the run's RunResult; `submits` the scheduler's submit tasks (``name``,
     ``outcome``, ``file``, ``line``); `workspace` a note on the folder the program's modules
-    came from (shown when it is not the program's own folder).
+    came from (shown when it is not the program's own folder); `starving` the lines of
+    :func:`starvation_lines` (they replace the generic hint).
     """
     out = [f"run {printable_path(program)} ({interp} interpreter)"]
     if workspace:
@@ -121,7 +123,9 @@ def summary_lines(result: Any, observer: RunObserver, *, program: str, interp: s
             detail = detail[:-len(f" at {where}")]      # the place is already in front
         if where or detail:
             out.append(f"             {where}{ctx}{': ' if where and detail else ''}{detail}{num}")
-        if result.reason in ("max_sim_time", "max_steps", "deadlock") and "WAIT FOR" in (result.text or ""):
+        if starving:
+            out.extend(starving)
+        elif result.reason in ("max_sim_time", "max_steps", "deadlock") and "WAIT FOR" in (result.text or ""):
             out.append("  hint       nothing set the inputs that WAIT FOR reads: give them with "
                        "--inputs STIMULI.yaml (- at: 1.0 / set: {\"$IN[n]\": true}; robot/stimuli.py)")
     for task in submits:
@@ -156,4 +160,103 @@ def summary_lines(result: Any, observer: RunObserver, *, program: str, interp: s
     detail = ", ".join(f"{k} {v}" for k, v in sorted(observer.io.items()))
     out.append(f"  I/O        {changes} change(s){f' ({detail})' if changes else ''}")
     out.append(f"  time       {result.sim_time:.3f} s simulated, {result.steps} steps")
+    return out
+
+
+# ------------------------------------------------------------------ a starving WAIT FOR
+def _wait_node(rt: Any, file: str, line: int):
+    """The WAIT FOR statement of the program's files at `file`:`line`, or None."""
+    from pathlib import Path  # noqa: PLC0415
+
+    from krl.ast import nodes as N  # noqa: PLC0415
+
+    target = str(Path(file).resolve())
+    for m in rt.program.modules:
+        src = m.unit.src
+        if src is None or str(Path(src.path).resolve()) != target:
+            continue
+        for node in src.module.walk():
+            if isinstance(node, N.WaitFor) and node.span.line == line:
+                return node
+    return None
+
+
+def _input_of(rt: Any, main: str, e: Any) -> str | None:
+    """``$IN[n]``, or the SIGNAL name on one input, that `e` reads; None for anything else."""
+    from krl.ast import nodes as N  # noqa: PLC0415
+    from interp.run import global_value, signal_of  # noqa: PLC0415
+
+    if isinstance(e, N.Name):
+        found = signal_of(rt, main, e.name)
+        if found is not None and found[0] == "$IN" and found[2] is None:
+            return e.name.upper()
+        return None
+    if isinstance(e, N.Index) and isinstance(e.base, N.Name) and e.base.name.upper() == "$IN" \
+            and len(e.indices) == 1:
+        i = e.indices[0]
+        n = i.value if isinstance(i, N.IntLit) else (global_value(rt, main, i.name) if isinstance(i, N.Name) else None)
+        if isinstance(n, int) and not isinstance(n, bool):
+            return f"$IN[{abs(n)}]" if isinstance(i, N.IntLit) or n > 0 else None
+    return None
+
+
+def _release(rt: Any, main: str, e: Any, want: bool) -> dict[str, bool] | None:
+    """Input values that make the condition `e` equal `want`: one way, the first operand of
+    an OR; None when the condition is not over inputs alone in a way this reads."""
+    from krl.ast import nodes as N  # noqa: PLC0415
+
+    name = _input_of(rt, main, e)
+    if name is not None:
+        return {name: want}
+    if isinstance(e, N.Unary) and e.op == "NOT":
+        return _release(rt, main, e.operand, not want)
+    if isinstance(e, N.Binary):
+        if e.op in ("==", "<>"):
+            for side, lit in ((e.left, e.right), (e.right, e.left)):
+                if isinstance(lit, N.BoolLit):
+                    return _release(rt, main, side, (lit.value == want) == (e.op == "=="))
+            return None
+        if (e.op == "AND" and want) or (e.op == "OR" and not want):
+            a, b = _release(rt, main, e.left, want), _release(rt, main, e.right, want)
+            return {**a, **b} if a is not None and b is not None else None
+        if e.op in ("AND", "OR"):
+            return _release(rt, main, e.left, want) or _release(rt, main, e.right, want)
+    return None
+
+
+def _inputs_read(rt: Any, main: str, e: Any) -> list[str]:
+    """The inputs (``$IN[n]``, SIGNAL names on one input) the condition `e` reads, in order."""
+    return list(dict.fromkeys(n for n in (_input_of(rt, main, node) for node in e.walk()) if n is not None))
+
+
+def starvation_lines(rt: Any) -> list[str]:
+    """When the run ended in a WAIT FOR that nothing released (time or step limit, deadlock):
+    the inputs it waits on and a cell rule (robot/cellrules.py) that would release it, as
+    summary lines. Empty otherwise. Names come from the program's files: printable."""
+    res = rt.result
+    task = rt.robot
+    if res is None or task is None or res.reason not in ("max_sim_time", "max_steps", "deadlock") \
+            or "WAIT FOR" not in (res.text or "") or not task.file:
+        return []
+    node = _wait_node(rt, task.file, task.line)
+    if node is None:
+        return []
+    main = rt.program.main_path.stem
+    from interp.run import signal_of  # noqa: PLC0415
+
+    names = []
+    for n in _inputs_read(rt, main, node.cond):
+        sig = None if n.startswith("$") else signal_of(rt, main, n)
+        names.append(f"{n} ($IN[{sig[1]}])" if sig else n)
+    release = _release(rt, main, node.cond, True)
+    where = _where(task.file, task.line)
+    out = [f"  starves    WAIT FOR at {where} waits on "
+           + (", ".join(printable(n) for n in names) if names else "no input (outputs or variables only)")]
+    if release:
+        sets = ", ".join(f"{printable(k) if k.isidentifier() else repr(printable(k))}: {str(v).lower()}"
+                         for k, v in release.items())
+        out.append("  a rule     that releases it, in a cell file given with --inputs (robot/cellrules.py):")
+        out.append("               rules:")
+        out.append(f"                 - {{when: \"TRUE\", after: 1.0, set: {{{sets}}}}}   "
+                   f"# when: the program's output that asks for it")
     return out

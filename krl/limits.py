@@ -123,3 +123,10 @@ MAX_MOTION_HISTORY = 10_000
 MAX_DAP_MESSAGE_BYTES = 1024 * 1024
 MAX_DAP_BREAKPOINTS = 1000
 MAX_DAP_REPLAY_STEPS = 10_000_000
+# Reactive rules of a cell file (`rules:` in a stimuli file, robot/cellrules.py): the most rules
+# in one file (a PLC program answering a cell has tens of handshakes, a few hundred at most) and
+# the most tokens in one rule's `when` expression (one line of KRL; real conditions have under
+# 20 tokens; the bound also bounds the bracket depth of the parse). Past either: an error naming
+# the file:line of the rule; the run does not start.
+MAX_CELL_RULES = 1000
+MAX_RULE_TOKENS = 200

@@ -39,7 +39,8 @@ from .limits import normalise_mode
 from .machine import MachineData, load_machine
 from .motion import MotionRequest, Trigger
 from .planner import CP_SPEED_LIMIT_FACTOR, RobotModel, Segment, TriggerPlan, plan, resolved_target
-from .stimuli import Stimulus, load_stimuli
+from .cellrules import Rule, rules_may_fire, step_rules
+from .stimuli import Stimulus, load_cell
 from .trace import TraceWriter
 
 EPS = 1e-9
@@ -177,7 +178,9 @@ class Controller:
     Args:
         machine: machine data (default :func:`robot.machine.load_machine`).
         trace: a :class:`~robot.trace.TraceWriter` or None.
-        stimuli: list of :class:`~robot.stimuli.Stimulus`, a YAML path, or None.
+        stimuli: list of :class:`~robot.stimuli.Stimulus`, a YAML path (stimuli and rules), or None.
+        rules: reactive rules of the cell (:class:`~robot.cellrules.Rule`), added to those of a
+            YAML `stimuli` file.
         start_axes: initial axes A1..A6 (deg), default HOME.
         actuated: drive MuJoCo with position/velocity actuators instead of qpos replay.
         strict_bco: the first motion needs a complete PTP/LIN target (reference §6.3).
@@ -193,10 +196,17 @@ class Controller:
     """
 
     def __init__(self, machine: MachineData | None = None, *, trace: TraceWriter | None = None,
-                 stimuli: list[Stimulus] | str | None = None,
+                 stimuli: list[Stimulus] | str | None = None, rules: list[Rule] | None = None,
                  start_axes: Any = None, actuated: bool = False, strict_bco: bool = True,
                  mujoco: bool = True, mode_op: str | None = None) -> None:
         self.machine = machine if machine is not None else load_machine()
+        self.rules: list[Rule] = []
+        self.pgno: int | None = None      # the cell file's pgno preset (interp/run.py builds its rules)
+        if isinstance(stimuli, str):
+            cell = load_cell(stimuli, self.machine.in_pos_car_mm)
+            stimuli, self.rules, self.pgno = cell.stimuli, cell.rules, cell.pgno
+            if cell.autoext and mode_op is None:
+                mode_op = "EX"            # Automatic External (robot/cellpresets.py)
         self.mode_op = normalise_mode(mode_op)
         self.model = RobotModel(self.machine, mode=self.mode_op)
         self.dt = float(self.machine.ipo_cycle_s)
@@ -206,8 +216,7 @@ class Controller:
         self.strict_bco = strict_bco
         self._bco_done = False
         self.io = IOImage(on_change=self._on_io)
-        if isinstance(stimuli, str):
-            stimuli = load_stimuli(stimuli, self.machine.in_pos_car_mm)
+        self.rules += list(rules or [])
         self.stimuli: list[Stimulus] = list(stimuli or [])
         q = np.array(self.machine.home_deg if start_axes is None else start_axes, dtype=float)
         self.model.kin.check_soft_limits(q)
@@ -309,10 +318,11 @@ class Controller:
 
     def io_may_change(self) -> bool:
         """True if an input or output can still change without the program doing anything:
-        a stimulus not yet applied, a PULSE not yet reset, a cyclic hook, a running timer
-        (for deadlock detection of WAIT FOR)."""
+        a stimulus not yet applied, a PULSE not yet reset, a cyclic hook, a running timer, a
+        cell rule with an answer pending or about to fire (for deadlock detection of WAIT FOR)."""
         return (any(not st.fired for st in self.stimuli) or bool(self._pulses)
-                or bool(self._cyclic) or not all(self.io.timer_stop[1:]))
+                or bool(self._cyclic) or not all(self.io.timer_stop[1:])
+                or (bool(self.rules) and rules_may_fire(self.rules, self.io)))
 
     def is_moving(self) -> bool:
         """True while a motion is being executed."""
@@ -579,6 +589,8 @@ class Controller:
                     keep.append((te, n, lvl))
             self._pulses = keep
         self._apply_stimuli(t)
+        if self.rules:
+            step_rules(self.rules, self.io, t, self.dt)
 
         # path time (BRAKE ramps scale the path speed)
         s_old = self._scale

@@ -16,10 +16,20 @@ A signal is ``$IN[n]`` or ``$ANIN[n]``, or the name of a ``SIGNAL`` declared on 
 $IN[1] TO $IN[4]`` takes an INT, bit 0 on the first input). The run resolves the names before
 it starts (:func:`resolve_signals`).
 
-The file is validated against this schema: a top-level mapping holds only ``stimuli``; a
-stimulus only ``at``, ``when``, ``set``, ``delay``; ``when`` only ``motion``, ``line``,
-``phase``, ``reached``. Anything else is a :class:`StimulusError` that names the key and the
-place (``file:line``). Limits: at most :data:`MAX_STIMULI` stimuli, :data:`MAX_STIMULI_BYTES` bytes.
+A *cell file* is a stimuli file with reactive rules and presets beside (issue 22)::
+
+    presets: {autoext: true, pgno: 2}    # robot/cellpresets.py
+    rules:                               # robot/cellrules.py: rising edge, `after` s later
+      - when: "$OUT[3] AND NOT PART_OK"
+        after: 0.2
+        set: {PART_OK: true}
+
+The file is validated against this schema: a top-level mapping holds only ``stimuli``,
+``rules``, ``presets``; a stimulus only ``at``, ``when``, ``set``, ``delay``; ``when`` only
+``motion``, ``line``, ``phase``, ``reached``; a rule only ``when`` (KRL text), ``after``, ``set``;
+``presets`` only ``pgno``, ``autoext``. Anything else is a :class:`StimulusError` that names the
+key and the place (``file:line``). Limits: at most :data:`MAX_STIMULI` stimuli,
+:data:`MAX_CELL_RULES` rules, :data:`MAX_STIMULI_BYTES` bytes.
 
 ``phase`` is one of start, blend_start, blend_end, end. ``reached`` (mm) fires in the
 first IPO cycle in which that motion is being executed and the TCP is within the given
@@ -38,12 +48,15 @@ from typing import Any
 
 import yaml
 
-from krl.limits import MAX_STIMULI, MAX_STIMULI_BYTES
+from krl.limits import MAX_CELL_RULES, MAX_STIMULI, MAX_STIMULI_BYTES
 
+from .cellrules import ConditionError, Rule, compile_condition, parse_condition
 from .io import IOError_, parse_signal
 
 PHASES = ("start", "blend_start", "blend_end", "end")
-TOP_KEYS = ("stimuli",)
+TOP_KEYS = ("stimuli", "rules", "presets")
+PRESET_KEYS = ("pgno", "autoext")
+RULE_KEYS = ("when", "after", "set")
 STIMULUS_KEYS = ("at", "when", "set", "delay")
 WHEN_KEYS = ("motion", "line", "phase", "reached")
 _NAME = re.compile(r"[A-Za-z_$][A-Za-z0-9_$]{0,23}\Z")   # a KRL name (reference §2: 24 characters)
@@ -160,23 +173,115 @@ def _signal_name(name: Any, where: str) -> str:
     return s
 
 
-def parse_stimuli(doc: Any, default_reach_mm: float = 0.1, source: str = "") -> list[Stimulus]:
-    """Build stimuli from a parsed YAML document (a list, or a mapping with ``stimuli``).
+def _parse_set(mapping: dict, where: _Where) -> dict[str, Any]:
+    """The ``set:`` mapping of a stimulus or rule: signal -> value (BOOL/INT for ``$IN`` and
+    SIGNAL names, REAL for ``$ANIN``)."""
+    sets: dict[str, Any] = {}
+    for name, v in mapping.items():
+        at = where(mapping, name)
+        key = _signal_name(name, at)
+        if isinstance(v, bool) or key.startswith("$ANIN"):
+            if key.startswith("$ANIN"):
+                v = _number(v, f"value of {key}", at)
+        else:
+            v = int(_number(v, f"value of {key}", at, integer=True))
+        sets[key] = v
+    return sets
+
+
+@dataclass
+class Cell:
+    """A stimuli file: its timed/motion stimuli and its reactive rules (robot/cellrules.py)."""
+
+    stimuli: list[Stimulus] = field(default_factory=list)
+    rules: list[Rule] = field(default_factory=list)
+    pgno: int | None = None        # presets: the program number the PLC answers (robot/cellpresets.py)
+    autoext: bool = False          # presets: Automatic External (operating mode EXT)
+
+
+def _parse_rules(doc: Any, where: _Where, key_where: str) -> list[Rule]:
+    if doc is None:
+        return []
+    if not isinstance(doc, list):
+        raise StimulusError(f"{key_where}: 'rules' must be a list of rules (when, after, set)")
+    if len(doc) > MAX_CELL_RULES:
+        raise StimulusError(f"{key_where}: {len(doc)} rules, more than the limit of {MAX_CELL_RULES}")
+    out = []
+    for i, item in enumerate(doc):
+        if not isinstance(item, dict):
+            raise StimulusError(f"{key_where}: rule {i + 1} must be a mapping (when, after, set)")
+        here = where(item)
+        _unknown(item, RULE_KEYS, f"field of rule {i + 1}:", where)
+        if "when" not in item:
+            raise StimulusError(f"{here}: rule {i + 1} needs 'when' (a KRL condition)")
+        if not isinstance(item.get("set"), dict) or not item["set"]:
+            raise StimulusError(f"{here}: rule {i + 1} needs a 'set' mapping of signals")
+        text = item["when"]
+        wat = where(item, "when")
+        if isinstance(text, bool):
+            text = "TRUE" if text else "FALSE"
+        if not isinstance(text, str):
+            raise StimulusError(f"{wat}: 'when' must be KRL text, not {text!r}")
+        try:
+            expr = parse_condition(text)
+        except ConditionError as exc:
+            col = f" (column {exc.column} of the condition)" if exc.column else ""
+            raise StimulusError(f"{wat}: {exc}{col}") from None
+        after = float(_number(item.get("after", 0.0), "after", where(item, "after")))
+        if after < 0:
+            raise StimulusError(f"{where(item, 'after')}: after must not be negative")
+        out.append(Rule(when=expr, text=text, set=_parse_set(item["set"], where), after=after, where=here))
+    return out
+
+
+def parse_cell(doc: Any, default_reach_mm: float = 0.1, source: str = "") -> Cell:
+    """Build a :class:`Cell` from a parsed YAML document: a list of stimuli, or a mapping with
+    ``stimuli`` and/or ``rules``.
 
     `source` is the file name used in messages. Raises :class:`StimulusError` for a key
-    outside the schema, a missing ``stimuli``/``set``/``at``-or-``when``, a value of the wrong
-    type, or more than :data:`MAX_STIMULI` stimuli.
+    outside the schema, a missing ``set``/``at``-or-``when``, a value of the wrong type, a rule
+    condition outside the subset of robot/cellrules.py, or more than :data:`MAX_STIMULI`
+    stimuli or :data:`MAX_CELL_RULES` rules.
     """
     where = _Where(source)
     if doc is None:
-        return []
+        return Cell()
+    rules: list[Rule] = []
     if isinstance(doc, dict):
         _unknown(doc, TOP_KEYS, "top-level key", where)
-        if "stimuli" not in doc:
-            raise StimulusError(f"{where(doc)}: the mapping needs a 'stimuli' list")
-        doc = doc["stimuli"]
-        if doc is None:
-            return []
+        if "stimuli" not in doc and "rules" not in doc and "presets" not in doc:
+            raise StimulusError(f"{where(doc)}: the mapping needs 'stimuli', 'rules' or 'presets'")
+        cell = Cell([], _parse_rules(doc.get("rules"), where, where(doc, "rules")))
+        _parse_presets(doc.get("presets"), cell, where, where(doc, "presets"))
+        if doc.get("stimuli") is not None:
+            cell.stimuli = _parse_stimuli(doc["stimuli"], default_reach_mm, where)
+        return cell
+    return Cell(_parse_stimuli(doc, default_reach_mm, where))
+
+
+def _parse_presets(doc: Any, cell: Cell, where: _Where, key_where: str) -> None:
+    if doc is None:
+        return
+    if not isinstance(doc, dict):
+        raise StimulusError(f"{key_where}: 'presets' must be a mapping ({', '.join(PRESET_KEYS)})")
+    _unknown(doc, PRESET_KEYS, "preset", where)
+    if "pgno" in doc and doc["pgno"] is not None:
+        n = int(_number(doc["pgno"], "pgno", where(doc, "pgno"), integer=True))
+        if not 0 < n < 1 << 16:
+            raise StimulusError(f"{where(doc, 'pgno')}: pgno must be 1..65535")
+        cell.pgno = n
+    if "autoext" in doc:
+        if not isinstance(doc["autoext"], bool):
+            raise StimulusError(f"{where(doc, 'autoext')}: autoext must be true or false")
+        cell.autoext = doc["autoext"]
+
+
+def parse_stimuli(doc: Any, default_reach_mm: float = 0.1, source: str = "") -> list[Stimulus]:
+    """The stimuli of a parsed YAML document (:func:`parse_cell` without the rules)."""
+    return parse_cell(doc, default_reach_mm, source).stimuli
+
+
+def _parse_stimuli(doc: Any, default_reach_mm: float, where: _Where) -> list[Stimulus]:
     if not isinstance(doc, list):
         raise StimulusError(f"{where()}: 'stimuli' must be a list of stimuli")
     if len(doc) > MAX_STIMULI:
@@ -189,16 +294,7 @@ def parse_stimuli(doc: Any, default_reach_mm: float = 0.1, source: str = "") -> 
         _unknown(item, STIMULUS_KEYS, f"field of stimulus {i + 1}:", where)
         if not isinstance(item.get("set"), dict) or not item["set"]:
             raise StimulusError(f"{here}: stimulus {i + 1} needs a 'set' mapping of signals")
-        sets: dict[str, Any] = {}
-        for name, v in item["set"].items():
-            at = where(item["set"], name)
-            key = _signal_name(name, at)
-            if isinstance(v, bool) or key.startswith("$ANIN"):
-                if key.startswith("$ANIN"):
-                    v = _number(v, f"value of {key}", at)
-            else:
-                v = int(_number(v, f"value of {key}", at, integer=True))
-            sets[key] = v
+        sets = _parse_set(item["set"], where)
         st = Stimulus(set=sets, delay=float(_number(item.get("delay", 0.0), "delay", where(item, "delay"))),
                       where=here)
         if st.delay < 0:
@@ -234,7 +330,12 @@ def parse_stimuli(doc: Any, default_reach_mm: float = 0.1, source: str = "") -> 
 
 
 def load_stimuli(path: str | Path, default_reach_mm: float = 0.1) -> list[Stimulus]:
-    """Read and validate a stimuli YAML file (see the module docstring).
+    """The stimuli of a stimuli YAML file (:func:`load_cell` without the rules)."""
+    return load_cell(path, default_reach_mm).stimuli
+
+
+def load_cell(path: str | Path, default_reach_mm: float = 0.1) -> Cell:
+    """Read and validate a stimuli YAML file, stimuli and rules (see the module docstring).
 
     Raises :class:`StimulusError` (with ``file:line``) for an unreadable, oversized or
     malformed file."""
@@ -259,42 +360,57 @@ def load_stimuli(path: str | Path, default_reach_mm: float = 0.1) -> list[Stimul
         raise StimulusError(f"{p}: not valid YAML: {exc}") from None
     except TypeError as exc:   # an unhashable mapping key
         raise StimulusError(f"{p}: not a valid stimuli file: {exc}") from None
-    return parse_stimuli(doc, default_reach_mm, source=str(p))
+    return parse_cell(doc, default_reach_mm, source=str(p))
 
 
 def resolve_signals(stimuli: list[Stimulus],
-                    lookup: Callable[[str], tuple[str, int, int | None] | None]) -> None:
-    """Replace SIGNAL names in the stimuli by the inputs they stand for, in place.
+                    lookup: Callable[[str], tuple[str, int, int | None] | None],
+                    rules: list[Rule] = ()) -> None:
+    """Replace SIGNAL names in the stimuli and rules by the inputs they stand for, in place,
+    and build each rule's condition (robot/cellrules.py ``compile_condition``).
 
     `lookup(NAME)` gives ``(base, first, last)`` for a SIGNAL declared on ``base``
     (``"$IN"``, ``"$ANIN"``, ...) from input ``first`` to ``last`` (None for one input), or
     None for an unknown name. A group takes an INT (bit 0 on ``first``), one ``$IN`` a BOOL.
-    Raises :class:`StimulusError` (with the stimulus's ``file:line``) for an unknown name, a
-    signal on an output, or a value that does not fit.
+    Raises :class:`StimulusError` (with the stimulus's or rule's ``file:line``) for an unknown
+    name, a signal on an output, a value that does not fit, or a condition that names an
+    unknown signal or mixes types.
     """
     for st in stimuli:
-        resolved: dict[str, Any] = {}
-        for name, value in st.set.items():
-            if name.startswith("$"):
-                resolved[name] = value
-                continue
-            where = st.where or "stimuli"
-            found = lookup(name)
-            if found is None:
-                raise StimulusError(f"{where}: unknown signal {name} (neither $IN[n]/$ANIN[n] nor a "
-                                    f"SIGNAL declared in $config.dat or the program's data list)")
-            base, first, last = found
-            if base not in ("$IN", "$ANIN"):
-                raise StimulusError(f"{where}: {name} is a SIGNAL on {base}; only $IN/$ANIN can be stimulated")
-            if base == "$ANIN" or last is None:
-                if base == "$IN" and not isinstance(value, bool):
-                    raise StimulusError(f"{where}: {name} is one input ($IN[{first}]): give true or false")
-                resolved[f"{base}[{first}]"] = value
-                continue
-            width = last - first + 1
-            if isinstance(value, bool) or not isinstance(value, int) or not 0 <= value < (1 << width):
-                raise StimulusError(f"{where}: {name} is the group $IN[{first}] TO $IN[{last}]: "
-                                    f"give a whole number 0..{(1 << width) - 1}")
-            for bit, n in enumerate(range(first, last + 1)):
-                resolved[f"$IN[{n}]"] = bool((value >> bit) & 1)
-        st.set = resolved
+        st.set = _resolve_set(st.set, st.where or "stimuli", lookup)
+    for r in rules:
+        where = r.where or "rules"
+        r.set = _resolve_set(r.set, where, lookup)
+        try:
+            r.condition = compile_condition(r.when, lookup)
+        except ConditionError as exc:
+            col = f" (column {exc.column} of the condition)" if exc.column else ""
+            raise StimulusError(f"{where}: when {r.text!r}: {exc}{col}") from None
+
+
+def _resolve_set(sets: dict[str, Any], where: str,
+                 lookup: Callable[[str], tuple[str, int, int | None] | None]) -> dict[str, Any]:
+    resolved: dict[str, Any] = {}
+    for name, value in sets.items():
+        if name.startswith("$"):
+            resolved[name] = value
+            continue
+        found = lookup(name)
+        if found is None:
+            raise StimulusError(f"{where}: unknown signal {name} (neither $IN[n]/$ANIN[n] nor a "
+                                f"SIGNAL declared in $config.dat or the program's data list)")
+        base, first, last = found
+        if base not in ("$IN", "$ANIN"):
+            raise StimulusError(f"{where}: {name} is a SIGNAL on {base}; only $IN/$ANIN can be stimulated")
+        if base == "$ANIN" or last is None:
+            if base == "$IN" and not isinstance(value, bool):
+                raise StimulusError(f"{where}: {name} is one input ($IN[{first}]): give true or false")
+            resolved[f"{base}[{first}]"] = value
+            continue
+        width = last - first + 1
+        if isinstance(value, bool) or not isinstance(value, int) or not 0 <= value < (1 << width):
+            raise StimulusError(f"{where}: {name} is the group $IN[{first}] TO $IN[{last}]: "
+                                f"give a whole number 0..{(1 << width) - 1}")
+        for bit, n in enumerate(range(first, last + 1)):
+            resolved[f"$IN[{n}]"] = bool((value >> bit) & 1)
+    return resolved

@@ -38,7 +38,7 @@ SCHEMA: dict[str, list[tuple[str, str]]] = {
     "io": [
         ("signal", "str: e.g. $OUT[3], $IN[5], $ANOUT[1], $ANIN[2]"),
         ("value", "bool or float: the new value"),
-        ("source", "optional str: program | trigger | pulse | stimulus"),
+        ("source", "optional str: program | trigger | pulse | stimulus | cell (a rule of the cell file; a preset names itself: cell:pgno, cell:autoext)"),
     ],
     "pose": [
         ("axes", "list[6] float: A1..A6 in deg (setpoint read back from MuJoCo)"),

@@ -375,6 +375,9 @@ _LIVE = {
     "$T2": _computed(lambda sv: sv.rt.mode_op == "T2"),
     "$AUT": _computed(lambda sv: sv.rt.mode_op == "AUT"),
     "$EXT": _computed(lambda sv: sv.rt.mode_op == "EX"),
+    # Automatic External active: EXT selected and $I_O_ACT TRUE (KSS 8.x System Integrators,
+    # Automatic External outputs; robot/cellpresets.py "autoext")
+    "$I_O_ACTCONF": _computed(lambda sv: sv.rt.mode_op == "EX" and bool(sv.store.get("$I_O_ACT", True))),
     "$INTERPRETER": _computed(lambda sv: 1 if sv.rt.current_task_kind() == "robot" else 0),
     "$ERR": _computed(_err),
     "$NULLFRAME": _computed(_nullframe),

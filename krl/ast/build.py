@@ -1099,3 +1099,12 @@ def build_module(result, sink: DiagnosticSink | None = None) -> N.Module:
     except Exception as exc:  # noqa: BLE001 - never raise on any parse tree
         sink.add(path, 1, 1, "E003", f"AST builder failed: {type(exc).__name__}: {exc}")
         return N.Module(path, "src", span=N.Span(path, 1, 1))
+
+
+def build_expression(tree, path: str, symbolic: list[str]) -> N.Expr | None:
+    """The AST of an expression parse tree (:func:`krl.syntax.parse.parse_expression`), or None
+    when the tree is malformed. `symbolic`: the parser's token names. Never raises."""
+    try:
+        return Builder(path, DiagnosticSink(), symbolic, recovered=False).expr(tree)
+    except BuildError:
+        return None

@@ -20,6 +20,7 @@ from types import ModuleType
 from antlr4 import CommonTokenStream, InputStream, Token
 from antlr4.atn.PredictionMode import PredictionMode
 from antlr4.error.ErrorStrategy import BailErrorStrategy
+from antlr4.error.ErrorListener import ErrorListener
 from antlr4.error.Errors import ParseCancellationException
 
 from krl.syntax.checks import may_fail, run_checks
@@ -275,3 +276,60 @@ def parse_source(source: SourceText, bundle: ParserBundle | None = None,
 
 def parse_file(path: str | Path, bundle: ParserBundle | None = None, keep_tree: bool = True) -> ParseResult:
     return parse_source(read_source(path), bundle, keep_tree)
+
+
+@dataclass(slots=True)
+class ExpressionParse:
+    """One KRL expression parsed on its own (:func:`parse_expression`): the parse tree of rule
+    ``expression``, or the first problem as ``(column, message)`` (column 1-based)."""
+
+    tree: object | None
+    error: tuple[int, str] | None = None
+
+
+class _FirstError(ErrorListener):
+    def __init__(self) -> None:
+        self.first: tuple[int, str] | None = None
+
+    def syntaxError(self, recognizer, offendingSymbol, line, column, msg, e):  # noqa: N802
+        if self.first is None:
+            self.first = (column + 1, msg)
+
+
+def parse_expression(text: str, max_tokens: int, bundle: ParserBundle | None = None) -> ExpressionParse:
+    """Parse `text` as one KRL expression (grammar rule ``expression``, reference §4) — the
+    condition of a cell rule (robot/cellrules.py), never a statement. The text must be one
+    line; more than `max_tokens` tokens (krl/limits.py) is refused before parsing. Never
+    raises for bad input: the result's ``error`` gives the column and a message."""
+    bundle = bundle or default_bundle()
+    if "\n" in text or "\r" in text:
+        return ExpressionParse(None, (1, "an expression is one line"))
+    listener = _FirstError()
+    lexer = bundle.lexer_cls(InputStream(text))
+    lexer.removeErrorListeners()
+    lexer.addErrorListener(listener)
+    tokens = CommonTokenStream(lexer)
+    tokens.fill()
+    visible = [t for t in tokens.tokens if t.channel == Token.DEFAULT_CHANNEL and t.type != Token.EOF]
+    if listener.first is not None:
+        return ExpressionParse(None, listener.first)
+    if not visible:
+        return ExpressionParse(None, (1, "empty expression"))
+    if len(visible) > max_tokens:
+        return ExpressionParse(None, (1, f"{len(visible)} tokens, more than the limit of {max_tokens}"))
+    parser = bundle.parser_cls(tokens)
+    parser.removeErrorListeners()
+    parser.addErrorListener(listener)
+    parser._interp.predictionMode = PredictionMode.LL
+    parser._errHandler = BailErrorStrategy()
+    try:
+        tree = parser.expression()
+    except ParseCancellationException:
+        tok = tokens.LT(1)
+        col = tok.column + 1 if tok is not None else 1
+        shown = tok.text if tok is not None and tok.type != Token.EOF else "the end"
+        return ExpressionParse(None, listener.first or (col, f"not a KRL expression at {shown!r}"))
+    rest = tokens.LT(1)
+    if rest is not None and rest.type != Token.EOF:
+        return ExpressionParse(None, (rest.column + 1, f"unexpected {rest.text!r} after the expression"))
+    return ExpressionParse(tree)

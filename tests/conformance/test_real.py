@@ -50,8 +50,11 @@ def _check(prog, request=None, must_run: bool = False):
     if request is not None and prog.stem in KNOWN:
         request.node.add_marker(pytest.mark.xfail(reason=f"known: {KNOWN[prog.stem]}", strict=True))
     interps = H.available_interpreters()
+    from interp.realprograms import cell_of
+
+    cell = cell_of(prog, R.DEFAULT_CORPUS)    # the committed cell file (corpus/cells, issue 22)
     runs = {it: H.run_program(prog, it, max_sim_time=10.0, max_steps=100_000, wall_timeout=120.0,
-                              check=False)   # the interpreters compared on all real code
+                              check=False, stimuli=cell)   # the interpreters compared on all real code
             for it in interps}
     for it, r in runs.items():
         prob = H.clean_run_problem(r)

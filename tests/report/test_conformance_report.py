@@ -9,10 +9,12 @@ from conformance.harness import Check
 
 def real_outcomes() -> list[R.RealOutcome]:
     a = R.RealOutcome("KRC/R1/Program/<script>x</script>.src", reasons={"tree": "completed", "vm": "completed"},
-                      tree_vm=[Check("end", True, "")])
+                      tree_vm=[Check("end", True, "")], cause="completed")
     b = R.RealOutcome("KRC/R1/Program/b|c.src", reasons={"tree": "max_sim_time", "vm": "error"},
-                      tree_vm=[Check("end", False, "tree max_sim_time, vm error")])
-    c = R.RealOutcome("KRC/R1/Program/c.src", reasons={"tree": "crash"}, crash={"tree": "KeyError: 'X'"})
+                      tree_vm=[Check("end", False, "tree max_sim_time, vm error")], cause="intended end",
+                      where="b.src:12", cell="corpus/cells/KRC.yaml")
+    c = R.RealOutcome("KRC/R1/Program/c.src", reasons={"tree": "crash"}, crash={"tree": "KeyError: 'X'"},
+                      cause="interpreter gap")
     return [a, b, c]
 
 
@@ -25,9 +27,14 @@ def test_real_programs_are_a_table(tmp_path):
     assert "{'" not in section and "{\"" not in section
     assert "| end reason (tree) | programs |" in section
     assert "| `completed` | 1 |" in section and "| `crash` | 1 |" in section and "| `max_sim_time` | 1 |" in section
-    assert "| program | tree | vm | tree = vm | crash |" in section
-    assert "| `KRC/R1/Program/b\\|c.src` | `max_sim_time` | `error` | NO |  |" in section
-    assert "| `KRC/R1/Program/c.src` | `crash` | `-` | n/a | `KeyError: 'X'` |" in section
+    assert "| program | cause | stop at | cell | tree | vm | tree = vm | crash |" in section
+    assert ("| `KRC/R1/Program/b\\|c.src` | `intended end` | `b.src:12` | `corpus/cells/KRC.yaml` | "
+            "`max_sim_time` | `error` | NO |  |") in section
+    assert "| `KRC/R1/Program/c.src` | `interpreter gap` |  |  | `crash` | `-` | n/a | `KeyError: 'X'` |" in section
+    # every stop explained: one cause a program, counted
+    assert "| cause | programs |" in section
+    assert "| `completed` | 1 |" in section and "| `intended end` | 1 |" in section
+    assert "Completed or intended end: 2 of 3." in section
 
 
 def test_conformance_html_escapes_and_has_the_table(tmp_path):

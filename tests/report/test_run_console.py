@@ -199,8 +199,10 @@ def test_a_wait_for_an_input_nobody_sets_gets_a_hint(tmp_path):
     assert code == 3, out
     lines = out.splitlines()
     assert lines[2] == f"             {prog}:3: deadlocked WAIT FOR"
-    assert lines[3].startswith("  hint       nothing set the inputs that WAIT FOR reads: give them with "
-                               "--inputs STIMULI.yaml")
+    # issue 22: the summary names the input the WAIT FOR starves on and a cell rule releasing it
+    assert lines[3] == f"  starves    WAIT FOR at {prog}:3 waits on $IN[5]"
+    assert lines[4].startswith("  a rule     that releases it, in a cell file given with --inputs")
+    assert "- {when: \"TRUE\", after: 1.0, set: {'$IN[5]': true}}" in lines[6]
     stim = write(tmp_path / "stim.yaml", """
         stimuli:
           - at: 0.1

@@ -1,0 +1,285 @@
+"""Reactive rules of a cell file: a PLC that answers the program (issue 22, "The cell").
+
+A rule of the ``rules:`` list of a stimuli file (robot/stimuli.py)::
+
+    rules:
+      - when: "$OUT[986] AND NOT PART_READY"   # a KRL boolean expression (one line)
+        after: 0.2                             # s after the condition became TRUE
+        set: {PART_READY: true, "$IN[12]": true}
+
+fires on the *rising edge* of its condition (FALSE in one IPO cycle, TRUE in the next; before
+the first cycle the condition counts as FALSE, so a condition TRUE at the start fires once at
+the first cycle) and sets its values in the first IPO cycle at least ``after`` seconds later,
+and at least one IPO cycle later (a PLC answers no earlier than its next scan). Edges seen while
+an earlier answer is still pending queue up; each is answered.
+
+The condition is KRL text from an untrusted file. It is parsed once, at load time, by the
+project's own parser (grammar rule ``expression``, krl/syntax/parse.py) into the project's AST
+(krl/ast), and only this subset is accepted (reference §4.1 for the operators):
+
+* literals: ``TRUE``, ``FALSE``, INT and REAL constants;
+* ``$IN[n]``, ``$OUT[n]``, ``$ANIN[n]``, ``$ANOUT[n]`` with a constant index;
+* a SIGNAL name — declared in ``$config.dat``, a data list of the program or the machine data
+  (``SIGNAL PART_OK $IN[3]``, ``SIGNAL $EXT_START $IN[12]``); a group
+  (``SIGNAL CODE $IN[1] TO $IN[4]``) reads as an INT, bit 0 on the first input;
+* ``NOT``, unary ``-``/``+``, ``AND``, ``OR``, ``EXOR``, ``==``, ``<>``, ``<``, ``>``, ``<=``, ``>=``,
+  brackets.
+
+Anything else (a call, a variable, a string, an enum, a structure component) is refused at load
+time with the rule's ``file:line``. The condition is evaluated on its AST (closures built once
+when the run resolves its signals, :func:`compile_condition`); its text never reaches ``eval``.
+Limits: :data:`krl.limits.MAX_CELL_RULES` rules, :data:`krl.limits.MAX_RULE_TOKENS` tokens in one
+condition.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+from krl.ast import nodes as N
+from krl.limits import MAX_RULE_TOKENS
+
+from .io import N_ANALOG, N_DIGITAL, IOImage
+
+#: the operators of the subset (reference §4.1)
+BOOL_OPS = ("AND", "OR", "EXOR")
+COMPARISONS = ("==", "<>", "<", ">", "<=", ">=")
+SIGNAL_ARRAYS = {"$IN": N_DIGITAL, "$OUT": N_DIGITAL, "$ANIN": N_ANALOG, "$ANOUT": N_ANALOG}
+
+Lookup = Callable[[str], "tuple[str, int, int | None] | None"]
+Eval = Callable[[IOImage], Any]
+
+
+class ConditionError(ValueError):
+    """A rule condition outside the subset, or naming an unknown signal. ``column`` (1-based,
+    in the condition's text) when known."""
+
+    def __init__(self, message: str, column: int | None = None) -> None:
+        super().__init__(message)
+        self.column = column
+
+
+def parse_condition(text: str) -> N.Expr:
+    """The AST of the condition `text` (one line of KRL), checked against the subset.
+
+    Raises :class:`ConditionError` for text that is no KRL expression, more than
+    :data:`~krl.limits.MAX_RULE_TOKENS` tokens, or a construct outside the subset."""
+    from krl.ast.build import build_expression  # noqa: PLC0415
+    from krl.syntax.parse import default_bundle, parse_expression  # noqa: PLC0415
+
+    bundle = default_bundle()
+    parsed = parse_expression(text, MAX_RULE_TOKENS, bundle)
+    if parsed.error is not None:
+        col, msg = parsed.error
+        raise ConditionError(f"not a KRL expression: {msg}", col)
+    expr = build_expression(parsed.tree, "<rule>", bundle.symbolic)
+    if expr is None:
+        raise ConditionError("not a KRL expression")
+    check_subset(expr)
+    return expr
+
+
+def _col(node: N.Node) -> int | None:
+    return node.span.column if node.span is not None else None
+
+
+def check_subset(expr: N.Expr) -> None:
+    """Raise :class:`ConditionError` for the first node of `expr` outside the subset."""
+    work = [expr]
+    while work:
+        e = work.pop()
+        if isinstance(e, (N.BoolLit, N.IntLit, N.RealLit)):
+            continue
+        if isinstance(e, N.Name):
+            continue
+        if isinstance(e, N.Index):
+            _signal_index(e)
+            continue
+        if isinstance(e, N.Unary):
+            if e.op not in ("NOT", "-", "+"):
+                raise ConditionError(f"operator {e.op} is not allowed in a rule condition", _col(e))
+            work.append(e.operand)
+            continue
+        if isinstance(e, N.Binary):
+            if e.op not in BOOL_OPS + COMPARISONS:
+                raise ConditionError(f"operator {e.op} is not allowed in a rule condition "
+                                     f"(allowed: NOT, {', '.join(BOOL_OPS + COMPARISONS)})", _col(e))
+            work.extend((e.left, e.right))
+            continue
+        what = {N.Call: "a function call", N.StrLit: "a string", N.EnumLit: "an enum constant",
+                N.Field: "a structure component", N.Aggregate: "an aggregate"}.get(type(e), type(e).__name__)
+        raise ConditionError(f"{what} is not allowed in a rule condition (only inputs, outputs, "
+                             f"SIGNAL names, constants and boolean/comparison operators)", _col(e))
+
+
+def _signal_index(e: N.Index) -> tuple[str, int]:
+    base = e.base.name.upper() if isinstance(e.base, N.Name) else ""
+    if base not in SIGNAL_ARRAYS:
+        raise ConditionError("only $IN[n], $OUT[n], $ANIN[n] and $ANOUT[n] may be indexed in a rule "
+                             "condition", _col(e))
+    if len(e.indices) != 1 or not isinstance(e.indices[0], N.IntLit):
+        raise ConditionError(f"{base}[...] needs one constant index in a rule condition", _col(e))
+    n = e.indices[0].value
+    if not 1 <= n <= SIGNAL_ARRAYS[base]:
+        raise ConditionError(f"{base}[{n}]: index outside 1..{SIGNAL_ARRAYS[base]}", _col(e))
+    return base, n
+
+
+def names_of(expr: N.Expr) -> list[str]:
+    """The signals a condition reads, in order: ``$IN[n]``-style and SIGNAL names (upper case)."""
+    out: list[str] = []
+    work = [expr]
+    while work:
+        e = work.pop()
+        if isinstance(e, N.Name):
+            out.append(e.name.upper())
+        elif isinstance(e, N.Index):
+            base, n = _signal_index(e)
+            out.append(f"{base}[{n}]")
+        elif isinstance(e, N.Unary):
+            work.append(e.operand)
+        elif isinstance(e, N.Binary):
+            work.extend((e.right, e.left))
+    return list(dict.fromkeys(out))
+
+
+# ------------------------------------------------------------------ evaluation on the AST
+def _reader(base: str, first: int, last: int | None) -> tuple[Eval, str]:
+    if base == "$ANIN":
+        return (lambda io: io.get_anin(first)), "REAL"
+    if base == "$ANOUT":
+        return (lambda io: io.get_anout(first)), "REAL"
+    get = "get_in" if base == "$IN" else "get_out"
+    if last is None:
+        return (lambda io: getattr(io, get)(first)), "BOOL"
+    bits = range(first, last + 1)
+
+    def group(io: IOImage) -> int:
+        g = getattr(io, get)
+        return sum(1 << i for i, n in enumerate(bits) if g(n))
+    return group, "INT"
+
+
+def compile_condition(expr: N.Expr, lookup: Lookup) -> Eval:
+    """A function of the I/O image giving the condition's BOOL value, built once from the AST.
+
+    `lookup(NAME)` resolves a SIGNAL name to ``(base, first, last)`` (interp/run.py
+    ``signal_of``). Raises :class:`ConditionError` for an unknown name, or operands of the
+    wrong type (``AND`` of an INT, a comparison of BOOL and REAL, a condition that is not BOOL)."""
+    fn, typ = _compile(expr, lookup)
+    if typ != "BOOL":
+        raise ConditionError(f"the condition is {typ}, not BOOL", _col(expr))
+    return fn
+
+
+def _compile(e: N.Expr, lookup: Lookup) -> tuple[Eval, str]:
+    if isinstance(e, N.BoolLit):
+        v = bool(e.value)
+        return (lambda io: v), "BOOL"
+    if isinstance(e, N.IntLit):
+        i = int(e.value)
+        return (lambda io: i), "INT"
+    if isinstance(e, N.RealLit):
+        r = float(e.value)
+        return (lambda io: r), "REAL"
+    if isinstance(e, N.Index):
+        base, n = _signal_index(e)
+        return _reader(base, n, None)
+    if isinstance(e, N.Name):
+        found = lookup(e.name.upper())
+        if found is None:
+            raise ConditionError(f"unknown signal {e.name.upper()} (neither $IN/$OUT/$ANIN/$ANOUT[n] nor "
+                                 f"a SIGNAL declared in $config.dat, the machine data or the program's "
+                                 f"data list)", _col(e))
+        base, first, last = found
+        if base not in SIGNAL_ARRAYS:
+            raise ConditionError(f"{e.name.upper()} is a SIGNAL on {base}, not on an input or output", _col(e))
+        return _reader(base, first, last)
+    if isinstance(e, N.Unary):
+        f, t = _compile(e.operand, lookup)
+        if e.op == "NOT":
+            if t != "BOOL":
+                raise ConditionError(f"NOT needs a BOOL operand, not {t}", _col(e))
+            return (lambda io: not f(io)), "BOOL"
+        if t == "BOOL":
+            raise ConditionError(f"{e.op} needs a number, not BOOL", _col(e))
+        return ((lambda io: -f(io)) if e.op == "-" else f), t
+    if isinstance(e, N.Binary):
+        fl, tl = _compile(e.left, lookup)
+        fr, tr = _compile(e.right, lookup)
+        if e.op in BOOL_OPS:
+            if tl != "BOOL" or tr != "BOOL":
+                raise ConditionError(f"{e.op} needs BOOL operands, not {tl} and {tr}", _col(e))
+            if e.op == "AND":
+                return (lambda io: fl(io) and fr(io)), "BOOL"
+            if e.op == "OR":
+                return (lambda io: fl(io) or fr(io)), "BOOL"
+            return (lambda io: bool(fl(io)) != bool(fr(io))), "BOOL"
+        if (tl == "BOOL") != (tr == "BOOL") or (tl == "BOOL" and e.op not in ("==", "<>")):
+            raise ConditionError(f"{e.op} cannot compare {tl} with {tr}", _col(e))
+        op = e.op
+        if op == "==":
+            return (lambda io: fl(io) == fr(io)), "BOOL"
+        if op == "<>":
+            return (lambda io: fl(io) != fr(io)), "BOOL"
+        if op == "<":
+            return (lambda io: fl(io) < fr(io)), "BOOL"
+        if op == ">":
+            return (lambda io: fl(io) > fr(io)), "BOOL"
+        if op == "<=":
+            return (lambda io: fl(io) <= fr(io)), "BOOL"
+        return (lambda io: fl(io) >= fr(io)), "BOOL"
+    raise ConditionError("not allowed in a rule condition", _col(e))   # check_subset ran first
+
+
+@dataclass
+class Rule:
+    """One reactive rule. ``when``: the condition's AST; ``text``: its source text (for
+    messages); ``after``: delay in s; ``set``: signal -> value (``$IN[n]``/``$ANIN[n]``, or a
+    SIGNAL name until the run resolves it); ``where``: ``file:line`` of the rule; ``source``:
+    the I/O event source its changes carry (``cell``; a preset names itself)."""
+
+    when: N.Expr
+    text: str
+    set: dict[str, Any]
+    after: float = 0.0
+    where: str = ""
+    source: str = "cell"
+    condition: Eval | None = field(default=None, repr=False)
+    last: bool = field(default=False, repr=False)
+    due: list[float] = field(default_factory=list, repr=False)
+    fired: int = field(default=0, repr=False)
+    last_fired: float | None = field(default=None, repr=False)   # s, the last answer written
+
+    def holds(self, io: IOImage) -> bool:
+        """The condition's value now (False before the run resolved it)."""
+        return bool(self.condition(io)) if self.condition is not None else False
+
+
+def step_rules(rules: list[Rule], io: IOImage, t: float, dt: float) -> None:
+    """One IPO cycle of the cell (Controller.step, after the timed stimuli): first every answer
+    that is due at `t` is written, then every condition is evaluated; a rising edge schedules
+    the rule's values for ``max(t + after, t + dt)`` (s)."""
+    eps = 1e-9
+    for r in rules:
+        while r.due and t >= r.due[0] - eps:
+            r.due.pop(0)
+            r.fired += 1
+            r.last_fired = t
+            for name, v in r.set.items():
+                io.set_signal(name, v, r.source)
+    for r in rules:
+        now = r.holds(io)
+        if now and not r.last:
+            r.due.append(t + max(r.after, dt))
+        r.last = now
+
+
+def rules_may_fire(rules: list[Rule], io: IOImage) -> bool:
+    """True if a rule has an answer pending, or its condition rose since the last cycle (it
+    will fire in the next one) — the cell may still change an input."""
+    return any(r.due or (not r.last and r.holds(io)) for r in rules)
+
