@@ -111,3 +111,13 @@ MAX_STIMULI = 100_000
 # has 8192 elements) and a few hundred MB of Python at most. Past it: the run-time error "data
 # memory exhausted" at the DECL line, before anything is allocated (interp/runtime/memory.py).
 MAX_DATA_ELEMENTS = 1 << 20
+
+# The backup diff (`krl diff`, krl/diff): the statement lines shown before and after for one
+# changed routine (each side; the count of the rest is given), and the routines, points and
+# other entries listed in one report. Past them: the report says how many were left out.
+MAX_DIFF_LINES = 200
+MAX_DIFF_ENTRIES = 20_000
+
+# The program map (`krl graph`, krl/programmap): the largest map rendered through Graphviz
+# (DOT/SVG) and the HTML page, in nodes. Past it: an error naming the count (JSON has no limit).
+MAX_GRAPH_NODES = 5000

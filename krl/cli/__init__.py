@@ -29,6 +29,7 @@ SUBCOMMAND_MODULES = (
     "conformance.cli",     # conformance
     "krl.fmt.cli",         # fmt
     "krl.lsp.cli",         # lsp
+    "krl.cli.changes",     # diff, graph, report
 )
 
 

@@ -1,0 +1,75 @@
+"""`krl diff OLD NEW`, `krl graph BACKUP` and `krl report BACKUP [--since OLD]` (issue 26):
+what changed between two backups (krl/diff), the program map (krl/programmap), and one HTML
+page with both and the check summary. Registered by krl/cli/__init__.py.
+
+Exit status of ``krl diff``: 0 no change, 1 changes, 2 error (a path that does not exist, a
+refused archive: the messages of ``krl check``, E001 and E004; files with syntax errors are
+listed as not compared and their errors printed on standard error). ``krl graph`` and
+``krl report``: 0, or 2 for an error. Never a traceback for bad input.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+
+import click
+
+from krl.terminal import printable
+
+
+def _fail(command: str, exc: Exception) -> None:
+    click.echo(f"krl {command}: {printable(exc)}", err=True)
+    sys.exit(2)
+
+
+def _write(text: str, output: str | None) -> None:
+    if output is None:
+        click.echo(text)
+    else:
+        Path(output).write_text(text + ("" if text.endswith("\n") else "\n"), encoding="utf-8")
+
+
+def _echo_errors(errors) -> None:
+    from krl.diagnostics.render import Renderer  # noqa: PLC0415
+
+    Renderer(lambda s: click.echo(s, err=True), False).emit(errors)
+
+
+@click.command()
+@click.argument("old")
+@click.argument("new")
+@click.option("--format", "fmt", type=click.Choice(["text", "json", "html"]), default="text", show_default=True,
+              help="text; json: one object (docs/diff.md); html: one page.")
+@click.option("--tolerance", type=click.FloatRange(min=0), default=0.0, show_default=True,
+              help="Hide point and frame deltas up to this size (mm or deg).")
+@click.option("-o", "--output", default=None, help="Write to this file instead of standard output.")
+def diff(old: str, new: str, fmt: str, tolerance: float, output: str | None) -> None:
+    """What changed between two KRC backups (folders or .zip) or two files: points, frames and
+    loads, routines, declarations and signals, inline-form motions. Exit 0 no change, 1
+    changes, 2 error."""
+    from krl.diff.core import diff_sides  # noqa: PLC0415
+    from krl.diff.load import DiffInputError, side  # noqa: PLC0415
+    from krl.diff.text import diff_html, diff_text  # noqa: PLC0415
+
+    single = Path(old).is_file() and Path(new).is_file() and not any(
+        p.lower().endswith(".zip") for p in (old, new))
+    try:
+        with side(old, single) as a, side(new, single) as b:
+            _echo_errors(a.errors + b.errors)
+            d = diff_sides(a, b, tolerance)
+    except DiffInputError as exc:
+        _fail("diff", exc)
+    except Exception as exc:  # noqa: BLE001 - a last line of defence: no traceback
+        _fail("diff", RuntimeError(f"internal error: {type(exc).__name__}: {exc}"))
+    if fmt == "json":
+        _write(json.dumps(d.as_json(), indent=2, ensure_ascii=False), output)
+    elif fmt == "html":
+        _write(diff_html(d), output)
+    else:
+        _write("\n".join(diff_text(d)), output)
+    sys.exit(1 if d.changed else 0)
+
+
+commands = [diff]
