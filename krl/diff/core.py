@@ -38,7 +38,7 @@ __all__ = ["Diff", "diff_sides"]
 
 FRAME_ARRAYS = ("TOOL_DATA", "BASE_DATA", "LOAD_DATA")
 _MOTION_DATA = ("PDAT_ACT", "LDAT_ACT", "FDAT_ACT")
-_MOTION_PARAMS = {"TOOL_NO": "tool", "BASE_NO": "base", "VEL": "velocity"}
+_MOTION_PARAMS = {"TOOL_NO": "tool", "BASE_NO": "base"}   # the BAS call gives "velocity"
 
 
 @dataclass
@@ -154,6 +154,7 @@ def _data(d: Diff, show: str, dlo: N.DataList | None, dln: N.DataList | None, to
         if kind is None:
             st = {c: [a.get(c), b.get(c)] for c in ("S", "T") if a.get(c) != b.get(c)}
             other = {c: v for c, v in other.items() if c not in ("S", "T")}
+            delta = {c: v for c, v in delta.items() if c not in ("S", "T")}
             if delta or st or other:
                 entry = {"file": show, "name": key, "kind": typ, "change": "changed", "delta": delta,
                          "status_turn_changed": bool(st)}
