@@ -72,4 +72,62 @@ def diff(old: str, new: str, fmt: str, tolerance: float, output: str | None) -> 
     sys.exit(1 if d.changed else 0)
 
 
-commands = [diff]
+def load_map(path: str):
+    """The program map of the backup (folder or .zip) or file at `path`, with paths shown as
+    the user names them; raises ValueError with the message of ``krl check`` for bad input."""
+    from dataclasses import replace  # noqa: PLC0415
+
+    from krl.archive import ArchiveError, backup_source  # noqa: PLC0415
+    from krl.limits import PARSE_TIMEOUT_S  # noqa: PLC0415
+    from krl.programmap import build_map  # noqa: PLC0415
+    from krl.workspace import workspaces_for  # noqa: PLC0415
+
+    p = Path(path)
+    if not p.exists() and not p.is_symlink():
+        raise ValueError(f"{path}:1:1: error[E001]: no such file or folder")
+    try:
+        with backup_source(p) as (folder, shown):
+            wss = workspaces_for(folder if shown.archive else p, timeout=PARSE_TIMEOUT_S)
+            if len(wss) != 1:
+                raise ValueError(f"{path} holds {len(wss)} programs (KRC backups or folders); name one of them")
+            ws = wss[0]
+            pm = build_map(ws)
+            diags = [shown.diagnostic(d) for d in ws.diagnostics]
+            pm.root = shown(pm.root)
+            for n in pm.nodes.values():
+                n.path = shown(n.path) if n.path else n.path
+            pm.edges = [replace(e, path=shown(e.path)) for e in pm.edges]
+            pm.unresolved = [(s, n, shown(f), ln) for s, n, f, ln in pm.unresolved]
+            return pm, diags, len(ws.files)
+    except ArchiveError as exc:
+        raise ValueError(f"{path}:1:1: error[E004]: {str(exc).removeprefix(f'{path}: ')}") from None
+
+
+@click.command()
+@click.argument("backup")
+@click.option("--format", "fmt", type=click.Choice(["dot", "svg", "html", "json"]), default="dot", show_default=True,
+              help="dot: Graphviz source; svg: drawn by Graphviz's dot; html: one page; json: nodes and edges.")
+@click.option("-o", "--output", default=None, help="Write to this file instead of standard output.")
+def graph(backup: str, fmt: str, output: str | None) -> None:
+    """The program map of a KRC backup (folder or .zip) or a folder: routines, calls,
+    interrupts, triggers, RUN commands and EKI channels, entry points and dead routines."""
+    from krl.programmap.render import GraphTooLarge, GraphvizMissing, to_dot, to_html, to_svg  # noqa: PLC0415
+
+    try:
+        pm, _diags, _n = load_map(backup)
+        if fmt == "json":
+            text = json.dumps(pm.as_json(), indent=2, ensure_ascii=False)
+        elif fmt == "svg":
+            text = to_svg(pm)
+        elif fmt == "html":
+            text = to_html(pm)
+        else:
+            text = to_dot(pm)
+    except (ValueError, GraphTooLarge, GraphvizMissing) as exc:
+        _fail("graph", exc)
+    except Exception as exc:  # noqa: BLE001 - a last line of defence: no traceback
+        _fail("graph", RuntimeError(f"internal error: {type(exc).__name__}: {exc}"))
+    _write(text, output)
+
+
+commands = [diff, graph]
