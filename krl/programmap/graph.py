@@ -56,12 +56,13 @@ class Node:
 
 @dataclass(frozen=True)
 class Edge:
-    """From routine `source` to `target` (node ids); `path`:`line` of the statement."""
+    """From routine `source` to `target` (node ids); `path`:`line`:`column` of the called name."""
     source: str
     target: str
     kind: str
     path: str
     line: int
+    column: int = 0
 
 
 @dataclass
@@ -96,7 +97,7 @@ class ProgramMap:
             "nodes": [{"id": n.id, "name": n.name, "module": n.module, "kind": n.kind, "path": n.path,
                        "line": n.line, "entry": n.entry, "dead": n.dead} for n in self.nodes.values()],
             "edges": [{"source": e.source, "target": e.target, "kind": e.kind, "path": e.path,
-                       "line": e.line} for e in self.edges],
+                       "line": e.line, "column": e.column} for e in self.edges],
             "entries": list(self.entries),
             "dead": [n.id for n in self.dead],
             "unresolved": [{"source": s, "name": n, "path": p, "line": ln} for s, n, p, ln in self.unresolved],
@@ -165,7 +166,7 @@ def _edges(pm: ProgramMap, ws: Workspace, src: str, r: N.Routine, path: str, mai
                 continue
             target = _target(pm, ws, sym)
             if target is not None:
-                pm.edges.append(Edge(src, target, kinds.get(id(node), "call"), path, line))
+                pm.edges.append(Edge(src, target, kinds.get(id(node), "call"), path, line, node.span.column))
             elif sym.decl is None:
                 _builtin(pm, src, node, path, mains)
         elif isinstance(node, N.Name):
@@ -173,7 +174,7 @@ def _edges(pm: ProgramMap, ws: Workspace, src: str, r: N.Routine, path: str, mai
             if sym is not None and sym.kind == "routine":
                 target = _target(pm, ws, sym)
                 if target is not None:
-                    pm.edges.append(Edge(src, target, "call", path, node.span.line))
+                    pm.edges.append(Edge(src, target, "call", path, node.span.line, node.span.column))
 
 
 def _builtin(pm: ProgramMap, src: str, call: N.Call, path: str, mains: dict) -> None:
@@ -184,12 +185,12 @@ def _builtin(pm: ProgramMap, src: str, call: N.Call, path: str, mains: dict) -> 
         cid = f"EKI:{args[0].value}"
         if cid not in pm.nodes:
             pm.nodes[cid] = Node(cid, args[0].value, "EKI", kind="channel")
-        pm.edges.append(Edge(src, cid, "eki", path, call.span.line))
+        pm.edges.append(Edge(src, cid, "eki", path, call.span.line, call.span.column))
     elif name == "CWRITE" and args and isinstance(args[0], N.Name) and args[0].name.upper() == "$CMD":
         for a in args[1:]:
             m = _RUN.match(a.value) if isinstance(a, N.StrLit) else None
             if m is not None and m.group(1).upper() in mains:
-                pm.edges.append(Edge(src, mains[m.group(1).upper()], "run", path, call.span.line))
+                pm.edges.append(Edge(src, mains[m.group(1).upper()], "run", path, call.span.line, call.span.column))
 
 
 def _strings(e) -> list[str]:
