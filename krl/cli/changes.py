@@ -130,4 +130,37 @@ def graph(backup: str, fmt: str, output: str | None) -> None:
     _write(text, output)
 
 
-commands = [diff, graph]
+@click.command()
+@click.argument("backup")
+@click.option("--since", "since", default=None, help="An older backup (folder or .zip): add what changed since it.")
+@click.option("-o", "--output", default=None, help="Write the HTML page to this file instead of standard output.")
+def report(backup: str, since: str | None, output: str | None) -> None:
+    """One HTML page for a change request: the check summary of BACKUP, its program map and,
+    with --since OLD, the diff from OLD to BACKUP."""
+    from krl.diff.core import diff_sides  # noqa: PLC0415
+    from krl.diff.load import DiffInputError, side  # noqa: PLC0415
+    from krl.diff.report import report_html  # noqa: PLC0415
+    from krl.programmap.render import GraphTooLarge, GraphvizMissing, to_svg  # noqa: PLC0415
+
+    try:
+        pm, diags, n_files = load_map(backup)
+        try:
+            svg = to_svg(pm)
+        except GraphvizMissing as exc:
+            click.echo(f"krl report: {exc}; the page has no drawing", err=True)
+            svg = ""
+        d = None
+        if since is not None:
+            with side(since) as a, side(backup) as b:
+                d = diff_sides(a, b)
+        text = report_html(backup, n_files, diags, pm, svg, d)
+    except DiffInputError as exc:
+        _fail("report", exc)
+    except (ValueError, GraphTooLarge) as exc:
+        _fail("report", exc)
+    except Exception as exc:  # noqa: BLE001 - a last line of defence: no traceback
+        _fail("report", RuntimeError(f"internal error: {type(exc).__name__}: {exc}"))
+    _write(text, output)
+
+
+commands = [diff, graph, report]
