@@ -120,3 +120,21 @@ def test_corpus_backups_have_an_edge_for_every_call_the_checker_resolves(shared_
             if e.kind == "call":
                 text = Path(e.path).read_text(encoding="latin-1").splitlines()[e.line - 1]
                 assert pm.nodes[e.target].name.upper() in text.upper(), (b, e)
+
+
+@pytest.mark.may_skip("graphviz's dot is missing and cannot be installed (not root, or apt-get has no network)")
+def test_svg_drawn_by_graphviz(fixture_map):
+    import xml.etree.ElementTree as ET  # noqa: PLC0415
+
+    from krl.programmap.render import to_svg  # noqa: PLC0415
+    from tests.apt import apt_install  # noqa: PLC0415
+
+    if apt_install("graphviz", "dot") is None:
+        pytest.skip("graphviz's dot is not installed and cannot be installed with apt-get")
+    svg = ET.fromstring(to_svg(fixture_map))
+    ns = {"s": "http://www.w3.org/2000/svg"}
+    groups = svg.findall(".//s:g", ns)
+    assert sum(g.get("class") == "node" for g in groups) == 13       # 12 routines + the EKI channel
+    assert sum(g.get("class") == "edge" for g in groups) == 9
+    texts = {t.text for t in svg.findall(".//s:text", ns)}
+    assert {"helper_fct", "EKI ChannelA", "interrupt", "trigger", "RUN"} <= texts
