@@ -82,29 +82,27 @@ def _ranges(an: Analysis, edges, codec) -> list[L.Range]:
     return out
 
 
+def _grouped(an: Analysis, edges, other: str, uri_of, codec) -> list[tuple[L.CallHierarchyItem, list[L.Range]]]:
+    """(item of the routine at the `other` end, ranges of the calls) per routine, in edge order."""
+    pm = program_map(an)
+    by_node: dict[str, list] = {}
+    for e in edges:
+        by_node.setdefault(getattr(e, other), []).append(e)
+    out = []
+    for nid, group in by_node.items():
+        it = item(an, pm, nid, uri_of, codec)
+        if it is not None:
+            out.append((it, _ranges(an, group, codec)))
+    return out
+
+
 def incoming(an: Analysis, node_id: str, uri_of, codec=None) -> list[L.CallHierarchyIncomingCall]:
     """The routines that call, declare an interrupt handled by, trigger or RUN `node_id`."""
-    pm = program_map(an)
-    by_source: dict[str, list] = {}
-    for e in pm.incoming(node_id):
-        by_source.setdefault(e.source, []).append(e)
-    out = []
-    for src, edges in by_source.items():
-        it = item(an, pm, src, uri_of, codec)
-        if it is not None:
-            out.append(L.CallHierarchyIncomingCall(from_=it, from_ranges=_ranges(an, edges, codec)))
-    return out
+    return [L.CallHierarchyIncomingCall(from_=it, from_ranges=ranges)
+            for it, ranges in _grouped(an, program_map(an).incoming(node_id), "source", uri_of, codec)]
 
 
 def outgoing(an: Analysis, node_id: str, uri_of, codec=None) -> list[L.CallHierarchyOutgoingCall]:
     """The routines `node_id` calls (and its interrupt handlers, TRIGGER and RUN targets)."""
-    pm = program_map(an)
-    by_target: dict[str, list] = {}
-    for e in pm.outgoing(node_id):
-        by_target.setdefault(e.target, []).append(e)
-    out = []
-    for dst, edges in by_target.items():
-        it = item(an, pm, dst, uri_of, codec)
-        if it is not None:
-            out.append(L.CallHierarchyOutgoingCall(to=it, from_ranges=_ranges(an, edges, codec)))
-    return out
+    return [L.CallHierarchyOutgoingCall(to=it, from_ranges=ranges)
+            for it, ranges in _grouped(an, program_map(an).outgoing(node_id), "target", uri_of, codec)]

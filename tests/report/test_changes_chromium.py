@@ -6,14 +6,13 @@ markup from a backup (a file name, a KRL string) stays inert text."""
 from __future__ import annotations
 
 import shutil
-import tempfile
 from pathlib import Path
 
 import pytest
 from click.testing import CliRunner
 
 from krl.cli import main
-from tests.report.test_report_chromium import FLAGS
+from tests.report.test_report_chromium import loaded_page
 
 FIXTURE = Path(__file__).parents[1] / "programmap" / "fixtures" / "KRC"
 IMG = "<img src=x onerror=window.pwned=1>"
@@ -56,22 +55,10 @@ def pages(tmp_path_factory) -> dict[str, Path]:
 
 
 def _open(pw, chromium, page_path: Path, check):
-    with tempfile.TemporaryDirectory() as profile:
-        ctx = pw.chromium.launch_persistent_context(profile, executable_path=chromium, headless=True, args=FLAGS[1:])
-        try:
-            page = ctx.new_page()
-            problems: list[str] = []
-            page.on("console", lambda m: problems.append(f"{m.type}: {m.text}") if m.type in ("error", "warning") else None)
-            page.on("pageerror", lambda e: problems.append(f"page error: {e}"))
-            page.on("requestfailed", lambda r: problems.append(f"request failed: {r.url}"))
-            page.goto(page_path.as_uri())
-            page.wait_for_load_state("load")
-            assert problems == []
-            assert page.evaluate("document.querySelectorAll('script').length") == 0
-            assert page.evaluate("window.pwned === undefined")
-            check(page)
-        finally:
-            ctx.close()
+    with loaded_page(pw, chromium, page_path) as page:
+        assert page.evaluate("document.querySelectorAll('script').length") == 0
+        assert page.evaluate("window.pwned === undefined")
+        check(page)
 
 
 @pytest.mark.may_skip("chromium or graphviz is missing and cannot be installed (not root, or apt-get has no network)")
