@@ -4,7 +4,8 @@ page with both and the check summary. Registered by krl/cli/__init__.py.
 
 Exit status of ``krl diff``: 0 no change, 1 changes, 2 error (a path that does not exist, a
 refused archive: the messages of ``krl check``, E001 and E004; files with syntax errors are
-listed as not compared and their errors printed on standard error). ``krl graph`` and
+listed as not compared and their errors printed on standard error: without other changes the
+exit status is then 2, since "no change" cannot be said). ``krl graph`` and
 ``krl report``: 0, or 2 for an error. Never a traceback for bad input.
 """
 
@@ -31,10 +32,15 @@ def _write(text: str, output: str | None) -> None:
         Path(output).write_text(text + ("" if text.endswith("\n") else "\n"), encoding="utf-8")
 
 
-def _echo_errors(errors) -> None:
+def _echo_errors(sides) -> None:
+    """The input and syntax errors of the sides, on standard error as krl check prints them."""
     from krl.diagnostics.render import Renderer  # noqa: PLC0415
 
-    Renderer(lambda s: click.echo(s, err=True), False).emit(errors)
+    renderer = Renderer(lambda s: click.echo(s, err=True), False)
+    for s in sides:
+        for path, text in s.sources.items():
+            renderer.sources.add(path, text)
+        renderer.emit(s.errors)
 
 
 @click.command()
@@ -57,7 +63,7 @@ def diff(old: str, new: str, fmt: str, tolerance: float, output: str | None) -> 
         p.lower().endswith(".zip") for p in (old, new))
     try:
         with side(old, single) as a, side(new, single) as b:
-            _echo_errors(a.errors + b.errors)
+            _echo_errors((a, b))
             d = diff_sides(a, b, tolerance)
     except DiffInputError as exc:
         _fail("diff", exc)
@@ -69,7 +75,8 @@ def diff(old: str, new: str, fmt: str, tolerance: float, output: str | None) -> 
         _write(diff_html(d), output)
     else:
         _write("\n".join(diff_text(d)), output)
-    sys.exit(1 if d.changed else 0)
+    # files not compared (syntax errors): "no change" cannot be said
+    sys.exit(1 if d.changed else 2 if d.not_compared else 0)
 
 
 def load_map(path: str):

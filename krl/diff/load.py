@@ -5,7 +5,8 @@ limits and the same messages).
 ``with side(path) as s``: ``s.files`` maps a file's key (its path relative to the backup root,
 ``/``-separated, lower-case; for a single file, ``""``) to its :class:`krl.workspace.SourceFile`;
 ``s.shown(key)`` is how the user names it (``backup.zip/R1/Program/a.src``); ``s.errors`` the
-input and syntax errors (:class:`krl.diagnostics.Diagnostic`). An extracted archive is removed
+input and syntax errors (:class:`krl.diagnostics.Diagnostic`, paths as shown; ``s.sources`` the
+text of an archive's files that have errors, by shown path, for the caret lines). An extracted archive is removed
 when the block ends. Raises :class:`DiffInputError` for a path that does not exist or a refused
 archive (the message names the path, as ``krl check`` does: E001, E004).
 """
@@ -45,6 +46,7 @@ class Side:
     files: dict[str, SourceFile] = field(default_factory=dict)
     errors: list[Diagnostic] = field(default_factory=list)
     shown_of: object = None
+    sources: dict[str, str] = field(default_factory=dict)     # shown path -> text, for the errors
     _lines: dict[str, list[str]] = field(default_factory=dict)
 
     def shown(self, key: str) -> str:
@@ -91,7 +93,10 @@ def side(path: str | Path, single: bool | None = None) -> Iterator[Side]:
             for f in ws.files:
                 key = "" if is_file else _key(f.path, root)
                 s.files[key] = f
-            s.errors = [shown.diagnostic(d) for d in ws.sink.sorted() if d.is_error]
+            errors = [d for d in ws.sink.sorted() if d.is_error]
+            for real in {d.path for d in errors} if shown.archive else ():
+                s.sources[shown(real)] = read_source(real).text or ""
+            s.errors = [shown.diagnostic(d) for d in errors]
             yield s
     except ArchiveError as exc:
         raise DiffInputError(Diagnostic(str(path), 1, 1, "E004",

@@ -74,7 +74,7 @@ def diff_text(d: Diff) -> list[str]:
         out.append(f"not compared (syntax errors): {p(f)}")
     if d.left_out:
         out.append(f"... {d.left_out} more entries left out (limit MAX_DIFF_ENTRIES)")
-    summary = "no change" if not d.changed else ", ".join(
+    summary = ("no change" + (" in the files compared" if d.not_compared else "")) if not d.changed else ", ".join(
         f"{len(getattr(d, k))} {k}" for k in ("points", "frames", "routines", "declarations", "motions")
         if getattr(d, k))
     out.append(f"{p(d.old)} -> {p(d.new)}: {summary}; {d.comment_edits} comment and "

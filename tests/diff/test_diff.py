@@ -207,3 +207,23 @@ def test_cli_json_matches_the_schema_and_exit_status(tmp_path):
     r = CliRunner().invoke(main, ["diff", str(bad), str(a)])
     assert r.exit_code == 2 and "error[E004]" in r.output and "not a readable zip archive" in r.output
     assert "Traceback" not in r.output
+
+
+def test_a_file_with_syntax_errors_is_not_compared_and_named(tmp_path):
+    a, b = tmp_path / "a", tmp_path / "b"
+    for d in (a, b):
+        d.mkdir()
+        (d / "z.src").write_text("DEF z()\nEND\n")
+    (a / "x.src").write_text("DEF x()\nEND\n")
+    (b / "x.src").write_text("DEF x()\n  y = \nEND\n")
+    archive = tmp_path / "b.zip"
+    with zipfile.ZipFile(archive, "w") as zf:
+        for p in sorted(b.iterdir()):
+            zf.write(p, p.name)
+    r = CliRunner().invoke(main, ["diff", str(a), str(archive)])
+    assert r.exit_code == 2, r.output
+    assert f"not compared (syntax errors): {archive}/x.src" in r.output
+    # the syntax error as krl check prints it, with the archive's path, the line and a caret
+    assert f"{archive}/x.src:2:7: error[E012]: an expression is missing here" in r.output
+    assert " 2 |   y =" in r.output and "Traceback" not in r.output
+    assert "no change in the files compared" in r.output
