@@ -32,15 +32,16 @@ def _write(text: str, output: str | None) -> None:
         Path(output).write_text(text + ("" if text.endswith("\n") else "\n"), encoding="utf-8")
 
 
-def _echo_errors(sides) -> None:
-    """The input and syntax errors of the sides, on standard error as krl check prints them."""
+def _echo_errors(sides, paths) -> None:
+    """The input and syntax errors of the sides' files `paths` (shown paths), on standard error
+    as krl check prints them."""
     from krl.diagnostics.render import Renderer  # noqa: PLC0415
 
     renderer = Renderer(lambda s: click.echo(s, err=True), False)
     for s in sides:
         for path, text in s.sources.items():
             renderer.sources.add(path, text)
-        renderer.emit(s.errors)
+        renderer.emit([d for d in s.errors if d.path in paths])
 
 
 @click.command()
@@ -63,8 +64,8 @@ def diff(old: str, new: str, fmt: str, tolerance: float, output: str | None) -> 
         p.lower().endswith(".zip") for p in (old, new))
     try:
         with side(old, single) as a, side(new, single) as b:
-            _echo_errors((a, b))
             d = diff_sides(a, b, tolerance)
+            _echo_errors((a, b), set(d.not_compared))
     except DiffInputError as exc:
         _fail("diff", exc)
     except Exception as exc:  # noqa: BLE001 - a last line of defence: no traceback

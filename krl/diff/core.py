@@ -70,14 +70,17 @@ class Diff:
 
 
 def diff_sides(old: Side, new: Side, tolerance: float = 0.0) -> Diff:
-    """Compare two loaded sides; `tolerance` (mm or deg) hides smaller deltas. Files that did
-    not parse on either side are listed in ``not_compared`` (their errors are the sides')."""
+    """Compare two loaded sides; `tolerance` (mm or deg) hides smaller deltas. A file that did
+    not parse on either side is unchanged when its text is the same on both, else listed in
+    ``not_compared`` (its errors are the sides')."""
     d = Diff(old.path, new.path)
     keys = sorted(set(old.files) | set(new.files))
     ok_keys = []
     for k in keys:
         fo, fn = old.files.get(k), new.files.get(k)
         if (fo is not None and not fo.ok) or (fn is not None and not fn.ok):
+            if fo is not None and fn is not None and old.text(k) is not None and old.text(k) == new.text(k):
+                continue        # the same text on both sides: unchanged, though it does not parse
             d.not_compared.append(new.shown(k) if fn is not None else old.shown(k))
         else:
             ok_keys.append(k)

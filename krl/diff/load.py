@@ -64,6 +64,11 @@ class Side:
         except ValueError:
             return Path(f.path).name
 
+    def text(self, key: str) -> str | None:
+        """The decoded text of the file of `key` (krl.source.read_source), None if unreadable."""
+        f = self.files.get(key)
+        return read_source(f.path).text if f is not None else None
+
     def line(self, path: str, number: int) -> str:
         """Line `number` (1-based) of the file `path`, without its end ("" past the end)."""
         lines = self._lines.get(path)

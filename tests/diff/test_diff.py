@@ -227,3 +227,12 @@ def test_a_file_with_syntax_errors_is_not_compared_and_named(tmp_path):
     assert f"{archive}/x.src:2:7: error[E012]: an expression is missing here" in r.output
     assert " 2 |   y =" in r.output and "Traceback" not in r.output
     assert "no change in the files compared" in r.output
+
+
+def test_corpus_backup_with_unparsed_files_against_itself_is_no_change(shared_corpus):
+    # two of this backup's files do not parse (kuka_internals.src, sample_program.src): the same
+    # text on both sides is no change
+    b = shared_corpus / "rawpython__kukaKRLmagic"
+    r = CliRunner().invoke(main, ["diff", str(b), str(b)])
+    assert r.exit_code == 0, r.output
+    assert "not compared" not in r.output and ": no change;" in r.output
