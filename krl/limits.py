@@ -123,6 +123,7 @@ MAX_MOTION_HISTORY = 10_000
 MAX_DAP_MESSAGE_BYTES = 1024 * 1024
 MAX_DAP_BREAKPOINTS = 1000
 MAX_DAP_REPLAY_STEPS = 10_000_000
+
 # Reactive rules of a cell file (`rules:` in a stimuli file, robot/cellrules.py): the most rules
 # in one file (a PLC program answering a cell has tens of handshakes, a few hundred at most) and
 # the most tokens in one rule's `when` expression (one line of KRL; real conditions have under
@@ -130,3 +131,13 @@ MAX_DAP_REPLAY_STEPS = 10_000_000
 # the file:line of the rule; the run does not start.
 MAX_CELL_RULES = 1000
 MAX_RULE_TOKENS = 200
+
+# The backup diff (`krl diff`, krl/diff): the statement lines shown before and after for one
+# changed routine (each side; the count of the rest is given), and the routines, points and
+# other entries listed in one report. Past them: the report says how many were left out.
+MAX_DIFF_LINES = 200
+MAX_DIFF_ENTRIES = 20_000
+
+# The program map (`krl graph`, krl/programmap): the largest map rendered through Graphviz
+# (DOT/SVG) and the HTML page, in nodes. Past it: an error naming the count (JSON has no limit).
+MAX_GRAPH_NODES = 5000

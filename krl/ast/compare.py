@@ -8,6 +8,9 @@ formatter check needs:
   case-insensitive (reference 1.1) and the formatter may change keyword case. Names of
   variables, routines, components and string contents still compare exactly: identifiers
   cannot spell a reserved word, and :class:`~krl.ast.nodes.StrLit` values are never folded;
+* with ``fold_case=True`` (the backup diff, krl/diff), every name compares case-insensitively
+  too: ``Count`` and ``COUNT`` are one variable (reference 1.1); string contents
+  (:class:`~krl.ast.nodes.StrLit`) still compare exactly;
 * :func:`first_difference` names the path of the first differing field, for test messages.
 """
 
@@ -31,9 +34,10 @@ def _keywords() -> frozenset[str]:
 _KW: frozenset[str] | None = None
 
 
-def structure(node, fold_keywords: bool = False):
+def structure(node, fold_keywords: bool = False, fold_case: bool = False):
     """A nested tuple of the node's compared fields (no spans, no annotations); iterative,
-    so deep trees do not hit the recursion limit."""
+    so deep trees do not hit the recursion limit. `fold_case`: every string outside a
+    StrLit upper-case (names, keywords, approximation words)."""
     global _KW
     if fold_keywords and _KW is None:
         _KW = _keywords()
@@ -43,6 +47,8 @@ def structure(node, fold_keywords: bool = False):
     work: list = [(node, False, None)]
     while work:
         item, done, meta = work.pop()
+        if fold_case and isinstance(item, str) and meta != "keep":
+            item = item.upper()
         if done:
             kind, n = meta
             vals = [out_stack.pop() for _ in range(n)][::-1]
@@ -52,11 +58,12 @@ def structure(node, fold_keywords: bool = False):
             fields = [f for f in dataclasses.fields(item) if f.compare]
             work.append((None, True, (type(item).__name__, len(fields))))
             fold = fold_keywords and not isinstance(item, N.StrLit)
+            keep = "keep" if isinstance(item, N.StrLit) else None
             for f in reversed(fields):
                 v = getattr(item, f.name)
                 if fold and isinstance(v, str) and v.upper() in kw:
                     v = v.upper()
-                work.append((v, False, None))
+                work.append((v, False, keep))
         elif isinstance(item, (list, tuple)):
             work.append((None, True, (None, len(item))))
             for v in reversed(item):
@@ -66,12 +73,12 @@ def structure(node, fold_keywords: bool = False):
     return out_stack[0]
 
 
-def same_tree(a, b, fold_keywords: bool = False) -> bool:
+def same_tree(a, b, fold_keywords: bool = False, fold_case: bool = False) -> bool:
     """True when the two ASTs are equal without positions (and, with `fold_keywords`, up to
-    the case of reserved words)."""
-    if not fold_keywords:
+    the case of reserved words; with `fold_case`, up to the case of every name)."""
+    if not (fold_keywords or fold_case):
         return a == b
-    return structure(a, True) == structure(b, True)
+    return structure(a, fold_keywords, fold_case) == structure(b, fold_keywords, fold_case)
 
 
 def first_difference(a, b, fold_keywords: bool = False) -> str | None:

@@ -30,6 +30,7 @@ SUBCOMMAND_MODULES = (
     "krl.fmt.cli",         # fmt
     "krl.lsp.cli",         # lsp
     "interp.debug.cli",    # debug
+    "krl.cli.changes",     # diff, graph, report
 )
 
 

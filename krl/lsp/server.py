@@ -335,6 +335,8 @@ def create_server() -> KrlLanguageServer:
             return None
         return L.CompletionList(is_incomplete=False, items=_complete.complete(an, path, line, col))
 
+    _register_calls(server, place, uri_of)
+
     fmt = formatter()
     if fmt is not None:
         @server.feature(L.TEXT_DOCUMENT_FORMATTING)
@@ -354,6 +356,33 @@ def create_server() -> KrlLanguageServer:
             return [L.TextEdit(range=L.Range(start=L.Position(line=0, character=0), end=end), new_text=new)]
 
     return server
+
+
+def _register_calls(server: KrlLanguageServer, place, uri_of) -> None:
+    """Call hierarchy from the program map (krl/lsp/calls.py)."""
+    from krl.lsp import calls as _calls  # noqa: PLC0415
+
+    @server.feature(L.TEXT_DOCUMENT_PREPARE_CALL_HIERARCHY)
+    @guarded(list)
+    async def prepare_call_hierarchy(ls: KrlLanguageServer, params: L.CallHierarchyPrepareParams):
+        an, path, line, col = await place(ls, params.text_document, params.position)
+        return _calls.prepare(an, path, line, col, uri_of, ls.codec()) if an is not None else []
+
+    async def item_analysis(ls: KrlLanguageServer, it: L.CallHierarchyItem):
+        an = await ls.fresh(path_of(it.uri))
+        return (an, str(it.data)) if an is not None and it.data else (None, "")
+
+    @server.feature(L.CALL_HIERARCHY_INCOMING_CALLS)
+    @guarded(list)
+    async def incoming_calls(ls: KrlLanguageServer, params: L.CallHierarchyIncomingCallsParams):
+        an, nid = await item_analysis(ls, params.item)
+        return _calls.incoming(an, nid, uri_of, ls.codec()) if an is not None else []
+
+    @server.feature(L.CALL_HIERARCHY_OUTGOING_CALLS)
+    @guarded(list)
+    async def outgoing_calls(ls: KrlLanguageServer, params: L.CallHierarchyOutgoingCallsParams):
+        an, nid = await item_analysis(ls, params.item)
+        return _calls.outgoing(an, nid, uri_of, ls.codec()) if an is not None else []
 
 
 def serve(log_file: str | None = None) -> None:

@@ -4,6 +4,7 @@ elements are there, and markup from the corpus stays inert (issue 12)."""
 from __future__ import annotations
 
 import tempfile
+from contextlib import contextmanager
 from pathlib import Path
 
 import pytest
@@ -43,10 +44,11 @@ def report(tmp_path_factory) -> Path:
     return out / "report.html"
 
 
-@pytest.mark.may_skip("chromium is missing and cannot be installed (not root, or apt-get has no network)")
-def test_report_renders_in_headless_chromium(chromium, report):
-    import playwright.sync_api as playwright  # a dev dependency: missing is a failure, not a skip
-    with playwright.sync_playwright() as pw, tempfile.TemporaryDirectory() as profile:
+@contextmanager
+def loaded_page(pw, chromium: str, path: Path):
+    """A page of a fresh headless Chromium profile with `path` loaded, after checking that
+    loading it logged no console error or warning, no page error and no failed request."""
+    with tempfile.TemporaryDirectory() as profile:
         ctx = pw.chromium.launch_persistent_context(profile, executable_path=chromium, headless=True,
                                                     args=FLAGS[1:])
         try:
@@ -55,29 +57,36 @@ def test_report_renders_in_headless_chromium(chromium, report):
             page.on("console", lambda m: problems.append(f"{m.type}: {m.text}") if m.type in ("error", "warning") else None)
             page.on("pageerror", lambda e: problems.append(f"page error: {e}"))
             page.on("requestfailed", lambda r: problems.append(f"request failed: {r.url}"))
-            page.goto(report.as_uri())
+            page.goto(path.as_uri())
             page.wait_for_load_state("load")
             assert problems == []
-            assert page.title() == "KRL grammar recovery report"
-            assert page.locator("h1").inner_text() == "Grammar recovery report"
-            assert page.locator("table#summary tr").count() == 3
-            # one ranked construct (IF, 2 files), shown with its line shape and example links
-            cards = page.locator("#missing ~ section.cluster")
-            assert page.locator("section.cluster").count() == 2          # IF ranked + TODO known-invalid
-            first = cards.first.inner_text()
-            assert "IF — 2 files, 2 occurrences" in first and "Line shape: IF ‹name› =" in first
-            assert page.locator("a.example").count() == 3
-            # the chart loaded and has a size
-            assert page.evaluate("document.getElementById('chart').naturalWidth") > 500
-            assert page.locator("#known-invalid").count() == 1 and page.locator("#internal").count() == 1
-            assert "deep/i.src" in page.locator("#internal ~ table").first.inner_text()
-            # the static-check Markdown is a real table
-            assert page.locator("#static-check table tr").count() == 2
-            # markup from the corpus is text: no script element, nothing ran
-            assert page.evaluate("document.querySelectorAll('script').length") == 0
-            assert page.evaluate("window.pwned === undefined")
-            assert PWNED in page.locator("#missing ~ section.cluster").first.inner_text()
-            page.screenshot(path=str(report.with_name("report.png")), full_page=True)
+            yield page
         finally:
             ctx.close()
+
+
+@pytest.mark.may_skip("chromium is missing and cannot be installed (not root, or apt-get has no network)")
+def test_report_renders_in_headless_chromium(chromium, report):
+    import playwright.sync_api as playwright  # a dev dependency: missing is a failure, not a skip
+    with playwright.sync_playwright() as pw, loaded_page(pw, chromium, report) as page:
+        assert page.title() == "KRL grammar recovery report"
+        assert page.locator("h1").inner_text() == "Grammar recovery report"
+        assert page.locator("table#summary tr").count() == 3
+        # one ranked construct (IF, 2 files), shown with its line shape and example links
+        cards = page.locator("#missing ~ section.cluster")
+        assert page.locator("section.cluster").count() == 2          # IF ranked + TODO known-invalid
+        first = cards.first.inner_text()
+        assert "IF — 2 files, 2 occurrences" in first and "Line shape: IF ‹name› =" in first
+        assert page.locator("a.example").count() == 3
+        # the chart loaded and has a size
+        assert page.evaluate("document.getElementById('chart').naturalWidth") > 500
+        assert page.locator("#known-invalid").count() == 1 and page.locator("#internal").count() == 1
+        assert "deep/i.src" in page.locator("#internal ~ table").first.inner_text()
+        # the static-check Markdown is a real table
+        assert page.locator("#static-check table tr").count() == 2
+        # markup from the corpus is text: no script element, nothing ran
+        assert page.evaluate("document.querySelectorAll('script').length") == 0
+        assert page.evaluate("window.pwned === undefined")
+        assert PWNED in page.locator("#missing ~ section.cluster").first.inner_text()
+        page.screenshot(path=str(report.with_name("report.png")), full_page=True)
     assert report.with_name("report.png").stat().st_size > 10_000

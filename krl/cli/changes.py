@@ -1,0 +1,174 @@
+"""`krl diff OLD NEW`, `krl graph BACKUP` and `krl report BACKUP [--since OLD]` (issue 26):
+what changed between two backups (krl/diff), the program map (krl/programmap), and one HTML
+page with both and the check summary. Registered by krl/cli/__init__.py.
+
+Exit status of ``krl diff``: 0 no change, 1 changes, 2 error (a path that does not exist, a
+refused archive: the messages of ``krl check``, E001 and E004; files with syntax errors are
+listed as not compared and their errors printed on standard error: without other changes the
+exit status is then 2, since "no change" cannot be said). ``krl graph`` and
+``krl report``: 0, or 2 for an error. Never a traceback for bad input.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+
+import click
+
+from krl.terminal import printable
+
+
+def _fail(command: str, exc: Exception) -> None:
+    click.echo(f"krl {command}: {printable(exc)}", err=True)
+    sys.exit(2)
+
+
+def _write(text: str, output: str | None) -> None:
+    if output is None:
+        click.echo(text)
+    else:
+        Path(output).write_text(text + ("" if text.endswith("\n") else "\n"), encoding="utf-8")
+
+
+def _echo_errors(sides, paths) -> None:
+    """The input and syntax errors of the sides' files `paths` (shown paths), on standard error
+    as krl check prints them."""
+    from krl.diagnostics.render import Renderer  # noqa: PLC0415
+
+    renderer = Renderer(lambda s: click.echo(s, err=True), False)
+    for s in sides:
+        for path, text in s.sources.items():
+            renderer.sources.add(path, text)
+        renderer.emit([d for d in s.errors if d.path in paths])
+
+
+@click.command()
+@click.argument("old")
+@click.argument("new")
+@click.option("--format", "fmt", type=click.Choice(["text", "json", "html"]), default="text", show_default=True,
+              help="text; json: one object (docs/diff.md); html: one page.")
+@click.option("--tolerance", type=click.FloatRange(min=0), default=0.0, show_default=True,
+              help="Hide point and frame deltas up to this size (mm or deg).")
+@click.option("-o", "--output", default=None, help="Write to this file instead of standard output.")
+def diff(old: str, new: str, fmt: str, tolerance: float, output: str | None) -> None:
+    """What changed between two KRC backups (folders or .zip) or two files: points, frames and
+    loads, routines, declarations and signals, inline-form motions. Exit 0 no change, 1
+    changes, 2 error."""
+    from krl.diff.core import diff_sides  # noqa: PLC0415
+    from krl.diff.load import DiffInputError, side  # noqa: PLC0415
+    from krl.diff.text import diff_html, diff_text  # noqa: PLC0415
+
+    single = Path(old).is_file() and Path(new).is_file() and not any(
+        p.lower().endswith(".zip") for p in (old, new))
+    try:
+        with side(old, single) as a, side(new, single) as b:
+            d = diff_sides(a, b, tolerance)
+            _echo_errors((a, b), set(d.not_compared))
+    except DiffInputError as exc:
+        _fail("diff", exc)
+    except Exception as exc:  # noqa: BLE001 - a last line of defence: no traceback
+        _fail("diff", RuntimeError(f"internal error: {type(exc).__name__}: {exc}"))
+    if fmt == "json":
+        _write(json.dumps(d.as_json(), indent=2, ensure_ascii=False), output)
+    elif fmt == "html":
+        _write(diff_html(d), output)
+    else:
+        _write("\n".join(diff_text(d)), output)
+    # files not compared (syntax errors): "no change" cannot be said
+    sys.exit(1 if d.changed else 2 if d.not_compared else 0)
+
+
+def load_map(path: str):
+    """The program map of the backup (folder or .zip) or file at `path`, with paths shown as
+    the user names them; raises ValueError with the message of ``krl check`` for bad input."""
+    from dataclasses import replace  # noqa: PLC0415
+
+    from krl.archive import ArchiveError, backup_source  # noqa: PLC0415
+    from krl.limits import PARSE_TIMEOUT_S  # noqa: PLC0415
+    from krl.programmap import build_map  # noqa: PLC0415
+    from krl.workspace import workspaces_for  # noqa: PLC0415
+
+    p = Path(path)
+    if not p.exists() and not p.is_symlink():
+        raise ValueError(f"{path}:1:1: error[E001]: no such file or folder")
+    try:
+        with backup_source(p) as (folder, shown):
+            wss = workspaces_for(folder if shown.archive else p, timeout=PARSE_TIMEOUT_S)
+            if len(wss) != 1:
+                raise ValueError(f"{path} holds {len(wss)} programs (KRC backups or folders); name one of them")
+            ws = wss[0]
+            pm = build_map(ws)
+            diags = [shown.diagnostic(d) for d in ws.diagnostics]
+            pm.root = shown(pm.root)
+            for n in pm.nodes.values():
+                n.path = shown(n.path) if n.path else n.path
+            pm.edges = [replace(e, path=shown(e.path)) for e in pm.edges]
+            pm.unresolved = [(s, n, shown(f), ln) for s, n, f, ln in pm.unresolved]
+            return pm, diags, len(ws.files)
+    except ArchiveError as exc:
+        raise ValueError(f"{path}:1:1: error[E004]: {str(exc).removeprefix(f'{path}: ')}") from None
+
+
+@click.command()
+@click.argument("backup")
+@click.option("--format", "fmt", type=click.Choice(["dot", "svg", "html", "json"]), default="dot", show_default=True,
+              help="dot: Graphviz source; svg: drawn by Graphviz's dot; html: one page; json: nodes and edges.")
+@click.option("-o", "--output", default=None, help="Write to this file instead of standard output.")
+def graph(backup: str, fmt: str, output: str | None) -> None:
+    """The program map of a KRC backup (folder or .zip) or a folder: routines, calls,
+    interrupts, triggers, RUN commands and EKI channels, entry points and dead routines."""
+    from krl.programmap.render import GraphTooLarge, GraphvizMissing, to_dot, to_html, to_svg  # noqa: PLC0415
+
+    try:
+        pm, _diags, _n = load_map(backup)
+        if fmt == "json":
+            text = json.dumps(pm.as_json(), indent=2, ensure_ascii=False)
+        elif fmt == "svg":
+            text = to_svg(pm)
+        elif fmt == "html":
+            text = to_html(pm)
+        else:
+            text = to_dot(pm)
+    except (ValueError, GraphTooLarge, GraphvizMissing) as exc:
+        _fail("graph", exc)
+    except Exception as exc:  # noqa: BLE001 - a last line of defence: no traceback
+        _fail("graph", RuntimeError(f"internal error: {type(exc).__name__}: {exc}"))
+    _write(text, output)
+
+
+@click.command()
+@click.argument("backup")
+@click.option("--since", "since", default=None, help="An older backup (folder or .zip): add what changed since it.")
+@click.option("-o", "--output", default=None, help="Write the HTML page to this file instead of standard output.")
+def report(backup: str, since: str | None, output: str | None) -> None:
+    """One HTML page for a change request: the check summary of BACKUP, its program map and,
+    with --since OLD, the diff from OLD to BACKUP."""
+    from krl.diff.core import diff_sides  # noqa: PLC0415
+    from krl.diff.load import DiffInputError, side  # noqa: PLC0415
+    from krl.diff.report import report_html  # noqa: PLC0415
+    from krl.programmap.render import GraphTooLarge, GraphvizMissing, to_svg  # noqa: PLC0415
+
+    try:
+        pm, diags, n_files = load_map(backup)
+        try:
+            svg = to_svg(pm)
+        except GraphvizMissing as exc:
+            click.echo(f"krl report: {exc}; the page has no drawing", err=True)
+            svg = ""
+        d = None
+        if since is not None:
+            with side(since) as a, side(backup) as b:
+                d = diff_sides(a, b)
+        text = report_html(backup, n_files, diags, pm, svg, d)
+    except DiffInputError as exc:
+        _fail("report", exc)
+    except (ValueError, GraphTooLarge) as exc:
+        _fail("report", exc)
+    except Exception as exc:  # noqa: BLE001 - a last line of defence: no traceback
+        _fail("report", RuntimeError(f"internal error: {type(exc).__name__}: {exc}"))
+    _write(text, output)
+
+
+commands = [diff, graph, report]

@@ -1,0 +1,115 @@
+"""One side of a diff: a backup folder, a backup ``.zip`` or a single file, read the way
+``krl check`` reads it (krl/archive.py for archives, krl/workspace.py for the files; the same
+limits and the same messages).
+
+``with side(path) as s``: ``s.files`` maps a file's key (its path relative to the backup root,
+``/``-separated, lower-case; for a single file, ``""``) to its :class:`krl.workspace.SourceFile`;
+``s.shown(key)`` is how the user names it (``backup.zip/R1/Program/a.src``); ``s.errors`` the
+input and syntax errors (:class:`krl.diagnostics.Diagnostic`, paths as shown; ``s.sources`` the
+text of an archive's files that have errors, by shown path, for the caret lines). An extracted archive is removed
+when the block ends. Raises :class:`DiffInputError` for a path that does not exist or a refused
+archive (the message names the path, as ``krl check`` does: E001, E004).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from krl.archive import ArchiveError, backup_source
+from krl.diagnostics import Diagnostic
+from krl.limits import PARSE_TIMEOUT_S
+from krl.project import find_backups
+from krl.source import read_source
+from krl.workspace import SourceFile, Workspace, load_workspace
+
+__all__ = ["DiffInputError", "Side", "side"]
+
+
+class DiffInputError(ValueError):
+    """An input that cannot be compared; ``diagnostic`` says why (E001, E004)."""
+
+    def __init__(self, diagnostic: Diagnostic):
+        super().__init__(f"{diagnostic.path}:{diagnostic.line}:{diagnostic.column}: "
+                         f"error[{diagnostic.code}]: {diagnostic.message}")
+        self.diagnostic = diagnostic
+
+
+@dataclass
+class Side:
+    """One loaded side (see the module docstring)."""
+    path: str
+    root: Path
+    workspace: Workspace
+    files: dict[str, SourceFile] = field(default_factory=dict)
+    errors: list[Diagnostic] = field(default_factory=list)
+    shown_of: object = None
+    sources: dict[str, str] = field(default_factory=dict)     # shown path -> text, for the errors
+    _lines: dict[str, list[str]] = field(default_factory=dict)
+
+    def shown(self, key: str) -> str:
+        """The file of `key` as the user names it."""
+        f = self.files.get(key)
+        return self.shown_of(f.path) if f is not None else key
+
+    def rel(self, key: str) -> str:
+        """The file of `key` relative to the backup root, in its own letter case."""
+        f = self.files.get(key)
+        if f is None:
+            return key
+        try:
+            return Path(f.path).relative_to(self.root).as_posix()
+        except ValueError:
+            return Path(f.path).name
+
+    def text(self, key: str) -> str | None:
+        """The decoded text of the file of `key` (krl.source.read_source), None if unreadable."""
+        f = self.files.get(key)
+        return read_source(f.path).text if f is not None else None
+
+    def line(self, path: str, number: int) -> str:
+        """Line `number` (1-based) of the file `path`, without its end ("" past the end)."""
+        lines = self._lines.get(path)
+        if lines is None:
+            lines = self._lines[path] = (read_source(path).text or "").splitlines()
+        return lines[number - 1].strip() if 0 < number <= len(lines) else ""
+
+
+@contextmanager
+def side(path: str | Path, single: bool | None = None) -> Iterator[Side]:
+    """Load `path` (see the module docstring). `single`: treat it as one file (default: when
+    it is a file other than a .zip)."""
+    p = Path(path)
+    if not p.exists() and not p.is_symlink():
+        raise DiffInputError(Diagnostic(str(p), 1, 1, "E001", "no such file or folder"))
+    try:
+        with backup_source(p) as (folder, shown):
+            is_file = not folder.is_dir() if single is None else single
+            if is_file:
+                ws = load_workspace([folder], str(folder), timeout=PARSE_TIMEOUT_S)
+                root = folder.parent
+            else:
+                backups = find_backups(folder)
+                root = backups[0] if len(backups) == 1 else folder
+                ws = load_workspace([root], str(root), timeout=PARSE_TIMEOUT_S)
+            s = Side(str(path), root, ws, shown_of=shown)
+            for f in ws.files:
+                key = "" if is_file else _key(f.path, root)
+                s.files[key] = f
+            errors = [d for d in ws.sink.sorted() if d.is_error]
+            for real in {d.path for d in errors} if shown.archive else ():
+                s.sources[shown(real)] = read_source(real).text or ""
+            s.errors = [shown.diagnostic(d) for d in errors]
+            yield s
+    except ArchiveError as exc:
+        raise DiffInputError(Diagnostic(str(path), 1, 1, "E004",
+                                        str(exc).removeprefix(f"{path}: "))) from None
+
+
+def _key(path: str, root: Path) -> str:
+    try:
+        return Path(path).relative_to(root).as_posix().lower()
+    except ValueError:
+        return Path(path).name.lower()

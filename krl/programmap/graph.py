@@ -1,0 +1,243 @@
+"""The program map of a checked workspace: routines, what calls what, entry points, dead code.
+
+:func:`build_map` reads a :class:`krl.workspace.Workspace` after ``ws.check()``. Every edge
+comes from the checker's annotations (``node.ann.symbol``, krl/semantics/checker.py), never
+from the text: a call whose name the checker did not resolve is listed in ``unresolved``, not
+drawn. Edge kinds:
+
+* ``call`` -- a procedure or function call (reference 2.3), also a parameterless function
+  named without parentheses; an EXT declaration leads to the routine it declares;
+* ``interrupt`` -- ``INTERRUPT DECL n WHEN ... DO handler()`` (5.16): from the routine that
+  declares the interrupt to its handler;
+* ``trigger`` -- ``TRIGGER WHEN ... DO routine()`` (5.18);
+* ``run`` -- ``CWRITE($CMD, ..., "RUN /R1/NAME()")`` (KUKA CWRITE, ``$CMD`` channel): the
+  program it starts;
+* ``eki`` -- ``EKI_Init("name")``, ``EKI_Open("name")``... (KUKA.Ethernet KRL): to a channel
+  node ``EKI name``.
+
+Entry points: the cell program (module ``CELL``), every submit interpreter (``.sub`` file:
+``sps.sub``), every program a system data list (``$config.dat``, ``$custom.dat``,
+``$option.dat``) names as ``"/R1/NAME()"`` (``$PRO_I_O``, ``$PRO_I_O_PROC_IDn``), the
+main routines of KUKA's own files (krl.workspace.is_kuka_file: the controller calls them),
+and, for a folder that is not a KRC backup (no ``$config.dat``), the main routine of every
+module. A routine that no entry point reaches along the edges is dead.
+"""
+
+from __future__ import annotations
+
+import re
+from collections import deque
+from dataclasses import dataclass, field
+
+from krl.ast import nodes as N
+from krl.workspace import Workspace, is_kuka_file
+
+__all__ = ["Node", "Edge", "ProgramMap", "build_map", "routine_id"]
+
+_RUN = re.compile(r"^\s*RUN\s+(?:/R1/)?([A-Za-z_$][A-Za-z0-9_$]*)\s*\(", re.I)
+_SELECTED = re.compile(r"^\s*/R1/([A-Za-z_$][A-Za-z0-9_$]*)\s*\(", re.I)
+
+
+@dataclass
+class Node:
+    """A routine (kind ``routine``) or an EKI channel (kind ``channel``). ``path``/``line``:
+    where it is declared (1-based); ``entry``: why it is an entry point, else ""."""
+    id: str
+    name: str
+    module: str = ""
+    path: str = ""
+    line: int = 0
+    kind: str = "routine"
+    entry: str = ""
+    dead: bool = False
+    kuka: bool = False
+    main: bool = False
+
+
+@dataclass(frozen=True)
+class Edge:
+    """From routine `source` to `target` (node ids); `path`:`line`:`column` of the called name."""
+    source: str
+    target: str
+    kind: str
+    path: str
+    line: int
+    column: int = 0
+
+
+@dataclass
+class ProgramMap:
+    """Nodes by id, edges in source order, entry node ids, and the calls the checker left
+    unresolved: (source id, name, path, line)."""
+    root: str
+    nodes: dict[str, Node] = field(default_factory=dict)
+    edges: list[Edge] = field(default_factory=list)
+    entries: list[str] = field(default_factory=list)
+    unresolved: list[tuple[str, str, str, int]] = field(default_factory=list)
+
+    def node_of(self, routine: N.Routine) -> Node | None:
+        """The node of a Routine of the workspace."""
+        return self.nodes.get(self._by_decl.get(id(routine), ""))
+
+    def outgoing(self, node_id: str) -> list[Edge]:
+        return [e for e in self.edges if e.source == node_id]
+
+    def incoming(self, node_id: str) -> list[Edge]:
+        return [e for e in self.edges if e.target == node_id]
+
+    @property
+    def dead(self) -> list[Node]:
+        return [n for n in self.nodes.values() if n.dead]
+
+    def as_json(self) -> dict:
+        """``{"root", "nodes": [...], "edges": [...], "entries": [...], "dead": [...],
+        "unresolved": [...]}`` (docs/diff.md, "krl graph")."""
+        return {
+            "root": self.root,
+            "nodes": [{"id": n.id, "name": n.name, "module": n.module, "kind": n.kind, "path": n.path,
+                       "line": n.line, "entry": n.entry, "dead": n.dead} for n in self.nodes.values()],
+            "edges": [{"source": e.source, "target": e.target, "kind": e.kind, "path": e.path,
+                       "line": e.line, "column": e.column} for e in self.edges],
+            "entries": list(self.entries),
+            "dead": [n.id for n in self.dead],
+            "unresolved": [{"source": s, "name": n, "path": p, "line": ln} for s, n, p, ln in self.unresolved],
+        }
+
+    _by_decl: dict = field(default_factory=dict, repr=False)
+
+
+def routine_id(module: str, name: str) -> str:
+    """The node id of routine `name` of `module`: ``MODULE:NAME``, upper-case."""
+    return f"{module.upper()}:{name.upper()}"
+
+
+def build_map(ws: Workspace) -> ProgramMap:
+    """The program map of `ws` (checked here if it is not yet; see the module docstring)."""
+    ws.check()
+    pm = ProgramMap(ws.root)
+    mains: dict[str, str] = {}            # MODULE -> node id of its main routine
+    for u in ws.units:
+        if u.src is None:
+            continue
+        kuka = is_kuka_file(u.src.path)
+        for i, r in enumerate(u.src.module.routines):
+            nid = routine_id(u.name, r.name)
+            if nid in pm.nodes:
+                continue                   # a duplicate routine (E102): the first one stands
+            pm.nodes[nid] = Node(nid, r.name, u.name, u.src.path, r.span.line, kuka=kuka, main=i == 0)
+            pm._by_decl[id(r)] = nid
+            if i == 0:
+                mains[u.name.upper()] = nid
+    for u in ws.units:
+        if u.src is None or not u.src.ok:
+            continue
+        for r in u.src.module.routines:
+            src = pm._by_decl.get(id(r))
+            if src is not None:
+                _edges(pm, ws, src, r, u.src.path, mains)
+    _entries(pm, ws, mains)
+    _mark_dead(pm)
+    return pm
+
+
+def _target(pm: ProgramMap, ws: Workspace, sym) -> str | None:
+    decl = sym.decl if sym is not None else None
+    if not isinstance(decl, N.Routine) and sym is not None and ws.global_scope is not None:
+        g = ws.global_scope.routines.get(sym.name.upper())     # EXT x() -> the GLOBAL DEF x
+        if g is not None and isinstance(g.decl, N.Routine):
+            decl = g.decl
+    return pm._by_decl.get(id(decl)) if isinstance(decl, N.Routine) else None
+
+
+def _edges(pm: ProgramMap, ws: Workspace, src: str, r: N.Routine, path: str, mains: dict) -> None:
+    kinds: dict[int, str] = {}
+    for node in r.walk():
+        if isinstance(node, N.InterruptDecl) and node.brake is None:
+            kinds[id(node.call)] = "interrupt"
+        elif isinstance(node, N.Trigger) and isinstance(node.action, N.CallStmt):
+            kinds[id(node.action.call)] = "trigger"
+    for node in r.walk():
+        if isinstance(node, N.Call):
+            sym = N.symbol_of(node)
+            line = node.span.line
+            if sym is None:
+                if node.name.upper() not in ("BRAKE", "BRAKE_F"):
+                    pm.unresolved.append((src, node.name, path, line))
+                continue
+            target = _target(pm, ws, sym)
+            if target is not None:
+                pm.edges.append(Edge(src, target, kinds.get(id(node), "call"), path, line, node.span.column))
+            elif sym.decl is None:
+                _builtin(pm, src, node, path, mains)
+        elif isinstance(node, N.Name):
+            sym = N.symbol_of(node)
+            if sym is not None and sym.kind == "routine":
+                target = _target(pm, ws, sym)
+                if target is not None:
+                    pm.edges.append(Edge(src, target, "call", path, node.span.line, node.span.column))
+
+
+def _builtin(pm: ProgramMap, src: str, call: N.Call, path: str, mains: dict) -> None:
+    """EKI channel and CWRITE RUN edges of a built-in call."""
+    name = call.name.upper()
+    args = [a for a in call.args if a is not None]
+    if name.startswith("EKI_") and args and isinstance(args[0], N.StrLit):
+        cid = f"EKI:{args[0].value}"
+        if cid not in pm.nodes:
+            pm.nodes[cid] = Node(cid, args[0].value, "EKI", kind="channel")
+        pm.edges.append(Edge(src, cid, "eki", path, call.span.line, call.span.column))
+    elif name == "CWRITE" and args and isinstance(args[0], N.Name) and args[0].name.upper() == "$CMD":
+        for a in args[1:]:
+            m = _RUN.match(a.value) if isinstance(a, N.StrLit) else None
+            if m is not None and m.group(1).upper() in mains:
+                pm.edges.append(Edge(src, mains[m.group(1).upper()], "run", path, call.span.line, call.span.column))
+
+
+def _strings(e) -> list[str]:
+    if e is None:
+        return []
+    return [n.value for n in e.walk() if isinstance(n, N.StrLit)]
+
+
+def _entries(pm: ProgramMap, ws: Workspace, mains: dict) -> None:
+    def add(nid: str | None, why: str) -> None:
+        if nid is not None and nid in pm.nodes and not pm.nodes[nid].entry:
+            pm.nodes[nid].entry = why
+            pm.entries.append(nid)
+
+    backup = any(f.path.replace("\\", "/").lower().endswith("$config.dat") for f in ws.files)
+    add(mains.get("CELL"), "cell program")
+    for nid, n in pm.nodes.items():
+        if n.main and n.name.upper() == "CELL":
+            add(nid, "cell program")         # DEF CELL() in a file of another name
+    for u in ws.units:
+        if u.src is not None and u.src.path.lower().endswith(".sub"):
+            add(mains.get(u.name.upper()), "submit interpreter")
+    for u in ws.units:
+        dl = u.dat.module.data if u.dat is not None else None
+        if dl is None or not dl.name.startswith("$"):
+            continue
+        for d in dl.items:
+            value = d.init if isinstance(d, N.VarDecl) else d.value if isinstance(d, N.ArrayInit) else None
+            for s in _strings(value):
+                m = _SELECTED.match(s)
+                if m is not None:
+                    add(mains.get(m.group(1).upper()), f"selected by {dl.name.lower()}.dat")
+    for nid, n in pm.nodes.items():
+        if n.kind == "routine" and n.main and (n.kuka or not backup):
+            add(nid, "KUKA system program" if n.kuka else "main routine of a module")
+
+
+def _mark_dead(pm: ProgramMap) -> None:
+    out: dict[str, list[str]] = {}
+    for e in pm.edges:
+        out.setdefault(e.source, []).append(e.target)
+    seen = set(pm.entries)
+    todo = deque(pm.entries)
+    while todo:
+        for t in out.get(todo.popleft(), ()):
+            if t not in seen:
+                seen.add(t)
+                todo.append(t)
+    for nid, n in pm.nodes.items():
+        n.dead = n.kind == "routine" and nid not in seen

@@ -1,0 +1,238 @@
+"""krl diff on pairs made from a corpus backup by scripted edits (issue 26).
+
+The base is the Palletizer backup of the shared corpus (a flat KRC4 export: System/$config.dat,
+Program/...), copied into a temporary folder; each test edits a copy with exact text
+replacements and expects exactly the scripted changes, every delta worked out by hand below.
+"""
+
+from __future__ import annotations
+
+import json
+import shutil
+import zipfile
+from contextlib import ExitStack
+from pathlib import Path
+
+import pytest
+from click.testing import CliRunner
+
+from krl.cli import main
+from krl.diff.core import diff_sides
+from krl.diff.load import DiffInputError, side
+
+BACKUP = "ingeniado__KRC4-Robot-Palletizer"
+M1_DAT = "Program/CAJA_G/caja_g_m1.dat"
+XC1 = ("DECL E6POS XC1={X 1070.0,Y -610.0,Z 500.0,A 87.0299988,B 0.189999998,C -180.0,S 2,T 43,"
+       "E1 0.0,E2 0.0,E3 0.0,E4 0.0,E5 0.0,E6 0.0}")
+XC2 = ("DECL E6POS XC2={X 1070.0,Y -375.0,Z 500.0,A 87.0299988,B 0.189999998,C -180.0,S 2,T 43,"
+       "E1 0.0,E2 0.0,E3 0.0,E4 0.0,E5 0.0,E6 0.0}")
+
+
+def edit(root: Path, rel: str, old: str, new: str, count: int = 1) -> None:
+    """Replace `old` by `new` in root/rel; the scripted text must occur exactly `count` times."""
+    p = root / rel
+    text = p.read_bytes().decode("latin-1")
+    assert text.count(old) == count, (rel, old, text.count(old))
+    p.write_bytes(text.replace(old, new).encode("latin-1"))
+
+
+@pytest.fixture(scope="module")
+def base(shared_corpus, tmp_path_factory) -> Path:
+    out = tmp_path_factory.mktemp("base") / "backup"
+    shutil.copytree(shared_corpus / BACKUP, out)
+    return out
+
+
+@pytest.fixture(scope="module")
+def old(base):
+    with ExitStack() as stack:
+        yield stack.enter_context(side(base))
+
+
+def copy_of(base: Path, tmp_path: Path) -> Path:
+    out = tmp_path / "new"
+    shutil.copytree(base, out)
+    return out
+
+
+def diff_to(old, path: Path, tolerance: float = 0.0):
+    with side(path) as new:
+        return diff_sides(old, new, tolerance)
+
+
+def no_change(d) -> None:
+    assert not d.changed, d.as_json()
+    assert (d.points, d.frames, d.routines, d.declarations, d.motions) == ([], [], [], [], [])
+
+
+def test_backup_against_itself_is_no_change(old, base):
+    d = diff_to(old, base)
+    no_change(d)
+    assert d.comment_edits == d.fold_edits == 0
+    assert d.not_compared == []
+
+
+def test_backup_against_its_fmt_output_is_no_change(old, base, tmp_path):
+    new = copy_of(base, tmp_path)
+    before = {p: p.read_bytes() for p in new.rglob("*") if p.is_file()}
+    r = CliRunner().invoke(main, ["fmt", "--keyword-case", "lower", "--indent", "2", str(new)])
+    assert r.exit_code in (0, 2), r.output
+    changed = [p for p, b in before.items() if p.read_bytes() != b]
+    assert len(changed) >= 20          # the formatter really rewrote the modules
+    d = diff_to(old, new)
+    no_change(d)
+    assert d.comment_edits == 0        # fmt keeps comments and folds
+    assert d.fold_edits == 0
+
+
+def test_retaught_points_report_their_deltas_and_nothing_else(old, base, tmp_path):
+    new = copy_of(base, tmp_path)
+    # XC1: X 1070.0 -> 1071.5 (+1.5 mm), Z 500.0 -> 498.0 (-2.0 mm)
+    edit(new, M1_DAT, XC1, XC1.replace("X 1070.0", "X 1071.5").replace("Z 500.0", "Z 498.0"))
+    # XC2: C -180.0 -> 179.0 is -1 deg (359 wrapped), status S 2 -> 6
+    edit(new, M1_DAT, XC2, XC2.replace("C -180.0", "C 179.0").replace("S 2", "S 6"))
+    d = diff_to(old, new)
+    assert d.points == [
+        {"file": M1_DAT, "name": "XC1", "kind": "E6POS", "change": "changed", "delta": {"X": 1.5, "Z": -2.0},
+         "status_turn_changed": False},
+        {"file": M1_DAT, "name": "XC2", "kind": "E6POS", "change": "changed", "delta": {"C": -1.0},
+         "status_turn_changed": True, "status_turn": {"S": [2, 6]}},
+    ]
+    assert (d.frames, d.routines, d.declarations, d.motions) == ([], [], [], [])
+    # a tolerance of 1.5 mm/deg hides the 1.5 and the 1.0, not the 2.0; the status stays flagged
+    d = diff_to(old, new, tolerance=1.5)
+    assert [(p["name"], p["delta"], p["status_turn_changed"]) for p in d.points] == [
+        ("XC1", {"Z": -2.0}, False), ("XC2", {}, True)]
+
+
+def test_changed_tool_data_is_a_frame_delta(old, base, tmp_path):
+    new = copy_of(base, tmp_path)
+    edit(new, "System/$config.dat", "TOOL_DATA[1]={X 0.0,Y 0.0,Z 775.0,A 0.0,B 0.0,C 0.0}",
+         "TOOL_DATA[1]={X 0.0,Y 0.0,Z 780.5,A 90.0,B 0.0,C 0.0}")
+    d = diff_to(old, new)
+    assert d.frames == [{"file": "System/$config.dat", "name": "TOOL_DATA[1]", "kind": "TOOL_DATA",
+                         "change": "changed", "delta": {"A": 90.0, "Z": 5.5}}]
+    assert (d.points, d.routines, d.declarations, d.motions) == ([], [], [], [])
+
+
+def test_renamed_routine_is_removed_added_and_its_callers_changed(old, base, tmp_path):
+    new = copy_of(base, tmp_path)
+    edit(new, "System/MsgLib.src", "CheckOfMsgOpt", "CheckMsgOptions", count=7)
+    d = diff_to(old, new)
+    got = [(r["change"], r["name"]) for r in d.routines]
+    # the five GLOBAL routines that call it (lines 75, 155, 238, 361, 577), then the rename
+    assert sorted(got) == sorted([("changed", "MsgNotify"), ("changed", "MsgQuit"), ("changed", "MsgState"),
+                                  ("changed", "MsgDialog"), ("changed", "MsgNotifyTextPar"),
+                                  ("added", "CheckMsgOptions"), ("removed", "CheckOfMsgOpt")])
+    calls = {75, 155, 238, 361, 577}
+    for r in d.routines:
+        assert r["module"] == "MsgLib" and r["file"] == "System/MsgLib.src"
+        if r["change"] == "changed":
+            assert [ln["text"] for ln in r["before"]] == ["MsgOpt=CheckOfMsgOpt(MsgOpt)"]
+            assert [ln["text"] for ln in r["after"]] == ["MsgOpt=CheckMsgOptions(MsgOpt)"]
+            assert r["before"][0]["line"] == r["after"][0]["line"]
+            calls.remove(r["after"][0]["line"])
+    assert calls == set()
+    assert (d.points, d.frames, d.declarations, d.motions) == ([], [], [], [])
+
+
+def test_zip_against_its_folder_is_no_change(old, base, tmp_path):
+    archive = tmp_path / "backup.zip"
+    with zipfile.ZipFile(archive, "w", zipfile.ZIP_DEFLATED) as zf:
+        for p in sorted(base.rglob("*")):
+            if p.is_file():
+                zf.write(p, p.relative_to(base).as_posix())
+    no_change(diff_to(old, archive))
+
+
+def test_comment_and_case_edits_are_counted_not_changes(tmp_path):
+    a = tmp_path / "a.src"
+    b = tmp_path / "b.src"
+    a.write_text("DEF a()\nINT n\n;FOLD init\nn = 1 ; one\n;ENDFOLD\nEND\n")
+    b.write_text("def A()\n  int N\n;FOLD init;%{PE} regenerated\n  N=1 ; uno\n;ENDFOLD\nend\n")
+    with side(a, True) as x, side(b, True) as y:
+        d = diff_sides(x, y)
+    no_change(d)
+    assert (d.comment_edits, d.fold_edits) == (1, 1)
+
+
+def test_declarations_signals_and_motions(tmp_path):
+    a, b = tmp_path / "old", tmp_path / "new"
+    for d in (a, b):
+        d.mkdir()
+    (a / "m.src").write_text(
+        "DEF m()\n;FOLD PTP P1 Vel=100 % PDAT1 Tool[1] Base[0]\nPDAT_ACT=PPDAT1\nFDAT_ACT=FP1\n"
+        "BAS(#PTP_PARAMS,100)\nPTP XP1 C_PTP\n;ENDFOLD\nEND\n")
+    (b / "m.src").write_text(
+        "DEF m()\n;FOLD PTP P1 Vel=50 % PDAT1 Tool[2] Base[0]\nPDAT_ACT=PPDAT1\nFDAT_ACT=FP1\n"
+        "BAS(#PTP_PARAMS,50)\nPTP XP1 C_PTP\n;ENDFOLD\nEND\n")
+    dat = ("DEFDAT m\nDECL E6POS XP1={X 1.0,Y 2.0,Z 3.0,A 0.0,B 0.0,C 0.0,S 2,T 2}\n"
+           "DECL FDAT FP1={TOOL_NO %d,BASE_NO 0,IPO_FRAME #BASE}\nDECL PDAT PPDAT1={VEL 100.0,ACC 100.0,APO_DIST 100.0}\n"
+           "%s\nENDDAT\n")
+    (a / "m.dat").write_text(dat % (1, "SIGNAL GRIP $OUT[1]\nDECL INT count\nDECL REAL gone"))
+    (b / "m.dat").write_text(dat % (2, "SIGNAL GRIP $OUT[2]\nDECL REAL count\nDECL BOOL fresh"))
+    with side(a) as x, side(b) as y:
+        d = diff_sides(x, y)
+    assert [(e["name"], e["kind"], e["change"], e["before"], e["after"]) for e in d.declarations] == [
+        ("fresh", "variable", "added", None, "BOOL"),
+        ("gone", "variable", "removed", "REAL", None),
+        ("GRIP", "signal", "retyped", "$OUT[1]", "$OUT[2]"),
+        ("count", "variable", "retyped", "INT", "REAL"),
+    ]
+    assert d.motions == [{"file": "m.src", "routine": "m", "motion": "PTP", "point": "XP1", "line": 6,
+                          "changed": {"tool": [1, 2], "velocity": [100, 50]}}]
+    assert [(r["name"], r["change"], [x["line"] for x in r["before"]]) for r in d.routines] == [("m", "changed", [5])]
+    assert d.points == [] and d.frames == []
+
+
+def test_cli_json_matches_the_schema_and_exit_status(tmp_path):
+    jsonschema = pytest.importorskip("jsonschema")   # a dev dependency (pyproject.toml)
+    a, b = tmp_path / "a.dat", tmp_path / "b.dat"
+    a.write_text("DEFDAT a\nDECL E6AXIS XHOME={A1 0.0,A2 -90.0,A3 90.0,A4 0.0,A5 0.0,A6 0.0,E1 0.0}\nENDDAT\n")
+    b.write_text("DEFDAT a\nDECL E6AXIS XHOME={A1 0.5,A2 -90.0,A3 90.0,A4 0.0,A5 -10.0,A6 0.0,E1 0.0}\nENDDAT\n")
+    r = CliRunner().invoke(main, ["diff", str(a), str(b), "--format", "json"])
+    assert r.exit_code == 1, r.output
+    doc = json.loads(r.output)
+    schema = json.loads((Path(__file__).parents[2] / "krl" / "diff" / "diff.schema.json").read_text())
+    jsonschema.validate(doc, schema)
+    assert doc["points"] == [{"file": "b.dat", "name": "XHOME", "kind": "E6AXIS", "change": "changed",
+                              "delta": {"A1": 0.5, "A5": -10.0}, "status_turn_changed": False}]
+    r = CliRunner().invoke(main, ["diff", str(a), str(a)])
+    assert r.exit_code == 0 and "no change" in r.output
+    r = CliRunner().invoke(main, ["diff", str(a), str(tmp_path / "missing")])
+    assert r.exit_code == 2
+    assert "missing:1:1: error[E001]: no such file or folder" in r.output
+    bad = tmp_path / "bad.zip"
+    bad.write_bytes(b"not a zip")
+    r = CliRunner().invoke(main, ["diff", str(bad), str(a)])
+    assert r.exit_code == 2 and "error[E004]" in r.output and "not a readable zip archive" in r.output
+    assert "Traceback" not in r.output
+
+
+def test_a_file_with_syntax_errors_is_not_compared_and_named(tmp_path):
+    a, b = tmp_path / "a", tmp_path / "b"
+    for d in (a, b):
+        d.mkdir()
+        (d / "z.src").write_text("DEF z()\nEND\n")
+    (a / "x.src").write_text("DEF x()\nEND\n")
+    (b / "x.src").write_text("DEF x()\n  y = \nEND\n")
+    archive = tmp_path / "b.zip"
+    with zipfile.ZipFile(archive, "w") as zf:
+        for p in sorted(b.iterdir()):
+            zf.write(p, p.name)
+    r = CliRunner().invoke(main, ["diff", str(a), str(archive)])
+    assert r.exit_code == 2, r.output
+    assert f"not compared (syntax errors): {archive}/x.src" in r.output
+    # the syntax error as krl check prints it, with the archive's path, the line and a caret
+    assert f"{archive}/x.src:2:7: error[E012]: an expression is missing here" in r.output
+    assert " 2 |   y =" in r.output and "Traceback" not in r.output
+    assert "no change in the files compared" in r.output
+
+
+def test_corpus_backup_with_unparsed_files_against_itself_is_no_change(shared_corpus):
+    # two of this backup's files do not parse (kuka_internals.src, sample_program.src): the same
+    # text on both sides is no change
+    b = shared_corpus / "rawpython__kukaKRLmagic"
+    r = CliRunner().invoke(main, ["diff", str(b), str(b)])
+    assert r.exit_code == 0, r.output
+    assert "not compared" not in r.output and ": no change;" in r.output
