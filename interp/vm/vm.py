@@ -161,11 +161,17 @@ class Bound:
 class VM:
     def __init__(self, rt, loop: str = "generated") -> None:
         """`loop`: "generated" (interp/vm/loop.py, the dispatch loop generated from
-        :meth:`run`, the default) or "source" (:meth:`run` itself, the handlers' source,
-        kept runnable and tested: tests/vm/test_generated_loop.py)."""
+        :meth:`run`, compiled by Cython when built: :data:`COMPILED`; the default),
+        "python" (loop.py as plain Python, also when the compiled one exists) or "source"
+        (:meth:`run` itself, the handlers' source); all three are kept runnable and tested
+        (tests/vm/test_generated_loop.py, tests/vm/test_compiled_loop.py)."""
         self.rt = rt
-        self.loop = _generated_run if loop == "generated" else VM.run
-        self.dispatch = GENERATED_DISPATCH if loop == "generated" else SOURCE_DISPATCH
+        if loop == "source":
+            self.loop, self.dispatch = VM.run, SOURCE_DISPATCH
+        elif loop == "python":
+            self.loop, self.dispatch = _python_loop().run, GENERATED_DISPATCH
+        else:
+            self.loop, self.dispatch = _generated_run, GENERATED_DISPATCH
         self.codes: dict = {}          # id(routine) -> Bound
         # the cold opcodes' handlers by the loop's number of the opcode
         self.cold = [None] * len(OP.OPS)
@@ -188,7 +194,7 @@ class VM:
         code = self.codes.get(id(routine))
         if code is None:
             extra = routine.ann.extra
-            key = "vm_linked" if self.loop is _generated_run else "vm_linked_source"
+            key = "vm_linked" if self.dispatch is GENERATED_DISPATCH else "vm_linked_source"
             linked = extra.get(key)
             if linked is None:
                 linked = extra[key] = link(compile_routine(routine), self.dispatch)
@@ -447,7 +453,7 @@ class VM:
         """Run ``code`` from ``ip`` in the activation of ``frame`` (its runtime Frame) with
         the temporaries ``temps``; returns the value of RETURN,
         or of the thunk at END_THUNK. The ``_name`` helpers are the runtime functions of
-        :data:`HELPERS`, closure variables of the loop (see :func:`_specialize`)."""
+        :data:`HELPERS` (module names of the generated loop: interp/vm/gen_loop.py)."""
         rt = self.rt
         prog = code.prog
         mrefs = code.mrefs
@@ -466,7 +472,7 @@ class VM:
                     ins = prog[ip]
                     op = ins[0]
                     # hottest first (measured on the benchmark): the rank weights the search
-                    # tree _specialize makes of this chain
+                    # tree interp/vm/gen_loop.py makes of this chain
                     if op == OP.STMT_G:
                         info = ins[1]
                         frame.line = info.line
@@ -1059,6 +1065,38 @@ class VM:
 
 # The loops: VM.run above is the source of every handler (runnable: VM(rt, loop="source"),
 # dispatching on the opcode numbers themselves); interp/vm/loop.py is generated from it
-# (python -m interp.vm.gen_loop) and dispatches on its own numbering.
+# (python -m interp.vm.gen_loop) and dispatches on its own numbering. `make` compiles loop.py
+# with Cython (interp/vm/build.py) into an extension beside it, which Python imports in its
+# place; it runs (loop="generated") only when it was built from this vm.py, else loop.py does.
 SOURCE_DISPATCH = [o.number for o in OP.OPS]
-from .loop import DISPATCH as GENERATED_DISPATCH, run as _generated_run  # noqa: E402
+
+
+def _python_loop():
+    """interp/vm/loop.py itself, imported from its file (also when the extension exists)."""
+    import importlib.util  # noqa: PLC0415
+    import sys  # noqa: PLC0415
+    from pathlib import Path  # noqa: PLC0415
+
+    name = "interp.vm._loop_python"
+    mod = sys.modules.get(name)
+    if mod is None:
+        spec = importlib.util.spec_from_file_location(name, Path(__file__).with_name("loop.py"))
+        mod = importlib.util.module_from_spec(spec)
+        sys.modules[name] = mod
+        spec.loader.exec_module(mod)
+    return mod
+
+
+def _current(mod) -> bool:
+    import hashlib  # noqa: PLC0415
+    from pathlib import Path  # noqa: PLC0415
+
+    return mod.VM_SOURCE == hashlib.sha256(Path(__file__).read_bytes()).hexdigest()
+
+
+from . import loop as _loop  # noqa: E402
+
+COMPILED = not _loop.__file__.endswith(".py") and _current(_loop)
+if not COMPILED:
+    _loop = _python_loop()
+GENERATED_DISPATCH, _generated_run = _loop.DISPATCH, _loop.run
