@@ -5,5 +5,6 @@
 import cython
 
 @cython.locals(prog=list, ins=tuple, op=cython.Py_ssize_t, store=list, fvars=list, mrefs=list,
-               grefs=list, cold=list, argc=cython.Py_ssize_t)
+               grefs=list, cold=list, argc=cython.Py_ssize_t, left=cython.Py_ssize_t,
+               unsaved=cython.Py_ssize_t)
 cpdef object run(object self, object code, object frame, list temps, Py_ssize_t ip, list stack, bint thunk=*)

@@ -9,7 +9,7 @@ there; vm.py runs the compiled module only when its VM_SOURCE matches vm.py."""
 from interp.vm.vm import (INT_MAX, INT_MIN, KrlRuntimeError, Slot, Struct, UNSET, ValueRef, add, array_index, component, element, element1, element2, ended_without_return, eq, for_done, for_limits, for_next, function_result, ge, gt, le, load, lt, math, mul, ne, read_value, return_without_value, set_component, set_element, set_element1, store, sub)
 
 # sha256 of the vm.py this file was generated from
-VM_SOURCE = 'e927da482654eaf93ebca12ad38dff68bedb500ee816dab705d6bdf9cf78c704'
+VM_SOURCE = 'c72e7d5eb3869bf1a0245aa2fb1bc8ab3447a2136e653f40e5ea4a9d5bf8a0f4'
 
 # opcode number (interp/vm/opcodes.py) -> this loop's number of the opcode
 DISPATCH = [43, 0, 35, 83, 87, 86, 78, 101, 22, 111, 100, 23, 24, 99, 26, 34, 92, 40, 81, 5, 76, 98, 58, 93, 90, 95, 62, 102, 73, 2, 28, 96, 4, 110, 109, 107, 106, 103, 42, 33, 30, 41, 25, 38, 31, 112, 57, 32, 82, 44, 55, 54, 49, 48, 51, 36, 29, 75, 97, 45, 50, 84, 108, 1, 37, 47, 85, 77, 52, 105, 74, 104, 53, 79, 56, 89, 8, 80, 72, 27, 39, 3, 46, 91, 88, 94, 71, 60, 61, 66, 10, 69, 70, 11, 7, 6, 65, 18, 67, 64, 63, 68, 12, 20, 59, 19, 21, 9, 14, 16, 17, 15, 13]
@@ -53,705 +53,821 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
     before, tick, take_error_proceed, quiet_limit = self.hooks
     cold = self.cold
     task = rt.current_task
+    left = task.quiet - rt.steps
+    unsaved = 0
     proceed = False
-    while True:
-        try:
-            while True:
-                ins = prog[ip]
-                op = ins[0]
-                if op < 36:
-                    if op < 1:
-                        info = ins[1]
-                        frame.line = info.line
-                        n = rt.steps
-                        if n < task.quiet and (not info.stops):
-                            rt.steps = n + 1
-                            task.at = info
-                            proceed = False
-                        else:
-                            before(info)
-                            proceed = take_error_proceed()
-                            task.quiet = quiet_limit(task)
-                        ip += 1
-                    elif op < 2:
-                        a = store[ins[1]]
-                        i = store[ins[2]]
-                        if type(i) is int and 0 < i <= a.dims[0] and ((v := a.data[i - 1]) is not UNSET):
-                            stack.append(v)
-                        else:
-                            stack.append(_element1(fvars[ins[1]], _load(fvars[ins[2]]), ins[3]))
-                        ip += 1
-                    elif op < 26:
-                        if op < 3:
-                            b = stack.pop()
-                            a = stack[-1]
-                            if type(a) is float and type(b) is float:
-                                stack[-1] = a + b
-                            elif type(a) is int and type(b) is int and (INT_MIN <= (v := (a + b)) <= INT_MAX):
-                                stack[-1] = v
+    try:
+        while True:
+            try:
+                while True:
+                    ins = prog[ip]
+                    op = ins[0]
+                    if op < 36:
+                        if op < 1:
+                            info = ins[1]
+                            frame.line = info.line
+                            if left > 0 and (not info.stops):
+                                left -= 1
+                                unsaved += 1
+                                task.at = info
+                                proceed = False
                             else:
-                                stack[-1] = _add(a, b)
+                                rt.steps += unsaved
+                                unsaved = 0
+                                before(info)
+                                proceed = take_error_proceed()
+                                task.quiet = n = quiet_limit(task)
+                                left = n - rt.steps
                             ip += 1
-                        elif op < 6:
-                            if op < 4:
-                                argc = ins[2]
-                                if argc:
-                                    args = stack[-argc:]
-                                    del stack[-argc:]
-                                else:
-                                    args = []
-                                flags = ins[3]
-                                target = code.callsites.get(ip)
-                                if target is not None:
-                                    v = self.invoke(target, args, frame, 'N' not in flags)
-                                else:
-                                    v = self.call(code, ip, ins[1], args, frame, flags)
-                                if flags == 'E':
-                                    stack.append(v if v is not None else function_result(ins[1], v))
-                                ip += 1
-                            elif op < 5:
-                                b = stack.pop()
-                                stack[-1] = _lt(stack[-1], b)
-                                ip += 1
+                        elif op < 2:
+                            a = store[ins[1]]
+                            i = store[ins[2]]
+                            if type(i) is int and 0 < i <= a.dims[0] and ((v := a.data[i - 1]) is not UNSET):
+                                stack.append(v)
                             else:
-                                ref = stack.pop()
-                                _store(ref, stack.pop())
-                                ip += 1
-                        elif op < 25:
-                            if op < 24:
-                                if op < 22:
-                                    if op < 14:
-                                        if op < 10:
-                                            if op < 8:
-                                                if op < 7:
-                                                    ip = cold[op](ins, code, frame, temps, stack, ip)
-                                                else:
-                                                    ip = cold[op](ins, code, frame, temps, stack, ip)
-                                            elif op < 9:
-                                                ip = cold[op](ins, code, frame, temps, stack, ip)
-                                            else:
-                                                ip = cold[op](ins, code, frame, temps, stack, ip)
-                                        elif op < 12:
-                                            if op < 11:
-                                                ip = cold[op](ins, code, frame, temps, stack, ip)
-                                            else:
-                                                ip = cold[op](ins, code, frame, temps, stack, ip)
-                                        elif op < 13:
-                                            ip = cold[op](ins, code, frame, temps, stack, ip)
-                                        else:
-                                            ip = cold[op](ins, code, frame, temps, stack, ip)
-                                    elif op < 18:
-                                        if op < 16:
-                                            if op < 15:
-                                                ip = cold[op](ins, code, frame, temps, stack, ip)
-                                            else:
-                                                ip = cold[op](ins, code, frame, temps, stack, ip)
-                                        elif op < 17:
-                                            ip = cold[op](ins, code, frame, temps, stack, ip)
-                                        else:
-                                            ip = cold[op](ins, code, frame, temps, stack, ip)
-                                    elif op < 20:
-                                        if op < 19:
-                                            ip = cold[op](ins, code, frame, temps, stack, ip)
-                                        else:
-                                            ip = cold[op](ins, code, frame, temps, stack, ip)
-                                    elif op < 21:
-                                        ip = cold[op](ins, code, frame, temps, stack, ip)
-                                    else:
-                                        ip = cold[op](ins, code, frame, temps, stack, ip)
-                                elif op < 23:
-                                    g = ins[1]
-                                    ref = grefs[g]
-                                    if ref is None:
-                                        ref = rt.storage_ref(code.gstorage[g], frame)
-                                        grefs[g] = ref
-                                    if op == 22:
-                                        stack.append(_load(ref))
-                                    elif op == 23:
-                                        stack.append(ref)
-                                    else:
-                                        _store(ref, stack.pop())
-                                    ip += 1
-                                else:
-                                    g = ins[1]
-                                    ref = grefs[g]
-                                    if ref is None:
-                                        ref = rt.storage_ref(code.gstorage[g], frame)
-                                        grefs[g] = ref
-                                    if op == 22:
-                                        stack.append(_load(ref))
-                                    elif op == 23:
-                                        stack.append(ref)
-                                    else:
-                                        _store(ref, stack.pop())
-                                    ip += 1
-                            else:
-                                n = ins[1]
-                                idx = [None if x is None else _array_index(x) for x in stack[-n:]]
-                                del stack[-n:]
-                                stack[-1] = rt.index(stack[-1], idx, ins[2])
-                                ip += 1
-                        else:
-                            b = ins[1]
-                            a = stack[-1]
-                            if type(a) is float and type(b) is float:
-                                stack[-1] = a + b
-                            elif type(a) is int and type(b) is int and (INT_MIN <= (v := (a + b)) <= INT_MAX):
-                                stack[-1] = v
-                            else:
-                                stack[-1] = _add(a, b)
+                                stack.append(_element1(fvars[ins[1]], _load(fvars[ins[2]]), ins[3]))
                             ip += 1
-                    elif op < 30:
-                        if op < 29:
-                            if op < 28:
-                                if op < 27:
-                                    n = ins[1]
-                                    idx = stack[-n:]
-                                    del stack[-n:]
-                                    stack[-1] = _element(stack[-1], idx, ins[2])
-                                    ip += 1
-                                else:
-                                    t = ins[1]
-                                    if for_done(temps[t].get(), temps[t + 1], temps[t + 2]):
-                                        ip = ins[2]
-                                    else:
-                                        ip += 1
-                            else:
+                        elif op < 26:
+                            if op < 3:
                                 b = stack.pop()
                                 a = stack[-1]
                                 if type(a) is float and type(b) is float:
-                                    stack[-1] = a - b
-                                elif type(a) is int and type(b) is int and (INT_MIN <= (v := (a - b)) <= INT_MAX):
+                                    stack[-1] = a + b
+                                elif type(a) is int and type(b) is int and (INT_MIN <= (v := (a + b)) <= INT_MAX):
                                     stack[-1] = v
                                 else:
-                                    stack[-1] = _sub(a, b)
+                                    stack[-1] = _add(a, b)
                                 ip += 1
-                        else:
-                            a = store[ins[1]]
-                            b = ins[2]
-                            if type(a) is int and type(b) is int and (INT_MIN <= (v := (a + b)) <= INT_MAX):
-                                stack.append(v)
-                            elif type(a) is float and type(b) is float:
-                                stack.append(a + b)
-                            else:
-                                stack.append(_add(a if a is not UNSET else _load(fvars[ins[1]]), b))
-                            ip += 1
-                    elif op < 33:
-                        if op < 32:
-                            if op < 31:
-                                stack.append(_element2(fvars[ins[1]], _load(fvars[ins[2]]), _load(fvars[ins[3]]), ins[4]))
-                                ip += 1
-                            else:
-                                stack.append(_sub(_load(fvars[ins[1]]), ins[2]))
-                                ip += 1
-                        else:
-                            b = ins[1]
-                            a = stack[-1]
-                            if type(a) is float and type(b) is float:
-                                stack[-1] = a * b
-                            elif type(a) is int and type(b) is int and (INT_MIN <= (v := (a * b)) <= INT_MAX):
-                                stack[-1] = v
-                            else:
-                                stack[-1] = _mul(a, b)
-                            ip += 1
-                    elif op < 35:
-                        if op < 34:
-                            _set_element1(fvars[ins[1]], _load(fvars[ins[2]]), stack.pop(), ins[3])
-                            ip += 1
-                        else:
-                            n = ins[1]
-                            if n == 1:
-                                i = stack.pop()
-                                base = stack.pop()
-                                _set_element1(base, i, stack.pop(), ins[2])
-                            else:
-                                idx = stack[-n:]
-                                del stack[-n:]
-                                base = stack.pop()
-                                _set_element(base, idx, stack.pop(), ins[2])
-                            ip += 1
-                    else:
-                        n = rt.steps
-                        if n < task.quiet and (not ins[1].cond_stops):
-                            rt.steps = n + 1
-                        else:
-                            tick(ins[1])
-                            task.quiet = quiet_limit(task)
-                        ip += 1
-                elif op < 57:
-                    if op < 51:
-                        if op < 41:
-                            if op < 37:
-                                v = store[ins[1]]
-                                stack.append(v if v is not UNSET else _load(fvars[ins[1]]))
-                                v = store[ins[2]]
-                                stack.append(v if v is not UNSET else _load(fvars[ins[2]]))
-                                ip += 1
-                            elif op < 38:
-                                a = store[ins[1]]
-                                i = store[ins[2]]
-                                v = stack.pop()
-                                t = ins[4]
-                                if type(i) is int and 0 < i <= a.dims[0] and (type(v) is t) and (t is not int or INT_MIN <= v <= INT_MAX):
-                                    a.data[i - 1] = v
-                                else:
-                                    _set_element1(fvars[ins[1]], _load(fvars[ins[2]]), v, ins[3])
-                                ip += 1
-                            elif op < 40:
-                                if op < 39:
-                                    stack.append(_add(_load(fvars[ins[1]]), ins[2]))
+                            elif op < 6:
+                                if op < 4:
+                                    argc = ins[2]
+                                    if argc:
+                                        args = stack[-argc:]
+                                        del stack[-argc:]
+                                    else:
+                                        args = []
+                                    flags = ins[3]
+                                    target = code.callsites.get(ip)
+                                    rt.steps += unsaved
+                                    unsaved = 0
+                                    if target is not None:
+                                        v = self.invoke(target, args, frame, 'N' not in flags)
+                                    else:
+                                        v = self.call(code, ip, ins[1], args, frame, flags)
+                                    left = task.quiet - rt.steps
+                                    if flags == 'E':
+                                        stack.append(v if v is not None else function_result(ins[1], v))
+                                    ip += 1
+                                elif op < 5:
+                                    b = stack.pop()
+                                    stack[-1] = _lt(stack[-1], b)
                                     ip += 1
                                 else:
-                                    t = ins[1]
-                                    if _for_next(temps[t], temps[t + 1], temps[t + 2], ins[2]):
-                                        n = rt.steps
-                                        if n < task.quiet and (not ins[2].cond_stops):
-                                            rt.steps = n + 1
+                                    ref = stack.pop()
+                                    _store(ref, stack.pop())
+                                    ip += 1
+                            elif op < 25:
+                                if op < 24:
+                                    if op < 22:
+                                        if op < 14:
+                                            if op < 10:
+                                                if op < 8:
+                                                    if op < 7:
+                                                        rt.steps += unsaved
+                                                        unsaved = 0
+                                                        ip = cold[op](ins, code, frame, temps, stack, ip)
+                                                        left = task.quiet - rt.steps
+                                                    else:
+                                                        rt.steps += unsaved
+                                                        unsaved = 0
+                                                        ip = cold[op](ins, code, frame, temps, stack, ip)
+                                                        left = task.quiet - rt.steps
+                                                elif op < 9:
+                                                    rt.steps += unsaved
+                                                    unsaved = 0
+                                                    ip = cold[op](ins, code, frame, temps, stack, ip)
+                                                    left = task.quiet - rt.steps
+                                                else:
+                                                    rt.steps += unsaved
+                                                    unsaved = 0
+                                                    ip = cold[op](ins, code, frame, temps, stack, ip)
+                                                    left = task.quiet - rt.steps
+                                            elif op < 12:
+                                                if op < 11:
+                                                    rt.steps += unsaved
+                                                    unsaved = 0
+                                                    ip = cold[op](ins, code, frame, temps, stack, ip)
+                                                    left = task.quiet - rt.steps
+                                                else:
+                                                    rt.steps += unsaved
+                                                    unsaved = 0
+                                                    ip = cold[op](ins, code, frame, temps, stack, ip)
+                                                    left = task.quiet - rt.steps
+                                            elif op < 13:
+                                                rt.steps += unsaved
+                                                unsaved = 0
+                                                ip = cold[op](ins, code, frame, temps, stack, ip)
+                                                left = task.quiet - rt.steps
+                                            else:
+                                                rt.steps += unsaved
+                                                unsaved = 0
+                                                ip = cold[op](ins, code, frame, temps, stack, ip)
+                                                left = task.quiet - rt.steps
+                                        elif op < 18:
+                                            if op < 16:
+                                                if op < 15:
+                                                    rt.steps += unsaved
+                                                    unsaved = 0
+                                                    ip = cold[op](ins, code, frame, temps, stack, ip)
+                                                    left = task.quiet - rt.steps
+                                                else:
+                                                    rt.steps += unsaved
+                                                    unsaved = 0
+                                                    ip = cold[op](ins, code, frame, temps, stack, ip)
+                                                    left = task.quiet - rt.steps
+                                            elif op < 17:
+                                                rt.steps += unsaved
+                                                unsaved = 0
+                                                ip = cold[op](ins, code, frame, temps, stack, ip)
+                                                left = task.quiet - rt.steps
+                                            else:
+                                                rt.steps += unsaved
+                                                unsaved = 0
+                                                ip = cold[op](ins, code, frame, temps, stack, ip)
+                                                left = task.quiet - rt.steps
+                                        elif op < 20:
+                                            if op < 19:
+                                                rt.steps += unsaved
+                                                unsaved = 0
+                                                ip = cold[op](ins, code, frame, temps, stack, ip)
+                                                left = task.quiet - rt.steps
+                                            else:
+                                                rt.steps += unsaved
+                                                unsaved = 0
+                                                ip = cold[op](ins, code, frame, temps, stack, ip)
+                                                left = task.quiet - rt.steps
+                                        elif op < 21:
+                                            rt.steps += unsaved
+                                            unsaved = 0
+                                            ip = cold[op](ins, code, frame, temps, stack, ip)
+                                            left = task.quiet - rt.steps
                                         else:
-                                            tick(ins[2])
-                                            task.quiet = quiet_limit(task)
-                                        ip = ins[3]
-                                    else:
+                                            rt.steps += unsaved
+                                            unsaved = 0
+                                            ip = cold[op](ins, code, frame, temps, stack, ip)
+                                            left = task.quiet - rt.steps
+                                    elif op < 23:
+                                        g = ins[1]
+                                        ref = grefs[g]
+                                        if ref is None:
+                                            ref = rt.storage_ref(code.gstorage[g], frame)
+                                            grefs[g] = ref
+                                        if op == 22:
+                                            stack.append(_load(ref))
+                                        elif op == 23:
+                                            stack.append(ref)
+                                        else:
+                                            _store(ref, stack.pop())
                                         ip += 1
+                                    else:
+                                        g = ins[1]
+                                        ref = grefs[g]
+                                        if ref is None:
+                                            ref = rt.storage_ref(code.gstorage[g], frame)
+                                            grefs[g] = ref
+                                        if op == 22:
+                                            stack.append(_load(ref))
+                                        elif op == 23:
+                                            stack.append(ref)
+                                        else:
+                                            _store(ref, stack.pop())
+                                        ip += 1
+                                else:
+                                    n = ins[1]
+                                    idx = [None if x is None else _array_index(x) for x in stack[-n:]]
+                                    del stack[-n:]
+                                    stack[-1] = rt.index(stack[-1], idx, ins[2])
+                                    ip += 1
                             else:
-                                base = stack.pop()
-                                _set_component(base, ins[1][0], stack.pop(), ins[2])
+                                b = ins[1]
+                                a = stack[-1]
+                                if type(a) is float and type(b) is float:
+                                    stack[-1] = a + b
+                                elif type(a) is int and type(b) is int and (INT_MIN <= (v := (a + b)) <= INT_MAX):
+                                    stack[-1] = v
+                                else:
+                                    stack[-1] = _add(a, b)
                                 ip += 1
-                        elif op < 45:
-                            if op < 44:
-                                if op < 43:
-                                    if op < 42:
-                                        stack.append(_load(fvars[ins[1]]))
-                                        stack.append(_load(fvars[ins[2]]))
+                        elif op < 30:
+                            if op < 29:
+                                if op < 28:
+                                    if op < 27:
+                                        n = ins[1]
+                                        idx = stack[-n:]
+                                        del stack[-n:]
+                                        stack[-1] = _element(stack[-1], idx, ins[2])
                                         ip += 1
                                     else:
-                                        stack.append(_element1(fvars[ins[1]], _load(fvars[ins[2]]), ins[3]))
-                                        ip += 1
+                                        t = ins[1]
+                                        if for_done(temps[t].get(), temps[t + 1], temps[t + 2]):
+                                            ip = ins[2]
+                                        else:
+                                            ip += 1
                                 else:
-                                    info = ins[1]
-                                    if not thunk:
-                                        frame.line = info.line
-                                    n = rt.steps
-                                    if n < task.quiet and (not info.stops):
-                                        rt.steps = n + 1
-                                        task.at = info
-                                    else:
-                                        before(info)
-                                        task.quiet = quiet_limit(task)
-                                    ip += 1
-                            else:
-                                b = stack.pop()
-                                a = stack.pop()
-                                ca = type(a)
-                                cb = type(b)
-                                if a <= b if (ca is int or ca is float) and (cb is int or cb is float) else _le(a, b):
-                                    ip += 1
-                                else:
-                                    ip = ins[1]
-                        elif op < 48:
-                            if op < 47:
-                                if op < 46:
-                                    a = store[ins[1]]
-                                    i = stack[-1]
-                                    if type(i) is int and 0 < i <= a.dims[0] and ((v := a.data[i - 1]) is not UNSET):
+                                    b = stack.pop()
+                                    a = stack[-1]
+                                    if type(a) is float and type(b) is float:
+                                        stack[-1] = a - b
+                                    elif type(a) is int and type(b) is int and (INT_MIN <= (v := (a - b)) <= INT_MAX):
                                         stack[-1] = v
                                     else:
-                                        stack[-1] = _element1(fvars[ins[1]], i, ins[2])
-                                    ip += 1
-                                else:
-                                    if code.kind == 'DEFFCT':
-                                        raise return_without_value(code.routine, frame.line)
-                                    return None
-                            else:
-                                a = store[ins[1]]
-                                i = store[ins[2]]
-                                j = store[ins[3]]
-                                n, m = a.dims
-                                if type(i) is int and type(j) is int and (0 < i <= n) and (0 < j <= m) and ((v := a.data[(i - 1) * m + j - 1]) is not UNSET):
-                                    stack.append(v)
-                                else:
-                                    stack.append(_element2(fvars[ins[1]], _load(fvars[ins[2]]), _load(fvars[ins[3]]), ins[4]))
-                                ip += 1
-                        elif op < 50:
-                            if op < 49:
-                                b = stack.pop()
-                                a = stack.pop()
-                                ca = type(a)
-                                cb = type(b)
-                                if a != b if (ca is int or ca is float) and (cb is int or cb is float) else _ne(a, b):
-                                    ip += 1
-                                else:
-                                    ip = ins[1]
-                            else:
-                                b = stack.pop()
-                                a = stack.pop()
-                                ca = type(a)
-                                cb = type(b)
-                                if a == b if (ca is int or ca is float) and (cb is int or cb is float) else _eq(a, b):
-                                    ip += 1
-                                else:
-                                    ip = ins[1]
-                        else:
-                            j = stack.pop()
-                            i = stack[-1]
-                            a = store[ins[1]]
-                            n, m = a.dims
-                            if type(i) is int and type(j) is int and (0 < i <= n) and (0 < j <= m) and ((v := a.data[(i - 1) * m + j - 1]) is not UNSET):
-                                stack[-1] = v
-                            else:
-                                stack[-1] = _element2(fvars[ins[1]], i, j, ins[2])
-                            ip += 1
-                    elif op < 52:
-                        v = store[ins[1]]
-                        stack.append(v if v is not UNSET else _load(fvars[ins[1]]))
-                        ip += 1
-                    elif op < 53:
-                        t = ins[2]
-                        c = store[ins[1]]
-                        if type(c) is int and (c := (c + temps[t + 2])) <= temps[t + 3]:
-                            store[ins[1]] = c
-                            go = True
-                        else:
-                            go = _for_next(temps[t], temps[t + 1], temps[t + 2], ins[3])
-                        if go:
-                            n = rt.steps
-                            if n < task.quiet:
-                                rt.steps = n + 1
-                            else:
-                                tick(ins[3])
-                                task.quiet = quiet_limit(task)
-                            ip = ins[4]
-                        else:
-                            ip += 1
-                    elif op < 54:
-                        a = store[ins[1]]
-                        b = ins[2]
-                        ca = type(a)
-                        cb = type(b)
-                        f = ins[3]
-                        if f[0](a, b) if (ca is int or ca is float) and (cb is int or cb is float) else f[1](a if a is not UNSET else _load(fvars[ins[1]]), b):
-                            ip += 1
-                        else:
-                            ip = ins[4]
-                    elif op < 56:
-                        if op < 55:
-                            b = stack.pop()
-                            a = stack.pop()
-                            ca = type(a)
-                            cb = type(b)
-                            if a >= b if (ca is int or ca is float) and (cb is int or cb is float) else _ge(a, b):
-                                ip += 1
-                            else:
-                                ip = ins[1]
-                        else:
-                            b = stack.pop()
-                            a = stack.pop()
-                            ca = type(a)
-                            cb = type(b)
-                            if a > b if (ca is int or ca is float) and (cb is int or cb is float) else _gt(a, b):
-                                ip += 1
-                            else:
-                                ip = ins[1]
-                    elif rt.to_bool(stack.pop()):
-                        ip += 1
-                    else:
-                        ip = ins[1]
-                elif op < 89:
-                    if op < 83:
-                        if op < 75:
-                            if op < 74:
-                                if op < 73:
-                                    if op < 58:
-                                        b = ins[1]
-                                        a = stack[-1]
-                                        if type(a) is float and type(b) is float:
-                                            stack[-1] = a - b
-                                        elif type(a) is int and type(b) is int and (INT_MIN <= (v := (a - b)) <= INT_MAX):
-                                            stack[-1] = v
-                                        else:
-                                            stack[-1] = _sub(a, b)
-                                        ip += 1
-                                    elif op < 72:
-                                        if op < 59:
-                                            g = ins[1]
-                                            ref = grefs[g]
-                                            if ref is None:
-                                                ref = rt.storage_ref(code.gstorage[g], frame)
-                                                grefs[g] = ref
-                                            if op == 22:
-                                                stack.append(_load(ref))
-                                            elif op == 23:
-                                                stack.append(ref)
-                                            else:
-                                                _store(ref, stack.pop())
-                                            ip += 1
-                                        elif op < 64:
-                                            if op < 61:
-                                                if op < 60:
-                                                    ip = cold[op](ins, code, frame, temps, stack, ip)
-                                                else:
-                                                    ip = cold[op](ins, code, frame, temps, stack, ip)
-                                            elif op < 62:
-                                                ip = cold[op](ins, code, frame, temps, stack, ip)
-                                            elif op < 63:
-                                                ip = cold[op](ins, code, frame, temps, stack, ip)
-                                            else:
-                                                ip = cold[op](ins, code, frame, temps, stack, ip)
-                                        elif op < 68:
-                                            if op < 66:
-                                                if op < 65:
-                                                    ip = cold[op](ins, code, frame, temps, stack, ip)
-                                                else:
-                                                    ip = cold[op](ins, code, frame, temps, stack, ip)
-                                            elif op < 67:
-                                                ip = cold[op](ins, code, frame, temps, stack, ip)
-                                            else:
-                                                ip = cold[op](ins, code, frame, temps, stack, ip)
-                                        elif op < 70:
-                                            if op < 69:
-                                                ip = cold[op](ins, code, frame, temps, stack, ip)
-                                            else:
-                                                ip = cold[op](ins, code, frame, temps, stack, ip)
-                                        elif op < 71:
-                                            ip = cold[op](ins, code, frame, temps, stack, ip)
-                                        else:
-                                            ip = cold[op](ins, code, frame, temps, stack, ip)
-                                    else:
-                                        _store(temps[ins[1]], stack.pop())
-                                        ip += 1
-                                else:
-                                    stack[-1] = rt.unary_op(ins[1], stack[-1])
+                                        stack[-1] = _sub(a, b)
                                     ip += 1
                             else:
                                 a = store[ins[1]]
                                 b = ins[2]
-                                t = ins[4]
-                                ca = type(a)
-                                if ca is type(b) and ca is t and (ca is float or (ca is int and INT_MIN <= (v := (a - b)) <= INT_MAX)):
-                                    store[ins[3]] = a - b if ca is float else v
+                                if type(a) is int and type(b) is int and (INT_MIN <= (v := (a + b)) <= INT_MAX):
+                                    stack.append(v)
+                                elif type(a) is float and type(b) is float:
+                                    stack.append(a + b)
                                 else:
-                                    _store(fvars[ins[3]], _sub(a if a is not UNSET else _load(fvars[ins[1]]), b))
+                                    stack.append(_add(a if a is not UNSET else _load(fvars[ins[1]]), b))
                                 ip += 1
-                        elif op < 78:
-                            if op < 77:
-                                if op < 76:
+                        elif op < 33:
+                            if op < 32:
+                                if op < 31:
+                                    stack.append(_element2(fvars[ins[1]], _load(fvars[ins[2]]), _load(fvars[ins[3]]), ins[4]))
+                                    ip += 1
+                                else:
+                                    stack.append(_sub(_load(fvars[ins[1]]), ins[2]))
+                                    ip += 1
+                            else:
+                                b = ins[1]
+                                a = stack[-1]
+                                if type(a) is float and type(b) is float:
+                                    stack[-1] = a * b
+                                elif type(a) is int and type(b) is int and (INT_MIN <= (v := (a * b)) <= INT_MAX):
+                                    stack[-1] = v
+                                else:
+                                    stack[-1] = _mul(a, b)
+                                ip += 1
+                        elif op < 35:
+                            if op < 34:
+                                _set_element1(fvars[ins[1]], _load(fvars[ins[2]]), stack.pop(), ins[3])
+                                ip += 1
+                            else:
+                                n = ins[1]
+                                if n == 1:
+                                    i = stack.pop()
+                                    base = stack.pop()
+                                    _set_element1(base, i, stack.pop(), ins[2])
+                                else:
+                                    idx = stack[-n:]
+                                    del stack[-n:]
+                                    base = stack.pop()
+                                    _set_element(base, idx, stack.pop(), ins[2])
+                                ip += 1
+                        else:
+                            if left > 0 and (not ins[1].cond_stops):
+                                left -= 1
+                                unsaved += 1
+                            else:
+                                rt.steps += unsaved
+                                unsaved = 0
+                                tick(ins[1])
+                                task.quiet = n = quiet_limit(task)
+                                left = n - rt.steps
+                            ip += 1
+                    elif op < 57:
+                        if op < 51:
+                            if op < 41:
+                                if op < 37:
+                                    v = store[ins[1]]
+                                    stack.append(v if v is not UNSET else _load(fvars[ins[1]]))
+                                    v = store[ins[2]]
+                                    stack.append(v if v is not UNSET else _load(fvars[ins[2]]))
+                                    ip += 1
+                                elif op < 38:
                                     a = store[ins[1]]
-                                    b = ins[2]
-                                    if type(a) is int and type(b) is int and (INT_MIN <= (v := (a - b)) <= INT_MAX):
-                                        stack.append(v)
-                                    elif type(a) is float and type(b) is float:
-                                        stack.append(a - b)
+                                    i = store[ins[2]]
+                                    v = stack.pop()
+                                    t = ins[4]
+                                    if type(i) is int and 0 < i <= a.dims[0] and (type(v) is t) and (t is not int or INT_MIN <= v <= INT_MAX):
+                                        a.data[i - 1] = v
                                     else:
-                                        stack.append(_sub(a if a is not UNSET else _load(fvars[ins[1]]), b))
+                                        _set_element1(fvars[ins[1]], _load(fvars[ins[2]]), v, ins[3])
                                     ip += 1
-                                else:
-                                    _store(fvars[ins[1]], stack.pop())
-                                    ip += 1
-                            else:
-                                _set_component(fvars[ins[1]], ins[2][0], stack.pop(), ins[3])
-                                ip += 1
-                        elif op < 80:
-                            if op < 79:
-                                stack.append(_load(fvars[ins[1]]))
-                                ip += 1
-                            else:
-                                ip = ins[1]
-                        elif op < 82:
-                            if op < 81:
-                                t = ins[1]
-                                step = stack.pop()
-                                end = stack.pop()
-                                start = stack.pop()
-                                temps[t] = stack.pop()
-                                temps[t + 1], temps[t + 2] = end, step = _for_limits(end, step)
-                                temps[t + 3] = min(end, INT_MAX) if type(step) is int and step > 0 else -math.inf
-                                stack.append(start)
-                                ip += 1
-                            else:
-                                stack[-1] = _read_value(stack[-1])
-                                ip += 1
-                        else:
-                            b = stack.pop()
-                            a = stack.pop()
-                            ca = type(a)
-                            cb = type(b)
-                            if a < b if (ca is int or ca is float) and (cb is int or cb is float) else _lt(a, b):
-                                ip += 1
-                            else:
-                                ip = ins[1]
-                    elif op < 84:
-                        stack.append(ins[1])
-                        ip += 1
-                    elif op < 85:
-                        i = stack.pop()
-                        v = stack.pop()
-                        a = store[ins[1]]
-                        t = ins[3]
-                        if type(i) is int and 0 < i <= a.dims[0] and (type(v) is t) and (t is not int or INT_MIN <= v <= INT_MAX):
-                            a.data[i - 1] = v
-                        else:
-                            _set_element1(fvars[ins[1]], i, v, ins[2])
-                        ip += 1
-                    elif op < 86:
-                        base = fvars[ins[1]]
-                        if type(base) is Slot and type((x := base.c[base.k])) is Struct and (type((x := x.f.get(ins[2][1]))) is float or type(x) is int or type(x) is bool):
-                            stack.append(x)
-                        else:
-                            stack.append(_component(base, ins[2][0], ins[3]))
-                        ip += 1
-                    elif op < 88:
-                        if op < 87:
-                            stack.pop()
-                            ip += 1
-                        else:
-                            stack.append(None)
-                            ip += 1
-                    else:
-                        if code.kind == 'DEFFCT':
-                            raise ended_without_return(code.routine, frame.line)
-                        return None
-                elif op < 104:
-                    if op < 97:
-                        if op < 93:
-                            if op < 92:
-                                if op < 91:
-                                    if op < 90:
-                                        if rt.to_bool(stack.pop()):
-                                            ip = ins[1]
+                                elif op < 40:
+                                    if op < 39:
+                                        stack.append(_add(_load(fvars[ins[1]]), ins[2]))
+                                        ip += 1
+                                    else:
+                                        t = ins[1]
+                                        if _for_next(temps[t], temps[t + 1], temps[t + 2], ins[2]):
+                                            if left > 0 and (not ins[2].cond_stops):
+                                                left -= 1
+                                                unsaved += 1
+                                            else:
+                                                rt.steps += unsaved
+                                                unsaved = 0
+                                                tick(ins[2])
+                                                task.quiet = n = quiet_limit(task)
+                                                left = n - rt.steps
+                                            ip = ins[3]
                                         else:
                                             ip += 1
+                                else:
+                                    base = stack.pop()
+                                    _set_component(base, ins[1][0], stack.pop(), ins[2])
+                                    ip += 1
+                            elif op < 45:
+                                if op < 44:
+                                    if op < 43:
+                                        if op < 42:
+                                            stack.append(_load(fvars[ins[1]]))
+                                            stack.append(_load(fvars[ins[2]]))
+                                            ip += 1
+                                        else:
+                                            stack.append(_element1(fvars[ins[1]], _load(fvars[ins[2]]), ins[3]))
+                                            ip += 1
                                     else:
-                                        temps[ins[1]] = stack.pop()
+                                        info = ins[1]
+                                        if not thunk:
+                                            frame.line = info.line
+                                        if left > 0 and (not info.stops):
+                                            left -= 1
+                                            unsaved += 1
+                                            task.at = info
+                                        else:
+                                            rt.steps += unsaved
+                                            unsaved = 0
+                                            before(info)
+                                            task.quiet = n = quiet_limit(task)
+                                            left = n - rt.steps
                                         ip += 1
                                 else:
-                                    v = stack.pop()
-                                    return v if code.kind == 'DEFFCT' else None
-                            else:
-                                base = stack[-1]
-                                if type(base) is Slot and type((x := base.c[base.k])) is Struct and (type((x := x.f.get(ins[1][1]))) is float or type(x) is int or type(x) is bool):
-                                    stack[-1] = x
+                                    b = stack.pop()
+                                    a = stack.pop()
+                                    ca = type(a)
+                                    cb = type(b)
+                                    if a <= b if (ca is int or ca is float) and (cb is int or cb is float) else _le(a, b):
+                                        ip += 1
+                                    else:
+                                        ip = ins[1]
+                            elif op < 48:
+                                if op < 47:
+                                    if op < 46:
+                                        a = store[ins[1]]
+                                        i = stack[-1]
+                                        if type(i) is int and 0 < i <= a.dims[0] and ((v := a.data[i - 1]) is not UNSET):
+                                            stack[-1] = v
+                                        else:
+                                            stack[-1] = _element1(fvars[ins[1]], i, ins[2])
+                                        ip += 1
+                                    else:
+                                        if code.kind == 'DEFFCT':
+                                            raise return_without_value(code.routine, frame.line)
+                                        return None
                                 else:
-                                    stack[-1] = _component(base, ins[1][0], ins[2])
-                                ip += 1
-                        elif op < 96:
-                            if op < 95:
-                                if op < 94:
-                                    stack.append(temps[ins[1]])
+                                    a = store[ins[1]]
+                                    i = store[ins[2]]
+                                    j = store[ins[3]]
+                                    n, m = a.dims
+                                    if type(i) is int and type(j) is int and (0 < i <= n) and (0 < j <= m) and ((v := a.data[(i - 1) * m + j - 1]) is not UNSET):
+                                        stack.append(v)
+                                    else:
+                                        stack.append(_element2(fvars[ins[1]], _load(fvars[ins[2]]), _load(fvars[ins[3]]), ins[4]))
                                     ip += 1
+                            elif op < 50:
+                                if op < 49:
+                                    b = stack.pop()
+                                    a = stack.pop()
+                                    ca = type(a)
+                                    cb = type(b)
+                                    if a != b if (ca is int or ca is float) and (cb is int or cb is float) else _ne(a, b):
+                                        ip += 1
+                                    else:
+                                        ip = ins[1]
                                 else:
-                                    return stack[-1] if stack else None
+                                    b = stack.pop()
+                                    a = stack.pop()
+                                    ca = type(a)
+                                    cb = type(b)
+                                    if a == b if (ca is int or ca is float) and (cb is int or cb is float) else _eq(a, b):
+                                        ip += 1
+                                    else:
+                                        ip = ins[1]
                             else:
-                                stack[-1] = ValueRef(stack[-1])
+                                j = stack.pop()
+                                i = stack[-1]
+                                a = store[ins[1]]
+                                n, m = a.dims
+                                if type(i) is int and type(j) is int and (0 < i <= n) and (0 < j <= m) and ((v := a.data[(i - 1) * m + j - 1]) is not UNSET):
+                                    stack[-1] = v
+                                else:
+                                    stack[-1] = _element2(fvars[ins[1]], i, j, ins[2])
                                 ip += 1
-                        else:
-                            b = stack.pop()
-                            a = stack[-1]
-                            if type(a) is float and type(b) is float:
-                                stack[-1] = a * b
-                            elif type(a) is int and type(b) is int and (INT_MIN <= (v := (a * b)) <= INT_MAX):
-                                stack[-1] = v
+                        elif op < 52:
+                            v = store[ins[1]]
+                            stack.append(v if v is not UNSET else _load(fvars[ins[1]]))
+                            ip += 1
+                        elif op < 53:
+                            t = ins[2]
+                            c = store[ins[1]]
+                            if type(c) is int and (c := (c + temps[t + 2])) <= temps[t + 3]:
+                                store[ins[1]] = c
+                                go = True
                             else:
-                                stack[-1] = _mul(a, b)
-                            ip += 1
-                    elif op < 98:
-                        v = stack.pop()
-                        t = ins[2]
-                        if type(v) is t and (t is not int or INT_MIN <= v <= INT_MAX):
-                            store[ins[1]] = v
-                        else:
-                            _store(fvars[ins[1]], v)
-                        ip += 1
-                    elif op < 101:
-                        if op < 99:
-                            _store(mrefs[ins[1]], stack.pop())
-                            ip += 1
-                        elif op < 100:
-                            stack[-1] = rt.field(stack[-1], ins[1], ins[2])
-                            ip += 1
-                        else:
-                            stack.append(mrefs[ins[1]])
-                            ip += 1
-                    elif op < 102:
-                        stack.append(_load(mrefs[ins[1]]))
-                        ip += 1
-                    elif op < 103:
-                        b = stack.pop()
-                        stack[-1] = rt.binary_op(ins[1], stack[-1], b)
-                        ip += 1
-                    else:
-                        b = stack.pop()
-                        stack[-1] = _ne(stack[-1], b)
-                        ip += 1
-                elif op < 112:
-                    if op < 108:
-                        if op < 105:
+                                go = _for_next(temps[t], temps[t + 1], temps[t + 2], ins[3])
+                            if go:
+                                if left > 0:
+                                    left -= 1
+                                    unsaved += 1
+                                else:
+                                    rt.steps += unsaved
+                                    unsaved = 0
+                                    tick(ins[3])
+                                    task.quiet = n = quiet_limit(task)
+                                    left = n - rt.steps
+                                ip = ins[4]
+                            else:
+                                ip += 1
+                        elif op < 54:
                             a = store[ins[1]]
-                            b = store[ins[2]]
+                            b = ins[2]
                             ca = type(a)
                             cb = type(b)
                             f = ins[3]
-                            if f[0](a, b) if (ca is int or ca is float) and (cb is int or cb is float) else f[1](a if a is not UNSET else _load(fvars[ins[1]]), b if b is not UNSET else _load(fvars[ins[2]])):
+                            if f[0](a, b) if (ca is int or ca is float) and (cb is int or cb is float) else f[1](a if a is not UNSET else _load(fvars[ins[1]]), b):
                                 ip += 1
                             else:
                                 ip = ins[4]
-                        elif op < 106:
-                            a = store[ins[1]]
-                            b = ins[2]
-                            t = ins[4]
-                            ca = type(a)
-                            if ca is type(b) and ca is t and (ca is float or (ca is int and INT_MIN <= (v := (a + b)) <= INT_MAX)):
-                                store[ins[3]] = a + b if ca is float else v
+                        elif op < 56:
+                            if op < 55:
+                                b = stack.pop()
+                                a = stack.pop()
+                                ca = type(a)
+                                cb = type(b)
+                                if a >= b if (ca is int or ca is float) and (cb is int or cb is float) else _ge(a, b):
+                                    ip += 1
+                                else:
+                                    ip = ins[1]
                             else:
-                                _store(fvars[ins[3]], _add(a if a is not UNSET else _load(fvars[ins[1]]), b))
-                            ip += 1
-                        elif op < 107:
-                            b = stack.pop()
-                            stack[-1] = _eq(stack[-1], b)
+                                b = stack.pop()
+                                a = stack.pop()
+                                ca = type(a)
+                                cb = type(b)
+                                if a > b if (ca is int or ca is float) and (cb is int or cb is float) else _gt(a, b):
+                                    ip += 1
+                                else:
+                                    ip = ins[1]
+                        elif rt.to_bool(stack.pop()):
                             ip += 1
                         else:
-                            b = stack.pop()
-                            stack[-1] = _ge(stack[-1], b)
+                            ip = ins[1]
+                    elif op < 89:
+                        if op < 83:
+                            if op < 75:
+                                if op < 74:
+                                    if op < 73:
+                                        if op < 58:
+                                            b = ins[1]
+                                            a = stack[-1]
+                                            if type(a) is float and type(b) is float:
+                                                stack[-1] = a - b
+                                            elif type(a) is int and type(b) is int and (INT_MIN <= (v := (a - b)) <= INT_MAX):
+                                                stack[-1] = v
+                                            else:
+                                                stack[-1] = _sub(a, b)
+                                            ip += 1
+                                        elif op < 72:
+                                            if op < 59:
+                                                g = ins[1]
+                                                ref = grefs[g]
+                                                if ref is None:
+                                                    ref = rt.storage_ref(code.gstorage[g], frame)
+                                                    grefs[g] = ref
+                                                if op == 22:
+                                                    stack.append(_load(ref))
+                                                elif op == 23:
+                                                    stack.append(ref)
+                                                else:
+                                                    _store(ref, stack.pop())
+                                                ip += 1
+                                            elif op < 64:
+                                                if op < 61:
+                                                    if op < 60:
+                                                        rt.steps += unsaved
+                                                        unsaved = 0
+                                                        ip = cold[op](ins, code, frame, temps, stack, ip)
+                                                        left = task.quiet - rt.steps
+                                                    else:
+                                                        rt.steps += unsaved
+                                                        unsaved = 0
+                                                        ip = cold[op](ins, code, frame, temps, stack, ip)
+                                                        left = task.quiet - rt.steps
+                                                elif op < 62:
+                                                    rt.steps += unsaved
+                                                    unsaved = 0
+                                                    ip = cold[op](ins, code, frame, temps, stack, ip)
+                                                    left = task.quiet - rt.steps
+                                                elif op < 63:
+                                                    rt.steps += unsaved
+                                                    unsaved = 0
+                                                    ip = cold[op](ins, code, frame, temps, stack, ip)
+                                                    left = task.quiet - rt.steps
+                                                else:
+                                                    rt.steps += unsaved
+                                                    unsaved = 0
+                                                    ip = cold[op](ins, code, frame, temps, stack, ip)
+                                                    left = task.quiet - rt.steps
+                                            elif op < 68:
+                                                if op < 66:
+                                                    if op < 65:
+                                                        rt.steps += unsaved
+                                                        unsaved = 0
+                                                        ip = cold[op](ins, code, frame, temps, stack, ip)
+                                                        left = task.quiet - rt.steps
+                                                    else:
+                                                        rt.steps += unsaved
+                                                        unsaved = 0
+                                                        ip = cold[op](ins, code, frame, temps, stack, ip)
+                                                        left = task.quiet - rt.steps
+                                                elif op < 67:
+                                                    rt.steps += unsaved
+                                                    unsaved = 0
+                                                    ip = cold[op](ins, code, frame, temps, stack, ip)
+                                                    left = task.quiet - rt.steps
+                                                else:
+                                                    rt.steps += unsaved
+                                                    unsaved = 0
+                                                    ip = cold[op](ins, code, frame, temps, stack, ip)
+                                                    left = task.quiet - rt.steps
+                                            elif op < 70:
+                                                if op < 69:
+                                                    rt.steps += unsaved
+                                                    unsaved = 0
+                                                    ip = cold[op](ins, code, frame, temps, stack, ip)
+                                                    left = task.quiet - rt.steps
+                                                else:
+                                                    rt.steps += unsaved
+                                                    unsaved = 0
+                                                    ip = cold[op](ins, code, frame, temps, stack, ip)
+                                                    left = task.quiet - rt.steps
+                                            elif op < 71:
+                                                rt.steps += unsaved
+                                                unsaved = 0
+                                                ip = cold[op](ins, code, frame, temps, stack, ip)
+                                                left = task.quiet - rt.steps
+                                            else:
+                                                rt.steps += unsaved
+                                                unsaved = 0
+                                                ip = cold[op](ins, code, frame, temps, stack, ip)
+                                                left = task.quiet - rt.steps
+                                        else:
+                                            _store(temps[ins[1]], stack.pop())
+                                            ip += 1
+                                    else:
+                                        stack[-1] = rt.unary_op(ins[1], stack[-1])
+                                        ip += 1
+                                else:
+                                    a = store[ins[1]]
+                                    b = ins[2]
+                                    t = ins[4]
+                                    ca = type(a)
+                                    if ca is type(b) and ca is t and (ca is float or (ca is int and INT_MIN <= (v := (a - b)) <= INT_MAX)):
+                                        store[ins[3]] = a - b if ca is float else v
+                                    else:
+                                        _store(fvars[ins[3]], _sub(a if a is not UNSET else _load(fvars[ins[1]]), b))
+                                    ip += 1
+                            elif op < 78:
+                                if op < 77:
+                                    if op < 76:
+                                        a = store[ins[1]]
+                                        b = ins[2]
+                                        if type(a) is int and type(b) is int and (INT_MIN <= (v := (a - b)) <= INT_MAX):
+                                            stack.append(v)
+                                        elif type(a) is float and type(b) is float:
+                                            stack.append(a - b)
+                                        else:
+                                            stack.append(_sub(a if a is not UNSET else _load(fvars[ins[1]]), b))
+                                        ip += 1
+                                    else:
+                                        _store(fvars[ins[1]], stack.pop())
+                                        ip += 1
+                                else:
+                                    _set_component(fvars[ins[1]], ins[2][0], stack.pop(), ins[3])
+                                    ip += 1
+                            elif op < 80:
+                                if op < 79:
+                                    stack.append(_load(fvars[ins[1]]))
+                                    ip += 1
+                                else:
+                                    ip = ins[1]
+                            elif op < 82:
+                                if op < 81:
+                                    t = ins[1]
+                                    step = stack.pop()
+                                    end = stack.pop()
+                                    start = stack.pop()
+                                    temps[t] = stack.pop()
+                                    temps[t + 1], temps[t + 2] = end, step = _for_limits(end, step)
+                                    temps[t + 3] = min(end, INT_MAX) if type(step) is int and step > 0 else -math.inf
+                                    stack.append(start)
+                                    ip += 1
+                                else:
+                                    stack[-1] = _read_value(stack[-1])
+                                    ip += 1
+                            else:
+                                b = stack.pop()
+                                a = stack.pop()
+                                ca = type(a)
+                                cb = type(b)
+                                if a < b if (ca is int or ca is float) and (cb is int or cb is float) else _lt(a, b):
+                                    ip += 1
+                                else:
+                                    ip = ins[1]
+                        elif op < 84:
+                            stack.append(ins[1])
                             ip += 1
-                    elif op < 111:
-                        if op < 109:
-                            j = stack.pop()
+                        elif op < 85:
                             i = stack.pop()
                             v = stack.pop()
                             a = store[ins[1]]
-                            n, m = a.dims
                             t = ins[3]
-                            if type(i) is int and type(j) is int and (0 < i <= n) and (0 < j <= m) and (type(v) is t) and (t is not int or INT_MIN <= v <= INT_MAX):
-                                a.data[(i - 1) * m + j - 1] = v
+                            if type(i) is int and 0 < i <= a.dims[0] and (type(v) is t) and (t is not int or INT_MIN <= v <= INT_MAX):
+                                a.data[i - 1] = v
                             else:
-                                _set_element(fvars[ins[1]], [i, j], v, ins[2])
+                                _set_element1(fvars[ins[1]], i, v, ins[2])
                             ip += 1
-                        elif op < 110:
+                        elif op < 86:
+                            base = fvars[ins[1]]
+                            if type(base) is Slot and type((x := base.c[base.k])) is Struct and (type((x := x.f.get(ins[2][1]))) is float or type(x) is int or type(x) is bool):
+                                stack.append(x)
+                            else:
+                                stack.append(_component(base, ins[2][0], ins[3]))
+                            ip += 1
+                        elif op < 88:
+                            if op < 87:
+                                stack.pop()
+                                ip += 1
+                            else:
+                                stack.append(None)
+                                ip += 1
+                        else:
+                            if code.kind == 'DEFFCT':
+                                raise ended_without_return(code.routine, frame.line)
+                            return None
+                    elif op < 104:
+                        if op < 97:
+                            if op < 93:
+                                if op < 92:
+                                    if op < 91:
+                                        if op < 90:
+                                            if rt.to_bool(stack.pop()):
+                                                ip = ins[1]
+                                            else:
+                                                ip += 1
+                                        else:
+                                            temps[ins[1]] = stack.pop()
+                                            ip += 1
+                                    else:
+                                        v = stack.pop()
+                                        return v if code.kind == 'DEFFCT' else None
+                                else:
+                                    base = stack[-1]
+                                    if type(base) is Slot and type((x := base.c[base.k])) is Struct and (type((x := x.f.get(ins[1][1]))) is float or type(x) is int or type(x) is bool):
+                                        stack[-1] = x
+                                    else:
+                                        stack[-1] = _component(base, ins[1][0], ins[2])
+                                    ip += 1
+                            elif op < 96:
+                                if op < 95:
+                                    if op < 94:
+                                        stack.append(temps[ins[1]])
+                                        ip += 1
+                                    else:
+                                        return stack[-1] if stack else None
+                                else:
+                                    stack[-1] = ValueRef(stack[-1])
+                                    ip += 1
+                            else:
+                                b = stack.pop()
+                                a = stack[-1]
+                                if type(a) is float and type(b) is float:
+                                    stack[-1] = a * b
+                                elif type(a) is int and type(b) is int and (INT_MIN <= (v := (a * b)) <= INT_MAX):
+                                    stack[-1] = v
+                                else:
+                                    stack[-1] = _mul(a, b)
+                                ip += 1
+                        elif op < 98:
+                            v = stack.pop()
+                            t = ins[2]
+                            if type(v) is t and (t is not int or INT_MIN <= v <= INT_MAX):
+                                store[ins[1]] = v
+                            else:
+                                _store(fvars[ins[1]], v)
+                            ip += 1
+                        elif op < 101:
+                            if op < 99:
+                                _store(mrefs[ins[1]], stack.pop())
+                                ip += 1
+                            elif op < 100:
+                                stack[-1] = rt.field(stack[-1], ins[1], ins[2])
+                                ip += 1
+                            else:
+                                stack.append(mrefs[ins[1]])
+                                ip += 1
+                        elif op < 102:
+                            stack.append(_load(mrefs[ins[1]]))
+                            ip += 1
+                        elif op < 103:
                             b = stack.pop()
-                            stack[-1] = _gt(stack[-1], b)
+                            stack[-1] = rt.binary_op(ins[1], stack[-1], b)
                             ip += 1
                         else:
                             b = stack.pop()
-                            stack[-1] = _le(stack[-1], b)
+                            stack[-1] = _ne(stack[-1], b)
+                            ip += 1
+                    elif op < 112:
+                        if op < 108:
+                            if op < 105:
+                                a = store[ins[1]]
+                                b = store[ins[2]]
+                                ca = type(a)
+                                cb = type(b)
+                                f = ins[3]
+                                if f[0](a, b) if (ca is int or ca is float) and (cb is int or cb is float) else f[1](a if a is not UNSET else _load(fvars[ins[1]]), b if b is not UNSET else _load(fvars[ins[2]])):
+                                    ip += 1
+                                else:
+                                    ip = ins[4]
+                            elif op < 106:
+                                a = store[ins[1]]
+                                b = ins[2]
+                                t = ins[4]
+                                ca = type(a)
+                                if ca is type(b) and ca is t and (ca is float or (ca is int and INT_MIN <= (v := (a + b)) <= INT_MAX)):
+                                    store[ins[3]] = a + b if ca is float else v
+                                else:
+                                    _store(fvars[ins[3]], _add(a if a is not UNSET else _load(fvars[ins[1]]), b))
+                                ip += 1
+                            elif op < 107:
+                                b = stack.pop()
+                                stack[-1] = _eq(stack[-1], b)
+                                ip += 1
+                            else:
+                                b = stack.pop()
+                                stack[-1] = _ge(stack[-1], b)
+                                ip += 1
+                        elif op < 111:
+                            if op < 109:
+                                j = stack.pop()
+                                i = stack.pop()
+                                v = stack.pop()
+                                a = store[ins[1]]
+                                n, m = a.dims
+                                t = ins[3]
+                                if type(i) is int and type(j) is int and (0 < i <= n) and (0 < j <= m) and (type(v) is t) and (t is not int or INT_MIN <= v <= INT_MAX):
+                                    a.data[(i - 1) * m + j - 1] = v
+                                else:
+                                    _set_element(fvars[ins[1]], [i, j], v, ins[2])
+                                ip += 1
+                            elif op < 110:
+                                b = stack.pop()
+                                stack[-1] = _gt(stack[-1], b)
+                                ip += 1
+                            else:
+                                b = stack.pop()
+                                stack[-1] = _le(stack[-1], b)
+                                ip += 1
+                        else:
+                            stack.append(fvars[ins[1]])
                             ip += 1
                     else:
-                        stack.append(fvars[ins[1]])
-                        ip += 1
-                else:
-                    n = rt.steps
-                    if n < task.quiet and (not ins[1].cond_stops):
-                        rt.steps = n + 1
-                    else:
-                        tick(ins[1])
-                        task.quiet = quiet_limit(task)
-                    ip = ins[2]
-        except KrlRuntimeError as e:
-            reg = code.iregions[ip]
-            if reg is None:
-                raise
-            e.at(code.file, reg.line)
-            if reg.kind != 'G' or thunk or (not proceed):
-                raise
-            proceed = False
-            rt.record_error(e, frame)
-            del stack[:]
-            ip = reg.end
+                        if left > 0 and (not ins[1].cond_stops):
+                            left -= 1
+                            unsaved += 1
+                        else:
+                            rt.steps += unsaved
+                            unsaved = 0
+                            tick(ins[1])
+                            task.quiet = n = quiet_limit(task)
+                            left = n - rt.steps
+                        ip = ins[2]
+            except KrlRuntimeError as e:
+                reg = code.iregions[ip]
+                if reg is None:
+                    raise
+                e.at(code.file, reg.line)
+                if reg.kind != 'G' or thunk or (not proceed):
+                    raise
+                proceed = False
+                rt.steps += unsaved
+                unsaved = 0
+                rt.record_error(e, frame)
+                left = task.quiet - rt.steps
+                del stack[:]
+                ip = reg.end
+    finally:
+        rt.steps += unsaved
