@@ -10,6 +10,7 @@ skipped when the extension is newer than loop.py and loop.pxd.
 
 from __future__ import annotations
 
+import os
 import sys
 import sysconfig
 from pathlib import Path
@@ -43,12 +44,14 @@ def build(force: bool = False) -> str:
                          compiler_directives={"language_level": 3})
         dist = Distribution({"name": "krl-vm-loop", "ext_modules": exts})
         cmd = build_ext(dist)
-        cmd.inplace = True
+        cmd.build_lib = str(tmp / "lib")
         cmd.build_temp = str(tmp / "temp")
         cmd.ensure_finalized()
         cmd.run()
     except Exception as e:  # noqa: BLE001  (no compiler, no Python headers: the fallback runs)
         return f"not compiled ({type(e).__name__}: {e}): the VM runs the pure-Python loop.py"
+    # a rename, not a copy over the old file: a process that has the old one loaded keeps it
+    os.replace(tmp / "lib" / "interp" / "vm" / out.name, out)
     return f"compiled {out.relative_to(REPO)}"
 
 

@@ -9,7 +9,7 @@ there; vm.py runs the compiled module only when its VM_SOURCE matches vm.py."""
 from interp.vm.vm import (INT_MAX, INT_MIN, KrlRuntimeError, Slot, Struct, UNSET, ValueRef, add, array_index, component, element, element1, element2, ended_without_return, eq, for_done, for_limits, for_next, function_result, ge, gt, le, load, lt, math, mul, ne, read_value, return_without_value, set_component, set_element, set_element1, store, sub)
 
 # sha256 of the vm.py this file was generated from
-VM_SOURCE = 'c72e7d5eb3869bf1a0245aa2fb1bc8ab3447a2136e653f40e5ea4a9d5bf8a0f4'
+VM_SOURCE = '4d994424e87115eb5ff88ef130718be1d12eb56faf0abab8f40c1690eefbdd1f'
 
 # opcode number (interp/vm/opcodes.py) -> this loop's number of the opcode
 DISPATCH = [43, 0, 35, 83, 87, 86, 78, 101, 22, 111, 100, 23, 24, 99, 26, 34, 92, 40, 81, 5, 76, 98, 58, 93, 90, 95, 62, 102, 73, 2, 28, 96, 4, 110, 109, 107, 106, 103, 42, 33, 30, 41, 25, 38, 31, 112, 57, 32, 82, 44, 55, 54, 49, 48, 51, 36, 29, 75, 97, 45, 50, 84, 108, 1, 37, 47, 85, 77, 52, 105, 74, 104, 53, 79, 56, 89, 8, 80, 72, 27, 39, 3, 46, 91, 88, 94, 71, 60, 61, 66, 10, 69, 70, 11, 7, 6, 65, 18, 67, 64, 63, 68, 12, 20, 59, 19, 21, 9, 14, 16, 17, 15, 13]
@@ -65,8 +65,8 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                     if op < 36:
                         if op < 1:
                             info = ins[1]
-                            frame.line = info.line
-                            if left > 0 and (not info.stops):
+                            frame.line = ins[2]
+                            if left > 0 and (not ins[3]):
                                 left -= 1
                                 unsaved += 1
                                 task.at = info
@@ -393,8 +393,8 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                     else:
                                         info = ins[1]
                                         if not thunk:
-                                            frame.line = info.line
-                                        if left > 0 and (not info.stops):
+                                            frame.line = ins[2]
+                                        if left > 0 and (not ins[3]):
                                             left -= 1
                                             unsaved += 1
                                             task.at = info

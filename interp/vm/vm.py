@@ -71,7 +71,8 @@ _COMPARE = {"<": (operator.lt, lt), "<=": (operator.le, le), ">": (operator.gt, 
 
 class Linked:
     """The VM's executed form of one routine, made from its listing (interp/vm/compiler.py)
-    by :func:`link`: one tuple ``(opcode, operand, ...)`` per instruction of the listing, in
+    by :func:`link`: one tuple ``(opcode, operand, ...)`` per instruction of the listing
+    (``STMT_G``/``STMT`` also carry their statement's line and ``stops`` after it), in
     the listing's order (so `krl asm`, which prints the listing, shows exactly what runs),
     constants and statement infos in place, jump targets as instruction numbers, frame slots
     as slot numbers, module and global slots as indexes into ``mstorage`` / ``gstorage``
@@ -123,6 +124,8 @@ def link(lst, dispatch) -> Linked:
             elif k == "k":
                 v = (v, v.upper())
             ins.append(v)
+        if name == "STMT_G" or name == "STMT":
+            ins += (ins[1].line, ins[1].stops)      # read by every statement: kept in the tuple
         prog.append(tuple(ins))
         if reg is not None and reg.kind == "G":
             got = moved.get(id(reg))
@@ -483,8 +486,8 @@ class VM:
                         # tree interp/vm/gen_loop.py makes of this chain
                         if op == OP.STMT_G:
                             info = ins[1]
-                            frame.line = info.line
-                            if left > 0 and not info.stops:     # a quiet step (Runtime.quiet_limit)
+                            frame.line = ins[2]                 # info.line, info.stops: link()
+                            if left > 0 and not ins[3]:         # a quiet step (Runtime.quiet_limit)
                                 left -= 1
                                 unsaved += 1
                                 task.at = info
@@ -706,8 +709,8 @@ class VM:
                         elif op == OP.STMT:
                             info = ins[1]
                             if not thunk:
-                                frame.line = info.line
-                            if left > 0 and not info.stops:
+                                frame.line = ins[2]
+                            if left > 0 and not ins[3]:
                                 left -= 1
                                 unsaved += 1
                                 task.at = info
