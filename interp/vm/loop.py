@@ -9,7 +9,7 @@ there; vm.py runs the compiled module only when its VM_SOURCE matches vm.py."""
 from interp.vm.vm import (INT_MAX, INT_MIN, KrlRuntimeError, Slot, Struct, UNSET, ValueRef, add, array_index, component, element, element1, element2, ended_without_return, eq, for_done, for_limits, for_next, function_result, ge, gt, le, load, lt, math, mul, ne, read_value, return_without_value, set_component, set_element, set_element1, store, sub)
 
 # sha256 of the vm.py this file was generated from
-VM_SOURCE = '4d994424e87115eb5ff88ef130718be1d12eb56faf0abab8f40c1690eefbdd1f'
+VM_SOURCE = 'e65af394e2af81e6761bd16e55a37f8b07653c84d2fc9373430f57830b07b811'
 
 # opcode number (interp/vm/opcodes.py) -> this loop's number of the opcode
 DISPATCH = [43, 0, 35, 83, 87, 86, 78, 101, 22, 111, 100, 23, 24, 99, 26, 34, 92, 40, 81, 5, 76, 98, 58, 93, 90, 95, 62, 102, 73, 2, 28, 96, 4, 110, 109, 107, 106, 103, 42, 33, 30, 41, 25, 38, 31, 112, 57, 32, 82, 44, 55, 54, 49, 48, 51, 36, 29, 75, 97, 45, 50, 84, 108, 1, 37, 47, 85, 77, 52, 105, 74, 104, 53, 79, 56, 89, 8, 80, 72, 27, 39, 3, 46, 91, 88, 94, 71, 60, 61, 66, 10, 69, 70, 11, 7, 6, 65, 18, 67, 64, 63, 68, 12, 20, 59, 19, 21, 9, 14, 16, 17, 15, 13]
@@ -53,7 +53,7 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
     before, tick, take_error_proceed, quiet_limit = self.hooks
     cold = self.cold
     task = rt.current_task
-    left = task.quiet - rt.steps
+    left = task.quiet - rt.steps if task is not None else 0
     unsaved = 0
     proceed = False
     try:
@@ -114,7 +114,7 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                         v = self.invoke(target, args, frame, 'N' not in flags)
                                     else:
                                         v = self.call(code, ip, ins[1], args, frame, flags)
-                                    left = task.quiet - rt.steps
+                                    left = task.quiet - rt.steps if task is not None else 0
                                     if flags == 'E':
                                         stack.append(v if v is not None else function_result(ins[1], v))
                                     ip += 1
@@ -136,86 +136,86 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                                         rt.steps += unsaved
                                                         unsaved = 0
                                                         ip = cold[op](ins, code, frame, temps, stack, ip)
-                                                        left = task.quiet - rt.steps
+                                                        left = task.quiet - rt.steps if task is not None else 0
                                                     else:
                                                         rt.steps += unsaved
                                                         unsaved = 0
                                                         ip = cold[op](ins, code, frame, temps, stack, ip)
-                                                        left = task.quiet - rt.steps
+                                                        left = task.quiet - rt.steps if task is not None else 0
                                                 elif op < 9:
                                                     rt.steps += unsaved
                                                     unsaved = 0
                                                     ip = cold[op](ins, code, frame, temps, stack, ip)
-                                                    left = task.quiet - rt.steps
+                                                    left = task.quiet - rt.steps if task is not None else 0
                                                 else:
                                                     rt.steps += unsaved
                                                     unsaved = 0
                                                     ip = cold[op](ins, code, frame, temps, stack, ip)
-                                                    left = task.quiet - rt.steps
+                                                    left = task.quiet - rt.steps if task is not None else 0
                                             elif op < 12:
                                                 if op < 11:
                                                     rt.steps += unsaved
                                                     unsaved = 0
                                                     ip = cold[op](ins, code, frame, temps, stack, ip)
-                                                    left = task.quiet - rt.steps
+                                                    left = task.quiet - rt.steps if task is not None else 0
                                                 else:
                                                     rt.steps += unsaved
                                                     unsaved = 0
                                                     ip = cold[op](ins, code, frame, temps, stack, ip)
-                                                    left = task.quiet - rt.steps
+                                                    left = task.quiet - rt.steps if task is not None else 0
                                             elif op < 13:
                                                 rt.steps += unsaved
                                                 unsaved = 0
                                                 ip = cold[op](ins, code, frame, temps, stack, ip)
-                                                left = task.quiet - rt.steps
+                                                left = task.quiet - rt.steps if task is not None else 0
                                             else:
                                                 rt.steps += unsaved
                                                 unsaved = 0
                                                 ip = cold[op](ins, code, frame, temps, stack, ip)
-                                                left = task.quiet - rt.steps
+                                                left = task.quiet - rt.steps if task is not None else 0
                                         elif op < 18:
                                             if op < 16:
                                                 if op < 15:
                                                     rt.steps += unsaved
                                                     unsaved = 0
                                                     ip = cold[op](ins, code, frame, temps, stack, ip)
-                                                    left = task.quiet - rt.steps
+                                                    left = task.quiet - rt.steps if task is not None else 0
                                                 else:
                                                     rt.steps += unsaved
                                                     unsaved = 0
                                                     ip = cold[op](ins, code, frame, temps, stack, ip)
-                                                    left = task.quiet - rt.steps
+                                                    left = task.quiet - rt.steps if task is not None else 0
                                             elif op < 17:
                                                 rt.steps += unsaved
                                                 unsaved = 0
                                                 ip = cold[op](ins, code, frame, temps, stack, ip)
-                                                left = task.quiet - rt.steps
+                                                left = task.quiet - rt.steps if task is not None else 0
                                             else:
                                                 rt.steps += unsaved
                                                 unsaved = 0
                                                 ip = cold[op](ins, code, frame, temps, stack, ip)
-                                                left = task.quiet - rt.steps
+                                                left = task.quiet - rt.steps if task is not None else 0
                                         elif op < 20:
                                             if op < 19:
                                                 rt.steps += unsaved
                                                 unsaved = 0
                                                 ip = cold[op](ins, code, frame, temps, stack, ip)
-                                                left = task.quiet - rt.steps
+                                                left = task.quiet - rt.steps if task is not None else 0
                                             else:
                                                 rt.steps += unsaved
                                                 unsaved = 0
                                                 ip = cold[op](ins, code, frame, temps, stack, ip)
-                                                left = task.quiet - rt.steps
+                                                left = task.quiet - rt.steps if task is not None else 0
                                         elif op < 21:
                                             rt.steps += unsaved
                                             unsaved = 0
                                             ip = cold[op](ins, code, frame, temps, stack, ip)
-                                            left = task.quiet - rt.steps
+                                            left = task.quiet - rt.steps if task is not None else 0
                                         else:
                                             rt.steps += unsaved
                                             unsaved = 0
                                             ip = cold[op](ins, code, frame, temps, stack, ip)
-                                            left = task.quiet - rt.steps
+                                            left = task.quiet - rt.steps if task is not None else 0
                                     elif op < 23:
                                         g = ins[1]
                                         ref = grefs[g]
@@ -560,70 +560,70 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                                         rt.steps += unsaved
                                                         unsaved = 0
                                                         ip = cold[op](ins, code, frame, temps, stack, ip)
-                                                        left = task.quiet - rt.steps
+                                                        left = task.quiet - rt.steps if task is not None else 0
                                                     else:
                                                         rt.steps += unsaved
                                                         unsaved = 0
                                                         ip = cold[op](ins, code, frame, temps, stack, ip)
-                                                        left = task.quiet - rt.steps
+                                                        left = task.quiet - rt.steps if task is not None else 0
                                                 elif op < 62:
                                                     rt.steps += unsaved
                                                     unsaved = 0
                                                     ip = cold[op](ins, code, frame, temps, stack, ip)
-                                                    left = task.quiet - rt.steps
+                                                    left = task.quiet - rt.steps if task is not None else 0
                                                 elif op < 63:
                                                     rt.steps += unsaved
                                                     unsaved = 0
                                                     ip = cold[op](ins, code, frame, temps, stack, ip)
-                                                    left = task.quiet - rt.steps
+                                                    left = task.quiet - rt.steps if task is not None else 0
                                                 else:
                                                     rt.steps += unsaved
                                                     unsaved = 0
                                                     ip = cold[op](ins, code, frame, temps, stack, ip)
-                                                    left = task.quiet - rt.steps
+                                                    left = task.quiet - rt.steps if task is not None else 0
                                             elif op < 68:
                                                 if op < 66:
                                                     if op < 65:
                                                         rt.steps += unsaved
                                                         unsaved = 0
                                                         ip = cold[op](ins, code, frame, temps, stack, ip)
-                                                        left = task.quiet - rt.steps
+                                                        left = task.quiet - rt.steps if task is not None else 0
                                                     else:
                                                         rt.steps += unsaved
                                                         unsaved = 0
                                                         ip = cold[op](ins, code, frame, temps, stack, ip)
-                                                        left = task.quiet - rt.steps
+                                                        left = task.quiet - rt.steps if task is not None else 0
                                                 elif op < 67:
                                                     rt.steps += unsaved
                                                     unsaved = 0
                                                     ip = cold[op](ins, code, frame, temps, stack, ip)
-                                                    left = task.quiet - rt.steps
+                                                    left = task.quiet - rt.steps if task is not None else 0
                                                 else:
                                                     rt.steps += unsaved
                                                     unsaved = 0
                                                     ip = cold[op](ins, code, frame, temps, stack, ip)
-                                                    left = task.quiet - rt.steps
+                                                    left = task.quiet - rt.steps if task is not None else 0
                                             elif op < 70:
                                                 if op < 69:
                                                     rt.steps += unsaved
                                                     unsaved = 0
                                                     ip = cold[op](ins, code, frame, temps, stack, ip)
-                                                    left = task.quiet - rt.steps
+                                                    left = task.quiet - rt.steps if task is not None else 0
                                                 else:
                                                     rt.steps += unsaved
                                                     unsaved = 0
                                                     ip = cold[op](ins, code, frame, temps, stack, ip)
-                                                    left = task.quiet - rt.steps
+                                                    left = task.quiet - rt.steps if task is not None else 0
                                             elif op < 71:
                                                 rt.steps += unsaved
                                                 unsaved = 0
                                                 ip = cold[op](ins, code, frame, temps, stack, ip)
-                                                left = task.quiet - rt.steps
+                                                left = task.quiet - rt.steps if task is not None else 0
                                             else:
                                                 rt.steps += unsaved
                                                 unsaved = 0
                                                 ip = cold[op](ins, code, frame, temps, stack, ip)
-                                                left = task.quiet - rt.steps
+                                                left = task.quiet - rt.steps if task is not None else 0
                                         else:
                                             _store(temps[ins[1]], stack.pop())
                                             ip += 1
@@ -866,7 +866,7 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                 rt.steps += unsaved
                 unsaved = 0
                 rt.record_error(e, frame)
-                left = task.quiet - rt.steps
+                left = task.quiet - rt.steps if task is not None else 0
                 del stack[:]
                 ip = reg.end
     finally:

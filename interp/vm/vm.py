@@ -473,7 +473,8 @@ class VM:
         # rt.steps. Before anything that reads or changes rt.steps or task.quiet (the full
         # statement hooks, a call, a cold opcode, an error's $ERR, leaving the loop) the loop
         # adds ``unsaved`` to rt.steps; after it, it takes ``left`` from task.quiet again.
-        left = task.quiet - rt.steps
+        # (No task: a cyclic flag's or analog output's expression the controller evaluates.)
+        left = task.quiet - rt.steps if task is not None else 0
         unsaved = 0
         proceed = False
         try:
@@ -781,7 +782,7 @@ class VM:
                                 v = self.invoke(target, args, frame, "N" not in flags)
                             else:
                                 v = self.call(code, ip, ins[1], args, frame, flags)
-                            left = task.quiet - rt.steps
+                            left = task.quiet - rt.steps if task is not None else 0
                             if flags == "E":
                                 push(v if v is not None else function_result(ins[1], v))
                             ip += 1
@@ -1073,7 +1074,7 @@ class VM:
                             rt.steps += unsaved
                             unsaved = 0
                             ip = cold[op](ins, code, frame, temps, stack, ip)
-                            left = task.quiet - rt.steps
+                            left = task.quiet - rt.steps if task is not None else 0
                         else:
                             raise RuntimeError(f"bad opcode {op} at {ip} in {code.name}")
                 except KrlRuntimeError as e:
@@ -1087,7 +1088,7 @@ class VM:
                     rt.steps += unsaved
                     unsaved = 0
                     rt.record_error(e, frame)
-                    left = task.quiet - rt.steps
+                    left = task.quiet - rt.steps if task is not None else 0
                     del stack[:]
                     ip = reg.end
         finally:
