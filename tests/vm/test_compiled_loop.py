@@ -15,18 +15,14 @@ import shutil
 import sys
 import sysconfig
 import types
-from pathlib import Path
 
 import pytest
 
 from interp.run import make_runtime
 from interp.vm import build
 from interp.vm import vm as V
-from robot.trace import TraceWriter
 
-REPO = Path(__file__).resolve().parents[2]
-PROGRAMS = sorted((REPO / "tests" / "vm" / "programs" / "fast").glob("*.src")) + \
-    [REPO / "interp" / "bench" / "bench.src"]
+from .test_generated_loop import PROGRAMS, _trace
 
 
 def _can_compile() -> bool:
@@ -45,16 +41,6 @@ def test_the_compiled_loop_is_built_and_runs():
     assert not V._loop.__file__.endswith(".py")
     rt, vm = make_runtime(PROGRAMS[-1], mujoco=False, interp="vm")
     assert vm.loop is V._loop.run and not inspect.isfunction(vm.loop)     # compiled, not bytecode
-
-
-def _trace(program: Path, interp: str, loop: str = "generated"):
-    tw = TraceWriter(keep=True)
-    stimuli = program.with_suffix(".yaml")
-    rt, _ = make_runtime(program, trace=tw, mujoco=False, interp=interp, max_steps=200_000,
-                         max_sim_time=30.0, check=False, vm_loop=loop,
-                         inputs=stimuli if stimuli.exists() else None)
-    res = rt.run()
-    return (res.reason, res.text, res.line, rt.steps), list(tw.events)
 
 
 @pytest.mark.parametrize("program", PROGRAMS[1::2], ids=lambda p: p.stem)
