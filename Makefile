@@ -11,7 +11,7 @@ GEN_DIR := krl/syntax/generated
 PARSER  := $(GEN_DIR)/KRLParser.py
 SHARED_CORPUS ?= ../shared/krl-corpus
 
-.PHONY: all recover test validate growth conformance nightly bench parser java-parser clean check-python check-java vsix check-node
+.PHONY: all recover test validate growth conformance nightly bench parser java-parser clean check-python check-java vsix check-node vm-loop
 
 all: test
 
@@ -48,6 +48,12 @@ $(JAVA_STAMP): $(PARSER)
 
 java-parser: $(JAVA_STAMP)
 
+# The compiled VM loop: Cython compiles the generated interp/vm/loop.py (with loop.pxd) into
+# an extension beside it (interp/vm/build.py). Without Cython or a C compiler it says so and
+# the pure-Python loop.py runs.
+vm-loop: $(BIN)/.installed
+	@$(BIN)/python -m interp.vm.build
+
 recover: $(PARSER) java-parser
 	$(BIN)/krl recover $(CORPUS) --out $(OUT); status=$$?; \
 	  if [ $$status -le 1 ]; then echo "report: $(OUT)/report.html (open it in a browser; Markdown: $(OUT)/report.md)"; exit 0; else exit $$status; fi
@@ -58,14 +64,14 @@ growth: $(PARSER) java-parser
 validate: $(PARSER) java-parser
 	$(BIN)/krl validate
 
-test: $(PARSER) java-parser
+test: $(PARSER) java-parser vm-loop
 	$(BIN)/python -m pytest -q -n 2 -p no:cacheprovider -r fEsxX
 
-bench: $(PARSER) java-parser
+bench: $(PARSER) java-parser vm-loop
 	$(BIN)/krl bench
 
 clean:
-	rm -rf $(VENV) $(GEN_DIR) build/java reports/recovery reports/growth
+	rm -rf $(VENV) $(GEN_DIR) build/java build/cython interp/vm/*.so reports/recovery reports/growth
 
 # Conformance suites (issue 8): hand-written cases, differential fuzzing, corpus programs.
 CONF_OUT  ?= reports/conformance

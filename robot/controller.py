@@ -740,6 +740,8 @@ class Controller:
     def _check_speed(self, q: np.ndarray) -> None:
         """Reject a setpoint that would move an axis faster than
         ``CP_SPEED_LIMIT_FACTOR`` x its maximum speed (a CP path through a singularity)."""
+        if q is self._q_prev:        # at rest: the main run kept the last setpoint
+            return
         step = np.abs(np.asarray(q) - self._q_prev)
         lim = CP_SPEED_LIMIT_FACTOR * self.model.v_max * self.dt + 1e-9
         if np.any(step > lim):

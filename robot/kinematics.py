@@ -73,6 +73,7 @@ class Kinematics:
         self.phi_deg = float(m.status_phi_deg)
         self._ks = np.arange(-2, 3) * 360.0
         self._rows = np.arange(6)
+        self._fk_last: tuple[bytes, np.ndarray] | None = None   # (axes, FLANGE) of the last forward()
 
     # ------------------------------------------------------------------ FK
     def forward(self, axes_deg: Sequence[float]) -> np.ndarray:
@@ -82,8 +83,15 @@ class Kinematics:
             axes_deg: A1..A6 in degrees (6 values).
         Returns:
             4x4 homogeneous transform, translation in mm.
+
+        The last result is kept: a robot at rest asks for the same axes every IPO cycle.
         """
-        q = self._kuka_sign * np.radians(np.asarray(axes_deg, dtype=float)[:6])
+        a = np.asarray(axes_deg, dtype=float)[:6]
+        key = a.tobytes()
+        last = self._fk_last
+        if last is not None and last[0] == key:
+            return last[1].copy()
+        q = self._kuka_sign * np.radians(a)
         Rj = Rotation.from_rotvec(self._axes * q[:, None]).as_matrix()  # (6, 3, 3)
         R = np.eye(3)
         p = np.zeros(3)
@@ -95,6 +103,7 @@ class Kinematics:
         T = np.eye(4)
         T[:3, :3] = R @ self._R_flange
         T[:3, 3] = p + R @ self._p_flange
+        self._fk_last = (key, T.copy())
         return T
 
     def forward_many(self, axes_deg: np.ndarray) -> np.ndarray:

@@ -539,6 +539,13 @@ class Runtime:
                     fvars[k] = Slot(store, k, t, name)
                     continue
                 v = a.peek()
+                if v.__class__ is Struct and v.type is t:
+                    # a structure of the parameter's own type: its copy (the same components,
+                    # already of their types: what make_value + assign_into give), its size
+                    frame.data += self.memory.take(size, f"a copy of :IN parameter {name}")
+                    store[k] = copy_value(v)
+                    fvars[k] = Slot(store, k, t, name)
+                    continue
                 frame.data += self.memory.take(value_size(v) if isinstance(v, (Struct, Arr)) else size,
                                                f"a copy of :IN parameter {name}")
                 v = store[k] = self._param_copy(v, t, name)

@@ -3,7 +3,9 @@
 Pipeline, one file per stage: ``opcodes.py`` (the single opcode table) ->
 ``compiler.py`` (routine AST -> instruction listing) -> ``assembler.py`` (listing -> code;
 the readable text for `krl asm` and its round trip, never read at run time) -> ``vm.py`` (one dispatch loop on the shared runtime,
-interp/runtime). ``cli.py`` is `krl asm`; ``bench/`` the compute benchmark of `krl bench`.
+interp/runtime). ``gen_loop.py`` generates the dispatch loop ``loop.py`` from ``vm.py``;
+``build.py`` compiles it with Cython (``make vm-loop``; loop.py is the pure-Python fallback).
+``cli.py`` is `krl asm`; ``bench/`` the compute benchmark of `krl bench`.
 """
 
 __all__ = ["VM"]

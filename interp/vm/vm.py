@@ -71,7 +71,8 @@ _COMPARE = {"<": (operator.lt, lt), "<=": (operator.le, le), ">": (operator.gt, 
 
 class Linked:
     """The VM's executed form of one routine, made from its listing (interp/vm/compiler.py)
-    by :func:`link`: one tuple ``(opcode, operand, ...)`` per instruction of the listing, in
+    by :func:`link`: one tuple ``(opcode, operand, ...)`` per instruction of the listing
+    (``STMT_G``/``STMT`` also carry their statement's line and ``stops`` after it), in
     the listing's order (so `krl asm`, which prints the listing, shows exactly what runs),
     constants and statement infos in place, jump targets as instruction numbers, frame slots
     as slot numbers, module and global slots as indexes into ``mstorage`` / ``gstorage``
@@ -123,6 +124,8 @@ def link(lst, dispatch) -> Linked:
             elif k == "k":
                 v = (v, v.upper())
             ins.append(v)
+        if name == "STMT_G" or name == "STMT":
+            ins += (ins[1].line, ins[1].stops)      # read by every statement: kept in the tuple
         prog.append(tuple(ins))
         if reg is not None and reg.kind == "G":
             got = moved.get(id(reg))
@@ -161,11 +164,17 @@ class Bound:
 class VM:
     def __init__(self, rt, loop: str = "generated") -> None:
         """`loop`: "generated" (interp/vm/loop.py, the dispatch loop generated from
-        :meth:`run`, the default) or "source" (:meth:`run` itself, the handlers' source,
-        kept runnable and tested: tests/vm/test_generated_loop.py)."""
+        :meth:`run`, compiled by Cython when built: :data:`COMPILED`; the default),
+        "python" (loop.py as plain Python, also when the compiled one exists) or "source"
+        (:meth:`run` itself, the handlers' source); all three are kept runnable and tested
+        (tests/vm/test_generated_loop.py, tests/vm/test_compiled_loop.py)."""
         self.rt = rt
-        self.loop = _generated_run if loop == "generated" else VM.run
-        self.dispatch = GENERATED_DISPATCH if loop == "generated" else SOURCE_DISPATCH
+        if loop == "source":
+            self.loop, self.dispatch = VM.run, SOURCE_DISPATCH
+        elif loop == "python":
+            self.loop, self.dispatch = _python_loop().run, GENERATED_DISPATCH
+        else:
+            self.loop, self.dispatch = _generated_run, GENERATED_DISPATCH
         self.codes: dict = {}          # id(routine) -> Bound
         # the cold opcodes' handlers by the loop's number of the opcode
         self.cold = [None] * len(OP.OPS)
@@ -188,7 +197,7 @@ class VM:
         code = self.codes.get(id(routine))
         if code is None:
             extra = routine.ann.extra
-            key = "vm_linked" if self.loop is _generated_run else "vm_linked_source"
+            key = "vm_linked" if self.dispatch is GENERATED_DISPATCH else "vm_linked_source"
             linked = extra.get(key)
             if linked is None:
                 linked = extra[key] = link(compile_routine(routine), self.dispatch)
@@ -447,7 +456,7 @@ class VM:
         """Run ``code`` from ``ip`` in the activation of ``frame`` (its runtime Frame) with
         the temporaries ``temps``; returns the value of RETURN,
         or of the thunk at END_THUNK. The ``_name`` helpers are the runtime functions of
-        :data:`HELPERS`, closure variables of the loop (see :func:`_specialize`)."""
+        :data:`HELPERS` (module names of the generated loop: interp/vm/gen_loop.py)."""
         rt = self.rt
         prog = code.prog
         mrefs = code.mrefs
@@ -459,593 +468,631 @@ class VM:
         before, tick, take_error_proceed, quiet_limit = self.hooks
         cold = self.cold
         task = rt.current_task
+        # Quiet steps (Runtime.quiet_limit) are counted here, in two locals: ``left``, how many
+        # more steps may be quiet, and ``unsaved``, the quiet steps taken and not yet added to
+        # rt.steps. Before anything that reads or changes rt.steps or task.quiet (the full
+        # statement hooks, a call, a cold opcode, an error's $ERR, leaving the loop) the loop
+        # adds ``unsaved`` to rt.steps; after it, it takes ``left`` from task.quiet again.
+        # (No task: a cyclic flag's or analog output's expression the controller evaluates.)
+        left = task.quiet - rt.steps if task is not None else 0
+        unsaved = 0
         proceed = False
-        while True:
-            try:
-                while True:
-                    ins = prog[ip]
-                    op = ins[0]
-                    # hottest first (measured on the benchmark): the rank weights the search
-                    # tree _specialize makes of this chain
-                    if op == OP.STMT_G:
-                        info = ins[1]
-                        frame.line = info.line
-                        n = rt.steps
-                        if n < task.quiet and not info.stops:     # a quiet step (Runtime.quiet_limit)
-                            rt.steps = n + 1
-                            task.at = info
-                            proceed = False
-                        else:
-                            before(info)
-                            proceed = take_error_proceed()
-                            task.quiet = quiet_limit(task)
-                        ip += 1
-                    elif op == OP.LOAD_ELEM1_V:
-                        a = store[ins[1]]
-                        i = store[ins[2]]
-                        if i.__class__ is int and 0 < i <= a.dims[0] and (v := a.data[i - 1]) is not UNSET:
-                            push(v)
-                        else:
-                            push(_element1(fvars[ins[1]], _load(fvars[ins[2]]), ins[3]))
-                        ip += 1
-                    elif op == OP.LOAD_FAST:
-                        v = store[ins[1]]
-                        push(v if v is not UNSET else _load(fvars[ins[1]]))
-                        ip += 1
-                    elif op == OP.JUMP_TICK:
-                        n = rt.steps
-                        if n < task.quiet and not ins[1].cond_stops:
-                            rt.steps = n + 1
-                        else:
-                            tick(ins[1])
-                            task.quiet = quiet_limit(task)
-                        ip = ins[2]
-                    elif op == OP.CONST:
-                        push(ins[1])
-                        ip += 1
-                    elif op == OP.FOR_NEXT_FAST:
-                        t = ins[2]
-                        c = store[ins[1]]
-                        if c.__class__ is int and (c := c + temps[t + 2]) <= temps[t + 3]:
-                            store[ins[1]] = c
-                            go = True
-                        else:
-                            go = _for_next(temps[t], temps[t + 1], temps[t + 2], ins[3])
-                        if go:
-                            n = rt.steps
-                            if n < task.quiet:
-                                rt.steps = n + 1
+        try:
+            while True:
+                try:
+                    while True:
+                        ins = prog[ip]
+                        op = ins[0]
+                        # hottest first (measured on the benchmark): the rank weights the search
+                        # tree interp/vm/gen_loop.py makes of this chain
+                        if op == OP.STMT_G:
+                            info = ins[1]
+                            frame.line = ins[2]                 # info.line, info.stops: link()
+                            if left > 0 and not ins[3]:         # a quiet step (Runtime.quiet_limit)
+                                left -= 1
+                                unsaved += 1
+                                task.at = info
+                                proceed = False
                             else:
-                                tick(ins[3])
-                                task.quiet = quiet_limit(task)
-                            ip = ins[4]
-                        else:
+                                rt.steps += unsaved
+                                unsaved = 0
+                                before(info)
+                                proceed = take_error_proceed()
+                                task.quiet = n = quiet_limit(task)
+                                left = n - rt.steps
                             ip += 1
-                    elif op == OP.LOAD_FAST2:
-                        v = store[ins[1]]
-                        push(v if v is not UNSET else _load(fvars[ins[1]]))
-                        v = store[ins[2]]
-                        push(v if v is not UNSET else _load(fvars[ins[2]]))
-                        ip += 1
-                    elif op == OP.ADD:
-                        b = pop()
-                        a = stack[-1]
-                        if a.__class__ is float and b.__class__ is float:
-                            stack[-1] = a + b
-                        elif a.__class__ is int and b.__class__ is int and INT_MIN <= (v := a + b) <= INT_MAX:
-                            stack[-1] = v
-                        else:
-                            stack[-1] = _add(a, b)
-                        ip += 1
-                    elif op == OP.STORE_FAST:
-                        v = pop()
-                        t = ins[2]
-                        if v.__class__ is t and (t is not int or INT_MIN <= v <= INT_MAX):
-                            store[ins[1]] = v
-                        else:
-                            _store(fvars[ins[1]], v)
-                        ip += 1
-                    elif op == OP.STORE_ELEM1:
-                        i = pop()
-                        v = pop()
-                        a = store[ins[1]]
-                        t = ins[3]
-                        if i.__class__ is int and 0 < i <= a.dims[0] and v.__class__ is t and (t is not int or INT_MIN <= v <= INT_MAX):
-                            a.data[i - 1] = v
-                        else:
-                            _set_element1(fvars[ins[1]], i, v, ins[2])
-                        ip += 1
-                    elif op == OP.SUBC_FAST:
-                        a = store[ins[1]]
-                        b = ins[2]
-                        t = ins[4]
-                        ca = a.__class__
-                        if ca is b.__class__ and ca is t and (ca is float or (ca is int and INT_MIN <= (v := a - b) <= INT_MAX)):
-                            store[ins[3]] = a - b if ca is float else v
-                        else:
-                            _store(fvars[ins[3]], _sub(a if a is not UNSET else _load(fvars[ins[1]]), b))
-                        ip += 1
-                    elif op == OP.IF_NOT_VC:
-                        a = store[ins[1]]
-                        b = ins[2]
-                        ca = a.__class__
-                        cb = b.__class__
-                        f = ins[3]
-                        if (f[0](a, b) if (ca is int or ca is float) and (cb is int or cb is float)
-                                else f[1](a if a is not UNSET else _load(fvars[ins[1]]), b)):
-                            ip += 1
-                        else:
-                            ip = ins[4]
-                    elif op == OP.IF_NOT_LE:
-                        b = pop()
-                        a = pop()
-                        ca = a.__class__
-                        cb = b.__class__
-                        if (a <= b) if (ca is int or ca is float) and (cb is int or cb is float) else _le(a, b):
-                            ip += 1
-                        else:
-                            ip = ins[1]
-                    elif op == OP.STORE_ELEM1_V:
-                        a = store[ins[1]]
-                        i = store[ins[2]]
-                        v = pop()
-                        t = ins[4]
-                        if i.__class__ is int and 0 < i <= a.dims[0] and v.__class__ is t and (t is not int or INT_MIN <= v <= INT_MAX):
-                            a.data[i - 1] = v
-                        else:
-                            _set_element1(fvars[ins[1]], _load(fvars[ins[2]]), v, ins[3])
-                        ip += 1
-                    elif op == OP.FAST_ADD_CONST:
-                        a = store[ins[1]]
-                        b = ins[2]
-                        if a.__class__ is int and b.__class__ is int and INT_MIN <= (v := a + b) <= INT_MAX:
-                            push(v)
-                        elif a.__class__ is float and b.__class__ is float:
-                            push(a + b)
-                        else:
-                            push(_add(a if a is not UNSET else _load(fvars[ins[1]]), b))
-                        ip += 1
-                    elif op == OP.REF_LOCAL:
-                        push(fvars[ins[1]])
-                        ip += 1
-                    elif op == OP.IF_NOT_VV:
-                        a = store[ins[1]]
-                        b = store[ins[2]]
-                        ca = a.__class__
-                        cb = b.__class__
-                        f = ins[3]
-                        if (f[0](a, b) if (ca is int or ca is float) and (cb is int or cb is float)
-                                else f[1](a if a is not UNSET else _load(fvars[ins[1]]), b if b is not UNSET else _load(fvars[ins[2]]))):
-                            ip += 1
-                        else:
-                            ip = ins[4]
-                    elif op == OP.MUL:
-                        b = pop()
-                        a = stack[-1]
-                        if a.__class__ is float and b.__class__ is float:
-                            stack[-1] = a * b
-                        elif a.__class__ is int and b.__class__ is int and INT_MIN <= (v := a * b) <= INT_MAX:
-                            stack[-1] = v
-                        else:
-                            stack[-1] = _mul(a, b)
-                        ip += 1
-                    elif op == OP.LOAD_FIELD:
-                        base = stack[-1]
-                        if base.__class__ is Slot and (x := base.c[base.k]).__class__ is Struct and (
-                                (x := x.f.get(ins[1][1])).__class__ is float or x.__class__ is int
-                                or x.__class__ is bool):
-                            stack[-1] = x
-                        else:
-                            stack[-1] = _component(base, ins[1][0], ins[2])
-                        ip += 1
-                    elif op == OP.LOAD_FIELD_L:
-                        base = fvars[ins[1]]
-                        if base.__class__ is Slot and (x := base.c[base.k]).__class__ is Struct and (
-                                (x := x.f.get(ins[2][1])).__class__ is float or x.__class__ is int
-                                or x.__class__ is bool):
-                            push(x)
-                        else:
-                            push(_component(base, ins[2][0], ins[3]))
-                        ip += 1
-                    elif op == OP.STORE_FIELD_L:
-                        _set_component(fvars[ins[1]], ins[2][0], pop(), ins[3])
-                        ip += 1
-                    elif op == OP.UNOP:
-                        stack[-1] = rt.unary_op(ins[1], stack[-1])
-                        ip += 1
-                    elif op == OP.JUMP_IF_FALSE:
-                        if rt.to_bool(pop()):
-                            ip += 1
-                        else:
-                            ip = ins[1]
-                    elif op == OP.LOAD_ELEM2:
-                        j = pop()
-                        i = stack[-1]
-                        a = store[ins[1]]
-                        n, m = a.dims
-                        if i.__class__ is int and j.__class__ is int and 0 < i <= n and 0 < j <= m \
-                                and (v := a.data[(i - 1) * m + j - 1]) is not UNSET:
-                            stack[-1] = v
-                        else:
-                            stack[-1] = _element2(fvars[ins[1]], i, j, ins[2])
-                        ip += 1
-                    elif op == OP.LOAD_ELEM2_VV:
-                        a = store[ins[1]]
-                        i = store[ins[2]]
-                        j = store[ins[3]]
-                        n, m = a.dims
-                        if i.__class__ is int and j.__class__ is int and 0 < i <= n and 0 < j <= m \
-                                and (v := a.data[(i - 1) * m + j - 1]) is not UNSET:
-                            push(v)
-                        else:
-                            push(_element2(fvars[ins[1]], _load(fvars[ins[2]]), _load(fvars[ins[3]]), ins[4]))
-                        ip += 1
-                    elif op == OP.STMT:
-                        info = ins[1]
-                        if not thunk:
-                            frame.line = info.line
-                        n = rt.steps
-                        if n < task.quiet and not info.stops:
-                            rt.steps = n + 1
-                            task.at = info
-                        else:
-                            before(info)
-                            task.quiet = quiet_limit(task)
-                        ip += 1
-                    elif op == OP.STORE_FIELD:
-                        base = pop()
-                        _set_component(base, ins[1][0], pop(), ins[2])
-                        ip += 1
-                    elif op == OP.TICK:
-                        n = rt.steps
-                        if n < task.quiet and not ins[1].cond_stops:
-                            rt.steps = n + 1
-                        else:
-                            tick(ins[1])
-                            task.quiet = quiet_limit(task)
-                        ip += 1
-                    elif op == OP.MUL_CONST:
-                        b = ins[1]
-                        a = stack[-1]
-                        if a.__class__ is float and b.__class__ is float:
-                            stack[-1] = a * b
-                        elif a.__class__ is int and b.__class__ is int and INT_MIN <= (v := a * b) <= INT_MAX:
-                            stack[-1] = v
-                        else:
-                            stack[-1] = _mul(a, b)
-                        ip += 1
-                    elif op == OP.SUB:
-                        b = pop()
-                        a = stack[-1]
-                        if a.__class__ is float and b.__class__ is float:
-                            stack[-1] = a - b
-                        elif a.__class__ is int and b.__class__ is int and INT_MIN <= (v := a - b) <= INT_MAX:
-                            stack[-1] = v
-                        else:
-                            stack[-1] = _sub(a, b)
-                        ip += 1
-                    elif op == OP.ADD_CONST:
-                        b = ins[1]
-                        a = stack[-1]
-                        if a.__class__ is float and b.__class__ is float:
-                            stack[-1] = a + b
-                        elif a.__class__ is int and b.__class__ is int and INT_MIN <= (v := a + b) <= INT_MAX:
-                            stack[-1] = v
-                        else:
-                            stack[-1] = _add(a, b)
-                        ip += 1
-                    elif op == OP.CALL:
-                        argc = ins[2]
-                        if argc:
-                            args = stack[-argc:]
-                            del stack[-argc:]
-                        else:
-                            args = []
-                        flags = ins[3]
-                        target = code.callsites.get(ip)
-                        if target is not None:
-                            v = self.invoke(target, args, frame, "N" not in flags)
-                        else:
-                            v = self.call(code, ip, ins[1], args, frame, flags)
-                        if flags == "E":
-                            push(v if v is not None else function_result(ins[1], v))
-                        ip += 1
-                    elif op == OP.STORE_ELEM2:
-                        j = pop()
-                        i = pop()
-                        v = pop()
-                        a = store[ins[1]]
-                        n, m = a.dims
-                        t = ins[3]
-                        if i.__class__ is int and j.__class__ is int and 0 < i <= n and 0 < j <= m and v.__class__ is t and (t is not int or INT_MIN <= v <= INT_MAX):
-                            a.data[(i - 1) * m + j - 1] = v
-                        else:
-                            _set_element(fvars[ins[1]], [i, j], v, ins[2])
-                        ip += 1
-                    elif op == OP.ADDC_FAST:
-                        a = store[ins[1]]
-                        b = ins[2]
-                        t = ins[4]
-                        ca = a.__class__
-                        if ca is b.__class__ and ca is t and (ca is float or (ca is int and INT_MIN <= (v := a + b) <= INT_MAX)):
-                            store[ins[3]] = a + b if ca is float else v
-                        else:
-                            _store(fvars[ins[3]], _add(a if a is not UNSET else _load(fvars[ins[1]]), b))
-                        ip += 1
-                    elif op == OP.LOAD_MOD:
-                        push(_load(mrefs[ins[1]]))
-                        ip += 1
-                    elif op == OP.STORE_MOD:
-                        _store(mrefs[ins[1]], pop())
-                        ip += 1
-                    elif op == OP.VALARG:
-                        stack[-1] = ValueRef(stack[-1])
-                        ip += 1
-                    elif op == OP.RETURN_VAL:
-                        v = pop()
-                        return v if code.kind == "DEFFCT" else None
-                    elif op == OP.END:
-                        if code.kind == "DEFFCT":
-                            raise ended_without_return(code.routine, frame.line)
-                        return None
-                    elif op == OP.IF_NOT_LT:
-                        b = pop()
-                        a = pop()
-                        ca = a.__class__
-                        cb = b.__class__
-                        if (a < b) if (ca is int or ca is float) and (cb is int or cb is float) else _lt(a, b):
-                            ip += 1
-                        else:
-                            ip = ins[1]
-                    elif op == OP.JUMP:
-                        ip = ins[1]
-                    elif op == OP.LOAD_LOCAL:
-                        push(_load(fvars[ins[1]]))
-                        ip += 1
-                    elif op == OP.STORE_LOCAL:
-                        _store(fvars[ins[1]], pop())
-                        ip += 1
-                    elif op == OP.FAST_SUB_CONST:
-                        a = store[ins[1]]
-                        b = ins[2]
-                        if a.__class__ is int and b.__class__ is int and INT_MIN <= (v := a - b) <= INT_MAX:
-                            push(v)
-                        elif a.__class__ is float and b.__class__ is float:
-                            push(a - b)
-                        else:
-                            push(_sub(a if a is not UNSET else _load(fvars[ins[1]]), b))
-                        ip += 1
-                    elif op == OP.SUB_CONST:
-                        b = ins[1]
-                        a = stack[-1]
-                        if a.__class__ is float and b.__class__ is float:
-                            stack[-1] = a - b
-                        elif a.__class__ is int and b.__class__ is int and INT_MIN <= (v := a - b) <= INT_MAX:
-                            stack[-1] = v
-                        else:
-                            stack[-1] = _sub(a, b)
-                        ip += 1
-                    elif op == OP.IF_NOT_GT:
-                        b = pop()
-                        a = pop()
-                        ca = a.__class__
-                        cb = b.__class__
-                        if (a > b) if (ca is int or ca is float) and (cb is int or cb is float) else _gt(a, b):
-                            ip += 1
-                        else:
-                            ip = ins[1]
-                    elif op == OP.IF_NOT_GE:
-                        b = pop()
-                        a = pop()
-                        ca = a.__class__
-                        cb = b.__class__
-                        if (a >= b) if (ca is int or ca is float) and (cb is int or cb is float) else _ge(a, b):
-                            ip += 1
-                        else:
-                            ip = ins[1]
-                    elif op == OP.IF_NOT_EQ:
-                        b = pop()
-                        a = pop()
-                        ca = a.__class__
-                        cb = b.__class__
-                        if (a == b) if (ca is int or ca is float) and (cb is int or cb is float) else _eq(a, b):
-                            ip += 1
-                        else:
-                            ip = ins[1]
-                    elif op == OP.IF_NOT_NE:
-                        b = pop()
-                        a = pop()
-                        ca = a.__class__
-                        cb = b.__class__
-                        if (a != b) if (ca is int or ca is float) and (cb is int or cb is float) else _ne(a, b):
-                            ip += 1
-                        else:
-                            ip = ins[1]
-                    elif op == OP.RETURN:
-                        if code.kind == "DEFFCT":
-                            raise return_without_value(code.routine, frame.line)
-                        return None
-                    elif op == OP.LOAD_ELEM1:
-                        a = store[ins[1]]
-                        i = stack[-1]
-                        if i.__class__ is int and 0 < i <= a.dims[0] and (v := a.data[i - 1]) is not UNSET:
-                            stack[-1] = v
-                        else:
-                            stack[-1] = _element1(fvars[ins[1]], i, ins[2])
-                        ip += 1
-                    elif op == OP.LOAD_ELEM_LL:
-                        push(_element1(fvars[ins[1]], _load(fvars[ins[2]]), ins[3]))
-                        ip += 1
-                    elif op == OP.LOAD_LOCAL2:
-                        push(_load(fvars[ins[1]]))
-                        push(_load(fvars[ins[2]]))
-                        ip += 1
-                    elif op == OP.FOR_NEXT:
-                        t = ins[1]
-                        if _for_next(temps[t], temps[t + 1], temps[t + 2], ins[2]):
-                            n = rt.steps
-                            if n < task.quiet and not ins[2].cond_stops:
-                                rt.steps = n + 1
+                        elif op == OP.LOAD_ELEM1_V:
+                            a = store[ins[1]]
+                            i = store[ins[2]]
+                            if i.__class__ is int and 0 < i <= a.dims[0] and (v := a.data[i - 1]) is not UNSET:
+                                push(v)
                             else:
-                                tick(ins[2])
-                                task.quiet = quiet_limit(task)
-                            ip = ins[3]
-                        else:
+                                push(_element1(fvars[ins[1]], _load(fvars[ins[2]]), ins[3]))
                             ip += 1
-                    elif op == OP.LOCAL_ADD_CONST:
-                        push(_add(_load(fvars[ins[1]]), ins[2]))
-                        ip += 1
-                    elif op == OP.STORE_INDEX:
-                        n = ins[1]
-                        if n == 1:
+                        elif op == OP.LOAD_FAST:
+                            v = store[ins[1]]
+                            push(v if v is not UNSET else _load(fvars[ins[1]]))
+                            ip += 1
+                        elif op == OP.JUMP_TICK:
+                            if left > 0 and not ins[1].cond_stops:
+                                left -= 1
+                                unsaved += 1
+                            else:
+                                rt.steps += unsaved
+                                unsaved = 0
+                                tick(ins[1])
+                                task.quiet = n = quiet_limit(task)
+                                left = n - rt.steps
+                            ip = ins[2]
+                        elif op == OP.CONST:
+                            push(ins[1])
+                            ip += 1
+                        elif op == OP.FOR_NEXT_FAST:
+                            t = ins[2]
+                            c = store[ins[1]]
+                            if c.__class__ is int and (c := c + temps[t + 2]) <= temps[t + 3]:
+                                store[ins[1]] = c
+                                go = True
+                            else:
+                                go = _for_next(temps[t], temps[t + 1], temps[t + 2], ins[3])
+                            if go:
+                                if left > 0:
+                                    left -= 1
+                                    unsaved += 1
+                                else:
+                                    rt.steps += unsaved
+                                    unsaved = 0
+                                    tick(ins[3])
+                                    task.quiet = n = quiet_limit(task)
+                                    left = n - rt.steps
+                                ip = ins[4]
+                            else:
+                                ip += 1
+                        elif op == OP.LOAD_FAST2:
+                            v = store[ins[1]]
+                            push(v if v is not UNSET else _load(fvars[ins[1]]))
+                            v = store[ins[2]]
+                            push(v if v is not UNSET else _load(fvars[ins[2]]))
+                            ip += 1
+                        elif op == OP.ADD:
+                            b = pop()
+                            a = stack[-1]
+                            if a.__class__ is float and b.__class__ is float:
+                                stack[-1] = a + b
+                            elif a.__class__ is int and b.__class__ is int and INT_MIN <= (v := a + b) <= INT_MAX:
+                                stack[-1] = v
+                            else:
+                                stack[-1] = _add(a, b)
+                            ip += 1
+                        elif op == OP.STORE_FAST:
+                            v = pop()
+                            t = ins[2]
+                            if v.__class__ is t and (t is not int or INT_MIN <= v <= INT_MAX):
+                                store[ins[1]] = v
+                            else:
+                                _store(fvars[ins[1]], v)
+                            ip += 1
+                        elif op == OP.STORE_ELEM1:
                             i = pop()
+                            v = pop()
+                            a = store[ins[1]]
+                            t = ins[3]
+                            if i.__class__ is int and 0 < i <= a.dims[0] and v.__class__ is t and (t is not int or INT_MIN <= v <= INT_MAX):
+                                a.data[i - 1] = v
+                            else:
+                                _set_element1(fvars[ins[1]], i, v, ins[2])
+                            ip += 1
+                        elif op == OP.SUBC_FAST:
+                            a = store[ins[1]]
+                            b = ins[2]
+                            t = ins[4]
+                            ca = a.__class__
+                            if ca is b.__class__ and ca is t and (ca is float or (ca is int and INT_MIN <= (v := a - b) <= INT_MAX)):
+                                store[ins[3]] = a - b if ca is float else v
+                            else:
+                                _store(fvars[ins[3]], _sub(a if a is not UNSET else _load(fvars[ins[1]]), b))
+                            ip += 1
+                        elif op == OP.IF_NOT_VC:
+                            a = store[ins[1]]
+                            b = ins[2]
+                            ca = a.__class__
+                            cb = b.__class__
+                            f = ins[3]
+                            if (f[0](a, b) if (ca is int or ca is float) and (cb is int or cb is float)
+                                    else f[1](a if a is not UNSET else _load(fvars[ins[1]]), b)):
+                                ip += 1
+                            else:
+                                ip = ins[4]
+                        elif op == OP.IF_NOT_LE:
+                            b = pop()
+                            a = pop()
+                            ca = a.__class__
+                            cb = b.__class__
+                            if (a <= b) if (ca is int or ca is float) and (cb is int or cb is float) else _le(a, b):
+                                ip += 1
+                            else:
+                                ip = ins[1]
+                        elif op == OP.STORE_ELEM1_V:
+                            a = store[ins[1]]
+                            i = store[ins[2]]
+                            v = pop()
+                            t = ins[4]
+                            if i.__class__ is int and 0 < i <= a.dims[0] and v.__class__ is t and (t is not int or INT_MIN <= v <= INT_MAX):
+                                a.data[i - 1] = v
+                            else:
+                                _set_element1(fvars[ins[1]], _load(fvars[ins[2]]), v, ins[3])
+                            ip += 1
+                        elif op == OP.FAST_ADD_CONST:
+                            a = store[ins[1]]
+                            b = ins[2]
+                            if a.__class__ is int and b.__class__ is int and INT_MIN <= (v := a + b) <= INT_MAX:
+                                push(v)
+                            elif a.__class__ is float and b.__class__ is float:
+                                push(a + b)
+                            else:
+                                push(_add(a if a is not UNSET else _load(fvars[ins[1]]), b))
+                            ip += 1
+                        elif op == OP.REF_LOCAL:
+                            push(fvars[ins[1]])
+                            ip += 1
+                        elif op == OP.IF_NOT_VV:
+                            a = store[ins[1]]
+                            b = store[ins[2]]
+                            ca = a.__class__
+                            cb = b.__class__
+                            f = ins[3]
+                            if (f[0](a, b) if (ca is int or ca is float) and (cb is int or cb is float)
+                                    else f[1](a if a is not UNSET else _load(fvars[ins[1]]), b if b is not UNSET else _load(fvars[ins[2]]))):
+                                ip += 1
+                            else:
+                                ip = ins[4]
+                        elif op == OP.MUL:
+                            b = pop()
+                            a = stack[-1]
+                            if a.__class__ is float and b.__class__ is float:
+                                stack[-1] = a * b
+                            elif a.__class__ is int and b.__class__ is int and INT_MIN <= (v := a * b) <= INT_MAX:
+                                stack[-1] = v
+                            else:
+                                stack[-1] = _mul(a, b)
+                            ip += 1
+                        elif op == OP.LOAD_FIELD:
+                            base = stack[-1]
+                            if base.__class__ is Slot and (x := base.c[base.k]).__class__ is Struct and (
+                                    (x := x.f.get(ins[1][1])).__class__ is float or x.__class__ is int
+                                    or x.__class__ is bool):
+                                stack[-1] = x
+                            else:
+                                stack[-1] = _component(base, ins[1][0], ins[2])
+                            ip += 1
+                        elif op == OP.LOAD_FIELD_L:
+                            base = fvars[ins[1]]
+                            if base.__class__ is Slot and (x := base.c[base.k]).__class__ is Struct and (
+                                    (x := x.f.get(ins[2][1])).__class__ is float or x.__class__ is int
+                                    or x.__class__ is bool):
+                                push(x)
+                            else:
+                                push(_component(base, ins[2][0], ins[3]))
+                            ip += 1
+                        elif op == OP.STORE_FIELD_L:
+                            _set_component(fvars[ins[1]], ins[2][0], pop(), ins[3])
+                            ip += 1
+                        elif op == OP.UNOP:
+                            stack[-1] = rt.unary_op(ins[1], stack[-1])
+                            ip += 1
+                        elif op == OP.JUMP_IF_FALSE:
+                            if rt.to_bool(pop()):
+                                ip += 1
+                            else:
+                                ip = ins[1]
+                        elif op == OP.LOAD_ELEM2:
+                            j = pop()
+                            i = stack[-1]
+                            a = store[ins[1]]
+                            n, m = a.dims
+                            if i.__class__ is int and j.__class__ is int and 0 < i <= n and 0 < j <= m \
+                                    and (v := a.data[(i - 1) * m + j - 1]) is not UNSET:
+                                stack[-1] = v
+                            else:
+                                stack[-1] = _element2(fvars[ins[1]], i, j, ins[2])
+                            ip += 1
+                        elif op == OP.LOAD_ELEM2_VV:
+                            a = store[ins[1]]
+                            i = store[ins[2]]
+                            j = store[ins[3]]
+                            n, m = a.dims
+                            if i.__class__ is int and j.__class__ is int and 0 < i <= n and 0 < j <= m \
+                                    and (v := a.data[(i - 1) * m + j - 1]) is not UNSET:
+                                push(v)
+                            else:
+                                push(_element2(fvars[ins[1]], _load(fvars[ins[2]]), _load(fvars[ins[3]]), ins[4]))
+                            ip += 1
+                        elif op == OP.STMT:
+                            info = ins[1]
+                            if not thunk:
+                                frame.line = ins[2]
+                            if left > 0 and not ins[3]:
+                                left -= 1
+                                unsaved += 1
+                                task.at = info
+                            else:
+                                rt.steps += unsaved
+                                unsaved = 0
+                                before(info)
+                                task.quiet = n = quiet_limit(task)
+                                left = n - rt.steps
+                            ip += 1
+                        elif op == OP.STORE_FIELD:
                             base = pop()
-                            _set_element1(base, i, pop(), ins[2])
-                        else:
+                            _set_component(base, ins[1][0], pop(), ins[2])
+                            ip += 1
+                        elif op == OP.TICK:
+                            if left > 0 and not ins[1].cond_stops:
+                                left -= 1
+                                unsaved += 1
+                            else:
+                                rt.steps += unsaved
+                                unsaved = 0
+                                tick(ins[1])
+                                task.quiet = n = quiet_limit(task)
+                                left = n - rt.steps
+                            ip += 1
+                        elif op == OP.MUL_CONST:
+                            b = ins[1]
+                            a = stack[-1]
+                            if a.__class__ is float and b.__class__ is float:
+                                stack[-1] = a * b
+                            elif a.__class__ is int and b.__class__ is int and INT_MIN <= (v := a * b) <= INT_MAX:
+                                stack[-1] = v
+                            else:
+                                stack[-1] = _mul(a, b)
+                            ip += 1
+                        elif op == OP.SUB:
+                            b = pop()
+                            a = stack[-1]
+                            if a.__class__ is float and b.__class__ is float:
+                                stack[-1] = a - b
+                            elif a.__class__ is int and b.__class__ is int and INT_MIN <= (v := a - b) <= INT_MAX:
+                                stack[-1] = v
+                            else:
+                                stack[-1] = _sub(a, b)
+                            ip += 1
+                        elif op == OP.ADD_CONST:
+                            b = ins[1]
+                            a = stack[-1]
+                            if a.__class__ is float and b.__class__ is float:
+                                stack[-1] = a + b
+                            elif a.__class__ is int and b.__class__ is int and INT_MIN <= (v := a + b) <= INT_MAX:
+                                stack[-1] = v
+                            else:
+                                stack[-1] = _add(a, b)
+                            ip += 1
+                        elif op == OP.CALL:
+                            argc = ins[2]
+                            if argc:
+                                args = stack[-argc:]
+                                del stack[-argc:]
+                            else:
+                                args = []
+                            flags = ins[3]
+                            target = code.callsites.get(ip)
+                            rt.steps += unsaved
+                            unsaved = 0
+                            if target is not None:
+                                v = self.invoke(target, args, frame, "N" not in flags)
+                            else:
+                                v = self.call(code, ip, ins[1], args, frame, flags)
+                            left = task.quiet - rt.steps if task is not None else 0
+                            if flags == "E":
+                                push(v if v is not None else function_result(ins[1], v))
+                            ip += 1
+                        elif op == OP.STORE_ELEM2:
+                            j = pop()
+                            i = pop()
+                            v = pop()
+                            a = store[ins[1]]
+                            n, m = a.dims
+                            t = ins[3]
+                            if i.__class__ is int and j.__class__ is int and 0 < i <= n and 0 < j <= m and v.__class__ is t and (t is not int or INT_MIN <= v <= INT_MAX):
+                                a.data[(i - 1) * m + j - 1] = v
+                            else:
+                                _set_element(fvars[ins[1]], [i, j], v, ins[2])
+                            ip += 1
+                        elif op == OP.ADDC_FAST:
+                            a = store[ins[1]]
+                            b = ins[2]
+                            t = ins[4]
+                            ca = a.__class__
+                            if ca is b.__class__ and ca is t and (ca is float or (ca is int and INT_MIN <= (v := a + b) <= INT_MAX)):
+                                store[ins[3]] = a + b if ca is float else v
+                            else:
+                                _store(fvars[ins[3]], _add(a if a is not UNSET else _load(fvars[ins[1]]), b))
+                            ip += 1
+                        elif op == OP.LOAD_MOD:
+                            push(_load(mrefs[ins[1]]))
+                            ip += 1
+                        elif op == OP.STORE_MOD:
+                            _store(mrefs[ins[1]], pop())
+                            ip += 1
+                        elif op == OP.VALARG:
+                            stack[-1] = ValueRef(stack[-1])
+                            ip += 1
+                        elif op == OP.RETURN_VAL:
+                            v = pop()
+                            return v if code.kind == "DEFFCT" else None
+                        elif op == OP.END:
+                            if code.kind == "DEFFCT":
+                                raise ended_without_return(code.routine, frame.line)
+                            return None
+                        elif op == OP.IF_NOT_LT:
+                            b = pop()
+                            a = pop()
+                            ca = a.__class__
+                            cb = b.__class__
+                            if (a < b) if (ca is int or ca is float) and (cb is int or cb is float) else _lt(a, b):
+                                ip += 1
+                            else:
+                                ip = ins[1]
+                        elif op == OP.JUMP:
+                            ip = ins[1]
+                        elif op == OP.LOAD_LOCAL:
+                            push(_load(fvars[ins[1]]))
+                            ip += 1
+                        elif op == OP.STORE_LOCAL:
+                            _store(fvars[ins[1]], pop())
+                            ip += 1
+                        elif op == OP.FAST_SUB_CONST:
+                            a = store[ins[1]]
+                            b = ins[2]
+                            if a.__class__ is int and b.__class__ is int and INT_MIN <= (v := a - b) <= INT_MAX:
+                                push(v)
+                            elif a.__class__ is float and b.__class__ is float:
+                                push(a - b)
+                            else:
+                                push(_sub(a if a is not UNSET else _load(fvars[ins[1]]), b))
+                            ip += 1
+                        elif op == OP.SUB_CONST:
+                            b = ins[1]
+                            a = stack[-1]
+                            if a.__class__ is float and b.__class__ is float:
+                                stack[-1] = a - b
+                            elif a.__class__ is int and b.__class__ is int and INT_MIN <= (v := a - b) <= INT_MAX:
+                                stack[-1] = v
+                            else:
+                                stack[-1] = _sub(a, b)
+                            ip += 1
+                        elif op == OP.IF_NOT_GT:
+                            b = pop()
+                            a = pop()
+                            ca = a.__class__
+                            cb = b.__class__
+                            if (a > b) if (ca is int or ca is float) and (cb is int or cb is float) else _gt(a, b):
+                                ip += 1
+                            else:
+                                ip = ins[1]
+                        elif op == OP.IF_NOT_GE:
+                            b = pop()
+                            a = pop()
+                            ca = a.__class__
+                            cb = b.__class__
+                            if (a >= b) if (ca is int or ca is float) and (cb is int or cb is float) else _ge(a, b):
+                                ip += 1
+                            else:
+                                ip = ins[1]
+                        elif op == OP.IF_NOT_EQ:
+                            b = pop()
+                            a = pop()
+                            ca = a.__class__
+                            cb = b.__class__
+                            if (a == b) if (ca is int or ca is float) and (cb is int or cb is float) else _eq(a, b):
+                                ip += 1
+                            else:
+                                ip = ins[1]
+                        elif op == OP.IF_NOT_NE:
+                            b = pop()
+                            a = pop()
+                            ca = a.__class__
+                            cb = b.__class__
+                            if (a != b) if (ca is int or ca is float) and (cb is int or cb is float) else _ne(a, b):
+                                ip += 1
+                            else:
+                                ip = ins[1]
+                        elif op == OP.RETURN:
+                            if code.kind == "DEFFCT":
+                                raise return_without_value(code.routine, frame.line)
+                            return None
+                        elif op == OP.LOAD_ELEM1:
+                            a = store[ins[1]]
+                            i = stack[-1]
+                            if i.__class__ is int and 0 < i <= a.dims[0] and (v := a.data[i - 1]) is not UNSET:
+                                stack[-1] = v
+                            else:
+                                stack[-1] = _element1(fvars[ins[1]], i, ins[2])
+                            ip += 1
+                        elif op == OP.LOAD_ELEM_LL:
+                            push(_element1(fvars[ins[1]], _load(fvars[ins[2]]), ins[3]))
+                            ip += 1
+                        elif op == OP.LOAD_LOCAL2:
+                            push(_load(fvars[ins[1]]))
+                            push(_load(fvars[ins[2]]))
+                            ip += 1
+                        elif op == OP.FOR_NEXT:
+                            t = ins[1]
+                            if _for_next(temps[t], temps[t + 1], temps[t + 2], ins[2]):
+                                if left > 0 and not ins[2].cond_stops:
+                                    left -= 1
+                                    unsaved += 1
+                                else:
+                                    rt.steps += unsaved
+                                    unsaved = 0
+                                    tick(ins[2])
+                                    task.quiet = n = quiet_limit(task)
+                                    left = n - rt.steps
+                                ip = ins[3]
+                            else:
+                                ip += 1
+                        elif op == OP.LOCAL_ADD_CONST:
+                            push(_add(_load(fvars[ins[1]]), ins[2]))
+                            ip += 1
+                        elif op == OP.STORE_INDEX:
+                            n = ins[1]
+                            if n == 1:
+                                i = pop()
+                                base = pop()
+                                _set_element1(base, i, pop(), ins[2])
+                            else:
+                                idx = stack[-n:]
+                                del stack[-n:]
+                                base = pop()
+                                _set_element(base, idx, pop(), ins[2])
+                            ip += 1
+                        elif op == OP.STORE_ELEM_LL:
+                            _set_element1(fvars[ins[1]], _load(fvars[ins[2]]), pop(), ins[3])
+                            ip += 1
+                        elif op == OP.LOCAL_SUB_CONST:
+                            push(_sub(_load(fvars[ins[1]]), ins[2]))
+                            ip += 1
+                        elif op == OP.LOAD_ELEM2_LLL:
+                            push(_element2(fvars[ins[1]], _load(fvars[ins[2]]), _load(fvars[ins[3]]),
+                                          ins[4]))
+                            ip += 1
+                        elif op == OP.FOR_TEST:
+                            t = ins[1]
+                            if for_done(temps[t].get(), temps[t + 1], temps[t + 2]):
+                                ip = ins[2]
+                            else:
+                                ip += 1
+                        elif op == OP.LOAD_INDEX:
+                            n = ins[1]
                             idx = stack[-n:]
                             del stack[-n:]
-                            base = pop()
-                            _set_element(base, idx, pop(), ins[2])
-                        ip += 1
-                    elif op == OP.STORE_ELEM_LL:
-                        _set_element1(fvars[ins[1]], _load(fvars[ins[2]]), pop(), ins[3])
-                        ip += 1
-                    elif op == OP.LOCAL_SUB_CONST:
-                        push(_sub(_load(fvars[ins[1]]), ins[2]))
-                        ip += 1
-                    elif op == OP.LOAD_ELEM2_LLL:
-                        push(_element2(fvars[ins[1]], _load(fvars[ins[2]]), _load(fvars[ins[3]]),
-                                      ins[4]))
-                        ip += 1
-                    elif op == OP.FOR_TEST:
-                        t = ins[1]
-                        if for_done(temps[t].get(), temps[t + 1], temps[t + 2]):
-                            ip = ins[2]
-                        else:
+                            stack[-1] = _element(stack[-1], idx, ins[2])
                             ip += 1
-                    elif op == OP.LOAD_INDEX:
-                        n = ins[1]
-                        idx = stack[-n:]
-                        del stack[-n:]
-                        stack[-1] = _element(stack[-1], idx, ins[2])
-                        ip += 1
-                    elif op == OP.INDEX:
-                        n = ins[1]
-                        idx = [None if x is None else _array_index(x) for x in stack[-n:]]
-                        del stack[-n:]
-                        stack[-1] = rt.index(stack[-1], idx, ins[2])
-                        ip += 1
-                    elif op == OP.ASSIGN:
-                        ref = pop()
-                        _store(ref, pop())
-                        ip += 1
-                    elif op == OP.LT:
-                        b = pop()
-                        stack[-1] = _lt(stack[-1], b)
-                        ip += 1
-                    elif op == OP.LE:
-                        b = pop()
-                        stack[-1] = _le(stack[-1], b)
-                        ip += 1
-                    elif op == OP.GT:
-                        b = pop()
-                        stack[-1] = _gt(stack[-1], b)
-                        ip += 1
-                    elif op == OP.GE:
-                        b = pop()
-                        stack[-1] = _ge(stack[-1], b)
-                        ip += 1
-                    elif op == OP.EQ:
-                        b = pop()
-                        stack[-1] = _eq(stack[-1], b)
-                        ip += 1
-                    elif op == OP.NE:
-                        b = pop()
-                        stack[-1] = _ne(stack[-1], b)
-                        ip += 1
-                    elif op == OP.BINOP:
-                        b = pop()
-                        stack[-1] = rt.binary_op(ins[1], stack[-1], b)
-                        ip += 1
-                    elif op == OP.REF_MOD:
-                        push(mrefs[ins[1]])
-                        ip += 1
-                    elif op == OP.LOAD_GLOBAL or op == OP.REF_GLOBAL or op == OP.STORE_GLOBAL:
-                        g = ins[1]
-                        ref = grefs[g]
-                        if ref is None:
-                            ref = rt.storage_ref(code.gstorage[g], frame)
-                            grefs[g] = ref
-                        if op == OP.LOAD_GLOBAL:
-                            push(_load(ref))
-                        elif op == OP.REF_GLOBAL:
-                            push(ref)
-                        else:
+                        elif op == OP.INDEX:
+                            n = ins[1]
+                            idx = [None if x is None else _array_index(x) for x in stack[-n:]]
+                            del stack[-n:]
+                            stack[-1] = rt.index(stack[-1], idx, ins[2])
+                            ip += 1
+                        elif op == OP.ASSIGN:
+                            ref = pop()
                             _store(ref, pop())
-                        ip += 1
-                    elif op == OP.FIELD:
-                        stack[-1] = rt.field(stack[-1], ins[1], ins[2])
-                        ip += 1
-                    elif op == OP.END_THUNK:
-                        return stack[-1] if stack else None
-                    elif op == OP.LOAD_TEMP:
-                        push(temps[ins[1]])
-                        ip += 1
-                    elif op == OP.STORE_TEMP:
-                        temps[ins[1]] = pop()
-                        ip += 1
-                    elif op == OP.JUMP_IF_TRUE:
-                        if rt.to_bool(pop()):
-                            ip = ins[1]
-                        else:
                             ip += 1
-                    elif op == OP.NONE:
-                        push(None)
-                        ip += 1
-                    elif op == OP.POP:
-                        pop()
-                        ip += 1
-                    elif op == OP.DEREF:
-                        stack[-1] = _read_value(stack[-1])
-                        ip += 1
-                    elif op == OP.FOR_PREP:
-                        t = ins[1]
-                        step = pop()
-                        end = pop()
-                        start = pop()
-                        temps[t] = pop()
-                        temps[t + 1], temps[t + 2] = end, step = _for_limits(end, step)
-                        temps[t + 3] = min(end, INT_MAX) if step.__class__ is int and step > 0 else -math.inf
-                        push(start)
-                        ip += 1
-                    elif op == OP.FOR_INIT:
-                        _store(temps[ins[1]], pop())
-                        ip += 1
-                    elif (op == OP.AGG or op == OP.JUMP_IF_NONE or op == OP.HALT or op == OP.WAIT_FOR or
-                          op == OP.WAIT_SEC or op == OP.CONTINUE or op == OP.ON_ERROR_PROCEED or
-                          op == OP.EXIT_SIGNAL or op == OP.GOTO_FAIL or op == OP.RAISE or
-                          op == OP.INT_DECL or op == OP.INT_CTL or op == OP.BRAKE or op == OP.STUB or
-                          op == OP.CYCFLAG or op == OP.ANOUT_ON or op == OP.ANIN_ON or op == OP.CYCLIC_OFF or
-                          op == OP.RESUME or op == OP.TRIG_FIND or op == OP.TRIG_PACK or op == OP.TRIGGER or
-                          op == OP.TRIG_INVOKE or op == OP.MOTION or op == OP.SPL_BEGIN or
-                          op == OP.SPL_TRIG_BEGIN or op == OP.SPL_TRIG_END or op == OP.SPL_SEG or
-                          op == OP.SPLINE):
-                        # the cold opcodes (statements of motion, interrupts, I/O, ...): one
-                        # method each (VM._cold_NAME), so the loop stays the hot path
-                        ip = cold[op](ins, code, frame, temps, stack, ip)
-                    else:
-                        raise RuntimeError(f"bad opcode {op} at {ip} in {code.name}")
-            except KrlRuntimeError as e:
-                reg = code.iregions[ip]
-                if reg is None:
-                    raise
-                e.at(code.file, reg.line)
-                if reg.kind != "G" or thunk or not proceed:
-                    raise
-                proceed = False
-                rt.record_error(e, frame)
-                del stack[:]
-                ip = reg.end
+                        elif op == OP.LT:
+                            b = pop()
+                            stack[-1] = _lt(stack[-1], b)
+                            ip += 1
+                        elif op == OP.LE:
+                            b = pop()
+                            stack[-1] = _le(stack[-1], b)
+                            ip += 1
+                        elif op == OP.GT:
+                            b = pop()
+                            stack[-1] = _gt(stack[-1], b)
+                            ip += 1
+                        elif op == OP.GE:
+                            b = pop()
+                            stack[-1] = _ge(stack[-1], b)
+                            ip += 1
+                        elif op == OP.EQ:
+                            b = pop()
+                            stack[-1] = _eq(stack[-1], b)
+                            ip += 1
+                        elif op == OP.NE:
+                            b = pop()
+                            stack[-1] = _ne(stack[-1], b)
+                            ip += 1
+                        elif op == OP.BINOP:
+                            b = pop()
+                            stack[-1] = rt.binary_op(ins[1], stack[-1], b)
+                            ip += 1
+                        elif op == OP.REF_MOD:
+                            push(mrefs[ins[1]])
+                            ip += 1
+                        elif op == OP.LOAD_GLOBAL or op == OP.REF_GLOBAL or op == OP.STORE_GLOBAL:
+                            g = ins[1]
+                            ref = grefs[g]
+                            if ref is None:
+                                ref = rt.storage_ref(code.gstorage[g], frame)
+                                grefs[g] = ref
+                            if op == OP.LOAD_GLOBAL:
+                                push(_load(ref))
+                            elif op == OP.REF_GLOBAL:
+                                push(ref)
+                            else:
+                                _store(ref, pop())
+                            ip += 1
+                        elif op == OP.FIELD:
+                            stack[-1] = rt.field(stack[-1], ins[1], ins[2])
+                            ip += 1
+                        elif op == OP.END_THUNK:
+                            return stack[-1] if stack else None
+                        elif op == OP.LOAD_TEMP:
+                            push(temps[ins[1]])
+                            ip += 1
+                        elif op == OP.STORE_TEMP:
+                            temps[ins[1]] = pop()
+                            ip += 1
+                        elif op == OP.JUMP_IF_TRUE:
+                            if rt.to_bool(pop()):
+                                ip = ins[1]
+                            else:
+                                ip += 1
+                        elif op == OP.NONE:
+                            push(None)
+                            ip += 1
+                        elif op == OP.POP:
+                            pop()
+                            ip += 1
+                        elif op == OP.DEREF:
+                            stack[-1] = _read_value(stack[-1])
+                            ip += 1
+                        elif op == OP.FOR_PREP:
+                            t = ins[1]
+                            step = pop()
+                            end = pop()
+                            start = pop()
+                            temps[t] = pop()
+                            temps[t + 1], temps[t + 2] = end, step = _for_limits(end, step)
+                            temps[t + 3] = min(end, INT_MAX) if step.__class__ is int and step > 0 else -math.inf
+                            push(start)
+                            ip += 1
+                        elif op == OP.FOR_INIT:
+                            _store(temps[ins[1]], pop())
+                            ip += 1
+                        elif (op == OP.AGG or op == OP.JUMP_IF_NONE or op == OP.HALT or op == OP.WAIT_FOR or
+                              op == OP.WAIT_SEC or op == OP.CONTINUE or op == OP.ON_ERROR_PROCEED or
+                              op == OP.EXIT_SIGNAL or op == OP.GOTO_FAIL or op == OP.RAISE or
+                              op == OP.INT_DECL or op == OP.INT_CTL or op == OP.BRAKE or op == OP.STUB or
+                              op == OP.CYCFLAG or op == OP.ANOUT_ON or op == OP.ANIN_ON or op == OP.CYCLIC_OFF or
+                              op == OP.RESUME or op == OP.TRIG_FIND or op == OP.TRIG_PACK or op == OP.TRIGGER or
+                              op == OP.TRIG_INVOKE or op == OP.MOTION or op == OP.SPL_BEGIN or
+                              op == OP.SPL_TRIG_BEGIN or op == OP.SPL_TRIG_END or op == OP.SPL_SEG or
+                              op == OP.SPLINE):
+                            # the cold opcodes (statements of motion, interrupts, I/O, ...): one
+                            # method each (VM._cold_NAME), so the loop stays the hot path
+                            rt.steps += unsaved
+                            unsaved = 0
+                            ip = cold[op](ins, code, frame, temps, stack, ip)
+                            left = task.quiet - rt.steps if task is not None else 0
+                        else:
+                            raise RuntimeError(f"bad opcode {op} at {ip} in {code.name}")
+                except KrlRuntimeError as e:
+                    reg = code.iregions[ip]
+                    if reg is None:
+                        raise
+                    e.at(code.file, reg.line)
+                    if reg.kind != "G" or thunk or not proceed:
+                        raise
+                    proceed = False
+                    rt.steps += unsaved
+                    unsaved = 0
+                    rt.record_error(e, frame)
+                    left = task.quiet - rt.steps if task is not None else 0
+                    del stack[:]
+                    ip = reg.end
+        finally:
+            rt.steps += unsaved
 
     @staticmethod
     def pairs(stack: list, n: int) -> list:
@@ -1059,6 +1106,38 @@ class VM:
 
 # The loops: VM.run above is the source of every handler (runnable: VM(rt, loop="source"),
 # dispatching on the opcode numbers themselves); interp/vm/loop.py is generated from it
-# (python -m interp.vm.gen_loop) and dispatches on its own numbering.
+# (python -m interp.vm.gen_loop) and dispatches on its own numbering. `make` compiles loop.py
+# with Cython (interp/vm/build.py) into an extension beside it, which Python imports in its
+# place; it runs (loop="generated") only when it was built from this vm.py, else loop.py does.
 SOURCE_DISPATCH = [o.number for o in OP.OPS]
-from .loop import DISPATCH as GENERATED_DISPATCH, run as _generated_run  # noqa: E402
+
+
+def _python_loop():
+    """interp/vm/loop.py itself, imported from its file (also when the extension exists)."""
+    import importlib.util  # noqa: PLC0415
+    import sys  # noqa: PLC0415
+    from pathlib import Path  # noqa: PLC0415
+
+    name = "interp.vm._loop_python"
+    mod = sys.modules.get(name)
+    if mod is None:
+        spec = importlib.util.spec_from_file_location(name, Path(__file__).with_name("loop.py"))
+        mod = importlib.util.module_from_spec(spec)
+        sys.modules[name] = mod
+        spec.loader.exec_module(mod)
+    return mod
+
+
+def _current(mod) -> bool:
+    import hashlib  # noqa: PLC0415
+    from pathlib import Path  # noqa: PLC0415
+
+    return mod.VM_SOURCE == hashlib.sha256(Path(__file__).read_bytes()).hexdigest()
+
+
+from . import loop as _loop  # noqa: E402
+
+COMPILED = not _loop.__file__.endswith(".py") and _current(_loop)
+if not COMPILED:
+    _loop = _python_loop()
+GENERATED_DISPATCH, _generated_run = _loop.DISPATCH, _loop.run
