@@ -26,10 +26,12 @@ from krl.lsp import folding as _folding
 from krl.lsp import hover as _hover
 from krl.lsp import navigate as _nav
 from krl.lsp import outline as _outline
+from krl.lsp import rename as _rename
 from krl.lsp.analysis import Analysis
 from krl.lsp.convert import lsp_diagnostic
 from krl.lsp.project import Project, norm
-from krl.lsp.text import from_position, to_range, units
+from krl.lsp.text import from_position, to_range, token_at, units
+from pygls.exceptions import JsonRpcException
 from krl.terminal import printable, printable_path
 
 log = logging.getLogger("krl.lsp")       # file names and messages in it pass krl.terminal.printable
@@ -177,13 +179,21 @@ class KrlLanguageServer(LanguageServer):
             pass
 
 
+class RequestFailed(JsonRpcException):
+    """A request the server refuses, with the reason for the user (LSP RequestFailed)."""
+    CODE = -32803
+
+
 def guarded(empty=None):
-    """Run a handler; an exception is logged and answered with `empty`."""
+    """Run a handler; an exception is logged and answered with `empty` (a refusal,
+    :class:`RequestFailed`, goes to the client as an error with its message)."""
     def wrap(fn):
         @functools.wraps(fn)
         async def run(ls: KrlLanguageServer, params):
             try:
                 return await fn(ls, params)
+            except RequestFailed:
+                raise
             except Exception as exc:  # noqa: BLE001
                 log.error("handler %s failed: %s", fn.__name__, printable(exc), exc_info=TRACEBACKS["on"])
                 ls._report(f"krl lsp: {fn.__name__} failed: {type(exc).__name__}: {printable(exc)}")
@@ -334,6 +344,38 @@ def create_server() -> KrlLanguageServer:
         if an is None:
             return None
         return L.CompletionList(is_incomplete=False, items=_complete.complete(an, path, line, col))
+
+    @server.feature(L.TEXT_DOCUMENT_PREPARE_RENAME)
+    @guarded()
+    async def prepare_rename(ls: KrlLanguageServer, params: L.PrepareRenameParams):
+        an, path, line, col = await place(ls, params.text_document, params.position)
+        if an is None:
+            raise RequestFailed("the file is not analysed yet")
+        try:
+            t = _rename.renamable(an, _nav.resolve(an, path, line, col))
+        except _rename.Refused as exc:
+            raise RequestFailed(str(exc)) from None
+        _, tok, _ = token_at(an.files[path].lines, line, col)
+        start = tok.column + (1 if tok.word == "ENUMLITERAL" else 0)
+        return L.PrepareRenamePlaceholder(
+            range=to_range(an.files[path].lines, line, start, len(t.name), ls.codec()),
+            placeholder=tok.text.lstrip("#"))
+
+    @server.feature(L.TEXT_DOCUMENT_RENAME, L.RenameOptions(prepare_provider=True))
+    @guarded()
+    async def rename(ls: KrlLanguageServer, params: L.RenameParams):
+        an, path, line, col = await place(ls, params.text_document, params.position)
+        if an is None:
+            raise RequestFailed("the file is not analysed yet")
+        try:
+            places = _rename.plan(an, _nav.resolve(an, path, line, col), params.new_name)
+        except _rename.Refused as exc:
+            raise RequestFailed(str(exc)) from None
+        codec = ls.codec()
+        return L.WorkspaceEdit(changes={
+            uri_of(p): [L.TextEdit(range=to_range(an.files[p].lines, x.line, x.column, x.length, codec),
+                                   new_text=params.new_name) for x in xs]
+            for p, xs in places.items()})
 
     fmt = formatter()
     if fmt is not None:
