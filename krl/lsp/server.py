@@ -24,6 +24,7 @@ from krl import __version__
 from krl.lsp import complete as _complete
 from krl.lsp import folding as _folding
 from krl.lsp import hover as _hover
+from krl.lsp import inlay as _inlay
 from krl.lsp import navigate as _nav
 from krl.lsp import outline as _outline
 from krl.lsp import rename as _rename
@@ -376,6 +377,23 @@ def create_server() -> KrlLanguageServer:
             uri_of(p): [L.TextEdit(range=to_range(an.files[p].lines, x.line, x.column, x.length, codec),
                                    new_text=params.new_name) for x in xs]
             for p, xs in places.items()})
+
+    @server.feature(L.TEXT_DOCUMENT_INLAY_HINT)
+    @guarded(list)
+    async def inlay_hint(ls: KrlLanguageServer, params: L.InlayHintParams):
+        an, path = await holding(ls, params.text_document)
+        if an is None:
+            return []
+        lines = an.files[path].lines
+        codec = ls.codec()
+        out = []
+        for h in _inlay.hints(an, path, params.range.start.line + 1, params.range.end.line + 1):
+            io = h.kind == "io"
+            out.append(L.InlayHint(
+                position=to_range(lines, h.line, h.column, 0, codec).start, label=h.label,
+                kind=L.InlayHintKind.Type if io else L.InlayHintKind.Parameter,
+                padding_left=io, padding_right=not io, tooltip=h.tooltip or None))
+        return out
 
     fmt = formatter()
     if fmt is not None:
