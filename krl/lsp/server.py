@@ -28,6 +28,7 @@ from krl.lsp import inlay as _inlay
 from krl.lsp import navigate as _nav
 from krl.lsp import outline as _outline
 from krl.lsp import rename as _rename
+from krl.lsp import semtokens as _semtokens
 from krl.lsp.analysis import Analysis
 from krl.lsp.convert import lsp_diagnostic
 from krl.lsp.project import Project, norm
@@ -394,6 +395,15 @@ def create_server() -> KrlLanguageServer:
                 kind=L.InlayHintKind.Type if io else L.InlayHintKind.Parameter,
                 padding_left=io, padding_right=not io, tooltip=h.tooltip or None))
         return out
+
+    @server.feature(L.TEXT_DOCUMENT_SEMANTIC_TOKENS_FULL, L.SemanticTokensLegend(
+        token_types=_semtokens.TYPES, token_modifiers=_semtokens.MODIFIERS))
+    @guarded()
+    async def semantic_tokens(ls: KrlLanguageServer, params: L.SemanticTokensParams):
+        an, path = await holding(ls, params.text_document)
+        if an is None:
+            return L.SemanticTokens(data=[])
+        return L.SemanticTokens(data=_semtokens.tokens(an, path, ls.codec()))
 
     fmt = formatter()
     if fmt is not None:
