@@ -21,6 +21,7 @@ from pygls.lsp.server import LanguageServer
 from pygls.uris import from_fs_path, to_fs_path
 
 from krl import __version__
+from krl.lsp import actions as _actions
 from krl.lsp import complete as _complete
 from krl.lsp import folding as _folding
 from krl.lsp import hover as _hover
@@ -404,6 +405,27 @@ def create_server() -> KrlLanguageServer:
         if an is None:
             return L.SemanticTokens(data=[])
         return L.SemanticTokens(data=_semtokens.tokens(an, path, ls.codec()))
+
+    @server.feature(L.TEXT_DOCUMENT_CODE_ACTION, L.CodeActionOptions(code_action_kinds=[L.CodeActionKind.QuickFix]))
+    @guarded(list)
+    async def code_action(ls: KrlLanguageServer, params: L.CodeActionParams):
+        an, path = await holding(ls, params.text_document)
+        if an is None:
+            return []
+        codec = ls.codec()
+        out = []
+        for fx in _actions.fixes(an, path, params.range.start.line + 1, params.range.end.line + 1):
+            changes: dict[str, list[L.TextEdit]] = {}
+            for e in fx.edits:
+                lines = an.files[e.path].lines
+                rng = L.Range(start=to_range(lines, e.line, e.column, 0, codec).start,
+                              end=to_range(lines, e.end_line, e.end_column, 0, codec).start)
+                changes.setdefault(uri_of(e.path), []).append(L.TextEdit(range=rng, new_text=e.text))
+            d = fx.diagnostic
+            out.append(L.CodeAction(title=fx.title, kind=L.CodeActionKind.QuickFix, is_preferred=fx.preferred,
+                                    diagnostics=[lsp_diagnostic(d, an.files[d.path].lines, codec, uri_of)],
+                                    edit=L.WorkspaceEdit(changes=changes)))
+        return out
 
     fmt = formatter()
     if fmt is not None:
