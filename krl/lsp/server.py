@@ -30,6 +30,8 @@ from krl.lsp import navigate as _nav
 from krl.lsp import outline as _outline
 from krl.lsp import rename as _rename
 from krl.lsp import semtokens as _semtokens
+from krl.lsp import signature as _signature
+from krl.lsp.occurrences import DECL, WRITE, file_occurrences
 from krl.lsp.analysis import Analysis
 from krl.lsp.convert import lsp_diagnostic
 from krl.lsp.project import Project, norm
@@ -426,6 +428,33 @@ def create_server() -> KrlLanguageServer:
                                     diagnostics=[lsp_diagnostic(d, an.files[d.path].lines, codec, uri_of)],
                                     edit=L.WorkspaceEdit(changes=changes)))
         return out
+
+    @server.feature(L.TEXT_DOCUMENT_SIGNATURE_HELP, L.SignatureHelpOptions(trigger_characters=["(", ","]))
+    @guarded()
+    async def signature_help(ls: KrlLanguageServer, params: L.SignatureHelpParams):
+        an, path, line, col = await place(ls, params.text_document, params.position)
+        if an is None:
+            return None
+        sig = _signature.signature_at(an, path, line, col)
+        if sig is None:
+            return None
+        return L.SignatureHelp(signatures=[L.SignatureInformation(
+            label=sig.label, documentation=sig.documentation or None,
+            parameters=[L.ParameterInformation(label=p) for p in sig.params])],
+            active_signature=0, active_parameter=sig.active)
+
+    @server.feature(L.TEXT_DOCUMENT_DOCUMENT_HIGHLIGHT)
+    @guarded(list)
+    async def document_highlight(ls: KrlLanguageServer, params: L.DocumentHighlightParams):
+        an, t = await target(ls, params.text_document, params.position)
+        if t is None:
+            return []
+        path = path_of(params.text_document.uri)
+        lines = an.files[path].lines
+        kinds = {DECL: L.DocumentHighlightKind.Text, WRITE: L.DocumentHighlightKind.Write}
+        return [L.DocumentHighlight(range=to_range(lines, o.place.line, o.place.column, o.place.length, ls.codec()),
+                                    kind=kinds.get(o.kind, L.DocumentHighlightKind.Read))
+                for o in file_occurrences(an, path) if o.key == t.key]
 
     fmt = formatter()
     if fmt is not None:
