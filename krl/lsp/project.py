@@ -119,11 +119,33 @@ class Project:
         result is remembered as the latest analysis of that workspace."""
         docs = dict(self.docs) if docs is None else docs
         root, files, skipped = self.workspace_files(path, docs)
-        an = build_analysis(root, [self.parsed(f, docs) for f in files], skipped)
+        parsed = [self.parsed(f, docs) for f in files]
+        an = self._recheck(root, files, parsed, skipped)
+        if an is None:
+            an = build_analysis(root, parsed, skipped)
         self.analyses[root] = an
         for f in files:
             self._root_of[f] = root
         return an
+
+    def _recheck(self, root: str, files: list[str], parsed: list[Parsed], skipped) -> Analysis | None:
+        """The latest analysis of `root` with the one file whose parse changed re-checked on its
+        own (krl/lsp/incremental.py), else None (check the whole workspace)."""
+        prev = self.analyses.get(root)
+        if prev is None or skipped or list(prev.files) != files:
+            return None
+        changed = [p for p in parsed if prev.files[p.path].parsed is not p]
+        if not changed:
+            return prev
+        if len(changed) != 1:
+            return None
+        from krl.lsp.incremental import recheck  # noqa: PLC0415
+        try:
+            return recheck(prev, changed[0].path, changed[0])
+        except Exception:  # noqa: BLE001 - the whole workspace is checked again from the parses
+            import logging  # noqa: PLC0415
+            logging.getLogger("krl.lsp").error("incremental re-check failed; checking the workspace", exc_info=True)
+            return None
 
     def latest(self, path: str) -> Analysis | None:
         """The latest analysis holding `path`, or None."""
