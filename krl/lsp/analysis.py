@@ -141,7 +141,7 @@ class Analysis:
 
     def diagnostics_for(self, path: str) -> list[Diagnostic]:
         """The workspace's diagnostics of one file, with the root's krl.toml applied."""
-        diags = [d for d in self.ws.diagnostics if d.path == path]
+        diags = sorted((d for d in self.ws.sink.items if d.path == path), key=lambda d: (d.line, d.column, d.code))
         from krl.lsp.project import is_uri  # noqa: PLC0415
         if is_uri(path):        # an unsaved new buffer has no file name to match its main routine
             diags = [d for d in diags if d.code != "W111"]

@@ -23,6 +23,8 @@ file: the editor features read the checker's annotations (``ann.symbol``, ``ann.
 
 from __future__ import annotations
 
+from functools import lru_cache
+
 from krl.ast import nodes as N
 from krl.diagnostics import DiagnosticSink
 from krl.lsp.analysis import Analysis, FileInfo
@@ -71,7 +73,7 @@ def recheck(prev: Analysis, path: str, parsed: Parsed) -> Analysis | None:
     if any(id(r_old) not in syms for r_old, _ in pairs):
         return None
     declarer, checker = phases["declarer"], phases["checker"]
-    from krl.workspace import ADVISORY, is_kuka_file  # noqa: PLC0415
+    from krl.workspace import ADVISORY  # noqa: PLC0415
 
     # the new routines take the old ones' places
     for r_old, r_new in pairs:
@@ -83,17 +85,12 @@ def recheck(prev: Analysis, path: str, parsed: Parsed) -> Analysis | None:
     sf.module = new_mod
     sf.status = parsed.status
 
-    # diagnostics kept: all but this file's parse and body ones, and the unresolved report
+    # this file's parse and body diagnostics go; the unresolved report is made again below
     old_parse = {id(d) for d in fi.parsed.diagnostics}
     body_ids, report_ids = phases["body"], phases["unresolved"]
-    kept, kept_body = [], set()
-    for d in ws.sink.items:
-        if id(d) in report_ids or (d.path == path and (id(d) in body_ids or id(d) in old_parse)):
-            continue
-        kept.append(d)
-        if id(d) in body_ids:
-            kept_body.add(id(d))
+    drop = {id(d) for d in ws.sink.items if d.path == path and (id(d) in body_ids or id(d) in old_parse)}
     unresolved = declarer.unresolved
+    old_uses = _uses_of(unresolved, path)
     for key in list(unresolved.uses):
         name, uses = unresolved.uses[key]
         uses[:] = [u for u in uses if u.path != path]
@@ -103,7 +100,7 @@ def recheck(prev: Analysis, path: str, parsed: Parsed) -> Analysis | None:
     body = DiagnosticSink()
     declarer.sink = checker.sink = body
     try:
-        soft = is_kuka_file(path)
+        soft = _kuka(path)
         for _r_old, r in pairs:
             declarer.soft_types = soft
             local = Scope("routine", r.name, unit.scope)
@@ -117,30 +114,44 @@ def recheck(prev: Analysis, path: str, parsed: Parsed) -> Analysis | None:
         for _r_old, r in pairs:
             checker.check_routine(r, ws.routine_scopes[id(r)], path)
         checker.system_file = declarer.soft_types = checker.submit = False
-        report = DiagnosticSink()
-        unresolved.finish(report)
+        report = None
+        if _uses_of(unresolved, path) != old_uses:      # else the report reads as before
+            report = DiagnosticSink()
+            unresolved.finish(report)
     finally:
         declarer.sink = checker.sink = ws.sink
         checker.system_file = declarer.soft_types = checker.submit = False
-    kuka = {f.path for f in ws.files if is_kuka_file(f.path)}
 
     def shown(items):
-        return [d for d in items if not (d.code in ADVISORY and d.path in kuka)]
-    sink = DiagnosticSink()
-    sink.extend(kept)
+        return [d for d in items if not (d.code in ADVISORY and _kuka(d.path))]
+    sink = ws.sink
+    sink.remove(drop | (report_ids if report is not None else set()))
     sink.extend(parsed.diagnostics)
     n = len(sink.items)
     sink.extend(shown(body.items))
     m = len(sink.items)
-    sink.extend(shown(report.items))
-    phases["body"] = kept_body | {id(d) for d in sink.items[n:m]}
-    phases["unresolved"] = {id(d) for d in sink.items[m:]}
+    phases["body"] = {i for i in body_ids if i not in drop} | {id(d) for d in sink.items[n:m]}
+    if report is not None:
+        sink.extend(shown(report.items))
+        phases["unresolved"] = {id(d) for d in sink.items[m:]}
     ws.sink = declarer.sink = checker.sink = sink
     ws.resolver = None                      # storage of the new routines not placed: Analysis.resolved()
 
     an = Analysis(prev.root, ws, dict(prev.files))
     an.files[path] = FileInfo(path, parsed, sf, _lines(parsed.text))
     return an
+
+
+def _uses_of(unresolved, path: str) -> list:
+    """The recorded uses of unresolved names in one file: (kind, name, line, column, evidence)."""
+    return sorted((key, u.line, u.column, u.evidence) for key, (_name, uses) in unresolved.uses.items()
+                  for u in uses if u.path == path)
+
+
+@lru_cache(maxsize=65536)
+def _kuka(path: str) -> bool:
+    from krl.workspace import is_kuka_file  # noqa: PLC0415
+    return is_kuka_file(path)
 
 
 def _lines(text: str) -> list[str]:

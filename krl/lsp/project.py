@@ -48,6 +48,7 @@ class Project:
         self._roots: dict[str, tuple[float, str, list[str], list]] = {}
         self.analyses: dict[str, Analysis] = {}  # root -> latest analysis
         self._root_of: dict[str, str] = {}       # path -> root of its latest analysis
+        self.watched = False    # the client reports file changes: file lists kept until it does
 
     # ------------------------------------------------------------------ documents
 
@@ -82,7 +83,7 @@ class Project:
             return p, [p], []       # not a file: checked on its own
         got = self._roots.get(p)
         now = time.monotonic()
-        if got is None or now - got[0] > ROOTS_TTL_S:
+        if got is None or (not self.watched and now - got[0] > ROOTS_TTL_S):
             root, files, skipped = workspace_of(Path(p), self.folders)
             got = (now, norm(root), [norm(f) for f in files], skipped)
             self._roots[p] = got

@@ -41,7 +41,9 @@ from krl.terminal import printable, printable_path
 
 log = logging.getLogger("krl.lsp")       # file names and messages in it pass krl.terminal.printable
 TRACEBACKS = {"on": False}                # Python tracebacks only into a --log-file, never to stderr
-DEBOUNCE_S = 0.05          # seconds after the last change before the analysis starts
+DEBOUNCE_S = 0.02          # seconds after the last change before the analysis starts
+EARLY_S = 0.5              # after opening: the file's own parse diagnostics when its workspace's
+                           # first check is not done within this many seconds (a big workspace)
 
 
 def path_of(uri: str) -> str:
@@ -81,6 +83,7 @@ class KrlLanguageServer(LanguageServer):
         self._dirty: set[str] = set()
         self._versions: dict[str, int | None] = {}
         self._gen: dict[str, int] = {}          # path -> count of changes (stale-analysis check)
+        self._quick = ThreadPoolExecutor(max_workers=1, thread_name_prefix="krl-first-parse")
 
     @property
     def lock(self) -> asyncio.Lock:
@@ -146,6 +149,31 @@ class KrlLanguageServer(LanguageServer):
             diags = [lsp_diagnostic(d, fi.lines, codec, uri_of) for d in an.diagnostics_for(path)]
             self.text_document_publish_diagnostics(L.PublishDiagnosticsParams(
                 uri=uri_of(path), diagnostics=diags, version=versions.get(path)))
+
+    async def early(self, path: str, text: str, version: int | None) -> None:
+        """Publish the parse diagnostics of a just-opened file (syntax, FOLD balance: they
+        depend on the file alone) when the check of its workspace is not done after
+        :data:`EARLY_S`; the checked diagnostics replace them when the check ends."""
+        try:
+            await self._early(path, text, version)
+        except Exception as exc:  # noqa: BLE001 - the checked diagnostics follow anyway
+            log.error("first diagnostics of %s failed: %s", printable_path(path), printable(exc), exc_info=TRACEBACKS["on"])
+
+    async def _early(self, path: str, text: str, version: int | None) -> None:
+        await asyncio.sleep(EARLY_S)
+        if self.project.latest(path) is not None:
+            return
+        from krl.diagnostics.render import split_lines  # noqa: PLC0415
+        from krl.lsp.parsing import ParseCache  # noqa: PLC0415
+        loop = asyncio.get_running_loop()
+        parsed = await loop.run_in_executor(self._quick, ParseCache().parse, path, text)
+        if self.project.latest(path) is not None or self._versions.get(path) != version:
+            return                                  # checked meanwhile, or changed: not stale news
+        lines = split_lines(text)
+        codec = self.codec()
+        self.text_document_publish_diagnostics(L.PublishDiagnosticsParams(
+            uri=uri_of(path), version=version,
+            diagnostics=[lsp_diagnostic(d, lines, codec, uri_of) for d in parsed.diagnostics if d.path == path]))
 
     def schedule(self, path: str, delay: float | None = None) -> None:
         """Analyse the workspace of `path` after the debounce delay (a newer change restarts it)."""
@@ -223,6 +251,7 @@ def create_server() -> KrlLanguageServer:
             await ls.client_register_capability_async(L.RegistrationParams(registrations=[L.Registration(
                 id="krl-watch", method=L.WORKSPACE_DID_CHANGE_WATCHED_FILES,
                 register_options=L.DidChangeWatchedFilesRegistrationOptions(watchers=watchers))]))
+            ls.project.watched = True       # created/deleted files arrive as didChangeWatchedFiles
 
     @server.feature(L.TEXT_DOCUMENT_DID_OPEN)
     @guarded()
@@ -231,6 +260,8 @@ def create_server() -> KrlLanguageServer:
         ls.project.open(path, params.text_document.text)
         ls._versions[path] = params.text_document.version
         ls.schedule(path, 0.0)
+        if ls.project.latest(path) is None:
+            asyncio.ensure_future(ls.early(path, params.text_document.text, params.text_document.version))
 
     @server.feature(L.TEXT_DOCUMENT_DID_CHANGE)
     @guarded()
