@@ -42,8 +42,8 @@ from krl.terminal import printable, printable_path
 log = logging.getLogger("krl.lsp")       # file names and messages in it pass krl.terminal.printable
 TRACEBACKS = {"on": False}                # Python tracebacks only into a --log-file, never to stderr
 DEBOUNCE_S = 0.02          # seconds after the last change before the analysis starts
-EARLY_S = 0.5              # after opening: the file's own parse diagnostics when its workspace's
-                           # first check is not done within this many seconds (a big workspace)
+EARLY_S = 0.5              # after opening: the file's own parse diagnostics when the first check of
+EARLY_MIN_FILES = 100      # a workspace of this many files is not done within this many seconds
 
 
 def path_of(uri: str) -> str:
@@ -152,8 +152,9 @@ class KrlLanguageServer(LanguageServer):
 
     async def early(self, path: str, text: str, version: int | None) -> None:
         """Publish the parse diagnostics of a just-opened file (syntax, FOLD balance: they
-        depend on the file alone) when the check of its workspace is not done after
-        :data:`EARLY_S`; the checked diagnostics replace them when the check ends."""
+        depend on the file alone) when the check of its workspace (of at least
+        :data:`EARLY_MIN_FILES` files) is not done after :data:`EARLY_S`; the checked
+        diagnostics replace them when the check ends."""
         try:
             await self._early(path, text, version)
         except Exception as exc:  # noqa: BLE001 - the checked diagnostics follow anyway
@@ -166,8 +167,12 @@ class KrlLanguageServer(LanguageServer):
         from krl.diagnostics.render import split_lines  # noqa: PLC0415
         from krl.lsp.parsing import ParseCache  # noqa: PLC0415
         loop = asyncio.get_running_loop()
-        parsed = await loop.run_in_executor(self._quick, ParseCache().parse, path, text)
-        if self.project.latest(path) is not None or self._versions.get(path) != version:
+
+        def parse():
+            _root, files, _skipped = self.project.workspace_files(path, {})
+            return ParseCache().parse(path, text) if len(files) >= EARLY_MIN_FILES else None
+        parsed = await loop.run_in_executor(self._quick, parse)
+        if parsed is None or self.project.latest(path) is not None or self._versions.get(path) != version:
             return                                  # checked meanwhile, or changed: not stale news
         lines = split_lines(text)
         codec = self.codec()
