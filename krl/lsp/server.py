@@ -31,6 +31,7 @@ from krl.lsp import outline as _outline
 from krl.lsp import rename as _rename
 from krl.lsp import semtokens as _semtokens
 from krl.lsp import signature as _signature
+from krl.lsp import unused as _unused
 from krl.lsp.occurrences import DECL, WRITE, file_occurrences
 from krl.lsp.analysis import Analysis
 from krl.lsp.convert import lsp_diagnostic
@@ -147,6 +148,10 @@ class KrlLanguageServer(LanguageServer):
             if path not in docs or path not in self.project.docs:
                 continue
             diags = [lsp_diagnostic(d, fi.lines, codec, uri_of) for d in an.diagnostics_for(path)]
+            for u in _unused.never_read(an, path):
+                diags.append(L.Diagnostic(
+                    range=to_range(fi.lines, u.place.line, u.place.column, u.place.length, codec), message=u.message,
+                    severity=L.DiagnosticSeverity.Hint, tags=[L.DiagnosticTag.Unnecessary], source="krl"))
             self.text_document_publish_diagnostics(L.PublishDiagnosticsParams(
                 uri=uri_of(path), diagnostics=diags, version=versions.get(path)))
 

@@ -26,9 +26,9 @@ vim.api.nvim_create_autocmd("VimEnter", { callback = function()
     local id = vim.lsp.start_client(config)
     vim.lsp.buf_attach_client(0, id)
   end
-  vim.wait(90000, function() return #vim.diagnostic.get(0) > 0 end, 100)
+  vim.wait(90000, function() return #vim.diagnostic.get(0, { severity = { min = vim.diagnostic.severity.INFO } }) > 0 end, 100)
   local lines = {}
-  for _, d in ipairs(vim.diagnostic.get(0)) do
+  for _, d in ipairs(vim.diagnostic.get(0, { severity = { min = vim.diagnostic.severity.INFO } })) do
     local code = d.code or (d.user_data and d.user_data.lsp and d.user_data.lsp.code) or ""
     table.insert(lines, string.format("%s|%d|%d|%s", code, d.lnum, d.col, d.message))
   end
