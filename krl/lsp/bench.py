@@ -54,6 +54,25 @@ def generate(lines: int = 3000) -> str:
     return "\r\n".join(out) + "\r\n"
 
 
+def _collect(client) -> asyncio.Queue:
+    """A queue of (arrival time, PublishDiagnosticsParams) filled by `client`."""
+    from lsprotocol import types as L  # noqa: PLC0415
+    arrived: asyncio.Queue = asyncio.Queue()
+
+    @client.feature(L.TEXT_DOCUMENT_PUBLISH_DIAGNOSTICS)
+    def on_diagnostics(params: L.PublishDiagnosticsParams):
+        arrived.put_nowait((time.perf_counter(), params))
+    return arrived
+
+
+async def _until(arrived: asyncio.Queue, uri: str, version: int, timeout: float) -> tuple[float, list]:
+    """(arrival time, diagnostics) of the first publication for `uri` at `version`."""
+    while True:
+        t, params = await asyncio.wait_for(arrived.get(), timeout)
+        if params.uri == uri and params.version == version:
+            return t, params.diagnostics
+
+
 def _pct(values: list[float], p: float) -> float:
     s = sorted(values)
     return s[min(len(s) - 1, int(round(p * (len(s) - 1))))]
@@ -69,21 +88,13 @@ async def measure(lines: int, runs: int) -> dict:
     path.write_text(text)
     uri = path.as_uri()
     client = BaseLanguageClient("krl-lsp-bench", "1")
-    arrived: asyncio.Queue = asyncio.Queue()
-
-    @client.feature(L.TEXT_DOCUMENT_PUBLISH_DIAGNOSTICS)
-    def on_diagnostics(params: L.PublishDiagnosticsParams):
-        arrived.put_nowait((time.perf_counter(), params))
-
+    arrived = _collect(client)
     await client.start_io(sys.executable, "-m", "krl.lsp")
     await client.initialize_async(L.InitializeParams(capabilities=L.ClientCapabilities(), root_uri=folder.as_uri()))
     client.initialized(L.InitializedParams())
 
     async def until(version: int) -> tuple[float, list]:
-        while True:
-            t, params = await asyncio.wait_for(arrived.get(), 600)
-            if params.uri == uri and params.version == version:
-                return t, params.diagnostics
+        return await _until(arrived, uri, version, 600)
 
     t0 = time.perf_counter()
     client.text_document_did_open(L.DidOpenTextDocumentParams(
@@ -174,11 +185,7 @@ async def measure_workspace(runs: int) -> dict:
     text = path.read_bytes().decode("cp1252")
     uri = path.as_uri()
     client = BaseLanguageClient("krl-lsp-bench", "1")
-    arrived: asyncio.Queue = asyncio.Queue()
-
-    @client.feature(L.TEXT_DOCUMENT_PUBLISH_DIAGNOSTICS)
-    def on_diagnostics(params: L.PublishDiagnosticsParams):
-        arrived.put_nowait((time.perf_counter(), params))
+    arrived = _collect(client)
 
     @client.feature(L.CLIENT_REGISTER_CAPABILITY)
     def on_register(params: L.RegistrationParams):
@@ -193,10 +200,7 @@ async def measure_workspace(runs: int) -> dict:
     client.initialized(L.InitializedParams())
 
     async def until(version: int) -> tuple[float, list]:
-        while True:
-            t, params = await asyncio.wait_for(arrived.get(), 900)
-            if params.uri == uri and params.version == version:
-                return t, params.diagnostics
+        return await _until(arrived, uri, version, 900)
 
     t0 = time.perf_counter()
     client.text_document_did_open(L.DidOpenTextDocumentParams(

@@ -19,6 +19,7 @@ from krl.ast import nodes as N
 from krl.lsp.analysis import Analysis
 from krl.lsp.navigate import routine_target
 from krl.lsp.text import line_tokens
+from krl.syntax.folds import comment_start
 
 IO = ("$IN", "$OUT")
 
@@ -34,14 +35,9 @@ class Hint:
 
 
 def comment_of(line: str) -> str:
-    """The text after the first ``;`` outside a string (KRL strings have no escapes), stripped."""
-    quoted = False
-    for i, ch in enumerate(line):
-        if ch == '"':
-            quoted = not quoted
-        elif ch == ";" and not quoted:
-            return line[i + 1:].strip()
-    return ""
+    """The text after the first ``;`` outside a string, stripped ('' without a comment)."""
+    i = comment_start(line)
+    return line[i + 1:].strip() if i >= 0 else ""
 
 
 def io_names(an: Analysis) -> dict[tuple[str, int], list[tuple[str, str]]]:

@@ -15,6 +15,7 @@ from __future__ import annotations
 from krl.ast import nodes as N
 from krl.lsp.analysis import Analysis
 from krl.lsp.text import NAME_WORDS, find_name, line_tokens, units
+from krl.syntax.folds import comment_start
 
 TYPES = ["keyword", "variable", "parameter", "function", "type", "enumMember", "property",
          "macro", "comment", "string", "number"]
@@ -23,17 +24,6 @@ _T = {n: i for i, n in enumerate(TYPES)}
 DECLARATION, READONLY, LIBRARY = 1, 2, 4
 SIMPLE_TYPES = {"INT", "REAL", "BOOL", "CHAR"}
 NUMBERS = {"INTLITERAL", "REALLITERAL", "HEXLITERAL", "BINLITERAL"}
-
-
-def comment_start(line: str) -> int:
-    """0-based index of the ``;`` that starts a comment (outside a string), else -1."""
-    quoted = False
-    for i, ch in enumerate(line):
-        if ch == '"':
-            quoted = not quoted
-        elif ch == ";" and not quoted:
-            return i
-    return -1
 
 
 def _symbol_class(sym) -> tuple[str, int]:

@@ -391,16 +391,20 @@ def create_server() -> KrlLanguageServer:
             return None
         return L.CompletionList(is_incomplete=False, items=_complete.complete(an, path, line, col))
 
+    def refusing(step, an, *args):
+        """`step(an, *args)`, a refusal (krl/lsp/rename.py Refused) sent as the request's error."""
+        if an is None:
+            raise RequestFailed("the file is not analysed yet")
+        try:
+            return step(an, *args)
+        except _rename.Refused as exc:
+            raise RequestFailed(str(exc)) from None
+
     @server.feature(L.TEXT_DOCUMENT_PREPARE_RENAME)
     @guarded()
     async def prepare_rename(ls: KrlLanguageServer, params: L.PrepareRenameParams):
         an, path, line, col = await place(ls, params.text_document, params.position)
-        if an is None:
-            raise RequestFailed("the file is not analysed yet")
-        try:
-            t = _rename.renamable(an, _nav.resolve(an, path, line, col))
-        except _rename.Refused as exc:
-            raise RequestFailed(str(exc)) from None
+        t = refusing(_rename.renamable, an, _nav.resolve(an, path, line, col) if an is not None else None)
         _, tok, _ = token_at(an.files[path].lines, line, col)
         start = tok.column + (1 if tok.word == "ENUMLITERAL" else 0)
         return L.PrepareRenamePlaceholder(
@@ -411,12 +415,8 @@ def create_server() -> KrlLanguageServer:
     @guarded()
     async def rename(ls: KrlLanguageServer, params: L.RenameParams):
         an, path, line, col = await place(ls, params.text_document, params.position)
-        if an is None:
-            raise RequestFailed("the file is not analysed yet")
-        try:
-            places = _rename.plan(an, _nav.resolve(an, path, line, col), params.new_name)
-        except _rename.Refused as exc:
-            raise RequestFailed(str(exc)) from None
+        places = refusing(_rename.plan, an, _nav.resolve(an, path, line, col) if an is not None else None,
+                          params.new_name)
         codec = ls.codec()
         return L.WorkspaceEdit(changes={
             uri_of(p): [L.TextEdit(range=to_range(an.files[p].lines, x.line, x.column, x.length, codec),

@@ -45,27 +45,39 @@ def neovim() -> str | None:
     return apt_install("neovim", "nvim")
 
 
-@pytest.mark.may_skip("Neovim is not installed and cannot be installed here (no apt-get, not root, or no package source)")
-def test_neovim_reads_krl_diagnostics(tmp_path: Path):
+@pytest.fixture
+def nvim_backup(tmp_path: Path) -> tuple[str, Path, Path]:
+    """(nvim, a copy of the fixture backup, its main.src); skips without Neovim."""
     nvim = neovim()
     if nvim is None:
         pytest.skip("nvim missing and `apt-get install -y neovim` not possible")
     root = tmp_path / "KRC"
     shutil.copytree(BACKUP, root)
-    main = root / "R1" / "Program" / "main.src"
-    # line 9 (1-based) uses an undeclared name: E101 at 0-based line 8, column 2
-    main.write_text(main.read_text().replace("  counter = 0\n", "  countr = 0\n"))
+    return nvim, root, root / "R1" / "Program" / "main.src"
+
+
+def run_nvim(nvim: str, tmp_path: Path, lua: str, root: Path, opened: Path, **extra: str) -> list[list[str]]:
+    """Run headless Neovim with the Lua config `lua` on the file `opened` of the workspace
+    `root`; the rows ('|'-separated fields) the config wrote to $KRL_NVIM_OUT."""
     init = tmp_path / "init.lua"
-    init.write_text(LUA)
-    out = tmp_path / "diagnostics.txt"
+    init.write_text(lua)
+    out = tmp_path / "nvim-out.txt"
     env = dict(os.environ, KRL_NVIM_OUT=str(out), KRL_PYTHON=sys.executable, KRL_ROOT=str(root),
                XDG_CONFIG_HOME=str(tmp_path / "cfg"), XDG_DATA_HOME=str(tmp_path / "data"),
                XDG_STATE_HOME=str(tmp_path / "state"), XDG_CACHE_HOME=str(tmp_path / "cache"),
-               PYTHONPATH=str(Path(__file__).resolve().parents[2]))
-    proc = subprocess.run([nvim, "--headless", "-n", "-i", "NONE", "-u", str(init), str(main)],
+               PYTHONPATH=str(Path(__file__).resolve().parents[2]), **extra)
+    proc = subprocess.run([nvim, "--headless", "-n", "-i", "NONE", "-u", str(init), str(opened)],
                           env=env, capture_output=True, text=True, timeout=180, check=False)
-    assert out.exists(), f"nvim wrote no diagnostics (exit {proc.returncode}): {proc.stderr[-2000:]}"
-    rows = [line.split("|", 3) for line in out.read_text().splitlines() if line]
+    assert out.exists(), f"nvim wrote nothing (exit {proc.returncode}): {proc.stderr[-2000:]}"
+    return [line.split("|", 3) for line in out.read_text().splitlines() if line]
+
+
+@pytest.mark.may_skip("Neovim is not installed and cannot be installed here (no apt-get, not root, or no package source)")
+def test_neovim_reads_krl_diagnostics(tmp_path: Path, nvim_backup):
+    nvim, root, main = nvim_backup
+    # line 9 (1-based) uses an undeclared name: E101 at 0-based line 8, column 2
+    main.write_text(main.read_text().replace("  counter = 0\n", "  countr = 0\n"))
+    rows = run_nvim(nvim, tmp_path, LUA, root, main)
     assert rows == [["E101", "8", "2", "'countr' is not declared"]]
 
 
@@ -116,29 +128,14 @@ end })
 
 
 @pytest.mark.may_skip("Neovim is not installed and cannot be installed here (no apt-get, not root, or no package source)")
-def test_neovim_renames_and_gets_an_inlay_hint(tmp_path: Path):
+def test_neovim_renames_and_gets_an_inlay_hint(tmp_path: Path, nvim_backup):
     """Neovim's LSP client asks for the inlay hints of main.src (``$IN[1]`` on line 5 is
     ``SIGNAL stop_btn $IN[1] ;Stop button of the cell`` of $config.dat, the hint after ``]`` at
     char 30) and renames ``counter`` (main.src lines 8 and 10, $config.dat line 1), applying
     the server's edit to its buffers."""
-    nvim = neovim()
-    if nvim is None:
-        pytest.skip("nvim missing and `apt-get install -y neovim` not possible")
-    root = tmp_path / "KRC"
-    shutil.copytree(BACKUP, root)
-    main = root / "R1" / "Program" / "main.src"
-    init = tmp_path / "init.lua"
-    init.write_text(LUA_FEATURES)
-    out = tmp_path / "features.txt"
-    env = dict(os.environ, KRL_NVIM_OUT=str(out), KRL_PYTHON=sys.executable, KRL_ROOT=str(root),
-               KRL_CONFIG_DAT=str(root / "R1" / "System" / "$config.dat"),
-               XDG_CONFIG_HOME=str(tmp_path / "cfg"), XDG_DATA_HOME=str(tmp_path / "data"),
-               XDG_STATE_HOME=str(tmp_path / "state"), XDG_CACHE_HOME=str(tmp_path / "cache"),
-               PYTHONPATH=str(Path(__file__).resolve().parents[2]))
-    proc = subprocess.run([nvim, "--headless", "-n", "-i", "NONE", "-u", str(init), str(main)],
-                          env=env, capture_output=True, text=True, timeout=180, check=False)
-    assert out.exists(), f"nvim wrote nothing (exit {proc.returncode}): {proc.stderr[-2000:]}"
-    rows = [line.split("|", 3) for line in out.read_text().splitlines() if line]
+    nvim, root, main = nvim_backup
+    rows = run_nvim(nvim, tmp_path, LUA_FEATURES, root, main,
+                    KRL_CONFIG_DAT=str(root / "R1" / "System" / "$config.dat"))
     assert ["hint", "5", "30", "stop_btn: Stop button of the cell"] in rows
     assert ["hint", "18", "9", "lamp"] in rows
     assert [r for r in rows if r[0] in ("main", "config", "error")] == [
