@@ -121,22 +121,22 @@ class Analysis:
 
     # ------------------------------------------------------------------ set-up
 
-    def annotate_partial(self) -> None:
+    def annotate_partial(self, only: str | None = None) -> None:
         """Type the routines of files that did not parse (their findings are not reported:
-        ``krl check`` reports only the syntax errors of such files)."""
+        ``krl check`` reports only the syntax errors of such files); `only`: of that file."""
         if self.ws.global_scope is None:
             return
         sink = DiagnosticSink()
         checker = Checker(sink, Declarer(sink, True), True)
         for f in self.ws.files:
-            if f.ok:
+            if f.ok or (only is not None and f.path != only):
                 continue
             for r in f.module.routines:
                 sc = self.ws.routine_scope(r)
                 if sc is not None:
                     checker.check_routine(r, sc, f.path)
         for f in self.ws.files:
-            if not f.ok and f.module.data is not None and f.scope is not None:
+            if not f.ok and f.module.data is not None and f.scope is not None and only is None:
                 checker.check_datalist(f.module.data, f.scope)
 
     def diagnostics_for(self, path: str) -> list[Diagnostic]:

@@ -14,9 +14,11 @@ with their modes and declared types, return types -- re-checks only that file's 
   warnings once per backup with counts over all files) is made again from the recorded uses,
   the file's old uses replaced by its new ones, so it reads exactly as after a full check.
 
-Everything else -- a .dat file, a change of the interface, a file that gains or loses a syntax
-error, a file added or removed -- checks the whole workspace again (every module that may depend
-on the change). The resolver (storage places for the interpreters) is not run for the edited
+A file that gains or loses a syntax error is handled the same way (its routines are then typed
+but not reported, as ``krl check`` does, and the words of the files that do not parse, which
+soften the unresolved-name report, are gathered again). Everything else -- a .dat file, a change
+of the interface, a file added or removed -- checks the whole workspace again (every module that
+may depend on the change). The resolver (storage places for the interpreters) is not run for the edited
 file: the editor features read the checker's annotations (``ann.symbol``, ``ann.type``) only;
 :meth:`krl.lsp.analysis.Analysis.resolved` runs it for a feature that needs it.
 """
@@ -61,7 +63,7 @@ def recheck(prev: Analysis, path: str, parsed: Parsed) -> Analysis | None:
         return None
     sf = fi.source
     old_mod, new_mod = sf.module, parsed.module
-    if not (sf.ok and parsed.ok) or old_mod.kind != "src" or new_mod.kind != "src":
+    if old_mod.kind != "src" or new_mod.kind != "src" or parsed.unreadable or fi.parsed.unreadable:
         return None
     if old_mod.data is not None or new_mod.data is not None or interface(old_mod) != interface(new_mod):
         return None
@@ -83,7 +85,14 @@ def recheck(prev: Analysis, path: str, parsed: Parsed) -> Analysis | None:
             sym.decl = r_new
         ws.routine_scopes.pop(id(r_old), None)
     sf.module = new_mod
-    sf.status = parsed.status
+    sf.status, sf.ok = parsed.status, parsed.ok
+    # the words of files that do not parse (a name among them may be declared there: W101)
+    old_failed = set(ws.failed_words)
+    ws.failed_words = set()
+    for p, other in prev.files.items():
+        got = parsed if p == path else other.parsed
+        if not got.ok:
+            ws.failed_words.update(got.failed_words)
 
     # this file's parse and body diagnostics go; the unresolved report is made again below
     old_parse = {id(d) for d in fi.parsed.diagnostics}
@@ -111,11 +120,12 @@ def recheck(prev: Analysis, path: str, parsed: Parsed) -> Analysis | None:
             ws.routine_scopes[id(r)] = local
         checker.system_file = declarer.soft_types = soft
         checker.submit = path.lower().endswith(".sub")
-        for _r_old, r in pairs:
-            checker.check_routine(r, ws.routine_scopes[id(r)], path)
+        if parsed.ok:           # a file with syntax errors: only its syntax errors are reported
+            for _r_old, r in pairs:
+                checker.check_routine(r, ws.routine_scopes[id(r)], path)
         checker.system_file = declarer.soft_types = checker.submit = False
         report = None
-        if _uses_of(unresolved, path) != old_uses:      # else the report reads as before
+        if _uses_of(unresolved, path) != old_uses or ws.failed_words != old_failed:   # else as before
             report = DiagnosticSink()
             unresolved.finish(report)
     finally:
@@ -139,6 +149,8 @@ def recheck(prev: Analysis, path: str, parsed: Parsed) -> Analysis | None:
 
     an = Analysis(prev.root, ws, dict(prev.files))
     an.files[path] = FileInfo(path, parsed, sf, _lines(parsed.text))
+    if not parsed.ok:
+        an.annotate_partial(only=path)
     return an
 
 

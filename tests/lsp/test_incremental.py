@@ -39,8 +39,12 @@ def test_body_edits_on_the_fixture(tmp_path):
         (text.replace("  counter = 0\n", "  countr = 0.5\n"), True),                 # E101
         (text.replace("  counter = 0\n", "  counter = 0.5\n  $IN[3] = TRUE\n  bar()\n"), True),   # W202, E501, E106
         (text, True),
+        (text.replace("IF run_mode == #auto THEN", "IF run_mode == #auto"), True),   # a syntax error
+        (text.replace("IF run_mode == #auto THEN", "IF run_mode == #auto").replace("counter = 0", "countr = 0"), True),
+        (text, True),
         (text.replace("DEF on_stop( )", "GLOBAL DEF on_stop( )"), False),           # interface: GLOBAL
-        (text.replace("IF run_mode == #auto THEN", "IF run_mode == #auto"), False),  # a syntax error
+        (text, False),
+        (text.replace("DEF on_stop( )", "DEF on_stop(x:IN)\n  DECL INT x"), False),  # interface: a parameter
         (text, False),
     ])
     an = p.latest(main)
@@ -60,5 +64,6 @@ def test_body_edits_on_a_real_backup(shared_corpus, tmp_path):
     edits_agree(p, path, [
         (text.replace("   SALIR = TRUE\n", "   SALIRR = TRUE\n", 1), True),
         (text.replace("   SALIR = TRUE\n", "   no_such_routine()\n   SALIR = $NO_SUCH_SYSVAR\n", 1), True),
+        (text.replace("   SALIR = TRUE\n", "   SALIR = TRUE +\n", 1), True),          # a syntax error
         (text, True),
     ])
