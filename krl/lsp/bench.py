@@ -19,7 +19,8 @@ the ChinaMilling backup (156 files) with further corpus files copied into its ``
 until there are 400. It opens one program of the backup and reports: the time to its first
 diagnostics (the file's own parse diagnostics, published while the workspace is checked), the
 time until the first check of the 400 files is done, didChange -> publishDiagnostics for edits
-inside a routine (median, 95th percentile), and the server's memory (VmRSS, VmHWM).
+inside a routine and for edits that leave a syntax error (median, 95th percentile), and the
+server's memory (VmRSS, VmHWM).
 """
 
 from __future__ import annotations
@@ -215,18 +216,21 @@ async def measure_workspace(runs: int) -> dict:
     sep = "\r\n" if "\r\n" in text else "\n"
     targets = [i for i, ln in enumerate(lines) if ln.strip().upper().startswith(("WAIT SEC", "IF ", "$OUT[", "RETURN"))] or [1]
     version = 1
-    times: list[float] = []
-    for r in range(runs):
-        edited = list(lines)
-        i = targets[(r * 7) % len(targets)]
-        edited[i] = edited[i] + f" ;edit {r}"
-        version += 1
-        t0e = time.perf_counter()
-        client.text_document_did_change(L.DidChangeTextDocumentParams(
-            text_document=L.VersionedTextDocumentIdentifier(uri=uri, version=version),
-            content_changes=[L.TextDocumentContentChangeWholeDocument(text=sep.join(edited))]))
-        t1, diags = await until(version)
-        times.append((t1 - t0e) * 1000)
+    results: dict[str, list[float]] = {"edit": [], "error": []}
+    for kind, n in (("edit", runs), ("error", max(3, runs // 3))):
+        for r in range(n):
+            edited = list(lines)
+            i = targets[(r * 7) % len(targets)]
+            # a valid change, or one that leaves a syntax error in the statement (`x =` and no value)
+            edited[i] = edited[i] + f" ;edit {r}" if kind == "edit" else "  x ="
+            version += 1
+            t0e = time.perf_counter()
+            client.text_document_did_change(L.DidChangeTextDocumentParams(
+                text_document=L.VersionedTextDocumentIdentifier(uri=uri, version=version),
+                content_changes=[L.TextDocumentContentChangeWholeDocument(text=sep.join(edited))]))
+            t1, diags = await until(version)
+            results[kind].append((t1 - t0e) * 1000)
+    times = results["edit"]
     mem = _memory(pid)
     await client.shutdown_async(None)
     client.exit(None)
@@ -236,7 +240,9 @@ async def measure_workspace(runs: int) -> dict:
     return {"files": count, "first_diagnostics_ms": round((t_first - t0) * 1000, 1),
             "first_check_ms": round((t_checked - t0) * 1000, 1),
             "edit_median_ms": round(statistics.median(times), 1), "edit_p95_ms": round(_pct(times, 0.95), 1),
-            "edit_runs": len(times), "rss_mib": mem.get("VmRSS"), "peak_rss_mib": mem.get("VmHWM"),
+            "edit_runs": len(times), "error_median_ms": round(statistics.median(results["error"]), 1),
+            "error_p95_ms": round(_pct(results["error"], 0.95), 1), "error_runs": len(results["error"]),
+            "rss_mib": mem.get("VmRSS"), "peak_rss_mib": mem.get("VmHWM"),
             "loadavg": Path("/proc/loadavg").read_text().split()[:3] if Path("/proc/loadavg").exists() else []}
 
 
@@ -253,6 +259,8 @@ def main(argv: list[str] | None = None) -> None:
               f"first check done {res['first_check_ms']} ms")
         print(f"didChange -> publishDiagnostics, edit inside a routine: median {res['edit_median_ms']} ms, "
               f"p95 {res['edit_p95_ms']} ms ({res['edit_runs']} runs)")
+        print(f"didChange -> publishDiagnostics, edit leaving a syntax error: median {res['error_median_ms']} ms, "
+              f"p95 {res['error_p95_ms']} ms ({res['error_runs']} runs)")
         print(f"server memory: {res['rss_mib']} MiB resident, peak {res['peak_rss_mib']} MiB; "
               f"load average {' '.join(res['loadavg'])}")
         print(json.dumps(res))
