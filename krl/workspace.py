@@ -220,6 +220,10 @@ class Workspace:
     # every name (krl/semantics/resolve.py)
     system_names: list = field(default_factory=list)
     resolver: object = None
+    # what an editor needs to re-check one module after a change (krl/lsp/incremental.py):
+    # the declarer and checker of the last check, the ids of the diagnostics of its body phase
+    # (routine scopes, data-list values, routine bodies) and of the unresolved-name report
+    phases: dict = field(default_factory=dict)
 
     def maybe_declared(self, name: str) -> bool:
         """True when a file that could not be parsed (or read) may declare `name`."""
@@ -483,6 +487,7 @@ class Workspace:
                     sink.at(main.span, "W111", f"main routine '{main.name}' differs from the file name '{u.name}'")
 
         # routine scopes (parameters and locals), then signatures, then bodies
+        body_mark = len(sink.items)
         for r, sym, u in routine_syms:
             declarer.soft_types = is_kuka_file(u.src.path)
             local = Scope("routine", r.name, u.scope)
@@ -507,7 +512,12 @@ class Workspace:
             checker.submit = u.src.path.lower().endswith(".sub")
             checker.check_routine(r, self.routine_scopes[id(r)], u.src.path)
         checker.system_file = declarer.soft_types = checker.submit = False
+        finish_mark = len(sink.items)
         declarer.unresolved.finish(sink)
+        self.phases = {"declarer": declarer, "checker": checker,
+                       "body": {id(d) for d in sink.items[body_mark:finish_mark]},
+                       "unresolved": {id(d) for d in sink.items[finish_mark:]},
+                       "routine_symbols": {id(r): sym for r, sym, _u in routine_syms}}
         # advisory warnings are for code its maintainer can change: not for KUKA's own files
         kuka = {f.path for f in self.files if is_kuka_file(f.path)} | {
             u.dat.path for u in self.units

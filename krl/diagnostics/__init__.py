@@ -195,6 +195,16 @@ class DiagnosticSink:
             self._seen.add(key)
             self.items.append(d)
 
+    def remove(self, ids: set[int]) -> None:
+        """Drop the diagnostics whose ``id()`` is in `ids` (an editor re-checking one file
+        replaces that file's findings); their keys are freed for :meth:`add`."""
+        gone = [d for d in self.items if id(d) in ids]
+        if not gone:
+            return
+        self.items = [d for d in self.items if id(d) not in ids]
+        for d in gone:
+            self._seen.discard((d.path, d.line, d.column if d.code.startswith("E0") else 0, d.code, d.message))
+
     def at(self, span, code: str, message: str, severity: str = "") -> None:
         """Add a diagnostic at a krl.ast.nodes.Span."""
         self.add(span.file, span.line, span.column, code, message, severity)

@@ -111,29 +111,37 @@ class Analysis:
                 self._types.setdefault(id(sym.type), sym)
                 self._type_of_decl.setdefault(id(sym.decl), sym)
 
+    def resolved(self) -> "Analysis":
+        """This analysis with every name placed by the resolver (krl/semantics/resolve.py:
+        ``ann.storage``); an incremental re-check (krl/lsp/incremental.py) leaves it to this."""
+        if self.ws.resolver is None and self.ws.global_scope is not None:
+            from krl.semantics.resolve import resolve_workspace  # noqa: PLC0415
+            resolve_workspace(self.ws)
+        return self
+
     # ------------------------------------------------------------------ set-up
 
-    def annotate_partial(self) -> None:
+    def annotate_partial(self, only: str | None = None) -> None:
         """Type the routines of files that did not parse (their findings are not reported:
-        ``krl check`` reports only the syntax errors of such files)."""
+        ``krl check`` reports only the syntax errors of such files); `only`: of that file."""
         if self.ws.global_scope is None:
             return
         sink = DiagnosticSink()
         checker = Checker(sink, Declarer(sink, True), True)
         for f in self.ws.files:
-            if f.ok:
+            if f.ok or (only is not None and f.path != only):
                 continue
             for r in f.module.routines:
                 sc = self.ws.routine_scope(r)
                 if sc is not None:
                     checker.check_routine(r, sc, f.path)
         for f in self.ws.files:
-            if not f.ok and f.module.data is not None and f.scope is not None:
+            if not f.ok and f.module.data is not None and f.scope is not None and only is None:
                 checker.check_datalist(f.module.data, f.scope)
 
     def diagnostics_for(self, path: str) -> list[Diagnostic]:
         """The workspace's diagnostics of one file, with the root's krl.toml applied."""
-        diags = [d for d in self.ws.diagnostics if d.path == path]
+        diags = sorted((d for d in self.ws.sink.items if d.path == path), key=lambda d: (d.line, d.column, d.code))
         from krl.lsp.project import is_uri  # noqa: PLC0415
         if is_uri(path):        # an unsaved new buffer has no file name to match its main routine
             diags = [d for d in diags if d.code != "W111"]

@@ -12,6 +12,15 @@ diagnostics of that version arrive (the debounce delay included). Two kinds of e
 
 Prints one line per kind with the median and 90th percentile in ms, and one JSON line. A
 benchmark, not a test: the figures depend on the machine and its load.
+
+``--workspace`` measures a 400-file project instead, built at bench time in a temporary folder
+from the shared corpus (krl/files.py ``SHARED_CORPUS``; nothing is copied into the repository):
+the ChinaMilling backup (156 files) with further corpus files copied into its ``R1/Program/corpus``
+until there are 400. It opens one program of the backup and reports: the time to its first
+diagnostics (the file's own parse diagnostics, published while the workspace is checked), the
+time until the first check of the 400 files is done, didChange -> publishDiagnostics for edits
+inside a routine and for edits that leave a syntax error (median, 95th percentile), and the
+server's memory (VmRSS, VmHWM).
 """
 
 from __future__ import annotations
@@ -46,6 +55,25 @@ def generate(lines: int = 3000) -> str:
     return "\r\n".join(out) + "\r\n"
 
 
+def _collect(client) -> asyncio.Queue:
+    """A queue of (arrival time, PublishDiagnosticsParams) filled by `client`."""
+    from lsprotocol import types as L  # noqa: PLC0415
+    arrived: asyncio.Queue = asyncio.Queue()
+
+    @client.feature(L.TEXT_DOCUMENT_PUBLISH_DIAGNOSTICS)
+    def on_diagnostics(params: L.PublishDiagnosticsParams):
+        arrived.put_nowait((time.perf_counter(), params))
+    return arrived
+
+
+async def _until(arrived: asyncio.Queue, uri: str, version: int, timeout: float) -> tuple[float, list]:
+    """(arrival time, diagnostics) of the first publication for `uri` at `version`."""
+    while True:
+        t, params = await asyncio.wait_for(arrived.get(), timeout)
+        if params.uri == uri and params.version == version:
+            return t, params.diagnostics
+
+
 def _pct(values: list[float], p: float) -> float:
     s = sorted(values)
     return s[min(len(s) - 1, int(round(p * (len(s) - 1))))]
@@ -61,21 +89,13 @@ async def measure(lines: int, runs: int) -> dict:
     path.write_text(text)
     uri = path.as_uri()
     client = BaseLanguageClient("krl-lsp-bench", "1")
-    arrived: asyncio.Queue = asyncio.Queue()
-
-    @client.feature(L.TEXT_DOCUMENT_PUBLISH_DIAGNOSTICS)
-    def on_diagnostics(params: L.PublishDiagnosticsParams):
-        arrived.put_nowait((time.perf_counter(), params))
-
+    arrived = _collect(client)
     await client.start_io(sys.executable, "-m", "krl.lsp")
     await client.initialize_async(L.InitializeParams(capabilities=L.ClientCapabilities(), root_uri=folder.as_uri()))
     client.initialized(L.InitializedParams())
 
     async def until(version: int) -> tuple[float, list]:
-        while True:
-            t, params = await asyncio.wait_for(arrived.get(), 600)
-            if params.uri == uri and params.version == version:
-                return t, params.diagnostics
+        return await _until(arrived, uri, version, 600)
 
     t0 = time.perf_counter()
     client.text_document_did_open(L.DidOpenTextDocumentParams(
@@ -112,11 +132,139 @@ async def measure(lines: int, runs: int) -> dict:
     return out
 
 
+WORKSPACE_BASE = "HugoDanielson__ChinaMilling/KRC"
+WORKSPACE_FILE = "R1/Program/KukaMiling/Main_2.src"
+KRL_SUFFIXES = (".src", ".dat", ".sub")
+
+
+def build_workspace(dst: Path, files: int = 400, corpus: Path | None = None) -> tuple[Path, int]:
+    """Copy the corpus backup WORKSPACE_BASE to `dst`/KRC and further corpus KRL files (not
+    $-files, not of that backup) into KRC/R1/Program/corpus until it holds `files` KRL files;
+    returns (backup root, number of KRL files)."""
+    import shutil  # noqa: PLC0415
+
+    from krl.files import SHARED_CORPUS  # noqa: PLC0415
+    corpus = corpus or SHARED_CORPUS
+    base = corpus / WORKSPACE_BASE
+    if not base.is_dir():
+        raise SystemExit(f"the shared corpus is not at {corpus}: --workspace needs it")
+    root = dst / "KRC"
+    shutil.copytree(base, root)
+    count = sum(1 for p in root.rglob("*") if p.is_file() and p.suffix.lower() in KRL_SUFFIXES)
+    extra = root / "R1" / "Program" / "corpus"
+    for p in sorted(corpus.rglob("*")):
+        if count >= files:
+            break
+        if not p.is_file() or p.suffix.lower() not in KRL_SUFFIXES or p.name.startswith("$") or base in p.parents:
+            continue
+        target = extra / p.relative_to(corpus)
+        target.parent.mkdir(parents=True, exist_ok=True)
+        shutil.copyfile(p, target)
+        count += 1
+    return root, count
+
+
+def _memory(pid: int) -> dict[str, float]:
+    out = {}
+    try:
+        for line in Path(f"/proc/{pid}/status").read_text().splitlines():
+            key, _, value = line.partition(":")
+            if key in ("VmRSS", "VmHWM"):
+                out[key] = round(int(value.split()[0]) / 1024, 1)       # MiB
+    except OSError:
+        pass
+    return out
+
+
+async def measure_workspace(runs: int) -> dict:
+    from lsprotocol import types as L  # noqa: PLC0415
+    from pygls.lsp.client import BaseLanguageClient  # noqa: PLC0415
+
+    folder = Path(tempfile.mkdtemp(prefix="krl-lsp-bench-ws-"))
+    root, count = build_workspace(folder)
+    path = root / WORKSPACE_FILE
+    text = path.read_bytes().decode("cp1252")
+    uri = path.as_uri()
+    client = BaseLanguageClient("krl-lsp-bench", "1")
+    arrived = _collect(client)
+
+    @client.feature(L.CLIENT_REGISTER_CAPABILITY)
+    def on_register(params: L.RegistrationParams):
+        return None                 # the editor watches the files (VS Code and Neovim do)
+
+    await client.start_io(sys.executable, "-m", "krl.lsp")
+    pid = client._server.pid
+    caps = L.ClientCapabilities(workspace=L.WorkspaceClientCapabilities(
+        did_change_watched_files=L.DidChangeWatchedFilesClientCapabilities(dynamic_registration=True)))
+    await client.initialize_async(L.InitializeParams(capabilities=caps, root_uri=root.as_uri(),
+                                                     workspace_folders=[L.WorkspaceFolder(uri=root.as_uri(), name="KRC")]))
+    client.initialized(L.InitializedParams())
+
+    async def until(version: int) -> tuple[float, list]:
+        return await _until(arrived, uri, version, 900)
+
+    t0 = time.perf_counter()
+    client.text_document_did_open(L.DidOpenTextDocumentParams(
+        text_document=L.TextDocumentItem(uri=uri, language_id="krl", version=1, text=text)))
+    t_first, _ = await until(1)
+    await client.text_document_document_symbol_async(L.DocumentSymbolParams(
+        text_document=L.TextDocumentIdentifier(uri=uri)))          # answered after the first check
+    t_checked = time.perf_counter()
+    while not arrived.empty():
+        arrived.get_nowait()
+    lines = text.split("\r\n") if "\r\n" in text else text.split("\n")
+    sep = "\r\n" if "\r\n" in text else "\n"
+    targets = [i for i, ln in enumerate(lines) if ln.strip().upper().startswith(("WAIT SEC", "IF ", "$OUT[", "RETURN"))] or [1]
+    version = 1
+    results: dict[str, list[float]] = {"edit": [], "error": []}
+    for kind, n in (("edit", runs), ("error", max(3, runs // 3))):
+        for r in range(n):
+            edited = list(lines)
+            i = targets[(r * 7) % len(targets)]
+            # a valid change, or one that leaves a syntax error in the statement (`x =` and no value)
+            edited[i] = edited[i] + f" ;edit {r}" if kind == "edit" else "  x ="
+            version += 1
+            t0e = time.perf_counter()
+            client.text_document_did_change(L.DidChangeTextDocumentParams(
+                text_document=L.VersionedTextDocumentIdentifier(uri=uri, version=version),
+                content_changes=[L.TextDocumentContentChangeWholeDocument(text=sep.join(edited))]))
+            t1, diags = await until(version)
+            results[kind].append((t1 - t0e) * 1000)
+    times = results["edit"]
+    mem = _memory(pid)
+    await client.shutdown_async(None)
+    client.exit(None)
+    await client.stop()
+    import shutil  # noqa: PLC0415
+    shutil.rmtree(folder, ignore_errors=True)
+    return {"files": count, "first_diagnostics_ms": round((t_first - t0) * 1000, 1),
+            "first_check_ms": round((t_checked - t0) * 1000, 1),
+            "edit_median_ms": round(statistics.median(times), 1), "edit_p95_ms": round(_pct(times, 0.95), 1),
+            "edit_runs": len(times), "error_median_ms": round(statistics.median(results["error"]), 1),
+            "error_p95_ms": round(_pct(results["error"], 0.95), 1), "error_runs": len(results["error"]),
+            "rss_mib": mem.get("VmRSS"), "peak_rss_mib": mem.get("VmHWM"),
+            "loadavg": Path("/proc/loadavg").read_text().split()[:3] if Path("/proc/loadavg").exists() else []}
+
+
 def main(argv: list[str] | None = None) -> None:
     ap = argparse.ArgumentParser(prog="python -m krl.lsp.bench", description=__doc__.splitlines()[0])
     ap.add_argument("--lines", type=int, default=3000)
     ap.add_argument("--runs", type=int, default=20)
+    ap.add_argument("--workspace", action="store_true",
+                    help="a 400-file workspace built from the shared corpus (see the module docstring)")
     args = ap.parse_args(argv)
+    if args.workspace:
+        res = asyncio.run(measure_workspace(args.runs))
+        print(f"{res['files']} files; first diagnostics {res['first_diagnostics_ms']} ms, "
+              f"first check done {res['first_check_ms']} ms")
+        print(f"didChange -> publishDiagnostics, edit inside a routine: median {res['edit_median_ms']} ms, "
+              f"p95 {res['edit_p95_ms']} ms ({res['edit_runs']} runs)")
+        print(f"didChange -> publishDiagnostics, edit leaving a syntax error: median {res['error_median_ms']} ms, "
+              f"p95 {res['error_p95_ms']} ms ({res['error_runs']} runs)")
+        print(f"server memory: {res['rss_mib']} MiB resident, peak {res['peak_rss_mib']} MiB; "
+              f"load average {' '.join(res['loadavg'])}")
+        print(json.dumps(res))
+        return
     res = asyncio.run(measure(args.lines, args.runs))
     print(f"{res['lines']} lines; open: {res['open_ms']} ms")
     print(f"didChange -> publishDiagnostics, valid edit:  median {res['edit_median_ms']} ms, "

@@ -48,6 +48,7 @@ class Project:
         self._roots: dict[str, tuple[float, str, list[str], list]] = {}
         self.analyses: dict[str, Analysis] = {}  # root -> latest analysis
         self._root_of: dict[str, str] = {}       # path -> root of its latest analysis
+        self.watched = False    # the client reports file changes: file lists kept until it does
 
     # ------------------------------------------------------------------ documents
 
@@ -82,7 +83,7 @@ class Project:
             return p, [p], []       # not a file: checked on its own
         got = self._roots.get(p)
         now = time.monotonic()
-        if got is None or now - got[0] > ROOTS_TTL_S:
+        if got is None or (not self.watched and now - got[0] > ROOTS_TTL_S):
             root, files, skipped = workspace_of(Path(p), self.folders)
             got = (now, norm(root), [norm(f) for f in files], skipped)
             self._roots[p] = got
@@ -119,11 +120,33 @@ class Project:
         result is remembered as the latest analysis of that workspace."""
         docs = dict(self.docs) if docs is None else docs
         root, files, skipped = self.workspace_files(path, docs)
-        an = build_analysis(root, [self.parsed(f, docs) for f in files], skipped)
+        parsed = [self.parsed(f, docs) for f in files]
+        an = self._recheck(root, files, parsed, skipped)
+        if an is None:
+            an = build_analysis(root, parsed, skipped)
         self.analyses[root] = an
         for f in files:
             self._root_of[f] = root
         return an
+
+    def _recheck(self, root: str, files: list[str], parsed: list[Parsed], skipped) -> Analysis | None:
+        """The latest analysis of `root` with the one file whose parse changed re-checked on its
+        own (krl/lsp/incremental.py), else None (check the whole workspace)."""
+        prev = self.analyses.get(root)
+        if prev is None or skipped or list(prev.files) != files:
+            return None
+        changed = [p for p in parsed if prev.files[p.path].parsed is not p]
+        if not changed:
+            return prev
+        if len(changed) != 1:
+            return None
+        from krl.lsp.incremental import recheck  # noqa: PLC0415
+        try:
+            return recheck(prev, changed[0].path, changed[0])
+        except Exception:  # noqa: BLE001 - the whole workspace is checked again from the parses
+            import logging  # noqa: PLC0415
+            logging.getLogger("krl.lsp").error("incremental re-check failed; checking the workspace", exc_info=True)
+            return None
 
     def latest(self, path: str) -> Analysis | None:
         """The latest analysis holding `path`, or None."""

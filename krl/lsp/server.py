@@ -21,20 +21,30 @@ from pygls.lsp.server import LanguageServer
 from pygls.uris import from_fs_path, to_fs_path
 
 from krl import __version__
+from krl.lsp import actions as _actions
 from krl.lsp import complete as _complete
 from krl.lsp import folding as _folding
 from krl.lsp import hover as _hover
+from krl.lsp import inlay as _inlay
 from krl.lsp import navigate as _nav
 from krl.lsp import outline as _outline
+from krl.lsp import rename as _rename
+from krl.lsp import semtokens as _semtokens
+from krl.lsp import signature as _signature
+from krl.lsp import unused as _unused
+from krl.lsp.occurrences import DECL, WRITE, file_occurrences
 from krl.lsp.analysis import Analysis
 from krl.lsp.convert import lsp_diagnostic
 from krl.lsp.project import Project, norm
-from krl.lsp.text import from_position, to_range, units
+from krl.lsp.text import from_position, to_range, token_at, units
+from pygls.exceptions import JsonRpcException
 from krl.terminal import printable, printable_path
 
 log = logging.getLogger("krl.lsp")       # file names and messages in it pass krl.terminal.printable
 TRACEBACKS = {"on": False}                # Python tracebacks only into a --log-file, never to stderr
-DEBOUNCE_S = 0.05          # seconds after the last change before the analysis starts
+DEBOUNCE_S = 0.02          # seconds after the last change before the analysis starts
+EARLY_S = 0.5              # after opening: the file's own parse diagnostics when the first check of
+EARLY_MIN_FILES = 100      # a workspace of this many files is not done within this many seconds
 
 
 def path_of(uri: str) -> str:
@@ -74,6 +84,7 @@ class KrlLanguageServer(LanguageServer):
         self._dirty: set[str] = set()
         self._versions: dict[str, int | None] = {}
         self._gen: dict[str, int] = {}          # path -> count of changes (stale-analysis check)
+        self._quick = ThreadPoolExecutor(max_workers=1, thread_name_prefix="krl-first-parse")
 
     @property
     def lock(self) -> asyncio.Lock:
@@ -137,8 +148,42 @@ class KrlLanguageServer(LanguageServer):
             if path not in docs or path not in self.project.docs:
                 continue
             diags = [lsp_diagnostic(d, fi.lines, codec, uri_of) for d in an.diagnostics_for(path)]
+            for u in _unused.never_read(an, path):
+                diags.append(L.Diagnostic(
+                    range=to_range(fi.lines, u.place.line, u.place.column, u.place.length, codec), message=u.message,
+                    severity=L.DiagnosticSeverity.Hint, tags=[L.DiagnosticTag.Unnecessary], source="krl"))
             self.text_document_publish_diagnostics(L.PublishDiagnosticsParams(
                 uri=uri_of(path), diagnostics=diags, version=versions.get(path)))
+
+    async def early(self, path: str, text: str, version: int | None) -> None:
+        """Publish the parse diagnostics of a just-opened file (syntax, FOLD balance: they
+        depend on the file alone) when the check of its workspace (of at least
+        :data:`EARLY_MIN_FILES` files) is not done after :data:`EARLY_S`; the checked
+        diagnostics replace them when the check ends."""
+        try:
+            await self._early(path, text, version)
+        except Exception as exc:  # noqa: BLE001 - the checked diagnostics follow anyway
+            log.error("first diagnostics of %s failed: %s", printable_path(path), printable(exc), exc_info=TRACEBACKS["on"])
+
+    async def _early(self, path: str, text: str, version: int | None) -> None:
+        await asyncio.sleep(EARLY_S)
+        if self.project.latest(path) is not None:
+            return
+        from krl.diagnostics.render import split_lines  # noqa: PLC0415
+        from krl.lsp.parsing import ParseCache  # noqa: PLC0415
+        loop = asyncio.get_running_loop()
+
+        def parse():
+            _root, files, _skipped = self.project.workspace_files(path, {})
+            return ParseCache().parse(path, text) if len(files) >= EARLY_MIN_FILES else None
+        parsed = await loop.run_in_executor(self._quick, parse)
+        if parsed is None or self.project.latest(path) is not None or self._versions.get(path) != version:
+            return                                  # checked meanwhile, or changed: not stale news
+        lines = split_lines(text)
+        codec = self.codec()
+        self.text_document_publish_diagnostics(L.PublishDiagnosticsParams(
+            uri=uri_of(path), version=version,
+            diagnostics=[lsp_diagnostic(d, lines, codec, uri_of) for d in parsed.diagnostics if d.path == path]))
 
     def schedule(self, path: str, delay: float | None = None) -> None:
         """Analyse the workspace of `path` after the debounce delay (a newer change restarts it)."""
@@ -177,13 +222,21 @@ class KrlLanguageServer(LanguageServer):
             pass
 
 
+class RequestFailed(JsonRpcException):
+    """A request the server refuses, with the reason for the user (LSP RequestFailed)."""
+    CODE = -32803
+
+
 def guarded(empty=None):
-    """Run a handler; an exception is logged and answered with `empty`."""
+    """Run a handler; an exception is logged and answered with `empty` (a refusal,
+    :class:`RequestFailed`, goes to the client as an error with its message)."""
     def wrap(fn):
         @functools.wraps(fn)
         async def run(ls: KrlLanguageServer, params):
             try:
                 return await fn(ls, params)
+            except RequestFailed:
+                raise
             except Exception as exc:  # noqa: BLE001
                 log.error("handler %s failed: %s", fn.__name__, printable(exc), exc_info=TRACEBACKS["on"])
                 ls._report(f"krl lsp: {fn.__name__} failed: {type(exc).__name__}: {printable(exc)}")
@@ -208,6 +261,7 @@ def create_server() -> KrlLanguageServer:
             await ls.client_register_capability_async(L.RegistrationParams(registrations=[L.Registration(
                 id="krl-watch", method=L.WORKSPACE_DID_CHANGE_WATCHED_FILES,
                 register_options=L.DidChangeWatchedFilesRegistrationOptions(watchers=watchers))]))
+            ls.project.watched = True       # created/deleted files arrive as didChangeWatchedFiles
 
     @server.feature(L.TEXT_DOCUMENT_DID_OPEN)
     @guarded()
@@ -216,6 +270,8 @@ def create_server() -> KrlLanguageServer:
         ls.project.open(path, params.text_document.text)
         ls._versions[path] = params.text_document.version
         ls.schedule(path, 0.0)
+        if ls.project.latest(path) is None:
+            asyncio.ensure_future(ls.early(path, params.text_document.text, params.text_document.version))
 
     @server.feature(L.TEXT_DOCUMENT_DID_CHANGE)
     @guarded()
@@ -336,6 +392,111 @@ def create_server() -> KrlLanguageServer:
         return L.CompletionList(is_incomplete=False, items=_complete.complete(an, path, line, col))
 
     _register_calls(server, place, uri_of)
+    def refusing(step, an, *args):
+        """`step(an, *args)`, a refusal (krl/lsp/rename.py Refused) sent as the request's error."""
+        if an is None:
+            raise RequestFailed("the file is not analysed yet")
+        try:
+            return step(an, *args)
+        except _rename.Refused as exc:
+            raise RequestFailed(str(exc)) from None
+
+    @server.feature(L.TEXT_DOCUMENT_PREPARE_RENAME)
+    @guarded()
+    async def prepare_rename(ls: KrlLanguageServer, params: L.PrepareRenameParams):
+        an, path, line, col = await place(ls, params.text_document, params.position)
+        t = refusing(_rename.renamable, an, _nav.resolve(an, path, line, col) if an is not None else None)
+        _, tok, _ = token_at(an.files[path].lines, line, col)
+        start = tok.column + (1 if tok.word == "ENUMLITERAL" else 0)
+        return L.PrepareRenamePlaceholder(
+            range=to_range(an.files[path].lines, line, start, len(t.name), ls.codec()),
+            placeholder=tok.text.lstrip("#"))
+
+    @server.feature(L.TEXT_DOCUMENT_RENAME, L.RenameOptions(prepare_provider=True))
+    @guarded()
+    async def rename(ls: KrlLanguageServer, params: L.RenameParams):
+        an, path, line, col = await place(ls, params.text_document, params.position)
+        places = refusing(_rename.plan, an, _nav.resolve(an, path, line, col) if an is not None else None,
+                          params.new_name)
+        codec = ls.codec()
+        return L.WorkspaceEdit(changes={
+            uri_of(p): [L.TextEdit(range=to_range(an.files[p].lines, x.line, x.column, x.length, codec),
+                                   new_text=params.new_name) for x in xs]
+            for p, xs in places.items()})
+
+    @server.feature(L.TEXT_DOCUMENT_INLAY_HINT)
+    @guarded(list)
+    async def inlay_hint(ls: KrlLanguageServer, params: L.InlayHintParams):
+        an, path = await holding(ls, params.text_document)
+        if an is None:
+            return []
+        lines = an.files[path].lines
+        codec = ls.codec()
+        out = []
+        for h in _inlay.hints(an, path, params.range.start.line + 1, params.range.end.line + 1):
+            io = h.kind == "io"
+            out.append(L.InlayHint(
+                position=to_range(lines, h.line, h.column, 0, codec).start, label=h.label,
+                kind=L.InlayHintKind.Type if io else L.InlayHintKind.Parameter,
+                padding_left=io, padding_right=not io, tooltip=h.tooltip or None))
+        return out
+
+    @server.feature(L.TEXT_DOCUMENT_SEMANTIC_TOKENS_FULL, L.SemanticTokensLegend(
+        token_types=_semtokens.TYPES, token_modifiers=_semtokens.MODIFIERS))
+    @guarded()
+    async def semantic_tokens(ls: KrlLanguageServer, params: L.SemanticTokensParams):
+        an, path = await holding(ls, params.text_document)
+        if an is None:
+            return L.SemanticTokens(data=[])
+        return L.SemanticTokens(data=_semtokens.tokens(an, path, ls.codec()))
+
+    @server.feature(L.TEXT_DOCUMENT_CODE_ACTION, L.CodeActionOptions(code_action_kinds=[L.CodeActionKind.QuickFix]))
+    @guarded(list)
+    async def code_action(ls: KrlLanguageServer, params: L.CodeActionParams):
+        an, path = await holding(ls, params.text_document)
+        if an is None:
+            return []
+        codec = ls.codec()
+        out = []
+        for fx in _actions.fixes(an, path, params.range.start.line + 1, params.range.end.line + 1):
+            changes: dict[str, list[L.TextEdit]] = {}
+            for e in fx.edits:
+                lines = an.files[e.path].lines
+                rng = L.Range(start=to_range(lines, e.line, e.column, 0, codec).start,
+                              end=to_range(lines, e.end_line, e.end_column, 0, codec).start)
+                changes.setdefault(uri_of(e.path), []).append(L.TextEdit(range=rng, new_text=e.text))
+            d = fx.diagnostic
+            out.append(L.CodeAction(title=fx.title, kind=L.CodeActionKind.QuickFix, is_preferred=fx.preferred,
+                                    diagnostics=[lsp_diagnostic(d, an.files[d.path].lines, codec, uri_of)],
+                                    edit=L.WorkspaceEdit(changes=changes)))
+        return out
+
+    @server.feature(L.TEXT_DOCUMENT_SIGNATURE_HELP, L.SignatureHelpOptions(trigger_characters=["(", ","]))
+    @guarded()
+    async def signature_help(ls: KrlLanguageServer, params: L.SignatureHelpParams):
+        an, path, line, col = await place(ls, params.text_document, params.position)
+        if an is None:
+            return None
+        sig = _signature.signature_at(an, path, line, col)
+        if sig is None:
+            return None
+        return L.SignatureHelp(signatures=[L.SignatureInformation(
+            label=sig.label, documentation=sig.documentation or None,
+            parameters=[L.ParameterInformation(label=p) for p in sig.params])],
+            active_signature=0, active_parameter=sig.active)
+
+    @server.feature(L.TEXT_DOCUMENT_DOCUMENT_HIGHLIGHT)
+    @guarded(list)
+    async def document_highlight(ls: KrlLanguageServer, params: L.DocumentHighlightParams):
+        an, t = await target(ls, params.text_document, params.position)
+        if t is None:
+            return []
+        path = path_of(params.text_document.uri)
+        lines = an.files[path].lines
+        kinds = {DECL: L.DocumentHighlightKind.Text, WRITE: L.DocumentHighlightKind.Write}
+        return [L.DocumentHighlight(range=to_range(lines, o.place.line, o.place.column, o.place.length, ls.codec()),
+                                    kind=kinds.get(o.kind, L.DocumentHighlightKind.Read))
+                for o in file_occurrences(an, path) if o.key == t.key]
 
     fmt = formatter()
     if fmt is not None:

@@ -156,7 +156,8 @@ class Unresolved:
             if not why:
                 for u in uses:
                     msg = (f"unknown type '{name}'" if kind == "type" else f"{shown} is not declared")
-                    sink.add(u.path, u.line, u.column, err, msg)
+                    helps = {"name": "declare it in the routine or in the module's data list (.dat)"}
+                    sink.add(u.path, u.line, u.column, err, msg, help=helps.get(kind, ""))
                 continue
             uses = sorted(uses, key=lambda u: (u.path, u.line, u.column))
             first = uses[0]

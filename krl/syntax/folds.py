@@ -86,6 +86,9 @@ def _comment_start(line: str) -> int:
     return -1
 
 
+comment_start = _comment_start      # the public name (the language server's tokens and hints)
+
+
 def _lines(text: str) -> list[str]:
     from krl.diagnostics.render import split_lines  # noqa: PLC0415
 

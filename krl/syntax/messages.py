@@ -320,6 +320,12 @@ def _describe(path: str, e, f: _File | None) -> Diagnostic:
 _GLUE_KEYWORDS = sorted(_STATEMENT | _DECL | {"DEF", "DEFFCT", "DEFDAT", "DECL"}, key=len, reverse=True)
 
 
+def split_glued(text: str) -> tuple[str, str] | None:
+    """(keyword, rest) of a keyword glued to a number or a keyword (see :func:`_glued`): the
+    language server's quick fix inserts the space the E002 help asks for."""
+    return _glued(text)
+
+
 def _glued(text: str) -> tuple[str, str] | None:
     """(keyword, rest) when `text` is a keyword glued to a number or to another keyword
     (``INTERRUPT5`` -> INTERRUPT 5, ``GLOBALSTRUC`` -> GLOBAL STRUC), else None."""

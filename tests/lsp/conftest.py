@@ -44,24 +44,28 @@ async def client(lsp_client: LanguageClient):
     await lsp_client.shutdown_session()
 
 
-async def wait_diagnostics(client: LanguageClient, uri: str) -> list[L.Diagnostic]:
-    """The next diagnostics published for `uri` (call after clearing client.diagnostics[uri])."""
+async def wait_diagnostics(client: LanguageClient, uri: str, hints: bool = False) -> list[L.Diagnostic]:
+    """The next diagnostics published for `uri` (call after clearing client.diagnostics[uri]);
+    without `hints`, those of ``krl check`` only (the never-read hints, severity Hint, are
+    tested in test_unused.py)."""
     async def loop():
         while uri not in client.diagnostics:
             await client.wait_for_notification(L.TEXT_DOCUMENT_PUBLISH_DIAGNOSTICS)
-        return list(client.diagnostics[uri])
+        return [d for d in client.diagnostics[uri] if hints or d.severity != L.DiagnosticSeverity.Hint]
     return await asyncio.wait_for(loop(), WAIT_S)
 
 
-async def open_doc(client: LanguageClient, path: Path, text: str | None = None, version: int = 1) -> list[L.Diagnostic]:
-    """Open `path` (with `text` as the unsaved buffer, else its content) and return its first diagnostics."""
+async def open_doc(client: LanguageClient, path: Path, text: str | None = None, version: int = 1,
+                   hints: bool = False) -> list[L.Diagnostic]:
+    """Open `path` (with `text` as the unsaved buffer, else its content) and return its first
+    diagnostics (with the never-read hints when `hints`)."""
     uri = path.as_uri()
     client.diagnostics.pop(uri, None)
     if text is None:
         text = path.read_bytes().decode("utf-8", errors="replace")
     client.text_document_did_open(L.DidOpenTextDocumentParams(
         text_document=L.TextDocumentItem(uri=uri, language_id="krl", version=version, text=text)))
-    return await wait_diagnostics(client, uri)
+    return await wait_diagnostics(client, uri, hints)
 
 
 async def change_doc(client: LanguageClient, path: Path, text: str, version: int) -> list[L.Diagnostic]:
