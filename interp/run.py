@@ -13,7 +13,7 @@ def make_runtime(program, *, workspace=None, inputs=None, trace=None, max_sim_ti
                  max_steps=None, submit=None, mujoco: bool = True, controller=None,
                  robot_budget=None, interp: str = "tree", observer=None,
                  mode: str | None = None, check: bool = True,
-                 vm_loop: str = "generated") -> tuple[Runtime, object]:
+                 vm_loop: str = "generated", robot=None) -> tuple[Runtime, object]:
     """Build the runtime and the interpreter (``interp``: tree or vm) for ``program``
     (not started yet). Its files (krl.project.project_of, with the `submit` programs) are
     loaded, checked and resolved first; with `check` (``krl run`` without ``--no-check``) a
@@ -22,7 +22,8 @@ def make_runtime(program, *, workspace=None, inputs=None, trace=None, max_sim_ti
     (VM.run as written; tests compare the two). `observer` (an :class:`interp.summary.RunObserver`) sees the
     controller's events on their way to `trace`; it is not used with a given `controller`.
     ``mode``: operating mode T1/T2/AUT/EXT (``$MODE_OP``; default AUT, robot/limits.py);
-    ignored with a given `controller` (it has its own)."""
+    ignored with a given `controller` (it has its own). ``robot``: the simulated robot (a
+    MachineData or a path for :func:`robot.mada.load_robot`); default :func:`robot_for`."""
     from interp.tree import TreeInterpreter  # noqa: PLC0415
 
     if controller is None:
@@ -30,7 +31,8 @@ def make_runtime(program, *, workspace=None, inputs=None, trace=None, max_sim_ti
 
         if observer is not None:
             observer.inner = trace
-        controller = Controller(trace=observer if observer is not None else trace,
+        controller = Controller(robot_for(program, workspace, robot),
+                                trace=observer if observer is not None else trace,
                                 stimuli=str(inputs) if inputs else None, mujoco=mujoco,
                                 mode_op=mode)
     rt = Runtime(program, workspace=workspace, controller=controller, trace=trace,
@@ -58,6 +60,26 @@ def make_runtime(program, *, workspace=None, inputs=None, trace=None, max_sim_ti
         sp = Path(sub).resolve()
         rt.add_task("submit", sp.stem, lambda name=sp: interp.run_program(name))
     return rt, interp
+
+
+def robot_for(program, workspace=None, robot=None):
+    """The robot a run of `program` simulates (issue 22): `robot` when given (a MachineData,
+    or a path: robot YAML, ``$machine.dat``, backup folder or .zip, robot/mada.py
+    ``load_robot``); else the robot of the KRC backup holding the program (the backup root of
+    krl.project.backup_of, its ``R1/Mada/$machine.dat``); else the KR 6 R900 of
+    robot/data/kr6_r900.yaml. Raises robot.mada.MachineDataError for machine data that
+    cannot make a model (file:line)."""
+    from krl.project import backup_of  # noqa: PLC0415
+    from robot.machine import MachineData, load_machine  # noqa: PLC0415
+    from robot.mada import load_robot, robot_of_backup  # noqa: PLC0415
+
+    if isinstance(robot, MachineData):
+        return robot
+    if robot is not None:
+        return load_robot(robot)
+    root = backup_of(Path(program).resolve(), Path(workspace).resolve() if workspace else None)
+    found = robot_of_backup(root) if root is not None else None
+    return found if found is not None else load_machine()
 
 
 def signal_of(rt: Runtime, main: str, name: str) -> tuple[str, int, int | None] | None:
