@@ -400,6 +400,26 @@ def load_mada(machine_dat: str | Path, shown: str | None = None) -> MachineData:
     p = Path(machine_dat)
     name = shown or str(p)
     try:
+        st = p.stat()
+        key = (str(p.resolve()), name, st.st_mtime_ns, st.st_size)
+    except OSError as exc:
+        raise MachineDataError(f"{name}: cannot be read ({exc.strerror})") from None
+    got = _CACHE.get(key)
+    if got is None:
+        got = _load_mada(p, name)
+        if len(_CACHE) >= 16:
+            _CACHE.clear()
+        _CACHE[key] = got
+    return got
+
+
+#: Models already built in this process, by (path, name, mtime, size): the real-programs report
+#: runs every program of a backup on the same robot.
+_CACHE: dict[tuple, MachineData] = {}
+
+
+def _load_mada(p: Path, name: str) -> MachineData:
+    try:
         values = read_data_list(p, name)
         rob = next((c for c in p.parent.iterdir() if c.name.lower() == "$robcor.dat" and c.is_file()), None) \
             if p.parent.is_dir() else None
