@@ -73,6 +73,16 @@ class Kinematics:
         self.phi_deg = float(m.status_phi_deg)
         self._ks = np.arange(-2, 3) * 360.0
         self._rows = np.arange(6)
+        # per-robot constants of the OPW solution and of the status test (hot loop: plain floats)
+        self._kappa_2 = o.a2 * o.a2 + o.c3 * o.c3
+        self._c2_2 = o.c2 * o.c2
+        self._k = math.sqrt(self._kappa_2)
+        self._at23 = math.atan2(o.a2, o.c3)
+        self._tmp2 = None
+        self._sgn = [float(v) for v in self._sign]
+        self._offs = [float(v) for v in self._off]
+        self._lo_eps = (self._lo - LIMIT_EPS_DEG)[None, :, None]
+        self._hi_eps = (self._hi + LIMIT_EPS_DEG)[None, :, None]
 
     # ------------------------------------------------------------------ FK
     def forward(self, axes_deg: Sequence[float]) -> np.ndarray:
@@ -156,16 +166,19 @@ class Kinematics:
         """Vectorised S of the rows of Q (n, 6), plus a mask of the S bits that sit
         on their switching point (wrist point on the A1 axis, A3 = phi, A5 = 0)."""
         o = self._opw
-        t2 = np.radians(self._sign[1] * Q[:, 1]) - self._off[1]
-        t23 = t2 + np.radians(self._sign[2] * Q[:, 2]) - self._off[2]
-        xw = o.a1 + o.c2 * np.sin(t2) + o.c3 * np.sin(t23) + o.a2 * np.cos(t23)
-        s = ((xw < -BOUNDARY_EPS).astype(int)
-             | ((Q[:, 2] >= self.phi_deg - BOUNDARY_EPS).astype(int) << 1)
-             | ((Q[:, 4] < -BOUNDARY_EPS).astype(int) << 2))
-        amb = ((np.abs(xw) < OVERHEAD_SINGULAR_MM).astype(int)
-               | ((np.abs(Q[:, 2] - self.phi_deg) < 1e-7).astype(int) << 1)
-               | ((np.abs(Q[:, 4]) < WRIST_SINGULAR_DEG).astype(int) << 2))
-        return s, amb
+        sg1, sg2 = self._sgn[1], self._sgn[2]
+        of1, of2 = self._offs[1], self._offs[2]
+        phi = self.phi_deg
+        s_out, amb_out = [], []
+        for q in Q.tolist():
+            t2 = math.radians(sg1 * q[1]) - of1
+            t23 = t2 + math.radians(sg2 * q[2]) - of2
+            xw = o.a1 + o.c2 * math.sin(t2) + o.c3 * math.sin(t23) + o.a2 * math.cos(t23)
+            s_out.append(int(xw < -BOUNDARY_EPS) | (int(q[2] >= phi - BOUNDARY_EPS) << 1)
+                         | (int(q[4] < -BOUNDARY_EPS) << 2))
+            amb_out.append(int(abs(xw) < OVERHEAD_SINGULAR_MM) | (int(abs(q[2] - phi) < 1e-7) << 1)
+                           | (int(abs(q[4]) < WRIST_SINGULAR_DEG) << 2))
+        return np.array(s_out, dtype=int), np.array(amb_out, dtype=int)
 
     # ------------------------------------------------------------------ limits
     def check_soft_limits(self, axes_deg: Sequence[float]) -> None:
@@ -192,16 +205,15 @@ class Kinematics:
         A1 when the wrist point is on the A1 axis, A4 when A5 = 0.
         """
         o = self._opw
-        T = np.asarray(flange_T, dtype=float)
-        R = T[:3, :3]
-        c = T[:3, 3] - o.c4 * R[:, 2]  # wrist point
-        cx, cy, cz = c
+        rows = np.asarray(flange_T, dtype=float).tolist()
+        (r00, r01, r02, px), (r10, r11, r12, py), (r20, r21, r22, pz) = rows[0], rows[1], rows[2]
+        cx, cy, cz = px - o.c4 * r02, py - o.c4 * r12, pz - o.c4 * r22  # wrist point
         rho2 = cx * cx + cy * cy - o.b * o.b
         if rho2 < 0.0:
             return np.empty((0, 6))
         nx1 = math.sqrt(rho2) - o.a1
         if math.sqrt(cx * cx + cy * cy) < OVERHEAD_SINGULAR_MM and ref_deg is not None:
-            tmp1 = math.radians(self._sign[0] * ref_deg[0]) - self._off[0]
+            tmp1 = math.radians(self._sgn[0] * float(ref_deg[0])) - self._offs[0]
         else:
             tmp1 = math.atan2(cy, cx)
         tmp2 = math.atan2(o.b, nx1 + o.a1)
@@ -211,12 +223,12 @@ class Kinematics:
         s1_2 = nx1 * nx1 + tmp3 * tmp3
         tmp4 = nx1 + 2.0 * o.a1
         s2_2 = tmp4 * tmp4 + tmp3 * tmp3
-        kappa_2 = o.a2 * o.a2 + o.c3 * o.c3
-        c2_2 = o.c2 * o.c2
+        kappa_2 = self._kappa_2
+        c2_2 = self._c2_2
         s1 = math.sqrt(s1_2)
         s2 = math.sqrt(s2_2)
-        k = math.sqrt(kappa_2)
-        at23 = math.atan2(o.a2, o.c3)
+        k = self._k
+        at23 = self._at23
 
         arms = []  # (th1, th2, th3)
         for th1, s_, s_2, base2 in ((th1_i, s1, s1_2, math.atan2(nx1, tmp3)),
@@ -238,16 +250,16 @@ class Kinematics:
         for th1, th2, th3 in arms:
             sn1, cs1 = math.sin(th1), math.cos(th1)
             s23, c23 = math.sin(th2 + th3), math.cos(th2 + th3)
-            mm = R[0, 2] * s23 * cs1 + R[1, 2] * s23 * sn1 + R[2, 2] * c23
+            mm = r02 * s23 * cs1 + r12 * s23 * sn1 + r22 * c23
             th5 = math.atan2(math.sqrt(max(0.0, 1.0 - mm * mm)), mm)
-            th4 = math.atan2(R[1, 2] * cs1 - R[0, 2] * sn1,
-                             R[0, 2] * c23 * cs1 + R[1, 2] * c23 * sn1 - R[2, 2] * s23)
-            th6 = math.atan2(R[0, 1] * s23 * cs1 + R[1, 1] * s23 * sn1 + R[2, 1] * c23,
-                             -R[0, 0] * s23 * cs1 - R[1, 0] * s23 * sn1 - R[2, 0] * c23)
+            th4 = math.atan2(r12 * cs1 - r02 * sn1,
+                             r02 * c23 * cs1 + r12 * c23 * sn1 - r22 * s23)
+            th6 = math.atan2(r01 * s23 * cs1 + r11 * s23 * sn1 + r21 * c23,
+                             -r00 * s23 * cs1 - r10 * s23 * sn1 - r20 * c23)
             if ref_deg is not None and abs(math.degrees(th5)) < WRIST_SINGULAR_DEG:
                 # Wrist singularity: only th4 + th6 is defined; keep A4 of the reference.
                 total = th4 + th6
-                th4 = math.radians(self._sign[3] * ref_deg[3]) - self._off[3]
+                th4 = math.radians(self._sgn[3] * float(ref_deg[3])) - self._offs[3]
                 th6 = total - th4
             sols.append((th1, th2, th3, th4, th5, th6))
             sols.append((th1, th2, th3, th4 + math.pi, -th5, th6 - math.pi))
@@ -310,6 +322,20 @@ class Kinematics:
 
         if turn is not None:
             neg = ((int(turn) >> np.arange(6)) & 1).astype(bool)[:, None]  # (6, 1)
+        # all candidates at once (n, 6, 5): the ±360° variants per axis of each solution;
+        # the one with the least axis motion among those within the limits (the first of
+        # equals, as the loop below for the error would take it)
+        cands = matching[:, :, None] + self._ks[None, None, :]
+        inlim = (cands >= self._lo_eps) & (cands <= self._hi_eps)
+        if turn is not None:
+            inlim &= ((cands < 0) == neg[None]) | (np.abs(cands) < 1e-6)
+        dist = np.where(inlim, np.abs(cands - ref[None, :, None]), np.inf)
+        pick = np.argmin(dist, axis=2)
+        qs = cands[np.arange(len(cands))[:, None], self._rows[None, :], pick]
+        good = inlim.any(axis=2).all(axis=1)
+        if good.any():
+            costs = np.where(good, np.sum(np.abs(qs - ref[None, :]), axis=1), np.inf)
+            return qs[int(np.argmin(costs))].copy()
         best_ok: tuple[float, np.ndarray] | None = None
         best_bad: tuple[float, np.ndarray, int] | None = None
         for b in matching:
