@@ -81,8 +81,9 @@ class Kinematics:
         self._tmp2 = None
         self._sgn = [float(v) for v in self._sign]
         self._offs = [float(v) for v in self._off]
-        self._lo_eps = (self._lo - LIMIT_EPS_DEG)[None, :, None]
-        self._hi_eps = (self._hi + LIMIT_EPS_DEG)[None, :, None]
+        self._lo_l = [float(v) - LIMIT_EPS_DEG for v in self._lo]
+        self._hi_l = [float(v) + LIMIT_EPS_DEG for v in self._hi]
+        self._ks_l = [float(v) for v in self._ks]
 
     # ------------------------------------------------------------------ FK
     def forward(self, axes_deg: Sequence[float]) -> np.ndarray:
@@ -162,22 +163,25 @@ class Kinematics:
                 t |= 1 << i
         return s, t
 
+    def _status_row(self, q: list[float]) -> tuple[int, int]:
+        """S of one axis configuration (list of 6 floats, deg) and the mask of its S bits
+        that sit on their switching point (see :meth:`_status_bits`)."""
+        o = self._opw
+        t2 = math.radians(self._sgn[1] * q[1]) - self._offs[1]
+        t23 = t2 + math.radians(self._sgn[2] * q[2]) - self._offs[2]
+        xw = o.a1 + o.c2 * math.sin(t2) + o.c3 * math.sin(t23) + o.a2 * math.cos(t23)
+        phi = self.phi_deg
+        s = int(xw < -BOUNDARY_EPS) | (int(q[2] >= phi - BOUNDARY_EPS) << 1) | (int(q[4] < -BOUNDARY_EPS) << 2)
+        amb = (int(abs(xw) < OVERHEAD_SINGULAR_MM) | (int(abs(q[2] - phi) < 1e-7) << 1)
+               | (int(abs(q[4]) < WRIST_SINGULAR_DEG) << 2))
+        return s, amb
+
     def _status_bits(self, Q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Vectorised S of the rows of Q (n, 6), plus a mask of the S bits that sit
         on their switching point (wrist point on the A1 axis, A3 = phi, A5 = 0)."""
-        o = self._opw
-        sg1, sg2 = self._sgn[1], self._sgn[2]
-        of1, of2 = self._offs[1], self._offs[2]
-        phi = self.phi_deg
-        s_out, amb_out = [], []
-        for q in Q.tolist():
-            t2 = math.radians(sg1 * q[1]) - of1
-            t23 = t2 + math.radians(sg2 * q[2]) - of2
-            xw = o.a1 + o.c2 * math.sin(t2) + o.c3 * math.sin(t23) + o.a2 * math.cos(t23)
-            s_out.append(int(xw < -BOUNDARY_EPS) | (int(q[2] >= phi - BOUNDARY_EPS) << 1)
-                         | (int(q[4] < -BOUNDARY_EPS) << 2))
-            amb_out.append(int(abs(xw) < OVERHEAD_SINGULAR_MM) | (int(abs(q[2] - phi) < 1e-7) << 1)
-                           | (int(abs(q[4]) < WRIST_SINGULAR_DEG) << 2))
+        pairs = [self._status_row(q) for q in np.asarray(Q, dtype=float).tolist()]
+        s_out = [p[0] for p in pairs]
+        amb_out = [p[1] for p in pairs]
         return np.array(s_out, dtype=int), np.array(amb_out, dtype=int)
 
     # ------------------------------------------------------------------ limits
@@ -199,7 +203,13 @@ class Kinematics:
 
     # ------------------------------------------------------------------ IK
     def _opw_solve(self, flange_T: np.ndarray, ref_deg: np.ndarray | None) -> np.ndarray:
-        """OPW closed form: (n, 6) array of KUKA axis values (deg, wrapped to (-180, 180]).
+        """OPW closed form: (n, 6) array of KUKA axis values (deg, wrapped to (-180, 180]);
+        see :meth:`_opw_rows`."""
+        rows = self._opw_rows(flange_T, ref_deg)
+        return np.array(rows) if rows else np.empty((0, 6))
+
+    def _opw_rows(self, flange_T: np.ndarray, ref_deg: np.ndarray | None) -> list[list[float]]:
+        """OPW closed form: up to 8 lists of KUKA axis values (deg, wrapped to (-180, 180]).
 
         With ``ref_deg`` the free angle at a singularity is taken from it:
         A1 when the wrist point is on the A1 axis, A4 when A5 = 0.
@@ -210,7 +220,7 @@ class Kinematics:
         cx, cy, cz = px - o.c4 * r02, py - o.c4 * r12, pz - o.c4 * r22  # wrist point
         rho2 = cx * cx + cy * cy - o.b * o.b
         if rho2 < 0.0:
-            return np.empty((0, 6))
+            return []
         nx1 = math.sqrt(rho2) - o.a1
         if math.sqrt(cx * cx + cy * cy) < OVERHEAD_SINGULAR_MM and ref_deg is not None:
             tmp1 = math.radians(self._sgn[0] * float(ref_deg[0])) - self._offs[0]
@@ -244,7 +254,7 @@ class Kinematics:
             arms.append((th1, -a2c + base2, a3c - at23))
             arms.append((th1, a2c + base2, -a3c - at23))
         if not arms:
-            return np.empty((0, 6))
+            return []
 
         sols = []
         for th1, th2, th3 in arms:
@@ -263,9 +273,11 @@ class Kinematics:
                 th6 = total - th4
             sols.append((th1, th2, th3, th4, th5, th6))
             sols.append((th1, th2, th3, th4 + math.pi, -th5, th6 - math.pi))
-        opw = np.array(sols)
-        q = np.degrees((opw + self._off) * self._sign)
-        return _wrap180(q)
+        # q = wrap180(degrees((opw + offset) * sign)), in plain floats (the same operations,
+        # in the same order, as numpy's degrees/remainder: the same values)
+        offs, sgn, deg = self._offs, self._sgn, math.degrees
+        return [[-((-deg((th + offs[i]) * sgn[i]) + 180.0) % 360.0) + 180.0 for i, th in enumerate(sol)]
+                for sol in sols]
 
     def solutions(self, flange_T: np.ndarray) -> list[np.ndarray]:
         """All analytic OPW solutions for a flange pose (robot-model.md §4.2, §8).
@@ -304,38 +316,56 @@ class Kinematics:
                 ``$SOFTN_END``/``$SOFTP_END``.
         """
         ref = self._home.copy() if reference_deg is None else np.asarray(reference_deg, dtype=float)[:6]
-        sols = self._opw_solve(flange_T, ref)
-        if len(sols) == 0:
+        rows = self._opw_rows(flange_T, ref)
+        if not rows:
             raise WorkspaceError("workspace error: target not reachable")
         if status is not None:
             s_target, free = int(status) & 7, 0
         else:
             # keep the reference's status; bits the reference sits exactly on
             # (A5 = 0, A3 = phi, wrist point on the A1 axis) are free
-            s_ref, free_ref = self._status_bits(ref[None, :])
-            s_target, free = int(s_ref[0]), int(free_ref[0])
-
-        s_all, amb = self._status_bits(sols)
-        matching = sols[((s_all ^ s_target) & ~(amb | free) & 7) == 0]
-        if len(matching) == 0:
+            s_target, free = self._status_row(ref.tolist())
+        keep = ~free
+        matching_rows = []
+        for r in rows:
+            s_r, amb = self._status_row(r)
+            if ((s_r ^ s_target) & ~amb & keep & 7) == 0:
+                matching_rows.append(r)
+        if not matching_rows:
             raise WorkspaceError(f"workspace error: target not reachable with status S={s_target}")
-
+        # per solution and axis the ±360° variant within the limits (and the turn) nearest to
+        # the reference, then the solution with the least axis motion (the first of equals)
+        ref_l = ref.tolist()
+        lo, hi = self._lo_l, self._hi_l
+        negs = [(int(turn) >> i) & 1 == 1 for i in range(6)] if turn is not None else None
+        best: tuple[float, list[float]] | None = None
+        for b in matching_rows:
+            q: list[float] = []
+            for i in range(6):
+                best_c, best_d = None, math.inf
+                for kk in self._ks_l:
+                    c = b[i] + kk
+                    if c < lo[i] or c > hi[i]:
+                        continue
+                    if negs is not None and not ((c < 0) == negs[i] or abs(c) < 1e-6):
+                        continue
+                    d = abs(c - ref_l[i])
+                    if d < best_d:
+                        best_c, best_d = c, d
+                if best_c is None:
+                    break
+                q.append(best_c)
+            else:
+                cost = 0.0
+                for i in range(6):
+                    cost += abs(q[i] - ref_l[i])
+                if best is None or cost < best[0]:
+                    best = (cost, q)
+        if best is not None:
+            return np.array(best[1])
+        matching = np.array(matching_rows)
         if turn is not None:
             neg = ((int(turn) >> np.arange(6)) & 1).astype(bool)[:, None]  # (6, 1)
-        # all candidates at once (n, 6, 5): the ±360° variants per axis of each solution;
-        # the one with the least axis motion among those within the limits (the first of
-        # equals, as the loop below for the error would take it)
-        cands = matching[:, :, None] + self._ks[None, None, :]
-        inlim = (cands >= self._lo_eps) & (cands <= self._hi_eps)
-        if turn is not None:
-            inlim &= ((cands < 0) == neg[None]) | (np.abs(cands) < 1e-6)
-        dist = np.where(inlim, np.abs(cands - ref[None, :, None]), np.inf)
-        pick = np.argmin(dist, axis=2)
-        qs = cands[np.arange(len(cands))[:, None], self._rows[None, :], pick]
-        good = inlim.any(axis=2).all(axis=1)
-        if good.any():
-            costs = np.where(good, np.sum(np.abs(qs - ref[None, :]), axis=1), np.inf)
-            return qs[int(np.argmin(costs))].copy()
         best_ok: tuple[float, np.ndarray] | None = None
         best_bad: tuple[float, np.ndarray, int] | None = None
         for b in matching:
