@@ -43,8 +43,11 @@ import click
               help="Start the program even when the front end's checker finds errors in its own "
                    "module (by default, like the controller, such a program does not start: exit 1). "
                    "A name nothing declares is then a run-time error where it is evaluated.")
+@click.option("--robot", "robot", type=click.Path(path_type=Path), default=None,
+              help="The robot to simulate: a robot YAML, a $machine.dat, a KRC backup folder or .zip "
+                   "(default: the backup's own robot from its R1/Mada/$machine.dat, else the KR 6 R900).")
 def run(program: Path, interp_kind: str, workspace, inputs, trace_path, max_sim_time, max_steps, submit,
-        mode, run_mode, pgno, no_check) -> None:
+        mode, run_mode, pgno, no_check, robot) -> None:
     """Run PROGRAM (.src) on the simulated KR C4; print where and why it ended.
 
     With --workspace BACKUP.zip (a KRC backup archive) PROGRAM is a path inside the archive
@@ -67,13 +70,13 @@ def run(program: Path, interp_kind: str, workspace, inputs, trace_path, max_sim_
                     sys.exit(2)
                 _run(found, folder, inputs, trace_path, max_sim_time, max_steps, submit, interp_kind,
                      mode=mode, shown=lambda text: text.replace(str(folder), str(workspace)), check=not no_check,
-                     run_mode=run_mode, pgno=pgno)
+                     run_mode=run_mode, pgno=pgno, robot=robot)
         except ArchiveError as exc:
             click.echo(f"error: {printable(exc)}", err=True)
             sys.exit(2)
         return
     _run(program, workspace, inputs, trace_path, max_sim_time, max_steps, submit, interp_kind, mode=mode,
-         check=not no_check, run_mode=run_mode, pgno=pgno)
+         check=not no_check, run_mode=run_mode, pgno=pgno, robot=robot)
 
 
 def program_in(folder: Path, program: Path) -> Path | None:
@@ -95,23 +98,33 @@ def program_in(folder: Path, program: Path) -> Path | None:
 
 def _run(program: Path, workspace, inputs, trace_path, max_sim_time, max_steps, submit, interp_kind,
          mode=None, shown=lambda text: text, check: bool = True, run_mode: str = "GO",
-         pgno: int | None = None) -> None:
+         pgno: int | None = None, robot=None) -> None:
     if not program.exists():
         click.echo(f"error: {program}: no such file", err=True)
         sys.exit(2)
-    from interp.run import make_runtime  # noqa: PLC0415
+    from interp.run import make_runtime, robot_for  # noqa: PLC0415
     from interp.summary import RunObserver, starvation_lines, summary_lines  # noqa: PLC0415
+    from robot.mada import MachineDataError  # noqa: PLC0415
     from krl.terminal import printable  # noqa: PLC0415
     from robot.stimuli import StimulusError  # noqa: PLC0415
     from robot.trace import TraceWriter  # noqa: PLC0415
 
+    try:
+        machine = robot_for(program, workspace, robot)
+    except MachineDataError as exc:
+        click.echo(f"error: {shown(printable(exc))}", err=True)
+        sys.exit(2)
     trace = TraceWriter(trace_path) if trace_path else None
+    if trace is not None:
+        # the trace header: which robot the run simulates and where its data came from
+        trace.write("robot", 0.0, name=machine.name, source=shown(machine.source),
+                    trafoname=machine.trafoname or None)
     observer = RunObserver()
     try:
         rt, _ = make_runtime(program, workspace=workspace, inputs=inputs, trace=trace,
                              max_sim_time=max_sim_time, max_steps=max_steps, submit=list(submit),
                              interp=interp_kind, observer=observer, mode=mode, check=check,
-                             run_mode=run_mode.upper(), pgno=pgno)
+                             run_mode=run_mode.upper(), pgno=pgno, robot=machine)
         errors = rt.program.errors_of(rt.program.module_of(rt.program.main_path))
         if errors:
             # the checker rejects the program's own module: like the controller, it does not start
@@ -137,7 +150,8 @@ def _run(program: Path, workspace, inputs, trace_path, max_sim_time, max_steps, 
         ws_note = str(prog.workspace)
     for line in summary_lines(res, observer, program=str(program), interp=interp_kind,
                               submits=[t for t in rt.scheduler.tasks if t.kind == "submit"],
-                              workspace=ws_note, starving=starvation_lines(rt)):
+                              workspace=ws_note, starving=starvation_lines(rt),
+                              robot=f"{machine.name} ({machine.source})"):
         click.echo(shown(line))
     sys.exit(res.exit_code)
 

@@ -14,7 +14,7 @@ def make_runtime(program, *, workspace=None, inputs=None, trace=None, max_sim_ti
                  robot_budget=None, interp: str = "tree", observer=None,
                  mode: str | None = None, check: bool = True,
                  vm_loop: str = "generated", run_mode: str | None = None,
-                 pgno: int | None = None) -> tuple[Runtime, object]:
+                 pgno: int | None = None, robot=None) -> tuple[Runtime, object]:
     """Build the runtime and the interpreter (``interp``: tree or vm) for ``program``
     (not started yet). Its files (krl.project.project_of, with the `submit` programs) are
     loaded, checked and resolved first; with `check` (``krl run`` without ``--no-check``) a
@@ -27,8 +27,10 @@ def make_runtime(program, *, workspace=None, inputs=None, trace=None, max_sim_ti
     (`inputs`) has the ``autoext`` preset. ``pgno``: the program number the cell's PLC answers
     in P00's handshake (robot/cellpresets.py; overrides the cell file's ``pgno`` preset).
     ``run_mode``: ``$PRO_MODE`` at the start (GO, MSTEP, ISTEP, BSTEP; interp/runtime/runmode.py;
-    default GO). Raises :class:`robot.stimuli.StimulusError` for a bad cell file or a preset the
-    backup's ``$config.dat`` does not allow."""
+    default GO). ``robot``: the simulated robot (a MachineData or a path for
+    :func:`robot.mada.load_robot`); default :func:`robot_for`. Raises
+    :class:`robot.stimuli.StimulusError` for a bad cell file or a preset the backup's
+    ``$config.dat`` does not allow."""
     from interp.tree import TreeInterpreter  # noqa: PLC0415
 
     if controller is None:
@@ -36,7 +38,8 @@ def make_runtime(program, *, workspace=None, inputs=None, trace=None, max_sim_ti
 
         if observer is not None:
             observer.inner = trace
-        controller = Controller(trace=observer if observer is not None else trace,
+        controller = Controller(robot_for(program, workspace, robot),
+                                trace=observer if observer is not None else trace,
                                 stimuli=str(inputs) if inputs else None, mujoco=mujoco,
                                 mode_op=mode)
     rt = Runtime(program, workspace=workspace, controller=controller, trace=trace,
@@ -102,6 +105,24 @@ def global_value(rt: Runtime, main: str, name: str):
         return rt.storage_ref(prog.ws.resolver.storage(name, sym, None, module.index if module else -1), None).get()
     except KrlRuntimeError:
         return None
+def robot_for(program, workspace=None, robot=None):
+    """The robot a run of `program` simulates (issue 22): `robot` when given (a MachineData,
+    or a path: robot YAML, ``$machine.dat``, backup folder or .zip, robot/mada.py
+    ``load_robot``); else the robot of the KRC backup holding the program (the backup root of
+    krl.project.backup_of, its ``R1/Mada/$machine.dat``); else the KR 6 R900 of
+    robot/data/kr6_r900.yaml. Raises robot.mada.MachineDataError for machine data that
+    cannot make a model (file:line)."""
+    from krl.project import backup_of  # noqa: PLC0415
+    from robot.machine import MachineData, load_machine  # noqa: PLC0415
+    from robot.mada import load_robot, robot_of_backup  # noqa: PLC0415
+
+    if isinstance(robot, MachineData):
+        return robot
+    if robot is not None:
+        return load_robot(robot)
+    root = backup_of(Path(program).resolve(), Path(workspace).resolve() if workspace else None)
+    found = robot_of_backup(root) if root is not None else None
+    return found if found is not None else load_machine()
 
 
 def signal_of(rt: Runtime, main: str, name: str) -> tuple[str, int, int | None] | None:

@@ -95,13 +95,15 @@ def _clip(text: str) -> str:
 
 def summary_lines(result: Any, observer: RunObserver, *, program: str, interp: str,
                   submits: list[Any] = (), workspace: str | None = None,
-                  starving: list[str] = ()) -> list[str]:
+                  starving: list[str] = (), robot: str | None = None) -> list[str]:
     """The console summary of one run, about a screen (at most ~20 lines).
 
     `result` is the run's RunResult; `submits` the scheduler's submit tasks (``name``,
     ``outcome``, ``file``, ``line``); `workspace` a note on the folder the program's modules
     came from (shown when it is not the program's own folder); `starving` the lines of
     :func:`starvation_lines` (they replace the generic hint).
+    came from (shown when it is not the program's own folder); `robot` the simulated robot
+    and where its data came from (issue 22).
     """
     out = [f"run {printable_path(program)} ({interp} interpreter)"]
     if workspace:
@@ -137,6 +139,8 @@ def summary_lines(result: Any, observer: RunObserver, *, program: str, interp: s
                        f"{w}: {_clip(err.message)}{num}")
         elif reason is not None and reason != "completed":
             out.append(f"  submit     {printable(task.name)}: {ENDINGS.get(reason, reason)}")
+    if robot:
+        out.append(f"  robot      {printable(robot)}")
     notes = [n for n in observer.notes if not n.text.startswith(SIMULATOR_NOTES)]
     sim = Counter(n.text.split(":", 1)[0] for n in observer.notes if n.text.startswith(SIMULATOR_NOTES))
     if notes:

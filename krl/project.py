@@ -36,7 +36,7 @@ from krl.limits import MAX_FOLDER_DEPTH
 from krl.source import is_krl_file
 
 __all__ = ["Project", "backup_of", "collect_entries", "collect_files", "find_backups",
-           "folder_groups", "is_system_path", "project_of", "system_folder"]
+           "folder_groups", "is_system_path", "machine_data_file", "project_of", "system_folder"]
 
 SYSTEM_DIRS = ("system", "tp", "mada", "steu")
 
@@ -111,6 +111,23 @@ def system_folder(root: Path) -> Path | None:
     for base in ([r1] if r1 is not None else []) + [root]:
         if _is_base(base):
             return _child(base, "system")
+    return None
+
+
+def machine_data_file(root: Path) -> Path | None:
+    """The robot's machine data of the backup rooted at `root`: ``R1/Mada/$machine.dat`` (or
+    ``Mada/$machine.dat`` of a flat export), any letter case, links never followed; None when
+    the backup has none (robot/mada.py builds the robot model from it)."""
+    r1 = _child(root, "r1")
+    for base in ([r1] if r1 is not None else []) + [root]:
+        if base.is_symlink() or not base.is_dir():
+            continue
+        mada = _child(base, "mada")
+        if mada is None or mada.is_symlink() or not mada.is_dir():
+            continue
+        f = _child(mada, "$machine.dat")
+        if f is not None and not f.is_symlink() and f.is_file():
+            return f
     return None
 
 

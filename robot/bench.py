@@ -39,33 +39,44 @@ def run_motions(ctl: Controller, requests: Iterable[MotionRequest], *,
     return out
 
 
+#: Reach (mm, wrist point) of the KR 6 R900 for which the benchmark's points are written.
+_KR6_REACH_MM = 901.456
+
+
 def bench_program(machine: Any = None) -> list[MotionRequest]:
-    """One loop (about 8 s of motion) of the benchmark program."""
+    """One loop (about 8 s of motion on the KR 6 R900) of the benchmark program. On another
+    robot the Cartesian points and the path speed scale with its reach (issue 22), so the
+    same program runs on a KR 210 from machine data."""
     P = MotionParams.initmov(machine)
-    slow = P.with_(vel_cp=0.25, apo_cdis=20.0)
+    k = (machine.reach_wrist_point_mm / _KR6_REACH_MM) if machine is not None else 1.0
+    slow = P.with_(vel_cp=0.25 * k, apo_cdis=20.0 * k)
     ptp = P.with_(vel_axis=(30.0,) * 6, apo_cptp=50.0)
+
+    def xyz(x: float, y: float, z: float) -> dict[str, float]:
+        return {"X": x * k, "Y": y * k, "Z": z * k}
+
     return [
         MotionRequest("PTP", {"A1": 0, "A2": -90, "A3": 90, "A4": 0, "A5": 90, "A6": 0}, ptp),
-        MotionRequest("LIN", {"X": 445, "Y": 150, "Z": 600}, slow, approx="C_DIS",
+        MotionRequest("LIN", xyz(445, 150, 600), slow, approx="C_DIS",
                       triggers=(Trigger(distance=1, delay_ms=-50, line=1),)),
-        MotionRequest("LIN", {"X": 600, "Y": 150, "Z": 600}, slow, approx="C_DIS"),
-        MotionRequest("CIRC", {"X": 600, "Y": -150, "Z": 600}, slow, approx="C_DIS",
-                      aux={"X": 700, "Y": 0, "Z": 600}),
-        MotionRequest("LIN", {"X": 445, "Y": -150, "Z": 700}, slow,
+        MotionRequest("LIN", xyz(600, 150, 600), slow, approx="C_DIS"),
+        MotionRequest("CIRC", xyz(600, -150, 600), slow, approx="C_DIS", aux=xyz(700, 0, 600)),
+        MotionRequest("LIN", xyz(445, -150, 700), slow,
                       triggers=(Trigger(distance=0, delay_ms=20, line=2),)),
         MotionRequest("PTP", {"A1": 40, "A2": -80, "A3": 100, "A5": 60}, ptp, approx="C_PTP"),
         MotionRequest("PTP", {"A1": -40, "A2": -100, "A3": 80, "A5": 80}, ptp, approx="C_PTP"),
     ]
 
 
-def run_bench(min_motion_s: float = 60.0, trace_path: str | None = None) -> dict[str, Any]:
+def run_bench(min_motion_s: float = 60.0, trace_path: str | None = None, machine: Any = None) -> dict[str, Any]:
     """Simulate the benchmark program until at least ``min_motion_s`` of simulated time has
     passed; the trace goes to ``trace_path`` (default: the null device, so serialisation is
-    still paid). Returns {sim_s, wall_s, sim_realtime_factor, cycles, motions, target}."""
+    still paid). ``machine``: the robot (default the KR 6 R900). Returns {robot, sim_s,
+    wall_s, sim_realtime_factor, cycles, motions, target}."""
     sink = trace_path or os.devnull
     with TraceWriter(sink) as tw:
         t0 = time.perf_counter()
-        ctl = Controller(trace=tw)
+        ctl = Controller(machine, trace=tw)
         n = 0
         while ctl.time < min_motion_s:
             reqs = bench_program(ctl.machine)
@@ -80,16 +91,28 @@ def run_bench(min_motion_s: float = 60.0, trace_path: str | None = None) -> dict
         ctl.finish("program_end")
         wall = time.perf_counter() - t0
     sim = ctl.time
-    return {"sim_s": round(sim, 3), "wall_s": round(wall, 3),
+    return {"robot": ctl.machine.name, "sim_s": round(sim, 3), "wall_s": round(wall, 3),
             "sim_realtime_factor": round(sim / wall, 2) if wall > 0 else float("inf"),
             "cycles": ctl.cycle, "motions": n, "target": TARGET_FACTOR}
 
 
-def main() -> int:  # pragma: no cover - manual entry point
-    """``python -m robot.bench``: run the benchmark, print JSON, exit 1 below target."""
+def main(argv: list[str] | None = None) -> int:  # pragma: no cover - manual entry point
+    """``python -m robot.bench [--robot PATH]``: run the benchmark on the KR 6 R900 or on the
+    robot of PATH (a backup folder or .zip, a $machine.dat or a robot YAML:
+    robot/mada.py ``load_robot``), print JSON with the real-time ratio, exit 1 below target."""
+    import argparse
     import json
 
-    r = run_bench()
+    ap = argparse.ArgumentParser(prog="python -m robot.bench")
+    ap.add_argument("--robot", default=None, help="robot: backup folder/.zip, $machine.dat or robot YAML")
+    ap.add_argument("--min-motion-s", type=float, default=60.0, help="simulated seconds of motion")
+    args = ap.parse_args(argv)
+    machine = None
+    if args.robot:
+        from .mada import load_robot
+
+        machine = load_robot(args.robot)
+    r = run_bench(args.min_motion_s, machine=machine)
     print(json.dumps(r))
     return 0 if r["sim_realtime_factor"] >= TARGET_FACTOR else 1
 

@@ -247,7 +247,67 @@ def plan_blend(prev: Segment, nxt: Segment, keyword: str, tau_a: float) -> Blend
     a_sum = np.abs(prev.qd_end) * bp.a_b + np.abs(nxt.qd_start) * rp.a_r
     if np.any(rev & (a_sum > prev.model.a_max * (1.0 + 1e-6))):
         return None
+    if blend_space(prev, nxt) == "joint" and tau_p > 0.0 and \
+            _joint_blend_acc_ratio(prev, bp, nxt, rp, tau_p) > 1.0 + 1e-6:
+        return None
     return BlendPlan(bp, rp, tau_p)
+
+
+#: Samples of a blend window, and of a CP motion's path, for :func:`_joint_blend_acc_ratio`.
+_BLEND_SAMPLES = 16
+
+
+def _rates_at(seg: Segment, us: np.ndarray, from_end: bool) -> tuple[np.ndarray, np.ndarray]:
+    """dq/du and d2q/du2 (deg, shape (n, 6)) of a segment at the path parameters ``us``. A PTP
+    is linear in u; a CP motion is sampled with inverse kinematics along its path, from its
+    end point's axes (``from_end``) or its start's (the segment's own state is not touched). If the IK cannot follow the window
+    (the planner already accepted this path), the planned end rates are used."""
+    n = len(us)
+    if not seg.cart:
+        return np.broadcast_to(seg.q1 - seg.q0, (n, 6)), np.zeros((n, 6))
+    lo, hi = float(np.min(us)), float(np.max(us))
+    if hi - lo < 1e-9:
+        lo, hi = max(0.0, lo - 1e-3), min(1.0, hi + 1e-3)
+    grid = np.linspace(lo, hi, _BLEND_SAMPLES + 1)
+    order = range(len(grid) - 1, -1, -1) if from_end else range(len(grid))
+    ref = seg.q1 if from_end else seg.q0
+    Q = np.empty((len(grid), 6))
+    try:
+        for j in order:
+            p, R = seg.pose_u(float(grid[j]))
+            ref = Q[j] = seg.ik(p, R, ref)
+    except Exception:  # noqa: BLE001 - keep the planned rates
+        d = seg.qd_start if lo <= 0.0 else seg.qd_end
+        return np.broadcast_to(d, (n, 6)), np.zeros((n, 6))
+    h = float(grid[1] - grid[0])
+    d1 = np.gradient(Q, h, axis=0, edge_order=2)
+    d2 = np.gradient(d1, h, axis=0, edge_order=2)
+    return (np.stack([np.interp(us, grid, d1[:, i]) for i in range(6)], axis=1),
+            np.stack([np.interp(us, grid, d2[:, i]) for i in range(6)], axis=1))
+
+
+def _joint_blend_acc_ratio(prev: Segment, bp: Any, nxt: Segment, rp: Any, window: float) -> float:
+    """Largest ratio of an axis acceleration to ``a_max`` over a blend superposed in axis
+    space (``q = q_prev(t) + q_next(t) - P``): ``a_i = q'_i(u) u'' + q''_i(u) u'^2`` of the
+    braking motion plus that of the ramping one, on samples of the window. The two can add
+    up on an axis that reverses, and a CP side's axis rates change along its path, so the
+    sum is evaluated, not bounded at the programmed point (issue 22: a PTP C_PTP into a LIN
+    reached 1.13-1.15x a_max at the end of the blend)."""
+    ts = np.linspace(0.0, window, _BLEND_SAMPLES + 1)
+    tb = np.minimum(ts, bp.tau)
+    up = np.clip(bp.u_a + bp.v_a * tb - 0.5 * bp.a_b * tb * tb, 0.0, 1.0)
+    udp = np.maximum(bp.v_a - bp.a_b * tb, 0.0)
+    uddp = np.where(ts <= bp.tau, -bp.a_b, 0.0)
+    d1, d2 = _rates_at(prev, up, True)
+    acc = d1 * uddp[:, None] + d2 * (udp * udp)[:, None]
+    if rp.tau > 0.0:
+        s = np.clip(ts - rp.delay, 0.0, rp.tau)
+        un = 0.5 * rp.a_r * s * s
+        udn = rp.a_r * s
+        uddn = np.where((ts > rp.delay) & (ts - rp.delay <= rp.tau), rp.a_r, 0.0)
+        d1, d2 = _rates_at(nxt, un, False)
+        acc = acc + d1 * uddn[:, None] + d2 * (udn * udn)[:, None]
+    return float(np.max(np.abs(acc) / np.asarray(prev.model.a_max, dtype=float)))
 
 
 def superpose_pose(p0: np.ndarray, R0: np.ndarray, p1: np.ndarray, R1: np.ndarray,

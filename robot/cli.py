@@ -1,4 +1,5 @@
-"""``krl plot``: the robot package's subcommand (registered by krl/cli/__init__.py)."""
+"""``krl plot`` and ``krl robot show|export``: the robot package's subcommands (registered by
+krl/cli/__init__.py)."""
 
 from __future__ import annotations
 
@@ -26,4 +27,52 @@ def plot(trace: Path, output: Path | None) -> None:
     click.echo(str(out))
 
 
-commands = [plot]
+@click.group("robot")
+def robot_group() -> None:
+    """The simulated robot: its model from a backup's machine data or a robot YAML (issue 22)."""
+
+
+def _load(path: Path | None):
+    from robot.machine import load_machine  # noqa: PLC0415
+    from robot.mada import MachineDataError, load_robot  # noqa: PLC0415
+    from krl.terminal import printable  # noqa: PLC0415
+
+    try:
+        return load_robot(path) if path is not None else load_machine()
+    except MachineDataError as exc:
+        click.echo(f"error: {printable(exc)}", err=True)
+        sys.exit(2)
+
+
+@robot_group.command("show")
+@click.argument("robot", type=click.Path(path_type=Path), required=False)
+def show(robot: Path | None) -> None:
+    """Print the robot model of ROBOT (a KRC backup folder or .zip, a $machine.dat or a robot
+    YAML; default the KR 6 R900): name, parameters with their source (file:line or the rule
+    that derived them), axis limits, speeds, accelerations, reach."""
+    from robot.show import show_lines  # noqa: PLC0415
+
+    for line in show_lines(_load(robot)):
+        click.echo(line)
+
+
+@robot_group.command("export")
+@click.argument("robot", type=click.Path(path_type=Path), required=False)
+@click.option("--format", "fmt", type=click.Choice(["urdf", "mjcf"]), default="urdf", show_default=True)
+@click.option("-o", "--output", type=click.Path(path_type=Path), required=True, help="File to write.")
+def export(robot: Path | None, fmt: str, output: Path) -> None:
+    """Write the robot model of ROBOT (as for `krl robot show`) as URDF or MJCF (MuJoCo)."""
+    m = _load(robot)
+    if fmt == "urdf":
+        from robot.urdf import build_urdf  # noqa: PLC0415
+
+        text = build_urdf(m)
+    else:
+        from robot.mjcf import build_mjcf  # noqa: PLC0415
+
+        text = build_mjcf(m)
+    output.write_text(text, encoding="utf-8")
+    click.echo(str(output))
+
+
+commands = [plot, robot_group]

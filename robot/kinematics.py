@@ -74,6 +74,17 @@ class Kinematics:
         self._ks = np.arange(-2, 3) * 360.0
         self._rows = np.arange(6)
         self._fk_last: tuple[bytes, np.ndarray] | None = None   # (axes, FLANGE) of the last forward()
+        # per-robot constants of the OPW solution and of the status test (hot loop: plain floats)
+        self._kappa_2 = o.a2 * o.a2 + o.c3 * o.c3
+        self._c2_2 = o.c2 * o.c2
+        self._k = math.sqrt(self._kappa_2)
+        self._at23 = math.atan2(o.a2, o.c3)
+        self._tmp2 = None
+        self._sgn = [float(v) for v in self._sign]
+        self._offs = [float(v) for v in self._off]
+        self._lo_l = [float(v) - LIMIT_EPS_DEG for v in self._lo]
+        self._hi_l = [float(v) + LIMIT_EPS_DEG for v in self._hi]
+        self._ks_l = [float(v) for v in self._ks]
 
     # ------------------------------------------------------------------ FK
     def forward(self, axes_deg: Sequence[float]) -> np.ndarray:
@@ -161,20 +172,26 @@ class Kinematics:
                 t |= 1 << i
         return s, t
 
+    def _status_row(self, q: list[float]) -> tuple[int, int]:
+        """S of one axis configuration (list of 6 floats, deg) and the mask of its S bits
+        that sit on their switching point (see :meth:`_status_bits`)."""
+        o = self._opw
+        t2 = math.radians(self._sgn[1] * q[1]) - self._offs[1]
+        t23 = t2 + math.radians(self._sgn[2] * q[2]) - self._offs[2]
+        xw = o.a1 + o.c2 * math.sin(t2) + o.c3 * math.sin(t23) + o.a2 * math.cos(t23)
+        phi = self.phi_deg
+        s = int(xw < -BOUNDARY_EPS) | (int(q[2] >= phi - BOUNDARY_EPS) << 1) | (int(q[4] < -BOUNDARY_EPS) << 2)
+        amb = (int(abs(xw) < OVERHEAD_SINGULAR_MM) | (int(abs(q[2] - phi) < 1e-7) << 1)
+               | (int(abs(q[4]) < WRIST_SINGULAR_DEG) << 2))
+        return s, amb
+
     def _status_bits(self, Q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Vectorised S of the rows of Q (n, 6), plus a mask of the S bits that sit
         on their switching point (wrist point on the A1 axis, A3 = phi, A5 = 0)."""
-        o = self._opw
-        t2 = np.radians(self._sign[1] * Q[:, 1]) - self._off[1]
-        t23 = t2 + np.radians(self._sign[2] * Q[:, 2]) - self._off[2]
-        xw = o.a1 + o.c2 * np.sin(t2) + o.c3 * np.sin(t23) + o.a2 * np.cos(t23)
-        s = ((xw < -BOUNDARY_EPS).astype(int)
-             | ((Q[:, 2] >= self.phi_deg - BOUNDARY_EPS).astype(int) << 1)
-             | ((Q[:, 4] < -BOUNDARY_EPS).astype(int) << 2))
-        amb = ((np.abs(xw) < OVERHEAD_SINGULAR_MM).astype(int)
-               | ((np.abs(Q[:, 2] - self.phi_deg) < 1e-7).astype(int) << 1)
-               | ((np.abs(Q[:, 4]) < WRIST_SINGULAR_DEG).astype(int) << 2))
-        return s, amb
+        pairs = [self._status_row(q) for q in np.asarray(Q, dtype=float).tolist()]
+        s_out = [p[0] for p in pairs]
+        amb_out = [p[1] for p in pairs]
+        return np.array(s_out, dtype=int), np.array(amb_out, dtype=int)
 
     # ------------------------------------------------------------------ limits
     def check_soft_limits(self, axes_deg: Sequence[float]) -> None:
@@ -195,22 +212,27 @@ class Kinematics:
 
     # ------------------------------------------------------------------ IK
     def _opw_solve(self, flange_T: np.ndarray, ref_deg: np.ndarray | None) -> np.ndarray:
-        """OPW closed form: (n, 6) array of KUKA axis values (deg, wrapped to (-180, 180]).
+        """OPW closed form: (n, 6) array of KUKA axis values (deg, wrapped to (-180, 180]);
+        see :meth:`_opw_rows`."""
+        rows = self._opw_rows(flange_T, ref_deg)
+        return np.array(rows) if rows else np.empty((0, 6))
+
+    def _opw_rows(self, flange_T: np.ndarray, ref_deg: np.ndarray | None) -> list[list[float]]:
+        """OPW closed form: up to 8 lists of KUKA axis values (deg, wrapped to (-180, 180]).
 
         With ``ref_deg`` the free angle at a singularity is taken from it:
         A1 when the wrist point is on the A1 axis, A4 when A5 = 0.
         """
         o = self._opw
-        T = np.asarray(flange_T, dtype=float)
-        R = T[:3, :3]
-        c = T[:3, 3] - o.c4 * R[:, 2]  # wrist point
-        cx, cy, cz = c
+        rows = np.asarray(flange_T, dtype=float).tolist()
+        (r00, r01, r02, px), (r10, r11, r12, py), (r20, r21, r22, pz) = rows[0], rows[1], rows[2]
+        cx, cy, cz = px - o.c4 * r02, py - o.c4 * r12, pz - o.c4 * r22  # wrist point
         rho2 = cx * cx + cy * cy - o.b * o.b
         if rho2 < 0.0:
-            return np.empty((0, 6))
+            return []
         nx1 = math.sqrt(rho2) - o.a1
         if math.sqrt(cx * cx + cy * cy) < OVERHEAD_SINGULAR_MM and ref_deg is not None:
-            tmp1 = math.radians(self._sign[0] * ref_deg[0]) - self._off[0]
+            tmp1 = math.radians(self._sgn[0] * float(ref_deg[0])) - self._offs[0]
         else:
             tmp1 = math.atan2(cy, cx)
         tmp2 = math.atan2(o.b, nx1 + o.a1)
@@ -220,12 +242,12 @@ class Kinematics:
         s1_2 = nx1 * nx1 + tmp3 * tmp3
         tmp4 = nx1 + 2.0 * o.a1
         s2_2 = tmp4 * tmp4 + tmp3 * tmp3
-        kappa_2 = o.a2 * o.a2 + o.c3 * o.c3
-        c2_2 = o.c2 * o.c2
+        kappa_2 = self._kappa_2
+        c2_2 = self._c2_2
         s1 = math.sqrt(s1_2)
         s2 = math.sqrt(s2_2)
-        k = math.sqrt(kappa_2)
-        at23 = math.atan2(o.a2, o.c3)
+        k = self._k
+        at23 = self._at23
 
         arms = []  # (th1, th2, th3)
         for th1, s_, s_2, base2 in ((th1_i, s1, s1_2, math.atan2(nx1, tmp3)),
@@ -241,28 +263,30 @@ class Kinematics:
             arms.append((th1, -a2c + base2, a3c - at23))
             arms.append((th1, a2c + base2, -a3c - at23))
         if not arms:
-            return np.empty((0, 6))
+            return []
 
         sols = []
         for th1, th2, th3 in arms:
             sn1, cs1 = math.sin(th1), math.cos(th1)
             s23, c23 = math.sin(th2 + th3), math.cos(th2 + th3)
-            mm = R[0, 2] * s23 * cs1 + R[1, 2] * s23 * sn1 + R[2, 2] * c23
+            mm = r02 * s23 * cs1 + r12 * s23 * sn1 + r22 * c23
             th5 = math.atan2(math.sqrt(max(0.0, 1.0 - mm * mm)), mm)
-            th4 = math.atan2(R[1, 2] * cs1 - R[0, 2] * sn1,
-                             R[0, 2] * c23 * cs1 + R[1, 2] * c23 * sn1 - R[2, 2] * s23)
-            th6 = math.atan2(R[0, 1] * s23 * cs1 + R[1, 1] * s23 * sn1 + R[2, 1] * c23,
-                             -R[0, 0] * s23 * cs1 - R[1, 0] * s23 * sn1 - R[2, 0] * c23)
+            th4 = math.atan2(r12 * cs1 - r02 * sn1,
+                             r02 * c23 * cs1 + r12 * c23 * sn1 - r22 * s23)
+            th6 = math.atan2(r01 * s23 * cs1 + r11 * s23 * sn1 + r21 * c23,
+                             -r00 * s23 * cs1 - r10 * s23 * sn1 - r20 * c23)
             if ref_deg is not None and abs(math.degrees(th5)) < WRIST_SINGULAR_DEG:
                 # Wrist singularity: only th4 + th6 is defined; keep A4 of the reference.
                 total = th4 + th6
-                th4 = math.radians(self._sign[3] * ref_deg[3]) - self._off[3]
+                th4 = math.radians(self._sgn[3] * float(ref_deg[3])) - self._offs[3]
                 th6 = total - th4
             sols.append((th1, th2, th3, th4, th5, th6))
             sols.append((th1, th2, th3, th4 + math.pi, -th5, th6 - math.pi))
-        opw = np.array(sols)
-        q = np.degrees((opw + self._off) * self._sign)
-        return _wrap180(q)
+        # q = wrap180(degrees((opw + offset) * sign)), in plain floats (the same operations,
+        # in the same order, as numpy's degrees/remainder: the same values)
+        offs, sgn, deg = self._offs, self._sgn, math.degrees
+        return [[-((-deg((th + offs[i]) * sgn[i]) + 180.0) % 360.0) + 180.0 for i, th in enumerate(sol)]
+                for sol in sols]
 
     def solutions(self, flange_T: np.ndarray) -> list[np.ndarray]:
         """All analytic OPW solutions for a flange pose (robot-model.md §4.2, §8).
@@ -301,22 +325,54 @@ class Kinematics:
                 ``$SOFTN_END``/``$SOFTP_END``.
         """
         ref = self._home.copy() if reference_deg is None else np.asarray(reference_deg, dtype=float)[:6]
-        sols = self._opw_solve(flange_T, ref)
-        if len(sols) == 0:
+        rows = self._opw_rows(flange_T, ref)
+        if not rows:
             raise WorkspaceError("workspace error: target not reachable")
         if status is not None:
             s_target, free = int(status) & 7, 0
         else:
             # keep the reference's status; bits the reference sits exactly on
             # (A5 = 0, A3 = phi, wrist point on the A1 axis) are free
-            s_ref, free_ref = self._status_bits(ref[None, :])
-            s_target, free = int(s_ref[0]), int(free_ref[0])
-
-        s_all, amb = self._status_bits(sols)
-        matching = sols[((s_all ^ s_target) & ~(amb | free) & 7) == 0]
-        if len(matching) == 0:
+            s_target, free = self._status_row(ref.tolist())
+        keep = ~free
+        matching_rows = []
+        for r in rows:
+            s_r, amb = self._status_row(r)
+            if ((s_r ^ s_target) & ~amb & keep & 7) == 0:
+                matching_rows.append(r)
+        if not matching_rows:
             raise WorkspaceError(f"workspace error: target not reachable with status S={s_target}")
-
+        # per solution and axis the ±360° variant within the limits (and the turn) nearest to
+        # the reference, then the solution with the least axis motion (the first of equals)
+        ref_l = ref.tolist()
+        lo, hi = self._lo_l, self._hi_l
+        negs = [(int(turn) >> i) & 1 == 1 for i in range(6)] if turn is not None else None
+        best: tuple[float, list[float]] | None = None
+        for b in matching_rows:
+            q: list[float] = []
+            for i in range(6):
+                best_c, best_d = None, math.inf
+                for kk in self._ks_l:
+                    c = b[i] + kk
+                    if c < lo[i] or c > hi[i]:
+                        continue
+                    if negs is not None and not ((c < 0) == negs[i] or abs(c) < 1e-6):
+                        continue
+                    d = abs(c - ref_l[i])
+                    if d < best_d:
+                        best_c, best_d = c, d
+                if best_c is None:
+                    break
+                q.append(best_c)
+            else:
+                cost = 0.0
+                for i in range(6):
+                    cost += abs(q[i] - ref_l[i])
+                if best is None or cost < best[0]:
+                    best = (cost, q)
+        if best is not None:
+            return np.array(best[1])
+        matching = np.array(matching_rows)
         if turn is not None:
             neg = ((int(turn) >> np.arange(6)) & 1).astype(bool)[:, None]  # (6, 1)
         best_ok: tuple[float, np.ndarray] | None = None

@@ -183,6 +183,20 @@ def _frame(f: Iterable[float]) -> np.ndarray:
     return frame_to_matrix(*[float(v) for v in f])
 
 
+def _trace_robot(events: list[dict[str, Any]]) -> Any:
+    """The robot named by the trace's ``robot`` header (krl run, issue 22), or None when the
+    trace has none or its source is no longer there (a backup archive's temporary folder)."""
+    from pathlib import Path  # noqa: PLC0415
+
+    from .mada import load_robot  # noqa: PLC0415
+
+    for ev in events[:4]:
+        if ev.get("kind") == "robot":
+            src = Path(str(ev.get("source", "")))
+            return load_robot(src) if src.is_file() else None
+    return None
+
+
 def check_trace(events: Iterable[dict[str, Any]], machine: Any = None, *,
                 limits: dict[int, MotionLimits] | None = None,
                 tol_speed: float = TOL_SPEED, tol_acc: float = TOL_ACC,
@@ -191,8 +205,9 @@ def check_trace(events: Iterable[dict[str, Any]], machine: Any = None, *,
 
     Args:
         events: trace event dicts (:func:`robot.trace.read_trace`).
-        machine: machine data (default :func:`robot.machine.load_machine`): axis maxima,
-            kinematics for the TCP/flange speed.
+        machine: machine data: axis maxima, kinematics for the TCP/flange speed. Default:
+            the robot the trace's ``robot`` header names (its ``source``, read with
+            :func:`robot.mada.load_robot`), else :func:`robot.machine.load_machine`.
         limits: motion id -> :class:`MotionLimits`; default: the ``limits`` fields of the
             trace's motion ``start`` events (motions without one are checked against the
             machine axis maxima only).
@@ -206,7 +221,8 @@ def check_trace(events: Iterable[dict[str, Any]], machine: Any = None, *,
     from .kinematics import Kinematics
     from .machine import load_machine
 
-    machine = machine if machine is not None else load_machine()
+    events = list(events)
+    machine = machine if machine is not None else _trace_robot(events) or load_machine()
     v_max = np.asarray(machine.max_speed_deg_s, dtype=float)
     a_max = np.asarray(machine.max_acc_deg_s2, dtype=float)
     lim: dict[int, MotionLimits] = dict(limits or {})

@@ -110,7 +110,8 @@ class MachineData:
     """All machine data of the robot (robot-model.md; loaded by :func:`load_machine`).
 
     Attributes:
-        name: robot name, ``"KR 6 R900 sixx"``.
+        name: robot name, ``"KR 6 R900 sixx"`` (from machine data: ``$TRAFONAME`` without
+            its ``#``, robot/mada.py).
         joints: six :class:`JointData`, A1..A6.
         home_deg: ``$AXIS_HOME[1]`` / XHOME, deg.
         mastering_deg: ``$MAMES``, deg.
@@ -162,6 +163,15 @@ class MachineData:
     home_flange_pose: tuple[float, ...] = field()
     source: str = ""
     raw: dict[str, Any] = field(default_factory=dict, repr=False, compare=False)
+    #: ``$TRAFONAME`` of the machine data ("" for the yaml robot).
+    trafoname: str = ""
+    #: parameter name -> where its value came from: ``"file:line"`` or ``"derived: rule"``
+    #: (robot/mada.py; empty for the yaml robot, whose sources are the yaml's comments).
+    provenance: dict[str, str] = field(default_factory=dict, repr=False, compare=False)
+    #: palletizer flags ``$DEF_A4FIX`` (A4 fixed at 0) and ``$DEF_A5LINK`` (A5 led by a
+    #: parallelogram; 4-axis palletizer), False for the yaml robot.
+    a4fix: bool = False
+    a5link: bool = False
 
     @property
     def limits_deg(self) -> tuple[tuple[float, float], ...]:

@@ -70,6 +70,11 @@ SCHEMA: dict[str, list[tuple[str, str]]] = {
         ("line", "optional int: source line where the run ended"),
         ("context", "optional str: main | interrupt | trigger | submit"),
     ],
+    "robot": [
+        ("name", "str: the simulated robot, e.g. 'KR210R2700_2 C4 FLR' (krl run's trace header, t=0)"),
+        ("source", "str: where its data came from: a $machine.dat path or a robot YAML"),
+        ("trafoname", "optional str: $TRAFONAME of the machine data"),
+    ],
     # written by the interpreters (same writer)
     "stmt": [
         ("file", "str: source file"),

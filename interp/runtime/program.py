@@ -216,6 +216,30 @@ class Program:
                 self.ensure_loaded(m)
         except ResourceError as exc:     # the program cannot start (Runtime.main_routine)
             self.fatal = self.fatal or exc
+        self._robot_values()
+
+    def _robot_values(self) -> None:
+        """KRL code and the controller see one robot (issue 22): the system variables that
+        name the robot (SysVars.ROBOT_SYSVARS: $TRAFONAME, soft limits, $ROBROOT, ...) hold
+        the simulated robot's machine data, also where the backup's Mada declares other
+        values (a run with --robot); the Mada data list's own variables follow."""
+        sv = self.rt.sysvars
+        sv.robot_values()
+        if not self.backup:
+            return
+        for m in self.modules:
+            if not (m.loaded and _in_mada(m)):
+                continue
+            for key in sv.ROBOT_SYSVARS:
+                ref = m.data.get(key)
+                if ref is None or key not in sv.store:
+                    continue
+                try:
+                    cur, v = ref.peek(), sv.store[key]
+                    if isinstance(cur, Struct) or hasattr(cur, "dims"):
+                        assign_into(cur, v)
+                except KrlRuntimeError:
+                    pass
 
     def ensure_loaded(self, m: ModuleRT) -> ModuleRT:
         if m.loaded or m.loading:
@@ -241,6 +265,11 @@ class Program:
                 raise
             except KrlRuntimeError as exc:
                 m.errors.append(f"line {item.span.line}: {exc.message}")
+        if mada:
+            # arrays set element by element (`$SOFTP_END[3]=168.0`, `$TRAFONAME[]="..."`)
+            # initialise their system variable whole, once the list is read
+            for key, ref in m.data.items():
+                self._machine_data(key, ref)
 
     @staticmethod
     def _decl_span(vn: N.VarName, decl) -> N.Span:

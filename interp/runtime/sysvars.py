@@ -109,8 +109,6 @@ class SysVars:
             "$TOOL": dict(zip("XYZABC", [0.0] * 6)),
             "$WORLD": dict(zip("XYZABC", [0.0] * 6)),
             "$ROBROOT": dict(zip("XYZABC", [float(x) for x in m.robroot_frame])),
-            "$VEL_MA": {"CP": 3.0, "ORI1": 400.0, "ORI2": 400.0},
-            "$ACC_MA": {"CP": 10.0, "ORI1": 1000.0, "ORI2": 1000.0},
             "$LOAD": {"M": -1.0},
         }
         for key, info in self.info.items():
@@ -130,9 +128,6 @@ class SysVars:
         for key in ("$FLAG", "$CYCFLAG"):
             a = s[key]
             a.data[:] = [False] * len(a.data)
-        for i, j in enumerate(m.joints[:6] if hasattr(m, "joints") else []):
-            s["$SOFTN_END"].data[i] = float(j.limit_deg[0])
-            s["$SOFTP_END"].data[i] = float(j.limit_deg[1])
         s["$ADVANCE"] = int(ctl.advance)
         s["$OV_PRO"] = 100
         s["$ORI_TYPE"] = EnumValue("VAR")
@@ -173,6 +168,35 @@ class SysVars:
         s["$H_POS"] = axis_struct(m.home_deg)
         for i in range(5):
             s["$AXIS_HOME"].data[i] = axis_struct(m.home_deg)
+        self.robot_values()
+
+    #: The system variables that name the simulated robot (issue 22): they always hold the
+    #: controller's machine data, also in a backup run with ``--robot`` (whose Mada says otherwise).
+    ROBOT_SYSVARS = ("$TRAFONAME", "$SOFTN_END", "$SOFTP_END", "$ROBROOT", "$VEL_MA", "$ACC_MA")
+
+    def robot_values(self) -> None:
+        """Set :data:`ROBOT_SYSVARS` from the controller's robot (robot/machine.py
+        MachineData): ``$TRAFONAME`` (when the robot has one), the soft limits of A1..A6,
+        ``$ROBROOT``, ``$VEL_MA`` and ``$ACC_MA``. KRL code and the main run see one robot."""
+        m = self.rt.controller.machine
+        s = self.store
+        name = getattr(m, "trafoname", "")
+        if name and "$TRAFONAME" in s and hasattr(s["$TRAFONAME"], "data"):
+            data = s["$TRAFONAME"].data
+            text = list(name[:len(data)])
+            data[:len(text)] = text
+            data[len(text):] = [make_value(T.CHAR)] * (len(data) - len(text))
+        for i, j in enumerate(m.joints[:6] if hasattr(m, "joints") else []):
+            s["$SOFTN_END"].data[i] = float(j.limit_deg[0])
+            s["$SOFTP_END"].data[i] = float(j.limit_deg[1])
+        for key, values in (("$ROBROOT", dict(zip("XYZABC", (float(x) for x in m.robroot_frame)))),
+                            ("$VEL_MA", {"CP": m.vel_ma.cp, "ORI1": m.vel_ma.ori1, "ORI2": m.vel_ma.ori2}),
+                            ("$ACC_MA", {"CP": m.acc_ma.cp, "ORI1": m.acc_ma.ori1, "ORI2": m.acc_ma.ori2})):
+            v = s.get(key)
+            if isinstance(v, Struct):
+                for k, x in values.items():
+                    if k in v.f:
+                        v.f[k] = float(x)
 
     # ------------------------------------------------------------------ lookup
     def lookup(self, name: str):

@@ -4,26 +4,31 @@ random $VEL/$OV_PRO/$APO, T1 or AUT — the trace keeps the limits: path speed <
 $OV_PRO (3 %), PTP axes <= $VEL_AXIS · v_max (3 %), every axis <= machine speed (3 %) and
 acceleration (10 %, finite differences), TCP/flange <= 250 mm/s in T1. Checked from the pose
 events with robot/limits.py. Motions the planner refuses (unreachable, singular) are left
-out, as an advance run would stop there."""
+out, as an advance run would stop there.
+
+It runs on the KR 6 R900 and on two large robots built from corpus machine data (issue 22):
+the KR 210 R2700-2 and the KR 120 R2700 extra HA (robot/mada.py); their targets are the same
+axis ranges, so their paths are three times longer."""
 
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from robot.controller import Controller
 from robot.errors import RobotError
 from robot.frames import matrix_to_frame
-from robot.kinematics import Kinematics
 from robot.limits import check_trace
 from robot.machine import load_machine
 from robot.motion import MotionParams, MotionRequest, SplineSegment
 from robot.trace import TraceWriter
 from tests.budget import examples
 
-M = load_machine()
-KIN = Kinematics(M)
+#: robot -> (corpus folder, or None for the yaml KR 6 R900)
+ROBOTS = {"KR 6 R900": None, "KR210R2700_2": "HugoDanielson__ChinaMilling",
+          "KR120R2700_EXTRA_HA": "khrzysio__KRC4_test"}
 HOME = (0.0, -90.0, 90.0, 0.0, 60.0, 0.0)
 # a comfortable part of the workspace: wrist away from A5 = 0, arm not stretched
 RANGES = ((-70, 70), (-115, -55), (60, 125), (-60, 60), (25, 105), (-90, 90))
@@ -53,12 +58,22 @@ def step_st(draw):
     return step
 
 
-def _pose(q):
-    return matrix_to_frame(KIN.forward(np.asarray(q, dtype=float)))
+@pytest.fixture(scope="module", params=sorted(ROBOTS))
+def robot(request):
+    folder = ROBOTS[request.param]
+    if folder is None:
+        return load_machine()
+    from robot.mada import load_robot  # noqa: PLC0415
+
+    return load_robot(request.getfixturevalue("shared_corpus") / folder)
 
 
-def _cart(q):
-    return dict(zip("XYZABC", _pose(q)))
+def _pose(kin, q):
+    return matrix_to_frame(kin.forward(np.asarray(q, dtype=float)))
+
+
+def _cart(kin, q):
+    return dict(zip("XYZABC", _pose(kin, q)))
 
 
 def _aux(p0, p1, bulge):
@@ -72,8 +87,8 @@ def _aux(p0, p1, bulge):
     return {"X": float(m[0]), "Y": float(m[1]), "Z": float(m[2])}
 
 
-def _requests(steps):
-    cur = _pose(HOME)
+def _requests(kin, steps):
+    cur = _pose(kin, HOME)
     out = [MotionRequest("PTP", dict(zip(("A1", "A2", "A3", "A4", "A5", "A6"), HOME)), MotionParams())]
     for s in steps:
         P, q, k = s["params"], s["q"], s["kind"]
@@ -81,28 +96,28 @@ def _requests(steps):
         if k in ("PTP", "SPTP"):
             out.append(MotionRequest(k, dict(zip(("A1", "A2", "A3", "A4", "A5", "A6"), q)), P, approx=ax,
                                      approx2=ax and "C_DIS"))
-            cur = _pose(q)
+            cur = _pose(kin, q)
         elif k == "LIN":
-            out.append(MotionRequest("LIN", _cart(q), P, approx=ax))
-            cur = _pose(q)
+            out.append(MotionRequest("LIN", _cart(kin, q), P, approx=ax))
+            cur = _pose(kin, q)
         elif k == "CIRC":
-            end = _pose(q)
+            end = _pose(kin, q)
             aux = _aux(cur, end, s["bulge"])
             if aux is None:
                 continue
-            out.append(MotionRequest("CIRC", _cart(q), P, approx=ax, aux=aux))
+            out.append(MotionRequest("CIRC", _cart(kin, q), P, approx=ax, aux=aux))
             cur = end
         else:
             segs = []
             for kind, qs, bulge in s["segs"]:
-                end = _pose(qs)
+                end = _pose(kin, qs)
                 if kind == "SCIRC":
                     aux = _aux(cur, end, bulge)
                     if aux is None:
                         kind, aux = "SLIN", None
-                    segs.append(SplineSegment(kind, _cart(qs), aux=aux))
+                    segs.append(SplineSegment(kind, _cart(kin, qs), aux=aux))
                 else:
-                    segs.append(SplineSegment(kind, _cart(qs)))
+                    segs.append(SplineSegment(kind, _cart(kin, qs)))
                 cur = end
             out.append(MotionRequest("SPLINE", {}, P, approx=ax, segments=tuple(segs)))
     return out
@@ -111,11 +126,11 @@ def _requests(steps):
 @settings(max_examples=examples(10), deadline=None,
           suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
 @given(steps=st.lists(step_st(), min_size=1, max_size=5), mode=st.sampled_from(["AUT", "AUT", "T1"]))
-def test_every_trace_keeps_the_limits(steps, mode):
+def test_every_trace_keeps_the_limits(robot, steps, mode):
     tw = TraceWriter(keep=True)
-    ctl = Controller(trace=tw, mujoco=False, mode_op=mode)
+    ctl = Controller(robot, trace=tw, mujoco=False, mode_op=mode)
     planned = 0
-    for req in _requests(steps):
+    for req in _requests(ctl.model.kin, steps):
         while not ctl.can_enqueue():
             ctl.step()
         try:
@@ -126,5 +141,5 @@ def test_every_trace_keeps_the_limits(steps, mode):
         if ctl.time > 120.0:
             break
     ctl.step_until(ctl.is_idle, max_cycles=200_000)
-    rep = check_trace(tw.events, M)
+    rep = check_trace(tw.events, robot)
     assert rep.ok, f"{rep.summary()}\n" + "\n".join(str(v) for v in rep.violations[:10])

@@ -238,3 +238,38 @@ def test_no_setpoint_jumps_through_mixed_blends():
     ax = np.array([e["axes"] for e in ev if e["kind"] == "pose"])
     vmax = np.array(ctl.machine.max_speed_deg_s)
     assert np.all(np.abs(np.diff(ax, axis=0)).max(axis=0) <= 1.1 * vmax * DT)
+
+
+def test_ptp_c_ptp_into_lin_keeps_the_axis_acceleration_at_the_blend_end():
+    """Issue 22: a PTP C_PTP blended into a LIN reached 1.13x the A2 acceleration limit at the
+    end of the blend (A2 reverses; the LIN's axis rates grow along its path). Now every
+    axis stays within a_max (+10 % finite-difference tolerance of robot/limits.py)."""
+    from robot.limits import check_trace
+
+    ax = ("A1", "A2", "A3", "A4", "A5", "A6")
+    rows = [([33.9, -83.122, 113.28, 7.754, 34.821, 25.543], [427.081, 351.007, 529.874, -153.625, 9.044, -128.525],
+             (64.571, 79.46, 1.481, 54.633)),
+            ([21.749, -58.884, 104.513, -15.924, 97.861, 58.972], [167.609, -249.479, 1054.977, 25.055, 42.651, 104.46],
+             (74.661, 81.934, 1.355, 55.002)),
+            ([8.368, -113.709, 96.573, 42.816, 31.244, -21.003], [310.996, 265.445, 1073.105, -121.104, 57.751, -134.62],
+             (68.144, 86.503, 0.724, 43.79))]
+    reqs = [MotionRequest("PTP", dict(zip(ax, (0, -90, 90, 0, 60, 0))), MotionParams())]
+    for qa, lin, (vax, cptp, vcp, cdis) in rows:
+        P = MotionParams().with_(vel_axis=(vax,) * 6, apo_cptp=cptp, vel_cp=vcp, apo_cdis=cdis)
+        reqs.append(MotionRequest("PTP", dict(zip(ax, qa)), P, approx="C_PTP"))
+        reqs.append(MotionRequest("LIN", dict(zip("XYZABC", lin)), P))
+    from robot.errors import RobotError
+
+    tw = TraceWriter(keep=True)
+    ctl = Controller(trace=tw, mujoco=False)
+    for req in reqs:
+        while not ctl.can_enqueue():
+            ctl.step()
+        try:
+            ctl.enqueue(req)
+        except RobotError:
+            continue        # one LIN target is outside A5's limits: the advance run would stop there
+    ctl.step_until(ctl.is_idle, max_cycles=100_000)
+    rep = check_trace(tw.events, ctl.machine)
+    assert rep.ok, rep.summary()
+    assert sum(1 for e in tw.events if e["kind"] == "motion" and e["phase"] == "blend_start") >= 1

@@ -1,0 +1,58 @@
+"""``krl robot show``: the robot model as text (name, parameters and their sources, limits,
+reach). Every text that came from a file (names, paths) passes krl.terminal.printable."""
+
+from __future__ import annotations
+
+import math
+
+from krl.terminal import printable
+
+from .kinematics import Kinematics
+from .machine import MachineData
+
+#: Parameters shown with their source, in this order (those the model has).
+_PARAMS = ("$TRAFONAME", "$TIRORO", "$LENGTH_A", "$LENGTH_B", "$TX3P3", "$DH_4", "$DH_5", "$TFLWP",
+           "$AXIS_DIR", "$SOFTN_END", "$SOFTP_END", "$VEL_AXIS_MA", "$RAT_MOT_AX", "$AXIS_JERK",
+           "$VEL_MA", "$ACC_MA", "$ROBROOT", "$DEF_A4FIX", "$DEF_A5LINK", "$AXIS_HOME[1]", "$MAMES",
+           "$DEF_L_M", "max_speed_deg_s", "max_acc_deg_s2", "opw", "status_phi_deg",
+           "reach_wrist_point_mm", "ipo_cycle_s", "motion_defaults", "default_load")
+
+
+def _fmt(values, nd: int = 3) -> str:
+    return ", ".join(f"{float(v):.{nd}f}".rstrip("0").rstrip(".") for v in values)
+
+
+def show_lines(m: MachineData) -> list[str]:
+    """The lines printed by ``krl robot show`` for the model ``m`` (mm, deg, s)."""
+    out = [f"robot      {printable(m.name)}",
+           f"source     {printable(m.source)}"]
+    if m.trafoname:
+        out.append(f"$TRAFONAME {printable(m.trafoname)}")
+    o = m.opw
+    out.append(f"kinematics OPW a1={o.a1:g} a2={o.a2:g} b={o.b:g} c1={o.c1:g} c2={o.c2:g} "
+               f"c3={o.c3:g} c4={o.c4:g} mm")
+    k = Kinematics(m)
+    zero = k.forward([0.0] * 6)[:3, 3]
+    out.append(f"reach      {m.reach_wrist_point_mm:.1f} mm to the wrist point; flange at A=0: "
+               f"({_fmt(zero, 1)}) mm")
+    out.append(f"home       A = ({_fmt(m.home_deg)}) deg; flange X,Y,Z,A,B,C = ({_fmt(m.home_flange_pose, 1)})")
+    out.append(f"$ROBROOT   ({_fmt(m.robroot_frame)})")
+    out.append(f"$VEL_MA    CP {m.vel_ma.cp:g} m/s, ORI1 {m.vel_ma.ori1:g}, ORI2 {m.vel_ma.ori2:g} deg/s; "
+               f"$ACC_MA CP {m.acc_ma.cp:g} m/s2")
+    if m.a4fix or m.a5link:
+        out.append(f"palletizer $DEF_A4FIX={m.a4fix} $DEF_A5LINK={m.a5link}")
+    out.append("axes       axis   limits (deg)         v max (deg/s)  a max (deg/s2)  jerk (deg/s3)")
+    for j in m.joints:
+        out.append(f"           A{j.axis}   {j.limit_deg[0]:8.1f} .. {j.limit_deg[1]:7.1f}   {j.max_speed_deg_s:12.2f}"
+                   f"  {j.max_acc_deg_s2:14.1f}  {j.max_jerk_deg_s3:13.1f}")
+    if m.provenance:
+        out.append("parameters (source file:line, or the rule that derived the value)")
+        for key in _PARAMS:
+            if key in m.provenance:
+                out.append(f"  {key:<22} {printable(m.provenance[key])}")
+    else:
+        out.append("parameters from the robot YAML; each number's source is in its comments")
+    return out
+
+
+__all__ = ["show_lines"]
