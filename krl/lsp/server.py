@@ -14,6 +14,7 @@ import importlib.util
 import logging
 import os
 import sys
+import time
 from concurrent.futures import ThreadPoolExecutor
 
 from lsprotocol import types as L
@@ -42,7 +43,9 @@ from krl.terminal import printable, printable_path
 
 log = logging.getLogger("krl.lsp")       # file names and messages in it pass krl.terminal.printable
 TRACEBACKS = {"on": False}                # Python tracebacks only into a --log-file, never to stderr
-DEBOUNCE_S = 0.02          # seconds after the last change before the analysis starts
+DEBOUNCE_S = 0.02          # seconds after the last change before the analysis starts, in a burst
+BURST_GAP_S = 0.15         # a change this soon after the one before is part of a burst (typing);
+                           # a change after a longer pause starts the analysis at once (leading edge)
 EARLY_S = 0.5              # after opening: the file's own parse diagnostics when the first check of
 EARLY_MIN_FILES = 100      # a workspace of this many files is not done within this many seconds
 
@@ -78,6 +81,7 @@ class KrlLanguageServer(LanguageServer):
         super().__init__("krl-lsp", __version__)
         self.project = Project()
         self.debounce_s = DEBOUNCE_S
+        self._last_change: dict[str, float] = {}
         self._executor = ThreadPoolExecutor(max_workers=1, thread_name_prefix="krl-analysis")
         self._lock: asyncio.Lock | None = None
         self._pending: dict[str, asyncio.Task] = {}
@@ -186,7 +190,17 @@ class KrlLanguageServer(LanguageServer):
             diagnostics=[lsp_diagnostic(d, lines, codec, uri_of) for d in parsed.diagnostics if d.path == path]))
 
     def schedule(self, path: str, delay: float | None = None) -> None:
-        """Analyse the workspace of `path` after the debounce delay (a newer change restarts it)."""
+        """Analyse the workspace of `path` after `delay` seconds (a newer change restarts it).
+
+        Without `delay` (an edit): at once when the edit follows a pause of more than
+        :data:`BURST_GAP_S` (a single edit waits for no debounce), else after :data:`DEBOUNCE_S`,
+        so that a burst of keystrokes is analysed once (edits arriving while an analysis runs
+        mark the file dirty and wait for it, as before)."""
+        now = time.monotonic()
+        last = self._last_change.get(path)
+        self._last_change[path] = now
+        if delay is None:
+            delay = 0.0 if last is None or now - last > BURST_GAP_S else self.debounce_s
         self._dirty.add(path)
         self._gen[path] = self._gen.get(path, 0) + 1
         old = self._pending.pop(path, None)
@@ -195,7 +209,7 @@ class KrlLanguageServer(LanguageServer):
 
         async def later() -> None:
             try:
-                await asyncio.sleep(self.debounce_s if delay is None else delay)
+                await asyncio.sleep(delay)
             except asyncio.CancelledError:
                 return
             self._pending.pop(path, None)
