@@ -16,8 +16,7 @@ Every stop gets one *cause* (:func:`cause_of`, issue 22 "Every stop explained"):
 * ``program error``: a KRL run-time error of the program, at its file:line;
 * ``interpreter gap``: an error that is the simulator's (:data:`GAP_MESSAGES`: a feature not
   simulated; a target, a CP path or an axis range the simulated KR 6 R900 cannot follow — the
-  backup's own robot is another; an element of a CONST array a data list sets line by line, which
-  the runtime leaves unset, :func:`const_array_gap`),
+  backup's own robot is another),
   or an internal error;
 * ``limit``: the time or step limit (or a deadlock) with no cell answering: the program starves
   for an input (named by the stop text, "waits: WAIT FOR ...") or loops on its own.
@@ -51,7 +50,7 @@ CAUSES = ("completed", "intended end", "program error", "interpreter gap", "limi
 
 #: parts of a run-time error message that make it the simulator's gap, not the program's error
 GAP_MESSAGES = ("target not reachable", "through a singularity", "software limit switch",
-                "CONST array element", "not supported", "unsupported", "not simulated",
+                "not supported", "unsupported", "not simulated",
                 "not implemented", "internal error")
 
 #: the committed cell files of the corpus backups (issue 22)
@@ -72,19 +71,6 @@ def cell_of(path: Path, corpus: Path = DEFAULT_CORPUS, cells: Path = CELLS) -> P
     return None
 
 
-def const_array_gap(rt, res) -> bool:
-    """True when the run stopped on "value invalid" reading an element of a ``DECL CONST``
-    array (the checker's symbol of the name, in the module of the stop): the reference lets a
-    data list initialise it element by element; the runtime does not yet (issue 22)."""
-    m = re.match(r"value invalid: ([A-Za-z_$][A-Za-z0-9_$]*)\[", res.text or "")
-    if res.reason != "error" or m is None or not res.file:
-        return False
-    module = rt.program.module_of(res.file)
-    scope = rt.program.ws.units[module.index].scope if module is not None else None
-    sym = scope.lookup(m.group(1)) if scope is not None else None
-    return sym is not None and sym.kind == "const"
-
-
 def row_from_trace(program: Path, events: list[dict]) -> dict:
     """A row as :func:`run_one` gives it, from the trace of a run of `program` with its cell
     (the conformance report runs programs through ``krl run``): the ``end`` event, the cell's
@@ -97,16 +83,6 @@ def row_from_trace(program: Path, events: list[dict]) -> dict:
            "cell_answers": len(cell), "cell_last": max(cell) if cell else None}
     if row["reason"] == "program_end":
         row["reason"] = "completed"
-    if row["reason"] == "error" and row["text"].startswith("value invalid:"):
-        from interp.run import make_runtime  # noqa: PLC0415
-        from interp.runtime.core import RunResult  # noqa: PLC0415
-
-        try:
-            rt, _ = make_runtime(program, mujoco=False, check=False)
-            if const_array_gap(rt, RunResult("error", None, row["file"], row["line"], None, row["text"])):
-                row["text"] += " (a CONST array element set line by line in its data list)"
-        except Exception:  # noqa: BLE001 - the cause stays a program error
-            pass
     row["cause"] = cause_of(row)
     return row
 
@@ -195,10 +171,7 @@ def run_one(path: Path, max_sim_time: float, max_steps: int, cell: Path | None =
         row["cause"] = cause_of(row)
         return row
     del tw
-    text = res.text
-    if const_array_gap(rt, res):
-        text = f"{text} (a CONST array element set line by line in its data list)"
-    row = {"program": str(path), "reason": res.reason, "text": text,
+    row = {"program": str(path), "reason": res.reason, "text": res.text,
            "number": res.error.number if res.error is not None else None,
            "file": res.file, "line": res.line, "sim_time": round(res.sim_time, 3),
            "steps": res.steps, "stubs": stubs, "submit": submit_errors(rt),
