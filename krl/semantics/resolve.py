@@ -168,6 +168,7 @@ class Resolver:
         self.places: dict[int, tuple[int, int, int]] = {}   # id(Symbol) -> (kind, owner, slot)
         self.system_index: dict[str, int] = {}
         self.unit_of: dict[int, int] = {}                    # id(Routine) -> unit index
+        self.linkable: dict[str, N.Routine] = {}             # NAME -> main or GLOBAL routine
         self.native_names = set(self.system.routines)
 
     # ------------------------------------------------------------------ layouts
@@ -182,8 +183,12 @@ class Resolver:
                     returns.setdefault(id(sym.decl), sym.signature.returns)
         for i, u in enumerate(ws.units):
             if u.src is not None:
-                for r in u.src.module.routines:
+                for k, r in enumerate(u.src.module.routines):
                     self.unit_of[id(r)] = i
+                    if k == 0 or r.is_global:
+                        # what an EXT declaration links to (reference 2.6): a module's main
+                        # routine or a GLOBAL routine; the first one in file order
+                        self.linkable.setdefault(r.name.upper(), r)
             if u.dat is not None and u.dat.module.data is not None:
                 lay = _data_layout(u.dat.module.data, i)
                 u.dat.module.data.annotate().storage = lay
@@ -298,9 +303,14 @@ class Resolver:
             sym = scope.lookup_routine(c.name)
         callee = Callee(c.name)
         if isinstance(sym, Symbol):
-            if isinstance(sym.decl, N.Routine):
-                callee.routine = sym.decl
-                callee.owner = self.unit_of.get(id(sym.decl), -1)
+            decl = sym.decl
+            if isinstance(decl, N.ExtDecl):
+                # EXT/EXTFCT names a routine of another module: the link binds the call to it
+                # (a technology package absent from the backup leaves it unbound: a stub)
+                decl = self.linkable.get(c.name.upper(), decl)
+            if isinstance(decl, N.Routine):
+                callee.routine = decl
+                callee.owner = self.unit_of.get(id(decl), -1)
             elif sym.scope == "system" or (sym.decl is None and c.name.upper() in self.native_names):
                 callee.native = True
         c.annotate().storage = callee

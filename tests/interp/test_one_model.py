@@ -87,3 +87,30 @@ def test_an_undeclared_name_is_refused_and_a_run_time_error_with_no_check(tmp_pa
     res = rt.run()
     assert (res.reason, res.text, res.line) == ("error", "unknown name nothere", 3)
     assert rt.controller.io.get_out(1) and not rt.controller.io.get_out(2)
+
+
+EXT_PROG = """DEF caller()
+  EXT callee(INT :IN)
+  callee(7)
+END
+"""
+EXT_CALLEE = """DEF callee(n :IN)
+  DECL INT n
+  $OUT[n] = TRUE
+END
+"""
+
+
+@pytest.mark.parametrize("interp", ["tree", "vm"])
+def test_an_ext_declaration_links_to_the_module_it_names(tmp_path, interp):
+    """``EXT callee(...)`` in a module declares the main routine of module callee.src
+    (reference 2.6): the call runs it, as the controller's linker binds it (issue 22: the
+    backups' ``EXT BAS (...)`` lines had made every BAS call a stub)."""
+    (tmp_path / "caller.src").write_text(EXT_PROG)
+    (tmp_path / "callee.src").write_text(EXT_CALLEE)
+    tw = TraceWriter(keep=True)
+    rt, _ = make_runtime(tmp_path / "caller.src", trace=tw, mujoco=False, interp=interp)
+    res = rt.run()
+    assert res.reason == "completed", res
+    assert [e["name"] for e in tw.events if e["kind"] == "call"] == ["caller", "callee"]
+    assert rt.controller.io.get_out(7)
