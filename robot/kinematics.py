@@ -85,6 +85,12 @@ class Kinematics:
         self._lo_l = [float(v) - LIMIT_EPS_DEG for v in self._lo]
         self._hi_l = [float(v) + LIMIT_EPS_DEG for v in self._hi]
         self._ks_l = [float(v) for v in self._ks]
+        # the 4-axis palletizer ($DEF_A5LINK, docs/robot.md "The palletizer"): its own inverse
+        self._pa: tuple[np.ndarray, np.ndarray] | None = None
+        self._s_free = 0            # S bits that select nothing on this robot
+        self._t_free = 0            # T bits that select nothing on this robot
+        if m.a5link:
+            self._init_palletizer()
 
     # ------------------------------------------------------------------ FK
     def forward(self, axes_deg: Sequence[float]) -> np.ndarray:
@@ -182,7 +188,7 @@ class Kinematics:
         phi = self.phi_deg
         s = int(xw < -BOUNDARY_EPS) | (int(q[2] >= phi - BOUNDARY_EPS) << 1) | (int(q[4] < -BOUNDARY_EPS) << 2)
         amb = (int(abs(xw) < OVERHEAD_SINGULAR_MM) | (int(abs(q[2] - phi) < 1e-7) << 1)
-               | (int(abs(q[4]) < WRIST_SINGULAR_DEG) << 2))
+               | (int(abs(q[4]) < WRIST_SINGULAR_DEG) << 2) | self._s_free)
         return s, amb
 
     def _status_bits(self, Q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -217,7 +223,78 @@ class Kinematics:
         rows = self._opw_rows(flange_T, ref_deg)
         return np.array(rows) if rows else np.empty((0, 6))
 
+    # ------------------------------------------------------------------ palletizer
+    def _init_palletizer(self) -> None:
+        """The 4-axis palletizer (``$DEF_A4FIX``, ``$DEF_A5LINK``; docs/robot.md "The
+        palletizer"): A4 stays at 0 and the parallelogram keeps the flange vertical, so a
+        flange pose has four degrees of freedom (X, Y, Z and the rotation about the vertical).
+        Kept here: the flange's offset from the A5 axis point in the arm's vertical plane at
+        A1 = 0 (mm), and the flange rotation at HOME with A1 = A6 = 0. The OPW solver then runs
+        on the A5 point (``c4 = 0``). S bit 2 and T bits 3, 4 (A4, A5) select nothing."""
+        from dataclasses import replace  # noqa: PLC0415
+
+        q = np.array(self.machine.home_deg, dtype=float)
+        q[0] = q[3] = q[5] = 0.0
+        T = self.forward(q)
+        self._pa = (T[:3, 3] - self._joint_point(q, 4), T[:3, :3].copy())
+        self._opw = replace(self._opw, c4=0.0)
+        self._s_free = 4
+        self._t_free = 0b11000
+
+    def _joint_point(self, axes_deg: Sequence[float], index: int) -> np.ndarray:
+        """Position (mm, in ``$ROBROOT``) of the origin of joint `index` (0 = A1)."""
+        q = self._kuka_sign * np.radians(np.asarray(axes_deg, dtype=float)[:6])
+        R = np.eye(3)
+        p = np.zeros(3)
+        for i in range(index + 1):
+            p = p + R @ self._origins[i]
+            if self._origin_rot:
+                R = R @ self._R_origin[i]
+            R = R @ Rotation.from_rotvec(self._axes[i] * q[i]).as_matrix()
+        return p
+
+    def _palletizer_rows(self, flange_T: np.ndarray, ref_deg: np.ndarray | None) -> list[list[float]]:
+        """Solutions of a flange pose on the 4-axis palletizer (see :meth:`_init_palletizer`).
+
+        The pose's tilt (its B and C against the vertical) is not followed: KUKA's 4-axis
+        transformation has no axis for it, and the flange keeps the nearest vertical pose
+        (the rotation about the vertical that is closest in the least-squares sense). The arm
+        plane's direction is that of the flange seen from the A1 axis; the A5 point lies the
+        fixed offset back from the flange in that plane; OPW solves the arm for that point.
+        Only rows that put the flange where asked (1e-6 mm) are kept; A4 is 0."""
+        offset, R_ref = self._pa  # type: ignore[misc]
+        T = np.asarray(flange_T, dtype=float)
+        R_rel = T[:3, :3] @ R_ref.T
+        psi = math.atan2(R_rel[1, 0] - R_rel[0, 1], R_rel[0, 0] + R_rel[1, 1])
+        c, s = math.cos(psi), math.sin(psi)
+        Rz = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+        R_v = Rz @ R_ref
+        p = T[:3, 3]
+        rows: list[list[float]] = []
+        phi = math.atan2(p[1], p[0])
+        for arm in (phi, phi + math.pi):
+            ca, sa = math.cos(arm), math.sin(arm)
+            w = p - np.array([ca * offset[0] - sa * offset[1], sa * offset[0] + ca * offset[1], offset[2]])
+            Tw = np.eye(4)
+            Tw[:3, :3] = R_v
+            Tw[:3, 3] = w
+            for row in self._opw_core(Tw, ref_deg):
+                if abs(row[3]) < 1e-6:
+                    row[3] = 0.0
+                elif abs(abs(row[3]) - 180.0) < 1e-6:
+                    continue                    # the flipped wrist: A4 cannot turn
+                if float(np.abs(self.forward(row)[:3, 3] - p).max()) < 1e-6:
+                    rows.append(row)
+        return rows
+
     def _opw_rows(self, flange_T: np.ndarray, ref_deg: np.ndarray | None) -> list[list[float]]:
+        """The analytic solutions of a flange pose: :meth:`_opw_core`, or for the 4-axis
+        palletizer :meth:`_palletizer_rows`."""
+        if self._pa is not None:
+            return self._palletizer_rows(flange_T, ref_deg)
+        return self._opw_core(flange_T, ref_deg)
+
+    def _opw_core(self, flange_T: np.ndarray, ref_deg: np.ndarray | None) -> list[list[float]]:
         """OPW closed form: up to 8 lists of KUKA axis values (deg, wrapped to (-180, 180]).
 
         With ``ref_deg`` the free angle at a singularity is taken from it:
@@ -346,7 +423,10 @@ class Kinematics:
         # the reference, then the solution with the least axis motion (the first of equals)
         ref_l = ref.tolist()
         lo, hi = self._lo_l, self._hi_l
+        if turn is not None:
+            turn = int(turn) & ~self._t_free
         negs = [(int(turn) >> i) & 1 == 1 for i in range(6)] if turn is not None else None
+        free_t = [(self._t_free >> i) & 1 == 1 for i in range(6)]
         best: tuple[float, list[float]] | None = None
         for b in matching_rows:
             q: list[float] = []
@@ -356,7 +436,7 @@ class Kinematics:
                     c = b[i] + kk
                     if c < lo[i] or c > hi[i]:
                         continue
-                    if negs is not None and not ((c < 0) == negs[i] or abs(c) < 1e-6):
+                    if negs is not None and not ((c < 0) == negs[i] or abs(c) < 1e-6 or free_t[i]):
                         continue
                     d = abs(c - ref_l[i])
                     if d < best_d:
@@ -375,13 +455,14 @@ class Kinematics:
         matching = np.array(matching_rows)
         if turn is not None:
             neg = ((int(turn) >> np.arange(6)) & 1).astype(bool)[:, None]  # (6, 1)
+            t_free = ((self._t_free >> np.arange(6)) & 1).astype(bool)[:, None]
         best_ok: tuple[float, np.ndarray] | None = None
         best_bad: tuple[float, np.ndarray, int] | None = None
         for b in matching:
             cands = b[:, None] + self._ks[None, :]  # (6, 5): the ±360° variants per axis
             ok = np.ones(cands.shape, dtype=bool)
             if turn is not None:
-                ok = ((cands < 0) == neg) | (np.abs(cands) < 1e-6)
+                ok = ((cands < 0) == neg) | (np.abs(cands) < 1e-6) | t_free
             inlim = ok & (cands >= self._lo[:, None] - LIMIT_EPS_DEG) & (cands <= self._hi[:, None] + LIMIT_EPS_DEG)
             dist = np.where(inlim, np.abs(cands - ref[:, None]), np.inf)
             pick = np.argmin(dist, axis=1)

@@ -332,7 +332,15 @@ def _self_check(model: MachineData, fixed, local, prov) -> None:
     rng = np.random.default_rng(0)
     lo = np.array([max(j.limit_deg[0], -170.0) for j in model.joints])
     hi = np.array([min(j.limit_deg[1], 170.0) for j in model.joints])
+    home = np.array(model.home_deg, dtype=float)
+    if model.a5link and abs(k.forward(home)[2, 2] + 1.0) > 1e-9:
+        raise MachineDataError(f"{prov.get('$DEF_A5LINK', prov['$TX3P3'])}: $DEF_A5LINK: the flange of "
+                               f"this palletizer does not point straight down at $AXIS_HOME[1]")
     for q in rng.uniform(lo, hi, size=(4, 6)):
+        if model.a5link:
+            # the parallelogram: A4 = 0 and A2 + A3 + A5 as at HOME (the flange stays vertical)
+            q[3] = 0.0
+            q[4] = home[4] + home[1] + home[2] - q[1] - q[2]
         T = chain_forward(fixed, local, q)
         if np.abs(k.forward(q) - T).max() > _SELF_CHECK_MM:
             raise MachineDataError(f"{prov['$TX3P3']}: internal chain does not close")
