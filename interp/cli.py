@@ -45,7 +45,8 @@ import click
                    "A name nothing declares is then a run-time error where it is evaluated.")
 @click.option("--robot", "robot", type=click.Path(path_type=Path), default=None,
               help="The robot to simulate: a robot YAML, a $machine.dat, a KRC backup folder or .zip "
-                   "(default: the backup's own robot from its R1/Mada/$machine.dat, else the KR 6 R900).")
+                   "(default: the robot the --inputs cell file names, else the backup's own robot from its "
+                   "R1/Mada/$machine.dat, else the KR 6 R900).")
 def run(program: Path, interp_kind: str, workspace, inputs, trace_path, max_sim_time, max_steps, submit,
         mode, run_mode, pgno, no_check, robot) -> None:
     """Run PROGRAM (.src) on the simulated KR C4; print where and why it ended.
@@ -110,8 +111,8 @@ def _run(program: Path, workspace, inputs, trace_path, max_sim_time, max_steps, 
     from robot.trace import TraceWriter  # noqa: PLC0415
 
     try:
-        machine = robot_for(program, workspace, robot)
-    except MachineDataError as exc:
+        machine = robot_for(program, workspace, robot, inputs)
+    except (MachineDataError, StimulusError) as exc:
         click.echo(f"error: {shown(printable(exc))}", err=True)
         sys.exit(2)
     trace = TraceWriter(trace_path) if trace_path else None

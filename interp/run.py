@@ -28,7 +28,7 @@ def make_runtime(program, *, workspace=None, inputs=None, trace=None, max_sim_ti
     in P00's handshake (robot/cellpresets.py; overrides the cell file's ``pgno`` preset).
     ``run_mode``: ``$PRO_MODE`` at the start (GO, MSTEP, ISTEP, BSTEP; interp/runtime/runmode.py;
     default GO). ``robot``: the simulated robot (a MachineData or a path for
-    :func:`robot.mada.load_robot`); default :func:`robot_for`. Raises
+    :func:`robot.mada.load_robot`); default: the cell file's ``robot``, else :func:`robot_for`. Raises
     :class:`robot.stimuli.StimulusError` for a bad cell file or a preset the backup's
     ``$config.dat`` does not allow."""
     from interp.tree import TreeInterpreter  # noqa: PLC0415
@@ -38,7 +38,7 @@ def make_runtime(program, *, workspace=None, inputs=None, trace=None, max_sim_ti
 
         if observer is not None:
             observer.inner = trace
-        controller = Controller(robot_for(program, workspace, robot),
+        controller = Controller(robot_for(program, workspace, robot, inputs),
                                 trace=observer if observer is not None else trace,
                                 stimuli=str(inputs) if inputs else None, mujoco=mujoco,
                                 mode_op=mode)
@@ -105,19 +105,24 @@ def global_value(rt: Runtime, main: str, name: str):
         return rt.storage_ref(prog.ws.resolver.storage(name, sym, None, module.index if module else -1), None).get()
     except KrlRuntimeError:
         return None
-def robot_for(program, workspace=None, robot=None):
+def robot_for(program, workspace=None, robot=None, inputs=None):
     """The robot a run of `program` simulates (issue 22): `robot` when given (a MachineData,
     or a path: robot YAML, ``$machine.dat``, backup folder or .zip, robot/mada.py
-    ``load_robot``); else the robot of the KRC backup holding the program (the backup root of
-    krl.project.backup_of, its ``R1/Mada/$machine.dat``); else the KR 6 R900 of
+    ``load_robot``); else the robot the cell file `inputs` names (``robot:``, one of the
+    project's robot library); else the robot of the KRC backup holding the program (the backup
+    root of krl.project.backup_of, its ``R1/Mada/$machine.dat``); else the KR 6 R900 of
     robot/data/kr6_r900.yaml. Raises robot.mada.MachineDataError for machine data that
-    cannot make a model (file:line)."""
+    cannot make a model (file:line), robot.stimuli.StimulusError for a bad cell file."""
     from krl.project import backup_of  # noqa: PLC0415
     from robot.machine import MachineData, load_machine  # noqa: PLC0415
     from robot.mada import load_robot, robot_of_backup  # noqa: PLC0415
 
     if isinstance(robot, MachineData):
         return robot
+    if robot is None and inputs:
+        from robot.stimuli import load_cell  # noqa: PLC0415
+
+        robot = load_cell(inputs).robot
     if robot is not None:
         return load_robot(robot)
     root = backup_of(Path(program).resolve(), Path(workspace).resolve() if workspace else None)

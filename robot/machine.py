@@ -21,6 +21,15 @@ import yaml
 from scipy.spatial.transform import Rotation
 
 DEFAULT_MACHINE_FILE = Path(__file__).with_name("data") / "kr6_r900.yaml"
+#: The project's robot library: robot YAMLs and machine data (``*.dat``) that a cell file names
+#: by their stem (``robot: kr180_r3200_pa``, robot/stimuli.py).
+ROBOT_LIBRARY = DEFAULT_MACHINE_FILE.parent
+
+
+def library_robots() -> dict[str, Path]:
+    """The robots of :data:`ROBOT_LIBRARY`: file stem -> path (``.yaml`` and ``.dat`` files)."""
+    return {p.stem: p for p in sorted(ROBOT_LIBRARY.iterdir())
+            if p.is_file() and p.suffix in (".yaml", ".dat")}
 
 
 @dataclass(frozen=True)

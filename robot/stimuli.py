@@ -18,14 +18,19 @@ it starts (:func:`resolve_signals`).
 
 A *cell file* is a stimuli file with reactive rules and presets beside (issue 22)::
 
+    robot: kr180_r3200_pa                # a robot of robot/data, by name (optional)
     presets: {autoext: true, pgno: 2}    # robot/cellpresets.py
     rules:                               # robot/cellrules.py: rising edge, `after` s later
       - when: "$OUT[3] AND NOT PART_OK"
         after: 0.2
         set: {PART_OK: true}
 
+``robot`` names the robot the cell holds, when the backup has no machine data of its own: one
+of the project's robot library (robot/machine.py ``library_robots``; a name, never a path, as
+the file is untrusted). ``krl run --robot`` overrides it; it overrides the backup's machine data.
+
 The file is validated against this schema: a top-level mapping holds only ``stimuli``,
-``rules``, ``presets``; a stimulus only ``at``, ``when``, ``set``, ``delay``; ``when`` only
+``rules``, ``presets``, ``robot``; a stimulus only ``at``, ``when``, ``set``, ``delay``; ``when`` only
 ``motion``, ``line``, ``phase``, ``reached``; a rule only ``when`` (KRL text), ``after``, ``set``;
 ``presets`` only ``pgno``, ``autoext``. Anything else is a :class:`StimulusError` that names the
 key and the place (``file:line``). Limits: at most :data:`MAX_STIMULI` stimuli,
@@ -54,7 +59,7 @@ from .cellrules import ConditionError, Rule, compile_condition, parse_condition
 from .io import IOError_, parse_signal
 
 PHASES = ("start", "blend_start", "blend_end", "end")
-TOP_KEYS = ("stimuli", "rules", "presets")
+TOP_KEYS = ("stimuli", "rules", "presets", "robot")
 PRESET_KEYS = ("pgno", "autoext")
 RULE_KEYS = ("when", "after", "set")
 STIMULUS_KEYS = ("at", "when", "set", "delay")
@@ -197,6 +202,7 @@ class Cell:
     rules: list[Rule] = field(default_factory=list)
     pgno: int | None = None        # presets: the program number the PLC answers (robot/cellpresets.py)
     autoext: bool = False          # presets: Automatic External (operating mode EXT)
+    robot: Path | None = None      # the robot of the project's library the cell names
 
 
 def _parse_rules(doc: Any, where: _Where, key_where: str) -> list[Rule]:
@@ -249,14 +255,26 @@ def parse_cell(doc: Any, default_reach_mm: float = 0.1, source: str = "") -> Cel
     rules: list[Rule] = []
     if isinstance(doc, dict):
         _unknown(doc, TOP_KEYS, "top-level key", where)
-        if "stimuli" not in doc and "rules" not in doc and "presets" not in doc:
-            raise StimulusError(f"{where(doc)}: the mapping needs 'stimuli', 'rules' or 'presets'")
+        if not any(k in doc for k in TOP_KEYS):
+            raise StimulusError(f"{where(doc)}: the mapping needs 'stimuli', 'rules', 'presets' or 'robot'")
         cell = Cell([], _parse_rules(doc.get("rules"), where, where(doc, "rules")))
         _parse_presets(doc.get("presets"), cell, where, where(doc, "presets"))
+        if "robot" in doc:
+            cell.robot = _library_robot(doc["robot"], where(doc, "robot"))
         if doc.get("stimuli") is not None:
             cell.stimuli = _parse_stimuli(doc["stimuli"], default_reach_mm, where)
         return cell
     return Cell(_parse_stimuli(doc, default_reach_mm, where))
+
+
+def _library_robot(name: Any, at: str) -> Path:
+    from .machine import library_robots  # noqa: PLC0415
+
+    robots = library_robots()
+    if not isinstance(name, str) or name not in robots:
+        raise StimulusError(f"{at}: robot must name a robot of the project's library "
+                            f"({', '.join(robots)}), not {str(name)[:60]!r}")
+    return robots[name]
 
 
 def _parse_presets(doc: Any, cell: Cell, where: _Where, key_where: str) -> None:

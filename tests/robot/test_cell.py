@@ -106,3 +106,30 @@ def test_cell_init_lists_the_inputs_with_their_declarations(tmp_path):
     from robot.stimuli import load_cell
     cell = load_cell(dest)
     assert cell.rules == [] and cell.autoext is False
+
+
+def test_a_cell_file_names_its_robot_from_the_library(tmp_path):
+    """``robot:`` in a cell file (issue 22): a robot of the project's library by name; the run
+    simulates it, and ``--robot`` still overrides it. A path or an unknown name is refused."""
+    from interp.run import robot_for
+    from robot.stimuli import StimulusError, load_cell
+
+    cell = tmp_path / "cell.yaml"
+    cell.write_text("robot: kr180_r3200_pa\nrules: []\n", encoding="utf-8")
+    assert load_cell(cell).robot.name == "kr180_r3200_pa.dat"
+    assert robot_for(JOB, inputs=cell).trafoname == "#KR180R3200 PA C4 FLR"
+    kr6 = Path(__file__).resolve().parents[2] / "robot" / "data" / "kr6_r900.yaml"
+    assert robot_for(JOB, robot=kr6, inputs=cell).name == "KR 6 R900 sixx"
+    res = CliRunner().invoke(main, ["run", str(JOB), "--inputs", str(cell), "--no-check",
+                                    "--max-sim-time", "1"])
+    assert "robot      KR180R3200 PA C4 FLR" in res.output, res.output
+    for bad in ("../../etc/passwd", "/etc/passwd", "kr999", 3):
+        cell.write_text(f"robot: {bad}\n", encoding="utf-8")
+        try:
+            load_cell(cell)
+        except StimulusError as exc:
+            assert f"{cell}:1" in str(exc) and "library" in str(exc)
+        else:
+            raise AssertionError(f"robot: {bad} was accepted")
+    res = CliRunner().invoke(main, ["run", str(JOB), "--inputs", str(cell)])
+    assert res.exit_code == 2 and "Traceback" not in res.output and "robot must name" in res.output
