@@ -20,7 +20,8 @@ Every stop gets one *cause* (:func:`cause_of`, issue 22 "Every stop explained"):
   whose target the backup's own robot cannot take (the run simulates the robot of the
   backup's ``$machine.dat``, and no axis configuration of the target — any status, turn,
   ±360° variant — lies within that machine data's software limits,
-  ``Controller.target_outside_limits``): the real controller of that robot refuses it too;
+  ``Controller.target_outside_limits``; the error says so, interp/runtime/core.py
+  ``TARGET_OUTSIDE_NOTE``): the real controller of that robot refuses it too;
 * ``interpreter gap``: an error that is the simulator's (:data:`GAP_MESSAGES`: a feature not
   simulated; a target, a CP path or an axis range the simulated robot cannot follow when it is
   not the backup's own — the KR 6 R900 of a backup without machine data — or when only the
@@ -49,6 +50,7 @@ import time
 from collections import Counter
 from pathlib import Path
 
+from interp.runtime.core import TARGET_OUTSIDE_NOTE
 from krl.files import SHARED_CORPUS as DEFAULT_CORPUS
 from krl.project import backup_of, find_backups, system_folder
 
@@ -91,13 +93,25 @@ def row_from_trace(program: Path, events: list[dict]) -> dict:
     ends = [e for e in events if e.get("kind") == "end"]
     end = ends[-1] if ends else {}
     cell = [e["t"] for e in events if e.get("kind") == "io" and str(e.get("source", "")).startswith("cell")]
+    robots = [e for e in events if e.get("kind") == "robot"]
     row = {"program": str(program), "reason": end.get("reason", "internal"), "text": end.get("text") or "",
            "file": end.get("file"), "line": end.get("line"), "sim_time": end.get("t", 0.0),
-           "cell_answers": len(cell), "cell_last": max(cell) if cell else None}
+           "cell_answers": len(cell), "cell_last": max(cell) if cell else None,
+           "robot_own": bool(robots) and _own_machine_data(program, robots[0].get("source"))}
     if row["reason"] == "program_end":
         row["reason"] = "completed"
     row["cause"] = cause_of(row)
     return row
+
+
+def _own_machine_data(program: Path, source) -> bool:
+    """True when `source` (the ``robot`` trace event's) is the machine data of the backup
+    holding `program`: the run simulated the backup's own robot."""
+    from krl.project import machine_data_file  # noqa: PLC0415
+
+    root = backup_of(Path(program).resolve())
+    f = machine_data_file(root) if root is not None else None
+    return f is not None and source is not None and Path(str(source)).resolve() == f.resolve()
 
 
 def cause_of(row: dict) -> str:
@@ -111,7 +125,7 @@ def cause_of(row: dict) -> str:
         return "interpreter gap"
     if reason == "error":
         text = (row.get("text") or "").lower()
-        if row.get("robot_own") and row.get("target_outside") and any(m in text for m in REACH_MESSAGES):
+        if row.get("robot_own") and TARGET_OUTSIDE_NOTE.lower() in text and any(m in text for m in REACH_MESSAGES):
             return "program error"
         return "interpreter gap" if any(g.lower() in text for g in GAP_MESSAGES) else "program error"
     last = row.get("cell_last")
@@ -214,11 +228,6 @@ def run_one(path: Path, max_sim_time: float, max_steps: int, cell: Path | None =
            "cell": str(cell) if cell else None, "cell_answers": sum(r.fired for r in rules),
            "cell_last": round(max(fired), 3) if fired else None,
            "robot": robot.name, "robot_own": own is not None}
-    refused = rt.controller.refused
-    if res.reason == "error" and refused is not None and (refused.file, refused.line) == (res.file, res.line) \
-            and any(m in (res.text or "") for m in REACH_MESSAGES):
-        # the motion statement the run stopped at could not be planned: is its target itself out?
-        row["target_outside"] = rt.controller.target_outside_limits(refused)
     row["cause"] = cause_of(row)
     return row
 

@@ -193,7 +193,6 @@ class Controller:
         io: the :class:`~robot.io.IOImage`.
         dt: IPO cycle in s (0.012).
         last_error: the last :class:`RobotError` of the main run, or None.
-        refused: the last :class:`MotionRequest` that :meth:`enqueue` could not plan, or None.
     """
 
     def __init__(self, machine: MachineData | None = None, *, trace: TraceWriter | None = None,
@@ -243,7 +242,6 @@ class Controller:
         self._blend: _Blend | None = None
         self._tracked: list[_Run] = []  # runs with unfired triggers
         self._next_id = 1
-        self.refused: MotionRequest | None = None   # the last request enqueue could not plan
         self._events: list[Event] = []
         self._pulses: list[tuple[float, int, bool]] = []
         self._cyclic: dict[int, Callable[["Controller"], None]] = {}
@@ -292,11 +290,7 @@ class Controller:
         space: check :meth:`can_enqueue` first.
         """
         req.id = self._next_id
-        try:
-            seg = plan(req, self._plan_q, self.model, first=self.strict_bco and not self._bco_done)
-        except RobotError:
-            self.refused = req
-            raise
+        seg = plan(req, self._plan_q, self.model, first=self.strict_bco and not self._bco_done)
         self._next_id += 1
         self._bco_done = True
         self._pending.append(seg)

@@ -398,3 +398,33 @@ def test_machine_data_signal_wiring_is_no_value(tmp_path):
         assert [rt.controller.io.get_out(n) for n in (1, 2, 3)] == [True, True, True], interp
         events.append(tw.events)
     assert events[0] == events[1]
+
+
+def test_a_target_out_of_the_robots_limits_says_so(tmp_path):
+    """A LIN to the pose of {0,-90,90,0,125,0} (KR 6 R900: A5 within +-120; every configuration
+    of that pose has |A5| >= 125, tests/robot/test_controller.py) is refused at planning with
+    the note that the target itself is out; a PTP to A1 200 (limit 170) is an axis target: the
+    plain message."""
+    from interp.runtime.core import TARGET_OUTSIDE_NOTE
+    from robot.frames import matrix_to_frame
+    from robot.kinematics import Kinematics
+
+    x, y, z, a, b, c = matrix_to_frame(Kinematics().forward([0, -90, 90, 0, 125, 0]))
+    src = f"""
+    DEF prog()
+      PTP {{A1 0, A2 -90, A3 90, A4 0, A5 0, A6 0}}
+      LIN {{X {x:.4f}, Y {y:.4f}, Z {z:.4f}, A {a:.4f}, B {b:.4f}, C {c:.4f}}}
+    END
+    """
+    for run in both(tmp_path, src):
+        assert (run.result.reason, run.result.line) == ("error", 3)
+        # A5 past +120 or -120, as the configuration the planner tries: the sign is its choice
+        assert run.result.text in (f"software limit switch {s}A5 ({TARGET_OUTSIDE_NOTE})" for s in "+-")
+    src = """
+    DEF prog()
+      PTP {A1 0, A2 -90, A3 90, A4 0, A5 0, A6 0}
+      PTP {A1 200}
+    END
+    """
+    for run in both(tmp_path, src):
+        assert (run.result.reason, run.result.text) == ("error", "software limit switch +A1")

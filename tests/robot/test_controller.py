@@ -377,12 +377,3 @@ def test_target_outside_limits_is_the_target_no_configuration_reaches():
     assert not ctl.target_outside_limits(MotionRequest("PTP", {"A1": 500}, MotionParams()))  # axis target
     assert not ctl.target_outside_limits(MotionRequest("LIN", {"X": 5000}, MotionParams()))  # partial
 
-
-def test_enqueue_keeps_the_refused_request():
-    ctl, _ = _ctl()
-    ctl.enqueue(MotionRequest("PTP", HOME, MotionParams()))
-    assert ctl.refused is None
-    req = _lin_to_pose_of(ctl, [0, -90, 90, 0, 125, 0])
-    with pytest.raises(RobotError, match="software limit switch"):
-        ctl.enqueue(req)
-    assert ctl.refused is req
