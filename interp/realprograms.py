@@ -5,7 +5,10 @@ A *backup* is a folder with ``R1/System`` (or a flat export with ``System/$confi
 *programs* are the ``.src`` files under its Program folders (and ``cell.src``) whose main
 routine takes no parameters. Each runs on the tree interpreter with the backup's own
 System folder (BASIS, ``$config.dat``), its cell file (:func:`cell_of`: the committed
-``corpus/cells``; ``--no-cells`` runs without), ``--max-sim-time`` 60 s and 300 000 steps.
+``corpus/cells``; ``--no-cells`` runs without), ``--max-sim-time`` 60 s and 300 000 steps of
+the program's own, beside its SPS.SUB: the steps a submit program may take within the time
+limit are added to the step limit (:func:`step_limit`), so a submit cycling at its budget does
+not end the run before its time.
 
 Every stop gets one *cause* (:func:`cause_of`, issue 22 "Every stop explained"):
 
@@ -13,10 +16,16 @@ Every stop gets one *cause* (:func:`cause_of`, issue 22 "Every stop explained"):
 * ``intended end``: the program's own ``HALT``, or a cycle loop stopped by the time or step
   limit while the cell answers it (a rule of the cell file wrote an input in the last quarter
   of the run: the cycle was still running);
-* ``program error``: a KRL run-time error of the program, at its file:line;
+* ``program error``: a KRL run-time error of the program, at its file:line; also a motion
+  whose target the backup's own robot cannot take (the run simulates the robot of the
+  backup's ``$machine.dat``, and no axis configuration of the target — any status, turn,
+  ±360° variant — lies within that machine data's software limits,
+  ``Controller.target_outside_limits``; the error says so, interp/runtime/core.py
+  ``TARGET_OUTSIDE_NOTE``): the real controller of that robot refuses it too;
 * ``interpreter gap``: an error that is the simulator's (:data:`GAP_MESSAGES`: a feature not
-  simulated; a target, a CP path or an axis range the simulated KR 6 R900 cannot follow — the
-  backup's own robot is another),
+  simulated; a target, a CP path or an axis range the simulated robot cannot follow when it is
+  not the backup's own — the KR 6 R900 of a backup without machine data — or when only the
+  path, not the target, leaves the limits),
   or an internal error;
 * ``limit``: the time or step limit (or a deadlock) with no cell answering: the program starves
   for an input (named by the stop text, "waits: WAIT FOR ...") or loops on its own.
@@ -34,12 +43,14 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import re
 import sys
 import time
 from collections import Counter
 from pathlib import Path
 
+from interp.runtime.core import TARGET_OUTSIDE_NOTE
 from krl.files import SHARED_CORPUS as DEFAULT_CORPUS
 from krl.project import backup_of, find_backups, system_folder
 
@@ -52,6 +63,10 @@ CAUSES = ("completed", "intended end", "program error", "interpreter gap", "limi
 GAP_MESSAGES = ("target not reachable", "through a singularity", "software limit switch",
                 "not supported", "unsupported", "not simulated",
                 "not implemented", "internal error")
+
+#: errors of a motion the robot cannot follow: the program's when the robot is the backup's own
+#: and the target itself is out of its limits (:func:`cause_of`)
+REACH_MESSAGES = ("target not reachable", "software limit switch")
 
 #: the committed cell files of the corpus backups (issue 22)
 CELLS = Path(__file__).resolve().parent.parent / "corpus" / "cells"
@@ -78,13 +93,25 @@ def row_from_trace(program: Path, events: list[dict]) -> dict:
     ends = [e for e in events if e.get("kind") == "end"]
     end = ends[-1] if ends else {}
     cell = [e["t"] for e in events if e.get("kind") == "io" and str(e.get("source", "")).startswith("cell")]
+    robots = [e for e in events if e.get("kind") == "robot"]
     row = {"program": str(program), "reason": end.get("reason", "internal"), "text": end.get("text") or "",
            "file": end.get("file"), "line": end.get("line"), "sim_time": end.get("t", 0.0),
-           "cell_answers": len(cell), "cell_last": max(cell) if cell else None}
+           "cell_answers": len(cell), "cell_last": max(cell) if cell else None,
+           "robot_own": bool(robots) and _own_machine_data(program, robots[0].get("source"))}
     if row["reason"] == "program_end":
         row["reason"] = "completed"
     row["cause"] = cause_of(row)
     return row
+
+
+def _own_machine_data(program: Path, source) -> bool:
+    """True when `source` (the ``robot`` trace event's) is the machine data of the backup
+    holding `program`: the run simulated the backup's own robot."""
+    from krl.project import machine_data_file  # noqa: PLC0415
+
+    root = backup_of(Path(program).resolve())
+    f = machine_data_file(root) if root is not None else None
+    return f is not None and source is not None and Path(str(source)).resolve() == f.resolve()
 
 
 def cause_of(row: dict) -> str:
@@ -98,6 +125,8 @@ def cause_of(row: dict) -> str:
         return "interpreter gap"
     if reason == "error":
         text = (row.get("text") or "").lower()
+        if row.get("robot_own") and TARGET_OUTSIDE_NOTE.lower() in text and any(m in text for m in REACH_MESSAGES):
+            return "program error"
         return "interpreter gap" if any(g.lower() in text for g in GAP_MESSAGES) else "program error"
     last = row.get("cell_last")
     t = row.get("sim_time") or 0.0
@@ -151,16 +180,36 @@ def submit_of(path: Path) -> list[Path]:
     return []
 
 
+def step_limit(max_steps: int, max_sim_time: float, n_submits: int, ipo_cycle_s: float) -> int:
+    """The step limit of a run: `max_steps` for the program, plus the statements its
+    `n_submits` submit programs may execute within `max_sim_time` s — each at most
+    ``SUBMIT_BUDGET`` (interp/runtime/scheduler.py) per IPO cycle of `ipo_cycle_s` s. A submit
+    program is an endless cyclic loop by design (reference §9): its steps say nothing of the
+    robot program looping, and counted against `max_steps` they would end a run with an SPS.SUB
+    (100 statements per 12 ms cycle: 300 000 steps in 36 s) before its time limit."""
+    from interp.runtime.scheduler import SUBMIT_BUDGET  # noqa: PLC0415
+
+    cycles = math.ceil(max_sim_time / ipo_cycle_s) + 1
+    return max_steps + n_submits * SUBMIT_BUDGET * cycles
+
+
 def run_one(path: Path, max_sim_time: float, max_steps: int, cell: Path | None = None) -> dict:
     from interp.run import make_runtime  # noqa: PLC0415
+    from robot.machine import load_machine  # noqa: PLC0415
+    from robot.mada import robot_of_backup  # noqa: PLC0415
     from robot.trace import TraceWriter  # noqa: PLC0415
 
     t0 = time.time()
     tw = TraceWriter(keep=False)
     try:
+        root = backup_of(path.resolve())
+        own = robot_of_backup(root) if root is not None else None   # interp.run.robot_for
+        robot = own if own is not None else load_machine()
+        submit = submit_of(path)
+        limit = step_limit(max_steps, max_sim_time, len(submit), robot.ipo_cycle_s)
         # --no-check: the report says how each real program runs, also those the checker rejects
-        rt, _ = make_runtime(path, trace=None, mujoco=False, max_sim_time=max_sim_time, max_steps=max_steps,
-                             submit=submit_of(path), check=False, inputs=cell)
+        rt, _ = make_runtime(path, trace=None, mujoco=False, max_sim_time=max_sim_time, max_steps=limit,
+                             submit=submit, check=False, inputs=cell, robot=robot)
         res = rt.run()
         stubs = sorted(rt.program.stubs)
         rules = rt.controller.rules
@@ -177,7 +226,8 @@ def run_one(path: Path, max_sim_time: float, max_steps: int, cell: Path | None =
            "steps": res.steps, "stubs": stubs, "submit": submit_errors(rt),
            "seconds": round(time.time() - t0, 2),
            "cell": str(cell) if cell else None, "cell_answers": sum(r.fired for r in rules),
-           "cell_last": round(max(fired), 3) if fired else None}
+           "cell_last": round(max(fired), 3) if fired else None,
+           "robot": robot.name, "robot_own": own is not None}
     row["cause"] = cause_of(row)
     return row
 

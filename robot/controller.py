@@ -299,6 +299,28 @@ class Controller:
             self._moved_while_held = True
         return req.id
 
+    def target_outside_limits(self, req: MotionRequest) -> bool:
+        """True when the target of `req` is itself out of this robot's reach: an absolute
+        Cartesian target with X, Y, Z, A, B, C in ``$BASE``/``$TOOL`` (``$IPO_MODE #BASE``) for
+        which no axis configuration — any of the analytic solutions, any status and turn,
+        each axis with its ±360° variants — lies within ``$SOFTN_END``/``$SOFTP_END``. Then no
+        path and no S/T of the program reaches it: the robot of this machine data cannot take
+        that pose. False for any other request (an axis target, a relative or partial one,
+        ``#TCP``), or when some configuration is within the limits."""
+        p = req.params
+        keys = ("X", "Y", "Z", "A", "B", "C")
+        if req.relative or req.is_axis_target or p.ipo_mode != "BASE" or \
+                not all(k in req.target for k in keys):
+            return False
+        flange = (inv_pos(self.model.robroot_T) @ frame_to_matrix(*p.base)
+                  @ frame_to_matrix(*(float(req.target[k]) for k in keys)) @ inv_pos(frame_to_matrix(*p.tool)))
+        limits = [j.limit_deg for j in self.machine.joints[:6]]
+        for q in self.model.kin.solutions(flange):
+            if all(any(lo <= v + k <= hi for k in (-720.0, -360.0, 0.0, 360.0, 720.0))
+                   for v, (lo, hi) in zip(q, limits)):
+                return False
+        return True
+
     def last_planned(self):
         """The Segment (robot.planner) that :meth:`enqueue` planned last (for the motion
         history of backward motion, interp/runtime/runmode.py)."""

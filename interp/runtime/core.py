@@ -55,6 +55,22 @@ def _scalar(t) -> bool:
     return isinstance(t, (T.Simple, T.Enum)) and t is not T.UNKNOWN
 
 
+#: appended to a workspace or software-limit error whose motion target itself is out of the
+#: simulated robot's limits in every configuration (robot/controller.py target_outside_limits)
+TARGET_OUTSIDE_NOTE = "the target itself: no axis configuration of this robot reaches it within its software limits"
+
+
+def reach_message(ctl, req, err) -> str:
+    """The message of a motion `req` the controller `ctl` refused with `err`: a workspace or
+    software-limit error says so when the target itself is out of the robot's limits in
+    every configuration (not only on the way there, or with the program's S/T)."""
+    from robot.errors import SoftLimitError, WorkspaceError  # noqa: PLC0415
+
+    if isinstance(err, (SoftLimitError, WorkspaceError)) and ctl.target_outside_limits(req):
+        return f"{err.message} ({TARGET_OUTSIDE_NOTE})"
+    return err.message
+
+
 class Runtime:
     """Shared runtime of one run.
 
@@ -896,7 +912,7 @@ class Runtime:
         try:
             mid = ctl.enqueue(req)
         except RobotError as e:
-            raise KrlRuntimeError(e.message, e.number) from None
+            raise KrlRuntimeError(reach_message(ctl, req, e), e.number) from None
         self.history.record(req, ctl.last_planned())
         if self.run_mode in STEP_MODES:
             # the advance run does not pass the motion: the next statement is read when it ends

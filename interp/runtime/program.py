@@ -368,9 +368,16 @@ class Program:
 
     def _machine_data(self, key: str, ref) -> None:
         """A machine data list (Mada) declares a system variable of the tables: the system
-        variable takes its value (the data list only initialises it)."""
+        variable takes its value (the data list only initialises it).
+
+        A SIGNAL of the machine data that wires a system signal to an input or output
+        (``SIGNAL $I_O_ACT $IN[11]`` in ``STEU/Mada/$machine.dat``) is no value: the state of
+        that I/O at load time (FALSE) is not the system variable's value, and the wiring is
+        not simulated (docs/robot.md "Presets": ``$I_O_ACT``, ``$MOVE_ENABLE``, ``$USER_SAF``
+        keep their boot values). ``SIGNAL $X FALSE`` (a signal permanently FALSE) is a value
+        and is taken."""
         sv = self.rt.sysvars
-        if key not in sv.store:
+        if key not in sv.store or isinstance(ref, SignalRef):
             return
         try:
             v = ref.peek()

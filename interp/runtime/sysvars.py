@@ -168,6 +168,11 @@ class SysVars:
         s["$H_POS"] = axis_struct(m.home_deg)
         for i in range(5):
             s["$AXIS_HOME"].data[i] = axis_struct(m.home_deg)
+        # the home windows: 2 deg per axis, the value of every backup's $machine.dat
+        # (shared/docs/robot-model.md "HOME"); a backup's Mada sets its own
+        s["$H_POS_TOL"] = axis_struct([HOME_TOL_DEG] * 6)
+        for i in range(5):
+            s["$H_AXIS_TOL"].data[i] = axis_struct([HOME_TOL_DEG] * 6)
         self.robot_values()
 
     #: The system variables that name the simulated robot (issue 22): they always hold the
@@ -375,6 +380,32 @@ def _ro_const(v):
     return lambda sv: v
 
 
+#: the default window of ``$IN_HOME``/``$IN_HOME1..5`` (``$H_POS_TOL``, ``$H_AXIS_TOL[n]``), deg
+HOME_TOL_DEG = 2.0
+
+
+def _in_home(n: int):
+    """``$IN_HOME`` (`n` = 0) or ``$IN_HOME1..5`` (`n` = 1..5): TRUE while every robot axis
+    A1..A6 stands within the window of the home position — ``|$AXIS_ACT.Ai - $H_POS.Ai| <=
+    $H_POS_TOL.Ai`` (deg), for ``$IN_HOMEn`` ``$AXIS_HOME[n]`` and ``$H_AXIS_TOL[n]`` (KUKA
+    System Variables, KSS 8.x: "$IN_HOME: robot in the home position, the position window
+    defined by $H_POS and $H_POS_TOL"). The external axes are not simulated and not compared.
+    A home position or window with an unset component gives FALSE."""
+    def value(sv: SysVars) -> bool:
+        s = sv.store
+        if n == 0:
+            home, tol = s["$H_POS"], s["$H_POS_TOL"]
+        else:
+            home, tol = s["$AXIS_HOME"].data[n - 1], s["$H_AXIS_TOL"].data[n - 1]
+        q = sv.rt.controller.axis_act()
+        try:
+            return all(abs(float(q[i]) - float(home.f[k])) <= float(tol.f[k])
+                       for i, k in enumerate(E6AXIS_KEYS[:6]))
+        except (TypeError, ValueError):     # an UNSET component
+            return False
+    return value
+
+
 _LIVE = {
     "$IN": _io("$IN"), "$OUT": _io("$OUT"), "$ANIN": _io("$ANIN"), "$ANOUT": _io("$ANOUT"),
     "$TIMER": _io("$TIMER"), "$TIMER_STOP": _io("$TIMER_STOP"), "$TIMER_FLAG": _io("$TIMER_FLAG"),
@@ -409,8 +440,12 @@ _LIVE = {
     "$EX_AX_NUM": _computed(_ro_const(0)),
     "$PERI_RDY": _computed(_ro_const(True)),
     "$ROB_CAL": _computed(_ro_const(True)),
-    "$IN_HOME": _computed(_ro_const(False)),
-    "$IN_HOME1": _computed(_ro_const(False)),
+    "$IN_HOME": _computed(_in_home(0)),
+    "$IN_HOME1": _computed(_in_home(1)),
+    "$IN_HOME2": _computed(_in_home(2)),
+    "$IN_HOME3": _computed(_in_home(3)),
+    "$IN_HOME4": _computed(_in_home(4)),
+    "$IN_HOME5": _computed(_in_home(5)),
     "$NEAR_POSRET": _computed(_ro_const(False)),
     "$ROBRUNTIME": _computed(lambda sv: int(sv.rt.controller.time / 60)),
 }

@@ -48,6 +48,48 @@ def test_every_stop_gets_one_cause():
     # the cell answered once at the start, then the program starved: a limit
     assert cause_of({"reason": "max_steps", "sim_time": 60.0, "cell_answers": 6, "cell_last": 2.0}) == "limit"
     assert cause_of({"reason": "max_sim_time", "sim_time": 60.0, "cell_answers": 0}) == "limit"
+    # a target the backup's own robot cannot take in any configuration: the program's error;
+    # on another robot (a backup without machine data), or when only the path is out: a gap
+    note = f" ({rp.TARGET_OUTSIDE_NOTE})"
+    own = {"reason": "error", "text": "software limit switch -A5" + note, "robot_own": True}
+    assert cause_of(own) == "program error"
+    assert cause_of({**own, "robot_own": False}) == "interpreter gap"
+    assert cause_of({**own, "text": "software limit switch -A5"}) == "interpreter gap"   # the path only
+    assert cause_of({**own, "text": "workspace error: target not reachable" + note}) == "program error"
+    assert cause_of({**own, "text": "LIN through a singularity"}) == "interpreter gap"
+
+
+def test_step_limit_leaves_the_submit_its_cycles():
+    """A submit program runs at most SUBMIT_BUDGET (100) statements per 12 ms IPO cycle:
+    within 60 s, 5000 cycles (+1 for the last partial one) of 100 steps each."""
+    assert rp.step_limit(300_000, 60.0, 0, 0.012) == 300_000
+    assert rp.step_limit(300_000, 60.0, 1, 0.012) == 300_000 + 100 * 5001
+    assert rp.step_limit(300_000, 60.0, 2, 0.012) == 300_000 + 2 * 100 * 5001
+
+
+def test_block_calibration_target_is_out_of_its_own_robots_limits(tmp_path):
+    """HugoDanielson__ChinaMilling BlockCalibration: Get3Basepoints.src:21 LIN
+    gfStartMeasPoint[1]:{X -15,Y 0,Z 55} in BASE_DATA[2] with TOOL_DATA[2] (BlockCalibration.src:15-24)
+    asks the KR210 R2700-2 of its $machine.dat for a pose whose 8 configurations all leave
+    its soft limits (A5 +-129.2 or +-137.3 past +-125, or A2 past -140..-5): the program's error."""
+    p = (rp.DEFAULT_CORPUS / "HugoDanielson__ChinaMilling/KRC/R1/Program/KukaMiling/Subprogs/BaseCalib"
+         / "BlockCalibration.src")
+    row = rp.run_one(p, 60.0, 300_000, rp.cell_of(p))
+    assert (row["reason"], Path(row["file"]).name, row["line"]) == ("error", "Get3Basepoints.src", 21)
+    assert row["text"] == f"software limit switch -A5 ({rp.TARGET_OUTSIDE_NOTE})"
+    assert row["robot_own"] and row["cause"] == "program error"
+    # the conformance report's row, from the trace of `krl run`, says the same
+    import json
+
+    from click.testing import CliRunner
+
+    from krl.cli import main
+
+    trace = tmp_path / "trace.jsonl"
+    CliRunner().invoke(main, ["run", str(p), "--no-check", "--max-sim-time", "5", "--trace", str(trace),
+                              "--inputs", str(rp.cell_of(p))])
+    trow = rp.row_from_trace(p, [json.loads(x) for x in trace.read_text().splitlines()])
+    assert trow["robot_own"] and (trow["line"], trow["cause"]) == (21, "program error")
 
 
 def test_committed_cell_files_load_and_are_found():

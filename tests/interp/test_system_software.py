@@ -325,3 +325,106 @@ def test_inverse_gives_the_axes_of_a_pose_and_a_status_when_out_of_reach(tmp_pat
         far = run.var("prog", "far")
         assert run.var("prog", "st2") == 3
         assert [far.f[k] for k in ("A1", "A2", "A3")] == [10.0, -80.0, 80.0]
+
+
+# ------------------------------------------------------------------ $IN_HOME, machine-data signals
+
+HOME_PROG = """
+DEF prog()
+  $OUT[1] = $IN_HOME                 ; the KR 6 starts at $H_POS = $AXIS_HOME[1] = {0,-90,90,0,0,0}
+  $OUT[2] = $IN_HOME1
+  PTP {A1 1.5, A2 -90, A3 90, A4 0, A5 0, A6 0}   ; a complete first target (BCO)
+  WAIT SEC 0                         ; the advance run waits: $IN_HOME reads the robot at rest
+  $OUT[3] = $IN_HOME                 ; 1.5 deg off, within $H_POS_TOL = 2 deg
+  PTP {A1 -2.5}
+  WAIT SEC 0
+  $OUT[4] = $IN_HOME                 ; 2.5 deg off: outside
+  $OUT[5] = $IN_HOME3                ; $AXIS_HOME[3] with $H_AXIS_TOL[3] = 2 deg: outside
+  $H_POS_TOL.A1 = 3.0
+  $OUT[6] = $IN_HOME                 ; the window is 3 deg now
+  $H_AXIS_TOL[3].A1 = 2.6
+  $OUT[7] = $IN_HOME3
+  $H_POS.A1 = -2.5
+  $H_POS_TOL.A1 = 0.1
+  $OUT[8] = $IN_HOME                 ; the home position moved to the robot
+  $H_POS.A5 = 10.0
+  $OUT[9] = $IN_HOME                 ; every axis counts: A5 is 10 deg off
+END
+"""
+
+
+def test_in_home_is_the_robot_within_the_home_window(tmp_path):
+    """$IN_HOME: |$AXIS_ACT.Ai - $H_POS.Ai| <= $H_POS_TOL.Ai for A1..A6; $IN_HOMEn the same
+    with $AXIS_HOME[n] and $H_AXIS_TOL[n] (2 deg by default, every backup's machine data)."""
+    for run in both(tmp_path, HOME_PROG):
+        assert run.result.reason == "completed", run.result.text
+        got = {n: [v for _, v in run.io(f"$OUT[{n}]")] for n in range(1, 10)}
+        assert got == {1: [True], 2: [True], 3: [True], 4: [], 5: [], 6: [True], 7: [True],
+                       8: [True], 9: []}, got
+
+
+def _steu_backup(tmp: Path) -> Path:
+    """A backup whose STEU/Mada/$machine.dat wires system signals to I/O, as KUKA's does
+    (HugoDanielson__ChinaMilling/KRC/STEU/Mada/$machine.dat:20-89)."""
+    prog = _backup(tmp, """
+    DEF prog()
+      $OUT[1] = $I_O_ACT
+      $OUT[2] = $I_O_ACTCONF
+      $OUT[3] = $MOVE_ENABLE
+    END
+    """)
+    (tmp / "STEU" / "Mada").mkdir(parents=True)
+    write(tmp, "STEU/Mada/$machine.dat", """
+    DEFDAT $MACHINE PUBLIC
+    SIGNAL $MOVE_ENABLE $IN[13] ;FAHRFREIGABE GESAMT
+    SIGNAL $I_O_ACTCONF $OUT[15] ;E/A-SCHNITTSTELLE AKTIV QUITTUNG
+    SIGNAL $I_O_ACT $IN[11] ;E/A-SCHNITTSTELLE AKTIV
+    ENDDAT
+    """)
+    return prog
+
+
+def test_machine_data_signal_wiring_is_no_value(tmp_path):
+    """`SIGNAL $I_O_ACT $IN[11]` of the machine data does not copy the input's state at load
+    time (FALSE) into $I_O_ACT: the system signals keep their boot values (TRUE), so in
+    Automatic External $I_O_ACTCONF is TRUE (docs/robot.md, Presets)."""
+    prog = _steu_backup(tmp_path)
+    events = []
+    for interp in INTERPS:
+        tw = TraceWriter(keep=True)
+        rt, _ = make_runtime(prog, trace=tw, mujoco=False, check=False, interp=interp, mode="EXT")
+        res = rt.run()
+        assert res.reason == "completed", res.text
+        assert [rt.controller.io.get_out(n) for n in (1, 2, 3)] == [True, True, True], interp
+        events.append(tw.events)
+    assert events[0] == events[1]
+
+
+def test_a_target_out_of_the_robots_limits_says_so(tmp_path):
+    """A LIN to the pose of {0,-90,90,0,125,0} (KR 6 R900: A5 within +-120; every configuration
+    of that pose has |A5| >= 125, tests/robot/test_controller.py) is refused at planning with
+    the note that the target itself is out; a PTP to A1 200 (limit 170) is an axis target: the
+    plain message."""
+    from interp.runtime.core import TARGET_OUTSIDE_NOTE
+    from robot.frames import matrix_to_frame
+    from robot.kinematics import Kinematics
+
+    x, y, z, a, b, c = matrix_to_frame(Kinematics().forward([0, -90, 90, 0, 125, 0]))
+    src = f"""
+    DEF prog()
+      PTP {{A1 0, A2 -90, A3 90, A4 0, A5 0, A6 0}}
+      LIN {{X {x:.4f}, Y {y:.4f}, Z {z:.4f}, A {a:.4f}, B {b:.4f}, C {c:.4f}}}
+    END
+    """
+    for run in both(tmp_path, src):
+        assert (run.result.reason, run.result.line) == ("error", 3)
+        # A5 past +120 or -120, as the configuration the planner tries: the sign is its choice
+        assert run.result.text in (f"software limit switch {s}A5 ({TARGET_OUTSIDE_NOTE})" for s in "+-")
+    src = """
+    DEF prog()
+      PTP {A1 0, A2 -90, A3 90, A4 0, A5 0, A6 0}
+      PTP {A1 200}
+    END
+    """
+    for run in both(tmp_path, src):
+        assert (run.result.reason, run.result.text) == ("error", "software limit switch +A1")

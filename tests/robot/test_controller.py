@@ -353,3 +353,27 @@ def test_public_state_queries():
     assert c2.is_suspended()
     c2.cancel_pending()
     assert not c2.is_suspended()
+
+
+# ------------------------------------------------------------------ a target out of the robot's limits
+def _lin_to_pose_of(ctl, axes):
+    from robot.frames import matrix_to_frame
+
+    pose = matrix_to_frame(ctl.model.kin.forward(axes))      # $TOOL = $BASE = $NULLFRAME
+    return MotionRequest("LIN", dict(zip("XYZABC", pose)), MotionParams())
+
+
+def test_target_outside_limits_is_the_target_no_configuration_reaches():
+    """KR 6 R900: A5 within -120..120. The pose of {0,-90,90,0,125,0} has 8 analytic
+    configurations whose A5 is +-125, +-145.7, +-143.0, +-134.9: none within the limits. The
+    pose of {..., A5 119} is reachable (that very configuration); the pose of
+    {30,-60,100,0,-130,0} too, by another one (A1 -150, A5 116.8)."""
+    ctl, _ = _ctl()
+    assert ctl.target_outside_limits(_lin_to_pose_of(ctl, [0, -90, 90, 0, 125, 0]))
+    assert not ctl.target_outside_limits(_lin_to_pose_of(ctl, [0, -90, 90, 0, 119, 0]))
+    assert not ctl.target_outside_limits(_lin_to_pose_of(ctl, [30, -60, 100, 0, -130, 0]))
+    far = MotionRequest("LIN", {"X": 5000, "Y": 0, "Z": 0, "A": 0, "B": 0, "C": 0}, MotionParams())
+    assert ctl.target_outside_limits(far)                      # out of reach
+    assert not ctl.target_outside_limits(MotionRequest("PTP", {"A1": 500}, MotionParams()))  # axis target
+    assert not ctl.target_outside_limits(MotionRequest("LIN", {"X": 5000}, MotionParams()))  # partial
+
