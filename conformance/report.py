@@ -128,7 +128,8 @@ def run_real(corpus: Path = DEFAULT_CORPUS, interps: list[str] | None = None, *,
         except Exception:  # noqa: BLE001 - no submit program then
             subs = []
         for it in interps:
-            res = H.run_program(prog, it, workspace=None, max_sim_time=max_sim_time, stimuli=cell,
+            res = H.run_program(prog, it, workspace=None, max_sim_time=R.time_limit(prog, cell, max_sim_time),
+                                stimuli=cell,
                                 max_steps=max_steps, submit=subs[0] if subs else None,
                                 wall_timeout=300.0, check=False)
             runs[it] = res

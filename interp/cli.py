@@ -24,7 +24,9 @@ import click
 @click.option("--max-steps", type=int, default=10_000_000, show_default=True,
               help="Limit of executed statements and loop iterations.")
 @click.option("--submit", "submit", type=click.Path(path_type=Path), multiple=True,
-              help="A submit program (.sub) to run beside the robot program (repeatable).")
+              help="A submit program (.sub) to run beside the robot program (repeatable). Default: "
+                   "in a KRC backup, its SPS.SUB, as the controller starts it at boot.")
+@click.option("--no-submit", is_flag=True, help="Run without the backup's SPS.SUB.")
 @click.option("--mode", "mode", type=click.Choice(["T1", "T2", "AUT", "EXT"], case_sensitive=False),
               default=None,
               help="Operating mode ($MODE_OP): T1 limits TCP and flange to 250 mm/s and PTP to "
@@ -48,7 +50,7 @@ import click
                    "(default: the robot the --inputs cell file names, else the backup's own robot from its "
                    "R1/Mada/$machine.dat, else the KR 6 R900).")
 def run(program: Path, interp_kind: str, workspace, inputs, trace_path, max_sim_time, max_steps, submit,
-        mode, run_mode, pgno, no_check, robot) -> None:
+        mode, run_mode, pgno, no_check, robot, no_submit) -> None:
     """Run PROGRAM (.src) on the simulated KR C4; print where and why it ended.
 
     With --workspace BACKUP.zip (a KRC backup archive) PROGRAM is a path inside the archive
@@ -71,13 +73,13 @@ def run(program: Path, interp_kind: str, workspace, inputs, trace_path, max_sim_
                     sys.exit(2)
                 _run(found, folder, inputs, trace_path, max_sim_time, max_steps, submit, interp_kind,
                      mode=mode, shown=lambda text: text.replace(str(folder), str(workspace)), check=not no_check,
-                     run_mode=run_mode, pgno=pgno, robot=robot)
+                     run_mode=run_mode, pgno=pgno, robot=robot, auto_submit=not no_submit)
         except ArchiveError as exc:
             click.echo(f"error: {printable(exc)}", err=True)
             sys.exit(2)
         return
     _run(program, workspace, inputs, trace_path, max_sim_time, max_steps, submit, interp_kind, mode=mode,
-         check=not no_check, run_mode=run_mode, pgno=pgno, robot=robot)
+         check=not no_check, run_mode=run_mode, pgno=pgno, robot=robot, auto_submit=not no_submit)
 
 
 def program_in(folder: Path, program: Path) -> Path | None:
@@ -99,10 +101,24 @@ def program_in(folder: Path, program: Path) -> Path | None:
 
 def _run(program: Path, workspace, inputs, trace_path, max_sim_time, max_steps, submit, interp_kind,
          mode=None, shown=lambda text: text, check: bool = True, run_mode: str = "GO",
-         pgno: int | None = None, robot=None) -> None:
+         pgno: int | None = None, robot=None, auto_submit: bool = False) -> None:
     if not program.exists():
         click.echo(f"error: {program}: no such file", err=True)
         sys.exit(2)
+    for sub in submit:
+        if not Path(sub).is_file():
+            click.echo(f"error: {shown(str(sub))}: no such submit program", err=True)
+            sys.exit(2)
+    booted = None
+    if not submit and auto_submit:
+        from krl.project import backup_of, submit_program  # noqa: PLC0415
+
+        root = backup_of(program.resolve(), Path(workspace).resolve() if workspace else None)
+        booted = submit_program(root) if root is not None else None
+        if booted is not None and booted.resolve() != program.resolve():
+            submit = (booted,)
+        else:
+            booted = None
     from interp.run import make_runtime, robot_for  # noqa: PLC0415
     from interp.summary import RunObserver, starvation_lines, summary_lines  # noqa: PLC0415
     from robot.mada import MachineDataError  # noqa: PLC0415
@@ -154,6 +170,8 @@ def _run(program: Path, workspace, inputs, trace_path, max_sim_time, max_steps, 
                               workspace=ws_note, starving=starvation_lines(rt),
                               robot=f"{machine.name} ({machine.source})"):
         click.echo(shown(line))
+        if booted is not None and line.startswith("  workspace"):
+            click.echo(shown(f"  submit     {booted} (the backup's, started as at boot; --no-submit: without)"))
     sys.exit(res.exit_code)
 
 

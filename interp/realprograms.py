@@ -167,17 +167,13 @@ def normalise(text: str) -> str:
 
 
 def submit_of(path: Path) -> list[Path]:
-    """The backup's SPS.SUB (R1/SPS.SUB or System/sps.sub): started beside the program as
-    the controller does at boot (reference §9)."""
+    """The backup's SPS.SUB (krl.project.submit_program), started beside the program as
+    the controller does at boot (reference §9); empty outside a backup."""
+    from krl.project import submit_program  # noqa: PLC0415
+
     root = backup_of(path.resolve())
-    sysdir = system_folder(root) if root is not None else None
-    if sysdir is None:
-        return []
-    for d in (sysdir.parent, sysdir):
-        for p in d.iterdir():
-            if p.name.upper() == "SPS.SUB":
-                return [p]
-    return []
+    sub = submit_program(root) if root is not None else None
+    return [sub] if sub is not None else []
 
 
 def step_limit(max_steps: int, max_sim_time: float, n_submits: int, ipo_cycle_s: float) -> int:
@@ -193,18 +189,26 @@ def step_limit(max_steps: int, max_sim_time: float, n_submits: int, ipo_cycle_s:
     return max_steps + n_submits * SUBMIT_BUDGET * cycles
 
 
+def time_limit(path: Path, cell: Path | None, default: float) -> float:
+    """The simulated-time limit (s) of a run of `path`: `default`, or the longer time its cell
+    file says the program needs (``sim_time``, robot/stimuli.py)."""
+    if cell is None:
+        return default
+    from robot.stimuli import load_cell  # noqa: PLC0415
+
+    return max(default, load_cell(cell).sim_time.get(path.stem.upper(), 0.0))
+
+
 def run_one(path: Path, max_sim_time: float, max_steps: int, cell: Path | None = None) -> dict:
-    from interp.run import make_runtime  # noqa: PLC0415
-    from robot.machine import load_machine  # noqa: PLC0415
-    from robot.mada import robot_of_backup  # noqa: PLC0415
+    from interp.run import make_runtime, robot_for  # noqa: PLC0415
     from robot.trace import TraceWriter  # noqa: PLC0415
 
     t0 = time.time()
     tw = TraceWriter(keep=False)
     try:
-        root = backup_of(path.resolve())
-        own = robot_of_backup(root) if root is not None else None   # interp.run.robot_for
-        robot = own if own is not None else load_machine()
+        robot = robot_for(path, inputs=cell)    # the cell's robot, else the backup's own, else the KR 6 R900
+        max_sim_time = time_limit(path, cell, max_sim_time)
+        own = _own_machine_data(path, robot.source)
         submit = submit_of(path)
         limit = step_limit(max_steps, max_sim_time, len(submit), robot.ipo_cycle_s)
         # --no-check: the report says how each real program runs, also those the checker rejects
@@ -227,7 +231,7 @@ def run_one(path: Path, max_sim_time: float, max_steps: int, cell: Path | None =
            "seconds": round(time.time() - t0, 2),
            "cell": str(cell) if cell else None, "cell_answers": sum(r.fired for r in rules),
            "cell_last": round(max(fired), 3) if fired else None,
-           "robot": robot.name, "robot_own": own is not None}
+           "robot": robot.name, "robot_own": own}
     row["cause"] = cause_of(row)
     return row
 

@@ -130,6 +130,9 @@ MAX_DAP_REPLAY_STEPS = 10_000_000
 # 20 tokens; the bound also bounds the bracket depth of the parse). Past either: an error naming
 # the file:line of the rule; the run does not start.
 MAX_CELL_RULES = 1000
+#: The longest simulated time (s) a cell file may ask for a program's run (``sim_time``,
+#: robot/stimuli.py): one hour.
+MAX_CELL_SIM_TIME_S = 3600.0
 MAX_RULE_TOKENS = 200
 
 # The backup diff (`krl diff`, krl/diff): the statement lines shown before and after for one

@@ -131,6 +131,20 @@ def machine_data_file(root: Path) -> Path | None:
     return None
 
 
+def submit_program(root: Path) -> Path | None:
+    """The backup's submit program, which the controller starts at boot (reference §9):
+    ``R1/SPS.SUB`` (or ``SPS.SUB`` at a flat export's top), else ``SPS.SUB`` in its System
+    folder; any letter case, links never followed; None when the backup has none."""
+    sysdir = system_folder(root)
+    if sysdir is None:
+        return None
+    for d in (sysdir.parent, sysdir):
+        f = _child(d, "sps.sub")
+        if f is not None and not f.is_symlink() and f.is_file():
+            return f
+    return None
+
+
 def project_of(path: str | Path, within: str | Path | None = None, limit: int | None = None,
                max_entries: int | None = None) -> Project:
     """Rule 3: the program of the file `path` (``krl run``, ``krl check FILE``, the language

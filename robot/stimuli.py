@@ -19,6 +19,7 @@ it starts (:func:`resolve_signals`).
 A *cell file* is a stimuli file with reactive rules and presets beside (issue 22)::
 
     robot: kr180_r3200_pa                # a robot of robot/data, by name (optional)
+    sim_time: {Mill_FrameAut3: 180}      # s a program of the cell needs to reach its end (optional)
     presets: {autoext: true, pgno: 2}    # robot/cellpresets.py
     rules:                               # robot/cellrules.py: rising edge, `after` s later
       - when: "$OUT[3] AND NOT PART_OK"
@@ -28,9 +29,12 @@ A *cell file* is a stimuli file with reactive rules and presets beside (issue 22
 ``robot`` names the robot the cell holds, when the backup has no machine data of its own: one
 of the project's robot library (robot/machine.py ``library_robots``; a name, never a path, as
 the file is untrusted). ``krl run --robot`` overrides it; it overrides the backup's machine data.
+``sim_time`` maps a program's name to the simulated time (s, at most
+:data:`~krl.limits.MAX_CELL_SIM_TIME_S`) it needs to reach its end, for a long job: the
+real-programs report runs it that long when that is longer than its own limit.
 
 The file is validated against this schema: a top-level mapping holds only ``stimuli``,
-``rules``, ``presets``, ``robot``; a stimulus only ``at``, ``when``, ``set``, ``delay``; ``when`` only
+``rules``, ``presets``, ``robot``, ``sim_time``; a stimulus only ``at``, ``when``, ``set``, ``delay``; ``when`` only
 ``motion``, ``line``, ``phase``, ``reached``; a rule only ``when`` (KRL text), ``after``, ``set``;
 ``presets`` only ``pgno``, ``autoext``. Anything else is a :class:`StimulusError` that names the
 key and the place (``file:line``). Limits: at most :data:`MAX_STIMULI` stimuli,
@@ -53,13 +57,13 @@ from typing import Any
 
 import yaml
 
-from krl.limits import MAX_CELL_RULES, MAX_STIMULI, MAX_STIMULI_BYTES
+from krl.limits import MAX_CELL_RULES, MAX_CELL_SIM_TIME_S, MAX_STIMULI, MAX_STIMULI_BYTES
 
 from .cellrules import ConditionError, Rule, compile_condition, parse_condition
 from .io import IOError_, parse_signal
 
 PHASES = ("start", "blend_start", "blend_end", "end")
-TOP_KEYS = ("stimuli", "rules", "presets", "robot")
+TOP_KEYS = ("stimuli", "rules", "presets", "robot", "sim_time")
 PRESET_KEYS = ("pgno", "autoext")
 RULE_KEYS = ("when", "after", "set")
 STIMULUS_KEYS = ("at", "when", "set", "delay")
@@ -203,6 +207,7 @@ class Cell:
     pgno: int | None = None        # presets: the program number the PLC answers (robot/cellpresets.py)
     autoext: bool = False          # presets: Automatic External (operating mode EXT)
     robot: Path | None = None      # the robot of the project's library the cell names
+    sim_time: dict[str, float] = field(default_factory=dict)   # PROGRAM (upper case) -> s it needs
 
 
 def _parse_rules(doc: Any, where: _Where, key_where: str) -> list[Rule]:
@@ -261,10 +266,26 @@ def parse_cell(doc: Any, default_reach_mm: float = 0.1, source: str = "") -> Cel
         _parse_presets(doc.get("presets"), cell, where, where(doc, "presets"))
         if "robot" in doc:
             cell.robot = _library_robot(doc["robot"], where(doc, "robot"))
+        if "sim_time" in doc:
+            cell.sim_time = _sim_times(doc["sim_time"], where, where(doc, "sim_time"))
         if doc.get("stimuli") is not None:
             cell.stimuli = _parse_stimuli(doc["stimuli"], default_reach_mm, where)
         return cell
     return Cell(_parse_stimuli(doc, default_reach_mm, where))
+
+
+def _sim_times(doc: Any, where: _Where, at: str) -> dict[str, float]:
+    if not isinstance(doc, dict):
+        raise StimulusError(f"{at}: 'sim_time' must map program names to seconds")
+    out = {}
+    for name, value in doc.items():
+        if not isinstance(name, str) or not re.fullmatch(r"[A-Za-z_$][A-Za-z0-9_$]{0,23}", name):
+            raise StimulusError(f"{at}: sim_time: {str(name)[:40]!r} is not a program name")
+        s = float(_number(value, f"sim_time of {name}", where(doc, name)))
+        if not 0 < s <= MAX_CELL_SIM_TIME_S:
+            raise StimulusError(f"{where(doc, name)}: sim_time of {name} must be 0 < s <= {MAX_CELL_SIM_TIME_S:g}")
+        out[name.upper()] = s
+    return out
 
 
 def _library_robot(name: Any, at: str) -> Path:

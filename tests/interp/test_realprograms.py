@@ -106,3 +106,42 @@ def test_committed_cell_files_load_and_are_found():
     assert cell_of(corpus / "khrzysio__KRC4_test/R1/CELL.src", corpus) == CELLS / "khrzysio__KRC4_test/cell.yaml"
     assert cell_of(corpus / "khrzysio__KRC4_test/R1/Program/a.src", corpus) == CELLS / "khrzysio__KRC4_test.yaml"
     assert cell_of(corpus / "nobody/R1/a.src", corpus) is None
+
+
+@pytest.mark.parametrize("interp", ["tree", "vm"])
+def test_the_palletizer_runs_on_the_robot_its_cell_chooses(interp):
+    """ingeniado__KRC4-Robot-Palletizer has no machine data; its cell file names the KR 180
+    R3200 PA (robot: kr180_r3200_pa). coge_20.src, the bag pick, then runs to its end on it: the
+    pick XC1 (coge_20.dat:24, in BASE_DATA[1] with TOOL_DATA[1] Z 775) lies 1.5 m from the
+    robot, out of the KR 6 R900's 0.9 m. Its BAS calls run the backup's System/bas.src (its
+    EXT BAS declaration links to it) and it reports the pick with PULSE SACO_COGIDO."""
+    from interp.run import make_runtime
+    from robot.trace import TraceWriter
+
+    p = rp.DEFAULT_CORPUS / "ingeniado__KRC4-Robot-Palletizer/Program/SACO_20/coge_20.src"
+    cell = rp.cell_of(p)
+    assert cell is not None and cell.name == "ingeniado__KRC4-Robot-Palletizer.yaml"
+    tw = TraceWriter(keep=True)
+    rt, _ = make_runtime(p, trace=tw, mujoco=False, max_sim_time=30.0, submit=rp.submit_of(p),
+                         check=False, inputs=cell, interp=interp)
+    res = rt.run()
+    assert res.reason == "completed", (res.reason, res.text, res.file, res.line)
+    assert rt.controller.machine.trafoname == "#KR180R3200 PA C4 FLR"
+    assert "BAS" not in rt.program.stubs
+    motions = [e for e in tw.events if e["kind"] == "motion"]
+    assert len(motions) >= 5
+    # the flange stays vertical all along (A2 + A3 + A5 = 90, A4 = 0): the parallelogram;
+    # 0.01 deg: the taught XHOME ($config.dat:186) itself sums to 90.0013
+    poses = [e["axes"] for e in tw.events if e["kind"] == "pose"]
+    assert len(poses) > 100
+    for a in poses:
+        assert abs(a[3]) < 1e-6 and abs(a[1] + a[2] + a[4] - 90.0) < 0.01, a
+
+
+def test_a_cell_gives_a_long_job_its_time():
+    """khrzysio's Mill_FrameAut3 mills a whole frame: its cell says it needs 180 s (sim_time)."""
+    p = rp.DEFAULT_CORPUS / "khrzysio__KRC4_test/R1/Program/CELL/Frame/Mill_FrameAut3.src"
+    cell = rp.cell_of(p)
+    assert rp.time_limit(p, cell, 60.0) == 180.0
+    assert rp.time_limit(p.with_name("Mill_FrameGlue.src"), cell, 60.0) == 60.0
+    assert rp.time_limit(p, None, 60.0) == 60.0

@@ -133,3 +133,43 @@ def test_a_cell_file_names_its_robot_from_the_library(tmp_path):
             raise AssertionError(f"robot: {bad} was accepted")
     res = CliRunner().invoke(main, ["run", str(JOB), "--inputs", str(cell)])
     assert res.exit_code == 2 and "Traceback" not in res.output and "robot must name" in res.output
+
+
+def test_sim_time_of_a_long_job_is_validated(tmp_path):
+    from robot.stimuli import StimulusError, load_cell
+
+    cell = tmp_path / "cell.yaml"
+    cell.write_text("sim_time: {Mill_Frame: 180, job: 90.5}\n", encoding="utf-8")
+    assert load_cell(cell).sim_time == {"MILL_FRAME": 180.0, "JOB": 90.5}
+    for bad, what in (("{job: 0}", "0 < s"), ("{job: 99999}", "0 < s"), ("{'../x': 10}", "not a program name"),
+                      ("[job]", "must map"), ("{job: soon}", "sim_time of job")):
+        cell.write_text(f"rules: []\nsim_time: {bad}\n", encoding="utf-8")
+        try:
+            load_cell(cell)
+        except StimulusError as exc:
+            assert f"{cell}:2" in str(exc) and what in str(exc), str(exc)
+        else:
+            raise AssertionError(f"sim_time: {bad} was accepted")
+
+
+def test_krl_run_starts_the_backups_sps_sub_as_at_boot(tmp_path):
+    """In a backup `krl run` starts its SPS.SUB beside the program, as the controller does at boot
+    (reference §9), and says so; --no-submit runs without; a --submit that is not there is a
+    clear error."""
+    import shutil
+
+    root = tmp_path / "b"
+    shutil.copytree(BACKUP, root)
+    (root / "R1" / "SPS.SUB").write_text("DEF SPS()\n  LOOP\n    $OUT[40] = TRUE\n    WAIT SEC 0.1\n  ENDLOOP\nEND\n",
+                                         encoding="ascii")
+    job = root / "R1" / "Program" / "job.src"
+    trace = tmp_path / "t.jsonl"
+    res = CliRunner().invoke(main, ["run", str(job), "--no-check", "--max-sim-time", "2", "--trace", str(trace)])
+    assert f"submit     {root / 'R1' / 'SPS.SUB'} (the backup's, started as at boot" in res.output, res.output
+    assert '"signal":"$OUT[40]"' in trace.read_text().replace(" ", "")
+    res = CliRunner().invoke(main, ["run", str(job), "--no-check", "--max-sim-time", "2", "--no-submit",
+                                    "--trace", str(trace)])
+    assert "the backup's, started as at boot" not in res.output
+    assert '"signal":"$OUT[40]"' not in trace.read_text().replace(" ", "")
+    res = CliRunner().invoke(main, ["run", str(job), "--submit", str(tmp_path / "none.sub")])
+    assert res.exit_code == 2 and "none.sub: no such submit program" in res.output
