@@ -453,14 +453,22 @@ def robot_of_backup(root: str | Path, shown: str | None = None) -> MachineData |
 def load_robot(path: str | Path) -> MachineData:
     """The robot model named by ``krl run --robot`` / ``krl robot show``: a robot YAML (the
     layout of robot/data/kr6_r900.yaml), a ``$machine.dat``, a KRC backup folder or a backup
-    ``.zip`` (krl/archive.py checks and extracts it). Raises :class:`MachineDataError` with a
+    ``.zip`` (krl/archive.py checks and extracts it), or the name of a robot of the project's
+    library (``kr180_r3200_pa``: robot/machine.py ``library_robots``). Raises :class:`MachineDataError` with a
     clear message for anything else."""
     from krl.archive import ArchiveError, backup_source, is_archive  # noqa: PLC0415
     from krl.project import backup_of, find_backups  # noqa: PLC0415
 
     p = Path(path)
     if not p.exists():
-        raise MachineDataError(f"{p}: no such file or folder")
+        from .machine import library_robots  # noqa: PLC0415
+
+        lib = library_robots()
+        if str(path) in lib:                    # a robot of the project's library, by name
+            p = lib[str(path)]
+        else:
+            raise MachineDataError(f"{p}: no such file or folder, nor a robot of the library "
+                                   f"({', '.join(lib)})")
     if p.is_file() and p.suffix.lower() in (".yaml", ".yml"):
         try:
             return load_machine(p)

@@ -72,3 +72,14 @@ def test_export_mjcf_site_is_the_flange(tmp_path, shared_corpus):
     data.qpos[:6] = np.radians(q)
     mujoco.mj_kinematics(model, data)
     np.testing.assert_allclose(data.site("tool0").xpos * 1000.0, k.forward(q)[:3, 3], atol=1e-6)
+
+
+def test_show_a_robot_of_the_library_by_name():
+    res = CliRunner().invoke(main, ["robot", "show", "kr180_r3200_pa"])
+    assert res.exit_code == 0, res.output
+    assert res.output.splitlines()[0] == "robot      KR180R3200 PA C4 FLR"
+    assert "palletizer $DEF_A4FIX=True $DEF_A5LINK=True" in res.output
+    # reach to the A5 point by hand: 350 + 1350 + 1220
+    assert "reach      2920.0 mm" in res.output
+    res = CliRunner().invoke(main, ["robot", "show", "kr999"])
+    assert res.exit_code == 2 and "nor a robot of the library (kr180_r3200_pa, kr6_r900)" in res.output
