@@ -109,14 +109,20 @@ def real_programs(corpus: Path = DEFAULT_CORPUS) -> list[tuple[Path, Path]]:
 
 
 def run_real(corpus: Path = DEFAULT_CORPUS, interps: list[str] | None = None, *, limit: int | None = None,
-             max_sim_time: float = 30.0, max_steps: int = 300_000, progress=None) -> list[RealOutcome]:
+             max_sim_time: float | None = None, max_steps: int | None = None, progress=None) -> list[RealOutcome]:
+    """Run the corpus programs on every interpreter with the real-programs report's limits
+    (interp/realprograms.py: 60 s or the cell's ``sim_time``, the step budget with the
+    submit's), so that the causes shown here are that report's."""
+    from interp import realprograms as R  # noqa: PLC0415
+    from interp.run import robot_for  # noqa: PLC0415
+
     interps = H.available_interpreters() if interps is None else interps
+    max_sim_time = R.REPORT_SIM_TIME_S if max_sim_time is None else max_sim_time
+    max_steps = R.REPORT_STEPS if max_steps is None else max_steps
     progs = real_programs(corpus)
     if limit is not None:
         progs = progs[:limit]
     out = []
-    from interp import realprograms as R  # noqa: PLC0415
-
     for prog, root in progs:
         ro = RealOutcome(str(prog.relative_to(corpus)) if prog.is_relative_to(corpus) else str(prog))
         cell = R.cell_of(prog, corpus)
@@ -128,9 +134,10 @@ def run_real(corpus: Path = DEFAULT_CORPUS, interps: list[str] | None = None, *,
         except Exception:  # noqa: BLE001 - no submit program then
             subs = []
         for it in interps:
-            res = H.run_program(prog, it, workspace=None, max_sim_time=R.time_limit(prog, cell, max_sim_time),
-                                stimuli=cell,
-                                max_steps=max_steps, submit=subs[0] if subs else None,
+            t = R.time_limit(prog, cell, max_sim_time)
+            steps = R.step_limit(max_steps, t, len(subs[:1]), robot_for(prog, inputs=cell).ipo_cycle_s)
+            res = H.run_program(prog, it, workspace=None, max_sim_time=t, stimuli=cell,
+                                max_steps=steps, submit=subs[0] if subs else None,
                                 wall_timeout=300.0, check=False)
             runs[it] = res
             if res.crash:

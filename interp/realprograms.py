@@ -56,6 +56,11 @@ from krl.project import backup_of, find_backups, system_folder
 
 LEGITIMATE = ("deadlock", "halt", "max_sim_time", "max_steps")
 
+#: the report's limits of a run: simulated time (s; a cell file may give a long job more,
+#: :func:`time_limit`) and statements of the robot program (:func:`step_limit` adds the submit's)
+REPORT_SIM_TIME_S = 60.0
+REPORT_STEPS = 300_000
+
 #: the causes of a stop, in report order
 CAUSES = ("completed", "intended end", "program error", "interpreter gap", "limit")
 
@@ -298,8 +303,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("corpus", nargs="?", default=str(DEFAULT_CORPUS))
     ap.add_argument("--json", default=None, help="write one JSON object per program")
     ap.add_argument("--limit", type=int, default=0)
-    ap.add_argument("--max-sim-time", type=float, default=60.0)
-    ap.add_argument("--max-steps", type=int, default=300_000)
+    ap.add_argument("--max-sim-time", type=float, default=REPORT_SIM_TIME_S)
+    ap.add_argument("--max-steps", type=int, default=REPORT_STEPS)
     ap.add_argument("--no-cells", action="store_true", help="run without the committed cell files")
     a = ap.parse_args(argv)
     corpus = Path(a.corpus)
