@@ -59,6 +59,7 @@ class RobotModel:
         self.kin = kin if kin is not None else Kinematics(machine)
         self.robroot_T = frame_to_matrix(*machine.robroot_frame)
         self._robroot_is_null = bool(np.allclose(self.robroot_T, np.eye(4)))
+        self._robroot_inv_T = inv_pos(self.robroot_T)
         self.v_max = np.array(machine.max_speed_deg_s, dtype=float)
         self.a_max = np.array(machine.max_acc_deg_s2, dtype=float)
         self.apo_dis_ptp = np.array(machine.apo_dis_ptp_deg, dtype=float)
@@ -71,12 +72,15 @@ class RobotModel:
             F = self.robroot_T @ F
         return base_inv_T @ F @ tool_T
 
-    def ik(self, T_base: np.ndarray, tool_inv_T: np.ndarray, base_T: np.ndarray,
+    def ik(self, T_base: np.ndarray, tool_inv_T: np.ndarray | None, base_T: np.ndarray | None,
            status: int | None, turn: int | None, ref: np.ndarray) -> np.ndarray:
-        """Axes for a TCP pose in $BASE (``tool_inv_T`` = INV_POS($TOOL))."""
-        F = base_T @ T_base @ tool_inv_T
+        """Axes for a TCP pose in $BASE (``tool_inv_T`` = INV_POS($TOOL); None for a
+        ``$TOOL``/``$BASE`` that is the null frame: the product with the identity is skipped)."""
+        F = T_base if base_T is None else base_T @ T_base
+        if tool_inv_T is not None:
+            F = F @ tool_inv_T
         if not self._robroot_is_null:
-            F = inv_pos(self.robroot_T) @ F
+            F = self._robroot_inv_T @ F
         return self.kin.inverse(F, status=status, turn=turn, reference_deg=ref)
 
     def status_turn(self, q: np.ndarray) -> tuple[int, int]:
@@ -345,6 +349,9 @@ class CatmullRomPiece(_Piece):
 
 
 # ------------------------------------------------------------------------- segments
+_BOTTOM_ROW = np.array([0.0, 0.0, 0.0, 1.0])
+
+
 @dataclass
 class TriggerPlan:
     """A trigger resolved to its segment: reference parameter ``u_ref`` on the path
@@ -382,6 +389,10 @@ class Segment:
         self.base_T = base_T
         self.tool_inv_T = inv_pos(tool_T)
         self.base_inv_T = inv_pos(base_T)
+        # the frames the IK multiplies with, None for a null frame (RobotModel.ik skips them)
+        eye = np.eye(4)
+        self._ik_tool = None if np.array_equal(self.tool_inv_T, eye) else self.tool_inv_T
+        self._ik_base = None if np.array_equal(base_T, eye) else base_T
         self.model = model
         self.status = model.status_turn(q0)[0]
         self.triggers: list[TriggerPlan] = []
@@ -508,6 +519,7 @@ class CartSegment(Segment):
         self.joint_ori = req.params.ori_type == "JOINT" and req.kind != "SPLINE"
         cw = np.concatenate([[0.0], np.cumsum(weights)])
         self.u_bounds = cw / W if W > 0 else np.linspace(0.0, 1.0, len(pieces) + 1)
+        self._ub = self.u_bounds.tolist()
         self.lengths = np.array([p.length for p in pieces])
         self.s_bounds = np.concatenate([[0.0], np.cumsum(self.lengths)])
         # orientation of piece k at fraction f: R_k · exp(f · r_k) (= slerp, reference §6.7)
@@ -519,13 +531,13 @@ class CartSegment(Segment):
         return float(self.s_bounds[-1])
 
     def _locate(self, u: float) -> tuple[int, float]:
-        ub = self.u_bounds
+        ub = self._ub
         n = len(self.pieces)
         if u <= 0.0:
             return 0, 0.0
         if u >= 1.0:
             return n - 1, 1.0
-        k = int(np.searchsorted(ub, u, side="right")) - 1
+        k = bisect_right(ub, u) - 1
         k = min(max(k, 0), n - 1)
         du = ub[k + 1] - ub[k]
         return k, (u - ub[k]) / du if du > 0 else 1.0
@@ -556,10 +568,11 @@ class CartSegment(Segment):
     def ik(self, p: np.ndarray, R: np.ndarray, ref: np.ndarray) -> np.ndarray:
         """Axes for a TCP pose (position mm, 3x3 rotation) in this segment's $BASE/$TOOL,
         start status S, turn nearest to ``ref``. Raises WorkspaceError/SoftLimitError."""
-        T = np.eye(4)
+        T = np.empty((4, 4))
         T[:3, :3] = R
         T[:3, 3] = p
-        return self.model.ik(T, self.tool_inv_T, self.base_T, self.status, None, ref)
+        T[3] = _BOTTOM_ROW
+        return self.model.ik(T, self._ik_tool, self._ik_base, self.status, None, ref)
 
     def axes(self, tau: float) -> np.ndarray:
         if tau >= self.T:
