@@ -525,6 +525,10 @@ class CartSegment(Segment):
         # orientation of piece k at fraction f: R_k · exp(f · r_k) (= slerp, reference §6.7)
         self._R = [r.as_matrix() for r in rots]
         self._rv = [(rots[k].inv() * rots[k + 1]).as_rotvec() for k in range(len(pieces))]
+        # a piece without orientation change (a LIN that keeps the start orientation): its
+        # R_k · exp(f · 0) once, instead of a product with the identity every cycle
+        self._R_still = [self._R[k] @ rotvec_matrix(np.zeros(3)) if float(np.linalg.norm(rv)) < 1e-12
+                         else None for k, rv in enumerate(self._rv)]
 
     @property
     def path_length(self) -> float:
@@ -554,7 +558,9 @@ class CartSegment(Segment):
             elif f >= 1.0:
                 R = self._R[k + 1]
             else:
-                R = self._R[k] @ rotvec_matrix(f * self._rv[k])
+                R = self._R_still[k]
+                if R is None:
+                    R = self._R[k] @ rotvec_matrix(f * self._rv[k])
         elif mode == "PATH":
             assert isinstance(piece, ArcPiece)
             R = rotvec_matrix(piece.n * piece.phi(f * piece.length)) @ self._R[k]
