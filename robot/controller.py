@@ -252,6 +252,7 @@ class Controller:
         self._tcp_T = self.model.tcp(self._q, self._tool_T, self._base_inv_T)
         self._tcp_prev = self._tcp_T[:3, 3].copy()
         self.last_error: RobotError | None = None
+        self._step_lim: list[float] | None = None   # largest axis step per cycle (_check_speed)
         self._ret_q: np.ndarray | None = None
         self._ended = False
 
@@ -764,10 +765,12 @@ class Controller:
         ``CP_SPEED_LIMIT_FACTOR`` x its maximum speed (a CP path through a singularity)."""
         if q is self._q_prev:        # at rest: the main run kept the last setpoint
             return
-        step = np.abs(np.asarray(q) - self._q_prev)
-        lim = CP_SPEED_LIMIT_FACTOR * self.model.v_max * self.dt + 1e-9
-        if np.any(step > lim):
-            i = int(np.argmax(step / lim))
+        lim = self._step_lim
+        if lim is None:
+            lim = self._step_lim = (CP_SPEED_LIMIT_FACTOR * self.model.v_max * self.dt + 1e-9).tolist()
+        step = [abs(a - b) for a, b in zip(np.asarray(q).tolist(), self._q_prev.tolist())]
+        if any(d > m for d, m in zip(step, lim)):
+            i = max(range(6), key=lambda j: step[j] / lim[j])
             raise RobotError(f"speed limit exceeded A{i + 1}: CP path through a singularity")
 
     def _fault(self, err: RobotError) -> np.ndarray:

@@ -130,6 +130,9 @@ def build_mjcf(machine: MachineData | None = None, actuated: bool = False, *,
     return "\n".join(lines) + "\n"
 
 
+_BOTTOM_ROW = np.array([0.0, 0.0, 0.0, 1.0])
+
+
 class ArmModel:
     """The MuJoCo arm, driven in KUKA axis values (deg) and read back in mm.
 
@@ -148,6 +151,10 @@ class ArmModel:
         self.data = mujoco.MjData(self.model)
         self._qadr = np.array([self.model.joint(j.name).qposadr[0] for j in self.machine.joints])
         self._dadr = np.array([self.model.joint(j.name).dofadr[0] for j in self.machine.joints])
+        # the six joints sit side by side in qpos (they do in build_mjcf's model): a slice
+        # instead of a fancy index in the per-cycle replay
+        q0 = int(self._qadr[0])
+        self._qidx = slice(q0, q0 + 6) if list(self._qadr) == list(range(q0, q0 + 6)) else self._qadr
         self._sign = np.array([j.kuka_sign for j in self.machine.joints], dtype=float)
         self._site = self.model.site("tool0").id
         self._robroot = frame_to_matrix(self.machine.robroot_frame)
@@ -161,7 +168,7 @@ class ArmModel:
         """Kinematic playback: write ``qpos`` (and ``qvel``) from A1..A6 in deg (deg/s)
         and run ``mj_kinematics`` (``mj_forward`` with ``full=True``)."""
         d = self.data
-        d.qpos[self._qadr] = self._sign * np.radians(np.asarray(axes_deg, dtype=float)[:6])
+        d.qpos[self._qidx] = self._sign * np.radians(np.asarray(axes_deg, dtype=float)[:6])
         if vel_deg_s is not None:
             d.qvel[self._dadr] = self._sign * np.radians(np.asarray(vel_deg_s, dtype=float)[:6])
         if full:
@@ -171,7 +178,7 @@ class ArmModel:
 
     def axes_deg(self) -> np.ndarray:
         """Current A1..A6 (deg) read back from ``qpos``; shape (6,)."""
-        return np.degrees(self._sign * self.data.qpos[self._qadr])
+        return np.degrees(self._sign * self.data.qpos[self._qidx])
 
     def axes_vel_deg_s(self) -> np.ndarray:
         """Current axis speeds (deg/s) from ``qvel``; shape (6,)."""
@@ -179,9 +186,10 @@ class ArmModel:
 
     def flange_pose_world(self) -> np.ndarray:
         """KUKA flange frame (site ``tool0``) in ``$WORLD`` (MuJoCo world), 4x4, mm."""
-        T = np.eye(4)
+        T = np.empty((4, 4))
         T[:3, :3] = self.data.site_xmat[self._site].reshape(3, 3)
         T[:3, 3] = 1000.0 * self.data.site_xpos[self._site]
+        T[3] = _BOTTOM_ROW
         return T
 
     def flange_pose(self) -> np.ndarray:

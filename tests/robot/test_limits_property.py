@@ -58,16 +58,7 @@ def step_st(draw):
     return step
 
 
-# Known breach, found when the large robots joined (2026-11-23): a SPLINE block after a PTP
-# C_DIS on the KR 210 R2700-2 reached 103.5 % of the CP path speed. Issue 22 stays open for it;
-# until it is fixed the large robots' runs are reported (xfail, not strict: the search is
-# random) instead of failing the suite. The KR 6 R900 keeps the strict property.
-LARGE_ROBOT_BREACH = pytest.mark.xfail(strict=False, reason="SPLINE after PTP C_DIS: CP path speed up to "
-                                       "103.5 % on the KR 210 R2700-2 (issue 22, open)")
-
-
-@pytest.fixture(scope="module", params=[pytest.param(r, marks=() if ROBOTS[r] is None else LARGE_ROBOT_BREACH)
-                                        for r in sorted(ROBOTS)])
+@pytest.fixture(scope="module", params=sorted(ROBOTS))
 def robot(request):
     folder = ROBOTS[request.param]
     if folder is None:

@@ -156,3 +156,69 @@ def test_resume_logs_an_abort_end_for_the_abandoned_motion():
     assert len(ends) == 1 and ends[0]["reason"] == "abort"
     rep = check_trace(tw.events, ctl.machine)
     assert rep.ok, [str(v) for v in rep.violations]
+
+
+# --- issue 22: a SPLINE block on the KR 210 R2700-2 (corpus machine data) ran 3.5 % fast
+#: axes of the hypothesis example (tests/robot/test_limits_property.py) that found it
+_Q_PTP = (0.1119580201929864, -56.96738358343825, 93.00162128323555, 49.222207072650406,
+          40.18797832928211, -38.851313995089335)
+_Q_SLIN = (48.46763857996379, -84.68297076522397, 98.28514676886586, -55.85690038183901,
+           44.41919788344541, 53.532764559774506)
+_Q_SPL = (-18.602663600207677, -62.036078556012775, 110.42944724739775, 28.58585569981011,
+          31.917407178259865, 29.47640487191653)
+
+
+def test_spl_after_a_reversing_slin_keeps_vel_cp_on_the_kr210(shared_corpus):
+    """The breach of issue 22, reduced to its last two spline segments: on the KR 210 R2700-2
+    (HugoDanielson__ChinaMilling's R1/Mada/$machine.dat) a PTP C_DIS, then a SPLINE block with
+    an SLIN and an SPL point that turns back (> 90° from the line's direction, so the curve
+    has zero end tangents: a straight piece whose speed |P'(t)| is 0 at both ends). The block
+    runs at $VEL.CP 0.14834713588757553 m/s · $OV_PRO 30 % = 44.504 mm/s (program values);
+    the TCP speed measured cycle by cycle after the PTP has ended must stay there (the trace
+    rounds positions to 1e-6 mm: ±1.7e-4 mm/s). The arc-length table interpolated linearly ran
+    up to 46.18 mm/s (103.8 %) on the SPL piece."""
+    from robot.frames import matrix_to_frame
+    from robot.mada import load_robot
+
+    robot = load_robot(shared_corpus / "HugoDanielson__ChinaMilling")
+    assert robot.name.startswith("KR210R2700_2")
+    tw = TraceWriter(keep=True)
+    ctl = Controller(robot, trace=tw, mujoco=False)
+
+    def cart(q):
+        return dict(zip("XYZABC", matrix_to_frame(ctl.model.kin.forward(np.asarray(q)))))
+
+    axes = ("A1", "A2", "A3", "A4", "A5", "A6")
+    P_ptp = MotionParams().with_(vel_axis=(18.447362809681138,) * 6, ov_pro=30.0, apo_cdis=4.37334970611875)
+    P = MotionParams().with_(vel_cp=0.14834713588757553, ov_pro=30.0)
+    run_motions(ctl, [
+        MotionRequest("PTP", {"A1": 0, "A2": -90, "A3": 90, "A4": 0, "A5": 60, "A6": 0}, MotionParams()),
+        MotionRequest("PTP", dict(zip(axes, _Q_PTP)), P_ptp, approx="C_DIS", approx2="C_DIS"),
+        MotionRequest("SPLINE", {}, P, segments=(SplineSegment("SLIN", cart(_Q_SLIN)),
+                                                 SplineSegment("SPL", cart(_Q_SPL))))])
+    ev = tw.events
+    limit = 148.34713588757553 * 0.30
+    sp = _speeds(ev, _phases(ev, 2)["end"], _phases(ev, 3)["end"])
+    assert len(sp) > 5000  # about 80 s of spline at 44.5 mm/s
+    assert max(sp) <= limit + 2e-4, max(sp)
+    assert max(sp) >= limit - 1e-3  # and it does run at the programmed speed
+    rep = check_trace(ev, robot)
+    assert rep.ok, [str(v) for v in rep.violations]
+
+
+def test_catmull_rom_piece_is_parametrised_by_exact_arc_length():
+    """A SPL point that turns back from the SLIN before it (tangent · chord < 0): the curve
+    becomes the straight chord with zero end tangents, P(t) = P1 + (3t² - 2t³)·(P2 - P1). On a
+    straight piece the arc length is the distance from P1, so pos(s) must lie s mm from P1
+    along the chord, including next to the ends where |P'(t)| vanishes."""
+    from robot.planner import CatmullRomPiece
+
+    P1, P2 = np.array([100.0, 0.0, 0.0]), np.array([-1900.0, 300.0, 200.0])
+    m1 = np.array([1.0, 0.0, 0.0]) * float(np.linalg.norm(P2 - P1))  # the SLIN's direction
+    pc = CatmullRomPiece(2 * P1 - P2, P1, P2, 2 * P2 - P1, m1, None)
+    L = float(np.linalg.norm(P2 - P1))
+    assert not pc.c1.any()  # the fallback: zero end tangents
+    assert pc.length == pytest.approx(L, rel=1e-12)
+    u = (P2 - P1) / L
+    for s in [0.01, 0.3, 0.53, 1.0, 5.0, 37.0, 0.5 * L, L - 5.0, L - 0.53, L - 0.01]:
+        assert np.linalg.norm(pc.pos(s) - (P1 + s * u)) < 1e-8, s
