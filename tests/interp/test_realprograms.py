@@ -136,6 +136,11 @@ def test_the_palletizer_runs_on_the_robot_its_cell_chooses(interp):
     assert len(poses) > 100
     for a in poses:
         assert abs(a[3]) < 1e-6 and abs(a[1] + a[2] + a[4] - 90.0) < 0.01, a
+    # and the motion limits of the palletizer's own machine data hold on the whole pick
+    from robot.limits import check_trace
+
+    rep = check_trace(tw.events, rt.controller.machine)
+    assert rep.ok, rep.summary()
 
 
 def test_a_cell_gives_a_long_job_its_time():
