@@ -126,13 +126,22 @@ def _input(e: N.Node, root: Path, cache: dict) -> InputUse | None:
     return InputUse(sym.name.upper(), addr, declared, comment, group=b is not None)
 
 
-def starter(uses: list[InputUse], programs: list[str]) -> str:
-    """The text of the starter cell file (YAML; every rule commented out)."""
+def starter(uses: list[InputUse], programs: list[str], own_robot: bool = True) -> str:
+    """The text of the starter cell file (YAML; every rule commented out). `own_robot`: the
+    backup has machine data of its own (else the file asks for the cell's robot)."""
+    from robot.machine import library_robots  # noqa: PLC0415
+
+    names = ", ".join(library_robots())
+    robot = (f"# robot: NAME       # the backup's own robot (its R1/Mada/$machine.dat) runs; a name of "
+             f"robot/data overrides it: {names}" if own_robot else
+             f"# robot: NAME       # this backup has no R1/Mada/$machine.dat: name the cell's robot "
+             f"(robot/data: {names}); without, the KR 6 R900 runs")
     out = ["# Starter cell file written by `krl cell init` (issue 22; robot/cellrules.py, docs/robot.md).",
            "# Programs: " + ", ".join(printable(p) for p in programs),
            "# Every input the programs read is listed with a rule to fill in: uncomment it, write in",
            "# `when` the program's output (or condition) the PLC answers, in `after` its delay (s).",
            "# A rule fires on the rising edge of `when`; run with: krl run PROGRAM --inputs THIS_FILE",
+           robot,
            "presets:",
            "  autoext: false      # true: Automatic External ($I_O_ACTCONF; P00 of a cell program)",
            "  # pgno: 1           # the program number the PLC answers in P00's handshake",
@@ -177,4 +186,6 @@ def cell_init(root: Path, programs: list[Path]) -> str:
             shown.append(str(p.resolve().relative_to(root.resolve())))
         except ValueError:
             shown.append(p.name)
-    return starter(list(found.values()), shown)
+    from krl.project import machine_data_file  # noqa: PLC0415
+
+    return starter(list(found.values()), shown, own_robot=machine_data_file(root) is not None)
