@@ -168,7 +168,6 @@ class Resolver:
         self.places: dict[int, tuple[int, int, int]] = {}   # id(Symbol) -> (kind, owner, slot)
         self.system_index: dict[str, int] = {}
         self.unit_of: dict[int, int] = {}                    # id(Routine) -> unit index
-        self.linkable: dict[str, N.Routine] = {}             # NAME -> main or GLOBAL routine
         self.native_names = set(self.system.routines)
 
     # ------------------------------------------------------------------ layouts
@@ -183,12 +182,8 @@ class Resolver:
                     returns.setdefault(id(sym.decl), sym.signature.returns)
         for i, u in enumerate(ws.units):
             if u.src is not None:
-                for k, r in enumerate(u.src.module.routines):
+                for r in u.src.module.routines:
                     self.unit_of[id(r)] = i
-                    if k == 0 or r.is_global:
-                        # what an EXT declaration links to (reference 2.6): a module's main
-                        # routine or a GLOBAL routine; the first one in file order
-                        self.linkable.setdefault(r.name.upper(), r)
             if u.dat is not None and u.dat.module.data is not None:
                 lay = _data_layout(u.dat.module.data, i)
                 u.dat.module.data.annotate().storage = lay
@@ -304,10 +299,14 @@ class Resolver:
         callee = Callee(c.name)
         if isinstance(sym, Symbol):
             decl = sym.decl
-            if isinstance(decl, N.ExtDecl):
-                # EXT/EXTFCT names a routine of another module: the link binds the call to it
-                # (a technology package absent from the backup leaves it unbound: a stub)
-                decl = self.linkable.get(c.name.upper(), decl)
+            if isinstance(decl, N.ExtDecl) and self.ws.global_scope is not None:
+                # EXT/EXTFCT names a routine of another module (reference 2.6): the link binds
+                # the call to the module main or GLOBAL routine that the global scope holds
+                # (krl/workspace.py: a routine replaces an EXT signature there); a technology
+                # package absent from the backup leaves it unbound: a stub
+                linked = self.ws.global_scope.routines.get(c.name.upper())
+                if linked is not None and isinstance(linked.decl, N.Routine):
+                    decl = linked.decl
             if isinstance(decl, N.Routine):
                 callee.routine = decl
                 callee.owner = self.unit_of.get(id(decl), -1)
