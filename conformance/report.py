@@ -114,7 +114,6 @@ def run_real(corpus: Path = DEFAULT_CORPUS, interps: list[str] | None = None, *,
     (interp/realprograms.py: 60 s or the cell's ``sim_time``, the step budget with the
     submit's), so that the causes shown here are that report's."""
     from interp import realprograms as R  # noqa: PLC0415
-    from interp.run import robot_for  # noqa: PLC0415
 
     interps = H.available_interpreters() if interps is None else interps
     max_sim_time = R.REPORT_SIM_TIME_S if max_sim_time is None else max_sim_time
@@ -128,14 +127,17 @@ def run_real(corpus: Path = DEFAULT_CORPUS, interps: list[str] | None = None, *,
         cell = R.cell_of(prog, corpus)
         ro.cell = str(cell.relative_to(R.CELLS.parent.parent)) if cell is not None else ""
         runs = {}
-        subs = []
         try:
-            subs = list(R.submit_of(prog))
-        except Exception:  # noqa: BLE001 - no submit program then
-            subs = []
+            _robot, subs, t, steps = R.report_run(prog, cell, max_sim_time, max_steps)
+        except Exception as exc:  # noqa: BLE001 - a robot or cell file that cannot be read: this row says so
+            ro.crash = {it: f"{type(exc).__name__}: {exc}"[:300] for it in interps}
+            ro.reasons = {it: "crash" for it in interps}
+            ro.cause = "interpreter gap"
+            out.append(ro)
+            if progress:
+                progress(ro)
+            continue
         for it in interps:
-            t = R.time_limit(prog, cell, max_sim_time)
-            steps = R.step_limit(max_steps, t, len(subs[:1]), robot_for(prog, inputs=cell).ipo_cycle_s)
             res = H.run_program(prog, it, workspace=None, max_sim_time=t, stimuli=cell,
                                 max_steps=steps, submit=subs[0] if subs else None,
                                 wall_timeout=300.0, check=False)

@@ -111,14 +111,10 @@ def _run(program: Path, workspace, inputs, trace_path, max_sim_time, max_steps, 
             sys.exit(2)
     booted = None
     if not submit and auto_submit:
-        from krl.project import backup_of, submit_program  # noqa: PLC0415
+        from krl.project import boot_submit  # noqa: PLC0415
 
-        root = backup_of(program.resolve(), Path(workspace).resolve() if workspace else None)
-        booted = submit_program(root) if root is not None else None
-        if booted is not None and booted.resolve() != program.resolve():
-            submit = (booted,)
-        else:
-            booted = None
+        booted = boot_submit(program, workspace)
+        submit = (booted,) if booted is not None else ()
     from interp.run import make_runtime, robot_for  # noqa: PLC0415
     from interp.summary import RunObserver, starvation_lines, summary_lines  # noqa: PLC0415
     from robot.mada import MachineDataError  # noqa: PLC0415

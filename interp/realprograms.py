@@ -172,12 +172,11 @@ def normalise(text: str) -> str:
 
 
 def submit_of(path: Path) -> list[Path]:
-    """The backup's SPS.SUB (krl.project.submit_program), started beside the program as
+    """The backup's SPS.SUB (krl.project.boot_submit), started beside the program as
     the controller does at boot (reference §9); empty outside a backup."""
-    from krl.project import submit_program  # noqa: PLC0415
+    from krl.project import boot_submit  # noqa: PLC0415
 
-    root = backup_of(path.resolve())
-    sub = submit_program(root) if root is not None else None
+    sub = boot_submit(path)
     return [sub] if sub is not None else []
 
 
@@ -204,18 +203,29 @@ def time_limit(path: Path, cell: Path | None, default: float) -> float:
     return max(default, load_cell(cell).sim_time.get(path.stem.upper(), 0.0))
 
 
+def report_run(path: Path, cell: Path | None, max_sim_time: float = REPORT_SIM_TIME_S,
+               max_steps: int = REPORT_STEPS) -> tuple:
+    """``(robot, submit programs, simulated-time limit s, step limit)`` of the report's run of
+    `path` with its cell file (this report and the conformance report's real programs): the
+    cell's robot, else the backup's own, else the KR 6 R900 (interp.run.robot_for); the
+    backup's SPS.SUB; :func:`time_limit` and :func:`step_limit`."""
+    from interp.run import robot_for  # noqa: PLC0415
+
+    robot = robot_for(path, inputs=cell)
+    submit = submit_of(path)
+    t = time_limit(path, cell, max_sim_time)
+    return robot, submit, t, step_limit(max_steps, t, len(submit), robot.ipo_cycle_s)
+
+
 def run_one(path: Path, max_sim_time: float, max_steps: int, cell: Path | None = None) -> dict:
-    from interp.run import make_runtime, robot_for  # noqa: PLC0415
+    from interp.run import make_runtime  # noqa: PLC0415
     from robot.trace import TraceWriter  # noqa: PLC0415
 
     t0 = time.time()
     tw = TraceWriter(keep=False)
     try:
-        robot = robot_for(path, inputs=cell)    # the cell's robot, else the backup's own, else the KR 6 R900
-        max_sim_time = time_limit(path, cell, max_sim_time)
+        robot, submit, max_sim_time, limit = report_run(path, cell, max_sim_time, max_steps)
         own = _own_machine_data(path, robot.source)
-        submit = submit_of(path)
-        limit = step_limit(max_steps, max_sim_time, len(submit), robot.ipo_cycle_s)
         # --no-check: the report says how each real program runs, also those the checker rejects
         rt, _ = make_runtime(path, trace=None, mujoco=False, max_sim_time=max_sim_time, max_steps=limit,
                              submit=submit, check=False, inputs=cell, robot=robot)

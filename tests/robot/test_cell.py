@@ -166,6 +166,11 @@ def test_krl_run_starts_the_backups_sps_sub_as_at_boot(tmp_path):
     (root / "R1" / "SPS.SUB").write_text("DEF SPS()\n  LOOP\n    $OUT[40] = TRUE\n    WAIT SEC 0.1\n  ENDLOOP\nEND\n",
                                          encoding="ascii")
     job = root / "R1" / "Program" / "job.src"
+    from krl.project import boot_submit
+
+    assert boot_submit(job) == root / "R1" / "SPS.SUB"
+    assert boot_submit(root / "R1" / "SPS.SUB") is None      # the submit program is not booted twice
+    assert boot_submit(tmp_path / "elsewhere.src") is None    # outside a backup
     trace = tmp_path / "t.jsonl"
     res = CliRunner().invoke(main, ["run", str(job), "--no-check", "--max-sim-time", "2", "--trace", str(trace)])
     assert f"submit     {root / 'R1' / 'SPS.SUB'} (the backup's, started as at boot" in res.output, res.output
