@@ -111,18 +111,23 @@ def round_time(t: float) -> float:
     return 0.0 if r == 0.0 else r
 
 
-def _clean(v: Any, nd: int = 6) -> Any:
+def _round6(v: float) -> float:
+    """A trace float: rounded to 6 decimals, -0.0 written as 0.0."""
+    r = round(v, 6)
+    return 0.0 if r == 0.0 else r
+
+
+def _clean(v: Any) -> Any:
     if isinstance(v, bool) or v is None or isinstance(v, str) or isinstance(v, int):
         return v
     if isinstance(v, float):
-        r = round(v, nd)
-        return 0.0 if r == 0.0 else r
+        return _round6(v)
     if isinstance(v, dict):
-        return {str(k): _clean(x, nd) for k, x in v.items()}
+        return {str(k): _clean(x) for k, x in v.items()}
     if isinstance(v, (list, tuple)):
-        return [_clean(x, nd) for x in v]
+        return [_clean(x) for x in v]
     try:  # numpy scalars
-        return _clean(v.item(), nd)
+        return _clean(v.item())
     except AttributeError:
         return str(v)
 
@@ -213,24 +218,17 @@ class TraceWriter:
             return
         poses, self._poses = self._poses, []
         frames = _frames_of([T for _, _, T in poses])
-        keep, memory, fh = self.keep, self._memory, self._fh
         for (t, axes, _), fr in zip(poses, frames):
             vals = axes.tolist() if hasattr(axes, "tolist") else axes
-            ax = [0.0 if (r := round(float(v), 6)) == 0.0 else r for v in vals]
-            tcp = [0.0 if (r := round(v, 6)) == 0.0 else r for v in fr]
+            ax = [_round6(float(v)) for v in vals]
+            tcp = [_round6(v) for v in fr]
             tt = round_time(t)
             axs, tcs = ",".join(map(repr, ax)), ",".join(map(repr, tcp))
+            ev = {"t": tt, "kind": "pose", "axes": ax, "tcp": tcp}
             if "n" in axs or "n" in tcs:  # nan / inf: json.dumps writes NaN / Infinity
-                self._emit({"t": tt, "kind": "pose", "axes": ax, "tcp": tcp})
-                continue
-            line = f'{{"t":{tt!r},"kind":"pose","axes":[{axs}],"tcp":[{tcs}]}}'
-            if keep:
-                self._events.append({"t": tt, "kind": "pose", "axes": ax, "tcp": tcp})
-            if memory:
-                self._lines.append(line)
-            elif fh is not None:
-                fh.write(line)
-                fh.write("\n")
+                self._emit(ev)
+            else:
+                self._emit(ev, f'{{"t":{tt!r},"kind":"pose","axes":[{axs}],"tcp":[{tcs}]}}')
 
     def write_event(self, ev: dict[str, Any]) -> None:
         """Write an already built event dict (from :func:`make_event`)."""
@@ -242,8 +240,10 @@ class TraceWriter:
                 return
         self._emit(ev)
 
-    def _emit(self, ev: dict[str, Any]) -> None:
-        line = json.dumps(ev, separators=(",", ":"), ensure_ascii=True)
+    def _emit(self, ev: dict[str, Any], line: str | None = None) -> None:
+        """Keep and/or write event `ev`; `line` is its JSON text when the caller formatted it."""
+        if line is None:
+            line = json.dumps(ev, separators=(",", ":"), ensure_ascii=True)
         if self.keep:
             self._events.append(ev)
         if self._memory:
