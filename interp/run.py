@@ -28,7 +28,8 @@ def make_runtime(program, *, workspace=None, inputs=None, trace=None, max_sim_ti
     in P00's handshake (robot/cellpresets.py; overrides the cell file's ``pgno`` preset).
     ``run_mode``: ``$PRO_MODE`` at the start (GO, MSTEP, ISTEP, BSTEP; interp/runtime/runmode.py;
     default GO). ``robot``: the simulated robot (a MachineData or a path for
-    :func:`robot.mada.load_robot`); default: the cell file's ``robot``, else :func:`robot_for`. Raises
+    :func:`robot.mada.load_robot`); default :func:`robot_for` (the cell file's ``robot``, else the
+    backup's own robot, else the KR 6 R900). Raises
     :class:`robot.stimuli.StimulusError` for a bad cell file or a preset the backup's
     ``$config.dat`` does not allow."""
     from interp.tree import TreeInterpreter  # noqa: PLC0415

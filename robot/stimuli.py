@@ -261,7 +261,7 @@ def parse_cell(doc: Any, default_reach_mm: float = 0.1, source: str = "") -> Cel
     if isinstance(doc, dict):
         _unknown(doc, TOP_KEYS, "top-level key", where)
         if not any(k in doc for k in TOP_KEYS):
-            raise StimulusError(f"{where(doc)}: the mapping needs 'stimuli', 'rules', 'presets' or 'robot'")
+            raise StimulusError(f"{where(doc)}: the mapping needs one of " + ", ".join(f"'{k}'" for k in TOP_KEYS))
         cell = Cell([], _parse_rules(doc.get("rules"), where, where(doc, "rules")))
         _parse_presets(doc.get("presets"), cell, where, where(doc, "presets"))
         if "robot" in doc:
