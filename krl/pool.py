@@ -56,7 +56,7 @@ def _death(exitcode: int | None) -> str:
 
 def run_tasks(fn: Callable[..., Any], tasks: Iterable[tuple[Hashable, tuple]], *, jobs: int | None = None,
               timeout: float | None = None, initializer: Callable | None = None, initargs: tuple = (),
-              in_process: bool = False) -> Iterator[Outcome]:
+              in_process: bool = False, preload: tuple[str, ...] | None = None) -> Iterator[Outcome]:
     """Run ``fn(*args)`` for every ``(key, args)`` of `tasks`; yield one :class:`Outcome` per
     task as tasks finish.
 
@@ -81,9 +81,14 @@ def run_tasks(fn: Callable[..., Any], tasks: Iterable[tuple[Hashable, tuple]], *
     window = 2 * jobs
     import multiprocessing  # noqa: PLC0415
 
-    # fork, explicitly (Python 3.14 changes the default): workers start with what this process
-    # has loaded (the parser) and with what a test patched in it
-    context = multiprocessing.get_context("fork" if "fork" in multiprocessing.get_all_start_methods() else None)
+    methods = multiprocessing.get_all_start_methods()
+    if preload is not None and "forkserver" in methods:
+        context = multiprocessing.get_context("forkserver")
+        context.set_forkserver_preload(list(preload))   # heeded when the fork server starts
+    else:
+        # fork, explicitly (Python 3.14 changes the default): workers start with what this
+        # process has loaded (the parser) and with what a test patched in it
+        context = multiprocessing.get_context("fork" if "fork" in methods else None)
     pool = ProcessPool(max_workers=jobs, initializer=initializer, initargs=initargs, context=context)
     finished = False
     try:

@@ -77,8 +77,15 @@ class FoldScan:
 
 def _comment_start(line: str) -> int:
     """Index of the `;` that starts the line's comment (outside a string), or -1."""
+    semi = line.find(";")
+    if semi < 0:
+        return -1
+    quote = line.find('"', 0, semi)
+    if quote < 0:
+        return semi         # no string before the first `;` (most lines): found without a loop
     in_string = False
-    for i, ch in enumerate(line):
+    for i in range(quote, len(line)):
+        ch = line[i]
         if ch == '"':
             in_string = not in_string
         elif ch == ";" and not in_string:
