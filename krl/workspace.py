@@ -17,11 +17,18 @@ krl/project.py says which files form a program (:func:`krl.project.project_of`, 
 every command); :func:`load_project` and :func:`load_workspace` load them.
 Files are read with krl.source.read_source and parsed with parse_source only.
 
+The check records what each of its owners left (the declarations; each routine's scope and
+body; each data-list value: findings and unresolved uses), so that :meth:`Workspace.replace`
+puts a new version of one file in place (an editor's buffer) and runs the same phases again for
+the routines or values whose AST changed, or the whole check when the file's interface changed;
+the diagnostics are those of a full check either way.
+
 Usage::
 
     ws = load_workspace([Path("KRC")])
     ws.check()                      # runs the checker, fills ws.diagnostics
     ws.modules["DEMO"].routines     # AST; expression types in node.ann.type
+    ws.replace(load_text(new_text, path))   # an edit: "routines", "values" or "workspace"
 """
 
 from __future__ import annotations
@@ -48,7 +55,7 @@ from krl.semantics.symbols import Scope, Symbol, system_scopes
 from krl.syntax.folds import fold_diagnostics
 from krl.syntax.messages import syntax_diagnostics
 from krl.syntax.engines import parse_source, result_from_answer
-from krl.syntax.parse import ParseResult
+from krl.syntax.parse import ParseResult, parse_text
 from krl.source import SourceText, is_krl_file, read_source
 
 
@@ -278,7 +285,7 @@ class Workspace:
 
     def add_file(self, path: str | Path) -> SourceFile:
         """Read, parse and build one file (never raises for bad content)."""
-        return self._add_loaded(load_file(path))
+        return self.add_loaded(load_file(path))
 
     def add_files(self, paths, timeout: float | None = None, jobs: int | None = None) -> None:
         """:meth:`add_file` for each of `paths`, in order. With `timeout` (seconds per file) the
@@ -313,8 +320,6 @@ class Workspace:
         sf = SourceFile(lf.path, lf.module, lf.ok, lf.status, parse_seconds=lf.parse_seconds)
         self.files.append(sf)
         return sf
-
-    _add_loaded = add_loaded
 
     def add_unread(self, entries) -> None:
         """W002 for each walk entry that was not read (krl.files.Entry: a link, FIFO, folder too
@@ -721,7 +726,7 @@ class Workspace:
         old_mod, new_mod = sf.module, lf.module
         if old_mod.kind != "src" or new_mod.kind != "src" or old_mod.data is not None or new_mod.data is not None:
             return None
-        if routine_interface(old_mod) != routine_interface(new_mod):
+        if not _same_interface(old_mod, new_mod):
             return None
         recs = [st.by_routine.get(id(r)) for r in old_mod.routines]
         if any(rec is None for rec in recs):
@@ -950,20 +955,26 @@ def _type_key(t: N.TypeRef | None):
     return None if t is None else (t.name.upper(), t.size)
 
 
-def routine_interface(module: N.Module) -> tuple:
-    """What other modules and the module's other routines can see of a .src file: per
-    routine its kind, name, GLOBAL mark, return type and parameters (name, mode, open
-    dimensions, declared type and dimensions)."""
-    out = []
-    for r in module.routines:
-        decl_of: dict[str, tuple] = {}
-        for d in r.decls:
-            if isinstance(d, N.VarDecl):
-                for v in d.names:
+def routine_interface(r: N.Routine) -> tuple:
+    """What other modules and the module's other routines can see of a routine: its kind,
+    name, GLOBAL mark, return type and parameters (name, mode, open dimensions, declared type
+    and dimensions)."""
+    decl_of: dict[str, tuple] = {}
+    names = {p.name.upper() for p in r.params}
+    for d in r.decls:
+        if isinstance(d, N.VarDecl):
+            for v in d.names:
+                if v.name.upper() in names:
                     decl_of.setdefault(v.name.upper(), (_type_key(d.type), tuple(v.dims), d.is_const))
-        params = tuple((p.name.upper(), p.mode, p.dims, decl_of.get(p.name.upper())) for p in r.params)
-        out.append((r.kind, r.name.upper(), r.is_global, _type_key(r.return_type), params))
-    return tuple(out)
+    params = tuple((p.name.upper(), p.mode, p.dims, decl_of.get(p.name.upper())) for p in r.params)
+    return r.kind, r.name.upper(), r.is_global, _type_key(r.return_type), params
+
+
+def _same_interface(old: N.Module, new: N.Module) -> bool:
+    """True when two versions of a .src file show the same routines to the rest (an
+    unchanged routine, the same AST, is not looked at)."""
+    return len(old.routines) == len(new.routines) and all(
+        a is b or routine_interface(a) == routine_interface(b) for a, b in zip(old.routines, new.routines))
 
 
 def _declaration(d: N.Decl):
@@ -1002,8 +1013,6 @@ def failed_load(path, o, timeout: float) -> LoadedFile:
 
 def load_text(text: str, path: str = "<string>.src") -> LoadedFile:
     """Parse (the Python engine) and build KRL text as if it were the file `path`."""
-    from krl.syntax.parse import parse_text  # noqa: PLC0415
-
     t = time.perf_counter()
     src = SourceText(path, text, "", len(text.encode("utf-8", "surrogatepass")))
     return _loaded(src, parse_text(text, path), t)

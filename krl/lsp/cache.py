@@ -33,10 +33,13 @@ import time
 from pathlib import Path
 
 import msgpack
+import platformdirs
 
 from krl.ast import nodes as N
 from krl.diagnostics import Diagnostic, Note
 from krl.limits import MAX_LSP_CACHE_BYTES
+from krl.syntax.engines import grammar_text
+from krl.syntax.parse import default_bundle
 from krl.workspace import LoadedFile
 
 log = logging.getLogger("krl.lsp")
@@ -176,11 +179,8 @@ def front_end_version() -> str:
     """A hash of everything a cached entry depends on: the grammar the parser was generated
     from and every .py/.yaml/.java file of the ``krl`` package (computed once per process)."""
     if not _VERSION:
-        from krl.syntax.engines import _grammar_text  # noqa: PLC0415
-        from krl.syntax.parse import default_bundle  # noqa: PLC0415
-
         h = hashlib.sha256(CODEC.encode())
-        h.update(_grammar_text(default_bundle()).encode("utf-8"))
+        h.update(grammar_text(default_bundle()).encode("utf-8"))
         root = Path(N.__file__).resolve().parents[1]
         for p in sorted(root.rglob("*")):
             if p.suffix in (".py", ".yaml", ".java") and "generated" not in p.parts and p.is_file():
@@ -209,7 +209,6 @@ def check_key(files: list[tuple[str, str]], skipped: list[tuple[str, str]]) -> s
 
 def cache_dir() -> Path:
     """``$KRL_CACHE_DIR`` or the user cache folder (platformdirs), never the repository."""
-    import platformdirs  # noqa: PLC0415
     return Path(os.environ.get("KRL_CACHE_DIR") or platformdirs.user_cache_dir("krl-tools"))
 
 

@@ -44,7 +44,7 @@ from krl.ast.build import build_module
 from krl.diagnostics import Diagnostic, DiagnosticSink
 from krl.limits import MAX_FILE_BYTES
 from krl.semantics.outside import template_lines
-from krl.source import SourceText
+from krl.source import SourceText, read_source
 from krl.pool import default_jobs
 from krl.syntax.engines import java_answers, parse_piece, result_from_answer, unavailable_reason
 from krl.syntax.folds import fold_diagnostics
@@ -105,7 +105,6 @@ def _failed(status: str, ok: bool, text: str) -> tuple[set, bool]:
 def parse_disk(path: str) -> Parsed:
     """A file on disk, read, parsed and built by krl/workspace.py ``load_file`` (what
     ``krl check`` does for each file)."""
-    from krl.source import read_source  # noqa: PLC0415
     lf = load_file(path)
     src = read_source(path)
     return Parsed(lf.path, src.text if src.status == "ok" else "", lf)

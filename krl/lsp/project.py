@@ -37,8 +37,10 @@ from krl.lsp.analysis import Analysis, build_analysis, updated
 from krl.lsp.parsing import MIN_CHUNKED_LINES, ParseCache, Parsed
 from krl.lsp.paths import is_uri, norm
 from krl.lsp.roots import workspace_of
+from krl.pool import default_jobs
 from krl.source import SourceText, read_source
-from krl.workspace import load_batch, load_parsed
+from krl.syntax.engines import EngineUnavailable, java_answers, resolve
+from krl.workspace import failed_load, load_batch, load_parsed
 
 __all__ = ["Project", "is_uri", "norm"]
 
@@ -49,7 +51,6 @@ MAX_RECHECKED_FILES = 16        # more changed files at once: the workspace is c
 
 
 def _java() -> bool:
-    from krl.syntax.engines import EngineUnavailable, resolve  # noqa: PLC0415
     try:
         return resolve() == "java"
     except EngineUnavailable:
@@ -63,9 +64,11 @@ def text_sha(text: str) -> str:
 
 class Project:
     """Documents and analyses of one editor session; `store`: the persistent cache (None:
-    none)."""
+    none); `threaded`: the caller runs other threads (the server), so worker processes come from
+    a fork server, never from a fork of this process (krl/workspace.py ``load_batch``)."""
 
-    def __init__(self, store: _cache.Store | None = None) -> None:
+    def __init__(self, store: _cache.Store | None = None, threaded: bool = False) -> None:
+        self.threaded = threaded
         self.docs: dict[str, str] = {}          # open buffers: path -> text
         self.folders: list[Path] = []           # the editor's workspace folders
         self.parser = ParseCache()
@@ -77,6 +80,7 @@ class Project:
         self.analyses: dict[str, Analysis] = {}  # root -> latest analysis
         self._root_of: dict[str, str] = {}       # path -> root of its latest analysis
         self.watched = False    # the client reports file changes: file lists kept until it does
+        self._disk_known = False    # ... and the files read stay as read until it does
 
     # ------------------------------------------------------------------ documents
 
@@ -99,8 +103,10 @@ class Project:
                         del self._root_of[f]
 
     def files_changed(self) -> None:
-        """Files were created or deleted on disk: list the workspaces again."""
+        """Files were created, changed or deleted on disk: list the workspaces and look at
+        their files again."""
         self._roots.clear()
+        self._disk_known = False
 
     # ------------------------------------------------------------------ files and parses
 
@@ -169,17 +175,15 @@ class Project:
         processes past PARALLEL_BYTES), else by the Python engine, in this process."""
         if not sources:
             return {}
-        from krl.pool import default_jobs  # noqa: PLC0415
-        from krl.workspace import failed_load  # noqa: PLC0415
         size = sum(s.size for s in sources)
         jobs = default_jobs()
         if _java() and size >= PARALLEL_BYTES and jobs > 1:
             out = {}
-            for src, o in zip(sources, load_batch([s.path for s in sources], PARSE_TIMEOUT_S, jobs, threaded=True)):
+            for src, o in zip(sources, load_batch([s.path for s in sources], PARSE_TIMEOUT_S, jobs,
+                                                   threaded=self.threaded)):
                 out[src.path] = o.value if o.status == "done" else failed_load(src.path, o, PARSE_TIMEOUT_S)
             return out
         if _java():
-            from krl.syntax.engines import java_answers  # noqa: PLC0415
             return {src.path: load_parsed(src, raw)
                     for _i, src, raw in java_answers(enumerate(sources), threads=jobs, trees=True)}
         return {src.path: load_parsed(src, None) for src in sources}
@@ -200,8 +204,6 @@ class Project:
                 return got[1]
         if text.count("\n") < MIN_CHUNKED_LINES or not _java():
             return self.parser.parse(path, text)
-        from krl.pool import default_jobs  # noqa: PLC0415
-        from krl.syntax.engines import java_answers  # noqa: PLC0415
         src = SourceText(path, text, "", len(text.encode("utf-8", "surrogatepass")))
         [(_i, src, raw)] = list(java_answers([(0, src)], threads=default_jobs(), trees=True))
         parsed = Parsed(path, text, load_parsed(src, raw))
@@ -220,7 +222,8 @@ class Project:
                 if p is not self._disk.get(path, (None, None))[1]:
                     self._keys[id(p)] = text_sha(text)
             return got[1]
-        self.load_files([path])
+        if path not in self._disk:
+            self.load_files([path])
         return self._disk[path][1]
 
     def content_key(self, parsed: Parsed) -> str:
@@ -245,7 +248,11 @@ class Project:
         p = norm(path)
         if on_parsed is not None and root not in self.analyses and p in files:
             on_parsed(self.parsed(p, docs))
-        self.load_files([f for f in files if f not in docs])
+        if not (self.watched and self._disk_known):     # else the client says when files change
+            self.load_files([f for f in files if f not in docs])
+        else:
+            self.load_files([f for f in files if f not in docs and f not in self._disk])
+        self._disk_known = True
         parsed = [self.parsed(f, docs) for f in files]
         an = self._recheck(root, files, parsed, skipped)
         if an is None:

@@ -17,6 +17,7 @@ import importlib.util
 import logging
 import os
 import sys
+import threading
 import time
 from concurrent.futures import ThreadPoolExecutor
 
@@ -25,6 +26,12 @@ from pygls.lsp.server import LanguageServer
 from pygls.uris import from_fs_path, to_fs_path
 
 from krl import __version__
+from krl.diagnostics.render import split_lines
+from krl.pool import default_jobs
+from krl.semantics.config import config_for
+from krl.semantics.symbols import system_scopes
+from krl.source import SourceText
+from krl.syntax.engines import EngineUnavailable, java_answers, resolve
 from krl.lsp import actions as _actions
 from krl.lsp import complete as _complete
 from krl.lsp import folding as _folding
@@ -38,6 +45,7 @@ from krl.lsp import signature as _signature
 from krl.lsp import unused as _unused
 from krl.lsp.occurrences import DECL, WRITE, file_occurrences
 from krl.lsp.analysis import Analysis
+from krl.lsp.bench import generate
 from krl.lsp.cache import Store
 from krl.lsp.convert import lsp_diagnostic
 from krl.lsp.parsing import Parsed
@@ -85,7 +93,7 @@ class KrlLanguageServer(LanguageServer):
 
     def __init__(self) -> None:
         super().__init__("krl-lsp", __version__)
-        self.project = Project(store=Store())
+        self.project = Project(store=Store(), threaded=True)
         self.debounce_s = DEBOUNCE_S
         self._last_change: dict[str, float] = {}
         self._executor = ThreadPoolExecutor(max_workers=1, thread_name_prefix="krl-analysis")
@@ -183,7 +191,6 @@ class KrlLanguageServer(LanguageServer):
             _root, files, _skipped = self.project.workspace_files(path, docs)
             if len(files) < EARLY_MIN_FILES or self._stale(path, docs):
                 return
-            from krl.diagnostics.render import split_lines  # noqa: PLC0415
             lines, codec = split_lines(parsed.text), self.codec()
             self.text_document_publish_diagnostics(L.PublishDiagnosticsParams(
                 uri=uri_of(path), version=versions.get(path),
@@ -195,8 +202,6 @@ class KrlLanguageServer(LanguageServer):
         """The diagnostics the cache holds for the whole check to come (the same files, the
         same front end), for the open documents of that workspace."""
         try:
-            from krl.diagnostics.render import split_lines  # noqa: PLC0415
-            from krl.semantics.config import config_for  # noqa: PLC0415
             by: dict[str, list] = {}
             for d in diags:
                 by.setdefault(d.path, []).append(d)
@@ -218,21 +223,16 @@ class KrlLanguageServer(LanguageServer):
         background (the first parse and check then wait for neither)."""
         def run() -> None:
             try:
-                from krl.pool import default_jobs  # noqa: PLC0415
-                from krl.semantics.symbols import system_scopes  # noqa: PLC0415
-                from krl.source import SourceText  # noqa: PLC0415
-                from krl.syntax.engines import EngineUnavailable, java_answers, resolve  # noqa: PLC0415
                 try:
-                    if resolve() == "java":
-                        text = "DEF warm( )\nEND\n"
+                    if resolve() == "java":     # the worker's JIT and parse caches warm on a sample
+                        text = generate(400)
                         list(java_answers([(0, SourceText("warm.src", text, "", len(text)))],
-                                          threads=default_jobs(), trees=True))
+                                          threads=default_jobs(), trees=False))
                 except EngineUnavailable:
                     pass
                 system_scopes()
             except Exception as exc:  # noqa: BLE001 - only a head start
                 log.error("warming up failed: %s", printable(exc), exc_info=TRACEBACKS["on"])
-        import threading  # noqa: PLC0415
         threading.Thread(target=run, name="krl-warm", daemon=True).start()
 
     def schedule(self, path: str, delay: float | None = None) -> None:

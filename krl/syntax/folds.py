@@ -40,6 +40,8 @@ from krl.diagnostics import Diagnostic, Note
 _MARKER = re.compile(r";[ \t]*(END)?FOLD(?![A-Za-z0-9_$])", re.I)
 _OPEN = re.compile(r"[ \t\f]*(?:GLOBAL[ \t]+)?(DEF|DEFFCT|DEFDAT)[ \t]+([A-Za-z_$][A-Za-z0-9_$]*)", re.I)
 _CLOSE = re.compile(r"[ \t\f]*(END|ENDFCT|ENDDAT)(?![A-Za-z0-9_$])", re.I)
+# a line that can matter to the scan: a comment, a lone CR, or the start of a routine or its end
+_MAYBE = re.compile(r"[ \t\f]*(?:GLOBAL|DEF|END)", re.I)
 
 
 @dataclass(frozen=True, slots=True)
@@ -116,6 +118,8 @@ def scan_fold_lines(lines: list[str]) -> FoldScan:
     current: int | None = None                                 # index into routines, None outside
     out.last = len(lines) - (1 if len(lines) > 1 and lines[-1] == "" else 0)
     for number, whole in enumerate(lines, start=1):
+        if ";" not in whole and "\r" not in whole and not _MAYBE.match(whole):
+            continue                             # a statement line: nothing to see
         offset = 0
         for line in whole.split("\r"):           # a lone CR ends a statement and its comment
             semi = _comment_start(line)

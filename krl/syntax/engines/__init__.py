@@ -30,7 +30,7 @@ from krl.source import SourceText
 ENGINES = ("auto", "python", "java")
 REPO_GRAMMAR = Path(__file__).resolve().parents[3] / "grammar" / "KRL.g4"
 
-__all__ = ["ENGINES", "EngineUnavailable", "available", "java_answers", "parse_piece", "resolve",
+__all__ = ["ENGINES", "EngineUnavailable", "available", "grammar_text", "java_answers", "parse_piece", "resolve",
            "result_from_answer", "set_default", "use_engine", "parse_file", "parse_source", "parse_sources",
            "unavailable_reason"]
 
@@ -83,6 +83,11 @@ def resolve(name: str | None = None) -> str:
 
 
 _GRAMMARS: dict[str, str] = {}
+
+
+def grammar_text(bundle: ParserBundle) -> str:
+    """The text of the grammar a parser bundle was generated from (cached per file)."""
+    return _grammar_text(bundle)
 
 
 def _grammar_text(bundle: ParserBundle) -> str:
