@@ -54,6 +54,17 @@ def _death(exitcode: int | None) -> str:
     return f"the worker process died (exit status {exitcode})"
 
 
+def start_fork_server(preload: tuple[str, ...]) -> None:
+    """Start the fork server of :func:`run_tasks` ``preload`` now (it takes a second: a fresh
+    interpreter importing `preload`), so that the first pool does not wait for it."""
+    import multiprocessing  # noqa: PLC0415 - only for a caller of worker processes
+    from multiprocessing import forkserver  # noqa: PLC0415
+
+    if "forkserver" in multiprocessing.get_all_start_methods():
+        multiprocessing.get_context("forkserver").set_forkserver_preload(list(preload))
+        forkserver.ensure_running()
+
+
 def run_tasks(fn: Callable[..., Any], tasks: Iterable[tuple[Hashable, tuple]], *, jobs: int | None = None,
               timeout: float | None = None, initializer: Callable | None = None, initargs: tuple = (),
               in_process: bool = False, preload: tuple[str, ...] | None = None) -> Iterator[Outcome]:

@@ -601,40 +601,39 @@ class Workspace:
     def _reported(self, f: SourceFile) -> bool:
         return f.ok and (self.check_only is None or f.path in self.check_only)
 
-    def _report(self) -> None:
-        """The unresolved-name report (krl/semantics/outside.py) from every recorded use, in
-        the order of a check: declarations, routine scopes, data-list values, routine bodies."""
+    def _owners(self) -> list[tuple[DiagnosticSink, "_Uses"]]:
+        """(findings, unresolved uses) of every owner that is reported, in the order of a check:
+        the declarations, routine scopes, data-list values (of files that parse), routine bodies
+        (of files that parse)."""
         st = self._state
-        un = Unresolved(load_builtins().packages, self.maybe_declared)
-        owners = [st.decl_uses, *(rec.scope_uses for rec in st.routines)]
+        out = [(st.decl_sink, st.decl_uses), *((rec.scope_diags, rec.scope_uses) for rec in st.routines)]
         for u in self.units:
             if u.dat is not None and self._reported(u.dat):
-                owners += [rec.uses for rec in st.values.get(id(u), ())]
-        owners += [rec.body_uses for rec in st.routines
-                   if rec.body_uses is not None and self._reported(rec.unit.src)]
-        for owner in owners:
-            for use in owner.items:
+                out += [(rec.diags, rec.uses) for rec in st.values.get(id(u), ())]
+        out += [(rec.body_diags, rec.body_uses) for rec in st.routines
+                if rec.body_diags is not None and self._reported(rec.unit.src)]
+        return out
+
+    def _report(self) -> None:
+        """The unresolved-name report (krl/semantics/outside.py) from every recorded use, in
+        the order a check records them."""
+        un = Unresolved(load_builtins().packages, self.maybe_declared)
+        for _diags, uses in self._owners():
+            for use in uses.items:
                 un.use(*use)
-        st.report = DiagnosticSink()
-        un.finish(st.report)
+        self._state.report = DiagnosticSink()
+        un.finish(self._state.report)
 
     def _assemble(self) -> None:
-        """The workspace's diagnostics in the order a check adds them (the input's, the
-        declarations', routine scopes', data-list values', routine bodies', the report), a
-        repeat dropped as one sink drops it, advisory warnings left out in KUKA's files."""
+        """The workspace's diagnostics in the order a check adds them (the input's, each
+        owner's, the report), a repeat dropped as one sink drops it, advisory warnings left out
+        in KUKA's files."""
         st = self._state
         sink = DiagnosticSink()
         add = sink.add_diagnostic
         for d in self._inputs:
             add(d)
-        parts = [st.decl_sink, *(rec.scope_diags for rec in st.routines)]
-        for u in self.units:
-            if u.dat is not None and self._reported(u.dat):
-                parts += [rec.diags for rec in st.values.get(id(u), ())]
-        parts += [rec.body_diags for rec in st.routines
-                  if rec.body_diags is not None and self._reported(rec.unit.src)]
-        parts.append(st.report)
-        for part in parts:
+        for part in [diags for diags, _uses in self._owners()] + [st.report]:
             for d in part.items:
                 add(d)
         kuka = st.kuka

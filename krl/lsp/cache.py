@@ -238,12 +238,15 @@ class Store:
 
     def _off(self, why: str) -> None:
         log.warning("%s", why)
-        if self.db is not None:
+        self._close()
+
+    def _close(self) -> None:
+        db, self.db = self.db, None
+        if db is not None:
             try:
-                self.db.close()
+                db.close()
             except sqlite3.Error:
                 pass
-        self.db = None
 
     def get(self, kind: str, keys: list[str]) -> dict[str, bytes]:
         """The verified data of the entries of `kind` among `keys`."""
@@ -299,9 +302,4 @@ class Store:
 
     def close(self) -> None:
         with self.lock:
-            if self.db is not None:
-                try:
-                    self.db.close()
-                except sqlite3.Error:
-                    pass
-                self.db = None
+            self._close()

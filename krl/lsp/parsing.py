@@ -202,14 +202,18 @@ class ParseCache:
         got = self._parse_pieces(path, text, t)
         return got if got is not None else self._whole(path, text, t)
 
-    def _whole(self, path: str, text: str, started: float) -> Parsed:
-        sink = DiagnosticSink()
+    def _full(self, text: str, path: str):
+        """A whole text parsed with error recovery and messages (``parse_text``), by the fast
+        engine when it runs here (the same result: tests/syntax/test_engines.py)."""
         if self.fast and unavailable_reason() is None:
             src = SourceText(path, text, "", len(text.encode("utf-8", "surrogatepass")))
             [(_k, src, raw)] = list(java_answers([(0, src)], threads=default_jobs(), trees=True))
-            result = result_from_answer(src, raw, keep_tree=True)     # the Python engine when raw is None
-        else:
-            result = parse_text(text, path)
+            return result_from_answer(src, raw, keep_tree=True)     # the Python engine when raw is None
+        return parse_text(text, path)
+
+    def _whole(self, path: str, text: str, started: float) -> Parsed:
+        sink = DiagnosticSink()
+        result = self._full(text, path)
         sink.extend(syntax_diagnostics(result, text))
         sink.extend(fold_diagnostics(path, text))
         module = build_module(result, sink)
@@ -305,7 +309,7 @@ class ParseCache:
                 padded = ("\n" * a + piece) if k == 0 else ("\n" * (a - 1) + "DEFDAT PIECE\n" + piece)
                 if b < len(lines):
                     padded += "ENDDAT\n"
-                result = parse_text(padded, path)
+                result = self._full(padded, path)
                 if result.status != "syntax_error":
                     return None
                 sink.extend(syntax_diagnostics(result, padded))
@@ -318,7 +322,7 @@ class ParseCache:
             return _Piece(build_module(result, sink), a + 1, True, sink.items)
         # messages quote line numbers and lines: parse the piece at its place
         padded = "\n" * a + piece
-        result = parse_text(padded, path)
+        result = self._full(padded, path)
         if result.status != "syntax_error" or not _closed(lines[a:b], a):
             return None
         sink.extend(syntax_diagnostics(result, padded))

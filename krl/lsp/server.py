@@ -27,11 +27,12 @@ from pygls.uris import from_fs_path, to_fs_path
 
 from krl import __version__
 from krl.diagnostics.render import split_lines
-from krl.pool import default_jobs
+from krl.pool import default_jobs, start_fork_server
 from krl.semantics.config import config_for
 from krl.semantics.symbols import system_scopes
 from krl.source import SourceText
 from krl.syntax.engines import EngineUnavailable, java_answers, resolve
+from krl.workspace import WORKER_MODULES
 from krl.lsp import actions as _actions
 from krl.lsp import complete as _complete
 from krl.lsp import folding as _folding
@@ -231,6 +232,8 @@ class KrlLanguageServer(LanguageServer):
                 except EngineUnavailable:
                     pass
                 system_scopes()
+                if default_jobs() > 1:
+                    start_fork_server(WORKER_MODULES)    # for the parallel loads of large workspaces
             except Exception as exc:  # noqa: BLE001 - only a head start
                 log.error("warming up failed: %s", printable(exc), exc_info=TRACEBACKS["on"])
         threading.Thread(target=run, name="krl-warm", daemon=True).start()
