@@ -105,9 +105,10 @@ class Network:
             self.replay_events = load_replay(settings.replay)
 
     # ------------------------------------------------------------------ lifecycle
-    def attach(self, ctl) -> None:
+    def attach(self, ctl, plc_map=None) -> None:
         """Bind to the controller `ctl` and start the servers the settings name (KukaVarProxy,
-        the PLC). Raises :class:`NetError` when one cannot start."""
+        the PLC with the address map `plc_map`, net/plc.py). Raises OSError when one cannot
+        start (a port in use)."""
         self.ctl = ctl
         ctl.network = self
         if getattr(self, "replay_events", None) is not None:
@@ -125,7 +126,7 @@ class Network:
         if s.modbus is not None or s.opcua is not None:
             from .plc import Plc  # noqa: PLC0415
 
-            self.plc = Plc(self, s)
+            self.plc = Plc(self, s, plc_map)
             self.plc.start()
 
     @property
