@@ -100,6 +100,7 @@ class Network:
         self.plc = None
         self.addresses: dict[str, tuple[str, int]] = {}        # "eki:NAME" / "varproxy" / ... -> bound
         self.ready = threading.Condition()
+        self.listen_hook = None     # listen_hook(key, (host, port)) when a server starts (krl run says where)
         self.closed = False
         if settings is not None and settings.replay is not None:
             self.replay_events = load_replay(settings.replay)
@@ -165,6 +166,8 @@ class Network:
         with self.ready:
             self.addresses[key] = tuple(address[:2])
             self.ready.notify_all()
+        if self.listen_hook is not None:
+            self.listen_hook(key, tuple(address[:2]))
         if self.ctl is not None:
             self.net_message(f"{key} listening on {address[0]}:{address[1]}")
 

@@ -284,7 +284,9 @@ def rsi_call(hub, rt, method: str, a: list):
     """RSI_CREATE(NAME, CONTID :OUT, BOOL), RSI_DELETE(CONTID), RSI_ON(#ABSOLUTE|#RELATIVE
     [, #IPO|#IPO_FAST]), RSI_OFF(), RSI_MOVECORR() (waits until the STOP object or an error
     ends it), RSI_SETPUBLICPAR(CONTID, OBJ, PARAM, VALUE), RSI_GETPUBLICPAR(CONTID, OBJ,
-    PARAM, VALUE :OUT); net/rsi.py holds the behaviour. Returns the RSIERR number (INT)."""
+    PARAM, VALUE :OUT); RSI 5's RSI_LOAD(NAME), RSI_ACTIVATE(NAME), RSI_PROCESS_ON(mode),
+    RSI_PROCESS_OFF(), RSI_DEACTIVATE, RSI_UNLOAD as the same. net/rsi.py holds the behaviour.
+    Returns the RSIERR number (INT)."""
     from net.rsi import RSIOK, Rsi  # noqa: PLC0415
 
     from .convert import num  # noqa: PLC0415
@@ -300,6 +302,8 @@ def rsi_call(hub, rt, method: str, a: list):
         return ret
     if method == "delete":
         return rsi.delete()
+    if method == "activate":
+        return RSIOK if rsi.ctx is not None else RSI_CONSTANTS["RSIINVOBJID"]
     if method == "on":
         rt.wait_main_run(rt.current_task)     # RSI_ON stops the advance run: it corrects from the robot at rest
         return rsi.start(ctl, _arg_enum(a, 0, "RELATIVE"), _arg_enum(a, 1, "IPO") == "IPO_FAST")
@@ -340,6 +344,9 @@ NATIVES = {
     "RSI_CREATE": _rsi("create"), "RSI_DELETE": _rsi("delete"), "RSI_ON": _rsi("on"),
     "RSI_OFF": _rsi("off"), "RSI_MOVECORR": _rsi("movecorr"),
     "RSI_SETPUBLICPAR": _rsi("setpar"), "RSI_GETPUBLICPAR": _rsi("getpar"),
+    # RSI 5 (iiQKA): a context is loaded and activated by name, the process switched on and off
+    "RSI_LOAD": _rsi("create"), "RSI_ACTIVATE": _rsi("activate"), "RSI_DEACTIVATE": _rsi("activate"),
+    "RSI_UNLOAD": _rsi("delete"), "RSI_PROCESS_ON": _rsi("on"), "RSI_PROCESS_OFF": _rsi("off"),
 }
 
 __all__ = ["NATIVES", "RSI_CONSTANTS", "network"]

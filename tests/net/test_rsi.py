@@ -16,7 +16,7 @@ import pytest
 
 from net.settings import Channel, NetworkSettings
 
-from .helpers import CONFIGS, PROGRAMS, net_events, run_with_partner
+from .helpers import CONFIGS, EXAMPLES, net_events, run_with_partner
 
 ROS_RSI = "ros-industrial__kuka_experimental/kuka_rsi_hw_interface/krl/KR_C4/ros_rsi.src"
 
@@ -68,8 +68,8 @@ def test_rsi_corrections_shift_the_tcp_path(interp):
         return f'<RKorr X="0" Y="0" Z="{z}" A="0" B="0" C="0"/><Stop>{stop}</Stop>'
 
     partner, addr = sensor(answer)
-    settings = NetworkSettings(PROGRAMS, rsi=Channel(PROGRAMS / "rsi_path.rsi.xml", addr))
-    result, trace, got = run_with_partner(PROGRAMS / "rsi_path.src", settings, partner, interp=interp)
+    settings = NetworkSettings(EXAMPLES, rsi=Channel(EXAMPLES / "rsi_path.rsi.xml", addr))
+    result, trace, got = run_with_partner(EXAMPLES / "rsi_path.src", settings, partner, interp=interp)
     assert result.reason == "completed", (result.reason, result.text)
     events = trace.events
     first = ET.fromstring(net_events(trace, iface="rsi", dir="out")[0]["data"]).find("RIst")
@@ -102,9 +102,9 @@ def test_a_silent_sensor_stops_the_motion():
         return '<RKorr X="0" Y="0" Z="1" A="0" B="0" C="0"/><Stop>0</Stop>' if i < 10 else None
 
     partner, addr = sensor(answer, stop_after=8.0)
-    settings = NetworkSettings(PROGRAMS, rsi=Channel(PROGRAMS / "rsi_path.rsi.xml", addr))
+    settings = NetworkSettings(EXAMPLES, rsi=Channel(EXAMPLES / "rsi_path.rsi.xml", addr))
     started = time.monotonic()
-    result, trace, got = run_with_partner(PROGRAMS / "rsi_path.src", settings, partner)
+    result, trace, got = run_with_partner(EXAMPLES / "rsi_path.src", settings, partner)
     assert time.monotonic() - started < 60
     assert result.reason == "error"
     assert "maximum number of late packets exceeded" in result.text

@@ -14,9 +14,9 @@ from py_openshowvar import openshowvar
 
 from net.settings import NetworkSettings
 
-from .helpers import PROGRAMS, run_with_partner
+from .helpers import EXAMPLES, run_with_partner
 
-PROGRAM = PROGRAMS / "wait_global.src"
+PROGRAM = EXAMPLES / "wait_global.src"
 
 
 def read_until(client, name: str, want: bytes, deadline: float) -> bytes:
@@ -30,7 +30,7 @@ def read_until(client, name: str, want: bytes, deadline: float) -> bytes:
 
 @pytest.mark.parametrize("interp", ["tree", "vm"])
 def test_py_openshowvar_reads_and_writes(interp):
-    settings = NetworkSettings(PROGRAMS, varproxy=("127.0.0.1", 0))
+    settings = NetworkSettings(EXAMPLES, varproxy=("127.0.0.1", 0))
 
     def partner(net, rt):
         host, port = net.wait_address("varproxy")
@@ -67,7 +67,7 @@ def test_py_openshowvar_reads_and_writes(interp):
 
 
 def test_bad_requests_close_only_that_client():
-    settings = NetworkSettings(PROGRAMS, varproxy=("127.0.0.1", 0))
+    settings = NetworkSettings(EXAMPLES, varproxy=("127.0.0.1", 0))
 
     def partner(net, rt):
         addr = net.wait_address("varproxy")
