@@ -35,7 +35,11 @@ from .xmlsafe import XmlRefused
 
 
 class Pacer:
-    """Wall-clock pacing: :meth:`wait` returns when cycle `k` may start."""
+    """Wall-clock pacing: :meth:`wait` returns when cycle `k` may start. A run that falls more
+    than :data:`REANCHOR_S` behind (a debugger pause, an overloaded machine) is paced again
+    from now on, instead of racing to catch up; `behind` keeps the largest lag seen (s)."""
+
+    REANCHOR_S = 0.5
 
     def __init__(self, dt: float, pace: float = 1.0) -> None:
         self.dt = dt
@@ -52,8 +56,10 @@ class Pacer:
         target = self.t0 + (k - self.k0) * self.dt / self.pace
         if target > now:
             time.sleep(target - now)
-        else:
-            self.behind = max(self.behind, now - target)
+            return
+        self.behind = max(self.behind, now - target)
+        if now - target > self.REANCHOR_S:
+            self.k0, self.t0 = k, now
 
 
 class NullSink:
