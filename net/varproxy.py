@@ -23,13 +23,12 @@ closes that client's connection.
 
 from __future__ import annotations
 
-import socket
 import struct
 
 from krl.limits import (MAX_VARPROXY_CLIENTS, MAX_VARPROXY_NAME_CHARS, MAX_VARPROXY_REQUESTS_PER_CYCLE,
                         MAX_VARPROXY_VALUE_CHARS)
 
-from .transport import Endpoint
+from .transport import Endpoint, listen
 
 OK = b"\x00\x01\x01"
 FAILED = b"\x00\x01\x00"
@@ -87,18 +86,8 @@ class VarProxy:
 
     def __init__(self, hub, address: tuple[str, int]) -> None:
         self.hub = hub
-        host, port = address
-        s = socket.socket(socket.AF_INET6 if ":" in host else socket.AF_INET, socket.SOCK_STREAM)
-        s.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
-        try:
-            s.bind((host, port))
-            s.listen(MAX_VARPROXY_CLIENTS)
-        except OSError:
-            s.close()
-            raise
-        s.setblocking(False)
-        self.sock = s
-        self.address = s.getsockname()[:2]
+        self.sock = listen(address[0], address[1], MAX_VARPROXY_CLIENTS)
+        self.address = self.sock.getsockname()[:2]
         self.clients: list[_Client] = []
 
     def poll(self) -> None:

@@ -11,8 +11,7 @@ functions return an RSIERR number as INT (``RSIOK`` = 0, :data:`RSI_CONSTANTS`).
 
 from __future__ import annotations
 
-from krl.semantics import types as T
-
+from .builtins import _text      # builtins.py adds these natives at its end, after _text
 from .errors import KrlRuntimeError, value_invalid
 from .values import UNSET, Arr, EnumValue, Struct, is_char_array
 
@@ -36,17 +35,6 @@ def network(rt):
         net = Network(program=rt.program.main_path, sink=RuntimeSink(rt))
         net.attach(ctl)
     return net
-
-
-def _text(ref, what: str) -> str:
-    if ref is None:
-        raise value_invalid(what)
-    v = ref.get()
-    if isinstance(v, str):
-        return v
-    if isinstance(v, Arr) and v.type.elem == T.CHAR:
-        return v.text()
-    raise KrlRuntimeError(f"{what} is not a string")
 
 
 def _status(st) -> Struct:
