@@ -10,7 +10,9 @@ import importlib.util
 
 import pytest
 
+from interp.run import make_runtime
 from net.settings import NetworkSettings
+from robot.trace import TraceWriter
 from tests.conftest import REPO_ROOT
 
 from .helpers import net_events, run_with_partner
@@ -26,7 +28,7 @@ def plc_script():
 
 
 @pytest.mark.parametrize("interp, number", [("tree", 2), ("vm", 1)])
-def test_a_plc_selects_a_program_and_opcua_reads_its_outputs(interp, number):
+def test_a_plc_selects_a_program_and_opcua_reads_its_outputs(interp, number, tmp_path):
     plc = plc_script()
     settings = NetworkSettings(CELL, modbus=("127.0.0.1", 0), opcua="opc.tcp://127.0.0.1:0")
 
@@ -53,3 +55,14 @@ def test_a_plc_selects_a_program_and_opcua_reads_its_outputs(interp, number):
     assert len(req) >= 2
     done_t = [t for t, s, v in io if s == f"$OUT[{done}]" and v is True]
     assert done_t and done_t[0] > req[1]
+    # the trace is a recording: replayed on the other interpreter, without sockets, the PLC's
+    # writes arrive at the same cycles and the cycle sets the same outputs at the same times
+    recording = tmp_path / "plc.jsonl"
+    recording.write_text("\n".join(trace.lines) + "\n")
+    other = "vm" if interp == "tree" else "tree"
+    replayed = TraceWriter(keep=True)
+    rt, _ = make_runtime(CELL / "R1" / "cell.src", network=NetworkSettings(tmp_path, replay=recording),
+                         trace=replayed, max_sim_time=result.sim_time, mujoco=False, interp=other)
+    rt.run()
+    again = [(e["t"], e["signal"], e["value"]) for e in replayed.events if e["kind"] == "io"]
+    assert again == io
