@@ -108,6 +108,9 @@ class Network:
         self.ready = threading.Condition()
         self.listen_hook = None     # listen_hook(key, (host, port)) when a server starts (krl run says where)
         self.closed = False
+        # the controller calls cycle() only while this is True: partners configured, a replay,
+        # or RSI on; a run without any costs one attribute test per IPO cycle
+        self.polling = settings is not None
         if settings is not None and settings.replay is not None:
             self.replay_events = load_replay(settings.replay)
 
@@ -198,6 +201,8 @@ class Network:
                 self.rsi.cycle(ctl, live=False)
             return
         if not self.attached:
+            if self.rsi is not None and self.rsi.on:
+                self.rsi.cycle(ctl, live=False)     # no sensor: every packet is late
             return
         if self.pacer is None:
             pace = self.settings.pace if self.settings is not None else 1.0

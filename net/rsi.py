@@ -290,6 +290,7 @@ class Rsi:
                 self.hub.net_message(f"RSI: cannot open the ETHERNET object's socket: {exc.strerror or exc}")
                 return RSIINVCONN
         ctl.set_correction(self)
+        self.hub.polling = True
         return RSIOK
 
     def off(self, ctl=None) -> int:

@@ -610,7 +610,7 @@ class Controller:
         self._k += 1
         t = self.time
         self.io.now = t
-        if self.network is not None:
+        if self.network is not None and self.network.polling:
             self.network.cycle(self)
         self.io.tick_timers(self._dt_ms)
         if self._pulses:

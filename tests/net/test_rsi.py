@@ -140,3 +140,22 @@ def test_ros_industrial_rsi_axis_corrections(shared_corpus, interp):
     assert np.allclose(state["start"], [0, -90, 90, 0, 90, 0], atol=1e-6)   # its PTP before RSI_ON
     poses = [e["axes"] for e in trace.events if e["kind"] == "pose"]
     assert np.allclose(poses[-1], np.array([0, -90, 90, 0, 90, 0]) + target, atol=1e-4)
+
+
+@pytest.mark.parametrize("interp", ["tree", "vm"])
+def test_without_a_sensor_every_packet_is_late(interp):
+    """No `network:` key: no socket, no pacing; RSI_ON sends to nobody, so the robot stops after
+    Timeout + 1 late cycles, deterministically, as KSS would without its sensor."""
+    from interp.run import make_runtime
+    from robot.trace import TraceWriter
+
+    trace = TraceWriter(keep=True)
+    rt, _ = make_runtime(EXAMPLES / "rsi_path.src", trace=trace, mujoco=False, interp=interp)
+    started = time.monotonic()
+    result = rt.run()
+    assert time.monotonic() - started < 30
+    assert result.reason == "error" and "late packets" in result.text
+    on = next(e["t"] for e in trace.events if e["kind"] == "net" and e["dir"] == "out")
+    err = next(e["t"] for e in trace.events if e["kind"] == "error")
+    assert err - on == pytest.approx(0.012 * 101, abs=1e-6)
+    assert rt.controller.network.pacer is None
