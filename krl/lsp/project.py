@@ -141,16 +141,18 @@ class Project:
         except OSError:
             return -1, -1
 
-    def load_files(self, paths: list[str]) -> None:
+    def load_files(self, paths: list[str], read: dict[str, tuple[tuple, SourceText]] | None = None) -> None:
         """Read the files `paths` from disk (the ones not read since they last changed): their
         parses from the persistent cache by content hash, the others parsed together (see the
-        module docstring) and put in the cache."""
+        module docstring) and put in the cache. `read`: path -> (stamp, source) of files read
+        already (:meth:`_read_keys`)."""
         todo = []
         for p in paths:
             stamp = self._stamp(p)
             got = self._disk.get(p)
             if got is None or got[0] != stamp:
-                todo.append((p, stamp, read_source(p)))
+                pre = (read or {}).get(p)
+                todo.append((p, stamp, pre[1] if pre is not None and pre[0] == stamp else read_source(p)))
         if not todo:
             return
         found: dict[str, object] = {}
@@ -250,25 +252,64 @@ class Project:
         docs = dict(self.docs) if docs is None else docs
         root, files, skipped = self.workspace_files(path, docs)
         p = norm(path)
-        if on_parsed is not None and root not in self.analyses and p in files:
+        first = root not in self.analyses
+        if on_parsed is not None and first and p in files:
             on_parsed(self.parsed(p, docs))
+        read: dict[str, tuple[tuple, SourceText]] = {}
+        cached = False
+        if on_cached is not None and first and self.store is not None and self.store.db is not None:
+            # the check's diagnostics from the cache before any parse is decoded: its key needs
+            # only the files' content hashes
+            key = _cache.check_key(self._read_keys(files, docs, read), [(str(e.path), e.message) for e in skipped])
+            got = self.store.get("check", [key]).get(key)
+            if got is not None:
+                try:
+                    on_cached(root, _cache.decode_diagnostics(got))
+                    cached = True
+                except _cache.CorruptEntry:
+                    self.store.corrupt += 1
         if not (self.watched and self._disk_known):     # else the client says when files change
-            self.load_files([f for f in files if f not in docs])
+            self.load_files([f for f in files if f not in docs], read)
         else:
-            self.load_files([f for f in files if f not in docs and f not in self._disk])
+            self.load_files([f for f in files if f not in docs and f not in self._disk], read)
         self._disk_known = True
         parsed = [self.parsed(f, docs) for f in files]
         an = self._recheck(root, files, parsed, skipped)
         if an is None:
-            an = self._check(root, parsed, skipped, on_cached)
+            an = self._check(root, parsed, skipped, None if first else on_cached, cached)
         self.analyses[root] = an
         for f in files:
             self._root_of[f] = root
         return an
 
-    def _check(self, root: str, parsed: list[Parsed], skipped, on_cached) -> Analysis:
+    def _read_keys(self, files: list[str], docs: dict[str, str],
+                   read: dict[str, tuple[tuple, SourceText]]) -> list[tuple[str, str]]:
+        """(path, content key) of `files` as :meth:`content_key` will give them once parsed,
+        from the files' bytes (a file read now is put in `read` for :meth:`load_files`)."""
+        out = []
+        for f in files:
+            text = docs.get(f)
+            got = self._disk.get(f)
+            if got is None or got[0] != self._stamp(f):
+                stamp = self._stamp(f)
+                src = read_source(f) if not is_uri(f) and stamp[0] != -1 else None
+                if src is not None:
+                    read[f] = (stamp, src)
+                disk = (src.text if src.status == "ok" else "", "b" + src.sha if src.sha else "") \
+                    if src is not None else None
+            else:
+                disk = (got[1].text, got[2])
+            if text is None:
+                out.append((f, disk[1] if disk is not None else ""))
+            else:
+                out.append((f, disk[1] if disk is not None and disk[0] == text else text_sha(text)))
+        return out
+
+    def _check(self, root: str, parsed: list[Parsed], skipped, on_cached, cached: bool = False) -> Analysis:
+        """Check the workspace whole; `on_cached(root, diagnostics)` when the cache holds its
+        diagnostics, which are put in the cache unless `cached` (they were found already)."""
         key = None
-        if self.store is not None and self.store.db is not None:
+        if not cached and self.store is not None and self.store.db is not None:
             key = _cache.check_key([(p.path, self.content_key(p)) for p in parsed],
                                    [(str(e.path), e.message) for e in skipped])
             if on_cached is not None:

@@ -108,3 +108,25 @@ def test_no_cache_when_the_folder_cannot_be_made(tmp_path: Path):
     assert store.db is None
     assert store.get("parse", ["a"]) == {}
     store.put("parse", {"a": b"x"})                     # never raises
+
+
+def test_the_cached_diagnostics_come_before_any_parse_is_decoded(tmp_path: Path, monkeypatch):
+    """The check's key needs only the files' content hashes: the cached diagnostics of a
+    workspace opened again are handed over before the first parse entry is decoded, with the
+    opened file's buffer as it is on disk and with a buffer edited in a session before."""
+    shutil.copytree(BACKUP, tmp_path / "KRC")
+    main = norm(tmp_path / "KRC" / "R1" / "Program" / "main.src")
+    text = Path(main).read_text()
+    edited = text.replace("\nEND", "\n  no_such_name = 1\nEND", 1)      # an undeclared name: a finding
+    assert edited != text
+    store = C.Store(tmp_path / "cache")
+    for docs in ({main: text}, {main: edited}):
+        expected = Project(store=store).analyze(main, docs=docs).ws.diagnostics
+        assert bool(expected) == (docs[main] is edited)
+        events: list = []
+        decode = C.decode_loaded
+        monkeypatch.setattr(C, "decode_loaded", lambda data, path: events.append("decoded") or decode(data, path))
+        an = Project(store=store).analyze(main, docs=docs, on_cached=lambda root, diags: events.append(rows(diags)))
+        monkeypatch.undo()
+        assert events[0] == rows(expected) == rows(an.ws.diagnostics)
+        assert events.count("decoded") >= 4 and len([e for e in events if e != "decoded"]) == 1
