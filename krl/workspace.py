@@ -519,7 +519,7 @@ class Workspace:
             self._declare_locals(rec)
         for u in self.units:
             if u.dat is not None and u.dat.module.data is not None:
-                st.values[id(u)] = self._check_values(u, u.dat.module.data.items, {})
+                st.set_values(u, self._check_values(u, u.dat.module.data.items, {}))
         for rec in st.routines:
             if self._body_wanted(rec):
                 self._check_body(rec)
@@ -609,7 +609,7 @@ class Workspace:
         out = [(st.decl_sink, st.decl_uses), *((rec.scope_diags, rec.scope_uses) for rec in st.routines)]
         for u in self.units:
             if u.dat is not None and self._reported(u.dat):
-                out += [(rec.diags, rec.uses) for rec in st.values.get(id(u), ())]
+                out += st.value_owners.get(id(u), ())
         out += [(rec.body_diags, rec.body_uses) for rec in st.routines
                 if rec.body_diags is not None and self._reported(rec.unit.src)]
         return out
@@ -778,7 +778,7 @@ class Workspace:
         for rec in st.values.get(id(unit), ()):
             if rec.move(old_template, lf.template):
                 kept[id(rec.item)] = rec
-        st.values[id(unit)] = self._check_values(unit, ndl.items, kept)
+        st.set_values(unit, self._check_values(unit, ndl.items, kept))
         return "values"
 
 
@@ -892,9 +892,17 @@ class _CheckState:
         self.routines: list[_RoutineCheck] = []
         self.by_routine: dict[int, _RoutineCheck] = {}
         self.values: dict[int, list[_ValueCheck]] = {}     # id(unit) -> its values' records
+        self.value_owners: dict[int, list[tuple]] = {}      # id(unit) -> (findings, uses) of the records with any
         self.symbols_of: dict[int, tuple] = {}  # id(declaration) -> (declaration, its symbols)
         self.report = DiagnosticSink()
         self.kuka: set[str] = set()
+
+    def set_values(self, unit: ModuleUnit, recs: list[_ValueCheck]) -> None:
+        """The records of `unit`'s data-list values; those without findings or unresolved
+        uses are left out of what each edit's report and assembly walk (a data list can hold
+        thousands of values)."""
+        self.values[id(unit)] = recs
+        self.value_owners[id(unit)] = [(r.diags, r.uses) for r in recs if r.diags.items or r.uses.items]
 
     def add_routine(self, rec: _RoutineCheck) -> None:
         self.routines.append(rec)
