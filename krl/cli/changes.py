@@ -97,7 +97,9 @@ def load_map(path: str):
         with backup_source(p) as (folder, shown):
             wss = workspaces_for(folder if shown.archive else p, timeout=PARSE_TIMEOUT_S)
             if len(wss) != 1:
-                raise ValueError(f"{path} holds {len(wss)} programs (KRC backups or folders); name one of them")
+                names = ", ".join(printable(shown(w.root)) for w in wss)
+                raise ValueError(f"{path} holds {len(wss)} programs (KRC backups or folders): {names}; "
+                                 "name one of them")
             ws = wss[0]
             pm = build_map(ws)
             diags = [shown.diagnostic(d) for d in ws.diagnostics]
@@ -114,11 +116,14 @@ def load_map(path: str):
 @click.command()
 @click.argument("backup")
 @click.option("--format", "fmt", type=click.Choice(["dot", "svg", "html", "json"]), default="dot", show_default=True,
-              help="dot: Graphviz source; svg: drawn by Graphviz's dot; html: one page; json: nodes and edges.")
+              help="dot: Graphviz source; svg: drawn by Graphviz's dot; html: an interactive page; json: nodes and edges.")
+@click.option("--links", type=click.Choice(["file", "vscode", "none"]), default="file", show_default=True,
+              help="html: how a routine links to its file:line (file: URL, vscode: URL, or no link).")
 @click.option("-o", "--output", default=None, help="Write to this file instead of standard output.")
-def graph(backup: str, fmt: str, output: str | None) -> None:
+def graph(backup: str, fmt: str, links: str, output: str | None) -> None:
     """The program map of a KRC backup (folder or .zip) or a folder: routines, calls,
-    interrupts, triggers, RUN commands and EKI channels, entry points and dead routines."""
+    interrupts, triggers, RUN commands and EKI channels, entry points and unreachable routines.
+    html: an interactive page (zoom, pan, search, a routine's neighbourhood), offline."""
     from krl.programmap.render import GraphTooLarge, GraphvizMissing, to_dot, to_html, to_svg  # noqa: PLC0415
 
     try:
@@ -128,7 +133,7 @@ def graph(backup: str, fmt: str, output: str | None) -> None:
         elif fmt == "svg":
             text = to_svg(pm)
         elif fmt == "html":
-            text = to_html(pm)
+            text = to_html(pm, links)
         else:
             text = to_dot(pm)
     except (ValueError, GraphTooLarge, GraphvizMissing) as exc:
