@@ -88,6 +88,7 @@ def load_map(path: str):
     from krl.archive import ArchiveError, backup_source  # noqa: PLC0415
     from krl.limits import PARSE_TIMEOUT_S  # noqa: PLC0415
     from krl.programmap import build_map  # noqa: PLC0415
+    from krl.project import folder_groups  # noqa: PLC0415
     from krl.workspace import workspaces_for  # noqa: PLC0415
 
     p = Path(path)
@@ -95,11 +96,13 @@ def load_map(path: str):
         raise ValueError(f"{path}:1:1: error[E001]: no such file or folder")
     try:
         with backup_source(p) as (folder, shown):
-            wss = workspaces_for(folder if shown.archive else p, timeout=PARSE_TIMEOUT_S)
-            if len(wss) != 1:
-                names = ", ".join(printable(shown(w.root)) for w in wss)
-                raise ValueError(f"{path} holds {len(wss)} programs (KRC backups or folders): {names}; "
+            target = folder if shown.archive else p
+            groups = folder_groups(target) if target.is_dir() else None
+            if groups is not None and len(groups) > 1:
+                names = ", ".join(printable(shown(root)) for root, _ in groups)
+                raise ValueError(f"{path} holds {len(groups)} programs (KRC backups or folders): {names}; "
                                  "name one of them")
+            wss = workspaces_for(target, timeout=PARSE_TIMEOUT_S, groups=groups)
             ws = wss[0]
             pm = build_map(ws)
             diags = [shown.diagnostic(d) for d in ws.diagnostics]

@@ -21,7 +21,9 @@ that applies is named):
 * ``cell`` -- the cell program (module ``CELL``, or a main routine ``DEF CELL()``), which
   Automatic External starts;
 * ``plc`` -- the program numbers the cell program's ``SWITCH`` selects: every routine called
-  in a ``CASE`` branch (KUKA's cell.src: ``SWITCH PGNO ... CASE 1 ... EXAMPLE1()``);
+  in one ``CASE`` branch (KUKA's cell.src: ``SWITCH PGNO ... CASE 1 ... EXAMPLE1()``); a
+  routine called in several branches is a step of the cell's own sequence
+  (``CellProgramStart()``), not a program;
 * ``submit`` -- every submit interpreter (``.sub`` file: ``sps.sub``);
 * ``selected`` -- every program a system data list (``$config.dat``, ``$custom.dat``,
   ``$option.dat``) names as ``"/R1/NAME()"`` (``$PRO_I_O``, ``$PRO_I_O_PROC_IDn``);
@@ -291,13 +293,23 @@ def _case_programs(pm: ProgramMap, ws: Workspace, cell_id: str) -> list[tuple[st
             continue
         for r in u.src.module.routines:
             for sw in (x for x in r.walk() if isinstance(x, N.Switch)):
+                branches = []
                 for case in sw.cases:
                     number = ", ".join(printer.expr(v) for v in case.values)
+                    calls = {}
                     for st in case.body:
                         for call in (x for x in st.walk() if isinstance(x, N.Call)):
                             target = _target(pm, ws, N.symbol_of(call))
                             if target is not None and not pm.nodes[target].kuka:
-                                out.append((number, target, call.span.line))
+                                calls.setdefault(target, call.span.line)
+                    branches.append((number, calls))
+                # a routine called in several branches is a step of the cell's own sequence
+                # (KUKA's template: CellProgramStart(), CellProgramEnd()), not a program
+                seen: dict[str, int] = {}
+                for _n, calls in branches:
+                    for t in calls:
+                        seen[t] = seen.get(t, 0) + 1
+                out += [(number, t, line) for number, calls in branches for t, line in calls.items() if seen[t] == 1]
     return out
 
 
