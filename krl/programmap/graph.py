@@ -75,6 +75,7 @@ class Node:
     unreachable: bool = False
     kuka: bool = False
     main: bool = False
+    end: int = 0                   # the END/ENDFCT line
 
     @property
     def dead(self) -> bool:
@@ -158,7 +159,8 @@ def build_map(ws: Workspace) -> ProgramMap:
             nid = routine_id(u.name, r.name)
             if nid in pm.nodes:
                 continue                   # a duplicate routine (E102): the first one stands
-            pm.nodes[nid] = Node(nid, r.name, u.name, u.src.path, r.span.line, kuka=kuka, main=i == 0)
+            pm.nodes[nid] = Node(nid, r.name, u.name, u.src.path, r.span.line, kuka=kuka, main=i == 0,
+                                 end=r.end_line or r.span.line)
             pm._by_decl[id(r)] = nid
             if i == 0:
                 mains[u.name.upper()] = nid

@@ -27,7 +27,8 @@ from urllib.parse import quote
 import graphviz
 from markupsafe import Markup
 
-from krl.limits import MAX_GRAPH_NODES
+from krl.limits import MAX_GRAPH_NODES, MAX_GRAPH_SOURCE_CHARS
+from krl.source import read_source
 from krl.programmap.graph import ProgramMap
 from krl.render import render_html
 
@@ -123,15 +124,28 @@ def _href(path: str, line: int, links: str) -> str:
 
 def page_data(pm: ProgramMap, links: str = "file") -> dict:
     """The map as the page's JSON: nodes (id, name, module, kind, file shown relative to the
-    root, line, href, system, entry, entry_kind, unreachable) and edges (source, target, kind,
-    file, line)."""
+    root, line, href, system, entry, entry_kind, unreachable, and ``source``: the routine's own
+    lines, DEF to END, up to krl.limits.MAX_GRAPH_SOURCE_CHARS in all) and edges (source,
+    target, kind, file, line)."""
+    texts: dict[str, list[str]] = {}
+    budget = MAX_GRAPH_SOURCE_CHARS
+    nodes = []
+    for n in pm.nodes.values():
+        source = []
+        if n.path and n.kind == "routine" and budget > 0:
+            if n.path not in texts:
+                texts[n.path] = (read_source(n.path).text or "").splitlines() if Path(n.path).is_file() else []
+            source = texts[n.path][n.line - 1:max(n.end, n.line)]
+            budget -= sum(len(x) + 1 for x in source)
+            if budget < 0:
+                source = []
+        nodes.append({"id": n.id, "name": n.name, "module": n.module, "kind": n.kind,
+                      "file": _short(n.path, pm.root) if n.path else "", "line": n.line,
+                      "href": _href(n.path, n.line, links) if n.path else "", "system": n.kuka,
+                      "entry": n.entry, "entry_kind": n.entry_kind, "unreachable": n.unreachable,
+                      "source": source})
     return {
-        "root": pm.root,
-        "nodes": [{"id": n.id, "name": n.name, "module": n.module, "kind": n.kind,
-                   "file": _short(n.path, pm.root) if n.path else "", "line": n.line,
-                   "href": _href(n.path, n.line, links) if n.path else "", "system": n.kuka,
-                   "entry": n.entry, "entry_kind": n.entry_kind, "unreachable": n.unreachable}
-                  for n in pm.nodes.values()],
+        "root": pm.root, "links": links, "nodes": nodes,
         "edges": [{"source": e.source, "target": e.target, "kind": e.kind, "file": _short(e.path, pm.root),
                    "line": e.line} for e in pm.edges],
     }

@@ -263,12 +263,50 @@ function routineButton(id, text) {
   return b;
 }
 
-function sourceLink(n) {
+function sourceLink(n, id) {
+  // the routine's file:line, opening its source in the page (its own lines travel in the JSON)
   const where = `${n.file}:${n.line}`;
-  if (!n.href) return el('code', where);
-  const a = el('a', where, { href: n.href, id: 'source-link' });
-  return a;
+  if (!n.source || !n.source.length) return n.href ? el('a', where, { href: n.href }) : el('code', where);
+  const attrs = { href: '#source=' + encodeURIComponent(n.id), class: 'source-link' };
+  if (id) attrs.id = id;
+  return el('a', where, attrs);
 }
+
+function showSource(id) {
+  const n = nodes.get(id);
+  const box = $('source');
+  box.replaceChildren();
+  if (!n) { box.hidden = true; return; }
+  const head = el('p');
+  head.append(el('strong', n.name));
+  head.append(document.createTextNode(` ${n.module} `));
+  head.append(el('code', `${n.file}:${n.line}`, { id: 'source-where' }));
+  if (n.href) {
+    head.append(document.createTextNode(' '));
+    head.append(el('a', data.links === 'vscode' ? 'open in VS Code' : 'open the file', { href: n.href, id: 'source-file' }));
+  }
+  const close = el('button', 'Close', { type: 'button' });
+  close.addEventListener('click', () => { box.hidden = true; history.replaceState(null, '', '#'); });
+  head.append(document.createTextNode(' '));
+  head.append(close);
+  box.append(head);
+  const pre = el('pre', null, { id: 'source-text' });
+  n.source.forEach((text, i) => {
+    const line = el('span', null, { class: 'src-line' + (i === 0 ? ' src-def' : ''), 'data-line': String(n.line + i) });
+    line.append(el('span', String(n.line + i).padStart(5, ' ') + '  ', { class: 'src-no' }));
+    line.append(document.createTextNode(text + '\n'));
+    pre.append(line);
+  });
+  box.append(pre);
+  box.hidden = false;
+  box.scrollIntoView({ block: 'nearest' });
+}
+
+function onHash() {
+  const m = /^#source=(.*)$/.exec(location.hash);
+  if (m) showSource(decodeURIComponent(m[1]));
+}
+window.addEventListener('hashchange', onHash);
 
 function showDetails(id) {
   const box = $('details');
@@ -280,7 +318,7 @@ function showDetails(id) {
     if (n.kind === 'routine') {
       box.append(el('p', `module ${n.module}${n.system ? " (KUKA's system software)" : ''}`));
       const p = el('p');
-      p.append(sourceLink(n));
+      p.append(sourceLink(n, 'source-link'));
       box.append(p);
       if (n.entry) box.append(el('p', 'entry point: ' + n.entry, { class: 'entry-why' }));
       if (n.unreachable) box.append(el('p', 'unreachable: no entry point starts it', { class: 'bad' }));
@@ -415,5 +453,5 @@ $('map-expand-all').addEventListener('click', () => {
 });
 $('map-collapse-all').addEventListener('click', () => { state.expanded.clear(); return overview(); });
 
-window.krlMap = { cy, state, focus, overview, toggle, render };
-render();
+window.krlMap = { cy, state, focus, overview, toggle, render, showSource };
+render().then(onHash);
