@@ -66,16 +66,17 @@ def diff(old: str, new: str, fmt: str, tolerance: float, output: str | None) -> 
         with side(old, single) as a, side(new, single) as b:
             d = diff_sides(a, b, tolerance)
             _echo_errors((a, b), set(d.not_compared))
+        if fmt == "json":
+            text = json.dumps(d.as_json(), indent=2, ensure_ascii=False)
+        elif fmt == "html":
+            text = diff_html(d)
+        else:
+            text = "\n".join(diff_text(d))
     except DiffInputError as exc:
         _fail("diff", exc)
     except Exception as exc:  # noqa: BLE001 - a last line of defence: no traceback
         _fail("diff", RuntimeError(f"internal error: {type(exc).__name__}: {exc}"))
-    if fmt == "json":
-        _write(json.dumps(d.as_json(), indent=2, ensure_ascii=False), output)
-    elif fmt == "html":
-        _write(diff_html(d), output)
-    else:
-        _write("\n".join(diff_text(d)), output)
+    _write(text, output)
     # files not compared (syntax errors): "no change" cannot be said
     sys.exit(1 if d.changed else 2 if d.not_compared else 0)
 

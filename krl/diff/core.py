@@ -101,7 +101,7 @@ def diff_sides(old: Side, new: Side, tolerance: float = 0.0) -> Diff:
     differences of REAL values. A file that did not parse on either side is unchanged when
     its text is the same on both, else listed in ``not_compared`` (its errors are the sides')."""
     d = Diff(old.path, new.path)
-    keys = list(new.files) + [k for k in old.files if k not in new.files]
+    keys = sorted(set(old.files) | set(new.files))
     ok_keys = []
     for k in keys:
         fo, fn = old.files.get(k), new.files.get(k)

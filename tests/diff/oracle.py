@@ -117,7 +117,7 @@ def same_leaf(a: tuple, b: tuple, real: bool, angle: bool) -> bool:
 
 def parse_all(paths: list[Path]) -> dict[Path, N.Module | None]:
     """{path: module AST, None when it did not parse}."""
-    outcomes = load_batch(paths, timeout=120.0)
+    outcomes = load_batch(paths, timeout=900.0)
     out = {}
     for p, o in zip(paths, outcomes):
         lf = getattr(o, "value", None)
