@@ -21,9 +21,10 @@ that applies is named):
 * ``cell`` -- the cell program (module ``CELL``, or a main routine ``DEF CELL()``), which
   Automatic External starts;
 * ``plc`` -- the program numbers the cell program's ``SWITCH`` selects: every routine called
-  in one ``CASE`` branch (KUKA's cell.src: ``SWITCH PGNO ... CASE 1 ... EXAMPLE1()``); a
-  routine called in several branches is a step of the cell's own sequence
-  (``CellProgramStart()``), not a program;
+  in a ``CASE`` branch (KUKA's cell.src: ``SWITCH PGNO ... CASE 1 ... EXAMPLE1()``; one program
+  may have several numbers, the first is named); a routine called in most branches (at least
+  three, more than half) is a step of the cell's own sequence (``CellProgramStart()``), not a
+  program;
 * ``submit`` -- every submit interpreter (``.sub`` file: ``sps.sub``);
 * ``selected`` -- every program a system data list (``$config.dat``, ``$custom.dat``,
   ``$option.dat``) names as ``"/R1/NAME()"`` (``$PRO_I_O``, ``$PRO_I_O_PROC_IDn``);
@@ -305,13 +306,15 @@ def _case_programs(pm: ProgramMap, ws: Workspace, cell_id: str) -> list[tuple[st
                             if target is not None and not pm.nodes[target].kuka:
                                 calls.setdefault(target, call.span.line)
                     branches.append((number, calls))
-                # a routine called in several branches is a step of the cell's own sequence
-                # (KUKA's template: CellProgramStart(), CellProgramEnd()), not a program
+                # a routine called in most branches (at least three, more than half) is a step
+                # of the cell's own sequence (CellProgramStart(), CellProgramEnd()), not a
+                # program; one program may have several numbers (CASE 1 and CASE 3: millingcn())
                 seen: dict[str, int] = {}
                 for _n, calls in branches:
                     for t in calls:
                         seen[t] = seen.get(t, 0) + 1
-                out += [(number, t, line) for number, calls in branches for t, line in calls.items() if seen[t] == 1]
+                step = {t for t, k in seen.items() if k >= 3 and 2 * k > len(branches)}
+                out += [(number, t, line) for number, calls in branches for t, line in calls.items() if t not in step]
     return out
 
 
