@@ -7,6 +7,9 @@ read in place (fmt works on a copy in a temporary folder).
   nothing but the files that did not parse left uncompared), and a second fmt changes nothing.
 * graph: the map of each side ends every edge at a node, names why each entry point is one, and
   no routine is both an entry point and unreachable; the JSON validates against its schema.
+
+The sweep reads every pair seven times over (about twice the cost of tests/diff/test_history.py,
+which stays in ``make test``): it is marked slow and runs in ``make nightly``.
 """
 
 from __future__ import annotations
@@ -23,6 +26,7 @@ from tests.diff.oracle import krl_files
 from tests.test_json_schemas import validate
 
 PAIRS = history_pairs() or ["(absent)"]
+pytestmark = pytest.mark.slow
 
 
 @pytest.fixture(autouse=True)
