@@ -1,4 +1,4 @@
-"""The program map of a checked workspace: routines, what calls what, entry points, dead code.
+"""The program map of a checked workspace: routines, what calls what, entry points, unreachable routines.
 
 :func:`build_map` reads a :class:`krl.workspace.Workspace` after ``ws.check()``. Every edge
 comes from the checker's annotations (``node.ann.symbol``, krl/semantics/checker.py), never
@@ -78,11 +78,6 @@ class Node:
     main: bool = False
     end: int = 0                   # the END/ENDFCT line
 
-    @property
-    def dead(self) -> bool:
-        """The former name of :attr:`unreachable`."""
-        return self.unreachable
-
 
 @dataclass(frozen=True)
 class Edge:
@@ -118,11 +113,6 @@ class ProgramMap:
     @property
     def unreachable(self) -> list[Node]:
         return [n for n in self.nodes.values() if n.unreachable]
-
-    @property
-    def dead(self) -> list[Node]:
-        """The former name of :attr:`unreachable`."""
-        return self.unreachable
 
     def as_json(self) -> dict:
         """``{"root", "nodes": [...], "edges": [...], "entries": [...], "unreachable": [...],
