@@ -37,7 +37,9 @@ that applies is named):
   controller calls them);
 * ``module`` -- for a folder that is not a KRC backup, the main routine of every module.
 
-A routine that none of these reaches along the edges is *unreachable* (``Node.unreachable``).
+A routine of the backup's own that none of these reaches along the edges is *unreachable*
+(``Node.unreachable``); a routine of KUKA's system software that nothing calls is unused
+library (the controller, its inline forms and technology packages call it), never unreachable.
 """
 
 from __future__ import annotations
@@ -320,4 +322,7 @@ def _mark_unreachable(pm: ProgramMap) -> None:
                 seen.add(t)
                 todo.append(t)
     for nid, n in pm.nodes.items():
-        n.unreachable = n.kind == "routine" and nid not in seen
+        # KUKA's system software is a library the controller, its inline forms and technology
+        # packages call (bas.src's SVEL_CP, collmonlib.src): what this backup does not call of
+        # it is unused, not unreachable
+        n.unreachable = n.kind == "routine" and not n.kuka and nid not in seen
