@@ -236,6 +236,10 @@ def test_corpus_backup_with_unparsed_files_against_itself_is_no_change(shared_co
     r = CliRunner().invoke(main, ["diff", str(b), str(b)])
     assert r.exit_code == 0, r.output
     assert "not compared" not in r.output and ": no change;" in r.output
+    assert "; 2 file(s) with syntax errors unchanged (the same text);" in r.output
+    r = CliRunner().invoke(main, ["diff", "--format", "json", str(b), str(b)])
+    summary = json.loads(r.stdout)["summary"]
+    assert (summary["unparsed_same"], summary["not_compared"]) == (2, 0)
 
 
 # The nine misses issue 37 saw on a real backup's history, each rebuilt on a small backup in
@@ -293,7 +297,7 @@ def test_the_nine_misses_of_issue_37(tmp_path):
                                "line": 2, "changed": {"PPDAT13.APO_DIST": [500.0, 200.0]}}]
     # 3. the summary names every kind compared, zeros included
     assert doc["summary"] == {"points": 0, "frames": 0, "values": 6, "routines": 0, "declarations": 1, "motions": 1,
-                              "files_compared": 5, "not_compared": 0}
+                              "files_compared": 5, "unparsed_same": 0, "not_compared": 0}
     # 4. F_TRIG defined twice: the first compared (no false "retyped"), the checker's E102 named
     assert [d["name"] for d in doc["declarations"]] == ["WEAV_DEF"]
     assert [(d["side"], d["file"], d["line"], d["code"]) for d in doc["duplicates"]] == [
