@@ -1,4 +1,5 @@
-"""Forward and inverse kinematics of the KR 6 R900 sixx in KUKA's conventions.
+"""Forward and inverse kinematics of any robot model (:class:`~robot.machine.MachineData`:
+the KR 6 R900 yaml or a backup's machine data) in KUKA's conventions.
 
 Sources: robot-model.md §2-§4 (chain, OPW parameters), §7 (frame chain),
 §8 (status S and turn T), reference §6.4-§6.5 and §8.2 (errors).
@@ -7,10 +8,20 @@ Units: mm and degrees everywhere (axis values A1..A6 in deg, frames as 4x4
 homogeneous transforms in mm). The FLANGE frame is KUKA's flange (= URDF
 ``tool0``: +Z out of the flange), expressed in ``$ROBROOT``.
 
-Forward kinematics walks the URDF chain of the yaml (joint origins and axes,
-``q_urdf = radians(A_i)``, robot-model.md §3). Inverse kinematics is the analytic
-OPW solution (Brandstötter et al. 2014) with the yaml ``opw`` parameters; it
-returns up to 8 solutions, one per status S (bits 0..2).
+Forward kinematics walks the URDF-style joints of the model (joint origins and axes,
+``q_urdf = radians(A_i)``, robot-model.md §3). The inverse kinematics is chosen from the
+chain, never from the robot's name (:attr:`Kinematics.family`):
+
+* ``"opw"``: the six-axis arm with a spherical wrist, the analytic OPW solution
+  (Brandstötter et al. 2014; its parameters from robot/chain.py ``opw_form``, with any
+  ``$TIRORO`` before it and any ``$TFLWP`` after it), up to 8 solutions, one per status S;
+* ``"palletizer4"`` (``$DEF_A4FIX`` and ``$DEF_A5LINK``) and ``"palletizer5"``
+  (``$DEF_A4FIX`` only): the closed forms of robot/ik_palletizer.py;
+* ``"numeric"``: any other arm, robot/ik_numeric.py (the MuJoCo model of the robot solved by
+  the ``mink`` library from seeds), with the same status/turn selection and errors.
+
+Each analytic form is checked against the machine-data chain when it is chosen. A vectorised
+entry point, :meth:`Kinematics.inverse_many`, solves N targets at once with numpy.
 """
 
 from __future__ import annotations
@@ -87,10 +98,81 @@ class Kinematics:
         self._ks_l = [float(v) for v in self._ks]
         # the 4-axis palletizer ($DEF_A5LINK, docs/robot.md "The palletizer"): its own inverse
         self._pa: tuple[np.ndarray, np.ndarray] | None = None
+        self._pa5: Any = None       # the 5-axis palletizer (robot/ik_palletizer.py)
+        self._numeric: Any = None   # the numeric solver (robot/ik_numeric.py), built on first use
+        self._base_inv: np.ndarray | None = None   # INV(frame before the OPW arm), None: identity
+        self._end_inv: np.ndarray | None = None    # INV(frame after it)
         self._s_free = 0            # S bits that select nothing on this robot
         self._t_free = 0            # T bits that select nothing on this robot
+        #: the inverse kinematics of this robot: "opw", "palletizer4", "palletizer5" or "numeric"
+        self.family = "opw"
+        where = m.provenance.get("$DEF_A4FIX", m.source)
         if m.a5link:
+            self.family = "palletizer4"
             self._init_palletizer()
+            self._check_palletizer4(where)
+        elif m.a4fix:
+            from .ik_palletizer import Palletizer5  # noqa: PLC0415
+
+            self.family = "palletizer5"
+            self._pa5 = Palletizer5(self)
+            self._s_free = 4
+            self._t_free = 0b01000
+            self._pa5.check(where)
+        elif m.chain is not None:
+            self._choose_form()
+
+    def _choose_form(self) -> None:
+        """The inverse of a machine-data arm: the standard OPW parameters of robot/mada.py when
+        they reproduce the chain, else the OPW form found in the chain's geometry
+        (robot/chain.py), else the numeric solver."""
+        from dataclasses import replace  # noqa: PLC0415
+
+        from .chain import opw_form  # noqa: PLC0415
+
+        if self._form_agrees():
+            return
+        form = opw_form(self.machine.chain)
+        if form is not None:
+            self._set_opw(form.params)
+            self._base_inv = np.linalg.inv(form.base) if form.base is not None else None
+            self._end_inv = np.linalg.inv(form.end) if form.end is not None else None
+            self.phi_deg = form.phi_deg
+            if self._form_agrees():
+                return
+            self._base_inv = self._end_inv = None
+        self._set_opw(replace(self.machine.opw))
+        self.phi_deg = float(self.machine.status_phi_deg)
+        self.family = "numeric"
+
+    def _set_opw(self, o) -> None:
+        self._opw = o
+        self._sign = np.array(o.sign_corrections, dtype=float)
+        self._off = np.radians(np.array(o.offsets_deg, dtype=float))
+        self._kappa_2 = o.a2 * o.a2 + o.c3 * o.c3
+        self._c2_2 = o.c2 * o.c2
+        self._k = math.sqrt(self._kappa_2)
+        self._at23 = math.atan2(o.a2, o.c3)
+        self._sgn = [float(v) for v in self._sign]
+        self._offs = [float(v) for v in self._off]
+
+    def _form_agrees(self) -> bool:
+        """True when the joints reproduce the machine-data chain and the analytic solutions
+        reproduce every sample pose (1e-6 mm; robot/chain.py ``chain_forward``)."""
+        from .chain import chain_forward  # noqa: PLC0415
+
+        chain = self.machine.chain
+        rng = np.random.default_rng(0)
+        lo = np.maximum(self._lo, -170.0)
+        hi = np.minimum(self._hi, 170.0)
+        for q in rng.uniform(lo, hi, size=(4, 6)):
+            T = chain_forward(chain, q)
+            if np.abs(self.forward(q) - T).max() > 1e-6:
+                return False
+            rows = self._opw_rows(T, None)
+            if not rows or min(np.abs(self.forward(r) - T).max() for r in rows) > 1e-6:
+                return False
+        return True
 
     # ------------------------------------------------------------------ FK
     def forward(self, axes_deg: Sequence[float]) -> np.ndarray:
@@ -241,6 +323,28 @@ class Kinematics:
         self._s_free = 4
         self._t_free = 0b11000
 
+    def _check_palletizer4(self, where: str) -> None:
+        """The 4-axis closed form must give back random linked configurations of the chain
+        (A4 = 0, A2 + A3 + A5 as at HOME); robot.mada.MachineDataError otherwise."""
+        from .chain import chain_forward  # noqa: PLC0415
+        from .mada import MachineDataError  # noqa: PLC0415
+
+        home = self._home
+        rng = np.random.default_rng(0)
+        lo = np.maximum(self._lo, -170.0)
+        hi = np.minimum(self._hi, 170.0)
+        for q in rng.uniform(lo, hi, size=(4, 6)):
+            q[3] = 0.0
+            q[4] = home[4] + home[1] + home[2] - q[1] - q[2]
+            T = self.forward(q)
+            if self.machine.chain is not None and np.abs(chain_forward(self.machine.chain, q) - T).max() > 1e-6:
+                raise MachineDataError(f"{where}: internal chain does not close")
+            rows = self._palletizer_rows(T, q)
+            if not rows or min(np.abs(self.forward(r) - T).max() for r in rows) > 1e-6:
+                raise MachineDataError(
+                    f"{where}: $DEF_A4FIX=TRUE, $DEF_A5LINK=TRUE: this palletizer's arm ($TIRORO, $TX3P3, "
+                    f"$DH_4, $DH_5, $TFLWP) is not one the 4-axis closed form covers")
+
     def _joint_point(self, axes_deg: Sequence[float], index: int) -> np.ndarray:
         """Position (mm, in ``$ROBROOT``) of the origin of joint `index` (0 = A1)."""
         q = self._kuka_sign * np.radians(np.asarray(axes_deg, dtype=float)[:6])
@@ -292,6 +396,21 @@ class Kinematics:
         palletizer :meth:`_palletizer_rows`."""
         if self._pa is not None:
             return self._palletizer_rows(flange_T, ref_deg)
+        if self._pa5 is not None:
+            return self._pa5.rows(flange_T, ref_deg)
+        if self.family == "numeric":
+            if self._numeric is None:
+                from .ik_numeric import NumericIK  # noqa: PLC0415
+
+                self._numeric = NumericIK(self)
+            return self._numeric.rows(flange_T, ref_deg)
+        if self._base_inv is not None or self._end_inv is not None:
+            T = np.asarray(flange_T, dtype=float)
+            if self._base_inv is not None:
+                T = self._base_inv @ T
+            if self._end_inv is not None:
+                T = T @ self._end_inv
+            return self._opw_core(T, ref_deg)
         return self._opw_core(flange_T, ref_deg)
 
     def _opw_core(self, flange_T: np.ndarray, ref_deg: np.ndarray | None) -> list[list[float]]:
@@ -402,7 +521,21 @@ class Kinematics:
                 ``$SOFTN_END``/``$SOFTP_END``.
         """
         ref = self._home.copy() if reference_deg is None else np.asarray(reference_deg, dtype=float)[:6]
-        rows = self._opw_rows(flange_T, ref)
+        if self.family == "numeric" and reference_deg is not None:
+            # the solution reached from the reference: the nearest one, when its S and T fit
+            if self._numeric is None:
+                self._opw_rows(np.eye(4), None)
+            near = self._numeric.rows(flange_T, ref, near_only=True)
+            if near:
+                try:
+                    return self._select(near, status, turn, ref)
+                except (WorkspaceError, SoftLimitError):
+                    pass
+        return self._select(self._opw_rows(flange_T, ref), status, turn, ref)
+
+    def _select(self, rows: list[list[float]], status: int | None, turn: int | None,
+                ref: np.ndarray) -> np.ndarray:
+        """The solution of `rows` that :meth:`inverse` returns (its steps 1-3), or its error."""
         if not rows:
             raise WorkspaceError("workspace error: target not reachable")
         if status is not None:

@@ -188,13 +188,15 @@ def test_missing_and_bad_values_name_file_and_line(tmp_path, shared_corpus):
         load_mada(p2)                      # a syntax error: file:line:col of the parser
     p2 = _write_mada(tmp_path / "b2", shared_corpus,
                      lambda t: t.replace("REAL $LENGTH_A=350.000", "REAL $LENGTH_A=TRUE"))
-    with pytest.raises(MachineDataError, match=r"\$machine\.dat:522: a number was expected, not True"):
+    with pytest.raises(MachineDataError, match=r"\$machine\.dat:522: \$LENGTH_A=TRUE: a number was expected"):
         load_mada(p2)
     p3 = _write_mada(tmp_path / "c", shared_corpus,
-                     lambda t: t.replace("$TX3P3={X 1200.00,Y 0.0,Z -41.0000,A 0.0,B 90.0000",
-                                         "$TX3P3={X 1200.00,Y 0.0,Z -41.0000,A 30.0,B 90.0000"))
-    with pytest.raises(MachineDataError, match="not of the standard KUKA structure"):
+                     lambda t: t.replace("DECL KINCLASS $KINCLASS=#STANDARD", "DECL KINCLASS $KINCLASS=#SPECIAL"))
+    with pytest.raises(MachineDataError, match=r"\$machine\.dat:455: \$KINCLASS=#SPECIAL: only the #STANDARD"):
         load_mada(p3)
+    p4 = _write_mada(tmp_path / "d", shared_corpus, lambda t: t.replace("$AXIS_DIR[3]=1", "$AXIS_DIR[3]=0"))
+    with pytest.raises(MachineDataError, match=r"\$AXIS_DIR\[3\]=0: 1 or -1 was expected"):
+        load_mada(p4)
 
 
 def test_palletizer_flag_fixes_a4(tmp_path, shared_corpus):
