@@ -78,8 +78,9 @@ def test_show_a_robot_of_the_library_by_name():
     res = CliRunner().invoke(main, ["robot", "show", "kr180_r3200_pa"])
     assert res.exit_code == 0, res.output
     assert res.output.splitlines()[0] == "robot      KR180R3200 PA C4 FLR"
-    assert "palletizer $DEF_A4FIX=True $DEF_A5LINK=True" in res.output
+    assert "palletizer $DEF_A4FIX=TRUE $DEF_A5LINK=TRUE" in res.output
     # reach to the A5 point by hand: 350 + 1350 + 1220
     assert "reach      2920.0 mm" in res.output
     res = CliRunner().invoke(main, ["robot", "show", "kr999"])
-    assert res.exit_code == 2 and "nor a robot of the library (kr180_r3200_pa, kr6_r900)" in res.output
+    assert res.exit_code == 2 and "nor a robot of the library (" in res.output
+    assert "kr180_r3200_pa, " in res.output and "kr6_r900)" in res.output
