@@ -619,6 +619,153 @@ class Kinematics:
         _, q, i = best_bad
         raise SoftLimitError(i + 1, float(q[i]), positive=bool(q[i] > self._hi[i]))
 
+    # ------------------------------------------------------------------ vectorised IK
+    def inverse_many(self, flange_T: np.ndarray, status: int | None = None, turn: int | None = None,
+                     reference_deg: Sequence[float] | np.ndarray | None = None) -> np.ndarray:
+        """:meth:`inverse` of N flange poses at once (numpy over the targets).
+
+        Args:
+            flange_T: (N, 4, 4) flange frames in ``$ROBROOT``, mm.
+            status, turn: as for :meth:`inverse`, the same for every target.
+            reference_deg: (6,) or (N, 6) axes (deg); default HOME.
+        Returns:
+            (N, 6) A1..A6 in deg, row i equal to ``inverse(flange_T[i], status, turn,
+            reference_deg[i])`` — bit for bit on the OPW family, where every operation is the
+            scalar one in the same order (``math.acos`` is used, as numpy's ``arccos`` may differ
+            in the last bit); the other families solve the rows one by one.
+        Raises:
+            WorkspaceError, SoftLimitError: those of the first row that fails, with the
+                attribute ``row`` (its index).
+        """
+        Ts = orig = np.asarray(flange_T, dtype=float).reshape(-1, 4, 4)
+        n = Ts.shape[0]
+        if reference_deg is None:
+            refs = np.broadcast_to(self._home, (n, 6)).astype(float)
+        else:
+            refs = np.broadcast_to(np.asarray(reference_deg, dtype=float)[..., :6], (n, 6)).astype(float)
+        if self.family != "opw" or n == 0:
+            return self._inverse_rows(Ts, status, turn, refs, range(n))
+        if self._base_inv is not None:
+            Ts = self._base_inv @ Ts
+        if self._end_inv is not None:
+            Ts = Ts @ self._end_inv
+        Q, valid = self._opw_core_many(Ts, refs)                   # (n, 8, 6), (n, 8)
+        S, amb = self._status_many(Q)                              # (n, 8)
+        if status is not None:
+            s_target = np.full(n, int(status) & 7)
+            free = np.zeros(n, dtype=int)
+        else:
+            s_target, free = self._status_many(refs[:, None, :])
+            s_target, free = s_target[:, 0], free[:, 0]
+        keep = ~free
+        match = valid & ((((S ^ s_target[:, None]) & ~amb & keep[:, None] & 7) == 0))
+        cands = Q[:, :, :, None] + np.array(self._ks_l)[None, None, None, :]   # (n, 8, 6, 5)
+        lo = np.array(self._lo_l)[None, None, :, None]
+        hi = np.array(self._hi_l)[None, None, :, None]
+        ok = (cands >= lo) & (cands <= hi)
+        if turn is not None:
+            t = int(turn) & ~self._t_free
+            neg = (((t >> np.arange(6)) & 1) == 1)[None, None, :, None]
+            free_t = (((self._t_free >> np.arange(6)) & 1) == 1)[None, None, :, None]
+            ok &= ((cands < 0) == neg) | (np.abs(cands) < 1e-6) | free_t
+        dist = np.where(ok, np.abs(cands - refs[:, None, :, None]), np.inf)
+        pick = np.argmin(dist, axis=3)                                          # first of equals
+        best = np.take_along_axis(cands, pick[..., None], axis=3)[..., 0]       # (n, 8, 6)
+        axis_ok = np.isfinite(np.take_along_axis(dist, pick[..., None], axis=3)[..., 0]).all(axis=2)
+        d = np.abs(best - refs[:, None, :])
+        cost = ((((d[..., 0] + d[..., 1]) + d[..., 2]) + d[..., 3]) + d[..., 4]) + d[..., 5]
+        usable = match & axis_ok
+        cost = np.where(usable, cost, np.inf)
+        j = np.argmin(cost, axis=1)
+        out = best[np.arange(n), j]
+        bad = ~usable.any(axis=1)
+        if bad.any():
+            out[bad] = self._inverse_rows(orig, status, turn, refs, np.flatnonzero(bad))
+        return out
+
+    def _inverse_rows(self, Ts: np.ndarray, status, turn, refs: np.ndarray, rows) -> np.ndarray:
+        """:meth:`inverse` row by row for the indices `rows`; the first error gets ``.row``."""
+        out = []
+        for i in rows:
+            try:
+                out.append(self.inverse(Ts[i], status, turn, refs[i]))
+            except (WorkspaceError, SoftLimitError) as exc:
+                exc.row = int(i)                     # type: ignore[attr-defined]
+                raise
+        return np.array(out, dtype=float).reshape(-1, 6)
+
+    def _status_many(self, Q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`_status_row` over the last axis of Q (..., 6): (S, ambiguous bits) arrays."""
+        o = self._opw
+        t2 = np.radians(self._sgn[1] * Q[..., 1]) - self._offs[1]
+        t23 = t2 + np.radians(self._sgn[2] * Q[..., 2]) - self._offs[2]
+        xw = o.a1 + o.c2 * np.sin(t2) + o.c3 * np.sin(t23) + o.a2 * np.cos(t23)
+        phi = self.phi_deg
+        s = ((xw < -BOUNDARY_EPS).astype(int) | ((Q[..., 2] >= phi - BOUNDARY_EPS).astype(int) << 1)
+             | ((Q[..., 4] < -BOUNDARY_EPS).astype(int) << 2))
+        amb = ((np.abs(xw) < OVERHEAD_SINGULAR_MM).astype(int) | ((np.abs(Q[..., 2] - phi) < 1e-7).astype(int) << 1)
+               | ((np.abs(Q[..., 4]) < WRIST_SINGULAR_DEG).astype(int) << 2) | self._s_free)
+        return s, amb
+
+    def _opw_core_many(self, Ts: np.ndarray, refs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`_opw_core` over N targets: (N, 8, 6) axes (deg, wrapped; NaN where a branch
+        does not exist) and the (N, 8) mask of existing solutions, in the scalar order."""
+        o = self._opw
+        acos = np.frompyfunc(math.acos, 1, 1)
+        atan2_ = np.frompyfunc(math.atan2, 2, 1)
+
+        def atan2(y, x):
+            return atan2_(y, x).astype(float)
+        r00, r01, r02, px = Ts[:, 0, 0], Ts[:, 0, 1], Ts[:, 0, 2], Ts[:, 0, 3]
+        r10, r11, r12, py = Ts[:, 1, 0], Ts[:, 1, 1], Ts[:, 1, 2], Ts[:, 1, 3]
+        r20, r21, r22, pz = Ts[:, 2, 0], Ts[:, 2, 1], Ts[:, 2, 2], Ts[:, 2, 3]
+        cx, cy, cz = px - o.c4 * r02, py - o.c4 * r12, pz - o.c4 * r22
+        rho2 = cx * cx + cy * cy - o.b * o.b
+        reach = rho2 >= 0.0
+        nx1 = np.sqrt(np.where(reach, rho2, 0.0)) - o.a1
+        over = np.sqrt(cx * cx + cy * cy) < OVERHEAD_SINGULAR_MM
+        tmp1 = np.where(over, np.radians(self._sgn[0] * refs[:, 0]) - self._offs[0], atan2(cy, cx))
+        tmp2 = atan2(o.b, nx1 + o.a1)
+        th1s = (tmp1 - tmp2, tmp1 + tmp2 - math.pi)
+        tmp3 = cz - o.c1
+        s1_2 = nx1 * nx1 + tmp3 * tmp3
+        tmp4 = nx1 + 2.0 * o.a1
+        s2_2 = tmp4 * tmp4 + tmp3 * tmp3
+        s_ = (np.sqrt(s1_2), np.sqrt(s2_2))
+        s_2 = (s1_2, s2_2)
+        base2 = (atan2(nx1, tmp3), -atan2(tmp4, tmp3))
+        n = Ts.shape[0]
+        Q = np.full((n, 8, 6), np.nan)
+        valid = np.zeros((n, 8), dtype=bool)
+        col = 0
+        for b in range(2):
+            with np.errstate(divide="ignore", invalid="ignore"):
+                arg2 = (s_2[b] + self._c2_2 - self._kappa_2) / (2.0 * s_[b] * o.c2)
+                arg3 = (s_2[b] - self._c2_2 - self._kappa_2) / (2.0 * o.c2 * self._k)
+            exists = reach & (s_[b] >= 1e-12) & (np.abs(arg2) <= 1.0 + _ACOS_TOL) & (np.abs(arg3) <= 1.0 + _ACOS_TOL)
+            a2c = acos(np.clip(np.where(exists, arg2, 0.0), -1.0, 1.0)).astype(float)
+            a3c = acos(np.clip(np.where(exists, arg3, 0.0), -1.0, 1.0)).astype(float)
+            for th1, th2, th3 in ((th1s[b], -a2c + base2[b], a3c - self._at23),
+                                  (th1s[b], a2c + base2[b], -a3c - self._at23)):
+                sn1, cs1 = np.sin(th1), np.cos(th1)
+                s23, c23 = np.sin(th2 + th3), np.cos(th2 + th3)
+                mm = r02 * s23 * cs1 + r12 * s23 * sn1 + r22 * c23
+                th5 = atan2(np.sqrt(np.maximum(0.0, 1.0 - mm * mm)), mm)
+                th4 = atan2(r12 * cs1 - r02 * sn1, r02 * c23 * cs1 + r12 * c23 * sn1 - r22 * s23)
+                th6 = atan2(r01 * s23 * cs1 + r11 * s23 * sn1 + r21 * c23,
+                                 -r00 * s23 * cs1 - r10 * s23 * sn1 - r20 * c23)
+                sing = np.abs(np.degrees(th5)) < WRIST_SINGULAR_DEG
+                total = th4 + th6
+                th4 = np.where(sing, np.radians(self._sgn[3] * refs[:, 3]) - self._offs[3], th4)
+                th6 = np.where(sing, total - th4, th6)
+                for sol in ((th1, th2, th3, th4, th5, th6), (th1, th2, th3, th4 + math.pi, -th5, th6 - math.pi)):
+                    for i, th in enumerate(sol):
+                        Q[:, col, i] = -((-np.degrees((th + self._offs[i]) * self._sgn[i]) + 180.0) % 360.0) + 180.0
+                    valid[:, col] = exists
+                    col += 1
+        Q[~valid] = np.nan
+        return Q, valid
+
     # ------------------------------------------------------------------ frame chain
     def tcp_pose(self, axes_deg: Sequence[float], tool: Any = None, base: Any = None,
                  robroot: Any = None) -> np.ndarray:
