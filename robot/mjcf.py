@@ -79,8 +79,24 @@ def build_mjcf(machine: MachineData | None = None, actuated: bool = False, *,
     rr = frame_to_matrix(m.robroot_frame)
     rx, ry, rz, rw = Rotation.from_matrix(rr[:3, :3]).as_quat()
     rr_attr = f'pos="{_vec(rr[:3, 3] / 1000.0)}" quat="{_vec((rw, rx, ry, rz))}"'
-    lines.append(f'    <site name="robroot" {rr_attr} size="0.01" rgba="0 0 1 1"/>')
-    lines.append(f'    <body name="base_link" {rr_attr}>')
+    # external kinematics (robot/external.py): a ROBROOT kinematic (#ERSYS) carries base_link, a
+    # BASE kinematic (#EASYS..) is a body tree of its own; their joints are named joint_e<n>
+    ext_close = 0
+    ersys = next((k for k in m.external_kinematics if k.robroot), None)
+    for kin in m.external_kinematics:
+        if kin is ersys:
+            continue
+        n_open = _ext_bodies(lines, m, kin, "    ")
+        lines.append("    " + "  " * n_open + f'<site name="et{kin.index}_flange" size="0.01" rgba="0 0 1 1"/>')
+        lines.append("    " + "  " * n_open + '<geom type="cylinder" size="0.4 0.02" rgba="0.5 0.5 0.5 1"/>')
+        for k in range(n_open, 0, -1):
+            lines.append("    " + "  " * (k - 1) + "</body>")
+    if ersys is not None:
+        ext_close = _ext_bodies(lines, m, ersys, "    ")
+        rr_attr = 'pos="0 0 0"'
+    pad = "  " * ext_close
+    lines.append(f'    {pad}<site name="robroot" {rr_attr} size="0.01" rgba="0 0 1 1"/>')
+    lines.append(f'    {pad}<body name="base_link" {rr_attr}>')
     # base column up to the A1 joint origin
     o1 = np.array(joints[0].origin_mm) / 1000.0
     lines.append(f'      <geom name="base_geom" type="capsule" size="0.07" fromto="0 0 0 {_vec(o1)}" rgba="0.2 0.2 0.2 1"/>')
@@ -111,6 +127,8 @@ def build_mjcf(machine: MachineData | None = None, actuated: bool = False, *,
         indent = indent[:-2]
         lines.append(f"{indent}</body>")
     lines.append("    </body>")
+    for k in range(ext_close, 0, -1):
+        lines.append("    " + "  " * (k - 1) + "</body>")
     lines.append("  </worldbody>")
     if actuated:
         lines.append("  <actuator>")
@@ -119,15 +137,57 @@ def build_mjcf(machine: MachineData | None = None, actuated: bool = False, *,
         for i, j in enumerate(joints):
             lines.append(f'    <velocity name="v{i + 1}" joint="{j.name}" kv="{_f(kv)}"/>')
         lines.append("  </actuator>")
-    home = [j.kuka_sign * math.radians(a) for j, a in zip(joints, m.home_deg)]
+    arm_home = [j.kuka_sign * math.radians(a) for j, a in zip(joints, m.home_deg)]
+    home = _ext_home(m, arm_home)
     lines.append("  <keyframe>")
     ctrl = ""
     if actuated:
-        ctrl = f' ctrl="{_vec(home + [0.0] * len(joints))}"'
+        ctrl = f' ctrl="{_vec(arm_home + [0.0] * len(joints))}"'
     lines.append(f'    <key name="home" qpos="{_vec(home)}"{ctrl}/>')
     lines.append("  </keyframe>")
     lines.append("</mujoco>")
     return "\n".join(lines) + "\n"
+
+
+def _ext_bodies(lines: list[str], m: MachineData, kin, indent: str) -> int:
+    """Open the bodies of the external kinematic `kin` (robot/external.py's chain: root,
+    TA1KR, axis, TA2A1, axis, ...; the axis along/about Z); returns how many were opened, the
+    last one being the kinematic's flange (TFLA3)."""
+    def attr(frame) -> str:
+        T = frame_to_matrix(*frame)
+        x, y, z, w = Rotation.from_matrix(T[:3, :3]).as_quat()
+        return f'pos="{_vec(T[:3, 3] / 1000.0)}" quat="{_vec((w, x, y, z))}"'
+
+    axes = {e.number: e for e in m.external_axes}
+    opened = 0
+    lines.append(f'{indent}<body name="et{kin.index}_root" {attr(kin.root)}>')
+    opened += 1
+    for k, num in enumerate(kin.axes):
+        e = axes[num]
+        lines.append(f'{indent}{"  " * opened}<body name="et{kin.index}_link{k + 1}" {attr(kin.frames[k])}>')
+        opened += 1
+        jt = "slide" if e.linear else "hinge"
+        scale = 0.001 if e.linear else math.pi / 180.0
+        rng = ("" if e.kind == "endless" else
+               f' range="{_f(e.limit[0] * scale)} {_f(e.limit[1] * scale)}"')
+        lines.append(f'{indent}{"  " * opened}<joint name="joint_e{num}" type="{jt}" axis="0 0 {e.direction}"{rng}/>')
+        lines.append(f'{indent}{"  " * opened}<geom type="box" size="0.15 0.15 0.05" rgba="0.3 0.3 0.6 1"/>')
+    lines.append(f'{indent}{"  " * opened}<body name="et{kin.index}_flange" {attr(kin.frames[3])}>')
+    return opened + 1
+
+
+def _ext_home(m: MachineData, home: list[float]) -> list[float]:
+    """The keyframe's qpos in MuJoCo's joint order: the bodies of the BASE kinematics come
+    first, then the ROBROOT kinematic's joints, then the arm (see build_mjcf)."""
+    axes = {e.number: e for e in m.external_axes}
+
+    def val(num: int) -> float:
+        e = axes[num]
+        return e.home * (0.001 if e.linear else math.pi / 180.0)
+
+    before = [val(n) for k in m.external_kinematics if not k.robroot for n in k.axes]
+    ers = [val(n) for k in m.external_kinematics if k.robroot for n in k.axes]
+    return before + ers + home
 
 
 _BOTTOM_ROW = np.array([0.0, 0.0, 0.0, 1.0])
