@@ -273,6 +273,26 @@ class MachineData:
     def max_jerk_deg_s3(self) -> tuple[float, ...]:
         return tuple(j.max_jerk_deg_s3 for j in self.joints)
 
+    @property
+    def n_ext(self) -> int:
+        """The number of external axes E1..En."""
+        return len(self.external_axes)
+
+    @property
+    def all_max_speed(self) -> tuple[float, ...]:
+        """Axis speeds of A1..A6 (deg/s) and then E1..En (mm/s or deg/s): the planner's axes."""
+        return self.max_speed_deg_s + tuple(e.max_speed for e in self.external_axes)
+
+    @property
+    def all_max_acc(self) -> tuple[float, ...]:
+        """Axis accelerations of A1..A6 and E1..En (deg/s^2, mm/s^2)."""
+        return self.max_acc_deg_s2 + tuple(e.max_acc for e in self.external_axes)
+
+    @property
+    def home_all(self) -> tuple[float, ...]:
+        """``$AXIS_HOME[1]``: A1..A6 and E1..En."""
+        return tuple(self.home_deg) + tuple(e.home for e in self.external_axes)
+
 
 def _floats(seq) -> tuple[float, ...]:
     return tuple(float(v) for v in seq)

@@ -1,5 +1,7 @@
-"""MuJoCo model of the KR 6 R900 sixx, generated from the machine-data yaml
-(robot-model.md §2, §11).
+"""MuJoCo model of a robot (:class:`~robot.machine.MachineData`: the KR 6 R900 yaml or a
+backup's machine data), generated from its joints (robot-model.md §2, §11), with its external
+kinematics (robot/external.py): a track's joint ``joint_e<n>`` carries ``base_link``, a
+turntable is a body tree of its own ending in the site ``et<n>_flange``.
 
 The body tree mirrors the URDF chain exactly (joint origins, axes, ranges), so
 ``qpos = kuka_sign * radians(A_i)`` (= radians(A_i) here, robot-model.md §3) and
@@ -216,6 +218,10 @@ class ArmModel:
         q0 = int(self._qadr[0])
         self._qidx = slice(q0, q0 + 6) if list(self._qadr) == list(range(q0, q0 + 6)) else self._qadr
         self._sign = np.array([j.kuka_sign for j in self.machine.joints], dtype=float)
+        # external axes E1..En (joint_e<n>): qpos in m or rad, set from mm or deg
+        ext = self.machine.external_axes
+        self._eadr = np.array([self.model.joint(f"joint_e{e.number}").qposadr[0] for e in ext], dtype=int)
+        self._escale = np.array([0.001 if e.linear else math.pi / 180.0 for e in ext])
         self._site = self.model.site("tool0").id
         self._robroot = frame_to_matrix(self.machine.robroot_frame)
         self._robroot_inv = inv_pos(self._robroot)
@@ -228,7 +234,10 @@ class ArmModel:
         """Kinematic playback: write ``qpos`` (and ``qvel``) from A1..A6 in deg (deg/s)
         and run ``mj_kinematics`` (``mj_forward`` with ``full=True``)."""
         d = self.data
-        d.qpos[self._qidx] = self._sign * np.radians(np.asarray(axes_deg, dtype=float)[:6])
+        a = np.asarray(axes_deg, dtype=float)
+        d.qpos[self._qidx] = self._sign * np.radians(a[:6])
+        if len(self._eadr) and len(a) > 6:
+            d.qpos[self._eadr] = self._escale * a[6:6 + len(self._eadr)]
         if vel_deg_s is not None:
             d.qvel[self._dadr] = self._sign * np.radians(np.asarray(vel_deg_s, dtype=float)[:6])
         if full:
@@ -237,8 +246,12 @@ class ArmModel:
             self._mj.mj_kinematics(self.model, d)
 
     def axes_deg(self) -> np.ndarray:
-        """Current A1..A6 (deg) read back from ``qpos``; shape (6,)."""
-        return np.degrees(self._sign * self.data.qpos[self._qidx])
+        """Current A1..A6 (deg) read back from ``qpos``, then E1..En (mm, deg) when the robot
+        has external axes; shape (6,) or (6 + n,)."""
+        q = np.degrees(self._sign * self.data.qpos[self._qidx])
+        if len(self._eadr):
+            q = np.concatenate([q, self.data.qpos[self._eadr] / self._escale])
+        return q
 
     def axes_vel_deg_s(self) -> np.ndarray:
         """Current axis speeds (deg/s) from ``qvel``; shape (6,)."""

@@ -144,3 +144,91 @@ def test_a_refusal_names_the_external_variable(tmp_path):
     p.write_text(text, encoding="utf-8")
     with pytest.raises(MachineDataError, match=r"\$AXIS_TYPE\[7\]=2"):
         load_mada(p)
+
+
+# ---------------------------------------------------------------- motions with external axes
+from robot.controller import Controller  # noqa: E402
+from robot.bench import run_motions  # noqa: E402
+from robot.limits import check_trace  # noqa: E402
+from robot.motion import MotionParams, MotionRequest  # noqa: E402
+from robot.trace import TraceWriter  # noqa: E402
+
+AX = ("A1", "A2", "A3", "A4", "A5", "A6")
+
+
+def _run(machine, reqs):
+    tw = TraceWriter(keep=True)
+    ctl = Controller(machine, trace=tw, mujoco=True)
+    run_motions(ctl, reqs)
+    poses = [e for e in tw.events if e["kind"] == "pose"]
+    return ctl, tw, np.array([p["axes"] for p in poses]), np.array([p["tcp"] for p in poses])
+
+
+def test_a_ptp_moves_the_track_synchronised_with_the_arm(track):
+    P = MotionParams.initmov(track)
+    start = dict(zip(AX, (0.0, -90.0, 90.0, 0.0, 45.0, 0.0)), E1=1000.0)
+    end = dict(zip(AX, (40.0, -70.0, 80.0, 10.0, 60.0, 30.0)), E1=2500.0)
+    ctl, tw, Q, _ = _run(track, [MotionRequest("PTP", start, P), MotionRequest("PTP", end, P)])
+    assert Q.shape[1] == 7
+    assert ctl.axis_act()[6] == pytest.approx(2500.0, abs=1e-6)
+    # synchronised: every axis covers the same fraction of its way in every cycle
+    moving = Q[(Q[:, 6] > 1000.0 + 1e-6) & (Q[:, 6] < 2500.0 - 1e-6)]
+    frac_e = (moving[:, 6] - 1000.0) / 1500.0
+    frac_a1 = moving[:, 0] / 40.0
+    np.testing.assert_allclose(frac_a1, frac_e, atol=1e-6)
+    assert check_trace(tw.events, track).ok
+
+
+def test_a_lin_on_the_track_keeps_the_tcp_on_its_line_in_the_world(track):
+    P = MotionParams.initmov(track).with_(vel_cp=0.3)
+    home = dict(zip(AX, (0.0, -90.0, 90.0, 0.0, 45.0, 0.0)), E1=1000.0)
+    k, ext = Kinematics(track), ExternalAxes(track)
+    q0 = np.array([0.0, -90.0, 90.0, 0.0, 45.0, 0.0])
+    W0 = ext.world_flange(k.forward, q0, [1000.0])
+    x0, y0, z0 = W0[:3, 3]
+    from robot.frames import matrix_to_frame
+
+    a, b, c = matrix_to_frame(W0)[3:]
+    target = {"X": x0 + 900.0, "Y": y0 + 200.0, "Z": z0 - 300.0, "A": a, "B": b, "C": c, "E1": 1800.0}
+    ctl, tw, Q, tcp = _run(track, [MotionRequest("PTP", home, P), MotionRequest("LIN", target, P)])
+    on = (Q[:, 6] > 1000.0 + 1e-6)
+    p = tcp[on, :3]
+    d = np.array([900.0, 200.0, -300.0])
+    frac = (p - [x0, y0, z0]) @ d / (d @ d)
+    off = (p - [x0, y0, z0]) - frac[:, None] * d
+    assert np.abs(off).max() < 0.01                              # straight in $WORLD (= $BASE)
+    np.testing.assert_allclose((Q[on, 6] - 1000.0) / 800.0, frac, atol=1e-4)   # E1 linear in the path
+    assert ctl.axis_act()[6] == pytest.approx(1800.0, abs=1e-6)
+    rep = check_trace(tw.events, track)
+    assert rep.ok, rep.summary()
+
+
+def test_a_base_on_the_turntable_turns_with_it(table):
+    """LIN in a $BASE linked to the table (EK): the TCP moves straight in the turning base."""
+    k, ext = Kinematics(table), ExternalAxes(table)
+    P = MotionParams.initmov(table).with_(vel_cp=0.2, base_kin="#EASYS")
+    home = dict(zip(AX, (0.0, -80.0, 100.0, 0.0, 70.0, 0.0)), E1=0.0)
+    p1 = {"X": -350.0, "Y": -100.0, "Z": 200.0, "A": 0.0, "B": 180.0, "C": 0.0}
+    p2 = {"X": -250.0, "Y": 150.0, "Z": 250.0, "A": 0.0, "B": 180.0, "C": 0.0, "E1": 40.0}
+    ctl, tw, Q, tcp = _run(table, [MotionRequest("PTP", home, P.with_(base_kin=None)),
+                                    MotionRequest("PTP", p1, P), MotionRequest("LIN", p2, P)])
+    assert ctl.axis_act()[6] == pytest.approx(40.0, abs=1e-6)
+    on = Q[:, 6] > 1e-6
+    assert on.sum() > 20
+    a, b = np.array([-350.0, -100.0, 200.0]), np.array([-250.0, 150.0, 250.0])
+    for q in Q[on]:
+        pt = (np.linalg.inv(ext.chain(table.external_kinematics[0], q[6:])) @ k.forward(q[:6]))[:3, 3]
+        f = float((pt - a) @ (b - a) / ((b - a) @ (b - a)))
+        assert np.linalg.norm(pt - (a + f * (b - a))) < 0.01
+        assert q[6] == pytest.approx(40.0 * f, abs=1e-3)
+    rep = check_trace(tw.events, table)
+    assert rep.ok, rep.summary()
+
+
+def test_an_external_axis_outside_its_limits_is_refused(track):
+    from robot.errors import SoftLimitError
+
+    ctl = Controller(track, mujoco=False)
+    P = MotionParams.initmov(track)
+    with pytest.raises(SoftLimitError, match=r"software limit switch \+E1"):
+        ctl.enqueue(MotionRequest("PTP", dict(zip(AX, (0.0, -90.0, 90.0, 0.0, 45.0, 0.0)), E1=5000.0), P))
