@@ -67,9 +67,8 @@ def step_st(draw):
     return step
 
 
-@pytest.fixture(scope="module", params=sorted(ROBOTS))
-def robot(request):
-    folder = ROBOTS[request.param]
+def _load(request, name):
+    folder = ROBOTS[name]
     if folder is None:
         return load_machine()
     from robot.mada import load_robot  # noqa: PLC0415
@@ -77,6 +76,16 @@ def robot(request):
     if folder.startswith("lib:"):
         return load_robot(folder[4:])
     return load_robot(request.getfixturevalue("shared_corpus") / folder)
+
+
+@pytest.fixture(scope="module", params=sorted(k for k, v in ROBOTS.items() if not (v or "").startswith("lib:")))
+def robot(request):
+    return _load(request, request.param)
+
+
+@pytest.fixture(scope="module", params=sorted(k for k, v in ROBOTS.items() if (v or "").startswith("lib:")))
+def library_robot(request):
+    return _load(request, request.param)
 
 
 def _shape(machine, q, e_frac=0.5):
@@ -165,6 +174,26 @@ def _requests(kin, steps):
           suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
 @given(steps=st.lists(step_st(), min_size=1, max_size=5), mode=st.sampled_from(["AUT", "AUT", "T1"]))
 def test_every_trace_keeps_the_limits(robot, steps, mode):
+    _keeps_the_limits(robot, steps, mode)
+
+
+@settings(max_examples=examples(3), deadline=None,
+          suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+@given(steps=st.lists(step_st(), min_size=1, max_size=5), mode=st.sampled_from(["AUT", "AUT", "T1"]))
+def test_every_trace_keeps_the_limits_on_the_library_robots(library_robot, steps, mode):
+    _keeps_the_limits(library_robot, steps, mode)
+
+
+@pytest.mark.slow
+@settings(max_examples=examples(30), deadline=None,
+          suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+@given(steps=st.lists(step_st(), min_size=1, max_size=5), mode=st.sampled_from(["AUT", "AUT", "T1"]))
+def test_long_run_on_the_library_robots(library_robot, steps, mode):
+    """The nightly's long run on the hand-written machine data (make nightly)."""
+    _keeps_the_limits(library_robot, steps, mode)
+
+
+def _keeps_the_limits(robot, steps, mode):
     tw = TraceWriter(keep=True)
     ctl = Controller(robot, trace=tw, mujoco=False, mode_op=mode)
     planned = 0
@@ -181,3 +210,29 @@ def test_every_trace_keeps_the_limits(robot, steps, mode):
     ctl.step_until(ctl.is_idle, max_cycles=200_000)
     rep = check_trace(tw.events, robot)
     assert rep.ok, f"{rep.summary()}\n" + "\n".join(str(v) for v in rep.violations[:10])
+
+
+def test_a_fixed_sequence_moves_every_library_robot(library_robot):
+    """The property run is not vacuous on the library robots: a fixed PTP, LIN, CIRC and SPLINE
+    sequence plans on each (no motion refused), moves it, and keeps the limits."""
+    P = MotionParams().with_(vel_cp=0.5)
+    q1, q2, q3 = (30.0, -80.0, 100.0, 20.0, 60.0, 10.0), (-20.0, -70.0, 90.0, -15.0, 50.0, -30.0), \
+        (10.0, -95.0, 110.0, 0.0, 70.0, 45.0)
+    steps = [{"kind": "PTP", "q": q1, "approx": None, "params": P, "bulge": 0.0, "e": 0.2},
+             {"kind": "LIN", "q": q2, "approx": "C_DIS", "params": P, "bulge": 0.0, "e": 0.6},
+             {"kind": "CIRC", "q": q3, "approx": None, "params": P, "bulge": 60.0, "e": 0.9},
+             {"kind": "SPLINE", "q": q1, "approx": None, "params": P, "bulge": 0.0, "e": 0.3,
+              "segs": [("SPL", q2, 0.0), ("SLIN", q1, 0.0)]}]
+    tw = TraceWriter(keep=True)
+    ctl = Controller(library_robot, trace=tw, mujoco=False)
+    reqs = _requests(ctl.model, steps)
+    assert len(reqs) == 5
+    for req in reqs:
+        while not ctl.can_enqueue():
+            ctl.step()
+        ctl.enqueue(req)                   # every motion plans
+    ctl.step_until(ctl.is_idle, max_cycles=200_000)
+    assert ctl.last_error is None
+    assert np.abs(ctl.axis_act()[:3] - np.array(q1[:3])).max() < 1e-6 or library_robot.a5link
+    rep = check_trace(tw.events, library_robot)
+    assert rep.ok, rep.summary()
