@@ -193,7 +193,13 @@ class Controller:
         io: the :class:`~robot.io.IOImage`.
         dt: IPO cycle in s (0.012).
         last_error: the last :class:`RobotError` of the main run, or None.
+        batch: class switch (default True): a CP segment at full path speed solves its
+            coming IPO cycles at once (robot/planner.py ``CartSegment.axes_run``; the same
+            setpoints bit for bit). False: every cycle alone (the reference path of
+            ``python -m robot.tracecheck --per-cycle``).
     """
+
+    batch: bool = True
 
     def __init__(self, machine: MachineData | None = None, *, trace: TraceWriter | None = None,
                  stimuli: list[Stimulus] | str | None = None, rules: list[Rule] | None = None,
@@ -730,6 +736,13 @@ class Controller:
             self._motion_event(seg, "end")
             seg._last_q = seg.q1.copy()
             return seg.q1.copy()
+        if self.batch and self._scale == 1.0 and self._scale_rate == 0.0:
+            # at full path speed pt advances by one cycle each step: the segment solves the
+            # coming cycles at once, up to its end or its blend start (robot/planner.py)
+            end = seg.T - EPS
+            if not r.decided and r.tau_cache is not None and r.tau_cache[1] is not None:
+                end = min(end, r.tau_cache[1] - EPS)
+            return seg.axes_run(pt, r.t0, self.dt * 0.5 * (1.0 + 1.0), end)
         return seg.axes(tau)
 
     def _begin_blend(self, r: _Run, pt: float, bp: "blending.BlendPlan") -> np.ndarray:
