@@ -659,10 +659,10 @@ class Kinematics:
         those of N calls in turn, or None when the chain is to be solved call by call (not
         the OPW family, an error on some pose, no fixed point within `passes`).
 
-        Each pass solves every row at once (:meth:`inverse_many`) with the previous pass's
-        rows, shifted by one, as references (first pass: `reference_deg` for all); a pass that
-        gives back its own references is the sequential chain (row i's reference is row i-1's
-        solution, by induction over i). The analytic solutions are computed once unless a
+        Each pass solves every row at once (:meth:`inverse_many`) with a guess of the rows,
+        shifted by one, as references (first pass: `reference_deg` for all; then the previous
+        pass's rows, unwrapped); a pass that gives back its guess is the sequential chain
+        (row i's reference is row i-1's solution, by induction over i). The analytic solutions are computed once unless a
         pose sits at a singularity, where they take a free angle from the reference.
         Raises nothing: errors give None (the caller's per-pose solve raises them)."""
         if self.family != "opw":
@@ -681,11 +681,16 @@ class Kinematics:
             Q, valid, ref_free = self._opw_core_many(Ts, refs)
             out = self._select_many(Q, valid, orig, status, None, refs)
             for _ in range(passes):
-                refs[1:] = out[:-1]
+                # the guess: each axis continued from the row before (±360°, np.unwrap), so a
+                # turn past ±180° is followed in one pass, within the soft limits (past one
+                # the pass's own value); unchanged values keep their bits
+                g = np.unwrap(out, period=360.0, axis=0)
+                g = np.where((g == out) | (g < self._lo) | (g > self._hi), out, g)
+                refs[1:] = g[:-1]
                 if not ref_free:
                     Q, valid, _ = self._opw_core_many(Ts, refs)
                 new = self._select_many(Q, valid, orig, status, None, refs)
-                if new.tobytes() == out.tobytes():
+                if new.tobytes() == g.tobytes():
                     return new
                 out = new
         except (WorkspaceError, SoftLimitError):
