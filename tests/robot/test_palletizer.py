@@ -109,3 +109,90 @@ def test_a_palletizer_whose_home_does_not_look_down_is_refused(tmp_path):
     bad.write_text(text, encoding="utf-8")
     with pytest.raises(MachineDataError, match=r"\$DEF_A5LINK.*straight down"):
         load_mada(bad)
+
+
+# ---------------------------------------------------------------- the 5-axis palletizer
+# robot/data/kr180_r3200_pa5.dat: the same arm with $DEF_A4FIX TRUE and $DEF_A5LINK FALSE (issue 34):
+# A5 is driven, so the flange tilts in the arm's vertical plane by d = A2 + A3 + A5 - 90 deg from
+# pointing straight down (A5 decreasing turns it towards the front, as A5 > 0 turns a six-axis
+# KUKA flange down). By hand, in the arm plane (r ahead, z up): the flange axis points along
+# (-sin d, -cos d), the direction 'ahead' of it along (cos d, -sin d), and the flange sits 280 mm
+# ahead of and 250 mm along the axis from the A5 point.
+
+PA5 = ROBOT_LIBRARY / "kr180_r3200_pa5.dat"
+
+
+@pytest.fixture(scope="module")
+def pa5():
+    return load_mada(PA5)
+
+
+def hand_flange5(a1, a2, a3, a5):
+    up, fore = math.radians(-a2), math.radians(-(a2 + a3))
+    d = math.radians(a2 + a3 + a5 - 90.0)
+    r = 350 + 1350 * math.cos(up) + 1220 * math.cos(fore) + 280 * math.cos(d) - 250 * math.sin(d)
+    z = 675 + 1350 * math.sin(up) + 1220 * math.sin(fore) - 280 * math.sin(d) - 250 * math.cos(d)
+    w = math.radians(-a1)
+    axis = np.array([-math.sin(d) * math.cos(w), -math.sin(d) * math.sin(w), -math.cos(d)])
+    return np.array([r * math.cos(w), r * math.sin(w), z]), axis
+
+
+def test_the_5_axis_palletizer_is_its_own_family(pa5):
+    assert pa5.a4fix and not pa5.a5link
+    assert Kinematics(pa5).family == "palletizer5"
+    assert pa5.joints[3].limit_deg == (0.0, 0.0)
+
+
+@pytest.mark.parametrize("q", [(0, -90, 90, 90), (30, -45, 90, 10), (-120, -100, 140, -30), (75, -20, 40, 100)])
+def test_5_axis_forward_kinematics_by_hand(pa5, q):
+    a1, a2, a3, a5 = q
+    T = Kinematics(pa5).forward([a1, a2, a3, 0.0, a5, 23.0])
+    pos, axis = hand_flange5(a1, a2, a3, a5)
+    assert np.allclose(T[:3, 3], pos, atol=1e-6)
+    assert np.allclose(T[:3, 2], axis, atol=1e-12)         # the flange's Z is the A6 axis
+
+
+def test_5_axis_inverse_round_trip(pa5):
+    k = Kinematics(pa5)
+    rng = np.random.default_rng(9)
+    n = 0
+    for _ in range(60):
+        axes = [rng.uniform(-170, 170), rng.uniform(-130, -15), rng.uniform(10, 150), 0.0,
+                rng.uniform(-115, 115), rng.uniform(-300, 300)]
+        if not k.within_limits(axes) or abs(axes[4]) < 1.0:
+            continue
+        s, t = k.status_turn(axes)
+        got = k.inverse(k.forward(axes), s, t, reference_deg=axes)
+        assert np.allclose(got, axes, atol=1e-7), (axes, got)
+        if s & 1 == 0:                   # from HOME (in front of A1): the position is reached
+            got = k.inverse(k.forward(axes), reference_deg=pa5.home_deg)
+            assert np.allclose(k.forward(got)[:3, 3], k.forward(axes)[:3, 3], atol=1e-6)
+        n += 1
+    assert n > 30
+
+
+def test_5_axis_target_out_of_the_arm_plane_keeps_its_position_and_pitch(pa5):
+    k = Kinematics(pa5)
+    axes = [20.0, -60.0, 110.0, 0.0, 30.0, 45.0]
+    T = k.forward(axes)
+    # tilt the target 5 deg about its own direction 'ahead' x the axis: out of the arm plane
+    from scipy.spatial.transform import Rotation
+
+    n = np.array([-math.sin(math.radians(-20.0)), math.cos(math.radians(-20.0)), 0.0])   # plane normal
+    ahead = np.cross(n, T[:3, 2])
+    R = Rotation.from_rotvec(ahead / np.linalg.norm(ahead) * math.radians(5.0)).as_matrix()
+    T2 = T.copy()
+    T2[:3, :3] = R @ T[:3, :3]
+    q = k.inverse(T2, reference_deg=axes)
+    F = k.forward(q)
+    assert np.allclose(F[:3, 3], T[:3, 3], atol=1e-6)         # the position is kept
+    assert abs(float(F[:3, 2] @ n)) < 1e-9                    # the A6 axis stays in the plane
+    assert np.allclose(q, axes, atol=1e-6)                    # the out-of-plane tilt is dropped
+
+
+def test_5_axis_status_bit_2_and_turn_of_a4_select_nothing(pa5):
+    k = Kinematics(pa5)
+    axes = [15.0, -54.0, 140.0, 0.0, 14.0, 14.0]
+    T = k.forward(axes)
+    for status, turn in ((2, 2), (6, 10), (6, 2)):
+        assert np.allclose(k.inverse(T, status, turn, pa5.home_deg), axes, atol=1e-7)
