@@ -17,7 +17,12 @@ kinematic (``MotionParams.base_kin``, KSS ``EK``) turns with it.
   a chain of path pieces (line, circular arc, Catmull-Rom curve for SPL points); the
   orientation follows ``$ORI_TYPE``/``$CIRC_TYPE``; axis values come from the inverse
   kinematics each cycle, keeping the start status S and the turn nearest to the last
-  setpoint (reference §6.5: CP motions ignore the target's S and T).
+  setpoint (reference §6.5: CP motions ignore the target's S and T). Where each solution
+  is the next one's reference (the planning walk of a path, the main run's coming cycles at
+  full path speed: :meth:`CartSegment.axes_run`) the chain is solved at once in numpy
+  (:meth:`RobotModel.ik_chain`), with the same results bit for bit; a kept row is used only
+  for the same time law, time and reference, so a BRAKE, a blend, an interrupt's motion or an
+  advance-run event between cycles gets the per-cycle setpoint.
 
 Planning happens in the advance run (:func:`plan`), so an unreachable target or a soft-limit
 violation of a target raises :class:`~robot.errors.RobotError` at the motion statement.
