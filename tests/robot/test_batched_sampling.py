@@ -91,5 +91,5 @@ def test_the_main_run_batched_writes_the_same_trace(case, monkeypatch):
     n_planning = calls["n"]
     monkeypatch.setattr(Controller, "batch", True)
     batched = tracecheck.run_case(case)
-    assert calls["n"] > 2 * n_planning > 0      # the main run solved chains of cycles
+    assert calls["n"] - 2 * n_planning > 0      # the main run solved chains of cycles
     assert batched == per_cycle
