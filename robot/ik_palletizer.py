@@ -26,11 +26,22 @@ import math
 from typing import Any
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 
 def _rot_about(axis: np.ndarray, angle: float) -> np.ndarray:
-    return Rotation.from_rotvec(axis * angle).as_matrix()
+    return _rotvecs(np.asarray(axis, dtype=float)[None, :] * angle)[0]
+
+
+def _rotvecs(v: np.ndarray) -> np.ndarray:
+    """Rotation matrices (N x 3 x 3) of rotation vectors `v` (N x 3, rad): Rodrigues' formula,
+    the matrices of scipy's ``Rotation.from_rotvec`` without its per-call overhead."""
+    th = np.linalg.norm(v, axis=1)
+    u = np.divide(v, th[:, None], out=np.zeros_like(v), where=th[:, None] > 0.0)
+    K = np.zeros((len(v), 3, 3))
+    K[:, 0, 1], K[:, 0, 2], K[:, 1, 2] = -u[:, 2], u[:, 1], -u[:, 0]
+    K[:, 1, 0], K[:, 2, 0], K[:, 2, 1] = u[:, 2], -u[:, 1], u[:, 0]
+    s, c = np.sin(th)[:, None, None], np.cos(th)[:, None, None]
+    return np.eye(3) + s * K + (1.0 - c) * (K @ K)
 
 
 class Palletizer5:
@@ -46,13 +57,14 @@ class Palletizer5:
         #: the A6 axis in the flange frame (constant: the flange turns with A6 about it)
         self.a6_in_flange = R0.T @ dirs[5]
         self.arm_opw = replace(kin._opw, c4=0.0)
+        self._a1_sign: float | None = None
 
     def joints(self, q: np.ndarray) -> tuple[list[np.ndarray], list[np.ndarray], np.ndarray]:
         """Points and unit directions of the six joint axes, and the flange (4x4), at axes `q`
         (deg), in ``$ROBROOT``."""
         k = self.kin
         qr = k._kuka_sign * np.radians(np.asarray(q, dtype=float)[:6])
-        Rj = Rotation.from_rotvec(k._axes * qr[:, None]).as_matrix()
+        Rj = _rotvecs(k._axes * qr[:, None])
         R = np.eye(3)
         p = np.zeros(3)
         pts, dirs = [], []
@@ -111,10 +123,10 @@ class Palletizer5:
 
     def _a1_of(self, azimuth: float) -> float:
         """A1 (deg) that turns the arm plane (the A1 = 0 plane contains +X) to `azimuth` (rad)."""
-        k = self.kin
-        pts, dirs, _ = self.joints(np.zeros(6))
-        d1 = dirs[0] / np.linalg.norm(dirs[0])
-        return math.degrees(azimuth) * (1.0 if d1[2] > 0 else -1.0)
+        if self._a1_sign is None:
+            d1 = self.joints(np.zeros(6))[1][0]
+            self._a1_sign = 1.0 if d1[2] > 0 else -1.0
+        return math.degrees(azimuth) * self._a1_sign
 
     def _wrist(self, a123, R: np.ndarray, a_des: np.ndarray, p: np.ndarray) -> list[float] | None:
         q = [float(a123[0]), float(a123[1]), float(a123[2]), 0.0, 0.0, 0.0]
@@ -133,8 +145,9 @@ class Palletizer5:
         Rc = R if s < 1e-15 else _rot_about(c / s, math.atan2(s, float(a_des @ a_p))) @ R
         d6 = dirs[5] / np.linalg.norm(dirs[5])
         rel = Rc @ F[:3, :3].T                                  # = Rot(d6, A6)
-        rv = Rotation.from_matrix(rel).as_rotvec()
-        q[5] = math.degrees(float(rv @ d6))
+        # the angle of the rotation `rel` about d6: sin from its skew part, cos from its trace
+        sin_t = 0.5 * float(d6 @ (rel[2, 1] - rel[1, 2], rel[0, 2] - rel[2, 0], rel[1, 0] - rel[0, 1]))
+        q[5] = math.degrees(math.atan2(sin_t, 0.5 * (float(np.trace(rel)) - 1.0)))
         q = [-((-v + 180.0) % 360.0) + 180.0 for v in q]
         if float(np.abs(self.kin.forward(q)[:3, 3] - p).max()) > 1e-6:
             return None

@@ -342,7 +342,7 @@ class Kinematics:
             rows = self._palletizer_rows(T, q)
             if not rows or min(np.abs(self.forward(r) - T).max() for r in rows) > 1e-6:
                 raise MachineDataError(
-                    f"{where}: $DEF_A4FIX=TRUE, $DEF_A5LINK=TRUE: this palletizer's arm ($TIRORO, $TX3P3, "
+                    f"{where}: $DEF_A4FIX=TRUE, A5 led ({'$NUM_AX=4' if 'a5_led' in self.machine.provenance else '$DEF_A5LINK=TRUE'}): this palletizer's arm ($TIRORO, $TX3P3, "
                     f"$DH_4, $DH_5, $TFLWP) is not one the 4-axis closed form covers")
 
     def _joint_point(self, axes_deg: Sequence[float], index: int) -> np.ndarray:

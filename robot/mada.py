@@ -60,6 +60,8 @@ RULES = {
     "external_speed": "derived: $VEL_AXIS_MA / |$RAT_MOT_AX.N / .D| * 6 deg/s (rotary) or * 1000/60 mm/s "
                       "(linear: N/D motor revolutions per 1000 mm, KR C2 machine-data handbook §2.1.10)",
     "ersysroot": "derived: $NULLFRAME ($ERSYSROOT not set)",
+    "a5_led": "derived: A5 led by the parallelogram, the flange kept vertical ($NUM_AX=4 with "
+              "$DEF_A4FIX=TRUE leaves A5 no drive, whatever $DEF_A5LINK says)",
     "easys_root": "derived: $WORLD (the root point of a BASE kinematic is MACHINE_DEF[].ROOT of "
                   "$config.dat, not machine data)",
 }
@@ -183,12 +185,18 @@ def _structure(machine: dict[str, DataValue], source: str, prov: dict[str, str])
     nax = machine.get("$NUM_AX")
     if nax is not None and nax.value is not None:
         n = nax.value
-        least = 4 if a5link else 5 if a4fix else 6
+        least = 4 if a4fix else 6
         if isinstance(n, bool) or not isinstance(n, int) or not least <= n <= 6:
             raise MachineDataError(f"{nax.where()}: $NUM_AX={krl_value(n)}: a robot with "
-                                   f"{'$DEF_A4FIX and $DEF_A5LINK' if a5link else '$DEF_A4FIX' if a4fix else 'six axes'}"
-                                   f" has {least}..6 axes")
+                                   f"{'$DEF_A4FIX' if a4fix else 'six axes'} has {least}..6 axes")
         prov["$NUM_AX"] = nax.where()
+        if a4fix and not a5link and n == 4:
+            # A1, A2, A3 and the flange axis A6 are driven: A5 has no drive, so the parallelogram
+            # leads it, whatever $DEF_A5LINK says (KUKA's palletizers keep $DEF_A5LINK FALSE).
+            a5link = True
+            prov["a5_led"] = (f"derived: A5 led by the parallelogram, the flange kept vertical "
+                              f"($NUM_AX=4 with $DEF_A4FIX=TRUE leaves A5 no drive; $DEF_A5LINK=FALSE "
+                              f"at {dv5.where() if dv5 is not None else 'default'})")
     return a4fix, a5link
 
 
@@ -392,6 +400,13 @@ def machine_from_values(machine: dict[str, DataValue], robcor: dict[str, DataVal
             (file:line, the variable and its value).
     """
     prov: dict[str, str] = {}
+    arm = ("$TRAFONAME", "$TIRORO", "$LENGTH_A", "$LENGTH_B", "$TX3P3", "$TFLWP")
+    if not any(machine.get(k) is not None and machine[k].value not in (None, {}, "") for k in arm):
+        steu = machine.get("$V_STEUMADA")
+        what = (f"it is the controller's machine data ($V_STEUMADA={krl_value(steu.value)[:40]}, STEU/Mada); "
+                f"the robot's is R1/Mada/$machine.dat" if steu is not None and steu.value else
+                "it is not a robot's $machine.dat")
+        raise MachineDataError(f"{source}: none of the robot's machine data ({', '.join(arm)}) is set: {what}")
     a4fix, a5link = _structure(machine, source, prov)
 
     tiroro, dv = _frame(machine, "$TIRORO", source)
@@ -459,7 +474,7 @@ def machine_from_values(machine: dict[str, DataValue], robcor: dict[str, DataVal
     robroot_T, dv = _frame(machine, "$ROBROOT", source) if "$ROBROOT" in machine else (np.eye(4), None)
     robroot = tuple(float(v) for v in matrix_to_frame(robroot_T))
     prov["$ROBROOT"] = dv.where() if dv is not None else "derived: $NULLFRAME ($ROBROOT not set)"
-    home, home_ext = _e6axis(machine, "$AXIS_HOME", 1, prov)
+    home, home_ext = _home(machine, prov)
     mames = (tuple(_axes(machine, "$MAMES", source)[0]) if "$MAMES" in machine else home)
     if "$MAMES" in machine:
         prov["$MAMES"] = machine["$MAMES"].where(1)
@@ -507,9 +522,11 @@ def machine_from_values(machine: dict[str, DataValue], robcor: dict[str, DataVal
         external_axes=ext_axes, external_kinematics=ext_kin)
     home_T = chain_forward(chain, model.home_deg)
     if a5link and abs(home_T[2, 2] + 1.0) > 1e-9:
-        where = prov.get("$AXIS_HOME[1]", prov["$DEF_A5LINK"])
+        label = "$AXIS_HOME[1]" if "$AXIS_HOME[1]" in prov else "$H_POS"
+        where = prov.get(label, prov.get("$DEF_A5LINK", source))
         raise MachineDataError(
-            f"{where}: $AXIS_HOME[1]={{A2 {home[1]:g},A3 {home[2]:g},A5 {home[4]:g}}}: with $DEF_A5LINK the "
+            f"{where}: {label}={{A2 {home[1]:g},A3 {home[2]:g},A5 {home[4]:g}}}: with A5 led "
+            f"({'$NUM_AX=4' if 'a5_led' in prov else '$DEF_A5LINK'}) the "
             f"flange of this palletizer must point straight down at HOME (the parallelogram keeps it so)")
     return replace(model, home_flange_pose=tuple(float(v) for v in matrix_to_frame(home_T)))
 
@@ -534,16 +551,24 @@ def _scalar(vals, name, default, prov) -> float:
     return _num(dv.value, dv.where())
 
 
-def _e6axis(vals, name, index, prov) -> tuple[tuple[float, ...], dict[str, float]]:
-    """A1..A6 of the E6AXIS ``name[index]`` and its E1..E6 (deg, mm)."""
-    dv = vals.get(name)
-    v = dv.value.get(index) if dv is not None and isinstance(dv.value, dict) else None
-    if not isinstance(v, dict):
-        prov["home_deg"] = "derived: {0, -90, 90, 0, 0, 0} ($AXIS_HOME[1] not set)"
-        return (0.0, -90.0, 90.0, 0.0, 0.0, 0.0), {}
-    prov[f"{name}[{index}]"] = dv.where(index)
-    ext = {f"E{i}": _num(v[f"E{i}"], dv.where(index), f"{name}[{index}].E{i}") for i in range(1, 7) if f"E{i}" in v}
-    return tuple(_num(v.get(f"A{i}", 0.0), dv.where(index), f"{name}[{index}].A{i}") for i in range(1, 7)), ext
+def _home(vals, prov) -> tuple[tuple[float, ...], dict[str, float]]:
+    """A1..A6 and E1..E6 (deg, mm) of the robot's HOME: the KR C4's ``$AXIS_HOME[1]``, else the
+    home position ``$H_POS`` that KR C2 and KR C4 machine data both hold, else the derived
+    {0, -90, 90, 0, 0, 0}."""
+    dv = vals.get("$AXIS_HOME")
+    v = dv.value.get(1) if dv is not None and isinstance(dv.value, dict) else None
+    if isinstance(v, dict) and any(k.startswith("A") for k in v):
+        label, where = "$AXIS_HOME[1]", dv.where(1)
+    else:
+        dv = vals.get("$H_POS")
+        v = dv.value if dv is not None else None
+        if not (isinstance(v, dict) and any(isinstance(k, str) and k.startswith("A") for k in v)):
+            prov["home_deg"] = "derived: {0, -90, 90, 0, 0, 0} ($AXIS_HOME[1] and $H_POS not set)"
+            return (0.0, -90.0, 90.0, 0.0, 0.0, 0.0), {}
+        label, where = "$H_POS", dv.where()
+    prov[label] = where
+    ext = {f"E{i}": _num(v[f"E{i}"], where, f"{label}.E{i}") for i in range(1, 7) if f"E{i}" in v}
+    return tuple(_num(v.get(f"A{i}", 0.0), where, f"{label}.A{i}") for i in range(1, 7)), ext
 
 
 def _load(robcor, prov) -> dict[str, Any]:

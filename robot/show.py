@@ -14,14 +14,14 @@ from .machine import MachineData
 _PARAMS = ("$TRAFONAME", "$KINCLASS", "$NUM_AX", "$TIRORO", "$LENGTH_A", "$LENGTH_B", "$TX3P3", "$DH_4",
            "$DH_5", "$TFLWP", "$AXIS_DIR", "$SOFTN_END", "$SOFTP_END", "$VEL_AXIS_MA", "$RAT_MOT_AX",
            "$RAISE_TIME", "$AXIS_JERK", "$VEL_MA", "$ACC_MA", "$ACC_OV", "$ROBROOT", "$DEF_A4FIX",
-           "$DEF_A5LINK", "$AXIS_HOME[1]", "home_deg", "$MAMES", "$IN_POS_CAR", "$IN_POS_ORI",
+           "$DEF_A5LINK", "a5_led", "$AXIS_HOME[1]", "$H_POS", "home_deg", "$MAMES", "$IN_POS_CAR", "$IN_POS_ORI",
            "$DEF_FLT_PTP", "$DEF_FLT_CP", "$DEF_L_M", "max_speed_deg_s", "max_acc_deg_s2", "opw",
            "status_phi_deg", "reach_wrist_point_mm", "ipo_cycle_s", "motion_defaults", "default_load",
            "$EX_AX_NUM", "$AXIS_TYPE", "E_speed", "$EX_KIN", "$ERSYSROOT")
 
 #: How each family of inverse kinematics is named (robot/kinematics.py ``Kinematics.family``).
 _FAMILIES = {"opw": "analytic (OPW: six axes, spherical wrist)",
-             "palletizer4": "analytic (4-axis palletizer: $DEF_A4FIX, $DEF_A5LINK)",
+             "palletizer4": "analytic (4-axis palletizer: $DEF_A4FIX, A5 led by the parallelogram)",
              "palletizer5": "analytic (5-axis palletizer: $DEF_A4FIX)",
              "numeric": "numeric (mink on the MuJoCo model; no closed form for this arm)"}
 
@@ -49,7 +49,9 @@ def show_lines(m: MachineData) -> list[str]:
     out.append(f"$VEL_MA    CP {m.vel_ma.cp:g} m/s, ORI1 {m.vel_ma.ori1:g}, ORI2 {m.vel_ma.ori2:g} deg/s; "
                f"$ACC_MA CP {m.acc_ma.cp:g} m/s2")
     if m.a4fix or m.a5link:
-        out.append(f"palletizer $DEF_A4FIX={str(m.a4fix).upper()} $DEF_A5LINK={str(m.a5link).upper()}")
+        led = "a5_led" in m.provenance     # $NUM_AX=4: A5 led although $DEF_A5LINK is FALSE
+        out.append(f"palletizer $DEF_A4FIX={str(m.a4fix).upper()} $DEF_A5LINK={str(m.a5link and not led).upper()}"
+                   + (" (A5 led: $NUM_AX=4)" if led else ""))
     acc_d = "*" if m.provenance.get("max_acc_deg_s2", "").startswith("derived") else " "
     jerk_d = "*" if m.provenance.get("$AXIS_JERK", "").startswith("derived") else " "
     out.append("axes       axis   limits (deg)         v max (deg/s)  a max (deg/s2)  jerk (deg/s3)")

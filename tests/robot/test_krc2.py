@@ -127,3 +127,20 @@ def test_a_kinclass_the_model_does_not_build_is_refused_naming_it(tmp_path):
     p.write_text(text, encoding="utf-8")
     with pytest.raises(MachineDataError, match=r"\$machine\.dat:15: \$KINCLASS=#DELTA_KIN"):
         load_mada(p)
+
+
+def test_home_from_h_pos_when_axis_home_is_absent(tmp_path):
+    """KR C2 machine data give the home position in $H_POS (E6AXIS); the model's HOME takes it,
+    naming its line, and a run starts there."""
+    line = "E6AXIS $H_POS={A1 10.0,A2 -80.0,A3 95.0,A4 5.0,A5 30.0,A6 -20.0,E1 0.0,E2 0.0,E3 0.0,E4 0.0,E5 0.0,E6 0.0}"
+    text = KR16.read_text(encoding="utf-8").replace("ENDDAT", line + "\nENDDAT")
+    p = tmp_path / "$machine.dat"
+    p.write_text(text, encoding="utf-8")
+    m = load_mada(p)
+    assert m.home_deg == (10.0, -80.0, 95.0, 5.0, 30.0, -20.0)
+    n = text.splitlines().index(line) + 1
+    assert m.provenance["$H_POS"] == f"{p}:{n}" and "home_deg" not in m.provenance
+    # the HOME flange pose is the forward kinematics of those axes
+    from robot.frames import matrix_to_frame
+
+    assert np.allclose(m.home_flange_pose, matrix_to_frame(Kinematics(m).forward(m.home_deg)), atol=1e-9)

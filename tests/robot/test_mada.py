@@ -227,3 +227,23 @@ def test_backup_zip_and_machine_dat_give_the_same_robot(tmp_path, shared_corpus)
     b = load_robot(archive)
     assert a.opw == b.opw and a.joints == b.joints
     assert b.source.startswith(archive)
+
+
+def test_every_machine_data_file_of_the_corpus(shared_corpus):
+    """Every ``$machine.dat`` of the corpus, found by walking it: a robot's (R1/Mada) builds the
+    model that BACKUPS describes; the controller's (STEU/Mada: signals, ``$V_STEUMADA``, no arm)
+    is refused with a message that says so and names the robot's file."""
+    files = sorted(p for p in shared_corpus.rglob("*") if p.name.lower() == "$machine.dat" and p.is_file())
+    robots, controllers = [], []
+    for f in files:
+        head = f.read_text(encoding="latin-1")
+        if "$V_STEUMADA" in head and "$TIRORO" not in head:
+            with pytest.raises(MachineDataError, match=r"none of the robot's machine data .* is set: it is the "
+                               r"controller's machine data \(\$V_STEUMADA=.*R1/Mada/\$machine\.dat"):
+                load_mada(f)
+            controllers.append(f)
+        else:
+            robots.append(str(f.relative_to(shared_corpus)))
+            assert load_mada(f).trafoname
+    assert sorted(robots) == sorted(f"{folder}/{rel}" for folder, rel, *_ in BACKUPS.values())
+    assert len(controllers) == len(robots)

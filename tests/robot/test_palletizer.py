@@ -196,3 +196,47 @@ def test_5_axis_status_bit_2_and_turn_of_a4_select_nothing(pa5):
     T = k.forward(axes)
     for status, turn in ((2, 2), (6, 10), (6, 2)):
         assert np.allclose(k.inverse(T, status, turn, pa5.home_deg), axes, atol=1e-7)
+
+
+# ---------------------------------------------------------------- KUKA's flags on a 4-axis palletizer
+# KUKA's palletizers keep $DEF_A4FIX TRUE and $DEF_A5LINK FALSE on the 4-axis form too; $NUM_AX = 4
+# (A1, A2, A3 and the flange axis A6 driven) leaves A5 without a drive, so the parallelogram leads it.
+
+
+@pytest.fixture(scope="module")
+def pa4_kuka_flags(tmp_path_factory):
+    text = PA5.read_text(encoding="utf-8").replace("INT $NUM_AX=5 ;", "INT $NUM_AX=4 ;")
+    assert "INT $NUM_AX=4 ;" in text and "BOOL $DEF_A5LINK=FALSE" in text
+    f = tmp_path_factory.mktemp("pa4") / "$machine.dat"
+    f.write_text(text, encoding="utf-8")
+    return load_mada(f)
+
+
+def test_num_ax_4_with_a5link_false_is_the_4_axis_palletizer(pa4_kuka_flags):
+    m = pa4_kuka_flags
+    assert m.a4fix and m.a5link and Kinematics(m).family == "palletizer4"
+    assert "$NUM_AX=4" in m.provenance["a5_led"] and m.provenance["a5_led"].startswith("derived")
+    from robot.show import show_lines
+
+    text = "\n".join(show_lines(m))
+    assert "$DEF_A4FIX=TRUE $DEF_A5LINK=FALSE (A5 led: $NUM_AX=4)" in text
+    assert "4-axis palletizer" in text
+
+
+@pytest.mark.parametrize("q", [(0, -90, 90), (30, -45, 90), (-120, -100, 140)])
+def test_num_ax_4_forward_and_inverse_are_those_of_the_linked_arm(pa4_kuka_flags, q):
+    a1, a2, a3 = q
+    axes = [a1, a2, a3, 0.0, 90.0 - a2 - a3, -40.0]
+    k = Kinematics(pa4_kuka_flags)
+    T = k.forward(axes)
+    assert np.allclose(T[:3, 3], hand_flange(a1, a2, a3), atol=1e-6)
+    assert T[2, 2] == pytest.approx(-1.0, abs=1e-12)
+    assert np.allclose(k.inverse(T, reference_deg=axes), axes, atol=1e-7)
+
+
+def test_num_ax_below_4_is_refused_naming_it(tmp_path):
+    bad = tmp_path / "$machine.dat"
+    bad.write_text(PA5.read_text(encoding="utf-8").replace("INT $NUM_AX=5 ;", "INT $NUM_AX=3 ;"),
+                   encoding="utf-8")
+    with pytest.raises(MachineDataError, match=r"\$machine.dat:21: \$NUM_AX=3: a robot with \$DEF_A4FIX has 4..6"):
+        load_mada(bad)
