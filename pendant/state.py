@@ -1,0 +1,166 @@
+"""What the pendant page shows, read from the engine on the engine's thread (pendant/engine.py
+``krl/state``): the status line, the pointers, the threads, the message window and the
+simulator's notes, the I/O by number and SIGNAL name, the watch list, the actual position.
+
+Every text here is data for the page (JSON): the page writes it with ``textContent``, never
+as markup (pendant/web/src/main.js).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from krl.limits import MAX_WEB_EXPRESSION_CHARS, MAX_WEB_WATCHES
+
+#: I/O shown always (the rest: declared as a SIGNAL, or TRUE)
+IO_ALWAYS = 16
+FRAME_KEYS = ("X", "Y", "Z", "A", "B", "C")
+
+
+def snapshot(s, args: dict) -> dict:
+    """The page's state of the engine session ``s`` (an interp.debug session with the
+    pendant's requests). ``args``: ``watch`` (expressions), ``static`` (also the signal table)."""
+    rt = s.rt
+    out = {"state": s.state, "pointers": s.pointers() if rt is not None else {}}
+    if rt is None:
+        return out
+    ctl = rt.controller
+    store = rt.sysvars.store
+    out.update({
+        "modeOp": "EXT" if rt.mode_op == "EX" else rt.mode_op,
+        "runMode": rt.run_mode,
+        "override": _num(store.get("$OV_PRO")),
+        "time": round(ctl.time, 3),
+        "stop": {"reason": getattr(s, "stop_reason", None), "description": getattr(s, "stop_description", None)}
+        if s.state == "stopped" else None,
+        "threads": _threads(s),
+        "messages": [{"handle": m.handle, "kind": m.kind, "text": m.text, "module": m.module,
+                      "number": m.number, "softkeys": m.softkeys, "time": round(m.time, 3)}
+                     for m in rt.messages.shown],
+        "notes": list(getattr(s, "notes", ())),
+        "io": _io(rt, getattr(s, "signals", None) or []),
+        "position": _position(rt),
+        "watch": _watch(s, args.get("watch") or []),
+    })
+    return out
+
+
+def _num(v):
+    return v if isinstance(v, (int, float)) and not isinstance(v, bool) else None
+
+
+def _threads(s) -> list[dict]:
+    out = []
+    try:
+        threads = s.thread_list()
+    except Exception:  # noqa: BLE001 - a thread list between two cycles may be incomplete
+        return out
+    for tid, name, _task, frames in threads:
+        f = frames[0] if frames else None
+        path = str(f.module.path) if f is not None and f.module is not None else None
+        out.append({"id": tid, "name": name, "routine": f.name if f is not None else None,
+                    "path": path, "line": f.line if f is not None else None})
+    return out
+
+
+def signals_of(rt) -> list[dict]:
+    """The SIGNAL declarations the program sees (global scope: $config.dat and public data
+    lists): name, I/O (``$IN``/``$OUT``/``$ANIN``/``$ANOUT``), first and last index, and the long
+    text (the comment of the declaration line, as KUKA's WorkVisual writes them)."""
+    from interp.run import signal_of  # noqa: PLC0415
+
+    prog = rt.program
+    scope = prog.ws.global_scope
+    main = prog.main_path.stem
+    out = []
+    lines_cache: dict[str, list[str]] = {}
+    for key, sym in sorted(scope.values.items()):
+        if sym.kind != "signal":
+            continue
+        where = signal_of(rt, main, sym.name)
+        if where is None:
+            continue
+        base, first, last = where
+        out.append({"name": sym.name, "io": base, "first": first, "last": last,
+                    "text": _long_text(sym, lines_cache)})
+        if len(out) >= 2000:
+            break
+    return out
+
+
+def _long_text(sym, cache: dict) -> str:
+    span = getattr(sym.decl, "span", None)
+    if span is None or not span.file:
+        return ""
+    lines = cache.get(span.file)
+    if lines is None:
+        try:
+            data = Path(span.file).read_bytes()[:4 * 1024 * 1024]
+            from krl.source import decode_bytes  # noqa: PLC0415
+
+            lines = decode_bytes(data)[0].splitlines()
+        except Exception:  # noqa: BLE001 - a long text is optional
+            lines = []
+        cache[span.file] = lines
+    if not 1 <= span.line <= len(lines):
+        return ""
+    text = lines[span.line - 1]
+    i = text.find(";")
+    return text[i + 1:].strip()[:80] if i >= 0 else ""
+
+
+def _io(rt, signals: list[dict]) -> dict:
+    io = rt.controller.io
+    names: dict[tuple[str, int], list[str]] = {}
+    for sig in signals:
+        if sig["last"] is None and sig["io"] in ("$IN", "$OUT"):
+            names.setdefault((sig["io"], sig["first"]), []).append(sig["name"])
+    rows = {}
+    for arr, get in (("$IN", io.get_in), ("$OUT", io.get_out)):
+        shown = set(range(1, IO_ALWAYS + 1)) | {n for (a, n) in names if a == arr}
+        entries = []
+        for n in sorted(shown):
+            if not 1 <= n <= 8192:
+                continue
+            sig = names.get((arr, n), [])
+            entries.append({"index": n, "value": bool(get(n)), "names": sig,
+                            "text": next((s["text"] for s in signals if s["io"] == arr and s["first"] == n
+                                          and s["last"] is None and s["text"]), "")})
+        rows[arr] = entries
+    return rows
+
+
+def _frame(v) -> dict | None:
+    f = getattr(v, "f", None)
+    if not isinstance(f, dict):
+        return None
+    out = {}
+    for k in FRAME_KEYS + ("S", "T"):
+        x = f.get(k)
+        if isinstance(x, (int, float)) and not isinstance(x, bool):
+            out[k] = round(float(x), 3)
+    return out
+
+
+def _position(rt) -> dict:
+    ctl = rt.controller
+    store = rt.sysvars.store
+    try:
+        pos = ctl.pos_act()
+    except Exception:  # noqa: BLE001 - a pose outside the model shows as unknown
+        pos = None
+    return {"axes": [round(float(v), 4) for v in ctl.axis_act()],
+            "pos": {k: round(float(v), 3) for k, v in pos.items()} if pos else None,
+            "base": _frame(store.get("$BASE")), "tool": _frame(store.get("$TOOL"))}
+
+
+def _watch(s, exprs: list) -> list[dict]:
+    out = []
+    for text in exprs[:MAX_WEB_WATCHES]:
+        text = str(text)[:MAX_WEB_EXPRESSION_CHARS]
+        try:
+            value = s.watch_value(text)
+            out.append({"expr": text, "value": value})
+        except Exception as exc:  # noqa: BLE001 - the watch shows why it has no value
+            out.append({"expr": text, "error": str(exc)[:200]})
+    return out
