@@ -219,9 +219,13 @@ class _Engine(DebugSession):
             return
         replay = self.target is not None or self.scan is not None
         robot = self.rt.robot
-        self.owner.live = {"time": ctl.time, "axes": [float(v) for v in ctl.axis_act()],
-                           "line": robot.line if robot is not None else None,
-                           "file": robot.file if robot is not None else None}
+        req = ctl.current_request()
+        self.owner.live = {
+            "time": round(ctl.time, 6), "axes": [float(v) for v in ctl.axis_act()],
+            "blending": getattr(ctl, "_blend", None) is not None,
+            "pointers": {"advanceRun": {"path": robot.file, "line": robot.line}
+                         if robot is not None and robot.at is not None else None,
+                         "mainRun": {"path": req.file, "line": req.line} if req is not None and req.line else None}}
         if replay or not self.owner.realtime or self.busy and not getattr(self, "pacing_busy", False):
             self._pace0 = None
             return

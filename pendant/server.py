@@ -1,0 +1,374 @@
+"""The pendant's web application: Starlette on uvicorn (its websockets come from the
+``websockets`` package), bound to loopback, behind :class:`pendant.security.Guard`.
+
+Routes: ``/`` the page, ``/static/...`` its bundle (built from pendant/web, committed), ``/ws``
+the one websocket. On the websocket the page sends operator actions as JSON objects
+``{"op": ..., ...}`` (:data:`OPS`) and receives ``{"type": ...}`` objects: ``init`` (workspace,
+programs, robot), ``module`` (a file's text and taught points), ``state`` (pendant/state.py),
+``live`` (time, axes and pointers at display rate while the program runs), ``error`` (a key's
+refusal, in the controller's words) and ``event`` (the engine's stops and ends).
+
+Threads: uvicorn's event loop serves the page; the program runs on the engine's thread
+(pendant/engine.py); a blocking engine request runs in the loop's executor. Limits
+(krl/limits.py): MAX_WEB_MESSAGE_BYTES per websocket message (uvicorn's ``ws_max_size``: a
+larger one closes the connection, 1009), MAX_WEB_CONNECTIONS websockets at once,
+MAX_WEB_MESSAGES_PER_S per connection (past it: closed, 1008).
+"""
+
+from __future__ import annotations
+
+import asyncio
+import contextlib
+import json
+import time
+from pathlib import Path
+
+from starlette.applications import Starlette
+from starlette.responses import FileResponse, PlainTextResponse, Response
+from starlette.routing import Mount, Route, WebSocketRoute
+from starlette.staticfiles import StaticFiles
+from starlette.websockets import WebSocket, WebSocketDisconnect
+
+from krl.limits import (MAX_WEB_BODY_BYTES, MAX_WEB_CONNECTIONS, MAX_WEB_EXPRESSION_CHARS, MAX_WEB_MESSAGE_BYTES,
+                        MAX_WEB_MESSAGES_PER_S, MAX_WEB_WATCHES)
+
+from .engine import MODES_OP, RUN_MODES, Engine, EngineError
+from .security import COOKIE, Guard, PathRefused, inside
+
+STATIC = Path(__file__).resolve().parent / "static"
+#: display rate of the live pose (Hz) and of the full state while running
+LIVE_HZ = 30.0
+STATE_HZ = 5.0
+CSP = ("default-src 'none'; script-src 'self'; style-src 'self'; img-src 'self' data: blob:; "
+       "connect-src 'self'; font-src 'self'; frame-ancestors 'self' vscode-webview:; base-uri 'none'; "
+       "form-action 'none'")
+OPS = ("hello", "select", "cancel", "reset", "start", "stop", "backward", "runMode", "modeOp", "drives",
+       "override", "breakpoint", "input", "ack", "answer", "watch", "setWatch", "jog", "touchup", "open")
+
+
+class Pendant:
+    """One workspace served to the pages connected to it (they share one selected program)."""
+
+    def __init__(self, root: Path, *, inputs: str | None = None, mode: str = "T1", realtime: bool = True,
+                 trace: str | None = None, program: str | None = None, readonly: bool = False,
+                 shown_root: str | None = None) -> None:
+        self.root = root.resolve()
+        self.shown_root = shown_root or str(root)
+        self.inputs = inputs
+        self.mode = mode
+        self.run_mode = "GO"
+        self.trace = trace
+        self.readonly = readonly
+        self.initial = program
+        self.engine = Engine(self._engine_event, realtime=realtime)
+        self.clients: set[WebSocket] = set()
+        self.loop: asyncio.AbstractEventLoop | None = None
+        self.program: str | None = None
+        self.drives = False
+        self.watch: list[str] = []
+        self.breakpoints: dict[str, set[int]] = {}
+        self.busy = asyncio.Lock()
+        self._robot = None
+        self._programs = None
+        self._last_live = None
+
+    # ------------------------------------------------------------------ static data
+    def robot(self) -> dict:
+        if self._robot is None:
+            from interp.run import robot_for  # noqa: PLC0415
+
+            from .view import robot_view  # noqa: PLC0415
+
+            probe = self.initial or next(iter(self.programs()), None)
+            prog = str(self.root / probe) if probe else str(self.root / "none.src")
+            self._robot = robot_view(robot_for(prog, str(self.root), None, self.inputs))
+        return self._robot
+
+    def programs(self) -> list[str]:
+        if self._programs is None:
+            from .view import programs  # noqa: PLC0415
+
+            self._programs = programs(self.root)
+        return self._programs
+
+    # ------------------------------------------------------------------ engine events
+    def _engine_event(self, msg: dict) -> None:
+        """Engine thread: hand the event to the loop."""
+        if self.loop is not None:
+            self.loop.call_soon_threadsafe(lambda: asyncio.ensure_future(self._on_event(msg)))
+
+    async def _on_event(self, msg: dict) -> None:
+        ev = msg.get("event")
+        if ev in ("stopped", "terminated", "exited", "output"):
+            await self.broadcast({"type": "event", "event": ev, "body": msg.get("body") or {}})
+            await self.push_state()
+
+    async def broadcast(self, msg: dict) -> None:
+        text = json.dumps(msg, allow_nan=False, default=str)
+        for ws in list(self.clients):
+            try:
+                await ws.send_text(text)
+            except Exception:  # noqa: BLE001 - a client gone meanwhile
+                self.clients.discard(ws)
+
+    async def state(self) -> dict:
+        if not self.engine.selected:
+            return {"state": "none", "program": None, "drives": self.drives, "modeOp": self.mode,
+                    "runMode": self.run_mode}
+        loop = asyncio.get_running_loop()
+        try:
+            s = await loop.run_in_executor(None, lambda: self.engine.request("krl/state", {"watch": self.watch}, 30.0))
+        except EngineError as exc:
+            s = {"state": "ended" if not self.engine.selected else "busy", "note": str(exc)}
+        s.update({"program": self.program, "drives": self.drives, "breakpoints":
+                  {p: sorted(v) for p, v in self.breakpoints.items()}})
+        return s
+
+    async def push_state(self) -> None:
+        if self.clients:
+            await self.broadcast({"type": "state", **await self.state()})
+
+    async def ticker(self) -> None:
+        """Display rate: the live pose while the program runs, the state now and then."""
+        period = 1.0 / LIVE_HZ
+        every = max(1, int(LIVE_HZ / STATE_HZ))
+        k = 0
+        while True:
+            await asyncio.sleep(period)
+            if not self.clients:
+                continue
+            live = self.engine.live
+            if live and live is not self._last_live:
+                self._last_live = live
+                await self.broadcast({"type": "live", **live})
+                k += 1
+                if k % every == 0 and self.engine.session is not None and self.engine.session.state == "running":
+                    await self.push_state()
+
+    # ------------------------------------------------------------------ operator actions
+    async def handle(self, ws: WebSocket, msg: dict) -> None:
+        op = msg.get("op")
+        if op not in OPS:
+            raise EngineError(f"unknown action {str(op)[:40]!r}")
+        loop = asyncio.get_running_loop()
+
+        def req(command, args=None, timeout=60.0):
+            return loop.run_in_executor(None, lambda: self.engine.request(command, args, timeout))
+
+        if op == "hello":
+            await ws.send_text(json.dumps({"type": "init", "workspace": self.shown_root, "programs": self.programs(),
+                                           "robot": self.robot(), "modes": MODES_OP, "runModes": RUN_MODES,
+                                           "readonly": self.readonly}))
+            if self.program is not None:
+                await self.send_module(ws, self.program)
+        elif op == "select":
+            await self.select(str(msg.get("program", "")))
+        elif op == "cancel":
+            await loop.run_in_executor(None, self.engine.cancel)
+            self.program = None
+        elif op == "reset":
+            if self.program is None:
+                raise EngineError("no program is selected")
+            await self.select(self.program)
+        elif op == "start":
+            self._need_drives()
+            await req("continue", {"threadId": 1})
+        elif op == "stop":
+            await req("pause", {"threadId": 1})
+        elif op == "backward":
+            self._need_drives()
+            await req("krl/backwardStep", {}, 600.0)
+        elif op == "runMode":
+            value = str(msg.get("value", "")).upper()
+            if value not in RUN_MODES:
+                raise EngineError(f"run mode: one of {', '.join(RUN_MODES)}")
+            self.run_mode = value
+            if self.engine.selected:
+                await req("krl/runMode", {"value": value})
+        elif op == "modeOp":
+            value = str(msg.get("value", "")).upper()
+            if value not in MODES_OP:
+                raise EngineError(f"operating mode: one of {', '.join(MODES_OP)}")
+            if self.engine.selected:
+                await req("krl/modeOp", {"value": value})
+            self.mode = value
+            self.drives = False          # turning the mode switch switches the drives off
+        elif op == "drives":
+            self.drives = bool(msg.get("on"))
+        elif op == "override":
+            await req("krl/override", {"value": msg.get("value")})
+        elif op == "breakpoint":
+            path = str(inside(self.root, str(msg.get("path", "")), suffixes=(".src", ".sub")))
+            line = msg.get("line")
+            if not isinstance(line, int) or isinstance(line, bool) or line < 1:
+                raise EngineError("breakpoint: a line number")
+            lines = self.breakpoints.setdefault(path, set())
+            (lines.add if msg.get("on") else lines.discard)(line)
+            if self.engine.selected:
+                await req("setBreakpoints", {"source": {"path": path},
+                                             "breakpoints": [{"line": n} for n in sorted(lines)]})
+        elif op == "input":
+            await req("krl/setInput", {"index": msg.get("index"), "value": bool(msg.get("value"))})
+        elif op == "ack":
+            await req("krl/message", {"handle": msg.get("handle")})
+        elif op == "answer":
+            await req("krl/message", {"handle": msg.get("handle"), "answer": msg.get("key")})
+        elif op == "watch":
+            exprs = msg.get("exprs")
+            if not isinstance(exprs, list) or len(exprs) > MAX_WEB_WATCHES or \
+                    any(not isinstance(e, str) or len(e) > MAX_WEB_EXPRESSION_CHARS for e in exprs):
+                raise EngineError(f"watch list: at most {MAX_WEB_WATCHES} expressions of "
+                                  f"{MAX_WEB_EXPRESSION_CHARS} characters")
+            self.watch = list(exprs)
+        elif op == "setWatch":
+            await req("krl/setWatch", {"expr": msg.get("expr"), "value": msg.get("value")})
+        elif op == "jog":
+            self._need_drives()
+            await req("krl/jog", {"system": msg.get("system"), "axis": msg.get("axis"), "step": msg.get("step")},
+                      120.0)
+        elif op == "touchup":
+            if self.readonly:
+                raise EngineError("touch-up: the workspace is a backup archive (read-only)")
+            dat = inside(self.root, str(msg.get("path", "")), suffixes=(".dat",))
+            await req("krl/touchUp", {"path": str(dat), "name": msg.get("name")})
+            if self.program is not None:
+                await self.broadcast_module(self.program)
+        elif op == "open":
+            path = inside(self.root, str(msg.get("path", "")), suffixes=(".src", ".sub", ".dat"))
+            await self.send_module(ws, str(path))
+            return
+        await self.push_state()
+
+    def _need_drives(self) -> None:
+        if not self.drives:
+            raise EngineError("the drives are off: switch them on first")
+
+    async def select(self, program: str) -> None:
+        from krl.project import boot_submit  # noqa: PLC0415
+
+        path = inside(self.root, program, suffixes=(".src",))
+        loop = asyncio.get_running_loop()
+        sub = boot_submit(path, self.root)
+        await self.broadcast({"type": "event", "event": "selecting", "body": {"program": str(path)}})
+        await loop.run_in_executor(None, lambda: self.engine.select(
+            str(path), workspace=str(self.root), inputs=self.inputs, mode=self.mode, run_mode=self.run_mode,
+            trace=self.trace, submit=[str(sub)] if sub is not None else []))
+        self.program = str(path)
+        for p, lines in self.breakpoints.items():
+            await loop.run_in_executor(None, lambda p=p, lines=lines: self.engine.request(
+                "setBreakpoints", {"source": {"path": p}, "breakpoints": [{"line": n} for n in sorted(lines)]}))
+        await self.broadcast_module(str(path))
+
+    async def send_module(self, ws: WebSocket, path: str) -> None:
+        from .view import module_view  # noqa: PLC0415
+
+        view = await asyncio.get_running_loop().run_in_executor(None, module_view, Path(path), self.root)
+        await ws.send_text(json.dumps({"type": "module", **view}))
+
+    async def broadcast_module(self, path: str) -> None:
+        for ws in list(self.clients):
+            try:
+                await self.send_module(ws, path)
+            except Exception:  # noqa: BLE001
+                self.clients.discard(ws)
+
+    # ------------------------------------------------------------------ websocket
+    async def websocket(self, ws: WebSocket) -> None:
+        if len(self.clients) >= MAX_WEB_CONNECTIONS:
+            await ws.close(code=1013, reason="too many connections")
+            return
+        await ws.accept()
+        self.clients.add(ws)
+        window, count = time.monotonic(), 0
+        try:
+            while True:
+                text = await ws.receive_text()
+                now = time.monotonic()
+                if now - window >= 1.0:
+                    window, count = now, 0
+                count += 1
+                if count > MAX_WEB_MESSAGES_PER_S:
+                    await ws.close(code=1008, reason="too many messages")
+                    return
+                if len(text) > MAX_WEB_MESSAGE_BYTES:
+                    await ws.close(code=1009, reason="message too large")
+                    return
+                try:
+                    msg = json.loads(text)
+                    if not isinstance(msg, dict):
+                        raise ValueError("not an object")
+                except ValueError:
+                    await ws.send_text(json.dumps({"type": "error", "text": "not a JSON object"}))
+                    continue
+                rid = msg.get("id")
+                try:
+                    async with self.busy:
+                        await self.handle(ws, msg)
+                    await ws.send_text(json.dumps({"type": "done", "id": rid, "op": str(msg.get("op"))[:40]}))
+                except (EngineError, PathRefused) as exc:
+                    await ws.send_text(json.dumps({"type": "error", "id": rid, "op": str(msg.get("op"))[:40],
+                                                   "text": str(exc)[:500]}))
+        except WebSocketDisconnect:
+            pass
+        finally:
+            self.clients.discard(ws)
+
+
+def create_app(pendant: Pendant, token: str, port_of) -> Guard:
+    """The ASGI application: the page, its bundle and the websocket behind the guard."""
+
+    async def index(request) -> Response:
+        resp = FileResponse(STATIC / "index.html", media_type="text/html")
+        resp.set_cookie(COOKIE, token, httponly=True, samesite="strict", path="/")
+        return resp
+
+    async def ws_endpoint(ws: WebSocket) -> None:
+        await pendant.websocket(ws)
+
+    @contextlib.asynccontextmanager
+    async def lifespan(app):
+        pendant.loop = asyncio.get_running_loop()
+        ticker = asyncio.ensure_future(pendant.ticker())
+        if pendant.initial:
+            try:
+                await pendant.select(pendant.initial)
+            except (EngineError, PathRefused) as exc:
+                print(f"krl pendant: {exc}", flush=True)
+        try:
+            yield
+        finally:
+            ticker.cancel()
+            await asyncio.get_running_loop().run_in_executor(None, pendant.engine.cancel)
+
+    async def not_found(request, exc) -> Response:
+        return PlainTextResponse("not found\n", status_code=404)
+
+    app = Starlette(routes=[Route("/", index), WebSocketRoute("/ws", ws_endpoint),
+                            Mount("/static", StaticFiles(directory=STATIC), name="static")],
+                    lifespan=lifespan, exception_handlers={404: not_found}, max_body_size=MAX_WEB_BODY_BYTES)
+    return Guard(_Headers(app), token, port_of)
+
+
+class _Headers:
+    """Adds the page's security headers (CSP, no sniffing, no referrer, no caching of the token
+    page) to every HTTP response."""
+
+    def __init__(self, app) -> None:
+        self.app = app
+
+    async def __call__(self, scope, receive, send) -> None:
+        if scope["type"] != "http":
+            await self.app(scope, receive, send)
+            return
+
+        async def send_with(msg):
+            if msg["type"] == "http.response.start":
+                headers = list(msg.get("headers") or [])
+                headers += [(b"content-security-policy", CSP.encode()), (b"x-content-type-options", b"nosniff"),
+                            (b"referrer-policy", b"no-referrer"), (b"cache-control", b"no-store")]
+                msg = {**msg, "headers": headers}
+            await send(msg)
+        await self.app(scope, receive, send_with)
+
+
+__all__ = ["Pendant", "create_app", "CSP", "OPS"]
