@@ -262,6 +262,11 @@ class _Engine(DebugSession):
 
     def stop(self, task, reason: str, description: str | None = None, *args, **kw) -> None:
         self._pace0 = None                   # time stands while stopped
+        if self._trace is not None:          # the trace up to the stop is on disk while it stands
+            self._trace.flush()
+            fh = getattr(self._trace, "_fh", None)
+            if fh is not None:
+                fh.flush()
         self.stop_reason, self.stop_description = reason, description or kw.get("text")
         super().stop(task, reason, description, *args, **kw)
 

@@ -339,7 +339,7 @@ function loadRobot(r) {
     tool0.add(toolFrame);
   }
   P.robot = robot;
-  const span = Math.max(1.5, reach * 1.6);
+  const span = Math.max(1.2, reach * 1.05);
   camera.position.set(span * 1.1, span * 0.9, span * 1.2);
   controls.target.set(0, reach * 0.45, 0);
   controls.update();
