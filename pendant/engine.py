@@ -213,6 +213,19 @@ class _Engine(DebugSession):
             self._trace.close()
             self._trace = None
 
+    def _flush_trace(self) -> None:
+        if self._trace is not None:
+            self._trace.flush()
+            fh = getattr(self._trace, "_fh", None)
+            if fh is not None:
+                fh.flush()
+
+    def req_krl_backwardStep(self, req, args) -> None:  # noqa: N802
+        try:
+            super().req_krl_backwardStep(req, args)
+        finally:
+            self._flush_trace()
+
     def _cycle(self, ctl) -> None:
         """Once per IPO cycle (engine thread): publish the live pose, pace to the wall clock."""
         if self.rt is None or ctl is not self.rt.controller:
@@ -262,11 +275,7 @@ class _Engine(DebugSession):
 
     def stop(self, task, reason: str, description: str | None = None, *args, **kw) -> None:
         self._pace0 = None                   # time stands while stopped
-        if self._trace is not None:          # the trace up to the stop is on disk while it stands
-            self._trace.flush()
-            fh = getattr(self._trace, "_fh", None)
-            if fh is not None:
-                fh.flush()
+        self._flush_trace()                  # the trace up to the stop is on disk while it stands
         self.stop_reason, self.stop_description = reason, description or kw.get("text")
         super().stop(task, reason, description, *args, **kw)
 
@@ -446,6 +455,7 @@ class _Engine(DebugSession):
             rt.wait_main_run(task)
         finally:
             self.busy = False
+            self._flush_trace()
         self.respond(req, {"axes": [float(v) for v in ctl.axis_act()]})
 
     def req_krl_message(self, req, args) -> None:

@@ -156,7 +156,12 @@ class Pendant:
             return loop.run_in_executor(None, lambda: self.engine.request(command, args, timeout))
 
         if op == "hello":
-            await ws.send_text(json.dumps({"type": "init", "workspace": self.shown_root, "programs": self.programs(),
+            from .view import modules  # noqa: PLC0415
+
+            entries = self.programs()
+            others = [m for m in await loop.run_in_executor(None, modules, self.root) if m not in set(entries)]
+            await ws.send_text(json.dumps({"type": "init", "workspace": self.shown_root, "programs": entries,
+                                           "modules": others,
                                            "robot": self.robot(), "modes": MODES_OP, "runModes": RUN_MODES,
                                            "readonly": self.readonly}))
             if self.program is not None:

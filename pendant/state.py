@@ -65,24 +65,20 @@ def _threads(s) -> list[dict]:
 
 def signals_of(rt) -> list[dict]:
     """The SIGNAL declarations the program sees (global scope: $config.dat and public data
-    lists): name, I/O (``$IN``/``$OUT``/``$ANIN``/``$ANOUT``), first and last index, and the long
-    text (the comment of the declaration line, as KUKA's WorkVisual writes them)."""
-    from interp.run import signal_of  # noqa: PLC0415
+    lists), read from the checked AST (nothing is evaluated, so the run is not touched): name,
+    I/O (``$IN``/``$OUT``/``$ANIN``/``$ANOUT``), first and last index, and the long text (the
+    comment of the declaration line, as KUKA's WorkVisual writes them)."""
+    from krl.ast import nodes as N  # noqa: PLC0415
 
-    prog = rt.program
-    scope = prog.ws.global_scope
-    main = prog.main_path.stem
+    scope = rt.program.ws.global_scope
     out = []
     lines_cache: dict[str, list[str]] = {}
-    for key, sym in sorted(scope.values.items()):
-        if sym.kind != "signal":
+    for _key, sym in sorted(scope.values.items()):
+        d = sym.decl
+        if sym.kind != "signal" or not isinstance(d, N.SignalDecl) or d.start is None:
             continue
-        where = signal_of(rt, main, sym.name)
-        if where is None:
-            continue
-        base, first, last = where
-        out.append({"name": sym.name, "io": base, "first": first, "last": last,
-                    "text": _long_text(sym, lines_cache)})
+        out.append({"name": sym.name, "io": d.start.sysvar.upper(), "first": d.start.index,
+                    "last": d.end.index if d.end is not None else None, "text": _long_text(sym, lines_cache)})
         if len(out) >= 2000:
             break
     return out

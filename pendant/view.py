@@ -30,6 +30,15 @@ def programs(root: Path) -> list[str]:
     return out
 
 
+def modules(root: Path) -> list[str]:
+    """Every program file (.src) of the workspace, relative to ``root`` (the navigator's view:
+    any of them can be selected)."""
+    from krl.files import walk  # noqa: PLC0415
+
+    out = [e.rel for e in walk(root.resolve()) if e.kind == "file" and e.rel.lower().endswith(".src")]
+    return sorted(out, key=str.lower)[:5000]
+
+
 def module_view(path: Path, root: Path) -> dict:
     """``{path, lines, points}``: the text of ``path`` (lines as str) and the taught points of
     its data list (the .dat beside it, any case)."""

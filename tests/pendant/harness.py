@@ -60,13 +60,20 @@ def pendant_server(target: Path, *args: str):
             proc.wait(30)
 
 
-@contextmanager
-def browser_page(url: str, viewport=(1400, 900)):
-    """A fresh headless Chromium profile with the page loaded and its robot drawn; page errors
-    are collected in ``page.problems``."""
+@pytest.fixture(scope="session")
+def pw():
+    """The one Playwright driver of the session (its sync API cannot be nested)."""
     import playwright.sync_api as playwright  # noqa: PLC0415 - a dev dependency: missing fails
 
-    with playwright.sync_playwright() as pw, tempfile.TemporaryDirectory() as profile:
+    with playwright.sync_playwright() as p:
+        yield p
+
+
+@contextmanager
+def browser_page(pw, url: str, viewport=(1400, 900)):
+    """A fresh headless Chromium profile with the page loaded and its robot drawn; page errors
+    are collected in ``page.problems``."""
+    with tempfile.TemporaryDirectory() as profile:
         # bypass_csp: Playwright's wait_for_function evaluates its predicate, which the page's
         # Content-Security-Policy (script-src 'self') forbids; the page itself runs under it
         ctx = pw.chromium.launch_persistent_context(profile, executable_path=chromium_or_skip(), headless=True,

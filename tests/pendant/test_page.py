@@ -16,8 +16,8 @@ import sys
 import pytest
 
 from tests.conftest import REPO_ROOT
-from tests.pendant.harness import (CELLS, KR120, MILLING, act, browser_page, cell_without, pendant_server,
-                                   pose_at, read_trace, select, state, wait_state)
+from tests.pendant.harness import (CELLS, KR120, MILLING, browser_page, cell_without, pendant_server, pose_at,  # noqa: F401
+                                   pw, read_trace, select, state, wait_state)
 
 pytestmark = pytest.mark.may_skip("chromium is missing and cannot be installed (not root, or apt-get has no network)")
 
@@ -27,11 +27,11 @@ TOL_DEG = 0.01
 
 
 @pytest.fixture(scope="module")
-def kr120(shared_corpus, tmp_path_factory):
+def kr120(pw, shared_corpus, tmp_path_factory):
     """One server on the KR 120 backup (khrzysio__KRC4_test) with its cell, and one page."""
     trace = tmp_path_factory.mktemp("pendant") / "run.jsonl"
     with pendant_server(KR120, "--no-realtime", "--inputs", str(KR120_CELL), "--trace", str(trace)) as url, \
-            browser_page(url) as page:
+            browser_page(pw, url) as page:
         page.trace_path = trace
         yield page
         assert page.problems == []
@@ -141,11 +141,11 @@ def test_override_changes_the_motion_time(kr120):
     assert times[40] > 1.5 * times[100], times
 
 
-def test_quit_message_is_acknowledged(shared_corpus, tmp_path):
+def test_quit_message_is_acknowledged(pw, shared_corpus, tmp_path):
     """ChinaMilling's PokeOutputs.src: MsgQuit("Output Value not initialized!") then HALT; the
     program waits in MsgLib's EXISTS_KRLMSG loop until the operator acknowledges."""
     trace = tmp_path / "run.jsonl"
-    with pendant_server(MILLING, "--no-realtime", "--trace", str(trace)) as url, browser_page(url) as page:
+    with pendant_server(MILLING, "--no-realtime", "--trace", str(trace)) as url, browser_page(pw, url) as page:
         select(page, "KRC/R1/System/PokeOutputs.src", run_mode="GO", mode="AUT")
         page.click("#start")
         s = wait_state(page, "s.messages && s.messages.some(m => m.kind == 'QUIT')")
@@ -165,13 +165,13 @@ def test_quit_message_is_acknowledged(shared_corpus, tmp_path):
     assert end and end[-1]["reason"] == "halt" and end[-1]["t"] > t_shown + 1.0
 
 
-def test_input_by_hand_releases_wait_for(shared_corpus, tmp_path):
+def test_input_by_hand_releases_wait_for(pw, shared_corpus, tmp_path):
     """PrepareMillingTools waits at Spindle.src:140 (WAIT FOR inHsdToolReleased, $IN[8]) after
     opening the tool release; the cell without its answer leaves the input to the operator."""
     cell = cell_without(KR120_CELL, "inHsdToolReleased", tmp_path / "cell.yaml")
     trace = tmp_path / "run.jsonl"
     with pendant_server(KR120, "--no-realtime", "--inputs", str(cell), "--trace", str(trace)) as url, \
-            browser_page(url) as page:
+            browser_page(pw, url) as page:
         select(page, PREPARE, run_mode="GO", mode="AUT")
         page.click("#start")
         s = wait_state(page, "s.pointers.advanceRun && s.pointers.advanceRun.path.endsWith('Spindle.src')"
@@ -190,12 +190,12 @@ def test_input_by_hand_releases_wait_for(shared_corpus, tmp_path):
     assert ev and ev[0]["value"] is True and ev[0]["source"] == "operator" and ev[0]["t"] > t_wait + 2.0
 
 
-def test_the_pendant_run_gives_krl_runs_trace(shared_corpus, tmp_path):
+def test_the_pendant_run_gives_krl_runs_trace(pw, shared_corpus, tmp_path):
     """The same program, cell and modes: the trace of the run under the pendant (GO, AUT, run to
     its end from the page) is byte for byte the trace of `krl run`."""
     trace = tmp_path / "pendant.jsonl"
     with pendant_server(KR120, "--no-realtime", "--inputs", str(KR120_CELL), "--trace", str(trace),
-                        "--mode", "AUT") as url, browser_page(url) as page:
+                        "--mode", "AUT") as url, browser_page(pw, url) as page:
         select(page, PREPARE, run_mode="GO", mode="AUT")
         page.click("#start")
         s = wait_state(page, "s.state == 'ended' || s.state == 'none'", timeout=900_000)

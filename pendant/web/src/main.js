@@ -75,7 +75,8 @@ function fillSelect(sel, values, current) {
 
 function onInit(m) {
   $('workspace').textContent = m.workspace;
-  fillSelect($('programs'), m.programs);
+  const group = (label, values) => el('optgroup', { label }, ...values.map((v) => el('option', { text: v, value: v })));
+  $('programs').replaceChildren(group('entry points', m.programs), group('other modules', m.modules || []));
   fillSelect($('mode-op'), m.modes);
   fillSelect($('run-mode'), m.runModes);
   $('touchup').disabled = !!m.readonly;
