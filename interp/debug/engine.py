@@ -101,21 +101,17 @@ class Restart(BaseException):
 
 @dataclass
 class LaunchConfig:
-    """What to run and how (``krl run``'s options, docs/editors.md "Launch").
-
-    ``program``: a .src path; ``workspace``: its folder or KRC backup (a .zip is extracted by
-    the front end); ``inputs``: the cell file; ``mode``: T1/T2/AUT/EXT; ``run_mode``:
-    GO/MSTEP/ISTEP/BSTEP; ``interp``: tree or vm; ``max_sim_time`` (s); ``submit``: submit
-    programs beside the robot program; ``stop_on_entry``: stop at the first statement."""
-    program: str
-    workspace: str | None = None
-    inputs: str | None = None
-    mode: str = "T1"
-    run_mode: str = "GO"
-    interp: str = "tree"
+    """What to run and how: ``options``, ``krl run``'s options by their click names
+    (interp/cli.py ``run``: program, workspace, inputs, submit, no_submit, robot, mode,
+    run_mode, interp_kind, max_sim_time, max_steps, pgno, no_check, trace_path; one left out
+    takes krl run's default), and ``stop_on_entry`` (stop at the first statement)."""
+    options: dict
     stop_on_entry: bool = False
-    max_sim_time: float = 600.0
-    submit: list = field(default_factory=list)
+
+    @classmethod
+    def of(cls, program, stop_on_entry: bool = False, **options) -> "LaunchConfig":
+        """``LaunchConfig.of("prog.src", mode="T1", run_mode="MSTEP")``."""
+        return cls({"program": str(program), **options}, stop_on_entry)
 
 
 @dataclass
@@ -171,6 +167,8 @@ class Engine:
         self.on_runtime = on_runtime
         self.inbox: queue.Queue = queue.Queue()
         self.config: LaunchConfig | None = None
+        self.setup = None                      # interp.run.RunSetup of the launch
+        self._trace = None                     # the trace file's writer (krl run --trace)
         self.configured = False
         self.started = False
         self.done = False
@@ -241,6 +239,7 @@ class Engine:
             if self._built is not None:
                 self._built.scheduler.close()
                 self._built = None
+            self._close_trace()
             self.cleanup.close()
 
     def _do(self, item) -> None:
@@ -280,11 +279,21 @@ class Engine:
         """Load, check and build the run of ``config`` (not started yet). Raises
         :class:`Refused` when the checker finds errors in the program's own module (the run
         would not start, as with ``krl run``)."""
+        from interp.run import RunSetupError, run_setup  # noqa: PLC0415
+
+        from .launch import run_defaults  # noqa: PLC0415
+
+        options = {**run_defaults(), **config.options}
+        try:
+            self.setup = self.cleanup.enter_context(run_setup(options))
+        except RunSetupError as exc:
+            raise Refused(str(exc)) from None
         self.config = config
         rt, _ = self._build()
         errors = rt.program.errors_of(rt.program.module_of(rt.program.main_path))
         if errors:
             rt.scheduler.close()
+            self._close_trace()
             self.config = None
             raise Refused("not started: the checker finds errors: " + "; ".join(str(d) for d in errors[:5]))
         self._built = rt
@@ -624,13 +633,23 @@ class Engine:
 
     # ------------------------------------------------------------------ the run
     def _build(self):
-        from interp.run import make_runtime  # noqa: PLC0415
+        """A new run of the launch's setup (interp.run.RunSetup), its trace (``trace_path``)
+        written anew: the trace file always holds the run as it stands."""
+        from robot.trace import TraceWriter  # noqa: PLC0415
 
-        a = self.config
-        rt, interp = make_runtime(a.program, workspace=a.workspace, inputs=a.inputs,
-                                  max_sim_time=a.max_sim_time, max_steps=MAX_DAP_REPLAY_STEPS,
-                                  interp=a.interp, mode=a.mode, submit=a.submit, run_mode=a.run_mode)
-        return rt, interp
+        setup = self.setup
+        self._close_trace()
+        path = setup.options.get("trace_path")
+        if path:
+            m = setup.machine
+            self._trace = TraceWriter(path)
+            self._trace.write("robot", 0.0, name=m.name, source=setup.shown(m.source), trafoname=m.trafoname or None)
+        return setup.make_runtime(trace=self._trace)
+
+    def _close_trace(self) -> None:
+        if self._trace is not None:
+            self._trace.close()
+            self._trace = None
 
     def _run_loop(self) -> None:
         from interp.tree import TreeInterpreter  # noqa: PLC0415

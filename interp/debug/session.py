@@ -128,44 +128,11 @@ class DebugSession:
         self.event("initialized")
 
     def req_launch(self, req, args) -> None:
-        program = args.get("program")
-        if not isinstance(program, str) or not program:
-            raise Refused("launch needs 'program': the path of a .src file")
-        workspace = args.get("workspace")
-        from krl.archive import ArchiveError, backup_source, is_archive  # noqa: PLC0415
+        """Every option of ``krl run`` (interp/debug/launch.py), and ``stopOnEntry``."""
+        from .launch import run_options  # noqa: PLC0415
 
-        if workspace is not None and is_archive(Path(str(workspace))):
-            # a KRC backup .zip: checked and extracted for the session (krl run --workspace BACKUP.zip)
-            from interp.cli import program_in  # noqa: PLC0415
-
-            try:
-                folder, _shown = self.engine.cleanup.enter_context(backup_source(str(workspace)))
-            except ArchiveError as exc:
-                raise Refused(str(exc)) from None
-            found = program_in(folder, Path(program))
-            if found is None:
-                raise Refused(f"no program {program} in {workspace}")
-            program, workspace = str(found), str(folder)
-            args = {**args, "workspace": workspace}
-        if not Path(program).is_file():
-            raise Refused(f"no such program: {program}")
-        mode = str(args.get("mode") or "T1").upper()
-        if mode not in ("T1", "T2", "AUT", "EXT"):
-            raise Refused(f"mode {mode!r}: one of T1, T2, AUT, EXT")
-        run_mode = str(args.get("runMode") or "GO").upper().lstrip("#")
-        if run_mode not in ("GO", "MSTEP", "ISTEP", "BSTEP"):
-            raise Refused(f"runMode {run_mode!r}: one of GO, MSTEP, ISTEP, BSTEP")
-        interp = str(args.get("interp") or "tree")
-        if interp not in ("tree", "vm"):
-            raise Refused(f"interp {interp!r}: tree or vm")
-        for key in ("workspace", "inputs"):
-            if args.get(key) is not None and not Path(str(args[key])).exists():
-                raise Refused(f"{key}: no such file or folder: {args[key]}")
-        self.engine.launch(LaunchConfig(
-            program=program, workspace=workspace, inputs=args.get("inputs"), mode=mode, run_mode=run_mode,
-            interp=interp, stop_on_entry=bool(args.get("stopOnEntry", False)),
-            max_sim_time=float(args.get("maxSimTime", 600.0)),
-            submit=[str(s) for s in (args.get("submit") or [])]))
+        options, extra = run_options(args)
+        self.engine.launch(LaunchConfig(options, stop_on_entry=extra["stopOnEntry"]))
         self.respond(req)
 
     def req_configurationDone(self, req, args) -> None:  # noqa: N802 - DAP's name

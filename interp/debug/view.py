@@ -133,11 +133,11 @@ def entries(rt, scope: tuple) -> list:
     elif kind == "module":
         m = scope[1]
         if m is not None:
-            out = list(m.data.items())
+            out = _declared(m.data)
     elif kind == "globals":
         for m in rt.modules:
             if m is not None and m.name == "$CONFIG":
-                out = list(m.data.items())
+                out = _declared(m.data)
     elif kind == "sysvars":
         for name in SHOWN_SYSVARS:
             out.append((name, rt.sysvars.lookup(name)))
@@ -159,6 +159,12 @@ def entries(rt, scope: tuple) -> list:
             else:
                 out.append((label, child(rt, ref, step, name)))
     return out
+
+
+def _declared(data: dict) -> list:
+    """(name as declared, ref) of a data list's variables (``ModuleRT.data`` is keyed by the
+    upper-case name; each reference keeps the declared one)."""
+    return [(getattr(ref, "name", None) or key, ref) for key, ref in data.items()]
 
 
 def child(rt, ref, step, name):

@@ -50,7 +50,7 @@ def front():
 def test_breakpoint_edit_and_step_back_through_the_python_api(front):
     # 011_call_in_out: a = 1 (l.4), arr[2] = 5 (l.5), f = {X 1, Y 2, Z 3, ...} (l.6), Bump (l.7)
     e = front.engine
-    front.call(e.launch, LaunchConfig(program=str(CALL)))
+    front.call(e.launch, LaunchConfig.of(CALL))
     front.call(e.set_breakpoints, str(CALL), [{"line": 6}])
     front.call(e.configuration_done)
     stopped = front.wait("stopped")
@@ -85,7 +85,7 @@ def test_breakpoint_edit_and_step_back_through_the_python_api(front):
 def test_going_back_before_an_edit_forgets_it(front):
     # 007_while: n = 1 (l.3); WHILE n < 20 (l.4): n = n * 3 (l.5) runs with n = 1, 3, 9
     e = front.engine
-    front.call(e.launch, LaunchConfig(program=str(WHILE)))
+    front.call(e.launch, LaunchConfig.of(WHILE))
     front.call(e.set_breakpoints, str(WHILE), [{"line": 5}])
     front.call(e.configuration_done)
     front.wait("stopped")
@@ -104,7 +104,7 @@ def test_refusals_are_refused_errors(front):
     e = front.engine
     with pytest.raises(Refused, match="not stopped"):
         front.call(e.resume)
-    front.call(e.launch, LaunchConfig(program=str(CALL), stop_on_entry=True))
+    front.call(e.launch, LaunchConfig.of(CALL, stop_on_entry=True))
     front.call(e.configuration_done)
     assert front.wait("stopped")["reason"] == "entry"
     with pytest.raises(Refused, match="value invalid"):
