@@ -32,6 +32,7 @@ from starlette.websockets import WebSocket, WebSocketDisconnect
 from krl.limits import (MAX_WEB_BODY_BYTES, MAX_WEB_CONNECTIONS, MAX_WEB_EXPRESSION_CHARS, MAX_WEB_MESSAGE_BYTES,
                         MAX_WEB_MESSAGES_PER_S, MAX_WEB_WATCHES)
 
+from . import engine as keys
 from .engine import MODES_OP, RUN_MODES, Engine, EngineError
 from .security import COOKIE, Guard, PathRefused, inside
 
@@ -92,16 +93,14 @@ class Pendant:
         return self._programs
 
     # ------------------------------------------------------------------ engine events
-    def _engine_event(self, msg: dict) -> None:
+    def _engine_event(self, name: str, body: dict) -> None:
         """Engine thread: hand the event to the loop."""
-        if self.loop is not None:
-            self.loop.call_soon_threadsafe(lambda: asyncio.ensure_future(self._on_event(msg)))
+        if self.loop is not None and name in ("stopped", "terminated", "exited", "output"):
+            self.loop.call_soon_threadsafe(lambda: asyncio.ensure_future(self._on_event(name, body)))
 
-    async def _on_event(self, msg: dict) -> None:
-        ev = msg.get("event")
-        if ev in ("stopped", "terminated", "exited", "output"):
-            await self.broadcast({"type": "event", "event": ev, "body": msg.get("body") or {}})
-            await self.push_state()
+    async def _on_event(self, name: str, body: dict) -> None:
+        await self.broadcast({"type": "event", "event": name, "body": body or {}})
+        await self.push_state()
 
     async def broadcast(self, msg: dict) -> None:
         text = json.dumps(msg, allow_nan=False, default=str)
@@ -117,7 +116,10 @@ class Pendant:
                     "runMode": self.run_mode}
         loop = asyncio.get_running_loop()
         try:
-            s = await loop.run_in_executor(None, lambda: self.engine.request("krl/state", {"watch": self.watch}, 30.0))
+            from .state import snapshot  # noqa: PLC0415
+
+            eng, watch = self.engine, list(self.watch)
+            s = await loop.run_in_executor(None, lambda: eng.do(lambda core: snapshot(eng, core, watch), 60.0))
         except EngineError as exc:
             s = {"state": "ended" if not self.engine.selected else "busy", "note": str(exc)}
         s.update({"program": self.program, "drives": self.drives, "breakpoints":
@@ -142,7 +144,7 @@ class Pendant:
                 self._last_live = live
                 await self.broadcast({"type": "live", **live})
                 k += 1
-                if k % every == 0 and self.engine.session is not None and self.engine.session.state == "running":
+                if k % every == 0 and self.engine.state == "running":
                     await self.push_state()
 
     # ------------------------------------------------------------------ operator actions
@@ -152,8 +154,8 @@ class Pendant:
             raise EngineError(f"unknown action {str(op)[:40]!r}")
         loop = asyncio.get_running_loop()
 
-        def req(command, args=None, timeout=60.0):
-            return loop.run_in_executor(None, lambda: self.engine.request(command, args, timeout))
+        def do(fn, timeout=120.0):
+            return loop.run_in_executor(None, lambda: self.engine.do(fn, timeout))
 
         if op == "hello":
             from .view import modules  # noqa: PLC0415
@@ -177,31 +179,31 @@ class Pendant:
             await self.select(self.program)
         elif op == "start":
             self._need_drives()
-            await req("continue", {"threadId": 1})
+            await do(lambda core: core.resume())
         elif op == "stop":
-            await req("pause", {"threadId": 1})
+            await do(lambda core: core.pause())
         elif op == "backward":
             self._need_drives()
-            await req("krl/backwardStep", {}, 600.0)
+            await do(lambda core: core.backward_motion(), 900.0)
         elif op == "runMode":
             value = str(msg.get("value", "")).upper()
             if value not in RUN_MODES:
                 raise EngineError(f"run mode: one of {', '.join(RUN_MODES)}")
             self.run_mode = value
             if self.engine.selected:
-                await req("krl/runMode", {"value": value})
+                await do(lambda core: keys.run_mode(core, value))
         elif op == "modeOp":
             value = str(msg.get("value", "")).upper()
             if value not in MODES_OP:
                 raise EngineError(f"operating mode: one of {', '.join(MODES_OP)}")
             if self.engine.selected:
-                await req("krl/modeOp", {"value": value})
+                await do(lambda core: keys.mode_op(core, value))
             self.mode = value
             self.drives = False          # turning the mode switch switches the drives off
         elif op == "drives":
             self.drives = bool(msg.get("on"))
         elif op == "override":
-            await req("krl/override", {"value": msg.get("value")})
+            await do(lambda core: keys.override(core, msg.get("value")))
         elif op == "breakpoint":
             path = str(inside(self.root, str(msg.get("path", "")), suffixes=(".src", ".sub")))
             line = msg.get("line")
@@ -210,14 +212,14 @@ class Pendant:
             lines = self.breakpoints.setdefault(path, set())
             (lines.add if msg.get("on") else lines.discard)(line)
             if self.engine.selected:
-                await req("setBreakpoints", {"source": {"path": path},
-                                             "breakpoints": [{"line": n} for n in sorted(lines)]})
+                specs = [{"line": n} for n in sorted(lines)]
+                await do(lambda core: core.set_breakpoints(path, specs))
         elif op == "input":
-            await req("krl/setInput", {"index": msg.get("index"), "value": bool(msg.get("value"))})
+            await do(lambda core: keys.set_input(core, msg.get("index"), bool(msg.get("value"))))
         elif op == "ack":
-            await req("krl/message", {"handle": msg.get("handle")})
+            await do(lambda core: keys.message(core, msg.get("handle")))
         elif op == "answer":
-            await req("krl/message", {"handle": msg.get("handle"), "answer": msg.get("key")})
+            await do(lambda core: keys.message(core, msg.get("handle"), msg.get("key")))
         elif op == "watch":
             exprs = msg.get("exprs")
             if not isinstance(exprs, list) or len(exprs) > MAX_WEB_WATCHES or \
@@ -226,16 +228,16 @@ class Pendant:
                                   f"{MAX_WEB_EXPRESSION_CHARS} characters")
             self.watch = list(exprs)
         elif op == "setWatch":
-            await req("krl/setWatch", {"expr": msg.get("expr"), "value": msg.get("value")})
+            await do(lambda core: keys.set_watch(core, str(msg.get("expr", "")), str(msg.get("value", ""))))
         elif op == "jog":
             self._need_drives()
-            await req("krl/jog", {"system": msg.get("system"), "axis": msg.get("axis"), "step": msg.get("step")},
-                      120.0)
+            await do(lambda core: keys.jog(core, str(msg.get("system", "")).upper(), msg.get("axis"), msg.get("step")),
+                     900.0)
         elif op == "touchup":
             if self.readonly:
                 raise EngineError("touch-up: the workspace is a backup archive (read-only)")
             dat = inside(self.root, str(msg.get("path", "")), suffixes=(".dat",))
-            await req("krl/touchUp", {"path": str(dat), "name": msg.get("name")})
+            await do(lambda core: keys.touch_up(core, str(dat), str(msg.get("name", ""))))
             if self.program is not None:
                 await self.broadcast_module(self.program)
         elif op == "open":
@@ -249,19 +251,14 @@ class Pendant:
             raise EngineError("the drives are off: switch them on first")
 
     async def select(self, program: str) -> None:
-        from krl.project import boot_submit  # noqa: PLC0415
-
         path = inside(self.root, program, suffixes=(".src",))
         loop = asyncio.get_running_loop()
-        sub = boot_submit(path, self.root)
         await self.broadcast({"type": "event", "event": "selecting", "body": {"program": str(path)}})
+        bps = {p: sorted(v) for p, v in self.breakpoints.items()}
         await loop.run_in_executor(None, lambda: self.engine.select(
             str(path), workspace=str(self.root), inputs=self.inputs, mode=self.mode, run_mode=self.run_mode,
-            trace=self.trace, submit=[str(sub)] if sub is not None else []))
+            trace=self.trace, breakpoints=bps))
         self.program = str(path)
-        for p, lines in self.breakpoints.items():
-            await loop.run_in_executor(None, lambda p=p, lines=lines: self.engine.request(
-                "setBreakpoints", {"source": {"path": p}, "breakpoints": [{"line": n} for n in sorted(lines)]}))
         await self.broadcast_module(str(path))
 
     async def send_module(self, ws: WebSocket, path: str) -> None:

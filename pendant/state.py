@@ -17,30 +17,33 @@ IO_ALWAYS = 16
 FRAME_KEYS = ("X", "Y", "Z", "A", "B", "C")
 
 
-def snapshot(s, args: dict) -> dict:
-    """The page's state of the engine session ``s`` (an interp.debug session with the
-    pendant's requests). ``args``: ``watch`` (expressions), ``static`` (also the signal table)."""
-    rt = s.rt
-    out = {"state": s.state, "pointers": s.pointers() if rt is not None else {}}
+def snapshot(eng, core, watch: list) -> dict:
+    """The page's state (engine thread): ``eng`` the pendant's :class:`pendant.engine.Engine`
+    (notes, signals), ``core`` its run-control engine, ``watch`` the watched expressions."""
+    rt = core.rt
+    out = {"state": core.state, "pointers": core.pointers() if rt is not None else {}}
     if rt is None:
         return out
+    if eng.signals is None:
+        eng.signals = signals_of(rt)
     ctl = rt.controller
     store = rt.sysvars.store
+    body = core.stop_body or {}
     out.update({
         "modeOp": "EXT" if rt.mode_op == "EX" else rt.mode_op,
         "runMode": rt.run_mode,
         "override": _num(store.get("$OV_PRO")),
         "time": round(ctl.time, 3),
-        "stop": {"reason": getattr(s, "stop_reason", None), "description": getattr(s, "stop_description", None)}
-        if s.state == "stopped" else None,
-        "threads": _threads(s),
+        "stop": {"reason": body.get("reason"), "description": body.get("description") or body.get("text")}
+        if core.state == "stopped" else None,
+        "threads": _threads(rt),
         "messages": [{"handle": m.handle, "kind": m.kind, "text": m.text, "module": m.module,
                       "number": m.number, "softkeys": m.softkeys, "time": round(m.time, 3)}
                      for m in rt.messages.shown],
-        "notes": list(getattr(s, "notes", ())),
-        "io": _io(rt, getattr(s, "signals", None) or []),
+        "notes": list(eng.notes),
+        "io": _io(rt, eng.signals),
         "position": _position(rt),
-        "watch": _watch(s, args.get("watch") or []),
+        "watch": _watch(core, watch),
     })
     return out
 
@@ -49,10 +52,12 @@ def _num(v):
     return v if isinstance(v, (int, float)) and not isinstance(v, bool) else None
 
 
-def _threads(s) -> list[dict]:
+def _threads(rt) -> list[dict]:
+    from interp.debug.view import thread_list  # noqa: PLC0415
+
     out = []
     try:
-        threads = s.thread_list()
+        threads = thread_list(rt)
     except Exception:  # noqa: BLE001 - a thread list between two cycles may be incomplete
         return out
     for tid, name, _task, frames in threads:
@@ -150,13 +155,17 @@ def _position(rt) -> dict:
             "base": _frame(store.get("$BASE")), "tool": _frame(store.get("$TOOL"))}
 
 
-def _watch(s, exprs: list) -> list[dict]:
+def _watch(core, exprs: list) -> list[dict]:
+    from interp.debug.values import value_text  # noqa: PLC0415
+    from interp.runtime.errors import KrlRuntimeError  # noqa: PLC0415
+
     out = []
     for text in exprs[:MAX_WEB_WATCHES]:
         text = str(text)[:MAX_WEB_EXPRESSION_CHARS]
         try:
-            value = s.watch_value(text)
-            out.append({"expr": text, "value": value})
+            out.append({"expr": text, "value": value_text(core.evaluate_now(text))})
+        except KrlRuntimeError as exc:
+            out.append({"expr": text, "error": exc.message[:200]})
         except Exception as exc:  # noqa: BLE001 - the watch shows why it has no value
             out.append({"expr": text, "error": str(exc)[:200]})
     return out
