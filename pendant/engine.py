@@ -29,6 +29,10 @@ RUN_MODES = ("GO", "MSTEP", "ISTEP")
 #: jog: the coordinate systems and the largest increment of one press of a jog key (mm, deg)
 JOG_SYSTEMS = ("AXIS", "WORLD", "BASE", "TOOL")
 JOG_MAX_STEP = 100.0
+#: the TCP path drawn: a point each PATH_STEP_MM of TCP motion, at most MAX_PATH_POINTS
+PATH_STEP_MM = 2.0
+MAX_PATH_POINTS = 50_000
+NULLFRAME = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
 
 
 class EngineError(Exception):
@@ -49,6 +53,8 @@ class Engine:
         self.live: dict = {}
         self.notes: list[dict] = []
         self.signals: list[dict] | None = None
+        self.path: list[tuple] = []            # the TCP path of this run: (X, Y, Z mm in $WORLD, blending)
+        self.run_no = 0                        # counts the runs built (a replay starts a new path)
         self._pace0: tuple[float, float] | None = None
 
     # ------------------------------------------------------------------ lifecycle
@@ -113,6 +119,8 @@ class Engine:
         ctl.add_cyclic(self._cycle)
         self._pace0 = None
         self.notes = []
+        self.path = []
+        self.run_no += 1
         inner = ctl.message
 
         def message(text, motion_id=None, number=None):
@@ -131,9 +139,11 @@ class Engine:
             return
         robot = core.rt.robot
         req = ctl.current_request()
+        blending = getattr(ctl, "_blend", None) is not None
+        self._record_path(ctl, blending)
         self.live = {
             "time": round(ctl.time, 6), "axes": [float(v) for v in ctl.axis_act()],
-            "blending": getattr(ctl, "_blend", None) is not None,
+            "blending": blending, "run": self.run_no,
             "pointers": {"advanceRun": {"path": robot.file, "line": robot.line}
                          if robot is not None and robot.at is not None else None,
                          "mainRun": {"path": req.file, "line": req.line} if req is not None and req.line else None}}
@@ -149,6 +159,23 @@ class Engine:
             time.sleep(ahead)
         elif ahead < -0.25:
             self._pace0 = (now, ctl.time)    # fell behind (a stop, a slow cycle): pace from here
+
+
+    def _record_path(self, ctl, blending: bool) -> None:
+        """The TCP in $WORLD once it has moved PATH_STEP_MM, or when an approximation starts
+        or ends (at most MAX_PATH_POINTS points: the oldest are dropped)."""
+        try:
+            p = ctl.pos_act(base=NULLFRAME)
+        except Exception:  # noqa: BLE001 - a pose the model cannot take draws no path
+            return
+        x, y, z = round(p["X"], 1), round(p["Y"], 1), round(p["Z"], 1)
+        if self.path:
+            lx, ly, lz, lb = self.path[-1]
+            if lb == blending and (x - lx) ** 2 + (y - ly) ** 2 + (z - lz) ** 2 < PATH_STEP_MM ** 2:
+                return
+        self.path.append((x, y, z, blending))
+        if len(self.path) > MAX_PATH_POINTS:
+            del self.path[:len(self.path) - MAX_PATH_POINTS]
 
 
 # ---------------------------------------------------------------------- the keys (engine thread)

@@ -72,6 +72,7 @@ class Pendant:
         self._robot = None
         self._programs = None
         self._last_live = None
+        self._path_run, self._path_sent = None, 0
 
     # ------------------------------------------------------------------ static data
     def robot(self) -> dict:
@@ -140,9 +141,14 @@ class Pendant:
             if not self.clients:
                 continue
             live = self.engine.live
-            if live and live is not self._last_live:
+            if live and (live is not self._last_live or len(self.engine.path) > self._path_sent):
                 self._last_live = live
-                await self.broadcast({"type": "live", **live})
+                path, run = self.engine.path, live.get("run")
+                if run != self._path_run:
+                    self._path_run, self._path_sent = run, 0
+                new = path[self._path_sent:self._path_sent + 5000]
+                self._path_sent += len(new)
+                await self.broadcast({"type": "live", **live, "path": new})
                 k += 1
                 if k % every == 0 and self.engine.state == "running":
                     await self.push_state()

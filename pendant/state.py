@@ -41,6 +41,7 @@ def snapshot(eng, core, watch: list) -> dict:
                       "number": m.number, "softkeys": m.softkeys, "time": round(m.time, 3)}
                      for m in rt.messages.shown],
         "notes": list(eng.notes),
+        "path": {"run": eng.run_no, "points": len(eng.path)},
         "io": _io(rt, eng.signals),
         "position": _position(rt),
         "watch": _watch(core, watch),

@@ -60,15 +60,6 @@ def pendant_server(target: Path, *args: str):
             proc.wait(30)
 
 
-@pytest.fixture(scope="session")
-def pw():
-    """The one Playwright driver of the session (its sync API cannot be nested)."""
-    import playwright.sync_api as playwright  # noqa: PLC0415 - a dev dependency: missing fails
-
-    with playwright.sync_playwright() as p:
-        yield p
-
-
 @contextmanager
 def browser_page(pw, url: str, viewport=(1400, 900)):
     """A fresh headless Chromium profile with the page loaded and its robot drawn; page errors

@@ -16,12 +16,13 @@ import sys
 import pytest
 
 from tests.conftest import REPO_ROOT
-from tests.pendant.harness import (CELLS, KR120, MILLING, browser_page, cell_without, pendant_server, pose_at,  # noqa: F401
-                                   pw, read_trace, select, state, wait_state)
+from tests.pendant.harness import (CELLS, KR120, MILLING, browser_page, cell_without, pendant_server, pose_at,
+                                   read_trace, select, state, wait_state)
 
 pytestmark = pytest.mark.may_skip("chromium is missing and cannot be installed (not root, or apt-get has no network)")
 
 PREPARE = "R1/Program/CELL/Other/PrepareMillingTools.src"
+HOME = "R1/Program/CELL/Other/GoHomePos.src"
 KR120_CELL = CELLS / "khrzysio__KRC4_test.yaml"
 TOL_DEG = 0.01
 
@@ -196,12 +197,12 @@ def test_the_pendant_run_gives_krl_runs_trace(pw, shared_corpus, tmp_path):
     trace = tmp_path / "pendant.jsonl"
     with pendant_server(KR120, "--no-realtime", "--inputs", str(KR120_CELL), "--trace", str(trace),
                         "--mode", "AUT") as url, browser_page(pw, url) as page:
-        select(page, PREPARE, run_mode="GO", mode="AUT")
+        select(page, HOME, run_mode="GO", mode="AUT")
         page.click("#start")
         s = wait_state(page, "s.state == 'ended' || s.state == 'none'", timeout=900_000)
         assert page.problems == []
     ref = tmp_path / "run.jsonl"
-    run = subprocess.run([sys.executable, "-m", "krl.cli", "run", str(KR120 / PREPARE), "--inputs", str(KR120_CELL),
+    run = subprocess.run([sys.executable, "-m", "krl.cli", "run", str(KR120 / HOME), "--inputs", str(KR120_CELL),
                           "--mode", "AUT", "--trace", str(ref)], cwd=REPO_ROOT, capture_output=True, text=True,
                          timeout=900, check=False)
     assert run.returncode == 0, run.stdout + run.stderr

@@ -14,7 +14,7 @@ import pytest
 import websockets
 
 from krl.limits import MAX_WEB_MESSAGE_BYTES, MAX_WEB_MESSAGES_PER_S
-from tests.pendant.harness import browser_page, pendant_server, pw, select  # noqa: F401
+from tests.pendant.harness import browser_page, pendant_server, select
 
 PWNED = '<img src=x onerror="window.pwned=1"><script>window.pwned=1</script>'
 

@@ -353,7 +353,6 @@ function setAxes(axes, tool, base) {
   if (tool) { const f = frameArr(tool); toolFrame.matrixAutoUpdate = false; toolFrame.matrix.copy(kukaMatrix(f)); }
   if (base) { const f = frameArr(base); baseFrame.matrixAutoUpdate = false; baseFrame.matrix.copy(kukaMatrix(f)); }
   P.axesShown = axes.slice();
-  recordPath(P.live ? P.live.blending : false);
 }
 
 // the rendered joint values (deg), read back from the drawn robot: what the page shows
@@ -369,24 +368,22 @@ pathGeom.setAttribute('color', new THREE.BufferAttribute(pathCol, 3));
 pathGeom.setDrawRange(0, 0);
 const pathLine = new THREE.Line(pathGeom, new THREE.LineBasicMaterial({ vertexColors: true }));
 pathLine.frustumCulled = false;
-scene.add(pathLine);
+world.add(pathLine);
 let pathN = 0;
-const tcpWorld = new THREE.Vector3();
-function recordPath(blending) {
-  if (!tool0) return;
-  scene.updateMatrixWorld(true);
-  toolFrame.getWorldPosition(tcpWorld);
-  if (pathN > 0) {
-    const k = (pathN - 1) * 3;
-    if (Math.abs(pathPos[k] - tcpWorld.x) + Math.abs(pathPos[k + 1] - tcpWorld.y) + Math.abs(pathPos[k + 2] - tcpWorld.z) < 1e-4) return;
+let pathRun = null;
+// the controller's TCP path (pendant/engine.py: $WORLD mm, a point each 2 mm, blending flag)
+function addPath(run, points) {
+  if (run !== pathRun) { pathRun = run; pathN = 0; }
+  for (const [x, y, z, blending] of points) {
+    if (pathN >= MAX_PATH) { pathPos.copyWithin(0, 3); pathCol.copyWithin(0, 3); pathN = MAX_PATH - 1; }
+    pathPos.set([x / 1000, y / 1000, z / 1000], pathN * 3);
+    pathCol.set(blending ? [1, 0.35, 0] : [0, 0.78, 1], pathN * 3);
+    pathN++;
   }
-  if (pathN >= MAX_PATH) { pathPos.copyWithin(0, 3); pathCol.copyWithin(0, 3); pathN = MAX_PATH - 1; }
-  pathPos.set([tcpWorld.x, tcpWorld.y, tcpWorld.z], pathN * 3);
-  pathCol.set(blending ? [1, 0.35, 0] : [0, 0.78, 1], pathN * 3);
-  pathN++;
   pathGeom.setDrawRange(0, pathN);
   pathGeom.attributes.position.needsUpdate = true;
   pathGeom.attributes.color.needsUpdate = true;
+  P.pathPoints = pathN;
 }
 
 const pointsGroup = new THREE.Group();
@@ -408,6 +405,7 @@ function onLive(m) {
   P.live = m;
   if (typeof m.time === 'number') $('st-time').textContent = `t = ${m.time.toFixed(3)} s`;
   setAxes(m.axes);
+  if (m.path) addPath(m.run, m.path);
   if (m.pointers && P.state) drawPointers(m.pointers, P.state.breakpoints || {});
 }
 
