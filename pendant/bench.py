@@ -1,0 +1,208 @@
+"""Benchmark of the pendant (issue 36): the simulation's real-time factor without and with the
+page open, and the page's latency from an input to its visible change, in one run.
+
+    python -m pendant.bench [BACKUP] [--program P] [--inputs CELL] [--seconds S] [--toggles N]
+
+For each condition the program is selected anew and run in GO/AUT at real time by
+``krl pendant`` (a subprocess): "closed" with only a control connection (a websocket client
+that polls the state once a second), "open" with the page rendered by headless Chromium
+besides. The real-time factor is simulated time over wall time across ``--seconds`` of running.
+The same two conditions are then run unpaced (``--no-realtime``): there the factor is the
+simulation's throughput, and its drop is what the page costs the simulation. The latency is
+measured in the page while the program runs at real time: an input key pressed, until the
+page shows the new value (``performance.now()`` at the click and in the animation frame that
+first shows it), ``--toggles`` times. Prints one line per figure and the ratios; a benchmark,
+not a test (nothing asserts a time).
+"""
+
+from __future__ import annotations
+
+import argparse
+import asyncio
+import json
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+from urllib.parse import urlsplit
+
+ROOT = Path(__file__).resolve().parents[1]
+DEFAULT_BACKUP = ROOT.parent / "shared" / "krl-corpus" / "khrzysio__KRC4_test"
+DEFAULT_PROGRAM = "R1/Program/CELL/Other/PrepareMillingTools.src"
+DEFAULT_CELL = ROOT / "corpus" / "cells" / "khrzysio__KRC4_test.yaml"
+FLAGS = ["--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run", "--disable-background-networking",
+         "--disable-component-update", "--disable-sync"]
+
+
+def _server(backup: Path, cell: Path | None, realtime: bool):
+    cmd = [sys.executable, "-m", "krl.cli", "pendant", str(backup), "--no-browser", "--mode", "AUT"]
+    if cell is not None:
+        cmd += ["--inputs", str(cell)]
+    if not realtime:
+        cmd.append("--no-realtime")
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True, cwd=ROOT)
+    return proc, proc.stdout.readline().strip()
+
+
+async def _control(url: str, program: str, seconds: float) -> tuple[float, float]:
+    """Select and start ``program``; (simulated s, wall s) over ``seconds`` of running."""
+    import websockets  # noqa: PLC0415
+
+    u = urlsplit(url)
+    token = u.query.split("token=", 1)[1]
+    async with websockets.connect(f"ws://{u.hostname}:{u.port}/ws?token={token}", max_size=None,
+                                  additional_headers={"Origin": f"http://{u.hostname}:{u.port}"}) as ws:
+        seq = iter(range(1, 1_000_000))
+
+        async def act(op, **args):
+            rid = next(seq)
+            await ws.send(json.dumps({"op": op, "id": rid, **args}))
+            while True:
+                m = json.loads(await ws.recv())
+                if m.get("id") == rid and m["type"] in ("done", "error"):
+                    if m["type"] == "error":
+                        raise RuntimeError(m["text"])
+                    return m
+
+        async def sim_time():
+            last = None
+            while True:
+                m = json.loads(await ws.recv())
+                if m["type"] == "live":
+                    last = m["time"]
+                elif m["type"] == "state" and m.get("time") is not None:
+                    last = m["time"]
+                if last is not None:
+                    return last
+        await act("runMode", value="GO")
+        await act("select", program=program)
+        await act("drives", on=True)
+        await act("start")
+        await asyncio.sleep(1.0)                       # past the start-up
+        t0_sim, t0 = await sim_time(), time.perf_counter()
+        end = t0 + seconds
+        while time.perf_counter() < end:
+            await asyncio.sleep(0.5)
+            await sim_time()
+        t1_sim, t1 = await sim_time(), time.perf_counter()
+        return t1_sim - t0_sim, t1 - t0
+
+
+def _with_page(url: str, work):
+    """Run ``work(page)`` with the page open in headless Chromium."""
+    from playwright.sync_api import sync_playwright  # noqa: PLC0415
+
+    with sync_playwright() as pw, tempfile.TemporaryDirectory() as profile:
+        ctx = pw.chromium.launch_persistent_context(profile, executable_path="/usr/bin/chromium", headless=True,
+                                                    args=FLAGS, bypass_csp=True,
+                                                    viewport={"width": 1400, "height": 900})
+        try:
+            page = ctx.new_page()
+            page.goto(url)
+            page.wait_for_function("() => window.pendant && window.pendant.robot", timeout=300_000)
+            return work(page)
+        finally:
+            ctx.close()
+
+
+def rtf(backup, program, cell, seconds, realtime: bool, page: bool) -> float:
+    proc, url = _server(backup, cell, realtime)
+    try:
+        if not page:
+            sim, wall = asyncio.run(_control(url, program, seconds))
+        else:
+            import threading  # noqa: PLC0415
+
+            out = {}
+            done = threading.Event()
+
+            def control():
+                out["r"] = asyncio.run(_control(url, program, seconds))
+                done.set()
+
+            def work(pg):
+                threading.Thread(target=control, daemon=True).start()
+                while not done.wait(0.25):
+                    pg.evaluate("() => window.pendant.frames")   # the page goes on rendering
+                return out["r"]
+            sim, wall = _with_page(url, work)
+        return sim / wall
+    finally:
+        proc.terminate()
+        proc.wait(30)
+
+
+LATENCY_JS = """async (n) => {
+  const btn = document.querySelector(`[data-input="${n}"]`);
+  const before = btn.textContent;
+  const t0 = performance.now();
+  btn.click();
+  return await new Promise((resolve) => {
+    const check = () => {
+      const now = document.querySelector(`[data-input="${n}"]`);
+      if (now && now.textContent !== before) resolve(performance.now() - t0);
+      else requestAnimationFrame(check);
+    };
+    requestAnimationFrame(check);
+  });
+}"""
+
+
+def latency(backup, program, cell, toggles: int, index: int) -> list[float]:
+    proc, url = _server(backup, cell, True)
+    try:
+        def work(page):
+            page.select_option("#mode-op", "AUT")
+            page.select_option("#run-mode", "GO")
+            page.select_option("#programs", program)
+            page.click("#select")
+            page.wait_for_function("() => window.pendant.state && window.pendant.state.state == 'stopped'",
+                                   timeout=600_000)
+            page.click("#drives")
+            page.click("#start")
+            page.wait_for_function("() => window.pendant.state.state == 'running' && window.pendant.state.time > 1",
+                                   timeout=600_000)
+            page.click('#tabs button[data-tab="io"]')
+            out = []
+            for _ in range(toggles):
+                out.append(page.evaluate(LATENCY_JS, index))
+                page.wait_for_timeout(100)
+            return out
+        return _with_page(url, work)
+    finally:
+        proc.terminate()
+        proc.wait(30)
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("backup", nargs="?", type=Path, default=DEFAULT_BACKUP)
+    ap.add_argument("--program", default=DEFAULT_PROGRAM)
+    ap.add_argument("--inputs", type=Path, default=DEFAULT_CELL)
+    ap.add_argument("--seconds", type=float, default=15.0)
+    ap.add_argument("--toggles", type=int, default=20)
+    ap.add_argument("--input", type=int, default=16, help="the input toggled (one the program does not read)")
+    a = ap.parse_args(argv)
+    print(f"load: {os.getloadavg()[0]:.2f} {os.getloadavg()[1]:.2f} {os.getloadavg()[2]:.2f}; "
+          f"{time.strftime('%Y-%m-%d %H:%M')}; {a.backup.name} {a.program}", flush=True)
+    res = {}
+    for realtime in (True, False):
+        for page in (False, True):
+            r = rtf(a.backup, a.program, a.inputs, a.seconds, realtime, page)
+            res[(realtime, page)] = r
+            print(f"real-time factor, {'paced' if realtime else 'unpaced'}, page {'open' if page else 'closed'}: "
+                  f"{r:.3f}", flush=True)
+        drop = 1 - res[(realtime, True)] / res[(realtime, False)]
+        print(f"  {'paced' if realtime else 'unpaced'}: the page costs {drop:+.1%} of the real-time factor", flush=True)
+    lat = latency(a.backup, a.program, a.inputs, a.toggles, a.input)
+    lat.sort()
+    print(f"input -> visible change (ms, {len(lat)} toggles at real time): median {statistics.median(lat):.1f}, "
+          f"p95 {lat[int(0.95 * (len(lat) - 1))]:.1f}, max {lat[-1]:.1f}", flush=True)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
