@@ -47,8 +47,16 @@ def _server(backup: Path, cell: Path | None, realtime: bool):
     return proc, proc.stdout.readline().strip()
 
 
-async def _control(url: str, program: str, seconds: float) -> tuple[float, float]:
-    """Select and start ``program``; (simulated s, wall s) over ``seconds`` of running."""
+async def _control(url: str, program: str, seconds: float, pid: int) -> tuple[float, float, float]:
+    """Select and start ``program``; (simulated s, wall s, the server's CPU s) over ``seconds``
+    of running."""
+    import psutil  # noqa: PLC0415
+
+    proc = psutil.Process(pid)
+
+    def cpu() -> float:
+        c = proc.cpu_times()
+        return c.user + c.system
     import websockets  # noqa: PLC0415
 
     u = urlsplit(url)
@@ -82,13 +90,13 @@ async def _control(url: str, program: str, seconds: float) -> tuple[float, float
         await act("drives", on=True)
         await act("start")
         await asyncio.sleep(1.0)                       # past the start-up
-        t0_sim, t0 = await sim_time(), time.perf_counter()
+        t0_sim, t0, c0 = await sim_time(), time.perf_counter(), cpu()
         end = t0 + seconds
         while time.perf_counter() < end:
             await asyncio.sleep(0.5)
             await sim_time()
-        t1_sim, t1 = await sim_time(), time.perf_counter()
-        return t1_sim - t0_sim, t1 - t0
+        t1_sim, t1, c1 = await sim_time(), time.perf_counter(), cpu()
+        return t1_sim - t0_sim, t1 - t0, c1 - c0
 
 
 def _with_page(url: str, work):
@@ -108,11 +116,12 @@ def _with_page(url: str, work):
             ctx.close()
 
 
-def rtf(backup, program, cell, seconds, realtime: bool, page: bool) -> float:
+def rtf(backup, program, cell, seconds, realtime: bool, page: bool) -> tuple[float, float]:
+    """(simulated s per wall s, simulated s per CPU s of the server process)."""
     proc, url = _server(backup, cell, realtime)
     try:
         if not page:
-            sim, wall = asyncio.run(_control(url, program, seconds))
+            sim, wall, cpu = asyncio.run(_control(url, program, seconds, proc.pid))
         else:
             import threading  # noqa: PLC0415
 
@@ -120,7 +129,7 @@ def rtf(backup, program, cell, seconds, realtime: bool, page: bool) -> float:
             done = threading.Event()
 
             def control():
-                out["r"] = asyncio.run(_control(url, program, seconds))
+                out["r"] = asyncio.run(_control(url, program, seconds, proc.pid))
                 done.set()
 
             def work(pg):
@@ -128,8 +137,8 @@ def rtf(backup, program, cell, seconds, realtime: bool, page: bool) -> float:
                 while not done.wait(0.25):
                     pg.evaluate("() => window.pendant.frames")   # the page goes on rendering
                 return out["r"]
-            sim, wall = _with_page(url, work)
-        return sim / wall
+            sim, wall, cpu = _with_page(url, work)
+        return sim / wall, sim / max(cpu, 1e-9)
     finally:
         proc.terminate()
         proc.wait(30)
@@ -183,6 +192,7 @@ def main(argv=None) -> int:
     ap.add_argument("--program", default=DEFAULT_PROGRAM)
     ap.add_argument("--inputs", type=Path, default=DEFAULT_CELL)
     ap.add_argument("--seconds", type=float, default=15.0)
+    ap.add_argument("--no-latency", action="store_true", help="measure the real-time factors only")
     ap.add_argument("--toggles", type=int, default=20)
     ap.add_argument("--input", type=int, default=16, help="the input toggled (one the program does not read)")
     a = ap.parse_args(argv)
@@ -191,12 +201,16 @@ def main(argv=None) -> int:
     res = {}
     for realtime in (True, False):
         for page in (False, True):
-            r = rtf(a.backup, a.program, a.inputs, a.seconds, realtime, page)
-            res[(realtime, page)] = r
+            r, per_cpu = rtf(a.backup, a.program, a.inputs, a.seconds, realtime, page)
+            res[(realtime, page)] = (r, per_cpu)
             print(f"real-time factor, {'paced' if realtime else 'unpaced'}, page {'open' if page else 'closed'}: "
-                  f"{r:.3f}", flush=True)
-        drop = 1 - res[(realtime, True)] / res[(realtime, False)]
-        print(f"  {'paced' if realtime else 'unpaced'}: the page costs {drop:+.1%} of the real-time factor", flush=True)
+                  f"{r:.3f} (simulated s per CPU s of the server: {per_cpu:.3f})", flush=True)
+        for k, what in ((0, "real-time factor"), (1, "simulated s per server CPU s")):
+            drop = 1 - res[(realtime, True)][k] / res[(realtime, False)][k]
+            print(f"  {'paced' if realtime else 'unpaced'}: with the page open the {what} drops by {drop:+.1%}",
+                  flush=True)
+    if a.no_latency:
+        return 0
     lat = latency(a.backup, a.program, a.inputs, a.toggles, a.input)
     lat.sort()
     print(f"input -> visible change (ms, {len(lat)} toggles at real time): median {statistics.median(lat):.1f}, "

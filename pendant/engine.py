@@ -55,6 +55,7 @@ class Engine:
         self.signals: list[dict] | None = None
         self.path: list[tuple] = []            # the TCP path of this run: (X, Y, Z mm in $WORLD, blending)
         self.run_no = 0                        # counts the runs built (a replay starts a new path)
+        self._base_inv = self._base_T = None
         self._pace0: tuple[float, float] | None = None
 
     # ------------------------------------------------------------------ lifecycle
@@ -74,6 +75,9 @@ class Engine:
         for path, lines in (breakpoints or {}).items():
             self.call(core.set_breakpoints, path, [{"line": n} for n in lines])
         self.call(core.configuration_done)
+        deadline = time.monotonic() + 900.0          # the run starts: wait for its entry stop
+        while core.state not in ("stopped", "ended") and not core.done and time.monotonic() < deadline:
+            time.sleep(0.01)
 
     def cancel(self, timeout: float = 30.0) -> None:
         """Cancel the selected program: the run ends at once."""
@@ -163,12 +167,18 @@ class Engine:
 
     def _record_path(self, ctl, blending: bool) -> None:
         """The TCP in $WORLD once it has moved PATH_STEP_MM, or when an approximation starts
-        or ends (at most MAX_PATH_POINTS points: the oldest are dropped)."""
-        try:
-            p = ctl.pos_act(base=NULLFRAME)
-        except Exception:  # noqa: BLE001 - a pose the model cannot take draws no path
+        or ends (at most MAX_PATH_POINTS points: the oldest are dropped). It is the pose the
+        controller computed in this cycle (its TCP in $BASE and that $BASE, the numbers the
+        trace's pose events hold), so the path costs the simulation a matrix product a cycle."""
+        import numpy as np  # noqa: PLC0415
+
+        tcp, base_inv = getattr(ctl, "_tcp_T", None), getattr(ctl, "_base_inv_T", None)
+        if tcp is None or base_inv is None:
             return
-        x, y, z = round(p["X"], 1), round(p["Y"], 1), round(p["Z"], 1)
+        if base_inv is not self._base_inv:
+            self._base_inv, self._base_T = base_inv, np.linalg.inv(base_inv)
+        w = self._base_T[:3, :3] @ tcp[:3, 3] + self._base_T[:3, 3]
+        x, y, z = round(float(w[0]), 1), round(float(w[1]), 1), round(float(w[2]), 1)
         if self.path:
             lx, ly, lz, lb = self.path[-1]
             if lb == blending and (x - lx) ** 2 + (y - ly) ** 2 + (z - lz) ** 2 < PATH_STEP_MM ** 2:
