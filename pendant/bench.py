@@ -4,9 +4,9 @@ page open, and the page's latency from an input to its visible change, in one ru
     python -m pendant.bench [BACKUP] [--program P] [--inputs CELL] [--seconds S] [--toggles N]
 
 For each condition the program is selected anew and run in GO/AUT at real time by
-``krl pendant`` (a subprocess): "closed" with only a control connection (a websocket client
-that polls the state once a second), "open" with the page rendered by headless Chromium
-besides. The real-time factor is simulated time over wall time across ``--seconds`` of running.
+``krl pendant`` (a subprocess), started by a short websocket connection: "closed" with no
+client connected while it is measured (a short connection reads the simulated time at both
+ends of the window), "open" with the page rendered by headless Chromium meanwhile. The real-time factor is simulated time over wall time across ``--seconds`` of running.
 The same two conditions are then run unpaced (``--no-realtime``): there the factor is the
 simulation's throughput, and its drop is what the page costs the simulation. The latency is
 measured in the page while the program runs at real time: an input key pressed, until the
@@ -47,9 +47,58 @@ def _server(backup: Path, cell: Path | None, realtime: bool):
     return proc, proc.stdout.readline().strip()
 
 
-async def _control(url: str, program: str, seconds: float, pid: int) -> tuple[float, float, float]:
-    """Select and start ``program``; (simulated s, wall s, the server's CPU s) over ``seconds``
-    of running."""
+async def _connect(url: str):
+    import websockets  # noqa: PLC0415
+
+    u = urlsplit(url)
+    token = u.query.split("token=", 1)[1]
+    return await websockets.connect(f"ws://{u.hostname}:{u.port}/ws?token={token}", max_size=None,
+                                    additional_headers={"Origin": f"http://{u.hostname}:{u.port}"})
+
+
+async def _act(ws, rid: int, op: str, **args) -> dict:
+    """One action; the state pushed after it."""
+    await ws.send(json.dumps({"op": op, "id": rid, **args}))
+    state = None
+    while True:
+        m = json.loads(await ws.recv())
+        if m["type"] == "state":
+            state = m
+        if m.get("id") == rid and m["type"] in ("done", "error"):
+            if m["type"] == "error":
+                raise RuntimeError(m["text"])
+            while state is None:
+                m = json.loads(await ws.recv())
+                state = m if m["type"] == "state" else None
+            return state
+
+
+async def _start(url: str, program: str) -> None:
+    """Select ``program`` in GO and start it; the connection is closed again (no client)."""
+    async with await _connect(url) as ws:
+        await _act(ws, 1, "runMode", value="GO")
+        await _act(ws, 2, "select", program=program)
+        await _act(ws, 3, "drives", on=True)
+        await _act(ws, 4, "start")
+
+
+async def _sim_time(url: str) -> float:
+    """The simulated time now, by a short connection."""
+    async with await _connect(url) as ws:
+        return float((await _act(ws, 1, "watch", exprs=[]))["time"])
+
+
+def _in_thread(coro):
+    """``asyncio.run(coro)`` on a thread of its own (Playwright's sync API holds this one's loop)."""
+    import concurrent.futures  # noqa: PLC0415
+
+    with concurrent.futures.ThreadPoolExecutor(1) as ex:
+        return ex.submit(asyncio.run, coro).result()
+
+
+def _window(url: str, pid: int, seconds: float) -> tuple[float, float, float]:
+    """(simulated s, wall s, the server's CPU s) over ``seconds`` of running, with no client of
+    this script connected meanwhile."""
     import psutil  # noqa: PLC0415
 
     proc = psutil.Process(pid)
@@ -57,46 +106,10 @@ async def _control(url: str, program: str, seconds: float, pid: int) -> tuple[fl
     def cpu() -> float:
         c = proc.cpu_times()
         return c.user + c.system
-    import websockets  # noqa: PLC0415
-
-    u = urlsplit(url)
-    token = u.query.split("token=", 1)[1]
-    async with websockets.connect(f"ws://{u.hostname}:{u.port}/ws?token={token}", max_size=None,
-                                  additional_headers={"Origin": f"http://{u.hostname}:{u.port}"}) as ws:
-        seq = iter(range(1, 1_000_000))
-
-        async def act(op, **args):
-            rid = next(seq)
-            await ws.send(json.dumps({"op": op, "id": rid, **args}))
-            while True:
-                m = json.loads(await ws.recv())
-                if m.get("id") == rid and m["type"] in ("done", "error"):
-                    if m["type"] == "error":
-                        raise RuntimeError(m["text"])
-                    return m
-
-        async def sim_time():
-            last = None
-            while True:
-                m = json.loads(await ws.recv())
-                if m["type"] == "live":
-                    last = m["time"]
-                elif m["type"] == "state" and m.get("time") is not None:
-                    last = m["time"]
-                if last is not None:
-                    return last
-        await act("runMode", value="GO")
-        await act("select", program=program)
-        await act("drives", on=True)
-        await act("start")
-        await asyncio.sleep(1.0)                       # past the start-up
-        t0_sim, t0, c0 = await sim_time(), time.perf_counter(), cpu()
-        end = t0 + seconds
-        while time.perf_counter() < end:
-            await asyncio.sleep(0.5)
-            await sim_time()
-        t1_sim, t1, c1 = await sim_time(), time.perf_counter(), cpu()
-        return t1_sim - t0_sim, t1 - t0, c1 - c0
+    s0, t0, c0 = _in_thread(_sim_time(url)), time.perf_counter(), cpu()
+    time.sleep(seconds)
+    s1, t1, c1 = _in_thread(_sim_time(url)), time.perf_counter(), cpu()
+    return s1 - s0, t1 - t0, c1 - c0
 
 
 def _with_page(url: str, work):
@@ -120,28 +133,20 @@ def rtf(backup, program, cell, seconds, realtime: bool, page: bool) -> tuple[flo
     """(simulated s per wall s, simulated s per CPU s of the server process)."""
     proc, url = _server(backup, cell, realtime)
     try:
+        _in_thread(_start(url, program))
+        time.sleep(1.0)                                # past the start-up
         if not page:
-            sim, wall, cpu = asyncio.run(_control(url, program, seconds, proc.pid))
+            sim, wall, cpu = _window(url, proc.pid, seconds)
         else:
-            import threading  # noqa: PLC0415
-
-            out = {}
-            done = threading.Event()
-
-            def control():
-                out["r"] = asyncio.run(_control(url, program, seconds, proc.pid))
-                done.set()
-
             def work(pg):
-                threading.Thread(target=control, daemon=True).start()
-                while not done.wait(0.25):
-                    pg.evaluate("() => window.pendant.frames")   # the page goes on rendering
-                return out["r"]
+                pg.wait_for_function("() => window.pendant.state && window.pendant.state.state == 'running'",
+                                     timeout=120_000)
+                return _window(url, proc.pid, seconds)
             sim, wall, cpu = _with_page(url, work)
         return sim / wall, sim / max(cpu, 1e-9)
     finally:
         proc.terminate()
-        proc.wait(30)
+        proc.wait(60)
 
 
 LATENCY_JS = """async (n) => {
