@@ -39,7 +39,7 @@ from .security import COOKIE, Guard, PathRefused, inside
 STATIC = Path(__file__).resolve().parent / "static"
 #: display rate of the live pose (Hz) and of the full state while running
 LIVE_HZ = 30.0
-STATE_HZ = 5.0
+STATE_HZ = 2.0
 CSP = ("default-src 'none'; script-src 'self'; style-src 'self'; img-src 'self' data: blob:; "
        "connect-src 'self'; font-src 'self'; frame-ancestors 'self' vscode-webview:; base-uri 'none'; "
        "form-action 'none'")

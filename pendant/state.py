@@ -43,7 +43,7 @@ def snapshot(eng, core, watch: list) -> dict:
         "notes": list(eng.notes),
         "path": {"run": eng.run_no, "points": len(eng.path)},
         "io": _io(rt, eng.signals),
-        "position": _position(rt),
+        "position": _position(eng, rt),
         "watch": _watch(core, watch),
     })
     return out
@@ -114,21 +114,18 @@ def _long_text(sym, cache: dict) -> str:
 def _io(rt, signals: list[dict]) -> dict:
     io = rt.controller.io
     names: dict[tuple[str, int], list[str]] = {}
+    texts: dict[tuple[str, int], str] = {}
     for sig in signals:
         if sig["last"] is None and sig["io"] in ("$IN", "$OUT"):
-            names.setdefault((sig["io"], sig["first"]), []).append(sig["name"])
+            key = (sig["io"], sig["first"])
+            names.setdefault(key, []).append(sig["name"])
+            if sig["text"] and key not in texts:
+                texts[key] = sig["text"]
     rows = {}
     for arr, get in (("$IN", io.get_in), ("$OUT", io.get_out)):
         shown = set(range(1, IO_ALWAYS + 1)) | {n for (a, n) in names if a == arr}
-        entries = []
-        for n in sorted(shown):
-            if not 1 <= n <= 8192:
-                continue
-            sig = names.get((arr, n), [])
-            entries.append({"index": n, "value": bool(get(n)), "names": sig,
-                            "text": next((s["text"] for s in signals if s["io"] == arr and s["first"] == n
-                                          and s["last"] is None and s["text"]), "")})
-        rows[arr] = entries
+        rows[arr] = [{"index": n, "value": bool(get(n)), "names": names.get((arr, n), []),
+                      "text": texts.get((arr, n), "")} for n in sorted(shown) if 1 <= n <= 8192]
     return rows
 
 
@@ -144,13 +141,19 @@ def _frame(v) -> dict | None:
     return out
 
 
-def _position(rt) -> dict:
+def _position(eng, rt) -> dict:
     ctl = rt.controller
     store = rt.sysvars.store
-    try:
-        pos = ctl.pos_act()
-    except Exception:  # noqa: BLE001 - a pose outside the model shows as unknown
-        pos = None
+    key = (ctl.cycle, ctl.time, tuple(float(v) for v in ctl.axis_act()))
+    cached = getattr(eng, "pos_cache", None)        # $POS_ACT is the same until the robot moves
+    if cached is not None and cached[0] == key:
+        pos = cached[1]
+    else:
+        try:
+            pos = ctl.pos_act()
+        except Exception:  # noqa: BLE001 - a pose outside the model shows as unknown
+            pos = None
+        eng.pos_cache = (key, pos)
     return {"axes": [round(float(v), 4) for v in ctl.axis_act()],
             "pos": {k: round(float(v), 3) for k, v in pos.items()} if pos else None,
             "base": _frame(store.get("$BASE")), "tool": _frame(store.get("$TOOL"))}
