@@ -71,10 +71,14 @@ class Engine:
         self.thread = thread_main(core, "krl-pendant-engine")
         options = {"workspace": workspace, "inputs": inputs, "mode": mode, "run_mode": run_mode,
                    "trace_path": trace, "max_sim_time": 7 * 24 * 3600.0}
-        self.call(core.launch, LaunchConfig.of(program, stop_on_entry=True, **options), timeout=900.0)
-        for path, lines in (breakpoints or {}).items():
-            self.call(core.set_breakpoints, path, [{"line": n} for n in lines])
-        self.call(core.configuration_done)
+        try:
+            self.call(core.launch, LaunchConfig.of(program, stop_on_entry=True, **options), timeout=900.0)
+            for path, lines in (breakpoints or {}).items():
+                self.call(core.set_breakpoints, path, [{"line": n} for n in lines])
+            self.call(core.configuration_done)
+        except EngineError:
+            self.cancel()                            # nothing stays selected
+            raise
         deadline = time.monotonic() + 900.0          # the run starts: wait for its entry stop
         while core.state not in ("stopped", "ended") and not core.done and time.monotonic() < deadline:
             time.sleep(0.01)

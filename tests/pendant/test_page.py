@@ -208,3 +208,18 @@ def test_the_pendant_run_gives_krl_runs_trace(pw, shared_corpus, tmp_path):
     assert run.returncode == 0, run.stdout + run.stderr
     assert read_trace(ref)[-1]["kind"] == "end" and read_trace(ref)[-1]["reason"] == "completed"
     assert trace.read_text() == ref.read_text()
+
+
+def test_breakpoint_from_the_program_view(kr120):
+    """A breakpoint set by clicking a line number stops the run there (GO), as the engine's
+    breakpoints do for `krl debug`."""
+    page = kr120
+    select(page, PREPARE, run_mode="GO", mode="T1")
+    page.locator('#program-view .ln[data-line="20"] .no').click()
+    page.wait_for_selector('#program-view .ln.bp[data-line="20"]', timeout=60_000)
+    page.click("#start")
+    s = wait_state(page, "s.state == 'stopped' && s.stop && s.stop.reason == 'breakpoint'")
+    assert s["pointers"]["advanceRun"]["path"].endswith("PrepareMillingTools.src")
+    assert s["pointers"]["advanceRun"]["line"] == 20
+    page.locator('#program-view .ln[data-line="20"] .no').click()       # and off again
+    page.wait_for_selector('#program-view .ln.bp', state="detached", timeout=60_000)
