@@ -40,6 +40,8 @@ STATIC = Path(__file__).resolve().parent / "static"
 #: display rate of the live pose (Hz) and of the full state while running
 LIVE_HZ = 30.0
 STATE_HZ = 2.0
+#: module views kept (text and taught points of a file, until it changes)
+MODULE_CACHE = 64
 CSP = ("default-src 'none'; script-src 'self'; style-src 'self'; img-src 'self' data: blob:; "
        "connect-src 'self'; font-src 'self'; frame-ancestors 'self' vscode-webview:; base-uri 'none'; "
        "form-action 'none'")
@@ -73,6 +75,7 @@ class Pendant:
         self._programs = None
         self._last_live = None
         self._path_run, self._path_sent = None, 0
+        self._modules: dict[str, tuple] = {}
 
     # ------------------------------------------------------------------ static data
     def robot(self) -> dict:
@@ -268,10 +271,30 @@ class Pendant:
         await self.broadcast_module(str(path))
 
     async def send_module(self, ws: WebSocket, path: str) -> None:
+        await ws.send_text(await self.module_text(path))
+
+    async def module_text(self, path: str) -> str:
+        """The ``module`` message of ``path``, kept while the file and its data list are
+        unchanged (the page follows the advance run through modules again and again)."""
         from .view import module_view  # noqa: PLC0415
 
-        view = await asyncio.get_running_loop().run_in_executor(None, module_view, Path(path), self.root)
-        await ws.send_text(json.dumps({"type": "module", **view}))
+        p = Path(path)
+        key = []
+        for f in (p, *[q for q in p.parent.iterdir() if q.stem.lower() == p.stem.lower() and q != p]):
+            try:
+                st = f.stat()
+                key.append((str(f), st.st_mtime_ns, st.st_size))
+            except OSError:
+                pass
+        hit = self._modules.get(path)
+        if hit is not None and hit[0] == key:
+            return hit[1]
+        view = await asyncio.get_running_loop().run_in_executor(None, module_view, p, self.root)
+        text = json.dumps({"type": "module", **view})
+        self._modules[path] = (key, text)
+        while len(self._modules) > MODULE_CACHE:
+            del self._modules[next(iter(self._modules))]
+        return text
 
     async def broadcast_module(self, path: str) -> None:
         for ws in list(self.clients):

@@ -133,7 +133,14 @@ $('watch-add').onclick = () => {
 };
 
 // ------------------------------------------------------------------ program view
+const moduleCache = new Map();   // path -> the module message: following the advance run costs no round trip
 function onModule(m) {
+  moduleCache.set(m.path, m);
+  if (moduleCache.size > 64) moduleCache.delete(moduleCache.keys().next().value);
+  showModule(m);
+}
+
+function showModule(m) {
   P.module = m;
   $('module-label').textContent = m.label;
   const box = $('program-view');
@@ -172,7 +179,11 @@ function drawPointers(ptr, bps) {
   if (target && P.scrollTo !== target) { P.scrollTo = target; target.scrollIntoView({ block: 'center' }); }
   // follow the advance run into another module, as the smartPAD does
   const want = (ptr.advanceRun && ptr.advanceRun.path) || null;
-  if (want && !samePath(want, m.path) && P.opening !== want) { P.opening = want; send('open', { path: want }).catch(() => {}); }
+  if (want && !samePath(want, m.path)) {
+    const cached = moduleCache.get(want);
+    if (cached) showModule(cached);
+    else if (P.opening !== want) { P.opening = want; send('open', { path: want }).catch(() => {}); }
+  }
 }
 
 // ------------------------------------------------------------------ state
@@ -406,7 +417,7 @@ function onLive(m) {
   if (typeof m.time === 'number') $('st-time').textContent = `t = ${m.time.toFixed(3)} s`;
   setAxes(m.axes);
   if (m.path) addPath(m.run, m.path);
-  if (m.pointers && P.state) drawPointers(m.pointers, P.state.breakpoints || {});
+  if (m.pointers && P.state) { P.state.pointers = m.pointers; drawPointers(m.pointers, P.state.breakpoints || {}); }
 }
 
 function resize() {
