@@ -351,6 +351,7 @@ function loadRobot(r) {
     tool0.add(toolFrame);
   }
   P.robot = robot;
+  requestRender();
   const span = Math.max(1.2, reach * 1.05);
   camera.position.set(span * 1.1, span * 0.9, span * 1.2);
   controls.target.set(0, reach * 0.45, 0);
@@ -364,6 +365,7 @@ function setAxes(axes, tool, base) {
   if (tool) { const f = frameArr(tool); toolFrame.matrixAutoUpdate = false; toolFrame.matrix.copy(kukaMatrix(f)); }
   if (base) { const f = frameArr(base); baseFrame.matrixAutoUpdate = false; baseFrame.matrix.copy(kukaMatrix(f)); }
   P.axesShown = axes.slice();
+  requestRender();
 }
 
 // the rendered joint values (deg), read back from the drawn robot: what the page shows
@@ -395,6 +397,7 @@ function addPath(run, points) {
   pathGeom.attributes.position.needsUpdate = true;
   pathGeom.attributes.color.needsUpdate = true;
   P.pathPoints = pathN;
+  requestRender();
 }
 
 const pointsGroup = new THREE.Group();
@@ -410,6 +413,7 @@ function showPoints(points) {
     s.name = p.name;
     pointsGroup.add(s);
   }
+  requestRender();
 }
 
 function onLive(m) {
@@ -428,12 +432,21 @@ function resize() {
   camera.aspect = w / h;
   camera.updateProjectionMatrix();
 }
-window.addEventListener('resize', resize);
-function frame() {
-  resize();
-  renderer.render(scene, camera);
-  P.frames++;
-  requestAnimationFrame(frame);
+// render on demand: a frame when the pose, the path, the frames or the camera changed (a
+// software-rendered WebGL page at 60 Hz would take the CPU the simulation needs)
+let framePending = false;
+function requestRender() {
+  if (framePending) return;
+  framePending = true;
+  requestAnimationFrame(() => {
+    framePending = false;
+    resize();
+    renderer.render(scene, camera);
+    P.frames++;
+  });
 }
-requestAnimationFrame(frame);
+P.requestRender = requestRender;
+window.addEventListener('resize', requestRender);
+controls.addEventListener('change', requestRender);
+requestRender();
 connect();
