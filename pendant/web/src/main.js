@@ -421,7 +421,12 @@ function onLive(m) {
   if (typeof m.time === 'number') $('st-time').textContent = `t = ${m.time.toFixed(3)} s`;
   setAxes(m.axes);
   if (m.path) addPath(m.run, m.path);
-  if (m.pointers && P.state) { P.state.pointers = m.pointers; drawPointers(m.pointers, P.state.breakpoints || {}); }
+  // the pointers of a cycle newer than the last state (at a stop the state, taken after the
+  // last cycle, is the newer one even at the same simulated time)
+  if (m.pointers && P.state && typeof P.state.time === 'number' && m.time > P.state.time + 1e-9) {
+    P.state.pointers = { ...P.state.pointers, ...m.pointers };
+    drawPointers(P.state.pointers, P.state.breakpoints || {});
+  }
 }
 
 function resize() {
