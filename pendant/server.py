@@ -12,7 +12,8 @@ Threads: uvicorn's event loop serves the page; the program runs on the engine's 
 (pendant/engine.py); a blocking engine request runs in the loop's executor. Limits
 (krl/limits.py): MAX_WEB_MESSAGE_BYTES per websocket message (uvicorn's ``ws_max_size``: a
 larger one closes the connection, 1009), MAX_WEB_CONNECTIONS websockets at once,
-MAX_WEB_MESSAGES_PER_S per connection (past it: closed, 1008).
+MAX_WEB_MESSAGES_PER_S per connection, counted as they arrive (past it, or with a second's
+worth of actions not yet carried out: closed, 1008).
 """
 
 from __future__ import annotations
@@ -305,44 +306,70 @@ class Pendant:
 
     # ------------------------------------------------------------------ websocket
     async def websocket(self, ws: WebSocket) -> None:
+        """One page's connection. Its messages are read as they arrive and counted there (the
+        rate limit holds however slowly the actions are carried out) and queued for
+        :meth:`_actions`; a backlog of more than a second's worth of actions is a flood too."""
         if len(self.clients) >= MAX_WEB_CONNECTIONS:
             await ws.close(code=1013, reason="too many connections")
             return
         await ws.accept()
         self.clients.add(ws)
+        queue: asyncio.Queue = asyncio.Queue(maxsize=MAX_WEB_MESSAGES_PER_S)
+        worker = asyncio.ensure_future(self._actions(ws, queue))
         window, count = time.monotonic(), 0
         try:
-            while True:
+            while not worker.done():
                 text = await ws.receive_text()
                 now = time.monotonic()
                 if now - window >= 1.0:
                     window, count = now, 0
                 count += 1
-                if count > MAX_WEB_MESSAGES_PER_S:
+                if count > MAX_WEB_MESSAGES_PER_S or queue.full():
                     await ws.close(code=1008, reason="too many messages")
                     return
                 if len(text) > MAX_WEB_MESSAGE_BYTES:
                     await ws.close(code=1009, reason="message too large")
                     return
-                try:
-                    msg = json.loads(text)
-                    if not isinstance(msg, dict):
-                        raise ValueError("not an object")
-                except ValueError:
-                    await ws.send_text(json.dumps({"type": "error", "text": "not a JSON object"}))
-                    continue
-                rid = msg.get("id")
-                try:
-                    async with self.busy:
-                        await self.handle(ws, msg)
-                    await ws.send_text(json.dumps({"type": "done", "id": rid, "op": str(msg.get("op"))[:40]}))
-                except (EngineError, PathRefused) as exc:
-                    await ws.send_text(json.dumps({"type": "error", "id": rid, "op": str(msg.get("op"))[:40],
-                                                   "text": str(exc)[:500]}))
+                queue.put_nowait(text)
         except WebSocketDisconnect:
             pass
         finally:
+            worker.cancel()
+            with contextlib.suppress(asyncio.CancelledError, WebSocketDisconnect):
+                await worker
             self.clients.discard(ws)
+
+    async def _actions(self, ws: WebSocket, queue: asyncio.Queue) -> None:
+        """Carry out the queued messages of one connection in order, each answered with
+        ``done`` or ``error`` (its id and op). A failure that is not a refusal closes the
+        connection (1011) and is logged by uvicorn."""
+        try:
+            await self._carry_out(ws, queue)
+        except (asyncio.CancelledError, WebSocketDisconnect):
+            raise
+        except Exception:
+            with contextlib.suppress(Exception):
+                await ws.close(code=1011, reason="server error")
+            raise
+
+    async def _carry_out(self, ws: WebSocket, queue: asyncio.Queue) -> None:
+        while True:
+            text = await queue.get()
+            try:
+                msg = json.loads(text)
+                if not isinstance(msg, dict):
+                    raise ValueError("not an object")
+            except ValueError:
+                await ws.send_text(json.dumps({"type": "error", "text": "not a JSON object"}))
+                continue
+            rid = msg.get("id")
+            try:
+                async with self.busy:
+                    await self.handle(ws, msg)
+                await ws.send_text(json.dumps({"type": "done", "id": rid, "op": str(msg.get("op"))[:40]}))
+            except (EngineError, PathRefused) as exc:
+                await ws.send_text(json.dumps({"type": "error", "id": rid, "op": str(msg.get("op"))[:40],
+                                               "text": str(exc)[:500]}))
 
 
 def create_app(pendant: Pendant, token: str, port_of) -> Guard:

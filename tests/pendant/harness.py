@@ -41,23 +41,32 @@ def chromium_or_skip() -> str:
 
 @contextmanager
 def pendant_server(target: Path, *args: str):
-    """`krl pendant TARGET --no-browser ARGS...`: yields the URL it printed first."""
+    """`krl pendant TARGET --no-browser ARGS...`: yields the URL it printed first. Its stderr
+    goes to a file (a pipe nobody reads would stall the server once full), shown on failure."""
     cmd = [sys.executable, "-m", "krl.cli", "pendant", str(target), "--no-browser", *args]
-    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=REPO_ROOT,
-                            env={**os.environ, "PYTHONUNBUFFERED": "1"})
-    try:
-        url = proc.stdout.readline().strip()
-        if not url.startswith("http://127.0.0.1:"):
-            proc.kill()
-            raise AssertionError(f"krl pendant printed {url!r} first; stderr:\n{proc.stderr.read()[-3000:]}")
-        yield url
-    finally:
-        proc.terminate()
+    with tempfile.TemporaryFile("w+") as err:
+        proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=err, text=True, cwd=REPO_ROOT,
+                                env={**os.environ, "PYTHONUNBUFFERED": "1"})
         try:
-            proc.wait(30)
-        except subprocess.TimeoutExpired:
-            proc.kill()
-            proc.wait(30)
+            url = proc.stdout.readline().strip()
+            if not url.startswith("http://127.0.0.1:"):
+                proc.kill()
+                proc.wait(30)
+                err.seek(0)
+                raise AssertionError(f"krl pendant printed {url!r} first; stderr:\n{err.read()[-3000:]}")
+            try:
+                yield url
+            except BaseException:
+                err.seek(0)
+                print(f"krl pendant's stderr:\n{err.read()[-5000:]}", file=sys.stderr)
+                raise
+        finally:
+            proc.terminate()
+            try:
+                proc.wait(30)
+            except subprocess.TimeoutExpired:
+                proc.kill()
+                proc.wait(30)
 
 
 @contextmanager
@@ -70,6 +79,9 @@ def browser_page(pw, url: str, viewport=(1400, 900)):
         ctx = pw.chromium.launch_persistent_context(profile, executable_path=chromium_or_skip(), headless=True,
                                                     args=FLAGS, bypass_csp=True,
                                                     viewport={"width": viewport[0], "height": viewport[1]})
+        # every Playwright wait and action (a click waits for its element) gets the loaded
+        # machine's time limit, not Playwright's 30 s
+        ctx.set_default_timeout(WAIT_MS)
         try:
             page = ctx.new_page()
             page.problems = []
@@ -114,6 +126,13 @@ def select(page, program: str, *, run_mode: str = "MSTEP", mode: str = "T1") -> 
         page.click("#drives")
         s = wait_state(page, "s.drives")
     return s
+
+
+def wait_drawn(page) -> None:
+    """Wait until the 3D view has drawn a frame of what the page holds now: a frame is asked for
+    and drawn (the page renders on demand, pendant/web/src/main.js)."""
+    before = page.evaluate("() => { window.pendant.requestRender(); return window.pendant.frames; }")
+    page.wait_for_function(f"() => !window.pendant.renderPending() && window.pendant.frames > {before}")
 
 
 def read_trace(path: Path) -> list[dict]:

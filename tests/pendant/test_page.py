@@ -54,7 +54,7 @@ def step_stops(page) -> list[dict]:
 def assert_drawn_as_traced(page, t: float) -> None:
     want = pose_at(read_trace(page.trace_path), t)
     page.wait_for_function(f"() => {{ const a = window.pendant.renderedAxes(); const w = {json.dumps(want)};"
-                           f" return a && a.every((v, i) => Math.abs(v - w[i]) <= {TOL_DEG}); }}", timeout=60_000)
+                           f" return a && a.every((v, i) => Math.abs(v - w[i]) <= {TOL_DEG}); }}")
     got = rendered(page)
     assert all(abs(g - w) <= TOL_DEG for g, w in zip(got, want)), (got, want)
 
@@ -65,7 +65,7 @@ def test_mstep_pointer_and_pose_advance(kr120):
     entry = (s0["pointers"]["advanceRun"]["path"], s0["pointers"]["advanceRun"]["line"])
     assert entry[0].endswith("PrepareMillingTools.src")
     # the program view shows the advance-run pointer on its line
-    page.wait_for_selector(f'#program-view .ln.advance[data-line="{entry[1]}"]', timeout=60_000)
+    page.wait_for_selector(f'#program-view .ln.advance[data-line="{entry[1]}"]')
     previous, poses = entry, []
     for _ in range(2):
         s = start_to_step(page, state(page)["pointers"]["step"])
@@ -74,7 +74,7 @@ def test_mstep_pointer_and_pose_advance(kr120):
         stop = step_stops(page)[-1]
         assert stop["mode"] == "MSTEP" and abs(stop["t"] - s["time"]) < 0.0015
         assert_drawn_as_traced(page, stop["t"])
-        page.wait_for_selector(f'#program-view .ln.advance[data-line="{here[1]}"]', timeout=60_000)
+        page.wait_for_selector(f'#program-view .ln.advance[data-line="{here[1]}"]')
         poses.append(rendered(page))
         previous = here
     assert max(abs(a - b) for a, b in zip(*poses)) > 1.0, "the robot did not move between the two stops"
@@ -91,7 +91,7 @@ def test_step_backward_to_previous_point(kr120):
     assert max(abs(a - b) for a, b in zip(at_first, pose_at(read_trace(page.trace_path), second["t"]))) > 1.0
     page.click("#backward")
     page.wait_for_function(f"() => {{ const a = window.pendant.renderedAxes(); const w = {json.dumps(at_first)};"
-                           f" return a && a.every((v, i) => Math.abs(v - w[i]) <= {TOL_DEG}); }}", timeout=300_000)
+                           f" return a && a.every((v, i) => Math.abs(v - w[i]) <= {TOL_DEG}); }}")
     back = [e for e in step_stops(page) if e["mode"] == "BSTEP"]
     assert back, "no backward step in the trace"
     assert all(abs(a - b) <= TOL_DEG for a, b in zip(pose_at(read_trace(page.trace_path), back[-1]["t"]), at_first))
@@ -104,10 +104,10 @@ def test_jog_an_axis_in_t1(kr120):
     page.select_option("#jog-system", "AXIS")
     page.select_option("#jog-step", "10")
     page.click('[data-jog="A1+"]')
-    s = wait_state(page, f"Math.abs(s.position.axes[0] - {a1 + 10}) < 1e-3", timeout=120_000)
+    s = wait_state(page, f"Math.abs(s.position.axes[0] - {a1 + 10}) < 1e-3")
     assert all(abs(a - b) < 1e-3 for a, b in zip(s["position"]["axes"][1:], others)), "only A1 moves"
     jogged = s["position"]["axes"]
-    page.wait_for_function(f"() => Math.abs(window.pendant.renderedAxes()[0] - {a1 + 10}) <= {TOL_DEG}", timeout=60_000)
+    page.wait_for_function(f"() => Math.abs(window.pendant.renderedAxes()[0] - {a1 + 10}) <= {TOL_DEG}")
     # the jog is a motion of the controller, within T1's limits: it is in the trace
     jog = [e for e in read_trace(page.trace_path) if e["kind"] == "motion" and e["phase"] == "start"][-1]
     assert abs(jog["target"]["A1"] - (a1 + 10)) < 1e-6 and jog["limits"]["flange"] == 250.0
@@ -216,10 +216,10 @@ def test_breakpoint_from_the_program_view(kr120):
     page = kr120
     select(page, PREPARE, run_mode="GO", mode="T1")
     page.locator('#program-view .ln[data-line="20"] .no').click()
-    page.wait_for_selector('#program-view .ln.bp[data-line="20"]', timeout=60_000)
+    page.wait_for_selector('#program-view .ln.bp[data-line="20"]')
     page.click("#start")
     s = wait_state(page, "s.state == 'stopped' && s.stop && s.stop.reason == 'breakpoint'")
     assert s["pointers"]["advanceRun"]["path"].endswith("PrepareMillingTools.src")
     assert s["pointers"]["advanceRun"]["line"] == 20
     page.locator('#program-view .ln[data-line="20"] .no').click()       # and off again
-    page.wait_for_selector('#program-view .ln.bp', state="detached", timeout=60_000)
+    page.wait_for_selector('#program-view .ln.bp', state="detached")

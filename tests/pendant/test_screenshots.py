@@ -16,7 +16,8 @@ import pytest
 from PIL import Image
 
 from tests.conftest import REPO_ROOT
-from tests.pendant.harness import CELLS, KR120, PALLETIZER, browser_page, pendant_server, select, wait_state
+from tests.pendant.harness import CELLS, KR120, PALLETIZER, browser_page, pendant_server, select, wait_drawn,
+                                   wait_state
 
 pytestmark = pytest.mark.may_skip("chromium is missing and cannot be installed (not root, or apt-get has no network)")
 
@@ -35,10 +36,10 @@ def shot(pw, backup, cell, program) -> bytes:
         # everything of this stop has reached the page: the whole TCP path and the pose
         page.wait_for_function("() => { const s = window.pendant.state; return window.pendant.pathPoints === "
                                "s.path.points && window.pendant.renderedAxes().every((v, i) => "
-                               "Math.abs(v - s.position.axes[i]) < 1e-3); }", timeout=120_000)
+                               "Math.abs(v - s.position.axes[i]) < 1e-3); }")
         page.click('#tabs button[data-tab="io"]')
         page.evaluate("() => document.activeElement && document.activeElement.blur()")
-        page.wait_for_timeout(500)     # two animation frames at least: the drawn frame is the last state's
+        wait_drawn(page)               # the drawn frame is this stop's, whatever the machine's load
         assert page.problems == []
         return page.screenshot()
 

@@ -87,7 +87,7 @@ def test_touch_up_from_the_page_in_t1(pw, tmp_path):
         page.fill("#touchup-name", "XP1")
         page.click("#touchup")
         page.wait_for_function("() => window.pendant.module && window.pendant.module.points.some("
-                               "p => p.name == 'XP1' && Math.abs(p.frame[2] - 1200) > 1)", timeout=60_000)
+                               "p => p.name == 'XP1' && Math.abs(p.frame[2] - 1200) > 1)")
         pos = s["position"]["pos"]
     raw = dat.read_bytes()
     assert "Schweißpunkt".encode("cp1252") in raw and b"\r\n" in raw and raw.count(b"\n") == raw.count(b"\r\n")

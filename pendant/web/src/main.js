@@ -451,6 +451,8 @@ function requestRender() {
   });
 }
 P.requestRender = requestRender;
+// true while a frame is asked for and not drawn yet (the tests wait for the drawn frame)
+P.renderPending = () => framePending;
 window.addEventListener('resize', requestRender);
 controls.addEventListener('change', requestRender);
 requestRender();
