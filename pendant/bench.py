@@ -1,12 +1,13 @@
 """Benchmark of the pendant (issue 36): the simulation's real-time factor without and with the
 page open, and the page's latency from an input to its visible change, in one run.
 
-    python -m pendant.bench [BACKUP] [--program P] [--inputs CELL] [--seconds S] [--toggles N]
+    python -m pendant.bench [BACKUP] [--program P] [--inputs CELL] [--seconds S] [--rounds R] [--toggles N]
 
 For each condition the program is selected anew and run in GO/AUT at real time by
 ``krl pendant`` (a subprocess), started by a short websocket connection: "closed" with no
 client connected while it is measured (a short connection reads the simulated time at both
-ends of the window), "open" with the page rendered by headless Chromium meanwhile. The real-time factor is simulated time over wall time across ``--seconds`` of running.
+ends of the window), "open" with the page rendered by headless Chromium meanwhile. The real-time factor is simulated time over wall time across ``--seconds`` of running;
+the two conditions alternate ``--rounds`` times and the medians are compared.
 The same two conditions are then run unpaced (``--no-realtime``): there the factor is the
 simulation's throughput, and its drop is what the page costs the simulation. The latency is
 measured in the page while the program runs at real time: an input key pressed, until the
@@ -198,6 +199,7 @@ def main(argv=None) -> int:
     ap.add_argument("--inputs", type=Path, default=DEFAULT_CELL)
     ap.add_argument("--seconds", type=float, default=15.0)
     ap.add_argument("--no-latency", action="store_true", help="measure the real-time factors only")
+    ap.add_argument("--rounds", type=int, default=2, help="alternations of page closed and open per pacing")
     ap.add_argument("--toggles", type=int, default=20)
     ap.add_argument("--input", type=int, default=16, help="the input toggled (one the program does not read)")
     a = ap.parse_args(argv)
@@ -205,15 +207,24 @@ def main(argv=None) -> int:
           f"{time.strftime('%Y-%m-%d %H:%M')}; {a.backup.name} {a.program}", flush=True)
     res = {}
     for realtime in (True, False):
+        # the two conditions alternate, --rounds times each, so that a shared machine's changing
+        # load falls on both alike; the median of each is compared
+        runs = {False: [], True: []}
+        for _ in range(a.rounds):
+            for page in (False, True):
+                runs[page].append(rtf(a.backup, a.program, a.inputs, a.seconds, realtime, page))
         for page in (False, True):
-            r, per_cpu = rtf(a.backup, a.program, a.inputs, a.seconds, realtime, page)
+            r = statistics.median(x[0] for x in runs[page])
+            per_cpu = statistics.median(x[1] for x in runs[page])
             res[(realtime, page)] = (r, per_cpu)
+            each = ", ".join(f"{x[0]:.3f}" for x in runs[page])
             print(f"real-time factor, {'paced' if realtime else 'unpaced'}, page {'open' if page else 'closed'}: "
-                  f"{r:.3f} (simulated s per CPU s of the server: {per_cpu:.3f})", flush=True)
+                  f"{r:.3f} (rounds: {each}; simulated s per CPU s of the server: {per_cpu:.3f})", flush=True)
         for k, what in ((0, "real-time factor"), (1, "simulated s per server CPU s")):
             drop = 1 - res[(realtime, True)][k] / res[(realtime, False)][k]
             print(f"  {'paced' if realtime else 'unpaced'}: with the page open the {what} drops by {drop:+.1%}",
                   flush=True)
+    print(f"load at the end: {os.getloadavg()[0]:.2f} {os.getloadavg()[1]:.2f} {os.getloadavg()[2]:.2f}", flush=True)
     if a.no_latency:
         return 0
     lat = latency(a.backup, a.program, a.inputs, a.toggles, a.input)

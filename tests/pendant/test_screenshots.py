@@ -16,8 +16,8 @@ import pytest
 from PIL import Image
 
 from tests.conftest import REPO_ROOT
-from tests.pendant.harness import CELLS, KR120, PALLETIZER, browser_page, pendant_server, select, wait_drawn,
-                                   wait_state
+from tests.pendant.harness import (CELLS, KR120, PALLETIZER, browser_page, pendant_server, select, wait_drawn,
+                                   wait_state)
 
 pytestmark = pytest.mark.may_skip("chromium is missing and cannot be installed (not root, or apt-get has no network)")
 
