@@ -49,85 +49,33 @@ import click
               help="The robot to simulate: a robot YAML, a $machine.dat, a KRC backup folder or .zip "
                    "(default: the robot the --inputs cell file names, else the backup's own robot from its "
                    "R1/Mada/$machine.dat, else the KR 6 R900).")
-def run(program: Path, interp_kind: str, workspace, inputs, trace_path, max_sim_time, max_steps, submit,
-        mode, run_mode, pgno, no_check, robot, no_submit) -> None:
+def run(**options) -> None:
     """Run PROGRAM (.src) on the simulated KR C4; print where and why it ended.
 
     With --workspace BACKUP.zip (a KRC backup archive) PROGRAM is a path inside the archive
     (KRC/R1/Program/demo.src) or a module name (demo); the archive is checked and extracted
     to a temporary folder (krl/archive.py) that is removed after the run.
     """
-    from krl.archive import ArchiveError, backup_source, is_archive  # noqa: PLC0415
-    from krl.terminal import printable  # noqa: PLC0415
+    from interp.run import RunSetupError, run_setup  # noqa: PLC0415
 
-    if is_archive(program):
-        click.echo(f"error: {printable(program)} is a backup archive; name the program to run in it: "
-                   f"krl run --workspace {printable(program)} PROGRAM", err=True)
+    try:
+        with run_setup(options) as setup:
+            _run(setup)
+    except RunSetupError as exc:
+        click.echo(f"error: {exc}", err=True)
         sys.exit(2)
-    if workspace is not None and is_archive(workspace):
-        try:
-            with backup_source(workspace) as (folder, shown):
-                found = program_in(folder, program)
-                if found is None:
-                    click.echo(f"error: no program {printable(program)} in {printable(workspace)}", err=True)
-                    sys.exit(2)
-                _run(found, folder, inputs, trace_path, max_sim_time, max_steps, submit, interp_kind,
-                     mode=mode, shown=lambda text: text.replace(str(folder), str(workspace)), check=not no_check,
-                     run_mode=run_mode, pgno=pgno, robot=robot, auto_submit=not no_submit)
-        except ArchiveError as exc:
-            click.echo(f"error: {printable(exc)}", err=True)
-            sys.exit(2)
-        return
-    _run(program, workspace, inputs, trace_path, max_sim_time, max_steps, submit, interp_kind, mode=mode,
-         check=not no_check, run_mode=run_mode, pgno=pgno, robot=robot, auto_submit=not no_submit)
 
 
-def program_in(folder: Path, program: Path) -> Path | None:
-    """PROGRAM inside an extracted archive: its relative path (any letter case of the file
-    name), else the .src (then .sub) file whose stem is its name; None when there is none."""
-    from krl.source import is_krl_file  # noqa: PLC0415
-
-    direct = folder / program
-    if not program.is_absolute() and ".." not in program.parts and direct.is_file():
-        return direct
-    stem = program.stem.lower()
-    candidates = sorted(p for p in folder.rglob("*") if p.is_file() and is_krl_file(p) and p.stem.lower() == stem)
-    for suffix in (".src", ".sub"):
-        for p in candidates:
-            if p.suffix.lower() == suffix:
-                return p
-    return None
-
-
-def _run(program: Path, workspace, inputs, trace_path, max_sim_time, max_steps, submit, interp_kind,
-         mode=None, shown=lambda text: text, check: bool = True, run_mode: str = "GO",
-         pgno: int | None = None, robot=None, auto_submit: bool = False) -> None:
-    if not program.exists():
-        click.echo(f"error: {program}: no such file", err=True)
-        sys.exit(2)
-    for sub in submit:
-        if not Path(sub).is_file():
-            click.echo(f"error: {shown(str(sub))}: no such submit program", err=True)
-            sys.exit(2)
-    booted = None
-    if not submit and auto_submit:
-        from krl.project import boot_submit  # noqa: PLC0415
-
-        booted = boot_submit(program, workspace)
-        submit = (booted,) if booted is not None else ()
-    from interp.run import make_runtime, robot_for  # noqa: PLC0415
+def _run(setup) -> None:
+    """Run `setup` (interp.run.RunSetup) and print the summary; exits with the run's code."""
     from interp.summary import RunObserver, starvation_lines, summary_lines  # noqa: PLC0415
-    from robot.mada import MachineDataError  # noqa: PLC0415
     from krl.terminal import printable  # noqa: PLC0415
     from robot.stimuli import StimulusError  # noqa: PLC0415
     from robot.trace import TraceWriter  # noqa: PLC0415
     from net.hub import NetError  # noqa: PLC0415
 
-    try:
-        machine = robot_for(program, workspace, robot, inputs)
-    except (MachineDataError, StimulusError) as exc:
-        click.echo(f"error: {shown(printable(exc))}", err=True)
-        sys.exit(2)
+    shown, machine, program = setup.shown, setup.machine, setup.program
+    trace_path = setup.options.get("trace_path")
     trace = TraceWriter(trace_path) if trace_path else None
     if trace is not None:
         # the trace header: which robot the run simulates and where its data came from
@@ -135,10 +83,7 @@ def _run(program: Path, workspace, inputs, trace_path, max_sim_time, max_steps, 
                     trafoname=machine.trafoname or None)
     observer = RunObserver()
     try:
-        rt, _ = make_runtime(program, workspace=workspace, inputs=inputs, trace=trace,
-                             max_sim_time=max_sim_time, max_steps=max_steps, submit=list(submit),
-                             interp=interp_kind, observer=observer, mode=mode, check=check,
-                             run_mode=run_mode.upper(), pgno=pgno, robot=machine)
+        rt, _ = setup.make_runtime(trace=trace, observer=observer)
         _announce_partners(rt)
         errors = rt.program.errors_of(rt.program.module_of(rt.program.main_path))
         if errors:
@@ -163,10 +108,11 @@ def _run(program: Path, workspace, inputs, trace_path, max_sim_time, max_steps, 
     prog = rt.program
     ws_note = None
     if prog.backup:
-        ws_note = f"{prog.workspace} (KRC backup{' found above the program' if workspace is None else ''})"
-    elif workspace is not None:
+        ws_note = f"{prog.workspace} (KRC backup{' found above the program' if setup.workspace is None else ''})"
+    elif setup.workspace is not None:
         ws_note = str(prog.workspace)
-    for line in summary_lines(res, observer, program=str(program), interp=interp_kind,
+    booted = setup.booted
+    for line in summary_lines(res, observer, program=str(program), interp=setup.interp,
                               submits=[t for t in rt.scheduler.tasks if t.kind == "submit"],
                               workspace=ws_note, starving=starvation_lines(rt),
                               robot=f"{machine.name} ({machine.source})"):
@@ -211,6 +157,7 @@ def cell_init_cmd(backup: Path, program: Path | None, output: Path | None) -> No
     program of BACKUP: each input the programs read, with a rule to fill in."""
     from interp.cellinit import cell_init  # noqa: PLC0415
     from interp.realprograms import programs_of  # noqa: PLC0415
+    from interp.run import program_in  # noqa: PLC0415
     from krl.project import backup_of  # noqa: PLC0415
     from krl.terminal import printable  # noqa: PLC0415
 

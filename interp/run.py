@@ -1,8 +1,18 @@
-"""One run of a KRL program: controller + runtime + interpreter (used by `krl run`, the
-tests and the real-programs report)."""
+"""One run of a KRL program: controller + runtime + interpreter (used by `krl run`, `krl debug`,
+the tests and the real-programs report).
+
+:func:`run_setup` turns ``krl run``'s options (the parameters of the click command in
+interp/cli.py, by name) into a :class:`RunSetup`: the program found (in a backup archive
+too), the submit programs (the backup's SPS.SUB at boot unless ``no_submit``), the robot. Both
+``krl run`` and ``krl debug``'s launch go through it, so they run the same thing;
+:meth:`RunSetup.make_runtime` builds the run (:func:`make_runtime`).
+"""
 
 from __future__ import annotations
 
+import contextlib
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from interp.runtime.core import RunResult, Runtime
@@ -217,3 +227,123 @@ def signal_of(rt: Runtime, main: str, name: str) -> tuple[str, int, int | None] 
 def run_program(program, **kw) -> RunResult:
     rt, _ = make_runtime(program, **kw)
     return rt.run()
+
+
+class RunSetupError(Exception):
+    """``krl run``'s options do not make a run (a usage error: exit 2); the message names the
+    file."""
+
+
+@dataclass
+class RunSetup:
+    """What one run of ``krl run`` runs (:func:`run_setup`): ``program`` (the .src file),
+    ``workspace``, ``inputs`` (cell file), ``submit`` (the submit programs beside it),
+    ``booted`` (the backup's SPS.SUB when it was started as at boot, else None), ``machine``
+    (the simulated robot, robot.machine.MachineData), ``options`` (the rest of krl run's
+    options by their click names: interp_kind, max_sim_time, max_steps, mode, run_mode, pgno,
+    no_check, trace_path), ``shown`` (a path as the user named it: an archive's temporary
+    folder is shown as the archive)."""
+    program: Path
+    workspace: Path | None
+    inputs: Path | None
+    submit: list
+    booted: Path | None
+    machine: object
+    options: dict
+    shown: Callable[[str], str] = field(default=lambda text: text)
+
+    @property
+    def interp(self) -> str:
+        return self.options.get("interp_kind") or "tree"
+
+    @property
+    def check(self) -> bool:
+        return not self.options.get("no_check")
+
+    def make_runtime(self, trace=None, observer=None, **override) -> tuple:
+        """(Runtime, interpreter) of this run, not started (:func:`make_runtime`); ``override``:
+        keyword arguments of make_runtime that differ (a debugger's step limit)."""
+        o = self.options
+        kw = dict(workspace=self.workspace, inputs=self.inputs, trace=trace,
+                  max_sim_time=o.get("max_sim_time", 600.0), max_steps=o.get("max_steps"),
+                  submit=[str(s) for s in self.submit], interp=self.interp, observer=observer,
+                  mode=o.get("mode"), check=self.check, run_mode=str(o.get("run_mode") or "GO").upper(),
+                  pgno=o.get("pgno"), robot=self.machine)
+        kw.update(override)
+        return make_runtime(self.program, **kw)
+
+
+def program_in(folder: Path, program: Path) -> Path | None:
+    """PROGRAM inside an extracted archive: its relative path (any letter case of the file
+    name), else the .src (then .sub) file whose stem is its name; None when there is none."""
+    from krl.source import is_krl_file  # noqa: PLC0415
+
+    direct = folder / program
+    if not program.is_absolute() and ".." not in program.parts and direct.is_file():
+        return direct
+    stem = program.stem.lower()
+    candidates = sorted(p for p in folder.rglob("*") if p.is_file() and is_krl_file(p) and p.stem.lower() == stem)
+    for suffix in (".src", ".sub"):
+        for p in candidates:
+            if p.suffix.lower() == suffix:
+                return p
+    return None
+
+
+@contextlib.contextmanager
+def run_setup(options: dict) -> Iterator[RunSetup]:
+    """The run that ``krl run``'s `options` describe (keys: the click parameters' names of
+    interp/cli.py ``run``: program, workspace, inputs, submit, no_submit, robot, ...; the others
+    are kept in :attr:`RunSetup.options`). A ``workspace`` that is a KRC backup archive is
+    checked and extracted for the duration of the ``with`` block (krl/archive.py), the program
+    named by its path or module name in it. Without ``submit`` and ``no_submit``, the backup's
+    SPS.SUB runs beside the program, as the controller starts it at boot (krl.project
+    ``boot_submit``). Raises :class:`RunSetupError`."""
+    from krl.archive import ArchiveError, backup_source, is_archive  # noqa: PLC0415
+    from krl.terminal import printable  # noqa: PLC0415
+
+    program = Path(options["program"])
+    workspace = Path(options["workspace"]) if options.get("workspace") is not None else None
+    if is_archive(program):
+        raise RunSetupError(f"{printable(program)} is a backup archive; name the program to run in it: "
+                            f"krl run --workspace {printable(program)} PROGRAM")
+    if workspace is not None and is_archive(workspace):
+        try:
+            with backup_source(workspace) as (folder, _shown):
+                found = program_in(folder, program)
+                if found is None:
+                    raise RunSetupError(f"no program {printable(program)} in {printable(workspace)}")
+                yield _setup(found, folder, options,
+                             shown=lambda text: text.replace(str(folder), str(workspace)))
+        except ArchiveError as exc:
+            raise RunSetupError(printable(exc)) from None
+        return
+    yield _setup(program, workspace, options)
+
+
+def _setup(program: Path, workspace, options: dict, shown=lambda text: text) -> RunSetup:
+    from krl.project import boot_submit  # noqa: PLC0415
+    from krl.terminal import printable  # noqa: PLC0415
+    from robot.mada import MachineDataError  # noqa: PLC0415
+    from robot.stimuli import StimulusError  # noqa: PLC0415
+
+    if not program.is_file():
+        raise RunSetupError(f"{shown(printable(program))}: no such file")
+    if workspace is not None and not workspace.is_dir():
+        raise RunSetupError(f"{shown(printable(workspace))}: no such folder")
+    inputs = Path(options["inputs"]) if options.get("inputs") is not None else None
+    submit = [Path(s) for s in options.get("submit") or ()]
+    for sub in submit:
+        if not sub.is_file():
+            raise RunSetupError(f"{shown(printable(sub))}: no such submit program")
+    booted = None
+    if not submit and not options.get("no_submit"):
+        booted = boot_submit(program, workspace)
+        submit = [booted] if booted is not None else []
+    try:
+        machine = robot_for(program, workspace, options.get("robot"), inputs)
+    except (MachineDataError, StimulusError) as exc:
+        raise RunSetupError(shown(printable(exc))) from None
+    rest = {k: v for k, v in options.items()
+            if k not in ("program", "workspace", "inputs", "submit", "no_submit", "robot")}
+    return RunSetup(program, workspace, inputs, submit, booted, machine, rest, shown)

@@ -153,6 +153,22 @@ MAX_DIFF_ENTRIES = 20_000
 # (DOT/SVG) and the HTML page, in nodes. Past it: an error naming the count (JSON has no limit).
 MAX_GRAPH_NODES = 5000
 
+# The controller's message window (interp/runtime/messages.py): the most messages shown at once
+# (a real cell shows a handful; past it the oldest notify message is dropped).
+MAX_KRL_MESSAGES = 100
+
+# `krl pendant` (pendant/, docs/security.md "The pendant's web server"): the largest websocket
+# message the server reads (a larger one closes the connection with 1009), the largest HTTP
+# request body, the connections served at once, the operator's messages per second on one
+# connection (past it the connection is closed), the watch list's length and the length of one
+# watched expression, and the largest KRL file the page shows or touch-up rewrites.
+MAX_WEB_MESSAGE_BYTES = 64 * 1024
+MAX_WEB_BODY_BYTES = 64 * 1024
+MAX_WEB_CONNECTIONS = 8
+MAX_WEB_MESSAGES_PER_S = 200
+MAX_WEB_WATCHES = 64
+MAX_WEB_EXPRESSION_CHARS = 200
+MAX_WEB_FILE_BYTES = 4 * 1024 * 1024
 # The controller on the network (net/, docs/network.md, docs/security.md "Network"). Everything
 # that arrives on a socket is untrusted; every size, rate and count below ends in an EKI/RSI
 # message, a closed connection or a stopped motion, never in unbounded memory or a hang.

@@ -23,6 +23,7 @@ from .contexts import Context, Irq
 from .convert import assign_into, binary_op, convert_scalar, to_bool, trunc_int, unary_op
 from .errors import (HaltSignal, KrlRuntimeError, ResumeSignal, StopRun)
 from .memory import DataMemory, Frame, ProxyRef, Ref, SignalRef, Slot, field_ref, index_ref
+from .messages import MessageWindow
 from .motion import frame_of, params_from, request, segment, target_of
 from .program import Program
 from .runmode import STEP_MODES, BackwardRefused, MotionHistory, mode_name
@@ -96,6 +97,7 @@ class Runtime:
         self.random = random.Random(0)
         self.mode_op = getattr(controller, "mode_op", "AUT")  # $MODE_OP (robot/limits.py)
         self.msg_handle = 0
+        self.messages = MessageWindow()  # the message window (interp/runtime/messages.py)
         self.noted: set[str] = set()    # simulator notes given once per run (builtins)
         self.steps = 0
         self.max_steps = max_steps
