@@ -11,6 +11,8 @@ from pathlib import Path
 
 import click
 
+from robot.trace import TRACE_REPEATS
+
 
 @click.command("run")
 @click.argument("program", type=click.Path(path_type=Path))
@@ -18,7 +20,9 @@ import click
               show_default=True, help="Interpreter.")
 @click.option("--workspace", type=click.Path(path_type=Path), default=None,
               help="Folder of the program's modules, or a KRC backup .zip (default: the program's folder; a KRC backup is detected).")
-@click.option("--inputs", type=click.Path(path_type=Path), default=None, help="Stimuli YAML (robot/stimuli.py).")
+@click.option("--inputs", type=click.Path(path_type=Path), default=None,
+              help="A cell file (stimuli, rules, presets: robot/stimuli.py), or `auto`: the automatic cell "
+                   "sets the inputs the program starves for (interp/runtime/autocell.py; docs/robot.md).")
 @click.option("--trace", "trace_path", type=click.Path(path_type=Path), default=None, help="Write the JSONL trace here.")
 @click.option("--max-sim-time", type=float, default=600.0, show_default=True, help="Simulated-time limit (s).")
 @click.option("--max-steps", type=int, default=10_000_000, show_default=True,
@@ -49,8 +53,19 @@ import click
               help="The robot to simulate: a robot YAML, a $machine.dat, a KRC backup folder or .zip "
                    "(default: the robot the --inputs cell file names, else the backup's own robot from its "
                    "R1/Mada/$machine.dat, else the KR 6 R900).")
+@click.option("--start", "start", default=None, metavar="AXIS_OR_POINT",
+              help="Where the robot stands at the start: an E6AXIS literal (\"{A1 0, A2 -90, A3 90, A4 0, A5 0, "
+                   "A6 0}\") or a point of the program such as XHOME (default: the cell file's start:, with "
+                   "--inputs auto XHOME, else $AXIS_HOME[1]).")
+@click.option("--on-halt", "on_halt", default="stop", show_default=True, metavar="stop|continue[:N]",
+              help="After a HALT: stop the run, or `continue`: the operator presses Start again (at most N "
+                   "times, default 10; then the HALT ends the run).")
+@click.option("--trace-repeats", "trace_repeats", type=click.IntRange(0, None), default=TRACE_REPEATS,
+              show_default=True,
+              help="A spin in the trace: each repeated event (statement, call, I/O change, message, pose "
+                   "at rest) is written this many times, then counted in a `repeat` event; 0 writes every event.")
 def run(program: Path, interp_kind: str, workspace, inputs, trace_path, max_sim_time, max_steps, submit,
-        mode, run_mode, pgno, no_check, robot, no_submit) -> None:
+        mode, run_mode, pgno, no_check, robot, no_submit, trace_repeats, start, on_halt) -> None:
     """Run PROGRAM (.src) on the simulated KR C4; print where and why it ended.
 
     With --workspace BACKUP.zip (a KRC backup archive) PROGRAM is a path inside the archive
@@ -60,6 +75,7 @@ def run(program: Path, interp_kind: str, workspace, inputs, trace_path, max_sim_
     from krl.archive import ArchiveError, backup_source, is_archive  # noqa: PLC0415
     from krl.terminal import printable  # noqa: PLC0415
 
+    halt_continues = halt_option(on_halt)
     if is_archive(program):
         click.echo(f"error: {printable(program)} is a backup archive; name the program to run in it: "
                    f"krl run --workspace {printable(program)} PROGRAM", err=True)
@@ -73,13 +89,34 @@ def run(program: Path, interp_kind: str, workspace, inputs, trace_path, max_sim_
                     sys.exit(2)
                 _run(found, folder, inputs, trace_path, max_sim_time, max_steps, submit, interp_kind,
                      mode=mode, shown=lambda text: text.replace(str(folder), str(workspace)), check=not no_check,
-                     run_mode=run_mode, pgno=pgno, robot=robot, auto_submit=not no_submit)
+                     run_mode=run_mode, pgno=pgno, robot=robot, auto_submit=not no_submit,
+                     trace_repeats=trace_repeats, start=start, halt_continues=halt_continues)
         except ArchiveError as exc:
             click.echo(f"error: {printable(exc)}", err=True)
             sys.exit(2)
         return
     _run(program, workspace, inputs, trace_path, max_sim_time, max_steps, submit, interp_kind, mode=mode,
-         check=not no_check, run_mode=run_mode, pgno=pgno, robot=robot, auto_submit=not no_submit)
+         check=not no_check, run_mode=run_mode, pgno=pgno, robot=robot, auto_submit=not no_submit,
+         trace_repeats=trace_repeats, start=start, halt_continues=halt_continues)
+
+
+#: ``--on-halt continue`` without a count: the operator presses Start again at most this often
+HALT_CONTINUES = 10
+
+
+def halt_option(text: str) -> int:
+    """The times the operator presses Start again after a HALT (``--on-halt``: ``stop`` 0,
+    ``continue`` :data:`HALT_CONTINUES`, ``continue:N`` N, 1 <= N <= 1000). Exits 2 for
+    anything else."""
+    t = (text or "stop").strip().lower()
+    if t == "stop":
+        return 0
+    if t == "continue":
+        return HALT_CONTINUES
+    if t.startswith("continue:") and t[9:].isdigit() and 1 <= int(t[9:]) <= 1000:
+        return int(t[9:])
+    click.echo(f"error: --on-halt {text!r}: stop, continue or continue:N (N 1..1000)", err=True)
+    sys.exit(2)
 
 
 def program_in(folder: Path, program: Path) -> Path | None:
@@ -101,7 +138,8 @@ def program_in(folder: Path, program: Path) -> Path | None:
 
 def _run(program: Path, workspace, inputs, trace_path, max_sim_time, max_steps, submit, interp_kind,
          mode=None, shown=lambda text: text, check: bool = True, run_mode: str = "GO",
-         pgno: int | None = None, robot=None, auto_submit: bool = False) -> None:
+         pgno: int | None = None, robot=None, auto_submit: bool = False,
+         trace_repeats: int = TRACE_REPEATS, start: str | None = None, halt_continues: int = 0) -> None:
     if not program.exists():
         click.echo(f"error: {program}: no such file", err=True)
         sys.exit(2)
@@ -119,7 +157,7 @@ def _run(program: Path, workspace, inputs, trace_path, max_sim_time, max_steps, 
     from interp.summary import RunObserver, starvation_lines, summary_lines  # noqa: PLC0415
     from robot.mada import MachineDataError  # noqa: PLC0415
     from krl.terminal import printable  # noqa: PLC0415
-    from robot.stimuli import StimulusError  # noqa: PLC0415
+    from robot.stimuli import StartError, StimulusError  # noqa: PLC0415
     from robot.trace import TraceWriter  # noqa: PLC0415
 
     try:
@@ -127,7 +165,7 @@ def _run(program: Path, workspace, inputs, trace_path, max_sim_time, max_steps, 
     except (MachineDataError, StimulusError) as exc:
         click.echo(f"error: {shown(printable(exc))}", err=True)
         sys.exit(2)
-    trace = TraceWriter(trace_path) if trace_path else None
+    trace = TraceWriter(trace_path, repeats=trace_repeats or None) if trace_path else None
     if trace is not None:
         # the trace header: which robot the run simulates and where its data came from
         trace.write("robot", 0.0, name=machine.name, source=shown(machine.source),
@@ -137,7 +175,8 @@ def _run(program: Path, workspace, inputs, trace_path, max_sim_time, max_steps, 
         rt, _ = make_runtime(program, workspace=workspace, inputs=inputs, trace=trace,
                              max_sim_time=max_sim_time, max_steps=max_steps, submit=list(submit),
                              interp=interp_kind, observer=observer, mode=mode, check=check,
-                             run_mode=run_mode.upper(), pgno=pgno, robot=machine)
+                             run_mode=run_mode.upper(), pgno=pgno, robot=machine, start=start,
+                             halt_continues=halt_continues)
         errors = rt.program.errors_of(rt.program.module_of(rt.program.main_path))
         if errors:
             # the checker rejects the program's own module: like the controller, it does not start
@@ -146,7 +185,7 @@ def _run(program: Path, workspace, inputs, trace_path, max_sim_time, max_steps, 
             click.echo(f"not started: {len(errors)} error(s) found by the checker (--no-check runs it anyway)")
             sys.exit(1)
         res = rt.run()
-    except StimulusError as exc:
+    except (StimulusError, StartError) as exc:
         click.echo(f"error: {shown(printable(exc))}", err=True)
         sys.exit(2)
     except Exception as exc:  # noqa: BLE001
@@ -164,7 +203,7 @@ def _run(program: Path, workspace, inputs, trace_path, max_sim_time, max_steps, 
     for line in summary_lines(res, observer, program=str(program), interp=interp_kind,
                               submits=[t for t in rt.scheduler.tasks if t.kind == "submit"],
                               workspace=ws_note, starving=starvation_lines(rt),
-                              robot=f"{machine.name} ({machine.source})"):
+                              robot=f"{machine.name} ({machine.source})", run=rt):
         click.echo(shown(line))
         if booted is not None and line.startswith("  workspace"):
             click.echo(shown(f"  submit     {booted} (the backup's, started as at boot; --no-submit: without)"))

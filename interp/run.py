@@ -7,6 +7,7 @@ from pathlib import Path
 
 from interp.runtime.core import RunResult, Runtime
 from interp.runtime.errors import KrlRuntimeError, ResourceError
+from interp.runtime.values import Struct
 
 
 def make_runtime(program, *, workspace=None, inputs=None, trace=None, max_sim_time=None,
@@ -14,7 +15,8 @@ def make_runtime(program, *, workspace=None, inputs=None, trace=None, max_sim_ti
                  robot_budget=None, interp: str = "tree", observer=None,
                  mode: str | None = None, check: bool = True,
                  vm_loop: str = "generated", run_mode: str | None = None,
-                 pgno: int | None = None, robot=None) -> tuple[Runtime, object]:
+                 pgno: int | None = None, robot=None, start: str | None = None,
+                 halt_continues: int = 0) -> tuple[Runtime, object]:
     """Build the runtime and the interpreter (``interp``: tree or vm) for ``program``
     (not started yet). Its files (krl.project.project_of, with the `submit` programs) are
     loaded, checked and resolved first; with `check` (``krl run`` without ``--no-check``) a
@@ -29,11 +31,21 @@ def make_runtime(program, *, workspace=None, inputs=None, trace=None, max_sim_ti
     ``run_mode``: ``$PRO_MODE`` at the start (GO, MSTEP, ISTEP, BSTEP; interp/runtime/runmode.py;
     default GO). ``robot``: the simulated robot (a MachineData or a path for
     :func:`robot.mada.load_robot`); default :func:`robot_for` (the cell file's ``robot``, else the
-    backup's own robot, else the KR 6 R900). Raises
+    backup's own robot, else the KR 6 R900). ``inputs``: a cell file, or ``"auto"`` (the
+    automatic cell, interp/runtime/autocell.py: mode EXT unless `mode` says otherwise, P00's
+    program numbers, the solver; the robot starts at ``XHOME`` when the program has one and
+    no `start` is given). ``start``: where the robot stands at the start
+    (:func:`start_axes`: an E6AXIS literal or a point name; default the cell file's
+    ``start:``, else ``$AXIS_HOME[1]``). ``halt_continues``: ``--on-halt continue``, the
+    times the operator presses Start again after a HALT (0: a HALT ends the run). Raises
     :class:`robot.stimuli.StimulusError` for a bad cell file or a preset the backup's
-    ``$config.dat`` does not allow."""
+    ``$config.dat`` does not allow, :class:`robot.stimuli.StartError` for a start position that cannot
+    place the robot."""
     from interp.tree import TreeInterpreter  # noqa: PLC0415
 
+    auto = is_auto(inputs)
+    if auto:
+        inputs = None
     if controller is None:
         from robot.controller import Controller  # noqa: PLC0415
 
@@ -42,19 +54,34 @@ def make_runtime(program, *, workspace=None, inputs=None, trace=None, max_sim_ti
         controller = Controller(robot_for(program, workspace, robot, inputs),
                                 trace=observer if observer is not None else trace,
                                 stimuli=str(inputs) if inputs else None, mujoco=mujoco,
-                                mode_op=mode)
+                                mode_op=mode if mode is not None or not auto else "EX")
     rt = Runtime(program, workspace=workspace, controller=controller, trace=trace,
                  max_sim_time=max_sim_time, max_steps=max_steps, robot_budget=robot_budget,
                  submits=list(submit or ()), check=check)
     if run_mode is not None:
         rt.set_run_mode(run_mode)
+    rt.halt_continues = halt_continues
+    main = Path(program).stem
+    where = start if start is not None else getattr(controller, "start", None)
+    if where is None and auto and isinstance(global_value(rt, main, "XHOME"), Struct):
+        where = "XHOME"             # the automatic cell starts at home, as a cell in Automatic External
+    if where is not None:
+        controller.place(start_axes(rt, main, where))
+        rt.start = where
     if observer is not None:
         # The interpreters trace into the user's trace only: without one the VM keeps its
         # quiet fast path (Runtime.quiet_limit); the observer needs the controller's events.
         rt.trace = trace
     number = pgno if pgno is not None else getattr(controller, "pgno", None)
     if number is not None:
-        controller.rules += _pgno_rules(rt, Path(program).stem, number)
+        controller.rules += _pgno_rules(rt, Path(program).stem, number,
+                                        "--pgno" if pgno is not None else "the cell file's pgno preset")
+    if auto:
+        from interp.runtime.autocell import handshake_rules  # noqa: PLC0415
+
+        rt.enable_autocell()
+        if number is None:
+            controller.rules += handshake_rules(rt, Path(program).stem, _pgno_parameters(rt, Path(program).stem))
     if controller.stimuli or controller.rules:
         from robot.stimuli import resolve_signals  # noqa: PLC0415
 
@@ -76,21 +103,35 @@ def make_runtime(program, *, workspace=None, inputs=None, trace=None, max_sim_ti
     return rt, interp
 
 
-def _pgno_rules(rt: Runtime, main: str, number: int) -> list:
-    """The PLC's rules of P00's program-number handshake answering `number`, with the
-    ``PGNO_*`` parameters the program sees ($config.dat)."""
-    from robot.cellpresets import PGNO_PARAMETERS, PresetError, pgno_rules  # noqa: PLC0415
-    from robot.stimuli import StimulusError  # noqa: PLC0415
+def is_auto(inputs) -> bool:
+    """True for ``--inputs auto``: the automatic cell (interp/runtime/autocell.py) instead of
+    a cell file. A file of that name is written ``./auto``."""
+    return isinstance(inputs, (str, Path)) and str(inputs) == "auto"
+
+
+def _pgno_parameters(rt: Runtime, main: str) -> dict:
+    """The ``PGNO_*`` parameters the program `main` sees ($config.dat), those with an INT value."""
+    from robot.cellpresets import PGNO_PARAMETERS  # noqa: PLC0415
 
     params = {}
     for name in PGNO_PARAMETERS:
         value = global_value(rt, main, name)
         if isinstance(value, int) and not isinstance(value, bool):
             params[name] = value
+    return params
+
+
+def _pgno_rules(rt: Runtime, main: str, number: int, origin: str = "--pgno") -> list:
+    """The PLC's rules of P00's program-number handshake answering `number`, with the
+    ``PGNO_*`` parameters the program sees ($config.dat). `origin` names where the number came
+    from in the error (``--pgno``, the cell file's preset)."""
+    from robot.cellpresets import PresetError, pgno_rules  # noqa: PLC0415
+    from robot.stimuli import StimulusError  # noqa: PLC0415
+
     try:
-        return pgno_rules(params, number)
+        return pgno_rules(_pgno_parameters(rt, main), number)
     except PresetError as exc:
-        raise StimulusError(f"--pgno {number}: {exc}") from None
+        raise StimulusError(f"{origin} {number}: {exc}") from None
 
 
 def global_value(rt: Runtime, main: str, name: str):
@@ -120,7 +161,7 @@ def robot_for(program, workspace=None, robot=None, inputs=None):
 
     if isinstance(robot, MachineData):
         return robot
-    if robot is None and inputs:
+    if robot is None and inputs and not is_auto(inputs):
         from robot.stimuli import load_cell  # noqa: PLC0415
 
         robot = load_cell(inputs).robot
@@ -155,3 +196,53 @@ def signal_of(rt: Runtime, main: str, name: str) -> tuple[str, int, int | None] 
 def run_program(program, **kw) -> RunResult:
     rt, _ = make_runtime(program, **kw)
     return rt.run()
+
+
+def start_axes(rt: Runtime, main: str, text: str):
+    """The axes (deg, A1..A6) the robot starts at for the start position `text` of
+    :func:`parse_start`: an axis literal as given (missing axes: those of ``$AXIS_HOME[1]``);
+    a point of the program (its data list, then ``$config.dat``: ``XHOME``) that is an
+    AXIS/E6AXIS as it is, a POS/E6POS (TCP in the world: null $TOOL and $BASE) through the
+    robot's inverse kinematics with its S and T. Raises
+    :class:`robot.stimuli.StartError`."""
+    import numpy as np  # noqa: PLC0415
+
+    from krl.ast import nodes as N  # noqa: PLC0415
+    from interp.runtime.values import Struct  # noqa: PLC0415
+
+    from robot.stimuli import START_AXES as _AXES, START_CART as _CART, StartError, parse_start  # noqa: PLC0415
+
+    expr = parse_start(text)
+    if isinstance(expr, N.Name):
+        value = global_value(rt, main, expr.name)
+        if not isinstance(value, Struct):
+            raise StartError(f"start {text}: no point {expr.name} in the program's data lists or $config.dat")
+        comps = {k: v for k, v in value.f.items() if isinstance(v, (int, float)) and not isinstance(v, bool)}
+    else:
+        comps = {}
+        for it in expr.items:
+            v = it.value
+            sign = -1 if isinstance(v, N.Unary) and v.op == "-" else 1
+            if isinstance(v, N.Unary):
+                v = v.operand
+            comps[it.name.upper()] = sign * v.value
+    ctl = rt.controller
+    if any(k in comps for k in _AXES):
+        q = [float(comps.get(k, ctl.machine.home_deg[i])) for i, k in enumerate(_AXES)]
+    elif all(k in comps for k in _CART):
+        from robot.frames import frame_to_matrix  # noqa: PLC0415
+
+        T_world = frame_to_matrix(*(float(comps[k]) for k in _CART))
+        try:
+            q = ctl.model.ik(T_world, None, None, int(comps["S"]) if "S" in comps else None,
+                             int(comps["T"]) if "T" in comps else None,
+                             np.array(ctl.machine.home_deg, dtype=float))
+        except Exception as exc:  # noqa: BLE001 - a robot error names the reason
+            raise StartError(f"start {text}: {getattr(exc, 'message', exc)}") from None
+    else:
+        raise StartError(f"start {text}: neither the axes A1..A6 nor X, Y, Z, A, B, C")
+    try:
+        ctl.model.kin.check_soft_limits(q)
+    except Exception as exc:  # noqa: BLE001
+        raise StartError(f"start {text}: {getattr(exc, 'message', exc)}") from None
+    return np.asarray(q, dtype=float)

@@ -142,6 +142,7 @@ def _atan2(rt, a):
 
 def _frand(rt, a):
     lo, hi = _real(a[0]), _real(a[1])
+    rt.clock_read()     # a random number: not idle (interp/runtime/idle.py)
     return rt.random.uniform(lo, hi)
 
 
