@@ -216,35 +216,50 @@ def cell() -> None:
 
 
 @cell.command("init")
-@click.argument("backup", type=click.Path(path_type=Path))
+@click.argument("backup", required=False, type=click.Path(path_type=Path))
 @click.argument("program", required=False, type=click.Path(path_type=Path))
 @click.option("-o", "--output", type=click.Path(path_type=Path), default=None,
               help="Write the starter file here (default: print it).")
-def cell_init_cmd(backup: Path, program: Path | None, output: Path | None) -> None:
-    """Write a starter cell file for PROGRAM (a path or a module name in BACKUP), or for every
-    program of BACKUP: each input the programs read, with a rule to fill in."""
-    from interp.cellinit import cell_init  # noqa: PLC0415
+@click.option("--from-run", "from_run", type=click.Path(path_type=Path), default=None, metavar="TRACE",
+              help="Instead: the answers of a `krl run --inputs auto --trace TRACE` run as rules (commented).")
+def cell_init_cmd(backup: Path | None, program: Path | None, output: Path | None, from_run: Path | None) -> None:
+    """Write a starter cell file for PROGRAM (a path or a module name in BACKUP): each input it
+    reads, with a rule to fill in; without PROGRAM for every program of BACKUP. With
+    --from-run TRACE, the answers of an automatic cell's run as rules."""
+    from interp.cellinit import cell_init, from_run as rules_from_run  # noqa: PLC0415
     from interp.realprograms import programs_of  # noqa: PLC0415
     from krl.project import backup_of  # noqa: PLC0415
     from krl.terminal import printable  # noqa: PLC0415
 
-    if not backup.is_dir():
-        click.echo(f"error: {printable(backup)}: not a folder", err=True)
-        sys.exit(2)
-    root = backup_of(backup.resolve()) or backup.resolve()
-    if program is not None:
-        found = program if program.is_file() else program_in(root, program)
-        if found is None:
-            click.echo(f"error: no program {printable(program)} in {printable(backup)}", err=True)
+    if from_run is not None:
+        from robot.trace import read_trace  # noqa: PLC0415
+
+        try:
+            text = rules_from_run(read_trace(from_run), str(from_run))
+        except (OSError, ValueError, UnicodeDecodeError) as exc:
+            click.echo(f"error: {printable(from_run)}: not a trace of krl run: {printable(exc)}", err=True)
             sys.exit(2)
-        programs = [found]
     else:
-        programs = programs_of(root)
-    try:
-        text = cell_init(root, programs)
-    except Exception as exc:  # noqa: BLE001 - never a traceback for input
-        click.echo(f"error: {printable(exc)}", err=True)
-        sys.exit(2)
+        if backup is None:
+            click.echo("error: name the BACKUP (or give --from-run TRACE)", err=True)
+            sys.exit(2)
+        if not backup.is_dir():
+            click.echo(f"error: {printable(backup)}: not a folder", err=True)
+            sys.exit(2)
+        root = backup_of(backup.resolve()) or backup.resolve()
+        if program is not None:
+            found = program if program.is_file() else program_in(root, program)
+            if found is None:
+                click.echo(f"error: no program {printable(program)} in {printable(backup)}", err=True)
+                sys.exit(2)
+            programs = [found]
+        else:
+            programs = programs_of(root)
+        try:
+            text = cell_init(root, programs, whole=program is None)
+        except Exception as exc:  # noqa: BLE001 - never a traceback for input
+            click.echo(f"error: {printable(exc)}", err=True)
+            sys.exit(2)
     if output is None:
         click.echo(text, nl=False)
     else:

@@ -175,6 +175,10 @@ class AutoCell:
             return []
         return self._statements().get((str(Path(file).resolve()), line), [])
 
+    def pending(self) -> bool:
+        """True while an answer has not taken effect yet."""
+        return any(st.source == "auto" and not st.fired for st in self.rt.controller.stimuli)
+
     # ------------------------------------------------------------------ answering
     def answer(self, watch) -> str:
         """The run is idle (or its WAIT FOR deadlocked): answer. Returns ``"answered"``,

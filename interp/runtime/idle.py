@@ -132,6 +132,9 @@ class IdleWatch:
         self.skipped = 0             # cycles skipped in the run
         self.jumps = 0               # fast-forwards in the run
         self.auto = None             # interp.runtime.autocell.AutoCell of --inputs auto
+        self.robot_io = 0            # I/O changes the robot program made (Scheduler._resume)
+        self.enabled = True          # False: never fast-forward (tests compare with and without)
+        self._robot: tuple | None = None   # (cycle, marks, frames) of the robot program's quiet window
 
     def clock_read(self) -> None:
         """A task read the clock or a random number: its next statements may differ without
@@ -165,8 +168,46 @@ class IdleWatch:
         self.window = WINDOW_CYCLES
 
     def cycle(self) -> int:
-        """One IPO cycle ended (the tasks ran): check, and fast-forward when the run is idle.
-        Returns the cycles skipped."""
+        """One IPO cycle ended (the tasks ran): check, and fast-forward when the run is idle;
+        with the automatic cell, also answer a robot program that starves while a submit
+        program keeps changing its own state (:meth:`robot_starves`). Returns the cycles
+        skipped."""
+        n = self._cycle()
+        if n == 0 and self.auto is not None and self.since is None:
+            self.robot_starves()
+        return n
+
+    def robot_starves(self) -> None:
+        """The robot program starves while the run is not idle (a submit program blinks a
+        lamp on a timer): for a whole window it stood in one WAIT FOR, or it executed
+        statements without moving the robot, without an I/O change of its own and without a
+        change of its own frames (its locals and :IN copies). Then the automatic cell answers
+        (it watches one more window first for a polling loop). A heuristic for answering only:
+        nothing is fast-forwarded on it."""
+        rt = self.rt
+        ctl = rt.controller
+        robot = rt.robot
+        if robot is None or robot.done or self.auto.pending() or not self._quiet():
+            self._robot = None
+            return
+        if robot.wake_cycle is not None:
+            self._robot = None          # WAIT SEC: time is what it waits for
+            return
+        marks = (self.robot_io, robot.waiting, tuple(ctl._q.tolist()), tuple(ctl.planned_axes().tolist()))
+        if self._robot is None or self._robot[1] != marks:
+            self._robot = (ctl.cycle, marks, None)
+            return
+        start, _, frames = self._robot
+        if ctl.cycle - start < WINDOW_CYCLES:
+            return
+        now = tuple(tuple([x if x.__class__ in _SCALARS else freeze(x) for x in f.store]) for f in _frames(robot))
+        if frames is None or frames != now:
+            self._robot = (ctl.cycle, marks, now)
+            return
+        got = self.auto.answer(self)
+        self._robot = (ctl.cycle, marks, now if got == "watching" else None)
+
+    def _cycle(self) -> int:
         rt = self.rt
         ctl = rt.controller
         if not self._quiet():
@@ -193,7 +234,7 @@ class IdleWatch:
         # idle: nothing changed for a whole window
         if self.since is None:
             self.since = self.start * ctl.dt
-        if self.auto is not None:
+        if self.auto is not None and not self.auto.pending():
             got = self.auto.answer(self)
             if got == "watching":
                 self.start = ctl.cycle      # the same state is compared again a window later
@@ -222,6 +263,8 @@ class IdleWatch:
         returns the cycles skipped."""
         rt = self.rt
         ctl = rt.controller
+        if not self.enabled:
+            return 0
         nxt = self.next_cycle()
         if nxt is None or not ctl.at_rest():
             return 0

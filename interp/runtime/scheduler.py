@@ -99,10 +99,14 @@ class Scheduler:
         self.rt.current_task = task
         task.slice_end = self.rt.steps + task.budget
         task.quiet = 0
+        log = self.rt.controller.io.log
+        before = len(log)
         try:
             task.glet.switch()
         finally:
             self.rt.current_task = None
+            if task.kind == "robot":
+                self.idle.robot_io += len(log) - before     # the robot program's own I/O changes
 
     def run(self) -> None:
         rt = self.rt
@@ -121,7 +125,7 @@ class Scheduler:
                 break
             if robot.waiting and self.deadlocked():
                 auto = self.idle.auto
-                if auto is None or auto.answer(self.idle) != "answered":
+                if auto is None or (not auto.pending() and auto.answer(self.idle) != "answered"):
                     self.stop = ("deadlock", f"deadlocked {robot.waiting}", robot)
                     break
             self.idle.cycle()
