@@ -15,7 +15,7 @@ def make_runtime(program, *, workspace=None, inputs=None, trace=None, max_sim_ti
                  robot_budget=None, interp: str = "tree", observer=None,
                  mode: str | None = None, check: bool = True,
                  vm_loop: str = "generated", run_mode: str | None = None,
-                 pgno: int | None = None, robot=None, start: str | None = None,
+                 pgno: int | None = None, robot=None, network=None, start: str | None = None,
                  halt_continues: int = 0) -> tuple[Runtime, object]:
     """Build the runtime and the interpreter (``interp``: tree or vm) for ``program``
     (not started yet). Its files (krl.project.project_of, with the `submit` programs) are
@@ -37,7 +37,10 @@ def make_runtime(program, *, workspace=None, inputs=None, trace=None, max_sim_ti
     no `start` is given). ``start``: where the robot stands at the start
     (:func:`start_axes`: an E6AXIS literal or a point name; default the cell file's
     ``start:``, else ``$AXIS_HOME[1]``). ``halt_continues``: ``--on-halt continue``, the
-    times the operator presses Start again after a HALT (0: a HALT ends the run). Raises
+    times the operator presses Start again after a HALT (0: a HALT ends the run). ``network``: the partners
+    (net.settings.NetworkSettings; default the cell file's ``network:`` key): the run's network
+    hub (net/hub.py) is attached to the controller either way; without partners its EKI
+    channels stay "not connected". Raises
     :class:`robot.stimuli.StimulusError` for a bad cell file or a preset the backup's
     ``$config.dat`` does not allow, :class:`robot.stimuli.StartError` for a start position that cannot
     place the robot."""
@@ -60,6 +63,7 @@ def make_runtime(program, *, workspace=None, inputs=None, trace=None, max_sim_ti
                  submits=list(submit or ()), check=check)
     if run_mode is not None:
         rt.set_run_mode(run_mode)
+    attach_network(rt, program, workspace, network if network is not None else getattr(controller, "cell_network", None))
     rt.halt_continues = halt_continues
     main = Path(program).stem
     where = start if start is not None else getattr(controller, "start", None)
@@ -101,6 +105,28 @@ def make_runtime(program, *, workspace=None, inputs=None, trace=None, max_sim_ti
         sp = Path(sub).resolve()
         rt.add_task("submit", sp.stem, lambda name=sp: interp.run_program(name))
     return rt, interp
+
+
+def attach_network(rt: Runtime, program, workspace, settings) -> None:
+    """The run's network hub (net/hub.py) on `rt`'s controller, with `settings` (None: no
+    partner). Raises net.hub.NetError when a partner's server cannot start."""
+    from krl.project import backup_of  # noqa: PLC0415
+    from net.hub import Network  # noqa: PLC0415
+
+    from interp.runtime.netvars import RuntimeSink  # noqa: PLC0415
+
+    old = getattr(rt.controller, "network", None)
+    if old is not None:
+        old.close()
+    root = backup_of(Path(program).resolve(), Path(workspace).resolve() if workspace else None)
+    net = Network(settings, program=Path(program).resolve(), backup=root, sink=RuntimeSink(rt))
+    try:
+        net.attach(rt.controller)
+    except OSError as exc:
+        net.close()
+        from net.hub import NetError  # noqa: PLC0415
+
+        raise NetError(f"a network partner cannot start: {exc.strerror or exc}") from None
 
 
 def is_auto(inputs) -> bool:

@@ -19,7 +19,7 @@ from pathlib import Path
 REPO = Path(__file__).resolve().parents[1]
 DOC = REPO / "docs" / "architecture.md"
 CONFIG = REPO / ".importlinter"
-ROOTS = ("krl", "interp", "robot", "recovery", "conformance")
+ROOTS = ("krl", "interp", "robot", "recovery", "conformance", "net")
 
 
 def _between(text: str, name: str) -> list[str]:
