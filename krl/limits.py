@@ -39,6 +39,14 @@ MAX_MESSAGE_CHARS = 160
 # the program does not start).
 MAX_EXPRESSION_TERMS = 500
 
+# One KRL expression given on its own, outside a program's text (krl/semantics/expression.py:
+# a debugger's watch, condition or new value, the pendant's watch list): one line of at most
+# this many characters and tokens (nesting and terms as in a program: MAX_NESTING,
+# MAX_EXPRESSION_TERMS). A cell rule's condition has its own, smaller MAX_RULE_TOKENS. Past
+# either: "not a KRL expression: ..." / "an expression is at most ... characters".
+MAX_EXPRESSION_CHARS = 4096
+MAX_EXPRESSION_TOKENS = 2048
+
 # The Python stack that parsing, building and checking one file within the limits above may
 # take, in frames above the caller. Only MAX_NESTING levels recurse (blocks, brackets, prefix
 # operators; never the terms of a chain): measured at most 5.25 frames per level (100 nested IFs
