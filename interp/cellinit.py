@@ -371,7 +371,7 @@ def from_run(events, source: str = "") -> str:
         out.append(f"  # at {t:.3f} s: {printable(str(ev.get('statement', '')))} at {place}"
                    + (f": {printable(str(ev.get('condition')))[:100]}" if ev.get("condition") else ""))
         if key in seen:
-            out.append("  #   (the same rule as above)")
+            out.append("  # (the same rule as above)")
             continue
         seen.add(key)
         n += 1

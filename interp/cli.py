@@ -203,11 +203,19 @@ def _run(program: Path, workspace, inputs, trace_path, max_sim_time, max_steps, 
     for line in summary_lines(res, observer, program=str(program), interp=interp_kind,
                               submits=[t for t in rt.scheduler.tasks if t.kind == "submit"],
                               workspace=ws_note, starving=starvation_lines(rt),
-                              robot=f"{machine.name} ({machine.source})", run=rt):
+                              robot=f"{machine.name} ({machine.source}{_chosen(program, workspace)})", run=rt):
         click.echo(shown(line))
         if booted is not None and line.startswith("  workspace"):
             click.echo(shown(f"  submit     {booted} (the backup's, started as at boot; --no-submit: without)"))
     sys.exit(res.exit_code)
+
+
+def _chosen(program: Path, workspace) -> str:
+    """``; chosen by ...`` when --inputs auto chose the robot (interp/scene.py)."""
+    from interp.scene import chosen  # noqa: PLC0415
+
+    c = chosen(program, workspace)
+    return f"; {c.note}" if c is not None else ""
 
 
 @click.group("cell")

@@ -66,6 +66,10 @@ LEGITIMATE = ("deadlock", "halt", "max_sim_time", "max_steps")
 #: :func:`time_limit`) and statements of the robot program (:func:`step_limit` adds the submit's)
 REPORT_SIM_TIME_S = 60.0
 REPORT_STEPS = 300_000
+#: the time limit of the --inputs auto column: ``krl run``'s own (s). Nothing hand-written says
+#: how long a job takes; a program that starves costs nothing while it waits (the idle
+#: fast-forward), one that works runs to its end. An SPS.SUB entry keeps REPORT_SIM_TIME_S.
+AUTO_SIM_TIME_S = 600.0
 
 #: the causes of a stop, in report order
 CAUSES = ("completed", "intended end", "program error", "interpreter gap", "limit")
@@ -225,17 +229,24 @@ def time_limit(path: Path, cell: Path | None, default: float) -> float:
 
 
 def report_run(path: Path, cell: Path | None, max_sim_time: float = REPORT_SIM_TIME_S,
-               max_steps: int = REPORT_STEPS) -> tuple:
+               max_steps: int = REPORT_STEPS, auto: bool = False) -> tuple:
     """``(robot, submit programs, simulated-time limit s, step limit)`` of the report's run of
-    `path` with its cell file (this report and the conformance report's real programs): the
-    cell's robot, else the backup's own, else the KR 6 R900 (interp.run.robot_for); the
-    backup's SPS.SUB; :func:`time_limit` and :func:`step_limit`."""
+    `path` with its cell file, or with ``--inputs auto`` (`auto`; this report and the
+    conformance report's real programs): the cell's robot, else the backup's own, else (auto)
+    the library robot that reaches the backup's points, else the KR 6 R900
+    (interp.run.robot_for); the backup's SPS.SUB (none for the SPS.SUB itself: it runs as the
+    program, at a submit interpreter's pace); :func:`time_limit` (auto: the longer
+    :data:`AUTO_SIM_TIME_S` for a robot program) and :func:`step_limit`."""
     from interp.run import robot_for  # noqa: PLC0415
 
-    robot = robot_for(path, inputs=cell)
+    robot = robot_for(path, inputs="auto" if auto else cell)
     submit = submit_of(path)
-    t = time_limit(path, cell, max_sim_time)
-    return robot, submit, t, step_limit(max_steps, t, len(submit), robot.ipo_cycle_s)
+    sub = path.suffix.lower() == ".sub"
+    if auto:
+        t = max_sim_time if sub else max(max_sim_time, AUTO_SIM_TIME_S)
+    else:
+        t = time_limit(path, cell, max_sim_time)
+    return robot, submit, t, step_limit(max_steps, t, len(submit) + sub, robot.ipo_cycle_s)
 
 
 def run_one(path: Path, max_sim_time: float, max_steps: int, cell: Path | None = None,
@@ -250,11 +261,14 @@ def run_one(path: Path, max_sim_time: float, max_steps: int, cell: Path | None =
     t0 = time.time()
     inputs = "auto" if auto else cell
     try:
-        robot, submit, max_sim_time, limit = report_run(path, None if auto else cell, max_sim_time, max_steps)
+        robot, submit, max_sim_time, limit = report_run(path, None if auto else cell, max_sim_time, max_steps, auto)
         own = _own_machine_data(path, robot.source)
+        from interp.runtime.scheduler import SUBMIT_BUDGET  # noqa: PLC0415
+
         # --no-check: the report says how each real program runs, also those the checker rejects
         rt, _ = make_runtime(path, trace=None, mujoco=False, max_sim_time=max_sim_time, max_steps=limit,
-                             submit=submit, check=False, inputs=inputs, robot=robot, interp=interp)
+                             submit=submit, check=False, inputs=inputs, robot=robot, interp=interp,
+                             robot_budget=SUBMIT_BUDGET if path.suffix.lower() == ".sub" else None)
         res = rt.run()
         stubs = {name: n for name, _what, n in rt.kss.summary()}
         rules = rt.controller.rules

@@ -70,7 +70,9 @@ def make_runtime(program, *, workspace=None, inputs=None, trace=None, max_sim_ti
     if where is None and auto and isinstance(global_value(rt, main, "XHOME"), Struct):
         where = "XHOME"             # the automatic cell starts at home, as a cell in Automatic External
     if where is not None:
-        controller.place(start_axes(rt, main, where))
+        from interp.scene import start_axes  # noqa: PLC0415
+
+        controller.place(start_axes(controller, lambda name: global_value(rt, main, name), where))
         rt.start = where
     if observer is not None:
         # The interpreters trace into the user's trace only: without one the VM keeps its
@@ -195,6 +197,16 @@ def robot_for(program, workspace=None, robot=None, inputs=None):
         return load_robot(robot)
     root = backup_of(Path(program).resolve(), Path(workspace).resolve() if workspace else None)
     found = robot_of_backup(root) if root is not None else None
+    if found is None and is_auto(inputs):
+        from interp.scene import choose_robot  # noqa: PLC0415
+
+        def probe():
+            rt, _ = make_runtime(program, workspace=workspace, mujoco=False, check=False, robot=load_machine())
+            main = Path(program).stem
+            return rt, lambda name: global_value(rt, main, name)
+        choice = choose_robot(Path(program), probe, workspace)
+        if choice is not None:
+            return choice.machine
     return found if found is not None else load_machine()
 
 
@@ -222,53 +234,3 @@ def signal_of(rt: Runtime, main: str, name: str) -> tuple[str, int, int | None] 
 def run_program(program, **kw) -> RunResult:
     rt, _ = make_runtime(program, **kw)
     return rt.run()
-
-
-def start_axes(rt: Runtime, main: str, text: str):
-    """The axes (deg, A1..A6) the robot starts at for the start position `text` of
-    :func:`parse_start`: an axis literal as given (missing axes: those of ``$AXIS_HOME[1]``);
-    a point of the program (its data list, then ``$config.dat``: ``XHOME``) that is an
-    AXIS/E6AXIS as it is, a POS/E6POS (TCP in the world: null $TOOL and $BASE) through the
-    robot's inverse kinematics with its S and T. Raises
-    :class:`robot.stimuli.StartError`."""
-    import numpy as np  # noqa: PLC0415
-
-    from krl.ast import nodes as N  # noqa: PLC0415
-    from interp.runtime.values import Struct  # noqa: PLC0415
-
-    from robot.stimuli import START_AXES as _AXES, START_CART as _CART, StartError, parse_start  # noqa: PLC0415
-
-    expr = parse_start(text)
-    if isinstance(expr, N.Name):
-        value = global_value(rt, main, expr.name)
-        if not isinstance(value, Struct):
-            raise StartError(f"start {text}: no point {expr.name} in the program's data lists or $config.dat")
-        comps = {k: v for k, v in value.f.items() if isinstance(v, (int, float)) and not isinstance(v, bool)}
-    else:
-        comps = {}
-        for it in expr.items:
-            v = it.value
-            sign = -1 if isinstance(v, N.Unary) and v.op == "-" else 1
-            if isinstance(v, N.Unary):
-                v = v.operand
-            comps[it.name.upper()] = sign * v.value
-    ctl = rt.controller
-    if any(k in comps for k in _AXES):
-        q = [float(comps.get(k, ctl.machine.home_deg[i])) for i, k in enumerate(_AXES)]
-    elif all(k in comps for k in _CART):
-        from robot.frames import frame_to_matrix  # noqa: PLC0415
-
-        T_world = frame_to_matrix(*(float(comps[k]) for k in _CART))
-        try:
-            q = ctl.model.ik(T_world, None, None, int(comps["S"]) if "S" in comps else None,
-                             int(comps["T"]) if "T" in comps else None,
-                             np.array(ctl.machine.home_deg, dtype=float))
-        except Exception as exc:  # noqa: BLE001 - a robot error names the reason
-            raise StartError(f"start {text}: {getattr(exc, 'message', exc)}") from None
-    else:
-        raise StartError(f"start {text}: neither the axes A1..A6 nor X, Y, Z, A, B, C")
-    try:
-        ctl.model.kin.check_soft_limits(q)
-    except Exception as exc:  # noqa: BLE001
-        raise StartError(f"start {text}: {getattr(exc, 'message', exc)}") from None
-    return np.asarray(q, dtype=float)

@@ -184,7 +184,9 @@ def _run_lines(rt: Any) -> list[str]:
     kss = getattr(rt, "kss", None)
     stubs = kss.summary() if kss is not None else []
     if stubs:
-        shown = ", ".join(f"{printable(name)} ({what}, {n} use{'s' if n != 1 else ''})" for name, what, n in stubs[:12])
+        shown = ", ".join(f"{printable(name)} ({what}" + ("" if "variable" in what or what == "type" else
+                                                          f", {n} call{'s' if n != 1 else ''}") + ")"
+                          for name, what, n in stubs[:12])
         more = f", ... {len(stubs) - 12} more" if len(stubs) > 12 else ""
         out.append(f"  stubs      {len(stubs)}: {shown}{more}")
     auto = getattr(rt, "autocell", None)

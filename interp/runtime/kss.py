@@ -197,8 +197,7 @@ class SystemSoftware:
         key = name.upper()
         ref = self._refs.get(key)
         if ref is not None:
-            self.uses[key] += 1
-            return ref
+            return ref          # a variable is counted once: how often an interpreter looks it up is its own
         why = self.outside().get(("sysvar" if key[:1] == "$" else "name", key))
         if why is None:
             return None
@@ -229,6 +228,22 @@ class SystemSoftware:
             if is_kuka_file(sym.path):
                 return f"declared by an EXT of KUKA's system file {sym.path.rsplit('/', 1)[-1]}"
         return None
+
+    def _returns(self, key: str):
+        """The declared return type of the routine `key`: its EXTFCT in the program's files,
+        else its signature in the platform tables; None when neither says."""
+        t = getattr(getattr(self._symbol(key), "signature", None), "returns", None)
+        if t is not None and t is not T.UNKNOWN:
+            return t
+        from krl.semantics.builtins import load_builtins  # noqa: PLC0415
+
+        info = load_builtins().routines.get(key)
+        name = getattr(info, "returns", None)
+        if not name or name == "ANY":
+            return None
+        from .sysvars import sys_type  # noqa: PLC0415
+
+        return sys_type(name) or getattr(T, name.upper(), None)
 
     def _symbol(self, key: str):
         scope = getattr(self.rt.program.ws, "global_scope", None)
@@ -262,9 +277,7 @@ class SystemSoftware:
                 v, doc = DOCUMENTED[key]
                 self._record(key, StandIn(name, "function", f"returns {_shown(v)} ({doc})", why))
                 return v
-            sym = self._symbol(key)
-            sig = getattr(sym, "signature", None)
-            t = getattr(sig, "returns", None)
+            t = self._returns(key)
             if t is None or t is T.UNKNOWN:
                 t = self.use_types().get(key)
             v = _zero(t) if t is not None else None
@@ -277,8 +290,7 @@ class SystemSoftware:
             return None
         if key in DOCUMENTED:
             return DOCUMENTED[key][0]
-        return _zero(self.use_types().get(key) or getattr(getattr(self._symbol(key), "signature", None),
-                                                            "returns", None))
+        return _zero(self._returns(key) or self.use_types().get(key))
 
     def statement(self, what: str) -> None:
         """A statement of reference §5.20 that is recognised and not simulated."""
@@ -287,8 +299,9 @@ class SystemSoftware:
 
     # ------------------------------------------------------------------ report
     def summary(self) -> list[tuple[str, str, int]]:
-        """(name, what, uses) of every stand-in of the run, most used first; the types of
-        absent system data lists (Program.stubs) count once."""
+        """(name, what, uses) of every stand-in of the run, most used first: the calls of a
+        routine, the statements of a statement; a variable and a type count once (how often an
+        interpreter looks a variable up is its own business: the two interpreters differ)."""
         out = [(st.name, st.what, self.uses[k]) for k, st in self.standins.items()]
         for name in sorted(self.rt.program.stubs):
             if name.upper() not in self.standins and not name.startswith("STMT "):
