@@ -106,16 +106,19 @@ HALT_CONTINUES = 10
 
 def halt_option(text: str) -> int:
     """The times the operator presses Start again after a HALT (``--on-halt``: ``stop`` 0,
-    ``continue`` :data:`HALT_CONTINUES`, ``continue:N`` N, 1 <= N <= 1000). Exits 2 for
+    ``continue`` :data:`HALT_CONTINUES`, ``continue:N`` N, 1 <= N <= MAX_HALT_CONTINUES).
+    Exits 2 for
     anything else."""
     t = (text or "stop").strip().lower()
     if t == "stop":
         return 0
     if t == "continue":
         return HALT_CONTINUES
-    if t.startswith("continue:") and t[9:].isdigit() and 1 <= int(t[9:]) <= 1000:
+    from krl.limits import MAX_HALT_CONTINUES  # noqa: PLC0415
+
+    if t.startswith("continue:") and t[9:].isdigit() and 1 <= int(t[9:]) <= MAX_HALT_CONTINUES:
         return int(t[9:])
-    click.echo(f"error: --on-halt {text!r}: stop, continue or continue:N (N 1..1000)", err=True)
+    click.echo(f"error: --on-halt {text!r}: stop, continue or continue:N (N 1..{MAX_HALT_CONTINUES})", err=True)
     sys.exit(2)
 
 

@@ -18,12 +18,11 @@ from pathlib import Path
 import numpy as np
 
 from interp.runtime.values import Arr, Struct
+from krl.limits import MAX_CHOICE_POINTS
 
 #: the components of a Cartesian point and of an axis point
 _CART = ("X", "Y", "Z", "A", "B", "C")
 _AXES = ("A1", "A2", "A3", "A4", "A5", "A6")
-#: points of one backup the robot choice looks at (the first ones, in file order)
-MAX_CHOICE_POINTS = 2000
 
 
 def start_axes(controller, value_of: Callable[[str], object], text: str) -> np.ndarray:

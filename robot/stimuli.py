@@ -62,7 +62,7 @@ from typing import Any
 
 import yaml
 
-from krl.limits import MAX_CELL_RULES, MAX_CELL_SIM_TIME_S, MAX_STIMULI, MAX_STIMULI_BYTES
+from krl.limits import MAX_CELL_RULES, MAX_CELL_SIM_TIME_S, MAX_START_CHARS, MAX_STIMULI, MAX_STIMULI_BYTES
 
 from .cellrules import ConditionError, Rule, compile_condition, parse_condition
 from .io import IOError_, parse_signal
@@ -332,6 +332,8 @@ def parse_start(text: str):
 
     if not isinstance(text, str) or not text.strip():
         raise StartError("a start position is an E6AXIS literal or the name of a point, e.g. XHOME")
+    if len(text) > MAX_START_CHARS:
+        raise StartError(f"a start position is at most {MAX_START_CHARS} characters")
     bundle = default_bundle()
     parsed = parse_expression(text.strip(), MAX_RULE_TOKENS, bundle)
     expr = build_expression(parsed.tree, "<start>", bundle.symbolic) if parsed.error is None else None
@@ -358,7 +360,7 @@ def _start(value: Any, at: str) -> str:
                 raise StimulusError(f"{at}: start: {str(k)[:24]!r} must map to a number")
             parts.append(f"{k} {v}")
         value = "{" + ", ".join(parts) + "}"
-    if not isinstance(value, str) or len(value) > 400:
+    if not isinstance(value, str) or len(value) > MAX_START_CHARS:
         raise StimulusError(f"{at}: start must be a point name (XHOME) or an E6AXIS literal "
                             f"(\"{{A1 0, A2 -90, A3 90, A4 0, A5 0, A6 0}}\")")
     try:

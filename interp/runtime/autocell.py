@@ -51,6 +51,7 @@ from pathlib import Path
 
 from krl.ast import nodes as N
 
+from krl.limits import AUTO_MAX_INPUTS, AUTO_MAX_TRIES
 from robot.io import ALWAYS_TRUE_INPUT
 
 from .errors import KrlRuntimeError
@@ -60,10 +61,9 @@ from .values import EnumValue
 #: s between the moment the cell sees the program starve and its answer (a PLC scan, the
 #: sensor and the bus: a stated figure, not a measured one)
 AUTO_DELAY_S = 0.5
-#: inputs of one condition the solver combines
-MAX_ATOMS = 8
-#: assignments the solver evaluates for one condition
-MAX_TRIES = 4096
+#: inputs of one condition the solver combines; assignments it evaluates (krl/limits.py)
+MAX_ATOMS = AUTO_MAX_INPUTS
+MAX_TRIES = AUTO_MAX_TRIES
 
 _KIND_RANK = {"WAIT FOR": 0, "UNTIL": 0, "WHILE": 0, "IF": 1, "SWITCH": 2}
 
