@@ -18,8 +18,9 @@ accept KRL literal syntax only (reference §1.5). CAST_TO/CAST_FROM are in cast.
 GETSYSSTATE answers "STOPBITS" (no stop reaction active; :func:`_getsysstate`); INVERSE
 solves the inverse kinematics of the simulated robot (:func:`_inverse`).
 The EthernetKRL and RSI functions (EKI_*, RSI_*) are in netfunctions.py.
-Unsupported: CREAD/COPEN/CCLOSE/CIOCTL, GET_SIG_INF, channels other than $CMD — a clear
-"not supported" run-time error.
+COPEN(:SER_3, HANDLE) finds no device on any channel: HANDLE 0, the channel not connected
+(:func:`_copen`). Unsupported: CREAD/CCLOSE/CIOCTL, GET_SIG_INF, CWRITE channels other than
+$CMD — a clear "not supported" run-time error.
 """
 
 from __future__ import annotations
@@ -143,6 +144,7 @@ def _atan2(rt, a):
 
 def _frand(rt, a):
     lo, hi = _real(a[0]), _real(a[1])
+    rt.clock_read()     # a random number: not idle (interp/runtime/idle.py)
     return rt.random.uniform(lo, hi)
 
 
@@ -516,6 +518,23 @@ def _exists_krldlg(rt, a):
     if answer is not None and len(a) > 1 and a[1] is not None:
         a[1].set(answer)
     return open_
+
+
+def _copen(rt, a):
+    """``COPEN(:SER_3, HANDLE)``: open a channel of the controller. No device answers on any
+    channel in the simulation: the channel is *not connected*, HANDLE is 0 (KUKA: a handle > 0
+    for an open channel, 0 when it could not be opened), and the run notes it once per channel."""
+    from .values import Channel  # noqa: PLC0415
+
+    if len(a) != 2 or a[0] is None or not isinstance(a[0].peek(), Channel):
+        raise KrlRuntimeError("COPEN needs a channel name and a handle variable: COPEN(:SER_3, HANDLE)")
+    ch = a[0].peek()
+    a[1].set(0)
+    key = f"COPEN {ch.name}"
+    if key not in rt.noted:
+        rt.noted.add(key)
+        rt.message(f"not simulated: channel :{ch.name} is not connected (no device on it): COPEN gives HANDLE 0")
+    return None
 
 
 def _cwrite(rt, a):
@@ -912,7 +931,7 @@ NATIVES: dict = {
     "SET_KRLMSG": _set_krlmsg, "EXISTS_KRLMSG": _exists_krlmsg, "CLEAR_KRLMSG": _clear_krlmsg,
     "SET_KRLDLG": _set_krldlg, "EXISTS_KRLDLG": _exists_krldlg,
     "CAST_TO": cast_to, "CAST_FROM": cast_from,
-    "CREAD": _unsupported("CREAD"), "COPEN": _unsupported("COPEN"),
+    "CREAD": _unsupported("CREAD"), "COPEN": _copen,
     "CCLOSE": _unsupported("CCLOSE"), "CIOCTL": _unsupported("CIOCTL"),
     "GET_SIG_INF": _unsupported("GET_SIG_INF"), "GETSYSSTATE": _getsysstate,
 }
