@@ -6,11 +6,23 @@ trapezoid, or a piecewise profile for a SPLINE block; CP paths are slowed so the
 machine data, issue 15):
 
 * :class:`JointSegment` (PTP, SPTP): ``q(u) = q0 + u·(q1 - q0)``, synchronised axes.
+
+External axes E1..En (robot/external.py) are the axis vector's entries after A1..A6: a PTP
+moves them synchronised with the robot axes; on a CP path they move linearly in the path
+parameter, ``E(u) = E0 + u·(E1 - E0)``, start and stop with the robot, and the path is slowed
+for their speed and acceleration like for the robot's axes. A track (#ERSYS) moves
+``$ROBROOT`` with E, so the arm's axes on a CP path follow it; a ``$BASE`` linked to a BASE
+kinematic (``MotionParams.base_kin``, KSS ``EK``) turns with it.
 * :class:`CartSegment` (LIN, CIRC, SLIN, SCIRC, SPLINE): the TCP moves in ``$BASE`` along
   a chain of path pieces (line, circular arc, Catmull-Rom curve for SPL points); the
   orientation follows ``$ORI_TYPE``/``$CIRC_TYPE``; axis values come from the inverse
   kinematics each cycle, keeping the start status S and the turn nearest to the last
-  setpoint (reference §6.5: CP motions ignore the target's S and T).
+  setpoint (reference §6.5: CP motions ignore the target's S and T). Where each solution
+  is the next one's reference (the planning walk of a path, the main run's coming cycles at
+  full path speed: :meth:`CartSegment.axes_run`) the chain is solved at once in numpy
+  (:meth:`RobotModel.ik_chain`), with the same results bit for bit; a kept row is used only
+  for the same time law, time and reference, so a BRAKE, a blend, an interrupt's motion or an
+  advance-run event between cycles gets the per-cycle setpoint.
 
 Planning happens in the advance run (:func:`plan`), so an unreachable target or a soft-limit
 violation of a target raises :class:`~robot.errors.RobotError` at the motion statement.
@@ -29,7 +41,7 @@ from scipy.spatial.transform import Rotation
 from .errors import RobotError, WorkspaceError
 from .frames import frame_to_matrix, inv_pos, matrix_to_frame
 from .kinematics import Kinematics
-from .motion import AXIS_KEYS, CART_KEYS, MotionParams, MotionRequest, Trigger
+from .motion import AXIS_KEYS, CART_KEYS, EXT_KEYS, MotionParams, MotionRequest, Trigger
 from .limits import DEFAULT_MODE, T1_SPEED_MM_S, cp_path_speed, motion_limits, ptp_axis_speeds
 from .profiles import PiecewiseProfile, Trapezoid
 
@@ -44,6 +56,14 @@ CP_SPEED_LIMIT_FACTOR = 1.5
 CP_SAMPLE_STEP_DEG = 1.0
 #: Safety factor on the sampled TCP/flange speed of a path in T1 (sampling between points).
 T1_MARGIN = 1.02
+#: Passes of the batched IK chain (:meth:`RobotModel.ik_chain`) before it gives up and the
+#: chain is solved pose by pose (each pass fixes at least one more row).
+IK_CHAIN_PASSES = 6
+#: IPO cycles of a CP segment the main run solves at once (:meth:`CartSegment.axes_run`).
+AHEAD_CYCLES = 128
+#: Shortest chain solved at once: below it numpy's fixed cost per pass (two passes at least)
+#: is more than the per-pose solves (measured 2026-11-24: even at 40 poses, about 1.1x slower).
+MIN_CHAIN = 64
 
 
 class RobotModel:
@@ -60,15 +80,59 @@ class RobotModel:
         self.robroot_T = frame_to_matrix(*machine.robroot_frame)
         self._robroot_is_null = bool(np.allclose(self.robroot_T, np.eye(4)))
         self._robroot_inv_T = inv_pos(self.robroot_T)
-        self.v_max = np.array(machine.max_speed_deg_s, dtype=float)
-        self.a_max = np.array(machine.max_acc_deg_s2, dtype=float)
-        self.apo_dis_ptp = np.array(machine.apo_dis_ptp_deg, dtype=float)
+        #: external axes (robot/external.py), None without; axis vectors are A1..A6, E1..En
+        self.n_ext = len(getattr(machine, "external_axes", ()))
+        self.ext = None
+        self._ersys = False
+        if self.n_ext:
+            from .external import ExternalAxes  # noqa: PLC0415
+
+            self.ext = ExternalAxes(machine)
+            self._ersys = self.ext.robroot_kin is not None
+            self.v_max = np.array(machine.all_max_speed, dtype=float)
+            self.a_max = np.array(machine.all_max_acc, dtype=float)
+            ext_apo = [90.0] * self.n_ext
+            self.apo_dis_ptp = np.array(list(machine.apo_dis_ptp_deg)[:6] + ext_apo, dtype=float)
+            self._e_lo = np.array([e.limit[0] for e in machine.external_axes], dtype=float)
+            self._e_hi = np.array([e.limit[1] for e in machine.external_axes], dtype=float)
+        else:
+            self.v_max = np.array(machine.max_speed_deg_s, dtype=float)
+            self.a_max = np.array(machine.max_acc_deg_s2, dtype=float)
+            self.apo_dis_ptp = np.array(machine.apo_dis_ptp_deg, dtype=float)
+
+    def linked(self, system: str) -> "RobotModel":
+        """This model with ``$BASE`` on the BASE kinematic `system` (robot/external.py):
+        ``$BASE_C(E) = ETn(E) : $BASE`` in :meth:`tcp` and :meth:`ik`."""
+        if self.ext is None or system not in self.ext.base_kins:
+            raise RobotError(f"$BASE linked to {system}: no such external kinematic in $EX_KIN")
+        return _LinkedBase(self, system)
+
+    def robroot_at(self, q: np.ndarray) -> np.ndarray | None:
+        """``$ROBROOT_C`` for the axis vector `q` (the track's E values), None for the null frame."""
+        if self._ersys:
+            return self.ext.robroot(q[6:])           # type: ignore[union-attr]
+        return None if self._robroot_is_null else self.robroot_T
+
+    def check_limits(self, q: np.ndarray) -> None:
+        """``$SOFTN_END``/``$SOFTP_END`` of A1..A6 and E1..En (SoftLimitError, reference §8.2)."""
+        self.kin.check_soft_limits(q)
+        if self.n_ext:
+            from .errors import SoftLimitError  # noqa: PLC0415
+
+            e = np.asarray(q, dtype=float)[6:6 + self.n_ext]
+            for i in range(self.n_ext):
+                if e[i] < self._e_lo[i] - 1e-9 or e[i] > self._e_hi[i] + 1e-9:
+                    pos = bool(e[i] > self._e_hi[i])
+                    raise SoftLimitError(6 + i + 1, float(e[i]), positive=pos,
+                                         message=f"software limit switch {'+' if pos else '-'}E{i + 1}")
 
     def tcp(self, q: np.ndarray, tool_T: np.ndarray, base_inv_T: np.ndarray) -> np.ndarray:
         """TCP in $BASE: INV_POS($BASE) : $ROBROOT : FLANGE(q) : $TOOL (``base_inv_T`` is
-        INV_POS($BASE), precomputed)."""
+        INV_POS($BASE), precomputed; ``$ROBROOT_C(E)`` on a track)."""
         F = self.kin.forward(q)
-        if not self._robroot_is_null:
+        if self._ersys:
+            F = self.ext.robroot(q[6:]) @ F          # type: ignore[union-attr]
+        elif not self._robroot_is_null:
             F = self.robroot_T @ F
         return base_inv_T @ F @ tool_T
 
@@ -79,6 +143,15 @@ class RobotModel:
         F = T_base if base_T is None else base_T @ T_base
         if tool_inv_T is not None:
             F = F @ tool_inv_T
+        if self.n_ext:
+            # the external axes are given (ref's E part): the arm solves in $ROBROOT_C(E)
+            e = np.asarray(ref, dtype=float)[6:6 + self.n_ext]
+            if self._ersys:
+                F = inv_pos(self.ext.robroot(e)) @ F      # type: ignore[union-attr]
+            elif not self._robroot_is_null:
+                F = self._robroot_inv_T @ F
+            q = self.kin.inverse(F, status=status, turn=turn, reference_deg=ref[:6])
+            return np.concatenate([q, e])
         if not self._robroot_is_null:
             F = self._robroot_inv_T @ F
         return self.kin.inverse(F, status=status, turn=turn, reference_deg=ref)
@@ -86,10 +159,45 @@ class RobotModel:
     def status_turn(self, q: np.ndarray) -> tuple[int, int]:
         return self.kin.status_turn(q)
 
+    @property
+    def batch_ik(self) -> bool:
+        """True when :meth:`ik_chain` solves in numpy (the OPW family, no external axes and
+        no linked $BASE); otherwise it returns None and callers solve cycle by cycle."""
+        return type(self) is RobotModel and not self.n_ext and self.kin.family == "opw"
+
+    def ik_chain(self, poses: list[tuple[np.ndarray, np.ndarray]], tool_inv_T: np.ndarray | None,
+                 base_T: np.ndarray | None, status: int | None, ref: np.ndarray) -> np.ndarray | None:
+        """:meth:`ik` along a chain of TCP poses ``(p (3,), R (3, 3))`` in $BASE where each
+        solution is the next one's reference (the first one's is `ref`): the (n, 6) axes,
+        bit for bit those of n calls of :meth:`ik` in turn, or None when the chain must be
+        solved call by call (not :attr:`batch_ik`, an error on some pose, no fixed point).
+
+        The rows are solved at once by :meth:`Kinematics.inverse_chain` (passes of
+        :meth:`Kinematics.inverse_many` until a fixed point). Issue 39, "Simulator"."""
+        n = len(poses)
+        if n < MIN_CHAIN or not self.batch_ik:
+            return None
+        F = np.empty((n, 4, 4))
+        for i, (p, R) in enumerate(poses):
+            T = np.empty((4, 4))
+            T[:3, :3] = R
+            T[:3, 3] = p
+            T[3] = _BOTTOM_ROW
+            if base_T is not None:
+                T = base_T @ T
+            if tool_inv_T is not None:
+                T = T @ tool_inv_T
+            if not self._robroot_is_null:
+                T = self._robroot_inv_T @ T
+            F[i] = T
+        return self.kin.inverse_chain(F, status, ref, IK_CHAIN_PASSES)
+
     def tcp_pos_many(self, Q: np.ndarray, tool_T: np.ndarray, base_inv_T: np.ndarray) -> np.ndarray:
-        """TCP positions (n, 3) in $BASE for axis rows Q (n, 6)."""
+        """TCP positions (n, 3) in $BASE for axis rows Q (n, 6 + external axes)."""
         F = self.kin.forward_many(Q)
-        if not self._robroot_is_null:
+        if self._ersys:
+            F = np.array([self.ext.robroot(q[6:]) for q in Q]) @ F      # type: ignore[union-attr]
+        elif not self._robroot_is_null:
             F = self.robroot_T @ F
         T = base_inv_T @ F @ tool_T
         return T[:, :3, 3]
@@ -110,7 +218,7 @@ class RobotModel:
             P = self.tcp_pos_many(Q, tool_T, base_inv_T)
             r = P[0] - p
             if float(np.linalg.norm(r)) < 1e-7:
-                self.kin.check_soft_limits(q)
+                self.check_limits(q)
                 return q
             J = (P[1:] - P[0]).T / h
             try:
@@ -119,6 +227,27 @@ class RobotModel:
                 break
             q[:3] += np.clip(dx, -20.0, 20.0)
         raise WorkspaceError("workspace error: target not reachable ($ORI_TYPE #JOINT)")
+
+
+class _LinkedBase(RobotModel):
+    """A :class:`RobotModel` whose ``$BASE`` turns with a BASE kinematic (a turntable)."""
+
+    def __init__(self, model: RobotModel, system: str) -> None:   # noqa: D107 - a view of `model`
+        self.__dict__.update(model.__dict__)
+        self._kin_et = model.ext.base_kins[system]               # type: ignore[union-attr]
+
+    def _et(self, e: np.ndarray) -> np.ndarray:
+        return self.ext.chain(self._kin_et, e)                   # type: ignore[union-attr]
+
+    def tcp(self, q: np.ndarray, tool_T: np.ndarray, base_inv_T: np.ndarray) -> np.ndarray:
+        return RobotModel.tcp(self, q, tool_T, base_inv_T @ inv_pos(self._et(q[6:])))
+
+    def ik(self, T_base, tool_inv_T, base_T, status, turn, ref):
+        E = self._et(np.asarray(ref, dtype=float)[6:])
+        return RobotModel.ik(self, T_base, tool_inv_T, E if base_T is None else E @ base_T, status, turn, ref)
+
+    def tcp_pos_many(self, Q: np.ndarray, tool_T: np.ndarray, base_inv_T: np.ndarray) -> np.ndarray:
+        return np.array([self.tcp(q, tool_T, base_inv_T)[:3, 3] for q in Q])
 
 
 def rotvec_matrix(v: np.ndarray) -> np.ndarray:
@@ -397,12 +526,14 @@ class Segment:
         self.status = model.status_turn(q0)[0]
         self.triggers: list[TriggerPlan] = []
         self.limits: Any = None            # robot.limits.MotionLimits, set by plan()
-        self.vel_peak = np.zeros(6)        # highest planned axis speeds (deg/s)
-        self.acc_peak = np.zeros(6)        # highest planned axis accelerations (deg/s²)
+        self.vel_peak = np.zeros(len(q0))  # highest planned axis speeds (deg/s)
+        self.acc_peak = np.zeros(len(q0))  # highest planned axis accelerations (deg/s²)
         self.qd_start = q1 - q0            # dq/du at the start and at the end (deg)
         self.qd_end = q1 - q0
         self._last_q = q0.copy()
         self._end_frame: list[float] | None = None
+        #: the main run's solved cycles ahead (CartSegment.axes_run)
+        self._ahead: tuple | None = None
 
     @property
     def T(self) -> float:  # noqa: N802 - the duration's symbol in the planner's formulas
@@ -415,6 +546,10 @@ class Segment:
     # overridden
     def axes(self, tau: float) -> np.ndarray:
         raise NotImplementedError
+
+    def axes_run(self, pt: float, t0: float, dt: float, end: float) -> np.ndarray:
+        """:meth:`axes` at ``pt - t0`` from the main run (see :meth:`CartSegment.axes_run`)."""
+        return self.axes(pt - t0)
 
     def pose(self, tau: float) -> tuple[np.ndarray, np.ndarray]:
         """TCP position (mm, (3,)) and rotation matrix (3, 3) in $BASE at local time tau."""
@@ -511,6 +646,8 @@ class CartSegment(Segment):
                  pieces: list[_Piece], rots: list[Rotation], weights: list[float],
                  ori: list[str]) -> None:
         super().__init__(req, q0, q1, profile, v_prog, tool_T, base_T, model)
+        #: E1..En at the end of the path (they move linearly in u from q0's)
+        self.e1 = np.asarray(q1, dtype=float)[6:].copy()
         self.pieces = pieces
         self.rots = rots
         self.ori = ori
@@ -571,14 +708,63 @@ class CartSegment(Segment):
     def pose(self, tau: float) -> tuple[np.ndarray, np.ndarray]:
         return self.pose_u(self.profile.u(tau))
 
-    def ik(self, p: np.ndarray, R: np.ndarray, ref: np.ndarray) -> np.ndarray:
+    def ik(self, p: np.ndarray, R: np.ndarray, ref: np.ndarray, u: float | None = None) -> np.ndarray:
         """Axes for a TCP pose (position mm, 3x3 rotation) in this segment's $BASE/$TOOL,
-        start status S, turn nearest to ``ref``. Raises WorkspaceError/SoftLimitError."""
+        start status S, turn nearest to ``ref``. With external axes they take their value
+        at the path parameter `u` (``E0 + u·(E1 - E0)``), or ``ref``'s without `u`.
+        Raises WorkspaceError/SoftLimitError."""
         T = np.empty((4, 4))
         T[:3, :3] = R
         T[:3, 3] = p
         T[3] = _BOTTOM_ROW
+        if u is not None and len(ref) > 6:
+            ref = np.concatenate([ref[:6], self.q0[6:] + u * (self.e1 - self.q0[6:])])
         return self.model.ik(T, self._ik_tool, self._ik_base, self.status, None, ref)
+
+    def ik_chain(self, poses: list[tuple[np.ndarray, np.ndarray]], ref: np.ndarray) -> np.ndarray | None:
+        """:meth:`ik` of each pose with the previous solution as reference (the first: `ref`),
+        solved at once (:meth:`RobotModel.ik_chain`): (n, 6) axes, or None (solve one by one)."""
+        return self.model.ik_chain(poses, self._ik_tool, self._ik_base, self.status, ref)
+
+    def axes_run(self, pt: float, t0: float, dt: float, end: float) -> np.ndarray:
+        """:meth:`axes` at ``tau = pt - t0`` for the main run, which advances ``pt`` by `dt`
+        each IPO cycle: the coming cycles up to local time `end` (exclusive; the segment's end
+        or its blend start) are solved at once (:meth:`ik_chain`, up to
+        :data:`AHEAD_CYCLES`) and kept. A kept row is returned only for the same profile, the
+        same ``tau`` and the same reference (the last setpoint, byte for byte); anything
+        else (a BRAKE, a new blend profile, a setpoint set from outside) solves again, so
+        the result is always the one :meth:`axes` gives."""
+        tau = pt - t0
+        ahead = self._ahead
+        if ahead is not None:
+            prof, taus, refs, Q, i = ahead
+            if (i < len(taus) and prof is self.profile and taus[i] == tau
+                    and refs[i] == self._last_q.tobytes()):
+                q = Q[i].copy()
+                self._ahead = (prof, taus, refs, Q, i + 1)
+                self._last_q = q
+                return q
+            self._ahead = None
+        if self.joint_ori or len(self.q0) > 6 or tau >= self.T or not self.model.batch_ik:
+            return self.axes(tau)
+        if end - tau < (MIN_CHAIN - 2) * dt:     # the segment's tail: cycle by cycle
+            return self.axes(tau)
+        taus = [tau]
+        t = pt
+        while len(taus) < AHEAD_CYCLES:
+            t = t + dt
+            if t - t0 >= end:
+                break
+            taus.append(t - t0)
+        if len(taus) < MIN_CHAIN:
+            return self.axes(tau)
+        ref = self._last_q
+        Q = self.ik_chain([self.pose(x) for x in taus], ref)
+        if Q is None:
+            return self.axes(tau)
+        refs = [ref.tobytes()] + [row.tobytes() for row in Q[:-1]]
+        self._ahead = (self.profile, taus, refs, Q, 0)
+        return self.axes_run(pt, t0, dt, end)
 
     def axes(self, tau: float) -> np.ndarray:
         if tau >= self.T:
@@ -589,11 +775,18 @@ class CartSegment(Segment):
             u = self.profile.u(tau)
             p = self.pose_u(u)[0]
             wrist = self.q0[3:6] + u * (self.q1[3:6] - self.q0[3:6])
-            q = self.model.solve_position(p, wrist, self._last_q, self.tool_T, self.base_inv_T)
+            ref = self._last_q
+            if len(ref) > 6:
+                ref = np.concatenate([ref[:6], self.q0[6:] + u * (self.e1 - self.q0[6:])])
+            q = self.model.solve_position(p, wrist, ref, self.tool_T, self.base_inv_T)
             self._last_q = q
             return q
-        p, R = self.pose(tau)
-        q = self.ik(p, R, self._last_q)
+        if len(self.q0) > 6:
+            u = self.profile.u(tau)
+            q = self.ik(*self.pose_u(u), self._last_q, u)
+        else:
+            p, R = self.pose(tau)
+            q = self.ik(p, R, self._last_q)
         self._last_q = q
         return q
 
@@ -655,6 +848,18 @@ def _cart_target(req_target: dict[str, float], start_T: np.ndarray, relative: bo
     return frame_to_matrix(*_apply_partial(start6, req_target))
 
 
+def _ext_target(q0: np.ndarray, target: dict[str, float], relative: bool) -> np.ndarray:
+    """``q0`` with its external axes E1..En set from the target's E components (relative:
+    added), the rest kept; ``q0`` itself without external axes."""
+    if len(q0) <= 6:
+        return q0
+    out = q0.copy()
+    for i, key in enumerate(EXT_KEYS[:len(q0) - 6]):
+        if key in target:
+            out[6 + i] = (q0[6 + i] if relative else 0.0) + float(target[key])
+    return out
+
+
 def _check_complete(req: MotionRequest) -> None:
     t = req.target
     if req.relative or req.kind in ("CIRC", "SCIRC", "SPLINE"):
@@ -686,6 +891,8 @@ def plan(req: MotionRequest, q_start: np.ndarray, model: RobotModel, *,
     elif p.ipo_mode != "BASE":
         raise RobotError(f"$IPO_MODE=#{p.ipo_mode} is not supported by the simulator")
     q0 = np.asarray(q_start, dtype=float).copy()
+    if getattr(p, "base_kin", None) and model.n_ext:
+        model = model.linked(p.base_kin)      # $BASE on a BASE kinematic (robot/external.py)
     tool_T = frame_to_matrix(*p.tool)
     base_T = frame_to_matrix(*p.base)
     base_inv = inv_pos(base_T)
@@ -705,15 +912,17 @@ def _plan_joint(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_T:
     t = req.target
     if req.is_axis_target:
         if req.relative:
-            q1 = q0 + np.array([float(t.get(k, 0.0)) for k in AXIS_KEYS])
+            q1 = q0 + np.array([float(t.get(k, 0.0)) for k in AXIS_KEYS + EXT_KEYS[:len(q0) - 6]])
         else:
-            q1 = np.array([float(t[k]) if k in t else q0[i] for i, k in enumerate(AXIS_KEYS)])
-        model.kin.check_soft_limits(q1)
+            q1 = np.array([float(t[k]) if k in t else q0[i] for i, k in enumerate(AXIS_KEYS + EXT_KEYS[:len(q0) - 6])])
+        model.check_limits(q1)
     else:
         T1 = _cart_target(t, start_T, req.relative, req.rel_frame)
         s = int(t["S"]) if "S" in t and not req.relative else None
         tt = int(t["T"]) if "T" in t and not req.relative else None
-        q1 = model.ik(T1, inv_pos(tool_T), base_T, s, tt, q0)
+        q1 = model.ik(T1, inv_pos(tool_T), base_T, s, tt, _ext_target(q0, t, req.relative))
+        if len(q1) > 6:
+            model.check_limits(q1)
     dq = np.abs(q1 - q0)
     moving = dq > 1e-9
     if not moving.any():
@@ -722,7 +931,7 @@ def _plan_joint(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_T:
         V = A = 0.0
     else:
         v_axis = ptp_axis_speeds(p, model.machine, model.mode)     # $RED_T1 in T1 (issue 15)
-        a_axis = model.a_max * np.array(p.acc_axis) / 100.0
+        a_axis = model.a_max * np.array(list(p.acc_axis)[:6] + [100.0] * (len(q0) - 6)) / 100.0
         if np.any(v_axis[moving] <= 0) or np.any(a_axis[moving] <= 0):
             raise RobotError("PTP: $VEL_AXIS, $ACC_AXIS and $OV_PRO must be positive")
         V = float(np.min(v_axis[moving] / dq[moving]))
@@ -865,10 +1074,17 @@ def _plan_cart(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_T: 
     c = v_cp0 / v_ori0
     weights = [max(pc.length, th * c) for pc, th in zip(pieces, thetas)]
     W = float(sum(weights))
-    seg = CartSegment(req, q0, q0.copy(), Trapezoid.plan(math.inf, math.inf), math.inf,
+    q_end = _ext_target(q0, req.target if req.kind != "SPLINE" else
+                        (req.segments[-1].target if req.segments else {}), req.relative)
+    if len(q0) > 6:
+        model.check_limits(np.concatenate([q0[:6], q_end[6:]]))
+    seg = CartSegment(req, q0, q_end, Trapezoid.plan(math.inf, math.inf), math.inf,
                       tool_T, base_T, model, pieces, rots, weights, ori)
-    seg.vel_peak = np.zeros(6)
-    seg.acc_peak = np.zeros(6)
+    seg.vel_peak = np.zeros(len(q0))
+    seg.acc_peak = np.zeros(len(q0))
+    if len(q0) > 6 and W <= 1e-6 and float(np.max(np.abs(q_end[6:] - q0[6:]))) > 1e-9:
+        raise RobotError(f"{req.kind}: a CP motion that moves only the external axes is not simulated "
+                         f"(the TCP stands still); move them with PTP")
     if W <= 1e-6:  # nothing to move (a zero-length LIN): zero duration, never approximated
         seg.q1 = q0.copy()
         return seg
@@ -927,12 +1143,25 @@ def _plan_cart(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_T: 
         start = ref
         while True:
             us = np.linspace(float(ub[k]), float(ub[k + 1]), nk + 1)
-            Q = np.empty((nk + 1, 6))
+            Q = np.empty((nk + 1, len(q0)))
             Q[0] = start
             ref = start
-            for j in range(1, nk + 1):
+            chain = None
+            if len(q0) == 6 and nk >= MIN_CHAIN and model.batch_ik:
+                chain = seg.ik_chain([seg.pose_u(float(us[j])) for j in range(1, nk + 1)], ref)
+            if chain is not None:
+                # the same rows as the loop below; its singularity check, in its order
+                jumps = np.abs(np.diff(np.concatenate([Q[:1], chain]), axis=0))
+                for j in range(nk):
+                    if float(jumps[j].max()) > SINGULAR_JUMP_DEG:
+                        i = int(np.argmax(jumps[j]))
+                        raise RobotError(f"CP path through a singularity: A{i + 1} would turn "
+                                         f"{jumps[j][i]:.0f} deg at once (keep the status on CP paths)")
+                Q[1:] = chain
+                ref = Q[nk].copy()
+            for j in range(1, nk + 1 if chain is None else 1):
                 pu, Ru = seg.pose_u(float(us[j]))
-                q = seg.ik(pu, Ru, ref)
+                q = seg.ik(pu, Ru, ref, float(us[j])) if len(q0) > 6 else seg.ik(pu, Ru, ref)
                 jump = np.abs(q - ref)
                 if float(jump.max()) > SINGULAR_JUMP_DEG:
                     i = int(np.argmax(jump))
@@ -949,7 +1178,7 @@ def _plan_cart(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_T: 
         h = float(us[1] - us[0])
         if h <= 0:
             junction_q.append(Q[0].copy())
-            sec_d.append((np.zeros(6), np.zeros(6), 1.0))
+            sec_d.append((np.zeros(len(q0)), np.zeros(len(q0)), 1.0))
             continue
         d1 = np.gradient(Q, h, axis=0, edge_order=2)
         d2 = np.gradient(d1, h, axis=0, edge_order=2)
@@ -993,9 +1222,10 @@ def _plan_cart(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_T: 
         if vnode[k] <= 0.0:
             continue
         uk, du_ = float(ub[k]), 1e-5
-        qj = seg.ik(*seg.pose_u(uk), junction_q[k])
-        qL = seg.ik(*seg.pose_u(uk - du_), qj)
-        qR = seg.ik(*seg.pose_u(uk + du_), qj)
+        e_u = (lambda v: v) if len(q0) > 6 else (lambda v: None)
+        qj = seg.ik(*seg.pose_u(uk), junction_q[k], e_u(uk))
+        qL = seg.ik(*seg.pose_u(uk - du_), qj, e_u(uk - du_))
+        qR = seg.ik(*seg.pose_u(uk + du_), qj, e_u(uk + du_))
         jump = np.abs((qR - qj) - (qj - qL)) / du_
         # a jump that matters at full speed (> 5 % of a_max within one cycle; e.g. the
         # orientation rate changing between pieces) is a corner for the axes

@@ -65,7 +65,7 @@ def test_evaluate_errors_are_refused_with_krl_words():
         assert c.evaluate("a", ok=False)["message"] == "value invalid: a (1422)"   # a is not set yet
         assert "not a KRL expression" in c.evaluate("a +", ok=False)["message"]
         assert "after the expression" in c.evaluate("a = 1", ok=False)["message"]
-        assert c.value("$MODE_OP") == "#T1"               # launch mode defaults to T1
+        assert c.value("$MODE_OP") == "#AUT"              # krl run's default mode
         assert c.value("$PRO_MODE") == "#GO"
 
 
@@ -204,7 +204,7 @@ def test_mstep_and_backward_motion_over_dap():
 def test_launch_refuses_bad_arguments(tmp_path):
     with DapClient() as c:
         c.initialize()
-        with pytest.raises(DapError, match="no such program"):
+        with pytest.raises(DapError, match="none.src: no such file"):
             c.request("launch", {"program": str(tmp_path / "none.src")})
         with pytest.raises(DapError, match="mode"):
             c.request("launch", {"program": str(CALL), "mode": "T3"})
