@@ -33,7 +33,6 @@ from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
-import platformdirs
 
 from krl.files import display_path, walk
 from krl.limits import PARSE_TIMEOUT_S
@@ -199,12 +198,7 @@ def failed_row(rel_path: str, size: int, sha: str, status: str, detail: str) -> 
 
 # ----------------------------------------------------------------------- cache
 
-def cache_dir() -> Path:
-    """The user cache directory (never inside the repository); created here. Raises OSError
-    when it cannot be created."""
-    d = Path(os.environ.get("KRL_CACHE_DIR") or platformdirs.user_cache_dir("krl-tools"))
-    d.mkdir(parents=True, exist_ok=True)
-    return d
+from krl.store import cache_dir  # noqa: E402 - the one user cache folder (re-exported)
 
 
 _WARNED: set[str] = set()
