@@ -24,7 +24,7 @@ def make_runtime(program, *, workspace=None, inputs=None, trace=None, max_sim_ti
                  robot_budget=None, interp: str = "tree", observer=None,
                  mode: str | None = None, check: bool = True,
                  vm_loop: str = "generated", run_mode: str | None = None,
-                 pgno: int | None = None, robot=None) -> tuple[Runtime, object]:
+                 pgno: int | None = None, robot=None, network=None) -> tuple[Runtime, object]:
     """Build the runtime and the interpreter (``interp``: tree or vm) for ``program``
     (not started yet). Its files (krl.project.project_of, with the `submit` programs) are
     loaded, checked and resolved first; with `check` (``krl run`` without ``--no-check``) a
@@ -39,7 +39,10 @@ def make_runtime(program, *, workspace=None, inputs=None, trace=None, max_sim_ti
     ``run_mode``: ``$PRO_MODE`` at the start (GO, MSTEP, ISTEP, BSTEP; interp/runtime/runmode.py;
     default GO). ``robot``: the simulated robot (a MachineData or a path for
     :func:`robot.mada.load_robot`); default :func:`robot_for` (the cell file's ``robot``, else the
-    backup's own robot, else the KR 6 R900). Raises
+    backup's own robot, else the KR 6 R900). ``network``: the partners
+    (net.settings.NetworkSettings; default the cell file's ``network:`` key): the run's network
+    hub (net/hub.py) is attached to the controller either way; without partners its EKI
+    channels stay "not connected". Raises
     :class:`robot.stimuli.StimulusError` for a bad cell file or a preset the backup's
     ``$config.dat`` does not allow."""
     from interp.tree import TreeInterpreter  # noqa: PLC0415
@@ -73,6 +76,7 @@ def make_runtime(program, *, workspace=None, inputs=None, trace=None, max_sim_ti
                             controller.rules)
         except ResourceError:
             pass    # a data list past a limit: the program does not start (Runtime.main_routine says why)
+    attach_network(rt, program, workspace, network if network is not None else getattr(controller, "cell_network", None))
     if interp == "vm":
         from interp.vm import VM  # noqa: PLC0415
 
@@ -84,6 +88,64 @@ def make_runtime(program, *, workspace=None, inputs=None, trace=None, max_sim_ti
         sp = Path(sub).resolve()
         rt.add_task("submit", sp.stem, lambda name=sp: interp.run_program(name))
     return rt, interp
+
+
+def attach_network(rt: Runtime, program, workspace, settings) -> None:
+    """The run's network hub (net/hub.py) on `rt`'s controller, with `settings` (None: no
+    partner). Raises net.hub.NetError when a partner's server cannot start."""
+    from krl.project import backup_of  # noqa: PLC0415
+    from net.hub import Network  # noqa: PLC0415
+
+    from interp.runtime.netvars import RuntimeSink  # noqa: PLC0415
+
+    old = getattr(rt.controller, "network", None)
+    if old is not None:
+        old.close()
+    root = backup_of(Path(program).resolve(), Path(workspace).resolve() if workspace else None)
+    net = Network(settings, program=Path(program).resolve(), backup=root, sink=RuntimeSink(rt))
+    amap = None
+    if settings is not None and (settings.modbus is not None or settings.opcua is not None):
+        amap = plc_map(rt, Path(program).stem)
+    try:
+        net.attach(rt.controller, amap)
+    except OSError as exc:
+        net.close()
+        from net.hub import NetError  # noqa: PLC0415
+
+        raise NetError(f"a network partner cannot start: {exc.strerror or exc}") from None
+
+
+def plc_map(rt: Runtime, main: str):
+    """The PLC's address map (net/plc.py) derived from the cell: the inputs and outputs its
+    rules, stimuli and program-number handshake (``PGNO_*`` of $config.dat) use, and the
+    SIGNALs of the global declarations on ``$IN``/``$OUT``."""
+    import re  # noqa: PLC0415
+
+    from net.plc import derive_map  # noqa: PLC0415
+    from robot.cellpresets import PGNO_PARAMETERS  # noqa: PLC0415
+
+    ctl = rt.controller
+    indices: list[int] = []
+    for name in PGNO_PARAMETERS:
+        v = global_value(rt, main, name)
+        if isinstance(v, int) and not isinstance(v, bool) and name != "PGNO_TYPE":
+            indices.append(abs(v))
+    fbit, length = global_value(rt, main, "PGNO_FBIT"), global_value(rt, main, "PGNO_LENGTH")
+    if isinstance(fbit, int) and isinstance(length, int):
+        indices.append(abs(fbit) + max(0, min(length, 64)))
+    texts = [str(st.set) for st in ctl.stimuli] + [f"{r.text} {r.set}" for r in ctl.rules]
+    for text in texts:
+        indices += [int(x) for x in re.findall(r"\$(?:IN|OUT)\[(\d{1,4})\]", text)]
+    signals = {}
+    scope = rt.program.ws.global_scope
+    for sym in (scope.values.values() if scope is not None else ()):
+        if sym.kind != "signal":
+            continue
+        found = signal_of(rt, main, sym.name)
+        if found is not None and found[0] in ("$IN", "$OUT"):
+            base, a, b = found
+            signals[sym.name.upper()] = (base, a, b if b is not None else a)
+    return derive_map(indices, signals)
 
 
 def _pgno_rules(rt: Runtime, main: str, number: int) -> list:

@@ -13,9 +13,10 @@ the first cycle) and sets its values in the first IPO cycle at least ``after`` s
 and at least one IPO cycle later (a PLC answers no earlier than its next scan). Edges seen while
 an earlier answer is still pending queue up; each is answered.
 
-The condition is KRL text from an untrusted file. It is parsed once, at load time, by the
-project's own parser (grammar rule ``expression``, krl/syntax/parse.py) into the project's AST
-(krl/ast), and only this subset is accepted (reference §4.1 for the operators):
+The condition is KRL text from an untrusted file. It is read only by the front end's
+expression API (krl/semantics/expression.py): parsed once, at load time, by the project's own
+parser (grammar rule ``expression``) into the project's AST, and only this subset is accepted
+(reference §4.1 for the operators):
 
 * literals: ``TRUE``, ``FALSE``, INT and REAL constants;
 * ``$IN[n]``, ``$OUT[n]``, ``$ANIN[n]``, ``$ANOUT[n]`` with a constant index;
@@ -26,21 +27,25 @@ project's own parser (grammar rule ``expression``, krl/syntax/parse.py) into the
   brackets.
 
 Anything else (a call, a variable, a string, an enum, a structure component) is refused at load
-time with the rule's ``file:line``. The condition is evaluated on its AST (closures built once
-when the run resolves its signals, :func:`compile_condition`); its text never reaches ``eval``.
+time with the rule's ``file:line``. When the run knows the program's signals, the condition is
+type-checked by the front end's checker (the messages of ``krl check``) and compiled once by the
+front end's evaluator (:func:`compile_condition`), which reads the signals from the I/O image;
+its text never reaches ``eval``.
 Limits: :data:`krl.limits.MAX_CELL_RULES` rules, :data:`krl.limits.MAX_RULE_TOKENS` tokens in one
 condition.
 """
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
 from krl.ast import nodes as N
 from krl.limits import MAX_RULE_TOKENS
+from krl.semantics import expression as X
+from krl.semantics import types as T
+from krl.semantics.symbols import Scope, Symbol, system_scopes
 
 from .io import N_ANALOG, N_DIGITAL, IOImage
 
@@ -67,17 +72,10 @@ def parse_condition(text: str) -> N.Expr:
 
     Raises :class:`ConditionError` for text that is no KRL expression, more than
     :data:`~krl.limits.MAX_RULE_TOKENS` tokens, or a construct outside the subset."""
-    from krl.ast.build import build_expression  # noqa: PLC0415
-    from krl.syntax.parse import default_bundle, parse_expression  # noqa: PLC0415
-
-    bundle = default_bundle()
-    parsed = parse_expression(text, MAX_RULE_TOKENS, bundle)
-    if parsed.error is not None:
-        col, msg = parsed.error
-        raise ConditionError(f"not a KRL expression: {msg}", col)
-    expr = build_expression(parsed.tree, "<rule>", bundle.symbolic)
-    if expr is None:
-        raise ConditionError("not a KRL expression")
+    try:
+        expr = X.parse(text, max_tokens=MAX_RULE_TOKENS, path="<rule>")
+    except X.ExpressionError as exc:
+        raise ConditionError(exc.message, exc.column) from None
     check_subset(expr)
     return expr
 
@@ -146,49 +144,62 @@ def names_of(expr: N.Expr) -> list[str]:
     return list(dict.fromkeys(out))
 
 
-# ------------------------------------------------------------------ evaluation on the AST
-def _reader(base: str, first: int, last: int | None) -> tuple[Eval, str]:
+# ------------------------------------------------------------------ evaluation (the front end's)
+def _reader(io_of: Callable[[], IOImage], base: str, first: int, last: int | None) -> X.Reader:
+    """A reader of input or output `first` (to `last`: a group, an INT with bit 0 on
+    `first`) of the signal array `base` in the I/O image ``io_of()``."""
     if base == "$ANIN":
-        return (lambda io: io.get_anin(first)), "REAL"
+        return lambda: io_of().get_anin(first)
     if base == "$ANOUT":
-        return (lambda io: io.get_anout(first)), "REAL"
+        return lambda: io_of().get_anout(first)
     get = "get_in" if base == "$IN" else "get_out"
     if last is None:
-        return (lambda io: getattr(io, get)(first)), "BOOL"
+        return lambda: getattr(io_of(), get)(first)
     bits = range(first, last + 1)
 
-    def group(io: IOImage) -> int:
-        g = getattr(io, get)
+    def group() -> int:
+        g = getattr(io_of(), get)
         return sum(1 << i for i, n in enumerate(bits) if g(n))
-    return group, "INT"
+    return group
+
+
+class _IOEnv(X.Env):
+    """What a rule condition reads (krl.semantics.expression.Env): the signal arrays with a
+    constant index and the SIGNAL names `signals` gives, from the I/O image of the cycle."""
+
+    def __init__(self, signals: dict[str, tuple[str, int, int | None]]) -> None:
+        self.signals = signals
+        self.io: IOImage | None = None
+
+    def refuse(self, node: N.Node, what: str):
+        raise ConditionError(f"{what} is not allowed in a rule condition", _col(node))
+
+    def name(self, node: N.Name) -> X.Reader:
+        key = node.name.upper()
+        if key in SIGNAL_ARRAYS:
+            return lambda: None          # the array of an element read (:meth:`index`)
+        base, first, last = self.signals[key]
+        return _reader(lambda: self.io, base, first, last)
+
+    def index(self, node: N.Index, base: X.Reader, indices: list) -> X.Reader:
+        array, n = _signal_index(node)
+        return _reader(lambda: self.io, array, n, None)
 
 
 def compile_condition(expr: N.Expr, lookup: Lookup) -> Eval:
-    """A function of the I/O image giving the condition's BOOL value, built once from the AST.
+    """A function of the I/O image giving the condition's BOOL value, compiled once from the
+    AST by the front end's evaluator (krl/semantics/expression.py) after its checker typed it.
 
     `lookup(NAME)` resolves a SIGNAL name to ``(base, first, last)`` (interp/run.py
-    ``signal_of``). Raises :class:`ConditionError` for an unknown name, or operands of the
-    wrong type (``AND`` of an INT, a comparison of BOOL and REAL, a condition that is not BOOL)."""
-    fn, typ = _compile(expr, lookup)
-    if typ != "BOOL":
-        raise ConditionError(f"the condition is {typ}, not BOOL", _col(expr))
-    return fn
-
-
-def _compile(e: N.Expr, lookup: Lookup) -> tuple[Eval, str]:
-    if isinstance(e, N.BoolLit):
-        v = bool(e.value)
-        return (lambda io: v), "BOOL"
-    if isinstance(e, N.IntLit):
-        i = int(e.value)
-        return (lambda io: i), "INT"
-    if isinstance(e, N.RealLit):
-        r = float(e.value)
-        return (lambda io: r), "REAL"
-    if isinstance(e, N.Index):
-        base, n = _signal_index(e)
-        return _reader(base, n, None)
-    if isinstance(e, N.Name):
+    ``signal_of``). Raises :class:`ConditionError` for an unknown name, operands of the wrong
+    type (the checker's message: ``'AND' cannot be applied to BOOL and INT``) or a condition
+    that is not BOOL."""
+    system = system_scopes()[0]
+    scope = Scope("rule", "<rule>", system)
+    signals: dict[str, tuple[str, int, int | None]] = {}
+    for e in expr.walk():
+        if not isinstance(e, N.Name) or e.name.upper() in SIGNAL_ARRAYS or e.name.upper() in signals:
+            continue
         found = lookup(e.name.upper())
         if found is None:
             raise ConditionError(f"unknown signal {e.name.upper()} (neither $IN/$OUT/$ANIN/$ANOUT[n] nor "
@@ -197,42 +208,22 @@ def _compile(e: N.Expr, lookup: Lookup) -> tuple[Eval, str]:
         base, first, last = found
         if base not in SIGNAL_ARRAYS:
             raise ConditionError(f"{e.name.upper()} is a SIGNAL on {base}, not on an input or output", _col(e))
-        return _reader(base, first, last)
-    if isinstance(e, N.Unary):
-        f, t = _compile(e.operand, lookup)
-        if e.op == "NOT":
-            if t != "BOOL":
-                raise ConditionError(f"NOT needs a BOOL operand, not {t}", _col(e))
-            return (lambda io: not f(io)), "BOOL"
-        if t == "BOOL":
-            raise ConditionError(f"{e.op} needs a number, not BOOL", _col(e))
-        return ((lambda io: -f(io)) if e.op == "-" else f), t
-    if isinstance(e, N.Binary):
-        fl, tl = _compile(e.left, lookup)
-        fr, tr = _compile(e.right, lookup)
-        if e.op in BOOL_OPS:
-            if tl != "BOOL" or tr != "BOOL":
-                raise ConditionError(f"{e.op} needs BOOL operands, not {tl} and {tr}", _col(e))
-            if e.op == "AND":
-                return (lambda io: fl(io) and fr(io)), "BOOL"
-            if e.op == "OR":
-                return (lambda io: fl(io) or fr(io)), "BOOL"
-            return (lambda io: bool(fl(io)) != bool(fr(io))), "BOOL"
-        if (tl == "BOOL") != (tr == "BOOL") or (tl == "BOOL" and e.op not in ("==", "<>")):
-            raise ConditionError(f"{e.op} cannot compare {tl} with {tr}", _col(e))
-        op = e.op
-        if op == "==":
-            return (lambda io: fl(io) == fr(io)), "BOOL"
-        if op == "<>":
-            return (lambda io: fl(io) != fr(io)), "BOOL"
-        if op == "<":
-            return (lambda io: fl(io) < fr(io)), "BOOL"
-        if op == ">":
-            return (lambda io: fl(io) > fr(io)), "BOOL"
-        if op == "<=":
-            return (lambda io: fl(io) <= fr(io)), "BOOL"
-        return (lambda io: fl(io) >= fr(io)), "BOOL"
-    raise ConditionError("not allowed in a rule condition", _col(e))   # check_subset ran first
+        signals[e.name.upper()] = found
+        typ = T.REAL if base in ("$ANIN", "$ANOUT") else (T.INT if last is not None else T.BOOL)
+        scope.define("values", Symbol(e.name, "signal", typ, "rule"))
+    try:
+        typ = X.check(expr, scope)
+    except X.ExpressionError as exc:
+        raise ConditionError(exc.message, exc.column) from None
+    if typ != T.BOOL:
+        raise ConditionError(f"the condition is {typ}, not BOOL", _col(expr))
+    env = _IOEnv(signals)
+    read = X.compile_expression(expr, env)
+
+    def condition(io: IOImage):
+        env.io = io
+        return read()
+    return condition
 
 
 @dataclass

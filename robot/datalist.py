@@ -4,8 +4,9 @@ Used for a backup's machine data (``R1/Mada/$machine.dat``, ``$robcor.dat``): th
 parsed by krl/syntax and built into the AST by krl/ast; every declaration's initialiser and
 every array element line (``$SOFTP_END[3]=168.0``) is evaluated from the AST. Only literal
 values are allowed there, as in any data list: numbers, booleans, strings, enumeration
-values (``#STANDARD``), a sign before a number, and aggregates (``{X 0.0, Y 0.0}``). No text
-is evaluated and nothing is parsed twice.
+values (``#STANDARD``), a sign before a number, and aggregates (``{X 0.0, Y 0.0}``), evaluated
+by the front end's evaluator (krl/semantics/expression.py). No text is evaluated and nothing is
+parsed twice.
 
 :func:`read_data_list` returns ``name -> DataValue`` (upper-case names). A value is a Python
 scalar, a dict (an aggregate, component names upper-case) or, for an array, a dict
@@ -20,6 +21,8 @@ from typing import Any
 
 from krl.ast import nodes as N
 from krl.limits import MAX_FILE_BYTES
+from krl.semantics import expression as X
+from krl.semantics.values import KrlRuntimeError
 
 
 class DataListError(ValueError):
@@ -43,24 +46,33 @@ class DataValue:
         return f"{self.file}:{line}"
 
 
+class _LiteralEnv(X.Env):
+    """A data list's initialiser reads no variable (krl.semantics.expression.Env): literals,
+    signs and aggregates only; enumeration values as ``"#NAME"``."""
+
+    def __init__(self, where: str) -> None:
+        self.where = where
+
+    def refuse(self, node: N.Node, what: str):
+        raise DataListError(f"{self.where}: only literal values are allowed in a data list ({what})")
+
+    def enum(self, node: N.EnumLit) -> X.Reader:
+        v = "#" + node.name.lstrip("#").upper()
+        return lambda: v
+
+
 def literal(e: N.Expr, where: str) -> Any:
-    """The value of a literal initialiser ``e`` (reference §2.5: only literals in a data list).
+    """The value of a literal initialiser ``e`` (reference §2.5: only literals in a data list),
+    by the front end's evaluator (krl/semantics/expression.py).
 
     Returns int, float, bool, str, ``"#NAME"`` for an enumeration value, or a dict for an
-    aggregate (component names upper-case). Raises :class:`DataListError` for anything else.
+    aggregate (component names upper-case). Raises :class:`DataListError` for anything else,
+    or for an operator that fails (a sign before a value that is not a number).
     """
-    if isinstance(e, (N.IntLit, N.RealLit, N.BoolLit, N.StrLit)):
-        return e.value
-    if isinstance(e, N.EnumLit):
-        return "#" + e.name.lstrip("#").upper()
-    if isinstance(e, N.Unary) and e.op in ("-", "+"):
-        v = literal(e.operand, where)
-        if isinstance(v, bool) or not isinstance(v, (int, float)):
-            raise DataListError(f"{where}: a sign before a value that is not a number")
-        return -v if e.op == "-" else v
-    if isinstance(e, N.Aggregate):
-        return {item.name.upper(): literal(item.value, where) for item in e.items}
-    raise DataListError(f"{where}: only literal values are allowed in a data list")
+    try:
+        return X.evaluate(e, _LiteralEnv(where))
+    except KrlRuntimeError as exc:
+        raise DataListError(f"{where}: {exc.message}") from None
 
 
 def read_data_list(path: str | Path, shown: str | None = None) -> dict[str, DataValue]:

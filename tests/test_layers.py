@@ -1,12 +1,22 @@
 """The import contract of docs/architecture.md ("Packages and layers") is the code's.
 
-The table of that section lists each package and the packages it may import; the list of
-interp's layers orders interp's parts. `.importlinter` is generated from both (one forbidden
-contract per package, direct imports; one layers contract for interp), and:
+The table of that section lists each package, the packages of the project it imports itself
+(``imports``) and the third-party packages it imports itself (``external``); the list of
+interp's layers orders interp's parts. `.importlinter` is generated from both:
+
+* one forbidden contract per package: every package of the project that its ``imports`` do not
+  reach, directly or through the packages they import (no ``allow_indirect_imports``);
+* one protected contract per third-party package: only the packages whose row names it may
+  import it (``antlr4``: only ``krl.syntax`` and ``krl.ast``);
+* one layers contract for interp.
+
+And:
 
 * the checked-in `.importlinter` must be exactly what the documentation generates (a stale
   file fails: ``python tests/test_layers.py --write`` regenerates it);
-* `lint-imports` (import-linter) must keep every contract on the code as it is.
+* each row is what its package imports, no more and no less (the import graph, grimp);
+* `lint-imports` (import-linter) must keep every contract on the code as it is, and the
+  antlr4 contract fails on an import of ANTLR outside krl/syntax and krl/ast.
 """
 
 from __future__ import annotations
@@ -19,7 +29,10 @@ from pathlib import Path
 REPO = Path(__file__).resolve().parents[1]
 DOC = REPO / "docs" / "architecture.md"
 CONFIG = REPO / ".importlinter"
-ROOTS = ("krl", "interp", "robot", "recovery", "conformance")
+ROOTS = ("krl", "interp", "robot", "recovery", "conformance", "net")
+#: the generated parser's own fallback import (``from KRLParser import KRLParser`` when the
+#: generated visitor is run as a script): not a package anyone installs
+GENERATED_SELF_IMPORTS = {"KRLParser"}
 
 
 def _between(text: str, name: str) -> list[str]:
@@ -30,40 +43,109 @@ def _between(text: str, name: str) -> list[str]:
 
 
 def documented() -> tuple[dict[str, list[str]], list[list[str]]]:
-    """({package: packages it may import}, interp's layers top to bottom) from the doc."""
+    """({package: packages of the project it imports}, interp's layers top to bottom) from the
+    doc; ``["*"]`` for the row that may import every package."""
+    allowed, _external, layers = documented_all()
+    return allowed, layers
+
+
+def documented_all() -> tuple[dict[str, list[str]], dict[str, list[str]], list[list[str]]]:
+    """({package: project packages it imports}, {package: third-party packages it imports},
+    interp's layers) from the doc."""
     text = DOC.read_text(encoding="utf-8")
     allowed: dict[str, list[str]] = {}
+    external: dict[str, list[str]] = {}
     for row in _between(text, "layers")[2:]:            # header and rule first
         cells = [c.strip() for c in row.strip().strip("|").split("|")]
         package = cells[0].strip("`")
         allowed[package] = ["*"] if cells[2] == "every package" else re.findall(r"`([\w.]+)`", cells[2])
+        external[package] = re.findall(r"`([\w.]+)`", cells[3]) if len(cells) > 3 else []
     layers = [re.findall(r"[\w.]+", ln.lstrip("- ").replace("`", "")) for ln in _between(text, "interp-layers")]
-    return allowed, layers
+    return allowed, external, layers
+
+
+def reach(allowed: dict[str, list[str]], package: str) -> set[str]:
+    """The packages `package` may use: its ``imports``, and theirs, transitively."""
+    seen: set[str] = set()
+    work = [q for q in allowed[package] if q != "*"]
+    while work:
+        q = work.pop()
+        if q not in seen:
+            seen.add(q)
+            work.extend(x for x in allowed[q] if x != "*")
+    return seen
 
 
 def generate() -> str:
     """The text of `.importlinter` that the documentation defines."""
-    allowed, layers = documented()
+    allowed, external, layers = documented_all()
     packages = list(allowed)
     out = ["# Generated from docs/architecture.md (\"Packages and layers\") by",
            "# python tests/test_layers.py --write; tests/test_layers.py keeps the two equal.",
            "[importlinter]",
-           "root_packages =", *(f"    {r}" for r in ROOTS), ""]
+           "root_packages =", *(f"    {r}" for r in ROOTS),
+           "include_external_packages = True", ""]
     for package in packages:
         if allowed[package] == ["*"]:
             continue
-        forbidden = [p for p in packages if p != package and p not in allowed[package]]
+        may = reach(allowed, package)
+        forbidden = [p for p in packages if p != package and p not in may]
         out += [f"[importlinter:contract:{package}]",
-                f"name = {package} imports only " + (", ".join(allowed[package]) or "no package of the project"),
+                f"name = {package} imports only " + (", ".join(allowed[package]) or "no package of the project")
+                + " (and what they import)",
                 "type = forbidden",
                 f"source_modules = {package}",
-                "forbidden_modules =", *(f"    {p}" for p in forbidden),
-                "allow_indirect_imports = True", ""]
+                "forbidden_modules =", *(f"    {p}" for p in forbidden), ""]
+    importers: dict[str, list[str]] = {}
+    for package in packages:
+        for ext in external[package]:
+            importers.setdefault(ext, []).append(package)
+    for ext in sorted(importers):
+        out += [f"[importlinter:contract:external-{ext}]",
+                f"name = only {', '.join(importers[ext])} import {ext}",
+                "type = protected",
+                f"protected_modules = {ext}",
+                "allowed_importers =", *(f"    {p}" for p in importers[ext]), ""]
     out += ["[importlinter:contract:interp-layers]",
             "name = interp's layers",
             "type = layers",
             "layers =", *(f"    {' | '.join(group)}" for group in layers), ""]
     return "\n".join(out)
+
+
+def _graph():
+    import grimp  # noqa: PLC0415 - only these tests build the graph
+
+    return grimp.build_graph(*ROOTS, include_external_packages=True, cache_dir=None)
+
+
+def _owner(module: str, packages: list[str]) -> str | None:
+    best = None
+    for p in packages:
+        if (module == p or module.startswith(p + ".")) and (best is None or len(p) > len(best)):
+            best = p
+    return best
+
+
+def used(graph, packages: list[str]) -> tuple[dict[str, set[str]], dict[str, set[str]]]:
+    """({package: project packages it imports}, {package: third-party packages it imports})
+    from the import graph (module-level and function-level imports alike)."""
+    std = set(sys.stdlib_module_names) | {"__future__"}
+    direct: dict[str, set[str]] = {p: set() for p in packages}
+    external: dict[str, set[str]] = {p: set() for p in packages}
+    for m in graph.modules:
+        owner = _owner(m, packages)
+        if owner is None:
+            continue
+        for imp in graph.find_modules_directly_imported_by(m):
+            other = _owner(imp, packages)
+            top = imp.split(".")[0]
+            if other is not None:
+                if other != owner:
+                    direct[owner].add(other)
+            elif top not in ROOTS and top not in std and top not in GENERATED_SELF_IMPORTS:
+                external[owner].add(top)
+    return direct, external
 
 
 def test_documented_imports_form_layers():
@@ -108,6 +190,43 @@ def test_every_package_of_the_project_is_in_the_table():
 def test_importlinter_file_is_generated_from_the_doc():
     assert CONFIG.read_text(encoding="utf-8") == generate(), \
         ".importlinter is stale: run python tests/test_layers.py --write"
+    assert "allow_indirect_imports" not in CONFIG.read_text(encoding="utf-8")
+
+
+def test_each_row_is_what_its_package_imports():
+    """No allow-list wider or narrower than the code: the table's ``imports`` and ``external``
+    are exactly the packages each package imports itself."""
+    allowed, external, _ = documented_all()
+    packages = list(allowed)
+    direct, ext = used(_graph(), packages)
+    for p in packages:
+        if allowed[p] != ["*"]:
+            assert direct[p] == set(allowed[p]), \
+                f"{p}: imports {sorted(direct[p])}, the table says {sorted(allowed[p])}"
+        assert ext[p] == set(external[p]), f"{p}: imports {sorted(ext[p])}, the table says {sorted(external[p])}"
+
+
+def test_antlr4_only_in_syntax_and_ast():
+    """ANTLR is contained: only krl.syntax and krl.ast import antlr4, and the protected
+    contract generated for it fails when any other module imports it."""
+    from importlinter.contracts.protected import ProtectedContract  # noqa: PLC0415
+
+    graph = _graph()
+    importers = {m for m in graph.find_modules_that_directly_import("antlr4")}
+    assert importers and all(m.startswith(("krl.syntax.", "krl.ast.")) for m in importers), sorted(importers)
+    assert "[importlinter:contract:external-antlr4]\nname = only krl.syntax, krl.ast import antlr4\n" \
+           "type = protected\nprotected_modules = antlr4\nallowed_importers =\n    krl.syntax\n    krl.ast\n" \
+        in generate()
+
+    def check() -> bool:
+        contract = ProtectedContract(name="antlr4", session_options={"root_packages": list(ROOTS)},
+                                     contract_options={"protected_modules": ["antlr4"],
+                                                       "allowed_importers": ["krl.syntax", "krl.ast"]})
+        return contract.check(graph, verbose=False).kept
+
+    assert check()
+    graph.add_import(importer="krl.fmt.core", imported="antlr4", line_number=1, line_contents="import antlr4")
+    assert not check()
 
 
 def test_lint_imports_keeps_the_contract():

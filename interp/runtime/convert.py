@@ -1,80 +1,29 @@
-"""Conversions and operator semantics (reference §3.9, §4.1, §4.3).
+"""Conversions and the geometric operator (reference §3.9, §4.3).
 
-* INT is 32-bit: a result outside -2^31..2^31-1 is the run-time error "INT overflow"
-  (the reference leaves wrap vs. error open and recommends the error).
-* ``INT / INT`` truncates toward zero (7/2 = 3, -7/2 = -3); division by zero is an error.
-* REAL -> INT rounds to the nearest integer, ties away from zero (5 + 10.6 -> 16,
-  2.5 -> 3, -2.5 -> -3); ``ROUNDING`` can be switched to "trunc".
-* CHAR <-> INT use the character code; CHAR takes part in arithmetic and comparisons as
-  its code.
-* No short circuit: the interpreter evaluates both operands, then calls :func:`binary_op`.
-* ``:`` composes frames (``T(A:B) = T(A)·T(B)``); the result has the right operand's type
-  and its S, T and external axes.
-* REAL is a Python float (double); results are not rounded to binary32.
+The scalar operators and conversions (INT range, INT division, REAL -> INT rounding, CHAR
+codes, comparisons, BOOL and bitwise operators) are the front end's, krl/semantics/values.py,
+one meaning for both interpreters, the compiler's folding and the front end's evaluator; this
+module adds what needs the runtime's structures and arrays:
+
+* :func:`convert_scalar`, :func:`assign_into`: assignment (§3.9; partial aggregates and
+  geometric relatives copy the components present);
+* :func:`binary_op`: the front end's operators, and ``:``, which composes frames
+  (``T(A:B) = T(A)·T(B)``); the result has the right operand's type and its S, T and external
+  axes.
 """
 
 from __future__ import annotations
 
-import math
-
 from krl.semantics import types as T
+from krl.semantics.values import INT_MAX, INT_MIN, KrlRuntimeError, UNSET, EnumValue, check_int, compare, num
+from krl.semantics.values import binary_op as _binary_op
+from krl.semantics.values import real_to_int, to_bool, trunc_int, unary_op, value_invalid
 
-from .errors import KrlRuntimeError, value_invalid
-from .values import UNSET, Arr, EnumValue, Struct, copy_value, make_value
+from .values import Arr, Struct, copy_value, make_value
 
-INT_MIN = -(2 ** 31)
-INT_MAX = 2 ** 31 - 1
-ROUNDING = "half_away"   # or "trunc" (reference §3.9 [U])
-
-
-def check_int(v: int) -> int:
-    if v < INT_MIN or v > INT_MAX:
-        shown = v if v.bit_length() <= 128 else ("a huge negative number" if v < 0 else "a huge number")
-        raise KrlRuntimeError(f"INT overflow ({shown} outside -2147483648..2147483647)")
-    return v
-
-
-def real_to_int(x: float) -> int:
-    """REAL -> INT: nearest integer, ties away from zero (or truncation, see ROUNDING)."""
-    if math.isnan(x) or math.isinf(x):
-        raise KrlRuntimeError("REAL value cannot be converted to INT")
-    if ROUNDING == "trunc":
-        return check_int(int(x))
-    r = math.floor(abs(x) + 0.5)
-    return check_int(int(r if x >= 0 else -r))
-
-
-def trunc_int(v, what: str = "operand") -> int:
-    """``int(num(v))``: a REAL truncated toward zero, as interrupt numbers, S/T, TRIGGER
-    DISTANCE/PRIO and SWRITE's %c take it; a NaN or infinite REAL is the run-time error
-    "REAL value cannot be converted to INT", a REAL past the INT range "INT overflow", never a
-    Python exception or a huge Python int."""
-    x = num(v, what)
-    if x.__class__ is float and not math.isfinite(x):
-        raise KrlRuntimeError(f"{what}: REAL value cannot be converted to INT")
-    return check_int(int(x))
-
-
-def num(v, what: str = "operand"):
-    """A numeric operand: INT, REAL, or a CHAR as its code."""
-    if v.__class__ is int or v.__class__ is float:
-        return v
-    if isinstance(v, str) and len(v) == 1:
-        return ord(v)
-    if v is UNSET:
-        raise value_invalid()
-    if isinstance(v, bool):
-        raise KrlRuntimeError(f"BOOL {what} where a number is needed")
-    raise KrlRuntimeError(f"{what} is not a number: {v!r}")
-
-
-def to_bool(v, what: str = "condition") -> bool:
-    if v is True or v is False:
-        return v
-    if v is UNSET:
-        raise value_invalid()
-    raise KrlRuntimeError(f"{what} is not BOOL: {v!r}")
-
+__all__ = ["INT_MAX", "INT_MIN", "assign_chars", "assign_into", "binary_op", "check_int", "compare",
+           "convert_scalar", "frame_tuple", "geo_compose", "inv_pos", "num", "real_to_int",
+           "struct_from_frame", "to_bool", "trunc_int", "unary_op"]
 
 def convert_scalar(v, t):
     """Convert ``v`` for storage in a leaf of simple/enum type ``t`` (assignment, §3.9)."""
@@ -189,114 +138,15 @@ def assign_into(dest, v) -> None:
     raise KrlRuntimeError("assignment to a non-aggregate")
 
 
-# ------------------------------------------------------------------ operators (§4.1)
-
-_ARITH = {"+", "-", "*", "/"}
-_CMP = {"==", "<>", "<", ">", "<=", ">="}
-
-
-def _wrap32(v: int) -> int:
-    v &= 0xFFFFFFFF
-    return v - (1 << 32) if v & 0x80000000 else v
-
+# ------------------------------------------------------------------ operators (§4.1, §4.3)
 
 def binary_op(op: str, a, b):
-    """Apply binary operator ``op`` (upper-case, as in the AST) to two values."""
-    if op in _ARITH:
-        x = num(a)
-        y = num(b)
-        if x.__class__ is int and y.__class__ is int:
-            if op == "+":
-                return check_int(x + y)
-            if op == "-":
-                return check_int(x - y)
-            if op == "*":
-                return check_int(x * y)
-            if y == 0:
-                raise KrlRuntimeError("division by zero")
-            q = abs(x) // abs(y)
-            return check_int(q if (x >= 0) == (y >= 0) else -q)
-        if op == "+":
-            return float(x + y)
-        if op == "-":
-            return float(x - y)
-        if op == "*":
-            return float(x * y)
-        if y == 0:
-            raise KrlRuntimeError("division by zero")
-        return x / y
-    if op in _CMP:
-        return compare(op, a, b)
-    if op in ("AND", "OR", "EXOR"):
-        if (a is True or a is False) and (b is True or b is False):
-            if op == "AND":
-                return a and b
-            if op == "OR":
-                return a or b
-            return a != b
-        op = "B_" + op  # INT operands: the bitwise meaning (lenient)
-    if op in ("B_AND", "B_OR", "B_EXOR"):
-        x, y = num(a), num(b)
-        if x.__class__ is not int or y.__class__ is not int:
-            raise KrlRuntimeError(f"{op} needs INT operands")
-        if op == "B_AND":
-            return _wrap32(x & y)
-        if op == "B_OR":
-            return _wrap32(x | y)
-        return _wrap32(x ^ y)
+    """Apply binary operator ``op`` (upper-case, as in the AST) to two values: ``:`` composes
+    frames (:func:`geo_compose`), every other operator is the front end's
+    (krl.semantics.values.binary_op)."""
     if op == ":":
         return geo_compose(a, b)
-    raise KrlRuntimeError(f"unknown operator {op}")
-
-
-def compare(op: str, a, b) -> bool:
-    if a is UNSET or b is UNSET:
-        raise value_invalid()
-    if isinstance(a, EnumValue) or isinstance(b, EnumValue):
-        if op == "==":
-            return a == b
-        if op == "<>":
-            return a != b
-        raise KrlRuntimeError("enum values have no order")
-    if (a is True or a is False) or (b is True or b is False):
-        if (a is True or a is False) and (b is True or b is False):
-            if op == "==":
-                return a == b
-            if op == "<>":
-                return a != b
-        raise KrlRuntimeError(f"cannot compare {a!r} {op} {b!r}")
-    x, y = num(a), num(b)
-    if op == "==":
-        return x == y
-    if op == "<>":
-        return x != y
-    if op == "<":
-        return x < y
-    if op == ">":
-        return x > y
-    if op == "<=":
-        return x <= y
-    return x >= y
-
-
-def unary_op(op: str, a):
-    if op == "-":
-        x = num(a)
-        return check_int(-x) if x.__class__ is int else -x
-    if op == "+":
-        return num(a)
-    if op == "NOT":
-        if a is True or a is False:
-            return not a
-        if a.__class__ is int:
-            return _wrap32(~a)
-        raise KrlRuntimeError("NOT needs a BOOL operand")
-    if op == "B_NOT":
-        x = num(a)
-        if x.__class__ is not int:
-            raise KrlRuntimeError("B_NOT needs an INT operand")
-        return _wrap32(~x)
-    raise KrlRuntimeError(f"unknown operator {op}")
+    return _binary_op(op, a, b)
 
 
 # ------------------------------------------------------------------ geometry (§4.3)

@@ -12,11 +12,13 @@ from dataclasses import dataclass
 
 from krl.ast import nodes as N
 from krl.limits import MAX_CALL_DEPTH
+from krl.semantics import expression as X
 from krl.semantics import types as T
 from krl.semantics.advance import StmtInfo
 from krl.semantics.resolve import Callee, Storage
 
 from .builtins import NATIVES, ValueRef, call_builtin
+from .netfunctions import RSI_CONSTANTS
 from .contexts import Context, Irq
 from .convert import assign_into, binary_op, convert_scalar, to_bool, trunc_int, unary_op
 from .errors import (HaltSignal, KrlRuntimeError, ResumeSignal, StopRun)
@@ -169,6 +171,9 @@ class Runtime:
             self.scheduler.run()
         finally:
             sys.setrecursionlimit(old)
+            net = getattr(self.controller, "network", None)
+            if net is not None:
+                net.close()
         robot = self.robot
         stop = self.scheduler.stop
         if stop is not None:
@@ -394,6 +399,8 @@ class Runtime:
             r = self.sysvars.lookup(key)
             if r is not None:
                 return r
+        elif key in RSI_CONSTANTS:      # RSI's constants (RSIOK, ...): the option declares them
+            return ValueRef(RSI_CONSTANTS[key], key)
         raise KrlRuntimeError(f"unknown name {name}")
 
     def index(self, base: Ref, idx: list, name: str) -> Ref:
@@ -685,44 +692,47 @@ class Runtime:
         return convert_scalar(value, t)
 
     def ref_from_text(self, text: str):
-        """The reference named by a string such as ``"P[2].X"`` (VARSTATE), or None. The
-        name is looked up in the scopes the front end built for the running routine
-        (``Layout.scope``, the checker's), and placed by the resolver's rules: the text is a
-        run-time value, so this is the one lookup that happens while the program runs,
-        besides the ``$``-name fallback."""
-        import re  # noqa: PLC0415
-
+        """The reference named by a string such as ``"P[2].X"`` (VARSTATE), or None. The text
+        is read by the front end's expression API (krl/semantics/expression.py): a name with
+        constant indices and components, placed by the resolver's rules in the scopes the
+        front end built for the running routine (``Layout.scope``, the checker's). The text
+        is a run-time value, so this is the one name lookup that happens while the program
+        runs, besides the ``$``-name fallback."""
         task = self.current_task
         frame = getattr(task, "frame", None)
-        m = re.match(r"\s*(\$?[A-Za-z_][\w$]*)(.*)$", text)
-        if not m or frame is None or frame.layout is None:
+        if frame is None or frame.layout is None:
             return None
-        name = m.group(1)
+        try:
+            expr = X.parse(text)
+        except X.ExpressionError:
+            return None
+        chain = []
+        e = expr
+        while isinstance(e, (N.Index, N.Field)):
+            chain.append(e)
+            e = e.base
+        if not isinstance(e, N.Name):
+            return None
         layout = frame.layout
         resolver = self.program.ws.resolver
-        sym = layout.scope.lookup(name) if layout.scope is not None else None
-        local = {id(s.symbol) if s.symbol is not None else s.name.upper(): k for k, s in enumerate(layout.slots)}
+        sym = layout.scope.lookup(e.name) if layout.scope is not None else None
         try:
-            ref = self.storage_ref(resolver.storage(name, sym, local, layout.owner), frame)
+            ref = self.storage_ref(resolver.storage(e.name, sym, resolver.locals_of(layout), layout.owner), frame)
         except KrlRuntimeError:
             return None
-        rest = m.group(2).strip()
-        while rest:
-            if rest.startswith("["):
-                j = rest.find("]")
-                parts = [x.strip() for x in rest[1:j].split(",")] if j > 0 else None
-                if parts is None or not all(x == "" or re.fullmatch(r"-?[0-9]{1,10}", x) for x in parts):
-                    return None     # no closing bracket, or an index that is not an INT literal
-                ref = index_ref(ref, [int(x) if x else None for x in parts], name)
-                rest = rest[j + 1:].strip()
-            elif rest.startswith("."):
-                mm = re.match(r"\.\s*([A-Za-z_][A-Za-z0-9_$]*)", rest)
-                if mm is None:
-                    return None
-                ref = field_ref(ref, mm.group(1), name)
-                rest = rest[mm.end():].strip()
-            else:
-                return None
+        for part in reversed(chain):
+            if isinstance(part, N.Field):
+                ref = field_ref(ref, part.name, e.name)
+                continue
+            idx = []
+            for i in part.indices:
+                if i is None or isinstance(i, N.IntLit):
+                    idx.append(None if i is None else i.value)
+                elif isinstance(i, N.Unary) and i.op == "-" and isinstance(i.operand, N.IntLit):
+                    idx.append(-i.operand.value)
+                else:
+                    return None     # an index that is not an INT literal
+            ref = index_ref(ref, idx, e.name)
         return ref
 
     # ================================================================== errors ($ERR)
@@ -1053,6 +1063,15 @@ class Runtime:
             if self.trace is not None:
                 self.trace.write("interrupt", ctl.time, prio=irq.number, name=irq.name,
                                  line=task.line, phase="exit")
+        if ok and task.irqs.armed and not task.in_poll:
+            # the conditions are monitored while the handler runs: what it leaves (a timer it
+            # restarted, a flag it reset) is sampled at its end, so the next rising edge counts
+            # (ROS-Industrial's EKI state timer: `$TIMER[1] = -10` in its own handler)
+            task.in_poll = True
+            try:
+                task.irqs.poll()
+            finally:
+                task.in_poll = False
         if ok and task.kind == "robot":
             ctl.release()
 

@@ -1,8 +1,10 @@
 """Run-time errors of KRL programs (reference §8).
 
-:class:`KrlRuntimeError` carries the KRL message, the KSS message number where the
-reference gives one (1422 "value invalid", 1430 "interrupt not declared") and the place
-(file, line) — filled in by :meth:`KrlRuntimeError.at` when the error crosses a statement.
+:class:`KrlRuntimeError` (the front end's, krl/semantics/values.py: the operators raise it
+too) carries the KRL message, the KSS message number where the reference gives one (1422
+"value invalid", 1430 "interrupt not declared") and the place (file, line) — filled in by
+:meth:`KrlRuntimeError.at` when the error crosses a statement. :class:`ResourceError` is the
+error of a resource limit.
 
 The control-flow signals (:class:`GotoSignal`, :class:`ExitSignal`, :class:`ReturnSignal`,
 :class:`ResumeSignal`, :class:`HaltSignal`, :class:`StopRun`) are exceptions too: the tree
@@ -11,44 +13,12 @@ interpreter unwinds with them, as the paper describes; the VM uses the last thre
 
 from __future__ import annotations
 
-VALUE_INVALID = 1422
-INTERRUPT_NOT_DECLARED = 1430
-
-
-class KrlRuntimeError(Exception):
-    """A KRL run-time error: ``message``, ``number`` (or None), ``file``, ``line``."""
-
-    def __init__(self, message: str, number: int | None = None, file: str | None = None,
-                 line: int | None = None) -> None:
-        super().__init__(message)
-        self.message = message
-        self.number = number
-        self.file = file
-        self.line = line
-        # True when the trace already holds this error's `error` event (a main-run fault,
-        # written by the controller with its motion id): the run does not write it again
-        self.traced = False
-        self.debug_seen = False     # a debugger stopped at it already (Runtime.error_hook)
-
-    def at(self, file: str | None, line: int | None) -> "KrlRuntimeError":
-        """Set the place if it is not set yet (the innermost statement wins); returns self."""
-        if self.line is None:
-            self.file, self.line = file, line
-        return self
-
-    def __str__(self) -> str:
-        where = f"{self.file}:{self.line}: " if self.line is not None else ""
-        num = f" ({self.number})" if self.number is not None else ""
-        return f"{where}{self.message}{num}"
+from krl.semantics.values import INTERRUPT_NOT_DECLARED, VALUE_INVALID, KrlRuntimeError, value_invalid
 
 
 class ResourceError(KrlRuntimeError):
     """A run-time error for a resource limit of krl/limits.py (data memory, type nesting):
     loading a data list never skips it as it skips a bad initial value; it stops the run."""
-
-
-def value_invalid(what: str = "") -> KrlRuntimeError:
-    return KrlRuntimeError(f"value invalid{': ' + what if what else ''}", VALUE_INVALID)
 
 
 class ControlSignal(Exception):

@@ -32,12 +32,13 @@ from krl.ast import nodes as N
 from krl.diagnostics import SYNTAX_CODES
 from krl.project import project_of   # which files make the program: one rule
 from krl.semantics import types as T
+from krl.semantics.expression import Env, evaluate
 from krl.semantics.resolve import GLOBAL, LOCAL, MODULE, SYSTEM, Storage
 
 from .convert import assign_into, convert_scalar
 from .errors import KrlRuntimeError, ResourceError
 from .memory import Slot, SignalRef, index_ref
-from .values import UNSET, EnumValue, Struct, data_size, make_value
+from .values import UNSET, Struct, data_size, make_value
 
 BASIS_DIR = Path(__file__).resolve().parent.parent / "basis"
 
@@ -170,6 +171,7 @@ class Program:
         self.sysrefs: list = [None] * len(ws.system_names)
         self.stubs: set[str] = set()
         self.fatal: ResourceError | None = None   # a data list past a limit: the program cannot start
+        self._initialiser_env = _InitialiserEnv(self)
         self._syntax_errors()
         self._load_all()
 
@@ -421,32 +423,38 @@ class Program:
             raise KrlRuntimeError(f"unknown name {st.name}")
         return ref
 
-    def literal(self, e, t):
-        """Value of a data-list or CONST initialiser (literals, aggregates, a leading sign,
-        constants: a name's resolved storage)."""
-        if isinstance(e, (N.IntLit, N.RealLit, N.BoolLit, N.StrLit)):
-            return e.value
-        if isinstance(e, N.EnumLit):
-            return EnumValue(e.name)
-        if isinstance(e, N.Unary) and e.op in ("-", "+"):
-            v = self.literal(e.operand, t)
-            return -v if e.op == "-" else v
-        if isinstance(e, N.Aggregate):
-            st = e.ann.storage if e.ann is not None else None
-            out = Struct(st if isinstance(st, T.Struc) else None, {})
-            ft = t if isinstance(t, T.Struc) else st
-            for it in e.items:
-                sub_t = ft.fields.get(it.name.upper(), (None, None))[1] if isinstance(ft, T.Struc) else None
-                out.f[it.name.upper()] = self.literal(it.value, sub_t)
-            return out
-        if isinstance(e, N.Name):
-            st = e.ann.storage if e.ann is not None else None
-            if isinstance(st, Storage) and st.kind in (MODULE, GLOBAL):
-                return self.data_ref(st).get()
-            if isinstance(st, Storage) and st.kind == SYSTEM:
-                return self.rt.sysref(st).get()
-            raise KrlRuntimeError(f"unknown name {e.name} in a data list initialisation")
+    def literal(self, e, t=None):
+        """Value of a data-list or CONST initialiser: literals, aggregates, a leading sign and
+        constants (a name's resolved storage), by the front end's evaluator
+        (krl/semantics/expression.py) reading this program's data lists. `t`: the declared
+        type (the caller converts the value to it)."""
+        return evaluate(e, self._initialiser_env)
+
+
+class _InitialiserEnv(Env):
+    """What a data-list or CONST initialiser reads (krl.semantics.expression.Env): another
+    data list's variable or a system variable, by the storage the resolver gave the name;
+    an aggregate is a Struct of the STRUC its TYPE prefix names."""
+
+    def __init__(self, program: Program) -> None:
+        self.program = program
+
+    def refuse(self, node, what: str):
         raise KrlRuntimeError("only literal values are allowed in a data list")
+
+    def name(self, node: N.Name):
+        st = node.ann.storage if node.ann is not None else None
+        program = self.program
+        if isinstance(st, Storage) and st.kind in (MODULE, GLOBAL):
+            return lambda: program.data_ref(st).get()
+        if isinstance(st, Storage) and st.kind == SYSTEM:
+            return lambda: program.rt.sysref(st).get()
+        raise KrlRuntimeError(f"unknown name {node.name} in a data list initialisation")
+
+    def aggregate(self, node: N.Aggregate, items: list):
+        st = node.ann.storage if node.ann is not None else None
+        struc = st if isinstance(st, T.Struc) else None
+        return lambda: Struct(struc, {k: r() for k, r in items})
 
 
 def _has_unknown(t) -> bool:

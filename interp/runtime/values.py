@@ -5,7 +5,8 @@ Representation (shared by both interpreters):
 * INT -> ``int`` (32-bit range enforced by :mod:`convert`), REAL -> ``float``,
   BOOL -> ``bool``, CHAR -> a one-character ``str`` (code 0..255; arithmetic uses the code);
 * a string literal -> ``str``;
-* ENUM -> :class:`EnumValue` (compared by value name; the enum type comes from the context);
+* ENUM -> :class:`EnumValue` (compared by value name; the enum type comes from the context;
+  the front end's, krl/semantics/values.py, as :data:`UNSET`);
 * STRUC -> :class:`Struct`: ``type`` (a :class:`krl.semantics.types.Struc`, or None for an
   untyped aggregate) and ``f``, a dict UPPER component name -> value. An aggregate
   evaluates to a Struct holding only the components it names (a *partial* value,
@@ -20,40 +21,7 @@ Types are the front end's :mod:`krl.semantics.types` classes (Simple, Array, Str
 from __future__ import annotations
 
 from krl.semantics import types as T
-
-
-class _Unset:
-    __slots__ = ()
-
-    def __repr__(self) -> str:
-        return "UNSET"
-
-    def __bool__(self) -> bool:  # never used as a truth value by accident
-        raise TypeError("UNSET has no truth value")
-
-
-UNSET = _Unset()
-
-
-
-
-class EnumValue:
-    """``#NAME``: an enum value (name upper-case; ``type`` the Enum type if known)."""
-
-    __slots__ = ("name", "type")
-
-    def __init__(self, name: str, type_=None) -> None:
-        self.name = name.upper()
-        self.type = type_
-
-    def __eq__(self, other: object) -> bool:
-        return isinstance(other, EnumValue) and other.name == self.name
-
-    def __hash__(self) -> int:
-        return hash(("#", self.name))
-
-    def __repr__(self) -> str:
-        return f"#{self.name}"
+from krl.semantics.values import UNSET, EnumValue  # the front end's scalar values
 
 
 class Struct:

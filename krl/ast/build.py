@@ -1103,8 +1103,11 @@ def build_module(result, sink: DiagnosticSink | None = None) -> N.Module:
 
 def build_expression(tree, path: str, symbolic: list[str]) -> N.Expr | None:
     """The AST of an expression parse tree (:func:`krl.syntax.parse.parse_expression`), or None
-    when the tree is malformed. `symbolic`: the parser's token names. Never raises."""
+    when the tree is malformed or holds a construct the builder cannot build. `symbolic`: the
+    parser's token names. Never raises."""
+    sink = DiagnosticSink()
     try:
-        return Builder(path, DiagnosticSink(), symbolic, recovered=False).expr(tree)
+        expr = Builder(path, sink, symbolic, recovered=False).expr(tree)
     except BuildError:
         return None
+    return None if sink.items else expr

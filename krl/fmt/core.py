@@ -46,11 +46,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Literal
 
-from antlr4 import InputStream, ParserRuleContext
-from antlr4.Token import Token
-from antlr4.tree.Tree import TerminalNode
-
 from krl.syntax.parse import ParseResult, ParserBundle, default_bundle, keyword_types, parse_text
+from krl.syntax.tokens import DEFAULT_CHANNEL, EOF, is_rule, is_token_node, lex, rule_name
 
 __all__ = ["FormatOptions", "FormatError", "FormatSyntaxError", "FormatSafetyError", "format_text",
            "format_parsed"]
@@ -150,26 +147,19 @@ _WORDISH = frozenset("ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz012345
 _OPCHARS = frozenset("<>=")
 
 
-def _rule_name(ctx) -> str:
-    name = type(ctx).__name__
-    if name.endswith("Context"):
-        name = name[:-7]
-    return name[:1].lower() + name[1:]
-
-
 def _roles(tree) -> dict[int, str]:
     """token index -> role, for the tokens whose spacing depends on their place in the tree."""
     roles: dict[int, str] = {}
     stack = [tree]
     while stack:
         ctx = stack.pop()
-        rule = _rule_name(ctx)
+        rule = rule_name(ctx)
         kids = ctx.children or ()
         for i, c in enumerate(kids):
-            if isinstance(c, ParserRuleContext):
+            if is_rule(c):
                 stack.append(c)
                 continue
-            if not isinstance(c, TerminalNode):
+            if not is_token_node(c):
                 continue
             tok = c.symbol
             text = tok.text
@@ -331,8 +321,8 @@ def format_parsed(text: str, result: ParseResult, options: FormatOptions) -> str
         end = nl_tok.start if nl_tok is not None else len(text)
         raw = text[line_start:end]
         newline = nl_tok.text if nl_tok is not None else ""
-        code = [t for t in line_tokens if t.channel == Token.DEFAULT_CHANNEL]
-        hidden = [t for t in line_tokens if t.channel != Token.DEFAULT_CHANNEL]
+        code = [t for t in line_tokens if t.channel == DEFAULT_CHANNEL]
+        hidden = [t for t in line_tokens if t.channel != DEFAULT_CHANNEL]
         verbatim = verbatim_from > 0
         # block structure, from the line's first word (the file parses, so this is exact)
         first = sym[code[0].type] if code else ""
@@ -410,7 +400,7 @@ def format_parsed(text: str, result: ParseResult, options: FormatOptions) -> str
         line_start = nl_tok.stop + 1 if nl_tok is not None else len(text)
 
     for tok in tokens:
-        if tok.type == Token.EOF:
+        if tok.type == EOF:
             break
         if tok.type == NL:
             emit(line, tok)
@@ -466,7 +456,7 @@ def _place_comments(lines: list[list]) -> list[str]:
 def _signature(tokens, kw: frozenset[int]) -> list[tuple[int, str]]:
     out = []
     for tok in tokens:
-        if tok.type == Token.EOF:
+        if tok.type == EOF:
             break
         out.append((tok.type, tok.text.upper() if tok.type in kw else tok.text))
     return out
@@ -479,7 +469,5 @@ def _verify(tokens, before: str, after: str, bundle: ParserBundle) -> None:
     if before == after:
         return
     kw = keyword_types(bundle)
-    lexer = bundle.lexer_cls(InputStream(after))
-    lexer.removeErrorListeners()
-    if _signature(tokens, kw) != _signature(lexer.getAllTokens(), kw):
+    if _signature(tokens, kw) != _signature(lex(after, bundle), kw):
         raise FormatSafetyError("formatting would change the token stream; the text is left as it is")

@@ -53,18 +53,12 @@ def to_range(lines: list[str], line: int, column: int, length: int, codec=None) 
 
 @lru_cache(maxsize=8192)
 def _lex(line_text: str) -> tuple[Tok, ...]:
-    from antlr4 import InputStream  # noqa: PLC0415
-    from antlr4 import CommonTokenStream  # noqa: PLC0415
-
     from krl.syntax.parse import default_bundle  # noqa: PLC0415
+    from krl.syntax.tokens import lex  # noqa: PLC0415
 
     bundle = default_bundle()
-    lexer = bundle.lexer_cls(InputStream(line_text + "\n"))
-    lexer.removeErrorListeners()
-    stream = CommonTokenStream(lexer)
-    stream.fill()
     out: list[Tok] = []
-    for ln in lines_of(stream.tokens, bundle):
+    for ln in lines_of(lex(line_text + "\n", bundle), bundle):
         out.extend(ln.toks)
     return tuple(out)
 

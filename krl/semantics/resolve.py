@@ -217,14 +217,19 @@ class Resolver:
                 lay = _routine_layout(r, ws.routine_scope(r), i)
                 lay.returns = returns.get(id(r)) if r.kind == "DEFFCT" else None
                 r.annotate().storage = lay
-                local = {id(s.symbol) if s.symbol is not None else s.name.upper(): k
-                         for k, s in enumerate(lay.slots)}
+                local = self.locals_of(lay)
                 for d in r.decls:
                     if isinstance(d, N.VarDecl) and d.init is not None:
                         self.expr(d.init, scope, local, i)
                 self.block(r.body, scope, local, i)
 
     # ------------------------------------------------------------------ names
+    @staticmethod
+    def locals_of(layout: Layout) -> dict:
+        """The frame slots of a routine's `layout` by symbol (``id``), or by upper-case name
+        for a parameter without a declaration: what :meth:`storage` takes as ``local``."""
+        return {id(s.symbol) if s.symbol is not None else s.name.upper(): k for k, s in enumerate(layout.slots)}
+
     def import_target(self, d: N.ImportDecl) -> Symbol | None:
         """The data-list variable ``IMPORT type name IS /R1/module..var`` names (2.5): the
         module's own or exported declaration of that name (as Workspace._link_imports links

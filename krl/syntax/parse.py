@@ -297,10 +297,11 @@ class _FirstError(ErrorListener):
 
 
 def parse_expression(text: str, max_tokens: int, bundle: ParserBundle | None = None) -> ExpressionParse:
-    """Parse `text` as one KRL expression (grammar rule ``expression``, reference §4) — the
-    condition of a cell rule (robot/cellrules.py), never a statement. The text must be one
-    line; more than `max_tokens` tokens (krl/limits.py) is refused before parsing. Never
-    raises for bad input: the result's ``error`` gives the column and a message."""
+    """Parse `text` as one KRL expression (grammar rule ``expression``, reference §4), never a
+    statement: the front end's expression API (krl/semantics/expression.py). The text must
+    be one line; more than `max_tokens` tokens, or nesting and terms past krl/limits.py, are
+    refused before parsing. Never raises for bad input: the result's ``error`` gives the
+    column and a message."""
     bundle = bundle or default_bundle()
     if "\n" in text or "\r" in text:
         return ExpressionParse(None, (1, "an expression is one line"))
@@ -317,6 +318,9 @@ def parse_expression(text: str, max_tokens: int, bundle: ParserBundle | None = N
         return ExpressionParse(None, (1, "empty expression"))
     if len(visible) > max_tokens:
         return ExpressionParse(None, (1, f"{len(visible)} tokens, more than the limit of {max_tokens}"))
+    past = first_past_limit(tokens.tokens, bundle)       # nesting and terms, as in a program
+    if past is not None:
+        return ExpressionParse(None, (past.column or 1, past.message))
     parser = bundle.parser_cls(tokens)
     parser.removeErrorListeners()
     parser.addErrorListener(listener)
