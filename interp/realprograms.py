@@ -36,7 +36,8 @@ A run-time error of the backup's submit program (SPS.SUB) does not end the run: 
 Routines of technology packages absent from the backup are stubbed (a ``message`` event
 "stub: NAME"), and the report lists the stubs.
 
-Usage: ``python -m interp.realprograms [CORPUS] [--json OUT] [--limit N]``.
+Usage: ``python -m interp.realprograms [CORPUS] [--json OUT] [--limit N] [--scheduler tcp://HOST:PORT]``
+(``--scheduler``: the programs run on a Dask cluster, :func:`run_rows`; the same report).
 """
 
 from __future__ import annotations
@@ -308,6 +309,43 @@ def report(rows: list[dict]) -> str:
     return "\n".join(lines)
 
 
+def run_rows(corpus: Path, max_sim_time: float = REPORT_SIM_TIME_S, max_steps: int = REPORT_STEPS, *,
+             cells: bool = True, limit: int = 0, scheduler: str | None = None, progress=None) -> list[dict]:
+    """The report's rows: :func:`run_one` for each program of the backups below `corpus` (at most
+    `limit`, 0: all), in the corpus's order, with its cell file unless `cells` is False.
+    `scheduler`: the address of a Dask scheduler (``tcp://HOST:8786``) whose workers run the
+    programs (krl/cluster.py; they read the corpus at the same paths); the rows are the same as
+    here, ``seconds`` aside. `progress(row)` is called as each row arrives. Raises
+    krl.cluster.SchedulerError when the scheduler cannot be used."""
+    programs = [p for root in find_backups(corpus) for p in programs_of(root)]
+    if limit:
+        programs = programs[:limit]
+    tasks = [(i, (p, max_sim_time, max_steps, cell_of(p, corpus) if cells else None))
+             for i, p in enumerate(programs)]
+    if scheduler is None:
+        rows = []
+        for _i, args in tasks:
+            rows.append(run_one(*args))
+            if progress:
+                progress(rows[-1])
+        return rows
+    from krl.cluster import run_batches  # noqa: PLC0415
+
+    got: dict[int, dict] = {}
+    for o in run_batches(scheduler, run_one, tasks, batch_files=1, name="krl-realprograms"):
+        path = tasks[o.key][1][0]
+        if o.status == "done":
+            row = o.value
+        else:           # the worker failed (not the program): said as run_one says an internal error
+            row = {"program": str(path), "reason": "internal", "text": o.detail, "seconds": 0.0,
+                   "cell": str(tasks[o.key][1][3]) if tasks[o.key][1][3] else None}
+            row["cause"] = cause_of(row)
+        got[o.key] = row
+        if progress:
+            progress(row)
+    return [got[i] for i in range(len(tasks))]
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("corpus", nargs="?", default=str(DEFAULT_CORPUS))
@@ -316,21 +354,30 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--max-sim-time", type=float, default=REPORT_SIM_TIME_S)
     ap.add_argument("--max-steps", type=int, default=REPORT_STEPS)
     ap.add_argument("--no-cells", action="store_true", help="run without the committed cell files")
+    ap.add_argument("--scheduler", default=None, metavar="tcp://HOST:PORT",
+                    help="run the programs on this Dask distributed scheduler's cluster (its workers "
+                         "see the corpus at the same paths); the same report as the local run")
     a = ap.parse_args(argv)
     corpus = Path(a.corpus)
     if not corpus.is_dir():
         print(f"no corpus at {corpus}; nothing to do")
         return 0
-    rows = []
-    for root in find_backups(corpus):
-        for p in programs_of(root):
-            rows.append(run_one(p, a.max_sim_time, a.max_steps, None if a.no_cells else cell_of(p, corpus)))
-            r = rows[-1]
-            sub = f"  [submit: {r['submit'][0][:60]}]" if r.get("submit") else ""
-            print(f"{r['cause']:15s} {r['reason']:13s} {r.get('seconds', 0):6.1f}s {p.relative_to(corpus)}  {r['text'][:80]}{sub}",
-                  file=sys.stderr)
-            if a.limit and len(rows) >= a.limit:
-                break
+
+    def progress(r: dict) -> None:
+        sub = f"  [submit: {r['submit'][0][:60]}]" if r.get("submit") else ""
+        shown = Path(r["program"])
+        shown = shown.relative_to(corpus) if shown.is_relative_to(corpus) else shown
+        print(f"{r['cause']:15s} {r['reason']:13s} {r.get('seconds', 0):6.1f}s {shown}  {r['text'][:80]}{sub}",
+              file=sys.stderr)
+
+    from krl.cluster import SchedulerError  # noqa: PLC0415
+
+    try:
+        rows = run_rows(corpus, a.max_sim_time, a.max_steps, cells=not a.no_cells, limit=a.limit,
+                        scheduler=a.scheduler, progress=progress)
+    except SchedulerError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
     if a.json:
         with open(a.json, "w", encoding="utf-8") as fh:
             for r in rows:
