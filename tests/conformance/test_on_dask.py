@@ -1,6 +1,6 @@
-"""Many backups on Dask (issue 39): the real-programs report and `krl conformance` run on a real
-Dask LocalCluster (two worker processes on loopback) give the same report as the local run,
-and an unreachable scheduler is a clear error, never a traceback.
+"""Many backups on Dask (issue 39): the real-programs report, `krl conformance` and `krl check` of a
+folder of backups run on a real Dask LocalCluster (two worker processes on loopback) give the
+same report as the local run, and an unreachable scheduler is a clear error, never a traceback.
 
 The programs are those of one small corpus backup (rawpython__kukaKRLmagic: two programs under
 R1/Program and its cell.src, whose committed cell file answers it), so the comparison covers a
@@ -9,10 +9,7 @@ program with a cell file and programs without."""
 from __future__ import annotations
 
 import json
-import os
 import re
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
@@ -81,6 +78,24 @@ def test_krl_conformance_on_a_local_cluster_writes_the_same_report(cluster, one_
     assert json.loads((tmp_path / "dask" / "summary.json").read_text()) == outs["local"]
 
 
+def test_krl_check_of_a_folder_of_backups_on_a_local_cluster_prints_the_same(cluster):
+    # examples/ holds a KRC backup (plc_cell: R1/...) and the files of examples/network beside
+    # it: two workspaces, one task each
+    from krl.cli.check import run_check  # noqa: PLC0415
+
+    folder = str(REPO / "examples")
+    out = {}
+    for fmt in ("json", "text"):
+        for name, scheduler in (("local", None), ("dask", cluster.scheduler_address)):
+            lines: list[str] = []
+            status = run_check([folder], fmt=fmt, echo=lines.append, timeout=60, scheduler=scheduler)
+            out[fmt, name] = (status, lines)
+        assert out[fmt, "dask"] == out[fmt, "local"]
+    workspaces = [json.loads(line) for line in out["json", "local"][1]]
+    assert [Path(w["workspace"]).name for w in workspaces] == ["plc_cell", "network"]   # backups first
+    assert all(w["files"] >= 4 for w in workspaces)
+
+
 def test_an_unreachable_scheduler_is_a_clear_error(tmp_path, monkeypatch, capsys):
     # nothing listens on port 1 of loopback; Dask's connect timeout is shortened for the test
     monkeypatch.setenv("DASK_DISTRIBUTED__COMM__TIMEOUTS__CONNECT", "2s")
@@ -94,9 +109,22 @@ def test_an_unreachable_scheduler_is_a_clear_error(tmp_path, monkeypatch, capsys
         dask.config.refresh()
     err = capsys.readouterr().err
     assert "error: cannot reach the Dask scheduler at tcp://127.0.0.1:1" in err and "Traceback" not in err
-    p = subprocess.run([sys.executable, "-m", "krl.cli", "conformance", "--out", str(tmp_path / "c"), "--fuzz", "0",
-                        "--no-real", "--scheduler", "tcp://127.0.0.1:1"], cwd=REPO, capture_output=True,
-                       text=True, timeout=300, env={**os.environ, "DASK_DISTRIBUTED__COMM__TIMEOUTS__CONNECT": "2s"})
-    assert p.returncode == 2, p.stderr[-2000:]
-    assert "error: cannot reach the Dask scheduler at tcp://127.0.0.1:1" in p.stderr
-    assert "Traceback" not in p.stderr + p.stdout
+    # krl conformance and krl check, as the user runs them (the interpreters' probe is skipped)
+    from click.testing import CliRunner  # noqa: PLC0415
+
+    from conformance.cli import conformance  # noqa: PLC0415
+    from krl.cli.check import check  # noqa: PLC0415
+
+    monkeypatch.setattr(H, "_STATUS", {"tree": None, "vm": None})
+    monkeypatch.setenv("DASK_DISTRIBUTED__COMM__TIMEOUTS__CONNECT", "2s")
+    dask.config.refresh()
+    try:
+        for cmd, args in ((conformance, ["--out", str(tmp_path / "c"), "--fuzz", "0", "--no-real"]),
+                          (check, [str(REPO / "examples")])):
+            r = CliRunner().invoke(cmd, [*args, "--scheduler", "tcp://127.0.0.1:1"])
+            assert r.exit_code == 2, r.output
+            assert "error: cannot reach the Dask scheduler at tcp://127.0.0.1:1" in r.output
+            assert "Traceback" not in r.output and isinstance(r.exception, SystemExit)
+    finally:
+        monkeypatch.undo()
+        dask.config.refresh()
