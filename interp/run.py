@@ -17,6 +17,7 @@ from pathlib import Path
 
 from interp.runtime.core import RunResult, Runtime
 from interp.runtime.errors import KrlRuntimeError, ResourceError
+from interp.runtime.values import Struct
 
 
 def make_runtime(program, *, workspace=None, inputs=None, trace=None, max_sim_time=None,
@@ -24,7 +25,8 @@ def make_runtime(program, *, workspace=None, inputs=None, trace=None, max_sim_ti
                  robot_budget=None, interp: str = "tree", observer=None,
                  mode: str | None = None, check: bool = True,
                  vm_loop: str = "generated", run_mode: str | None = None,
-                 pgno: int | None = None, robot=None, network=None) -> tuple[Runtime, object]:
+                 pgno: int | None = None, robot=None, network=None, start: str | None = None,
+                 halt_continues: int = 0) -> tuple[Runtime, object]:
     """Build the runtime and the interpreter (``interp``: tree or vm) for ``program``
     (not started yet). Its files (krl.project.project_of, with the `submit` programs) are
     loaded, checked and resolved first; with `check` (``krl run`` without ``--no-check``) a
@@ -39,14 +41,24 @@ def make_runtime(program, *, workspace=None, inputs=None, trace=None, max_sim_ti
     ``run_mode``: ``$PRO_MODE`` at the start (GO, MSTEP, ISTEP, BSTEP; interp/runtime/runmode.py;
     default GO). ``robot``: the simulated robot (a MachineData or a path for
     :func:`robot.mada.load_robot`); default :func:`robot_for` (the cell file's ``robot``, else the
-    backup's own robot, else the KR 6 R900). ``network``: the partners
+    backup's own robot, else the KR 6 R900). ``inputs``: a cell file, or ``"auto"`` (the
+    automatic cell, interp/runtime/autocell.py: mode EXT unless `mode` says otherwise, P00's
+    program numbers, the solver; the robot starts at ``XHOME`` when the program has one and
+    no `start` is given). ``start``: where the robot stands at the start
+    (:func:`start_axes`: an E6AXIS literal or a point name; default the cell file's
+    ``start:``, else ``$AXIS_HOME[1]``). ``halt_continues``: ``--on-halt continue``, the
+    times the operator presses Start again after a HALT (0: a HALT ends the run). ``network``: the partners
     (net.settings.NetworkSettings; default the cell file's ``network:`` key): the run's network
     hub (net/hub.py) is attached to the controller either way; without partners its EKI
     channels stay "not connected". Raises
     :class:`robot.stimuli.StimulusError` for a bad cell file or a preset the backup's
-    ``$config.dat`` does not allow."""
+    ``$config.dat`` does not allow, :class:`robot.stimuli.StartError` for a start position that cannot
+    place the robot."""
     from interp.tree import TreeInterpreter  # noqa: PLC0415
 
+    auto = is_auto(inputs)
+    if auto:
+        inputs = None
     if controller is None:
         from robot.controller import Controller  # noqa: PLC0415
 
@@ -55,19 +67,36 @@ def make_runtime(program, *, workspace=None, inputs=None, trace=None, max_sim_ti
         controller = Controller(robot_for(program, workspace, robot, inputs),
                                 trace=observer if observer is not None else trace,
                                 stimuli=str(inputs) if inputs else None, mujoco=mujoco,
-                                mode_op=mode)
+                                mode_op=mode if mode is not None or not auto else "EX")
     rt = Runtime(program, workspace=workspace, controller=controller, trace=trace,
                  max_sim_time=max_sim_time, max_steps=max_steps, robot_budget=robot_budget,
                  submits=list(submit or ()), check=check)
     if run_mode is not None:
         rt.set_run_mode(run_mode)
+    rt.halt_continues = halt_continues
+    main = Path(program).stem
+    where = start if start is not None else getattr(controller, "start", None)
+    if where is None and auto and isinstance(global_value(rt, main, "XHOME"), Struct):
+        where = "XHOME"             # the automatic cell starts at home, as a cell in Automatic External
+    if where is not None:
+        from interp.scene import start_axes  # noqa: PLC0415
+
+        controller.place(start_axes(controller, lambda name: global_value(rt, main, name), where))
+        rt.start = where
     if observer is not None:
         # The interpreters trace into the user's trace only: without one the VM keeps its
         # quiet fast path (Runtime.quiet_limit); the observer needs the controller's events.
         rt.trace = trace
     number = pgno if pgno is not None else getattr(controller, "pgno", None)
     if number is not None:
-        controller.rules += _pgno_rules(rt, Path(program).stem, number)
+        controller.rules += _pgno_rules(rt, Path(program).stem, number,
+                                        "--pgno" if pgno is not None else "the cell file's pgno preset")
+    if auto:
+        from interp.runtime.autocell import handshake_rules  # noqa: PLC0415
+
+        rt.enable_autocell()
+        if number is None:
+            controller.rules += handshake_rules(rt, Path(program).stem, _pgno_parameters(rt, Path(program).stem))
     if controller.stimuli or controller.rules:
         from robot.stimuli import resolve_signals  # noqa: PLC0415
 
@@ -115,6 +144,12 @@ def attach_network(rt: Runtime, program, workspace, settings) -> None:
         raise NetError(f"a network partner cannot start: {exc.strerror or exc}") from None
 
 
+def is_auto(inputs) -> bool:
+    """True for ``--inputs auto``: the automatic cell (interp/runtime/autocell.py) instead of
+    a cell file. A file of that name is written ``./auto``."""
+    return isinstance(inputs, (str, Path)) and str(inputs) == "auto"
+
+
 def plc_map(rt: Runtime, main: str):
     """The PLC's address map (net/plc.py) derived from the cell: the inputs and outputs its
     rules, stimuli and program-number handshake (``PGNO_*`` of $config.dat) use, and the
@@ -148,21 +183,29 @@ def plc_map(rt: Runtime, main: str):
     return derive_map(indices, signals)
 
 
-def _pgno_rules(rt: Runtime, main: str, number: int) -> list:
-    """The PLC's rules of P00's program-number handshake answering `number`, with the
-    ``PGNO_*`` parameters the program sees ($config.dat)."""
-    from robot.cellpresets import PGNO_PARAMETERS, PresetError, pgno_rules  # noqa: PLC0415
-    from robot.stimuli import StimulusError  # noqa: PLC0415
+def _pgno_parameters(rt: Runtime, main: str) -> dict:
+    """The ``PGNO_*`` parameters the program `main` sees ($config.dat), those with an INT value."""
+    from robot.cellpresets import PGNO_PARAMETERS  # noqa: PLC0415
 
     params = {}
     for name in PGNO_PARAMETERS:
         value = global_value(rt, main, name)
         if isinstance(value, int) and not isinstance(value, bool):
             params[name] = value
+    return params
+
+
+def _pgno_rules(rt: Runtime, main: str, number: int, origin: str = "--pgno") -> list:
+    """The PLC's rules of P00's program-number handshake answering `number`, with the
+    ``PGNO_*`` parameters the program sees ($config.dat). `origin` names where the number came
+    from in the error (``--pgno``, the cell file's preset)."""
+    from robot.cellpresets import PresetError, pgno_rules  # noqa: PLC0415
+    from robot.stimuli import StimulusError  # noqa: PLC0415
+
     try:
-        return pgno_rules(params, number)
+        return pgno_rules(_pgno_parameters(rt, main), number)
     except PresetError as exc:
-        raise StimulusError(f"--pgno {number}: {exc}") from None
+        raise StimulusError(f"{origin} {number}: {exc}") from None
 
 
 def global_value(rt: Runtime, main: str, name: str):
@@ -192,7 +235,7 @@ def robot_for(program, workspace=None, robot=None, inputs=None):
 
     if isinstance(robot, MachineData):
         return robot
-    if robot is None and inputs:
+    if robot is None and inputs and not is_auto(inputs):
         from robot.stimuli import load_cell  # noqa: PLC0415
 
         robot = load_cell(inputs).robot
@@ -200,6 +243,16 @@ def robot_for(program, workspace=None, robot=None, inputs=None):
         return load_robot(robot)
     root = backup_of(Path(program).resolve(), Path(workspace).resolve() if workspace else None)
     found = _backup_robot(root) if root is not None else None
+    if found is None and is_auto(inputs):
+        from interp.scene import choose_robot  # noqa: PLC0415
+
+        def probe():
+            rt, _ = make_runtime(program, workspace=workspace, mujoco=False, check=False, robot=load_machine())
+            main = Path(program).stem
+            return rt, lambda name: global_value(rt, main, name)
+        choice = choose_robot(Path(program), probe, workspace)
+        if choice is not None:
+            return choice.machine
     return found if found is not None else load_machine()
 
 
@@ -259,8 +312,8 @@ class RunSetup:
     ``booted`` (the backup's SPS.SUB when it was started as at boot, else None), ``machine``
     (the simulated robot, robot.machine.MachineData), ``options`` (the rest of krl run's
     options by their click names: interp_kind, max_sim_time, max_steps, mode, run_mode, pgno,
-    no_check, trace_path), ``shown`` (a path as the user named it: an archive's temporary
-    folder is shown as the archive)."""
+    no_check, trace_path, trace_repeats, start, halt_continues), ``shown`` (a path as the
+    user named it: an archive's temporary folder is shown as the archive)."""
     program: Path
     workspace: Path | None
     inputs: Path | None
@@ -286,7 +339,8 @@ class RunSetup:
                   max_sim_time=o.get("max_sim_time", 600.0), max_steps=o.get("max_steps"),
                   submit=[str(s) for s in self.submit], interp=self.interp, observer=observer,
                   mode=o.get("mode"), check=self.check, run_mode=str(o.get("run_mode") or "GO").upper(),
-                  pgno=o.get("pgno"), robot=self.machine)
+                  pgno=o.get("pgno"), robot=self.machine, start=o.get("start"),
+                  halt_continues=o.get("halt_continues", 0))
         kw.update(override)
         return make_runtime(self.program, **kw)
 

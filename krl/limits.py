@@ -160,6 +160,22 @@ MAX_DIFF_ENTRIES = 20_000
 # (DOT/SVG) and the HTML page, in nodes. Past it: an error naming the count (JSON has no limit).
 MAX_GRAPH_NODES = 5000
 
+# The controller's message window (interp/runtime/messages.py): the most messages shown at once
+# (a real cell shows a handful; past it the oldest notify message is dropped).
+MAX_KRL_MESSAGES = 100
+
+# `krl pendant` (pendant/, docs/security.md "The pendant's web server"): the largest websocket
+# message the server reads (a larger one closes the connection with 1009), the largest HTTP
+# request body, the connections served at once, the operator's messages per second on one
+# connection (past it the connection is closed), the watch list's length and the length of one
+# watched expression, and the largest KRL file the page shows or touch-up rewrites.
+MAX_WEB_MESSAGE_BYTES = 64 * 1024
+MAX_WEB_BODY_BYTES = 64 * 1024
+MAX_WEB_CONNECTIONS = 8
+MAX_WEB_MESSAGES_PER_S = 200
+MAX_WEB_WATCHES = 64
+MAX_WEB_EXPRESSION_CHARS = 200
+MAX_WEB_FILE_BYTES = 4 * 1024 * 1024
 # The controller on the network (net/, docs/network.md, docs/security.md "Network"). Everything
 # that arrives on a socket is untrusted; every size, rate and count below ends in an EKI/RSI
 # message, a closed connection or a stopped motion, never in unbounded memory or a hang.
@@ -201,6 +217,19 @@ MAX_NET_REPLAY_EVENTS = 1_000_000
 # The wall-clock pace factor of a run with a partner attached (simulated s per wall s): 1 is
 # real time; up to 10 where the protocol allows (EKI, KukaVarProxy, the PLC), never for RSI.
 MAX_NET_PACE = 10.0
+# The automatic cell (krl run --inputs auto, interp/runtime/autocell.py): the inputs of one
+# condition it combines, and the evaluations of that condition it tries (2^8 combinations of
+# one-bit inputs and a few values of each group), before it leaves the condition unanswered.
+AUTO_MAX_INPUTS = 8
+AUTO_MAX_TRIES = 4096
+# The points of one backup the automatic cell's robot choice looks at (interp/scene.py): a
+# palletizer's backup teaches about 300.
+MAX_CHOICE_POINTS = 2000
+# `krl run --on-halt continue:N`: the operator presses Start again at most this often.
+MAX_HALT_CONTINUES = 1000
+# A start position (`krl run --start`, a cell file's `start:`): characters of its text; its
+# tokens are at most MAX_RULE_TOKENS.
+MAX_START_CHARS = 400
 # The routines' source text the interactive map page carries (krl graph --format html), in
 # characters in all; past it the remaining routines show their file:line without the text.
 MAX_GRAPH_SOURCE_CHARS = 8_000_000

@@ -44,8 +44,10 @@ The engine's methods (to be called on the engine thread):
 * inspection while stopped: :meth:`threads`, :meth:`stack`, :meth:`scopes`,
   :meth:`variables`, :meth:`evaluate`, :meth:`pointers`, :meth:`exception`;
 * edits while stopped (each recorded, see below): :meth:`set_variable`, :meth:`assign`,
-  :meth:`set_input`, :meth:`backward_motion`, and :meth:`edit` for a front end's own
-  (a jog, the override, the operating mode).
+  :meth:`set_input`, :meth:`backward_motion`, :meth:`move` (a jog), and :meth:`edit` for a
+  front end's own (the override, the operating mode); :meth:`edit_now` makes an edit while the
+  program runs too (the pendant's input toggles and acknowledgements), :meth:`evaluate_now`
+  evaluates while it runs, :meth:`flush_trace` puts the trace so far on disk.
 
 Reverse execution and edits
 ---------------------------
@@ -398,6 +400,64 @@ class Engine:
         self.edits.append(Edit(self.stop_where, label, apply))
         return result
 
+    def edit_now(self, label: str, apply) -> object:
+        """:meth:`edit`, also while the program runs (a front end's key that works at any time:
+        an input set by hand, the override, a message acknowledged): made on the live run where
+        the work is served (between two statements or IPO cycles) and recorded at that place
+        (hook count, hook calls inside the statement) for every replay."""
+        if self.state == "stopped":
+            return self.edit(label, apply)
+        if self.state != "running" or self.rt is None:
+            raise Refused("no program is running")
+        result = apply(self)
+        self.edits.append(Edit((self.n, self.sub), label, apply))
+        return result
+
+    def move(self, request) -> list:
+        """A motion made at the stop outside the program (a jog): the robot.motion.MotionRequest
+        ``request`` is planned and executed by the main run, within the operating mode's
+        limits, and the engine waits until the robot stands; recorded as an edit. Returns the
+        axes reached (deg). Raises :class:`Refused` (the controller's reason)."""
+        self.need_stopped()
+        task = self.stop_task
+        if task is None or task.kind != "robot":
+            raise Refused("stop the robot program first")
+
+        def apply(engine: Engine) -> list:
+            from robot.errors import RobotError  # noqa: PLC0415
+
+            rt = engine.rt
+            with engine._quiet():
+                rt.wait_main_run(rt.robot)
+                try:
+                    rt.controller.enqueue(request)
+                except RobotError as e:
+                    raise Refused(e.message) from None
+                rt.wait_main_run(rt.robot)
+            engine.flush_trace()
+            return [float(v) for v in rt.controller.axis_act()]
+        return self.edit(getattr(request, "kind", "motion"), apply)
+
+    def evaluate_now(self, text: str):
+        """The value of the KRL expression ``text`` in the stopped frame, or, while the program
+        runs, in the robot program's innermost frame (a watch list shown as the program goes on)."""
+        if self.state == "stopped":
+            return self.evaluate(text)
+        if self.rt is None or self.state != "running":
+            raise Refused("no program is running")
+        robot = self.rt.robot
+        return self._eval(text, robot.frame if robot is not None else None)
+
+    def flush_trace(self) -> None:
+        """Write what the trace file holds so far (at a stop, after an edit): a reader of the
+        file sees the run up to here."""
+        tr = self._trace
+        if tr is not None:
+            tr.flush()
+            fh = getattr(tr, "_fh", None)
+            if fh is not None:
+                fh.flush()
+
     def set_variable(self, scope: Scope, name: str, value: str) -> str:
         """Assign the KRL expression ``value`` (evaluated in the stopped frame) to the
         variable ``name`` (any letter case) listed under ``scope``; the new value's text."""
@@ -458,6 +518,7 @@ class Engine:
             events_before = len(rt.history.records)
             with engine._quiet():
                 ok = rt.backward_step(rt.robot)
+            engine.flush_trace()
             if not ok:
                 raise Refused(engine.last_refusal or "backward motion not possible")
             return events_before - len(rt.history.records)
@@ -853,6 +914,7 @@ class Engine:
         if bp is not None:
             body["hitBreakpointIds"] = [bp.id]
         self.stop_body = body
+        self.flush_trace()
         self.emit("stopped", dict(body))
         self.emit("krl/pointers", self.pointers())
         while self.resumed is None:

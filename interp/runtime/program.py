@@ -158,6 +158,9 @@ class Program:
         self.workspace = self.project.root
         self.system_dir = self.project.system if self.backup and self.project.system else BASIS_DIR
         extra = [] if self.backup else sorted(p for p in BASIS_DIR.iterdir() if p.is_file())
+        from .kss import standard_files  # noqa: PLC0415
+
+        extra += standard_files(self.project)     # KUKA's P00 when the backup lacks it
         extra += [Path(s).resolve() for s in submits if Path(s).resolve() not in self.project.files]
         self.ws = ws = checked_workspace(self.project, extra)
         self.check = check

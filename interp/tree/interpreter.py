@@ -23,7 +23,7 @@ from interp.runtime.slots import (anout_limits, anout_value, array_index, ended_
                                  for_limits, for_next, label_not_found, return_without_value, trigger_args)
 from interp.runtime.errors import lvalue_name, ExitSignal, GotoSignal, KrlRuntimeError, ReturnSignal
 from krl.semantics.resolve import LOCAL, SYSTEM
-from interp.runtime.values import EnumValue, Struct, copy_value
+from interp.runtime.values import Channel, EnumValue, Struct, copy_value
 
 
 class TreeInterpreter:
@@ -57,6 +57,7 @@ class TreeInterpreter:
             N.StrLit: self.e_lit, N.EnumLit: self.e_enum, N.Aggregate: self.e_aggregate,
             N.Name: self.e_var, N.Index: self.e_var, N.Field: self.e_var,
             N.Call: self.e_call, N.Unary: self.e_unary, N.Binary: self.e_binary,
+            N.ChannelName: self.e_channel,
         }
 
     # ------------------------------------------------------------------ entry points
@@ -500,6 +501,9 @@ class TreeInterpreter:
 
     def e_enum(self, e, frame):
         return EnumValue(e.name)
+
+    def e_channel(self, e, frame):
+        return Channel(e.name)
 
     def e_aggregate(self, e, frame):
         items = []

@@ -31,7 +31,7 @@ from krl.ast import nodes as N
 
 from interp.runtime.convert import binary_op, unary_op
 from interp.runtime.errors import KrlRuntimeError
-from interp.runtime.values import EnumValue
+from interp.runtime.values import Channel, EnumValue
 from krl.semantics import types as T
 from krl.semantics.resolve import LOCAL, MODULE
 
@@ -719,6 +719,8 @@ class Compiler:
             self.emit("CONST", e.value)
         elif isinstance(e, N.EnumLit):
             self.emit("CONST", EnumValue(e.name))
+        elif isinstance(e, N.ChannelName):
+            self.emit("CONST", Channel(e.name))
         elif self.fast_scalar(e) is not None:
             self.emit("LOAD_FAST", self.spelled(e.name))
         elif isinstance(e, N.Name):

@@ -58,6 +58,8 @@ def expr(e: N.Expr | None) -> str:
         return f'"{e.value}"'
     if isinstance(e, N.EnumLit):
         return f"#{e.name}"
+    if isinstance(e, N.ChannelName):
+        return f":{e.name}"
     if isinstance(e, N.Name):
         return e.name
     if isinstance(e, N.Index):
