@@ -159,6 +159,9 @@ MAX_DIFF_ENTRIES = 20_000
 # The program map (`krl graph`, krl/programmap): the largest map rendered through Graphviz
 # (DOT/SVG) and the HTML page, in nodes. Past it: an error naming the count (JSON has no limit).
 MAX_GRAPH_NODES = 5000
+# The routines' source text the interactive map page carries (krl graph --format html), in
+# characters in all; past it the remaining routines show their file:line without the text.
+MAX_GRAPH_SOURCE_CHARS = 8_000_000
 
 # The controller's message window (interp/runtime/messages.py): the most messages shown at once
 # (a real cell shows a handful; past it the oldest notify message is dropped).
