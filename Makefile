@@ -86,15 +86,18 @@ conformance: $(PARSER) java-parser
 # (fuzz/), the tests marked slow (long sweeps; hypothesis with the nightly profile); dated
 # reports under reports/nightly/<date>/, then the history (reports/nightly/history.sqlite) and
 # the index with charts and the changes since the night before. Not part of `make test`.
+# SCHEDULER=tcp://HOST:PORT: recovery and conformance run on that Dask cluster (same reports)
+SCHEDULER ?=
+SCHED_OPT = $(if $(SCHEDULER),--scheduler $(SCHEDULER),)
 NIGHTLY_FUZZ ?= 2000
 FUZZ_SECONDS ?= 120
 nightly: $(PARSER) java-parser
 	@d=reports/nightly/$$(date -u +%Y-%m-%d); mkdir -p $$d; \
-	$(BIN)/krl recover $(SHARED_CORPUS) --out $$d/recovery; s=$$?; [ $$s -le 1 ] || exit $$s; \
+	$(BIN)/krl recover $(SHARED_CORPUS) --out $$d/recovery $(SCHED_OPT); s=$$?; [ $$s -le 1 ] || exit $$s; \
 	$(BIN)/krl growth $(SHARED_CORPUS) --out $$d/growth || exit $$?; \
 	$(BIN)/python -m recovery.scale_bench $(SHARED_CORPUS) --json > $$d/scale.json || exit $$?; \
 	$(BIN)/krl check --report $$d/check $(SHARED_CORPUS) > $$d/check.log 2>&1; \
-	$(BIN)/krl conformance --out $$d/conformance --fuzz $(NIGHTLY_FUZZ) --fuzz-random; c=$$?; \
+	$(BIN)/krl conformance --out $$d/conformance --fuzz $(NIGHTLY_FUZZ) --fuzz-random $(SCHED_OPT); c=$$?; \
 	$(BIN)/krl bench --json > $$d/bench.json 2> $$d/bench.log; \
 	$(BIN)/krl bench parse --json > $$d/bench-parse.json 2>> $$d/bench.log; \
 	$(BIN)/python -m robot.limits_bench > $$d/limits.jsonl 2>> $$d/bench.log; \

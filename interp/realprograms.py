@@ -42,7 +42,9 @@ A run-time error of the backup's submit program (SPS.SUB) does not end the run: 
 Routines of technology packages absent from the backup are stubbed (a ``message`` event
 "stub: NAME"), and the report lists the stubs.
 
-Usage: ``python -m interp.realprograms [CORPUS] [--json OUT] [--limit N] [--columns cells,auto]``.
+Usage: ``python -m interp.realprograms [CORPUS] [--json OUT] [--limit N] [--columns cells,auto]
+[--scheduler tcp://HOST:PORT]`` (``--scheduler``: the runs go to a Dask cluster, :func:`run_rows`;
+the same report).
 """
 
 from __future__ import annotations
@@ -393,6 +395,49 @@ def report(rows: list[dict]) -> str:
     return "\n".join(lines)
 
 
+def run_rows(corpus: Path, max_sim_time: float = REPORT_SIM_TIME_S, max_steps: int = REPORT_STEPS, *,
+             cells: bool = True, limit: int = 0, columns: tuple[str, ...] = ("cells",), interp: str = "tree",
+             scheduler: str | None = None, progress=None) -> list[dict]:
+    """The report's rows: :func:`run_one` of each entry point of the backups below `corpus`
+    (:func:`entries_of`; at most `limit` of them, 0: all), in the corpus's order, once per
+    column of `columns` ("cells": with its committed cell file unless `cells` is False;
+    "auto": with ``--inputs auto``), on `interp`. `scheduler`: the address of a Dask scheduler
+    (``tcp://HOST:8786``) whose workers make the runs (krl/cluster.py; they read the corpus at
+    the same paths); the rows are the same as here, ``seconds`` aside. `progress(column, row)`
+    is called as each row arrives. Raises krl.cluster.SchedulerError when the scheduler cannot
+    be used."""
+    programs = [p for root in find_backups(corpus) for p in entries_of(root)]
+    if limit:
+        programs = programs[:limit]
+    tasks = []
+    for p in programs:
+        for col in columns:
+            cell = None if not cells or col == "auto" else cell_of(p, corpus)
+            tasks.append((len(tasks), (p, max_sim_time, max_steps, cell, col == "auto", interp)))
+    if scheduler is None:
+        rows = []
+        for _i, args in tasks:
+            rows.append(run_one(*args))
+            if progress:
+                progress("auto" if args[4] else "cells", rows[-1])
+        return rows
+    from krl.cluster import run_batches  # noqa: PLC0415
+
+    got: dict[int, dict] = {}
+    for o in run_batches(scheduler, run_one, tasks, batch_files=1, name="krl-realprograms"):
+        path, _t, _s, cell, auto, _interp = tasks[o.key][1]
+        if o.status == "done":
+            row = o.value
+        else:           # the worker failed (not the program): said as run_one says an internal error
+            row = {"program": str(path), "reason": "internal", "text": o.detail, "seconds": 0.0,
+                   "cell": str(cell) if cell else None, "mode": "auto" if auto else "cells"}
+            row["cause"] = cause_of(row)
+        got[o.key] = row
+        if progress:
+            progress("auto" if auto else "cells", row)
+    return [got[i] for i in range(len(tasks))]
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("corpus", nargs="?", default=str(DEFAULT_CORPUS))
@@ -404,6 +449,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--columns", default="cells,auto",
                     help="which runs: cells (the committed cell files), auto (--inputs auto), or both (default)")
     ap.add_argument("--interp", choices=("tree", "vm"), default="tree")
+    ap.add_argument("--scheduler", default=None, metavar="tcp://HOST:PORT",
+                    help="make the runs on this Dask distributed scheduler's cluster (its workers "
+                         "see the corpus at the same paths); the same report as the local run")
     a = ap.parse_args(argv)
     corpus = Path(a.corpus)
     cols = [c.strip() for c in a.columns.split(",") if c.strip()]
@@ -412,21 +460,22 @@ def main(argv: list[str] | None = None) -> int:
     if not corpus.is_dir():
         print(f"no corpus at {corpus}; nothing to do")
         return 0
-    rows = []
-    n = 0
-    for root in find_backups(corpus):
-        for p in entries_of(root):
-            n += 1
-            for col in cols:
-                rows.append(run_one(p, a.max_sim_time, a.max_steps,
-                                    None if a.no_cells or col == "auto" else cell_of(p, corpus),
-                                    auto=col == "auto", interp=a.interp))
-                r = rows[-1]
-                sub = f"  [submit: {r['submit'][0][:60]}]" if r.get("submit") else ""
-                print(f"{col:5s} {r['cause']:15s} {r['reason']:13s} {r.get('seconds', 0):6.1f}s "
-                      f"{p.relative_to(corpus)}  {r['text'][:80]}{sub}", file=sys.stderr)
-            if a.limit and n >= a.limit:
-                break
+
+    def progress(col: str, r: dict) -> None:
+        sub = f"  [submit: {r['submit'][0][:60]}]" if r.get("submit") else ""
+        shown = Path(r["program"])
+        shown = shown.relative_to(corpus) if shown.is_relative_to(corpus) else shown
+        print(f"{col:5s} {r['cause']:15s} {r['reason']:13s} {r.get('seconds', 0):6.1f}s "
+              f"{shown}  {r['text'][:80]}{sub}", file=sys.stderr)
+
+    from krl.cluster import SchedulerError  # noqa: PLC0415
+
+    try:
+        rows = run_rows(corpus, a.max_sim_time, a.max_steps, cells=not a.no_cells, limit=a.limit,
+                        columns=tuple(cols), interp=a.interp, scheduler=a.scheduler, progress=progress)
+    except SchedulerError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
     if a.json:
         with open(a.json, "w", encoding="utf-8") as fh:
             for r in rows:

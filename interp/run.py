@@ -231,7 +231,7 @@ def robot_for(program, workspace=None, robot=None, inputs=None):
     cannot make a model (file:line), robot.stimuli.StimulusError for a bad cell file."""
     from krl.project import backup_of  # noqa: PLC0415
     from robot.machine import MachineData, load_machine  # noqa: PLC0415
-    from robot.mada import load_robot, robot_of_backup  # noqa: PLC0415
+    from robot.mada import load_robot  # noqa: PLC0415
 
     if isinstance(robot, MachineData):
         return robot
@@ -242,7 +242,7 @@ def robot_for(program, workspace=None, robot=None, inputs=None):
     if robot is not None:
         return load_robot(robot)
     root = backup_of(Path(program).resolve(), Path(workspace).resolve() if workspace else None)
-    found = robot_of_backup(root) if root is not None else None
+    found = _backup_robot(root) if root is not None else None
     if found is None and is_auto(inputs):
         from interp.scene import choose_robot  # noqa: PLC0415
 
@@ -254,6 +254,24 @@ def robot_for(program, workspace=None, robot=None, inputs=None):
         if choice is not None:
             return choice.machine
     return found if found is not None else load_machine()
+
+
+def _backup_robot(root: Path):
+    """robot.mada ``robot_of_backup(root)``, kept across processes (krl/store.py) for the
+    same files of its machine-data folder."""
+    from krl.project import machine_data_file  # noqa: PLC0415
+    from krl.store import file_key, stored  # noqa: PLC0415
+    from robot.mada import robot_of_backup  # noqa: PLC0415
+
+    f = machine_data_file(root)
+    if f is None:
+        return None
+    try:
+        files = sorted(c for c in f.parent.iterdir() if c.is_file())
+    except OSError:
+        return robot_of_backup(root)
+    return stored("robot", (str(root), str(f), file_key(files)), lambda: robot_of_backup(root),
+                  code=("krl", "robot"))
 
 
 def signal_of(rt: Runtime, main: str, name: str) -> tuple[str, int, int | None] | None:

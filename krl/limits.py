@@ -136,6 +136,13 @@ MAX_DAP_MESSAGE_BYTES = 1024 * 1024
 MAX_DAP_BREAKPOINTS = 1000
 MAX_DAP_REPLAY_STEPS = 10_000_000
 
+# Results kept across processes (krl/store.py: a program's checked workspace, a backup's robot
+# model) in the user cache folder: the largest one result kept (a checked 150-file backup is
+# about 5 MB) and all of them together; past the first the result is not kept, past the second
+# the results used least recently are removed.
+MAX_STORED_BYTES = 256 * 1024 * 1024
+MAX_STORE_BYTES = 1024 * 1024 * 1024
+
 # Reactive rules of a cell file (`rules:` in a stimuli file, robot/cellrules.py): the most rules
 # in one file (a PLC program answering a cell has tens of handshakes, a few hundred at most) and
 # the most tokens in one rule's `when` expression (one line of KRL; real conditions have under

@@ -67,6 +67,7 @@ it had not been made.
 from __future__ import annotations
 
 import contextlib
+import gc
 import os
 import queue
 import sys
@@ -291,7 +292,16 @@ class Engine:
         except RunSetupError as exc:
             raise Refused(str(exc)) from None
         self.config = config
-        rt, _ = self._build()
+        enabled = gc.isenabled()
+        gc.disable()
+        try:
+            rt, _ = self._build()
+        finally:
+            # the checked program and the tables live as long as the session: out of the
+            # collector's sight (a full collection over them costs as much as loading them)
+            gc.freeze()
+            if enabled:
+                gc.enable()
         errors = rt.program.errors_of(rt.program.module_of(rt.program.main_path))
         if errors:
             rt.scheduler.close()

@@ -5,8 +5,9 @@ This module only speaks the protocol: a reader thread parses messages (interp/de
 and posts each request to the engine thread, where :meth:`DebugSession.dispatch` answers it
 with the engine's methods; the engine's events go out as DAP events. What DAP numbers
 itself lives here: frame ids and variables references (valid until the run resumes).
-Custom requests: ``krl/pointers`` (the two pointers, the simulated time, the step) and
-``krl/backwardStep`` (one backward motion at a stop).
+Custom requests: ``krl/pointers`` (the two pointers, the simulated time, the step),
+``krl/backwardStep`` (one backward motion at a stop) and ``krl/setInput`` (an input set by
+hand at a stop).
 """
 
 from __future__ import annotations
@@ -21,6 +22,18 @@ from dap_types import (Breakpoint as DapBreakpoint, Capabilities, ExceptionBreak
 from .engine import Engine, LaunchConfig, Refused, Restart, Terminate
 from .values import value_text
 from .wire import ProtocolError, read_message, write_message
+
+
+def _prepare() -> None:
+    """Import what a launch needs (the simulated controller, the interpreters) while the
+    client starts the session: the launch request then finds them loaded."""
+    import importlib  # noqa: PLC0415
+
+    for name in ("interp.run", "robot.controller", "interp.tree", "mujoco", "interp.debug.launch"):
+        try:
+            importlib.import_module(name)
+        except Exception:  # noqa: BLE001 - the launch imports it again and says what is wrong
+            return
 
 
 def _dump(model) -> dict:
@@ -88,6 +101,7 @@ class DebugSession:
     # ------------------------------------------------------------------ main loop
     def serve(self) -> int:
         """Serve until the client disconnects or the input ends; the exit status (0)."""
+        threading.Thread(target=_prepare, daemon=True).start()
         threading.Thread(target=self._reader, daemon=True).start()
         self.engine.serve()
         return 0
@@ -265,6 +279,15 @@ class DebugSession:
     # custom requests ----------------------------------------------------------
     def req_krl_pointers(self, req, args) -> None:
         self.respond(req, self.engine.pointers())
+
+    def req_krl_setInput(self, req, args) -> None:  # noqa: N802
+        """``$IN[index]`` set by hand at a stop (``value`` true or false); the cell's rules
+        stay active; stepBack replays it."""
+        self.engine.need_stopped()
+        index, value = args.get("index"), args.get("value")
+        if not isinstance(value, bool):
+            raise Refused("setInput: value true or false")
+        self.respond(req, {"index": index, "value": self.engine.set_input(index, value)})
 
     def req_krl_backwardStep(self, req, args) -> None:  # noqa: N802
         """One backward motion (#BSTEP, T1/T2) at the stop; no statement runs."""

@@ -77,8 +77,11 @@ def checked_workspace(project, extra: list[Path] = ()):
     """The loaded, checked and resolved workspace of `project` and the `extra` files (a run's
     BASIS, a submit program outside the project): cached per process for the same files
     (path, size, modification time), so the two interpreters of a conformance run, or the
-    programs of one backup, load and check their files once. Never raises for bad input."""
+    programs of one backup, load and check their files once, and kept across processes in the
+    user cache folder (krl/store.py), so a command started again on unchanged files does not
+    parse and check them again. Never raises for bad input."""
     from krl.limits import PARSE_TIMEOUT_S  # noqa: PLC0415
+    from krl.store import stored  # noqa: PLC0415
     from krl.workspace import load_project  # noqa: PLC0415
 
     paths = [*project.files, *extra]
@@ -97,9 +100,13 @@ def checked_workspace(project, extra: list[Path] = ()):
     if ws is not None:
         _CACHE.move_to_end(key)
         return ws
-    ws = load_project(project, str(project.root), PARSE_TIMEOUT_S if size > _BATCH_BYTES else None,
-                      extra=list(extra))
-    ws.check()
+    def make():
+        ws = load_project(project, str(project.root), PARSE_TIMEOUT_S if size > _BATCH_BYTES else None,
+                          extra=list(extra))
+        ws.check()
+        return ws
+
+    ws = stored("workspace", key, make, fix_ids=True)   # kept across processes too (krl/store.py)
     _CACHE[key] = ws
     while len(_CACHE) > _CACHE_SIZE:
         _CACHE.popitem(last=False)

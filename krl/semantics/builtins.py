@@ -124,7 +124,14 @@ def _read(name: str) -> dict:
 
 @lru_cache(maxsize=1)
 def load_builtins() -> Builtins:
-    """Read the three data tables (cached). Raises ValueError for a malformed table."""
+    """Read the three data tables (cached, and kept across processes: krl/store.py). Raises
+    ValueError for a malformed table."""
+    from krl.store import stored  # noqa: PLC0415
+
+    return stored("builtins", (), _load_builtins)
+
+
+def _load_builtins() -> Builtins:
     types = _read("types.yaml")
     sysv = _read("sysvars.yaml")
     funcs = _read("functions.yaml")
