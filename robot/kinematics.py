@@ -326,24 +326,39 @@ class Kinematics:
     def _check_palletizer4(self, where: str) -> None:
         """The 4-axis closed form must give back random linked configurations of the chain
         (A4 = 0, A2 + A3 + A5 as at HOME); robot.mada.MachineDataError otherwise."""
+        home = self._home
+
+        def link(q):
+            q[4] = home[4] + home[1] + home[2] - q[1] - q[2]
+
+        led = "$NUM_AX=4" if "a5_led" in self.machine.provenance else "$DEF_A5LINK=TRUE"
+        self.check_closed_form(
+            self._palletizer_rows, where,
+            f"$DEF_A4FIX=TRUE, A5 led ({led}): this palletizer's arm ($TIRORO, $TX3P3, $DH_4, $DH_5, "
+            f"$TFLWP) is not one the 4-axis closed form covers", link=link)
+
+    def check_closed_form(self, rows, where: str, message: str, link=None) -> None:
+        """Raise robot.mada.MachineDataError (``"{where}: {message}"``) unless the closed form
+        ``rows(T, q)`` (a list of axis rows for the flange pose T, 4x4, mm) gives back four
+        random configurations of the machine-data chain within 1e-6: A4 = 0, and `link(q)`
+        sets the axes the arm's linkage leads. Also raises when the chain of the machine data
+        does not close on :meth:`forward`."""
         from .chain import chain_forward  # noqa: PLC0415
         from .mada import MachineDataError  # noqa: PLC0415
 
-        home = self._home
         rng = np.random.default_rng(0)
         lo = np.maximum(self._lo, -170.0)
         hi = np.minimum(self._hi, 170.0)
         for q in rng.uniform(lo, hi, size=(4, 6)):
             q[3] = 0.0
-            q[4] = home[4] + home[1] + home[2] - q[1] - q[2]
+            if link is not None:
+                link(q)
             T = self.forward(q)
             if self.machine.chain is not None and np.abs(chain_forward(self.machine.chain, q) - T).max() > 1e-6:
                 raise MachineDataError(f"{where}: internal chain does not close")
-            rows = self._palletizer_rows(T, q)
-            if not rows or min(np.abs(self.forward(r) - T).max() for r in rows) > 1e-6:
-                raise MachineDataError(
-                    f"{where}: $DEF_A4FIX=TRUE, A5 led ({'$NUM_AX=4' if 'a5_led' in self.machine.provenance else '$DEF_A5LINK=TRUE'}): this palletizer's arm ($TIRORO, $TX3P3, "
-                    f"$DH_4, $DH_5, $TFLWP) is not one the 4-axis closed form covers")
+            found = rows(T, q)
+            if not found or min(np.abs(self.forward(r) - T).max() for r in found) > 1e-6:
+                raise MachineDataError(f"{where}: {message}")
 
     def _joint_point(self, axes_deg: Sequence[float], index: int) -> np.ndarray:
         """Position (mm, in ``$ROBROOT``) of the origin of joint `index` (0 = A1)."""
