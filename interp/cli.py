@@ -109,17 +109,10 @@ def _run(setup) -> None:
     from interp.summary import RunObserver, starvation_lines, summary_lines  # noqa: PLC0415
     from krl.terminal import printable  # noqa: PLC0415
     from robot.stimuli import StartError, StimulusError  # noqa: PLC0415
-    from robot.trace import TraceWriter  # noqa: PLC0415
     from net.hub import NetError  # noqa: PLC0415
 
     shown, machine, program = setup.shown, setup.machine, setup.program
-    trace_path = setup.options.get("trace_path")
-    trace_repeats = setup.options.get("trace_repeats", TRACE_REPEATS)
-    trace = TraceWriter(trace_path, repeats=trace_repeats or None) if trace_path else None
-    if trace is not None:
-        # the trace header: which robot the run simulates and where its data came from
-        trace.write("robot", 0.0, name=machine.name, source=shown(machine.source),
-                    trafoname=machine.trafoname or None)
+    trace = setup.trace_writer()
     observer = RunObserver()
     try:
         rt, _ = setup.make_runtime(trace=trace, observer=observer)

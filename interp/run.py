@@ -331,6 +331,22 @@ class RunSetup:
     def check(self) -> bool:
         return not self.options.get("no_check")
 
+    def trace_writer(self):
+        """The run's trace (robot.trace.TraceWriter) at option ``trace_path``, or None: bounded
+        by ``trace_repeats`` (default robot.trace.TRACE_REPEATS; 0 writes every event), headed by
+        the simulated robot and where its data came from. One rule for krl run, krl debug and
+        krl pendant, so their traces of one run are the same bytes."""
+        from robot.trace import TRACE_REPEATS, TraceWriter  # noqa: PLC0415
+
+        path = self.options.get("trace_path")
+        if not path:
+            return None
+        repeats = self.options.get("trace_repeats", TRACE_REPEATS)
+        trace = TraceWriter(path, repeats=repeats or None)
+        m = self.machine
+        trace.write("robot", 0.0, name=m.name, source=self.shown(m.source), trafoname=m.trafoname or None)
+        return trace
+
     def make_runtime(self, trace=None, observer=None, **override) -> tuple:
         """(Runtime, interpreter) of this run, not started (:func:`make_runtime`); ``override``:
         keyword arguments of make_runtime that differ (a debugger's step limit)."""

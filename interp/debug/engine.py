@@ -706,15 +706,9 @@ class Engine:
     def _build(self):
         """A new run of the launch's setup (interp.run.RunSetup), its trace (``trace_path``)
         written anew: the trace file always holds the run as it stands."""
-        from robot.trace import TraceWriter  # noqa: PLC0415
-
         setup = self.setup
         self._close_trace()
-        path = setup.options.get("trace_path")
-        if path:
-            m = setup.machine
-            self._trace = TraceWriter(path)
-            self._trace.write("robot", 0.0, name=m.name, source=setup.shown(m.source), trafoname=m.trafoname or None)
+        self._trace = setup.trace_writer()
         return setup.make_runtime(trace=self._trace)
 
     def _close_trace(self) -> None:
