@@ -126,7 +126,7 @@ class ModuleRT:
         self.path = unit.src.path if unit.src is not None else (unit.dat.path if unit.dat is not None else "")
         dl = unit.dat.module.data if unit.dat is not None else None
         self.datalist: N.DataList | None = dl
-        self.layout = dl.ann.storage if dl is not None and dl.ann is not None else None
+        self.layout = dl.ann.layout if dl is not None and dl.ann is not None else None
         n = len(self.layout.slots) if self.layout is not None else 0
         self.refs: list = [None] * n       # slot -> reference (the interpreters' storage)
         self.store: list = [UNSET] * n     # slot -> value of a variable
@@ -342,7 +342,7 @@ class Program:
                 if system_list and vn.name[:1] == "$":
                     self.rt.sysvars.declare(vn.name.upper(), ref, self._decl_span(vn, item))
         elif isinstance(item, N.ArrayInit):
-            st = item.ann.storage if item.ann is not None else None
+            st = item.ann.place if item.ann is not None else None
             ref = m.refs[st.slot] if st is not None else None
             if ref is None:
                 return
@@ -436,7 +436,7 @@ class _InitialiserEnv(Env):
         raise KrlRuntimeError("only literal values are allowed in a data list")
 
     def name(self, node: N.Name):
-        st = node.ann.storage if node.ann is not None else None
+        st = node.ann.place if node.ann is not None else None
         program = self.program
         if isinstance(st, Storage) and st.kind in (MODULE, GLOBAL):
             return lambda: program.data_ref(st).get()
@@ -445,8 +445,7 @@ class _InitialiserEnv(Env):
         raise KrlRuntimeError(f"unknown name {node.name} in a data list initialisation")
 
     def aggregate(self, node: N.Aggregate, items: list):
-        st = node.ann.storage if node.ann is not None else None
-        struc = st if isinstance(st, T.Struc) else None
+        struc = node.ann.struc if node.ann is not None else None
         return lambda: Struct(struc, {k: r() for k, r in items})
 
 

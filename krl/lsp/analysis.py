@@ -113,7 +113,7 @@ class Analysis:
 
     def resolved(self) -> "Analysis":
         """This analysis with every name placed by the resolver (krl/semantics/resolve.py:
-        ``ann.storage``); an incremental re-check (krl/lsp/incremental.py) leaves it to this."""
+        ``ann.place``, ``ann.callee``, ...); an incremental re-check (krl/lsp/incremental.py) leaves it to this."""
         if self.ws.resolver is None and self.ws.global_scope is not None:
             from krl.semantics.resolve import resolve_workspace  # noqa: PLC0415
             resolve_workspace(self.ws)
