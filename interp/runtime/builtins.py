@@ -1,9 +1,10 @@
 """Built-in functions and procedures (reference §4.5-§4.8, §5.12, §5.19).
 
-:func:`call_builtin` is the single entry: ``args`` is a list of references
-(:class:`memory.Ref`; an expression argument is wrapped in :class:`ValueRef`, an omitted
-one is None). :IN arguments are read with ``get()``, :OUT arguments written with ``set()``.
-:data:`NATIVES` lists what is implemented; signatures are the front end's data table
+:data:`NATIVES` maps each built-in the simulator implements (upper-case name: the key the resolver
+gives a NATIVE callee, krl/semantics/resolve.py; ``Runtime.native``) to ``fn(rt, args)``;
+``args`` is a list of references (:class:`memory.Ref`; an expression argument is wrapped in
+:class:`ValueRef`, an omitted one is None). :IN arguments are read with ``get()``, :OUT
+arguments written with ``set()``. Signatures are the front end's data table
 (krl/semantics/data/functions.yaml). BASIS routines (BAS, SVEL_JOINT, ...) are KRL in
 interp/basis/bas.src (or the backup's), not natives.
 
@@ -858,14 +859,5 @@ NATIVES: dict = {
     "GET_SIG_INF": _unsupported("GET_SIG_INF"), "GETSYSSTATE": _getsysstate,
 }
 
-# built-ins whose result type is needed to convert a native Python result
-FUNCTION_RESULT = {"ABS", "SQRT", "SIN", "COS", "TAN", "ACOS", "ATAN2", "FRAND"}
 
-
-def call_builtin(rt, name: str, args: list):
-    """Call native ``name`` (UPPER) with reference arguments; returns the value (None for
-    procedures). Raises KeyError if ``name`` is not a native."""
-    return NATIVES[name](rt, args)
-
-
-__all__ = ["NATIVES", "ValueRef", "call_builtin", "swrite_text", "sread_values", "parse_format"]
+__all__ = ["NATIVES", "ValueRef", "swrite_text", "sread_values", "parse_format"]
