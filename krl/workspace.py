@@ -38,7 +38,9 @@ from pathlib import Path
 from krl.ast import nodes as N
 from krl.ast.build import build_module
 from krl.files import Entry
-from krl.project import Project, collect_entries, folder_groups, is_system_path, project_of
+from krl.project import (ProgramFiles, collect_entries, folder_groups, is_submit_file, is_system_path, module_key,
+                         modules_of, project_of)
+from krl.project import module_files as project_module_files
 from krl.semantics.builtins import load_builtins
 from krl.semantics.checker import Checker, Declarer, _is_system_datalist
 from krl.diagnostics import Diagnostic, DiagnosticSink
@@ -362,23 +364,9 @@ class Workspace:
                 sym.alias, sym.module = target, target.module
 
     def _pair(self) -> None:
-        by_key: dict[tuple[str, str], ModuleUnit] = {}
-        for f in self.files:
-            p = Path(f.path)
-            key = (str(p.parent).lower(), p.stem.lower())
-            unit = by_key.get(key)
-            if unit is None:
-                unit = ModuleUnit(p.stem)
-                by_key[key] = unit
-                self.units.append(unit)
-            if f.module.kind == "dat" or p.suffix.lower() == ".dat":
-                if unit.dat is None:
-                    unit.dat = f
-            elif unit.src is None:
-                unit.src = f
-            else:  # two code files with one stem (e.g. x.src and x.sub): keep both as units
-                other = ModuleUnit(p.stem, src=f)
-                self.units.append(other)
+        """The modules of the files (krl/project.py rule 5, :func:`krl.project.modules_of`)."""
+        for name, code, dat in modules_of(self.files, lambda f: f.module.kind == "dat"):
+            self.units.append(ModuleUnit(name, src=code, dat=dat))
 
     def check(self) -> list[Diagnostic]:
         """Link the files into scopes and run the checker; returns the sorted diagnostics."""
@@ -483,7 +471,7 @@ class Workspace:
             declarer.soft_types = False
             if u.src.module.routines:
                 main = u.src.module.routines[0]
-                if main.name.upper() != u.name.upper() and not u.src.path.lower().endswith(".sub"):
+                if main.name.upper() != u.name.upper() and not is_submit_file(u.src.path):
                     sink.at(main.span, "W111", f"main routine '{main.name}' differs from the file name '{u.name}'")
 
         # routine scopes (parameters and locals), then signatures, then bodies
@@ -509,7 +497,7 @@ class Workspace:
             if self.check_only is not None and u.src.path not in self.check_only:
                 continue
             checker.system_file = declarer.soft_types = is_kuka_file(u.src.path)
-            checker.submit = u.src.path.lower().endswith(".sub")
+            checker.submit = is_submit_file(u.src.path)
             checker.check_routine(r, self.routine_scopes[id(r)], u.src.path)
         checker.system_file = declarer.soft_types = checker.submit = False
         finish_mark = len(sink.items)
@@ -648,28 +636,27 @@ def check_texts(files: dict[str, str]) -> Workspace:
 
 
 def module_files(path: Path) -> list[Path]:
-    """`path` and the other KRL files of its module: the .src/.dat/.sub beside it with the
-    same name (any case; links not followed)."""
-    files = [path]
+    """`path` and the other file of its module (krl/project.py rule 5): the .src/.sub and the
+    .dat beside it with the same name (any case; links not followed)."""
     try:
         siblings = sorted(path.parent.iterdir()) if path.parent.is_dir() else []
     except OSError:
         siblings = []
-    for sib in siblings:
-        if sib != path and sib.stem.lower() == path.stem.lower() and is_krl_file(sib) and not sib.is_symlink():
-            files.append(sib)
-    return files
+    key = module_key(path)
+    same = [sib for sib in siblings if module_key(sib) == key and is_krl_file(sib) and not sib.is_symlink()]
+    if path not in same:
+        same.append(path)
+    return [Path(f) for f in project_module_files(path, same)]
 
 
-def load_project(project: Project, root: str = "", timeout: float | None = None, jobs: int | None = None,
+def load_project(project: ProgramFiles, root: str = "", timeout: float | None = None, jobs: int | None = None,
                  extra: list[Path] = ()) -> Workspace:
     """The workspace of `project` (krl.project.project_of): its files in walk order, then
-    `extra` files (a run's BASIS, a submit program outside the project); the entries not read
-    are W002 warnings."""
+    `extra` files (a run's BASIS: krl.project.with_basis; a submit program outside the
+    project); the entries not read are W002 warnings."""
     ws = Workspace(root or str(project.root))
     files = project.files
-    known = {f.stem.lower() for f in files}
-    more = [f for f in extra if f.stem.lower() not in known and f not in files]
+    more = [f for f in extra if f not in files]
     _add_entries(ws, project.entries + [Entry(f, f.name, "file") for f in more], timeout, jobs)
     return ws
 

@@ -6,7 +6,8 @@
   command): the KRC backup holding the program (its whole root, ``R1`` and ``STEU``), else
   every KRL file below the program's folder (or ``--workspace``); outside a backup the
   project's BASIS (interp/basis: ``$config.dat``, ``bas.src``, ``ir_stopm.src``) is added as
-  the System folder, inside one the backup's own System folder is used;
+  the System folder (:func:`basis_files`, krl/project.py rule 4: its ``$config.dat`` merges
+  with a folder's own), inside one the backup's own System folder is used;
 * they are loaded, checked and resolved together by the front end
   (:func:`krl.workspace.load_project`, ``Workspace.check``; krl/semantics/resolve.py gives
   every use its storage class and slot, every call its routine, every statement its
@@ -30,7 +31,7 @@ from pathlib import Path
 
 from krl.ast import nodes as N
 from krl.diagnostics import SYNTAX_CODES
-from krl.project import project_of   # which files make the program: one rule
+from krl.project import project_of, with_basis   # which files make the program: one rule
 from krl.semantics import types as T
 from krl.semantics.expression import Env, evaluate
 from krl.semantics.resolve import GLOBAL, LOCAL, MODULE, SYSTEM, Storage
@@ -60,6 +61,14 @@ class SyntaxProblem(str):
         self.file = file
         self.line = line
         return self
+
+
+def basis_files(project) -> list[Path]:
+    """The files of the project's BASIS (:data:`BASIS_DIR`) that the program of `project`
+    (krl.project.ProgramFiles) runs on: krl/project.py rule 4 (none in a backup; the BASIS
+    ``$config.dat`` merges with the program's own; another BASIS module only when the program
+    has none of its name)."""
+    return with_basis(project, sorted(p for p in BASIS_DIR.iterdir() if p.is_file()))
 
 
 def parse_module(path: str):
@@ -150,8 +159,10 @@ class Program:
         self.backup = self.project.backup
         self.workspace = self.project.root
         self.system_dir = self.project.system if self.backup and self.project.system else BASIS_DIR
-        extra = [] if self.backup else sorted(p for p in BASIS_DIR.iterdir() if p.is_file())
-        extra += [Path(s).resolve() for s in submits if Path(s).resolve() not in self.project.files]
+        extra = basis_files(self.project)
+        own = {f.stem.lower() for f in self.project.files}
+        extra += [Path(s).resolve() for s in submits if Path(s).resolve() not in self.project.files
+                  and Path(s).stem.lower() not in own]
         self.ws = ws = checked_workspace(self.project, extra)
         self.check = check
         self.modules: list[ModuleRT] = [ModuleRT(self, i, u) for i, u in enumerate(ws.units)]
@@ -458,4 +469,4 @@ def _in_mada(m: ModuleRT) -> bool:
     return p is not None and p.parent.name.upper() == "MADA"
 
 
-__all__ = ["BASIS_DIR", "LOCAL", "ModuleRT", "Program", "SyntaxProblem", "checked_workspace", "parse_module"]
+__all__ = ["BASIS_DIR", "LOCAL", "ModuleRT", "Program", "SyntaxProblem", "basis_files", "checked_workspace", "parse_module"]
