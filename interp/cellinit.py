@@ -19,9 +19,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from krl.ast import nodes as N
+from krl.project import system_folder_of
 from krl.terminal import printable
 
-SKIP_DIRS = ("system", "mada", "steu")
 
 
 @dataclass
@@ -73,7 +73,8 @@ def _skipped(path: str, root: Path) -> bool:
         rel = p.resolve().relative_to(root.resolve())
     except ValueError:
         return True        # the project's BASIS, or a file outside the backup
-    return p.name.startswith("$") or any(x.lower() in SKIP_DIRS for x in rel.parts[:-1])
+    # KUKA's system folders (krl/project.py), but TP: P00's handshake reads cell inputs
+    return p.name.startswith("$") or system_folder_of(rel) not in (None, "tp")
 
 
 def inputs_read(rt, root: Path) -> list[InputUse]:

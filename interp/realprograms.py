@@ -52,7 +52,7 @@ from pathlib import Path
 
 from interp.runtime.core import TARGET_OUTSIDE_NOTE
 from krl.files import SHARED_CORPUS as DEFAULT_CORPUS
-from krl.project import backup_of, find_backups, system_folder
+from krl.project import backup_of, find_backups, system_folder, system_folder_of
 
 LEGITIMATE = ("deadlock", "halt", "max_sim_time", "max_steps")
 
@@ -152,9 +152,10 @@ def programs_of(root: Path) -> list[Path]:
     for p in sorted(root.rglob("*")):
         if p.suffix.lower() != ".src" or not p.is_file():
             continue
-        parts = [x.upper() for x in p.relative_to(root).parts]
-        if "SYSTEM" in parts or "TP" in parts or "MADA" in parts:
+        rel = p.relative_to(root)
+        if system_folder_of(rel) is not None:        # KUKA's system folders (krl/project.py)
             continue
+        parts = [x.upper() for x in rel.parts]
         if "PROGRAM" in parts or p.stem.upper() == "CELL" or p.parent == root:
             cands.append(p)
     out = []
@@ -193,24 +194,26 @@ def step_limit(max_steps: int, max_sim_time: float, n_submits: int, ipo_cycle_s:
     return max_steps + n_submits * SUBMIT_BUDGET * cycles
 
 
-def time_limit(path: Path, cell: Path | None, default: float) -> float:
+def time_limit(path: Path, cell, default: float) -> float:
     """The simulated-time limit (s) of a run of `path`: `default`, or the longer time its cell
-    file says the program needs (``sim_time``, robot/stimuli.py)."""
+    file (a path or a Cell: interp.run.cell_of) says the program needs (``sim_time``,
+    robot/stimuli.py)."""
     if cell is None:
         return default
-    from robot.stimuli import load_cell  # noqa: PLC0415
+    from interp.run import cell_of  # noqa: PLC0415
 
-    return max(default, load_cell(cell).sim_time.get(path.stem.upper(), 0.0))
+    return max(default, cell_of(cell).sim_time.get(path.stem.upper(), 0.0))
 
 
 def report_run(path: Path, cell: Path | None, max_sim_time: float = REPORT_SIM_TIME_S,
                max_steps: int = REPORT_STEPS) -> tuple:
     """``(robot, submit programs, simulated-time limit s, step limit)`` of the report's run of
-    `path` with its cell file (this report and the conformance report's real programs): the
-    cell's robot, else the backup's own, else the KR 6 R900 (interp.run.robot_for); the
-    backup's SPS.SUB; :func:`time_limit` and :func:`step_limit`."""
-    from interp.run import robot_for  # noqa: PLC0415
+    `path` with its cell file (a path or a Cell; this report and the conformance report's real
+    programs): the cell's robot, else the backup's own, else the KR 6 R900
+    (interp.run.robot_for); the backup's SPS.SUB; :func:`time_limit` and :func:`step_limit`."""
+    from interp.run import cell_of, robot_for  # noqa: PLC0415
 
+    cell = cell_of(cell)
     robot = robot_for(path, inputs=cell)
     submit = submit_of(path)
     t = time_limit(path, cell, max_sim_time)
@@ -218,12 +221,14 @@ def report_run(path: Path, cell: Path | None, max_sim_time: float = REPORT_SIM_T
 
 
 def run_one(path: Path, max_sim_time: float, max_steps: int, cell: Path | None = None) -> dict:
-    from interp.run import make_runtime  # noqa: PLC0415
+    from interp.run import cell_of, make_runtime  # noqa: PLC0415
     from robot.trace import TraceWriter  # noqa: PLC0415
 
     t0 = time.time()
     tw = TraceWriter(keep=False)
+    shown = cell
     try:
+        cell = cell_of(cell)          # the cell file, read once for the robot, the limits and the run
         robot, submit, max_sim_time, limit = report_run(path, cell, max_sim_time, max_steps)
         own = _own_machine_data(path, robot.source)
         # --no-check: the report says how each real program runs, also those the checker rejects
@@ -235,7 +240,7 @@ def run_one(path: Path, max_sim_time: float, max_steps: int, cell: Path | None =
         fired = [r.last_fired for r in rules if r.last_fired is not None]
     except Exception as exc:  # noqa: BLE001 - an internal error is a bug to report
         row = {"program": str(path), "reason": "internal", "text": f"{type(exc).__name__}: {exc}",
-               "seconds": round(time.time() - t0, 2), "cell": str(cell) if cell else None}
+               "seconds": round(time.time() - t0, 2), "cell": str(shown) if shown else None}
         row["cause"] = cause_of(row)
         return row
     del tw
@@ -244,7 +249,7 @@ def run_one(path: Path, max_sim_time: float, max_steps: int, cell: Path | None =
            "file": res.file, "line": res.line, "sim_time": round(res.sim_time, 3),
            "steps": res.steps, "stubs": stubs, "submit": submit_errors(rt),
            "seconds": round(time.time() - t0, 2),
-           "cell": str(cell) if cell else None, "cell_answers": sum(r.fired for r in rules),
+           "cell": str(shown) if shown else None, "cell_answers": sum(r.fired for r in rules),
            "cell_last": round(max(fired), 3) if fired else None,
            "robot": robot.name, "robot_own": own}
     row["cause"] = cause_of(row)
