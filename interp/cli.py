@@ -115,7 +115,7 @@ def _run(program: Path, workspace, inputs, trace_path, max_sim_time, max_steps, 
 
         booted = boot_submit(program, workspace)
         submit = (booted,) if booted is not None else ()
-    from interp.run import make_runtime, robot_for  # noqa: PLC0415
+    from interp.run import cell_of, make_runtime, robot_for  # noqa: PLC0415
     from interp.summary import RunObserver, starvation_lines, summary_lines  # noqa: PLC0415
     from robot.mada import MachineDataError  # noqa: PLC0415
     from krl.terminal import printable  # noqa: PLC0415
@@ -123,6 +123,7 @@ def _run(program: Path, workspace, inputs, trace_path, max_sim_time, max_steps, 
     from robot.trace import TraceWriter  # noqa: PLC0415
 
     try:
+        inputs = cell_of(inputs)      # the cell file, read once: the robot and the run take it
         machine = robot_for(program, workspace, robot, inputs)
     except (MachineDataError, StimulusError) as exc:
         click.echo(f"error: {shown(printable(exc))}", err=True)

@@ -22,6 +22,7 @@ def make_runtime(program, *, workspace=None, inputs=None, trace=None, max_sim_ti
     error). `vm_loop`: the VM's dispatch loop, "generated" (interp/vm/loop.py) or "source"
     (VM.run as written; tests compare the two). `observer` (an :class:`interp.summary.RunObserver`) sees the
     controller's events on their way to `trace`; it is not used with a given `controller`.
+    `inputs`: the cell file (a path, or the Cell :func:`cell_of` read; read once per run).
     ``mode``: operating mode T1/T2/AUT/EXT (``$MODE_OP``; default AUT, robot/limits.py);
     ignored with a given `controller` (it has its own); None: AUT, or EXT when the cell file
     (`inputs`) has the ``autoext`` preset. ``pgno``: the program number the cell's PLC answers
@@ -39,10 +40,10 @@ def make_runtime(program, *, workspace=None, inputs=None, trace=None, max_sim_ti
 
         if observer is not None:
             observer.inner = trace
-        controller = Controller(robot_for(program, workspace, robot, inputs),
+        cell = cell_of(inputs)       # the cell file, read once for the robot and the controller
+        controller = Controller(robot_for(program, workspace, robot, cell),
                                 trace=observer if observer is not None else trace,
-                                stimuli=str(inputs) if inputs else None, mujoco=mujoco,
-                                mode_op=mode)
+                                stimuli=cell, mujoco=mujoco, mode_op=mode)
     rt = Runtime(program, workspace=workspace, controller=controller, trace=trace,
                  max_sim_time=max_sim_time, max_steps=max_steps, robot_budget=robot_budget,
                  submits=list(submit or ()), check=check)
@@ -106,6 +107,16 @@ def global_value(rt: Runtime, main: str, name: str):
         return rt.storage_ref(prog.ws.resolver.storage(name, sym, None, module.index if module else -1), None).get()
     except KrlRuntimeError:
         return None
+def cell_of(inputs):
+    """The cell file `inputs` read by its one loader (robot.stimuli.load_cell), or `inputs`
+    itself when it is a Cell already, or None. Raises robot.stimuli.StimulusError."""
+    if not inputs:
+        return None
+    from robot.stimuli import Cell, load_cell  # noqa: PLC0415
+
+    return inputs if isinstance(inputs, Cell) else load_cell(inputs)
+
+
 def robot_for(program, workspace=None, robot=None, inputs=None):
     """The robot a run of `program` simulates (issue 22): `robot` when given (a MachineData,
     or a path: robot YAML, ``$machine.dat``, backup folder or .zip, robot/mada.py
@@ -121,9 +132,7 @@ def robot_for(program, workspace=None, robot=None, inputs=None):
     if isinstance(robot, MachineData):
         return robot
     if robot is None and inputs:
-        from robot.stimuli import load_cell  # noqa: PLC0415
-
-        robot = load_cell(inputs).robot
+        robot = cell_of(inputs).robot
     if robot is not None:
         return load_robot(robot)
     root = backup_of(Path(program).resolve(), Path(workspace).resolve() if workspace else None)
