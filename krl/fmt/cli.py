@@ -1,8 +1,8 @@
 """`krl fmt [--check] [--diff] [--keyword-case upper|lower|keep] [--indent N|tab] PATHS...`
 (registered by krl/cli/__init__.py).
 
-PATHS are KRL files (.src, .dat, .sub) or folders, walked by krl/files.py ``walk`` as
-``krl check`` walks them: a symbolic link, FIFO, socket or device named like a KRL file and a
+PATHS are KRL files (.src, .dat, .sub) or folders, listed by the project model
+(krl/project.py ``folder_entries``) as ``krl check`` walks them: a symbolic link, FIFO, socket or device named like a KRL file and a
 folder more than ``MAX_FOLDER_DEPTH`` levels deep are never read nor written; each is reported
 on stderr as a W002 warning naming it (``path:1:1: warning[W002]: not read: a symbolic link
 (never followed)``), as is a folder that cannot be listed. ``-`` alone formats standard input
@@ -30,14 +30,12 @@ import re
 import sys
 from collections.abc import Iterator
 from pathlib import Path
-from typing import TYPE_CHECKING
 
 import click
 
+from krl.files import Entry
 from krl.fmt.core import FormatError, FormatOptions, FormatSyntaxError, format_text
-
-if TYPE_CHECKING:
-    from krl.files import Entry
+from krl.project import folder_entries
 
 _LINE_END = re.compile(r"\r\n|\n|\r")
 
@@ -49,16 +47,15 @@ _UNREADABLE = ("unreadable_folder", "unreadable")
 def fmt_entries(paths) -> Iterator[tuple[Entry, bool]]:
     """What `krl fmt PATHS` works on, in order: (krl/files.py entry, named). A path that is
     not a folder is one ``file`` entry, named (a named link is followed; a missing path is
-    reported unreadable when read). A folder (also one named through a link) is walked by
-    :func:`krl.files.walk`, the one folder walk of the project: iterative, links inside never
-    followed, every link, FIFO/socket/device, unreadable or too deep folder (past
-    krl/limits.py ``MAX_FOLDER_DEPTH``) listed as an entry that is not read."""
-    from krl.files import Entry, walk  # noqa: PLC0415
-
+    reported unreadable when read). A folder (also one named through a link) is listed by the
+    project model (krl/project.py ``folder_entries``, the walk ``krl check`` makes of it:
+    krl/files.py, iterative, links inside never followed, every link, FIFO/socket/device,
+    unreadable or too deep folder (past krl/limits.py ``MAX_FOLDER_DEPTH``) listed as an entry
+    that is not read)."""
     for raw in paths:
         p = Path(raw)
         if p.is_dir():
-            for e in walk(p):
+            for e in folder_entries(p):
                 yield e, False
         else:
             yield Entry(p, str(p), "file"), True

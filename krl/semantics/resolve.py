@@ -108,9 +108,12 @@ class Callee:
 
 
 @dataclass(slots=True, eq=False)
-class Slot:
-    """One slot of a Layout: the declared spelling, the symbol, its declaration node (VarDecl,
-    SignalDecl or Param), the VarName for a variable, its type and the parameter mode."""
+class LayoutSlot:
+    """What the front end knows of one slot of a Layout (a *slot* is a numbered place of a
+    frame or a data list: ``Storage.slot``): the declared spelling, the symbol, its declaration
+    node (VarDecl, SignalDecl or Param), the VarName for a variable, its type and the
+    parameter mode. At run time the value of a slot is reached through a reference
+    (interp/runtime/memory.py ``Slot``)."""
     name: str
     symbol: Symbol | None
     decl: object
@@ -124,7 +127,7 @@ class Layout:
     """The slots of a routine's frame (parameters first: ``nparams``) or of a data list,
     and the scope the names were resolved in (VARSTATE's text, typed expressions and tools
     use it)."""
-    slots: list[Slot] = field(default_factory=list)
+    slots: list[LayoutSlot] = field(default_factory=list)
     nparams: int = 0
     scope: Scope | None = None
     owner: int = -1
@@ -149,10 +152,10 @@ def _data_layout(dl: N.DataList, owner: int) -> Layout:
                 if v.name.upper() in seen:
                     continue
                 seen.add(v.name.upper())
-                lay.slots.append(Slot(v.name, N.symbol_of(v), d, v, N.type_of(v)))
+                lay.slots.append(LayoutSlot(v.name, N.symbol_of(v), d, v, N.type_of(v)))
         elif isinstance(d, N.SignalDecl) and d.name.upper() not in seen:
             seen.add(d.name.upper())
-            lay.slots.append(Slot(d.name, None, d))
+            lay.slots.append(LayoutSlot(d.name, None, d))
     return lay
 
 
@@ -168,7 +171,7 @@ def _routine_layout(r: N.Routine, scope: Scope | None, owner: int) -> Layout:
             continue
         seen.add(key)
         sym = values.get(key)
-        lay.slots.append(Slot(p.name, sym, p, type=sym.type if sym is not None else None, mode=p.mode))
+        lay.slots.append(LayoutSlot(p.name, sym, p, type=sym.type if sym is not None else None, mode=p.mode))
     lay.nparams = len(lay.slots)
     for d in r.decls:
         if isinstance(d, N.VarDecl):
@@ -182,10 +185,10 @@ def _routine_layout(r: N.Routine, scope: Scope | None, owner: int) -> Layout:
                         lay.slots[i].type = N.type_of(v)
                     continue
                 seen.add(key)
-                lay.slots.append(Slot(v.name, values.get(key), d, v, N.type_of(v)))
+                lay.slots.append(LayoutSlot(v.name, values.get(key), d, v, N.type_of(v)))
         elif isinstance(d, N.SignalDecl) and d.name.upper() not in seen:
             seen.add(d.name.upper())
-            lay.slots.append(Slot(d.name, values.get(d.name.upper()), d))
+            lay.slots.append(LayoutSlot(d.name, values.get(d.name.upper()), d))
     return lay
 
 
