@@ -6,7 +6,13 @@ Cython (interp/vm/build.py; the C types of its locals are in loop.pxd) when a co
 there; vm.py runs the compiled module only when its VM_SOURCE matches vm.py."""
 # ruff: noqa
 
-from interp.vm.vm import (INT_MAX, INT_MIN, KrlRuntimeError, Slot, Struct, UNSET, ValueRef, add, array_index, component, element, element1, element2, ended_without_return, eq, for_done, for_limits, for_next, function_result, ge, gt, le, load, lt, math, mul, ne, read_value, return_without_value, set_component, set_element, set_element1, store, sub)
+import math
+from interp.runtime.builtins import (ValueRef)
+from interp.runtime.convert import (INT_MAX, INT_MIN)
+from interp.runtime.errors import (KrlRuntimeError)
+from interp.runtime.memory import (Slot)
+from interp.runtime.slots import (add, array_index, component, element, element1, element2, ended_without_return, eq, for_done, for_limits, for_next, function_result, ge, gt, le, load, lt, mul, ne, read_value, return_without_value, set_component, set_element, set_element1, store, sub)
+from interp.runtime.values import (Struct, UNSET)
 
 # sha256 of the vm.py this file was generated from
 VM_SOURCE = '5666798175c96f95f2112c295a4c3a59cd1c9ef6e8d3724240f8783aa2b62fcb'

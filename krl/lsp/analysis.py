@@ -13,6 +13,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from krl.ast import nodes as N
+from krl.lsp.names import is_uri
 from krl.lsp.parsing import Parsed
 from krl.semantics import types as T
 from krl.semantics.checker import Checker, Declarer
@@ -142,7 +143,6 @@ class Analysis:
     def diagnostics_for(self, path: str) -> list[Diagnostic]:
         """The workspace's diagnostics of one file, with the root's krl.toml applied."""
         diags = sorted((d for d in self.ws.sink.items if d.path == path), key=lambda d: (d.line, d.column, d.code))
-        from krl.lsp.project import is_uri  # noqa: PLC0415
         if is_uri(path):        # an unsaved new buffer has no file name to match its main routine
             diags = [d for d in diags if d.code != "W111"]
         try:

@@ -10,30 +10,15 @@ the whole workspace from the cached parses; only changed buffers and files are p
 from __future__ import annotations
 
 import os
-import re
 import time
 from pathlib import Path
 
 from krl.lsp.analysis import Analysis, build_analysis
+from krl.lsp.names import is_uri, norm
 from krl.lsp.parsing import ParseCache, Parsed, parse_disk
 from krl.lsp.roots import workspace_of
 
-_SCHEME = re.compile(r"^[A-Za-z][A-Za-z0-9+.-]+:")
 ROOTS_TTL_S = 2.0        # seconds a workspace's file list is trusted before it is listed again
-
-
-def norm(path: str | Path) -> str:
-    """One spelling per file: absolute, normalised (symbolic links kept). A document that is
-    not a file (``untitled:...``) keeps its URI as its name."""
-    p = str(path)
-    if is_uri(p):
-        return p
-    return os.path.normpath(os.path.abspath(p))
-
-
-def is_uri(name: str) -> bool:
-    """True for a document name that is a URI, not a file path (``untitled:Untitled-1``)."""
-    return bool(_SCHEME.match(name)) and not os.path.isabs(name)
 
 
 class Project:
