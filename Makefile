@@ -25,7 +25,7 @@ check-java:
 	  echo "       On Debian/Ubuntu: sudo apt-get install -y openjdk-17-jre-headless"; exit 2; }
 	@java -version 2>&1 | awk -F'"' '/version/ { split($$2, v, "."); if ((v[1] == 1 ? v[2] : v[1]) + 0 < 11) { print "error: Java 11 or later is needed, found " $$2; exit 2 } }'
 
-$(BIN)/.installed: pyproject.toml constraints.txt | check-python
+$(BIN)/.installed: pyproject.toml setup.py constraints.txt | check-python
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/pip install --quiet --upgrade pip
 	$(BIN)/pip install --quiet -c constraints.txt -e '.[dev]'
@@ -48,13 +48,14 @@ $(JAVA_STAMP): $(PARSER)
 
 java-parser: $(JAVA_STAMP)
 
-# The compiled VM loop: Cython compiles the generated interp/vm/loop.py (with loop.pxd) into
-# an extension beside it (interp/vm/build.py). Without Cython or a C compiler it says so and
+# The compiled VM loop: every install builds it (setup.py); this target rebuilds it in place
+# after loop.py was regenerated. Cython compiles the generated interp/vm/loop.py (with loop.pxd)
+# into an extension beside it (interp/vm/build.py). Without Cython or a C compiler it says so and
 # the pure-Python loop.py runs.
 vm-loop: $(BIN)/.installed
 	@$(BIN)/python -m interp.vm.build
 
-recover: $(PARSER) java-parser
+recover: $(PARSER) java-parser vm-loop
 	$(BIN)/krl recover $(CORPUS) --out $(OUT); status=$$?; \
 	  if [ $$status -le 1 ]; then echo "report: $(OUT)/report.html (open it in a browser; Markdown: $(OUT)/report.md)"; exit 0; else exit $$status; fi
 

@@ -14,7 +14,7 @@ def make_runtime(program, *, workspace=None, inputs=None, trace=None, max_sim_ti
                  robot_budget=None, interp: str = "tree", observer=None,
                  mode: str | None = None, check: bool = True,
                  vm_loop: str = "generated", run_mode: str | None = None,
-                 pgno: int | None = None, robot=None) -> tuple[Runtime, object]:
+                 pgno: int | None = None, robot=None, network=None) -> tuple[Runtime, object]:
     """Build the runtime and the interpreter (``interp``: tree or vm) for ``program``
     (not started yet). Its files (krl.project.project_of, with the `submit` programs) are
     loaded, checked and resolved first; with `check` (``krl run`` without ``--no-check``) a
@@ -30,7 +30,10 @@ def make_runtime(program, *, workspace=None, inputs=None, trace=None, max_sim_ti
     ``run_mode``: ``$PRO_MODE`` at the start (GO, MSTEP, ISTEP, BSTEP; interp/runtime/runmode.py;
     default GO). ``robot``: the simulated robot (a MachineData or a path for
     :func:`robot.mada.load_robot`); default :func:`robot_for` (the cell file's ``robot``, else the
-    backup's own robot, else the KR 6 R900). Raises
+    backup's own robot, else the KR 6 R900). ``network``: the partners
+    (net.settings.NetworkSettings; default the cell file's ``network:`` key): the run's network
+    hub (net/hub.py) is attached to the controller either way; without partners its EKI
+    channels stay "not connected". Raises
     :class:`robot.stimuli.StimulusError` for a bad cell file or a preset the backup's
     ``$config.dat`` does not allow."""
     from interp.tree import TreeInterpreter  # noqa: PLC0415
@@ -49,6 +52,7 @@ def make_runtime(program, *, workspace=None, inputs=None, trace=None, max_sim_ti
                  submits=list(submit or ()), check=check)
     if run_mode is not None:
         rt.set_run_mode(run_mode)
+    attach_network(rt, program, workspace, network if network is not None else getattr(controller, "cell_network", None))
     if observer is not None:
         # The interpreters trace into the user's trace only: without one the VM keeps its
         # quiet fast path (Runtime.quiet_limit); the observer needs the controller's events.
@@ -75,6 +79,28 @@ def make_runtime(program, *, workspace=None, inputs=None, trace=None, max_sim_ti
         sp = Path(sub).resolve()
         rt.add_task("submit", sp.stem, lambda name=sp: interp.run_program(name))
     return rt, interp
+
+
+def attach_network(rt: Runtime, program, workspace, settings) -> None:
+    """The run's network hub (net/hub.py) on `rt`'s controller, with `settings` (None: no
+    partner). Raises net.hub.NetError when a partner's server cannot start."""
+    from krl.project import backup_of  # noqa: PLC0415
+    from net.hub import Network  # noqa: PLC0415
+
+    from interp.runtime.netvars import RuntimeSink  # noqa: PLC0415
+
+    old = getattr(rt.controller, "network", None)
+    if old is not None:
+        old.close()
+    root = backup_of(Path(program).resolve(), Path(workspace).resolve() if workspace else None)
+    net = Network(settings, program=Path(program).resolve(), backup=root, sink=RuntimeSink(rt))
+    try:
+        net.attach(rt.controller)
+    except OSError as exc:
+        net.close()
+        from net.hub import NetError  # noqa: PLC0415
+
+        raise NetError(f"a network partner cannot start: {exc.strerror or exc}") from None
 
 
 def _pgno_rules(rt: Runtime, main: str, number: int) -> list:
@@ -107,6 +133,8 @@ def global_value(rt: Runtime, main: str, name: str):
         return rt.storage_ref(prog.ws.resolver.storage(name, sym, None, module.index if module else -1), None).get()
     except KrlRuntimeError:
         return None
+
+
 def cell_of(inputs):
     """The cell file `inputs` read by its one loader (robot.stimuli.load_cell), or `inputs`
     itself when it is a Cell already, or None. Raises robot.stimuli.StimulusError."""

@@ -152,3 +152,45 @@ MAX_DIFF_ENTRIES = 20_000
 # The program map (`krl graph`, krl/programmap): the largest map rendered through Graphviz
 # (DOT/SVG) and the HTML page, in nodes. Past it: an error naming the count (JSON has no limit).
 MAX_GRAPH_NODES = 5000
+
+# The controller on the network (net/, docs/network.md, docs/security.md "Network"). Everything
+# that arrives on a socket is untrusted; every size, rate and count below ends in an EKI/RSI
+# message, a closed connection or a stopped motion, never in unbounded memory or a hang.
+# EthernetKRL (KUKA.EthernetKRL manual): at most 16 channels at once (the manual's limit of
+# active connections); at most 512 entries buffered per element (BUFFERING Limit's system
+# maximum); one message at most BUFFSIZE bytes, default 16384 and at most 65534 (the manual's
+# range); a channel's XML configuration at most 256 KiB (real ones are a few KiB).
+MAX_EKI_CHANNELS = 16
+MAX_EKI_BUFFERING = 512
+EKI_BUFFSIZE_DEFAULT = 16384
+MAX_EKI_BUFFSIZE = 65534
+MAX_NET_CONFIG_BYTES = 256 * 1024
+# One received XML message: the deepest element nesting and the most elements and attributes
+# (real EKI and RSI messages nest 3-4 levels and carry a few dozen values). Past either: the
+# message is refused as unreadable (EKI01024, RSI: a late packet).
+MAX_NET_XML_DEPTH = 32
+MAX_NET_XML_NODES = 4096
+# Bytes read from one connection in one IPO cycle (12 ms): 256 KiB is 21 MB/s, far above any
+# partner (RSI sends about 1 KiB per cycle); a flood past it waits in the kernel's buffer, so a
+# partner cannot make one cycle take unbounded time or memory.
+MAX_NET_BYTES_PER_CYCLE = 256 * 1024
+# RSI (KUKA.RobotSensorInterface): one UDP datagram at most 8 KiB (a real answer is under 1 KiB);
+# datagrams read per cycle at most 64 (the rest are dropped by the kernel).
+MAX_RSI_DATAGRAM_BYTES = 8 * 1024
+MAX_RSI_DATAGRAMS_PER_CYCLE = 64
+# KukaVarProxy (OpenShowVar protocol): clients at once (KukaVarProxy itself takes 10), requests
+# answered per client per IPO cycle, and the longest variable name and value text (the protocol
+# counts them in 16 bits; real names are under 30 characters, values under 300).
+MAX_VARPROXY_CLIENTS = 10
+MAX_VARPROXY_REQUESTS_PER_CYCLE = 16
+MAX_VARPROXY_NAME_CHARS = 256
+MAX_VARPROXY_VALUE_CHARS = 4096
+# The PLC side (Modbus TCP, OPC UA): clients at once on each server.
+MAX_PLC_CLIENTS = 8
+# A recorded message sequence replayed into a run (`network: {replay: trace.jsonl}`): its
+# largest file, in bytes, and its most network events.
+MAX_NET_REPLAY_BYTES = 64 * 1024 * 1024
+MAX_NET_REPLAY_EVENTS = 1_000_000
+# The wall-clock pace factor of a run with a partner attached (simulated s per wall s): 1 is
+# real time; up to 10 where the protocol allows (EKI, KukaVarProxy, the PLC), never for RSI.
+MAX_NET_PACE = 10.0

@@ -205,11 +205,13 @@ class Controller:
         self.machine = machine if machine is not None else load_machine()
         self.rules: list[Rule] = []
         self.pgno: int | None = None      # the cell file's pgno preset (interp/run.py builds its rules)
+        self.cell_network = None          # the cell file's `network:` settings (interp/run.py attaches them)
         if isinstance(stimuli, (str, Path)):
             raise TypeError("a cell file is read by robot.stimuli.load_cell; pass its Cell")
         if isinstance(stimuli, Cell):
             cell = stimuli
             stimuli, self.rules, self.pgno = cell.stimuli, list(cell.rules), cell.pgno
+            self.cell_network = cell.network
             if cell.autoext and mode_op is None:
                 mode_op = "EX"            # Automatic External (robot/cellpresets.py)
         for st in stimuli or ():
@@ -263,6 +265,7 @@ class Controller:
         self._step_lim: list[float] | None = None   # largest axis step per cycle (_check_speed)
         self._ret_q: np.ndarray | None = None
         self._ended = False
+        self.network = None     # net.hub.Network: the partners, polled at each cycle's start
 
     # ================================================================= clock
     @property
@@ -353,7 +356,8 @@ class Controller:
         cell rule with an answer pending or about to fire (for deadlock detection of WAIT FOR)."""
         return (any(not st.fired for st in self.stimuli) or bool(self._pulses)
                 or bool(self._cyclic) or not all(self.io.timer_stop[1:])
-                or (bool(self.rules) and rules_may_fire(self.rules, self.io)))
+                or (bool(self.rules) and rules_may_fire(self.rules, self.io))
+                or (self.network is not None and self.network.may_change()))
 
     def is_moving(self) -> bool:
         """True while a motion is being executed."""
@@ -610,6 +614,8 @@ class Controller:
         self._k += 1
         t = self.time
         self.io.now = t
+        if self.network is not None:
+            self.network.cycle(self)
         self.io.tick_timers(self._dt_ms)
         if self._pulses:
             keep = []

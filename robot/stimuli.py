@@ -29,6 +29,8 @@ A *cell file* is a stimuli file with reactive rules and presets beside (issue 22
 ``robot`` names the robot the cell holds, when the backup has no machine data of its own: one
 of the project's robot library (robot/machine.py ``library_robots``; a name, never a path, as
 the file is untrusted). ``krl run --robot`` overrides it; it overrides the backup's machine data.
+``network`` names the partners the run connects (EKI channels, RSI, the PLC's Modbus TCP and
+OPC UA servers, KukaVarProxy; net/settings.py, docs/network.md).
 ``sim_time`` maps a program's name to the simulated time (s, at most
 :data:`~krl.limits.MAX_CELL_SIM_TIME_S`) it needs to reach its end, for a long job: the
 real-programs report runs it that long when that is longer than its own limit.
@@ -63,7 +65,7 @@ from .cellrules import ConditionError, Rule, compile_condition, parse_condition
 from .io import IOError_, parse_signal
 
 PHASES = ("start", "blend_start", "blend_end", "end")
-TOP_KEYS = ("stimuli", "rules", "presets", "robot", "sim_time")
+TOP_KEYS = ("stimuli", "rules", "presets", "robot", "sim_time", "network")
 PRESET_KEYS = ("pgno", "autoext")
 RULE_KEYS = ("when", "after", "set")
 STIMULUS_KEYS = ("at", "when", "set", "delay")
@@ -211,6 +213,7 @@ class Cell:
     autoext: bool = False          # presets: Automatic External (operating mode EXT)
     robot: Path | None = None      # the robot of the project's library the cell names
     sim_time: dict[str, float] = field(default_factory=dict)   # PROGRAM (upper case) -> s it needs
+    network: Any = None            # net.settings.NetworkSettings: the partners (`network:`, docs/network.md)
 
 
 def _parse_rules(doc: Any, where: _Where, key_where: str) -> list[Rule]:
@@ -273,6 +276,13 @@ def parse_cell(doc: Any, default_reach_mm: float = 0.1, source: str = "") -> Cel
             cell.sim_time = _sim_times(doc["sim_time"], where, where(doc, "sim_time"))
         if doc.get("stimuli") is not None:
             cell.stimuli = _parse_stimuli(doc["stimuli"], default_reach_mm, where)
+        if doc.get("network") is not None:
+            from net.settings import SettingsError, parse_network  # noqa: PLC0415
+
+            try:
+                cell.network = parse_network(doc["network"], Path(source).parent if source else Path("."))
+            except SettingsError as exc:
+                raise StimulusError(f"{where(doc, 'network')}: {exc}") from None
         return cell
     return Cell(_parse_stimuli(doc, default_reach_mm, where))
 

@@ -70,6 +70,14 @@ SCHEMA: dict[str, list[tuple[str, str]]] = {
         ("line", "optional int: source line where the run ended"),
         ("context", "optional str: main | interrupt | trigger | submit"),
     ],
+    "net": [
+        ("iface", "str: eki | rsi | varproxy | plc (net/, docs/network.md)"),
+        ("dir", "str: in (a message arrived) | out (sent) | connect | disconnect | refused | error"),
+        ("name", "optional str: the EKI channel"),
+        ("data", "optional str: the message (bytes as Latin-1; the replay feeds them back)"),
+        ("number", "optional int: the EKI/RSI message number of an error"),
+        ("text", "optional str: detail (why a connection ended, what was refused)"),
+    ],
     "robot": [
         ("name", "str: the simulated robot, e.g. 'KR210R2700_2 C4 FLR' (krl run's trace header, t=0)"),
         ("source", "str: where its data came from: a $machine.dat path or a robot YAML"),

@@ -10,6 +10,7 @@ verifies that the wheel's dependency ranges accept the pinned versions.
 
 from __future__ import annotations
 
+import json
 import shutil
 import subprocess
 import sys
@@ -38,10 +39,10 @@ def wheel(tmp_path_factory) -> Path:
     if not (REPO / "krl/syntax/generated/KRLParser.py").is_file():
         pytest.fail("the generated parser is missing: run `make parser` first")
     src = tmp_path_factory.mktemp("src")
-    for name in ("pyproject.toml", "README.md", "LICENSE"):
+    for name in ("pyproject.toml", "setup.py", "README.md", "LICENSE"):
         shutil.copy2(REPO / name, src / name)
     for pkg in PACKAGES:
-        shutil.copytree(REPO / pkg, src / pkg, ignore=shutil.ignore_patterns("__pycache__", "*.pyc"))
+        shutil.copytree(REPO / pkg, src / pkg, ignore=shutil.ignore_patterns("__pycache__", "*.pyc", "*.so"))
     out = tmp_path_factory.mktemp("dist")
     res = _run([sys.executable, "-m", "pip", "wheel", "--no-deps", "-q", "-w", str(out), str(src)])
     assert res.returncode == 0, res.stdout + res.stderr
@@ -58,6 +59,10 @@ def test_wheel_ships_the_generated_parser_and_the_data(wheel):
                    "krl/semantics/data/sysvars.yaml", "interp/basis/bas.src", "robot/data/kr6_r900.yaml"):
         assert needed in names, needed
     assert not any(n.startswith("tests/") for n in names)
+    # the package build compiles the VM's dispatch loop (setup.py, interp/vm/build.py): the wheel
+    # carries the extension beside the pure-Python loop.py, its fallback
+    ext = "interp/vm/loop" + sysconfig.get_config_var("EXT_SUFFIX")
+    assert ext in names and "interp/vm/loop.py" in names
 
 
 def test_installed_wheel_checks_a_backup_without_java(wheel, tmp_path):
@@ -106,6 +111,11 @@ def test_installed_wheel_checks_a_backup_without_java(wheel, tmp_path):
     where, tool = res.stdout.splitlines()[-2:]
     assert Path(where).is_relative_to(site), where
     assert tool == "[]"
+
+    # the installed VM runs the compiled loop, and the benchmark says so
+    res = _run([str(bindir / "krl"), "bench", "vm", "--repeat", "1", "--json"], env=env, cwd=work)
+    assert res.returncode == 0, res.stdout + res.stderr
+    assert json.loads(res.stdout)["vm_loop"] == "compiled", res.stdout
 
 
 def test_constraints_pin_installed_versions_and_every_dependency():

@@ -118,7 +118,9 @@ class Baseline:
 
 def compute(repeat: int = 3, baseline: Baseline | None = None) -> dict:
     """Best-of-``repeat`` times of tree, VM and Python (and, with `baseline`, the tree
-    interpreter of another revision), interleaved in this run; ratios and statement rates."""
+    interpreter of another revision), interleaved in this run; ratios and statement rates,
+    and ``vm_loop``: which dispatch loop the VM ran ("compiled": the Cython build of
+    interp/vm/loop.py; "python": loop.py itself, when no current build exists)."""
     best = {"tree": None, "vm": None, "python": None, "baseline": None}
     steps = None
     checks = {}
@@ -139,8 +141,11 @@ def compute(repeat: int = 3, baseline: Baseline | None = None) -> dict:
             best["baseline"] = dt if best["baseline"] is None else min(best["baseline"], dt)
     if not (checks["tree"] == checks["vm"] == checks["python"] == checks.get("baseline", checks["tree"])):
         raise RuntimeError(f"benchmark results differ: {checks}")
+    from interp.vm.vm import COMPILED  # noqa: PLC0415  (the VM loads only for the benchmark)
+
     out = {
         "steps": steps,
+        "vm_loop": "compiled" if COMPILED else "python",
         "tree_s": best["tree"], "vm_s": best["vm"], "python_s": best["python"],
         "vm_vs_tree": best["tree"] / best["vm"],
         "tree_stmts_per_s": steps / best["tree"],

@@ -18,6 +18,7 @@ the program goes on (without a STATE_T variable it is a run-time error). StrToIn
 accept KRL literal syntax only (reference §1.5). CAST_TO/CAST_FROM are in cast.py.
 GETSYSSTATE answers "STOPBITS" (no stop reaction active; :func:`_getsysstate`); INVERSE
 solves the inverse kinematics of the simulated robot (:func:`_inverse`).
+The EthernetKRL and RSI functions (EKI_*, RSI_*) are in netfunctions.py.
 Unsupported: CREAD/COPEN/CCLOSE/CIOCTL, GET_SIG_INF, channels other than $CMD — a clear
 "not supported" run-time error.
 """
@@ -859,5 +860,8 @@ NATIVES: dict = {
     "GET_SIG_INF": _unsupported("GET_SIG_INF"), "GETSYSSTATE": _getsysstate,
 }
 
+from .netfunctions import NATIVES as _NET_NATIVES  # noqa: E402  (EKI_*, RSI_*: docs/network.md)
+
+NATIVES.update(_NET_NATIVES)
 
 __all__ = ["NATIVES", "ValueRef", "swrite_text", "sread_values", "parse_format"]

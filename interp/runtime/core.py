@@ -18,6 +18,7 @@ from krl.semantics.advance import StmtInfo
 from krl.semantics.resolve import NATIVE, ROUTINE, Callee, Storage
 
 from .builtins import NATIVES, ValueRef
+from .netfunctions import RSI_CONSTANTS
 from .contexts import Context, Irq
 from .convert import assign_into, binary_op, convert_scalar, to_bool, trunc_int, unary_op
 from .errors import (HaltSignal, KrlRuntimeError, ResumeSignal, StopRun)
@@ -170,6 +171,9 @@ class Runtime:
             self.scheduler.run()
         finally:
             sys.setrecursionlimit(old)
+            net = getattr(self.controller, "network", None)
+            if net is not None:
+                net.close()
         robot = self.robot
         stop = self.scheduler.stop
         if stop is not None:
@@ -395,6 +399,8 @@ class Runtime:
             r = self.sysvars.lookup(key)
             if r is not None:
                 return r
+        elif key in RSI_CONSTANTS:      # RSI's constants (RSIOK, ...): the option declares them
+            return ValueRef(RSI_CONSTANTS[key], key)
         raise KrlRuntimeError(f"unknown name {name}")
 
     def index(self, base: Ref, idx: list, name: str) -> Ref:
@@ -1056,6 +1062,15 @@ class Runtime:
             if self.trace is not None:
                 self.trace.write("interrupt", ctl.time, prio=irq.number, name=irq.name,
                                  line=task.line, phase="exit")
+        if ok and task.irqs.armed and not task.in_poll:
+            # the conditions are monitored while the handler runs: what it leaves (a timer it
+            # restarted, a flag it reset) is sampled at its end, so the next rising edge counts
+            # (ROS-Industrial's EKI state timer: `$TIMER[1] = -10` in its own handler)
+            task.in_poll = True
+            try:
+                task.irqs.poll()
+            finally:
+                task.in_poll = False
         if ok and task.kind == "robot":
             ctl.release()
 

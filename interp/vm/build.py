@@ -1,11 +1,18 @@
 """Build the compiled dispatch loop: interp/vm/loop.py compiled by Cython, with the C types of
-interp/vm/loop.pxd, into an extension module beside it (``loop.*.so``; gitignored). `make`
-runs ``python -m interp.vm.build`` before the tests.
+interp/vm/loop.pxd, into an extension module beside it (``loop.*.so``; gitignored).
 
-The pure-Python loop.py stays the tested fallback: without Cython or a C compiler this says
-so and exits 0, and vm.py imports loop.py. vm.py runs the extension only when its
-``VM_SOURCE`` is the sha256 of the current vm.py (a stale build is never run); the build is
-skipped when the extension is newer than loop.py and loop.pxd.
+Two ways in, one definition (:func:`extension`):
+
+* the package build: ``setup.py`` loads this file (by path: the build environment has none of
+  the project's dependencies) and gives :func:`extension` to setuptools, so ``pip install``,
+  ``pip install -e`` (which ``make`` runs) and the wheel all carry the compiled loop;
+* ``python -m interp.vm.build`` (``make vm-loop``): rebuilds it in place after vm.py changed
+  and loop.py was regenerated (interp/vm/gen_loop.py).
+
+The pure-Python loop.py stays the tested fallback: without Cython or a C compiler the build
+says so and succeeds, and vm.py imports loop.py. vm.py runs the extension only when its
+``VM_SOURCE`` is the sha256 of the current vm.py (a stale build is never run); the in-place
+build is skipped when the extension is newer than loop.py and loop.pxd.
 """
 
 from __future__ import annotations
@@ -25,6 +32,32 @@ def target() -> Path:
     return HERE / ("loop" + sysconfig.get_config_var("EXT_SUFFIX"))
 
 
+MODULE = "interp.vm.loop"
+
+
+def extension(root: Path | None = None):
+    """The setuptools ``Extension`` of the compiled loop, its source path absolute, or
+    relative to ``root`` (a package build wants paths relative to the project). Cython compiles the .py
+    source with the .pxd beside it; ``optional``: a failed compile leaves the pure-Python
+    loop in place instead of failing the install. Raises ImportError without setuptools."""
+    from setuptools import Extension  # noqa: PLC0415  (setuptools loads only for a build)
+
+    src = HERE / "loop.py"
+    src = str(src) if root is None else src.relative_to(root).as_posix()
+    return Extension(MODULE, [src], extra_compile_args=["-O2"], optional=True)
+
+
+def cythonized(root: Path | None = None) -> list:
+    """:func:`extension` translated to C by Cython (``language_level`` 3), or ``[]`` when
+    Cython is not installed: then nothing is compiled and loop.py runs."""
+    try:
+        from Cython.Build import cythonize  # noqa: PLC0415
+    except ImportError:
+        return []
+    return cythonize([extension(root)], build_dir="build/cython", quiet=True,
+                     compiler_directives={"language_level": 3})
+
+
 def build(force: bool = False) -> str:
     """Compile loop.py; the outcome in words. Raises nothing for a missing Cython or
     compiler (the pure-Python loop runs then)."""
@@ -33,14 +66,13 @@ def build(force: bool = False) -> str:
         return f"{out.name} is up to date"
     try:
         from Cython.Build import cythonize  # noqa: PLC0415
-        from setuptools import Distribution, Extension  # noqa: PLC0415
+        from setuptools import Distribution  # noqa: PLC0415
         from setuptools.command.build_ext import build_ext  # noqa: PLC0415
     except ImportError as e:
         return f"not compiled ({e.name} is not installed): the VM runs the pure-Python loop.py"
     tmp = REPO / "build" / "cython"
-    ext = Extension("interp.vm.loop", [str(HERE / "loop.py")], extra_compile_args=["-O2"])
     try:
-        exts = cythonize([ext], build_dir=str(tmp), quiet=True, force=True,
+        exts = cythonize([extension()], build_dir=str(tmp), quiet=True, force=True,
                          compiler_directives={"language_level": 3})
         dist = Distribution({"name": "krl-vm-loop", "ext_modules": exts})
         cmd = build_ext(dist)
@@ -50,6 +82,8 @@ def build(force: bool = False) -> str:
         cmd.run()
     except Exception as e:  # noqa: BLE001  (no compiler, no Python headers: the fallback runs)
         return f"not compiled ({type(e).__name__}: {e}): the VM runs the pure-Python loop.py"
+    if not (tmp / "lib" / "interp" / "vm" / out.name).is_file():   # optional: the compile failed
+        return "not compiled (the C compiler failed): the VM runs the pure-Python loop.py"
     # a rename, not a copy over the old file: a process that has the old one loaded keeps it
     os.replace(tmp / "lib" / "interp" / "vm" / out.name, out)
     return f"compiled {out.relative_to(REPO)}"

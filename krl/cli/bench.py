@@ -94,6 +94,7 @@ def all_figures(repeat: int = 3, sim_seconds: float = 60.0, parse_kb: int = 512)
     parse = parse_rate(corpus, limit_bytes=parse_kb * 1024)
     return {
         "vm_vs_tree": round(c["vm_vs_tree"], 2),
+        "vm_loop": c["vm_loop"],
         "tree_stmts_per_s": round(c["tree_stmts_per_s"]),
         "vm_stmts_per_s": round(c["vm_stmts_per_s"]),
         "sim_realtime_factor": sim["sim_realtime_factor"],
@@ -135,7 +136,7 @@ def _print_compute(repeat: int, baseline_rev: str | None, as_json: bool = False)
     click.echo(f"compute benchmark, {c['steps']} statements and loop iterations, best of {repeat}:")
     click.echo(f"  tree interpreter {c['tree_s']:.3f} s  {c['tree_stmts_per_s']:>12,.0f} stmts/s")
     click.echo(f"  VM               {c['vm_s']:.3f} s  {c['vm_stmts_per_s']:>12,.0f} stmts/s"
-               f"  ({c['vm_vs_tree']:.2f}x the tree interpreter)")
+               f"  ({c['vm_vs_tree']:.2f}x the tree interpreter; {c['vm_loop']} loop)")
     click.echo(f"  Python           {c['python_s']:.4f} s  {c['python_stmts_per_s']:>12,.0f} stmts/s"
                f"  ({c['python_vs_vm']:.0f}x the VM)")
     if baseline_rev:

@@ -7,6 +7,7 @@ import json
 from click.testing import CliRunner
 
 from interp.bench import run_krl, run_python
+from interp.vm.vm import COMPILED
 from krl.cli.bench import bench
 
 KEYS = {"vm_vs_tree", "tree_stmts_per_s", "vm_stmts_per_s", "sim_realtime_factor", "parse_kb_per_s"}
@@ -28,9 +29,12 @@ def test_bench_json_line():
     data = json.loads(lines[0])
     assert KEYS <= set(data)
     assert all(isinstance(data[k], (int, float)) and data[k] > 0 for k in KEYS)
+    # make (pip install -e) builds the Cython loop: the benchmark must have run it
+    assert data["vm_loop"] == ("compiled" if COMPILED else "python") == "compiled"
 
 
 def test_bench_text():
     res = CliRunner().invoke(bench, ["--repeat", "1"])
     assert res.exit_code == 0, res.output
     assert "VM" in res.output and "Python" in res.output
+    assert "compiled loop" in res.output

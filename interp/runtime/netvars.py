@@ -1,0 +1,202 @@
+"""The runtime as the network hub sees it (net/hub.py "sink"): flags and outputs a partner's
+message sets, and global variables read and written by name in the controller's text form
+(KukaVarProxy, net/varproxy.py; docs/network.md "KukaVarProxy").
+
+Text forms (what the OpenShowVar protocol carries): INT ``42``, REAL ``12.5`` (fixed point, at
+most 6 decimals), BOOL ``TRUE``/``FALSE``, ENUM ``#T1``, CHAR array ``"text"``, a structure
+``{E6POS: X 1.5, Y 0, ...}``. A write takes the same forms (a structure may name only some
+components). Names are global: ``$`` system variables, the variables of ``$config.dat`` and
+of public data lists, with ``[i]`` and ``.COMPONENT`` after them. A value text is read by
+:func:`parse_value` (literals only: nothing is evaluated) and assigned with the program's own
+conversions.
+"""
+
+from __future__ import annotations
+
+import re
+
+from krl.limits import MAX_VARPROXY_NAME_CHARS, MAX_VARPROXY_VALUE_CHARS
+
+from .errors import KrlRuntimeError
+from .memory import field_ref, index_ref
+from .values import UNSET, Arr, EnumValue, Struct, is_char_array
+
+
+class ValueTextError(ValueError):
+    """A value text that is not a KRL literal (or past the size limits)."""
+
+
+def format_real(v: float) -> str:
+    s = f"{float(v):.6f}".rstrip("0").rstrip(".")
+    return "0" if s in ("-0", "") else s
+
+
+def value_text(v) -> str:
+    """The controller's text of value `v` (see the module docstring)."""
+    if v is UNSET or v is None:
+        return ""
+    if isinstance(v, bool):
+        return "TRUE" if v else "FALSE"
+    if isinstance(v, int):
+        return str(v)
+    if isinstance(v, float):
+        return format_real(v)
+    if isinstance(v, EnumValue):
+        return "#" + v.name
+    if isinstance(v, str):
+        return '"' + v + '"'
+    if is_char_array(v):
+        return '"' + v.text() + '"'
+    if isinstance(v, Struct):
+        parts = [f"{k} {value_text(x)}" for k, x in v.f.items() if x is not UNSET]
+        name = getattr(v.type, "name", None)
+        return "{" + (f"{name}: " if name else "") + ", ".join(parts) + "}"
+    if isinstance(v, Arr):
+        return "{" + ", ".join(value_text(x) for x in v.data[:64]) + "}"
+    return str(v)
+
+
+_TOKEN = re.compile(r'\s*(?:(?P<str>"[^"]*")|(?P<num>[+-]?(?:\d+\.?\d*(?:[Ee][+-]?\d+)?|\.\d+(?:[Ee][+-]?\d+)?))'
+                    r"|(?P<enum>#[A-Za-z_$][\w$]*)|(?P<name>[A-Za-z_$][\w$]*)|(?P<p>[{}:,]))")
+
+
+def parse_value(text: str):
+    """A literal value text -> Python value (int, float, bool, EnumValue, str, or a dict for
+    a structure). Raises :class:`ValueTextError`."""
+    if len(text) > MAX_VARPROXY_VALUE_CHARS:
+        raise ValueTextError(f"value text longer than {MAX_VARPROXY_VALUE_CHARS} characters")
+    toks = []
+    pos = 0
+    t = text.strip()
+    while pos < len(t):
+        m = _TOKEN.match(t, pos)
+        if not m or m.end() == pos:
+            raise ValueTextError(f"not a KRL literal at {t[pos:pos + 20]!r}")
+        toks.append((m.lastgroup, m.group(m.lastgroup)))
+        pos = m.end()
+        while pos < len(t) and t[pos].isspace():
+            pos += 1
+    if not toks:
+        raise ValueTextError("empty value")
+    val, i = _value(toks, 0, 0)
+    if i != len(toks):
+        raise ValueTextError("text after the value")
+    return val
+
+
+def _value(toks, i, depth):
+    if depth > 8:
+        raise ValueTextError("structure nested too deeply")
+    if i >= len(toks):
+        raise ValueTextError("value missing")
+    kind, tok = toks[i]
+    if kind == "str":
+        return tok[1:-1], i + 1
+    if kind == "num":
+        if re.fullmatch(r"[+-]?\d+", tok):
+            if len(tok.lstrip("+-")) > 10:
+                raise ValueTextError("INT out of range")
+            return int(tok), i + 1
+        return float(tok), i + 1
+    if kind == "enum":
+        return EnumValue(tok[1:].upper()), i + 1
+    if kind == "name" and tok.upper() in ("TRUE", "FALSE"):
+        return tok.upper() == "TRUE", i + 1
+    if tok == "{":
+        i += 1
+        if i + 1 < len(toks) and toks[i][0] == "name" and toks[i + 1][1] == ":":
+            i += 2                      # the type name is the variable's own
+        out = {}
+        while i < len(toks) and toks[i][1] != "}":
+            if toks[i][0] != "name":
+                raise ValueTextError("a component name expected")
+            comp = toks[i][1].upper()
+            v, i = _value(toks, i + 1, depth + 1)
+            out[comp] = v
+            if i < len(toks) and toks[i][1] == ",":
+                i += 1
+        if i >= len(toks):
+            raise ValueTextError("'}' missing")
+        return out, i + 1
+    raise ValueTextError(f"not a KRL literal: {tok[:20]!r}")
+
+
+_PATH = re.compile(r"\s*(\$?[A-Za-z_][\w$]*)")
+
+
+class RuntimeSink:
+    """The sink of the network hub for runtime `rt`."""
+
+    def __init__(self, rt) -> None:
+        self.rt = rt
+
+    def set_flag(self, n: int, v: bool) -> None:
+        flags = self.rt.sysvars.store.get("$FLAG")
+        if isinstance(flags, Arr) and 1 <= n <= len(flags.data):
+            flags.data[n - 1] = bool(v)
+
+    def set_out(self, n: int, v: bool) -> None:
+        self.rt.controller.set_out(n, bool(v), "network")
+
+    def ref(self, text: str):
+        """The reference a global name with indices and components denotes. Raises KeyError."""
+        if len(text) > MAX_VARPROXY_NAME_CHARS:
+            raise KeyError("name too long")
+        m = _PATH.match(text)
+        if not m:
+            raise KeyError(text)
+        name = m.group(1)
+        rt = self.rt
+        ref = None
+        if name.startswith("$"):
+            ref = rt.sysvars.lookup(name.upper())
+        if ref is None:
+            prog = rt.program
+            scope = prog.ws.global_scope
+            sym = scope.lookup(name) if scope is not None else None
+            if sym is None or sym.kind not in ("var", "const", "signal"):
+                raise KeyError(name)
+            try:
+                ref = rt.storage_ref(prog.ws.resolver.storage(name, sym, None, -1), None)
+            except (KrlRuntimeError, IndexError):
+                raise KeyError(name) from None
+        rest = text[m.end():].strip()
+        while rest:
+            if rest.startswith("["):
+                j = rest.find("]")
+                parts = [x.strip() for x in rest[1:j].split(",")] if j > 0 else None
+                if parts is None or not all(re.fullmatch(r"-?[0-9]{1,10}", x) for x in parts):
+                    raise KeyError(text)
+                ref = index_ref(ref, [int(x) for x in parts], name)
+                rest = rest[j + 1:].strip()
+            elif rest.startswith("."):
+                mm = re.match(r"\.\s*([A-Za-z_][\w$]*)", rest)
+                if not mm:
+                    raise KeyError(text)
+                ref = field_ref(ref, mm.group(1).upper(), name)
+                rest = rest[mm.end():].strip()
+            else:
+                raise KeyError(text)
+        return ref
+
+    def read_var(self, name: str) -> str:
+        """The text of a global variable (KeyError: no such name; KrlRuntimeError: no value)."""
+        return value_text(self.ref(name).get())
+
+    def write_var(self, name: str, text: str) -> str:
+        """Assign the value `text` to a global variable; returns its new text. Raises KeyError,
+        ValueTextError, KrlRuntimeError (a read-only variable, a conversion)."""
+        ref = self.ref(name)
+        if getattr(ref, "readonly", False):
+            raise KrlRuntimeError(f"{name} is read-only")
+        v = parse_value(text)
+        if isinstance(v, dict):
+            v = Struct(None, v)
+        cur = ref.peek()
+        if is_char_array(cur) and isinstance(v, str):
+            data = cur.data
+            for i in range(len(data)):
+                data[i] = v[i] if i < len(v) else "\0"
+        else:
+            ref.set(v)
+        return value_text(ref.get())

@@ -1,0 +1,381 @@
+"""EthernetKRL channels: the element memory, the EKI functions' semantics and EKI_STATUS
+(KUKA.EthernetKRL 2.2/3.x manual, "Programming", "Messages"; docs/network.md "EthernetKRL").
+
+A :class:`Channel` is created by ``EKI_Init`` from its :class:`~net.ekiconfig.EkiConfig`,
+opened by ``EKI_Open`` (a server listens, a client connects; net/transport.py), closed by
+``EKI_Close`` and deleted by ``EKI_Clear``. What arrives is split into messages (an XML
+document, a fixed-length record or a record ending in the EOS string), checked, and its
+configured elements are put into the element memory: per element a FIFO (or LIFO) of at most
+BUFFERING Limit entries, each with the message counter (EKI_STATUS.Counter). ``EKI_Get*``
+takes the oldest entry; ``EKI_CheckBuffer`` counts them; ``EKI_Set*`` fills the send
+structure and ``EKI_Send`` sends the part under a path (or a literal XML string).
+
+Every function returns a :class:`Status` (Buff, Read, Msg_No, Connected, Counter) and, for an
+error of the call itself, an :class:`EkiError`: the runtime stops the program with it unless
+the channel's ``MESSAGES Display="disabled"`` (then only Msg_No tells). Errors of reception
+(malformed XML, a message too long, a full memory, a dropped connection) are messages of the
+controller: traced, and given as Msg_No of the channel's next call, never a stop.
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from dataclasses import dataclass
+
+from .ekiconfig import EkiConfig, Element
+from .xmlsafe import XmlFramer, XmlRefused, local, parse
+
+# EKI's own message numbers (Msg_No; the controller shows "EKI000nn"). Confirmed from public
+# sources: 9, 23 and 512; the others follow the manual's list as far as it could be read, and
+# are decisions recorded in docs/network.md.
+MESSAGES = {
+    3: "Access to the configuration file failed",
+    9: "Channel not available (not initialized)",
+    10: "Ethernet connection is not open",
+    15: "Access to empty element memory",
+    16: "Element not found in the configuration",
+    19: "No data to send",
+    20: "Data type mismatch",
+    22: "Error while reading the configuration",
+    23: "Initialization already performed",
+    24: "Binding to the internal parameters (IP, port) failed",
+    25: "Maximum number of channels reached",
+    512: "Ethernet connection destroyed",
+    768: "Ping reports no contact",
+    1024: "Error while reading received XML data",
+    1280: "Limit of element memory reached",
+    1536: "Received string too long",
+}
+
+
+@dataclass
+class Status:
+    """EKI_STATUS: Buff (entries left in memory), Read (entries read), Msg_No (0 or an EKI
+    message number), Connected, Counter (the message counter of the data read)."""
+
+    buff: int = 0
+    read: int = 0
+    msg_no: int = 0
+    connected: bool = False
+    counter: int = 0
+
+
+class EkiError(Exception):
+    """An EKI function's own error: number (Msg_No) and text; ``stops`` when the channel's
+    messages are displayed (the controller's acknowledgement message stops the program)."""
+
+    def __init__(self, number: int, detail: str = "", stops: bool = True) -> None:
+        self.number = number
+        self.stops = stops
+        base = MESSAGES.get(number, "EthernetKRL error")
+        super().__init__(f"EKI{number:05d} {base}" + (f": {detail}" if detail else ""))
+
+
+def format_real(v: float) -> str:
+    """A REAL as EKI writes it into a message: fixed point, at most 6 decimals."""
+    s = f"{float(v):.6f}".rstrip("0").rstrip(".")
+    return "0" if s in ("-0", "") else s
+
+
+class Channel:
+    """One EKI channel (see the module docstring). `hub` is the network hub (net/hub.py): it
+    owns the sockets and the trace; `cfg` the configuration."""
+
+    def __init__(self, hub, cfg: EkiConfig) -> None:
+        self.hub = hub
+        self.cfg = cfg
+        self.name = cfg.name
+        self.opened = False
+        self.connected = False
+        self.endpoint = None
+        self.counter = 0
+        self.memory: dict[str, deque] = {}
+        self.sendvals: dict[str, str | dict] = {}
+        self.locked = False
+        self.held: list[bytes] = []
+        self.async_no = 0
+        self.framer = XmlFramer(cfg.buffsize) if cfg.receive_kind != "raw" else None
+        self.rawbuf = bytearray()
+
+    # ------------------------------------------------------------------ status
+    def status(self, **kw) -> Status:
+        st = Status(connected=self.connected, **kw)
+        if self.async_no and not st.msg_no:
+            st.msg_no, self.async_no = self.async_no, 0
+        return st
+
+    def error(self, number: int, detail: str = "") -> EkiError:
+        return EkiError(number, f"channel {self.name}" + (f", {detail}" if detail else ""), self.cfg.display)
+
+    # ------------------------------------------------------------------ open / close
+    def open(self) -> Status:
+        if not self.opened:
+            self.opened = True
+            self.hub.eki_opened(self)
+        return self.status()
+
+    def close(self) -> Status:
+        if self.opened:
+            self.hub.eki_closed(self)
+            self.opened = False
+        self.set_connected(False, "closed by the program")
+        return self.status()
+
+    def set_connected(self, on: bool, text: str = "") -> None:
+        if on == self.connected:
+            return
+        self.connected = on
+        cfg = self.cfg
+        if cfg.alive_flag is not None:
+            self.hub.sink.set_flag(cfg.alive_flag, on)
+        if cfg.alive_out is not None:
+            self.hub.sink.set_out(cfg.alive_out, on)
+        if not on:
+            if self.framer is not None:
+                self.framer.buf.clear()
+            self.rawbuf.clear()
+
+    # ------------------------------------------------------------------ events
+    def connected_event(self) -> None:
+        self.set_connected(True)
+
+    def disconnected_event(self, reason: str) -> None:
+        if self.connected:
+            self.async_error(512, reason)
+        self.set_connected(False, reason)
+
+    def async_error(self, number: int, detail: str) -> None:
+        """A message of reception (see the module docstring): traced, given as the next Msg_No."""
+        self.async_no = number
+        self.hub.net_message(f"EKI{number:05d} {MESSAGES.get(number, '')}: channel {self.name}, {detail}", number)
+
+    def data_event(self, data: bytes) -> list:
+        """Split received bytes into messages; returns ``[(bytes | XmlRefused), ...]`` for
+        the hub to trace and hand to :meth:`message` (so a replay feeds the same messages)."""
+        if self.cfg.receive_kind == "raw":
+            return self._raw_frames(data)
+        if self.cfg.protocol == "UDP":      # one datagram, one message
+            if len(data) > self.cfg.buffsize:
+                return [XmlRefused(f"message of {len(data)} bytes, longer than {self.cfg.buffsize}")]
+            return [bytes(data)]
+        return self.framer.feed(data)
+
+    def _raw_frames(self, data: bytes) -> list:
+        el = self.cfg.receive[0]
+        self.rawbuf += data
+        out: list = []
+        limit = min(el.size or self.cfg.buffsize, self.cfg.buffsize)
+        if el.eos:
+            while True:
+                i = self.rawbuf.find(el.eos)
+                if i < 0:
+                    if len(self.rawbuf) > limit:
+                        out.append(XmlRefused(f"record longer than {limit} bytes without its end string"))
+                        self.rawbuf.clear()
+                    return out
+                rec = bytes(self.rawbuf[:i])
+                del self.rawbuf[:i + len(el.eos)]
+                out.append(rec if len(rec) <= limit else XmlRefused(f"record of {len(rec)} bytes, longer than {limit}"))
+        size = el.size or limit
+        while len(self.rawbuf) >= size:
+            out.append(bytes(self.rawbuf[:size]))
+            del self.rawbuf[:size]
+        return out
+
+    def message(self, msg: bytes) -> list[tuple[str, int]]:
+        """Process one complete message: its elements go into memory (or wait while the
+        channel is locked). Returns the (flag|out, n) the message sets."""
+        if self.locked:
+            self.held.append(msg)
+            return []
+        self.counter += 1
+        if self.cfg.receive_kind == "raw":
+            el = self.cfg.receive[0]
+            return self._store(el, msg.decode("latin-1"))
+        try:
+            root = parse(msg, self.cfg.buffsize, f"message on channel {self.name}")
+        except XmlRefused as exc:
+            self.async_error(1024, str(exc))
+            return []
+        sets: list[tuple[str, int]] = []
+        for el in self.cfg.receive:
+            for v in _values(root, el):
+                sets += self._store(el, v)
+        return sets
+
+    def refused(self, exc: XmlRefused) -> None:
+        number = 1536 if "longer than" in str(exc) else 1024
+        self.async_error(number, str(exc))
+
+    def _store(self, el: Element, value) -> list[tuple[str, int]]:
+        q = self.memory.setdefault(el.tag.upper(), deque())
+        if len(q) >= self.cfg.buffering:
+            self.async_error(1280, f"element {el.tag}: {self.cfg.buffering} entries")
+            return []
+        q.append((value, self.counter))
+        out = []
+        if el.set_flag is not None:
+            out.append(("flag", el.set_flag))
+        if el.set_out is not None:
+            out.append(("out", el.set_out))
+        return out
+
+    # ------------------------------------------------------------------ functions
+    def check(self, path: str) -> tuple[Status, EkiError | None]:
+        """EKI_CheckBuffer: Buff = the entries of the element at `path`."""
+        el = self._receive_element(path)
+        if el is None:
+            return self.status(msg_no=16), self.error(16, f"element {path[:60]}")
+        q = self.memory.get(el.tag.upper()) or ()
+        return self.status(buff=len(q), counter=q[0][1] if q else 0), None
+
+    def get(self, path: str, n: int | None = None) -> tuple[list, Status, EkiError | None]:
+        """EKI_Get*: the oldest entry (or up to `n` entries for an array getter) of the element
+        at `path`; (values, status, error)."""
+        el = self._receive_element(path)
+        if el is None:
+            return [], self.status(msg_no=16), self.error(16, f"element {path[:60]}")
+        q = self.memory.get(el.tag.upper())
+        if not q:
+            return [], self.status(msg_no=15), self.error(15, f"element {path[:60]}")
+        take = 1 if n is None else max(0, min(n, len(q)))
+        vals = []
+        counter = 0
+        for _ in range(take):
+            v, counter = q.pop() if self.cfg.lifo else q.popleft()
+            vals.append(v)
+        return vals, self.status(buff=len(q), read=take, counter=counter), None
+
+    def clear_buffer(self, path: str) -> tuple[Status, EkiError | None]:
+        """EKI_ClearBuffer: empty the memory of `path` and of every element under it (the root
+        or ``""``: all)."""
+        key = path.strip().upper().rstrip("/")
+        for tag in list(self.memory):
+            if not key or tag == key or tag.startswith(key + "/"):
+                del self.memory[tag]
+        return self.status(), None
+
+    def set_value(self, path: str, value) -> tuple[Status, EkiError | None]:
+        """EKI_Set*: the send structure's value at `path` (text, or a dict for a FRAME)."""
+        if self.cfg.send_kind == "xml":
+            if self.cfg.send_element(path) is None:
+                return self.status(msg_no=16), self.error(16, f"send element {path[:60]}")
+        self.sendvals[path.strip().upper()] = value
+        return self.status(), None
+
+    def send(self, data: str, length: int | None = None) -> tuple[Status, EkiError | None]:
+        """EKI_Send: `data` is a path of the send structure (its part is sent) or, beginning
+        with ``<``, an XML string sent as it is; a RAW channel sends `length` bytes of it."""
+        if not self.connected:
+            return self.status(msg_no=10), self.error(10, "nothing is connected")
+        if self.cfg.send_kind == "raw" or (self.cfg.send_kind is None and self.cfg.receive_kind == "raw"):
+            raw = data.encode("latin-1", "replace")
+            if length is not None:
+                raw = raw[:max(0, length)]
+            payload = raw
+        elif data.lstrip().startswith("<"):
+            payload = data.encode("utf-8")
+        else:
+            payload = self._build(data)
+            if payload is None:
+                return self.status(msg_no=16), self.error(16, f"send path {data[:60]}")
+        if not payload:
+            return self.status(msg_no=19), self.error(19)
+        self.hub.eki_send(self, payload)
+        return self.status(), None
+
+    def lock(self) -> Status:
+        self.locked = True
+        return self.status()
+
+    def unlock(self) -> Status:
+        self.locked = False
+        held, self.held = self.held, []
+        for msg in held:
+            self.hub.eki_apply(self, self.message(msg))
+        return self.status()
+
+    # ------------------------------------------------------------------ helpers
+    def _receive_element(self, path: str) -> Element | None:
+        return self.cfg.receive_element(path) if self.cfg.receive_kind == "xml" else (
+            self.cfg.receive[0] if self.cfg.receive and self.cfg.receive[0].tag.upper() == path.strip().upper() else None)
+
+    def _build(self, path: str) -> bytes | None:
+        """The XML text of the send elements under `path`, with the values set."""
+        key = path.strip().strip("/")
+        keyu = key.upper()
+        els = [e for e in self.cfg.send
+               if e.tag.upper() == keyu or e.tag.upper().startswith(keyu + "/")]
+        if not els or not key:
+            return None
+        import xml.etree.ElementTree as ET  # noqa: PLC0415
+
+        root_name = els[0].tag.split("/")[0]
+        root = ET.Element(root_name)
+        for e in els:
+            parts = e.tag.split("/")
+            if parts[0].upper() != root_name.upper():
+                continue
+            node = root
+            attr = None
+            for p in parts[1:]:
+                if p.startswith("@"):
+                    attr = p[1:]
+                    break
+                found = None
+                for c in node:
+                    if c.tag.upper() == p.upper():
+                        found = c
+                        break
+                node = found if found is not None else ET.SubElement(node, p)
+            v = self.sendvals.get(e.tag.upper())
+            if v is None:
+                continue
+            if isinstance(v, dict):
+                for k, x in v.items():
+                    node.set(k, x)
+            elif attr is not None:
+                node.set(attr, v)
+            else:
+                node.text = v
+        # the part under `path`: the element it names
+        target = root
+        for p in key.split("/")[1:]:
+            if p.startswith("@"):
+                break
+            nxt = None
+            for c in target:
+                if c.tag.upper() == p.upper():
+                    nxt = c
+                    break
+            if nxt is None:
+                return None
+            target = nxt
+        return ET.tostring(target, encoding="unicode", short_empty_elements=True).encode("utf-8")
+
+
+def _values(root, el: Element) -> list:
+    """The values of configured element `el` in the message `root` (each occurrence)."""
+    parts = el.tag.split("/")
+    if local(root.tag).upper() != parts[0].upper():
+        return []
+    nodes = [root]
+    attr = None
+    for p in parts[1:]:
+        if p.startswith("@"):
+            attr = p[1:].upper()
+            break
+        nodes = [c for n in nodes for c in n if local(c.tag).upper() == p.upper()]
+        if not nodes:
+            return []
+    out = []
+    for n in nodes:
+        if attr is not None:
+            for k, v in n.attrib.items():
+                if local(k).upper() == attr:
+                    out.append(v)
+        elif el.type == "FRAME":
+            out.append({local(k).upper(): v for k, v in n.attrib.items()})
+        else:
+            out.append((n.text or "").strip())
+    return out

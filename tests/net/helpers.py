@@ -1,0 +1,55 @@
+"""Helpers of the partner tests: run a program on the simulated controller in this thread
+while a partner (written from the protocol, not from our code) talks to it from another
+thread over loopback, and stop the run when the partner is done."""
+
+from __future__ import annotations
+
+import threading
+from pathlib import Path
+
+from interp.run import make_runtime
+from robot.trace import TraceWriter
+
+HERE = Path(__file__).resolve().parent
+CONFIGS = HERE / "configs"
+PROGRAMS = HERE / "programs"
+
+
+class PartnerFailed(AssertionError):
+    pass
+
+
+def run_with_partner(program, settings, partner, *, interp: str = "tree", max_sim_time: float = 60.0,
+                     wall_timeout: float = 120.0, box: dict | None = None, **kw):
+    """Run `program` with network `settings`; `partner(net, rt)` runs in a thread and its
+    return value is returned with the run's result and trace: (result, trace, partner_value).
+    When the partner returns (or fails) the run is stopped at the next IPO cycle; `box`, when
+    given, receives the runtime as ``box["rt"]`` (to read the program's variables after)."""
+    trace = TraceWriter(keep=True)
+    rt, _ = make_runtime(Path(program), network=settings, trace=trace, max_sim_time=max_sim_time,
+                         mujoco=False, interp=interp, **kw)
+    net = rt.controller.network
+    box = {} if box is None else box
+
+    def body():
+        try:
+            box["value"] = partner(net, rt)
+        except BaseException as exc:       # reported in the test's thread
+            box["error"] = exc
+        finally:
+            rt.scheduler.max_sim_time = rt.controller.time   # stop at the next cycle
+
+    th = threading.Thread(target=body, daemon=True)
+    th.start()
+    result = rt.run()
+    th.join(wall_timeout)
+    if th.is_alive():
+        raise PartnerFailed("the partner did not finish")
+    if "error" in box:
+        raise box["error"]
+    box["rt"] = rt
+    return result, trace, box.get("value")
+
+
+def net_events(trace, **match):
+    return [e for e in trace.events if e["kind"] == "net" and all(e.get(k) == v for k, v in match.items())]
