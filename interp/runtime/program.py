@@ -31,10 +31,12 @@ from pathlib import Path
 
 from krl.ast import nodes as N
 from krl.diagnostics import SYNTAX_CODES
+from krl.limits import PARSE_TIMEOUT_S
 from krl.project import project_of, with_basis   # which files make the program: one rule
 from krl.semantics import types as T
 from krl.semantics.expression import Env, evaluate
 from krl.semantics.resolve import GLOBAL, LOCAL, MODULE, SYSTEM, Storage
+from krl.workspace import load_file, load_project
 
 from .convert import assign_into, convert_scalar
 from .errors import KrlRuntimeError, ResourceError
@@ -74,8 +76,6 @@ def basis_files(project) -> list[Path]:
 def parse_module(path: str):
     """(Module AST, syntax error strings) of one file on its own (tools and tests; a run
     loads its files through :func:`checked_workspace`)."""
-    from krl.workspace import load_file  # noqa: PLC0415
-
     lf = load_file(path)
     errs = [SyntaxProblem(f"{d.path}:{d.line}:{d.column}: {d.message}", d.path, d.line)
             for d in lf.diagnostics if d.is_error and d.code in _START_CODES]
@@ -87,9 +87,6 @@ def checked_workspace(project, extra: list[Path] = ()):
     BASIS, a submit program outside the project): cached per process for the same files
     (path, size, modification time), so the two interpreters of a conformance run, or the
     programs of one backup, load and check their files once. Never raises for bad input."""
-    from krl.limits import PARSE_TIMEOUT_S  # noqa: PLC0415
-    from krl.workspace import load_project  # noqa: PLC0415
-
     paths = [*project.files, *extra]
     key = [str(project.root), project.backup]
     size = 0

@@ -25,12 +25,15 @@ current vm.py. Regenerate with ``python -m interp.vm.gen_loop``.
 from __future__ import annotations
 
 import ast
+import builtins
 import copy
 import hashlib
 import heapq
 import itertools
 import sys
 from pathlib import Path
+
+from interp.vm import opcodes as OP
 
 HERE = Path(__file__).resolve().parent
 SOURCE = HERE / "vm.py"
@@ -178,10 +181,6 @@ def _imports(module: ast.Module, names: list[str]) -> list[str]:
 
 def generate(source: str | None = None) -> str:
     """The text of loop.py for the vm.py source `source` (default: the file)."""
-    import builtins  # noqa: PLC0415
-
-    from interp.vm import opcodes as OP  # noqa: PLC0415  (the package imports vm.py lazily)
-
     text = SOURCE.read_text(encoding="utf-8") if source is None else source
     module = ast.parse(text)
     helpers = next(ast.literal_eval(n.value) for n in module.body if isinstance(n, ast.Assign)

@@ -32,9 +32,13 @@ The cold opcodes (motion, interrupts, triggers, analog I/O, waits, ...) are meth
 
 from __future__ import annotations
 
+import hashlib
+import importlib.util
 import math
 import operator
+import sys
 import weakref
+from pathlib import Path
 
 from interp.runtime.builtins import ValueRef
 from interp.runtime.convert import INT_MAX, INT_MIN, num
@@ -1132,10 +1136,6 @@ SOURCE_DISPATCH = [o.number for o in OP.OPS]
 
 def _python_loop():
     """interp/vm/loop.py itself, imported from its file (also when the extension exists)."""
-    import importlib.util  # noqa: PLC0415
-    import sys  # noqa: PLC0415
-    from pathlib import Path  # noqa: PLC0415
-
     name = "interp.vm._loop_python"
     mod = sys.modules.get(name)
     if mod is None:
@@ -1147,9 +1147,6 @@ def _python_loop():
 
 
 def _current(mod) -> bool:
-    import hashlib  # noqa: PLC0415
-    from pathlib import Path  # noqa: PLC0415
-
     return mod.VM_SOURCE == hashlib.sha256(Path(__file__).read_bytes()).hexdigest()
 
 

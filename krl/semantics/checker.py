@@ -23,7 +23,9 @@ from __future__ import annotations
 
 from krl.ast import nodes as N
 from krl.ast.visit import EXPRESSIONS, STATEMENTS, handlers
+from krl.ast.printer import expr as printed
 from krl.semantics import types as T
+from krl.semantics.outside import KINDS
 from krl.diagnostics import DiagnosticSink
 from krl.semantics.symbols import ParamSig, RoutineSig, Scope, Symbol, make_array
 
@@ -71,7 +73,6 @@ class Declarer:
         if self.unresolved is not None:
             self.unresolved.use(kind, name, span.file, span.line, span.column, evidence)
             return
-        from krl.semantics.outside import KINDS  # noqa: PLC0415
         err, warn, _noun = KINDS[kind]
         soft = evidence or kind == "sysvar" or self.maybe_declared(name)
         msg = {"type": f"unknown type '{name}'", "routine": f"routine '{name}' is not declared",
@@ -972,8 +973,7 @@ def _char_like(t: T.KrlType) -> bool:
 
 
 def _show(e: N.Expr) -> str:
-    from krl.ast.printer import expr  # noqa: PLC0415 - only for messages
     try:
-        return expr(e)
+        return printed(e)
     except Exception:  # noqa: BLE001
         return "?"
