@@ -10,7 +10,8 @@ SIGNAL's declaration), never by matching text. Every text taken from the backup 
 names) passes through :func:`krl.terminal.printable` and loses its line breaks: the file is YAML
 whose comments cannot be escaped from. Files of the KUKA system folders (System, Mada, STEU,
 ``$``-files) and of the project's own BASIS are not read; ``TP`` (P00, the technology packages)
-is, since P00's program-number handshake reads cell inputs.
+is, since P00's program-number handshake reads cell inputs. The EKI channels and RSI contexts
+the programs open are listed in a commented ``network:`` section (docs/network.md).
 """
 
 from __future__ import annotations
@@ -127,7 +128,72 @@ def _input(e: N.Node, root: Path, cache: dict) -> InputUse | None:
     return InputUse(sym.name.upper(), addr, declared, comment, group=b is not None)
 
 
-def starter(uses: list[InputUse], programs: list[str], own_robot: bool = True) -> str:
+NETWORK_CALLS = {"EKI_INIT": "eki", "EKI_LOAD": "eki", "RSI_CREATE": "rsi", "RSI_LOAD": "rsi"}
+
+
+def network_opened(rt, root: Path) -> list[tuple[str, str, str]]:
+    """(kind, name, where) of every EKI channel and RSI context the modules of `rt` in the
+    backup `root` open (``EKI_Init("NAME")``, ``RSI_CREATE("NAME", ...)``; a name held in a
+    global CHAR array is read from its data list), in order of first use."""
+    from interp.run import global_value  # noqa: PLC0415
+
+    from interp.runtime.values import Arr  # noqa: PLC0415
+
+    found: dict[tuple[str, str], tuple[str, str, str]] = {}
+    main = Path(rt.program.main_path).stem
+    for m in rt.program.modules:
+        src = m.unit.src
+        if src is None or _skipped(src.path, root):
+            continue
+        shown = printable(str(Path(src.path).resolve().relative_to(root.resolve())))
+        for node in src.module.walk():
+            if not isinstance(node, N.Call) or node.name.upper() not in NETWORK_CALLS or not node.args:
+                continue
+            arg = node.args[0]
+            name = None
+            if isinstance(arg, N.StrLit):
+                name = arg.value
+            elif isinstance(arg, (N.Name, N.Index)):
+                base = arg if isinstance(arg, N.Name) else arg.base
+                if isinstance(base, N.Name):
+                    v = global_value(rt, main, base.name)
+                    name = v.text() if isinstance(v, Arr) else None
+            if not name:
+                continue
+            kind = NETWORK_CALLS[node.name.upper()]
+            key = (kind, name.upper())
+            if key not in found:
+                found[key] = (kind, printable(name)[:64], f"{shown}:{node.span.line}")
+    return list(found.values())
+
+
+def _network_lines(opened: list[tuple[str, str, str]], root: Path) -> list[str]:
+    """The commented `network:` section of the starter (docs/network.md)."""
+    from net.ekiconfig import find_config  # noqa: PLC0415
+    from net.rsi import find_context  # noqa: PLC0415
+
+    if not opened:
+        return []
+    out = ["# network:            # the partners (docs/network.md); without this key every EKI channel",
+           "#                     # stays \"not connected\" and the run is not paced to the wall clock"]
+    eki = [o for o in opened if o[0] == "eki"]
+    if eki:
+        out.append("#   eki:")
+        for _, name, where in eki:
+            cfg = find_config(name, None, root)
+            note = f"config {printable(str(cfg.relative_to(root)))}" if cfg is not None else \
+                "no Config/User/Common/EthernetKRL/" + name + ".xml in the backup: name one with config:"
+            out.append(f"#     {name}: {{address: 127.0.0.1:54600}}   # opened at {where}; {note}")
+    for _, name, where in [o for o in opened if o[0] == "rsi"]:
+        ctx = find_context(name, None, root)
+        note = f"context {printable(str(ctx.relative_to(root)))}" if ctx is not None else \
+            "no SensorInterface/" + name + ".rsi.xml in the backup: name one with config:"
+        out.append(f"#   rsi: {{address: 127.0.0.1:49152}}   # the sensor; context {name} created at {where}; {note}")
+    return out
+
+
+def starter(uses: list[InputUse], programs: list[str], own_robot: bool = True,
+            network: list[str] = ()) -> str:
     """The text of the starter cell file (YAML; every rule commented out). `own_robot`: the
     backup has machine data of its own (else the file asks for the cell's robot)."""
     from robot.machine import library_robots  # noqa: PLC0415
@@ -146,6 +212,7 @@ def starter(uses: list[InputUse], programs: list[str], own_robot: bool = True) -
            "presets:",
            "  autoext: false      # true: Automatic External ($I_O_ACTCONF; P00 of a cell program)",
            "  # pgno: 1           # the program number the PLC answers in P00's handshake",
+           *network,
            "rules:"]
     if not uses:
         out.append("  # (the programs read no input in a condition)")
@@ -171,6 +238,7 @@ def cell_init(root: Path, programs: list[Path]) -> str:
     from interp.run import make_runtime  # noqa: PLC0415
 
     found: dict[str, InputUse] = {}
+    opened: dict[tuple[str, str], tuple[str, str, str]] = {}
     covered: set[str] = set()
     for prog in programs:
         if str(prog.resolve()) in covered:
@@ -181,6 +249,8 @@ def cell_init(root: Path, programs: list[Path]) -> str:
             have = found.setdefault(u.name, u)
             if have is not u:
                 have.reads += [r for r in u.reads if r not in have.reads]
+        for o in network_opened(rt, root):
+            opened.setdefault((o[0], o[1].upper()), o)
     shown = []
     for p in programs:
         try:
@@ -189,4 +259,5 @@ def cell_init(root: Path, programs: list[Path]) -> str:
             shown.append(p.name)
     from krl.project import machine_data_file  # noqa: PLC0415
 
-    return starter(list(found.values()), shown, own_robot=machine_data_file(root) is not None)
+    return starter(list(found.values()), shown, own_robot=machine_data_file(root) is not None,
+                   network=_network_lines(list(opened.values()), root))

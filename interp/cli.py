@@ -121,6 +121,7 @@ def _run(program: Path, workspace, inputs, trace_path, max_sim_time, max_steps, 
     from krl.terminal import printable  # noqa: PLC0415
     from robot.stimuli import StimulusError  # noqa: PLC0415
     from robot.trace import TraceWriter  # noqa: PLC0415
+    from net.hub import NetError  # noqa: PLC0415
 
     try:
         inputs = cell_of(inputs)      # the cell file, read once: the robot and the run take it
@@ -139,6 +140,7 @@ def _run(program: Path, workspace, inputs, trace_path, max_sim_time, max_steps, 
                              max_sim_time=max_sim_time, max_steps=max_steps, submit=list(submit),
                              interp=interp_kind, observer=observer, mode=mode, check=check,
                              run_mode=run_mode.upper(), pgno=pgno, robot=machine)
+        _announce_partners(rt)
         errors = rt.program.errors_of(rt.program.module_of(rt.program.main_path))
         if errors:
             # the checker rejects the program's own module: like the controller, it does not start
@@ -147,9 +149,12 @@ def _run(program: Path, workspace, inputs, trace_path, max_sim_time, max_steps, 
             click.echo(f"not started: {len(errors)} error(s) found by the checker (--no-check runs it anyway)")
             sys.exit(1)
         res = rt.run()
-    except StimulusError as exc:
+    except (StimulusError, NetError) as exc:
         click.echo(f"error: {shown(printable(exc))}", err=True)
         sys.exit(2)
+    except KeyboardInterrupt:
+        click.echo("interrupted", err=True)
+        sys.exit(130)
     except Exception as exc:  # noqa: BLE001
         click.echo(f"internal error: {type(exc).__name__}: {shown(printable(exc))}", err=True)
         sys.exit(2)
@@ -170,6 +175,26 @@ def _run(program: Path, workspace, inputs, trace_path, max_sim_time, max_steps, 
         if booted is not None and line.startswith("  workspace"):
             click.echo(shown(f"  submit     {booted} (the backup's, started as at boot; --no-submit: without)"))
     sys.exit(res.exit_code)
+
+
+def _announce_partners(rt) -> None:
+    """Say on stderr where the run's network partners connect, as each server starts (the cell
+    file's `network:` key; a port 0 becomes the free port taken). The run is paced to the wall
+    clock while a partner is attached (docs/network.md)."""
+    from krl.terminal import printable  # noqa: PLC0415
+
+    net = getattr(rt.controller, "network", None)
+    if net is None or net.settings is None:
+        return
+
+    def say(key, address):
+        click.echo(f"network: {printable(key)} listening on {address[0]}:{address[1]}", err=True)
+
+    for key, address in list(net.addresses.items()):
+        say(key, address)
+    net.listen_hook = say
+    if net.settings.replay is not None:
+        click.echo(f"network: replaying {printable(str(net.settings.replay))}", err=True)
 
 
 @click.group("cell")

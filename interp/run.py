@@ -52,7 +52,6 @@ def make_runtime(program, *, workspace=None, inputs=None, trace=None, max_sim_ti
                  submits=list(submit or ()), check=check)
     if run_mode is not None:
         rt.set_run_mode(run_mode)
-    attach_network(rt, program, workspace, network if network is not None else getattr(controller, "cell_network", None))
     if observer is not None:
         # The interpreters trace into the user's trace only: without one the VM keeps its
         # quiet fast path (Runtime.quiet_limit); the observer needs the controller's events.
@@ -68,6 +67,7 @@ def make_runtime(program, *, workspace=None, inputs=None, trace=None, max_sim_ti
                             controller.rules)
         except ResourceError:
             pass    # a data list past a limit: the program does not start (Runtime.main_routine says why)
+    attach_network(rt, program, workspace, network if network is not None else getattr(controller, "cell_network", None))
     if interp == "vm":
         from interp.vm import VM  # noqa: PLC0415
 
@@ -94,13 +94,49 @@ def attach_network(rt: Runtime, program, workspace, settings) -> None:
         old.close()
     root = backup_of(Path(program).resolve(), Path(workspace).resolve() if workspace else None)
     net = Network(settings, program=Path(program).resolve(), backup=root, sink=RuntimeSink(rt))
+    amap = None
+    if settings is not None and (settings.modbus is not None or settings.opcua is not None):
+        amap = plc_map(rt, Path(program).stem)
     try:
-        net.attach(rt.controller)
+        net.attach(rt.controller, amap)
     except OSError as exc:
         net.close()
         from net.hub import NetError  # noqa: PLC0415
 
         raise NetError(f"a network partner cannot start: {exc.strerror or exc}") from None
+
+
+def plc_map(rt: Runtime, main: str):
+    """The PLC's address map (net/plc.py) derived from the cell: the inputs and outputs its
+    rules, stimuli and program-number handshake (``PGNO_*`` of $config.dat) use, and the
+    SIGNALs of the global declarations on ``$IN``/``$OUT``."""
+    import re  # noqa: PLC0415
+
+    from net.plc import derive_map  # noqa: PLC0415
+    from robot.cellpresets import PGNO_PARAMETERS  # noqa: PLC0415
+
+    ctl = rt.controller
+    indices: list[int] = []
+    for name in PGNO_PARAMETERS:
+        v = global_value(rt, main, name)
+        if isinstance(v, int) and not isinstance(v, bool) and name != "PGNO_TYPE":
+            indices.append(abs(v))
+    fbit, length = global_value(rt, main, "PGNO_FBIT"), global_value(rt, main, "PGNO_LENGTH")
+    if isinstance(fbit, int) and isinstance(length, int):
+        indices.append(abs(fbit) + max(0, min(length, 64)))
+    texts = [str(st.set) for st in ctl.stimuli] + [f"{r.text} {r.set}" for r in ctl.rules]
+    for text in texts:
+        indices += [int(x) for x in re.findall(r"\$(?:IN|OUT)\[(\d{1,4})\]", text)]
+    signals = {}
+    scope = rt.program.ws.global_scope
+    for sym in (scope.values.values() if scope is not None else ()):
+        if sym.kind != "signal":
+            continue
+        found = signal_of(rt, main, sym.name)
+        if found is not None and found[0] in ("$IN", "$OUT"):
+            base, a, b = found
+            signals[sym.name.upper()] = (base, a, b if b is not None else a)
+    return derive_map(indices, signals)
 
 
 def _pgno_rules(rt: Runtime, main: str, number: int) -> list:

@@ -35,7 +35,11 @@ from .xmlsafe import XmlRefused
 
 
 class Pacer:
-    """Wall-clock pacing: :meth:`wait` returns when cycle `k` may start."""
+    """Wall-clock pacing: :meth:`wait` returns when cycle `k` may start. A run that falls more
+    than :data:`REANCHOR_S` behind (a debugger pause, an overloaded machine) is paced again
+    from now on, instead of racing to catch up; `behind` keeps the largest lag seen (s)."""
+
+    REANCHOR_S = 0.5
 
     def __init__(self, dt: float, pace: float = 1.0) -> None:
         self.dt = dt
@@ -52,8 +56,10 @@ class Pacer:
         target = self.t0 + (k - self.k0) * self.dt / self.pace
         if target > now:
             time.sleep(target - now)
-        else:
-            self.behind = max(self.behind, now - target)
+            return
+        self.behind = max(self.behind, now - target)
+        if now - target > self.REANCHOR_S:
+            self.k0, self.t0 = k, now
 
 
 class NullSink:
@@ -100,14 +106,19 @@ class Network:
         self.plc = None
         self.addresses: dict[str, tuple[str, int]] = {}        # "eki:NAME" / "varproxy" / ... -> bound
         self.ready = threading.Condition()
+        self.listen_hook = None     # listen_hook(key, (host, port)) when a server starts (krl run says where)
         self.closed = False
+        # the controller calls cycle() only while this is True: partners configured, a replay,
+        # or RSI on; a run without any costs one attribute test per IPO cycle
+        self.polling = settings is not None
         if settings is not None and settings.replay is not None:
             self.replay_events = load_replay(settings.replay)
 
     # ------------------------------------------------------------------ lifecycle
-    def attach(self, ctl) -> None:
+    def attach(self, ctl, plc_map=None) -> None:
         """Bind to the controller `ctl` and start the servers the settings name (KukaVarProxy,
-        the PLC). Raises :class:`NetError` when one cannot start."""
+        the PLC with the address map `plc_map`, net/plc.py). Raises OSError when one cannot
+        start (a port in use)."""
         self.ctl = ctl
         ctl.network = self
         if getattr(self, "replay_events", None) is not None:
@@ -125,7 +136,7 @@ class Network:
         if s.modbus is not None or s.opcua is not None:
             from .plc import Plc  # noqa: PLC0415
 
-            self.plc = Plc(self, s)
+            self.plc = Plc(self, s, plc_map)
             self.plc.start()
 
     @property
@@ -164,6 +175,8 @@ class Network:
         with self.ready:
             self.addresses[key] = tuple(address[:2])
             self.ready.notify_all()
+        if self.listen_hook is not None:
+            self.listen_hook(key, tuple(address[:2]))
         if self.ctl is not None:
             self.net_message(f"{key} listening on {address[0]}:{address[1]}")
 
@@ -188,6 +201,8 @@ class Network:
                 self.rsi.cycle(ctl, live=False)
             return
         if not self.attached:
+            if self.rsi is not None and self.rsi.on:
+                self.rsi.cycle(ctl, live=False)     # no sensor: every packet is late
             return
         if self.pacer is None:
             pace = self.settings.pace if self.settings is not None else 1.0

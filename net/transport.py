@@ -23,6 +23,20 @@ SEND_BUFFER_LIMIT = 1024 * 1024
 """Bytes the controller holds for a partner that does not read (then the connection drops)."""
 
 
+def listen(host: str, port: int, backlog: int) -> socket.socket:
+    """A non-blocking TCP socket listening on (host, port). Raises OSError (a port in use)."""
+    s = socket.socket(socket.AF_INET6 if ":" in host else socket.AF_INET, socket.SOCK_STREAM)
+    s.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+    try:
+        s.bind((host, port))
+        s.listen(backlog)
+    except OSError:
+        s.close()
+        raise
+    s.setblocking(False)
+    return s
+
+
 class Endpoint:
     """The common part: ``address`` (host, port) bound or connected to, ``peer``, ``connected``."""
 
@@ -101,19 +115,10 @@ class Endpoint:
 class TcpServer(Endpoint):
     """Listens on (host, port) and takes one partner at a time."""
 
-    def __init__(self, host: str, port: int, clients: int = 1) -> None:
+    def __init__(self, host: str, port: int) -> None:
         super().__init__()
-        s = socket.socket(socket.AF_INET6 if ":" in host else socket.AF_INET, socket.SOCK_STREAM)
-        s.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
-        try:
-            s.bind((host, port))
-            s.listen(4)
-        except OSError:
-            s.close()
-            raise
-        s.setblocking(False)
-        self.sock = s
-        self.address = s.getsockname()[:2]
+        self.sock = listen(host, port, 4)
+        self.address = self.sock.getsockname()[:2]
 
     def poll(self) -> list:
         events: list = []

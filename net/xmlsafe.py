@@ -55,6 +55,9 @@ def local(tag: str) -> str:
     return tag.rsplit("}", 1)[-1]
 
 
+_SKIPPED = ((b"<!--", b"-->"), (b"<?", b"?>"), (b"<![CDATA[", b"]]>"))
+
+
 class XmlFramer:
     """Splits a TCP byte stream into complete XML documents (one EKI message each): a message
     ends where its root element closes. Comments, processing instructions and whitespace
@@ -114,23 +117,12 @@ class XmlFramer:
             lt = b.find(b"<", i)
             if lt < 0:
                 return None
-            if b.startswith(b"<!--", lt):
-                e = b.find(b"-->", lt + 4)
+            skip = next(((o, c) for o, c in _SKIPPED if b.startswith(o, lt)), None)
+            if skip is not None:             # a comment, a processing instruction, CDATA
+                e = b.find(skip[1], lt + len(skip[0]))
                 if e < 0:
                     return None
-                i = e + 3
-                continue
-            if b.startswith(b"<?", lt):
-                e = b.find(b"?>", lt + 2)
-                if e < 0:
-                    return None
-                i = e + 2
-                continue
-            if b.startswith(b"<![CDATA[", lt):
-                e = b.find(b"]]>", lt + 9)
-                if e < 0:
-                    return None
-                i = e + 3
+                i = e + len(skip[1])
                 continue
             # a tag: find its end outside quotes
             j = lt + 1

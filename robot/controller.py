@@ -266,6 +266,10 @@ class Controller:
         self._ret_q: np.ndarray | None = None
         self._ended = False
         self.network = None     # net.hub.Network: the partners, polled at each cycle's start
+        # a sensor correction superposed on the setpoint (RSI, net/rsi.py): an object with
+        # `axes` (A1..A6 deg) and `cart` (X, Y, Z mm, A, B, C deg in $BASE); None: none
+        self.correction = None
+        self._q_raw = self._q.copy()
 
     # ================================================================= clock
     @property
@@ -614,7 +618,7 @@ class Controller:
         self._k += 1
         t = self.time
         self.io.now = t
-        if self.network is not None:
+        if self.network is not None and self.network.polling:
             self.network.cycle(self)
         self.io.tick_timers(self._dt_ms)
         if self._pulses:
@@ -639,6 +643,8 @@ class Controller:
         self._q_prev = self._q
         try:
             q = self._main_run(self._pt)
+            if self.correction is not None:
+                q = self._corrected(q)
             self._check_speed(q)
         except RobotError as err:
             q = self._fault(err)
@@ -773,6 +779,53 @@ class Controller:
         q = b.prev.seg.axes(t_prev) + (b.nxt.seg.axes(t_next) - b.nxt.seg.q0)
         self.model.kin.check_soft_limits(q)
         return q
+
+    def _corrected(self, q: np.ndarray) -> np.ndarray:
+        """The setpoint `q` with the sensor correction superposed: the axis correction added,
+        the Cartesian one applied to the TCP in $BASE (translation added, rotation
+        pre-multiplied) and solved back to axes near `q`. At rest the main run keeps its last
+        setpoint, which already holds the correction: the uncorrected one is used instead."""
+        if q is self._q:
+            q = self._q_raw
+        self._q_raw = np.asarray(q, dtype=float)
+        out = self._q_raw.copy()
+        corr = self.correction
+        axes = np.asarray(corr.axes, dtype=float)
+        if np.any(axes):
+            out[:6] += axes
+        cart = np.asarray(corr.cart, dtype=float)
+        if np.any(cart):
+            T = self.model.tcp(out[:6], self._tool_T, self._base_inv_T)
+            C = frame_to_matrix(*cart)
+            target = T.copy()
+            target[:3, 3] = T[:3, 3] + C[:3, 3]
+            target[:3, :3] = C[:3, :3] @ T[:3, :3]
+            out[:6] = self.model.ik(target, np.linalg.inv(self._tool_T), self._base_T, None, None, out[:6])
+        return out
+
+    def set_correction(self, correction) -> None:
+        """Superpose `correction` (``axes``, ``cart``; see ``__init__``) from the next cycle on."""
+        self.correction = correction
+        self._q_raw = self._q.copy()
+
+    def keep_correction(self) -> None:
+        """The sensor correction ends (RSI_OFF) and the robot keeps its corrected position: the
+        next motion is planned from it."""
+        self.correction = None
+        self._q_raw = self._q.copy()
+        if self.is_idle():
+            self._plan_q = self._q.copy()
+
+    def stop_with(self, text: str, number: int | None = None) -> None:
+        """Stop the robot now with the message `text` (a sensor's error, as KSS stops on
+        RSI's): the main run is aborted and the program gets the error at its next step."""
+        q = self._fault(RobotError(text, number))
+        self._q = q
+        self.correction = None
+
+    def tcp_frame(self) -> tuple:
+        """The TCP (X, Y, Z mm, A, B, C deg) in $BASE read back this cycle (``$POS_ACT``'s frame)."""
+        return matrix_to_frame(self._tcp_T)
 
     def _check_speed(self, q: np.ndarray) -> None:
         """Reject a setpoint that would move an axis faster than

@@ -15,6 +15,7 @@ import shutil
 import subprocess
 import sys
 import sysconfig
+import tomllib
 import venv
 import zipfile
 from pathlib import Path
@@ -22,7 +23,9 @@ from pathlib import Path
 import pytest
 
 REPO = Path(__file__).resolve().parents[1]
-PACKAGES = ("krl", "interp", "robot", "recovery", "conformance")
+# the top-level packages the wheel ships: pyproject's package list, one source of truth
+PACKAGES = tuple(p.rstrip("*") for p in tomllib.loads((REPO / "pyproject.toml").read_text())
+                 ["tool"]["setuptools"]["packages"]["find"]["include"])
 
 DEMO = ("DEF demo()\n"
         "  INT i\n"
@@ -56,7 +59,7 @@ def test_wheel_ships_the_generated_parser_and_the_data(wheel):
     for needed in ("krl/syntax/generated/KRLParser.py", "krl/syntax/generated/KRLLexer.py",
                    "krl/syntax/generated/__init__.py", "krl/templates/_base.html.j2",
                    "recovery/templates/recovery.html.j2", "conformance/templates/conformance.html.j2",
-                   "krl/semantics/data/sysvars.yaml", "interp/basis/bas.src", "robot/data/kr6_r900.yaml"):
+                   "krl/semantics/data/sysvars.yaml", "interp/basis/bas.src", "robot/data/kr6_r900.yaml", "net/hub.py"):
         assert needed in names, needed
     assert not any(n.startswith("tests/") for n in names)
     # the package build compiles the VM's dispatch loop (setup.py, interp/vm/build.py): the wheel

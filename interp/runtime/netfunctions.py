@@ -11,8 +11,7 @@ functions return an RSIERR number as INT (``RSIOK`` = 0, :data:`RSI_CONSTANTS`).
 
 from __future__ import annotations
 
-from krl.semantics import types as T
-
+from .builtins import _text      # builtins.py adds these natives at its end, after _text
 from .errors import KrlRuntimeError, value_invalid
 from .values import UNSET, Arr, EnumValue, Struct, is_char_array
 
@@ -36,17 +35,6 @@ def network(rt):
         net = Network(program=rt.program.main_path, sink=RuntimeSink(rt))
         net.attach(ctl)
     return net
-
-
-def _text(ref, what: str) -> str:
-    if ref is None:
-        raise value_invalid(what)
-    v = ref.get()
-    if isinstance(v, str):
-        return v
-    if isinstance(v, Arr) and v.type.elem == T.CHAR:
-        return v.text()
-    raise KrlRuntimeError(f"{what} is not a string")
 
 
 def _status(st) -> Struct:
@@ -266,10 +254,67 @@ def _getter(kind: str, array: bool = False):
 
 def _rsi(method: str):
     def native(rt, a):
-        from net.rsi import rsi_call  # noqa: PLC0415
-
         return rsi_call(network(rt), rt, method, a)
     return native
+
+
+def _arg_text(a: list, i: int) -> str:
+    v = a[i].get() if len(a) > i and a[i] is not None else ""
+    return v.text() if isinstance(v, Arr) else str(v)
+
+
+def _arg_enum(a: list, i: int, default: str) -> str:
+    v = a[i].get() if len(a) > i and a[i] is not None else None
+    return v.name.upper() if isinstance(v, EnumValue) else default
+
+
+def rsi_call(hub, rt, method: str, a: list):
+    """RSI_CREATE(NAME, CONTID :OUT, BOOL), RSI_DELETE(CONTID), RSI_ON(#ABSOLUTE|#RELATIVE
+    [, #IPO|#IPO_FAST]), RSI_OFF(), RSI_MOVECORR() (waits until the STOP object or an error
+    ends it), RSI_SETPUBLICPAR(CONTID, OBJ, PARAM, VALUE), RSI_GETPUBLICPAR(CONTID, OBJ,
+    PARAM, VALUE :OUT); RSI 5's RSI_LOAD(NAME), RSI_ACTIVATE(NAME), RSI_PROCESS_ON(mode),
+    RSI_PROCESS_OFF(), RSI_DEACTIVATE, RSI_UNLOAD as the same. net/rsi.py holds the behaviour.
+    Returns the RSIERR number (INT)."""
+    from net.rsi import RSIOK, Rsi  # noqa: PLC0415
+
+    from .convert import num  # noqa: PLC0415
+
+    if hub.rsi is None:
+        hub.rsi = Rsi(hub)
+    rsi = hub.rsi
+    ctl = rt.controller
+    if method == "create":
+        ret = rsi.create(_arg_text(a, 0))
+        if ret == RSIOK and len(a) > 1 and a[1] is not None:
+            a[1].set(1)
+        return ret
+    if method == "delete":
+        return rsi.delete()
+    if method == "activate":
+        return RSIOK if rsi.ctx is not None else RSI_CONSTANTS["RSIINVOBJID"]
+    if method == "on":
+        rt.wait_main_run(rt.current_task)     # RSI_ON stops the advance run: it corrects from the robot at rest
+        return rsi.start(ctl, _arg_enum(a, 0, "RELATIVE"), _arg_enum(a, 1, "IPO") == "IPO_FAST")
+    if method == "off":
+        rt.wait_main_run(rt.current_task)
+        return rsi.off(ctl)
+    if method == "setpar":
+        if len(a) < 4 or a[3] is None:
+            raise value_invalid("RSI_SETPUBLICPAR value")
+        return rsi.set_param(_arg_text(a, 1), _arg_text(a, 2), float(num(a[3].get(), "RSI_SETPUBLICPAR value")))
+    if method == "getpar":
+        ret, v = rsi.get_param(_arg_text(a, 1), _arg_text(a, 2))
+        if len(a) > 3 and a[3] is not None:
+            a[3].set(v)
+        return ret
+    # movecorr: the robot follows the corrections only, until the STOP object or an error
+    if not rsi.on:
+        raise KrlRuntimeError("RSI_MOVECORR without RSI_ON")
+    task = rt.current_task
+    rt.wait_main_run(task)
+    while rsi.on and not rsi.stopped and not rsi.failed:
+        rt.yield_cycle(task)
+    return None
 
 
 NATIVES = {
@@ -286,6 +331,10 @@ NATIVES = {
     "EKI_GETBOOLARRAY": _getter("Bool", True), "EKI_GETFRAMEARRAY": _getter("Frame", True),
     "RSI_CREATE": _rsi("create"), "RSI_DELETE": _rsi("delete"), "RSI_ON": _rsi("on"),
     "RSI_OFF": _rsi("off"), "RSI_MOVECORR": _rsi("movecorr"),
+    "RSI_SETPUBLICPAR": _rsi("setpar"), "RSI_GETPUBLICPAR": _rsi("getpar"),
+    # RSI 5 (iiQKA): a context is loaded and activated by name, the process switched on and off
+    "RSI_LOAD": _rsi("create"), "RSI_ACTIVATE": _rsi("activate"), "RSI_DEACTIVATE": _rsi("activate"),
+    "RSI_UNLOAD": _rsi("delete"), "RSI_PROCESS_ON": _rsi("on"), "RSI_PROCESS_OFF": _rsi("off"),
 }
 
 __all__ = ["NATIVES", "RSI_CONSTANTS", "network"]

@@ -13,6 +13,7 @@ from robot.trace import TraceWriter
 HERE = Path(__file__).resolve().parent
 CONFIGS = HERE / "configs"
 PROGRAMS = HERE / "programs"
+EXAMPLES = HERE.parents[1] / "examples" / "network"     # the runnable examples of docs/network.md
 
 
 class PartnerFailed(AssertionError):

@@ -12,7 +12,7 @@ from interp.run import make_runtime
 from net.ekiconfig import ConfigError, parse_config
 from robot.trace import TraceWriter
 
-from .helpers import CONFIGS, PROGRAMS
+from .helpers import CONFIGS, EXAMPLES, PROGRAMS
 
 PROGRAM = PROGRAMS / "eki_errors.src"
 
@@ -55,10 +55,10 @@ def test_without_a_partner_the_channel_is_not_connected(interp):
 
 
 def test_the_shipped_configurations_read():
-    for name in ("EkiHwInterface", "ros_eki_motion", "ros_eki_state"):
-        cfg = parse_config((CONFIGS / f"{name}.xml").read_bytes(), name)
+    for folder, name in ((EXAMPLES, "EkiHwInterface"), (CONFIGS, "ros_eki_motion"), (CONFIGS, "ros_eki_state")):
+        cfg = parse_config((folder / f"{name}.xml").read_bytes(), name)
         assert cfg.server and cfg.port in (54600, 54601)
-    cfg = parse_config((CONFIGS / "EkiHwInterface.xml").read_bytes(), "EkiHwInterface")
+    cfg = parse_config((EXAMPLES / "EkiHwInterface.xml").read_bytes(), "EkiHwInterface")
     assert cfg.protocol == "UDP" and cfg.alive_flag == 1 and cfg.buffering == 512
     assert [e.tag for e in cfg.receive][:2] == ["RobotCommand/Pos/@A1", "RobotCommand/Pos/@A2"]
     assert cfg.receive[0].type == "REAL" and cfg.send_kind == "xml"

@@ -19,7 +19,7 @@ import pytest
 
 from net.settings import Channel, NetworkSettings
 
-from .helpers import CONFIGS, net_events, run_with_partner
+from .helpers import CONFIGS, EXAMPLES, net_events, run_with_partner
 
 ROSI = "ros-industrial__kuka_experimental/kuka_eki_hw_interface/krl/kuka_eki_hw_interface.src"
 TINGELST = "tingelst__kuka_eki/kuka_eki/krl/ros_eki.src"
@@ -49,7 +49,7 @@ def test_ros_industrial_eki_hw_interface(shared_corpus, interp):
     """ROS-Industrial's kuka_eki_hw_interface: UDP, RobotCommand/Pos A1..A6 in, RobotState/Pos
     out every ~24 ms (its timer interrupt)."""
     target = [12.5, -75.0, 70.0, 8.0, 25.0, -30.0]
-    settings = NetworkSettings(CONFIGS, eki={"EKIHWINTERFACE": Channel(CONFIGS / "EkiHwInterface.xml", ("127.0.0.1", 0))})
+    settings = NetworkSettings(EXAMPLES, eki={"EKIHWINTERFACE": Channel(EXAMPLES / "EkiHwInterface.xml", ("127.0.0.1", 0))})
 
     def partner(net, rt):
         addr = net.wait_address("eki:EkiHwInterface")

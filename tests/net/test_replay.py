@@ -16,7 +16,7 @@ import pytest
 from net.settings import Channel, NetworkSettings
 from robot.trace import TraceWriter
 
-from .helpers import CONFIGS, HERE
+from .helpers import EXAMPLES, HERE
 
 ROSI = "ros-industrial__kuka_experimental/kuka_eki_hw_interface/krl/kuka_eki_hw_interface.src"
 RECORDING = HERE / "recordings" / "eki_hw_interface.jsonl"
@@ -25,7 +25,7 @@ RECORDING = HERE / "recordings" / "eki_hw_interface.jsonl"
 def replay(program, interp: str) -> TraceWriter:
     from interp.run import make_runtime
 
-    settings = NetworkSettings(HERE, eki={"EKIHWINTERFACE": Channel(CONFIGS / "EkiHwInterface.xml")},
+    settings = NetworkSettings(HERE, eki={"EKIHWINTERFACE": Channel(EXAMPLES / "EkiHwInterface.xml")},
                                replay=RECORDING)
     trace = TraceWriter(keep=True)
     rt, _ = make_runtime(program, network=settings, trace=trace, max_sim_time=2.4, mujoco=False, interp=interp)

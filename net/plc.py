@@ -1,0 +1,340 @@
+"""The PLC side: the controller's I/O image and the Automatic External handshake as a Modbus
+TCP server (pymodbus) and an OPC UA server (asyncua) (docs/network.md "The PLC side").
+
+The address map (:class:`AddressMap`, derived from the cell file by :func:`derive_map`): the
+robot's inputs are what the PLC writes, its outputs what the PLC reads.
+
+=====================  ==================  =======================================
+robot                  Modbus TCP          OPC UA (namespace ``urn:krl-tools:plc``)
+=====================  ==================  =======================================
+``$IN[n]``             coil n-1 (rw)       ``Robot/Inputs/IN[n]`` Boolean (rw)
+``$OUT[n]``            discrete input n-1  ``Robot/Outputs/OUT[n]`` Boolean (ro)
+``$ANIN[n]``           holding reg. n-1    ``Robot/AnalogInputs/ANIN[n]`` Double (rw)
+``$ANOUT[n]``          input reg. n-1      ``Robot/AnalogOutputs/ANOUT[n]`` Double (ro)
+a SIGNAL of the cell   (its bits above)    ``Robot/Signals/NAME`` (rw on inputs)
+=====================  ==================  =======================================
+
+Modbus registers carry an analog value as a signed 16-bit integer, value x 32767 (-1.0 ..
++1.0). The map covers inputs and outputs 1..N, N the highest signal the cell file and the
+program-number handshake name (its ``PGNO_*`` parameters, the SIGNALs of the rules), rounded
+up to 64 (at least 64, at most 8192); analog 1..32. A PLC program or a plain client script
+drives P00's handshake through these bits (``PGNO_FBIT``.., ``PGNO_PARITY``, ``PGNO_VALID``
+in, ``PGNO_REQ`` out) as ``--pgno`` does (robot/cellpresets.py), and EXT start on its input.
+
+The servers run in one thread with their own asyncio loop; once per IPO cycle
+(:meth:`Plc.sync`, called by the hub) the loop copies, as one step between two requests, what
+the PLC wrote since the last cycle into the inputs (traced as ``net`` events: a replay applies
+them again) and the controller's outputs into the PLC's view. At most
+:data:`~krl.limits.MAX_PLC_CLIENTS` clients per server; servers bind loopback unless the
+cell file names another address.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import threading
+from dataclasses import dataclass, field
+
+from krl.limits import MAX_PLC_CLIENTS
+
+N_ANALOG = 32
+SCALE = 32767
+
+
+@dataclass
+class AddressMap:
+    """Inputs/outputs 1..`digital`, analog 1..`analog`; `signals`: NAME -> ("$IN"/"$OUT", first, last)."""
+
+    digital: int = 64
+    analog: int = N_ANALOG
+    signals: dict[str, tuple[str, int, int]] = field(default_factory=dict)
+
+    def rows(self) -> list[tuple[str, str, str]]:
+        """(robot, Modbus, OPC UA) rows of the map, for docs and `krl run`'s message."""
+        out = [(f"$IN[1..{self.digital}]", f"coils 0..{self.digital - 1}", "Robot/Inputs/IN[n]"),
+               (f"$OUT[1..{self.digital}]", f"discrete inputs 0..{self.digital - 1}", "Robot/Outputs/OUT[n]"),
+               (f"$ANIN[1..{self.analog}]", f"holding registers 0..{self.analog - 1}", "Robot/AnalogInputs/ANIN[n]"),
+               (f"$ANOUT[1..{self.analog}]", f"input registers 0..{self.analog - 1}", "Robot/AnalogOutputs/ANOUT[n]")]
+        for name, (base, a, b) in sorted(self.signals.items()):
+            out.append((f"{name} = {base}[{a}]" + (f"..[{b}]" if b != a else ""),
+                        f"{'coil' if base == '$IN' else 'discrete input'} {a - 1}" + (f"..{b - 1}" if b != a else ""),
+                        f"Robot/Signals/{name}"))
+        return out
+
+
+def derive_map(indices: list[int], signals: dict[str, tuple[str, int, int]] | None = None) -> AddressMap:
+    """The map covering digital `indices` (every $IN/$OUT number the cell uses) and `signals`."""
+    top = max([64] + [abs(i) for i in indices] + [b for _, _, b in (signals or {}).values()])
+    top = min(8192, (top + 63) // 64 * 64)
+    return AddressMap(top, N_ANALOG, dict(signals or {}))
+
+
+def _to_reg(v: float) -> int:
+    return int(round(max(-1.0, min(1.0, float(v))) * SCALE)) & 0xFFFF
+
+
+def _from_reg(r: int) -> float:
+    r = int(r) & 0xFFFF
+    return (r - 0x10000 if r >= 0x8000 else r) / SCALE
+
+
+class Plc:
+    """The Modbus TCP and OPC UA servers of a run (see the module docstring)."""
+
+    def __init__(self, hub, settings, amap: AddressMap | None = None) -> None:
+        self.hub = hub
+        self.settings = settings
+        self.map = amap or AddressMap()
+        self.loop: asyncio.AbstractEventLoop | None = None
+        self.thread: threading.Thread | None = None
+        self.modbus = None
+        self.device = None
+        self.opcua = None
+        self.nodes: dict[str, object] = {}
+        self.seen_in: list[bool] = []
+        self.seen_anin: list[float] = []
+        self.seen_nodes: dict[str, object] = {}
+        self.error: BaseException | None = None
+        self.refused = 0            # Modbus clients closed past MAX_PLC_CLIENTS (traced in sync)
+        self.traced_refused = 0
+
+    # ------------------------------------------------------------------ start / stop
+    def start(self) -> None:
+        """Start the servers; returns when they listen. Raises OSError (a port in use)."""
+        ready = threading.Event()
+        self.loop = asyncio.new_event_loop()
+
+        def main():
+            asyncio.set_event_loop(self.loop)
+            try:
+                self.loop.run_until_complete(self._start())
+            except BaseException as exc:  # noqa: BLE001 - reported to the starting thread
+                self.error = exc
+                ready.set()
+                return
+            ready.set()
+            self.loop.run_forever()
+
+        self.thread = threading.Thread(target=main, name="plc", daemon=True)
+        self.thread.start()
+        ready.wait(60)
+        if self.error is not None:
+            raise OSError(f"the PLC servers cannot start: {self.error}") from None
+
+    async def _start(self) -> None:
+        io = self.hub.ctl.io
+        m = self.map
+        self.seen_in = [io.get_in(n) for n in range(1, m.digital + 1)]
+        self.seen_anin = [io.get_anin(n) for n in range(1, m.analog + 1)]
+        if self.settings.modbus is not None:
+            await self._start_modbus()
+        if self.settings.opcua is not None:
+            await self._start_opcua()
+
+    async def _start_modbus(self) -> None:
+        from pymodbus.datastore import (ModbusDeviceContext, ModbusSequentialDataBlock,  # noqa: PLC0415
+                                        ModbusServerContext)
+        from pymodbus.server import ModbusTcpServer  # noqa: PLC0415
+
+        import logging  # noqa: PLC0415
+
+        logging.getLogger("pymodbus").setLevel(logging.ERROR)   # its v4 deprecation notes are not the user's
+        m = self.map
+        io = self.hub.ctl.io
+        # the blocks start at 1: pymodbus maps the PDU's address a to the block's a+1 (address 0 = $IN[1])
+        self.device = ModbusDeviceContext(
+            co=ModbusSequentialDataBlock(1, [io.get_in(n) for n in range(1, m.digital + 1)]),
+            di=ModbusSequentialDataBlock(1, [io.get_out(n) for n in range(1, m.digital + 1)]),
+            hr=ModbusSequentialDataBlock(1, [_to_reg(io.get_anin(n)) for n in range(1, m.analog + 1)]),
+            ir=ModbusSequentialDataBlock(1, [_to_reg(io.get_anout(n)) for n in range(1, m.analog + 1)]))
+        ctx = ModbusServerContext(devices=self.device, single=True)
+        holder: dict = {}
+
+        def connected(up: bool) -> None:
+            srv = holder.get("server")
+            if up and srv is not None and len(srv.active_connections) > MAX_PLC_CLIENTS:
+                key = list(srv.active_connections)[-1]
+                srv.active_connections[key].close()
+                self.refused += 1
+
+        host, port = self.settings.modbus
+        srv = ModbusTcpServer(ctx, address=(host, port), trace_connect=connected)
+        holder["server"] = srv
+        await srv.listen()
+        self.modbus = srv
+        socks = getattr(srv.transport, "sockets", None) or ()
+        bound = socks[0].getsockname()[:2] if socks else (host, port)
+        self.hub.published("modbus", bound)
+
+    async def _start_opcua(self) -> None:
+        from asyncua import Server, ua  # noqa: PLC0415
+
+        url = self.settings.opcua
+        server = Server()
+        await server.init()
+        server.set_endpoint(url)
+        server.set_server_name("krl-tools simulated KR C4")
+        server.set_security_policy([ua.SecurityPolicyType.NoSecurity])
+        ns = await server.register_namespace("urn:krl-tools:plc")
+        robot = await server.nodes.objects.add_object(ns, "Robot")
+        m = self.map
+        io = self.hub.ctl.io
+        groups = {}
+        for gname in ("Inputs", "Outputs", "AnalogInputs", "AnalogOutputs", "Signals"):
+            groups[gname] = await robot.add_folder(ns, gname)
+        for n in range(1, m.digital + 1):
+            node = await groups["Inputs"].add_variable(ns, f"IN[{n}]", io.get_in(n), ua.VariantType.Boolean)
+            await node.set_writable()
+            self.nodes[f"$IN[{n}]"] = node
+            self.nodes[f"$OUT[{n}]"] = await groups["Outputs"].add_variable(ns, f"OUT[{n}]", io.get_out(n), ua.VariantType.Boolean)
+        for n in range(1, m.analog + 1):
+            node = await groups["AnalogInputs"].add_variable(ns, f"ANIN[{n}]", io.get_anin(n), ua.VariantType.Double)
+            await node.set_writable()
+            self.nodes[f"$ANIN[{n}]"] = node
+            self.nodes[f"$ANOUT[{n}]"] = await groups["AnalogOutputs"].add_variable(ns, f"ANOUT[{n}]", io.get_anout(n), ua.VariantType.Double)
+        for name, (base, a, b) in m.signals.items():
+            node = await groups["Signals"].add_variable(ns, name, self._signal_value(base, a, b),
+                                                        ua.VariantType.Boolean if a == b else ua.VariantType.Int32)
+            if base == "$IN":
+                await node.set_writable()
+            self.nodes["SIGNAL " + name] = node
+        await server.start()
+        self.opcua = server
+        socks = getattr(getattr(server.bserver, "_server", None), "sockets", None) or ()
+        self.seen_nodes = {k: await n.read_value() for k, n in self.nodes.items()
+                           if k.startswith(("$IN", "$ANIN", "SIGNAL"))}
+        from .settings import parse_address  # noqa: PLC0415
+
+        host, port = parse_address(url[len("opc.tcp://"):].split("/", 1)[0], "opcua")
+        if socks:
+            port = socks[0].getsockname()[1]
+        self.hub.published("opcua", (host, port))
+
+    def _signal_value(self, base: str, a: int, b: int):
+        io = self.hub.ctl.io
+        get = io.get_in if base == "$IN" else io.get_out
+        if a == b:
+            return get(a)
+        return sum(1 << i for i, n in enumerate(range(a, b + 1)) if get(n))
+
+    def close(self) -> None:
+        loop = self.loop
+        if loop is None:
+            return
+
+        async def stop():
+            if self.modbus is not None:
+                await self.modbus.shutdown()
+            if self.opcua is not None:
+                await self.opcua.stop()
+
+        if self.thread is not None and self.thread.is_alive():
+            try:
+                asyncio.run_coroutine_threadsafe(stop(), loop).result(30)
+            except Exception:  # noqa: BLE001 - a server that does not stop cleanly is left to the thread's end
+                pass
+            loop.call_soon_threadsafe(loop.stop)
+            self.thread.join(30)
+        self.loop = None
+
+    # ------------------------------------------------------------------ the cycle
+    def sync(self) -> None:
+        """Once per IPO cycle (see the module docstring)."""
+        if self.loop is None or self.thread is None or not self.thread.is_alive():
+            return
+        writes = asyncio.run_coroutine_threadsafe(self._exchange(), self.loop).result(30)
+        while self.traced_refused < self.refused:
+            self.traced_refused += 1
+            self.hub.trace("plc", "refused", text=f"more than {MAX_PLC_CLIENTS} Modbus clients")
+        for signal, value in writes:
+            self.apply(signal, value)
+
+    async def _exchange(self) -> list:
+        """In the servers' loop: what the PLC wrote, then the robot's image published."""
+        io = self.hub.ctl.io
+        m = self.map
+        writes: list = []
+        ctx = self.modbus.context if self.modbus is not None else None
+        if ctx is not None:
+            co = await ctx.async_getValues(0, 1, 0, m.digital)
+            for i, v in enumerate(co):
+                if bool(v) != self.seen_in[i]:
+                    writes.append((f"$IN[{i + 1}]", bool(v)))
+            hr = await ctx.async_getValues(0, 3, 0, m.analog)
+            for i, r in enumerate(hr):
+                v = _from_reg(r)
+                if abs(v - self.seen_anin[i]) > 0.5 / SCALE:
+                    writes.append((f"$ANIN[{i + 1}]", v))
+        if self.opcua is not None:
+            for key, node in self.nodes.items():
+                if key in self.seen_nodes:
+                    v = await node.read_value()
+                    if v != self.seen_nodes[key]:
+                        self.seen_nodes[key] = v
+                        if key.startswith("SIGNAL "):
+                            base, a, b = m.signals[key[7:]]
+                            if a == b:
+                                writes.append((f"$IN[{a}]", bool(v)))
+                            else:
+                                writes += [(f"$IN[{n}]", bool((int(v) >> i) & 1)) for i, n in enumerate(range(a, b + 1))]
+                        else:
+                            writes.append((key, bool(v) if key.startswith("$IN") else float(v)))
+        # the image as it will be after these writes, published to both servers
+        pending = dict(writes)
+        ins = [pending.get(f"$IN[{n}]", io.get_in(n)) for n in range(1, m.digital + 1)]
+        anins = [pending.get(f"$ANIN[{n}]", io.get_anin(n)) for n in range(1, m.analog + 1)]
+        self.seen_in = [bool(x) for x in ins]
+        self.seen_anin = [float(x) for x in anins]
+        if ctx is not None:
+            await ctx.async_setValues(0, 1, 0, ins)
+            await ctx.async_setValues(0, 2, 0, [io.get_out(n) for n in range(1, m.digital + 1)])
+            await ctx.async_setValues(0, 3, 0, [_to_reg(x) for x in anins])
+            await ctx.async_setValues(0, 4, 0, [_to_reg(io.get_anout(n)) for n in range(1, m.analog + 1)])
+        if self.opcua is not None:
+            from asyncua import ua  # noqa: PLC0415
+
+            for n in range(1, m.digital + 1):
+                await self._publish(f"$IN[{n}]", ins[n - 1], ua.VariantType.Boolean)
+                await self._publish(f"$OUT[{n}]", io.get_out(n), ua.VariantType.Boolean)
+            for n in range(1, m.analog + 1):
+                await self._publish(f"$ANIN[{n}]", anins[n - 1], ua.VariantType.Double)
+                await self._publish(f"$ANOUT[{n}]", io.get_anout(n), ua.VariantType.Double)
+        return writes
+
+    async def _publish(self, key: str, value, vtype) -> None:
+        from asyncua import ua  # noqa: PLC0415
+
+        cache = self.__dict__.setdefault("_published", {})
+        if cache.get(key) == value:
+            return
+        cache[key] = value
+        node = self.nodes[key]
+        await self.opcua.write_attribute_value(node.nodeid, ua.DataValue(ua.Variant(value, vtype)))
+        if key in self.seen_nodes:
+            self.seen_nodes[key] = value
+
+    def apply(self, signal: str, value) -> None:
+        """A PLC write: the input changes now (traced, so a replay applies it again)."""
+        self.hub.trace("plc", "in", data=f"{signal}={'TRUE' if value is True else 'FALSE' if value is False else value}")
+        apply_write(self.hub, signal, value)
+
+
+def apply_write(hub, signal: str, value) -> None:
+    io = hub.ctl.io
+    io.now = hub.ctl.time
+    n = int(signal[signal.index("[") + 1:-1])
+    if signal.startswith("$IN"):
+        io.set_in(n, bool(value), "plc")
+    else:
+        io.set_anin(n, float(value), "plc")
+
+
+def replay_write(hub, ev: dict) -> None:
+    """A recorded PLC write, applied again."""
+    text = str(ev.get("data", ""))
+    if "=" not in text:
+        return
+    signal, value = text.split("=", 1)
+    hub.trace("plc", "in", data=text)
+    v = True if value == "TRUE" else False if value == "FALSE" else float(value)
+    apply_write(hub, signal, v)
