@@ -15,7 +15,8 @@ REPO = Path(__file__).resolve().parents[1]
 CHECKED = ["krl/semantics", "krl/ast", "krl/syntax", "krl/fmt", "krl/project.py", "krl/workspace.py",
            "interp/tree", "interp/vm/compiler.py", "interp/vm/vm.py", "interp/vm/gen_loop.py",
            "interp/runtime/program.py", "interp/asm.py", "interp/debug/expr.py", "robot/cellrules.py",
-           "robot/datalist.py"]
+           "robot/datalist.py", "krl/files.py", "krl/pool.py", "krl/render.py", "krl/source.py",
+           "interp/vm/__init__.py", "interp/vm/build.py"]
 REASON = re.compile(r"costs? \d|\d+(\.\d+)? s\b|optional|only for a build|loads only for a build")
 
 

@@ -15,7 +15,7 @@ __all__ = ["VM"]
 
 
 def __getattr__(name: str):
-    # loaded on first use (PEP 562): vm.py imports the runtime and the compiled loop, which
+    # loaded on first use (PEP 562; optional for commands that run nothing): vm.py imports the runtime and the compiled loop, which
     # `krl` commands that run no program (check, fmt, lsp) do not need
     if name == "VM":
         from .vm import VM  # noqa: PLC0415
