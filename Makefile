@@ -11,7 +11,7 @@ GEN_DIR := krl/syntax/generated
 PARSER  := $(GEN_DIR)/KRLParser.py
 SHARED_CORPUS ?= ../shared/krl-corpus
 
-.PHONY: all recover test validate growth conformance nightly bench parser java-parser clean check-python check-java vsix check-node vm-loop
+.PHONY: all recover test validate growth conformance nightly bench parser java-parser clean check-python check-java vsix check-node vm-loop programmap-js
 
 all: test
 
@@ -129,3 +129,16 @@ vsix: $(VSCODE_EXT)/node_modules/.installed
 	  echo "error: @vscode/vsce needs Node.js 20 or later (found $$(node --version))"; exit 2; }
 	cd $(VSCODE_EXT) && node_modules/.bin/vsce package --allow-missing-repository --skip-license --out krl.vsix
 	@echo "extension: $(VSCODE_EXT)/krl.vsix (install: code --install-extension $(VSCODE_EXT)/krl.vsix)"
+
+# The program map's front end (krl/programmap/web, issue 37): cytoscape and elkjs from
+# package-lock.json (npm ci, again only when the lock file changes), bundled by esbuild into
+# krl/programmap/static/programmap.js. The built file is committed and shipped in the wheel:
+# `krl graph --format html` needs neither npm nor a network; rebuild it after changing
+# web/src or the lock file (tests/programmap/test_map_page.py checks the versions it names).
+PROGRAMMAP_WEB := krl/programmap/web
+$(PROGRAMMAP_WEB)/node_modules/.installed: $(PROGRAMMAP_WEB)/package-lock.json | check-node
+	cd $(PROGRAMMAP_WEB) && npm ci --no-audit --no-fund
+	@sha256sum $(PROGRAMMAP_WEB)/package-lock.json | cut -c1-64 > $@
+
+programmap-js: $(PROGRAMMAP_WEB)/node_modules/.installed
+	cd $(PROGRAMMAP_WEB) && npm run build

@@ -236,6 +236,7 @@ def starter(uses: list[InputUse], programs: list[str], own_robot: bool = True,
 def cell_init(root: Path, programs: list[Path]) -> str:
     """The starter cell file for `programs` of the backup `root` (see the module docstring)."""
     from interp.run import make_runtime  # noqa: PLC0415
+    from robot.machine import load_machine  # noqa: PLC0415
 
     found: dict[str, InputUse] = {}
     opened: dict[tuple[str, str], tuple[str, str, str]] = {}
@@ -243,7 +244,9 @@ def cell_init(root: Path, programs: list[Path]) -> str:
     for prog in programs:
         if str(prog.resolve()) in covered:
             continue        # its module was loaded with an earlier program's files (one backup)
-        rt, _ = make_runtime(prog, mujoco=False, check=False)
+        # the starter reads inputs and moves no robot: the backup's machine data are not read
+        # (a robot the model refuses must not stop it; docs/robot.md), the default robot stands in
+        rt, _ = make_runtime(prog, mujoco=False, check=False, robot=load_machine())
         covered |= {str(Path(m.unit.src.path).resolve()) for m in rt.program.modules if m.unit.src is not None}
         for u in inputs_read(rt, root):
             have = found.setdefault(u.name, u)

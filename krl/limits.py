@@ -194,3 +194,6 @@ MAX_NET_REPLAY_EVENTS = 1_000_000
 # The wall-clock pace factor of a run with a partner attached (simulated s per wall s): 1 is
 # real time; up to 10 where the protocol allows (EKI, KukaVarProxy, the PLC), never for RSI.
 MAX_NET_PACE = 10.0
+# The routines' source text the interactive map page carries (krl graph --format html), in
+# characters in all; past it the remaining routines show their file:line without the text.
+MAX_GRAPH_SOURCE_CHARS = 8_000_000

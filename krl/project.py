@@ -53,8 +53,8 @@ from krl.limits import MAX_FOLDER_DEPTH
 from krl.source import is_krl_file
 
 __all__ = ["ProgramFiles", "SYSTEM_DIRS", "backup_of", "collect_entries", "collect_files", "find_backups",
-           "folder_entries", "folder_groups", "is_submit_file", "is_system_path", "machine_data_file", "module_key", "modules_of",
-           "project_of", "system_folder", "system_folder_of", "with_basis"]
+           "folder_entries", "folder_groups", "is_submit_file", "is_system_path", "machine_data_file", "module_key",
+           "modules_of", "program_folder", "project_of", "system_folder", "system_folder_of", "with_basis"]
 
 #: KUKA's system folders of a backup (rule 7), lower case
 SYSTEM_DIRS = ("system", "tp", "mada", "steu")
@@ -131,6 +131,17 @@ def system_folder(root: Path) -> Path | None:
         if _is_base(base):
             return _child(base, "system")
     return None
+
+
+def program_folder(root: Path) -> Path | None:
+    """The folder of the programs an operator selects at the pendant: ``R1/Program`` of the
+    backup rooted at `root` (``Program`` of a flat export), any letter case, links never
+    followed; None when the backup has none."""
+    sysdir = system_folder(root)
+    if sysdir is None:
+        return None
+    f = _child(sysdir.parent, "program")
+    return f if f is not None and not f.is_symlink() and f.is_dir() else None
 
 
 def machine_data_file(root: Path) -> Path | None:

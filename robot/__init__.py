@@ -1,5 +1,7 @@
-"""Simulated KR 6 R900 sixx controller: machine data, frames, kinematics (and MuJoCo model
-in robot.mjcf, imported lazily because it needs mujoco)."""
+"""The simulated KUKA controller and its robot: the robot model of any machine data (the KR 6
+R900 of robot/data by default, a backup's own $machine.dat through robot.mada), frames,
+kinematics with their external axes, the planner and main run, and the MuJoCo model
+(robot.mjcf, imported lazily because it needs mujoco)."""
 
 import importlib
 

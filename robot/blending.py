@@ -263,27 +263,28 @@ def _rates_at(seg: Segment, us: np.ndarray, from_end: bool) -> tuple[np.ndarray,
     end point's axes (``from_end``) or its start's (the segment's own state is not touched). If the IK cannot follow the window
     (the planner already accepted this path), the planned end rates are used."""
     n = len(us)
+    w = len(seg.q0)                       # A1..A6 and the external axes (robot/planner.py)
     if not seg.cart:
-        return np.broadcast_to(seg.q1 - seg.q0, (n, 6)), np.zeros((n, 6))
+        return np.broadcast_to(seg.q1 - seg.q0, (n, w)), np.zeros((n, w))
     lo, hi = float(np.min(us)), float(np.max(us))
     if hi - lo < 1e-9:
         lo, hi = max(0.0, lo - 1e-3), min(1.0, hi + 1e-3)
     grid = np.linspace(lo, hi, _BLEND_SAMPLES + 1)
     order = range(len(grid) - 1, -1, -1) if from_end else range(len(grid))
     ref = seg.q1 if from_end else seg.q0
-    Q = np.empty((len(grid), 6))
+    Q = np.empty((len(grid), w))
     try:
         for j in order:
             p, R = seg.pose_u(float(grid[j]))
-            ref = Q[j] = seg.ik(p, R, ref)
+            ref = Q[j] = seg.ik(p, R, ref, float(grid[j])) if w > 6 else seg.ik(p, R, ref)
     except Exception:  # noqa: BLE001 - keep the planned rates
         d = seg.qd_start if lo <= 0.0 else seg.qd_end
-        return np.broadcast_to(d, (n, 6)), np.zeros((n, 6))
+        return np.broadcast_to(d, (n, w)), np.zeros((n, w))
     h = float(grid[1] - grid[0])
     d1 = np.gradient(Q, h, axis=0, edge_order=2)
     d2 = np.gradient(d1, h, axis=0, edge_order=2)
-    return (np.stack([np.interp(us, grid, d1[:, i]) for i in range(6)], axis=1),
-            np.stack([np.interp(us, grid, d2[:, i]) for i in range(6)], axis=1))
+    return (np.stack([np.interp(us, grid, d1[:, i]) for i in range(w)], axis=1),
+            np.stack([np.interp(us, grid, d2[:, i]) for i in range(w)], axis=1))
 
 
 def _joint_blend_acc_ratio(prev: Segment, bp: Any, nxt: Segment, rp: Any, window: float) -> float:

@@ -229,7 +229,11 @@ class Controller:
         self.rules += list(rules or [])
         self.stimuli: list[Stimulus] = list(stimuli or [])
         q = np.array(self.machine.home_deg if start_axes is None else start_axes, dtype=float)
-        self.model.kin.check_soft_limits(q)
+        if self.model.n_ext:
+            # A1..A6 then E1..En (robot/planner.py): E from $AXIS_HOME[1] unless given
+            home = np.array(self.machine.home_all, dtype=float)
+            q = np.concatenate([q[:6], q[6:6 + self.model.n_ext], home[6 + len(q[6:]):]])[:6 + self.model.n_ext]
+        self.model.check_limits(q)
         self._arm = None
         self.actuated = actuated
         if mujoco:
@@ -533,7 +537,8 @@ class Controller:
 
     # ================================================================= read-back
     def axis_act(self) -> np.ndarray:
-        """``$AXIS_ACT``: A1..A6 (deg) read back from the MuJoCo model, shape (6,)."""
+        """``$AXIS_ACT``: A1..A6 (deg) read back from the MuJoCo model, shape (6,); then E1..En
+        (mm, deg) on a robot with external axes."""
         if self._arm is not None:
             return self._arm.axes_deg()
         return self._q.copy()
@@ -557,7 +562,10 @@ class Controller:
             T = inv_pos(T)
         x, y, z, a, b, c = matrix_to_frame(T)
         s, t = self.model.status_turn(q)
-        return {"X": x, "Y": y, "Z": z, "A": a, "B": b, "C": c, "S": s, "T": t}
+        out = {"X": x, "Y": y, "Z": z, "A": a, "B": b, "C": c, "S": s, "T": t}
+        for i, v in enumerate(q[6:]):
+            out[f"E{i + 1}"] = float(v)
+        return out
 
     def _tcp_read_back(self, q: np.ndarray, tool_T: np.ndarray, base_inv_T: np.ndarray) -> np.ndarray:
         """TCP in $BASE from the MuJoCo flange site (``INV_POS($BASE) : FLANGE_world : $TOOL``),
@@ -775,9 +783,15 @@ class Controller:
             p1, R1 = b.nxt.seg.pose(t_next)
             pc, Rc = b.nxt.seg.pose(0.0)
             p, R = blending.superpose_pose(p0, R0, p1, R1, pc, Rc)
-            return b.nxt.seg.ik(p, R, self._q)  # type: ignore[attr-defined]
+            ref = self._q
+            if len(ref) > 6:
+                # the external axes overlap like axes: E_prev(t) + E_next(t) - E at the point
+                e = (_e_at(b.prev.seg, b.prev.seg.u(t_prev)) + _e_at(b.nxt.seg, b.nxt.seg.u(t_next))
+                     - b.nxt.seg.q0[6:])
+                ref = np.concatenate([ref[:6], e])
+            return b.nxt.seg.ik(p, R, ref)  # type: ignore[attr-defined]
         q = b.prev.seg.axes(t_prev) + (b.nxt.seg.axes(t_next) - b.nxt.seg.q0)
-        self.model.kin.check_soft_limits(q)
+        self.model.check_limits(q)
         return q
 
     def _corrected(self, q: np.ndarray) -> np.ndarray:
@@ -837,8 +851,9 @@ class Controller:
             lim = self._step_lim = (CP_SPEED_LIMIT_FACTOR * self.model.v_max * self.dt + 1e-9).tolist()
         step = [abs(a - b) for a, b in zip(np.asarray(q).tolist(), self._q_prev.tolist())]
         if any(d > m for d, m in zip(step, lim)):
-            i = max(range(6), key=lambda j: step[j] / lim[j])
-            raise RobotError(f"speed limit exceeded A{i + 1}: CP path through a singularity")
+            i = max(range(len(step)), key=lambda j: step[j] / lim[j])
+            name = f"A{i + 1}" if i < 6 else f"E{i - 5}"
+            raise RobotError(f"speed limit exceeded {name}: CP path through a singularity")
 
     def _fault(self, err: RobotError) -> np.ndarray:
         mid = self._runs[0].seg.id if self._runs else None
@@ -928,6 +943,11 @@ class Controller:
                             st.fired = True
                             for name, v in st.set.items():
                                 self.io.set_signal(name, v, "stimulus")
+
+
+def _e_at(seg: Segment, u: float) -> np.ndarray:
+    """The external axes of `seg` at its path parameter `u` (linear from start to end)."""
+    return seg.q0[6:] + u * (seg.q1[6:] - seg.q0[6:])
 
 
 def _as4(F: Any) -> np.ndarray:

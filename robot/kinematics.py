@@ -1,4 +1,5 @@
-"""Forward and inverse kinematics of the KR 6 R900 sixx in KUKA's conventions.
+"""Forward and inverse kinematics of any robot model (:class:`~robot.machine.MachineData`:
+the KR 6 R900 yaml or a backup's machine data) in KUKA's conventions.
 
 Sources: robot-model.md §2-§4 (chain, OPW parameters), §7 (frame chain),
 §8 (status S and turn T), reference §6.4-§6.5 and §8.2 (errors).
@@ -7,10 +8,20 @@ Units: mm and degrees everywhere (axis values A1..A6 in deg, frames as 4x4
 homogeneous transforms in mm). The FLANGE frame is KUKA's flange (= URDF
 ``tool0``: +Z out of the flange), expressed in ``$ROBROOT``.
 
-Forward kinematics walks the URDF chain of the yaml (joint origins and axes,
-``q_urdf = radians(A_i)``, robot-model.md §3). Inverse kinematics is the analytic
-OPW solution (Brandstötter et al. 2014) with the yaml ``opw`` parameters; it
-returns up to 8 solutions, one per status S (bits 0..2).
+Forward kinematics walks the URDF-style joints of the model (joint origins and axes,
+``q_urdf = radians(A_i)``, robot-model.md §3). The inverse kinematics is chosen from the
+chain, never from the robot's name (:attr:`Kinematics.family`):
+
+* ``"opw"``: the six-axis arm with a spherical wrist, the analytic OPW solution
+  (Brandstötter et al. 2014; its parameters from robot/chain.py ``opw_form``, with any
+  ``$TIRORO`` before it and any ``$TFLWP`` after it), up to 8 solutions, one per status S;
+* ``"palletizer4"`` (``$DEF_A4FIX`` and ``$DEF_A5LINK``) and ``"palletizer5"``
+  (``$DEF_A4FIX`` only): the closed forms of robot/ik_palletizer.py;
+* ``"numeric"``: any other arm, robot/ik_numeric.py (the MuJoCo model of the robot solved by
+  the ``mink`` library from seeds), with the same status/turn selection and errors.
+
+Each analytic form is checked against the machine-data chain when it is chosen. A vectorised
+entry point, :meth:`Kinematics.inverse_many`, solves N targets at once with numpy.
 """
 
 from __future__ import annotations
@@ -87,10 +98,81 @@ class Kinematics:
         self._ks_l = [float(v) for v in self._ks]
         # the 4-axis palletizer ($DEF_A5LINK, docs/robot.md "The palletizer"): its own inverse
         self._pa: tuple[np.ndarray, np.ndarray] | None = None
+        self._pa5: Any = None       # the 5-axis palletizer (robot/ik_palletizer.py)
+        self._numeric: Any = None   # the numeric solver (robot/ik_numeric.py), built on first use
+        self._base_inv: np.ndarray | None = None   # INV(frame before the OPW arm), None: identity
+        self._end_inv: np.ndarray | None = None    # INV(frame after it)
         self._s_free = 0            # S bits that select nothing on this robot
         self._t_free = 0            # T bits that select nothing on this robot
+        #: the inverse kinematics of this robot: "opw", "palletizer4", "palletizer5" or "numeric"
+        self.family = "opw"
+        where = m.provenance.get("$DEF_A4FIX", m.source)
         if m.a5link:
+            self.family = "palletizer4"
             self._init_palletizer()
+            self._check_palletizer4(where)
+        elif m.a4fix:
+            from .ik_palletizer import Palletizer5  # noqa: PLC0415
+
+            self.family = "palletizer5"
+            self._pa5 = Palletizer5(self)
+            self._s_free = 4
+            self._t_free = 0b01000
+            self._pa5.check(where)
+        elif m.chain is not None:
+            self._choose_form()
+
+    def _choose_form(self) -> None:
+        """The inverse of a machine-data arm: the standard OPW parameters of robot/mada.py when
+        they reproduce the chain, else the OPW form found in the chain's geometry
+        (robot/chain.py), else the numeric solver."""
+        from dataclasses import replace  # noqa: PLC0415
+
+        from .chain import opw_form  # noqa: PLC0415
+
+        if self._form_agrees():
+            return
+        form = opw_form(self.machine.chain)
+        if form is not None:
+            self._set_opw(form.params)
+            self._base_inv = np.linalg.inv(form.base) if form.base is not None else None
+            self._end_inv = np.linalg.inv(form.end) if form.end is not None else None
+            self.phi_deg = form.phi_deg
+            if self._form_agrees():
+                return
+            self._base_inv = self._end_inv = None
+        self._set_opw(replace(self.machine.opw))
+        self.phi_deg = float(self.machine.status_phi_deg)
+        self.family = "numeric"
+
+    def _set_opw(self, o) -> None:
+        self._opw = o
+        self._sign = np.array(o.sign_corrections, dtype=float)
+        self._off = np.radians(np.array(o.offsets_deg, dtype=float))
+        self._kappa_2 = o.a2 * o.a2 + o.c3 * o.c3
+        self._c2_2 = o.c2 * o.c2
+        self._k = math.sqrt(self._kappa_2)
+        self._at23 = math.atan2(o.a2, o.c3)
+        self._sgn = [float(v) for v in self._sign]
+        self._offs = [float(v) for v in self._off]
+
+    def _form_agrees(self) -> bool:
+        """True when the joints reproduce the machine-data chain and the analytic solutions
+        reproduce every sample pose (1e-6 mm; robot/chain.py ``chain_forward``)."""
+        from .chain import chain_forward  # noqa: PLC0415
+
+        chain = self.machine.chain
+        rng = np.random.default_rng(0)
+        lo = np.maximum(self._lo, -170.0)
+        hi = np.minimum(self._hi, 170.0)
+        for q in rng.uniform(lo, hi, size=(4, 6)):
+            T = chain_forward(chain, q)
+            if np.abs(self.forward(q) - T).max() > 1e-6:
+                return False
+            rows = self._opw_rows(T, None)
+            if not rows or min(np.abs(self.forward(r) - T).max() for r in rows) > 1e-6:
+                return False
+        return True
 
     # ------------------------------------------------------------------ FK
     def forward(self, axes_deg: Sequence[float]) -> np.ndarray:
@@ -241,6 +323,28 @@ class Kinematics:
         self._s_free = 4
         self._t_free = 0b11000
 
+    def _check_palletizer4(self, where: str) -> None:
+        """The 4-axis closed form must give back random linked configurations of the chain
+        (A4 = 0, A2 + A3 + A5 as at HOME); robot.mada.MachineDataError otherwise."""
+        from .chain import chain_forward  # noqa: PLC0415
+        from .mada import MachineDataError  # noqa: PLC0415
+
+        home = self._home
+        rng = np.random.default_rng(0)
+        lo = np.maximum(self._lo, -170.0)
+        hi = np.minimum(self._hi, 170.0)
+        for q in rng.uniform(lo, hi, size=(4, 6)):
+            q[3] = 0.0
+            q[4] = home[4] + home[1] + home[2] - q[1] - q[2]
+            T = self.forward(q)
+            if self.machine.chain is not None and np.abs(chain_forward(self.machine.chain, q) - T).max() > 1e-6:
+                raise MachineDataError(f"{where}: internal chain does not close")
+            rows = self._palletizer_rows(T, q)
+            if not rows or min(np.abs(self.forward(r) - T).max() for r in rows) > 1e-6:
+                raise MachineDataError(
+                    f"{where}: $DEF_A4FIX=TRUE, A5 led ({'$NUM_AX=4' if 'a5_led' in self.machine.provenance else '$DEF_A5LINK=TRUE'}): this palletizer's arm ($TIRORO, $TX3P3, "
+                    f"$DH_4, $DH_5, $TFLWP) is not one the 4-axis closed form covers")
+
     def _joint_point(self, axes_deg: Sequence[float], index: int) -> np.ndarray:
         """Position (mm, in ``$ROBROOT``) of the origin of joint `index` (0 = A1)."""
         q = self._kuka_sign * np.radians(np.asarray(axes_deg, dtype=float)[:6])
@@ -292,6 +396,21 @@ class Kinematics:
         palletizer :meth:`_palletizer_rows`."""
         if self._pa is not None:
             return self._palletizer_rows(flange_T, ref_deg)
+        if self._pa5 is not None:
+            return self._pa5.rows(flange_T, ref_deg)
+        if self.family == "numeric":
+            if self._numeric is None:
+                from .ik_numeric import NumericIK  # noqa: PLC0415
+
+                self._numeric = NumericIK(self)
+            return self._numeric.rows(flange_T, ref_deg)
+        if self._base_inv is not None or self._end_inv is not None:
+            T = np.asarray(flange_T, dtype=float)
+            if self._base_inv is not None:
+                T = self._base_inv @ T
+            if self._end_inv is not None:
+                T = T @ self._end_inv
+            return self._opw_core(T, ref_deg)
         return self._opw_core(flange_T, ref_deg)
 
     def _opw_core(self, flange_T: np.ndarray, ref_deg: np.ndarray | None) -> list[list[float]]:
@@ -402,7 +521,21 @@ class Kinematics:
                 ``$SOFTN_END``/``$SOFTP_END``.
         """
         ref = self._home.copy() if reference_deg is None else np.asarray(reference_deg, dtype=float)[:6]
-        rows = self._opw_rows(flange_T, ref)
+        if self.family == "numeric" and reference_deg is not None:
+            # the solution reached from the reference: the nearest one, when its S and T fit
+            if self._numeric is None:
+                self._opw_rows(np.eye(4), None)
+            near = self._numeric.rows(flange_T, ref, near_only=True)
+            if near:
+                try:
+                    return self._select(near, status, turn, ref)
+                except (WorkspaceError, SoftLimitError):
+                    pass
+        return self._select(self._opw_rows(flange_T, ref), status, turn, ref)
+
+    def _select(self, rows: list[list[float]], status: int | None, turn: int | None,
+                ref: np.ndarray) -> np.ndarray:
+        """The solution of `rows` that :meth:`inverse` returns (its steps 1-3), or its error."""
         if not rows:
             raise WorkspaceError("workspace error: target not reachable")
         if status is not None:
@@ -485,6 +618,153 @@ class Kinematics:
         assert best_bad is not None
         _, q, i = best_bad
         raise SoftLimitError(i + 1, float(q[i]), positive=bool(q[i] > self._hi[i]))
+
+    # ------------------------------------------------------------------ vectorised IK
+    def inverse_many(self, flange_T: np.ndarray, status: int | None = None, turn: int | None = None,
+                     reference_deg: Sequence[float] | np.ndarray | None = None) -> np.ndarray:
+        """:meth:`inverse` of N flange poses at once (numpy over the targets).
+
+        Args:
+            flange_T: (N, 4, 4) flange frames in ``$ROBROOT``, mm.
+            status, turn: as for :meth:`inverse`, the same for every target.
+            reference_deg: (6,) or (N, 6) axes (deg); default HOME.
+        Returns:
+            (N, 6) A1..A6 in deg, row i equal to ``inverse(flange_T[i], status, turn,
+            reference_deg[i])`` — bit for bit on the OPW family, where every operation is the
+            scalar one in the same order (``math.acos`` is used, as numpy's ``arccos`` may differ
+            in the last bit); the other families solve the rows one by one.
+        Raises:
+            WorkspaceError, SoftLimitError: those of the first row that fails, with the
+                attribute ``row`` (its index).
+        """
+        Ts = orig = np.asarray(flange_T, dtype=float).reshape(-1, 4, 4)
+        n = Ts.shape[0]
+        if reference_deg is None:
+            refs = np.broadcast_to(self._home, (n, 6)).astype(float)
+        else:
+            refs = np.broadcast_to(np.asarray(reference_deg, dtype=float)[..., :6], (n, 6)).astype(float)
+        if self.family != "opw" or n == 0:
+            return self._inverse_rows(Ts, status, turn, refs, range(n))
+        if self._base_inv is not None:
+            Ts = self._base_inv @ Ts
+        if self._end_inv is not None:
+            Ts = Ts @ self._end_inv
+        Q, valid = self._opw_core_many(Ts, refs)                   # (n, 8, 6), (n, 8)
+        S, amb = self._status_many(Q)                              # (n, 8)
+        if status is not None:
+            s_target = np.full(n, int(status) & 7)
+            free = np.zeros(n, dtype=int)
+        else:
+            s_target, free = self._status_many(refs[:, None, :])
+            s_target, free = s_target[:, 0], free[:, 0]
+        keep = ~free
+        match = valid & ((((S ^ s_target[:, None]) & ~amb & keep[:, None] & 7) == 0))
+        cands = Q[:, :, :, None] + np.array(self._ks_l)[None, None, None, :]   # (n, 8, 6, 5)
+        lo = np.array(self._lo_l)[None, None, :, None]
+        hi = np.array(self._hi_l)[None, None, :, None]
+        ok = (cands >= lo) & (cands <= hi)
+        if turn is not None:
+            t = int(turn) & ~self._t_free
+            neg = (((t >> np.arange(6)) & 1) == 1)[None, None, :, None]
+            free_t = (((self._t_free >> np.arange(6)) & 1) == 1)[None, None, :, None]
+            ok &= ((cands < 0) == neg) | (np.abs(cands) < 1e-6) | free_t
+        dist = np.where(ok, np.abs(cands - refs[:, None, :, None]), np.inf)
+        pick = np.argmin(dist, axis=3)                                          # first of equals
+        best = np.take_along_axis(cands, pick[..., None], axis=3)[..., 0]       # (n, 8, 6)
+        axis_ok = np.isfinite(np.take_along_axis(dist, pick[..., None], axis=3)[..., 0]).all(axis=2)
+        d = np.abs(best - refs[:, None, :])
+        cost = ((((d[..., 0] + d[..., 1]) + d[..., 2]) + d[..., 3]) + d[..., 4]) + d[..., 5]
+        usable = match & axis_ok
+        cost = np.where(usable, cost, np.inf)
+        j = np.argmin(cost, axis=1)
+        out = best[np.arange(n), j]
+        bad = ~usable.any(axis=1)
+        if bad.any():
+            out[bad] = self._inverse_rows(orig, status, turn, refs, np.flatnonzero(bad))
+        return out
+
+    def _inverse_rows(self, Ts: np.ndarray, status, turn, refs: np.ndarray, rows) -> np.ndarray:
+        """:meth:`inverse` row by row for the indices `rows`; the first error gets ``.row``."""
+        out = []
+        for i in rows:
+            try:
+                out.append(self.inverse(Ts[i], status, turn, refs[i]))
+            except (WorkspaceError, SoftLimitError) as exc:
+                exc.row = int(i)                     # type: ignore[attr-defined]
+                raise
+        return np.array(out, dtype=float).reshape(-1, 6)
+
+    def _status_many(self, Q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`_status_row` over the last axis of Q (..., 6): (S, ambiguous bits) arrays."""
+        o = self._opw
+        t2 = np.radians(self._sgn[1] * Q[..., 1]) - self._offs[1]
+        t23 = t2 + np.radians(self._sgn[2] * Q[..., 2]) - self._offs[2]
+        xw = o.a1 + o.c2 * np.sin(t2) + o.c3 * np.sin(t23) + o.a2 * np.cos(t23)
+        phi = self.phi_deg
+        s = ((xw < -BOUNDARY_EPS).astype(int) | ((Q[..., 2] >= phi - BOUNDARY_EPS).astype(int) << 1)
+             | ((Q[..., 4] < -BOUNDARY_EPS).astype(int) << 2))
+        amb = ((np.abs(xw) < OVERHEAD_SINGULAR_MM).astype(int) | ((np.abs(Q[..., 2] - phi) < 1e-7).astype(int) << 1)
+               | ((np.abs(Q[..., 4]) < WRIST_SINGULAR_DEG).astype(int) << 2) | self._s_free)
+        return s, amb
+
+    def _opw_core_many(self, Ts: np.ndarray, refs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`_opw_core` over N targets: (N, 8, 6) axes (deg, wrapped; NaN where a branch
+        does not exist) and the (N, 8) mask of existing solutions, in the scalar order."""
+        o = self._opw
+        acos = np.frompyfunc(math.acos, 1, 1)
+        atan2_ = np.frompyfunc(math.atan2, 2, 1)
+
+        def atan2(y, x):
+            return atan2_(y, x).astype(float)
+        r00, r01, r02, px = Ts[:, 0, 0], Ts[:, 0, 1], Ts[:, 0, 2], Ts[:, 0, 3]
+        r10, r11, r12, py = Ts[:, 1, 0], Ts[:, 1, 1], Ts[:, 1, 2], Ts[:, 1, 3]
+        r20, r21, r22, pz = Ts[:, 2, 0], Ts[:, 2, 1], Ts[:, 2, 2], Ts[:, 2, 3]
+        cx, cy, cz = px - o.c4 * r02, py - o.c4 * r12, pz - o.c4 * r22
+        rho2 = cx * cx + cy * cy - o.b * o.b
+        reach = rho2 >= 0.0
+        nx1 = np.sqrt(np.where(reach, rho2, 0.0)) - o.a1
+        over = np.sqrt(cx * cx + cy * cy) < OVERHEAD_SINGULAR_MM
+        tmp1 = np.where(over, np.radians(self._sgn[0] * refs[:, 0]) - self._offs[0], atan2(cy, cx))
+        tmp2 = atan2(o.b, nx1 + o.a1)
+        th1s = (tmp1 - tmp2, tmp1 + tmp2 - math.pi)
+        tmp3 = cz - o.c1
+        s1_2 = nx1 * nx1 + tmp3 * tmp3
+        tmp4 = nx1 + 2.0 * o.a1
+        s2_2 = tmp4 * tmp4 + tmp3 * tmp3
+        s_ = (np.sqrt(s1_2), np.sqrt(s2_2))
+        s_2 = (s1_2, s2_2)
+        base2 = (atan2(nx1, tmp3), -atan2(tmp4, tmp3))
+        n = Ts.shape[0]
+        Q = np.full((n, 8, 6), np.nan)
+        valid = np.zeros((n, 8), dtype=bool)
+        col = 0
+        for b in range(2):
+            with np.errstate(divide="ignore", invalid="ignore"):
+                arg2 = (s_2[b] + self._c2_2 - self._kappa_2) / (2.0 * s_[b] * o.c2)
+                arg3 = (s_2[b] - self._c2_2 - self._kappa_2) / (2.0 * o.c2 * self._k)
+            exists = reach & (s_[b] >= 1e-12) & (np.abs(arg2) <= 1.0 + _ACOS_TOL) & (np.abs(arg3) <= 1.0 + _ACOS_TOL)
+            a2c = acos(np.clip(np.where(exists, arg2, 0.0), -1.0, 1.0)).astype(float)
+            a3c = acos(np.clip(np.where(exists, arg3, 0.0), -1.0, 1.0)).astype(float)
+            for th1, th2, th3 in ((th1s[b], -a2c + base2[b], a3c - self._at23),
+                                  (th1s[b], a2c + base2[b], -a3c - self._at23)):
+                sn1, cs1 = np.sin(th1), np.cos(th1)
+                s23, c23 = np.sin(th2 + th3), np.cos(th2 + th3)
+                mm = r02 * s23 * cs1 + r12 * s23 * sn1 + r22 * c23
+                th5 = atan2(np.sqrt(np.maximum(0.0, 1.0 - mm * mm)), mm)
+                th4 = atan2(r12 * cs1 - r02 * sn1, r02 * c23 * cs1 + r12 * c23 * sn1 - r22 * s23)
+                th6 = atan2(r01 * s23 * cs1 + r11 * s23 * sn1 + r21 * c23,
+                                 -r00 * s23 * cs1 - r10 * s23 * sn1 - r20 * c23)
+                sing = np.abs(np.degrees(th5)) < WRIST_SINGULAR_DEG
+                total = th4 + th6
+                th4 = np.where(sing, np.radians(self._sgn[3] * refs[:, 3]) - self._offs[3], th4)
+                th6 = np.where(sing, total - th4, th6)
+                for sol in ((th1, th2, th3, th4, th5, th6), (th1, th2, th3, th4 + math.pi, -th5, th6 - math.pi)):
+                    for i, th in enumerate(sol):
+                        Q[:, col, i] = -((-np.degrees((th + self._offs[i]) * self._sgn[i]) + 180.0) % 360.0) + 180.0
+                    valid[:, col] = exists
+                    col += 1
+        Q[~valid] = np.nan
+        return Q, valid
 
     # ------------------------------------------------------------------ frame chain
     def tcp_pose(self, axes_deg: Sequence[float], tool: Any = None, base: Any = None,

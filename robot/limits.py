@@ -81,25 +81,33 @@ class MotionLimits:
     flange: float | None = None
     tool: tuple[float, ...] = (0.0,) * 6
     base: tuple[float, ...] = (0.0,) * 6
+    #: the BASE kinematic the base is linked to (robot/external.py), None: a fixed base
+    base_kin: str | None = None
 
     def as_trace(self) -> dict[str, Any]:
         """The ``limits`` field of a motion ``start`` trace event."""
-        return {"path": self.path, "axes": list(self.axes), "flange": self.flange,
-                "tool": list(self.tool), "base": list(self.base)}
+        out = {"path": self.path, "axes": list(self.axes), "flange": self.flange,
+               "tool": list(self.tool), "base": list(self.base)}
+        if self.base_kin:
+            out["base_kin"] = self.base_kin
+        return out
 
     @staticmethod
     def from_trace(d: dict[str, Any]) -> "MotionLimits":
         return MotionLimits(d.get("path"), tuple(float(v) for v in d["axes"]), d.get("flange"),
                             tuple(float(v) for v in d.get("tool") or (0.0,) * 6),
-                            tuple(float(v) for v in d.get("base") or (0.0,) * 6))
+                            tuple(float(v) for v in d.get("base") or (0.0,) * 6), d.get("base_kin"))
 
 
 def ptp_axis_speeds(params: Any, machine: Any, mode: str = DEFAULT_MODE) -> np.ndarray:
-    """The programmed axis speeds of a PTP/SPTP motion, deg/s per axis (shape (6,)):
+    """The programmed axis speeds of a PTP/SPTP motion, deg/s per axis (shape (6,), then the
+    external axes E1..En in mm/s or deg/s):
     ``v_max_i · $VEL_AXIS[i]% · $OV_PRO%``, ``· $RED_T1%`` in T1 (reference §6.7, robot-model.md
-    §10). The one formula: the planner plans with it, :func:`motion_limits` checks with it."""
-    v_max = np.asarray(machine.max_speed_deg_s, dtype=float)
-    axes = v_max * np.asarray(params.vel_axis, dtype=float) / 100.0 * params.ov_pro / 100.0
+    §10; an external axis at 100 % of ``$VEL_AXIS``). The one formula: the planner plans with
+    it, :func:`motion_limits` checks with it."""
+    v_max = np.asarray(getattr(machine, "all_max_speed", machine.max_speed_deg_s), dtype=float)
+    vel_axis = list(params.vel_axis)[:6] + [100.0] * (len(v_max) - 6)
+    axes = v_max * np.asarray(vel_axis, dtype=float) / 100.0 * params.ov_pro / 100.0
     if mode == "T1":
         axes = axes * red_t1_pct(machine) / 100.0
     return axes
@@ -126,10 +134,11 @@ def motion_limits(req: Any, machine: Any, mode: str = DEFAULT_MODE) -> MotionLim
     else:
         pieces = [p] + [s.params for s in getattr(req, "segments", ()) if s.params]
         path = max(cp_path_speed(q, mode) for q in pieces)
-        axes = np.asarray(machine.max_speed_deg_s, dtype=float)
+        axes = np.asarray(getattr(machine, "all_max_speed", machine.max_speed_deg_s), dtype=float)
     flange = T1_SPEED_MM_S if mode == "T1" else None
     return MotionLimits(path, tuple(float(v) for v in axes), flange,
-                        tuple(float(v) for v in p.tool), tuple(float(v) for v in p.base))
+                        tuple(float(v) for v in p.tool), tuple(float(v) for v in p.base),
+                        getattr(p, "base_kin", None))
 
 
 # ----------------------------------------------------------------------------- checker
@@ -223,8 +232,8 @@ def check_trace(events: Iterable[dict[str, Any]], machine: Any = None, *,
 
     events = list(events)
     machine = machine if machine is not None else _trace_robot(events) or load_machine()
-    v_max = np.asarray(machine.max_speed_deg_s, dtype=float)
-    a_max = np.asarray(machine.max_acc_deg_s2, dtype=float)
+    v_max = np.asarray(getattr(machine, "all_max_speed", machine.max_speed_deg_s), dtype=float)
+    a_max = np.asarray(getattr(machine, "all_max_acc", machine.max_acc_deg_s2), dtype=float)
     lim: dict[int, MotionLimits] = dict(limits or {})
     ts: list[float] = []
     qs: list[list[float]] = []
@@ -260,8 +269,14 @@ def check_trace(events: Iterable[dict[str, Any]], machine: Any = None, *,
     kin = Kinematics(machine)
     F = kin.forward_many(Q)
     from .frames import frame_to_matrix, inv_pos
-    robroot = frame_to_matrix(*machine.robroot_frame)
-    F = robroot @ F
+    if any(k.robroot for k in getattr(machine, "external_kinematics", ())):
+        from .external import ExternalAxes  # noqa: PLC0415
+
+        ext = ExternalAxes(machine)
+        F = np.array([ext.robroot(q[6:]) for q in Q]) @ F     # $ROBROOT_C on a track
+    else:
+        robroot = frame_to_matrix(*machine.robroot_frame)
+        F = robroot @ F
     ids = sorted(span, key=lambda m: (span[m][0], m))
     starts = np.array([span[m][0] for m in ids]) if ids else np.zeros(0)
     ends = np.array([span[m][1] for m in ids]) if ids else np.zeros(0)
@@ -305,8 +320,17 @@ def check_trace(events: Iterable[dict[str, Any]], machine: Any = None, *,
             f_lim = None if any(f is None for f in fl) else max(fl)  # type: ignore[type-var]
             if p_lim is not None:
                 tool, binv = frames_of(newest)
-                a = (binv @ F[k - 1] @ tool)[:3, 3]
-                b = (binv @ F[k] @ tool)[:3, 3]
+                ml = lim.get(newest)
+                if ml is not None and ml.base_kin:
+                    # a base on a turntable: the path is measured in the turning base
+                    from .external import ExternalAxes  # noqa: PLC0415
+
+                    ext = ExternalAxes(machine)
+                    a = (binv @ inv_pos(ext.chain(ext.base_kins[ml.base_kin], Q[k - 1][6:])) @ F[k - 1] @ tool)[:3, 3]
+                    b = (binv @ inv_pos(ext.chain(ext.base_kins[ml.base_kin], Q[k][6:])) @ F[k] @ tool)[:3, 3]
+                else:
+                    a = (binv @ F[k - 1] @ tool)[:3, 3]
+                    b = (binv @ F[k] @ tool)[:3, 3]
                 sp = float(np.linalg.norm(b - a)) / dt
                 rep.path_ratio = max(rep.path_ratio, sp / p_lim)
                 if sp > p_lim * (1.0 + tol_speed):

@@ -1,8 +1,12 @@
-"""Machine data of the simulated robot, read from ``robot/data/kr6_r900.yaml``.
+"""The robot model's data (:class:`MachineData`) and the default robot, the KR 6 R900 sixx of
+``robot/data/kr6_r900.yaml``.
 
-The yaml file is a copy of ``shared/robots/kr6_r900.yaml`` (robot-model.md §1-§5,
-§10); every number used by the kinematics, the MJCF builder and the planner comes
-from it, nothing is hard-coded a second time in the code.
+:class:`MachineData` is the one model of a robot whatever its source: the yaml (read here by
+:func:`load_machine`; a copy of ``shared/robots/kr6_r900.yaml``, robot-model.md §1-§5, §10) or
+a KUKA ``$machine.dat`` (robot/mada.py), with its external axes E1..E6
+(:class:`ExternalAxis`) and external kinematics (:class:`ExternalKinematic`). Every number
+used by the kinematics, the MJCF builder and the planner comes from it, nothing is
+hard-coded a second time in the code.
 
 Units: lengths in mm (the yaml geometry is in metres and is converted here),
 angles in degrees unless a name says otherwise.
@@ -115,6 +119,63 @@ class OPWParams:
 
 
 @dataclass(frozen=True)
+class ExternalAxis:
+    """An external axis E1..E6 (``$EX_AX_NUM``; machine-data index 6 + number).
+
+    Attributes:
+        number: 1..6 (E1..E6).
+        kind: ``"linear"`` (``$AXIS_TYPE`` 1; mm), ``"rotary"`` (3; deg) or ``"endless"``
+            (5; deg, no soft limits).
+        limit: ``($SOFTN_END, $SOFTP_END)`` in mm or deg.
+        max_speed: mm/s or deg/s (``$VEL_AXIS_MA`` and ``$RAT_MOT_AX``, robot/mada.py).
+        max_acc: mm/s^2 or deg/s^2 (derived, robot/mada.py ``RULES``).
+        direction: ``$AXIS_DIR`` (+1 or -1).
+        home: the value in ``$AXIS_HOME[1]``.
+    """
+
+    number: int
+    kind: str
+    limit: tuple[float, float]
+    max_speed: float
+    max_acc: float
+    max_jerk: float
+    direction: int = 1
+    home: float = 0.0
+
+    @property
+    def name(self) -> str:
+        return f"E{self.number}"
+
+    @property
+    def linear(self) -> bool:
+        return self.kind == "linear"
+
+
+@dataclass(frozen=True)
+class ExternalKinematic:
+    """An external kinematic system ETn of ``$EX_KIN`` (KR C2 machine-data handbook
+    "Maschinendaten 12.0400" §2.2.5-§2.2.11): ``system`` ``"#ERSYS"`` (the ROBROOT kinematic:
+    a track carrying the robot) or ``"#EASYS"``..``"#EFSYS"`` (a BASE kinematic: a turntable or
+    positioner carrying the workpiece); ``axes`` the E numbers of ``$ETn_AX`` (TR_A1..TR_A3);
+    ``frames`` ``$ETn_TA1KR``, ``$ETn_TA2A1``, ``$ETn_TA3A2``, ``$ETn_TFLA3`` (X, Y, Z, A, B, C);
+    ``root`` the kinematic's root point in ``$WORLD`` (``$ERSYSROOT`` for #ERSYS). Its flange is
+    ``root : TA1KR : Ax(E_a) : TA2A1 : Ax(E_b) : TA3A2 : Ax(E_c) : TFLA3`` with each axis moving
+    along or about the Z axis of the frame before it (robot/external.py)."""
+
+    index: int
+    system: str
+    name: str
+    axes: tuple[int, ...]
+    frames: tuple[tuple[float, ...], ...]
+    root: tuple[float, ...] = (0.0,) * 6
+
+    @property
+    def robroot(self) -> bool:
+        """True for the ROBROOT kinematic (#ERSYS)."""
+        return self.system == "#ERSYS"
+
+
+@dataclass(frozen=True)
 class MachineData:
     """All machine data of the robot (robot-model.md; loaded by :func:`load_machine`).
 
@@ -181,6 +242,11 @@ class MachineData:
     #: parallelogram; 4-axis palletizer), False for the yaml robot.
     a4fix: bool = False
     a5link: bool = False
+    #: the kinematic chain of the machine data (robot/chain.py ``Chain``); None for the yaml robot
+    chain: Any = field(default=None, compare=False, repr=False)
+    #: external axes E1..E6 (``$EX_AX_NUM``) and external kinematic systems (``$EX_KIN``)
+    external_axes: tuple[ExternalAxis, ...] = ()
+    external_kinematics: tuple[ExternalKinematic, ...] = ()
 
     @property
     def limits_deg(self) -> tuple[tuple[float, float], ...]:
@@ -206,6 +272,26 @@ class MachineData:
     @property
     def max_jerk_deg_s3(self) -> tuple[float, ...]:
         return tuple(j.max_jerk_deg_s3 for j in self.joints)
+
+    @property
+    def n_ext(self) -> int:
+        """The number of external axes E1..En."""
+        return len(self.external_axes)
+
+    @property
+    def all_max_speed(self) -> tuple[float, ...]:
+        """Axis speeds of A1..A6 (deg/s) and then E1..En (mm/s or deg/s): the planner's axes."""
+        return self.max_speed_deg_s + tuple(e.max_speed for e in self.external_axes)
+
+    @property
+    def all_max_acc(self) -> tuple[float, ...]:
+        """Axis accelerations of A1..A6 and E1..En (deg/s^2, mm/s^2)."""
+        return self.max_acc_deg_s2 + tuple(e.max_acc for e in self.external_axes)
+
+    @property
+    def home_all(self) -> tuple[float, ...]:
+        """``$AXIS_HOME[1]``: A1..A6 and E1..En."""
+        return tuple(self.home_deg) + tuple(e.home for e in self.external_axes)
 
 
 def _floats(seq) -> tuple[float, ...]:

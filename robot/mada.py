@@ -5,63 +5,78 @@ limits follow from the same numbers.
 
 Sources: shared/docs/robot-model.md §4.3 (KUKA's chain rebuilt from ``$TIRORO``,
 ``$LENGTH_A``, ``$LENGTH_B``, ``$TX3P3``, ``$DH_4``, ``$DH_5``, ``$TFLWP``, ``$AXIS_DIR``),
-§5 (speeds from ``$VEL_AXIS_MA`` and ``$RAT_MOT_AX``), §7 (``$ROBROOT``), §8 (status). The
-values are read through the project's KRL front end (robot/datalist.py). The same variables
-exist in KR C2 and KR C4 machine data.
+§5 (speeds from ``$VEL_AXIS_MA`` and ``$RAT_MOT_AX``), §7 (``$ROBROOT``), §8 (status); KUKA's
+KR C2 machine-data handbook "Maschinendaten 12.0400 en" (2005) §2.1.9 ``$ERSYSROOT``, §2.1.10
+``$RAT_MOT_AX`` (linear axes: motor revolutions per 1000 mm), §2.1.47 ``$RAISE_TIME``, §2.2
+the external axes (``$EX_AX_NUM``, ``$EX_KIN``, ``$ETn_AX``, ``$ETn_TA1KR`` ..
+``$ETn_TFLA3``). The values are read through the project's KRL front end (robot/datalist.py).
+KR C2 and KR C4 machine data use the same names; what a KR C2 file lacks (``$AXIS_JERK``)
+is derived by the rules of :data:`RULES` and marked "derived" in
+:attr:`MachineData.provenance` (``krl robot show``).
 
-The chain (mm, deg; ``d_i = $AXIS_DIR[i]``)::
-
-    FLANGE(A) = $TIRORO · Rz(d1·A1) · Tx($LENGTH_A) · Ry(d2·A2) · Tx($LENGTH_B) · Ry(d3·A3)
-              · $TX3P3 · Rz(d4·A4) · DH($DH_4) · Rz(d5·A5) · DH($DH_5) · Rz(d6·A6) · $TFLWP
-
-with ``DH({a, d, alpha}) = Tz(d) · Tx(a) · Rx(alpha)``. It is turned into URDF-style joints
-(translation-only joint origins, KUKA's directions in the joint axes, ``q = radians(A_i)``)
-by moving each fixed rotation past the following joints; the rotation left at the end is
-the link_6 -> flange frame. The OPW parameters for the analytic IK (robot-model.md §4.2)
-follow from the same variables and are checked against the chain when the model is built.
-
-Values the machine data do not hold are derived by the rules of :data:`RULES` and marked
-"derived" in :attr:`MachineData.provenance`.
+The chain is robot/chain.py's; it becomes URDF-style joints (translation-only joint origins,
+KUKA's directions in the joint axes, ``q = radians(A_i)``). Reading the machine data never
+builds the inverse kinematics: robot/kinematics.py chooses the closed form the chain has (or
+the numeric solver) when a tool moves the robot, so ``krl cell init``, ``krl check``,
+``krl graph`` and ``krl diff`` never need it. A value the model cannot take is refused with
+:class:`MachineDataError` naming the variable, its value and its file:line.
 """
 
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from .chain import Chain, chain_forward, chain_to_joints
 from .datalist import DataListError, DataValue, read_data_list
 from .frames import frame_to_matrix, matrix_to_frame
-from .machine import CartLimits, JointData, MachineData, OPWParams, load_machine
+from .machine import (CartLimits, ExternalAxis, ExternalKinematic, JointData, MachineData, OPWParams,
+                      load_machine)
 
 #: The rules for values that machine data lack (docs/robot.md, "Robots from machine data").
 RULES = {
     "max_acc_deg_s2": "derived: sqrt(v_max * $AXIS_JERK[i]), the peak acceleration of a jerk-limited "
                       "ramp from rest to full axis speed without a constant-acceleration phase "
                       "(the KR C4 takes accelerations from its dynamic model, $ADAP_ACC)",
+    "max_acc_raise_time": "derived: v_max / ($RAISE_TIME[i] + $DEF_FLT_PTP/2) ms, the time in which the "
+                          "axis reaches its rated speed (KR C2 machine-data handbook §2.1.47)",
+    "max_acc_default": "derived: v_max / 0.2 s ($AXIS_JERK and $RAISE_TIME not set; the ramp time of the "
+                       "KR C4 robots of the corpus, 0.1-0.2 s)",
+    "max_jerk": "derived: a_max / $DEF_FLT_PTP ms ($AXIS_JERK not set: the $DEF_FLT_PTP filter spreads "
+                "the acceleration step over its length)",
     "ipo_cycle_s": "derived: 12 ms interpolation cycle of the KR C4 (robot-model.md §10)",
     "motion_defaults": "derived: KSS defaults of bas.src/$config.dat (robot/data/kr6_r900.yaml "
                        "motion_defaults)",
     "status_phi_deg": "derived: atan2($TX3P3.Z, $TX3P3.X), A3 where the arm is stretched (robot-model.md §8)",
     "reach_wrist_point_mm": "derived: $LENGTH_A + $LENGTH_B + |($TX3P3.X, $TX3P3.Z)|",
     "opw": "derived: a1=$LENGTH_A, a2=-$TX3P3.Z, b=$TX3P3.Y, c1=$TIRORO.Z, c2=$LENGTH_B, "
-           "c3=$TX3P3.X, c4=$TFLWP.Z (robot-model.md §4.2-4.3)",
+           "c3=$TX3P3.X, c4=$TFLWP.Z (robot-model.md §4.2-4.3); signs from the chain's axes",
     "default_load": "derived: none given ($robcor.dat absent)",
+    "external_speed": "derived: $VEL_AXIS_MA / |$RAT_MOT_AX.N / .D| * 6 deg/s (rotary) or * 1000/60 mm/s "
+                      "(linear: N/D motor revolutions per 1000 mm, KR C2 machine-data handbook §2.1.10)",
+    "ersysroot": "derived: $NULLFRAME ($ERSYSROOT not set)",
+    "a5_led": "derived: A5 led by the parallelogram, the flange kept vertical ($NUM_AX=4 with "
+              "$DEF_A4FIX=TRUE leaves A5 no drive, whatever $DEF_A5LINK says)",
+    "easys_root": "derived: $WORLD (the root point of a BASE kinematic is MACHINE_DEF[].ROOT of "
+                  "$config.dat, not machine data)",
 }
 
-#: The axis directions for which the OPW solver's sign corrections are known
-#: (robot-model.md §3: $AXIS_DIR = [-1, 1, 1, -1, -1, -1] <-> OPW signs [-1, 1, 1, -1, 1, -1]).
-_OPW_SIGNS = (-1, 1, 1, -1, 1, -1)
-_OPW_OFFSETS_DEG = (0.0, -90.0, 0.0, 0.0, 0.0, 0.0)
-#: Largest disagreement (mm) allowed between the OPW model and the chain when a model is built.
-_SELF_CHECK_MM = 1e-6
+#: ``$AXIS_TYPE`` values (KR C2 machine-data handbook §2.1.4): 1 linear, 3 rotary, 5 endless.
+_AXIS_TYPES = {1: "linear", 3: "rotary", 5: "endless"}
+#: ``$EX_KIN`` systems the model builds (the handbook §2.2.5).
+_EX_SYSTEMS = ("#ERSYS", "#EASYS", "#EBSYS", "#ECSYS", "#EDSYS", "#EESYS", "#EFSYS")
+#: A6 limits when ``$DEF_A4FIX`` holds A4 at 0 (deg).
+_FIXED = (0.0, 0.0)
 
 
 class MachineDataError(ValueError):
-    """Machine data that cannot make a robot model; the message names file:line."""
+    """Machine data that cannot make a robot model; the message names file:line, the variable
+    and the value it cannot take."""
 
 
 def _get(vals: dict[str, DataValue], name: str, where: str) -> DataValue:
@@ -71,32 +86,51 @@ def _get(vals: dict[str, DataValue], name: str, where: str) -> DataValue:
     return v
 
 
-def _num(v: Any, where: str) -> float:
+def krl_value(v: Any) -> str:
+    """A machine-data value as KRL writes it (TRUE, #STANDARD, 12.5, "text", {..})."""
+    if isinstance(v, bool):
+        return "TRUE" if v else "FALSE"
+    if isinstance(v, (int, float)):
+        return f"{v:g}"
+    if isinstance(v, dict):
+        return "{" + ",".join(f"{k} {krl_value(x)}" for k, x in v.items()) + "}"
+    if isinstance(v, str) and not v.startswith("#"):
+        return f'"{v}"'
+    return str(v)
+
+
+def _num(v: Any, where: str, name: str = "") -> float:
+    label = f"{name}={krl_value(v)}: " if name else ""
     if isinstance(v, bool) or not isinstance(v, (int, float)):
-        raise MachineDataError(f"{where}: a number was expected, not {v!r}")
+        raise MachineDataError(f"{where}: {label}a number was expected")
     if not math.isfinite(float(v)):
-        raise MachineDataError(f"{where}: the value is not finite")
+        raise MachineDataError(f"{where}: {label}the value is not finite")
     return float(v)
 
 
-def _axes(vals: dict[str, DataValue], name: str, where: str, n: int = 6) -> tuple[list[float], DataValue]:
+def _axes(vals: dict[str, DataValue], name: str, where: str, n: int = 6,
+          first: int = 1) -> tuple[list[float], DataValue]:
     dv = _get(vals, name, where)
     if not isinstance(dv.value, dict):
         raise MachineDataError(f"{dv.where()}: {name} is not an array")
     out = []
-    for i in range(1, n + 1):
+    for i in range(first, first + n):
         if i not in dv.value:
             raise MachineDataError(f"{dv.where()}: {name}[{i}] is not set")
-        out.append(_num(dv.value[i], dv.where(i)))
+        out.append(_num(dv.value[i], dv.where(i), f"{name}[{i}]"))
     return out, dv
 
 
-def _frame(vals: dict[str, DataValue], name: str, where: str) -> tuple[np.ndarray, DataValue]:
+def _frame6(vals: dict[str, DataValue], name: str, where: str) -> tuple[tuple[float, ...], DataValue]:
     dv = _get(vals, name, where)
     if not isinstance(dv.value, dict):
-        raise MachineDataError(f"{dv.where()}: {name} is not a FRAME")
-    comps = {k: _num(dv.value.get(k, 0.0), dv.where()) for k in "XYZABC"}
-    return frame_to_matrix(comps["X"], comps["Y"], comps["Z"], comps["A"], comps["B"], comps["C"]), dv
+        raise MachineDataError(f"{dv.where()}: {name}={krl_value(dv.value)}: a FRAME was expected")
+    return tuple(_num(dv.value.get(k, 0.0), dv.where(), f"{name}.{k}") for k in "XYZABC"), dv
+
+
+def _frame(vals: dict[str, DataValue], name: str, where: str) -> tuple[np.ndarray, DataValue]:
+    f, dv = _frame6(vals, name, where)
+    return frame_to_matrix(*f), dv
 
 
 def _tr(x: float = 0.0, y: float = 0.0, z: float = 0.0) -> np.ndarray:
@@ -111,83 +145,276 @@ def _rot(axis: str, deg: float) -> np.ndarray:
     return T
 
 
-def _dh(dv: DataValue) -> np.ndarray:
+def _dh(dv: DataValue) -> tuple[np.ndarray, tuple[float, float, float]]:
     v = dv.value if isinstance(dv.value, dict) else {}
     try:
-        a = _num(v["DHART_A"], dv.where())
-        d = _num(v["DHART_D"], dv.where())
-        alpha = _num(v["DHART_ALPHA"], dv.where())
+        a = _num(v["DHART_A"], dv.where(), f"{dv.name}.DHART_A")
+        d = _num(v["DHART_D"], dv.where(), f"{dv.name}.DHART_D")
+        alpha = _num(v["DHART_ALPHA"], dv.where(), f"{dv.name}.DHART_ALPHA")
     except KeyError as exc:
         raise MachineDataError(f"{dv.where()}: {dv.name} lacks component {exc.args[0]}") from None
-    return _tr(z=d) @ _tr(x=a) @ _rot("x", alpha)
+    return _tr(z=d) @ _tr(x=a) @ _rot("x", alpha), (a, d, alpha)
 
 
-def chain_to_joints(fixed: list[np.ndarray], axes_local: list[np.ndarray]
-                    ) -> tuple[list[np.ndarray], list[np.ndarray], np.ndarray]:
-    """URDF-style joints of a serial chain ``F0 · Rot(u1, q1) · F1 · ... · Rot(u6, q6) · F6``.
+def _flag(vals: dict[str, DataValue], name: str) -> tuple[bool, DataValue | None]:
+    dv = vals.get(name)
+    if dv is None or dv.value is None:
+        return False, None
+    if not isinstance(dv.value, bool):
+        raise MachineDataError(f"{dv.where()}: {name}={krl_value(dv.value)}: TRUE or FALSE was expected")
+    return dv.value, dv
 
-    Args:
-        fixed: seven 4x4 fixed transforms F0..F6 (mm).
-        axes_local: six unit joint axes u1..u6 in the frame after F(i-1).
-    Returns:
-        (origins, axes, flange): joint origins (translations in the parent joint's frame,
-        no rotation), joint axes in that frame, and the 4x4 link_6 -> flange transform.
-        Each fixed rotation is moved past the joints that follow it
-        (``R · Rot(u, q) = Rot(R u, q) · R``); a translation along a wrist axis (A4, A6) is
-        moved to the joint origin where ROS-Industrial URDFs put it (it commutes with the
-        rotation about that axis).
-    """
-    R = np.eye(3)
-    origins: list[np.ndarray] = []
-    axes: list[np.ndarray] = []
+
+def _structure(machine: dict[str, DataValue], source: str, prov: dict[str, str]) -> tuple[bool, bool]:
+    """The robot's kinematic class and axis flags; refuses what the model does not build."""
+    kin = machine.get("$KINCLASS")
+    if kin is not None and kin.value not in (None, "#STANDARD"):
+        raise MachineDataError(f"{kin.where()}: $KINCLASS={kin.value}: only the #STANDARD kinematic class "
+                               f"(the KUKA arm of $TIRORO .. $TFLWP) is simulated")
+    if kin is not None:
+        prov["$KINCLASS"] = kin.where()
+    a4fix, dv4 = _flag(machine, "$DEF_A4FIX")
+    a5link, dv5 = _flag(machine, "$DEF_A5LINK")
+    if a5link and not a4fix:
+        assert dv5 is not None
+        raise MachineDataError(f"{dv5.where()}: $DEF_A5LINK=TRUE with $DEF_A4FIX=FALSE: the parallelogram of "
+                               f"the 4-axis palletizer needs A4 fixed at 0")
+    for key, dv in (("$DEF_A4FIX", dv4), ("$DEF_A5LINK", dv5)):
+        if dv is not None:
+            prov[key] = dv.where()
+    nax = machine.get("$NUM_AX")
+    if nax is not None and nax.value is not None:
+        n = nax.value
+        least = 4 if a4fix else 6
+        if isinstance(n, bool) or not isinstance(n, int) or not least <= n <= 6:
+            raise MachineDataError(f"{nax.where()}: $NUM_AX={krl_value(n)}: a robot with "
+                                   f"{'$DEF_A4FIX' if a4fix else 'six axes'} has {least}..6 axes")
+        prov["$NUM_AX"] = nax.where()
+        if a4fix and not a5link and n == 4:
+            # A1, A2, A3 and the flange axis A6 are driven: A5 has no drive, so the parallelogram
+            # leads it, whatever $DEF_A5LINK says (KUKA's palletizers keep $DEF_A5LINK FALSE).
+            a5link = True
+            prov["a5_led"] = (f"derived: A5 led by the parallelogram, the flange kept vertical "
+                              f"($NUM_AX=4 with $DEF_A4FIX=TRUE leaves A5 no drive; $DEF_A5LINK=FALSE "
+                              f"at {dv5.where() if dv5 is not None else 'default'})")
+    return a4fix, a5link
+
+
+def _joint_limits(machine: dict[str, DataValue], source: str, prov: dict[str, str], a4fix: bool,
+                  flt_ptp: float) -> list[tuple[tuple[float, float], float, float, float]]:
+    """(limits, v_max, a_max, jerk) of A1..A6, with the rules of :data:`RULES` for what is missing."""
+    lo, dv_lo = _axes(machine, "$SOFTN_END", source)
+    hi, dv_hi = _axes(machine, "$SOFTP_END", source)
+    speeds, dv_rpm, ratios = _speeds(machine, source, range(1, 7), [False] * 6)
+    jerk = raise_t = None
+    if "$AXIS_JERK" in machine and machine["$AXIS_JERK"].value:
+        jerk, dv_jerk = _axes(machine, "$AXIS_JERK", source)
+        prov["$AXIS_JERK"] = dv_jerk.where(1)
+        prov["max_acc_deg_s2"] = RULES["max_acc_deg_s2"]
+    elif "$RAISE_TIME" in machine and machine["$RAISE_TIME"].value:
+        raise_t, dv_rt = _axes(machine, "$RAISE_TIME", source)
+        prov["$RAISE_TIME"] = dv_rt.where(1)
+        prov["max_acc_deg_s2"] = RULES["max_acc_raise_time"]
+        prov["$AXIS_JERK"] = RULES["max_jerk"]
+    else:
+        prov["max_acc_deg_s2"] = RULES["max_acc_default"]
+        prov["$AXIS_JERK"] = RULES["max_jerk"]
+    out = []
     for i in range(6):
-        origins.append(R @ fixed[i][:3, 3])
-        R = R @ fixed[i][:3, :3]
-        axes.append(R @ axes_local[i])
-    flange = np.eye(4)
-    flange[:3, :3] = R @ fixed[6][:3, :3]
-    flange[:3, 3] = R @ fixed[6][:3, 3]
-    # A4: the part of its origin along its own axis goes to A5's origin
-    a = axes[3]
-    along = float(origins[3] @ a) * a
-    origins[3] = origins[3] - along
-    origins[4] = origins[4] + along
-    # A6: the part of the flange offset along its axis goes to A6's origin
-    a = axes[5]
-    along = float(flange[:3, 3] @ a) * a
-    origins[5] = origins[5] + along
-    flange[:3, 3] = flange[:3, 3] - along
-    clean = [np.round(v, 9) + 0.0 for v in origins]
-    clean_axes = [np.where(np.abs(v) < 1e-12, 0.0, np.round(v, 12)) + 0.0 for v in axes]
-    flange[np.abs(flange) < 1e-12] = 0.0
-    return clean, clean_axes, flange
+        vmax = speeds[i]
+        if lo[i] > hi[i]:
+            raise MachineDataError(f"{dv_lo.where(i + 1)}: $SOFTN_END[{i + 1}]={lo[i]:g} is above "
+                                   f"$SOFTP_END[{i + 1}]={hi[i]:g}")
+        if jerk is not None:
+            if jerk[i] <= 0:
+                raise MachineDataError(f"{machine['$AXIS_JERK'].where(i + 1)}: $AXIS_JERK[{i + 1}]={jerk[i]:g}: "
+                                       f"a positive jerk was expected")
+            acc, j = math.sqrt(vmax * jerk[i]), jerk[i]
+        else:
+            if raise_t is not None:
+                ramp = (raise_t[i] + flt_ptp / 2.0) / 1000.0
+                if ramp <= 0:
+                    raise MachineDataError(f"{machine['$RAISE_TIME'].where(i + 1)}: $RAISE_TIME[{i + 1}]="
+                                           f"{raise_t[i]:g}: a positive time was expected")
+            else:
+                ramp = 0.2
+            acc = vmax / ramp
+            j = acc / (max(flt_ptp, 12.0) / 1000.0)
+        limit = (lo[i], hi[i])
+        if i == 3 and a4fix:
+            limit = _FIXED
+        out.append((limit, vmax, acc, j))
+    prov["$SOFTN_END"], prov["$SOFTP_END"] = dv_lo.where(1), dv_hi.where(1)
+    prov["$VEL_AXIS_MA"], prov["$RAT_MOT_AX"] = dv_rpm.where(1), ratios.where(1)
+    prov["max_speed_deg_s"] = "derived: $VEL_AXIS_MA[i] / |$RAT_MOT_AX[i].N / .D| * 6 (robot-model.md §5)"
+    return out
+
+
+def _speeds(machine: dict[str, DataValue], source: str, indices, linear: list[bool]
+            ) -> tuple[list[float], DataValue, DataValue]:
+    """Axis speeds (deg/s, or mm/s for a linear axis) of the machine-data indices `indices`."""
+    rpm_dv = _get(machine, "$VEL_AXIS_MA", source)
+    ratios = _get(machine, "$RAT_MOT_AX", source)
+    out = []
+    for k, i in enumerate(indices):
+        rpm = rpm_dv.value.get(i) if isinstance(rpm_dv.value, dict) else None
+        if rpm is None:
+            raise MachineDataError(f"{rpm_dv.where()}: $VEL_AXIS_MA[{i}] is not set")
+        rpm = _num(rpm, rpm_dv.where(i), f"$VEL_AXIS_MA[{i}]")
+        r = ratios.value.get(i) if isinstance(ratios.value, dict) else None
+        if not isinstance(r, dict) or "N" not in r or "D" not in r:
+            raise MachineDataError(f"{ratios.where(i)}: $RAT_MOT_AX[{i}] is not set")
+        n = _num(r["N"], ratios.where(i), f"$RAT_MOT_AX[{i}].N")
+        d = _num(r["D"], ratios.where(i), f"$RAT_MOT_AX[{i}].D")
+        if n == 0 or d == 0:
+            raise MachineDataError(f"{ratios.where(i)}: $RAT_MOT_AX[{i}]={{N {n:g},D {d:g}}}: a zero N or D")
+        # robot-model.md §5; linear axes: N/D motor revolutions per 1000 mm (handbook §2.1.10)
+        v = rpm / abs(n / d) * (1000.0 / 60.0 if linear[k] else 6.0)
+        if v <= 0:
+            raise MachineDataError(f"{rpm_dv.where(i)}: $VEL_AXIS_MA[{i}]={rpm:g}: a positive speed was expected")
+        out.append(v)
+    return out, rpm_dv, ratios
+
+
+def _external(machine: dict[str, DataValue], source: str, prov: dict[str, str], flt_ptp: float,
+              home: dict[str, float]) -> tuple[tuple[ExternalAxis, ...], tuple[ExternalKinematic, ...]]:
+    """The external axes (``$EX_AX_NUM``) and kinematic systems (``$EX_KIN``, ``$ETn_*``)."""
+    num = machine.get("$EX_AX_NUM")
+    if num is None or not num.value:
+        return (), ()
+    n = num.value
+    if isinstance(n, bool) or not isinstance(n, int) or not 0 <= n <= 6:
+        raise MachineDataError(f"{num.where()}: $EX_AX_NUM={krl_value(n)}: 0..6 external axes were expected")
+    prov["$EX_AX_NUM"] = num.where()
+    types = machine.get("$AXIS_TYPE")
+    kinds = []
+    for e in range(1, n + 1):
+        t = types.value.get(6 + e) if types is not None and isinstance(types.value, dict) else None
+        if t not in _AXIS_TYPES:
+            where = types.where(6 + e) if types is not None else source
+            raise MachineDataError(f"{where}: $AXIS_TYPE[{6 + e}]={krl_value(t)}: E{e} must be 1 (linear), 3 (rotary) "
+                                   f"or 5 (endless)")
+        kinds.append(_AXIS_TYPES[t])
+    if types is not None:
+        prov["$AXIS_TYPE"] = types.where(7)
+    idx = list(range(7, 7 + n))
+    lo, dv_lo = _axes(machine, "$SOFTN_END", source, n, 7)
+    hi, _ = _axes(machine, "$SOFTP_END", source, n, 7)
+    speeds, _, _ = _speeds(machine, source, idx, [k == "linear" for k in kinds])
+    prov["E_speed"] = RULES["external_speed"]
+    dirs = machine.get("$AXIS_DIR")
+    axes = []
+    for k, e in enumerate(range(1, n + 1)):
+        d = dirs.value.get(6 + e, 1) if dirs is not None and isinstance(dirs.value, dict) else 1
+        if d not in (1, -1, 0):
+            raise MachineDataError(f"{dirs.where(6 + e)}: $AXIS_DIR[{6 + e}]={krl_value(d)}: 1 or -1 was expected")
+        jerk_dv = machine.get("$AXIS_JERK")
+        raise_dv = machine.get("$RAISE_TIME")
+        if jerk_dv is not None and isinstance(jerk_dv.value, dict) and 6 + e in jerk_dv.value:
+            j = _num(jerk_dv.value[6 + e], jerk_dv.where(6 + e), f"$AXIS_JERK[{6 + e}]")
+            acc = math.sqrt(speeds[k] * j)
+        else:
+            rt = (_num(raise_dv.value[6 + e], raise_dv.where(6 + e), f"$RAISE_TIME[{6 + e}]")
+                  if raise_dv is not None and isinstance(raise_dv.value, dict) and 6 + e in raise_dv.value
+                  else None)
+            acc = speeds[k] / ((rt + flt_ptp / 2.0) / 1000.0 if rt is not None else 0.2)
+            j = acc / (max(flt_ptp, 12.0) / 1000.0)
+        if lo[k] > hi[k]:
+            raise MachineDataError(f"{dv_lo.where(6 + e)}: $SOFTN_END[{6 + e}]={lo[k]:g} is above "
+                                   f"$SOFTP_END[{6 + e}]={hi[k]:g}")
+        limit = (-math.inf, math.inf) if kinds[k] == "endless" else (lo[k], hi[k])
+        axes.append(ExternalAxis(number=e, kind=kinds[k], limit=limit, max_speed=speeds[k], max_acc=acc,
+                                 max_jerk=j, direction=-1 if d == -1 else 1, home=home.get(f"E{e}", 0.0)))
+    ex = machine.get("$EX_KIN")
+    systems: list[ExternalKinematic] = []
+    if ex is not None and isinstance(ex.value, dict):
+        prov["$EX_KIN"] = ex.where()
+        used: set[int] = set()
+        for t in range(1, 7):
+            sysname = ex.value.get(f"ET{t}", "#NONE")
+            if sysname in (None, "#NONE"):
+                continue
+            if sysname not in _EX_SYSTEMS:
+                raise MachineDataError(f"{ex.where()}: $EX_KIN.ET{t}={sysname}: the simulator builds #ERSYS (a "
+                                       f"ROBROOT kinematic) and #EASYS..#EFSYS (BASE kinematics)")
+            systems.append(_et_system(machine, source, prov, t, sysname, n, used))
+        if sum(s.robroot for s in systems) > 1:
+            raise MachineDataError(f"{ex.where()}: $EX_KIN holds more than one #ERSYS")
+    return tuple(axes), tuple(systems)
+
+
+def _et_system(machine, source, prov, t: int, sysname: str, n_ext: int, used: set[int]) -> ExternalKinematic:
+    name = f"$ET{t}_AX"
+    dv = _get(machine, name, source)
+    ax: list[int] = []
+    for k in ("TR_A1", "TR_A2", "TR_A3"):
+        v = dv.value.get(k, "#NONE") if isinstance(dv.value, dict) else "#NONE"
+        if v in (None, "#NONE"):
+            break
+        e = int(v[2:]) if isinstance(v, str) and v[:2] == "#E" and v[2:].isdigit() else 0
+        if not 1 <= e <= n_ext or e in used:
+            raise MachineDataError(f"{dv.where()}: {name}.{k}={v}: an external axis #E1..#E{n_ext} "
+                                   f"($EX_AX_NUM) not used by another transformation was expected")
+        used.add(e)
+        ax.append(e)
+    if not ax:
+        raise MachineDataError(f"{dv.where()}: {name}={{TR_A1 #NONE}}: $EX_KIN.ET{t}={sysname} moves no axis")
+    prov[name] = dv.where()
+    frames = []
+    for key in ("TA1KR", "TA2A1", "TA3A2", "TFLA3"):
+        var = f"$ET{t}_{key}"
+        if var in machine and machine[var].value is not None:
+            f, fdv = _frame6(machine, var, source)
+            prov[var] = fdv.where()
+        else:
+            f = (0.0,) * 6
+            if key in ("TA1KR", "TFLA3"):
+                raise MachineDataError(f"{source}: {var} is not set; cannot build $EX_KIN.ET{t}")
+        frames.append(f)
+    root = (0.0,) * 6
+    if sysname == "#ERSYS":
+        if "$ERSYSROOT" in machine and machine["$ERSYSROOT"].value is not None:
+            root, rdv = _frame6(machine, "$ERSYSROOT", source)
+            prov["$ERSYSROOT"] = rdv.where()
+        else:
+            prov["$ERSYSROOT"] = RULES["ersysroot"]
+    else:
+        prov[f"ET{t} root"] = RULES["easys_root"]
+    nm = machine.get(f"$ET{t}_NAME")
+    label = str(nm.value).strip() if nm is not None and isinstance(nm.value, str) else ""
+    return ExternalKinematic(index=t, system=sysname, name=label or f"ET{t}", axes=tuple(ax),
+                             frames=tuple(frames), root=root)
 
 
 def machine_from_values(machine: dict[str, DataValue], robcor: dict[str, DataValue] | None,
                         source: str) -> MachineData:
-    """Build the robot model from read machine data (see the module docstring).
+    """Build the robot model from read machine data (see the module docstring). Builds no
+    inverse kinematics (robot/kinematics.py does, for the tools that move the robot).
 
     Args:
         machine: the values of ``$machine.dat`` (:func:`robot.datalist.read_data_list`).
         robcor: the values of ``$robcor.dat`` or None.
         source: the name shown for the machine data (e.g. the ``$machine.dat`` path).
     Raises:
-        MachineDataError: a variable is missing or malformed, or the kinematics is not a
-            6-axis KUKA arm of the standard class that the OPW solver covers (file:line).
+        MachineDataError: a variable is missing or holds a value the model cannot take
+            (file:line, the variable and its value).
     """
     prov: dict[str, str] = {}
-    kin = machine.get("$KINCLASS")
-    if kin is not None and kin.value not in (None, "#STANDARD"):
-        raise MachineDataError(f"{kin.where()}: $KINCLASS {kin.value} is not simulated (only #STANDARD)")
-    nax = machine.get("$NUM_AX")
-    if nax is not None and isinstance(nax.value, int) and nax.value < 6:
-        raise MachineDataError(f"{nax.where()}: $NUM_AX={nax.value}: only 6-axis robots are simulated")
+    arm = ("$TRAFONAME", "$TIRORO", "$LENGTH_A", "$LENGTH_B", "$TX3P3", "$TFLWP")
+    if not any(machine.get(k) is not None and machine[k].value not in (None, {}, "") for k in arm):
+        steu = machine.get("$V_STEUMADA")
+        what = (f"it is the controller's machine data ($V_STEUMADA={krl_value(steu.value)[:40]}, STEU/Mada); "
+                f"the robot's is R1/Mada/$machine.dat" if steu is not None and steu.value else
+                "it is not a robot's $machine.dat")
+        raise MachineDataError(f"{source}: none of the robot's machine data ({', '.join(arm)}) is set: {what}")
+    a4fix, a5link = _structure(machine, source, prov)
 
     tiroro, dv = _frame(machine, "$TIRORO", source)
     prov["$TIRORO"] = dv.where()
     la = _get(machine, "$LENGTH_A", source)
     lb = _get(machine, "$LENGTH_B", source)
-    length_a, length_b = _num(la.value, la.where()), _num(lb.value, lb.where())
+    length_a = _num(la.value, la.where(), "$LENGTH_A")
+    length_b = _num(lb.value, lb.where(), "$LENGTH_B")
     prov["$LENGTH_A"], prov["$LENGTH_B"] = la.where(), lb.where()
     tx3p3, dv = _frame(machine, "$TX3P3", source)
     prov["$TX3P3"] = dv.where()
@@ -196,62 +423,50 @@ def machine_from_values(machine: dict[str, DataValue], robcor: dict[str, DataVal
     dh4 = _get(machine, "$DH_4", source)
     dh5 = _get(machine, "$DH_5", source)
     prov["$DH_4"], prov["$DH_5"] = dh4.where(), dh5.where()
-    axis_dir, dv = _axes(machine, "$AXIS_DIR", source)
-    prov["$AXIS_DIR"] = dv.where(1)
-    if any(d not in (-1.0, 1.0) for d in axis_dir):
-        raise MachineDataError(f"{dv.where(1)}: $AXIS_DIR[1..6] must be 1 or -1")
+    dirs = _get(machine, "$AXIS_DIR", source)
+    axis_dir = []
+    for i in range(1, 7):
+        d = dirs.value.get(i) if isinstance(dirs.value, dict) else None
+        if d not in (1, -1) or isinstance(d, bool):
+            raise MachineDataError(f"{dirs.where(i)}: $AXIS_DIR[{i}]={krl_value(d)}: 1 or -1 was expected")
+        axis_dir.append(float(d))
+    prov["$AXIS_DIR"] = dirs.where(1)
 
-    fixed = [tiroro, _tr(x=length_a), _tr(x=length_b), tx3p3, _dh(dh4), _dh(dh5), tflwp]
+    F4, dh4_v = _dh(dh4)
+    F5, dh5_v = _dh(dh5)
+    fixed = [tiroro, _tr(x=length_a), _tr(x=length_b), tx3p3, F4, F5, tflwp]
     local = [np.array([0.0, 0.0, axis_dir[0]]), np.array([0.0, axis_dir[1], 0.0]),
              np.array([0.0, axis_dir[2], 0.0]), np.array([0.0, 0.0, axis_dir[3]]),
              np.array([0.0, 0.0, axis_dir[4]]), np.array([0.0, 0.0, axis_dir[5]])]
     origins, jaxes, flange = chain_to_joints(fixed, local)
+    chain = Chain.of(fixed, local)
 
-    lo, dv_lo = _axes(machine, "$SOFTN_END", source)
-    hi, dv_hi = _axes(machine, "$SOFTP_END", source)
-    rpm, dv_rpm = _axes(machine, "$VEL_AXIS_MA", source)
-    ratios = _get(machine, "$RAT_MOT_AX", source)
-    jerk, dv_jerk = _axes(machine, "$AXIS_JERK", source)
-    a4fix = bool(getattr(machine.get("$DEF_A4FIX"), "value", False))
-    a5link = bool(getattr(machine.get("$DEF_A5LINK"), "value", False))
+    flt_ptp = _scalar(machine, "$DEF_FLT_PTP", load_machine().def_flt_ptp, prov)
+    lims = _joint_limits(machine, source, prov, a4fix, flt_ptp)
     joints = []
     for i in range(6):
-        r = ratios.value.get(i + 1) if isinstance(ratios.value, dict) else None
-        if not isinstance(r, dict) or "N" not in r or "D" not in r:
-            raise MachineDataError(f"{ratios.where(i + 1)}: $RAT_MOT_AX[{i + 1}] is not set")
-        n, d = _num(r["N"], ratios.where(i + 1)), _num(r["D"], ratios.where(i + 1))
-        if n == 0 or d == 0:
-            raise MachineDataError(f"{ratios.where(i + 1)}: $RAT_MOT_AX[{i + 1}] has a zero N or D")
-        vmax = rpm[i] / abs(n / d) * 6.0          # robot-model.md §5
-        if vmax <= 0 or jerk[i] <= 0 or lo[i] > hi[i]:
-            raise MachineDataError(f"{dv_rpm.where(i + 1)}: axis A{i + 1} has no positive speed, "
-                                   f"jerk or limit range")
-        limit = (lo[i], hi[i])
-        if i == 3 and a4fix:
-            limit = (0.0, 0.0)
+        limit, vmax, acc, jerk = lims[i]
         joints.append(JointData(
             name=f"joint_a{i + 1}", axis=i + 1, limit_deg=limit, max_speed_deg_s=vmax,
-            max_acc_deg_s2=math.sqrt(vmax * jerk[i]), max_jerk_deg_s3=jerk[i],
+            max_acc_deg_s2=acc, max_jerk_deg_s3=jerk,
             origin_mm=tuple(float(v) for v in origins[i]),       # type: ignore[arg-type]
             joint_axis=tuple(float(v) for v in jaxes[i]),        # type: ignore[arg-type]
             urdf_max_speed_deg_s=vmax, parent="base_link" if i == 0 else f"link_{i}",
             child=f"link_{i + 1}", kuka_sign=1))
-    prov["$SOFTN_END"], prov["$SOFTP_END"] = dv_lo.where(1), dv_hi.where(1)
-    prov["$VEL_AXIS_MA"], prov["$RAT_MOT_AX"] = dv_rpm.where(1), ratios.where(1)
-    prov["$AXIS_JERK"] = dv_jerk.where(1)
-    prov["max_speed_deg_s"] = "derived: $VEL_AXIS_MA[i] / |$RAT_MOT_AX[i].N / .D| * 6 (robot-model.md §5)"
-    prov["max_acc_deg_s2"] = RULES["max_acc_deg_s2"]
-    for key in ("$DEF_A4FIX", "$DEF_A5LINK"):
-        if key in machine:
-            prov[key] = machine[key].where()
 
-    # OPW parameters (robot-model.md §4.2) and the structure they require
+    # OPW parameters of the standard arm (robot-model.md §4.2); robot/kinematics.py checks them
+    # against the chain and finds the form of any other arm from the chain itself (robot/chain.py)
     tx = {k: _num(machine["$TX3P3"].value.get(k, 0.0), prov["$TX3P3"]) for k in "XYZABC"}
     ti = {k: _num(machine["$TIRORO"].value.get(k, 0.0), prov["$TIRORO"]) for k in "XYZABC"}
     fl = {k: _num(machine["$TFLWP"].value.get(k, 0.0), prov["$TFLWP"]) for k in "XYZABC"}
+    from .chain import opw_form  # noqa: PLC0415
+
+    form = opw_form(chain)
+    signs = form.params.sign_corrections if form is not None else (-1, 1, 1, -1, 1, -1)
     opw = OPWParams(a1=length_a, a2=-tx["Z"], b=tx["Y"], c1=ti["Z"], c2=length_b, c3=tx["X"],
-                    c4=fl["Z"], offsets_deg=_OPW_OFFSETS_DEG, sign_corrections=_OPW_SIGNS)
+                    c4=fl["Z"], offsets_deg=(0.0, -90.0, 0.0, 0.0, 0.0, 0.0), sign_corrections=signs)
     prov["opw"] = RULES["opw"]
+    del dh4_v, dh5_v
 
     vel_ma = _cp(machine, "$VEL_MA", source, prov)
     acc_ma = _cp(machine, "$ACC_MA", source, prov)
@@ -259,7 +474,7 @@ def machine_from_values(machine: dict[str, DataValue], robcor: dict[str, DataVal
     robroot_T, dv = _frame(machine, "$ROBROOT", source) if "$ROBROOT" in machine else (np.eye(4), None)
     robroot = tuple(float(v) for v in matrix_to_frame(robroot_T))
     prov["$ROBROOT"] = dv.where() if dv is not None else "derived: $NULLFRAME ($ROBROOT not set)"
-    home = _e6axis(machine, "$AXIS_HOME", 1, prov)
+    home, home_ext = _home(machine, prov)
     mames = (tuple(_axes(machine, "$MAMES", source)[0]) if "$MAMES" in machine else home)
     if "$MAMES" in machine:
         prov["$MAMES"] = machine["$MAMES"].where(1)
@@ -269,7 +484,6 @@ def machine_from_values(machine: dict[str, DataValue], robcor: dict[str, DataVal
     in_pos_ma = _axes(machine, "$IN_POS_MA", source)[0] if "$IN_POS_MA" in machine else list(base.in_pos_ma_deg)
     in_car = _scalar(machine, "$IN_POS_CAR", base.in_pos_car_mm, prov)
     in_ori = _scalar(machine, "$IN_POS_ORI", base.in_pos_ori_deg, prov)
-    flt_ptp = int(_scalar(machine, "$DEF_FLT_PTP", base.def_flt_ptp, prov))
     flt_cp = int(_scalar(machine, "$DEF_FLT_CP", base.def_flt_cp, prov))
     load = _load(robcor, prov)
     trafo = machine.get("$TRAFONAME")
@@ -279,6 +493,7 @@ def machine_from_values(machine: dict[str, DataValue], robcor: dict[str, DataVal
     name = trafoname.lstrip("#").strip() or Path(source).parent.name
     for key in ("ipo_cycle_s", "motion_defaults", "status_phi_deg", "reach_wrist_point_mm"):
         prov[key] = RULES[key]
+    ext_axes, ext_kin = _external(machine, source, prov, flt_ptp, home_ext)
 
     md = dict(base.motion_defaults)
     md["tool_data_1_mm_deg"] = [0.0] * 6
@@ -298,57 +513,22 @@ def machine_from_values(machine: dict[str, DataValue], robcor: dict[str, DataVal
         status_phi_deg=math.degrees(math.atan2(tx["Z"], tx["X"])),
         vel_ma=vel_ma, acc_ma=acc_ma, acc_ov=acc_ov, apo_dis_ptp_deg=tuple(apo),
         in_pos_ma_deg=tuple(in_pos_ma), in_pos_car_mm=in_car, in_pos_ori_deg=in_ori,
-        def_flt_ptp=flt_ptp, def_flt_cp=flt_cp, ipo_cycle_s=base.ipo_cycle_s,
+        def_flt_ptp=int(flt_ptp), def_flt_cp=flt_cp, ipo_cycle_s=base.ipo_cycle_s,
         motion_defaults=md, default_load=load,
         reach_wrist_point_mm=length_a + length_b + math.hypot(tx["X"], tx["Z"]),
         home_flange_pose=(0.0,) * 6, source=source,
         raw={"machine_data": {k: v.value for k, v in machine.items()}},
-        trafoname=trafoname, provenance=prov, a4fix=a4fix, a5link=a5link)
-    _self_check(model, fixed, local, prov)
-    from dataclasses import replace  # noqa: PLC0415
-
-    from .kinematics import Kinematics  # noqa: PLC0415
-
-    home_pose = matrix_to_frame(Kinematics(model).forward(model.home_deg))
-    return replace(model, home_flange_pose=tuple(float(v) for v in home_pose))
-
-
-def chain_forward(fixed: list[np.ndarray], local: list[np.ndarray], axes_deg) -> np.ndarray:
-    """The flange frame of the machine-data chain itself (4x4, mm), for checks."""
-    T = fixed[0].copy()
-    for i in range(6):
-        J = np.eye(4)
-        J[:3, :3] = Rotation.from_rotvec(local[i] * math.radians(float(axes_deg[i]))).as_matrix()
-        T = T @ J @ fixed[i + 1]
-    return T
-
-
-def _self_check(model: MachineData, fixed, local, prov) -> None:
-    """The URDF-style joints and the OPW solver must reproduce the chain; else the robot's
-    structure is not one the simulator covers (MachineDataError naming ``$TX3P3``)."""
-    from .kinematics import Kinematics  # noqa: PLC0415
-
-    k = Kinematics(model)
-    rng = np.random.default_rng(0)
-    lo = np.array([max(j.limit_deg[0], -170.0) for j in model.joints])
-    hi = np.array([min(j.limit_deg[1], 170.0) for j in model.joints])
-    home = np.array(model.home_deg, dtype=float)
-    if model.a5link and abs(k.forward(home)[2, 2] + 1.0) > 1e-9:
-        raise MachineDataError(f"{prov.get('$DEF_A5LINK', prov['$TX3P3'])}: $DEF_A5LINK: the flange of "
-                               f"this palletizer does not point straight down at $AXIS_HOME[1]")
-    for q in rng.uniform(lo, hi, size=(4, 6)):
-        if model.a5link:
-            # the parallelogram: A4 = 0 and A2 + A3 + A5 as at HOME (the flange stays vertical)
-            q[3] = 0.0
-            q[4] = home[4] + home[1] + home[2] - q[1] - q[2]
-        T = chain_forward(fixed, local, q)
-        if np.abs(k.forward(q) - T).max() > _SELF_CHECK_MM:
-            raise MachineDataError(f"{prov['$TX3P3']}: internal chain does not close")
-        sols = k.solutions(T)
-        if not sols or min(np.abs(k.forward(s) - T).max() for s in sols) > _SELF_CHECK_MM:
-            raise MachineDataError(
-                f"{prov['$TX3P3']}: this arm ($TIRORO, $TX3P3, $DH_4/$DH_5, $TFLWP, $AXIS_DIR) is not "
-                f"of the standard KUKA structure that the inverse kinematics covers")
+        trafoname=trafoname, provenance=prov, a4fix=a4fix, a5link=a5link, chain=chain,
+        external_axes=ext_axes, external_kinematics=ext_kin)
+    home_T = chain_forward(chain, model.home_deg)
+    if a5link and abs(home_T[2, 2] + 1.0) > 1e-9:
+        label = "$AXIS_HOME[1]" if "$AXIS_HOME[1]" in prov else "$H_POS"
+        where = prov.get(label, prov.get("$DEF_A5LINK", source))
+        raise MachineDataError(
+            f"{where}: {label}={{A2 {home[1]:g},A3 {home[2]:g},A5 {home[4]:g}}}: with A5 led "
+            f"({'$NUM_AX=4' if 'a5_led' in prov else '$DEF_A5LINK'}) the "
+            f"flange of this palletizer must point straight down at HOME (the parallelogram keeps it so)")
+    return replace(model, home_flange_pose=tuple(float(v) for v in matrix_to_frame(home_T)))
 
 
 def _cp(vals, name, source, prov) -> CartLimits:
@@ -371,14 +551,24 @@ def _scalar(vals, name, default, prov) -> float:
     return _num(dv.value, dv.where())
 
 
-def _e6axis(vals, name, index, prov) -> tuple[float, ...]:
-    dv = vals.get(name)
-    v = dv.value.get(index) if dv is not None and isinstance(dv.value, dict) else None
-    if not isinstance(v, dict):
-        prov["home_deg"] = "derived: {0, -90, 90, 0, 0, 0} ($AXIS_HOME[1] not set)"
-        return (0.0, -90.0, 90.0, 0.0, 0.0, 0.0)
-    prov[f"{name}[{index}]"] = dv.where(index)
-    return tuple(_num(v.get(f"A{i}", 0.0), dv.where(index)) for i in range(1, 7))
+def _home(vals, prov) -> tuple[tuple[float, ...], dict[str, float]]:
+    """A1..A6 and E1..E6 (deg, mm) of the robot's HOME: the KR C4's ``$AXIS_HOME[1]``, else the
+    home position ``$H_POS`` that KR C2 and KR C4 machine data both hold, else the derived
+    {0, -90, 90, 0, 0, 0}."""
+    dv = vals.get("$AXIS_HOME")
+    v = dv.value.get(1) if dv is not None and isinstance(dv.value, dict) else None
+    if isinstance(v, dict) and any(k.startswith("A") for k in v):
+        label, where = "$AXIS_HOME[1]", dv.where(1)
+    else:
+        dv = vals.get("$H_POS")
+        v = dv.value if dv is not None else None
+        if not (isinstance(v, dict) and any(isinstance(k, str) and k.startswith("A") for k in v)):
+            prov["home_deg"] = "derived: {0, -90, 90, 0, 0, 0} ($AXIS_HOME[1] and $H_POS not set)"
+            return (0.0, -90.0, 90.0, 0.0, 0.0, 0.0), {}
+        label, where = "$H_POS", dv.where()
+    prov[label] = where
+    ext = {f"E{i}": _num(v[f"E{i}"], where, f"{label}.E{i}") for i in range(1, 7) if f"E{i}" in v}
+    return tuple(_num(v.get(f"A{i}", 0.0), where, f"{label}.A{i}") for i in range(1, 7)), ext
 
 
 def _load(robcor, prov) -> dict[str, Any]:

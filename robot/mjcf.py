@@ -1,5 +1,7 @@
-"""MuJoCo model of the KR 6 R900 sixx, generated from the machine-data yaml
-(robot-model.md §2, §11).
+"""MuJoCo model of a robot (:class:`~robot.machine.MachineData`: the KR 6 R900 yaml or a
+backup's machine data), generated from its joints (robot-model.md §2, §11), with its external
+kinematics (robot/external.py): a track's joint ``joint_e<n>`` carries ``base_link``, a
+turntable is a body tree of its own ending in the site ``et<n>_flange``.
 
 The body tree mirrors the URDF chain exactly (joint origins, axes, ranges), so
 ``qpos = kuka_sign * radians(A_i)`` (= radians(A_i) here, robot-model.md §3) and
@@ -79,8 +81,24 @@ def build_mjcf(machine: MachineData | None = None, actuated: bool = False, *,
     rr = frame_to_matrix(m.robroot_frame)
     rx, ry, rz, rw = Rotation.from_matrix(rr[:3, :3]).as_quat()
     rr_attr = f'pos="{_vec(rr[:3, 3] / 1000.0)}" quat="{_vec((rw, rx, ry, rz))}"'
-    lines.append(f'    <site name="robroot" {rr_attr} size="0.01" rgba="0 0 1 1"/>')
-    lines.append(f'    <body name="base_link" {rr_attr}>')
+    # external kinematics (robot/external.py): a ROBROOT kinematic (#ERSYS) carries base_link, a
+    # BASE kinematic (#EASYS..) is a body tree of its own; their joints are named joint_e<n>
+    ext_close = 0
+    ersys = next((k for k in m.external_kinematics if k.robroot), None)
+    for kin in m.external_kinematics:
+        if kin is ersys:
+            continue
+        n_open = _ext_bodies(lines, m, kin, "    ")
+        lines.append("    " + "  " * n_open + f'<site name="et{kin.index}_flange" size="0.01" rgba="0 0 1 1"/>')
+        lines.append("    " + "  " * n_open + '<geom type="cylinder" size="0.4 0.02" rgba="0.5 0.5 0.5 1"/>')
+        for k in range(n_open, 0, -1):
+            lines.append("    " + "  " * (k - 1) + "</body>")
+    if ersys is not None:
+        ext_close = _ext_bodies(lines, m, ersys, "    ")
+        rr_attr = 'pos="0 0 0"'
+    pad = "  " * ext_close
+    lines.append(f'    {pad}<site name="robroot" {rr_attr} size="0.01" rgba="0 0 1 1"/>')
+    lines.append(f'    {pad}<body name="base_link" {rr_attr}>')
     # base column up to the A1 joint origin
     o1 = np.array(joints[0].origin_mm) / 1000.0
     lines.append(f'      <geom name="base_geom" type="capsule" size="0.07" fromto="0 0 0 {_vec(o1)}" rgba="0.2 0.2 0.2 1"/>')
@@ -111,6 +129,8 @@ def build_mjcf(machine: MachineData | None = None, actuated: bool = False, *,
         indent = indent[:-2]
         lines.append(f"{indent}</body>")
     lines.append("    </body>")
+    for k in range(ext_close, 0, -1):
+        lines.append("    " + "  " * (k - 1) + "</body>")
     lines.append("  </worldbody>")
     if actuated:
         lines.append("  <actuator>")
@@ -119,15 +139,57 @@ def build_mjcf(machine: MachineData | None = None, actuated: bool = False, *,
         for i, j in enumerate(joints):
             lines.append(f'    <velocity name="v{i + 1}" joint="{j.name}" kv="{_f(kv)}"/>')
         lines.append("  </actuator>")
-    home = [j.kuka_sign * math.radians(a) for j, a in zip(joints, m.home_deg)]
+    arm_home = [j.kuka_sign * math.radians(a) for j, a in zip(joints, m.home_deg)]
+    home = _ext_home(m, arm_home)
     lines.append("  <keyframe>")
     ctrl = ""
     if actuated:
-        ctrl = f' ctrl="{_vec(home + [0.0] * len(joints))}"'
+        ctrl = f' ctrl="{_vec(arm_home + [0.0] * len(joints))}"'
     lines.append(f'    <key name="home" qpos="{_vec(home)}"{ctrl}/>')
     lines.append("  </keyframe>")
     lines.append("</mujoco>")
     return "\n".join(lines) + "\n"
+
+
+def _ext_bodies(lines: list[str], m: MachineData, kin, indent: str) -> int:
+    """Open the bodies of the external kinematic `kin` (robot/external.py's chain: root,
+    TA1KR, axis, TA2A1, axis, ...; the axis along/about Z); returns how many were opened, the
+    last one being the kinematic's flange (TFLA3)."""
+    def attr(frame) -> str:
+        T = frame_to_matrix(*frame)
+        x, y, z, w = Rotation.from_matrix(T[:3, :3]).as_quat()
+        return f'pos="{_vec(T[:3, 3] / 1000.0)}" quat="{_vec((w, x, y, z))}"'
+
+    axes = {e.number: e for e in m.external_axes}
+    opened = 0
+    lines.append(f'{indent}<body name="et{kin.index}_root" {attr(kin.root)}>')
+    opened += 1
+    for k, num in enumerate(kin.axes):
+        e = axes[num]
+        lines.append(f'{indent}{"  " * opened}<body name="et{kin.index}_link{k + 1}" {attr(kin.frames[k])}>')
+        opened += 1
+        jt = "slide" if e.linear else "hinge"
+        scale = 0.001 if e.linear else math.pi / 180.0
+        rng = ("" if e.kind == "endless" else
+               f' range="{_f(e.limit[0] * scale)} {_f(e.limit[1] * scale)}"')
+        lines.append(f'{indent}{"  " * opened}<joint name="joint_e{num}" type="{jt}" axis="0 0 {e.direction}"{rng}/>')
+        lines.append(f'{indent}{"  " * opened}<geom type="box" size="0.15 0.15 0.05" rgba="0.3 0.3 0.6 1"/>')
+    lines.append(f'{indent}{"  " * opened}<body name="et{kin.index}_flange" {attr(kin.frames[3])}>')
+    return opened + 1
+
+
+def _ext_home(m: MachineData, home: list[float]) -> list[float]:
+    """The keyframe's qpos in MuJoCo's joint order: the bodies of the BASE kinematics come
+    first, then the ROBROOT kinematic's joints, then the arm (see build_mjcf)."""
+    axes = {e.number: e for e in m.external_axes}
+
+    def val(num: int) -> float:
+        e = axes[num]
+        return e.home * (0.001 if e.linear else math.pi / 180.0)
+
+    before = [val(n) for k in m.external_kinematics if not k.robroot for n in k.axes]
+    ers = [val(n) for k in m.external_kinematics if k.robroot for n in k.axes]
+    return before + ers + home
 
 
 _BOTTOM_ROW = np.array([0.0, 0.0, 0.0, 1.0])
@@ -156,6 +218,10 @@ class ArmModel:
         q0 = int(self._qadr[0])
         self._qidx = slice(q0, q0 + 6) if list(self._qadr) == list(range(q0, q0 + 6)) else self._qadr
         self._sign = np.array([j.kuka_sign for j in self.machine.joints], dtype=float)
+        # external axes E1..En (joint_e<n>): qpos in m or rad, set from mm or deg
+        ext = self.machine.external_axes
+        self._eadr = np.array([self.model.joint(f"joint_e{e.number}").qposadr[0] for e in ext], dtype=int)
+        self._escale = np.array([0.001 if e.linear else math.pi / 180.0 for e in ext])
         self._site = self.model.site("tool0").id
         self._robroot = frame_to_matrix(self.machine.robroot_frame)
         self._robroot_inv = inv_pos(self._robroot)
@@ -168,7 +234,10 @@ class ArmModel:
         """Kinematic playback: write ``qpos`` (and ``qvel``) from A1..A6 in deg (deg/s)
         and run ``mj_kinematics`` (``mj_forward`` with ``full=True``)."""
         d = self.data
-        d.qpos[self._qidx] = self._sign * np.radians(np.asarray(axes_deg, dtype=float)[:6])
+        a = np.asarray(axes_deg, dtype=float)
+        d.qpos[self._qidx] = self._sign * np.radians(a[:6])
+        if len(self._eadr) and len(a) > 6:
+            d.qpos[self._eadr] = self._escale * a[6:6 + len(self._eadr)]
         if vel_deg_s is not None:
             d.qvel[self._dadr] = self._sign * np.radians(np.asarray(vel_deg_s, dtype=float)[:6])
         if full:
@@ -177,8 +246,12 @@ class ArmModel:
             self._mj.mj_kinematics(self.model, d)
 
     def axes_deg(self) -> np.ndarray:
-        """Current A1..A6 (deg) read back from ``qpos``; shape (6,)."""
-        return np.degrees(self._sign * self.data.qpos[self._qidx])
+        """Current A1..A6 (deg) read back from ``qpos``, then E1..En (mm, deg) when the robot
+        has external axes; shape (6,) or (6 + n,)."""
+        q = np.degrees(self._sign * self.data.qpos[self._qidx])
+        if len(self._eadr):
+            q = np.concatenate([q, self.data.qpos[self._eadr] / self._escale])
+        return q
 
     def axes_vel_deg_s(self) -> np.ndarray:
         """Current axis speeds (deg/s) from ``qvel``; shape (6,)."""

@@ -55,6 +55,8 @@ class MotionParams:
         circ_type: ``BASE`` or ``PATH`` (``$CIRC_TYPE``).
         ov_pro: ``$OV_PRO`` %.
         ipo_mode: ``BASE`` or ``TCP`` (external TCP, robot/external_tcp.py).
+        base_kin: the BASE kinematic ``$BASE`` is linked to (``"#EASYS"`` .. ``"#EFSYS"``,
+            KSS ``EK``; robot/external.py): the base turns with its external axes; None: fixed.
     """
 
     vel_cp: float = 2.0
@@ -75,6 +77,7 @@ class MotionParams:
     circ_type: str = "BASE"
     ov_pro: float = 100.0
     ipo_mode: str = "BASE"
+    base_kin: str | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "ori_type", _enum(self.ori_type))

@@ -6,6 +6,13 @@ trapezoid, or a piecewise profile for a SPLINE block; CP paths are slowed so the
 machine data, issue 15):
 
 * :class:`JointSegment` (PTP, SPTP): ``q(u) = q0 + u·(q1 - q0)``, synchronised axes.
+
+External axes E1..En (robot/external.py) are the axis vector's entries after A1..A6: a PTP
+moves them synchronised with the robot axes; on a CP path they move linearly in the path
+parameter, ``E(u) = E0 + u·(E1 - E0)``, start and stop with the robot, and the path is slowed
+for their speed and acceleration like for the robot's axes. A track (#ERSYS) moves
+``$ROBROOT`` with E, so the arm's axes on a CP path follow it; a ``$BASE`` linked to a BASE
+kinematic (``MotionParams.base_kin``, KSS ``EK``) turns with it.
 * :class:`CartSegment` (LIN, CIRC, SLIN, SCIRC, SPLINE): the TCP moves in ``$BASE`` along
   a chain of path pieces (line, circular arc, Catmull-Rom curve for SPL points); the
   orientation follows ``$ORI_TYPE``/``$CIRC_TYPE``; axis values come from the inverse
@@ -29,7 +36,7 @@ from scipy.spatial.transform import Rotation
 from .errors import RobotError, WorkspaceError
 from .frames import frame_to_matrix, inv_pos, matrix_to_frame
 from .kinematics import Kinematics
-from .motion import AXIS_KEYS, CART_KEYS, MotionParams, MotionRequest, Trigger
+from .motion import AXIS_KEYS, CART_KEYS, EXT_KEYS, MotionParams, MotionRequest, Trigger
 from .limits import DEFAULT_MODE, T1_SPEED_MM_S, cp_path_speed, motion_limits, ptp_axis_speeds
 from .profiles import PiecewiseProfile, Trapezoid
 
@@ -60,15 +67,59 @@ class RobotModel:
         self.robroot_T = frame_to_matrix(*machine.robroot_frame)
         self._robroot_is_null = bool(np.allclose(self.robroot_T, np.eye(4)))
         self._robroot_inv_T = inv_pos(self.robroot_T)
-        self.v_max = np.array(machine.max_speed_deg_s, dtype=float)
-        self.a_max = np.array(machine.max_acc_deg_s2, dtype=float)
-        self.apo_dis_ptp = np.array(machine.apo_dis_ptp_deg, dtype=float)
+        #: external axes (robot/external.py), None without; axis vectors are A1..A6, E1..En
+        self.n_ext = len(getattr(machine, "external_axes", ()))
+        self.ext = None
+        self._ersys = False
+        if self.n_ext:
+            from .external import ExternalAxes  # noqa: PLC0415
+
+            self.ext = ExternalAxes(machine)
+            self._ersys = self.ext.robroot_kin is not None
+            self.v_max = np.array(machine.all_max_speed, dtype=float)
+            self.a_max = np.array(machine.all_max_acc, dtype=float)
+            ext_apo = [90.0] * self.n_ext
+            self.apo_dis_ptp = np.array(list(machine.apo_dis_ptp_deg)[:6] + ext_apo, dtype=float)
+            self._e_lo = np.array([e.limit[0] for e in machine.external_axes], dtype=float)
+            self._e_hi = np.array([e.limit[1] for e in machine.external_axes], dtype=float)
+        else:
+            self.v_max = np.array(machine.max_speed_deg_s, dtype=float)
+            self.a_max = np.array(machine.max_acc_deg_s2, dtype=float)
+            self.apo_dis_ptp = np.array(machine.apo_dis_ptp_deg, dtype=float)
+
+    def linked(self, system: str) -> "RobotModel":
+        """This model with ``$BASE`` on the BASE kinematic `system` (robot/external.py):
+        ``$BASE_C(E) = ETn(E) : $BASE`` in :meth:`tcp` and :meth:`ik`."""
+        if self.ext is None or system not in self.ext.base_kins:
+            raise RobotError(f"$BASE linked to {system}: no such external kinematic in $EX_KIN")
+        return _LinkedBase(self, system)
+
+    def robroot_at(self, q: np.ndarray) -> np.ndarray | None:
+        """``$ROBROOT_C`` for the axis vector `q` (the track's E values), None for the null frame."""
+        if self._ersys:
+            return self.ext.robroot(q[6:])           # type: ignore[union-attr]
+        return None if self._robroot_is_null else self.robroot_T
+
+    def check_limits(self, q: np.ndarray) -> None:
+        """``$SOFTN_END``/``$SOFTP_END`` of A1..A6 and E1..En (SoftLimitError, reference §8.2)."""
+        self.kin.check_soft_limits(q)
+        if self.n_ext:
+            from .errors import SoftLimitError  # noqa: PLC0415
+
+            e = np.asarray(q, dtype=float)[6:6 + self.n_ext]
+            for i in range(self.n_ext):
+                if e[i] < self._e_lo[i] - 1e-9 or e[i] > self._e_hi[i] + 1e-9:
+                    pos = bool(e[i] > self._e_hi[i])
+                    raise SoftLimitError(6 + i + 1, float(e[i]), positive=pos,
+                                         message=f"software limit switch {'+' if pos else '-'}E{i + 1}")
 
     def tcp(self, q: np.ndarray, tool_T: np.ndarray, base_inv_T: np.ndarray) -> np.ndarray:
         """TCP in $BASE: INV_POS($BASE) : $ROBROOT : FLANGE(q) : $TOOL (``base_inv_T`` is
-        INV_POS($BASE), precomputed)."""
+        INV_POS($BASE), precomputed; ``$ROBROOT_C(E)`` on a track)."""
         F = self.kin.forward(q)
-        if not self._robroot_is_null:
+        if self._ersys:
+            F = self.ext.robroot(q[6:]) @ F          # type: ignore[union-attr]
+        elif not self._robroot_is_null:
             F = self.robroot_T @ F
         return base_inv_T @ F @ tool_T
 
@@ -79,6 +130,15 @@ class RobotModel:
         F = T_base if base_T is None else base_T @ T_base
         if tool_inv_T is not None:
             F = F @ tool_inv_T
+        if self.n_ext:
+            # the external axes are given (ref's E part): the arm solves in $ROBROOT_C(E)
+            e = np.asarray(ref, dtype=float)[6:6 + self.n_ext]
+            if self._ersys:
+                F = inv_pos(self.ext.robroot(e)) @ F      # type: ignore[union-attr]
+            elif not self._robroot_is_null:
+                F = self._robroot_inv_T @ F
+            q = self.kin.inverse(F, status=status, turn=turn, reference_deg=ref[:6])
+            return np.concatenate([q, e])
         if not self._robroot_is_null:
             F = self._robroot_inv_T @ F
         return self.kin.inverse(F, status=status, turn=turn, reference_deg=ref)
@@ -87,9 +147,11 @@ class RobotModel:
         return self.kin.status_turn(q)
 
     def tcp_pos_many(self, Q: np.ndarray, tool_T: np.ndarray, base_inv_T: np.ndarray) -> np.ndarray:
-        """TCP positions (n, 3) in $BASE for axis rows Q (n, 6)."""
+        """TCP positions (n, 3) in $BASE for axis rows Q (n, 6 + external axes)."""
         F = self.kin.forward_many(Q)
-        if not self._robroot_is_null:
+        if self._ersys:
+            F = np.array([self.ext.robroot(q[6:]) for q in Q]) @ F      # type: ignore[union-attr]
+        elif not self._robroot_is_null:
             F = self.robroot_T @ F
         T = base_inv_T @ F @ tool_T
         return T[:, :3, 3]
@@ -110,7 +172,7 @@ class RobotModel:
             P = self.tcp_pos_many(Q, tool_T, base_inv_T)
             r = P[0] - p
             if float(np.linalg.norm(r)) < 1e-7:
-                self.kin.check_soft_limits(q)
+                self.check_limits(q)
                 return q
             J = (P[1:] - P[0]).T / h
             try:
@@ -119,6 +181,27 @@ class RobotModel:
                 break
             q[:3] += np.clip(dx, -20.0, 20.0)
         raise WorkspaceError("workspace error: target not reachable ($ORI_TYPE #JOINT)")
+
+
+class _LinkedBase(RobotModel):
+    """A :class:`RobotModel` whose ``$BASE`` turns with a BASE kinematic (a turntable)."""
+
+    def __init__(self, model: RobotModel, system: str) -> None:   # noqa: D107 - a view of `model`
+        self.__dict__.update(model.__dict__)
+        self._kin_et = model.ext.base_kins[system]               # type: ignore[union-attr]
+
+    def _et(self, e: np.ndarray) -> np.ndarray:
+        return self.ext.chain(self._kin_et, e)                   # type: ignore[union-attr]
+
+    def tcp(self, q: np.ndarray, tool_T: np.ndarray, base_inv_T: np.ndarray) -> np.ndarray:
+        return RobotModel.tcp(self, q, tool_T, base_inv_T @ inv_pos(self._et(q[6:])))
+
+    def ik(self, T_base, tool_inv_T, base_T, status, turn, ref):
+        E = self._et(np.asarray(ref, dtype=float)[6:])
+        return RobotModel.ik(self, T_base, tool_inv_T, E if base_T is None else E @ base_T, status, turn, ref)
+
+    def tcp_pos_many(self, Q: np.ndarray, tool_T: np.ndarray, base_inv_T: np.ndarray) -> np.ndarray:
+        return np.array([self.tcp(q, tool_T, base_inv_T)[:3, 3] for q in Q])
 
 
 def rotvec_matrix(v: np.ndarray) -> np.ndarray:
@@ -397,8 +480,8 @@ class Segment:
         self.status = model.status_turn(q0)[0]
         self.triggers: list[TriggerPlan] = []
         self.limits: Any = None            # robot.limits.MotionLimits, set by plan()
-        self.vel_peak = np.zeros(6)        # highest planned axis speeds (deg/s)
-        self.acc_peak = np.zeros(6)        # highest planned axis accelerations (deg/s²)
+        self.vel_peak = np.zeros(len(q0))  # highest planned axis speeds (deg/s)
+        self.acc_peak = np.zeros(len(q0))  # highest planned axis accelerations (deg/s²)
         self.qd_start = q1 - q0            # dq/du at the start and at the end (deg)
         self.qd_end = q1 - q0
         self._last_q = q0.copy()
@@ -507,6 +590,8 @@ class CartSegment(Segment):
                  pieces: list[_Piece], rots: list[Rotation], weights: list[float],
                  ori: list[str]) -> None:
         super().__init__(req, q0, q1, profile, v_prog, tool_T, base_T, model)
+        #: E1..En at the end of the path (they move linearly in u from q0's)
+        self.e1 = np.asarray(q1, dtype=float)[6:].copy()
         self.pieces = pieces
         self.rots = rots
         self.ori = ori
@@ -567,13 +652,17 @@ class CartSegment(Segment):
     def pose(self, tau: float) -> tuple[np.ndarray, np.ndarray]:
         return self.pose_u(self.profile.u(tau))
 
-    def ik(self, p: np.ndarray, R: np.ndarray, ref: np.ndarray) -> np.ndarray:
+    def ik(self, p: np.ndarray, R: np.ndarray, ref: np.ndarray, u: float | None = None) -> np.ndarray:
         """Axes for a TCP pose (position mm, 3x3 rotation) in this segment's $BASE/$TOOL,
-        start status S, turn nearest to ``ref``. Raises WorkspaceError/SoftLimitError."""
+        start status S, turn nearest to ``ref``. With external axes they take their value
+        at the path parameter `u` (``E0 + u·(E1 - E0)``), or ``ref``'s without `u`.
+        Raises WorkspaceError/SoftLimitError."""
         T = np.empty((4, 4))
         T[:3, :3] = R
         T[:3, 3] = p
         T[3] = _BOTTOM_ROW
+        if u is not None and len(ref) > 6:
+            ref = np.concatenate([ref[:6], self.q0[6:] + u * (self.e1 - self.q0[6:])])
         return self.model.ik(T, self._ik_tool, self._ik_base, self.status, None, ref)
 
     def axes(self, tau: float) -> np.ndarray:
@@ -585,11 +674,18 @@ class CartSegment(Segment):
             u = self.profile.u(tau)
             p = self.pose_u(u)[0]
             wrist = self.q0[3:6] + u * (self.q1[3:6] - self.q0[3:6])
-            q = self.model.solve_position(p, wrist, self._last_q, self.tool_T, self.base_inv_T)
+            ref = self._last_q
+            if len(ref) > 6:
+                ref = np.concatenate([ref[:6], self.q0[6:] + u * (self.e1 - self.q0[6:])])
+            q = self.model.solve_position(p, wrist, ref, self.tool_T, self.base_inv_T)
             self._last_q = q
             return q
-        p, R = self.pose(tau)
-        q = self.ik(p, R, self._last_q)
+        if len(self.q0) > 6:
+            u = self.profile.u(tau)
+            q = self.ik(*self.pose_u(u), self._last_q, u)
+        else:
+            p, R = self.pose(tau)
+            q = self.ik(p, R, self._last_q)
         self._last_q = q
         return q
 
@@ -651,6 +747,18 @@ def _cart_target(req_target: dict[str, float], start_T: np.ndarray, relative: bo
     return frame_to_matrix(*_apply_partial(start6, req_target))
 
 
+def _ext_target(q0: np.ndarray, target: dict[str, float], relative: bool) -> np.ndarray:
+    """``q0`` with its external axes E1..En set from the target's E components (relative:
+    added), the rest kept; ``q0`` itself without external axes."""
+    if len(q0) <= 6:
+        return q0
+    out = q0.copy()
+    for i, key in enumerate(EXT_KEYS[:len(q0) - 6]):
+        if key in target:
+            out[6 + i] = (q0[6 + i] if relative else 0.0) + float(target[key])
+    return out
+
+
 def _check_complete(req: MotionRequest) -> None:
     t = req.target
     if req.relative or req.kind in ("CIRC", "SCIRC", "SPLINE"):
@@ -682,6 +790,8 @@ def plan(req: MotionRequest, q_start: np.ndarray, model: RobotModel, *,
     elif p.ipo_mode != "BASE":
         raise RobotError(f"$IPO_MODE=#{p.ipo_mode} is not supported by the simulator")
     q0 = np.asarray(q_start, dtype=float).copy()
+    if getattr(p, "base_kin", None) and model.n_ext:
+        model = model.linked(p.base_kin)      # $BASE on a BASE kinematic (robot/external.py)
     tool_T = frame_to_matrix(*p.tool)
     base_T = frame_to_matrix(*p.base)
     base_inv = inv_pos(base_T)
@@ -701,15 +811,17 @@ def _plan_joint(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_T:
     t = req.target
     if req.is_axis_target:
         if req.relative:
-            q1 = q0 + np.array([float(t.get(k, 0.0)) for k in AXIS_KEYS])
+            q1 = q0 + np.array([float(t.get(k, 0.0)) for k in AXIS_KEYS + EXT_KEYS[:len(q0) - 6]])
         else:
-            q1 = np.array([float(t[k]) if k in t else q0[i] for i, k in enumerate(AXIS_KEYS)])
-        model.kin.check_soft_limits(q1)
+            q1 = np.array([float(t[k]) if k in t else q0[i] for i, k in enumerate(AXIS_KEYS + EXT_KEYS[:len(q0) - 6])])
+        model.check_limits(q1)
     else:
         T1 = _cart_target(t, start_T, req.relative, req.rel_frame)
         s = int(t["S"]) if "S" in t and not req.relative else None
         tt = int(t["T"]) if "T" in t and not req.relative else None
-        q1 = model.ik(T1, inv_pos(tool_T), base_T, s, tt, q0)
+        q1 = model.ik(T1, inv_pos(tool_T), base_T, s, tt, _ext_target(q0, t, req.relative))
+        if len(q1) > 6:
+            model.check_limits(q1)
     dq = np.abs(q1 - q0)
     moving = dq > 1e-9
     if not moving.any():
@@ -718,7 +830,7 @@ def _plan_joint(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_T:
         V = A = 0.0
     else:
         v_axis = ptp_axis_speeds(p, model.machine, model.mode)     # $RED_T1 in T1 (issue 15)
-        a_axis = model.a_max * np.array(p.acc_axis) / 100.0
+        a_axis = model.a_max * np.array(list(p.acc_axis)[:6] + [100.0] * (len(q0) - 6)) / 100.0
         if np.any(v_axis[moving] <= 0) or np.any(a_axis[moving] <= 0):
             raise RobotError("PTP: $VEL_AXIS, $ACC_AXIS and $OV_PRO must be positive")
         V = float(np.min(v_axis[moving] / dq[moving]))
@@ -861,10 +973,17 @@ def _plan_cart(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_T: 
     c = v_cp0 / v_ori0
     weights = [max(pc.length, th * c) for pc, th in zip(pieces, thetas)]
     W = float(sum(weights))
-    seg = CartSegment(req, q0, q0.copy(), Trapezoid.plan(math.inf, math.inf), math.inf,
+    q_end = _ext_target(q0, req.target if req.kind != "SPLINE" else
+                        (req.segments[-1].target if req.segments else {}), req.relative)
+    if len(q0) > 6:
+        model.check_limits(np.concatenate([q0[:6], q_end[6:]]))
+    seg = CartSegment(req, q0, q_end, Trapezoid.plan(math.inf, math.inf), math.inf,
                       tool_T, base_T, model, pieces, rots, weights, ori)
-    seg.vel_peak = np.zeros(6)
-    seg.acc_peak = np.zeros(6)
+    seg.vel_peak = np.zeros(len(q0))
+    seg.acc_peak = np.zeros(len(q0))
+    if len(q0) > 6 and W <= 1e-6 and float(np.max(np.abs(q_end[6:] - q0[6:]))) > 1e-9:
+        raise RobotError(f"{req.kind}: a CP motion that moves only the external axes is not simulated "
+                         f"(the TCP stands still); move them with PTP")
     if W <= 1e-6:  # nothing to move (a zero-length LIN): zero duration, never approximated
         seg.q1 = q0.copy()
         return seg
@@ -923,12 +1042,12 @@ def _plan_cart(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_T: 
         start = ref
         while True:
             us = np.linspace(float(ub[k]), float(ub[k + 1]), nk + 1)
-            Q = np.empty((nk + 1, 6))
+            Q = np.empty((nk + 1, len(q0)))
             Q[0] = start
             ref = start
             for j in range(1, nk + 1):
                 pu, Ru = seg.pose_u(float(us[j]))
-                q = seg.ik(pu, Ru, ref)
+                q = seg.ik(pu, Ru, ref, float(us[j])) if len(q0) > 6 else seg.ik(pu, Ru, ref)
                 jump = np.abs(q - ref)
                 if float(jump.max()) > SINGULAR_JUMP_DEG:
                     i = int(np.argmax(jump))
@@ -945,7 +1064,7 @@ def _plan_cart(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_T: 
         h = float(us[1] - us[0])
         if h <= 0:
             junction_q.append(Q[0].copy())
-            sec_d.append((np.zeros(6), np.zeros(6), 1.0))
+            sec_d.append((np.zeros(len(q0)), np.zeros(len(q0)), 1.0))
             continue
         d1 = np.gradient(Q, h, axis=0, edge_order=2)
         d2 = np.gradient(d1, h, axis=0, edge_order=2)
@@ -989,9 +1108,10 @@ def _plan_cart(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_T: 
         if vnode[k] <= 0.0:
             continue
         uk, du_ = float(ub[k]), 1e-5
-        qj = seg.ik(*seg.pose_u(uk), junction_q[k])
-        qL = seg.ik(*seg.pose_u(uk - du_), qj)
-        qR = seg.ik(*seg.pose_u(uk + du_), qj)
+        e_u = (lambda v: v) if len(q0) > 6 else (lambda v: None)
+        qj = seg.ik(*seg.pose_u(uk), junction_q[k], e_u(uk))
+        qL = seg.ik(*seg.pose_u(uk - du_), qj, e_u(uk - du_))
+        qR = seg.ik(*seg.pose_u(uk + du_), qj, e_u(uk + du_))
         jump = np.abs((qR - qj) - (qj - qL)) / du_
         # a jump that matters at full speed (> 5 % of a_max within one cycle; e.g. the
         # orientation rate changing between pieces) is a corner for the axes

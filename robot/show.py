@@ -11,11 +11,19 @@ from .kinematics import Kinematics
 from .machine import MachineData
 
 #: Parameters shown with their source, in this order (those the model has).
-_PARAMS = ("$TRAFONAME", "$TIRORO", "$LENGTH_A", "$LENGTH_B", "$TX3P3", "$DH_4", "$DH_5", "$TFLWP",
-           "$AXIS_DIR", "$SOFTN_END", "$SOFTP_END", "$VEL_AXIS_MA", "$RAT_MOT_AX", "$AXIS_JERK",
-           "$VEL_MA", "$ACC_MA", "$ROBROOT", "$DEF_A4FIX", "$DEF_A5LINK", "$AXIS_HOME[1]", "$MAMES",
-           "$DEF_L_M", "max_speed_deg_s", "max_acc_deg_s2", "opw", "status_phi_deg",
-           "reach_wrist_point_mm", "ipo_cycle_s", "motion_defaults", "default_load")
+_PARAMS = ("$TRAFONAME", "$KINCLASS", "$NUM_AX", "$TIRORO", "$LENGTH_A", "$LENGTH_B", "$TX3P3", "$DH_4",
+           "$DH_5", "$TFLWP", "$AXIS_DIR", "$SOFTN_END", "$SOFTP_END", "$VEL_AXIS_MA", "$RAT_MOT_AX",
+           "$RAISE_TIME", "$AXIS_JERK", "$VEL_MA", "$ACC_MA", "$ACC_OV", "$ROBROOT", "$DEF_A4FIX",
+           "$DEF_A5LINK", "a5_led", "$AXIS_HOME[1]", "$H_POS", "home_deg", "$MAMES", "$IN_POS_CAR", "$IN_POS_ORI",
+           "$DEF_FLT_PTP", "$DEF_FLT_CP", "$DEF_L_M", "max_speed_deg_s", "max_acc_deg_s2", "opw",
+           "status_phi_deg", "reach_wrist_point_mm", "ipo_cycle_s", "motion_defaults", "default_load",
+           "$EX_AX_NUM", "$AXIS_TYPE", "E_speed", "$EX_KIN", "$ERSYSROOT")
+
+#: How each family of inverse kinematics is named (robot/kinematics.py ``Kinematics.family``).
+_FAMILIES = {"opw": "analytic (OPW: six axes, spherical wrist)",
+             "palletizer4": "analytic (4-axis palletizer: $DEF_A4FIX, A5 led by the parallelogram)",
+             "palletizer5": "analytic (5-axis palletizer: $DEF_A4FIX)",
+             "numeric": "numeric (mink on the MuJoCo model; no closed form for this arm)"}
 
 
 def _fmt(values, nd: int = 3) -> str:
@@ -28,10 +36,11 @@ def show_lines(m: MachineData) -> list[str]:
            f"source     {printable(m.source)}"]
     if m.trafoname:
         out.append(f"$TRAFONAME {printable(m.trafoname)}")
-    o = m.opw
-    out.append(f"kinematics OPW a1={o.a1:g} a2={o.a2:g} b={o.b:g} c1={o.c1:g} c2={o.c2:g} "
-               f"c3={o.c3:g} c4={o.c4:g} mm")
     k = Kinematics(m)
+    o = k._opw if k.family == "opw" else m.opw
+    out.append(f"kinematics OPW a1={o.a1 + 0.0:g} a2={o.a2 + 0.0:g} b={o.b + 0.0:g} c1={o.c1 + 0.0:g} "
+               f"c2={o.c2 + 0.0:g} c3={o.c3 + 0.0:g} c4={o.c4 + 0.0:g} mm")
+    out.append(f"inverse    {_FAMILIES.get(k.family, k.family)}")
     zero = k.forward([0.0] * 6)[:3, 3]
     out.append(f"reach      {m.reach_wrist_point_mm:.1f} mm to the wrist point; flange at A=0: "
                f"({_fmt(zero, 1)}) mm")
@@ -40,11 +49,26 @@ def show_lines(m: MachineData) -> list[str]:
     out.append(f"$VEL_MA    CP {m.vel_ma.cp:g} m/s, ORI1 {m.vel_ma.ori1:g}, ORI2 {m.vel_ma.ori2:g} deg/s; "
                f"$ACC_MA CP {m.acc_ma.cp:g} m/s2")
     if m.a4fix or m.a5link:
-        out.append(f"palletizer $DEF_A4FIX={m.a4fix} $DEF_A5LINK={m.a5link}")
+        led = "a5_led" in m.provenance     # $NUM_AX=4: A5 led although $DEF_A5LINK is FALSE
+        out.append(f"palletizer $DEF_A4FIX={str(m.a4fix).upper()} $DEF_A5LINK={str(m.a5link and not led).upper()}"
+                   + (" (A5 led: $NUM_AX=4)" if led else ""))
+    acc_d = "*" if m.provenance.get("max_acc_deg_s2", "").startswith("derived") else " "
+    jerk_d = "*" if m.provenance.get("$AXIS_JERK", "").startswith("derived") else " "
     out.append("axes       axis   limits (deg)         v max (deg/s)  a max (deg/s2)  jerk (deg/s3)")
     for j in m.joints:
         out.append(f"           A{j.axis}   {j.limit_deg[0]:8.1f} .. {j.limit_deg[1]:7.1f}   {j.max_speed_deg_s:12.2f}"
-                   f"  {j.max_acc_deg_s2:14.1f}  {j.max_jerk_deg_s3:13.1f}")
+                   f"  {j.max_acc_deg_s2:13.1f}{acc_d}  {j.max_jerk_deg_s3:12.1f}{jerk_d}")
+    for e in m.external_axes:
+        u = "mm" if e.linear else "deg"
+        lim = "endless" if e.kind == "endless" else f"{e.limit[0]:8.1f} .. {e.limit[1]:7.1f}"
+        out.append(f"           {e.name}   {lim:<20} {e.max_speed:12.2f}  {e.max_acc:13.1f}   "
+                   f"{e.max_jerk:12.1f}   {e.kind} ({u})")
+    if "*" in acc_d + jerk_d:
+        out.append("           * derived by a rule (below), the machine data hold no value")
+    for s in m.external_kinematics:
+        kind = "ROBROOT kinematic (the robot rides on it)" if s.robroot else "BASE kinematic (it carries the workpiece)"
+        out.append(f"ET{s.index}        {s.system} {kind}: {printable(s.name)}, axes "
+                   f"{', '.join(f'E{e}' for e in s.axes)}; root ({_fmt(s.root)})")
     if m.provenance:
         out.append("parameters (source file:line, or the rule that derived the value)")
         for key in _PARAMS:

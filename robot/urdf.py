@@ -5,6 +5,11 @@ links ``base_link``, ``link_1`` .. ``link_6``, joints ``joint_a1`` .. ``joint_a6
 ``q = radians(A_i)`` (KUKA's directions are in the joint axes), the fixed frames ``base``
 (= ``$ROBROOT``) and ``tool0`` (= KUKA's flange frame), as the ROS-Industrial KUKA URDFs do.
 No meshes and no inertias (the machine data hold none). Lengths in m, angles in rad.
+
+With external kinematics (robot/external.py) the root is a link ``world`` (``$WORLD``): a ROBROOT
+kinematic (#ERSYS, a track) carries ``base_link`` through its joints ``joint_e<n>`` (prismatic
+for a linear axis, revolute for a rotary one, in E's units: m or rad), a BASE kinematic
+(#EASYS.., a turntable) is a branch ending in the link ``et<n>_flange``.
 """
 
 from __future__ import annotations
@@ -12,6 +17,7 @@ from __future__ import annotations
 import math
 import xml.etree.ElementTree as ET
 
+from .frames import frame_to_matrix
 from .machine import MachineData
 
 
@@ -43,8 +49,66 @@ def build_urdf(machine: MachineData) -> str:
     ET.SubElement(el, "child", link="tool0")
     ET.SubElement(el, "origin", xyz=_v(v / 1000.0 for v in machine.flange_pos_mm),
                   rpy=_v(machine.flange_rpy_rad))
+    if machine.external_kinematics:
+        _external(robot, machine)
     ET.indent(robot)
     return '<?xml version="1.0"?>\n' + ET.tostring(robot, encoding="unicode") + "\n"
+
+
+def _origin(el, T) -> None:
+    import warnings  # noqa: PLC0415
+
+    from scipy.spatial.transform import Rotation  # noqa: PLC0415
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", UserWarning)      # B = ±90: any split of the angles is the rotation
+        rpy = Rotation.from_matrix(T[:3, :3]).as_euler("xyz")
+    ET.SubElement(el, "origin", xyz=_v(T[:3, 3] / 1000.0), rpy=_v(rpy))
+
+
+def _fixed(robot, name: str, parent: str, child: str, T) -> None:
+    el = ET.SubElement(robot, "joint", name=name, type="fixed")
+    ET.SubElement(el, "parent", link=parent)
+    ET.SubElement(el, "child", link=child)
+    _origin(el, T)
+
+
+def _external(robot, machine: MachineData) -> None:
+    """The links and joints of the external kinematics (module docstring)."""
+    import numpy as np  # noqa: PLC0415
+
+    axes = {e.number: e for e in machine.external_axes}
+    ET.SubElement(robot, "link", name="world")
+    for kin in machine.external_kinematics:
+        parent = "world"
+        pending = frame_to_matrix(*kin.root)
+        for k, num in enumerate(kin.axes):
+            e = axes[num]
+            pending = pending @ frame_to_matrix(*kin.frames[k])
+            link_in = f"et{kin.index}_link{k + 1}_in"
+            ET.SubElement(robot, "link", name=link_in)
+            _fixed(robot, f"{parent}-{link_in}", parent, link_in, pending)
+            link_out = f"et{kin.index}_link{k + 1}"
+            ET.SubElement(robot, "link", name=link_out)
+            el = ET.SubElement(robot, "joint", name=f"joint_e{num}", type="prismatic" if e.linear else
+                               ("continuous" if e.kind == "endless" else "revolute"))
+            ET.SubElement(el, "parent", link=link_in)
+            ET.SubElement(el, "child", link=link_out)
+            ET.SubElement(el, "origin", xyz="0 0 0", rpy="0 0 0")
+            ET.SubElement(el, "axis", xyz=f"0 0 {e.direction}")
+            scale = 0.001 if e.linear else math.pi / 180.0
+            if e.kind != "endless":
+                ET.SubElement(el, "limit", effort="0", lower=_v([e.limit[0] * scale]), upper=_v([e.limit[1] * scale]),
+                              velocity=_v([e.max_speed * scale]))
+            parent, pending = link_out, np.eye(4)
+        pending = pending @ frame_to_matrix(*kin.frames[3])
+        if kin.robroot:
+            _fixed(robot, f"{parent}-base_link", parent, "base_link", pending)
+        else:
+            ET.SubElement(robot, "link", name=f"et{kin.index}_flange")
+            _fixed(robot, f"{parent}-et{kin.index}_flange", parent, f"et{kin.index}_flange", pending)
+    if not any(k.robroot for k in machine.external_kinematics):
+        _fixed(robot, "world-base_link", "world", "base_link", frame_to_matrix(*machine.robroot_frame))
 
 
 __all__ = ["build_urdf"]

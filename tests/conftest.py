@@ -22,6 +22,7 @@ from hypothesis import HealthCheck, settings
 REPO_ROOT = Path(__file__).resolve().parents[1]
 SHARED = REPO_ROOT.parent / "shared"
 SHARED_CORPUS = SHARED / "krl-corpus"
+SHARED_HISTORY = SHARED / "krl-history"
 
 settings.register_profile("ci", max_examples=50, deadline=None, print_blob=True,
                           suppress_health_check=[HealthCheck.too_slow])
@@ -29,7 +30,7 @@ settings.register_profile("nightly", max_examples=2000, deadline=None, print_blo
                           suppress_health_check=[HealthCheck.too_slow])
 settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "ci"))
 
-CORPUS_FIXTURES = {"shared_corpus", "corpus"}
+CORPUS_FIXTURES = {"shared_corpus", "corpus", "shared_history"}
 
 
 def corpus_present() -> bool:
@@ -47,6 +48,26 @@ def shared_corpus() -> Path:
     if not corpus_present():
         pytest.skip("../shared/krl-corpus is not present")
     return SHARED_CORPUS
+
+
+def history_pairs() -> list[str]:
+    """The pair folders of ../shared/krl-history (``owner__name/NN-sha``), as its MANIFEST.csv
+    lists them; [] when it is absent."""
+    import csv  # noqa: PLC0415
+
+    manifest = SHARED_HISTORY / "MANIFEST.csv"
+    if not manifest.exists():
+        return []
+    with manifest.open(newline="", encoding="utf-8") as f:
+        return [f"{row['repo'].replace('/', '__')}/{row['pair']}" for row in csv.DictReader(f)]
+
+
+@pytest.fixture(scope="session")
+def shared_history() -> Path:
+    """The real version histories, read in place. Absent: the test skips (a failure under CI=true)."""
+    if not (SHARED_HISTORY / "MANIFEST.csv").exists():
+        pytest.skip("../shared/krl-history is not present")
+    return SHARED_HISTORY
 
 
 def pytest_configure(config: pytest.Config) -> None:

@@ -66,16 +66,17 @@ def diff(old: str, new: str, fmt: str, tolerance: float, output: str | None) -> 
         with side(old, single) as a, side(new, single) as b:
             d = diff_sides(a, b, tolerance)
             _echo_errors((a, b), set(d.not_compared))
+        if fmt == "json":
+            text = json.dumps(d.as_json(), indent=2, ensure_ascii=False)
+        elif fmt == "html":
+            text = diff_html(d)
+        else:
+            text = "\n".join(diff_text(d))
     except DiffInputError as exc:
         _fail("diff", exc)
     except Exception as exc:  # noqa: BLE001 - a last line of defence: no traceback
         _fail("diff", RuntimeError(f"internal error: {type(exc).__name__}: {exc}"))
-    if fmt == "json":
-        _write(json.dumps(d.as_json(), indent=2, ensure_ascii=False), output)
-    elif fmt == "html":
-        _write(diff_html(d), output)
-    else:
-        _write("\n".join(diff_text(d)), output)
+    _write(text, output)
     # files not compared (syntax errors): "no change" cannot be said
     sys.exit(1 if d.changed else 2 if d.not_compared else 0)
 
@@ -88,6 +89,7 @@ def load_map(path: str):
     from krl.archive import ArchiveError, backup_source  # noqa: PLC0415
     from krl.limits import PARSE_TIMEOUT_S  # noqa: PLC0415
     from krl.programmap import build_map  # noqa: PLC0415
+    from krl.project import folder_groups  # noqa: PLC0415
     from krl.workspace import workspaces_for  # noqa: PLC0415
 
     p = Path(path)
@@ -95,9 +97,13 @@ def load_map(path: str):
         raise ValueError(f"{path}:1:1: error[E001]: no such file or folder")
     try:
         with backup_source(p) as (folder, shown):
-            wss = workspaces_for(folder if shown.archive else p, timeout=PARSE_TIMEOUT_S)
-            if len(wss) != 1:
-                raise ValueError(f"{path} holds {len(wss)} programs (KRC backups or folders); name one of them")
+            target = folder if shown.archive else p
+            groups = folder_groups(target) if target.is_dir() else None
+            if groups is not None and len(groups) > 1:
+                names = ", ".join(printable(shown(root)) for root, _ in groups)
+                raise ValueError(f"{path} holds {len(groups)} programs (KRC backups or folders): {names}; "
+                                 "name one of them")
+            wss = workspaces_for(target, timeout=PARSE_TIMEOUT_S, groups=groups)
             ws = wss[0]
             pm = build_map(ws)
             diags = [shown.diagnostic(d) for d in ws.diagnostics]
@@ -114,11 +120,14 @@ def load_map(path: str):
 @click.command()
 @click.argument("backup")
 @click.option("--format", "fmt", type=click.Choice(["dot", "svg", "html", "json"]), default="dot", show_default=True,
-              help="dot: Graphviz source; svg: drawn by Graphviz's dot; html: one page; json: nodes and edges.")
+              help="dot: Graphviz source; svg: drawn by Graphviz's dot; html: an interactive page; json: nodes and edges.")
+@click.option("--links", type=click.Choice(["file", "vscode", "none"]), default="file", show_default=True,
+              help="html: how a routine links to its file:line (file: URL, vscode: URL, or no link).")
 @click.option("-o", "--output", default=None, help="Write to this file instead of standard output.")
-def graph(backup: str, fmt: str, output: str | None) -> None:
+def graph(backup: str, fmt: str, links: str, output: str | None) -> None:
     """The program map of a KRC backup (folder or .zip) or a folder: routines, calls,
-    interrupts, triggers, RUN commands and EKI channels, entry points and dead routines."""
+    interrupts, triggers, RUN commands and EKI channels, entry points and unreachable routines.
+    html: an interactive page (zoom, pan, search, a routine's neighbourhood), offline."""
     from krl.programmap.render import GraphTooLarge, GraphvizMissing, to_dot, to_html, to_svg  # noqa: PLC0415
 
     try:
@@ -128,7 +137,7 @@ def graph(backup: str, fmt: str, output: str | None) -> None:
         elif fmt == "svg":
             text = to_svg(pm)
         elif fmt == "html":
-            text = to_html(pm)
+            text = to_html(pm, links)
         else:
             text = to_dot(pm)
     except (ValueError, GraphTooLarge, GraphvizMissing) as exc:

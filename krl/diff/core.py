@@ -1,25 +1,34 @@
-"""The semantic diff of two loaded sides (krl/diff/load.py), on the AST.
+"""The semantic diff of two loaded sides (krl/diff/load.py), on the AST and the checker's types.
 
-:func:`diff_sides` returns a :class:`Diff` whose lists are, in the order of the report:
+:func:`diff_sides` returns a :class:`Diff` whose lists are, in the order of the report
+(:data:`KINDS`; docs/diff.md has the JSON of each entry):
 
-* ``points`` -- every E6POS, E6AXIS, POS, AXIS and FRAME a data list declares with a value
-  (reference 3.7), matched by file and name: ``delta`` maps a component to new minus old (X Y Z
-  in mm; A B C in degrees, wrapped into -180..180; A1..A6 and E1..E6 in degrees or mm), only the
-  components that moved more than the tolerance; ``status_turn_changed`` when S or T differ;
-* ``frames`` -- TOOL_DATA, BASE_DATA, LOAD_DATA of ``$config.dat`` and the values of
-  ``$machine.dat`` (numbers as deltas, other values as ``[old, new]``);
+* ``points`` -- every point (E6POS, E6AXIS, POS, AXIS, FRAME, E3POS, E3AXIS) a data list gives
+  a value, matched by file and name: ``delta`` maps a component to new minus old (X Y Z in mm;
+  A B C in degrees, wrapped into -180..180; A1..A6 and E1..E6 in degrees or mm), only the
+  components that moved; ``status_turn`` when S or T differ; an added or removed point has its
+  ``coordinates``;
+* ``frames`` -- TOOL_DATA, BASE_DATA and LOAD_DATA of ``$config.dat``, as points;
+* ``values`` -- every other value of every data list (``.dat`` files, ``$config.dat``,
+  ``$machine.dat``, the other system data lists): scalars, array elements and STRUC
+  components, compared with their types (krl/diff/values.py: REAL as 32-bit floats or within
+  the tolerance, ENUM by name, STRING exactly);
 * ``routines`` -- added, removed, or changed; a routine changes when its case-folded AST
   differs (krl.ast.compare.structure with ``fold_case``: formatting, letter case, comments and
   fold lines are not in the AST), with the statement lines before and after, and, apart, the
   count of comment and fold lines edited;
 * ``declarations`` -- variables, constants, types (STRUC, ENUM), SIGNAL names and EXT
-  declarations added, removed or retyped, per data list or routine;
-* ``motions`` -- inline-form motions (the ``PDAT_ACT``/``LDAT_ACT``/``FDAT_ACT`` and ``BAS``
-  lines before a motion, KUKA's inline forms) whose velocity, approximation, tool, base or
-  motion data changed.
+  declarations added, removed or retyped, per data list or routine, shown as KRL;
+* ``motions`` -- the parameters of each motion of a routine present on both sides: KUKA's
+  inline forms (``PDAT_ACT``/``LDAT_ACT``/``FDAT_ACT`` and ``BAS`` lines before a motion), the
+  ``WITH`` parameters of the KSS 8 motions (SPTP, SLIN, SCIRC, SPL, spline blocks) and every
+  component of the motion data sets (PDAT, LDAT, FDAT records) they name.
 
-``comment_edits`` and ``fold_edits`` count the comment and fold lines edited in all routines
-present on both sides (they are never a change). Each list is cut at krl.limits.MAX_DIFF_ENTRIES.
+A name defined twice (the checker's E102) is compared by its first definition, the one the
+checker keeps; the checker's E102 diagnostics of the compared files are listed in
+``duplicates``. Names are shown as written (the NEW side's spelling). ``comment_edits`` and
+``fold_edits`` count the comment and fold lines edited in all routines present on both sides
+(they are never a change). Each list is cut at krl.limits.MAX_DIFF_ENTRIES.
 """
 
 from __future__ import annotations
@@ -29,12 +38,19 @@ import math
 from dataclasses import dataclass, field
 
 from krl.ast import nodes as N
+from krl.ast import printer
 from krl.ast.compare import structure
 from krl.diff.load import Side
-from krl.diff.values import CARTESIAN, POINT_TYPES, data_items, flatten, number
+from krl.diff.values import CARTESIAN, POINT_TYPES, DataValue, Leaf, data_values, number, real32, same
 from krl.limits import MAX_DIFF_ENTRIES, MAX_DIFF_LINES
 
-__all__ = ["Diff", "diff_sides"]
+__all__ = ["Diff", "KINDS", "KIND_TITLES", "diff_sides"]
+
+# the kinds of change compared, in the order of the report, with the title each is shown under
+KINDS = ("points", "frames", "values", "routines", "declarations", "motions")
+KIND_TITLES = {"points": "Points", "frames": "Frames and loads", "values": "Data values",
+               "routines": "Routines", "declarations": "Declarations and signals",
+               "motions": "Motion parameters"}
 
 FRAME_ARRAYS = ("TOOL_DATA", "BASE_DATA", "LOAD_DATA")
 _MOTION_DATA = ("PDAT_ACT", "LDAT_ACT", "FDAT_ACT")
@@ -48,31 +64,42 @@ class Diff:
     new: str
     points: list[dict] = field(default_factory=list)
     frames: list[dict] = field(default_factory=list)
+    values: list[dict] = field(default_factory=list)
     routines: list[dict] = field(default_factory=list)
     declarations: list[dict] = field(default_factory=list)
     motions: list[dict] = field(default_factory=list)
+    duplicates: list[dict] = field(default_factory=list)
     comment_edits: int = 0
     fold_edits: int = 0
+    files_compared: int = 0
     not_compared: list[str] = field(default_factory=list)
     left_out: int = 0
 
     @property
     def changed(self) -> bool:
-        return bool(self.points or self.frames or self.routines or self.declarations or self.motions)
+        return any(getattr(self, k) for k in KINDS)
+
+    def summary(self) -> dict[str, int]:
+        """{kind: number of changes} for every kind compared (zeros included)."""
+        return {k: len(getattr(self, k)) for k in KINDS}
 
     def as_json(self) -> dict:
         """The JSON object of ``krl diff --format json`` (docs/diff.md)."""
-        return {"old": self.old, "new": self.new, "changed": self.changed,
-                "points": self.points, "frames": self.frames, "routines": self.routines,
-                "declarations": self.declarations, "motions": self.motions,
-                "comment_edits": self.comment_edits, "fold_edits": self.fold_edits,
-                "not_compared": self.not_compared, "left_out": self.left_out}
+        out: dict = {"old": self.old, "new": self.new, "changed": self.changed,
+                     "summary": {**self.summary(), "files_compared": self.files_compared,
+                                 "not_compared": len(self.not_compared)}}
+        for k in KINDS:
+            out[k] = getattr(self, k)
+        out.update({"duplicates": self.duplicates, "comment_edits": self.comment_edits,
+                    "fold_edits": self.fold_edits, "not_compared": self.not_compared,
+                    "left_out": self.left_out})
+        return out
 
 
 def diff_sides(old: Side, new: Side, tolerance: float = 0.0) -> Diff:
-    """Compare two loaded sides; `tolerance` (mm or deg) hides smaller deltas. A file that did
-    not parse on either side is unchanged when its text is the same on both, else listed in
-    ``not_compared`` (its errors are the sides')."""
+    """Compare two loaded sides; `tolerance` (mm, deg, or the REAL value's unit) hides smaller
+    differences of REAL values. A file that did not parse on either side is unchanged when
+    its text is the same on both, else listed in ``not_compared`` (its errors are the sides')."""
     d = Diff(old.path, new.path)
     keys = sorted(set(old.files) | set(new.files))
     ok_keys = []
@@ -84,7 +111,9 @@ def diff_sides(old: Side, new: Side, tolerance: float = 0.0) -> Diff:
             d.not_compared.append(new.shown(k) if fn is not None else old.shown(k))
         else:
             ok_keys.append(k)
-    records_old, records_new = _records(old), _records(new)
+    d.files_compared = len(ok_keys)
+    values_old, values_new = _all_values(old), _all_values(new)
+    records_old, records_new = _records(old, values_old), _records(new, values_new)
     for k in ok_keys:
         mo = old.files[k].module if k in old.files else None
         mn = new.files[k].module if k in new.files else None
@@ -92,10 +121,11 @@ def diff_sides(old: Side, new: Side, tolerance: float = 0.0) -> Diff:
         dlo = mo.data if mo is not None else None
         dln = mn.data if mn is not None else None
         if dlo is not None or dln is not None:
-            _data(d, show, dlo, dln, tolerance)
-            _declarations(d, show, "", dlo.items if dlo else [], dln.items if dln else [])
-        ro = {r.name.upper(): r for r in (mo.routines if mo is not None else [])}
-        rn = {r.name.upper(): r for r in (mn.routines if mn is not None else [])}
+            system = (dln or dlo).name.upper()
+            _data(d, show, system, _first(values_old.get(k, [])), _first(values_new.get(k, [])), tolerance)
+            _declarations(d, show, "", dlo.items if dlo else [], dln.items if dln else [], new, k)
+        ro = _routines(mo)
+        rn = _routines(mn)
         module = _module_name(mn or mo, show)
         for name in sorted(set(ro) | set(rn), key=lambda n: _order(n, ro, rn)):
             a, b = ro.get(name), rn.get(name)
@@ -107,15 +137,33 @@ def diff_sides(old: Side, new: Side, tolerance: float = 0.0) -> Diff:
                                    "comment_edits": 0, "fold_edits": 0})
                 continue
             _routine(d, old, new, show, module, a, b)
-            _declarations(d, show, b.name, a.decls, b.decls)
-            _motions(d, show, a, b, records_old.get(_module_key(k), {}), records_new.get(_module_key(k), {}),
-                     records_old.get("*", {}), records_new.get("*", {}))
-    for name in ("points", "frames", "routines", "declarations", "motions"):
+            _declarations(d, show, b.name, a.decls, b.decls, new, k)
+            mk = _module_key(k)
+            _motions(d, show, a, b, (records_old.get(mk, {}), records_old["*"]),
+                     (records_new.get(mk, {}), records_new["*"]), tolerance)
+    _duplicates(d, old, new, set(ok_keys))
+    for name in (*KINDS, "duplicates"):
         items = getattr(d, name)
         if len(items) > MAX_DIFF_ENTRIES:
             d.left_out += len(items) - MAX_DIFF_ENTRIES
             del items[MAX_DIFF_ENTRIES:]
     return d
+
+
+def _routines(m: N.Module | None) -> dict[str, N.Routine]:
+    """{NAME: routine}; of a name defined twice, the first (the checker's E102 is on the second)."""
+    out: dict[str, N.Routine] = {}
+    for r in (m.routines if m is not None else []):
+        out.setdefault(r.name.upper(), r)
+    return out
+
+
+def _first(values: list[DataValue]) -> dict[str, DataValue]:
+    """{NAME: value}; of a name given twice, the first (as the checker keeps it)."""
+    out: dict[str, DataValue] = {}
+    for v in values:
+        out.setdefault(v.name.upper().replace(" ", ""), v)
+    return out
 
 
 def _order(name: str, ro: dict, rn: dict) -> tuple:
@@ -128,66 +176,122 @@ def _module_name(m: N.Module, show: str) -> str:
     return stem.rsplit(".", 1)[0] if "." in stem else (m.name if m is not None else stem)
 
 
-# ---------------------------------------------------------------------- points and frames
+# ---------------------------------------------------------------------- data-list values
 
-def _data(d: Diff, show: str, dlo: N.DataList | None, dln: N.DataList | None, tol: float) -> None:
-    name = (dln or dlo).name.upper()
-    io = {n: (t, v) for n, t, v, _ in data_items(dlo)} if dlo is not None else {}
-    inn = {n: (t, v) for n, t, v, _ in data_items(dln)} if dln is not None else {}
-    for key in [k for k in inn if k not in io] + [k for k in io if k not in inn] + [k for k in inn if k in io]:
-        typ = (inn.get(key) or io.get(key))[0]
-        base = key.split("[", 1)[0]
-        if name == "$CONFIG" and base in FRAME_ARRAYS:
-            kind = base
-        elif name == "$MACHINE":
-            kind = "machine"
-        elif typ in POINT_TYPES:
-            kind = None
+def _section(system: str, value: DataValue) -> str:
+    base = value.name.split("[", 1)[0].upper()
+    if system == "$CONFIG" and base in FRAME_ARRAYS:
+        return "frames"
+    if value.type.upper() in POINT_TYPES:
+        return "points"
+    return "values"
+
+
+def json_value(leaf: Leaf):
+    """A leaf in JSON: a number for INT and REAL (and a CHAR given as a number), true/false for
+    BOOL, else its KRL text."""
+    if leaf.kind in ("INT", "REAL", "CHAR") and _is_num(leaf.value):
+        return leaf.value
+    if leaf.kind == "BOOL":
+        return leaf.value
+    return leaf.text
+
+
+def _coordinates(v: DataValue) -> dict:
+    return {leaf.path or "value": json_value(leaf) for leaf in v.leaves.values()}
+
+
+def _data(d: Diff, show: str, system: str, io: dict[str, DataValue], inn: dict[str, DataValue],
+          tol: float) -> None:
+    order = [k for k in inn if k not in io] + [k for k in io if k not in inn] + [k for k in inn if k in io]
+    for key in order:
+        a, b = io.get(key), inn.get(key)
+        v = b or a
+        section = _section(system, v)
+        if a is None or b is None:
+            change = "added" if a is None else "removed"
+            if section == "values":
+                shown = json_value(v.leaves[""]) if list(v.leaves) == [""] else v.text
+                d.values.append({"file": show, "name": v.name, "type": v.type,
+                                 "kind": _whole_kind(v), "change": change,
+                                 "old": None if a is None else shown, "new": None if b is None else shown,
+                                 "line": v.line})
+            else:
+                entry = {"file": show, "name": v.name, "kind": _point_kind(section, v), "change": change,
+                         "delta": {}, "coordinates": _coordinates(v)}
+                if section == "points":
+                    entry["status_turn_changed"] = False
+                getattr(d, section).append(entry)
+            continue
+        if section == "values":
+            _value_changes(d, show, a, b, tol)
         else:
-            continue
-        if key not in io or key not in inn:
-            entry = {"file": show, "name": key, "kind": kind or typ, "change": "added" if key in inn else "removed",
-                     "delta": {}}
-            if kind is None:
-                entry["status_turn_changed"] = False
-            (d.frames if kind else d.points).append(entry)
-            continue
-        a, b = flatten(io[key][1]), flatten(inn[key][1])
-        delta, other = _delta(a, b, typ in CARTESIAN, tol)
-        if kind is None:
-            st = {c: [a.get(c), b.get(c)] for c in ("S", "T") if a.get(c) != b.get(c)}
-            other = {c: v for c, v in other.items() if c not in ("S", "T")}
-            delta = {c: v for c, v in delta.items() if c not in ("S", "T")}
-            if delta or st or other:
-                entry = {"file": show, "name": key, "kind": typ, "change": "changed", "delta": delta,
-                         "status_turn_changed": bool(st)}
-                if st:
-                    entry["status_turn"] = st
-                if other:
-                    entry["values"] = other
-                d.points.append(entry)
-        elif delta or other:
-            entry = {"file": show, "name": key, "kind": kind, "change": "changed", "delta": delta}
-            if other:
-                entry["values"] = other
-            d.frames.append(entry)
+            _point_change(d, show, section, a, b, tol)
 
 
-def _delta(a: dict, b: dict, cartesian: bool, tol: float) -> tuple[dict, dict]:
-    """({component: new - old} beyond `tol`, {component: [old, new]} for the other changes)."""
-    delta, other = {}, {}
-    for c in sorted(set(a) | set(b)):
-        x, y = a.get(c), b.get(c)
-        if _is_num(x) and _is_num(y):
-            diff = y - x
-            if cartesian and c in ("A", "B", "C"):
+def _whole_kind(v: DataValue) -> str:
+    if list(v.leaves) == [""]:
+        return v.leaves[""].kind
+    return "record"
+
+
+def _point_kind(section: str, v: DataValue) -> str:
+    if section == "frames":
+        return v.name.split("[", 1)[0].upper()
+    return v.type.upper()
+
+
+def _value_changes(d: Diff, show: str, a: DataValue, b: DataValue, tol: float) -> None:
+    for path in [p for p in b.leaves if p not in a.leaves] + [p for p in a.leaves if p not in b.leaves] \
+            + [p for p in b.leaves if p in a.leaves]:
+        x, y = a.leaves.get(path), b.leaves.get(path)
+        if x is not None and y is not None and same(x, y, tol):
+            continue
+        leaf = y or x
+        name = b.name + (f".{leaf.path}" if leaf.path else "")
+        entry = {"file": show, "name": name, "type": leaf.type, "kind": leaf.kind,
+                 "change": "added" if x is None else "removed" if y is None else "changed",
+                 "old": json_value(x) if x is not None else None,
+                 "new": json_value(y) if y is not None else None,
+                 "line": (y or x).line}
+        if x is not None and y is not None and _is_num(x.value) and _is_num(y.value):
+            entry["delta"] = round(y.value - x.value, 9)
+        d.values.append(entry)
+
+
+def _point_change(d: Diff, show: str, section: str, a: DataValue, b: DataValue, tol: float) -> None:
+    cartesian = section == "frames" or b.type.upper() in CARTESIAN
+    delta, other, st = {}, {}, {}
+    for path in list(b.leaves) + [p for p in a.leaves if p not in b.leaves]:
+        x, y = a.leaves.get(path), b.leaves.get(path)
+        comp = (y or x).path or "value"
+        if x is not None and y is not None and _is_num(x.value) and _is_num(y.value) \
+                and comp.upper() not in ("S", "T"):
+            diff = y.value - x.value
+            if cartesian and comp.upper() in ("A", "B", "C"):
+                # an angle modulo 360 degrees: C -180 -> 179 is -1
                 diff = math.remainder(diff, 360.0)
-            diff = round(diff, 6)
-            if abs(diff) > tol and diff != 0:
-                delta[c or "value"] = diff
-        elif x != y:
-            other[c or "value"] = [x, y]
-    return delta, other
+                if abs(diff) <= tol or real32(x.value) == real32(x.value + diff):
+                    continue
+            elif same(x, y, tol):
+                continue
+            delta[comp] = float(f"{diff:.9g}")
+        elif x is not None and y is not None and same(x, y, 0.0):
+            continue
+        elif comp.upper() in ("S", "T") and section == "points":
+            st[comp] = [json_value(x) if x else None, json_value(y) if y else None]
+        else:
+            other[comp] = [json_value(x) if x else None, json_value(y) if y else None]
+    if not (delta or other or st):
+        return
+    entry = {"file": show, "name": b.name, "kind": _point_kind(section, b), "change": "changed", "delta": delta}
+    if section == "points":
+        entry["status_turn_changed"] = bool(st)
+        if st:
+            entry["status_turn"] = st
+    if other:
+        entry["values"] = other
+    getattr(d, section).append(entry)
 
 
 def _is_num(v) -> bool:
@@ -196,52 +300,54 @@ def _is_num(v) -> bool:
 
 # ---------------------------------------------------------------------- declarations
 
-def _declared(items: list) -> dict[str, tuple[str, str, object]]:
-    out: dict[str, tuple[str, str, object]] = {}
+def _type_text(d: N.VarDecl, v: N.VarName) -> str:
+    t = d.type.name + (f"[{d.type.size or ''}]" if d.type.size is not None else "")
+    return t + (f"[{','.join(str(x) for x in v.dims)}]" if v.dims else "")
+
+
+def _declared(items: list) -> dict[str, tuple[str, object, str, N.Node, str]]:
+    """{NAME: (kind, compared key, KRL text, node, name as written)}; the first of a name
+    given twice."""
+    out: dict[str, tuple[str, object, str, N.Node, str]] = {}
     for d in items:
         if isinstance(d, N.DeclStmt):
             d = d.decl
         if isinstance(d, N.VarDecl):
-            t = d.type.name.upper() + (f"[{d.type.size or ''}]" if d.type.size is not None else "")
             for v in d.names:
-                dims = f"[{','.join(str(x) for x in v.dims)}]" if v.dims else ""
-                out[v.name.upper()] = ("constant" if d.is_const else "variable", t + dims, d)
-        elif isinstance(d, N.StrucDecl):
-            comps = ", ".join(f"{c.type_name.upper()} {c.name.upper()}"
-                              + (f"[{','.join(map(str, c.dims))}]" if c.dims else "") for c in d.components)
-            out[d.name.upper()] = ("type", f"STRUC {comps}", d)
-        elif isinstance(d, N.EnumDecl):
-            out[d.name.upper()] = ("type", "ENUM " + ", ".join(v.upper() for v in d.values), d)
-        elif isinstance(d, N.SignalDecl):
-            wire = "FALSE" if d.start is None else f"{d.start.sysvar.upper()}[{d.start.index}]"
-            if d.end is not None:
-                wire += f" TO {d.end.sysvar.upper()}[{d.end.index}]"
-            out[d.name.upper()] = ("signal", wire, d)
-        elif isinstance(d, N.ExtDecl):
-            out[d.name.upper()] = ("external", repr(structure(d, fold_case=True)), d)
+                text = _type_text(d, v)
+                out.setdefault(v.name.upper(), ("constant" if d.is_const else "variable", text.upper(), text, d,
+                                                v.name))
+        elif isinstance(d, (N.StrucDecl, N.EnumDecl, N.SignalDecl, N.ExtDecl)):
+            kind = {N.StrucDecl: "type", N.EnumDecl: "type", N.SignalDecl: "signal", N.ExtDecl: "external"}[type(d)]
+            text = printer.decl(d)
+            if isinstance(d, N.SignalDecl):
+                text = text.split(" ", 2)[-1] if not d.is_global else text.split(" ", 3)[-1]
+            key = structure(d, fold_case=True) if not isinstance(d, N.SignalDecl) else text.upper()
+            out.setdefault(d.name.upper(), (kind, key, text, d, d.name))
     return out
 
 
-def _declarations(d: Diff, show: str, scope: str, old_items: list, new_items: list) -> None:
+def _declarations(d: Diff, show: str, scope: str, old_items: list, new_items: list, new: Side, k: str) -> None:
     a, b = _declared(old_items), _declared(new_items)
     for name in [n for n in b if n not in a] + [n for n in a if n not in b] + [n for n in b if n in a]:
         x, y = a.get(name), b.get(name)
-        if x is not None and y is not None and x[:2] == y[:2]:
+        if x is not None and y is not None and (x[0], x[1]) == (y[0], y[1]):
             continue
         change = "added" if x is None else "removed" if y is None else "retyped"
-        node = (y or x)[2]
-        d.declarations.append({"file": show, "scope": scope, "name": node_name(node, name),
+        node = (y or x)[3]
+        d.declarations.append({"file": show, "scope": scope, "name": (y or x)[4],
                                "kind": (y or x)[0], "change": change,
-                               "before": x[1] if x else None, "after": y[1] if y else None,
+                               "before": x[2] if x else None, "after": y[2] if y else None,
                                "line": node.span.line})
 
 
-def node_name(node, key: str) -> str:
-    if isinstance(node, N.VarDecl):
-        for v in node.names:
-            if v.name.upper() == key:
-                return v.name
-    return getattr(node, "name", key)
+def _duplicates(d: Diff, old: Side, new: Side, keys: set[str]) -> None:
+    """The checker's E102 diagnostics in the compared files, of each side."""
+    for name, s in (("old", old), ("new", new)):
+        for diag, key in s.duplicates:
+            if key in keys:
+                d.duplicates.append({"side": name, "file": s.rel(key), "line": diag.line,
+                                     "code": diag.code, "message": s.relative(diag.message)})
 
 
 # ---------------------------------------------------------------------- routines
@@ -322,20 +428,27 @@ def _routine(d: Diff, old: Side, new: Side, show: str, module: str, a: N.Routine
                        "comment_edits": comment_edits, "fold_edits": fold_edits})
 
 
-# ---------------------------------------------------------------------- inline-form motions
+# ---------------------------------------------------------------------- motion parameters
 
-def _records(s: Side) -> dict[str, dict[str, dict]]:
-    """{file key: {NAME: flattened value}} of every data list; key "*" holds the system data
-    lists' and $config.dat's (the global motion data such as PDEFAULT)."""
-    out: dict[str, dict[str, dict]] = {"*": {}}
-    for k, f in s.files.items():
-        dl = f.module.data
-        if dl is None or not f.ok:
-            continue
+def _all_values(s: Side) -> dict[str, list[DataValue]]:
+    """{file key: the values of its data list} of the files that parsed."""
+    return {k: data_values(f.module.data, s.lines(k)) for k, f in s.files.items()
+            if f.ok and f.module.data is not None}
+
+
+def _records(s: Side, values: dict[str, list[DataValue]]) -> dict[str, dict[str, DataValue]]:
+    """{module key: {NAME: value}} of every data list's values; key "*" holds those of the
+    system data lists ($config.dat's PDEFAULT and the like) and the GLOBAL ones."""
+    out: dict[str, dict[str, DataValue]] = {"*": {}}
+    for k, vals in values.items():
+        dl = s.files[k].module.data
         own = out.setdefault(_module_key(k), {})
-        glob = dl.name.startswith("$")
-        for name, _t, v, _n in data_items(dl):
-            (out["*"] if glob else own)[name] = flatten(v)
+        system = dl.name.startswith("$")
+        for v in vals:
+            glob = system or (isinstance(v.node, N.VarDecl) and v.node.is_global)
+            (out["*"] if glob else own).setdefault(v.name.upper(), v)
+            if glob and not system:
+                own.setdefault(v.name.upper(), v)
     return out
 
 
@@ -343,26 +456,67 @@ def _module_key(k: str) -> str:
     return k.rsplit(".", 1)[0]
 
 
-def _inline_motions(r: N.Routine) -> list[tuple[tuple, int, dict]]:
-    """((target, occurrence), line, {param: value}) of the routine's inline-form motions."""
+def _text_leaf(e: N.Expr) -> Leaf:
+    n = number(e)
+    if n is not None:
+        kind = "REAL" if isinstance(n, float) else "INT"
+        return Leaf("", kind, kind, n, n, printer.expr(e), e.span.line)
+    text = printer.expr(e)
+    return Leaf("", "expression", "", text, structure(e, fold_case=True), text, e.span.line)
+
+
+def _names(e: N.Expr) -> list[str]:
+    return [n.name for n in e.walk() if isinstance(n, N.Name)]
+
+
+def _set_record(params: dict[str, Leaf], prefix: str, rec: DataValue | None) -> None:
+    for leaf in (rec.leaves.values() if rec is not None else ()):
+        params[f"{prefix}.{leaf.path}" if leaf.path else prefix] = leaf
+
+
+def _motion_list(r: N.Routine, records: tuple[dict, dict]) -> list[tuple[tuple, int, dict[str, Leaf]]]:
+    """((kind, target, occurrence), line, {parameter: Leaf}) of each motion and spline block
+    of the routine that has parameters: an inline form's (the ``*DAT_ACT`` and ``BAS`` lines
+    before it), its WITH parameters, and the components of the data sets they name."""
+    local, glob = records
     out, seen = [], {}
     work: list = [list(r.body)]
     while work:
-        ctx: dict[str, object] = {}
+        ctx: dict[str, Leaf] = {}
         for s in work.pop():
             if isinstance(s, N.Assign) and isinstance(s.target, N.Name) and s.target.name.upper() in _MOTION_DATA:
                 if isinstance(s.value, N.Name):
-                    ctx[s.target.name.upper()] = s.value.name.upper()
-            elif isinstance(s, N.CallStmt) and s.call.name.upper() == "BAS" and len(s.call.args) == 2:
-                v = s.call.args[1]
-                ctx["BAS"] = number(v) if number(v) is not None else flatten(v).get("")
-            elif isinstance(s, N.Motion):
-                if ctx:
-                    target = flatten(s.target).get("") if not isinstance(s.target, N.Aggregate) else "{...}"
-                    n = seen.get(target, 0)
-                    seen[target] = n + 1
-                    ctx["approximation"] = " ".join(a.upper() for a in s.approx)
-                    out.append(((s.kind.upper(), target, n), s.span.line, ctx))
+                    var = s.target.name.upper().split("_")[0]
+                    ctx[var] = _text_leaf(s.value)
+                    rec = local.get(s.value.name.upper()) or glob.get(s.value.name.upper())
+                    for leaf in (rec.leaves.values() if rec is not None else ()):
+                        ctx[_MOTION_PARAMS.get(leaf.path.upper(), f"{var}.{leaf.path}")] = leaf
+            elif isinstance(s, N.CallStmt) and s.call.name.upper() == "BAS" and len(s.call.args) == 2 \
+                    and s.call.args[1] is not None:
+                ctx["velocity"] = _text_leaf(s.call.args[1])
+            elif isinstance(s, (N.Motion, N.SplineBlock)):
+                params = dict(ctx)
+                if isinstance(s, N.Motion):
+                    params["approximation"] = Leaf("", "expression", "", " ".join(s.approx),
+                                                   " ".join(a.upper() for a in s.approx), " ".join(s.approx), s.span.line)
+                    target = printer.expr(s.target)
+                else:
+                    if s.approx:
+                        params["approximation"] = Leaf("", "expression", "", s.approx, s.approx.upper(), s.approx,
+                                                       s.span.line)
+                    target = ""
+                for w in s.with_:
+                    params[f"WITH {printer.expr(w.target)}"] = _text_leaf(w.value)
+                    for name in _names(w.value):
+                        rec = local.get(name.upper()) or glob.get(name.upper())
+                        if rec is not None and len(rec.leaves) > 1:
+                            _set_record(params, rec.name, rec)
+                if isinstance(s, N.SplineBlock):
+                    work.append(s.body)
+                if ctx or s.with_ or isinstance(s, N.SplineBlock):
+                    key = (s.kind.upper(), target.upper(), seen.get((s.kind.upper(), target.upper()), 0))
+                    seen[key[:2]] = key[2] + 1
+                    out.append(((key, target), s.span.line, params))
                 ctx = {}
             else:
                 for name in s.__dataclass_fields__:
@@ -374,28 +528,18 @@ def _inline_motions(r: N.Routine) -> list[tuple[tuple, int, dict]]:
     return out
 
 
-def _params(ctx: dict, local: dict, glob: dict) -> dict[str, object]:
-    out: dict[str, object] = {"approximation": ctx.get("approximation", "")}
-    if "BAS" in ctx:
-        out["velocity"] = ctx["BAS"]
-    for var in _MOTION_DATA:
-        name = ctx.get(var)
-        if name is None:
+def _motions(d: Diff, show: str, a: N.Routine, b: N.Routine, ro: tuple, rn: tuple, tol: float) -> None:
+    ma = {key: params for (key, _t), _line, params in _motion_list(a, ro)}
+    for (key, target), line, pb in _motion_list(b, rn):
+        pa = ma.get(key)
+        if pa is None:
             continue
-        rec = local.get(name, glob.get(name))
-        out[var.split("_")[0]] = name
-        for comp, value in (rec or {}).items():
-            out[_MOTION_PARAMS.get(comp, f"{var.split('_')[0]}.{comp}")] = value
-    return out
-
-
-def _motions(d: Diff, show: str, a: N.Routine, b: N.Routine, lo: dict, ln: dict, go: dict, gn: dict) -> None:
-    ma = {key: (line, ctx) for key, line, ctx in _inline_motions(a)}
-    for key, line, ctx in _inline_motions(b):
-        if key not in ma:
-            continue
-        pa, pb = _params(ma[key][1], lo, go), _params(ctx, ln, gn)
-        changed = {p: [pa.get(p), pb.get(p)] for p in sorted(set(pa) | set(pb)) if pa.get(p) != pb.get(p)}
+        changed = {}
+        for p in list(pb) + [p for p in pa if p not in pb]:
+            x, y = pa.get(p), pb.get(p)
+            if x is not None and y is not None and same(x, y, tol):
+                continue
+            changed[p] = [json_value(x) if x is not None else None, json_value(y) if y is not None else None]
         if changed:
-            d.motions.append({"file": show, "routine": b.name, "motion": key[0], "point": key[1],
+            d.motions.append({"file": show, "routine": b.name, "motion": key[0], "point": target,
                               "line": line, "changed": changed})

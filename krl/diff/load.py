@@ -3,7 +3,12 @@
 limits and the same messages).
 
 ``with side(path) as s``: ``s.files`` maps a file's key (its path relative to the backup root,
-``/``-separated, lower-case; for a single file, ``""``) to its :class:`krl.workspace.SourceFile`;
+``/``-separated, lower-case, so a file renamed only in letter case is the same file, as on the
+controller; for a single file, ``""``) to its :class:`krl.workspace.SourceFile`. The workspace
+is checked (krl/semantics): the diff reads the declared types from the checker's annotations,
+and ``s.duplicates`` holds the checker's E102 diagnostics (a name defined twice) with their
+file keys. Of two files whose paths differ only in letter case (impossible on the
+controller), the first in walk order is compared and the other is an E102 there too;
 ``s.shown(key)`` is how the user names it (``backup.zip/R1/Program/a.src``); ``s.errors`` the
 input and syntax errors (:class:`krl.diagnostics.Diagnostic`, paths as shown; ``s.sources`` the
 text of an archive's files that have errors, by shown path, for the caret lines). An extracted archive is removed
@@ -43,10 +48,12 @@ class Side:
     path: str
     root: Path
     workspace: Workspace
+    folder: Path | None = None
     files: dict[str, SourceFile] = field(default_factory=dict)
     errors: list[Diagnostic] = field(default_factory=list)
     shown_of: object = None
     sources: dict[str, str] = field(default_factory=dict)     # shown path -> text, for the errors
+    duplicates: list[tuple[Diagnostic, str]] = field(default_factory=list)
     _lines: dict[str, list[str]] = field(default_factory=dict)
 
     def shown(self, key: str) -> str:
@@ -55,26 +62,42 @@ class Side:
         return self.shown_of(f.path) if f is not None else key
 
     def rel(self, key: str) -> str:
-        """The file of `key` relative to the backup root, in its own letter case."""
+        """The file of `key` relative to the backup root (else to the folder given), in its own
+        letter case."""
         f = self.files.get(key)
         if f is None:
             return key
-        try:
-            return Path(f.path).relative_to(self.root).as_posix()
-        except ValueError:
-            return Path(f.path).name
+        for base in (self.root, self.folder):
+            try:
+                return Path(f.path).relative_to(base).as_posix()
+            except (ValueError, TypeError):
+                continue
+        return Path(f.path).name
 
     def text(self, key: str) -> str | None:
         """The decoded text of the file of `key` (krl.source.read_source), None if unreadable."""
         f = self.files.get(key)
         return read_source(f.path).text if f is not None else None
 
-    def line(self, path: str, number: int) -> str:
-        """Line `number` (1-based) of the file `path`, without its end ("" past the end)."""
+    def lines(self, key: str) -> list[str]:
+        """The text lines of the file of `key` ([] if unreadable)."""
+        f = self.files.get(key)
+        return self._file_lines(f.path) if f is not None else []
+
+    def _file_lines(self, path: str) -> list[str]:
         lines = self._lines.get(path)
         if lines is None:
             lines = self._lines[path] = (read_source(path).text or "").splitlines()
+        return lines
+
+    def line(self, path: str, number: int) -> str:
+        """Line `number` (1-based) of the file `path`, stripped ("" past the end)."""
+        lines = self._file_lines(path)
         return lines[number - 1].strip() if 0 < number <= len(lines) else ""
+
+    def relative(self, message: str) -> str:
+        """`message` with the backup root's path left out of the file names it holds."""
+        return message.replace(str(self.root) + "/", "")
 
 
 @contextmanager
@@ -93,12 +116,16 @@ def side(path: str | Path, single: bool | None = None) -> Iterator[Side]:
             else:
                 backups = find_backups(folder)
                 root = backups[0] if len(backups) == 1 else folder
-                ws = load_workspace([root], str(root), timeout=PARSE_TIMEOUT_S)
-            s = Side(str(path), root, ws, shown_of=shown)
+                ws = load_workspace([folder], str(root), timeout=PARSE_TIMEOUT_S)
+            s = Side(str(path), root, ws, folder=folder, shown_of=shown)
             for f in ws.files:
-                key = "" if is_file else _key(f.path, root)
-                s.files[key] = f
-            errors = [d for d in ws.sink.sorted() if d.is_error]
+                key = "" if is_file else _key(f.path, root, folder)
+                s.files.setdefault(key, f)
+            errors = [d for d in ws.sink.sorted() if d.is_error]      # input and syntax errors
+            ws.check_only = set()     # declarations only (names, types, E102): no routine body is checked
+            ws.check()
+            keys = {f.path: k for k, f in s.files.items()}
+            s.duplicates = [(d, keys[d.path]) for d in ws.sink.sorted() if d.code == "E102" and d.path in keys]
             for real in {d.path for d in errors} if shown.archive else ():
                 s.sources[shown(real)] = read_source(real).text or ""
             s.errors = [shown.diagnostic(d) for d in errors]
@@ -108,8 +135,11 @@ def side(path: str | Path, single: bool | None = None) -> Iterator[Side]:
                                         str(exc).removeprefix(f"{path}: "))) from None
 
 
-def _key(path: str, root: Path) -> str:
-    try:
-        return Path(path).relative_to(root).as_posix().lower()
-    except ValueError:
-        return Path(path).name.lower()
+def _key(path: str, root: Path, folder: Path) -> str:
+    """The file's path below the backup root, else below the folder given, lower-case."""
+    for base in (root, folder):
+        try:
+            return Path(path).relative_to(base).as_posix().lower()
+        except ValueError:
+            continue
+    return Path(path).name.lower()

@@ -9,7 +9,7 @@ from __future__ import annotations
 from markupsafe import Markup
 
 from krl.diff.core import Diff
-from krl.diff.text import format_delta
+from krl.diff.text import format_delta, html_helpers
 from krl.programmap.graph import ProgramMap
 from krl.programmap.render import context
 from krl.render import render_html
@@ -29,4 +29,4 @@ def report_html(backup: str, files: int, diagnostics: list, pm: ProgramMap, svg:
     return render_html("krl.diff", "report.html.j2", title=f"Change report: {backup}", backup=backup,
                        files=files, errors=errors, warnings=len(diagnostics) - errors,
                        diagnostics=diagnostics[:MAX_REPORT_DIAGNOSTICS], more=max(0, len(diagnostics) - MAX_REPORT_DIAGNOSTICS),
-                       map_section=map_section, diff=diff, format_delta=format_delta)
+                       map_section=map_section, diff=diff, format_delta=format_delta, **html_helpers())

@@ -7,11 +7,11 @@ environment (krl/render.py, template ``diff.html.j2``) in the HTML form.
 
 from __future__ import annotations
 
-from krl.diff.core import Diff
+from krl.diff.core import KIND_TITLES, KINDS, Diff
 from krl.render import render_html
 from krl.terminal import printable
 
-__all__ = ["diff_text", "diff_html", "format_delta"]
+__all__ = ["diff_text", "diff_html", "format_delta", "format_coordinates", "html_helpers", "krl_text", "summary_line"]
 
 _UNITS = {"X": "mm", "Y": "mm", "Z": "mm", "A": "deg", "B": "deg", "C": "deg"}
 
@@ -21,8 +21,35 @@ def format_delta(delta: dict) -> str:
     return ", ".join(f"Δ{c} {v:+g}" + (f" {_UNITS[c]}" if c in _UNITS else "") for c, v in delta.items())
 
 
+def krl_text(v: object) -> str:
+    """A JSON value of the diff as KRL shows it: numbers as numbers, TRUE/FALSE, "-" for none,
+    text (already KRL) as it is."""
+    if v is None:
+        return "-"
+    if isinstance(v, bool):
+        return "TRUE" if v else "FALSE"
+    if isinstance(v, float):
+        return f"{v:.9g}"
+    return str(v)
+
+
 def _values(values: dict) -> str:
-    return ", ".join(f"{c}: {a!r} -> {b!r}" for c, (a, b) in values.items())
+    return ", ".join(f"{c} {krl_text(a)} -> {krl_text(b)}" for c, (a, b) in values.items())
+
+
+def format_coordinates(coords: dict) -> str:
+    """``X 1070, Y -610, Z 500, ...`` (the components of an added or removed point)."""
+    return ", ".join(f"{c} {krl_text(v)}" for c, v in coords.items())
+
+
+def summary_line(d: Diff) -> str:
+    """Every kind compared with its count, then the edits that are not changes and the files
+    not compared."""
+    counts = ", ".join(f"{n} {KIND_TITLES[k].lower()}" for k, n in d.summary().items())
+    out = f"compared {d.files_compared} file(s): {counts}"
+    if d.not_compared:
+        out += f"; {len(d.not_compared)} file(s) not compared (syntax errors)"
+    return out + f"; {d.comment_edits} comment and {d.fold_edits} fold line(s) edited (not changes)"
 
 
 def diff_text(d: Diff) -> list[str]:
@@ -33,6 +60,8 @@ def diff_text(d: Diff) -> list[str]:
         out.append(f"Points ({len(d.points)}):")
         for e in d.points:
             what = e["change"] if e["change"] != "changed" else format_delta(e["delta"])
+            if e.get("coordinates"):
+                what += f" {{{format_coordinates(e['coordinates'])}}}"
             extra = [] if not e.get("status_turn") else [
                 "status/turn changed " + ", ".join(f"{c} {a}->{b}" for c, (a, b) in e["status_turn"].items())]
             if e.get("values"):
@@ -42,9 +71,22 @@ def diff_text(d: Diff) -> list[str]:
         out.append(f"Frames and loads ({len(d.frames)}):")
         for e in d.frames:
             what = e["change"] if e["change"] != "changed" else format_delta(e["delta"])
+            if e.get("coordinates"):
+                what += f" {{{format_coordinates(e['coordinates'])}}}"
             if e.get("values"):
                 what = "; ".join(x for x in (what, _values(e["values"])) if x)
             out.append(f"  {p(e['file'])} {p(e['name'])} ({e['kind']}): {p(what)}")
+    if d.values:
+        out.append(f"Data values ({len(d.values)}):")
+        for e in d.values:
+            typ = e["type"] or e["kind"]
+            if e["change"] == "changed":
+                what = f"{krl_text(e['old'])} -> {krl_text(e['new'])}"
+                if "delta" in e:
+                    what += f" ({e['delta']:+.9g})"
+            else:
+                what = f"{e['change']} {krl_text(e['new'] if e['change'] == 'added' else e['old'])}"
+            out.append(f"  {p(e['file'])}:{e['line']} {p(e['name'])} ({p(typ)}): {p(what)}")
     if d.routines:
         out.append(f"Routines ({len(d.routines)}):")
         for e in d.routines:
@@ -66,23 +108,30 @@ def diff_text(d: Diff) -> list[str]:
                     "retyped": f"retyped {p(e['before'])} -> {p(e['after'])}"}[e["change"]]
             out.append(f"  {where}: {e['kind']} {p(e['name'])} {what}")
     if d.motions:
-        out.append(f"Inline-form motions ({len(d.motions)}):")
+        out.append(f"Motion parameters ({len(d.motions)}):")
         for e in d.motions:
-            ch = ", ".join(f"{k} {p(repr(a))} -> {p(repr(b))}" for k, (a, b) in e["changed"].items())
-            out.append(f"  {p(e['file'])}:{e['line']} {p(e['routine'])}: {e['motion']} {p(e['point'])}: {ch}")
+            ch = ", ".join(f"{k} {krl_text(a)} -> {krl_text(b)}" for k, (a, b) in e["changed"].items())
+            out.append(f"  {p(e['file'])}:{e['line']} {p(e['routine'])}: {e['motion']} {p(e['point'])}: {p(ch)}")
+    if d.duplicates:
+        out.append(f"Duplicate definitions, compared by the first as krl check does ({len(d.duplicates)}):")
+        for e in d.duplicates:
+            out.append(f"  {e['side']} {p(e['file'])}:{e['line']}: {e['code']} {p(e['message'])}")
     for f in d.not_compared:
         out.append(f"not compared (syntax errors): {p(f)}")
     if d.left_out:
         out.append(f"... {d.left_out} more entries left out (limit MAX_DIFF_ENTRIES)")
-    summary = ("no change" + (" in the files compared" if d.not_compared else "")) if not d.changed else ", ".join(
-        f"{len(getattr(d, k))} {k}" for k in ("points", "frames", "routines", "declarations", "motions")
-        if getattr(d, k))
-    out.append(f"{p(d.old)} -> {p(d.new)}: {summary}; {d.comment_edits} comment and "
-               f"{d.fold_edits} fold line(s) edited (not changes)")
+    verdict = ("no change" + (" in the files compared" if d.not_compared else "")) if not d.changed else "changed"
+    out.append(f"{p(d.old)} -> {p(d.new)}: {verdict}; {summary_line(d)}")
     return out
+
+
+def html_helpers() -> dict:
+    """The template helpers of the diff section (shared with the change report)."""
+    return {"format_coordinates": format_coordinates, "krl_text": krl_text, "kinds": KINDS,
+            "kind_titles": KIND_TITLES, "summary_line": summary_line}
 
 
 def diff_html(d: Diff) -> str:
     """The report as one HTML page (template krl/diff/templates/diff.html.j2)."""
-    return render_html("krl.diff", "diff.html.j2", diff=d, format_delta=format_delta,
+    return render_html("krl.diff", "diff.html.j2", diff=d, format_delta=format_delta, **html_helpers(),
                        title=f"KRL backup diff: {d.old} -> {d.new}")

@@ -15,12 +15,28 @@ drawn. Edge kinds:
 * ``eki`` -- ``EKI_Init("name")``, ``EKI_Open("name")``... (KUKA.Ethernet KRL): to a channel
   node ``EKI name``.
 
-Entry points: the cell program (module ``CELL``), every submit interpreter (``.sub`` file:
-``sps.sub``), every program a system data list (``$config.dat``, ``$custom.dat``,
-``$option.dat``) names as ``"/R1/NAME()"`` (``$PRO_I_O``, ``$PRO_I_O_PROC_IDn``), the
-main routines of KUKA's own files (krl.workspace.is_kuka_file: the controller calls them),
-and, for a folder that is not a KRC backup (no ``$config.dat``), the main routine of every
-module. A routine that no entry point reaches along the edges is dead.
+Entry points (``Node.entry`` says why, ``Node.entry_kind`` which of these kinds; the first
+that applies is named):
+
+* ``cell`` -- the cell program (module ``CELL``, or a main routine ``DEF CELL()``), which
+  Automatic External starts;
+* ``plc`` -- the program numbers the cell program's ``SWITCH`` selects: every routine called
+  in one ``CASE`` branch (KUKA's cell.src: ``SWITCH PGNO ... CASE 1 ... EXAMPLE1()``); a
+  routine called in several branches is a step of the cell's own sequence
+  (``CellProgramStart()``), not a program;
+* ``submit`` -- every submit interpreter (``.sub`` file: ``sps.sub``);
+* ``selected`` -- every program a system data list (``$config.dat``, ``$custom.dat``,
+  ``$option.dat``) names as ``"/R1/NAME()"`` (``$PRO_I_O``, ``$PRO_I_O_PROC_IDn``);
+* ``operator`` -- the main routine of every module under ``R1/Program`` (krl.project
+  .program_folder): the programs an operator can select at the pendant, so a KR C2 backup
+  without cell.src has its user programs as entries;
+* ``interrupt`` -- every interrupt handler (the routine an ``INTERRUPT DECL`` calls): the
+  controller starts it when its condition fires;
+* ``system`` -- the main routines of KUKA's own files (krl.workspace.is_kuka_file: the
+  controller calls them);
+* ``module`` -- for a folder that is not a KRC backup, the main routine of every module.
+
+A routine that none of these reaches along the edges is *unreachable* (``Node.unreachable``).
 """
 
 from __future__ import annotations
@@ -29,7 +45,11 @@ import re
 from collections import deque
 from dataclasses import dataclass, field
 
+from pathlib import Path
+
 from krl.ast import nodes as N
+from krl.ast import printer
+from krl.project import backup_of, program_folder
 from krl.workspace import Workspace, is_kuka_file
 
 __all__ = ["Node", "Edge", "ProgramMap", "build_map", "routine_id"]
@@ -41,7 +61,9 @@ _SELECTED = re.compile(r"^\s*/R1/([A-Za-z_$][A-Za-z0-9_$]*)\s*\(", re.I)
 @dataclass
 class Node:
     """A routine (kind ``routine``) or an EKI channel (kind ``channel``). ``path``/``line``:
-    where it is declared (1-based); ``entry``: why it is an entry point, else ""."""
+    where it is declared (1-based); ``entry``: why it is an entry point, else ""; ``entry_kind``:
+    which kind of entry point (see the module docstring), else ""; ``kuka``: in KUKA's system
+    software (krl.workspace.is_kuka_file)."""
     id: str
     name: str
     module: str = ""
@@ -49,9 +71,16 @@ class Node:
     line: int = 0
     kind: str = "routine"
     entry: str = ""
-    dead: bool = False
+    entry_kind: str = ""
+    unreachable: bool = False
     kuka: bool = False
     main: bool = False
+    end: int = 0                   # the END/ENDFCT line
+
+    @property
+    def dead(self) -> bool:
+        """The former name of :attr:`unreachable`."""
+        return self.unreachable
 
 
 @dataclass(frozen=True)
@@ -86,20 +115,26 @@ class ProgramMap:
         return [e for e in self.edges if e.target == node_id]
 
     @property
+    def unreachable(self) -> list[Node]:
+        return [n for n in self.nodes.values() if n.unreachable]
+
+    @property
     def dead(self) -> list[Node]:
-        return [n for n in self.nodes.values() if n.dead]
+        """The former name of :attr:`unreachable`."""
+        return self.unreachable
 
     def as_json(self) -> dict:
-        """``{"root", "nodes": [...], "edges": [...], "entries": [...], "dead": [...],
-        "unresolved": [...]}`` (docs/diff.md, "krl graph")."""
+        """``{"root", "nodes": [...], "edges": [...], "entries": [...], "unreachable": [...],
+        "unresolved": [...]}`` (docs/diff.md, "krl graph"; docs/schemas/graph.schema.json)."""
         return {
             "root": self.root,
             "nodes": [{"id": n.id, "name": n.name, "module": n.module, "kind": n.kind, "path": n.path,
-                       "line": n.line, "entry": n.entry, "dead": n.dead} for n in self.nodes.values()],
+                       "line": n.line, "system": n.kuka, "entry": n.entry, "entry_kind": n.entry_kind,
+                       "unreachable": n.unreachable} for n in self.nodes.values()],
             "edges": [{"source": e.source, "target": e.target, "kind": e.kind, "path": e.path,
                        "line": e.line, "column": e.column} for e in self.edges],
             "entries": list(self.entries),
-            "dead": [n.id for n in self.dead],
+            "unreachable": [n.id for n in self.unreachable],
             "unresolved": [{"source": s, "name": n, "path": p, "line": ln} for s, n, p, ln in self.unresolved],
         }
 
@@ -124,7 +159,8 @@ def build_map(ws: Workspace) -> ProgramMap:
             nid = routine_id(u.name, r.name)
             if nid in pm.nodes:
                 continue                   # a duplicate routine (E102): the first one stands
-            pm.nodes[nid] = Node(nid, r.name, u.name, u.src.path, r.span.line, kuka=kuka, main=i == 0)
+            pm.nodes[nid] = Node(nid, r.name, u.name, u.src.path, r.span.line, kuka=kuka, main=i == 0,
+                                 end=r.end_line or r.span.line)
             pm._by_decl[id(r)] = nid
             if i == 0:
                 mains[u.name.upper()] = nid
@@ -136,7 +172,7 @@ def build_map(ws: Workspace) -> ProgramMap:
             if src is not None:
                 _edges(pm, ws, src, r, u.src.path, mains)
     _entries(pm, ws, mains)
-    _mark_dead(pm)
+    _mark_unreachable(pm)
     return pm
 
 
@@ -200,19 +236,24 @@ def _strings(e) -> list[str]:
 
 
 def _entries(pm: ProgramMap, ws: Workspace, mains: dict) -> None:
-    def add(nid: str | None, why: str) -> None:
+    def add(nid: str | None, kind: str, why: str) -> None:
         if nid is not None and nid in pm.nodes and not pm.nodes[nid].entry:
-            pm.nodes[nid].entry = why
+            pm.nodes[nid].entry, pm.nodes[nid].entry_kind = why, kind
             pm.entries.append(nid)
 
-    backup = any(f.path.replace("\\", "/").lower().endswith("$config.dat") for f in ws.files)
-    add(mains.get("CELL"), "cell program")
-    for nid, n in pm.nodes.items():
-        if n.main and n.name.upper() == "CELL":
-            add(nid, "cell program")         # DEF CELL() in a file of another name
+    root = backup_of(ws.root) if ws.root else None
+    backup = root is not None or any(f.path.replace("\\", "/").lower().endswith("/system/$config.dat")
+                                     for f in ws.files)
+    cells = [nid for nid, n in pm.nodes.items() if n.main and n.kind == "routine"
+             and (n.module.upper() == "CELL" or n.name.upper() == "CELL")]
+    for nid in cells:
+        add(nid, "cell", "cell program (Automatic External)")
+    for nid in cells:
+        for number, target, line in _case_programs(pm, ws, nid):
+            add(target, "plc", f"PLC program number {number} (cell program, line {line})")
     for u in ws.units:
         if u.src is not None and u.src.path.lower().endswith(".sub"):
-            add(mains.get(u.name.upper()), "submit interpreter")
+            add(mains.get(u.name.upper()), "submit", "submit interpreter")
     for u in ws.units:
         dl = u.dat.module.data if u.dat is not None else None
         if dl is None or not dl.name.startswith("$"):
@@ -222,13 +263,59 @@ def _entries(pm: ProgramMap, ws: Workspace, mains: dict) -> None:
             for s in _strings(value):
                 m = _SELECTED.match(s)
                 if m is not None:
-                    add(mains.get(m.group(1).upper()), f"selected by {dl.name.lower()}.dat")
+                    add(mains.get(m.group(1).upper()), "selected", f"selected by {dl.name.lower()}.dat")
+    programs = program_folder(root) if root is not None else None
+    for nid, n in pm.nodes.items():
+        if n.kind == "routine" and n.main and not n.kuka and programs is not None and _inside(n.path, programs):
+            add(nid, "operator", "selectable at the pendant (R1/Program)")
+    for e in pm.edges:
+        if e.kind == "interrupt":
+            add(e.target, "interrupt", f"interrupt handler (declared by {pm.nodes[e.source].name})")
     for nid, n in pm.nodes.items():
         if n.kind == "routine" and n.main and (n.kuka or not backup):
-            add(nid, "KUKA system program" if n.kuka else "main routine of a module")
+            add(nid, "system" if n.kuka else "module",
+                "KUKA system program" if n.kuka else "main routine of a module")
 
 
-def _mark_dead(pm: ProgramMap) -> None:
+def _inside(path: str, folder: Path) -> bool:
+    try:
+        Path(path).relative_to(folder)
+    except ValueError:
+        return False
+    return True
+
+
+def _case_programs(pm: ProgramMap, ws: Workspace, cell_id: str) -> list[tuple[str, str, int]]:
+    """(program number, routine id, line) of each routine called in a CASE branch of a SWITCH
+    of the cell program's routines (its module's routines: the main one and its helpers)."""
+    cell = pm.nodes[cell_id]
+    out = []
+    for u in ws.units:
+        if u.src is None or u.src.path != cell.path:
+            continue
+        for r in u.src.module.routines:
+            for sw in (x for x in r.walk() if isinstance(x, N.Switch)):
+                branches = []
+                for case in sw.cases:
+                    number = ", ".join(printer.expr(v) for v in case.values)
+                    calls = {}
+                    for st in case.body:
+                        for call in (x for x in st.walk() if isinstance(x, N.Call)):
+                            target = _target(pm, ws, N.symbol_of(call))
+                            if target is not None and not pm.nodes[target].kuka:
+                                calls.setdefault(target, call.span.line)
+                    branches.append((number, calls))
+                # a routine called in several branches is a step of the cell's own sequence
+                # (KUKA's template: CellProgramStart(), CellProgramEnd()), not a program
+                seen: dict[str, int] = {}
+                for _n, calls in branches:
+                    for t in calls:
+                        seen[t] = seen.get(t, 0) + 1
+                out += [(number, t, line) for number, calls in branches for t, line in calls.items() if seen[t] == 1]
+    return out
+
+
+def _mark_unreachable(pm: ProgramMap) -> None:
     out: dict[str, list[str]] = {}
     for e in pm.edges:
         out.setdefault(e.source, []).append(e.target)
@@ -240,4 +327,4 @@ def _mark_dead(pm: ProgramMap) -> None:
                 seen.add(t)
                 todo.append(t)
     for nid, n in pm.nodes.items():
-        n.dead = n.kind == "routine" and nid not in seen
+        n.unreachable = n.kind == "routine" and nid not in seen

@@ -1,26 +1,42 @@
-"""The program map as DOT, SVG, JSON and one HTML page (``krl graph``).
+"""The program map as DOT, SVG, JSON and one interactive HTML page (``krl graph``).
 
 DOT and SVG go through the ``graphviz`` Python binding (PyPI ``graphviz``), which quotes every
 name and label; SVG runs Graphviz's ``dot`` (Debian package ``graphviz``). Labels from the
 input (routine, module and file names) pass through :func:`graphviz.escape`, so a backslash
-in a file name is text, not a DOT escape. The HTML page is rendered in the project's one Jinja
-environment (krl/render.py, autoescape on) from ``templates/graph.html.j2``; the SVG is put in
-the page as an ``<img>`` data URI, so nothing of it runs as the page's markup. Maps larger than
+in a file name is text, not a DOT escape.
+
+The HTML page (:func:`to_html`) is rendered in the project's one Jinja environment
+(krl/render.py, autoescape on) from ``templates/graph.html.j2``: the map travels as JSON in a
+``<script type="application/json">`` element written by Jinja's ``tojson`` (``<``, ``>``, ``&``
+and ``'`` escaped, so no text from the backup can close it), and the vendored front end
+``static/programmap.js`` (cytoscape and elkjs from the npm registry, bundled from
+``web/package-lock.json`` by ``make programmap-js``; docs/diff.md) draws it: zoom and pan,
+search, a routine's neighbourhood, modules and KUKA's system software collapsed, and a link
+from each routine to its file:line. The page needs no network. Maps larger than
 krl.limits.MAX_GRAPH_NODES are refused with :class:`GraphTooLarge`.
 """
 
 from __future__ import annotations
 
 import base64
+from functools import lru_cache
+from importlib.resources import files
 from pathlib import Path
+from urllib.parse import quote
 
 import graphviz
+from markupsafe import Markup
 
-from krl.limits import MAX_GRAPH_NODES
+from krl.limits import MAX_GRAPH_NODES, MAX_GRAPH_SOURCE_CHARS
+from krl.source import read_source
 from krl.programmap.graph import ProgramMap
 from krl.render import render_html
 
-__all__ = ["GraphTooLarge", "GraphvizMissing", "to_dot", "to_svg", "to_html"]
+__all__ = ["GraphTooLarge", "GraphvizMissing", "LINKS", "to_dot", "to_svg", "to_html", "page_data"]
+
+# how a routine links to its file:line: a file: URL (the file opens in the browser), a vscode:
+# URL (the file opens at the line in VS Code), or no link
+LINKS = ("file", "vscode", "none")
 
 _EDGE_STYLE = {"call": {}, "interrupt": {"style": "dashed", "color": "#aa1111", "label": "interrupt"},
                "trigger": {"style": "dashed", "color": "#176b2c", "label": "trigger"},
@@ -95,18 +111,66 @@ def svg_data_uri(svg: str) -> str:
     return "data:image/svg+xml;base64," + base64.b64encode(svg.encode("utf-8")).decode("ascii")
 
 
-def to_html(pm: ProgramMap, svg: str | None = None) -> str:
-    """One HTML page: the drawing (when `svg` is given or dot is installed), the entry points,
-    the dead routines and the edges, as tables."""
-    if svg is None:
-        try:
-            svg = to_svg(pm)
-        except GraphvizMissing:
-            svg = ""
-    return render_html("krl.programmap", "graph.html.j2", title=f"Program map: {pm.root}", **context(pm, svg))
+def _href(path: str, line: int, links: str) -> str:
+    """The link of a routine at `path`:`line`: "" when `links` is "none" or the file is not on
+    this machine (a map read from an archive names files inside the archive)."""
+    p = Path(path)
+    if links == "none" or not p.is_absolute() or not p.is_file():
+        return ""
+    if links == "vscode":
+        return "vscode://file" + quote(p.as_posix()) + f":{line}"
+    return p.as_uri()
 
 
-def context(pm: ProgramMap, svg: str) -> dict:
-    """The template values of the map section (shared with the change report)."""
-    return {"map": pm, "image": svg_data_uri(svg) if svg else "",
+def page_data(pm: ProgramMap, links: str = "file") -> dict:
+    """The map as the page's JSON: nodes (id, name, module, kind, file shown relative to the
+    root, line, href, system, entry, entry_kind, unreachable, and ``source``: the routine's own
+    lines, DEF to END, up to krl.limits.MAX_GRAPH_SOURCE_CHARS in all) and edges (source,
+    target, kind, file, line)."""
+    texts: dict[str, list[str]] = {}
+    budget = MAX_GRAPH_SOURCE_CHARS
+    nodes = []
+    for n in pm.nodes.values():
+        source = []
+        if n.path and n.kind == "routine" and budget > 0:
+            if n.path not in texts:
+                texts[n.path] = (read_source(n.path).text or "").splitlines() if Path(n.path).is_file() else []
+            source = texts[n.path][n.line - 1:max(n.end, n.line)]
+            budget -= sum(len(x) + 1 for x in source)
+            if budget < 0:
+                source = []
+        nodes.append({"id": n.id, "name": n.name, "module": n.module, "kind": n.kind,
+                      "file": _short(n.path, pm.root) if n.path else "", "line": n.line,
+                      "href": _href(n.path, n.line, links) if n.path else "", "system": n.kuka,
+                      "entry": n.entry, "entry_kind": n.entry_kind, "unreachable": n.unreachable,
+                      "source": source})
+    return {
+        "root": pm.root, "links": links, "nodes": nodes,
+        "edges": [{"source": e.source, "target": e.target, "kind": e.kind, "file": _short(e.path, pm.root),
+                   "line": e.line} for e in pm.edges],
+    }
+
+
+@lru_cache(maxsize=1)
+def _script() -> Markup:
+    """The vendored front end, as the page's script (it never holds ``</script``)."""
+    text = (files("krl.programmap") / "static" / "programmap.js").read_text(encoding="utf-8")
+    if "</script" in text.lower():
+        raise ValueError("static/programmap.js holds '</script': it cannot be put in the page")
+    return Markup(text)
+
+
+def to_html(pm: ProgramMap, links: str = "file") -> str:
+    """The interactive page (see the module docstring), with the entry points, the unreachable
+    routines and the edges as tables below the map. `links`: one of :data:`LINKS`."""
+    if len(pm.nodes) > MAX_GRAPH_NODES:
+        raise GraphTooLarge(f"the program map has {len(pm.nodes)} nodes (limit MAX_GRAPH_NODES = {MAX_GRAPH_NODES})")
+    return render_html("krl.programmap", "graph.html.j2", title=f"Program map: {pm.root}",
+                       data=page_data(pm, links), script=_script(), **context(pm, None))
+
+
+def context(pm: ProgramMap, svg: str | None) -> dict:
+    """The template values of the map section (shared with the change report); `svg` None: no
+    drawing in the section (the interactive page draws it), "" for Graphviz missing."""
+    return {"map": pm, "image": None if svg is None else svg_data_uri(svg) if svg else "",
             "short": lambda p: _short(p, pm.root)}

@@ -186,15 +186,15 @@ def test_declarations_signals_and_motions(tmp_path):
 
 
 def test_cli_json_matches_the_schema_and_exit_status(tmp_path):
-    jsonschema = pytest.importorskip("jsonschema")   # a dev dependency (pyproject.toml)
+    from tests.test_json_schemas import validate  # noqa: PLC0415
+
     a, b = tmp_path / "a.dat", tmp_path / "b.dat"
     a.write_text("DEFDAT a\nDECL E6AXIS XHOME={A1 0.0,A2 -90.0,A3 90.0,A4 0.0,A5 0.0,A6 0.0,E1 0.0}\nENDDAT\n")
     b.write_text("DEFDAT a\nDECL E6AXIS XHOME={A1 0.5,A2 -90.0,A3 90.0,A4 0.0,A5 -10.0,A6 0.0,E1 0.0}\nENDDAT\n")
     r = CliRunner().invoke(main, ["diff", str(a), str(b), "--format", "json"])
     assert r.exit_code == 1, r.output
     doc = json.loads(r.output)
-    schema = json.loads((Path(__file__).parents[2] / "krl" / "diff" / "diff.schema.json").read_text())
-    jsonschema.validate(doc, schema)
+    validate("diff", doc)
     assert doc["points"] == [{"file": "b.dat", "name": "XHOME", "kind": "E6AXIS", "change": "changed",
                               "delta": {"A1": 0.5, "A5": -10.0}, "status_turn_changed": False}]
     r = CliRunner().invoke(main, ["diff", str(a), str(a)])

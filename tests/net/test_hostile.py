@@ -33,29 +33,49 @@ def connect(net):
     return socket.create_connection(net.wait_address("eki:Guard"), timeout=10)
 
 
-def settle(seconds: float = 0.3) -> None:
-    time.sleep(seconds)
+def wait_for(predicate, what: str, timeout: float = 90.0) -> None:
+    """Poll `predicate` until it holds: the partner's next step waits on what the program
+    has seen, never on a guess of how long the controller takes (the suite runs under load)."""
+    deadline = time.monotonic() + timeout
+    while not predicate():
+        if time.monotonic() > deadline:
+            raise AssertionError(f"waited {timeout:g} s for {what}")
+        time.sleep(0.02)
+
+
+def seen(net) -> set[int]:
+    """The Msg_No values the program has recorded (MSGS[1..min(NMSG, 16)])."""
+    sink = net.sink
+    n = int(sink.read_var("NMSG"))
+    return {int(sink.read_var(f"MSGS[{i}]")) for i in range(1, min(n, 16) + 1)}
+
+
+def saw(net, msg_no: int) -> None:
+    wait_for(lambda: msg_no in seen(net), f"EKI Msg_No {msg_no}")
+
+
+def read_good(net) -> None:
+    wait_for(lambda: float(net.sink.read_var("LASTVAL")) == 7.5, "the good message (LASTVAL = 7.5)")
 
 
 def random_bytes(net, rt):
     s = connect(net)
     rng = random.Random(35)
     s.sendall(bytes(rng.randrange(256) for _ in range(20000)))
-    settle()
     s.close()                                   # whatever was pending is dropped with it
-    settle()
+    saw(net, 512)
     s = connect(net)
     s.sendall(good(7.5))
-    settle()
+    read_good(net)
     return s
 
 
 def xml_bomb(net, rt):
     s = connect(net)
     s.sendall(BOMB)
-    settle()
+    saw(net, 1024)
     s.sendall(good(7.5))
-    settle()
+    read_good(net)
     return s
 
 
@@ -63,30 +83,29 @@ def flood(net, rt):
     s = connect(net)
     payload = b"".join(good(i) for i in range(3000))
     s.sendall(payload)
-    settle(1.0)
+    saw(net, 1280)
     s.sendall(good(7.5))
-    settle(1.5)
+    read_good(net)
     return s
 
 
 def drop_mid_message(net, rt):
     s = connect(net)
     s.sendall(b'<Cmd Val="99')
-    settle()
     s.close()
-    settle()
+    saw(net, 512)
     s = connect(net)
     s.sendall(good(7.5))
-    settle()
+    read_good(net)
     return s
 
 
 def oversized(net, rt):
     s = connect(net)
     s.sendall(b'<Cmd Val="1">' + b"x" * 5000 + b"</Cmd>")
-    settle()
+    saw(net, 1536)
     s.sendall(good(7.5))
-    settle()
+    read_good(net)
     return s
 
 
@@ -95,7 +114,7 @@ def slow_sender(net, rt):
     for b in good(7.5):
         s.sendall(bytes([b]))
         time.sleep(0.005)
-    settle()
+    read_good(net)
     return s
 
 

@@ -43,11 +43,21 @@ def test_edges_counted_by_hand(fixture_map):
     assert fixture_map.unresolved == []
 
 
-def test_entry_points_and_dead_routines_counted_by_hand(fixture_map):
-    entries = {nid: fixture_map.nodes[nid].entry for nid in fixture_map.entries}
-    assert entries == {"CELL:CELL": "cell program", "SPS:SPS": "submit interpreter",
-                       "BG:BG": "selected by $custom.dat"}
-    assert sorted(n.id for n in fixture_map.dead) == ["ORPHAN:HELPER2", "ORPHAN:ORPHAN", "PICK:UNUSED_LOCAL"]
+def test_entry_points_and_unreachable_routines_counted_by_hand(fixture_map):
+    entries = {nid: (fixture_map.nodes[nid].entry_kind, fixture_map.nodes[nid].entry) for nid in fixture_map.entries}
+    assert entries == {
+        "CELL:CELL": ("cell", "cell program (Automatic External)"),
+        "SPS:SPS": ("submit", "submit interpreter"),
+        "BG:BG": ("selected", "selected by $custom.dat"),                 # also under R1/Program
+        # the module mains under R1/Program an operator can select at the pendant
+        "AUX:AUX": ("operator", "selectable at the pendant (R1/Program)"),
+        "ORPHAN:ORPHAN": ("operator", "selectable at the pendant (R1/Program)"),
+        "PICK:PICK": ("operator", "selectable at the pendant (R1/Program)"),
+        # INTERRUPT DECL 5 ... DO stop_handler() in cell.src
+        "CELL:STOP_HANDLER": ("interrupt", "interrupt handler (declared by cell)"),
+    }
+    # orphan's helper2 is reached from the selectable orphan; only a local routine nobody calls
+    assert [n.id for n in fixture_map.unreachable] == ["PICK:UNUSED_LOCAL"]
     # 12 routines + 1 channel; every routine knows its module and file:line
     assert sum(n.kind == "routine" for n in fixture_map.nodes.values()) == 12
     helper = fixture_map.nodes["PICK:HELPER_FCT"]
@@ -59,14 +69,15 @@ def test_loose_folder_makes_every_main_routine_an_entry(tmp_path):
     (tmp_path / "c.src").write_text("DEF c()\nEND\n")
     pm = build_map(workspaces_for(tmp_path)[0])
     assert sorted(pm.entries) == ["A:A", "C:C"]
-    assert [n.id for n in pm.dead] == ["A:NEVER"]
+    assert [n.id for n in pm.unreachable] == ["A:NEVER"]
+    assert {pm.nodes[e].entry_kind for e in pm.entries} == {"module"}
 
 
 def test_dot_has_one_arrow_per_edge_and_no_port_syntax(fixture_map):
     dot = to_dot(fixture_map)
     arrows = re.findall(r"^\s*(n\d+) -> (n\d+)", dot, re.M)
     assert len(arrows) == 9
-    assert dot.count("peripheries=2") == 3        # the three entry points
+    assert dot.count("peripheries=2") == 7        # the seven entry points
     assert "EKI ChannelA" in dot
 
 
@@ -74,7 +85,7 @@ def test_cli_graph_json_and_errors(tmp_path):
     r = CliRunner().invoke(main, ["graph", str(FIXTURE), "--format", "json"])
     assert r.exit_code == 0, r.output
     doc = json.loads(r.output)
-    assert len(doc["edges"]) == 9 and sorted(doc["dead"]) == ["ORPHAN:HELPER2", "ORPHAN:ORPHAN", "PICK:UNUSED_LOCAL"]
+    assert len(doc["edges"]) == 9 and doc["unreachable"] == ["PICK:UNUSED_LOCAL"]
     r = CliRunner().invoke(main, ["graph", str(tmp_path / "nope")])
     assert r.exit_code == 2 and "error[E001]: no such file or folder" in r.output
 

@@ -17,6 +17,7 @@ from tests.report.test_report_chromium import loaded_page
 FIXTURE = Path(__file__).parents[1] / "programmap" / "fixtures" / "KRC"
 IMG = "<img src=x onerror=window.pwned=1>"
 SCRIPT = "<script>window.pwned=1</script>"
+LONG = "a_long_text_without_spaces_" * 12
 
 
 @pytest.fixture(scope="module")
@@ -38,11 +39,14 @@ def pages(tmp_path_factory) -> dict[str, Path]:
     shutil.copytree(FIXTURE, old)
     shutil.copytree(FIXTURE, new)
     (new / "R1" / "Program" / f"{IMG}.src").write_text("DEF odd()\nEND\n")
+    # an added point (its coordinates are shown) and a long line (it wraps)
+    (new / "R1" / "Program" / "points.dat").write_text(
+        "DEFDAT points\nDECL E6POS XP_NEW={X 1.5,Y -2.0,Z 300.25,A 0.0,B 90.0,C 180.0,S 6,T 2}\nENDDAT\n")
     pick = new / "R1" / "Program" / "pick.src"
     text = pick.read_text()
     assert text.count("  n = helper_fct(2)\n") == 1
     pick.write_text(text.replace("  DECL EKI_STATUS ret\n", f"  DECL EKI_STATUS ret\n  DECL CHAR msg[40]\n")
-                    .replace("  n = helper_fct(2)\n", f'  n = helper_fct(3)\n  msg[] = "{SCRIPT}"\n'))
+                    .replace("  n = helper_fct(2)\n", f'  n = helper_fct(3)\n  msg[] = "{SCRIPT}"\n  msg[] = "{LONG}"\n'))
     out = {}
     runner = CliRunner()
     for name, args in (("report", ["report", str(new), "--since", str(old)]),
@@ -54,9 +58,10 @@ def pages(tmp_path_factory) -> dict[str, Path]:
     return out
 
 
-def _open(pw, chromium, page_path: Path, check):
+def _open(pw, chromium, page_path: Path, check, scripts: int = 0):
     with loaded_page(pw, chromium, page_path) as page:
-        assert page.evaluate("document.querySelectorAll('script').length") == 0
+        # the interactive map has two: its JSON data and the vendored front end
+        assert page.evaluate("document.querySelectorAll('script').length") == scripts
         assert page.evaluate("window.pwned === undefined")
         check(page)
 
@@ -67,13 +72,15 @@ def test_change_pages_render_in_headless_chromium(chromium, pages):
 
     def graph(page):
         assert page.locator("h1").inner_text() == "Program map"
-        # 13 routines (the 12 of the fixture + odd), 9 edges; entries cell, sps, bg; dead: 3 + odd
-        assert page.locator("table.map-entries tr").count() == 1 + 3
-        assert page.locator("table.map-dead tr").count() == 1 + 4
+        page.wait_for_function("document.body.dataset.ready === '1'", timeout=120_000)
+        # 13 routines (the 12 of the fixture + odd), 9 edges; the 7 entry points of the fixture
+        # (tests/programmap/test_graph.py) and odd, selectable under R1/Program; unreachable: 1
+        assert page.locator("table.map-entries tr").count() == 1 + 8
+        assert page.locator("table.map-unreachable tr").count() == 1 + 1
         assert page.locator("table.map-edges tr").count() == 1 + 9
-        assert page.evaluate("document.getElementById('map-image').naturalWidth") > 200
-        assert IMG in page.locator("table.map-dead").inner_text()      # the module name, as text
-        assert page.locator("img").count() == 1                          # only the drawing
+        assert IMG in page.locator("table.map-entries").text_content()   # the module name, as text
+        assert page.locator("img").count() == 0
+        assert page.evaluate("document.querySelector('script[type=\"application/json\"]').id") == "map-data"
 
     def diff(page):
         routines = page.locator("section.diff-routine")
@@ -83,7 +90,14 @@ def test_change_pages_render_in_headless_chromium(chromium, pages):
         assert "changed pick:pick" in text
         assert "- 6: n = helper_fct(2)" in text and "+ 7: n = helper_fct(3)" in text
         assert f'msg[] = "{SCRIPT}"' in text
-        assert page.locator("table.diff-declarations tr").count() == 1 + 1   # msg added
+        assert page.locator("table.diff-declarations tr").count() == 1 + 2   # msg and XP_NEW added
+        # the added point with its coordinates
+        assert page.locator("table.diff-points .coordinates").inner_text() == \
+            "X 1.5, Y -2, Z 300.25, A 0, B 90, C 180, S 6, T 2"
+        # the long line wraps inside the page: nothing is wider than the window
+        assert LONG in text
+        assert page.evaluate("document.documentElement.scrollWidth <= window.innerWidth")
+        assert page.evaluate("[...document.querySelectorAll('pre')].every(p => p.scrollWidth <= p.clientWidth + 1)")
 
     def report(page):
         assert page.locator("#check-summary").count() == 1
@@ -92,6 +106,6 @@ def test_change_pages_render_in_headless_chromium(chromium, pages):
         diff(page)
 
     with playwright.sync_playwright() as pw:
-        _open(pw, chromium, pages["graph"], graph)
+        _open(pw, chromium, pages["graph"], graph, scripts=2)
         _open(pw, chromium, pages["diff"], diff)
         _open(pw, chromium, pages["report"], report)

@@ -103,8 +103,11 @@ def test_cell_init_lists_the_inputs_with_their_declarations(tmp_path):
     assert "# $IN[8]\n  #   read at R1/Program/job.src:4 (WAIT FOR)" in text
     assert "CLAMP =" not in text            # an output is not listed
     # the fixture has no machine data: the starter asks for the cell's robot, from the library
+    from robot.machine import library_robots
+
     assert "# robot: NAME       # this backup has no R1/Mada/$machine.dat: name the cell's robot " \
-           "(robot/data: kr180_r3200_pa, kr6_r900)" in text
+           f"(robot/data: {', '.join(library_robots())})" in text
+    assert "kr180_r3200_pa" in library_robots()
     # the starter is a valid cell file (every rule commented out)
     from robot.stimuli import load_cell
     cell = load_cell(dest)

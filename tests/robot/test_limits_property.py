@@ -8,7 +8,11 @@ out, as an advance run would stop there.
 
 It runs on the KR 6 R900 and on two large robots built from corpus machine data (issue 22):
 the KR 210 R2700-2 and the KR 120 R2700 extra HA (robot/mada.py); their targets are the same
-axis ranges, so their paths are three times longer."""
+axis ranges, so their paths are three times longer. Issue 34 adds the hand-written machine data
+of robot/data: a KR C2 robot (KR 16-2), the 4- and 5-axis palletizers (A4 = 0; the 4-axis one's
+A5 linked, A2 + A3 + A5 = 90 deg) and the KR 16-2 on a track (E1 along it) and with a turntable
+(E1 turning); their targets carry E1, which moves with every motion. Long runs: the nightly
+profile multiplies the examples (tests/budget.py)."""
 
 from __future__ import annotations
 
@@ -16,6 +20,7 @@ import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from pathlib import Path
 
 from robot.controller import Controller
 from robot.errors import RobotError
@@ -26,9 +31,13 @@ from robot.motion import MotionParams, MotionRequest, SplineSegment
 from robot.trace import TraceWriter
 from tests.budget import examples
 
-#: robot -> (corpus folder, or None for the yaml KR 6 R900)
+#: robot -> corpus folder, "lib:NAME" for a robot of robot/data, or None for the yaml KR 6 R900
 ROBOTS = {"KR 6 R900": None, "KR210R2700_2": "HugoDanielson__ChinaMilling",
-          "KR120R2700_EXTRA_HA": "khrzysio__KRC4_test"}
+          "KR120R2700_EXTRA_HA": "khrzysio__KRC4_test", "KR16-2 KR C2": "lib:kr16_2_krc2",
+          "KR180 PA 4-axis": "lib:kr180_r3200_pa", "KR180 PA 5-axis": "lib:kr180_r3200_pa5",
+          "KR16-2 track": "lib:kr16_2_kl1500", "KR16-2 turntable": "lib:kr16_2_turntable"}
+#: the range of E1 in the targets of a robot with an external axis (mm or deg)
+E_RANGE = {"kr16_2_kl1500": (300.0, 3500.0), "kr16_2_turntable": (-120.0, 120.0)}
 HOME = (0.0, -90.0, 90.0, 0.0, 60.0, 0.0)
 # a comfortable part of the workspace: wrist away from A5 = 0, arm not stretched
 RANGES = ((-70, 70), (-115, -55), (60, 125), (-60, 60), (25, 105), (-90, 90))
@@ -51,29 +60,64 @@ def params_st(draw):
 def step_st(draw):
     kind = draw(st.sampled_from(["PTP", "SPTP", "LIN", "CIRC", "SPLINE"]))
     step = {"kind": kind, "q": draw(axes_st), "approx": draw(approx_st), "params": draw(params_st()),
-            "bulge": draw(st.floats(-120.0, 120.0))}
+            "bulge": draw(st.floats(-120.0, 120.0)), "e": draw(st.floats(0.0, 1.0))}
     if kind == "SPLINE":
         step["segs"] = draw(st.lists(st.tuples(st.sampled_from(["SPL", "SLIN", "SCIRC"]), axes_st,
                                                st.floats(-80.0, 80.0)), min_size=2, max_size=5))
     return step
 
 
-@pytest.fixture(scope="module", params=sorted(ROBOTS))
-def robot(request):
-    folder = ROBOTS[request.param]
+def _load(request, name):
+    folder = ROBOTS[name]
     if folder is None:
         return load_machine()
     from robot.mada import load_robot  # noqa: PLC0415
 
+    if folder.startswith("lib:"):
+        return load_robot(folder[4:])
     return load_robot(request.getfixturevalue("shared_corpus") / folder)
 
 
+@pytest.fixture(scope="module", params=sorted(k for k, v in ROBOTS.items() if not (v or "").startswith("lib:")))
+def robot(request):
+    return _load(request, request.param)
+
+
+@pytest.fixture(scope="module", params=sorted(k for k, v in ROBOTS.items() if (v or "").startswith("lib:")))
+def library_robot(request):
+    return _load(request, request.param)
+
+
+def _shape(machine, q, e_frac=0.5):
+    """Axes of the robot's family from a drawn 6-tuple: A4 = 0 on a palletizer, A5 linked on
+    the 4-axis one; E1 from its range (`e_frac` in 0..1) when the robot has one."""
+    q = list(q)
+    if machine.a4fix:
+        q[3] = 0.0
+    if machine.a5link:
+        h = machine.home_deg
+        q[4] = h[1] + h[2] + h[4] - q[1] - q[2]
+    for e in machine.external_axes:
+        lo, hi = E_RANGE[Path(machine.source).stem]
+        q.append(lo + e_frac * (hi - lo))
+    return np.asarray(q, dtype=float)
+
+
 def _pose(kin, q):
-    return matrix_to_frame(kin.forward(np.asarray(q, dtype=float)))
+    """The TCP pose of axes `q` (A1..A6 and E1..) in $WORLD: `kin` is the controller's
+    planner model (robot/planner.py RobotModel), which puts a track's robot where E1 is."""
+    I = np.eye(4)
+    return matrix_to_frame(kin.tcp(np.asarray(q, dtype=float), I, I))
 
 
 def _cart(kin, q):
-    return dict(zip("XYZABC", _pose(kin, q)))
+    out = dict(zip("XYZABC", _pose(kin, q)))
+    for i, v in enumerate(np.asarray(q, dtype=float)[6:]):
+        out[f"E{i + 1}"] = float(v)
+    return out
+
+
+AXES = ("A1", "A2", "A3", "A4", "A5", "A6", "E1", "E2", "E3", "E4", "E5", "E6")
 
 
 def _aux(p0, p1, bulge):
@@ -88,13 +132,15 @@ def _aux(p0, p1, bulge):
 
 
 def _requests(kin, steps):
-    cur = _pose(kin, HOME)
-    out = [MotionRequest("PTP", dict(zip(("A1", "A2", "A3", "A4", "A5", "A6"), HOME)), MotionParams())]
+    m = kin.machine
+    home = _shape(m, HOME)
+    cur = _pose(kin, home)
+    out = [MotionRequest("PTP", dict(zip(AXES, home)), MotionParams())]
     for s in steps:
-        P, q, k = s["params"], s["q"], s["kind"]
+        P, q, k = s["params"], _shape(m, s["q"], s["e"]), s["kind"]
         ax = s["approx"]
         if k in ("PTP", "SPTP"):
-            out.append(MotionRequest(k, dict(zip(("A1", "A2", "A3", "A4", "A5", "A6"), q)), P, approx=ax,
+            out.append(MotionRequest(k, dict(zip(AXES, q)), P, approx=ax,
                                      approx2=ax and "C_DIS"))
             cur = _pose(kin, q)
         elif k == "LIN":
@@ -110,6 +156,7 @@ def _requests(kin, steps):
         else:
             segs = []
             for kind, qs, bulge in s["segs"]:
+                qs = _shape(m, qs, s["e"])
                 end = _pose(kin, qs)
                 if kind == "SCIRC":
                     aux = _aux(cur, end, bulge)
@@ -127,10 +174,30 @@ def _requests(kin, steps):
           suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
 @given(steps=st.lists(step_st(), min_size=1, max_size=5), mode=st.sampled_from(["AUT", "AUT", "T1"]))
 def test_every_trace_keeps_the_limits(robot, steps, mode):
+    _keeps_the_limits(robot, steps, mode)
+
+
+@settings(max_examples=examples(3), deadline=None,
+          suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+@given(steps=st.lists(step_st(), min_size=1, max_size=5), mode=st.sampled_from(["AUT", "AUT", "T1"]))
+def test_every_trace_keeps_the_limits_on_the_library_robots(library_robot, steps, mode):
+    _keeps_the_limits(library_robot, steps, mode)
+
+
+@pytest.mark.slow
+@settings(max_examples=examples(30), deadline=None,
+          suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+@given(steps=st.lists(step_st(), min_size=1, max_size=5), mode=st.sampled_from(["AUT", "AUT", "T1"]))
+def test_long_run_on_the_library_robots(library_robot, steps, mode):
+    """The nightly's long run on the hand-written machine data (make nightly)."""
+    _keeps_the_limits(library_robot, steps, mode)
+
+
+def _keeps_the_limits(robot, steps, mode):
     tw = TraceWriter(keep=True)
     ctl = Controller(robot, trace=tw, mujoco=False, mode_op=mode)
     planned = 0
-    for req in _requests(ctl.model.kin, steps):
+    for req in _requests(ctl.model, steps):
         while not ctl.can_enqueue():
             ctl.step()
         try:
@@ -143,3 +210,29 @@ def test_every_trace_keeps_the_limits(robot, steps, mode):
     ctl.step_until(ctl.is_idle, max_cycles=200_000)
     rep = check_trace(tw.events, robot)
     assert rep.ok, f"{rep.summary()}\n" + "\n".join(str(v) for v in rep.violations[:10])
+
+
+def test_a_fixed_sequence_moves_every_library_robot(library_robot):
+    """The property run is not vacuous on the library robots: a fixed PTP, LIN, CIRC and SPLINE
+    sequence plans on each (no motion refused), moves it, and keeps the limits."""
+    P = MotionParams().with_(vel_cp=0.5)
+    q1, q2, q3 = (30.0, -80.0, 100.0, 20.0, 60.0, 10.0), (-20.0, -70.0, 90.0, -15.0, 50.0, -30.0), \
+        (10.0, -95.0, 110.0, 0.0, 70.0, 45.0)
+    steps = [{"kind": "PTP", "q": q1, "approx": None, "params": P, "bulge": 0.0, "e": 0.2},
+             {"kind": "LIN", "q": q2, "approx": "C_DIS", "params": P, "bulge": 0.0, "e": 0.6},
+             {"kind": "CIRC", "q": q3, "approx": None, "params": P, "bulge": 60.0, "e": 0.9},
+             {"kind": "SPLINE", "q": q1, "approx": None, "params": P, "bulge": 0.0, "e": 0.3,
+              "segs": [("SPL", q2, 0.0), ("SLIN", q1, 0.0)]}]
+    tw = TraceWriter(keep=True)
+    ctl = Controller(library_robot, trace=tw, mujoco=False)
+    reqs = _requests(ctl.model, steps)
+    assert len(reqs) == 5
+    for req in reqs:
+        while not ctl.can_enqueue():
+            ctl.step()
+        ctl.enqueue(req)                   # every motion plans
+    ctl.step_until(ctl.is_idle, max_cycles=200_000)
+    assert ctl.last_error is None
+    assert np.abs(ctl.axis_act()[:3] - np.array(q1[:3])).max() < 1e-6 or library_robot.a5link
+    rep = check_trace(tw.events, library_robot)
+    assert rep.ok, rep.summary()

@@ -58,9 +58,17 @@ URDF_KR210_R2700_EXTRA = (
      ((1.200, 0, 0), (0, 0, 0), (0, 1, 0)), ((0.215, 0, 0), (0, 0, 0), (-1, 0, 0))],
     ((0, 0, 0), (0, PI / 2, 0)))
 
-URDFS = {"KR210R2700_2": (URDF_KR210_R2700_2, 1e-6),
-         "KR120R2700_2": (URDF_KR120_R2700_2, 0.05),
-         "KR120R2700_EXTRA_HA": (URDF_KR210_R2700_EXTRA, 1e-6)}
+# kroshu/kuka_robot_descriptions kuka_quantec_support/urdf/kr210_r2700_extra_macro.xacro (KUKA's own
+# ROS 2 description of the same R2700 extra arm): joints about their local Z
+URDF_KR210_R2700_EXTRA_KROSHU = (
+    [((0, 0, 0.302), (PI, 0, 0), (0, 0, 1)), ((0.35, 0, -0.373), (PI / 2, 0, 0), (0, 0, 1)),
+     ((1.15, 0, 0), (0, 0, 0), (0, 0, 1)), ((0.9, 0.041, 0), (PI / 2, 0, -PI / 2), (0, 0, 1)),
+     ((0, 0, -0.3), (0, PI / 2, PI / 2), (0, 0, 1)), ((0.215, 0, 0), (PI / 2, 0, -PI / 2), (0, 0, 1))],
+    ((0, 0, 0), (PI, 0, PI)))
+
+URDFS = {"KR210R2700_2": [(URDF_KR210_R2700_2, 1e-6)],
+         "KR120R2700_2": [(URDF_KR120_R2700_2, 0.05)],
+         "KR120R2700_EXTRA_HA": [(URDF_KR210_R2700_EXTRA, 1e-6), (URDF_KR210_R2700_EXTRA_KROSHU, 1e-6)]}
 
 
 def urdf_forward(urdf, axes_deg) -> np.ndarray:
@@ -119,15 +127,15 @@ def test_zero_and_home_pose_by_hand(backup):
 
 def test_forward_kinematics_matches_ros_industrial_urdf(backup):
     key, m, *_ = backup
-    urdf, tol = URDFS[key]
     k = Kinematics(m)
     rng = np.random.default_rng(7)
     lo = np.array(m.softn_end)
     hi = np.array(m.softp_end)
-    for q in [np.zeros(6), np.array(m.home_deg)] + list(rng.uniform(lo, hi, size=(20, 6))):
-        A, B = k.forward(q), urdf_forward(urdf, q)
-        assert np.abs(A[:3, 3] - B[:3, 3]).max() < tol, q
-        assert np.abs(A[:3, :3] - B[:3, :3]).max() < 1e-4, q
+    for urdf, tol in URDFS[key]:
+        for q in [np.zeros(6), np.array(m.home_deg)] + list(rng.uniform(lo, hi, size=(20, 6))):
+            A, B = k.forward(q), urdf_forward(urdf, q)
+            assert np.abs(A[:3, 3] - B[:3, 3]).max() < min(tol, 0.05), q
+            assert np.abs(A[:3, :3] - B[:3, :3]).max() < 1e-4, q
 
 
 def test_inverse_kinematics_round_trip(backup):
@@ -188,13 +196,15 @@ def test_missing_and_bad_values_name_file_and_line(tmp_path, shared_corpus):
         load_mada(p2)                      # a syntax error: file:line:col of the parser
     p2 = _write_mada(tmp_path / "b2", shared_corpus,
                      lambda t: t.replace("REAL $LENGTH_A=350.000", "REAL $LENGTH_A=TRUE"))
-    with pytest.raises(MachineDataError, match=r"\$machine\.dat:522: a number was expected, not True"):
+    with pytest.raises(MachineDataError, match=r"\$machine\.dat:522: \$LENGTH_A=TRUE: a number was expected"):
         load_mada(p2)
     p3 = _write_mada(tmp_path / "c", shared_corpus,
-                     lambda t: t.replace("$TX3P3={X 1200.00,Y 0.0,Z -41.0000,A 0.0,B 90.0000",
-                                         "$TX3P3={X 1200.00,Y 0.0,Z -41.0000,A 30.0,B 90.0000"))
-    with pytest.raises(MachineDataError, match="not of the standard KUKA structure"):
+                     lambda t: t.replace("DECL KINCLASS $KINCLASS=#STANDARD", "DECL KINCLASS $KINCLASS=#SPECIAL"))
+    with pytest.raises(MachineDataError, match=r"\$machine\.dat:455: \$KINCLASS=#SPECIAL: only the #STANDARD"):
         load_mada(p3)
+    p4 = _write_mada(tmp_path / "d", shared_corpus, lambda t: t.replace("$AXIS_DIR[3]=1", "$AXIS_DIR[3]=0"))
+    with pytest.raises(MachineDataError, match=r"\$AXIS_DIR\[3\]=0: 1 or -1 was expected"):
+        load_mada(p4)
 
 
 def test_palletizer_flag_fixes_a4(tmp_path, shared_corpus):
@@ -217,3 +227,23 @@ def test_backup_zip_and_machine_dat_give_the_same_robot(tmp_path, shared_corpus)
     b = load_robot(archive)
     assert a.opw == b.opw and a.joints == b.joints
     assert b.source.startswith(archive)
+
+
+def test_every_machine_data_file_of_the_corpus(shared_corpus):
+    """Every ``$machine.dat`` of the corpus, found by walking it: a robot's (R1/Mada) builds the
+    model that BACKUPS describes; the controller's (STEU/Mada: signals, ``$V_STEUMADA``, no arm)
+    is refused with a message that says so and names the robot's file."""
+    files = sorted(p for p in shared_corpus.rglob("*") if p.name.lower() == "$machine.dat" and p.is_file())
+    robots, controllers = [], []
+    for f in files:
+        head = f.read_text(encoding="latin-1")
+        if "$V_STEUMADA" in head and "$TIRORO" not in head:
+            with pytest.raises(MachineDataError, match=r"none of the robot's machine data .* is set: it is the "
+                               r"controller's machine data \(\$V_STEUMADA=.*R1/Mada/\$machine\.dat"):
+                load_mada(f)
+            controllers.append(f)
+        else:
+            robots.append(str(f.relative_to(shared_corpus)))
+            assert load_mada(f).trafoname
+    assert sorted(robots) == sorted(f"{folder}/{rel}" for folder, rel, *_ in BACKUPS.values())
+    assert len(controllers) == len(robots)

@@ -109,3 +109,134 @@ def test_a_palletizer_whose_home_does_not_look_down_is_refused(tmp_path):
     bad.write_text(text, encoding="utf-8")
     with pytest.raises(MachineDataError, match=r"\$DEF_A5LINK.*straight down"):
         load_mada(bad)
+
+
+# ---------------------------------------------------------------- the 5-axis palletizer
+# robot/data/kr180_r3200_pa5.dat: the same arm with $DEF_A4FIX TRUE and $DEF_A5LINK FALSE (issue 34):
+# A5 is driven, so the flange tilts in the arm's vertical plane by d = A2 + A3 + A5 - 90 deg from
+# pointing straight down (A5 decreasing turns it towards the front, as A5 > 0 turns a six-axis
+# KUKA flange down). By hand, in the arm plane (r ahead, z up): the flange axis points along
+# (-sin d, -cos d), the direction 'ahead' of it along (cos d, -sin d), and the flange sits 280 mm
+# ahead of and 250 mm along the axis from the A5 point.
+
+PA5 = ROBOT_LIBRARY / "kr180_r3200_pa5.dat"
+
+
+@pytest.fixture(scope="module")
+def pa5():
+    return load_mada(PA5)
+
+
+def hand_flange5(a1, a2, a3, a5):
+    up, fore = math.radians(-a2), math.radians(-(a2 + a3))
+    d = math.radians(a2 + a3 + a5 - 90.0)
+    r = 350 + 1350 * math.cos(up) + 1220 * math.cos(fore) + 280 * math.cos(d) - 250 * math.sin(d)
+    z = 675 + 1350 * math.sin(up) + 1220 * math.sin(fore) - 280 * math.sin(d) - 250 * math.cos(d)
+    w = math.radians(-a1)
+    axis = np.array([-math.sin(d) * math.cos(w), -math.sin(d) * math.sin(w), -math.cos(d)])
+    return np.array([r * math.cos(w), r * math.sin(w), z]), axis
+
+
+def test_the_5_axis_palletizer_is_its_own_family(pa5):
+    assert pa5.a4fix and not pa5.a5link
+    assert Kinematics(pa5).family == "palletizer5"
+    assert pa5.joints[3].limit_deg == (0.0, 0.0)
+
+
+@pytest.mark.parametrize("q", [(0, -90, 90, 90), (30, -45, 90, 10), (-120, -100, 140, -30), (75, -20, 40, 100)])
+def test_5_axis_forward_kinematics_by_hand(pa5, q):
+    a1, a2, a3, a5 = q
+    T = Kinematics(pa5).forward([a1, a2, a3, 0.0, a5, 23.0])
+    pos, axis = hand_flange5(a1, a2, a3, a5)
+    assert np.allclose(T[:3, 3], pos, atol=1e-6)
+    assert np.allclose(T[:3, 2], axis, atol=1e-12)         # the flange's Z is the A6 axis
+
+
+def test_5_axis_inverse_round_trip(pa5):
+    k = Kinematics(pa5)
+    rng = np.random.default_rng(9)
+    n = 0
+    for _ in range(60):
+        axes = [rng.uniform(-170, 170), rng.uniform(-130, -15), rng.uniform(10, 150), 0.0,
+                rng.uniform(-115, 115), rng.uniform(-300, 300)]
+        if not k.within_limits(axes) or abs(axes[4]) < 1.0:
+            continue
+        s, t = k.status_turn(axes)
+        got = k.inverse(k.forward(axes), s, t, reference_deg=axes)
+        assert np.allclose(got, axes, atol=1e-7), (axes, got)
+        if s & 1 == 0:                   # from HOME (in front of A1): the position is reached
+            got = k.inverse(k.forward(axes), reference_deg=pa5.home_deg)
+            assert np.allclose(k.forward(got)[:3, 3], k.forward(axes)[:3, 3], atol=1e-6)
+        n += 1
+    assert n > 30
+
+
+def test_5_axis_target_out_of_the_arm_plane_keeps_its_position_and_pitch(pa5):
+    k = Kinematics(pa5)
+    axes = [20.0, -60.0, 110.0, 0.0, 30.0, 45.0]
+    T = k.forward(axes)
+    # tilt the target 5 deg about its own direction 'ahead' x the axis: out of the arm plane
+    from scipy.spatial.transform import Rotation
+
+    n = np.array([-math.sin(math.radians(-20.0)), math.cos(math.radians(-20.0)), 0.0])   # plane normal
+    ahead = np.cross(n, T[:3, 2])
+    R = Rotation.from_rotvec(ahead / np.linalg.norm(ahead) * math.radians(5.0)).as_matrix()
+    T2 = T.copy()
+    T2[:3, :3] = R @ T[:3, :3]
+    q = k.inverse(T2, reference_deg=axes)
+    F = k.forward(q)
+    assert np.allclose(F[:3, 3], T[:3, 3], atol=1e-6)         # the position is kept
+    assert abs(float(F[:3, 2] @ n)) < 1e-9                    # the A6 axis stays in the plane
+    assert np.allclose(q, axes, atol=1e-6)                    # the out-of-plane tilt is dropped
+
+
+def test_5_axis_status_bit_2_and_turn_of_a4_select_nothing(pa5):
+    k = Kinematics(pa5)
+    axes = [15.0, -54.0, 140.0, 0.0, 14.0, 14.0]
+    T = k.forward(axes)
+    for status, turn in ((2, 2), (6, 10), (6, 2)):
+        assert np.allclose(k.inverse(T, status, turn, pa5.home_deg), axes, atol=1e-7)
+
+
+# ---------------------------------------------------------------- KUKA's flags on a 4-axis palletizer
+# KUKA's palletizers keep $DEF_A4FIX TRUE and $DEF_A5LINK FALSE on the 4-axis form too; $NUM_AX = 4
+# (A1, A2, A3 and the flange axis A6 driven) leaves A5 without a drive, so the parallelogram leads it.
+
+
+@pytest.fixture(scope="module")
+def pa4_kuka_flags(tmp_path_factory):
+    text = PA5.read_text(encoding="utf-8").replace("INT $NUM_AX=5 ;", "INT $NUM_AX=4 ;")
+    assert "INT $NUM_AX=4 ;" in text and "BOOL $DEF_A5LINK=FALSE" in text
+    f = tmp_path_factory.mktemp("pa4") / "$machine.dat"
+    f.write_text(text, encoding="utf-8")
+    return load_mada(f)
+
+
+def test_num_ax_4_with_a5link_false_is_the_4_axis_palletizer(pa4_kuka_flags):
+    m = pa4_kuka_flags
+    assert m.a4fix and m.a5link and Kinematics(m).family == "palletizer4"
+    assert "$NUM_AX=4" in m.provenance["a5_led"] and m.provenance["a5_led"].startswith("derived")
+    from robot.show import show_lines
+
+    text = "\n".join(show_lines(m))
+    assert "$DEF_A4FIX=TRUE $DEF_A5LINK=FALSE (A5 led: $NUM_AX=4)" in text
+    assert "4-axis palletizer" in text
+
+
+@pytest.mark.parametrize("q", [(0, -90, 90), (30, -45, 90), (-120, -100, 140)])
+def test_num_ax_4_forward_and_inverse_are_those_of_the_linked_arm(pa4_kuka_flags, q):
+    a1, a2, a3 = q
+    axes = [a1, a2, a3, 0.0, 90.0 - a2 - a3, -40.0]
+    k = Kinematics(pa4_kuka_flags)
+    T = k.forward(axes)
+    assert np.allclose(T[:3, 3], hand_flange(a1, a2, a3), atol=1e-6)
+    assert T[2, 2] == pytest.approx(-1.0, abs=1e-12)
+    assert np.allclose(k.inverse(T, reference_deg=axes), axes, atol=1e-7)
+
+
+def test_num_ax_below_4_is_refused_naming_it(tmp_path):
+    bad = tmp_path / "$machine.dat"
+    bad.write_text(PA5.read_text(encoding="utf-8").replace("INT $NUM_AX=5 ;", "INT $NUM_AX=3 ;"),
+                   encoding="utf-8")
+    with pytest.raises(MachineDataError, match=r"\$machine.dat:21: \$NUM_AX=3: a robot with \$DEF_A4FIX has 4..6"):
+        load_mada(bad)

@@ -78,8 +78,34 @@ def test_show_a_robot_of_the_library_by_name():
     res = CliRunner().invoke(main, ["robot", "show", "kr180_r3200_pa"])
     assert res.exit_code == 0, res.output
     assert res.output.splitlines()[0] == "robot      KR180R3200 PA C4 FLR"
-    assert "palletizer $DEF_A4FIX=True $DEF_A5LINK=True" in res.output
+    assert "palletizer $DEF_A4FIX=TRUE $DEF_A5LINK=TRUE" in res.output
     # reach to the A5 point by hand: 350 + 1350 + 1220
     assert "reach      2920.0 mm" in res.output
     res = CliRunner().invoke(main, ["robot", "show", "kr999"])
-    assert res.exit_code == 2 and "nor a robot of the library (kr180_r3200_pa, kr6_r900)" in res.output
+    assert res.exit_code == 2 and "nor a robot of the library (" in res.output
+    assert "kr180_r3200_pa, " in res.output and "kr6_r900)" in res.output
+
+
+@pytest.mark.parametrize("name", ["kr16_2_krc2", "kr180_r3200_pa", "kr180_r3200_pa5", "kr16_2_kl1500",
+                                  "kr16_2_turntable"])
+def test_export_works_for_every_family(tmp_path, name):
+    """`krl robot export` (the pendant renders the backup's robot from it) for every family of
+    robot/data: the URDF is one tree and the MJCF loads in MuJoCo with a joint per axis."""
+    import xml.etree.ElementTree as ET
+
+    import mujoco
+
+    from robot.mada import load_robot
+
+    m = load_robot(name)
+    for fmt in ("urdf", "mjcf"):
+        out = tmp_path / f"{name}.{fmt}"
+        res = CliRunner().invoke(main, ["robot", "export", name, "--format", fmt, "-o", str(out)])
+        assert res.exit_code == 0, res.output
+        if fmt == "urdf":
+            root = ET.parse(out).getroot()
+            children = {j.find("child").get("link") for j in root.findall("joint")}
+            assert len({ln.get("name") for ln in root.findall("link")} - children) == 1
+        else:
+            model = mujoco.MjModel.from_xml_path(str(out))
+            assert model.njnt == 6 + len(m.external_axes)
