@@ -11,7 +11,7 @@ GEN_DIR := krl/syntax/generated
 PARSER  := $(GEN_DIR)/KRLParser.py
 SHARED_CORPUS ?= ../shared/krl-corpus
 
-.PHONY: all recover test validate growth conformance nightly bench parser java-parser clean check-python check-java vsix check-node vm-loop programmap-js
+.PHONY: all recover test validate growth conformance nightly bench parser java-parser clean check-python check-java vsix check-node vm-loop pendant-assets programmap-js
 
 all: test
 
@@ -86,15 +86,18 @@ conformance: $(PARSER) java-parser
 # (fuzz/), the tests marked slow (long sweeps; hypothesis with the nightly profile); dated
 # reports under reports/nightly/<date>/, then the history (reports/nightly/history.sqlite) and
 # the index with charts and the changes since the night before. Not part of `make test`.
+# SCHEDULER=tcp://HOST:PORT: recovery and conformance run on that Dask cluster (same reports)
+SCHEDULER ?=
+SCHED_OPT = $(if $(SCHEDULER),--scheduler $(SCHEDULER),)
 NIGHTLY_FUZZ ?= 2000
 FUZZ_SECONDS ?= 120
 nightly: $(PARSER) java-parser
 	@d=reports/nightly/$$(date -u +%Y-%m-%d); mkdir -p $$d; \
-	$(BIN)/krl recover $(SHARED_CORPUS) --out $$d/recovery; s=$$?; [ $$s -le 1 ] || exit $$s; \
+	$(BIN)/krl recover $(SHARED_CORPUS) --out $$d/recovery $(SCHED_OPT); s=$$?; [ $$s -le 1 ] || exit $$s; \
 	$(BIN)/krl growth $(SHARED_CORPUS) --out $$d/growth || exit $$?; \
 	$(BIN)/python -m recovery.scale_bench $(SHARED_CORPUS) --json > $$d/scale.json || exit $$?; \
 	$(BIN)/krl check --report $$d/check $(SHARED_CORPUS) > $$d/check.log 2>&1; \
-	$(BIN)/krl conformance --out $$d/conformance --fuzz $(NIGHTLY_FUZZ) --fuzz-random; c=$$?; \
+	$(BIN)/krl conformance --out $$d/conformance --fuzz $(NIGHTLY_FUZZ) --fuzz-random $(SCHED_OPT); c=$$?; \
 	$(BIN)/krl bench --json > $$d/bench.json 2> $$d/bench.log; \
 	$(BIN)/krl bench parse --json > $$d/bench-parse.json 2>> $$d/bench.log; \
 	$(BIN)/python -m robot.limits_bench > $$d/limits.jsonl 2>> $$d/bench.log; \
@@ -129,6 +132,18 @@ vsix: $(VSCODE_EXT)/node_modules/.installed
 	  echo "error: @vscode/vsce needs Node.js 20 or later (found $$(node --version))"; exit 2; }
 	cd $(VSCODE_EXT) && node_modules/.bin/vsce package --allow-missing-repository --skip-license --out krl.vsix
 	@echo "extension: $(VSCODE_EXT)/krl.vsix (install: code --install-extension $(VSCODE_EXT)/krl.vsix)"
+
+# The pendant's page (krl pendant, issue 36): three.js and urdf-loader from pendant/web's
+# package-lock.json (`npm ci`, again only when the lock file changes), bundled by esbuild into
+# pendant/static/pendant.js, which is committed so that pip users get it (tests/pendant checks
+# that the committed bundle is what this target builds).
+PENDANT_WEB := pendant/web
+$(PENDANT_WEB)/node_modules/.installed: $(PENDANT_WEB)/package-lock.json | check-node
+	cd $(PENDANT_WEB) && npm ci --no-audit --no-fund
+	@sha256sum $(PENDANT_WEB)/package-lock.json | cut -c1-64 > $@
+
+pendant-assets: $(PENDANT_WEB)/node_modules/.installed
+	cd $(PENDANT_WEB) && npm run build
 
 # The program map's front end (krl/programmap/web, issue 37): cytoscape and elkjs from
 # package-lock.json (npm ci, again only when the lock file changes), bundled by esbuild into

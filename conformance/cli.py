@@ -19,17 +19,25 @@ import click
 @click.option("--real-limit", type=int, default=None, help="Run at most N real programs.")
 @click.option("--fuzz-random", is_flag=True,
               help="Fresh random programs (default: the same reproducible set every run).")
+@click.option("--scheduler", default=None, metavar="tcp://HOST:PORT",
+              help="Run the cases and the real programs on this Dask distributed scheduler's cluster "
+                   "(its workers see the repository and the corpus at the same paths); the same report.")
 def conformance(out: Path, fuzz_n: int, no_real: bool, corpus: Path | None, real_limit: int | None,
-                fuzz_random: bool) -> None:
+                fuzz_random: bool, scheduler: str | None) -> None:
     """Run the hand-written cases on every available interpreter, the differential fuzzer and
     the corpus programs; write summary.json, report.md and report.html to --out.
 
     Exit code 0 when every case that is not marked pending passes and the interpreters agree,
     1 otherwise."""
     from conformance.report import DEFAULT_CORPUS, run_all  # noqa: PLC0415
+    from krl.cluster import SchedulerError  # noqa: PLC0415
 
-    s = run_all(out, fuzz_n=fuzz_n, real=not no_real, corpus=corpus or DEFAULT_CORPUS,
-                real_limit=real_limit, fuzz_random=fuzz_random, echo=click.echo)
+    try:
+        s = run_all(out, fuzz_n=fuzz_n, real=not no_real, corpus=corpus or DEFAULT_CORPUS,
+                    real_limit=real_limit, fuzz_random=fuzz_random, echo=click.echo, scheduler=scheduler)
+    except SchedulerError as exc:
+        click.echo(f"error: {exc}", err=True)
+        sys.exit(2)
     click.echo(f"cases {s['passed']}/{s['cases']} pass; pending: {len(s['pending'])}; "
                f"tree = vm: {s['tree_vm_agree'] if s['tree_vm_agree'] is not None else 'n/a (' + s['vm'] + ')'}")
     bad = bool(s["failed_not_pending"])

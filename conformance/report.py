@@ -57,22 +57,63 @@ class CaseOutcome:
         return self.agree is not False or self.case.pending_for("vm") is not None
 
 
+def case_outcome(case: H.Case, interps: list[str]) -> CaseOutcome:
+    """One case run and checked on each of `interps`, and the interpreters compared."""
+    co = CaseOutcome(case)
+    for it in interps:
+        res = H.run_case(case, it)
+        co.runs[it] = res
+        co.results[it] = H.check_case(case, res)
+    if "tree" in co.runs and "vm" in co.runs:
+        co.tree_vm = H.compare_runs(co.runs["tree"], co.runs["vm"])
+    return co
+
+
+def _on_cluster(scheduler: str, fn, tasks: list[tuple[int, tuple]], name: str, progress, failed) -> list:
+    """``fn(*args)`` of each task on the Dask cluster at `scheduler` (krl/cluster.py), in the
+    tasks' order; `progress(result)` as each arrives. A task that fails on the cluster (its
+    worker died: not a failure of the interpreters, which the results hold themselves) is
+    ``failed(*args, detail)``, a result that says so. Raises krl.cluster.SchedulerError."""
+    from krl.cluster import run_batches  # noqa: PLC0415
+
+    got = {}
+    for o in run_batches(scheduler, fn, tasks, batch_files=1, name=name):
+        got[o.key] = o.value if o.status == "done" else failed(*tasks[o.key][1], f"{o.status}: {o.detail}")
+        if progress:
+            progress(got[o.key])
+    return [got[i] for i in range(len(tasks))]
+
+
+def _case_failed(case: H.Case, interps: list[str], detail: str) -> CaseOutcome:
+    co = CaseOutcome(case)
+    for it in interps:
+        co.runs[it] = H.RunResult(it, [], None, crash=f"on the Dask cluster: {detail}")
+        co.results[it] = H.check_case(case, co.runs[it])
+    return co
+
+
+def _real_failed(prog: Path, corpus: Path, interps: list[str], _t: float, _steps: int, detail: str) -> RealOutcome:
+    ro = RealOutcome(str(prog.relative_to(corpus)) if prog.is_relative_to(corpus) else str(prog))
+    ro.crash = {it: f"on the Dask cluster: {detail}"[:300] for it in interps}
+    ro.reasons = {it: "crash" for it in interps}
+    ro.cause = "interpreter gap"
+    return ro
+
+
 def run_cases(cases: list[H.Case] | None = None, interps: list[str] | None = None,
-              *, progress=None) -> list[CaseOutcome]:
+              *, progress=None, scheduler: str | None = None) -> list[CaseOutcome]:
+    """:func:`case_outcome` of every case (default the whole suite), on this machine or, with
+    `scheduler` (``tcp://HOST:8786``), on that Dask cluster's workers (the same outcomes)."""
     cases = H.load_cases() if cases is None else cases
     interps = H.available_interpreters() if interps is None else interps
+    if scheduler is not None:
+        return _on_cluster(scheduler, case_outcome, [(i, (c, interps)) for i, c in enumerate(cases)],
+                           "krl-conformance-cases", progress, _case_failed)
     out = []
     for case in cases:
-        co = CaseOutcome(case)
-        for it in interps:
-            res = H.run_case(case, it)
-            co.runs[it] = res
-            co.results[it] = H.check_case(case, res)
-        if "tree" in co.runs and "vm" in co.runs:
-            co.tree_vm = H.compare_runs(co.runs["tree"], co.runs["vm"])
-        out.append(co)
+        out.append(case_outcome(case, interps))
         if progress:
-            progress(co)
+            progress(out[-1])
     return out
 
 
@@ -109,10 +150,12 @@ def real_programs(corpus: Path = DEFAULT_CORPUS) -> list[tuple[Path, Path]]:
 
 
 def run_real(corpus: Path = DEFAULT_CORPUS, interps: list[str] | None = None, *, limit: int | None = None,
-             max_sim_time: float | None = None, max_steps: int | None = None, progress=None) -> list[RealOutcome]:
+             max_sim_time: float | None = None, max_steps: int | None = None, progress=None,
+             scheduler: str | None = None) -> list[RealOutcome]:
     """Run the corpus programs on every interpreter with the real-programs report's limits
     (interp/realprograms.py: 60 s or the cell's ``sim_time``, the step budget with the
-    submit's), so that the causes shown here are that report's."""
+    submit's), so that the causes shown here are that report's. `scheduler`: run them on that
+    Dask cluster's workers (they see the corpus at the same paths; the same outcomes)."""
     from interp import realprograms as R  # noqa: PLC0415
 
     interps = H.available_interpreters() if interps is None else interps
@@ -121,47 +164,55 @@ def run_real(corpus: Path = DEFAULT_CORPUS, interps: list[str] | None = None, *,
     progs = real_programs(corpus)
     if limit is not None:
         progs = progs[:limit]
+    tasks = [(i, (prog, corpus, interps, max_sim_time, max_steps)) for i, (prog, _root) in enumerate(progs)]
+    if scheduler is not None:
+        return _on_cluster(scheduler, real_outcome, tasks, "krl-conformance-real", progress, _real_failed)
     out = []
-    for prog, root in progs:
-        ro = RealOutcome(str(prog.relative_to(corpus)) if prog.is_relative_to(corpus) else str(prog))
-        cell = R.cell_of(prog, corpus)
-        ro.cell = str(cell.relative_to(R.CELLS.parent.parent)) if cell is not None else ""
-        runs = {}
-        try:
-            _robot, subs, t, steps = R.report_run(prog, cell, max_sim_time, max_steps)
-        except Exception as exc:  # noqa: BLE001 - a robot or cell file that cannot be read: this row says so
-            ro.crash = {it: f"{type(exc).__name__}: {exc}"[:300] for it in interps}
-            ro.reasons = {it: "crash" for it in interps}
-            ro.cause = "interpreter gap"
-            out.append(ro)
-            if progress:
-                progress(ro)
-            continue
-        for it in interps:
-            res = H.run_program(prog, it, workspace=None, max_sim_time=t, stimuli=cell,
-                                max_steps=steps, submit=subs[0] if subs else None,
-                                wall_timeout=300.0, check=False)
-            runs[it] = res
-            if res.crash:
-                ro.crash[it] = res.crash.splitlines()[0][:300]
-                ro.reasons[it] = "crash"
-            else:
-                ends = [e for e in res.events if e.get("kind") == "end"]
-                ro.reasons[it] = ends[-1].get("reason", "?") if ends else "no end event"
-        if "tree" in runs and "vm" in runs:
-            ro.tree_vm = H.compare_runs(runs["tree"], runs["vm"], path_tol_mm=1e-6)
-        first = runs.get("tree") or next(iter(runs.values()), None)
-        if first is not None:
-            if first.crash:
-                ro.cause = "interpreter gap"
-            else:
-                row = R.row_from_trace(prog, first.events)
-                ro.cause = row["cause"]
-                ro.where = f"{Path(row['file']).name}:{row['line']}" if row.get("file") and row.get("line") else ""
-        out.append(ro)
+    for _i, args in tasks:
+        out.append(real_outcome(*args))
         if progress:
-            progress(ro)
+            progress(out[-1])
     return out
+
+
+def real_outcome(prog: Path, corpus: Path, interps: list[str], max_sim_time: float,
+                 max_steps: int) -> RealOutcome:
+    """One corpus program run on each of `interps` with the real-programs report's limits."""
+    from interp import realprograms as R  # noqa: PLC0415
+
+    ro = RealOutcome(str(prog.relative_to(corpus)) if prog.is_relative_to(corpus) else str(prog))
+    cell = R.cell_of(prog, corpus)
+    ro.cell = str(cell.relative_to(R.CELLS.parent.parent)) if cell is not None else ""
+    runs = {}
+    try:
+        _robot, subs, t, steps = R.report_run(prog, cell, max_sim_time, max_steps)
+    except Exception as exc:  # noqa: BLE001 - a robot or cell file that cannot be read: this row says so
+        ro.crash = {it: f"{type(exc).__name__}: {exc}"[:300] for it in interps}
+        ro.reasons = {it: "crash" for it in interps}
+        ro.cause = "interpreter gap"
+        return ro
+    for it in interps:
+        res = H.run_program(prog, it, workspace=None, max_sim_time=t, stimuli=cell,
+                            max_steps=steps, submit=subs[0] if subs else None,
+                            wall_timeout=300.0, check=False)
+        runs[it] = res
+        if res.crash:
+            ro.crash[it] = res.crash.splitlines()[0][:300]
+            ro.reasons[it] = "crash"
+        else:
+            ends = [e for e in res.events if e.get("kind") == "end"]
+            ro.reasons[it] = ends[-1].get("reason", "?") if ends else "no end event"
+    if "tree" in runs and "vm" in runs:
+        ro.tree_vm = H.compare_runs(runs["tree"], runs["vm"], path_tol_mm=1e-6)
+    first = runs.get("tree") or next(iter(runs.values()), None)
+    if first is not None:
+        if first.crash:
+            ro.cause = "interpreter gap"
+        else:
+            row = R.row_from_trace(prog, first.events)
+            ro.cause = row["cause"]
+            ro.where = f"{Path(row['file']).name}:{row['line']}" if row.get("file") and row.get("line") else ""
+    return ro
 
 
 # ============================================================================ plots
@@ -366,8 +417,11 @@ def _html(s, rows, interps, fuzz, real) -> str:
 
 
 def run_all(out: Path, *, fuzz_n: int = 200, real: bool = True, corpus: Path = DEFAULT_CORPUS,
-            real_limit: int | None = None, fuzz_random: bool = False, echo=print) -> dict[str, Any]:
-    """Everything `krl conformance` / `make conformance` does."""
+            real_limit: int | None = None, fuzz_random: bool = False, echo=print,
+            scheduler: str | None = None, cases: list[H.Case] | None = None) -> dict[str, Any]:
+    """Everything `krl conformance` / `make conformance` does. `scheduler`: the cases and the
+    real programs run on that Dask cluster (the fuzzer's programs run here); `cases`: these
+    instead of the whole suite."""
     status = H.interpreter_status()
     for k, v in status.items():
         echo(f"{k}: {'available' if v is None else v}")
@@ -376,7 +430,7 @@ def run_all(out: Path, *, fuzz_n: int = 200, real: bool = True, corpus: Path = D
     def prog(co):
         st = "pass" if co.passed and co.agree is not False else ("pending" if co.ok_or_pending else "FAIL")
         echo(f"  {st:7s} {co.case.name}")
-    outcomes = run_cases(progress=prog)
+    outcomes = run_cases(cases, progress=prog, scheduler=scheduler)
     echo(f"cases: {sum(o.passed for o in outcomes)}/{len(outcomes)} pass ({time.monotonic() - t0:.0f} s)")
     fz = None
     if fuzz_n > 0:
@@ -387,7 +441,7 @@ def run_all(out: Path, *, fuzz_n: int = 200, real: bool = True, corpus: Path = D
     rl = None
     if real:
         if corpus.is_dir():
-            rl = run_real(corpus, limit=real_limit,
+            rl = run_real(corpus, limit=real_limit, scheduler=scheduler,
                           progress=lambda r: echo(f"  real {r.reasons} {r.program}"))
             echo(f"real programs: {len(rl)}")
         else:
@@ -397,5 +451,5 @@ def run_all(out: Path, *, fuzz_n: int = 200, real: bool = True, corpus: Path = D
     return s
 
 
-__all__ = ["run_cases", "run_real", "write_report", "run_all", "plot_case", "summary", "CaseOutcome",
+__all__ = ["case_outcome", "real_outcome", "run_cases", "run_real", "write_report", "run_all", "plot_case", "summary", "CaseOutcome",
            "RealOutcome", "real_programs"]

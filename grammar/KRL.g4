@@ -327,6 +327,13 @@ argumentList
 
 argument
     : expression
+    | channelName
+    ;
+
+// A channel of the controller as a call argument, COPEN(:SER_3, HANDLE) (KUKA's serial
+// channels of the CREAD/CWRITE interface; declared by CHANNEL lines of $custom.dat).
+channelName
+    : ':' name
     ;
 
 switchCase

@@ -1,21 +1,38 @@
-"""`krl cell init BACKUP [PROGRAM]`: a starter cell file (issue 22, "The cell").
+"""`krl cell init BACKUP [PROGRAM]`: a starter cell file (issue 22, "The cell"; issue 34);
+`krl cell init --from-run TRACE`: the answers of a ``--inputs auto`` run as rules.
 
-It lists every input that the program(s) read — in ``WAIT FOR``, the conditions of ``IF``,
-``WHILE``, ``REPEAT ... UNTIL``, and ``INTERRUPT DECL ... WHEN`` — with the SIGNAL name, its
-input, the place it is declared and the comment of that declaration line (``$config.dat``
-comments are the I/O texts of a backup), and each with a rule to fill in, commented out.
+**The starter** lists every input that the program reads — in ``WAIT FOR``, the conditions
+of ``IF``, ``WHILE``, ``REPEAT ... UNTIL``, ``INTERRUPT DECL ... WHEN``, and the selector of
+``SWITCH`` (``SWITCH Program_PLC``, a SIGNAL group) — with the SIGNAL name, its input, the
+place it is declared and the comment of that declaration line (``$config.dat`` comments are
+the I/O texts of a backup), and each with a rule to fill in, commented out. For PROGRAM only
+what it runs is read: its own routines and every routine it calls (the checker's resolution
+of each call, transitively, interrupt routines and TRIGGER actions included), not the whole
+backup. An input passed to a routine whose parameter a condition reads
+(``WaitPermit(bPermisoEntradaBPAbajo)`` and ``WAIT FOR bPermit`` in the library routine) is
+read at that condition "through" the parameter: the parameter flow is followed through any
+number of calls. Without PROGRAM every program of the backup is read.
 
-Names are resolved by the checker (the annotations of krl/semantics: a Name's symbol, a
-SIGNAL's declaration), never by matching text. Every text taken from the backup (comments, file
-names) passes through :func:`krl.terminal.printable` and loses its line breaks: the file is YAML
-whose comments cannot be escaped from. Files of the KUKA system folders (System, Mada, STEU,
-``$``-files) and of the project's own BASIS are not read; ``TP`` (P00, the technology packages)
-is, since P00's program-number handshake reads cell inputs. The EKI channels and RSI contexts
-the programs open are listed in a commented ``network:`` section (docs/network.md).
+Names are resolved by the checker (the annotations of krl/semantics: a Name's symbol and
+storage, a call's routine, a SIGNAL's declaration), never by matching text. Every text taken
+from the backup (comments, file names) passes through :func:`krl.terminal.printable` and loses
+its line breaks: the file is YAML whose comments cannot be escaped from. Files of the KUKA
+system folders (System, Mada, STEU, ``$``-files) and of the project's own BASIS are not read;
+``TP`` (P00, the technology packages) is, since P00's program-number handshake reads cell
+inputs. Every rule the file writes is valid YAML and a valid rule once its ``#`` are taken
+away (tests/robot/test_cell.py uncomments them). The EKI channels and RSI contexts the
+programs open are listed in a commented ``network:`` section (docs/network.md).
+
+**From a run** (:func:`from_run`): each ``answer`` event of the trace (interp/runtime/autocell.py)
+becomes a commented rule that sets the same inputs; its ``when`` is the last output the program
+switched on before the answer (the request a PLC would answer), else ``"TRUE"``; ``after`` is
+the time from that output to the answer; the comment names the statement it released, its
+condition and the time.
 """
 
 from __future__ import annotations
 
+import json
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -23,6 +40,8 @@ from krl.ast import nodes as N
 from krl.project import system_folder_of
 from krl.terminal import printable
 
+#: places listed per input; the rest are counted
+MAX_PLACES = 8
 
 
 @dataclass
@@ -38,9 +57,10 @@ class InputUse:
     reads: list[str] = field(default_factory=list)
 
 
-def _conditions(module: N.Module):
-    """(kind, condition) of every WAIT FOR, IF, WHILE, REPEAT and INTERRUPT DECL of `module`."""
-    for node in module.walk():
+def _conditions(routine: N.Routine):
+    """(kind, condition) of every WAIT FOR, IF, WHILE, REPEAT, SWITCH and INTERRUPT DECL of
+    `routine`."""
+    for node in routine.walk():
         if isinstance(node, N.WaitFor):
             yield "WAIT FOR", node.cond
         elif isinstance(node, N.If):
@@ -49,8 +69,34 @@ def _conditions(module: N.Module):
             yield "WHILE", node.cond
         elif isinstance(node, N.Repeat):
             yield "UNTIL", node.cond
+        elif isinstance(node, N.Switch):
+            yield "SWITCH", node.selector
         elif isinstance(node, N.InterruptDecl):
             yield "INTERRUPT", node.when
+
+
+def _calls(routine: N.Routine):
+    for node in routine.walk():
+        if isinstance(node, N.Call):
+            yield node
+
+
+def _callee(call: N.Call):
+    """(owner module index, Routine) a call runs, or None (a built-in, nothing declares it)."""
+    c = call.ann.storage if call.ann is not None else None
+    r = getattr(c, "routine", None)
+    return (c.owner, r) if r is not None else None
+
+
+def _param_index(e, routine: N.Routine) -> int | None:
+    """The parameter of `routine` that the Name `e` is, or None."""
+    if not isinstance(e, N.Name) or e.ann is None or e.ann.storage is None:
+        return None
+    st = e.ann.storage
+    layout = routine.ann.storage if routine.ann is not None else None
+    if getattr(st, "kind", None) == 0 and layout is not None and st.slot < layout.nparams:
+        return st.slot
+    return None
 
 
 def _line_comment(path: str, line: int, cache: dict) -> str:
@@ -78,26 +124,111 @@ def _skipped(path: str, root: Path) -> bool:
     return p.name.startswith("$") or system_folder_of(rel) not in (None, "tp")
 
 
-def inputs_read(rt, root: Path) -> list[InputUse]:
-    """The inputs read by the modules of the run `rt` (an :class:`interp.runtime.core.Runtime`
-    built for the program) that lie in the backup `root`, in order of first reading."""
+def reachable(rt, program: Path | None) -> list[tuple[N.Routine, object]]:
+    """(routine, unit) of every routine the program `program` runs — its main routine and
+    every routine reached by a resolved call, transitively — or of every routine of the run's
+    files when `program` is None; in a stable order."""
+    units = rt.program.ws.units
+    where: dict[int, object] = {}
+    for u in units:
+        if u.src is not None and u.src.module is not None:
+            for r in u.src.module.routines:
+                where[id(r)] = u
+    if program is None:
+        return [(r, where[id(r)]) for u in units if u.src is not None and u.src.module is not None
+                for r in u.src.module.routines]
+    m = rt.program.module_of(program)
+    if m is None or m.main is None:
+        return []
+    todo = [m.main]
+    seen: dict[int, N.Routine] = {}
+    while todo:
+        r = todo.pop()
+        if id(r) in seen or id(r) not in where:
+            continue
+        seen[id(r)] = r
+        for call in _calls(r):
+            got = _callee(call)
+            if got is not None:
+                todo.append(got[1])
+    return [(r, where[id(r)]) for r in seen.values()]
+
+
+def _param_reads(routines: list[tuple[N.Routine, object]]) -> dict:
+    """id(routine) -> {parameter index: [(kind, Name node, file)]}: the conditions that read
+    each parameter, directly or in a routine it is passed on to (a fixed point over the calls)."""
+    reads: dict[int, dict[int, list]] = {}
+    for r, u in routines:
+        d = reads.setdefault(id(r), {})
+        for kind, cond in _conditions(r):
+            for e in cond.walk():
+                k = _param_index(e, r)
+                if k is not None:
+                    d.setdefault(k, []).append((kind, e, u.src.path))
+    changed = True
+    while changed:
+        changed = False
+        for r, _u in routines:
+            d = reads[id(r)]
+            for call in _calls(r):
+                got = _callee(call)
+                if got is None or id(got[1]) not in reads:
+                    continue
+                inner = reads[id(got[1])]
+                for j, a in enumerate(call.args):
+                    k = _param_index(a, r)
+                    if k is None or j not in inner:
+                        continue
+                    have = d.setdefault(k, [])
+                    for item in inner[j]:
+                        if item not in have:
+                            have.append(item)
+                            changed = True
+    return reads
+
+
+def inputs_read(rt, root: Path, program: Path | None = None) -> list[InputUse]:
+    """The inputs read by the routines `program` runs (every routine of the run when None)
+    that lie in the backup `root`, in order of first reading (module docstring)."""
     found: dict[str, InputUse] = {}
     cache: dict = {}
-    for m in rt.program.modules:
-        src = m.unit.src
-        if src is None or _skipped(src.path, root):
-            continue
-        shown = printable(str(Path(src.path).resolve().relative_to(root.resolve())))
-        for kind, cond in _conditions(src.module):
+    routines = reachable(rt, program)
+    mine = [(r, u) for r, u in routines if u.src is not None and not _skipped(u.src.path, root)]
+    params = _param_reads(routines)
+
+    def note(use: InputUse | None, place: str) -> None:
+        if use is None:
+            return
+        use = found.setdefault(use.name, use)
+        if place not in use.reads:
+            use.reads.append(place)
+
+    for r, u in mine:
+        shown = _shown(u.src.path, root)
+        for kind, cond in _conditions(r):
             for e in cond.walk():
-                use = _input(e, root, cache)
+                note(_input(e, root, cache), f"{shown}:{e.span.line} ({kind})")
+        for call in _calls(r):
+            got = _callee(call)
+            inner = params.get(id(got[1]), {}) if got is not None else {}
+            for j, a in enumerate(call.args):
+                if a is None or j not in inner:
+                    continue
+                use = _input(a, root, cache)
                 if use is None:
                     continue
-                use = found.setdefault(use.name, use)
-                place = f"{shown}:{e.span.line} ({kind})"
-                if place not in use.reads:
-                    use.reads.append(place)
+                pname = got[1].params[j].name if j < len(got[1].params) else "?"
+                for kind, e, path in inner[j]:
+                    note(use, f"{_shown(path, root)}:{e.span.line} ({kind}, through parameter {pname} "
+                              f"from {shown}:{call.span.line})")
     return list(found.values())
+
+
+def _shown(path: str, root: Path) -> str:
+    try:
+        return printable(str(Path(path).resolve().relative_to(root.resolve())))
+    except ValueError:
+        return printable(Path(path).name)
 
 
 def _input(e: N.Node, root: Path, cache: dict) -> InputUse | None:
@@ -119,13 +250,14 @@ def _input(e: N.Node, root: Path, cache: dict) -> InputUse | None:
     path = sym.path or (decl.span.file if decl.span is not None else "")
     declared = ""
     if path:
-        try:
-            declared = printable(str(Path(path).resolve().relative_to(root.resolve())))
-        except ValueError:
-            declared = printable(Path(path).name)
-        declared += f":{decl.span.line}"
+        declared = _shown(path, root) + f":{decl.span.line}"
     comment = _line_comment(path, decl.span.line, cache) if path else ""
     return InputUse(sym.name.upper(), addr, declared, comment, group=b is not None)
+
+
+def _key(name: str) -> str:
+    """A signal name as a YAML flow-mapping key: a SIGNAL name as it is, ``$IN[n]`` quoted."""
+    return name if name.replace("_", "A").isalnum() else json.dumps(name)
 
 
 NETWORK_CALLS = {"EKI_INIT": "eki", "EKI_LOAD": "eki", "RSI_CREATE": "rsi", "RSI_LOAD": "rsi"}
@@ -194,8 +326,9 @@ def _network_lines(opened: list[tuple[str, str, str]], root: Path) -> list[str]:
 
 def starter(uses: list[InputUse], programs: list[str], own_robot: bool = True,
             network: list[str] = ()) -> str:
-    """The text of the starter cell file (YAML; every rule commented out). `own_robot`: the
-    backup has machine data of its own (else the file asks for the cell's robot)."""
+    """The text of the starter cell file (YAML; every rule commented out, each valid once
+    uncommented). `own_robot`: the backup has machine data of its own (else the file asks for
+    the cell's robot). `network`: the commented ``network:`` lines."""
     from robot.machine import library_robots  # noqa: PLC0415
 
     names = ", ".join(library_robots())
@@ -208,7 +341,10 @@ def starter(uses: list[InputUse], programs: list[str], own_robot: bool = True,
            "# Every input the programs read is listed with a rule to fill in: uncomment it, write in",
            "# `when` the program's output (or condition) the PLC answers, in `after` its delay (s).",
            "# A rule fires on the rising edge of `when`; run with: krl run PROGRAM --inputs THIS_FILE",
+           "# (or let the automatic cell answer: krl run PROGRAM --inputs auto --trace RUN.jsonl, then",
+           "# krl cell init --from-run RUN.jsonl writes its answers as rules)",
            robot,
+           "# start: XHOME      # where the robot stands at the start (a point name or an E6AXIS literal)",
            "presets:",
            "  autoext: false      # true: Automatic External ($I_O_ACTCONF; P00 of a cell program)",
            "  # pgno: 1           # the program number the PLC answers in P00's handshake",
@@ -223,18 +359,18 @@ def starter(uses: list[InputUse], programs: list[str], own_robot: bool = True,
         if u.comment:
             head += f"   ; {u.comment}"
         out.append(head)
-        for place in u.reads[:8]:
+        for place in u.reads[:MAX_PLACES]:
             out.append(f"  #   read at {place}")
-        if len(u.reads) > 8:
-            out.append(f"  #   ... and {len(u.reads) - 8} more places")
-        key = u.name if not u.name.startswith("$") else f"\"{u.name}\""
-        value = "0   # a number: the group's bits" if u.group else "true"
-        out += ["  # - when: \"TRUE\"", "  #   after: 1.0", f"  #   set: {{{key}: {value}}}", ""]
+        if len(u.reads) > MAX_PLACES:
+            out.append(f"  #   ... and {len(u.reads) - MAX_PLACES} more places")
+        value = "0}   # a number: the group's bits, bit 0 on its first input" if u.group else "true}"
+        out += ["  # - when: \"TRUE\"", "  #   after: 1.0", f"  #   set: {{{_key(u.name)}: {value}", ""]
     return "\n".join(out).rstrip() + "\n"
 
 
-def cell_init(root: Path, programs: list[Path]) -> str:
-    """The starter cell file for `programs` of the backup `root` (see the module docstring)."""
+def cell_init(root: Path, programs: list[Path], whole: bool = False) -> str:
+    """The starter cell file for `programs` of the backup `root` (see the module docstring):
+    what each program runs; with `whole` (no program asked), every routine of the backup."""
     from interp.run import make_runtime  # noqa: PLC0415
     from robot.machine import load_machine  # noqa: PLC0415
 
@@ -242,13 +378,13 @@ def cell_init(root: Path, programs: list[Path]) -> str:
     opened: dict[tuple[str, str], tuple[str, str, str]] = {}
     covered: set[str] = set()
     for prog in programs:
-        if str(prog.resolve()) in covered:
+        if whole and str(prog.resolve()) in covered:
             continue        # its module was loaded with an earlier program's files (one backup)
         # the starter reads inputs and moves no robot: the backup's machine data are not read
         # (a robot the model refuses must not stop it; docs/robot.md), the default robot stands in
         rt, _ = make_runtime(prog, mujoco=False, check=False, robot=load_machine())
         covered |= {str(Path(m.unit.src.path).resolve()) for m in rt.program.modules if m.unit.src is not None}
-        for u in inputs_read(rt, root):
+        for u in inputs_read(rt, root, None if whole else prog):
             have = found.setdefault(u.name, u)
             if have is not u:
                 have.reads += [r for r in u.reads if r not in have.reads]
@@ -264,3 +400,63 @@ def cell_init(root: Path, programs: list[Path]) -> str:
 
     return starter(list(found.values()), shown, own_robot=machine_data_file(root) is not None,
                    network=_network_lines(list(opened.values()), root))
+
+
+# ---------------------------------------------------------------------- from a run
+def from_run(events, source: str = "") -> str:
+    """The rules file of the answers of a ``--inputs auto`` run: `events` the trace's events
+    (robot/trace.py ``read_trace``), `source` the trace's name for the header (module
+    docstring). Every rule is commented out, each valid once uncommented."""
+    out = ["# Cell rules from the answers of an automatic cell (krl run --inputs auto), written by",
+           f"# `krl cell init --from-run{' ' + printable(source) if source else ''}` (issue 34; robot/cellrules.py).",
+           "# Each answer set the inputs a starving program waited for. Uncomment a rule to keep it and",
+           "# write in `when` what the PLC really answers (the program's output that asks for it).",
+           "rules:"]
+    last_on: tuple[float, str] | None = None
+    n = 0
+    seen: set = set()
+    for ev in events:
+        kind = ev.get("kind")
+        if kind == "io" and ev.get("source") in ("program", "trigger") and ev.get("value") is True \
+                and str(ev.get("signal", "")).startswith("$OUT["):
+            last_on = (float(ev["t"]), str(ev["signal"]))
+        if kind != "answer":
+            continue
+        sets = ev.get("sets") or {}
+        names = ev.get("names") or {}
+        t = float(ev["t"])
+        items = []
+        for sig, v in sets.items():
+            name = names.get(sig)
+            if name and name.replace("_", "A").isalnum():
+                items.append(f"{_key(printable(name).upper())}: {_value(v)}")
+            elif sig.count("[") == 1 and ".." not in sig:
+                items.append(f"{_key(printable(sig))}: {_value(v)}")
+            else:       # a group without a SIGNAL name: its bits
+                a, b = sig[4:-1].split("..")
+                for i, bit in enumerate(range(int(a), int(b) + 1)):
+                    items.append(f"{_key(f'$IN[{bit}]')}: {_value(bool((int(v) >> i) & 1))}")
+        if not items:
+            continue
+        when, after = '"TRUE"', 0.5
+        if last_on is not None and last_on[0] <= t:
+            when, after = json.dumps(last_on[1]), round(t - last_on[0], 3)
+        key = (when, tuple(items))
+        place = f"{printable(Path(str(ev.get('file', ''))).name)}:{ev.get('line')}"
+        out.append(f"  # at {t:.3f} s: {printable(str(ev.get('statement', '')))} at {place}"
+                   + (f": {printable(str(ev.get('condition')))[:100]}" if ev.get("condition") else ""))
+        if key in seen:
+            out.append("  # (the same rule as above)")
+            continue
+        seen.add(key)
+        n += 1
+        out += [f"  # - when: {when}", f"  #   after: {after}", f"  #   set: {{{', '.join(items)}}}", ""]
+    if n == 0:
+        out.append("  # (the run has no answers of the automatic cell: was it run with --inputs auto and --trace?)")
+    return "\n".join(out).rstrip() + "\n"
+
+
+def _value(v) -> str:
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    return str(int(v))

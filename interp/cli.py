@@ -11,6 +11,8 @@ from pathlib import Path
 
 import click
 
+from robot.trace import TRACE_REPEATS
+
 
 @click.command("run")
 @click.argument("program", type=click.Path(path_type=Path))
@@ -18,7 +20,9 @@ import click
               show_default=True, help="Interpreter.")
 @click.option("--workspace", type=click.Path(path_type=Path), default=None,
               help="Folder of the program's modules, or a KRC backup .zip (default: the program's folder; a KRC backup is detected).")
-@click.option("--inputs", type=click.Path(path_type=Path), default=None, help="Stimuli YAML (robot/stimuli.py).")
+@click.option("--inputs", type=click.Path(path_type=Path), default=None,
+              help="A cell file (stimuli, rules, presets: robot/stimuli.py), or `auto`: the automatic cell "
+                   "sets the inputs the program starves for (interp/runtime/autocell.py; docs/robot.md).")
 @click.option("--trace", "trace_path", type=click.Path(path_type=Path), default=None, help="Write the JSONL trace here.")
 @click.option("--max-sim-time", type=float, default=600.0, show_default=True, help="Simulated-time limit (s).")
 @click.option("--max-steps", type=int, default=10_000_000, show_default=True,
@@ -49,97 +53,76 @@ import click
               help="The robot to simulate: a robot YAML, a $machine.dat, a KRC backup folder or .zip "
                    "(default: the robot the --inputs cell file names, else the backup's own robot from its "
                    "R1/Mada/$machine.dat, else the KR 6 R900).")
-def run(program: Path, interp_kind: str, workspace, inputs, trace_path, max_sim_time, max_steps, submit,
-        mode, run_mode, pgno, no_check, robot, no_submit) -> None:
+@click.option("--start", "start", default=None, metavar="AXIS_OR_POINT",
+              help="Where the robot stands at the start: an E6AXIS literal (\"{A1 0, A2 -90, A3 90, A4 0, A5 0, "
+                   "A6 0}\") or a point of the program such as XHOME (default: the cell file's start:, with "
+                   "--inputs auto XHOME, else $AXIS_HOME[1]).")
+@click.option("--on-halt", "on_halt", default="stop", show_default=True, metavar="stop|continue[:N]",
+              help="After a HALT: stop the run, or `continue`: the operator presses Start again (at most N "
+                   "times, default 10; then the HALT ends the run).")
+@click.option("--trace-repeats", "trace_repeats", type=click.IntRange(0, None), default=TRACE_REPEATS,
+              show_default=True,
+              help="A spin in the trace: each repeated event (statement, call, I/O change, message, pose "
+                   "at rest) is written this many times, then counted in a `repeat` event; 0 writes every event.")
+def run(**options) -> None:
     """Run PROGRAM (.src) on the simulated KR C4; print where and why it ended.
 
     With --workspace BACKUP.zip (a KRC backup archive) PROGRAM is a path inside the archive
     (KRC/R1/Program/demo.src) or a module name (demo); the archive is checked and extracted
     to a temporary folder (krl/archive.py) that is removed after the run.
     """
-    from krl.archive import ArchiveError, backup_source, is_archive  # noqa: PLC0415
-    from krl.terminal import printable  # noqa: PLC0415
+    from interp.run import RunSetupError, run_setup  # noqa: PLC0415
 
-    if is_archive(program):
-        click.echo(f"error: {printable(program)} is a backup archive; name the program to run in it: "
-                   f"krl run --workspace {printable(program)} PROGRAM", err=True)
+    options["halt_continues"] = halt_option(options.pop("on_halt"))
+    try:
+        with run_setup(options) as setup:
+            _run(setup)
+    except RunSetupError as exc:
+        click.echo(f"error: {exc}", err=True)
         sys.exit(2)
-    if workspace is not None and is_archive(workspace):
-        try:
-            with backup_source(workspace) as (folder, shown):
-                found = program_in(folder, program)
-                if found is None:
-                    click.echo(f"error: no program {printable(program)} in {printable(workspace)}", err=True)
-                    sys.exit(2)
-                _run(found, folder, inputs, trace_path, max_sim_time, max_steps, submit, interp_kind,
-                     mode=mode, shown=lambda text: text.replace(str(folder), str(workspace)), check=not no_check,
-                     run_mode=run_mode, pgno=pgno, robot=robot, auto_submit=not no_submit)
-        except ArchiveError as exc:
-            click.echo(f"error: {printable(exc)}", err=True)
-            sys.exit(2)
-        return
-    _run(program, workspace, inputs, trace_path, max_sim_time, max_steps, submit, interp_kind, mode=mode,
-         check=not no_check, run_mode=run_mode, pgno=pgno, robot=robot, auto_submit=not no_submit)
 
 
-def program_in(folder: Path, program: Path) -> Path | None:
-    """PROGRAM inside an extracted archive: its relative path (any letter case of the file
-    name), else the .src (then .sub) file whose stem is its name; None when there is none."""
-    from krl.source import is_krl_file  # noqa: PLC0415
-
-    direct = folder / program
-    if not program.is_absolute() and ".." not in program.parts and direct.is_file():
-        return direct
-    stem = program.stem.lower()
-    candidates = sorted(p for p in folder.rglob("*") if p.is_file() and is_krl_file(p) and p.stem.lower() == stem)
-    for suffix in (".src", ".sub"):
-        for p in candidates:
-            if p.suffix.lower() == suffix:
-                return p
-    return None
+#: ``--on-halt continue`` without a count: the operator presses Start again at most this often
+HALT_CONTINUES = 10
 
 
-def _run(program: Path, workspace, inputs, trace_path, max_sim_time, max_steps, submit, interp_kind,
-         mode=None, shown=lambda text: text, check: bool = True, run_mode: str = "GO",
-         pgno: int | None = None, robot=None, auto_submit: bool = False) -> None:
-    if not program.exists():
-        click.echo(f"error: {program}: no such file", err=True)
-        sys.exit(2)
-    for sub in submit:
-        if not Path(sub).is_file():
-            click.echo(f"error: {shown(str(sub))}: no such submit program", err=True)
-            sys.exit(2)
-    booted = None
-    if not submit and auto_submit:
-        from krl.project import boot_submit  # noqa: PLC0415
+def halt_option(text: str) -> int:
+    """The times the operator presses Start again after a HALT (``--on-halt``: ``stop`` 0,
+    ``continue`` :data:`HALT_CONTINUES`, ``continue:N`` N, 1 <= N <= MAX_HALT_CONTINUES).
+    Exits 2 for
+    anything else."""
+    t = (text or "stop").strip().lower()
+    if t == "stop":
+        return 0
+    if t == "continue":
+        return HALT_CONTINUES
+    from krl.limits import MAX_HALT_CONTINUES  # noqa: PLC0415
 
-        booted = boot_submit(program, workspace)
-        submit = (booted,) if booted is not None else ()
-    from interp.run import cell_of, make_runtime, robot_for  # noqa: PLC0415
+    if t.startswith("continue:") and t[9:].isdigit() and 1 <= int(t[9:]) <= MAX_HALT_CONTINUES:
+        return int(t[9:])
+    click.echo(f"error: --on-halt {text!r}: stop, continue or continue:N (N 1..{MAX_HALT_CONTINUES})", err=True)
+    sys.exit(2)
+
+
+def _run(setup) -> None:
+    """Run `setup` (interp.run.RunSetup) and print the summary; exits with the run's code."""
     from interp.summary import RunObserver, starvation_lines, summary_lines  # noqa: PLC0415
-    from robot.mada import MachineDataError  # noqa: PLC0415
     from krl.terminal import printable  # noqa: PLC0415
-    from robot.stimuli import StimulusError  # noqa: PLC0415
+    from robot.stimuli import StartError, StimulusError  # noqa: PLC0415
     from robot.trace import TraceWriter  # noqa: PLC0415
     from net.hub import NetError  # noqa: PLC0415
 
-    try:
-        inputs = cell_of(inputs)      # the cell file, read once: the robot and the run take it
-        machine = robot_for(program, workspace, robot, inputs)
-    except (MachineDataError, StimulusError) as exc:
-        click.echo(f"error: {shown(printable(exc))}", err=True)
-        sys.exit(2)
-    trace = TraceWriter(trace_path) if trace_path else None
+    shown, machine, program = setup.shown, setup.machine, setup.program
+    trace_path = setup.options.get("trace_path")
+    trace_repeats = setup.options.get("trace_repeats", TRACE_REPEATS)
+    trace = TraceWriter(trace_path, repeats=trace_repeats or None) if trace_path else None
     if trace is not None:
         # the trace header: which robot the run simulates and where its data came from
         trace.write("robot", 0.0, name=machine.name, source=shown(machine.source),
                     trafoname=machine.trafoname or None)
     observer = RunObserver()
     try:
-        rt, _ = make_runtime(program, workspace=workspace, inputs=inputs, trace=trace,
-                             max_sim_time=max_sim_time, max_steps=max_steps, submit=list(submit),
-                             interp=interp_kind, observer=observer, mode=mode, check=check,
-                             run_mode=run_mode.upper(), pgno=pgno, robot=machine)
+        rt, _ = setup.make_runtime(trace=trace, observer=observer)
         _announce_partners(rt)
         errors = rt.program.errors_of(rt.program.module_of(rt.program.main_path))
         if errors:
@@ -149,7 +132,7 @@ def _run(program: Path, workspace, inputs, trace_path, max_sim_time, max_steps, 
             click.echo(f"not started: {len(errors)} error(s) found by the checker (--no-check runs it anyway)")
             sys.exit(1)
         res = rt.run()
-    except (StimulusError, NetError) as exc:
+    except (StimulusError, StartError, NetError) as exc:
         click.echo(f"error: {shown(printable(exc))}", err=True)
         sys.exit(2)
     except KeyboardInterrupt:
@@ -164,17 +147,27 @@ def _run(program: Path, workspace, inputs, trace_path, max_sim_time, max_steps, 
     prog = rt.program
     ws_note = None
     if prog.backup:
-        ws_note = f"{prog.workspace} (KRC backup{' found above the program' if workspace is None else ''})"
-    elif workspace is not None:
+        ws_note = f"{prog.workspace} (KRC backup{' found above the program' if setup.workspace is None else ''})"
+    elif setup.workspace is not None:
         ws_note = str(prog.workspace)
-    for line in summary_lines(res, observer, program=str(program), interp=interp_kind,
+    booted = setup.booted
+    for line in summary_lines(res, observer, program=str(program), interp=setup.interp,
                               submits=[t for t in rt.scheduler.tasks if t.kind == "submit"],
                               workspace=ws_note, starving=starvation_lines(rt),
-                              robot=f"{machine.name} ({machine.source})"):
+                              robot=f"{machine.name} ({machine.source}{_chosen(program, setup.workspace)})",
+                              run=rt):
         click.echo(shown(line))
         if booted is not None and line.startswith("  workspace"):
             click.echo(shown(f"  submit     {booted} (the backup's, started as at boot; --no-submit: without)"))
     sys.exit(res.exit_code)
+
+
+def _chosen(program: Path, workspace) -> str:
+    """``; chosen by ...`` when --inputs auto chose the robot (interp/scene.py)."""
+    from interp.scene import chosen  # noqa: PLC0415
+
+    c = chosen(program, workspace)
+    return f"; {c.note}" if c is not None else ""
 
 
 def _announce_partners(rt) -> None:
@@ -203,35 +196,51 @@ def cell() -> None:
 
 
 @cell.command("init")
-@click.argument("backup", type=click.Path(path_type=Path))
+@click.argument("backup", required=False, type=click.Path(path_type=Path))
 @click.argument("program", required=False, type=click.Path(path_type=Path))
 @click.option("-o", "--output", type=click.Path(path_type=Path), default=None,
               help="Write the starter file here (default: print it).")
-def cell_init_cmd(backup: Path, program: Path | None, output: Path | None) -> None:
-    """Write a starter cell file for PROGRAM (a path or a module name in BACKUP), or for every
-    program of BACKUP: each input the programs read, with a rule to fill in."""
-    from interp.cellinit import cell_init  # noqa: PLC0415
+@click.option("--from-run", "from_run", type=click.Path(path_type=Path), default=None, metavar="TRACE",
+              help="Instead: the answers of a `krl run --inputs auto --trace TRACE` run as rules (commented).")
+def cell_init_cmd(backup: Path | None, program: Path | None, output: Path | None, from_run: Path | None) -> None:
+    """Write a starter cell file for PROGRAM (a path or a module name in BACKUP): each input it
+    reads, with a rule to fill in; without PROGRAM for every program of BACKUP. With
+    --from-run TRACE, the answers of an automatic cell's run as rules."""
+    from interp.cellinit import cell_init, from_run as rules_from_run  # noqa: PLC0415
     from interp.realprograms import programs_of  # noqa: PLC0415
+    from interp.run import program_in  # noqa: PLC0415
     from krl.project import backup_of  # noqa: PLC0415
     from krl.terminal import printable  # noqa: PLC0415
 
-    if not backup.is_dir():
-        click.echo(f"error: {printable(backup)}: not a folder", err=True)
-        sys.exit(2)
-    root = backup_of(backup.resolve()) or backup.resolve()
-    if program is not None:
-        found = program if program.is_file() else program_in(root, program)
-        if found is None:
-            click.echo(f"error: no program {printable(program)} in {printable(backup)}", err=True)
+    if from_run is not None:
+        from robot.trace import read_trace  # noqa: PLC0415
+
+        try:
+            text = rules_from_run(read_trace(from_run), str(from_run))
+        except (OSError, ValueError, UnicodeDecodeError) as exc:
+            click.echo(f"error: {printable(from_run)}: not a trace of krl run: {printable(exc)}", err=True)
             sys.exit(2)
-        programs = [found]
     else:
-        programs = programs_of(root)
-    try:
-        text = cell_init(root, programs)
-    except Exception as exc:  # noqa: BLE001 - never a traceback for input
-        click.echo(f"error: {printable(exc)}", err=True)
-        sys.exit(2)
+        if backup is None:
+            click.echo("error: name the BACKUP (or give --from-run TRACE)", err=True)
+            sys.exit(2)
+        if not backup.is_dir():
+            click.echo(f"error: {printable(backup)}: not a folder", err=True)
+            sys.exit(2)
+        root = backup_of(backup.resolve()) or backup.resolve()
+        if program is not None:
+            found = program if program.is_file() else program_in(root, program)
+            if found is None:
+                click.echo(f"error: no program {printable(program)} in {printable(backup)}", err=True)
+                sys.exit(2)
+            programs = [found]
+        else:
+            programs = programs_of(root)
+        try:
+            text = cell_init(root, programs, whole=program is None)
+        except Exception as exc:  # noqa: BLE001 - never a traceback for input
+            click.echo(f"error: {printable(exc)}", err=True)
+            sys.exit(2)
     if output is None:
         click.echo(text, nl=False)
     else:

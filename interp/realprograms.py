@@ -2,20 +2,26 @@
 (issue 6, "Real programs").
 
 A *backup* is a folder with ``R1/System`` (or a flat export with ``System/$config.dat``); its
-*programs* are the ``.src`` files under its Program folders (and ``cell.src``) whose main
-routine takes no parameters. Each runs on the tree interpreter with the backup's own
-System folder (BASIS, ``$config.dat``), its cell file (:func:`cell_of`: the committed
-``corpus/cells``; ``--no-cells`` runs without), ``--max-sim-time`` 60 s and 300 000 steps of
-the program's own, beside its SPS.SUB: the steps a submit program may take within the time
-limit are added to the step limit (:func:`step_limit`), so a submit cycling at its budget does
-not end the run before its time.
+*programs* (entry points, :func:`entries_of`) are the ``.src`` files under its Program folders
+(and ``cell.src``) whose main routine takes no parameters, and its ``SPS.SUB``. Each runs on
+the tree interpreter with the backup's own System folder (BASIS, ``$config.dat``),
+``--max-sim-time`` 60 s and 300 000 steps of the program's own, beside its SPS.SUB (an
+SPS.SUB entry runs alone): the steps a submit program may take within the time limit are
+added to the step limit (:func:`step_limit`), so a submit cycling at its budget does not end
+the run before its time.
+
+Each program runs twice (two columns of the report, issue 34): with its committed cell file
+(:func:`cell_of`: ``corpus/cells``; ``--no-cells`` runs this column without), and with
+``--inputs auto`` — the automatic cell (interp/runtime/autocell.py) and nothing hand-written.
+``--columns cells`` or ``--columns auto`` runs one.
 
 Every stop gets one *cause* (:func:`cause_of`, issue 22 "Every stop explained"):
 
 * ``completed``;
 * ``intended end``: the program's own ``HALT``, or a cycle loop stopped by the time or step
-  limit while the cell answers it (a rule of the cell file wrote an input in the last quarter
-  of the run: the cycle was still running);
+  limit while the cell answers it (a rule of the cell file or an answer of the automatic cell
+  wrote an input in the last quarter of the run: the cycle was still running), or an
+  ``SPS.SUB`` cycling at the limit (a submit program never ends, reference §9);
 * ``program error``: a KRL run-time error of the program, at its file:line; also a motion
   whose target the backup's own robot cannot take (the run simulates the robot of the
   backup's ``$machine.dat``, and no axis configuration of the target — any status, turn,
@@ -36,7 +42,9 @@ A run-time error of the backup's submit program (SPS.SUB) does not end the run: 
 Routines of technology packages absent from the backup are stubbed (a ``message`` event
 "stub: NAME"), and the report lists the stubs.
 
-Usage: ``python -m interp.realprograms [CORPUS] [--json OUT] [--limit N]``.
+Usage: ``python -m interp.realprograms [CORPUS] [--json OUT] [--limit N] [--columns cells,auto]
+[--scheduler tcp://HOST:PORT]`` (``--scheduler``: the runs go to a Dask cluster, :func:`run_rows`;
+the same report).
 """
 
 from __future__ import annotations
@@ -60,6 +68,10 @@ LEGITIMATE = ("deadlock", "halt", "max_sim_time", "max_steps")
 #: :func:`time_limit`) and statements of the robot program (:func:`step_limit` adds the submit's)
 REPORT_SIM_TIME_S = 60.0
 REPORT_STEPS = 300_000
+#: the time limit of the --inputs auto column: ``krl run``'s own (s). Nothing hand-written says
+#: how long a job takes; a program that starves costs nothing while it waits (the idle
+#: fast-forward), one that works runs to its end. An SPS.SUB entry keeps REPORT_SIM_TIME_S.
+AUTO_SIM_TIME_S = 600.0
 
 #: the causes of a stop, in report order
 CAUSES = ("completed", "intended end", "program error", "interpreter gap", "limit")
@@ -137,6 +149,8 @@ def cause_of(row: dict) -> str:
     t = row.get("sim_time") or 0.0
     if row.get("cell_answers") and last is not None and last >= 0.75 * t:
         return "intended end"
+    if str(row.get("program", "")).lower().endswith(".sub") and reason in ("max_sim_time", "max_steps"):
+        return "intended end"
     return "limit"
 
 
@@ -166,6 +180,16 @@ def programs_of(root: Path) -> list[Path]:
     return out
 
 
+def entries_of(root: Path) -> list[Path]:
+    """The entry points of the backup at `root`: :func:`programs_of`, then its ``SPS.SUB``
+    (krl.project.boot_submit), as a controller starts it at boot."""
+    from krl.project import boot_submit  # noqa: PLC0415
+
+    progs = programs_of(root)
+    sub = boot_submit(progs[0]) if progs else None
+    return progs + ([sub] if sub is not None and sub not in progs else [])
+
+
 def normalise(text: str) -> str:
     t = re.sub(r"-?\d+(\.\d+)?", "N", text or "")
     t = re.sub(r"/\S+", "PATH", t)
@@ -174,10 +198,13 @@ def normalise(text: str) -> str:
 
 def submit_of(path: Path) -> list[Path]:
     """The backup's SPS.SUB (krl.project.boot_submit), started beside the program as
-    the controller does at boot (reference §9); empty outside a backup."""
+    the controller does at boot (reference §9); empty outside a backup, and for the SPS.SUB
+    itself run as the entry point."""
     from krl.project import boot_submit  # noqa: PLC0415
 
     sub = boot_submit(path)
+    if sub is not None and Path(sub).resolve() == Path(path).resolve():
+        return []
     return [sub] if sub is not None else []
 
 
@@ -206,51 +233,72 @@ def time_limit(path: Path, cell, default: float) -> float:
 
 
 def report_run(path: Path, cell: Path | None, max_sim_time: float = REPORT_SIM_TIME_S,
-               max_steps: int = REPORT_STEPS) -> tuple:
+               max_steps: int = REPORT_STEPS, auto: bool = False) -> tuple:
     """``(robot, submit programs, simulated-time limit s, step limit)`` of the report's run of
-    `path` with its cell file (a path or a Cell; this report and the conformance report's real
-    programs): the cell's robot, else the backup's own, else the KR 6 R900
-    (interp.run.robot_for); the backup's SPS.SUB; :func:`time_limit` and :func:`step_limit`."""
+    `path` with its cell file (a path or a Cell: interp.run.cell_of), or with ``--inputs auto``
+    (`auto`; this report and the conformance report's real programs): the cell's robot, else
+    the backup's own, else (auto) the library robot that reaches the backup's points, else the
+    KR 6 R900 (interp.run.robot_for); the backup's SPS.SUB (none for the SPS.SUB itself: it
+    runs as the program, at a submit interpreter's pace); :func:`time_limit` (auto: the longer
+    :data:`AUTO_SIM_TIME_S` for a robot program) and :func:`step_limit`."""
     from interp.run import cell_of, robot_for  # noqa: PLC0415
 
-    cell = cell_of(cell)
-    robot = robot_for(path, inputs=cell)
+    cell = None if auto else cell_of(cell)
+    robot = robot_for(path, inputs="auto" if auto else cell)
     submit = submit_of(path)
-    t = time_limit(path, cell, max_sim_time)
-    return robot, submit, t, step_limit(max_steps, t, len(submit), robot.ipo_cycle_s)
+    sub = path.suffix.lower() == ".sub"
+    if auto:
+        t = max_sim_time if sub else max(max_sim_time, AUTO_SIM_TIME_S)
+    else:
+        t = time_limit(path, cell, max_sim_time)
+    return robot, submit, t, step_limit(max_steps, t, len(submit) + sub, robot.ipo_cycle_s)
 
 
-def run_one(path: Path, max_sim_time: float, max_steps: int, cell: Path | None = None) -> dict:
+def run_one(path: Path, max_sim_time: float, max_steps: int, cell: Path | None = None,
+            auto: bool = False, interp: str = "tree") -> dict:
+    """One run of the report (module docstring): with the cell file `cell` (a path or a Cell:
+    interp.run.cell_of), or with ``--inputs auto`` (`auto`; then `cell` is not used), on the
+    interpreter `interp`. The row holds how it ended, its cause, the stand-ins of KUKA's
+    software (``stubs``, name -> uses), the cell's answers (``cell_answers``, ``cell_last`` s;
+    ``answers``: the automatic cell's, described) and the idle time skipped."""
     from interp.run import cell_of, make_runtime  # noqa: PLC0415
-    from robot.trace import TraceWriter  # noqa: PLC0415
 
     t0 = time.time()
-    tw = TraceWriter(keep=False)
-    shown = cell
+    shown = None if auto else cell
     try:
-        cell = cell_of(cell)          # the cell file, read once for the robot, the limits and the run
-        robot, submit, max_sim_time, limit = report_run(path, cell, max_sim_time, max_steps)
+        cell = None if auto else cell_of(cell)   # the cell file, read once for the robot, the limits and the run
+        inputs = "auto" if auto else cell
+        robot, submit, max_sim_time, limit = report_run(path, cell, max_sim_time, max_steps, auto)
         own = _own_machine_data(path, robot.source)
+        from interp.runtime.scheduler import SUBMIT_BUDGET  # noqa: PLC0415
+
         # --no-check: the report says how each real program runs, also those the checker rejects
         rt, _ = make_runtime(path, trace=None, mujoco=False, max_sim_time=max_sim_time, max_steps=limit,
-                             submit=submit, check=False, inputs=cell, robot=robot)
+                             submit=submit, check=False, inputs=inputs, robot=robot, interp=interp,
+                             robot_budget=SUBMIT_BUDGET if path.suffix.lower() == ".sub" else None)
         res = rt.run()
-        stubs = sorted(rt.program.stubs)
+        stubs = {name: n for name, _what, n in rt.kss.summary()}
         rules = rt.controller.rules
         fired = [r.last_fired for r in rules if r.last_fired is not None]
+        answers = rt.autocell.answers if rt.autocell is not None else []
+        fired += [a.t for a in answers]
     except Exception as exc:  # noqa: BLE001 - an internal error is a bug to report
-        row = {"program": str(path), "reason": "internal", "text": f"{type(exc).__name__}: {exc}",
+        row = {"program": str(path), "mode": "auto" if auto else "cells", "reason": "internal",
+               "text": f"{type(exc).__name__}: {exc}",
                "seconds": round(time.time() - t0, 2), "cell": str(shown) if shown else None}
         row["cause"] = cause_of(row)
         return row
-    del tw
-    row = {"program": str(path), "reason": res.reason, "text": res.text,
+    row = {"program": str(path), "mode": "auto" if auto else "cells", "interp": interp,
+           "reason": res.reason, "text": res.text,
            "number": res.error.number if res.error is not None else None,
            "file": res.file, "line": res.line, "sim_time": round(res.sim_time, 3),
            "steps": res.steps, "stubs": stubs, "submit": submit_errors(rt),
            "seconds": round(time.time() - t0, 2),
-           "cell": str(shown) if shown else None, "cell_answers": sum(r.fired for r in rules),
+           "cell": str(shown) if shown else None,
+           "cell_answers": sum(r.fired for r in rules) + len(answers),
            "cell_last": round(max(fired), 3) if fired else None,
+           "answers": [a.describe() for a in answers],
+           "idle_s": round(rt.scheduler.idle.skipped * rt.controller.dt, 3),
            "robot": robot.name, "robot_own": own}
     row["cause"] = cause_of(row)
     return row
@@ -271,6 +319,35 @@ def causes(rows: list[dict]) -> Counter:
     """Programs by cause, in :data:`CAUSES` order."""
     by = Counter(r.get("cause") or cause_of(r) for r in rows)
     return Counter({k: by[k] for k in CAUSES if by[k]})
+
+
+def report_columns(rows: list[dict]) -> str:
+    """The two columns side by side (issue 34): each program's cause with its committed cell
+    file and with ``--inputs auto``, and the totals of each column."""
+    by_prog: dict[str, dict] = {}
+    for r in rows:
+        by_prog.setdefault(r["program"], {})[r.get("mode", "cells")] = r
+    cols = [c for c in ("cells", "auto") if any(c in v for v in by_prog.values())]
+    head = {"cells": "with corpus/cells", "auto": "with --inputs auto"}
+    out = []
+    for c in cols:
+        sub = [v[c] for v in by_prog.values() if c in v]
+        by = causes(sub)
+        out.append(f"{head[c]}: {len(sub)} programs: " + ", ".join(f"{k} {v}" for k, v in by.items())
+                   + f"; completed or intended end {by['completed'] + by['intended end']}")
+    out.append("")
+    out.append(f"  {'program':34s} " + " ".join(f"{head[c]:44s}" for c in cols))
+    for prog, v in by_prog.items():
+        cells = []
+        for c in cols:
+            r = v.get(c)
+            if r is None:
+                cells.append(f"{'-':44s}")
+                continue
+            where = f"{Path(r['file']).name}:{r['line']}" if r.get("file") and r.get("line") else ""
+            cells.append(f"{(r.get('cause') or cause_of(r)):15s} {where[:28]:28s}")
+        out.append(f"  {Path(prog).name[:34]:34s} " + " ".join(cells))
+    return "\n".join(out)
 
 
 def report(rows: list[dict]) -> str:
@@ -305,12 +382,65 @@ def report(rows: list[dict]) -> str:
     lines.append(f"Submit-interpreter errors: {n_sub} of {n} runs" + (":" if subs else ""))
     for msg, c in subs.most_common():
         lines.append(f"  {c:4d}  {msg}")
-    stubs = Counter(s for r in rows for s in r.get("stubs", []))
+    stubs: Counter = Counter()
+    runs: Counter = Counter()
+    for r in rows:
+        for s, c in (r.get("stubs") or {}).items():
+            stubs[s] += c
+            runs[s] += 1
     if stubs:
         lines.append("")
-        lines.append("Stubs (routines of absent technology packages; types of absent system data lists): " +
-                     ", ".join(f"{s} ({c})" for s, c in stubs.most_common()))
+        lines.append("Stand-ins of KUKA's software the backups lack (uses, in how many runs; "
+                     "interp/runtime/kss.py): " + ", ".join(f"{s} ({c} in {runs[s]})" for s, c in stubs.most_common()))
+    answers = sum(len(r.get("answers") or ()) for r in rows)
+    if any(r.get("mode") == "auto" for r in rows):
+        lines.append("")
+        lines.append(f"Answers of --inputs auto: {answers} in {sum(1 for r in rows if r.get('answers'))} runs; "
+                     f"idle time fast-forwarded: {sum(r.get('idle_s') or 0 for r in rows):.1f} s")
     return "\n".join(lines)
+
+
+def run_rows(corpus: Path, max_sim_time: float = REPORT_SIM_TIME_S, max_steps: int = REPORT_STEPS, *,
+             cells: bool = True, limit: int = 0, columns: tuple[str, ...] = ("cells",), interp: str = "tree",
+             scheduler: str | None = None, progress=None) -> list[dict]:
+    """The report's rows: :func:`run_one` of each entry point of the backups below `corpus`
+    (:func:`entries_of`; at most `limit` of them, 0: all), in the corpus's order, once per
+    column of `columns` ("cells": with its committed cell file unless `cells` is False;
+    "auto": with ``--inputs auto``), on `interp`. `scheduler`: the address of a Dask scheduler
+    (``tcp://HOST:8786``) whose workers make the runs (krl/cluster.py; they read the corpus at
+    the same paths); the rows are the same as here, ``seconds`` aside. `progress(column, row)`
+    is called as each row arrives. Raises krl.cluster.SchedulerError when the scheduler cannot
+    be used."""
+    programs = [p for root in find_backups(corpus) for p in entries_of(root)]
+    if limit:
+        programs = programs[:limit]
+    tasks = []
+    for p in programs:
+        for col in columns:
+            cell = None if not cells or col == "auto" else cell_of(p, corpus)
+            tasks.append((len(tasks), (p, max_sim_time, max_steps, cell, col == "auto", interp)))
+    if scheduler is None:
+        rows = []
+        for _i, args in tasks:
+            rows.append(run_one(*args))
+            if progress:
+                progress("auto" if args[4] else "cells", rows[-1])
+        return rows
+    from krl.cluster import run_batches  # noqa: PLC0415
+
+    got: dict[int, dict] = {}
+    for o in run_batches(scheduler, run_one, tasks, batch_files=1, name="krl-realprograms"):
+        path, _t, _s, cell, auto, _interp = tasks[o.key][1]
+        if o.status == "done":
+            row = o.value
+        else:           # the worker failed (not the program): said as run_one says an internal error
+            row = {"program": str(path), "reason": "internal", "text": o.detail, "seconds": 0.0,
+                   "cell": str(cell) if cell else None, "mode": "auto" if auto else "cells"}
+            row["cause"] = cause_of(row)
+        got[o.key] = row
+        if progress:
+            progress("auto" if auto else "cells", row)
+    return [got[i] for i in range(len(tasks))]
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -320,27 +450,48 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--limit", type=int, default=0)
     ap.add_argument("--max-sim-time", type=float, default=REPORT_SIM_TIME_S)
     ap.add_argument("--max-steps", type=int, default=REPORT_STEPS)
-    ap.add_argument("--no-cells", action="store_true", help="run without the committed cell files")
+    ap.add_argument("--no-cells", action="store_true", help="run the cells column without the committed cell files")
+    ap.add_argument("--columns", default="cells,auto",
+                    help="which runs: cells (the committed cell files), auto (--inputs auto), or both (default)")
+    ap.add_argument("--interp", choices=("tree", "vm"), default="tree")
+    ap.add_argument("--scheduler", default=None, metavar="tcp://HOST:PORT",
+                    help="make the runs on this Dask distributed scheduler's cluster (its workers "
+                         "see the corpus at the same paths); the same report as the local run")
     a = ap.parse_args(argv)
     corpus = Path(a.corpus)
+    cols = [c.strip() for c in a.columns.split(",") if c.strip()]
+    if not cols or any(c not in ("cells", "auto") for c in cols):
+        ap.error("--columns takes cells, auto or cells,auto")
     if not corpus.is_dir():
         print(f"no corpus at {corpus}; nothing to do")
         return 0
-    rows = []
-    for root in find_backups(corpus):
-        for p in programs_of(root):
-            rows.append(run_one(p, a.max_sim_time, a.max_steps, None if a.no_cells else cell_of(p, corpus)))
-            r = rows[-1]
-            sub = f"  [submit: {r['submit'][0][:60]}]" if r.get("submit") else ""
-            print(f"{r['cause']:15s} {r['reason']:13s} {r.get('seconds', 0):6.1f}s {p.relative_to(corpus)}  {r['text'][:80]}{sub}",
-                  file=sys.stderr)
-            if a.limit and len(rows) >= a.limit:
-                break
+
+    def progress(col: str, r: dict) -> None:
+        sub = f"  [submit: {r['submit'][0][:60]}]" if r.get("submit") else ""
+        shown = Path(r["program"])
+        shown = shown.relative_to(corpus) if shown.is_relative_to(corpus) else shown
+        print(f"{col:5s} {r['cause']:15s} {r['reason']:13s} {r.get('seconds', 0):6.1f}s "
+              f"{shown}  {r['text'][:80]}{sub}", file=sys.stderr)
+
+    from krl.cluster import SchedulerError  # noqa: PLC0415
+
+    try:
+        rows = run_rows(corpus, a.max_sim_time, a.max_steps, cells=not a.no_cells, limit=a.limit,
+                        columns=tuple(cols), interp=a.interp, scheduler=a.scheduler, progress=progress)
+    except SchedulerError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
     if a.json:
         with open(a.json, "w", encoding="utf-8") as fh:
             for r in rows:
                 fh.write(json.dumps(r) + "\n")
-    print(report(rows))
+    if len(cols) > 1:
+        print(report_columns(rows))
+        print()
+    for col in cols:
+        if len(cols) > 1:
+            print(f"== {col}")
+        print(report([r for r in rows if r.get("mode") == col]))
     return 0
 
 

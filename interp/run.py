@@ -1,12 +1,23 @@
-"""One run of a KRL program: controller + runtime + interpreter (used by `krl run`, the
-tests and the real-programs report)."""
+"""One run of a KRL program: controller + runtime + interpreter (used by `krl run`, `krl debug`,
+the tests and the real-programs report).
+
+:func:`run_setup` turns ``krl run``'s options (the parameters of the click command in
+interp/cli.py, by name) into a :class:`RunSetup`: the program found (in a backup archive
+too), the submit programs (the backup's SPS.SUB at boot unless ``no_submit``), the robot. Both
+``krl run`` and ``krl debug``'s launch go through it, so they run the same thing;
+:meth:`RunSetup.make_runtime` builds the run (:func:`make_runtime`).
+"""
 
 from __future__ import annotations
 
+import contextlib
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from interp.runtime.core import RunResult, Runtime
 from interp.runtime.errors import KrlRuntimeError, ResourceError
+from interp.runtime.values import Struct
 
 
 def make_runtime(program, *, workspace=None, inputs=None, trace=None, max_sim_time=None,
@@ -14,7 +25,8 @@ def make_runtime(program, *, workspace=None, inputs=None, trace=None, max_sim_ti
                  robot_budget=None, interp: str = "tree", observer=None,
                  mode: str | None = None, check: bool = True,
                  vm_loop: str = "generated", run_mode: str | None = None,
-                 pgno: int | None = None, robot=None, network=None) -> tuple[Runtime, object]:
+                 pgno: int | None = None, robot=None, network=None, start: str | None = None,
+                 halt_continues: int = 0) -> tuple[Runtime, object]:
     """Build the runtime and the interpreter (``interp``: tree or vm) for ``program``
     (not started yet). Its files (krl.project.project_of, with the `submit` programs) are
     loaded, checked and resolved first; with `check` (``krl run`` without ``--no-check``) a
@@ -30,14 +42,24 @@ def make_runtime(program, *, workspace=None, inputs=None, trace=None, max_sim_ti
     ``run_mode``: ``$PRO_MODE`` at the start (GO, MSTEP, ISTEP, BSTEP; interp/runtime/runmode.py;
     default GO). ``robot``: the simulated robot (a MachineData or a path for
     :func:`robot.mada.load_robot`); default :func:`robot_for` (the cell file's ``robot``, else the
-    backup's own robot, else the KR 6 R900). ``network``: the partners
+    backup's own robot, else the KR 6 R900). ``inputs``: a cell file, or ``"auto"`` (the
+    automatic cell, interp/runtime/autocell.py: mode EXT unless `mode` says otherwise, P00's
+    program numbers, the solver; the robot starts at ``XHOME`` when the program has one and
+    no `start` is given). ``start``: where the robot stands at the start
+    (:func:`start_axes`: an E6AXIS literal or a point name; default the cell file's
+    ``start:``, else ``$AXIS_HOME[1]``). ``halt_continues``: ``--on-halt continue``, the
+    times the operator presses Start again after a HALT (0: a HALT ends the run). ``network``: the partners
     (net.settings.NetworkSettings; default the cell file's ``network:`` key): the run's network
     hub (net/hub.py) is attached to the controller either way; without partners its EKI
     channels stay "not connected". Raises
     :class:`robot.stimuli.StimulusError` for a bad cell file or a preset the backup's
-    ``$config.dat`` does not allow."""
+    ``$config.dat`` does not allow, :class:`robot.stimuli.StartError` for a start position that cannot
+    place the robot."""
     from interp.tree import TreeInterpreter  # noqa: PLC0415
 
+    auto = is_auto(inputs)
+    if auto:
+        inputs = None
     if controller is None:
         from robot.controller import Controller  # noqa: PLC0415
 
@@ -46,19 +68,37 @@ def make_runtime(program, *, workspace=None, inputs=None, trace=None, max_sim_ti
         cell = cell_of(inputs)       # the cell file, read once for the robot and the controller
         controller = Controller(robot_for(program, workspace, robot, cell),
                                 trace=observer if observer is not None else trace,
-                                stimuli=cell, mujoco=mujoco, mode_op=mode)
+                                stimuli=cell, mujoco=mujoco,
+                                mode_op=mode if mode is not None or not auto else "EX")
     rt = Runtime(program, workspace=workspace, controller=controller, trace=trace,
                  max_sim_time=max_sim_time, max_steps=max_steps, robot_budget=robot_budget,
                  submits=list(submit or ()), check=check)
     if run_mode is not None:
         rt.set_run_mode(run_mode)
+    rt.halt_continues = halt_continues
+    main = Path(program).stem
+    where = start if start is not None else getattr(controller, "start", None)
+    if where is None and auto and isinstance(global_value(rt, main, "XHOME"), Struct):
+        where = "XHOME"             # the automatic cell starts at home, as a cell in Automatic External
+    if where is not None:
+        from interp.scene import start_axes  # noqa: PLC0415
+
+        controller.place(start_axes(controller, lambda name: global_value(rt, main, name), where))
+        rt.start = where
     if observer is not None:
         # The interpreters trace into the user's trace only: without one the VM keeps its
         # quiet fast path (Runtime.quiet_limit); the observer needs the controller's events.
         rt.trace = trace
     number = pgno if pgno is not None else getattr(controller, "pgno", None)
     if number is not None:
-        controller.rules += _pgno_rules(rt, Path(program).stem, number)
+        controller.rules += _pgno_rules(rt, Path(program).stem, number,
+                                        "--pgno" if pgno is not None else "the cell file's pgno preset")
+    if auto:
+        from interp.runtime.autocell import handshake_rules  # noqa: PLC0415
+
+        rt.enable_autocell()
+        if number is None:
+            controller.rules += handshake_rules(rt, Path(program).stem, _pgno_parameters(rt, Path(program).stem))
     if controller.stimuli or controller.rules:
         from robot.stimuli import resolve_signals  # noqa: PLC0415
 
@@ -106,6 +146,12 @@ def attach_network(rt: Runtime, program, workspace, settings) -> None:
         raise NetError(f"a network partner cannot start: {exc.strerror or exc}") from None
 
 
+def is_auto(inputs) -> bool:
+    """True for ``--inputs auto``: the automatic cell (interp/runtime/autocell.py) instead of
+    a cell file. A file of that name is written ``./auto``."""
+    return isinstance(inputs, (str, Path)) and str(inputs) == "auto"
+
+
 def plc_map(rt: Runtime, main: str):
     """The PLC's address map (net/plc.py) derived from the cell: the inputs and outputs its
     rules, stimuli and program-number handshake (``PGNO_*`` of $config.dat) use, and the
@@ -139,21 +185,29 @@ def plc_map(rt: Runtime, main: str):
     return derive_map(indices, signals)
 
 
-def _pgno_rules(rt: Runtime, main: str, number: int) -> list:
-    """The PLC's rules of P00's program-number handshake answering `number`, with the
-    ``PGNO_*`` parameters the program sees ($config.dat)."""
-    from robot.cellpresets import PGNO_PARAMETERS, PresetError, pgno_rules  # noqa: PLC0415
-    from robot.stimuli import StimulusError  # noqa: PLC0415
+def _pgno_parameters(rt: Runtime, main: str) -> dict:
+    """The ``PGNO_*`` parameters the program `main` sees ($config.dat), those with an INT value."""
+    from robot.cellpresets import PGNO_PARAMETERS  # noqa: PLC0415
 
     params = {}
     for name in PGNO_PARAMETERS:
         value = global_value(rt, main, name)
         if isinstance(value, int) and not isinstance(value, bool):
             params[name] = value
+    return params
+
+
+def _pgno_rules(rt: Runtime, main: str, number: int, origin: str = "--pgno") -> list:
+    """The PLC's rules of P00's program-number handshake answering `number`, with the
+    ``PGNO_*`` parameters the program sees ($config.dat). `origin` names where the number came
+    from in the error (``--pgno``, the cell file's preset)."""
+    from robot.cellpresets import PresetError, pgno_rules  # noqa: PLC0415
+    from robot.stimuli import StimulusError  # noqa: PLC0415
+
     try:
-        return pgno_rules(params, number)
+        return pgno_rules(_pgno_parameters(rt, main), number)
     except PresetError as exc:
-        raise StimulusError(f"--pgno {number}: {exc}") from None
+        raise StimulusError(f"{origin} {number}: {exc}") from None
 
 
 def global_value(rt: Runtime, main: str, name: str):
@@ -191,17 +245,45 @@ def robot_for(program, workspace=None, robot=None, inputs=None):
     cannot make a model (file:line), robot.stimuli.StimulusError for a bad cell file."""
     from krl.project import backup_of  # noqa: PLC0415
     from robot.machine import MachineData, load_machine  # noqa: PLC0415
-    from robot.mada import load_robot, robot_of_backup  # noqa: PLC0415
+    from robot.mada import load_robot  # noqa: PLC0415
 
     if isinstance(robot, MachineData):
         return robot
-    if robot is None and inputs:
+    if robot is None and inputs and not is_auto(inputs):
         robot = cell_of(inputs).robot
     if robot is not None:
         return load_robot(robot)
     root = backup_of(Path(program).resolve(), Path(workspace).resolve() if workspace else None)
-    found = robot_of_backup(root) if root is not None else None
+    found = _backup_robot(root) if root is not None else None
+    if found is None and is_auto(inputs):
+        from interp.scene import choose_robot  # noqa: PLC0415
+
+        def probe():
+            rt, _ = make_runtime(program, workspace=workspace, mujoco=False, check=False, robot=load_machine())
+            main = Path(program).stem
+            return rt, lambda name: global_value(rt, main, name)
+        choice = choose_robot(Path(program), probe, workspace)
+        if choice is not None:
+            return choice.machine
     return found if found is not None else load_machine()
+
+
+def _backup_robot(root: Path):
+    """robot.mada ``robot_of_backup(root)``, kept across processes (krl/store.py) for the
+    same files of its machine-data folder."""
+    from krl.project import machine_data_file  # noqa: PLC0415
+    from krl.store import file_key, stored  # noqa: PLC0415
+    from robot.mada import robot_of_backup  # noqa: PLC0415
+
+    f = machine_data_file(root)
+    if f is None:
+        return None
+    try:
+        files = sorted(c for c in f.parent.iterdir() if c.is_file())
+    except OSError:
+        return robot_of_backup(root)
+    return stored("robot", (str(root), str(f), file_key(files)), lambda: robot_of_backup(root),
+                  code=("krl", "robot"))
 
 
 def signal_of(rt: Runtime, main: str, name: str) -> tuple[str, int, int | None] | None:
@@ -228,3 +310,127 @@ def signal_of(rt: Runtime, main: str, name: str) -> tuple[str, int, int | None] 
 def run_program(program, **kw) -> RunResult:
     rt, _ = make_runtime(program, **kw)
     return rt.run()
+
+
+class RunSetupError(Exception):
+    """``krl run``'s options do not make a run (a usage error: exit 2); the message names the
+    file."""
+
+
+@dataclass
+class RunSetup:
+    """What one run of ``krl run`` runs (:func:`run_setup`): ``program`` (the .src file),
+    ``workspace``, ``inputs`` (cell file), ``submit`` (the submit programs beside it),
+    ``booted`` (the backup's SPS.SUB when it was started as at boot, else None), ``machine``
+    (the simulated robot, robot.machine.MachineData), ``options`` (the rest of krl run's
+    options by their click names: interp_kind, max_sim_time, max_steps, mode, run_mode, pgno,
+    no_check, trace_path, trace_repeats, start, halt_continues), ``shown`` (a path as the
+    user named it: an archive's temporary folder is shown as the archive), ``cell`` (the cell
+    file `inputs` read once, robot.stimuli.Cell; ``"auto"`` for the automatic cell; None without one)."""
+    program: Path
+    workspace: Path | None
+    inputs: Path | None
+    submit: list
+    booted: Path | None
+    machine: object
+    options: dict
+    shown: Callable[[str], str] = field(default=lambda text: text)
+    cell: object = None
+
+    @property
+    def interp(self) -> str:
+        return self.options.get("interp_kind") or "tree"
+
+    @property
+    def check(self) -> bool:
+        return not self.options.get("no_check")
+
+    def make_runtime(self, trace=None, observer=None, **override) -> tuple:
+        """(Runtime, interpreter) of this run, not started (:func:`make_runtime`); ``override``:
+        keyword arguments of make_runtime that differ (a debugger's step limit)."""
+        o = self.options
+        kw = dict(workspace=self.workspace, inputs=self.cell if self.cell is not None else self.inputs, trace=trace,
+                  max_sim_time=o.get("max_sim_time", 600.0), max_steps=o.get("max_steps"),
+                  submit=[str(s) for s in self.submit], interp=self.interp, observer=observer,
+                  mode=o.get("mode"), check=self.check, run_mode=str(o.get("run_mode") or "GO").upper(),
+                  pgno=o.get("pgno"), robot=self.machine, start=o.get("start"),
+                  halt_continues=o.get("halt_continues", 0))
+        kw.update(override)
+        return make_runtime(self.program, **kw)
+
+
+def program_in(folder: Path, program: Path) -> Path | None:
+    """PROGRAM inside an extracted archive: its relative path (any letter case of the file
+    name), else the .src (then .sub) file whose stem is its name; None when there is none."""
+    from krl.source import is_krl_file  # noqa: PLC0415
+
+    direct = folder / program
+    if not program.is_absolute() and ".." not in program.parts and direct.is_file():
+        return direct
+    stem = program.stem.lower()
+    candidates = sorted(p for p in folder.rglob("*") if p.is_file() and is_krl_file(p) and p.stem.lower() == stem)
+    for suffix in (".src", ".sub"):
+        for p in candidates:
+            if p.suffix.lower() == suffix:
+                return p
+    return None
+
+
+@contextlib.contextmanager
+def run_setup(options: dict) -> Iterator[RunSetup]:
+    """The run that ``krl run``'s `options` describe (keys: the click parameters' names of
+    interp/cli.py ``run``: program, workspace, inputs, submit, no_submit, robot, ...; the others
+    are kept in :attr:`RunSetup.options`). A ``workspace`` that is a KRC backup archive is
+    checked and extracted for the duration of the ``with`` block (krl/archive.py), the program
+    named by its path or module name in it. Without ``submit`` and ``no_submit``, the backup's
+    SPS.SUB runs beside the program, as the controller starts it at boot (krl.project
+    ``boot_submit``). Raises :class:`RunSetupError`."""
+    from krl.archive import ArchiveError, backup_source, is_archive  # noqa: PLC0415
+    from krl.terminal import printable  # noqa: PLC0415
+
+    program = Path(options["program"])
+    workspace = Path(options["workspace"]) if options.get("workspace") is not None else None
+    if is_archive(program):
+        raise RunSetupError(f"{printable(program)} is a backup archive; name the program to run in it: "
+                            f"krl run --workspace {printable(program)} PROGRAM")
+    if workspace is not None and is_archive(workspace):
+        try:
+            with backup_source(workspace) as (folder, _shown):
+                found = program_in(folder, program)
+                if found is None:
+                    raise RunSetupError(f"no program {printable(program)} in {printable(workspace)}")
+                yield _setup(found, folder, options,
+                             shown=lambda text: text.replace(str(folder), str(workspace)))
+        except ArchiveError as exc:
+            raise RunSetupError(printable(exc)) from None
+        return
+    yield _setup(program, workspace, options)
+
+
+def _setup(program: Path, workspace, options: dict, shown=lambda text: text) -> RunSetup:
+    from krl.project import boot_submit  # noqa: PLC0415
+    from krl.terminal import printable  # noqa: PLC0415
+    from robot.mada import MachineDataError  # noqa: PLC0415
+    from robot.stimuli import StimulusError  # noqa: PLC0415
+
+    if not program.is_file():
+        raise RunSetupError(f"{shown(printable(program))}: no such file")
+    if workspace is not None and not workspace.is_dir():
+        raise RunSetupError(f"{shown(printable(workspace))}: no such folder")
+    inputs = Path(options["inputs"]) if options.get("inputs") is not None else None
+    submit = [Path(s) for s in options.get("submit") or ()]
+    for sub in submit:
+        if not sub.is_file():
+            raise RunSetupError(f"{shown(printable(sub))}: no such submit program")
+    booted = None
+    if not submit and not options.get("no_submit"):
+        booted = boot_submit(program, workspace)
+        submit = [booted] if booted is not None else []
+    try:
+        cell = inputs if is_auto(inputs) else cell_of(inputs)   # the cell file, read once for the robot and the run
+        machine = robot_for(program, workspace, options.get("robot"), cell)
+    except (MachineDataError, StimulusError) as exc:
+        raise RunSetupError(shown(printable(exc))) from None
+    rest = {k: v for k, v in options.items()
+            if k not in ("program", "workspace", "inputs", "submit", "no_submit", "robot")}
+    return RunSetup(program, workspace, inputs, submit, booted, machine, rest, shown, cell)

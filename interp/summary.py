@@ -93,17 +93,23 @@ def _clip(text: str) -> str:
     return clip(printable(text))
 
 
+#: answers of the automatic cell listed one by one; the rest are counted
+MAX_ANSWERS = 8
+
+
 def summary_lines(result: Any, observer: RunObserver, *, program: str, interp: str,
                   submits: list[Any] = (), workspace: str | None = None,
-                  starving: list[str] = (), robot: str | None = None) -> list[str]:
-    """The console summary of one run, about a screen (at most ~20 lines).
+                  starving: list[str] = (), robot: str | None = None, run: Any = None) -> list[str]:
+    """The console summary of one run, about a screen (at most ~25 lines).
 
     `result` is the run's RunResult; `submits` the scheduler's submit tasks (``name``,
     ``outcome``, ``file``, ``line``); `workspace` a note on the folder the program's modules
     came from (shown when it is not the program's own folder); `starving` the lines of
-    :func:`starvation_lines` (they replace the generic hint).
-    came from (shown when it is not the program's own folder); `robot` the simulated robot
-    and where its data came from (issue 22).
+    :func:`starvation_lines` (they replace the generic hint); `robot` the simulated robot
+    and where its data came from (issue 22); `run` the Runtime (issue 34): where the robot
+    started, each stand-in of KUKA's software with its count
+    (interp/runtime/kss.py), the answers of ``--inputs auto`` (interp/runtime/autocell.py),
+    the idle time skipped (interp/runtime/idle.py).
     """
     out = [f"run {printable_path(program)} ({interp} interpreter)"]
     if workspace:
@@ -141,6 +147,7 @@ def summary_lines(result: Any, observer: RunObserver, *, program: str, interp: s
             out.append(f"  submit     {printable(task.name)}: {ENDINGS.get(reason, reason)}")
     if robot:
         out.append(f"  robot      {printable(robot)}")
+    out.extend(_run_lines(run))
     notes = [n for n in observer.notes if not n.text.startswith(SIMULATOR_NOTES)]
     sim = Counter(n.text.split(":", 1)[0] for n in observer.notes if n.text.startswith(SIMULATOR_NOTES))
     if notes:
@@ -164,6 +171,38 @@ def summary_lines(result: Any, observer: RunObserver, *, program: str, interp: s
     detail = ", ".join(f"{k} {v}" for k, v in sorted(observer.io.items()))
     out.append(f"  I/O        {changes} change(s){f' ({detail})' if changes else ''}")
     out.append(f"  time       {result.sim_time:.3f} s simulated, {result.steps} steps")
+    return out
+
+
+def _run_lines(rt: Any) -> list[str]:
+    """The lines of issue 34: start, stand-ins, answers, idle time (see summary_lines)."""
+    if rt is None:
+        return []
+    out = []
+    if getattr(rt, "start", None):
+        out.append(f"  start      {printable(rt.start)}")
+    kss = getattr(rt, "kss", None)
+    stubs = kss.summary() if kss is not None else []
+    if stubs:
+        shown = ", ".join(f"{printable(name)} ({what}" + ("" if "variable" in what or what == "type" else
+                                                          f", {n} call{'s' if n != 1 else ''}") + ")"
+                          for name, what, n in stubs[:12])
+        more = f", ... {len(stubs) - 12} more" if len(stubs) > 12 else ""
+        out.append(f"  stubs      {len(stubs)}: {shown}{more}")
+    auto = getattr(rt, "autocell", None)
+    if auto is not None:
+        answers = auto.answers
+        out.append(f"  auto cell  {len(answers)} answer(s), each {auto.delay:g} s after the program starved"
+                   + (":" if answers else " (nothing starved that inputs could release)"))
+        for a in answers[:MAX_ANSWERS]:
+            out.append(f"    {printable(a.describe())}")
+        if len(answers) > MAX_ANSWERS:
+            out.append(f"    ... {len(answers) - MAX_ANSWERS} more (see --trace)")
+    idle = getattr(getattr(rt, "scheduler", None), "idle", None)
+    if idle is not None and idle.jumps:
+        dt = rt.controller.dt
+        out.append(f"  idle       {idle.skipped * dt:.3f} s fast-forwarded in {idle.jumps} jump(s): nothing "
+                   f"changed until the next event")
     return out
 
 

@@ -99,6 +99,10 @@ MAX_LSP_SCAN_ENTRIES = 200_000
 # one request. A backup declares tens of thousands of names; an editor shows a few dozen.
 MAX_LSP_SYMBOLS = 500
 MAX_LSP_COMPLETIONS = 1000
+# The persistent parse and check cache of `krl lsp` (krl/lsp/cache.py), in bytes of entries: a
+# 400-file workspace takes about 2.5 MB. Past it the least recently used quarter of the entries
+# is deleted.
+MAX_LSP_CACHE_BYTES = 512 * 1024 * 1024
 
 # A `krl.toml` (the diagnostic configuration of a workspace), in bytes: a few lines in practice.
 # Past it: the configuration error names the file (krl check exits 2).
@@ -132,6 +136,13 @@ MAX_DAP_MESSAGE_BYTES = 1024 * 1024
 MAX_DAP_BREAKPOINTS = 1000
 MAX_DAP_REPLAY_STEPS = 10_000_000
 
+# Results kept across processes (krl/store.py: a program's checked workspace, a backup's robot
+# model) in the user cache folder: the largest one result kept (a checked 150-file backup is
+# about 5 MB) and all of them together; past the first the result is not kept, past the second
+# the results used least recently are removed.
+MAX_STORED_BYTES = 256 * 1024 * 1024
+MAX_STORE_BYTES = 1024 * 1024 * 1024
+
 # Reactive rules of a cell file (`rules:` in a stimuli file, robot/cellrules.py): the most rules
 # in one file (a PLC program answering a cell has tens of handshakes, a few hundred at most) and
 # the most tokens in one rule's `when` expression (one line of KRL; real conditions have under
@@ -152,7 +163,26 @@ MAX_DIFF_ENTRIES = 20_000
 # The program map (`krl graph`, krl/programmap): the largest map rendered through Graphviz
 # (DOT/SVG) and the HTML page, in nodes. Past it: an error naming the count (JSON has no limit).
 MAX_GRAPH_NODES = 5000
+# The routines' source text the interactive map page carries (krl graph --format html), in
+# characters in all; past it the remaining routines show their file:line without the text.
+MAX_GRAPH_SOURCE_CHARS = 8_000_000
 
+# The controller's message window (interp/runtime/messages.py): the most messages shown at once
+# (a real cell shows a handful; past it the oldest notify message is dropped).
+MAX_KRL_MESSAGES = 100
+
+# `krl pendant` (pendant/, docs/security.md "The pendant's web server"): the largest websocket
+# message the server reads (a larger one closes the connection with 1009), the largest HTTP
+# request body, the connections served at once, the operator's messages per second on one
+# connection (past it the connection is closed), the watch list's length and the length of one
+# watched expression, and the largest KRL file the page shows or touch-up rewrites.
+MAX_WEB_MESSAGE_BYTES = 64 * 1024
+MAX_WEB_BODY_BYTES = 64 * 1024
+MAX_WEB_CONNECTIONS = 8
+MAX_WEB_MESSAGES_PER_S = 200
+MAX_WEB_WATCHES = 64
+MAX_WEB_EXPRESSION_CHARS = 200
+MAX_WEB_FILE_BYTES = 4 * 1024 * 1024
 # The controller on the network (net/, docs/network.md, docs/security.md "Network"). Everything
 # that arrives on a socket is untrusted; every size, rate and count below ends in an EKI/RSI
 # message, a closed connection or a stopped motion, never in unbounded memory or a hang.
@@ -194,6 +224,19 @@ MAX_NET_REPLAY_EVENTS = 1_000_000
 # The wall-clock pace factor of a run with a partner attached (simulated s per wall s): 1 is
 # real time; up to 10 where the protocol allows (EKI, KukaVarProxy, the PLC), never for RSI.
 MAX_NET_PACE = 10.0
+# The automatic cell (krl run --inputs auto, interp/runtime/autocell.py): the inputs of one
+# condition it combines, and the evaluations of that condition it tries (2^8 combinations of
+# one-bit inputs and a few values of each group), before it leaves the condition unanswered.
+AUTO_MAX_INPUTS = 8
+AUTO_MAX_TRIES = 4096
+# The points of one backup the automatic cell's robot choice looks at (interp/scene.py): a
+# palletizer's backup teaches about 300.
+MAX_CHOICE_POINTS = 2000
+# `krl run --on-halt continue:N`: the operator presses Start again at most this often.
+MAX_HALT_CONTINUES = 1000
+# A start position (`krl run --start`, a cell file's `start:`): characters of its text; its
+# tokens are at most MAX_RULE_TOKENS.
+MAX_START_CHARS = 400
 # The routines' source text the interactive map page carries (krl graph --format html), in
 # characters in all; past it the remaining routines show their file:line without the text.
 MAX_GRAPH_SOURCE_CHARS = 8_000_000

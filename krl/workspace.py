@@ -17,11 +17,18 @@ krl/project.py says which files form a program (:func:`krl.project.project_of`, 
 every command); :func:`load_project` and :func:`load_workspace` load them.
 Files are read with krl.source.read_source and parsed with parse_source only.
 
+The check records what each of its owners left (the declarations; each routine's scope and
+body; each data-list value: findings and unresolved uses), so that :meth:`Workspace.replace`
+puts a new version of one file in place (an editor's buffer) and runs the same phases again for
+the routines or values whose AST changed, or the whole check when the file's interface changed;
+the diagnostics are those of a full check either way.
+
 Usage::
 
     ws = load_workspace([Path("KRC")])
     ws.check()                      # runs the checker, fills ws.diagnostics
     ws.modules["DEMO"].routines     # AST; expression types in node.ann.type
+    ws.replace(load_text(new_text, path))   # an edit: "routines", "values" or "workspace"
 """
 
 from __future__ import annotations
@@ -32,7 +39,7 @@ import time
 from collections.abc import Callable
 from contextlib import contextmanager
 from contextvars import ContextVar
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from krl.ast import nodes as N
@@ -129,12 +136,18 @@ def _loaded(src: SourceText, result: ParseResult, started: float) -> LoadedFile:
                       sink.items, unreadable, words, template_lines(src.text or ""))
 
 
-def load_batch(paths: list, timeout: float, jobs: int | None = None) -> list:
+# What the workers of a fork server import before they fork (krl.pool.run_tasks `preload`).
+WORKER_MODULES = ("krl.workspace", "krl.syntax.engines.tree", "krl.syntax.generated.KRLLexer",
+                  "krl.syntax.generated.KRLParser")
+
+
+def load_batch(paths: list, timeout: float, jobs: int | None = None, threaded: bool = False) -> list:
     """Read `paths` here, parse and build them in `jobs` worker processes (krl/pool.py), each
     file stopped past `timeout` seconds; returns one krl.pool.Outcome per path, in order (value:
     a LoadedFile). A batch of at least JAVA_BATCH_BYTES is parsed by the Java engine
     (:func:`_parse_tasks`): the same trees. Progress: the :func:`on_each_file` callback, as
-    files finish."""
+    files finish. `threaded`: the caller runs other threads (the language server), so the
+    workers come from a fork server (WORKER_MODULES loaded), not from a fork of this process."""
     # on use: the worker pool (pebble) costs 0.42 s (python -X importtime, 2026-11-23, load average
     # 22 on the 2 cores), which single files, `krl run` and the language server, who never start a
     # pool, do not pay
@@ -152,7 +165,7 @@ def load_batch(paths: list, timeout: float, jobs: int | None = None) -> list:
     try:
         # (the workers, forked from here, collect as usual: their parse trees are cyclic garbage)
         for o in run_tasks(load_parsed, _parse_tasks(sources, jobs, timeout), jobs=jobs, timeout=timeout,
-                           initializer=gc.enable):
+                           initializer=gc.enable, preload=WORKER_MODULES if threaded else None):
             done[o.key] = o
             sources[o.key] = None
             if hook is not None:
@@ -221,10 +234,15 @@ class Workspace:
     # every name (krl/semantics/resolve.py)
     system_names: list = field(default_factory=list)
     resolver: object = None
-    # what an editor needs to re-check one module after a change (krl/lsp/incremental.py):
-    # the declarer and checker of the last check, the ids of the diagnostics of its body phase
-    # (routine scopes, data-list values, routine bodies) and of the unresolved-name report
-    phases: dict = field(default_factory=dict)
+    # the LoadedFile of each file added from one (path -> LoadedFile): what a full check is
+    # made from again when :meth:`replace` cannot re-check a change on its own
+    loaded: dict = field(default_factory=dict, repr=False)
+    # what the last check left for :meth:`replace` (_CheckState), and the check's options
+    _state: "_CheckState | None" = field(default=None, repr=False)
+    _options: tuple = field(default=(True, False), repr=False)      # (resolve, partial)
+    _unread: bool = field(default=False, repr=False)                # an entry not read (not a file's)
+    _by_path: dict | None = field(default=None, repr=False)
+    _inputs: list = field(default_factory=list, repr=False)         # the load's diagnostics, in order
 
     def maybe_declared(self, name: str) -> bool:
         """True when a file that could not be parsed (or read) may declare `name`."""
@@ -239,14 +257,6 @@ class Workspace:
         if line in inline and kind in ("routine", "type"):
             return "a KUKA inline form (;FOLD ... ;%{PE}) uses it"
         return ""
-
-    def _note_failed(self, result, text: str) -> None:
-        if result.ok:
-            return
-        if result.status in ("binary", "too_large", "unreadable", "not_regular"):
-            self.unreadable = True
-        elif text:
-            self.failed_words.update(w.upper() for w in _WORD.findall(text))
 
     @property
     def diagnostics(self) -> list[Diagnostic]:
@@ -278,7 +288,7 @@ class Workspace:
 
     def add_file(self, path: str | Path) -> SourceFile:
         """Read, parse and build one file (never raises for bad content)."""
-        return self._add_loaded(load_file(path))
+        return self.add_loaded(load_file(path))
 
     def add_files(self, paths, timeout: float | None = None, jobs: int | None = None) -> None:
         """:meth:`add_file` for each of `paths`, in order. With `timeout` (seconds per file) the
@@ -293,46 +303,38 @@ class Workspace:
 
     def add_outcome(self, path, o, timeout: float) -> None:
         """Add one file of :func:`load_batch`: its LoadedFile, or E005 (stopped past `timeout`
-        seconds) or E001 (its worker died) and an empty module."""
-        if o.status == "done":
-            self._add_loaded(o.value, notify=False)
-            return
-        if o.status == "timeout":
-            self.sink.add(str(path), 1, 1, "E005", f"file not checked: not parsed within {timeout:g} s "
-                          "(--timeout; the parse was stopped)")
-        else:
-            self.sink.add(str(path), 1, 1, "E001", f"file not checked: {o.detail}")
-        self.unreadable = True
-        module = build_module(ParseResult(str(path), False, "", o.status), DiagnosticSink())
-        self.files.append(SourceFile(str(path), module, False, o.status))
+        seconds) or E001 (its worker died) and an empty module (:func:`failed_load`)."""
+        self.add_loaded(o.value if o.status == "done" else failed_load(path, o, timeout), notify=False)
 
-    def _add_loaded(self, lf: "LoadedFile", notify: bool = True) -> SourceFile:
+    def add_loaded(self, lf: "LoadedFile", notify: bool = True) -> SourceFile:
+        """Add one file read, parsed and built apart (:func:`load_file`, :func:`load_batch`, an
+        editor's buffer): its AST and its input, syntax and build diagnostics."""
         self.parse_seconds += lf.parse_seconds
         self.check_seconds += lf.build_seconds
         self.sink.extend(lf.diagnostics)
         self.unreadable |= lf.unreadable
-        self.failed_words |= lf.failed_words
+        if not lf.ok:
+            self.failed_words |= lf.failed_words
         hook = _ON_FILE.get() if notify else None
         if hook is not None:
             hook(lf.path)
         self.template[lf.path] = lf.template
+        self.loaded[lf.path] = lf
         sf = SourceFile(lf.path, lf.module, lf.ok, lf.status, parse_seconds=lf.parse_seconds)
         self.files.append(sf)
         return sf
 
+    def add_unread(self, entries) -> None:
+        """W002 for each walk entry that was not read (krl.files.Entry: a link, FIFO, folder too
+        deep): it may declare what the other files use."""
+        for e in entries:
+            if e.kind != "file":
+                self.sink.add(str(e.path), 1, 1, "W002", f"not read: {e.message}")
+                self.unreadable = self._unread = True
+
     def add_text(self, text: str, path: str = "<string>.src") -> SourceFile:
         """Parse and build KRL text as if it were the file `path` (tests, editors, REPLs)."""
-        t = time.perf_counter()
-        result = parse_text(text, path)
-        self.parse_seconds += time.perf_counter() - t
-        self.sink.extend(syntax_diagnostics(result, text))
-        self.sink.extend(fold_diagnostics(path, text))
-        self._note_failed(result, text)
-        self.template[path] = template_lines(text)
-        module = build_module(result, self.sink)
-        sf = SourceFile(path, module, result.ok, result.status)
-        self.files.append(sf)
-        return sf
+        return self.add_loaded(load_text(text, path), notify=False)
 
     # ------------------------------------------------------------------ linking
 
@@ -365,30 +367,60 @@ class Workspace:
         for name, code, dat in modules_of(self.files, lambda f: f.module.kind == "dat"):
             self.units.append(ModuleUnit(name, src=code, dat=dat))
 
-    def check(self) -> list[Diagnostic]:
-        """Link the files into scopes and run the checker; returns the sorted diagnostics."""
+    def check(self, resolve: bool = True, partial: bool = False) -> list[Diagnostic]:
+        """Link the files into scopes and run the checker; returns the sorted diagnostics.
+
+        `resolve` False: no storage places for the interpreters (krl/semantics/resolve.py; an
+        editor needs only the checker's annotations; :meth:`resolve` places them later).
+        `partial` True: the routines and data lists of files that do not parse are typed too
+        (an editor's look-ups), their findings not reported, as ``krl check`` reports only the
+        syntax errors of such files."""
         if self.checked:
             return self.diagnostics
         t = time.perf_counter()
         self.checked = True
+        self._options = (resolve, partial)
+        self._inputs = list(self.sink.items)
         try:
             self._check()
         except Exception as exc:  # noqa: BLE001 - never a traceback for bad input
+            self._state = None
             self.sink.add(self.root, 1, 1, "E901", f"internal checker error: {type(exc).__name__}: {exc}")
+        self._by_path = None
         self.check_seconds += time.perf_counter() - t
         return self.diagnostics
 
+    def resolve(self) -> None:
+        """Place every name for the interpreters (krl/semantics/resolve.py) when the last check
+        or re-check left it out."""
+        if self.resolver is None and self.global_scope is not None:
+            resolve_workspace(self)
+
+    def diagnostics_of(self, path: str) -> list[Diagnostic]:
+        """The diagnostics of one file, in the order of :attr:`diagnostics` (an index kept until
+        the next check or re-check)."""
+        if self._by_path is None:
+            by: dict[str, list[Diagnostic]] = {}
+            for d in self.sink.sorted():
+                by.setdefault(d.path, []).append(d)
+            self._by_path = by
+        return list(self._by_path.get(path, ()))
+
     def _check(self) -> None:
+        """The phases of a check (reference 2.5-2.7), each finding and unresolved use recorded
+        with its owner (the declarations, a routine's locals and body, a data-list value:
+        :class:`_CheckState`) so that :meth:`replace` runs the same phases for one owner."""
         _system, basis = system_scopes()
         incomplete = self.incomplete
-        sink = self.sink
-        declarer = Declarer(sink, incomplete, self.maybe_declared)
-        declarer.unresolved = Unresolved(load_builtins().packages, self.maybe_declared)
+        st = self._state = _CheckState()
+        declarer = st.declarer = Declarer(st.decl_sink, incomplete, self.maybe_declared)
+        declarer.unresolved = st.decl_uses
         declarer.evidence = self.evidence
-        checker = Checker(sink, declarer, incomplete)
+        checker = st.checker = Checker(st.decl_sink, declarer, incomplete)
         glob = Scope("global", "$GLOBAL", basis)
         self.global_scope = glob
         self._pair()
+        sink = st.decl_sink
 
         # which scope each data list's declarations go to
         def targets(unit: ModuleUnit) -> list[tuple[Scope, list[N.Decl], str]]:
@@ -447,7 +479,6 @@ class Workspace:
         self._link_imports(checker)
 
         # routines: main routines and GLOBAL ones are global, others module-local
-        routine_syms: list[tuple[N.Routine, Symbol, ModuleUnit]] = []
         for u in self.units:
             if u.src is None:
                 continue
@@ -464,53 +495,523 @@ class Workspace:
                     scope.routines[r.name.upper()] = sym  # a routine replaces its EXT signature
                 if is_global and scope is glob:
                     u.scope.routines.setdefault(r.name.upper(), sym)
-                routine_syms.append((r, sym, u))
+                st.add_routine(_RoutineCheck(r, u, sym, r.span, r.end_line))
             declarer.soft_types = False
             if u.src.module.routines:
                 main = u.src.module.routines[0]
                 if main.name.upper() != u.name.upper() and not is_submit_file(u.src.path):
                     sink.at(main.span, "W111", f"main routine '{main.name}' differs from the file name '{u.name}'")
+        st.declarations_done(self)
 
-        # routine scopes (parameters and locals), then signatures, then bodies
-        body_mark = len(sink.items)
-        for r, sym, u in routine_syms:
-            declarer.soft_types = is_kuka_file(u.src.path)
+        # routine scopes (parameters and locals), then data-list values, then bodies
+        for rec in st.routines:
+            self._declare_locals(rec)
+        for u in self.units:
+            if u.dat is not None and u.dat.module.data is not None:
+                st.set_values(u, self._check_values(u, u.dat.module.data.items, {}))
+        for rec in st.routines:
+            if self._body_wanted(rec):
+                self._check_body(rec)
+        # advisory warnings are for code its maintainer can change: not for KUKA's own files
+        st.kuka = {f.path for f in self.files if is_kuka_file(f.path)} | {
+            u.dat.path for u in self.units
+            if u.dat is not None and u.dat.module.data is not None and _is_system_datalist(u.dat.module.data.name)}
+        self._report()
+        self._assemble()
+        # every use gets its storage and every statement its advance-run facts, once, for the
+        # interpreters (krl/semantics/resolve.py)
+        if self._options[0]:
+            resolve_workspace(self)
+
+    # ------------------------------------------------------------------ the phases of one owner
+
+    def _declare_locals(self, rec: "_RoutineCheck") -> None:
+        """A routine's scope: its parameters and local declarations, its signature completed."""
+        st = self._state
+        declarer, r, u = st.declarer, rec.routine, rec.unit
+        rec.scope_diags, rec.scope_uses = declarer.sink, declarer.unresolved = DiagnosticSink(), _Uses()
+        declarer.soft_types = is_kuka_file(u.src.path)
+        try:
             local = Scope("routine", r.name, u.scope)
             declarer.declare_types(local, r.decls, path=u.src.path, module=u.name)
             declarer.fill_types(local, r.decls)
-            declarer.declare_values(local, r.decls, u.name, u.src.path if u.src else "")
-            declarer.complete_signature(sym, local)
+            declarer.declare_values(local, r.decls, u.name, u.src.path)
+            declarer.complete_signature(rec.symbol, local)
             self.routine_scopes[id(r)] = local
-        declarer.soft_types = False
-        for u in self.units:
-            if u.dat is not None and u.dat.module.data is not None and u.dat.ok:
-                if self.check_only is not None and u.dat.path not in self.check_only:
+        finally:
+            declarer.soft_types = False
+
+    def _body_wanted(self, rec: "_RoutineCheck") -> bool:
+        """True when the routine's body is checked: its file parses (a file with syntax errors:
+        its AST may miss tokens; E002 says why) or the check types such files too."""
+        f = rec.unit.src
+        return (f.ok or self._options[1]) and (self.check_only is None or f.path in self.check_only)
+
+    def _check_body(self, rec: "_RoutineCheck") -> None:
+        st = self._state
+        declarer, checker, path = st.declarer, st.checker, rec.unit.src.path
+        sink, uses = DiagnosticSink(), _Uses()
+        checker.sink = declarer.sink = sink
+        declarer.unresolved = uses
+        checker.system_file = declarer.soft_types = is_kuka_file(path)
+        checker.submit = is_submit_file(path)
+        try:
+            checker.check_routine(rec.routine, self.routine_scopes[id(rec.routine)], path)
+        finally:
+            checker.system_file = declarer.soft_types = checker.submit = False
+        rec.body_diags, rec.body_uses = sink, uses
+
+    def _check_values(self, u: ModuleUnit, items: list, kept: dict) -> list:
+        """The initial values of a data list's `items` against the declared types, one record
+        per item (`kept`: id(item) -> a record still valid, not checked again)."""
+        f = u.dat
+        if not ((f.ok or self._options[1]) and (self.check_only is None or f.path in self.check_only)):
+            return []
+        st = self._state
+        declarer, checker = st.declarer, st.checker
+        dl = f.module.data
+        out = []
+        checker.system_file = declarer.soft_types = is_kuka_file(f.path)
+        try:
+            for item in items:
+                if not (isinstance(item, N.ArrayInit) or isinstance(item, N.VarDecl) and item.init is not None):
                     continue
-                checker.system_file = declarer.soft_types = is_kuka_file(u.dat.path)
-                checker.check_datalist(u.dat.module.data, u.scope)
-        for r, _sym, u in routine_syms:
-            if u.src is None or not u.src.ok:
-                continue  # a file with syntax errors: its AST may miss tokens; E002 says why
-            if self.check_only is not None and u.src.path not in self.check_only:
-                continue
-            checker.system_file = declarer.soft_types = is_kuka_file(u.src.path)
-            checker.submit = is_submit_file(u.src.path)
-            checker.check_routine(r, self.routine_scopes[id(r)], u.src.path)
-        checker.system_file = declarer.soft_types = checker.submit = False
-        finish_mark = len(sink.items)
-        declarer.unresolved.finish(sink)
-        self.phases = {"declarer": declarer, "checker": checker,
-                       "body": {id(d) for d in sink.items[body_mark:finish_mark]},
-                       "unresolved": {id(d) for d in sink.items[finish_mark:]},
-                       "routine_symbols": {id(r): sym for r, sym, _u in routine_syms}}
-        # advisory warnings are for code its maintainer can change: not for KUKA's own files
-        kuka = {f.path for f in self.files if is_kuka_file(f.path)} | {
-            u.dat.path for u in self.units
-            if u.dat is not None and u.dat.module.data is not None and _is_system_datalist(u.dat.module.data.name)}
+                rec = kept.get(id(item))
+                if rec is None:
+                    rec = _ValueCheck(item, item.span, DiagnosticSink(), _Uses())
+                    checker.sink = declarer.sink = rec.diags
+                    declarer.unresolved = rec.uses
+                    checker.check_datalist(N.DataList(dl.name, [item], dl.public, span=dl.span), u.scope)
+                out.append(rec)
+        finally:
+            checker.system_file = declarer.soft_types = False
+        return out
+
+    def _reported(self, f: SourceFile) -> bool:
+        return f.ok and (self.check_only is None or f.path in self.check_only)
+
+    def _owners(self) -> list[tuple[DiagnosticSink, "_Uses"]]:
+        """(findings, unresolved uses) of every owner that is reported, in the order of a check:
+        the declarations, routine scopes, data-list values (of files that parse), routine bodies
+        (of files that parse)."""
+        st = self._state
+        out = [(st.decl_sink, st.decl_uses), *((rec.scope_diags, rec.scope_uses) for rec in st.routines)]
+        for u in self.units:
+            if u.dat is not None and self._reported(u.dat):
+                out += st.value_owners.get(id(u), ())
+        out += [(rec.body_diags, rec.body_uses) for rec in st.routines
+                if rec.body_diags is not None and self._reported(rec.unit.src)]
+        return out
+
+    def _report(self) -> None:
+        """The unresolved-name report (krl/semantics/outside.py) from every recorded use, in
+        the order a check records them."""
+        un = Unresolved(load_builtins().packages, self.maybe_declared)
+        for _diags, uses in self._owners():
+            for use in uses.items:
+                un.use(*use)
+        self._state.report = DiagnosticSink()
+        un.finish(self._state.report)
+
+    def _assemble(self) -> None:
+        """The workspace's diagnostics in the order a check adds them (the input's, each
+        owner's, the report), a repeat dropped as one sink drops it, advisory warnings left out
+        in KUKA's files."""
+        st = self._state
+        sink = DiagnosticSink()
+        add = sink.add_diagnostic
+        for d in self._inputs:
+            add(d)
+        for part in [diags for diags, _uses in self._owners()] + [st.report]:
+            for d in part.items:
+                add(d)
+        kuka = st.kuka
         sink.items = [d for d in sink.items if not (d.code in ADVISORY and d.path in kuka)]
-        # every use gets its storage and every statement its advance-run facts, once, for the
-        # interpreters (krl/semantics/resolve.py)
-        resolve_workspace(self)
+        self.sink = sink
+        self._by_path = None
+
+    # ------------------------------------------------------------------ re-check after a change
+
+    def replace(self, lf: "LoadedFile") -> str:
+        """Put `lf`, a new version of the file ``lf.path`` of this workspace, in the old one's
+        place and, when the workspace was checked, check again what the change can affect; the
+        diagnostics are then those of a full check of the same files (tests/lsp/test_edits.py
+        replays real edits). Returns what was checked again:
+
+        * "routines": a .src/.sub whose interface (routine kinds, names, GLOBAL marks,
+          parameters and their declared types, return types) is the same: only its routines
+          whose AST changed, against the kept module and global scopes; the other routines
+          keep their findings (moved with their lines);
+        * "values": a .dat whose declarations are the same but for initial values: only the
+          values that changed are checked;
+        * "workspace": any other change (an interface, a file that cannot be read, a file whose
+          declarations other findings quote by line): every module that may depend on it, the
+          whole workspace, from the parses it holds;
+        * "none": not checked yet.
+
+        The unresolved-name report (per backup) is always made again. Storage places
+        (:meth:`resolve`) are left for later. Raises KeyError when no file is ``lf.path``."""
+        path = lf.path
+        sf = next((f for f in self.files if f.path == path), None)
+        old = self.loaded.get(path)
+        if sf is None or old is None:
+            raise KeyError(path)
+        old_template = old.template
+        self._set_loaded(lf)
+        st = self._state
+        if not self.checked or st is None:
+            sf.module, sf.ok, sf.status = lf.module, lf.ok, lf.status
+            return "none" if not self.checked else self._check_again()
+        self._by_path = None
+        self.resolver = None
+        st.declarer.incomplete = st.checker.incomplete = self.incomplete
+        try:
+            if old.unreadable or lf.unreadable or self.check_only is not None:
+                done = None
+            elif sf.module.kind == "dat" or lf.module.kind == "dat":
+                done = self._recheck_data(sf, lf, old_template)
+            else:
+                done = self._recheck_code(sf, lf, old_template)
+            if done is None:
+                return self._check_again()
+            self._report()
+            self._assemble()
+            return done
+        except Exception:  # noqa: BLE001 - the full check decides (and reports E901 itself)
+            return self._check_again()
+
+    def _set_loaded(self, lf: "LoadedFile") -> None:
+        old = self.loaded[lf.path]
+        self.loaded[lf.path] = lf
+        self.template[lf.path] = lf.template
+        gone = {id(d) for d in old.diagnostics}
+        if self.checked:
+            self._inputs = [d for d in self._inputs if id(d) not in gone] + list(lf.diagnostics)
+        else:
+            self.sink.remove(gone)
+            self.sink.extend(lf.diagnostics)
+        self.failed_words = set()
+        for x in self.loaded.values():
+            if not x.ok:
+                self.failed_words |= x.failed_words
+        self.unreadable = self._unread or any(x.unreadable for x in self.loaded.values())
+
+    def _check_again(self) -> str:
+        """The whole workspace checked again from the parses it holds."""
+        self.sink = DiagnosticSink()
+        self.sink.extend(self._inputs)
+        self.global_scope, self.units, self.routine_scopes = None, [], {}
+        self.system_names, self.resolver, self._state, self.checked = [], None, None, False
+        for f in self.files:
+            lf = self.loaded.get(f.path)
+            if lf is not None:
+                f.module, f.ok, f.status, f.scope = lf.module, lf.ok, lf.status, None
+        self.check(*self._options)
+        return "workspace"
+
+    def _recheck_code(self, sf: SourceFile, lf: "LoadedFile", old_template) -> str | None:
+        st = self._state
+        old_mod, new_mod = sf.module, lf.module
+        if old_mod.kind != "src" or new_mod.kind != "src" or old_mod.data is not None or new_mod.data is not None:
+            return None
+        if not _same_interface(old_mod, new_mod):
+            return None
+        recs = [st.by_routine.get(id(r)) for r in old_mod.routines]
+        if any(rec is None for rec in recs):
+            return None
+        new_template = lf.template
+        if sf.path in st.decl_paths and (old_template != new_template or any(
+                rec.span != r.span for rec, r in zip(recs, new_mod.routines))):
+            return None         # a finding of the declarations quotes this file's lines
+        sf.module, sf.ok, sf.status = new_mod, lf.ok, lf.status
+        redo = []
+        for rec, r in zip(recs, new_mod.routines):
+            if r is not rec.routine:
+                st.rebind_routine(rec, r, self.routine_scopes)
+                redo.append(rec)
+            elif (r.span != rec.span or old_template != new_template) and not rec.move(r, old_template, new_template):
+                redo.append(rec)
+        for rec in redo:
+            self._declare_locals(rec)
+            rec.body_diags = rec.body_uses = None
+        for rec in recs:
+            if rec.body_diags is None and self._body_wanted(rec):
+                self._check_body(rec)
+        return "routines"
+
+    def _recheck_data(self, sf: SourceFile, lf: "LoadedFile", old_template) -> str | None:
+        st = self._state
+        old_mod, new_mod = sf.module, lf.module
+        if old_mod.kind != "dat" or new_mod.kind != "dat" or old_mod.data is None or new_mod.data is None \
+                or old_mod.routines or new_mod.routines:
+            return None
+        odl, ndl = old_mod.data, new_mod.data
+        if (odl.name, odl.public) != (ndl.name, ndl.public):
+            return None
+        old_decls = [d for d in odl.items if not isinstance(d, N.ArrayInit)]
+        new_decls = [d for d in ndl.items if not isinstance(d, N.ArrayInit)]
+        if len(old_decls) != len(new_decls) or any(
+                a is not b and _declaration(a) != _declaration(b) for a, b in zip(old_decls, new_decls)):
+            return None
+        if sf.path in st.decl_paths and (old_template != lf.template
+                                         or st.anchors.get(sf.path) != _anchors(new_decls)):
+            return None         # a finding of the declarations quotes this file's lines
+        unit = next((u for u in self.units if u.dat is sf), None)
+        if unit is None:
+            return None
+        for a, b in zip(old_decls, new_decls):
+            if a is not b:
+                st.rebind_item(a, b)
+        sf.module, sf.ok, sf.status = new_mod, lf.ok, lf.status
+        kept = {}
+        for rec in st.values.get(id(unit), ()):
+            if rec.move(old_template, lf.template):
+                kept[id(rec.item)] = rec
+        st.set_values(unit, self._check_values(unit, ndl.items, kept))
+        return "values"
+
+
+# ---------------------------------------------------------------------- what a check leaves
+
+class _Uses:
+    """The unresolved-name uses of one owner (:class:`krl.semantics.outside.Unresolved.use`'s
+    arguments), replayed into the report in the order of a check."""
+
+    __slots__ = ("items",)
+
+    def __init__(self) -> None:
+        self.items: list[tuple] = []
+
+    def use(self, kind: str, name: str, path: str, line: int, column: int, evidence: str = "") -> None:
+        self.items.append((kind, name, path, line, column, evidence))
+
+
+def _moved_diagnostics(sink: DiagnosticSink, delta: int) -> DiagnosticSink:
+    out = DiagnosticSink()
+    for d in sink.items:
+        out.add_diagnostic(replace(d, line=d.line + delta, end_line=d.end_line + delta if d.end_line else 0,
+                                   notes=[replace(n, line=n.line + delta) for n in d.notes]))
+    return out
+
+
+def _same_template(old, new, lines: range, delta: int) -> bool:
+    """True when lines `lines` of the old text lie in the same template folds (INI, inline
+    form: the evidence of an unresolved use) as those lines moved by `delta` in the new."""
+    return all((n in old[0]) == (n + delta in new[0]) and (n in old[1]) == (n + delta in new[1]) for n in lines)
+
+
+@dataclass(slots=True, eq=False)
+class _RoutineCheck:
+    """What the check of one routine left: the routine, its module, its symbol, where it
+    stood (span, END line), the findings and unresolved uses of its scope (parameters and
+    locals) and of its body (None: the body was not checked)."""
+    routine: N.Routine
+    unit: ModuleUnit
+    symbol: Symbol
+    span: N.Span
+    end_line: int
+    scope_diags: DiagnosticSink | None = None
+    scope_uses: _Uses | None = None
+    body_diags: DiagnosticSink | None = None
+    body_uses: _Uses | None = None
+
+    def move(self, r: N.Routine, old_template, new_template) -> bool:
+        """The routine kept its AST but stands elsewhere (lines inserted above it) or the
+        template folds around it changed: move its findings with it. False when that is not
+        exact: a finding quotes a line of the file, or a use now lies in another fold."""
+        delta = r.span.line - self.span.line
+        path = self.span.file
+        parts = [p for p in (self.scope_diags, self.body_diags) if p is not None]
+        if any(path in d.message for p in parts for d in p.items):
+            return False
+        uses = [p for p in (self.scope_uses, self.body_uses) if p is not None and p.items]
+        if uses and (self.end_line < self.span.line or not _same_template(
+                old_template, new_template, range(self.span.line, self.end_line + 1), delta)):
+            return False
+        if delta:
+            self.scope_diags = _moved_diagnostics(self.scope_diags, delta)
+            if self.body_diags is not None:
+                self.body_diags = _moved_diagnostics(self.body_diags, delta)
+            for p in uses:
+                p.items = [(k, n, f, line + delta, c, e) for k, n, f, line, c, e in p.items]
+        self.span, self.end_line = r.span, r.end_line
+        return True
+
+
+@dataclass(slots=True, eq=False)
+class _ValueCheck:
+    """What the check of one data-list value (an initialised declaration or an array
+    element's value) left: the item, where it stood, its findings and unresolved uses."""
+    item: N.Decl
+    span: N.Span
+    diags: DiagnosticSink
+    uses: _Uses
+
+    def move(self, old_template, new_template) -> bool:
+        """Like :meth:`_RoutineCheck.move` for an item that kept its AST (one line)."""
+        delta = self.item.span.line - self.span.line
+        if any(self.span.file in d.message for d in self.diags.items):
+            return False
+        if self.uses.items and not _same_template(old_template, new_template, range(self.span.line, self.span.line + 1),
+                                                  delta):
+            return False
+        if delta:
+            self.diags = _moved_diagnostics(self.diags, delta)
+            self.uses.items = [(k, n, f, line + delta, c, e) for k, n, f, line, c, e in self.uses.items]
+        self.span = self.item.span
+        return True
+
+
+_FIRST_AT = re.compile(r"first declared at (.+):\d+:\d+\)")
+
+
+class _CheckState:
+    """The declarer and checker of the last check, and what each of its owners left: the
+    declaration phases (types, values, imports, routine symbols: one owner, made again only
+    by a full check), each routine (:class:`_RoutineCheck`, in check order) and each
+    data-list value (:class:`_ValueCheck`, per module), the unresolved-name report."""
+
+    def __init__(self) -> None:
+        self.declarer: Declarer | None = None
+        self.checker: Checker | None = None
+        self.decl_sink = DiagnosticSink()
+        self.decl_uses = _Uses()
+        self.decl_paths: set[str] = set()       # files whose lines the declarations' findings quote
+        self.anchors: dict[str, list] = {}      # such a .dat file: the spans of its declarations
+        self.routines: list[_RoutineCheck] = []
+        self.by_routine: dict[int, _RoutineCheck] = {}
+        self.values: dict[int, list[_ValueCheck]] = {}     # id(unit) -> its values' records
+        self.value_owners: dict[int, list[tuple]] = {}      # id(unit) -> (findings, uses) of the records with any
+        self.symbols_of: dict[int, tuple] = {}  # id(declaration) -> (declaration, its symbols)
+        self.report = DiagnosticSink()
+        self.kuka: set[str] = set()
+
+    def set_values(self, unit: ModuleUnit, recs: list[_ValueCheck]) -> None:
+        """The records of `unit`'s data-list values; those without findings or unresolved
+        uses are left out of what each edit's report and assembly walk (a data list can hold
+        thousands of values)."""
+        self.values[id(unit)] = recs
+        self.value_owners[id(unit)] = [(r.diags, r.uses) for r in recs if r.diags.items or r.uses.items]
+
+    def add_routine(self, rec: _RoutineCheck) -> None:
+        self.routines.append(rec)
+        self.by_routine[id(rec.routine)] = rec
+
+    def declarations_done(self, ws: "Workspace") -> None:
+        """Note which files the declarations' findings and uses name (their lines must stay
+        put for a re-check of that file alone) and which symbols each declaration entered."""
+        paths = self.decl_paths
+        for d in self.decl_sink.items:
+            paths.add(d.path)
+            m = _FIRST_AT.search(d.message)
+            if m:
+                paths.add(m.group(1))
+        paths.update(u[2] for u in self.decl_uses.items)
+        for u in ws.units:
+            if u.dat is not None and u.dat.path in paths and u.dat.module.data is not None:
+                self.anchors[u.dat.path] = _anchors([d for d in u.dat.module.data.items if not isinstance(d, N.ArrayInit)])
+        scopes = [ws.global_scope, *(u.scope for u in ws.units)]
+        for sc in scopes:
+            for table in (sc.values, sc.routines, sc.type_symbols):
+                for sym in table.values():
+                    if sym.decl is not None:
+                        got = self.symbols_of.get(id(sym.decl))
+                        if got is None:
+                            got = self.symbols_of[id(sym.decl)] = (sym.decl, [])
+                        if sym not in got[1]:
+                            got[1].append(sym)
+
+    def rebind_routine(self, rec: _RoutineCheck, r: N.Routine, routine_scopes: dict) -> None:
+        """A routine's new AST takes the old one's place (same interface): the symbol points
+        at it; its scope and findings are made again by the caller."""
+        old = rec.routine
+        del self.by_routine[id(old)]
+        routine_scopes.pop(id(old), None)
+        if rec.symbol.decl is old:
+            rec.symbol.decl = r
+        rec.routine, rec.span, rec.end_line = r, r.span, r.end_line
+        self.by_routine[id(r)] = rec
+
+    def rebind_item(self, a: N.Decl, b: N.Decl) -> None:
+        """A data-list declaration's new AST `b` takes the old one's place (same declaration
+        but for its value): the symbols it entered point at it, its names keep their
+        annotations."""
+        _node, syms = self.symbols_of.pop(id(a), (None, []))
+        for sym in syms:
+            if sym.decl is a:
+                sym.decl = b
+        if syms:
+            self.symbols_of[id(b)] = (b, syms)
+        if isinstance(a, N.VarDecl):
+            for va, vb in zip(a.names, b.names):
+                vb.ann = va.ann
+
+
+def _type_key(t: N.TypeRef | None):
+    return None if t is None else (t.name.upper(), t.size)
+
+
+def routine_interface(r: N.Routine) -> tuple:
+    """What other modules and the module's other routines can see of a routine: its kind,
+    name, GLOBAL mark, return type and parameters (name, mode, open dimensions, declared type
+    and dimensions)."""
+    decl_of: dict[str, tuple] = {}
+    names = {p.name.upper() for p in r.params}
+    for d in r.decls:
+        if isinstance(d, N.VarDecl):
+            for v in d.names:
+                if v.name.upper() in names:
+                    decl_of.setdefault(v.name.upper(), (_type_key(d.type), tuple(v.dims), d.is_const))
+    params = tuple((p.name.upper(), p.mode, p.dims, decl_of.get(p.name.upper())) for p in r.params)
+    return r.kind, r.name.upper(), r.is_global, _type_key(r.return_type), params
+
+
+def _same_interface(old: N.Module, new: N.Module) -> bool:
+    """True when two versions of a .src file show the same routines to the rest (an
+    unchanged routine, the same AST, is not looked at)."""
+    return len(old.routines) == len(new.routines) and all(
+        a is b or routine_interface(a) == routine_interface(b) for a, b in zip(old.routines, new.routines))
+
+
+def _declaration(d: N.Decl):
+    """A data-list declaration as the declaration phases see it: all but its initial value
+    (AST equality leaves spans out)."""
+    if isinstance(d, N.VarDecl):
+        return ("var", d.type, tuple(d.names), d.is_global, d.is_const, d.decl_keyword)
+    return d
+
+
+def _anchors(decls: list) -> list:
+    """The spans of a data list's declarations and of their parts (not their values)."""
+    out = []
+    for d in decls:
+        stack = [d]
+        while stack:
+            n = stack.pop()
+            out.append(n.span)
+            stack.extend(c for c in n.children() if not (isinstance(n, N.VarDecl) and c is n.init))
+    return out
+
+
+def failed_load(path, o, timeout: float) -> LoadedFile:
+    """The LoadedFile of a file whose load in :func:`load_batch` did not end (krl.pool.Outcome
+    `o`): E005 (stopped past `timeout` seconds) or E001 (its worker died), an empty module; it
+    may declare anything (unreadable)."""
+    sink = DiagnosticSink()
+    if o.status == "timeout":
+        sink.add(str(path), 1, 1, "E005", f"file not checked: not parsed within {timeout:g} s "
+                 "(--timeout; the parse was stopped)")
+    else:
+        sink.add(str(path), 1, 1, "E001", f"file not checked: {o.detail}")
+    module = build_module(ParseResult(str(path), False, "", o.status), DiagnosticSink())
+    return LoadedFile(str(path), module, False, o.status, 0.0, 0.0, sink.items, unreadable=True)
+
+
+def load_text(text: str, path: str = "<string>.src") -> LoadedFile:
+    """Parse (the Python engine) and build KRL text as if it were the file `path`."""
+    t = time.perf_counter()
+    src = SourceText(path, text, "", len(text.encode("utf-8", "surrogatepass")))
+    return _loaded(src, parse_text(text, path), t)
 
 
 _ON_FILE: ContextVar[Callable[[str], None] | None] = ContextVar("krl_workspace_on_file", default=None)
@@ -578,7 +1079,7 @@ def _unit_names(u: "ModuleUnit") -> set[str]:
 
 def _add_entries(ws: "Workspace", entries, timeout: float | None = None, jobs: int | None = None) -> None:
     ws.add_files([e.path for e in entries if e.kind == "file"], timeout=timeout, jobs=jobs)
-    _note_unread(ws, entries)
+    ws.add_unread(entries)
 
 
 def load_workspaces(groups: list[tuple[str, list]], timeout: float | None = None,
@@ -594,15 +1095,8 @@ def load_workspaces(groups: list[tuple[str, list]], timeout: float | None = None
         for (k, path), outcome in zip(files, load_batch([p for _, p in files], timeout, jobs)):
             out[k].add_outcome(path, outcome, timeout)
     for ws, (_, entries) in zip(out, groups):
-        _note_unread(ws, entries)
+        ws.add_unread(entries)
     return out
-
-
-def _note_unread(ws: "Workspace", entries) -> None:
-    for e in entries:
-        if e.kind != "file":
-            ws.sink.add(str(e.path), 1, 1, "W002", f"not read: {e.message}")
-            ws.unreadable = True   # it may declare what the other files use
 
 
 def load_workspace(paths: list[str | Path], root: str = "", timeout: float | None = None,

@@ -37,7 +37,7 @@ def recover(corpus: Path, out: Path, jobs: int | None, no_cache: bool, timeout: 
     from krl.terminal import printable_path  # noqa: PLC0415
     from recovery.pipeline import run_recovery  # noqa: PLC0415
     from krl.syntax.engines import use_engine  # noqa: PLC0415
-    from recovery.distributed import SchedulerError  # noqa: PLC0415
+    from krl.cluster import SchedulerError  # noqa: PLC0415
     from recovery.report import ReportError  # noqa: PLC0415
 
     use_engine(engine)

@@ -33,7 +33,6 @@ from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
-import platformdirs
 
 from krl.files import display_path, walk
 from krl.limits import PARSE_TIMEOUT_S
@@ -199,12 +198,7 @@ def failed_row(rel_path: str, size: int, sha: str, status: str, detail: str) -> 
 
 # ----------------------------------------------------------------------- cache
 
-def cache_dir() -> Path:
-    """The user cache directory (never inside the repository); created here. Raises OSError
-    when it cannot be created."""
-    d = Path(os.environ.get("KRL_CACHE_DIR") or platformdirs.user_cache_dir("krl-tools"))
-    d.mkdir(parents=True, exist_ok=True)
-    return d
+from krl.store import cache_dir  # noqa: E402 - the one user cache folder (re-exported)
 
 
 _WARNED: set[str] = set()
@@ -375,7 +369,7 @@ def scan(corpus: Path, gsha: str, parser_dir: str | None = None, jobs: int | Non
     to on_row and the scan returns [] (memory stays flat whatever the corpus size; the cache,
     when used, still holds one entry per file). scheduler: the address of a Dask scheduler
     (``tcp://HOST:8786``): the files are parsed on its cluster, in batches, with the same rows
-    (recovery/distributed.py; raises SchedulerError when it cannot be reached). Never raises
+    (krl/cluster.py; raises SchedulerError when it cannot be reached). Never raises
     for what it finds in the corpus.
     """
     from rich.progress import Progress  # noqa: PLC0415
@@ -424,10 +418,10 @@ def scan(corpus: Path, gsha: str, parser_dir: str | None = None, jobs: int | Non
 
     with bar:
         if scheduler is not None:
-            from recovery.distributed import run_batches  # noqa: PLC0415
+            from krl.cluster import run_batches  # noqa: PLC0415
 
             outcomes = run_batches(scheduler, scan_bytes, tasks(), timeout=timeout,
-                                   initializer=_init_worker, initargs=(parser_dir,))
+                                   initializer=_init_worker, initargs=(parser_dir,), name="krl-scan")
         else:
             outcomes = run_tasks(scan_bytes, tasks(), jobs=jobs or default_jobs(), timeout=timeout,
                                  initializer=_init_worker, initargs=(parser_dir,), in_process=in_process)

@@ -231,7 +231,9 @@ class Rule:
     """One reactive rule. ``when``: the condition's AST; ``text``: its source text (for
     messages); ``after``: delay in s; ``set``: signal -> value (``$IN[n]``/``$ANIN[n]``, or a
     SIGNAL name until the run resolves it); ``where``: ``file:line`` of the rule; ``source``:
-    the I/O event source its changes carry (``cell``; a preset names itself)."""
+    the I/O event source its changes carry (``cell``; a preset names itself); ``on_fire``: called
+    as ``on_fire(rule, t)`` after each answer is written (the automatic cell's program numbers
+    in turn, interp/runtime/autocell.py)."""
 
     when: N.Expr
     text: str
@@ -244,6 +246,7 @@ class Rule:
     due: list[float] = field(default_factory=list, repr=False)
     fired: int = field(default=0, repr=False)
     last_fired: float | None = field(default=None, repr=False)   # s, the last answer written
+    on_fire: Callable[["Rule", float], None] | None = field(default=None, repr=False, compare=False)
 
     def holds(self, io: IOImage) -> bool:
         """The condition's value now (False before the run resolved it)."""
@@ -262,6 +265,8 @@ def step_rules(rules: list[Rule], io: IOImage, t: float, dt: float) -> None:
             r.last_fired = t
             for name, v in r.set.items():
                 io.set_signal(name, v, r.source)
+            if r.on_fire is not None:
+                r.on_fire(r, t)
     for r in rules:
         now = r.holds(io)
         if now and not r.last:

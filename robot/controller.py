@@ -196,7 +196,13 @@ class Controller:
         io: the :class:`~robot.io.IOImage`.
         dt: IPO cycle in s (0.012).
         last_error: the last :class:`RobotError` of the main run, or None.
+        batch: class switch (default True): a CP segment at full path speed solves its
+            coming IPO cycles at once (robot/planner.py ``CartSegment.axes_run``; the same
+            setpoints bit for bit). False: every cycle alone (the reference path of
+            ``python -m robot.tracecheck --per-cycle``).
     """
+
+    batch: bool = True
 
     def __init__(self, machine: MachineData | None = None, *, trace: TraceWriter | None = None,
                  stimuli: list[Stimulus] | Cell | None = None, rules: list[Rule] | None = None,
@@ -205,12 +211,14 @@ class Controller:
         self.machine = machine if machine is not None else load_machine()
         self.rules: list[Rule] = []
         self.pgno: int | None = None      # the cell file's pgno preset (interp/run.py builds its rules)
+        self.start: str | None = None     # the cell file's start: position (interp/run.py places the robot)
         self.cell_network = None          # the cell file's `network:` settings (interp/run.py attaches them)
         if isinstance(stimuli, (str, Path)):
             raise TypeError("a cell file is read by robot.stimuli.load_cell; pass its Cell")
         if isinstance(stimuli, Cell):
             cell = stimuli
             stimuli, self.rules, self.pgno = cell.stimuli, list(cell.rules), cell.pgno
+            self.start = cell.start
             self.cell_network = cell.network
             if cell.autoext and mode_op is None:
                 mode_op = "EX"            # Automatic External (robot/cellpresets.py)
@@ -370,6 +378,71 @@ class Controller:
     def is_moving(self) -> bool:
         """True while a motion is being executed."""
         return bool(self._runs) or self._blend is not None
+
+    def place(self, axes: Any) -> None:
+        """Set the scene (``krl run --start``, a cell file's ``start:``): the robot stands at
+        `axes` (A1..A6, deg) before the first cycle. Raises
+        :class:`~robot.errors.SoftLimitError` for axes outside the software limits, ValueError
+        once the run has started."""
+        if self._k or self._runs or self._pending or self._next_id > 1:
+            raise ValueError("the robot can only be placed before the run starts")
+        q = np.array(axes, dtype=float)[:6]
+        self.model.kin.check_soft_limits(q)
+        self._q = q.copy()
+        self._q_prev = q.copy()
+        self._plan_q = q.copy()
+        if self._arm is not None:
+            self._arm.reset(q)
+        self._tcp_T = self.model.tcp(self._q, self._tool_T, self._base_inv_T)
+        self._tcp_prev = self._tcp_T[:3, 3].copy()
+
+    # ================================================================= idle fast-forward
+    def at_rest(self) -> bool:
+        """True when nothing the main run has will move the robot or change by itself: no
+        motion suspended, braking or blending, every motion executing or queued leads from
+        its start to the same axes without a TRIGGER (``PTP XHOME`` at XHOME, again and
+        again), no cell rule about to rise (the condition of :meth:`skip`;
+        interp/runtime/idle.py)."""
+        if self._braking or self._held is not None or self._blend is not None or self._tracked:
+            return False
+        for seg in [r.seg for r in self._runs] + list(self._pending):
+            if seg.triggers or not np.array_equal(seg.q0, seg.q1) or not np.array_equal(seg.q0, self._q):
+                return False
+        return not (self.rules and any(not r.last and r.holds(self.io) for r in self.rules))
+
+    def next_event_cycle(self) -> int | None:
+        """The first IPO cycle at which the controller changes something by itself while the
+        program does nothing: a timed stimulus, a stimulus delay that runs, a cell rule's
+        pending answer, a PULSE's reset. None when there is none. (A cycle ``k`` is the one
+        whose :meth:`step` makes ``time = k · dt``.)"""
+        times = [st.at if st.at is not None else st.due for st in self.stimuli
+                 if not st.fired and (st.at is not None or st.due is not None)]
+        times += [r.due[0] for r in self.rules if r.due]
+        times += [te for te, _, _ in self._pulses]
+        if not times:
+            return None
+        return max(self._k + 1, int(math.ceil(min(times) / self.dt - EPS)))
+
+    def skip(self, cycles: int) -> None:
+        """Fast-forward `cycles` IPO cycles in which nothing happens (interp/runtime/idle.py
+        decides that; issue 34 "Idle time costs nothing"): the clock, the path time and every
+        running ``$TIMER`` advance exactly as :meth:`step` would advance them, no event,
+        pose or cyclic hook runs (the robot stands: the pose is the one of the last cycle; a
+        motion that does not move it, executing or queued, goes on after the jump).
+        Raises ValueError when the main run is not :meth:`at_rest` or a skipped cycle would
+        reach :meth:`next_event_cycle`."""
+        if cycles <= 0:
+            return
+        nxt = self.next_event_cycle()
+        if not self.at_rest() or (nxt is not None and self._k + cycles >= nxt):
+            raise ValueError("the controller cannot skip these cycles: something happens in them")
+        self._k += cycles
+        self._pt += cycles * self.dt
+        tm, st = self.io.timer_ms, self.io.timer_stop
+        for i in range(1, len(tm)):
+            if not st[i]:
+                tm[i] += cycles * self._dt_ms
+        self.io.now = self.time
 
     def queue_length(self) -> int:
         """Motions planned but not yet started by the main run."""
@@ -738,6 +811,13 @@ class Controller:
             self._motion_event(seg, "end")
             seg._last_q = seg.q1.copy()
             return seg.q1.copy()
+        if self.batch and self._scale == 1.0 and self._scale_rate == 0.0:
+            # at full path speed pt advances by one cycle each step: the segment solves the
+            # coming cycles at once, up to its end or its blend start (robot/planner.py)
+            end = seg.T - EPS
+            if not r.decided and r.tau_cache is not None and r.tau_cache[1] is not None:
+                end = min(end, r.tau_cache[1] - EPS)
+            return seg.axes_run(pt, r.t0, self.dt * 0.5 * (1.0 + 1.0), end)
         return seg.axes(tau)
 
     def _begin_blend(self, r: _Run, pt: float, bp: "blending.BlendPlan") -> np.ndarray:
@@ -922,7 +1002,9 @@ class Controller:
             if due is not None and t >= due - EPS:
                 st.fired = True
                 for name, v in st.set.items():
-                    self.io.set_signal(name, v, "stimulus")
+                    self.io.set_signal(name, v, st.source)
+                if st.on_fire is not None:
+                    st.on_fire(t)
 
     def _reach_stimuli(self) -> None:
         if not self.stimuli or not self._runs:
@@ -942,7 +1024,7 @@ class Controller:
                         if st.delay <= 0:
                             st.fired = True
                             for name, v in st.set.items():
-                                self.io.set_signal(name, v, "stimulus")
+                                self.io.set_signal(name, v, st.source)
 
 
 def _e_at(seg: Segment, u: float) -> np.ndarray:

@@ -155,24 +155,12 @@ class Palletizer5:
 
     def check(self, where: str) -> None:
         """Raise robot.mada.MachineDataError (at `where`) unless the closed form gives back
-        random configurations of the machine-data chain (A4 = 0)."""
-        from .chain import chain_forward  # noqa: PLC0415
-        from .mada import MachineDataError  # noqa: PLC0415
-
-        k = self.kin
-        rng = np.random.default_rng(0)
-        lo = np.maximum(k._lo, -170.0)
-        hi = np.minimum(k._hi, 170.0)
-        for q in rng.uniform(lo, hi, size=(4, 6)):
-            q[3] = 0.0
-            T = k.forward(q)
-            if k.machine.chain is not None and np.abs(chain_forward(k.machine.chain, q) - T).max() > 1e-6:
-                raise MachineDataError(f"{where}: internal chain does not close")
-            rows = self.rows(T, q)
-            if not rows or min(np.abs(k.forward(r) - T).max() for r in rows) > 1e-6:
-                raise MachineDataError(
-                    f"{where}: $DEF_A4FIX=TRUE, $DEF_A5LINK=FALSE: the wrist of this 5-axis palletizer "
-                    f"($DH_4, $DH_5, $TFLWP) does not keep the A6 axis in the arm's plane")
+        random configurations of the machine-data chain (A4 = 0;
+        robot.kinematics.Kinematics.check_closed_form)."""
+        self.kin.check_closed_form(
+            self.rows, where,
+            "$DEF_A4FIX=TRUE, $DEF_A5LINK=FALSE: the wrist of this 5-axis palletizer "
+            "($DH_4, $DH_5, $TFLWP) does not keep the A6 axis in the arm's plane")
 
 
 __all__ = ["Palletizer5"]

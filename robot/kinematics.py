@@ -326,24 +326,39 @@ class Kinematics:
     def _check_palletizer4(self, where: str) -> None:
         """The 4-axis closed form must give back random linked configurations of the chain
         (A4 = 0, A2 + A3 + A5 as at HOME); robot.mada.MachineDataError otherwise."""
+        home = self._home
+
+        def link(q):
+            q[4] = home[4] + home[1] + home[2] - q[1] - q[2]
+
+        led = "$NUM_AX=4" if "a5_led" in self.machine.provenance else "$DEF_A5LINK=TRUE"
+        self.check_closed_form(
+            self._palletizer_rows, where,
+            f"$DEF_A4FIX=TRUE, A5 led ({led}): this palletizer's arm ($TIRORO, $TX3P3, $DH_4, $DH_5, "
+            f"$TFLWP) is not one the 4-axis closed form covers", link=link)
+
+    def check_closed_form(self, rows, where: str, message: str, link=None) -> None:
+        """Raise robot.mada.MachineDataError (``"{where}: {message}"``) unless the closed form
+        ``rows(T, q)`` (a list of axis rows for the flange pose T, 4x4, mm) gives back four
+        random configurations of the machine-data chain within 1e-6: A4 = 0, and `link(q)`
+        sets the axes the arm's linkage leads. Also raises when the chain of the machine data
+        does not close on :meth:`forward`."""
         from .chain import chain_forward  # noqa: PLC0415
         from .mada import MachineDataError  # noqa: PLC0415
 
-        home = self._home
         rng = np.random.default_rng(0)
         lo = np.maximum(self._lo, -170.0)
         hi = np.minimum(self._hi, 170.0)
         for q in rng.uniform(lo, hi, size=(4, 6)):
             q[3] = 0.0
-            q[4] = home[4] + home[1] + home[2] - q[1] - q[2]
+            if link is not None:
+                link(q)
             T = self.forward(q)
             if self.machine.chain is not None and np.abs(chain_forward(self.machine.chain, q) - T).max() > 1e-6:
                 raise MachineDataError(f"{where}: internal chain does not close")
-            rows = self._palletizer_rows(T, q)
-            if not rows or min(np.abs(self.forward(r) - T).max() for r in rows) > 1e-6:
-                raise MachineDataError(
-                    f"{where}: $DEF_A4FIX=TRUE, A5 led ({'$NUM_AX=4' if 'a5_led' in self.machine.provenance else '$DEF_A5LINK=TRUE'}): this palletizer's arm ($TIRORO, $TX3P3, "
-                    f"$DH_4, $DH_5, $TFLWP) is not one the 4-axis closed form covers")
+            found = rows(T, q)
+            if not found or min(np.abs(self.forward(r) - T).max() for r in found) > 1e-6:
+                raise MachineDataError(f"{where}: {message}")
 
     def _joint_point(self, axes_deg: Sequence[float], index: int) -> np.ndarray:
         """Position (mm, in ``$ROBROOT``) of the origin of joint `index` (0 = A1)."""
@@ -649,7 +664,59 @@ class Kinematics:
             Ts = self._base_inv @ Ts
         if self._end_inv is not None:
             Ts = Ts @ self._end_inv
-        Q, valid = self._opw_core_many(Ts, refs)                   # (n, 8, 6), (n, 8)
+        Q, valid, _ = self._opw_core_many(Ts, refs)                # (n, 8, 6), (n, 8)
+        return self._select_many(Q, valid, orig, status, turn, refs)
+
+    def inverse_chain(self, flange_T: np.ndarray, status: int | None, reference_deg: Sequence[float],
+                      passes: int) -> np.ndarray | None:
+        """:meth:`inverse` along a chain of N flange poses, each solution the reference of
+        the next one (the first one's: `reference_deg`; turn None): (N, 6) axes, bit for bit
+        those of N calls in turn, or None when the chain is to be solved call by call (not
+        the OPW family, an error on some pose, no fixed point within `passes`).
+
+        Each pass solves every row at once (:meth:`inverse_many`) with a guess of the rows,
+        shifted by one, as references (first pass: `reference_deg` for all; then the previous
+        pass's rows, unwrapped); a pass that gives back its guess is the sequential chain
+        (row i's reference is row i-1's solution, by induction over i). The analytic solutions are computed once unless a
+        pose sits at a singularity, where they take a free angle from the reference.
+        Raises nothing: errors give None (the caller's per-pose solve raises them)."""
+        if self.family != "opw":
+            return None
+        Ts = orig = np.asarray(flange_T, dtype=float).reshape(-1, 4, 4)
+        n = Ts.shape[0]
+        if n == 0:
+            return None
+        refs = np.empty((n, 6))
+        refs[:] = np.asarray(reference_deg, dtype=float)[:6]
+        if self._base_inv is not None:
+            Ts = self._base_inv @ Ts
+        if self._end_inv is not None:
+            Ts = Ts @ self._end_inv
+        try:
+            Q, valid, ref_free = self._opw_core_many(Ts, refs)
+            out = self._select_many(Q, valid, orig, status, None, refs)
+            for _ in range(passes):
+                # the guess: each axis continued from the row before (±360°, np.unwrap), so a
+                # turn past ±180° is followed in one pass, within the soft limits (past one
+                # the pass's own value); unchanged values keep their bits
+                g = np.unwrap(out, period=360.0, axis=0)
+                g = np.where((g == out) | (g < self._lo) | (g > self._hi), out, g)
+                refs[1:] = g[:-1]
+                if not ref_free:
+                    Q, valid, _ = self._opw_core_many(Ts, refs)
+                new = self._select_many(Q, valid, orig, status, None, refs)
+                if new.tobytes() == g.tobytes():
+                    return new
+                out = new
+        except (WorkspaceError, SoftLimitError):
+            return None
+        return None
+
+    def _select_many(self, Q: np.ndarray, valid: np.ndarray, orig: np.ndarray, status: int | None,
+                     turn: int | None, refs: np.ndarray) -> np.ndarray:
+        """:meth:`_select` over the analytic solutions Q (N, 8, 6) of the flange poses `orig`
+        (rows without a usable solution are solved by :meth:`inverse`, raising its error)."""
+        n = Q.shape[0]
         S, amb = self._status_many(Q)                              # (n, 8)
         if status is not None:
             s_target = np.full(n, int(status) & 7)
@@ -707,9 +774,10 @@ class Kinematics:
                | ((np.abs(Q[..., 4]) < WRIST_SINGULAR_DEG).astype(int) << 2) | self._s_free)
         return s, amb
 
-    def _opw_core_many(self, Ts: np.ndarray, refs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def _opw_core_many(self, Ts: np.ndarray, refs: np.ndarray) -> tuple[np.ndarray, np.ndarray, bool]:
         """:meth:`_opw_core` over N targets: (N, 8, 6) axes (deg, wrapped; NaN where a branch
-        does not exist) and the (N, 8) mask of existing solutions, in the scalar order."""
+        does not exist), the (N, 8) mask of existing solutions, in the scalar order, and
+        whether the result is free of `refs` (no target at a singularity)."""
         o = self._opw
         acos = np.frompyfunc(math.acos, 1, 1)
         atan2_ = np.frompyfunc(math.atan2, 2, 1)
@@ -724,6 +792,7 @@ class Kinematics:
         reach = rho2 >= 0.0
         nx1 = np.sqrt(np.where(reach, rho2, 0.0)) - o.a1
         over = np.sqrt(cx * cx + cy * cy) < OVERHEAD_SINGULAR_MM
+        ref_free = not bool(over.any())
         tmp1 = np.where(over, np.radians(self._sgn[0] * refs[:, 0]) - self._offs[0], atan2(cy, cx))
         tmp2 = atan2(o.b, nx1 + o.a1)
         th1s = (tmp1 - tmp2, tmp1 + tmp2 - math.pi)
@@ -755,6 +824,7 @@ class Kinematics:
                 th6 = atan2(r01 * s23 * cs1 + r11 * s23 * sn1 + r21 * c23,
                                  -r00 * s23 * cs1 - r10 * s23 * sn1 - r20 * c23)
                 sing = np.abs(np.degrees(th5)) < WRIST_SINGULAR_DEG
+                ref_free = ref_free and not bool((sing & exists).any())
                 total = th4 + th6
                 th4 = np.where(sing, np.radians(self._sgn[3] * refs[:, 3]) - self._offs[3], th4)
                 th6 = np.where(sing, total - th4, th6)
@@ -764,7 +834,7 @@ class Kinematics:
                     valid[:, col] = exists
                     col += 1
         Q[~valid] = np.nan
-        return Q, valid
+        return Q, valid, ref_free
 
     # ------------------------------------------------------------------ frame chain
     def tcp_pose(self, axes_deg: Sequence[float], tool: Any = None, base: Any = None,

@@ -17,7 +17,12 @@ kinematic (``MotionParams.base_kin``, KSS ``EK``) turns with it.
   a chain of path pieces (line, circular arc, Catmull-Rom curve for SPL points); the
   orientation follows ``$ORI_TYPE``/``$CIRC_TYPE``; axis values come from the inverse
   kinematics each cycle, keeping the start status S and the turn nearest to the last
-  setpoint (reference §6.5: CP motions ignore the target's S and T).
+  setpoint (reference §6.5: CP motions ignore the target's S and T). Where each solution
+  is the next one's reference (the planning walk of a path, the main run's coming cycles at
+  full path speed: :meth:`CartSegment.axes_run`) the chain is solved at once in numpy
+  (:meth:`RobotModel.ik_chain`), with the same results bit for bit; a kept row is used only
+  for the same time law, time and reference, so a BRAKE, a blend, an interrupt's motion or an
+  advance-run event between cycles gets the per-cycle setpoint.
 
 Planning happens in the advance run (:func:`plan`), so an unreachable target or a soft-limit
 violation of a target raises :class:`~robot.errors.RobotError` at the motion statement.
@@ -51,6 +56,14 @@ CP_SPEED_LIMIT_FACTOR = 1.5
 CP_SAMPLE_STEP_DEG = 1.0
 #: Safety factor on the sampled TCP/flange speed of a path in T1 (sampling between points).
 T1_MARGIN = 1.02
+#: Passes of the batched IK chain (:meth:`RobotModel.ik_chain`) before it gives up and the
+#: chain is solved pose by pose (each pass fixes at least one more row).
+IK_CHAIN_PASSES = 6
+#: IPO cycles of a CP segment the main run solves at once (:meth:`CartSegment.axes_run`).
+AHEAD_CYCLES = 128
+#: Shortest chain solved at once: below it numpy's fixed cost per pass (two passes at least)
+#: is more than the per-pose solves (measured 2026-11-24: even at 40 poses, about 1.1x slower).
+MIN_CHAIN = 64
 
 
 class RobotModel:
@@ -145,6 +158,39 @@ class RobotModel:
 
     def status_turn(self, q: np.ndarray) -> tuple[int, int]:
         return self.kin.status_turn(q)
+
+    @property
+    def batch_ik(self) -> bool:
+        """True when :meth:`ik_chain` solves in numpy (the OPW family, no external axes and
+        no linked $BASE); otherwise it returns None and callers solve cycle by cycle."""
+        return type(self) is RobotModel and not self.n_ext and self.kin.family == "opw"
+
+    def ik_chain(self, poses: list[tuple[np.ndarray, np.ndarray]], tool_inv_T: np.ndarray | None,
+                 base_T: np.ndarray | None, status: int | None, ref: np.ndarray) -> np.ndarray | None:
+        """:meth:`ik` along a chain of TCP poses ``(p (3,), R (3, 3))`` in $BASE where each
+        solution is the next one's reference (the first one's is `ref`): the (n, 6) axes,
+        bit for bit those of n calls of :meth:`ik` in turn, or None when the chain must be
+        solved call by call (not :attr:`batch_ik`, an error on some pose, no fixed point).
+
+        The rows are solved at once by :meth:`Kinematics.inverse_chain` (passes of
+        :meth:`Kinematics.inverse_many` until a fixed point). Issue 39, "Simulator"."""
+        n = len(poses)
+        if n < MIN_CHAIN or not self.batch_ik:
+            return None
+        F = np.empty((n, 4, 4))
+        for i, (p, R) in enumerate(poses):
+            T = np.empty((4, 4))
+            T[:3, :3] = R
+            T[:3, 3] = p
+            T[3] = _BOTTOM_ROW
+            if base_T is not None:
+                T = base_T @ T
+            if tool_inv_T is not None:
+                T = T @ tool_inv_T
+            if not self._robroot_is_null:
+                T = self._robroot_inv_T @ T
+            F[i] = T
+        return self.kin.inverse_chain(F, status, ref, IK_CHAIN_PASSES)
 
     def tcp_pos_many(self, Q: np.ndarray, tool_T: np.ndarray, base_inv_T: np.ndarray) -> np.ndarray:
         """TCP positions (n, 3) in $BASE for axis rows Q (n, 6 + external axes)."""
@@ -486,6 +532,8 @@ class Segment:
         self.qd_end = q1 - q0
         self._last_q = q0.copy()
         self._end_frame: list[float] | None = None
+        #: the main run's solved cycles ahead (CartSegment.axes_run)
+        self._ahead: tuple | None = None
 
     @property
     def T(self) -> float:  # noqa: N802 - the duration's symbol in the planner's formulas
@@ -498,6 +546,10 @@ class Segment:
     # overridden
     def axes(self, tau: float) -> np.ndarray:
         raise NotImplementedError
+
+    def axes_run(self, pt: float, t0: float, dt: float, end: float) -> np.ndarray:
+        """:meth:`axes` at ``pt - t0`` from the main run (see :meth:`CartSegment.axes_run`)."""
+        return self.axes(pt - t0)
 
     def pose(self, tau: float) -> tuple[np.ndarray, np.ndarray]:
         """TCP position (mm, (3,)) and rotation matrix (3, 3) in $BASE at local time tau."""
@@ -664,6 +716,51 @@ class CartSegment(Segment):
         if u is not None and len(ref) > 6:
             ref = np.concatenate([ref[:6], self.q0[6:] + u * (self.e1 - self.q0[6:])])
         return self.model.ik(T, self._ik_tool, self._ik_base, self.status, None, ref)
+
+    def ik_chain(self, poses: list[tuple[np.ndarray, np.ndarray]], ref: np.ndarray) -> np.ndarray | None:
+        """:meth:`ik` of each pose with the previous solution as reference (the first: `ref`),
+        solved at once (:meth:`RobotModel.ik_chain`): (n, 6) axes, or None (solve one by one)."""
+        return self.model.ik_chain(poses, self._ik_tool, self._ik_base, self.status, ref)
+
+    def axes_run(self, pt: float, t0: float, dt: float, end: float) -> np.ndarray:
+        """:meth:`axes` at ``tau = pt - t0`` for the main run, which advances ``pt`` by `dt`
+        each IPO cycle: the coming cycles up to local time `end` (exclusive; the segment's end
+        or its blend start) are solved at once (:meth:`ik_chain`, up to
+        :data:`AHEAD_CYCLES`) and kept. A kept row is returned only for the same profile, the
+        same ``tau`` and the same reference (the last setpoint, byte for byte); anything
+        else (a BRAKE, a new blend profile, a setpoint set from outside) solves again, so
+        the result is always the one :meth:`axes` gives."""
+        tau = pt - t0
+        ahead = self._ahead
+        if ahead is not None:
+            prof, taus, refs, Q, i = ahead
+            if (i < len(taus) and prof is self.profile and taus[i] == tau
+                    and refs[i] == self._last_q.tobytes()):
+                q = Q[i].copy()
+                self._ahead = (prof, taus, refs, Q, i + 1)
+                self._last_q = q
+                return q
+            self._ahead = None
+        if self.joint_ori or len(self.q0) > 6 or tau >= self.T or not self.model.batch_ik:
+            return self.axes(tau)
+        if end - tau < (MIN_CHAIN - 2) * dt:     # the segment's tail: cycle by cycle
+            return self.axes(tau)
+        taus = [tau]
+        t = pt
+        while len(taus) < AHEAD_CYCLES:
+            t = t + dt
+            if t - t0 >= end:
+                break
+            taus.append(t - t0)
+        if len(taus) < MIN_CHAIN:
+            return self.axes(tau)
+        ref = self._last_q
+        Q = self.ik_chain([self.pose(x) for x in taus], ref)
+        if Q is None:
+            return self.axes(tau)
+        refs = [ref.tobytes()] + [row.tobytes() for row in Q[:-1]]
+        self._ahead = (self.profile, taus, refs, Q, 0)
+        return self.axes_run(pt, t0, dt, end)
 
     def axes(self, tau: float) -> np.ndarray:
         if tau >= self.T:
@@ -1045,7 +1142,20 @@ def _plan_cart(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_T: 
             Q = np.empty((nk + 1, len(q0)))
             Q[0] = start
             ref = start
-            for j in range(1, nk + 1):
+            chain = None
+            if len(q0) == 6 and nk >= MIN_CHAIN and model.batch_ik:
+                chain = seg.ik_chain([seg.pose_u(float(us[j])) for j in range(1, nk + 1)], ref)
+            if chain is not None:
+                # the same rows as the loop below; its singularity check, in its order
+                jumps = np.abs(np.diff(np.concatenate([Q[:1], chain]), axis=0))
+                for j in range(nk):
+                    if float(jumps[j].max()) > SINGULAR_JUMP_DEG:
+                        i = int(np.argmax(jumps[j]))
+                        raise RobotError(f"CP path through a singularity: A{i + 1} would turn "
+                                         f"{jumps[j][i]:.0f} deg at once (keep the status on CP paths)")
+                Q[1:] = chain
+                ref = Q[nk].copy()
+            for j in range(1, nk + 1 if chain is None else 1):
                 pu, Ru = seg.pose_u(float(us[j]))
                 q = seg.ik(pu, Ru, ref, float(us[j])) if len(q0) > 6 else seg.ik(pu, Ru, ref)
                 jump = np.abs(q - ref)

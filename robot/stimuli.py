@@ -26,6 +26,9 @@ A *cell file* is a stimuli file with reactive rules and presets beside (issue 22
         after: 0.2
         set: {PART_OK: true}
 
+``start`` says where the robot stands when the run begins: a point of the program (``XHOME``)
+or an axis literal (``"{A1 0, A2 -90, A3 90, A4 0, A5 0, A6 0}"``, or the same as a mapping
+``{A1: 0, A2: -90, ...}``); ``krl run --start`` overrides it (interp/run.py ``start_axes``).
 ``robot`` names the robot the cell holds, when the backup has no machine data of its own: one
 of the project's robot library (robot/machine.py ``library_robots``; a name, never a path, as
 the file is untrusted). ``krl run --robot`` overrides it; it overrides the backup's machine data.
@@ -36,7 +39,7 @@ OPC UA servers, KukaVarProxy; net/settings.py, docs/network.md).
 real-programs report runs it that long when that is longer than its own limit.
 
 The file is validated against this schema: a top-level mapping holds only ``stimuli``,
-``rules``, ``presets``, ``robot``, ``sim_time``; a stimulus only ``at``, ``when``, ``set``, ``delay``; ``when`` only
+``rules``, ``presets``, ``robot``, ``sim_time``, ``start``; a stimulus only ``at``, ``when``, ``set``, ``delay``; ``when`` only
 ``motion``, ``line``, ``phase``, ``reached``; a rule only ``when`` (KRL text), ``after``, ``set``;
 ``presets`` only ``pgno``, ``autoext``. Anything else is a :class:`StimulusError` that names the
 key and the place (``file:line``). Limits: at most :data:`MAX_STIMULI` stimuli,
@@ -59,13 +62,13 @@ from typing import Any
 
 import yaml
 
-from krl.limits import MAX_CELL_RULES, MAX_CELL_SIM_TIME_S, MAX_STIMULI, MAX_STIMULI_BYTES
+from krl.limits import MAX_CELL_RULES, MAX_CELL_SIM_TIME_S, MAX_START_CHARS, MAX_STIMULI, MAX_STIMULI_BYTES
 
 from .cellrules import ConditionError, Rule, compile_condition, parse_condition
 from .io import IOError_, parse_signal
 
 PHASES = ("start", "blend_start", "blend_end", "end")
-TOP_KEYS = ("stimuli", "rules", "presets", "robot", "sim_time", "network")
+TOP_KEYS = ("stimuli", "rules", "presets", "robot", "sim_time", "start", "network")
 PRESET_KEYS = ("pgno", "autoext")
 RULE_KEYS = ("when", "after", "set")
 STIMULUS_KEYS = ("at", "when", "set", "delay")
@@ -91,6 +94,9 @@ class Stimulus:
         (``reached_default``; the controller of the run sets it from its machine data).
         delay: extra delay in s after the condition holds.
         where: ``file:line`` of the stimulus in its file ("" when built from data).
+        source: the ``source`` of its I/O events (``stimulus``; ``auto`` for an answer of
+            ``--inputs auto``, interp/runtime/autocell.py); on_fire: called with the time
+            when it takes effect.
     """
 
     set: dict[str, Any]
@@ -104,6 +110,8 @@ class Stimulus:
     fired: bool = False
     due: float | None = field(default=None, repr=False)
     where: str = field(default="", repr=False)
+    source: str = field(default="stimulus", repr=False)   # the I/O events' source (auto: --inputs auto)
+    on_fire: Callable[[float], None] | None = field(default=None, repr=False, compare=False)
 
     def matches_motion(self, motion_id: int, line: int | None) -> bool:
         if self.motion is not None:
@@ -213,6 +221,7 @@ class Cell:
     autoext: bool = False          # presets: Automatic External (operating mode EXT)
     robot: Path | None = None      # the robot of the project's library the cell names
     sim_time: dict[str, float] = field(default_factory=dict)   # PROGRAM (upper case) -> s it needs
+    start: str | None = None       # where the robot stands at the start (interp/run.py start_axes)
     network: Any = None            # net.settings.NetworkSettings: the partners (`network:`, docs/network.md)
 
 
@@ -274,6 +283,8 @@ def parse_cell(doc: Any, default_reach_mm: float = 0.1, source: str = "") -> Cel
             cell.robot = _library_robot(doc["robot"], where(doc, "robot"))
         if "sim_time" in doc:
             cell.sim_time = _sim_times(doc["sim_time"], where, where(doc, "sim_time"))
+        if "start" in doc:
+            cell.start = _start(doc["start"], where(doc, "start"))
         if doc.get("stimuli") is not None:
             cell.stimuli = _parse_stimuli(doc["stimuli"], default_reach_mm, where)
         if doc.get("network") is not None:
@@ -299,6 +310,67 @@ def _sim_times(doc: Any, where: _Where, at: str) -> dict[str, float]:
             raise StimulusError(f"{where(doc, name)}: sim_time of {name} must be 0 < s <= {MAX_CELL_SIM_TIME_S:g}")
         out[name.upper()] = s
     return out
+
+
+class StartError(ValueError):
+    """A start position (``krl run --start``, a cell file's ``start:``) that cannot place the
+    robot; the message names it and why."""
+
+
+#: the components of an AXIS/E6AXIS and of a POS/E6POS start, in order
+START_AXES = ("A1", "A2", "A3", "A4", "A5", "A6")
+START_CART = ("X", "Y", "Z", "A", "B", "C")
+
+
+def parse_start(text: str):
+    """The AST of a start position: an AXIS/E6AXIS or POS/E6POS aggregate literal
+    (``{A1 0, A2 -90, A3 90, A4 0, A5 0, A6 0}``, ``{X 500, Y 0, Z 800, A 0, B 90, C 0, S 2,
+    T 35}``) or the name of a point (``XHOME``), parsed by the project's expression parser
+    (one line, at most :data:`~krl.limits.MAX_RULE_TOKENS` tokens). Raises
+    :class:`StartError` for anything else."""
+    from krl.ast import nodes as N  # noqa: PLC0415
+    from krl.ast.build import build_expression  # noqa: PLC0415
+    from krl.limits import MAX_RULE_TOKENS  # noqa: PLC0415
+    from krl.syntax.parse import default_bundle, parse_expression  # noqa: PLC0415
+
+    if not isinstance(text, str) or not text.strip():
+        raise StartError("a start position is an E6AXIS literal or the name of a point, e.g. XHOME")
+    if len(text) > MAX_START_CHARS:
+        raise StartError(f"a start position is at most {MAX_START_CHARS} characters")
+    bundle = default_bundle()
+    parsed = parse_expression(text.strip(), MAX_RULE_TOKENS, bundle)
+    expr = build_expression(parsed.tree, "<start>", bundle.symbolic) if parsed.error is None else None
+    if isinstance(expr, N.Name):
+        return expr
+    if isinstance(expr, N.Aggregate):
+        for it in expr.items:
+            v = it.value
+            if isinstance(v, N.Unary) and v.op in ("-", "+"):
+                v = v.operand
+            if not isinstance(v, (N.IntLit, N.RealLit)):
+                raise StartError(f"start {text!r}: {it.name} must be a number")
+        return expr
+    raise StartError(f"start {text!r}: not an E6AXIS literal ({{A1 0, A2 -90, ...}}) or a point name")
+
+
+def _start(value: Any, at: str) -> str:
+    """The ``start:`` of a cell file: an E6AXIS literal or a point name, checked by the
+    project's expression parser (:func:`parse_start`)."""
+    if isinstance(value, dict):
+        parts = []
+        for k, v in value.items():
+            if not isinstance(k, str) or isinstance(v, bool) or not isinstance(v, (int, float)):
+                raise StimulusError(f"{at}: start: {str(k)[:24]!r} must map to a number")
+            parts.append(f"{k} {v}")
+        value = "{" + ", ".join(parts) + "}"
+    if not isinstance(value, str) or len(value) > MAX_START_CHARS:
+        raise StimulusError(f"{at}: start must be a point name (XHOME) or an E6AXIS literal "
+                            f"(\"{{A1 0, A2 -90, A3 90, A4 0, A5 0, A6 0}}\")")
+    try:
+        parse_start(value)
+    except StartError as exc:
+        raise StimulusError(f"{at}: {exc}") from None
+    return value
 
 
 def _library_robot(name: Any, at: str) -> Path:

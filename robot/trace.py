@@ -38,7 +38,7 @@ SCHEMA: dict[str, list[tuple[str, str]]] = {
     "io": [
         ("signal", "str: e.g. $OUT[3], $IN[5], $ANOUT[1], $ANIN[2]"),
         ("value", "bool or float: the new value"),
-        ("source", "optional str: program | trigger | pulse | stimulus | cell (a rule of the cell file; a preset names itself: cell:pgno, cell:autoext)"),
+        ("source", "optional str: program | trigger | pulse | stimulus | cell (a rule of the cell file; a preset names itself: cell:pgno, cell:autoext) | auto (an answer of --inputs auto)"),
     ],
     "pose": [
         ("axes", "list[6] float: A1..A6 in deg (setpoint read back from MuJoCo)"),
@@ -92,7 +92,8 @@ SCHEMA: dict[str, list[tuple[str, str]]] = {
     ],
     "step_stop": [
         ("mode", "str: the run mode that stops: MSTEP (a motion ended), ISTEP (before the next "
-                 "statement), BSTEP (a backward motion ended, or was refused: then text)"),
+                 "statement), BSTEP (a backward motion ended, or was refused: then text); HALT "
+                 "(krl run --on-halt continue: the operator presses Start again)"),
         ("file", "optional str: source file of the statement"),
         ("line", "optional int: source line of the statement (of the motion, for MSTEP and BSTEP)"),
         ("id", "optional int: motion id (MSTEP, BSTEP)"),
@@ -100,6 +101,28 @@ SCHEMA: dict[str, list[tuple[str, str]]] = {
     ],
     "call": [("name", "str: routine name"), ("line", "optional int")],
     "return": [("name", "str: routine name"), ("line", "optional int")],
+    "idle": [
+        ("until", "float: s, the clock jumped from t to here (interp/runtime/idle.py): nothing "
+                  "changed and nothing happens before the next event"),
+        ("since", "optional float: s, the state has stood still since"),
+        ("cycles", "optional int: IPO cycles skipped (they execute no statement)"),
+    ],
+    "answer": [
+        ("sets", "dict: what the automatic cell sets (krl run --inputs auto): $IN[n] -> bool, or a "
+                 "SIGNAL group $IN[a..b] -> its INT value (bit 0 on $IN[a])"),
+        ("names", "optional dict: signal -> the name the condition reads it by (a SIGNAL name)"),
+        ("file", "str: source file of the statement the answer releases"),
+        ("line", "int: its line"),
+        ("statement", "str: WAIT FOR | UNTIL | WHILE | IF | SWITCH"),
+        ("condition", "optional str: the source text of the condition's line"),
+    ],
+    "repeat": [
+        ("count", "int: events left out since the last written one that was not a repetition "
+                  "(a bounded trace, TraceWriter repeats=N: each repeated event is written N "
+                  "times, then counted)"),
+        ("since", "float: s, the first event left out"),
+        ("kinds", "dict: kind -> events of that kind left out"),
+    ],
     "interrupt": [
         ("prio", "int: interrupt number / priority"),
         ("name", "str: handler routine"),
@@ -109,6 +132,10 @@ SCHEMA: dict[str, list[tuple[str, str]]] = {
 }
 
 KINDS = tuple(SCHEMA)
+
+#: ``krl run --trace``: each repeated event of a spin is written this many times, then counted
+#: (TraceWriter ``repeats``; ``--trace-repeats 0`` writes every event)
+TRACE_REPEATS = 10
 _REQUIRED = {k: tuple(f for f, d in v if not d.startswith("optional")) for k, v in SCHEMA.items()}
 _ORDER = {k: tuple(f for f, _ in v) for k, v in SCHEMA.items()}
 
@@ -167,10 +194,20 @@ class TraceWriter:
     ``TraceWriter()`` keeps the lines in memory only (see :attr:`lines`). With
     ``keep=True`` the events are also kept as dicts in :attr:`events`.
     ``pose_every`` > 1 thins the per-IPO-cycle pose events (1 = every cycle).
+
+    ``repeats`` = N bounds a spin (issue 34): an event that repeats one written before —
+    the same statement (file, line, context), call or return of the same routine, the same
+    I/O change, message, interrupt phase, or motion phase of the same statement to the same
+    target — is written N times, then left out and counted, until something that is not a
+    repetition (an event not seen before once events were left out, a pose that differs from
+    the last: the robot moves, an error, the end, a jump of the idle clock, ...) starts afresh; a ``pose`` equal to
+    the one before (the robot at rest) is written N times in a row, then counted. Before the next written event a
+    ``repeat`` event says how many events of each kind were left out and since when. None
+    (the default) writes every event.
     """
 
     def __init__(self, target: str | Path | IO[str] | None = None, *, keep: bool = False,
-                 pose_every: int = 1) -> None:
+                 pose_every: int = 1, repeats: int | None = None) -> None:
         self._own = False
         if target is None:
             self._fh: IO[str] | None = None
@@ -187,6 +224,13 @@ class TraceWriter:
         self.pose_every = max(1, int(pose_every))
         self._pose_count = 0
         self.closed = False
+        self.repeats = repeats
+        self._seen: dict = {}            # key of a repeatable event -> times seen since the reset
+        self._left: dict[str, int] = {}  # kind -> events left out since the last repeat event
+        self._left_since: float | None = None
+        self._left_last = 0.0
+        self._last_pose = None           # (axes) of the last pose queued
+        self._same_pose = 0
 
     @property
     def events(self) -> list[dict[str, Any]]:
@@ -213,6 +257,17 @@ class TraceWriter:
         self._pose_count += 1
         if (self._pose_count - 1) % self.pose_every:
             return
+        if self.repeats is not None:
+            key = tuple(_round6(float(v)) for v in (axes.tolist() if hasattr(axes, "tolist") else axes))
+            if key == self._last_pose:
+                self._same_pose += 1
+                if self._same_pose >= self.repeats:
+                    self._leave_out("pose", t)
+                    return
+            else:
+                self._last_pose, self._same_pose = key, 0
+                self._seen.clear()          # the robot moves: progress
+            self._write_left(t)
         self._poses.append((t, axes, tcp_T))
         if len(self._poses) >= 512:
             self.flush()
@@ -240,13 +295,44 @@ class TraceWriter:
 
     def write_event(self, ev: dict[str, Any]) -> None:
         """Write an already built event dict (from :func:`make_event`)."""
-        if self._poses:
-            self.flush()
         if ev["kind"] == "pose":
             self._pose_count += 1
             if (self._pose_count - 1) % self.pose_every:
                 return
+        elif self.repeats is not None and ev["kind"] != "repeat":
+            key = _repeat_key(ev)
+            if key is None:
+                self._seen.clear()          # progress: every repetition counts afresh
+            else:
+                n = self._seen.get(key, 0)
+                if n == 0 and self._left:
+                    self._seen.clear()      # something new after a spin: the spin is over
+                self._seen[key] = n + 1
+                if n >= self.repeats:
+                    self._leave_out(ev["kind"], ev["t"])
+                    return
+            self._write_left(ev["t"])
+        if self._poses:
+            self.flush()
         self._emit(ev)
+
+    def _leave_out(self, kind: str, t: float) -> None:
+        if self._left_since is None:
+            self._left_since = t
+        self._left[kind] = self._left.get(kind, 0) + 1
+        self._left_last = t
+
+    def _write_left(self, t: float | None = None) -> None:
+        """Write the ``repeat`` event of the events left out, if any, at time `t` (the event
+        written next; default: the last one left out)."""
+        if not self._left:
+            return
+        left, self._left = self._left, {}
+        since, self._left_since = self._left_since, None
+        if self._poses:
+            self.flush()
+        self._emit(make_event("repeat", self._left_last if t is None else max(t, self._left_last),
+                              count=sum(left.values()), since=since, kinds=dict(sorted(left.items()))))
 
     def _emit(self, ev: dict[str, Any], line: str | None = None) -> None:
         """Keep and/or write event `ev`; `line` is its JSON text when the caller formatted it."""
@@ -265,6 +351,7 @@ class TraceWriter:
         return "".join(line + "\n" for line in self.lines)
 
     def close(self) -> None:
+        self._write_left()
         self.flush()
         if self._own and self._fh is not None and not self.closed:
             self._fh.close()
@@ -275,6 +362,29 @@ class TraceWriter:
 
     def __exit__(self, *exc: object) -> None:
         self.close()
+
+
+def _repeat_key(ev: dict[str, Any]) -> tuple | None:
+    """The key under which event `ev` repeats (TraceWriter ``repeats``), None for an event
+    that is never a repetition (motion, error, end, idle, ...)."""
+    k = ev["kind"]
+    if k == "stmt":
+        return ("stmt", ev.get("file"), ev.get("line"), ev.get("context"))
+    if k in ("call", "return"):
+        return (k, ev.get("name"), ev.get("line"))
+    if k == "io":
+        return ("io", ev.get("signal"), ev.get("value"), ev.get("source"))
+    if k == "message":
+        return ("message", ev.get("text"), ev.get("id"))
+    if k == "interrupt":
+        return ("interrupt", ev.get("prio"), ev.get("name"), ev.get("phase"))
+    if k == "motion":
+        # the same motion statement to the same target again (the robot does not move: a pose
+        # that changes clears the repetitions)
+        target = ev.get("target")
+        return ("motion", ev.get("type"), ev.get("phase"), ev.get("file"), ev.get("line"),
+                tuple(sorted(target.items())) if isinstance(target, dict) else None)
+    return None
 
 
 def _wrap180(v: Any) -> Any:

@@ -14,6 +14,7 @@ condition under which skipping is honest. Tests that take the corpus fixtures ar
 from __future__ import annotations
 
 import os
+import tempfile
 from pathlib import Path
 
 import pytest
@@ -23,6 +24,10 @@ REPO_ROOT = Path(__file__).resolve().parents[1]
 SHARED = REPO_ROOT.parent / "shared"
 SHARED_CORPUS = SHARED / "krl-corpus"
 SHARED_HISTORY = SHARED / "krl-history"
+
+# The caches of what the tests run (the language servers they start: krl/lsp/cache.py) go to a
+# temporary folder of the session, never to the user's cache folder.
+os.environ.setdefault("KRL_CACHE_DIR", tempfile.mkdtemp(prefix="krl-test-cache-"))
 
 settings.register_profile("ci", max_examples=50, deadline=None, print_blob=True,
                           suppress_health_check=[HealthCheck.too_slow])

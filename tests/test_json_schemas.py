@@ -117,3 +117,47 @@ def test_bench_outputs(tmp_path):
     assert len(rows) >= 5
     for row in rows:
         validate("limits", row)
+
+
+DIFF_OLD = {
+    "R1/System/$config.dat": "DEFDAT $CONFIG\nDECL FRAME TOOL_DATA[16]\nTOOL_DATA[1]={X 0.0,Y 0.0,Z 100.0,A 0.0,B 0.0,C 0.0}\n"
+                             "DECL BOOL STOPM_FLAG=TRUE\nENDDAT\n",
+    "R1/Program/m.src": "DEF m()\n  SPTP XP1 WITH $APO=SAPO_PTP(PPDAT1)\nEND\nDEFFCT INT f()\n  RETURN 1\nENDFCT\n"
+                        "DEFFCT INT f()\n  RETURN 2\nENDFCT\n",
+    "R1/Program/m.dat": "DEFDAT m\nDECL E6POS XP1={X 1.0,Y 2.0,Z 3.0,A 0.0,B 0.0,C 0.0,S 2,T 10}\n"
+                        "DECL PDAT PPDAT1={VEL 100.0,ACC 100.0,APO_DIST 500.0,APO_MODE #CDIS}\n"
+                        "DECL CHAR name[8]\nname[]=\"old\"\nEXT WEAV_DEF(INT:IN)\nENDDAT\n",
+}
+DIFF_NEW = {
+    "R1/System/$config.dat": DIFF_OLD["R1/System/$config.dat"].replace("Z 100.0", "Z 105.5").replace("=TRUE", "=FALSE"),
+    "R1/Program/m.src": DIFF_OLD["R1/Program/m.src"].replace("  SPTP", "  HALT\n  SPTP"),
+    "R1/Program/m.dat": DIFF_OLD["R1/Program/m.dat"].replace("X 1.0", "X 1.5").replace("APO_DIST 500.0", "APO_DIST 200.0")
+                        .replace('"old"', '"new"').replace("EXT WEAV_DEF(INT:IN)\n", "")
+                        + "",
+}
+
+
+def _write_tree(root: Path, files: dict) -> None:
+    for rel, text in files.items():
+        p = root / rel
+        p.parent.mkdir(parents=True, exist_ok=True)
+        p.write_text(text)
+
+
+def test_diff_and_graph_json(tmp_path):
+    _write_tree(tmp_path / "old", DIFF_OLD)
+    _write_tree(tmp_path / "new", DIFF_NEW)
+    new_dat = tmp_path / "new" / "R1" / "Program" / "m.dat"
+    new_dat.write_text(new_dat.read_text().replace("ENDDAT", "DECL E6POS XP2={X 0.0,Y 0.0,Z 0.0,A 0.0,B 0.0,C 0.0}\nENDDAT"))
+    out = subprocess.run([*KRL, "diff", "--format", "json", str(tmp_path / "old"), str(tmp_path / "new")],
+                         capture_output=True, text=True, check=False)
+    assert out.returncode == 1, out.stderr
+    doc = json.loads(out.stdout)
+    validate("diff", doc)
+    # every kind the schema knows is exercised once
+    assert all(doc["summary"][k] for k in ("points", "frames", "values", "routines", "declarations", "motions"))
+    assert doc["duplicates"] and doc["duplicates"][0]["code"] == "E102"
+    out = subprocess.run([*KRL, "graph", "--format", "json", str(tmp_path / "new")], capture_output=True, text=True,
+                         check=False)
+    assert out.returncode == 0, out.stderr
+    validate("graph", json.loads(out.stdout))

@@ -1,10 +1,12 @@
 // The KRL extension's client: starts the project's language server (`krl lsp`, stdio) for the
 // `krl` language, and the project's debug adapter (`krl debug`, stdio) for launch configurations
-// of type "krl". Both commands come from the setting `krl.server.path` (default: `krl` on PATH).
+// of type "krl", and the pendant (`krl pendant`, a local web page) in a webview panel (pendant.js).
+// All of them come from the setting `krl.server.path` (default: `krl` on PATH).
 'use strict';
 
 const vscode = require('vscode');
 const { LanguageClient, TransportKind } = require('vscode-languageclient/node');
+const { openPendant } = require('./pendant');
 
 /** @type {LanguageClient | undefined} */
 let client;
@@ -83,6 +85,7 @@ async function activate(context) {
       }
       await startClient(context);
     }),
+    vscode.commands.registerCommand('krl.openPendant', () => openPendant(serverCommand().command)),
     vscode.workspace.onDidChangeConfiguration(async (event) => {
       if (event.affectsConfiguration('krl.server')) {
         await vscode.commands.executeCommand('krl.restartServer');

@@ -16,10 +16,13 @@ def debug() -> None:
     stopOnEntry and interp (tree/vm). Nothing but protocol messages is written to stdout.
     """
     from interp.debug.session import DebugSession  # noqa: PLC0415
+    from interp.debug.wire import FdReader  # noqa: PLC0415
 
     out = sys.stdout.buffer
     sys.stdout = sys.stderr         # a stray print must not corrupt the protocol stream
-    sys.exit(DebugSession(sys.stdin.buffer, out).serve())
+    code = DebugSession(FdReader(sys.stdin.fileno()), out).serve()
+    out.flush()
+    sys.exit(code)
 
 
 commands = [debug]

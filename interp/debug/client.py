@@ -28,11 +28,14 @@ class DapError(Exception):
 
 
 class DapClient:
-    def __init__(self, timeout: float = 60.0, transcript: list | None = None) -> None:
-        env = dict(os.environ)
-        env["PYTHONPATH"] = str(ROOT) + (os.pathsep + env["PYTHONPATH"] if env.get("PYTHONPATH") else "")
-        self.proc = subprocess.Popen([sys.executable, "-m", "krl.cli", "debug"], stdin=subprocess.PIPE,
-                                     stdout=subprocess.PIPE, stderr=subprocess.PIPE, env=env, cwd=str(ROOT))
+    def __init__(self, timeout: float = 60.0, transcript: list | None = None, root: Path = ROOT,
+                 python: str | None = None, env: dict | None = None) -> None:
+        """``root``: the checkout whose ``krl debug`` runs (default this one), with ``python``
+        (default this interpreter); ``env``: variables added to the environment."""
+        env = {**os.environ, **(env or {})}
+        env["PYTHONPATH"] = str(root) + (os.pathsep + env["PYTHONPATH"] if env.get("PYTHONPATH") else "")
+        self.proc = subprocess.Popen([python or sys.executable, "-m", "krl.cli", "debug"], stdin=subprocess.PIPE,
+                                     stdout=subprocess.PIPE, stderr=subprocess.PIPE, env=env, cwd=str(root))
         self.timeout = timeout
         self.seq = 0
         self.msgs: queue.Queue = queue.Queue()

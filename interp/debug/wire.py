@@ -10,6 +10,7 @@ a JSON object: :class:`ProtocolError` (the session ends; nothing is executed).
 from __future__ import annotations
 
 import json
+import os
 from typing import BinaryIO
 
 from krl.limits import MAX_DAP_MESSAGE_BYTES
@@ -78,3 +79,53 @@ def write_message(stream: BinaryIO, msg: dict) -> None:
     """Write one framed message and flush."""
     stream.write(encode_message(msg))
     stream.flush()
+
+
+class FdReader:
+    """The requests' byte stream read straight from a file descriptor (``krl debug``'s stdin),
+    with a buffer of its own: ``readline(limit)`` and ``read(n)`` as :func:`read_message`
+    uses them.
+
+    Why not ``sys.stdin.buffer``: the reader thread blocks in a read of it while the session
+    ends, and a buffered reader's lock held by a daemon thread aborts the interpreter's
+    shutdown ("Fatal Python error: _enter_buffered_busy", exit -6). Nothing else touches this
+    object, and it holds no lock."""
+
+    CHUNK = 64 * 1024
+
+    def __init__(self, fd: int) -> None:
+        self.fd = fd
+        self.buf = bytearray()
+        self.eof = False
+
+    def _fill(self) -> bool:
+        if self.eof:
+            return False
+        chunk = os.read(self.fd, self.CHUNK)
+        if not chunk:
+            self.eof = True
+            return False
+        self.buf += chunk
+        return True
+
+    def _take(self, n: int) -> bytes:
+        out = bytes(self.buf[:n])
+        del self.buf[:n]
+        return out
+
+    def readline(self, limit: int = -1) -> bytes:
+        """One line with its ``\n`` (at most ``limit`` bytes; at the end, what is left)."""
+        while True:
+            end = self.buf.find(b"\n")
+            if end >= 0 and (limit < 0 or end < limit):
+                return self._take(end + 1)
+            if limit >= 0 and len(self.buf) >= limit:
+                return self._take(limit)
+            if not self._fill():
+                return self._take(len(self.buf))
+
+    def read(self, n: int) -> bytes:
+        """``n`` bytes (fewer only at the end of the stream)."""
+        while len(self.buf) < n and self._fill():
+            pass
+        return self._take(n)

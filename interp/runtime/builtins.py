@@ -19,8 +19,9 @@ accept KRL literal syntax only (reference §1.5). CAST_TO/CAST_FROM are in cast.
 GETSYSSTATE answers "STOPBITS" (no stop reaction active; :func:`_getsysstate`); INVERSE
 solves the inverse kinematics of the simulated robot (:func:`_inverse`).
 The EthernetKRL and RSI functions (EKI_*, RSI_*) are in netfunctions.py.
-Unsupported: CREAD/COPEN/CCLOSE/CIOCTL, GET_SIG_INF, channels other than $CMD — a clear
-"not supported" run-time error.
+COPEN(:SER_3, HANDLE) finds no device on any channel: HANDLE 0, the channel not connected
+(:func:`_copen`). Unsupported: CREAD/CCLOSE/CIOCTL, GET_SIG_INF, CWRITE channels other than
+$CMD — a clear "not supported" run-time error.
 """
 
 from __future__ import annotations
@@ -133,6 +134,7 @@ def _atan2(rt, a):
 
 def _frand(rt, a):
     lo, hi = _real(a[0]), _real(a[1])
+    rt.clock_read()     # a random number: not idle (interp/runtime/idle.py)
     return rt.random.uniform(lo, hi)
 
 
@@ -419,35 +421,110 @@ def _pulse(rt, a):
     rt.pulse(sig, lvl, d)
 
 
-def _set_krlmsg(rt, a):
-    msg = a[1].peek() if len(a) > 1 and a[1] is not None else None
-    text = ""
+def _krlmsg(a_msg, a_par) -> tuple[str, str, int, list[str]]:
+    """(text, module, number, parameter texts) of a KrlMsg_T and its KrlMsgPar_T[] arguments."""
+    msg = a_msg.peek() if a_msg is not None else None
+    text, module, number = "", "", 0
     if isinstance(msg, Struct):
-        t = msg.f.get("MSG_TXT")
-        text = t.text() if isinstance(t, Arr) else ""
-    rt.message(f"KRL message: {text}")
-    rt.msg_handle += 1
-    return rt.msg_handle
+        for key in ("MSG_TXT", "MODUL"):
+            v = msg.f.get(key)
+            if isinstance(v, Arr):
+                if key == "MSG_TXT":
+                    text = v.text()
+                else:
+                    module = v.text()
+        nr = msg.f.get("NR")
+        number = nr if isinstance(nr, int) and not isinstance(nr, bool) else 0
+    params = []
+    pars = a_par.peek() if a_par is not None else None
+    if isinstance(pars, Arr):
+        for p in pars.data[:3]:
+            if not isinstance(p, Struct):
+                params.append("")
+                continue
+            kind = getattr(p.f.get("PAR_TYPE"), "name", "")
+            t = p.f.get("PAR_TXT")
+            if str(kind).upper() == "VALUE" and isinstance(t, Arr) and t.text() == "":
+                v = next((p.f.get(k) for k in ("PAR_INT", "PAR_REAL", "PAR_BOOL") if p.f.get(k) is not UNSET), "")
+                params.append("" if v is UNSET else str(v))
+            else:
+                params.append(t.text() if isinstance(t, Arr) else "")
+    return text, module, number, params
+
+
+def _set_krlmsg(rt, a):
+    from .messages import format_text  # noqa: PLC0415
+
+    kind = str(getattr(a[0].peek(), "name", a[0].peek()) if a and a[0] is not None else "NOTIFY").lstrip("#").upper()
+    text, module, number, params = _krlmsg(a[1] if len(a) > 1 else None, a[2] if len(a) > 2 else None)
+    rt.controller.message(f"KRL message: {text}")
+    m = rt.messages.add(kind, format_text(text, params), module, number, time=rt.controller.time)
+    rt.msg_handle = m.handle
+    return m.handle
+
+
+def _handle(a) -> int | None:
+    """The message handle argument, None when it has no value (no message has it)."""
+    try:
+        return _int(a[0], "handle") if a else None
+    except KrlRuntimeError:
+        return None
 
 
 def _exists_krlmsg(rt, a):
-    return False
+    h = _handle(a)
+    return h is not None and rt.messages.exists(h)
 
 
 def _clear_krlmsg(rt, a):
-    return True
+    h = _handle(a)
+    return h is not None and rt.messages.clear(h)
 
 
 def _set_krldlg(rt, a):
-    rt.message("KRL dialog (answered with the first softkey)")
-    rt.msg_handle += 1
-    return rt.msg_handle
+    from .messages import format_text  # noqa: PLC0415
+
+    text, module, number, params = _krlmsg(a[0] if a else None, a[1] if len(a) > 1 else None)
+    keys = []
+    sk = a[2].peek() if len(a) > 2 and a[2] is not None else None
+    if isinstance(sk, Arr):
+        for k in sk.data:
+            t = k.f.get("SK_TXT") if isinstance(k, Struct) else None
+            keys.append(t.text() if isinstance(t, Arr) else "")
+    while keys and not keys[-1].strip():
+        keys.pop()
+    if rt.messages.interactive:
+        rt.controller.message(f"KRL dialog: {text}")
+    else:
+        rt.controller.message("KRL dialog (answered with the first softkey)")
+    m = rt.messages.add("DIALOG", format_text(text, params), module, number, keys or ["OK"], rt.controller.time)
+    rt.msg_handle = m.handle
+    return m.handle
 
 
 def _exists_krldlg(rt, a):
-    if len(a) > 1 and a[1] is not None:
-        a[1].set(1)
-    return False
+    h = _handle(a)
+    open_, answer = rt.messages.dialog_answer(h) if h is not None else (False, None)
+    if answer is not None and len(a) > 1 and a[1] is not None:
+        a[1].set(answer)
+    return open_
+
+
+def _copen(rt, a):
+    """``COPEN(:SER_3, HANDLE)``: open a channel of the controller. No device answers on any
+    channel in the simulation: the channel is *not connected*, HANDLE is 0 (KUKA: a handle > 0
+    for an open channel, 0 when it could not be opened), and the run notes it once per channel."""
+    from .values import Channel  # noqa: PLC0415
+
+    if len(a) != 2 or a[0] is None or not isinstance(a[0].peek(), Channel):
+        raise KrlRuntimeError("COPEN needs a channel name and a handle variable: COPEN(:SER_3, HANDLE)")
+    ch = a[0].peek()
+    a[1].set(0)
+    key = f"COPEN {ch.name}"
+    if key not in rt.noted:
+        rt.noted.add(key)
+        rt.message(f"not simulated: channel :{ch.name} is not connected (no device on it): COPEN gives HANDLE 0")
+    return None
 
 
 def _cwrite(rt, a):
@@ -844,7 +921,7 @@ NATIVES: dict = {
     "SET_KRLMSG": _set_krlmsg, "EXISTS_KRLMSG": _exists_krlmsg, "CLEAR_KRLMSG": _clear_krlmsg,
     "SET_KRLDLG": _set_krldlg, "EXISTS_KRLDLG": _exists_krldlg,
     "CAST_TO": cast_to, "CAST_FROM": cast_from,
-    "CREAD": _unsupported("CREAD"), "COPEN": _unsupported("COPEN"),
+    "CREAD": _unsupported("CREAD"), "COPEN": _copen,
     "CCLOSE": _unsupported("CCLOSE"), "CIOCTL": _unsupported("CIOCTL"),
     "GET_SIG_INF": _unsupported("GET_SIG_INF"), "GETSYSSTATE": _getsysstate,
 }

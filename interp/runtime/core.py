@@ -23,6 +23,7 @@ from .contexts import Context, Irq
 from .convert import assign_into, binary_op, convert_scalar, to_bool, trunc_int, unary_op
 from .errors import (HaltSignal, KrlRuntimeError, ResumeSignal, StopRun)
 from .memory import DataMemory, Frame, ProxyRef, Ref, SignalRef, Slot, field_ref, index_ref
+from .messages import MessageWindow
 from .motion import frame_of, params_from, request, segment, target_of
 from .program import Program
 from .runmode import STEP_MODES, BackwardRefused, MotionHistory, mode_name
@@ -30,6 +31,10 @@ from .scheduler import Scheduler, Task
 from .sysvars import SysVars, struct_of
 from .values import UNSET, Arr, EnumValue, Struct, copy_value, make_value, value_size
 
+
+#: s the operator takes to press Start again after a HALT (``krl run --on-halt continue``; a
+#: stated figure)
+OPERATOR_DELAY_S = 1.0
 
 EXIT_CODES = {"completed": 0, "halt": 3, "deadlock": 3, "max_steps": 3, "max_sim_time": 3,
               "error": 1, "internal": 2}
@@ -96,6 +101,7 @@ class Runtime:
         self.random = random.Random(0)
         self.mode_op = getattr(controller, "mode_op", "AUT")  # $MODE_OP (robot/limits.py)
         self.msg_handle = 0
+        self.messages = MessageWindow()  # the message window (interp/runtime/messages.py)
         self.noted: set[str] = set()    # simulator notes given once per run (builtins)
         self.steps = 0
         self.max_steps = max_steps
@@ -103,6 +109,9 @@ class Runtime:
         self.sysvars = SysVars(self)
         self.memory = DataMemory()
         self.program = Program(self, main_path, workspace, submits, check)
+        from .kss import SystemSoftware  # noqa: PLC0415
+
+        self.kss = SystemSoftware(self)   # stand-ins for KUKA's software the backup lacks
         self.modules = self.program.modules       # by Storage.owner / Callee.owner
         self.scheduler = Scheduler(self, max_sim_time, max_steps)
         self.robot: Task | None = None
@@ -117,6 +126,10 @@ class Runtime:
         self.step_hook = None           # debugger: step_hook(task, mode, text) at a step stop
         self.error_hook = None          # debugger: error_hook(task, frame, err) where an error leaves a routine
         self.cycle_hook = None          # debugger: cycle_hook(task) when a waiting task resumes (pause in a WAIT)
+        self.autocell = None            # krl run --inputs auto (interp/runtime/autocell.py)
+        self.halt_continues = 0         # krl run --on-halt continue: Start pressed again at most so often
+        self.start: str | None = None   # krl run --start / the cell's start: (interp/run.py), as given
+        self.halts = 0                  # HALTs continued so far
 
     # ================================================================== tasks and run
     def add_task(self, kind: str, name: str, body) -> Task:
@@ -163,6 +176,15 @@ class Runtime:
             self.trace.write("error", self.controller.time, text=f"submit {task.name}: {err.message}",
                              number=err.number, line=err.line, file=err.file)
 
+    def enable_autocell(self, delay: float | None = None):
+        """``--inputs auto``: the automatic cell answers what the program starves for
+        (interp/runtime/autocell.py); returns it."""
+        from .autocell import AUTO_DELAY_S, AutoCell  # noqa: PLC0415
+
+        self.autocell = AutoCell(self, AUTO_DELAY_S if delay is None else delay)
+        self.scheduler.idle.auto = self.autocell
+        return self.autocell
+
     def run(self) -> RunResult:
         """Run all tasks to the end; writes the ``end`` trace event; returns the result."""
         old = sys.getrecursionlimit()
@@ -207,6 +229,13 @@ class Runtime:
         if robot:
             return self.robot is not None and not self.robot.done
         return any(not t.done for t in self.scheduler.tasks[1:])
+
+    def clock_read(self) -> None:
+        """A task read the clock ($DATE, a running $TIMER) or drew a random number: the run
+        is not idle (interp/runtime/idle.py)."""
+        sched = getattr(self, "scheduler", None)
+        if sched is not None:
+            sched.idle.clock_read()
 
     def current_task_kind(self) -> str:
         return self.current_task.kind if self.current_task is not None else "robot"
@@ -265,6 +294,8 @@ class Runtime:
         if self.trace is not None:
             self.trace.write("stmt", self.controller.time, file=info.file, line=info.line,
                              context=task.context.kind)
+        if self.autocell is not None and self.autocell.recording is not None:
+            self.autocell.record(task, info)
         if self.stmt_hook is not None:
             self.stmt_hook(task, info)
 
@@ -290,7 +321,8 @@ class Runtime:
         CONTINUE, ON_ERROR_PROCEED, an interrupt declared or switched) resets it."""
         if self.trace is not None or task.irqs.armed or task.continue_line is not None \
                 or self.stmt_hook is not None or self.run_mode == "ISTEP" \
-                or any(c.error_proceed for c in task.contexts):
+                or any(c.error_proceed for c in task.contexts) \
+                or (self.autocell is not None and self.autocell.recording is not None):
             return 0
         lim = task.slice_end - 1
         if self.max_steps is not None and self.max_steps < lim:
@@ -309,6 +341,8 @@ class Runtime:
         self._count_step(task)
         if info.cond_stops and task.kind == "robot":
             self.advance_stop(task)
+        if self.autocell is not None and self.autocell.recording is not None:
+            self.autocell.record(task, info)
 
     def set_continue(self, info: StmtInfo) -> None:
         """CONTINUE: the next line does not stop the advance run."""
@@ -357,11 +391,30 @@ class Runtime:
         task = self.current_task
         ctl = self.controller
         end = ctl.cycle + ctl.cycles_for(t)
-        while ctl.cycle < end:
-            self.yield_cycle(task)
+        outer, task.wake_cycle = task.wake_cycle, end
+        try:
+            while ctl.cycle < end:
+                self.yield_cycle(task)
+        finally:
+            task.wake_cycle = outer
 
     def halt(self) -> None:
-        raise HaltSignal()
+        """HALT (reference §5.7): the program stops as if the operator pressed STOP. With
+        ``krl run --on-halt continue`` (:attr:`halt_continues` > 0) the operator presses Start
+        again: the robot comes to rest at the end of its motion, :data:`OPERATOR_DELAY_S`
+        later the program goes on with the next statement — at most :attr:`halt_continues`
+        times in a run, then the HALT ends it. Each is a ``step_stop`` trace event (mode
+        HALT) and a message. HALT in a submit program ends that program."""
+        task = self.current_task
+        if task is None or task.kind != "robot" or self.halts >= self.halt_continues:
+            raise HaltSignal()
+        self.halts += 1
+        self.wait_main_run(task)
+        where = f"{Path(task.file).name}:{task.line}" if task.file else "?"
+        text = f"HALT at {where}: Start pressed again ({self.halts} of {self.halt_continues}, --on-halt continue)"
+        self.step_stop(task, "HALT", text=text)
+        self.message(text)
+        self.wait_sec(OPERATOR_DELAY_S)
 
     # ================================================================== memory
     def sysref(self, st: Storage) -> Ref:
@@ -392,8 +445,9 @@ class Runtime:
         """The one run-time name lookup, for a name nothing declares (storage class
         UNRESOLVED; docs/architecture.md, "One program model"): a ``$`` name is a system
         variable the simulator knows, or one that a system data list or KSS's system files
-        declare (``SysVars.lookup``); any other name, an undeclared ``$`` name included, is the
-        run-time error "unknown name", as on the controller."""
+        declare (``SysVars.lookup``); in a backup, a variable of KUKA's software the backup
+        lacks stands in (interp/runtime/kss.py: its zero value, one note); any other name is
+        the run-time error "unknown name", as on the controller."""
         key = name.upper()
         if key[:1] == "$":
             r = self.sysvars.lookup(key)
@@ -401,6 +455,10 @@ class Runtime:
                 return r
         elif key in RSI_CONSTANTS:      # RSI's constants (RSIOK, ...): the option declares them
             return ValueRef(RSI_CONSTANTS[key], key)
+        if self.program.backup:
+            r = self.kss.name_ref(name)     # a variable of KUKA's software (interp/runtime/kss.py)
+            if r is not None:
+                return r
         raise KrlRuntimeError(f"unknown name {name}")
 
     def index(self, base: Ref, idx: list, name: str) -> Ref:
@@ -468,16 +526,10 @@ class Runtime:
         return NATIVES.get(c.native) if c.kind == NATIVE else None
 
     def stub_call(self, name: str, is_function: bool):
-        """The stub policy for a routine that is not found (a technology package absent from
-        the backup): in a backup a procedure call is skipped and logged as a ``message``
-        event; anything else is the run-time error "routine not found"."""
-        key = name.upper()
-        if self.program.backup and not is_function:
-            if key not in self.program.stubs:
-                self.program.stubs.add(key)
-            self.message(f"stub: {name} (routine not in the backup; technology package not simulated)")
-            return None
-        raise KrlRuntimeError(f"routine {name} not found")
+        """A call of a routine that the program does not contain: in a backup, a routine of
+        KUKA's system software stands in (interp/runtime/kss.py: counted, one note);
+        anything else is the run-time error "routine NAME not found"."""
+        return self.kss.call(name, is_function)
 
     def enter_routine(self, module, routine: N.Routine, args: list, caller: Frame | None) -> Frame:
         """Create the frame of a call (§2.3): :IN parameters get converted copies, :OUT
@@ -486,6 +538,8 @@ class Runtime:
         Layout (krl/semantics/resolve.py), planned once (:meth:`_frame_plan`)."""
         task = self.current_task
         depth = caller.depth + 1 if caller is not None else 0
+        if self.kss.standard and id(routine) in self.kss.standard:
+            self.kss.standard_call(routine)
         if depth > MAX_CALL_DEPTH:
             raise KrlRuntimeError(f"stack overflow: more than {MAX_CALL_DEPTH} nested calls")
         plan = self._plans.get(id(routine))
@@ -832,10 +886,7 @@ class Runtime:
     def stub_statement(self, what: str) -> None:
         """A statement of §5.20 that is recognised and not simulated (CONFIRM, ASYPTP,
         MOVE_EMI, ...): logged once as a ``message`` event, no effect."""
-        key = "STMT " + what.upper()
-        if key not in self.program.stubs:
-            self.program.stubs.add(key)
-            self.message(f"stub: {what} (statement not simulated)")
+        self.kss.statement(what)
 
     # ================================================================== motion
     def _params(self, with_: list):
@@ -1076,6 +1127,8 @@ class Runtime:
 
     def brake(self, fast: bool = False) -> None:
         """BRAKE / BRAKE F: ramp the path speed down and wait until the robot stands (5.17).
+        Only in an interrupt routine (a routine run by an interrupt, at any depth below it):
+        elsewhere it is the run-time error "BRAKE outside an interrupt routine" at its line.
 
         Standstill is confirmed one IPO cycle after the path speed has reached zero (the
         controller sees two equal setpoints), so even `DO BRAKE`, whose interrupt ends with
@@ -1084,6 +1137,11 @@ class Runtime:
         task = self.current_task
         if task.kind != "robot":
             raise KrlRuntimeError("BRAKE is not allowed in the submit interpreter")
+        if not any(c.kind == "interrupt" for c in task.contexts):
+            # reference §5.17 and §8.2: BRAKE only in interrupt routines; the checker cannot
+            # tell a routine that only ever runs as an interrupt routine, so the run says it
+            raise KrlRuntimeError("BRAKE outside an interrupt routine: BRAKE is allowed only in "
+                                  "interrupt routines (reference 5.17)")
         ctl = self.controller
         ctl.brake(fast)
         while ctl.is_braking():

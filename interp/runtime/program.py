@@ -36,10 +36,12 @@ from krl.project import project_of, with_basis   # which files make the program:
 from krl.semantics import types as T
 from krl.semantics.expression import Env, evaluate
 from krl.semantics.resolve import GLOBAL, LOCAL, MODULE, SYSTEM, Storage
+from krl.store import stored
 from krl.workspace import load_file, load_project
 
 from .convert import assign_into, convert_scalar
 from .errors import KrlRuntimeError, ResourceError
+from .kss import standard_files
 from .memory import Slot, SignalRef, index_ref
 from .values import UNSET, Struct, data_size, make_value
 
@@ -86,7 +88,9 @@ def checked_workspace(project, extra: list[Path] = ()):
     """The loaded, checked and resolved workspace of `project` and the `extra` files (a run's
     BASIS, a submit program outside the project): cached per process for the same files
     (path, size, modification time), so the two interpreters of a conformance run, or the
-    programs of one backup, load and check their files once. Never raises for bad input."""
+    programs of one backup, load and check their files once, and kept across processes in the
+    user cache folder (krl/store.py), so a command started again on unchanged files does not
+    parse and check them again. Never raises for bad input."""
     paths = [*project.files, *extra]
     key = [str(project.root), project.backup]
     size = 0
@@ -103,9 +107,13 @@ def checked_workspace(project, extra: list[Path] = ()):
     if ws is not None:
         _CACHE.move_to_end(key)
         return ws
-    ws = load_project(project, str(project.root), PARSE_TIMEOUT_S if size > _BATCH_BYTES else None,
-                      extra=list(extra))
-    ws.check()
+    def make():
+        ws = load_project(project, str(project.root), PARSE_TIMEOUT_S if size > _BATCH_BYTES else None,
+                          extra=list(extra))
+        ws.check()
+        return ws
+
+    ws = stored("workspace", key, make, fix_ids=True)   # kept across processes too (krl/store.py)
     _CACHE[key] = ws
     while len(_CACHE) > _CACHE_SIZE:
         _CACHE.popitem(last=False)
@@ -157,6 +165,7 @@ class Program:
         self.workspace = self.project.root
         self.system_dir = self.project.system if self.backup and self.project.system else BASIS_DIR
         extra = basis_files(self.project)
+        extra += standard_files(self.project)     # KUKA's P00 when the backup lacks it
         own = {f.stem.lower() for f in self.project.files}
         extra += [Path(s).resolve() for s in submits if Path(s).resolve() not in self.project.files
                   and Path(s).stem.lower() not in own]

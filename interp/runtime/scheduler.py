@@ -16,7 +16,9 @@ its own greenlet. Per IPO cycle the scheduler
    (``max_sim_time``), deadlock (``deadlock``: the robot program waits in WAIT FOR while
    nothing can change any more — no motion, no stimulus or pulse pending, no running
    timer, no submit program, no armed interrupt);
-3. runs one ``controller.step()`` and hands its events to the robot task: TRIGGER actions
+3. lets the idle watch fast-forward a run in which nothing changes to the cycle before its
+   next event (interp/runtime/idle.py);
+4. runs one ``controller.step()`` and hands its events to the robot task: TRIGGER actions
    and main-run errors are picked up when the robot task resumes (its first act after a
    switch is :meth:`core.Runtime.service`: triggers, then interrupt conditions).
 """
@@ -49,6 +51,7 @@ class Task:
         self.pending_error = None
         self.next_triggers: list = []   # TRIGGERs waiting for the next motion
         self.waiting: str | None = None
+        self.wake_cycle: int | None = None  # the IPO cycle that ends its WAIT SEC (idle fast-forward)
         self.at = None                  # StmtInfo of the statement that ran last (file, line)
         self.done = False
         self.outcome = None             # (reason, error or None)
@@ -80,6 +83,9 @@ class Scheduler:
         self.tasks: list[Task] = []
         self.stop: tuple | None = None      # (reason, text, task)
         self.main = greenlet.getcurrent()
+        from .idle import IdleWatch  # noqa: PLC0415
+
+        self.idle = IdleWatch(rt)           # fast-forward of idle cycles (interp/runtime/idle.py)
 
     def add(self, task: Task) -> None:
         task.glet = greenlet(lambda: self.rt.task_main(task), parent=self.main)
@@ -93,10 +99,14 @@ class Scheduler:
         self.rt.current_task = task
         task.slice_end = self.rt.steps + task.budget
         task.quiet = 0
+        log = self.rt.controller.io.log
+        before = len(log)
         try:
             task.glet.switch()
         finally:
             self.rt.current_task = None
+            if task.kind == "robot":
+                self.idle.robot_io += len(log) - before     # the robot program's own I/O changes
 
     def run(self) -> None:
         rt = self.rt
@@ -114,8 +124,11 @@ class Scheduler:
                 self.stop = ("max_sim_time", f"simulated time limit {self.max_sim_time} s reached", robot)
                 break
             if robot.waiting and self.deadlocked():
-                self.stop = ("deadlock", f"deadlocked {robot.waiting}", robot)
-                break
+                auto = self.idle.auto
+                if auto is None or (not auto.pending() and auto.answer(self.idle) != "answered"):
+                    self.stop = ("deadlock", f"deadlocked {robot.waiting}", robot)
+                    break
+            self.idle.cycle()
             events = ctl.step()
             for ev in events:
                 k = ev.kind

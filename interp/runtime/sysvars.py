@@ -298,13 +298,29 @@ def _io(kind: str):
             arr = LiveArray(name, 32, T.REAL, io.get_anout,
                             lambda i, v: _set_anout(sv, i, v))
         elif kind == "$TIMER":
-            arr = LiveArray(name, 64, T.INT, io.get_timer, io.set_timer)
+            arr = LiveArray(name, 64, T.INT, lambda i: _timer(sv, io.get_timer, i), io.set_timer)
         elif kind == "$TIMER_STOP":
             arr = LiveArray(name, 64, T.BOOL, io.get_timer_stop, io.set_timer_stop)
         else:  # $TIMER_FLAG
-            arr = LiveArray(name, 64, T.BOOL, io.get_timer_flag)
+            arr = LiveArray(name, 64, T.BOOL, lambda i: _timer(sv, io.get_timer_flag, i))
         return ComputedRef(lambda: arr, t, name)
     return make
+
+
+def _timer(sv: SysVars, get, i: int):
+    """``$TIMER[i]``/``$TIMER_FLAG[i]``: a running timer is the clock (interp/runtime/idle.py)."""
+    io = sv.rt.controller.io
+    if 1 <= i < len(io.timer_stop) and not io.timer_stop[i]:
+        sv.rt.clock_read()
+    return get(i)
+
+
+def _clock(fn):
+    """A value computed from the simulated time: reading it is reading the clock."""
+    def read(sv: SysVars):
+        sv.rt.clock_read()
+        return fn(sv)
+    return read
 
 
 def _set_anout(sv: SysVars, i: int, v) -> None:
@@ -411,7 +427,7 @@ _LIVE = {
     "$POS_INT": _computed(_pos_int),
     "$AXIS_INT": _computed(_axis_int),
     "$VEL_ACT": _computed(lambda sv: float(sv.rt.controller.vel_act())),
-    "$DATE": _computed(_date),
+    "$DATE": _computed(_clock(_date)),
     "$PRO_STATE": _computed(_pro_state_self),
     "$PRO_STATE0": _computed(_pro_state(False)),
     "$PRO_STATE1": _computed(_pro_state(True)),
@@ -442,7 +458,7 @@ _LIVE = {
     "$IN_HOME4": _computed(_in_home(4)),
     "$IN_HOME5": _computed(_in_home(5)),
     "$NEAR_POSRET": _computed(_ro_const(False)),
-    "$ROBRUNTIME": _computed(lambda sv: int(sv.rt.controller.time / 60)),
+    "$ROBRUNTIME": _computed(_clock(lambda sv: int(sv.rt.controller.time / 60))),
 }
 
 

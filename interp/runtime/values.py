@@ -24,6 +24,24 @@ from krl.semantics import types as T
 from krl.semantics.values import UNSET, EnumValue  # the front end's scalar values
 
 
+class Channel:
+    """``:SER_3``: a channel of the controller as an argument (COPEN), by its upper-case name."""
+
+    __slots__ = ("name",)
+
+    def __init__(self, name: str) -> None:
+        self.name = name.upper()
+
+    def __eq__(self, other: object) -> bool:
+        return isinstance(other, Channel) and other.name == self.name
+
+    def __hash__(self) -> int:
+        return hash((":", self.name))
+
+    def __repr__(self) -> str:
+        return f":{self.name}"
+
+
 class Struct:
     """A structure value; ``f`` maps UPPER component names to values (see module doc)."""
 

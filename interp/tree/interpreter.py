@@ -27,7 +27,7 @@ from interp.runtime.convert import num
 from interp.runtime.errors import ExitSignal, GotoSignal, KrlRuntimeError, ReturnSignal, lvalue_name
 from interp.runtime.slots import (anout_limits, anout_value, array_index, ended_without_return, for_done,
                                  for_limits, for_next, label_not_found, return_without_value, trigger_args)
-from interp.runtime.values import EnumValue, Struct, copy_value
+from interp.runtime.values import Channel, EnumValue, Struct, copy_value
 
 
 class TreeInterpreter:
@@ -477,6 +477,9 @@ class TreeInterpreter:
 
     def e_EnumLit(self, e, frame):
         return EnumValue(e.name)
+
+    def e_ChannelName(self, e, frame):
+        return Channel(e.name)
 
     def e_Aggregate(self, e, frame):
         items = []

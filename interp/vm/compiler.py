@@ -38,6 +38,7 @@ from krl.semantics.resolve import LOCAL, MODULE
 from krl.semantics.values import EnumValue, KrlRuntimeError, binary_op, unary_op
 
 from interp.runtime.errors import lvalue_name
+from interp.runtime.values import Channel
 
 from .assembler import Listing, Region, format_listing
 from .opcodes import BY_NAME as OPS
@@ -703,6 +704,9 @@ class Compiler:
 
     def e_EnumLit(self, e) -> None:
         self.emit("CONST", EnumValue(e.name))
+
+    def e_ChannelName(self, e) -> None:
+        self.emit("CONST", Channel(e.name))
 
     def e_Name(self, e) -> None:
         if self.fast_scalar(e) is not None:

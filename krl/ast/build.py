@@ -931,6 +931,8 @@ class Builder:
             return self.call(ctx)
         if base in ("aggregate", "constantAggregate"):
             return self.aggregate(ctx)
+        if base == "channelName":
+            return N.ChannelName(self.name(self.rule(ctx, "name")), span=self.span(ctx))
         kids = ctx.children or []
         term = kids[0]
         return N.Unary(term.getText().upper(), self.expr(kids[1]), span=self.span(ctx))

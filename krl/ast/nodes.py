@@ -182,6 +182,13 @@ class StrLit(Expr):
 
 
 @dataclass(slots=True)
+class ChannelName(Expr):
+    """``:SER_3`` as a call argument (``COPEN(:SER_3, HANDLE)``): a channel of the controller;
+    ``name`` without the ':' (4.7, the CREAD/CWRITE channels)."""
+    name: str
+
+
+@dataclass(slots=True)
 class EnumLit(Expr):
     """``#NAME``; ``name`` without the '#'. Its enum type comes from the context (3.6)."""
     name: str

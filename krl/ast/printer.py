@@ -77,6 +77,10 @@ def _e_EnumLit(e: N.Expr):
     return f"#{e.name}"
 
 
+def _e_ChannelName(e: N.Expr):
+    return f":{e.name}"
+
+
 def _e_Name(e: N.Expr):
     return e.name
 

@@ -31,6 +31,7 @@ SUBCOMMAND_MODULES = (
     "krl.lsp.cli",         # lsp
     "interp.debug.cli",    # debug
     "krl.cli.changes",     # diff, graph, report
+    "pendant.cli",         # pendant
 )
 
 

@@ -51,8 +51,10 @@ def _echo_errors(sides, paths) -> None:
               help="text; json: one object (docs/diff.md); html: one page.")
 @click.option("--tolerance", type=click.FloatRange(min=0), default=0.0, show_default=True,
               help="Hide point and frame deltas up to this size (mm or deg).")
+@click.option("--timeout", type=click.FloatRange(min=0, min_open=True), default=None,
+              help="Seconds one file may parse (default: krl check's); past it the file is not compared (E005).")
 @click.option("-o", "--output", default=None, help="Write to this file instead of standard output.")
-def diff(old: str, new: str, fmt: str, tolerance: float, output: str | None) -> None:
+def diff(old: str, new: str, fmt: str, tolerance: float, timeout: float | None, output: str | None) -> None:
     """What changed between two KRC backups (folders or .zip) or two files: points, frames and
     loads, routines, declarations and signals, inline-form motions. Exit 0 no change, 1
     changes, 2 error."""
@@ -63,7 +65,7 @@ def diff(old: str, new: str, fmt: str, tolerance: float, output: str | None) -> 
     single = Path(old).is_file() and Path(new).is_file() and not any(
         p.lower().endswith(".zip") for p in (old, new))
     try:
-        with side(old, single) as a, side(new, single) as b:
+        with side(old, single, timeout) as a, side(new, single, timeout) as b:
             d = diff_sides(a, b, tolerance)
             _echo_errors((a, b), set(d.not_compared))
         if fmt == "json":

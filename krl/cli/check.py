@@ -33,8 +33,11 @@ from krl.limits import PARSE_TIMEOUT_S
               show_default=True, help="Seconds one file may parse; past it the parse is stopped (error E005).")
 @click.option("--jobs", type=click.IntRange(min=1), default=None,
               help="Worker processes that parse the files (default: the number of cores).")
+@click.option("--scheduler", default=None, metavar="tcp://HOST:PORT",
+              help="Check the backups of a folder on this Dask distributed scheduler's cluster, one "
+                   "backup per task (its workers see the folder at the same path); the same output.")
 def check(paths: tuple[str, ...], fmt: str, as_json: bool, no_warnings: bool, ignore: tuple[str, ...],
-          report_dir: str | None, timeout: float, jobs: int | None) -> None:
+          report_dir: str | None, timeout: float, jobs: int | None, scheduler: str | None) -> None:
     """Type-check KRL files, KRC backup folders or backup .zip archives; exit 1 when there are
     errors. Every code is explained in docs/diagnostics.md."""
     if report_dir is not None:
@@ -52,20 +55,24 @@ def check(paths: tuple[str, ...], fmt: str, as_json: bool, no_warnings: bool, ig
     fmt = "json" if as_json else fmt
     status = run_check(list(paths), no_warnings=no_warnings, echo=click.echo, fmt=fmt,
                        ignore=[c for v in ignore for c in v.split(",") if c.strip()],
-                       colour=fmt == "text" and use_colour(sys.stdout), timeout=timeout, jobs=jobs)
+                       colour=fmt == "text" and use_colour(sys.stdout), timeout=timeout, jobs=jobs,
+                       scheduler=scheduler)
     sys.exit(status)
 
 
 def run_check(paths: list[str], as_json: bool = False, no_warnings: bool = False, echo=print,
               fmt: str = "text", ignore=(), colour: bool = False, timeout: float | None = None,
-              jobs: int | None = None) -> int:
+              jobs: int | None = None, scheduler: str | None = None) -> int:
     """Check `paths` and print the diagnostics in `fmt` ("text", "json", "sarif"; `as_json` is
     the old spelling of "json"); `ignore`: codes not to report (with the krl.toml of each
     workspace, krl/semantics/config.py). `timeout`: seconds per file, files parsed in worker
     processes that are killed past it (None: parse here, without a limit; the command passes
-    krl.limits.PARSE_TIMEOUT_S); `jobs`: worker processes. Returns the exit status: 0, 1
-    (errors), 2 (bad configuration or internal failure)."""
+    krl.limits.PARSE_TIMEOUT_S); `jobs`: worker processes. `scheduler`: the address of a Dask
+    scheduler whose workers load and check the backups of a folder holding several, one per
+    task (:func:`check_group`; the output is the local one). Returns the exit status: 0, 1
+    (errors), 2 (bad configuration, internal failure, a scheduler that cannot be used)."""
     from krl.archive import ArchiveError, backup_source  # noqa: PLC0415
+    from krl.cluster import SchedulerError  # noqa: PLC0415
     from krl.semantics.config import ConfigError, Selection, config_for, parse_codes  # noqa: PLC0415
     from krl.diagnostics import Diagnostic  # noqa: PLC0415
     from krl.source import read_source  # noqa: PLC0415
@@ -101,7 +108,7 @@ def run_check(paths: list[str], as_json: bool = False, no_warnings: bool = False
                 continue
             try:
                 with backup_source(path) as (folder, as_shown):
-                    for ws in _loaded(folder if as_shown.archive else path, timeout, jobs):
+                    for ws in _loaded(folder if as_shown.archive else path, timeout, jobs, scheduler):
                         seen.update(_resolved(f.path) for f in ws.files)
                         try:
                             sel = config_for(ws.root, folder if as_shown.archive else path).merged(cli_sel)
@@ -123,6 +130,9 @@ def run_check(paths: list[str], as_json: bool = False, no_warnings: bool = False
     except ConfigError as exc:
         echo(f"krl check: {printable(exc)}")
         return 2
+    except SchedulerError as exc:
+        echo(f"krl check: error: {printable(exc)}")
+        return 2
     except Exception as exc:  # noqa: BLE001 - a last line of defence: no traceback
         echo(f"krl check: internal error: {type(exc).__name__}: {printable(exc)}")
         return 2
@@ -134,14 +144,20 @@ def run_check(paths: list[str], as_json: bool = False, no_warnings: bool = False
     return 1 if any_error else 0
 
 
-def _loaded(path, timeout: float | None = None, jobs: int | None = None) -> list:
+def _loaded(path, timeout: float | None = None, jobs: int | None = None, scheduler: str | None = None) -> list:
     """workspaces_for(path), with a transient progress bar on standard error when it is a
     terminal (a KRC backup of a few hundred files takes tens of seconds to parse); piped or
-    redirected, nothing is shown, so the output is the same either way."""
+    redirected, nothing is shown, so the output is the same either way. With `scheduler`, a
+    folder holding backups is checked on that Dask cluster (:class:`Checked` per group)."""
     from pathlib import Path  # noqa: PLC0415
 
     from krl.workspace import on_each_file, workspaces_for  # noqa: PLC0415
     from krl.project import folder_groups  # noqa: PLC0415
+
+    if scheduler is not None:
+        groups = folder_groups(Path(path))
+        if groups is not None and (len(groups) > 1 or groups[0][0] != str(path)):
+            return _on_cluster(scheduler, groups, timeout)
 
     if not _progress_shown():
         return workspaces_for(path, timeout=timeout, jobs=jobs)
@@ -160,6 +176,54 @@ def _loaded(path, timeout: float | None = None, jobs: int | None = None) -> list
             bar.update(task, advance=1, description=escape(f"parsing {Path(file).name}"))
         with on_each_file(advance):
             return workspaces_for(path, timeout=timeout, jobs=jobs, groups=groups)
+
+
+class Checked:
+    """A workspace checked on a Dask worker, as run_check uses it: `root`, `files` (objects
+    with a ``path``) and its diagnostics (:meth:`check`)."""
+
+    def __init__(self, root: str, files: list[str], diagnostics: list) -> None:
+        from types import SimpleNamespace  # noqa: PLC0415
+
+        self.root = root
+        self.files = [SimpleNamespace(path=f) for f in files]
+        self.diagnostics = diagnostics
+
+    def check(self) -> list:
+        return self.diagnostics
+
+
+def check_group(root: str, entries: list, timeout: float | None) -> tuple[str, list[str], list]:
+    """On a worker: (root, file paths, sorted diagnostics) of the workspace of one (root,
+    entries) group of krl.project.folder_groups, loaded and checked as workspaces_for does
+    (the files are parsed in the worker's process: a Dask worker may not start the killable
+    pool; the batch's deadline on the cluster bounds it, krl/cluster.py)."""
+    from krl.workspace import load_workspaces  # noqa: PLC0415
+
+    ws = load_workspaces([(root, entries)], None)[0]
+    diags = ws.check()
+    return ws.root, [str(f.path) for f in ws.files], list(diags)
+
+
+def _on_cluster(scheduler: str, groups: list, timeout: float | None) -> list:
+    """The groups checked on the Dask cluster at `scheduler`, in their order. Raises
+    krl.cluster.SchedulerError; a group whose task fails is an E901 diagnostic of its root."""
+    from krl.cluster import run_batches  # noqa: PLC0415
+    from krl.diagnostics import Diagnostic  # noqa: PLC0415
+
+    tasks = [(i, (root, entries, timeout)) for i, (root, entries) in enumerate(groups)]
+    # a task's deadline: the per-file timeout times its files (krl/cluster.py adds the transfer)
+    most = max((sum(e.kind == "file" for e in entries) for _r, entries in groups), default=1)
+    got = {}
+    for o in run_batches(scheduler, check_group, tasks, batch_files=1, name="krl-check",
+                         timeout=None if timeout is None else timeout * max(most, 1)):
+        root = groups[o.key][0]
+        if o.status == "done":
+            got[o.key] = Checked(*o.value)
+        else:
+            got[o.key] = Checked(root, [], [Diagnostic(root, 1, 1, "E901", f"not checked on the Dask cluster: "
+                                                                            f"{o.status}: {o.detail}")])
+    return [got[i] for i in range(len(groups))]
 
 
 def _progress_shown() -> bool:

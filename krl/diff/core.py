@@ -72,6 +72,7 @@ class Diff:
     comment_edits: int = 0
     fold_edits: int = 0
     files_compared: int = 0
+    unparsed_same: int = 0          # files with syntax errors whose text is the same on both sides
     not_compared: list[str] = field(default_factory=list)
     left_out: int = 0
 
@@ -87,6 +88,7 @@ class Diff:
         """The JSON object of ``krl diff --format json`` (docs/diff.md)."""
         out: dict = {"old": self.old, "new": self.new, "changed": self.changed,
                      "summary": {**self.summary(), "files_compared": self.files_compared,
+                                 "unparsed_same": self.unparsed_same,
                                  "not_compared": len(self.not_compared)}}
         for k in KINDS:
             out[k] = getattr(self, k)
@@ -107,7 +109,8 @@ def diff_sides(old: Side, new: Side, tolerance: float = 0.0) -> Diff:
         fo, fn = old.files.get(k), new.files.get(k)
         if (fo is not None and not fo.ok) or (fn is not None and not fn.ok):
             if fo is not None and fn is not None and old.text(k) is not None and old.text(k) == new.text(k):
-                continue        # the same text on both sides: unchanged, though it does not parse
+                d.unparsed_same += 1    # the same text on both sides: unchanged, though it does not parse
+                continue
             d.not_compared.append(new.shown(k) if fn is not None else old.shown(k))
         else:
             ok_keys.append(k)

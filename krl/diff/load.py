@@ -101,22 +101,24 @@ class Side:
 
 
 @contextmanager
-def side(path: str | Path, single: bool | None = None) -> Iterator[Side]:
+def side(path: str | Path, single: bool | None = None, timeout: float | None = None) -> Iterator[Side]:
     """Load `path` (see the module docstring). `single`: treat it as one file (default: when
-    it is a file other than a .zip)."""
+    it is a file other than a .zip). `timeout`: seconds one file may parse (default
+    krl.limits.PARSE_TIMEOUT_S; past it the file is E005, not compared)."""
     p = Path(path)
+    timeout = PARSE_TIMEOUT_S if timeout is None else timeout
     if not p.exists() and not p.is_symlink():
         raise DiffInputError(Diagnostic(str(p), 1, 1, "E001", "no such file or folder"))
     try:
         with backup_source(p) as (folder, shown):
             is_file = not folder.is_dir() if single is None else single
             if is_file:
-                ws = load_workspace([folder], str(folder), timeout=PARSE_TIMEOUT_S)
+                ws = load_workspace([folder], str(folder), timeout=timeout)
                 root = folder.parent
             else:
                 backups = find_backups(folder)
                 root = backups[0] if len(backups) == 1 else folder
-                ws = load_workspace([folder], str(root), timeout=PARSE_TIMEOUT_S)
+                ws = load_workspace([folder], str(root), timeout=timeout)
             s = Side(str(path), root, ws, folder=folder, shown_of=shown)
             for f in ws.files:
                 key = "" if is_file else _key(f.path, root, folder)

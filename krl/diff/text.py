@@ -47,6 +47,8 @@ def summary_line(d: Diff) -> str:
     not compared."""
     counts = ", ".join(f"{n} {KIND_TITLES[k].lower()}" for k, n in d.summary().items())
     out = f"compared {d.files_compared} file(s): {counts}"
+    if d.unparsed_same:
+        out += f"; {d.unparsed_same} file(s) with syntax errors unchanged (the same text)"
     if d.not_compared:
         out += f"; {len(d.not_compared)} file(s) not compared (syntax errors)"
     return out + f"; {d.comment_edits} comment and {d.fold_edits} fold line(s) edited (not changes)"

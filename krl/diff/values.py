@@ -255,8 +255,8 @@ def data_values(dl: N.DataList | None, lines: list[str]) -> list[DataValue]:
             idx = ",".join("" if i is None else str(i) for i in d.indices)
             tname, t = types.get(d.name.upper(), ("", None))
             elem = t.elem if isinstance(t, T.Array) and len(t.dims) == len(d.indices) else None
-            if elem is None and isinstance(t, T.Array) and t.elem == T.CHAR:
-                elem = T.Array(T.CHAR, t.dims[len(d.indices):])     # a row of a CHAR matrix: text
+            if isinstance(t, T.Array) and t.elem == T.CHAR and (elem is None or d.indices[-1] is None):
+                elem = T.Array(T.CHAR, t.dims[-1:])       # NAME[] = "text", a row of a CHAR matrix: text
             out.append(DataValue(f"{d.name}[{idx}]", tname, d, value_text(lines, d) or printer.expr(d.value),
                                  leaves(d.value, elem, lines)))
     return out

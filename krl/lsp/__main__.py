@@ -2,4 +2,5 @@
 
 from krl.lsp.server import serve
 
-serve()
+if __name__ == "__main__":      # not when a worker process of the server imports this module
+    serve()

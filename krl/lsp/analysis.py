@@ -4,8 +4,10 @@ An :class:`Analysis` is a :class:`krl.workspace.Workspace` after ``check()`` plu
 text and lines. The scopes are the front end's (krl/semantics/symbols.py): a position's scope is
 the routine scope of the routine around it (``Workspace.routine_scope``), else the module scope
 of its file, else the global scope. Routines of files with syntax errors are not checked by
-``krl check``; here they are typed with a checker whose findings are dropped, so that names in a
-partial tree still resolve (:meth:`Analysis.annotate_partial`).
+``krl check``; here the workspace types them too (``Workspace.check(partial=True)``), their
+findings not reported, so that names in a partial tree still resolve. After an edit,
+:func:`updated` hands the new parse to the workspace, which re-checks what the edit can affect
+(``Workspace.replace``); the language server holds no phase of the check itself.
 """
 
 from __future__ import annotations
@@ -13,11 +15,12 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from krl.ast import nodes as N
-from krl.lsp.names import is_uri
+from krl.diagnostics import Diagnostic
+from krl.diagnostics.render import split_lines
 from krl.lsp.parsing import Parsed
+from krl.lsp.paths import is_uri
 from krl.semantics import types as T
-from krl.semantics.checker import Checker, Declarer
-from krl.diagnostics import Diagnostic, DiagnosticSink
+from krl.semantics.config import config_for
 from krl.semantics.symbols import Scope, Symbol
 from krl.workspace import SourceFile, Workspace
 
@@ -47,6 +50,10 @@ class Analysis:
     root: str
     ws: Workspace
     files: dict[str, FileInfo] = field(default_factory=dict)
+    how: str = "workspace"      # what the check that made it checked: Workspace.replace's answer
+    # per AST node, what editor features derived from its annotations (krl/lsp/unused.py); handed
+    # on while the workspace's symbols stay the same (a re-check of some routines or values)
+    memo: dict = field(default_factory=dict, repr=False)
     _types: dict[int, Symbol] | None = None
     _type_of_decl: dict[int, Symbol] | None = None
     _routine_path: dict[int, str] | None = None
@@ -112,64 +119,36 @@ class Analysis:
                 self._types.setdefault(id(sym.type), sym)
                 self._type_of_decl.setdefault(id(sym.decl), sym)
 
-    def resolved(self) -> "Analysis":
-        """This analysis with every name placed by the resolver (krl/semantics/resolve.py:
-        ``ann.place``, ``ann.callee``, ...); an incremental re-check (krl/lsp/incremental.py) leaves it to this."""
-        if self.ws.resolver is None and self.ws.global_scope is not None:
-            from krl.semantics.resolve import resolve_workspace  # noqa: PLC0415
-            resolve_workspace(self.ws)
-        return self
-
-    # ------------------------------------------------------------------ set-up
-
-    def annotate_partial(self, only: str | None = None) -> None:
-        """Type the routines of files that did not parse (their findings are not reported:
-        ``krl check`` reports only the syntax errors of such files); `only`: of that file."""
-        if self.ws.global_scope is None:
-            return
-        sink = DiagnosticSink()
-        checker = Checker(sink, Declarer(sink, True), True)
-        for f in self.ws.files:
-            if f.ok or (only is not None and f.path != only):
-                continue
-            for r in f.module.routines:
-                sc = self.ws.routine_scope(r)
-                if sc is not None:
-                    checker.check_routine(r, sc, f.path)
-        for f in self.ws.files:
-            if not f.ok and f.module.data is not None and f.scope is not None and only is None:
-                checker.check_datalist(f.module.data, f.scope)
-
     def diagnostics_for(self, path: str) -> list[Diagnostic]:
         """The workspace's diagnostics of one file, with the root's krl.toml applied."""
-        diags = sorted((d for d in self.ws.sink.items if d.path == path), key=lambda d: (d.line, d.column, d.code))
+        diags = self.ws.diagnostics_of(path)
         if is_uri(path):        # an unsaved new buffer has no file name to match its main routine
             diags = [d for d in diags if d.code != "W111"]
         try:
-            from krl.semantics.config import config_for  # noqa: PLC0415
             return config_for(self.root).apply(diags)     # the workspace root only, as krl check
         except Exception:  # noqa: BLE001 - a bad krl.toml: `krl check` says why; here all are shown
             return diags
 
 
 def build_analysis(root: str, parsed: list[Parsed], skipped=()) -> Analysis:
-    """Link and check parsed files as one workspace (krl/workspace.py ``Workspace.check``);
-    `skipped`: the krl.files entries not read (links, FIFOs, ...), W002 as in ``krl check``."""
+    """Link and check parsed files as one workspace (krl/workspace.py ``Workspace.check``, the
+    routines of files that do not parse typed too); `skipped`: the krl.files entries not read
+    (links, FIFOs, ...), W002 as in ``krl check``."""
     ws = Workspace(root)
     an = Analysis(root, ws)
-    from krl.diagnostics.render import split_lines  # noqa: PLC0415
     for p in parsed:
-        sf = SourceFile(p.path, p.module, p.ok, p.status)
-        ws.files.append(sf)
-        ws.sink.extend(p.diagnostics)
-        if not p.ok:
-            if p.unreadable:
-                ws.unreadable = True
-            ws.failed_words.update(p.failed_words)
+        sf = ws.add_loaded(p.loaded, notify=False)
         an.files[p.path] = FileInfo(p.path, p, sf, split_lines(p.text))
-    for e in skipped:
-        ws.sink.add(str(e.path), 1, 1, "W002", f"not read: {e.message}")
-        ws.unreadable = True
-    ws.check()
-    an.annotate_partial()
+    ws.add_unread(skipped)
+    ws.check(resolve=False, partial=True)
+    return an
+
+
+def updated(prev: Analysis, parsed: Parsed) -> Analysis:
+    """A new analysis of `prev`'s workspace with one file's new parse in place: the workspace
+    re-checks what the change can affect (``Workspace.replace``); ``how`` says what that was."""
+    fi = prev.files[parsed.path]
+    how = prev.ws.replace(parsed.loaded)
+    an = Analysis(prev.root, prev.ws, dict(prev.files), how=how, memo=prev.memo if how != "workspace" else {})
+    an.files[parsed.path] = FileInfo(parsed.path, parsed, fi.source, split_lines(parsed.text))
     return an

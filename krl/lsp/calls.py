@@ -56,7 +56,7 @@ def item(an: Analysis, pm: ProgramMap, node_id: str, uri_of, codec=None) -> L.Ca
     full = L.Range(start=to_position(lines, n.line, 1, codec), end=to_position(lines, end_line, len(end_text) + 1, codec))
     return L.CallHierarchyItem(name=n.name, kind=L.SymbolKind.Function, uri=uri_of(n.path), range=full,
                                selection_range=to_range(lines, n.line, col, len(n.name), codec),
-                               detail=f"{n.module}" + (" (never reached)" if n.dead else ""), data=n.id)
+                               detail=f"{n.module}" + (" (never reached)" if n.unreachable else ""), data=n.id)
 
 
 def prepare(an: Analysis, path: str, line: int, column: int, uri_of, codec=None) -> list[L.CallHierarchyItem]:

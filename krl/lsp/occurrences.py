@@ -40,11 +40,12 @@ def _root_name(e: N.Node | None) -> N.Name | None:
     return e if isinstance(e, N.Name) else None
 
 
-def _written(module: N.Module) -> set[int]:
-    """ids of the Name nodes a statement of `module` writes (assignment targets, FOR counters,
-    arguments passed to OUT parameters: reference 2.3 treats a parameter without a mode as OUT)."""
+def written_names(node: N.Node) -> set[int]:
+    """ids of the Name nodes a statement in `node` (a module, a routine) writes (assignment
+    targets, FOR counters, arguments passed to OUT parameters: reference 2.3 treats a parameter
+    without a mode as OUT)."""
     out: set[int] = set()
-    for n in module.walk():
+    for n in node.walk():
         if isinstance(n, N.Assign):
             r = _root_name(n.target)
             if r is not None:
@@ -100,7 +101,7 @@ def file_occurrences(an: Analysis, path: str) -> list[Occurrence]:
 def _file_occurrences(an: Analysis, path: str, fi) -> list[Occurrence]:
     lines = fi.lines
     module = fi.source.module
-    written = _written(module)
+    written = written_names(module)
     routine_of = None
     out: list[Occurrence] = []
 

@@ -1,4 +1,4 @@
-"""The program map of a checked workspace: routines, what calls what, entry points, dead code.
+"""The program map of a checked workspace: routines, what calls what, entry points, unreachable routines.
 
 :func:`build_map` reads a :class:`krl.workspace.Workspace` after ``ws.check()``. Every edge
 comes from the checker's annotations (``node.ann.symbol``, krl/semantics/checker.py), never
@@ -21,9 +21,10 @@ that applies is named):
 * ``cell`` -- the cell program (module ``CELL``, or a main routine ``DEF CELL()``), which
   Automatic External starts;
 * ``plc`` -- the program numbers the cell program's ``SWITCH`` selects: every routine called
-  in one ``CASE`` branch (KUKA's cell.src: ``SWITCH PGNO ... CASE 1 ... EXAMPLE1()``); a
-  routine called in several branches is a step of the cell's own sequence
-  (``CellProgramStart()``), not a program;
+  in a ``CASE`` branch (KUKA's cell.src: ``SWITCH PGNO ... CASE 1 ... EXAMPLE1()``; one program
+  may have several numbers, the first is named); a routine called in most branches (at least
+  three, more than half) is a step of the cell's own sequence (``CellProgramStart()``), not a
+  program;
 * ``submit`` -- every submit interpreter (``.sub`` file: ``sps.sub``);
 * ``selected`` -- every program a system data list (``$config.dat``, ``$custom.dat``,
   ``$option.dat``) names as ``"/R1/NAME()"`` (``$PRO_I_O``, ``$PRO_I_O_PROC_IDn``);
@@ -36,7 +37,9 @@ that applies is named):
   controller calls them);
 * ``module`` -- for a folder that is not a KRC backup, the main routine of every module.
 
-A routine that none of these reaches along the edges is *unreachable* (``Node.unreachable``).
+A routine of the backup's own that none of these reaches along the edges is *unreachable*
+(``Node.unreachable``); a routine of KUKA's system software that nothing calls is unused
+library (the controller, its inline forms and technology packages call it), never unreachable.
 """
 
 from __future__ import annotations
@@ -77,11 +80,6 @@ class Node:
     main: bool = False
     end: int = 0                   # the END/ENDFCT line
 
-    @property
-    def dead(self) -> bool:
-        """The former name of :attr:`unreachable`."""
-        return self.unreachable
-
 
 @dataclass(frozen=True)
 class Edge:
@@ -117,11 +115,6 @@ class ProgramMap:
     @property
     def unreachable(self) -> list[Node]:
         return [n for n in self.nodes.values() if n.unreachable]
-
-    @property
-    def dead(self) -> list[Node]:
-        """The former name of :attr:`unreachable`."""
-        return self.unreachable
 
     def as_json(self) -> dict:
         """``{"root", "nodes": [...], "edges": [...], "entries": [...], "unreachable": [...],
@@ -305,13 +298,15 @@ def _case_programs(pm: ProgramMap, ws: Workspace, cell_id: str) -> list[tuple[st
                             if target is not None and not pm.nodes[target].kuka:
                                 calls.setdefault(target, call.span.line)
                     branches.append((number, calls))
-                # a routine called in several branches is a step of the cell's own sequence
-                # (KUKA's template: CellProgramStart(), CellProgramEnd()), not a program
+                # a routine called in most branches (at least three, more than half) is a step
+                # of the cell's own sequence (CellProgramStart(), CellProgramEnd()), not a
+                # program; one program may have several numbers (CASE 1 and CASE 3: millingcn())
                 seen: dict[str, int] = {}
                 for _n, calls in branches:
                     for t in calls:
                         seen[t] = seen.get(t, 0) + 1
-                out += [(number, t, line) for number, calls in branches for t, line in calls.items() if seen[t] == 1]
+                step = {t for t, k in seen.items() if k >= 3 and 2 * k > len(branches)}
+                out += [(number, t, line) for number, calls in branches for t, line in calls.items() if t not in step]
     return out
 
 
@@ -327,4 +322,7 @@ def _mark_unreachable(pm: ProgramMap) -> None:
                 seen.add(t)
                 todo.append(t)
     for nid, n in pm.nodes.items():
-        n.unreachable = n.kind == "routine" and nid not in seen
+        # KUKA's system software is a library the controller, its inline forms and technology
+        # packages call (bas.src's SVEL_CP, collmonlib.src): what this backup does not call of
+        # it is unused, not unreachable
+        n.unreachable = n.kind == "routine" and not n.kuka and nid not in seen

@@ -66,7 +66,7 @@ def _label(*lines: str) -> str:
 
 
 def digraph(pm: ProgramMap) -> graphviz.Digraph:
-    """The map as a graphviz.Digraph: entry points double-bordered, dead routines grey."""
+    """The map as a graphviz.Digraph: entry points double-bordered, unreachable routines grey."""
     if len(pm.nodes) > MAX_GRAPH_NODES:
         raise GraphTooLarge(f"the program map has {len(pm.nodes)} nodes (limit MAX_GRAPH_NODES = {MAX_GRAPH_NODES})")
     g = graphviz.Digraph("program_map", graph_attr={"rankdir": "LR", "fontname": "Helvetica"},
@@ -81,7 +81,7 @@ def digraph(pm: ProgramMap) -> graphviz.Digraph:
         attrs = {}
         if n.entry:
             attrs.update(peripheries="2", color="#224466", tooltip=_label(n.entry))
-        if n.dead:
+        if n.unreachable:
             attrs.update(style="filled", fillcolor="#eeeeee", fontcolor="#777777")
         g.node(names[n.id], _label(n.name, f"{n.module} {_short(n.path, pm.root)}:{n.line}"), **attrs)
     seen = set()

@@ -17,6 +17,8 @@ from pathlib import Path
 
 import yaml
 
+from krl.store import stored
+
 DATA_DIR = Path(__file__).parent / "data"
 
 try:  # the C loader is much faster where libyaml is present
@@ -127,7 +129,12 @@ def _read(name: str) -> dict:
 
 @lru_cache(maxsize=1)
 def load_builtins() -> Builtins:
-    """Read the three data tables (cached). Raises ValueError for a malformed table."""
+    """Read the three data tables (cached, and kept across processes: krl/store.py). Raises
+    ValueError for a malformed table."""
+    return stored("builtins", (), _load_builtins)
+
+
+def _load_builtins() -> Builtins:
     types = _read("types.yaml")
     sysv = _read("sysvars.yaml")
     funcs = _read("functions.yaml")

@@ -730,6 +730,10 @@ class Checker:
     def e_StrLit(self, e: N.StrLit, sc: Scope, expected) -> T.KrlType:
         return self.set_type(e, T.StrType(len(e.value)))
 
+    def e_ChannelName(self, e: N.ChannelName, sc: Scope, expected) -> T.KrlType:
+        # a channel (COPEN(:SER_3, HANDLE)) is an argument of a channel routine, no typed value
+        return T.UNKNOWN
+
     def e_EnumLit(self, e: N.EnumLit, sc: Scope, expected) -> T.KrlType:
         if isinstance(expected, T.Enum):
             if expected.values and e.name.upper() not in expected.values:

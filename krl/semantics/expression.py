@@ -180,6 +180,10 @@ class _Compiler:
     def e_Aggregate(self, e: N.Aggregate) -> Reader:
         return self.env.aggregate(e, [(it.name.upper(), self.build(it.value)) for it in e.items])
 
+    def e_ChannelName(self, e: N.ChannelName) -> Reader:
+        # a channel (COPEN(:SER_3, HANDLE)) is an argument of a channel routine, no value
+        self.env.refuse(e, f"the channel :{e.name}")
+
     def e_Name(self, e: N.Name) -> Reader:
         return self.env.name(e)
 

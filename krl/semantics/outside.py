@@ -53,7 +53,7 @@ def template_lines(text: str) -> tuple[frozenset[int], frozenset[int]]:
     inline: set[int] = set()
     stack: list[str] = []
     for no, line in enumerate(text.splitlines(), 1):
-        m = _FOLD.match(line)
+        m = _FOLD.match(line) if ";" in line else None
         if m:
             rest = m.group(1)
             title = rest.split(";", 1)[0].strip().upper()
@@ -71,7 +71,7 @@ def template_lines(text: str) -> tuple[frozenset[int], frozenset[int]]:
                 ini.add(no)
             elif where == "inline":
                 inline.add(no)
-        if not m and _ENDFOLD.match(line) and stack:
+        if not m and stack and ";" in line and _ENDFOLD.match(line):
             stack.pop()
     return frozenset(ini), frozenset(inline)
 

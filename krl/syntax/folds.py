@@ -40,6 +40,8 @@ from krl.diagnostics import Diagnostic, Note
 _MARKER = re.compile(r";[ \t]*(END)?FOLD(?![A-Za-z0-9_$])", re.I)
 _OPEN = re.compile(r"[ \t\f]*(?:GLOBAL[ \t]+)?(DEF|DEFFCT|DEFDAT)[ \t]+([A-Za-z_$][A-Za-z0-9_$]*)", re.I)
 _CLOSE = re.compile(r"[ \t\f]*(END|ENDFCT|ENDDAT)(?![A-Za-z0-9_$])", re.I)
+# a line that can matter to the scan: a comment, a lone CR, or the start of a routine or its end
+_MAYBE = re.compile(r"[ \t\f]*(?:GLOBAL|DEF|END)", re.I)
 
 
 @dataclass(frozen=True, slots=True)
@@ -77,8 +79,15 @@ class FoldScan:
 
 def _comment_start(line: str) -> int:
     """Index of the `;` that starts the line's comment (outside a string), or -1."""
+    semi = line.find(";")
+    if semi < 0:
+        return -1
+    quote = line.find('"', 0, semi)
+    if quote < 0:
+        return semi         # no string before the first `;` (most lines): found without a loop
     in_string = False
-    for i, ch in enumerate(line):
+    for i in range(quote, len(line)):
+        ch = line[i]
         if ch == '"':
             in_string = not in_string
         elif ch == ";" and not in_string:
@@ -112,6 +121,8 @@ def scan_fold_lines(lines: list[str]) -> FoldScan:
     current: int | None = None                                 # index into routines, None outside
     out.last = len(lines) - (1 if len(lines) > 1 and lines[-1] == "" else 0)
     for number, whole in enumerate(lines, start=1):
+        if ";" not in whole and "\r" not in whole and not _MAYBE.match(whole):
+            continue                             # a statement line: nothing to see
         offset = 0
         for line in whole.split("\r"):           # a lone CR ends a statement and its comment
             semi = _comment_start(line)

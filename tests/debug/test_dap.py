@@ -65,7 +65,7 @@ def test_evaluate_errors_are_refused_with_krl_words():
         assert c.evaluate("a", ok=False)["message"] == "value invalid: a (1422)"   # a is not set yet
         assert "not a KRL expression" in c.evaluate("a +", ok=False)["message"]
         assert "after the expression" in c.evaluate("a = 1", ok=False)["message"]
-        assert c.value("$MODE_OP") == "#T1"               # launch mode defaults to T1
+        assert c.value("$MODE_OP") == "#AUT"              # krl run's default mode
         assert c.value("$PRO_MODE") == "#GO"
 
 
@@ -204,7 +204,7 @@ def test_mstep_and_backward_motion_over_dap():
 def test_launch_refuses_bad_arguments(tmp_path):
     with DapClient() as c:
         c.initialize()
-        with pytest.raises(DapError, match="no such program"):
+        with pytest.raises(DapError, match="none.src: no such file"):
             c.request("launch", {"program": str(tmp_path / "none.src")})
         with pytest.raises(DapError, match="mode"):
             c.request("launch", {"program": str(CALL), "mode": "T3"})
@@ -276,3 +276,88 @@ def test_a_krc_backup_zip_as_workspace(tmp_path):
         assert c.stack()[0]["source"]["path"].endswith("KRC/R1/Program/prog.src")
         c.step("next")
         assert c.value("n") == "41"
+
+
+def _locals_ref(c):
+    scopes = c.request("scopes", {"frameId": c.stack()[0]["id"]})["body"]["scopes"]
+    return next(s["variablesReference"] for s in scopes if s["name"] == "Locals")
+
+
+def test_step_back_after_set_variable_returns_the_edited_state(tmp_path):
+    # z = 0 (l.3); a = 1 (l.4); a = 10 / z (l.5); a = a + 1 (l.6). At l.4 the user sets Z = 2
+    # (the name in another letter case): l.5 divides by 2, and stepping back must replay the
+    # edit, not run into the division by zero it avoided.
+    prog = tmp_path / "divide.src"
+    prog.write_text("DEF divide()\n  DECL INT a, z\n  z = 0\n  a = 1\n  a = 10 / z\n  a = a + 1\nEND\n")
+    with DapClient() as c:
+        c.start(prog, breakpoints={prog: [4]})
+        assert c.scope_vars(c.stack()[0]["id"], "Locals") == {"a": "<value invalid>", "z": "0"}
+        r = c.request("setVariable", {"variablesReference": _locals_ref(c), "name": "Z", "value": "1 + 1"})
+        assert r["body"]["value"] == "2"
+        assert c.step("next")["body"]["reason"] == "step" and frames(c) == [("divide()", 5)]
+        c.step("next")
+        assert frames(c) == [("divide()", 6)] and (c.value("a"), c.value("Z")) == ("5", "2")
+        c.request("stepBack", {"threadId": 1})
+        assert c.wait_event("stopped")["body"]["reason"] == "step"
+        assert frames(c) == [("divide()", 5)] and (c.value("a"), c.value("z")) == ("1", "2")
+        c.request("stepBack", {"threadId": 1})                 # back to the stop of the edit
+        c.wait_event("stopped")
+        assert frames(c) == [("divide()", 4)] and c.value("z") == "2"
+        c.request("continue", {"threadId": 1})
+        assert c.wait_event("exited")["body"]["exitCode"] == 0
+        assert not [e for e in c.events if e.get("event") == "stopped"]
+
+
+def test_step_back_replays_an_input_set_by_hand(tmp_path):
+    # n = 1 (l.3); WAIT FOR $IN[3] (l.4); n = 2 (l.5): $IN[3] set at the stop on l.4
+    prog = tmp_path / "waitin.src"
+    prog.write_text("DEF waitin()\n  DECL INT n\n  n = 1\n  WAIT FOR $IN[3]\n  n = 2\nEND\n")
+    with DapClient() as c:
+        c.start(prog, breakpoints={prog: [4]}, maxSimTime=30)
+        assert c.value("$IN[3]") == "FALSE"
+        assert c.request("krl/setInput", {"index": 3, "value": True})["body"]["value"] is True
+        c.step("next")
+        assert frames(c) == [("waitin()", 5)]
+        c.request("stepBack", {"threadId": 1})
+        c.wait_event("stopped")
+        assert frames(c) == [("waitin()", 4)] and c.value("$IN[3]") == "TRUE"
+        c.step("next")                                       # the WAIT FOR passes again at once
+        assert frames(c) == [("waitin()", 5)] and c.request("krl/pointers")["body"]["time"] == 0.0
+
+
+def test_step_back_replays_a_backward_motion():
+    # 064 in #MSTEP (T1): PTP (l.4), CIRC to X 605 Y 0 Z 810 (l.7), LIN to Y -100 (l.8)
+    with DapClient() as c:
+        c.start(CIRC, runMode="MSTEP", mode="T1")
+        c.request("continue", {"threadId": 1})
+        c.wait_event("stopped")                              # the CIRC has ended
+        assert [round(float(c.value(f"$POS_ACT.{k}")), 3) for k in "XYZ"] == [605.0, 0.0, 810.0]
+        c.request("krl/backwardStep", {})                    # back along the CIRC, to its start
+        back = [c.value(f"$POS_ACT.{k}") for k in "XYZ"]
+        assert round(float(back[0]), 3) != 605.0
+        c.step("next")                                       # to the LIN's statement
+        assert frames(c) == [("program()", 8)] and [c.value(f"$POS_ACT.{k}") for k in "XYZ"] == back
+        c.step("next")                                       # the LIN {Y -100}, to its end
+        assert round(float(c.value("$POS_ACT.Y")), 3) == -100.0
+        c.request("stepBack", {"threadId": 1})               # before the LIN: where the retrace left it
+        c.wait_event("stopped")
+        assert frames(c) == [("program()", 8)] and [c.value(f"$POS_ACT.{k}") for k in "XYZ"] == back
+
+
+@pytest.mark.parametrize("when", ["stopped", "running", "terminate"])
+def test_disconnect_ends_the_adapter_cleanly(tmp_path, when):
+    prog = tmp_path / "spin.src"
+    prog.write_text("DEF spin()\n  DECL INT n\n  n = 0\n  LOOP\n    n = n + 1\n  ENDLOOP\nEND\n")
+    c = DapClient()
+    try:
+        c.initialize()
+        c.request("launch", {"program": str(prog), "stopOnEntry": when != "running"})
+        c.request("configurationDone")
+        if when != "running":
+            c.wait_event("stopped")
+        c.request("terminate" if when == "terminate" else "disconnect", {})
+        assert c.proc.wait(timeout=60) == 0
+        err = c.proc.stderr.read().decode()
+        assert "Fatal" not in err and "Traceback" not in err
+    finally:
+        c.close()

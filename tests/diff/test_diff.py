@@ -230,9 +230,109 @@ def test_a_file_with_syntax_errors_is_not_compared_and_named(tmp_path):
 
 
 def test_corpus_backup_with_unparsed_files_against_itself_is_no_change(shared_corpus):
-    # two of this backup's files do not parse (kuka_internals.src, sample_program.src): the same
-    # text on both sides is no change
+    # three of this backup's files do not parse (kuka_internals.src, kuka_internals.dat,
+    # sample_program.src: krl check's E0xx): the same text on both sides is no change
     b = shared_corpus / "rawpython__kukaKRLmagic"
-    r = CliRunner().invoke(main, ["diff", str(b), str(b)])
+    r = CliRunner().invoke(main, ["diff", "--timeout", "900", str(b), str(b)])
     assert r.exit_code == 0, r.output
     assert "not compared" not in r.output and ": no change;" in r.output
+    assert "; 3 file(s) with syntax errors unchanged (the same text);" in r.output
+    r = CliRunner().invoke(main, ["diff", "--timeout", "900", "--format", "json", str(b), str(b)])
+    summary = json.loads(r.stdout)["summary"]
+    assert (summary["unparsed_same"], summary["not_compared"]) == (3, 0)
+
+
+# The nine misses issue 37 saw on a real backup's history, each rebuilt on a small backup in
+# the same shape (names and values invented here) and expected by hand.
+MISSES_OLD = {
+    "R1/System/$config.dat": "DEFDAT $CONFIG\nDECL GLOBAL REAL gProcessSpeed=1.5\nENDDAT\n",
+    "R1/Program/laser.src": "DEF laser()\n  SPTP XP13 WITH $APO=SAPO_PTP(PPDAT13), $VEL_AXIS[1]=SVEL_JOINT(100) C_SPL\nEND\n",
+    "R1/Program/laser.dat": "DEFDAT laser\nDECL E6POS XP13={X 1.0,Y 2.0,Z 3.0,A 0.0,B 0.0,C 0.0,S 2,T 10}\n"
+                            "DECL PDAT PPDAT13={VEL 100.0,ACC 100.0,APO_DIST 500.0,APO_MODE #CDIS}\nENDDAT\n",
+    "R1/Program/Paint/Dryer.dat": "DEFDAT Dryer\nDECL BOOL bDryerOn=FALSE\nDECL INT DryTime=15\n"
+                                  "DECL REAL ProcParam[4]\nProcParam[1]=0.5\nProcParam[2]=0.75\n"
+                                  "STRUC RecipeT INT Layers, REAL Thickness, CHAR Name[12]\n"
+                                  "DECL RecipeT Recipe1={Layers 2,Thickness 0.8,Name[] \"Blue\"}\n"
+                                  "EXT WEAV_DEF(INT:IN, REAL:OUT)\nENDDAT\n",
+    "R1/Program/Paint/Dryer.src": "DEF Dryer()\nEND\nDEFFCT BOOL F_TRIG(x:IN)\n  BOOL x\n  RETURN x\nENDFCT\n"
+                                  "DEFFCT BOOL F_TRIG(y:IN)\n  INT y\n  RETURN TRUE\nENDFCT\n",
+}
+
+
+def _tree(root: Path, files: dict) -> Path:
+    for rel, text in files.items():
+        p = root / rel
+        p.parent.mkdir(parents=True, exist_ok=True)
+        p.write_text(text.replace("\n", "\r\n"), encoding="latin-1", newline="")
+    return root
+
+
+def test_the_nine_misses_of_issue_37(tmp_path):
+    new = dict(MISSES_OLD)
+    new["R1/System/$config.dat"] = new["R1/System/$config.dat"].replace("1.5", "1.75")
+    new["R1/Program/laser.dat"] = new["R1/Program/laser.dat"].replace("APO_DIST 500.0", "APO_DIST 200.0")
+    new["R1/Program/Paint/Dryer.dat"] = (new["R1/Program/Paint/Dryer.dat"].replace("=FALSE", "=TRUE")
+                                         .replace("DryTime=15", "DryTime=12").replace("[2]=0.75", "[2]=0.8")
+                                         .replace("Thickness 0.8", "Thickness 1.2")
+                                         .replace("EXT WEAV_DEF(INT:IN, REAL:OUT)\n", ""))
+    old_root = _tree(tmp_path / "old", MISSES_OLD)
+    new_root = _tree(tmp_path / "new", new)
+    # the commit also renamed files in letter case only (on the controller: the same files)
+    (new_root / "R1/Program/Paint/Dryer.src").rename(new_root / "R1/Program/Paint/DRYER.SRC")
+    (new_root / "R1/Program/laser.dat").rename(new_root / "R1/Program/Laser.dat")
+    r = CliRunner().invoke(main, ["diff", "--format", "json", str(old_root), str(new_root)])
+    assert r.exit_code == 1, r.output
+    doc = json.loads(r.stdout)
+    values = {(e["file"], e["name"], e["old"], e["new"]) for e in doc["values"]}
+    assert values == {
+        ("R1/Program/Laser.dat", "PPDAT13.APO_DIST", 500.0, 200.0),      # 1. a KSS 8 motion data set
+        ("R1/Program/Paint/Dryer.dat", "bDryerOn", False, True),        # 2. a BOOL flag, as written
+        ("R1/Program/Paint/Dryer.dat", "DryTime", 15, 12),              #    a drying time (INT)
+        ("R1/Program/Paint/Dryer.dat", "ProcParam[2]", 0.75, 0.8),      #    an array element
+        ("R1/Program/Paint/Dryer.dat", "Recipe1.Thickness", 0.8, 1.2),  #    a recipe STRUC
+        ("R1/System/$config.dat", "gProcessSpeed", 1.5, 1.75),          #    global process data
+    }
+    # the motion that uses PPDAT13 has no PDAT_ACT line: its data set's change is on it
+    assert doc["motions"] == [{"file": "R1/Program/laser.src", "routine": "laser", "motion": "SPTP", "point": "XP13",
+                               "line": 2, "changed": {"PPDAT13.APO_DIST": [500.0, 200.0]}}]
+    # 3. the summary names every kind compared, zeros included
+    assert doc["summary"] == {"points": 0, "frames": 0, "values": 6, "routines": 0, "declarations": 1, "motions": 1,
+                              "files_compared": 5, "unparsed_same": 0, "not_compared": 0}
+    # 4. F_TRIG defined twice: the first compared (no false "retyped"), the checker's E102 named
+    assert [d["name"] for d in doc["declarations"]] == ["WEAV_DEF"]
+    assert [(d["side"], d["file"], d["line"], d["code"]) for d in doc["duplicates"]] == [
+        ("old", "R1/Program/Paint/Dryer.src", 7, "E102"), ("new", "R1/Program/Paint/DRYER.SRC", 7, "E102")]
+    assert "'F_TRIG' is declared more than once" in doc["duplicates"][1]["message"]
+    # 5. a removed EXT is KRL, never a Python tuple
+    assert doc["declarations"][0]["before"] == "EXT WEAV_DEF(INT :IN, REAL :OUT)"
+    text = CliRunner().invoke(main, ["diff", str(old_root), str(new_root)]).stdout
+    assert "external WEAV_DEF removed EXT WEAV_DEF(INT :IN, REAL :OUT)" in text
+    assert "('" not in text and "ExtDecl" not in text
+    # 6. names as written
+    assert "Recipe1.Thickness (REAL): 0.8 -> 1.2" in text and "bDryerOn (BOOL): FALSE -> TRUE" in text
+    assert "compared 5 file(s): 0 points, 0 frames and loads, 6 data values, 0 routines, " in text
+    # 7. only the letter case of the file names changed: no change, exit 0
+    r = CliRunner().invoke(main, ["diff", str(old_root), str(_case_only(old_root, tmp_path / "case"))])
+    assert r.exit_code == 0, r.output
+    assert ": no change; compared 5 file(s)" in r.stdout
+
+
+def _case_only(src: Path, dst: Path) -> Path:
+    shutil.copytree(src, dst)
+    for p in sorted(dst.rglob("*"), key=lambda p: -len(p.parts)):
+        p.rename(p.with_name(p.name.upper() if p.name.islower() or "$" in p.name else p.name.lower()))
+    return dst
+
+
+def test_values_compared_with_their_types(tmp_path):
+    old = {"a.dat": "DEFDAT a\nDECL REAL r1=87.03\nDECL REAL r2=1.0\nDECL INT i=16777217\n"
+                    "DECL APO_MODE_T m=#CDIS\nDECL CHAR s[8]\ns[]=\"Abc\"\nENDDAT\n"}
+    new = {"a.dat": "DEFDAT a\nDECL REAL r1=87.0299988\nDECL REAL r2=1.0001\nDECL INT i=16777216\n"
+                    "DECL APO_MODE_T m=#cdis\nDECL CHAR s[8]\ns[]=\"abc\"\nENDDAT\n"}
+    a, b = _tree(tmp_path / "a", old), _tree(tmp_path / "b", new)
+    doc = json.loads(CliRunner().invoke(main, ["diff", "--format", "json", str(a), str(b)]).stdout)
+    # REAL: 87.03 and 87.0299988 are one 32-bit float; 1.0 -> 1.0001 is not; INT exactly (a REAL
+    # would take 16777217 for 16777216); ENUM by name in any case; STRING exactly
+    assert sorted((e["name"], e["kind"]) for e in doc["values"]) == [("i", "INT"), ("r2", "REAL"), ("s[]", "STRING")]
+    doc = json.loads(CliRunner().invoke(main, ["diff", "--format", "json", "--tolerance", "0.001", str(a), str(b)]).stdout)
+    assert sorted(e["name"] for e in doc["values"]) == ["i", "s[]"]

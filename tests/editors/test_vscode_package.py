@@ -33,8 +33,10 @@ def test_vsce_packages_the_extension(tmp_path: Path):
     launch = debugger["configurationAttributes"]["launch"]["properties"]
     assert debugger["type"] == "krl"
     assert launch["mode"]["enum"] == ["T1", "T2", "AUT", "EXT"]
-    assert launch["runMode"]["enum"] == ["#GO", "#MSTEP", "#ISTEP", "#BSTEP"]
+    assert launch["runMode"]["enum"] == ["GO", "MSTEP", "ISTEP", "BSTEP"]     # krl run --run-mode's choices
     assert launch["interp"]["enum"] == ["tree", "vm"]
-    assert {"program", "workspace", "inputs", "stopOnEntry"} <= set(launch)
+    # every krl run option (issue 37: submit and maxSimTime were missing), and the debugger's own
+    assert {"program", "workspace", "inputs", "stopOnEntry", "submit", "noSubmit", "maxSimTime", "maxSteps",
+            "robot", "pgno", "noCheck", "trace"} <= set(launch)
     settings = contributes["configuration"]["properties"]
     assert settings["krl.server.path"]["default"] == "krl" and settings["krl.server.args"]["default"] == ["lsp"]

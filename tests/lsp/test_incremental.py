@@ -1,31 +1,33 @@
-"""An edit that keeps a module's interface re-checks that module only (krl/lsp/incremental.py),
-and gives exactly the diagnostics of a full check of the same texts; an edit of the interface
-checks the whole workspace again."""
+"""An edit that keeps a module's interface re-checks that module's changed routines (or a data
+list's changed values) only (krl/workspace.py ``Workspace.replace``), and gives exactly the
+diagnostics of a full check of the same texts, parsed afresh; an edit of the interface checks the
+whole workspace again."""
 
 from __future__ import annotations
 
 import shutil
 
-from krl.lsp.analysis import build_analysis
 from krl.lsp.project import Project
+from krl.workspace import check_texts
 from tests.lsp.conftest import BACKUP
 
 
-def rows(an):
-    return [(d.path, d.code, d.line, d.column, d.message, d.help) for d in an.ws.diagnostics]
+def rows(diags):
+    return [(d.path, d.code, d.line, d.column, d.message, d.help, d.end_line, d.end_column,
+             [(n.path, n.line, n.column, n.message) for n in d.notes]) for d in diags]
 
 
-def full(p: Project, an):
-    return build_analysis(an.root, [p.parsed(f) for f in an.files])
+def fresh(p: Project, an):
+    """A full check of the analysis's texts, every file parsed again (krl check's pipeline)."""
+    return check_texts({path: fi.parsed.text for path, fi in an.files.items()})
 
 
-def edits_agree(p: Project, path: str, texts: list[tuple[str, bool]]) -> None:
-    for text, incremental in texts:
-        prev = p.latest(path)
+def edits_agree(p: Project, path: str, texts: list[tuple[str, str]]) -> None:
+    for text, how in texts:
         p.change(path, text)
         an = p.analyze(path)
-        assert (an.ws is prev.ws) == incremental, text[:200]
-        assert rows(an) == rows(full(p, an))
+        assert an.how == how, text[:200]
+        assert rows(an.ws.diagnostics) == rows(fresh(p, an).diagnostics)
 
 
 def test_body_edits_on_the_fixture(tmp_path):
@@ -36,20 +38,42 @@ def test_body_edits_on_the_fixture(tmp_path):
     p.open(main, text)
     p.analyze(main)
     edits_agree(p, main, [
-        (text.replace("  counter = 0\n", "  countr = 0.5\n"), True),                 # E101
-        (text.replace("  counter = 0\n", "  counter = 0.5\n  $IN[3] = TRUE\n  bar()\n"), True),   # W202, E501, E106
-        (text, True),
-        (text.replace("IF run_mode == #auto THEN", "IF run_mode == #auto"), True),   # a syntax error
-        (text.replace("IF run_mode == #auto THEN", "IF run_mode == #auto").replace("counter = 0", "countr = 0"), True),
-        (text, True),
-        (text.replace("DEF on_stop( )", "GLOBAL DEF on_stop( )"), False),           # interface: GLOBAL
-        (text, False),
-        (text.replace("DEF on_stop( )", "DEF on_stop(x:IN)\n  DECL INT x"), False),  # interface: a parameter
-        (text, False),
+        (text.replace("  counter = 0\n", "  countr = 0.5\n"), "routines"),                  # E101
+        (text.replace("  counter = 0\n", "  counter = 0.5\n  $IN[3] = TRUE\n  bar()\n"), "routines"),   # W202, E501, E106
+        (text, "routines"),
+        (text.replace("IF run_mode == #auto THEN", "IF run_mode == #auto"), "routines"),    # a syntax error
+        (text.replace("IF run_mode == #auto THEN", "IF run_mode == #auto").replace("counter = 0", "countr = 0"),
+         "routines"),
+        (text, "routines"),
+        (text.replace("DEF on_stop( )", "GLOBAL DEF on_stop( )"), "workspace"),           # interface: GLOBAL
+        (text, "workspace"),
+        (text.replace("DEF on_stop( )", "DEF on_stop(x:IN)\n  DECL INT x"), "workspace"),  # interface: a parameter
+        (text, "workspace"),
     ])
     an = p.latest(main)
     # go to definition from another file still reaches the new routine node
     assert an.ws.global_scope.routines["HELPER"].decl in an.files[str(tmp_path / "KRC" / "R1" / "Program" / "tools.src")].source.module.routines
+
+
+def test_data_list_edits_on_the_fixture(tmp_path):
+    """A value of a data list changes: only that value is checked again; a declaration
+    changes: the workspace."""
+    shutil.copytree(BACKUP, tmp_path / "KRC")
+    path = str(tmp_path / "KRC" / "R1" / "Program" / "main.dat")
+    text = open(path).read()
+    p = Project()
+    p.open(path, text)
+    p.analyze(path)
+    value = "  DECL INT local_count = 0\n"
+    assert value in text
+    edits_agree(p, path, [
+        (text.replace(value, "  DECL INT local_count = \"a string\"\n"), "values"),    # E201
+        (text.replace(value, "  DECL INT local_count = #no_such\n"), "values"),
+        (text.replace(value, "\n\n" + value), "values"),                               # lines inserted above
+        (text, "values"),
+        (text.replace(value, value.replace("DECL", "DECL GLOBAL", 1)), "workspace"),
+        (text, "workspace"),
+    ])
 
 
 def test_body_edits_on_a_real_backup(shared_corpus, tmp_path):
@@ -62,8 +86,8 @@ def test_body_edits_on_a_real_backup(shared_corpus, tmp_path):
     p.analyze(path)
     assert "   SALIR = TRUE\n" in text
     edits_agree(p, path, [
-        (text.replace("   SALIR = TRUE\n", "   SALIRR = TRUE\n", 1), True),
-        (text.replace("   SALIR = TRUE\n", "   no_such_routine()\n   SALIR = $NO_SUCH_SYSVAR\n", 1), True),
-        (text.replace("   SALIR = TRUE\n", "   SALIR = TRUE +\n", 1), True),          # a syntax error
-        (text, True),
+        (text.replace("   SALIR = TRUE\n", "   SALIRR = TRUE\n", 1), "routines"),
+        (text.replace("   SALIR = TRUE\n", "   no_such_routine()\n   SALIR = $NO_SUCH_SYSVAR\n", 1), "routines"),
+        (text.replace("   SALIR = TRUE\n", "   SALIR = TRUE +\n", 1), "routines"),          # a syntax error
+        (text, "routines"),
     ])

@@ -12,6 +12,7 @@ import time
 import pytest
 from py_openshowvar import openshowvar
 
+from krl.limits import MAX_VARPROXY_CLIENTS
 from net.settings import NetworkSettings
 
 from .helpers import EXAMPLES, run_with_partner
@@ -82,3 +83,49 @@ def test_bad_requests_close_only_that_client():
 
     result, trace, (closed, v) = run_with_partner(PROGRAM, settings, partner)
     assert closed and v in (b"100", b"75")
+
+
+def test_client_count_limit():
+    """krl.limits.MAX_VARPROXY_CLIENTS clients at once: each is answered; one more is closed
+    at once (a 'refused' net event) while the others go on; when one leaves, a new client is
+    accepted again."""
+    settings = NetworkSettings(EXAMPLES, varproxy=("127.0.0.1", 0))
+
+    def partner(net, rt):
+        addr = net.wait_address("varproxy")
+        clients = [openshowvar(*addr) for _ in range(MAX_VARPROXY_CLIENTS)]
+        # a read answers only once the server took the client: all of them are in
+        first = [c.read("$OV_PRO", debug=False) for c in clients]
+        extra = socket.create_connection(addr, timeout=20)
+        extra.settimeout(20)
+        try:
+            extra_closed = extra.recv(100) == b""          # closed by the server, unanswered
+        except ConnectionResetError:
+            extra_closed = True
+        extra.close()
+        still = [c.read("$OV_PRO", debug=False) for c in clients]
+        clients.pop().close()
+        # the freed place: a new client is answered (the server sees the close first, in the
+        # same or an earlier cycle than the new connection; retried until a bounded deadline)
+        deadline = time.monotonic() + 20
+        again = None
+        while again is None and time.monotonic() < deadline:
+            late = openshowvar(*addr)
+            late.sock.settimeout(20)
+            try:
+                again = late.read("$OV_PRO", debug=False)
+            except (ConnectionError, OSError, struct.error):   # closed unanswered: still full
+                again = None
+            late.close()
+        for c in clients:
+            c.close()
+        return first, extra_closed, still, again
+
+    result, trace, (first, extra_closed, still, again) = run_with_partner(PROGRAM, settings, partner)
+    ov = (b"100", b"75")
+    assert len(first) == MAX_VARPROXY_CLIENTS and all(v in ov for v in first)
+    assert extra_closed
+    assert all(v in ov for v in still)
+    assert again in ov
+    refused = [e for e in trace.events if e["kind"] == "net" and e["iface"] == "varproxy" and e["dir"] == "refused"]
+    assert refused and f"more than {MAX_VARPROXY_CLIENTS} clients" in refused[0]["text"]

@@ -32,7 +32,7 @@ def test_programs_the_plc_selects_by_number(krc4_test):
     plc = {n.name: n.entry for n in krc4_test.nodes.values() if n.entry_kind == "plc"}
     # CELL.src: CASE 1 GetProcessData(), CASE 10 PrepareMillingTools(), CASE 20..23 Cut_Frame*(),
     # CASE 45 Mill_FrameGlue(), CASE 200 GoHomePos(); CASE 30, 31, 42, 43, 50..55 only HALT (their
-    # programs are commented out); CellProgramStart()/CellProgramEnd() run in every branch
+    # programs are commented out); CellProgramStart()/CellProgramEnd() run in most branches
     expected = {"GetProcessData": 1, "PrepareMillingTools": 10, "Cut_FrameLeft": 20, "Cut_FrameRight": 21,
                 "Cut_FrameUpper": 22, "Cut_FrameThreshold": 23, "Mill_FrameGlue": 45, "GoHomePos": 200}
     assert set(plc) == set(expected)
@@ -43,6 +43,14 @@ def test_programs_the_plc_selects_by_number(krc4_test):
     for name in ("CellProgramStart", "CellProgramEnd"):
         node = next(n for n in krc4_test.nodes.values() if n.name == name)
         assert node.entry_kind != "plc" and not node.unreachable
+
+
+def test_one_program_with_two_numbers(shared_corpus):
+    # ChinaMilling's cell.src: CASE 1 millingcn(), CASE 2 nothing, CASE 3 millingcn()
+    pm = build_map(workspaces_for(shared_corpus / "HugoDanielson__ChinaMilling" / "KRC", timeout=60)[0])
+    plc = [(n.name, n.entry) for n in pm.nodes.values() if n.entry_kind == "plc"]
+    assert len(plc) == 1 and plc[0][0] == "millingcn"
+    assert plc[0][1].startswith("PLC program number 1 (cell program, line ")
 
 
 def test_operator_selectable_programs(krc4_test, shared_corpus):

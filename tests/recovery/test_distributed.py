@@ -12,7 +12,7 @@ from pathlib import Path
 
 import pytest
 
-from recovery import distributed
+from krl import cluster as distributed
 from recovery.pipeline import run_recovery
 
 REPO = Path(__file__).resolve().parents[2]

@@ -266,6 +266,8 @@ def test_error_in_main_run_stops_and_reports(monkeypatch):
         return orig(p, R, ref)
 
     monkeypatch.setattr(seg, "ik", failing)
+    # the batched solve declines a chain with an error and the cycle solves alone, raising it
+    monkeypatch.setattr(seg, "ik_chain", lambda poses, ref: None)
     events = ctl.wait_idle()
     errs = [e for e in events if isinstance(e, ErrorEvent)]
     assert len(errs) == 1 and errs[0].id == 2

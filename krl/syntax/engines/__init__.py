@@ -37,8 +37,9 @@ from krl.syntax.engines.tree import TreeDataError, tree_from_raw
 ENGINES = ("auto", "python", "java")
 REPO_GRAMMAR = Path(__file__).resolve().parents[3] / "grammar" / "KRL.g4"
 
-__all__ = ["ENGINES", "EngineUnavailable", "available", "java_answers", "resolve", "result_from_answer",
-           "set_default", "use_engine", "parse_file", "parse_source", "parse_sources", "unavailable_reason"]
+__all__ = ["ENGINES", "EngineUnavailable", "available", "grammar_text", "java_answers", "parse_piece", "resolve",
+           "result_from_answer", "set_default", "use_engine", "parse_file", "parse_source", "parse_sources",
+           "unavailable_reason"]
 
 
 def set_default(name: str) -> None:
@@ -85,6 +86,11 @@ def resolve(name: str | None = None) -> str:
 
 
 _GRAMMARS: dict[str, str] = {}
+
+
+def grammar_text(bundle: ParserBundle) -> str:
+    """The text of the grammar a parser bundle was generated from (cached per file)."""
+    return _grammar_text(bundle)
 
 
 def _grammar_text(bundle: ParserBundle) -> str:
@@ -199,6 +205,37 @@ def result_from_answer(source: SourceText, raw: dict | bytes | None, bundle: Par
     res = result_from_raw(raw, text, source.path, source.encoding, bundle, tree)
     res.size = source.size
     return res
+
+
+def parse_piece(text: str, path: str, first_line: int, threads: int = 1,
+                bundle: ParserBundle | None = None) -> ParseResult | None:
+    """A piece of a file (its first line is line `first_line` of the file) parsed by the java
+    engine with its tree, as ``parse_text(text, path, first_line=first_line, recover=False)``
+    parses it: a ParseResult with the tree when it parses, a not-ok result without errors when
+    it does not. None when the java engine cannot answer (not running here, a Python-only check
+    could fire, the worker failed): then the Python engine must parse it. `threads`: the worker's
+    (one worker per thread count)."""
+
+    if unavailable_reason() is not None:
+        return None
+    bundle = bundle or default_bundle()
+    text = prepare_text(text)
+    if _needs_python(text):
+        return None
+    try:
+        worker = worker_for(_grammar_text(bundle), threads)
+        [(_k, raw)] = list(worker.parse_raw([text], trees=True, first_line=first_line))
+    except (EngineUnavailable, WorkerError, ValueError):
+        return None
+    if "fail" in raw:
+        return None
+    if raw["stage"] != "sll":
+        return ParseResult(path, False, "", "syntax_error", [], None, "ll")
+    try:
+        tree = tree_from_raw(raw, text, bundle)
+    except TreeDataError:
+        return None
+    return ParseResult(path, True, "", "ok", [], tree, "sll")
 
 
 def parse_source(source: SourceText, bundle: ParserBundle | None = None, keep_tree: bool = False,

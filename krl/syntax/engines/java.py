@@ -270,8 +270,9 @@ class JavaWorker:
             proc.wait()
 
     def parse_raw(self, texts: Iterable[str], trees: bool = False, stall: float | None = None,
-                  decode: bool = True) -> Iterator[tuple[int, dict | bytes]]:
-        """Send every text; yield (index in `texts`, raw record) in completion order. `trees`:
+                  decode: bool = True, first_line: int = 1) -> Iterator[tuple[int, dict | bytes]]:
+        """Send every text; yield (index in `texts`, raw record) in completion order. `first_line`:
+        the line number the texts' first line has (a piece of a file). `trees`:
         the records carry the parse trees as data (worker/KrlWorker.java's header;
         krl/syntax/engines/tree.py rebuilds them). `decode=False`: the records as the JSON
         line the worker wrote (bytes), for a process that decodes them elsewhere.
@@ -287,7 +288,7 @@ class JavaWorker:
             window = threading.Semaphore(IN_FLIGHT)
             failure: list[BaseException] = []
             done = threading.Event()
-            flag = b" t" if trees else b""
+            flag = (b" t" if trees else b"") + (b" L%d" % first_line if first_line != 1 else b"")
 
             def write() -> None:
                 try:

@@ -1,7 +1,7 @@
 // The extension's client side, in node without VS Code: starts the language server the way
 // extension.js does (the command and arguments of the settings `krl.server.path` and
 // `krl.server.args`, stdio transport), initializes it on a workspace folder, opens KRL files
-// and waits for their publishDiagnostics; then shuts the server down and prints one JSON object:
+// and waits for their checked publishDiagnostics; then shuts the server down and prints one JSON object:
 // {capabilities, diagnostics: {<file path>: [Diagnostic...]}}.
 //
 // usage: node diagnostics.js COMMAND ARGS_JSON WORKSPACE_DIR FILE... (ARGS_JSON "" = the default)
@@ -38,9 +38,9 @@ async function main() {
   let done;
   const allReceived = new Promise((resolve) => { done = resolve; });
   connection.onNotification(rpc.PublishDiagnosticsNotification.type, (params) => {
-    if (uris.has(params.uri) && !received.has(params.uri)) {
-      received.set(params.uri, params.diagnostics);
-      if (received.size === uris.size) done();
+    if (uris.has(params.uri)) {
+      received.set(params.uri, params.diagnostics);     // the latest: the checked ones replace a
+      if (received.size === uris.size) done();          // file's own parse diagnostics
     }
   });
   connection.onRequest(rpc.RegistrationRequest.type, () => null);
@@ -69,6 +69,12 @@ async function main() {
     process.exit(3);
   }, TIMEOUT_MS);
   await allReceived;
+  // In a workspace of 20 files or more the server first publishes each file's own parse
+  // diagnostics; a documentSymbol request is answered once the analysis is done, after the
+  // checked diagnostics it published.
+  for (const uri of uris.keys()) {
+    await connection.sendRequest(rpc.DocumentSymbolRequest.type, { textDocument: { uri } });
+  }
   clearTimeout(timer);
   await connection.sendRequest(rpc.ShutdownRequest.type);
   await connection.sendNotification(rpc.ExitNotification.type);

@@ -13,7 +13,8 @@
 // records, so it exists once. The two ports (LineErrorStrategy, lineTokens) are tested
 // against the Python originals on every file of the corpora (tests/syntax/test_engines.py).
 //
-// Protocol: requests on stdin, "<id> <n>\n" (or "<id> <n> t\n": with the parse tree) followed
+// Protocol: requests on stdin, "<id> <n>\n" (or "<id> <n> t\n": with the parse tree; a further
+// "L<line>": the text is a piece of a file whose first line is that line number) followed
 // by n bytes of UTF-8 KRL text (already decoded and given its final newline by Python); one
 // JSON line per request on stdout, {"id": .., "stage": "sll"|"ll", "lex": [[line, column, msg],
 // ..], "syn": [{..}, ..]} or {"id": .., "fail": "<exception>"}. Requests are parsed on a thread
@@ -279,8 +280,11 @@ public final class KrlWorker {
         return i > 0 && Character.isHighSurrogate(s.charAt(i - 1));
     }
 
-    static String parse(long id, String text, boolean wantTree) throws Exception {
+    static String parse(long id, String text, boolean wantTree, int firstLine) throws Exception {
         Lexer lexer = (Lexer) lexerNew.newInstance(CharStreams.fromString(text));
+        if (firstLine != 1) {
+            lexer.setLine(firstLine);   // a piece of a file: tokens carry the file's line numbers
+        }
         lexer.removeErrorListeners();
         LexerErrors lexErrors = new LexerErrors();
         lexer.addErrorListener(lexErrors);
@@ -483,7 +487,17 @@ public final class KrlWorker {
             String[] parts = header.trim().split(" ");
             long id = Long.parseLong(parts[0]);
             int n = Integer.parseInt(parts[1]);
-            boolean wantTree = parts.length > 2 && parts[2].equals("t");
+            boolean wantTree = false;
+            int firstLine = 1;
+            for (int k = 2; k < parts.length; k++) {
+                if (parts[k].equals("t")) {
+                    wantTree = true;
+                } else if (parts[k].startsWith("L")) {
+                    firstLine = Integer.parseInt(parts[k].substring(1));
+                }
+            }
+            final boolean tree = wantTree;
+            final int first = firstLine;
             if (n < 0) {
                 break;
             }
@@ -493,7 +507,7 @@ public final class KrlWorker {
             pool.execute(() -> {
                 String answer;
                 try {
-                    answer = parse(id, text, wantTree);
+                    answer = parse(id, text, tree, first);
                 } catch (Throwable ex) {  // one bad file never stops the worker
                     Throwable cause = ex instanceof java.lang.reflect.InvocationTargetException ? ex.getCause() : ex;
                     StringBuilder b = new StringBuilder("{\"id\":").append(id).append(",\"fail\":");

@@ -1,6 +1,5 @@
-"""Document names of the language server: a file path or, for a buffer that is not a file, a
-URI (``untitled:Untitled-1``). Its own module so that the analysis and the session
-(krl/lsp/analysis.py, krl/lsp/project.py) share it without importing each other."""
+"""One name per document: a file's absolute, normalised path, or the URI of a document that is
+not a file (``untitled:Untitled-1``)."""
 
 from __future__ import annotations
 
@@ -23,6 +22,3 @@ def norm(path: str | Path) -> str:
 def is_uri(name: str) -> bool:
     """True for a document name that is a URI, not a file path (``untitled:Untitled-1``)."""
     return bool(_SCHEME.match(name)) and not os.path.isabs(name)
-
-
-__all__ = ["is_uri", "norm"]

@@ -1,18 +1,21 @@
-"""Running the scan on a Dask distributed cluster (``krl recover CORPUS --scheduler tcp://HOST:8786``).
+"""Tasks on a Dask distributed cluster (``--scheduler tcp://HOST:8786`` of ``krl recover``, the
+real-programs report, ``krl conformance``).
 
-The scan is the same wherever it runs. The client walks the corpus and reads each file once
-(recovery/scan.py); this module ships batches of ``(relative path, bytes, sha)`` to the
-cluster's workers, which parse them with the same function as the local pool
-(:func:`recovery.scan.scan_bytes`) and send back picklable rows. Workers need the project
-installed (the same version, with its generated parser) but no access to the corpus folder:
-nothing on a worker opens a path named by the corpus.
+A job is the same wherever it runs: the client lists its tasks, this module ships them in
+batches to the cluster's workers, which run the same module-level function as the local run and
+send back picklable results. :func:`run_batches` keeps the contract of
+:func:`krl.pool.run_tasks`: one :class:`krl.pool.Outcome` per task, in completion order, with a
+bounded number of batches in flight (so the inputs of a large job are never all in memory at
+once). The per-task timeout becomes a per-batch deadline (``timeout`` x tasks in the batch,
+plus the transfer allowance): a batch past it gives each of its tasks a ``timeout`` outcome;
+its worker thread cannot be killed from here, which is why the local pool (killable
+processes) stays the default.
 
-:func:`run_batches` keeps the contract of :func:`krl.pool.run_tasks`: one
-:class:`krl.pool.Outcome` per task, in completion order, with a bounded number of batches in
-flight (so the bytes of a large corpus are never all in memory at once). The per-file timeout
-becomes a per-batch deadline (``timeout`` x files in the batch, plus the transfer allowance):
-a batch past it gives each of its files a ``timeout`` row; its worker thread cannot be killed
-from here, which is why the local pool (killable processes) stays the default.
+Workers need the project installed (the same version, with its generated parser). What they
+read is the job's: ``krl recover`` sends each file's bytes (its workers never open a path of
+the corpus), while the runs of the real-programs report and of ``krl conformance`` read the
+programs, the backups and the cell files by path, so their workers see the corpus and the
+repository at the same paths as the client (one machine, or a shared file system).
 
 Dask is imported only when a scheduler address is given.
 
@@ -29,8 +32,9 @@ from typing import Any
 
 from krl.pool import Outcome
 
-#: Files per task sent to a worker: big enough that the scheduler's per-task cost (about a
-#: millisecond) is small against the parses, small enough that a slow batch does not hold the tail.
+#: Tasks per batch sent to a worker (the scan's files): big enough that the scheduler's per-task
+#: cost (about a millisecond) is small against the parses, small enough that a slow batch does
+#: not hold the tail. A job of long tasks (a program's run) passes ``batch_files=1``.
 DEFAULT_BATCH_FILES = 16
 #: Batches in flight per worker thread of the cluster (bounds the client's memory).
 IN_FLIGHT_PER_THREAD = 4
@@ -51,7 +55,7 @@ def _run_batch(fn: Callable[..., Any], batch: list[tuple[Hashable, tuple]],
     for key, args in batch:
         try:
             out.append((key, "done", fn(*args), ""))
-        except Exception as exc:  # noqa: BLE001 - one bad file never fails its batch
+        except Exception as exc:  # noqa: BLE001 - one bad task never fails its batch
             out.append((key, "internal_error", None, f"{type(exc).__name__}: {exc}"))
     return out
 
@@ -70,13 +74,13 @@ def _batches(tasks: Iterable[tuple[Hashable, tuple]], size: int) -> Iterator[lis
 def run_batches(address: str, fn: Callable[..., Any], tasks: Iterable[tuple[Hashable, tuple]], *,
                 timeout: float | None = None, initializer: Callable[..., None] | None = None,
                 initargs: tuple = (), batch_files: int = DEFAULT_BATCH_FILES,
-                connect_s: float | None = None) -> Iterator[Outcome]:
+                connect_s: float | None = None, name: str = "krl") -> Iterator[Outcome]:
     """Run ``fn(*args)`` for every ``(key, args)`` of `tasks` on the cluster at `address`
     (``tcp://HOST:PORT``), in batches of `batch_files`; yield one Outcome per task as batches
     finish. `fn` and `initializer` must be importable module-level functions on the workers.
     `timeout`: seconds per file (None: no deadline). `connect_s`: seconds to reach the
     scheduler (None: Dask's ``distributed.comm.timeouts.connect``, 30 s unless configured).
-    Raises SchedulerError."""
+    `name`: the prefix of the tasks' keys on the cluster's dashboard. Raises SchedulerError."""
     try:
         from distributed import Client, wait  # noqa: PLC0415
     except ImportError as exc:  # pragma: no cover - dask.distributed is a dependency
@@ -104,7 +108,7 @@ def run_batches(address: str, fn: Callable[..., Any], tasks: Iterable[tuple[Hash
             if batch is None:
                 return False
             fut = client.submit(_run_batch, fn, batch, initializer, initargs, pure=False,
-                                key=f"krl-scan-{run}-{n}")
+                                key=f"{name}-{run}-{n}")
             n += 1
             in_flight[fut] = batch
             return True

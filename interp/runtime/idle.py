@@ -1,0 +1,281 @@
+"""Idle time costs nothing: a run in which nothing changes fast-forwards to its next event
+(issue 34, "Idle time costs nothing"; docs/robot.md "Idle runs").
+
+A program that polls an input nothing sets (``LOOP IF $IN[3] THEN ... ENDIF ENDLOOP``), a
+submit program cycling over the same values, a WAIT FOR beside a running submit program: the
+tasks execute statements, the simulated time passes, and nothing changes. :class:`IdleWatch`
+(one per run, called by the scheduler at the end of every IPO cycle, the same for both
+interpreters) sees it and moves the clock to the next cycle in which something can change.
+
+**When a run is idle.** At the end of a cycle the run *may* be idle when
+
+* the robot has not moved (its axes and the end point of the last planned motion are those
+  of the window's start: a loop of ``PTP XHOME`` at XHOME plans motions that do not move),
+  no task has a trigger, an error or an interrupt pending, no input or output changed, and no
+  task read the clock (``$DATE``, ``$ROBRUNTIME``, a running ``$TIMER``:
+  :meth:`IdleWatch.clock_read`) or drew a random number, since the cycle the window began;
+* for a *window* of :data:`WINDOW_CYCLES` such cycles, and then the *state* of the run is the
+  same at both ends of the window: every data list, every frame of every task (locals and
+  :IN copies), the system variables, the I/O image (a running timer's value aside: it is
+  time), the interrupt tables (declared, on, enabled, last value, pending), each task's
+  context stack and what it waits for (:func:`state_of`).
+
+A window whose ends differ doubles (up to :data:`MAX_WINDOW_CYCLES`), so a program that
+computes without I/O for a long time is compared rarely.
+
+**What happens then.** The run is idle: the statements the tasks execute have no effect, and
+nothing outside them changes before the next *event*. When the main run is at rest as well
+(``Controller.at_rest``: nothing suspended, braking or blending, every motion executing or
+queued a motion that does not move the robot, no cell rule about to fire) the clock jumps to
+the cycle before that event: a timed stimulus or its delay, a cell rule's pending answer (an
+answer of ``--inputs auto`` included), a PULSE's reset, the end of a task's ``WAIT SEC``, the
+time limit (``Controller.skip``: time, path time and running timers advance exactly), so the
+event is processed by the ordinary IPO cycle at its exact time. An interrupt condition is a function of
+the state: it cannot rise while the state stands still. The skipped cycles execute no
+statement: they do not count against ``--max-steps`` (a run that only polls ends at its time
+limit), and the trace gets one ``idle`` event instead of their statements and poses. Each task
+resumes, after the jump, at the statement where it was; where in its loop it would have been
+after the same time is not simulated (the loop had no effect, so only which statement of the
+loop sees the event first may differ by a few statements, never the cycle times of the event).
+
+Before the jump the automatic cell (``krl run --inputs auto``, :mod:`interp.runtime.autocell`)
+is asked whether it answers the starving condition; its answer is an event like any other.
+
+A run with a debugger attached (statement, step or cycle hooks) never fast-forwards.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from .values import UNSET, Arr, EnumValue, Struct
+
+#: cycles (12 ms) a run must be quiet before its state is compared (0.384 s)
+WINDOW_CYCLES = 32
+#: the longest window, after repeated changes of state without any I/O (6.1 s)
+MAX_WINDOW_CYCLES = 512
+
+_SCALARS = (int, float, bool, str, type(None))
+
+
+def freeze(v):
+    """A comparable, hashable image of a KRL value (:mod:`interp.runtime.values`): scalars as
+    they are, structures and arrays as nested tuples, enum values by name."""
+    c = v.__class__
+    if c in _SCALARS:
+        return v
+    if c is Struct:
+        return (1, tuple((k, freeze(x)) for k, x in v.f.items()))
+    if c is Arr:
+        return (2, tuple([x if x.__class__ in _SCALARS else freeze(x) for x in v.data]))
+    if c is EnumValue:
+        return (3, v.name)
+    if v is UNSET:
+        return (4,)
+    return (5, id(v))
+
+
+def _frames(task):
+    f = task.frame
+    while f is not None:
+        yield f
+        f = f.caller
+
+
+def state_of(rt) -> tuple:
+    """The state of the run `rt` that its future depends on, besides the positions of its
+    tasks in their loops (see the module docstring): data lists, frames, system variables,
+    I/O image, interrupt tables, contexts and waits."""
+    prog = rt.program
+    mods = tuple(tuple([x if x.__class__ in _SCALARS else freeze(x) for x in m.store])
+                 for m in prog.modules if m.loaded)
+    tasks = []
+    for t in rt.scheduler.tasks:
+        frames = tuple(tuple([x if x.__class__ in _SCALARS else freeze(x) for x in f.store])
+                       for f in _frames(t))
+        irqs = tuple((n, i.on, i.enabled, i.last, i.pending, id(i.frame))
+                     for n, i in sorted(t.irqs.irqs.items()))
+        tasks.append((t.done, t.waiting, len(t.contexts), frames, irqs, t.err_text))
+    sv = rt.sysvars.store
+    sysvars = tuple((k, v if v.__class__ in _SCALARS else freeze(v)) for k, v in sv.items())
+    io = rt.controller.io
+    timers = tuple(ms if stop else None for ms, stop in zip(io.timer_ms, io.timer_stop))
+    ioimg = (bytes(io._in), bytes(io._out), tuple(io._anin), tuple(io._anout),
+             tuple(io.timer_stop), timers)
+    return (mods, tuple(tasks), sysvars, ioimg, rt.msg_handle)
+
+
+@dataclass
+class _Marks:
+    """What changes without being state: counters and the robot's axes, read at the start of
+    a window."""
+
+    io: int
+    clock: int
+    axes: tuple
+
+
+class IdleWatch:
+    """The idle detector of one run (module docstring). The scheduler calls :meth:`cycle`
+    after the tasks of an IPO cycle ran and before the controller steps; it returns the
+    number of cycles it skipped (0: none)."""
+
+    def __init__(self, rt) -> None:
+        self.rt = rt
+        self.clock = 0               # clock and random reads (clock_read)
+        self.window = WINDOW_CYCLES
+        self.start: int | None = None    # cycle at which the quiet window began
+        self.marks: _Marks | None = None
+        self.state = None
+        self.since: float | None = None  # s: the run has been idle since (None: it is not)
+        self.skipped = 0             # cycles skipped in the run
+        self.jumps = 0               # fast-forwards in the run
+        self.auto = None             # interp.runtime.autocell.AutoCell of --inputs auto
+        self.robot_io = 0            # I/O changes the robot program made (Scheduler._resume)
+        self.enabled = True          # False: never fast-forward (tests compare with and without)
+        self._robot: tuple | None = None   # (cycle, marks, frames) of the robot program's quiet window
+
+    def clock_read(self) -> None:
+        """A task read the clock or a random number: its next statements may differ without
+        any change of state, so the quiet window starts again."""
+        self.clock += 1
+
+    def _marks(self) -> _Marks:
+        ctl = self.rt.controller
+        return _Marks(len(ctl.io.log), self.clock, tuple(ctl.planned_axes().tolist()) + tuple(ctl._q.tolist()))
+
+    def _quiet(self) -> bool:
+        rt = self.rt
+        if rt.stmt_hook is not None or rt.step_hook is not None or rt.cycle_hook is not None:
+            return False
+        for t in rt.scheduler.tasks:
+            if t.done:
+                continue
+            if t.pending_triggers or t.pending_error is not None or t.next_triggers:
+                return False
+            if any(i.pending for i in t.irqs.irqs.values()):
+                return False
+        return True
+
+    def reset(self) -> None:
+        if self.auto is not None:
+            self.auto.recording = None
+        self.start = None
+        self.marks = None
+        self.state = None
+        self.since = None
+        self.window = WINDOW_CYCLES
+
+    def cycle(self) -> int:
+        """One IPO cycle ended (the tasks ran): check, and fast-forward when the run is idle;
+        with the automatic cell, also answer a robot program that starves while a submit
+        program keeps changing its own state (:meth:`robot_starves`). Returns the cycles
+        skipped."""
+        n = self._cycle()
+        if n == 0 and self.auto is not None and self.since is None:
+            self.robot_starves()
+        return n
+
+    def robot_starves(self) -> None:
+        """The robot program starves while the run is not idle (a submit program blinks a
+        lamp on a timer): for a whole window it stood in one WAIT FOR, or it executed
+        statements without moving the robot, without an I/O change of its own and without a
+        change of its own frames (its locals and :IN copies). Then the automatic cell answers
+        (it watches one more window first for a polling loop). A heuristic for answering only:
+        nothing is fast-forwarded on it."""
+        rt = self.rt
+        ctl = rt.controller
+        robot = rt.robot
+        if robot is None or robot.done or self.auto.pending() or not self._quiet():
+            self._robot = None
+            return
+        if robot.wake_cycle is not None:
+            self._robot = None          # WAIT SEC: time is what it waits for
+            return
+        marks = (self.robot_io, robot.waiting, tuple(ctl._q.tolist()), tuple(ctl.planned_axes().tolist()))
+        if self._robot is None or self._robot[1] != marks:
+            self._robot = (ctl.cycle, marks, None)
+            return
+        start, _, frames = self._robot
+        if ctl.cycle - start < WINDOW_CYCLES:
+            return
+        now = tuple(tuple([x if x.__class__ in _SCALARS else freeze(x) for x in f.store]) for f in _frames(robot))
+        if frames is None or frames != now:
+            self._robot = (ctl.cycle, marks, now)
+            return
+        got = self.auto.answer(self)
+        self._robot = (ctl.cycle, marks, now if got == "watching" else None)
+
+    def _cycle(self) -> int:
+        rt = self.rt
+        ctl = rt.controller
+        if not self._quiet():
+            self.reset()
+            return 0
+        marks = self._marks()
+        if self.start is None or marks != self.marks:
+            if self.auto is not None:
+                self.auto.recording = None
+            self.start, self.marks, self.state = ctl.cycle, marks, None
+            self.since = None
+            return 0
+        if ctl.cycle - self.start < self.window:
+            return 0
+        state = state_of(rt)
+        if self.state is None or state != self.state:
+            if self.state is not None:
+                self.window = min(2 * self.window, MAX_WINDOW_CYCLES)
+                if self.auto is not None:
+                    self.auto.recording = None
+            self.start, self.state = ctl.cycle, state
+            self.since = None
+            return 0
+        # idle: nothing changed for a whole window
+        if self.since is None:
+            self.since = self.start * ctl.dt
+        if self.auto is not None and not self.auto.pending():
+            got = self.auto.answer(self)
+            if got == "watching":
+                self.start = ctl.cycle      # the same state is compared again a window later
+                return 0
+        return self.jump()
+
+    def next_cycle(self) -> int | None:
+        """The first cycle in which something can change (module docstring), or None: the
+        controller's next event, the end of a task's WAIT SEC, the time limit."""
+        rt = self.rt
+        ctl = rt.controller
+        cands = []
+        nxt = ctl.next_event_cycle()
+        if nxt is not None:
+            cands.append(nxt)
+        for t in rt.scheduler.tasks:
+            if not t.done and t.wake_cycle is not None:
+                cands.append(t.wake_cycle)
+        lim = rt.scheduler.max_sim_time
+        if lim is not None:
+            cands.append(int(math.ceil(lim / ctl.dt - 1e-9)))
+        return min(cands) if cands else None
+
+    def jump(self) -> int:
+        """Skip to the cycle before the next event (its own cycle then runs as usual);
+        returns the cycles skipped."""
+        rt = self.rt
+        ctl = rt.controller
+        if not self.enabled:
+            return 0
+        nxt = self.next_cycle()
+        if nxt is None or not ctl.at_rest():
+            return 0
+        n = nxt - 1 - ctl.cycle
+        if n <= 0:
+            return 0
+        t0 = ctl.time
+        ctl.skip(n)
+        self.skipped += n
+        self.jumps += 1
+        if rt.trace is not None:
+            rt.trace.write("idle", t0, until=ctl.time, since=self.since, cycles=n)
+        self.start = ctl.cycle
+        return n

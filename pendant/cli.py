@@ -1,0 +1,106 @@
+"""`krl pendant`: serve the virtual smartPAD on loopback and open it in the browser
+(docs/pendant.md)."""
+
+from __future__ import annotations
+
+import contextlib
+import socket
+import sys
+from pathlib import Path
+
+import click
+
+
+@click.command("pendant")
+@click.argument("target", required=False, type=click.Path(path_type=Path))
+@click.option("--port", type=click.IntRange(0, 65535), default=0, show_default=True,
+              help="Port on 127.0.0.1 (0: a free port).")
+@click.option("--no-browser", is_flag=True, help="Print the URL only; do not open a browser.")
+@click.option("--inputs", type=click.Path(path_type=Path, exists=True, dir_okay=False), default=None,
+              help="Cell file (stimuli and rules, as for krl run --inputs): its rules stay active beside "
+                   "the inputs set by hand.")
+@click.option("--mode", type=click.Choice(["T1", "T2", "AUT", "EXT"], case_sensitive=False), default="T1",
+              show_default=True, help="Operating mode at the start.")
+@click.option("--trace", "trace_path", type=click.Path(path_type=Path, dir_okay=False), default=None,
+              help="Write the run's JSONL trace here (as krl run --trace; rewritten at each selection).")
+@click.option("--no-realtime", is_flag=True,
+              help="Run the simulation as fast as it goes instead of at real time.")
+def pendant(target: Path | None, port: int, no_browser: bool, inputs: Path | None, mode: str,
+            trace_path: Path | None, no_realtime: bool) -> None:
+    """Serve a virtual smartPAD for TARGET (a KRC backup folder or .zip, a folder of KRL, or a
+    program .src: selected at the start; default the current folder) on 127.0.0.1 and open it
+    in the browser. The first line printed is the page's URL with the session token."""
+    from krl.archive import ArchiveError, backup_source, is_archive  # noqa: PLC0415
+    from krl.project import backup_of  # noqa: PLC0415
+    from krl.terminal import printable  # noqa: PLC0415
+
+    target = target if target is not None else Path.cwd()
+    if not target.exists():
+        click.echo(f"error: {printable(target)}: no such file or folder", err=True)
+        sys.exit(2)
+    with contextlib.ExitStack() as stack:
+        program = None
+        readonly = False
+        shown = str(target)
+        if is_archive(target):
+            try:
+                folder, _ = stack.enter_context(backup_source(target))
+            except ArchiveError as exc:
+                click.echo(f"error: {printable(exc)}", err=True)
+                sys.exit(2)
+            root, readonly = Path(folder), True
+        elif target.is_file():
+            if target.suffix.lower() != ".src":
+                click.echo(f"error: {printable(target)}: a program is a .src file", err=True)
+                sys.exit(2)
+            root = backup_of(target.resolve()) or target.resolve().parent
+            program = str(target.resolve().relative_to(root.resolve()))
+            shown = str(root)
+        else:
+            root = backup_of(target.resolve()) or target.resolve()
+        sys.exit(serve(root, port=port, open_browser=not no_browser, inputs=str(inputs) if inputs else None,
+                       mode=mode.upper(), trace=str(trace_path) if trace_path else None, program=program,
+                       readonly=readonly, realtime=not no_realtime, shown=shown))
+
+
+def serve(root: Path, *, port: int = 0, open_browser: bool = True, inputs: str | None = None, mode: str = "T1",
+          trace: str | None = None, program: str | None = None, readonly: bool = False, realtime: bool = True,
+          shown: str | None = None) -> int:
+    """Bind 127.0.0.1:``port``, print the URL with the token, serve until interrupted; 0."""
+    import uvicorn  # noqa: PLC0415
+
+    from krl.limits import MAX_WEB_MESSAGE_BYTES  # noqa: PLC0415
+
+    from .security import new_token  # noqa: PLC0415
+    from .server import Pendant, create_app  # noqa: PLC0415
+
+    sock = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+    sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+    try:
+        sock.bind(("127.0.0.1", port))
+    except OSError as exc:
+        click.echo(f"error: cannot listen on 127.0.0.1:{port} ({exc.strerror})", err=True)
+        return 2
+    sock.listen(16)
+    bound = sock.getsockname()[1]
+    token = new_token()
+    url = f"http://127.0.0.1:{bound}/?token={token}"
+    click.echo(url)
+    sys.stdout.flush()
+    app = Pendant(root, inputs=inputs, mode=mode, realtime=realtime, trace=trace, program=program,
+                  readonly=readonly, shown_root=shown)
+    config = uvicorn.Config(create_app(app, token, lambda: bound), log_level="warning", ws="websockets-sansio",
+                            ws_max_size=MAX_WEB_MESSAGE_BYTES, lifespan="on", access_log=False)
+    if open_browser:
+        import threading  # noqa: PLC0415
+        import webbrowser  # noqa: PLC0415
+
+        threading.Timer(0.5, lambda: webbrowser.open(url)).start()
+    try:
+        uvicorn.Server(config).run(sockets=[sock])
+    except KeyboardInterrupt:
+        pass
+    return 0
+
+
+commands = [pendant]

@@ -1,0 +1,337 @@
+"""The pendant's handle on the run: the one run-control engine of ``krl debug``
+(interp/debug/engine.py), on a thread of its own, driven through its Python API.
+
+Nothing of run control is written here. Every key of the pendant is a call of the engine
+(``resume``, ``pause``, ``backward_motion``, ``set_breakpoints``, ``move`` for a jog,
+``edit``/``edit_now`` for the override, the operating and run modes, an input set by hand, a
+message acknowledged, a touch-up) posted to the engine thread, where the program and the
+simulated controller live; edits are recorded by the engine and made again in a replay.
+
+Display: through the engine's ``on_runtime`` each run gets a per-IPO-cycle hook that
+publishes :attr:`Pendant.live` (simulated time, $AXIS_ACT, blending, the pointers) and, when
+the run is paced (``realtime``), sleeps until the wall clock has caught up with the simulated
+clock; a replay is never paced. The message window waits for the operator
+(``rt.messages.interactive``), and the controller's own notes are kept apart from the KRL
+messages.
+"""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+from interp.debug.engine import Engine as RunEngine
+from interp.debug.engine import LaunchConfig, Refused, thread_main
+
+#: the operating modes and run modes the keys offer (robot/limits.py, interp/runtime/runmode.py)
+MODES_OP = ("T1", "T2", "AUT", "EXT")
+RUN_MODES = ("GO", "MSTEP", "ISTEP")
+#: jog: the coordinate systems and the largest increment of one press of a jog key (mm, deg)
+JOG_SYSTEMS = ("AXIS", "WORLD", "BASE", "TOOL")
+JOG_MAX_STEP = 100.0
+#: the TCP path drawn: a point each PATH_STEP_MM of TCP motion, at most MAX_PATH_POINTS
+PATH_STEP_MM = 2.0
+MAX_PATH_POINTS = 50_000
+NULLFRAME = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+
+
+class EngineError(Exception):
+    """An action the engine refused (its message is the pendant's text)."""
+
+
+class Engine:
+    """One selected program at a time, run by a debug engine on its own thread.
+
+    ``on_event(name, body)`` receives the engine's events (``stopped``, ``krl/pointers``,
+    ``output``, ``exited``, ``terminated``) on the engine thread; it must only hand them on."""
+
+    def __init__(self, on_event, *, realtime: bool = True) -> None:
+        self.on_event = on_event
+        self.realtime = realtime
+        self.core: RunEngine | None = None
+        self.thread = None
+        self.live: dict = {}
+        self.notes: list[dict] = []
+        self.signals: list[dict] | None = None
+        self.path: list[tuple] = []            # the TCP path of this run: (X, Y, Z mm in $WORLD, blending)
+        self.run_no = 0                        # counts the runs built (a replay starts a new path)
+        self._base_inv = self._base_T = None
+        self._pace0: tuple[float, float] | None = None
+
+    # ------------------------------------------------------------------ lifecycle
+    def select(self, program: str, *, workspace: str | None, inputs: str | None, mode: str,
+               run_mode: str, trace: str | None, breakpoints: dict[str, list[int]] | None = None) -> None:
+        """Select ``program`` (a .src path): launch it (krl run's setup: the backup's SPS.SUB at
+        boot, its robot, the cell file) and stop at its first statement, as the program pointer
+        stands on the first line after Select. Raises :class:`EngineError` (the checker's
+        errors, a bad cell file)."""
+        self.cancel()
+        core = RunEngine(on_event=self.on_event, on_runtime=self._on_runtime)
+        self.core, self.signals = core, None
+        self.thread = thread_main(core, "krl-pendant-engine")
+        options = {"workspace": workspace, "inputs": inputs, "mode": mode, "run_mode": run_mode,
+                   "trace_path": trace, "max_sim_time": 7 * 24 * 3600.0}
+        try:
+            self.call(core.launch, LaunchConfig.of(program, stop_on_entry=True, **options), timeout=900.0)
+            for path, lines in (breakpoints or {}).items():
+                self.call(core.set_breakpoints, path, [{"line": n} for n in lines])
+            self.call(core.configuration_done)
+        except EngineError:
+            self.cancel()                            # nothing stays selected
+            raise
+        deadline = time.monotonic() + 900.0          # the run starts: wait for its entry stop
+        while core.state not in ("stopped", "ended") and not core.done and time.monotonic() < deadline:
+            time.sleep(0.01)
+
+    def cancel(self, timeout: float = 30.0) -> None:
+        """Cancel the selected program: the run ends at once."""
+        core, thread = self.core, self.thread
+        if core is None:
+            return
+        core.close()
+        if thread is not None:
+            thread.join(timeout)
+        self.core = self.thread = None
+        self.live = {}
+
+    @property
+    def selected(self) -> bool:
+        return self.core is not None and not self.core.done
+
+    @property
+    def state(self) -> str:
+        return self.core.state if self.core is not None else "none"
+
+    def call(self, fn, *args, timeout: float = 120.0):
+        """Run ``fn(*args)`` on the engine thread; its result. Raises :class:`EngineError`."""
+        core = self.core
+        if core is None or core.done:
+            raise EngineError("no program is selected")
+        try:
+            return core.call(fn, *args, timeout=timeout)
+        except Refused as exc:
+            raise EngineError(str(exc)) from None
+        except TimeoutError:
+            raise EngineError("the controller did not answer in time") from None
+
+    def do(self, fn, timeout: float = 120.0):
+        """Run ``fn(core)`` on the engine thread (the pendant's own work: keys, the snapshot)."""
+        return self.call(lambda: fn(self.core), timeout=timeout)
+
+    # ------------------------------------------------------------------ each run
+    def _on_runtime(self, rt) -> None:
+        """A run is built (the first, or a replay): the message window waits for the operator,
+        the simulator's notes are kept, the display and the pacing hook once per IPO cycle."""
+        rt.messages.interactive = True
+        ctl = rt.controller
+        ctl.add_cyclic(self._cycle)
+        self._pace0 = None
+        self.notes = []
+        self.path = []
+        self.run_no += 1
+        inner = ctl.message
+
+        def message(text, motion_id=None, number=None):
+            from krl.limits import MAX_KRL_MESSAGES  # noqa: PLC0415
+
+            if not (text.startswith("KRL message: ") or text.startswith("KRL dialog")):
+                self.notes.append({"time": round(ctl.time, 3), "text": str(text)[:300]})
+                del self.notes[:-MAX_KRL_MESSAGES]
+            inner(text, motion_id, number)
+        ctl.message = message
+
+    def _cycle(self, ctl) -> None:
+        """Once per IPO cycle (engine thread): publish the live pose, pace to the wall clock."""
+        core = self.core
+        if core is None or core.rt is None or ctl is not core.rt.controller:
+            return
+        robot = core.rt.robot
+        req = ctl.current_request()
+        blending = getattr(ctl, "_blend", None) is not None
+        self._record_path(ctl, blending)
+        self.live = {
+            "time": round(ctl.time, 6), "axes": [float(v) for v in ctl.axis_act()],
+            "blending": blending, "run": self.run_no,
+            "pointers": {"advanceRun": {"path": robot.file, "line": robot.line}
+                         if robot is not None and robot.at is not None else None,
+                         "mainRun": {"path": req.file, "line": req.line} if req is not None and req.line else None}}
+        if core.target is not None or core.scan is not None or not self.realtime:
+            self._pace0 = None
+            return
+        now = time.perf_counter()
+        if self._pace0 is None or core.state == "stopped" and not core.busy:
+            self._pace0 = (now, ctl.time)
+            return
+        ahead = (ctl.time - self._pace0[1]) - (now - self._pace0[0])
+        if ahead > 0:
+            time.sleep(ahead)
+        elif ahead < -0.25:
+            self._pace0 = (now, ctl.time)    # fell behind (a stop, a slow cycle): pace from here
+
+
+    def _record_path(self, ctl, blending: bool) -> None:
+        """The TCP in $WORLD once it has moved PATH_STEP_MM, or when an approximation starts
+        or ends (at most MAX_PATH_POINTS points: the oldest are dropped). It is the pose the
+        controller computed in this cycle (its TCP in $BASE and that $BASE, the numbers the
+        trace's pose events hold), so the path costs the simulation a matrix product a cycle."""
+        import numpy as np  # noqa: PLC0415
+
+        tcp, base_inv = getattr(ctl, "_tcp_T", None), getattr(ctl, "_base_inv_T", None)
+        if tcp is None or base_inv is None:
+            return
+        if base_inv is not self._base_inv:
+            self._base_inv, self._base_T = base_inv, np.linalg.inv(base_inv)
+        w = self._base_T[:3, :3] @ tcp[:3, 3] + self._base_T[:3, 3]
+        x, y, z = round(float(w[0]), 1), round(float(w[1]), 1), round(float(w[2]), 1)
+        if self.path:
+            lx, ly, lz, lb = self.path[-1]
+            if lb == blending and (x - lx) ** 2 + (y - ly) ** 2 + (z - lz) ** 2 < PATH_STEP_MM ** 2:
+                return
+        self.path.append((x, y, z, blending))
+        if len(self.path) > MAX_PATH_POINTS:
+            del self.path[:len(self.path) - MAX_PATH_POINTS]
+
+
+# ---------------------------------------------------------------------- the keys (engine thread)
+
+def override(core: RunEngine, value) -> int:
+    """$OV_PRO (0..100 %): applies to the motions planned from then on."""
+    if not isinstance(value, int) or isinstance(value, bool) or not 0 <= value <= 100:
+        raise Refused("override: an integer 0..100")
+
+    def apply(engine):
+        engine.rt.sysvars.store["$OV_PRO"] = value
+        return value
+    return core.edit_now(f"$OV_PRO = {value}", apply)
+
+
+def run_mode(core: RunEngine, value: str) -> str:
+    """$PRO_MODE (GO, MSTEP, ISTEP): applies from the next statement."""
+    if value not in RUN_MODES:
+        raise Refused(f"run mode {value!r}: one of {', '.join(RUN_MODES)}")
+
+    def apply(engine):
+        engine.rt.set_run_mode(value)
+        return value
+    return core.edit_now(f"$PRO_MODE = #{value}", apply)
+
+
+def mode_op(core: RunEngine, value: str) -> str:
+    """The operating mode, changed while the program stands (on the robot, turning the mode
+    selector stops the program and switches the drives off)."""
+    from robot.limits import normalise_mode  # noqa: PLC0415
+
+    if value not in MODES_OP:
+        raise Refused(f"operating mode {value!r}: one of {', '.join(MODES_OP)}")
+    if core.state == "running":
+        raise Refused("operating mode: stop the program first")
+    m = normalise_mode(value)
+
+    def apply(engine):
+        rt = engine.rt
+        rt.mode_op = rt.controller.mode_op = rt.controller.model.mode = m
+        return value
+    return core.edit(f"$MODE_OP = #{value}", apply)
+
+
+def set_input(core: RunEngine, index, value: bool) -> bool:
+    """``$IN[index]`` set by hand (source ``operator``), running or stopped; the cell's rules
+    stay active."""
+    from robot.io import N_DIGITAL  # noqa: PLC0415
+
+    if not isinstance(index, int) or isinstance(index, bool) or not 1 <= index <= N_DIGITAL:
+        raise Refused(f"input: an index 1..{N_DIGITAL}")
+
+    def apply(engine):
+        ctl = engine.rt.controller
+        ctl.io.now = ctl.time
+        ctl.io.set_in(index, bool(value), "operator")
+        return ctl.get_in(index)
+    return core.edit_now(f"$IN[{index}] = {'TRUE' if value else 'FALSE'}", apply)
+
+
+def message(core: RunEngine, handle, answer=None) -> None:
+    """Acknowledge a message, or press softkey ``answer`` of a dialog (interp/runtime/messages.py)."""
+    def apply(engine):
+        win = engine.rt.messages
+        try:
+            if answer is not None:
+                win.answer(handle, answer)
+            else:
+                win.acknowledge(handle)
+        except ValueError as exc:
+            raise Refused(str(exc)) from None
+    what = f"answer {answer} to message {handle}" if answer is not None else f"acknowledge message {handle}"
+    core.edit_now(what, apply)
+
+
+def jog(core: RunEngine, system: str, axis, step) -> list:
+    """One jog increment in T1 with the program stopped: AXIS (``axis`` 1..6, ``step`` deg) or
+    WORLD/BASE/TOOL (``axis`` X, Y, Z, A, B, C, ``step`` mm or deg), as a PTP (axis) or a
+    relative LIN under T1's speed limits (robot/limits.py), made by the engine's ``move``."""
+    from interp.runtime.motion import params_from  # noqa: PLC0415
+    from robot.motion import NULLFRAME, MotionRequest  # noqa: PLC0415
+
+    core.need_stopped()
+    rt = core.rt
+    if rt.mode_op != "T1":
+        raise Refused(f"jog: only in T1 (operating mode {rt.mode_op})")
+    if system not in JOG_SYSTEMS:
+        raise Refused(f"jog: coordinate system one of {', '.join(JOG_SYSTEMS)}")
+    if not isinstance(step, (int, float)) or isinstance(step, bool) or not 0 < abs(step) <= JOG_MAX_STEP:
+        raise Refused(f"jog: a step of at most {JOG_MAX_STEP:g} mm or deg")
+    params = params_from(rt.sysvars.store).with_(ov_pro=100.0)
+    if system == "AXIS":
+        if axis not in (1, 2, 3, 4, 5, 6):
+            raise Refused("jog: axis 1..6")
+        target = {f"A{i + 1}": float(v) for i, v in enumerate(rt.controller.axis_setpoint())}
+        target[f"A{axis}"] += float(step)
+        req = MotionRequest("PTP", target, params)
+    else:
+        comp = str(axis).upper()
+        if comp not in ("X", "Y", "Z", "A", "B", "C"):
+            raise Refused("jog: component X, Y, Z, A, B or C")
+        if system == "WORLD":
+            params = params.with_(base=NULLFRAME)
+        req = MotionRequest("LIN", {comp: float(step)}, params, relative=True,
+                            rel_frame="TOOL" if system == "TOOL" else "BASE")
+    return core.move(req)
+
+
+def touch_up(core: RunEngine, path: str, name: str) -> dict:
+    """Touch up the point ``name`` of the data list ``path`` (inside the workspace: the server
+    checked it) with the actual position, in T1/T2 with the program stopped; the running
+    program's copy of the point gets the same values (an edit of the engine)."""
+    from .touchup import TouchUpError, touch_up as write_point  # noqa: PLC0415
+
+    core.need_stopped()
+    rt = core.rt
+    if rt.mode_op not in ("T1", "T2"):
+        raise Refused("touch-up: only in T1 or T2")
+    if not name or len(name) > 24 or not name.replace("_", "").replace("$", "").isalnum():
+        raise Refused("touch-up: a point name")
+    try:
+        new = write_point(Path(path), name, rt.controller.pos_act(), [float(v) for v in rt.controller.axis_act()])
+    except TouchUpError as exc:
+        raise Refused(str(exc)) from None
+    except OSError as exc:
+        raise Refused(f"touch-up: cannot write the data list ({exc.strerror})") from None
+    for k, v in new.items():
+        try:
+            core.assign(f"{name}.{k}", repr(v))
+        except Refused:
+            break                          # not visible from here: the file holds the new point
+    return {"name": name, "values": new}
+
+
+def set_watch(core: RunEngine, expr: str, value: str) -> str:
+    """``expr = value`` (KRL texts) at the stop: the engine's assign."""
+    from krl.limits import MAX_WEB_EXPRESSION_CHARS  # noqa: PLC0415
+
+    if len(expr) > MAX_WEB_EXPRESSION_CHARS or len(value) > MAX_WEB_EXPRESSION_CHARS:
+        raise Refused(f"at most {MAX_WEB_EXPRESSION_CHARS} characters")
+    return core.assign(expr, value)
+
+
+__all__ = ["Engine", "EngineError", "JOG_SYSTEMS", "MODES_OP", "RUN_MODES", "jog", "message", "mode_op",
+           "override", "run_mode", "set_input", "set_watch", "touch_up"]

@@ -1,0 +1,432 @@
+"""The pendant's web application: Starlette on uvicorn (its websockets come from the
+``websockets`` package), bound to loopback, behind :class:`pendant.security.Guard`.
+
+Routes: ``/`` the page, ``/static/...`` its bundle (built from pendant/web, committed), ``/ws``
+the one websocket. On the websocket the page sends operator actions as JSON objects
+``{"op": ..., ...}`` (:data:`OPS`) and receives ``{"type": ...}`` objects: ``init`` (workspace,
+programs, robot), ``module`` (a file's text and taught points), ``state`` (pendant/state.py),
+``live`` (time, axes and pointers at display rate while the program runs), ``error`` (a key's
+refusal, in the controller's words) and ``event`` (the engine's stops and ends).
+
+Threads: uvicorn's event loop serves the page; the program runs on the engine's thread
+(pendant/engine.py); a blocking engine request runs in the loop's executor. Limits
+(krl/limits.py): MAX_WEB_MESSAGE_BYTES per websocket message (uvicorn's ``ws_max_size``: a
+larger one closes the connection, 1009), MAX_WEB_CONNECTIONS websockets at once,
+MAX_WEB_MESSAGES_PER_S per connection, counted as they arrive (past it, or with a second's
+worth of actions not yet carried out: closed, 1008).
+"""
+
+from __future__ import annotations
+
+import asyncio
+import contextlib
+import json
+import time
+from pathlib import Path
+
+from starlette.applications import Starlette
+from starlette.responses import FileResponse, PlainTextResponse, Response
+from starlette.routing import Mount, Route, WebSocketRoute
+from starlette.staticfiles import StaticFiles
+from starlette.websockets import WebSocket, WebSocketDisconnect
+
+from krl.limits import (MAX_WEB_BODY_BYTES, MAX_WEB_CONNECTIONS, MAX_WEB_EXPRESSION_CHARS, MAX_WEB_MESSAGE_BYTES,
+                        MAX_WEB_MESSAGES_PER_S, MAX_WEB_WATCHES)
+
+from . import engine as keys
+from .engine import MODES_OP, RUN_MODES, Engine, EngineError
+from .security import COOKIE, Guard, PathRefused, inside
+
+STATIC = Path(__file__).resolve().parent / "static"
+#: display rate of the live pose (Hz) and of the full state while running
+LIVE_HZ = 30.0
+STATE_HZ = 2.0
+#: module views kept (text and taught points of a file, until it changes)
+MODULE_CACHE = 64
+CSP = ("default-src 'none'; script-src 'self'; style-src 'self'; img-src 'self' data: blob:; "
+       "connect-src 'self'; font-src 'self'; frame-ancestors 'self' vscode-webview:; base-uri 'none'; "
+       "form-action 'none'")
+OPS = ("hello", "select", "cancel", "reset", "start", "stop", "backward", "runMode", "modeOp", "drives",
+       "override", "breakpoint", "input", "ack", "answer", "watch", "setWatch", "jog", "touchup", "open")
+
+
+class Pendant:
+    """One workspace served to the pages connected to it (they share one selected program)."""
+
+    def __init__(self, root: Path, *, inputs: str | None = None, mode: str = "T1", realtime: bool = True,
+                 trace: str | None = None, program: str | None = None, readonly: bool = False,
+                 shown_root: str | None = None) -> None:
+        self.root = root.resolve()
+        self.shown_root = shown_root or str(root)
+        self.inputs = inputs
+        self.mode = mode
+        self.run_mode = "GO"
+        self.trace = trace
+        self.readonly = readonly
+        self.initial = program
+        self.engine = Engine(self._engine_event, realtime=realtime)
+        self.clients: set[WebSocket] = set()
+        self.loop: asyncio.AbstractEventLoop | None = None
+        self.program: str | None = None
+        self.drives = False
+        self.watch: list[str] = []
+        self.breakpoints: dict[str, set[int]] = {}
+        self.busy = asyncio.Lock()
+        self._robot = None
+        self._programs = None
+        self._last_live = None
+        self._path_run, self._path_sent = None, 0
+        self._modules: dict[str, tuple] = {}
+
+    # ------------------------------------------------------------------ static data
+    def robot(self) -> dict:
+        if self._robot is None:
+            from interp.run import robot_for  # noqa: PLC0415
+
+            from .view import robot_view  # noqa: PLC0415
+
+            probe = self.initial or next(iter(self.programs()), None)
+            prog = str(self.root / probe) if probe else str(self.root / "none.src")
+            self._robot = robot_view(robot_for(prog, str(self.root), None, self.inputs))
+        return self._robot
+
+    def programs(self) -> list[str]:
+        if self._programs is None:
+            from .view import programs  # noqa: PLC0415
+
+            self._programs = programs(self.root)
+        return self._programs
+
+    # ------------------------------------------------------------------ engine events
+    def _engine_event(self, name: str, body: dict) -> None:
+        """Engine thread: hand the event to the loop."""
+        if self.loop is not None and name in ("stopped", "terminated", "exited", "output"):
+            self.loop.call_soon_threadsafe(lambda: asyncio.ensure_future(self._on_event(name, body)))
+
+    async def _on_event(self, name: str, body: dict) -> None:
+        await self.broadcast({"type": "event", "event": name, "body": body or {}})
+        await self.push_state()
+
+    async def broadcast(self, msg: dict) -> None:
+        text = json.dumps(msg, allow_nan=False, default=str)
+        for ws in list(self.clients):
+            try:
+                await ws.send_text(text)
+            except Exception:  # noqa: BLE001 - a client gone meanwhile
+                self.clients.discard(ws)
+
+    async def state(self) -> dict:
+        if not self.engine.selected:
+            return {"state": "none", "program": None, "drives": self.drives, "modeOp": self.mode,
+                    "runMode": self.run_mode}
+        loop = asyncio.get_running_loop()
+        try:
+            from .state import snapshot  # noqa: PLC0415
+
+            eng, watch = self.engine, list(self.watch)
+            s = await loop.run_in_executor(None, lambda: eng.do(lambda core: snapshot(eng, core, watch), 60.0))
+        except EngineError as exc:
+            s = {"state": "ended" if not self.engine.selected else "busy", "note": str(exc)}
+        s.update({"program": self.program, "drives": self.drives, "breakpoints":
+                  {p: sorted(v) for p, v in self.breakpoints.items()}})
+        return s
+
+    async def push_state(self) -> None:
+        if self.clients:
+            await self.broadcast({"type": "state", **await self.state()})
+
+    async def ticker(self) -> None:
+        """Display rate: the live pose while the program runs, the state now and then."""
+        period = 1.0 / LIVE_HZ
+        every = max(1, int(LIVE_HZ / STATE_HZ))
+        k = 0
+        while True:
+            await asyncio.sleep(period)
+            if not self.clients:
+                continue
+            live = self.engine.live
+            if live and (live is not self._last_live or len(self.engine.path) > self._path_sent):
+                self._last_live = live
+                path, run = self.engine.path, live.get("run")
+                if run != self._path_run:
+                    self._path_run, self._path_sent = run, 0
+                new = path[self._path_sent:self._path_sent + 5000]
+                self._path_sent += len(new)
+                await self.broadcast({"type": "live", **live, "path": new})
+                k += 1
+                if k % every == 0 and self.engine.state == "running":
+                    await self.push_state()
+
+    # ------------------------------------------------------------------ operator actions
+    async def handle(self, ws: WebSocket, msg: dict) -> None:
+        op = msg.get("op")
+        if op not in OPS:
+            raise EngineError(f"unknown action {str(op)[:40]!r}")
+        loop = asyncio.get_running_loop()
+
+        def do(fn, timeout=120.0):
+            return loop.run_in_executor(None, lambda: self.engine.do(fn, timeout))
+
+        if op == "hello":
+            from .view import modules  # noqa: PLC0415
+
+            entries = self.programs()
+            others = [m for m in await loop.run_in_executor(None, modules, self.root) if m not in set(entries)]
+            await ws.send_text(json.dumps({"type": "init", "workspace": self.shown_root, "programs": entries,
+                                           "modules": others,
+                                           "robot": self.robot(), "modes": MODES_OP, "runModes": RUN_MODES,
+                                           "readonly": self.readonly}))
+            if self.program is not None:
+                await self.send_module(ws, self.program)
+        elif op == "select":
+            await self.select(str(msg.get("program", "")))
+        elif op == "cancel":
+            await loop.run_in_executor(None, self.engine.cancel)
+            self.program = None
+        elif op == "reset":
+            if self.program is None:
+                raise EngineError("no program is selected")
+            await self.select(self.program)
+        elif op == "start":
+            self._need_drives()
+            await do(lambda core: core.resume())
+        elif op == "stop":
+            await do(lambda core: core.pause())
+        elif op == "backward":
+            self._need_drives()
+            await do(lambda core: core.backward_motion(), 900.0)
+        elif op == "runMode":
+            value = str(msg.get("value", "")).upper()
+            if value not in RUN_MODES:
+                raise EngineError(f"run mode: one of {', '.join(RUN_MODES)}")
+            self.run_mode = value
+            if self.engine.selected:
+                await do(lambda core: keys.run_mode(core, value))
+        elif op == "modeOp":
+            value = str(msg.get("value", "")).upper()
+            if value not in MODES_OP:
+                raise EngineError(f"operating mode: one of {', '.join(MODES_OP)}")
+            if self.engine.selected:
+                await do(lambda core: keys.mode_op(core, value))
+            self.mode = value
+            self.drives = False          # turning the mode switch switches the drives off
+        elif op == "drives":
+            self.drives = bool(msg.get("on"))
+        elif op == "override":
+            await do(lambda core: keys.override(core, msg.get("value")))
+        elif op == "breakpoint":
+            path = str(inside(self.root, str(msg.get("path", "")), suffixes=(".src", ".sub")))
+            line = msg.get("line")
+            if not isinstance(line, int) or isinstance(line, bool) or line < 1:
+                raise EngineError("breakpoint: a line number")
+            lines = self.breakpoints.setdefault(path, set())
+            (lines.add if msg.get("on") else lines.discard)(line)
+            if self.engine.selected:
+                specs = [{"line": n} for n in sorted(lines)]
+                await do(lambda core: core.set_breakpoints(path, specs))
+        elif op == "input":
+            await do(lambda core: keys.set_input(core, msg.get("index"), bool(msg.get("value"))))
+        elif op == "ack":
+            await do(lambda core: keys.message(core, msg.get("handle")))
+        elif op == "answer":
+            await do(lambda core: keys.message(core, msg.get("handle"), msg.get("key")))
+        elif op == "watch":
+            exprs = msg.get("exprs")
+            if not isinstance(exprs, list) or len(exprs) > MAX_WEB_WATCHES or \
+                    any(not isinstance(e, str) or len(e) > MAX_WEB_EXPRESSION_CHARS for e in exprs):
+                raise EngineError(f"watch list: at most {MAX_WEB_WATCHES} expressions of "
+                                  f"{MAX_WEB_EXPRESSION_CHARS} characters")
+            self.watch = list(exprs)
+        elif op == "setWatch":
+            await do(lambda core: keys.set_watch(core, str(msg.get("expr", "")), str(msg.get("value", ""))))
+        elif op == "jog":
+            self._need_drives()
+            await do(lambda core: keys.jog(core, str(msg.get("system", "")).upper(), msg.get("axis"), msg.get("step")),
+                     900.0)
+        elif op == "touchup":
+            if self.readonly:
+                raise EngineError("touch-up: the workspace is a backup archive (read-only)")
+            dat = inside(self.root, str(msg.get("path", "")), suffixes=(".dat",))
+            await do(lambda core: keys.touch_up(core, str(dat), str(msg.get("name", ""))))
+            if self.program is not None:
+                await self.broadcast_module(self.program)
+        elif op == "open":
+            path = inside(self.root, str(msg.get("path", "")), suffixes=(".src", ".sub", ".dat"))
+            await self.send_module(ws, str(path))
+            return
+        await self.push_state()
+
+    def _need_drives(self) -> None:
+        if not self.drives:
+            raise EngineError("the drives are off: switch them on first")
+
+    async def select(self, program: str) -> None:
+        path = inside(self.root, program, suffixes=(".src",))
+        loop = asyncio.get_running_loop()
+        await self.broadcast({"type": "event", "event": "selecting", "body": {"program": str(path)}})
+        bps = {p: sorted(v) for p, v in self.breakpoints.items()}
+        await loop.run_in_executor(None, lambda: self.engine.select(
+            str(path), workspace=str(self.root), inputs=self.inputs, mode=self.mode, run_mode=self.run_mode,
+            trace=self.trace, breakpoints=bps))
+        self.program = str(path)
+        await self.broadcast_module(str(path))
+
+    async def send_module(self, ws: WebSocket, path: str) -> None:
+        await ws.send_text(await self.module_text(path))
+
+    async def module_text(self, path: str) -> str:
+        """The ``module`` message of ``path``, kept while the file and its data list are
+        unchanged (the page follows the advance run through modules again and again)."""
+        from .view import module_view  # noqa: PLC0415
+
+        p = Path(path)
+        key = []
+        for f in (p, *[q for q in p.parent.iterdir() if q.stem.lower() == p.stem.lower() and q != p]):
+            try:
+                st = f.stat()
+                key.append((str(f), st.st_mtime_ns, st.st_size))
+            except OSError:
+                pass
+        hit = self._modules.get(path)
+        if hit is not None and hit[0] == key:
+            return hit[1]
+        view = await asyncio.get_running_loop().run_in_executor(None, module_view, p, self.root)
+        text = json.dumps({"type": "module", **view})
+        self._modules[path] = (key, text)
+        while len(self._modules) > MODULE_CACHE:
+            del self._modules[next(iter(self._modules))]
+        return text
+
+    async def broadcast_module(self, path: str) -> None:
+        for ws in list(self.clients):
+            try:
+                await self.send_module(ws, path)
+            except Exception:  # noqa: BLE001
+                self.clients.discard(ws)
+
+    # ------------------------------------------------------------------ websocket
+    async def websocket(self, ws: WebSocket) -> None:
+        """One page's connection. Its messages are read as they arrive and counted there (the
+        rate limit holds however slowly the actions are carried out) and queued for
+        :meth:`_actions`; a backlog of more than a second's worth of actions is a flood too."""
+        if len(self.clients) >= MAX_WEB_CONNECTIONS:
+            await ws.close(code=1013, reason="too many connections")
+            return
+        await ws.accept()
+        self.clients.add(ws)
+        queue: asyncio.Queue = asyncio.Queue(maxsize=MAX_WEB_MESSAGES_PER_S)
+        worker = asyncio.ensure_future(self._actions(ws, queue))
+        window, count = time.monotonic(), 0
+        try:
+            while not worker.done():
+                text = await ws.receive_text()
+                now = time.monotonic()
+                if now - window >= 1.0:
+                    window, count = now, 0
+                count += 1
+                if count > MAX_WEB_MESSAGES_PER_S or queue.full():
+                    await ws.close(code=1008, reason="too many messages")
+                    return
+                if len(text) > MAX_WEB_MESSAGE_BYTES:
+                    await ws.close(code=1009, reason="message too large")
+                    return
+                queue.put_nowait(text)
+        except WebSocketDisconnect:
+            pass
+        finally:
+            worker.cancel()
+            with contextlib.suppress(asyncio.CancelledError, WebSocketDisconnect):
+                await worker
+            self.clients.discard(ws)
+
+    async def _actions(self, ws: WebSocket, queue: asyncio.Queue) -> None:
+        """Carry out the queued messages of one connection in order, each answered with
+        ``done`` or ``error`` (its id and op). A failure that is not a refusal closes the
+        connection (1011) and is logged by uvicorn."""
+        try:
+            await self._carry_out(ws, queue)
+        except (asyncio.CancelledError, WebSocketDisconnect):
+            raise
+        except Exception:
+            with contextlib.suppress(Exception):
+                await ws.close(code=1011, reason="server error")
+            raise
+
+    async def _carry_out(self, ws: WebSocket, queue: asyncio.Queue) -> None:
+        while True:
+            text = await queue.get()
+            try:
+                msg = json.loads(text)
+                if not isinstance(msg, dict):
+                    raise ValueError("not an object")
+            except ValueError:
+                await ws.send_text(json.dumps({"type": "error", "text": "not a JSON object"}))
+                continue
+            rid = msg.get("id")
+            try:
+                async with self.busy:
+                    await self.handle(ws, msg)
+                await ws.send_text(json.dumps({"type": "done", "id": rid, "op": str(msg.get("op"))[:40]}))
+            except (EngineError, PathRefused) as exc:
+                await ws.send_text(json.dumps({"type": "error", "id": rid, "op": str(msg.get("op"))[:40],
+                                               "text": str(exc)[:500]}))
+
+
+def create_app(pendant: Pendant, token: str, port_of) -> Guard:
+    """The ASGI application: the page, its bundle and the websocket behind the guard."""
+
+    async def index(request) -> Response:
+        resp = FileResponse(STATIC / "index.html", media_type="text/html")
+        resp.set_cookie(COOKIE, token, httponly=True, samesite="strict", path="/")
+        return resp
+
+    async def ws_endpoint(ws: WebSocket) -> None:
+        await pendant.websocket(ws)
+
+    @contextlib.asynccontextmanager
+    async def lifespan(app):
+        pendant.loop = asyncio.get_running_loop()
+        ticker = asyncio.ensure_future(pendant.ticker())
+        if pendant.initial:
+            try:
+                await pendant.select(pendant.initial)
+            except (EngineError, PathRefused) as exc:
+                print(f"krl pendant: {exc}", flush=True)
+        try:
+            yield
+        finally:
+            ticker.cancel()
+            await asyncio.get_running_loop().run_in_executor(None, pendant.engine.cancel)
+
+    async def not_found(request, exc) -> Response:
+        return PlainTextResponse("not found\n", status_code=404)
+
+    app = Starlette(routes=[Route("/", index), WebSocketRoute("/ws", ws_endpoint),
+                            Mount("/static", StaticFiles(directory=STATIC), name="static")],
+                    lifespan=lifespan, exception_handlers={404: not_found}, max_body_size=MAX_WEB_BODY_BYTES)
+    return Guard(_Headers(app), token, port_of)
+
+
+class _Headers:
+    """Adds the page's security headers (CSP, no sniffing, no referrer, no caching of the token
+    page) to every HTTP response."""
+
+    def __init__(self, app) -> None:
+        self.app = app
+
+    async def __call__(self, scope, receive, send) -> None:
+        if scope["type"] != "http":
+            await self.app(scope, receive, send)
+            return
+
+        async def send_with(msg):
+            if msg["type"] == "http.response.start":
+                headers = list(msg.get("headers") or [])
+                headers += [(b"content-security-policy", CSP.encode()), (b"x-content-type-options", b"nosniff"),
+                            (b"referrer-policy", b"no-referrer"), (b"cache-control", b"no-store")]
+                msg = {**msg, "headers": headers}
+            await send(msg)
+        await self.app(scope, receive, send_with)
+
+
+__all__ = ["Pendant", "create_app", "CSP", "OPS"]

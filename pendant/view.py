@@ -1,0 +1,133 @@
+"""The program view's data: the programs a workspace offers, a module's text, its taught points
+(in $WORLD, mm/deg, for the 3D view) and the robot the page draws.
+
+Files are read through krl/source.py (decoded in their own encoding, size-limited) and the data
+lists through the front end (robot/datalist.py); nothing here runs KRL.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from krl.limits import MAX_WEB_FILE_BYTES
+
+POINT_KEYS = ("X", "Y", "Z")
+
+
+def programs(root: Path) -> list[str]:
+    """The runnable programs of the workspace (interp/realprograms.py ``programs_of``: a
+    backup's entry points; else every .src with a main routine), relative to ``root``."""
+    from interp.realprograms import programs_of  # noqa: PLC0415
+
+    out = []
+    for p in programs_of(root.resolve()):
+        try:
+            out.append(str(p.resolve().relative_to(root.resolve())))
+        except ValueError:
+            continue
+    return out
+
+
+def modules(root: Path) -> list[str]:
+    """Every program file (.src) of the workspace, relative to ``root`` (the navigator's view:
+    any of them can be selected)."""
+    from krl.files import walk  # noqa: PLC0415
+
+    out = [e.rel for e in walk(root.resolve()) if e.kind == "file" and e.rel.lower().endswith(".src")]
+    return sorted(out, key=str.lower)[:5000]
+
+
+def module_view(path: Path, root: Path) -> dict:
+    """``{path, lines, points}``: the text of ``path`` (lines as str) and the taught points of
+    its data list (the .dat beside it, any case)."""
+    from krl.source import read_source  # noqa: PLC0415
+
+    src = read_source(path, max_bytes=MAX_WEB_FILE_BYTES)
+    text = getattr(src, "text", None) or ""
+    dat = _data_list_of(path)
+    return {"path": str(path), "label": str(path.relative_to(root.resolve())),
+            "lines": text.splitlines(), "points": taught_points(dat, root) if dat is not None else [],
+            "dat": str(dat) if dat is not None else None}
+
+
+def _data_list_of(path: Path) -> Path | None:
+    if path.suffix.lower() == ".dat":
+        return path
+    for p in path.parent.iterdir():
+        if p.is_file() and p.stem.lower() == path.stem.lower() and p.suffix.lower() == ".dat":
+            return p
+    return None
+
+
+def taught_points(dat: Path, root: Path) -> list[dict]:
+    """The Cartesian points of the data list ``dat``: name, X..C (in their base) and the
+    position in $WORLD (``world``: mm), using the base their FDAT names (``BASE_DATA[n]`` of the
+    backup's $config.dat; $WORLD when none). Axis points are listed with ``axes``."""
+    from robot.datalist import DataListError, read_data_list  # noqa: PLC0415
+    from robot.frames import frame_to_matrix  # noqa: PLC0415
+
+    try:
+        values = read_data_list(dat)
+    except DataListError:
+        return []
+    bases = _base_data(root)
+    out = []
+    for name, dv in values.items():
+        v = dv.value
+        if not isinstance(v, dict):
+            continue
+        if all(k in v and isinstance(v[k], (int, float)) for k in POINT_KEYS):
+            frame = [float(v.get(k, 0.0) or 0.0) for k in ("X", "Y", "Z", "A", "B", "C")]
+            fdat = values.get("F" + name[1:] if name.startswith("X") else "F" + name)
+            base_no = 0
+            if fdat is not None and isinstance(fdat.value, dict):
+                b = fdat.value.get("BASE_NO")
+                base_no = b if isinstance(b, int) and not isinstance(b, bool) else 0
+            base = bases.get(base_no, (0.0,) * 6)
+            T = frame_to_matrix(*base) @ frame_to_matrix(*frame)
+            out.append({"name": dv.name, "line": dv.line, "frame": frame, "base": base_no,
+                        "world": [round(float(x), 3) for x in np.asarray(T)[:3, 3]]})
+        elif all(f"A{i}" in v for i in range(1, 7)):
+            out.append({"name": dv.name, "line": dv.line,
+                        "axes": [float(v[f"A{i}"]) for i in range(1, 7)]})
+        if len(out) >= 5000:
+            break
+    return out
+
+
+def _base_data(root: Path) -> dict[int, tuple]:
+    """``BASE_DATA[n]`` of the workspace's $config.dat (n -> X..C), {} when there is none."""
+    from krl.project import backup_of, system_folder  # noqa: PLC0415
+    from robot.datalist import DataListError, read_data_list  # noqa: PLC0415
+
+    base = backup_of(root.resolve()) or root.resolve()
+    folder = system_folder(base)
+    if folder is None:
+        return {}
+    cfg = next((p for p in folder.iterdir() if p.name.lower() == "$config.dat"), None)
+    if cfg is None:
+        return {}
+    try:
+        dv = read_data_list(cfg).get("BASE_DATA")
+    except DataListError:
+        return {}
+    out = {}
+    if dv is not None and isinstance(dv.value, dict):
+        for n, f in dv.value.items():
+            if isinstance(f, dict):
+                out[int(n)] = tuple(float(f.get(k, 0.0) or 0.0) for k in ("X", "Y", "Z", "A", "B", "C"))
+    return out
+
+
+def robot_view(machine) -> dict:
+    """The robot the page draws: its URDF (``krl robot export``'s, robot/urdf.py), $ROBROOT
+    (X..C mm/deg) and the joint names in A1..A6 order."""
+    from robot.urdf import build_urdf  # noqa: PLC0415
+
+    return {"name": machine.name, "urdf": build_urdf(machine), "robroot": list(machine.robroot_frame),
+            "joints": [j.name for j in machine.joints[:6]]}
+
+
+__all__ = ["module_view", "programs", "robot_view", "taught_points"]

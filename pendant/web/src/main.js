@@ -1,0 +1,459 @@
+// The page of `krl pendant` (pendant/server.py): the program view, the keys, the message
+// window, I/O, watch list, position and the 3D view of the backup's own robot.
+// Every text that comes from KRL or the workspace is written with textContent, never as markup.
+import * as THREE from 'three';
+import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
+import URDFLoader from 'urdf-loader';
+
+const $ = (id) => document.getElementById(id);
+const el = (tag, props = {}, ...children) => {
+  const e = document.createElement(tag);
+  for (const [k, v] of Object.entries(props)) {
+    if (k === 'text') e.textContent = v;
+    else if (k === 'class') e.className = v;
+    else if (k.startsWith('on')) e.addEventListener(k.slice(2), v);
+    else e.setAttribute(k, v);
+  }
+  for (const c of children) e.append(c);
+  return e;
+};
+
+// ------------------------------------------------------------------ connection
+const params = new URLSearchParams(location.search);
+const token = params.get('token');
+const wsUrl = `${location.protocol === 'https:' ? 'wss' : 'ws'}://${location.host}/ws` + (token ? `?token=${encodeURIComponent(token)}` : '');
+let ws = null;
+let nextId = 1;
+const waiting = new Map();
+
+function connect() {
+  ws = new WebSocket(wsUrl);
+  ws.onopen = () => send('hello').catch(showError);
+  ws.onmessage = (ev) => onMessage(JSON.parse(ev.data));
+  ws.onclose = () => { setState({ state: 'disconnected' }); };
+}
+
+function send(op, args = {}) {
+  const id = nextId++;
+  ws.send(JSON.stringify({ op, id, ...args }));
+  return new Promise((resolve, reject) => waiting.set(id, { resolve, reject, t0: performance.now() }));
+}
+
+function act(op, args) {
+  showError('');
+  return send(op, args).catch(showError);
+}
+
+function showError(e) {
+  $('errorbar').textContent = e ? String(e.message || e) : '';
+}
+
+const P = window.pendant = { state: null, module: null, robot: null, frames: 0, live: null, lastChange: 0, events: [] };
+P.send = send;
+
+function onMessage(m) {
+  switch (m.type) {
+    case 'init': onInit(m); break;
+    case 'module': onModule(m); break;
+    case 'state': setState(m); break;
+    case 'live': onLive(m); break;
+    case 'event': P.events.push(m); if (P.events.length > 200) P.events.shift(); break;
+    case 'done': { const w = waiting.get(m.id); if (w) { waiting.delete(m.id); w.resolve(m); } break; }
+    case 'error': {
+      const w = waiting.get(m.id);
+      if (w) { waiting.delete(m.id); w.reject(new Error(m.text)); } else showError(m.text);
+      break;
+    }
+  }
+}
+
+// ------------------------------------------------------------------ init, programs, keys
+function fillSelect(sel, values, current) {
+  sel.replaceChildren(...values.map((v) => el('option', { text: v, value: v })));
+  if (current) sel.value = current;
+}
+
+function onInit(m) {
+  $('workspace').textContent = m.workspace;
+  const group = (label, values) => el('optgroup', { label }, ...values.map((v) => el('option', { text: v, value: v })));
+  $('programs').replaceChildren(group('entry points', m.programs), group('other modules', m.modules || []));
+  fillSelect($('mode-op'), m.modes);
+  fillSelect($('run-mode'), m.runModes);
+  $('touchup').disabled = !!m.readonly;
+  $('robot-name').textContent = m.robot.name;
+  loadRobot(m.robot);
+}
+
+$('select').onclick = () => act('select', { program: $('programs').value });
+$('cancel').onclick = () => act('cancel');
+$('reset').onclick = () => act('reset');
+$('start').onclick = () => act('start');
+$('stop').onclick = () => act('stop');
+$('backward').onclick = () => act('backward');
+$('mode-op').onchange = (e) => act('modeOp', { value: e.target.value });
+$('run-mode').onchange = (e) => act('runMode', { value: e.target.value });
+$('drives').onclick = () => act('drives', { on: $('drives').getAttribute('aria-pressed') !== 'true' });
+$('override').oninput = (e) => { $('override-value').textContent = e.target.value; };
+$('override').onchange = (e) => act('override', { value: parseInt(e.target.value, 10) });
+for (const b of document.querySelectorAll('#tabs button')) {
+  b.onclick = () => {
+    for (const x of document.querySelectorAll('#tabs button, .tab')) x.classList.remove('active');
+    b.classList.add('active');
+    $('tab-' + b.dataset.tab).classList.add('active');
+  };
+}
+
+function buildJogKeys() {
+  const system = $('jog-system').value;
+  const names = system === 'AXIS' ? ['A1', 'A2', 'A3', 'A4', 'A5', 'A6'] : ['X', 'Y', 'Z', 'A', 'B', 'C'];
+  const box = $('jog-keys');
+  box.replaceChildren();
+  names.forEach((n, i) => {
+    const axis = system === 'AXIS' ? i + 1 : n;
+    const jog = (sign) => act('jog', { system, axis, step: sign * parseFloat($('jog-step').value) });
+    box.append(el('span', { text: n }),
+      el('button', { text: '\u2212', 'data-jog': `${n}-`, onclick: () => jog(-1) }),
+      el('button', { text: '+', 'data-jog': `${n}+`, onclick: () => jog(1) }));
+  });
+}
+$('jog-system').onchange = buildJogKeys;
+buildJogKeys();
+$('touchup').onclick = () => {
+  if (!P.module || !P.module.dat) { showError('touch-up: the module has no data list'); return; }
+  act('touchup', { path: P.module.dat, name: $('touchup-name').value.trim() });
+};
+
+let watchList = [];
+$('watch-add').onclick = () => {
+  const e = $('watch-expr').value.trim();
+  if (!e) return;
+  watchList = [...watchList, e];
+  $('watch-expr').value = '';
+  act('watch', { exprs: watchList });
+};
+
+// ------------------------------------------------------------------ program view
+const moduleCache = new Map();   // path -> the module message: following the advance run costs no round trip
+function onModule(m) {
+  moduleCache.set(m.path, m);
+  if (moduleCache.size > 64) moduleCache.delete(moduleCache.keys().next().value);
+  showModule(m);
+}
+
+function showModule(m) {
+  P.module = m;
+  $('module-label').textContent = m.label;
+  const box = $('program-view');
+  const rows = m.lines.map((text, i) => {
+    const no = el('span', { class: 'no', text: String(i + 1), title: 'breakpoint' });
+    no.onclick = () => act('breakpoint', { path: m.path, line: i + 1, on: !row.classList.contains('bp') });
+    const row = el('div', { class: 'ln', role: 'listitem', 'data-line': String(i + 1) }, el('span', { class: 'ptr' }), no, el('span', { class: 'tx', text }));
+    return row;
+  });
+  box.replaceChildren(...rows);
+  showPoints(m.points || []);
+  if (P.state) drawPointers(P.state.pointers || {}, P.state.breakpoints || {});
+}
+
+function samePath(a, b) { return a && b && a === b; }
+
+function drawPointers(ptr, bps) {
+  const m = P.module;
+  if (!m) return;
+  const box = $('program-view');
+  for (const r of box.querySelectorAll('.main, .advance, .bp')) r.classList.remove('main', 'advance', 'bp');
+  const mark = (p, cls) => {
+    if (p && samePath(p.path, m.path)) {
+      const r = box.querySelector(`[data-line="${p.line}"]`);
+      if (r) { r.classList.add(cls); return r; }
+    }
+    return null;
+  };
+  const adv = mark(ptr.advanceRun, 'advance');
+  const main = mark(ptr.mainRun, 'main');
+  for (const line of (bps[m.path] || [])) {
+    const r = box.querySelector(`[data-line="${line}"]`);
+    if (r) r.classList.add('bp');
+  }
+  const target = main || adv;
+  if (target && P.scrollTo !== target) { P.scrollTo = target; target.scrollIntoView({ block: 'center' }); }
+  // follow the advance run into another module, as the smartPAD does
+  const want = (ptr.advanceRun && ptr.advanceRun.path) || null;
+  if (want && !samePath(want, m.path)) {
+    const cached = moduleCache.get(want);
+    if (cached) showModule(cached);
+    else if (P.opening !== want) { P.opening = want; send('open', { path: want }).catch(() => {}); }
+  }
+}
+
+// ------------------------------------------------------------------ state
+const fmt = (v, d = 3) => (typeof v === 'number' ? v.toFixed(d) : '—');
+
+function setState(s) {
+  P.state = s;
+  P.lastChange = performance.now();
+  const st = s.state || 'none';
+  $('st-state').dataset.state = st;
+  $('st-state').textContent = st + (s.stop && s.stop.description ? `: ${s.stop.description}` : '');
+  $('st-program').textContent = s.program ? s.program.split('/').slice(-1)[0] : 'no program';
+  if (s.modeOp) $('mode-op').value = s.modeOp;
+  if (s.runMode) $('run-mode').value = s.runMode;
+  $('drives').setAttribute('aria-pressed', s.drives ? 'true' : 'false');
+  $('drives').textContent = s.drives ? 'drives on' : 'drives off';
+  if (typeof s.override === 'number' && document.activeElement !== $('override')) {
+    $('override').value = s.override; $('override-value').textContent = String(s.override);
+  }
+  if (typeof s.time === 'number') $('st-time').textContent = `t = ${s.time.toFixed(3)} s`;
+  drawPointers(s.pointers || {}, s.breakpoints || {});
+  drawMessages(s.messages || []);
+  $('notes').replaceChildren(...(s.notes || []).slice().reverse().map((n) => el('li', { text: `t=${fmt(n.time)} s  ${n.text}` })));
+  drawIo(s.io);
+  drawWatch(s.watch || []);
+  drawThreads(s.threads || []);
+  if (s.position) { drawPosition(s.position); setAxes(s.position.axes, s.position.tool, s.position.base); }
+}
+
+function drawMessages(list) {
+  $('msg-count').textContent = list.length ? `(${list.length})` : '';
+  $('messages').replaceChildren(...list.map((m) => {
+    const buttons = [];
+    if (m.kind === 'QUIT' || m.kind === 'NOTIFY') buttons.push(el('button', { text: 'Ack', 'data-ack': String(m.handle), onclick: () => act('ack', { handle: m.handle }) }));
+    if (m.kind === 'DIALOG') m.softkeys.forEach((k, i) => { if (k.trim()) buttons.push(el('button', { text: k, 'data-answer': String(i + 1), onclick: () => act('answer', { handle: m.handle, key: i + 1 }) })); });
+    return el('li', { 'data-kind': m.kind, 'data-handle': String(m.handle) }, el('span', { class: 'kind', text: m.kind }),
+      el('span', { class: 'text', text: m.text }), el('span', { class: 'src', text: `${m.module} ${m.number || ''}` }), ...buttons);
+  }));
+}
+
+function drawIo(io) {
+  if (!io) return;
+  const table = (rows, arr, toggle) => [el('tr', {}, el('th', { text: arr }), el('th', { text: 'name' }), el('th', { text: 'long text' }), el('th', { text: 'value' })),
+    ...rows.map((r) => {
+      const v = el('span', { class: r.value ? 'io-on' : 'io-off', text: r.value ? 'TRUE' : 'FALSE' });
+      const cell = toggle ? el('button', { 'data-input': String(r.index), onclick: () => act('input', { index: r.index, value: !r.value }) }, v) : v;
+      return el('tr', { 'data-io': `${arr}[${r.index}]` }, el('td', { text: String(r.index) }), el('td', { text: r.names.join(', ') }), el('td', { text: r.text }), el('td', {}, cell));
+    })];
+  $('inputs').replaceChildren(...table(io.$IN || [], '$IN', true));
+  $('outputs').replaceChildren(...table(io.$OUT || [], '$OUT', false));
+}
+
+function drawWatch(list) {
+  $('watch').replaceChildren(...list.map((w) => {
+    const input = el('input', { value: w.value !== undefined ? w.value : '', 'aria-label': `value of ${w.expr}` });
+    input.onkeydown = (e) => { if (e.key === 'Enter') act('setWatch', { expr: w.expr, value: input.value }); };
+    return el('tr', { 'data-watch': w.expr }, el('td', { text: w.expr }), el('td', {}, w.error !== undefined ? el('span', { class: 'io-off', text: w.error }) : input));
+  }));
+}
+
+function drawThreads(list) {
+  $('threads').replaceChildren(el('tr', {}, el('th', { text: 'thread' }), el('th', { text: 'routine' }), el('th', { text: 'line' })),
+    ...list.map((t) => el('tr', {}, el('td', { text: t.name }), el('td', { text: t.routine || '' }), el('td', { text: t.line ? String(t.line) : '' }))));
+}
+
+function drawPosition(p) {
+  const rows = [];
+  const keys = ['X', 'Y', 'Z', 'A', 'B', 'C'];
+  for (let i = 0; i < 6; i++) {
+    rows.push(el('tr', {}, el('th', { text: `A${i + 1}` }), el('td', { 'data-axis': String(i + 1), text: fmt(p.axes[i], 3) }),
+      el('th', { text: keys[i] }), el('td', { 'data-pos': keys[i], text: p.pos ? fmt(p.pos[keys[i]], 2) : '—' })));
+  }
+  if (p.pos) rows.push(el('tr', {}, el('th', { text: 'S' }), el('td', { text: String(p.pos.S) }), el('th', { text: 'T' }), el('td', { text: String(p.pos.T) })));
+  const frame = (f) => (f ? keys.map((k) => fmt(f[k], 1)).join(' ') : '—');
+  rows.push(el('tr', {}, el('th', { text: '$BASE' }), el('td', { colspan: '3', text: frame(p.base) })));
+  rows.push(el('tr', {}, el('th', { text: '$TOOL' }), el('td', { colspan: '3', text: frame(p.tool) })));
+  $('position').replaceChildren(...rows);
+}
+
+// ------------------------------------------------------------------ 3D view
+const scene = new THREE.Scene();
+scene.background = new THREE.Color(0x0f1215);
+const world = new THREE.Group();            // KUKA $WORLD: Z up, metres
+world.rotation.x = -Math.PI / 2;
+scene.add(world);
+scene.add(new THREE.HemisphereLight(0xffffff, 0x334455, 2.2));
+const sun = new THREE.DirectionalLight(0xffffff, 1.6);
+sun.position.set(3, 6, 4);
+scene.add(sun);
+const grid = new THREE.GridHelper(6, 30, 0x44505c, 0x2a3138);
+scene.add(grid);
+world.add(new THREE.AxesHelper(0.4));
+const camera = new THREE.PerspectiveCamera(45, 1, 0.01, 100);
+camera.position.set(3.2, 2.6, 3.6);
+const renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
+renderer.setPixelRatio(Math.min(2, window.devicePixelRatio || 1));
+$('view3d').append(renderer.domElement);
+const controls = new OrbitControls(camera, renderer.domElement);
+controls.target.set(0, 1.0, 0);
+controls.update();
+P.view = { camera, controls, scene };
+
+function kukaMatrix(f) {           // X,Y,Z mm and A,B,C deg -> Matrix4 (m): Rz(A) Ry(B) Rx(C)
+  const m = new THREE.Matrix4();
+  const d = Math.PI / 180;
+  m.makeRotationFromEuler(new THREE.Euler(f[5] * d, f[4] * d, f[3] * d, 'ZYX'));
+  m.setPosition(f[0] / 1000, f[1] / 1000, f[2] / 1000);
+  return m;
+}
+const frameArr = (f) => (f ? ['X', 'Y', 'Z', 'A', 'B', 'C'].map((k) => f[k] || 0) : null);
+
+const robotRoot = new THREE.Group();
+world.add(robotRoot);
+const baseFrame = new THREE.AxesHelper(0.25);
+world.add(baseFrame);
+const toolFrame = new THREE.AxesHelper(0.15);
+let tool0 = null;
+let jointNames = [];
+const linkMaterial = new THREE.MeshStandardMaterial({ color: 0xff5800, metalness: 0.2, roughness: 0.6 });
+const jointMaterial = new THREE.MeshStandardMaterial({ color: 0x30353b, metalness: 0.3, roughness: 0.5 });
+
+function limb(from, to, radius) {   // a cylinder from one point to another in a link's frame
+  const a = new THREE.Vector3(...from);
+  const b = new THREE.Vector3(...to);
+  const len = a.distanceTo(b);
+  if (len < 1e-4) return null;
+  const g = new THREE.CylinderGeometry(radius, radius, len, 20);
+  const mesh = new THREE.Mesh(g, linkMaterial);
+  mesh.position.copy(a).add(b).multiplyScalar(0.5);
+  mesh.quaternion.setFromUnitVectors(new THREE.Vector3(0, 1, 0), b.clone().sub(a).normalize());
+  return mesh;
+}
+
+function loadRobot(r) {
+  const loader = new URDFLoader();
+  loader.parseVisual = false;
+  const robot = loader.parse(r.urdf);
+  jointNames = r.joints;
+  robotRoot.clear();
+  robotRoot.matrixAutoUpdate = false;
+  robotRoot.matrix.copy(kukaMatrix(r.robroot));
+  robotRoot.add(robot);
+  // the URDF has no meshes (machine data hold none): each link drawn as a limb from its joint
+  // to the next joint (or the flange), with a joint drum, scaled to the robot's size
+  let reach = 0;
+  for (const name of jointNames) reach += robot.joints[name].position.length();
+  const radius = Math.max(0.03, reach * 0.035);
+  for (const name of jointNames) {
+    const j = robot.joints[name];
+    j.ignoreLimits = true;
+    const child = j.children.find((c) => c.isURDFLink);
+    const next = child && child.children.find((c) => c.isURDFJoint);
+    if (child && next) { const m = limb([0, 0, 0], next.position.toArray(), radius); if (m) child.add(m); }
+    const drum = new THREE.Mesh(new THREE.CylinderGeometry(radius * 1.25, radius * 1.25, radius * 2.2, 24), jointMaterial);
+    drum.quaternion.setFromUnitVectors(new THREE.Vector3(0, 1, 0), j.axis.clone().normalize());
+    j.add(drum);
+  }
+  const first = robot.joints[jointNames[0]];
+  const base = limb([0, 0, 0], first.position.toArray(), radius * 1.6);
+  if (base) robot.add(base);
+  tool0 = robot.links.tool0 || null;
+  if (tool0) {
+    const link6 = tool0.parent && tool0.parent.parent;
+    if (link6) { const m = limb([0, 0, 0], tool0.parent.position.toArray(), radius * 0.7); if (m) link6.add(m); }
+    tool0.add(toolFrame);
+  }
+  P.robot = robot;
+  requestRender();
+  const span = Math.max(1.2, reach * 1.05);
+  camera.position.set(span * 1.1, span * 0.9, span * 1.2);
+  controls.target.set(0, reach * 0.45, 0);
+  controls.update();
+}
+
+function setAxes(axes, tool, base) {
+  if (!P.robot || !axes) return;
+  const d = Math.PI / 180;
+  jointNames.forEach((n, i) => P.robot.setJointValue(n, axes[i] * d));
+  if (tool) { const f = frameArr(tool); toolFrame.matrixAutoUpdate = false; toolFrame.matrix.copy(kukaMatrix(f)); }
+  if (base) { const f = frameArr(base); baseFrame.matrixAutoUpdate = false; baseFrame.matrix.copy(kukaMatrix(f)); }
+  P.axesShown = axes.slice();
+  requestRender();
+}
+
+// the rendered joint values (deg), read back from the drawn robot: what the page shows
+P.renderedAxes = () => (P.robot ? jointNames.map((n) => (P.robot.joints[n].angle * 180) / Math.PI) : null);
+
+// TCP path: a trail of the drawn TCP, blue on the path, orange inside an approximation
+const MAX_PATH = 20000;
+const pathPos = new Float32Array(MAX_PATH * 3);
+const pathCol = new Float32Array(MAX_PATH * 3);
+const pathGeom = new THREE.BufferGeometry();
+pathGeom.setAttribute('position', new THREE.BufferAttribute(pathPos, 3));
+pathGeom.setAttribute('color', new THREE.BufferAttribute(pathCol, 3));
+pathGeom.setDrawRange(0, 0);
+const pathLine = new THREE.Line(pathGeom, new THREE.LineBasicMaterial({ vertexColors: true }));
+pathLine.frustumCulled = false;
+world.add(pathLine);
+let pathN = 0;
+let pathRun = null;
+// the controller's TCP path (pendant/engine.py: $WORLD mm, a point each 2 mm, blending flag)
+function addPath(run, points) {
+  if (run !== pathRun) { pathRun = run; pathN = 0; }
+  for (const [x, y, z, blending] of points) {
+    if (pathN >= MAX_PATH) { pathPos.copyWithin(0, 3); pathCol.copyWithin(0, 3); pathN = MAX_PATH - 1; }
+    pathPos.set([x / 1000, y / 1000, z / 1000], pathN * 3);
+    pathCol.set(blending ? [1, 0.35, 0] : [0, 0.78, 1], pathN * 3);
+    pathN++;
+  }
+  pathGeom.setDrawRange(0, pathN);
+  pathGeom.attributes.position.needsUpdate = true;
+  pathGeom.attributes.color.needsUpdate = true;
+  P.pathPoints = pathN;
+  requestRender();
+}
+
+const pointsGroup = new THREE.Group();
+world.add(pointsGroup);
+function showPoints(points) {
+  pointsGroup.clear();
+  const g = new THREE.SphereGeometry(0.012, 12, 8);
+  const mat = new THREE.MeshBasicMaterial({ color: 0xf2c94c });
+  for (const p of points) {
+    if (!p.world) continue;
+    const s = new THREE.Mesh(g, mat);
+    s.position.set(p.world[0] / 1000, p.world[1] / 1000, p.world[2] / 1000);
+    s.name = p.name;
+    pointsGroup.add(s);
+  }
+  requestRender();
+}
+
+function onLive(m) {
+  P.live = m;
+  if (typeof m.time === 'number') $('st-time').textContent = `t = ${m.time.toFixed(3)} s`;
+  setAxes(m.axes);
+  if (m.path) addPath(m.run, m.path);
+  // the pointers of a cycle newer than the last state (at a stop the state, taken after the
+  // last cycle, is the newer one even at the same simulated time)
+  if (m.pointers && P.state && typeof P.state.time === 'number' && m.time > P.state.time + 1e-9) {
+    P.state.pointers = { ...P.state.pointers, ...m.pointers };
+    drawPointers(P.state.pointers, P.state.breakpoints || {});
+  }
+}
+
+function resize() {
+  const box = $('view3d');
+  const w = box.clientWidth || 1;
+  const h = box.clientHeight || 1;
+  renderer.setSize(w, h, false);
+  camera.aspect = w / h;
+  camera.updateProjectionMatrix();
+}
+// render on demand: a frame when the pose, the path, the frames or the camera changed (a
+// software-rendered WebGL page at 60 Hz would take the CPU the simulation needs)
+let framePending = false;
+function requestRender() {
+  if (framePending) return;
+  framePending = true;
+  requestAnimationFrame(() => {
+    framePending = false;
+    resize();
+    renderer.render(scene, camera);
+    P.frames++;
+  });
+}
+P.requestRender = requestRender;
+// true while a frame is asked for and not drawn yet (the tests wait for the drawn frame)
+P.renderPending = () => framePending;
+window.addEventListener('resize', requestRender);
+controls.addEventListener('change', requestRender);
+requestRender();
+connect();

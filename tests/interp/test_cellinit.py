@@ -1,0 +1,51 @@
+"""`krl cell init` (issue 34): inputs read in SWITCH and through routine parameters, only for
+the program asked, every rule valid YAML once uncommented (interp/cellinit.py)."""
+
+from __future__ import annotations
+
+import yaml
+from click.testing import CliRunner
+
+from krl.cli import main
+from robot.stimuli import parse_cell
+
+from .helpers import write
+from .test_autocell import _backup, uncomment_rules
+
+OTHER = """
+DEF other()
+  WAIT FOR $IN[77]
+END
+"""
+
+
+def test_the_starter_reads_switch_parameters_and_only_the_program(tmp_path):
+    _backup(tmp_path)
+    write(tmp_path, "R1/Program/other.src", OTHER)
+    out = CliRunner().invoke(main, ["cell", "init", str(tmp_path), "job"])
+    assert out.exit_code == 0, out.output
+    text = out.output
+    # the SWITCH's selector: a SIGNAL group, with its rule taking a number
+    assert "# PROG_NR = $IN[17] TO $IN[20]   declared R1/System/$config.dat:6   ; program number of the PLC" in text
+    assert "#   read at R1/Program/job.src:9 (SWITCH)" in text
+    assert "#   set: {PROG_NR: 0}   # a number: the group's bits, bit 0 on its first input" in text
+    # a SIGNAL passed to a routine whose parameter a WAIT FOR reads
+    assert "# BPERMISOENTRADA = $IN[12]   declared R1/System/$config.dat:5   ; permission to enter" in text
+    assert "#   read at R1/Program/job.src:29 (WAIT FOR, through parameter bPermit from R1/Program/job.src:6)" in text
+    # another program's input is not this program's
+    assert "$IN[77]" not in text
+    # every rule, once uncommented, is a valid rule of a valid cell file
+    cell = parse_cell(yaml.safe_load(uncomment_rules(text)), source="starter")
+    assert len(cell.rules) == 7            # PART_READY, CLAMPED, $IN[8], BPERMISOENTRADA, PROG_NR, $IN[4], $IN[9]
+    # without PROGRAM: every program of the backup
+    out = CliRunner().invoke(main, ["cell", "init", str(tmp_path)])
+    assert out.exit_code == 0 and "$IN[77]" in out.output
+    parse_cell(yaml.safe_load(uncomment_rules(out.output)), source="starter")
+
+
+def test_from_run_needs_a_trace(tmp_path):
+    bad = write(tmp_path, "bad.jsonl", "not json\n")
+    out = CliRunner().invoke(main, ["cell", "init", "--from-run", str(bad)])
+    assert out.exit_code == 2 and "not a trace of krl run" in out.output and "Traceback" not in out.output
+    out = CliRunner().invoke(main, ["cell", "init"])
+    assert out.exit_code == 2 and "name the BACKUP" in out.output

@@ -1,0 +1,168 @@
+"""Idle time costs nothing (issue 34): a run in which nothing changes fast-forwards to its next
+event with the clock exact, identically in both interpreters (interp/runtime/idle.py), and a
+trace bounds the spins it still writes (robot/trace.py ``repeats``).
+
+Expected times are IPO cycles of 12 ms, worked out by hand from the reference (§5.8: WAIT SEC
+t waits ceil(t / 12 ms) cycles) and from the controller's rules (a stimulus ``at: t`` is
+applied in the first cycle k with k * 12 ms >= t; a task reads it in that cycle)."""
+
+from __future__ import annotations
+
+import pytest
+
+from interp.run import make_runtime
+from robot.trace import TraceWriter
+
+from .helpers import write
+
+INTERPS = ("tree", "vm")
+
+POLL = """
+DEF poll()
+  INT n
+  n = 0
+  LOOP
+    IF $IN[3] THEN
+      n = n + 1
+      $OUT[1] = TRUE
+      EXIT
+    ENDIF
+  ENDLOOP
+END
+"""
+
+
+def _run(prog, *, interp="tree", inputs=None, max_sim_time=600.0, max_steps=10_000_000, submit=(),
+         fast=True, repeats=None, keep=True):
+    tw = TraceWriter(keep=keep, repeats=repeats)
+    rt, _ = make_runtime(prog, inputs=inputs, trace=tw, max_sim_time=max_sim_time, max_steps=max_steps,
+                         mujoco=False, check=False, interp=interp, submit=list(submit))
+    rt.scheduler.idle.enabled = fast
+    res = rt.run()
+    tw.close()
+    return rt, res, tw
+
+
+@pytest.mark.parametrize("interp", INTERPS)
+def test_a_polling_program_nothing_answers_ends_at_the_time_limit_at_once(tmp_path, interp):
+    """LOOP IF $IN[3] ... ENDLOOP with nothing setting $IN[3]: the run ends at the 600 s limit
+    as before, but after one quiet window (32 cycles) and the state compared over a second
+    one, the clock jumps to the last cycle: at most ~100 cycles execute statements
+    (1000 a cycle) instead of 50 000."""
+    prog = write(tmp_path, "poll.src", POLL)
+    rt, res, tw = _run(prog, interp=interp)
+    assert (res.reason, res.sim_time) == ("max_sim_time", pytest.approx(600.0))
+    assert res.steps < 100 * 1000
+    idle = [e for e in tw.events if e["kind"] == "idle"]
+    assert len(idle) == 1
+    # the clock jumps from the cycle the state was seen unchanged to the cycle before the limit
+    assert idle[0]["until"] == pytest.approx(599.988)
+    assert idle[0]["cycles"] == round((599.988 - idle[0]["t"]) / 0.012)
+    assert rt.scheduler.idle.skipped == idle[0]["cycles"]
+
+
+def test_the_two_interpreters_fast_forward_identically(tmp_path):
+    prog = write(tmp_path, "poll.src", POLL)
+    stim = write(tmp_path, "s.yaml", "- at: 2.0\n  set: {\"$IN[3]\": true}\n")
+    out = []
+    for interp in INTERPS:
+        _rt, res, tw = _run(prog, interp=interp, inputs=stim)
+        out.append(tw.events)
+        assert res.reason == "completed"
+    assert out[0] == out[1]
+
+
+@pytest.mark.parametrize("interp", INTERPS)
+def test_a_stimulus_ends_the_jump_at_its_exact_cycle(tmp_path, interp):
+    """The stimulus at 2.0 s: cycle ceil(2 / 0.012) = 167 (2.004 s); the program reads
+    $IN[3] in that cycle and sets $OUT[1] at once, with and without the fast-forward."""
+    prog = write(tmp_path, "poll.src", POLL)
+    stim = write(tmp_path, "s.yaml", "- at: 2.0\n  set: {\"$IN[3]\": true}\n")
+    got = []
+    for fast in (True, False):
+        rt, res, tw = _run(prog, interp=interp, inputs=stim, fast=fast)
+        assert res.reason == "completed"
+        got.append([(e["t"], e["signal"]) for e in tw.events if e["kind"] == "io"])
+        assert rt.scheduler.idle.jumps == (1 if fast else 0)
+    assert got[0] == got[1] == [(2.004, "$IN[3]"), (2.004, "$OUT[1]")]
+
+
+@pytest.mark.parametrize("interp", INTERPS)
+def test_wait_sec_and_a_running_timer_keep_their_time(tmp_path, interp):
+    """WAIT SEC 3 beside a submit program that polls: 250 cycles (3.000 s); the timer
+    started before runs on through the jump: $TIMER[1] = 250 * 12 ms = 3000 ms at the
+    statement after the wait (the submit never reads it, so the run is idle)."""
+    prog = write(tmp_path, "timed.src", """
+    DEF timed()
+      INT t
+      $TIMER[1] = 0
+      $TIMER_STOP[1] = FALSE
+      WAIT SEC 3.0
+      t = $TIMER[1]
+      $OUT[2] = t == 3000
+    END
+    """)
+    sub = write(tmp_path, "plc.sub", """
+    DEF plc()
+      LOOP
+        IF $IN[9] THEN
+          $OUT[9] = TRUE
+        ENDIF
+      ENDLOOP
+    END
+    """)
+    got = []
+    for fast in (True, False):
+        rt, res, tw = _run(prog, interp=interp, submit=[sub], fast=fast)
+        assert res.reason == "completed", res.text
+        got.append([(e["t"], e["signal"], e["value"]) for e in tw.events if e["kind"] == "io"])
+        assert (rt.scheduler.idle.jumps > 0) == fast
+    assert got[0] == got[1] == [(3.0, "$OUT[2]", True)]
+
+
+def test_reading_the_clock_is_not_idle(tmp_path):
+    """A loop that waits on $DATE reads time: it is never fast-forwarded past its end."""
+    prog = write(tmp_path, "clock.src", """
+    DEF clock()
+      WHILE $DATE.SEC < 2
+      ENDWHILE
+      $OUT[4] = TRUE
+    END
+    """)
+    rt, res, tw = _run(prog, max_sim_time=10.0)
+    assert res.reason == "completed"
+    assert rt.scheduler.idle.jumps == 0
+    assert [(e["t"], e["signal"]) for e in tw.events if e["kind"] == "io"] == [(2.004, "$OUT[4]")]
+
+
+def test_a_bounded_trace_of_a_spin_stays_small(tmp_path):
+    """Without the fast-forward a spin writes 1000 steps' statements a cycle; the bounded trace
+    writes each repeated event 10 times and counts the rest in ``repeat`` events: the events
+    written plus those counted are exactly the unbounded trace's."""
+    prog = write(tmp_path, "poll.src", POLL)
+    _rt, res, full = _run(prog, max_sim_time=0.6, fast=False)
+    _rt, res2, tw = _run(prog, max_sim_time=0.6, fast=False, repeats=10)
+    assert res.steps == res2.steps > 45_000
+    kinds = {}
+    for e in full.events:
+        kinds[e["kind"]] = kinds.get(e["kind"], 0) + 1
+    written = {}
+    for e in tw.events:
+        written[e["kind"]] = written.get(e["kind"], 0) + 1
+    left = {}
+    for e in tw.events:
+        if e["kind"] == "repeat":
+            for k, n in e["kinds"].items():
+                left[k] = left.get(k, 0) + n
+    assert written["stmt"] < 100 and written["pose"] <= 20
+    assert written["stmt"] + left["stmt"] == kinds["stmt"]
+    assert written["pose"] + left.get("pose", 0) == kinds["pose"] == 50
+    assert [e for e in tw.events if e["kind"] == "end"] == [e for e in full.events if e["kind"] == "end"]
+
+
+def test_an_unbounded_trace_writes_every_statement(tmp_path):
+    """The trace without ``repeats`` (the default of TraceWriter) is unchanged: one stmt
+    event per statement, 2 steps per pass of the loop (the LOOP's iteration and the IF)."""
+    prog = write(tmp_path, "poll.src", POLL)
+    _rt, res, tw = _run(prog, max_sim_time=0.12, fast=False)
+    assert 2 * sum(1 for e in tw.events if e["kind"] == "stmt") in (res.steps, res.steps + 1, res.steps - 1)

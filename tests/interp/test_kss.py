@@ -1,0 +1,227 @@
+"""KUKA's system software at run time (issue 34, interp/runtime/kss.py), the standard P00
+(interp/basis/kuka/p00.src), BRAKE outside an interrupt routine, EKI_CHECK, and setting the
+scene: ``--start`` and ``--on-halt continue``."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from click.testing import CliRunner
+
+from interp.run import make_runtime
+from krl.cli import main
+from robot.trace import TraceWriter
+
+from .helpers import write
+
+INTERPS = ("tree", "vm")
+
+KRC2_PROG = """
+DEF weld()
+  ;FOLD INI
+  ;FOLD BASISTECH INI
+  $OUT[9] = TRUE
+  ;ENDFOLD (BASISTECH INI)
+  ;FOLD SPOTTECH INI
+  USERSPOT(1)
+  USERSPOT(2)
+  ;ENDFOLD (SPOTTECH INI)
+  ;FOLD ARCHTECHDIGITAL INI
+  IF ARC20==TRUE THEN
+    A20 (ARC_INI)
+    INTERRUPT DECL 6 WHEN $CYCFLAG[3]==FALSE DO A20(TECH_STOP2)
+  ENDIF
+  ;ENDFOLD (ARCHTECHDIGITAL INI)
+  ;FOLD USER INI
+  ;ENDFOLD (USER INI)
+  ;ENDFOLD (INI)
+  IF IS_KEY_PRESSED(5) THEN
+    $OUT[2] = TRUE
+  ENDIF
+  $OUT[1] = TRUE
+  GetJobNr()
+END
+"""
+
+
+def _backup(tmp: Path, program: str, config: str = "DEFDAT $CONFIG\nENDDAT\n", name="weld.src",
+            files: dict | None = None) -> Path:
+    for d in ("R1/System", "R1/Program"):
+        (tmp / d).mkdir(parents=True, exist_ok=True)
+    write(tmp, "R1/System/$config.dat", config)
+    for f, text in (files or {}).items():
+        write(tmp, f, text)
+    return write(tmp, f"R1/Program/{name}", program)
+
+
+def _run(prog, interp="tree", **kw):
+    tw = TraceWriter(keep=True)
+    rt, _ = make_runtime(prog, trace=tw, mujoco=False, check=False, interp=interp, **kw)
+    res = rt.run()
+    return rt, res, tw.events
+
+
+@pytest.mark.parametrize("interp", INTERPS)
+def test_the_template_names_of_technology_packages_stand_in(tmp_path, interp):
+    """The KR C2 template's ArcTech INI fold (IF ARC20==TRUE THEN A20(ARC_INI) ...) on a
+    backup without ArcTech: ARC20 reads FALSE (the package is not installed), the INI is
+    skipped; SpotTech's USERSPOT of the template's SPOTTECH INI fold runs as a no-op;
+    IS_KEY_PRESSED (KSS, $operate.dat) is FALSE; a routine of the program that nothing
+    declares stays its error."""
+    prog = _backup(tmp_path, KRC2_PROG)
+    rt, res, events = _run(prog, interp)
+    notes = [e["text"] for e in events if e["kind"] == "message"]
+    assert len(notes) == 3                      # one note per stand-in
+    assert notes[0].startswith("stub: USERSPOT (procedure of KUKA's system software not in the backup: ")
+    assert notes[1].startswith("stub: ARC20 (variable of KUKA's system software not in the backup: ")
+    assert notes[1].endswith("): reads FALSE")
+    assert "stub: IS_KEY_PRESSED (function of KUKA's system software not in the backup: a routine of the " \
+           "platform tables (krl/semantics/data)): returns FALSE (TRUE while the key is held on the " \
+           "KCP/smartPAD ($operate.dat EXTFCTP BOOL IS_KEY_PRESSED(INT KEY :IN)); nobody presses a key in " \
+           "a simulation)" in notes
+    io = [(e["signal"], e["value"]) for e in events if e["kind"] == "io"]
+    assert io == [("$OUT[9]", True), ("$OUT[1]", True)]
+    # GetJobNr: the program's own routine that nothing declares: the controller's error
+    assert (res.reason, res.line, res.text) == ("error", 23, "routine GetJobNr not found")
+    summary = {name: (what, n) for name, what, n in rt.kss.summary()}
+    assert summary["ARC20"] == ("variable", 1)
+    assert summary["IS_KEY_PRESSED"] == ("function", 1)
+    assert summary["USERSPOT"] == ("procedure", 2)
+
+
+def test_a_name_of_the_program_only_is_its_error(tmp_path):
+    prog = _backup(tmp_path, "DEF weld()\n  IF GATE_OPEN THEN\n    $OUT[1] = TRUE\n  ENDIF\nEND\n")
+    _rt, res, _ = _run(prog)
+    assert (res.reason, res.line, res.text) == ("error", 2, "unknown name GATE_OPEN")
+
+
+@pytest.mark.parametrize("interp", INTERPS)
+def test_a_system_variable_only_kuka_writes_stands_in(tmp_path, interp):
+    """$CP_VEL_MODE = 5 on a line of a KUKA system file (the backup's bas.src): a system
+    variable no table lists, its uses give it INT; written, then read."""
+    sysfile = """
+    GLOBAL DEF HopVel(V :IN)
+      DECL REAL V
+      $CP_VEL_MODE = 5
+      IF V > 0.1 * $CP_VEL_MODE THEN
+        $OUT[3] = TRUE
+      ENDIF
+    END
+    """
+    prog = _backup(tmp_path, "DEF weld()\n  HopVel(2.0)\nEND\n", files={"R1/System/hop.src": sysfile})
+    rt, res, events = _run(prog, interp)
+    assert res.reason == "completed", res.text
+    assert ("$OUT[3]", True) in [(e["signal"], e["value"]) for e in events if e["kind"] == "io"]
+    # a variable counts once (the interpreters look it up differently)
+    assert {n: (w, c) for n, w, c in rt.kss.summary()}["$CP_VEL_MODE"] == ("system variable", 1)
+
+
+P00_CONFIG = """
+DEFDAT  $CONFIG
+ENUM FUNCT_TYPE PGNO_GET,PGNO_ACKN,PGNO_FAULT
+ENUM P00_COMMAND INIT_EXT,EXT_PGNO,CHK_HOME,EXT_ERR
+EXT  P00 (P00_COMMAND  :IN,FUNCT_TYPE  :IN,CHAR [] :OUT,INT  :IN )
+INT PGNO=0 ;copy of ext. pgno
+INT PGNO_ERROR=0 ;transmission error
+INT PGNO_TYPE=1 ;coding type of ext. pgno
+INT PGNO_LENGTH=8 ;length of ext. pgno
+INT PGNO_FBIT=33 ;first bit of ext. pgno input $IN[]
+INT PGNO_PARITY=41 ;parity bit of ext. pgno
+INT PGNO_REQ=33 ;request ext. pgno output
+INT PGNO_VALID=42 ;validate ext. pgno input
+ENDDAT
+"""
+
+P00_CELL = """
+DEF cell()
+  DECL CHAR DMY[3]
+  DMY[]="---"
+  P00 (#INIT_EXT,#PGNO_GET,DMY[],0 )
+  P00 (#EXT_PGNO,#PGNO_GET,DMY[],0 )
+  SWITCH PGNO
+  CASE 2
+    P00 (#EXT_PGNO,#PGNO_ACKN,DMY[],0 )
+    $OUT[2] = TRUE
+  DEFAULT
+    P00 (#EXT_PGNO,#PGNO_FAULT,DMY[],0 )
+  ENDSWITCH
+END
+"""
+
+
+@pytest.mark.parametrize("interp", INTERPS)
+def test_the_standard_p00_runs_when_the_backup_has_none(tmp_path, interp):
+    """A backup whose $config.dat declares P00 (EXT P00, PGNO_*) but has no R1/TP/p00.src:
+    the project's standard P00 runs, with a note. The PLC (--pgno 2, robot/cellpresets.py)
+    answers the request ($OUT[33] set at t = 0, seen in cycle 1, answered 0.1 s later in
+    cycle 10): 2 = bit 1 on $IN[34], odd parity $IN[41], PGNO_VALID $IN[42] at 0.120 s; P00
+    reads 2, CASE 2 acknowledges ($OUT[33] FALSE) and sets $OUT[2] in the same cycle."""
+    prog = _backup(tmp_path, P00_CELL, P00_CONFIG, name="cell.src")
+    rt, res, events = _run(prog, interp, pgno=2, mode="EXT")
+    assert res.reason == "completed", (res.text, res.file, res.line)
+    io = [(e["t"], e["signal"], e["value"]) for e in events if e["kind"] == "io"]
+    assert (0.12, "$IN[34]", True) in io and (0.12, "$IN[42]", True) in io
+    assert (0.12, "$OUT[2]", True) in io and (0.12, "$OUT[33]", False) in io
+    notes = [e["text"] for e in events if e["kind"] == "message"]
+    assert notes[0].startswith("stub: P00 (the backup has no P00 of its own (KUKA's R1/TP/p00.src); "
+                               "the project's standard P00 runs (interp/basis/kuka/p00.src))")
+    assert {n: (w, c) for n, w, c in rt.kss.summary()}["P00"] == ("standard program", 3)
+
+
+@pytest.mark.parametrize("interp", INTERPS)
+def test_brake_outside_an_interrupt_routine_is_an_error_at_its_line(tmp_path, interp):
+    prog = write(tmp_path, "brk.src", "DEF brk()\n  PTP {A1 10, A2 -90, A3 90, A4 0, A5 0, A6 0}\n  BRAKE\n  $OUT[1] = TRUE\nEND\n")
+    _rt, res, _ = _run(prog, interp)
+    assert (res.reason, res.line) == ("error", 3)
+    assert res.text.startswith("BRAKE outside an interrupt routine")
+
+
+def test_eki_check_is_in_the_ethernetkrl_table(tmp_path):
+    prog = write(tmp_path, "eki.src", """
+    DEF eki()
+      DECL EKI_STATUS ret
+      ret = EKI_Init("XmlCallBack")
+      EKI_CHECK(ret, #QUIT, "XmlCallBack")
+    END
+    """)
+    out = CliRunner().invoke(main, ["check", str(prog)])
+    assert out.exit_code == 0, out.output
+    assert "EKI_CHECK" not in out.output
+
+
+# ---------------------------------------------------------------------- set the scene
+HOME_PROG = """
+DEF home()
+  E6AXIS here
+  here = $AXIS_ACT
+  $OUT[1] = (here.A1 > 44.9) AND (here.A1 < 45.1) AND (here.A2 > -100.1) AND (here.A2 < -99.9)
+  HALT
+  $OUT[2] = TRUE
+  HALT
+  $OUT[3] = TRUE
+END
+"""
+
+
+def test_start_places_the_robot_and_on_halt_continue_presses_start(tmp_path):
+    prog = write(tmp_path, "home.src", HOME_PROG)
+    write(tmp_path, "home.dat", "DEFDAT home\nDECL E6AXIS XSTART={A1 45.0,A2 -100.0,A3 100.0,A4 0.0,A5 30.0,"
+                                "A6 0.0,E1 0.0,E2 0.0,E3 0.0,E4 0.0,E5 0.0,E6 0.0}\nENDDAT\n")
+    runner = CliRunner()
+    out = runner.invoke(main, ["run", str(prog), "--start", "XSTART", "--on-halt", "continue"])
+    assert out.exit_code == 0, out.output
+    assert "start      XSTART" in out.output
+    assert "HALT at home.src:5: Start pressed again (1 of 10, --on-halt continue)" in out.output
+    out = runner.invoke(main, ["run", str(prog), "--start", "{A1 45, A2 -100, A3 100, A5 30}",
+                               "--on-halt", "continue:1"])
+    assert out.exit_code == 3 and "stopped by HALT" in out.output   # the second HALT ends it
+    out = runner.invoke(main, ["run", str(prog)])                    # $AXIS_HOME: $OUT[1] FALSE
+    assert out.exit_code == 3 and "I/O        0 change(s)" in out.output
+    for bad, why in (("NOWHERE", "no point NOWHERE"), ("{A1 500}", "software limit switch +A1"),
+                     ("1+2", "not an E6AXIS literal")):
+        out = runner.invoke(main, ["run", str(prog), "--start", bad])
+        assert out.exit_code == 2 and why in out.output and "Traceback" not in out.output, out.output
+    cell = write(tmp_path, "cell.yaml", "start: XSTART\n")
+    out = runner.invoke(main, ["run", str(prog), "--inputs", str(cell)])
+    assert "start      XSTART" in out.output and "$OUT 1" in out.output

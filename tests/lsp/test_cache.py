@@ -1,0 +1,132 @@
+"""The language server's persistent parse and check cache (krl/lsp/cache.py): entries decode to
+exactly what was parsed, a workspace opened again gets its files from the cache and its
+diagnostics before its check, and a corrupt or hostile entry is ignored (parsed again), never
+trusted."""
+
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+import msgpack
+import pytest
+
+from krl.lsp import cache as C
+from krl.lsp.paths import norm
+from krl.lsp.project import Project
+from krl.workspace import load_file
+from tests.lsp.conftest import BACKUP
+
+
+def rows(diags):
+    return [(d.path, d.line, d.column, d.code, d.message, d.end_line, d.end_column, d.help,
+             [(n.path, n.line, n.column, n.message) for n in d.notes]) for d in diags]
+
+
+def spans(m):
+    return [(type(n).__name__, n.span.file, n.span.line, n.span.column, getattr(n, "end_line", 0)) for n in m.walk()]
+
+
+def test_entries_decode_to_what_was_parsed(shared_corpus: Path):
+    """Every file of a real backup: AST (spans included), diagnostics, template folds, status."""
+    backup = shared_corpus / "rawpython__kukaKRLmagic"
+    files = sorted(p for p in backup.rglob("*") if p.suffix.lower() in (".src", ".dat", ".sub") and p.is_file())
+    assert len(files) > 20
+    for f in files:
+        lf = load_file(f)
+        data = C.encode_loaded(lf)
+        assert data is not None, f
+        back = C.decode_loaded(data, lf.path)
+        assert back.module == lf.module and spans(back.module) == spans(lf.module), f
+        assert rows(back.diagnostics) == rows(lf.diagnostics)
+        assert (back.ok, back.status, back.unreadable, back.failed_words, back.template) == \
+            (lf.ok, lf.status, lf.unreadable, lf.failed_words, lf.template)
+
+
+@pytest.mark.parametrize("body", [
+    [],                                             # too short
+    [[999, 1, 1], True, "ok", [], False, [], [], []],          # no such node class
+    [[C._INDEX[C.N.Module], 1, 1], True, "ok", [], False, [], [], []],     # a node of another shape
+    [None, True, "ok", [], False, [], [], []],       # not a module
+    [[C._INDEX[C.N.Module], 1, 1, [C._LIST], [C._LIST], None, "x"], True, "ok", [[1, 1, "E", "m"]], False, [], [], []],
+])
+def test_a_hostile_entry_is_refused(body):
+    with pytest.raises(C.CorruptEntry):
+        C.decode_loaded(msgpack.packb(body), "/w/x.src")
+
+
+def test_the_cache_serves_a_workspace_opened_again(tmp_path: Path):
+    shutil.copytree(BACKUP, tmp_path / "KRC")
+    main = norm(tmp_path / "KRC" / "R1" / "Program" / "main.src")
+    store = C.Store(tmp_path / "cache")
+    assert store.db is not None
+    first = Project(store=store)
+    an = first.analyze(main, docs={})
+    assert store.hits == 0 and store.misses == 5
+    cached: list = []
+    again = Project(store=store)
+    an2 = again.analyze(main, docs={}, on_cached=lambda root, diags: cached.append(diags))
+    assert store.hits >= 5                              # every file from the cache
+    assert rows(an2.ws.diagnostics) == rows(an.ws.diagnostics)
+    assert cached and rows(cached[0]) == rows(an.ws.diagnostics)      # before the check: the same
+    # a file changed on disk is parsed again, not taken from the cache
+    tools = tmp_path / "KRC" / "R1" / "Program" / "tools.src"
+    tools.write_text(tools.read_text() + "\n; changed\n")
+    third = Project(store=store)
+    misses = store.misses
+    third.analyze(main, docs={})
+    assert store.misses == misses + 1                   # tools.src
+
+
+def test_a_corrupt_database_entry_is_parsed_again(tmp_path: Path):
+    shutil.copytree(BACKUP, tmp_path / "KRC")
+    main = norm(tmp_path / "KRC" / "R1" / "Program" / "main.src")
+    store = C.Store(tmp_path / "cache")
+    an = Project(store=store).analyze(main, docs={})
+    store.db.execute("UPDATE entries SET data = X'00112233' WHERE kind = 'parse'")
+    store.db.commit()
+    corrupt = store.corrupt
+    an2 = Project(store=store).analyze(main, docs={})
+    assert store.corrupt == corrupt + 5
+    assert rows(an2.ws.diagnostics) == rows(an.ws.diagnostics)
+
+
+def test_the_database_keeps_within_its_limit(tmp_path: Path, monkeypatch):
+    monkeypatch.setattr(C, "MAX_LSP_CACHE_BYTES", 4000)
+    store = C.Store(tmp_path / "cache")
+    for k in range(40):
+        store.put("parse", {f"k{k}": bytes(200)})
+    size = store.db.execute("SELECT SUM(LENGTH(data)) FROM entries").fetchone()[0]
+    assert size <= 4000
+    assert store.get("parse", ["k39"])                  # the latest kept
+
+
+def test_no_cache_when_the_folder_cannot_be_made(tmp_path: Path):
+    blocker = tmp_path / "file"
+    blocker.write_text("x")
+    store = C.Store(blocker / "cache")
+    assert store.db is None
+    assert store.get("parse", ["a"]) == {}
+    store.put("parse", {"a": b"x"})                     # never raises
+
+
+def test_the_cached_diagnostics_come_before_any_parse_is_decoded(tmp_path: Path, monkeypatch):
+    """The check's key needs only the files' content hashes: the cached diagnostics of a
+    workspace opened again are handed over before the first parse entry is decoded, with the
+    opened file's buffer as it is on disk and with a buffer edited in a session before."""
+    shutil.copytree(BACKUP, tmp_path / "KRC")
+    main = norm(tmp_path / "KRC" / "R1" / "Program" / "main.src")
+    text = Path(main).read_text()
+    edited = text.replace("\nEND", "\n  no_such_name = 1\nEND", 1)      # an undeclared name: a finding
+    assert edited != text
+    store = C.Store(tmp_path / "cache")
+    for docs in ({main: text}, {main: edited}):
+        expected = Project(store=store).analyze(main, docs=docs).ws.diagnostics
+        assert bool(expected) == (docs[main] is edited)
+        events: list = []
+        decode = C.decode_loaded
+        monkeypatch.setattr(C, "decode_loaded", lambda data, path: events.append("decoded") or decode(data, path))
+        an = Project(store=store).analyze(main, docs=docs, on_cached=lambda root, diags: events.append(rows(diags)))
+        monkeypatch.undo()
+        assert events[0] == rows(expected) == rows(an.ws.diagnostics)
+        assert events.count("decoded") >= 4 and len([e for e in events if e != "decoded"]) == 1

@@ -1,0 +1,159 @@
+"""Test harness of the pendant: `krl pendant` started as the user starts it (a subprocess, its
+first line the URL with the token), and the page in Debian's Chromium driven by Playwright
+(PyPI playwright given /usr/bin/chromium as its executable; the flags of the machine notes).
+
+Waits are conditions on the page's state (``window.pendant``), with generous time limits for a
+loaded machine; no assertion depends on how long anything took.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import tempfile
+from contextlib import contextmanager
+from pathlib import Path
+
+import pytest
+
+from tests.conftest import REPO_ROOT, SHARED_CORPUS
+
+CHROMIUM = "/usr/bin/chromium"
+FLAGS = ["--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run", "--disable-background-networking",
+         "--disable-component-update", "--disable-sync"]
+KR120 = SHARED_CORPUS / "khrzysio__KRC4_test"
+PALLETIZER = SHARED_CORPUS / "ingeniado__KRC4-Robot-Palletizer"
+MILLING = SHARED_CORPUS / "HugoDanielson__ChinaMilling"
+CELLS = REPO_ROOT / "corpus" / "cells"
+WAIT_MS = 300_000         # a selection loads and checks a whole backup: minutes on a loaded machine
+
+
+def chromium_or_skip() -> str:
+    from tests.apt import apt_install  # noqa: PLC0415
+
+    if not Path(CHROMIUM).exists() and apt_install("chromium", "chromium") is None:
+        pytest.skip("chromium is not installed and cannot be installed with apt-get "
+                    "(not root, no apt-get, or no package source)")
+    return CHROMIUM
+
+
+@contextmanager
+def pendant_server(target: Path, *args: str):
+    """`krl pendant TARGET --no-browser ARGS...`: yields the URL it printed first. Its stderr
+    goes to a file (a pipe nobody reads would stall the server once full), shown on failure."""
+    cmd = [sys.executable, "-m", "krl.cli", "pendant", str(target), "--no-browser", *args]
+    with tempfile.TemporaryFile("w+") as err:
+        proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=err, text=True, cwd=REPO_ROOT,
+                                env={**os.environ, "PYTHONUNBUFFERED": "1"})
+        try:
+            url = proc.stdout.readline().strip()
+            if not url.startswith("http://127.0.0.1:"):
+                proc.kill()
+                proc.wait(30)
+                err.seek(0)
+                raise AssertionError(f"krl pendant printed {url!r} first; stderr:\n{err.read()[-3000:]}")
+            try:
+                yield url
+            except BaseException:
+                err.seek(0)
+                print(f"krl pendant's stderr:\n{err.read()[-5000:]}", file=sys.stderr)
+                raise
+        finally:
+            proc.terminate()
+            try:
+                proc.wait(30)
+            except subprocess.TimeoutExpired:
+                proc.kill()
+                proc.wait(30)
+
+
+@contextmanager
+def browser_page(pw, url: str, viewport=(1400, 900)):
+    """A fresh headless Chromium profile with the page loaded and its robot drawn; page errors
+    are collected in ``page.problems``."""
+    with tempfile.TemporaryDirectory() as profile:
+        # bypass_csp: Playwright's wait_for_function evaluates its predicate, which the page's
+        # Content-Security-Policy (script-src 'self') forbids; the page itself runs under it
+        ctx = pw.chromium.launch_persistent_context(profile, executable_path=chromium_or_skip(), headless=True,
+                                                    args=FLAGS, bypass_csp=True,
+                                                    viewport={"width": viewport[0], "height": viewport[1]})
+        # every Playwright wait and action (a click waits for its element) gets the loaded
+        # machine's time limit, not Playwright's 30 s
+        ctx.set_default_timeout(WAIT_MS)
+        try:
+            page = ctx.new_page()
+            page.problems = []
+            page.on("pageerror", lambda e: page.problems.append(f"page error: {e}"))
+            page.on("console", lambda m: page.problems.append(f"console: {m.text}") if m.type == "error" else None)
+            page.goto(url)
+            page.wait_for_function("() => window.pendant && window.pendant.robot", timeout=WAIT_MS)
+            yield page
+        finally:
+            ctx.close()
+
+
+def state(page) -> dict:
+    return page.evaluate("() => window.pendant.state")
+
+
+def wait_state(page, predicate_js: str, timeout: int = WAIT_MS) -> dict:
+    """Wait until ``predicate_js`` (a JS expression over ``s``, the page's state) holds."""
+    page.wait_for_function(f"() => {{ const s = window.pendant.state; return !!s && ({predicate_js}); }}",
+                           timeout=timeout)
+    return state(page)
+
+
+def act(page, op: str, **args) -> None:
+    """Send an operator action through the page's own connection and wait for its answer (a
+    refusal raises)."""
+    page.evaluate("([op, args]) => window.pendant.send(op, args)", [op, args])
+
+
+def select(page, program: str, *, run_mode: str = "MSTEP", mode: str = "T1") -> dict:
+    """Choose the modes and select ``program`` with the page's own controls; the state at the
+    program's first statement."""
+    page.select_option("#mode-op", mode)
+    wait_state(page, f"s.modeOp == '{mode}'")
+    page.select_option("#run-mode", run_mode)
+    wait_state(page, f"s.runMode == '{run_mode}'")
+    page.select_option("#programs", program)
+    page.click("#select")
+    s = wait_state(page, f"s.state == 'stopped' && s.stop && s.stop.reason == 'entry' && s.program && "
+                         f"s.program.endsWith({json.dumps(Path(program).name)})")
+    if not s.get("drives"):
+        page.click("#drives")
+        s = wait_state(page, "s.drives")
+    return s
+
+
+def wait_drawn(page) -> None:
+    """Wait until the 3D view has drawn a frame of what the page holds now: a frame is asked for
+    and drawn (the page renders on demand, pendant/web/src/main.js)."""
+    before = page.evaluate("() => { window.pendant.requestRender(); return window.pendant.frames; }")
+    page.wait_for_function(f"() => !window.pendant.renderPending() && window.pendant.frames > {before}")
+
+
+def read_trace(path: Path) -> list[dict]:
+    return [json.loads(line) for line in path.read_text().splitlines() if line.strip()]
+
+
+def pose_at(events: list[dict], t: float) -> list[float]:
+    """The axes of the last pose event at or before ``t`` (s)."""
+    last = None
+    for e in events:
+        if e["kind"] == "pose" and e["t"] <= t + 1e-9:
+            last = e["axes"]
+    assert last is not None, f"no pose at or before t={t}"
+    return last
+
+
+def cell_without(cell: Path, signal: str, out: Path) -> Path:
+    """The cell file ``cell`` without the rules that set ``signal`` (written to ``out``)."""
+    import yaml  # noqa: PLC0415
+
+    doc = yaml.safe_load(cell.read_text())
+    doc["rules"] = [r for r in doc.get("rules", []) if signal not in (r.get("set") or {})]
+    out.write_text(yaml.safe_dump(doc))
+    return out

@@ -1,0 +1,164 @@
+"""Hostile requests to `krl pendant` (issue 36, docs/security.md "The pendant's web server"):
+each is refused. The server is the real command on 127.0.0.1; the websocket client is the
+`websockets` package's, the HTTP client the standard library's."""
+
+from __future__ import annotations
+
+import asyncio
+import http.client
+import json
+from pathlib import Path
+from urllib.parse import urlsplit
+
+import pytest
+import websockets
+
+from krl.limits import MAX_WEB_MESSAGE_BYTES, MAX_WEB_MESSAGES_PER_S
+from tests.pendant.harness import browser_page, pendant_server, select
+
+PWNED = '<img src=x onerror="window.pwned=1"><script>window.pwned=1</script>'
+
+
+@pytest.fixture(scope="module")
+def workspace(tmp_path_factory) -> Path:
+    """A folder of KRL with markup in its text and in a file name, and a secret beside it."""
+    root = tmp_path_factory.mktemp("ws")
+    ws = root / "cell"
+    ws.mkdir()
+    (ws / "prog.src").write_text(f"DEF prog()\n  ; {PWNED}\n  $OUT[1] = TRUE\nEND\n", encoding="utf-8")
+    (ws / "prog.dat").write_text("DEFDAT prog\nDECL E6POS XP1={X 1.0,Y 2.0,Z 3.0,A 0.0,B 0.0,C 0.0,S 2,T 0}\nENDDAT\n")
+    (root / "secret.dat").write_text("DEFDAT secret\nENDDAT\n")
+    return ws
+
+
+@pytest.fixture(scope="module")
+def server(workspace):
+    with pendant_server(workspace, "--no-realtime") as url:
+        yield url
+
+
+def _parts(url: str):
+    u = urlsplit(url)
+    return u.hostname, u.port, u.query.split("token=", 1)[1]
+
+
+def _get(url: str, path: str, headers: dict | None = None) -> int:
+    host, port, _ = _parts(url)
+    c = http.client.HTTPConnection(host, port, timeout=30)
+    c.request("GET", path, headers=headers or {})
+    status = c.getresponse().status
+    c.close()
+    return status
+
+
+def test_http_needs_token_host_and_origin(server):
+    host, port, token = _parts(server)
+    assert host == "127.0.0.1"                                   # loopback only
+    assert _get(server, f"/?token={token}") == 200
+    assert _get(server, "/") == 403                              # no token
+    assert _get(server, "/?token=" + "x" * len(token)) == 403    # wrong token
+    assert _get(server, "/", {"Authorization": "token nope"}) == 403
+    assert _get(server, f"/?token={token}", {"Host": "evil.example"}) == 400          # DNS rebinding
+    assert _get(server, f"/?token={token}", {"Origin": "http://evil.example"}) == 403  # cross-site
+    assert _get(server, f"/static/../../../etc/passwd?token={token}") in (400, 403, 404)
+    assert _get(server, f"/static/%2e%2e/%2e%2e/secret.dat?token={token}") in (400, 403, 404)
+
+
+async def _ws(url: str, origin: str | None, token: str | None):
+    host, port, good = _parts(url)
+    q = f"?token={token}" if token is not None else ""
+    headers = {"Origin": origin} if origin else {}
+    return await websockets.connect(f"ws://{host}:{port}/ws{q}", additional_headers=headers,
+                                    max_size=None, open_timeout=30)
+
+
+def _refused(url, origin, token) -> bool:
+    async def go():
+        try:
+            ws = await _ws(url, origin, token)
+        except websockets.exceptions.InvalidStatus as exc:
+            return exc.response.status_code == 403
+        await ws.close()
+        return False
+    return asyncio.run(go())
+
+
+def test_websocket_needs_token_and_origin(server):
+    host, port, token = _parts(server)
+    own = f"http://{host}:{port}"
+    assert _refused(server, own, None)                       # no token
+    assert _refused(server, own, "wrong")                    # wrong token
+    assert _refused(server, "http://evil.example", token)    # cross-site websocket hijacking
+    assert _refused(server, None, token)                     # no Origin
+    assert not _refused(server, own, token)
+
+
+def _session(url: str, messages: list) -> list:
+    """Send ``messages`` on one accepted connection; the answers (or the close code)."""
+    host, port, token = _parts(url)
+
+    async def go():
+        ws = await _ws(url, f"http://{host}:{port}", token)
+        out = []
+        try:
+            for m in messages:
+                await ws.send(m if isinstance(m, str) else json.dumps(m))
+                while True:
+                    a = json.loads(await asyncio.wait_for(ws.recv(), 120))
+                    if a["type"] in ("done", "error"):
+                        out.append(a)
+                        break
+        except websockets.exceptions.ConnectionClosed as exc:
+            out.append({"closed": exc.rcvd.code if exc.rcvd else None})
+        finally:
+            await ws.close()
+        return out
+    return asyncio.run(go())
+
+
+def test_paths_outside_the_workspace_are_refused(server, workspace):
+    secret = str(workspace.parent / "secret.dat")
+    answers = _session(server, [
+        {"op": "open", "id": 1, "path": "../secret.dat"},
+        {"op": "open", "id": 2, "path": secret},
+        {"op": "open", "id": 3, "path": "/etc/passwd"},
+        {"op": "select", "id": 4, "program": "../../../../etc/passwd"},
+        {"op": "touchup", "id": 5, "path": secret, "name": "XP1"},
+        {"op": "breakpoint", "id": 6, "path": "/etc/hosts", "line": 1, "on": True},
+        {"op": "open", "id": 7, "path": "prog.src"},
+    ])
+    for a in answers[:6]:
+        assert a["type"] == "error" and ("outside the workspace" in a["text"] or "no such file" in a["text"]
+                                         or "not a" in a["text"]), a
+    assert answers[6]["type"] == "done"
+
+
+def test_bad_and_oversized_messages(server):
+    answers = _session(server, ["not json", {"op": "rm -rf", "id": 1}, {"op": "watch", "id": 2, "exprs": ["x" * 10_000]}])
+    assert [a["type"] for a in answers] == ["error", "error", "error"]
+    assert _session(server, ["x" * (MAX_WEB_MESSAGE_BYTES + 1)]) == [{"closed": 1009}]
+
+    host, port, token = _parts(server)
+
+    async def flood():
+        # sent without waiting for answers until the server closes the connection: however
+        # slowly the server carries the actions out, it counts them as they arrive
+        ws = await _ws(server, f"http://{host}:{port}", token)
+        try:
+            for i in range(MAX_WEB_MESSAGES_PER_S * 100):
+                await ws.send(json.dumps({"op": "drives", "id": i, "on": False}))
+            while True:
+                await asyncio.wait_for(ws.recv(), 300)
+        except websockets.exceptions.ConnectionClosed as exc:
+            return exc.rcvd.code if exc.rcvd else None
+    assert asyncio.run(flood()) == 1008
+
+
+@pytest.mark.may_skip("chromium is missing and cannot be installed (not root, or apt-get has no network)")
+def test_krl_text_is_shown_as_text(pw, server):
+    with browser_page(pw, server) as page:
+        select(page, "prog.src", run_mode="GO", mode="T1")
+        page.wait_for_selector('#program-view .ln[data-line="2"]')
+        assert PWNED in page.locator('#program-view .ln[data-line="2"] .tx').inner_text()
+        assert page.evaluate("() => window.pwned") is None
+        assert page.locator("#program-view img, #program-view script").count() == 0
