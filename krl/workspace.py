@@ -603,13 +603,22 @@ class Workspace:
                 if rec.body_diags is not None and self._reported(rec.unit.src)]
         return out
 
-    def _report(self) -> None:
-        """The unresolved-name report (krl/semantics/outside.py) from every recorded use, in
-        the order a check records them."""
+    def unresolved(self) -> Unresolved | None:
+        """The names of the last check that the workspace does not declare
+        (krl/semantics/outside.py ``Unresolved``: every recorded use, in the order a check
+        records them, with the evidence that KUKA's software declares them); None before a
+        check. The run's stand-ins for KUKA's system software read it (interp/runtime/kss.py)."""
+        if self._state is None:
+            return None
         un = Unresolved(load_builtins().packages, self.maybe_declared)
         for _diags, uses in self._owners():
             for use in uses.items:
                 un.use(*use)
+        return un
+
+    def _report(self) -> None:
+        """The unresolved-name report (krl/semantics/outside.py) from every recorded use."""
+        un = self.unresolved()
         self._state.report = DiagnosticSink()
         un.finish(self._state.report)
 

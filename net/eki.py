@@ -301,7 +301,9 @@ class Channel:
             self.cfg.receive[0] if self.cfg.receive and self.cfg.receive[0].tag.upper() == path.strip().upper() else None)
 
     def _build(self, path: str) -> bytes | None:
-        """The XML text of the send elements under `path`, with the values set."""
+        """The XML text of the send elements under `path`, with the values set, inside the
+        elements above `path` (the document's root down to it); None when nothing is
+        configured under `path`."""
         key = path.strip().strip("/")
         keyu = key.upper()
         els = [e for e in self.cfg.send
@@ -338,20 +340,10 @@ class Channel:
                 node.set(attr, v)
             else:
                 node.text = v
-        # the part under `path`: the element it names
-        target = root
-        for p in key.split("/")[1:]:
-            if p.startswith("@"):
-                break
-            nxt = None
-            for c in target:
-                if c.tag.upper() == p.upper():
-                    nxt = c
-                    break
-            if nxt is None:
-                return None
-            target = nxt
-        return ET.tostring(target, encoding="unicode", short_empty_elements=True).encode("utf-8")
+        # the part under `path` inside its ancestors, its siblings left out (KUKA.EthernetKRL
+        # 2.2 manual, EKI_Send's example "Sending part of the XML structure":
+        # EKI_Send(CH, "Robot/ActPos") sends <Robot><ActPos X=".."></ActPos></Robot>)
+        return ET.tostring(root, encoding="unicode", short_empty_elements=True).encode("utf-8")
 
 
 def _values(root, el: Element) -> list:

@@ -154,6 +154,17 @@ class Network:
             return any(k >= self.ctl.cycle for k in self.replay)
         return False
 
+    def next_event_cycle(self, k: int) -> int | None:
+        """The first IPO cycle after cycle `k` in which a message can arrive (the idle
+        fast-forward, interp/runtime/idle.py, never jumps past it): the next one while a
+        partner is attached (it runs on the wall clock) or an RSI object is on (each cycle
+        has its exchange, or its late packet), the next recorded cycle of a replay, None
+        when nothing can arrive."""
+        if self.attached or (self.rsi is not None and self.rsi.on):
+            return k + 1
+        later = [c for c in self.replay if c > k] if self.replay else []
+        return min(later) if later else None
+
     def close(self) -> None:
         """Close every socket and stop the servers (the run ended; EKI channels of
         ENVIRONMENT Program are deleted at a program's end)."""

@@ -413,15 +413,18 @@ class Controller:
     def next_event_cycle(self) -> int | None:
         """The first IPO cycle at which the controller changes something by itself while the
         program does nothing: a timed stimulus, a stimulus delay that runs, a cell rule's
-        pending answer, a PULSE's reset. None when there is none. (A cycle ``k`` is the one
-        whose :meth:`step` makes ``time = k · dt``.)"""
+        pending answer, a PULSE's reset, the network's next message (net.hub.Network: any
+        cycle while a partner is attached, the next recorded one of a replay). None when
+        there is none. (A cycle ``k`` is the one whose :meth:`step` makes ``time = k · dt``.)"""
         times = [st.at if st.at is not None else st.due for st in self.stimuli
                  if not st.fired and (st.at is not None or st.due is not None)]
         times += [r.due[0] for r in self.rules if r.due]
         times += [te for te, _, _ in self._pulses]
+        net = self.network.next_event_cycle(self._k) if self.network is not None else None
         if not times:
-            return None
-        return max(self._k + 1, int(math.ceil(min(times) / self.dt - EPS)))
+            return net
+        k = max(self._k + 1, int(math.ceil(min(times) / self.dt - EPS)))
+        return k if net is None else min(k, net)
 
     def skip(self, cycles: int) -> None:
         """Fast-forward `cycles` IPO cycles in which nothing happens (interp/runtime/idle.py

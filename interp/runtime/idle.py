@@ -28,7 +28,8 @@ nothing outside them changes before the next *event*. When the main run is at re
 (``Controller.at_rest``: nothing suspended, braking or blending, every motion executing or
 queued a motion that does not move the robot, no cell rule about to fire) the clock jumps to
 the cycle before that event: a timed stimulus or its delay, a cell rule's pending answer (an
-answer of ``--inputs auto`` included), a PULSE's reset, the end of a task's ``WAIT SEC``, the
+answer of ``--inputs auto`` included), a PULSE's reset, a network message (any cycle while a partner
+is attached or RSI is on, the next recorded one of a replay), the end of a task's ``WAIT SEC``, the
 time limit (``Controller.skip``: time, path time and running timers advance exactly), so the
 event is processed by the ordinary IPO cycle at its exact time. An interrupt condition is a function of
 the state: it cannot rise while the state stands still. The skipped cycles execute no

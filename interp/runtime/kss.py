@@ -154,7 +154,7 @@ class SystemSoftware:
         if self._outside is None:
             out: dict = {}
             ws = self.rt.program.ws
-            unresolved = getattr(getattr(ws, "phases", {}).get("declarer"), "unresolved", None)
+            unresolved = ws.unresolved()
             if unresolved is not None:
                 for (kind, key), (name, uses) in unresolved.uses.items():
                     if kind == "sysvar" and key not in unresolved.packages and not any(u.evidence for u in uses):

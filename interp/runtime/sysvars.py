@@ -434,7 +434,18 @@ _LIVE = {
     "$PRO_MOVE": _computed(lambda sv: bool(sv.rt.controller.is_moving())),
     "$STOPMESS": _computed(_ro_const(False)),
     "$POWER_FAIL": _computed(_ro_const(False)),
-    "$ALARM_STOP": _computed(_ro_const(False)),
+    # the EMERGENCY STOP signals are active-low, TRUE while no EMERGENCY STOP is pressed (KSS
+    # 8.x System Integrators, Automatic External outputs: "ALARM_STOP: this output is reset
+    # in the event of an EMERGENCY STOP"; $machine.dat: SIGNAL $ALARM_STOP ;NOT-STOP,
+    # $ALARM_STOP_INTERN ;NOT-STOP INTERN): the simulated cell has no EMERGENCY STOP
+    "$ALARM_STOP": _computed(_ro_const(True)),
+    "$ALARM_STOP_INTERN": _computed(_ro_const(True)),
+    # every condition to start a motion holds (drives enabled, motion enable): what a KR C4
+    # in AUT/EXT reads while nothing holds it; $MOVE_ENABLE is the one the program can drop
+    "$COULD_START_MOTION": _computed(lambda sv: bool(sv.store.get("$MOVE_ENABLE", True))),
+    # a process is active at robot level: a robot program (or its interrupt) is being run
+    # (KSS 8.x System Integrators, Automatic External outputs, PRO_ACT)
+    "$PRO_ACT": _computed(lambda sv: bool(sv.rt.interpreter_active(True))),
     "$ON_PATH": _computed(_ro_const(True)),
     "$MODE_OP": _computed(lambda sv: EnumValue(sv.rt.mode_op)),
     "$T1": _computed(lambda sv: sv.rt.mode_op == "T1"),

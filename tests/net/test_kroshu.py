@@ -17,7 +17,9 @@ The corpus's KSS copy has no ``status.dat`` and no ``logging.src``; the test's b
 them from the same SDK's iiQKA copy (copied into a temporary folder, never into the repository;
 the SDK repository's own KSS ``logging.src`` is the same code, docs/network.md "Decisions").
 The robot program is the one CMD_START would select: ``CWRITE($CMD, .., "RUN/...")`` from the
-submit interpreter is not simulated."""
+submit interpreter is not simulated (docs/network.md, Decisions), so the run starts it.
+``EKI_Send(CH, "Robot/Init")`` sends the part inside its root (``<Robot><Init .../></Robot>``),
+as KUKA's EthernetKRL manual shows a partial send."""
 
 from __future__ import annotations
 
@@ -111,12 +113,7 @@ def rsi_client(target: np.ndarray, box: dict):
     return serve, sock.getsockname()
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "not met yet (docs/network.md, Decisions): the status check of status.src reads "
-    "$ALARM_STOP_INTERN and $COULD_START_MOTION, which the simulator does not declare "
-    "(the submit stops with 1422 after CMD_CON's Init); EKI_Send of a partial path sends the "
-    "element without its ancestors (<Init/>, not <Robot><Init/></Robot>)"))
-@pytest.mark.parametrize("interp", ["tree"])      # "vm" joins once it passes
+@pytest.mark.parametrize("interp", ["tree", "vm"])
 def test_kroshu_external_control_sdk(kroshu_backup, interp):
     program, sub = kroshu_backup
     target = np.array([10.0, -80.0, 85.0, 5.0, 35.0, -20.0])
@@ -160,6 +157,11 @@ def test_kroshu_external_control_sdk(kroshu_backup, interp):
     statuses = [d.find("Status") for d in seen if d.find("Status") is not None]
     assert statuses and statuses[0].get("OperationMode") == "3"
     assert statuses[0].get("DrivesPowered") in ("0", "1")
+    # no EMERGENCY STOP ($ALARM_STOP, $ALARM_STOP_INTERN active-low: TRUE), operator safety
+    # closed ($USER_SAF), and the robot program (started with the run) active with nothing
+    # holding motion ($COULD_START_MOTION AND $PRO_ACT)
+    assert statuses[0].get("EmergencyStop") == "0" and statuses[0].get("GuardStop") == "0"
+    assert statuses[0].get("MotionPossible") == "1"
     # the RSI program: the axes reached the target the client commanded, every packet
     # carried the robot's axes, and the client's Stop ended RSI_MOVECORR: the program ran to
     # its end (RSI_OFF, PTP $AXIS_ACT_MEAS, RSI_DELETE)

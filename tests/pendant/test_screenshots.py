@@ -1,7 +1,8 @@
 """The screenshots of docs/pendant.md are the page as it is (issue 36): the page on two corpus
-backups — the KR 120 milling cell (khrzysio__KRC4_test) and the palletizer on its KR 180 PA
-(ingeniado__KRC4-Robot-Palletizer) — at a deterministic stop (MSTEP, the first motion ended),
-compared with the committed PNGs. `KRL_UPDATE_SCREENSHOTS=1` writes them anew.
+backups — the milling cell on its KR 210 R2700-2 (HugoDanielson__ChinaMilling, the robot its own
+$machine.dat names) and the palletizer on its KR 180 PA (ingeniado__KRC4-Robot-Palletizer) — at a
+deterministic stop (MSTEP, after the first real motion), compared with the committed PNGs.
+`KRL_UPDATE_SCREENSHOTS=1` writes them anew.
 
 The comparison allows what differs between two machines' software rendering (anti-aliasing,
 font hinting): at most 2 % of the pixels differ by more than 48 levels in a channel."""
@@ -16,23 +17,27 @@ import pytest
 from PIL import Image
 
 from tests.conftest import REPO_ROOT
-from tests.pendant.harness import (CELLS, KR120, PALLETIZER, browser_page, pendant_server, select, wait_drawn,
+from tests.pendant.harness import (CELLS, MILLING, PALLETIZER, browser_page, pendant_server, select, wait_drawn,
                                    wait_state)
 
 pytestmark = pytest.mark.may_skip("chromium is missing and cannot be installed (not root, or apt-get has no network)")
 
 DOCS = REPO_ROOT / "docs" / "pendant"
+# name: (backup, cell file, program, MSTEP stops). ChinaMilling's Main calls Home(), whose first
+# motion is PTP $POS_ACT (no movement); its second, PTP XHOME, moves the arm to $config.dat's XHOME.
 SHOTS = {
-    "kr120-milling": (KR120, CELLS / "khrzysio__KRC4_test.yaml", "R1/Program/CELL/Other/PrepareMillingTools.src"),
-    "palletizer": (PALLETIZER, CELLS / "ingeniado__KRC4-Robot-Palletizer.yaml", "Program/SACO_20/saco_20_m1.src"),
+    "kr210-milling": (MILLING, CELLS / "HugoDanielson__ChinaMilling.yaml", "KRC/R1/Program/KukaMiling/Main.src", 2),
+    "palletizer": (PALLETIZER, CELLS / "ingeniado__KRC4-Robot-Palletizer.yaml", "Program/SACO_20/saco_20_m1.src", 1),
 }
 
 
-def shot(pw, backup, cell, program) -> bytes:
+def shot(pw, backup, cell, program, stops) -> bytes:
     with pendant_server(backup, "--no-realtime", "--inputs", str(cell)) as url, browser_page(pw, url, (1400, 900)) as page:
         select(page, program, run_mode="MSTEP", mode="T1")
-        page.click("#start")
-        wait_state(page, "s.state == 'stopped' && s.stop && s.stop.reason == 'step'")
+        for _ in range(stops):
+            before = page.evaluate("() => window.pendant.state.pointers.step")
+            page.click("#start")
+            wait_state(page, f"s.state == 'stopped' && s.stop && s.stop.reason == 'step' && s.pointers.step > {before}")
         # everything of this stop has reached the page: the whole TCP path and the pose
         page.wait_for_function("() => { const s = window.pendant.state; return window.pendant.pathPoints === "
                                "s.path.points && window.pendant.renderedAxes().every((v, i) => "
