@@ -36,7 +36,7 @@ from dataclasses import dataclass, field
 from krl.terminal import printable
 
 from krl.semantics.advance import StmtInfo
-from interp.runtime.values import EnumValue
+from interp.runtime.values import Channel, EnumValue
 
 from . import opcodes as O
 
@@ -84,6 +84,8 @@ def fmt_const(v) -> str:
         return "FALSE"
     if isinstance(v, EnumValue):
         return "#" + v.name
+    if isinstance(v, Channel):
+        return ":" + v.name             # a channel argument (COPEN(:SER_3, HANDLE))
     if isinstance(v, int):
         return str(v)
     if isinstance(v, float):
@@ -101,6 +103,8 @@ def parse_const(tok: str):
         return True
     if tok == "FALSE":
         return False
+    if tok.startswith(":"):
+        return Channel(tok[1:])
     if tok.startswith("#"):
         return EnumValue(tok[1:])
     if tok.startswith('"'):
