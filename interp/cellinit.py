@@ -37,9 +37,10 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from krl.ast import nodes as N
+from krl.project import system_folder_of
+from krl.semantics.resolve import LOCAL, ROUTINE
 from krl.terminal import printable
 
-SKIP_DIRS = ("system", "mada", "steu")
 #: places listed per input; the rest are counted
 MAX_PLACES = 8
 
@@ -83,18 +84,17 @@ def _calls(routine: N.Routine):
 
 def _callee(call: N.Call):
     """(owner module index, Routine) a call runs, or None (a built-in, nothing declares it)."""
-    c = call.ann.storage if call.ann is not None else None
-    r = getattr(c, "routine", None)
-    return (c.owner, r) if r is not None else None
+    c = call.ann.callee if call.ann is not None else None
+    return (c.owner, c.routine) if c is not None and c.kind == ROUTINE else None
 
 
 def _param_index(e, routine: N.Routine) -> int | None:
     """The parameter of `routine` that the Name `e` is, or None."""
-    if not isinstance(e, N.Name) or e.ann is None or e.ann.storage is None:
+    if not isinstance(e, N.Name) or e.ann is None or e.ann.place is None:
         return None
-    st = e.ann.storage
-    layout = routine.ann.storage if routine.ann is not None else None
-    if getattr(st, "kind", None) == 0 and layout is not None and st.slot < layout.nparams:
+    st = e.ann.place
+    layout = routine.ann.layout if routine.ann is not None else None
+    if st.kind == LOCAL and layout is not None and st.slot < layout.nparams:
         return st.slot
     return None
 
@@ -120,7 +120,8 @@ def _skipped(path: str, root: Path) -> bool:
         rel = p.resolve().relative_to(root.resolve())
     except ValueError:
         return True        # the project's BASIS, or a file outside the backup
-    return p.name.startswith("$") or any(x.lower() in SKIP_DIRS for x in rel.parts[:-1])
+    # KUKA's system folders (krl/project.py), but TP: P00's handshake reads cell inputs
+    return p.name.startswith("$") or system_folder_of(rel) not in (None, "tp")
 
 
 def reachable(rt, program: Path | None) -> list[tuple[N.Routine, object]]:

@@ -60,7 +60,7 @@ from pathlib import Path
 
 from interp.runtime.core import TARGET_OUTSIDE_NOTE
 from krl.files import SHARED_CORPUS as DEFAULT_CORPUS
-from krl.project import backup_of, find_backups, system_folder
+from krl.project import backup_of, find_backups, system_folder, system_folder_of
 
 LEGITIMATE = ("deadlock", "halt", "max_sim_time", "max_steps")
 
@@ -166,9 +166,10 @@ def programs_of(root: Path) -> list[Path]:
     for p in sorted(root.rglob("*")):
         if p.suffix.lower() != ".src" or not p.is_file():
             continue
-        parts = [x.upper() for x in p.relative_to(root).parts]
-        if "SYSTEM" in parts or "TP" in parts or "MADA" in parts:
+        rel = p.relative_to(root)
+        if system_folder_of(rel) is not None:        # KUKA's system folders (krl/project.py)
             continue
+        parts = [x.upper() for x in rel.parts]
         if "PROGRAM" in parts or p.stem.upper() == "CELL" or p.parent == root:
             cands.append(p)
     out = []
@@ -220,27 +221,29 @@ def step_limit(max_steps: int, max_sim_time: float, n_submits: int, ipo_cycle_s:
     return max_steps + n_submits * SUBMIT_BUDGET * cycles
 
 
-def time_limit(path: Path, cell: Path | None, default: float) -> float:
+def time_limit(path: Path, cell, default: float) -> float:
     """The simulated-time limit (s) of a run of `path`: `default`, or the longer time its cell
-    file says the program needs (``sim_time``, robot/stimuli.py)."""
+    file (a path or a Cell: interp.run.cell_of) says the program needs (``sim_time``,
+    robot/stimuli.py)."""
     if cell is None:
         return default
-    from robot.stimuli import load_cell  # noqa: PLC0415
+    from interp.run import cell_of  # noqa: PLC0415
 
-    return max(default, load_cell(cell).sim_time.get(path.stem.upper(), 0.0))
+    return max(default, cell_of(cell).sim_time.get(path.stem.upper(), 0.0))
 
 
 def report_run(path: Path, cell: Path | None, max_sim_time: float = REPORT_SIM_TIME_S,
                max_steps: int = REPORT_STEPS, auto: bool = False) -> tuple:
     """``(robot, submit programs, simulated-time limit s, step limit)`` of the report's run of
-    `path` with its cell file, or with ``--inputs auto`` (`auto`; this report and the
-    conformance report's real programs): the cell's robot, else the backup's own, else (auto)
-    the library robot that reaches the backup's points, else the KR 6 R900
-    (interp.run.robot_for); the backup's SPS.SUB (none for the SPS.SUB itself: it runs as the
-    program, at a submit interpreter's pace); :func:`time_limit` (auto: the longer
+    `path` with its cell file (a path or a Cell: interp.run.cell_of), or with ``--inputs auto``
+    (`auto`; this report and the conformance report's real programs): the cell's robot, else
+    the backup's own, else (auto) the library robot that reaches the backup's points, else the
+    KR 6 R900 (interp.run.robot_for); the backup's SPS.SUB (none for the SPS.SUB itself: it
+    runs as the program, at a submit interpreter's pace); :func:`time_limit` (auto: the longer
     :data:`AUTO_SIM_TIME_S` for a robot program) and :func:`step_limit`."""
-    from interp.run import robot_for  # noqa: PLC0415
+    from interp.run import cell_of, robot_for  # noqa: PLC0415
 
+    cell = None if auto else cell_of(cell)
     robot = robot_for(path, inputs="auto" if auto else cell)
     submit = submit_of(path)
     sub = path.suffix.lower() == ".sub"
@@ -253,17 +256,19 @@ def report_run(path: Path, cell: Path | None, max_sim_time: float = REPORT_SIM_T
 
 def run_one(path: Path, max_sim_time: float, max_steps: int, cell: Path | None = None,
             auto: bool = False, interp: str = "tree") -> dict:
-    """One run of the report (module docstring): with the cell file `cell`, or with
-    ``--inputs auto`` (`auto`; then `cell` is not used), on the interpreter `interp`. The row
-    holds how it ended, its cause, the stand-ins of KUKA's software (``stubs``, name ->
-    uses), the cell's answers (``cell_answers``, ``cell_last`` s; ``answers``: the automatic
-    cell's, described) and the idle time skipped."""
-    from interp.run import make_runtime  # noqa: PLC0415
+    """One run of the report (module docstring): with the cell file `cell` (a path or a Cell:
+    interp.run.cell_of), or with ``--inputs auto`` (`auto`; then `cell` is not used), on the
+    interpreter `interp`. The row holds how it ended, its cause, the stand-ins of KUKA's
+    software (``stubs``, name -> uses), the cell's answers (``cell_answers``, ``cell_last`` s;
+    ``answers``: the automatic cell's, described) and the idle time skipped."""
+    from interp.run import cell_of, make_runtime  # noqa: PLC0415
 
     t0 = time.time()
-    inputs = "auto" if auto else cell
+    shown = None if auto else cell
     try:
-        robot, submit, max_sim_time, limit = report_run(path, None if auto else cell, max_sim_time, max_steps, auto)
+        cell = None if auto else cell_of(cell)   # the cell file, read once for the robot, the limits and the run
+        inputs = "auto" if auto else cell
+        robot, submit, max_sim_time, limit = report_run(path, cell, max_sim_time, max_steps, auto)
         own = _own_machine_data(path, robot.source)
         from interp.runtime.scheduler import SUBMIT_BUDGET  # noqa: PLC0415
 
@@ -280,7 +285,7 @@ def run_one(path: Path, max_sim_time: float, max_steps: int, cell: Path | None =
     except Exception as exc:  # noqa: BLE001 - an internal error is a bug to report
         row = {"program": str(path), "mode": "auto" if auto else "cells", "reason": "internal",
                "text": f"{type(exc).__name__}: {exc}",
-               "seconds": round(time.time() - t0, 2), "cell": str(cell) if cell and not auto else None}
+               "seconds": round(time.time() - t0, 2), "cell": str(shown) if shown else None}
         row["cause"] = cause_of(row)
         return row
     row = {"program": str(path), "mode": "auto" if auto else "cells", "interp": interp,
@@ -289,7 +294,7 @@ def run_one(path: Path, max_sim_time: float, max_steps: int, cell: Path | None =
            "file": res.file, "line": res.line, "sim_time": round(res.sim_time, 3),
            "steps": res.steps, "stubs": stubs, "submit": submit_errors(rt),
            "seconds": round(time.time() - t0, 2),
-           "cell": str(cell) if cell and not auto else None,
+           "cell": str(shown) if shown else None,
            "cell_answers": sum(r.fired for r in rules) + len(answers),
            "cell_last": round(max(fired), 3) if fired else None,
            "answers": [a.describe() for a in answers],

@@ -34,6 +34,7 @@ def make_runtime(program, *, workspace=None, inputs=None, trace=None, max_sim_ti
     error). `vm_loop`: the VM's dispatch loop, "generated" (interp/vm/loop.py) or "source"
     (VM.run as written; tests compare the two). `observer` (an :class:`interp.summary.RunObserver`) sees the
     controller's events on their way to `trace`; it is not used with a given `controller`.
+    `inputs`: the cell file (a path, or the Cell :func:`cell_of` read; read once per run).
     ``mode``: operating mode T1/T2/AUT/EXT (``$MODE_OP``; default AUT, robot/limits.py);
     ignored with a given `controller` (it has its own); None: AUT, or EXT when the cell file
     (`inputs`) has the ``autoext`` preset. ``pgno``: the program number the cell's PLC answers
@@ -64,9 +65,10 @@ def make_runtime(program, *, workspace=None, inputs=None, trace=None, max_sim_ti
 
         if observer is not None:
             observer.inner = trace
-        controller = Controller(robot_for(program, workspace, robot, inputs),
+        cell = cell_of(inputs)       # the cell file, read once for the robot and the controller
+        controller = Controller(robot_for(program, workspace, robot, cell),
                                 trace=observer if observer is not None else trace,
-                                stimuli=str(inputs) if inputs else None, mujoco=mujoco,
+                                stimuli=cell, mujoco=mujoco,
                                 mode_op=mode if mode is not None or not auto else "EX")
     rt = Runtime(program, workspace=workspace, controller=controller, trace=trace,
                  max_sim_time=max_sim_time, max_steps=max_steps, robot_budget=robot_budget,
@@ -221,6 +223,18 @@ def global_value(rt: Runtime, main: str, name: str):
         return rt.storage_ref(prog.ws.resolver.storage(name, sym, None, module.index if module else -1), None).get()
     except KrlRuntimeError:
         return None
+
+
+def cell_of(inputs):
+    """The cell file `inputs` read by its one loader (robot.stimuli.load_cell), or `inputs`
+    itself when it is a Cell already, or None. Raises robot.stimuli.StimulusError."""
+    if not inputs:
+        return None
+    from robot.stimuli import Cell, load_cell  # noqa: PLC0415
+
+    return inputs if isinstance(inputs, Cell) else load_cell(inputs)
+
+
 def robot_for(program, workspace=None, robot=None, inputs=None):
     """The robot a run of `program` simulates (issue 22): `robot` when given (a MachineData,
     or a path: robot YAML, ``$machine.dat``, backup folder or .zip, robot/mada.py
@@ -236,9 +250,7 @@ def robot_for(program, workspace=None, robot=None, inputs=None):
     if isinstance(robot, MachineData):
         return robot
     if robot is None and inputs and not is_auto(inputs):
-        from robot.stimuli import load_cell  # noqa: PLC0415
-
-        robot = load_cell(inputs).robot
+        robot = cell_of(inputs).robot
     if robot is not None:
         return load_robot(robot)
     root = backup_of(Path(program).resolve(), Path(workspace).resolve() if workspace else None)
@@ -313,7 +325,8 @@ class RunSetup:
     (the simulated robot, robot.machine.MachineData), ``options`` (the rest of krl run's
     options by their click names: interp_kind, max_sim_time, max_steps, mode, run_mode, pgno,
     no_check, trace_path, trace_repeats, start, halt_continues), ``shown`` (a path as the
-    user named it: an archive's temporary folder is shown as the archive)."""
+    user named it: an archive's temporary folder is shown as the archive), ``cell`` (the cell
+    file `inputs` read once, robot.stimuli.Cell; ``"auto"`` for the automatic cell; None without one)."""
     program: Path
     workspace: Path | None
     inputs: Path | None
@@ -322,6 +335,7 @@ class RunSetup:
     machine: object
     options: dict
     shown: Callable[[str], str] = field(default=lambda text: text)
+    cell: object = None
 
     @property
     def interp(self) -> str:
@@ -351,7 +365,7 @@ class RunSetup:
         """(Runtime, interpreter) of this run, not started (:func:`make_runtime`); ``override``:
         keyword arguments of make_runtime that differ (a debugger's step limit)."""
         o = self.options
-        kw = dict(workspace=self.workspace, inputs=self.inputs, trace=trace,
+        kw = dict(workspace=self.workspace, inputs=self.cell if self.cell is not None else self.inputs, trace=trace,
                   max_sim_time=o.get("max_sim_time", 600.0), max_steps=o.get("max_steps"),
                   submit=[str(s) for s in self.submit], interp=self.interp, observer=observer,
                   mode=o.get("mode"), check=self.check, run_mode=str(o.get("run_mode") or "GO").upper(),
@@ -429,9 +443,10 @@ def _setup(program: Path, workspace, options: dict, shown=lambda text: text) -> 
         booted = boot_submit(program, workspace)
         submit = [booted] if booted is not None else []
     try:
-        machine = robot_for(program, workspace, options.get("robot"), inputs)
+        cell = inputs if is_auto(inputs) else cell_of(inputs)   # the cell file, read once for the robot and the run
+        machine = robot_for(program, workspace, options.get("robot"), cell)
     except (MachineDataError, StimulusError) as exc:
         raise RunSetupError(shown(printable(exc))) from None
     rest = {k: v for k, v in options.items()
             if k not in ("program", "workspace", "inputs", "submit", "no_submit", "robot")}
-    return RunSetup(program, workspace, inputs, submit, booted, machine, rest, shown)
+    return RunSetup(program, workspace, inputs, submit, booted, machine, rest, shown, cell)

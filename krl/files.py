@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import os
 import stat
+import tempfile
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
@@ -129,8 +130,6 @@ def write_bytes_atomic(path: str | Path, data: bytes, mode: int | None = 0o644) 
     """Write `data` to `path` atomically: into a temporary file in the same folder, flushed to
     disk, then renamed over `path`, so a reader (or a crash) never sees half a file.
     mode: the new file's permission bits (None: keep those of the existing file). Raises OSError."""
-    import tempfile  # noqa: PLC0415
-
     path = Path(path)
     if mode is None:
         mode = path.stat().st_mode & 0o7777

@@ -15,11 +15,28 @@ static check of ``krl recover`` (docs/architecture.md, "Project model"):
    (``within``, else the folder holding the program). Folders are walked by
    :func:`krl.files.walk` (iterative; links, FIFOs, unreadable and too deep folders are listed,
    never read: warning W002), in its order (the files of a folder before its sub-folders,
-   names sorted), which decides which of two declarations comes first. A run outside a backup
-   adds the project's own BASIS (``interp/basis``) after them, as its System folder.
-4. **A folder given to ``krl check`` or ``krl recover``** (:func:`folder_groups`) is split by
-   the same rule, from one walk: one program per backup below it, then one per top-level folder
-   for the files outside every backup (a folder without backups is one program).
+   names sorted), which decides which of two declarations comes first.
+4. **The BASIS** (:func:`with_basis`): a program outside a backup runs on the project's own
+   BASIS (``interp/basis``: ``$config.dat``, ``bas.src``, ``ir_stopm.src``), added after its
+   files as its System folder. A backup's ``$config.dat`` holds KUKA's BASIS part and the
+   cell's own part in one data list; so the BASIS ``$config.dat`` merges with a program's own
+   ``$config.dat`` as a backup's would — both are read, the program's first (its declarations
+   win, the BASIS's fill in the rest: system data lists may repeat a declaration, the first
+   one holds it) — while any other BASIS module is left out when the program has a module of
+   that name (its own ``bas.src`` replaces the BASIS's).
+5. **Modules** (:func:`modules_of`): ``NAME.src`` or ``NAME.sub`` and ``NAME.dat`` in one
+   folder (any case) form one module, the data list being its module scope; when a folder
+   holds both ``NAME.src`` and ``NAME.sub``, the first in walk order pairs with ``NAME.dat``
+   and the other is a module of its own. A ``.sub`` file is a submit program
+   (:func:`is_submit_file`).
+6. **A folder given to ``krl check``, ``krl recover`` or ``krl fmt``** (:func:`folder_groups`)
+   is split by the same rule, from one walk: one program per backup below it, then one per
+   top-level folder for the files outside every backup (a folder without backups is one
+   program).
+7. **KUKA's system folders** (:data:`SYSTEM_DIRS`: ``System``, ``TP``, ``Mada``, ``STEU``, any
+   case; :func:`system_folder_of`) hold KUKA's software, not the cell's programs: the one list
+   for the checker's leniency (:func:`is_system_path`), the real-programs report and the cell
+   starter.
 
 :func:`find_backups` lists the backup roots below a folder; :func:`backup_of` answers rule 2.
 """
@@ -35,15 +52,16 @@ from krl.files import Entry
 from krl.limits import MAX_FOLDER_DEPTH
 from krl.source import is_krl_file
 
-__all__ = ["Project", "backup_of", "collect_entries", "collect_files", "find_backups",
-           "folder_groups", "is_system_path", "machine_data_file", "program_folder", "project_of",
-           "system_folder"]
+__all__ = ["ProgramFiles", "SYSTEM_DIRS", "backup_of", "collect_entries", "collect_files", "find_backups",
+           "folder_entries", "folder_groups", "is_submit_file", "is_system_path", "machine_data_file", "module_key",
+           "modules_of", "program_folder", "project_of", "system_folder", "system_folder_of", "with_basis"]
 
+#: KUKA's system folders of a backup (rule 7), lower case
 SYSTEM_DIRS = ("system", "tp", "mada", "steu")
 
 
 @dataclass
-class Project:
+class ProgramFiles:
     """The files of one program (rule 3). ``root``: the backup root or the folder; ``backup``:
     True inside a KRC backup; ``system``: the backup's System folder (None outside a backup);
     ``entries``: the walk of ``root`` (:class:`krl.files.Entry`: files, and the entries not read)."""
@@ -168,7 +186,7 @@ def boot_submit(program: str | Path, within: str | Path | None = None) -> Path |
 
 
 def project_of(path: str | Path, within: str | Path | None = None, limit: int | None = None,
-               max_entries: int | None = None) -> Project:
+               max_entries: int | None = None) -> ProgramFiles:
     """Rule 3: the program of the file `path` (``krl run``, ``krl check FILE``, the language
     server's open file). `within`: the folder the caller names (``--workspace``, the editor's
     folder). `limit`, `max_entries`: stop the walk after that many KRL files / entries looked
@@ -177,14 +195,14 @@ def project_of(path: str | Path, within: str | Path | None = None, limit: int | 
     path = Path(path)
     root = backup_of(path, within)
     if root is not None:
-        project = Project(root, True, system_folder(root))
+        project = ProgramFiles(root, True, system_folder(root))
     else:
         folder = Path(within) if within is not None else path.parent
-        project = Project(folder, False, None)
+        project = ProgramFiles(folder, False, None)
     entries = list_entries(project.root, limit, max_entries)
     if root is None and any(e.kind == "file" and e.path.name.lower() == "$config.dat"
                             and e.path.parent.name.lower() == "system" for e in entries):
-        # rule 4: the folder holds backups; a file outside them belongs to its top-level group
+        # rule 6: the folder holds backups; a file outside them belongs to its top-level group
         try:
             rel = path.relative_to(project.root)
         except ValueError:
@@ -231,11 +249,78 @@ def list_entries(folder: Path, limit: int | None = None, max_entries: int | None
     return out
 
 
+def system_folder_of(path: str | Path) -> str | None:
+    """The KUKA system folder (rule 7, lower case: ``"system"``, ``"tp"``, ``"mada"``,
+    ``"steu"``) that a file `path` lies in (any of its folders), else None."""
+    for part in Path(path).parts[:-1]:
+        if part.lower() in SYSTEM_DIRS:
+            return part.lower()
+    return None
+
+
 def is_system_path(path: str) -> bool:
-    """True for KUKA system files of a backup (folders System, TP, Mada, STEU, or a $-file):
-    they rely on $operate.dat declarations that a backup never contains (see W101/W105/W106)."""
-    parts = Path(path).parts
-    return Path(path).name.startswith("$") or any(p.lower() in SYSTEM_DIRS for p in parts[:-1])
+    """True for KUKA system files of a backup (rule 7, or a $-file): they rely on $operate.dat
+    declarations that a backup never contains (see W101/W105/W106)."""
+    return Path(path).name.startswith("$") or system_folder_of(path) is not None
+
+
+def is_submit_file(path: str | Path) -> bool:
+    """True for a submit program's file (``.sub``, any case; rule 5)."""
+    return str(path).lower().endswith(".sub")
+
+
+def module_key(path: str | Path) -> tuple[str, str]:
+    """What the files of one module share (rule 5): their folder and name, any case."""
+    p = Path(path)
+    return str(p.parent).lower(), p.stem.lower()
+
+
+def modules_of(paths, is_data=None) -> list[tuple[str, object, object]]:
+    """Rule 5: the modules of `paths` (file paths, or objects with a ``path``), in the order of
+    their first file: ``(name, code file or None, data list file or None)``, where the name is
+    the stem of the module's first file. `is_data(f)`: True for a file that is a data list
+    whatever its name (a parsed ``DEFDAT``); by default a ``.dat`` file is one."""
+    def path_of(x) -> str:
+        return x if isinstance(x, (str, Path)) else x.path
+
+    by_key: dict[tuple[str, str], list] = {}
+    out: list[list] = []
+    for f in paths:
+        p = Path(path_of(f))
+        key = module_key(p)
+        unit = by_key.get(key)
+        if unit is None:
+            unit = by_key[key] = [p.stem, None, None]
+            out.append(unit)
+        if p.suffix.lower() == ".dat" or (is_data is not None and is_data(f)):
+            if unit[2] is None:
+                unit[2] = f
+        elif unit[1] is None:
+            unit[1] = f
+        else:          # NAME.src and NAME.sub: the second code file is a module of its own
+            out.append([p.stem, f, None])
+    return [tuple(u) for u in out]
+
+
+def module_files(path: str | Path, paths) -> list:
+    """The files of `path`'s module among `paths` (rule 5): its code file and data list."""
+    p = str(Path(path))
+    for _name, code, dat in modules_of(paths):
+        files = [f for f in (code, dat) if f is not None]
+        if any(str(Path(f if isinstance(f, (str, Path)) else f.path)) == p for f in files):
+            return files
+    return [path]
+
+
+def with_basis(project: ProgramFiles, basis: list[Path]) -> list[Path]:
+    """Rule 4: the files of the project's BASIS (`basis`: its files, in order) that a program
+    outside a backup adds to its own, after them; none inside a backup. The BASIS
+    ``$config.dat`` is always added (it merges with the program's own); another BASIS file only
+    when the program has no module of its name (its own ``bas.src`` replaces the BASIS's)."""
+    if project.backup:
+        return []
+    own = {f.stem.lower() for f in project.files}
+    return [f for f in basis if f.name.lower() == "$config.dat" or f.stem.lower() not in own]
 
 
 def find_backups(root: str | Path) -> list[Path]:
@@ -268,7 +353,7 @@ def _levels(rel: str) -> int:
 
 
 def folder_groups(path: str | Path) -> list[tuple[str, list]] | None:
-    """Rule 4, from one walk of the folder (krl.files.walk): the (root, entries) groups -- one
+    """Rule 6, from one walk of the folder (krl.files.walk): the (root, entries) groups -- one
     per backup (:func:`find_backups`), then one per top-level folder for the entries outside
     every backup, sorted; a folder without backups is one group. The entries are those that
     :func:`collect_entries` of each root gives (each root's own MAX_FOLDER_DEPTH, its own
@@ -325,13 +410,20 @@ def _as_walk_of(entries: list, rel: str) -> list:
     return out
 
 
+def folder_entries(folder: Path) -> list:
+    """The KRL entries (:class:`krl.files.Entry`) of `folder` in walk order, as ``krl check``
+    and ``krl fmt`` walk a folder they are given (a folder named through a link is walked;
+    krl/files.py: links inside listed, never followed; unreadable or too deep folders listed)."""
+    return list(_files.walk(Path(folder)))
+
+
 def collect_entries(path: Path) -> list:
     """The KRL entries (:class:`krl.files.Entry`) of a file or folder, in walk order: a folder is
     walked (krl/files.py: links and FIFOs listed, never read; unreadable or too deep folders
     listed); anything else that exists is one ``file`` entry, classified when it is read."""
     path = Path(path)
     if path.is_dir() and not path.is_symlink():
-        return list(_files.walk(path))
+        return folder_entries(path)
     if path.is_symlink() and path.is_dir():
         return [Entry(path, path.name, "symlink")]
     return [Entry(path, path.name, "file")]

@@ -45,7 +45,9 @@ from pathlib import Path
 from krl.ast import nodes as N
 from krl.ast.build import build_module
 from krl.files import Entry
-from krl.project import Project, collect_entries, folder_groups, is_system_path, project_of
+from krl.project import (ProgramFiles, collect_entries, folder_groups, is_submit_file, is_system_path, module_key,
+                         modules_of, project_of)
+from krl.project import module_files as project_module_files
 from krl.semantics.builtins import load_builtins
 from krl.semantics.checker import Checker, Declarer, _is_system_datalist
 from krl.diagnostics import Diagnostic, DiagnosticSink
@@ -54,8 +56,8 @@ from krl.semantics.resolve import resolve_workspace
 from krl.semantics.symbols import Scope, Symbol, system_scopes
 from krl.syntax.folds import fold_diagnostics
 from krl.syntax.messages import syntax_diagnostics
-from krl.syntax.engines import parse_source, result_from_answer
-from krl.syntax.parse import ParseResult, parse_text
+from krl.syntax.engines import EngineUnavailable, java_answers, parse_source, resolve, result_from_answer
+from krl.syntax.parse import ParseResult, default_bundle, parse_text
 from krl.source import SourceText, is_krl_file, read_source
 
 
@@ -146,8 +148,10 @@ def load_batch(paths: list, timeout: float, jobs: int | None = None, threaded: b
     (:func:`_parse_tasks`): the same trees. Progress: the :func:`on_each_file` callback, as
     files finish. `threaded`: the caller runs other threads (the language server), so the
     workers come from a fork server (WORKER_MODULES loaded), not from a fork of this process."""
+    # on use: the worker pool (pebble) costs 0.42 s (python -X importtime, 2026-11-23, load average
+    # 22 on the 2 cores), which single files, `krl run` and the language server, who never start a
+    # pool, do not pay
     from krl.pool import run_tasks  # noqa: PLC0415
-    from krl.syntax.parse import default_bundle  # noqa: PLC0415
 
     default_bundle()    # imported once here, inherited by the forked workers
     hook = _ON_FILE.get()
@@ -176,8 +180,7 @@ def _parse_tasks(sources: list[SourceText], jobs: int | None, stall: float):
     """(index, (source, raw)) for :func:`load_parsed` in worker processes: one Java worker
     with `jobs` threads parses a batch of at least JAVA_BATCH_BYTES here, with trees, while
     the workers rebuild and build what it has answered (raw None: the Python engine)."""
-    from krl.pool import default_jobs  # noqa: PLC0415
-    from krl.syntax.engines import EngineUnavailable, java_answers, resolve  # noqa: PLC0415
+    from krl.pool import default_jobs  # noqa: PLC0415 - on use: the pool's 0.42 s (run_tasks above)
 
     try:
         engine = resolve()
@@ -360,23 +363,9 @@ class Workspace:
                 sym.alias, sym.module = target, target.module
 
     def _pair(self) -> None:
-        by_key: dict[tuple[str, str], ModuleUnit] = {}
-        for f in self.files:
-            p = Path(f.path)
-            key = (str(p.parent).lower(), p.stem.lower())
-            unit = by_key.get(key)
-            if unit is None:
-                unit = ModuleUnit(p.stem)
-                by_key[key] = unit
-                self.units.append(unit)
-            if f.module.kind == "dat" or p.suffix.lower() == ".dat":
-                if unit.dat is None:
-                    unit.dat = f
-            elif unit.src is None:
-                unit.src = f
-            else:  # two code files with one stem (e.g. x.src and x.sub): keep both as units
-                other = ModuleUnit(p.stem, src=f)
-                self.units.append(other)
+        """The modules of the files (krl/project.py rule 5, :func:`krl.project.modules_of`)."""
+        for name, code, dat in modules_of(self.files, lambda f: f.module.kind == "dat"):
+            self.units.append(ModuleUnit(name, src=code, dat=dat))
 
     def check(self, resolve: bool = True, partial: bool = False) -> list[Diagnostic]:
         """Link the files into scopes and run the checker; returns the sorted diagnostics.
@@ -510,7 +499,7 @@ class Workspace:
             declarer.soft_types = False
             if u.src.module.routines:
                 main = u.src.module.routines[0]
-                if main.name.upper() != u.name.upper() and not u.src.path.lower().endswith(".sub"):
+                if main.name.upper() != u.name.upper() and not is_submit_file(u.src.path):
                     sink.at(main.span, "W111", f"main routine '{main.name}' differs from the file name '{u.name}'")
         st.declarations_done(self)
 
@@ -565,7 +554,7 @@ class Workspace:
         checker.sink = declarer.sink = sink
         declarer.unresolved = uses
         checker.system_file = declarer.soft_types = is_kuka_file(path)
-        checker.submit = path.lower().endswith(".sub")
+        checker.submit = is_submit_file(path)
         try:
             checker.check_routine(rec.routine, self.routine_scopes[id(rec.routine)], path)
         finally:
@@ -1147,28 +1136,27 @@ def check_texts(files: dict[str, str]) -> Workspace:
 
 
 def module_files(path: Path) -> list[Path]:
-    """`path` and the other KRL files of its module: the .src/.dat/.sub beside it with the
-    same name (any case; links not followed)."""
-    files = [path]
+    """`path` and the other file of its module (krl/project.py rule 5): the .src/.sub and the
+    .dat beside it with the same name (any case; links not followed)."""
     try:
         siblings = sorted(path.parent.iterdir()) if path.parent.is_dir() else []
     except OSError:
         siblings = []
-    for sib in siblings:
-        if sib != path and sib.stem.lower() == path.stem.lower() and is_krl_file(sib) and not sib.is_symlink():
-            files.append(sib)
-    return files
+    key = module_key(path)
+    same = [sib for sib in siblings if module_key(sib) == key and is_krl_file(sib) and not sib.is_symlink()]
+    if path not in same:
+        same.append(path)
+    return [Path(f) for f in project_module_files(path, same)]
 
 
-def load_project(project: Project, root: str = "", timeout: float | None = None, jobs: int | None = None,
+def load_project(project: ProgramFiles, root: str = "", timeout: float | None = None, jobs: int | None = None,
                  extra: list[Path] = ()) -> Workspace:
     """The workspace of `project` (krl.project.project_of): its files in walk order, then
-    `extra` files (a run's BASIS, a submit program outside the project); the entries not read
-    are W002 warnings."""
+    `extra` files (a run's BASIS: krl.project.with_basis; a submit program outside the
+    project); the entries not read are W002 warnings."""
     ws = Workspace(root or str(project.root))
     files = project.files
-    known = {f.stem.lower() for f in files}
-    more = [f for f in extra if f.stem.lower() not in known and f not in files]
+    more = [f for f in extra if f not in files]
     _add_entries(ws, project.entries + [Entry(f, f.name, "file") for f in more], timeout, jobs)
     return ws
 

@@ -27,6 +27,7 @@ import math
 from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -40,7 +41,7 @@ from .machine import MachineData, load_machine
 from .motion import MotionRequest, Trigger
 from .planner import CP_SPEED_LIMIT_FACTOR, RobotModel, Segment, TriggerPlan, plan, resolved_target
 from .cellrules import Rule, rules_may_fire, step_rules
-from .stimuli import Stimulus, load_cell
+from .stimuli import Cell, Stimulus
 from .trace import TraceWriter
 
 EPS = 1e-9
@@ -178,9 +179,11 @@ class Controller:
     Args:
         machine: machine data (default :func:`robot.machine.load_machine`).
         trace: a :class:`~robot.trace.TraceWriter` or None.
-        stimuli: list of :class:`~robot.stimuli.Stimulus`, a YAML path (stimuli and rules), or None.
+        stimuli: list of :class:`~robot.stimuli.Stimulus`, a cell file's
+            :class:`~robot.stimuli.Cell` (its stimuli, rules and presets; read by
+            :func:`robot.stimuli.load_cell`, the one loader), or None.
         rules: reactive rules of the cell (:class:`~robot.cellrules.Rule`), added to those of a
-            YAML `stimuli` file.
+            `stimuli` Cell.
         start_axes: initial axes A1..A6 (deg), default HOME.
         actuated: drive MuJoCo with position/velocity actuators instead of qpos replay.
         strict_bco: the first motion needs a complete PTP/LIN target (reference §6.3).
@@ -202,7 +205,7 @@ class Controller:
     batch: bool = True
 
     def __init__(self, machine: MachineData | None = None, *, trace: TraceWriter | None = None,
-                 stimuli: list[Stimulus] | str | None = None, rules: list[Rule] | None = None,
+                 stimuli: list[Stimulus] | Cell | None = None, rules: list[Rule] | None = None,
                  start_axes: Any = None, actuated: bool = False, strict_bco: bool = True,
                  mujoco: bool = True, mode_op: str | None = None) -> None:
         self.machine = machine if machine is not None else load_machine()
@@ -210,12 +213,18 @@ class Controller:
         self.pgno: int | None = None      # the cell file's pgno preset (interp/run.py builds its rules)
         self.start: str | None = None     # the cell file's start: position (interp/run.py places the robot)
         self.cell_network = None          # the cell file's `network:` settings (interp/run.py attaches them)
-        if isinstance(stimuli, str):
-            cell = load_cell(stimuli, self.machine.in_pos_car_mm)
-            stimuli, self.rules, self.pgno, self.start = cell.stimuli, cell.rules, cell.pgno, cell.start
+        if isinstance(stimuli, (str, Path)):
+            raise TypeError("a cell file is read by robot.stimuli.load_cell; pass its Cell")
+        if isinstance(stimuli, Cell):
+            cell = stimuli
+            stimuli, self.rules, self.pgno = cell.stimuli, list(cell.rules), cell.pgno
+            self.start = cell.start
             self.cell_network = cell.network
             if cell.autoext and mode_op is None:
                 mode_op = "EX"            # Automatic External (robot/cellpresets.py)
+        for st in stimuli or ():
+            if st.reached_default:        # `reached: true`: this robot's $IN_POS_CAR
+                st.reached_mm = self.machine.in_pos_car_mm
         self.mode_op = normalise_mode(mode_op)
         self.model = RobotModel(self.machine, mode=self.mode_op)
         self.dt = float(self.machine.ipo_cycle_s)

@@ -20,9 +20,11 @@ from pathlib import Path
 from typing import Any
 
 from krl.ast import nodes as N
+from krl.ast.build import build_module
 from krl.limits import MAX_FILE_BYTES
 from krl.semantics import expression as X
 from krl.semantics.values import KrlRuntimeError
+from krl.syntax.parse import parse_file
 
 
 class DataListError(ValueError):
@@ -89,9 +91,6 @@ def read_data_list(path: str | Path, shown: str | None = None) -> dict[str, Data
         DataListError: the file cannot be read, has syntax errors, is not a data list, or
             holds an initialiser that is not a literal (message: file:line:col).
     """
-    from krl.ast.build import build_module  # noqa: PLC0415
-    from krl.syntax.parse import parse_file  # noqa: PLC0415
-
     p = Path(path)
     name = shown or str(p)
     try:

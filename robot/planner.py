@@ -568,10 +568,6 @@ class Segment:
         T = self.model.tcp(self.q1, self.tool_T, self.base_inv_T)
         return T[:3, 3].copy(), T[:3, :3].copy()
 
-    def start_pose(self) -> tuple[np.ndarray, np.ndarray]:
-        T = self.model.tcp(self.q0, self.tool_T, self.base_inv_T)
-        return T[:3, 3].copy(), T[:3, :3].copy()
-
     def tcp_dist_to_end(self, u: float) -> float:
         """Euclidean TCP distance (mm) from the point at parameter u to the end point."""
         raise NotImplementedError

@@ -89,7 +89,9 @@ class Stimulus:
             :func:`resolve_signals` replaces it).
         at: time in s, or None.
         motion: motion id (n-th enqueued motion), or None. line: source line, or None.
-        phase: motion phase, or None. reached_mm: distance for "TCP reaches the point".
+        phase: motion phase, or None. reached_mm: distance for "TCP reaches the point";
+        ``reached: true`` takes the robot's in-position distance ``$IN_POS_CAR``
+        (``reached_default``; the controller of the run sets it from its machine data).
         delay: extra delay in s after the condition holds.
         where: ``file:line`` of the stimulus in its file ("" when built from data).
         source: the ``source`` of its I/O events (``stimulus``; ``auto`` for an answer of
@@ -103,6 +105,7 @@ class Stimulus:
     line: int | None = None
     phase: str | None = None
     reached_mm: float | None = None
+    reached_default: bool = False
     delay: float = 0.0
     fired: bool = False
     due: float | None = field(default=None, repr=False)
@@ -441,6 +444,7 @@ def _parse_stimuli(doc: Any, default_reach_mm: float, where: _Where) -> list[Sti
                 st.phase = str(w["phase"])
             if "reached" in w:
                 r = w["reached"]
+                st.reached_default = r is True
                 st.reached_mm = default_reach_mm if r is True else float(_number(r, "reached", where(w, "reached")))
             if st.phase is None and st.reached_mm is None:
                 st.phase = "end"
@@ -456,7 +460,9 @@ def load_stimuli(path: str | Path, default_reach_mm: float = 0.1) -> list[Stimul
 
 
 def load_cell(path: str | Path, default_reach_mm: float = 0.1) -> Cell:
-    """Read and validate a stimuli YAML file, stimuli and rules (see the module docstring).
+    """Read and validate a stimuli YAML file, stimuli and rules (see the module docstring):
+    the one loader of a cell file (a run reads it once: interp/run.py ``make_runtime`` hands
+    the Cell to the robot choice and the controller).
 
     Raises :class:`StimulusError` (with ``file:line``) for an unreadable, oversized or
     malformed file."""

@@ -91,7 +91,12 @@ def random_program(seed: int, machine: Any, trace: Any, cell_path: str | None = 
 
     rng = random.Random(seed)
     mode = "T1" if seed % 8 == 5 else None
-    ctl = Controller(machine, trace=trace, stimuli=cell_path, mode_op=mode)
+    try:
+        ctl = Controller(machine, trace=trace, stimuli=cell_path, mode_op=mode)
+    except TypeError:      # this checkout's Controller takes the Cell of the one loader, not a path
+        from robot.stimuli import load_cell
+
+        ctl = Controller(machine, trace=trace, stimuli=load_cell(cell_path), mode_op=mode)
     mach = ctl.machine
     k = mach.reach_wrist_point_mm / 901.456
     P0 = MotionParams.initmov(mach)

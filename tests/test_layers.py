@@ -229,6 +229,51 @@ def test_antlr4_only_in_syntax_and_ast():
     assert not check()
 
 
+def test_no_module_imports_itself_through_others():
+    """The module import graph has no cycle (module-level and function-level imports alike):
+    an import cycle hides the order modules depend on each other in."""
+    graph = _graph()
+    modules = sorted(m for m in graph.modules if m.split(".")[0] in ROOTS)
+    index: dict[str, int] = {}
+    low: dict[str, int] = {}
+    stack: list[str] = []
+    on: set[str] = set()
+    cycles = []
+    for start in modules:                # Tarjan's strongly connected components, iteratively
+        if start in index:
+            continue
+        work = [(start, iter(sorted(graph.find_modules_directly_imported_by(start))))]
+        index[start] = low[start] = len(index)
+        stack.append(start)
+        on.add(start)
+        while work:
+            v, it = work[-1]
+            w = next((x for x in it if x.split(".")[0] in ROOTS), None)
+            if w is not None:
+                if w not in index:
+                    index[w] = low[w] = len(index)
+                    stack.append(w)
+                    on.add(w)
+                    work.append((w, iter(sorted(graph.find_modules_directly_imported_by(w)))))
+                elif w in on:
+                    low[v] = min(low[v], index[w])
+                continue
+            work.pop()
+            if work:
+                low[work[-1][0]] = min(low[work[-1][0]], low[v])
+            if low[v] == index[v]:
+                comp = []
+                while True:
+                    x = stack.pop()
+                    on.discard(x)
+                    comp.append(x)
+                    if x == v:
+                        break
+                if len(comp) > 1:
+                    cycles.append(sorted(comp))
+    assert not cycles, cycles
+
+
 def test_lint_imports_keeps_the_contract():
     lint = Path(sys.executable).with_name("lint-imports")
     proc = subprocess.run([str(lint), "--no-cache", "--config", str(CONFIG)], cwd=REPO,

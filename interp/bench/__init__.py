@@ -25,52 +25,78 @@ def rounds(program: Path = PROGRAM) -> int:
     return int(m.group(1))
 
 
-def run_krl(interp: str, program: Path = PROGRAM):
-    """One run: (seconds, steps, (CHECK_I, CHECK_R))."""
+def run_krl(interp: str, program: Path = PROGRAM, clock=None):
+    """One run: (seconds, steps, (CHECK_I, CHECK_R)); seconds of `clock` (default
+    time.perf_counter, wall time; time.process_time: this process's CPU time)."""
+    clock = clock or time.perf_counter
     from interp.run import make_runtime  # noqa: PLC0415
 
     rt, _ = make_runtime(program, mujoco=False, max_steps=10 ** 9, interp=interp)
-    t0 = time.perf_counter()
+    t0 = clock()
     res = rt.run()
-    dt = time.perf_counter() - t0
+    dt = clock() - t0
     if res.reason != "completed":
         raise RuntimeError(f"benchmark did not complete on {interp}: {res.reason} {res.text} line {res.line}")
     m = rt.program.module(program.stem)
     return dt, rt.steps, (m.data["CHECK_I"].get(), m.data["CHECK_R"].get())
 
 
-def run_python(loops: int = 20):
+def run_python(loops: int = 20, clock=None):
     """The Python version, ``loops`` times (it is too fast to time once): (seconds per
-    run, result)."""
+    run, result); seconds of `clock` as in :func:`run_krl`."""
+    clock = clock or time.perf_counter
     from . import bench as py  # noqa: PLC0415
 
     n = rounds()
-    t0 = time.perf_counter()
+    t0 = clock()
     for _ in range(loops):
         got = py.bench(n)
-    return (time.perf_counter() - t0) / loops, got
+    return (clock() - t0) / loops, got
 
 
 # the starting commit of issue 23: the tree interpreter must stay at least as fast as there
 BASELINE_REV = "89ac166"
 
+# CPU mode: every revision's run_krl times with time.perf_counter, so this fresh process,
+# which runs only the benchmark, reads the CPU clock there
 _BASELINE_SNIPPET = """
-import json
+import json, sys, time
+if sys.argv[1] == "cpu":
+    time.perf_counter = time.process_time
 try:
     from interp.bench import run_krl            # the layout since issue 23
 except ImportError:
     from interp.vm.bench import run_krl         # before it
-dt, steps, check = run_krl("tree")
-print(json.dumps([dt, steps, [check[0], check[1]]]))
+out = {}
+for kind in ("tree", "vm"):
+    dt, steps, check = run_krl(kind)
+    out[kind] = [dt, steps, [check[0], check[1]]]
+try:
+    from interp.vm.vm import COMPILED
+except ImportError:                             # a revision before the compiled loop
+    COMPILED = False
+out["vm_loop"] = "compiled" if COMPILED else "python"
+print(json.dumps(out))
+"""
+
+# compiles the revision's own loop where it has one (interp/vm/build.py, since issue 23)
+_BASELINE_BUILD = """
+try:
+    from interp.vm.build import build
+except ImportError:
+    print("no build")
+else:
+    print(build())
 """
 
 
 class Baseline:
-    """The tree interpreter of another revision of this repository (``rev``), run side by
-    side with this one: a temporary ``git worktree`` of ``rev`` (with this checkout's
-    generated parser: the grammar is the same), each run a fresh process whose Python path
-    is that worktree; the time is measured inside it, as :func:`run_krl` measures. Use as a
-    context manager; the worktree is removed afterwards."""
+    """The tree interpreter and the VM of another revision of this repository (``rev``), run
+    side by side with this one: a temporary ``git worktree`` of ``rev`` (with this checkout's
+    generated parser: the grammar is the same; its own VM loop compiled there by its own
+    interp/vm/build.py where it has one), each run a fresh process whose Python path is that
+    worktree; the time is measured inside it, as :func:`run_krl` measures. Use as a context
+    manager; the worktree is removed afterwards."""
 
     def __init__(self, rev: str = BASELINE_REV) -> None:
         self.rev = rev
@@ -88,6 +114,7 @@ class Baseline:
         gen = repo / "krl" / "syntax" / "generated"
         shutil.copytree(gen, self.dir / "krl" / "syntax" / "generated", dirs_exist_ok=True,
                         ignore=shutil.ignore_patterns("__pycache__"))
+        self._python(_BASELINE_BUILD)
         return self
 
     def __exit__(self, *exc) -> None:
@@ -99,52 +126,68 @@ class Baseline:
                        capture_output=True, text=True)
         shutil.rmtree(self.dir.parent, ignore_errors=True)
 
-    def run_tree(self):
-        """One run of the benchmark on that revision's tree interpreter: (seconds, steps,
-        (CHECK_I, CHECK_R))."""
-        import json  # noqa: PLC0415
+    def _python(self, code: str, *args: str) -> str:
+        """Run `code` (with `args` in sys.argv[1:]) in a fresh process on that revision; its
+        output's last line. Raises RuntimeError when it fails."""
         import os  # noqa: PLC0415
         import subprocess  # noqa: PLC0415
         import sys  # noqa: PLC0415
 
         env = dict(os.environ, PYTHONPATH=str(self.dir))
-        p = subprocess.run([sys.executable, "-c", _BASELINE_SNIPPET], cwd=self.dir, env=env,
+        p = subprocess.run([sys.executable, "-c", code, *args], cwd=self.dir, env=env,
                            capture_output=True, text=True, timeout=3600)
         if p.returncode != 0:
             raise RuntimeError(f"baseline {self.rev} failed: {p.stderr[-2000:]}")
-        dt, steps, check = json.loads(p.stdout.strip().splitlines()[-1])
-        return dt, steps, tuple(check)
+        return p.stdout.strip().splitlines()[-1]
+
+    def run(self, cpu: bool = False) -> dict:
+        """One run of the benchmark on that revision's tree interpreter and VM: ``{"tree":
+        (seconds, steps, (CHECK_I, CHECK_R)), "vm": (...), "vm_loop": "compiled" | "python"}``;
+        `cpu`: seconds of the process's CPU time instead of wall time."""
+        import json  # noqa: PLC0415
+
+        got = json.loads(self._python(_BASELINE_SNIPPET, "cpu" if cpu else "wall"))
+        out = {kind: (got[kind][0], got[kind][1], tuple(got[kind][2])) for kind in ("tree", "vm")}
+        out["vm_loop"] = got["vm_loop"]
+        return out
 
 
-def compute(repeat: int = 3, baseline: Baseline | None = None) -> dict:
+def compute(repeat: int = 3, baseline: Baseline | None = None, cpu: bool = False) -> dict:
     """Best-of-``repeat`` times of tree, VM and Python (and, with `baseline`, the tree
-    interpreter of another revision), interleaved in this run; ratios and statement rates,
+    interpreter and the VM of another revision), interleaved in this run; `cpu`: each time is
+    the CPU time of the process that runs it (time.process_time), which a shared machine's
+    load disturbs far less than wall time (``clock`` in the result says which); ratios and statement rates,
     and ``vm_loop``: which dispatch loop the VM ran ("compiled": the Cython build of
     interp/vm/loop.py; "python": loop.py itself, when no current build exists)."""
-    best = {"tree": None, "vm": None, "python": None, "baseline": None}
+    best = {"tree": None, "vm": None, "python": None, "baseline": None, "baseline_vm": None}
+    baseline_loop = None
+    clock = time.process_time if cpu else time.perf_counter
     steps = None
     checks = {}
     for _ in range(repeat):
         for kind in ("tree", "vm"):
-            dt, n, check = run_krl(kind)
+            dt, n, check = run_krl(kind, clock=clock)
             steps = n
             checks[kind] = check
             best[kind] = dt if best[kind] is None else min(best[kind], dt)
-        dt, check = run_python()
+        dt, check = run_python(clock=clock)
         checks["python"] = check
         best["python"] = dt if best["python"] is None else min(best["python"], dt)
         if baseline is not None:
-            dt, n, check = baseline.run_tree()
-            if n != steps:
-                raise RuntimeError(f"baseline {baseline.rev} counts {n} steps, this tree {steps}")
-            checks["baseline"] = check
-            best["baseline"] = dt if best["baseline"] is None else min(best["baseline"], dt)
-    if not (checks["tree"] == checks["vm"] == checks["python"] == checks.get("baseline", checks["tree"])):
+            got = baseline.run(cpu)
+            baseline_loop = got["vm_loop"]
+            for kind, key in (("tree", "baseline"), ("vm", "baseline_vm")):
+                dt, n, check = got[kind]
+                if n != steps:
+                    raise RuntimeError(f"baseline {baseline.rev} counts {n} steps on its {kind}, this tree {steps}")
+                checks[key] = check
+                best[key] = dt if best[key] is None else min(best[key], dt)
+    if len({checks[k] for k in checks}) != 1:
         raise RuntimeError(f"benchmark results differ: {checks}")
     from interp.vm.vm import COMPILED  # noqa: PLC0415  (the VM loads only for the benchmark)
 
     out = {
-        "steps": steps,
+        "steps": steps, "clock": "cpu" if cpu else "wall",
         "vm_loop": "compiled" if COMPILED else "python",
         "tree_s": best["tree"], "vm_s": best["vm"], "python_s": best["python"],
         "vm_vs_tree": best["tree"] / best["vm"],
@@ -155,5 +198,7 @@ def compute(repeat: int = 3, baseline: Baseline | None = None) -> dict:
     }
     if baseline is not None:
         out.update({"baseline_rev": baseline.rev, "baseline_tree_s": best["baseline"],
-                    "tree_vs_baseline": best["baseline"] / best["tree"]})
+                    "tree_vs_baseline": best["baseline"] / best["tree"],
+                    "baseline_vm_s": best["baseline_vm"], "baseline_vm_loop": baseline_loop,
+                    "vm_vs_baseline": best["baseline_vm"] / best["vm"]})
     return out

@@ -79,12 +79,9 @@ from krl.limits import MAX_DAP_BREAKPOINTS, MAX_DAP_REPLAY_STEPS
 
 from . import view
 from .breakpoints import Breakpoint
+from .errors import Refused
 from .expr import ExpressionError, compile_in_frame
 from .values import has_children, value_text
-
-
-class Refused(Exception):
-    """A request that cannot be served (its message is for the user)."""
 
 
 class Terminate(BaseException):

@@ -9,7 +9,7 @@ path); a repeatable option is an array. The debugger adds :data:`DEBUG_ATTRIBUTE
 extension declares (editors/vscode/package.json; ``python -m interp.debug.launch --write``
 writes it, tests/debug/test_launch.py checks it).
 
-Errors: :class:`interp.debug.engine.Refused` naming the attribute ("maxSimTime: ... is not a
+Errors: :class:`interp.debug.errors.Refused` naming the attribute ("maxSimTime: ... is not a
 valid float").
 """
 
@@ -22,7 +22,7 @@ from pathlib import Path
 
 import click
 
-from .engine import Refused
+from .errors import Refused
 
 PACKAGE_JSON = Path(__file__).resolve().parents[2] / "editors" / "vscode" / "package.json"
 

@@ -481,7 +481,7 @@ class _Eval:
     def ref(self, e, over: dict):
         rt = self.rt
         if e.__class__ is N.Name:
-            st = e.ann.storage if e.ann is not None else None
+            st = e.ann.place if e.ann is not None else None
             if st is None:
                 raise Unsolvable(e.name)
             return rt.storage_ref(st, self.frame)

@@ -1,9 +1,10 @@
 """Built-in functions and procedures (reference §4.5-§4.8, §5.12, §5.19).
 
-:func:`call_builtin` is the single entry: ``args`` is a list of references
-(:class:`memory.Ref`; an expression argument is wrapped in :class:`ValueRef`, an omitted
-one is None). :IN arguments are read with ``get()``, :OUT arguments written with ``set()``.
-:data:`NATIVES` lists what is implemented; signatures are the front end's data table
+:data:`NATIVES` maps each built-in the simulator implements (upper-case name: the key the resolver
+gives a NATIVE callee, krl/semantics/resolve.py; ``Runtime.native``) to ``fn(rt, args)``;
+``args`` is a list of references (:class:`memory.Ref`; an expression argument is wrapped in
+:class:`ValueRef`, an omitted one is None). :IN arguments are read with ``get()``, :OUT
+arguments written with ``set()``. Signatures are the front end's data table
 (krl/semantics/data/functions.yaml). BASIS routines (BAS, SVEL_JOINT, ...) are KRL in
 interp/basis/bas.src (or the backup's), not natives.
 
@@ -31,7 +32,7 @@ import re
 from krl.semantics import types as T
 
 from .cast import cast_from, cast_to
-from .convert import INT_MAX, INT_MIN, frame_tuple, inv_pos, num, real_to_int, to_bool, trunc_int
+from .convert import INT_MAX, INT_MIN, frame_tuple, inv_pos, num, real_to_int, ref_text, to_bool, trunc_int
 from .errors import KrlRuntimeError, value_invalid
 from .memory import Ref
 from .values import UNSET, Arr, EnumValue, Struct, is_char_array
@@ -52,17 +53,6 @@ class ValueRef(Ref):
 
     def set(self, v) -> None:
         self.v = v
-
-
-def _text(ref: Ref | None, what: str) -> str:
-    if ref is None:
-        raise value_invalid(what)
-    v = ref.get()
-    if isinstance(v, str):
-        return v
-    if isinstance(v, Arr) and v.type.elem == T.CHAR:
-        return v.text()
-    raise KrlRuntimeError(f"{what} is not a string")
 
 
 def _real(ref, what="argument") -> float:
@@ -229,7 +219,7 @@ def _real_leaf(s, k):
 # ------------------------------------------------------------------ VARSTATE (§4.5)
 
 def _varstate(rt, a):
-    name = _text(a[0], "VARSTATE argument")
+    name = ref_text(a[0], "VARSTATE argument")
     try:
         ref = rt.ref_from_text(name)
     except KrlRuntimeError:
@@ -246,7 +236,7 @@ def _varstate(rt, a):
 
 
 def _vartype(rt, a):
-    name = _text(a[0], "VARTYPE argument")
+    name = ref_text(a[0], "VARTYPE argument")
     ref = rt.ref_from_text(name)
     if ref is None:
         return EnumValue("TYP_UNKNOWN")
@@ -264,7 +254,7 @@ def _vartype(rt, a):
 # ------------------------------------------------------------------ strings (§4.6)
 
 def _strlen(rt, a):
-    return len(_text(a[0], "STRLEN argument"))
+    return len(ref_text(a[0], "STRLEN argument"))
 
 
 def _strdecllen(rt, a):
@@ -283,18 +273,18 @@ def _strclear(rt, a):
 
 def _stradd(rt, a):
     dest = _chars(a[0], "STRADD destination")
-    return _put_text(dest, dest.text() + _text(a[1], "STRADD argument"))
+    return _put_text(dest, dest.text() + ref_text(a[1], "STRADD argument"))
 
 
 def _strcopy(rt, a):
     dest = _chars(a[0], "STRCOPY destination")
-    src = _text(a[1], "STRCOPY source")
+    src = ref_text(a[1], "STRCOPY source")
     _put_text(dest, src)
     return len(src) <= len(dest.data)
 
 
 def _strcomp(rt, a):
-    s1, s2 = _text(a[0], "STRCOMP argument 1"), _text(a[1], "STRCOMP argument 2")
+    s1, s2 = ref_text(a[0], "STRCOMP argument 1"), ref_text(a[1], "STRCOMP argument 2")
     if not _mode_sens(a[2] if len(a) > 2 else None):
         return s1.upper() == s2.upper()
     return s1 == s2
@@ -302,7 +292,7 @@ def _strcomp(rt, a):
 
 def _strfind(rt, a):
     start = _int(a[0])
-    s, sub = _text(a[1], "STRFIND string"), _text(a[2], "STRFIND pattern")
+    s, sub = ref_text(a[1], "STRFIND string"), ref_text(a[2], "STRFIND pattern")
     if not _mode_sens(a[3] if len(a) > 3 else None):
         s, sub = s.upper(), sub.upper()
     if start < 1:
@@ -313,7 +303,7 @@ def _strfind(rt, a):
 
 def _strto(conv):
     def fn(rt, a):
-        s = _text(a[0], "string")
+        s = ref_text(a[0], "string")
         try:
             v = conv(s)
         except (ValueError, KrlRuntimeError):
@@ -377,13 +367,13 @@ def _to_bool(s: str) -> bool:
 
 def _strtostring(rt, a):
     dest = _chars(a[1], "STRTOSTRING destination")
-    _put_text(dest, _text(a[0], "string"))
+    _put_text(dest, ref_text(a[0], "string"))
     return True
 
 
 def _strto_struct(tname):
     def fn(rt, a):
-        text = _text(a[0], "string").strip()
+        text = ref_text(a[0], "string").strip()
         if not (text.startswith("{") and text.endswith("}")):
             return False
         body = text[1:-1]
@@ -540,7 +530,7 @@ def _copen(rt, a):
 def _cwrite(rt, a):
     ch = _int(a[0], "channel")
     cmd = rt.sysvars.store.get("$CMD")
-    fmt = _text(a[3], "CWRITE format") if len(a) > 3 else ""
+    fmt = ref_text(a[3], "CWRITE format") if len(a) > 3 else ""
     if ch != cmd:
         raise KrlRuntimeError("CWRITE: only the $CMD channel is supported by this simulator")
     rt.message(f"CWRITE $CMD: {fmt}")
@@ -563,7 +553,7 @@ def _getsysstate(rt, a):
     RPAR = 0.0. The simulated controller never holds the robot in a stop reaction that a
     program goes on past (a stop ends the run), so IPAR is always 0: the simulated answer.
     Any other command: FALSE, IPAR and RPAR unchanged, one ``message`` event per command."""
-    cmd = _text(a[0], "GETSYSSTATE command").strip().upper()
+    cmd = ref_text(a[0], "GETSYSSTATE command").strip().upper()
     if cmd not in GETSYSSTATE_COMMANDS:
         key = "GETSYSSTATE " + cmd[:64]
         if key not in rt.noted:
@@ -774,7 +764,7 @@ def _swrite(rt, a):
     dest = _chars(a[0], "SWRITE destination")
     off_ref = a[2]
     off = _int(off_ref, "SWRITE offset") if off_ref is not None else 0
-    fmt = _text(a[3], "SWRITE format")
+    fmt = ref_text(a[3], "SWRITE format")
     vals = [r.get() if r is not None else UNSET for r in a[4:]]
     if any(v is UNSET for v in vals):
         raise value_invalid("SWRITE argument")
@@ -890,10 +880,10 @@ def sread_values(src: str, fmt: str, start: int = 0, limit: int | None = None) -
 
 
 def _sread(rt, a):
-    src = _text(a[0], "SREAD source")
+    src = ref_text(a[0], "SREAD source")
     off_ref = a[2]
     off = _int(off_ref, "SREAD offset") if off_ref is not None else 0
-    fmt = _text(a[3], "SREAD format")
+    fmt = ref_text(a[3], "SREAD format")
     buf = a[0].peek()
     got, pos, error = sread_values(src, fmt, max(0, off), len(buf.data) if isinstance(buf, Arr) else len(src))
     if error is not None:
@@ -940,14 +930,4 @@ from .netfunctions import NATIVES as _NET_NATIVES  # noqa: E402  (EKI_*, RSI_*: 
 
 NATIVES.update(_NET_NATIVES)
 
-# built-ins whose result type is needed to convert a native Python result
-FUNCTION_RESULT = {"ABS", "SQRT", "SIN", "COS", "TAN", "ACOS", "ATAN2", "FRAND"}
-
-
-def call_builtin(rt, name: str, args: list):
-    """Call native ``name`` (UPPER) with reference arguments; returns the value (None for
-    procedures). Raises KeyError if ``name`` is not a native."""
-    return NATIVES[name](rt, args)
-
-
-__all__ = ["NATIVES", "ValueRef", "call_builtin", "swrite_text", "sread_values", "parse_format"]
+__all__ = ["NATIVES", "ValueRef", "swrite_text", "sread_values", "parse_format"]

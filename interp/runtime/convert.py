@@ -23,7 +23,7 @@ from .values import Arr, Struct, copy_value, make_value
 
 __all__ = ["INT_MAX", "INT_MIN", "assign_chars", "assign_into", "binary_op", "check_int", "compare",
            "convert_scalar", "frame_tuple", "geo_compose", "inv_pos", "num", "real_to_int",
-           "struct_from_frame", "to_bool", "trunc_int", "unary_op"]
+           "ref_text", "struct_from_frame", "to_bool", "trunc_int", "unary_op"]
 
 def convert_scalar(v, t):
     """Convert ``v`` for storage in a leaf of simple/enum type ``t`` (assignment, §3.9)."""
@@ -136,6 +136,19 @@ def assign_into(dest, v) -> None:
             return
         raise KrlRuntimeError(f"cannot assign {v!r} to {dest.type}")
     raise KrlRuntimeError("assignment to a non-aggregate")
+
+
+def ref_text(ref, what: str) -> str:
+    """The text of a STRING or CHAR-array argument (a memory.Ref, None when omitted) of a
+    built-in; raises KrlRuntimeError ("value invalid" when omitted, "not a string" otherwise)."""
+    if ref is None:
+        raise value_invalid(what)
+    v = ref.get()
+    if isinstance(v, str):
+        return v
+    if isinstance(v, Arr) and v.type.elem == T.CHAR:
+        return v.text()
+    raise KrlRuntimeError(f"{what} is not a string")
 
 
 # ------------------------------------------------------------------ operators (§4.1, §4.3)

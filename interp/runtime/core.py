@@ -15,9 +15,9 @@ from krl.limits import MAX_CALL_DEPTH
 from krl.semantics import expression as X
 from krl.semantics import types as T
 from krl.semantics.advance import StmtInfo
-from krl.semantics.resolve import Callee, Storage
+from krl.semantics.resolve import NATIVE, ROUTINE, Callee, Storage
 
-from .builtins import NATIVES, ValueRef, call_builtin
+from .builtins import NATIVES, ValueRef
 from .netfunctions import RSI_CONSTANTS
 from .contexts import Context, Irq
 from .convert import assign_into, binary_op, convert_scalar, to_bool, trunc_int, unary_op
@@ -481,7 +481,7 @@ class Runtime:
     @staticmethod
     def aggregate(struc, items: list) -> Struct:
         """Value of ``{[TYPE:] NAME value, ...}``: a partial Struct; ``struc``: the resolved
-        STRUC of the TYPE prefix (the resolver's, ``Aggregate.ann.storage``), else None."""
+        STRUC of the TYPE prefix (the resolver's, ``Aggregate.ann.struc``), else None."""
         return Struct(struc if isinstance(struc, T.Struc) else None, dict(items))
 
     # ================================================================== routines
@@ -514,17 +514,16 @@ class Runtime:
         return m, m.main
 
     def callee(self, c: Callee):
-        """(module, Routine) of a resolved call, or None (a built-in or nothing declares it)."""
-        if c.routine is None:
+        """(module, Routine) of a call whose callee is a routine of the program, else None."""
+        if c.kind != ROUTINE:
             return None
         return self.modules[c.owner], c.routine
 
     @staticmethod
-    def is_native(name: str) -> bool:
-        return name.upper() in NATIVES
-
-    def call_builtin(self, name: str, args: list):
-        return call_builtin(self, name.upper(), args)
+    def native(c: Callee):
+        """The implementation ``fn(rt, args)`` of a built-in callee (NATIVE) the simulator
+        has (interp/runtime/builtins.py), else None (the stub policy: :meth:`stub_call`)."""
+        return NATIVES.get(c.native) if c.kind == NATIVE else None
 
     def stub_call(self, name: str, is_function: bool):
         """A call of a routine that the program does not contain: in a backup, a routine of
@@ -639,7 +638,7 @@ class Runtime:
         whose values are converted by convert_scalar (INT, REAL, BOOL, CHAR, ENUM). Types are
         the checker's; raises KrlRuntimeError for a type nothing declares (outside a backup),
         ResourceError for a type that nests too deep (values.data_size)."""
-        layout = routine.ann.storage
+        layout = routine.ann.layout
         prog = self.program
         decls, params, sizes = [], [], []
         for k, s in enumerate(layout.slots):
@@ -702,7 +701,7 @@ class Runtime:
         returned = False
         try:
             value = body(frame)
-            if routine.kind == "DEFFCT":
+            if routine.is_function:
                 value = self.return_value(routine, value, module)
             returned = True
             return value
@@ -737,7 +736,7 @@ class Runtime:
             return value
         t = self._return_types.get(id(routine))
         if t is None:
-            t = self._return_types[id(routine)] = self.program.declared_type(routine.ann.storage.returns,
+            t = self._return_types[id(routine)] = self.program.declared_type(routine.ann.layout.returns,
                                                                               routine.return_type)
         if isinstance(t, T.Array) and isinstance(value, str):
             arr = make_value(t)

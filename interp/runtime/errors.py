@@ -26,9 +26,14 @@ class ControlSignal(Exception):
 
 
 class GotoSignal(ControlSignal):
-    def __init__(self, label: str) -> None:
+    """GOTO: unwinds to the statement list that holds ``target`` (the Label the front end
+    resolved, krl/semantics/resolve.py; None: no enclosing block has it); ``label`` the
+    GOTO's label name, for the error "label not found"."""
+
+    def __init__(self, label: str, target=None) -> None:
         super().__init__(label)
         self.label = label.upper()
+        self.target = target
 
 
 class ExitSignal(ControlSignal):

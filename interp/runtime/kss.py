@@ -46,6 +46,7 @@ from pathlib import Path
 
 from krl.ast import nodes as N
 from krl.semantics import types as T
+from krl.semantics.resolve import ROUTINE, UNRESOLVED
 
 from .errors import KrlRuntimeError
 from .memory import Slot
@@ -313,13 +314,13 @@ class SystemSoftware:
 def _unresolved(e) -> str | None:
     """The UPPER name of an unresolved Name, or of a call of a routine no program has."""
     if isinstance(e, N.Name):
-        st = e.ann.storage if e.ann is not None else None
-        if st is not None and getattr(st, "kind", None) == 4:       # UNRESOLVED
+        st = e.ann.place if e.ann is not None else None
+        if st is not None and st.kind == UNRESOLVED:
             return e.name.upper()
         return None
     if isinstance(e, N.Call):
-        c = e.ann.storage if e.ann is not None else None
-        if c is not None and getattr(c, "routine", None) is None:
+        c = e.ann.callee if e.ann is not None else None
+        if c is not None and c.kind != ROUTINE:
             return e.name.upper()
     return None
 

@@ -47,6 +47,11 @@ class Ref:
 
 
 class Slot(Ref):
+    """The reference of one storage slot: the value ``c[k]`` of a container (a frame's or a
+    data list's store, whose slots the front end numbered: krl/semantics/resolve.py
+    ``LayoutSlot``; an array's ``data``; a structure's components). interp/runtime/slots.py
+    holds the operations both interpreters apply on such references."""
+
     __slots__ = ("c", "k", "type", "name", "readonly", "on_write")
 
     def __init__(self, container, key, type_, name: str, readonly: bool = False, on_write=None) -> None:

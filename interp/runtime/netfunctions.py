@@ -11,7 +11,7 @@ functions return an RSIERR number as INT (``RSIOK`` = 0, :data:`RSI_CONSTANTS`).
 
 from __future__ import annotations
 
-from .builtins import _text      # builtins.py adds these natives at its end, after _text
+from .convert import ref_text
 from .errors import KrlRuntimeError, value_invalid
 from .values import UNSET, Arr, EnumValue, Struct, is_char_array
 
@@ -72,42 +72,42 @@ def _call(fn):
 
 @_call
 def eki_init(rt, a):
-    ch = network(rt).eki_init(_text(a[0], "EKI_Init channel"))
+    ch = network(rt).eki_init(ref_text(a[0], "EKI_Init channel"))
     return _status(ch.status())
 
 
 @_call
 def eki_open(rt, a):
-    return _status(network(rt).eki_channel(_text(a[0], "EKI_Open channel")).open())
+    return _status(network(rt).eki_channel(ref_text(a[0], "EKI_Open channel")).open())
 
 
 @_call
 def eki_close(rt, a):
-    return _status(network(rt).eki_channel(_text(a[0], "EKI_Close channel")).close())
+    return _status(network(rt).eki_channel(ref_text(a[0], "EKI_Close channel")).close())
 
 
 @_call
 def eki_clear(rt, a):
     from net.eki import Status  # noqa: PLC0415
 
-    network(rt).eki_clear(_text(a[0], "EKI_Clear channel"))
+    network(rt).eki_clear(ref_text(a[0], "EKI_Clear channel"))
     return _status(Status())
 
 
 @_call
 def eki_lock(rt, a):
-    return _status(network(rt).eki_channel(_text(a[0], "EKI_Lock channel")).lock())
+    return _status(network(rt).eki_channel(ref_text(a[0], "EKI_Lock channel")).lock())
 
 
 @_call
 def eki_unlock(rt, a):
-    return _status(network(rt).eki_channel(_text(a[0], "EKI_Unlock channel")).unlock())
+    return _status(network(rt).eki_channel(ref_text(a[0], "EKI_Unlock channel")).unlock())
 
 
 @_call
 def eki_send(rt, a):
-    ch = network(rt).eki_channel(_text(a[0], "EKI_Send channel"))
-    data = _text(a[1] if len(a) > 1 else None, "EKI_Send data")
+    ch = network(rt).eki_channel(ref_text(a[0], "EKI_Send channel"))
+    data = ref_text(a[1] if len(a) > 1 else None, "EKI_Send data")
     length = None
     if len(a) > 2 and a[2] is not None:
         from .convert import num  # noqa: PLC0415
@@ -118,14 +118,14 @@ def eki_send(rt, a):
 
 @_call
 def eki_checkbuffer(rt, a):
-    ch = network(rt).eki_channel(_text(a[0], "EKI_CheckBuffer channel"))
-    return _result(*ch.check(_text(a[1] if len(a) > 1 else None, "EKI_CheckBuffer element")))
+    ch = network(rt).eki_channel(ref_text(a[0], "EKI_CheckBuffer channel"))
+    return _result(*ch.check(ref_text(a[1] if len(a) > 1 else None, "EKI_CheckBuffer element")))
 
 
 @_call
 def eki_clearbuffer(rt, a):
-    ch = network(rt).eki_channel(_text(a[0], "EKI_ClearBuffer channel"))
-    return _result(*ch.clear_buffer(_text(a[1] if len(a) > 1 else None, "EKI_ClearBuffer element")))
+    ch = network(rt).eki_channel(ref_text(a[0], "EKI_ClearBuffer channel"))
+    return _result(*ch.clear_buffer(ref_text(a[1] if len(a) > 1 else None, "EKI_ClearBuffer element")))
 
 
 def _setter(kind: str):
@@ -135,8 +135,8 @@ def _setter(kind: str):
 
         from .convert import num  # noqa: PLC0415
 
-        ch = network(rt).eki_channel(_text(a[0], f"EKI_Set{kind} channel"))
-        path = _text(a[1] if len(a) > 1 else None, f"EKI_Set{kind} element")
+        ch = network(rt).eki_channel(ref_text(a[0], f"EKI_Set{kind} channel"))
+        path = ref_text(a[1] if len(a) > 1 else None, f"EKI_Set{kind} element")
         if len(a) < 3 or a[2] is None:
             raise value_invalid(f"EKI_Set{kind} value")
         v = a[2].get()
@@ -148,7 +148,7 @@ def _setter(kind: str):
         elif kind == "Bool":
             text = "TRUE" if bool(v) else "FALSE"
         elif kind == "String":
-            text = _text(a[2], "EKI_SetString value")
+            text = ref_text(a[2], "EKI_SetString value")
         else:       # Frame, Pos, Axis: the components as attributes
             if not isinstance(v, Struct):
                 raise KrlRuntimeError(f"EKI_Set{kind} needs a structure")
@@ -213,8 +213,8 @@ def _getter(kind: str, array: bool = False):
         from net.eki import EkiError  # noqa: PLC0415
 
         name = f"EKI_Get{kind}{'Array' if array else ''}"
-        ch = network(rt).eki_channel(_text(a[0], f"{name} channel"))
-        path = _text(a[1] if len(a) > 1 else None, f"{name} element")
+        ch = network(rt).eki_channel(ref_text(a[0], f"{name} channel"))
+        path = ref_text(a[1] if len(a) > 1 else None, f"{name} element")
         target = a[2] if len(a) > 2 else None
         if target is None:
             raise value_invalid(f"{name} variable")

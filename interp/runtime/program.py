@@ -6,7 +6,8 @@
   command): the KRC backup holding the program (its whole root, ``R1`` and ``STEU``), else
   every KRL file below the program's folder (or ``--workspace``); outside a backup the
   project's BASIS (interp/basis: ``$config.dat``, ``bas.src``, ``ir_stopm.src``) is added as
-  the System folder, inside one the backup's own System folder is used;
+  the System folder (:func:`basis_files`, krl/project.py rule 4: its ``$config.dat`` merges
+  with a folder's own), inside one the backup's own System folder is used;
 * they are loaded, checked and resolved together by the front end
   (:func:`krl.workspace.load_project`, ``Workspace.check``; krl/semantics/resolve.py gives
   every use its storage class and slot, every call its routine, every statement its
@@ -30,13 +31,17 @@ from pathlib import Path
 
 from krl.ast import nodes as N
 from krl.diagnostics import SYNTAX_CODES
-from krl.project import project_of   # which files make the program: one rule
+from krl.limits import PARSE_TIMEOUT_S
+from krl.project import project_of, with_basis   # which files make the program: one rule
 from krl.semantics import types as T
 from krl.semantics.expression import Env, evaluate
 from krl.semantics.resolve import GLOBAL, LOCAL, MODULE, SYSTEM, Storage
+from krl.store import stored
+from krl.workspace import load_file, load_project
 
 from .convert import assign_into, convert_scalar
 from .errors import KrlRuntimeError, ResourceError
+from .kss import standard_files
 from .memory import Slot, SignalRef, index_ref
 from .values import UNSET, Struct, data_size, make_value
 
@@ -62,11 +67,17 @@ class SyntaxProblem(str):
         return self
 
 
+def basis_files(project) -> list[Path]:
+    """The files of the project's BASIS (:data:`BASIS_DIR`) that the program of `project`
+    (krl.project.ProgramFiles) runs on: krl/project.py rule 4 (none in a backup; the BASIS
+    ``$config.dat`` merges with the program's own; another BASIS module only when the program
+    has none of its name)."""
+    return with_basis(project, sorted(p for p in BASIS_DIR.iterdir() if p.is_file()))
+
+
 def parse_module(path: str):
     """(Module AST, syntax error strings) of one file on its own (tools and tests; a run
     loads its files through :func:`checked_workspace`)."""
-    from krl.workspace import load_file  # noqa: PLC0415
-
     lf = load_file(path)
     errs = [SyntaxProblem(f"{d.path}:{d.line}:{d.column}: {d.message}", d.path, d.line)
             for d in lf.diagnostics if d.is_error and d.code in _START_CODES]
@@ -80,10 +91,6 @@ def checked_workspace(project, extra: list[Path] = ()):
     programs of one backup, load and check their files once, and kept across processes in the
     user cache folder (krl/store.py), so a command started again on unchanged files does not
     parse and check them again. Never raises for bad input."""
-    from krl.limits import PARSE_TIMEOUT_S  # noqa: PLC0415
-    from krl.store import stored  # noqa: PLC0415
-    from krl.workspace import load_project  # noqa: PLC0415
-
     paths = [*project.files, *extra]
     key = [str(project.root), project.backup]
     size = 0
@@ -133,7 +140,7 @@ class ModuleRT:
         self.path = unit.src.path if unit.src is not None else (unit.dat.path if unit.dat is not None else "")
         dl = unit.dat.module.data if unit.dat is not None else None
         self.datalist: N.DataList | None = dl
-        self.layout = dl.ann.storage if dl is not None and dl.ann is not None else None
+        self.layout = dl.ann.layout if dl is not None and dl.ann is not None else None
         n = len(self.layout.slots) if self.layout is not None else 0
         self.refs: list = [None] * n       # slot -> reference (the interpreters' storage)
         self.store: list = [UNSET] * n     # slot -> value of a variable
@@ -157,11 +164,11 @@ class Program:
         self.backup = self.project.backup
         self.workspace = self.project.root
         self.system_dir = self.project.system if self.backup and self.project.system else BASIS_DIR
-        extra = [] if self.backup else sorted(p for p in BASIS_DIR.iterdir() if p.is_file())
-        from .kss import standard_files  # noqa: PLC0415
-
+        extra = basis_files(self.project)
         extra += standard_files(self.project)     # KUKA's P00 when the backup lacks it
-        extra += [Path(s).resolve() for s in submits if Path(s).resolve() not in self.project.files]
+        own = {f.stem.lower() for f in self.project.files}
+        extra += [Path(s).resolve() for s in submits if Path(s).resolve() not in self.project.files
+                  and Path(s).stem.lower() not in own]
         self.ws = ws = checked_workspace(self.project, extra)
         self.check = check
         self.modules: list[ModuleRT] = [ModuleRT(self, i, u) for i, u in enumerate(ws.units)]
@@ -352,7 +359,7 @@ class Program:
                 if system_list and vn.name[:1] == "$":
                     self.rt.sysvars.declare(vn.name.upper(), ref, self._decl_span(vn, item))
         elif isinstance(item, N.ArrayInit):
-            st = item.ann.storage if item.ann is not None else None
+            st = item.ann.place if item.ann is not None else None
             ref = m.refs[st.slot] if st is not None else None
             if ref is None:
                 return
@@ -446,7 +453,7 @@ class _InitialiserEnv(Env):
         raise KrlRuntimeError("only literal values are allowed in a data list")
 
     def name(self, node: N.Name):
-        st = node.ann.storage if node.ann is not None else None
+        st = node.ann.place if node.ann is not None else None
         program = self.program
         if isinstance(st, Storage) and st.kind in (MODULE, GLOBAL):
             return lambda: program.data_ref(st).get()
@@ -455,8 +462,7 @@ class _InitialiserEnv(Env):
         raise KrlRuntimeError(f"unknown name {node.name} in a data list initialisation")
 
     def aggregate(self, node: N.Aggregate, items: list):
-        st = node.ann.storage if node.ann is not None else None
-        struc = st if isinstance(st, T.Struc) else None
+        struc = node.ann.struc if node.ann is not None else None
         return lambda: Struct(struc, {k: r() for k, r in items})
 
 
@@ -469,4 +475,4 @@ def _in_mada(m: ModuleRT) -> bool:
     return p is not None and p.parent.name.upper() == "MADA"
 
 
-__all__ = ["BASIS_DIR", "LOCAL", "ModuleRT", "Program", "SyntaxProblem", "checked_workspace", "parse_module"]
+__all__ = ["BASIS_DIR", "LOCAL", "ModuleRT", "Program", "SyntaxProblem", "basis_files", "checked_workspace", "parse_module"]

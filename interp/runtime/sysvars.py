@@ -259,11 +259,6 @@ class SysVars:
         self.refs[name] = ref
         return ref
 
-    def stops(self, name: str) -> tuple[bool, bool]:
-        """(stops on read, stops on write) for system variable ``name``."""
-        info = self.info.get(name)
-        return (info.stop_read, info.stop_write) if info is not None else (False, False)
-
     # ------------------------------------------------------------------ helpers for motion
     def value(self, name: str):
         return self.store[name]

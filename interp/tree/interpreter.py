@@ -7,22 +7,26 @@ variables, advance run, motion, interrupts, triggers, time) is a call into
 (:mod:`interp.runtime.errors`); a block that holds the GOTO's label catches it and
 continues there.
 
-Names: the front end resolved them (krl/semantics/resolve.py): each Name carries its
-Storage (a frame slot, a data-list slot, a system variable), each Call its Callee and each
-statement its StmtInfo (advance-run stops); the interpreter reads them and never looks a name
-up (``Runtime.storage_ref``).
+Meaning comes from the front end's typed facts (krl/semantics/resolve.py), never from a
+name's spelling: each Name carries its place (a frame slot, a data-list slot, a system
+variable), each Call its Callee (a routine, a built-in, a stub), a GOTO its target Label, an
+assignment whether it sets a cyclic flag, an analog statement its channel, an interrupt
+declaration its BRAKE, each statement its StmtInfo (advance-run stops). Dispatch is the one
+node-dispatch helper (krl/ast/visit.py): one method per statement (``s_Kind``) and expression
+kind (``e_Kind``).
 """
 
 from __future__ import annotations
 
 from krl.ast import nodes as N
+from krl.ast.visit import EXPRESSIONS, STATEMENTS, handlers
+from krl.semantics.resolve import LOCAL, ROUTINE, SYSTEM
 
 from interp.runtime.builtins import ValueRef
 from interp.runtime.convert import num
+from interp.runtime.errors import ExitSignal, GotoSignal, KrlRuntimeError, ReturnSignal, lvalue_name
 from interp.runtime.slots import (anout_limits, anout_value, array_index, ended_without_return, for_done,
                                  for_limits, for_next, label_not_found, return_without_value, trigger_args)
-from interp.runtime.errors import lvalue_name, ExitSignal, GotoSignal, KrlRuntimeError, ReturnSignal
-from krl.semantics.resolve import LOCAL, SYSTEM
 from interp.runtime.values import Channel, EnumValue, Struct, copy_value
 
 
@@ -30,35 +34,8 @@ class TreeInterpreter:
     def __init__(self, rt) -> None:
         self.rt = rt
         self._labels: dict = {}
-        self.stmt_dispatch = {
-            N.Assign: self.s_assign, N.CallStmt: self.s_call, N.If: self.s_if,
-            N.Switch: self.s_switch, N.For: self.s_for, N.While: self.s_while,
-            N.Repeat: self.s_repeat, N.Loop: self.s_loop, N.Exit: self.s_exit,
-            N.Goto: self.s_goto, N.Label: self.s_label, N.Halt: self.s_halt,
-            N.WaitFor: self.s_wait_for, N.WaitSec: self.s_wait_sec, N.Continue: self.s_continue,
-            N.Return: self.s_return, N.OnErrorProceed: self.s_on_error_proceed,
-            N.InterruptDecl: self.s_int_decl, N.InterruptCtl: self.s_int_ctl,
-            N.Brake: self.s_brake, N.Resume: self.s_resume, N.Trigger: self.s_trigger,
-            N.Motion: self.s_motion, N.SplineBlock: self.s_spline,
-            N.AninOn: self.s_unsupported, N.AninOff: self.s_unsupported,
-            N.AnoutOn: self.s_unsupported, N.AnoutOff: self.s_unsupported,
-            N.DeclStmt: self.s_declstmt, N.Unsupported: self.s_unsupported_text,
-        }
-        for cls_name in ("KeywordStmt", "MoveEmi"):
-            cls = getattr(N, cls_name, None)
-            if cls is not None:
-                self.stmt_dispatch[cls] = self.s_stub
-        self.stmt_dispatch[N.AninOn] = self.s_anin_on
-        self.stmt_dispatch[N.AninOff] = self.s_anin_off
-        self.stmt_dispatch[N.AnoutOn] = self.s_anout_on
-        self.stmt_dispatch[N.AnoutOff] = self.s_anout_off
-        self.expr_dispatch = {
-            N.IntLit: self.e_lit, N.RealLit: self.e_lit, N.BoolLit: self.e_lit,
-            N.StrLit: self.e_lit, N.EnumLit: self.e_enum, N.Aggregate: self.e_aggregate,
-            N.Name: self.e_var, N.Index: self.e_var, N.Field: self.e_var,
-            N.Call: self.e_call, N.Unary: self.e_unary, N.Binary: self.e_binary,
-            N.ChannelName: self.e_channel,
-        }
+        self.stmt_dispatch = handlers(self, "s_", STATEMENTS)
+        self.expr_dispatch = handlers(self, "e_", EXPRESSIONS)
 
     # ------------------------------------------------------------------ entry points
     def run_program(self, module_name: str | None = None) -> None:
@@ -76,20 +53,21 @@ class TreeInterpreter:
                 dispatch[st.__class__](st, frame)
                 i += 1
             except GotoSignal as g:
-                pos = self._label_pos(stmts, g.label)
+                pos = self._label_pos(stmts, g.target)
                 if pos is None:
                     raise
                 i = pos
 
-    def _label_pos(self, stmts: list, label: str):
+    def _label_pos(self, stmts: list, target):
+        """The position of Label `target` in the statement list `stmts`, or None."""
         key = id(stmts)
         table = self._labels.get(key)
         if table is None:
-            table = {s.name.upper(): i for i, s in enumerate(stmts) if isinstance(s, N.Label)}
+            table = {id(s): i for i, s in enumerate(stmts) if isinstance(s, N.Label)}
             self._labels[key] = (table, stmts)
         else:
             table = table[0]
-        return table.get(label)
+        return table.get(id(target))
 
     def begin(self, st, frame):
         """Common statement prologue: runtime bookkeeping; returns the StmtInfo."""
@@ -122,24 +100,23 @@ class TreeInterpreter:
             return False
         return True
 
-    def s_assign(self, st, frame) -> None:
+    def s_Assign(self, st, frame) -> None:
         self.begin(st, frame)
 
         def do():
             value = self.eval(st.value, frame)
             ref = self.ref(st.target, frame)
             self.rt.assign(ref, value)
-            t = st.target
-            if isinstance(t, N.Index) and isinstance(t.base, N.Name) and t.base.name.upper() == "$CYCFLAG":
+            if st.ann.cyclic:
                 # a cyclic flag: re-evaluated every IPO cycle until assigned again (§5.15)
-                self.rt.cyclic_on(("CYCFLAG", ref.name), lambda: self.rt.assign(ref, self.eval(st.value, frame)))
+                self.rt.cyclic_on(("cyclic flag", ref.name), lambda: self.rt.assign(ref, self.eval(st.value, frame)))
         self.guarded(do, st, frame)
 
-    def s_call(self, st, frame) -> None:
+    def s_CallStmt(self, st, frame) -> None:
         self.begin(st, frame)
         self.guarded(lambda: self.call(st.call, frame, statement=True), st, frame)
 
-    def s_if(self, st, frame) -> None:
+    def s_If(self, st, frame) -> None:
         self.begin(st, frame)
         cond = []
         self.guarded(lambda: cond.append(self.rt.to_bool(self.eval(st.cond, frame))), st, frame)
@@ -150,7 +127,7 @@ class TreeInterpreter:
         elif st.orelse:
             self.exec_block(st.orelse, frame)
 
-    def s_switch(self, st, frame) -> None:
+    def s_Switch(self, st, frame) -> None:
         self.begin(st, frame)
         sel = []
         self.guarded(lambda: sel.append(self.eval(st.selector, frame)), st, frame)
@@ -165,7 +142,7 @@ class TreeInterpreter:
         if st.default is not None:
             self.exec_block(st.default, frame)
 
-    def s_for(self, st, frame) -> None:
+    def s_For(self, st, frame) -> None:
         info = self.begin(st, frame)
         rt = self.rt
         head = []
@@ -191,7 +168,7 @@ class TreeInterpreter:
         except ExitSignal:
             pass
 
-    def s_while(self, st, frame) -> None:
+    def s_While(self, st, frame) -> None:
         info = self.begin(st, frame)
         rt = self.rt
         proceed = rt.take_error_proceed()
@@ -210,7 +187,7 @@ class TreeInterpreter:
         except ExitSignal:
             pass
 
-    def s_repeat(self, st, frame) -> None:
+    def s_Repeat(self, st, frame) -> None:
         info = self.plain(st, frame)
         rt = self.rt
         try:
@@ -222,7 +199,7 @@ class TreeInterpreter:
         except ExitSignal:
             pass
 
-    def s_loop(self, st, frame) -> None:
+    def s_Loop(self, st, frame) -> None:
         info = self.plain(st, frame)
         rt = self.rt
         try:
@@ -232,34 +209,34 @@ class TreeInterpreter:
         except ExitSignal:
             pass
 
-    def s_exit(self, st, frame) -> None:
+    def s_Exit(self, st, frame) -> None:
         self.plain(st, frame)
         raise ExitSignal()
 
-    def s_goto(self, st, frame) -> None:
+    def s_Goto(self, st, frame) -> None:
         self.plain(st, frame)
-        raise GotoSignal(st.label)
+        raise GotoSignal(st.label, st.ann.target)
 
-    def s_label(self, st, frame) -> None:
+    def s_Label(self, st, frame) -> None:
         pass
 
-    def s_halt(self, st, frame) -> None:
+    def s_Halt(self, st, frame) -> None:
         self.plain(st, frame)
         self.rt.halt()
 
-    def s_wait_for(self, st, frame) -> None:
+    def s_WaitFor(self, st, frame) -> None:
         self.begin(st, frame)
         self.guarded(lambda: self.rt.wait_for(lambda: self.eval(st.cond, frame)), st, frame)
 
-    def s_wait_sec(self, st, frame) -> None:
+    def s_WaitSec(self, st, frame) -> None:
         self.begin(st, frame)
         self.guarded(lambda: self.rt.wait_sec(self.eval(st.time, frame)), st, frame)
 
-    def s_continue(self, st, frame) -> None:
+    def s_Continue(self, st, frame) -> None:
         info = self.plain(st, frame)
         self.rt.set_continue(info)
 
-    def s_return(self, st, frame) -> None:
+    def s_Return(self, st, frame) -> None:
         self.begin(st, frame)
         value = []
         # ON_ERROR_PROCEED covers the value: after an error the next statement runs
@@ -267,11 +244,11 @@ class TreeInterpreter:
                         st, frame):
             raise ReturnSignal(value[0])
 
-    def s_on_error_proceed(self, st, frame) -> None:
+    def s_OnErrorProceed(self, st, frame) -> None:
         self.plain(st, frame)
         self.rt.on_error_proceed()
 
-    def s_declstmt(self, st, frame) -> None:
+    def s_DeclStmt(self, st, frame) -> None:
         raise KrlRuntimeError("declaration after the first statement", None, st.span.file, st.span.line)
 
     def s_stub(self, st, frame) -> None:
@@ -280,30 +257,32 @@ class TreeInterpreter:
         words = getattr(st, "words", None)
         self.rt.stub_statement(" ".join(words) if words else type(st).__name__.upper())
 
+    s_KeywordStmt = s_MoveEmi = s_stub
+
     # analog I/O (§5.14) --------------------------------------------------------------
-    def s_anout_on(self, st, frame) -> None:
+    def s_AnoutOn(self, st, frame) -> None:
         self.begin(st, frame)
         rt = self.rt
 
         def do():
-            ref = rt.storage_ref(st.ann.storage, frame)
+            ref = rt.storage_ref(st.ann.channel, frame)
             lo, hi = anout_limits(self.eval(st.minimum, frame) if st.minimum is not None else None,
                                   self.eval(st.maximum, frame) if st.maximum is not None else None)
 
             def tick():
                 ref.set(anout_value(self.eval(st.value, frame), lo, hi))
             tick()
-            rt.cyclic_on(("ANOUT", st.name.upper()), tick)
+            rt.cyclic_on(("analog output", st.ann.channel.key), tick)
         self.guarded(do, st, frame)
 
-    def s_anout_off(self, st, frame) -> None:
+    def s_AnoutOff(self, st, frame) -> None:
         self.plain(st, frame)
-        self.rt.cyclic_off(("ANOUT", st.name.upper()))
+        self.rt.cyclic_off(("analog output", st.ann.channel.key))
 
-    def s_anin_on(self, st, frame) -> None:
+    def s_AninOn(self, st, frame) -> None:
         self.begin(st, frame)
         rt = self.rt
-        names = [n.name.upper() for n in st.value.walk() if isinstance(n, N.Name)]
+        channel = st.ann.channel
 
         def do():
             ref = self.ref(st.target, frame)
@@ -311,26 +290,20 @@ class TreeInterpreter:
             def tick():
                 rt.assign(ref, self.eval(st.value, frame))
             tick()
-            for name in names:
-                rt.cyclic_on(("ANIN", name), tick)
-                break
+            if channel is not None:
+                rt.cyclic_on(("analog input", channel.key), tick)
         self.guarded(do, st, frame)
 
-    def s_anin_off(self, st, frame) -> None:
+    def s_AninOff(self, st, frame) -> None:
         self.plain(st, frame)
-        self.rt.cyclic_off(("ANIN", st.name.upper()))
+        self.rt.cyclic_off(("analog input", st.ann.channel.key))
 
-    def s_unsupported(self, st, frame) -> None:
-        self.plain(st, frame)
-        raise KrlRuntimeError(f"{type(st).__name__} is not supported by this simulator", None,
-                              st.span.file, st.span.line)
-
-    def s_unsupported_text(self, st, frame) -> None:
+    def s_Unsupported(self, st, frame) -> None:
         raise KrlRuntimeError(f"unsupported statement: {st.text.strip()[:60]}", None,
                               st.span.file, st.span.line)
 
     # interrupts, triggers, brake ------------------------------------------------------
-    def s_int_decl(self, st, frame) -> None:
+    def s_InterruptDecl(self, st, frame) -> None:
         self.begin(st, frame)
         rt = self.rt
         call = st.call
@@ -339,8 +312,8 @@ class TreeInterpreter:
         def cond():
             return rt.to_bool(self.eval(cond_expr, frame), "interrupt condition")
 
-        if call.name.upper() in ("BRAKE", "BRAKE_F") and not call.args:
-            fast = call.name.upper() == "BRAKE_F"
+        if st.brake is not None:                 # DO BRAKE / DO BRAKE F (§5.16)
+            fast = st.brake.fast
 
             def handler():
                 rt.brake(fast)
@@ -353,20 +326,20 @@ class TreeInterpreter:
                               st.is_global, st.span.line)
         self.guarded(do, st, frame)
 
-    def s_int_ctl(self, st, frame) -> None:
+    def s_InterruptCtl(self, st, frame) -> None:
         self.begin(st, frame)
         self.guarded(lambda: self.rt.interrupt_ctl(
             st.action, self.eval(st.prio, frame) if st.prio is not None else None), st, frame)
 
-    def s_brake(self, st, frame) -> None:
+    def s_Brake(self, st, frame) -> None:
         self.plain(st, frame)
         self.rt.brake(st.fast)
 
-    def s_resume(self, st, frame) -> None:
+    def s_Resume(self, st, frame) -> None:
         self.plain(st, frame)
         self.rt.resume()
 
-    def s_trigger(self, st, frame) -> None:
+    def s_Trigger(self, st, frame) -> None:
         self.begin(st, frame)
         rt = self.rt
         act = st.action
@@ -374,7 +347,7 @@ class TreeInterpreter:
         def do():
             if isinstance(act, N.CallStmt):
                 call = act.call
-                target = rt.callee(call.ann.storage)
+                target = rt.callee(call.ann.callee)
                 if target is not None:
                     # the arguments are evaluated now, in the advance run (§5.18)
                     args = [None if a is None else ValueRef(copy_value(self.eval(a, frame)))
@@ -406,7 +379,7 @@ class TreeInterpreter:
     def with_pairs(self, with_, frame) -> list:
         return [(self.ref(w.target, frame), self.eval(w.value, frame)) for w in with_]
 
-    def s_motion(self, st, frame) -> None:
+    def s_Motion(self, st, frame) -> None:
         self.begin(st, frame)
         rt = self.rt
 
@@ -418,7 +391,7 @@ class TreeInterpreter:
                       st.span.file, st.span.line)
         self.guarded(do, st, frame)
 
-    def s_spline(self, st, frame) -> None:
+    def s_SplineBlock(self, st, frame) -> None:
         self.begin(st, frame)
         rt = self.rt
         task = rt.current_task
@@ -430,7 +403,7 @@ class TreeInterpreter:
                 if isinstance(s, N.Trigger):
                     saved = task.next_triggers
                     task.next_triggers = []
-                    self.s_trigger(s, frame)
+                    self.s_Trigger(s, frame)
                     pending += task.next_triggers
                     task.next_triggers = saved
                 elif isinstance(s, N.Motion):
@@ -458,12 +431,13 @@ class TreeInterpreter:
 
     def call(self, call: N.Call, frame, statement: bool = False, catch_resume: bool = True):
         rt = self.rt
-        target = rt.callee(call.ann.storage)
-        if target is None:
-            if rt.is_native(call.name):
-                return rt.call_builtin(call.name, self.args_for(call, frame))
-            return rt.stub_call(call.name, not statement)
-        return self.invoke(target, self.args_for(call, frame), frame, catch_resume)
+        callee = call.ann.callee
+        if callee.kind == ROUTINE:
+            return self.invoke(rt.callee(callee), self.args_for(call, frame), frame, catch_resume)
+        native = rt.native(callee)
+        if native is None:
+            return rt.stub_call(callee.name, not statement)
+        return native(rt, self.args_for(call, frame))
 
     def invoke(self, target, args: list, caller, catch_resume: bool = True):
         """Run routine ``target`` = (module, Routine) with reference ``args`` (the
@@ -477,12 +451,12 @@ class TreeInterpreter:
         try:
             self.exec_block(routine.body, frame)
         except ReturnSignal as r:
-            if routine.kind == "DEFFCT" and r.value is None:
+            if routine.is_function and r.value is None:
                 raise return_without_value(routine, frame.line) from None
-            return r.value if routine.kind == "DEFFCT" else None
+            return r.value if routine.is_function else None
         except GotoSignal as g:
             raise label_not_found(g.label, routine, frame.line) from None
-        if routine.kind == "DEFFCT":
+        if routine.is_function:
             raise ended_without_return(routine, frame.line)
         return None
 
@@ -499,17 +473,19 @@ class TreeInterpreter:
     def e_lit(self, e, frame):
         return e.value
 
-    def e_enum(self, e, frame):
+    e_IntLit = e_RealLit = e_BoolLit = e_StrLit = e_lit
+
+    def e_EnumLit(self, e, frame):
         return EnumValue(e.name)
 
-    def e_channel(self, e, frame):
+    def e_ChannelName(self, e, frame):
         return Channel(e.name)
 
-    def e_aggregate(self, e, frame):
+    def e_Aggregate(self, e, frame):
         items = []
         for it in e.items:
             items.append((it.name.upper(), self.eval(it.value, frame)))
-        return self.rt.aggregate(e.ann.storage if e.type_name else None, items)
+        return self.rt.aggregate(e.ann.struc if e.type_name else None, items)
 
     def e_var(self, e, frame):
         v = self.ref(e, frame).get()
@@ -517,16 +493,18 @@ class TreeInterpreter:
             return copy_value(v)
         return v
 
-    def e_call(self, e, frame):
+    e_Name = e_Index = e_Field = e_var
+
+    def e_Call(self, e, frame):
         v = self.call(e, frame)
         if v is None:
             raise KrlRuntimeError(f"{e.name} does not return a value")
         return v
 
-    def e_unary(self, e, frame):
+    def e_Unary(self, e, frame):
         return self.rt.unary_op(e.op, self.eval(e.operand, frame))
 
-    def e_binary(self, e, frame):
+    def e_Binary(self, e, frame):
         # a left-nested chain (up to MAX_EXPRESSION_TERMS terms) in a loop: left before right
         left, chain = N.left_chain(e)
         a = self.eval(left, frame)
@@ -538,7 +516,7 @@ class TreeInterpreter:
         """The reference of an lvalue expression (Name / Index / Field chain)."""
         rt = self.rt
         if e.__class__ is N.Name:
-            st = e.ann.storage
+            st = e.ann.place
             k = st.kind
             if k == LOCAL:
                 return frame.vars[st.slot]
@@ -553,11 +531,9 @@ class TreeInterpreter:
                     idx.append(None)
                 else:
                     idx.append(array_index(self.eval(i, frame)))
-            return rt.index(base, idx, _name_of(e.base))
+            return rt.index(base, idx, lvalue_name(e.base))
         if isinstance(e, N.Field):
             base = self.ref(e.base, frame)
-            return rt.field(base, e.name, _name_of(e.base))
+            return rt.field(base, e.name, lvalue_name(e.base))
         raise KrlRuntimeError("not a variable")
 
-
-_name_of = lvalue_name

@@ -1,18 +1,22 @@
 """The bytecode VM (issue 7; docs/architecture.md, "Bytecode VM").
 
 Pipeline, one file per stage: ``opcodes.py`` (the single opcode table) ->
-``compiler.py`` (routine AST -> instruction listing) -> ``assembler.py`` (listing -> code;
-the readable text for `krl asm` and its round trip, never read at run time) -> ``vm.py`` (one dispatch loop on the shared runtime,
-interp/runtime). ``gen_loop.py`` generates the dispatch loop ``loop.py`` from ``vm.py``;
-``build.py`` compiles it with Cython (``make vm-loop``; loop.py is the pure-Python fallback).
-``cli.py`` is `krl asm`; ``bench/`` the compute benchmark of `krl bench`.
+``compiler.py`` (routine AST -> instruction listing, from the front end's typed facts) ->
+``vm.py`` (``link``: the listing's executed form, kept per checked workspace; ``Bound``: one
+run's storage and call sites; one dispatch loop on the shared runtime, interp/runtime).
+``assembler.py`` writes a listing as the readable text of `krl asm` (interp/asm.py) and reads
+it back for the round-trip tests; no text is read at run time. ``gen_loop.py`` generates the
+dispatch loop ``loop.py`` from ``vm.py``; ``build.py`` compiles it with Cython (``make
+vm-loop``; loop.py is the pure-Python fallback). The compute benchmark of `krl bench` is
+interp/bench.
 """
 
 __all__ = ["VM"]
 
 
 def __getattr__(name: str):
-    # loaded on first use (PEP 562), so that `krl` commands that run no program stay quick
+    # loaded on first use (PEP 562; optional for commands that run nothing): vm.py imports the runtime and the compiled loop, which
+    # `krl` commands that run no program (check, fmt, lsp) do not need
     if name == "VM":
         from .vm import VM  # noqa: PLC0415
 

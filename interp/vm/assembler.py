@@ -36,7 +36,7 @@ from dataclasses import dataclass, field
 from krl.terminal import printable
 
 from krl.semantics.advance import StmtInfo
-from interp.runtime.values import EnumValue
+from interp.runtime.values import Channel, EnumValue
 
 from . import opcodes as O
 
@@ -54,7 +54,9 @@ class Region:
 
 @dataclass
 class Code:
-    """One assembled routine: flat instruction words + pools + line table."""
+    """One assembled routine: flat instruction words + pools + line table (the encoded form
+    of a listing: the assembler's round trip text -> words -> text; the VM runs the linked
+    form of interp/vm/vm.py instead)."""
     name: str
     kind: str = "DEF"
     file: str = ""
@@ -66,19 +68,6 @@ class Code:
     gnames: list = field(default_factory=list)    # global slots
     ntemps: int = 0
     regions: list = field(default_factory=list)   # per word: Region or None
-    # linked when the routine is first called (interp/vm/vm.py, VM.code_for)
-    routine: object = None                        # the AST Routine
-    module: object = None                         # its runtime ModuleRT
-    mrefs: list | None = None                     # module slots -> data-list references
-    grefs: list | None = None                     # global slots -> references (bound on first use)
-    lkeys: list | None = None                     # frame slots -> Frame.vars keys
-    prog: list | None = None                      # decoded instructions (vm.decode)
-    iregions: list | None = None                  # error region per decoded instruction
-    callsites: dict = field(default_factory=dict)  # instruction -> (module, routine) of a CALL
-
-    @property
-    def is_function(self) -> bool:
-        return self.kind == "DEFFCT"
 
 
 # ---------------------------------------------------------------------------- literals
@@ -95,6 +84,8 @@ def fmt_const(v) -> str:
         return "FALSE"
     if isinstance(v, EnumValue):
         return "#" + v.name
+    if isinstance(v, Channel):
+        return ":" + v.name             # a channel argument (COPEN(:SER_3, HANDLE))
     if isinstance(v, int):
         return str(v)
     if isinstance(v, float):
@@ -112,6 +103,8 @@ def parse_const(tok: str):
         return True
     if tok == "FALSE":
         return False
+    if tok.startswith(":"):
+        return Channel(tok[1:])
     if tok.startswith("#"):
         return EnumValue(tok[1:])
     if tok.startswith('"'):
@@ -127,8 +120,12 @@ def parse_const(tok: str):
 
 
 def fmt_name(s) -> str:
+    """A name operand as text (``-`` for None); a resolved fact (a place, a Callee, a STRUC)
+    is written by its name."""
     if s is None:
         return "-"
+    if not isinstance(s, str):
+        s = s.name
     return s if _PLAIN.match(s) else json.dumps(s)
 
 
@@ -205,7 +202,7 @@ def format_listing(lst: Listing) -> str:
                 parts.append(lab[v])
             elif k == "c":
                 parts.append(fmt_const(v))
-            elif k in "nsmgvyok":
+            elif k in "nsmgvyokrap":
                 parts.append(fmt_name(v))
             elif k == "f":
                 parts.append(fmt_flags(v))
@@ -268,7 +265,7 @@ def parse_listings(text: str) -> list[Listing]:
                 for k, t in zip(info.operands, args):
                     if k == "c":
                         ops.append(parse_const(t))
-                    elif k in "nsmgvyok":
+                    elif k in "nsmgvyokrap":
                         ops.append(parse_name(t))
                     elif k == "f":
                         ops.append("" if t == "-" else t)
@@ -327,7 +324,7 @@ def encode(lst: Listing) -> Code:
         words.append(info.number)
         regions.append(r)
         for k, v in zip(info.operands, ops):
-            if k in "cnfyok":
+            if k in "cnfyokrap":
                 w = const(v)
             elif k == "l":
                 w = label(v)
@@ -372,7 +369,7 @@ def to_listing(code: Code) -> Listing:
         ops = []
         for j, k in enumerate(info.operands):
             w = words[a + 1 + j]
-            if k in "cnfyok":
+            if k in "cnfyokrap":
                 ops.append(code.consts[w])
             elif k == "l":
                 name = f"@{w}"

@@ -51,7 +51,7 @@ def cythonized(root: Path | None = None) -> list:
     """:func:`extension` translated to C by Cython (``language_level`` 3), or ``[]`` when
     Cython is not installed: then nothing is compiled and loop.py runs."""
     try:
-        from Cython.Build import cythonize  # noqa: PLC0415
+        from Cython.Build import cythonize  # noqa: PLC0415  (optional; loads only for a build)
     except ImportError:
         return []
     return cythonize([extension(root)], build_dir="build/cython", quiet=True,
@@ -64,7 +64,7 @@ def build(force: bool = False) -> str:
     out = target()
     if not force and out.exists() and all(out.stat().st_mtime >= s.stat().st_mtime for s in SOURCES):
         return f"{out.name} is up to date"
-    try:
+    try:  # optional build tools, which load only for a build
         from Cython.Build import cythonize  # noqa: PLC0415
         from setuptools import Distribution  # noqa: PLC0415
         from setuptools.command.build_ext import build_ext  # noqa: PLC0415

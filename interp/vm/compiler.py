@@ -1,23 +1,27 @@
 """The bytecode compiler: a routine's AST -> its instruction listing (interp/vm/assembler.py).
 
-The VM encodes the listing directly (assembler.encode); no text is produced or parsed on
+The VM links the listing directly (interp/vm/vm.py ``link``); no text is produced or parsed on
 the way to running code, so no KRL text (a comment, a string) can ever be read back as an
-instruction. The readable assembly (assembler.format_listing) is written only for
-`krl asm` and the assembler's round-trip tests.
+instruction. The readable assembly (assembler.format_listing) is written only for `krl asm`
+and the assembler's round-trip tests.
 
-It mirrors the tree interpreter statement by statement (interp/tree/interpreter.py), so
-that the VM makes the same runtime calls in the same order; only the stepping differs:
+It mirrors the tree interpreter statement by statement (interp/tree/interpreter.py; one
+handler per statement and expression kind through the one node-dispatch helper,
+krl/ast/visit.py), so that the VM makes the same runtime calls in the same order; only the
+stepping differs:
 
-* names come resolved from the front end (krl/semantics/resolve.py): a LOCAL storage is a
-  *frame slot* (parameters and locals, in ``.locals`` order, the routine's Layout), a
-  MODULE storage a *module slot* (the data list of the routine's module), anything else a
-  *global slot* (another data list, a system variable, the ``$``-name fallback; its
-  reference is taken on first use from the storage, Runtime.storage_ref); calls carry their
-  Callee, aggregates their STRUC;
-* structured statements become jumps; GOTO jumps to the label of the nearest enclosing
-  block that holds it (the tree interpreter's rule), EXIT to the end of the innermost loop;
-* constant operands are folded with the runtime's own operator (Runtime.binary_op /
-  unary_op); an expression whose folding raises is left for run time;
+* meaning comes from the front end's typed facts (krl/semantics/resolve.py), never from a
+  name's spelling: a LOCAL place is a *frame slot* (parameters and locals, in ``.locals``
+  order, the routine's Layout), a MODULE place a *module slot* (the data list of the
+  routine's module), any other place a *global slot* (another data list, a system variable,
+  the ``$``-name fallback; its reference is taken on first use, Runtime.storage_ref); the
+  listing carries each place (operands ``m``/``g``), each call's Callee (``r``), each
+  aggregate's STRUC (``a``) and each analog channel (``p``) for the VM to link;
+* structured statements become jumps; GOTO jumps to its target Label, in the nearest
+  enclosing block that holds it (the tree interpreter's rule), EXIT to the end of the
+  innermost loop;
+* constant operands are folded with the front end's operators (krl/semantics/values.py, the
+  runtime's); an expression whose folding raises is left for run time;
 * conditions that are evaluated later (WAIT FOR, interrupt conditions and handlers,
   TRIGGER actions) are compiled as *thunks* after the routine's END;
 * each statement's StmtInfo (advance-run stop flags) is the front end's (``stmt.ann.info``,
@@ -28,20 +32,16 @@ that the VM makes the same runtime calls in the same order; only the stepping di
 from __future__ import annotations
 
 from krl.ast import nodes as N
-
-from interp.runtime.convert import binary_op, unary_op
-from interp.runtime.errors import KrlRuntimeError
-from interp.runtime.values import Channel, EnumValue
+from krl.ast.visit import EXPRESSIONS, STATEMENTS, handlers
 from krl.semantics import types as T
 from krl.semantics.resolve import LOCAL, MODULE
+from krl.semantics.values import EnumValue, KrlRuntimeError, binary_op, unary_op
 
 from interp.runtime.errors import lvalue_name
+from interp.runtime.values import Channel
 
 from .assembler import Listing, Region, format_listing
 from .opcodes import BY_NAME as OPS
-
-
-name_of = lvalue_name   # the shared runtime's helper, so both interpreters name lvalues alike
 
 
 _FAST_BINOPS = {"+": "ADD", "-": "SUB", "*": "MUL", "<": "LT", "<=": "LE", ">": "GT", ">=": "GE",
@@ -52,20 +52,20 @@ _FOLDABLE = (int, float, bool, str, EnumValue)
 def local_names(routine: N.Routine) -> list[str]:
     """Frame slots of a routine (its Layout, krl/semantics/resolve.py): its parameters, then
     its variables and SIGNALs (declaration order)."""
-    return [s.name for s in routine.ann.storage.slots]
+    return [s.name for s in routine.ann.layout.slots]
 
 
 _LETTERS = {T.INT: "I", T.REAL: "R", T.BOOL: "B", T.CHAR: "C"}
 
 
 def store_variables(routine: N.Routine) -> dict:
-    """The routine's *store variables* (operand kind ``v``, interp/vm/opcodes.py): UPPER
-    name -> (type letter I/R/B/C, number of array dimensions, 0 for a scalar) for each
-    variable the frame holds in its own store (Runtime.enter_routine: a local, or an :IN
-    parameter) whose type (the checker's, from the routine's Layout) is INT, REAL, BOOL or
-    CHAR, scalar or an array of 1 or 2 fixed dimensions; not CONST, not an :OUT parameter
-    (an alias of the caller's variable)."""
-    layout = routine.ann.storage
+    """The routine's *store variables* (operand kind ``v``, interp/vm/opcodes.py): frame slot
+    -> (type letter I/R/B/C, number of array dimensions, 0 for a scalar) for each variable
+    the frame holds in its own store (Runtime.enter_routine: a local, or an :IN parameter)
+    whose type (the checker's, from the routine's Layout) is INT, REAL, BOOL or CHAR, scalar
+    or an array of 1 or 2 fixed dimensions; not CONST, not an :OUT parameter (an alias of
+    the caller's variable)."""
+    layout = routine.ann.layout
     out: dict = {}
     for k, s in enumerate(layout.slots):
         d = s.decl
@@ -82,7 +82,7 @@ def store_variables(routine: N.Routine) -> dict:
             t = t.elem
         letter = _LETTERS.get(t)
         if letter is not None:
-            out[s.name.upper()] = (letter, dims)
+            out[k] = (letter, dims)
     return out
 
 
@@ -90,21 +90,16 @@ class Compiler:
     def __init__(self, routine: N.Routine) -> None:
         self.routine = routine
         self.locals = local_names(routine)
-        self.local_set = {n.upper() for n in self.locals}
         self.fast = store_variables(routine)
-        self.spelling = {n.upper(): n for n in self.locals}
         self.lst = Listing(routine.name, routine.kind, routine.span.file, self.locals, 0)
-        # what the front end resolved, for the names this code uses (by upper-case spelling:
-        # one routine's text resolves a spelling one way): the VM binds them (VM.code_for)
-        self.lst.storages = {}
-        self.lst.callees = {}
-        self.lst.types = {}
         self.region: Region | None = None
         self.nlabels = 0
-        self.blocks: list[dict] = []      # label tables of the enclosing statement lists
+        self.blocks: list[dict] = []      # label tables (id of a Label -> label) of the enclosing blocks
         self.loops: list[str] = []        # exit labels of the enclosing loops
         self.thunks: list = []            # (label, emitter) compiled after END
         self.in_thunk = False
+        self.stmt_dispatch = handlers(self, "s_", STATEMENTS)
+        self.expr_dispatch = handlers(self, "e_", EXPRESSIONS)
 
     # ------------------------------------------------------------------ emitting
     def emit(self, name: str, *ops) -> None:
@@ -164,16 +159,12 @@ class Compiler:
         return label
 
     def block(self, stmts: list) -> None:
-        labels = {s.name.upper(): self.new_label() for s in stmts if isinstance(s, N.Label)}
+        labels = {id(s): self.new_label() for s in stmts if isinstance(s, N.Label)}
         self.blocks.append(labels)
+        dispatch = self.stmt_dispatch
         try:
             for st in stmts:
-                fn = getattr(self, "s_" + type(st).__name__, None)
-                if fn is None:
-                    self.region = None
-                    self.emit("RAISE", f"{type(st).__name__} is not supported by this simulator", st.span.line)
-                else:
-                    fn(st)
+                dispatch[st.__class__](st)
         finally:
             self.blocks.pop()
 
@@ -182,13 +173,13 @@ class Compiler:
         end = self.guarded(st)
         self.expr(st.value)
         t = st.target
-        if isinstance(t, N.Index) and isinstance(t.base, N.Name) and t.base.name.upper() == "$CYCFLAG":
+        if st.ann.cyclic:
             # a cyclic flag: re-evaluated every IPO cycle until assigned again (§5.15)
             def value():
                 self.region = None
                 self.expr(st.value)
             self.ref(t)
-            self.emit("CYCFLAG", self.thunk(value))
+            self.emit("CYCLIC_ASSIGN", self.thunk(value))
         else:
             self.store(t)
         self.place(end)
@@ -263,7 +254,7 @@ class Compiler:
         self.loop_body(st.body, end)
         self.region = None
         if self.fast_scalar(st.var) == "I" and "C" not in info[1]:
-            self.emit("FOR_NEXT_FAST", self.spelled(st.var.name), t, info, body)
+            self.emit("FOR_NEXT_FAST", self.local(st.var), t, info, body)
         else:
             self.emit("FOR_NEXT", t, info, body)
         self.place(end)
@@ -334,15 +325,15 @@ class Compiler:
 
     def s_Goto(self, st) -> None:
         self.stmt(st)
-        key = st.label.upper()
+        key = id(st.ann.target)
         for labels in reversed(self.blocks):
             if key in labels:
                 self.emit("JUMP", labels[key])
                 return
-        self.emit("GOTO_FAIL", key)
+        self.emit("GOTO_FAIL", st.label.upper())
 
     def s_Label(self, st) -> None:
-        self.place(self.blocks[-1][st.name.upper()])
+        self.place(self.blocks[-1][id(st)])
 
     def s_Halt(self, st) -> None:
         self.stmt(st)
@@ -406,7 +397,7 @@ class Compiler:
         def value():
             self.region = None
             self.expr(st.value)
-        self.emit("REF_" + self.kind_of(st.name, st.ann.storage), self.spelled(st.name))
+        self.ref_place(st.ann.channel)
         flags = ""
         if st.minimum is not None:
             self.expr(st.minimum)
@@ -415,27 +406,26 @@ class Compiler:
             self.expr(st.maximum)
             flags += "H"
         self.region = region
-        self.emit("ANOUT_ON", st.name.upper(), flags, self.thunk(value))
+        self.emit("ANOUT_ON", st.ann.channel, flags, self.thunk(value))
         self.place(end)
 
     def s_AnoutOff(self, st) -> None:
         self.stmt(st)
-        self.emit("CYCLIC_OFF", "ANOUT", st.name.upper())
+        self.emit("CYCLIC_OFF", "analog output", st.ann.channel)
 
     def s_AninOn(self, st) -> None:
         end = self.guarded(st)
-        names = [n.name.upper() for n in st.value.walk() if isinstance(n, N.Name)]
 
         def value():
             self.region = None
             self.expr(st.value)
         self.ref(st.target)
-        self.emit("ANIN_ON", names[0] if names else None, self.thunk(value))
+        self.emit("ANIN_ON", st.ann.channel, self.thunk(value))
         self.place(end)
 
     def s_AninOff(self, st) -> None:
         self.stmt(st)
-        self.emit("CYCLIC_OFF", "ANIN", st.name.upper())
+        self.emit("CYCLIC_OFF", "analog input", st.ann.channel)
 
     # interrupts, triggers, brake ------------------------------------------------------
     def s_InterruptDecl(self, st) -> None:
@@ -446,8 +436,8 @@ class Compiler:
             self.region = None
             self.expr(st.when)
 
-        if call.name.upper() in ("BRAKE", "BRAKE_F") and not call.args:
-            fast = "F" if call.name.upper() == "BRAKE_F" else ""
+        if st.brake is not None:                 # DO BRAKE / DO BRAKE F (§5.16)
+            fast = "F" if st.brake.fast else ""
 
             def handler():
                 self.region = None
@@ -482,8 +472,7 @@ class Compiler:
         region = self.region
         if isinstance(act, N.CallStmt):
             nf = self.new_label()
-            self.callee(act.call)
-            self.emit("TRIG_FIND", act.call.name, nf)
+            self.emit("TRIG_FIND", act.call.ann.callee, nf)
             for a in act.call.args:      # evaluated now, in the advance run, by value (§5.18)
                 if a is None:
                     self.emit("NONE")
@@ -578,35 +567,26 @@ class Compiler:
                 self.expr(a)
                 self.emit("VALARG")
 
-    def callee(self, call: N.Call) -> None:
-        self.lst.callees[call.name.upper()] = call.ann.storage
-
     def call(self, call: N.Call, flags: str) -> None:
         self.args(call)
-        self.callee(call)
-        self.emit("CALL", call.name, len(call.args), flags)
+        self.emit("CALL", call.ann.callee, len(call.args), flags)
 
     # ------------------------------------------------------------------ names
-    def spelled(self, name: str) -> str:
-        """One spelling per name in a routine's text (KRL names ignore case): the
-        declaration's for locals, else the first one used."""
-        key = name.upper()
-        got = self.spelling.get(key)
-        if got is None:
-            got = self.spelling[key] = name
-        return got
+    def operand(self, place):
+        """(class, operand) of a place (the front end's Storage): LOCAL and the frame slot's
+        declared name, MOD or GLOBAL and the place itself (the VM links it)."""
+        if place.kind == LOCAL:
+            return "LOCAL", self.locals[place.slot]
+        return ("MOD" if place.kind == MODULE else "GLOBAL"), place
 
-    def kind_of(self, name: str, st) -> str:
-        """The operand class of a resolved name (its Storage): LOCAL, MOD or GLOBAL."""
-        if st.kind == LOCAL:
-            return "LOCAL"
-        self.lst.storages[name.upper()] = st
-        return "MOD" if st.kind == MODULE else "GLOBAL"
+    def ref_place(self, place) -> None:
+        kind, op = self.operand(place)
+        self.emit("REF_" + kind, op)
 
     def fast_scalar(self, e) -> str | None:
         """The type letter of ``e`` if it is a scalar store variable, else None."""
-        if isinstance(e, N.Name) and e.ann.storage.kind == LOCAL:
-            got = self.fast.get(e.name.upper())
+        if e.__class__ is N.Name and e.ann.place.kind == LOCAL:
+            got = self.fast.get(e.ann.place.slot)
             if got is not None and got[1] == 0:
                 return got[0]
         return None
@@ -615,22 +595,26 @@ class Compiler:
         """The element type letter of ``e`` if it is ``store array[i]`` or ``[i, j]`` with
         every index given and as many as the array's dimensions, else None."""
         if isinstance(e, N.Index) and isinstance(e.base, N.Name) and None not in e.indices \
-                and e.base.ann.storage.kind == LOCAL:
-            got = self.fast.get(e.base.name.upper())
+                and e.base.ann.place.kind == LOCAL:
+            got = self.fast.get(e.base.ann.place.slot)
             if got is not None and got[1] == len(e.indices):
                 return got[0]
         return None
 
+    def local(self, e: N.Name) -> str:
+        """The declared name of the frame slot of a LOCAL name (the ``s``/``v`` operand)."""
+        return self.locals[e.ann.place.slot]
+
     def ref(self, e) -> None:
         if isinstance(e, N.Name):
-            self.emit("REF_" + self.kind_of(e.name, e.ann.storage), self.spelled(e.name))
+            self.ref_place(e.ann.place)
         elif isinstance(e, N.Index):
             self.ref(e.base)
             self.indices(e)
-            self.emit("INDEX", len(e.indices), name_of(e.base))
+            self.emit("INDEX", len(e.indices), lvalue_name(e.base))
         elif isinstance(e, N.Field):
             self.ref(e.base)
-            self.emit("FIELD", e.name, name_of(e.base))
+            self.emit("FIELD", e.name, lvalue_name(e.base))
         else:
             self.emit("RAISE", "not a variable", 0)
 
@@ -644,30 +628,31 @@ class Compiler:
     def store(self, target) -> None:
         letter = self.fast_scalar(target)
         if letter is not None and letter in "IRB":
-            self.emit("STORE_FAST", self.spelled(target.name), letter)
+            self.emit("STORE_FAST", self.local(target), letter)
             return
         letter = self.fast_array(target)
         if letter is not None:
             self.indices(target)
-            self.emit(f"STORE_ELEM{len(target.indices)}", self.spelled(target.base.name), name_of(target.base),
+            self.emit(f"STORE_ELEM{len(target.indices)}", self.local(target.base), lvalue_name(target.base),
                       letter)
             return
         if isinstance(target, N.Name):
-            self.emit("STORE_" + self.kind_of(target.name, target.ann.storage), self.spelled(target.name))
+            kind, op = self.operand(target.ann.place)
+            self.emit("STORE_" + kind, op)
         elif isinstance(target, N.Index) and None not in target.indices:
             self.ref(target.base)
             self.indices(target)
-            self.emit("STORE_INDEX", len(target.indices), name_of(target.base))
+            self.emit("STORE_INDEX", len(target.indices), lvalue_name(target.base))
         elif isinstance(target, N.Field):
             self.ref(target.base)
-            self.emit("STORE_FIELD", target.name, name_of(target.base))
+            self.emit("STORE_FIELD", target.name, lvalue_name(target.base))
         else:
             self.ref(target)
             self.emit("ASSIGN")
 
     # ------------------------------------------------------------------ expressions
     def fold(self, e):
-        """(True, value) if ``e`` is a constant the runtime's operators can fold."""
+        """(True, value) if ``e`` is a constant the operators (krl/semantics/values.py) can fold."""
         if isinstance(e, (N.IntLit, N.RealLit, N.BoolLit, N.StrLit)):
             return True, e.value
         if isinstance(e, N.EnumLit):
@@ -710,64 +695,79 @@ class Compiler:
         return len(chain), a
 
     def expr(self, e) -> None:
-        if isinstance(e, (N.Unary, N.Binary)):
-            ok, v = self.fold(e)
-            if ok:
-                self.emit("CONST", v)
-                return
-        if isinstance(e, (N.IntLit, N.RealLit, N.BoolLit, N.StrLit)):
-            self.emit("CONST", e.value)
-        elif isinstance(e, N.EnumLit):
-            self.emit("CONST", EnumValue(e.name))
-        elif isinstance(e, N.ChannelName):
-            self.emit("CONST", Channel(e.name))
-        elif self.fast_scalar(e) is not None:
-            self.emit("LOAD_FAST", self.spelled(e.name))
-        elif isinstance(e, N.Name):
-            self.emit("LOAD_" + self.kind_of(e.name, e.ann.storage), self.spelled(e.name))
-        elif self.fast_array(e) is not None:
+        self.expr_dispatch[e.__class__](e)
+
+    def e_literal(self, e) -> None:
+        self.emit("CONST", e.value)
+
+    e_IntLit = e_RealLit = e_BoolLit = e_StrLit = e_literal
+
+    def e_EnumLit(self, e) -> None:
+        self.emit("CONST", EnumValue(e.name))
+
+    def e_ChannelName(self, e) -> None:
+        self.emit("CONST", Channel(e.name))
+
+    def e_Name(self, e) -> None:
+        if self.fast_scalar(e) is not None:
+            self.emit("LOAD_FAST", self.local(e))
+            return
+        kind, op = self.operand(e.ann.place)
+        self.emit("LOAD_" + kind, op)
+
+    def e_Index(self, e) -> None:
+        if self.fast_array(e) is not None:
             self.indices(e)
-            self.emit(f"LOAD_ELEM{len(e.indices)}", self.spelled(e.base.name), name_of(e.base))
-        elif isinstance(e, N.Index):
-            self.ref(e.base)
-            self.indices(e)
-            if None in e.indices:
-                self.emit("INDEX", len(e.indices), name_of(e.base))
-                self.emit("DEREF")
-            else:
-                self.emit("LOAD_INDEX", len(e.indices), name_of(e.base))
-        elif isinstance(e, N.Field):
-            self.ref(e.base)
-            self.emit("LOAD_FIELD", e.name, name_of(e.base))
-        elif isinstance(e, N.Call):
-            self.call(e, "E")
-        elif isinstance(e, N.Unary):
-            self.expr(e.operand)
-            self.emit("UNOP", e.op)
-        elif isinstance(e, N.Binary):
-            # a left-nested chain (up to MAX_EXPRESSION_TERMS terms) in a loop: the longest
-            # constant start of the chain is one CONST, as recursing would fold it
-            left, chain = N.left_chain(e)
-            n, v = self.fold_chain(left, chain)
-            if n:
-                self.emit("CONST", v)
-            else:
-                self.expr(left)
-            for b in chain[n:]:
-                self.expr(b.right)
-                fast = _FAST_BINOPS.get(b.op)
-                if fast is not None:
-                    self.emit(fast)
-                else:
-                    self.emit("BINOP", b.op)
-        elif isinstance(e, N.Aggregate):
-            for it in e.items:
-                self.expr(it.value)
-            if e.type_name:
-                self.lst.types[e.type_name.upper()] = e.ann.storage
-            self.emit("AGG", e.type_name, ",".join(it.name.upper() for it in e.items))
+            self.emit(f"LOAD_ELEM{len(e.indices)}", self.local(e.base), lvalue_name(e.base))
+            return
+        self.ref(e.base)
+        self.indices(e)
+        if None in e.indices:
+            self.emit("INDEX", len(e.indices), lvalue_name(e.base))
+            self.emit("DEREF")
         else:
-            self.emit("RAISE", f"cannot evaluate {type(e).__name__}", 0)
+            self.emit("LOAD_INDEX", len(e.indices), lvalue_name(e.base))
+
+    def e_Field(self, e) -> None:
+        self.ref(e.base)
+        self.emit("LOAD_FIELD", e.name, lvalue_name(e.base))
+
+    def e_Call(self, e) -> None:
+        self.call(e, "E")
+
+    def e_Unary(self, e) -> None:
+        ok, v = self.fold(e)
+        if ok:
+            self.emit("CONST", v)
+            return
+        self.expr(e.operand)
+        self.emit("UNOP", e.op)
+
+    def e_Binary(self, e) -> None:
+        # a left-nested chain (up to MAX_EXPRESSION_TERMS terms) in a loop: the longest
+        # constant start of the chain is one CONST, as recursing would fold it
+        left, chain = N.left_chain(e)
+        n, v = self.fold_chain(left, chain)
+        if n == len(chain):                      # all of it is a constant
+            self.emit("CONST", v)
+            return
+        if n:
+            self.emit("CONST", v)
+        else:
+            self.expr(left)
+        for b in chain[n:]:
+            self.expr(b.right)
+            fast = _FAST_BINOPS.get(b.op)
+            if fast is not None:
+                self.emit(fast)
+            else:
+                self.emit("BINOP", b.op)
+
+    def e_Aggregate(self, e) -> None:
+        for it in e.items:
+            self.expr(it.value)
+        struc = e.ann.struc if e.type_name else None
+        self.emit("AGG", struc if struc is not None else e.type_name, ",".join(it.name.upper() for it in e.items))
 
 
 _CMP_JUMPS = {"LT": "IF_NOT_LT", "LE": "IF_NOT_LE", "GT": "IF_NOT_GT", "GE": "IF_NOT_GE",
@@ -868,14 +868,10 @@ def peephole(lst: Listing) -> bool:
 
 def compile_routine(routine: N.Routine) -> Listing:
     """The instruction listing of ``routine``, from its annotated AST alone (the front end's
-    resolution, krl/semantics/resolve.py; no runtime): for assembler.link (the VM's executed
-    form) and assembler.format_listing (`krl asm`). Kept on the routine (``ann.extra``), so
-    a routine is compiled once per process whatever the runs."""
-    extra = routine.ann.extra
-    lst = extra.get("vm_listing")
-    if lst is None:
-        lst = extra["vm_listing"] = Compiler(routine).compile()
-    return lst
+    facts, krl/semantics/resolve.py; no runtime): for vm.link (the VM's executed form, kept
+    per workspace by the VM, interp/vm/vm.py ``code_cache``) and assembler.format_listing
+    (`krl asm`)."""
+    return Compiler(routine).compile()
 
 
 def compile_module(routines) -> str:

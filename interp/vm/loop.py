@@ -6,10 +6,16 @@ Cython (interp/vm/build.py; the C types of its locals are in loop.pxd) when a co
 there; vm.py runs the compiled module only when its VM_SOURCE matches vm.py."""
 # ruff: noqa
 
-from interp.vm.vm import (INT_MAX, INT_MIN, KrlRuntimeError, Slot, Struct, UNSET, ValueRef, add, array_index, component, element, element1, element2, ended_without_return, eq, for_done, for_limits, for_next, function_result, ge, gt, le, load, lt, math, mul, ne, read_value, return_without_value, set_component, set_element, set_element1, store, sub)
+import math
+from interp.runtime.builtins import (ValueRef)
+from interp.runtime.convert import (INT_MAX, INT_MIN)
+from interp.runtime.errors import (KrlRuntimeError)
+from interp.runtime.memory import (Slot)
+from interp.runtime.slots import (add, array_index, component, element, element1, element2, ended_without_return, eq, for_done, for_limits, for_next, function_result, ge, gt, le, load, lt, mul, ne, read_value, return_without_value, set_component, set_element, set_element1, store, sub)
+from interp.runtime.values import (Struct, UNSET)
 
 # sha256 of the vm.py this file was generated from
-VM_SOURCE = 'e65af394e2af81e6761bd16e55a37f8b07653c84d2fc9373430f57830b07b811'
+VM_SOURCE = 'ebb2a7a405b8b22821a1ba9aa1e9e39b39be1f1dcd11868cc9f05aa48fbb981f'
 
 # opcode number (interp/vm/opcodes.py) -> this loop's number of the opcode
 DISPATCH = [43, 0, 35, 83, 87, 86, 78, 101, 22, 111, 100, 23, 24, 99, 26, 34, 92, 40, 81, 5, 76, 98, 58, 93, 90, 95, 62, 102, 73, 2, 28, 96, 4, 110, 109, 107, 106, 103, 42, 33, 30, 41, 25, 38, 31, 112, 57, 32, 82, 44, 55, 54, 49, 48, 51, 36, 29, 75, 97, 45, 50, 84, 108, 1, 37, 47, 85, 77, 52, 105, 74, 104, 53, 79, 56, 89, 8, 80, 72, 27, 39, 3, 46, 91, 88, 94, 71, 60, 61, 66, 10, 69, 70, 11, 7, 6, 65, 18, 67, 64, 63, 68, 12, 20, 59, 19, 21, 9, 14, 16, 17, 15, 13]
@@ -116,7 +122,7 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                         v = self.call(code, ip, ins[1], args, frame, flags)
                                     left = task.quiet - rt.steps if task is not None else 0
                                     if flags == 'E':
-                                        stack.append(v if v is not None else function_result(ins[1], v))
+                                        stack.append(v if v is not None else function_result(ins[1].name, v))
                                     ip += 1
                                 elif op < 5:
                                     b = stack.pop()
@@ -425,7 +431,7 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                             stack[-1] = _element1(fvars[ins[1]], i, ins[2])
                                         ip += 1
                                     else:
-                                        if code.kind == 'DEFFCT':
+                                        if code.is_function:
                                             raise return_without_value(code.routine, frame.line)
                                         return None
                                 else:
@@ -715,7 +721,7 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                 stack.append(None)
                                 ip += 1
                         else:
-                            if code.kind == 'DEFFCT':
+                            if code.is_function:
                                 raise ended_without_return(code.routine, frame.line)
                             return None
                     elif op < 104:
@@ -733,7 +739,7 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                             ip += 1
                                     else:
                                         v = stack.pop()
-                                        return v if code.kind == 'DEFFCT' else None
+                                        return v if code.is_function else None
                                 else:
                                     base = stack[-1]
                                     if type(base) is Slot and type((x := base.c[base.k])) is Struct and (type((x := x.f.get(ins[1][1]))) is float or type(x) is int or type(x) is bool):

@@ -37,7 +37,21 @@ k     a structure component by name              index into the constant pool (a
 x     a statement: ``LINE`` or ``LINE/FLAGS``      index into the code's statement table
       (S: stops the advance run, C: its loop      (advance.StmtInfo objects)
       condition stops it)
+r     the routine a call runs, by name            index into the constant pool (a str);
+                                                  the compiler's and the VM's form is the
+                                                  call's Callee (krl/semantics/resolve.py),
+                                                  linked when the routine is first called
+a     the STRUC an aggregate names (``-``: none)  index into the constant pool (a str);
+                                                  the compiler's and the VM's form is the
+                                                  front end's Struc (or its name when
+                                                  nothing declares it)
+p     an analog channel by name                   index into the constant pool (a str);
+                                                  the compiler's and the VM's form is the
+                                                  channel's place (a Storage)
 ====  ==========================================  =====================================
+
+Operands ``m`` and ``g`` are written as names; the compiler's and the VM's form of each is the
+place (Storage) the front end resolved, so the VM never reads a name to decide a meaning.
 
 Stack effect: the net change of the operand-stack depth; ``None`` where it depends on an
 operand (documented per opcode).
@@ -87,7 +101,7 @@ _TABLE = [
     ("LOAD_TEMP",     1,  "t",  "push a temporary"),
     ("STORE_TEMP",   -1,  "t",  "pop into a temporary"),
     ("VALARG",        0,  "",   "wrap a value as an :IN argument (ValueRef)"),
-    ("AGG",        None,  "nn", "pop k values, push an aggregate; n: type name or -, n: component names (effect 1-k)"),
+    ("AGG",        None,  "an", "pop k values, push an aggregate; a: its STRUC or -, n: component names (effect 1-k)"),
     # -- operators
     ("BINOP",        -1,  "n",  "Runtime.binary_op"),
     ("UNOP",          0,  "n",  "Runtime.unary_op"),
@@ -152,7 +166,7 @@ _TABLE = [
     ("FOR_TEST",      0,  "tl", "jump when the counter is past the end"),
     ("FOR_NEXT",      0,  "txl", "counter = counter + step; unless it is past the end: TICK x and jump to l"),
     # -- calls
-    ("CALL",       None,  "nif","pop i arguments, call routine n (effect -i, +1 for a function call); f: S statement, E expression, N no RESUME catch"),
+    ("CALL",       None,  "rif","pop i arguments, call r (effect -i, +1 for a function call); f: S statement, E expression, N no RESUME catch"),
     ("RETURN",        0,  "",   "return from the routine (no value)"),
     ("RETURN_VAL",   -1,  "",   "return the top of the stack"),
     ("END",           0,  "",   "end of the routine body"),
@@ -170,12 +184,12 @@ _TABLE = [
     ("INT_CTL",    None,  "nf", "Runtime.interrupt_ctl(action[, popped number]); f: P if a number is given"),
     ("BRAKE",         0,  "f",  "Runtime.brake (f: F for BRAKE F)"),
     ("STUB",          0,  "n",  "Runtime.stub_statement (CONFIRM, ASYPTP, MOVE_EMI, ...)"),
-    ("CYCFLAG",      -2,  "l",  "pop a reference and a value: assign, then Runtime.cyclic_on re-assigns the thunk's value every IPO cycle"),
-    ("ANOUT_ON",   None,  "nfl", "pop [max,] [min,] the output reference: ANOUT ON (f: L min, H max), value thunk l, Runtime.cyclic_on"),
-    ("ANIN_ON",      -1,  "nl", "pop the target reference: ANIN ON, value thunk l, Runtime.cyclic_on (n: the input's name or -)"),
-    ("CYCLIC_OFF",    0,  "nn", "Runtime.cyclic_off((n1, n2))"),
+    ("CYCLIC_ASSIGN",-2,  "l",  "pop a reference and a value: assign, then Runtime.cyclic_on re-assigns the thunk's value every IPO cycle (a cyclic flag)"),
+    ("ANOUT_ON",   None,  "pfl", "pop [max,] [min,] the output reference: ANOUT ON channel p (f: L min, H max), value thunk l, Runtime.cyclic_on"),
+    ("ANIN_ON",      -1,  "pl", "pop the target reference: ANIN ON, value thunk l, Runtime.cyclic_on (p: the input channel or -)"),
+    ("CYCLIC_OFF",    0,  "np", "Runtime.cyclic_off of what n switched on for channel p (ANOUT OFF, ANIN OFF)"),
     ("RESUME",        0,  "",   "Runtime.resume"),
-    ("TRIG_FIND",     1,  "nl", "push the routine target of a TRIGGER action call, or None and jump"),
+    ("TRIG_FIND",     1,  "rl", "push the routine target of a TRIGGER action call r, or None and jump"),
     ("TRIG_PACK",  None,  "i",  "pop i arguments and the target, push the packed call (effect -i)"),
     ("TRIGGER",    None,  "nfil", "pop [prio,] delay, at and the packed call: Runtime.trigger; n: kind, f: O onstart / P prio; i: line; l: action thunk"),
     ("TRIG_INVOKE",  -1,  "",   "in an action thunk: invoke the packed call"),
@@ -189,7 +203,7 @@ _TABLE = [
 
 OPS: list[OpInfo] = [OpInfo(name, i, eff, ops, doc) for i, (name, eff, ops, doc) in enumerate(_TABLE)]
 BY_NAME: dict[str, OpInfo] = {o.name: o for o in OPS}
-OPERAND_KINDS = "icnlsmgtfxvyok"
+OPERAND_KINDS = "icnlsmgtfxvyokrap"
 
 # bind the numbers as module constants (STMT, CONST, ...) for the compiler and the VM
 globals().update({o.name: o.number for o in OPS})

@@ -17,10 +17,12 @@ an instruction is placed on its region's line; in a guarded region after ON_ERRO
 it is recorded ($ERR) and execution goes on after the statement, as in the tree
 interpreter.
 
-Code: the compiler makes a routine's listing from its annotated AST alone (no runtime;
-kept on the routine), :func:`link` turns the listing into the executed form (one tuple per
-listing instruction: `krl asm` prints exactly what runs), and :class:`Bound` binds it to a
-run's storage when the routine is first called. Dispatch: :meth:`VM.run` is the source of
+Code: the compiler makes a routine's listing from its annotated AST alone (no runtime),
+:func:`link` turns the listing into the executed form (one tuple per listing instruction:
+`krl asm` prints exactly what runs; kept per checked workspace by :func:`linked_code`, not on
+the AST), and :class:`Bound` binds it to a run's storage and links every call site from its
+Callee (a routine of the program: the (module, Routine) to invoke) when the routine is first
+called; a built-in or a stub is run through the runtime (:meth:`VM.call`). Dispatch: :meth:`VM.run` is the source of
 every opcode's handler, a chain in frequency order; interp/vm/loop.py, generated from it by
 interp/vm/gen_loop.py and checked in, is the same loop with a Huffman-shaped binary search
 for the dispatch, and is what runs by default (``VM(rt, loop="source")`` runs the source).
@@ -30,8 +32,13 @@ The cold opcodes (motion, interrupts, triggers, analog I/O, waits, ...) are meth
 
 from __future__ import annotations
 
+import hashlib
+import importlib.util
 import math
 import operator
+import sys
+import weakref
+from pathlib import Path
 
 from interp.runtime.builtins import ValueRef
 from interp.runtime.convert import INT_MAX, INT_MIN, num
@@ -46,6 +53,7 @@ from interp.runtime.slots import (add, anout_limits, anout_value, array_index, c
 
 from . import opcodes as OP
 from krl.semantics.advance import StmtInfo
+from krl.semantics.resolve import ROUTINE
 
 from .assembler import Region
 from .compiler import compile_routine
@@ -79,24 +87,28 @@ class Linked:
     (the front end's Storage, bound per run by :class:`Bound`); and the error region of
     each instruction. It holds nothing of a run and is kept per routine and loop."""
 
-    __slots__ = ("name", "kind", "file", "routine", "prog", "iregions", "lnames", "ntemps",
-                 "mnames", "mstorage", "gnames", "gstorage", "callees", "types")
+    __slots__ = ("name", "kind", "file", "prog", "iregions", "lnames", "ntemps",
+                 "mnames", "mstorage", "gnames", "gstorage", "calls", "is_function")
 
 
 def link(lst, dispatch) -> Linked:
-    """The executed form of listing `lst` for the loop whose opcode numbering is
-    `dispatch` (opcode number -> the loop's number)."""
+    """The executed form of listing `lst` (interp/vm/compiler.py) for the loop whose opcode
+    numbering is `dispatch` (opcode number -> the loop's number). Module and global slots
+    are numbered by the places the front end resolved (``Storage.key``), never by a name."""
     out = Linked()
     out.name, out.kind, out.file, out.ntemps = lst.name, lst.kind, lst.file, lst.ntemps
+    out.is_function = lst.kind == "DEFFCT"
     out.lnames = list(lst.lnames)
     lix = {n.upper(): i for i, n in enumerate(out.lnames)}
-    out.mnames, out.gnames = [], []
+    out.mnames, out.gnames, out.mstorage, out.gstorage = [], [], [], []
+    out.calls = []       # the instructions that call a routine of the program (Bound links them)
     mix: dict = {}
     gix: dict = {}
     labels = lst.labels
     prog = []
     regions = []
     moved: dict = {}     # guarded regions with their end as an instruction number
+    call_op = dispatch[OP.CALL]
     for name, ops, reg in lst.instrs:
         info = OP.BY_NAME[name]
         ins = [dispatch[info.number]]
@@ -107,16 +119,13 @@ def link(lst, dispatch) -> Linked:
                 v = labels[v]
             elif k == "s" or k == "v":
                 v = lix[v.upper()]
-            elif k == "m":
-                name_ = v
-                v = mix.setdefault(name_.upper(), len(mix))
-                if v == len(out.mnames):
-                    out.mnames.append(name_)
-            elif k == "g":
-                name_ = v
-                v = gix.setdefault(name_.upper(), len(gix))
-                if v == len(out.gnames):
-                    out.gnames.append(name_)
+            elif k == "m" or k == "g":
+                index, names, places = (mix, out.mnames, out.mstorage) if k == "m" else (gix, out.gnames, out.gstorage)
+                place = v
+                v = index.setdefault(place.key, len(index))
+                if v == len(places):
+                    names.append(place.name)
+                    places.append(place)
             elif k == "y":
                 v = _VALUE_CLASS.get(v)
             elif k == "o":
@@ -126,6 +135,8 @@ def link(lst, dispatch) -> Linked:
             ins.append(v)
         if name == "STMT_G" or name == "STMT":
             ins += (ins[1].line, ins[1].stops)      # read by every statement: kept in the tuple
+        elif ins[0] == call_op and ins[1].kind == ROUTINE:
+            out.calls.append(len(prog))
         prog.append(tuple(ins))
         if reg is not None and reg.kind == "G":
             got = moved.get(id(reg))
@@ -136,29 +147,27 @@ def link(lst, dispatch) -> Linked:
             reg = Region(reg.kind, reg.line, -1)
         regions.append(reg)
     out.prog, out.iregions = prog, regions
-    out.mstorage = [lst.storages[n.upper()] for n in out.mnames]
-    out.gstorage = [lst.storages[n.upper()] for n in out.gnames]
-    out.callees, out.types = lst.callees, lst.types
-    out.routine = None
     return out
 
 
 class Bound:
     """One run's view of a routine's code: the Linked form (shared) and this run's bindings
     of its module slots (``mrefs``, bound when first called: the data lists are loaded),
-    global slots (``grefs``, bound on first use) and call sites (``callsites``)."""
+    global slots (``grefs``, bound on first use) and of each call site that runs a routine
+    of the program (``callsites``: instruction -> (module, Routine), from its Callee)."""
 
-    __slots__ = ("name", "kind", "file", "routine", "prog", "iregions", "ntemps", "gstorage", "callees",
-                 "types", "mrefs", "grefs", "callsites", "gnames")
+    __slots__ = ("name", "kind", "is_function", "file", "routine", "prog", "iregions", "ntemps", "gstorage",
+                 "mrefs", "grefs", "callsites", "gnames")
 
     def __init__(self, linked: Linked, routine, rt) -> None:
         self.name, self.kind, self.file, self.routine = linked.name, linked.kind, linked.file, routine
+        self.is_function = linked.is_function
         self.prog, self.iregions, self.ntemps = linked.prog, linked.iregions, linked.ntemps
         self.gstorage, self.gnames = linked.gstorage, linked.gnames
-        self.callees, self.types = linked.callees, linked.types
         self.mrefs = [rt.storage_ref(st, None) for st in linked.mstorage]
         self.grefs = [None] * len(linked.gstorage)
-        self.callsites: dict = {}
+        prog = linked.prog
+        self.callsites = {ip: rt.callee(prog[ip][1]) for ip in linked.calls}
 
 
 class VM:
@@ -191,16 +200,12 @@ class VM:
         self.invoke(self.rt.main_routine(module_name), [], None)
 
     def code_for(self, routine) -> Bound:
-        """This run's code of `routine`: compiled from its annotated AST (once per process,
-        interp/vm/compiler.py), linked for this VM's loop (once per process), bound to this
-        run's storage (once per run)."""
+        """This run's code of `routine`: compiled from its annotated AST and linked for this
+        VM's loop once per process (:func:`linked_code`), bound to this run's storage and call
+        sites once per run."""
         code = self.codes.get(id(routine))
         if code is None:
-            extra = routine.ann.extra
-            key = "vm_linked" if self.dispatch is GENERATED_DISPATCH else "vm_linked_source"
-            linked = extra.get(key)
-            if linked is None:
-                linked = extra[key] = link(compile_routine(routine), self.dispatch)
+            linked = linked_code(self.rt.program.ws, routine, self.dispatch)
             code = self.codes[id(routine)] = Bound(linked, routine, self.rt)
         return code
 
@@ -217,17 +222,14 @@ class VM:
         code = self.codes.get(id(routine)) or self.code_for(routine)
         return self.loop(self, code, frame, [None] * code.ntemps, 0, [])
 
-    def call(self, code, ip: int, name: str, args: list, frame, flags: str):
-        """A CALL whose routine is not known yet (the loop calls a known one itself):
-        a built-in, a stub, or a routine found now and kept for this call site."""
+    def call(self, code, ip: int, callee, args: list, frame, flags: str):
+        """A CALL whose Callee is not a routine of the program (Bound links those): a
+        built-in the simulator implements, else the stub policy."""
         rt = self.rt
-        target = rt.callee(code.callees[name.upper()])
-        if target is None:
-            if rt.is_native(name):
-                return rt.call_builtin(name, args)
-            return rt.stub_call(name, flags == "E")
-        code.callsites[ip] = target
-        return self.invoke(target, args, frame, "N" not in flags)
+        native = rt.native(callee)
+        if native is None:
+            return rt.stub_call(callee.name, flags == "E")
+        return native(rt, args)
 
     def thunk(self, code, frame, temps: list, ip: int, stack: list | None = None):
         """A callable that runs the thunk at ``ip`` of ``code`` in the activation (``frame``,
@@ -244,8 +246,7 @@ class VM:
         k = len(keys)
         vals = stack[len(stack) - k:]
         del stack[len(stack) - k:]
-        push(rt.aggregate(code.types.get(ins[1].upper()) if ins[1] else None,
-                          list(zip(keys, vals))))
+        push(rt.aggregate(ins[1], list(zip(keys, vals))))
         return ip + 1
 
     def _cold_JUMP_IF_NONE(self, ins, code, frame, temps, stack, ip):
@@ -318,13 +319,13 @@ class VM:
         rt.stub_statement(ins[1])
         return ip + 1
 
-    def _cold_CYCFLAG(self, ins, code, frame, temps, stack, ip):
+    def _cold_CYCLIC_ASSIGN(self, ins, code, frame, temps, stack, ip):
         rt = self.rt
         pop = stack.pop
         ref = pop()
         _store(ref, pop())
         value = self.thunk(code, frame, temps, ins[1])
-        rt.cyclic_on(("CYCFLAG", ref.name), lambda r=ref, f=value: rt.assign(r, f()))
+        rt.cyclic_on(("cyclic flag", ref.name), lambda r=ref, f=value: rt.assign(r, f()))
         return ip + 1
 
     def _cold_ANOUT_ON(self, ins, code, frame, temps, stack, ip):
@@ -340,7 +341,7 @@ class VM:
         def anout(ref=ref, value=value, lo=lo, hi=hi):
             ref.set(anout_value(value(), lo, hi))
         anout()
-        rt.cyclic_on(("ANOUT", ins[1]), anout)
+        rt.cyclic_on(("analog output", ins[1].key), anout)
         return ip + 1
 
     def _cold_ANIN_ON(self, ins, code, frame, temps, stack, ip):
@@ -352,14 +353,14 @@ class VM:
         def anin(ref=ref, value=value):
             rt.assign(ref, value())
         anin()
-        key = ins[1]
-        if key is not None:
-            rt.cyclic_on(("ANIN", key), anin)
+        channel = ins[1]
+        if channel is not None:
+            rt.cyclic_on(("analog input", channel.key), anin)
         return ip + 1
 
     def _cold_CYCLIC_OFF(self, ins, code, frame, temps, stack, ip):
         rt = self.rt
-        rt.cyclic_off((ins[1], ins[2]))
+        rt.cyclic_off((ins[1], ins[2].key))
         return ip + 1
 
     def _cold_RESUME(self, ins, code, frame, temps, stack, ip):
@@ -370,7 +371,7 @@ class VM:
     def _cold_TRIG_FIND(self, ins, code, frame, temps, stack, ip):
         rt = self.rt
         push = stack.append
-        target = rt.callee(code.callees[ins[1].upper()])
+        target = rt.callee(ins[1])
         push(target)
         return ins[2] if target is None else ip + 1
 
@@ -784,7 +785,7 @@ class VM:
                                 v = self.call(code, ip, ins[1], args, frame, flags)
                             left = task.quiet - rt.steps if task is not None else 0
                             if flags == "E":
-                                push(v if v is not None else function_result(ins[1], v))
+                                push(v if v is not None else function_result(ins[1].name, v))
                             ip += 1
                         elif op == OP.STORE_ELEM2:
                             j = pop()
@@ -819,9 +820,9 @@ class VM:
                             ip += 1
                         elif op == OP.RETURN_VAL:
                             v = pop()
-                            return v if code.kind == "DEFFCT" else None
+                            return v if code.is_function else None
                         elif op == OP.END:
-                            if code.kind == "DEFFCT":
+                            if code.is_function:
                                 raise ended_without_return(code.routine, frame.line)
                             return None
                         elif op == OP.IF_NOT_LT:
@@ -898,7 +899,7 @@ class VM:
                             else:
                                 ip = ins[1]
                         elif op == OP.RETURN:
-                            if code.kind == "DEFFCT":
+                            if code.is_function:
                                 raise return_without_value(code.routine, frame.line)
                             return None
                         elif op == OP.LOAD_ELEM1:
@@ -1064,7 +1065,7 @@ class VM:
                               op == OP.WAIT_SEC or op == OP.CONTINUE or op == OP.ON_ERROR_PROCEED or
                               op == OP.EXIT_SIGNAL or op == OP.GOTO_FAIL or op == OP.RAISE or
                               op == OP.INT_DECL or op == OP.INT_CTL or op == OP.BRAKE or op == OP.STUB or
-                              op == OP.CYCFLAG or op == OP.ANOUT_ON or op == OP.ANIN_ON or op == OP.CYCLIC_OFF or
+                              op == OP.CYCLIC_ASSIGN or op == OP.ANOUT_ON or op == OP.ANIN_ON or op == OP.CYCLIC_OFF or
                               op == OP.RESUME or op == OP.TRIG_FIND or op == OP.TRIG_PACK or op == OP.TRIGGER or
                               op == OP.TRIG_INVOKE or op == OP.MOTION or op == OP.SPL_BEGIN or
                               op == OP.SPL_TRIG_BEGIN or op == OP.SPL_TRIG_END or op == OP.SPL_SEG or
@@ -1104,6 +1105,27 @@ class VM:
         return [(items[2 * i], items[2 * i + 1]) for i in range(n)]
 
 
+# The linked code of each routine, per checked workspace: a routine is compiled and linked once
+# per process for each loop numbering (the two interpreters of a conformance case, the programs
+# of one backup, the runs of a test share it), and dropped with its workspace. The VM's caches
+# live here, not on the AST.
+_LINKED: dict = {}       # id(workspace) -> (weak reference to it, {(id(routine), id(dispatch)): ...})
+
+
+def linked_code(ws, routine, dispatch) -> Linked:
+    """The Linked form of `routine` (a Routine of the checked workspace `ws`) for the loop
+    numbering `dispatch`, compiled (interp/vm/compiler.py) and linked on first use."""
+    entry = _LINKED.get(id(ws))
+    if entry is None or entry[0]() is not ws:
+        entry = _LINKED[id(ws)] = (weakref.ref(ws, lambda _ref, key=id(ws): _LINKED.pop(key, None)), {})
+    per = entry[1]
+    key = (id(routine), id(dispatch))
+    got = per.get(key)
+    if got is None or got[0] is not routine:
+        got = per[key] = (routine, link(compile_routine(routine), dispatch))
+    return got[1]
+
+
 # The loops: VM.run above is the source of every handler (runnable: VM(rt, loop="source"),
 # dispatching on the opcode numbers themselves); interp/vm/loop.py is generated from it
 # (python -m interp.vm.gen_loop) and dispatches on its own numbering. `make` compiles loop.py
@@ -1114,10 +1136,6 @@ SOURCE_DISPATCH = [o.number for o in OP.OPS]
 
 def _python_loop():
     """interp/vm/loop.py itself, imported from its file (also when the extension exists)."""
-    import importlib.util  # noqa: PLC0415
-    import sys  # noqa: PLC0415
-    from pathlib import Path  # noqa: PLC0415
-
     name = "interp.vm._loop_python"
     mod = sys.modules.get(name)
     if mod is None:
@@ -1129,9 +1147,6 @@ def _python_loop():
 
 
 def _current(mod) -> bool:
-    import hashlib  # noqa: PLC0415
-    from pathlib import Path  # noqa: PLC0415
-
     return mod.VM_SOURCE == hashlib.sha256(Path(__file__).read_bytes()).hexdigest()
 
 

@@ -19,12 +19,12 @@ from __future__ import annotations
 import dataclasses
 
 from krl.ast import nodes as N
+from krl.syntax.parse import default_bundle, keyword_types
 
 __all__ = ["same_tree", "first_difference", "structure"]
 
 
 def _keywords() -> frozenset[str]:
-    from krl.syntax.parse import default_bundle, keyword_types  # noqa: PLC0415
 
     bundle = default_bundle()
     return frozenset(bundle.symbolic[t].replace("_F", " F") if bundle.symbolic[t] == "BRAKE_F"

@@ -57,22 +57,63 @@ NO_SPAN = Span()
 
 @dataclass(slots=True)
 class Annotation:
-    """The checker's results for one node.
+    """The front end's results for one node (the checker's and the resolver's).
 
     type:    static type of an expression (krl.semantics.types.KrlType) or None;
-    symbol:  resolved symbol of a Name/Call/For variable/Goto (krl.semantics.symbols.Symbol);
-    extra:   free-form notes (e.g. ``{"whole_array": True}``, ``{"conversion": "REAL->INT"}``);
-    storage: where a Name's variable lives, or which routine a Call runs (the resolver,
-             krl/semantics/resolve.py: ``Storage``, ``Callee``); a Routine's or DataList's
-             slot layout (``Layout``);
+    symbol:  resolved symbol of a Name/Call/For variable (krl.semantics.symbols.Symbol);
+    extra:   notes of the checker for tools (``{"whole_array": True}``, ``{"conversion":
+             "REAL->INT"}``, ``{"advance_stop": ...}``);
     info:    a statement's place and advance-run stops (krl/semantics/advance.py ``StmtInfo``).
-    """
+
+    The resolver's typed facts (krl/semantics/resolve.py) live in the subclasses below, one
+    per kind of node that has them; :meth:`Node.annotate` creates the one of its node."""
 
     type: Any = None
     symbol: Any = None
     extra: dict = field(default_factory=dict)
-    storage: Any = None
     info: Any = None
+
+
+@dataclass(slots=True)
+class PlaceFacts(Annotation):
+    """A Name (and an ArrayInit's element): ``place``, where its variable lives (``Storage``)."""
+    place: "Storage | None" = None
+
+
+@dataclass(slots=True)
+class CallFacts(Annotation):
+    """A Call: ``callee``, what it runs (``Callee``: a routine, a built-in, or a stub)."""
+    callee: "Callee | None" = None
+
+
+@dataclass(slots=True)
+class LayoutFacts(Annotation):
+    """A Routine or DataList: ``layout``, its slots (``Layout``)."""
+    layout: "Layout | None" = None
+
+
+@dataclass(slots=True)
+class AggregateFacts(Annotation):
+    """An Aggregate: ``struc``, the STRUC its TYPE prefix names (a ``types.Struc``), else None."""
+    struc: "Struc | None" = None
+
+
+@dataclass(slots=True)
+class GotoFacts(Annotation):
+    """A Goto: ``target``, the Label it jumps to (the nearest enclosing block's), else None."""
+    target: "Label | None" = None
+
+
+@dataclass(slots=True)
+class AssignFacts(Annotation):
+    """An Assign: ``cyclic``, True when it assigns a cyclic flag (re-evaluated every IPO cycle)."""
+    cyclic: bool = False
+
+
+@dataclass(slots=True)
+class ChannelFacts(Annotation):
+    """ANIN ON/OFF, ANOUT ON/OFF: ``channel``, the analog signal's place (``Storage``)."""
+    channel: "Storage | None" = None
 
 
 @dataclass(slots=True)
@@ -81,9 +122,9 @@ class Node:
     ann: Annotation | None = field(default=None, compare=False, repr=False, kw_only=True)
 
     def annotate(self) -> Annotation:
-        """The node's Annotation, created on first use."""
+        """The node's Annotation (the one of its kind: :data:`FACTS`), created on first use."""
         if self.ann is None:
-            self.ann = Annotation()
+            self.ann = FACTS.get(self.__class__, Annotation)()
         return self.ann
 
     def children(self) -> Iterator["Node"]:
@@ -634,6 +675,11 @@ class Routine(Node):
     is_global: bool = False
     end_line: int = field(default=0, compare=False, repr=False, kw_only=True)   # END/ENDFCT line
 
+    @property
+    def is_function(self) -> bool:
+        """True for a DEFFCT (it returns a value, reference 2.4)."""
+        return self.kind == "DEFFCT"
+
 
 @dataclass(slots=True)
 class DataList(Node):
@@ -664,6 +710,14 @@ class Module(Node):
         return stem.rsplit(".", 1)[0]
 
 
+#: the Annotation class of each node kind that has typed facts (:meth:`Node.annotate`)
+FACTS: dict[type, type] = {
+    Name: PlaceFacts, ArrayInit: PlaceFacts, Call: CallFacts, Routine: LayoutFacts, DataList: LayoutFacts,
+    Aggregate: AggregateFacts, Goto: GotoFacts, Assign: AssignFacts, AninOn: ChannelFacts,
+    AninOff: ChannelFacts, AnoutOn: ChannelFacts, AnoutOff: ChannelFacts,
+}
+
+
 def type_of(expr: Node):
     """The static type the checker gave `expr` (krl.semantics.types.KrlType), or None."""
     return expr.ann.type if expr.ann is not None else None
@@ -672,9 +726,6 @@ def type_of(expr: Node):
 def symbol_of(node: Node):
     """The symbol the checker resolved for a Name/Call/For/Goto node, or None."""
     return node.ann.symbol if node.ann is not None else None
-
-
-LVALUE_TYPES = (Name, Index, Field)
 
 
 def is_lvalue(expr: Node | None) -> bool:

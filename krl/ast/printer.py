@@ -9,7 +9,10 @@ operators associate to the left.
 
 from __future__ import annotations
 
+import sys
+
 from krl.ast import nodes as N
+from krl.ast.visit import EXPRESSIONS, STATEMENTS, handlers
 
 PREC = {
     "==": 1, "<>": 1, "<": 1, ">": 1, "<=": 1, ">=": 1,
@@ -44,55 +47,85 @@ def expr(e: N.Expr | None) -> str:
     """One expression as KRL text."""
     if e is None:
         return ""
-    if isinstance(e, N.IntLit):
-        if e.base == 16:
-            return f"'H{e.value:X}'"
-        if e.base == 2:
-            return f"'B{e.value:b}'"
-        return str(e.value)
-    if isinstance(e, N.RealLit):
-        return fmt_real(e.value)
-    if isinstance(e, N.BoolLit):
-        return "TRUE" if e.value else "FALSE"
-    if isinstance(e, N.StrLit):
-        return f'"{e.value}"'
-    if isinstance(e, N.EnumLit):
-        return f"#{e.name}"
-    if isinstance(e, N.ChannelName):
-        return f":{e.name}"
-    if isinstance(e, N.Name):
-        return e.name
-    if isinstance(e, N.Index):
-        return f"{expr(e.base)}[{','.join(expr(i) for i in e.indices)}]"
-    if isinstance(e, N.Field):
-        return f"{expr(e.base)}.{e.name}"
-    if isinstance(e, N.Call):
-        return f"{e.name}({', '.join(expr(a) for a in e.args)})"
-    if isinstance(e, N.Aggregate):
-        head = f"{e.type_name}: " if e.type_name else ""
-        items = ", ".join(f"{i.name}{'[]' if i.array else ''} {expr(i.value)}" for i in e.items)
-        return "{" + head + items + "}"
-    if isinstance(e, N.Unary):
-        inner = expr(e.operand)
-        if _prec(e.operand) < UNARY_PREC:
-            inner = f"({inner})"
-        if e.op in ("NOT", "B_NOT"):
-            return f"{e.op} {inner}"
-        return f"{e.op}{inner}"
-    if isinstance(e, N.Binary):
-        # a left-associative chain (up to MAX_EXPRESSION_TERMS terms) in a loop, not recursively
-        left, chain = N.left_chain(e)
-        text, inner = expr(left), left
-        for b in chain:
-            p = PREC.get(b.op, 0)
-            right = expr(b.right)
-            if _prec(inner) < p:
-                text = f"({text})"
-            if _prec(b.right) <= p:
-                right = f"({right})"
-            text, inner = f"{text} {b.op} {right}", b
-        return text
-    raise TypeError(f"not an expression: {type(e).__name__}")
+    fn = _EXPR.get(e.__class__)
+    if fn is None:
+        raise TypeError(f"not an expression: {type(e).__name__}")
+    return fn(e)
+
+
+def _e_IntLit(e: N.Expr):
+    if e.base == 16:
+        return f"'H{e.value:X}'"
+    if e.base == 2:
+        return f"'B{e.value:b}'"
+    return str(e.value)
+
+
+def _e_RealLit(e: N.Expr):
+    return fmt_real(e.value)
+
+
+def _e_BoolLit(e: N.Expr):
+    return "TRUE" if e.value else "FALSE"
+
+
+def _e_StrLit(e: N.Expr):
+    return f'"{e.value}"'
+
+
+def _e_EnumLit(e: N.Expr):
+    return f"#{e.name}"
+
+
+def _e_ChannelName(e: N.Expr):
+    return f":{e.name}"
+
+
+def _e_Name(e: N.Expr):
+    return e.name
+
+
+def _e_Index(e: N.Expr):
+    return f"{expr(e.base)}[{','.join(expr(i) for i in e.indices)}]"
+
+
+def _e_Field(e: N.Expr):
+    return f"{expr(e.base)}.{e.name}"
+
+
+def _e_Call(e: N.Expr):
+    return f"{e.name}({', '.join(expr(a) for a in e.args)})"
+
+
+def _e_Aggregate(e: N.Expr):
+    head = f"{e.type_name}: " if e.type_name else ""
+    items = ", ".join(f"{i.name}{'[]' if i.array else ''} {expr(i.value)}" for i in e.items)
+    return "{" + head + items + "}"
+
+
+def _e_Unary(e: N.Expr):
+    inner = expr(e.operand)
+    if _prec(e.operand) < UNARY_PREC:
+        inner = f"({inner})"
+    if e.op in ("NOT", "B_NOT"):
+        return f"{e.op} {inner}"
+    return f"{e.op}{inner}"
+
+
+def _e_Binary(e: N.Expr):
+    # a left-associative chain (up to MAX_EXPRESSION_TERMS terms) in a loop, not recursively
+    left, chain = N.left_chain(e)
+    text, inner = expr(left), left
+    for b in chain:
+        p = PREC.get(b.op, 0)
+        right = expr(b.right)
+        if _prec(inner) < p:
+            text = f"({text})"
+        if _prec(b.right) <= p:
+            right = f"({right})"
+        text, inner = f"{text} {b.op} {right}", b
+    return text
+
 
 
 def _with(items: list[N.WithAssign]) -> str:
@@ -190,94 +223,161 @@ def _trigger_action(s: N.Stmt) -> str:
 
 def stmt(s: N.Stmt, level: int = 1) -> list[str]:
     """A statement as indented lines."""
-    ind = INDENT * level
-    if isinstance(s, N.Assign):
-        return [f"{ind}{expr(s.target)} = {expr(s.value)}"]
-    if isinstance(s, N.CallStmt):
-        return [ind + expr(s.call)]
-    if isinstance(s, N.If):
-        out = [f"{ind}IF {expr(s.cond)} THEN"] + block(s.then, level + 1)
-        if s.orelse is not None:
-            out += [f"{ind}ELSE"] + block(s.orelse, level + 1)
-        return out + [f"{ind}ENDIF"]
-    if isinstance(s, N.Switch):
-        out = [f"{ind}SWITCH {expr(s.selector)}"]
-        for c in s.cases:
-            out += [f"{ind}CASE {', '.join(expr(v) for v in c.values)}"] + block(c.body, level + 1)
-        if s.default is not None:
-            out += [f"{ind}DEFAULT"] + block(s.default, level + 1)
-        return out + [f"{ind}ENDSWITCH"]
-    if isinstance(s, N.For):
-        step = f" STEP {expr(s.step)}" if s.step is not None else ""
-        return ([f"{ind}FOR {s.var.name} = {expr(s.start)} TO {expr(s.end)}{step}"]
-                + block(s.body, level + 1) + [f"{ind}ENDFOR"])
-    if isinstance(s, N.While):
-        return [f"{ind}WHILE {expr(s.cond)}"] + block(s.body, level + 1) + [f"{ind}ENDWHILE"]
-    if isinstance(s, N.Repeat):
-        return [f"{ind}REPEAT"] + block(s.body, level + 1) + [f"{ind}UNTIL {expr(s.cond)}"]
-    if isinstance(s, N.Loop):
-        return [f"{ind}LOOP"] + block(s.body, level + 1) + [f"{ind}ENDLOOP"]
-    if isinstance(s, N.Exit):
-        return [ind + "EXIT"]
-    if isinstance(s, N.Goto):
-        return [f"{ind}GOTO {s.label}"]
-    if isinstance(s, N.Label):
-        return [f"{ind}{s.name}:"]
-    if isinstance(s, N.Halt):
-        return [ind + "HALT"]
-    if isinstance(s, N.WaitFor):
-        return [f"{ind}WAIT FOR {expr(s.cond)}"]
-    if isinstance(s, N.WaitSec):
-        return [f"{ind}WAIT SEC {expr(s.time)}"]
-    if isinstance(s, N.Continue):
-        return [ind + "CONTINUE"]
-    if isinstance(s, N.Return):
-        return [ind + "RETURN" + (f" {expr(s.value)}" if s.value is not None else "")]
-    if isinstance(s, N.OnErrorProceed):
-        return [ind + "ON_ERROR_PROCEED"]
-    if isinstance(s, N.InterruptDecl):
-        g = "GLOBAL " if s.is_global else ""
-        action = ("BRAKE F" if s.brake.fast else "BRAKE") if s.brake is not None else expr(s.call)
-        return [f"{ind}{g}INTERRUPT DECL {expr(s.prio)} WHEN {expr(s.when)} DO {action}"]
-    if isinstance(s, N.InterruptCtl):
-        return [f"{ind}INTERRUPT {s.action}" + (f" {expr(s.prio)}" if s.prio is not None else "")]
-    if isinstance(s, N.Brake):
-        return [ind + ("BRAKE F" if s.fast else "BRAKE")]
-    if isinstance(s, N.Resume):
-        return [ind + "RESUME"]
-    if isinstance(s, N.Trigger):
-        at = f"{s.kind} = {expr(s.at)}" + (" ONSTART" if s.onstart else "")
-        text = f"{ind}TRIGGER WHEN {at} DELAY = {expr(s.delay)} DO {_trigger_action(s.action)}"
-        if s.prio is not None:
-            text += f" PRIO = {expr(s.prio)}"
-        return [text]
-    if isinstance(s, N.AninOn):
-        return [f"{ind}ANIN ON {expr(s.target)} = {expr(s.value)}"]
-    if isinstance(s, N.AninOff):
-        return [f"{ind}ANIN OFF {s.name}"]
-    if isinstance(s, N.AnoutOn):
-        text = f"{ind}ANOUT ON {s.name} = {expr(s.value)}"
-        for key, v in (("DELAY", s.delay), ("MINIMUM", s.minimum), ("MAXIMUM", s.maximum)):
-            if v is not None:
-                text += f" {key} = {expr(v)}"
-        return [text]
-    if isinstance(s, N.AnoutOff):
-        return [f"{ind}ANOUT OFF {s.name}"]
-    if isinstance(s, N.Motion):
-        return [ind + _motion(s)]
-    if isinstance(s, N.SplineBlock):
-        out = [f"{ind}{s.kind}{_with(s.with_)}"] + block(s.body, level + 1)
-        return out + [f"{ind}ENDSPLINE" + (f" {s.approx}" if s.approx else "")]
-    if isinstance(s, N.KeywordStmt):
-        return [ind + " ".join(s.words + ([", ".join(expr(a) for a in s.args)] if s.args else []))]
-    if isinstance(s, N.MoveEmi):
-        tail = f" {s.key} {expr(s.value)}" if s.key is not None else ""
-        return [f'{ind}MOVE_EMI {expr(s.target)} "{s.file}"{tail}']
-    if isinstance(s, N.DeclStmt):
-        return [ind + decl(s.decl)]
-    if isinstance(s, N.Unsupported):
-        return [ind + line for line in s.text.splitlines()] or [ind]
-    raise TypeError(f"not a statement: {type(s).__name__}")
+    fn = _STMT.get(s.__class__)
+    if fn is None:
+        raise TypeError(f"not a statement: {type(s).__name__}")
+    return fn(s, INDENT * level, level)
+
+
+def _s_Assign(s, ind: str, level: int):
+    return [f"{ind}{expr(s.target)} = {expr(s.value)}"]
+
+
+def _s_CallStmt(s, ind: str, level: int):
+    return [ind + expr(s.call)]
+
+
+def _s_If(s, ind: str, level: int):
+    out = [f"{ind}IF {expr(s.cond)} THEN"] + block(s.then, level + 1)
+    if s.orelse is not None:
+        out += [f"{ind}ELSE"] + block(s.orelse, level + 1)
+    return out + [f"{ind}ENDIF"]
+
+
+def _s_Switch(s, ind: str, level: int):
+    out = [f"{ind}SWITCH {expr(s.selector)}"]
+    for c in s.cases:
+        out += [f"{ind}CASE {', '.join(expr(v) for v in c.values)}"] + block(c.body, level + 1)
+    if s.default is not None:
+        out += [f"{ind}DEFAULT"] + block(s.default, level + 1)
+    return out + [f"{ind}ENDSWITCH"]
+
+
+def _s_For(s, ind: str, level: int):
+    step = f" STEP {expr(s.step)}" if s.step is not None else ""
+    return ([f"{ind}FOR {s.var.name} = {expr(s.start)} TO {expr(s.end)}{step}"]
+            + block(s.body, level + 1) + [f"{ind}ENDFOR"])
+
+
+def _s_While(s, ind: str, level: int):
+    return [f"{ind}WHILE {expr(s.cond)}"] + block(s.body, level + 1) + [f"{ind}ENDWHILE"]
+
+
+def _s_Repeat(s, ind: str, level: int):
+    return [f"{ind}REPEAT"] + block(s.body, level + 1) + [f"{ind}UNTIL {expr(s.cond)}"]
+
+
+def _s_Loop(s, ind: str, level: int):
+    return [f"{ind}LOOP"] + block(s.body, level + 1) + [f"{ind}ENDLOOP"]
+
+
+def _s_Exit(s, ind: str, level: int):
+    return [ind + "EXIT"]
+
+
+def _s_Goto(s, ind: str, level: int):
+    return [f"{ind}GOTO {s.label}"]
+
+
+def _s_Label(s, ind: str, level: int):
+    return [f"{ind}{s.name}:"]
+
+
+def _s_Halt(s, ind: str, level: int):
+    return [ind + "HALT"]
+
+
+def _s_WaitFor(s, ind: str, level: int):
+    return [f"{ind}WAIT FOR {expr(s.cond)}"]
+
+
+def _s_WaitSec(s, ind: str, level: int):
+    return [f"{ind}WAIT SEC {expr(s.time)}"]
+
+
+def _s_Continue(s, ind: str, level: int):
+    return [ind + "CONTINUE"]
+
+
+def _s_Return(s, ind: str, level: int):
+    return [ind + "RETURN" + (f" {expr(s.value)}" if s.value is not None else "")]
+
+
+def _s_OnErrorProceed(s, ind: str, level: int):
+    return [ind + "ON_ERROR_PROCEED"]
+
+
+def _s_InterruptDecl(s, ind: str, level: int):
+    g = "GLOBAL " if s.is_global else ""
+    action = ("BRAKE F" if s.brake.fast else "BRAKE") if s.brake is not None else expr(s.call)
+    return [f"{ind}{g}INTERRUPT DECL {expr(s.prio)} WHEN {expr(s.when)} DO {action}"]
+
+
+def _s_InterruptCtl(s, ind: str, level: int):
+    return [f"{ind}INTERRUPT {s.action}" + (f" {expr(s.prio)}" if s.prio is not None else "")]
+
+
+def _s_Brake(s, ind: str, level: int):
+    return [ind + ("BRAKE F" if s.fast else "BRAKE")]
+
+
+def _s_Resume(s, ind: str, level: int):
+    return [ind + "RESUME"]
+
+
+def _s_Trigger(s, ind: str, level: int):
+    at = f"{s.kind} = {expr(s.at)}" + (" ONSTART" if s.onstart else "")
+    text = f"{ind}TRIGGER WHEN {at} DELAY = {expr(s.delay)} DO {_trigger_action(s.action)}"
+    if s.prio is not None:
+        text += f" PRIO = {expr(s.prio)}"
+    return [text]
+
+
+def _s_AninOn(s, ind: str, level: int):
+    return [f"{ind}ANIN ON {expr(s.target)} = {expr(s.value)}"]
+
+
+def _s_AninOff(s, ind: str, level: int):
+    return [f"{ind}ANIN OFF {s.name}"]
+
+
+def _s_AnoutOn(s, ind: str, level: int):
+    text = f"{ind}ANOUT ON {s.name} = {expr(s.value)}"
+    for key, v in (("DELAY", s.delay), ("MINIMUM", s.minimum), ("MAXIMUM", s.maximum)):
+        if v is not None:
+            text += f" {key} = {expr(v)}"
+    return [text]
+
+
+def _s_AnoutOff(s, ind: str, level: int):
+    return [f"{ind}ANOUT OFF {s.name}"]
+
+
+def _s_Motion(s, ind: str, level: int):
+    return [ind + _motion(s)]
+
+
+def _s_SplineBlock(s, ind: str, level: int):
+    out = [f"{ind}{s.kind}{_with(s.with_)}"] + block(s.body, level + 1)
+    return out + [f"{ind}ENDSPLINE" + (f" {s.approx}" if s.approx else "")]
+
+
+def _s_KeywordStmt(s, ind: str, level: int):
+    return [ind + " ".join(s.words + ([", ".join(expr(a) for a in s.args)] if s.args else []))]
+
+
+def _s_MoveEmi(s, ind: str, level: int):
+    tail = f" {s.key} {expr(s.value)}" if s.key is not None else ""
+    return [f'{ind}MOVE_EMI {expr(s.target)} "{s.file}"{tail}']
+
+
+def _s_DeclStmt(s, ind: str, level: int):
+    return [ind + decl(s.decl)]
+
+
+def _s_Unsupported(s, ind: str, level: int):
+    return [ind + line for line in s.text.splitlines()] or [ind]
+
 
 
 def block(stmts: list[N.Stmt], level: int) -> list[str]:
@@ -315,3 +415,8 @@ def print_module(m: N.Module) -> str:
             lines.append("")
         lines += routine(r)
     return "\n".join(lines) + "\n"
+
+
+# one function per expression and statement kind (krl/ast/visit.py: a kind the AST gains fails here)
+_EXPR = handlers(sys.modules[__name__], "_e_", EXPRESSIONS)
+_STMT = handlers(sys.modules[__name__], "_s_", STATEMENTS)

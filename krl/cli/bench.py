@@ -122,18 +122,19 @@ def bench(ctx: click.Context, as_json: bool, repeat: int, sim_seconds: float, pa
     _print_compute(repeat, None)
 
 
-def _print_compute(repeat: int, baseline_rev: str | None, as_json: bool = False) -> None:
+def _print_compute(repeat: int, baseline_rev: str | None, as_json: bool = False, cpu: bool = False) -> None:
     from interp.bench import Baseline, compute  # noqa: PLC0415
 
     if baseline_rev:
         with Baseline(baseline_rev) as base:
-            c = compute(repeat, base)
+            c = compute(repeat, base, cpu=cpu)
     else:
-        c = compute(repeat)
+        c = compute(repeat, cpu=cpu)
     if as_json:
         click.echo(json.dumps(c))
         return
-    click.echo(f"compute benchmark, {c['steps']} statements and loop iterations, best of {repeat}:")
+    click.echo(f"compute benchmark, {c['steps']} statements and loop iterations, best of {repeat}"
+               f"{' (CPU time of each process)' if cpu else ''}:")
     click.echo(f"  tree interpreter {c['tree_s']:.3f} s  {c['tree_stmts_per_s']:>12,.0f} stmts/s")
     click.echo(f"  VM               {c['vm_s']:.3f} s  {c['vm_stmts_per_s']:>12,.0f} stmts/s"
                f"  ({c['vm_vs_tree']:.2f}x the tree interpreter; {c['vm_loop']} loop)")
@@ -143,19 +144,25 @@ def _print_compute(repeat: int, baseline_rev: str | None, as_json: bool = False)
         click.echo(f"  tree at {c['baseline_rev']:7s} {c['baseline_tree_s']:.3f} s  "
                    f"{c['steps'] / c['baseline_tree_s']:>12,.0f} stmts/s  (this tree interpreter: "
                    f"{c['tree_vs_baseline']:.2f}x its speed)")
+        click.echo(f"  VM at {c['baseline_rev']:7s}   {c['baseline_vm_s']:.3f} s  "
+                   f"{c['steps'] / c['baseline_vm_s']:>12,.0f} stmts/s  (this VM: "
+                   f"{c['vm_vs_baseline']:.2f}x its speed; {c['baseline_vm_loop']} loop)")
 
 
 @bench.command("vm")
 @click.option("--repeat", type=int, default=3, show_default=True, help="Runs of each (best counts).")
 @click.option("--baseline", "baseline_rev", default=None, metavar="REV",
-              help="Also run the tree interpreter of git revision REV (e.g. 89ac166, the starting "
-                   "commit of issue 23) side by side, from a temporary git worktree.")
+              help="Also run the tree interpreter and the VM of git revision REV (e.g. 8175047, the "
+                   "starting commit of issue 38) side by side, from a temporary git worktree (its "
+                   "VM loop compiled there).")
+@click.option("--cpu", is_flag=True, help="Time each run by its process's CPU time instead of wall "
+                                          "time (a shared machine's load disturbs it far less).")
 @click.option("--json", "as_json", is_flag=True, help="One JSON object.")
-def bench_vm(repeat: int, baseline_rev: str | None, as_json: bool) -> None:
+def bench_vm(repeat: int, baseline_rev: str | None, as_json: bool, cpu: bool) -> None:
     """The compute benchmark (interp/bench/bench.src) on the tree interpreter, the VM and in
-    Python, interleaved in this run; with --baseline, the tree interpreter of another
-    revision too (this tree interpreter must stay at least as fast)."""
-    _print_compute(repeat, baseline_rev, as_json)
+    Python, interleaved in this run; with --baseline, the tree interpreter and the VM of
+    another revision too (this tree interpreter and this VM must stay at least as fast)."""
+    _print_compute(repeat, baseline_rev, as_json, cpu)
 
 
 def engine_rates(corpus: Path, repeat: int = 3, engines: list[str] | None = None) -> dict:

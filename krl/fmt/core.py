@@ -46,6 +46,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Literal
 
+from krl.syntax.messages import syntax_diagnostics
 from krl.syntax.parse import ParseResult, ParserBundle, default_bundle, keyword_types, parse_text
 from krl.syntax.tokens import DEFAULT_CHANNEL, EOF, is_rule, is_token_node, lex, rule_name
 
@@ -248,7 +249,6 @@ def _would_merge(ta: str, tb: str) -> bool:
 def _syntax_error(result: ParseResult, text: str) -> FormatSyntaxError:
     """The error for a text that does not parse: its syntax errors as `krl parse` words them
     (krl/syntax/messages.py: codes E0xx), worded once."""
-    from krl.syntax.messages import syntax_diagnostics  # noqa: PLC0415
 
     diags = syntax_diagnostics(result, text)
     out = [SyntaxProblem(d.line, d.column, d.message, d.code) for d in diags]

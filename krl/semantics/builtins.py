@@ -17,6 +17,8 @@ from pathlib import Path
 
 import yaml
 
+from krl.store import stored
+
 DATA_DIR = Path(__file__).parent / "data"
 
 try:  # the C loader is much faster where libyaml is present
@@ -27,13 +29,16 @@ except AttributeError:  # pragma: no cover
 
 @dataclass(slots=True)
 class SysVarInfo:
-    """A system variable: type name, array sizes, access ('RW' or 'RO'), advance-run stops."""
+    """A system variable: type name, array sizes, access ('RW' or 'RO'), advance-run stops,
+    and ``cyclic``: an assignment to one of its elements is re-evaluated every IPO cycle
+    (``$CYCFLAG``, reference §5.15)."""
     name: str
     type_name: str
     dims: tuple[int, ...] = ()
     access: str = "RW"
     stop_read: bool = False
     stop_write: bool = False
+    cyclic: bool = False
 
 
 @dataclass(slots=True)
@@ -126,8 +131,6 @@ def _read(name: str) -> dict:
 def load_builtins() -> Builtins:
     """Read the three data tables (cached, and kept across processes: krl/store.py). Raises
     ValueError for a malformed table."""
-    from krl.store import stored  # noqa: PLC0415
-
     return stored("builtins", (), _load_builtins)
 
 
@@ -141,7 +144,7 @@ def _load_builtins() -> Builtins:
         name, dims = split_name(key)
         stops = info.get("stop", []) or []
         sysvars[name.upper()] = SysVarInfo(name, info["type"], dims, info.get("access", "RW"),
-                                           "read" in stops, "write" in stops)
+                                           "read" in stops, "write" in stops, bool(info.get("cyclic")))
     routines: dict[str, SignatureInfo] = {}
     for text in funcs.get("functions", []):
         sig = parse_signature(text, True)

@@ -22,7 +22,10 @@ W101/W105/W106/W107 per name) or it is the program's error (E101/E105/E106 at ea
 from __future__ import annotations
 
 from krl.ast import nodes as N
+from krl.ast.visit import EXPRESSIONS, STATEMENTS, handlers
+from krl.ast.printer import expr as printed
 from krl.semantics import types as T
+from krl.semantics.outside import KINDS
 from krl.diagnostics import DiagnosticSink
 from krl.semantics.symbols import ParamSig, RoutineSig, Scope, Symbol, make_array
 
@@ -70,7 +73,6 @@ class Declarer:
         if self.unresolved is not None:
             self.unresolved.use(kind, name, span.file, span.line, span.column, evidence)
             return
-        from krl.semantics.outside import KINDS  # noqa: PLC0415
         err, warn, _noun = KINDS[kind]
         soft = evidence or kind == "sysvar" or self.maybe_declared(name)
         msg = {"type": f"unknown type '{name}'", "routine": f"routine '{name}' is not declared",
@@ -245,6 +247,9 @@ class Checker:
         self.sink = sink
         self.decl = declarer
         self.incomplete = incomplete
+        # one method per statement and expression kind (krl/ast/visit.py)
+        self.stmt_dispatch = handlers(self, "s_", STATEMENTS)
+        self.expr_dispatch = handlers(self, "e_", EXPRESSIONS)
         # set while checking KUKA system files (R1/System, TP, Mada, STEU): they use
         # declarations of $operate.dat, which is not part of a backup
         self.system_file = False
@@ -319,8 +324,7 @@ class Checker:
             if got is None:
                 self.sink.at(g.span, "E401", f"GOTO target '{g.label}' is not a label of {r.name}")
                 continue
-            label, lpath = got
-            g.annotate().extra["label"] = label
+            _label, lpath = got
             if tuple(path[:len(lpath)]) != lpath:
                 self.sink.at(g.span, "E402", f"GOTO {g.label} jumps into a block")
 
@@ -338,103 +342,141 @@ class Checker:
                 ctx.block_path.pop()
 
     def stmt(self, s: N.Stmt, ctx: _Ctx) -> None:
+        self.stmt_dispatch[s.__class__](s, ctx)
+
+    def s_Assign(self, s: N.Assign, ctx: _Ctx) -> None:
+        self.assign(s.target, s.value, ctx.scope, s.span)
+
+    def s_CallStmt(self, s: N.CallStmt, ctx: _Ctx) -> None:
+        self.call(s.call, ctx.scope, statement=True)
+
+    def s_If(self, s: N.If, ctx: _Ctx) -> None:
+        self.cond(s.cond, ctx.scope, "IF")
+        self.block(s.then, ctx, True)
+        if s.orelse is not None:
+            self.block(s.orelse, ctx, True)
+
+    def s_Switch(self, s: N.Switch, ctx: _Ctx) -> None:
+        self.switch(s, ctx)
+
+    def s_For(self, s: N.For, ctx: _Ctx) -> None:
+        self.for_(s, ctx)
+
+    def s_While(self, s: N.While, ctx: _Ctx) -> None:
+        self.cond(s.cond, ctx.scope, "WHILE")
+        self.loop_body(s.body, ctx)
+
+    def s_Repeat(self, s: N.Repeat, ctx: _Ctx) -> None:
+        self.loop_body(s.body, ctx)
+        self.cond(s.cond, ctx.scope, "UNTIL")
+
+    def s_Loop(self, s: N.Loop, ctx: _Ctx) -> None:
+        self.loop_body(s.body, ctx)
+
+    def s_Exit(self, s: N.Exit, ctx: _Ctx) -> None:
+        if ctx.loops == 0:
+            self.sink.at(s.span, "E403", "EXIT outside a loop")
+
+    def s_Goto(self, s: N.Goto, ctx: _Ctx) -> None:
+        ctx.gotos.append((s, tuple(ctx.block_path)))
+
+    def s_Label(self, s: N.Label, ctx: _Ctx) -> None:
+        self.decl.ident(s.name, s.span)
+        key = s.name.upper()
+        if key in ctx.labels:
+            self.sink.at(s.span, "E405", f"label '{s.name}' is defined more than once")
+        else:
+            ctx.labels[key] = (s, tuple(ctx.block_path))
+
+    def s_WaitFor(self, s: N.WaitFor, ctx: _Ctx) -> None:
+        self.cond(s.cond, ctx.scope, "WAIT FOR")
+
+    def s_WaitSec(self, s: N.WaitSec, ctx: _Ctx) -> None:
+        self.numeric(s.time, ctx.scope, "WAIT SEC")
+
+    def s_Return(self, s: N.Return, ctx: _Ctx) -> None:
+        self.return_(s, ctx)
+
+    def s_InterruptDecl(self, s: N.InterruptDecl, ctx: _Ctx) -> None:
         sc = ctx.scope
-        if isinstance(s, N.Assign):
-            self.assign(s.target, s.value, sc, s.span)
-        elif isinstance(s, N.CallStmt):
+        self.int_expr(s.prio, sc, "interrupt number")
+        if isinstance(s.prio, N.IntLit) and not 1 <= s.prio.value <= 128:
+            self.sink.at(s.prio.span, "E408", f"interrupt priority {s.prio.value} is outside 1..128")
+        self.cond(s.when, sc, "WHEN")
+        if s.brake is None:
             self.call(s.call, sc, statement=True)
-        elif isinstance(s, N.If):
-            self.cond(s.cond, sc, "IF")
-            self.block(s.then, ctx, True)
-            if s.orelse is not None:
-                self.block(s.orelse, ctx, True)
-        elif isinstance(s, N.Switch):
-            self.switch(s, ctx)
-        elif isinstance(s, N.For):
-            self.for_(s, ctx)
-        elif isinstance(s, N.While):
-            self.cond(s.cond, sc, "WHILE")
-            self.loop_body(s.body, ctx)
-        elif isinstance(s, N.Repeat):
-            self.loop_body(s.body, ctx)
-            self.cond(s.cond, sc, "UNTIL")
-        elif isinstance(s, N.Loop):
-            self.loop_body(s.body, ctx)
-        elif isinstance(s, N.Exit):
-            if ctx.loops == 0:
-                self.sink.at(s.span, "E403", "EXIT outside a loop")
-        elif isinstance(s, N.Goto):
-            ctx.gotos.append((s, tuple(ctx.block_path)))
-        elif isinstance(s, N.Label):
-            self.decl.ident(s.name, s.span)
-            key = s.name.upper()
-            if key in ctx.labels:
-                self.sink.at(s.span, "E405", f"label '{s.name}' is defined more than once")
+        else:
+            self.set_type(s.call, T.VOID)
+
+    def s_InterruptCtl(self, s: N.InterruptCtl, ctx: _Ctx) -> None:
+        if s.prio is not None:
+            self.int_expr(s.prio, ctx.scope, "interrupt number")
+
+    def s_Trigger(self, s: N.Trigger, ctx: _Ctx) -> None:
+        sc = ctx.scope
+        self.no_motion_in_submit(s, "TRIGGER")
+        self.numeric(s.at, sc, s.kind)
+        self.numeric(s.delay, sc, "DELAY")
+        if s.prio is not None:
+            self.int_expr(s.prio, sc, "PRIO")
+        elif isinstance(s.action, N.CallStmt) and s.action.call.name.upper() != "PULSE":
+            # PULSE is a statement of its own, not a subprogram call (5.12, 5.18)
+            self.sink.at(s.span, "E409", "a TRIGGER that calls a routine needs PRIO (-1 lets the system choose)")
+        self.stmt(s.action, ctx)
+
+    def s_Motion(self, s: N.Motion, ctx: _Ctx) -> None:
+        self.no_motion_in_submit(s, s.kind)
+        self.motion(s, ctx.scope)
+
+    def s_SplineBlock(self, s: N.SplineBlock, ctx: _Ctx) -> None:
+        self.no_motion_in_submit(s, s.kind)
+        for w in s.with_:
+            self.with_assign(w, ctx.scope)
+        for inner in s.body:
+            self.stmt(inner, ctx)
+
+    def s_AninOn(self, s: N.AninOn, ctx: _Ctx) -> None:
+        self.assign_target(s.target, ctx.scope, s.span)
+        self.expr(s.value, ctx.scope)
+
+    def s_AnoutOn(self, s: N.AnoutOn, ctx: _Ctx) -> None:
+        sc = ctx.scope
+        self.signal_name(s.name, s.span, sc)
+        self.numeric(s.value, sc, "ANOUT")
+        for e in (s.delay, s.minimum, s.maximum):
+            if e is not None:
+                self.numeric(e, sc, "ANOUT")
+
+    def s_AninOff(self, s: N.AninOff | N.AnoutOff, ctx: _Ctx) -> None:
+        self.signal_name(s.name, s.span, ctx.scope)
+
+    s_AnoutOff = s_AninOff
+
+    def s_KeywordStmt(self, s: N.KeywordStmt, ctx: _Ctx) -> None:
+        for a in s.args:
+            if isinstance(a, N.Aggregate):
+                self.aggregate(a, ctx.scope, T.UNKNOWN)
             else:
-                ctx.labels[key] = (s, tuple(ctx.block_path))
-        elif isinstance(s, N.WaitFor):
-            self.cond(s.cond, sc, "WAIT FOR")
-        elif isinstance(s, N.WaitSec):
-            self.numeric(s.time, sc, "WAIT SEC")
-        elif isinstance(s, N.Return):
-            self.return_(s, ctx)
-        elif isinstance(s, N.InterruptDecl):
-            self.int_expr(s.prio, sc, "interrupt number")
-            if isinstance(s.prio, N.IntLit) and not 1 <= s.prio.value <= 128:
-                self.sink.at(s.prio.span, "E408", f"interrupt priority {s.prio.value} is outside 1..128")
-            self.cond(s.when, sc, "WHEN")
-            if s.brake is None:
-                self.call(s.call, sc, statement=True)
-            else:
-                self.set_type(s.call, T.VOID)
-        elif isinstance(s, N.InterruptCtl):
-            if s.prio is not None:
-                self.int_expr(s.prio, sc, "interrupt number")
-        elif isinstance(s, N.Trigger):
-            self.no_motion_in_submit(s, "TRIGGER")
-            self.numeric(s.at, sc, s.kind)
-            self.numeric(s.delay, sc, "DELAY")
-            if s.prio is not None:
-                self.int_expr(s.prio, sc, "PRIO")
-            elif isinstance(s.action, N.CallStmt) and s.action.call.name.upper() != "PULSE":
-                # PULSE is a statement of its own, not a subprogram call (5.12, 5.18)
-                self.sink.at(s.span, "E409", "a TRIGGER that calls a routine needs PRIO (-1 lets the system choose)")
-            self.stmt(s.action, ctx)
-        elif isinstance(s, N.Motion):
-            self.no_motion_in_submit(s, s.kind)
-            self.motion(s, sc)
-        elif isinstance(s, N.SplineBlock):
-            self.no_motion_in_submit(s, s.kind)
-            for w in s.with_:
-                self.with_assign(w, sc)
-            for inner in s.body:
-                self.stmt(inner, ctx)
-        elif isinstance(s, N.AninOn):
-            self.assign_target(s.target, sc, s.span)
-            self.expr(s.value, sc)
-        elif isinstance(s, N.AnoutOn):
-            self.signal_name(s.name, s.span, sc)
-            self.numeric(s.value, sc, "ANOUT")
-            for e in (s.delay, s.minimum, s.maximum):
-                if e is not None:
-                    self.numeric(e, sc, "ANOUT")
-        elif isinstance(s, (N.AninOff, N.AnoutOff)):
-            self.signal_name(s.name, s.span, sc)
-        elif isinstance(s, N.KeywordStmt):
-            for a in s.args:
-                if isinstance(a, N.Aggregate):
-                    self.aggregate(a, sc, T.UNKNOWN)
-                else:
-                    self.expr(a, sc)
-        elif isinstance(s, N.MoveEmi):
-            self.expr(s.target, sc)
-            if s.value is not None:
-                self.expr(s.value, sc)
-        elif isinstance(s, N.DeclStmt):
-            self.sink.at(s.span, "E104", "declaration after the first statement of the routine")
-        elif isinstance(s, (N.Brake, N.Resume)):
-            self.no_motion_in_submit(s, "BRAKE" if isinstance(s, N.Brake) else "RESUME")
-        # Halt, Continue, OnErrorProceed, Unsupported: nothing to check
+                self.expr(a, ctx.scope)
+
+    def s_MoveEmi(self, s: N.MoveEmi, ctx: _Ctx) -> None:
+        self.expr(s.target, ctx.scope)
+        if s.value is not None:
+            self.expr(s.value, ctx.scope)
+
+    def s_DeclStmt(self, s: N.DeclStmt, ctx: _Ctx) -> None:
+        self.sink.at(s.span, "E104", "declaration after the first statement of the routine")
+
+    def s_Brake(self, s: N.Brake, ctx: _Ctx) -> None:
+        self.no_motion_in_submit(s, "BRAKE")
+
+    def s_Resume(self, s: N.Resume, ctx: _Ctx) -> None:
+        self.no_motion_in_submit(s, "RESUME")
+
+    def s_nothing(self, s: N.Stmt, ctx: _Ctx) -> None:
+        """HALT, CONTINUE, ON_ERROR_PROCEED, an unsupported construct: nothing to check."""
+
+    s_Halt = s_Continue = s_OnErrorProceed = s_Unsupported = s_nothing
 
     def no_motion_in_submit(self, s: N.Stmt, what: str) -> None:
         if self.submit:
@@ -562,7 +604,7 @@ class Checker:
         self.check_value(tt, value, sc, value.span)
 
     def assign_target(self, target: N.Expr, sc: Scope, span: N.Span) -> T.KrlType:
-        tt = self.expr(target, sc, lvalue=True)
+        tt = self.expr(target, sc)
         root = N.root_name(target)
         if root is None:
             self.sink.at(target.span, "E503", "the left side of an assignment must be a variable")
@@ -668,58 +710,71 @@ class Checker:
         self.sink.at(e.span, "E203", f"{what} must be INT, not {t}")
 
     def set_type(self, e: N.Expr, t: T.KrlType) -> T.KrlType:
-        ann = e.ann
-        if ann is None:
-            e.ann = ann = N.Annotation()
-        ann.type = t
+        (e.ann or e.annotate()).type = t
         return t
 
-    def expr(self, e: N.Expr, sc: Scope, expected: T.KrlType | None = None,
-             lvalue: bool = False) -> T.KrlType:
-        """Type `e` (annotating it) and report errors; never raises for a valid AST."""
-        if isinstance(e, N.IntLit):
-            return self.set_type(e, T.INT)
-        if isinstance(e, N.RealLit):
-            return self.set_type(e, T.REAL)
-        if isinstance(e, N.BoolLit):
-            return self.set_type(e, T.BOOL)
-        if isinstance(e, N.StrLit):
-            return self.set_type(e, T.StrType(len(e.value)))
-        if isinstance(e, N.EnumLit):
-            if isinstance(expected, T.Enum):
-                if expected.values and e.name.upper() not in expected.values:
-                    self.sink.at(e.span, "W205" if expected.soft else "E205",
-                                 f"#{e.name} is not a value of {expected.name}")
-                    return self.set_type(e, T.UNKNOWN)
-                return self.set_type(e, expected)
-            return self.set_type(e, T.EnumLitType(e.name))
-        if isinstance(e, N.Name):
-            return self.name(e, sc)
-        if isinstance(e, N.Index):
-            return self.index(e, sc)
-        if isinstance(e, N.Field):
-            bt = self.expr(e.base, sc)
-            if bt is T.UNKNOWN:
-                return self.set_type(e, T.UNKNOWN)
-            if isinstance(bt, T.Struc):
-                ft = bt.field_type(e.name)
-                if ft is None:
-                    if bt.fields:
-                        self.sink.at(e.span, "W108" if bt.soft else "E108",
-                                     f"{bt.name} has no component '{e.name}'")
-                    return self.set_type(e, T.UNKNOWN)
-                return self.set_type(e, ft)
-            self.sink.at(e.span, "E108", f"'.{e.name}' applied to {bt}, which is not a structure")
-            return self.set_type(e, T.UNKNOWN)
-        if isinstance(e, N.Call):
-            return self.call(e, sc, statement=False)
-        if isinstance(e, N.Aggregate):
-            return self.set_type(e, self.aggregate(e, sc, expected or T.UNKNOWN))
-        if isinstance(e, N.Unary):
-            return self.set_type(e, self.unary(e, sc))
-        if isinstance(e, N.Binary):
-            return self.set_type(e, self.binary(e, sc))
+    def expr(self, e: N.Expr, sc: Scope, expected: T.KrlType | None = None) -> T.KrlType:
+        """Type `e` (annotating it) and report errors; never raises for a valid AST.
+        `expected`: the type the value is for (an enum literal or aggregate takes it)."""
+        return self.expr_dispatch[e.__class__](e, sc, expected)
+
+    def e_IntLit(self, e: N.IntLit, sc: Scope, expected) -> T.KrlType:
+        return self.set_type(e, T.INT)
+
+    def e_RealLit(self, e: N.RealLit, sc: Scope, expected) -> T.KrlType:
+        return self.set_type(e, T.REAL)
+
+    def e_BoolLit(self, e: N.BoolLit, sc: Scope, expected) -> T.KrlType:
+        return self.set_type(e, T.BOOL)
+
+    def e_StrLit(self, e: N.StrLit, sc: Scope, expected) -> T.KrlType:
+        return self.set_type(e, T.StrType(len(e.value)))
+
+    def e_ChannelName(self, e: N.ChannelName, sc: Scope, expected) -> T.KrlType:
+        # a channel (COPEN(:SER_3, HANDLE)) is an argument of a channel routine, no typed value
         return T.UNKNOWN
+
+    def e_EnumLit(self, e: N.EnumLit, sc: Scope, expected) -> T.KrlType:
+        if isinstance(expected, T.Enum):
+            if expected.values and e.name.upper() not in expected.values:
+                self.sink.at(e.span, "W205" if expected.soft else "E205",
+                             f"#{e.name} is not a value of {expected.name}")
+                return self.set_type(e, T.UNKNOWN)
+            return self.set_type(e, expected)
+        return self.set_type(e, T.EnumLitType(e.name))
+
+    def e_Name(self, e: N.Name, sc: Scope, expected) -> T.KrlType:
+        return self.name(e, sc)
+
+    def e_Index(self, e: N.Index, sc: Scope, expected) -> T.KrlType:
+        return self.index(e, sc)
+
+    def e_Field(self, e: N.Field, sc: Scope, expected) -> T.KrlType:
+        bt = self.expr(e.base, sc)
+        if bt is T.UNKNOWN:
+            return self.set_type(e, T.UNKNOWN)
+        if isinstance(bt, T.Struc):
+            ft = bt.field_type(e.name)
+            if ft is None:
+                if bt.fields:
+                    self.sink.at(e.span, "W108" if bt.soft else "E108",
+                                 f"{bt.name} has no component '{e.name}'")
+                return self.set_type(e, T.UNKNOWN)
+            return self.set_type(e, ft)
+        self.sink.at(e.span, "E108", f"'.{e.name}' applied to {bt}, which is not a structure")
+        return self.set_type(e, T.UNKNOWN)
+
+    def e_Call(self, e: N.Call, sc: Scope, expected) -> T.KrlType:
+        return self.call(e, sc, statement=False)
+
+    def e_Aggregate(self, e: N.Aggregate, sc: Scope, expected) -> T.KrlType:
+        return self.set_type(e, self.aggregate(e, sc, expected or T.UNKNOWN))
+
+    def e_Unary(self, e: N.Unary, sc: Scope, expected) -> T.KrlType:
+        return self.set_type(e, self.unary(e, sc))
+
+    def e_Binary(self, e: N.Binary, sc: Scope, expected) -> T.KrlType:
+        return self.set_type(e, self.binary(e, sc))
 
     def name(self, e: N.Name, sc: Scope) -> T.KrlType:
         sym = sc.lookup(e.name)
@@ -922,8 +977,7 @@ def _char_like(t: T.KrlType) -> bool:
 
 
 def _show(e: N.Expr) -> str:
-    from krl.ast.printer import expr  # noqa: PLC0415 - only for messages
     try:
-        return expr(e)
+        return printed(e)
     except Exception:  # noqa: BLE001
         return "?"

@@ -4,11 +4,11 @@ The checker (krl/semantics/checker.py) gives each Name and Call its :class:`Symb
 (:func:`resolve_workspace`, run by ``Workspace.check``) turns symbols into places, once, ahead
 of any run; the interpreters (interp/) allocate storage for them and never look a name up:
 
-* every Routine gets a :class:`Layout` (``routine.ann.storage``): its frame slots — the
+* every Routine gets a :class:`Layout` (``routine.ann.layout``): its frame slots — the
   parameters in order, then its local variables, SIGNALs and IMPORTs in declaration order;
 * every DataList gets a :class:`Layout` of its data-list slots (variables and SIGNALs);
-* every Name (an expression, an assignment target, a FOR variable, a WITH target) gets a
-  :class:`Storage` (``name.ann.storage``): its *storage class* and *slot*:
+* every Name (an expression, an assignment target, a FOR variable, a WITH target) gets its
+  *place*, a :class:`Storage` (``name.ann.place``): its *storage class* and *slot*:
 
   ========== ============================================================================
   class      where the variable lives
@@ -31,9 +31,21 @@ of any run; the interpreters (interp/) allocate storage for them and never look 
   An IMPORT name stands for the imported data-list variable (its storage). A name inside a
   routine whose file does not parse (the checker does not check such bodies) is resolved
   with the same scopes (``Scope.lookup``).
-* every Call gets a :class:`Callee` (``call.ann.storage``): the module and Routine it runs,
-  or a built-in routine (``native``), or none (the stub policy decides at run time);
+* every Call gets a :class:`Callee` (``call.ann.callee``): a ROUTINE of the program (the
+  module and Routine it runs), a NATIVE built-in of the tables (``native``: its name there,
+  the key of the runtime's implementation), or a STUB (nothing implements it: the run-time
+  stub policy);
+* every Aggregate with a TYPE prefix gets the STRUC it names (``aggregate.ann.struc``);
+* every GOTO gets its ``target``, the Label it jumps to: the label of that name in the nearest
+  block around the GOTO that holds one (the last one in that block), else None (the run-time
+  error "label not found");
+* an assignment to an element of a *cyclic* system variable (``cyclic: true`` in the tables:
+  ``$CYCFLAG``, reference §5.15) gets ``assign.ann.cyclic``;
+* ANIN ON/OFF and ANOUT ON/OFF get their analog signal's place (``ann.channel``): the name
+  the statement switches, and for ANIN ON the SIGNAL its value expression reads;
 * every statement gets its :class:`krl.semantics.advance.StmtInfo` (``stmt.ann.info``).
+
+The back ends read these facts and never a name's spelling.
 """
 
 from __future__ import annotations
@@ -43,10 +55,13 @@ from dataclasses import dataclass, field
 from krl.ast import nodes as N
 from krl.semantics import types as T
 from krl.semantics.advance import analyse
+from krl.semantics.builtins import load_builtins
 from krl.semantics.symbols import Scope, Symbol, system_scopes
 
 LOCAL, MODULE, GLOBAL, SYSTEM, UNRESOLVED = range(5)
 CLASS_NAMES = ("local", "module", "global", "system", "unresolved")
+ROUTINE, NATIVE, STUB = range(3)
+CALLEE_NAMES = ("routine", "native", "stub")
 
 
 @dataclass(slots=True, eq=False)
@@ -66,22 +81,39 @@ class Storage:
         where = f"{self.owner}:{self.slot}" if self.owner >= 0 else str(self.slot)
         return f"Storage({CLASS_NAMES[self.kind]} {self.name} @{where})"
 
+    @property
+    def key(self) -> tuple:
+        """Equal for two uses of the same variable (a frame slot, a data-list slot, a system
+        variable; an unresolved name by its upper-case spelling)."""
+        if self.kind == UNRESOLVED:
+            return (UNRESOLVED, self.name.upper())
+        return (self.kind, self.owner, self.slot)
+
 
 @dataclass(slots=True, eq=False)
 class Callee:
-    """What a call runs: ``routine`` (a Routine of the program) in module ``owner`` (index in
-    ``Workspace.units``), or ``native`` True (a built-in routine of the tables), or neither
-    (nothing declares it: the run-time stub policy); ``name`` as called."""
+    """What a call runs. ``kind`` ROUTINE: ``routine`` (a Routine of the program) in module
+    ``owner`` (index in ``Workspace.units``); NATIVE: the built-in routine of the tables named
+    ``native`` (upper case: the key of the runtime's implementation, when it has one); STUB:
+    nothing implements it (a technology package absent from the backup: the run-time stub
+    policy). ``name`` as called (for messages and traces)."""
     name: str
+    kind: int = STUB
     owner: int = -1
     routine: N.Routine | None = None
-    native: bool = False
+    native: str = ""
+
+    def __repr__(self) -> str:
+        return f"Callee({CALLEE_NAMES[self.kind]} {self.name})"
 
 
 @dataclass(slots=True, eq=False)
-class Slot:
-    """One slot of a Layout: the declared spelling, the symbol, its declaration node (VarDecl,
-    SignalDecl or Param), the VarName for a variable, its type and the parameter mode."""
+class LayoutSlot:
+    """What the front end knows of one slot of a Layout (a *slot* is a numbered place of a
+    frame or a data list: ``Storage.slot``): the declared spelling, the symbol, its declaration
+    node (VarDecl, SignalDecl or Param), the VarName for a variable, its type and the
+    parameter mode. At run time the value of a slot is reached through a reference
+    (interp/runtime/memory.py ``Slot``)."""
     name: str
     symbol: Symbol | None
     decl: object
@@ -93,8 +125,9 @@ class Slot:
 @dataclass(slots=True, eq=False)
 class Layout:
     """The slots of a routine's frame (parameters first: ``nparams``) or of a data list,
-    and the scope the names were resolved in (VARSTATE's text and tools use it)."""
-    slots: list[Slot] = field(default_factory=list)
+    and the scope the names were resolved in (VARSTATE's text, typed expressions and tools
+    use it)."""
+    slots: list[LayoutSlot] = field(default_factory=list)
     nparams: int = 0
     scope: Scope | None = None
     owner: int = -1
@@ -119,10 +152,10 @@ def _data_layout(dl: N.DataList, owner: int) -> Layout:
                 if v.name.upper() in seen:
                     continue
                 seen.add(v.name.upper())
-                lay.slots.append(Slot(v.name, N.symbol_of(v), d, v, N.type_of(v)))
+                lay.slots.append(LayoutSlot(v.name, N.symbol_of(v), d, v, N.type_of(v)))
         elif isinstance(d, N.SignalDecl) and d.name.upper() not in seen:
             seen.add(d.name.upper())
-            lay.slots.append(Slot(d.name, None, d))
+            lay.slots.append(LayoutSlot(d.name, None, d))
     return lay
 
 
@@ -138,7 +171,7 @@ def _routine_layout(r: N.Routine, scope: Scope | None, owner: int) -> Layout:
             continue
         seen.add(key)
         sym = values.get(key)
-        lay.slots.append(Slot(p.name, sym, p, type=sym.type if sym is not None else None, mode=p.mode))
+        lay.slots.append(LayoutSlot(p.name, sym, p, type=sym.type if sym is not None else None, mode=p.mode))
     lay.nparams = len(lay.slots)
     for d in r.decls:
         if isinstance(d, N.VarDecl):
@@ -152,10 +185,10 @@ def _routine_layout(r: N.Routine, scope: Scope | None, owner: int) -> Layout:
                         lay.slots[i].type = N.type_of(v)
                     continue
                 seen.add(key)
-                lay.slots.append(Slot(v.name, values.get(key), d, v, N.type_of(v)))
+                lay.slots.append(LayoutSlot(v.name, values.get(key), d, v, N.type_of(v)))
         elif isinstance(d, N.SignalDecl) and d.name.upper() not in seen:
             seen.add(d.name.upper())
-            lay.slots.append(Slot(d.name, values.get(d.name.upper()), d))
+            lay.slots.append(LayoutSlot(d.name, values.get(d.name.upper()), d))
     return lay
 
 
@@ -169,6 +202,8 @@ class Resolver:
         self.system_index: dict[str, int] = {}
         self.unit_of: dict[int, int] = {}                    # id(Routine) -> unit index
         self.native_names = set(self.system.routines)
+        tables = load_builtins()
+        self.cyclic = frozenset(k for k, info in tables.sysvars.items() if info.cyclic)
 
     # ------------------------------------------------------------------ layouts
     def run(self) -> None:
@@ -186,7 +221,7 @@ class Resolver:
                     self.unit_of[id(r)] = i
             if u.dat is not None and u.dat.module.data is not None:
                 lay = _data_layout(u.dat.module.data, i)
-                u.dat.module.data.annotate().storage = lay
+                u.dat.module.data.annotate().layout = lay
                 for k, s in enumerate(lay.slots):
                     sym = s.symbol if s.symbol is not None else (u.scope.values.get(s.name.upper())
                                                                  if u.scope is not None else None)
@@ -206,8 +241,8 @@ class Resolver:
                         self.expr(d.init, scope, None, i)
                     elif isinstance(d, N.ArrayInit):
                         # `NAME[i] = value`: an element of this data list's own variable
-                        k = u.dat.module.data.ann.storage.index(d.name)
-                        d.annotate().storage = Storage(MODULE, k, i, d.name) if k is not None else None
+                        k = u.dat.module.data.ann.layout.index(d.name)
+                        d.annotate().place = Storage(MODULE, k, i, d.name) if k is not None else None
                         for e in (*d.indices, d.value):
                             self.expr(e, scope, None, i)
             if u.src is None:
@@ -216,7 +251,7 @@ class Resolver:
                 scope = ws.routine_scope(r) or u.scope
                 lay = _routine_layout(r, ws.routine_scope(r), i)
                 lay.returns = returns.get(id(r)) if r.kind == "DEFFCT" else None
-                r.annotate().storage = lay
+                r.annotate().layout = lay
                 local = self.locals_of(lay)
                 for d in r.decls:
                     if isinstance(d, N.VarDecl) and d.init is not None:
@@ -295,7 +330,7 @@ class Resolver:
         sym = N.symbol_of(e)
         if not isinstance(sym, Symbol) and scope is not None:
             sym = scope.lookup(e.name)
-        e.annotate().storage = self.storage(e.name, sym, local, unit)
+        e.annotate().place = self.storage(e.name, sym, local, unit)
 
     def call(self, c: N.Call, scope: Scope | None, unit: int) -> None:
         sym = N.symbol_of(c)
@@ -308,16 +343,20 @@ class Resolver:
                 # EXT/EXTFCT names a routine of another module (reference 2.6): the link binds
                 # the call to the module main or GLOBAL routine that the global scope holds
                 # (krl/workspace.py: a routine replaces an EXT signature there); a technology
-                # package absent from the backup leaves it unbound: a stub
+                # package absent from the backup leaves it unbound
                 linked = self.ws.global_scope.routines.get(c.name.upper())
                 if linked is not None and isinstance(linked.decl, N.Routine):
                     decl = linked.decl
             if isinstance(decl, N.Routine):
+                callee.kind = ROUTINE
                 callee.routine = decl
                 callee.owner = self.unit_of.get(id(decl), -1)
-            elif sym.scope == "system" or (sym.decl is None and c.name.upper() in self.native_names):
-                callee.native = True
-        c.annotate().storage = callee
+        if callee.kind != ROUTINE and c.name.upper() in self.native_names:
+            # a built-in of the tables (also behind an EXT declaration nothing implements:
+            # the controller's own routine runs)
+            callee.kind = NATIVE
+            callee.native = c.name.upper()
+        c.annotate().callee = callee
 
     def expr(self, e, scope, local, unit: int) -> None:
         """Resolve every Name and Call of expression `e` (iteratively: a 500-term chain costs
@@ -334,18 +373,26 @@ class Resolver:
                 self.call(n, scope, unit)
             elif isinstance(n, N.Aggregate) and n.type_name and scope is not None:
                 t = N.type_of(n)
-                n.annotate().storage = t if isinstance(t, T.Struc) else scope.lookup_type(n.type_name)
+                if not isinstance(t, T.Struc):
+                    t = scope.lookup_type(n.type_name)
+                n.annotate().struc = t if isinstance(t, T.Struc) else None
             stack.extend(n.children())
 
     # ------------------------------------------------------------------ statements
     def block(self, stmts, scope, local, unit: int) -> None:
         """Resolve a statement list and the blocks nested in it, with a work list (nesting costs
-        no stack: the deepest legal file checks within krl.limits.MAX_CHECK_FRAMES)."""
-        work = [stmts]
+        no stack: the deepest legal file checks within krl.limits.MAX_CHECK_FRAMES). Each
+        block's labels (the last of a name wins) are chained to the enclosing blocks', for
+        the GOTO targets."""
+        work = [(stmts, None)]
         while work:
+            stmts, outer = work.pop()
+            labels = ({s.name.upper(): s for s in stmts if isinstance(s, N.Label)}, outer)
             after_continue = False
-            for s in work.pop():
-                work.extend(self.stmt(s, scope, local, unit))
+            for s in stmts:
+                work.extend((b, labels) for b in self.stmt(s, scope, local, unit))
+                if isinstance(s, N.Goto):
+                    s.annotate().target = _label_target(s.label.upper(), labels)
                 info = s.annotate().info = analyse(s, _symbol_of)
                 if info.reason is not None:
                     s.ann.extra["advance_stop"] = info.reason
@@ -376,7 +423,18 @@ class Resolver:
                 self.expr(v, scope, local, unit)
         if isinstance(s, (N.AnoutOn, N.AnoutOff, N.AninOff)) and scope is not None:
             # the analog channel is named by a plain word in these statements
-            s.annotate().storage = self.storage(s.name, scope.lookup(s.name), local, unit)
+            s.annotate().channel = self.storage(s.name, scope.lookup(s.name), local, unit)
+        elif isinstance(s, N.AninOn):
+            # the analog input is the SIGNAL the value reads (`ANIN ON v = factor * SIG`)
+            names = [n for n in s.value.walk() if isinstance(n, N.Name)]
+            sig = next((n for n in names if getattr(_symbol_of(n), "kind", None) == "signal"),
+                       names[0] if names else None)
+            s.annotate().channel = sig.ann.place if sig is not None else None
+        elif isinstance(s, N.Assign):
+            t = s.target
+            place = t.base.ann.place if isinstance(t, N.Index) and isinstance(t.base, N.Name) else None
+            if place is not None and place.kind == SYSTEM and place.name in self.cyclic:
+                s.annotate().cyclic = True        # a cyclic flag (reference §5.15)
         return blocks
 
     def exprs(self, es, scope, local, unit) -> None:
@@ -384,13 +442,24 @@ class Resolver:
             self.expr(e, scope, local, unit)
 
 
+def _label_target(key: str, labels: tuple | None) -> N.Label | None:
+    """The Label `key` names in the nearest block of the chain `labels` ((table, outer))."""
+    while labels is not None:
+        got = labels[0].get(key)
+        if got is not None:
+            return got
+        labels = labels[1]
+    return None
+
+
 def _symbol_of(node) -> Symbol | None:
-    st = node.ann.storage if node.ann is not None else None
+    st = getattr(node.ann, "place", None)
     sym = st.symbol if isinstance(st, Storage) else None
     return sym if sym is not None else N.symbol_of(node)
 
 
 def resolve_workspace(ws) -> None:
     """Give every routine and data list of the checked workspace `ws` its Layout, every Name
-    its Storage, every Call its Callee and every statement its StmtInfo (module docstring)."""
+    its place, every Call its Callee, every statement its facts and StmtInfo (module
+    docstring)."""
     Resolver(ws).run()

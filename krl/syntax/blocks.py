@@ -21,6 +21,8 @@ import bisect
 import re
 from dataclasses import dataclass, field
 
+from antlr4 import Token
+
 from krl.limits import MAX_EXPRESSION_TERMS, MAX_NESTING
 
 # opener -> its closer; middle keywords of a block
@@ -83,8 +85,6 @@ class Finding:
 
 def lines_of(tokens, bundle) -> list[Line]:
     """Group ANTLR tokens (default channel) into lines at NEWLINE tokens."""
-    from antlr4 import Token  # noqa: PLC0415
-
     out: list[Line] = []
     cur: list[Tok] = []
     for t in tokens:

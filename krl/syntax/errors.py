@@ -8,12 +8,37 @@ independent missing construct of a file.
 
 from __future__ import annotations
 
+from dataclasses import dataclass, field
+
 from antlr4 import Token
 from antlr4.atn.ATNState import ATNState
 from antlr4.error.ErrorListener import ErrorListener
 from antlr4.error.ErrorStrategy import DefaultErrorStrategy
 from antlr4.error.Errors import InputMismatchException
 from antlr4.IntervalSet import IntervalSet
+
+
+@dataclass(slots=True)
+class SyntaxIssue:
+    """One syntax or lexer error at line:column (1-based line, 0-based column as ANTLR)."""
+
+    line: int
+    column: int
+    message: str
+    offending: str
+    expected: list[str]
+    rule_stack: list[str]
+    kind: str = "syntax"          # "syntax" or "lexer"
+    offending_type: str = ""      # symbolic token name, "<EOF>" or "" for lexer errors
+    line_shape: list[str] = field(default_factory=list)  # tokens of the line up to the offending one
+    line_text: str = ""
+    cascade: bool = False          # a follow-on error of an earlier one (not a construct of its own)
+
+    def as_json(self) -> dict:
+        return {"line": self.line, "column": self.column, "message": self.message,
+                "offending": self.offending, "expected": self.expected,
+                "rule_stack": self.rule_stack, "kind": self.kind, "cascade": self.cascade}
+
 
 _LOOP_STATES = (ATNState.BLOCK_START, ATNState.STAR_BLOCK_START, ATNState.PLUS_BLOCK_START,
                 ATNState.STAR_LOOP_ENTRY, ATNState.STAR_LOOP_BACK, ATNState.PLUS_LOOP_BACK)
@@ -115,7 +140,6 @@ class CollectingErrorListener(ErrorListener):
         """Record one syntax error from its raw data (this listener, or a parse engine's record:
         krl/syntax/engines): expected token types, the rule stack outermost first, and the
         default-channel tokens of the line up to the offending one (objects with .type, .text)."""
-        from krl.syntax.parse import SyntaxIssue  # noqa: PLC0415  (cyclic at import time)
 
         names = sorted({self.bundle.display_name(t) for t in expected})
         if offending_text is not None and offending_text in ("\n", "\r\n", "\r"):
@@ -129,7 +153,6 @@ class CollectingErrorListener(ErrorListener):
 
     def check_issue(self, failure) -> object:
         """A SyntaxIssue for a failed post-parse token check (krl.syntax.checks)."""
-        from krl.syntax.parse import SyntaxIssue  # noqa: PLC0415
 
         token, check = failure.token, failure.check
         return SyntaxIssue(line=token.line, column=token.column,
@@ -140,7 +163,6 @@ class CollectingErrorListener(ErrorListener):
 
     def finish_lexer(self, text: str) -> list:
         """Turn the collected lexer errors into SyntaxIssue records."""
-        from krl.syntax.parse import SyntaxIssue  # noqa: PLC0415
 
         lines = text.splitlines()
         issues = []

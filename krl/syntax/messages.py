@@ -28,8 +28,11 @@ from __future__ import annotations
 from pathlib import Path
 
 from krl.diagnostics import Diagnostic, Note
+from krl.source import read_source
 from krl.terminal import clip
 from krl.syntax.blocks import CLOSER, OPENER_OF, MIDDLE, BlockScan, lines_of, scan
+from krl.syntax.parse import default_bundle
+from krl.syntax.tokens import lex
 
 MAX_ALTERNATIVES = 6
 
@@ -147,13 +150,7 @@ class _File:
     """The line tokens and block scan of one file, made only when it has syntax errors."""
 
     def __init__(self, text: str, bundle) -> None:
-        from antlr4 import CommonTokenStream, InputStream  # noqa: PLC0415
-
-        lexer = bundle.lexer_cls(InputStream(text))
-        lexer.removeErrorListeners()
-        stream = CommonTokenStream(lexer)
-        stream.fill()
-        self.lines = {ln.number: ln for ln in lines_of(stream.tokens, bundle)}
+        self.lines = {ln.number: ln for ln in lines_of(lex(text, bundle), bundle)}
         self.scan: BlockScan = scan(list(self.lines.values()))
 
 
@@ -173,8 +170,6 @@ def syntax_diagnostics(result, text: str, bundle=None) -> list[Diagnostic]:
             out.append(Diagnostic(path, e.line, e.column + 1, e.offending_type or "E018", e.message))
     if out:
         return out
-    from krl.syntax.parse import default_bundle  # noqa: PLC0415
-
     try:
         f = _File(text, bundle or default_bundle())
     except Exception:  # noqa: BLE001 - fall back to the parser's words
@@ -371,8 +366,10 @@ def file_diagnostics(path: Path, keep_tree: bool = True):
     """(ParseResult, decoded text, diagnostics) of one file; never raises for bad content.
     The default parse engine (krl/syntax/engines) parses it; with keep_tree the result has its
     parse tree (the java engine's is rebuilt from its data, the same tree)."""
+    # on first use: the parse engines (the Java engine's process machinery) cost 0.10 s (python -X
+    # importtime, 2026-11-23, load average 22 on the 2 cores) of every krl command's start-up, which
+    # imports this module
     from krl.syntax.engines import parse_source  # noqa: PLC0415
-    from krl.source import read_source  # noqa: PLC0415
 
     src = read_source(path)
     result = parse_source(src, keep_tree=keep_tree)

@@ -25,32 +25,10 @@ from antlr4.error.Errors import ParseCancellationException
 
 from krl.syntax.checks import may_fail, run_checks
 from krl.syntax.blocks import first_past_limit
-from krl.syntax.errors import CollectingErrorListener, LineErrorStrategy
+from krl.syntax.errors import CollectingErrorListener, LineErrorStrategy, SyntaxIssue
 from krl.source import SourceText, read_source
 
 GENERATED_DIR = Path(__file__).parent / "generated"
-
-
-@dataclass(slots=True)
-class SyntaxIssue:
-    """One syntax or lexer error at line:column (1-based line, 0-based column as ANTLR)."""
-
-    line: int
-    column: int
-    message: str
-    offending: str
-    expected: list[str]
-    rule_stack: list[str]
-    kind: str = "syntax"          # "syntax" or "lexer"
-    offending_type: str = ""      # symbolic token name, "<EOF>" or "" for lexer errors
-    line_shape: list[str] = field(default_factory=list)  # tokens of the line up to the offending one
-    line_text: str = ""
-    cascade: bool = False          # a follow-on error of an earlier one (not a construct of its own)
-
-    def as_json(self) -> dict:
-        return {"line": self.line, "column": self.column, "message": self.message,
-                "offending": self.offending, "expected": self.expected,
-                "rule_stack": self.rule_stack, "kind": self.kind, "cascade": self.cascade}
 
 
 @dataclass(slots=True)
@@ -125,6 +103,9 @@ def default_bundle() -> ParserBundle:
         if not (GENERATED_DIR / "KRLParser.py").exists():
             raise RuntimeError("the generated parser is missing: run `make parser` "
                                "(it generates krl/syntax/generated from grammar/KRL.g4)")
+        # on first use: the generated parser exists only after `make parser`, and importing it costs
+        # 0.87 s (python -X importtime, 2026-11-23, load average 22 on the 2 cores), which commands
+        # that parse nothing (krl --help, krl lsp before the first file) do not pay
         from krl.syntax.generated.KRLLexer import KRLLexer  # noqa: PLC0415
         from krl.syntax.generated.KRLParser import KRLParser  # noqa: PLC0415
         _default_bundle = ParserBundle(KRLLexer, KRLParser)

@@ -65,10 +65,10 @@ def test_every_use_has_its_storage_class_and_slot(tmp_path):
     [ws] = workspaces_for(prog)
     ws.check()
     r = ws.modules["PROG"].routines[0]
-    assert [s.name for s in r.ann.storage.slots] == ["n"]
-    names = {(n.name, n.ann.storage.kind, n.ann.storage.slot) for n in r.walk() if isinstance(n, N.Name)}
+    assert [s.name for s in r.ann.layout.slots] == ["n"]
+    names = {(n.name, n.ann.place.kind, n.ann.place.slot) for n in r.walk() if isinstance(n, N.Name)}
     assert ("n", LOCAL, 0) in names and ("$OUT", SYSTEM, 0) in names
-    done = next(n for n in r.walk() if isinstance(n, N.Name) and n.name == "done").ann.storage
+    done = next(n for n in r.walk() if isinstance(n, N.Name) and n.name == "done").ann.place
     prog_unit = next(i for i, u in enumerate(ws.units) if u.name.upper() == "PROG")
     assert (done.kind, done.owner, done.slot) == (MODULE, prog_unit, 0)
     assert GLOBAL != MODULE and UNRESOLVED not in {k for _, k, _ in names}

@@ -10,7 +10,7 @@ from robot.bench import run_motions
 from robot.controller import Controller, ErrorEvent, TriggerEvent
 from robot.errors import RobotError, WorkspaceError
 from robot.motion import MotionParams, MotionRequest, Trigger
-from robot.stimuli import parse_stimuli
+from robot.stimuli import parse_stimuli, load_cell
 from robot.trace import TraceWriter
 
 DT = 0.012
@@ -241,7 +241,7 @@ def test_stimuli_at_time_and_on_motion():
 def test_stimuli_from_yaml_file(tmp_path):
     f = tmp_path / "s.yaml"
     f.write_text("stimuli:\n  - at: 0.024\n    set: {\"$IN[7]\": true}\n")
-    ctl = Controller(mujoco=False, stimuli=str(f))
+    ctl = Controller(mujoco=False, stimuli=load_cell(f))     # the one loader; the controller reads no YAML
     ctl.step()
     assert not ctl.get_in(7)
     ctl.step()

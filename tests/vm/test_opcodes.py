@@ -86,11 +86,11 @@ def check_stack(lst) -> None:
     n = len(lst.instrs)
     depth: dict = {0: 0}
     entries = [0]
-    # thunk entries: targets of WAIT_FOR/INT_DECL/TRIGGER/CYCFLAG/ANOUT_ON/ANIN_ON
+    # thunk entries: targets of WAIT_FOR/INT_DECL/TRIGGER/CYCLIC_ASSIGN/ANOUT_ON/ANIN_ON
     for name, ops, _ in lst.instrs:
         kinds = O.BY_NAME[name].operands
         for k, v in zip(kinds, ops):
-            if k == "l" and name in ("WAIT_FOR", "INT_DECL", "TRIGGER", "CYCFLAG", "ANOUT_ON", "ANIN_ON"):
+            if k == "l" and name in ("WAIT_FOR", "INT_DECL", "TRIGGER", "CYCLIC_ASSIGN", "ANOUT_ON", "ANIN_ON"):
                 pos = lst.labels[v]
                 depth[pos] = 1 if name == "TRIGGER" else 0
                 entries.append(pos)
@@ -112,7 +112,7 @@ def check_stack(lst) -> None:
         succ = []
         kinds = O.BY_NAME[name].operands
         for k, v in zip(kinds, ops):
-            if k == "l" and name not in ("WAIT_FOR", "INT_DECL", "TRIGGER", "CYCFLAG", "ANOUT_ON", "ANIN_ON"):
+            if k == "l" and name not in ("WAIT_FOR", "INT_DECL", "TRIGGER", "CYCLIC_ASSIGN", "ANOUT_ON", "ANIN_ON"):
                 t = lst.labels[v]
                 td = nd - 1 if name == "JUMP_IF_NONE" else nd
                 succ.append((t, td))

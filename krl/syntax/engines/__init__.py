@@ -19,13 +19,20 @@ Python engine's result, tree included (tests/syntax/test_engines.py).
 
 from __future__ import annotations
 
+import json
 import os
 from collections.abc import Iterable, Iterator
 from pathlib import Path
 
+import click
+
 from krl.syntax.parse import (ParseResult, ParserBundle, default_bundle, parse_source as _py_parse_source,
                               prepare_text, result_from_raw)
-from krl.source import SourceText
+from krl.source import SourceText, source_from_bytes
+from krl.syntax.blocks import may_pass_limit
+from krl.syntax.checks import may_fail
+from krl.syntax.engines.java import EngineUnavailable, WorkerError, unavailable_reason, worker_for
+from krl.syntax.engines.tree import TreeDataError, tree_from_raw
 
 ENGINES = ("auto", "python", "java")
 REPO_GRAMMAR = Path(__file__).resolve().parents[3] / "grammar" / "KRL.g4"
@@ -33,8 +40,6 @@ REPO_GRAMMAR = Path(__file__).resolve().parents[3] / "grammar" / "KRL.g4"
 __all__ = ["ENGINES", "EngineUnavailable", "available", "grammar_text", "java_answers", "parse_piece", "resolve",
            "result_from_answer", "set_default", "use_engine", "parse_file", "parse_source", "parse_sources",
            "unavailable_reason"]
-
-from krl.syntax.engines.java import EngineUnavailable, WorkerError, unavailable_reason  # noqa: E402
 
 
 def set_default(name: str) -> None:
@@ -52,8 +57,6 @@ def use_engine(name: str | None) -> str:
     try:
         chosen = resolve(name)
     except EngineUnavailable as exc:
-        import click  # noqa: PLC0415
-
         click.echo(f"error: {exc}; use --engine python (or auto)", err=True)
         raise SystemExit(2) from None
     set_default(name)
@@ -106,9 +109,6 @@ _NEEDS: dict[tuple[int, int], bool] = {}
 def _needs_python(text: str) -> bool:
     """True when a Python-only check could change the result of `text` (grammar-independent,
     so remembered per text for the many grammar versions of `krl growth`)."""
-    from krl.syntax.blocks import may_pass_limit  # noqa: PLC0415
-    from krl.syntax.checks import may_fail  # noqa: PLC0415
-
     key = (hash(text), len(text))
     found = _NEEDS.get(key)
     if found is None:
@@ -150,8 +150,6 @@ def java_answers(items: Iterable[tuple[object, SourceText]], bundle: ParserBundl
     seconds without answering); such sources come first, or last when the worker gave up.
     `decode=False`: raw is the answer's JSON line (bytes), for :func:`result_from_answer` in
     another process. Never raises for bad input."""
-    from krl.syntax.engines.java import worker_for  # noqa: PLC0415
-
     bundle = bundle or default_bundle()
     items = list(items)
     try:
@@ -191,8 +189,6 @@ def result_from_answer(source: SourceText, raw: dict | bytes | None, bundle: Par
     bundle = bundle or default_bundle()
     if raw is not None:
         if isinstance(raw, bytes):
-            import json  # noqa: PLC0415
-
             try:
                 raw = json.loads(raw)
             except ValueError:
@@ -202,8 +198,6 @@ def result_from_answer(source: SourceText, raw: dict | bytes | None, bundle: Par
     text = prepare_text(source.text)
     tree = None
     if keep_tree:
-        from krl.syntax.engines.tree import TreeDataError, tree_from_raw  # noqa: PLC0415
-
         try:
             tree = tree_from_raw(raw, text, bundle)
         except TreeDataError:
@@ -221,8 +215,6 @@ def parse_piece(text: str, path: str, first_line: int, threads: int = 1,
     it does not. None when the java engine cannot answer (not running here, a Python-only check
     could fire, the worker failed): then the Python engine must parse it. `threads`: the worker's
     (one worker per thread count)."""
-    from krl.syntax.engines.java import worker_for  # noqa: PLC0415
-    from krl.syntax.engines.tree import TreeDataError, tree_from_raw  # noqa: PLC0415
 
     if unavailable_reason() is not None:
         return None
@@ -260,8 +252,6 @@ def parse_file(data: bytes | str | SourceText, path: str = "<string>", engine: s
     if isinstance(data, SourceText):
         source = data
     elif isinstance(data, bytes):
-        from krl.source import source_from_bytes  # noqa: PLC0415
-
         source = source_from_bytes(path, data)
     else:
         source = SourceText(path, data, "", len(data.encode("utf-8", "surrogatepass")))

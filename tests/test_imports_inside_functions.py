@@ -1,0 +1,48 @@
+"""Imports inside functions only where a measured start-up cost needs them (issue 38).
+
+In the packages listed here every import inside a function carries a comment on its line or
+just above it that names why it is there: a measured cost (``python -X importtime``: "costs
+0.87 s"), an optional dependency, or a build-only tool. The other packages of the project are
+not converted yet."""
+
+from __future__ import annotations
+
+import ast
+import re
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parents[1]
+CHECKED = ["krl/semantics", "krl/ast", "krl/syntax", "krl/fmt", "krl/project.py", "krl/workspace.py",
+           "interp/tree", "interp/vm/compiler.py", "interp/vm/vm.py", "interp/vm/gen_loop.py",
+           "interp/runtime/program.py", "interp/asm.py", "interp/debug/expr.py", "robot/cellrules.py",
+           "robot/datalist.py", "krl/files.py", "krl/pool.py", "krl/render.py", "krl/source.py",
+           "interp/vm/__init__.py", "interp/vm/build.py"]
+REASON = re.compile(r"costs? \d|\d+(\.\d+)? s\b|optional|only for a build|loads only for a build")
+
+
+def _files():
+    for entry in CHECKED:
+        p = REPO / entry
+        yield from (sorted(p.rglob("*.py")) if p.is_dir() else [p])
+
+
+def _nested_imports(path: Path):
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    for fn in ast.walk(tree):
+        if isinstance(fn, (ast.FunctionDef, ast.AsyncFunctionDef)):
+            for node in ast.walk(fn):
+                if isinstance(node, (ast.Import, ast.ImportFrom)):
+                    yield node
+
+
+def test_each_import_inside_a_function_names_its_cost():
+    missing = []
+    for path in _files():
+        if "generated" in path.parts:
+            continue
+        lines = path.read_text(encoding="utf-8").splitlines()
+        for node in _nested_imports(path):
+            context = "\n".join(lines[max(0, node.lineno - 6):node.end_lineno])
+            if not REASON.search(context):
+                missing.append(f"{path.relative_to(REPO)}:{node.lineno}")
+    assert not missing, missing
