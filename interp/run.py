@@ -429,7 +429,8 @@ def _setup(program: Path, workspace, options: dict, shown=lambda text: text) -> 
     from robot.mada import MachineDataError  # noqa: PLC0415
     from robot.stimuli import StimulusError  # noqa: PLC0415
 
-    if not program.is_file():
+    if not program.exists():
+        # a FIFO, socket or device exists: the reader (krl.source) refuses it with its reason
         raise RunSetupError(f"{shown(printable(program))}: no such file")
     if workspace is not None and not workspace.is_dir():
         raise RunSetupError(f"{shown(printable(workspace))}: no such folder")
