@@ -15,6 +15,7 @@ import time
 
 import pytest
 
+import krl.syntax.engines as engines_mod
 import krl.workspace as workspace_mod
 from krl.syntax.engines import java as java_engine
 from krl.syntax.engines import java_answers, parse_file, result_from_answer
@@ -104,7 +105,8 @@ def test_java_answers_hands_every_unanswered_file_to_python(monkeypatch):
                 yield k, {"id": k, "stage": "sll", "lex": [], "syn": []}
             raise java_engine.WorkerError("the Java worker exited")
 
-    monkeypatch.setattr(java_engine, "worker_for", lambda *a, **k: Dying())
+    # java_answers calls the name krl.syntax.engines imported (its import sits at the top)
+    monkeypatch.setattr(engines_mod, "worker_for", lambda *a, **k: Dying())
     sources = [SourceText(f"f{i}.src", "DEF f()\nEND\n", "ascii", 12) for i in range(6)]
     sources.append(SourceText("bin.src", "", "", 3, "binary"))
     got = list(java_answers(enumerate(sources)))
