@@ -17,7 +17,6 @@ from pathlib import Path
 
 import yaml
 
-from krl.store import stored
 
 DATA_DIR = Path(__file__).parent / "data"
 
@@ -129,9 +128,9 @@ def _read(name: str) -> dict:
 
 @lru_cache(maxsize=1)
 def load_builtins() -> Builtins:
-    """Read the three data tables (cached, and kept across processes: krl/store.py). Raises
-    ValueError for a malformed table."""
-    return stored("builtins", (), _load_builtins)
+    """Read the three data tables (cached per process). Raises ValueError for a malformed
+    table."""
+    return _load_builtins()
 
 
 def _load_builtins() -> Builtins:

@@ -1,0 +1,210 @@
+"""Parse entries of the one store (krl/store.py): a file's parse (krl/workspace.py
+``LoadedFile``) as bytes and back, and a program's files loaded from the store by content hash
+(:func:`load_project`), so that ``krl run``, ``krl debug``, ``krl check`` and the language server
+parse a file once and share what they parsed.
+
+The codec is msgpack by a schema (:func:`encode_loaded`): an AST node is its class's number in
+:data:`krl.ast.nodes` (sorted by name) and its fields in declaration order, a diagnostic its
+fields; the entry is path-free (the path is given when it is decoded). Decoding builds only
+those classes, checks every node's field count and every diagnostic's field types: anything
+else raises :class:`CorruptEntry` and the caller parses the file again. Nothing is ever
+unpickled or evaluated (docs/security.md, "The cache").
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+
+import msgpack
+
+from krl.ast import nodes as N
+from krl.diagnostics import Diagnostic, Note
+from krl.files import Entry
+from krl.source import read_source
+from krl.store import Store, parse_key, shared_store
+from krl.workspace import LoadedFile, Workspace, failed_load, load_batch, load_parsed
+
+
+_CLASSES = sorted((c for c in vars(N).values() if isinstance(c, type) and dataclasses.is_dataclass(c)
+                   and issubclass(c, N.Node)), key=lambda c: c.__name__)
+_INDEX = {c: i for i, c in enumerate(_CLASSES)}
+_POS = [tuple(f.name for f in dataclasses.fields(c) if f.name not in ("span", "ann") and not f.kw_only)
+        for c in _CLASSES]
+_KW = [tuple(f.name for f in dataclasses.fields(c) if f.name not in ("span", "ann") and f.kw_only)
+       for c in _CLASSES]
+_LIST, _TUPLE = -1, -2
+
+
+class CorruptEntry(ValueError):
+    """An entry that does not decode to what this codec writes."""
+
+
+# ---------------------------------------------------------------------- the codec
+
+def _enc(v):
+    if isinstance(v, N.Node):
+        i = _INDEX[type(v)]
+        return [i, v.span.line, v.span.column, *[_enc(getattr(v, f)) for f in _POS[i]],
+                *[_enc(getattr(v, f)) for f in _KW[i]]]
+    if type(v) is list:
+        return [_LIST, *[_enc(x) for x in v]]
+    if type(v) is tuple:
+        return [_TUPLE, *[_enc(x) for x in v]]
+    if v is None or type(v) in (int, float, str, bool):
+        return v
+    raise TypeError(f"no cache encoding for {type(v).__name__}")
+
+
+def _dec(v, path: str):
+    if type(v) is not list:
+        if v is None or type(v) in (int, float, str, bool):
+            return v
+        raise CorruptEntry(f"unexpected {type(v).__name__}")
+    tag = v[0]
+    if tag == _LIST:
+        return [_dec(x, path) for x in v[1:]]
+    if tag == _TUPLE:
+        return tuple(_dec(x, path) for x in v[1:])
+    if type(tag) is not int or not 0 <= tag < len(_CLASSES):
+        raise CorruptEntry("not a node")
+    pos, kw = _POS[tag], _KW[tag]
+    n = 3 + len(pos)
+    if len(v) != n + len(kw) or type(v[1]) is not int or type(v[2]) is not int:
+        raise CorruptEntry("a node of another shape")
+    return _CLASSES[tag](*[_dec(x, path) for x in v[3:n]], span=N.Span(path, v[1], v[2]),
+                         **{k: _dec(x, path) for k, x in zip(kw, v[n:])})
+
+
+_DIAG = (int, int, str, str, str, int, int, str, list)
+
+
+def _enc_diag(d: Diagnostic) -> list:
+    return [d.line, d.column, d.code, d.message, d.severity, d.end_line, d.end_column, d.help,
+            [[n.path, n.line, n.column, n.message] for n in d.notes]]
+
+
+def _dec_diag(x, path: str) -> Diagnostic:
+    if type(x) is not list or len(x) != len(_DIAG) or not all(type(a) is t for a, t in zip(x, _DIAG)):
+        raise CorruptEntry("not a diagnostic")
+    notes = []
+    for n in x[8]:
+        if type(n) is not list or len(n) != 4 or [type(a) for a in n] != [str, int, int, str]:
+            raise CorruptEntry("not a note")
+        notes.append(Note(*n))
+    return Diagnostic(path, x[0], x[1], x[2], x[3], x[4], x[5], x[6], notes, x[7])
+
+
+def encode_loaded(lf: LoadedFile) -> bytes | None:
+    """The entry of one file, None when it cannot be cached (a diagnostic of another file)."""
+    if any(d.path != lf.path or any(n.path != lf.path for n in d.notes) for d in lf.diagnostics):
+        return None
+    try:
+        body = [_enc(lf.module), lf.ok, lf.status, [_enc_diag(d) for d in lf.diagnostics], lf.unreadable,
+                sorted(lf.failed_words), sorted(lf.template[0]), sorted(lf.template[1])]
+        return msgpack.packb(body, use_bin_type=True)
+    except (TypeError, ValueError, OverflowError):
+        return None
+
+
+def decode_loaded(data: bytes, path: str) -> LoadedFile:
+    """The LoadedFile of an entry for the file `path`. Raises CorruptEntry."""
+    try:
+        body = msgpack.unpackb(data, raw=False, use_list=True, strict_map_key=True)
+        if type(body) is not list or len(body) != 8:
+            raise CorruptEntry("not an entry")
+        module = _dec(body[0], path)
+        ok, status, diags, unreadable, words, ini, inline = body[1:]
+        if not isinstance(module, N.Module) or type(ok) is not bool or type(status) is not str \
+                or type(unreadable) is not bool or not all(type(w) is str for w in words) \
+                or not all(type(x) is int for x in (*ini, *inline)):
+            raise CorruptEntry("not an entry")
+        module.path = path
+        return LoadedFile(path, module, ok, status, 0.0, 0.0, [_dec_diag(d, path) for d in diags], unreadable,
+                          set(words), (frozenset(ini), frozenset(inline)))
+    except CorruptEntry:
+        raise
+    except (ValueError, TypeError, RecursionError, msgpack.exceptions.ExtraData) as exc:
+        raise CorruptEntry(str(exc)) from None
+
+
+def encode_diagnostics(diags: list[Diagnostic]) -> bytes:
+    return msgpack.packb([[d.path, *_enc_diag(d)] for d in diags], use_bin_type=True)
+
+
+def decode_diagnostics(data: bytes) -> list[Diagnostic]:
+    """Raises CorruptEntry."""
+    try:
+        rows = msgpack.unpackb(data, raw=False, use_list=True)
+        if type(rows) is not list:
+            raise CorruptEntry("not a list")
+        out = []
+        for r in rows:
+            if type(r) is not list or not r or type(r[0]) is not str:
+                raise CorruptEntry("not a diagnostic")
+            out.append(_dec_diag(r[1:], r[0]))
+        return out
+    except CorruptEntry:
+        raise
+    except (ValueError, TypeError, msgpack.exceptions.ExtraData) as exc:
+        raise CorruptEntry(str(exc)) from None
+
+
+# ---------------------------------------------------------------------- loading through the store
+
+def load_files(paths: list, timeout: float | None = None, store: Store | None = None) -> list[LoadedFile]:
+    """The LoadedFile of each of `paths`, in order: from the store (`store`, default the
+    process's :func:`krl.store.shared_store`) by content hash, the others parsed (in worker
+    processes with `timeout` seconds per file, as :meth:`krl.workspace.Workspace.add_files`,
+    else here by the Python engine) and put in the store. Never raises for bad content."""
+    store = shared_store() if store is None else store
+    sources = [read_source(p) for p in paths]
+    keys = {i: parse_key(s.sha, s.path) for i, s in enumerate(sources) if s.status == "ok" and s.sha}
+    out: list = [None] * len(sources)
+    if keys and store.db is not None:
+        data = store.get("parse", sorted(set(keys.values())))
+        for i, key in keys.items():
+            got = data.get(key)
+            if got is not None:
+                try:
+                    out[i] = decode_loaded(got, sources[i].path)
+                except CorruptEntry:
+                    store.corrupt += 1
+    missing = [i for i, lf in enumerate(out) if lf is None]
+    if not missing:
+        return out
+    failed = set()          # stopped past the timeout or a dead worker: never kept
+    if timeout is None:
+        for i in missing:
+            out[i] = load_parsed(sources[i])
+    else:
+        for i, o in zip(missing, load_batch([sources[i].path for i in missing], timeout)):
+            if o.status == "done":
+                out[i] = o.value
+            else:
+                out[i] = failed_load(sources[i].path, o, timeout)
+                failed.add(i)
+    if store.db is not None:
+        store.put("parse", {keys[i]: e for i in missing if i in keys and i not in failed
+                            and (e := encode_loaded(out[i])) is not None})
+    return out
+
+
+def load_file(path) -> LoadedFile:
+    """One file's LoadedFile through the store (:func:`load_files`)."""
+    return load_files([path])[0]
+
+
+def load_project(project, root: str = "", timeout: float | None = None, extra: list[Path] = (),
+                 store: Store | None = None) -> Workspace:
+    """:func:`krl.workspace.load_project` with the files' parses from the store: the same
+    workspace (files in the same order, the same diagnostics), not checked yet."""
+    ws = Workspace(root or str(project.root))
+    files = project.files
+    more = [f for f in extra if f not in files]
+    entries = project.entries + [Entry(f, f.name, "file") for f in more]
+    paths = [e.path for e in entries if e.kind == "file"]
+    for lf in load_files(paths, timeout, store):
+        ws.add_loaded(lf, notify=timeout is None)
+    ws.add_unread(entries)
+    return ws
