@@ -14,6 +14,7 @@ unpickled or evaluated (docs/security.md, "The cache").
 from __future__ import annotations
 
 import dataclasses
+from contextlib import contextmanager
 from pathlib import Path
 
 import msgpack
@@ -23,7 +24,7 @@ from krl.diagnostics import Diagnostic, Note
 from krl.files import Entry
 from krl.source import read_source
 from krl.store import Store, parse_key, shared_store
-from krl.workspace import LoadedFile, Workspace, failed_load, load_batch, load_parsed
+from krl.workspace import LoadedFile, Workspace, failed_load, load_batch, load_parsed, loading_files_by
 
 
 _CLASSES = sorted((c for c in vars(N).values() if isinstance(c, type) and dataclasses.is_dataclass(c)
@@ -152,11 +153,13 @@ def decode_diagnostics(data: bytes) -> list[Diagnostic]:
 
 # ---------------------------------------------------------------------- loading through the store
 
-def load_files(paths: list, timeout: float | None = None, store: Store | None = None) -> list[LoadedFile]:
+def load_files(paths: list, timeout: float | None = None, store: Store | None = None,
+               jobs: int | None = None) -> list[LoadedFile]:
     """The LoadedFile of each of `paths`, in order: from the store (`store`, default the
     process's :func:`krl.store.shared_store`) by content hash, the others parsed (in worker
-    processes with `timeout` seconds per file, as :meth:`krl.workspace.Workspace.add_files`,
-    else here by the Python engine) and put in the store. Never raises for bad content."""
+    processes with `timeout` seconds per file and `jobs` workers, as
+    :meth:`krl.workspace.Workspace.add_files`, else here by the Python engine) and put in the
+    store. Never raises for bad content."""
     store = shared_store() if store is None else store
     sources = [read_source(p) for p in paths]
     keys = {i: parse_key(s.sha, s.path) for i, s in enumerate(sources) if s.status == "ok" and s.sha}
@@ -178,7 +181,7 @@ def load_files(paths: list, timeout: float | None = None, store: Store | None = 
         for i in missing:
             out[i] = load_parsed(sources[i])
     else:
-        for i, o in zip(missing, load_batch([sources[i].path for i in missing], timeout)):
+        for i, o in zip(missing, load_batch([sources[i].path for i in missing], timeout, jobs)):
             if o.status == "done":
                 out[i] = o.value
             else:
@@ -208,3 +211,12 @@ def load_project(project, root: str = "", timeout: float | None = None, extra: l
         ws.add_loaded(lf, notify=timeout is None)
     ws.add_unread(entries)
     return ws
+
+
+@contextmanager
+def through_store(store: Store | None = None):
+    """``with through_store():`` every workspace loaded in the block (krl.workspace
+    ``load_workspace``, ``workspaces_for``: ``krl check``) takes its files' parses from the
+    store (:func:`load_files`)."""
+    with loading_files_by(lambda paths, timeout, jobs: load_files(paths, timeout, store, jobs)):
+        yield
