@@ -27,6 +27,28 @@ def spans(m):
     return [(type(n).__name__, n.span.file, n.span.line, n.span.column, getattr(n, "end_line", 0)) for n in m.walk()]
 
 
+def reference_entry(lf) -> bytes:
+    """The entry's bytes as the cache's schema describes them (krl/lsp/cache.py), written out
+    plainly: the on-disk format must not change with the codec's implementation."""
+    import dataclasses
+
+    def enc(v):
+        if isinstance(v, C.N.Node):
+            fields = [f for f in dataclasses.fields(v) if f.name not in ("span", "ann")]
+            fields = [f for f in fields if not f.kw_only] + [f for f in fields if f.kw_only]
+            return [C._INDEX[type(v)], v.span.line, v.span.column, *[enc(getattr(v, f.name)) for f in fields]]
+        if type(v) is list:
+            return [C._LIST, *map(enc, v)]
+        if type(v) is tuple:
+            return [C._TUPLE, *map(enc, v)]
+        assert v is None or type(v) in (int, float, str, bool), type(v)
+        return v
+    diags = [[d.line, d.column, d.code, d.message, d.severity, d.end_line, d.end_column, d.help,
+              [[n.path, n.line, n.column, n.message] for n in d.notes]] for d in lf.diagnostics]
+    return msgpack.packb([enc(lf.module), lf.ok, lf.status, diags, lf.unreadable, sorted(lf.failed_words),
+                          sorted(lf.template[0]), sorted(lf.template[1])], use_bin_type=True)
+
+
 def test_entries_decode_to_what_was_parsed(shared_corpus: Path):
     """Every file of a real backup: AST (spans included), diagnostics, template folds, status."""
     backup = shared_corpus / "rawpython__kukaKRLmagic"
@@ -36,6 +58,7 @@ def test_entries_decode_to_what_was_parsed(shared_corpus: Path):
         lf = load_file(f)
         data = C.encode_loaded(lf)
         assert data is not None, f
+        assert data == reference_entry(lf), f
         back = C.decode_loaded(data, lf.path)
         assert back.module == lf.module and spans(back.module) == spans(lf.module), f
         assert rows(back.diagnostics) == rows(lf.diagnostics)
@@ -49,10 +72,21 @@ def test_entries_decode_to_what_was_parsed(shared_corpus: Path):
     [[C._INDEX[C.N.Module], 1, 1], True, "ok", [], False, [], [], []],     # a node of another shape
     [None, True, "ok", [], False, [], [], []],       # not a module
     [[C._INDEX[C.N.Module], 1, 1, [C._LIST], [C._LIST], None, "x"], True, "ok", [[1, 1, "E", "m"]], False, [], [], []],
+    # a valid empty module ([C._INDEX[C.N.Module], 1, 1, "p", "src", [C._LIST], [C._LIST], None]) changed:
+    [[C._INDEX[C.N.Module], 1, 1, "p", b"", [C._LIST], [C._LIST], None], True, "ok", [], False, [], [], []],  # bytes
+    [[C._INDEX[C.N.Module], 1, 1, "p", "src", {}, [C._LIST], None], True, "ok", [], False, [], [], []],     # a map
+    [[C._INDEX[C.N.Module], 1, 1, "p", "src", [C._LIST], [C._LIST, [7]], None], True, "ok", [], False, [], [], []],
+    [[C._INDEX[C.N.Module], 1, 1, "p", "src", [C._LIST], [C._LIST], None], True, "ok", [], False, [], [], [], 0],
 ])
 def test_a_hostile_entry_is_refused(body):
     with pytest.raises(C.CorruptEntry):
-        C.decode_loaded(msgpack.packb(body), "/w/x.src")
+        C.decode_loaded(msgpack.packb(body, use_bin_type=True), "/w/x.src")
+
+
+def test_the_valid_entry_the_hostile_ones_change_decodes():
+    body = [[C._INDEX[C.N.Module], 1, 1, "p", "src", [C._LIST], [C._LIST], None], True, "ok", [], False, [], [], []]
+    lf = C.decode_loaded(msgpack.packb(body, use_bin_type=True), "/w/x.src")
+    assert lf.module == C.N.Module("/w/x.src", "src", [], [], None) and lf.ok
 
 
 def test_the_cache_serves_a_workspace_opened_again(tmp_path: Path):
