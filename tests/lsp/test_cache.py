@@ -164,3 +164,27 @@ def test_the_cached_diagnostics_come_before_any_parse_is_decoded(tmp_path: Path,
         monkeypatch.undo()
         assert events[0] == rows(expected) == rows(an.ws.diagnostics)
         assert events.count("decoded") >= 4 and len([e for e in events if e != "decoded"]) == 1
+
+
+def test_deferred_parse_entries_are_written_later_and_open_files_at_once(tmp_path: Path):
+    """The server's way (Project(defer_writes=True)): the open file's entry is written before the
+    check, the others by write_cache, step by step; a file opened in between is left out."""
+    shutil.copytree(BACKUP, tmp_path / "KRC")
+    main = norm(tmp_path / "KRC" / "R1" / "Program" / "main.src")
+    tools = norm(tmp_path / "KRC" / "R1" / "Program" / "tools.src")
+    store = C.Store(tmp_path / "cache")
+    first = Project(store=store, defer_writes=True)
+    first.open(main, Path(main).read_text())
+    an = first.analyze(main)
+    count = lambda: store.db.execute("SELECT COUNT(*) FROM entries WHERE kind = 'parse'").fetchone()[0]  # noqa: E731
+    assert count() == 1                                 # main.src, the open file
+    assert sorted(p for _k, p, _lf in first.unwritten) == sorted(set(an.files) - {main})
+    first.open(tools, Path(tools).read_text())          # opened before its entry is written
+    assert first.write_cache(1) == len(an.files) - 2
+    assert first.write_cache() == 0 and not first.unwritten
+    assert count() == len(an.files) - 1                 # all but tools.src
+    again = Project(store=store)
+    hits = store.hits
+    an2 = again.analyze(main, docs={})
+    assert store.hits - hits == len(an.files) - 1
+    assert rows(an2.ws.diagnostics) == rows(an.ws.diagnostics)
