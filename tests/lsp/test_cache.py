@@ -188,3 +188,48 @@ def test_deferred_parse_entries_are_written_later_and_open_files_at_once(tmp_pat
     an2 = again.analyze(main, docs={})
     assert store.hits - hits == len(an.files) - 1
     assert rows(an2.ws.diagnostics) == rows(an.ws.diagnostics)
+
+
+def _backups():
+    from krl.lsp.bench import corpus_backups  # noqa: PLC0415 - the bench's list: each KRC backup as it is
+    from tests.conftest import SHARED  # noqa: PLC0415
+    if not (SHARED / "krl-corpus").is_dir():
+        return []
+    return [pytest.param(root, largest, id=label) for label, root, largest in corpus_backups(SHARED / "krl-corpus")]
+
+
+@pytest.mark.parametrize("root,largest", _backups())
+def test_every_corpus_backup_gives_krl_checks_diagnostics_cold_and_from_the_cache(tmp_path: Path, root: Path,
+                                                                                  largest: Path):
+    """The server's way on each corpus backup as it is (its largest file open, as the bench
+    does): cold (parse entries written after the check), from the cache, and the cached
+    diagnostics shown before the check: all exactly those of ``krl check``'s pipeline on the
+    same files (krl/workspace.py: each file loaded whole by its loader, then checked)."""
+    from krl.limits import PARSE_TIMEOUT_S  # noqa: PLC0415
+    from krl.source import decode_bytes  # noqa: PLC0415
+    from krl.workspace import Workspace, load_batch  # noqa: PLC0415
+
+    store = C.Store(tmp_path / "cache")
+    path = norm(largest)
+    text = decode_bytes(largest.read_bytes())[0]
+    expected = None
+    for run in ("cold", "warm"):
+        p = Project(store=store, defer_writes=True)
+        p.open(path, text)
+        cached: list = []
+        an = p.analyze(path, on_cached=lambda _root, diags: cached.append(diags))
+        if expected is None:
+            ref = Workspace(an.root)
+            for o in load_batch(list(an.files), PARSE_TIMEOUT_S):
+                ref.add_loaded(o.value, notify=False)
+            ref.add_unread(p.workspace_files(path)[2])
+            ref.check()
+            expected = rows(ref.diagnostics)
+            assert expected
+        assert rows(an.ws.diagnostics) == expected, run
+        if run == "cold":
+            assert not cached and p.unwritten
+            assert p.write_cache() == 0
+        else:
+            assert cached and sorted(rows(cached[0])) == sorted(expected)
+            assert store.corrupt == 0 and store.hits >= len(an.files)
