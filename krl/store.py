@@ -38,6 +38,7 @@ from pathlib import Path
 from krl.limits import MAX_CACHE_BYTES, MAX_CACHE_ENTRY_BYTES
 
 log = logging.getLogger("krl.store")
+log.addHandler(logging.NullHandler())   # a command's standard error never gets it unless logging is set up
 #: the codec's name and version: part of :func:`front_end_version`
 CODEC = "krl-store 2 (msgpack by schema)"
 LOCK_WAIT_S = 5.0
