@@ -19,6 +19,7 @@ from pathlib import Path
 import msgpack
 import yaml
 
+from krl.store import Store, shared_store
 
 DATA_DIR = Path(__file__).parent / "data"
 
@@ -132,8 +133,6 @@ def _read(name: str, store=None) -> dict:
     ``table``, keyed by the SHA-256 of the file's bytes) when it holds it: msgpack of the plain
     document (dicts, lists, scalars), kept only when it reads back equal. A stored entry that
     does not unpack to a mapping is corrupt: the YAML is read again."""
-    from krl.store import shared_store  # noqa: PLC0415
-
     raw = (DATA_DIR / name).read_bytes()
     key = f"{hashlib.sha256(raw).hexdigest()}:{name}"
     store = shared_store() if store is None else store
@@ -160,12 +159,16 @@ def _read(name: str, store=None) -> dict:
 def load_builtins() -> Builtins:
     """Read the data tables (cached per process; each document from the one store when it
     holds it, :func:`_read`). Raises ValueError for a malformed table."""
+    return _builtins()
+
+
+def _builtins() -> Builtins:
+    """The tables from the store's documents, or from the YAML files when a stored document
+    misleads the reader (a corrupt entry: made anew)."""
     try:
         return _load_builtins()
     except (ValueError, KeyError, TypeError, AttributeError):
-        from krl.store import Store  # noqa: PLC0415
-
-        return _load_builtins(Store(enabled=False))     # a stored document that misleads: the YAML
+        return _load_builtins(Store(enabled=False))
 
 
 def _load_builtins(store=None) -> Builtins:

@@ -199,6 +199,18 @@ def test_the_store_never_unpickles(cache, tmp_path, monkeypatch):
         assert "pickle" not in text.replace("unpickled", "").replace("pickles", ""), module
 
 
+@pytest.mark.parametrize("data", [msgpack.packb([1, 2]), msgpack.packb({"x": msgpack.ExtType(1, b"x")}),
+                                  msgpack.packb({"types": 5, "functions": "x"})])
+def test_a_corrupt_table_entry_is_read_from_the_yaml_again(cache, data):
+    from krl.semantics import builtins as B
+    fresh = B._load_builtins(store.Store(enabled=False))
+    B._load_builtins()                                  # fills the store
+    digest = hashlib.sha256(data).digest()
+    with sqlite3.connect(_database(cache)) as db:
+        assert db.execute("UPDATE entries SET data = ?, digest = ? WHERE kind = 'table'", (data, digest)).rowcount == 4
+    assert B._builtins() == fresh
+
+
 def test_krl_store_0_keeps_nothing(cache, monkeypatch):
     monkeypatch.setenv("KRL_STORE", "0")
     load_files([BACKUP / "R1" / "Program" / "main.src"])
