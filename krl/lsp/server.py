@@ -102,6 +102,7 @@ class KrlLanguageServer(LanguageServer):
         self.project = Project(store=None, threaded=True, defer_writes=True)
         self._store_ready = threading.Event()
         self._writing = False
+        self._edits_warm = False
         # the cache is opened beside the start-up (its version hashes the krl package's sources)
         threading.Thread(target=self._open_store, name="krl-cache", daemon=True).start()
         self.debounce_s = DEBOUNCE_S
@@ -214,6 +215,8 @@ class KrlLanguageServer(LanguageServer):
                 # unfrozen here and collected as usual.
                 gc.unfreeze()
                 gc.freeze()
+            if an.how == "workspace":
+                self.warm_edits({p: t for p, t in docs.items() if p in an.files})
             self.write_cache_later()
             return an
 
@@ -289,6 +292,26 @@ class KrlLanguageServer(LanguageServer):
             except Exception as exc:  # noqa: BLE001 - only a head start
                 log.error("warming up failed: %s", printable(exc), exc_info=TRACEBACKS["on"])
         threading.Thread(target=run, name="krl-warm", daemon=True).start()
+
+    def warm_edits(self, docs: dict[str, str]) -> None:
+        """Once, after the first whole analysis: the fast engine parses the open documents with
+        their trees, as it parses an edited piece, in the background. After a start from the
+        cache it had parsed nothing but the warm-up sample, and its JIT compiled the tree
+        answers during the first edits (KRC4_test bas.src, 20 value edits, server CPU per edit
+        p50/p95 30/70 ms from the cache against 20/30 ms after a cold start, 2026-11-24)."""
+        if self._edits_warm:
+            return
+        self._edits_warm = True
+        sources = [SourceText(p, t, "", len(t.encode("utf-8", "surrogatepass"))) for p, t in docs.items()]
+
+        def run() -> None:
+            try:
+                if sources and resolve() == "java":
+                    for _ in java_answers(enumerate(sources), threads=default_jobs(), trees=True, decode=False):
+                        pass
+            except Exception as exc:  # noqa: BLE001 - only a head start (EngineUnavailable included)
+                log.error("warming up for edits failed: %s", printable(exc), exc_info=TRACEBACKS["on"])
+        threading.Thread(target=run, name="krl-warm-edits", daemon=True).start()
 
     def schedule(self, path: str, delay: float | None = None) -> None:
         """Analyse the workspace of `path` after `delay` seconds (a newer change restarts it).
