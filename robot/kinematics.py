@@ -21,7 +21,9 @@ chain, never from the robot's name (:attr:`Kinematics.family`):
   the ``mink`` library from seeds), with the same status/turn selection and errors.
 
 Each analytic form is checked against the machine-data chain when it is chosen. A vectorised
-entry point, :meth:`Kinematics.inverse_many`, solves N targets at once with numpy.
+entry point, :meth:`Kinematics.inverse_many`, solves N targets at once with numpy. For the OPW
+family, :meth:`Kinematics.inverse` runs the compiled mirror of its Python code when it is built
+(robot/ikcore.pyx, robot/build.py; the same axes bit for bit, about 20x faster).
 """
 
 from __future__ import annotations
@@ -37,6 +39,11 @@ from .errors import SoftLimitError, WorkspaceError
 from .frames import as_matrix, inv_pos
 from .machine import MachineData, load_machine
 
+try:  # the compiled OPW inverse (robot/build.py); absent without a build: the Python code runs
+    from . import ikcore as _ikcore
+except ImportError:
+    _ikcore = None
+
 #: Values closer than this to a status/turn switching point count as "on" it (deg, mm).
 BOUNDARY_EPS = 1e-9
 #: |A5| (deg) below which the wrist is treated as singular (A4 + A6 only defined).
@@ -47,11 +54,25 @@ OVERHEAD_SINGULAR_MM = 1e-6
 _ACOS_TOL = 1e-9
 #: Tolerance of the soft-limit test (deg), absorbs floating-point noise.
 LIMIT_EPS_DEG = 1e-9
+#: Use the compiled OPW inverse (robot/ikcore.pyx) when it is built; False: the Python code
+#: (the reference: the two agree bit for bit, tests/robot/test_ikcore.py)
+USE_COMPILED = True
+#: The ``ABI`` of robot/ikcore.pyx this module mirrors (a stale build is not used)
+IKCORE_ABI = 1
 
 
 def _wrap180(v: np.ndarray) -> np.ndarray:
     """Wrap angles (deg) to (-180, 180]."""
     return -((-np.asarray(v, dtype=float) + 180.0) % 360.0) + 180.0
+
+
+def _compiled_opw(kin: "Kinematics") -> Any:
+    """The compiled OPW inverse of `kin` (robot/ikcore.pyx, built by robot/build.py), or False
+    when the extension is not built, is stale (its ``ABI``) or :data:`USE_COMPILED` is off."""
+    if not USE_COMPILED or _ikcore is None or getattr(_ikcore, "ABI", None) != IKCORE_ABI:
+        return False
+    return _ikcore.OPW(kin._opw, kin._kappa_2, kin._c2_2, kin._k, kin._at23, kin.phi_deg, kin._sgn,
+                      kin._offs, kin._lo_l, kin._hi_l, kin._ks_l, kin._s_free, kin._t_free)
 
 
 class Kinematics:
@@ -102,6 +123,7 @@ class Kinematics:
         self._numeric: Any = None   # the numeric solver (robot/ik_numeric.py), built on first use
         self._base_inv: np.ndarray | None = None   # INV(frame before the OPW arm), None: identity
         self._end_inv: np.ndarray | None = None    # INV(frame after it)
+        self._c_opw: Any = None     # robot/ikcore.pyx's OPW for this robot; False: not used
         self._s_free = 0            # S bits that select nothing on this robot
         self._t_free = 0            # T bits that select nothing on this robot
         #: the inverse kinematics of this robot: "opw", "palletizer4", "palletizer5" or "numeric"
@@ -147,6 +169,7 @@ class Kinematics:
 
     def _set_opw(self, o) -> None:
         self._opw = o
+        self._c_opw = None
         self._sign = np.array(o.sign_corrections, dtype=float)
         self._off = np.radians(np.array(o.offsets_deg, dtype=float))
         self._kappa_2 = o.a2 * o.a2 + o.c3 * o.c3
@@ -536,6 +559,19 @@ class Kinematics:
                 ``$SOFTN_END``/``$SOFTP_END``.
         """
         ref = self._home.copy() if reference_deg is None else np.asarray(reference_deg, dtype=float)[:6]
+        c = self._c_opw
+        if c is None and self.family == "opw" and self._pa is None and self._pa5 is None:
+            c = self._c_opw = _compiled_opw(self)
+        if c:
+            # the compiled mirror of _opw_core + _select (robot/ikcore.pyx); None: Python decides
+            T = np.asarray(flange_T, dtype=float)
+            if self._base_inv is not None:
+                T = self._base_inv @ T
+            if self._end_inv is not None:
+                T = T @ self._end_inv
+            q = c.inverse(T, status, turn, ref)
+            if q is not None:
+                return q
         if self.family == "numeric" and reference_deg is not None:
             # the solution reached from the reference: the nearest one, when its S and T fit
             if self._numeric is None:
