@@ -560,8 +560,8 @@ class Kinematics:
         """
         ref = self._home.copy() if reference_deg is None else np.asarray(reference_deg, dtype=float)[:6]
         c = self._c_opw
-        if c is None and self.family == "opw" and self._pa is None and self._pa5 is None:
-            c = self._c_opw = _compiled_opw(self)
+        if c is None:
+            c = self._compiled()
         if c:
             # the compiled mirror of _opw_core + _select (robot/ikcore.pyx); None: Python decides
             T = np.asarray(flange_T, dtype=float)
@@ -583,6 +583,18 @@ class Kinematics:
                 except (WorkspaceError, SoftLimitError):
                     pass
         return self._select(self._opw_rows(flange_T, ref), status, turn, ref)
+
+    def _compiled(self) -> Any:
+        """The compiled OPW inverse of this robot (kept), or False (not built, not the OPW family)."""
+        if self._c_opw is None:
+            ok = self.family == "opw" and self._pa is None and self._pa5 is None
+            self._c_opw = _compiled_opw(self) if ok else False
+        return self._c_opw
+
+    @property
+    def compiled_inverse(self) -> bool:
+        """True when :meth:`inverse` runs the compiled OPW code (robot/ikcore.pyx)."""
+        return bool(self._compiled())
 
     def _select(self, rows: list[list[float]], status: int | None, turn: int | None,
                 ref: np.ndarray) -> np.ndarray:
