@@ -1,11 +1,11 @@
-"""Build the compiled inverse kinematics of the simulator: robot/ikcore.pyx compiled by Cython
-into an extension module beside it (``ikcore.*.so``; gitignored). Issue 39, "Simulator".
+"""Build the compiled inverse kinematics of the simulator: robot/simcore.pyx compiled by Cython
+into an extension module beside it (``simcore.*.so``; gitignored). Issue 39, "Simulator".
 
 One definition (:func:`extension`), two ways in, as for the VM loop (interp/vm/build.py):
 
 * the package build: ``setup.py`` loads this file by path and gives :func:`cythonized` to
   setuptools, so ``pip install``, ``pip install -e`` (which ``make`` runs) and the wheel carry it;
-* ``python -m robot.build`` (``make sim-core``): rebuilds it in place after ikcore.pyx changed.
+* ``python -m robot.build`` (``make sim-core``): rebuilds it in place after simcore.pyx changed.
 
 Without Cython or a C compiler the build says so and succeeds; robot/kinematics.py then runs
 its pure-Python OPW code, which the extension mirrors bit for bit (``-ffp-contract=off``: no
@@ -21,15 +21,15 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 REPO = HERE.parent
-SOURCE = HERE / "ikcore.pyx"
-MODULE = "robot.ikcore"
+SOURCE = HERE / "simcore.pyx"
+MODULE = "robot.simcore"
 #: C flags: optimised, and no contraction of a * b + c into one rounding (bit-identical results)
 CFLAGS = ["-O2", "-ffp-contract=off", "-fno-fast-math"]
 
 
 def target() -> Path:
     """The extension module's path for this interpreter."""
-    return HERE / ("ikcore" + sysconfig.get_config_var("EXT_SUFFIX"))
+    return HERE / ("simcore" + sysconfig.get_config_var("EXT_SUFFIX"))
 
 
 def extension(root: Path | None = None):
@@ -53,7 +53,7 @@ def cythonized(root: Path | None = None) -> list:
 
 
 def build(force: bool = False) -> str:
-    """Compile ikcore.pyx in place; the outcome in words. Raises nothing for a missing Cython
+    """Compile simcore.pyx in place; the outcome in words. Raises nothing for a missing Cython
     or compiler (the pure-Python inverse runs then)."""
     out = target()
     if not force and out.exists() and out.stat().st_mtime >= SOURCE.stat().st_mtime:

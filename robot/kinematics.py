@@ -23,7 +23,7 @@ chain, never from the robot's name (:attr:`Kinematics.family`):
 Each analytic form is checked against the machine-data chain when it is chosen. A vectorised
 entry point, :meth:`Kinematics.inverse_many`, solves N targets at once with numpy. For the OPW
 family, :meth:`Kinematics.inverse` runs the compiled mirror of its Python code when it is built
-(robot/ikcore.pyx, robot/build.py; the same axes bit for bit, about 20x faster).
+(robot/simcore.pyx, robot/build.py; the same axes bit for bit, about 20x faster).
 """
 
 from __future__ import annotations
@@ -40,9 +40,9 @@ from .frames import as_matrix, inv_pos
 from .machine import MachineData, load_machine
 
 try:  # the compiled OPW inverse (robot/build.py); absent without a build: the Python code runs
-    from . import ikcore as _ikcore
+    from . import simcore as _simcore
 except ImportError:
-    _ikcore = None
+    _simcore = None
 
 #: Values closer than this to a status/turn switching point count as "on" it (deg, mm).
 BOUNDARY_EPS = 1e-9
@@ -54,11 +54,11 @@ OVERHEAD_SINGULAR_MM = 1e-6
 _ACOS_TOL = 1e-9
 #: Tolerance of the soft-limit test (deg), absorbs floating-point noise.
 LIMIT_EPS_DEG = 1e-9
-#: Use the compiled OPW inverse (robot/ikcore.pyx) when it is built; False: the Python code
-#: (the reference: the two agree bit for bit, tests/robot/test_ikcore.py)
+#: Use the compiled OPW inverse (robot/simcore.pyx) when it is built; False: the Python code
+#: (the reference: the two agree bit for bit, tests/robot/test_simcore.py)
 USE_COMPILED = True
-#: The ``ABI`` of robot/ikcore.pyx this module mirrors (a stale build is not used)
-IKCORE_ABI = 1
+#: The ``ABI`` of robot/simcore.pyx this module mirrors (a stale build is not used)
+SIMCORE_ABI = 1
 
 
 def _wrap180(v: np.ndarray) -> np.ndarray:
@@ -67,11 +67,11 @@ def _wrap180(v: np.ndarray) -> np.ndarray:
 
 
 def _compiled_opw(kin: "Kinematics") -> Any:
-    """The compiled OPW inverse of `kin` (robot/ikcore.pyx, built by robot/build.py), or False
+    """The compiled OPW inverse of `kin` (robot/simcore.pyx, built by robot/build.py), or False
     when the extension is not built, is stale (its ``ABI``) or :data:`USE_COMPILED` is off."""
-    if not USE_COMPILED or _ikcore is None or getattr(_ikcore, "ABI", None) != IKCORE_ABI:
+    if not USE_COMPILED or _simcore is None or getattr(_simcore, "ABI", None) != SIMCORE_ABI:
         return False
-    return _ikcore.OPW(kin._opw, kin._kappa_2, kin._c2_2, kin._k, kin._at23, kin.phi_deg, kin._sgn,
+    return _simcore.OPW(kin._opw, kin._kappa_2, kin._c2_2, kin._k, kin._at23, kin.phi_deg, kin._sgn,
                       kin._offs, kin._lo_l, kin._hi_l, kin._ks_l, kin._s_free, kin._t_free)
 
 
@@ -123,7 +123,7 @@ class Kinematics:
         self._numeric: Any = None   # the numeric solver (robot/ik_numeric.py), built on first use
         self._base_inv: np.ndarray | None = None   # INV(frame before the OPW arm), None: identity
         self._end_inv: np.ndarray | None = None    # INV(frame after it)
-        self._c_opw: Any = None     # robot/ikcore.pyx's OPW for this robot; False: not used
+        self._c_opw: Any = None     # robot/simcore.pyx's OPW for this robot; False: not used
         self._s_free = 0            # S bits that select nothing on this robot
         self._t_free = 0            # T bits that select nothing on this robot
         #: the inverse kinematics of this robot: "opw", "palletizer4", "palletizer5" or "numeric"
@@ -563,7 +563,7 @@ class Kinematics:
         if c is None:
             c = self._compiled()
         if c:
-            # the compiled mirror of _opw_core + _select (robot/ikcore.pyx); None: Python decides
+            # the compiled mirror of _opw_core + _select (robot/simcore.pyx); None: Python decides
             T = np.asarray(flange_T, dtype=float)
             if self._base_inv is not None:
                 T = self._base_inv @ T
@@ -593,7 +593,7 @@ class Kinematics:
 
     @property
     def compiled_inverse(self) -> bool:
-        """True when :meth:`inverse` runs the compiled OPW code (robot/ikcore.pyx)."""
+        """True when :meth:`inverse` runs the compiled OPW code (robot/simcore.pyx)."""
         return bool(self._compiled())
 
     def _select(self, rows: list[list[float]], status: int | None, turn: int | None,

@@ -162,7 +162,7 @@ class RobotModel:
     @property
     def batch_ik(self) -> bool:
         """True when :meth:`ik_chain` solves in numpy (the OPW family, no external axes and
-        no linked $BASE, and no compiled inverse: robot/ikcore.pyx solves one pose faster than
+        no linked $BASE, and no compiled inverse: robot/simcore.pyx solves one pose faster than
         numpy's passes over a chain, measured); otherwise it returns None and callers solve
         cycle by cycle."""
         return (type(self) is RobotModel and not self.n_ext and self.kin.family == "opw"

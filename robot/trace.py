@@ -273,15 +273,21 @@ class TraceWriter:
             self.flush()
 
     def flush(self) -> None:
-        """Write the queued pose events. The line is formatted directly: the same bytes as
+        """Write the queued events: pose events and the events written after the first of
+        them, in order (the poses' X, Y, Z, A, B, C are converted in one batch: the conversion's
+        cost is mostly per call). A pose line is formatted directly: the same bytes as
         ``json.dumps`` of the event (``repr`` of each rounded float, ``-0.0`` written as 0),
         without its generic encoder and :func:`_clean`'s recursion (a quarter of the
         benchmark's time went here); a non-finite number takes the generic path."""
         if not self._poses:
             return
         poses, self._poses = self._poses, []
-        frames = _frames_of([T for _, _, T in poses])
-        for (t, axes, _), fr in zip(poses, frames):
+        frames = iter(_frames_of([T for t, _, T in poses if t is not None]))
+        for t, axes, line in poses:
+            if t is None:            # an event queued behind the poses (_emit)
+                self._write(axes, line)
+                continue
+            fr = next(frames)
             vals = axes.tolist() if hasattr(axes, "tolist") else axes
             ax = [_round6(float(v)) for v in vals]
             tcp = [_round6(v) for v in fr]
@@ -289,9 +295,9 @@ class TraceWriter:
             axs, tcs = ",".join(map(repr, ax)), ",".join(map(repr, tcp))
             ev = {"t": tt, "kind": "pose", "axes": ax, "tcp": tcp}
             if "n" in axs or "n" in tcs:  # nan / inf: json.dumps writes NaN / Infinity
-                self._emit(ev)
+                self._write(ev, json.dumps(ev, separators=(",", ":"), ensure_ascii=True))
             else:
-                self._emit(ev, f'{{"t":{tt!r},"kind":"pose","axes":[{axs}],"tcp":[{tcs}]}}')
+                self._write(ev, f'{{"t":{tt!r},"kind":"pose","axes":[{axs}],"tcp":[{tcs}]}}')
 
     def write_event(self, ev: dict[str, Any]) -> None:
         """Write an already built event dict (from :func:`make_event`)."""
@@ -312,8 +318,6 @@ class TraceWriter:
                     self._leave_out(ev["kind"], ev["t"])
                     return
             self._write_left(ev["t"])
-        if self._poses:
-            self.flush()
         self._emit(ev)
 
     def _leave_out(self, kind: str, t: float) -> None:
@@ -329,15 +333,20 @@ class TraceWriter:
             return
         left, self._left = self._left, {}
         since, self._left_since = self._left_since, None
-        if self._poses:
-            self.flush()
         self._emit(make_event("repeat", self._left_last if t is None else max(t, self._left_last),
                               count=sum(left.values()), since=since, kinds=dict(sorted(left.items()))))
 
     def _emit(self, ev: dict[str, Any], line: str | None = None) -> None:
-        """Keep and/or write event `ev`; `line` is its JSON text when the caller formatted it."""
+        """Keep and/or write event `ev`; `line` is its JSON text when the caller formatted it.
+        Behind queued poses the event waits in their queue (:meth:`flush` writes it in order)."""
         if line is None:
             line = json.dumps(ev, separators=(",", ":"), ensure_ascii=True)
+        if self._poses:
+            self._poses.append((None, ev, line))
+        else:
+            self._write(ev, line)
+
+    def _write(self, ev: dict[str, Any], line: str) -> None:
         if self.keep:
             self._events.append(ev)
         if self._memory:

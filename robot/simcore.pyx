@@ -4,7 +4,7 @@ robot/kinematics.py ``Kinematics._opw_core`` + ``_status_row`` + the selection o
 ``Kinematics._select`` for the six-axis arm with a spherical wrist, built by robot/build.py.
 
 Bit for bit the pure-Python code it mirrors, which stays the fallback (and the reference:
-tests/robot/test_ikcore.py compares the two on random poses): the same operations in the same
+tests/robot/test_simcore.py compares the two on random poses): the same operations in the same
 order on C doubles, libm's sin/cos/atan2/acos/sqrt (what Python's ``math`` calls), ``degrees``
 and ``radians`` as CPython's multiplications by 180/pi and pi/180, Python's float ``%`` as
 CPython's ``float_rem``, and no fused multiply-add (compiled with ``-ffp-contract=off``).

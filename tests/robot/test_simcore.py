@@ -1,4 +1,4 @@
-"""The compiled OPW inverse kinematics (robot/ikcore.pyx, built by robot/build.py; `make`
+"""The compiled OPW inverse kinematics (robot/simcore.pyx, built by robot/build.py; `make`
 builds it before the tests) against the pure-Python code it mirrors, the reference: the same
 axes bit for bit, and the same errors, on random poses of the KR 6 R900 and of a corpus
 KR 210 (issue 39, "Simulator": traces byte-identical)."""
@@ -30,7 +30,7 @@ def test_the_compiled_inverse_is_built_and_used():
     if not _can_compile():
         pytest.skip("no Cython or no C compiler: the pure-Python inverse runs (make vm-loop says so)")
     assert build.target().exists(), "the compiled inverse kinematics is missing: run make vm-loop"
-    assert kinematics._ikcore is not None and kinematics._ikcore.ABI == kinematics.IKCORE_ABI
+    assert kinematics._simcore is not None and kinematics._simcore.ABI == kinematics.SIMCORE_ABI
     k = Kinematics()
     k.inverse(k.forward([10, -80, 100, 20, 30, 40]))
     assert k._c_opw
@@ -52,7 +52,7 @@ def test_compiled_and_python_inverse_agree_bit_for_bit_on_a_corpus_kr210(shared_
 
 
 def _agree(machine, seed: int) -> None:
-    if kinematics._ikcore is None:
+    if kinematics._simcore is None:
         pytest.skip("not compiled: only the Python inverse runs")
     compiled, python = Kinematics(machine), Kinematics(machine)
     python._c_opw = False
