@@ -18,6 +18,11 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import IO, Any
 
+try:  # the compiled pose-line formatter (robot/build.py); absent without a build: Python formats
+    from .simcore import pose_line as _pose_line
+except ImportError:
+    _pose_line = None
+
 #: kind -> ordered list of (field, description). Fields marked "optional" may be absent.
 SCHEMA: dict[str, list[tuple[str, str]]] = {
     "motion": [
@@ -289,6 +294,11 @@ class TraceWriter:
                 continue
             fr = next(frames)
             vals = axes.tolist() if hasattr(axes, "tolist") else axes
+            if _pose_line is not None and not self.keep:
+                line = _pose_line(t, vals, fr)     # the same bytes, compiled (robot/simcore.pyx)
+                if line is not None:
+                    self._write(None, line)         # type: ignore[arg-type]  (not kept)
+                    continue
             ax = [_round6(float(v)) for v in vals]
             tcp = [_round6(v) for v in fr]
             tt = round_time(t)

@@ -1,10 +1,12 @@
-"""The compiled OPW inverse kinematics (robot/simcore.pyx, built by robot/build.py; `make`
-builds it before the tests) against the pure-Python code it mirrors, the reference: the same
-axes bit for bit, and the same errors, on random poses of the KR 6 R900 and of a corpus
-KR 210 (issue 39, "Simulator": traces byte-identical)."""
+"""The simulator's compiled hot path (robot/simcore.pyx, built by robot/build.py; `make`
+builds it before the tests) against the pure-Python code it mirrors, the reference: the OPW
+inverse kinematics (the same axes bit for bit, and the same errors, on random poses of the
+KR 6 R900 and of a corpus KR 210) and the trace's pose lines (the same bytes). Issue 39,
+"Simulator": traces byte-identical."""
 
 from __future__ import annotations
 
+import random
 import shutil
 import sys
 import sysconfig
@@ -16,6 +18,12 @@ from robot import build, kinematics
 from robot.errors import RobotError
 from robot.kinematics import Kinematics
 from robot.mada import load_robot
+from robot.trace import _round6, round_time
+
+try:
+    from robot import simcore
+except ImportError:
+    simcore = None
 
 
 def _can_compile() -> bool:
@@ -84,3 +92,42 @@ def _agree(machine, seed: int) -> None:
 def test_the_build_falls_back_without_cython(monkeypatch):
     monkeypatch.setitem(sys.modules, "Cython.Build", None)
     assert "not compiled" in build.build(force=True)
+
+
+def _python_pose_line(t, axes, tcp):
+    # robot/trace.py TraceWriter.flush's own formatting (the reference)
+    ax, tc, tt = [_round6(float(v)) for v in axes], [_round6(v) for v in tcp], round_time(t)
+    return (f'{{"t":{tt!r},"kind":"pose","axes":[{",".join(map(repr, ax))}],'
+            f'"tcp":[{",".join(map(repr, tc))}]}}')
+
+
+def test_the_compiled_pose_line_is_pythons_bit_for_bit():
+    if simcore is None:
+        pytest.skip("not compiled: only the Python formatting runs")
+    rng = random.Random(39)
+    tricky = [0.0, -0.0, 5e-7, -5e-7, 4.9999999e-7, 1.5e-6, 1.25e-5, -1.25e-5, 1e-4, 9.9995e-5,
+              -1e-4, 1.5e-4, 123.4565, 2.0000005, 99999999.9999995, 1e13, 99999999999999.98, 1e20]
+
+    def value():
+        r = rng.random()
+        if r < 0.2:
+            return rng.choice(tricky)
+        if r < 0.3:
+            return rng.uniform(-1e-3, 1e-3)                      # repr's exponent form below 1e-4
+        if r < 0.45:
+            return round(rng.uniform(-10, 10), 6) + rng.choice([5e-7, -5e-7])   # near a tie
+        if r < 0.6:
+            return round(rng.uniform(-1000, 1000), rng.choice([6, 7]))
+        if r < 0.7:
+            return rng.uniform(-1e14, 1e14) * rng.choice([1.0, 1e-3, 1e-6])
+        return rng.uniform(-2000, 2000)
+
+    for i in range(40_000):
+        t = rng.choice([i * 0.012, rng.uniform(0.0, 1e4)])
+        axes, tcp = [value() for _ in range(6)], [value() for _ in range(6)]
+        line = simcore.pose_line(t, axes, tcp)
+        if line is None:     # left to the Python path: only for a huge number
+            assert max(abs(v) for v in axes + tcp) >= 1e15, (t, axes, tcp)
+        else:
+            assert line == _python_pose_line(t, axes, tcp), (t, axes, tcp)
+    assert simcore.pose_line(1.0, [float("nan")] * 6, [0.0] * 6) is None    # json.dumps writes NaN
