@@ -413,6 +413,10 @@ def _wrap180(v: Any) -> Any:
     return np.where(np.abs(w) < 1e-12, 0.0, w)
 
 
+#: the last matrix (bytes) of a pose in gimbal lock that _frames_of converted, and its frame
+_GIMBAL_LAST: list[tuple[Any, Any]] = [(None, None)]
+
+
 def _frames_of(Ts: list[Any]) -> list[list[float]]:
     """Vectorised :func:`robot.frames.matrix_to_frame` for a list of 4x4 matrices."""
     import warnings
@@ -431,7 +435,14 @@ def _frames_of(Ts: list[Any]) -> list[list[float]]:
     out = []
     for i, (p, ai, b, ci) in enumerate(zip(M[:, :3, 3].tolist(), a.tolist(), abc[:, 1].tolist(), c.tolist())):
         if abs(abs(b) - 90.0) < GIMBAL_TOL_DEG:
-            out.append(list(matrix_to_frame(M[i])))
+            # one by one (a robot at rest in gimbal lock, e.g. at HOME, repeats its matrix:
+            # the last answer is kept)
+            key = M[i].tobytes()
+            last_key, frame = _GIMBAL_LAST[0]
+            if last_key != key:
+                frame = list(matrix_to_frame(M[i]))
+                _GIMBAL_LAST[0] = (key, frame)
+            out.append(list(frame))
         else:
             out.append([p[0], p[1], p[2], ai, b, ci])
     return out
