@@ -932,11 +932,13 @@ class Controller:
         lim = self._step_lim
         if lim is None:
             lim = self._step_lim = (CP_SPEED_LIMIT_FACTOR * self.model.v_max * self.dt + 1e-9).tolist()
-        step = [abs(a - b) for a, b in zip(np.asarray(q).tolist(), self._q_prev.tolist())]
-        if any(d > m for d, m in zip(step, lim)):
-            i = max(range(len(step)), key=lambda j: step[j] / lim[j])
-            name = f"A{i + 1}" if i < 6 else f"E{i - 5}"
-            raise RobotError(f"speed limit exceeded {name}: CP path through a singularity")
+        step = [abs(a - b) for a, b in zip(q.tolist() if type(q) is np.ndarray else np.asarray(q).tolist(),
+                                           self._q_prev.tolist())]
+        for d, m in zip(step, lim):
+            if d > m:
+                i = max(range(len(step)), key=lambda j: step[j] / lim[j])
+                name = f"A{i + 1}" if i < 6 else f"E{i - 5}"
+                raise RobotError(f"speed limit exceeded {name}: CP path through a singularity")
 
     def _fault(self, err: RobotError) -> np.ndarray:
         mid = self._runs[0].seg.id if self._runs else None
