@@ -19,7 +19,7 @@ import numpy as np
 
 #: Bumped whenever the mirrored Python code changes (robot/kinematics.py checks it: a stale
 #: build is not used).
-ABI = 1
+ABI = 2
 
 cdef double DEG_TO_RAD = M_PI / 180.0
 cdef double RAD_TO_DEG = 180.0 / M_PI
@@ -81,11 +81,12 @@ cdef class OPW:
         amb[0] = (<int>(fabs(xw) < OVERHEAD_SINGULAR_MM)) | ((<int>(fabs(q[2] - phi) < 1e-7)) << 1) \
             | ((<int>(fabs(q[4]) < WRIST_SINGULAR_DEG)) << 2) | self.s_free
 
-    cdef int _core(self, const double[:, :] T, const double* ref, double* out) noexcept nogil:
-        """``Kinematics._opw_core(T, ref)``: the solutions into out (8 x 6), their number."""
-        cdef double r00 = T[0, 0], r01 = T[0, 1], r02 = T[0, 2], px = T[0, 3]
-        cdef double r10 = T[1, 0], r11 = T[1, 1], r12 = T[1, 2], py = T[1, 3]
-        cdef double r20 = T[2, 0], r21 = T[2, 1], r22 = T[2, 2], pz = T[2, 3]
+    cdef int _core(self, const double* M, const double* ref, double* out) noexcept nogil:
+        """``Kinematics._opw_core(T, ref)`` of the pose M (the first three rows of T, 12
+        values): the solutions into out (8 x 6), their number."""
+        cdef double r00 = M[0], r01 = M[1], r02 = M[2], px = M[3]
+        cdef double r10 = M[4], r11 = M[5], r12 = M[6], py = M[7]
+        cdef double r20 = M[8], r21 = M[9], r22 = M[10], pz = M[11]
         cdef double cx = px - self.c4 * r02
         cdef double cy = py - self.c4 * r12
         cdef double cz = pz - self.c4 * r22
@@ -161,6 +162,24 @@ cdef class OPW:
         """``Kinematics.inverse`` of the flange pose T (4x4, mm, the OPW arm's own frame) for
         the reference ref6 (6 axes, deg): the axes (6,) as a numpy array, or None where the
         Python code raises (the caller runs it for the error)."""
+        cdef double M[12]
+        cdef int i, j
+        for i in range(3):
+            for j in range(4):
+                M[4 * i + j] = T[i, j]
+        return self._inverse(M, status, turn, ref6)
+
+    def inverse_rp(self, const double[:, :] R, const double[:] p, status, turn, const double[:] ref6):
+        """:meth:`inverse` of the pose with rotation R (3x3) and position p (3,, mm)."""
+        cdef double M[12]
+        cdef int i, j
+        for i in range(3):
+            for j in range(3):
+                M[4 * i + j] = R[i, j]
+            M[4 * i + 3] = p[i]
+        return self._inverse(M, status, turn, ref6)
+
+    cdef object _inverse(self, const double* M, status, turn, const double[:] ref6):
         cdef double ref[6]
         cdef double rows[48]
         cdef double q[6]
@@ -173,7 +192,7 @@ cdef class OPW:
         cdef double[:] rv
         for i in range(6):
             ref[i] = ref6[i]
-        n = self._core(T, ref, rows)
+        n = self._core(M, ref, rows)
         if n == 0:
             return None
         if status is not None:

@@ -84,6 +84,9 @@ def _agree(machine, seed: int) -> None:
         turn = None if rng.random() < 0.6 else int(rng.integers(0, 64))
         a, b = _answer(compiled, T, status, turn, ref), _answer(python, T, status, turn, ref)
         assert a == b, (q.tolist(), ref.tolist(), status, turn)
+        # the entry of robot/planner.py CartSegment.ik: rotation and position apart
+        rp = compiled._compiled().inverse_rp(T[:3, :3], T[:3, 3], status, turn, ref)
+        assert (rp.tobytes() if rp is not None else None) == (a if isinstance(a, bytes) else None)
         solved += isinstance(a, bytes)
         failed += not isinstance(a, bytes)
     assert solved > 1000 and failed > 100      # both the solutions and the errors were compared
