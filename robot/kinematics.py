@@ -913,10 +913,3 @@ class Kinematics:
         x, y, z, a, b, c = matrix_to_frame(self.tcp_pose(axes_deg, tool, base, robroot))
         s, t = self.status_turn(axes_deg)
         return (x, y, z, a, b, c, s, t)
-
-    def inverse_tcp(self, tcp_in_base: Any, status: int | None = None, turn: int | None = None,
-                    reference_deg: Sequence[float] | None = None, tool: Any = None,
-                    base: Any = None, robroot: Any = None) -> np.ndarray:
-        """Convenience: :meth:`inverse` of :meth:`flange_target`. Same errors."""
-        return self.inverse(self.flange_target(tcp_in_base, tool, base, robroot),
-                            status, turn, reference_deg)
