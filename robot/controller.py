@@ -700,7 +700,7 @@ class Controller:
         """
         self._events = []
         self._k += 1
-        t = self.time
+        t = self._k * self.dt          # self.time
         self.io.now = t
         if self.network is not None and self.network.polling:
             self.network.cycle(self)
@@ -713,7 +713,8 @@ class Controller:
                 else:
                     keep.append((te, n, lvl))
             self._pulses = keep
-        self._apply_stimuli(t)
+        if self.stimuli:
+            self._apply_stimuli(t)
         if self.rules:
             step_rules(self.rules, self.io, t, self.dt)
 
@@ -735,7 +736,8 @@ class Controller:
         self._q = np.asarray(q, dtype=float)
         if self._braking and self._scale <= 0.0:
             self._hold()
-        self._fire_triggers(self._pt)
+        if self._tracked:
+            self._fire_triggers(self._pt)
         if self._arm is not None:
             if self.actuated:
                 self._arm.step_actuated(self._q, self.dt, (self._q - self._q_prev) / self.dt)
@@ -744,9 +746,11 @@ class Controller:
         qa = self.axis_act()
         self._tcp_prev = self._tcp_T[:3, 3].copy()
         self._tcp_T = self._tcp_read_back(qa, self._tool_T, self._base_inv_T)
-        for fn in list(self._cyclic.values()):
-            fn(self)
-        self._reach_stimuli()
+        if self._cyclic:
+            for fn in list(self._cyclic.values()):
+                fn(self)
+        if self.stimuli and self._runs:
+            self._reach_stimuli()
         if self.trace is not None:
             self.trace.write_pose(t, qa, self._tcp_T)
         return self._events
