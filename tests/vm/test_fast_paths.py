@@ -553,7 +553,7 @@ def test_quiet_path_is_taken_only_without_a_trace(traced):
                           check=False)
     rt.program.module("fp_maxsteps").data["SEL"].set(2)
     calls = [0]
-    before, tick, take, quiet = vm.hooks
+    before, tick, take, quiet, *call_protocol = vm.hooks    # (run_routine, exec_routine)
 
     def counted(fn):
         def hook(*a):
@@ -561,7 +561,7 @@ def test_quiet_path_is_taken_only_without_a_trace(traced):
             return fn(*a)
         return hook
 
-    vm.hooks = (counted(before), counted(tick), take, quiet)
+    vm.hooks = (counted(before), counted(tick), take, quiet, *call_protocol)
     res = rt.run()
     assert res.reason == "max_steps" and res.steps == 20_001
     if traced:
