@@ -390,13 +390,16 @@ class Runtime:
             raise KrlRuntimeError(f"WAIT SEC with a negative time ({t})")
         task = self.current_task
         ctl = self.controller
-        end = ctl.cycle + ctl.cycles_for(t)
-        outer, task.wake_cycle = task.wake_cycle, end
+        idle = self.scheduler.idle
+        outer, task.wake_cycle = task.wake_cycle, ctl.cycle + ctl.cycles_for(t)
+        shifted = idle.shifted
         try:
-            while ctl.cycle < end:
+            # task.wake_cycle, not a local: a periodic jump of the idle watch moves it
+            while ctl.cycle < task.wake_cycle:
                 self.yield_cycle(task)
         finally:
-            task.wake_cycle = outer
+            # an outer WAIT SEC (this one ran in an interrupt routine) moves with the jumps too
+            task.wake_cycle = None if outer is None else outer + idle.shifted - shifted
 
     def halt(self) -> None:
         """HALT (reference §5.7): the program stops as if the operator pressed STOP. With
