@@ -277,7 +277,7 @@ class TraceWriter:
             if key != self._last_pose:
                 self._last_pose = key
                 self._spin.reset()          # the robot moves: progress
-            if self._spin.left_out(f"pose{key}"):   # at rest: a pose is part of the pass
+            if self._spin.left_out(f"pose{key}", pose=True):   # at rest: a pose is part of the pass
                 self._leave_out("pose", t)
                 return
             self._write_left(t)
@@ -393,44 +393,30 @@ def _content(ev: dict[str, Any], line: str) -> str:
 
 
 class _Spin:
-    """The spin detector of a bounded :class:`TraceWriter` (its docstring): the contents of
-    the last :data:`MAX_PASS_EVENTS` events and two :class:`_Pass` trackers. Each compares an
-    event with the one a *period* back; a run of matches as long as the period is one more copy
-    of the pass. When a match fails, the period is found again from the event's last occurrence.
-    The *inner* tracker also moves to a shorter period when the event repeats sooner (the 500
-    passes of a polling loop within one IPO cycle), the *outer* one keeps its period while it
-    matches (the cycle of a robot program's time slice and a submit program's, with the pose
-    between them). An event either leaves out is left out."""
+    """The spin detector of a bounded :class:`TraceWriter` (its docstring): two
+    :class:`_Pass` trackers, one over every event and one over the events of the programs
+    (poses aside). The second sees a polling loop's passes run on from one IPO cycle into the
+    next (the pose at rest between two time slices is not in its way); the first sees the cycle
+    itself repeat, poses included (a robot program's time slice and a submit program's, with the
+    pose between them). An event either leaves out is left out."""
 
     def __init__(self, repeats: int, writer: TraceWriter) -> None:
         self.writer = writer
-        self.hist: deque[str] = deque(maxlen=MAX_PASS_EVENTS)
-        self.last: dict[str, int] = {}    # content -> index of its last occurrence
-        self.n = 0                        # index of the next event
-        self.inner = _Pass(repeats, writer, shortest=True)
-        self.outer = _Pass(repeats, writer, shortest=False)
+        self.every = _Pass(repeats, writer)
+        self.program = _Pass(repeats, writer)
 
     def reset(self) -> None:
         """Progress (the robot moves): no event repeats one before it."""
-        self.hist.clear()
-        self.last.clear()
-        self.inner.unlock()
-        self.outer.unlock()
+        self.every.reset()
+        self.program.reset()
 
-    def left_out(self, key: str) -> bool:
-        """Account event `key` (:func:`_content`); True when it is to be left out."""
-        i = self.n
-        self.n += 1
-        j = self.last.get(key)
-        lag = i - j if j is not None and 0 < i - j <= len(self.hist) else 0
-        hist = self.hist
-        outer = self.outer.step(hist, key, lag)
-        inner = self.inner.step(hist, key, lag)
-        self.last[key] = i
-        hist.append(key)
-        if len(self.last) > 4 * MAX_PASS_EVENTS:
-            self.last = {k: v for k, v in self.last.items() if v > i - MAX_PASS_EVENTS}
-        done = outer if outer is not None else inner
+    def left_out(self, key: str, pose: bool = False) -> bool:
+        """Account event `key` (:func:`_content`; `pose`: a pose event); True when it is to be
+        left out."""
+        done = self.every.step(key)
+        if not pose:
+            inner = self.program.step(key)  # always: its history must see every event
+            done = done or inner
         if done is None:
             return False
         w = self.writer
@@ -441,13 +427,23 @@ class _Spin:
 
 
 class _Pass:
-    """One period tracker of :class:`_Spin`: the period of the pass, the matches in a row, and
-    the state comparisons that confirm the spin (the :class:`TraceWriter` docstring)."""
+    """One period tracker of :class:`_Spin`: the contents of its last :data:`MAX_PASS_EVENTS`
+    events, the period of the pass, the matches in a row, and the state comparisons that
+    confirm the spin (the :class:`TraceWriter` docstring). Each event is compared with the one
+    a period back; a run of matches as long as the period is one more copy of the pass. When a
+    match fails, the period is found again from the event's last occurrence."""
 
-    def __init__(self, repeats: int, writer: TraceWriter, shortest: bool) -> None:
+    def __init__(self, repeats: int, writer: TraceWriter) -> None:
         self.repeats = max(1, int(repeats))
         self.writer = writer
-        self.shortest = shortest
+        self.hist: deque[str] = deque(maxlen=MAX_PASS_EVENTS)
+        self.last: dict[str, int] = {}    # content -> index of its last occurrence
+        self.n = 0                        # index of the next event
+        self.unlock()
+
+    def reset(self) -> None:
+        self.hist.clear()
+        self.last.clear()
         self.unlock()
 
     def unlock(self) -> None:
@@ -460,25 +456,31 @@ class _Pass:
         self.recheck = 0                  # copy at whose end a confirmed spin's state is compared
         self.passes_ended = 0             # 1 when the event left out ended a pass
 
-    def step(self, hist: deque, key: str, lag: int) -> "_Pass | None":
-        """Event `key`, whose last occurrence was `lag` events ago (0: none in `hist`);
-        returns self when it is to be left out."""
+    def step(self, key: str) -> "_Pass | None":
+        """Account event `key`; returns self when it is to be left out."""
+        i = self.n
+        self.n += 1
+        hist = self.hist
         p = self.period
-        if p and len(hist) >= p and hist[-p] == key and not (
-                self.shortest and not self.confirmed and 0 < lag < p):
+        out = None
+        if p and len(hist) >= p and hist[-p] == key:
             self.match += 1
+            copy = (self.match - 1) // p + 2      # the original pass is copy 1
+            out = self if self.confirmed else None
+            end = self.match % p == 0
+            if end:
+                self._end_of(copy)
+            self.passes_ended = 1 if end else 0
         else:
             self.unlock()
-            if lag:
-                self.period, self.match = lag, 1
-            return None
-        copy = (self.match - 1) // p + 2      # the original pass is copy 1
-        out = self.confirmed
-        end = self.match % p == 0
-        if end:
-            self._end_of(copy)
-        self.passes_ended = 1 if end else 0
-        return self if out else None
+            j = self.last.get(key)
+            if j is not None and 0 < i - j <= len(hist):
+                self.period, self.match = i - j, 1
+        self.last[key] = i
+        hist.append(key)
+        if len(self.last) > 4 * MAX_PASS_EVENTS:
+            self.last = {k: v for k, v in self.last.items() if v > i - MAX_PASS_EVENTS}
+        return out
 
     def _end_of(self, copy: int) -> None:
         """Copy `copy` of the pass ended: capture or compare the state."""
