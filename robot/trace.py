@@ -142,6 +142,9 @@ TRACE_REPEATS = 10
 #: the longest pass (events) the bounding recognises: a cycle of a robot program's time slice
 #: (1000 steps) beside a submit program's (100) fits
 MAX_PASS_EVENTS = 4096
+#: the most events between two state probes after probes that found the state changed (a
+#: probe costs what the idle watch's state_of costs: milliseconds on a large backup)
+MAX_PROBE_GAP = 65536
 _REQUIRED = {k: tuple(f for f, d in v if not d.startswith("optional")) for k, v in SCHEMA.items()}
 _ORDER = {k: tuple(f for f, _ in v) for k, v in SCHEMA.items()}
 
@@ -245,6 +248,8 @@ class TraceWriter:
         self._left_last = 0.0
         self._left_passes = 0            # whole passes among the events left out
         self._left_period = 0            # events in their pass
+        self._probe_after = 0            # no state probe before this many events (_Pass._end_of)
+        self._probe_gap = 0
         self._last_pose = None           # (axes) of the last pose queued
 
     @property
@@ -497,17 +502,26 @@ class _Pass:
                 else:
                     self.recheck = 2 * copy
             return
+        w = self.writer
         if copy == self.capture:
-            self.ref = (copy, probe())
+            if w._spin.every.n < w._probe_after:
+                self.capture += 1            # the state changed lately: not yet (cost of the probe)
+            else:
+                self.ref = (copy, probe())
         elif self.ref is not None and copy == self.ref[0] + 1:
             state = probe()
             if state == self.ref[1]:
                 self.confirmed = True
                 self.recheck = 2 * copy
+                w._probe_gap = 0
             else:
                 self.gap *= 2                # the state changes: compare again later
                 self.capture = copy + self.gap
                 self.ref = None
+                # loops whose state changes cost a probe each: the next one, of any pass, after
+                # twice as many events as the last (at most MAX_PROBE_GAP)
+                w._probe_gap = min(max(2 * w._probe_gap, 64), MAX_PROBE_GAP)
+                w._probe_after = w._spin.every.n + w._probe_gap
 
 
 def _wrap180(v: Any) -> Any:
