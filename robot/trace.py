@@ -313,6 +313,7 @@ class TraceWriter:
 
     def write_event(self, ev: dict[str, Any]) -> None:
         """Write an already built event dict (from :func:`make_event`)."""
+        line = None
         if ev["kind"] == "pose":
             self._pose_count += 1
             if (self._pose_count - 1) % self.pose_every:
@@ -323,13 +324,9 @@ class TraceWriter:
                 self._leave_out(ev["kind"], ev["t"])
                 return
             self._write_left(ev["t"])
-            if self._poses:
-                self.flush()
-            self._emit(ev, line)
-            return
         if self._poses:
             self.flush()
-        self._emit(ev)
+        self._emit(ev, line)
 
     def _leave_out(self, kind: str, t: float) -> None:
         if self._left_since is None:
