@@ -104,7 +104,8 @@ SCHEMA: dict[str, list[tuple[str, str]]] = {
     "return": [("name", "str: routine name"), ("line", "optional int")],
     "idle": [
         ("until", "float: s, the clock jumped from t to here (interp/runtime/idle.py): nothing "
-                  "changed and nothing happens before the next event"),
+                  "changed and nothing happens before the next event, or the run repeats itself "
+                  "(a polling loop with WAIT SEC: whole periods)"),
         ("since", "optional float: s, the state has stood still since"),
         ("cycles", "optional int: IPO cycles skipped (they execute no statement)"),
     ],
