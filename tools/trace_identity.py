@@ -20,7 +20,10 @@ Usage::
     python tools/trace_identity.py record CHECKOUT OUTDIR [--interp tree,vm] [--limit N]
     python tools/trace_identity.py compare DIR_A DIR_B
 
-``record`` writes, per program and interpreter, ``NAME.INTERP.jsonl.gz`` (the trace, gzip level
+``record`` skips what its OUTDIR holds already (a ``.json``) or what another ``record`` process of the
+same OUTDIR has claimed (``NAME.INTERP.claim``; ``--workers N``: N processes per checkout and
+interpreter share the programs; after an interrupted run, delete the claims without a ``.json``
+and run again to finish). It writes, per program and interpreter, ``NAME.INTERP.jsonl.gz`` (the trace, gzip level
 1, mtime 0) and ``NAME.INTERP.json`` (sha256 and size of the uncompressed trace, events, how the
 run ended, CPU seconds). ``compare`` prints ``identical N, different M, missing K`` and, for each
 difference, the first line where the traces part. Exit status: 0 all identical, 1 any
@@ -70,6 +73,15 @@ class _Sink:
         self._raw.close()
 
 
+def _claim(path: Path) -> bool:
+    """True when this process made `path` (several ``record`` processes share one OUTDIR)."""
+    try:
+        os.close(os.open(path, os.O_CREAT | os.O_EXCL | os.O_WRONLY))
+    except FileExistsError:
+        return False
+    return True
+
+
 def record(checkout: Path, out: Path, interps: list[str], limit: int = 0, corpus: Path = CORPUS) -> int:
     """Run every entry point of `corpus` on each of `interps` with the code of `checkout` (which
     must come first on sys.path) and write its trace and summary to `out`."""
@@ -93,6 +105,8 @@ def record(checkout: Path, out: Path, interps: list[str], limit: int = 0, corpus
     for it in interps:
         for p in programs:
             name = str(p.relative_to(corpus)).replace("/", "__")
+            if (out / f"{name}.{it}.json").exists() or not _claim(out / f"{name}.{it}.claim"):
+                continue        # recorded, or another record process of the same OUTDIR has it
             sink = _Sink(out / f"{name}.{it}.jsonl.gz", str(checkout))
             summary: dict = {"program": str(p), "interp": it}
             c0 = time.process_time()
@@ -177,6 +191,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--interp", default="tree,vm")
     ap.add_argument("--limit", type=int, default=0)
     ap.add_argument("--jobs", type=int, default=2)
+    ap.add_argument("--workers", type=int, default=1,
+                    help="record processes per checkout and interpreter (they share the programs)")
     ap.add_argument("--corpus", default=str(CORPUS))
     a = ap.parse_args(argv)
     if not Path(a.corpus).is_dir():
@@ -184,7 +200,7 @@ def main(argv: list[str] | None = None) -> int:
         return 0
     out = Path(a.out)
     jobs = [(Path(co).resolve(), out / side, it) for it in a.interp.split(",")
-            for co, side in ((a.before, "before"), (a.after, "after"))]
+            for co, side in ((a.before, "before"), (a.after, "after")) for _w in range(max(1, a.workers))]
     running: list[subprocess.Popen] = []
     for co, dest, it in jobs:
         while len(running) >= max(1, a.jobs):
@@ -193,7 +209,7 @@ def main(argv: list[str] | None = None) -> int:
                 time.sleep(1.0)
         dest.mkdir(parents=True, exist_ok=True)
         env = dict(os.environ, PYTHONPATH=str(co))
-        log = open(dest / f"record.{it}.log", "w", encoding="utf-8")
+        log = open(dest / f"record.{it}.log", "a", encoding="utf-8")
         running.append(subprocess.Popen(
             [sys.executable, str(Path(__file__).resolve()), "record", str(co), str(dest), "--interp", it,
              "--limit", str(a.limit), "--corpus", a.corpus], cwd=co, env=env, stdout=log, stderr=subprocess.STDOUT))
