@@ -82,7 +82,8 @@ def _claim(path: Path) -> bool:
     return True
 
 
-def record(checkout: Path, out: Path, interps: list[str], limit: int = 0, corpus: Path = CORPUS) -> int:
+def record(checkout: Path, out: Path, interps: list[str], limit: int = 0, corpus: Path = CORPUS,
+           reverse: bool = False) -> int:
     """Run every entry point of `corpus` on each of `interps` with the code of `checkout` (which
     must come first on sys.path) and write its trace and summary to `out`."""
     checkout = checkout.resolve()
@@ -102,6 +103,8 @@ def record(checkout: Path, out: Path, interps: list[str], limit: int = 0, corpus
     programs = [p for root in find_backups(corpus) for p in entries_of(root)]
     if limit:
         programs = programs[:limit]
+    if reverse:                 # a second worker from the other end: other backups recorded first
+        programs = programs[::-1]
     for it in interps:
         for p in programs:
             name = str(p.relative_to(corpus)).replace("/", "__")
@@ -177,8 +180,9 @@ def main(argv: list[str] | None = None) -> int:
         ap.add_argument("--interp", default="tree,vm")
         ap.add_argument("--limit", type=int, default=0)
         ap.add_argument("--corpus", default=str(CORPUS))
+        ap.add_argument("--reverse", action="store_true", help="the programs in reverse order")
         a = ap.parse_args(argv)
-        return record(Path(a.checkout), Path(a.out), a.interp.split(","), a.limit, Path(a.corpus))
+        return record(Path(a.checkout), Path(a.out), a.interp.split(","), a.limit, Path(a.corpus), a.reverse)
     if argv[:1] == ["compare"]:
         ap.add_argument("cmd")
         ap.add_argument("a")
