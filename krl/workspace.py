@@ -294,6 +294,11 @@ class Workspace:
         """:meth:`add_file` for each of `paths`, in order. With `timeout` (seconds per file) the
         files are read here and parsed and built in worker processes (:func:`load_batch`)."""
         paths = list(paths)
+        loader = _LOADER.get()
+        if loader is not None and paths:
+            for lf in loader(paths, timeout, jobs):
+                self.add_loaded(lf, notify=timeout is None)
+            return
         if timeout is None or not paths:
             for p in paths:
                 self.add_file(p)
@@ -401,10 +406,14 @@ class Workspace:
         the next check or re-check)."""
         if self._by_path is None:
             by: dict[str, list[Diagnostic]] = {}
-            for d in self.sink.sorted():
+            for d in self.sink.items:       # grouped as added; each file's sorted when asked
                 by.setdefault(d.path, []).append(d)
-            self._by_path = by
-        return list(self._by_path.get(path, ()))
+            self._by_path = {p: (False, ds) for p, ds in by.items()}
+        done, ds = self._by_path.get(path, (True, []))
+        if not done:    # the stable sort of :attr:`diagnostics`, restricted to one path: the same order
+            ds.sort(key=lambda d: (d.line, d.column, d.code))
+            self._by_path[path] = (True, ds)
+        return list(ds)
 
     def _check(self) -> None:
         """The phases of a check (reference 2.5-2.7), each finding and unresolved use recorded
@@ -616,6 +625,11 @@ class Workspace:
                 un.use(*use)
         return un
 
+    def _all_uses(self) -> list[list[tuple]]:
+        """Every reported owner's unresolved uses, in the report's order (what :meth:`_report`
+        reads; the report of 400 files took two thirds of an edit's re-check)."""
+        return [list(uses.items) for _diags, uses in self._owners()]
+
     def _report(self) -> None:
         """The unresolved-name report (krl/semantics/outside.py) from every recorded use."""
         un = self.unresolved()
@@ -675,6 +689,7 @@ class Workspace:
         self.resolver = None
         st.declarer.incomplete = st.checker.incomplete = self.incomplete
         try:
+            uses = self._all_uses()
             if old.unreadable or lf.unreadable or self.check_only is not None:
                 done = None
             elif sf.module.kind == "dat" or lf.module.kind == "dat":
@@ -683,7 +698,8 @@ class Workspace:
                 done = self._recheck_code(sf, lf, old_template)
             if done is None:
                 return self._check_again()
-            self._report()
+            if self._all_uses() != uses:    # else the report, made from these alone, stays
+                self._report()
             self._assemble()
             return done
         except Exception:  # noqa: BLE001 - the full check decides (and reports E901 itself)
@@ -1037,6 +1053,23 @@ def on_each_file(callback: Callable[[str], None]):
         _ON_FILE.reset(token)
 
 
+#: how the files of a workspace are loaded instead of parsing them all (:func:`loading_files_by`)
+_LOADER: ContextVar[Callable[[list, float | None, int | None], list] | None] = ContextVar(
+    "krl_workspace_loader", default=None)
+
+
+@contextmanager
+def loading_files_by(loader: Callable[[list, float | None, int | None], list]):
+    """``with loading_files_by(f):`` the workspaces made in the block get their files from
+    ``f(paths, timeout, jobs)`` (one LoadedFile per path, in order, as :meth:`Workspace.add_files`
+    would make them): krl/parsecache.py takes them from the one store. Ends with the block."""
+    token = _LOADER.set(loader)
+    try:
+        yield
+    finally:
+        _LOADER.reset(token)
+
+
 # warnings that advise a change of the code (docs/diagnostics.md): not reported in KUKA's files
 ADVISORY = frozenset({"W108", "W111", "W201", "W202", "W205", "W206", "W210", "W501"})
 _WORD = re.compile(r"[A-Za-z_$][A-Za-z0-9_$]*")
@@ -1097,7 +1130,11 @@ def load_workspaces(groups: list[tuple[str, list]], timeout: float | None = None
     all groups loaded in one batch (:func:`load_batch`; with `timeout`, else here one by one)."""
     out = [Workspace(root) for root, _ in groups]
     files = [(k, e.path) for k, (_, entries) in enumerate(groups) for e in entries if e.kind == "file"]
-    if timeout is None:
+    loader = _LOADER.get()
+    if loader is not None and files:
+        for (k, _path), lf in zip(files, loader([p for _, p in files], timeout, jobs)):
+            out[k].add_loaded(lf, notify=timeout is None)
+    elif timeout is None:
         for k, path in files:
             out[k].add_file(path)
     else:
