@@ -192,8 +192,11 @@ class Network:
         if self.ctl is not None:
             self.net_message(f"{key} listening on {address[0]}:{address[1]}")
 
-    def wait_address(self, key: str, timeout: float = 30.0):
-        """The address `key` listens on, waiting for it up to `timeout` s (another thread)."""
+    def wait_address(self, key: str, timeout: float = 300.0):
+        """The address `key` listens on, waiting for it up to `timeout` s (another thread);
+        None when it is not published by then. The default is generous: the OPC UA server
+        builds its address space first (seconds of CPU), and on a loaded machine that took
+        over 30 s (load 40 on 2 cores, 2026-11-24). Waiting longer costs nothing when it is up."""
         end = time.monotonic() + timeout
         with self.ready:
             while key not in self.addresses and not self.closed:
