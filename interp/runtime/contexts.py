@@ -17,6 +17,9 @@ interrupts (its greenlet), at a statement boundary or at an IPO cycle.
   pending, enabled interrupt runs when its number is smaller (= higher priority) than
   the priority of the running context (main: 129, so every interrupt can run there);
   the smallest number runs first; equal or lower priorities wait;
+* a poll evaluates a condition again only when something it reads may have changed (its
+  *watch*, interp/runtime/watch.py: an I/O change, the clock, a probed state variable; a
+  condition over variables at every poll): the edges are those of evaluating at every poll;
 * a non-GLOBAL declaration is removed when the routine that declared it returns;
   ON/OFF/ENABLE/DISABLE of an undeclared number is error 1430.
 """
