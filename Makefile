@@ -48,12 +48,14 @@ $(JAVA_STAMP): $(PARSER)
 
 java-parser: $(JAVA_STAMP)
 
-# The compiled VM loop: every install builds it (setup.py); this target rebuilds it in place
+# The compiled VM loop and the simulator's inverse kinematics (robot/build.py: robot/simcore.pyx):
+# every install builds them (setup.py); this target rebuilds them in place
 # after loop.py was regenerated. Cython compiles the generated interp/vm/loop.py (with loop.pxd)
 # into an extension beside it (interp/vm/build.py). Without Cython or a C compiler it says so and
 # the pure-Python loop.py runs.
 vm-loop: $(BIN)/.installed
 	@$(BIN)/python -m interp.vm.build
+	@$(BIN)/python -m robot.build
 
 recover: $(PARSER) java-parser vm-loop
 	$(BIN)/krl recover $(CORPUS) --out $(OUT); status=$$?; \
@@ -72,7 +74,7 @@ bench: $(PARSER) java-parser vm-loop
 	$(BIN)/krl bench
 
 clean:
-	rm -rf $(VENV) $(GEN_DIR) build/java build/cython interp/vm/*.so reports/recovery reports/growth
+	rm -rf $(VENV) $(GEN_DIR) build/java build/cython interp/vm/*.so robot/*.so reports/recovery reports/growth
 
 # Conformance suites (issue 8): hand-written cases, differential fuzzing, corpus programs.
 CONF_OUT  ?= reports/conformance

@@ -2,18 +2,28 @@
 page open, and the page's latency from an input to its visible change, in one run.
 
     python -m pendant.bench [BACKUP] [--program P] [--inputs CELL] [--seconds S] [--rounds R] [--toggles N]
+                            [--baseline CHECKOUT] [--no-latency | --latency-only] [--no-unpaced]
 
-For each condition the program is selected anew and run in GO/AUT at real time by
-``krl pendant`` (a subprocess), started by a short websocket connection: "closed" with no
-client connected while it is measured (a short connection reads the simulated time at both
-ends of the window), "open" with the page rendered by headless Chromium meanwhile. The real-time factor is simulated time over wall time across ``--seconds`` of running;
-the two conditions alternate ``--rounds`` times and the medians are compared.
-The same two conditions are then run unpaced (``--no-realtime``): there the factor is the
-simulation's throughput, and its drop is what the page costs the simulation. The latency is
-measured in the page while the program runs at real time: an input key pressed, until the
-page shows the new value (``performance.now()`` at the click and in the animation frame that
-first shows it), ``--toggles`` times. Prints one line per figure and the ratios; a benchmark,
-not a test (nothing asserts a time).
+Each condition gets a ``krl pendant`` of its own (a subprocess) with the program selected in
+GO/AUT. With the page open, headless Chromium loads the page first and the program is started
+only once the page has drawn the robot, so a slow page load (a loaded machine) never eats the
+run and a fast run (a quiet machine) never ends before the page is up. The program is started
+by a short websocket connection, and the simulated time and the server's CPU time are read by
+short connections while it runs (``closed``: no client connected between them), until
+``--seconds`` have passed or the program has ended: the window is the span between the first
+and the last reading that found it running, so a run that ends early still gives an exact
+factor over a shorter window (one under MIN_WINDOW_S is an error, with its reason).
+
+The real-time factor is simulated time over wall time in that window; simulated time per CPU
+second of the server process says what the page costs the server, whatever the machine's load.
+Both conditions run paced (real time) and unpaced (``--no-realtime``: the simulation's
+throughput); closed and open alternate ``--rounds`` times and the medians are compared.
+
+The latency is measured in the page while the program runs at real time: an input key pressed,
+until the animation frame that first shows the new value (``performance.now()`` at the click
+and in that frame), ``--toggles`` times, with its parts: until the server's answer (``done``)
+arrived and until the new state was on the page. Prints one line per figure, the ratios, the
+load and the date; a benchmark, not a test (nothing asserts a time).
 """
 
 from __future__ import annotations
@@ -32,20 +42,37 @@ from urllib.parse import urlsplit
 
 ROOT = Path(__file__).resolve().parents[1]
 DEFAULT_BACKUP = ROOT.parent / "shared" / "krl-corpus" / "khrzysio__KRC4_test"
-DEFAULT_PROGRAM = "R1/Program/CELL/Other/PrepareMillingTools.src"
+# 142.6 s of simulated time with its cell (corpus/cells/khrzysio__KRC4_test.yaml): long enough
+# for the paced window and the latency toggles on any machine
+DEFAULT_PROGRAM = "R1/Program/CELL/Frame/Mill_FrameAut3.src"
 DEFAULT_CELL = ROOT / "corpus" / "cells" / "khrzysio__KRC4_test.yaml"
 FLAGS = ["--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run", "--disable-background-networking",
          "--disable-component-update", "--disable-sync"]
+#: the shortest window that gives a factor; the reading interval of an unpaced run (s)
+MIN_WINDOW_S = 2.0
+UNPACED_READING_S = 0.5
+#: time limits of the page (a selection checks a whole backup: minutes on a loaded machine)
+PAGE_WAIT_MS = 600_000
 
 
-def _server(backup: Path, cell: Path | None, realtime: bool):
+class BenchError(Exception):
+    """The benchmark could not measure (its reason)."""
+
+
+def _server(root: Path, backup: Path, cell: Path | None, realtime: bool):
+    """``krl pendant`` of the checkout ``root`` (its packages are imported from there)."""
     cmd = [sys.executable, "-m", "krl.cli", "pendant", str(backup), "--no-browser", "--mode", "AUT"]
     if cell is not None:
         cmd += ["--inputs", str(cell)]
     if not realtime:
         cmd.append("--no-realtime")
-    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True, cwd=ROOT)
-    return proc, proc.stdout.readline().strip()
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True, cwd=root)
+    url = proc.stdout.readline().strip()
+    if not url.startswith("http://"):
+        proc.kill()
+        proc.wait(30)
+        raise BenchError(f"krl pendant printed {url!r} first")
+    return proc, url
 
 
 async def _connect(url: str):
@@ -57,36 +84,57 @@ async def _connect(url: str):
                                     additional_headers={"Origin": f"http://{u.hostname}:{u.port}"})
 
 
+def _merge(state: dict | None, m: dict) -> dict:
+    """The state after the state message ``m`` (the whole state, or what changed: a key gone is
+    null), as the page keeps it."""
+    out = {} if m.get("full") or state is None else dict(state)
+    for k, v in m.items():
+        if v is None:
+            out.pop(k, None)
+        else:
+            out[k] = v
+    return out
+
+
 async def _act(ws, rid: int, op: str, **args) -> dict:
-    """One action; the state pushed after it."""
+    """One action; the state after it (the state messages of this connection merged)."""
     await ws.send(json.dumps({"op": op, "id": rid, **args}))
     state = None
     while True:
         m = json.loads(await ws.recv())
         if m["type"] == "state":
-            state = m
+            state = _merge(state, m)
         if m.get("id") == rid and m["type"] in ("done", "error"):
             if m["type"] == "error":
-                raise RuntimeError(m["text"])
+                raise BenchError(f"{op}: {m['text']}")
             while state is None:
                 m = json.loads(await ws.recv())
-                state = m if m["type"] == "state" else None
+                state = _merge(state, m) if m["type"] == "state" else None
             return state
 
 
-async def _start(url: str, program: str) -> None:
-    """Select ``program`` in GO and start it; the connection is closed again (no client)."""
+async def _select(url: str, program: str) -> None:
+    """Select ``program`` in GO (it stands at its first statement); the connection closes again."""
     async with await _connect(url) as ws:
         await _act(ws, 1, "runMode", value="GO")
-        await _act(ws, 2, "select", program=program)
-        await _act(ws, 3, "drives", on=True)
-        await _act(ws, 4, "start")
+        state = await _act(ws, 2, "select", program=program)
+        if state.get("state") != "stopped":
+            raise BenchError(f"{program}: after Select the program is {state.get('state')!r}, not stopped")
 
 
-async def _sim_time(url: str) -> float:
-    """The simulated time now, by a short connection."""
+async def _start(url: str) -> None:
+    """Drives on and Start; the connection closes again (no client)."""
     async with await _connect(url) as ws:
-        return float((await _act(ws, 1, "watch", exprs=[]))["time"])
+        await _act(ws, 1, "drives", on=True)
+        await _act(ws, 2, "start")
+
+
+async def _reading(url: str) -> tuple[str, float | None]:
+    """(the program's state, the simulated time) now, by a short connection."""
+    async with await _connect(url) as ws:
+        s = await _act(ws, 1, "watch", exprs=[])
+        t = s.get("time")
+        return str(s.get("state")), float(t) if isinstance(t, (int, float)) else None
 
 
 def _in_thread(coro):
@@ -97,24 +145,37 @@ def _in_thread(coro):
         return ex.submit(asyncio.run, coro).result()
 
 
-def _window(url: str, pid: int, seconds: float) -> tuple[float, float, float]:
-    """(simulated s, wall s, the server's CPU s) over ``seconds`` of running, with no client of
-    this script connected meanwhile."""
+def _window(url: str, pid: int, seconds: float, every: float) -> tuple[float, float, float]:
+    """(simulated s, wall s, the server's CPU s) between the first and the last reading that
+    found the program running, read each ``every`` s until ``seconds`` have passed or it ended."""
     import psutil  # noqa: PLC0415
 
     proc = psutil.Process(pid)
 
-    def cpu() -> float:
+    def reading():
+        state, sim = _in_thread(_reading(url))
         c = proc.cpu_times()
-        return c.user + c.system
-    s0, t0, c0 = _in_thread(_sim_time(url)), time.perf_counter(), cpu()
-    time.sleep(seconds)
-    s1, t1, c1 = _in_thread(_sim_time(url)), time.perf_counter(), cpu()
-    return s1 - s0, t1 - t0, c1 - c0
+        return state, sim, time.perf_counter(), c.user + c.system
+    first = reading()
+    if first[0] != "running" or first[1] is None:
+        raise BenchError(f"the program is {first[0]!r} a second after Start (not running): nothing to measure")
+    last = first
+    while last[2] - first[2] < seconds:
+        time.sleep(min(every, max(0.0, seconds - (last[2] - first[2]))))
+        r = reading()
+        if r[0] != "running" or r[1] is None:
+            print(f"  (the window ends early: the program is {r[0]!r} after {r[2] - first[2]:.1f} s)", flush=True)
+            break
+        last = r
+    wall = last[2] - first[2]
+    if wall < MIN_WINDOW_S:
+        raise BenchError(f"the program ran only {wall:.2f} s after the first reading (at least {MIN_WINDOW_S:g} s "
+                         "are needed): choose a longer program")
+    return last[1] - first[1], wall, last[3] - first[3]
 
 
 def _with_page(url: str, work):
-    """Run ``work(page)`` with the page open in headless Chromium."""
+    """Run ``work(page)`` with the page open in headless Chromium, once it has drawn the robot."""
     from playwright.sync_api import sync_playwright  # noqa: PLC0415
 
     with sync_playwright() as pw, tempfile.TemporaryDirectory() as profile:
@@ -124,33 +185,59 @@ def _with_page(url: str, work):
         try:
             page = ctx.new_page()
             page.goto(url)
-            page.wait_for_function("() => window.pendant && window.pendant.robot", timeout=300_000)
+            page.wait_for_function("() => window.pendant && window.pendant.robot && window.pendant.frames > 0",
+                                   timeout=PAGE_WAIT_MS)
             return work(page)
         finally:
             ctx.close()
 
 
-def rtf(backup, program, cell, seconds, realtime: bool, page: bool) -> tuple[float, float]:
-    """(simulated s per wall s, simulated s per CPU s of the server process)."""
-    proc, url = _server(backup, cell, realtime)
-    try:
-        _in_thread(_start(url, program))
+def _browser_cpu() -> float:
+    """CPU s of the browser's processes so far (Playwright's Chromium: this process's
+    descendants)."""
+    import psutil  # noqa: PLC0415
+
+    total = 0.0
+    for p in psutil.Process().children(recursive=True):
+        try:
+            if "chrom" in p.name().lower():
+                c = p.cpu_times()
+                total += c.user + c.system
+        except psutil.Error:
+            pass
+    return total
+
+
+def rtf(root, backup, program, cell, seconds, realtime: bool, page: bool) -> tuple:
+    """(simulated s per wall s, simulated s per CPU s of the server, the window's wall s, and
+    with the page open the frames it drew and the browser's CPU s, each per wall s)."""
+    proc, url = _server(root, backup, cell, realtime)
+    every = seconds if realtime else UNPACED_READING_S
+
+    def measure(pg=None):
+        _in_thread(_start(url))
         time.sleep(1.0)                                # past the start-up
-        if not page:
-            sim, wall, cpu = _window(url, proc.pid, seconds)
-        else:
-            def work(pg):
-                pg.wait_for_function("() => window.pendant.state && window.pendant.state.state == 'running'",
-                                     timeout=120_000)
-                return _window(url, proc.pid, seconds)
-            sim, wall, cpu = _with_page(url, work)
-        return sim / wall, sim / max(cpu, 1e-9)
+        if pg is None:
+            sim, wall, cpu = _window(url, proc.pid, seconds, every)
+            return sim / wall, sim / max(cpu, 1e-9), wall, None, None
+        f0, b0, t0 = pg.evaluate("() => window.pendant.frames"), _browser_cpu(), time.perf_counter()
+        sim, wall, cpu = _window(url, proc.pid, seconds, every)
+        f1, b1, t1 = pg.evaluate("() => window.pendant.frames"), _browser_cpu(), time.perf_counter()
+        return sim / wall, sim / max(cpu, 1e-9), wall, (f1 - f0) / (t1 - t0), (b1 - b0) / (t1 - t0)
+    try:
+        _in_thread(_select(url, program))
+        return _with_page(url, measure) if page else measure()
     finally:
         proc.terminate()
         proc.wait(60)
 
 
+# an input key pressed until the frame that shows its new value (ms), with the times at which
+# the server's answer (done) and the last state before it reached the page (``window.pendant``
+# ``lastDone``, ``lastChange``);
+# null when nothing changed within 30 s
 LATENCY_JS = """async (n) => {
+  const P = window.pendant;
   const btn = document.querySelector(`[data-input="${n}"]`);
   const before = btn.textContent;
   const t0 = performance.now();
@@ -158,7 +245,11 @@ LATENCY_JS = """async (n) => {
   return await new Promise((resolve) => {
     const check = () => {
       const now = document.querySelector(`[data-input="${n}"]`);
-      if (now && now.textContent !== before) resolve(performance.now() - t0);
+      const t = performance.now();
+      if (now && now.textContent !== before) {
+        resolve({visible: t - t0, done: (P.lastDone > t0 ? P.lastDone : t) - t0,
+                 state: (P.lastChange > t0 ? P.lastChange : t) - t0});
+      } else if (t - t0 > 30000) resolve(null);
       else requestAnimationFrame(check);
     };
     requestAnimationFrame(check);
@@ -166,30 +257,51 @@ LATENCY_JS = """async (n) => {
 }"""
 
 
-def latency(backup, program, cell, toggles: int, index: int) -> list[float]:
-    proc, url = _server(backup, cell, True)
+def latency(root, backup, program, cell, toggles: int, index: int) -> tuple[list[dict], int]:
+    """The toggles' times (ms) while the program ran at real time, and how many were skipped
+    (the program not running at that toggle, or no change seen)."""
+    proc, url = _server(root, backup, cell, True)
     try:
         def work(page):
             page.select_option("#mode-op", "AUT")
             page.select_option("#run-mode", "GO")
             page.select_option("#programs", program)
             page.click("#select")
-            page.wait_for_function("() => window.pendant.state && window.pendant.state.state == 'stopped'",
-                                   timeout=600_000)
+            page.wait_for_function("() => window.pendant.state && window.pendant.state.state == 'stopped' "
+                                   "&& window.pendant.state.program", timeout=PAGE_WAIT_MS)
             page.click("#drives")
+            page.wait_for_function("() => window.pendant.state.drives", timeout=PAGE_WAIT_MS)
             page.click("#start")
-            page.wait_for_function("() => window.pendant.state.state == 'running' && window.pendant.state.time > 1",
-                                   timeout=600_000)
+            page.wait_for_function("() => window.pendant.state.state != 'stopped' || !window.pendant.state.time",
+                                   timeout=PAGE_WAIT_MS)
+            page.wait_for_function("() => window.pendant.state.state != 'running' || window.pendant.state.time > 1",
+                                   timeout=PAGE_WAIT_MS)
             page.click('#tabs button[data-tab="io"]')
-            out = []
+            out, skipped = [], 0
             for _ in range(toggles):
-                out.append(page.evaluate(LATENCY_JS, index))
+                if page.evaluate("() => window.pendant.state.state") != "running":
+                    skipped += 1
+                    continue
+                r = page.evaluate(LATENCY_JS, index)
+                if r is None:
+                    skipped += 1
+                else:
+                    out.append(r)
                 page.wait_for_timeout(100)
-            return out
+            return out, skipped
         return _with_page(url, work)
     finally:
         proc.terminate()
-        proc.wait(30)
+        proc.wait(60)
+
+
+def _load() -> str:
+    return " ".join(f"{x:.2f}" for x in os.getloadavg())
+
+
+def _pct(xs: list[float], q: float) -> float:
+    xs = sorted(xs)
+    return xs[round(q * (len(xs) - 1))]
 
 
 def main(argv=None) -> int:
@@ -197,41 +309,70 @@ def main(argv=None) -> int:
     ap.add_argument("backup", nargs="?", type=Path, default=DEFAULT_BACKUP)
     ap.add_argument("--program", default=DEFAULT_PROGRAM)
     ap.add_argument("--inputs", type=Path, default=DEFAULT_CELL)
-    ap.add_argument("--seconds", type=float, default=15.0)
+    ap.add_argument("--seconds", type=float, default=15.0, help="the window of each measurement (s)")
     ap.add_argument("--no-latency", action="store_true", help="measure the real-time factors only")
+    ap.add_argument("--latency-only", action="store_true", help="measure the latency only")
+    ap.add_argument("--no-unpaced", action="store_true", help="measure the paced run only")
     ap.add_argument("--rounds", type=int, default=2, help="alternations of page closed and open per pacing")
     ap.add_argument("--toggles", type=int, default=20)
     ap.add_argument("--input", type=int, default=16, help="the input toggled (one the program does not read)")
+    ap.add_argument("--baseline", type=Path, default=None, metavar="CHECKOUT",
+                    help="also measure the krl pendant of another checkout (built: make parser vm-loop), "
+                         "alternating with this one in every round")
     a = ap.parse_args(argv)
-    print(f"load: {os.getloadavg()[0]:.2f} {os.getloadavg()[1]:.2f} {os.getloadavg()[2]:.2f}; "
-          f"{time.strftime('%Y-%m-%d %H:%M')}; {a.backup.name} {a.program}", flush=True)
-    res = {}
-    for realtime in (True, False):
-        # the two conditions alternate, --rounds times each, so that a shared machine's changing
-        # load falls on both alike; the median of each is compared
-        runs = {False: [], True: []}
-        for _ in range(a.rounds):
-            for page in (False, True):
-                runs[page].append(rtf(a.backup, a.program, a.inputs, a.seconds, realtime, page))
-        for page in (False, True):
-            r = statistics.median(x[0] for x in runs[page])
-            per_cpu = statistics.median(x[1] for x in runs[page])
-            res[(realtime, page)] = (r, per_cpu)
-            each = ", ".join(f"{x[0]:.3f}" for x in runs[page])
-            print(f"real-time factor, {'paced' if realtime else 'unpaced'}, page {'open' if page else 'closed'}: "
-                  f"{r:.3f} (rounds: {each}; simulated s per CPU s of the server: {per_cpu:.3f})", flush=True)
-        for k, what in ((0, "real-time factor"), (1, "simulated s per server CPU s")):
-            drop = 1 - res[(realtime, True)][k] / res[(realtime, False)][k]
-            print(f"  {'paced' if realtime else 'unpaced'}: with the page open the {what} drops by {drop:+.1%}",
-                  flush=True)
-    print(f"load at the end: {os.getloadavg()[0]:.2f} {os.getloadavg()[1]:.2f} {os.getloadavg()[2]:.2f}", flush=True)
-    if a.no_latency:
-        return 0
-    lat = latency(a.backup, a.program, a.inputs, a.toggles, a.input)
-    lat.sort()
-    print(f"input -> visible change (ms, {len(lat)} toggles at real time): median {statistics.median(lat):.1f}, "
-          f"p95 {lat[int(0.95 * (len(lat) - 1))]:.1f}, max {lat[-1]:.1f}", flush=True)
+    a.roots = [ROOT] + ([a.baseline.resolve()] if a.baseline is not None else [])
+    print(f"load: {_load()}; {time.strftime('%Y-%m-%d %H:%M %Z')}; {os.cpu_count()} cores; "
+          f"{a.backup.name} {a.program}; krl pendant of {', '.join(map(str, a.roots))}", flush=True)
+    try:
+        if not a.latency_only:
+            _factors(a)
+        if not a.no_latency:
+            _latency(a)
+    except BenchError as exc:
+        print(f"pendant.bench: {exc}", file=sys.stderr)
+        return 1
+    print(f"load at the end: {_load()}", flush=True)
     return 0
+
+
+def _factors(a) -> None:
+    for realtime in (True, False) if not a.no_unpaced else (True,):
+        # the conditions (each checkout with the page closed and open) alternate, --rounds times
+        # each, so that a shared machine's changing load falls on all alike; medians compared
+        runs = {(root, page): [] for root in a.roots for page in (False, True)}
+        for _ in range(a.rounds):
+            for root in a.roots:
+                for page in (False, True):
+                    runs[(root, page)].append(rtf(root, a.backup, a.program, a.inputs, a.seconds, realtime, page))
+        pacing = "paced" if realtime else "unpaced"
+        for root in a.roots:
+            res = {}
+            who = f" [{root}]" if len(a.roots) > 1 else ""
+            for page in (False, True):
+                xs = runs[(root, page)]
+                res[page] = (statistics.median(x[0] for x in xs), statistics.median(x[1] for x in xs))
+                each = ", ".join(f"{x[0]:.3f}/{x[1]:.2f} in {x[2]:.1f} s" for x in xs)
+                fps = (f"; the page drew {statistics.median(x[3] for x in xs):.1f} frames/s with "
+                       f"{statistics.median(x[4] for x in xs):.2f} browser CPU s/s") if page else ""
+                print(f"{pacing}, page {'open' if page else 'closed'}{who}: real-time factor {res[page][0]:.3f}, "
+                      f"simulated s per server CPU s {res[page][1]:.3f} (rounds: {each}{fps})", flush=True)
+            for k, what in ((0, "real-time factor"), (1, "simulated s per server CPU s")):
+                drop = 1 - res[True][k] / res[False][k]
+                print(f"  {pacing}{who}: with the page open the {what} drops by {drop:+.1%}", flush=True)
+
+
+def _latency(a) -> None:
+    for root in a.roots:
+        lat, skipped = latency(root, a.backup, a.program, a.inputs, a.toggles, a.input)
+        if not lat:
+            raise BenchError(f"no toggle was measured while the program ran ({skipped} skipped)")
+        who = f" [{root}]" if len(a.roots) > 1 else ""
+        for key, what in (("visible", "input -> visible change"),
+                          ("state", "  of which: until the new state was on the page"),
+                          ("done", "  of which: until the server's answer arrived")):
+            xs = [r[key] for r in lat]
+            print(f"{what}{who} (ms, {len(xs)} toggles at real time{f', {skipped} skipped' if skipped else ''}): "
+                  f"median {statistics.median(xs):.1f}, p95 {_pct(xs, 0.95):.1f}, max {max(xs):.1f}", flush=True)
 
 
 if __name__ == "__main__":

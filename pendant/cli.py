@@ -90,7 +90,11 @@ def serve(root: Path, *, port: int = 0, open_browser: bool = True, inputs: str |
     app = Pendant(root, inputs=inputs, mode=mode, realtime=realtime, trace=trace, program=program,
                   readonly=readonly, shown_root=shown)
     config = uvicorn.Config(create_app(app, token, lambda: bound), log_level="warning", ws="websockets-sansio",
-                            ws_max_size=MAX_WEB_MESSAGE_BYTES, lifespan="on", access_log=False)
+                            ws_max_size=MAX_WEB_MESSAGE_BYTES, lifespan="on", access_log=False,
+                            # loopback: compressing each message (the pose at display rate, the
+                            # state) cost the server more CPU than anything else it does for a page
+                            # (py-spy, python -m pendant.bench)
+                            ws_per_message_deflate=False)
     if open_browser:
         import threading  # noqa: PLC0415
         import webbrowser  # noqa: PLC0415

@@ -17,6 +17,7 @@ messages.
 
 from __future__ import annotations
 
+import asyncio
 import time
 from pathlib import Path
 
@@ -117,6 +118,20 @@ class Engine:
     def do(self, fn, timeout: float = 120.0):
         """Run ``fn(core)`` on the engine thread (the pendant's own work: keys, the snapshot)."""
         return self.call(lambda: fn(self.core), timeout=timeout)
+
+    async def do_async(self, fn, timeout: float = 120.0):
+        """:meth:`do` awaited on the event loop: the engine thread's result wakes the loop
+        directly (no executor thread blocks on it, so a key costs no thread hand-over beyond the
+        engine's own). Raises :class:`EngineError`."""
+        core = self.core
+        if core is None or core.done:
+            raise EngineError("no program is selected")
+        try:
+            return await asyncio.wait_for(asyncio.wrap_future(core.post(lambda: fn(core))), timeout)
+        except Refused as exc:
+            raise EngineError(str(exc)) from None
+        except asyncio.TimeoutError:
+            raise EngineError("the controller did not answer in time") from None
 
     # ------------------------------------------------------------------ each run
     def _on_runtime(self, rt) -> None:

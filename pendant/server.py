@@ -4,12 +4,16 @@
 Routes: ``/`` the page, ``/static/...`` its bundle (built from pendant/web, committed), ``/ws``
 the one websocket. On the websocket the page sends operator actions as JSON objects
 ``{"op": ..., ...}`` (:data:`OPS`) and receives ``{"type": ...}`` objects: ``init`` (workspace,
-programs, robot), ``module`` (a file's text and taught points), ``state`` (pendant/state.py),
-``live`` (time, axes and pointers at display rate while the program runs), ``error`` (a key's
-refusal, in the controller's words) and ``event`` (the engine's stops and ends).
+programs, robot), ``module`` (a file's text and taught points), ``state`` (pendant/state.py: the
+whole state first, ``"full": true``, then only the top-level keys that changed, a key gone as
+null), ``live`` (time, axes, the TCP path's new points and, when they changed, the pointers, at
+display rate while the program runs), ``error`` (a key's refusal, in the controller's words) and
+``event`` (the engine's stops and ends). The messages are not compressed (loopback: deflate was
+the largest CPU cost of a connected page).
 
 Threads: uvicorn's event loop serves the page; the program runs on the engine's thread
-(pendant/engine.py); a blocking engine request runs in the loop's executor. Limits
+(pendant/engine.py), whose answers the loop awaits (``Engine.do_async``); what blocks (select,
+cancel, reading files) runs in the loop's executor. Limits
 (krl/limits.py): MAX_WEB_MESSAGE_BYTES per websocket message (uvicorn's ``ws_max_size``: a
 larger one closes the connection, 1009), MAX_WEB_CONNECTIONS websockets at once,
 MAX_WEB_MESSAGES_PER_S per connection, counted as they arrive (past it, or with a second's
@@ -75,7 +79,10 @@ class Pendant:
         self._robot = None
         self._programs = None
         self._last_live = None
+        self._live_pointers = None
         self._path_run, self._path_sent = None, 0
+        self._shown: dict[WebSocket, dict] = {}     # per page: the state it was last sent
+        self._pushing = asyncio.Lock()
         self._modules: dict[str, tuple] = {}
 
     # ------------------------------------------------------------------ static data
@@ -119,12 +126,11 @@ class Pendant:
         if not self.engine.selected:
             return {"state": "none", "program": None, "drives": self.drives, "modeOp": self.mode,
                     "runMode": self.run_mode}
-        loop = asyncio.get_running_loop()
         try:
             from .state import snapshot  # noqa: PLC0415
 
             eng, watch = self.engine, list(self.watch)
-            s = await loop.run_in_executor(None, lambda: eng.do(lambda core: snapshot(eng, core, watch), 60.0))
+            s = await eng.do_async(lambda core: snapshot(eng, core, watch), 60.0)
         except EngineError as exc:
             s = {"state": "ended" if not self.engine.selected else "busy", "note": str(exc)}
         s.update({"program": self.program, "drives": self.drives, "breakpoints":
@@ -132,8 +138,36 @@ class Pendant:
         return s
 
     async def push_state(self) -> None:
-        if self.clients:
-            await self.broadcast({"type": "state", **await self.state()})
+        """The state to every page, as what changed since the state that page was sent last
+        (pendant/state.py: top-level keys, a key gone is sent as null; the first is whole,
+        ``"full": true``): a page keeps its state and redraws only the changed parts."""
+        if not self.clients:
+            return
+        async with self._pushing:                     # one at a time: each page's diffs in order
+            await self._push_state()
+
+    async def _push_state(self) -> None:
+        s = await self.state()
+        texts: dict[tuple, str] = {}                  # one encoding per distinct message
+        for ws in list(self.clients):
+            last = self._shown.get(ws)
+            if last is None:
+                msg = {"type": "state", "full": True, **s}
+            else:
+                msg = {k: v for k, v in s.items() if k not in last or last[k] != v}
+                msg.update({k: None for k in last if k not in s})
+                msg = {"type": "state", "state": s.get("state"), **msg}
+            key = tuple(msg) if last is not None else ("full",)
+            text = texts.get(key)
+            if text is None:
+                text = texts[key] = json.dumps(msg, allow_nan=False, default=str)
+            try:
+                await ws.send_text(text)
+            except Exception:  # noqa: BLE001 - a client gone meanwhile
+                self.clients.discard(ws)
+                self._shown.pop(ws, None)
+                continue
+            self._shown[ws] = s
 
     async def ticker(self) -> None:
         """Display rate: the live pose while the program runs, the state now and then."""
@@ -152,7 +186,12 @@ class Pendant:
                     self._path_run, self._path_sent = run, 0
                 new = path[self._path_sent:self._path_sent + 5000]
                 self._path_sent += len(new)
-                await self.broadcast({"type": "live", **live, "path": new})
+                msg = {"type": "live", **live, "axes": [round(v, 4) for v in live["axes"]], "path": new}
+                if live.get("pointers") == self._live_pointers:
+                    del msg["pointers"]              # unchanged since the last pose sent
+                else:
+                    self._live_pointers = live.get("pointers")
+                await self.broadcast(msg)
                 k += 1
                 if k % every == 0 and self.engine.state == "running":
                     await self.push_state()
@@ -165,7 +204,7 @@ class Pendant:
         loop = asyncio.get_running_loop()
 
         def do(fn, timeout=120.0):
-            return loop.run_in_executor(None, lambda: self.engine.do(fn, timeout))
+            return self.engine.do_async(fn, timeout)
 
         if op == "hello":
             from .view import modules  # noqa: PLC0415
@@ -338,6 +377,7 @@ class Pendant:
             with contextlib.suppress(asyncio.CancelledError, WebSocketDisconnect):
                 await worker
             self.clients.discard(ws)
+            self._shown.pop(ws, None)
 
     async def _actions(self, ws: WebSocket, queue: asyncio.Queue) -> None:
         """Carry out the queued messages of one connection in order, each answered with

@@ -700,7 +700,7 @@ class Controller:
         """
         self._events = []
         self._k += 1
-        t = self.time
+        t = self._k * self.dt          # self.time
         self.io.now = t
         if self.network is not None and self.network.polling:
             self.network.cycle(self)
@@ -713,7 +713,8 @@ class Controller:
                 else:
                     keep.append((te, n, lvl))
             self._pulses = keep
-        self._apply_stimuli(t)
+        if self.stimuli:
+            self._apply_stimuli(t)
         if self.rules:
             step_rules(self.rules, self.io, t, self.dt)
 
@@ -735,7 +736,8 @@ class Controller:
         self._q = np.asarray(q, dtype=float)
         if self._braking and self._scale <= 0.0:
             self._hold()
-        self._fire_triggers(self._pt)
+        if self._tracked:
+            self._fire_triggers(self._pt)
         if self._arm is not None:
             if self.actuated:
                 self._arm.step_actuated(self._q, self.dt, (self._q - self._q_prev) / self.dt)
@@ -744,9 +746,11 @@ class Controller:
         qa = self.axis_act()
         self._tcp_prev = self._tcp_T[:3, 3].copy()
         self._tcp_T = self._tcp_read_back(qa, self._tool_T, self._base_inv_T)
-        for fn in list(self._cyclic.values()):
-            fn(self)
-        self._reach_stimuli()
+        if self._cyclic:
+            for fn in list(self._cyclic.values()):
+                fn(self)
+        if self.stimuli and self._runs:
+            self._reach_stimuli()
         if self.trace is not None:
             self.trace.write_pose(t, qa, self._tcp_T)
         return self._events
@@ -932,11 +936,13 @@ class Controller:
         lim = self._step_lim
         if lim is None:
             lim = self._step_lim = (CP_SPEED_LIMIT_FACTOR * self.model.v_max * self.dt + 1e-9).tolist()
-        step = [abs(a - b) for a, b in zip(np.asarray(q).tolist(), self._q_prev.tolist())]
-        if any(d > m for d, m in zip(step, lim)):
-            i = max(range(len(step)), key=lambda j: step[j] / lim[j])
-            name = f"A{i + 1}" if i < 6 else f"E{i - 5}"
-            raise RobotError(f"speed limit exceeded {name}: CP path through a singularity")
+        step = [abs(a - b) for a, b in zip(q.tolist() if type(q) is np.ndarray else np.asarray(q).tolist(),
+                                           self._q_prev.tolist())]
+        for d, m in zip(step, lim):
+            if d > m:
+                i = max(range(len(step)), key=lambda j: step[j] / lim[j])
+                name = f"A{i + 1}" if i < 6 else f"E{i - 5}"
+                raise RobotError(f"speed limit exceeded {name}: CP path through a singularity")
 
     def _fault(self, err: RobotError) -> np.ndarray:
         mid = self._runs[0].seg.id if self._runs else None

@@ -148,6 +148,8 @@ class IOImage:
     def tick_timers(self, dt_ms: int) -> None:
         """Advance every running ``$TIMER`` by ``dt_ms`` (called once per IPO cycle)."""
         tm, st = self.timer_ms, self.timer_stop
+        if False not in st:         # every timer stopped (the common case): nothing to count
+            return
         for i in range(1, N_TIMERS + 1):
             if not st[i]:
                 tm[i] += dt_ms

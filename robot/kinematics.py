@@ -21,7 +21,9 @@ chain, never from the robot's name (:attr:`Kinematics.family`):
   the ``mink`` library from seeds), with the same status/turn selection and errors.
 
 Each analytic form is checked against the machine-data chain when it is chosen. A vectorised
-entry point, :meth:`Kinematics.inverse_many`, solves N targets at once with numpy.
+entry point, :meth:`Kinematics.inverse_many`, solves N targets at once with numpy. For the OPW
+family, :meth:`Kinematics.inverse` runs the compiled mirror of its Python code when it is built
+(robot/simcore.pyx, robot/build.py; the same axes bit for bit, about 20x faster).
 """
 
 from __future__ import annotations
@@ -37,6 +39,11 @@ from .errors import SoftLimitError, WorkspaceError
 from .frames import as_matrix, inv_pos
 from .machine import MachineData, load_machine
 
+try:  # the compiled OPW inverse (robot/build.py); absent without a build: the Python code runs
+    from . import simcore as _simcore
+except ImportError:
+    _simcore = None
+
 #: Values closer than this to a status/turn switching point count as "on" it (deg, mm).
 BOUNDARY_EPS = 1e-9
 #: |A5| (deg) below which the wrist is treated as singular (A4 + A6 only defined).
@@ -47,11 +54,25 @@ OVERHEAD_SINGULAR_MM = 1e-6
 _ACOS_TOL = 1e-9
 #: Tolerance of the soft-limit test (deg), absorbs floating-point noise.
 LIMIT_EPS_DEG = 1e-9
+#: Use the compiled OPW inverse (robot/simcore.pyx) when it is built; False: the Python code
+#: (the reference: the two agree bit for bit, tests/robot/test_simcore.py)
+USE_COMPILED = True
+#: The ``ABI`` of robot/simcore.pyx this module mirrors (a stale build is not used)
+SIMCORE_ABI = 2
 
 
 def _wrap180(v: np.ndarray) -> np.ndarray:
     """Wrap angles (deg) to (-180, 180]."""
     return -((-np.asarray(v, dtype=float) + 180.0) % 360.0) + 180.0
+
+
+def _compiled_opw(kin: "Kinematics") -> Any:
+    """The compiled OPW inverse of `kin` (robot/simcore.pyx, built by robot/build.py), or False
+    when the extension is not built, is stale (its ``ABI``) or :data:`USE_COMPILED` is off."""
+    if not USE_COMPILED or _simcore is None or getattr(_simcore, "ABI", None) != SIMCORE_ABI:
+        return False
+    return _simcore.OPW(kin._opw, kin._kappa_2, kin._c2_2, kin._k, kin._at23, kin.phi_deg, kin._sgn,
+                      kin._offs, kin._lo_l, kin._hi_l, kin._ks_l, kin._s_free, kin._t_free)
 
 
 class Kinematics:
@@ -102,6 +123,7 @@ class Kinematics:
         self._numeric: Any = None   # the numeric solver (robot/ik_numeric.py), built on first use
         self._base_inv: np.ndarray | None = None   # INV(frame before the OPW arm), None: identity
         self._end_inv: np.ndarray | None = None    # INV(frame after it)
+        self._c_opw: Any = None     # robot/simcore.pyx's OPW for this robot; False: not used
         self._s_free = 0            # S bits that select nothing on this robot
         self._t_free = 0            # T bits that select nothing on this robot
         #: the inverse kinematics of this robot: "opw", "palletizer4", "palletizer5" or "numeric"
@@ -147,6 +169,7 @@ class Kinematics:
 
     def _set_opw(self, o) -> None:
         self._opw = o
+        self._c_opw = None
         self._sign = np.array(o.sign_corrections, dtype=float)
         self._off = np.radians(np.array(o.offsets_deg, dtype=float))
         self._kappa_2 = o.a2 * o.a2 + o.c3 * o.c3
@@ -536,6 +559,19 @@ class Kinematics:
                 ``$SOFTN_END``/``$SOFTP_END``.
         """
         ref = self._home.copy() if reference_deg is None else np.asarray(reference_deg, dtype=float)[:6]
+        c = self._c_opw
+        if c is None:
+            c = self._compiled()
+        if c:
+            # the compiled mirror of _opw_core + _select (robot/simcore.pyx); None: Python decides
+            T = np.asarray(flange_T, dtype=float)
+            if self._base_inv is not None:
+                T = self._base_inv @ T
+            if self._end_inv is not None:
+                T = T @ self._end_inv
+            q = c.inverse(T, status, turn, ref)
+            if q is not None:
+                return q
         if self.family == "numeric" and reference_deg is not None:
             # the solution reached from the reference: the nearest one, when its S and T fit
             if self._numeric is None:
@@ -547,6 +583,18 @@ class Kinematics:
                 except (WorkspaceError, SoftLimitError):
                     pass
         return self._select(self._opw_rows(flange_T, ref), status, turn, ref)
+
+    def _compiled(self) -> Any:
+        """The compiled OPW inverse of this robot (kept), or False (not built, not the OPW family)."""
+        if self._c_opw is None:
+            ok = self.family == "opw" and self._pa is None and self._pa5 is None
+            self._c_opw = _compiled_opw(self) if ok else False
+        return self._c_opw
+
+    @property
+    def compiled_inverse(self) -> bool:
+        """True when :meth:`inverse` runs the compiled OPW code (robot/simcore.pyx)."""
+        return bool(self._compiled())
 
     def _select(self, rows: list[list[float]], status: int | None, turn: int | None,
                 ref: np.ndarray) -> np.ndarray:
@@ -865,10 +913,3 @@ class Kinematics:
         x, y, z, a, b, c = matrix_to_frame(self.tcp_pose(axes_deg, tool, base, robroot))
         s, t = self.status_turn(axes_deg)
         return (x, y, z, a, b, c, s, t)
-
-    def inverse_tcp(self, tcp_in_base: Any, status: int | None = None, turn: int | None = None,
-                    reference_deg: Sequence[float] | None = None, tool: Any = None,
-                    base: Any = None, robroot: Any = None) -> np.ndarray:
-        """Convenience: :meth:`inverse` of :meth:`flange_target`. Same errors."""
-        return self.inverse(self.flange_target(tcp_in_base, tool, base, robroot),
-                            status, turn, reference_deg)

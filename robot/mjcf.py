@@ -223,6 +223,8 @@ class ArmModel:
         self._eadr = np.array([self.model.joint(f"joint_e{e.number}").qposadr[0] for e in ext], dtype=int)
         self._escale = np.array([0.001 if e.linear else math.pi / 180.0 for e in ext])
         self._site = self.model.site("tool0").id
+        # views into MjData of the flange site's rotation (3x3) and position (m), read each cycle
+        self._site_views = (self.data.site_xmat[self._site].reshape(3, 3), self.data.site_xpos[self._site])
         self._robroot = frame_to_matrix(self.machine.robroot_frame)
         self._robroot_inv = inv_pos(self._robroot)
         self._robroot_null = bool(np.allclose(self._robroot, np.eye(4)))
@@ -259,9 +261,10 @@ class ArmModel:
 
     def flange_pose_world(self) -> np.ndarray:
         """KUKA flange frame (site ``tool0``) in ``$WORLD`` (MuJoCo world), 4x4, mm."""
+        xmat, xpos = self._site_views
         T = np.empty((4, 4))
-        T[:3, :3] = self.data.site_xmat[self._site].reshape(3, 3)
-        T[:3, 3] = 1000.0 * self.data.site_xpos[self._site]
+        T[:3, :3] = xmat
+        T[:3, 3] = 1000.0 * xpos
         T[3] = _BOTTOM_ROW
         return T
 

@@ -162,8 +162,11 @@ class RobotModel:
     @property
     def batch_ik(self) -> bool:
         """True when :meth:`ik_chain` solves in numpy (the OPW family, no external axes and
-        no linked $BASE); otherwise it returns None and callers solve cycle by cycle."""
-        return type(self) is RobotModel and not self.n_ext and self.kin.family == "opw"
+        no linked $BASE, and no compiled inverse: robot/simcore.pyx solves one pose faster than
+        numpy's passes over a chain, measured); otherwise it returns None and callers solve
+        cycle by cycle."""
+        return (type(self) is RobotModel and not self.n_ext and self.kin.family == "opw"
+                and not self.kin.compiled_inverse)
 
     def ik_chain(self, poses: list[tuple[np.ndarray, np.ndarray]], tool_inv_T: np.ndarray | None,
                  base_T: np.ndarray | None, status: int | None, ref: np.ndarray) -> np.ndarray | None:
@@ -522,6 +525,7 @@ class Segment:
         eye = np.eye(4)
         self._ik_tool = None if np.array_equal(self.tool_inv_T, eye) else self.tool_inv_T
         self._ik_base = None if np.array_equal(base_T, eye) else base_T
+        self._c_ik: Any = None      # CartSegment.ik's compiled inverse (robot/simcore.pyx), False: none
         self.model = model
         self.status = model.status_turn(q0)[0]
         self.triggers: list[TriggerPlan] = []
@@ -709,6 +713,19 @@ class CartSegment(Segment):
         start status S, turn nearest to ``ref``. With external axes they take their value
         at the path parameter `u` (``E0 + u·(E1 - E0)``), or ``ref``'s without `u`.
         Raises WorkspaceError/SoftLimitError."""
+        c = self._c_ik
+        if c is None:
+            c = self._c_ik = self._compiled_ik()
+        if c:
+            # no $TOOL, $BASE, $ROBROOT or external axes between this pose and the arm's: the
+            # compiled inverse solves it as it stands (robot/simcore.pyx; the same axes as
+            # below); None: the Python code decides (and raises)
+            try:
+                q = c.inverse_rp(R, p, self.status, None, ref)
+            except (TypeError, ValueError):     # not float64 arrays: the Python code takes them
+                q = None
+            if q is not None:
+                return q
         T = np.empty((4, 4))
         T[:3, :3] = R
         T[:3, 3] = p
@@ -716,6 +733,14 @@ class CartSegment(Segment):
         if u is not None and len(ref) > 6:
             ref = np.concatenate([ref[:6], self.q0[6:] + u * (self.e1 - self.q0[6:])])
         return self.model.ik(T, self._ik_tool, self._ik_base, self.status, None, ref)
+
+    def _compiled_ik(self) -> Any:
+        """The compiled inverse for :meth:`ik`'s poses as they stand, or False."""
+        m = self.model
+        if (type(m) is not RobotModel or m.n_ext or not m._robroot_is_null or self._ik_tool is not None
+                or self._ik_base is not None or m.kin._base_inv is not None or m.kin._end_inv is not None):
+            return False
+        return m.kin._compiled()
 
     def ik_chain(self, poses: list[tuple[np.ndarray, np.ndarray]], ref: np.ndarray) -> np.ndarray | None:
         """:meth:`ik` of each pose with the previous solution as reference (the first: `ref`),

@@ -18,6 +18,11 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import IO, Any
 
+try:  # the compiled pose-line formatter (robot/build.py); absent without a build: Python formats
+    from .simcore import pose_line as _pose_line
+except ImportError:
+    _pose_line = None
+
 #: kind -> ordered list of (field, description). Fields marked "optional" may be absent.
 SCHEMA: dict[str, list[tuple[str, str]]] = {
     "motion": [
@@ -273,25 +278,36 @@ class TraceWriter:
             self.flush()
 
     def flush(self) -> None:
-        """Write the queued pose events. The line is formatted directly: the same bytes as
+        """Write the queued events: pose events and the events written after the first of
+        them, in order (the poses' X, Y, Z, A, B, C are converted in one batch: the conversion's
+        cost is mostly per call). A pose line is formatted directly: the same bytes as
         ``json.dumps`` of the event (``repr`` of each rounded float, ``-0.0`` written as 0),
         without its generic encoder and :func:`_clean`'s recursion (a quarter of the
         benchmark's time went here); a non-finite number takes the generic path."""
         if not self._poses:
             return
         poses, self._poses = self._poses, []
-        frames = _frames_of([T for _, _, T in poses])
-        for (t, axes, _), fr in zip(poses, frames):
+        frames = iter(_frames_of([T for t, _, T in poses if t is not None]))
+        for t, axes, line in poses:
+            if t is None:            # an event queued behind the poses (_emit)
+                self._write(axes, line)
+                continue
+            fr = next(frames)
             vals = axes.tolist() if hasattr(axes, "tolist") else axes
+            if _pose_line is not None and not self.keep:
+                line = _pose_line(t, vals, fr)     # the same bytes, compiled (robot/simcore.pyx)
+                if line is not None:
+                    self._write(None, line)         # type: ignore[arg-type]  (not kept)
+                    continue
             ax = [_round6(float(v)) for v in vals]
             tcp = [_round6(v) for v in fr]
             tt = round_time(t)
             axs, tcs = ",".join(map(repr, ax)), ",".join(map(repr, tcp))
             ev = {"t": tt, "kind": "pose", "axes": ax, "tcp": tcp}
             if "n" in axs or "n" in tcs:  # nan / inf: json.dumps writes NaN / Infinity
-                self._emit(ev)
+                self._write(ev, json.dumps(ev, separators=(",", ":"), ensure_ascii=True))
             else:
-                self._emit(ev, f'{{"t":{tt!r},"kind":"pose","axes":[{axs}],"tcp":[{tcs}]}}')
+                self._write(ev, f'{{"t":{tt!r},"kind":"pose","axes":[{axs}],"tcp":[{tcs}]}}')
 
     def write_event(self, ev: dict[str, Any]) -> None:
         """Write an already built event dict (from :func:`make_event`)."""
@@ -312,8 +328,6 @@ class TraceWriter:
                     self._leave_out(ev["kind"], ev["t"])
                     return
             self._write_left(ev["t"])
-        if self._poses:
-            self.flush()
         self._emit(ev)
 
     def _leave_out(self, kind: str, t: float) -> None:
@@ -329,15 +343,20 @@ class TraceWriter:
             return
         left, self._left = self._left, {}
         since, self._left_since = self._left_since, None
-        if self._poses:
-            self.flush()
         self._emit(make_event("repeat", self._left_last if t is None else max(t, self._left_last),
                               count=sum(left.values()), since=since, kinds=dict(sorted(left.items()))))
 
     def _emit(self, ev: dict[str, Any], line: str | None = None) -> None:
-        """Keep and/or write event `ev`; `line` is its JSON text when the caller formatted it."""
+        """Keep and/or write event `ev`; `line` is its JSON text when the caller formatted it.
+        Behind queued poses the event waits in their queue (:meth:`flush` writes it in order)."""
         if line is None:
             line = json.dumps(ev, separators=(",", ":"), ensure_ascii=True)
+        if self._poses:
+            self._poses.append((None, ev, line))
+        else:
+            self._write(ev, line)
+
+    def _write(self, ev: dict[str, Any], line: str) -> None:
         if self.keep:
             self._events.append(ev)
         if self._memory:
@@ -394,6 +413,10 @@ def _wrap180(v: Any) -> Any:
     return np.where(np.abs(w) < 1e-12, 0.0, w)
 
 
+#: the last matrix (bytes) of a pose in gimbal lock that _frames_of converted, and its frame
+_GIMBAL_LAST: list[tuple[Any, Any]] = [(None, None)]
+
+
 def _frames_of(Ts: list[Any]) -> list[list[float]]:
     """Vectorised :func:`robot.frames.matrix_to_frame` for a list of 4x4 matrices."""
     import warnings
@@ -412,7 +435,14 @@ def _frames_of(Ts: list[Any]) -> list[list[float]]:
     out = []
     for i, (p, ai, b, ci) in enumerate(zip(M[:, :3, 3].tolist(), a.tolist(), abc[:, 1].tolist(), c.tolist())):
         if abs(abs(b) - 90.0) < GIMBAL_TOL_DEG:
-            out.append(list(matrix_to_frame(M[i])))
+            # one by one (a robot at rest in gimbal lock, e.g. at HOME, repeats its matrix:
+            # the last answer is kept)
+            key = M[i].tobytes()
+            last_key, frame = _GIMBAL_LAST[0]
+            if last_key != key:
+                frame = list(matrix_to_frame(M[i]))
+                _GIMBAL_LAST[0] = (key, frame)
+            out.append(list(frame))
         else:
             out.append([p[0], p[1], p[2], ai, b, ci])
     return out

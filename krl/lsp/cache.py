@@ -53,6 +53,7 @@ _POS = [tuple(f.name for f in dataclasses.fields(c) if f.name not in ("span", "a
         for c in _CLASSES]
 _KW = [tuple(f.name for f in dataclasses.fields(c) if f.name not in ("span", "ann") and f.kw_only)
        for c in _CLASSES]
+_FIELDS = [p + k for p, k in zip(_POS, _KW)]
 _LIST, _TUPLE = -1, -2
 
 
@@ -62,38 +63,70 @@ class CorruptEntry(ValueError):
 
 # ---------------------------------------------------------------------- the codec
 
-def _enc(v):
-    if isinstance(v, N.Node):
-        i = _INDEX[type(v)]
-        return [i, v.span.line, v.span.column, *[_enc(getattr(v, f)) for f in _POS[i]],
-                *[_enc(getattr(v, f)) for f in _KW[i]]]
-    if type(v) is list:
-        return [_LIST, *[_enc(x) for x in v]]
-    if type(v) is tuple:
-        return [_TUPLE, *[_enc(x) for x in v]]
-    if v is None or type(v) in (int, float, str, bool):
-        return v
-    raise TypeError(f"no cache encoding for {type(v).__name__}")
+# An AST in an entry: a node is [class number, line, column, *fields], a list [_LIST, *items], a
+# tuple [_TUPLE, *items], anything else a scalar (None, bool, int, float, str). msgpack's C code
+# walks the structure both ways. Encoding: it packs lists and scalars itself and asks
+# :func:`_pack_default` for nodes and tuples (strict_types: a tuple, or a subclass of a type it
+# packs, is never packed as something else; any other type is refused, the file not cached).
+# Decoding: it hands each array of the module's subtree, bottom-up, to the hook that builds its
+# node, list or tuple; bins, maps and extension types are refused. (Measured on the 596 corpus
+# files, CPU: encoding 0.71 -> 0.28 s, decoding 1.19 -> 0.86 s against the recursive Python
+# codec of the same bytes, 2026-11-24.)
+
+def _tagged_list(x: list) -> list:
+    return [_LIST, *(x if list not in map(type, x) else map(_wrap, x))]
 
 
-def _dec(v, path: str):
-    if type(v) is not list:
-        if v is None or type(v) in (int, float, str, bool):
+def _wrap(x):
+    return _tagged_list(x) if type(x) is list else x
+
+
+def _pack_default(v):
+    t = type(v)
+    i = _INDEX.get(t)
+    if i is not None:
+        out = [i, v.span.line, v.span.column]
+        for f in _FIELDS[i]:
+            x = getattr(v, f)
+            out.append(_tagged_list(x) if type(x) is list else x)
+        return out
+    if t is tuple:
+        return [_TUPLE, *(v if list not in map(type, v) else map(_wrap, v))]
+    raise TypeError(f"no cache encoding for {t.__name__}")
+
+
+def _refuse(*_args):
+    raise CorruptEntry("a map or an extension type in an entry")
+
+
+def _node_hook(path: str, on: list[bool]):
+    """The list hook of an entry of `path`: builds nodes while ``on[0]`` (the module's
+    subtree), else leaves arrays as they are."""
+    classes, pos, kw, span = _CLASSES, _POS, _KW, N.Span
+    count = len(classes)
+
+    def hook(v: list):
+        if not on[0]:
             return v
-        raise CorruptEntry(f"unexpected {type(v).__name__}")
-    tag = v[0]
-    if tag == _LIST:
-        return [_dec(x, path) for x in v[1:]]
-    if tag == _TUPLE:
-        return tuple(_dec(x, path) for x in v[1:])
-    if type(tag) is not int or not 0 <= tag < len(_CLASSES):
-        raise CorruptEntry("not a node")
-    pos, kw = _POS[tag], _KW[tag]
-    n = 3 + len(pos)
-    if len(v) != n + len(kw) or type(v[1]) is not int or type(v[2]) is not int:
-        raise CorruptEntry("a node of another shape")
-    return _CLASSES[tag](*[_dec(x, path) for x in v[3:n]], span=N.Span(path, v[1], v[2]),
-                         **{k: _dec(x, path) for k, x in zip(kw, v[n:])})
+        tag = v[0] if v else None
+        if type(tag) is not int:
+            raise CorruptEntry("not a node")
+        if bytes in map(type, v):
+            raise CorruptEntry("unexpected bytes")
+        if tag == _LIST:
+            return v[1:]
+        if tag == _TUPLE:
+            return tuple(v[1:])
+        if not 0 <= tag < count:
+            raise CorruptEntry("not a node")
+        p, k = pos[tag], kw[tag]
+        n = 3 + len(p)
+        if len(v) != n + len(k) or type(v[1]) is not int or type(v[2]) is not int:
+            raise CorruptEntry("a node of another shape")
+        if k:
+            return classes[tag](*v[3:n], span=span(path, v[1], v[2]), **dict(zip(k, v[n:])))
+        return classes[tag](*v[3:n], span=span(path, v[1], v[2]))
+    return hook
 
 
 _DIAG = (int, int, str, str, str, int, int, str, list)
@@ -120,9 +153,9 @@ def encode_loaded(lf: LoadedFile) -> bytes | None:
     if any(d.path != lf.path or any(n.path != lf.path for n in d.notes) for d in lf.diagnostics):
         return None
     try:
-        body = [_enc(lf.module), lf.ok, lf.status, [_enc_diag(d) for d in lf.diagnostics], lf.unreadable,
+        body = [lf.module, lf.ok, lf.status, [_enc_diag(d) for d in lf.diagnostics], lf.unreadable,
                 sorted(lf.failed_words), sorted(lf.template[0]), sorted(lf.template[1])]
-        return msgpack.packb(body, use_bin_type=True)
+        return msgpack.packb(body, use_bin_type=True, strict_types=True, default=_pack_default)
     except (TypeError, ValueError, OverflowError):
         return None
 
@@ -130,11 +163,18 @@ def encode_loaded(lf: LoadedFile) -> bytes | None:
 def decode_loaded(data: bytes, path: str) -> LoadedFile:
     """The LoadedFile of an entry for the file `path`. Raises CorruptEntry."""
     try:
-        body = msgpack.unpackb(data, raw=False, use_list=True, strict_map_key=True)
-        if type(body) is not list or len(body) != 8:
+        on = [False]
+        up = msgpack.Unpacker(None, raw=False, use_list=True, strict_map_key=True, max_buffer_size=max(1, len(data)),
+                              object_pairs_hook=_refuse, ext_hook=_refuse, list_hook=_node_hook(path, on))
+        up.feed(data)
+        if up.read_array_header() != 8:
             raise CorruptEntry("not an entry")
-        module = _dec(body[0], path)
-        ok, status, diags, unreadable, words, ini, inline = body[1:]
+        on[0] = True
+        module = up.unpack()            # the module's subtree, built by the hook
+        on[0] = False
+        ok, status, diags, unreadable, words, ini, inline = [up.unpack() for _ in range(7)]
+        if up.tell() != len(data):
+            raise CorruptEntry("extra data")
         if not isinstance(module, N.Module) or type(ok) is not bool or type(status) is not str \
                 or type(unreadable) is not bool or not all(type(w) is str for w in words) \
                 or not all(type(x) is int for x in (*ini, *inline)):
@@ -144,8 +184,8 @@ def decode_loaded(data: bytes, path: str) -> LoadedFile:
                           set(words), (frozenset(ini), frozenset(inline)))
     except CorruptEntry:
         raise
-    except (ValueError, TypeError, RecursionError, msgpack.exceptions.ExtraData) as exc:
-        raise CorruptEntry(str(exc)) from None
+    except (ValueError, TypeError, RecursionError, msgpack.exceptions.UnpackException) as exc:
+        raise CorruptEntry(str(exc) or type(exc).__name__) from None
 
 
 def encode_diagnostics(diags: list[Diagnostic]) -> bytes:

@@ -64,6 +64,10 @@ BURST_GAP_S = 0.15         # a change this soon after the one before is part of 
                            # a change after a longer pause starts the analysis at once (leading edge)
 EARLY_MIN_FILES = 20       # after opening a file of a workspace of this many files: its own parse
                            # diagnostics at once, before the first check of the workspace ends
+CACHE_WRITE_FILES = 25     # parse entries put in the cache per step after an analysis (an edit
+                           # waits for one step at most: ~25 ms of CPU)
+CACHE_WRITE_PAUSE_S = 0.05  # between those steps, and before the first
+STORE_WAIT_S = 30.0        # an analysis waits this long at most for the cache being opened
 
 
 def path_of(uri: str) -> str:
@@ -95,7 +99,12 @@ class KrlLanguageServer(LanguageServer):
 
     def __init__(self) -> None:
         super().__init__("krl-lsp", __version__)
-        self.project = Project(store=Store(), threaded=True)
+        self.project = Project(store=None, threaded=True, defer_writes=True)
+        self._store_ready = threading.Event()
+        self._writing = False
+        self._edits_warm = False
+        # the cache is opened beside the start-up (its version hashes the krl package's sources)
+        threading.Thread(target=self._open_store, name="krl-cache", daemon=True).start()
         self.debounce_s = DEBOUNCE_S
         self._last_change: dict[str, float] = {}
         self._executor = ThreadPoolExecutor(max_workers=1, thread_name_prefix="krl-analysis")
@@ -104,6 +113,40 @@ class KrlLanguageServer(LanguageServer):
         self._dirty: set[str] = set()
         self._versions: dict[str, int | None] = {}
         self._gen: dict[str, int] = {}          # path -> count of changes (stale-analysis check)
+
+    def _open_store(self) -> None:
+        try:
+            self.project.store = Store()
+        except Exception as exc:  # noqa: BLE001 - Store never raises; a server without cache anyway
+            log.error("the parse cache is not used: %s", printable(exc), exc_info=TRACEBACKS["on"])
+        finally:
+            self._store_ready.set()
+
+    def _run_analysis(self, path: str, docs: dict[str, str], on_parsed, on_cached) -> Analysis:
+        """Project.analyze in the analysis thread, once the cache is open."""
+        self._store_ready.wait(STORE_WAIT_S)
+        return self.project.analyze(path, docs, on_parsed, on_cached)
+
+    def write_cache_later(self) -> None:
+        """Put the parse entries the last analysis deferred in the cache, a few per step in
+        the analysis thread, while no analysis waits (edits go first)."""
+        if self._writing or not self.project.unwritten:
+            return
+        self._writing = True
+        loop = asyncio.get_running_loop()
+
+        async def run() -> None:
+            try:
+                while self.project.unwritten:
+                    await asyncio.sleep(CACHE_WRITE_PAUSE_S)
+                    if self._lock is not None and self._lock.locked() or any(not t.done() for t in self._pending.values()):
+                        continue
+                    await loop.run_in_executor(self._executor, self.project.write_cache, CACHE_WRITE_FILES)
+            except Exception as exc:  # noqa: BLE001 - a cache not written is parsed again next time
+                log.error("writing the parse cache failed: %s", printable(exc), exc_info=TRACEBACKS["on"])
+            finally:
+                self._writing = False
+        asyncio.ensure_future(run())
 
     @property
     def lock(self) -> asyncio.Lock:
@@ -149,7 +192,7 @@ class KrlLanguageServer(LanguageServer):
             def on_cached(root: str, diags: list) -> None:
                 loop.call_soon_threadsafe(self._publish_cached, root, diags, docs, versions)
             try:
-                an = await loop.run_in_executor(self._executor, self.project.analyze, path, docs, on_parsed, on_cached)
+                an = await loop.run_in_executor(self._executor, self._run_analysis, path, docs, on_parsed, on_cached)
             except Exception as exc:  # noqa: BLE001
                 log.error("analysis of %s failed: %s", printable_path(path), printable(exc), exc_info=TRACEBACKS["on"])
                 self._report(f"krl lsp: analysis of {printable_path(path)} failed: {type(exc).__name__}: {printable(exc)}")
@@ -172,6 +215,9 @@ class KrlLanguageServer(LanguageServer):
                 # unfrozen here and collected as usual.
                 gc.unfreeze()
                 gc.freeze()
+            if an.how == "workspace":
+                self.warm_edits({p: t for p, t in docs.items() if p in an.files})
+            self.write_cache_later()
             return an
 
     def publish(self, an: Analysis, docs: dict[str, str], versions: dict[str, int | None]) -> None:
@@ -246,6 +292,26 @@ class KrlLanguageServer(LanguageServer):
             except Exception as exc:  # noqa: BLE001 - only a head start
                 log.error("warming up failed: %s", printable(exc), exc_info=TRACEBACKS["on"])
         threading.Thread(target=run, name="krl-warm", daemon=True).start()
+
+    def warm_edits(self, docs: dict[str, str]) -> None:
+        """Once, after the first whole analysis: the fast engine parses the open documents with
+        their trees, as it parses an edited piece, in the background. After a start from the
+        cache it had parsed nothing but the warm-up sample, and its JIT compiled the tree
+        answers during the first edits (KRC4_test bas.src, 20 value edits, server CPU per edit
+        p50/p95 30/70 ms from the cache against 20/30 ms after a cold start, 2026-11-24)."""
+        if self._edits_warm:
+            return
+        self._edits_warm = True
+        sources = [SourceText(p, t, "", len(t.encode("utf-8", "surrogatepass"))) for p, t in docs.items()]
+
+        def run() -> None:
+            try:
+                if sources and resolve() == "java":
+                    for _ in java_answers(enumerate(sources), threads=default_jobs(), trees=True, decode=False):
+                        pass
+            except Exception as exc:  # noqa: BLE001 - only a head start (EngineUnavailable included)
+                log.error("warming up for edits failed: %s", printable(exc), exc_info=TRACEBACKS["on"])
+        threading.Thread(target=run, name="krl-warm-edits", daemon=True).start()
 
     def schedule(self, path: str, delay: float | None = None) -> None:
         """Analyse the workspace of `path` after `delay` seconds (a newer change restarts it).

@@ -27,6 +27,28 @@ def spans(m):
     return [(type(n).__name__, n.span.file, n.span.line, n.span.column, getattr(n, "end_line", 0)) for n in m.walk()]
 
 
+def reference_entry(lf) -> bytes:
+    """The entry's bytes as the cache's schema describes them (krl/lsp/cache.py), written out
+    plainly: the on-disk format must not change with the codec's implementation."""
+    import dataclasses
+
+    def enc(v):
+        if isinstance(v, C.N.Node):
+            fields = [f for f in dataclasses.fields(v) if f.name not in ("span", "ann")]
+            fields = [f for f in fields if not f.kw_only] + [f for f in fields if f.kw_only]
+            return [C._INDEX[type(v)], v.span.line, v.span.column, *[enc(getattr(v, f.name)) for f in fields]]
+        if type(v) is list:
+            return [C._LIST, *map(enc, v)]
+        if type(v) is tuple:
+            return [C._TUPLE, *map(enc, v)]
+        assert v is None or type(v) in (int, float, str, bool), type(v)
+        return v
+    diags = [[d.line, d.column, d.code, d.message, d.severity, d.end_line, d.end_column, d.help,
+              [[n.path, n.line, n.column, n.message] for n in d.notes]] for d in lf.diagnostics]
+    return msgpack.packb([enc(lf.module), lf.ok, lf.status, diags, lf.unreadable, sorted(lf.failed_words),
+                          sorted(lf.template[0]), sorted(lf.template[1])], use_bin_type=True)
+
+
 def test_entries_decode_to_what_was_parsed(shared_corpus: Path):
     """Every file of a real backup: AST (spans included), diagnostics, template folds, status."""
     backup = shared_corpus / "rawpython__kukaKRLmagic"
@@ -36,6 +58,7 @@ def test_entries_decode_to_what_was_parsed(shared_corpus: Path):
         lf = load_file(f)
         data = C.encode_loaded(lf)
         assert data is not None, f
+        assert data == reference_entry(lf), f
         back = C.decode_loaded(data, lf.path)
         assert back.module == lf.module and spans(back.module) == spans(lf.module), f
         assert rows(back.diagnostics) == rows(lf.diagnostics)
@@ -49,10 +72,21 @@ def test_entries_decode_to_what_was_parsed(shared_corpus: Path):
     [[C._INDEX[C.N.Module], 1, 1], True, "ok", [], False, [], [], []],     # a node of another shape
     [None, True, "ok", [], False, [], [], []],       # not a module
     [[C._INDEX[C.N.Module], 1, 1, [C._LIST], [C._LIST], None, "x"], True, "ok", [[1, 1, "E", "m"]], False, [], [], []],
+    # a valid empty module ([C._INDEX[C.N.Module], 1, 1, "p", "src", [C._LIST], [C._LIST], None]) changed:
+    [[C._INDEX[C.N.Module], 1, 1, "p", b"", [C._LIST], [C._LIST], None], True, "ok", [], False, [], [], []],  # bytes
+    [[C._INDEX[C.N.Module], 1, 1, "p", "src", {}, [C._LIST], None], True, "ok", [], False, [], [], []],     # a map
+    [[C._INDEX[C.N.Module], 1, 1, "p", "src", [C._LIST], [C._LIST, [7]], None], True, "ok", [], False, [], [], []],
+    [[C._INDEX[C.N.Module], 1, 1, "p", "src", [C._LIST], [C._LIST], None], True, "ok", [], False, [], [], [], 0],
 ])
 def test_a_hostile_entry_is_refused(body):
     with pytest.raises(C.CorruptEntry):
-        C.decode_loaded(msgpack.packb(body), "/w/x.src")
+        C.decode_loaded(msgpack.packb(body, use_bin_type=True), "/w/x.src")
+
+
+def test_the_valid_entry_the_hostile_ones_change_decodes():
+    body = [[C._INDEX[C.N.Module], 1, 1, "p", "src", [C._LIST], [C._LIST], None], True, "ok", [], False, [], [], []]
+    lf = C.decode_loaded(msgpack.packb(body, use_bin_type=True), "/w/x.src")
+    assert lf.module == C.N.Module("/w/x.src", "src", [], [], None) and lf.ok
 
 
 def test_the_cache_serves_a_workspace_opened_again(tmp_path: Path):
@@ -130,3 +164,72 @@ def test_the_cached_diagnostics_come_before_any_parse_is_decoded(tmp_path: Path,
         monkeypatch.undo()
         assert events[0] == rows(expected) == rows(an.ws.diagnostics)
         assert events.count("decoded") >= 4 and len([e for e in events if e != "decoded"]) == 1
+
+
+def test_deferred_parse_entries_are_written_later_and_open_files_at_once(tmp_path: Path):
+    """The server's way (Project(defer_writes=True)): the open file's entry is written before the
+    check, the others by write_cache, step by step; a file opened in between is left out."""
+    shutil.copytree(BACKUP, tmp_path / "KRC")
+    main = norm(tmp_path / "KRC" / "R1" / "Program" / "main.src")
+    tools = norm(tmp_path / "KRC" / "R1" / "Program" / "tools.src")
+    store = C.Store(tmp_path / "cache")
+    first = Project(store=store, defer_writes=True)
+    first.open(main, Path(main).read_text())
+    an = first.analyze(main)
+    count = lambda: store.db.execute("SELECT COUNT(*) FROM entries WHERE kind = 'parse'").fetchone()[0]  # noqa: E731
+    assert count() == 1                                 # main.src, the open file
+    assert sorted(p for _k, p, _lf in first.unwritten) == sorted(set(an.files) - {main})
+    first.open(tools, Path(tools).read_text())          # opened before its entry is written
+    assert first.write_cache(1) == len(an.files) - 2
+    assert first.write_cache() == 0 and not first.unwritten
+    assert count() == len(an.files) - 1                 # all but tools.src
+    again = Project(store=store)
+    hits = store.hits
+    an2 = again.analyze(main, docs={})
+    assert store.hits - hits == len(an.files) - 1
+    assert rows(an2.ws.diagnostics) == rows(an.ws.diagnostics)
+
+
+def _backups():
+    from krl.lsp.bench import corpus_backups  # noqa: PLC0415 - the bench's list: each KRC backup as it is
+    from tests.conftest import SHARED  # noqa: PLC0415
+    if not (SHARED / "krl-corpus").is_dir():
+        return []
+    return [pytest.param(root, largest, id=label) for label, root, largest in corpus_backups(SHARED / "krl-corpus")]
+
+
+@pytest.mark.parametrize("root,largest", _backups())
+def test_every_corpus_backup_gives_krl_checks_diagnostics_cold_and_from_the_cache(tmp_path: Path, root: Path,
+                                                                                  largest: Path):
+    """The server's way on each corpus backup as it is (its largest file open, as the bench
+    does): cold (parse entries written after the check), from the cache, and the cached
+    diagnostics shown before the check: all exactly those of ``krl check``'s pipeline on the
+    same files (krl/workspace.py: each file loaded whole by its loader, then checked)."""
+    from krl.limits import PARSE_TIMEOUT_S  # noqa: PLC0415
+    from krl.source import decode_bytes  # noqa: PLC0415
+    from krl.workspace import Workspace, load_batch  # noqa: PLC0415
+
+    store = C.Store(tmp_path / "cache")
+    path = norm(largest)
+    text = decode_bytes(largest.read_bytes())[0]
+    expected = None
+    for run in ("cold", "warm"):
+        p = Project(store=store, defer_writes=True)
+        p.open(path, text)
+        cached: list = []
+        an = p.analyze(path, on_cached=lambda _root, diags: cached.append(diags))
+        if expected is None:
+            ref = Workspace(an.root)
+            for o in load_batch(list(an.files), PARSE_TIMEOUT_S):
+                ref.add_loaded(o.value, notify=False)
+            ref.add_unread(p.workspace_files(path)[2])
+            ref.check()
+            expected = rows(ref.diagnostics)
+            assert expected
+        assert rows(an.ws.diagnostics) == expected, run
+        if run == "cold":
+            assert not cached and p.unwritten
+            assert p.write_cache() == 0
+        else:
+            assert cached and sorted(rows(cached[0])) == sorted(expected)
+            assert store.corrupt == 0 and store.hits >= len(an.files)

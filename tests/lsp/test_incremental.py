@@ -91,3 +91,22 @@ def test_body_edits_on_a_real_backup(shared_corpus, tmp_path):
         (text.replace("   SALIR = TRUE\n", "   SALIR = TRUE +\n", 1), "routines"),          # a syntax error
         (text, "routines"),
     ])
+
+
+def test_body_edits_that_change_the_unresolved_name_report(tmp_path):
+    """The report of names the backup does not declare counts uses across the workspace: an
+    edit that adds, repeats or removes such a use makes it again (Workspace.replace), one that
+    leaves the uses as they were keeps it; either way exactly a full check's diagnostics."""
+    shutil.copytree(BACKUP, tmp_path / "KRC")
+    main = str(tmp_path / "KRC" / "R1" / "Program" / "main.src")
+    text = open(main).read()
+    p = Project()
+    p.open(main, text)
+    p.analyze(main)
+    one = text.replace("  counter = 0\n", "  counter = 0\n  $NOT_A_KUKA_NAME = 1\n")
+    two = text.replace("  counter = 0\n", "  counter = 0\n  $NOT_A_KUKA_NAME = 1\n  $NOT_A_KUKA_NAME = 2\n")
+    edits_agree(p, main, [(one, "routines")])
+    reported = [d.message for d in p.latest(main).ws.diagnostics if "NOT_A_KUKA_NAME" in d.message]
+    assert reported
+    edits_agree(p, main, [(two, "routines"), (two.replace("= 2", "= 3"), "routines"), (text, "routines")])
+    assert not [d for d in p.latest(main).ws.diagnostics if "NOT_A_KUKA_NAME" in d.message]

@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from robot import tracecheck
+from robot import kinematics, tracecheck
 from robot.controller import Controller
 from robot.errors import SoftLimitError, WorkspaceError
 from robot.kinematics import Kinematics
@@ -86,6 +86,8 @@ def test_the_main_run_batched_writes_the_same_trace(case, monkeypatch):
         return orig(self, *a, **kw)
 
     monkeypatch.setattr(Kinematics, "inverse_chain", counting)
+    # the numpy chains run where the compiled inverse (robot/simcore.pyx) does not
+    monkeypatch.setattr(kinematics, "USE_COMPILED", False)
     monkeypatch.setattr(Controller, "batch", False)
     per_cycle = tracecheck.run_case(case)
     n_planning = calls["n"]

@@ -4,13 +4,15 @@ from __future__ import annotations
 
 import json
 
+import numpy as np
 import pytest
 
 from robot.bench import bench_program, run_motions
 from robot.controller import Controller
+from robot.frames import frame_to_matrix, matrix_to_frame
 from robot.motion import MotionParams, MotionRequest, Trigger
 from robot.stimuli import parse_stimuli
-from robot.trace import KINDS, SCHEMA, TraceWriter, make_event, read_trace, validate_event
+from robot.trace import KINDS, SCHEMA, TraceWriter, _frames_of, make_event, read_trace, validate_event
 
 
 def test_schema_has_the_issue_kinds():
@@ -87,3 +89,15 @@ def test_interpreter_events_through_same_writer():
     kinds = [e["kind"] for e in tw.events]
     # a zero-length PTP starts and ends in the same IPO cycle
     assert kinds == ["stmt", "motion", "motion", "pose", "call"]
+
+
+def test_frames_of_poses_in_gimbal_lock_are_matrix_to_frame_each():
+    # a robot at rest at HOME (B = 90: gimbal lock) repeats its matrix; the conversion keeps
+    # its last answer, which must be the one of each matrix (also when another comes between)
+    Ts = [frame_to_matrix(500.0, 0.0, 900.0, 30.0, 90.0, 0.0),
+          frame_to_matrix(500.0, 0.0, 900.0, -40.0, -90.0, 0.0),
+          frame_to_matrix(100.0, 2.0, 3.0, 10.0, 20.0, 30.0)]
+    seq = [Ts[0], Ts[0], Ts[1], Ts[0], Ts[2], Ts[1], Ts[1]]
+    for _ in range(2):
+        assert _frames_of(seq) == [list(matrix_to_frame(T)) for T in seq]
+    assert all(isinstance(v, float) for fr in _frames_of(seq) for v in fr) and np.isfinite(_frames_of(seq)).all()

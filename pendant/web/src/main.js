@@ -55,10 +55,10 @@ function onMessage(m) {
   switch (m.type) {
     case 'init': onInit(m); break;
     case 'module': onModule(m); break;
-    case 'state': setState(m); break;
+    case 'state': onState(m); break;
     case 'live': onLive(m); break;
     case 'event': P.events.push(m); if (P.events.length > 200) P.events.shift(); break;
-    case 'done': { const w = waiting.get(m.id); if (w) { waiting.delete(m.id); w.resolve(m); } break; }
+    case 'done': { P.lastDone = performance.now(); const w = waiting.get(m.id); if (w) { waiting.delete(m.id); w.resolve(m); } break; }
     case 'error': {
       const w = waiting.get(m.id);
       if (w) { waiting.delete(m.id); w.reject(new Error(m.text)); } else showError(m.text);
@@ -189,7 +189,19 @@ function drawPointers(ptr, bps) {
 // ------------------------------------------------------------------ state
 const fmt = (v, d = 3) => (typeof v === 'number' ? v.toFixed(d) : '—');
 
-function setState(s) {
+// the server sends the whole state first, then what changed (a key gone is null): the page keeps
+// the state and redraws only the parts that changed
+function onState(m) {
+  const s = m.full || !P.state ? {} : { ...P.state };
+  for (const [k, v] of Object.entries(m)) {
+    if (k === 'type' || k === 'full') continue;
+    if (v === null) delete s[k]; else s[k] = v;
+  }
+  setState(s, m.full ? null : new Set(Object.keys(m)));
+}
+
+function setState(s, changed = null) {
+  const has = (k) => !changed || changed.has(k);
   P.state = s;
   P.lastChange = performance.now();
   const st = s.state || 'none';
@@ -204,13 +216,13 @@ function setState(s) {
     $('override').value = s.override; $('override-value').textContent = String(s.override);
   }
   if (typeof s.time === 'number') $('st-time').textContent = `t = ${s.time.toFixed(3)} s`;
-  drawPointers(s.pointers || {}, s.breakpoints || {});
-  drawMessages(s.messages || []);
-  $('notes').replaceChildren(...(s.notes || []).slice().reverse().map((n) => el('li', { text: `t=${fmt(n.time)} s  ${n.text}` })));
-  drawIo(s.io);
-  drawWatch(s.watch || []);
-  drawThreads(s.threads || []);
-  if (s.position) { drawPosition(s.position); setAxes(s.position.axes, s.position.tool, s.position.base); }
+  if (has('pointers') || has('breakpoints')) drawPointers(s.pointers || {}, s.breakpoints || {});
+  if (has('messages')) drawMessages(s.messages || []);
+  if (has('notes')) $('notes').replaceChildren(...(s.notes || []).slice().reverse().map((n) => el('li', { text: `t=${fmt(n.time)} s  ${n.text}` })));
+  if (has('io')) drawIo(s.io);
+  if (has('watch')) drawWatch(s.watch || []);
+  if (has('threads')) drawThreads(s.threads || []);
+  if (has('position') && s.position) { drawPosition(s.position); setAxes(s.position.axes, s.position.tool, s.position.base); }
 }
 
 function drawMessages(list) {

@@ -1,0 +1,93 @@
+"""Build the compiled inverse kinematics of the simulator: robot/simcore.pyx compiled by Cython
+into an extension module beside it (``simcore.*.so``; gitignored). Issue 39, "Simulator".
+
+One definition (:func:`extension`), two ways in, as for the VM loop (interp/vm/build.py):
+
+* the package build: ``setup.py`` loads this file by path and gives :func:`cythonized` to
+  setuptools, so ``pip install``, ``pip install -e`` (which ``make`` runs) and the wheel carry it;
+* ``python -m robot.build`` (``make sim-core``): rebuilds it in place after simcore.pyx changed.
+
+Without Cython or a C compiler the build says so and succeeds; robot/kinematics.py then runs
+its pure-Python OPW code, which the extension mirrors bit for bit (``-ffp-contract=off``: no
+fused multiply-add, so C gives the products and sums Python gives).
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+import sysconfig
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+REPO = HERE.parent
+SOURCE = HERE / "simcore.pyx"
+MODULE = "robot.simcore"
+#: C flags: optimised, and no contraction of a * b + c into one rounding (bit-identical results)
+CFLAGS = ["-O2", "-ffp-contract=off", "-fno-fast-math"]
+
+
+def target() -> Path:
+    """The extension module's path for this interpreter."""
+    return HERE / ("simcore" + sysconfig.get_config_var("EXT_SUFFIX"))
+
+
+def extension(root: Path | None = None):
+    """The setuptools ``Extension`` (``optional``: a failed compile leaves the pure-Python
+    code in place), its source absolute or relative to ``root``. Raises ImportError without
+    setuptools."""
+    from setuptools import Extension  # noqa: PLC0415  (setuptools loads only for a build)
+
+    src = str(SOURCE) if root is None else SOURCE.relative_to(root).as_posix()
+    return Extension(MODULE, [src], extra_compile_args=CFLAGS, optional=True)
+
+
+def cythonized(root: Path | None = None) -> list:
+    """:func:`extension` translated to C by Cython, or ``[]`` without Cython."""
+    try:
+        from Cython.Build import cythonize  # noqa: PLC0415  (optional; loads only for a build)
+    except ImportError:
+        return []
+    return cythonize([extension(root)], build_dir="build/cython", quiet=True,
+                     compiler_directives={"language_level": 3})
+
+
+def build(force: bool = False) -> str:
+    """Compile simcore.pyx in place; the outcome in words. Raises nothing for a missing Cython
+    or compiler (the pure-Python inverse runs then)."""
+    out = target()
+    if not force and out.exists() and out.stat().st_mtime >= SOURCE.stat().st_mtime:
+        return f"{out.name} is up to date"
+    try:  # optional build tools, which load only for a build
+        from Cython.Build import cythonize  # noqa: PLC0415
+        from setuptools import Distribution  # noqa: PLC0415
+        from setuptools.command.build_ext import build_ext  # noqa: PLC0415
+    except ImportError as e:
+        return f"not compiled ({e.name} is not installed): the pure-Python inverse kinematics runs"
+    tmp = REPO / "build" / "cython"
+    try:
+        exts = cythonize([extension()], build_dir=str(tmp), quiet=True, force=True,
+                         compiler_directives={"language_level": 3})
+        dist = Distribution({"name": "krl-sim-core", "ext_modules": exts})
+        cmd = build_ext(dist)
+        cmd.build_lib = str(tmp / "lib")
+        cmd.build_temp = str(tmp / "temp")
+        cmd.ensure_finalized()
+        cmd.run()
+    except Exception as e:  # noqa: BLE001  (no compiler, no Python headers: the fallback runs)
+        return f"not compiled ({type(e).__name__}: {e}): the pure-Python inverse kinematics runs"
+    built = tmp / "lib" / "robot" / out.name
+    if not built.is_file():
+        return "not compiled (the C compiler failed): the pure-Python inverse kinematics runs"
+    os.replace(built, out)   # a rename: a process that has the old one loaded keeps it
+    return f"compiled {out.relative_to(REPO)}"
+
+
+def main(argv: list[str] | None = None) -> int:
+    argv = sys.argv[1:] if argv is None else argv
+    print(build(force="--force" in argv))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,383 @@
+# cython: language_level=3, boundscheck=False, wraparound=False, cdivision=True, initializedcheck=False
+"""The OPW inverse kinematics of one pose in C (issue 39, "Simulator"): the compiled form of
+robot/kinematics.py ``Kinematics._opw_core`` + ``_status_row`` + the selection of
+``Kinematics._select`` for the six-axis arm with a spherical wrist, built by robot/build.py.
+
+Bit for bit the pure-Python code it mirrors, which stays the fallback (and the reference:
+tests/robot/test_simcore.py compares the two on random poses): the same operations in the same
+order on C doubles, libm's sin/cos/atan2/acos/sqrt (what Python's ``math`` calls), ``degrees``
+and ``radians`` as CPython's multiplications by 180/pi and pi/180, Python's float ``%`` as
+CPython's ``float_rem``, and no fused multiply-add (compiled with ``-ffp-contract=off``).
+
+:meth:`OPW.inverse` answers the selected axes, or None whenever the Python code would raise or
+takes a path not mirrored here (no solution, no solution with the status, none within the
+limits): the caller then runs the Python code, which gives the error with its message.
+"""
+
+from libc.math cimport sin, cos, atan2, acos, sqrt, fmod, copysign, fabs, M_PI, INFINITY
+import numpy as np
+
+#: Bumped whenever the mirrored Python code changes (robot/kinematics.py checks it: a stale
+#: build is not used).
+ABI = 2
+
+cdef double DEG_TO_RAD = M_PI / 180.0
+cdef double RAD_TO_DEG = 180.0 / M_PI
+cdef double BOUNDARY_EPS = 1e-9
+cdef double WRIST_SINGULAR_DEG = 1e-6
+cdef double OVERHEAD_SINGULAR_MM = 1e-6
+cdef double ACOS_TOL = 1e-9
+
+
+cdef inline double _pymod(double vx, double wx) noexcept nogil:
+    """CPython's float ``vx % wx`` (Objects/floatobject.c float_rem), wx != 0."""
+    cdef double mod = fmod(vx, wx)
+    if mod != 0.0:
+        if (wx < 0) != (mod < 0):
+            mod += wx
+    else:
+        mod = copysign(0.0, wx)
+    return mod
+
+
+cdef inline double _wrapdeg(double th, double off, double sg) noexcept nogil:
+    # -((-degrees((th + off) * sg) + 180.0) % 360.0) + 180.0
+    return -_pymod(-((th + off) * sg * RAD_TO_DEG) + 180.0, 360.0) + 180.0
+
+
+cdef class OPW:
+    """The constants of one robot's OPW solution and soft limits (see robot/kinematics.py)."""
+
+    cdef double a1, a2, b, c1, c2, c3, c4, kappa_2, c2_2, k, at23, phi
+    cdef double sgn[6]
+    cdef double offs[6]
+    cdef double lo[6]
+    cdef double hi[6]
+    cdef double ks[5]
+    cdef int s_free, t_free
+
+    def __init__(self, o, double kappa_2, double c2_2, double k, double at23, double phi,
+                 sgn, offs, lo, hi, ks, int s_free, int t_free):
+        cdef int i
+        self.a1, self.a2, self.b = o.a1, o.a2, o.b
+        self.c1, self.c2, self.c3, self.c4 = o.c1, o.c2, o.c3, o.c4
+        self.kappa_2, self.c2_2, self.k, self.at23, self.phi = kappa_2, c2_2, k, at23, phi
+        for i in range(6):
+            self.sgn[i] = sgn[i]
+            self.offs[i] = offs[i]
+            self.lo[i] = lo[i]
+            self.hi[i] = hi[i]
+        for i in range(5):
+            self.ks[i] = ks[i]
+        self.s_free, self.t_free = s_free, t_free
+
+    cdef inline void _status_row(self, const double* q, int* s, int* amb) noexcept nogil:
+        cdef double t2 = (self.sgn[1] * q[1]) * DEG_TO_RAD - self.offs[1]
+        cdef double t23 = t2 + (self.sgn[2] * q[2]) * DEG_TO_RAD - self.offs[2]
+        cdef double xw = self.a1 + self.c2 * sin(t2) + self.c3 * sin(t23) + self.a2 * cos(t23)
+        cdef double phi = self.phi
+        s[0] = (<int>(xw < -BOUNDARY_EPS)) | ((<int>(q[2] >= phi - BOUNDARY_EPS)) << 1) \
+            | ((<int>(q[4] < -BOUNDARY_EPS)) << 2)
+        amb[0] = (<int>(fabs(xw) < OVERHEAD_SINGULAR_MM)) | ((<int>(fabs(q[2] - phi) < 1e-7)) << 1) \
+            | ((<int>(fabs(q[4]) < WRIST_SINGULAR_DEG)) << 2) | self.s_free
+
+    cdef int _core(self, const double* M, const double* ref, double* out) noexcept nogil:
+        """``Kinematics._opw_core(T, ref)`` of the pose M (the first three rows of T, 12
+        values): the solutions into out (8 x 6), their number."""
+        cdef double r00 = M[0], r01 = M[1], r02 = M[2], px = M[3]
+        cdef double r10 = M[4], r11 = M[5], r12 = M[6], py = M[7]
+        cdef double r20 = M[8], r21 = M[9], r22 = M[10], pz = M[11]
+        cdef double cx = px - self.c4 * r02
+        cdef double cy = py - self.c4 * r12
+        cdef double cz = pz - self.c4 * r22
+        cdef double rho2 = cx * cx + cy * cy - self.b * self.b
+        cdef double nx1, tmp1, tmp2, th1_i, th1_ii, tmp3, s1_2, tmp4, s2_2, s1, s2
+        cdef double th1, s_, s_2, base2, arg2, arg3, a2c, a3c, v
+        cdef double arm[4][3]
+        cdef int narm = 0, n = 0, j, i
+        cdef double th2, th3, sn1, cs1, s23, c23, mm, th4, th5, th6, total
+        cdef double sol[6]
+        if rho2 < 0.0:
+            return 0
+        nx1 = sqrt(rho2) - self.a1
+        if sqrt(cx * cx + cy * cy) < OVERHEAD_SINGULAR_MM:
+            tmp1 = (self.sgn[0] * ref[0]) * DEG_TO_RAD - self.offs[0]
+        else:
+            tmp1 = atan2(cy, cx)
+        tmp2 = atan2(self.b, nx1 + self.a1)
+        th1_i = tmp1 - tmp2
+        th1_ii = tmp1 + tmp2 - M_PI
+        tmp3 = cz - self.c1
+        s1_2 = nx1 * nx1 + tmp3 * tmp3
+        tmp4 = nx1 + 2.0 * self.a1
+        s2_2 = tmp4 * tmp4 + tmp3 * tmp3
+        s1 = sqrt(s1_2)
+        s2 = sqrt(s2_2)
+        for j in range(2):
+            if j == 0:
+                th1, s_, s_2, base2 = th1_i, s1, s1_2, atan2(nx1, tmp3)
+            else:
+                th1, s_, s_2, base2 = th1_ii, s2, s2_2, -atan2(tmp4, tmp3)
+            if s_ < 1e-12:
+                continue
+            arg2 = (s_2 + self.c2_2 - self.kappa_2) / (2.0 * s_ * self.c2)
+            arg3 = (s_2 - self.c2_2 - self.kappa_2) / (2.0 * self.c2 * self.k)
+            if fabs(arg2) > 1.0 + ACOS_TOL or fabs(arg3) > 1.0 + ACOS_TOL:
+                continue
+            # math.acos(min(1.0, max(-1.0, arg)))
+            v = arg2 if arg2 > -1.0 else -1.0
+            a2c = acos(v if v < 1.0 else 1.0)
+            v = arg3 if arg3 > -1.0 else -1.0
+            a3c = acos(v if v < 1.0 else 1.0)
+            arm[narm][0], arm[narm][1], arm[narm][2] = th1, -a2c + base2, a3c - self.at23
+            narm += 1
+            arm[narm][0], arm[narm][1], arm[narm][2] = th1, a2c + base2, -a3c - self.at23
+            narm += 1
+        for j in range(narm):
+            th1, th2, th3 = arm[j][0], arm[j][1], arm[j][2]
+            sn1, cs1 = sin(th1), cos(th1)
+            s23, c23 = sin(th2 + th3), cos(th2 + th3)
+            mm = r02 * s23 * cs1 + r12 * s23 * sn1 + r22 * c23
+            v = 1.0 - mm * mm
+            th5 = atan2(sqrt(v if v > 0.0 else 0.0), mm)
+            th4 = atan2(r12 * cs1 - r02 * sn1,
+                        r02 * c23 * cs1 + r12 * c23 * sn1 - r22 * s23)
+            th6 = atan2(r01 * s23 * cs1 + r11 * s23 * sn1 + r21 * c23,
+                        -r00 * s23 * cs1 - r10 * s23 * sn1 - r20 * c23)
+            if fabs(th5 * RAD_TO_DEG) < WRIST_SINGULAR_DEG:
+                total = th4 + th6
+                th4 = (self.sgn[3] * ref[3]) * DEG_TO_RAD - self.offs[3]
+                th6 = total - th4
+            sol[0], sol[1], sol[2], sol[3], sol[4], sol[5] = th1, th2, th3, th4, th5, th6
+            for i in range(6):
+                out[6 * n + i] = _wrapdeg(sol[i], self.offs[i], self.sgn[i])
+            n += 1
+            sol[3], sol[4], sol[5] = th4 + M_PI, -th5, th6 - M_PI
+            for i in range(6):
+                out[6 * n + i] = _wrapdeg(sol[i], self.offs[i], self.sgn[i])
+            n += 1
+        return n
+
+    def inverse(self, const double[:, :] T, status, turn, const double[:] ref6):
+        """``Kinematics.inverse`` of the flange pose T (4x4, mm, the OPW arm's own frame) for
+        the reference ref6 (6 axes, deg): the axes (6,) as a numpy array, or None where the
+        Python code raises (the caller runs it for the error)."""
+        cdef double M[12]
+        cdef int i, j
+        for i in range(3):
+            for j in range(4):
+                M[4 * i + j] = T[i, j]
+        return self._inverse(M, status, turn, ref6)
+
+    def inverse_rp(self, const double[:, :] R, const double[:] p, status, turn, const double[:] ref6):
+        """:meth:`inverse` of the pose with rotation R (3x3) and position p (3,, mm)."""
+        cdef double M[12]
+        cdef int i, j
+        for i in range(3):
+            for j in range(3):
+                M[4 * i + j] = R[i, j]
+            M[4 * i + 3] = p[i]
+        return self._inverse(M, status, turn, ref6)
+
+    cdef object _inverse(self, const double* M, status, turn, const double[:] ref6):
+        cdef double ref[6]
+        cdef double rows[48]
+        cdef double q[6]
+        cdef double best_q[6]
+        cdef int i, j, kk, n, s_target, free, keep, s_r, amb, tmask = 0, use_turn = 0
+        cdef int nmatch = 0, have_best = 0, ok
+        cdef double c, d, best_c, best_d, cost, best_cost = 0.0
+        cdef int found
+        cdef const double* b
+        cdef double[:] rv
+        for i in range(6):
+            ref[i] = ref6[i]
+        n = self._core(M, ref, rows)
+        if n == 0:
+            return None
+        if status is not None:
+            s_target = (<int>status) & 7
+            free = 0
+        else:
+            self._status_row(ref, &s_target, &free)
+        keep = ~free
+        if turn is not None:
+            tmask = (<int>turn) & ~self.t_free
+            use_turn = 1
+        for j in range(n):
+            b = &rows[6 * j]
+            self._status_row(b, &s_r, &amb)
+            if ((s_r ^ s_target) & ~amb & keep & 7) != 0:
+                continue
+            nmatch += 1
+            ok = 1
+            for i in range(6):
+                found = 0
+                best_c = 0.0
+                best_d = INFINITY
+                for kk in range(5):
+                    c = b[i] + self.ks[kk]
+                    if c < self.lo[i] or c > self.hi[i]:
+                        continue
+                    if use_turn and not (((c < 0) == (((tmask >> i) & 1) == 1)) or fabs(c) < 1e-6
+                                         or ((self.t_free >> i) & 1) == 1):
+                        continue
+                    d = fabs(c - ref[i])
+                    if d < best_d:
+                        best_c, best_d = c, d
+                        found = 1
+                if not found:
+                    ok = 0
+                    break
+                q[i] = best_c
+            if ok:
+                cost = 0.0
+                for i in range(6):
+                    cost += fabs(q[i] - ref[i])
+                if not have_best or cost < best_cost:
+                    have_best = 1
+                    best_cost = cost
+                    for i in range(6):
+                        best_q[i] = q[i]
+        if not have_best:
+            return None
+        res = np.empty(6)
+        rv = res
+        for i in range(6):
+            rv[i] = best_q[i]
+        return res
+
+
+# ----------------------------------------------------------------------------- trace lines
+cdef extern from "Python.h":
+    char* PyOS_double_to_string(double val, char format_code, int precision, int flags,
+                                int* ptype) except NULL
+    double PyOS_string_to_double(const char* s, char** endptr, object overflow_exception) except? -1.0
+    void PyMem_Free(void* p)
+    int Py_DTSF_ADD_DOT_0
+
+from libc.string cimport memcpy, strlen
+from libc.math cimport isfinite, floor
+
+#: |x| from which pose_line leaves a number to the Python path (its 'f' text would be long)
+cdef double _BIG = 1e15
+
+
+cdef Py_ssize_t _put_r6(double x, char* out) except -1:
+    """``repr(robot.trace._round6(x))`` into out (see :func:`_put_r6_dtoa`). Fast path: the
+    correctly rounded integer n = round(x · 10^6) is that of the computed product whenever the
+    product is farther from a half-integer than its rounding error; the rounded double is then
+    n / 10^6 (a correctly rounded quotient of exact integers: the double nearest to the decimal
+    n · 10^-6, as strtod gives), and its repr is that decimal with the trailing zeros cut
+    (fewer than 16 significant digits round-trip uniquely; repr writes fixed notation from
+    1e-4 on). Anything else (near a tie, below 1e-4, huge) takes the dtoa path."""
+    cdef double y = x * 1e6
+    cdef double fl, fr, d
+    cdef long long n, a, ip, fp
+    cdef Py_ssize_t k = 0, m, j
+    cdef char digits[24]
+    if fabs(y) < 1e14:
+        fl = floor(y)
+        fr = y - fl
+        d = fabs(fr - 0.5)
+        if d > fabs(y) * 1e-15 + 1e-12:
+            n = <long long>fl + (1 if fr > 0.5 else 0)
+            if n == 0:
+                memcpy(out, b"0.0", 3)
+                return 3
+            if n >= 100 or n <= -100:
+                if n < 0:
+                    out[k] = b'-'
+                    k += 1
+                    a = -n
+                else:
+                    a = n
+                ip = a // 1000000
+                fp = a % 1000000
+                m = 0
+                while True:
+                    digits[m] = <char>(48 + ip % 10)
+                    m += 1
+                    ip //= 10
+                    if ip == 0:
+                        break
+                for j in range(m):
+                    out[k] = digits[m - 1 - j]
+                    k += 1
+                out[k] = b'.'
+                k += 1
+                if fp == 0:
+                    out[k] = b'0'
+                    return k + 1
+                m = 6
+                while fp % 10 == 0:
+                    fp //= 10
+                    m -= 1
+                for j in range(m):
+                    digits[m - 1 - j] = <char>(48 + fp % 10)
+                    fp //= 10
+                for j in range(m):
+                    out[k] = digits[j]
+                    k += 1
+                return k
+    return _put_r6_dtoa(x, out)
+
+
+cdef Py_ssize_t _put_r6_dtoa(double x, char* out) except -1:
+    """``repr(robot.trace._round6(x))`` into out: CPython's round(x, 6) is the double nearest
+    to x's correctly rounded 6-decimal text (Objects/floatobject.c double_round: _Py_dg_dtoa
+    mode 3, then strtod), which is what ``'%.6f'`` formatting (the same dtoa call) read back
+    gives; -0.0 becomes 0.0; ``repr`` is the shortest text (format 'r', '.0' added)."""
+    cdef char* s = PyOS_double_to_string(x, b'f', 6, 0, NULL)
+    cdef double r
+    try:
+        r = PyOS_string_to_double(s, NULL, None)
+    finally:
+        PyMem_Free(s)
+    if r == 0.0:
+        r = 0.0
+    s = PyOS_double_to_string(r, b'r', 0, Py_DTSF_ADD_DOT_0, NULL)
+    cdef Py_ssize_t n = strlen(s)
+    memcpy(out, s, n)
+    PyMem_Free(s)
+    return n
+
+
+cdef inline Py_ssize_t _put(const char* s, char* out) noexcept:
+    cdef Py_ssize_t n = strlen(s)
+    memcpy(out, s, n)
+    return n
+
+
+def pose_line(double t, axes, tcp):
+    """The JSON line of a pose event (robot/trace.py ``TraceWriter.flush``): time t (s), the
+    axes and the TCP frame (sequences of numbers) each rounded by ``_round6``, written as
+    ``repr``; None when a number is not finite or very large (the Python path writes it)."""
+    cdef char buf[2048]
+    cdef Py_ssize_t n = 0, i, k
+    cdef double x
+    cdef list ax = [float(v) for v in axes]
+    cdef list tc = [float(v) for v in tcp]
+    if len(ax) > 32 or len(tc) > 32:
+        return None
+    if not isfinite(t) or t >= _BIG or t <= -_BIG:
+        return None
+    for seq in (ax, tc):
+        for v in seq:
+            x = v
+            if not isfinite(x) or x >= _BIG or x <= -_BIG:
+                return None
+    n += _put(b'{"t":', buf + n)
+    n += _put_r6(t, buf + n)
+    n += _put(b',"kind":"pose","axes":[', buf + n)
+    for k in range(2):
+        seq = ax if k == 0 else tc
+        if k == 1:
+            n += _put(b'],"tcp":[', buf + n)
+        for i in range(len(seq)):
+            if i:
+                buf[n] = b','
+                n += 1
+            n += _put_r6(seq[i], buf + n)
+    n += _put(b']}', buf + n)
+    return buf[:n].decode('ascii')

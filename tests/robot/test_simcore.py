@@ -1,0 +1,136 @@
+"""The simulator's compiled hot path (robot/simcore.pyx, built by robot/build.py; `make`
+builds it before the tests) against the pure-Python code it mirrors, the reference: the OPW
+inverse kinematics (the same axes bit for bit, and the same errors, on random poses of the
+KR 6 R900 and of a corpus KR 210) and the trace's pose lines (the same bytes). Issue 39,
+"Simulator": traces byte-identical."""
+
+from __future__ import annotations
+
+import random
+import shutil
+import sys
+import sysconfig
+
+import numpy as np
+import pytest
+
+from robot import build, kinematics
+from robot.errors import RobotError
+from robot.kinematics import Kinematics
+from robot.mada import load_robot
+from robot.trace import _round6, round_time
+
+try:
+    from robot import simcore
+except ImportError:
+    simcore = None
+
+
+def _can_compile() -> bool:
+    try:
+        import Cython  # noqa: F401, PLC0415
+    except ImportError:
+        return False
+    return shutil.which(sysconfig.get_config_var("CC").split()[0]) is not None
+
+
+def test_the_compiled_inverse_is_built_and_used():
+    if not _can_compile():
+        pytest.skip("no Cython or no C compiler: the pure-Python inverse runs (make vm-loop says so)")
+    assert build.target().exists(), "the compiled inverse kinematics is missing: run make vm-loop"
+    assert kinematics._simcore is not None and kinematics._simcore.ABI == kinematics.SIMCORE_ABI
+    k = Kinematics()
+    k.inverse(k.forward([10, -80, 100, 20, 30, 40]))
+    assert k._c_opw
+
+
+def _answer(k: Kinematics, T, status, turn, ref):
+    try:
+        return k.inverse(T, status, turn, ref).tobytes()
+    except RobotError as e:
+        return (type(e).__name__, str(e))
+
+
+def test_compiled_and_python_inverse_agree_bit_for_bit_kr6():
+    _agree(None, 39)
+
+
+def test_compiled_and_python_inverse_agree_bit_for_bit_on_a_corpus_kr210(shared_corpus):
+    _agree(load_robot(str(shared_corpus / "HugoDanielson__ChinaMilling")), 40)
+
+
+def _agree(machine, seed: int) -> None:
+    if kinematics._simcore is None:
+        pytest.skip("not compiled: only the Python inverse runs")
+    compiled, python = Kinematics(machine), Kinematics(machine)
+    python._c_opw = False
+    rng = np.random.default_rng(seed)
+    lo, hi = np.maximum(compiled._lo, -185.0), np.minimum(compiled._hi, 185.0)
+    solved = failed = 0
+    for _ in range(3000):
+        q = rng.uniform(lo, hi)
+        r = rng.random()
+        if r < 0.1:
+            q[4] = 0.0                                   # the wrist singularity: A4 from the reference
+        elif r < 0.15:
+            q[4] = float(rng.choice([1e-7, -1e-7, 1e-6]))
+        elif r < 0.2:
+            q[1], q[2] = -90.0, 90.0                     # near the A1 axis
+        T = compiled.forward(q)
+        ref = q + rng.normal(0.0, 25.0, 6) if rng.random() < 0.7 else q.copy()
+        if rng.random() < 0.1:
+            ref[2] = compiled.phi_deg                    # a reference on the A3 switching point
+        status = None if rng.random() < 0.6 else int(rng.integers(0, 8))
+        turn = None if rng.random() < 0.6 else int(rng.integers(0, 64))
+        a, b = _answer(compiled, T, status, turn, ref), _answer(python, T, status, turn, ref)
+        assert a == b, (q.tolist(), ref.tolist(), status, turn)
+        # the entry of robot/planner.py CartSegment.ik: rotation and position apart
+        rp = compiled._compiled().inverse_rp(T[:3, :3], T[:3, 3], status, turn, ref)
+        assert (rp.tobytes() if rp is not None else None) == (a if isinstance(a, bytes) else None)
+        solved += isinstance(a, bytes)
+        failed += not isinstance(a, bytes)
+    assert solved > 1000 and failed > 100      # both the solutions and the errors were compared
+
+
+def test_the_build_falls_back_without_cython(monkeypatch):
+    monkeypatch.setitem(sys.modules, "Cython.Build", None)
+    assert "not compiled" in build.build(force=True)
+
+
+def _python_pose_line(t, axes, tcp):
+    # robot/trace.py TraceWriter.flush's own formatting (the reference)
+    ax, tc, tt = [_round6(float(v)) for v in axes], [_round6(v) for v in tcp], round_time(t)
+    return (f'{{"t":{tt!r},"kind":"pose","axes":[{",".join(map(repr, ax))}],'
+            f'"tcp":[{",".join(map(repr, tc))}]}}')
+
+
+def test_the_compiled_pose_line_is_pythons_bit_for_bit():
+    if simcore is None:
+        pytest.skip("not compiled: only the Python formatting runs")
+    rng = random.Random(39)
+    tricky = [0.0, -0.0, 5e-7, -5e-7, 4.9999999e-7, 1.5e-6, 1.25e-5, -1.25e-5, 1e-4, 9.9995e-5,
+              -1e-4, 1.5e-4, 123.4565, 2.0000005, 99999999.9999995, 1e13, 99999999999999.98, 1e20]
+
+    def value():
+        r = rng.random()
+        if r < 0.2:
+            return rng.choice(tricky)
+        if r < 0.3:
+            return rng.uniform(-1e-3, 1e-3)                      # repr's exponent form below 1e-4
+        if r < 0.45:
+            return round(rng.uniform(-10, 10), 6) + rng.choice([5e-7, -5e-7])   # near a tie
+        if r < 0.6:
+            return round(rng.uniform(-1000, 1000), rng.choice([6, 7]))
+        if r < 0.7:
+            return rng.uniform(-1e14, 1e14) * rng.choice([1.0, 1e-3, 1e-6])
+        return rng.uniform(-2000, 2000)
+
+    for i in range(40_000):
+        t = rng.choice([i * 0.012, rng.uniform(0.0, 1e4)])
+        axes, tcp = [value() for _ in range(6)], [value() for _ in range(6)]
+        line = simcore.pose_line(t, axes, tcp)
+        if line is None:     # left to the Python path: only for a huge number
+            assert max(abs(v) for v in axes + tcp) >= 1e15, (t, axes, tcp)
+        else:
+            assert line == _python_pose_line(t, axes, tcp), (t, axes, tcp)
+    assert simcore.pose_line(1.0, [float("nan")] * 6, [0.0] * 6) is None    # json.dumps writes NaN
