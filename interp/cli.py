@@ -62,8 +62,9 @@ from robot.trace import TRACE_REPEATS
                    "times, default 10; then the HALT ends the run).")
 @click.option("--trace-repeats", "trace_repeats", type=click.IntRange(0, None), default=TRACE_REPEATS,
               show_default=True,
-              help="A spin in the trace: each repeated event (statement, call, I/O change, message, pose "
-                   "at rest) is written this many times, then counted in a `repeat` event; 0 writes every event.")
+              help="A spin in the trace: a pass of events repeated with nothing changed but time (the same "
+                   "events and values, the same state of the run) is written this many times, then counted "
+                   "in a `repeat` event; a loop whose state changes keeps every event; 0 writes every event.")
 def run(**options) -> None:
     """Run PROGRAM (.src) on the simulated KR C4; print where and why it ended.
 

@@ -269,21 +269,11 @@ def robot_for(program, workspace=None, robot=None, inputs=None):
 
 
 def _backup_robot(root: Path):
-    """robot.mada ``robot_of_backup(root)``, kept across processes (krl/store.py) for the
-    same files of its machine-data folder."""
-    from krl.project import machine_data_file  # noqa: PLC0415
-    from krl.store import file_key, stored  # noqa: PLC0415
+    """robot.mada ``robot_of_backup(root)`` (its data lists' parses come from the one store,
+    robot/datalist.py)."""
     from robot.mada import robot_of_backup  # noqa: PLC0415
 
-    f = machine_data_file(root)
-    if f is None:
-        return None
-    try:
-        files = sorted(c for c in f.parent.iterdir() if c.is_file())
-    except OSError:
-        return robot_of_backup(root)
-    return stored("robot", (str(root), str(f), file_key(files)), lambda: robot_of_backup(root),
-                  code=("krl", "robot"))
+    return robot_of_backup(root)
 
 
 def signal_of(rt: Runtime, main: str, name: str) -> tuple[str, int, int | None] | None:

@@ -99,10 +99,12 @@ MAX_LSP_SCAN_ENTRIES = 200_000
 # one request. A backup declares tens of thousands of names; an editor shows a few dozen.
 MAX_LSP_SYMBOLS = 500
 MAX_LSP_COMPLETIONS = 1000
-# The persistent parse and check cache of `krl lsp` (krl/lsp/cache.py), in bytes of entries: a
-# 400-file workspace takes about 2.5 MB. Past it the least recently used quarter of the entries
-# is deleted.
-MAX_LSP_CACHE_BYTES = 512 * 1024 * 1024
+# The one store of parse and check results (krl/store.py, shared by krl lsp, run, debug and
+# check), in bytes of entries: a 400-file workspace takes about 2.5 MB. Past it the least
+# recently used quarter of the entries is deleted. An entry (one file's parse, one workspace's
+# diagnostics) larger than MAX_CACHE_ENTRY_BYTES is not kept (made anew each time).
+MAX_CACHE_BYTES = 512 * 1024 * 1024
+MAX_CACHE_ENTRY_BYTES = 64 * 1024 * 1024
 
 # A `krl.toml` (the diagnostic configuration of a workspace), in bytes: a few lines in practice.
 # Past it: the configuration error names the file (krl check exits 2).
@@ -135,13 +137,6 @@ MAX_MOTION_HISTORY = 10_000
 MAX_DAP_MESSAGE_BYTES = 1024 * 1024
 MAX_DAP_BREAKPOINTS = 1000
 MAX_DAP_REPLAY_STEPS = 10_000_000
-
-# Results kept across processes (krl/store.py: a program's checked workspace, a backup's robot
-# model) in the user cache folder: the largest one result kept (a checked 150-file backup is
-# about 5 MB) and all of them together; past the first the result is not kept, past the second
-# the results used least recently are removed.
-MAX_STORED_BYTES = 256 * 1024 * 1024
-MAX_STORE_BYTES = 1024 * 1024 * 1024
 
 # Reactive rules of a cell file (`rules:` in a stimuli file, robot/cellrules.py): the most rules
 # in one file (a PLC program answering a cell has tens of handshakes, a few hundred at most) and

@@ -1,57 +1,49 @@
-"""Results kept across processes in the user cache folder, so that a command started again on
-the same files (``krl debug``'s launch, ``krl run``) does not parse and check them again.
+"""The one store of parse and check results kept across processes, shared by every command
+(``krl lsp``, ``krl run``, ``krl debug``, ``krl check``; docs/security.md, "The cache").
 
-:func:`stored` returns ``make()``'s result, kept in ``cache_dir()/stored/KIND/`` under the
-SHA-256 of its key (what it was made of: the files' paths, sizes and modification times) and of
-the code that made it (the sizes and modification times of the packages' sources, so any
-change of the code makes it anew). A kept result is a pickle (Python objects: a checked
-workspace's ASTs and scopes, a robot model), written by this user for this user:
+It is one SQLite database per version of the front end, ``cache_dir()/front-end/<version>.sqlite``
+(:func:`front_end_version` hashes the grammar and every source and data file of the ``krl``
+package, so any change of the parser, the AST, the checker or the codec starts a new database
+and an old one is never read). A row is (kind, key, SHA-256 of the data, data, last use):
 
-* the folder is created with mode 0700, each file with 0600, written atomically;
-* a file is read only when it and its folder belong to the current user and no one else may
-  write them (POSIX), when it starts with this module's header and the whole key's digest,
-  and when it is at most :data:`krl.limits.MAX_STORED_BYTES`; anything else is a miss (the
-  result is made anew and replaces the file);
-* at most :data:`krl.limits.MAX_STORE_BYTES` are kept in all; past it the results used least
-  recently are removed.
+* kind ``parse``: one per file content, keyed by :func:`parse_key` (the SHA-256 of the file's
+  bytes and whether it is a data list); the data is the file's parse encoded by
+  krl/parsecache.py (msgpack by a schema: AST node classes by number, fields in order,
+  diagnostics by their fields);
+* kind ``check``: one per workspace, keyed by :func:`check_key` (every file's path and content
+  hash); the data is the workspace's diagnostics (the language server shows them at once).
 
-Objects a result shares with the process (the type singletons ``INT``, ``UNKNOWN``, the system
-scopes and tables built once per process: what the packages of `code` hold in module globals and
-in their cached zero-argument functions) are not copied: they are stored as their place
-(module, name, the keys and attributes down to them) and found there again on load, so that
-identity (``t is T.INT``) holds as in a result made in the process. A place that does not
-lead to an object of the same type is a miss.
-
-A result that holds ``id()``-keyed tables (a dict whose keys, or a set whose members, are the
-``id()`` of objects it holds: the front end keys routines and diagnostics that way) is stored
-with ``fix_ids``: the objects behind those ids are stored with it and the tables re-keyed on
-load (ids are addresses, different in every process).
-
-Nothing here ever fails a command: a folder that cannot be written means results are not
-kept. ``KRL_STORE=0`` turns keeping off. See docs/security.md, "The cache".
+This module stores and returns bytes only; it never unpickles or evaluates anything it reads.
+The data of a row is returned only when its SHA-256 matches; what a codec cannot decode is a
+corrupt entry, and the caller makes the result anew (a silent recompute, counted in
+:attr:`Store.corrupt`). A database that cannot be opened, read or written (a file that is not
+SQLite, a full disk, a read-only folder) turns the store off for the process (said once in the
+``krl.store`` log): commands then parse and check as without a cache, and never fail for it.
+The database is kept within :data:`krl.limits.MAX_CACHE_BYTES` (past it the least recently used
+quarter of the rows goes), an entry larger than :data:`krl.limits.MAX_CACHE_ENTRY_BYTES` is not
+kept. The folder is created with mode 0700 (the database with the user's umask, in that
+folder). ``KRL_STORE=0`` (or ``KRL_LSP_NO_CACHE``) turns the store off.
 """
 
 from __future__ import annotations
 
-import contextlib
-import functools
-import gc
 import hashlib
-import importlib
-import importlib.util
-import io
+import logging
 import os
-import pickle
-import sys
-import types
-from collections.abc import Callable, Iterable
+import sqlite3
+import threading
+import time
 from pathlib import Path
 
-from krl.limits import MAX_STORE_BYTES, MAX_STORED_BYTES
+from krl.limits import MAX_CACHE_BYTES, MAX_CACHE_ENTRY_BYTES
 
-HEADER = b"krl-tools stored result 1\n"
-#: pickling a deep AST recurses once per level; KRL's nesting limits (krl/limits.py) bound it
-RECURSION = 20_000
+log = logging.getLogger("krl.store")
+log.addHandler(logging.NullHandler())   # a command's standard error never gets it unless logging is set up
+#: the codec's name and version: part of :func:`front_end_version`
+CODEC = "krl-store 2 (msgpack by schema)"
+LOCK_WAIT_S = 5.0
+KRL_ROOT = Path(__file__).resolve().parent
+GRAMMAR = KRL_ROOT.parent / "grammar" / "KRL.g4"
 
 
 def cache_dir() -> Path:
@@ -65,366 +57,154 @@ def cache_dir() -> Path:
     return d
 
 
-def file_key(paths: Iterable) -> tuple:
-    """(path, size, mtime ns) of each file (-1, -1 when it cannot be read): a key part that
-    changes when a file does."""
-    out = []
-    for p in paths:
+_VERSION: list[str] = []
+
+
+def front_end_version() -> str:
+    """A hash of everything a stored entry depends on: the codec, the grammar the parser was
+    generated from (grammar/KRL.g4) and every .py/.yaml/.java file of the ``krl`` package but
+    the generated parser (made from that grammar); computed once per process."""
+    if not _VERSION:
+        h = hashlib.sha256(CODEC.encode())
         try:
-            st = os.stat(p, follow_symlinks=False)
-            out.append((str(p), st.st_size, st.st_mtime_ns))
+            h.update(GRAMMAR.read_bytes())
         except OSError:
-            out.append((str(p), -1, -1))
-    return tuple(out)
+            h.update(b"no grammar")
+        for p in sorted(KRL_ROOT.rglob("*")):
+            if p.suffix in (".py", ".yaml", ".java") and "generated" not in p.parts and p.is_file():
+                h.update(str(p.relative_to(KRL_ROOT)).encode())
+                h.update(p.read_bytes())
+        _VERSION.append(h.hexdigest())
+    return _VERSION[0]
 
 
-@functools.lru_cache(maxsize=None)
-def code_version(packages: tuple[str, ...]) -> str:
-    """The digest of the sources of `packages` (their files' relative paths, sizes and
-    modification times; the grammar with ``krl``), the Python version and this module's
-    header: results made by other code are never read."""
-    h = hashlib.sha256(HEADER + sys.version.encode())
-    for name in packages:
-        spec = importlib.util.find_spec(name)
-        if spec is None or not spec.submodule_search_locations:
-            continue
-        root = Path(next(iter(spec.submodule_search_locations)))
-        for dirpath, dirnames, filenames in os.walk(root):
-            dirnames[:] = sorted(d for d in dirnames if d != "__pycache__")
-            for f in sorted(filenames):
-                if f.endswith((".pyc", ".pyo")):
-                    continue
-                p = Path(dirpath) / f
-                h.update(repr(file_key([p.relative_to(root)]) + file_key([p])).encode())
-    grammar = Path(__file__).resolve().parents[1] / "grammar" / "KRL.g4"
-    h.update(repr(file_key([grammar])).encode())
+def parse_key(sha: str, path: str) -> str:
+    """The key of a file's parse: its content hash and whether it is a data list (the only
+    thing of its name the parse depends on)."""
+    return f"{sha}:{'dat' if str(path).lower().endswith('.dat') else 'src'}"
+
+
+def check_key(files: list[tuple[str, str]], skipped: list[tuple[str, str]]) -> str:
+    """The key of a workspace's check: (path, content hash) of its files in order, and the
+    (path, reason) of the entries not read."""
+    h = hashlib.sha256()
+    for path, sha in files:
+        h.update(f"f\t{path}\t{sha}\n".encode("utf-8", "surrogatepass"))
+    for path, why in skipped:
+        h.update(f"s\t{path}\t{why}\n".encode("utf-8", "surrogatepass"))
     return h.hexdigest()
 
 
-def stored(kind: str, key, make: Callable[[], object], *, code: tuple[str, ...] = ("krl",),
-           fix_ids: bool = False):
-    """``make()``, or the result kept for (`kind`, `key`, the code of `code`). `key`: any value
-    with a stable ``repr`` (tuples of strings and numbers). The result is kept when ``make``
-    returns (exceptions pass through, nothing kept)."""
-    if os.environ.get("KRL_STORE", "1") == "0":
-        return make()
-    try:
-        folder = _folder(kind)
-    except OSError:
-        return make()
-    digest = hashlib.sha256(repr((kind, key, code_version(code))).encode()).hexdigest()
-    path = folder / f"{digest[:40]}.pickle"
-    got = _read(path, digest)
-    if got is not None:
-        return got[0]
-    value = make()
-    _write(path, digest, value, fix_ids, code)
-    return value
+def enabled() -> bool:
+    """False when the user turned the store off (``KRL_STORE=0``, ``KRL_LSP_NO_CACHE``)."""
+    return os.environ.get("KRL_STORE", "1") != "0" and not os.environ.get("KRL_LSP_NO_CACHE")
 
 
-def _folder(kind: str) -> Path:
-    root = cache_dir() / "stored"
-    root.mkdir(mode=0o700, exist_ok=True)
-    folder = root / kind
-    folder.mkdir(mode=0o700, exist_ok=True)
-    return folder
+class Store:
+    """The database (see the module docstring): bytes by (kind, key); thread-safe; never
+    raises. `folder`: the cache folder (default :func:`cache_dir`)."""
 
-
-def _trusted(st) -> bool:
-    """Owned by this user, writable by no one else (POSIX; elsewhere the user's own folder)."""
-    if not hasattr(os, "getuid"):
-        return True
-    return st.st_uid == os.getuid() and not st.st_mode & 0o022
-
-
-def _read(path: Path, digest: str) -> tuple | None:
-    """(value,) of a kept result, or None (a miss)."""
-    try:
-        st = os.stat(path, follow_symlinks=False)
-        if not (_trusted(st) and _trusted(os.stat(path.parent)) and _trusted(os.stat(path.parent.parent))):
-            return None
-        if st.st_size > MAX_STORED_BYTES or not path.is_file():
-            return None
-        with open(path, "rb") as fh:
-            head = fh.readline(len(HEADER) + 1)
-            if head != HEADER or fh.readline(80).strip() != digest.encode():
-                return None
-            data = fh.read()
-        old = sys.getrecursionlimit()
-        enabled = gc.isenabled()
-        gc.disable()            # millions of new objects and no garbage: the collector only costs
-        sys.setrecursionlimit(max(old, RECURSION))
-        try:
-            value, fixups = _Unpickler(io.BytesIO(data)).load()
-        finally:
-            sys.setrecursionlimit(old)
-            if enabled:
-                gc.enable()
-        for table, pairs in fixups:
-            table.clear()
-            if isinstance(table, dict):
-                table.update((id(obj), v) for obj, v in pairs)
-            else:
-                table.update(id(obj) for obj in pairs)
-        os.utime(path)          # used now: the last to be removed
-        return (value,)
-    except Exception:  # noqa: BLE001 - a result that cannot be read is made anew
-        return None
-
-
-def _write(path: Path, digest: str, value, fix_ids: bool, code: tuple) -> None:
-    """Keep `value` (in a detached grandchild process where the platform can fork one: the
-    command goes on at once, and no child is left for it to reap)."""
-    if hasattr(os, "fork") and sys.platform != "darwin":
-        import dataclasses, inspect, tempfile  # noqa: E401, F401, PLC0415 - imported before the fork
-        try:
-            pid = os.fork()
-        except OSError:
-            pid = -1
-        if pid == 0:                 # the child: fork the writer and leave at once
-            status = 0
-            try:
-                if os.fork() == 0:   # the writer: write, then leave without any clean-up
-                    null = os.open(os.devnull, os.O_RDWR)
-                    for fd in (0, 1, 2):     # the parent's pipes are not held open by the writer
-                        os.dup2(null, fd)
-                    _write_now(path, digest, value, fix_ids, code)
-            except BaseException:  # noqa: BLE001
-                status = 1
-            os._exit(status)
-        if pid > 0:
-            with contextlib.suppress(ChildProcessError):
-                os.waitpid(pid, 0)   # the child ends at once; the writer is init's to reap
+    def __init__(self, folder: Path | None = None, enabled: bool = True) -> None:
+        self.db: sqlite3.Connection | None = None
+        self.lock = threading.Lock()
+        self.path: Path | None = None
+        self.hits = self.misses = self.corrupt = 0
+        if not enabled or not globals()["enabled"]():
             return
-    try:
-        _write_now(path, digest, value, fix_ids, code)
-    except Exception:  # noqa: BLE001 - not kept
-        pass
-
-
-def _write_now(path: Path, digest: str, value, fix_ids: bool, code: tuple) -> None:
-    old = sys.getrecursionlimit()
-    sys.setrecursionlimit(max(old, RECURSION))
-    try:
-        buf = io.BytesIO()
-        _Pickler(buf, _anchors(code)).dump((value, _id_tables(value) if fix_ids else []))
-        data = buf.getvalue()
-    finally:
-        sys.setrecursionlimit(old)
-    if len(data) + 200 > MAX_STORED_BYTES:
-        return
-    _replace(path, HEADER + digest.encode() + b"\n" + data)
-    _trim(path.parent.parent)
-
-
-def _replace(path: Path, data: bytes) -> None:
-    """Write a new file (mode 0600) beside `path` and rename it over `path`: a reader sees the
-    old result or the new one, never half a file."""
-    import tempfile  # noqa: PLC0415
-
-    fd, tmp = tempfile.mkstemp(prefix=".", suffix=".tmp", dir=path.parent)   # mode 0600
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(data)
-        os.replace(tmp, path)
-    except BaseException:
-        with contextlib.suppress(OSError):
-            os.unlink(tmp)
-        raise
-
-
-def _trim(root: Path) -> None:
-    """Remove the results used least recently while all together exceed MAX_STORE_BYTES."""
-    files = []
-    for f in root.glob("*/*.pickle"):
         try:
-            st = f.stat()
-        except OSError:
-            continue
-        files.append((st.st_mtime_ns, st.st_size, f))
-    total = sum(s for _t, s, _f in files)
-    for _t, size, f in sorted(files):
-        if total <= MAX_STORE_BYTES:
-            break
-        try:
-            f.unlink()
-            total -= size
-        except OSError:
-            pass
+            folder = (folder or cache_dir()) / "front-end"
+            folder.mkdir(parents=True, exist_ok=True, mode=0o700)
+            self.path = folder / f"{front_end_version()[:24]}.sqlite"
+            db = sqlite3.connect(self.path, timeout=LOCK_WAIT_S, check_same_thread=False)
+            db.execute("CREATE TABLE IF NOT EXISTS entries (kind TEXT, key TEXT, digest BLOB, data BLOB, "
+                       "used REAL, PRIMARY KEY (kind, key))")
+            db.commit()
+            self.db = db
+        except (OSError, sqlite3.Error) as exc:
+            self._off(f"the cache is not used: {exc}")
+
+    def _off(self, why: str) -> None:
+        log.warning("%s", why)
+        self._close()
+
+    def _close(self) -> None:
+        db, self.db = self.db, None
+        if db is not None:
+            try:
+                db.close()
+            except sqlite3.Error:
+                pass
+
+    def get(self, kind: str, keys: list[str]) -> dict[str, bytes]:
+        """The verified data of the entries of `kind` among `keys` (a row whose data does not
+        match its digest is counted corrupt and left out)."""
+        out: dict[str, bytes] = {}
+        if self.db is None or not keys:
+            return out
+        with self.lock:
+            try:
+                for i in range(0, len(keys), 500):
+                    part = keys[i:i + 500]
+                    rows = self.db.execute(
+                        f"SELECT key, digest, data FROM entries WHERE kind = ? AND key IN ({','.join('?' * len(part))})",
+                        (kind, *part)).fetchall()
+                    for key, digest, data in rows:
+                        if isinstance(data, bytes) and hashlib.sha256(data).digest() == digest:
+                            out[key] = data
+                        else:
+                            self.corrupt += 1
+                if out:
+                    now = time.time()
+                    self.db.executemany("UPDATE entries SET used = ? WHERE kind = ? AND key = ?",
+                                        [(now, kind, k) for k in out])
+                    self.db.commit()
+            except sqlite3.Error as exc:
+                self._off(f"the cache is not used: {exc}")
+        self.hits += len(out)
+        self.misses += len(keys) - len(out)
+        return out
+
+    def put(self, kind: str, items: dict[str, bytes]) -> None:
+        """Keep `items` (key -> data; an entry past MAX_CACHE_ENTRY_BYTES is not kept)."""
+        items = {k: v for k, v in items.items() if len(v) <= MAX_CACHE_ENTRY_BYTES}
+        if self.db is None or not items:
+            return
+        now = time.time()
+        with self.lock:
+            try:
+                self.db.executemany("INSERT OR REPLACE INTO entries VALUES (?, ?, ?, ?, ?)",
+                                    [(kind, k, hashlib.sha256(v).digest(), v, now) for k, v in items.items()])
+                self.db.commit()
+                self._trim()
+            except sqlite3.Error as exc:
+                self._off(f"the cache is not written: {exc}")
+
+    def _trim(self) -> None:
+        """Keep the database within MAX_CACHE_BYTES: the least recently used quarter goes
+        while it is larger."""
+        size = self.db.execute("SELECT COALESCE(SUM(LENGTH(data)), 0), COUNT(*) FROM entries").fetchone()
+        if size[0] <= MAX_CACHE_BYTES:
+            return
+        self.db.execute("DELETE FROM entries WHERE rowid IN (SELECT rowid FROM entries ORDER BY used LIMIT ?)",
+                        (max(1, size[1] // 4),))
+        self.db.commit()
+        self.db.execute("VACUUM")
+
+    def close(self) -> None:
+        with self.lock:
+            self._close()
 
 
-_OPAQUE = (type, types.ModuleType, types.FunctionType, types.BuiltinFunctionType, types.MethodType,
-           types.CodeType, types.FrameType)
+_SHARED: dict[tuple, Store] = {}
+_SHARED_LOCK = threading.Lock()
 
 
-def _id_tables(root) -> list:
-    """(table, [(object, value)] or [object]) for every dict (set) reachable from `root` whose
-    int keys (members) are all ``id()`` of objects reachable from `root`."""
-    objs: dict[int, object] = {}
-    tables = []
-    stack = [root]
-    while stack:
-        o = stack.pop()
-        if id(o) in objs or isinstance(o, _OPAQUE):
-            continue
-        objs[id(o)] = o
-        t = type(o)
-        if t is dict or t is set:
-            if any(type(k) is int for k in o):
-                tables.append(o)
-        stack.extend(gc.get_referents(o))
-    out = []
-    for table in tables:
-        ints = [k for k in table if type(k) is int]
-        if not ints or not all(k in objs for k in ints):
-            continue
-        if len(ints) != len(table):
-            continue            # a table of ids and other keys: not ours to guess
-        if isinstance(table, dict):
-            out.append((table, [(objs[k], v) for k, v in table.items()]))
-        else:
-            out.append((table, [objs[k] for k in table]))
-    return out
-
-
-# ----------------------------------------------------------------------- shared objects
-
-#: objects visited when the process's shared objects are listed (module globals and below)
-ANCHOR_BUDGET = 400_000
-_PRIMITIVE = (str, int, float, bool, bytes, complex, type(None))
-
-def _own(obj, packages: tuple) -> bool:
-    return type(obj).__module__.split(".")[0] in packages
-
-
-def _anchors(packages: tuple) -> dict[int, tuple]:
-    """id -> (place, type name) of the objects the process shares: module globals of
-    `packages` and the results of their cached zero-argument functions, and what is reachable
-    from them through dict keys (str, int), list and tuple indices and the attributes of their
-    own classes (breadth first, so each object gets its shortest place)."""
-    import inspect  # noqa: PLC0415
-
-    roots = []
-    for modname, mod in sorted(sys.modules.items()):
-        if mod is None or modname.split(".")[0] not in packages:
-            continue
-        for name, v in sorted(vars(mod).items()):
-            if isinstance(v, _PRIMITIVE):
-                continue
-            if hasattr(v, "cache_info") and callable(v):
-                try:
-                    if v.cache_info().currsize and not inspect.signature(v).parameters:
-                        roots.append((("c", modname, name), v()))
-                except (TypeError, ValueError):
-                    pass
-                continue
-            if isinstance(v, _OPAQUE):
-                continue
-            roots.append((("g", modname, name), v))
-    out: dict[int, tuple] = {}
-    queue = list(roots)
-    head = 0
-    while head < len(queue) and len(out) < ANCHOR_BUDGET:
-        place, obj = queue[head]
-        head += 1
-        if id(obj) in out or isinstance(obj, _PRIMITIVE) or isinstance(obj, _OPAQUE):
-            continue
-        out[id(obj)] = (place, type(obj).__qualname__)
-        t = type(obj)
-        if t is dict:
-            queue.extend((place + (("k", k),), v) for k, v in obj.items() if type(k) in (str, int))
-        elif t is list or t is tuple:
-            queue.extend((place + (("i", i),), v) for i, v in enumerate(obj))
-        elif _own(obj, packages):
-            names = list(getattr(obj, "__dict__", {}))
-            for klass in t.__mro__:
-                names.extend(n for n in getattr(klass, "__slots__", ()) if n not in ("__dict__", "__weakref__"))
-            for n in names:
-                try:
-                    queue.append((place + (("a", n),), getattr(obj, n)))
-                except AttributeError:
-                    pass
-    return out
-
-
-class _Pickler(pickle.Pickler):
-    """Stores the process's shared objects as their place (:func:`_anchors`), and the
-    instances of slotted dataclasses by their slots' values (set again by :func:`_set_slots`
-    on load: the dataclass's own ``__setstate__`` looks its fields up for every object, most
-    of the time of loading an AST)."""
-
-    def __init__(self, file, anchors: dict) -> None:
-        super().__init__(file, protocol=pickle.HIGHEST_PROTOCOL)
-        self.anchors = anchors
-        self.slotted: dict = {}
-
-    def persistent_id(self, obj):
-        return self.anchors.get(id(obj))
-
-    def reducer_override(self, obj):
-        t = type(obj)
-        names = self.slotted.get(t)
-        if names is None:
-            names = self.slotted[t] = _slot_names(t)
-        if not names:
-            return NotImplemented
-        return (object.__new__, (t,), tuple(getattr(obj, n, _UNSET) for n in names), None, None, _set_slots)
-
-
-class _Unset:
-    """A slot without a value."""
-
-
-_UNSET = _Unset()
-_SLOTS: dict = {}
-
-
-def _slot_names(t: type) -> tuple:
-    """The slots of a dataclass with slots whose state is the dataclass's own (else ())."""
-    import dataclasses  # noqa: PLC0415
-
-    setstate = getattr(t, "__setstate__", None)
-    if not (dataclasses.is_dataclass(t) and "__slots__" in t.__dict__
-            and getattr(setstate, "__qualname__", "") == "_dataclass_setstate"):
-        return ()
-    names = []
-    for klass in reversed(t.__mro__):
-        names.extend(n for n in klass.__dict__.get("__slots__", ()) if n not in ("__dict__", "__weakref__"))
-    return tuple(names)
-
-
-def _set_slots(obj, values: tuple) -> None:
-    t = type(obj)
-    names = _SLOTS.get(t)
-    if names is None:
-        names = _SLOTS[t] = _slot_names(t)
-    setattr_ = object.__setattr__
-    for n, v in zip(names, values):
-        if v is not _UNSET:
-            setattr_(obj, n, v)
-
-
-class _Unpickler(pickle.Unpickler):
-    """Finds the shared objects at their place in this process."""
-
-    def __init__(self, file) -> None:
-        super().__init__(file)
-        self.found: dict = {}
-
-    def persistent_load(self, pid):
-        got = self.found.get(pid)
+def shared_store() -> Store:
+    """The process's store in the user cache folder (one per ``$KRL_CACHE_DIR``, opened on
+    first use; the language server opens its own with :class:`Store`)."""
+    key = (os.environ.get("KRL_CACHE_DIR"), enabled())
+    with _SHARED_LOCK:
+        got = _SHARED.get(key)
         if got is None:
-            got = self.found[pid] = _place(*pid)
+            got = _SHARED[key] = Store()
         return got
-
-
-def _place(place: tuple, type_name: str):
-    kind, modname, name, *steps = place
-    obj = getattr(importlib.import_module(modname), name)
-    if kind == "c":
-        obj = obj()
-    for how, key in steps:
-        obj = obj[key] if how in ("k", "i") else getattr(obj, key)
-    if type(obj).__qualname__ != type_name:
-        raise pickle.UnpicklingError(f"{place}: a {type(obj).__qualname__}, not a {type_name}")
-    return obj

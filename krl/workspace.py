@@ -294,6 +294,11 @@ class Workspace:
         """:meth:`add_file` for each of `paths`, in order. With `timeout` (seconds per file) the
         files are read here and parsed and built in worker processes (:func:`load_batch`)."""
         paths = list(paths)
+        loader = _LOADER.get()
+        if loader is not None and paths:
+            for lf in loader(paths, timeout, jobs):
+                self.add_loaded(lf, notify=timeout is None)
+            return
         if timeout is None or not paths:
             for p in paths:
                 self.add_file(p)
@@ -1048,6 +1053,23 @@ def on_each_file(callback: Callable[[str], None]):
         _ON_FILE.reset(token)
 
 
+#: how the files of a workspace are loaded instead of parsing them all (:func:`loading_files_by`)
+_LOADER: ContextVar[Callable[[list, float | None, int | None], list] | None] = ContextVar(
+    "krl_workspace_loader", default=None)
+
+
+@contextmanager
+def loading_files_by(loader: Callable[[list, float | None, int | None], list]):
+    """``with loading_files_by(f):`` the workspaces made in the block get their files from
+    ``f(paths, timeout, jobs)`` (one LoadedFile per path, in order, as :meth:`Workspace.add_files`
+    would make them): krl/parsecache.py takes them from the one store. Ends with the block."""
+    token = _LOADER.set(loader)
+    try:
+        yield
+    finally:
+        _LOADER.reset(token)
+
+
 # warnings that advise a change of the code (docs/diagnostics.md): not reported in KUKA's files
 ADVISORY = frozenset({"W108", "W111", "W201", "W202", "W205", "W206", "W210", "W501"})
 _WORD = re.compile(r"[A-Za-z_$][A-Za-z0-9_$]*")
@@ -1108,7 +1130,11 @@ def load_workspaces(groups: list[tuple[str, list]], timeout: float | None = None
     all groups loaded in one batch (:func:`load_batch`; with `timeout`, else here one by one)."""
     out = [Workspace(root) for root, _ in groups]
     files = [(k, e.path) for k, (_, entries) in enumerate(groups) for e in entries if e.kind == "file"]
-    if timeout is None:
+    loader = _LOADER.get()
+    if loader is not None and files:
+        for (k, _path), lf in zip(files, loader([p for _, p in files], timeout, jobs)):
+            out[k].add_loaded(lf, notify=timeout is None)
+    elif timeout is None:
         for k, path in files:
             out[k].add_file(path)
     else:

@@ -1,7 +1,8 @@
 """The values of a KRL data list, read through the project's own front end (reference §2.5).
 
 Used for a backup's machine data (``R1/Mada/$machine.dat``, ``$robcor.dat``): the file is
-parsed by krl/syntax and built into the AST by krl/ast; every declaration's initialiser and
+parsed by krl/syntax and built into the AST by krl/ast (or that AST taken from the one store,
+krl/parsecache.py, when a file of the same content was parsed before); every declaration's initialiser and
 every array element line (``$SOFTP_END[3]=168.0``) is evaluated from the AST. Only literal
 values are allowed there, as in any data list: numbers, booleans, strings, enumeration
 values (``#STANDARD``), a sign before a number, and aggregates (``{X 0.0, Y 0.0}``), evaluated
@@ -22,6 +23,7 @@ from typing import Any
 from krl.ast import nodes as N
 from krl.ast.build import build_module
 from krl.limits import MAX_FILE_BYTES
+from krl.parsecache import load_file
 from krl.semantics import expression as X
 from krl.semantics.values import KrlRuntimeError
 from krl.syntax.parse import parse_file
@@ -98,6 +100,9 @@ def read_data_list(path: str | Path, shown: str | None = None) -> dict[str, Data
             raise DataListError(f"{name}: larger than {MAX_FILE_BYTES} bytes")
     except OSError as exc:
         raise DataListError(f"{name}: cannot be read ({exc.strerror})") from None
+    cached = load_file(p)        # the parse of this content from the one store (krl/store.py)
+    if cached.ok and cached.module.data is not None:
+        return _values(cached.module, name)
     result = parse_file(p)
     if not result.ok:
         if result.errors:
@@ -107,6 +112,10 @@ def read_data_list(path: str | Path, shown: str | None = None) -> dict[str, Data
     module = build_module(result)
     if module.data is None:
         raise DataListError(f"{name}:1:1: not a data list (no DEFDAT)")
+    return _values(module, name)
+
+
+def _values(module: N.Module, name: str) -> dict[str, DataValue]:
     out: dict[str, DataValue] = {}
     for item in module.data.items:
         line = item.span.line

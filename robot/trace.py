@@ -14,7 +14,8 @@ gives the same bytes.
 from __future__ import annotations
 
 import json
-from collections.abc import Iterator
+from collections import deque
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import IO, Any
 
@@ -108,7 +109,8 @@ SCHEMA: dict[str, list[tuple[str, str]]] = {
     "return": [("name", "str: routine name"), ("line", "optional int")],
     "idle": [
         ("until", "float: s, the clock jumped from t to here (interp/runtime/idle.py): nothing "
-                  "changed and nothing happens before the next event"),
+                  "changed and nothing happens before the next event, or the run repeats itself "
+                  "(a polling loop with WAIT SEC: whole periods)"),
         ("since", "optional float: s, the state has stood still since"),
         ("cycles", "optional int: IPO cycles skipped (they execute no statement)"),
     ],
@@ -122,11 +124,13 @@ SCHEMA: dict[str, list[tuple[str, str]]] = {
         ("condition", "optional str: the source text of the condition's line"),
     ],
     "repeat": [
-        ("count", "int: events left out since the last written one that was not a repetition "
-                  "(a bounded trace, TraceWriter repeats=N: each repeated event is written N "
-                  "times, then counted)"),
+        ("count", "int: events left out since the last written one (a bounded trace, "
+                  "TraceWriter repeats=N: a pass of events repeated with nothing changed but "
+                  "time is written N times, then counted)"),
         ("since", "float: s, the first event left out"),
         ("kinds", "dict: kind -> events of that kind left out"),
+        ("passes", "optional int: whole repetitions of the pass among them"),
+        ("period", "optional int: events in one pass"),
     ],
     "interrupt": [
         ("prio", "int: interrupt number / priority"),
@@ -138,9 +142,15 @@ SCHEMA: dict[str, list[tuple[str, str]]] = {
 
 KINDS = tuple(SCHEMA)
 
-#: ``krl run --trace``: each repeated event of a spin is written this many times, then counted
+#: ``krl run --trace``: each pass of a spin is written this many times, then counted
 #: (TraceWriter ``repeats``; ``--trace-repeats 0`` writes every event)
 TRACE_REPEATS = 10
+#: the longest pass (events) the bounding recognises: a cycle of a robot program's time slice
+#: (1000 steps) beside a submit program's (100) fits
+MAX_PASS_EVENTS = 4096
+#: the most events between two state probes after probes that found the state changed (a
+#: probe costs what the idle watch's state_of costs: milliseconds on a large backup)
+MAX_PROBE_GAP = 65536
 _REQUIRED = {k: tuple(f for f, d in v if not d.startswith("optional")) for k, v in SCHEMA.items()}
 _ORDER = {k: tuple(f for f, _ in v) for k, v in SCHEMA.items()}
 
@@ -200,15 +210,21 @@ class TraceWriter:
     ``keep=True`` the events are also kept as dicts in :attr:`events`.
     ``pose_every`` > 1 thins the per-IPO-cycle pose events (1 = every cycle).
 
-    ``repeats`` = N bounds a spin (issue 34): an event that repeats one written before —
-    the same statement (file, line, context), call or return of the same routine, the same
-    I/O change, message, interrupt phase, or motion phase of the same statement to the same
-    target — is written N times, then left out and counted, until something that is not a
-    repetition (an event not seen before once events were left out, a pose that differs from
-    the last: the robot moves, an error, the end, a jump of the idle clock, ...) starts afresh; a ``pose`` equal to
-    the one before (the robot at rest) is written N times in a row, then counted. Before the next written event a
-    ``repeat`` event says how many events of each kind were left out and since when. None
-    (the default) writes every event.
+    ``repeats`` = N bounds a spin (issue 34): a *pass* — a sequence of events — that repeats
+    with nothing changed but time is written N times, then left out and counted. Repeated means
+    the same events with the same fields, time aside (:func:`_content`: values, outputs, motion
+    targets; not the motion and message ids, which only count, nor an ``idle`` jump's times),
+    back to back, for a whole pass (at most :data:`MAX_PASS_EVENTS` events), *and* the state of
+    the run the same at the ends of two passes: :attr:`state_probe`, set by the runtime (the
+    idle watch's ``state_of``: data lists, frames, system variables, I/O image, interrupts),
+    is called at the end of pass N-1 and N, so a counter loop (``N = N + 1``, whose
+    statements repeat, whose state does not) keeps every event. While a spin is left out the
+    state is compared again after 2N, 4N, ... passes; a change ends the spin. Without a probe
+    the events alone decide. A pose equal to the one before (the robot at rest) is an event
+    of the pass like the others (a WAIT FOR at rest is a pass of one pose); a pose that differs
+    (the robot moves) is progress: no event repeats one before it. Before the next written event a ``repeat`` event says how
+    many events of each kind were left out, since when, how many whole passes and of how many
+    events. None (the default) writes every event.
     """
 
     def __init__(self, target: str | Path | IO[str] | None = None, *, keep: bool = False,
@@ -230,12 +246,17 @@ class TraceWriter:
         self._pose_count = 0
         self.closed = False
         self.repeats = repeats
-        self._seen: dict = {}            # key of a repeatable event -> times seen since the reset
+        #: () -> a comparable image of the run's state, or None: the events alone decide a spin
+        self.state_probe: Callable[[], Any] | None = None
+        self._spin = _Spin(repeats, self) if repeats is not None else None
         self._left: dict[str, int] = {}  # kind -> events left out since the last repeat event
         self._left_since: float | None = None
         self._left_last = 0.0
+        self._left_passes = 0            # whole passes among the events left out
+        self._left_period = 0            # events in their pass
+        self._probe_after = 0            # no state probe before this many events (_Pass._end_of)
+        self._probe_gap = 0
         self._last_pose = None           # (axes) of the last pose queued
-        self._same_pose = 0
 
     @property
     def events(self) -> list[dict[str, Any]]:
@@ -262,16 +283,14 @@ class TraceWriter:
         self._pose_count += 1
         if (self._pose_count - 1) % self.pose_every:
             return
-        if self.repeats is not None:
+        if self._spin is not None:
             key = tuple(_round6(float(v)) for v in (axes.tolist() if hasattr(axes, "tolist") else axes))
-            if key == self._last_pose:
-                self._same_pose += 1
-                if self._same_pose >= self.repeats:
-                    self._leave_out("pose", t)
-                    return
-            else:
-                self._last_pose, self._same_pose = key, 0
-                self._seen.clear()          # the robot moves: progress
+            if key != self._last_pose:
+                self._last_pose = key
+                self._spin.reset()          # the robot moves: progress
+            if self._spin.left_out(f"pose{key}", pose=True):   # at rest: a pose is part of the pass
+                self._leave_out("pose", t)
+                return
             self._write_left(t)
         self._poses.append((t, axes, tcp_T))
         if len(self._poses) >= 512:
@@ -311,24 +330,18 @@ class TraceWriter:
 
     def write_event(self, ev: dict[str, Any]) -> None:
         """Write an already built event dict (from :func:`make_event`)."""
+        line = None
         if ev["kind"] == "pose":
             self._pose_count += 1
             if (self._pose_count - 1) % self.pose_every:
                 return
-        elif self.repeats is not None and ev["kind"] != "repeat":
-            key = _repeat_key(ev)
-            if key is None:
-                self._seen.clear()          # progress: every repetition counts afresh
-            else:
-                n = self._seen.get(key, 0)
-                if n == 0 and self._left:
-                    self._seen.clear()      # something new after a spin: the spin is over
-                self._seen[key] = n + 1
-                if n >= self.repeats:
-                    self._leave_out(ev["kind"], ev["t"])
-                    return
+        elif self._spin is not None and ev["kind"] != "repeat":
+            line = json.dumps(ev, separators=(",", ":"), ensure_ascii=True)
+            if self._spin.left_out(_content(ev, line)):
+                self._leave_out(ev["kind"], ev["t"])
+                return
             self._write_left(ev["t"])
-        self._emit(ev)
+        self._emit(ev, line)
 
     def _leave_out(self, kind: str, t: float) -> None:
         if self._left_since is None:
@@ -343,8 +356,10 @@ class TraceWriter:
             return
         left, self._left = self._left, {}
         since, self._left_since = self._left_since, None
+        passes, self._left_passes = self._left_passes, 0
         self._emit(make_event("repeat", self._left_last if t is None else max(t, self._left_last),
-                              count=sum(left.values()), since=since, kinds=dict(sorted(left.items()))))
+                              count=sum(left.values()), since=since, kinds=dict(sorted(left.items())),
+                              passes=passes or None, period=self._left_period if passes else None))
 
     def _emit(self, ev: dict[str, Any], line: str | None = None) -> None:
         """Keep and/or write event `ev`; `line` is its JSON text when the caller formatted it.
@@ -383,27 +398,147 @@ class TraceWriter:
         self.close()
 
 
-def _repeat_key(ev: dict[str, Any]) -> tuple | None:
-    """The key under which event `ev` repeats (TraceWriter ``repeats``), None for an event
-    that is never a repetition (motion, error, end, idle, ...)."""
-    k = ev["kind"]
-    if k == "stmt":
-        return ("stmt", ev.get("file"), ev.get("line"), ev.get("context"))
-    if k in ("call", "return"):
-        return (k, ev.get("name"), ev.get("line"))
-    if k == "io":
-        return ("io", ev.get("signal"), ev.get("value"), ev.get("source"))
-    if k == "message":
-        return ("message", ev.get("text"), ev.get("id"))
-    if k == "interrupt":
-        return ("interrupt", ev.get("prio"), ev.get("name"), ev.get("phase"))
-    if k == "motion":
-        # the same motion statement to the same target again (the robot does not move: a pose
-        # that changes clears the repetitions)
-        target = ev.get("target")
-        return ("motion", ev.get("type"), ev.get("phase"), ev.get("file"), ev.get("line"),
-                tuple(sorted(target.items())) if isinstance(target, dict) else None)
-    return None
+#: fields that only count or give a time, left out of an event's content (:func:`_content`)
+_COUNTERS = {"motion": ("id",), "trigger": ("id",), "message": ("id",), "error": ("id",),
+             "idle": ("until", "since", "cycles")}
+
+
+def _content(ev: dict[str, Any], line: str) -> str:
+    """What event `ev` (written as JSON `line`) says, time aside: the line without its ``t``,
+    and for the kinds of :data:`_COUNTERS` without the ids that only count motions and the
+    times of an idle jump. Two events with the same content are repetitions."""
+    drop = _COUNTERS.get(ev["kind"])
+    if drop is None:
+        return line[line.index(",") + 1:]
+    return json.dumps({k: v for k, v in ev.items() if k != "t" and k not in drop},
+                      separators=(",", ":"), ensure_ascii=True)
+
+
+class _Spin:
+    """The spin detector of a bounded :class:`TraceWriter` (its docstring): two
+    :class:`_Pass` trackers, one over every event and one over the events of the programs
+    (poses aside). The second sees a polling loop's passes run on from one IPO cycle into the
+    next (the pose at rest between two time slices is not in its way); the first sees the cycle
+    itself repeat, poses included (a robot program's time slice and a submit program's, with the
+    pose between them). An event either leaves out is left out."""
+
+    def __init__(self, repeats: int, writer: TraceWriter) -> None:
+        self.writer = writer
+        self.every = _Pass(repeats, writer)
+        self.program = _Pass(repeats, writer)
+
+    def reset(self) -> None:
+        """Progress (the robot moves): no event repeats one before it."""
+        self.every.reset()
+        self.program.reset()
+
+    def left_out(self, key: str, pose: bool = False) -> bool:
+        """Account event `key` (:func:`_content`; `pose`: a pose event); True when it is to be
+        left out."""
+        done = self.every.step(key)
+        if not pose:
+            inner = self.program.step(key)  # always: its history must see every event
+            done = done or inner
+        if done is None:
+            return False
+        w = self.writer
+        if w._left and w._left_period != done.period:
+            w._write_left()                 # a spin of another pass: one `repeat` event each
+        w._left_period, w._left_passes = done.period, w._left_passes + done.passes_ended
+        return True
+
+
+class _Pass:
+    """One period tracker of :class:`_Spin`: the contents of its last :data:`MAX_PASS_EVENTS`
+    events, the period of the pass, the matches in a row, and the state comparisons that
+    confirm the spin (the :class:`TraceWriter` docstring). Each event is compared with the one
+    a period back; a run of matches as long as the period is one more copy of the pass. When a
+    match fails, the period is found again from the event's last occurrence."""
+
+    def __init__(self, repeats: int, writer: TraceWriter) -> None:
+        self.repeats = max(1, int(repeats))
+        self.writer = writer
+        self.hist: deque[str] = deque(maxlen=MAX_PASS_EVENTS)
+        self.last: dict[str, int] = {}    # content -> index of its last occurrence
+        self.n = 0                        # index of the next event
+        self.unlock()
+
+    def reset(self) -> None:
+        self.hist.clear()
+        self.last.clear()
+        self.unlock()
+
+    def unlock(self) -> None:
+        self.period = 0                   # events in one pass (0: no repetition)
+        self.match = 0                    # events that matched the one a period back, in a row
+        self.confirmed = False            # the pass repeats with the same state: left out
+        self.capture = max(2, self.repeats - 1)   # copy at whose end the state is captured
+        self.gap = 1                      # passes before the next capture (doubles)
+        self.ref = None                   # (copy, state) captured
+        self.recheck = 0                  # copy at whose end a confirmed spin's state is compared
+        self.passes_ended = 0             # 1 when the event left out ended a pass
+
+    def step(self, key: str) -> "_Pass | None":
+        """Account event `key`; returns self when it is to be left out."""
+        i = self.n
+        self.n += 1
+        hist = self.hist
+        p = self.period
+        out = None
+        if p and len(hist) >= p and hist[-p] == key:
+            self.match += 1
+            copy = (self.match - 1) // p + 2      # the original pass is copy 1
+            out = self if self.confirmed else None
+            end = self.match % p == 0
+            if end:
+                self._end_of(copy)
+            self.passes_ended = 1 if end else 0
+        else:
+            self.unlock()
+            j = self.last.get(key)
+            if j is not None and 0 < i - j <= len(hist):
+                self.period, self.match = i - j, 1
+        self.last[key] = i
+        hist.append(key)
+        if len(self.last) > 4 * MAX_PASS_EVENTS:
+            self.last = {k: v for k, v in self.last.items() if v > i - MAX_PASS_EVENTS}
+        return out
+
+    def _end_of(self, copy: int) -> None:
+        """Copy `copy` of the pass ended: capture or compare the state."""
+        probe = self.writer.state_probe
+        if probe is None:
+            self.confirmed = copy >= self.repeats
+            return
+        if self.confirmed:
+            if copy >= self.recheck:
+                state = probe()
+                if state != self.ref[1]:
+                    self.confirmed = False       # the state changed: write again
+                    self.ref, self.capture, self.gap = (copy, state), copy, 1
+                else:
+                    self.recheck = 2 * copy
+            return
+        w = self.writer
+        if copy == self.capture:
+            if w._spin.every.n < w._probe_after:
+                self.capture += 1            # the state changed lately: not yet (cost of the probe)
+            else:
+                self.ref = (copy, probe())
+        elif self.ref is not None and copy == self.ref[0] + 1:
+            state = probe()
+            if state == self.ref[1]:
+                self.confirmed = True
+                self.recheck = 2 * copy
+                w._probe_gap = 0
+            else:
+                self.gap *= 2                # the state changes: compare again later
+                self.capture = copy + self.gap
+                self.ref = None
+                # loops whose state changes cost a probe each: the next one, of any pass, after
+                # twice as many events as the last (at most MAX_PROBE_GAP)
+                w._probe_gap = min(max(2 * w._probe_gap, 64), MAX_PROBE_GAP)
+                w._probe_after = w._spin.every.n + w._probe_gap
 
 
 def _wrap180(v: Any) -> Any:

@@ -13,7 +13,10 @@ defaults: the backup's SPS.SUB at boot, its robot):
   listed: until the editor shows the program pointer, all included;
 * ``CPU`` — the processor time (user + system) of the ``krl debug`` process when the launch
   response came (Linux: /proc): on a loaded machine, what the start and launch cost without
-  waiting for a processor.
+  waiting for a processor;
+* ``launchCPU`` — the processor time the process spent from the ``initialize`` response to the
+  ``launch`` response: the launch's own cost (the imports of the run that the adapter starts in
+  the background when it starts land mostly here, since an editor sends ``launch`` at once).
 
 The program is the first robot program (interp.realprograms ``programs_of``) of the corpus
 backup with the most KRL files. ``--against DIR`` times another checkout's ``krl debug``
@@ -61,11 +64,12 @@ def cpu_seconds(pid: int) -> float:
 
 
 def sample(program: Path, workspace: Path, root: Path, python: str | None, env: dict | None) -> tuple:
-    """(start s, launch s, entry s, CPU s) of one fresh krl debug process."""
+    """(start s, launch s, entry s, CPU s, launch CPU s) of one fresh krl debug process."""
     t0 = time.perf_counter()
     with DapClient(timeout=600, root=root, python=python, env=env) as c:
         c.initialize()
         t_start = time.perf_counter()
+        cpu_start = cpu_seconds(c.proc.pid)
         c.request("launch", {"program": str(program), "workspace": str(workspace), "stopOnEntry": True})
         t_launch = time.perf_counter() - t_start
         cpu = cpu_seconds(c.proc.pid)
@@ -74,7 +78,7 @@ def sample(program: Path, workspace: Path, root: Path, python: str | None, env: 
         c.stack()
         t_entry = time.perf_counter() - t0
         c.request("disconnect", {})
-    return t_start - t0, t_launch, t_entry, cpu
+    return t_start - t0, t_launch, t_entry, cpu, cpu - cpu_start
 
 
 def _fmt(xs: list[float]) -> str:
@@ -124,11 +128,11 @@ def main(argv: list[str] | None = None) -> int:
             if cold is not None:
                 env = {"KRL_CACHE_DIR": tempfile.mkdtemp(prefix="krl-bench-cache-", dir=cold)}
             results[name].append(sample(program, backup, root, python, env))
-    what = ("start", "launch", "entry", "CPU")
+    what = ("start", "launch", "entry", "CPU", "launchCPU")
     for name, xs in results.items():
         print(f"{name}:")
         for i, w in enumerate(what):
-            print(f"  {w:7s} {_fmt([x[i] for x in xs])}")
+            print(f"  {w:9s} {_fmt([x[i] for x in xs])}")
     if a.against is not None:
         base = results[sides[1][0]]
         here = results[sides[0][0]]

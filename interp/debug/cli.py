@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import sys
 
 import click
@@ -15,6 +16,9 @@ def debug() -> None:
     with program, workspace, inputs, mode (T1/T2/AUT/EXT), runMode (GO/MSTEP/ISTEP/BSTEP),
     stopOnEntry and interp (tree/vm). Nothing but protocol messages is written to stdout.
     """
+    # the simulated arm is never drawn here: MuJoCo's rendering back end (GLFW) is not loaded
+    # (0.03-0.05 s CPU of the launch, 2026-11-24); a user's own MUJOCO_GL is kept
+    os.environ.setdefault("MUJOCO_GL", "disable")
     from interp.debug.session import DebugSession  # noqa: PLC0415
     from interp.debug.wire import FdReader  # noqa: PLC0415
 

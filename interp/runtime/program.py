@@ -36,8 +36,8 @@ from krl.project import project_of, with_basis   # which files make the program:
 from krl.semantics import types as T
 from krl.semantics.expression import Env, evaluate
 from krl.semantics.resolve import GLOBAL, LOCAL, MODULE, SYSTEM, Storage
-from krl.store import stored
-from krl.workspace import load_file, load_project
+from krl.parsecache import load_project
+from krl.workspace import load_file
 
 from .convert import assign_into, convert_scalar
 from .errors import KrlRuntimeError, ResourceError
@@ -88,9 +88,9 @@ def checked_workspace(project, extra: list[Path] = ()):
     """The loaded, checked and resolved workspace of `project` and the `extra` files (a run's
     BASIS, a submit program outside the project): cached per process for the same files
     (path, size, modification time), so the two interpreters of a conformance run, or the
-    programs of one backup, load and check their files once, and kept across processes in the
-    user cache folder (krl/store.py), so a command started again on unchanged files does not
-    parse and check them again. Never raises for bad input."""
+    programs of one backup, load and check their files once; each file's parse comes from the
+    one store in the user cache folder (krl/store.py, shared with the language server) when a
+    file of the same content was parsed before. Never raises for bad input."""
     paths = [*project.files, *extra]
     key = [str(project.root), project.backup]
     size = 0
@@ -107,13 +107,10 @@ def checked_workspace(project, extra: list[Path] = ()):
     if ws is not None:
         _CACHE.move_to_end(key)
         return ws
-    def make():
-        ws = load_project(project, str(project.root), PARSE_TIMEOUT_S if size > _BATCH_BYTES else None,
-                          extra=list(extra))
-        ws.check()
-        return ws
-
-    ws = stored("workspace", key, make, fix_ids=True)   # kept across processes too (krl/store.py)
+    # each file's parse from the one store (krl/store.py, krl/parsecache.py) by content hash
+    ws = load_project(project, str(project.root), PARSE_TIMEOUT_S if size > _BATCH_BYTES else None,
+                      extra=list(extra))
+    ws.check()
     _CACHE[key] = ws
     while len(_CACHE) > _CACHE_SIZE:
         _CACHE.popitem(last=False)

@@ -202,8 +202,8 @@ def _zeroed(v, t):
 
 def copy_value(v):
     """A deep copy (for :IN parameters and whole-value reads)."""
-    if isinstance(v, Struct):
-        return Struct(v.type, {k: copy_value(x) for k, x in v.f.items()})
+    if isinstance(v, Struct):        # (a scalar component is its own copy: no call for it)
+        return Struct(v.type, {k: copy_value(x) if isinstance(x, (Struct, Arr)) else x for k, x in v.f.items()})
     if isinstance(v, Arr):
         if v.data and isinstance(v.data[0], (Struct, Arr)):
             return Arr(v.type, v.dims, [copy_value(x) for x in v.data])

@@ -13,9 +13,10 @@ from interp.runtime.errors import (KrlRuntimeError)
 from interp.runtime.memory import (Slot)
 from interp.runtime.slots import (add, array_index, component, element, element1, element2, ended_without_return, eq, for_done, for_limits, for_next, function_result, ge, gt, le, load, lt, mul, ne, read_value, return_without_value, set_component, set_element, set_element1, store, sub)
 from interp.runtime.values import (Struct, UNSET)
+from krl.semantics.types import (BOOL as T_BOOL, INT as T_INT, REAL as T_REAL)
 
 # sha256 of the vm.py this file was generated from
-VM_SOURCE = 'ebb2a7a405b8b22821a1ba9aa1e9e39b39be1f1dcd11868cc9f05aa48fbb981f'
+VM_SOURCE = '092e2af6f5d8a6793e336951ad2b4aebbfaabc73a94634144474876fd214a53c'
 
 # opcode number (interp/vm/opcodes.py) -> this loop's number of the opcode
 DISPATCH = [43, 0, 35, 83, 87, 86, 78, 101, 22, 111, 100, 23, 24, 99, 26, 34, 92, 40, 81, 5, 76, 98, 58, 93, 90, 95, 62, 102, 73, 2, 28, 96, 4, 110, 109, 107, 106, 103, 42, 33, 30, 41, 25, 38, 31, 112, 57, 32, 82, 44, 55, 54, 49, 48, 51, 36, 29, 75, 97, 45, 50, 84, 108, 1, 37, 47, 85, 77, 52, 105, 74, 104, 53, 79, 56, 89, 8, 80, 72, 27, 39, 3, 46, 91, 88, 94, 71, 60, 61, 66, 10, 69, 70, 11, 7, 6, 65, 18, 67, 64, 63, 68, 12, 20, 59, 19, 21, 9, 14, 16, 17, 15, 13]
@@ -56,7 +57,7 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
     grefs = code.grefs
     store = frame.store
     fvars = frame.vars
-    before, tick, take_error_proceed, quiet_limit = self.hooks
+    before, tick, take_error_proceed, quiet_limit, run_routine, exec_routine = self.hooks
     cold = self.cold
     task = rt.current_task
     left = task.quiet - rt.steps if task is not None else 0
@@ -86,12 +87,15 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                 left = n - rt.steps
                             ip += 1
                         elif op < 2:
-                            a = store[ins[1]]
-                            i = store[ins[2]]
-                            if type(i) is int and 0 < i <= a.dims[0] and ((v := a.data[i - 1]) is not UNSET):
+                            x1 = ins[1]
+                            x2 = ins[2]
+                            a = store[x1]
+                            i = store[x2]
+                            d = a.data
+                            if type(i) is int and 0 < i <= len(d) and ((v := d[(x3 := i) - 1]) is not UNSET):
                                 stack.append(v)
                             else:
-                                stack.append(_element1(fvars[ins[1]], _load(fvars[ins[2]]), ins[3]))
+                                stack.append(_element1(fvars[x1], _load(fvars[x2]), ins[3]))
                             ip += 1
                         elif op < 26:
                             if op < 3:
@@ -117,7 +121,7 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                     rt.steps += unsaved
                                     unsaved = 0
                                     if target is not None:
-                                        v = self.invoke(target, args, frame, 'N' not in flags)
+                                        v = run_routine(target, args, frame, exec_routine, 'N' not in flags)
                                     else:
                                         v = self.call(code, ip, ins[1], args, frame, flags)
                                     left = task.quiet - rt.steps if task is not None else 0
@@ -290,14 +294,15 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                         stack[-1] = _sub(a, b)
                                     ip += 1
                             else:
-                                a = store[ins[1]]
+                                x1 = ins[1]
+                                a = store[x1]
                                 b = ins[2]
                                 if type(a) is int and type(b) is int and (INT_MIN <= (v := (a + b)) <= INT_MAX):
                                     stack.append(v)
                                 elif type(a) is float and type(b) is float:
                                     stack.append(a + b)
                                 else:
-                                    stack.append(_add(a if a is not UNSET else _load(fvars[ins[1]]), b))
+                                    stack.append(_add(a if a is not UNSET else _load(fvars[x1]), b))
                                 ip += 1
                         elif op < 33:
                             if op < 32:
@@ -348,20 +353,26 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                         if op < 51:
                             if op < 41:
                                 if op < 37:
-                                    v = store[ins[1]]
-                                    stack.append(v if v is not UNSET else _load(fvars[ins[1]]))
-                                    v = store[ins[2]]
-                                    stack.append(v if v is not UNSET else _load(fvars[ins[2]]))
+                                    x1 = ins[1]
+                                    x2 = ins[2]
+                                    v = store[x1]
+                                    stack.append(v if v is not UNSET else _load(fvars[x1]))
+                                    v = store[x2]
+                                    stack.append(v if v is not UNSET else _load(fvars[x2]))
                                     ip += 1
                                 elif op < 38:
-                                    a = store[ins[1]]
-                                    i = store[ins[2]]
+                                    x1 = ins[1]
+                                    x2 = ins[2]
+                                    a = store[x1]
+                                    i = store[x2]
                                     v = stack.pop()
                                     t = ins[4]
-                                    if type(i) is int and 0 < i <= a.dims[0] and (type(v) is t) and (t is not int or INT_MIN <= v <= INT_MAX):
-                                        a.data[i - 1] = v
+                                    d = a.data
+                                    if type(i) is int and 0 < i <= len(d) and (type(v) is t) and (t is not int or INT_MIN <= v <= INT_MAX):
+                                        x3 = i
+                                        d[x3 - 1] = v
                                     else:
-                                        _set_element1(fvars[ins[1]], _load(fvars[ins[2]]), v, ins[3])
+                                        _set_element1(fvars[x1], _load(fvars[x2]), v, ins[3])
                                     ip += 1
                                 elif op < 40:
                                     if op < 39:
@@ -425,7 +436,8 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                     if op < 46:
                                         a = store[ins[1]]
                                         i = stack[-1]
-                                        if type(i) is int and 0 < i <= a.dims[0] and ((v := a.data[i - 1]) is not UNSET):
+                                        d = a.data
+                                        if type(i) is int and 0 < i <= len(d) and ((v := d[(x3 := i) - 1]) is not UNSET):
                                             stack[-1] = v
                                         else:
                                             stack[-1] = _element1(fvars[ins[1]], i, ins[2])
@@ -435,14 +447,17 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                             raise return_without_value(code.routine, frame.line)
                                         return None
                                 else:
-                                    a = store[ins[1]]
-                                    i = store[ins[2]]
-                                    j = store[ins[3]]
+                                    x1 = ins[1]
+                                    x2 = ins[2]
+                                    x3 = ins[3]
+                                    a = store[x1]
+                                    i = store[x2]
+                                    j = store[x3]
                                     n, m = a.dims
-                                    if type(i) is int and type(j) is int and (0 < i <= n) and (0 < j <= m) and ((v := a.data[(i - 1) * m + j - 1]) is not UNSET):
+                                    if type(i) is int and type(j) is int and (0 < i <= n) and (0 < j <= m) and ((v := a.data[((y1 := i) - 1) * (y2 := m) + (y3 := j) - 1]) is not UNSET):
                                         stack.append(v)
                                     else:
-                                        stack.append(_element2(fvars[ins[1]], _load(fvars[ins[2]]), _load(fvars[ins[3]]), ins[4]))
+                                        stack.append(_element2(fvars[x1], _load(fvars[x2]), _load(fvars[x3]), ins[4]))
                                     ip += 1
                             elif op < 50:
                                 if op < 49:
@@ -468,23 +483,25 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                 i = stack[-1]
                                 a = store[ins[1]]
                                 n, m = a.dims
-                                if type(i) is int and type(j) is int and (0 < i <= n) and (0 < j <= m) and ((v := a.data[(i - 1) * m + j - 1]) is not UNSET):
+                                if type(i) is int and type(j) is int and (0 < i <= n) and (0 < j <= m) and ((v := a.data[((y1 := i) - 1) * (y2 := m) + (y3 := j) - 1]) is not UNSET):
                                     stack[-1] = v
                                 else:
                                     stack[-1] = _element2(fvars[ins[1]], i, j, ins[2])
                                 ip += 1
                         elif op < 52:
-                            v = store[ins[1]]
-                            stack.append(v if v is not UNSET else _load(fvars[ins[1]]))
+                            x1 = ins[1]
+                            v = store[x1]
+                            stack.append(v if v is not UNSET else _load(fvars[x1]))
                             ip += 1
                         elif op < 53:
-                            t = ins[2]
-                            c = store[ins[1]]
-                            if type(c) is int and (c := (c + temps[t + 2])) <= temps[t + 3]:
-                                store[ins[1]] = c
+                            x2 = ins[2]
+                            x1 = ins[1]
+                            c = store[x1]
+                            if type(c) is int and (c := (c + temps[x2 + 2])) <= temps[x2 + 3]:
+                                store[x1] = c
                                 go = True
                             else:
-                                go = _for_next(temps[t], temps[t + 1], temps[t + 2], ins[3])
+                                go = _for_next(temps[x2], temps[x2 + 1], temps[x2 + 2], ins[3])
                             if go:
                                 if left > 0:
                                     left -= 1
@@ -499,12 +516,13 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                             else:
                                 ip += 1
                         elif op < 54:
-                            a = store[ins[1]]
+                            x1 = ins[1]
+                            a = store[x1]
                             b = ins[2]
                             ca = type(a)
                             cb = type(b)
                             f = ins[3]
-                            if f[0](a, b) if (ca is int or ca is float) and (cb is int or cb is float) else f[1](a if a is not UNSET else _load(fvars[ins[1]]), b):
+                            if f[0](a, b) if (ca is int or ca is float) and (cb is int or cb is float) else f[1](a if a is not UNSET else _load(fvars[x1]), b):
                                 ip += 1
                             else:
                                 ip = ins[4]
@@ -527,10 +545,14 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                     ip += 1
                                 else:
                                     ip = ins[1]
-                        elif rt.to_bool(stack.pop()):
-                            ip += 1
                         else:
-                            ip = ins[1]
+                            v = stack.pop()
+                            if v is True:
+                                ip += 1
+                            elif v is False or not rt.to_bool(v):
+                                ip = ins[1]
+                            else:
+                                ip += 1
                     elif op < 89:
                         if op < 83:
                             if op < 75:
@@ -634,17 +656,25 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                             _store(temps[ins[1]], stack.pop())
                                             ip += 1
                                     else:
-                                        stack[-1] = rt.unary_op(ins[1], stack[-1])
+                                        a = stack[-1]
+                                        if (a is True or a is False) and ins[1] == 'NOT':
+                                            stack[-1] = a is False
+                                        elif type(a) is float and ins[1] == '-':
+                                            stack[-1] = -a
+                                        else:
+                                            stack[-1] = rt.unary_op(ins[1], a)
                                         ip += 1
                                 else:
-                                    a = store[ins[1]]
+                                    x1 = ins[1]
+                                    a = store[x1]
                                     b = ins[2]
                                     t = ins[4]
                                     ca = type(a)
                                     if ca is type(b) and ca is t and (ca is float or (ca is int and INT_MIN <= (v := (a - b)) <= INT_MAX)):
-                                        store[ins[3]] = a - b if ca is float else v
+                                        x3 = ins[3]
+                                        store[x3] = a - b if ca is float else v
                                     else:
-                                        _store(fvars[ins[3]], _sub(a if a is not UNSET else _load(fvars[ins[1]]), b))
+                                        _store(fvars[ins[3]], _sub(a if a is not UNSET else _load(fvars[x1]), b))
                                     ip += 1
                             elif op < 78:
                                 if op < 77:
@@ -662,7 +692,13 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                         _store(fvars[ins[1]], stack.pop())
                                         ip += 1
                                 else:
-                                    _set_component(fvars[ins[1]], ins[2][0], stack.pop(), ins[3])
+                                    base = fvars[ins[1]]
+                                    v = stack.pop()
+                                    k = ins[2][1]
+                                    if type(base) is Slot and (not base.readonly) and (type((s := base.c[base.k])) is Struct) and (s.type is not None) and ((ft := s.type.fields.get(k)) is not None) and (k in s.f) and ((t := ft[1]) is T_REAL and type(v) is float or (t is T_INT and type(v) is int and (INT_MIN <= v <= INT_MAX)) or (t is T_BOOL and type(v) is bool)):
+                                        s.f[k] = v
+                                    else:
+                                        _set_component(base, ins[2][0], v, ins[3])
                                     ip += 1
                             elif op < 80:
                                 if op < 79:
@@ -699,15 +735,19 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                         elif op < 85:
                             i = stack.pop()
                             v = stack.pop()
-                            a = store[ins[1]]
+                            x1 = ins[1]
+                            a = store[x1]
                             t = ins[3]
-                            if type(i) is int and 0 < i <= a.dims[0] and (type(v) is t) and (t is not int or INT_MIN <= v <= INT_MAX):
-                                a.data[i - 1] = v
+                            d = a.data
+                            if type(i) is int and 0 < i <= len(d) and (type(v) is t) and (t is not int or INT_MIN <= v <= INT_MAX):
+                                x3 = i
+                                d[x3 - 1] = v
                             else:
-                                _set_element1(fvars[ins[1]], i, v, ins[2])
+                                _set_element1(fvars[x1], i, v, ins[2])
                             ip += 1
                         elif op < 86:
-                            base = fvars[ins[1]]
+                            x1 = ins[1]
+                            base = fvars[x1]
                             if type(base) is Slot and type((x := base.c[base.k])) is Struct and (type((x := x.f.get(ins[2][1]))) is float or type(x) is int or type(x) is bool):
                                 stack.append(x)
                             else:
@@ -730,10 +770,13 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                 if op < 92:
                                     if op < 91:
                                         if op < 90:
-                                            if rt.to_bool(stack.pop()):
+                                            v = stack.pop()
+                                            if v is True:
                                                 ip = ins[1]
-                                            else:
+                                            elif v is False or not rt.to_bool(v):
                                                 ip += 1
+                                            else:
+                                                ip = ins[1]
                                         else:
                                             temps[ins[1]] = stack.pop()
                                             ip += 1
@@ -753,7 +796,7 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                         stack.append(temps[ins[1]])
                                         ip += 1
                                     else:
-                                        return stack[-1] if stack else None
+                                        return stack[-1] if len(stack) > 8 else None
                                 else:
                                     stack[-1] = ValueRef(stack[-1])
                                     ip += 1
@@ -770,10 +813,11 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                         elif op < 98:
                             v = stack.pop()
                             t = ins[2]
+                            x1 = ins[1]
                             if type(v) is t and (t is not int or INT_MIN <= v <= INT_MAX):
-                                store[ins[1]] = v
+                                store[x1] = v
                             else:
-                                _store(fvars[ins[1]], v)
+                                _store(fvars[x1], v)
                             ip += 1
                         elif op < 101:
                             if op < 99:
@@ -799,24 +843,28 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                     elif op < 112:
                         if op < 108:
                             if op < 105:
-                                a = store[ins[1]]
-                                b = store[ins[2]]
+                                x1 = ins[1]
+                                x2 = ins[2]
+                                a = store[x1]
+                                b = store[x2]
                                 ca = type(a)
                                 cb = type(b)
                                 f = ins[3]
-                                if f[0](a, b) if (ca is int or ca is float) and (cb is int or cb is float) else f[1](a if a is not UNSET else _load(fvars[ins[1]]), b if b is not UNSET else _load(fvars[ins[2]])):
+                                if f[0](a, b) if (ca is int or ca is float) and (cb is int or cb is float) else f[1](a if a is not UNSET else _load(fvars[x1]), b if b is not UNSET else _load(fvars[x2])):
                                     ip += 1
                                 else:
                                     ip = ins[4]
                             elif op < 106:
-                                a = store[ins[1]]
+                                x1 = ins[1]
+                                a = store[x1]
                                 b = ins[2]
                                 t = ins[4]
                                 ca = type(a)
                                 if ca is type(b) and ca is t and (ca is float or (ca is int and INT_MIN <= (v := (a + b)) <= INT_MAX)):
-                                    store[ins[3]] = a + b if ca is float else v
+                                    x3 = ins[3]
+                                    store[x3] = a + b if ca is float else v
                                 else:
-                                    _store(fvars[ins[3]], _add(a if a is not UNSET else _load(fvars[ins[1]]), b))
+                                    _store(fvars[ins[3]], _add(a if a is not UNSET else _load(fvars[x1]), b))
                                 ip += 1
                             elif op < 107:
                                 b = stack.pop()
@@ -835,7 +883,10 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                 n, m = a.dims
                                 t = ins[3]
                                 if type(i) is int and type(j) is int and (0 < i <= n) and (0 < j <= m) and (type(v) is t) and (t is not int or INT_MIN <= v <= INT_MAX):
-                                    a.data[(i - 1) * m + j - 1] = v
+                                    y1 = i
+                                    y2 = m
+                                    y3 = j
+                                    a.data[(y1 - 1) * y2 + y3 - 1] = v
                                 else:
                                     _set_element(fvars[ins[1]], [i, j], v, ins[2])
                                 ip += 1
@@ -873,7 +924,7 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                 unsaved = 0
                 rt.record_error(e, frame)
                 left = task.quiet - rt.steps if task is not None else 0
-                del stack[:]
+                del stack[8:]
                 ip = reg.end
     finally:
         rt.steps += unsaved

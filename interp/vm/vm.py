@@ -53,6 +53,7 @@ from interp.runtime.slots import (add, anout_limits, anout_value, array_index, c
 
 from . import opcodes as OP
 from krl.semantics.advance import StmtInfo
+from krl.semantics.types import BOOL as T_BOOL, INT as T_INT, REAL as T_REAL
 from krl.semantics.resolve import ROUTINE
 
 from .assembler import Region
@@ -70,6 +71,11 @@ HELPERS = ("load", "store", "element", "element1", "element2", "set_element", "s
                                component, set_component, add, sub, mul, lt, le, gt, ge, eq, ne, for_next,
                                for_limits, read_value, array_index)
 
+
+# The operand stack starts with STACK_BASE placeholders that no instruction reads (the loop
+# spells the number out: ``len(stack) > 8``, ``del stack[8:]``): a statement's pushes and pops then
+# never take the list back to empty, which would free and reallocate its items at every statement.
+STACK_BASE = 8
 
 # the VM's forms of operand kinds y and o (opcodes.py)
 _VALUE_CLASS = {"I": int, "R": float, "B": bool}
@@ -192,7 +198,8 @@ class VM:
             if handler is not None:
                 self.cold[self.dispatch[o.number]] = handler
         # the runtime's statement hooks, bound once (the loop takes them at each call)
-        self.hooks = (rt.before_statement, rt.loop_tick, rt.take_error_proceed, rt.quiet_limit)
+        self.hooks = (rt.before_statement, rt.loop_tick, rt.take_error_proceed, rt.quiet_limit, rt.run_routine,
+                      self.exec_routine)
 
     # ------------------------------------------------------------------ entry points
     def run_program(self, module_name: str | None = None) -> None:
@@ -220,7 +227,7 @@ class VM:
         of its RETURN (None for a DEF)."""
         routine = frame.routine
         code = self.codes.get(id(routine)) or self.code_for(routine)
-        return self.loop(self, code, frame, [None] * code.ntemps, 0, [])
+        return self.loop(self, code, frame, [None] * code.ntemps, 0, [None] * STACK_BASE)
 
     def call(self, code, ip: int, callee, args: list, frame, flags: str):
         """A CALL whose Callee is not a routine of the program (Bound links those): a
@@ -235,7 +242,7 @@ class VM:
         """A callable that runs the thunk at ``ip`` of ``code`` in the activation (``frame``,
         ``temps``) that declared it."""
         loop = self.loop
-        return lambda: loop(self, code, frame, temps, ip, list(stack) if stack else [], True)
+        return lambda: loop(self, code, frame, temps, ip, [None] * STACK_BASE + (stack or []), True)
 
     # ------------------------------------------------------------------ cold opcodes
     def _cold_AGG(self, ins, code, frame, temps, stack, ip):
@@ -468,7 +475,7 @@ class VM:
         fvars = frame.vars
         push = stack.append
         pop = stack.pop
-        before, tick, take_error_proceed, quiet_limit = self.hooks
+        before, tick, take_error_proceed, quiet_limit, run_routine, exec_routine = self.hooks
         cold = self.cold
         task = rt.current_task
         # Quiet steps (Runtime.quiet_limit) are counted here, in two locals: ``left``, how many
@@ -505,16 +512,20 @@ class VM:
                                 left = n - rt.steps
                             ip += 1
                         elif op == OP.LOAD_ELEM1_V:
-                            a = store[ins[1]]
-                            i = store[ins[2]]
-                            if i.__class__ is int and 0 < i <= a.dims[0] and (v := a.data[i - 1]) is not UNSET:
+                            x1 = ins[1]             # x1, x2, x3: C integers when compiled (loop.pxd)
+                            x2 = ins[2]
+                            a = store[x1]
+                            i = store[x2]
+                            d = a.data              # 1-D: len(data) is dims[0] (values.Arr)
+                            if i.__class__ is int and 0 < i <= len(d) and (v := d[(x3 := i) - 1]) is not UNSET:
                                 push(v)
                             else:
-                                push(_element1(fvars[ins[1]], _load(fvars[ins[2]]), ins[3]))
+                                push(_element1(fvars[x1], _load(fvars[x2]), ins[3]))
                             ip += 1
                         elif op == OP.LOAD_FAST:
-                            v = store[ins[1]]
-                            push(v if v is not UNSET else _load(fvars[ins[1]]))
+                            x1 = ins[1]
+                            v = store[x1]
+                            push(v if v is not UNSET else _load(fvars[x1]))
                             ip += 1
                         elif op == OP.JUMP_TICK:
                             if left > 0 and not ins[1].cond_stops:
@@ -531,13 +542,14 @@ class VM:
                             push(ins[1])
                             ip += 1
                         elif op == OP.FOR_NEXT_FAST:
-                            t = ins[2]
-                            c = store[ins[1]]
-                            if c.__class__ is int and (c := c + temps[t + 2]) <= temps[t + 3]:
-                                store[ins[1]] = c
+                            x2 = ins[2]
+                            x1 = ins[1]
+                            c = store[x1]
+                            if c.__class__ is int and (c := c + temps[x2 + 2]) <= temps[x2 + 3]:
+                                store[x1] = c
                                 go = True
                             else:
-                                go = _for_next(temps[t], temps[t + 1], temps[t + 2], ins[3])
+                                go = _for_next(temps[x2], temps[x2 + 1], temps[x2 + 2], ins[3])
                             if go:
                                 if left > 0:
                                     left -= 1
@@ -552,10 +564,12 @@ class VM:
                             else:
                                 ip += 1
                         elif op == OP.LOAD_FAST2:
-                            v = store[ins[1]]
-                            push(v if v is not UNSET else _load(fvars[ins[1]]))
-                            v = store[ins[2]]
-                            push(v if v is not UNSET else _load(fvars[ins[2]]))
+                            x1 = ins[1]
+                            x2 = ins[2]
+                            v = store[x1]
+                            push(v if v is not UNSET else _load(fvars[x1]))
+                            v = store[x2]
+                            push(v if v is not UNSET else _load(fvars[x2]))
                             ip += 1
                         elif op == OP.ADD:
                             b = pop()
@@ -570,39 +584,46 @@ class VM:
                         elif op == OP.STORE_FAST:
                             v = pop()
                             t = ins[2]
+                            x1 = ins[1]
                             if v.__class__ is t and (t is not int or INT_MIN <= v <= INT_MAX):
-                                store[ins[1]] = v
+                                store[x1] = v
                             else:
-                                _store(fvars[ins[1]], v)
+                                _store(fvars[x1], v)
                             ip += 1
                         elif op == OP.STORE_ELEM1:
                             i = pop()
                             v = pop()
-                            a = store[ins[1]]
+                            x1 = ins[1]
+                            a = store[x1]
                             t = ins[3]
-                            if i.__class__ is int and 0 < i <= a.dims[0] and v.__class__ is t and (t is not int or INT_MIN <= v <= INT_MAX):
-                                a.data[i - 1] = v
+                            d = a.data
+                            if i.__class__ is int and 0 < i <= len(d) and v.__class__ is t and (t is not int or INT_MIN <= v <= INT_MAX):
+                                x3 = i
+                                d[x3 - 1] = v
                             else:
-                                _set_element1(fvars[ins[1]], i, v, ins[2])
+                                _set_element1(fvars[x1], i, v, ins[2])
                             ip += 1
                         elif op == OP.SUBC_FAST:
-                            a = store[ins[1]]
+                            x1 = ins[1]
+                            a = store[x1]
                             b = ins[2]
                             t = ins[4]
                             ca = a.__class__
                             if ca is b.__class__ and ca is t and (ca is float or (ca is int and INT_MIN <= (v := a - b) <= INT_MAX)):
-                                store[ins[3]] = a - b if ca is float else v
+                                x3 = ins[3]
+                                store[x3] = a - b if ca is float else v
                             else:
-                                _store(fvars[ins[3]], _sub(a if a is not UNSET else _load(fvars[ins[1]]), b))
+                                _store(fvars[ins[3]], _sub(a if a is not UNSET else _load(fvars[x1]), b))
                             ip += 1
                         elif op == OP.IF_NOT_VC:
-                            a = store[ins[1]]
+                            x1 = ins[1]
+                            a = store[x1]
                             b = ins[2]
                             ca = a.__class__
                             cb = b.__class__
                             f = ins[3]
                             if (f[0](a, b) if (ca is int or ca is float) and (cb is int or cb is float)
-                                    else f[1](a if a is not UNSET else _load(fvars[ins[1]]), b)):
+                                    else f[1](a if a is not UNSET else _load(fvars[x1]), b)):
                                 ip += 1
                             else:
                                 ip = ins[4]
@@ -616,36 +637,43 @@ class VM:
                             else:
                                 ip = ins[1]
                         elif op == OP.STORE_ELEM1_V:
-                            a = store[ins[1]]
-                            i = store[ins[2]]
+                            x1 = ins[1]
+                            x2 = ins[2]
+                            a = store[x1]
+                            i = store[x2]
                             v = pop()
                             t = ins[4]
-                            if i.__class__ is int and 0 < i <= a.dims[0] and v.__class__ is t and (t is not int or INT_MIN <= v <= INT_MAX):
-                                a.data[i - 1] = v
+                            d = a.data
+                            if i.__class__ is int and 0 < i <= len(d) and v.__class__ is t and (t is not int or INT_MIN <= v <= INT_MAX):
+                                x3 = i
+                                d[x3 - 1] = v
                             else:
-                                _set_element1(fvars[ins[1]], _load(fvars[ins[2]]), v, ins[3])
+                                _set_element1(fvars[x1], _load(fvars[x2]), v, ins[3])
                             ip += 1
                         elif op == OP.FAST_ADD_CONST:
-                            a = store[ins[1]]
+                            x1 = ins[1]
+                            a = store[x1]
                             b = ins[2]
                             if a.__class__ is int and b.__class__ is int and INT_MIN <= (v := a + b) <= INT_MAX:
                                 push(v)
                             elif a.__class__ is float and b.__class__ is float:
                                 push(a + b)
                             else:
-                                push(_add(a if a is not UNSET else _load(fvars[ins[1]]), b))
+                                push(_add(a if a is not UNSET else _load(fvars[x1]), b))
                             ip += 1
                         elif op == OP.REF_LOCAL:
                             push(fvars[ins[1]])
                             ip += 1
                         elif op == OP.IF_NOT_VV:
-                            a = store[ins[1]]
-                            b = store[ins[2]]
+                            x1 = ins[1]
+                            x2 = ins[2]
+                            a = store[x1]
+                            b = store[x2]
                             ca = a.__class__
                             cb = b.__class__
                             f = ins[3]
                             if (f[0](a, b) if (ca is int or ca is float) and (cb is int or cb is float)
-                                    else f[1](a if a is not UNSET else _load(fvars[ins[1]]), b if b is not UNSET else _load(fvars[ins[2]]))):
+                                    else f[1](a if a is not UNSET else _load(fvars[x1]), b if b is not UNSET else _load(fvars[x2]))):
                                 ip += 1
                             else:
                                 ip = ins[4]
@@ -669,7 +697,8 @@ class VM:
                                 stack[-1] = _component(base, ins[1][0], ins[2])
                             ip += 1
                         elif op == OP.LOAD_FIELD_L:
-                            base = fvars[ins[1]]
+                            x1 = ins[1]
+                            base = fvars[x1]
                             if base.__class__ is Slot and (x := base.c[base.k]).__class__ is Struct and (
                                     (x := x.f.get(ins[2][1])).__class__ is float or x.__class__ is int
                                     or x.__class__ is bool):
@@ -678,37 +707,62 @@ class VM:
                                 push(_component(base, ins[2][0], ins[3]))
                             ip += 1
                         elif op == OP.STORE_FIELD_L:
-                            _set_component(fvars[ins[1]], ins[2][0], pop(), ins[3])
+                            # set_component's fast path (slots.py): a writable Slot holding a typed
+                            # Struct, a field of type INT/REAL/BOOL, a value of that very type
+                            base = fvars[ins[1]]
+                            v = pop()
+                            k = ins[2][1]
+                            if base.__class__ is Slot and not base.readonly \
+                                    and (s := base.c[base.k]).__class__ is Struct and s.type is not None \
+                                    and (ft := s.type.fields.get(k)) is not None and k in s.f \
+                                    and (((t := ft[1]) is T_REAL and v.__class__ is float)
+                                         or (t is T_INT and v.__class__ is int and INT_MIN <= v <= INT_MAX)
+                                         or (t is T_BOOL and v.__class__ is bool)):
+                                s.f[k] = v
+                            else:
+                                _set_component(base, ins[2][0], v, ins[3])
                             ip += 1
                         elif op == OP.UNOP:
-                            stack[-1] = rt.unary_op(ins[1], stack[-1])
+                            a = stack[-1]
+                            if (a is True or a is False) and ins[1] == "NOT":
+                                stack[-1] = a is False
+                            elif a.__class__ is float and ins[1] == "-":
+                                stack[-1] = -a
+                            else:
+                                stack[-1] = rt.unary_op(ins[1], a)
                             ip += 1
                         elif op == OP.JUMP_IF_FALSE:
-                            if rt.to_bool(pop()):
+                            v = pop()
+                            if v is True:
                                 ip += 1
-                            else:
+                            elif v is False or not rt.to_bool(v):
                                 ip = ins[1]
+                            else:
+                                ip += 1
                         elif op == OP.LOAD_ELEM2:
                             j = pop()
                             i = stack[-1]
                             a = store[ins[1]]
                             n, m = a.dims
                             if i.__class__ is int and j.__class__ is int and 0 < i <= n and 0 < j <= m \
-                                    and (v := a.data[(i - 1) * m + j - 1]) is not UNSET:
+                                    and (v := a.data[((y1 := i) - 1) * (y2 := m) + (y3 := j) - 1]) is not UNSET:
                                 stack[-1] = v
                             else:
                                 stack[-1] = _element2(fvars[ins[1]], i, j, ins[2])
                             ip += 1
                         elif op == OP.LOAD_ELEM2_VV:
-                            a = store[ins[1]]
-                            i = store[ins[2]]
-                            j = store[ins[3]]
+                            x1 = ins[1]
+                            x2 = ins[2]
+                            x3 = ins[3]
+                            a = store[x1]
+                            i = store[x2]
+                            j = store[x3]
                             n, m = a.dims
                             if i.__class__ is int and j.__class__ is int and 0 < i <= n and 0 < j <= m \
-                                    and (v := a.data[(i - 1) * m + j - 1]) is not UNSET:
+                                    and (v := a.data[((y1 := i) - 1) * (y2 := m) + (y3 := j) - 1]) is not UNSET:
                                 push(v)
                             else:
-                                push(_element2(fvars[ins[1]], _load(fvars[ins[2]]), _load(fvars[ins[3]]), ins[4]))
+                                push(_element2(fvars[x1], _load(fvars[x2]), _load(fvars[x3]), ins[4]))
                             ip += 1
                         elif op == OP.STMT:
                             info = ins[1]
@@ -781,8 +835,8 @@ class VM:
                             target = code.callsites.get(ip)
                             rt.steps += unsaved
                             unsaved = 0
-                            if target is not None:
-                                v = self.invoke(target, args, frame, "N" not in flags)
+                            if target is not None:       # VM.invoke, without its Python frame
+                                v = run_routine(target, args, frame, exec_routine, "N" not in flags)
                             else:
                                 v = self.call(code, ip, ins[1], args, frame, flags)
                             left = task.quiet - rt.steps if task is not None else 0
@@ -797,19 +851,24 @@ class VM:
                             n, m = a.dims
                             t = ins[3]
                             if i.__class__ is int and j.__class__ is int and 0 < i <= n and 0 < j <= m and v.__class__ is t and (t is not int or INT_MIN <= v <= INT_MAX):
-                                a.data[(i - 1) * m + j - 1] = v
+                                y1 = i
+                                y2 = m
+                                y3 = j
+                                a.data[(y1 - 1) * y2 + y3 - 1] = v
                             else:
                                 _set_element(fvars[ins[1]], [i, j], v, ins[2])
                             ip += 1
                         elif op == OP.ADDC_FAST:
-                            a = store[ins[1]]
+                            x1 = ins[1]
+                            a = store[x1]
                             b = ins[2]
                             t = ins[4]
                             ca = a.__class__
                             if ca is b.__class__ and ca is t and (ca is float or (ca is int and INT_MIN <= (v := a + b) <= INT_MAX)):
-                                store[ins[3]] = a + b if ca is float else v
+                                x3 = ins[3]
+                                store[x3] = a + b if ca is float else v
                             else:
-                                _store(fvars[ins[3]], _add(a if a is not UNSET else _load(fvars[ins[1]]), b))
+                                _store(fvars[ins[3]], _add(a if a is not UNSET else _load(fvars[x1]), b))
                             ip += 1
                         elif op == OP.LOAD_MOD:
                             push(_load(mrefs[ins[1]]))
@@ -907,7 +966,8 @@ class VM:
                         elif op == OP.LOAD_ELEM1:
                             a = store[ins[1]]
                             i = stack[-1]
-                            if i.__class__ is int and 0 < i <= a.dims[0] and (v := a.data[i - 1]) is not UNSET:
+                            d = a.data
+                            if i.__class__ is int and 0 < i <= len(d) and (v := d[(x3 := i) - 1]) is not UNSET:
                                 stack[-1] = v
                             else:
                                 stack[-1] = _element1(fvars[ins[1]], i, ins[2])
@@ -1029,7 +1089,7 @@ class VM:
                             stack[-1] = rt.field(stack[-1], ins[1], ins[2])
                             ip += 1
                         elif op == OP.END_THUNK:
-                            return stack[-1] if stack else None
+                            return stack[-1] if len(stack) > 8 else None     # STACK_BASE
                         elif op == OP.LOAD_TEMP:
                             push(temps[ins[1]])
                             ip += 1
@@ -1037,10 +1097,13 @@ class VM:
                             temps[ins[1]] = pop()
                             ip += 1
                         elif op == OP.JUMP_IF_TRUE:
-                            if rt.to_bool(pop()):
+                            v = pop()
+                            if v is True:
                                 ip = ins[1]
-                            else:
+                            elif v is False or not rt.to_bool(v):
                                 ip += 1
+                            else:
+                                ip = ins[1]
                         elif op == OP.NONE:
                             push(None)
                             ip += 1
@@ -1092,7 +1155,7 @@ class VM:
                     unsaved = 0
                     rt.record_error(e, frame)
                     left = task.quiet - rt.steps if task is not None else 0
-                    del stack[:]
+                    del stack[8:]         # STACK_BASE
                     ip = reg.end
         finally:
             rt.steps += unsaved

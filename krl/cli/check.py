@@ -151,13 +151,24 @@ def _loaded(path, timeout: float | None = None, jobs: int | None = None, schedul
     folder holding backups is checked on that Dask cluster (:class:`Checked` per group)."""
     from pathlib import Path  # noqa: PLC0415
 
-    from krl.workspace import on_each_file, workspaces_for  # noqa: PLC0415
     from krl.project import folder_groups  # noqa: PLC0415
 
     if scheduler is not None:
         groups = folder_groups(Path(path))
         if groups is not None and (len(groups) > 1 or groups[0][0] != str(path)):
             return _on_cluster(scheduler, groups, timeout)
+
+    from krl.parsecache import through_store  # noqa: PLC0415
+
+    with through_store():       # each file's parse from the one store (krl/store.py) when it holds it
+        return _loaded_here(path, timeout, jobs)
+
+
+def _loaded_here(path, timeout: float | None, jobs: int | None) -> list:
+    from pathlib import Path  # noqa: PLC0415
+
+    from krl.project import folder_groups  # noqa: PLC0415
+    from krl.workspace import on_each_file, workspaces_for  # noqa: PLC0415
 
     if not _progress_shown():
         return workspaces_for(path, timeout=timeout, jobs=jobs)

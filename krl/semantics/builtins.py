@@ -10,14 +10,16 @@ Reference: 3.7 (predefined structures and enums), 4.5-4.8 (functions and procedu
 
 from __future__ import annotations
 
+import hashlib
 import re
 from dataclasses import dataclass, field
 from functools import lru_cache
 from pathlib import Path
 
+import msgpack
 import yaml
 
-from krl.store import stored
+from krl.store import Store, shared_store
 
 DATA_DIR = Path(__file__).parent / "data"
 
@@ -122,22 +124,57 @@ def parse_signature(text: str, is_function: bool) -> SignatureInfo:
     return sig
 
 
-def _read(name: str) -> dict:
-    with open(DATA_DIR / name, encoding="utf-8") as fh:
-        return yaml.load(fh, Loader=_Loader) or {}
+def _refuse(*_args):
+    raise ValueError("an extension type in a stored table")
+
+
+def _read(name: str, store=None) -> dict:
+    """The YAML document of the data table `name`, from the one store (krl/store.py, kind
+    ``table``, keyed by the SHA-256 of the file's bytes) when it holds it: msgpack of the plain
+    document (dicts, lists, scalars), kept only when it reads back equal. A stored entry that
+    does not unpack to a mapping is corrupt: the YAML is read again."""
+    raw = (DATA_DIR / name).read_bytes()
+    key = f"{hashlib.sha256(raw).hexdigest()}:{name}"
+    store = shared_store() if store is None else store
+    got = store.get("table", [key]).get(key)
+    if got is not None:
+        try:
+            doc = msgpack.unpackb(got, raw=False, strict_map_key=False, ext_hook=_refuse)
+            if type(doc) is dict:
+                return doc
+        except (ValueError, TypeError, msgpack.exceptions.UnpackException):
+            pass
+        store.corrupt += 1
+    doc = yaml.load(raw.decode("utf-8"), Loader=_Loader) or {}
+    try:
+        data = msgpack.packb(doc, use_bin_type=True, strict_types=True)
+        if msgpack.unpackb(data, raw=False, strict_map_key=False) == doc:
+            store.put("table", {key: data})
+    except (TypeError, ValueError, OverflowError):
+        pass                            # not plain data: read from the YAML each time
+    return doc
 
 
 @lru_cache(maxsize=1)
 def load_builtins() -> Builtins:
-    """Read the three data tables (cached, and kept across processes: krl/store.py). Raises
-    ValueError for a malformed table."""
-    return stored("builtins", (), _load_builtins)
+    """Read the data tables (cached per process; each document from the one store when it
+    holds it, :func:`_read`). Raises ValueError for a malformed table."""
+    return _builtins()
 
 
-def _load_builtins() -> Builtins:
-    types = _read("types.yaml")
-    sysv = _read("sysvars.yaml")
-    funcs = _read("functions.yaml")
+def _builtins() -> Builtins:
+    """The tables from the store's documents, or from the YAML files when a stored document
+    misleads the reader (a corrupt entry: made anew)."""
+    try:
+        return _load_builtins()
+    except (ValueError, KeyError, TypeError, AttributeError):
+        return _load_builtins(Store(enabled=False))
+
+
+def _load_builtins(store=None) -> Builtins:
+    types = _read("types.yaml", store)
+    sysv = _read("sysvars.yaml", store)
+    funcs = _read("functions.yaml", store)
     basis = types.get("basis", {})
     sysvars: dict[str, SysVarInfo] = {}
     for key, info in sysv.items():
@@ -155,7 +192,7 @@ def _load_builtins() -> Builtins:
     for names in (funcs.get("lenient") or {}).values():
         for name in names:
             routines.setdefault(str(name).upper(), SignatureInfo(str(name).upper(), "ANY", [], True))
-    kss = _read("kss.yaml")
+    kss = _read("kss.yaml", store)
     sources: dict[str, str] = {}
     kss_structs: dict[str, str] = {}
     kss_enums: dict[str, list[str]] = {}

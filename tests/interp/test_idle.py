@@ -137,8 +137,10 @@ def test_reading_the_clock_is_not_idle(tmp_path):
 
 def test_a_bounded_trace_of_a_spin_stays_small(tmp_path):
     """Without the fast-forward a spin writes 1000 steps' statements a cycle; the bounded trace
-    writes each repeated event 10 times and counts the rest in ``repeat`` events: the events
-    written plus those counted are exactly the unbounded trace's."""
+    writes each repeated pass 10 times and counts the rest in ``repeat`` events: within a cycle
+    the IF's pass (one statement), and the cycle itself (its statements and the pose at rest),
+    so after 10 cycles (0.12 s) nothing more is written; the events written plus those counted
+    are exactly the unbounded trace's."""
     prog = write(tmp_path, "poll.src", POLL)
     _rt, res, full = _run(prog, max_sim_time=0.6, fast=False)
     _rt, res2, tw = _run(prog, max_sim_time=0.6, fast=False, repeats=10)
@@ -154,7 +156,10 @@ def test_a_bounded_trace_of_a_spin_stays_small(tmp_path):
         if e["kind"] == "repeat":
             for k, n in e["kinds"].items():
                 left[k] = left.get(k, 0) + n
-    assert written["stmt"] < 100 and written["pose"] <= 20
+    assert written["stmt"] <= 10 * (10 + 2) and written["pose"] <= 10
+    assert max(e["t"] for e in tw.events if e["kind"] in ("stmt", "pose")) <= 0.12
+    assert sum(e["count"] for e in tw.events if e["kind"] == "repeat") == len(full.events) - len(tw.events) \
+        + sum(1 for e in tw.events if e["kind"] == "repeat")
     assert written["stmt"] + left["stmt"] == kinds["stmt"]
     assert written["pose"] + left.get("pose", 0) == kinds["pose"] == 50
     assert [e for e in tw.events if e["kind"] == "end"] == [e for e in full.events if e["kind"] == "end"]

@@ -1,99 +1,231 @@
-"""Results kept across processes (krl/store.py): a program run from a stored checked workspace
-runs exactly as from one checked now (the trace is the oracle), across processes too, and a
-stored file that is not this user's own, or not what it claims, is never read."""
+"""The one store of parse and check results (krl/store.py, krl/parsecache.py), shared by the
+language server and krl run/debug: a program run from stored parses runs exactly as from files
+parsed now (the trace is the oracle), a file parsed by `krl debug` is a hit for the language
+server and the other way round, a corrupt entry or database is parsed again (never a crash),
+and nothing read from the store is ever unpickled."""
 
 from __future__ import annotations
 
+import hashlib
 import json
 import os
+import pickle
+import sqlite3
 import subprocess
 import sys
-import time
 from pathlib import Path
 
+import msgpack
 import pytest
 
 import interp.runtime.program as program_mod
 import krl.store as store
+from interp.debug.client import DapClient
 from interp.run import make_runtime
+from krl.lsp import cache as C
+from krl.lsp.paths import norm
+from krl.lsp.project import Project
+from krl.parsecache import load_files
+from krl.project import project_of
 from robot.trace import TraceWriter
 
 REPO = Path(__file__).resolve().parents[2]
 CASES = sorted(p for p in (REPO / "conformance" / "cases").iterdir() if (p / "program.src").is_file())
+BACKUP = REPO / "tests" / "lsp" / "fixtures" / "backup"
 CORPUS = REPO.parent / "shared" / "krl-corpus"
 MILLING = CORPUS / "HugoDanielson__ChinaMilling" / "KRC"
 
 
-def _through_store(tmp_path: Path, value, code=("krl",), fix_ids=True):
-    """`value` written by the store and read back (as another process reads it)."""
-    path = tmp_path / "stored" / "t" / "x.pickle"
-    path.parent.mkdir(parents=True, exist_ok=True)
-    store._write_now(path, "d" * 64, value, fix_ids, code)
-    got = store._read(path, "d" * 64)
-    assert got is not None, "a result just written is read back"
-    return got[0]
+@pytest.fixture
+def cache(tmp_path, monkeypatch) -> Path:
+    """A fresh user cache folder for this process and the processes it starts."""
+    d = tmp_path / "cache"
+    monkeypatch.setenv("KRL_CACHE_DIR", str(d))
+    monkeypatch.delenv("KRL_STORE", raising=False)
+    program_mod._CACHE.clear()
+    yield d
+    program_mod._CACHE.clear()
 
 
-def _trace(program: Path, inputs=None) -> tuple[str, str]:
+def _rows(db_path: Path) -> dict:
+    """(kind, key) -> (rowid, used) of every entry of the database."""
+    with sqlite3.connect(db_path) as db:
+        return {(k, key): (rowid, used) for rowid, k, key, used in
+                db.execute("SELECT rowid, kind, key, used FROM entries")}
+
+
+def _database(cache: Path) -> Path:
+    [db] = list((cache / "front-end").glob("*.sqlite"))
+    return db
+
+
+def _trace(program: Path, inputs=None) -> str:
     tw = TraceWriter(keep=True)
     rt, _ = make_runtime(program, trace=tw, mujoco=False, max_sim_time=60, inputs=inputs, max_steps=2_000_000)
     res = rt.run()
-    return res.reason, json.dumps(tw.events, default=str)
+    return res.reason + json.dumps(tw.events, default=str)
 
 
-def _same_from_the_store(cases, tmp_path, monkeypatch) -> list[str]:
-    """The cases whose trace differs between a fresh checked workspace and a stored one."""
-    monkeypatch.setenv("KRL_STORE", "0")
-    fresh = program_mod.checked_workspace
-    stored: dict = {}
-
-    def from_store(project, extra=()):
-        key = (str(project.root), tuple(map(str, project.files)), tuple(map(str, extra)))
-        if key not in stored:
-            stored[key] = _through_store(tmp_path, fresh(project, extra))
-        return stored[key]
-
-    differ = []
-    for case in cases:
-        inputs = case / "stimuli.yaml" if (case / "stimuli.yaml").is_file() else None
-        monkeypatch.setattr(program_mod, "checked_workspace", fresh)
-        program_mod._CACHE.clear()
-        a = _trace(case / "program.src", inputs)
-        monkeypatch.setattr(program_mod, "checked_workspace", from_store)
-        b = _trace(case / "program.src", inputs)
-        if a != b:
-            differ.append(case.name)
-    return differ
-
-
-@pytest.mark.slow
-def test_every_conformance_program_runs_the_same_from_a_stored_workspace(tmp_path, monkeypatch):
-    assert len(CASES) > 100 and not _same_from_the_store(CASES, tmp_path, monkeypatch)
-
-
-def test_a_sample_of_conformance_programs_runs_the_same_from_a_stored_workspace(tmp_path, monkeypatch):
-    # every 25th case (motion, I/O, interrupts and submit cases among them); all of them nightly
+def test_a_sample_of_conformance_programs_runs_the_same_from_stored_parses(cache, monkeypatch):
+    # every 25th case (motion, I/O, interrupts and submit cases among them): without the store,
+    # then filling it, then from it (the per-process cache emptied each time)
     sample = CASES[::25]
-    assert len(sample) >= 4 and not _same_from_the_store(sample, tmp_path, monkeypatch)
+    assert len(sample) >= 4
+    for case in sample:
+        inputs = case / "stimuli.yaml" if (case / "stimuli.yaml").is_file() else None
+        runs = []
+        for keep in ("0", "1", "1"):
+            monkeypatch.setenv("KRL_STORE", keep)
+            program_mod._CACHE.clear()
+            s = store.shared_store()
+            hits = s.hits
+            runs.append((_trace(case / "program.src", inputs), s.hits - hits))
+        (fresh, h0), (first, _h1), (again, h2) = runs
+        assert first == fresh and again == fresh, case.name
+        assert h0 == 0 and h2 > 0, case.name           # the third run read its files from the store
 
 
-def test_shared_objects_keep_their_identity_and_id_tables_are_rekeyed(tmp_path, monkeypatch):
-    from krl.project import project_of
-    from krl.semantics import types as T
+def _lsp_analysis(root: Path, cache: Path) -> tuple[C.Store, list]:
+    s = C.Store(cache)
+    an = Project(store=s).analyze(norm(root / "R1" / "Program" / "main.src"), docs={})
+    return s, an.ws.diagnostics
 
+
+def _debug_launch(program: Path, cache: Path) -> None:
+    with DapClient(timeout=300, env={"KRL_CACHE_DIR": str(cache)}) as c:
+        c.initialize()
+        c.request("launch", {"program": str(program), "stopOnEntry": True})
+        c.request("configurationDone")
+        c.wait_event("stopped")
+        c.request("disconnect", {})
+
+
+def test_a_file_parsed_by_krl_debug_is_a_hit_for_the_language_server(tmp_path, cache):
+    root = tmp_path / "KRC"
+    import shutil
+    shutil.copytree(BACKUP, root)
+    _debug_launch(root / "R1" / "Program" / "main.src", cache)
+    before = _rows(_database(cache))
+    assert sum(k == "parse" for k, _ in before) >= 5
+    s, _diags = _lsp_analysis(root, cache)
+    assert s.misses == 0 and s.hits >= 5               # every file of the workspace from debug's parses
+    after = _rows(_database(cache))
+    assert all(after[k][0] == v[0] for k, v in before.items() if k[0] == "parse")     # none parsed again
+
+
+def test_a_file_parsed_by_the_language_server_is_a_hit_for_krl_debug(tmp_path, cache):
+    root = tmp_path / "KRC"
+    import shutil
+    shutil.copytree(BACKUP, root)
+    s, _diags = _lsp_analysis(root, cache)
+    assert s.hits == 0 and s.misses == 5
+    s.close()
+    before = _rows(_database(cache))
+    parses = {k: v for k, v in before.items() if k[0] == "parse"}
+    assert len(parses) == 5
+    _debug_launch(root / "R1" / "Program" / "main.src", cache)
+    after = _rows(_database(cache))
+    for k, (rowid, used) in parses.items():
+        assert after[k][0] == rowid                     # not written again: not parsed again
+        assert after[k][1] > used                       # read by the debugger (its last use moved)
+
+
+def _corrupt_every_parse(db_path: Path, data: bytes, good_digest: bool) -> int:
+    digest = hashlib.sha256(data).digest() if good_digest else b"\0" * 32
+    with sqlite3.connect(db_path) as db:
+        return db.execute("UPDATE entries SET data = ?, digest = ? WHERE kind = 'parse'", (data, digest)).rowcount
+
+
+@pytest.mark.parametrize("data,good_digest", [
+    (b"\x00\x11\x22\x33", False),                      # bytes that do not match their digest
+    (msgpack.packb([[999, 1, 1], True, "ok", [], False, [], [], []]), True),      # no such node class
+    (msgpack.packb({"a": 1}), True),                   # not an entry
+    (b"\xc1\xc1\xc1", True),                           # not msgpack
+])
+def test_a_corrupt_entry_is_parsed_again_not_a_crash(cache, data, good_digest):
+    case = CASES[0] / "program.src"
+    fresh = _trace(case)
+    db = _database(cache)
+    assert _corrupt_every_parse(db, data, good_digest) > 0
+    program_mod._CACHE.clear()
+    s = store.shared_store()
+    corrupt = s.corrupt
+    assert _trace(case) == fresh
+    assert s.corrupt > corrupt
+    program_mod._CACHE.clear()
+    hits = s.hits
+    assert _trace(case) == fresh and s.hits > hits      # the entries were made anew
+
+
+def test_a_database_that_is_not_sqlite_means_no_store_not_a_crash(cache, caplog):
+    case = CASES[0] / "program.src"
+    fresh = _trace(case)
+    db = _database(cache)
+    store._SHARED.clear()
+    db.write_bytes(b"this is not a database" * 100)
+    program_mod._CACHE.clear()
+    assert _trace(case) == fresh
+    assert store.shared_store().db is None            # off for this process, said in the log
+    assert "cache is not" in caplog.text
+    store._SHARED.clear()
+
+
+def test_the_store_never_unpickles(cache, tmp_path, monkeypatch):
+    """A pickle planted in an entry (with a matching digest) is a corrupt entry: it never
+    runs, and no part of loading a program from the store calls the pickle module."""
+    marker = tmp_path / "pwned"
+
+    class Planted:
+        def __reduce__(self):
+            return (os.system, (f"touch {marker}",))
+
+    case = CASES[0] / "program.src"
+    fresh = _trace(case)
+    payload = pickle.dumps(Planted())
+    assert _corrupt_every_parse(_database(cache), payload, True) > 0
+
+    def refuse(*_a, **_k):
+        raise AssertionError("the store unpickled something")
+    for name in ("load", "loads"):
+        monkeypatch.setattr(pickle, name, refuse)
+    monkeypatch.setattr(pickle, "Unpickler", refuse)
+    program_mod._CACHE.clear()
+    s = store.shared_store()
+    corrupt = s.corrupt
+    assert _trace(case) == fresh
+    assert s.corrupt > corrupt and not marker.exists()
+    for module in ("krl/store.py", "krl/parsecache.py", "krl/lsp/cache.py"):
+        text = (REPO / module).read_text()
+        assert "pickle" not in text.replace("unpickled", "").replace("pickles", ""), module
+
+
+@pytest.mark.parametrize("data", [msgpack.packb([1, 2]), msgpack.packb({"x": msgpack.ExtType(1, b"x")}),
+                                  msgpack.packb({"types": 5, "functions": "x"})])
+def test_a_corrupt_table_entry_is_read_from_the_yaml_again(cache, data):
+    from krl.semantics import builtins as B
+    fresh = B._load_builtins(store.Store(enabled=False))
+    B._load_builtins()                                  # fills the store
+    digest = hashlib.sha256(data).digest()
+    with sqlite3.connect(_database(cache)) as db:
+        assert db.execute("UPDATE entries SET data = ?, digest = ? WHERE kind = 'table'", (data, digest)).rowcount == 4
+    assert B._builtins() == fresh
+
+
+def test_krl_store_0_keeps_nothing(cache, monkeypatch):
     monkeypatch.setenv("KRL_STORE", "0")
-    prog = REPO / "conformance" / "cases" / "022_real_to_int" / "program.src"
-    ws = program_mod.checked_workspace(project_of(prog.resolve()), sorted(program_mod.BASIS_DIR.iterdir()))
-    back = _through_store(tmp_path, ws)
-    assert back is not ws
-    # id()-keyed tables: every routine finds its scope again
-    routines = [r for u in back.units for r in u.routines]
-    assert routines and all(back.routine_scope(r) is not None for r in routines)
-    # the type singletons are the process's own, not copies (022 declares INT and REAL locals)
-    simple = [s.type for r in routines for s in back.routine_scope(r).values.values()
-              if isinstance(s.type, T.Simple)]
-    assert {str(t) for t in simple} >= {"INT", "REAL"}
-    assert all(t is T.SIMPLE[t.name] for t in simple)
+    load_files([BACKUP / "R1" / "Program" / "main.src"])
+    assert not (cache / "front-end").exists()
+
+
+def test_the_database_keeps_within_its_limit(tmp_path, monkeypatch):
+    monkeypatch.setattr(store, "MAX_CACHE_BYTES", 4000)
+    monkeypatch.setattr(store, "MAX_CACHE_ENTRY_BYTES", 300)
+    s = store.Store(tmp_path)
+    for k in range(40):
+        s.put("parse", {f"k{k}": bytes(200)})
+    s.put("parse", {"big": bytes(301)})                # past the entry limit: not kept
+    size = s.db.execute("SELECT SUM(LENGTH(data)) FROM entries").fetchone()[0]
+    assert size <= 4000 and s.get("parse", ["k39"]) and not s.get("parse", ["big"])
 
 
 @pytest.mark.slow       # three krl runs of a 150-file backup
@@ -108,43 +240,12 @@ def test_krl_run_from_the_store_in_another_process_gives_the_same_trace(tmp_path
                        timeout=900, check=False)
 
     run(tmp_path / "fresh.jsonl", KRL_STORE="0")
-    assert not (tmp_path / "cache" / "stored").exists()          # KRL_STORE=0 keeps nothing
-    run(tmp_path / "first.jsonl")                                # checks and keeps
-    kept = tmp_path / "cache" / "stored"
-    for _ in range(1200):                                        # the writers are child processes
-        if list(kept.glob("workspace/*.pickle")) and list(kept.glob("robot/*.pickle")):
-            break
-        time.sleep(0.5)
-    assert len(list(kept.glob("workspace/*.pickle"))) == 1 and len(list(kept.glob("robot/*.pickle"))) == 1
+    assert not (tmp_path / "cache" / "front-end").exists()         # KRL_STORE=0 keeps nothing
+    run(tmp_path / "first.jsonl")                                # parses and keeps
+    rows = _rows(_database(tmp_path / "cache"))
+    assert sum(k == "parse" for k, _ in rows) >= len(project_of(program).files)
     run(tmp_path / "stored.jsonl")                               # reads what was kept
     fresh = (tmp_path / "fresh.jsonl").read_bytes()
     assert fresh and (tmp_path / "first.jsonl").read_bytes() == fresh
     assert (tmp_path / "stored.jsonl").read_bytes() == fresh
-
-
-def test_what_is_not_this_users_own_or_not_what_it_claims_is_never_read(tmp_path, monkeypatch):
-    monkeypatch.setenv("KRL_CACHE_DIR", str(tmp_path))
-    monkeypatch.delattr(os, "fork")                     # written at once, in this process
-    made = []
-
-    def make():
-        made.append(1)
-        return {"value": len(made)}
-
-    assert store.stored("t", ("k",), make) == {"value": 1}
-    files = list((tmp_path / "stored" / "t").glob("*.pickle"))
-    assert len(files) == 1 and files[0].stat().st_mode & 0o777 == 0o600
-    assert store.stored("t", ("k",), make) == {"value": 1} and len(made) == 1      # read back
-    f = files[0]
-    good = f.read_bytes()
-    os.chmod(f, 0o620)                                  # writable by the group: not read
-    assert store.stored("t", ("k",), make) == {"value": 2}
-    for bad in (b"not a stored result\n" + good, good.replace(good.splitlines()[1], b"0" * 64, 1),
-                good[:len(good) // 2]):
-        f.write_bytes(bad)
-        os.chmod(f, 0o600)
-        n = len(made)
-        assert store.stored("t", ("k",), make) == {"value": n + 1}
-    assert store.stored("t", ("k",), make) == {"value": len(made)}     # the last one made is kept
-    monkeypatch.setattr(store, "MAX_STORED_BYTES", 10)
-    assert store._read(f, good.splitlines()[1].decode()) is None       # past the size limit
+    assert {k: v[0] for k, v in _rows(_database(tmp_path / "cache")).items()} == {k: v[0] for k, v in rows.items()}

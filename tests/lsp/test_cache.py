@@ -126,7 +126,7 @@ def test_a_corrupt_database_entry_is_parsed_again(tmp_path: Path):
 
 
 def test_the_database_keeps_within_its_limit(tmp_path: Path, monkeypatch):
-    monkeypatch.setattr(C, "MAX_LSP_CACHE_BYTES", 4000)
+    monkeypatch.setattr("krl.store.MAX_CACHE_BYTES", 4000)
     store = C.Store(tmp_path / "cache")
     for k in range(40):
         store.put("parse", {f"k{k}": bytes(200)})

@@ -553,7 +553,7 @@ def test_quiet_path_is_taken_only_without_a_trace(traced):
                           check=False)
     rt.program.module("fp_maxsteps").data["SEL"].set(2)
     calls = [0]
-    before, tick, take, quiet = vm.hooks
+    before, tick, take, quiet, *call_protocol = vm.hooks    # (run_routine, exec_routine)
 
     def counted(fn):
         def hook(*a):
@@ -561,7 +561,7 @@ def test_quiet_path_is_taken_only_without_a_trace(traced):
             return fn(*a)
         return hook
 
-    vm.hooks = (counted(before), counted(tick), take, quiet)
+    vm.hooks = (counted(before), counted(tick), take, quiet, *call_protocol)
     res = rt.run()
     assert res.reason == "max_steps" and res.steps == 20_001
     if traced:
@@ -714,3 +714,51 @@ def test_on_error_proceed_before_repeat_is_taken_by_it():
     assert out.reason == "error", (out.reason, out.data)
     assert out.number == 1422 and out.line == marker_line(prog, "E")
     assert out.data["R1"] == -1
+
+
+# ---------------------------------------------------------------------------- issue 39: UNOP, conditions, fields
+UNOP = FAST / "fp_unop.src"
+
+# case -> parts of the message (reference §4.1 operators, §3.9 conversions, §8.2)
+UNOP_ERRORS = {
+    1: ["NOT needs a BOOL operand"],          # NOT on a REAL: out of UNOP's inline path
+    2: ["not BOOL"],                          # IF on an INT: JUMP_IF_FALSE's way out
+    3: ["cannot assign", "REAL"],             # BOOL into a REAL field (STORE_FIELD_L)
+    4: [_overflow(INT_MAX + 1)],              # REAL into an INT field, out of range
+    5: ["cannot assign", "BOOL"],             # INT into a BOOL field
+    6: ["not BOOL"],                          # NOT on an INT is an INT: not a condition
+    7: [_overflow(INT_MAX + 1)],              # -(-2147483648): UNOP on an INT
+}
+
+
+def test_unop_conditions_and_fields_values():
+    out = run_all(UNOP, max_steps=100_000, max_sim_time=10.0)
+    assert out.reason == "completed", out
+    d = out.data
+    assert d["DONE"] == 1
+    assert d["V_NOT"] == [False, True, False, False]
+    assert d["V_INOT"] == [~5, ~-1]                 # NOT on an INT: the bitwise complement
+    assert d["V_NEG"] == [-2.25, -4.5]
+    assert d["V_INEG"] == [-5, 7]
+    assert d["V_IF"] == [2, 2, 0]
+    assert d["V_REP"] == 4
+    assert d["V_FX"] == [1.5, 3.0, 11.0]            # INT 3 into the REAL field: 3.0; 3.0 * 2.0 + 5
+    assert d["V_FN"] == [7, 3, -3]                  # REAL into INT: nearest, ties away from zero
+    assert d["V_FB"] == [False, True]
+    ops = opcodes_of(UNOP)
+    assert {"UNOP", "JUMP_IF_FALSE", "STORE_FIELD_L"} <= ops, sorted(ops)
+
+
+def test_unop_error_cases_cover_every_marker():
+    assert sorted(int(n) for n in re.findall(r";\s*E(\d+)\s*$", UNOP.read_text(), re.M)) == sorted(UNOP_ERRORS)
+
+
+@pytest.mark.parametrize("case", sorted(UNOP_ERRORS))
+def test_unop_conditions_and_fields_errors(case):
+    out = run_all(UNOP, set_vars={"SEL": case}, max_steps=100_000, max_sim_time=10.0)
+    assert out.reason == "error", out
+    for p in UNOP_ERRORS[case]:
+        assert p.lower() in out.text.lower(), (p, out.text)
+    assert Path(out.file).name.lower() == "fp_unop.src"
+    assert out.line == marker_line(UNOP, f"E{case}")
+    assert out.data["DONE"] == 0
