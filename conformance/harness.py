@@ -47,8 +47,12 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
+import traceback
 
 import yaml
+import numpy as np
+
+from robot.limits import check_trace
 
 CASES_DIR = Path(__file__).parent / "cases"
 REPO = Path(__file__).resolve().parent.parent
@@ -329,7 +333,6 @@ def run_program(program: Path, interp: str, *, stimuli: Path | None = None,
             except _Timeout:
                 crash = f"wall-clock timeout after {wall_timeout:.0f} s"
             except Exception as exc:  # noqa: BLE001 - an internal error of the interpreter
-                import traceback
                 crash = f"internal error: {type(exc).__name__}: {exc}\n" + traceback.format_exc()[-3000:]
             output = buf.getvalue()[-4000:]
         events: list[dict[str, Any]] = []
@@ -522,8 +525,6 @@ def _dedupe(pts: list[list[float]]) -> list[list[float]]:
 
 
 def _dist_to_polyline(src: list[list[float]], dst: list[list[float]]) -> float:
-    import numpy as np
-
     P = np.asarray(src, dtype=float)
     D = np.asarray(dst, dtype=float)
     if len(D) == 1:
@@ -965,7 +966,6 @@ def check_limits(events: list[dict[str, Any]]) -> list[Check]:
     accelerations <= machine data (10 %, finite differences), T1 250 mm/s."""
     if not any(e.get("kind") == "pose" for e in events):
         return []
-    from robot.limits import check_trace  # noqa: PLC0415
 
     rep = check_trace(events)
     return [Check("limits", rep.ok, "" if rep.ok else rep.summary() + ": "

@@ -22,8 +22,11 @@ from pathlib import Path
 from typing import Any
 
 from krl.files import SHARED_CORPUS as DEFAULT_CORPUS
+from interp import realprograms as R
+from krl.cluster import run_batches
+from krl.render import markdown_code as md, render_html
 
-from . import harness as H
+from . import fuzz as F, harness as H
 
 REPO = H.REPO
 
@@ -74,7 +77,6 @@ def _on_cluster(scheduler: str, fn, tasks: list[tuple[int, tuple]], name: str, p
     tasks' order; `progress(result)` as each arrives. A task that fails on the cluster (its
     worker died: not a failure of the interpreters, which the results hold themselves) is
     ``failed(*args, detail)``, a result that says so. Raises krl.cluster.SchedulerError."""
-    from krl.cluster import run_batches  # noqa: PLC0415
 
     got = {}
     for o in run_batches(scheduler, fn, tasks, batch_files=1, name=name):
@@ -140,7 +142,6 @@ def real_programs(corpus: Path = DEFAULT_CORPUS) -> list[tuple[Path, Path]]:
     definition of issue 6: ``interp.realprograms``). Empty when the corpus is absent."""
     if not corpus.is_dir():
         return []
-    from interp import realprograms as R  # noqa: PLC0415
 
     out = []
     for root in R.find_backups(corpus):
@@ -156,7 +157,6 @@ def run_real(corpus: Path = DEFAULT_CORPUS, interps: list[str] | None = None, *,
     (interp/realprograms.py: 60 s or the cell's ``sim_time``, the step budget with the
     submit's), so that the causes shown here are that report's. `scheduler`: run them on that
     Dask cluster's workers (they see the corpus at the same paths; the same outcomes)."""
-    from interp import realprograms as R  # noqa: PLC0415
 
     interps = H.available_interpreters() if interps is None else interps
     max_sim_time = R.REPORT_SIM_TIME_S if max_sim_time is None else max_sim_time
@@ -178,7 +178,6 @@ def run_real(corpus: Path = DEFAULT_CORPUS, interps: list[str] | None = None, *,
 def real_outcome(prog: Path, corpus: Path, interps: list[str], max_sim_time: float,
                  max_steps: int) -> RealOutcome:
     """One corpus program run on each of `interps` with the real-programs report's limits."""
-    from interp import realprograms as R  # noqa: PLC0415
 
     ro = RealOutcome(str(prog.relative_to(corpus)) if prog.is_relative_to(corpus) else str(prog))
     cell = R.cell_of(prog, corpus)
@@ -222,11 +221,13 @@ def plot_case(co: CaseOutcome, png: Path) -> bool:
     runs = {k: r for k, r in co.runs.items() if r.events and any(e.get("kind") == "motion" for e in r.events)}
     if not runs:
         return False
+    # matplotlib costs 0.19 s and pyplot 0.45 s CPU (python -X importtime, 2026-11-24): loaded
+    # only when a chart is drawn
     import matplotlib  # noqa: PLC0415
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt  # noqa: PLC0415
-    from matplotlib.patches import Circle  # noqa: PLC0415
+    from matplotlib.patches import Circle  # noqa: PLC0415  (part of pyplot's 0.45 s)
 
     first = next(iter(runs.values()))
     mt = H.motion_times(first.events)
@@ -345,8 +346,6 @@ def write_report(out: Path, outcomes: list[CaseOutcome], fuzz: dict[str, Any] | 
 
 
 def _markdown(s, rows, interps, fuzz, real) -> str:
-    from krl.render import markdown_code as md  # noqa: PLC0415
-
     L = ["# Conformance report", "",
          f"Generated {time.strftime('%Y-%m-%d %H:%M:%S UTC', time.gmtime())}.", "",
          "| metric | value |", "|---|---|"]
@@ -404,8 +403,6 @@ def _markdown(s, rows, interps, fuzz, real) -> str:
 
 
 def _html(s, rows, interps, fuzz, real) -> str:
-    from krl.render import render_html  # noqa: PLC0415
-
     keys = ("cases", "passed", "tree_vm_agree", "fuzz_programs", "fuzz_agree", "real_programs", "real_agree", "vm")
     return render_html("conformance", "conformance.html.j2", when=time.strftime("%Y-%m-%d %H:%M:%S UTC", time.gmtime()),
                        summary_rows=[(k, s.get(k) if s.get(k) is not None else "n/a (no VM)") for k in keys],
@@ -434,7 +431,6 @@ def run_all(out: Path, *, fuzz_n: int = 200, real: bool = True, corpus: Path = D
     echo(f"cases: {sum(o.passed for o in outcomes)}/{len(outcomes)} pass ({time.monotonic() - t0:.0f} s)")
     fz = None
     if fuzz_n > 0:
-        from . import fuzz as F  # noqa: PLC0415
 
         fz = F.run_fuzz(fuzz_n, reproducible=not fuzz_random, save_failures=out / "fuzz_failures")
         echo(f"fuzz: {fz['programs']} programs, mode {fz['mode']}, tree clean {fz['tree_ok']}, agree {fz['agree']}")

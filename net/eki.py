@@ -21,6 +21,7 @@ from __future__ import annotations
 
 from collections import deque
 from dataclasses import dataclass
+import xml.etree.ElementTree as ET
 
 from .ekiconfig import EkiConfig, Element
 from .xmlsafe import XmlFramer, XmlRefused, local, parse
@@ -310,7 +311,6 @@ class Channel:
                if e.tag.upper() == keyu or e.tag.upper().startswith(keyu + "/")]
         if not els or not key:
             return None
-        import xml.etree.ElementTree as ET  # noqa: PLC0415
 
         root_name = els[0].tag.split("/")[0]
         root = ET.Element(root_name)

@@ -40,6 +40,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
+import time
 
 import numpy as np
 
@@ -336,7 +337,6 @@ class Rsi:
             if live and self.endpoint is not None:
                 self.endpoint.send(msg)
                 if self.fast and i < n - 1 and self.hub.pacer is not None:
-                    import time  # noqa: PLC0415
 
                     time.sleep(FAST_CYCLE_MS / 1000.0 / self.hub.pacer.pace)
                     for ev in self.endpoint.poll():

@@ -9,10 +9,16 @@
 Every change of a signal is appended to :attr:`IOImage.log` as ``(t, signal, value, source)``
 and reported to the optional ``on_change`` callback (the controller writes it to the trace
 as an ``io`` event). Writing the value a signal already has is not an event.
+
+:attr:`IOImage.version` changes with every change of a signal and every write of a timer or
+its stop flag (not with a running timer's count: that is the clock); it is unique across
+images, so "same version" means "nothing here changed" (the runtime re-evaluates an interrupt
+condition over I/O only then: interp/runtime/watch.py).
 """
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
@@ -20,6 +26,9 @@ N_DIGITAL = 8192
 N_ANALOG = 32
 N_TIMERS = 64
 ALWAYS_TRUE_INPUT = 1025
+
+#: the versions of every I/O image of the process (IOImage.version)
+_VERSIONS = itertools.count(1)
 
 
 class IOError_(ValueError):
@@ -48,6 +57,7 @@ class IOImage:
         self._anout = [0.0] * (N_ANALOG + 1)
         self.timer_ms = [0] * (N_TIMERS + 1)
         self.timer_stop = [True] * (N_TIMERS + 1)
+        self.version = next(_VERSIONS)
 
     # -- helpers ---------------------------------------------------------------------------
     @staticmethod
@@ -58,6 +68,7 @@ class IOImage:
         return n
 
     def _changed(self, name: str, value: object, source: str) -> None:
+        self.version = next(_VERSIONS)
         self.log.append((self.now, name, value, source))
         if self.on_change is not None:
             self.on_change(self.now, name, value, source)
@@ -150,6 +161,7 @@ class IOImage:
     def set_timer(self, n: int, ms: int) -> None:
         """Preset ``$TIMER[n]`` (ms)."""
         self.timer_ms[self._check(n, N_TIMERS, "$TIMER")] = int(ms)
+        self.version = next(_VERSIONS)
 
     def get_timer_stop(self, n: int) -> bool:
         return self.timer_stop[self._check(n, N_TIMERS, "$TIMER_STOP")]
@@ -157,6 +169,7 @@ class IOImage:
     def set_timer_stop(self, n: int, stopped: bool) -> None:
         """``$TIMER_STOP[n] = stopped``."""
         self.timer_stop[self._check(n, N_TIMERS, "$TIMER_STOP")] = bool(stopped)
+        self.version = next(_VERSIONS)
 
     def get_timer_flag(self, n: int) -> bool:
         """``$TIMER_FLAG[n]`` = ``$TIMER[n] >= 0``."""

@@ -16,6 +16,7 @@ from __future__ import annotations
 import os
 import tempfile
 from pathlib import Path
+import csv
 
 import pytest
 from hypothesis import HealthCheck, settings
@@ -58,7 +59,6 @@ def shared_corpus() -> Path:
 def history_pairs() -> list[str]:
     """The pair folders of ../shared/krl-history (``owner__name/NN-sha``), as its MANIFEST.csv
     lists them; [] when it is absent."""
-    import csv  # noqa: PLC0415
 
     manifest = SHARED_HISTORY / "MANIFEST.csv"
     if not manifest.exists():

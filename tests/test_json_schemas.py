@@ -14,6 +14,16 @@ import pytest
 from jsonschema import Draft202012Validator
 from referencing import Registry, Resource
 
+from conformance import harness as H
+
+from conformance.report import run_cases, write_report
+
+from krl.cli.bench import all_figures, engine_rates
+
+from recovery.pipeline import run_recovery
+
+from robot.trace import json_schema, read_trace
+
 REPO = Path(__file__).resolve().parents[1]
 SCHEMAS = REPO / "docs" / "schemas"
 KRL = [sys.executable, "-m", "krl.cli"]
@@ -41,8 +51,6 @@ def test_every_schema_is_valid_and_documented():
 
 
 def test_trace_schema_file_is_current():
-    from robot.trace import json_schema
-
     assert json.loads((SCHEMAS / "trace.schema.json").read_text()) == json_schema(), \
         "run: python -m robot.trace --schema > docs/schemas/trace.schema.json"
 
@@ -68,8 +76,6 @@ def test_parse_and_check_json(tmp_path):
 
 
 def test_recovery_summary_and_check_report(tmp_path):
-    from recovery.pipeline import run_recovery
-
     corpus = tmp_path / "corpus"
     corpus.mkdir()
     (corpus / "good.src").write_text(GOOD)
@@ -86,10 +92,6 @@ def test_recovery_summary_and_check_report(tmp_path):
 
 
 def test_conformance_summary_and_trace(tmp_path):
-    from conformance import harness as H
-    from conformance.report import run_cases, write_report
-    from robot.trace import read_trace
-
     case = H.load_case(REPO / "conformance" / "cases" / "053_lin_straight")
     write_report(tmp_path / "conf", run_cases([case], ["tree"]), plots=False)
     validate("conformance-summary", json.loads((tmp_path / "conf" / "summary.json").read_text()))
@@ -103,8 +105,6 @@ def test_conformance_summary_and_trace(tmp_path):
 
 
 def test_bench_outputs(tmp_path):
-    from krl.cli.bench import all_figures, engine_rates
-
     validate("bench", all_figures(repeat=1, sim_seconds=0.5, parse_kb=4))
 
     corpus = tmp_path / "c"

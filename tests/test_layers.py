@@ -114,7 +114,7 @@ def generate() -> str:
 
 
 def _graph():
-    import grimp  # noqa: PLC0415 - only these tests build the graph
+    import grimp  # noqa: PLC0415 - only these tests build the graph (costs 0.05 s)
 
     return grimp.build_graph(*ROOTS, include_external_packages=True, cache_dir=None)
 
@@ -209,7 +209,7 @@ def test_each_row_is_what_its_package_imports():
 def test_antlr4_only_in_syntax_and_ast():
     """ANTLR is contained: only krl.syntax and krl.ast import antlr4, and the protected
     contract generated for it fails when any other module imports it."""
-    from importlinter.contracts.protected import ProtectedContract  # noqa: PLC0415
+    from importlinter.contracts.protected import ProtectedContract  # noqa: PLC0415  (costs 0.09 s)
 
     graph = _graph()
     importers = {m for m in graph.find_modules_that_directly_import("antlr4")}

@@ -13,6 +13,7 @@ import asyncio
 import sys
 import time
 
+from asyncua import Client
 from pymodbus.client import ModbusTcpClient
 
 EXT_START, PGNO_FBIT, PGNO_LENGTH, PGNO_PARITY, PGNO_VALID, PGNO_REQ = 17, 33, 8, 42, 41, 20
@@ -49,7 +50,6 @@ def select_program(host: str, port: int, number: int, timeout: float = 60.0) -> 
 
 async def read_outputs(url: str, numbers) -> dict[int, bool]:
     """The robot's outputs `numbers` over OPC UA (Robot/Outputs/OUT[n])."""
-    from asyncua import Client
 
     async with Client(url) as client:
         ns = await client.get_namespace_index("urn:krl-tools:plc")

@@ -17,6 +17,9 @@ interrupts (its greenlet), at a statement boundary or at an IPO cycle.
   pending, enabled interrupt runs when its number is smaller (= higher priority) than
   the priority of the running context (main: 129, so every interrupt can run there);
   the smallest number runs first; equal or lower priorities wait;
+* a poll evaluates a condition again only when something it reads may have changed (its
+  *watch*, interp/runtime/watch.py: an I/O change, the clock, a probed state variable; a
+  condition over variables at every poll): the edges are those of evaluating at every poll;
 * a non-GLOBAL declaration is removed when the routine that declared it returns;
   ON/OFF/ENABLE/DISABLE of an undeclared number is error 1430.
 """
@@ -26,6 +29,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from .errors import INTERRUPT_NOT_DECLARED, KrlRuntimeError
+from .watch import stamp_key
 
 MAIN_PRIO = 129
 
@@ -55,6 +59,9 @@ class Irq:
     enabled: bool = True
     last: bool = False
     pending: bool = False
+    watch: str = ""               # when the condition is evaluated again (interp/runtime/watch.py)
+    seen: object = None           # the watch key of the evaluation that gave `last`
+    probes: tuple = ()            # readers of the probed system variables the condition reads
 
 
 @dataclass
@@ -78,13 +85,17 @@ class InterruptTable:
             raise KrlRuntimeError(f"interrupt {number} not declared", INTERRUPT_NOT_DECLARED)
         return [irq]
 
-    def control(self, action: str, number: int | None) -> None:
+    def control(self, action: str, number: int | None, io_version: int = 0, now: float = 0.0) -> None:
+        """INTERRUPT ON/OFF/ENABLE/DISABLE of `number` (None: all); ON takes the condition's
+        value with the I/O image at `io_version` at simulated time `now` (s) as reference."""
         for irq in self._targets(number):
             if action == "ON":
                 if not irq.on:
                     self.armed += 1
                 irq.on = True
+                irq.seen = None
                 irq.last = bool(irq.cond())
+                irq.seen = stamp_key(irq.watch, io_version, now, irq.probes)
                 irq.pending = False
             elif action == "OFF":
                 if irq.on:
@@ -98,15 +109,22 @@ class InterruptTable:
             else:
                 raise KrlRuntimeError(f"unknown INTERRUPT action {action}")
 
-    def poll(self) -> None:
-        """Evaluate the armed conditions; a rising edge makes the interrupt pending."""
+    def poll(self, io_version: int = 0, now: float = 0.0) -> None:
+        """Evaluate the armed conditions; a rising edge makes the interrupt pending. A
+        condition whose watch key (interp/runtime/watch.py) at `io_version` and simulated time
+        `now` (s) is that of its last evaluation keeps its value: nothing it reads changed."""
         for irq in list(self.irqs.values()):
             if not irq.on:
                 continue
+            key = stamp_key(irq.watch, io_version, now, irq.probes)
+            if key is not None and key == irq.seen:
+                continue
+            irq.seen = None
             cur = bool(irq.cond())
             if cur and not irq.last:
                 irq.pending = True
             irq.last = cur
+            irq.seen = key
 
     def next_ready(self, running_prio: int) -> Irq | None:
         best = None

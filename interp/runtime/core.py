@@ -20,6 +20,7 @@ from krl.semantics.resolve import NATIVE, ROUTINE, Callee, Storage
 from .builtins import NATIVES, ValueRef
 from .netfunctions import RSI_CONSTANTS
 from .contexts import Context, Irq
+from .watch import split_watch
 from .convert import assign_into, binary_op, convert_scalar, to_bool, trunc_int, unary_op
 from .errors import (HaltSignal, KrlRuntimeError, ResumeSignal, StopRun)
 from .idle import state_of
@@ -1070,17 +1071,23 @@ class Runtime:
 
     # ================================================================== interrupts
     def interrupt_decl(self, number, cond_fn, handler_fn, name: str, frame: Frame,
-                       is_global: bool = False, line: int | None = None) -> None:
+                       is_global: bool = False, line: int | None = None, watch: str = "") -> None:
+        """INTERRUPT DECL: `watch` is the condition's watch class (interp/runtime/watch.py
+        ``watch_of``; "" = evaluated at every poll)."""
         task = self.current_task
         n = trunc_int(number, "interrupt number")
-        task.irqs.declare(Irq(n, cond_fn, handler_fn, name, frame, is_global, line))
+        cls, names = split_watch(watch)
+        probes = tuple(self.sysvars.lookup(k).peek for k in names)
+        task.irqs.declare(Irq(n, cond_fn, handler_fn, name, frame, is_global, line, watch=cls,
+                              probes=probes))
         frame.interrupts.append(n)
         self._break(task)
 
     def interrupt_ctl(self, action: str, number=None) -> None:
         task = self.current_task
         n = trunc_int(number, "interrupt number") if number is not None else None
-        task.irqs.control(action.upper(), n)
+        ctl = self.controller
+        task.irqs.control(action.upper(), n, ctl.io.version, ctl.time)
         self._break(task)
         if action.upper() in ("ENABLE", "ON") and task.irqs.armed:
             self.check_interrupts(task)
@@ -1089,8 +1096,9 @@ class Runtime:
         if task.in_poll:
             return
         task.in_poll = True
+        ctl = self.controller
         try:
-            task.irqs.poll()
+            task.irqs.poll(ctl.io.version, ctl.time)
         finally:
             task.in_poll = False
         while True:
@@ -1127,7 +1135,7 @@ class Runtime:
             # (ROS-Industrial's EKI state timer: `$TIMER[1] = -10` in its own handler)
             task.in_poll = True
             try:
-                task.irqs.poll()
+                task.irqs.poll(ctl.io.version, ctl.time)
             finally:
                 task.in_poll = False
         if ok and task.kind == "robot":

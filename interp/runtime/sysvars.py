@@ -320,6 +320,7 @@ def _clock(fn):
     def read(sv: SysVars):
         sv.rt.clock_read()
         return fn(sv)
+    read.clock = True            # not in PROBED_NAMES: a read has an effect
     return read
 
 
@@ -332,6 +333,8 @@ def _set_anout(sv: SysVars, i: int, v) -> None:
 def _computed(fn, setter=None):
     def make(sv: SysVars, t, name):
         return ComputedRef(lambda: fn(sv), t, name, setter)
+    make.constant = getattr(fn, "constant", False) and setter is None
+    make.clock = getattr(fn, "clock", False)
     return make
 
 
@@ -388,7 +391,10 @@ def _nullframe(sv: SysVars):
 
 
 def _ro_const(v):
-    return lambda sv: v
+    def value(sv: SysVars):
+        return v
+    value.constant = True        # CONSTANT_NAMES
+    return value
 
 
 #: the default window of ``$IN_HOME``/``$IN_HOME1..5`` (``$H_POS_TOL``, ``$H_AXIS_TOL[n]``), deg
@@ -471,6 +477,19 @@ _LIVE = {
     "$NEAR_POSRET": _computed(_ro_const(False)),
     "$ROBRUNTIME": _computed(_clock(lambda sv: int(sv.rt.controller.time / 60))),
 }
+
+
+#: the system variables whose value never changes in a run (read-only constants of the
+#: simulated cell: $STOPMESS FALSE, $ALARM_STOP TRUE, $NUM_AX 6, ...); interp/runtime/watch.py
+CONSTANT_NAMES = frozenset(k for k, make in _LIVE.items() if getattr(make, "constant", False))
+
+#: computed scalar system variables whose read has no effect and raises nothing: the state of
+#: the run ($PRO_STATE1, $PRO_MOVE, $MODE_OP, ...). An interrupt condition over them keeps its
+#: value while theirs are unchanged (interp/runtime/watch.py, "probed").
+PROBED_NAMES = frozenset({"$PRO_STATE", "$PRO_STATE0", "$PRO_STATE1", "$PRO_MOVE", "$PRO_ACT",
+                          "$MODE_OP", "$T1", "$T2", "$AUT", "$EXT", "$I_O_ACTCONF",
+                          "$COULD_START_MOTION", "$VEL_ACT", "$INTERPRETER"}) - CONSTANT_NAMES
+assert all(k in _LIVE and not getattr(_LIVE[k], "clock", False) for k in PROBED_NAMES)
 
 
 def _sync_advance(sv: SysVars, ref) -> None:

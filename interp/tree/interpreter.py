@@ -28,6 +28,7 @@ from interp.runtime.errors import ExitSignal, GotoSignal, KrlRuntimeError, Retur
 from interp.runtime.slots import (anout_limits, anout_value, array_index, ended_without_return, for_done,
                                  for_limits, for_next, label_not_found, return_without_value, trigger_args)
 from interp.runtime.values import Channel, EnumValue, Struct, copy_value
+from interp.runtime.watch import watch_of_decl
 
 
 class TreeInterpreter:
@@ -321,9 +322,11 @@ class TreeInterpreter:
             def handler():
                 self.call(call, frame, statement=True, catch_resume=False)
 
+        watch = watch_of_decl(st)
+
         def do():
             rt.interrupt_decl(self.eval(st.prio, frame), cond, handler, call.name, frame,
-                              st.is_global, st.span.line)
+                              st.is_global, st.span.line, watch)
         self.guarded(do, st, frame)
 
     def s_InterruptCtl(self, st, frame) -> None:

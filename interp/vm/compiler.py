@@ -39,6 +39,7 @@ from krl.semantics.values import EnumValue, KrlRuntimeError, binary_op, unary_op
 
 from interp.runtime.errors import lvalue_name
 from interp.runtime.values import Channel
+from interp.runtime.watch import watch_of_decl
 
 from .assembler import Listing, Region, format_listing
 from .opcodes import BY_NAME as OPS
@@ -448,7 +449,9 @@ class Compiler:
                 self.call(call, "SN")
         lc, lh = self.thunk(cond), self.thunk(handler)
         self.expr(st.prio)
-        self.emit("INT_DECL", lc, lh, call.name, "G" if st.is_global else "", st.span.line)
+        # flags: G (GLOBAL) and the condition's watch class (interp/runtime/watch.py)
+        self.emit("INT_DECL", lc, lh, call.name, ("G" if st.is_global else "") + watch_of_decl(st),
+                  st.span.line)
         self.place(end)
 
     def s_InterruptCtl(self, st) -> None:

@@ -304,9 +304,11 @@ class VM:
         rt = self.rt
         pop = stack.pop
         cond = self.thunk(code, frame, temps, ins[1])
+        flags = ins[4]                 # G (GLOBAL), then the watch (interp/runtime/watch.py)
+        is_global = flags[:1] == "G"
         rt.interrupt_decl(pop(), lambda c=cond: rt.to_bool(c(), "interrupt condition"),
                           self.thunk(code, frame, temps, ins[2]), ins[3], frame,
-                          ins[4] == "G", ins[5])
+                          is_global, ins[5], flags[1:] if is_global else flags)
         return ip + 1
 
     def _cold_INT_CTL(self, ins, code, frame, temps, stack, ip):

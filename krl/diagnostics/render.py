@@ -30,6 +30,7 @@ from pathlib import Path
 from krl.diagnostics import Diagnostic
 from krl.limits import MAX_MESSAGE_CHARS
 from krl.terminal import printable, printable_path
+from krl.source import read_source
 
 TAB = "    "
 
@@ -73,8 +74,6 @@ class SourceLines:
 
     @staticmethod
     def _read(path: str) -> list[str] | None:
-        from krl.source import read_source  # noqa: PLC0415
-
         # never through a link (a linked file is not quoted) and never a FIFO/device (not opened)
         src = read_source(path, follow_symlinks=False)
         return split_lines(src.text) if src.status == "ok" else None

@@ -58,6 +58,17 @@ def _reads(expr, acc: list) -> None:
             _reads(c, acc)
 
 
+def reads(expr) -> list:
+    """The accesses of expression `expr` (None: none), in source order: ``("r", Name)`` for
+    each name it reads (index expressions included) and ``("call", Call)`` for each call
+    (whose arguments' reads follow). What a name denotes is its ``ann.place`` (a Storage:
+    krl/semantics/resolve.py) once the resolver has run. The runtime decides from it when an
+    interrupt condition must be evaluated again (interp/runtime/watch.py)."""
+    acc: list = []
+    _reads(expr, acc)
+    return acc
+
+
 def _target(expr, acc: list) -> None:
     """An assignment target: its root is written, index expressions are read."""
     if isinstance(expr, N.Name):

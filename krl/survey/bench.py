@@ -14,12 +14,12 @@ import sys
 from pathlib import Path
 
 from krl.files import SHARED_CORPUS as DEFAULT_CORPUS
+from krl.project import find_backups
+from krl.workspace import load_workspace
 
 
 def measure(corpus: Path) -> dict:
     """Parse and check every backup of ``corpus``; seconds of each phase and their ratio."""
-    from krl.workspace import load_workspace  # noqa: PLC0415
-    from krl.project import find_backups  # noqa: PLC0415
 
     parse_s = check_s = 0.0
     backups = find_backups(corpus)

@@ -30,7 +30,9 @@ import yaml
 from krl.ast import nodes as N
 from krl.ast.build import build_module
 from krl.syntax.parse import parse_source
-from krl.source import read_source
+from krl.source import is_krl_file, read_source
+from krl.project import find_backups, is_system_path
+from krl.semantics.outside import user_fold_lines
 
 # system data lists whose declarations are platform facts, in the order in which they win
 SYSTEM_DATALISTS = ("$OPERATE", "$OPERATE_R1", "$MACHINE", "$ROBCOR", "$CUSTOM", "$OPTION")
@@ -156,9 +158,6 @@ def _hooks(corpus: Path) -> tuple[dict, dict]:
     calls (outside its USER folds) and that a file under R1/Program declares as its main
     routine or GLOBAL (masref_user.src's MASREFSTARTG1, called by System/masref_main.src).
     Returns (packages entries of the routines, programs: UPPER file name -> source)."""
-    from krl.semantics.outside import user_fold_lines  # noqa: PLC0415
-    from krl.source import is_krl_file  # noqa: PLC0415
-    from krl.project import find_backups, is_system_path  # noqa: PLC0415
 
     invalid = _known_invalid(corpus)
     hooks: dict[str, dict] = {}

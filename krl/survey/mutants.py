@@ -57,6 +57,7 @@ from krl.semantics.symbols import Symbol
 from krl.source import read_source
 from krl.workspace import SourceFile, Workspace, load_workspace
 from krl.project import find_backups, is_system_path
+from krl.terminal import printable
 
 KINDS = ("misspelled_variable", "wrong_argument_count", "real_into_enum", "write_to_input",
          "undeclared_routine", "aggregate_type_mismatch", "assignment_to_const",
@@ -379,7 +380,6 @@ def judge(m: Mutant, p: _Program) -> None:
 
 
 def main(argv: list[str]) -> int:
-    from krl.terminal import printable  # noqa: PLC0415
     if not argv or not Path(argv[0]).is_dir():
         print("usage: python -m krl.survey.mutants CORPUS_FOLDER [PER_KIND]", file=sys.stderr)
         return 2

@@ -13,8 +13,15 @@ import gc
 import json
 from collections import Counter
 from pathlib import Path
+import csv
+import ctypes
+import sys
 
 from krl.diagnostics import CODES
+from krl.files import write_text_atomic
+from krl.project import collect_entries, find_backups
+from krl.terminal import printable
+from krl.workspace import load_workspace, load_workspaces
 
 
 def check_report(corpus: str | Path, out_dir: str | Path | None = None, top: int = 15,
@@ -23,7 +30,6 @@ def check_report(corpus: str | Path, out_dir: str | Path | None = None, top: int
     writes check_report.json and check_report.md there. `timeout`, `jobs`: files are parsed
     in that many worker processes, each file stopped past `timeout` seconds (see
     krl.workspace.load_workspace; None: in this process). Never raises for bad input files."""
-    from krl.project import find_backups  # noqa: PLC0415
 
     corpus = Path(corpus)
     backups = find_backups(corpus) if corpus.exists() else []
@@ -55,7 +61,6 @@ def check_report(corpus: str | Path, out_dir: str | Path | None = None, top: int
     data = {"corpus": str(corpus), "backups": rows, "total": total, "top_kinds": top_kinds}
     md = render_markdown(data)
     if out_dir is not None:
-        from krl.files import write_text_atomic  # noqa: PLC0415
 
         out = Path(out_dir)
         out.mkdir(parents=True, exist_ok=True)
@@ -71,8 +76,6 @@ BATCH_BYTES = 512 * 1024
 
 def _loaded_backups(backups: list[Path], timeout: float | None, jobs: int | None):
     """(backup, its loaded Workspace) for each backup, in order, loaded in batches."""
-    from krl.workspace import load_workspaces  # noqa: PLC0415
-    from krl.project import collect_entries  # noqa: PLC0415
 
     batch: list[tuple[Path, list]] = []
     size = 0
@@ -98,7 +101,6 @@ def _trim() -> None:
     global _MALLOC_TRIM
     if _MALLOC_TRIM is None:
         try:
-            import ctypes  # noqa: PLC0415
 
             _MALLOC_TRIM = ctypes.CDLL("libc.so.6").malloc_trim
         except (OSError, AttributeError):
@@ -131,7 +133,6 @@ def render_markdown(data: dict) -> str:
 
 def known_invalid(repo_root: str | Path | None = None) -> set[str]:
     """Corpus-relative paths listed in corpus/known-invalid.csv (files that are not valid KRL)."""
-    import csv  # noqa: PLC0415
     root = Path(repo_root) if repo_root is not None else Path(__file__).resolve().parents[2]
     try:
         with open(root / "corpus" / "known-invalid.csv", encoding="utf-8") as fh:
@@ -146,8 +147,6 @@ def measure(corpus: str | Path) -> dict:
     listed ones ("known_invalid"), and the error lines on valid files (path:line CODE message,
     paths relative to `corpus`). The figure of issue 14; reproducible with
     ``python -m krl.survey.report ../shared/krl-corpus``."""
-    from krl.workspace import load_workspace  # noqa: PLC0415
-    from krl.project import find_backups  # noqa: PLC0415
 
     corpus = Path(corpus).resolve()
     invalid = known_invalid()
@@ -168,9 +167,6 @@ def measure(corpus: str | Path) -> dict:
 
 
 def main(argv: list[str]) -> int:
-    import sys  # noqa: PLC0415
-    from krl.terminal import printable  # noqa: PLC0415
-
     if len(argv) != 1 or not Path(argv[0]).is_dir():
         print("usage: python -m krl.survey.report CORPUS_FOLDER", file=sys.stderr)
         return 2

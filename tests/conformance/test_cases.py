@@ -19,6 +19,7 @@ from pathlib import Path
 import pytest
 
 from conformance import harness as H
+from krl.syntax.parse import parse_file
 
 CASES = H.load_cases()
 IDS = [c.name for c in CASES]
@@ -38,8 +39,6 @@ def _require_interpreters() -> None:
 
 @pytest.mark.parametrize("case", CASES, ids=IDS)
 def test_case_is_well_formed(case: H.Case) -> None:
-    from krl.syntax.parse import parse_file
-
     assert case.program.exists(), f"{case.name}: no program.src"
     unknown = set(case.expect) - KNOWN_KEYS
     assert not unknown, f"{case.name}: unknown expect.yaml keys {sorted(unknown)}"

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import shutil
 
 import pytest
 from hypothesis import HealthCheck, given, settings
@@ -11,13 +12,12 @@ from conformance import fuzz as F
 from tests.budget import examples
 from conformance import harness as H
 from conformance import report as R
+from krl.syntax.parse import parse_file
 
 
 @settings(max_examples=examples(10), deadline=None, suppress_health_check=list(HealthCheck))
 @given(F.programs())
 def test_generated_programs_parse(tmp_path_factory, prog):
-    from krl.syntax.parse import parse_file
-
     src, _ = prog
     d = tmp_path_factory.mktemp("fz")
     (d / "program.src").write_text(src, encoding="utf-8")
@@ -44,7 +44,6 @@ def test_fuzz_failure_is_saved_as_a_case(tmp_path):
 
 def test_report_files(tmp_path):
     assert H.interpreter_status()["tree"] is None, H.interpreter_status()
-    import shutil
 
     pend_dir = tmp_path / "cases" / "999_pending_copy"
     shutil.copytree(H.CASES_DIR / "002_if_else", pend_dir)

@@ -12,13 +12,15 @@ import pytest
 
 from conformance import harness as H
 from conformance import report as R
+from interp.realprograms import cell_of
+from interp.runtime.program import parse_module
+from recovery.pipeline import load_known_invalid
 
 PROGRAMS = R.real_programs()
 
 
 def _has_statements(program) -> bool:
     """The program's main routine (its first) has at least one statement."""
-    from interp.runtime.program import parse_module
 
     module, errors = parse_module(str(program))
     return not errors and bool(module.routines) and bool(module.routines[0].body)
@@ -28,7 +30,6 @@ def _startable(programs):
     """Programs that can start and have something to run: not in corpus/known-invalid.csv (their
     files have syntax errors) and with a non-empty main routine (a backup may hold an empty
     template, such as CollDetect_UserAction.src)."""
-    from recovery.pipeline import load_known_invalid
 
     invalid = set(load_known_invalid())
     return [(p, root) for p, root in programs
@@ -50,7 +51,6 @@ def _check(prog, request=None, must_run: bool = False):
     if request is not None and prog.stem in KNOWN:
         request.node.add_marker(pytest.mark.xfail(reason=f"known: {KNOWN[prog.stem]}", strict=True))
     interps = H.available_interpreters()
-    from interp.realprograms import cell_of
 
     cell = cell_of(prog, R.DEFAULT_CORPUS)    # the committed cell file (corpus/cells, issue 22)
     runs = {it: H.run_program(prog, it, max_sim_time=10.0, max_steps=100_000, wall_timeout=120.0,

@@ -19,6 +19,7 @@ from click.testing import CliRunner
 from krl.cli import main
 from krl.diff.core import diff_sides
 from krl.diff.load import DiffInputError, side
+from tests.test_json_schemas import validate
 
 BACKUP = "ingeniado__KRC4-Robot-Palletizer"
 M1_DAT = "Program/CAJA_G/caja_g_m1.dat"
@@ -186,8 +187,6 @@ def test_declarations_signals_and_motions(tmp_path):
 
 
 def test_cli_json_matches_the_schema_and_exit_status(tmp_path):
-    from tests.test_json_schemas import validate  # noqa: PLC0415
-
     a, b = tmp_path / "a.dat", tmp_path / "b.dat"
     a.write_text("DEFDAT a\nDECL E6AXIS XHOME={A1 0.0,A2 -90.0,A3 90.0,A4 0.0,A5 0.0,A6 0.0,E1 0.0}\nENDDAT\n")
     b.write_text("DEFDAT a\nDECL E6AXIS XHOME={A1 0.5,A2 -90.0,A3 90.0,A4 0.0,A5 -10.0,A6 0.0,E1 0.0}\nENDDAT\n")

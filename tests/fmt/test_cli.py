@@ -9,6 +9,11 @@ import stat
 from click.testing import CliRunner
 
 from krl.cli import main
+import krl.fmt.core
+from krl.limits import MAX_FOLDER_DEPTH
+import krl.source
+import krl.syntax.engines
+import krl.syntax.parse
 
 MESSY = b"DEF t( )\r\nx=1 ; caf\xe9 = \x81 kept\r\nEND\r\n"          # cp1252, with an undefined byte
 TIDY = b"DEF t()\r\n   x = 1 ; caf\xe9 = \x81 kept\r\nEND\r\n"
@@ -176,8 +181,6 @@ def test_a_named_link_is_still_followed(tmp_path):
 
 
 def test_a_folder_too_deep_is_reported_and_not_entered(tmp_path):
-    from krl.limits import MAX_FOLDER_DEPTH
-
     root = tmp_path / "deep"
     shallow = root / "a.src"
     folders = [root]
@@ -210,10 +213,6 @@ NO_THEN = b"DEF v()\nIF a\n  x=1\nENDIF\nEND\n"
 
 def _count_parses_and_reads(monkeypatch) -> dict:
     """Wrap every way a file is parsed (the Python parser, the engine entry point) or read."""
-    import krl.fmt.core
-    import krl.syntax.engines
-    import krl.syntax.parse
-    import krl.source
 
     counts = {"parse": 0, "read": 0}
 

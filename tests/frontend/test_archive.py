@@ -18,6 +18,9 @@ from click.testing import CliRunner
 from krl import limits
 from krl.archive import ArchiveError, backup_source, extract_backup
 from krl.cli.check import run_check
+from interp.cli import run
+from krl.workspace import on_each_file, workspaces_for
+from recovery.cli import recover
 
 CONFIG = "DEFDAT $CONFIG\n  DECL INT counter = 0\nENDDAT\n"
 DEMO = ("DEF demo()\n"                    # 1
@@ -195,8 +198,6 @@ def test_only_krl_files_are_extracted(tmp_path):
 
 
 def test_krl_run_runs_a_program_of_the_archive(tmp_path, own_tmp):
-    from interp.cli import run
-
     archive = zip_folder(make_backup(tmp_path / "src"), tmp_path / "backup.zip")
     res = CliRunner().invoke(run, ["--workspace", str(archive), "done"])
     assert res.exit_code == 0, res.output
@@ -208,8 +209,6 @@ def test_krl_run_runs_a_program_of_the_archive(tmp_path, own_tmp):
 
 
 def test_krl_recover_reads_the_archive(tmp_path, own_tmp):
-    from recovery.cli import recover
-
     archive = zip_folder(make_backup(tmp_path / "src"), tmp_path / "backup.zip")
     res = CliRunner().invoke(recover, [str(archive), "--out", str(tmp_path / "rep")])
     assert res.exit_code == 0, res.output
@@ -223,8 +222,6 @@ def test_krl_recover_reads_the_archive(tmp_path, own_tmp):
 
 
 def test_each_file_read_is_reported_to_the_progress_hook(tmp_path):
-    from krl.workspace import on_each_file, workspaces_for
-
     folder = make_backup(tmp_path / "src")
     seen: list[str] = []
     with on_each_file(seen.append):

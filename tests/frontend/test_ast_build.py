@@ -3,9 +3,10 @@
 from __future__ import annotations
 
 from krl.ast import nodes as N
-from krl.ast.build import build_module
+from krl.ast.build import Builder, build_module
 from krl.diagnostics import DiagnosticSink
 from krl.syntax.parse import parse_text
+from krl.workspace import check_texts
 
 from .helpers import ast_of, body_of
 
@@ -132,7 +133,6 @@ def test_data_list_items():
 
 def test_unknown_context_degrades_to_unsupported():
     """The builder never raises: an unmapped statement becomes Unsupported + W003."""
-    from krl.ast.build import Builder
     result = parse_text("DEF t()\n  x = 1\nEND\n", "t.src")
     sink = DiagnosticSink()
     b = Builder("t.src", sink, list(type(result.tree.parser).symbolicNames), recovered=False)
@@ -185,7 +185,6 @@ def test_interrupt_brake_action():
 
 
 def test_workspace_routine_lookup():
-    from krl.workspace import check_texts
     ws = check_texts({"a.src": "DEF a()\n  b()\nEND\nDEF b()\nEND\n"})
     sym = ws.lookup_routine("A")
     assert sym.decl is ws.units[0].routines[0] and ws.lookup_routine("b") is None

@@ -10,6 +10,10 @@ import pytest
 
 from krl.ast import nodes as N
 from krl.semantics import types as T
+from krl.diagnostics import DiagnosticSink
+from krl.semantics.checker import Checker, Declarer, _Ctx
+from krl.semantics.symbols import Scope, system_scopes
+from krl.workspace import check_texts
 
 from .helpers import check, codes
 
@@ -112,9 +116,6 @@ def test_rule(code, bad, good):
 def test_declaration_after_statement_E104():
     """2.2: all declarations precede the first statement. The grammar rejects this form
     itself today; the checker also reports E104 for a DeclStmt that a grammar lets through."""
-    from krl.semantics.checker import Checker, Declarer, _Ctx
-    from krl.diagnostics import DiagnosticSink
-    from krl.semantics.symbols import Scope, system_scopes
 
     sink = DiagnosticSink()
     checker = Checker(sink, Declarer(sink))
@@ -157,7 +158,6 @@ def test_globals_from_config_and_public_data():
         "R1/Program/t.src": "DEF t()\n  DECL POINT_T p\n  gCount = gShared + own\n  p.X = 1\nEND\n",
         "R1/Program/t.dat": "DEFDAT t\n  INT own = 3\nENDDAT\n",
     }
-    from krl.workspace import check_texts
     ws = check_texts(files)
     assert not ws.diagnostics, [str(d) for d in ws.diagnostics]
     files["R1/Program/t.src"] = "DEF t()\n  gCount = hidden\nEND\n"
@@ -189,7 +189,6 @@ def test_system_variables_have_types_and_stops():
 
 def test_no_motion_in_submit_programs():
     """9, 8.2: the submit interpreter has no motion statements."""
-    from krl.workspace import check_texts
     bad = check_texts({"sps.sub": "DEF sps()\n  LOOP\n    PTP XHOME\n  ENDLOOP\nEND\n"})
     assert [d.code for d in bad.diagnostics] == ["E406"]
     ok = check_texts({"sps.sub": "DEF sps()\n  LOOP\n    $OUT[1] = $IN[2]\n  ENDLOOP\nEND\n"})
@@ -199,7 +198,6 @@ def test_no_motion_in_submit_programs():
 def test_duplicate_global_types_across_data_lists():
     """2.7: two PUBLIC data lists exporting the same GLOBAL ENUM is a link error;
     system data lists may repeat each other."""
-    from krl.workspace import check_texts
     a = "DEFDAT a PUBLIC\n  GLOBAL ENUM CMD_T X, Y\nENDDAT\n"
     b = "DEFDAT b PUBLIC\n  GLOBAL ENUM CMD_T X, Y, Z\nENDDAT\n"
     assert [d.code for d in check_texts({"a.dat": a, "b.dat": b}).diagnostics] == ["E102"]
@@ -227,7 +225,6 @@ def test_declared_names_carry_their_symbols():
 
 def test_import_links_to_the_data_list_variable():
     """2.5: IMPORT type name IS /R1/module..var."""
-    from krl.workspace import check_texts
     files = {"other.dat": "DEFDAT other\n  INT counter = 0\nENDDAT\n",
              "t.src": "DEF t()\n  n = n + 1\nEND\n",
              "t.dat": "DEFDAT t\n  IMPORT INT n IS /R1/other..counter\nENDDAT\n"}
@@ -241,7 +238,6 @@ def test_import_links_to_the_data_list_variable():
 
 def test_names_from_unparsable_files_are_warnings_only():
     """A name that a file with syntax errors mentions may be declared there: W101, not E101."""
-    from krl.workspace import check_texts
     ws = check_texts({"broken.dat": "DEFDAT broken PUBLIC\n  DECL GLOBAL INT foo = = 1\nENDDAT\n",
                       "t.src": "DEF t()\n  foo = 1\n  bar = 2\nEND\n"})
     got = sorted((d.code, d.message.split("'")[1]) for d in ws.diagnostics if d.code != "E002")

@@ -18,6 +18,7 @@ from krl.diagnostics import SYNTAX_CODES
 from krl.survey.report import check_report
 from krl.workspace import load_workspace
 from krl.project import find_backups
+from krl.ast import nodes as N
 
 # (path pattern, code, message pattern, why it is a true error, the lines: file name:line)
 TRUE_ERRORS = [
@@ -127,7 +128,6 @@ def test_no_false_errors(checked, corpus):
 @pytest.mark.corpus
 def test_every_expression_is_typed(checked):
     """The interpreters rely on ann.type for every expression of a checked file."""
-    from krl.ast import nodes as N
     untyped = []
     for ws in checked:
         for f in ws.files:

@@ -15,12 +15,14 @@ import re
 import time
 import zipfile
 from pathlib import Path
+from unittest import mock
 
 import pytest
 
 from krl.diagnostics import CODES
 from krl.cli.check import run_check
 from krl.workspace import check_texts, load_workspace
+import krl.workspace as workspace_mod
 
 DOC = Path(__file__).resolve().parents[2] / "docs" / "diagnostics.md"
 SECTION = re.compile(r"^## ([EW]\d{3})\s*$", re.M)
@@ -80,8 +82,6 @@ def _generated(code: str, tmp: Path) -> set[str]:
         return {d["code"] for line in out for d in json.loads(line)["diagnostics"]}
     if code == "E005":
         # a parse that never ends: the worker is killed after the timeout
-        import krl.workspace as workspace_mod  # noqa: PLC0415
-        from unittest import mock  # noqa: PLC0415
 
         def stuck(src, *a, **kw):
             while True:

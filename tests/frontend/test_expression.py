@@ -6,6 +6,8 @@ conversions, the decisions of krl/semantics/values.py), not taken from a run.
 
 from __future__ import annotations
 
+import sys
+
 import pytest
 
 from krl.ast import nodes as N
@@ -120,7 +122,6 @@ def test_an_env_reads_variables_and_the_base_env_none():
 
 
 def test_a_long_chain_costs_no_stack():
-    import sys
     text = "+".join(["1"] * 500)
     limit = sys.getrecursionlimit()
     sys.setrecursionlimit(200)

@@ -11,6 +11,9 @@ from tests.budget import examples
 
 from krl.cli.check import run_check
 from krl.workspace import check_texts, load_workspace
+from krl.ast import nodes as N
+from krl.ast.printer import print_module
+from krl.source import is_krl_file
 
 from .strategies import modules
 
@@ -129,8 +132,6 @@ def test_unreadable_inputs(tmp_path):
 
 @given(modules)
 def test_generated_programs_check_without_internal_errors(module):
-    from krl.ast import nodes as N
-    from krl.ast.printer import print_module
     ws = _safe_check_text(print_module(module))
     for f in ws.files:
         assert all(N.type_of(n) is not None for n in f.module.walk() if isinstance(n, N.Expr))
@@ -155,7 +156,6 @@ _SAMPLE: list = []
 
 def _sample_files(corpus):
     if not _SAMPLE:
-        from krl.source import is_krl_file
         files = sorted(p for p in corpus.rglob("*") if p.is_file() and is_krl_file(p)
                        and p.stat().st_size < 20_000)
         _SAMPLE.extend(files[:: max(1, len(files) // 40)])

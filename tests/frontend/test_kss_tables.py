@@ -14,7 +14,8 @@ import pytest
 import yaml
 
 from krl.semantics.builtins import DATA_DIR, load_builtins
-from krl.workspace import check_texts
+from krl.workspace import check_texts, is_kuka_file
+from krl.survey.derive_tables import derive, render
 
 TABLE = yaml.safe_load((DATA_DIR / "kss.yaml").read_text(encoding="utf-8"))
 
@@ -39,7 +40,6 @@ def test_sources_declare_what_the_table_says(corpus):
 
 @pytest.mark.corpus
 def test_table_is_the_derivation_of_the_corpus(corpus):
-    from krl.survey.derive_tables import derive, render
     assert render(derive(corpus)) == (DATA_DIR / "kss.yaml").read_text(encoding="utf-8")
 
 
@@ -63,7 +63,6 @@ def test_backup_declaration_wins_over_the_table():
 def test_hook_programs_are_kuka_files_and_their_routines_known():
     """masref_user.src under R1/Program is KUKA's hook program: System/masref_main.src calls its
     GLOBAL routines. The table records the file and the routines, each with its source."""
-    from krl.workspace import is_kuka_file
     b = load_builtins()
     assert b.packages["MASREFSTARTG1"][0] == "KSS hook program masref_user.src"
     assert "masref_user.src:8" in b.packages["MASREFSTARTG1"][1]

@@ -9,6 +9,8 @@ import pytest
 
 from krl.project import SYSTEM_DIRS, is_submit_file, is_system_path, modules_of, system_folder_of
 from krl.workspace import check_texts, module_files
+from robot.controller import Controller
+from robot.stimuli import load_cell
 
 
 def test_modules_pair_src_or_sub_with_dat():
@@ -42,9 +44,6 @@ def test_one_list_of_system_folders():
 
 
 def test_the_controller_reads_no_cell_file(tmp_path):
-    from robot.controller import Controller
-    from robot.stimuli import load_cell
-
     f = tmp_path / "cell.yaml"
     f.write_text("stimuli:\n  - when: {line: 3, reached: true}\n    set: {\"$IN[1]\": true}\n", encoding="utf-8")
     with pytest.raises(TypeError, match="load_cell"):

@@ -8,7 +8,7 @@ from click.testing import CliRunner
 
 from krl.cli.check import check as check_cmd
 from krl.survey.report import check_report
-from krl.workspace import workspaces_for
+from krl.workspace import check_texts, workspaces_for
 from krl.project import find_backups, is_system_path
 
 
@@ -116,7 +116,6 @@ def test_one_diagnostic_per_code_name_and_line():
     """An unknown type for every name of one DECL line is one E105, not one per name; in
     every parameter of EXT lines of several files it is one W105 for the backup (the
     software that provides the external routine declares its types)."""
-    from krl.workspace import check_texts
     ws = check_texts({"m.src": "DEF m()\nEND\n",
                       "m.dat": "DEFDAT m\n  DECL NOTYPE a, b, c\nENDDAT\n"})
     found = [(d.line, d.code) for d in ws.diagnostics if "NOTYPE" in d.message]

@@ -8,7 +8,7 @@ import subprocess
 import sys
 import pytest
 
-from tests.fuzz.run import REPO
+from tests.fuzz.run import REPO, seed_files
 from tests.fuzz.targets import TARGETS
 from tests.test_json_schemas import validate
 
@@ -30,8 +30,6 @@ def test_short_fuzz_run(target, tmp_path):
 
 
 def test_seeds_come_from_the_corpora():
-    from tests.fuzz.run import seed_files
-
     krl = seed_files("decode_parse", 50)
     assert 0 < len(krl) <= 50 + len(list((REPO / "tests" / "fuzz" / "crashes").rglob("*.bin")))
     assert all(p.suffix.lower() in (".src", ".dat", ".sub", ".bin") for p in krl)

@@ -15,6 +15,7 @@ import pytest
 
 from net.settings import Channel, NetworkSettings
 from robot.trace import TraceWriter
+from interp.run import make_runtime
 
 from .helpers import EXAMPLES, HERE
 
@@ -23,8 +24,6 @@ RECORDING = HERE / "recordings" / "eki_hw_interface.jsonl"
 
 
 def replay(program, interp: str) -> TraceWriter:
-    from interp.run import make_runtime
-
     settings = NetworkSettings(HERE, eki={"EKIHWINTERFACE": Channel(EXAMPLES / "EkiHwInterface.xml")},
                                replay=RECORDING)
     trace = TraceWriter(keep=True)

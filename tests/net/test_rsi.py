@@ -15,6 +15,8 @@ import numpy as np
 import pytest
 
 from net.settings import Channel, NetworkSettings
+from interp.run import make_runtime
+from robot.trace import TraceWriter
 
 from .helpers import CONFIGS, EXAMPLES, net_events, run_with_partner
 
@@ -146,8 +148,6 @@ def test_ros_industrial_rsi_axis_corrections(shared_corpus, interp):
 def test_without_a_sensor_every_packet_is_late(interp):
     """No `network:` key: no socket, no pacing; RSI_ON sends to nobody, so the robot stops after
     Timeout + 1 late cycles, deterministically, as KSS would without its sensor."""
-    from interp.run import make_runtime
-    from robot.trace import TraceWriter
 
     trace = TraceWriter(keep=True)
     rt, _ = make_runtime(EXAMPLES / "rsi_path.src", trace=trace, mujoco=False, interp=interp)

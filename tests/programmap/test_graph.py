@@ -7,6 +7,7 @@ from __future__ import annotations
 import json
 import re
 from pathlib import Path
+import xml.etree.ElementTree as ET
 
 import pytest
 from click.testing import CliRunner
@@ -14,9 +15,10 @@ from click.testing import CliRunner
 from krl.ast import nodes as N
 from krl.cli import main
 from krl.programmap import build_map
-from krl.programmap.render import to_dot
+from krl.programmap.render import to_dot, to_svg
 from krl.project import find_backups
 from krl.workspace import workspaces_for
+from tests.apt import apt_install
 
 FIXTURE = Path(__file__).parent / "fixtures" / "KRC"
 
@@ -135,11 +137,6 @@ def test_corpus_backups_have_an_edge_for_every_call_the_checker_resolves(shared_
 
 @pytest.mark.may_skip("graphviz's dot is missing and cannot be installed (not root, or apt-get has no network)")
 def test_svg_drawn_by_graphviz(fixture_map):
-    import xml.etree.ElementTree as ET  # noqa: PLC0415
-
-    from krl.programmap.render import to_svg  # noqa: PLC0415
-    from tests.apt import apt_install  # noqa: PLC0415
-
     if apt_install("graphviz", "dot") is None:
         pytest.skip("graphviz's dot is not installed and cannot be installed with apt-get")
     svg = ET.fromstring(to_svg(fixture_map))

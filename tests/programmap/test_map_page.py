@@ -20,6 +20,8 @@ from krl.cli import main
 from krl.programmap import build_map
 from krl.project import find_backups
 from krl.workspace import workspaces_for
+from tests.apt import apt_install
+from tests.report.test_report_chromium import CHROMIUM, loaded_page
 
 WEB = Path(__file__).parents[2] / "krl" / "programmap" / "web"
 STATIC = Path(__file__).parents[2] / "krl" / "programmap" / "static" / "programmap.js"
@@ -52,9 +54,6 @@ def largest(shared_corpus):
 
 @pytest.fixture(scope="module")
 def chromium() -> str:
-    from tests.report.test_report_chromium import CHROMIUM  # noqa: PLC0415
-    from tests.apt import apt_install  # noqa: PLC0415
-
     if not Path(CHROMIUM).exists() and apt_install("chromium", "chromium") is None:
         pytest.skip("chromium is not installed and cannot be installed with apt-get")
     return CHROMIUM
@@ -62,9 +61,8 @@ def chromium() -> str:
 
 @pytest.mark.may_skip("chromium is missing and cannot be installed (not root, or apt-get has no network)")
 def test_search_neighbourhood_and_source_link_in_chromium(chromium, largest, tmp_path):
-    import playwright.sync_api as playwright  # a dev dependency: missing is a failure, not a skip
+    import playwright.sync_api as playwright  # a dev dependency: missing is a failure, not a skip (costs 0.14 s CPU: only the browser tests)
 
-    from tests.report.test_report_chromium import loaded_page  # noqa: PLC0415
 
     root, pm = largest
     page_file = tmp_path / "map.html"
@@ -123,9 +121,8 @@ def test_search_neighbourhood_and_source_link_in_chromium(chromium, largest, tmp
 
 @pytest.mark.may_skip("chromium is missing and cannot be installed (not root, or apt-get has no network)")
 def test_markup_in_names_stays_text(chromium, tmp_path):
-    import playwright.sync_api as playwright  # noqa: PLC0415
+    import playwright.sync_api as playwright  # noqa: PLC0415 (costs 0.14 s CPU: only the browser tests)
 
-    from tests.report.test_report_chromium import loaded_page  # noqa: PLC0415
 
     evil = "<img src=x onerror=window.pwned=1>"
     (tmp_path / f"{evil}.src").write_text("DEF odd()\n  helper()\nEND\nDEF helper()\nEND\n")

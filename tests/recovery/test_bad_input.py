@@ -7,12 +7,17 @@ import subprocess
 import sys
 import time
 from pathlib import Path
+import csv
 
 import pytest
 
 from krl.syntax.parse import parse_text
-from krl.source import read_source
+from krl.source import decode_bytes, encode_text, read_source, source_from_bytes
 from recovery.scan import scan
+from krl.limits import MAX_FILE_BYTES
+from krl.syntax.engines import parse_file
+from recovery import scan as scan_mod
+from recovery.report import summarise, write_report
 
 VALID = "DEF t()\n  ; Grüße, Maß\n  x = 1\nEND\n"
 
@@ -70,7 +75,6 @@ def _stubborn(*_args):
 def test_timeout_is_a_row_not_a_hang(tmp_path: Path, monkeypatch) -> None:
     # The worker that parses slow.src never returns on its own; the scan kills it after the
     # timeout and goes on with the other files (parse_row is patched before the workers fork).
-    from recovery import scan as scan_mod
 
     (tmp_path / "slow.src").write_text(VALID)
     (tmp_path / "after.src").write_text(VALID)
@@ -119,7 +123,6 @@ def test_bom_followed_by_cp1252_is_not_rejected(tmp_path: Path) -> None:
     src = read_source(p)
     assert (src.encoding, src.text) == ("cp1252+bom", VALID)
     assert parse_text(src.text).ok
-    from krl.source import encode_text  # noqa: PLC0415 - krl fmt writes the same bytes back
 
     assert encode_text(src.text, src.encoding) == data
 
@@ -132,7 +135,6 @@ def test_central_european_code_page_is_detected(tmp_path: Path) -> None:
     p.write_bytes(text.encode("cp1250"))
     src = read_source(p)
     assert (src.encoding, src.text) == ("cp1250", text)
-    from krl.source import encode_text  # noqa: PLC0415
 
     assert encode_text(src.text, src.encoding) == text.encode("cp1250")
     # German umlauts are the same bytes in cp1250 and cp1252: named cp1252, the KRL default
@@ -142,8 +144,6 @@ def test_central_european_code_page_is_detected(tmp_path: Path) -> None:
 
 
 def test_files_csv_records_the_encoding(tmp_path: Path) -> None:
-    from recovery.report import summarise, write_report
-
     corpus = tmp_path / "c"
     corpus.mkdir()
     (corpus / "bom.src").write_bytes(b"\xef\xbb\xbf" + VALID.encode("utf-8"))
@@ -152,7 +152,6 @@ def test_files_csv_records_the_encoding(tmp_path: Path) -> None:
     (corpus / "plain.src").write_bytes(b"DEF t()\nEND\n")
     results = scan(corpus, "g", jobs=1, use_cache=False, progress=False)
     write_report(tmp_path / "out", summarise(results, "g", str(corpus), 0.0), results)
-    import csv  # noqa: PLC0415
 
     with (tmp_path / "out" / "files.csv").open(newline="", encoding="utf-8") as fh:
         got = {r["path"]: (r["encoding"], r["status"]) for r in csv.DictReader(fh)}
@@ -168,15 +167,12 @@ def test_files_csv_records_the_encoding(tmp_path: Path) -> None:
     ("; Привет мир, как дела", "cp1251"),
 ])
 def test_code_page_of_a_comment(text: str, page: str) -> None:
-    from krl.source import decode_bytes  # noqa: PLC0415
-
     data = f"DEF t()\r\n  x = 1 {text}\r\nEND\r\n".encode(page)
     assert decode_bytes(data) == (data.decode(page), page)
 
 
 def test_a_byte_undefined_in_cp1252_does_not_switch_to_cyrillic() -> None:
     # 0x81 is undefined in cp1252 and "Ѓ" in cp1251; "café" must stay café, not "cafй".
-    from krl.source import decode_bytes  # noqa: PLC0415
 
     assert decode_bytes(b"x=1 ; caf\xe9 = \x81 kept\n") == ("x=1 ; café = \x81 kept\n", "cp1252")
 
@@ -184,9 +180,6 @@ def test_a_byte_undefined_in_cp1252_does_not_switch_to_cyrillic() -> None:
 def test_bytes_past_the_file_limit_are_too_large_whoever_read_them() -> None:
     """source_from_bytes is the one classifier: bytes from an editor buffer or parse_file get the
     same size limit as a file read from disk (krl/limits.py MAX_FILE_BYTES)."""
-    from krl.limits import MAX_FILE_BYTES
-    from krl.syntax.engines import parse_file
-    from krl.source import source_from_bytes
 
     big = b"DEF a()\nEND\n" + b";" * MAX_FILE_BYTES
     assert source_from_bytes("big.src", big).status == "too_large"

@@ -9,6 +9,7 @@ import pytest
 from recovery.cluster import cluster_results
 from recovery.grammar_versions import committed_versions, parser_dir_for
 from recovery.scan import scan
+from krl.syntax.engines import java
 
 # Clustering is tested against the first, restrictive grammar, where spline blocks and
 # `INTERRUPT ... DO BRAKE` are missing constructs, so the test does not move as the grammar grows.
@@ -20,7 +21,6 @@ def first_grammar() -> tuple[str, str]:
     # Build the version's Java parser here, once: built on first use inside a scan worker,
     # javac ran within the per-file timeout, which a loaded machine exceeded (the file then
     # became an "internal | parser failure" row).
-    from krl.syntax.engines import java  # noqa: PLC0415
 
     if java.unavailable_reason() is None:
         java.grammar_classes(first.text)

@@ -15,11 +15,12 @@ from pathlib import Path
 
 import pytest
 
-from krl import limits
+from krl import files as files_mod, limits
 from krl.source import read_source
 from recovery.report import summarise, write_report
 from recovery.scan import scan
 from tests.deep import deep_chain, remove_bottom_up
+from krl.cli.check import run_check
 
 REPO_ROOT = Path(__file__).resolve().parents[2]
 KRL = [sys.executable, "-m", "krl.cli"]
@@ -115,7 +116,6 @@ def test_symlinks_are_rows_and_never_followed(tmp_path: Path) -> None:
     for f in out.iterdir():
         assert secret not in f.read_bytes().decode("utf-8", "replace"), f.name
     # krl check reports the link and never quotes the linked file
-    from krl.cli.check import run_check
 
     lines: list[str] = []
     run_check([str(corpus)], echo=lines.append)
@@ -125,8 +125,6 @@ def test_symlinks_are_rows_and_never_followed(tmp_path: Path) -> None:
 
 
 def test_unreadable_folder_is_reported(tmp_path: Path, monkeypatch) -> None:
-    from krl import files as files_mod  # the one folder walk
-
     (tmp_path / "ok").mkdir()
     (tmp_path / "ok" / "a.src").write_text(VALID)
     (tmp_path / "locked").mkdir()
@@ -142,7 +140,6 @@ def test_unreadable_folder_is_reported(tmp_path: Path, monkeypatch) -> None:
     rows = rows_of(tmp_path)
     assert {p: r.status for p, r in rows.items()} == {"ok/a.src": "ok", "locked": "unreadable_folder"}
     assert "Permission denied" in rows["locked"].detail
-    from krl.cli.check import run_check
 
     lines: list[str] = []
     run_check([str(tmp_path)], echo=lines.append)
@@ -164,7 +161,6 @@ def test_thousand_levels_deep_tree_does_not_crash_recover_or_check(tmp_path: Pat
         assert {p: r.status for p, r in rows.items()} == {
             "top.src": "ok", "/".join(["d"] * (MAX_FOLDER_DEPTH - 1)) + "/shallow.src": "ok",
             deep_rel: "too_deep_folder"}
-        from krl.cli.check import run_check
 
         lines: list[str] = []
         assert run_check([str(corpus)], echo=lines.append) == 0, lines

@@ -16,13 +16,14 @@ import subprocess
 import sys
 import time
 from pathlib import Path
+import random
 
 import pytest
 
-from recovery import report as report_mod
+from recovery import pipeline, report as report_mod
 from recovery import scan as scan_mod
 from recovery.cluster import Cluster
-from recovery.report import summarise, write_clusters_csv, write_report
+from recovery.report import ReportStream, SummaryBuilder, summarise, write_clusters_csv, write_report
 from recovery.scan import FileResult, scan
 
 REPO_ROOT = Path(__file__).resolve().parents[2]
@@ -171,8 +172,6 @@ def test_unwritable_cache_folder_means_no_cache_and_one_warning(tmp_path: Path, 
 
 
 def test_no_cache_never_touches_the_cache_folder(tmp_path: Path, monkeypatch, capsys) -> None:
-    from recovery import pipeline
-
     corpus = tmp_path / "corpus"
     (corpus / "KRC" / "R1" / "System").mkdir(parents=True)        # a backup: the static check runs
     (corpus / "KRC" / "R1" / "System" / "$config.dat").write_text("DEFDAT $CONFIG\nENDDAT\n")
@@ -299,9 +298,7 @@ def test_files_and_clusters_csv_hold_no_formula(tmp_path: Path) -> None:
 def test_streamed_report_equals_the_report_of_the_whole_list(tmp_path: Path) -> None:
     # Rows arrive in any order in a parallel scan; the streamed report (rows written as files
     # finish, only counts and clusters kept) must equal the report built from the full list.
-    import random
 
-    from recovery.report import ReportStream, SummaryBuilder
 
     corpus = tmp_path / "corpus"
     (corpus / "sub").mkdir(parents=True)

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from conformance import report as R
 from conformance.harness import Check
+from conformance.nightly import write_index
 
 
 def real_outcomes() -> list[R.RealOutcome]:
@@ -48,8 +49,6 @@ def test_conformance_html_escapes_and_has_the_table(tmp_path):
 
 
 def test_nightly_index_escapes_folder_names(tmp_path):
-    from conformance.nightly import write_index
-
     day = tmp_path / "2026-11-21<img src=x onerror=alert(1)>"
     (day / "conformance").mkdir(parents=True)
     (day / "conformance" / "report.html").write_text("<p>x</p>", encoding="utf-8")

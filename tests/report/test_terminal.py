@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import os
+
 from krl.terminal import printable, printable_path
 
 
@@ -40,7 +42,5 @@ def test_every_control_is_replaced():
 
 
 def test_path_with_undecodable_bytes():
-    import os
-
     name = os.fsdecode(b"Pr\xfcfung\x1b.src")
     assert printable_path(name) == "Pr\\xfcfung\\x1b.src"

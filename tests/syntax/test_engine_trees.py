@@ -12,6 +12,7 @@ import json
 import subprocess
 import sys
 import time
+import gc
 
 import pytest
 
@@ -23,6 +24,7 @@ from krl.syntax.engines.tree import RebuiltToken, TreeDataError, tree_from_raw
 from krl.syntax.parse import default_bundle, prepare_text
 from krl.source import SourceText
 from tests.syntax.test_engines import _java_or_skip, _record, needs_java, tree_shape
+from krl.project import collect_entries
 
 TEXT = "DEF a()\nDECL INT x\nx = -(1 + 2) * 3\nIF x > 1 THEN\nx = x - 1\nENDIF\nEND\n"
 BROKEN = "DEF b()\nx = = 1\nIF THEN\nEND\n"
@@ -121,7 +123,6 @@ def test_a_backup_checks_the_same_through_either_engine(shared_corpus, monkeypat
     the same diagnostics and the same ASTs as the Python engine, and it really ran."""
     _java_or_skip()
     backup = shared_corpus / "rawpython__kukaKRLmagic"
-    from krl.project import collect_entries  # noqa: PLC0415
 
     entries = collect_entries(backup)
 
@@ -153,8 +154,6 @@ def test_a_backup_checks_the_same_through_either_engine(shared_corpus, monkeypat
 
 
 def _collector_state(src, raw=None):
-    import gc  # noqa: PLC0415
-
     return gc.isenabled()
 
 
@@ -162,7 +161,6 @@ def test_load_batch_pauses_the_collector_here_but_never_in_the_workers(tmp_path,
     """The main process pauses the cyclic collector while a batch's ASTs arrive (and restores
     it after); the worker processes, forked meanwhile, must collect as usual: their parse
     trees are cyclic garbage, file after file."""
-    import gc
 
     paths = []
     for i in range(4):

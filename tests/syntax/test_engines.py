@@ -18,18 +18,20 @@ import sys
 from pathlib import Path
 
 import pytest
-from antlr4.tree.Tree import ErrorNode
+from antlr4.tree.Tree import ErrorNode, TerminalNode
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from antlr4 import CommonTokenStream, InputStream, ParserRuleContext
 
 from krl.syntax import blocks
 from krl.syntax.engines import EngineUnavailable, parse_file, parse_sources, resolve
 from krl.syntax.engines import java as java_engine
 from krl.syntax.engines.tree import RebuiltToken
-from krl.syntax.parse import default_bundle, prepare_text
+from krl.syntax.parse import ParserBundle, default_bundle, prepare_text
 from krl.source import SourceText, read_source
 from recovery.scan import discover
 from tests.budget import examples
+from recovery.grammar_versions import _git, parser_dir_for
 
 REPO = Path(__file__).resolve().parents[2]
 SHARDS = 6
@@ -63,8 +65,6 @@ def tree_shape(tree) -> list[tuple]:
     class, start and stop tokens (all their fields), invoking state, whether the rule recorded
     an exception, children (count or None), label fields and the parent's class; terminals and
     error nodes with their token."""
-    from antlr4 import ParserRuleContext  # noqa: PLC0415
-    from antlr4.tree.Tree import ErrorNode, TerminalNode  # noqa: PLC0415
 
     if tree is None:
         return []
@@ -165,7 +165,6 @@ def _krl_lines(draw):
 def test_may_pass_limit_never_misses_a_limit(text, nesting, terms):
     """Whenever the token pass finds a file past a limit, the text pre-filter said it might be
     (with small limits, so that generated files reach them)."""
-    from antlr4 import CommonTokenStream, InputStream  # noqa: PLC0415
 
     saved = blocks.MAX_NESTING, blocks.MAX_EXPRESSION_TERMS
     blocks.MAX_NESTING, blocks.MAX_EXPRESSION_TERMS = nesting, terms
@@ -242,8 +241,6 @@ def test_engines_agree_on_a_grammar_version_with_python_predicates():
     engines agree on tests/negative/ with such a version, and the files that exercise the
     predicates (DISTANCE, #WORLD) are among those parsed."""
     _java_or_skip()
-    from recovery.grammar_versions import _git, parser_dir_for  # noqa: PLC0415
-    from krl.syntax.parse import ParserBundle  # noqa: PLC0415
 
     commits = _git("log", "--format=%H", "--", "grammar/KRL.g4").split()
     text = next((t for t in (_git("show", f"{c}:grammar/KRL.g4") for c in commits) if "}?<fail=" in t), None)

@@ -6,6 +6,8 @@ import pytest
 
 from krl.syntax.folds import fold_diagnostics
 from krl.workspace import check_texts
+from krl.source import is_krl_file, read_source
+from krl.syntax.parse import parse_text
 
 
 def found(text: str):
@@ -92,8 +94,6 @@ def test_line_ends_are_the_lexers(eol, expected):
 
 
 def test_fold_lines_are_the_parsers_lines():
-    from krl.syntax.parse import parse_text
-
     text = "DEF t()\r\n  x = 1\r  ;FOLD a\n  y = 2\rEND\n"
     fold_tokens = [t for t in parse_text(text).tree.parser.getTokenStream().tokens if t.text.startswith(";FOLD")]
     assert [(t.line, t.column + 1) for t in fold_tokens] == [(2, 11)]   # "  x = 1" CR "  ;": 11th
@@ -108,8 +108,6 @@ def test_check_reports_the_warning_and_it_does_not_stop_the_file():
 
 @pytest.mark.corpus
 def test_real_corpus_fires_only_on_unbalanced_files(shared_corpus):
-    from krl.source import is_krl_file, read_source
-
     hits = {}
     for p in sorted(shared_corpus.rglob("*")):
         if p.is_file() and is_krl_file(p):

@@ -17,6 +17,7 @@ from pathlib import Path
 import pytest
 
 from krl.syntax.parse import parse_text
+from krl.survey.report import known_invalid
 
 REFERENCE = Path(__file__).resolve().parents[2].parent / "shared" / "docs" / "krl-reference.md"
 
@@ -104,7 +105,6 @@ def test_pulse_is_a_routine_name():
 def test_no_valid_file_declares_a_keyword(shared_corpus):
     """The evidence for the split: no file outside corpus/known-invalid.csv declares a listed
     word (other than PULSE and the attribute words) as a variable or parameter name."""
-    from krl.survey.report import known_invalid
     invalid = known_invalid()
     words = set(KEYWORDS) - NOT_RESERVED - ATTRIBUTE_NAMES
     header = re.compile(r"^\s*(?:GLOBAL\s+)?DEF(?:FCT\s+\S+)?\s+\w+\s*\((.*)\)", re.IGNORECASE)

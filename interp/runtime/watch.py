@@ -1,0 +1,123 @@
+"""When an interrupt condition must be evaluated again (reference §5.16, "the condition is
+monitored"; issue 39).
+
+An armed interrupt's condition is polled at every statement boundary and every IPO cycle of
+its task (interp/runtime/core.py ``check_interrupts``); a rising edge makes it pending. Its
+value can only change when something it reads changes, so each condition gets a *watch*
+class from the names it reads (the front end's accesses, krl/semantics/advance.py
+:func:`~krl.semantics.advance.reads`, and each name's Storage from the resolver):
+
+* :data:`CONSTANT` — it reads nothing that changes in a run: literals and the constant
+  system variables (interp/runtime/sysvars.py ``CONSTANT_NAMES``: ``$STOPMESS``,
+  ``$ALARM_STOP``, ...). Its value is the one taken at ``INTERRUPT ON``.
+* :data:`IO` — it reads also ``$IN``, ``$OUT``, ``$ANIN``, ``$ANOUT`` or a SIGNAL over one
+  of them: evaluated again when the I/O image changed (robot/io.py ``IOImage.version``).
+* :data:`CLOCK` — it reads a timer (``$TIMER``, ``$TIMER_FLAG``, ``$TIMER_STOP``, a SIGNAL
+  over another live array): evaluated again when the I/O image changed or the simulated
+  time advanced (a running timer counts with the clock).
+* *probed* names — computed scalar system variables of the run's state (sysvars.py
+  ``PROBED_NAMES``: ``$PRO_STATE1``, ``$PRO_MOVE``, ``$MODE_OP``, ...) add to any class their
+  current values, read at each poll straight from the system variable (no evaluation of the
+  condition): the watch string is ``CLASS:NAME,NAME``.
+* :data:`ALWAYS` — anything else (a variable, a stored or structured system variable such as
+  ``$FLAG``, ``$CYCFLAG``, ``$POS_ACT``, a function call, a name the resolver did not place):
+  evaluated at every poll, as before.
+
+:func:`stamp_key` gives the key a poll compares with the key of the condition's last
+evaluation: equal keys mean every value the condition reads is the same, so the poll keeps
+its value (no edge). The meaning and the traces are those of evaluating at every poll.
+"""
+
+from __future__ import annotations
+
+from krl.ast import nodes as N
+from krl.semantics.advance import reads
+from krl.semantics.builtins import load_builtins
+from krl.semantics.resolve import SYSTEM
+
+from .sysvars import CONSTANT_NAMES, PROBED_NAMES
+
+CONSTANT, IO, CLOCK, ALWAYS = "K", "I", "T", ""
+_ORDER = {CONSTANT: 0, IO: 1, CLOCK: 2, ALWAYS: 3}
+_IO_ARRAYS = frozenset({"$IN", "$OUT", "$ANIN", "$ANOUT"})
+_CLOCK_ARRAYS = frozenset({"$TIMER", "$TIMER_FLAG", "$TIMER_STOP"})
+
+
+def system_watch(name: str) -> str:
+    """The watch class of system variable `name` (any case)."""
+    key = name.upper()
+    if key not in load_builtins().sysvars:
+        return ALWAYS                 # a data list's value (SysVars._unsimulated): a variable
+    if key in CONSTANT_NAMES:
+        return CONSTANT
+    if key in _IO_ARRAYS:
+        return IO
+    if key in _CLOCK_ARRAYS:
+        return CLOCK
+    return ALWAYS
+
+
+def _name_watch(node: N.Name, probes: list) -> str:
+    place = getattr(node.ann, "place", None) if node.ann is not None else None
+    if place is None:
+        return ALWAYS
+    if place.kind == SYSTEM:
+        key = place.name.upper()
+        if key in PROBED_NAMES and key in load_builtins().sysvars:
+            if key not in probes:
+                probes.append(key)
+            return CONSTANT
+        return system_watch(key)
+    sym = place.symbol
+    if sym is not None and sym.kind == "signal":
+        decl = sym.decl
+        start = getattr(decl, "start", None)
+        if isinstance(decl, N.SignalDecl) and start is not None:
+            return IO if start.sysvar.upper() in _IO_ARRAYS else CLOCK
+    return ALWAYS
+
+
+def watch_of(expr) -> str:
+    """The watch class of condition `expr` (a resolved expression AST; module docstring)."""
+    worst = CONSTANT
+    probes: list = []
+    for mode, node in reads(expr):
+        w = ALWAYS if mode != "r" else _name_watch(node, probes)
+        if _ORDER[w] > _ORDER[worst]:
+            worst = w
+            if worst == ALWAYS:
+                return ALWAYS
+    return worst + (":" + ",".join(probes) if probes else "")
+
+
+def split_watch(watch: str) -> tuple[str, tuple[str, ...]]:
+    """``(class, probed system variable names)`` of a watch string."""
+    cls, _, names = watch.partition(":")
+    return cls, tuple(names.split(",")) if names else ()
+
+
+def watch_of_decl(st) -> str:
+    """The watch class of INTERRUPT DECL `st`'s condition (``st.when``), kept on its
+    annotation (``st.ann.extra["watch"]``) after the first call."""
+    ann = st.annotate()
+    w = ann.extra.get("watch")
+    if w is None:
+        w = ann.extra["watch"] = watch_of(st.when)
+    return w
+
+
+def stamp_key(watch: str, io_version: int, now: float, probes=()):
+    """The key of a condition of class `watch` (without probes) at a poll that sees the I/O
+    image at `io_version`, the simulated time `now` (s) and the probed system variables'
+    readers `probes` (zero-argument callables); None: evaluate (class ALWAYS)."""
+    if watch == CONSTANT:
+        key = 0
+    elif watch == IO:
+        key = io_version
+    elif watch == CLOCK:
+        key = (io_version, now)
+    else:
+        return None
+    if probes:
+        return (key, tuple(p() for p in probes))
+    return key

@@ -1,0 +1,150 @@
+"""When interrupt conditions are evaluated again (interp/runtime/watch.py, issue 39): the
+class each condition gets from the names it reads, the evaluations it saves, and the oracle —
+the same traces as evaluating every condition at every poll (stamp_key patched to None)."""
+
+from __future__ import annotations
+
+import pytest
+
+import interp.runtime.contexts as contexts
+from interp.runtime.contexts import InterruptTable, Irq
+
+from .helpers import run_krl
+
+DAT = """
+DEFDAT prog
+  DECL INT N1 = 0
+  DECL INT N2 = 0
+  DECL INT N3 = 0
+  DECL INT N4 = 0
+  DECL INT N5 = 0
+  DECL BOOL GO = FALSE
+ENDDAT
+"""
+
+#: every kind of condition: constant, an input, an output the handlers write, a timer, the
+#: motion state, a variable, a SIGNAL group; stimuli toggle the input, handlers toggle outputs
+PROG = """
+DEF prog()
+  SIGNAL GRP $IN[5] TO $IN[6]
+  GLOBAL INTERRUPT DECL 3 WHEN $STOPMESS==TRUE DO Never()
+  GLOBAL INTERRUPT DECL 10 WHEN $IN[3] AND NOT $OUT[7] DO OnIn()
+  GLOBAL INTERRUPT DECL 11 WHEN $TIMER_FLAG[1] DO OnTimer()
+  GLOBAL INTERRUPT DECL 12 WHEN $PRO_MOVE == TRUE DO OnMove()
+  GLOBAL INTERRUPT DECL 13 WHEN GO DO OnGo()
+  GLOBAL INTERRUPT DECL 14 WHEN GRP == 3 DO OnGrp()
+  INTERRUPT ON
+  $TIMER[1] = -100
+  $TIMER_STOP[1] = FALSE
+  PTP {A1 10, A2 -90, A3 90, A4 0, A5 0, A6 0}
+  PTP {A1 -10, A2 -90, A3 90, A4 0, A5 0, A6 0}
+  GO = TRUE
+  WAIT SEC 0.2
+  GO = FALSE
+  $OUT[7] = FALSE
+  GO = TRUE
+  WAIT SEC 0.6
+END
+DEF Never()
+  N1 = N1 + 100
+END
+DEF OnIn()
+  N1 = N1 + 1
+  $OUT[7] = TRUE
+END
+DEF OnTimer()
+  N2 = N2 + 1
+  $TIMER[1] = -50
+END
+DEF OnMove()
+  N3 = N3 + 1
+END
+DEF OnGo()
+  N4 = N4 + 1
+END
+DEF OnGrp()
+  N5 = N5 + 1
+END
+"""
+
+STIMULI = """stimuli:
+  - at: 0.05
+    set: {"$IN[3]": true}
+  - at: 0.3
+    set: {"$IN[3]": false}
+  - at: 0.5
+    set: {"$IN[3]": true, "$IN[5]": true}
+  - at: 0.9
+    set: {"$IN[6]": true}
+"""
+
+
+def _run(tmp_path, interp):
+    return run_krl(tmp_path, PROG, DAT, stimuli=STIMULI, interp=interp)
+
+
+def test_each_condition_gets_its_class(tmp_path):
+    r = _run(tmp_path, "tree")
+    irqs = r.rt.robot.irqs.irqs
+    got = {n: (irqs[n].watch, len(irqs[n].probes)) for n in (3, 10, 11, 12, 13, 14)}
+    assert got == {3: ("K", 0), 10: ("I", 0), 11: ("T", 0), 12: ("K", 1), 13: ("", 0), 14: ("I", 0)}
+
+
+@pytest.mark.parametrize("interp", ["tree", "vm"])
+def test_the_trace_is_that_of_evaluating_at_every_poll(tmp_path, monkeypatch, interp):
+    watched = _run(tmp_path, interp)
+    monkeypatch.setattr(contexts, "stamp_key", lambda *a, **k: None)
+    every = _run(tmp_path, interp)
+    assert watched.result.reason == every.result.reason == "completed"
+    assert watched.events == every.events
+    n = {k: watched.var("prog", k) for k in ("N1", "N2", "N3", "N4", "N5")}
+    # each condition rose: the input twice (the handler's $OUT[7] masks it until reset), the
+    # timer at least twice (the handler restarts it), the motion state, GO twice, the group
+    assert n["N1"] == 2 and n["N2"] >= 2 and n["N3"] >= 1 and n["N4"] == 2 and n["N5"] == 1
+    assert n == {k: every.var("prog", k) for k in n}
+
+
+def _table(watch, probes=()):
+    calls = []
+    t = InterruptTable()
+    t.declare(Irq(7, lambda: calls.append(1) or False, lambda: None, "H", None, watch=watch, probes=probes))
+    return t, calls
+
+
+def test_a_constant_condition_is_evaluated_once_per_on():
+    t, calls = _table("K")
+    t.control("ON", 7, io_version=1, now=0.0)
+    for k in range(100):
+        t.poll(io_version=k, now=k * 0.012)
+    assert len(calls) == 1
+
+
+def test_an_io_condition_is_evaluated_when_the_image_changed():
+    t, calls = _table("I")
+    t.control("ON", 7, io_version=1, now=0.0)
+    for k in range(100):
+        t.poll(io_version=1 + k // 10, now=k * 0.012)
+    assert len(calls) == 10            # at ON, then once per new version (2..10)
+
+
+def test_a_clock_condition_is_evaluated_once_per_cycle():
+    t, calls = _table("T")
+    t.control("ON", 7, io_version=1, now=0.0)
+    for k in range(100):
+        t.poll(io_version=1, now=(k // 4) * 0.012)     # four polls per cycle
+    assert len(calls) == 25
+
+
+def test_a_probed_condition_follows_its_values_and_others_every_poll():
+    state = {"v": 0}
+    t, calls = _table("K", probes=(lambda: state["v"],))
+    t.control("ON", 7)
+    for k in range(30):
+        state["v"] = k // 10
+        t.poll()
+    assert len(calls) == 3             # at ON (0), then 1 and 2
+    t, calls = _table("")
+    t.control("ON", 7)
+    for _ in range(30):
+        t.poll()
+    assert len(calls) == 31
