@@ -14,7 +14,6 @@ fused multiply-add, so C gives the products and sums Python gives).
 
 from __future__ import annotations
 
-import os
 import sys
 import sysconfig
 from pathlib import Path
@@ -58,29 +57,9 @@ def build(force: bool = False) -> str:
     out = target()
     if not force and out.exists() and out.stat().st_mtime >= SOURCE.stat().st_mtime:
         return f"{out.name} is up to date"
-    try:  # optional build tools, which load only for a build
-        from Cython.Build import cythonize  # noqa: PLC0415
-        from setuptools import Distribution  # noqa: PLC0415
-        from setuptools.command.build_ext import build_ext  # noqa: PLC0415
-    except ImportError as e:
-        return f"not compiled ({e.name} is not installed): the pure-Python inverse kinematics runs"
-    tmp = REPO / "build" / "cython"
-    try:
-        exts = cythonize([extension()], build_dir=str(tmp), quiet=True, force=True,
-                         compiler_directives={"language_level": 3})
-        dist = Distribution({"name": "krl-sim-core", "ext_modules": exts})
-        cmd = build_ext(dist)
-        cmd.build_lib = str(tmp / "lib")
-        cmd.build_temp = str(tmp / "temp")
-        cmd.ensure_finalized()
-        cmd.run()
-    except Exception as e:  # noqa: BLE001  (no compiler, no Python headers: the fallback runs)
-        return f"not compiled ({type(e).__name__}: {e}): the pure-Python inverse kinematics runs"
-    built = tmp / "lib" / "robot" / out.name
-    if not built.is_file():
-        return "not compiled (the C compiler failed): the pure-Python inverse kinematics runs"
-    os.replace(built, out)   # a rename: a process that has the old one loaded keeps it
-    return f"compiled {out.relative_to(REPO)}"
+    from krl.cbuild import build_in_place  # noqa: PLC0415  (setup.py loads this file by path: krl is not importable there)
+
+    return build_in_place(extension(), out, REPO, "krl-sim-core", "the pure-Python inverse kinematics runs")
 
 
 def main(argv: list[str] | None = None) -> int:

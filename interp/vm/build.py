@@ -17,7 +17,6 @@ build is skipped when the extension is newer than loop.py and loop.pxd.
 
 from __future__ import annotations
 
-import os
 import sys
 import sysconfig
 from pathlib import Path
@@ -64,29 +63,9 @@ def build(force: bool = False) -> str:
     out = target()
     if not force and out.exists() and all(out.stat().st_mtime >= s.stat().st_mtime for s in SOURCES):
         return f"{out.name} is up to date"
-    try:  # optional build tools, which load only for a build
-        from Cython.Build import cythonize  # noqa: PLC0415
-        from setuptools import Distribution  # noqa: PLC0415
-        from setuptools.command.build_ext import build_ext  # noqa: PLC0415
-    except ImportError as e:
-        return f"not compiled ({e.name} is not installed): the VM runs the pure-Python loop.py"
-    tmp = REPO / "build" / "cython"
-    try:
-        exts = cythonize([extension()], build_dir=str(tmp), quiet=True, force=True,
-                         compiler_directives={"language_level": 3})
-        dist = Distribution({"name": "krl-vm-loop", "ext_modules": exts})
-        cmd = build_ext(dist)
-        cmd.build_lib = str(tmp / "lib")
-        cmd.build_temp = str(tmp / "temp")
-        cmd.ensure_finalized()
-        cmd.run()
-    except Exception as e:  # noqa: BLE001  (no compiler, no Python headers: the fallback runs)
-        return f"not compiled ({type(e).__name__}: {e}): the VM runs the pure-Python loop.py"
-    if not (tmp / "lib" / "interp" / "vm" / out.name).is_file():   # optional: the compile failed
-        return "not compiled (the C compiler failed): the VM runs the pure-Python loop.py"
-    # a rename, not a copy over the old file: a process that has the old one loaded keeps it
-    os.replace(tmp / "lib" / "interp" / "vm" / out.name, out)
-    return f"compiled {out.relative_to(REPO)}"
+    from krl.cbuild import build_in_place  # noqa: PLC0415  (setup.py loads this file by path: krl is not importable there)
+
+    return build_in_place(extension(), out, REPO, "krl-vm-loop", "the VM runs the pure-Python loop.py")
 
 
 def main(argv: list[str] | None = None) -> int:
