@@ -56,7 +56,6 @@ A run with a debugger attached (statement, step or cycle hooks) never fast-forwa
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 from .values import UNSET, Arr, EnumValue, Struct
 
@@ -133,16 +132,6 @@ def state_of(rt) -> tuple:
     return (mods, tuple(tasks), sysvars, ioimg, rt.msg_handle)
 
 
-@dataclass
-class _Marks:
-    """What changes without being state: counters and the robot's axes, read at the start of
-    a window."""
-
-    io: int
-    clock: int
-    axes: tuple
-
-
 class IdleWatch:
     """The idle detector of one run (module docstring). The scheduler calls :meth:`cycle`
     after the tasks of an IPO cycle ran and before the controller steps; it returns the
@@ -153,7 +142,7 @@ class IdleWatch:
         self.clock = 0               # clock and random reads (clock_read)
         self.window = WINDOW_CYCLES
         self.start: int | None = None    # cycle at which the quiet window began
-        self.marks: _Marks | None = None
+        self.marks: tuple | None = None  # (I/O changes, clock reads, planned axes, axes) at its start
         self.state = None
         self.since: float | None = None  # s: the run has been idle since (None: it is not)
         self.skipped = 0             # cycles skipped in the run
@@ -170,9 +159,12 @@ class IdleWatch:
         any change of state, so the quiet window starts again."""
         self.clock += 1
 
-    def _marks(self) -> _Marks:
+    def _marks(self) -> tuple:
+        """What changes without being state, read every cycle of a quiet window: the count of
+        I/O changes and of clock reads, the end point of the last planned motion and the
+        robot's axes (deg)."""
         ctl = self.rt.controller
-        return _Marks(len(ctl.io.log), self.clock, tuple(ctl.planned_axes().tolist()) + tuple(ctl._q.tolist()))
+        return (len(ctl.io.log), self.clock, ctl._plan_q.tolist(), ctl._q.tolist())
 
     def _quiet(self) -> bool:
         rt = self.rt
