@@ -244,10 +244,10 @@ class Controller:
         self.model.check_limits(q)
         self._arm = None
         self.actuated = actuated
-        if mujoco:
-            from .mjcf import ArmModel
-            self._arm = ArmModel(self.machine, actuated=actuated)
-            self._arm.reset(q)
+        # the MuJoCo arm (robot/mjcf.py ArmModel) is compiled at its first use (_arm_model), reset
+        # to the axes it stands at then: a debugger's launch and first stop do not wait for
+        # MuJoCo's import and compile (issue 37); None: built, or no MuJoCo
+        self._arm_q: np.ndarray | None = q.copy() if mujoco else None
         self._k = 0
         self._pt = 0.0
         self._scale = 1.0
@@ -282,6 +282,17 @@ class Controller:
         # `axes` (A1..A6 deg) and `cart` (X, Y, Z mm, A, B, C deg in $BASE); None: none
         self.correction = None
         self._q_raw = self._q.copy()
+
+    def _arm_model(self):
+        """The MuJoCo arm, compiled now (its first use) and reset to the axes it would have
+        been reset to when built at once (the start axes, or :meth:`place`'s): the same state."""
+        if self._arm_q is not None:
+            from .mjcf import ArmModel  # noqa: PLC0415 - MuJoCo at the arm's first use (issue 37)
+
+            arm = ArmModel(self.machine, actuated=self.actuated)
+            arm.reset(self._arm_q)
+            self._arm, self._arm_q = arm, None
+        return self._arm
 
     # ================================================================= clock
     @property
@@ -391,7 +402,9 @@ class Controller:
         self._q = q.copy()
         self._q_prev = q.copy()
         self._plan_q = q.copy()
-        if self._arm is not None:
+        if self._arm_q is not None:
+            self._arm_q = q.copy()
+        elif self._arm is not None:
             self._arm.reset(q)
         self._tcp_T = self.model.tcp(self._q, self._tool_T, self._base_inv_T)
         self._tcp_prev = self._tcp_T[:3, 3].copy()
@@ -615,8 +628,9 @@ class Controller:
     def axis_act(self) -> np.ndarray:
         """``$AXIS_ACT``: A1..A6 (deg) read back from the MuJoCo model, shape (6,); then E1..En
         (mm, deg) on a robot with external axes."""
-        if self._arm is not None:
-            return self._arm.axes_deg()
+        arm = self._arm if self._arm_q is None else self._arm_model()
+        if arm is not None:
+            return arm.axes_deg()
         return self._q.copy()
 
     def axis_setpoint(self) -> np.ndarray:
@@ -646,8 +660,9 @@ class Controller:
     def _tcp_read_back(self, q: np.ndarray, tool_T: np.ndarray, base_inv_T: np.ndarray) -> np.ndarray:
         """TCP in $BASE from the MuJoCo flange site (``INV_POS($BASE) : FLANGE_world : $TOOL``),
         or from the forward kinematics of ``q`` without MuJoCo."""
-        if self._arm is not None:
-            return base_inv_T @ self._arm.flange_pose_world() @ tool_T
+        arm = self._arm if self._arm_q is None else self._arm_model()
+        if arm is not None:
+            return base_inv_T @ arm.flange_pose_world() @ tool_T
         return self.model.tcp(q, tool_T, base_inv_T)
 
     def vel_act(self) -> float:
@@ -738,11 +753,12 @@ class Controller:
             self._hold()
         if self._tracked:
             self._fire_triggers(self._pt)
-        if self._arm is not None:
+        arm = self._arm if self._arm_q is None else self._arm_model()
+        if arm is not None:
             if self.actuated:
-                self._arm.step_actuated(self._q, self.dt, (self._q - self._q_prev) / self.dt)
+                arm.step_actuated(self._q, self.dt, (self._q - self._q_prev) / self.dt)
             else:
-                self._arm.set_axes(self._q)
+                arm.set_axes(self._q)
         qa = self.axis_act()
         self._tcp_prev = self._tcp_T[:3, 3].copy()
         self._tcp_T = self._tcp_read_back(qa, self._tool_T, self._base_inv_T)

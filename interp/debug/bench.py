@@ -52,6 +52,14 @@ def largest_backup() -> Path | None:
     return Path(max(sized)[1]) if sized else None
 
 
+#: Python's compiled bytecode as an installed tool has it: written (an environment that sets
+#: PYTHONDONTWRITEBYTECODE would compile every changed module of the checkout at each start),
+#: under a directory of the benchmark's own (nothing written into the checkouts); the warm-up
+#: run fills it
+BYTECODE = {"PYTHONDONTWRITEBYTECODE": "",
+            "PYTHONPYCACHEPREFIX": str(Path(tempfile.gettempdir()) / f"krl-debug-bench-pycache-{os.getuid()}")}
+
+
 def cpu_seconds(pid: int) -> float:
     """User + system time of process `pid` and its waited-for children (Linux /proc; NaN
     elsewhere)."""
@@ -65,6 +73,7 @@ def cpu_seconds(pid: int) -> float:
 
 def sample(program: Path, workspace: Path, root: Path, python: str | None, env: dict | None) -> tuple:
     """(start s, launch s, entry s, CPU s, launch CPU s) of one fresh krl debug process."""
+    env = {**BYTECODE, **(env or {})}
     t0 = time.perf_counter()
     with DapClient(timeout=600, root=root, python=python, env=env) as c:
         c.initialize()

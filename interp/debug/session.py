@@ -26,10 +26,12 @@ from .wire import ProtocolError, read_message, write_message
 
 def _prepare() -> None:
     """Import what a launch needs (the simulated controller, the interpreters) while the
-    client starts the session: the launch request then finds them loaded."""
+    client starts the session: the launch request then finds them loaded. Not MuJoCo: the
+    controller compiles the arm at its first use (robot/controller.py ``_arm_model``), after
+    the launch."""
     import importlib  # noqa: PLC0415
 
-    for name in ("interp.run", "robot.controller", "interp.tree", "mujoco", "interp.debug.launch"):
+    for name in ("interp.run", "robot.controller", "interp.tree", "interp.debug.launch"):
         try:
             importlib.import_module(name)
         except Exception:  # noqa: BLE001 - the launch imports it again and says what is wrong
