@@ -56,7 +56,6 @@ A run with a debugger attached (statement, step or cycle hooks) never fast-forwa
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 from .values import UNSET, Arr, EnumValue, Struct
 
@@ -68,23 +67,41 @@ MAX_WINDOW_CYCLES = 512
 MAX_PHASES = 64
 
 _SCALARS = (int, float, bool, str, type(None))
+#: classes of the immutable leaf values: a sequence of only these is its own image (freeze)
+_FLAT = frozenset((int, float, bool, str, type(None), EnumValue, type(UNSET)))
 
 
 def freeze(v):
     """A comparable, hashable image of a KRL value (:mod:`interp.runtime.values`): scalars as
-    they are, structures and arrays as nested tuples, enum values by name."""
+    they are, structures and arrays as nested tuples, enum values by name.
+
+    A structure or array whose elements are all immutable leaves (:data:`_FLAT`: scalars, enum
+    values, UNSET) is imaged by a plain copy of its elements (one C-level pass): two such
+    images are equal exactly when the element-wise images are, and an image of this kind never
+    equals one with a nested image, as the element-wise images would not."""
     c = v.__class__
     if c in _SCALARS:
         return v
     if c is Struct:
-        return (1, tuple((k, freeze(x)) for k, x in v.f.items()))
+        f = v.f
+        if _FLAT.issuperset(map(type, f.values())):
+            return (1, tuple(f.items()))
+        return (1, tuple([(k, freeze(x)) for k, x in f.items()]))
     if c is Arr:
-        return (2, tuple([x if x.__class__ in _SCALARS else freeze(x) for x in v.data]))
+        d = v.data
+        if _FLAT.issuperset(map(type, d)):
+            return (2, tuple(d))
+        return (2, tuple([x if x.__class__ in _SCALARS else freeze(x) for x in d]))
     if c is EnumValue:
         return (3, v.name)
     if v is UNSET:
         return (4,)
     return (5, id(v))
+
+
+def _store(store) -> tuple:
+    """The image of a frame's or a data list's slots (their values by :func:`freeze`)."""
+    return tuple([x if x.__class__ in _SCALARS else freeze(x) for x in store])
 
 
 def _frames(task):
@@ -99,32 +116,20 @@ def state_of(rt) -> tuple:
     tasks in their loops (see the module docstring): data lists, frames, system variables,
     I/O image, interrupt tables, contexts and waits."""
     prog = rt.program
-    mods = tuple(tuple([x if x.__class__ in _SCALARS else freeze(x) for x in m.store])
-                 for m in prog.modules if m.loaded)
+    mods = tuple([_store(m.store) for m in prog.modules if m.loaded])
     tasks = []
     for t in rt.scheduler.tasks:
-        frames = tuple(tuple([x if x.__class__ in _SCALARS else freeze(x) for x in f.store])
-                       for f in _frames(t))
+        frames = tuple([_store(f.store) for f in _frames(t)])
         irqs = tuple((n, i.on, i.enabled, i.last, i.pending, id(i.frame))
                      for n, i in sorted(t.irqs.irqs.items()))
         tasks.append((t.done, t.waiting, len(t.contexts), frames, irqs, t.err_text))
     sv = rt.sysvars.store
-    sysvars = tuple((k, v if v.__class__ in _SCALARS else freeze(v)) for k, v in sv.items())
+    sysvars = tuple([(k, v if v.__class__ in _SCALARS else freeze(v)) for k, v in sv.items()])
     io = rt.controller.io
     timers = tuple(ms if stop else None for ms, stop in zip(io.timer_ms, io.timer_stop))
     ioimg = (bytes(io._in), bytes(io._out), tuple(io._anin), tuple(io._anout),
              tuple(io.timer_stop), timers)
     return (mods, tuple(tasks), sysvars, ioimg, rt.msg_handle)
-
-
-@dataclass
-class _Marks:
-    """What changes without being state: counters and the robot's axes, read at the start of
-    a window."""
-
-    io: int
-    clock: int
-    axes: tuple
 
 
 class IdleWatch:
@@ -137,7 +142,7 @@ class IdleWatch:
         self.clock = 0               # clock and random reads (clock_read)
         self.window = WINDOW_CYCLES
         self.start: int | None = None    # cycle at which the quiet window began
-        self.marks: _Marks | None = None
+        self.marks: tuple | None = None  # (I/O changes, clock reads, planned axes, axes) at its start
         self.state = None
         self.since: float | None = None  # s: the run has been idle since (None: it is not)
         self.skipped = 0             # cycles skipped in the run
@@ -154,9 +159,12 @@ class IdleWatch:
         any change of state, so the quiet window starts again."""
         self.clock += 1
 
-    def _marks(self) -> _Marks:
+    def _marks(self) -> tuple:
+        """What changes without being state, read every cycle of a quiet window: the count of
+        I/O changes and of clock reads, the end point of the last planned motion and the
+        robot's axes (deg)."""
         ctl = self.rt.controller
-        return _Marks(len(ctl.io.log), self.clock, tuple(ctl.planned_axes().tolist()) + tuple(ctl._q.tolist()))
+        return (len(ctl.io.log), self.clock, ctl._plan_q.tolist(), ctl._q.tolist())
 
     def _quiet(self) -> bool:
         rt = self.rt
@@ -214,7 +222,7 @@ class IdleWatch:
         start, _, frames = self._robot
         if ctl.cycle - start < WINDOW_CYCLES:
             return
-        now = tuple(tuple([x if x.__class__ in _SCALARS else freeze(x) for x in f.store]) for f in _frames(robot))
+        now = tuple([_store(f.store) for f in _frames(robot)])
         if frames is None or frames != now:
             self._robot = (ctl.cycle, marks, now)
             return

@@ -171,3 +171,53 @@ def test_an_unbounded_trace_writes_every_statement(tmp_path):
     prog = write(tmp_path, "poll.src", POLL)
     _rt, res, tw = _run(prog, max_sim_time=0.12, fast=False)
     assert 2 * sum(1 for e in tw.events if e["kind"] == "stmt") in (res.steps, res.steps + 1, res.steps - 1)
+
+
+def _elementwise(v):
+    """The state image of a value built one element at a time (scalars as they are, an enum
+    value by name, UNSET as a marker, a structure or array as its elements' images): what
+    :func:`interp.runtime.idle.freeze` must agree with on equality."""
+    from interp.runtime.values import UNSET, Arr, EnumValue, Struct
+
+    if isinstance(v, Struct):
+        return ("struc", tuple((k, _elementwise(x)) for k, x in v.f.items()))
+    if isinstance(v, Arr):
+        return ("array", tuple(_elementwise(x) for x in v.data))
+    if isinstance(v, EnumValue):
+        return ("enum", v.name)
+    if v is UNSET:
+        return ("unset",)
+    return ("scalar", v)
+
+
+def test_the_state_image_of_a_value_is_equal_exactly_when_its_elements_are():
+    """freeze images a structure or array of leaves by a plain copy (the fast path of the
+    idle check): two values' images are equal exactly when their element-wise images are,
+    across leaves, enum values, UNSET, nested structures and mixed arrays."""
+    from interp.runtime.idle import freeze
+    from interp.runtime.values import UNSET, Arr, EnumValue, Struct
+
+    def arr(*xs):
+        return Arr(None, (len(xs),), list(xs))
+
+    def struc(**f):
+        return Struct(None, dict(f))
+
+    values = [
+        1, 2, 1.5, True, "A", UNSET, EnumValue("ON"), EnumValue("OFF"),
+        arr(1, 2, 3), arr(1, 2, 4), arr(1.0, 2, 3), arr(UNSET, UNSET), arr(EnumValue("ON"), 1),
+        arr(EnumValue("OFF"), 1), arr(struc(X=1.0), struc(X=2.0)), arr(struc(X=1.0), struc(X=3.0)),
+        arr(UNSET, struc(X=1.0)), arr(struc(X=UNSET), UNSET),
+        struc(X=1.0, Y=2.0), struc(X=1.0, Y=2.5), struc(X=UNSET, Y=2.0), struc(S=EnumValue("ON")),
+        struc(S=EnumValue("OFF")), struc(P=struc(X=1.0)), struc(P=struc(X=2.0)), struc(P=arr(1, 2)),
+        struc(P=arr(1, 3)), struc(X=1.0), struc(Y=1.0),
+    ]
+    # equal copies built afresh (no shared objects) must image equal too
+    twins = [
+        arr(1, 2, 3), arr(UNSET, UNSET), arr(EnumValue("ON"), 1), arr(struc(X=1.0), struc(X=2.0)),
+        struc(X=1.0, Y=2.0), struc(S=EnumValue("ON")), struc(P=struc(X=1.0)), struc(P=arr(1, 2)),
+    ]
+    allv = values + twins
+    for a in allv:
+        for b in allv:
+            assert (freeze(a) == freeze(b)) == (_elementwise(a) == _elementwise(b)), (_elementwise(a), _elementwise(b))
