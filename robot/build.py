@@ -57,7 +57,7 @@ def build(force: bool = False) -> str:
     out = target()
     if not force and out.exists() and out.stat().st_mtime >= SOURCE.stat().st_mtime:
         return f"{out.name} is up to date"
-    from krl.cbuild import build_in_place  # noqa: PLC0415  (setup.py loads this file by path: krl is not importable there)
+    from krl.cbuild import build_in_place  # noqa: PLC0415  (loads only for a build; setup.py loads this file by path, where krl is not importable)
 
     return build_in_place(extension(), out, REPO, "krl-sim-core", "the pure-Python inverse kinematics runs")
 
