@@ -1,8 +1,9 @@
 """The package build's one addition to pyproject.toml: the compiled VM loop and the simulator's
 compiled inverse kinematics (Cython), so that ``pip install``, ``pip install -e`` and the wheel
-all run them (issue 39). Their definitions live in interp/vm/build.py and robot/build.py, loaded
-here by path: the isolated build environment has setuptools and Cython (pyproject.toml
-``[build-system]``) but none of the project's own dependencies. Without Cython or a C compiler
+all run them (issue 39). Their ``Extension``s live in interp/vm/build.py and robot/build.py, the
+translation in krl/cbuild.py, all loaded here by path: the isolated build environment has
+setuptools and Cython (pyproject.toml ``[build-system]``) but none of the project's own
+dependencies. Without Cython or a C compiler
 the extensions are skipped and the pure-Python code runs."""
 
 import importlib.util
@@ -20,7 +21,8 @@ def _load(name: str, path: Path):
     return mod
 
 
+_cbuild = _load("_krl_cbuild", ROOT / "krl" / "cbuild.py")
 _vm = _load("_krl_vm_build", ROOT / "interp" / "vm" / "build.py")
 _sim = _load("_krl_sim_build", ROOT / "robot" / "build.py")
 
-setup(ext_modules=_vm.cythonized(ROOT) + _sim.cythonized(ROOT))
+setup(ext_modules=_cbuild.cythonized([_vm.extension(ROOT), _sim.extension(ROOT)]))

@@ -1,7 +1,14 @@
-"""The in-place build of a compiled hot path (issue 39): one Cython extension compiled into
-the source tree beside its module, for ``make vm-loop`` after a source changed. Used by
-interp/vm/build.py (the VM's dispatch loop) and robot/build.py (the simulator's core); the
-package build (setup.py) does not come here: it hands their ``Extension`` to setuptools.
+"""The build of the compiled hot paths (issue 39): Cython extensions of the VM's dispatch loop
+(interp/vm/build.py) and the simulator's core (robot/build.py), each compiled beside its
+module. Each of those files defines its ``Extension``; this module holds what both builds do:
+
+* :func:`cythonized`: the package build. ``setup.py`` loads this file and the two build files
+  by path (the isolated build environment has setuptools and Cython, none of the project's
+  dependencies, so this module imports nothing of the project) and gives setuptools the
+  translated extensions: ``pip install``, ``pip install -e`` (which ``make`` runs) and the
+  wheel all carry them;
+* :func:`build_in_place`: ``make vm-loop`` (``python -m interp.vm.build``, ``python -m
+  robot.build``) after a source changed.
 
 Nothing here raises for missing build tools: without Cython, setuptools or a C compiler the
 outcome says so and the pure-Python module stays the one that runs.
@@ -12,23 +19,38 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
+#: Cython's options for every extension
+DIRECTIVES = {"language_level": 3}
 
-def build_in_place(extension, out: Path, repo: Path, name: str, fallback: str) -> str:
-    """Compile ``extension`` (a setuptools ``Extension`` named ``pkg.sub.mod``) with Cython
-    (``language_level`` 3) under ``repo/build/cython`` and move the module to ``out``; the
-    outcome in words: ``compiled PATH``, or ``not compiled (why): `` + ``fallback``.
-    ``name`` is the throwaway distribution's name."""
+
+def cythonized(extensions: list, build_dir: str = "build/cython", force: bool = False) -> list:
+    """``extensions`` (setuptools ``Extension``s, ``optional``) translated to C by Cython, or
+    ``[]`` without Cython: then nothing is compiled and the pure-Python modules run."""
+    try:
+        from Cython.Build import cythonize  # noqa: PLC0415  (optional; loads only for a build)
+    except ImportError:
+        return []
+    return cythonize(extensions, build_dir=build_dir, quiet=True, force=force,
+                     compiler_directives=DIRECTIVES)
+
+
+def build_in_place(extension, out: Path, sources, repo: Path, fallback: str, force: bool = False) -> str:
+    """Compile ``extension`` (named ``pkg.sub.mod``) under ``repo/build/cython`` and move the
+    module to ``out``, unless ``out`` is newer than every one of ``sources`` (``force``
+    rebuilds); the outcome in words: ``NAME is up to date``, ``compiled PATH``, or
+    ``not compiled (why): `` + ``fallback``."""
+    if not force and out.exists() and all(out.stat().st_mtime >= Path(s).stat().st_mtime for s in sources):
+        return f"{out.name} is up to date"
     try:  # optional build tools, which load only for a build
-        from Cython.Build import cythonize  # noqa: PLC0415
+        from Cython.Build import cythonize  # noqa: PLC0415, F401
         from setuptools import Distribution  # noqa: PLC0415
         from setuptools.command.build_ext import build_ext  # noqa: PLC0415
     except ImportError as e:
         return f"not compiled ({e.name} is not installed): {fallback}"
     tmp = repo / "build" / "cython"
     try:
-        exts = cythonize([extension], build_dir=str(tmp), quiet=True, force=True,
-                         compiler_directives={"language_level": 3})
-        dist = Distribution({"name": name, "ext_modules": exts})
+        exts = cythonized([extension], build_dir=str(tmp), force=True)
+        dist = Distribution({"name": extension.name.replace(".", "-"), "ext_modules": exts})
         cmd = build_ext(dist)
         cmd.build_lib = str(tmp / "lib")
         cmd.build_temp = str(tmp / "temp")

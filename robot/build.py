@@ -1,11 +1,13 @@
 """Build the compiled inverse kinematics of the simulator: robot/simcore.pyx compiled by Cython
 into an extension module beside it (``simcore.*.so``; gitignored). Issue 39, "Simulator".
 
-One definition (:func:`extension`), two ways in, as for the VM loop (interp/vm/build.py):
+One definition (:func:`extension`), two ways in, as for the VM loop (interp/vm/build.py), both
+through krl/cbuild.py:
 
-* the package build: ``setup.py`` loads this file by path and gives :func:`cythonized` to
-  setuptools, so ``pip install``, ``pip install -e`` (which ``make`` runs) and the wheel carry it;
-* ``python -m robot.build`` (``make sim-core``): rebuilds it in place after simcore.pyx changed.
+* the package build: ``setup.py`` loads this file by path and gives :func:`extension`, translated
+  by Cython, to setuptools, so ``pip install``, ``pip install -e`` (which ``make`` runs) and the
+  wheel carry it;
+* ``python -m robot.build`` (``make vm-loop``): rebuilds it in place after simcore.pyx changed.
 
 Without Cython or a C compiler the build says so and succeeds; robot/kinematics.py then runs
 its pure-Python OPW code, which the extension mirrors bit for bit (``-ffp-contract=off``: no
@@ -41,25 +43,12 @@ def extension(root: Path | None = None):
     return Extension(MODULE, [src], extra_compile_args=CFLAGS, optional=True)
 
 
-def cythonized(root: Path | None = None) -> list:
-    """:func:`extension` translated to C by Cython, or ``[]`` without Cython."""
-    try:
-        from Cython.Build import cythonize  # noqa: PLC0415  (optional; loads only for a build)
-    except ImportError:
-        return []
-    return cythonize([extension(root)], build_dir="build/cython", quiet=True,
-                     compiler_directives={"language_level": 3})
-
-
 def build(force: bool = False) -> str:
     """Compile simcore.pyx in place; the outcome in words. Raises nothing for a missing Cython
     or compiler (the pure-Python inverse runs then)."""
-    out = target()
-    if not force and out.exists() and out.stat().st_mtime >= SOURCE.stat().st_mtime:
-        return f"{out.name} is up to date"
     from krl.cbuild import build_in_place  # noqa: PLC0415  (loads only for a build; setup.py loads this file by path, where krl is not importable)
 
-    return build_in_place(extension(), out, REPO, "krl-sim-core", "the pure-Python inverse kinematics runs")
+    return build_in_place(extension(), target(), (SOURCE,), REPO, "the pure-Python inverse kinematics runs", force)
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -1,10 +1,10 @@
 """Build the compiled dispatch loop: interp/vm/loop.py compiled by Cython, with the C types of
 interp/vm/loop.pxd, into an extension module beside it (``loop.*.so``; gitignored).
 
-Two ways in, one definition (:func:`extension`):
+Two ways in, one definition (:func:`extension`), both through krl/cbuild.py:
 
 * the package build: ``setup.py`` loads this file (by path: the build environment has none of
-  the project's dependencies) and gives :func:`extension` to setuptools, so ``pip install``,
+  the project's dependencies) and gives :func:`extension`, translated by Cython, to setuptools, so ``pip install``,
   ``pip install -e`` (which ``make`` runs) and the wheel all carry the compiled loop;
 * ``python -m interp.vm.build`` (``make vm-loop``): rebuilds it in place after vm.py changed
   and loop.py was regenerated (interp/vm/gen_loop.py).
@@ -46,26 +46,12 @@ def extension(root: Path | None = None):
     return Extension(MODULE, [src], extra_compile_args=["-O2"], optional=True)
 
 
-def cythonized(root: Path | None = None) -> list:
-    """:func:`extension` translated to C by Cython (``language_level`` 3), or ``[]`` when
-    Cython is not installed: then nothing is compiled and loop.py runs."""
-    try:
-        from Cython.Build import cythonize  # noqa: PLC0415  (optional; loads only for a build)
-    except ImportError:
-        return []
-    return cythonize([extension(root)], build_dir="build/cython", quiet=True,
-                     compiler_directives={"language_level": 3})
-
-
 def build(force: bool = False) -> str:
     """Compile loop.py; the outcome in words. Raises nothing for a missing Cython or
     compiler (the pure-Python loop runs then)."""
-    out = target()
-    if not force and out.exists() and all(out.stat().st_mtime >= s.stat().st_mtime for s in SOURCES):
-        return f"{out.name} is up to date"
     from krl.cbuild import build_in_place  # noqa: PLC0415  (loads only for a build; setup.py loads this file by path, where krl is not importable)
 
-    return build_in_place(extension(), out, REPO, "krl-vm-loop", "the VM runs the pure-Python loop.py")
+    return build_in_place(extension(), target(), SOURCES, REPO, "the VM runs the pure-Python loop.py", force)
 
 
 def main(argv: list[str] | None = None) -> int:
