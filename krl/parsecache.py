@@ -114,19 +114,30 @@ def _node_hook(path: str, on: list[bool]):
 _DIAG = (int, int, str, str, str, int, int, str, list)
 
 
-def _enc_diag(d: Diagnostic) -> list:
+def _enc_diag(d: Diagnostic, note_paths: bool) -> list:
+    """A diagnostic's fields; its notes' paths only when `note_paths` (a check entry: notes
+    may point at other files). A parse entry's notes are all in its own file (encode_loaded)
+    and are stored without a path: the entry is keyed by content, and the same content at
+    another path must get notes at that path."""
     return [d.line, d.column, d.code, d.message, d.severity, d.end_line, d.end_column, d.help,
-            [[n.path, n.line, n.column, n.message] for n in d.notes]]
+            [[n.path, n.line, n.column, n.message] if note_paths else [n.line, n.column, n.message]
+             for n in d.notes]]
 
 
-def _dec_diag(x, path: str) -> Diagnostic:
+_NOTE = [str, int, int, str]
+
+
+def _dec_diag(x, path: str, note_path: str | None = None) -> Diagnostic:
+    """The diagnostic of `path` encoded by :func:`_enc_diag`; `note_path`: the path of its
+    notes when they were stored without one (a parse entry), None when each note has its own."""
     if type(x) is not list or len(x) != len(_DIAG) or not all(type(a) is t for a, t in zip(x, _DIAG)):
         raise CorruptEntry("not a diagnostic")
     notes = []
+    shape = _NOTE if note_path is None else _NOTE[1:]
     for n in x[8]:
-        if type(n) is not list or len(n) != 4 or [type(a) for a in n] != [str, int, int, str]:
+        if type(n) is not list or [type(a) for a in n] != shape:
             raise CorruptEntry("not a note")
-        notes.append(Note(*n))
+        notes.append(Note(*n) if note_path is None else Note(note_path, *n))
     return Diagnostic(path, x[0], x[1], x[2], x[3], x[4], x[5], x[6], notes, x[7])
 
 
@@ -135,7 +146,7 @@ def encode_loaded(lf: LoadedFile) -> bytes | None:
     if any(d.path != lf.path or any(n.path != lf.path for n in d.notes) for d in lf.diagnostics):
         return None
     try:
-        body = [lf.module, lf.ok, lf.status, [_enc_diag(d) for d in lf.diagnostics], lf.unreadable,
+        body = [lf.module, lf.ok, lf.status, [_enc_diag(d, False) for d in lf.diagnostics], lf.unreadable,
                 sorted(lf.failed_words), sorted(lf.template[0]), sorted(lf.template[1])]
         return msgpack.packb(body, use_bin_type=True, strict_types=True, default=_pack_default)
     except (TypeError, ValueError, OverflowError):
@@ -162,7 +173,7 @@ def decode_loaded(data: bytes, path: str) -> LoadedFile:
                 or not all(type(x) is int for x in (*ini, *inline)):
             raise CorruptEntry("not an entry")
         module.path = path
-        return LoadedFile(path, module, ok, status, 0.0, 0.0, [_dec_diag(d, path) for d in diags], unreadable,
+        return LoadedFile(path, module, ok, status, 0.0, 0.0, [_dec_diag(d, path, path) for d in diags], unreadable,
                           set(words), (frozenset(ini), frozenset(inline)))
     except CorruptEntry:
         raise
@@ -171,7 +182,7 @@ def decode_loaded(data: bytes, path: str) -> LoadedFile:
 
 
 def encode_diagnostics(diags: list[Diagnostic]) -> bytes:
-    return msgpack.packb([[d.path, *_enc_diag(d)] for d in diags], use_bin_type=True)
+    return msgpack.packb([[d.path, *_enc_diag(d, True)] for d in diags], use_bin_type=True)
 
 
 def decode_diagnostics(data: bytes) -> list[Diagnostic]:

@@ -40,7 +40,7 @@ from krl.limits import MAX_CACHE_BYTES, MAX_CACHE_ENTRY_BYTES
 log = logging.getLogger("krl.store")
 log.addHandler(logging.NullHandler())   # a command's standard error never gets it unless logging is set up
 #: the codec's name and version: part of :func:`front_end_version`
-CODEC = "krl-store 2 (msgpack by schema)"
+CODEC = "krl-store 3 (msgpack by schema; parse entries' notes without a path)"
 LOCK_WAIT_S = 5.0
 KRL_ROOT = Path(__file__).resolve().parent
 GRAMMAR = KRL_ROOT.parent / "grammar" / "KRL.g4"

@@ -249,3 +249,21 @@ def test_krl_run_from_the_store_in_another_process_gives_the_same_trace(tmp_path
     assert fresh and (tmp_path / "first.jsonl").read_bytes() == fresh
     assert (tmp_path / "stored.jsonl").read_bytes() == fresh
     assert {k: v[0] for k, v in _rows(_database(tmp_path / "cache")).items()} == {k: v[0] for k, v in rows.items()}
+
+
+def test_a_stored_parse_gives_notes_at_the_files_own_path(tmp_path):
+    """The same content at two paths is one parse entry (keyed by content): the second file's
+    diagnostics, read from the store, point their notes at the second file, not the first."""
+    text = "DEF x()\n;FOLD never closed\nx = 1\nEND\n"       # W021 at line 2, its note at the END (line 4)
+    a, b = tmp_path / "a" / "x.src", tmp_path / "b" / "x.src"
+    for f in (a, b):
+        f.parent.mkdir()
+        f.write_text(text)
+    s = store.Store(tmp_path / "cache")
+    [la] = load_files([a], store=s)
+    [lb] = load_files([b], store=s)
+    assert (s.misses, s.hits) == (1, 1)                 # b came from a's entry
+    for lf, f in ((la, a), (lb, b)):
+        [w] = [d for d in lf.diagnostics if d.code == "W021"]
+        assert (w.path, w.line) == (str(f), 2)
+        assert [(n.path, n.line) for n in w.notes] == [(str(f), 4)]

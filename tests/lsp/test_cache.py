@@ -44,7 +44,7 @@ def reference_entry(lf) -> bytes:
         assert v is None or type(v) in (int, float, str, bool), type(v)
         return v
     diags = [[d.line, d.column, d.code, d.message, d.severity, d.end_line, d.end_column, d.help,
-              [[n.path, n.line, n.column, n.message] for n in d.notes]] for d in lf.diagnostics]
+              [[n.line, n.column, n.message] for n in d.notes]] for d in lf.diagnostics]
     return msgpack.packb([enc(lf.module), lf.ok, lf.status, diags, lf.unreadable, sorted(lf.failed_words),
                           sorted(lf.template[0]), sorted(lf.template[1])], use_bin_type=True)
 
