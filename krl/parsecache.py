@@ -205,43 +205,62 @@ def decode_diagnostics(data: bytes) -> list[Diagnostic]:
 
 # ---------------------------------------------------------------------- loading through the store
 
+def read_parses(store: Store, wanted: dict) -> dict:
+    """The stored parses of `wanted` (any id -> (parse key, path)): id -> LoadedFile decoded
+    at that path, for the ids whose entry is in `store` and decodes; an entry that does not
+    decode is counted in ``store.corrupt`` and left out (the caller parses the file again).
+    The one lookup of parses for :func:`load_files` and the language server (krl/lsp/project.py)."""
+    out: dict = {}
+    if not wanted or store.db is None:
+        return out
+    data = store.get("parse", sorted({key for key, _path in wanted.values()}))
+    for i, (key, path) in wanted.items():
+        got = data.get(key)
+        if got is not None:
+            try:
+                out[i] = decode_loaded(got, path)
+            except CorruptEntry:
+                store.corrupt += 1
+    return out
+
+
+def keep_parses(store: Store, made) -> None:
+    """Put the parses `made` ((parse key, LoadedFile, outcome status) triples) in `store`:
+    only those whose parse ended (status "done", krl.pool.Outcome); a parse stopped past its
+    timeout (E005) or lost with its worker (E001) is never kept, so that one slow moment never
+    becomes a lasting error for that content in every command (docs/security.md, "The store").
+    A parse that cannot be encoded (:func:`encode_loaded`) is not kept either."""
+    if store.db is None:
+        return
+    store.put("parse", {key: e for key, lf, status in made
+                        if status == "done" and (e := encode_loaded(lf)) is not None})
+
+
 def load_files(paths: list, timeout: float | None = None, store: Store | None = None,
                jobs: int | None = None) -> list[LoadedFile]:
     """The LoadedFile of each of `paths`, in order: from the store (`store`, default the
     process's :func:`krl.store.shared_store`) by content hash, the others parsed (in worker
     processes with `timeout` seconds per file and `jobs` workers, as
     :meth:`krl.workspace.Workspace.add_files`, else here by the Python engine) and put in the
-    store. Never raises for bad content."""
+    store (:func:`keep_parses`: not those stopped). Never raises for bad content."""
     store = shared_store() if store is None else store
     sources = [read_source(p) for p in paths]
     keys = {i: parse_key(s.sha, s.path) for i, s in enumerate(sources) if s.status == "ok" and s.sha}
     out: list = [None] * len(sources)
-    if keys and store.db is not None:
-        data = store.get("parse", sorted(set(keys.values())))
-        for i, key in keys.items():
-            got = data.get(key)
-            if got is not None:
-                try:
-                    out[i] = decode_loaded(got, sources[i].path)
-                except CorruptEntry:
-                    store.corrupt += 1
+    for i, lf in read_parses(store, {i: (key, sources[i].path) for i, key in keys.items()}).items():
+        out[i] = lf
     missing = [i for i, lf in enumerate(out) if lf is None]
     if not missing:
         return out
-    failed = set()          # stopped past the timeout or a dead worker: never kept
+    status = {}
     if timeout is None:
         for i in missing:
-            out[i] = load_parsed(sources[i])
+            out[i], status[i] = load_parsed(sources[i]), "done"
     else:
         for i, o in zip(missing, load_batch([sources[i].path for i in missing], timeout, jobs)):
-            if o.status == "done":
-                out[i] = o.value
-            else:
-                out[i] = failed_load(sources[i].path, o, timeout)
-                failed.add(i)
-    if store.db is not None:
-        store.put("parse", {keys[i]: e for i in missing if i in keys and i not in failed
-                            and (e := encode_loaded(out[i])) is not None})
+            out[i] = o.value if o.status == "done" else failed_load(sources[i].path, o, timeout)
+            status[i] = o.status
+    keep_parses(store, [(keys[i], out[i], status[i]) for i in missing if i in keys])
     return out
 
 

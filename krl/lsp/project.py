@@ -6,7 +6,7 @@ one :class:`krl.workspace.Workspace`.
 
 * **Files on disk** are read once per change of their size or time stamp. Those not read yet
   are loaded together (:meth:`Project.load_files`): from the persistent parse cache
-  (krl/lsp/cache.py) by content hash, and the others parsed by the fast (Java) engine when it
+  (krl/store.py, krl/parsecache.py ``read_parses``) by content hash, and the others parsed by the fast (Java) engine when it
   runs here, in worker processes when there is enough to share out (krl/workspace.py
   ``load_batch``), else in this process.
 * **Buffers** are parsed by pieces (krl/lsp/parsing.py). A buffer that is its file as on disk
@@ -34,13 +34,14 @@ from pathlib import Path
 
 from krl.diagnostics import Diagnostic
 from krl.limits import PARSE_TIMEOUT_S
-from krl.lsp import cache as _cache
 from krl.lsp.analysis import Analysis, build_analysis, updated
 from krl.lsp.parsing import MIN_CHUNKED_LINES, ParseCache, Parsed
 from krl.lsp.paths import is_uri, norm
 from krl.lsp.roots import workspace_of
+from krl.parsecache import CorruptEntry, decode_diagnostics, encode_diagnostics, keep_parses, read_parses
 from krl.pool import default_jobs
 from krl.source import SourceText, read_source
+from krl.store import Store, check_key, parse_key
 from krl.syntax.engines import EngineUnavailable, java_answers, resolve
 from krl.workspace import failed_load, load_batch, load_parsed
 
@@ -95,10 +96,10 @@ class Project:
     :meth:`write_cache`, which the caller runs once the analysis is published (the server),
     instead of before the check (encoding 400 files: 0.3 s of CPU)."""
 
-    def __init__(self, store: _cache.Store | None = None, threaded: bool = False, defer_writes: bool = False) -> None:
+    def __init__(self, store: Store | None = None, threaded: bool = False, defer_writes: bool = False) -> None:
         self.threaded = threaded
         self.defer_writes = defer_writes
-        self.unwritten: list[tuple[str, str, object]] = []     # (parse key, path, LoadedFile) to cache
+        self.unwritten: list[tuple[str, str, object, str]] = []     # (parse key, path, LoadedFile, outcome status) to cache
         self.docs: dict[str, str] = {}          # open buffers: path -> text
         self.folders: list[Path] = []           # the editor's workspace folders
         self.parser = ParseCache()
@@ -181,25 +182,18 @@ class Project:
                 todo.append((p, stamp, pre[1] if pre is not None and pre[0] == stamp else read_source(p)))
         if not todo:
             return
-        found: dict[str, object] = {}
-        keys = {p: _cache.parse_key(src.sha, p) for p, _stamp, src in todo if src.status == "ok" and src.sha}
-        if self.store is not None:
-            data = self.store.get("parse", list(set(keys.values())))
-            for p, key in keys.items():
-                if key in data:
-                    try:
-                        found[p] = _cache.decode_loaded(data[key], p)
-                    except _cache.CorruptEntry:
-                        self.store.corrupt += 1
+        keys = {p: parse_key(src.sha, p) for p, _stamp, src in todo if src.status == "ok" and src.sha}
+        found: dict[str, object] = {} if self.store is None else \
+            read_parses(self.store, {p: (key, p) for p, key in keys.items()})
         missing = [(p, stamp, src) for p, stamp, src in todo if p not in found]
         made = self._parse_files([src for _p, _stamp, src in missing])
         if self.store is not None and made:
-            entries = [(keys[p], p, lf) for p, lf in made.items() if p in keys]
+            entries = [(keys[p], p, lf, status) for p, (lf, status) in made.items() if p in keys]
             later = self.defer_writes
             self.unwritten.extend(t for t in entries if later and t[1] not in self.docs)
             now = [t for t in entries if not later or t[1] in self.docs]   # open files: before an edit moves their lines
-            self.store.put("parse", {k: e for k, _p, lf in now if (e := _cache.encode_loaded(lf)) is not None})
-        found.update(made)
+            keep_parses(self.store, [(k, lf, status) for k, _p, lf, status in now])
+        found.update((p, lf) for p, (lf, _status) in made.items())
         for p, stamp, src in todo:
             lf = found[p]
             parsed = Parsed(p, src.text if src.status == "ok" else "", lf)
@@ -213,12 +207,13 @@ class Project:
         part = self.unwritten[:limit] if limit is not None else self.unwritten
         self.unwritten = self.unwritten[len(part):]
         if self.store is not None:
-            self.store.put("parse", {k: e for k, p, lf in part if p not in self.docs and p not in self._buffers
-                                     and (e := _cache.encode_loaded(lf)) is not None})
+            keep_parses(self.store, [(k, lf, status) for k, p, lf, status in part
+                                     if p not in self.docs and p not in self._buffers])
         return len(self.unwritten)
 
     def _parse_files(self, sources: list[SourceText]) -> dict:
-        """path -> LoadedFile for decoded files: by the fast engine when it runs here (in worker
+        """path -> (LoadedFile, outcome status: "done", or how a worker's parse was stopped:
+        krl.pool.Outcome) for decoded files: by the fast engine when it runs here (in worker
         processes past PARALLEL_BYTES), else by the Python engine, in this process."""
         if not sources:
             return {}
@@ -228,13 +223,13 @@ class Project:
             out = {}
             for src, o in zip(sources, load_batch([s.path for s in sources], PARSE_TIMEOUT_S, jobs,
                                                    threaded=self.threaded)):
-                out[src.path] = o.value if o.status == "done" else failed_load(src.path, o, PARSE_TIMEOUT_S)
+                out[src.path] = (o.value if o.status == "done" else failed_load(src.path, o, PARSE_TIMEOUT_S), o.status)
             return out
         if _java():
-            out = {src.path: load_parsed(src, raw)
+            out = {src.path: (load_parsed(src, raw), "done")
                    for _i, src, raw in java_answers(enumerate(sources), threads=jobs, trees=True)}
         else:
-            out = {src.path: load_parsed(src, None) for src in sources}
+            out = {src.path: (load_parsed(src, None), "done") for src in sources}
         if len(sources) >= IN_PROCESS_COLLECT_FILES:
             gc.collect()            # their parse trees (cyclic), once, under collector_off
         return out
@@ -310,13 +305,13 @@ class Project:
         if on_cached is not None and first and self.store is not None and self.store.db is not None:
             # the check's diagnostics from the cache before any parse is decoded: its key needs
             # only the files' content hashes
-            key = _cache.check_key(self._read_keys(files, docs, read), [(str(e.path), e.message) for e in skipped])
+            key = check_key(self._read_keys(files, docs, read), [(str(e.path), e.message) for e in skipped])
             got = self.store.get("check", [key]).get(key)
             if got is not None:
                 try:
-                    on_cached(root, _cache.decode_diagnostics(got))
+                    on_cached(root, decode_diagnostics(got))
                     cached = True
-                except _cache.CorruptEntry:
+                except CorruptEntry:
                     self.store.corrupt += 1
         if not (self.watched and self._disk_known):     # else the client says when files change
             self.load_files([f for f in files if f not in docs], read)
@@ -361,19 +356,19 @@ class Project:
         diagnostics, which are put in the cache unless `cached` (they were found already)."""
         key = None
         if not cached and self.store is not None and self.store.db is not None:
-            key = _cache.check_key([(p.path, self.content_key(p)) for p in parsed],
+            key = check_key([(p.path, self.content_key(p)) for p in parsed],
                                    [(str(e.path), e.message) for e in skipped])
             if on_cached is not None:
                 got = self.store.get("check", [key]).get(key)
                 if got is not None:
                     try:
-                        on_cached(root, _cache.decode_diagnostics(got))
+                        on_cached(root, decode_diagnostics(got))
                         key = None              # kept already
-                    except _cache.CorruptEntry:
+                    except CorruptEntry:
                         self.store.corrupt += 1
         an = build_analysis(root, parsed, skipped)
         if key is not None:
-            self.store.put("check", {key: _cache.encode_diagnostics(an.ws.diagnostics)})
+            self.store.put("check", {key: encode_diagnostics(an.ws.diagnostics)})
         return an
 
     def _recheck(self, root: str, files: list[str], parsed: list[Parsed], skipped) -> Analysis | None:

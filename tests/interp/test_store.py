@@ -267,3 +267,44 @@ def test_a_stored_parse_gives_notes_at_the_files_own_path(tmp_path):
         [w] = [d for d in lf.diagnostics if d.code == "W021"]
         assert (w.path, w.line) == (str(f), 2)
         assert [(n.path, n.line) for n in w.notes] == [(str(f), 4)]
+
+
+def _stopped(paths, timeout, jobs=None, threaded=False):
+    """load_batch as when each file's worker was stopped: the first past its timeout, the others
+    lost with their worker (krl.pool.Outcome)."""
+    from krl.pool import Outcome  # noqa: PLC0415
+    return [Outcome(p, "timeout" if i == 0 else "internal_error", None, "the worker process died (SIGKILL)")
+            for i, p in enumerate(paths)]
+
+
+@pytest.mark.parametrize("way", ["language server", "krl check"])
+def test_a_stopped_parse_is_never_stored(tmp_path, monkeypatch, way):
+    """A parse stopped past its timeout (E005) or lost with its worker (E001) is shown for what
+    it is, and never kept: the next load of the same content parses it (docs/security.md)."""
+    import krl.lsp.project as project_mod  # noqa: PLC0415
+    import krl.parsecache as parsecache  # noqa: PLC0415
+    root = tmp_path / "KRC"
+    import shutil
+    shutil.copytree(BACKUP, root)
+    files = sorted(norm(p) for p in root.rglob("*") if p.suffix.lower() in (".src", ".dat", ".sub"))
+    assert len(files) >= 2
+    s = store.Store(tmp_path / "cache")
+    if way == "language server":        # its worker path (a big workspace parsed by the fast engine)
+        monkeypatch.setattr(project_mod, "load_batch", _stopped)
+        monkeypatch.setattr(project_mod, "_java", lambda: True)
+        monkeypatch.setattr(project_mod, "PARALLEL_BYTES", 0)
+        monkeypatch.setattr(project_mod, "default_jobs", lambda: 2)
+        p = Project(store=s)
+        p.load_files(files)
+        got = [p._disk[f][1].loaded for f in files]
+    else:
+        monkeypatch.setattr(parsecache, "load_batch", _stopped)
+        got = load_files(files, timeout=1.0, store=s)
+    codes = [[d.code for d in lf.diagnostics] for lf in got]
+    assert codes == [["E005"]] + [["E001"]] * (len(files) - 1)
+    assert s.db.execute("SELECT COUNT(*) FROM entries WHERE kind = 'parse'").fetchone()[0] == 0
+    monkeypatch.undo()
+    again = store.Store(tmp_path / "cache")
+    fresh = load_files(files, store=again)
+    assert again.hits == 0 and again.misses == len(files)
+    assert all(not any(d.code in ("E001", "E005") for d in lf.diagnostics) for lf in fresh)

@@ -178,7 +178,7 @@ def test_deferred_parse_entries_are_written_later_and_open_files_at_once(tmp_pat
     an = first.analyze(main)
     count = lambda: store.db.execute("SELECT COUNT(*) FROM entries WHERE kind = 'parse'").fetchone()[0]  # noqa: E731
     assert count() == 1                                 # main.src, the open file
-    assert sorted(p for _k, p, _lf in first.unwritten) == sorted(set(an.files) - {main})
+    assert sorted(p for _k, p, _lf, _status in first.unwritten) == sorted(set(an.files) - {main})
     first.open(tools, Path(tools).read_text())          # opened before its entry is written
     assert first.write_cache(1) == len(an.files) - 2
     assert first.write_cache() == 0 and not first.unwritten
