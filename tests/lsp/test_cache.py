@@ -1,4 +1,4 @@
-"""The language server's persistent parse and check cache (krl/lsp/cache.py): entries decode to
+"""The language server's use of the one store (krl/store.py, krl/parsecache.py): entries decode to
 exactly what was parsed, a workspace opened again gets its files from the cache and its
 diagnostics before its check, and a corrupt or hostile entry is ignored (parsed again), never
 trusted."""
@@ -11,9 +11,10 @@ from pathlib import Path
 import msgpack
 import pytest
 
-from krl.lsp import cache as C
+import krl.parsecache as C
 from krl.lsp.paths import norm
 from krl.lsp.project import Project
+from krl.store import Store
 from krl.workspace import load_file
 from tests.lsp.conftest import BACKUP
 
@@ -28,7 +29,7 @@ def spans(m):
 
 
 def reference_entry(lf) -> bytes:
-    """The entry's bytes as the cache's schema describes them (krl/lsp/cache.py), written out
+    """The entry's bytes as the cache's schema describes them (krl/parsecache.py), written out
     plainly: the on-disk format must not change with the codec's implementation."""
     import dataclasses
 
@@ -92,7 +93,7 @@ def test_the_valid_entry_the_hostile_ones_change_decodes():
 def test_the_cache_serves_a_workspace_opened_again(tmp_path: Path):
     shutil.copytree(BACKUP, tmp_path / "KRC")
     main = norm(tmp_path / "KRC" / "R1" / "Program" / "main.src")
-    store = C.Store(tmp_path / "cache")
+    store = Store(tmp_path / "cache")
     assert store.db is not None
     first = Project(store=store)
     an = first.analyze(main, docs={})
@@ -115,7 +116,7 @@ def test_the_cache_serves_a_workspace_opened_again(tmp_path: Path):
 def test_a_corrupt_database_entry_is_parsed_again(tmp_path: Path):
     shutil.copytree(BACKUP, tmp_path / "KRC")
     main = norm(tmp_path / "KRC" / "R1" / "Program" / "main.src")
-    store = C.Store(tmp_path / "cache")
+    store = Store(tmp_path / "cache")
     an = Project(store=store).analyze(main, docs={})
     store.db.execute("UPDATE entries SET data = X'00112233' WHERE kind = 'parse'")
     store.db.commit()
@@ -127,7 +128,7 @@ def test_a_corrupt_database_entry_is_parsed_again(tmp_path: Path):
 
 def test_the_database_keeps_within_its_limit(tmp_path: Path, monkeypatch):
     monkeypatch.setattr("krl.store.MAX_CACHE_BYTES", 4000)
-    store = C.Store(tmp_path / "cache")
+    store = Store(tmp_path / "cache")
     for k in range(40):
         store.put("parse", {f"k{k}": bytes(200)})
     size = store.db.execute("SELECT SUM(LENGTH(data)) FROM entries").fetchone()[0]
@@ -138,7 +139,7 @@ def test_the_database_keeps_within_its_limit(tmp_path: Path, monkeypatch):
 def test_no_cache_when_the_folder_cannot_be_made(tmp_path: Path):
     blocker = tmp_path / "file"
     blocker.write_text("x")
-    store = C.Store(blocker / "cache")
+    store = Store(blocker / "cache")
     assert store.db is None
     assert store.get("parse", ["a"]) == {}
     store.put("parse", {"a": b"x"})                     # never raises
@@ -153,7 +154,7 @@ def test_the_cached_diagnostics_come_before_any_parse_is_decoded(tmp_path: Path,
     text = Path(main).read_text()
     edited = text.replace("\nEND", "\n  no_such_name = 1\nEND", 1)      # an undeclared name: a finding
     assert edited != text
-    store = C.Store(tmp_path / "cache")
+    store = Store(tmp_path / "cache")
     for docs in ({main: text}, {main: edited}):
         expected = Project(store=store).analyze(main, docs=docs).ws.diagnostics
         assert bool(expected) == (docs[main] is edited)
@@ -172,7 +173,7 @@ def test_deferred_parse_entries_are_written_later_and_open_files_at_once(tmp_pat
     shutil.copytree(BACKUP, tmp_path / "KRC")
     main = norm(tmp_path / "KRC" / "R1" / "Program" / "main.src")
     tools = norm(tmp_path / "KRC" / "R1" / "Program" / "tools.src")
-    store = C.Store(tmp_path / "cache")
+    store = Store(tmp_path / "cache")
     first = Project(store=store, defer_writes=True)
     first.open(main, Path(main).read_text())
     an = first.analyze(main)
@@ -209,7 +210,7 @@ def test_every_corpus_backup_gives_krl_checks_diagnostics_cold_and_from_the_cach
     from krl.source import decode_bytes  # noqa: PLC0415
     from krl.workspace import Workspace, load_batch  # noqa: PLC0415
 
-    store = C.Store(tmp_path / "cache")
+    store = Store(tmp_path / "cache")
     path = norm(largest)
     text = decode_bytes(largest.read_bytes())[0]
     expected = None
