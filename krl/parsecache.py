@@ -22,9 +22,9 @@ import msgpack
 
 from krl.ast import nodes as N
 from krl.diagnostics import Diagnostic, Note
-from krl.files import Entry
 from krl.source import read_source
 from krl.store import Store, parse_key, shared_store
+from krl import workspace
 from krl.workspace import LoadedFile, Workspace, failed_load, load_batch, load_parsed, loading_files_by
 
 
@@ -270,18 +270,11 @@ def load_file(path) -> LoadedFile:
 
 
 def load_project(project, root: str = "", timeout: float | None = None, extra: list[Path] = (),
-                 store: Store | None = None) -> Workspace:
-    """:func:`krl.workspace.load_project` with the files' parses from the store: the same
-    workspace (files in the same order, the same diagnostics), not checked yet."""
-    ws = Workspace(root or str(project.root))
-    files = project.files
-    more = [f for f in extra if f not in files]
-    entries = project.entries + [Entry(f, f.name, "file") for f in more]
-    paths = [e.path for e in entries if e.kind == "file"]
-    for lf in load_files(paths, timeout, store):
-        ws.add_loaded(lf, notify=timeout is None)
-    ws.add_unread(entries)
-    return ws
+                 store: Store | None = None, jobs: int | None = None) -> Workspace:
+    """:func:`krl.workspace.load_project` (the same arguments, and `store`) with the files'
+    parses from the store (:func:`through_store`): the same workspace, not checked yet."""
+    with through_store(store):
+        return workspace.load_project(project, root, timeout, jobs, extra)
 
 
 @contextmanager
