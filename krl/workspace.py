@@ -672,7 +672,9 @@ class Workspace:
           whole workspace, from the parses it holds;
         * "none": not checked yet.
 
-        The unresolved-name report (per backup) is always made again. Storage places
+        The unresolved-name report (per backup) is made again when what it reads changed: the
+        reported owners' unresolved uses, or what the files that do not parse may declare
+        (``failed_words``, ``unreadable``: :meth:`maybe_declared`). Storage places
         (:meth:`resolve`) are left for later. Raises KeyError when no file is ``lf.path``."""
         path = lf.path
         sf = next((f for f in self.files if f.path == path), None)
@@ -680,6 +682,7 @@ class Workspace:
         if sf is None or old is None:
             raise KeyError(path)
         old_template = old.template
+        may_declare = (frozenset(self.failed_words), self.unreadable)      # what maybe_declared reads
         self._set_loaded(lf)
         st = self._state
         if not self.checked or st is None:
@@ -698,8 +701,8 @@ class Workspace:
                 done = self._recheck_code(sf, lf, old_template)
             if done is None:
                 return self._check_again()
-            if self._all_uses() != uses:    # else the report, made from these alone, stays
-                self._report()
+            if self._all_uses() != uses or (frozenset(self.failed_words), self.unreadable) != may_declare:
+                self._report()              # else the report, made from these alone, stays
             self._assemble()
             return done
         except Exception:  # noqa: BLE001 - the full check decides (and reports E901 itself)

@@ -169,3 +169,30 @@ def test_every_history_edit_agrees_with_a_full_check(history: Path):
     assert len(pairs) >= 40
     for pair in pairs:
         replay(pair, most_files=1000, most_steps=1000)
+
+
+def test_edits_that_change_what_an_unparsable_file_may_declare_agree_with_a_full_check(tmp_path: Path):
+    """main.src assigns a name nobody declares (E101); tools.src is edited from parsing to not
+    parsing (its broken line without, then with that name: the name may be declared there, so a
+    warning, W101) and back. Each edit re-checks tools.src's routines alone, and the
+    unresolved-name report must follow what the unparsable file may declare."""
+    import shutil  # noqa: PLC0415
+    from tests.lsp.conftest import BACKUP  # noqa: PLC0415
+    shutil.copytree(BACKUP, tmp_path / "KRC")
+    main = norm(tmp_path / "KRC" / "R1" / "Program" / "main.src")
+    tools = norm(tmp_path / "KRC" / "R1" / "Program" / "tools.src")
+    text = Path(tools).read_text()
+    assert "  shared = n\n" in text
+    broken = lambda word: text.replace("  shared = n\n", f"  shared = n\n  {word} = = 2\n")  # noqa: E731
+    p = Project()
+    p.folders = [Path(norm(tmp_path / "KRC"))]
+    p.open(main, Path(main).read_text().replace("  $OUT[2] = TRUE\n", "  $OUT[2] = TRUE\n  mystery_flag = 1\n"))
+    p.open(tools, text)
+    oracle = Oracle()
+    codes, hows = [], []
+    for t in (text, broken("other_word"), broken("mystery_flag"), broken("other_word"), text):
+        hows.append(agree(p, oracle, tools, t))
+        codes.append(sorted(d.code for d in p.analyses[p._root_of[tools]].ws.diagnostics
+                            if d.path == main))
+    assert codes == [["E101"], ["E101"], ["W101"], ["E101"], ["E101"]]
+    assert hows[1:] == ["routines"] * 4                # the re-check of one routine, not a full check
