@@ -21,7 +21,7 @@ SQLite, a full disk, a read-only folder) turns the store off for the process (sa
 ``krl.store`` log): commands then parse and check as without a cache, and never fail for it.
 The database is kept within :data:`krl.limits.MAX_CACHE_BYTES` (past it the least recently used
 quarter of the rows goes), an entry larger than :data:`krl.limits.MAX_CACHE_ENTRY_BYTES` is not
-kept. The folder is created with mode 0700 (the database with the user's umask, in that
+kept (nor read: such a row is corrupt). The folder is created with mode 0700 (the database with the user's umask, in that
 folder). ``KRL_STORE=0`` (or ``KRL_LSP_NO_CACHE``) turns the store off.
 """
 
@@ -137,7 +137,8 @@ class Store:
 
     def get(self, kind: str, keys: list[str]) -> dict[str, bytes]:
         """The verified data of the entries of `kind` among `keys` (a row whose data does not
-        match its digest is counted corrupt and left out)."""
+        match its digest, or is larger than MAX_CACHE_ENTRY_BYTES, is counted corrupt and left
+        out)."""
         out: dict[str, bytes] = {}
         if self.db is None or not keys:
             return out
@@ -145,9 +146,11 @@ class Store:
             try:
                 for i in range(0, len(keys), 500):
                     part = keys[i:i + 500]
+                    # data past the entry limit (never written so: planted) is not even read
                     rows = self.db.execute(
-                        f"SELECT key, digest, data FROM entries WHERE kind = ? AND key IN ({','.join('?' * len(part))})",
-                        (kind, *part)).fetchall()
+                        "SELECT key, digest, CASE WHEN LENGTH(data) <= ? THEN data END FROM entries "
+                        f"WHERE kind = ? AND key IN ({','.join('?' * len(part))})",
+                        (MAX_CACHE_ENTRY_BYTES, kind, *part)).fetchall()
                     for key, digest, data in rows:
                         if isinstance(data, bytes) and hashlib.sha256(data).digest() == digest:
                             out[key] = data

@@ -308,3 +308,16 @@ def test_a_stopped_parse_is_never_stored(tmp_path, monkeypatch, way):
     fresh = load_files(files, store=again)
     assert again.hits == 0 and again.misses == len(files)
     assert all(not any(d.code in ("E001", "E005") for d in lf.diagnostics) for lf in fresh)
+
+
+def test_an_entry_past_the_size_limit_is_not_read(tmp_path, monkeypatch):
+    """A row larger than MAX_CACHE_ENTRY_BYTES (never written so: planted, with a matching
+    digest) is a corrupt entry: left out, counted, and its data never returned."""
+    monkeypatch.setattr(store, "MAX_CACHE_ENTRY_BYTES", 300)
+    s = store.Store(tmp_path)
+    s.put("parse", {"small": bytes(300)})
+    big = bytes(301)
+    s.db.execute("INSERT INTO entries VALUES ('parse', 'big', ?, ?, 0)", (hashlib.sha256(big).digest(), big))
+    s.db.commit()
+    assert s.get("parse", ["small", "big"]) == {"small": bytes(300)}
+    assert (s.hits, s.misses, s.corrupt) == (1, 1, 1)
