@@ -21,8 +21,10 @@ SQLite, a full disk, a read-only folder) turns the store off for the process (sa
 ``krl.store`` log): commands then parse and check as without a cache, and never fail for it.
 The database is kept within :data:`krl.limits.MAX_CACHE_BYTES` (past it the least recently used
 quarter of the rows goes), an entry larger than :data:`krl.limits.MAX_CACHE_ENTRY_BYTES` is not
-kept (nor read: such a row is corrupt). The folder is created with mode 0700 (the database with the user's umask, in that
-folder). ``KRL_STORE=0`` (or ``KRL_LSP_NO_CACHE``) turns the store off.
+kept (nor read: such a row is corrupt). The cache root (:func:`cache_dir`) and its
+``front-end`` folder are created with mode 0700 (the database with the user's umask, in that
+folder). When a store opens, :func:`tidy` removes, once per process, other versions'
+databases unused for 7 days and the folders earlier versions left. ``KRL_STORE=0`` (or ``KRL_LSP_NO_CACHE``) turns the store off.
 """
 
 from __future__ import annotations
@@ -30,6 +32,7 @@ from __future__ import annotations
 import hashlib
 import logging
 import os
+import shutil
 import sqlite3
 import threading
 import time
@@ -42,19 +45,70 @@ log.addHandler(logging.NullHandler())   # a command's standard error never gets 
 #: the codec's name and version: part of :func:`front_end_version`
 CODEC = "krl-store 3 (msgpack by schema; parse entries' notes without a path)"
 LOCK_WAIT_S = 5.0
+#: another front-end version's database not used for this long (by its mtime) is removed
+UNUSED_DATABASE_S = 7 * 24 * 3600.0
+#: folders of the cache root that earlier versions wrote (pickled results) and nothing reads now
+OBSOLETE_FOLDERS = ("lsp", "stored")
 KRL_ROOT = Path(__file__).resolve().parent
 GRAMMAR = KRL_ROOT.parent / "grammar" / "KRL.g4"
 
 
 def cache_dir() -> Path:
     """The user cache folder (``$KRL_CACHE_DIR``, else the platform's user cache folder of
-    krl-tools; never inside the repository), created here. Raises OSError when it cannot be
-    created."""
+    krl-tools; never inside the repository), created here with mode 0700 (a folder that exists
+    is left as it is). Raises OSError when it cannot be created."""
     import platformdirs  # noqa: PLC0415
 
     d = Path(os.environ.get("KRL_CACHE_DIR") or platformdirs.user_cache_dir("krl-tools"))
-    d.mkdir(parents=True, exist_ok=True)
+    d.mkdir(parents=True, exist_ok=True, mode=0o700)
     return d
+
+
+_TIDIED: set[str] = set()
+
+
+def tidy(root: Path, current: str) -> list[Path]:
+    """Remove from the cache root `root` what no process of this version reads: the databases
+    of other front-end versions (``front-end/<v>.sqlite`` and its journal files, `current`
+    being this version's file name) whose newest file was not modified for
+    :data:`UNUSED_DATABASE_S` (7 days), and the folders :data:`OBSOLETE_FOLDERS` of earlier
+    versions (pickled results). Only regular files and folders inside `root` are removed; a
+    symbolic link is never followed nor removed. Once per root and process; never raises (what
+    cannot be removed stays). Returns what was removed."""
+    key = str(root)
+    if key in _TIDIED:
+        return []
+    _TIDIED.add(key)
+    removed: list[Path] = []
+    try:
+        cutoff = time.time() - UNUSED_DATABASE_S
+        groups: dict[str, list[os.DirEntry]] = {}
+        front = root / "front-end"
+        if front.is_dir() and not front.is_symlink():
+            with os.scandir(front) as it:
+                for e in it:
+                    stem, dot, _rest = e.name.partition(".sqlite")
+                    if dot and stem and stem != current.partition(".sqlite")[0] and e.is_file(follow_symlinks=False):
+                        groups.setdefault(stem, []).append(e)
+        for files in groups.values():
+            if max(e.stat(follow_symlinks=False).st_mtime for e in files) < cutoff:
+                for e in files:
+                    try:
+                        os.unlink(e.path)
+                        removed.append(Path(e.path))
+                    except OSError:
+                        pass
+        for name in OBSOLETE_FOLDERS:
+            d = root / name
+            if d.is_dir() and not d.is_symlink():
+                shutil.rmtree(d, ignore_errors=True)     # never follows a link inside (fd-based on POSIX)
+                if not d.exists():
+                    removed.append(d)
+    except OSError as exc:
+        log.info("the cache folder was not tidied: %s", exc)
+    if removed:
+        log.info("removed from the cache folder: %s", ", ".join(map(str, removed)))
+    return removed
 
 
 _VERSION: list[str] = []
@@ -112,9 +166,12 @@ class Store:
         if not enabled or not globals()["enabled"]():
             return
         try:
-            folder = (folder or cache_dir()) / "front-end"
+            root = folder or cache_dir()
+            root.mkdir(parents=True, exist_ok=True, mode=0o700)
+            folder = root / "front-end"
             folder.mkdir(parents=True, exist_ok=True, mode=0o700)
             self.path = folder / f"{front_end_version()[:24]}.sqlite"
+            tidy(root, self.path.name)
             db = sqlite3.connect(self.path, timeout=LOCK_WAIT_S, check_same_thread=False)
             db.execute("CREATE TABLE IF NOT EXISTS entries (kind TEXT, key TEXT, digest BLOB, data BLOB, "
                        "used REAL, PRIMARY KEY (kind, key))")

@@ -13,6 +13,7 @@ import pickle
 import sqlite3
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import msgpack
@@ -321,3 +322,79 @@ def test_an_entry_past_the_size_limit_is_not_read(tmp_path, monkeypatch):
     s.db.commit()
     assert s.get("parse", ["small", "big"]) == {"small": bytes(300)}
     assert (s.hits, s.misses, s.corrupt) == (1, 1, 1)
+
+
+def test_opening_the_store_removes_old_versions_and_obsolete_folders_only(tmp_path, monkeypatch):
+    """In a cache root of its own ($KRL_CACHE_DIR): other versions' databases unused for more
+    than 7 days and the obsolete lsp/ and stored/ folders go; this version's database, another
+    version's used within the week, other files, and anything behind a symbolic link stay."""
+    root = tmp_path / "cache"
+    monkeypatch.setenv("KRL_CACHE_DIR", str(root))
+    monkeypatch.delenv("KRL_STORE", raising=False)
+    outside = tmp_path / "outside"
+    outside.mkdir()
+    (outside / "keep.sqlite").write_bytes(b"x")
+    (outside / "inner").mkdir()
+    (outside / "inner" / "keep").write_bytes(b"x")
+    front = root / "front-end"
+    front.mkdir(parents=True)
+    eight_days, six_days = time.time() - 8 * 86400, time.time() - 6 * 86400
+
+    def old(p: Path, when: float) -> Path:
+        os.utime(p, (when, when), follow_symlinks=False)
+        return p
+
+    current = front / f"{store.front_end_version()[:24]}.sqlite"
+    sqlite3.connect(current).close()
+    for name in ("aaaa.sqlite", "aaaa.sqlite-journal", "bbbb.sqlite", "bbbb.sqlite-journal", "notes.txt"):
+        (front / name).write_bytes(b"x")
+    old(front / "aaaa.sqlite-journal", eight_days)
+    old(current, eight_days)
+    old(front / "aaaa.sqlite", eight_days)
+    old(front / "bbbb.sqlite", eight_days)
+    old(front / "bbbb.sqlite-journal", six_days)       # its journal was written within the week
+    old(front / "notes.txt", eight_days)
+    (front / "link.sqlite").symlink_to(outside / "keep.sqlite")
+    old(front / "link.sqlite", eight_days)
+    for name in ("lsp", "stored"):
+        (root / name / "sub").mkdir(parents=True)
+        (root / name / "sub" / "x.pickle").write_bytes(b"p" * 100)
+    (root / "lsp" / "sub" / "out").symlink_to(outside / "inner")     # a link inside: removed, not followed
+    (root / "other").mkdir()
+    monkeypatch.setattr(store, "_TIDIED", set())
+    s = store.Store()
+    assert s.db is not None and s.path == current
+    assert sorted(p.name for p in front.iterdir()) == sorted(
+        [current.name, "bbbb.sqlite", "bbbb.sqlite-journal", "notes.txt", "link.sqlite"])
+    assert not (root / "lsp").exists() and not (root / "stored").exists() and (root / "other").is_dir()
+    assert (outside / "keep.sqlite").read_bytes() == b"x" and (outside / "inner" / "keep").read_bytes() == b"x"
+    # once per process: a database that ages later is left for the next process
+    old(front / "bbbb.sqlite-journal", eight_days)
+    store.Store().close()
+    assert (front / "bbbb.sqlite").exists()
+    s.close()
+
+
+def test_obsolete_folders_behind_a_symbolic_link_are_left(tmp_path, monkeypatch):
+    root = tmp_path / "cache"
+    root.mkdir()
+    target = tmp_path / "elsewhere"
+    (target / "sub").mkdir(parents=True)
+    (target / "sub" / "x").write_bytes(b"x")
+    (root / "stored").symlink_to(target)
+    monkeypatch.setattr(store, "_TIDIED", set())
+    monkeypatch.delenv("KRL_STORE", raising=False)
+    store.Store(root).close()
+    assert (root / "stored").is_symlink() and (target / "sub" / "x").exists()
+
+
+def test_the_cache_root_is_created_0700(tmp_path, monkeypatch):
+    monkeypatch.setenv("KRL_CACHE_DIR", str(tmp_path / "new" / "cache"))
+    d = store.cache_dir()
+    assert d.is_dir() and (d.stat().st_mode & 0o777) == 0o700 & ~_umask()
+
+
+def _umask() -> int:
+    m = os.umask(0)
+    os.umask(m)
+    return m
