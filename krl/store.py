@@ -47,7 +47,7 @@ CODEC = "krl-store 3 (msgpack by schema; parse entries' notes without a path)"
 LOCK_WAIT_S = 5.0
 #: another front-end version's database not used for this long (by its mtime) is removed
 UNUSED_DATABASE_S = 7 * 24 * 3600.0
-#: folders of the cache root that earlier versions wrote (pickled results) and nothing reads now
+#: folders of the cache root that earlier versions wrote (their serialized results) and nothing reads now
 OBSOLETE_FOLDERS = ("lsp", "stored")
 KRL_ROOT = Path(__file__).resolve().parent
 GRAMMAR = KRL_ROOT.parent / "grammar" / "KRL.g4"
@@ -72,7 +72,7 @@ def tidy(root: Path, current: str) -> list[Path]:
     of other front-end versions (``front-end/<v>.sqlite`` and its journal files, `current`
     being this version's file name) whose newest file was not modified for
     :data:`UNUSED_DATABASE_S` (7 days), and the folders :data:`OBSOLETE_FOLDERS` of earlier
-    versions (pickled results). Only regular files and folders inside `root` are removed; a
+    versions (their serialized results). Only regular files and folders inside `root` are removed; a
     symbolic link is never followed nor removed. Once per root and process; never raises (what
     cannot be removed stays). Returns what was removed."""
     key = str(root)
