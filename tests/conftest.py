@@ -26,7 +26,7 @@ SHARED = REPO_ROOT.parent / "shared"
 SHARED_CORPUS = SHARED / "krl-corpus"
 SHARED_HISTORY = SHARED / "krl-history"
 
-# The caches of what the tests run (the language servers they start: krl/lsp/cache.py) go to a
+# The caches of what the tests run (the one store of the commands and language servers they start: krl/store.py) go to a
 # temporary folder of the session, never to the user's cache folder.
 os.environ.setdefault("KRL_CACHE_DIR", tempfile.mkdtemp(prefix="krl-test-cache-"))
 

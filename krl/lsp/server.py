@@ -4,7 +4,7 @@ Analysis (parse, link, check: krl/lsp/project.py) runs in one worker thread, deb
 each change (:data:`DEBOUNCE_S`); requests wait for the analysis of their file when it is out of
 date. The first analysis of a workspace publishes, before its check ends, the opened file's own
 parse diagnostics (a workspace of :data:`EARLY_MIN_FILES` files or more) and the diagnostics the
-persistent cache holds for the same files (krl/lsp/cache.py). The fast parse engine's worker is
+persistent cache holds for the same files (the one store: krl/store.py, krl/parsecache.py). The fast parse engine's worker is
 started when the client is initialized. An exception in a handler is logged (stderr and
 ``window/logMessage``) and answered with an empty result: it never ends the server.
 """
@@ -32,6 +32,7 @@ from krl.pool import default_jobs, start_fork_server
 from krl.semantics.config import config_for
 from krl.semantics.symbols import system_scopes
 from krl.source import SourceText
+from krl.store import Store
 from krl.syntax.engines import EngineUnavailable, java_answers, resolve
 from krl.workspace import WORKER_MODULES
 from krl.lsp import actions as _actions
@@ -48,7 +49,6 @@ from krl.lsp import unused as _unused
 from krl.lsp.occurrences import DECL, WRITE, file_occurrences
 from krl.lsp.analysis import Analysis
 from krl.lsp.bench import generate
-from krl.lsp.cache import Store
 from krl.lsp.convert import lsp_diagnostic
 from krl.lsp.parsing import Parsed
 from krl.lsp.paths import norm

@@ -23,7 +23,6 @@ import interp.runtime.program as program_mod
 import krl.store as store
 from interp.debug.client import DapClient
 from interp.run import make_runtime
-from krl.lsp import cache as C
 from krl.lsp.paths import norm
 from krl.lsp.project import Project
 from krl.parsecache import load_files
@@ -86,8 +85,8 @@ def test_a_sample_of_conformance_programs_runs_the_same_from_stored_parses(cache
         assert h0 == 0 and h2 > 0, case.name           # the third run read its files from the store
 
 
-def _lsp_analysis(root: Path, cache: Path) -> tuple[C.Store, list]:
-    s = C.Store(cache)
+def _lsp_analysis(root: Path, cache: Path) -> tuple[store.Store, list]:
+    s = store.Store(cache)
     an = Project(store=s).analyze(norm(root / "R1" / "Program" / "main.src"), docs={})
     return s, an.ws.diagnostics
 
@@ -195,7 +194,7 @@ def test_the_store_never_unpickles(cache, tmp_path, monkeypatch):
     corrupt = s.corrupt
     assert _trace(case) == fresh
     assert s.corrupt > corrupt and not marker.exists()
-    for module in ("krl/store.py", "krl/parsecache.py", "krl/lsp/cache.py"):
+    for module in ("krl/store.py", "krl/parsecache.py"):
         text = (REPO / module).read_text()
         assert "pickle" not in text.replace("unpickled", "").replace("pickles", ""), module
 

@@ -126,16 +126,6 @@ def test_a_corrupt_database_entry_is_parsed_again(tmp_path: Path):
     assert rows(an2.ws.diagnostics) == rows(an.ws.diagnostics)
 
 
-def test_the_database_keeps_within_its_limit(tmp_path: Path, monkeypatch):
-    monkeypatch.setattr("krl.store.MAX_CACHE_BYTES", 4000)
-    store = Store(tmp_path / "cache")
-    for k in range(40):
-        store.put("parse", {f"k{k}": bytes(200)})
-    size = store.db.execute("SELECT SUM(LENGTH(data)) FROM entries").fetchone()[0]
-    assert size <= 4000
-    assert store.get("parse", ["k39"])                  # the latest kept
-
-
 def test_no_cache_when_the_folder_cannot_be_made(tmp_path: Path):
     blocker = tmp_path / "file"
     blocker.write_text("x")
