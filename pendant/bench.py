@@ -30,24 +30,21 @@ from __future__ import annotations
 
 import argparse
 import asyncio
-import json
 import os
 import statistics
-import subprocess
 import sys
 import tempfile
 import time
 from pathlib import Path
-from urllib.parse import urlsplit
 
-ROOT = Path(__file__).resolve().parents[1]
+from krl.cputime import tree_cpu_s
+
+from .client import CHROMIUM_FLAGS, ROOT, PendantClientError, act_state, connect, pendant_server
 DEFAULT_BACKUP = ROOT.parent / "shared" / "krl-corpus" / "khrzysio__KRC4_test"
 # 142.6 s of simulated time with its cell (corpus/cells/khrzysio__KRC4_test.yaml): long enough
 # for the paced window and the latency toggles on any machine
 DEFAULT_PROGRAM = "R1/Program/CELL/Frame/Mill_FrameAut3.src"
 DEFAULT_CELL = ROOT / "corpus" / "cells" / "khrzysio__KRC4_test.yaml"
-FLAGS = ["--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run", "--disable-background-networking",
-         "--disable-component-update", "--disable-sync"]
 #: the shortest window that gives a factor; the reading interval of an unpaced run (s)
 MIN_WINDOW_S = 2.0
 UNPACED_READING_S = 0.5
@@ -59,63 +56,17 @@ class BenchError(Exception):
     """The benchmark could not measure (its reason)."""
 
 
-def _server(root: Path, backup: Path, cell: Path | None, realtime: bool):
-    """``krl pendant`` of the checkout ``root`` (its packages are imported from there)."""
-    cmd = [sys.executable, "-m", "krl.cli", "pendant", str(backup), "--no-browser", "--mode", "AUT"]
-    if cell is not None:
-        cmd += ["--inputs", str(cell)]
-    if not realtime:
-        cmd.append("--no-realtime")
-    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True, cwd=root)
-    url = proc.stdout.readline().strip()
-    if not url.startswith("http://"):
-        proc.kill()
-        proc.wait(30)
-        raise BenchError(f"krl pendant printed {url!r} first")
-    return proc, url
-
-
-async def _connect(url: str):
-    import websockets  # noqa: PLC0415
-
-    u = urlsplit(url)
-    token = u.query.split("token=", 1)[1]
-    return await websockets.connect(f"ws://{u.hostname}:{u.port}/ws?token={token}", max_size=None,
-                                    additional_headers={"Origin": f"http://{u.hostname}:{u.port}"})
-
-
-def _merge(state: dict | None, m: dict) -> dict:
-    """The state after the state message ``m`` (the whole state, or what changed: a key gone is
-    null), as the page keeps it."""
-    out = {} if m.get("full") or state is None else dict(state)
-    for k, v in m.items():
-        if v is None:
-            out.pop(k, None)
-        else:
-            out[k] = v
-    return out
-
-
 async def _act(ws, rid: int, op: str, **args) -> dict:
-    """One action; the state after it (the state messages of this connection merged)."""
-    await ws.send(json.dumps({"op": op, "id": rid, **args}))
-    state = None
-    while True:
-        m = json.loads(await ws.recv())
-        if m["type"] == "state":
-            state = _merge(state, m)
-        if m.get("id") == rid and m["type"] in ("done", "error"):
-            if m["type"] == "error":
-                raise BenchError(f"{op}: {m['text']}")
-            while state is None:
-                m = json.loads(await ws.recv())
-                state = _merge(state, m) if m["type"] == "state" else None
-            return state
+    """``client.act_state``, a refusal being the benchmark's error."""
+    try:
+        return await act_state(ws, rid, op, **args)
+    except PendantClientError as exc:
+        raise BenchError(str(exc)) from exc
 
 
 async def _select(url: str, program: str) -> None:
     """Select ``program`` in GO (it stands at its first statement); the connection closes again."""
-    async with await _connect(url) as ws:
+    async with await connect(url) as ws:
         await _act(ws, 1, "runMode", value="GO")
         state = await _act(ws, 2, "select", program=program)
         if state.get("state") != "stopped":
@@ -124,14 +75,14 @@ async def _select(url: str, program: str) -> None:
 
 async def _start(url: str) -> None:
     """Drives on and Start; the connection closes again (no client)."""
-    async with await _connect(url) as ws:
+    async with await connect(url) as ws:
         await _act(ws, 1, "drives", on=True)
         await _act(ws, 2, "start")
 
 
 async def _reading(url: str) -> tuple[str, float | None]:
     """(the program's state, the simulated time) now, by a short connection."""
-    async with await _connect(url) as ws:
+    async with await connect(url) as ws:
         s = await _act(ws, 1, "watch", exprs=[])
         t = s.get("time")
         return str(s.get("state")), float(t) if isinstance(t, (int, float)) else None
@@ -148,14 +99,9 @@ def _in_thread(coro):
 def _window(url: str, pid: int, seconds: float, every: float) -> tuple[float, float, float]:
     """(simulated s, wall s, the server's CPU s) between the first and the last reading that
     found the program running, read each ``every`` s until ``seconds`` have passed or it ended."""
-    import psutil  # noqa: PLC0415
-
-    proc = psutil.Process(pid)
-
     def reading():
         state, sim = _in_thread(_reading(url))
-        c = proc.cpu_times()
-        return state, sim, time.perf_counter(), c.user + c.system
+        return state, sim, time.perf_counter(), tree_cpu_s(pid)
     first = reading()
     if first[0] != "running" or first[1] is None:
         raise BenchError(f"the program is {first[0]!r} a second after Start (not running): nothing to measure")
@@ -180,7 +126,7 @@ def _with_page(url: str, work):
 
     with sync_playwright() as pw, tempfile.TemporaryDirectory() as profile:
         ctx = pw.chromium.launch_persistent_context(profile, executable_path="/usr/bin/chromium", headless=True,
-                                                    args=FLAGS, bypass_csp=True,
+                                                    args=CHROMIUM_FLAGS, bypass_csp=True,
                                                     viewport={"width": 1400, "height": 900})
         try:
             page = ctx.new_page()
@@ -193,25 +139,20 @@ def _with_page(url: str, work):
 
 
 def _browser_cpu() -> float:
-    """CPU s of the browser's processes so far (Playwright's Chromium: this process's
+    """CPU s of the browser's processes so far (Playwright's Chromium among this process's
     descendants)."""
-    import psutil  # noqa: PLC0415
+    return tree_cpu_s(name="chrom")
 
-    total = 0.0
-    for p in psutil.Process().children(recursive=True):
-        try:
-            if "chrom" in p.name().lower():
-                c = p.cpu_times()
-                total += c.user + c.system
-        except psutil.Error:
-            pass
-    return total
+
+def _server_args(cell: Path | None, realtime: bool) -> list[str]:
+    """The arguments of ``krl pendant`` in a measurement: AUT, the cell, paced or not."""
+    return ["--mode", "AUT", *(["--inputs", str(cell)] if cell is not None else []),
+            *([] if realtime else ["--no-realtime"])]
 
 
 def rtf(root, backup, program, cell, seconds, realtime: bool, page: bool) -> tuple:
     """(simulated s per wall s, simulated s per CPU s of the server, the window's wall s, and
     with the page open the frames it drew and the browser's CPU s, each per wall s)."""
-    proc, url = _server(root, backup, cell, realtime)
     every = seconds if realtime else UNPACED_READING_S
 
     def measure(pg=None):
@@ -224,12 +165,9 @@ def rtf(root, backup, program, cell, seconds, realtime: bool, page: bool) -> tup
         sim, wall, cpu = _window(url, proc.pid, seconds, every)
         f1, b1, t1 = pg.evaluate("() => window.pendant.frames"), _browser_cpu(), time.perf_counter()
         return sim / wall, sim / max(cpu, 1e-9), wall, (f1 - f0) / (t1 - t0), (b1 - b0) / (t1 - t0)
-    try:
+    with pendant_server(backup, *_server_args(cell, realtime), root=root) as (proc, url):
         _in_thread(_select(url, program))
         return _with_page(url, measure) if page else measure()
-    finally:
-        proc.terminate()
-        proc.wait(60)
 
 
 # an input key pressed until the frame that shows its new value (ms), with the times at which
@@ -260,39 +198,35 @@ LATENCY_JS = """async (n) => {
 def latency(root, backup, program, cell, toggles: int, index: int) -> tuple[list[dict], int]:
     """The toggles' times (ms) while the program ran at real time, and how many were skipped
     (the program not running at that toggle, or no change seen)."""
-    proc, url = _server(root, backup, cell, True)
-    try:
-        def work(page):
-            page.select_option("#mode-op", "AUT")
-            page.select_option("#run-mode", "GO")
-            page.select_option("#programs", program)
-            page.click("#select")
-            page.wait_for_function("() => window.pendant.state && window.pendant.state.state == 'stopped' "
-                                   "&& window.pendant.state.program", timeout=PAGE_WAIT_MS)
-            page.click("#drives")
-            page.wait_for_function("() => window.pendant.state.drives", timeout=PAGE_WAIT_MS)
-            page.click("#start")
-            page.wait_for_function("() => window.pendant.state.state != 'stopped' || !window.pendant.state.time",
-                                   timeout=PAGE_WAIT_MS)
-            page.wait_for_function("() => window.pendant.state.state != 'running' || window.pendant.state.time > 1",
-                                   timeout=PAGE_WAIT_MS)
-            page.click('#tabs button[data-tab="io"]')
-            out, skipped = [], 0
-            for _ in range(toggles):
-                if page.evaluate("() => window.pendant.state.state") != "running":
-                    skipped += 1
-                    continue
-                r = page.evaluate(LATENCY_JS, index)
-                if r is None:
-                    skipped += 1
-                else:
-                    out.append(r)
-                page.wait_for_timeout(100)
-            return out, skipped
+    def work(page):
+        page.select_option("#mode-op", "AUT")
+        page.select_option("#run-mode", "GO")
+        page.select_option("#programs", program)
+        page.click("#select")
+        page.wait_for_function("() => window.pendant.state && window.pendant.state.state == 'stopped' "
+                               "&& window.pendant.state.program", timeout=PAGE_WAIT_MS)
+        page.click("#drives")
+        page.wait_for_function("() => window.pendant.state.drives", timeout=PAGE_WAIT_MS)
+        page.click("#start")
+        page.wait_for_function("() => window.pendant.state.state != 'stopped' || !window.pendant.state.time",
+                               timeout=PAGE_WAIT_MS)
+        page.wait_for_function("() => window.pendant.state.state != 'running' || window.pendant.state.time > 1",
+                               timeout=PAGE_WAIT_MS)
+        page.click('#tabs button[data-tab="io"]')
+        out, skipped = [], 0
+        for _ in range(toggles):
+            if page.evaluate("() => window.pendant.state.state") != "running":
+                skipped += 1
+                continue
+            r = page.evaluate(LATENCY_JS, index)
+            if r is None:
+                skipped += 1
+            else:
+                out.append(r)
+            page.wait_for_timeout(100)
+        return out, skipped
+    with pendant_server(backup, *_server_args(cell, True), root=root) as (_proc, url):
         return _with_page(url, work)
-    finally:
-        proc.terminate()
-        proc.wait(60)
 
 
 def _load() -> str:
@@ -328,7 +262,7 @@ def main(argv=None) -> int:
             _factors(a)
         if not a.no_latency:
             _latency(a)
-    except BenchError as exc:
+    except (BenchError, PendantClientError) as exc:
         print(f"pendant.bench: {exc}", file=sys.stderr)
         return 1
     print(f"load at the end: {_load()}", flush=True)

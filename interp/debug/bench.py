@@ -37,6 +37,8 @@ import tempfile
 import time
 from pathlib import Path
 
+from krl.cputime import tree_cpu_s
+
 from .client import ROOT, DapClient
 
 
@@ -60,17 +62,6 @@ BYTECODE = {"PYTHONDONTWRITEBYTECODE": "",
             "PYTHONPYCACHEPREFIX": str(Path(tempfile.gettempdir()) / f"krl-debug-bench-pycache-{os.getuid()}")}
 
 
-def cpu_seconds(pid: int) -> float:
-    """User + system time of process `pid` and its waited-for children (Linux /proc; NaN
-    elsewhere)."""
-    try:
-        fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
-        ticks = sum(int(x) for x in fields[11:15])     # utime stime cutime cstime
-        return ticks / os.sysconf("SC_CLK_TCK")
-    except (OSError, ValueError, IndexError):
-        return float("nan")
-
-
 def sample(program: Path, workspace: Path, root: Path, python: str | None, env: dict | None) -> tuple:
     """(start s, launch s, entry s, CPU s, launch CPU s) of one fresh krl debug process."""
     env = {**BYTECODE, **(env or {})}
@@ -78,10 +69,10 @@ def sample(program: Path, workspace: Path, root: Path, python: str | None, env: 
     with DapClient(timeout=600, root=root, python=python, env=env) as c:
         c.initialize()
         t_start = time.perf_counter()
-        cpu_start = cpu_seconds(c.proc.pid)
+        cpu_start = tree_cpu_s(c.proc.pid)
         c.request("launch", {"program": str(program), "workspace": str(workspace), "stopOnEntry": True})
         t_launch = time.perf_counter() - t_start
-        cpu = cpu_seconds(c.proc.pid)
+        cpu = tree_cpu_s(c.proc.pid)
         c.request("configurationDone")
         c.wait_event("stopped")
         c.stack()

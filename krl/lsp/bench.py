@@ -45,6 +45,8 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from krl.cputime import tree_cpu_s
+
 
 def generate(lines: int = 3000) -> str:
     """A valid KRL program of about `lines` lines (CRLF, as on the controller)."""
@@ -76,26 +78,6 @@ def loadavg() -> str:
         return " ".join(Path("/proc/loadavg").read_text().split()[:3])
     except OSError:
         return "?"
-
-
-def tree_cpu_s(pid: int) -> float:
-    """CPU seconds (user + system) of the process `pid` and its descendants, those that ended
-    included when their parent collected them."""
-    import psutil  # noqa: PLC0415 - the benchmark only
-
-    total = 0.0
-    try:
-        root = psutil.Process(pid)
-        procs = [root, *root.children(recursive=True)]
-    except psutil.Error:
-        return total
-    for p in procs:
-        try:
-            t = p.cpu_times()
-            total += t.user + t.system + t.children_user + t.children_system
-        except psutil.Error:
-            pass
-    return total
 
 
 def _memory(pid: int) -> dict[str, float]:

@@ -1,6 +1,6 @@
 """Test harness of the pendant: `krl pendant` started as the user starts it (a subprocess, its
 first line the URL with the token), and the page in Debian's Chromium driven by Playwright
-(PyPI playwright given /usr/bin/chromium as its executable; the flags of the machine notes).
+(PyPI playwright given /usr/bin/chromium as its executable, with pendant/client.py's flags).
 
 Waits are conditions on the page's state (``window.pendant``), with generous time limits for a
 loaded machine; no assertion depends on how long anything took.
@@ -9,20 +9,16 @@ loaded machine; no assertion depends on how long anything took.
 from __future__ import annotations
 
 import json
-import os
-import subprocess
-import sys
 import tempfile
 from contextlib import contextmanager
 from pathlib import Path
 
 import pytest
 
+from pendant import client
 from tests.conftest import REPO_ROOT, SHARED_CORPUS
 
 CHROMIUM = "/usr/bin/chromium"
-FLAGS = ["--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run", "--disable-background-networking",
-         "--disable-component-update", "--disable-sync"]
 KR120 = SHARED_CORPUS / "khrzysio__KRC4_test"
 PALLETIZER = SHARED_CORPUS / "ingeniado__KRC4-Robot-Palletizer"
 MILLING = SHARED_CORPUS / "HugoDanielson__ChinaMilling"
@@ -41,32 +37,10 @@ def chromium_or_skip() -> str:
 
 @contextmanager
 def pendant_server(target: Path, *args: str):
-    """`krl pendant TARGET --no-browser ARGS...`: yields the URL it printed first. Its stderr
-    goes to a file (a pipe nobody reads would stall the server once full), shown on failure."""
-    cmd = [sys.executable, "-m", "krl.cli", "pendant", str(target), "--no-browser", *args]
-    with tempfile.TemporaryFile("w+") as err:
-        proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=err, text=True, cwd=REPO_ROOT,
-                                env={**os.environ, "PYTHONUNBUFFERED": "1"})
-        try:
-            url = proc.stdout.readline().strip()
-            if not url.startswith("http://127.0.0.1:"):
-                proc.kill()
-                proc.wait(30)
-                err.seek(0)
-                raise AssertionError(f"krl pendant printed {url!r} first; stderr:\n{err.read()[-3000:]}")
-            try:
-                yield url
-            except BaseException:
-                err.seek(0)
-                print(f"krl pendant's stderr:\n{err.read()[-5000:]}", file=sys.stderr)
-                raise
-        finally:
-            proc.terminate()
-            try:
-                proc.wait(30)
-            except subprocess.TimeoutExpired:
-                proc.kill()
-                proc.wait(30)
+    """`krl pendant TARGET --no-browser ARGS...` (pendant/client.py): yields the URL it printed
+    first; its stderr is shown on failure."""
+    with client.pendant_server(target, *args, root=REPO_ROOT) as (_proc, url):
+        yield url
 
 
 @contextmanager
@@ -77,7 +51,7 @@ def browser_page(pw, url: str, viewport=(1400, 900)):
         # bypass_csp: Playwright's wait_for_function evaluates its predicate, which the page's
         # Content-Security-Policy (script-src 'self') forbids; the page itself runs under it
         ctx = pw.chromium.launch_persistent_context(profile, executable_path=chromium_or_skip(), headless=True,
-                                                    args=FLAGS, bypass_csp=True,
+                                                    args=client.CHROMIUM_FLAGS, bypass_csp=True,
                                                     viewport={"width": viewport[0], "height": viewport[1]})
         # every Playwright wait and action (a click waits for its element) gets the loaded
         # machine's time limit, not Playwright's 30 s
