@@ -151,6 +151,11 @@ MAX_PASS_EVENTS = 4096
 #: the most events between two state probes after probes that found the state changed (a
 #: probe costs what the idle watch's state_of costs: milliseconds on a large backup)
 MAX_PROBE_GAP = 65536
+#: the state probes of a bounded trace image at most this many values (fields, elements,
+#: slots: the probe's second result) per event accounted, over the run: a probe of a large
+#: backup's state (tens of thousands of values, milliseconds) waits until the events since
+#: the start pay for it, so the probes cost a bounded share of the run whatever the state's size
+PROBE_VALUES_PER_EVENT = 16
 _REQUIRED = {k: tuple(f for f, d in v if not d.startswith("optional")) for k, v in SCHEMA.items()}
 _ORDER = {k: tuple(f for f, _ in v) for k, v in SCHEMA.items()}
 
@@ -216,11 +221,16 @@ class TraceWriter:
     targets; not the motion and message ids, which only count, nor an ``idle`` jump's times),
     back to back, for a whole pass (at most :data:`MAX_PASS_EVENTS` events), *and* the state of
     the run the same at the ends of two passes: :attr:`state_probe`, set by the runtime (the
-    idle watch's ``state_of``: data lists, frames, system variables, I/O image, interrupts),
-    is called at the end of pass N-1 and N, so a counter loop (``N = N + 1``, whose
-    statements repeat, whose state does not) keeps every event. While a spin is left out the
-    state is compared again after 2N, 4N, ... passes; a change ends the spin. Without a probe
-    the events alone decide. A pose equal to the one before (the robot at rest) is an event
+    idle watch's ``state_of``: data lists, frames, system variables, I/O image, interrupts;
+    it returns the image and the number of values imaged), is called at the end of pass N-1
+    and N, so a counter loop (``N = N + 1``, whose statements repeat, whose state does not)
+    keeps every event. While a spin is left out the state is compared again after 2N, 4N, ...
+    passes; a change ends the spin. The probes keep to a budget of
+    :data:`PROBE_VALUES_PER_EVENT` values imaged per event: a probe over budget waits for a
+    later end of pass (the capture, the comparison with it, or the recheck of a spin moves
+    later, never earlier), so the bounding costs a bounded share of the run also on a backup
+    with a large state; being counted, the budget is the same in every run and interpreter.
+    Without a probe the events alone decide. A pose equal to the one before (the robot at rest) is an event
     of the pass like the others (a WAIT FOR at rest is a pass of one pose); a pose that differs
     (the robot moves) is progress: no event repeats one before it. Before the next written event a ``repeat`` event says how
     many events of each kind were left out, since when, how many whole passes and of how many
@@ -246,8 +256,9 @@ class TraceWriter:
         self._pose_count = 0
         self.closed = False
         self.repeats = repeats
-        #: () -> a comparable image of the run's state, or None: the events alone decide a spin
-        self.state_probe: Callable[[], Any] | None = None
+        #: () -> (a comparable image of the run's state, values imaged), or None: the events
+        #: alone decide a spin
+        self.state_probe: Callable[[], tuple[Any, int]] | None = None
         self._spin = _Spin(repeats, self) if repeats is not None else None
         self._left: dict[str, int] = {}  # kind -> events left out since the last repeat event
         self._left_since: float | None = None
@@ -256,6 +267,7 @@ class TraceWriter:
         self._left_period = 0            # events in their pass
         self._probe_after = 0            # no state probe before this many events (_Pass._end_of)
         self._probe_gap = 0
+        self._probe_spent = 0            # values imaged by the state probes so far
         self._last_pose = None           # (axes) of the last pose queued
 
     @property
@@ -380,6 +392,15 @@ class TraceWriter:
             self._fh.write(line)
             self._fh.write("\n")
 
+    def _probe(self) -> Any:
+        """The state image of :attr:`state_probe`, or None while the probes are over their
+        budget (:data:`PROBE_VALUES_PER_EVENT` values per event accounted so far)."""
+        if self._probe_spent > PROBE_VALUES_PER_EVENT * self._spin.every.n:
+            return None
+        state, values = self.state_probe()
+        self._probe_spent += values
+        return state
+
     def text(self) -> str:
         """The in-memory trace as one string (memory mode only)."""
         return "".join(line + "\n" for line in self.lines)
@@ -435,7 +456,9 @@ class _Spin:
     def left_out(self, key: str, pose: bool = False) -> bool:
         """Account event `key` (:func:`_content`; `pose`: a pose event); True when it is to be
         left out."""
-        done = self.every.step(key)
+        # while the programs' spin is confirmed it leaves their events out: the pass over every
+        # event would add only the poses at rest between, so it probes no state meanwhile
+        done = self.every.step(key, probe=pose or not self.program.confirmed)
         if not pose:
             inner = self.program.step(key)  # always: its history must see every event
             done = done or inner
@@ -478,8 +501,9 @@ class _Pass:
         self.recheck = 0                  # copy at whose end a confirmed spin's state is compared
         self.passes_ended = 0             # 1 when the event left out ended a pass
 
-    def step(self, key: str) -> "_Pass | None":
-        """Account event `key`; returns self when it is to be left out."""
+    def step(self, key: str, probe: bool = True) -> "_Pass | None":
+        """Account event `key`; returns self when it is to be left out. `probe` False: no
+        state probe at this event (as if over budget, :meth:`_end_of`)."""
         i = self.n
         self.n += 1
         hist = self.hist
@@ -491,7 +515,7 @@ class _Pass:
             out = self if self.confirmed else None
             end = self.match % p == 0
             if end:
-                self._end_of(copy)
+                self._end_of(copy, probe)
             self.passes_ended = 1 if end else 0
         else:
             self.unlock()
@@ -504,29 +528,34 @@ class _Pass:
             self.last = {k: v for k, v in self.last.items() if v > i - MAX_PASS_EVENTS}
         return out
 
-    def _end_of(self, copy: int) -> None:
-        """Copy `copy` of the pass ended: capture or compare the state."""
-        probe = self.writer.state_probe
-        if probe is None:
+    def _end_of(self, copy: int, probe: bool = True) -> None:
+        """Copy `copy` of the pass ended: capture or compare the state (`probe` False: not
+        now, as over budget)."""
+        w = self.writer
+        if w.state_probe is None:
             self.confirmed = copy >= self.repeats
             return
         if self.confirmed:
             if copy >= self.recheck:
-                state = probe()
+                state = w._probe() if probe else None
+                if state is None:
+                    return                       # over budget: at a later end of pass
                 if state != self.ref[1]:
                     self.confirmed = False       # the state changed: write again
                     self.ref, self.capture, self.gap = (copy, state), copy, 1
                 else:
                     self.recheck = 2 * copy
             return
-        w = self.writer
         if copy == self.capture:
-            if w._spin.every.n < w._probe_after:
-                self.capture += 1            # the state changed lately: not yet (cost of the probe)
+            state = None if not probe or w._spin.every.n < w._probe_after else w._probe()
+            if state is None:
+                self.capture += 1            # the state changed lately, or over budget: not yet
             else:
-                self.ref = (copy, probe())
-        elif self.ref is not None and copy == self.ref[0] + 1:
-            state = probe()
+                self.ref = (copy, state)
+        elif self.ref is not None and copy > self.ref[0]:
+            state = w._probe() if probe else None
+            if state is None:
+                return                       # over budget: compare at a later end of pass
             if state == self.ref[1]:
                 self.confirmed = True
                 self.recheck = 2 * copy

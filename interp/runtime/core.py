@@ -23,7 +23,7 @@ from .contexts import Context, Irq
 from .watch import split_watch
 from .convert import assign_into, binary_op, convert_scalar, to_bool, trunc_int, unary_op
 from .errors import (HaltSignal, KrlRuntimeError, ResumeSignal, StopRun)
-from .idle import state_of
+from .idle import probe_state
 from .memory import DataMemory, Frame, ProxyRef, Ref, SignalRef, Slot, field_ref, index_ref
 from .messages import MessageWindow
 from .motion import frame_of, params_from, request, segment, target_of
@@ -202,7 +202,7 @@ class Runtime:
         for writer in (self.trace, getattr(self.controller, "trace", None)):
             if hasattr(writer, "state_probe"):
                 # a bounded trace leaves a pass out only when the state repeats too (robot/trace.py)
-                writer.state_probe = lambda: state_of(self)
+                writer.state_probe = lambda: probe_state(self)
         old = sys.getrecursionlimit()
         sys.setrecursionlimit(max(old, 20000))
         try:

@@ -69,6 +69,9 @@ MAX_PHASES = 64
 _SCALARS = (int, float, bool, str, type(None))
 #: classes of the immutable leaf values: a sequence of only these is its own image (freeze)
 _FLAT = frozenset((int, float, bool, str, type(None), EnumValue, type(UNSET)))
+#: values imaged by :func:`freeze` and :func:`_store` so far (fields, elements, slots): the
+#: cost of a state image, counted the same way by both interpreters (:func:`probe_state`)
+_IMAGED = [0]
 
 
 def freeze(v):
@@ -84,11 +87,13 @@ def freeze(v):
         return v
     if c is Struct:
         f = v.f
+        _IMAGED[0] += len(f)
         if _FLAT.issuperset(map(type, f.values())):
             return (1, tuple(f.items()))
         return (1, tuple([(k, freeze(x)) for k, x in f.items()]))
     if c is Arr:
         d = v.data
+        _IMAGED[0] += len(d)
         if _FLAT.issuperset(map(type, d)):
             return (2, tuple(d))
         return (2, tuple([x if x.__class__ in _SCALARS else freeze(x) for x in d]))
@@ -101,6 +106,7 @@ def freeze(v):
 
 def _store(store) -> tuple:
     """The image of a frame's or a data list's slots (their values by :func:`freeze`)."""
+    _IMAGED[0] += len(store)
     return tuple([x if x.__class__ in _SCALARS else freeze(x) for x in store])
 
 
@@ -130,6 +136,16 @@ def state_of(rt) -> tuple:
     ioimg = (bytes(io._in), bytes(io._out), tuple(io._anin), tuple(io._anout),
              tuple(io.timer_stop), timers)
     return (mods, tuple(tasks), sysvars, ioimg, rt.msg_handle)
+
+
+def probe_state(rt) -> tuple[tuple, int]:
+    """``(state_of(rt), values)``: the state and the number of values its image walked
+    (fields, elements and slots), the probe's cost in a unit both interpreters count alike.
+    A bounded trace (robot/trace.py ``TraceWriter.state_probe``) keeps its probes within a
+    budget of this count."""
+    before = _IMAGED[0]
+    state = state_of(rt)
+    return state, _IMAGED[0] - before
 
 
 class IdleWatch:

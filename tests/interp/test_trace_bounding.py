@@ -203,3 +203,71 @@ def test_the_writer_alone_bounds_by_the_events():
     assert sum(1 for e in ev if e["kind"] == "stmt") == 11
     for e in ev:
         validate_event(e)
+
+
+def test_the_state_probes_keep_to_their_budget():
+    """A probe that images 100 000 values (a large backup's data lists) may run once per
+    100 000 / PROBE_VALUES_PER_EVENT (16) = 6250 events: over 200 events of a 2-event pass the
+    first probe (the capture at the end of pass 9) is the only one, so the spin is never
+    confirmed and every event is written; a probe of 10 values confirms it at the end of pass
+    10 (capture at 9, comparison at 10), as before the budget: 20 events written, 180 counted."""
+    for values, probes_expected, written_expected in ((100_000, 1, 200), (10, None, 20)):
+        tw = TraceWriter(keep=True, repeats=10)
+        calls = []
+
+        def probe(values=values, calls=calls):
+            calls.append(values)
+            return "same", values
+
+        tw.state_probe = probe
+        for k in range(100):
+            tw.write("stmt", 0.012 * k, file="a.src", line=4, context="main")
+            tw.write("io", 0.012 * k, signal="$OUT[2]", value=True, source="program")
+        tw.close()
+        ev = tw.events
+        assert sum(1 for e in ev if e["kind"] != "repeat") == written_expected
+        assert sum(e["count"] for e in ev if e["kind"] == "repeat") == 200 - written_expected
+        if probes_expected is not None:
+            assert len(calls) == probes_expected
+        assert tw._probe_spent <= 16 * 200 + values
+
+
+BIG = """
+DEF bigblink()
+  INT BIG[40000]
+  INT I
+  FOR I = 1 TO 40000
+    BIG[I] = I
+  ENDFOR
+  LOOP
+    $OUT[1] = NOT $OUT[1]
+  ENDLOOP
+END
+"""
+
+
+def test_a_large_state_costs_probes_in_proportion_to_the_events(tmp_path):
+    """The blink loop beside a local array of 40 000 values: each state probe images them all.
+    The probes image at most PROBE_VALUES_PER_EVENT (16) values per event plus one probe's
+    worth, the events written and counted are still the unbounded trace's, and both
+    interpreters write the same events."""
+    from robot.trace import PROBE_VALUES_PER_EVENT
+
+    assert PROBE_VALUES_PER_EVENT == 16
+    prog = write(tmp_path, "bigblink.src", BIG)
+    _rt, full_res, full = _run(prog, repeats=None, max_sim_time=2.0, fast=False)
+    per = []
+    for interp in INTERPS:
+        tw = TraceWriter(keep=True, repeats=TRACE_REPEATS)
+        rt, _ = make_runtime(prog, trace=tw, max_sim_time=2.0, mujoco=False, check=False, interp=interp)
+        rt.scheduler.idle.enabled = False
+        res = rt.run()
+        tw.close()
+        events = tw.events
+        assert res.steps == full_res.steps
+        written = sum(1 for e in events if e["kind"] != "repeat")
+        assert written + sum(e["count"] for e in events if e["kind"] == "repeat") == len(full)
+        assert tw._probe_spent <= 16 * len(full) + 40_002 + 100
+        assert any(e["kind"] == "repeat" for e in events)
+        per.append(events)
+    assert per[0] == per[1]
