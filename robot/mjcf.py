@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from typing import Any
 from xml.sax.saxutils import quoteattr
 
 import numpy as np
@@ -195,6 +196,34 @@ def _ext_home(m: MachineData, home: list[float]) -> list[float]:
 _BOTTOM_ROW = np.array([0.0, 0.0, 0.0, 1.0])
 
 
+def _arm_cycle(arm: "ArmModel") -> Any:
+    """robot/simcore.pyx's ``ArmCycle`` for `arm`, or None (see :meth:`ArmModel.compiled_cycle`).
+    ``mj_kinematics`` is looked up in the MuJoCo library the ``mujoco`` package ships and has
+    loaded (the same library: loading it again gives the loaded one)."""
+    from . import kinematics  # noqa: PLC0415  (the compiled module's one switch and ABI check)
+
+    sc = kinematics._simcore
+    if (arm.actuated or len(arm._eadr) or sc is None or not kinematics.USE_COMPILED
+            or getattr(sc, "ABI", None) != kinematics.SIMCORE_ABI):
+        return None
+    try:
+        import ctypes  # noqa: PLC0415
+        import glob  # noqa: PLC0415
+        import os  # noqa: PLC0415
+
+        libs = sorted(glob.glob(os.path.join(os.path.dirname(arm._mj.__file__), "libmujoco*")))
+        if not libs:
+            return None
+        fn = ctypes.cast(ctypes.CDLL(libs[0]).mj_kinematics, ctypes.c_void_p).value
+        m, d = arm.model._address, arm.data._address
+        qidx = list(range(arm._qidx.start, arm._qidx.stop)) if isinstance(arm._qidx, slice) \
+            else [int(i) for i in arm._qidx]
+        xmat, xpos = arm.data.site_xmat[arm._site], arm.data.site_xpos[arm._site]
+        return sc.ArmCycle(fn, m, d, arm.data.qpos, qidx, arm._sign.tolist(), xmat, xpos)
+    except (OSError, AttributeError, TypeError, ValueError):
+        return None
+
+
 class ArmModel:
     """The MuJoCo arm, driven in KUKA axis values (deg) and read back in mm.
 
@@ -228,6 +257,7 @@ class ArmModel:
         self._robroot = frame_to_matrix(self.machine.robroot_frame)
         self._robroot_inv = inv_pos(self._robroot)
         self._robroot_null = bool(np.allclose(self._robroot, np.eye(4)))
+        self._cycle: Any = None      # compiled_cycle's ArmCycle; False: none
         self.set_axes(self.machine.home_deg)
 
     # ------------------------------------------------------------------ replay
@@ -246,6 +276,15 @@ class ArmModel:
             self._mj.mj_forward(self.model, d)
         else:
             self._mj.mj_kinematics(self.model, d)
+
+    def compiled_cycle(self) -> Any:
+        """The compiled kinematic playback of one IPO cycle (robot/simcore.pyx ``ArmCycle``:
+        :meth:`set_axes`, :meth:`axes_deg` and :meth:`flange_pose_world` in one call, the same
+        numbers), kept; None in actuated mode, with external axes, without the compiled module
+        or without MuJoCo's library at hand (the Python methods run then)."""
+        if self._cycle is None:
+            self._cycle = _arm_cycle(self) or False
+        return self._cycle or None
 
     def axes_deg(self) -> np.ndarray:
         """Current A1..A6 (deg) read back from ``qpos``, then E1..En (mm, deg) when the robot

@@ -19,7 +19,7 @@ import numpy as np
 
 #: Bumped whenever the mirrored Python code changes (robot/kinematics.py checks it: a stale
 #: build is not used).
-ABI = 2
+ABI = 3
 
 cdef double DEG_TO_RAD = M_PI / 180.0
 cdef double RAD_TO_DEG = 180.0 / M_PI
@@ -179,22 +179,59 @@ cdef class OPW:
             M[4 * i + 3] = p[i]
         return self._inverse(M, status, turn, ref6)
 
+    def inverse_chain_rp(self, const double[:, :, :] R, const double[:, :] p, status, turn,
+                         const double[:] ref6):
+        """:meth:`inverse_rp` of each pose (R[j] (3x3), p[j] (3,)) in turn, each solution the
+        next one's reference (the first one's: ref6): the axes (n, 6), the rows those of n
+        calls of :meth:`inverse_rp` bit for bit, or None as soon as one of them would be None
+        (the caller then solves pose by pose for the error). Issue 39: the planner's samples
+        of a CP segment."""
+        cdef Py_ssize_t n = R.shape[0], j
+        cdef double M[12]
+        cdef double ref[6]
+        cdef int i, k
+        if p.shape[0] != n:
+            raise ValueError("R and p hold different numbers of poses")
+        res = np.empty((n, 6))
+        cdef double[:, :] out = res
+        for i in range(6):
+            ref[i] = ref6[i]
+        for j in range(n):
+            for i in range(3):
+                for k in range(3):
+                    M[4 * i + k] = R[j, i, k]
+                M[4 * i + 3] = p[j, i]
+            if not self._solve(M, status, turn, ref, &out[j, 0]):
+                return None
+            for i in range(6):
+                ref[i] = out[j, i]
+        return res
+
     cdef object _inverse(self, const double* M, status, turn, const double[:] ref6):
         cdef double ref[6]
+        cdef double[:] rv
+        cdef int i
+        for i in range(6):
+            ref[i] = ref6[i]
+        res = np.empty(6)
+        rv = res
+        if not self._solve(M, status, turn, ref, &rv[0]):
+            return None
+        return res
+
+    cdef int _solve(self, const double* M, status, turn, const double* ref, double* best_q) except -1:
+        """The selected axes of pose M (3x4, row-major) for the reference `ref` into best_q;
+        0 where the Python code raises or takes a path not mirrored here."""
         cdef double rows[48]
         cdef double q[6]
-        cdef double best_q[6]
         cdef int i, j, kk, n, s_target, free, keep, s_r, amb, tmask = 0, use_turn = 0
         cdef int nmatch = 0, have_best = 0, ok
         cdef double c, d, best_c, best_d, cost, best_cost = 0.0
         cdef int found
         cdef const double* b
-        cdef double[:] rv
-        for i in range(6):
-            ref[i] = ref6[i]
         n = self._core(M, ref, rows)
         if n == 0:
-            return None
+            return 0
         if status is not None:
             s_target = (<int>status) & 7
             free = 0
@@ -239,13 +276,85 @@ cdef class OPW:
                     best_cost = cost
                     for i in range(6):
                         best_q[i] = q[i]
-        if not have_best:
-            return None
-        res = np.empty(6)
-        rv = res
+        return have_best
+
+
+
+
+# ----------------------------------------------------------------------------- the IPO cycle
+def speed_ok(const double[:] q, const double[:] q_prev, const double[:] lim):
+    """True when no axis moves more than its limit in one cycle: ``abs(q[i] - q_prev[i]) <=
+    lim[i]`` over the shortest of the three (robot/controller.py ``_check_speed``, which gives
+    the error on False; a NaN step passes, as there)."""
+    cdef Py_ssize_t n = min(q.shape[0], q_prev.shape[0], lim.shape[0]), i
+    for i in range(n):
+        if fabs(q[i] - q_prev[i]) > lim[i]:
+            return False
+    return True
+
+
+ctypedef void (*_mj_kinematics_t)(const void* m, void* d) noexcept nogil
+
+
+cdef class ArmCycle:
+    """The kinematic playback of one IPO cycle on a MuJoCo arm (robot/mjcf.py ``ArmModel``
+    without external axes): ``set_axes`` (``qpos = sign * radians(A)``, ``mj_kinematics``),
+    ``axes_deg`` (``degrees(sign * qpos)``) and ``flange_pose_world`` (the ``tool0`` site,
+    position in mm) in one call, the same numbers (numpy's ``radians``/``degrees`` are one
+    multiplication by pi/180 and 180/pi). ``mj_kinematics`` is MuJoCo's own, called through
+    its address in the library the ``mujoco`` package loaded, on the model and data
+    addresses the package gives (``_address``); the arrays are views into that data, so the
+    caller keeps the ``ArmModel`` alive while this object is used."""
+
+    cdef _mj_kinematics_t fn
+    cdef size_t m, d
+    cdef object keep
+    cdef double* qpos
+    cdef const double* xmat
+    cdef const double* xpos
+    cdef int qidx[6]
+    cdef double sign[6]
+
+    def __init__(self, size_t fn, size_t m, size_t d, qpos, qidx, sign, site_xmat, site_xpos):
+        cdef double[::1] qp = qpos
+        cdef const double[::1] xm = site_xmat
+        cdef const double[::1] xp = site_xpos
+        cdef int i
+        if fn == 0 or m == 0 or d == 0 or len(qidx) != 6 or len(sign) != 6:
+            raise ValueError("ArmCycle: no mj_kinematics, model or data")
+        if xm.shape[0] != 9 or xp.shape[0] != 3:
+            raise ValueError("ArmCycle: the site's xmat is 9 values and its xpos 3")
         for i in range(6):
-            rv[i] = best_q[i]
-        return res
+            if not 0 <= qidx[i] < qp.shape[0]:
+                raise ValueError("ArmCycle: a qpos index out of range")
+            self.qidx[i] = qidx[i]
+            self.sign[i] = sign[i]
+        self.fn = <_mj_kinematics_t>fn
+        self.m, self.d = m, d
+        self.keep = (qpos, site_xmat, site_xpos)
+        self.qpos = &qp[0]
+        self.xmat = &xm[0]
+        self.xpos = &xp[0]
+
+    def cycle(self, const double[:] q, double[::1] qa, double[:, ::1] F):
+        """Set the axes q (A1..A6, deg; further values ignored), run ``mj_kinematics``, and
+        write the axes read back (deg) into qa (6,) and the flange in WORLD (4x4, mm) into F."""
+        cdef int i, j
+        if q.shape[0] < 6 or qa.shape[0] != 6 or F.shape[0] != 4 or F.shape[1] != 4:
+            raise ValueError("ArmCycle.cycle: q (>= 6,), qa (6,), F (4, 4)")
+        for i in range(6):
+            self.qpos[self.qidx[i]] = self.sign[i] * (q[i] * DEG_TO_RAD)
+        self.fn(<const void*>self.m, <void*>self.d)
+        for i in range(6):
+            qa[i] = (self.sign[i] * self.qpos[self.qidx[i]]) * RAD_TO_DEG
+        for i in range(3):
+            for j in range(3):
+                F[i, j] = self.xmat[3 * i + j]
+            F[i, 3] = 1000.0 * self.xpos[i]
+        F[3, 0] = 0.0
+        F[3, 1] = 0.0
+        F[3, 2] = 0.0
+        F[3, 3] = 1.0
 
 
 # ----------------------------------------------------------------------------- trace lines
