@@ -58,7 +58,7 @@ LIMIT_EPS_DEG = 1e-9
 #: (the reference: the two agree bit for bit, tests/robot/test_simcore.py)
 USE_COMPILED = True
 #: The ``ABI`` of robot/simcore.pyx this module mirrors (a stale build is not used)
-SIMCORE_ABI = 3
+SIMCORE_ABI = 4
 
 
 def _wrap180(v: np.ndarray) -> np.ndarray:

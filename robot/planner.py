@@ -40,6 +40,7 @@ from scipy.spatial.transform import Rotation
 
 from .errors import RobotError, WorkspaceError
 from .frames import frame_to_matrix, inv_pos, matrix_to_frame
+from . import kinematics
 from .kinematics import Kinematics
 from .motion import AXIS_KEYS, CART_KEYS, EXT_KEYS, MotionParams, MotionRequest, Trigger
 from .limits import DEFAULT_MODE, T1_SPEED_MM_S, cp_path_speed, motion_limits, ptp_axis_speeds
@@ -526,6 +527,7 @@ class Segment:
         self._ik_tool = None if np.array_equal(self.tool_inv_T, eye) else self.tool_inv_T
         self._ik_base = None if np.array_equal(base_T, eye) else base_T
         self._c_ik: Any = None      # CartSegment.ik's compiled inverse (robot/simcore.pyx), False: none
+        self._c_path: Any = None    # CartSegment's compiled poses (robot/simcore.pyx CartPath), False: none
         self.model = model
         self.status = model.status_turn(q0)[0]
         self.triggers: list[TriggerPlan] = []
@@ -685,6 +687,16 @@ class CartSegment(Segment):
 
     def pose_u(self, u: float) -> tuple[np.ndarray, np.ndarray]:
         """TCP position (mm, (3,)) and rotation matrix (3, 3) in $BASE at parameter u."""
+        cp = self._c_path
+        if cp is None:
+            cp = self._compiled_path()
+        if cp:
+            try:
+                pr = cp.pose_u(u)      # the same pose, compiled (robot/simcore.pyx CartPath)
+            except (TypeError, ValueError):
+                pr = None
+            if pr is not None:
+                return pr
         k, f = self._locate(u)
         piece = self.pieces[k]
         p = piece.pos(f * piece.length)
@@ -734,6 +746,25 @@ class CartSegment(Segment):
             ref = np.concatenate([ref[:6], self.q0[6:] + u * (self.e1 - self.q0[6:])])
         return self.model.ik(T, self._ik_tool, self._ik_base, self.status, None, ref)
 
+    def _compiled_path(self) -> Any:
+        """robot/simcore.pyx's ``CartPath`` of this segment's lines and arcs (kept; with the
+        compiled inverse when :meth:`ik` runs it), or False (no compiled module, external
+        axes, ``$ORI_TYPE #JOINT``)."""
+        if self._c_path is None:
+            self._c_path = False
+            sc = kinematics._simcore
+            if (sc is not None and kinematics.USE_COMPILED and getattr(sc, "ABI", None) == kinematics.SIMCORE_ABI
+                    and len(self.q0) == 6 and not self.joint_ori):
+                self._c_path = _cart_path(sc, self) or False
+        return self._c_path
+
+    def compiled_inverse(self) -> Any:
+        """The compiled inverse :meth:`ik` runs on its poses as they stand (kept), or False."""
+        c = self._c_ik
+        if c is None:
+            c = self._c_ik = self._compiled_ik()
+        return c
+
     def _compiled_ik(self) -> Any:
         """The compiled inverse for :meth:`ik`'s poses as they stand, or False."""
         m = self.model
@@ -746,6 +777,21 @@ class CartSegment(Segment):
         """:meth:`ik` of each pose with the previous solution as reference (the first: `ref`),
         solved at once (:meth:`RobotModel.ik_chain`): (n, 6) axes, or None (solve one by one)."""
         return self.model.ik_chain(poses, self._ik_tool, self._ik_base, self.status, ref)
+
+    def ik_chain_compiled(self, poses: list[tuple[np.ndarray, np.ndarray]], ref: np.ndarray) -> np.ndarray | None:
+        """:meth:`ik` of each pose with the previous solution as reference (the first: `ref`)
+        in one call of the compiled inverse (robot/simcore.pyx ``inverse_chain_rp``, the rows of
+        the calls :meth:`ik` makes, bit for bit): (n, 6) axes, or None where :meth:`ik` does
+        not run the compiled inverse as it stands or some pose needs the Python code (the
+        caller solves pose by pose, which raises the error)."""
+        c = self.compiled_inverse()
+        if not c or not poses or len(ref) != 6:
+            return None
+        R = np.array([pr[1] for pr in poses], dtype=float)
+        p = np.array([pr[0] for pr in poses], dtype=float)
+        if R.shape != (len(poses), 3, 3) or p.shape != (len(poses), 3):
+            return None
+        return c.inverse_chain_rp(R, p, self.status, None, np.asarray(ref, dtype=float))
 
     def axes_run(self, pt: float, t0: float, dt: float, end: float) -> np.ndarray:
         """:meth:`axes` at ``tau = pt - t0`` for the main run, which advances ``pt`` by `dt`
@@ -806,6 +852,18 @@ class CartSegment(Segment):
             u = self.profile.u(tau)
             q = self.ik(*self.pose_u(u), self._last_q, u)
         else:
+            cp = self._c_path
+            if cp is None:
+                cp = self._compiled_path()
+            if cp:
+                # pose_u and ik in one compiled call (the same axes); None: the code below
+                try:
+                    q = cp.axes_u(self.profile.u(tau), self.status, self._last_q)
+                except (TypeError, ValueError):
+                    q = None
+                if q is not None:
+                    self._last_q = q
+                    return q
             p, R = self.pose(tau)
             q = self.ik(p, R, self._last_q)
         self._last_q = q
@@ -837,6 +895,40 @@ class CartSegment(Segment):
     @property
     def ori_angle(self) -> float:
         return self.ori_angle_to_end(0.0)
+
+
+def _cart_path(sc: Any, seg: "CartSegment") -> Any:
+    """robot/simcore.pyx's ``CartPath`` of `seg`'s pieces (see ``CartSegment._compiled_path``):
+    lines and arcs with the rotations ``CartSegment.pose_u`` holds, other pieces (splines, a
+    ``#PATH`` orientation) marked for the Python code; None when no piece is mirrored."""
+    n = len(seg.pieces)
+    kinds = np.full(n, -1, dtype=np.intc)
+    mid_ok = np.zeros(n, dtype=np.intc)
+    length, r, angle = np.zeros(n), np.ones(n), np.zeros(n)
+    a, b, c = np.zeros((n, 3)), np.zeros((n, 3)), np.zeros((n, 3))
+    rots = np.zeros((n, 3, 3, 3))
+    for k, pc in enumerate(seg.pieces):
+        mode = seg.ori[k]
+        if mode == "VAR":
+            rots[k, 0], rots[k, 2] = seg._R[k], seg._R[k + 1]
+            if seg._R_still[k] is not None:
+                rots[k, 1], mid_ok[k] = seg._R_still[k], 1
+        elif mode == "CONSTANT":
+            rots[k, 0] = rots[k, 1] = rots[k, 2] = seg._R[k]
+            mid_ok[k] = 1
+        else:
+            continue
+        if type(pc) is LinePiece:
+            kinds[k], a[k], b[k] = 0, pc.p0, pc.dir
+        elif type(pc) is ArcPiece:
+            kinds[k], a[k], b[k], c[k], r[k], angle[k] = 1, pc.c, pc.e1, pc.e2, pc.r, pc.angle
+        else:
+            continue
+        length[k] = pc.length
+    if not (kinds >= 0).any():
+        return None
+    opw = seg.compiled_inverse() or None
+    return sc.CartPath(opw, np.asarray(seg._ub, dtype=float), kinds, mid_ok, length, r, angle, a, b, c, rots)
 
 
 # ------------------------------------------------------------------------- planning
@@ -1170,14 +1262,20 @@ def _plan_cart(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_T: 
             chain = None
             if len(q0) == 6 and nk >= MIN_CHAIN and model.batch_ik:
                 chain = seg.ik_chain([seg.pose_u(float(us[j])) for j in range(1, nk + 1)], ref)
+            elif len(q0) == 6 and seg.compiled_inverse():
+                # the poses and the compiled inverse along the samples in one call (the same
+                # rows); else the poses here and the inverse in one call
+                cp = seg._compiled_path()
+                chain = cp.chain_u(us[1:], seg.status, ref) if cp else None
+                if chain is None:
+                    chain = seg.ik_chain_compiled([seg.pose_u(float(us[j])) for j in range(1, nk + 1)], ref)
             if chain is not None:
                 # the same rows as the loop below; its singularity check, in its order
                 jumps = np.abs(np.diff(np.concatenate([Q[:1], chain]), axis=0))
-                for j in range(nk):
-                    if float(jumps[j].max()) > SINGULAR_JUMP_DEG:
-                        i = int(np.argmax(jumps[j]))
-                        raise RobotError(f"CP path through a singularity: A{i + 1} would turn "
-                                         f"{jumps[j][i]:.0f} deg at once (keep the status on CP paths)")
+                for j in np.flatnonzero(jumps.max(axis=1) > SINGULAR_JUMP_DEG)[:1].tolist():
+                    i = int(np.argmax(jumps[j]))
+                    raise RobotError(f"CP path through a singularity: A{i + 1} would turn "
+                                     f"{jumps[j][i]:.0f} deg at once (keep the status on CP paths)")
                 Q[1:] = chain
                 ref = Q[nk].copy()
             for j in range(1, nk + 1 if chain is None else 1):

@@ -19,7 +19,7 @@ import numpy as np
 
 #: Bumped whenever the mirrored Python code changes (robot/kinematics.py checks it: a stale
 #: build is not used).
-ABI = 3
+ABI = 4
 
 cdef double DEG_TO_RAD = M_PI / 180.0
 cdef double RAD_TO_DEG = 180.0 / M_PI
@@ -279,6 +279,154 @@ cdef class OPW:
         return have_best
 
 
+
+
+# ----------------------------------------------------------------------------- CP paths
+cdef class CartPath:
+    """The poses of a CP segment's lines and arcs, and their axes (``opw`` None: the poses only) (robot/planner.py
+    ``CartSegment.pose_u`` and ``CartSegment.ik`` with the compiled inverse, the same numbers):
+    for path parameter u the piece k and fraction f of ``CartSegment._locate``, the position
+    ``LinePiece.pos``/``ArcPiece.pos`` at ``s = f * length`` (libm's cos and sin, as ``math``)
+    and the rotation the segment keeps for that piece (at its start, within it and at its end:
+    the matrices the Python code holds; a rotation it would compute, such as a slerp between
+    two orientations, is not mirrored). A pose not mirrored (such a rotation, a spline piece)
+    gives None: the caller runs the Python code.
+
+    ``kinds`` per piece: 0 line (``a`` = p0, ``b`` = dir), 1 arc (``a`` = centre, ``b`` = e1,
+    ``c`` = e2, ``r``, ``angle``), -1 not mirrored; ``rots`` (n, 3, 3, 3): the rotation at
+    f <= 0, within, at f >= 1; ``mid_ok`` 0 where the rotation within is not mirrored."""
+
+    cdef OPW opw
+    cdef int n
+    cdef object keep
+    cdef const double[::1] ub
+    cdef const int[::1] kinds
+    cdef const int[::1] mid_ok
+    cdef const double[::1] length
+    cdef const double[::1] r
+    cdef const double[::1] angle
+    cdef const double[:, ::1] a
+    cdef const double[:, ::1] b
+    cdef const double[:, ::1] c
+    cdef const double[:, :, :, ::1] rots
+
+    def __init__(self, OPW opw, ub, kinds, mid_ok, length, r, angle, a, b, c, rots):
+        self.opw = opw
+        self.keep = (ub, kinds, mid_ok, length, r, angle, a, b, c, rots)
+        self.ub, self.kinds, self.mid_ok = ub, kinds, mid_ok
+        self.length, self.r, self.angle = length, r, angle
+        self.a, self.b, self.c, self.rots = a, b, c, rots
+        self.n = self.kinds.shape[0]
+        if (self.n < 1 or self.ub.shape[0] != self.n + 1 or self.mid_ok.shape[0] != self.n
+                or self.length.shape[0] != self.n or self.r.shape[0] != self.n
+                or self.angle.shape[0] != self.n or self.a.shape[0] != self.n or self.b.shape[0] != self.n
+                or self.c.shape[0] != self.n or self.rots.shape[0] != self.n or self.a.shape[1] != 3
+                or self.b.shape[1] != 3 or self.c.shape[1] != 3 or self.rots.shape[1] != 3
+                or self.rots.shape[2] != 3 or self.rots.shape[3] != 3):
+            raise ValueError("CartPath: inconsistent piece tables")
+
+    cdef int _pose(self, double u, double* M) noexcept:
+        """The pose at u into M (3x4, row-major); 0: not mirrored."""
+        cdef int n = self.n, k, lo, hi, mid, i, j, w
+        cdef double f, du, s, ph, cs, sn
+        if u <= 0.0:
+            k, f = 0, 0.0
+        elif u >= 1.0:
+            k, f = n - 1, 1.0
+        else:
+            # bisect_right(ub, u) - 1
+            lo, hi = 0, n + 1
+            while lo < hi:
+                mid = (lo + hi) // 2
+                if u < self.ub[mid]:
+                    hi = mid
+                else:
+                    lo = mid + 1
+            k = lo - 1
+            if k < 0:
+                k = 0
+            if k > n - 1:
+                k = n - 1
+            du = self.ub[k + 1] - self.ub[k]
+            f = (u - self.ub[k]) / du if du > 0 else 1.0
+        if self.kinds[k] < 0:
+            return 0
+        if f <= 0.0:
+            w = 0
+        elif f >= 1.0:
+            w = 2
+        else:
+            if not self.mid_ok[k]:
+                return 0
+            w = 1
+        s = f * self.length[k]
+        if self.kinds[k] == 0:
+            for i in range(3):
+                M[4 * i + 3] = self.a[k, i] + self.b[k, i] * s
+        else:
+            ph = copysign(s / self.r[k], self.angle[k]) if self.r[k] > 0 else 0.0
+            cs = cos(ph)
+            sn = sin(ph)
+            for i in range(3):
+                M[4 * i + 3] = self.a[k, i] + self.r[k] * (cs * self.b[k, i] + sn * self.c[k, i])
+        for i in range(3):
+            for j in range(3):
+                M[4 * i + j] = self.rots[k, w, i, j]
+        return 1
+
+    def pose_u(self, double u):
+        """(p (3,), R (3, 3)) at u, or None (not mirrored)."""
+        cdef double M[12]
+        cdef int i, j
+        if not self._pose(u, M):
+            return None
+        p = np.empty(3)
+        R = np.empty((3, 3))
+        cdef double[::1] pv = p
+        cdef double[:, ::1] Rv = R
+        for i in range(3):
+            pv[i] = M[4 * i + 3]
+            for j in range(3):
+                Rv[i, j] = M[4 * i + j]
+        return p, R
+
+    def axes_u(self, double u, status, const double[:] ref6):
+        """The axes (6,) at u for the reference ref6 (``CartSegment.ik`` of ``pose_u(u)``), or
+        None (not mirrored, or the Python inverse decides)."""
+        cdef double M[12]
+        cdef double ref[6]
+        cdef int i
+        if self.opw is None or ref6.shape[0] != 6 or not self._pose(u, M):
+            return None
+        for i in range(6):
+            ref[i] = ref6[i]
+        res = np.empty(6)
+        cdef double[::1] rv = res
+        if not self.opw._solve(M, status, None, ref, &rv[0]):
+            return None
+        return res
+
+    def chain_u(self, const double[:] us, status, const double[:] ref6):
+        """:meth:`axes_u` at each u of us in turn, each solution the next one's reference (the
+        first one's: ref6): (n, 6), or None as soon as one would be None."""
+        cdef Py_ssize_t n = us.shape[0], j
+        cdef double M[12]
+        cdef double ref[6]
+        cdef int i
+        if self.opw is None or ref6.shape[0] != 6:
+            return None
+        res = np.empty((n, 6))
+        cdef double[:, ::1] out = res
+        for i in range(6):
+            ref[i] = ref6[i]
+        for j in range(n):
+            if not self._pose(us[j], M):
+                return None
+            if not self.opw._solve(M, status, None, ref, &out[j, 0]):
+                return None
+            for i in range(6):
+                ref[i] = out[j, i]
+        return res
 
 
 # ----------------------------------------------------------------------------- the IPO cycle
