@@ -771,10 +771,15 @@ class Controller:
         cyc = arm.compiled_cycle() if arm is not None and not self.actuated else None
         if cyc is not None:
             # set_axes, axis_act and the flange site in one compiled call (the same numbers)
-            qa, F = np.empty(6), np.empty((4, 4))
+            qa, F, T = np.empty(6), np.empty((4, 4)), np.empty((4, 4))
             cyc.cycle(self._q, qa, F)
             self._tcp_prev = self._tcp_T[:3, 3].copy()
-            self._tcp_T = self._base_inv_T @ F @ self._tool_T      # _tcp_read_back's product
+            try:
+                # _tcp_read_back's product, numpy's own BLAS call (robot/mjcf.py _same_products)
+                done = cyc.product(self._base_inv_T, F, self._tool_T, T)
+            except (TypeError, ValueError):      # not C-contiguous float64: numpy multiplies
+                done = False
+            self._tcp_T = T if done else self._base_inv_T @ F @ self._tool_T
         else:
             if arm is not None:
                 if self.actuated:

@@ -219,9 +219,51 @@ def _arm_cycle(arm: "ArmModel") -> Any:
         qidx = list(range(arm._qidx.start, arm._qidx.stop)) if isinstance(arm._qidx, slice) \
             else [int(i) for i in arm._qidx]
         xmat, xpos = arm.data.site_xmat[arm._site], arm.data.site_xpos[arm._site]
-        return sc.ArmCycle(fn, m, d, arm.data.qpos, qidx, arm._sign.tolist(), xmat, xpos)
+        cyc = sc.ArmCycle(fn, m, d, arm.data.qpos, qidx, arm._sign.tolist(), xmat, xpos)
     except (OSError, AttributeError, TypeError, ValueError):
         return None
+    gemm = _numpy_dgemm()
+    if gemm:
+        cyc.use_gemm(gemm)
+        if not _same_products(cyc):
+            cyc.use_gemm(0)
+    return cyc
+
+
+def _numpy_dgemm() -> int:
+    """The address of the ILP64 ``cblas_dgemm`` numpy's own BLAS exports (the OpenBLAS a numpy
+    wheel bundles: ``scipy_cblas_dgemm64_``), 0 when there is none at hand."""
+    import ctypes  # noqa: PLC0415
+    import glob  # noqa: PLC0415
+    import os  # noqa: PLC0415
+
+    root = os.path.dirname(np.__file__)
+    for lib in sorted(glob.glob(os.path.join(root, "..", "numpy.libs", "*openblas64*"))
+                      + glob.glob(os.path.join(root, ".dylibs", "*openblas64*"))):
+        try:
+            return int(ctypes.cast(ctypes.CDLL(lib).scipy_cblas_dgemm64_, ctypes.c_void_p).value or 0)
+        except (OSError, AttributeError):
+            continue
+    return 0
+
+
+def _same_products(cyc: Any) -> bool:
+    """True when the compiled product gives numpy's ``A @ B @ C`` bit for bit on random 4x4
+    matrices (with identities and signed zeros): the check that the BLAS found is the one
+    numpy calls, the way numpy calls it."""
+    rng = np.random.default_rng(39)
+    out = np.empty((4, 4))
+    for i in range(64):
+        A, B, C = (rng.normal(0.0, 500.0, (4, 4)) for _ in range(3))
+        if i % 4 == 0:
+            A = np.eye(4)
+        if i % 3 == 0:
+            C = np.eye(4)
+        if i % 5 == 0:
+            B[rng.integers(0, 3), rng.integers(0, 4)] = -0.0
+        if not cyc.product(A, B, C, out) or out.tobytes() != (A @ B @ C).tobytes():
+            return False
+    return True
 
 
 class ArmModel:
@@ -280,7 +322,8 @@ class ArmModel:
     def compiled_cycle(self) -> Any:
         """The compiled kinematic playback of one IPO cycle (robot/simcore.pyx ``ArmCycle``:
         :meth:`set_axes`, :meth:`axes_deg` and :meth:`flange_pose_world` in one call, the same
-        numbers), kept; None in actuated mode, with external axes, without the compiled module
+        numbers; its ``product`` is numpy's ``A @ B @ C`` of 4x4 matrices when numpy's own BLAS
+        is found and gives the same products), kept; None in actuated mode, with external axes, without the compiled module
         or without MuJoCo's library at hand (the Python methods run then)."""
         if self._cycle is None:
             self._cycle = _arm_cycle(self) or False

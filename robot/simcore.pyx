@@ -442,6 +442,11 @@ def speed_ok(const double[:] q, const double[:] q_prev, const double[:] lim):
 
 
 ctypedef void (*_mj_kinematics_t)(const void* m, void* d) noexcept nogil
+#: cblas_dgemm of an ILP64 BLAS (numpy's own: the product numpy's ``@`` computes for two
+#: C-contiguous float64 4x4 matrices is this call, row-major, no transposes, alpha 1, beta 0)
+ctypedef void (*_dgemm_t)(int order, int ta, int tb, long long m, long long n, long long k,
+                          double alpha, const double* a, long long lda, const double* b,
+                          long long ldb, double beta, double* c, long long ldc) noexcept nogil
 
 
 cdef class ArmCycle:
@@ -455,8 +460,10 @@ cdef class ArmCycle:
     caller keeps the ``ArmModel`` alive while this object is used."""
 
     cdef _mj_kinematics_t fn
+    cdef _dgemm_t gemm
     cdef size_t m, d
     cdef object keep
+    cdef double[:, ::1] tmp
     cdef double* qpos
     cdef const double* xmat
     cdef const double* xpos
@@ -478,6 +485,8 @@ cdef class ArmCycle:
             self.qidx[i] = qidx[i]
             self.sign[i] = sign[i]
         self.fn = <_mj_kinematics_t>fn
+        self.gemm = NULL
+        self.tmp = np.empty((4, 4))
         self.m, self.d = m, d
         self.keep = (qpos, site_xmat, site_xpos)
         self.qpos = &qp[0]
@@ -503,6 +512,25 @@ cdef class ArmCycle:
         F[3, 1] = 0.0
         F[3, 2] = 0.0
         F[3, 3] = 1.0
+
+    def use_gemm(self, size_t gemm):
+        """Compute :meth:`product` with the BLAS ``cblas_dgemm`` at address `gemm` (the one
+        numpy calls; 0: none)."""
+        self.gemm = <_dgemm_t>gemm
+
+    def product(self, const double[:, ::1] A, const double[:, ::1] B, const double[:, ::1] C,
+                double[:, ::1] out):
+        """``out = (A @ B) @ C`` for C-contiguous 4x4 float64 matrices, as numpy's ``@`` computes
+        it (two ``cblas_dgemm`` calls with numpy's arguments, the first into a numpy-allocated
+        4x4); False without :meth:`use_gemm` (the caller multiplies with numpy)."""
+        if self.gemm == NULL:
+            return False
+        if (A.shape[0] != 4 or A.shape[1] != 4 or B.shape[0] != 4 or B.shape[1] != 4
+                or C.shape[0] != 4 or C.shape[1] != 4 or out.shape[0] != 4 or out.shape[1] != 4):
+            raise ValueError("ArmCycle.product: 4x4 matrices")
+        self.gemm(101, 111, 111, 4, 4, 4, 1.0, &A[0, 0], 4, &B[0, 0], 4, 0.0, &self.tmp[0, 0], 4)
+        self.gemm(101, 111, 111, 4, 4, 4, 1.0, &self.tmp[0, 0], 4, &C[0, 0], 4, 0.0, &out[0, 0], 4)
+        return True
 
 
 # ----------------------------------------------------------------------------- trace lines

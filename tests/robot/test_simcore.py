@@ -281,3 +281,29 @@ def test_the_trace_is_the_same_with_and_without_the_compiled_module(monkeypatch)
     monkeypatch.setattr(kinematics, "USE_COMPILED", False)
     monkeypatch.setattr(trace, "_pose_line", None)
     assert tracecheck.run_case("random-05") == compiled
+
+
+def test_the_compiled_tcp_product_is_numpys_matmul():
+    """The read-back's INV_POS($BASE) : FLANGE : $TOOL in numpy's own BLAS call: numpy's
+    ``@`` bit for bit (a C loop in the textbook order differs in the last bit: numpy's
+    OpenBLAS fuses multiply and add)."""
+    if simcore is None:
+        pytest.skip("not compiled")
+    from robot.frames import frame_to_matrix, inv_pos  # noqa: PLC0415
+    from robot.mjcf import ArmModel, _numpy_dgemm  # noqa: PLC0415
+
+    if not _numpy_dgemm():
+        pytest.skip("numpy without its bundled OpenBLAS: numpy multiplies")
+    cyc = ArmModel().compiled_cycle()
+    rng = np.random.default_rng(45)
+    out, F, qa = np.empty((4, 4)), np.empty((4, 4)), np.empty(6)
+    for i in range(5000):
+        cyc.cycle(rng.uniform(-170.0, 170.0, 6), qa, F)
+        tool = np.eye(4) if i % 3 == 0 else frame_to_matrix(*rng.uniform(-200.0, 200.0, 6))
+        base_inv = np.eye(4) if i % 4 == 0 else inv_pos(frame_to_matrix(*rng.uniform(-900.0, 900.0, 6)))
+        assert cyc.product(base_inv, F, tool, out)
+        assert out.tobytes() == (base_inv @ F @ tool).tobytes(), i
+    with pytest.raises(ValueError):                   # not C-contiguous: the caller's numpy
+        cyc.product(np.eye(4).T[:, ::-1], F, np.eye(4), out)
+    cyc.use_gemm(0)
+    assert cyc.product(np.eye(4), F, np.eye(4), out) is False
