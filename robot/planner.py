@@ -802,6 +802,8 @@ class CartSegment(Segment):
         else (a BRAKE, a new blend profile, a setpoint set from outside) solves again, so
         the result is always the one :meth:`axes` gives."""
         tau = pt - t0
+        if self._c_ik:                # the compiled inverse: cycle by cycle (no numpy chains)
+            return self.axes(tau)
         ahead = self._ahead
         if ahead is not None:
             prof, taus, refs, Q, i = ahead
