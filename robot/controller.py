@@ -771,15 +771,19 @@ class Controller:
         cyc = arm.compiled_cycle() if arm is not None and not self.actuated else None
         if cyc is not None:
             # set_axes, axis_act and the flange site in one compiled call (the same numbers)
-            qa, F, T = np.empty(6), np.empty((4, 4)), np.empty((4, 4))
-            cyc.cycle(self._q, qa, F)
+            qa, T = np.empty(6), np.empty((4, 4))
             self._tcp_prev = self._tcp_T[:3, 3].copy()
             try:
-                # _tcp_read_back's product, numpy's own BLAS call (robot/mjcf.py _same_products)
-                done = cyc.product(self._base_inv_T, F, self._tool_T, T)
-            except (TypeError, ValueError):      # not C-contiguous float64: numpy multiplies
+                # with _tcp_read_back's product in numpy's own BLAS call (robot/mjcf.py
+                # _same_products)
+                done = cyc.cycle_tcp(self._q, qa, self._base_inv_T, self._tool_T, T)
+            except (TypeError, ValueError):      # a frame not C-contiguous float64: numpy's @
                 done = False
-            self._tcp_T = T if done else self._base_inv_T @ F @ self._tool_T
+            if not done:
+                F = np.empty((4, 4))
+                cyc.cycle(self._q, qa, F)
+                T = self._base_inv_T @ F @ self._tool_T
+            self._tcp_T = T
         else:
             if arm is not None:
                 if self.actuated:

@@ -464,6 +464,7 @@ cdef class ArmCycle:
     cdef size_t m, d
     cdef object keep
     cdef double[:, ::1] tmp
+    cdef double[:, ::1] flange
     cdef double* qpos
     cdef const double* xmat
     cdef const double* xpos
@@ -487,6 +488,7 @@ cdef class ArmCycle:
         self.fn = <_mj_kinematics_t>fn
         self.gemm = NULL
         self.tmp = np.empty((4, 4))
+        self.flange = np.empty((4, 4))
         self.m, self.d = m, d
         self.keep = (qpos, site_xmat, site_xpos)
         self.qpos = &qp[0]
@@ -512,6 +514,16 @@ cdef class ArmCycle:
         F[3, 1] = 0.0
         F[3, 2] = 0.0
         F[3, 3] = 1.0
+
+    def cycle_tcp(self, const double[:] q, double[::1] qa, const double[:, ::1] base_inv,
+                  const double[:, ::1] tool, double[:, ::1] T):
+        """:meth:`cycle` (the flange into a buffer of this object) and ``T = (base_inv @ flange)
+        @ tool`` by :meth:`product`; False without :meth:`use_gemm`, before anything is set (the
+        caller then runs :meth:`cycle` and multiplies with numpy)."""
+        if self.gemm == NULL:
+            return False
+        self.cycle(q, qa, self.flange)
+        return self.product(base_inv, self.flange, tool, T)
 
     def use_gemm(self, size_t gemm):
         """Compute :meth:`product` with the BLAS ``cblas_dgemm`` at address `gemm` (the one
