@@ -495,12 +495,9 @@ cdef class ArmCycle:
         self.xmat = &xm[0]
         self.xpos = &xp[0]
 
-    def cycle(self, const double[:] q, double[::1] qa, double[:, ::1] F):
-        """Set the axes q (A1..A6, deg; further values ignored), run ``mj_kinematics``, and
-        write the axes read back (deg) into qa (6,) and the flange in WORLD (4x4, mm) into F."""
+    cdef void _play(self, const double[:] q, double* qa, double* F) noexcept:
+        """Set the axes q (its first 6), run mj_kinematics, read back qa (6) and F (4x4, row-major)."""
         cdef int i, j
-        if q.shape[0] < 6 or qa.shape[0] != 6 or F.shape[0] != 4 or F.shape[1] != 4:
-            raise ValueError("ArmCycle.cycle: q (>= 6,), qa (6,), F (4, 4)")
         for i in range(6):
             self.qpos[self.qidx[i]] = self.sign[i] * (q[i] * DEG_TO_RAD)
         self.fn(<const void*>self.m, <void*>self.d)
@@ -508,12 +505,19 @@ cdef class ArmCycle:
             qa[i] = (self.sign[i] * self.qpos[self.qidx[i]]) * RAD_TO_DEG
         for i in range(3):
             for j in range(3):
-                F[i, j] = self.xmat[3 * i + j]
-            F[i, 3] = 1000.0 * self.xpos[i]
-        F[3, 0] = 0.0
-        F[3, 1] = 0.0
-        F[3, 2] = 0.0
-        F[3, 3] = 1.0
+                F[4 * i + j] = self.xmat[3 * i + j]
+            F[4 * i + 3] = 1000.0 * self.xpos[i]
+        F[12] = 0.0
+        F[13] = 0.0
+        F[14] = 0.0
+        F[15] = 1.0
+
+    def cycle(self, const double[:] q, double[::1] qa, double[:, ::1] F):
+        """Set the axes q (A1..A6, deg; further values ignored), run ``mj_kinematics``, and
+        write the axes read back (deg) into qa (6,) and the flange in WORLD (4x4, mm) into F."""
+        if q.shape[0] < 6 or qa.shape[0] != 6 or F.shape[0] != 4 or F.shape[1] != 4:
+            raise ValueError("ArmCycle.cycle: q (>= 6,), qa (6,), F (4, 4)")
+        self._play(q, &qa[0], &F[0, 0])
 
     def cycle_tcp(self, const double[:] q, double[::1] qa, const double[:, ::1] base_inv,
                   const double[:, ::1] tool, double[:, ::1] T):
@@ -522,8 +526,12 @@ cdef class ArmCycle:
         caller then runs :meth:`cycle` and multiplies with numpy)."""
         if self.gemm == NULL:
             return False
-        self.cycle(q, qa, self.flange)
-        return self.product(base_inv, self.flange, tool, T)
+        if (q.shape[0] < 6 or qa.shape[0] != 6 or base_inv.shape[0] != 4 or base_inv.shape[1] != 4
+                or tool.shape[0] != 4 or tool.shape[1] != 4 or T.shape[0] != 4 or T.shape[1] != 4):
+            raise ValueError("ArmCycle.cycle_tcp: q (>= 6,), qa (6,), 4x4 frames")
+        self._play(q, &qa[0], &self.flange[0, 0])
+        self._product(&base_inv[0, 0], &self.flange[0, 0], &tool[0, 0], &T[0, 0])
+        return True
 
     def use_gemm(self, size_t gemm):
         """Compute :meth:`product` with the BLAS ``cblas_dgemm`` at address `gemm` (the one
@@ -540,9 +548,14 @@ cdef class ArmCycle:
         if (A.shape[0] != 4 or A.shape[1] != 4 or B.shape[0] != 4 or B.shape[1] != 4
                 or C.shape[0] != 4 or C.shape[1] != 4 or out.shape[0] != 4 or out.shape[1] != 4):
             raise ValueError("ArmCycle.product: 4x4 matrices")
-        self.gemm(101, 111, 111, 4, 4, 4, 1.0, &A[0, 0], 4, &B[0, 0], 4, 0.0, &self.tmp[0, 0], 4)
-        self.gemm(101, 111, 111, 4, 4, 4, 1.0, &self.tmp[0, 0], 4, &C[0, 0], 4, 0.0, &out[0, 0], 4)
+        self._product(&A[0, 0], &B[0, 0], &C[0, 0], &out[0, 0])
         return True
+
+    cdef void _product(self, const double* A, const double* B, const double* C, double* out) noexcept:
+        """out = (A @ B) @ C: numpy's two cblas_dgemm calls (row-major, no transposes, leading
+        dimension 4, alpha 1, beta 0), the first into a numpy-allocated 4x4."""
+        self.gemm(101, 111, 111, 4, 4, 4, 1.0, A, 4, B, 4, 0.0, &self.tmp[0, 0], 4)
+        self.gemm(101, 111, 111, 4, 4, 4, 1.0, &self.tmp[0, 0], 4, C, 4, 0.0, out, 4)
 
 
 # ----------------------------------------------------------------------------- trace lines
