@@ -401,3 +401,31 @@ def _umask() -> int:
     m = os.umask(0)
     os.umask(m)
     return m
+
+
+def test_a_file_changed_while_it_is_parsed_is_not_kept_under_its_old_hash(tmp_path, monkeypatch):
+    """load_files hashes the files, and the worker processes read them again by path: when a
+    file changes in between, the parse of the new content must not be kept under the old
+    content's hash (a later load of the old content would get the new text's AST)."""
+    import krl.parsecache as parsecache  # noqa: PLC0415
+    from krl.workspace import load_batch  # noqa: PLC0415
+    src = tmp_path / "a.src"
+    old_text = "DEF a()\n  $OUT[1] = TRUE\nEND\n"
+    src.write_text(old_text, encoding="utf-8")
+
+    def edit_then_parse(paths, timeout, jobs=None):
+        src.write_text("DEF a()\n  $OUT[2] = TRUE\nEND\n", encoding="utf-8")
+        return load_batch(paths, timeout, jobs)
+
+    monkeypatch.setattr(parsecache, "load_batch", edit_then_parse)
+    s = store.Store(tmp_path / "cache")
+    load_files([norm(src)], timeout=60.0, store=s)
+    assert s.db.execute("SELECT COUNT(*) FROM entries WHERE kind = 'parse'").fetchone()[0] == 0
+    monkeypatch.undo()
+    src.write_text(old_text, encoding="utf-8")
+    again = store.Store(tmp_path / "cache")
+    lf = load_files([norm(src)], store=again)[0]
+    assert again.hits == 0
+    assert lf.module.routines[0].body[0].target.indices[0].value == 1    # the old text's AST
+    kept = store.Store(tmp_path / "cache")
+    assert load_files([norm(src)], store=kept)[0] is not None and kept.hits == 1
