@@ -127,11 +127,30 @@ def test_a_file_parsed_by_the_language_server_is_a_hit_for_krl_debug(tmp_path, c
     before = _rows(_database(cache))
     parses = {k: v for k, v in before.items() if k[0] == "parse"}
     assert len(parses) == 5
+    with sqlite3.connect(_database(cache)) as db:     # last used two hours ago (the store keeps
+        db.execute("UPDATE entries SET used = used - 7200 WHERE kind = 'parse'")   # it to the hour)
     _debug_launch(root / "R1" / "Program" / "main.src", cache)
     after = _rows(_database(cache))
     for k, (rowid, used) in parses.items():
         assert after[k][0] == rowid                     # not written again: not parsed again
         assert after[k][1] > used                       # read by the debugger (its last use moved)
+
+
+def test_a_lookup_of_entries_used_within_the_hour_writes_nothing(tmp_path):
+    """Store.get writes an entry's last use again only when it is older than
+    USED_RESOLUTION_S (1 h): a second lookup right after the first changes no row."""
+    s = store.Store(tmp_path)
+    s.put("parse", {"a": b"x" * 10, "b": b"y" * 10})
+    with sqlite3.connect(s.path) as db:
+        db.execute("UPDATE entries SET used = used - 7200 WHERE key = 'a'")
+        old = dict(db.execute("SELECT key, used FROM entries"))
+    assert s.get("parse", ["a", "b"]) == {"a": b"x" * 10, "b": b"y" * 10}
+    with sqlite3.connect(s.path) as db:
+        new = dict(db.execute("SELECT key, used FROM entries"))
+    assert new["b"] == old["b"] and new["a"] > old["a"] + 7000
+    changes = s.db.total_changes
+    s.get("parse", ["a", "b"])
+    assert s.db.total_changes == changes
 
 
 def _corrupt_every_parse(db_path: Path, data: bytes, good_digest: bool) -> int:
