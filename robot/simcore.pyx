@@ -1,7 +1,14 @@
 # cython: language_level=3, boundscheck=False, wraparound=False, cdivision=True, initializedcheck=False
-"""The OPW inverse kinematics of one pose in C (issue 39, "Simulator"): the compiled form of
-robot/kinematics.py ``Kinematics._opw_core`` + ``_status_row`` + the selection of
-``Kinematics._select`` for the six-axis arm with a spherical wrist, built by robot/build.py.
+"""The simulator's hot path in C (issue 39, "Simulator"), built by robot/build.py:
+
+* :class:`OPW`: the OPW inverse kinematics of one pose (and along a chain of poses), the
+  compiled form of robot/kinematics.py ``Kinematics._opw_core`` + ``_status_row`` + the
+  selection of ``Kinematics._select`` for the six-axis arm with a spherical wrist;
+* :class:`CartPath`: the poses of a CP segment's lines and arcs (robot/planner.py
+  ``CartSegment.pose_u``) and their axes;
+* :class:`ArmCycle` and :func:`speed_ok`: the IPO cycle's MuJoCo playback with its TCP product,
+  and its axis step check (robot/controller.py ``Controller.step``);
+* :func:`pose_line`: the trace's pose line (robot/trace.py).
 
 Bit for bit the pure-Python code it mirrors, which stays the fallback (and the reference:
 tests/robot/test_simcore.py compares the two on random poses): the same operations in the same
