@@ -565,7 +565,7 @@ class Segment:
     def end_frame(self) -> list[float]:
         """Programmed end point as (X, Y, Z, A, B, C) of the TCP in $BASE (mm, deg)."""
         if self._end_frame is None:
-            self._end_frame = list(matrix_to_frame(self.model.tcp(self.q1, self.tool_T,
+            self._end_frame = list(_frame_of(self.model.tcp(self.q1, self.tool_T,
                                                                   self.base_inv_T)))
         return self._end_frame
 
@@ -899,6 +899,45 @@ class CartSegment(Segment):
         return self.ori_angle_to_end(0.0)
 
 
+#: Conversions kept by :func:`_frame_of` and :func:`_matrix_of` (cleared when full).
+FRAME_MEMO = 512
+_FRAME_OF: dict[bytes, tuple[float, ...]] = {}
+_MATRIX_OF: dict[bytes, np.ndarray] = {}
+
+
+def _frame_of(T: np.ndarray) -> tuple[float, ...]:
+    """:func:`robot.frames.matrix_to_frame` of T, kept by T's bytes: a program's cycle plans
+    the same points again, and the conversion (scipy's ``Rotation.from_matrix``) costs about
+    0.2 ms. The same tuple as the call."""
+    A = np.asarray(T, dtype=float)
+    key = A.tobytes() + str(A.shape).encode()
+    fr = _FRAME_OF.get(key)
+    if fr is None:
+        if len(_FRAME_OF) >= FRAME_MEMO:
+            _FRAME_OF.clear()
+        fr = _FRAME_OF[key] = tuple(matrix_to_frame(A))
+    return fr
+
+
+def _matrix_of(frame: Any) -> np.ndarray:
+    """:func:`robot.frames.frame_to_matrix` of six numbers (X, Y, Z, A, B, C), kept by their
+    float64 bytes (so -0.0 is not 0.0): the motions of a program share their $TOOL and $BASE.
+    A new array each call, as the function gives."""
+    try:
+        v = np.array(frame, dtype=float)
+    except (TypeError, ValueError):
+        return frame_to_matrix(*frame)
+    if v.shape != (6,):
+        return frame_to_matrix(*frame)
+    key = v.tobytes()
+    T = _MATRIX_OF.get(key)
+    if T is None:
+        if len(_MATRIX_OF) >= FRAME_MEMO:
+            _MATRIX_OF.clear()
+        T = _MATRIX_OF[key] = frame_to_matrix(*frame)
+    return T.copy()
+
+
 def _cart_path(sc: Any, seg: "CartSegment") -> Any:
     """robot/simcore.pyx's ``CartPath`` of `seg`'s pieces (see ``CartSegment._compiled_path``):
     lines and arcs with the rotations ``CartSegment.pose_u`` holds, other pieces (splines, a
@@ -950,7 +989,7 @@ def _cart_target(req_target: dict[str, float], start_T: np.ndarray, relative: bo
         out[:3, :3] = D[:3, :3] @ start_T[:3, :3]
         out[:3, 3] = start_T[:3, 3] + D[:3, 3]
         return out
-    start6 = matrix_to_frame(start_T)
+    start6 = _frame_of(start_T)
     if all(k in req_target for k in ("A", "B", "C")):
         return frame_to_matrix(*_apply_partial(start6, req_target))
     # partial orientation: keep the start rotation exactly when none of A, B, C is given
@@ -1008,8 +1047,8 @@ def plan(req: MotionRequest, q_start: np.ndarray, model: RobotModel, *,
     q0 = np.asarray(q_start, dtype=float).copy()
     if getattr(p, "base_kin", None) and model.n_ext:
         model = model.linked(p.base_kin)      # $BASE on a BASE kinematic (robot/external.py)
-    tool_T = frame_to_matrix(*p.tool)
-    base_T = frame_to_matrix(*p.base)
+    tool_T = _matrix_of(p.tool)
+    base_T = _matrix_of(p.base)
     base_inv = inv_pos(base_T)
     start_T = model.tcp(q0, tool_T, base_inv)
     if req.kind in ("PTP", "SPTP"):
