@@ -45,15 +45,15 @@ from .stimuli import Cell, Stimulus
 from .trace import TraceWriter
 
 
-def _compiled(name: str) -> Any:
-    """Function `name` of the compiled module robot/simcore.pyx when it is built, current and
-    switched on (robot/kinematics.py ``USE_COMPILED``), else None."""
+def _compiled_module() -> Any:
+    """The compiled module robot/simcore.pyx when it is built, current and switched on
+    (robot/kinematics.py ``USE_COMPILED``), else None."""
     from . import kinematics  # noqa: PLC0415  (the module's one switch and ABI check)
 
     sc = kinematics._simcore
     if sc is None or not kinematics.USE_COMPILED or getattr(sc, "ABI", None) != kinematics.SIMCORE_ABI:
         return None
-    return getattr(sc, name, None)
+    return sc
 
 EPS = 1e-9
 MSG_APPROX_IMPOSSIBLE = "approximation not possible"
@@ -287,8 +287,9 @@ class Controller:
         self.last_error: RobotError | None = None
         self._step_lim: list[float] | None = None   # largest axis step per cycle (_check_speed)
         self._step_lim_a: np.ndarray | None = None  # the same as an array (the compiled check)
-        #: robot/simcore.pyx's per-cycle step check, None: the Python loop alone
-        self._speed_ok = _compiled("speed_ok")
+        #: robot/simcore.pyx (None: the Python code alone) and its per-cycle step check
+        self._simcore = _compiled_module()
+        self._speed_ok = getattr(self._simcore, "speed_ok", None)
         self._ret_q: np.ndarray | None = None
         self._ended = False
         self.network = None     # net.hub.Network: the partners, polled at each cycle's start
@@ -768,7 +769,7 @@ class Controller:
         if self._tracked:
             self._fire_triggers(self._pt)
         arm = self._arm if self._arm_q is None else self._arm_model()
-        cyc = arm.compiled_cycle() if arm is not None and not self.actuated else None
+        cyc = arm.compiled_cycle(self._simcore) if arm is not None and not self.actuated else None
         if cyc is not None:
             # set_axes, axis_act and the flange site in one compiled call (the same numbers)
             qa, T = np.empty(6), np.empty((4, 4))

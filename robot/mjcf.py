@@ -196,15 +196,12 @@ def _ext_home(m: MachineData, home: list[float]) -> list[float]:
 _BOTTOM_ROW = np.array([0.0, 0.0, 0.0, 1.0])
 
 
-def _arm_cycle(arm: "ArmModel") -> Any:
-    """robot/simcore.pyx's ``ArmCycle`` for `arm`, or None (see :meth:`ArmModel.compiled_cycle`).
-    ``mj_kinematics`` is looked up in the MuJoCo library the ``mujoco`` package ships and has
-    loaded (the same library: loading it again gives the loaded one)."""
-    from . import kinematics  # noqa: PLC0415  (the compiled module's one switch and ABI check)
-
-    sc = kinematics._simcore
-    if (arm.actuated or len(arm._eadr) or sc is None or not kinematics.USE_COMPILED
-            or getattr(sc, "ABI", None) != kinematics.SIMCORE_ABI):
+def _arm_cycle(arm: "ArmModel", sc: Any) -> Any:
+    """The ``ArmCycle`` of the compiled module `sc` for `arm`, or None (see
+    :meth:`ArmModel.compiled_cycle`). ``mj_kinematics`` is looked up in the MuJoCo library the
+    ``mujoco`` package ships and has loaded (the same library: loading it again gives the
+    loaded one)."""
+    if arm.actuated or len(arm._eadr):
         return None
     try:
         import ctypes  # noqa: PLC0415
@@ -319,14 +316,16 @@ class ArmModel:
         else:
             self._mj.mj_kinematics(self.model, d)
 
-    def compiled_cycle(self) -> Any:
-        """The compiled kinematic playback of one IPO cycle (robot/simcore.pyx ``ArmCycle``:
+    def compiled_cycle(self, simcore: Any) -> Any:
+        """The compiled kinematic playback of one IPO cycle (``simcore``: robot/simcore.pyx, as
+        robot/controller.py ``_compiled_module`` gives it, or None; its ``ArmCycle``:
         :meth:`set_axes`, :meth:`axes_deg` and :meth:`flange_pose_world` in one call, the same
         numbers; its ``product`` is numpy's ``A @ B @ C`` of 4x4 matrices when numpy's own BLAS
-        is found and gives the same products), kept; None in actuated mode, with external axes, without the compiled module
-        or without MuJoCo's library at hand (the Python methods run then)."""
-        if self._cycle is None:
-            self._cycle = _arm_cycle(self) or False
+        is found and gives the same products), kept; None in actuated mode, with external axes,
+        without the compiled module or without MuJoCo's library at hand (the Python methods run
+        then)."""
+        if self._cycle is None and simcore is not None:
+            self._cycle = _arm_cycle(self, simcore) or False
         return self._cycle or None
 
     def axes_deg(self) -> np.ndarray:

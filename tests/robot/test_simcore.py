@@ -141,7 +141,7 @@ def _arm_agrees(machine, seed: int) -> None:
     from robot.mjcf import ArmModel  # noqa: PLC0415  (MuJoCo)
 
     a, b = ArmModel(machine), ArmModel(machine)
-    cyc = a.compiled_cycle()
+    cyc = a.compiled_cycle(simcore)
     assert cyc is not None, "the compiled playback is not used"
     rng = np.random.default_rng(seed)
     qa, F = np.empty(6), np.empty((4, 4))
@@ -171,9 +171,12 @@ def test_the_compiled_cycle_is_the_arm_models_playback_on_a_corpus_kr210(shared_
 def test_the_compiled_cycle_is_off_in_actuated_mode_and_without_the_module(monkeypatch):
     from robot.mjcf import ArmModel  # noqa: PLC0415
 
-    assert ArmModel(actuated=True).compiled_cycle() is None
+    from robot import controller  # noqa: PLC0415
+
+    assert ArmModel(actuated=True).compiled_cycle(simcore) is None
+    assert ArmModel().compiled_cycle(None) is None
     monkeypatch.setattr(kinematics, "USE_COMPILED", False)
-    assert ArmModel().compiled_cycle() is None
+    assert controller._compiled_module() is None
 
 
 def test_the_compiled_step_check_is_the_python_loops():
@@ -294,7 +297,7 @@ def test_the_compiled_tcp_product_is_numpys_matmul():
 
     if not _numpy_dgemm():
         pytest.skip("numpy without its bundled OpenBLAS: numpy multiplies")
-    cyc = ArmModel().compiled_cycle()
+    cyc = ArmModel().compiled_cycle(simcore)
     rng = np.random.default_rng(45)
     out, F, qa = np.empty((4, 4)), np.empty((4, 4)), np.empty(6)
     for i in range(5000):
