@@ -7,8 +7,8 @@ one :class:`krl.workspace.Workspace`.
 * **Files on disk** are read once per change of their size or time stamp. Those not read yet
   are loaded together (:meth:`Project.load_files`): from the persistent parse cache
   (krl/store.py, krl/parsecache.py ``read_parses``) by content hash, and the others parsed by the fast (Java) engine when it
-  runs here, in worker processes when there is enough to share out (krl/workspace.py
-  ``load_batch``), else in this process.
+  runs here: in this process while the engine's threads parse, or in worker processes when
+  there is enough to share out and more than two cores (krl/workspace.py ``load_batch``).
 * **Buffers** are parsed by pieces (krl/lsp/parsing.py). A buffer that is its file as on disk
   is that file's parse; the first parse of another is one whole-file parse by the fast engine,
   whose pieces are kept, so that an edit re-parses the piece it touches.
@@ -50,12 +50,15 @@ __all__ = ["Project", "is_uri", "norm"]
 log = logging.getLogger("krl.lsp")
 ROOTS_TTL_S = 2.0        # seconds a workspace's file list is trusted before it is listed again
 # Files to parse past this many bytes are shared out to worker processes (each rebuilds the Java
-# engine's trees and builds the ASTs). Below it the fork server's start and the results' transfer
-# cost more than the second core saves: a 365 KB backup loaded in 5.4 s in workers, 3.1 s in
-# this process, at a load average of 24 on the 2 cores; 400 files (1.8 MB) need both cores.
+# engine's trees and builds the ASTs) on PARALLEL_MIN_JOBS cores or more.
+# On 2 cores the Java engine's threads are the parallel part: its parse runs on one core while
+# this process builds the ASTs of the files it answered, on the other. Workers there cost twice
+# the CPU (the ASTs pickled and unpickled) and lost in wall time too: 400 files (1.8 MB),
+# 2026-11-24, load 8-9, CPU 8.0 s / wall 22-25 s through workers against 4.7-5.1 s / 8-11 s
+# in this process (/tmp profile of Project.analyze, cold cache).
 PARALLEL_BYTES = 1024 * 1024
+PARALLEL_MIN_JOBS = 3
 MAX_RECHECKED_FILES = 16        # more changed files at once: the workspace is checked whole again
-IN_PROCESS_COLLECT_FILES = 20   # an in-process parse of this many files: one collection after it
 
 
 @contextlib.contextmanager
@@ -65,8 +68,8 @@ def collector_off():
     garbage: the collector's repeated passes over the growing heap were half its CPU time (400
     files, 2026-11-24, load ~20: cold through the workers 4.6 -> 3.4 s, from the cache 1.8 ->
     0.7 s). Measured garbage left after such an analysis: 38 objects from the cache, 5,304 through
-    the workers; the cyclic parse trees of an in-process parse are collected once after it
-    (:meth:`Project._parse_files`)."""
+    the workers; the parse trees of an in-process parse are freed as each AST is built
+    (krl/workspace.py ``release_tree``)."""
     was = gc.isenabled()
     gc.disable()
     try:
@@ -214,12 +217,13 @@ class Project:
     def _parse_files(self, sources: list[SourceText]) -> dict:
         """path -> (LoadedFile, outcome status: "done", or how a worker's parse was stopped:
         krl.pool.Outcome) for decoded files: by the fast engine when it runs here (in worker
-        processes past PARALLEL_BYTES), else by the Python engine, in this process."""
+        processes past PARALLEL_BYTES on PARALLEL_MIN_JOBS cores or more), else by the Python
+        engine, in this process."""
         if not sources:
             return {}
         size = sum(s.size for s in sources)
         jobs = default_jobs()
-        if _java() and size >= PARALLEL_BYTES and jobs > 1:
+        if _java() and size >= PARALLEL_BYTES and jobs >= PARALLEL_MIN_JOBS:
             out = {}
             for src, o in zip(sources, load_batch([s.path for s in sources], PARSE_TIMEOUT_S, jobs,
                                                    threaded=self.threaded)):
@@ -230,8 +234,6 @@ class Project:
                    for _i, src, raw in java_answers(enumerate(sources), threads=jobs, trees=True)}
         else:
             out = {src.path: (load_parsed(src, None), "done") for src in sources}
-        if len(sources) >= IN_PROCESS_COLLECT_FILES:
-            gc.collect()            # their parse trees (cyclic), once, under collector_off
         return out
 
     def first_parse(self, path: str, text: str) -> Parsed:
