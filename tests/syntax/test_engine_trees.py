@@ -15,15 +15,19 @@ import time
 import gc
 
 import pytest
+from antlr4 import ParserRuleContext
+from antlr4.tree.Tree import TerminalNodeImpl
 
 import krl.syntax.engines as engines_mod
 import krl.workspace as workspace_mod
 from krl.syntax.engines import java as java_engine
 from krl.syntax.engines import java_answers, parse_file, result_from_answer
-from krl.syntax.engines.tree import RebuiltToken, TreeDataError, tree_from_raw
+from krl.syntax.engines.tree import RebuiltToken, TreeDataError, stream_tokens, tree_from_raw
+from krl.syntax.messages import syntax_diagnostics
+from krl.syntax.tokens import lex
 from krl.syntax.parse import default_bundle, prepare_text
-from krl.source import SourceText
-from tests.syntax.test_engines import _java_or_skip, _record, needs_java, tree_shape
+from krl.source import SourceText, read_source
+from tests.syntax.test_engines import _files, _java_or_skip, _record, needs_java, tree_shape
 from krl.project import collect_entries
 
 TEXT = "DEF a()\nDECL INT x\nx = -(1 + 2) * 3\nIF x > 1 THEN\nx = x - 1\nENDIF\nEND\n"
@@ -179,11 +183,6 @@ def test_the_syntax_messages_read_the_rebuilt_token_stream(shared_corpus):
     """A file with syntax errors is worded from the Java engine's token stream
     (``stream_tokens``), not lexed again: the stream is the Python lexer's, token by token,
     and the diagnostics are the same, on every corpus and negative-test file with an error."""
-    from krl.syntax.engines.tree import stream_tokens  # noqa: PLC0415
-    from krl.syntax.messages import syntax_diagnostics  # noqa: PLC0415
-    from krl.syntax.tokens import lex  # noqa: PLC0415
-    from krl.source import read_source  # noqa: PLC0415
-    from tests.syntax.test_engines import _files  # noqa: PLC0415
     _java_or_skip()
     sources = [s for s in (read_source(p) for p in _files(shared_corpus)) if s.status == "ok"]
     checked = 0
@@ -209,8 +208,6 @@ def test_a_loaded_file_leaves_its_parse_tree_to_reference_counting(engine, text)
     """load_parsed frees the parse tree its AST was built from (krl/workspace.py
     ``release_tree``): no node of it is left for the cyclic collector, and the AST is whole.
     (The Python engine's lexer and parser leave their own cycle: its tokens and the root.)"""
-    from antlr4 import ParserRuleContext  # noqa: PLC0415
-    from antlr4.tree.Tree import TerminalNodeImpl  # noqa: PLC0415
     if engine == "java":
         _java_or_skip()
     src = SourceText("a.src", text, "", len(text))
