@@ -129,8 +129,8 @@ class Project:
         self._roots: dict[str, tuple[float, str, list[str], list]] = {}
         self.analyses: dict[str, Analysis] = {}  # root -> latest analysis
         self._root_of: dict[str, str] = {}       # path -> root of its latest analysis
-        # set once the fast engine answered in this process (the server's warm-up); None: not
-        # watched (the engine is used whenever it runs here)
+        # set once the fast engine answered in this process (the server's warm-up); None: no
+        # warm-up runs (the fast engine is used whenever it runs here)
         self.engine_started: threading.Event | None = None
         self.watched = False    # the client reports file changes: file lists kept until it does
         self._disk_known = False    # ... and the files read stay as read until it does
