@@ -318,6 +318,28 @@ def superpose_pose(p0: np.ndarray, R0: np.ndarray, p1: np.ndarray, R1: np.ndarra
     return p0 + (p1 - pc), (R1 @ Rc.T) @ R0
 
 
+def reduced_orientation(model: Any) -> bool:
+    """Does the robot reach only part of an orientation? True for the palletizers
+    (``$DEF_A4FIX``: A4 stays at 0; docs/robot.md "The palletizers"), whose inverse drops the
+    component of a target's orientation it has no axis for."""
+    return bool(getattr(getattr(model, "machine", None), "a4fix", False))
+
+
+def reached_pose(seg: Segment, p: np.ndarray, R: np.ndarray, ref: np.ndarray,
+                 u: float | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """The pose the robot reaches for the pose ``(p, R)`` of ``seg``'s path (mm, (3,); 3x3, in
+    its ``$BASE``): the TCP of its inverse kinematics (solution nearest ``ref``, external axes
+    at path parameter ``u``). On a robot of :func:`reduced_orientation` a CP path may carry an
+    orientation the robot cannot take (``$ORI_TYPE #CONSTANT`` while A1 turns, a target's
+    tilt): the blend overlaps the reached poses, so that at its end the setpoint is the next
+    motion's own (a 5-axis palletizer's A2 jumped to 1.46x a_max at the end of a CIRC
+    #CONSTANT -> CIRC blend, whose orientations were 29 deg apart at the point). Raises
+    WorkspaceError/SoftLimitError as :meth:`CartSegment.ik`."""
+    q = seg.ik(p, R, ref, u) if len(ref) > 6 else seg.ik(p, R, ref)  # type: ignore[attr-defined]
+    T = seg.model.tcp(q, seg.tool_T, seg.base_inv_T)
+    return T[:3, 3], T[:3, :3]
+
+
 def blend_space(prev: Segment, nxt: Segment) -> str:
     """``"cart"`` when both segments are CP motions (combined in Cartesian space with the
     same $TOOL/$BASE, neither with ``$ORI_TYPE #JOINT``), else ``"joint"``."""
@@ -329,4 +351,4 @@ def blend_space(prev: Segment, nxt: Segment) -> str:
 
 
 __all__ = ["effective_keyword", "blend_start_tau", "blend_end_tau", "blend_space", "superpose_pose",
-           "plan_blend", "BlendPlan"]
+           "plan_blend", "BlendPlan", "reduced_orientation", "reached_pose"]

@@ -917,6 +917,13 @@ class Controller:
             p0, R0 = b.prev.seg.pose(t_prev)
             p1, R1 = b.nxt.seg.pose(t_next)
             pc, Rc = b.nxt.seg.pose(0.0)
+            if blending.reduced_orientation(self.model):
+                # a palletizer: overlap the poses it reaches, not the paths' own orientations
+                # (robot/blending.py reached_pose)
+                u0, u1 = b.prev.seg.u(t_prev), b.nxt.seg.u(t_next)
+                p0, R0 = blending.reached_pose(b.prev.seg, p0, R0, self._q, u0)
+                p1, R1 = blending.reached_pose(b.nxt.seg, p1, R1, self._q, u1)
+                pc, Rc = blending.reached_pose(b.nxt.seg, pc, Rc, self._q, 0.0)
             p, R = blending.superpose_pose(p0, R0, p1, R1, pc, Rc)
             ref = self._q
             if len(ref) > 6:

@@ -236,3 +236,39 @@ def test_a_fixed_sequence_moves_every_library_robot(library_robot):
     assert np.abs(ctl.axis_act()[:3] - np.array(q1[:3])).max() < 1e-6 or library_robot.a5link
     rep = check_trace(tw.events, library_robot)
     assert rep.ok, rep.summary()
+
+
+@pytest.mark.parametrize("approx", ["C_VEL", "C_ORI"])
+def test_a_blend_from_an_orientation_the_palletizer_cannot_take(approx):
+    """Regression (found by the property above on the KR 180 R3200 PA5): a CIRC with
+    ``$ORI_TYPE #CONSTANT`` keeps its start orientation while A1 turns, which a 5-axis
+    palletizer cannot (A4 = 0: the tilt out of the arm plane is dropped), so its planned end
+    orientation lies 29 deg from the one the robot reaches there. The Cartesian blend into the
+    next CIRC overlapped the planned orientations and ended off the next motion's own setpoint:
+    A2 jumped to 6.2x a_max in the cycle the blend ended (C_VEL), and C_ORI's longer blend
+    stopped with "speed limit exceeded A5". Expected, from the limits alone: every motion
+    plans, the program runs to its end without a fault, and the trace keeps the limits."""
+    machine = _load(None, "KR180 PA 5-axis")
+    steps = [{"kind": "PTP", "q": (-48.5, -84.2, 82.9, 20.3, 25.9, 0.0), "approx": None,
+              "params": MotionParams(), "bulge": 0.0, "e": 0.0},
+             {"kind": "CIRC", "q": (-16.2, -60.0, 113.5, 60.0, 79.6, 40.8), "approx": approx,
+              "params": MotionParams().with_(vel_cp=1.0, ori_type="CONSTANT"), "bulge": -47.7, "e": 0.0},
+             {"kind": "CIRC", "q": (0.0, -73.0, 116.8, 12.8, 89.5, -40.8), "approx": None,
+              "params": MotionParams().with_(vel_cp=1.0), "bulge": 80.7, "e": 0.0}]
+    tw = TraceWriter(keep=True)
+    ctl = Controller(machine, trace=tw, mujoco=False, mode_op="AUT")
+    reqs = _requests(ctl.model, steps)
+    assert [r.kind for r in reqs] == ["PTP", "PTP", "CIRC", "CIRC"]
+    for req in reqs:
+        while not ctl.can_enqueue():
+            ctl.step()
+        ctl.enqueue(req)                   # every motion plans
+    ctl.step_until(ctl.is_idle, max_cycles=200_000)
+    phases = [(ev["id"], ev["phase"]) for ev in tw.events if ev.get("kind") == "motion"]
+    assert (3, "blend_start") in phases    # the CIRC #CONSTANT is approximated
+    assert ctl.last_error is None
+    assert not [ev for ev in tw.events if ev.get("kind") == "error"]
+    rep = check_trace(tw.events, machine)
+    assert rep.ok, f"{rep.summary()}\n" + "\n".join(str(v) for v in rep.violations[:10])
+    # the planner plans within a_max (up to the second difference's own error): the jump was 6.2x
+    assert rep.axis_acc_ratio <= 1.02
