@@ -295,6 +295,12 @@ def test_division(values):
     assert values.data["V_RDIV"] == [3.5, 3.5, -1.75]
 
 
+def test_element_compare_and_move(values):
+    # a = [3, 1, 2]: 3 > 2, so a[2] = a[1]; then a[2] = 3 >= 4 is false; ra[3] = a[2] as REAL
+    assert values.data["V_SHIFT"] == [3, 3, 2]
+    assert values.data["V_RSHIFT"] == 3.0
+
+
 def test_comparisons_of_bool_char_enum(values):
     assert values.data["V_CMP"] == [
         False,   # TRUE == FALSE
