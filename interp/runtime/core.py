@@ -637,7 +637,13 @@ class Runtime:
                 if v.__class__ is Struct and v.type is t:
                     # a structure of the parameter's own type: its copy (the same components,
                     # already of their types: what make_value + assign_into give), its size
-                    frame.data += self.memory.take(size, f"a copy of :IN parameter {name}")
+                    # (DataMemory.take, inlined when it fits: the message is made only for its error)
+                    mem = self.memory
+                    if mem.used + size <= mem.limit:
+                        mem.used += size
+                        frame.data += size
+                    else:
+                        frame.data += mem.take(size, f"a copy of :IN parameter {name}")
                     store[k] = copy_value(v)
                     fvars[k] = Slot(store, k, t, name)
                     continue
