@@ -232,6 +232,3 @@ MAX_HALT_CONTINUES = 1000
 # A start position (`krl run --start`, a cell file's `start:`): characters of its text; its
 # tokens are at most MAX_RULE_TOKENS.
 MAX_START_CHARS = 400
-# The routines' source text the interactive map page carries (krl graph --format html), in
-# characters in all; past it the remaining routines show their file:line without the text.
-MAX_GRAPH_SOURCE_CHARS = 8_000_000

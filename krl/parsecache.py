@@ -229,11 +229,21 @@ def keep_parses(store: Store, made) -> None:
     only those whose parse ended (status "done", krl.pool.Outcome); a parse stopped past its
     timeout (E005) or lost with its worker (E001) is never kept, so that one slow moment never
     becomes a lasting error for that content in every command (docs/security.md, "The store").
-    A parse that cannot be encoded (:func:`encode_loaded`) is not kept either."""
+    A parse that cannot be encoded (:func:`encode_loaded`) is not kept either, nor one whose
+    file no longer holds the content of its key: the worker processes read a file again by its
+    path, so a file changed between the hash and the parse would otherwise be kept under the
+    old content's hash."""
     if store.db is None:
         return
     store.put("parse", {key: e for key, lf, status in made
-                        if status == "done" and (e := encode_loaded(lf)) is not None})
+                        if status == "done" and _on_disk(key, lf.path)
+                        and (e := encode_loaded(lf)) is not None})
+
+
+def _on_disk(key: str, path: str) -> bool:
+    """True when the file at `path` holds now the content whose hash begins parse key `key`."""
+    src = read_source(path)
+    return src.status == "ok" and bool(src.sha) and key.startswith(src.sha + ":")
 
 
 def load_files(paths: list, timeout: float | None = None, store: Store | None = None,

@@ -45,6 +45,8 @@ log.addHandler(logging.NullHandler())   # a command's standard error never gets 
 #: the codec's name and version: part of :func:`front_end_version`
 CODEC = "krl-store 3 (msgpack by schema; parse entries' notes without a path)"
 LOCK_WAIT_S = 5.0
+#: s: an entry's last use is kept to this precision (Store.get writes it only when older)
+USED_RESOLUTION_S = 3600.0
 #: another front-end version's database not used for this long (by its mtime) is removed
 UNUSED_DATABASE_S = 7 * 24 * 3600.0
 #: folders of the cache root that earlier versions wrote (their serialized results) and nothing reads now
@@ -199,24 +201,30 @@ class Store:
         out: dict[str, bytes] = {}
         if self.db is None or not keys:
             return out
+        # the last use is written again only when it is older than USED_RESOLUTION_S: the
+        # trim's order needs no finer time, and a lookup of entries used lately writes nothing
+        now = time.time()
+        stale = now - USED_RESOLUTION_S
+        touch: list[str] = []
         with self.lock:
             try:
                 for i in range(0, len(keys), 500):
                     part = keys[i:i + 500]
                     # data past the entry limit (never written so: planted) is not even read
                     rows = self.db.execute(
-                        "SELECT key, digest, CASE WHEN LENGTH(data) <= ? THEN data END FROM entries "
+                        "SELECT key, digest, CASE WHEN LENGTH(data) <= ? THEN data END, used FROM entries "
                         f"WHERE kind = ? AND key IN ({','.join('?' * len(part))})",
                         (MAX_CACHE_ENTRY_BYTES, kind, *part)).fetchall()
-                    for key, digest, data in rows:
+                    for key, digest, data, used in rows:
                         if isinstance(data, bytes) and hashlib.sha256(data).digest() == digest:
                             out[key] = data
+                            if not isinstance(used, (int, float)) or used < stale:
+                                touch.append(key)
                         else:
                             self.corrupt += 1
-                if out:
-                    now = time.time()
+                if touch:
                     self.db.executemany("UPDATE entries SET used = ? WHERE kind = ? AND key = ?",
-                                        [(now, kind, k) for k in out])
+                                        [(now, kind, k) for k in touch])
                     self.db.commit()
             except sqlite3.Error as exc:
                 self._off(f"the cache is not used: {exc}")
@@ -241,7 +249,11 @@ class Store:
 
     def _trim(self) -> None:
         """Keep the database within MAX_CACHE_BYTES: the least recently used quarter goes
-        while it is larger."""
+        while it is larger. The file's pages (two pragmas, no scan of the table) bound the
+        entries' size from above; only past the limit are the entries summed."""
+        pages = self.db.execute("PRAGMA page_count").fetchone()[0]
+        if pages * self.db.execute("PRAGMA page_size").fetchone()[0] <= MAX_CACHE_BYTES:
+            return
         size = self.db.execute("SELECT COALESCE(SUM(LENGTH(data)), 0), COUNT(*) FROM entries").fetchone()
         if size[0] <= MAX_CACHE_BYTES:
             return

@@ -127,11 +127,30 @@ def test_a_file_parsed_by_the_language_server_is_a_hit_for_krl_debug(tmp_path, c
     before = _rows(_database(cache))
     parses = {k: v for k, v in before.items() if k[0] == "parse"}
     assert len(parses) == 5
+    with sqlite3.connect(_database(cache)) as db:     # last used two hours ago (the store keeps
+        db.execute("UPDATE entries SET used = used - 7200 WHERE kind = 'parse'")   # it to the hour)
     _debug_launch(root / "R1" / "Program" / "main.src", cache)
     after = _rows(_database(cache))
     for k, (rowid, used) in parses.items():
         assert after[k][0] == rowid                     # not written again: not parsed again
         assert after[k][1] > used                       # read by the debugger (its last use moved)
+
+
+def test_a_lookup_of_entries_used_within_the_hour_writes_nothing(tmp_path):
+    """Store.get writes an entry's last use again only when it is older than
+    USED_RESOLUTION_S (1 h): a second lookup right after the first changes no row."""
+    s = store.Store(tmp_path)
+    s.put("parse", {"a": b"x" * 10, "b": b"y" * 10})
+    with sqlite3.connect(s.path) as db:
+        db.execute("UPDATE entries SET used = used - 7200 WHERE key = 'a'")
+        old = dict(db.execute("SELECT key, used FROM entries"))
+    assert s.get("parse", ["a", "b"]) == {"a": b"x" * 10, "b": b"y" * 10}
+    with sqlite3.connect(s.path) as db:
+        new = dict(db.execute("SELECT key, used FROM entries"))
+    assert new["b"] == old["b"] and new["a"] > old["a"] + 7000
+    changes = s.db.total_changes
+    s.get("parse", ["a", "b"])
+    assert s.db.total_changes == changes
 
 
 def _corrupt_every_parse(db_path: Path, data: bytes, good_digest: bool) -> int:
@@ -401,3 +420,31 @@ def _umask() -> int:
     m = os.umask(0)
     os.umask(m)
     return m
+
+
+def test_a_file_changed_while_it_is_parsed_is_not_kept_under_its_old_hash(tmp_path, monkeypatch):
+    """load_files hashes the files, and the worker processes read them again by path: when a
+    file changes in between, the parse of the new content must not be kept under the old
+    content's hash (a later load of the old content would get the new text's AST)."""
+    import krl.parsecache as parsecache  # noqa: PLC0415
+    from krl.workspace import load_batch  # noqa: PLC0415
+    src = tmp_path / "a.src"
+    old_text = "DEF a()\n  $OUT[1] = TRUE\nEND\n"
+    src.write_text(old_text, encoding="utf-8")
+
+    def edit_then_parse(paths, timeout, jobs=None):
+        src.write_text("DEF a()\n  $OUT[2] = TRUE\nEND\n", encoding="utf-8")
+        return load_batch(paths, timeout, jobs)
+
+    monkeypatch.setattr(parsecache, "load_batch", edit_then_parse)
+    s = store.Store(tmp_path / "cache")
+    load_files([norm(src)], timeout=60.0, store=s)
+    assert s.db.execute("SELECT COUNT(*) FROM entries WHERE kind = 'parse'").fetchone()[0] == 0
+    monkeypatch.undo()
+    src.write_text(old_text, encoding="utf-8")
+    again = store.Store(tmp_path / "cache")
+    lf = load_files([norm(src)], store=again)[0]
+    assert again.hits == 0
+    assert lf.module.routines[0].body[0].target.indices[0].value == 1    # the old text's AST
+    kept = store.Store(tmp_path / "cache")
+    assert load_files([norm(src)], store=kept)[0] is not None and kept.hits == 1
