@@ -29,9 +29,12 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from .errors import INTERRUPT_NOT_DECLARED, KrlRuntimeError
-from .watch import CLOCK, CONSTANT, IO, stamp_key
+from .watch import ALWAYS, CLOCK, CONSTANT, IO, stamp_key
 
 MAIN_PRIO = 129
+#: False: every armed condition is evaluated at every poll, whatever its watch (the oracle of
+#: tests/interp/test_interrupt_watch.py, with :func:`~.watch.stamp_key` patched to None)
+WATCHED = True
 
 
 @dataclass
@@ -117,10 +120,11 @@ class InterruptTable:
         Returns True when an interrupt is pending, on and enabled afterwards (then
         :meth:`next_ready` may find one to run), False when none is."""
         ready = False
+        watched = WATCHED
         for irq in tuple(self.irqs.values()):
             if not irq.on:
                 continue
-            w = irq.watch
+            w = irq.watch if watched else ALWAYS
             if w == CONSTANT:
                 key = 0
             elif w == IO:
