@@ -33,6 +33,7 @@ Usage::
 
 from __future__ import annotations
 
+import functools
 import gc
 import re
 import time
@@ -57,6 +58,7 @@ from krl.semantics.symbols import Scope, Symbol, system_scopes
 from krl.syntax.folds import fold_diagnostics
 from krl.syntax.messages import syntax_diagnostics
 from krl.syntax.engines import EngineUnavailable, java_answers, parse_source, resolve, result_from_answer
+from krl.syntax.engines.tree import stream_tokens
 from krl.syntax.parse import ParseResult, default_bundle, parse_text
 from krl.source import SourceText, is_krl_file, read_source
 
@@ -111,8 +113,31 @@ def load_parsed(src: SourceText, raw: bytes | None = None) -> LoadedFile:
     never raises for bad content."""
     t = time.perf_counter()
     if raw is None:
-        return _loaded(src, parse_source(src, keep_tree=True, engine="python"), t)
-    return _loaded(src, result_from_answer(src, raw, keep_tree=True), t)
+        result = parse_source(src, keep_tree=True, engine="python")
+    else:
+        result = result_from_answer(src, raw, keep_tree=True)
+    try:
+        return _loaded(src, result, t)
+    finally:
+        release_tree(result.tree)
+        result.tree = None
+
+
+def release_tree(tree) -> None:
+    """Break the cycles of a parse tree the AST was built from (each rule node's `children`
+    cleared: a child points back through `parentCtx`), so that reference counting frees it at
+    once. Without it a tree is cyclic garbage that only a full collection of the cyclic
+    collector finds: a pass over the whole heap (the language server's first check of 400
+    files: 1.9 M objects, 0.66 s of CPU against 0.31 s for this walk and the freeing,
+    2026-11-24)."""
+    stack = [tree] if tree is not None else []
+    pop, push = stack.pop, stack.extend
+    while stack:
+        node = pop()
+        children = getattr(node, "children", None)
+        if children:
+            node.children = None
+            push(children)
 
 
 def _loaded(src: SourceText, result: ParseResult, started: float) -> LoadedFile:
@@ -122,7 +147,7 @@ def _loaded(src: SourceText, result: ParseResult, started: float) -> LoadedFile:
     if result.status not in ("ok", "syntax_error") and not result.errors:
         sink.add(path_s, 1, 1, "E001", f"file not checked: {result.status}"
                  + (f" ({src.detail})" if src.detail else ""))
-    sink.extend(syntax_diagnostics(result, src.text))
+    sink.extend(syntax_diagnostics(result, src.text, tokens=stream_tokens(result.tree) if result.errors else None))
     sink.extend(fold_diagnostics(path_s, src.text))
     t = time.perf_counter()
     unreadable, words = False, set()
@@ -1103,10 +1128,13 @@ class _Decl:
         self.decl = node
 
 
+@functools.lru_cache(maxsize=8192)
 def is_kuka_file(path: str) -> bool:
     """A file KUKA's software wrote: a system file (:func:`is_system_path`) or one of KUKA's
     hook programs under R1/Program (kss.yaml ``programs``: masref_user.src,
-    CollDetect_UserAction.src; KUKA's system files call their routines)."""
+    CollDetect_UserAction.src; KUKA's system files call their routines). Remembered per path
+    (a check asks 6-7 times per file: 2,656 Path objects parsed for 400 files, 0.3 of 4.7 s
+    profiled, 2026-11-24)."""
     if is_system_path(path):
         return True
     p = Path(path)

@@ -130,7 +130,9 @@ SCHEMA: dict[str, list[tuple[str, str]]] = {
         ("since", "float: s, the first event left out"),
         ("kinds", "dict: kind -> events of that kind left out"),
         ("passes", "optional int: whole repetitions of the pass among them"),
-        ("period", "optional int: events in one pass"),
+        ("period", "optional int: events in one pass: each event left out repeats the one this "
+                   "many events before it, counted over every event or over the events other than "
+                   "poses (written also when no whole pass was left out)"),
     ],
     "interrupt": [
         ("prio", "int: interrupt number / priority"),
@@ -371,7 +373,7 @@ class TraceWriter:
         passes, self._left_passes = self._left_passes, 0
         self._emit(make_event("repeat", self._left_last if t is None else max(t, self._left_last),
                               count=sum(left.values()), since=since, kinds=dict(sorted(left.items())),
-                              passes=passes or None, period=self._left_period if passes else None))
+                              passes=passes or None, period=self._left_period or None))
 
     def _emit(self, ev: dict[str, Any], line: str | None = None) -> None:
         """Keep and/or write event `ev`; `line` is its JSON text when the caller formatted it.

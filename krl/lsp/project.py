@@ -7,8 +7,8 @@ one :class:`krl.workspace.Workspace`.
 * **Files on disk** are read once per change of their size or time stamp. Those not read yet
   are loaded together (:meth:`Project.load_files`): from the persistent parse cache
   (krl/store.py, krl/parsecache.py ``read_parses``) by content hash, and the others parsed by the fast (Java) engine when it
-  runs here, in worker processes when there is enough to share out (krl/workspace.py
-  ``load_batch``), else in this process.
+  runs here: in this process while the engine's threads parse, or in worker processes when
+  there is enough to share out and more than two cores (krl/workspace.py ``load_batch``).
 * **Buffers** are parsed by pieces (krl/lsp/parsing.py). A buffer that is its file as on disk
   is that file's parse; the first parse of another is one whole-file parse by the fast engine,
   whose pieces are kept, so that an edit re-parses the piece it touches.
@@ -28,6 +28,7 @@ import gc
 import hashlib
 import logging
 import os
+import threading
 import time
 from collections.abc import Callable
 from pathlib import Path
@@ -50,29 +51,44 @@ __all__ = ["Project", "is_uri", "norm"]
 log = logging.getLogger("krl.lsp")
 ROOTS_TTL_S = 2.0        # seconds a workspace's file list is trusted before it is listed again
 # Files to parse past this many bytes are shared out to worker processes (each rebuilds the Java
-# engine's trees and builds the ASTs). Below it the fork server's start and the results' transfer
-# cost more than the second core saves: a 365 KB backup loaded in 5.4 s in workers, 3.1 s in
-# this process, at a load average of 24 on the 2 cores; 400 files (1.8 MB) need both cores.
+# engine's trees and builds the ASTs) on PARALLEL_MIN_JOBS cores or more.
+# On 2 cores the Java engine's threads are the parallel part: its parse runs on one core while
+# this process builds the ASTs of the files it answered, on the other. Workers there cost twice
+# the CPU (the ASTs pickled and unpickled) and lost in wall time too: 400 files (1.8 MB),
+# 2026-11-24, load 8-9, CPU 8.0 s / wall 22-25 s through workers against 4.7-5.1 s / 8-11 s
+# in this process (/tmp profile of Project.analyze, cold cache).
 PARALLEL_BYTES = 1024 * 1024
+PARALLEL_MIN_JOBS = 3
+# While the fast engine has not answered yet in this process (its JVM starting: 0.5-1.6 s), a
+# batch up to this size (the file just opened) is parsed by the Python engine instead of waiting
+# for it: about 20 us per byte at load 9 (Main_2.src, 6.7 kB: 0.17 s; bas.src, 45 kB: 0.89 s,
+# against 1.1-1.6 s for the JVM's first answer), 2026-11-24.
+FIRST_PYTHON_BYTES = 48 * 1024
 MAX_RECHECKED_FILES = 16        # more changed files at once: the workspace is checked whole again
-IN_PROCESS_COLLECT_FILES = 20   # an in-process parse of this many files: one collection after it
 
 
 @contextlib.contextmanager
-def collector_off():
+def collector_off(freeze: bool = False):
     """Python's cyclic garbage collector paused (then restored as it was). A whole analysis
     creates millions of long-lived objects (ASTs, scopes, annotations) and next to no cyclic
     garbage: the collector's repeated passes over the growing heap were half its CPU time (400
     files, 2026-11-24, load ~20: cold through the workers 4.6 -> 3.4 s, from the cache 1.8 ->
     0.7 s). Measured garbage left after such an analysis: 38 objects from the cache, 5,304 through
-    the workers; the cyclic parse trees of an in-process parse are collected once after it
-    (:meth:`Project._parse_files`)."""
+    the workers; the parse trees of an in-process parse are freed as each AST is built
+    (krl/workspace.py ``release_tree``).
+
+    `freeze`: what was made is moved to the collector's permanent generation before it runs
+    again (``gc.freeze``, as the language server keeps a whole check's objects: krl/lsp/server.py),
+    so that the first allocation after it does not start a pass over the objects just made
+    (400 files from the cache: 0.43 of 4.7 s profiled, 2026-11-24)."""
     was = gc.isenabled()
     gc.disable()
     try:
         yield
     finally:
         if was:
+            if freeze:
+                gc.freeze()
             gc.enable()
 
 
@@ -94,10 +110,13 @@ class Project:
     a fork server, never from a fork of this process (krl/workspace.py ``load_batch``);
     `defer_writes`: the parse entries of files read from disk are put in the cache by
     :meth:`write_cache`, which the caller runs once the analysis is published (the server),
-    instead of before the check (encoding 400 files: 0.3 s of CPU)."""
+    instead of before the check (encoding 400 files: 0.3 s of CPU); `freeze`: a whole check's
+    objects go to the cyclic collector's permanent generation (:func:`collector_off`)."""
 
-    def __init__(self, store: Store | None = None, threaded: bool = False, defer_writes: bool = False) -> None:
+    def __init__(self, store: Store | None = None, threaded: bool = False, defer_writes: bool = False,
+                 freeze: bool = False) -> None:
         self.threaded = threaded
+        self.freeze = freeze
         self.defer_writes = defer_writes
         self.unwritten: list[tuple[str, str, object, str]] = []     # (parse key, path, LoadedFile, outcome status) to cache
         self.docs: dict[str, str] = {}          # open buffers: path -> text
@@ -110,6 +129,9 @@ class Project:
         self._roots: dict[str, tuple[float, str, list[str], list]] = {}
         self.analyses: dict[str, Analysis] = {}  # root -> latest analysis
         self._root_of: dict[str, str] = {}       # path -> root of its latest analysis
+        # set once the fast engine answered in this process (the server's warm-up); None: no
+        # warm-up runs (the fast engine is used whenever it runs here)
+        self.engine_started: threading.Event | None = None
         self.watched = False    # the client reports file changes: file lists kept until it does
         self._disk_known = False    # ... and the files read stay as read until it does
 
@@ -214,25 +236,29 @@ class Project:
     def _parse_files(self, sources: list[SourceText]) -> dict:
         """path -> (LoadedFile, outcome status: "done", or how a worker's parse was stopped:
         krl.pool.Outcome) for decoded files: by the fast engine when it runs here (in worker
-        processes past PARALLEL_BYTES), else by the Python engine, in this process."""
+        processes past PARALLEL_BYTES on PARALLEL_MIN_JOBS cores or more), else (or while it
+        starts, for a small batch: FIRST_PYTHON_BYTES) by the Python engine, in this process."""
         if not sources:
             return {}
         size = sum(s.size for s in sources)
         jobs = default_jobs()
-        if _java() and size >= PARALLEL_BYTES and jobs > 1:
+        if _java() and size >= PARALLEL_BYTES and jobs >= PARALLEL_MIN_JOBS:
             out = {}
             for src, o in zip(sources, load_batch([s.path for s in sources], PARSE_TIMEOUT_S, jobs,
                                                    threaded=self.threaded)):
                 out[src.path] = (o.value if o.status == "done" else failed_load(src.path, o, PARSE_TIMEOUT_S), o.status)
             return out
-        if _java():
+        if _java() and not self._engine_starting(size):
             out = {src.path: (load_parsed(src, raw), "done")
                    for _i, src, raw in java_answers(enumerate(sources), threads=jobs, trees=True)}
         else:
             out = {src.path: (load_parsed(src, None), "done") for src in sources}
-        if len(sources) >= IN_PROCESS_COLLECT_FILES:
-            gc.collect()            # their parse trees (cyclic), once, under collector_off
         return out
+
+    def _engine_starting(self, size: int) -> bool:
+        """True when `size` bytes are better parsed by the Python engine now than by the fast
+        engine, which is still starting (FIRST_PYTHON_BYTES)."""
+        return self.engine_started is not None and not self.engine_started.is_set() and size <= FIRST_PYTHON_BYTES
 
     def first_parse(self, path: str, text: str) -> Parsed:
         """The parse of a buffer seen for the first time: the file's own parse when the buffer
@@ -292,7 +318,7 @@ class Project:
         docs = dict(self.docs) if docs is None else docs
         root, files, skipped = self.workspace_files(path, docs)
         first = root not in self.analyses
-        with collector_off() if first else contextlib.nullcontext():
+        with collector_off(self.freeze) if first else contextlib.nullcontext():
             return self._analyze(path, docs, root, files, skipped, first, on_parsed, on_cached)
 
     def _analyze(self, path: str, docs: dict[str, str], root: str, files: list[str], skipped, first: bool,
@@ -321,7 +347,7 @@ class Project:
         parsed = [self.parsed(f, docs) for f in files]
         an = self._recheck(root, files, parsed, skipped)
         if an is None:
-            with collector_off():
+            with collector_off(self.freeze):
                 an = self._check(root, parsed, skipped, None if first else on_cached, cached)
         self.analyses[root] = an
         for f in files:

@@ -52,7 +52,7 @@ from krl.lsp.bench import generate
 from krl.lsp.convert import lsp_diagnostic
 from krl.lsp.parsing import Parsed
 from krl.lsp.paths import norm
-from krl.lsp.project import Project
+from krl.lsp.project import PARALLEL_MIN_JOBS, Project
 from krl.lsp.text import from_position, to_range, token_at, units
 from pygls.exceptions import JsonRpcException
 from krl.terminal import printable, printable_path
@@ -99,7 +99,7 @@ class KrlLanguageServer(LanguageServer):
 
     def __init__(self) -> None:
         super().__init__("krl-lsp", __version__)
-        self.project = Project(store=None, threaded=True, defer_writes=True)
+        self.project = Project(store=None, threaded=True, defer_writes=True, freeze=True)
         self._store_ready = threading.Event()
         self._writing = False
         self._edits_warm = False
@@ -212,7 +212,8 @@ class KrlLanguageServer(LanguageServer):
                 # kept out of the cyclic collector's generations, an edit's allocations never
                 # start a full collection over them (pauses of 1.7-1.9 s per few edits on the
                 # 400-file bench at load 26, none frozen). What the previous check left is
-                # unfrozen here and collected as usual.
+                # unfrozen here and collected as usual. (The project froze the check's objects
+                # as it ended already, before the collector ran again: Project(freeze=True).)
                 gc.unfreeze()
                 gc.freeze()
             if an.how == "workspace":
@@ -277,6 +278,8 @@ class KrlLanguageServer(LanguageServer):
     def warm(self) -> None:
         """Start the fast parse engine's worker and read the front end's tables, in the
         background (the first parse and check then wait for neither)."""
+        started = self.project.engine_started = threading.Event()
+
         def run() -> None:
             try:
                 try:
@@ -286,8 +289,10 @@ class KrlLanguageServer(LanguageServer):
                                           threads=default_jobs(), trees=False))
                 except EngineUnavailable:
                     pass
+                finally:
+                    started.set()   # (krl/lsp/project.py FIRST_PYTHON_BYTES)
                 system_scopes()
-                if default_jobs() > 1:
+                if default_jobs() >= PARALLEL_MIN_JOBS:
                     start_fork_server(WORKER_MODULES)    # for the parallel loads of large workspaces
             except Exception as exc:  # noqa: BLE001 - only a head start
                 log.error("warming up failed: %s", printable(exc), exc_info=TRACEBACKS["on"])

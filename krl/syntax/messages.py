@@ -149,16 +149,17 @@ def expected_phrase(expected: list[str]) -> str:
 class _File:
     """The line tokens and block scan of one file, made only when it has syntax errors."""
 
-    def __init__(self, text: str, bundle) -> None:
-        self.lines = {ln.number: ln for ln in lines_of(lex(text, bundle), bundle)}
+    def __init__(self, text: str, bundle, tokens: list | None = None) -> None:
+        self.lines = {ln.number: ln for ln in lines_of(lex(text, bundle) if tokens is None else tokens, bundle)}
         self.scan: BlockScan = scan(list(self.lines.values()))
 
 
-def syntax_diagnostics(result, text: str, bundle=None) -> list[Diagnostic]:
+def syntax_diagnostics(result, text: str, bundle=None, tokens: list | None = None) -> list[Diagnostic]:
     """The diagnostics of a ParseResult's syntax errors (cascades left out), in KRL words.
 
-    `text` is the decoded source the result was parsed from. Never raises: a message that
-    cannot be worded better keeps the generic E002 form.
+    `text` is the decoded source the result was parsed from; `tokens`: its token stream when
+    the caller has it (krl/syntax/engines/tree.py ``stream_tokens``), else it is lexed here.
+    Never raises: a message that cannot be worded better keeps the generic E002 form.
     """
     issues = [e for e in result.errors if not e.cascade]
     if not issues:
@@ -171,7 +172,7 @@ def syntax_diagnostics(result, text: str, bundle=None) -> list[Diagnostic]:
     if out:
         return out
     try:
-        f = _File(text, bundle or default_bundle())
+        f = _File(text, bundle or default_bundle(), tokens)
     except Exception:  # noqa: BLE001 - fall back to the parser's words
         f = None
     taken_lines: set[int] = set()

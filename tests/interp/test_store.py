@@ -316,7 +316,7 @@ def test_a_stopped_parse_is_never_stored(tmp_path, monkeypatch, way):
         monkeypatch.setattr(project_mod, "load_batch", _stopped)
         monkeypatch.setattr(project_mod, "_java", lambda: True)
         monkeypatch.setattr(project_mod, "PARALLEL_BYTES", 0)
-        monkeypatch.setattr(project_mod, "default_jobs", lambda: 2)
+        monkeypatch.setattr(project_mod, "default_jobs", lambda: project_mod.PARALLEL_MIN_JOBS)
         p = Project(store=s)
         p.load_files(files)
         got = [p._disk[f][1].loaded for f in files]

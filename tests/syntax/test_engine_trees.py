@@ -15,15 +15,19 @@ import time
 import gc
 
 import pytest
+from antlr4 import ParserRuleContext
+from antlr4.tree.Tree import TerminalNodeImpl
 
 import krl.syntax.engines as engines_mod
 import krl.workspace as workspace_mod
 from krl.syntax.engines import java as java_engine
 from krl.syntax.engines import java_answers, parse_file, result_from_answer
-from krl.syntax.engines.tree import RebuiltToken, TreeDataError, tree_from_raw
+from krl.syntax.engines.tree import RebuiltToken, TreeDataError, stream_tokens, tree_from_raw
+from krl.syntax.messages import syntax_diagnostics
+from krl.syntax.tokens import lex
 from krl.syntax.parse import default_bundle, prepare_text
-from krl.source import SourceText
-from tests.syntax.test_engines import _java_or_skip, _record, needs_java, tree_shape
+from krl.source import SourceText, read_source
+from tests.syntax.test_engines import _files, _java_or_skip, _record, needs_java, tree_shape
 from krl.project import collect_entries
 
 TEXT = "DEF a()\nDECL INT x\nx = -(1 + 2) * 3\nIF x > 1 THEN\nx = x - 1\nENDIF\nEND\n"
@@ -172,3 +176,56 @@ def test_load_batch_pauses_the_collector_here_but_never_in_the_workers(tmp_path,
     assert [o.status for o in outcomes] == ["done"] * 4
     assert [o.value for o in outcomes] == [True] * 4
     assert gc.isenabled()
+
+
+@needs_java
+def test_the_syntax_messages_read_the_rebuilt_token_stream(shared_corpus):
+    """A file with syntax errors is worded from the Java engine's token stream
+    (``stream_tokens``), not lexed again: the stream is the Python lexer's, token by token,
+    and the diagnostics are the same, on every corpus and negative-test file with an error."""
+    _java_or_skip()
+    sources = [s for s in (read_source(p) for p in _files(shared_corpus)) if s.status == "ok"]
+    checked = 0
+    for _i, src, raw in java_answers(enumerate(sources), threads=2, trees=True):
+        if raw is None:
+            continue
+        res = result_from_answer(src, raw, keep_tree=True)
+        if not res.errors:
+            continue
+        tokens = stream_tokens(res.tree)
+        assert [(t.type, t.channel, t.text, t.line, t.column) for t in tokens] == \
+            [(t.type, t.channel, t.text, t.line, t.column) for t in lex(prepare_text(src.text), default_bundle())], src.path
+        assert syntax_diagnostics(res, src.text, tokens=tokens) == syntax_diagnostics(res, src.text), src.path
+        checked += 1
+    assert checked >= 10        # the corpus and tests/negative hold files with syntax errors
+    assert stream_tokens(parse_file(TEXT, "a.src", engine="python", keep_tree=True).tree) is None
+
+
+# (the Python engine's error recovery keeps the nodes it recovered in exception <-> context
+# cycles: only its tree of a valid file is held to this)
+@pytest.mark.parametrize("engine, text", [("java", TEXT * 20), ("java", BROKEN), ("python", TEXT * 20)])
+def test_a_loaded_file_leaves_its_parse_tree_to_reference_counting(engine, text):
+    """load_parsed frees the parse tree its AST was built from (krl/workspace.py
+    ``release_tree``): no node of it is left for the cyclic collector, and the AST is whole.
+    (The Python engine's lexer and parser leave their own cycle: its tokens and the root.)"""
+    if engine == "java":
+        _java_or_skip()
+    src = SourceText("a.src", text, "", len(text))
+    raw = json.dumps(_raw(text)).encode() if engine == "java" else None
+    gc.collect()
+    was = gc.isenabled()
+    gc.disable()
+    gc.set_debug(gc.DEBUG_SAVEALL)
+    try:
+        lf = workspace_mod.load_parsed(src, raw)
+        gc.collect()
+        nodes = [o for o in gc.garbage if isinstance(o, (ParserRuleContext, TerminalNodeImpl))]
+    finally:
+        gc.set_debug(0)
+        gc.garbage.clear()
+        if was:
+            gc.enable()
+    # at most the root, childless, which the Python engine's parser holds in its own cycle
+    assert len(nodes) <= (1 if engine == "python" else 0)
+    assert all(isinstance(o, ParserRuleContext) and not o.children for o in nodes)
+    assert [r.name.upper() for r in lf.module.routines] == (["A"] * 20 if text != BROKEN else ["B"])

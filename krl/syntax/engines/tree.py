@@ -24,7 +24,7 @@ from antlr4.CommonTokenStream import CommonTokenStream
 from antlr4.error.Errors import RecognitionException
 from antlr4.tree.Tree import ErrorNodeImpl, TerminalNodeImpl
 
-__all__ = ["TreeDataError", "tree_from_raw"]
+__all__ = ["TreeDataError", "stream_tokens", "tree_from_raw"]
 
 
 class TreeDataError(ValueError):
@@ -222,3 +222,21 @@ def _build(tk: list[int], names: list[str], data: list[int], labels: list, text:
         else:
             raise TreeDataError(f"unknown label kind {kind!r}")
     return root
+
+
+def stream_tokens(tree) -> list | None:
+    """Every token of the stream a rebuilt tree was parsed from (all channels, in order, as
+    :func:`krl.syntax.tokens.lex` gives them for the same text), or None for a tree the Python
+    engine built (or no tree). The syntax messages read them instead of lexing the file again
+    with the Python runtime's lexer (krl/syntax/messages.py ``syntax_diagnostics``)."""
+    start = getattr(tree, "start", None)
+    if type(start) is not RebuiltToken:
+        return None
+    shared = start._data
+    out = []
+    for k in range(0, len(shared[0]) - 5, 6):
+        t = _new(RebuiltToken)
+        t._data = shared
+        t._k = k
+        out.append(t)
+    return out
