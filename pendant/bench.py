@@ -22,7 +22,8 @@ throughput); closed and open alternate ``--rounds`` times and the medians are co
 The latency is measured in the page while the program runs at real time: an input key pressed,
 until the animation frame that first shows the new value (``performance.now()`` at the click
 and in that frame), ``--toggles`` times, with its parts: until the server's answer (``done``)
-arrived and until the new state was on the page. Prints one line per figure, the ratios, the
+arrived, until the new state was on the page, and the server's own part (the key's arrival to
+its answer: less sensitive to a loaded machine than what the browser adds). Prints one line per figure, the ratios, the
 load and the date; a benchmark, not a test (nothing asserts a time).
 """
 
@@ -172,7 +173,8 @@ def rtf(root, backup, program, cell, seconds, realtime: bool, page: bool) -> tup
 
 # an input key pressed until the frame that shows its new value (ms), with the times at which
 # the server's answer (done) and the last state before it reached the page (``window.pendant``
-# ``lastDone``, ``lastChange``);
+# ``lastDone``, ``lastChange``) and the server's own part, from the key's arrival to its answer
+# (``lastServerMs``: the ``ms`` of ``done``; null when the answer came after the change showed);
 # null when nothing changed within 30 s
 LATENCY_JS = """async (n) => {
   const P = window.pendant;
@@ -181,12 +183,17 @@ LATENCY_JS = """async (n) => {
   const t0 = performance.now();
   btn.click();
   return await new Promise((resolve) => {
+    let r = null;
     const check = () => {
-      const now = document.querySelector(`[data-input="${n}"]`);
       const t = performance.now();
-      if (now && now.textContent !== before) {
-        resolve({visible: t - t0, done: (P.lastDone > t0 ? P.lastDone : t) - t0,
-                 state: (P.lastChange > t0 ? P.lastChange : t) - t0});
+      if (r === null) {
+        const now = document.querySelector(`[data-input="${n}"]`);
+        if (now && now.textContent !== before)
+          r = {visible: t - t0, state: (P.lastChange > t0 ? P.lastChange : t) - t0};
+      }
+      if (r !== null && P.lastDone > t0) {          // the answer too (it may come after the change showed)
+        resolve({...r, done: Math.min(P.lastDone - t0, r.visible),
+                 server: typeof P.lastServerMs === 'number' ? P.lastServerMs : null});
       } else if (t - t0 > 30000) resolve(null);
       else requestAnimationFrame(check);
     };
@@ -303,8 +310,12 @@ def _latency(a) -> None:
         who = f" [{root}]" if len(a.roots) > 1 else ""
         for key, what in (("visible", "input -> visible change"),
                           ("state", "  of which: until the new state was on the page"),
-                          ("done", "  of which: until the server's answer arrived")):
-            xs = [r[key] for r in lat]
+                          ("done", "  of which: until the server's answer arrived"),
+                          ("server", "  of which: in the server (key received -> answer sent)")):
+            xs = [r[key] for r in lat if r.get(key) is not None]
+            if not xs:
+                print(f"{what}{who}: not measured (the server of {root} does not send it)", flush=True)
+                continue
             print(f"{what}{who} (ms, {len(xs)} toggles at real time{f', {skipped} skipped' if skipped else ''}): "
                   f"median {statistics.median(xs):.1f}, p95 {_pct(xs, 0.95):.1f}, max {max(xs):.1f}", flush=True)
 

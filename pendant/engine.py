@@ -9,8 +9,9 @@ simulated controller live; edits are recorded by the engine and made again in a 
 
 Display: through the engine's ``on_runtime`` each run gets a per-IPO-cycle hook that
 publishes :attr:`Pendant.live` (simulated time, $AXIS_ACT, blending, the pointers) and, when
-the run is paced (``realtime``), sleeps until the wall clock has caught up with the simulated
-clock; a replay is never paced. The message window waits for the operator
+the run is paced (``realtime``), waits until the wall clock has caught up with the simulated
+clock, or until work is posted to the engine (a key, a snapshot: served at the next hook, not a
+cycle later); a replay is never paced. The message window waits for the operator
 (``rt.messages.interactive``), and the controller's own notes are kept apart from the KRL
 messages.
 """
@@ -18,6 +19,7 @@ messages.
 from __future__ import annotations
 
 import asyncio
+import threading
 import time
 from pathlib import Path
 
@@ -58,6 +60,7 @@ class Engine:
         self.run_no = 0                        # counts the runs built (a replay starts a new path)
         self._base_inv = self._base_T = None
         self._pace0: tuple[float, float] | None = None
+        self._posted = threading.Event()        # work posted to the engine: the pacing wait ends
 
     # ------------------------------------------------------------------ lifecycle
     def select(self, program: str, *, workspace: str | None, inputs: str | None, mode: str,
@@ -109,7 +112,9 @@ class Engine:
         if core is None or core.done:
             raise EngineError("no program is selected")
         try:
-            return core.call(fn, *args, timeout=timeout)
+            fut = core.post(fn, *args)
+            self._posted.set()
+            return fut.result(timeout)
         except Refused as exc:
             raise EngineError(str(exc)) from None
         except TimeoutError:
@@ -127,7 +132,9 @@ class Engine:
         if core is None or core.done:
             raise EngineError("no program is selected")
         try:
-            return await asyncio.wait_for(asyncio.wrap_future(core.post(lambda: fn(core))), timeout)
+            fut = core.post(lambda: fn(core))
+            self._posted.set()
+            return await asyncio.wait_for(asyncio.wrap_future(fut), timeout)
         except Refused as exc:
             raise EngineError(str(exc)) from None
         except asyncio.TimeoutError:
@@ -178,8 +185,12 @@ class Engine:
             self._pace0 = (now, ctl.time)
             return
         ahead = (ctl.time - self._pace0[1]) - (now - self._pace0[0])
-        if ahead > 0:
-            time.sleep(ahead)
+        if ahead > 0 and self._posted.wait(ahead):
+            # work was posted (a key, a snapshot): the wait ends at once and the engine serves
+            # it at the next hook (the tasks' next statement or cycle), where it would be served
+            # after the sleep too, so the simulated run is the same; the simulation is ahead of
+            # the wall clock for a moment, and the next cycles wait the longer
+            self._posted.clear()
         elif ahead < -0.25:
             self._pace0 = (now, ctl.time)    # fell behind (a stop, a slow cycle): pace from here
 

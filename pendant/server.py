@@ -7,8 +7,10 @@ the one websocket. On the websocket the page sends operator actions as JSON obje
 programs, robot), ``module`` (a file's text and taught points), ``state`` (pendant/state.py: the
 whole state first, ``"full": true``, then only the top-level keys that changed, a key gone as
 null), ``live`` (time, axes, the TCP path's new points and, when they changed, the pointers, at
-display rate while the program runs), ``error`` (a key's refusal, in the controller's words) and
-``event`` (the engine's stops and ends). The messages are not compressed (loopback: deflate was
+display rate while the program runs), ``done`` (an action carried out: its id and op, and ``ms``
+the server's time from the message's arrival to this answer; a key's changed state went out
+just before it), ``error`` (a key's refusal, in the controller's words) and ``event`` (the
+engine's stops and ends). The messages are not compressed (loopback: deflate was
 the largest CPU cost of a connected page).
 
 Threads: uvicorn's event loop serves the page; the program runs on the engine's thread
@@ -34,12 +36,15 @@ from starlette.routing import Mount, Route, WebSocketRoute
 from starlette.staticfiles import StaticFiles
 from starlette.websockets import WebSocket, WebSocketDisconnect
 
+from interp.debug.engine import Refused
+
 from krl.limits import (MAX_WEB_BODY_BYTES, MAX_WEB_CONNECTIONS, MAX_WEB_EXPRESSION_CHARS, MAX_WEB_MESSAGE_BYTES,
                         MAX_WEB_MESSAGES_PER_S, MAX_WEB_WATCHES)
 
 from . import engine as keys
 from .engine import MODES_OP, RUN_MODES, Engine, EngineError
 from .security import COOKIE, Guard, PathRefused, inside
+from .state import snapshot
 
 STATIC = Path(__file__).resolve().parent / "static"
 #: display rate of the live pose (Hz) and of the full state while running
@@ -122,32 +127,36 @@ class Pendant:
             except Exception:  # noqa: BLE001 - a client gone meanwhile
                 self.clients.discard(ws)
 
-    async def state(self) -> dict:
+    async def state(self, fresh: dict | None = None) -> dict:
+        """The page's state: ``fresh`` (a snapshot the engine took right after a key, in the
+        key's own engine call), else a snapshot asked for now."""
         if not self.engine.selected:
             return {"state": "none", "program": None, "drives": self.drives, "modeOp": self.mode,
                     "runMode": self.run_mode}
-        try:
-            from .state import snapshot  # noqa: PLC0415
-
-            eng, watch = self.engine, list(self.watch)
-            s = await eng.do_async(lambda core: snapshot(eng, core, watch), 60.0)
-        except EngineError as exc:
-            s = {"state": "ended" if not self.engine.selected else "busy", "note": str(exc)}
+        if fresh is not None:
+            s = dict(fresh)
+        else:
+            try:
+                eng, watch = self.engine, list(self.watch)
+                s = await eng.do_async(lambda core: snapshot(eng, core, watch), 60.0)
+            except EngineError as exc:
+                s = {"state": "ended" if not self.engine.selected else "busy", "note": str(exc)}
         s.update({"program": self.program, "drives": self.drives, "breakpoints":
                   {p: sorted(v) for p, v in self.breakpoints.items()}})
         return s
 
-    async def push_state(self) -> None:
+    async def push_state(self, fresh: dict | None = None) -> None:
         """The state to every page, as what changed since the state that page was sent last
         (pendant/state.py: top-level keys, a key gone is sent as null; the first is whole,
-        ``"full": true``): a page keeps its state and redraws only the changed parts."""
+        ``"full": true``): a page keeps its state and redraws only the changed parts.
+        ``fresh``: a snapshot taken in a key's engine call (:meth:`state`)."""
         if not self.clients:
             return
         async with self._pushing:                     # one at a time: each page's diffs in order
-            await self._push_state()
+            await self._push_state(fresh)
 
-    async def _push_state(self) -> None:
-        s = await self.state()
+    async def _push_state(self, fresh: dict | None) -> None:
+        s = await self.state(fresh)
         texts: dict[tuple, str] = {}                  # one encoding per distinct message
         for ws in list(self.clients):
             last = self._shown.get(ws)
@@ -202,9 +211,22 @@ class Pendant:
         if op not in OPS:
             raise EngineError(f"unknown action {str(op)[:40]!r}")
         loop = asyncio.get_running_loop()
+        eng, watch, fresh = self.engine, list(self.watch), []
 
-        def do(fn, timeout=120.0):
-            return self.engine.do_async(fn, timeout)
+        async def do(fn, timeout=120.0, *, state=True):
+            """The key ``fn(core)`` and, with ``state``, the state snapshot after it in the same
+            engine call (one round trip to the engine thread: the answer carries what the key
+            changed). Not for Start and Stop: their change comes after the call (the program
+            goes on, stops at its next statement), and the state is asked for afterwards."""
+            def key_and_state(core):
+                result = fn(core)
+                if state:
+                    try:
+                        fresh.append(snapshot(eng, core, watch))
+                    except Refused:
+                        pass                           # asked for again by push_state
+                return result
+            return await eng.do_async(key_and_state, timeout)
 
         if op == "hello":
             from .view import modules  # noqa: PLC0415
@@ -228,12 +250,12 @@ class Pendant:
             await self.select(self.program)
         elif op == "start":
             self._need_drives()
-            await do(lambda core: core.resume())
+            await do(lambda core: core.resume(), state=False)
         elif op == "stop":
-            await do(lambda core: core.pause())
+            await do(lambda core: core.pause(), state=False)
         elif op == "backward":
             self._need_drives()
-            await do(lambda core: core.backward_motion(), 900.0)
+            await do(lambda core: core.backward_motion(), 900.0, state=False)
         elif op == "runMode":
             value = str(msg.get("value", "")).upper()
             if value not in RUN_MODES:
@@ -293,7 +315,7 @@ class Pendant:
             path = inside(self.root, str(msg.get("path", "")), suffixes=(".src", ".sub", ".dat"))
             await self.send_module(ws, str(path))
             return
-        await self.push_state()
+        await self.push_state(fresh[-1] if fresh and self.watch == watch else None)
 
     def _need_drives(self) -> None:
         if not self.drives:
@@ -369,7 +391,7 @@ class Pendant:
                 if len(text) > MAX_WEB_MESSAGE_BYTES:
                     await ws.close(code=1009, reason="message too large")
                     return
-                queue.put_nowait(text)
+                queue.put_nowait((now, text))
         except WebSocketDisconnect:
             pass
         finally:
@@ -394,7 +416,7 @@ class Pendant:
 
     async def _carry_out(self, ws: WebSocket, queue: asyncio.Queue) -> None:
         while True:
-            text = await queue.get()
+            arrived, text = await queue.get()
             try:
                 msg = json.loads(text)
                 if not isinstance(msg, dict):
@@ -406,7 +428,8 @@ class Pendant:
             try:
                 async with self.busy:
                     await self.handle(ws, msg)
-                await ws.send_text(json.dumps({"type": "done", "id": rid, "op": str(msg.get("op"))[:40]}))
+                await ws.send_text(json.dumps({"type": "done", "id": rid, "op": str(msg.get("op"))[:40],
+                                               "ms": round((time.monotonic() - arrived) * 1000.0, 1)}))
             except (EngineError, PathRefused) as exc:
                 await ws.send_text(json.dumps({"type": "error", "id": rid, "op": str(msg.get("op"))[:40],
                                                "text": str(exc)[:500]}))

@@ -191,12 +191,15 @@ def test_input_by_hand_releases_wait_for(pw, shared_corpus, tmp_path):
     assert ev and ev[0]["value"] is True and ev[0]["source"] == "operator" and ev[0]["t"] > t_wait + 2.0
 
 
-def test_the_pendant_run_gives_krl_runs_trace(pw, shared_corpus, tmp_path):
+@pytest.mark.parametrize("pacing", [["--no-realtime"], []], ids=["unpaced", "paced"])
+def test_the_pendant_run_gives_krl_runs_trace(pw, shared_corpus, tmp_path, pacing):
     """The same program, cell and modes: the trace of the run under the pendant (GO, AUT, run to
-    its end from the page) is byte for byte the trace of `krl run`."""
+    its end from the page) is byte for byte the trace of `krl run`; also paced at real time
+    (5.3 s simulated), where the page's state requests end the pacing waits early and are
+    served at the engine's next hook (pendant/engine.py)."""
     trace = tmp_path / "pendant.jsonl"
-    with pendant_server(KR120, "--no-realtime", "--inputs", str(KR120_CELL), "--trace", str(trace),
-                        "--mode", "AUT") as url, browser_page(pw, url) as page:
+    with pendant_server(KR120, *pacing, "--inputs", str(KR120_CELL),
+                        "--trace", str(trace), "--mode", "AUT") as url, browser_page(pw, url) as page:
         select(page, HOME, run_mode="GO", mode="AUT")
         page.click("#start")
         s = wait_state(page, "s.state == 'ended' || s.state == 'none'", timeout=900_000)

@@ -58,7 +58,7 @@ function onMessage(m) {
     case 'state': onState(m); break;
     case 'live': onLive(m); break;
     case 'event': P.events.push(m); if (P.events.length > 200) P.events.shift(); break;
-    case 'done': { P.lastDone = performance.now(); const w = waiting.get(m.id); if (w) { waiting.delete(m.id); w.resolve(m); } break; }
+    case 'done': { P.lastDone = performance.now(); P.lastServerMs = m.ms; const w = waiting.get(m.id); if (w) { waiting.delete(m.id); w.resolve(m); } break; }
     case 'error': {
       const w = waiting.get(m.id);
       if (w) { waiting.delete(m.id); w.reject(new Error(m.text)); } else showError(m.text);
