@@ -1,4 +1,4 @@
-"""Build the compiled inverse kinematics of the simulator: robot/simcore.pyx compiled by Cython
+"""Build the compiled hot path of the simulator: robot/simcore.pyx compiled by Cython
 into an extension module beside it (``simcore.*.so``; gitignored). Issue 39, "Simulator".
 
 One definition (:func:`extension`), two ways in, as for the VM loop (interp/vm/build.py), both

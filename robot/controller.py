@@ -44,6 +44,17 @@ from .cellrules import Rule, rules_may_fire, step_rules
 from .stimuli import Cell, Stimulus
 from .trace import TraceWriter
 
+
+def _compiled_module() -> Any:
+    """The compiled module robot/simcore.pyx when it is built, current and switched on
+    (robot/kinematics.py ``USE_COMPILED``), else None."""
+    from . import kinematics  # noqa: PLC0415  (the module's one switch and ABI check)
+
+    sc = kinematics._simcore
+    if sc is None or not kinematics.USE_COMPILED or getattr(sc, "ABI", None) != kinematics.SIMCORE_ABI:
+        return None
+    return sc
+
 EPS = 1e-9
 _F8 = np.dtype(np.float64)
 MSG_APPROX_IMPOSSIBLE = "approximation not possible"
@@ -278,6 +289,10 @@ class Controller:
         self._tcp_last: tuple | None = None
         self.last_error: RobotError | None = None
         self._step_lim: list[float] | None = None   # largest axis step per cycle (_check_speed)
+        self._step_lim_a: np.ndarray | None = None  # the same as an array (the compiled check)
+        #: robot/simcore.pyx (None: the Python code alone) and its per-cycle step check
+        self._simcore = _compiled_module()
+        self._speed_ok = getattr(self._simcore, "speed_ok", None)
         self._ret_q: np.ndarray | None = None
         self._ended = False
         self.network = None     # net.hub.Network: the partners, polled at each cycle's start
@@ -767,14 +782,31 @@ class Controller:
         if self._tracked:
             self._fire_triggers(self._pt)
         arm = self._arm if self._arm_q is None else self._arm_model()
-        if arm is not None:
-            if self.actuated:
-                arm.step_actuated(self._q, self.dt, (self._q - self._q_prev) / self.dt)
-            else:
-                arm.set_axes(self._q)
-        qa = self.axis_act()
-        self._tcp_prev = self._tcp_T[:3, 3].copy()
-        self._tcp_T = self._tcp_read_back(qa, self._tool_T, self._base_inv_T)
+        cyc = arm.compiled_cycle(self._simcore) if arm is not None and not self.actuated else None
+        if cyc is not None:
+            # set_axes, axis_act and the flange site in one compiled call (the same numbers)
+            qa, T = np.empty(6), np.empty((4, 4))
+            self._tcp_prev = self._tcp_T[:3, 3].copy()
+            try:
+                # with _tcp_read_back's product in numpy's own BLAS call (robot/mjcf.py
+                # _same_products)
+                done = cyc.cycle_tcp(self._q, qa, self._base_inv_T, self._tool_T, T)
+            except (TypeError, ValueError):      # a frame not C-contiguous float64: numpy's @
+                done = False
+            if not done:
+                F = np.empty((4, 4))
+                cyc.cycle(self._q, qa, F)
+                T = self._base_inv_T @ F @ self._tool_T
+            self._tcp_T = T
+        else:
+            if arm is not None:
+                if self.actuated:
+                    arm.step_actuated(self._q, self.dt, (self._q - self._q_prev) / self.dt)
+                else:
+                    arm.set_axes(self._q)
+            qa = self.axis_act()
+            self._tcp_prev = self._tcp_T[:3, 3].copy()
+            self._tcp_T = self._tcp_read_back(qa, self._tool_T, self._base_inv_T)
         if self._cyclic:
             for fn in list(self._cyclic.values()):
                 fn(self)
@@ -965,6 +997,13 @@ class Controller:
         lim = self._step_lim
         if lim is None:
             lim = self._step_lim = (CP_SPEED_LIMIT_FACTOR * self.model.v_max * self.dt + 1e-9).tolist()
+            self._step_lim_a = np.array(lim, dtype=float)
+        if self._speed_ok is not None and type(q) is np.ndarray:
+            try:
+                if self._speed_ok(q, self._q_prev, self._step_lim_a):
+                    return
+            except (TypeError, ValueError):      # not float64: the loop below takes it
+                pass
         step = [abs(a - b) for a, b in zip(q.tolist() if type(q) is np.ndarray else np.asarray(q).tolist(),
                                            self._q_prev.tolist())]
         for d, m in zip(step, lim):

@@ -54,11 +54,13 @@ OVERHEAD_SINGULAR_MM = 1e-6
 _ACOS_TOL = 1e-9
 #: Tolerance of the soft-limit test (deg), absorbs floating-point noise.
 LIMIT_EPS_DEG = 1e-9
+#: Results :meth:`Kinematics.forward` keeps (by the axes' bytes; cleared when full).
+FK_MEMO = 256
 #: Use the compiled OPW inverse (robot/simcore.pyx) when it is built; False: the Python code
 #: (the reference: the two agree bit for bit, tests/robot/test_simcore.py)
 USE_COMPILED = True
 #: The ``ABI`` of robot/simcore.pyx this module mirrors (a stale build is not used)
-SIMCORE_ABI = 2
+SIMCORE_ABI = 4
 
 
 def _wrap180(v: np.ndarray) -> np.ndarray:
@@ -105,7 +107,9 @@ class Kinematics:
         self.phi_deg = float(m.status_phi_deg)
         self._ks = np.arange(-2, 3) * 360.0
         self._rows = np.arange(6)
-        self._fk_last: tuple[bytes, np.ndarray] | None = None   # (axes, FLANGE) of the last forward()
+        #: FLANGE of recent forward() axes, by their bytes (a robot at rest asks for the same axes
+        #: every IPO cycle; a program's cycle plans the same points again); at most FK_MEMO
+        self._fk_memo: dict[bytes, np.ndarray] = {}
         # per-robot constants of the OPW solution and of the status test (hot loop: plain floats)
         self._kappa_2 = o.a2 * o.a2 + o.c3 * o.c3
         self._c2_2 = o.c2 * o.c2
@@ -206,13 +210,14 @@ class Kinematics:
         Returns:
             4x4 homogeneous transform, translation in mm.
 
-        The last result is kept: a robot at rest asks for the same axes every IPO cycle.
+        Recent results are kept by the axes' bytes (at most :data:`FK_MEMO`): a robot at rest
+        asks for the same axes every IPO cycle, and a program's cycle plans the same points again.
         """
         a = np.asarray(axes_deg, dtype=float)[:6]
         key = a.tobytes()
-        last = self._fk_last
-        if last is not None and last[0] == key:
-            return last[1].copy()
+        known = self._fk_memo.get(key)
+        if known is not None:
+            return known.copy()
         q = self._kuka_sign * np.radians(a)
         Rj = Rotation.from_rotvec(self._axes * q[:, None]).as_matrix()  # (6, 3, 3)
         R = np.eye(3)
@@ -225,7 +230,9 @@ class Kinematics:
         T = np.eye(4)
         T[:3, :3] = R @ self._R_flange
         T[:3, 3] = p + R @ self._p_flange
-        self._fk_last = (key, T.copy())
+        if len(self._fk_memo) >= FK_MEMO:
+            self._fk_memo.clear()
+        self._fk_memo[key] = T.copy()
         return T
 
     def forward_many(self, axes_deg: np.ndarray) -> np.ndarray:

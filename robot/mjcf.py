@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from typing import Any
 from xml.sax.saxutils import quoteattr
 
 import numpy as np
@@ -195,6 +196,73 @@ def _ext_home(m: MachineData, home: list[float]) -> list[float]:
 _BOTTOM_ROW = np.array([0.0, 0.0, 0.0, 1.0])
 
 
+def _arm_cycle(arm: "ArmModel", sc: Any) -> Any:
+    """The ``ArmCycle`` of the compiled module `sc` for `arm`, or None (see
+    :meth:`ArmModel.compiled_cycle`). ``mj_kinematics`` is looked up in the MuJoCo library the
+    ``mujoco`` package ships and has loaded (the same library: loading it again gives the
+    loaded one)."""
+    if arm.actuated or len(arm._eadr):
+        return None
+    try:
+        import ctypes  # noqa: PLC0415
+        import glob  # noqa: PLC0415
+        import os  # noqa: PLC0415
+
+        libs = sorted(glob.glob(os.path.join(os.path.dirname(arm._mj.__file__), "libmujoco*")))
+        if not libs:
+            return None
+        fn = ctypes.cast(ctypes.CDLL(libs[0]).mj_kinematics, ctypes.c_void_p).value
+        m, d = arm.model._address, arm.data._address
+        qidx = list(range(arm._qidx.start, arm._qidx.stop)) if isinstance(arm._qidx, slice) \
+            else [int(i) for i in arm._qidx]
+        xmat, xpos = arm.data.site_xmat[arm._site], arm.data.site_xpos[arm._site]
+        cyc = sc.ArmCycle(fn, m, d, arm.data.qpos, qidx, arm._sign.tolist(), xmat, xpos)
+    except (OSError, AttributeError, TypeError, ValueError):
+        return None
+    gemm = _numpy_dgemm()
+    if gemm:
+        cyc.use_gemm(gemm)
+        if not _same_products(cyc):
+            cyc.use_gemm(0)
+    return cyc
+
+
+def _numpy_dgemm() -> int:
+    """The address of the ILP64 ``cblas_dgemm`` numpy's own BLAS exports (the OpenBLAS a numpy
+    wheel bundles: ``scipy_cblas_dgemm64_``), 0 when there is none at hand."""
+    import ctypes  # noqa: PLC0415
+    import glob  # noqa: PLC0415
+    import os  # noqa: PLC0415
+
+    root = os.path.dirname(np.__file__)
+    for lib in sorted(glob.glob(os.path.join(root, "..", "numpy.libs", "*openblas64*"))
+                      + glob.glob(os.path.join(root, ".dylibs", "*openblas64*"))):
+        try:
+            return int(ctypes.cast(ctypes.CDLL(lib).scipy_cblas_dgemm64_, ctypes.c_void_p).value or 0)
+        except (OSError, AttributeError):
+            continue
+    return 0
+
+
+def _same_products(cyc: Any) -> bool:
+    """True when the compiled product gives numpy's ``A @ B @ C`` bit for bit on random 4x4
+    matrices (with identities and signed zeros): the check that the BLAS found is the one
+    numpy calls, the way numpy calls it."""
+    rng = np.random.default_rng(39)
+    out = np.empty((4, 4))
+    for i in range(64):
+        A, B, C = (rng.normal(0.0, 500.0, (4, 4)) for _ in range(3))
+        if i % 4 == 0:
+            A = np.eye(4)
+        if i % 3 == 0:
+            C = np.eye(4)
+        if i % 5 == 0:
+            B[rng.integers(0, 3), rng.integers(0, 4)] = -0.0
+        if not cyc.product(A, B, C, out) or out.tobytes() != (A @ B @ C).tobytes():
+            return False
+    return True
+
+
 class ArmModel:
     """The MuJoCo arm, driven in KUKA axis values (deg) and read back in mm.
 
@@ -228,6 +296,7 @@ class ArmModel:
         self._robroot = frame_to_matrix(self.machine.robroot_frame)
         self._robroot_inv = inv_pos(self._robroot)
         self._robroot_null = bool(np.allclose(self._robroot, np.eye(4)))
+        self._cycle: Any = None      # compiled_cycle's ArmCycle; False: none
         self.set_axes(self.machine.home_deg)
 
     # ------------------------------------------------------------------ replay
@@ -246,6 +315,18 @@ class ArmModel:
             self._mj.mj_forward(self.model, d)
         else:
             self._mj.mj_kinematics(self.model, d)
+
+    def compiled_cycle(self, simcore: Any) -> Any:
+        """The compiled kinematic playback of one IPO cycle (``simcore``: robot/simcore.pyx, as
+        robot/controller.py ``_compiled_module`` gives it, or None; its ``ArmCycle``:
+        :meth:`set_axes`, :meth:`axes_deg` and :meth:`flange_pose_world` in one call, the same
+        numbers; its ``product`` is numpy's ``A @ B @ C`` of 4x4 matrices when numpy's own BLAS
+        is found and gives the same products), kept; None in actuated mode, with external axes,
+        without the compiled module or without MuJoCo's library at hand (the Python methods run
+        then)."""
+        if self._cycle is None and simcore is not None:
+            self._cycle = _arm_cycle(self, simcore) or False
+        return self._cycle or None
 
     def axes_deg(self) -> np.ndarray:
         """Current A1..A6 (deg) read back from ``qpos``, then E1..En (mm, deg) when the robot

@@ -40,6 +40,7 @@ from scipy.spatial.transform import Rotation
 
 from .errors import RobotError, WorkspaceError
 from .frames import frame_to_matrix, inv_pos, matrix_to_frame
+from . import kinematics
 from .kinematics import Kinematics
 from .motion import AXIS_KEYS, CART_KEYS, EXT_KEYS, MotionParams, MotionRequest, Trigger
 from .limits import DEFAULT_MODE, T1_SPEED_MM_S, cp_path_speed, motion_limits, ptp_axis_speeds
@@ -526,6 +527,7 @@ class Segment:
         self._ik_tool = None if np.array_equal(self.tool_inv_T, eye) else self.tool_inv_T
         self._ik_base = None if np.array_equal(base_T, eye) else base_T
         self._c_ik: Any = None      # CartSegment.ik's compiled inverse (robot/simcore.pyx), False: none
+        self._c_path: Any = None    # CartSegment's compiled poses (robot/simcore.pyx CartPath), False: none
         self.model = model
         self.status = model.status_turn(q0)[0]
         self.triggers: list[TriggerPlan] = []
@@ -563,7 +565,7 @@ class Segment:
     def end_frame(self) -> list[float]:
         """Programmed end point as (X, Y, Z, A, B, C) of the TCP in $BASE (mm, deg)."""
         if self._end_frame is None:
-            self._end_frame = list(matrix_to_frame(self.model.tcp(self.q1, self.tool_T,
+            self._end_frame = list(_frame_of(self.model.tcp(self.q1, self.tool_T,
                                                                   self.base_inv_T)))
         return self._end_frame
 
@@ -685,6 +687,16 @@ class CartSegment(Segment):
 
     def pose_u(self, u: float) -> tuple[np.ndarray, np.ndarray]:
         """TCP position (mm, (3,)) and rotation matrix (3, 3) in $BASE at parameter u."""
+        cp = self._c_path
+        if cp is None:
+            cp = self._compiled_path()
+        if cp:
+            try:
+                pr = cp.pose_u(u)      # the same pose, compiled (robot/simcore.pyx CartPath)
+            except (TypeError, ValueError):
+                pr = None
+            if pr is not None:
+                return pr
         k, f = self._locate(u)
         piece = self.pieces[k]
         p = piece.pos(f * piece.length)
@@ -734,6 +746,25 @@ class CartSegment(Segment):
             ref = np.concatenate([ref[:6], self.q0[6:] + u * (self.e1 - self.q0[6:])])
         return self.model.ik(T, self._ik_tool, self._ik_base, self.status, None, ref)
 
+    def _compiled_path(self) -> Any:
+        """robot/simcore.pyx's ``CartPath`` of this segment's lines and arcs (kept; with the
+        compiled inverse when :meth:`ik` runs it), or False (no compiled module, external
+        axes, ``$ORI_TYPE #JOINT``)."""
+        if self._c_path is None:
+            self._c_path = False
+            sc = kinematics._simcore
+            if (sc is not None and kinematics.USE_COMPILED and getattr(sc, "ABI", None) == kinematics.SIMCORE_ABI
+                    and len(self.q0) == 6 and not self.joint_ori):
+                self._c_path = _cart_path(sc, self) or False
+        return self._c_path
+
+    def compiled_inverse(self) -> Any:
+        """The compiled inverse :meth:`ik` runs on its poses as they stand (kept), or False."""
+        c = self._c_ik
+        if c is None:
+            c = self._c_ik = self._compiled_ik()
+        return c
+
     def _compiled_ik(self) -> Any:
         """The compiled inverse for :meth:`ik`'s poses as they stand, or False."""
         m = self.model
@@ -747,6 +778,21 @@ class CartSegment(Segment):
         solved at once (:meth:`RobotModel.ik_chain`): (n, 6) axes, or None (solve one by one)."""
         return self.model.ik_chain(poses, self._ik_tool, self._ik_base, self.status, ref)
 
+    def ik_chain_compiled(self, poses: list[tuple[np.ndarray, np.ndarray]], ref: np.ndarray) -> np.ndarray | None:
+        """:meth:`ik` of each pose with the previous solution as reference (the first: `ref`)
+        in one call of the compiled inverse (robot/simcore.pyx ``inverse_chain_rp``, the rows of
+        the calls :meth:`ik` makes, bit for bit): (n, 6) axes, or None where :meth:`ik` does
+        not run the compiled inverse as it stands or some pose needs the Python code (the
+        caller solves pose by pose, which raises the error)."""
+        c = self.compiled_inverse()
+        if not c or not poses or len(ref) != 6:
+            return None
+        R = np.array([pr[1] for pr in poses], dtype=float)
+        p = np.array([pr[0] for pr in poses], dtype=float)
+        if R.shape != (len(poses), 3, 3) or p.shape != (len(poses), 3):
+            return None
+        return c.inverse_chain_rp(R, p, self.status, None, np.asarray(ref, dtype=float))
+
     def axes_run(self, pt: float, t0: float, dt: float, end: float) -> np.ndarray:
         """:meth:`axes` at ``tau = pt - t0`` for the main run, which advances ``pt`` by `dt`
         each IPO cycle: the coming cycles up to local time `end` (exclusive; the segment's end
@@ -756,6 +802,8 @@ class CartSegment(Segment):
         else (a BRAKE, a new blend profile, a setpoint set from outside) solves again, so
         the result is always the one :meth:`axes` gives."""
         tau = pt - t0
+        if self._c_ik:                # the compiled inverse: cycle by cycle (no numpy chains)
+            return self.axes(tau)
         ahead = self._ahead
         if ahead is not None:
             prof, taus, refs, Q, i = ahead
@@ -806,6 +854,18 @@ class CartSegment(Segment):
             u = self.profile.u(tau)
             q = self.ik(*self.pose_u(u), self._last_q, u)
         else:
+            cp = self._c_path
+            if cp is None:
+                cp = self._compiled_path()
+            if cp:
+                # pose_u and ik in one compiled call (the same axes); None: the code below
+                try:
+                    q = cp.axes_u(self.profile.u(tau), self.status, self._last_q)
+                except (TypeError, ValueError):
+                    q = None
+                if q is not None:
+                    self._last_q = q
+                    return q
             p, R = self.pose(tau)
             q = self.ik(p, R, self._last_q)
         self._last_q = q
@@ -839,6 +899,96 @@ class CartSegment(Segment):
         return self.ori_angle_to_end(0.0)
 
 
+#: Conversions kept by :func:`_frame_of` and :func:`_matrix_of` (cleared when full).
+FRAME_MEMO = 512
+_FRAME_OF: dict[bytes, tuple[float, ...]] = {}
+_MATRIX_OF: dict[bytes, np.ndarray] = {}
+
+
+def _frame_of(T: np.ndarray) -> tuple[float, ...]:
+    """:func:`robot.frames.matrix_to_frame` of T, kept by T's bytes: a program's cycle plans
+    the same points again, and the conversion (scipy's ``Rotation.from_matrix``) costs about
+    0.2 ms. The same tuple as the call."""
+    A = np.asarray(T, dtype=float)
+    key = A.tobytes() + str(A.shape).encode()
+    fr = _FRAME_OF.get(key)
+    if fr is None:
+        if len(_FRAME_OF) >= FRAME_MEMO:
+            _FRAME_OF.clear()
+        fr = _FRAME_OF[key] = tuple(matrix_to_frame(A))
+    return fr
+
+
+_ROTATION_OF: dict[bytes, Rotation] = {}
+
+
+def _rotation_of(R: np.ndarray) -> Rotation:
+    """``Rotation.from_matrix(R)`` of a 3x3 rotation, kept by R's bytes (scipy's validation of
+    the matrix costs about 0.15 ms; a program's cycle plans the same orientations again). The
+    same object for the same bytes: scipy's rotations are not changed in place here."""
+    A = np.asarray(R, dtype=float)
+    key = A.tobytes() + str(A.shape).encode()
+    rot = _ROTATION_OF.get(key)
+    if rot is None:
+        if len(_ROTATION_OF) >= FRAME_MEMO:
+            _ROTATION_OF.clear()
+        rot = _ROTATION_OF[key] = Rotation.from_matrix(A)
+    return rot
+
+
+def _matrix_of(frame: Any) -> np.ndarray:
+    """:func:`robot.frames.frame_to_matrix` of six numbers (X, Y, Z, A, B, C), kept by their
+    float64 bytes (so -0.0 is not 0.0): the motions of a program share their $TOOL and $BASE.
+    A new array each call, as the function gives."""
+    try:
+        v = np.array(frame, dtype=float)
+    except (TypeError, ValueError):
+        return frame_to_matrix(*frame)
+    if v.shape != (6,):
+        return frame_to_matrix(*frame)
+    key = v.tobytes()
+    T = _MATRIX_OF.get(key)
+    if T is None:
+        if len(_MATRIX_OF) >= FRAME_MEMO:
+            _MATRIX_OF.clear()
+        T = _MATRIX_OF[key] = frame_to_matrix(*frame)
+    return T.copy()
+
+
+def _cart_path(sc: Any, seg: "CartSegment") -> Any:
+    """robot/simcore.pyx's ``CartPath`` of `seg`'s pieces (see ``CartSegment._compiled_path``):
+    lines and arcs with the rotations ``CartSegment.pose_u`` holds, other pieces (splines, a
+    ``#PATH`` orientation) marked for the Python code; None when no piece is mirrored."""
+    n = len(seg.pieces)
+    kinds = np.full(n, -1, dtype=np.intc)
+    mid_ok = np.zeros(n, dtype=np.intc)
+    length, r, angle = np.zeros(n), np.ones(n), np.zeros(n)
+    a, b, c = np.zeros((n, 3)), np.zeros((n, 3)), np.zeros((n, 3))
+    rots = np.zeros((n, 3, 3, 3))
+    for k, pc in enumerate(seg.pieces):
+        mode = seg.ori[k]
+        if mode == "VAR":
+            rots[k, 0], rots[k, 2] = seg._R[k], seg._R[k + 1]
+            if seg._R_still[k] is not None:
+                rots[k, 1], mid_ok[k] = seg._R_still[k], 1
+        elif mode == "CONSTANT":
+            rots[k, 0] = rots[k, 1] = rots[k, 2] = seg._R[k]
+            mid_ok[k] = 1
+        else:
+            continue
+        if type(pc) is LinePiece:
+            kinds[k], a[k], b[k] = 0, pc.p0, pc.dir
+        elif type(pc) is ArcPiece:
+            kinds[k], a[k], b[k], c[k], r[k], angle[k] = 1, pc.c, pc.e1, pc.e2, pc.r, pc.angle
+        else:
+            continue
+        length[k] = pc.length
+    if not (kinds >= 0).any():
+        return None
+    opw = seg.compiled_inverse() or None
+    return sc.CartPath(opw, np.asarray(seg._ub, dtype=float), kinds, mid_ok, length, r, angle, a, b, c, rots)
+
+
 # ------------------------------------------------------------------------- planning
 def _apply_partial(start6: tuple[float, ...], tgt: dict[str, float]) -> list[float]:
     return [float(tgt[k]) if k in tgt else float(start6[i]) for i, k in enumerate(CART_KEYS)]
@@ -856,7 +1006,7 @@ def _cart_target(req_target: dict[str, float], start_T: np.ndarray, relative: bo
         out[:3, :3] = D[:3, :3] @ start_T[:3, :3]
         out[:3, 3] = start_T[:3, 3] + D[:3, 3]
         return out
-    start6 = matrix_to_frame(start_T)
+    start6 = _frame_of(start_T)
     if all(k in req_target for k in ("A", "B", "C")):
         return frame_to_matrix(*_apply_partial(start6, req_target))
     # partial orientation: keep the start rotation exactly when none of A, B, C is given
@@ -914,8 +1064,8 @@ def plan(req: MotionRequest, q_start: np.ndarray, model: RobotModel, *,
     q0 = np.asarray(q_start, dtype=float).copy()
     if getattr(p, "base_kin", None) and model.n_ext:
         model = model.linked(p.base_kin)      # $BASE on a BASE kinematic (robot/external.py)
-    tool_T = frame_to_matrix(*p.tool)
-    base_T = frame_to_matrix(*p.base)
+    tool_T = _matrix_of(p.tool)
+    base_T = _matrix_of(p.base)
     base_inv = inv_pos(base_T)
     start_T = model.tcp(q0, tool_T, base_inv)
     if req.kind in ("PTP", "SPTP"):
@@ -1068,7 +1218,7 @@ def _plan_cart(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_T: 
         built[k] = CatmullRomPiece(P0, a, b, P3, m1, m2)
     pieces: list[_Piece] = [pc for pc in built if pc is not None]
 
-    rots: list[Rotation] = [Rotation.from_matrix(start_T[:3, :3])]
+    rots: list[Rotation] = [_rotation_of(start_T[:3, :3])]
     ori: list[str] = []
     thetas: list[float] = []
     speeds: list[tuple[float, float, float, float]] = []
@@ -1082,7 +1232,7 @@ def _plan_cart(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_T: 
             assert isinstance(piece, ArcPiece)
             R1 = Rotation.from_rotvec(piece.n * piece.angle) * rots[k]
         else:
-            R1 = Rotation.from_matrix(pts_T[k + 1][:3, :3])
+            R1 = _rotation_of(pts_T[k + 1][:3, :3])
         rots.append(R1)
         ori.append(mode)
         thetas.append(float(np.degrees((rots[k].inv() * R1).magnitude())))
@@ -1170,14 +1320,20 @@ def _plan_cart(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_T: 
             chain = None
             if len(q0) == 6 and nk >= MIN_CHAIN and model.batch_ik:
                 chain = seg.ik_chain([seg.pose_u(float(us[j])) for j in range(1, nk + 1)], ref)
+            elif len(q0) == 6 and seg.compiled_inverse():
+                # the poses and the compiled inverse along the samples in one call (the same
+                # rows); else the poses here and the inverse in one call
+                cp = seg._compiled_path()
+                chain = cp.chain_u(us[1:], seg.status, ref) if cp else None
+                if chain is None:
+                    chain = seg.ik_chain_compiled([seg.pose_u(float(us[j])) for j in range(1, nk + 1)], ref)
             if chain is not None:
                 # the same rows as the loop below; its singularity check, in its order
                 jumps = np.abs(np.diff(np.concatenate([Q[:1], chain]), axis=0))
-                for j in range(nk):
-                    if float(jumps[j].max()) > SINGULAR_JUMP_DEG:
-                        i = int(np.argmax(jumps[j]))
-                        raise RobotError(f"CP path through a singularity: A{i + 1} would turn "
-                                         f"{jumps[j][i]:.0f} deg at once (keep the status on CP paths)")
+                for j in np.flatnonzero(jumps.max(axis=1) > SINGULAR_JUMP_DEG)[:1].tolist():
+                    i = int(np.argmax(jumps[j]))
+                    raise RobotError(f"CP path through a singularity: A{i + 1} would turn "
+                                     f"{jumps[j][i]:.0f} deg at once (keep the status on CP paths)")
                 Q[1:] = chain
                 ref = Q[nk].copy()
             for j in range(1, nk + 1 if chain is None else 1):

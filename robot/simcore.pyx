@@ -1,7 +1,14 @@
 # cython: language_level=3, boundscheck=False, wraparound=False, cdivision=True, initializedcheck=False
-"""The OPW inverse kinematics of one pose in C (issue 39, "Simulator"): the compiled form of
-robot/kinematics.py ``Kinematics._opw_core`` + ``_status_row`` + the selection of
-``Kinematics._select`` for the six-axis arm with a spherical wrist, built by robot/build.py.
+"""The simulator's hot path in C (issue 39, "Simulator"), built by robot/build.py:
+
+* :class:`OPW`: the OPW inverse kinematics of one pose (and along a chain of poses), the
+  compiled form of robot/kinematics.py ``Kinematics._opw_core`` + ``_status_row`` + the
+  selection of ``Kinematics._select`` for the six-axis arm with a spherical wrist;
+* :class:`CartPath`: the poses of a CP segment's lines and arcs (robot/planner.py
+  ``CartSegment.pose_u``) and their axes;
+* :class:`ArmCycle` and :func:`speed_ok`: the IPO cycle's MuJoCo playback with its TCP product,
+  and its axis step check (robot/controller.py ``Controller.step``);
+* :func:`pose_line`: the trace's pose line (robot/trace.py).
 
 Bit for bit the pure-Python code it mirrors, which stays the fallback (and the reference:
 tests/robot/test_simcore.py compares the two on random poses): the same operations in the same
@@ -19,7 +26,7 @@ import numpy as np
 
 #: Bumped whenever the mirrored Python code changes (robot/kinematics.py checks it: a stale
 #: build is not used).
-ABI = 2
+ABI = 4
 
 cdef double DEG_TO_RAD = M_PI / 180.0
 cdef double RAD_TO_DEG = 180.0 / M_PI
@@ -179,22 +186,59 @@ cdef class OPW:
             M[4 * i + 3] = p[i]
         return self._inverse(M, status, turn, ref6)
 
+    def inverse_chain_rp(self, const double[:, :, :] R, const double[:, :] p, status, turn,
+                         const double[:] ref6):
+        """:meth:`inverse_rp` of each pose (R[j] (3x3), p[j] (3,)) in turn, each solution the
+        next one's reference (the first one's: ref6): the axes (n, 6), the rows those of n
+        calls of :meth:`inverse_rp` bit for bit, or None as soon as one of them would be None
+        (the caller then solves pose by pose for the error). Issue 39: the planner's samples
+        of a CP segment."""
+        cdef Py_ssize_t n = R.shape[0], j
+        cdef double M[12]
+        cdef double ref[6]
+        cdef int i, k
+        if p.shape[0] != n:
+            raise ValueError("R and p hold different numbers of poses")
+        res = np.empty((n, 6))
+        cdef double[:, :] out = res
+        for i in range(6):
+            ref[i] = ref6[i]
+        for j in range(n):
+            for i in range(3):
+                for k in range(3):
+                    M[4 * i + k] = R[j, i, k]
+                M[4 * i + 3] = p[j, i]
+            if not self._solve(M, status, turn, ref, &out[j, 0]):
+                return None
+            for i in range(6):
+                ref[i] = out[j, i]
+        return res
+
     cdef object _inverse(self, const double* M, status, turn, const double[:] ref6):
         cdef double ref[6]
+        cdef double[:] rv
+        cdef int i
+        for i in range(6):
+            ref[i] = ref6[i]
+        res = np.empty(6)
+        rv = res
+        if not self._solve(M, status, turn, ref, &rv[0]):
+            return None
+        return res
+
+    cdef int _solve(self, const double* M, status, turn, const double* ref, double* best_q) except -1:
+        """The selected axes of pose M (3x4, row-major) for the reference `ref` into best_q;
+        0 where the Python code raises or takes a path not mirrored here."""
         cdef double rows[48]
         cdef double q[6]
-        cdef double best_q[6]
         cdef int i, j, kk, n, s_target, free, keep, s_r, amb, tmask = 0, use_turn = 0
         cdef int nmatch = 0, have_best = 0, ok
         cdef double c, d, best_c, best_d, cost, best_cost = 0.0
         cdef int found
         cdef const double* b
-        cdef double[:] rv
-        for i in range(6):
-            ref[i] = ref6[i]
         n = self._core(M, ref, rows)
         if n == 0:
-            return None
+            return 0
         if status is not None:
             s_target = (<int>status) & 7
             free = 0
@@ -239,13 +283,286 @@ cdef class OPW:
                     best_cost = cost
                     for i in range(6):
                         best_q[i] = q[i]
-        if not have_best:
+        return have_best
+
+
+
+
+# ----------------------------------------------------------------------------- CP paths
+cdef class CartPath:
+    """The poses of a CP segment's lines and arcs, and their axes (``opw`` None: the poses only) (robot/planner.py
+    ``CartSegment.pose_u`` and ``CartSegment.ik`` with the compiled inverse, the same numbers):
+    for path parameter u the piece k and fraction f of ``CartSegment._locate``, the position
+    ``LinePiece.pos``/``ArcPiece.pos`` at ``s = f * length`` (libm's cos and sin, as ``math``)
+    and the rotation the segment keeps for that piece (at its start, within it and at its end:
+    the matrices the Python code holds; a rotation it would compute, such as a slerp between
+    two orientations, is not mirrored). A pose not mirrored (such a rotation, a spline piece)
+    gives None: the caller runs the Python code.
+
+    ``kinds`` per piece: 0 line (``a`` = p0, ``b`` = dir), 1 arc (``a`` = centre, ``b`` = e1,
+    ``c`` = e2, ``r``, ``angle``), -1 not mirrored; ``rots`` (n, 3, 3, 3): the rotation at
+    f <= 0, within, at f >= 1; ``mid_ok`` 0 where the rotation within is not mirrored."""
+
+    cdef OPW opw
+    cdef int n
+    cdef object keep
+    cdef const double[::1] ub
+    cdef const int[::1] kinds
+    cdef const int[::1] mid_ok
+    cdef const double[::1] length
+    cdef const double[::1] r
+    cdef const double[::1] angle
+    cdef const double[:, ::1] a
+    cdef const double[:, ::1] b
+    cdef const double[:, ::1] c
+    cdef const double[:, :, :, ::1] rots
+
+    def __init__(self, OPW opw, ub, kinds, mid_ok, length, r, angle, a, b, c, rots):
+        self.opw = opw
+        self.keep = (ub, kinds, mid_ok, length, r, angle, a, b, c, rots)
+        self.ub, self.kinds, self.mid_ok = ub, kinds, mid_ok
+        self.length, self.r, self.angle = length, r, angle
+        self.a, self.b, self.c, self.rots = a, b, c, rots
+        self.n = self.kinds.shape[0]
+        if (self.n < 1 or self.ub.shape[0] != self.n + 1 or self.mid_ok.shape[0] != self.n
+                or self.length.shape[0] != self.n or self.r.shape[0] != self.n
+                or self.angle.shape[0] != self.n or self.a.shape[0] != self.n or self.b.shape[0] != self.n
+                or self.c.shape[0] != self.n or self.rots.shape[0] != self.n or self.a.shape[1] != 3
+                or self.b.shape[1] != 3 or self.c.shape[1] != 3 or self.rots.shape[1] != 3
+                or self.rots.shape[2] != 3 or self.rots.shape[3] != 3):
+            raise ValueError("CartPath: inconsistent piece tables")
+
+    cdef int _pose(self, double u, double* M) noexcept:
+        """The pose at u into M (3x4, row-major); 0: not mirrored."""
+        cdef int n = self.n, k, lo, hi, mid, i, j, w
+        cdef double f, du, s, ph, cs, sn
+        if u <= 0.0:
+            k, f = 0, 0.0
+        elif u >= 1.0:
+            k, f = n - 1, 1.0
+        else:
+            # bisect_right(ub, u) - 1
+            lo, hi = 0, n + 1
+            while lo < hi:
+                mid = (lo + hi) // 2
+                if u < self.ub[mid]:
+                    hi = mid
+                else:
+                    lo = mid + 1
+            k = lo - 1
+            if k < 0:
+                k = 0
+            if k > n - 1:
+                k = n - 1
+            du = self.ub[k + 1] - self.ub[k]
+            f = (u - self.ub[k]) / du if du > 0 else 1.0
+        if self.kinds[k] < 0:
+            return 0
+        if f <= 0.0:
+            w = 0
+        elif f >= 1.0:
+            w = 2
+        else:
+            if not self.mid_ok[k]:
+                return 0
+            w = 1
+        s = f * self.length[k]
+        if self.kinds[k] == 0:
+            for i in range(3):
+                M[4 * i + 3] = self.a[k, i] + self.b[k, i] * s
+        else:
+            ph = copysign(s / self.r[k], self.angle[k]) if self.r[k] > 0 else 0.0
+            cs = cos(ph)
+            sn = sin(ph)
+            for i in range(3):
+                M[4 * i + 3] = self.a[k, i] + self.r[k] * (cs * self.b[k, i] + sn * self.c[k, i])
+        for i in range(3):
+            for j in range(3):
+                M[4 * i + j] = self.rots[k, w, i, j]
+        return 1
+
+    def pose_u(self, double u):
+        """(p (3,), R (3, 3)) at u, or None (not mirrored)."""
+        cdef double M[12]
+        cdef int i, j
+        if not self._pose(u, M):
             return None
-        res = np.empty(6)
-        rv = res
+        p = np.empty(3)
+        R = np.empty((3, 3))
+        cdef double[::1] pv = p
+        cdef double[:, ::1] Rv = R
+        for i in range(3):
+            pv[i] = M[4 * i + 3]
+            for j in range(3):
+                Rv[i, j] = M[4 * i + j]
+        return p, R
+
+    def axes_u(self, double u, status, const double[:] ref6):
+        """The axes (6,) at u for the reference ref6 (``CartSegment.ik`` of ``pose_u(u)``), or
+        None (not mirrored, or the Python inverse decides)."""
+        cdef double M[12]
+        cdef double ref[6]
+        cdef int i
+        if self.opw is None or ref6.shape[0] != 6 or not self._pose(u, M):
+            return None
         for i in range(6):
-            rv[i] = best_q[i]
+            ref[i] = ref6[i]
+        res = np.empty(6)
+        cdef double[::1] rv = res
+        if not self.opw._solve(M, status, None, ref, &rv[0]):
+            return None
         return res
+
+    def chain_u(self, const double[:] us, status, const double[:] ref6):
+        """:meth:`axes_u` at each u of us in turn, each solution the next one's reference (the
+        first one's: ref6): (n, 6), or None as soon as one would be None."""
+        cdef Py_ssize_t n = us.shape[0], j
+        cdef double M[12]
+        cdef double ref[6]
+        cdef int i
+        if self.opw is None or ref6.shape[0] != 6:
+            return None
+        res = np.empty((n, 6))
+        cdef double[:, ::1] out = res
+        for i in range(6):
+            ref[i] = ref6[i]
+        for j in range(n):
+            if not self._pose(us[j], M):
+                return None
+            if not self.opw._solve(M, status, None, ref, &out[j, 0]):
+                return None
+            for i in range(6):
+                ref[i] = out[j, i]
+        return res
+
+
+# ----------------------------------------------------------------------------- the IPO cycle
+def speed_ok(const double[:] q, const double[:] q_prev, const double[:] lim):
+    """True when no axis moves more than its limit in one cycle: ``abs(q[i] - q_prev[i]) <=
+    lim[i]`` over the shortest of the three (robot/controller.py ``_check_speed``, which gives
+    the error on False; a NaN step passes, as there)."""
+    cdef Py_ssize_t n = min(q.shape[0], q_prev.shape[0], lim.shape[0]), i
+    for i in range(n):
+        if fabs(q[i] - q_prev[i]) > lim[i]:
+            return False
+    return True
+
+
+ctypedef void (*_mj_kinematics_t)(const void* m, void* d) noexcept nogil
+#: cblas_dgemm of an ILP64 BLAS (numpy's own: the product numpy's ``@`` computes for two
+#: C-contiguous float64 4x4 matrices is this call, row-major, no transposes, alpha 1, beta 0)
+ctypedef void (*_dgemm_t)(int order, int ta, int tb, long long m, long long n, long long k,
+                          double alpha, const double* a, long long lda, const double* b,
+                          long long ldb, double beta, double* c, long long ldc) noexcept nogil
+
+
+cdef class ArmCycle:
+    """The kinematic playback of one IPO cycle on a MuJoCo arm (robot/mjcf.py ``ArmModel``
+    without external axes): ``set_axes`` (``qpos = sign * radians(A)``, ``mj_kinematics``),
+    ``axes_deg`` (``degrees(sign * qpos)``) and ``flange_pose_world`` (the ``tool0`` site,
+    position in mm) in one call, the same numbers (numpy's ``radians``/``degrees`` are one
+    multiplication by pi/180 and 180/pi). ``mj_kinematics`` is MuJoCo's own, called through
+    its address in the library the ``mujoco`` package loaded, on the model and data
+    addresses the package gives (``_address``); the arrays are views into that data, so the
+    caller keeps the ``ArmModel`` alive while this object is used."""
+
+    cdef _mj_kinematics_t fn
+    cdef _dgemm_t gemm
+    cdef size_t m, d
+    cdef object keep
+    cdef double[:, ::1] tmp
+    cdef double[:, ::1] flange
+    cdef double* qpos
+    cdef const double* xmat
+    cdef const double* xpos
+    cdef int qidx[6]
+    cdef double sign[6]
+
+    def __init__(self, size_t fn, size_t m, size_t d, qpos, qidx, sign, site_xmat, site_xpos):
+        cdef double[::1] qp = qpos
+        cdef const double[::1] xm = site_xmat
+        cdef const double[::1] xp = site_xpos
+        cdef int i
+        if fn == 0 or m == 0 or d == 0 or len(qidx) != 6 or len(sign) != 6:
+            raise ValueError("ArmCycle: no mj_kinematics, model or data")
+        if xm.shape[0] != 9 or xp.shape[0] != 3:
+            raise ValueError("ArmCycle: the site's xmat is 9 values and its xpos 3")
+        for i in range(6):
+            if not 0 <= qidx[i] < qp.shape[0]:
+                raise ValueError("ArmCycle: a qpos index out of range")
+            self.qidx[i] = qidx[i]
+            self.sign[i] = sign[i]
+        self.fn = <_mj_kinematics_t>fn
+        self.gemm = NULL
+        self.tmp = np.empty((4, 4))
+        self.flange = np.empty((4, 4))
+        self.m, self.d = m, d
+        self.keep = (qpos, site_xmat, site_xpos)
+        self.qpos = &qp[0]
+        self.xmat = &xm[0]
+        self.xpos = &xp[0]
+
+    cdef void _play(self, const double[:] q, double* qa, double* F) noexcept:
+        """Set the axes q (its first 6), run mj_kinematics, read back qa (6) and F (4x4, row-major)."""
+        cdef int i, j
+        for i in range(6):
+            self.qpos[self.qidx[i]] = self.sign[i] * (q[i] * DEG_TO_RAD)
+        self.fn(<const void*>self.m, <void*>self.d)
+        for i in range(6):
+            qa[i] = (self.sign[i] * self.qpos[self.qidx[i]]) * RAD_TO_DEG
+        for i in range(3):
+            for j in range(3):
+                F[4 * i + j] = self.xmat[3 * i + j]
+            F[4 * i + 3] = 1000.0 * self.xpos[i]
+        F[12] = 0.0
+        F[13] = 0.0
+        F[14] = 0.0
+        F[15] = 1.0
+
+    def cycle(self, const double[:] q, double[::1] qa, double[:, ::1] F):
+        """Set the axes q (A1..A6, deg; further values ignored), run ``mj_kinematics``, and
+        write the axes read back (deg) into qa (6,) and the flange in WORLD (4x4, mm) into F."""
+        if q.shape[0] < 6 or qa.shape[0] != 6 or F.shape[0] != 4 or F.shape[1] != 4:
+            raise ValueError("ArmCycle.cycle: q (>= 6,), qa (6,), F (4, 4)")
+        self._play(q, &qa[0], &F[0, 0])
+
+    def cycle_tcp(self, const double[:] q, double[::1] qa, const double[:, ::1] base_inv,
+                  const double[:, ::1] tool, double[:, ::1] T):
+        """:meth:`cycle` (the flange into a buffer of this object) and ``T = (base_inv @ flange)
+        @ tool`` by :meth:`product`; False without :meth:`use_gemm`, before anything is set (the
+        caller then runs :meth:`cycle` and multiplies with numpy)."""
+        if self.gemm == NULL:
+            return False
+        if (q.shape[0] < 6 or qa.shape[0] != 6 or base_inv.shape[0] != 4 or base_inv.shape[1] != 4
+                or tool.shape[0] != 4 or tool.shape[1] != 4 or T.shape[0] != 4 or T.shape[1] != 4):
+            raise ValueError("ArmCycle.cycle_tcp: q (>= 6,), qa (6,), 4x4 frames")
+        self._play(q, &qa[0], &self.flange[0, 0])
+        self._product(&base_inv[0, 0], &self.flange[0, 0], &tool[0, 0], &T[0, 0])
+        return True
+
+    def use_gemm(self, size_t gemm):
+        """Compute :meth:`product` with the BLAS ``cblas_dgemm`` at address `gemm` (the one
+        numpy calls; 0: none)."""
+        self.gemm = <_dgemm_t>gemm
+
+    def product(self, const double[:, ::1] A, const double[:, ::1] B, const double[:, ::1] C,
+                double[:, ::1] out):
+        """``out = (A @ B) @ C`` for C-contiguous 4x4 float64 matrices, as numpy's ``@`` computes
+        it (two ``cblas_dgemm`` calls with numpy's arguments, the first into a numpy-allocated
+        4x4); False without :meth:`use_gemm` (the caller multiplies with numpy)."""
+        if self.gemm == NULL:
+            return False
+        if (A.shape[0] != 4 or A.shape[1] != 4 or B.shape[0] != 4 or B.shape[1] != 4
+                or C.shape[0] != 4 or C.shape[1] != 4 or out.shape[0] != 4 or out.shape[1] != 4):
+            raise ValueError("ArmCycle.product: 4x4 matrices")
+        self._product(&A[0, 0], &B[0, 0], &C[0, 0], &out[0, 0])
+        return True
+
+    cdef void _product(self, const double* A, const double* B, const double* C, double* out) noexcept:
+        """out = (A @ B) @ C: numpy's two cblas_dgemm calls (row-major, no transposes, leading
+        dimension 4, alpha 1, beta 0), the first into a numpy-allocated 4x4."""
+        self.gemm(101, 111, 111, 4, 4, 4, 1.0, A, 4, B, 4, 0.0, &self.tmp[0, 0], 4)
+        self.gemm(101, 111, 111, 4, 4, 4, 1.0, &self.tmp[0, 0], 4, C, 4, 0.0, out, 4)
 
 
 # ----------------------------------------------------------------------------- trace lines

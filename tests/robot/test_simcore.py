@@ -134,3 +134,185 @@ def test_the_compiled_pose_line_is_pythons_bit_for_bit():
         else:
             assert line == _python_pose_line(t, axes, tcp), (t, axes, tcp)
     assert simcore.pose_line(1.0, [float("nan")] * 6, [0.0] * 6) is None    # json.dumps writes NaN
+
+
+# ----------------------------------------------------------------------------- the IPO cycle
+def _arm_agrees(machine, seed: int) -> None:
+    from robot.mjcf import ArmModel  # noqa: PLC0415  (MuJoCo)
+
+    a, b = ArmModel(machine), ArmModel(machine)
+    cyc = a.compiled_cycle(simcore)
+    assert cyc is not None, "the compiled playback is not used"
+    rng = np.random.default_rng(seed)
+    qa, F = np.empty(6), np.empty((4, 4))
+    for i in range(3000):
+        q = rng.uniform(-200.0, 200.0, 6)
+        if i % 7 == 0:
+            q[rng.integers(0, 6)] = rng.choice([0.0, -0.0, 90.0, -90.0, 180.0])
+        cyc.cycle(q, qa, F)
+        b.set_axes(q)
+        assert qa.tobytes() == b.axes_deg().tobytes(), q.tolist()
+        assert F.tobytes() == b.flange_pose_world().tobytes(), q.tolist()
+    assert a.axes_deg().tobytes() == qa.tobytes()        # the model's own read-back agrees
+
+
+def test_the_compiled_cycle_is_the_arm_models_playback_kr6():
+    if simcore is None:
+        pytest.skip("not compiled: only the Python playback runs")
+    _arm_agrees(None, 41)
+
+
+def test_the_compiled_cycle_is_the_arm_models_playback_on_a_corpus_kr210(shared_corpus):
+    if simcore is None:
+        pytest.skip("not compiled: only the Python playback runs")
+    _arm_agrees(load_robot(str(shared_corpus / "HugoDanielson__ChinaMilling")), 42)
+
+
+def test_the_compiled_cycle_is_off_in_actuated_mode_and_without_the_module(monkeypatch):
+    from robot.mjcf import ArmModel  # noqa: PLC0415
+
+    from robot import controller  # noqa: PLC0415
+
+    assert ArmModel(actuated=True).compiled_cycle(simcore) is None
+    assert ArmModel().compiled_cycle(None) is None
+    monkeypatch.setattr(kinematics, "USE_COMPILED", False)
+    assert controller._compiled_module() is None
+
+
+def test_the_compiled_step_check_is_the_python_loops():
+    if simcore is None:
+        pytest.skip("not compiled")
+    rng = np.random.default_rng(43)
+    lim = rng.uniform(0.5, 3.0, 6)
+    for _ in range(20_000):
+        q, prev = rng.uniform(-5, 5, 6), rng.uniform(-5, 5, 6)
+        if rng.random() < 0.1:
+            q[rng.integers(0, 6)] = float("nan")
+        want = all(not abs(x - y) > m for x, y, m in zip(q.tolist(), prev.tolist(), lim.tolist()))
+        assert simcore.speed_ok(q, prev, lim) == want
+    assert simcore.speed_ok(np.zeros(8), np.zeros(8), lim)         # external axes beyond the limits
+
+
+def _segments(machine, program):
+    """The CP segments a controller plans for `program` (a list of MotionRequest)."""
+    from robot import planner  # noqa: PLC0415
+    from robot.bench import run_motions  # noqa: PLC0415
+    from robot.controller import Controller  # noqa: PLC0415
+
+    segs = []
+    orig = planner.CartSegment.__init__
+
+    def keep(self, *a, **kw):
+        orig(self, *a, **kw)
+        segs.append(self)
+
+    planner.CartSegment.__init__ = keep
+    try:
+        run_motions(Controller(machine, mujoco=False), program)
+    finally:
+        planner.CartSegment.__init__ = orig
+    return segs
+
+
+@pytest.mark.parametrize("robot", ["kr6", "kr210"])
+def test_the_compiled_cp_path_is_the_segments_poses_and_axes(robot, shared_corpus):
+    if simcore is None:
+        pytest.skip("not compiled: only the Python path runs")
+    from robot.bench import bench_program  # noqa: PLC0415
+    from robot.motion import MotionParams, MotionRequest  # noqa: PLC0415
+
+    machine = None if robot == "kr6" else load_robot(str(shared_corpus / "HugoDanielson__ChinaMilling"))
+    P = MotionParams.initmov(machine)
+    k = machine.reach_wrist_point_mm / 901.456 if machine is not None else 1.0
+    const = P.with_(ori_type="CONSTANT")
+    turn = {"X": 500 * k, "Y": 100 * k, "Z": 650 * k, "A": 20.0, "B": 10.0, "C": 170.0}
+    program = bench_program(machine) + [
+        MotionRequest("LIN", turn, P),                                   # the orientation changes
+        MotionRequest("LIN", {"X": 450 * k, "Y": -100 * k, "Z": 600 * k}, const),
+        MotionRequest("CIRC", {"X": 450 * k, "Y": 100 * k, "Z": 600 * k}, const,
+                      aux={"X": 400 * k, "Y": 0.0, "Z": 600 * k})]
+    segs = _segments(machine, program)
+    rng = np.random.default_rng(44)
+    mirrored = compared = chains = 0
+    for seg in segs:
+        cp = seg._compiled_path()
+        assert cp, "the compiled path is not used"
+        us = np.concatenate([[-0.1, 0.0, 1.0, 1.2], rng.uniform(0.0, 1.0, 200)])
+        for u in us.tolist():
+            got = cp.pose_u(u)
+            seg._c_path = False
+            want = seg.pose_u(u)
+            seg._c_path = cp
+            if got is None:
+                continue
+            mirrored += 1
+            assert got[0].tobytes() == np.asarray(want[0]).tobytes() and got[1].tobytes() == np.asarray(want[1]).tobytes()
+            if seg.compiled_inverse():
+                ref = seg.q0 + rng.normal(0.0, 2.0, 6)
+                q = cp.axes_u(u, seg.status, ref)
+                try:
+                    expect = seg.ik(*want, ref).tobytes()
+                except RobotError:
+                    expect = None
+                assert (q.tobytes() if q is not None else None) == expect
+                compared += q is not None
+        if seg.compiled_inverse():
+            ups = np.sort(rng.uniform(0.0, 1.0, 40))
+            chain = cp.chain_u(ups, seg.status, seg.q0)
+            ref, rows = seg.q0, []
+            for u in ups.tolist():
+                seg._c_path = False
+                ref = seg.ik(*seg.pose_u(u), ref)
+                seg._c_path = cp
+                rows.append(ref)
+            if all(cp.pose_u(u) is not None for u in ups.tolist()):
+                assert chain is not None and chain.tobytes() == np.array(rows).tobytes()
+                chains += 1
+            else:                  # a pose the Python code computes (a slerp): the caller's
+                assert chain is None
+    assert mirrored > 500 and (compared > 500 or robot == "kr210") and chains > 3
+
+
+def test_the_trace_is_the_same_with_and_without_the_compiled_module(monkeypatch):
+    """The whole compiled path (inverse, CP poses, the IPO cycle, pose lines) against the
+    Python code on a random sequence of robot/tracecheck.py: the same bytes."""
+    if simcore is None:
+        pytest.skip("not compiled: only the Python code runs")
+    from robot import trace, tracecheck  # noqa: PLC0415
+
+    compiled = tracecheck.run_case("random-05")
+    monkeypatch.setattr(kinematics, "USE_COMPILED", False)
+    monkeypatch.setattr(trace, "_pose_line", None)
+    assert tracecheck.run_case("random-05") == compiled
+
+
+def test_the_compiled_tcp_product_is_numpys_matmul():
+    """The read-back's INV_POS($BASE) : FLANGE : $TOOL in numpy's own BLAS call: numpy's
+    ``@`` bit for bit (a C loop in the textbook order differs in the last bit: numpy's
+    OpenBLAS fuses multiply and add)."""
+    if simcore is None:
+        pytest.skip("not compiled")
+    from robot.frames import frame_to_matrix, inv_pos  # noqa: PLC0415
+    from robot.mjcf import ArmModel, _numpy_dgemm  # noqa: PLC0415
+
+    if not _numpy_dgemm():
+        pytest.skip("numpy without its bundled OpenBLAS: numpy multiplies")
+    cyc = ArmModel().compiled_cycle(simcore)
+    rng = np.random.default_rng(45)
+    out, F, qa = np.empty((4, 4)), np.empty((4, 4)), np.empty(6)
+    for i in range(5000):
+        cyc.cycle(rng.uniform(-170.0, 170.0, 6), qa, F)
+        tool = np.eye(4) if i % 3 == 0 else frame_to_matrix(*rng.uniform(-200.0, 200.0, 6))
+        base_inv = np.eye(4) if i % 4 == 0 else inv_pos(frame_to_matrix(*rng.uniform(-900.0, 900.0, 6)))
+        assert cyc.product(base_inv, F, tool, out)
+        assert out.tobytes() == (base_inv @ F @ tool).tobytes(), i
+        q = rng.uniform(-170.0, 170.0, 6)
+        qa2, T = np.empty(6), np.empty((4, 4))
+        assert cyc.cycle_tcp(q, qa2, base_inv, tool, T)
+        cyc.cycle(q, qa, F)
+        assert qa2.tobytes() == qa.tobytes() and T.tobytes() == (base_inv @ F @ tool).tobytes()
+    with pytest.raises(ValueError):                   # not C-contiguous: the caller's numpy
+        cyc.product(np.eye(4).T[:, ::-1], F, np.eye(4), out)
+    cyc.use_gemm(0)
+    assert cyc.product(np.eye(4), F, np.eye(4), out) is False
+    assert cyc.cycle_tcp(np.zeros(6), qa, np.eye(4), np.eye(4), out) is False
