@@ -4,7 +4,9 @@
 A *backup* is a folder with ``R1/System`` (or a flat export with ``System/$config.dat``); its
 *programs* (entry points, :func:`entries_of`) are the ``.src`` files under its Program folders
 (and ``cell.src``) whose main routine takes no parameters, and its ``SPS.SUB``. Each runs on
-the tree interpreter with the backup's own System folder (BASIS, ``$config.dat``),
+the bytecode VM (``--interp tree``: the tree interpreter; the same front end and runtime, and
+the same cause and reason on every corpus entry point, side by side 2026-11-24) with the
+backup's own System folder (BASIS, ``$config.dat``),
 ``--max-sim-time`` 60 s and 300 000 steps of the program's own, beside its SPS.SUB (an
 SPS.SUB entry runs alone): the steps a submit program may take within the time limit are
 added to the step limit (:func:`step_limit`), so a submit cycling at its budget does not end
@@ -43,7 +45,7 @@ Routines of technology packages absent from the backup are stubbed (a ``message`
 "stub: NAME"), and the report lists the stubs.
 
 Usage: ``python -m interp.realprograms [CORPUS] [--json OUT] [--limit N] [--columns cells,auto]
-[--scheduler tcp://HOST:PORT]`` (``--scheduler``: the runs go to a Dask cluster, :func:`run_rows`;
+[--interp vm|tree] [--scheduler tcp://HOST:PORT]`` (``--scheduler``: the runs go to a Dask cluster, :func:`run_rows`;
 the same report).
 """
 
@@ -453,7 +455,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--no-cells", action="store_true", help="run the cells column without the committed cell files")
     ap.add_argument("--columns", default="cells,auto",
                     help="which runs: cells (the committed cell files), auto (--inputs auto), or both (default)")
-    ap.add_argument("--interp", choices=("tree", "vm"), default="tree")
+    ap.add_argument("--interp", choices=("tree", "vm"), default="vm",
+                    help="the interpreter of the runs (default vm: the same causes, less CPU)")
     ap.add_argument("--scheduler", default=None, metavar="tcp://HOST:PORT",
                     help="make the runs on this Dask distributed scheduler's cluster (its workers "
                          "see the corpus at the same paths); the same report as the local run")

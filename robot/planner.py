@@ -32,6 +32,7 @@ from __future__ import annotations
 
 import math
 from bisect import bisect_right
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -899,10 +900,23 @@ class CartSegment(Segment):
         return self.ori_angle_to_end(0.0)
 
 
-#: Conversions kept by :func:`_frame_of` and :func:`_matrix_of` (cleared when full).
+#: Conversions kept by :func:`_frame_of`, :func:`_rotation_of` and :func:`_matrix_of` (each
+#: table cleared when full).
 FRAME_MEMO = 512
 _FRAME_OF: dict[bytes, tuple[float, ...]] = {}
+_ROTATION_OF: dict[bytes, Rotation] = {}
 _MATRIX_OF: dict[bytes, np.ndarray] = {}
+
+
+def _kept(table: dict, key: bytes, make: Callable[[], Any]) -> Any:
+    """``table[key]``, made by `make()` the first time (the table is cleared when it holds
+    :data:`FRAME_MEMO` entries): the one bounded memo of the planner's conversions."""
+    got = table.get(key)
+    if got is None:
+        if len(table) >= FRAME_MEMO:
+            table.clear()
+        got = table[key] = make()
+    return got
 
 
 def _frame_of(T: np.ndarray) -> tuple[float, ...]:
@@ -910,16 +924,7 @@ def _frame_of(T: np.ndarray) -> tuple[float, ...]:
     the same points again, and the conversion (scipy's ``Rotation.from_matrix``) costs about
     0.2 ms. The same tuple as the call."""
     A = np.asarray(T, dtype=float)
-    key = A.tobytes() + str(A.shape).encode()
-    fr = _FRAME_OF.get(key)
-    if fr is None:
-        if len(_FRAME_OF) >= FRAME_MEMO:
-            _FRAME_OF.clear()
-        fr = _FRAME_OF[key] = tuple(matrix_to_frame(A))
-    return fr
-
-
-_ROTATION_OF: dict[bytes, Rotation] = {}
+    return _kept(_FRAME_OF, A.tobytes() + str(A.shape).encode(), lambda: tuple(matrix_to_frame(A)))
 
 
 def _rotation_of(R: np.ndarray) -> Rotation:
@@ -927,13 +932,7 @@ def _rotation_of(R: np.ndarray) -> Rotation:
     the matrix costs about 0.15 ms; a program's cycle plans the same orientations again). The
     same object for the same bytes: scipy's rotations are not changed in place here."""
     A = np.asarray(R, dtype=float)
-    key = A.tobytes() + str(A.shape).encode()
-    rot = _ROTATION_OF.get(key)
-    if rot is None:
-        if len(_ROTATION_OF) >= FRAME_MEMO:
-            _ROTATION_OF.clear()
-        rot = _ROTATION_OF[key] = Rotation.from_matrix(A)
-    return rot
+    return _kept(_ROTATION_OF, A.tobytes() + str(A.shape).encode(), lambda: Rotation.from_matrix(A))
 
 
 def _matrix_of(frame: Any) -> np.ndarray:
@@ -946,13 +945,7 @@ def _matrix_of(frame: Any) -> np.ndarray:
         return frame_to_matrix(*frame)
     if v.shape != (6,):
         return frame_to_matrix(*frame)
-    key = v.tobytes()
-    T = _MATRIX_OF.get(key)
-    if T is None:
-        if len(_MATRIX_OF) >= FRAME_MEMO:
-            _MATRIX_OF.clear()
-        T = _MATRIX_OF[key] = frame_to_matrix(*frame)
-    return T.copy()
+    return _kept(_MATRIX_OF, v.tobytes(), lambda: frame_to_matrix(*frame)).copy()
 
 
 def _cart_path(sc: Any, seg: "CartSegment") -> Any:

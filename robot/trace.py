@@ -158,6 +158,9 @@ MAX_PROBE_GAP = 65536
 #: backup's state (tens of thousands of values, milliseconds) waits until the events since
 #: the start pay for it, so the probes cost a bounded share of the run whatever the state's size
 PROBE_VALUES_PER_EVENT = 16
+#: values the probes may image before the budget applies (a start credit: the first probes of a
+#: run, when few events are accounted yet, confirm its first spins at once; about 0.1 s of probes)
+PROBE_CREDIT_VALUES = 1 << 20
 _REQUIRED = {k: tuple(f for f, d in v if not d.startswith("optional")) for k, v in SCHEMA.items()}
 _ORDER = {k: tuple(f for f, _ in v) for k, v in SCHEMA.items()}
 
@@ -228,7 +231,8 @@ class TraceWriter:
     and N, so a counter loop (``N = N + 1``, whose statements repeat, whose state does not)
     keeps every event. While a spin is left out the state is compared again after 2N, 4N, ...
     passes; a change ends the spin. The probes keep to a budget of
-    :data:`PROBE_VALUES_PER_EVENT` values imaged per event: a probe over budget waits for a
+    :data:`PROBE_VALUES_PER_EVENT` values imaged per event (after a start credit of
+    :data:`PROBE_CREDIT_VALUES`): a probe over budget waits for a
     later end of pass (the capture, the comparison with it, or the recheck of a spin moves
     later, never earlier), so the bounding costs a bounded share of the run also on a backup
     with a large state; being counted, the budget is the same in every run and interpreter.
@@ -396,8 +400,9 @@ class TraceWriter:
 
     def _probe(self) -> Any:
         """The state image of :attr:`state_probe`, or None while the probes are over their
-        budget (:data:`PROBE_VALUES_PER_EVENT` values per event accounted so far)."""
-        if self._probe_spent > PROBE_VALUES_PER_EVENT * self._spin.every.n:
+        budget (:data:`PROBE_CREDIT_VALUES` plus :data:`PROBE_VALUES_PER_EVENT` values per
+        event accounted so far)."""
+        if self._probe_spent > PROBE_CREDIT_VALUES + PROBE_VALUES_PER_EVENT * self._spin.every.n:
             return None
         state, values = self.state_probe()
         self._probe_spent += values
@@ -458,9 +463,7 @@ class _Spin:
     def left_out(self, key: str, pose: bool = False) -> bool:
         """Account event `key` (:func:`_content`; `pose`: a pose event); True when it is to be
         left out."""
-        # while the programs' spin is confirmed it leaves their events out: the pass over every
-        # event would add only the poses at rest between, so it probes no state meanwhile
-        done = self.every.step(key, probe=pose or not self.program.confirmed)
+        done = self.every.step(key)
         if not pose:
             inner = self.program.step(key)  # always: its history must see every event
             done = done or inner

@@ -29,9 +29,12 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from .errors import INTERRUPT_NOT_DECLARED, KrlRuntimeError
-from .watch import stamp_key
+from .watch import ALWAYS, CLOCK, CONSTANT, IO, stamp_key
 
 MAIN_PRIO = 129
+#: False: every armed condition is evaluated at every poll, whatever its watch (the oracle of
+#: tests/interp/test_interrupt_watch.py, with :func:`~.watch.stamp_key` patched to None)
+WATCHED = True
 
 
 @dataclass
@@ -109,22 +112,44 @@ class InterruptTable:
             else:
                 raise KrlRuntimeError(f"unknown INTERRUPT action {action}")
 
-    def poll(self, io_version: int = 0, now: float = 0.0) -> None:
+    def poll(self, io_version: int = 0, now: float = 0.0) -> bool:
         """Evaluate the armed conditions; a rising edge makes the interrupt pending. A
-        condition whose watch key (interp/runtime/watch.py) at `io_version` and simulated time
-        `now` (s) is that of its last evaluation keeps its value: nothing it reads changed."""
-        for irq in list(self.irqs.values()):
+        condition whose watch key (interp/runtime/watch.py :func:`~.watch.stamp_key`, computed
+        here inline: this runs before every statement) at `io_version` and simulated time
+        `now` (s) is that of its last evaluation keeps its value: nothing it reads changed.
+        Returns True when an interrupt is pending, on and enabled afterwards (then
+        :meth:`next_ready` may find one to run), False when none is."""
+        ready = False
+        watched = WATCHED
+        for irq in tuple(self.irqs.values()):
             if not irq.on:
                 continue
-            key = stamp_key(irq.watch, io_version, now, irq.probes)
-            if key is not None and key == irq.seen:
-                continue
+            w = irq.watch if watched else ALWAYS
+            if w == CONSTANT:
+                key = 0
+            elif w == IO:
+                key = io_version
+            elif w == CLOCK:
+                key = (io_version, now)
+            else:
+                key = None
+            if key is not None:
+                probes = irq.probes
+                if probes:
+                    key = (key, (probes[0](),) if len(probes) == 1 else tuple([p() for p in probes]))
+                if key == irq.seen:
+                    if irq.pending and irq.enabled:
+                        ready = True
+                    continue
             irq.seen = None
             cur = bool(irq.cond())
             if cur and not irq.last:
                 irq.pending = True
             irq.last = cur
             irq.seen = key
+            if irq.pending and irq.enabled:
+                ready = True
+        return ready
 
     def next_ready(self, running_prio: int) -> Irq | None:
         best = None

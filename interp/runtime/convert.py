@@ -86,12 +86,12 @@ def assign_chars(dest: Arr, v) -> None:
         text = v
     else:
         raise KrlRuntimeError(f"cannot assign {v!r} to a CHAR array")
-    n = len(dest.data)
+    data = dest.data
+    n = len(data)
     text = text[:n]
-    for i, ch in enumerate(text):
-        dest.data[i] = ch
-    for i in range(len(text), n):
-        dest.data[i] = "\0"
+    k = len(text)
+    data[:k] = text                 # one character an element, in one slice
+    data[k:] = "\0" * (n - k)
 
 
 def assign_into(dest, v) -> None:

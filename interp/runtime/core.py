@@ -80,6 +80,13 @@ def reach_message(ctl, req, err) -> str:
     return err.message
 
 
+
+def _reader(ref):
+    """The zero-argument reader of system variable `ref` that an interrupt's watch key probes
+    (interp/runtime/watch.py): a computed variable's getter, else its peek."""
+    getter = getattr(ref, "getter", None)
+    return getter if getter is not None else ref.peek
+
 class Runtime:
     """Shared runtime of one run.
 
@@ -637,7 +644,13 @@ class Runtime:
                 if v.__class__ is Struct and v.type is t:
                     # a structure of the parameter's own type: its copy (the same components,
                     # already of their types: what make_value + assign_into give), its size
-                    frame.data += self.memory.take(size, f"a copy of :IN parameter {name}")
+                    # (DataMemory.take, inlined when it fits: the message is made only for its error)
+                    mem = self.memory
+                    if mem.used + size <= mem.limit:
+                        mem.used += size
+                        frame.data += size
+                    else:
+                        frame.data += mem.take(size, f"a copy of :IN parameter {name}")
                     store[k] = copy_value(v)
                     fvars[k] = Slot(store, k, t, name)
                     continue
@@ -1087,7 +1100,8 @@ class Runtime:
         task = self.current_task
         n = trunc_int(number, "interrupt number")
         cls, names = split_watch(watch)
-        probes = tuple(self.sysvars.lookup(k).peek for k in names)
+        # a computed variable's getter is its peek, one call less at each poll
+        probes = tuple(_reader(self.sysvars.lookup(k)) for k in names)
         task.irqs.declare(Irq(n, cond_fn, handler_fn, name, frame, is_global, line, watch=cls,
                               probes=probes))
         frame.interrupts.append(n)
@@ -1108,9 +1122,11 @@ class Runtime:
         task.in_poll = True
         ctl = self.controller
         try:
-            task.irqs.poll(ctl.io.version, ctl.time)
+            ready = task.irqs.poll(ctl.io.version, ctl.time)
         finally:
             task.in_poll = False
+        if not ready:
+            return          # nothing pending and enabled: next_ready would find nothing
         while True:
             irq = task.irqs.next_ready(task.context.prio)
             if irq is None:

@@ -13,6 +13,7 @@ interpreter unwinds with them, as the paper describes; the VM uses the last thre
 
 from __future__ import annotations
 
+from krl.ast import nodes as N
 from krl.semantics.values import INTERRUPT_NOT_DECLARED, VALUE_INVALID, KrlRuntimeError, value_invalid
 
 
@@ -71,8 +72,6 @@ class StopRun(ControlSignal):
 def lvalue_name(e) -> str:
     """The name of an lvalue expression (krl.ast nodes) as run-time messages show it:
     ``p``, ``a[..]``, ``p.X``."""
-    from krl.ast import nodes as N  # noqa: PLC0415
-
     if isinstance(e, N.Name):
         return e.name
     if isinstance(e, N.Index):

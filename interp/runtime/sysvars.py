@@ -290,8 +290,13 @@ def _io(kind: str):
         if kind == "$IN":
             arr = LiveArray(name, 8192, T.BOOL, io.get_in)
         elif kind == "$OUT":
-            arr = LiveArray(name, 8192, T.BOOL, io.get_out,
-                            lambda i, v: ctl.set_out(i, v, sv.rt.io_source()))
+            def set_out(i, v):
+                # an output written with the value it has changes nothing and logs nothing
+                # (robot/io.py IOImage.set_out): skip the controller's call for it
+                if i.__class__ is int and 1 <= i <= 8192 and io._out[i] == (1 if v else 0):
+                    return
+                ctl.set_out(i, v, sv.rt.io_source())
+            arr = LiveArray(name, 8192, T.BOOL, io.get_out, set_out)
         elif kind == "$ANIN":
             arr = LiveArray(name, 32, T.REAL, io.get_anin)
         elif kind == "$ANOUT":
@@ -372,14 +377,20 @@ def _date(sv: SysVars):
                               "HOUR": (s // 3600) % 24, "DAY": 1, "MONTH": 1, "YEAR": 2026})
 
 
+#: the values of $PRO_STATE*, made once: an enum value is an immutable leaf
+#: (interp/runtime/idle.py _FLAT), and an interrupt's watch key (watch.py) compares the same
+#: object at each poll by identity
+_P_ACTIVE, _P_FREE = EnumValue("P_ACTIVE"), EnumValue("P_FREE")
+
+
 def _pro_state(robot: bool):
     def fn(sv: SysVars):
-        return EnumValue("P_ACTIVE" if sv.rt.interpreter_active(robot) else "P_FREE")
+        return _P_ACTIVE if sv.rt.interpreter_active(robot) else _P_FREE
     return fn
 
 
 def _pro_state_self(sv: SysVars):
-    return EnumValue("P_ACTIVE")
+    return _P_ACTIVE
 
 
 def _err(sv: SysVars):

@@ -161,10 +161,22 @@ def value_size(v) -> int:
     return 1
 
 
+#: id(structure type) -> (the type, its field count, True when no field is a structure or an
+#: array): such a structure is made by one C-level dict.fromkeys (make_value, per routine call)
+_FLAT_STRUC: dict[int, tuple] = {}
+
+
 def make_value(t):
     """A fresh, uninitialised value of type ``t`` (UNSET leaves)."""
     if isinstance(t, T.Struc):
-        return Struct(t, {k: make_value(ft) for k, (_, ft) in t.fields.items()})
+        fields = t.fields
+        c = _FLAT_STRUC.get(id(t))
+        if c is None or c[0] is not t or c[1] != len(fields):
+            c = _FLAT_STRUC[id(t)] = (t, len(fields), not any(
+                isinstance(ft, (T.Struc, T.Array)) for _, ft in fields.values()))
+        if c[2]:
+            return Struct(t, dict.fromkeys(fields, UNSET))
+        return Struct(t, {k: make_value(ft) for k, (_, ft) in fields.items()})
     if isinstance(t, T.Array):
         n = 1
         for d in t.dims:
@@ -200,8 +212,15 @@ def _zeroed(v, t):
     return v
 
 
+#: classes of the immutable leaf values: a structure holding only these is copied by a plain
+#: copy of its components (:func:`copy_value`)
+_LEAVES = frozenset((int, float, bool, str, type(None), EnumValue, type(UNSET)))
+
+
 def copy_value(v):
     """A deep copy (for :IN parameters and whole-value reads)."""
+    if v.__class__ is Struct and _LEAVES.issuperset(map(type, v.f.values())):
+        return Struct(v.type, v.f.copy())    # only immutable leaves: one C-level copy
     if isinstance(v, Struct):        # (a scalar component is its own copy: no call for it)
         return Struct(v.type, {k: copy_value(x) if isinstance(x, (Struct, Arr)) else x for k, x in v.f.items()})
     if isinstance(v, Arr):

@@ -109,7 +109,9 @@ def watch_of_decl(st) -> str:
 def stamp_key(watch: str, io_version: int, now: float, probes=()):
     """The key of a condition of class `watch` (without probes) at a poll that sees the I/O
     image at `io_version`, the simulated time `now` (s) and the probed system variables'
-    readers `probes` (zero-argument callables); None: evaluate (class ALWAYS)."""
+    readers `probes` (zero-argument callables); None: evaluate (class ALWAYS).
+    interp/runtime/contexts.py ``InterruptTable.poll`` computes the same key inline (it runs
+    before every statement); tests/interp/test_interrupt_watch.py holds both to it."""
     if watch == CONSTANT:
         key = 0
     elif watch == IO:

@@ -30,6 +30,9 @@ from interp.runtime.slots import (anout_limits, anout_value, array_index, ended_
 from interp.runtime.values import Channel, EnumValue, Struct, copy_value
 from interp.runtime.watch import watch_of_decl
 
+#: classes of the values a variable read returns as they are (immutable: no copy)
+_IMMUTABLE = frozenset((int, float, bool, str, EnumValue, type(None)))
+
 
 class TreeInterpreter:
     def __init__(self, rt) -> None:
@@ -492,6 +495,8 @@ class TreeInterpreter:
 
     def e_var(self, e, frame):
         v = self.ref(e, frame).get()
+        if v.__class__ in _IMMUTABLE:
+            return v                # a scalar is its own copy
         if isinstance(v, Struct) or hasattr(v, "dims"):
             return copy_value(v)
         return v
@@ -508,6 +513,9 @@ class TreeInterpreter:
         return self.rt.unary_op(e.op, self.eval(e.operand, frame))
 
     def e_Binary(self, e, frame):
+        left = e.left
+        if not isinstance(left, N.Binary):       # one operator: no chain to walk
+            return self.rt.binary_op(e.op, self.eval(left, frame), self.eval(e.right, frame))
         # a left-nested chain (up to MAX_EXPRESSION_TERMS terms) in a loop: left before right
         left, chain = N.left_chain(e)
         a = self.eval(left, frame)

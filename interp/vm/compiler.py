@@ -789,6 +789,10 @@ def _fuse(group: list):
     if len(group) == 3 and names[:2] == ["REF_LOCAL", "LOAD_LOCAL"] and names[2] in ("LOAD_INDEX", "STORE_INDEX") \
             and ops[2][0] == 1:
         return ("LOAD_ELEM_LL" if names[2] == "LOAD_INDEX" else "STORE_ELEM_LL", [ops[0][0], ops[1][0], ops[2][1]])
+    if len(group) == 3 and names[:2] == ["LOAD_ELEM1_V", "LOAD_FAST"] and names[2] in _CMP_SYMBOLS:
+        return ("IF_NOT_EV", [*ops[0], ops[1][0], _CMP_SYMBOLS[names[2]], ops[2][0]])
+    if len(group) == 3 and names == ["LOAD_ELEM1_V", "FAST_ADD_CONST", "STORE_ELEM1"]:
+        return ("MOVE_ELEM1", [*ops[0], *ops[1], *ops[2]])
     if len(group) == 3 and names == ["LOAD_FAST", "LOAD_FAST", "LOAD_ELEM2"]:
         return ("LOAD_ELEM2_VV", [ops[2][0], ops[0][0], ops[1][0], ops[2][1]])
     if len(group) == 2 and names[0] in ("FAST_ADD_CONST", "FAST_SUB_CONST") and names[1] == "STORE_FAST":

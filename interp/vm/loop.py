@@ -16,10 +16,10 @@ from interp.runtime.values import (Struct, UNSET)
 from krl.semantics.types import (BOOL as T_BOOL, INT as T_INT, REAL as T_REAL)
 
 # sha256 of the vm.py this file was generated from
-VM_SOURCE = '635c9e51192d3825829ba2d7044b0ad88440d9a3f7517560310d0a6b6c54d33a'
+VM_SOURCE = '5b0d79b16e50a266fe67924b56af9bb39ae1709deceb317ddb0a278252ffc088'
 
 # opcode number (interp/vm/opcodes.py) -> this loop's number of the opcode
-DISPATCH = [43, 0, 35, 83, 87, 86, 78, 101, 22, 111, 100, 23, 24, 99, 26, 34, 92, 40, 81, 5, 76, 98, 58, 93, 90, 95, 62, 102, 73, 2, 28, 96, 4, 110, 109, 107, 106, 103, 42, 33, 30, 41, 25, 38, 31, 112, 57, 32, 82, 44, 55, 54, 49, 48, 51, 36, 29, 75, 97, 45, 50, 84, 108, 1, 37, 47, 85, 77, 52, 105, 74, 104, 53, 79, 56, 89, 8, 80, 72, 27, 39, 3, 46, 91, 88, 94, 71, 60, 61, 66, 10, 69, 70, 11, 7, 6, 65, 18, 67, 64, 63, 68, 12, 20, 59, 19, 21, 9, 14, 16, 17, 15, 13]
+DISPATCH = [18, 0, 10, 66, 64, 63, 56, 76, 110, 80, 78, 111, 112, 77, 4, 12, 58, 13, 61, 93, 53, 75, 36, 72, 70, 71, 40, 82, 34, 2, 3, 65, 92, 90, 89, 86, 85, 83, 20, 11, 7, 19, 91, 14, 8, 114, 35, 6, 59, 24, 30, 29, 27, 26, 32, 17, 88, 52, 81, 22, 25, 67, 84, 1, 16, 21, 55, 51, 33, 79, 54, 74, 31, 9, 113, 57, 28, 69, 96, 60, 50, 5, 15, 87, 23, 68, 62, 73, 49, 38, 39, 44, 98, 47, 48, 99, 95, 94, 43, 106, 45, 42, 41, 46, 100, 108, 37, 107, 109, 97, 102, 104, 105, 103, 101]
 
 # the runtime functions of vm.HELPERS under the names the handlers call
 _load = load
@@ -63,22 +63,24 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
     left = task.quiet - rt.steps if task is not None else 0
     unsaved = 0
     proceed = False
+    dirty = False
     try:
         while True:
             try:
                 while True:
                     ins = prog[ip]
                     op = ins[0]
-                    if op < 36:
+                    if op < 17:
                         if op < 1:
                             info = ins[1]
-                            frame.line = ins[2]
                             if left > 0 and (not ins[3]):
                                 left -= 1
                                 unsaved += 1
-                                task.at = info
+                                dirty = True
                                 proceed = False
                             else:
+                                frame.line = ins[2]
+                                dirty = False
                                 rt.steps += unsaved
                                 unsaved = 0
                                 before(info)
@@ -97,7 +99,7 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                             else:
                                 stack.append(_element1(fvars[x1], _load(fvars[x2]), ins[3]))
                             ip += 1
-                        elif op < 26:
+                        elif op < 9:
                             if op < 3:
                                 b = stack.pop()
                                 a = stack[-1]
@@ -110,180 +112,6 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                 ip += 1
                             elif op < 6:
                                 if op < 4:
-                                    argc = ins[2]
-                                    if argc:
-                                        args = stack[-argc:]
-                                        del stack[-argc:]
-                                    else:
-                                        args = []
-                                    flags = ins[3]
-                                    target = code.callsites.get(ip)
-                                    rt.steps += unsaved
-                                    unsaved = 0
-                                    if target is not None:
-                                        v = run_routine(target, args, frame, exec_routine, 'N' not in flags)
-                                    else:
-                                        v = self.call(code, ip, ins[1], args, frame, flags)
-                                    left = task.quiet - rt.steps if task is not None else 0
-                                    if flags == 'E':
-                                        stack.append(v if v is not None else function_result(ins[1].name, v))
-                                    ip += 1
-                                elif op < 5:
-                                    b = stack.pop()
-                                    stack[-1] = _lt(stack[-1], b)
-                                    ip += 1
-                                else:
-                                    ref = stack.pop()
-                                    _store(ref, stack.pop())
-                                    ip += 1
-                            elif op < 25:
-                                if op < 24:
-                                    if op < 22:
-                                        if op < 14:
-                                            if op < 10:
-                                                if op < 8:
-                                                    if op < 7:
-                                                        rt.steps += unsaved
-                                                        unsaved = 0
-                                                        ip = cold[op](ins, code, frame, temps, stack, ip)
-                                                        left = task.quiet - rt.steps if task is not None else 0
-                                                    else:
-                                                        rt.steps += unsaved
-                                                        unsaved = 0
-                                                        ip = cold[op](ins, code, frame, temps, stack, ip)
-                                                        left = task.quiet - rt.steps if task is not None else 0
-                                                elif op < 9:
-                                                    rt.steps += unsaved
-                                                    unsaved = 0
-                                                    ip = cold[op](ins, code, frame, temps, stack, ip)
-                                                    left = task.quiet - rt.steps if task is not None else 0
-                                                else:
-                                                    rt.steps += unsaved
-                                                    unsaved = 0
-                                                    ip = cold[op](ins, code, frame, temps, stack, ip)
-                                                    left = task.quiet - rt.steps if task is not None else 0
-                                            elif op < 12:
-                                                if op < 11:
-                                                    rt.steps += unsaved
-                                                    unsaved = 0
-                                                    ip = cold[op](ins, code, frame, temps, stack, ip)
-                                                    left = task.quiet - rt.steps if task is not None else 0
-                                                else:
-                                                    rt.steps += unsaved
-                                                    unsaved = 0
-                                                    ip = cold[op](ins, code, frame, temps, stack, ip)
-                                                    left = task.quiet - rt.steps if task is not None else 0
-                                            elif op < 13:
-                                                rt.steps += unsaved
-                                                unsaved = 0
-                                                ip = cold[op](ins, code, frame, temps, stack, ip)
-                                                left = task.quiet - rt.steps if task is not None else 0
-                                            else:
-                                                rt.steps += unsaved
-                                                unsaved = 0
-                                                ip = cold[op](ins, code, frame, temps, stack, ip)
-                                                left = task.quiet - rt.steps if task is not None else 0
-                                        elif op < 18:
-                                            if op < 16:
-                                                if op < 15:
-                                                    rt.steps += unsaved
-                                                    unsaved = 0
-                                                    ip = cold[op](ins, code, frame, temps, stack, ip)
-                                                    left = task.quiet - rt.steps if task is not None else 0
-                                                else:
-                                                    rt.steps += unsaved
-                                                    unsaved = 0
-                                                    ip = cold[op](ins, code, frame, temps, stack, ip)
-                                                    left = task.quiet - rt.steps if task is not None else 0
-                                            elif op < 17:
-                                                rt.steps += unsaved
-                                                unsaved = 0
-                                                ip = cold[op](ins, code, frame, temps, stack, ip)
-                                                left = task.quiet - rt.steps if task is not None else 0
-                                            else:
-                                                rt.steps += unsaved
-                                                unsaved = 0
-                                                ip = cold[op](ins, code, frame, temps, stack, ip)
-                                                left = task.quiet - rt.steps if task is not None else 0
-                                        elif op < 20:
-                                            if op < 19:
-                                                rt.steps += unsaved
-                                                unsaved = 0
-                                                ip = cold[op](ins, code, frame, temps, stack, ip)
-                                                left = task.quiet - rt.steps if task is not None else 0
-                                            else:
-                                                rt.steps += unsaved
-                                                unsaved = 0
-                                                ip = cold[op](ins, code, frame, temps, stack, ip)
-                                                left = task.quiet - rt.steps if task is not None else 0
-                                        elif op < 21:
-                                            rt.steps += unsaved
-                                            unsaved = 0
-                                            ip = cold[op](ins, code, frame, temps, stack, ip)
-                                            left = task.quiet - rt.steps if task is not None else 0
-                                        else:
-                                            rt.steps += unsaved
-                                            unsaved = 0
-                                            ip = cold[op](ins, code, frame, temps, stack, ip)
-                                            left = task.quiet - rt.steps if task is not None else 0
-                                    elif op < 23:
-                                        g = ins[1]
-                                        ref = grefs[g]
-                                        if ref is None:
-                                            ref = rt.storage_ref(code.gstorage[g], frame)
-                                            grefs[g] = ref
-                                        if op == 22:
-                                            stack.append(_load(ref))
-                                        elif op == 23:
-                                            stack.append(ref)
-                                        else:
-                                            _store(ref, stack.pop())
-                                        ip += 1
-                                    else:
-                                        g = ins[1]
-                                        ref = grefs[g]
-                                        if ref is None:
-                                            ref = rt.storage_ref(code.gstorage[g], frame)
-                                            grefs[g] = ref
-                                        if op == 22:
-                                            stack.append(_load(ref))
-                                        elif op == 23:
-                                            stack.append(ref)
-                                        else:
-                                            _store(ref, stack.pop())
-                                        ip += 1
-                                else:
-                                    n = ins[1]
-                                    idx = [None if x is None else _array_index(x) for x in stack[-n:]]
-                                    del stack[-n:]
-                                    stack[-1] = rt.index(stack[-1], idx, ins[2])
-                                    ip += 1
-                            else:
-                                b = ins[1]
-                                a = stack[-1]
-                                if type(a) is float and type(b) is float:
-                                    stack[-1] = a + b
-                                elif type(a) is int and type(b) is int and (INT_MIN <= (v := (a + b)) <= INT_MAX):
-                                    stack[-1] = v
-                                else:
-                                    stack[-1] = _add(a, b)
-                                ip += 1
-                        elif op < 30:
-                            if op < 29:
-                                if op < 28:
-                                    if op < 27:
-                                        n = ins[1]
-                                        idx = stack[-n:]
-                                        del stack[-n:]
-                                        stack[-1] = _element(stack[-1], idx, ins[2])
-                                        ip += 1
-                                    else:
-                                        t = ins[1]
-                                        if for_done(temps[t].get(), temps[t + 1], temps[t + 2]):
-                                            ip = ins[2]
-                                        else:
-                                            ip += 1
-                                else:
                                     b = stack.pop()
                                     a = stack[-1]
                                     if type(a) is float and type(b) is float:
@@ -293,26 +121,19 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                     else:
                                         stack[-1] = _sub(a, b)
                                     ip += 1
-                            else:
-                                x1 = ins[1]
-                                a = store[x1]
-                                b = ins[2]
-                                if type(a) is int and type(b) is int and (INT_MIN <= (v := (a + b)) <= INT_MAX):
-                                    stack.append(v)
-                                elif type(a) is float and type(b) is float:
-                                    stack.append(a + b)
-                                else:
-                                    stack.append(_add(a if a is not UNSET else _load(fvars[x1]), b))
-                                ip += 1
-                        elif op < 33:
-                            if op < 32:
-                                if op < 31:
-                                    stack.append(_element2(fvars[ins[1]], _load(fvars[ins[2]]), _load(fvars[ins[3]]), ins[4]))
+                                elif op < 5:
+                                    n = ins[1]
+                                    idx = stack[-n:]
+                                    del stack[-n:]
+                                    stack[-1] = _element(stack[-1], idx, ins[2])
                                     ip += 1
                                 else:
-                                    stack.append(_sub(_load(fvars[ins[1]]), ins[2]))
-                                    ip += 1
-                            else:
+                                    t = ins[1]
+                                    if for_done(temps[t].get(), temps[t + 1], temps[t + 2]):
+                                        ip = ins[2]
+                                    else:
+                                        ip += 1
+                            elif op < 7:
                                 b = ins[1]
                                 a = stack[-1]
                                 if type(a) is float and type(b) is float:
@@ -322,8 +143,48 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                 else:
                                     stack[-1] = _mul(a, b)
                                 ip += 1
-                        elif op < 35:
-                            if op < 34:
+                            elif op < 8:
+                                stack.append(_element2(fvars[ins[1]], _load(fvars[ins[2]]), _load(fvars[ins[3]]), ins[4]))
+                                ip += 1
+                            else:
+                                stack.append(_sub(_load(fvars[ins[1]]), ins[2]))
+                                ip += 1
+                        elif op < 13:
+                            if op < 10:
+                                x1 = ins[1]
+                                x2 = ins[2]
+                                a = store[x1]
+                                i = store[x2]
+                                d = a.data
+                                if not (type(i) is int and 0 < i <= len(d) and ((v := d[(x3 := i) - 1]) is not UNSET)):
+                                    v = _element1(fvars[x1], _load(fvars[x2]), ins[3])
+                                x1 = ins[4]
+                                b = store[x1]
+                                if b is UNSET:
+                                    b = _load(fvars[x1])
+                                ca = type(v)
+                                cb = type(b)
+                                f = ins[5]
+                                if f[0](v, b) if (ca is int or ca is float) and (cb is int or cb is float) else f[1](v, b):
+                                    ip += 1
+                                else:
+                                    ip = ins[6]
+                            elif op < 11:
+                                if left > 0 and (not ins[1].cond_stops):
+                                    left -= 1
+                                    unsaved += 1
+                                else:
+                                    if dirty:
+                                        frame.line = info.line
+                                        task.at = info
+                                        dirty = False
+                                    rt.steps += unsaved
+                                    unsaved = 0
+                                    tick(ins[1])
+                                    task.quiet = n = quiet_limit(task)
+                                    left = n - rt.steps
+                                ip += 1
+                            elif op < 12:
                                 _set_element1(fvars[ins[1]], _load(fvars[ins[2]]), stack.pop(), ins[3])
                                 ip += 1
                             else:
@@ -338,21 +199,51 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                     base = stack.pop()
                                     _set_element(base, idx, stack.pop(), ins[2])
                                 ip += 1
-                        else:
-                            if left > 0 and (not ins[1].cond_stops):
-                                left -= 1
-                                unsaved += 1
+                        elif op < 16:
+                            if op < 14:
+                                base = stack.pop()
+                                _set_component(base, ins[1][0], stack.pop(), ins[2])
+                                ip += 1
+                            elif op < 15:
+                                stack.append(_add(_load(fvars[ins[1]]), ins[2]))
+                                ip += 1
                             else:
-                                rt.steps += unsaved
-                                unsaved = 0
-                                tick(ins[1])
-                                task.quiet = n = quiet_limit(task)
-                                left = n - rt.steps
+                                t = ins[1]
+                                if _for_next(temps[t], temps[t + 1], temps[t + 2], ins[2]):
+                                    if left > 0 and (not ins[2].cond_stops):
+                                        left -= 1
+                                        unsaved += 1
+                                    else:
+                                        if dirty:
+                                            frame.line = info.line
+                                            task.at = info
+                                            dirty = False
+                                        rt.steps += unsaved
+                                        unsaved = 0
+                                        tick(ins[2])
+                                        task.quiet = n = quiet_limit(task)
+                                        left = n - rt.steps
+                                    ip = ins[3]
+                                else:
+                                    ip += 1
+                        else:
+                            x1 = ins[1]
+                            x2 = ins[2]
+                            a = store[x1]
+                            i = store[x2]
+                            v = stack.pop()
+                            t = ins[4]
+                            d = a.data
+                            if type(i) is int and 0 < i <= len(d) and (type(v) is t) and (t is not int or INT_MIN <= v <= INT_MAX):
+                                x3 = i
+                                d[x3 - 1] = v
+                            else:
+                                _set_element1(fvars[x1], _load(fvars[x2]), v, ins[3])
                             ip += 1
-                    elif op < 57:
-                        if op < 51:
-                            if op < 41:
-                                if op < 37:
+                    elif op < 54:
+                        if op < 32:
+                            if op < 24:
+                                if op < 18:
                                     x1 = ins[1]
                                     x2 = ins[2]
                                     v = store[x1]
@@ -360,55 +251,10 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                     v = store[x2]
                                     stack.append(v if v is not UNSET else _load(fvars[x2]))
                                     ip += 1
-                                elif op < 38:
-                                    x1 = ins[1]
-                                    x2 = ins[2]
-                                    a = store[x1]
-                                    i = store[x2]
-                                    v = stack.pop()
-                                    t = ins[4]
-                                    d = a.data
-                                    if type(i) is int and 0 < i <= len(d) and (type(v) is t) and (t is not int or INT_MIN <= v <= INT_MAX):
-                                        x3 = i
-                                        d[x3 - 1] = v
-                                    else:
-                                        _set_element1(fvars[x1], _load(fvars[x2]), v, ins[3])
-                                    ip += 1
-                                elif op < 40:
-                                    if op < 39:
-                                        stack.append(_add(_load(fvars[ins[1]]), ins[2]))
-                                        ip += 1
-                                    else:
-                                        t = ins[1]
-                                        if _for_next(temps[t], temps[t + 1], temps[t + 2], ins[2]):
-                                            if left > 0 and (not ins[2].cond_stops):
-                                                left -= 1
-                                                unsaved += 1
-                                            else:
-                                                rt.steps += unsaved
-                                                unsaved = 0
-                                                tick(ins[2])
-                                                task.quiet = n = quiet_limit(task)
-                                                left = n - rt.steps
-                                            ip = ins[3]
-                                        else:
-                                            ip += 1
-                                else:
-                                    base = stack.pop()
-                                    _set_component(base, ins[1][0], stack.pop(), ins[2])
-                                    ip += 1
-                            elif op < 45:
-                                if op < 44:
-                                    if op < 43:
-                                        if op < 42:
-                                            stack.append(_load(fvars[ins[1]]))
-                                            stack.append(_load(fvars[ins[2]]))
-                                            ip += 1
-                                        else:
-                                            stack.append(_element1(fvars[ins[1]], _load(fvars[ins[2]]), ins[3]))
-                                            ip += 1
-                                    else:
+                                elif op < 21:
+                                    if op < 19:
                                         info = ins[1]
+                                        dirty = False
                                         if not thunk:
                                             frame.line = ins[2]
                                         if left > 0 and (not ins[3]):
@@ -422,31 +268,14 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                             task.quiet = n = quiet_limit(task)
                                             left = n - rt.steps
                                         ip += 1
-                                else:
-                                    b = stack.pop()
-                                    a = stack.pop()
-                                    ca = type(a)
-                                    cb = type(b)
-                                    if a <= b if (ca is int or ca is float) and (cb is int or cb is float) else _le(a, b):
+                                    elif op < 20:
+                                        stack.append(_load(fvars[ins[1]]))
+                                        stack.append(_load(fvars[ins[2]]))
                                         ip += 1
                                     else:
-                                        ip = ins[1]
-                            elif op < 48:
-                                if op < 47:
-                                    if op < 46:
-                                        a = store[ins[1]]
-                                        i = stack[-1]
-                                        d = a.data
-                                        if type(i) is int and 0 < i <= len(d) and ((v := d[(x3 := i) - 1]) is not UNSET):
-                                            stack[-1] = v
-                                        else:
-                                            stack[-1] = _element1(fvars[ins[1]], i, ins[2])
+                                        stack.append(_element1(fvars[ins[1]], _load(fvars[ins[2]]), ins[3]))
                                         ip += 1
-                                    else:
-                                        if code.is_function:
-                                            raise return_without_value(code.routine, frame.line)
-                                        return None
-                                else:
+                                elif op < 22:
                                     x1 = ins[1]
                                     x2 = ins[2]
                                     x3 = ins[3]
@@ -459,8 +288,48 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                     else:
                                         stack.append(_element2(fvars[x1], _load(fvars[x2]), _load(fvars[x3]), ins[4]))
                                     ip += 1
-                            elif op < 50:
-                                if op < 49:
+                                elif op < 23:
+                                    a = store[ins[1]]
+                                    i = stack[-1]
+                                    d = a.data
+                                    if type(i) is int and 0 < i <= len(d) and ((v := d[(x3 := i) - 1]) is not UNSET):
+                                        stack[-1] = v
+                                    else:
+                                        stack[-1] = _element1(fvars[ins[1]], i, ins[2])
+                                    ip += 1
+                                else:
+                                    if code.is_function:
+                                        if dirty:
+                                            frame.line = info.line
+                                            task.at = info
+                                            dirty = False
+                                        raise return_without_value(code.routine, frame.line)
+                                    if dirty:
+                                        frame.line = info.line
+                                        task.at = info
+                                        dirty = False
+                                    return None
+                            elif op < 28:
+                                if op < 25:
+                                    b = stack.pop()
+                                    a = stack.pop()
+                                    ca = type(a)
+                                    cb = type(b)
+                                    if a <= b if (ca is int or ca is float) and (cb is int or cb is float) else _le(a, b):
+                                        ip += 1
+                                    else:
+                                        ip = ins[1]
+                                elif op < 26:
+                                    j = stack.pop()
+                                    i = stack[-1]
+                                    a = store[ins[1]]
+                                    n, m = a.dims
+                                    if type(i) is int and type(j) is int and (0 < i <= n) and (0 < j <= m) and ((v := a.data[((y1 := i) - 1) * (y2 := m) + (y3 := j) - 1]) is not UNSET):
+                                        stack[-1] = v
+                                    else:
+                                        stack[-1] = _element2(fvars[ins[1]], i, j, ins[2])
+                                    ip += 1
+                                elif op < 27:
                                     b = stack.pop()
                                     a = stack.pop()
                                     ca = type(a)
@@ -478,22 +347,50 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                         ip += 1
                                     else:
                                         ip = ins[1]
-                            else:
-                                j = stack.pop()
-                                i = stack[-1]
-                                a = store[ins[1]]
-                                n, m = a.dims
-                                if type(i) is int and type(j) is int and (0 < i <= n) and (0 < j <= m) and ((v := a.data[((y1 := i) - 1) * (y2 := m) + (y3 := j) - 1]) is not UNSET):
-                                    stack[-1] = v
+                            elif op < 31:
+                                if op < 29:
+                                    v = stack.pop()
+                                    if v is True:
+                                        ip += 1
+                                    elif v is False or not rt.to_bool(v):
+                                        ip = ins[1]
+                                    else:
+                                        ip += 1
+                                elif op < 30:
+                                    b = stack.pop()
+                                    a = stack.pop()
+                                    ca = type(a)
+                                    cb = type(b)
+                                    if a >= b if (ca is int or ca is float) and (cb is int or cb is float) else _ge(a, b):
+                                        ip += 1
+                                    else:
+                                        ip = ins[1]
                                 else:
-                                    stack[-1] = _element2(fvars[ins[1]], i, j, ins[2])
-                                ip += 1
-                        elif op < 52:
+                                    b = stack.pop()
+                                    a = stack.pop()
+                                    ca = type(a)
+                                    cb = type(b)
+                                    if a > b if (ca is int or ca is float) and (cb is int or cb is float) else _gt(a, b):
+                                        ip += 1
+                                    else:
+                                        ip = ins[1]
+                            else:
+                                x1 = ins[1]
+                                a = store[x1]
+                                b = ins[2]
+                                ca = type(a)
+                                cb = type(b)
+                                f = ins[3]
+                                if f[0](a, b) if (ca is int or ca is float) and (cb is int or cb is float) else f[1](a if a is not UNSET else _load(fvars[x1]), b):
+                                    ip += 1
+                                else:
+                                    ip = ins[4]
+                        elif op < 33:
                             x1 = ins[1]
                             v = store[x1]
                             stack.append(v if v is not UNSET else _load(fvars[x1]))
                             ip += 1
-                        elif op < 53:
+                        elif op < 34:
                             x2 = ins[2]
                             x1 = ins[1]
                             c = store[x1]
@@ -507,6 +404,10 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                     left -= 1
                                     unsaved += 1
                                 else:
+                                    if dirty:
+                                        frame.line = info.line
+                                        task.at = info
+                                        dirty = False
                                     rt.steps += unsaved
                                     unsaved = 0
                                     tick(ins[3])
@@ -515,156 +416,191 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                 ip = ins[4]
                             else:
                                 ip += 1
-                        elif op < 54:
-                            x1 = ins[1]
-                            a = store[x1]
-                            b = ins[2]
-                            ca = type(a)
-                            cb = type(b)
-                            f = ins[3]
-                            if f[0](a, b) if (ca is int or ca is float) and (cb is int or cb is float) else f[1](a if a is not UNSET else _load(fvars[x1]), b):
-                                ip += 1
-                            else:
-                                ip = ins[4]
-                        elif op < 56:
-                            if op < 55:
-                                b = stack.pop()
-                                a = stack.pop()
-                                ca = type(a)
-                                cb = type(b)
-                                if a >= b if (ca is int or ca is float) and (cb is int or cb is float) else _ge(a, b):
-                                    ip += 1
+                        elif op < 51:
+                            if op < 35:
+                                a = stack[-1]
+                                if (a is True or a is False) and ins[1] == 'NOT':
+                                    stack[-1] = a is False
+                                elif type(a) is float and ins[1] == '-':
+                                    stack[-1] = -a
                                 else:
-                                    ip = ins[1]
-                            else:
-                                b = stack.pop()
-                                a = stack.pop()
-                                ca = type(a)
-                                cb = type(b)
-                                if a > b if (ca is int or ca is float) and (cb is int or cb is float) else _gt(a, b):
-                                    ip += 1
+                                    stack[-1] = rt.unary_op(ins[1], a)
+                                ip += 1
+                            elif op < 36:
+                                b = ins[1]
+                                a = stack[-1]
+                                if type(a) is float and type(b) is float:
+                                    stack[-1] = a - b
+                                elif type(a) is int and type(b) is int and (INT_MIN <= (v := (a - b)) <= INT_MAX):
+                                    stack[-1] = v
                                 else:
-                                    ip = ins[1]
-                        else:
-                            v = stack.pop()
-                            if v is True:
+                                    stack[-1] = _sub(a, b)
                                 ip += 1
-                            elif v is False or not rt.to_bool(v):
-                                ip = ins[1]
-                            else:
-                                ip += 1
-                    elif op < 89:
-                        if op < 83:
-                            if op < 75:
-                                if op < 74:
-                                    if op < 73:
-                                        if op < 58:
-                                            b = ins[1]
-                                            a = stack[-1]
-                                            if type(a) is float and type(b) is float:
-                                                stack[-1] = a - b
-                                            elif type(a) is int and type(b) is int and (INT_MIN <= (v := (a - b)) <= INT_MAX):
-                                                stack[-1] = v
-                                            else:
-                                                stack[-1] = _sub(a, b)
-                                            ip += 1
-                                        elif op < 72:
-                                            if op < 59:
-                                                g = ins[1]
-                                                ref = grefs[g]
-                                                if ref is None:
-                                                    ref = rt.storage_ref(code.gstorage[g], frame)
-                                                    grefs[g] = ref
-                                                if op == 22:
-                                                    stack.append(_load(ref))
-                                                elif op == 23:
-                                                    stack.append(ref)
-                                                else:
-                                                    _store(ref, stack.pop())
-                                                ip += 1
-                                            elif op < 64:
-                                                if op < 61:
-                                                    if op < 60:
-                                                        rt.steps += unsaved
-                                                        unsaved = 0
-                                                        ip = cold[op](ins, code, frame, temps, stack, ip)
-                                                        left = task.quiet - rt.steps if task is not None else 0
-                                                    else:
-                                                        rt.steps += unsaved
-                                                        unsaved = 0
-                                                        ip = cold[op](ins, code, frame, temps, stack, ip)
-                                                        left = task.quiet - rt.steps if task is not None else 0
-                                                elif op < 62:
-                                                    rt.steps += unsaved
-                                                    unsaved = 0
-                                                    ip = cold[op](ins, code, frame, temps, stack, ip)
-                                                    left = task.quiet - rt.steps if task is not None else 0
-                                                elif op < 63:
-                                                    rt.steps += unsaved
-                                                    unsaved = 0
-                                                    ip = cold[op](ins, code, frame, temps, stack, ip)
-                                                    left = task.quiet - rt.steps if task is not None else 0
-                                                else:
-                                                    rt.steps += unsaved
-                                                    unsaved = 0
-                                                    ip = cold[op](ins, code, frame, temps, stack, ip)
-                                                    left = task.quiet - rt.steps if task is not None else 0
-                                            elif op < 68:
-                                                if op < 66:
-                                                    if op < 65:
-                                                        rt.steps += unsaved
-                                                        unsaved = 0
-                                                        ip = cold[op](ins, code, frame, temps, stack, ip)
-                                                        left = task.quiet - rt.steps if task is not None else 0
-                                                    else:
-                                                        rt.steps += unsaved
-                                                        unsaved = 0
-                                                        ip = cold[op](ins, code, frame, temps, stack, ip)
-                                                        left = task.quiet - rt.steps if task is not None else 0
-                                                elif op < 67:
-                                                    rt.steps += unsaved
-                                                    unsaved = 0
-                                                    ip = cold[op](ins, code, frame, temps, stack, ip)
-                                                    left = task.quiet - rt.steps if task is not None else 0
-                                                else:
-                                                    rt.steps += unsaved
-                                                    unsaved = 0
-                                                    ip = cold[op](ins, code, frame, temps, stack, ip)
-                                                    left = task.quiet - rt.steps if task is not None else 0
-                                            elif op < 70:
-                                                if op < 69:
-                                                    rt.steps += unsaved
-                                                    unsaved = 0
-                                                    ip = cold[op](ins, code, frame, temps, stack, ip)
-                                                    left = task.quiet - rt.steps if task is not None else 0
-                                                else:
-                                                    rt.steps += unsaved
-                                                    unsaved = 0
-                                                    ip = cold[op](ins, code, frame, temps, stack, ip)
-                                                    left = task.quiet - rt.steps if task is not None else 0
-                                            elif op < 71:
-                                                rt.steps += unsaved
-                                                unsaved = 0
-                                                ip = cold[op](ins, code, frame, temps, stack, ip)
-                                                left = task.quiet - rt.steps if task is not None else 0
-                                            else:
-                                                rt.steps += unsaved
-                                                unsaved = 0
-                                                ip = cold[op](ins, code, frame, temps, stack, ip)
-                                                left = task.quiet - rt.steps if task is not None else 0
-                                        else:
-                                            _store(temps[ins[1]], stack.pop())
-                                            ip += 1
+                            elif op < 50:
+                                if op < 37:
+                                    g = ins[1]
+                                    ref = grefs[g]
+                                    if ref is None:
+                                        ref = rt.storage_ref(code.gstorage[g], frame)
+                                        grefs[g] = ref
+                                    if op == 110:
+                                        stack.append(_load(ref))
+                                    elif op == 111:
+                                        stack.append(ref)
                                     else:
-                                        a = stack[-1]
-                                        if (a is True or a is False) and ins[1] == 'NOT':
-                                            stack[-1] = a is False
-                                        elif type(a) is float and ins[1] == '-':
-                                            stack[-1] = -a
+                                        _store(ref, stack.pop())
+                                    ip += 1
+                                elif op < 42:
+                                    if op < 39:
+                                        if op < 38:
+                                            if dirty:
+                                                frame.line = info.line
+                                                task.at = info
+                                                dirty = False
+                                            rt.steps += unsaved
+                                            unsaved = 0
+                                            ip = cold[op](ins, code, frame, temps, stack, ip)
+                                            left = task.quiet - rt.steps if task is not None else 0
                                         else:
-                                            stack[-1] = rt.unary_op(ins[1], a)
-                                        ip += 1
+                                            if dirty:
+                                                frame.line = info.line
+                                                task.at = info
+                                                dirty = False
+                                            rt.steps += unsaved
+                                            unsaved = 0
+                                            ip = cold[op](ins, code, frame, temps, stack, ip)
+                                            left = task.quiet - rt.steps if task is not None else 0
+                                    elif op < 40:
+                                        if dirty:
+                                            frame.line = info.line
+                                            task.at = info
+                                            dirty = False
+                                        rt.steps += unsaved
+                                        unsaved = 0
+                                        ip = cold[op](ins, code, frame, temps, stack, ip)
+                                        left = task.quiet - rt.steps if task is not None else 0
+                                    elif op < 41:
+                                        if dirty:
+                                            frame.line = info.line
+                                            task.at = info
+                                            dirty = False
+                                        rt.steps += unsaved
+                                        unsaved = 0
+                                        ip = cold[op](ins, code, frame, temps, stack, ip)
+                                        left = task.quiet - rt.steps if task is not None else 0
+                                    else:
+                                        if dirty:
+                                            frame.line = info.line
+                                            task.at = info
+                                            dirty = False
+                                        rt.steps += unsaved
+                                        unsaved = 0
+                                        ip = cold[op](ins, code, frame, temps, stack, ip)
+                                        left = task.quiet - rt.steps if task is not None else 0
+                                elif op < 46:
+                                    if op < 44:
+                                        if op < 43:
+                                            if dirty:
+                                                frame.line = info.line
+                                                task.at = info
+                                                dirty = False
+                                            rt.steps += unsaved
+                                            unsaved = 0
+                                            ip = cold[op](ins, code, frame, temps, stack, ip)
+                                            left = task.quiet - rt.steps if task is not None else 0
+                                        else:
+                                            if dirty:
+                                                frame.line = info.line
+                                                task.at = info
+                                                dirty = False
+                                            rt.steps += unsaved
+                                            unsaved = 0
+                                            ip = cold[op](ins, code, frame, temps, stack, ip)
+                                            left = task.quiet - rt.steps if task is not None else 0
+                                    elif op < 45:
+                                        if dirty:
+                                            frame.line = info.line
+                                            task.at = info
+                                            dirty = False
+                                        rt.steps += unsaved
+                                        unsaved = 0
+                                        ip = cold[op](ins, code, frame, temps, stack, ip)
+                                        left = task.quiet - rt.steps if task is not None else 0
+                                    else:
+                                        if dirty:
+                                            frame.line = info.line
+                                            task.at = info
+                                            dirty = False
+                                        rt.steps += unsaved
+                                        unsaved = 0
+                                        ip = cold[op](ins, code, frame, temps, stack, ip)
+                                        left = task.quiet - rt.steps if task is not None else 0
+                                elif op < 48:
+                                    if op < 47:
+                                        if dirty:
+                                            frame.line = info.line
+                                            task.at = info
+                                            dirty = False
+                                        rt.steps += unsaved
+                                        unsaved = 0
+                                        ip = cold[op](ins, code, frame, temps, stack, ip)
+                                        left = task.quiet - rt.steps if task is not None else 0
+                                    else:
+                                        if dirty:
+                                            frame.line = info.line
+                                            task.at = info
+                                            dirty = False
+                                        rt.steps += unsaved
+                                        unsaved = 0
+                                        ip = cold[op](ins, code, frame, temps, stack, ip)
+                                        left = task.quiet - rt.steps if task is not None else 0
+                                elif op < 49:
+                                    if dirty:
+                                        frame.line = info.line
+                                        task.at = info
+                                        dirty = False
+                                    rt.steps += unsaved
+                                    unsaved = 0
+                                    ip = cold[op](ins, code, frame, temps, stack, ip)
+                                    left = task.quiet - rt.steps if task is not None else 0
                                 else:
+                                    if dirty:
+                                        frame.line = info.line
+                                        task.at = info
+                                        dirty = False
+                                    rt.steps += unsaved
+                                    unsaved = 0
+                                    ip = cold[op](ins, code, frame, temps, stack, ip)
+                                    left = task.quiet - rt.steps if task is not None else 0
+                            else:
+                                _store(temps[ins[1]], stack.pop())
+                                ip += 1
+                        elif op < 52:
+                            base = fvars[ins[1]]
+                            v = stack.pop()
+                            k = ins[2][1]
+                            if type(base) is Slot and (not base.readonly) and (type((s := base.c[base.k])) is Struct) and (s.type is not None) and ((ft := s.type.fields.get(k)) is not None) and (k in s.f) and ((t := ft[1]) is T_REAL and type(v) is float or (t is T_INT and type(v) is int and (INT_MIN <= v <= INT_MAX)) or (t is T_BOOL and type(v) is bool)):
+                                s.f[k] = v
+                            else:
+                                _set_component(base, ins[2][0], v, ins[3])
+                            ip += 1
+                        elif op < 53:
+                            a = store[ins[1]]
+                            b = ins[2]
+                            if type(a) is int and type(b) is int and (INT_MIN <= (v := (a - b)) <= INT_MAX):
+                                stack.append(v)
+                            elif type(a) is float and type(b) is float:
+                                stack.append(a - b)
+                            else:
+                                stack.append(_sub(a if a is not UNSET else _load(fvars[ins[1]]), b))
+                            ip += 1
+                        else:
+                            _store(fvars[ins[1]], stack.pop())
+                            ip += 1
+                    elif op < 74:
+                        if op < 66:
+                            if op < 58:
+                                if op < 55:
                                     x1 = ins[1]
                                     a = store[x1]
                                     b = ins[2]
@@ -676,38 +612,37 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                     else:
                                         _store(fvars[ins[3]], _sub(a if a is not UNSET else _load(fvars[x1]), b))
                                     ip += 1
-                            elif op < 78:
-                                if op < 77:
-                                    if op < 76:
-                                        a = store[ins[1]]
-                                        b = ins[2]
-                                        if type(a) is int and type(b) is int and (INT_MIN <= (v := (a - b)) <= INT_MAX):
-                                            stack.append(v)
-                                        elif type(a) is float and type(b) is float:
-                                            stack.append(a - b)
-                                        else:
-                                            stack.append(_sub(a if a is not UNSET else _load(fvars[ins[1]]), b))
-                                        ip += 1
+                                elif op < 56:
+                                    x1 = ins[1]
+                                    base = fvars[x1]
+                                    if type(base) is Slot and type((x := base.c[base.k])) is Struct and (type((x := x.f.get(ins[2][1]))) is float or type(x) is int or type(x) is bool):
+                                        stack.append(x)
                                     else:
-                                        _store(fvars[ins[1]], stack.pop())
-                                        ip += 1
-                                else:
-                                    base = fvars[ins[1]]
-                                    v = stack.pop()
-                                    k = ins[2][1]
-                                    if type(base) is Slot and (not base.readonly) and (type((s := base.c[base.k])) is Struct) and (s.type is not None) and ((ft := s.type.fields.get(k)) is not None) and (k in s.f) and ((t := ft[1]) is T_REAL and type(v) is float or (t is T_INT and type(v) is int and (INT_MIN <= v <= INT_MAX)) or (t is T_BOOL and type(v) is bool)):
-                                        s.f[k] = v
-                                    else:
-                                        _set_component(base, ins[2][0], v, ins[3])
+                                        stack.append(_component(base, ins[2][0], ins[3]))
                                     ip += 1
-                            elif op < 80:
-                                if op < 79:
+                                elif op < 57:
                                     stack.append(_load(fvars[ins[1]]))
                                     ip += 1
                                 else:
                                     ip = ins[1]
-                            elif op < 82:
-                                if op < 81:
+                            elif op < 62:
+                                if op < 59:
+                                    base = stack[-1]
+                                    if type(base) is Slot and type((x := base.c[base.k])) is Struct and (type((x := x.f.get(ins[1][1]))) is float or type(x) is int or type(x) is bool):
+                                        stack[-1] = x
+                                    else:
+                                        stack[-1] = _component(base, ins[1][0], ins[2])
+                                    ip += 1
+                                elif op < 60:
+                                    b = stack.pop()
+                                    a = stack.pop()
+                                    ca = type(a)
+                                    cb = type(b)
+                                    if a < b if (ca is int or ca is float) and (cb is int or cb is float) else _lt(a, b):
+                                        ip += 1
+                                    else:
+                                        ip = ins[1]
+                                elif op < 61:
                                     t = ins[1]
                                     step = stack.pop()
                                     end = stack.pop()
@@ -720,19 +655,39 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                 else:
                                     stack[-1] = _read_value(stack[-1])
                                     ip += 1
-                            else:
-                                b = stack.pop()
-                                a = stack.pop()
-                                ca = type(a)
-                                cb = type(b)
-                                if a < b if (ca is int or ca is float) and (cb is int or cb is float) else _lt(a, b):
+                            elif op < 65:
+                                if op < 63:
+                                    if code.is_function:
+                                        if dirty:
+                                            frame.line = info.line
+                                            task.at = info
+                                            dirty = False
+                                        raise ended_without_return(code.routine, frame.line)
+                                    if dirty:
+                                        frame.line = info.line
+                                        task.at = info
+                                        dirty = False
+                                    return None
+                                elif op < 64:
+                                    stack.pop()
                                     ip += 1
                                 else:
-                                    ip = ins[1]
-                        elif op < 84:
+                                    stack.append(None)
+                                    ip += 1
+                            else:
+                                b = stack.pop()
+                                a = stack[-1]
+                                if type(a) is float and type(b) is float:
+                                    stack[-1] = a * b
+                                elif type(a) is int and type(b) is int and (INT_MIN <= (v := (a * b)) <= INT_MAX):
+                                    stack[-1] = v
+                                else:
+                                    stack[-1] = _mul(a, b)
+                                ip += 1
+                        elif op < 67:
                             stack.append(ins[1])
                             ip += 1
-                        elif op < 85:
+                        elif op < 68:
                             i = stack.pop()
                             v = stack.pop()
                             x1 = ins[1]
@@ -745,72 +700,78 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                             else:
                                 _set_element1(fvars[x1], i, v, ins[2])
                             ip += 1
-                        elif op < 86:
-                            x1 = ins[1]
-                            base = fvars[x1]
-                            if type(base) is Slot and type((x := base.c[base.k])) is Struct and (type((x := x.f.get(ins[2][1]))) is float or type(x) is int or type(x) is bool):
-                                stack.append(x)
-                            else:
-                                stack.append(_component(base, ins[2][0], ins[3]))
-                            ip += 1
-                        elif op < 88:
-                            if op < 87:
-                                stack.pop()
-                                ip += 1
-                            else:
-                                stack.append(None)
-                                ip += 1
-                        else:
-                            if code.is_function:
-                                raise ended_without_return(code.routine, frame.line)
-                            return None
-                    elif op < 104:
-                        if op < 97:
-                            if op < 93:
-                                if op < 92:
-                                    if op < 91:
-                                        if op < 90:
-                                            v = stack.pop()
-                                            if v is True:
-                                                ip = ins[1]
-                                            elif v is False or not rt.to_bool(v):
-                                                ip += 1
-                                            else:
-                                                ip = ins[1]
-                                        else:
-                                            temps[ins[1]] = stack.pop()
-                                            ip += 1
-                                    else:
-                                        v = stack.pop()
-                                        return v if code.is_function else None
-                                else:
-                                    base = stack[-1]
-                                    if type(base) is Slot and type((x := base.c[base.k])) is Struct and (type((x := x.f.get(ins[1][1]))) is float or type(x) is int or type(x) is bool):
-                                        stack[-1] = x
-                                    else:
-                                        stack[-1] = _component(base, ins[1][0], ins[2])
+                        elif op < 71:
+                            if op < 69:
+                                v = stack.pop()
+                                if dirty:
+                                    frame.line = info.line
+                                    task.at = info
+                                    dirty = False
+                                return v if code.is_function else None
+                            elif op < 70:
+                                v = stack.pop()
+                                if v is True:
+                                    ip = ins[1]
+                                elif v is False or not rt.to_bool(v):
                                     ip += 1
-                            elif op < 96:
-                                if op < 95:
-                                    if op < 94:
-                                        stack.append(temps[ins[1]])
+                                else:
+                                    ip = ins[1]
+                            else:
+                                temps[ins[1]] = stack.pop()
+                                ip += 1
+                        elif op < 72:
+                            stack[-1] = ValueRef(stack[-1])
+                            ip += 1
+                        elif op < 73:
+                            stack.append(temps[ins[1]])
+                            ip += 1
+                        else:
+                            return stack[-1] if len(stack) > 8 else None
+                    elif op < 88:
+                        if op < 81:
+                            if op < 77:
+                                if op < 75:
+                                    x1 = ins[1]
+                                    x2 = ins[2]
+                                    a = store[x1]
+                                    b = store[x2]
+                                    ca = type(a)
+                                    cb = type(b)
+                                    f = ins[3]
+                                    if f[0](a, b) if (ca is int or ca is float) and (cb is int or cb is float) else f[1](a if a is not UNSET else _load(fvars[x1]), b if b is not UNSET else _load(fvars[x2])):
                                         ip += 1
                                     else:
-                                        return stack[-1] if len(stack) > 8 else None
+                                        ip = ins[4]
+                                elif op < 76:
+                                    _store(mrefs[ins[1]], stack.pop())
+                                    ip += 1
                                 else:
-                                    stack[-1] = ValueRef(stack[-1])
+                                    stack.append(_load(mrefs[ins[1]]))
+                                    ip += 1
+                            elif op < 80:
+                                if op < 79:
+                                    if op < 78:
+                                        stack[-1] = rt.field(stack[-1], ins[1], ins[2])
+                                        ip += 1
+                                    else:
+                                        stack.append(mrefs[ins[1]])
+                                        ip += 1
+                                else:
+                                    x1 = ins[1]
+                                    a = store[x1]
+                                    b = ins[2]
+                                    t = ins[4]
+                                    ca = type(a)
+                                    if ca is type(b) and ca is t and (ca is float or (ca is int and INT_MIN <= (v := (a + b)) <= INT_MAX)):
+                                        x3 = ins[3]
+                                        store[x3] = a + b if ca is float else v
+                                    else:
+                                        _store(fvars[ins[3]], _add(a if a is not UNSET else _load(fvars[x1]), b))
                                     ip += 1
                             else:
-                                b = stack.pop()
-                                a = stack[-1]
-                                if type(a) is float and type(b) is float:
-                                    stack[-1] = a * b
-                                elif type(a) is int and type(b) is int and (INT_MIN <= (v := (a * b)) <= INT_MAX):
-                                    stack[-1] = v
-                                else:
-                                    stack[-1] = _mul(a, b)
+                                stack.append(fvars[ins[1]])
                                 ip += 1
-                        elif op < 98:
+                        elif op < 82:
                             v = stack.pop()
                             t = ins[2]
                             x1 = ins[1]
@@ -819,63 +780,26 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                             else:
                                 _store(fvars[x1], v)
                             ip += 1
-                        elif op < 101:
-                            if op < 99:
-                                _store(mrefs[ins[1]], stack.pop())
-                                ip += 1
-                            elif op < 100:
-                                stack[-1] = rt.field(stack[-1], ins[1], ins[2])
-                                ip += 1
-                            else:
-                                stack.append(mrefs[ins[1]])
-                                ip += 1
-                        elif op < 102:
-                            stack.append(_load(mrefs[ins[1]]))
-                            ip += 1
-                        elif op < 103:
-                            b = stack.pop()
-                            stack[-1] = rt.binary_op(ins[1], stack[-1], b)
-                            ip += 1
-                        else:
-                            b = stack.pop()
-                            stack[-1] = _ne(stack[-1], b)
-                            ip += 1
-                    elif op < 112:
-                        if op < 108:
-                            if op < 105:
-                                x1 = ins[1]
-                                x2 = ins[2]
-                                a = store[x1]
-                                b = store[x2]
-                                ca = type(a)
-                                cb = type(b)
-                                f = ins[3]
-                                if f[0](a, b) if (ca is int or ca is float) and (cb is int or cb is float) else f[1](a if a is not UNSET else _load(fvars[x1]), b if b is not UNSET else _load(fvars[x2])):
+                        elif op < 85:
+                            if op < 84:
+                                if op < 83:
+                                    b = stack.pop()
+                                    a = stack[-1]
+                                    if ins[1] == '/' and type(b) is type(a) and (b != 0):
+                                        if type(a) is float:
+                                            stack[-1] = a / b
+                                        elif type(a) is int and INT_MIN <= (v := (abs(a) // abs(b) if (a >= 0) == (b >= 0) else -(abs(a) // abs(b)))) <= INT_MAX:
+                                            stack[-1] = v
+                                        else:
+                                            stack[-1] = rt.binary_op(ins[1], a, b)
+                                    else:
+                                        stack[-1] = rt.binary_op(ins[1], a, b)
                                     ip += 1
                                 else:
-                                    ip = ins[4]
-                            elif op < 106:
-                                x1 = ins[1]
-                                a = store[x1]
-                                b = ins[2]
-                                t = ins[4]
-                                ca = type(a)
-                                if ca is type(b) and ca is t and (ca is float or (ca is int and INT_MIN <= (v := (a + b)) <= INT_MAX)):
-                                    x3 = ins[3]
-                                    store[x3] = a + b if ca is float else v
-                                else:
-                                    _store(fvars[ins[3]], _add(a if a is not UNSET else _load(fvars[x1]), b))
-                                ip += 1
-                            elif op < 107:
-                                b = stack.pop()
-                                stack[-1] = _eq(stack[-1], b)
-                                ip += 1
+                                    b = stack.pop()
+                                    stack[-1] = _ne(stack[-1], b)
+                                    ip += 1
                             else:
-                                b = stack.pop()
-                                stack[-1] = _ge(stack[-1], b)
-                                ip += 1
-                        elif op < 111:
-                            if op < 109:
                                 j = stack.pop()
                                 i = stack.pop()
                                 v = stack.pop()
@@ -890,22 +814,301 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                 else:
                                     _set_element(fvars[ins[1]], [i, j], v, ins[2])
                                 ip += 1
-                            elif op < 110:
+                        elif op < 87:
+                            if op < 86:
                                 b = stack.pop()
-                                stack[-1] = _gt(stack[-1], b)
+                                stack[-1] = _eq(stack[-1], b)
                                 ip += 1
                             else:
                                 b = stack.pop()
-                                stack[-1] = _le(stack[-1], b)
+                                stack[-1] = _ge(stack[-1], b)
                                 ip += 1
                         else:
-                            stack.append(fvars[ins[1]])
+                            argc = ins[2]
+                            if argc:
+                                args = stack[-argc:]
+                                del stack[-argc:]
+                            else:
+                                args = []
+                            flags = ins[3]
+                            target = code.callsites.get(ip)
+                            if dirty:
+                                frame.line = info.line
+                                task.at = info
+                                dirty = False
+                            rt.steps += unsaved
+                            unsaved = 0
+                            if target is not None:
+                                v = run_routine(target, args, frame, exec_routine, 'N' not in flags)
+                            else:
+                                v = self.call(code, ip, ins[1], args, frame, flags)
+                            left = task.quiet - rt.steps if task is not None else 0
+                            if flags == 'E':
+                                stack.append(v if v is not None else function_result(ins[1].name, v))
+                            ip += 1
+                    elif op < 114:
+                        if op < 92:
+                            if op < 89:
+                                x1 = ins[1]
+                                a = store[x1]
+                                b = ins[2]
+                                if type(a) is int and type(b) is int and (INT_MIN <= (v := (a + b)) <= INT_MAX):
+                                    stack.append(v)
+                                elif type(a) is float and type(b) is float:
+                                    stack.append(a + b)
+                                else:
+                                    stack.append(_add(a if a is not UNSET else _load(fvars[x1]), b))
+                                ip += 1
+                            elif op < 91:
+                                if op < 90:
+                                    b = stack.pop()
+                                    stack[-1] = _gt(stack[-1], b)
+                                    ip += 1
+                                else:
+                                    b = stack.pop()
+                                    stack[-1] = _le(stack[-1], b)
+                                    ip += 1
+                            else:
+                                b = ins[1]
+                                a = stack[-1]
+                                if type(a) is float and type(b) is float:
+                                    stack[-1] = a + b
+                                elif type(a) is int and type(b) is int and (INT_MIN <= (v := (a + b)) <= INT_MAX):
+                                    stack[-1] = v
+                                else:
+                                    stack[-1] = _add(a, b)
+                                ip += 1
+                        elif op < 113:
+                            if op < 94:
+                                if op < 93:
+                                    b = stack.pop()
+                                    stack[-1] = _lt(stack[-1], b)
+                                    ip += 1
+                                else:
+                                    ref = stack.pop()
+                                    _store(ref, stack.pop())
+                                    ip += 1
+                            elif op < 112:
+                                if op < 110:
+                                    if op < 102:
+                                        if op < 98:
+                                            if op < 96:
+                                                if op < 95:
+                                                    if dirty:
+                                                        frame.line = info.line
+                                                        task.at = info
+                                                        dirty = False
+                                                    rt.steps += unsaved
+                                                    unsaved = 0
+                                                    ip = cold[op](ins, code, frame, temps, stack, ip)
+                                                    left = task.quiet - rt.steps if task is not None else 0
+                                                else:
+                                                    if dirty:
+                                                        frame.line = info.line
+                                                        task.at = info
+                                                        dirty = False
+                                                    rt.steps += unsaved
+                                                    unsaved = 0
+                                                    ip = cold[op](ins, code, frame, temps, stack, ip)
+                                                    left = task.quiet - rt.steps if task is not None else 0
+                                            elif op < 97:
+                                                if dirty:
+                                                    frame.line = info.line
+                                                    task.at = info
+                                                    dirty = False
+                                                rt.steps += unsaved
+                                                unsaved = 0
+                                                ip = cold[op](ins, code, frame, temps, stack, ip)
+                                                left = task.quiet - rt.steps if task is not None else 0
+                                            else:
+                                                if dirty:
+                                                    frame.line = info.line
+                                                    task.at = info
+                                                    dirty = False
+                                                rt.steps += unsaved
+                                                unsaved = 0
+                                                ip = cold[op](ins, code, frame, temps, stack, ip)
+                                                left = task.quiet - rt.steps if task is not None else 0
+                                        elif op < 100:
+                                            if op < 99:
+                                                if dirty:
+                                                    frame.line = info.line
+                                                    task.at = info
+                                                    dirty = False
+                                                rt.steps += unsaved
+                                                unsaved = 0
+                                                ip = cold[op](ins, code, frame, temps, stack, ip)
+                                                left = task.quiet - rt.steps if task is not None else 0
+                                            else:
+                                                if dirty:
+                                                    frame.line = info.line
+                                                    task.at = info
+                                                    dirty = False
+                                                rt.steps += unsaved
+                                                unsaved = 0
+                                                ip = cold[op](ins, code, frame, temps, stack, ip)
+                                                left = task.quiet - rt.steps if task is not None else 0
+                                        elif op < 101:
+                                            if dirty:
+                                                frame.line = info.line
+                                                task.at = info
+                                                dirty = False
+                                            rt.steps += unsaved
+                                            unsaved = 0
+                                            ip = cold[op](ins, code, frame, temps, stack, ip)
+                                            left = task.quiet - rt.steps if task is not None else 0
+                                        else:
+                                            if dirty:
+                                                frame.line = info.line
+                                                task.at = info
+                                                dirty = False
+                                            rt.steps += unsaved
+                                            unsaved = 0
+                                            ip = cold[op](ins, code, frame, temps, stack, ip)
+                                            left = task.quiet - rt.steps if task is not None else 0
+                                    elif op < 106:
+                                        if op < 104:
+                                            if op < 103:
+                                                if dirty:
+                                                    frame.line = info.line
+                                                    task.at = info
+                                                    dirty = False
+                                                rt.steps += unsaved
+                                                unsaved = 0
+                                                ip = cold[op](ins, code, frame, temps, stack, ip)
+                                                left = task.quiet - rt.steps if task is not None else 0
+                                            else:
+                                                if dirty:
+                                                    frame.line = info.line
+                                                    task.at = info
+                                                    dirty = False
+                                                rt.steps += unsaved
+                                                unsaved = 0
+                                                ip = cold[op](ins, code, frame, temps, stack, ip)
+                                                left = task.quiet - rt.steps if task is not None else 0
+                                        elif op < 105:
+                                            if dirty:
+                                                frame.line = info.line
+                                                task.at = info
+                                                dirty = False
+                                            rt.steps += unsaved
+                                            unsaved = 0
+                                            ip = cold[op](ins, code, frame, temps, stack, ip)
+                                            left = task.quiet - rt.steps if task is not None else 0
+                                        else:
+                                            if dirty:
+                                                frame.line = info.line
+                                                task.at = info
+                                                dirty = False
+                                            rt.steps += unsaved
+                                            unsaved = 0
+                                            ip = cold[op](ins, code, frame, temps, stack, ip)
+                                            left = task.quiet - rt.steps if task is not None else 0
+                                    elif op < 108:
+                                        if op < 107:
+                                            if dirty:
+                                                frame.line = info.line
+                                                task.at = info
+                                                dirty = False
+                                            rt.steps += unsaved
+                                            unsaved = 0
+                                            ip = cold[op](ins, code, frame, temps, stack, ip)
+                                            left = task.quiet - rt.steps if task is not None else 0
+                                        else:
+                                            if dirty:
+                                                frame.line = info.line
+                                                task.at = info
+                                                dirty = False
+                                            rt.steps += unsaved
+                                            unsaved = 0
+                                            ip = cold[op](ins, code, frame, temps, stack, ip)
+                                            left = task.quiet - rt.steps if task is not None else 0
+                                    elif op < 109:
+                                        if dirty:
+                                            frame.line = info.line
+                                            task.at = info
+                                            dirty = False
+                                        rt.steps += unsaved
+                                        unsaved = 0
+                                        ip = cold[op](ins, code, frame, temps, stack, ip)
+                                        left = task.quiet - rt.steps if task is not None else 0
+                                    else:
+                                        if dirty:
+                                            frame.line = info.line
+                                            task.at = info
+                                            dirty = False
+                                        rt.steps += unsaved
+                                        unsaved = 0
+                                        ip = cold[op](ins, code, frame, temps, stack, ip)
+                                        left = task.quiet - rt.steps if task is not None else 0
+                                elif op < 111:
+                                    g = ins[1]
+                                    ref = grefs[g]
+                                    if ref is None:
+                                        ref = rt.storage_ref(code.gstorage[g], frame)
+                                        grefs[g] = ref
+                                    if op == 110:
+                                        stack.append(_load(ref))
+                                    elif op == 111:
+                                        stack.append(ref)
+                                    else:
+                                        _store(ref, stack.pop())
+                                    ip += 1
+                                else:
+                                    g = ins[1]
+                                    ref = grefs[g]
+                                    if ref is None:
+                                        ref = rt.storage_ref(code.gstorage[g], frame)
+                                        grefs[g] = ref
+                                    if op == 110:
+                                        stack.append(_load(ref))
+                                    elif op == 111:
+                                        stack.append(ref)
+                                    else:
+                                        _store(ref, stack.pop())
+                                    ip += 1
+                            else:
+                                n = ins[1]
+                                idx = [None if x is None else _array_index(x) for x in stack[-n:]]
+                                del stack[-n:]
+                                stack[-1] = rt.index(stack[-1], idx, ins[2])
+                                ip += 1
+                        else:
+                            x1 = ins[1]
+                            x2 = ins[2]
+                            a = store[x1]
+                            i = store[x2]
+                            d = a.data
+                            if not (type(i) is int and 0 < i <= len(d) and ((v := d[(x3 := i) - 1]) is not UNSET)):
+                                v = _element1(fvars[x1], _load(fvars[x2]), ins[3])
+                            x1 = ins[4]
+                            a = store[x1]
+                            b = ins[5]
+                            if type(a) is int and type(b) is int and (INT_MIN <= (i := (a + b)) <= INT_MAX):
+                                pass
+                            elif type(a) is float and type(b) is float:
+                                i = a + b
+                            else:
+                                i = _add(a if a is not UNSET else _load(fvars[x1]), b)
+                            x1 = ins[6]
+                            a = store[x1]
+                            t = ins[8]
+                            d = a.data
+                            if type(i) is int and 0 < i <= len(d) and (type(v) is t) and (t is not int or INT_MIN <= v <= INT_MAX):
+                                x3 = i
+                                d[x3 - 1] = v
+                            else:
+                                _set_element1(fvars[x1], i, v, ins[7])
                             ip += 1
                     else:
                         if left > 0 and (not ins[1].cond_stops):
                             left -= 1
                             unsaved += 1
                         else:
+                            if dirty:
+                                frame.line = info.line
+                                task.at = info
+                                dirty = False
                             rt.steps += unsaved
                             unsaved = 0
                             tick(ins[1])
@@ -913,6 +1116,10 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                             left = n - rt.steps
                         ip = ins[2]
             except KrlRuntimeError as e:
+                if dirty:
+                    frame.line = info.line
+                    task.at = info
+                    dirty = False
                 reg = code.iregions[ip]
                 if reg is None:
                     raise
@@ -926,5 +1133,11 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                 left = task.quiet - rt.steps if task is not None else 0
                 del stack[8:]
                 ip = reg.end
+    except BaseException:
+        if dirty:
+            frame.line = info.line
+            task.at = info
+            dirty = False
+        raise
     finally:
         rt.steps += unsaved

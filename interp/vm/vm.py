@@ -487,6 +487,10 @@ class VM:
         left = task.quiet - rt.steps if task is not None else 0
         unsaved = 0
         proceed = False
+        # ``dirty``: a quiet STMT_G ran and its line (frame.line) and StmtInfo (task.at) are not
+        # written yet. The loop writes them (the lines marked "flush") before anything that may
+        # read them: a statement or loop hook, a call, a cold opcode, an error, leaving the loop.
+        dirty = False
         try:
             while True:
                 try:
@@ -497,13 +501,14 @@ class VM:
                         # tree interp/vm/gen_loop.py makes of this chain
                         if op == OP.STMT_G:
                             info = ins[1]
-                            frame.line = ins[2]                 # info.line, info.stops: link()
                             if left > 0 and not ins[3]:         # a quiet step (Runtime.quiet_limit)
                                 left -= 1
                                 unsaved += 1
-                                task.at = info
+                                dirty = True                    # frame.line, task.at: flushed later
                                 proceed = False
                             else:
+                                frame.line = ins[2]             # info.line, info.stops: link()
+                                dirty = False
                                 rt.steps += unsaved
                                 unsaved = 0
                                 before(info)
@@ -532,6 +537,10 @@ class VM:
                                 left -= 1
                                 unsaved += 1
                             else:
+                                if dirty:                   # the quiet statement's frame.line and task.at (flush)
+                                    frame.line = info.line
+                                    task.at = info
+                                    dirty = False
                                 rt.steps += unsaved
                                 unsaved = 0
                                 tick(ins[1])
@@ -555,6 +564,10 @@ class VM:
                                     left -= 1
                                     unsaved += 1
                                 else:
+                                    if dirty:                   # the quiet statement's frame.line and task.at (flush)
+                                        frame.line = info.line
+                                        task.at = info
+                                        dirty = False
                                     rt.steps += unsaved
                                     unsaved = 0
                                     tick(ins[3])
@@ -649,6 +662,54 @@ class VM:
                                 d[x3 - 1] = v
                             else:
                                 _set_element1(fvars[x1], _load(fvars[x2]), v, ins[3])
+                            ip += 1
+                        elif op == OP.IF_NOT_EV:
+                            # LOAD_ELEM1_V, LOAD_FAST, IF_NOT_<o>: their handlers in a row
+                            x1 = ins[1]
+                            x2 = ins[2]
+                            a = store[x1]
+                            i = store[x2]
+                            d = a.data
+                            if not (i.__class__ is int and 0 < i <= len(d) and (v := d[(x3 := i) - 1]) is not UNSET):
+                                v = _element1(fvars[x1], _load(fvars[x2]), ins[3])
+                            x1 = ins[4]
+                            b = store[x1]
+                            if b is UNSET:
+                                b = _load(fvars[x1])
+                            ca = v.__class__
+                            cb = b.__class__
+                            f = ins[5]
+                            if (f[0](v, b) if (ca is int or ca is float) and (cb is int or cb is float) else f[1](v, b)):
+                                ip += 1
+                            else:
+                                ip = ins[6]
+                        elif op == OP.MOVE_ELEM1:
+                            # LOAD_ELEM1_V, FAST_ADD_CONST, STORE_ELEM1: their handlers in a row
+                            x1 = ins[1]
+                            x2 = ins[2]
+                            a = store[x1]
+                            i = store[x2]
+                            d = a.data
+                            if not (i.__class__ is int and 0 < i <= len(d) and (v := d[(x3 := i) - 1]) is not UNSET):
+                                v = _element1(fvars[x1], _load(fvars[x2]), ins[3])
+                            x1 = ins[4]
+                            a = store[x1]
+                            b = ins[5]
+                            if a.__class__ is int and b.__class__ is int and INT_MIN <= (i := a + b) <= INT_MAX:
+                                pass
+                            elif a.__class__ is float and b.__class__ is float:
+                                i = a + b
+                            else:
+                                i = _add(a if a is not UNSET else _load(fvars[x1]), b)
+                            x1 = ins[6]
+                            a = store[x1]
+                            t = ins[8]
+                            d = a.data
+                            if i.__class__ is int and 0 < i <= len(d) and v.__class__ is t and (t is not int or INT_MIN <= v <= INT_MAX):
+                                x3 = i
+                                d[x3 - 1] = v
+                            else:
+                                _set_element1(fvars[x1], i, v, ins[7])
                             ip += 1
                         elif op == OP.FAST_ADD_CONST:
                             x1 = ins[1]
@@ -766,6 +827,7 @@ class VM:
                             ip += 1
                         elif op == OP.STMT:
                             info = ins[1]
+                            dirty = False               # this statement's own line and info follow
                             if not thunk:
                                 frame.line = ins[2]
                             if left > 0 and not ins[3]:
@@ -788,6 +850,10 @@ class VM:
                                 left -= 1
                                 unsaved += 1
                             else:
+                                if dirty:                   # the quiet statement's frame.line and task.at (flush)
+                                    frame.line = info.line
+                                    task.at = info
+                                    dirty = False
                                 rt.steps += unsaved
                                 unsaved = 0
                                 tick(ins[1])
@@ -833,6 +899,10 @@ class VM:
                                 args = []
                             flags = ins[3]
                             target = code.callsites.get(ip)
+                            if dirty:                   # the quiet statement's frame.line and task.at (flush)
+                                frame.line = info.line
+                                task.at = info
+                                dirty = False
                             rt.steps += unsaved
                             unsaved = 0
                             if target is not None:       # VM.invoke, without its Python frame
@@ -881,10 +951,22 @@ class VM:
                             ip += 1
                         elif op == OP.RETURN_VAL:
                             v = pop()
+                            if dirty:                   # the quiet statement's frame.line and task.at (flush)
+                                frame.line = info.line
+                                task.at = info
+                                dirty = False
                             return v if code.is_function else None
                         elif op == OP.END:
                             if code.is_function:
+                                if dirty:                   # the quiet statement's frame.line and task.at (flush)
+                                    frame.line = info.line
+                                    task.at = info
+                                    dirty = False
                                 raise ended_without_return(code.routine, frame.line)
+                            if dirty:                   # the quiet statement's frame.line and task.at (flush)
+                                frame.line = info.line
+                                task.at = info
+                                dirty = False
                             return None
                         elif op == OP.IF_NOT_LT:
                             b = pop()
@@ -961,7 +1043,15 @@ class VM:
                                 ip = ins[1]
                         elif op == OP.RETURN:
                             if code.is_function:
+                                if dirty:                   # the quiet statement's frame.line and task.at (flush)
+                                    frame.line = info.line
+                                    task.at = info
+                                    dirty = False
                                 raise return_without_value(code.routine, frame.line)
+                            if dirty:                   # the quiet statement's frame.line and task.at (flush)
+                                frame.line = info.line
+                                task.at = info
+                                dirty = False
                             return None
                         elif op == OP.LOAD_ELEM1:
                             a = store[ins[1]]
@@ -986,6 +1076,10 @@ class VM:
                                     left -= 1
                                     unsaved += 1
                                 else:
+                                    if dirty:                   # the quiet statement's frame.line and task.at (flush)
+                                        frame.line = info.line
+                                        task.at = info
+                                        dirty = False
                                     rt.steps += unsaved
                                     unsaved = 0
                                     tick(ins[2])
@@ -1067,7 +1161,20 @@ class VM:
                             ip += 1
                         elif op == OP.BINOP:
                             b = pop()
-                            stack[-1] = rt.binary_op(ins[1], stack[-1], b)
+                            a = stack[-1]
+                            # "/" inline (krl.semantics.values.binary_op): INT / INT truncates
+                            # toward zero, REAL / REAL divides; zero divisors and every other
+                            # case take the runtime's call (its error, its INT range check)
+                            if ins[1] == "/" and b.__class__ is a.__class__ and b != 0:
+                                if a.__class__ is float:
+                                    stack[-1] = a / b
+                                elif a.__class__ is int and INT_MIN <= (v := (abs(a) // abs(b) if (a >= 0) == (b >= 0)
+                                                                        else -(abs(a) // abs(b)))) <= INT_MAX:
+                                    stack[-1] = v
+                                else:
+                                    stack[-1] = rt.binary_op(ins[1], a, b)
+                            else:
+                                stack[-1] = rt.binary_op(ins[1], a, b)
                             ip += 1
                         elif op == OP.REF_MOD:
                             push(mrefs[ins[1]])
@@ -1137,6 +1244,10 @@ class VM:
                               op == OP.SPLINE):
                             # the cold opcodes (statements of motion, interrupts, I/O, ...): one
                             # method each (VM._cold_NAME), so the loop stays the hot path
+                            if dirty:                   # the quiet statement's frame.line and task.at (flush)
+                                frame.line = info.line
+                                task.at = info
+                                dirty = False
                             rt.steps += unsaved
                             unsaved = 0
                             ip = cold[op](ins, code, frame, temps, stack, ip)
@@ -1144,6 +1255,10 @@ class VM:
                         else:
                             raise RuntimeError(f"bad opcode {op} at {ip} in {code.name}")
                 except KrlRuntimeError as e:
+                    if dirty:                   # the quiet statement's frame.line and task.at (flush)
+                        frame.line = info.line
+                        task.at = info
+                        dirty = False
                     reg = code.iregions[ip]
                     if reg is None:
                         raise
@@ -1157,6 +1272,12 @@ class VM:
                     left = task.quiet - rt.steps if task is not None else 0
                     del stack[8:]         # STACK_BASE
                     ip = reg.end
+        except BaseException:
+            if dirty:                   # the quiet statement's frame.line and task.at (flush)
+                frame.line = info.line
+                task.at = info
+                dirty = False
+            raise
         finally:
             rt.steps += unsaved
 

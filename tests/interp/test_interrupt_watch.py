@@ -1,6 +1,7 @@
 """When interrupt conditions are evaluated again (interp/runtime/watch.py, issue 39): the
 class each condition gets from the names it reads, the evaluations it saves, and the oracle —
-the same traces as evaluating every condition at every poll (stamp_key patched to None)."""
+the same traces as evaluating every condition at every poll (stamp_key patched to None,
+contexts.WATCHED False)."""
 
 from __future__ import annotations
 
@@ -94,6 +95,7 @@ def test_each_condition_gets_its_class(tmp_path):
 def test_the_trace_is_that_of_evaluating_at_every_poll(tmp_path, monkeypatch, interp):
     watched = _run(tmp_path, interp)
     monkeypatch.setattr(contexts, "stamp_key", lambda *a, **k: None)
+    monkeypatch.setattr(contexts, "WATCHED", False)
     every = _run(tmp_path, interp)
     assert watched.result.reason == every.result.reason == "completed"
     assert watched.events == every.events
@@ -148,3 +150,23 @@ def test_a_probed_condition_follows_its_values_and_others_every_poll():
     for _ in range(30):
         t.poll()
     assert len(calls) == 31
+
+
+def test_a_poll_says_whether_an_interrupt_is_ready():
+    """poll returns True exactly when an armed interrupt is pending and enabled (the runtime
+    looks for one to run only then), also on a poll that keeps a condition's value."""
+    state = {"v": False}
+    t = InterruptTable()
+    t.declare(Irq(7, lambda: state["v"], lambda: None, "H", None, watch="I"))
+    t.control("ON", 7, io_version=1)
+    assert t.poll(io_version=1) is False
+    state["v"] = True
+    assert t.poll(io_version=1) is False          # the image did not change: value kept
+    assert t.poll(io_version=2) is True           # the rising edge: pending
+    assert t.poll(io_version=2) is True           # still pending, key unchanged
+    t.control("DISABLE", 7)
+    assert t.poll(io_version=2) is False          # pending but disabled
+    t.control("ENABLE", 7)
+    assert t.poll(io_version=2) is True
+    t.irqs[7].pending = False
+    assert t.poll(io_version=3) is False          # TRUE stays TRUE: no new edge

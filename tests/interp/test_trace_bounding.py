@@ -206,12 +206,18 @@ def test_the_writer_alone_bounds_by_the_events():
 
 
 def test_the_state_probes_keep_to_their_budget():
-    """A probe that images 100 000 values (a large backup's data lists) may run once per
-    100 000 / PROBE_VALUES_PER_EVENT (16) = 6250 events: over 200 events of a 2-event pass the
-    first probe (the capture at the end of pass 9) is the only one, so the spin is never
-    confirmed and every event is written; a probe of 10 values confirms it at the end of pass
-    10 (capture at 9, comparison at 10), as before the budget: 20 events written, 180 counted."""
-    for values, probes_expected, written_expected in ((100_000, 1, 200), (10, None, 20)):
+    """A probe that images 2 000 000 values (more than the start credit of 2**20) may run again
+    only once (2 000 000 - 2**20) / PROBE_VALUES_PER_EVENT (16) = 59 464 events are accounted:
+    over 200 events of a 2-event pass the first probe (the capture at the end of pass 9) is the
+    only one, so the spin is never confirmed and every event is written; a probe of 10 values
+    confirms it at the end of pass 10 (capture at 9, comparison at 10), as without a budget:
+    20 events written, 180 counted, and 10 probes: each of the two trackers (every event; the
+    events other than poses, here the same) captures at 9, compares at 10 and again after
+    passes 20, 40 and 80."""
+    from robot.trace import PROBE_CREDIT_VALUES, PROBE_VALUES_PER_EVENT
+
+    assert (PROBE_CREDIT_VALUES, PROBE_VALUES_PER_EVENT) == (1 << 20, 16)
+    for values, probes_expected, written_expected in ((2_000_000, 1, 200), (10, 10, 20)):
         tw = TraceWriter(keep=True, repeats=10)
         calls = []
 
@@ -227,9 +233,7 @@ def test_the_state_probes_keep_to_their_budget():
         ev = tw.events
         assert sum(1 for e in ev if e["kind"] != "repeat") == written_expected
         assert sum(e["count"] for e in ev if e["kind"] == "repeat") == 200 - written_expected
-        if probes_expected is not None:
-            assert len(calls) == probes_expected
-        assert tw._probe_spent <= 16 * 200 + values
+        assert len(calls) == probes_expected
 
 
 BIG = """
@@ -248,8 +252,8 @@ END
 
 def test_a_large_state_costs_probes_in_proportion_to_the_events(tmp_path):
     """The blink loop beside a local array of 40 000 values: each state probe images them all.
-    The probes image at most PROBE_VALUES_PER_EVENT (16) values per event plus one probe's
-    worth, the events written and counted are still the unbounded trace's, and both
+    The probes image at most the start credit (2**20) and PROBE_VALUES_PER_EVENT (16) values per
+    event, plus one probe's worth, the events written and counted are still the unbounded trace's, and both
     interpreters write the same events."""
     from robot.trace import PROBE_VALUES_PER_EVENT
 
@@ -267,7 +271,7 @@ def test_a_large_state_costs_probes_in_proportion_to_the_events(tmp_path):
         assert res.steps == full_res.steps
         written = sum(1 for e in events if e["kind"] != "repeat")
         assert written + sum(e["count"] for e in events if e["kind"] == "repeat") == len(full)
-        assert tw._probe_spent <= 16 * len(full) + 40_002 + 100
+        assert tw._probe_spent <= (1 << 20) + 16 * len(full) + 40_002 + 100
         assert any(e["kind"] == "repeat" for e in events)
         per.append(events)
     assert per[0] == per[1]

@@ -192,6 +192,17 @@ ERROR_CASES = {
     52: (["BOOL"], None, 0),                        # INT - BOOL (SUB)
     53: ([_overflow(INT_MAX + 1)], None, 2 ** 30),  # i = i * 2 in REPEAT: 2^30 then overflow
     54: (["cannot assign", "REAL"], None, 0),       # BOOL into REAL (STORE_FAST)
+    55: (["value invalid", "a[3]"], VI, 0),        # IF_NOT_EV, unset element
+    56: (["value invalid", "k"], VI, 0),           # IF_NOT_EV, unset right operand
+    57: (["array index", "a[4]", "1..3"], None, 0),   # IF_NOT_EV, past the end
+    58: (["cannot compare"], None, 0),              # IF_NOT_EV, INT == BOOL
+    59: (["value invalid", "a[3]"], VI, 0),        # MOVE_ELEM1, unset source element
+    60: ([_overflow(INT_MAX + 1)], None, 0),        # MOVE_ELEM1, target index overflows
+    61: (["array index", "a[4]", "1..3"], None, 0),   # MOVE_ELEM1, target past the end
+    62: (["cannot assign", "BOOL"], None, 0),       # MOVE_ELEM1, INT into a BOOL element
+    63: ([_overflow(INT_MAX + 1)], None, 0),        # INT_MIN / -1 (BINOP /)
+    64: (["value invalid", "i"], VI, 0),           # INT / unset INT
+    65: (["division by zero"], None, 0),            # INT / 0
 }
 
 
@@ -278,6 +289,18 @@ def test_for_loops(values):
     assert values.data["V_RFOR"] == [5.0, 2.5]
 
 
+def test_division(values):
+    # §4.1: INT / INT is an INT division that truncates toward zero; a REAL operand divides
+    assert values.data["V_DIV"] == [3, -3, -3, 3, 0]
+    assert values.data["V_RDIV"] == [3.5, 3.5, -1.75]
+
+
+def test_element_compare_and_move(values):
+    # a = [3, 1, 2]: 3 > 2, so a[2] = a[1]; then a[2] = 3 >= 4 is false; ra[3] = a[2] as REAL
+    assert values.data["V_SHIFT"] == [3, 3, 2]
+    assert values.data["V_RSHIFT"] == 3.0
+
+
 def test_comparisons_of_bool_char_enum(values):
     assert values.data["V_CMP"] == [
         False,   # TRUE == FALSE
@@ -317,7 +340,7 @@ def test_on_error_proceed_around_fast_statements(values):
 
 FAST_OPS = {"LOAD_FAST", "LOAD_FAST2", "FAST_ADD_CONST", "FAST_SUB_CONST", "STORE_FAST", "LOAD_ELEM1",
             "LOAD_ELEM2", "STORE_ELEM1", "STORE_ELEM2", "LOAD_ELEM1_V", "STORE_ELEM1_V", "LOAD_ELEM2_VV",
-            "FOR_NEXT_FAST", "ADDC_FAST", "SUBC_FAST", "IF_NOT_VV", "IF_NOT_VC"}
+            "FOR_NEXT_FAST", "ADDC_FAST", "SUBC_FAST", "IF_NOT_VV", "IF_NOT_VC", "IF_NOT_EV", "MOVE_ELEM1"}
 INLINE_OPS = {"ADD", "SUB", "MUL", "ADD_CONST", "SUB_CONST", "MUL_CONST", "IF_NOT_LT", "IF_NOT_LE",
               "IF_NOT_GT", "IF_NOT_GE", "IF_NOT_EQ", "IF_NOT_NE"}
 
