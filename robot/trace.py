@@ -506,9 +506,8 @@ class _Pass:
         self.recheck = 0                  # copy at whose end a confirmed spin's state is compared
         self.passes_ended = 0             # 1 when the event left out ended a pass
 
-    def step(self, key: str, probe: bool = True) -> "_Pass | None":
-        """Account event `key`; returns self when it is to be left out. `probe` False: no
-        state probe at this event (as if over budget, :meth:`_end_of`)."""
+    def step(self, key: str) -> "_Pass | None":
+        """Account event `key`; returns self when it is to be left out."""
         i = self.n
         self.n += 1
         hist = self.hist
@@ -520,7 +519,7 @@ class _Pass:
             out = self if self.confirmed else None
             end = self.match % p == 0
             if end:
-                self._end_of(copy, probe)
+                self._end_of(copy)
             self.passes_ended = 1 if end else 0
         else:
             self.unlock()
@@ -533,16 +532,15 @@ class _Pass:
             self.last = {k: v for k, v in self.last.items() if v > i - MAX_PASS_EVENTS}
         return out
 
-    def _end_of(self, copy: int, probe: bool = True) -> None:
-        """Copy `copy` of the pass ended: capture or compare the state (`probe` False: not
-        now, as over budget)."""
+    def _end_of(self, copy: int) -> None:
+        """Copy `copy` of the pass ended: capture or compare the state."""
         w = self.writer
         if w.state_probe is None:
             self.confirmed = copy >= self.repeats
             return
         if self.confirmed:
             if copy >= self.recheck:
-                state = w._probe() if probe else None
+                state = w._probe()
                 if state is None:
                     return                       # over budget: at a later end of pass
                 if state != self.ref[1]:
@@ -552,13 +550,13 @@ class _Pass:
                     self.recheck = 2 * copy
             return
         if copy == self.capture:
-            state = None if not probe or w._spin.every.n < w._probe_after else w._probe()
+            state = None if w._spin.every.n < w._probe_after else w._probe()
             if state is None:
                 self.capture += 1            # the state changed lately, or over budget: not yet
             else:
                 self.ref = (copy, state)
         elif self.ref is not None and copy > self.ref[0]:
-            state = w._probe() if probe else None
+            state = w._probe()
             if state is None:
                 return                       # over budget: compare at a later end of pass
             if state == self.ref[1]:

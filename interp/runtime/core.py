@@ -630,7 +630,7 @@ class Runtime:
                     store[k] = UNSET
                     fvars[k] = Slot(store, k, None, name)
                 else:
-                    frame.data += self.memory.take(size, f"parameter {name}")
+                    frame.data += self.memory.take(size, name, what="parameter")
                     store[k] = make_value(t)
                     fvars[k] = Slot(store, k, t, name)
                 continue
@@ -644,18 +644,12 @@ class Runtime:
                 if v.__class__ is Struct and v.type is t:
                     # a structure of the parameter's own type: its copy (the same components,
                     # already of their types: what make_value + assign_into give), its size
-                    # (DataMemory.take, inlined when it fits: the message is made only for its error)
-                    mem = self.memory
-                    if mem.used + size <= mem.limit:
-                        mem.used += size
-                        frame.data += size
-                    else:
-                        frame.data += mem.take(size, f"a copy of :IN parameter {name}")
+                    frame.data += self.memory.take(size, name, what="a copy of :IN parameter")
                     store[k] = copy_value(v)
                     fvars[k] = Slot(store, k, t, name)
                     continue
                 frame.data += self.memory.take(value_size(v) if isinstance(v, (Struct, Arr)) else size,
-                                               f"a copy of :IN parameter {name}")
+                                               name, what="a copy of :IN parameter")
                 v = store[k] = self._param_copy(v, t, name)
                 fvars[k] = Slot(store, k, self._slot_type(t, v), name)
             else:

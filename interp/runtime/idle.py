@@ -57,7 +57,7 @@ from __future__ import annotations
 
 import math
 
-from .values import UNSET, Arr, EnumValue, Struct
+from .values import LEAVES, UNSET, Arr, EnumValue, Struct
 
 #: cycles (12 ms) a run must be quiet before its state is compared (0.384 s)
 WINDOW_CYCLES = 32
@@ -67,8 +67,8 @@ MAX_WINDOW_CYCLES = 512
 MAX_PHASES = 64
 
 _SCALARS = (int, float, bool, str, type(None))
-#: classes of the immutable leaf values: a sequence of only these is its own image (freeze)
-_FLAT = frozenset((int, float, bool, str, type(None), EnumValue, type(UNSET)))
+#: classes of the immutable leaf values (values.LEAVES): a sequence of only these is its own image (freeze)
+_FLAT = LEAVES
 #: values imaged by :func:`freeze` and :func:`_store` so far (fields, elements, slots): the
 #: cost of a state image, counted the same way by both interpreters (:func:`probe_state`)
 _IMAGED = [0]

@@ -298,11 +298,15 @@ class DataMemory:
         self.limit = MAX_DATA_ELEMENTS if limit is None else limit
         self.used = 0
 
-    def take(self, n: int, name: str, file: str | None = None, line: int | None = None) -> int:
-        """Reserve ``n`` elements for ``name``; returns ``n``. Raises ResourceError "data
-        memory exhausted" (at ``file``:``line`` when given) when they do not fit."""
+    def take(self, n: int, name: str, file: str | None = None, line: int | None = None,
+             what: str = "") -> int:
+        """Reserve ``n`` elements for ``name`` (a `what` of it, e.g. "parameter": the message
+        is put together only for its error); returns ``n``. Raises ResourceError "data memory
+        exhausted" (at ``file``:``line`` when given) when they do not fit."""
         if self.used + n > self.limit:
             free = self.limit - self.used
+            if what:
+                name = f"{what} {name}"
             raise ResourceError(f"data memory exhausted: {name} needs {n} data elements, "
                                 f"{free} of {self.limit} are free", None, file, line)
         self.used += n

@@ -213,13 +213,13 @@ def _zeroed(v, t):
 
 
 #: classes of the immutable leaf values: a structure holding only these is copied by a plain
-#: copy of its components (:func:`copy_value`)
-_LEAVES = frozenset((int, float, bool, str, type(None), EnumValue, type(UNSET)))
+#: copy of its components (:func:`copy_value`) and imaged by one (interp/runtime/idle.py freeze)
+LEAVES = frozenset((int, float, bool, str, type(None), EnumValue, type(UNSET)))
 
 
 def copy_value(v):
     """A deep copy (for :IN parameters and whole-value reads)."""
-    if v.__class__ is Struct and _LEAVES.issuperset(map(type, v.f.values())):
+    if v.__class__ is Struct and LEAVES.issuperset(map(type, v.f.values())):
         return Struct(v.type, v.f.copy())    # only immutable leaves: one C-level copy
     if isinstance(v, Struct):        # (a scalar component is its own copy: no call for it)
         return Struct(v.type, {k: copy_value(x) if isinstance(x, (Struct, Arr)) else x for k, x in v.f.items()})
