@@ -65,16 +65,24 @@ class Irq:
     watch: str = ""               # when the condition is evaluated again (interp/runtime/watch.py)
     seen: object = None           # the watch key of the evaluation that gave `last`
     probes: tuple = ()            # readers of the probed system variables the condition reads
+    by_epoch: bool = False        # every probe changes only with the runtime's state epoch
+    probe_epoch: object = None    # the state epoch at which `probed` was read
+    probed: tuple = ()            # the probes' values at `probe_epoch`
 
 
 @dataclass
 class InterruptTable:
     irqs: dict = field(default_factory=dict)
     armed: int = 0                # number of interrupts switched on (fast test)
+    #: the state epoch of the last poll when it left every armed interrupt *settled* (class
+    #: CONSTANT, probes read by epoch, nothing pending): until the epoch changes no poll can
+    #: evaluate or fire anything (interp/runtime/core.py ``Runtime.quiet_limit``); else None
+    settled: object = None
 
     def declare(self, irq: Irq) -> None:
         if not 1 <= irq.number <= 128:
             raise KrlRuntimeError(f"interrupt priority {irq.number} outside 1..128")
+        self.settled = None
         old = self.irqs.get(irq.number)
         if old is not None and old.on:
             self.armed -= 1
@@ -91,6 +99,7 @@ class InterruptTable:
     def control(self, action: str, number: int | None, io_version: int = 0, now: float = 0.0) -> None:
         """INTERRUPT ON/OFF/ENABLE/DISABLE of `number` (None: all); ON takes the condition's
         value with the I/O image at `io_version` at simulated time `now` (s) as reference."""
+        self.settled = None
         for irq in self._targets(number):
             if action == "ON":
                 if not irq.on:
@@ -112,15 +121,19 @@ class InterruptTable:
             else:
                 raise KrlRuntimeError(f"unknown INTERRUPT action {action}")
 
-    def poll(self, io_version: int = 0, now: float = 0.0) -> bool:
+    def poll(self, io_version: int = 0, now: float = 0.0, epoch: int | None = None) -> bool:
         """Evaluate the armed conditions; a rising edge makes the interrupt pending. A
         condition whose watch key (interp/runtime/watch.py :func:`~.watch.stamp_key`, computed
         here inline: this runs before every statement) at `io_version` and simulated time
         `now` (s) is that of its last evaluation keeps its value: nothing it reads changed.
+        `epoch`: the runtime's state epoch (interp/runtime/core.py ``Runtime.state_epoch``);
+        the probes of an interrupt whose probes all change only with it (``by_epoch``) are
+        read once per epoch (None: at every poll). Sets :attr:`settled`.
         Returns True when an interrupt is pending, on and enabled afterwards (then
         :meth:`next_ready` may find one to run), False when none is."""
         ready = False
         watched = WATCHED
+        settled = watched and epoch is not None
         for irq in tuple(self.irqs.values()):
             if not irq.on:
                 continue
@@ -129,17 +142,29 @@ class InterruptTable:
                 key = 0
             elif w == IO:
                 key = io_version
+                settled = False
             elif w == CLOCK:
                 key = (io_version, now)
+                settled = False
             else:
                 key = None
+                settled = False
             if key is not None:
                 probes = irq.probes
                 if probes:
-                    key = (key, (probes[0](),) if len(probes) == 1 else tuple([p() for p in probes]))
+                    if epoch is not None and irq.by_epoch:
+                        if irq.probe_epoch != epoch:
+                            irq.probed = (probes[0](),) if len(probes) == 1 else tuple([p() for p in probes])
+                            irq.probe_epoch = epoch
+                        key = (key, irq.probed)
+                    else:
+                        settled = False
+                        key = (key, (probes[0](),) if len(probes) == 1 else tuple([p() for p in probes]))
                 if key == irq.seen:
-                    if irq.pending and irq.enabled:
-                        ready = True
+                    if irq.pending:
+                        settled = False
+                        if irq.enabled:
+                            ready = True
                     continue
             irq.seen = None
             cur = bool(irq.cond())
@@ -147,8 +172,11 @@ class InterruptTable:
                 irq.pending = True
             irq.last = cur
             irq.seen = key
-            if irq.pending and irq.enabled:
-                ready = True
+            if irq.pending:
+                settled = False
+                if irq.enabled:
+                    ready = True
+        self.settled = epoch if settled else None
         return ready
 
     def next_ready(self, running_prio: int) -> Irq | None:
@@ -163,6 +191,7 @@ class InterruptTable:
         """The routine ``frame`` returned: drop its non-GLOBAL declarations."""
         for n, irq in list(self.irqs.items()):
             if irq.frame is frame and not irq.is_global:
+                self.settled = None
                 if irq.on:
                     self.armed -= 1
                 del self.irqs[n]

@@ -30,7 +30,7 @@ from .motion import frame_of, params_from, request, segment, target_of
 from .program import Program
 from .runmode import STEP_MODES, BackwardRefused, MotionHistory, mode_name
 from .scheduler import Scheduler, Task
-from .sysvars import SysVars, struct_of
+from .sysvars import EPOCH_PROBED, SysVars, struct_of
 from .values import UNSET, Arr, EnumValue, Struct, copy_value, make_value, value_size
 
 
@@ -100,11 +100,11 @@ class Runtime:
     # CPython 3.11 keeps an instance's attributes in fast inline storage only up to 30 names
     # (past that every attribute read and method call on the runtime is a dictionary lookup:
     # the tree interpreter ran 5-10 % slower with 32). A new attribute is added here too.
-    __slots__ = ("controller", "trace", "current_task", "random", "mode_op", "msg_handle", "messages",
+    __slots__ = ("controller", "trace", "current_task", "random", "_mode_op", "msg_handle", "messages",
                  "noted", "steps", "max_steps", "robot_budget", "sysvars", "memory", "program", "kss",
                  "modules", "scheduler", "robot", "result", "_plans", "_return_types", "_cyclic",
                  "run_mode", "history", "stmt_hook", "step_hook", "error_hook", "cycle_hook",
-                 "autocell", "halt_continues", "start", "halts")
+                 "autocell", "halt_continues", "start", "halts", "state_epoch")
 
     def __init__(self, main_path, *, workspace=None, controller=None, trace=None, stimuli=None,
                  max_sim_time: float | None = None, max_steps: int | None = None,
@@ -118,7 +118,11 @@ class Runtime:
         self.trace = trace if trace is not None else controller.trace
         self.current_task: Task | None = None
         self.random = random.Random(0)
-        self.mode_op = getattr(controller, "mode_op", "AUT")  # $MODE_OP (robot/limits.py)
+        #: the *state epoch*: bumped by everything that may change a probed system variable
+        #: (sysvars.py ``EPOCH_PROBED``: a task resumed after an IPO cycle, RESUME, BRAKE, the
+        #: operating mode, a task's end); an interrupt's poll reads those once per epoch
+        self.state_epoch = 0
+        self._mode_op = getattr(controller, "mode_op", "AUT")  # $MODE_OP (robot/limits.py)
         self.msg_handle = 0
         self.messages = MessageWindow()  # the message window (interp/runtime/messages.py)
         self.noted: set[str] = set()    # simulator notes given once per run (builtins)
@@ -184,6 +188,7 @@ class Runtime:
             task.outcome = ("error", KrlRuntimeError("stack overflow", None, task.file, task.line))
         finally:
             task.done = True
+            self.bump_epoch()       # $PRO_STATE0/1, $PRO_ACT
         reason = task.outcome[0]
         if task.kind == "robot" or reason in ("max_steps", "max_sim_time"):
             if self.scheduler.stop is None and (task.kind == "robot" and reason != "completed" or task.kind != "robot"):
@@ -247,6 +252,23 @@ class Runtime:
         self.trace = None       # the suspended tasks unwind now: nothing more is traced
         self.scheduler.close()
         return self.result
+
+    @property
+    def mode_op(self) -> str:
+        """``$MODE_OP``'s name (T1, T2, AUT, EX)."""
+        return self._mode_op
+
+    @mode_op.setter
+    def mode_op(self, value: str) -> None:
+        self._mode_op = value
+        self.bump_epoch()
+
+    def bump_epoch(self) -> None:
+        """A probed system variable may have changed (:attr:`state_epoch`): the running task's
+        next step takes the full hook, whose interrupt poll reads the probes again."""
+        self.state_epoch += 1
+        if self.current_task is not None:
+            self._break(self.current_task)
 
     def interpreter_active(self, robot: bool) -> bool:
         if robot:
@@ -341,8 +363,14 @@ class Runtime:
         reached, no armed interrupt, no pending CONTINUE or ON_ERROR_PROCEED. 0 when a
         step needs the full hook. An interpreter that takes the fast path stores the
         limit in ``task.quiet`` after each full hook; :meth:`_break` (a task switch,
-        CONTINUE, ON_ERROR_PROCEED, an interrupt declared or switched) resets it."""
-        if self.trace is not None or task.irqs.armed or task.continue_line is not None \
+        CONTINUE, ON_ERROR_PROCEED, an interrupt declared or switched, a new state epoch)
+        resets it. Armed interrupts allow quiet steps while their last poll left them settled
+        in this state epoch (contexts.py ``InterruptTable.settled``): conditions over
+        constants and probed state only, nothing pending, so a poll before these steps would
+        evaluate and fire nothing."""
+        irqs = task.irqs
+        if self.trace is not None or (irqs.armed and irqs.settled != self.state_epoch) \
+                or task.continue_line is not None \
                 or self.stmt_hook is not None or self.run_mode == "ISTEP" \
                 or any(c.error_proceed for c in task.contexts) \
                 or (self.autocell is not None and self.autocell.recording is not None):
@@ -1097,7 +1125,7 @@ class Runtime:
         # a computed variable's getter is its peek, one call less at each poll
         probes = tuple(_reader(self.sysvars.lookup(k)) for k in names)
         task.irqs.declare(Irq(n, cond_fn, handler_fn, name, frame, is_global, line, watch=cls,
-                              probes=probes))
+                              probes=probes, by_epoch=all(k in EPOCH_PROBED for k in names)))
         frame.interrupts.append(n)
         self._break(task)
 
@@ -1111,12 +1139,15 @@ class Runtime:
             self.check_interrupts(task)
 
     def check_interrupts(self, task: Task) -> None:
-        if task.in_poll:
+        """Poll ``task``'s armed interrupts and run those ready, by priority. Nothing to do
+        while the last poll left them settled in this state epoch (contexts.py
+        ``InterruptTable.settled``): a poll would evaluate and fire nothing."""
+        if task.in_poll or task.irqs.settled == self.state_epoch:
             return
         task.in_poll = True
         ctl = self.controller
         try:
-            ready = task.irqs.poll(ctl.io.version, ctl.time)
+            ready = task.irqs.poll(ctl.io.version, ctl.time, self.state_epoch)
         finally:
             task.in_poll = False
         if not ready:
@@ -1155,7 +1186,7 @@ class Runtime:
             # (ROS-Industrial's EKI state timer: `$TIMER[1] = -10` in its own handler)
             task.in_poll = True
             try:
-                task.irqs.poll(ctl.io.version, ctl.time)
+                task.irqs.poll(ctl.io.version, ctl.time, self.state_epoch)
             finally:
                 task.in_poll = False
         if ok and task.kind == "robot":
@@ -1180,6 +1211,7 @@ class Runtime:
                                   "interrupt routines (reference 5.17)")
         ctl = self.controller
         ctl.brake(fast)
+        self.bump_epoch()           # $PRO_MOVE, $VEL_ACT
         while ctl.is_braking():
             self.yield_cycle(task)
         self.yield_cycle(task)
@@ -1196,4 +1228,5 @@ class Runtime:
             raise KrlRuntimeError("RESUME outside an interrupt routine")
         if task.kind == "robot":
             self.controller.cancel_pending()
+            self.bump_epoch()       # $PRO_MOVE
         raise ResumeSignal(ctx.frame)

@@ -99,6 +99,7 @@ class Scheduler:
         self.rt.current_task = task
         task.slice_end = self.rt.steps + task.budget
         task.quiet = 0
+        self.rt.state_epoch += 1        # the IPO cycle moved the robot, another task ran
         log = self.rt.controller.io.log
         before = len(log)
         try:

@@ -170,3 +170,88 @@ def test_a_poll_says_whether_an_interrupt_is_ready():
     assert t.poll(io_version=2) is True
     t.irqs[7].pending = False
     assert t.poll(io_version=3) is False          # TRUE stays TRUE: no new edge
+
+
+#: the backups' SPS.SUB pattern (KRC4 System/sps.sub): interrupts over the probed run state,
+#: armed for the whole run, beside a loop of cheap statements; each handler notes the loop
+#: count at which it ran, so a handler one statement late shows
+SPS = """
+DEF plc()
+  INTERRUPT DECL 91 WHEN $PRO_STATE1==#P_FREE DO OnFree()
+  INTERRUPT DECL 92 WHEN $PRO_MOVE==TRUE DO OnMove()
+  INTERRUPT DECL 93 WHEN $STOPMESS==TRUE DO OnFree()
+  INTERRUPT ON 91
+  INTERRUPT ON 92
+  INTERRUPT ON 93
+  LOOP
+    K = K + 1
+    IF K > 100000 THEN
+      K = 0
+    ENDIF
+  ENDLOOP
+END
+DEF OnFree()
+  NF = NF + 1
+END
+DEF OnMove()
+  NM = NM + 1
+  AT[NM] = K
+END
+"""
+SPS_DAT = """
+DEFDAT plc
+  DECL INT K = 0
+  DECL INT NF = 0
+  DECL INT NM = 0
+  DECL INT AT[20]
+ENDDAT
+"""
+MOVER = """
+DEF prog()
+  PTP {A1 10, A2 -90, A3 90, A4 0, A5 0, A6 0}
+  WAIT SEC 0.1
+  PTP {A1 -10, A2 -90, A3 90, A4 0, A5 0, A6 0}
+  WAIT SEC 0.2
+  PTP {A1 0, A2 -90, A3 90, A4 0, A5 0, A6 0}
+  WAIT SEC 0.05
+END
+"""
+
+
+@pytest.mark.parametrize("interp", ["tree", "vm"])
+def test_settled_interrupts_poll_once_per_state_epoch(tmp_path, monkeypatch, interp):
+    """Interrupts over constants and the probed run state ($PRO_MOVE, $PRO_STATE1) keep the
+    VM's quiet steps and are polled once per state epoch (an IPO cycle, ...), not at each
+    statement; each handler still runs at the loop count of evaluating every condition at
+    every poll, untraced (quiet steps need no trace) and traced."""
+    polls = []
+    real = InterruptTable.poll
+
+    def counting(self, *a, **k):
+        polls.append(1)
+        return real(self, *a, **k)
+
+    monkeypatch.setattr(InterruptTable, "poll", counting)
+    files = {"plc.sub": SPS, "plc.dat": SPS_DAT}
+
+    def run(trace):
+        polls.clear()
+        r = run_krl(tmp_path, MOVER, files=files, submit=["plc.sub"], trace=trace, interp=interp)
+        assert r.result.reason == "completed", r.result.text
+        got = {k: r.var("plc", k) for k in ("K", "NF", "NM")}
+        got["AT"] = list(r.var("plc", "AT").data[:got["NM"]])
+        return got, r.rt.steps, len(polls), r.events
+
+    watched, steps, n_watched, _ = run(False)
+    traced, steps_t, _, events = run(True)
+    monkeypatch.setattr(contexts, "stamp_key", lambda *a, **k: None)
+    monkeypatch.setattr(contexts, "WATCHED", False)
+    every, steps_e, n_every, _ = run(False)
+    _, _, _, events_e = run(True)
+    # three motions, each a rising edge of $PRO_MOVE seen by the submit interpreter; the
+    # robot program's end, $PRO_STATE1 P_ACTIVE -> P_FREE, seen in its last cycle
+    assert watched["NM"] == 3 and watched["NF"] == 1
+    assert watched == traced == every and steps == steps_t == steps_e
+    assert events == events_e
+    assert n_every >= steps // 2                  # the submit interpreter polls at each step
+    assert n_watched * 20 < n_every               # settled: once per IPO cycle
