@@ -161,6 +161,7 @@ class Runtime:
         if kind == "robot":
             self.robot = task
         self.scheduler.add(task)
+        self.bump_epoch()           # $PRO_STATE0, $PRO_ACT
         return task
 
     def task_main(self, task: Task) -> None:
