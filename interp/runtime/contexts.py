@@ -20,6 +20,10 @@ interrupts (its greenlet), at a statement boundary or at an IPO cycle.
 * a poll evaluates a condition again only when something it reads may have changed (its
   *watch*, interp/runtime/watch.py: an I/O change, the clock, a probed state variable; a
   condition over variables at every poll): the edges are those of evaluating at every poll;
+* a poll that leaves every armed interrupt *settled* (constant and probed-state conditions,
+  nothing pending) in the runtime's state epoch (interp/runtime/core.py
+  ``Runtime.state_epoch``) is the last until the epoch changes or an interrupt is declared,
+  switched or removed: no poll could evaluate or fire anything before (``settled``);
 * a non-GLOBAL declaration is removed when the routine that declared it returns;
   ON/OFF/ENABLE/DISABLE of an undeclared number is error 1430.
 """

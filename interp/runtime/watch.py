@@ -17,8 +17,10 @@ class from the names it reads (the front end's accesses, krl/semantics/advance.p
   time advanced (a running timer counts with the clock).
 * *probed* names — computed scalar system variables of the run's state (sysvars.py
   ``PROBED_NAMES``: ``$PRO_STATE1``, ``$PRO_MOVE``, ``$MODE_OP``, ...) add to any class their
-  current values, read at each poll straight from the system variable (no evaluation of the
-  condition): the watch string is ``CLASS:NAME,NAME``.
+  current values, read straight from the system variable (no evaluation of the condition):
+  the watch string is ``CLASS:NAME,NAME``. Most of them change only with the runtime's state
+  epoch (sysvars.py ``EPOCH_PROBED``, interp/runtime/core.py ``Runtime.state_epoch``): a poll
+  reads those once per epoch; the others at each poll.
 * :data:`ALWAYS` — anything else (a variable, a stored or structured system variable such as
   ``$FLAG``, ``$CYCFLAG``, ``$POS_ACT``, a function call, a name the resolver did not place):
   evaluated at every poll, as before.
