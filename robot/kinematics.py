@@ -23,7 +23,9 @@ chain, never from the robot's name (:attr:`Kinematics.family`):
 Each analytic form is checked against the machine-data chain when it is chosen. A vectorised
 entry point, :meth:`Kinematics.inverse_many`, solves N targets at once with numpy. For the OPW
 family, :meth:`Kinematics.inverse` runs the compiled mirror of its Python code when it is built
-(robot/simcore.pyx, robot/build.py; the same axes bit for bit, about 20x faster).
+(robot/simcore.pyx, robot/build.py; the same axes bit for bit, about 20x faster), and so do
+:meth:`Kinematics.forward` (the same frames bit for bit, checked at set-up) and the 4-axis
+palletizer's solutions (the same rows).
 """
 
 from __future__ import annotations

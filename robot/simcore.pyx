@@ -4,6 +4,9 @@
 * :class:`OPW`: the OPW inverse kinematics of one pose (and along a chain of poses), the
   compiled form of robot/kinematics.py ``Kinematics._opw_core`` + ``_status_row`` + the
   selection of ``Kinematics._select`` for the six-axis arm with a spherical wrist;
+* :class:`Palletizer4`: the 4-axis palletizer's solutions (``Kinematics._palletizer_rows``: the
+  same rows; its flange test runs a forward kinematics of its own, see the class);
+* :class:`Forward`: ``Kinematics.forward`` (scipy's rotation matrices, numpy's own BLAS);
 * :class:`CartPath`: the poses of a CP segment's lines and arcs (robot/planner.py
   ``CartSegment.pose_u``) and their axes;
 * :class:`ArmCycle` and :func:`speed_ok`: the IPO cycle's MuJoCo playback with its TCP product,
