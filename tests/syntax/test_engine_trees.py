@@ -13,6 +13,7 @@ import subprocess
 import sys
 import time
 import gc
+import weakref
 
 import pytest
 from antlr4 import ParserRuleContext
@@ -73,7 +74,6 @@ def test_a_tree_rebuilt_without_parents_differs_only_there_and_is_freed_at_once(
     """parents=False (krl/workspace.py ``load_parsed``): the same nodes, tokens and labels, every
     parentCtx None, and no cycle: with the cyclic collector off, dropping the root frees a leaf
     context at once (reference counting)."""
-    import weakref  # noqa: PLC0415
     _java_or_skip()
     raw = _raw(text)
     with_parents = tree_from_raw(raw, prepare_text(text), default_bundle())
