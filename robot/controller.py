@@ -261,6 +261,9 @@ class Controller:
         # MuJoCo's import and compile (issue 37); None: built, or no MuJoCo
         self._arm_q: np.ndarray | None = q.copy() if mujoco else None
         self._k = 0
+        #: simulated time in s (IPO cycles · the IPO cycle): ``_k * dt``, kept with ``_k`` (the
+        #: interpreters read it before every statement)
+        self.time = self._k * self.dt
         self._pt = 0.0
         self._scale = 1.0
         self._scale_rate = 0.0
@@ -313,11 +316,6 @@ class Controller:
         return self._arm
 
     # ================================================================= clock
-    @property
-    def time(self) -> float:
-        """Simulated time in s (IPO cycles · 0.012)."""
-        return self._k * self.dt
-
     @property
     def cycle(self) -> int:
         """Number of IPO cycles run so far."""
@@ -471,6 +469,7 @@ class Controller:
         if not self.at_rest() or (nxt is not None and self._k + cycles >= nxt):
             raise ValueError("the controller cannot skip these cycles: something happens in them")
         self._k += cycles
+        self.time = self._k * self.dt
         self._pt += cycles * self.dt
         tm, st = self.io.timer_ms, self.io.timer_stop
         for i in range(1, len(tm)):
@@ -743,7 +742,7 @@ class Controller:
         """
         self._events = []
         self._k += 1
-        t = self._k * self.dt          # self.time
+        t = self.time = self._k * self.dt
         self.io.now = t
         if self.network is not None and self.network.polling:
             self.network.cycle(self)

@@ -76,6 +76,8 @@ class IOImage:
     # -- digital ---------------------------------------------------------------------------
     def get_in(self, n: int) -> bool:
         """``$IN[n]``."""
+        if type(n) is int and 0 < n <= N_DIGITAL:     # the common case, without the call
+            return bool(self._in[n])
         return bool(self._in[self._check(n, N_DIGITAL, "$IN")])
 
     def set_in(self, n: int, value: bool, source: str = "stimulus") -> None:
@@ -90,6 +92,8 @@ class IOImage:
 
     def get_out(self, n: int) -> bool:
         """``$OUT[n]``."""
+        if type(n) is int and 0 < n <= N_DIGITAL:     # the common case, without the call
+            return bool(self._out[n])
         return bool(self._out[self._check(n, N_DIGITAL, "$OUT")])
 
     def set_out(self, n: int, value: bool, source: str = "program") -> None:

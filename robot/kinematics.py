@@ -23,7 +23,9 @@ chain, never from the robot's name (:attr:`Kinematics.family`):
 Each analytic form is checked against the machine-data chain when it is chosen. A vectorised
 entry point, :meth:`Kinematics.inverse_many`, solves N targets at once with numpy. For the OPW
 family, :meth:`Kinematics.inverse` runs the compiled mirror of its Python code when it is built
-(robot/simcore.pyx, robot/build.py; the same axes bit for bit, about 20x faster).
+(robot/simcore.pyx, robot/build.py; the same axes bit for bit, about 20x faster), and so do
+:meth:`Kinematics.forward` (the same frames bit for bit, checked at set-up) and the 4-axis
+palletizer's solutions (the same rows).
 """
 
 from __future__ import annotations
@@ -60,7 +62,7 @@ FK_MEMO = 256
 #: (the reference: the two agree bit for bit, tests/robot/test_simcore.py)
 USE_COMPILED = True
 #: The ``ABI`` of robot/simcore.pyx this module mirrors (a stale build is not used)
-SIMCORE_ABI = 4
+SIMCORE_ABI = 5
 
 
 def _wrap180(v: np.ndarray) -> np.ndarray:
@@ -128,6 +130,8 @@ class Kinematics:
         self._base_inv: np.ndarray | None = None   # INV(frame before the OPW arm), None: identity
         self._end_inv: np.ndarray | None = None    # INV(frame after it)
         self._c_opw: Any = None     # robot/simcore.pyx's OPW for this robot; False: not used
+        self._c_pal: Any = None     # robot/simcore.pyx's 4-axis palletizer rows; False: not used
+        self._c_fk: Any = None      # robot/simcore.pyx's forward kinematics; False: not used
         self._s_free = 0            # S bits that select nothing on this robot
         self._t_free = 0            # T bits that select nothing on this robot
         #: the inverse kinematics of this robot: "opw", "palletizer4", "palletizer5" or "numeric"
@@ -218,6 +222,22 @@ class Kinematics:
         known = self._fk_memo.get(key)
         if known is not None:
             return known.copy()
+        c = self._c_fk
+        if c is None:
+            c = self._c_fk = self._compiled_forward()
+        if c:
+            T = np.empty((4, 4))
+            c.forward(a, T)
+        else:
+            T = self._forward_py(a)
+        if len(self._fk_memo) >= FK_MEMO:
+            self._fk_memo.clear()
+        self._fk_memo[key] = T.copy()
+        return T
+
+    def _forward_py(self, a: np.ndarray) -> np.ndarray:
+        """:meth:`forward` of the axes a (6,, deg) in numpy and scipy: the reference the
+        compiled forward (robot/simcore.pyx ``Forward``) reproduces bit for bit."""
         q = self._kuka_sign * np.radians(a)
         Rj = Rotation.from_rotvec(self._axes * q[:, None]).as_matrix()  # (6, 3, 3)
         R = np.eye(3)
@@ -230,10 +250,31 @@ class Kinematics:
         T = np.eye(4)
         T[:3, :3] = R @ self._R_flange
         T[:3, 3] = p + R @ self._p_flange
-        if len(self._fk_memo) >= FK_MEMO:
-            self._fk_memo.clear()
-        self._fk_memo[key] = T.copy()
         return T
+
+    def _compiled_forward(self) -> Any:
+        """robot/simcore.pyx's ``Forward`` of this robot when it is built, numpy's BLAS is at hand
+        (robot/blas.py) and it gives :meth:`_forward_py` bit for bit on 64 random axis sets
+        (wide angles, small ones, zeros and signed zeros); else False."""
+        if not USE_COMPILED or _simcore is None or getattr(_simcore, "ABI", None) != SIMCORE_ABI:
+            return False
+        from .blas import numpy_cblas  # noqa: PLC0415
+
+        gemm, gemv = numpy_cblas("dgemm"), numpy_cblas("dgemv")
+        if not gemm or not gemv:
+            return False
+        c = _simcore.Forward(gemm, gemv, self._origins.tolist(), self._axes.tolist(), self._kuka_sign.tolist(),
+                             self._R_origin, self._origin_rot, self._R_flange, self._p_flange.tolist())
+        rng = np.random.default_rng(39)
+        T = np.empty((4, 4))
+        for i in range(64):
+            a = rng.uniform(-360.0, 360.0, 6) * (1e-4 if i % 4 == 1 else 1.0)
+            if i % 3 == 0:
+                a[rng.integers(0, 6)] = -0.0 if i % 2 else 0.0
+            c.forward(a, T)
+            if T.tobytes() != self._forward_py(a).tobytes():
+                return False
+        return c
 
     def forward_many(self, axes_deg: np.ndarray) -> np.ndarray:
         """Vectorised :meth:`forward`: axes (n, 6) in deg -> flange frames (n, 4, 4), mm."""
@@ -419,6 +460,12 @@ class Kinematics:
         Rz = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
         R_v = Rz @ R_ref
         p = T[:3, 3]
+        c_pal = self._c_pal
+        if c_pal is None:
+            c_pal = self._c_pal = self._compiled_palletizer()
+        if c_pal:
+            # the compiled mirror of the loop below (robot/simcore.pyx Palletizer4): the same rows
+            return c_pal.rows(R_v, p, ref_deg)
         rows: list[list[float]] = []
         phi = math.atan2(p[1], p[0])
         for arm in (phi, phi + math.pi):
@@ -435,6 +482,16 @@ class Kinematics:
                 if float(np.abs(self.forward(row)[:3, 3] - p).max()) < 1e-6:
                     rows.append(row)
         return rows
+
+    def _compiled_palletizer(self) -> Any:
+        """robot/simcore.pyx's ``Palletizer4`` for this robot, or False (not built, stale, or
+        :data:`USE_COMPILED` off: :meth:`_palletizer_rows` runs its Python loop)."""
+        c = _compiled_opw(self)
+        if not c:
+            return False
+        return _simcore.Palletizer4(c, self._origins.tolist(), self._axes.tolist(), self._kuka_sign.tolist(),
+                                    self._R_origin.tolist(), self._origin_rot, self._R_flange.tolist(),
+                                    self._p_flange.tolist(), self._pa[0].tolist())
 
     def _opw_rows(self, flange_T: np.ndarray, ref_deg: np.ndarray | None) -> list[list[float]]:
         """The analytic solutions of a flange pose: :meth:`_opw_core`, or for the 4-axis

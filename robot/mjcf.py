@@ -228,20 +228,11 @@ def _arm_cycle(arm: "ArmModel", sc: Any) -> Any:
 
 
 def _numpy_dgemm() -> int:
-    """The address of the ILP64 ``cblas_dgemm`` numpy's own BLAS exports (the OpenBLAS a numpy
-    wheel bundles: ``scipy_cblas_dgemm64_``), 0 when there is none at hand."""
-    import ctypes  # noqa: PLC0415
-    import glob  # noqa: PLC0415
-    import os  # noqa: PLC0415
+    """The address of the ILP64 ``cblas_dgemm`` numpy's own BLAS exports (robot/blas.py), 0 when
+    there is none at hand."""
+    from .blas import numpy_cblas  # noqa: PLC0415
 
-    root = os.path.dirname(np.__file__)
-    for lib in sorted(glob.glob(os.path.join(root, "..", "numpy.libs", "*openblas64*"))
-                      + glob.glob(os.path.join(root, ".dylibs", "*openblas64*"))):
-        try:
-            return int(ctypes.cast(ctypes.CDLL(lib).scipy_cblas_dgemm64_, ctypes.c_void_p).value or 0)
-        except (OSError, AttributeError):
-            continue
-    return 0
+    return numpy_cblas("dgemm")
 
 
 def _same_products(cyc: Any) -> bool:

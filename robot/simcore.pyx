@@ -4,6 +4,9 @@
 * :class:`OPW`: the OPW inverse kinematics of one pose (and along a chain of poses), the
   compiled form of robot/kinematics.py ``Kinematics._opw_core`` + ``_status_row`` + the
   selection of ``Kinematics._select`` for the six-axis arm with a spherical wrist;
+* :class:`Palletizer4`: the 4-axis palletizer's solutions (``Kinematics._palletizer_rows``: the
+  same rows; its flange test runs a forward kinematics of its own, see the class);
+* :class:`Forward`: ``Kinematics.forward`` (scipy's rotation matrices, numpy's own BLAS);
 * :class:`CartPath`: the poses of a CP segment's lines and arcs (robot/planner.py
   ``CartSegment.pose_u``) and their axes;
 * :class:`ArmCycle` and :func:`speed_ok`: the IPO cycle's MuJoCo playback with its TCP product,
@@ -26,7 +29,7 @@ import numpy as np
 
 #: Bumped whenever the mirrored Python code changes (robot/kinematics.py checks it: a stale
 #: build is not used).
-ABI = 4
+ABI = 5
 
 cdef double DEG_TO_RAD = M_PI / 180.0
 cdef double RAD_TO_DEG = 180.0 / M_PI
@@ -90,7 +93,7 @@ cdef class OPW:
 
     cdef int _core(self, const double* M, const double* ref, double* out) noexcept nogil:
         """``Kinematics._opw_core(T, ref)`` of the pose M (the first three rows of T, 12
-        values): the solutions into out (8 x 6), their number."""
+        values; ref NULL: ``ref_deg`` None): the solutions into out (8 x 6), their number."""
         cdef double r00 = M[0], r01 = M[1], r02 = M[2], px = M[3]
         cdef double r10 = M[4], r11 = M[5], r12 = M[6], py = M[7]
         cdef double r20 = M[8], r21 = M[9], r22 = M[10], pz = M[11]
@@ -107,7 +110,7 @@ cdef class OPW:
         if rho2 < 0.0:
             return 0
         nx1 = sqrt(rho2) - self.a1
-        if sqrt(cx * cx + cy * cy) < OVERHEAD_SINGULAR_MM:
+        if ref != NULL and sqrt(cx * cx + cy * cy) < OVERHEAD_SINGULAR_MM:
             tmp1 = (self.sgn[0] * ref[0]) * DEG_TO_RAD - self.offs[0]
         else:
             tmp1 = atan2(cy, cx)
@@ -151,7 +154,7 @@ cdef class OPW:
                         r02 * c23 * cs1 + r12 * c23 * sn1 - r22 * s23)
             th6 = atan2(r01 * s23 * cs1 + r11 * s23 * sn1 + r21 * c23,
                         -r00 * s23 * cs1 - r10 * s23 * sn1 - r20 * c23)
-            if fabs(th5 * RAD_TO_DEG) < WRIST_SINGULAR_DEG:
+            if ref != NULL and fabs(th5 * RAD_TO_DEG) < WRIST_SINGULAR_DEG:
                 total = th4 + th6
                 th4 = (self.sgn[3] * ref[3]) * DEG_TO_RAD - self.offs[3]
                 th6 = total - th4
@@ -286,6 +289,141 @@ cdef class OPW:
         return have_best
 
 
+
+
+cdef class Palletizer4:
+    """The solutions of a flange pose on the 4-axis palletizer (robot/kinematics.py
+    ``Kinematics._palletizer_rows`` after the vertical rotation ``R_v`` is known): for each arm
+    plane (towards the flange, and behind the A1 axis) the A5 point the fixed offset back from
+    the flange, :meth:`OPW._core` for it (c4 = 0), A4 at 0 (within 1e-6 deg: set to 0.0; the
+    flipped wrist, |A4| = 180, dropped), and only the rows whose flange lies within 1e-6 mm of
+    the target. The rows are those of the Python code bit for bit; the flange test runs a
+    forward kinematics of its own (Rodrigues' formula per joint, the chain of
+    ``Kinematics.forward``), which may differ from numpy's and scipy's in the last bits:
+    it only tells the true solutions (errors about 1e-10 mm) from the wrong arm plane's
+    (millimetres), never near 1e-6 (tools/palletizer_rows_check.py shows it on the corpus)."""
+
+    cdef OPW opw
+    cdef double orig[6][3]
+    cdef double axis[6][3]
+    cdef double sign[6]
+    cdef double rorig[6][9]
+    cdef int origin_rot
+    cdef double rfl[9]
+    cdef double pfl[3]
+    cdef double off[3]
+
+    def __init__(self, OPW opw, origins, axes, sign, R_origin, origin_rot, R_flange, p_flange, offset):
+        cdef int i, j, k
+        self.opw = opw
+        for i in range(6):
+            self.sign[i] = sign[i]
+            for j in range(3):
+                self.orig[i][j] = origins[i][j]
+                self.axis[i][j] = axes[i][j]
+                for k in range(3):
+                    self.rorig[i][3 * j + k] = R_origin[i][j][k]
+        self.origin_rot = 1 if origin_rot else 0
+        for j in range(3):
+            self.pfl[j] = p_flange[j]
+            self.off[j] = offset[j]
+            for k in range(3):
+                self.rfl[3 * j + k] = R_flange[j][k]
+
+    cdef void _flange_pos(self, const double* row, double* out) noexcept nogil:
+        """Position (mm) of the flange at the axes row (6, deg)."""
+        cdef double R[9]
+        cdef double T[9]
+        cdef double J[9]
+        cdef double p[3]
+        cdef double q, c, s, C, x, y, z
+        cdef int i, a, b, k
+        for a in range(9):
+            R[a] = 0.0
+        R[0] = R[4] = R[8] = 1.0
+        p[0] = p[1] = p[2] = 0.0
+        for i in range(6):
+            for a in range(3):
+                p[a] += R[3 * a] * self.orig[i][0] + R[3 * a + 1] * self.orig[i][1] + R[3 * a + 2] * self.orig[i][2]
+            if self.origin_rot:
+                for a in range(3):
+                    for b in range(3):
+                        T[3 * a + b] = (R[3 * a] * self.rorig[i][b] + R[3 * a + 1] * self.rorig[i][3 + b]
+                                        + R[3 * a + 2] * self.rorig[i][6 + b])
+                for a in range(9):
+                    R[a] = T[a]
+            q = self.sign[i] * (row[i] * DEG_TO_RAD)
+            c = cos(q)
+            s = sin(q)
+            C = 1.0 - c
+            x, y, z = self.axis[i][0], self.axis[i][1], self.axis[i][2]
+            J[0], J[1], J[2] = c + x * x * C, x * y * C - z * s, x * z * C + y * s
+            J[3], J[4], J[5] = y * x * C + z * s, c + y * y * C, y * z * C - x * s
+            J[6], J[7], J[8] = z * x * C - y * s, z * y * C + x * s, c + z * z * C
+            for a in range(3):
+                for b in range(3):
+                    T[3 * a + b] = R[3 * a] * J[b] + R[3 * a + 1] * J[3 + b] + R[3 * a + 2] * J[6 + b]
+            for a in range(9):
+                R[a] = T[a]
+        for a in range(3):
+            out[a] = p[a] + R[3 * a] * self.pfl[0] + R[3 * a + 1] * self.pfl[1] + R[3 * a + 2] * self.pfl[2]
+
+    def flange_position(self, const double[:] row):
+        """The flange position (3,, mm) of the axes row (6, deg), as the flange test computes it."""
+        cdef double r[6]
+        cdef double out[3]
+        cdef int i
+        for i in range(6):
+            r[i] = row[i]
+        self._flange_pos(r, out)
+        return np.array([out[0], out[1], out[2]])
+
+    def rows(self, const double[:, :] R_v, const double[:] p, ref6):
+        """The rows (lists of 6 floats, deg) for the flange position p (3,, mm) with the
+        vertical rotation R_v (3x3); ref6 the reference axes (6,, deg) or None."""
+        cdef double M[12]
+        cdef double sols[48]
+        cdef double ref[6]
+        cdef double pos[3]
+        cdef const double* refp = NULL
+        cdef double phi, arm, ca, sa, err, e, px = p[0], py = p[1], pz = p[2]
+        cdef double* row
+        cdef int j, i, k, n
+        cdef list out = []
+        cdef const double[:] rv
+        if ref6 is not None:
+            rv = np.asarray(ref6, dtype=float)
+            for i in range(6):
+                ref[i] = rv[i]
+            refp = ref
+        for i in range(3):
+            for k in range(3):
+                M[4 * i + k] = R_v[i, k]
+        phi = atan2(py, px)
+        for j in range(2):
+            arm = phi if j == 0 else phi + M_PI
+            ca = cos(arm)
+            sa = sin(arm)
+            # w = p - [ca * o0 - sa * o1, sa * o0 + ca * o1, o2]
+            M[3] = px - (ca * self.off[0] - sa * self.off[1])
+            M[7] = py - (sa * self.off[0] + ca * self.off[1])
+            M[11] = pz - self.off[2]
+            n = self.opw._core(M, refp, sols)
+            for k in range(n):
+                row = &sols[6 * k]
+                if fabs(row[3]) < 1e-6:
+                    row[3] = 0.0
+                elif fabs(fabs(row[3]) - 180.0) < 1e-6:
+                    continue
+                self._flange_pos(row, pos)
+                err = 0.0
+                for i in range(3):
+                    e = fabs(pos[i] - (px if i == 0 else py if i == 1 else pz))
+                    if e > err or e != e:       # a NaN fails the test, as numpy's max gives it
+                        err = e
+                if err < 1e-6:
+                    out.append([row[0], row[1], row[2], row[3], row[4], row[5]])
+        return out
 
 
 # ----------------------------------------------------------------------------- CP paths
@@ -454,6 +592,117 @@ ctypedef void (*_mj_kinematics_t)(const void* m, void* d) noexcept nogil
 ctypedef void (*_dgemm_t)(int order, int ta, int tb, long long m, long long n, long long k,
                           double alpha, const double* a, long long lda, const double* b,
                           long long ldb, double beta, double* c, long long ldc) noexcept nogil
+
+
+ctypedef void (*_dgemv_t)(int order, int ta, long long m, long long n, double alpha, const double* a,
+                          long long lda, const double* x, long long incx, double beta, double* y,
+                          long long incy) noexcept nogil
+
+
+cdef class Forward:
+    """``Kinematics.forward`` (robot/kinematics.py) in one call, the same numbers: the joint
+    rotations of scipy's ``Rotation.from_rotvec(axis * q).as_matrix()`` (its quaternion, then
+    its matrix, the same operations in the same order), and every product ``@`` of the Python
+    code through numpy's own BLAS as numpy calls it (``cblas_dgemm`` for a 3x3 by 3x3 product,
+    ``cblas_dgemv`` for a 3x3 by vector one, at the addresses given). Its users check it against
+    the Python code at set-up (robot/kinematics.py ``_compiled_forward``)."""
+
+    cdef _dgemm_t gemm
+    cdef _dgemv_t gemv
+    cdef double orig[6][3]
+    cdef double axis[6][3]
+    cdef double sign[6]
+    cdef double[:, ::1] rorig      # (6 * 3, 3): R_origin, numpy-allocated
+    cdef int origin_rot
+    cdef double[:, ::1] rfl        # (3, 3)
+    cdef double pfl[3]
+    cdef double[:, ::1] buf        # scratch matrices, numpy-allocated: R, R', Rj (6), y
+
+    def __init__(self, size_t gemm, size_t gemv, origins, axes, sign, R_origin, origin_rot,
+                 R_flange, p_flange):
+        cdef int i, j
+        if gemm == 0 or gemv == 0:
+            raise ValueError("Forward: no BLAS")
+        self.gemm = <_dgemm_t>gemm
+        self.gemv = <_dgemv_t>gemv
+        for i in range(6):
+            self.sign[i] = sign[i]
+            for j in range(3):
+                self.orig[i][j] = origins[i][j]
+                self.axis[i][j] = axes[i][j]
+        self.rorig = np.ascontiguousarray(R_origin, dtype=float).reshape(18, 3)
+        self.origin_rot = 1 if origin_rot else 0
+        self.rfl = np.ascontiguousarray(R_flange, dtype=float)
+        for j in range(3):
+            self.pfl[j] = p_flange[j]
+        self.buf = np.zeros((3 * 9, 3))
+
+    def forward(self, const double[:] a, double[:, ::1] T):
+        """The flange frame (4x4, mm) of the axes a (A1..A6, deg; further values ignored) into T."""
+        cdef double rv[3]
+        cdef double p[3]
+        cdef double angle, a2, scale, x, y, z, w, x2, y2, z2, w2, xy, zw, xz, yw, yz, xw, qi
+        cdef double* R = &self.buf[0, 0]
+        cdef double* R2 = &self.buf[3, 0]
+        cdef double* Rj
+        cdef double* yv = &self.buf[24, 0]
+        cdef double* tmp
+        cdef int i, j
+        if a.shape[0] < 6 or T.shape[0] != 4 or T.shape[1] != 4:
+            raise ValueError("Forward.forward: a (>= 6,), T (4, 4)")
+        for i in range(6):
+            # q = sign * radians(a); rotvec = axis * q; scipy's from_rotvec(...).as_matrix()
+            qi = self.sign[i] * (a[i] * DEG_TO_RAD)
+            for j in range(3):
+                rv[j] = self.axis[i][j] * qi
+            angle = sqrt(rv[0] * rv[0] + rv[1] * rv[1] + rv[2] * rv[2])
+            if angle <= 1e-3:
+                a2 = angle * angle
+                scale = 0.5 - a2 / 48 + a2 * a2 / 3840
+            else:
+                scale = sin(angle / 2) / angle
+            x, y, z, w = scale * rv[0], scale * rv[1], scale * rv[2], cos(angle / 2)
+            x2 = x * x
+            y2 = y * y
+            z2 = z * z
+            w2 = w * w
+            xy = x * y
+            zw = z * w
+            xz = x * z
+            yw = y * w
+            yz = y * z
+            xw = x * w
+            Rj = &self.buf[6 + 3 * i, 0]
+            Rj[0], Rj[1], Rj[2] = x2 - y2 - z2 + w2, 2 * (xy - zw), 2 * (xz + yw)
+            Rj[3], Rj[4], Rj[5] = 2 * (xy + zw), - x2 + y2 - z2 + w2, 2 * (yz - xw)
+            Rj[6], Rj[7], Rj[8] = 2 * (xz - yw), 2 * (yz + xw), - x2 - y2 + z2 + w2
+        for j in range(9):
+            R[j] = 0.0
+        R[0] = R[4] = R[8] = 1.0
+        p[0] = p[1] = p[2] = 0.0
+        for i in range(6):
+            # p = p + R @ origins[i]; R = R @ R_origin[i]; R = R @ Rj[i]
+            self.gemv(102, 112, 3, 3, 1.0, R, 3, &self.orig[i][0], 1, 0.0, yv, 1)
+            for j in range(3):
+                p[j] = p[j] + yv[j]
+            if self.origin_rot:
+                self.gemm(101, 111, 111, 3, 3, 3, 1.0, R, 3, &self.rorig[3 * i, 0], 3, 0.0, R2, 3)
+                tmp = R
+                R = R2
+                R2 = tmp
+            self.gemm(101, 111, 111, 3, 3, 3, 1.0, R, 3, &self.buf[6 + 3 * i, 0], 3, 0.0, R2, 3)
+            tmp = R
+            R = R2
+            R2 = tmp
+        # T[:3, :3] = R @ R_flange; T[:3, 3] = p + R @ p_flange
+        self.gemm(101, 111, 111, 3, 3, 3, 1.0, R, 3, &self.rfl[0, 0], 3, 0.0, R2, 3)
+        self.gemv(102, 112, 3, 3, 1.0, R, 3, self.pfl, 1, 0.0, yv, 1)
+        for i in range(3):
+            for j in range(3):
+                T[i, j] = R2[3 * i + j]
+            T[i, 3] = p[i] + yv[i]
+            T[3, i] = 0.0
+        T[3, 3] = 1.0
 
 
 cdef class ArmCycle:

@@ -316,3 +316,79 @@ def test_the_compiled_tcp_product_is_numpys_matmul():
     cyc.use_gemm(0)
     assert cyc.product(np.eye(4), F, np.eye(4), out) is False
     assert cyc.cycle_tcp(np.zeros(6), qa, np.eye(4), np.eye(4), out) is False
+
+
+def test_the_compiled_forward_is_the_python_forward_bit_for_bit(shared_corpus):
+    """Kinematics.forward through robot/simcore.pyx ``Forward`` (scipy's rotation-vector matrices,
+    numpy's own BLAS products) against its numpy/scipy code: the same bytes on random axes of the
+    library's robots, of a corpus KR 210 and of a chain with rotated joint origins."""
+    if simcore is None:
+        pytest.skip("not compiled")
+    from scipy.spatial.transform import Rotation  # noqa: PLC0415
+
+    from robot.blas import numpy_cblas  # noqa: PLC0415
+    from robot.machine import library_robots  # noqa: PLC0415
+    from robot.mada import load_mada  # noqa: PLC0415
+
+    if not numpy_cblas("dgemm") or not numpy_cblas("dgemv"):
+        pytest.skip("numpy without its bundled OpenBLAS: numpy multiplies")
+    kins = [Kinematics(load_mada(p)) for p in library_robots().values() if p.suffix == ".dat"]
+    kins += [Kinematics(), Kinematics(load_robot(str(shared_corpus / "HugoDanielson__ChinaMilling")))]
+    rot = Kinematics()
+    rot._R_origin = Rotation.from_euler("xyz", np.random.default_rng(3).normal(size=(6, 3))).as_matrix()
+    rot._origin_rot = True
+    kins.append(rot)
+    rng = np.random.default_rng(47)
+    T = np.empty((4, 4))
+    for k in kins:
+        c = k._compiled_forward()
+        assert c, k.machine.name
+        for i in range(1500):
+            a = rng.uniform(k._lo, k._hi)
+            if i % 5 == 0:
+                a = np.round(a, 1)
+            if i % 7 == 0:
+                a[rng.integers(0, 6)] = 0.0 if i % 2 else -0.0
+            if i % 11 == 0:
+                a *= 1e-5                                # the small-angle series of from_rotvec
+            c.forward(a, T)
+            assert T.tobytes() == k._forward_py(a).tobytes(), (k.machine.name, a.tolist())
+    assert kins[-1].forward(np.zeros(6)).tobytes() == rot._forward_py(np.zeros(6)).tobytes()
+
+
+def test_the_compiled_palletizer_rows_are_the_pythons():
+    """The 4-axis palletizer's solutions (robot/simcore.pyx ``Palletizer4``) against the Python
+    loop of Kinematics._palletizer_rows: the same rows, bit for bit, on linked configurations
+    of the library palletizer, with tilted flanges, targets off the arm's reach and no
+    reference (``solutions``); its own flange test tells the rows apart by millimetres."""
+    if simcore is None:
+        pytest.skip("not compiled")
+    from scipy.spatial.transform import Rotation  # noqa: PLC0415
+
+    from robot.machine import ROBOT_LIBRARY  # noqa: PLC0415
+    from robot.mada import load_mada  # noqa: PLC0415
+
+    m = load_mada(ROBOT_LIBRARY / "kr180_r3200_pa.dat")
+    compiled, python = Kinematics(m), Kinematics(m)
+    python._c_pal = False
+    assert compiled._c_pal
+    home = compiled._home
+    rng = np.random.default_rng(48)
+    found = empty = 0
+    for _ in range(3000):
+        q = rng.uniform(compiled._lo, compiled._hi)
+        q[3] = 0.0
+        q[4] = home[4] + home[1] + home[2] - q[1] - q[2]
+        T = compiled.forward(q)
+        if rng.random() < 0.3:
+            T[:3, :3] = T[:3, :3] @ Rotation.from_rotvec(rng.normal(size=3) * 0.01).as_matrix()
+        if rng.random() < 0.2:
+            T[:3, 3] += rng.normal(size=3) * 300.0
+        ref = None if rng.random() < 0.2 else rng.uniform(compiled._lo, compiled._hi)
+        a, b = compiled._palletizer_rows(T, ref), python._palletizer_rows(T, ref)
+        assert len(a) == len(b) and np.array(a).tobytes() == np.array(b).tobytes(), (q.tolist(), ref)
+        found += bool(a)
+        empty += not a
+        for row in a:                                 # the compiled flange test: within 1e-6 mm
+            assert np.abs(compiled._c_pal.flange_position(np.array(row)) - T[:3, 3]).max() < 1e-6
+    assert found > 2000 and empty > 20
