@@ -1192,6 +1192,7 @@ class Runtime:
                 task.in_poll = False
         if ok and task.kind == "robot":
             ctl.release()
+            self.bump_epoch()       # $PRO_MOVE: the motion suspended by BRAKE runs again
 
     def brake(self, fast: bool = False) -> None:
         """BRAKE / BRAKE F: ramp the path speed down and wait until the robot stands (5.17).

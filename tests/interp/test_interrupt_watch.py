@@ -255,3 +255,63 @@ def test_settled_interrupts_poll_once_per_state_epoch(tmp_path, monkeypatch, int
     assert events == events_e
     assert n_every >= steps // 2                  # the submit interpreter polls at each step
     assert n_watched * 20 < n_every               # settled: once per IPO cycle
+
+
+#: a BRAKE in an interrupt routine that returns without RESUME: the held motion runs again at
+#: the routine's end (robot/controller.py ``release``), a change of $PRO_MOVE outside an IPO
+#: cycle; the loop counter at which OnMove runs shows whether the next poll saw it at once
+BRAKER = """
+DEF prog()
+  INTERRUPT DECL 5 WHEN $IN[1] DO Stopper()
+  INTERRUPT DECL 6 WHEN $PRO_MOVE==TRUE DO OnMove()
+  INTERRUPT ON 5
+  INTERRUPT ON 6
+  PTP {A1 150, A2 -90, A3 90, A4 0, A5 0, A6 0}
+  LOOP
+    K = K + 1
+    IF (NM >= 2) OR (K > 100000) THEN
+      EXIT
+    ENDIF
+  ENDLOOP
+END
+DEF Stopper()
+  BRAKE
+  NB = NB + 1
+END
+DEF OnMove()
+  NM = NM + 1
+  AT[NM] = K
+END
+"""
+BRAKER_DAT = """
+DEFDAT prog
+  DECL INT K = 0
+  DECL INT NB = 0
+  DECL INT NM = 0
+  DECL INT AT[20]
+ENDDAT
+"""
+BRAKER_STIMULI = """stimuli:
+  - at: 0.1
+    set: {"$IN[1]": true}
+"""
+
+
+@pytest.mark.parametrize("interp", ["tree", "vm"])
+def test_a_motion_released_after_brake_is_seen_by_the_next_poll(tmp_path, monkeypatch, interp):
+    """The motion a BRAKE held runs again when its interrupt routine returns: $PRO_MOVE rises
+    outside an IPO cycle, so that return begins a new state epoch, and OnMove runs at the
+    loop count of evaluating every condition at every poll."""
+    def run():
+        r = run_krl(tmp_path, BRAKER, BRAKER_DAT, stimuli=BRAKER_STIMULI, trace=False, interp=interp)
+        assert r.result.reason == "completed", r.result.text
+        nm = r.var("prog", "NM")
+        return r.var("prog", "NB"), nm, list(r.var("prog", "AT").data[:nm])
+
+    watched = run()
+    monkeypatch.setattr(contexts, "stamp_key", lambda *a, **k: None)
+    monkeypatch.setattr(contexts, "WATCHED", False)
+    every = run()
+    assert watched[0] == 1 and watched[1] == 2      # one BRAKE; moving at the start and again after
+    assert watched[2][1] > watched[2][0]
+    assert watched == every
