@@ -609,7 +609,8 @@ class Runtime:
                 if a is None:
                     self._omitted(frame, k, name, t, size)
                 elif mode == "IN" or a.__class__ is ValueRef:
-                    v = a.peek()
+                    c = a.__class__
+                    v = a.c[a.k] if c is Slot else a.v if c is ValueRef else a.peek()   # (Ref.peek)
                     if scalar:          # (the scalar case of _param_copy and _slot_type)
                         if v is not UNSET:
                             c = v.__class__
