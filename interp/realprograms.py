@@ -45,8 +45,8 @@ Routines of technology packages absent from the backup are stubbed (a ``message`
 "stub: NAME"), and the report lists the stubs.
 
 Usage: ``python -m interp.realprograms [CORPUS] [--json OUT] [--limit N] [--columns cells,auto]
-[--interp vm|tree] [--scheduler tcp://HOST:PORT]`` (``--scheduler``: the runs go to a Dask cluster, :func:`run_rows`;
-the same report).
+[--interp vm|tree] [--jobs N] [--scheduler tcp://HOST:PORT]`` (``--jobs``: worker processes of this machine,
+one per core by default; ``--scheduler``: the runs go to a Dask cluster, :func:`run_rows`; the same report).
 """
 
 from __future__ import annotations
@@ -404,15 +404,18 @@ def report(rows: list[dict]) -> str:
 
 def run_rows(corpus: Path, max_sim_time: float = REPORT_SIM_TIME_S, max_steps: int = REPORT_STEPS, *,
              cells: bool = True, limit: int = 0, columns: tuple[str, ...] = ("cells",), interp: str = "tree",
-             scheduler: str | None = None, progress=None) -> list[dict]:
+             scheduler: str | None = None, jobs: int = 1, progress=None) -> list[dict]:
     """The report's rows: :func:`run_one` of each entry point of the backups below `corpus`
     (:func:`entries_of`; at most `limit` of them, 0: all), in the corpus's order, once per
     column of `columns` ("cells": with its committed cell file unless `cells` is False;
     "auto": with ``--inputs auto``), on `interp`. `scheduler`: the address of a Dask scheduler
     (``tcp://HOST:8786``) whose workers make the runs (krl/cluster.py; they read the corpus at
-    the same paths); the rows are the same as here, ``seconds`` aside. `progress(column, row)`
-    is called as each row arrives. Raises krl.cluster.SchedulerError when the scheduler cannot
-    be used."""
+    the same paths); the rows are the same as here, ``seconds`` aside. Without a scheduler,
+    `jobs` > 1 runs them in that many worker processes of this machine (krl/pool.py: each run is
+    independent, so the rows are the same as one after the other, ``seconds`` aside).
+    `progress(column, row)` is called as each row arrives (in completion order when the runs
+    are parallel; the rows returned are always in the corpus's order). Raises
+    krl.cluster.SchedulerError when the scheduler cannot be used."""
     programs = [p for root in find_backups(corpus) for p in entries_of(root)]
     if limit:
         programs = programs[:limit]
@@ -421,17 +424,24 @@ def run_rows(corpus: Path, max_sim_time: float = REPORT_SIM_TIME_S, max_steps: i
         for col in columns:
             cell = None if not cells or col == "auto" else cell_of(p, corpus)
             tasks.append((len(tasks), (p, max_sim_time, max_steps, cell, col == "auto", interp)))
-    if scheduler is None:
+    if scheduler is None and jobs <= 1:
         rows = []
         for _i, args in tasks:
             rows.append(run_one(*args))
             if progress:
                 progress("auto" if args[4] else "cells", rows[-1])
         return rows
-    from krl.cluster import run_batches  # noqa: PLC0415
+    if scheduler is None:
+        from krl.pool import run_tasks  # noqa: PLC0415
+        from interp import run as _loaded  # noqa: F401, PLC0415  (forked workers start with the runtime imported)
 
+        outcomes = run_tasks(run_one, tasks, jobs=jobs, timeout=None)
+    else:
+        from krl.cluster import run_batches  # noqa: PLC0415
+
+        outcomes = run_batches(scheduler, run_one, tasks, batch_files=1, name="krl-realprograms")
     got: dict[int, dict] = {}
-    for o in run_batches(scheduler, run_one, tasks, batch_files=1, name="krl-realprograms"):
+    for o in outcomes:
         path, _t, _s, cell, auto, _interp = tasks[o.key][1]
         if o.status == "done":
             row = o.value
@@ -457,6 +467,9 @@ def main(argv: list[str] | None = None) -> int:
                     help="which runs: cells (the committed cell files), auto (--inputs auto), or both (default)")
     ap.add_argument("--interp", choices=("tree", "vm"), default="vm",
                     help="the interpreter of the runs (default vm: the same causes, less CPU)")
+    ap.add_argument("--jobs", type=int, default=None, metavar="N",
+                    help="worker processes of this machine (default: one per core; 1: one run after "
+                         "the other in this process); the same report")
     ap.add_argument("--scheduler", default=None, metavar="tcp://HOST:PORT",
                     help="make the runs on this Dask distributed scheduler's cluster (its workers "
                          "see the corpus at the same paths); the same report as the local run")
@@ -465,6 +478,8 @@ def main(argv: list[str] | None = None) -> int:
     cols = [c.strip() for c in a.columns.split(",") if c.strip()]
     if not cols or any(c not in ("cells", "auto") for c in cols):
         ap.error("--columns takes cells, auto or cells,auto")
+    if a.jobs is not None and a.jobs < 1:
+        ap.error("--jobs takes a number of worker processes, 1 or more")
     if not corpus.is_dir():
         print(f"no corpus at {corpus}; nothing to do")
         return 0
@@ -477,10 +492,12 @@ def main(argv: list[str] | None = None) -> int:
               f"{shown}  {r['text'][:80]}{sub}", file=sys.stderr)
 
     from krl.cluster import SchedulerError  # noqa: PLC0415
+    from krl.pool import default_jobs  # noqa: PLC0415
 
     try:
         rows = run_rows(corpus, a.max_sim_time, a.max_steps, cells=not a.no_cells, limit=a.limit,
-                        columns=tuple(cols), interp=a.interp, scheduler=a.scheduler, progress=progress)
+                        columns=tuple(cols), interp=a.interp, scheduler=a.scheduler,
+                        jobs=a.jobs if a.jobs is not None else default_jobs(), progress=progress)
     except SchedulerError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2

@@ -150,3 +150,33 @@ def test_a_cell_gives_a_long_job_its_time():
     assert rp.time_limit(p, cell, 60.0) == 180.0
     assert rp.time_limit(p.with_name("Mill_FrameGlue.src"), cell, 60.0) == 60.0
     assert rp.time_limit(p, None, 60.0) == 60.0
+
+
+def test_parallel_runs_give_the_rows_of_the_serial_run(monkeypatch):
+    """``--jobs`` (issue 39, "Real programs"): the runs of one small backup (two programs and
+    its cell.src, both columns) in two worker processes give the rows of the run one after the
+    other, in the corpus's order, ``seconds`` aside."""
+    small = rp.DEFAULT_CORPUS / "rawpython__kukaKRLmagic"
+    monkeypatch.setattr(rp, "find_backups", lambda corpus: [small])
+    seen = []
+    serial = rp.run_rows(rp.DEFAULT_CORPUS, max_sim_time=5.0, columns=("cells", "auto"))
+    parallel = rp.run_rows(rp.DEFAULT_CORPUS, max_sim_time=5.0, columns=("cells", "auto"), jobs=2,
+                           progress=lambda col, row: seen.append((col, row["program"])))
+
+    def same(rows):
+        return [{k: v for k, v in r.items() if k != "seconds"} for r in rows]
+
+    assert [Path(r["program"]).relative_to(small).as_posix() for r in parallel] == [
+        p for p in ("R1/Program/sample_program.src", "R1/Program/sample_program_with_globals.src", "R1/cell.src")
+        for _col in ("cells", "auto")]
+    assert [r["mode"] for r in parallel] == ["cells", "auto"] * 3
+    assert all(r["reason"] != "internal" for r in parallel)
+    assert same(parallel) == same(serial)
+    assert sorted(seen) == sorted((r["mode"], r["program"]) for r in serial)
+
+
+def test_jobs_below_one_is_a_usage_error(capsys):
+    with pytest.raises(SystemExit) as exc:
+        rp.main(["--jobs", "0"])
+    assert exc.value.code == 2
+    assert "--jobs takes a number of worker processes" in capsys.readouterr().err
