@@ -222,10 +222,8 @@ def maker(t, _building: frozenset = frozenset()):
             def make():
                 return Arr(t, dims, [mk() for _ in range(n)])
         else:
-            blank = [UNSET] * n
-
-            def make():
-                return Arr(t, dims, blank.copy())
+            def make():     # (no template: a value is made only after its data memory is taken)
+                return Arr(t, dims, [UNSET] * n)
         return make
     return _unset
 
