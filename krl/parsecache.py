@@ -235,9 +235,13 @@ def keep_parses(store: Store, made) -> None:
     old content's hash."""
     if store.db is None:
         return
-    store.put("parse", {key: e for key, lf, status in made
-                        if status == "done" and _on_disk(key, lf.path)
-                        and (e := encode_loaded(lf)) is not None})
+    store.put("parse", parse_entries(made))
+
+
+def parse_entries(made) -> dict[str, bytes]:
+    """The entries :func:`keep_parses` puts in the store for `made`: parse key -> entry."""
+    return {key: e for key, lf, status in made
+            if status == "done" and _on_disk(key, lf.path) and (e := encode_loaded(lf)) is not None}
 
 
 def _on_disk(key: str, path: str) -> bool:

@@ -58,7 +58,7 @@ from krl.semantics.symbols import Scope, Symbol, system_scopes
 from krl.syntax.folds import fold_diagnostics
 from krl.syntax.messages import syntax_diagnostics
 from krl.syntax.engines import EngineUnavailable, java_answers, parse_source, resolve, result_from_answer
-from krl.syntax.engines.tree import stream_tokens
+from krl.syntax.engines.tree import is_acyclic, stream_tokens
 from krl.syntax.parse import ParseResult, default_bundle, parse_text
 from krl.source import SourceText, is_krl_file, read_source
 
@@ -115,11 +115,15 @@ def load_parsed(src: SourceText, raw: bytes | None = None) -> LoadedFile:
     if raw is None:
         result = parse_source(src, keep_tree=True, engine="python")
     else:
-        result = result_from_answer(src, raw, keep_tree=True)
+        # without parent links: the builder and the messages never go up the tree, and a tree
+        # without cycles is freed by reference counting when dropped, with no walk of
+        # release_tree (400 files: 0.19 s of CPU, 2026-11-24)
+        result = result_from_answer(src, raw, keep_tree=True, parents=False)
     try:
         return _loaded(src, result, t)
     finally:
-        release_tree(result.tree)
+        if not is_acyclic(result.tree):
+            release_tree(result.tree)
         result.tree = None
 
 

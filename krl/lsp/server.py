@@ -130,14 +130,14 @@ class KrlLanguageServer(LanguageServer):
     def write_cache_later(self) -> None:
         """Put the parse entries the last analysis deferred in the cache, a few per step in
         the analysis thread, while no analysis waits (edits go first)."""
-        if self._writing or not self.project.unwritten:
+        if self._writing or not (self.project.unwritten or self.project.unwritten_entries):
             return
         self._writing = True
         loop = asyncio.get_running_loop()
 
         async def run() -> None:
             try:
-                while self.project.unwritten:
+                while self.project.unwritten or self.project.unwritten_entries:
                     await asyncio.sleep(CACHE_WRITE_PAUSE_S)
                     if self._lock is not None and self._lock.locked() or any(not t.done() for t in self._pending.values()):
                         continue

@@ -157,9 +157,11 @@ def test_the_cached_diagnostics_come_before_any_parse_is_decoded(tmp_path: Path,
         assert events.count("decoded") >= 4 and len([e for e in events if e != "decoded"]) == 1
 
 
-def test_deferred_parse_entries_are_written_later_and_open_files_at_once(tmp_path: Path):
-    """The server's way (Project(defer_writes=True)): the open file's entry is written before the
-    check, the others by write_cache, step by step; a file opened in between is left out."""
+def test_deferred_entries_are_written_after_the_check_open_files_encoded_at_once(tmp_path: Path):
+    """The server's way (Project(defer_writes=True)): nothing is written before the check is
+    published; the open file's entry (encoded before any edit) and the check's diagnostics are
+    written by the first write_cache step, the other files' entries by write_cache, step by step;
+    a file opened in between is left out."""
     shutil.copytree(BACKUP, tmp_path / "KRC")
     main = norm(tmp_path / "KRC" / "R1" / "Program" / "main.src")
     tools = norm(tmp_path / "KRC" / "R1" / "Program" / "tools.src")
@@ -168,10 +170,14 @@ def test_deferred_parse_entries_are_written_later_and_open_files_at_once(tmp_pat
     first.open(main, Path(main).read_text())
     an = first.analyze(main)
     count = lambda: store.db.execute("SELECT COUNT(*) FROM entries WHERE kind = 'parse'").fetchone()[0]  # noqa: E731
-    assert count() == 1                                 # main.src, the open file
+    checks = lambda: store.db.execute("SELECT COUNT(*) FROM entries WHERE kind = 'check'").fetchone()[0]  # noqa: E731
+    assert count() == 0 and checks() == 0               # no commit before the publication
+    assert [kind for kind, _items in first.unwritten_entries] == ["parse", "check"]
     assert sorted(p for _k, p, _lf, _status in first.unwritten) == sorted(set(an.files) - {main})
     first.open(tools, Path(tools).read_text())          # opened before its entry is written
     assert first.write_cache(1) == len(an.files) - 2
+    assert count() == 2 and checks() == 1               # main.src, the open file, one more, the check
+    assert not first.unwritten_entries
     assert first.write_cache() == 0 and not first.unwritten
     assert count() == len(an.files) - 1                 # all but tools.src
     again = Project(store=store)

@@ -13,6 +13,7 @@ import subprocess
 import sys
 import time
 import gc
+import weakref
 
 import pytest
 from antlr4 import ParserRuleContext
@@ -22,7 +23,7 @@ import krl.syntax.engines as engines_mod
 import krl.workspace as workspace_mod
 from krl.syntax.engines import java as java_engine
 from krl.syntax.engines import java_answers, parse_file, result_from_answer
-from krl.syntax.engines.tree import RebuiltToken, TreeDataError, stream_tokens, tree_from_raw
+from krl.syntax.engines.tree import RebuiltToken, TreeDataError, is_acyclic, stream_tokens, tree_from_raw
 from krl.syntax.messages import syntax_diagnostics
 from krl.syntax.tokens import lex
 from krl.syntax.parse import default_bundle, prepare_text
@@ -61,6 +62,49 @@ def test_a_rebuilt_tree_is_the_python_engines_tree(text):
     assert jv.tree.getText() == py.tree.getText()
 
 
+def _without_parents(shape: list[tuple]) -> list[tuple]:
+    """tree_shape rows with the parent's class (the row's last field but one for a context,
+    the last for a terminal) left out."""
+    return [row[:-1] if row[0] in ("terminal", "error") else row[:-2] + row[-1:] for row in shape]
+
+
+@needs_java
+@pytest.mark.parametrize("text", [TEXT, BROKEN])
+def test_a_tree_rebuilt_without_parents_differs_only_there_and_is_freed_at_once(text):
+    """parents=False (krl/workspace.py ``load_parsed``): the same nodes, tokens and labels, every
+    parentCtx None, and no cycle: with the cyclic collector off, dropping the root frees a leaf
+    context at once (reference counting)."""
+    _java_or_skip()
+    raw = _raw(text)
+    with_parents = tree_from_raw(raw, prepare_text(text), default_bundle())
+    tree = tree_from_raw(raw, prepare_text(text), default_bundle(), parents=False)
+    assert not is_acyclic(with_parents) and is_acyclic(tree)
+    assert _without_parents(tree_shape(tree)) == _without_parents(tree_shape(with_parents))
+    nodes, stack = [], [tree]
+    while stack:
+        n = stack.pop()
+        nodes.append(n)
+        stack.extend(getattr(n, "children", None) or ())
+    assert len(nodes) > 20 and all(n.parentCtx is None for n in nodes)
+    contexts = [n for n in nodes if isinstance(n, ParserRuleContext)]
+    deepest = weakref.ref(contexts[-1])     # the last context in preorder: below the root
+    assert contexts[-1] is not tree
+    kept = weakref.ref(with_parents.children[0])
+    del nodes, stack, n, contexts
+    was = gc.isenabled()
+    gc.disable()
+    try:
+        del tree
+        assert deepest() is None            # freed without the collector
+        del with_parents
+        assert kept() is not None           # a tree with parent links is cyclic garbage ...
+    finally:
+        if was:
+            gc.enable()
+    gc.collect()
+    assert kept() is None                   # ... until the collector runs
+
+
 @needs_java
 @pytest.mark.parametrize("damage", [
     lambda r: r.update(tree=r["tree"][:-1]),                       # ends inside a context
@@ -84,6 +128,15 @@ def test_bad_tree_data_is_an_error_and_the_python_engine_parses(damage):
     res = result_from_answer(src, json.dumps(raw).encode(), keep_tree=True)
     assert res.ok and not isinstance(res.tree.start, RebuiltToken)
     assert tree_shape(res.tree) == tree_shape(parse_file(TEXT, "a.src", engine="python", keep_tree=True).tree)
+
+
+def test_an_answer_is_read_by_orjson_or_else_by_json():
+    """load_answer: the worker's JSON line as data; a lone surrogate escape, which orjson
+    refuses, is read by the json module; a line that is no JSON raises ValueError."""
+    assert java_engine.load_answer(b'{"id":3,"tokens":[1,2],"s":"\\u00e4"}') == {"id": 3, "tokens": [1, 2], "s": "\u00e4"}
+    assert java_engine.load_answer(b'{"s":"\\ud800"}') == {"s": "\ud800"}
+    with pytest.raises(ValueError):
+        java_engine.load_answer(b'{"id":3,')
 
 
 def test_a_worker_that_stops_answering_is_killed_after_the_stall(monkeypatch):

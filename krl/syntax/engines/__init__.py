@@ -19,7 +19,6 @@ Python engine's result, tree included (tests/syntax/test_engines.py).
 
 from __future__ import annotations
 
-import json
 import os
 from collections.abc import Iterable, Iterator
 from pathlib import Path
@@ -31,7 +30,7 @@ from krl.syntax.parse import (ParseResult, ParserBundle, default_bundle, parse_s
 from krl.source import SourceText, source_from_bytes
 from krl.syntax.blocks import may_pass_limit
 from krl.syntax.checks import may_fail
-from krl.syntax.engines.java import EngineUnavailable, WorkerError, unavailable_reason, worker_for
+from krl.syntax.engines.java import EngineUnavailable, WorkerError, load_answer, unavailable_reason, worker_for
 from krl.syntax.engines.tree import TreeDataError, tree_from_raw
 
 ENGINES = ("auto", "python", "java")
@@ -183,14 +182,15 @@ def java_answers(items: Iterable[tuple[object, SourceText]], bundle: ParserBundl
 
 
 def result_from_answer(source: SourceText, raw: dict | bytes | None, bundle: ParserBundle | None = None,
-                       keep_tree: bool = False) -> ParseResult:
+                       keep_tree: bool = False, parents: bool = True) -> ParseResult:
     """The ParseResult of one :func:`java_answers` item (its parse tree rebuilt when
-    `keep_tree`); the Python engine's result when raw is None or unusable."""
+    `keep_tree`, without ``parentCtx`` links when not `parents`: krl/syntax/engines/tree.py
+    ``tree_from_raw``); the Python engine's result when raw is None or unusable."""
     bundle = bundle or default_bundle()
     if raw is not None:
         if isinstance(raw, bytes):
             try:
-                raw = json.loads(raw)
+                raw = load_answer(raw)
             except ValueError:
                 raw = None
     if raw is None or "fail" in raw:
@@ -199,7 +199,7 @@ def result_from_answer(source: SourceText, raw: dict | bytes | None, bundle: Par
     tree = None
     if keep_tree:
         try:
-            tree = tree_from_raw(raw, text, bundle)
+            tree = tree_from_raw(raw, text, bundle, parents)
         except TreeDataError:
             return _py_parse_source(source, bundle, keep_tree=True)
     res = result_from_raw(raw, text, source.path, source.encoding, bundle, tree)

@@ -29,6 +29,8 @@ import threading
 from collections.abc import Iterable, Iterator
 from pathlib import Path
 
+import orjson
+
 REPO_ROOT = Path(__file__).resolve().parents[3]
 WORKER_SOURCE = Path(__file__).parent / "worker" / "KrlWorker.java"
 # C1 only: half the JIT's CPU for runs of a few seconds, at about the same parse rate.
@@ -333,7 +335,7 @@ class JavaWorker:
                         continue
                     received += 1
                     window.release()
-                    yield ident - first, (json.loads(line) if decode else line)
+                    yield ident - first, (load_answer(line) if decode else line)
                 if writer is not None:
                     writer.join()
                 self.next_id = first + sent[0] + 1
@@ -346,6 +348,17 @@ class JavaWorker:
 
 
 _ID = re.compile(rb'\{"id":(\d+)[,}]')
+
+
+def load_answer(line: bytes) -> dict:
+    """One answer of the worker (a JSON line) as data: by orjson (0.12 s of CPU for the answers
+    with trees of the language server's 400-file bench against 0.28-0.32 s by the json module,
+    2026-11-24), by the json module where orjson refuses what json reads (a lone surrogate
+    escape). Raises ValueError for a line that is no JSON."""
+    try:
+        return orjson.loads(line)
+    except orjson.JSONDecodeError:
+        return json.loads(line)
 
 
 def _stalling_reader(stream, stall: float, last: int, sent: list[int]):

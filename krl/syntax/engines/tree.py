@@ -24,7 +24,7 @@ from antlr4.CommonTokenStream import CommonTokenStream
 from antlr4.error.Errors import RecognitionException
 from antlr4.tree.Tree import ErrorNodeImpl, TerminalNodeImpl
 
-__all__ = ["TreeDataError", "stream_tokens", "tree_from_raw"]
+__all__ = ["TreeDataError", "is_acyclic", "stream_tokens", "tree_from_raw"]
 
 
 class TreeDataError(ValueError):
@@ -79,17 +79,20 @@ def _context_class(parser_cls: type, name: str) -> type:
     return cls
 
 
-def tree_from_raw(raw: dict, text: str, bundle):
+def tree_from_raw(raw: dict, text: str, bundle, parents: bool = True):
     """The parse tree (the start rule's context) of a worker answer with tree data.
 
     `text`: the text the worker parsed (after :func:`krl.syntax.parse.prepare_text`);
-    `bundle`: the ParserBundle generated from the same grammar version. Raises TreeDataError."""
+    `bundle`: the ParserBundle generated from the same grammar version. `parents=False`: every
+    node's ``parentCtx`` is left None, for a reader that never goes up the tree (the AST
+    builder, the syntax messages): the tree then holds no cycle and reference counting frees
+    it as soon as it is dropped (:func:`is_acyclic`). Raises TreeDataError."""
     # Millions of new objects and none freed: the cyclic collector's passes over the growing
     # heap would cost more than the building itself, so it waits until the tree is built.
     enabled = gc.isenabled()
     gc.disable()
     try:
-        return _build(raw["tokens"], raw["names"], raw["tree"], raw["labels"], text, bundle)
+        return _build(raw["tokens"], raw["names"], raw["tree"], raw["labels"], text, bundle, parents)
     except TreeDataError:
         raise
     except (KeyError, IndexError, TypeError, ValueError, AttributeError) as exc:
@@ -131,7 +134,8 @@ _set_symbol = TerminalNodeImpl.symbol.__set__
 _set_term_parent = TerminalNodeImpl.parentCtx.__set__
 
 
-def _build(tk: list[int], names: list[str], data: list[int], labels: list, text: str, bundle):
+def _build(tk: list[int], names: list[str], data: list[int], labels: list, text: str, bundle,
+           parents_too: bool = True):
     parser = _parser(bundle)
     classes = [_context_class(bundle.parser_cls, n) for n in names]
     count = len(tk) // 6
@@ -172,7 +176,7 @@ def _build(tk: list[int], names: list[str], data: list[int], labels: list, text:
             _set_symbol(node, t)
             pos += 2
             parent = parents[-1]
-            _set_term_parent(node, parent)
+            _set_term_parent(node, parent if parents_too else None)
             parent.children.append(node)
             left[-1] -= 1
             if not left[-1]:
@@ -190,7 +194,7 @@ def _build(tk: list[int], names: list[str], data: list[int], labels: list, text:
         pos += 6
         if parents:
             parent = parents[-1]
-            node.parentCtx = parent
+            node.parentCtx = parent if parents_too else None
             parent.children.append(node)
             left[-1] -= 1
             if not left[-1]:
@@ -222,6 +226,15 @@ def _build(tk: list[int], names: list[str], data: list[int], labels: list, text:
         else:
             raise TreeDataError(f"unknown label kind {kind!r}")
     return root
+
+
+def is_acyclic(tree) -> bool:
+    """True for a tree rebuilt with ``parents=False`` (no node points up: nothing to break
+    before it is freed, krl/workspace.py ``release_tree``)."""
+    if type(getattr(tree, "start", None)) is not RebuiltToken:
+        return False        # the Python engine's tree, or none
+    children = tree.children
+    return not children or children[0].parentCtx is None
 
 
 def stream_tokens(tree) -> list | None:
