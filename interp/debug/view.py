@@ -129,7 +129,7 @@ def entries(rt, scope: tuple) -> list:
         frame = scope[1]
         if frame.layout is not None:
             for k, s in enumerate(frame.layout.slots):
-                out.append((s.name, frame.vars[k]))
+                out.append((s.name, frame.var(k)))
     elif kind == "module":
         m = scope[1]
         if m is not None:

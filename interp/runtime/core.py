@@ -21,7 +21,7 @@ from .builtins import NATIVES, ValueRef
 from .netfunctions import RSI_CONSTANTS
 from .contexts import Context, Irq
 from .watch import split_watch
-from .convert import assign_into, binary_op, convert_scalar, to_bool, trunc_int, unary_op
+from .convert import INT_MAX, INT_MIN, assign_into, binary_op, convert_scalar, to_bool, trunc_int, unary_op
 from .errors import (HaltSignal, KrlRuntimeError, ResumeSignal, StopRun)
 from .idle import probe_state
 from .memory import DataMemory, Frame, ProxyRef, Ref, SignalRef, Slot, field_ref, index_ref
@@ -31,7 +31,7 @@ from .program import Program
 from .runmode import STEP_MODES, BackwardRefused, MotionHistory, mode_name
 from .scheduler import Scheduler, Task
 from .sysvars import EPOCH_PROBED, SysVars, struct_of
-from .values import UNSET, Arr, EnumValue, Struct, copy_value, make_value, value_size
+from .values import LEAVES, UNSET, Arr, EnumValue, Struct, copy_value, make_value, maker, value_size
 
 
 #: s the operator takes to press Start again after a HALT (``krl run --on-halt continue``; a
@@ -62,6 +62,24 @@ def _scalar(t) -> bool:
     """A type of single values: INT, REAL, BOOL, CHAR or an ENUM (not an array, a STRUC or
     an unresolved type)."""
     return isinstance(t, (T.Simple, T.Enum)) and t is not T.UNKNOWN
+
+
+_INT, _REAL = T.INT, T.REAL
+
+
+class FramePlan:
+    """A routine's Layout made ready for its calls (:meth:`Runtime._frame_plan`, once per
+    routine and run): ``layout``; ``n`` slots; ``made`` (slot -> (type, name) of the Slot
+    ``Frame.var`` makes when first used, for a variable the frame holds itself: a plain
+    local, a scalar or structure :IN copy; else None); ``fresh`` ((slot, function making the
+    fresh value) for each local STRUC or array); ``decls`` ((slot, name, type, VarDecl) for
+    each local with an initial value, (slot, name, None, SignalDecl) for each SIGNAL);
+    ``params`` ((slot, name, mode, type or None, scalar?, data elements) for each parameter;
+    *scalar*: a type whose fresh value is UNSET and whose values are converted by
+    convert_scalar: INT, REAL, BOOL, CHAR, ENUM); ``elements``, the data elements of the
+    locals; ``sizes`` ((data elements, VarName, VarDecl) for each local)."""
+
+    __slots__ = ("layout", "n", "made", "fresh", "decls", "params", "elements", "sizes")
 
 
 #: appended to a workspace or software-limit error whose motion target itself is out of the
@@ -489,7 +507,7 @@ class Runtime:
         data-list slot, a system variable, or the fallback for what nothing declares."""
         k = st.kind
         if k == 0:                   # LOCAL
-            return frame.vars[st.slot]
+            return frame.vars[st.slot] or frame.var(st.slot)
         if k <= 2:                   # MODULE, GLOBAL
             return self.modules[st.owner].refs[st.slot] or self.program.data_ref(st)
         if k == 3:                   # SYSTEM
@@ -590,25 +608,57 @@ class Runtime:
         """Create the frame of a call (§2.3): :IN parameters get converted copies, :OUT
         (and unmarked) parameters are bound to the caller's reference; omitted arguments
         stay declared-but-unset; locals are declared unset. The routine's slots are its
-        Layout (krl/semantics/resolve.py), planned once (:meth:`_frame_plan`)."""
+        Layout (krl/semantics/resolve.py), planned once (:class:`FramePlan`); the Slot of a
+        variable the frame holds itself is made when first used (``Frame.var``)."""
         task = self.current_task
-        depth = caller.depth + 1 if caller is not None else 0
         if self.kss.standard and id(routine) in self.kss.standard:
             self.kss.standard_call(routine)
-        if depth > MAX_CALL_DEPTH:
+        if caller is not None and caller.depth >= MAX_CALL_DEPTH:
             raise KrlRuntimeError(f"stack overflow: more than {MAX_CALL_DEPTH} nested calls")
         plan = self._plans.get(id(routine))
         if plan is None:
             plan = self._plans[id(routine)] = self._frame_plan(module, routine)
-        layout, decls, params, local_elements, local_sizes = plan
         mem = self.memory
-        if mem.used + local_elements > mem.limit:
-            self._locals_do_not_fit(local_sizes)
-        mem.used += local_elements
-        frame = Frame(routine, module, caller, task, layout)
-        frame.data = local_elements
+        n = plan.elements
+        if mem.used + n > mem.limit:
+            self._locals_do_not_fit(plan.sizes)
+        mem.used += n
+        k = plan.n
+        store = [UNSET] * k
+        frame = Frame(routine, module, caller, task, plan.layout, store, [None] * k, plan.made)
+        frame.data = n
         try:
-            self._fill_frame(frame, decls, params, args)
+            for k, make in plan.fresh:
+                store[k] = make()
+            if plan.decls:
+                self._declare(frame, plan.decls)
+            nargs = len(args)
+            for k, name, mode, t, scalar, size in plan.params:
+                a = args[k] if k < nargs else None
+                if a is None:
+                    self._omitted(frame, k, name, t, size)
+                elif mode == "IN" or a.__class__ is ValueRef:
+                    c = a.__class__
+                    v = a.c[a.k] if c is Slot else a.v if c is ValueRef else a.peek()   # (Ref.peek)
+                    if scalar:          # (the scalar case of _param_copy and _slot_type)
+                        if v is not UNSET:
+                            c = v.__class__
+                            store[k] = v if (c is float and t is _REAL) or (
+                                c is int and t is _INT and INT_MIN <= v <= INT_MAX) else convert_scalar(v, t)
+                    elif v.__class__ is Struct and v.type is t:
+                        # a structure of the parameter's own type: its copy (the same components,
+                        # already of their types: what make_value + assign_into give), its size
+                        if mem.used + size > mem.limit:
+                            mem.take(size, name, what="a copy of :IN parameter")
+                        mem.used += size
+                        frame.data += size
+                        f = v.f
+                        store[k] = Struct(t, f.copy()) if LEAVES.issuperset(map(type, f.values())) \
+                            else copy_value(v)
+                    else:
+                        self._in_copy(frame, k, name, t, size, v)
+                else:
+                    frame.vars[k] = a
         except BaseException:
             mem.give(frame.data)
             raise
@@ -627,75 +677,60 @@ class Runtime:
         finally:
             mem.used = used
 
-    def _fill_frame(self, frame: Frame, decls, params, args) -> None:
-        """Declare the locals and bind the parameters of a new frame (:meth:`enter_routine`);
-        the data memory of :IN copies and omitted aggregate parameters is added to
-        ``frame.data``."""
+    def _declare(self, frame: Frame, decls) -> None:
+        """The locals of a new frame that are not plain variables: a DECL with an initial
+        value (DECL CONST INT OFFS = 10, KSS 8) and a SIGNAL of the routine."""
         store = frame.store
         fvars = frame.vars
-        for k, name, t, d, scalar in decls:
+        for k, name, t, d in decls:
             if t is not None:
-                store[k] = UNSET if scalar else make_value(t)
                 ref = fvars[k] = Slot(store, k, t, name)
-                if d is not None:      # DECL CONST INT OFFS = 10 (KSS 8)
-                    v = self.program.literal(d.init, t)
-                    cur = store[k]
-                    if isinstance(cur, (Struct, Arr)):
-                        assign_into(cur, v)
-                    else:
-                        store[k] = convert_scalar(v, t)
-                    ref.readonly = d.is_const
-            else:                      # a SIGNAL of the routine
-                fvars[k] = self.program.signal_ref(d)
-        for k, name, mode, t, scalar, size in params:
-            a = args[k] if k < len(args) else None
-            if a is None:
-                if isinstance(t, T.Array) and t.elem == T.CHAR and t.dims == (0,):
-                    # an omitted string parameter: declared, no characters (KUKA's MsgLib
-                    # calls STRLEN on it without ON_ERROR_PROCEED); VARSTATE says #DECLARED
-                    store[k] = Arr(t, (0,), [])
-                    fvars[k] = Slot(store, k, t, name)
-                elif t is None or (isinstance(t, T.Array) and 0 in t.dims):
-                    store[k] = UNSET
-                    fvars[k] = Slot(store, k, None, name)
+                v = self.program.literal(d.init, t)
+                cur = store[k]
+                if isinstance(cur, (Struct, Arr)):
+                    assign_into(cur, v)
                 else:
-                    frame.data += self.memory.take(size, name, what="parameter")
-                    store[k] = make_value(t)
-                    fvars[k] = Slot(store, k, t, name)
-                continue
-            if mode == "IN" or a.__class__ is ValueRef:
-                if scalar:      # (the scalar case of _param_copy and _slot_type)
-                    v = a.peek()
-                    store[k] = v if v is UNSET else convert_scalar(v, t)
-                    fvars[k] = Slot(store, k, t, name)
-                    continue
-                v = a.peek()
-                if v.__class__ is Struct and v.type is t:
-                    # a structure of the parameter's own type: its copy (the same components,
-                    # already of their types: what make_value + assign_into give), its size
-                    frame.data += self.memory.take(size, name, what="a copy of :IN parameter")
-                    store[k] = copy_value(v)
-                    fvars[k] = Slot(store, k, t, name)
-                    continue
-                frame.data += self.memory.take(value_size(v) if isinstance(v, (Struct, Arr)) else size,
-                                               name, what="a copy of :IN parameter")
-                v = store[k] = self._param_copy(v, t, name)
-                fvars[k] = Slot(store, k, self._slot_type(t, v), name)
+                    store[k] = convert_scalar(v, t)
+                ref.readonly = d.is_const
             else:
-                fvars[k] = a
+                fvars[k] = self.program.signal_ref(d)
 
-    def _frame_plan(self, module, routine: N.Routine) -> tuple:
-        """The routine's Layout made ready for :meth:`enter_routine`: (layout, [(slot, name,
-        type, VarDecl with an initial value or None, scalar?) for each local variable, or
-        (slot, name, None, SignalDecl, False)], [(slot, name, mode, type or None, scalar?, data
-        elements) for each parameter], data elements of the locals, [(data elements,
-        VarName, VarDecl) for each local]); *scalar*: a type whose fresh value is UNSET and
-        whose values are converted by convert_scalar (INT, REAL, BOOL, CHAR, ENUM). Types are
-        the checker's; raises KrlRuntimeError for a type nothing declares (outside a backup),
-        ResourceError for a type that nests too deep (values.data_size)."""
+    def _omitted(self, frame: Frame, k: int, name: str, t, size: int) -> None:
+        """Parameter ``k`` of a new frame whose argument is omitted: declared, unset."""
+        store = frame.store
+        if isinstance(t, T.Array) and t.elem == T.CHAR and t.dims == (0,):
+            # an omitted string parameter: declared, no characters (KUKA's MsgLib calls
+            # STRLEN on it without ON_ERROR_PROCEED); VARSTATE says #DECLARED
+            store[k] = Arr(t, (0,), [])
+            frame.vars[k] = Slot(store, k, t, name)
+        elif t is None or (isinstance(t, T.Array) and 0 in t.dims):
+            store[k] = UNSET
+            frame.vars[k] = Slot(store, k, None, name)
+        else:
+            frame.data += self.memory.take(size, name, what="parameter")
+            store[k] = make_value(t)
+            frame.vars[k] = Slot(store, k, t, name)
+
+    def _in_copy(self, frame: Frame, k: int, name: str, t, size: int, v) -> None:
+        """An :IN parameter ``k`` of a new frame (or a value given for a reference
+        parameter) that is not a scalar nor a structure of its own type: a converted copy of
+        ``v``, with its data memory."""
+        frame.data += self.memory.take(value_size(v) if isinstance(v, (Struct, Arr)) else size,
+                                       name, what="a copy of :IN parameter")
+        v = frame.store[k] = self._param_copy(v, t, name)
+        frame.vars[k] = Slot(frame.store, k, self._slot_type(t, v), name)
+
+    def _frame_plan(self, module, routine: N.Routine) -> FramePlan:
+        """The routine's Layout made ready for :meth:`enter_routine` (:class:`FramePlan`).
+        Types are the checker's; raises KrlRuntimeError for a type nothing declares (outside
+        a backup), ResourceError for a type that nests too deep (values.data_size)."""
         layout = routine.ann.layout
         prog = self.program
-        decls, params, sizes = [], [], []
+        plan = FramePlan()
+        plan.layout = layout
+        plan.n = len(layout.slots)
+        made = plan.made = [None] * plan.n
+        fresh, decls, params, sizes = [], [], [], []
         for k, s in enumerate(layout.slots):
             if k < layout.nparams:
                 if s.var is not None:            # the parameter's declaration (a VarDecl)
@@ -703,15 +738,25 @@ class Runtime:
                     n = prog.data_elements(t, s.var, s.decl)
                 else:                            # no declaration (E101): untyped
                     t, n = None, 1
-                params.append((k, s.name, s.mode, t, _scalar(t), n))
+                scalar = _scalar(t)
+                params.append((k, s.name, s.mode, t, scalar, n))
+                if scalar or isinstance(t, T.Struc):
+                    made[k] = (t, s.name)        # the Slot of its copy, made when first used
             elif isinstance(s.decl, N.VarDecl):
                 t = prog.declared_type(s.type, s.decl.type)
                 n = prog.data_elements(t, s.var, s.decl)
-                decls.append((k, s.name, t, s.decl if s.decl.init is not None else None, _scalar(t)))
                 sizes.append((n, s.var, s.decl))
-            else:
-                decls.append((k, s.name, None, s.decl, False))
-        return layout, decls, params, sum(n for n, _, _ in sizes), sizes
+                if isinstance(t, (T.Struc, T.Array)):
+                    fresh.append((k, maker(t)))
+                if s.decl.init is not None:
+                    decls.append((k, s.name, t, s.decl))
+                else:
+                    made[k] = (t, s.name)
+            else:                                # a SIGNAL of the routine
+                decls.append((k, s.name, None, s.decl))
+        plan.fresh, plan.decls, plan.params, plan.sizes = tuple(fresh), tuple(decls), tuple(params), sizes
+        plan.elements = sum(n for n, _, _ in sizes)
+        return plan
 
     @staticmethod
     def _slot_type(t, v):
@@ -746,8 +791,9 @@ class Runtime:
         routine and returns the value of its RETURN (None for a DEF) —, the value converted
         to a function's return type (:meth:`return_value`), RESUME caught at the caller
         that declared the interrupt (unless ``catch_resume`` is False: an interrupt
-        handler's own call), :meth:`leave_routine` (``returned`` False when the routine is
-        abandoned by an error or RESUME). ``target``: (module, Routine)."""
+        handler's own call), and leaving the routine: its data memory given back, its
+        interrupts removed, a ``return`` event written unless it is abandoned by an error or
+        RESUME (no event then). ``target``: (module, Routine)."""
         module, routine = target
         frame = self.enter_routine(module, routine, args, caller)
         task = self.current_task
@@ -756,8 +802,11 @@ class Runtime:
         returned = False
         try:
             value = body(frame)
-            if routine.is_function:
-                value = self.return_value(routine, value, module)
+            if routine.kind == "DEFFCT":       # (Routine.is_function)
+                t = self._return_types.get(id(routine))
+                c = value.__class__
+                if not ((c is float and t is _REAL) or (c is int and t is _INT and INT_MIN <= value <= INT_MAX)):
+                    value = self.return_value(routine, value, module)
             returned = True
             return value
         except ResumeSignal as r:
@@ -771,18 +820,13 @@ class Runtime:
             raise
         finally:
             task.frame = prev
-            self.leave_routine(frame, returned)
-
-    def leave_routine(self, frame: Frame, returned: bool = True) -> None:
-        """The routine of ``frame`` ends; ``returned`` False when it is abandoned (run-time
-        error, RESUME, end of the run): then no ``return`` event is written."""
-        task = self.current_task
-        self.memory.used -= frame.data      # DataMemory.give, inlined: once per call
-        frame.data = 0
-        if frame.interrupts:
-            task.irqs.remove_frame(frame)
-        if returned and self.trace is not None:
-            self.trace.write("return", self.controller.time, name=frame.name)
+            # leave_routine, inlined: once per call
+            self.memory.used -= frame.data      # DataMemory.give
+            frame.data = 0
+            if frame.interrupts:
+                self.current_task.irqs.remove_frame(frame)
+            if returned and self.trace is not None:
+                self.trace.write("return", self.controller.time, name=frame.name)
 
     def return_value(self, routine: N.Routine, value, module):
         """``RETURN expr`` of a function: converted to the return type (§2.4; the checker's,
@@ -1127,6 +1171,8 @@ class Runtime:
         probes = tuple(_reader(self.sysvars.lookup(k)) for k in names)
         task.irqs.declare(Irq(n, cond_fn, handler_fn, name, frame, is_global, line, watch=cls,
                               probes=probes, by_epoch=all(k in EPOCH_PROBED for k in names)))
+        if not frame.interrupts:
+            frame.interrupts = []
         frame.interrupts.append(n)
         self._break(task)
 

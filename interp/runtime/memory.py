@@ -250,34 +250,50 @@ class Frame:
 
     Attributes: routine (AST Routine), module (:class:`program.ModuleRT`), vars (frame slot ->
     Ref: the slots of the routine's Layout, krl/semantics/resolve.py: parameters, then
-    locals), store (frame slot -> the value of a variable the frame holds itself: a local or an
-    :IN copy), layout, caller (Frame or None), depth, interrupts (numbers declared here,
+    locals; None until first asked for, :meth:`var`, for a variable the frame holds in its
+    own store), store (frame slot -> the value of a variable the frame holds itself: a local
+    or an :IN copy), layout, caller (Frame or None), depth, interrupts (numbers declared here,
     removed on return), task (the owning task), line (current line), data (the elements of
-    the run's data memory it holds, given back on return).
+    the run's data memory it holds, given back on return), made (frame slot -> (type, name)
+    of the Slot :meth:`var` makes for a slot whose ``vars`` entry is None; shared by every
+    activation of the routine: interp/runtime/core.py FramePlan).
     """
 
     __slots__ = ("routine", "module", "vars", "caller", "depth", "interrupts", "task", "line",
-                 "store", "layout", "data")
+                 "store", "layout", "data", "made")
 
-    def __init__(self, routine, module, caller: "Frame | None", task=None, layout=None) -> None:
+    def __init__(self, routine, module, caller: "Frame | None", task=None, layout=None,
+                 store: list | None = None, vars_: list | None = None, made=None) -> None:
         self.routine = routine
         self.module = module
-        n = len(layout.slots) if layout is not None else 0
         self.layout = layout
-        self.vars: list = [None] * n
-        self.store: list = [UNSET] * n
+        if store is None:
+            n = len(layout.slots) if layout is not None else 0
+            store, vars_ = [UNSET] * n, [None] * n
+        self.vars: list = vars_
+        self.store: list = store
+        self.made = made
         self.caller = caller
         self.depth = caller.depth + 1 if caller is not None else 0
-        self.interrupts: list[int] = []
+        self.interrupts: list[int] | tuple = ()     # a list once one is declared
         self.task = task
         self.line = 0
         self.data = 0       # elements of the run's data memory this activation holds (DataMemory)
+
+    def var(self, k: int) -> Ref:
+        """The reference of frame slot ``k``: made on first use (a Slot of the store) for a
+        variable the frame holds itself, then kept, so every use sees the same Ref."""
+        ref = self.vars[k]
+        if ref is None:
+            t, name = self.made[k]
+            ref = self.vars[k] = Slot(self.store, k, t, name)
+        return ref
 
     def ref(self, name: str) -> Ref | None:
         """The reference of the parameter or local `name` (any case), else None: for tools
         (VARSTATE's text, a debugger); the interpreters use each use's Storage slot."""
         k = self.layout.index(name) if self.layout is not None else None
-        return self.vars[k] if k is not None else None
+        return self.var(k) if k is not None else None
 
     @property
     def name(self) -> str:

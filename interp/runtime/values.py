@@ -20,6 +20,8 @@ Types are the front end's :mod:`krl.semantics.types` classes (Simple, Array, Str
 
 from __future__ import annotations
 
+from functools import partial
+
 from krl.semantics import types as T
 from krl.semantics.values import UNSET, EnumValue  # the front end's scalar values
 
@@ -161,28 +163,92 @@ def value_size(v) -> int:
     return 1
 
 
-#: id(structure type) -> (the type, its field count, True when no field is a structure or an
-#: array): such a structure is made by one C-level dict.fromkeys (make_value, per routine call)
-_FLAT_STRUC: dict[int, tuple] = {}
+#: id(structure type) -> (the type, its field count, a function of no arguments that makes a
+#: fresh value of it): made once per type (:func:`struc_maker`); a structure type is never
+#: made by the run (only the front end's), so the table stays as small as the program's types
+_STRUC_MAKERS: dict[int, tuple] = {}
+
+
+def struc_maker(t, _building: frozenset = frozenset()):
+    """A function of no arguments returning a fresh value of structure type ``t`` (UNSET
+    leaves, the components in the type's order): a structure whose components are all scalars
+    is one C-level copy of a dict; a STRUC or array component is made by its own maker
+    (:func:`maker`; a STRUC that contains itself, which values.data_size refuses, by
+    :func:`make_value`)."""
+    c = _STRUC_MAKERS.get(id(t))
+    fields = t.fields
+    if c is not None and c[0] is t and c[1] == len(fields):
+        return c[2]
+    tmpl = dict.fromkeys(fields, UNSET)
+    inner = _building | {id(t)}
+    nested = tuple((k, partial(make_value, ft) if _contains(ft, inner) else maker(ft, inner))
+                   for k, (_, ft) in fields.items() if isinstance(ft, (T.Struc, T.Array)))
+    copy = tmpl.copy
+    if not nested:
+        def make():
+            return Struct(t, copy())
+    else:
+        def make():
+            f = copy()
+            for k, mk in nested:
+                f[k] = mk()
+            return Struct(t, f)
+    _STRUC_MAKERS[id(t)] = (t, len(fields), make)
+    return make
+
+
+def _contains(t, ids: frozenset) -> bool:
+    """True when type ``t`` is, or holds as an array element, a STRUC of ``ids``."""
+    while isinstance(t, T.Array):
+        t = t.elem
+    return isinstance(t, T.Struc) and id(t) in ids
+
+
+def maker(t, _building: frozenset = frozenset()):
+    """A function of no arguments returning a fresh :func:`make_value` of ``t`` (for a routine's
+    locals: made once per routine, called at each call). An array's maker is not kept
+    anywhere else (array types are also made while the program runs)."""
+    if isinstance(t, T.Struc):
+        return struc_maker(t, _building)
+    if isinstance(t, T.Array):
+        n = 1
+        for d in t.dims:
+            n *= d
+        dims = t.dims
+        e = t.elem
+        if isinstance(e, (T.Struc, T.Array)):
+            mk = partial(make_value, e) if _contains(e, _building) else maker(e, _building)
+
+            def make():
+                return Arr(t, dims, [mk() for _ in range(n)])
+        else:
+            def make():     # (no template: a value is made only after its data memory is taken)
+                return Arr(t, dims, [UNSET] * n)
+        return make
+    return _unset
+
+
+def _unset():
+    return UNSET
 
 
 def make_value(t):
     """A fresh, uninitialised value of type ``t`` (UNSET leaves)."""
     if isinstance(t, T.Struc):
-        fields = t.fields
-        c = _FLAT_STRUC.get(id(t))
-        if c is None or c[0] is not t or c[1] != len(fields):
-            c = _FLAT_STRUC[id(t)] = (t, len(fields), not any(
-                isinstance(ft, (T.Struc, T.Array)) for _, ft in fields.values()))
-        if c[2]:
-            return Struct(t, dict.fromkeys(fields, UNSET))
-        return Struct(t, {k: make_value(ft) for k, (_, ft) in fields.items()})
+        c = _STRUC_MAKERS.get(id(t))
+        if c is not None and c[0] is t and c[1] == len(t.fields):
+            return c[2]()
+        return struc_maker(t)()
     if isinstance(t, T.Array):
         n = 1
         for d in t.dims:
             n *= d
-        if isinstance(t.elem, (T.Struc, T.Array)):
-            return Arr(t, t.dims, [make_value(t.elem) for _ in range(n)])
+        e = t.elem
+        if isinstance(e, T.Struc):
+            make = struc_maker(e)
+            return Arr(t, t.dims, [make() for _ in range(n)])
+        if isinstance(e, T.Array):
+            return Arr(t, t.dims, [make_value(e) for _ in range(n)])
         return Arr(t, t.dims, [UNSET] * n)
     return UNSET
 

@@ -530,7 +530,7 @@ class TreeInterpreter:
             st = e.ann.place
             k = st.kind
             if k == LOCAL:
-                return frame.vars[st.slot]
+                return frame.vars[st.slot] or frame.var(st.slot)
             if k < SYSTEM:
                 return rt.modules[st.owner].refs[st.slot] or rt.storage_ref(st, frame)
             return rt.storage_ref(st, frame)

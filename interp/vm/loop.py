@@ -16,7 +16,7 @@ from interp.runtime.values import (Struct, UNSET)
 from krl.semantics.types import (BOOL as T_BOOL, INT as T_INT, REAL as T_REAL)
 
 # sha256 of the vm.py this file was generated from
-VM_SOURCE = '5b0d79b16e50a266fe67924b56af9bb39ae1709deceb317ddb0a278252ffc088'
+VM_SOURCE = 'a2ae269040db2c5b1025e4743a693d7a45d02da4338254384c081363e550ad2f'
 
 # opcode number (interp/vm/opcodes.py) -> this loop's number of the opcode
 DISPATCH = [18, 0, 10, 66, 64, 63, 56, 76, 110, 80, 78, 111, 112, 77, 4, 12, 58, 13, 61, 93, 53, 75, 36, 72, 70, 71, 40, 82, 34, 2, 3, 65, 92, 90, 89, 86, 85, 83, 20, 11, 7, 19, 91, 14, 8, 114, 35, 6, 59, 24, 30, 29, 27, 26, 32, 17, 88, 52, 81, 22, 25, 67, 84, 1, 16, 21, 55, 51, 33, 79, 54, 74, 31, 9, 113, 57, 28, 69, 96, 60, 50, 5, 15, 87, 23, 68, 62, 73, 49, 38, 39, 44, 98, 47, 48, 99, 95, 94, 43, 106, 45, 42, 41, 46, 100, 108, 37, 107, 109, 97, 102, 104, 105, 103, 101]
@@ -97,7 +97,7 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                             if type(i) is int and 0 < i <= len(d) and ((v := d[(x3 := i) - 1]) is not UNSET):
                                 stack.append(v)
                             else:
-                                stack.append(_element1(fvars[x1], _load(fvars[x2]), ins[3]))
+                                stack.append(_element1(fvars[x1] or frame.var(x1), _load(fvars[x2] or frame.var(x2)), ins[3]))
                             ip += 1
                         elif op < 9:
                             if op < 3:
@@ -144,10 +144,10 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                     stack[-1] = _mul(a, b)
                                 ip += 1
                             elif op < 8:
-                                stack.append(_element2(fvars[ins[1]], _load(fvars[ins[2]]), _load(fvars[ins[3]]), ins[4]))
+                                stack.append(_element2(fvars[ins[1]] or frame.var(ins[1]), _load(fvars[ins[2]] or frame.var(ins[2])), _load(fvars[ins[3]] or frame.var(ins[3])), ins[4]))
                                 ip += 1
                             else:
-                                stack.append(_sub(_load(fvars[ins[1]]), ins[2]))
+                                stack.append(_sub(_load(fvars[ins[1]] or frame.var(ins[1])), ins[2]))
                                 ip += 1
                         elif op < 13:
                             if op < 10:
@@ -157,11 +157,11 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                 i = store[x2]
                                 d = a.data
                                 if not (type(i) is int and 0 < i <= len(d) and ((v := d[(x3 := i) - 1]) is not UNSET)):
-                                    v = _element1(fvars[x1], _load(fvars[x2]), ins[3])
+                                    v = _element1(fvars[x1] or frame.var(x1), _load(fvars[x2] or frame.var(x2)), ins[3])
                                 x1 = ins[4]
                                 b = store[x1]
                                 if b is UNSET:
-                                    b = _load(fvars[x1])
+                                    b = _load(fvars[x1] or frame.var(x1))
                                 ca = type(v)
                                 cb = type(b)
                                 f = ins[5]
@@ -185,7 +185,7 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                     left = n - rt.steps
                                 ip += 1
                             elif op < 12:
-                                _set_element1(fvars[ins[1]], _load(fvars[ins[2]]), stack.pop(), ins[3])
+                                _set_element1(fvars[ins[1]] or frame.var(ins[1]), _load(fvars[ins[2]] or frame.var(ins[2])), stack.pop(), ins[3])
                                 ip += 1
                             else:
                                 n = ins[1]
@@ -205,7 +205,7 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                 _set_component(base, ins[1][0], stack.pop(), ins[2])
                                 ip += 1
                             elif op < 15:
-                                stack.append(_add(_load(fvars[ins[1]]), ins[2]))
+                                stack.append(_add(_load(fvars[ins[1]] or frame.var(ins[1])), ins[2]))
                                 ip += 1
                             else:
                                 t = ins[1]
@@ -238,7 +238,7 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                 x3 = i
                                 d[x3 - 1] = v
                             else:
-                                _set_element1(fvars[x1], _load(fvars[x2]), v, ins[3])
+                                _set_element1(fvars[x1] or frame.var(x1), _load(fvars[x2] or frame.var(x2)), v, ins[3])
                             ip += 1
                     elif op < 54:
                         if op < 32:
@@ -247,9 +247,9 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                     x1 = ins[1]
                                     x2 = ins[2]
                                     v = store[x1]
-                                    stack.append(v if v is not UNSET else _load(fvars[x1]))
+                                    stack.append(v if v is not UNSET else _load(fvars[x1] or frame.var(x1)))
                                     v = store[x2]
-                                    stack.append(v if v is not UNSET else _load(fvars[x2]))
+                                    stack.append(v if v is not UNSET else _load(fvars[x2] or frame.var(x2)))
                                     ip += 1
                                 elif op < 21:
                                     if op < 19:
@@ -269,11 +269,11 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                             left = n - rt.steps
                                         ip += 1
                                     elif op < 20:
-                                        stack.append(_load(fvars[ins[1]]))
-                                        stack.append(_load(fvars[ins[2]]))
+                                        stack.append(_load(fvars[ins[1]] or frame.var(ins[1])))
+                                        stack.append(_load(fvars[ins[2]] or frame.var(ins[2])))
                                         ip += 1
                                     else:
-                                        stack.append(_element1(fvars[ins[1]], _load(fvars[ins[2]]), ins[3]))
+                                        stack.append(_element1(fvars[ins[1]] or frame.var(ins[1]), _load(fvars[ins[2]] or frame.var(ins[2])), ins[3]))
                                         ip += 1
                                 elif op < 22:
                                     x1 = ins[1]
@@ -286,7 +286,7 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                     if type(i) is int and type(j) is int and (0 < i <= n) and (0 < j <= m) and ((v := a.data[((y1 := i) - 1) * (y2 := m) + (y3 := j) - 1]) is not UNSET):
                                         stack.append(v)
                                     else:
-                                        stack.append(_element2(fvars[x1], _load(fvars[x2]), _load(fvars[x3]), ins[4]))
+                                        stack.append(_element2(fvars[x1] or frame.var(x1), _load(fvars[x2] or frame.var(x2)), _load(fvars[x3] or frame.var(x3)), ins[4]))
                                     ip += 1
                                 elif op < 23:
                                     a = store[ins[1]]
@@ -295,7 +295,7 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                     if type(i) is int and 0 < i <= len(d) and ((v := d[(x3 := i) - 1]) is not UNSET):
                                         stack[-1] = v
                                     else:
-                                        stack[-1] = _element1(fvars[ins[1]], i, ins[2])
+                                        stack[-1] = _element1(fvars[ins[1]] or frame.var(ins[1]), i, ins[2])
                                     ip += 1
                                 else:
                                     if code.is_function:
@@ -327,7 +327,7 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                     if type(i) is int and type(j) is int and (0 < i <= n) and (0 < j <= m) and ((v := a.data[((y1 := i) - 1) * (y2 := m) + (y3 := j) - 1]) is not UNSET):
                                         stack[-1] = v
                                     else:
-                                        stack[-1] = _element2(fvars[ins[1]], i, j, ins[2])
+                                        stack[-1] = _element2(fvars[ins[1]] or frame.var(ins[1]), i, j, ins[2])
                                     ip += 1
                                 elif op < 27:
                                     b = stack.pop()
@@ -381,14 +381,14 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                 ca = type(a)
                                 cb = type(b)
                                 f = ins[3]
-                                if f[0](a, b) if (ca is int or ca is float) and (cb is int or cb is float) else f[1](a if a is not UNSET else _load(fvars[x1]), b):
+                                if f[0](a, b) if (ca is int or ca is float) and (cb is int or cb is float) else f[1](a if a is not UNSET else _load(fvars[x1] or frame.var(x1)), b):
                                     ip += 1
                                 else:
                                     ip = ins[4]
                         elif op < 33:
                             x1 = ins[1]
                             v = store[x1]
-                            stack.append(v if v is not UNSET else _load(fvars[x1]))
+                            stack.append(v if v is not UNSET else _load(fvars[x1] or frame.var(x1)))
                             ip += 1
                         elif op < 34:
                             x2 = ins[2]
@@ -576,13 +576,20 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                 _store(temps[ins[1]], stack.pop())
                                 ip += 1
                         elif op < 52:
-                            base = fvars[ins[1]]
+                            x1 = ins[1]
+                            base = fvars[x1]
                             v = stack.pop()
                             k = ins[2][1]
-                            if type(base) is Slot and (not base.readonly) and (type((s := base.c[base.k])) is Struct) and (s.type is not None) and ((ft := s.type.fields.get(k)) is not None) and (k in s.f) and ((t := ft[1]) is T_REAL and type(v) is float or (t is T_INT and type(v) is int and (INT_MIN <= v <= INT_MAX)) or (t is T_BOOL and type(v) is bool)):
+                            if base is None:
+                                s = store[x1]
+                            elif type(base) is Slot and (not base.readonly):
+                                s = base.c[base.k]
+                            else:
+                                s = None
+                            if type(s) is Struct and s.type is not None and ((ft := s.type.fields.get(k)) is not None) and (k in s.f) and ((t := ft[1]) is T_REAL and type(v) is float or (t is T_INT and type(v) is int and (INT_MIN <= v <= INT_MAX)) or (t is T_BOOL and type(v) is bool)):
                                 s.f[k] = v
                             else:
-                                _set_component(base, ins[2][0], v, ins[3])
+                                _set_component(base or frame.var(x1), ins[2][0], v, ins[3])
                             ip += 1
                         elif op < 53:
                             a = store[ins[1]]
@@ -592,10 +599,10 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                             elif type(a) is float and type(b) is float:
                                 stack.append(a - b)
                             else:
-                                stack.append(_sub(a if a is not UNSET else _load(fvars[ins[1]]), b))
+                                stack.append(_sub(a if a is not UNSET else _load(fvars[ins[1]] or frame.var(ins[1])), b))
                             ip += 1
                         else:
-                            _store(fvars[ins[1]], stack.pop())
+                            _store(fvars[ins[1]] or frame.var(ins[1]), stack.pop())
                             ip += 1
                     elif op < 74:
                         if op < 66:
@@ -610,18 +617,22 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                         x3 = ins[3]
                                         store[x3] = a - b if ca is float else v
                                     else:
-                                        _store(fvars[ins[3]], _sub(a if a is not UNSET else _load(fvars[x1]), b))
+                                        _store(fvars[ins[3]] or frame.var(ins[3]), _sub(a if a is not UNSET else _load(fvars[x1] or frame.var(x1)), b))
                                     ip += 1
                                 elif op < 56:
                                     x1 = ins[1]
-                                    base = fvars[x1]
-                                    if type(base) is Slot and type((x := base.c[base.k])) is Struct and (type((x := x.f.get(ins[2][1]))) is float or type(x) is int or type(x) is bool):
+                                    x = store[x1]
+                                    if type(x) is Struct and (type((x := x.f.get(ins[2][1]))) is float or type(x) is int or type(x) is bool):
                                         stack.append(x)
                                     else:
-                                        stack.append(_component(base, ins[2][0], ins[3]))
+                                        base = fvars[x1] or frame.var(x1)
+                                        if type(base) is Slot and type((x := base.c[base.k])) is Struct and (type((x := x.f.get(ins[2][1]))) is float or type(x) is int or type(x) is bool):
+                                            stack.append(x)
+                                        else:
+                                            stack.append(_component(base, ins[2][0], ins[3]))
                                     ip += 1
                                 elif op < 57:
-                                    stack.append(_load(fvars[ins[1]]))
+                                    stack.append(_load(fvars[ins[1]] or frame.var(ins[1])))
                                     ip += 1
                                 else:
                                     ip = ins[1]
@@ -698,7 +709,7 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                 x3 = i
                                 d[x3 - 1] = v
                             else:
-                                _set_element1(fvars[x1], i, v, ins[2])
+                                _set_element1(fvars[x1] or frame.var(x1), i, v, ins[2])
                             ip += 1
                         elif op < 71:
                             if op < 69:
@@ -738,7 +749,7 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                     ca = type(a)
                                     cb = type(b)
                                     f = ins[3]
-                                    if f[0](a, b) if (ca is int or ca is float) and (cb is int or cb is float) else f[1](a if a is not UNSET else _load(fvars[x1]), b if b is not UNSET else _load(fvars[x2])):
+                                    if f[0](a, b) if (ca is int or ca is float) and (cb is int or cb is float) else f[1](a if a is not UNSET else _load(fvars[x1] or frame.var(x1)), b if b is not UNSET else _load(fvars[x2] or frame.var(x2))):
                                         ip += 1
                                     else:
                                         ip = ins[4]
@@ -766,10 +777,10 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                         x3 = ins[3]
                                         store[x3] = a + b if ca is float else v
                                     else:
-                                        _store(fvars[ins[3]], _add(a if a is not UNSET else _load(fvars[x1]), b))
+                                        _store(fvars[ins[3]] or frame.var(ins[3]), _add(a if a is not UNSET else _load(fvars[x1] or frame.var(x1)), b))
                                     ip += 1
                             else:
-                                stack.append(fvars[ins[1]])
+                                stack.append(fvars[ins[1]] or frame.var(ins[1]))
                                 ip += 1
                         elif op < 82:
                             v = stack.pop()
@@ -778,7 +789,7 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                             if type(v) is t and (t is not int or INT_MIN <= v <= INT_MAX):
                                 store[x1] = v
                             else:
-                                _store(fvars[x1], v)
+                                _store(fvars[x1] or frame.var(x1), v)
                             ip += 1
                         elif op < 85:
                             if op < 84:
@@ -812,7 +823,7 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                     y3 = j
                                     a.data[(y1 - 1) * y2 + y3 - 1] = v
                                 else:
-                                    _set_element(fvars[ins[1]], [i, j], v, ins[2])
+                                    _set_element(fvars[ins[1]] or frame.var(ins[1]), [i, j], v, ins[2])
                                 ip += 1
                         elif op < 87:
                             if op < 86:
@@ -857,7 +868,7 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                 elif type(a) is float and type(b) is float:
                                     stack.append(a + b)
                                 else:
-                                    stack.append(_add(a if a is not UNSET else _load(fvars[x1]), b))
+                                    stack.append(_add(a if a is not UNSET else _load(fvars[x1] or frame.var(x1)), b))
                                 ip += 1
                             elif op < 91:
                                 if op < 90:
@@ -1080,7 +1091,7 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                             i = store[x2]
                             d = a.data
                             if not (type(i) is int and 0 < i <= len(d) and ((v := d[(x3 := i) - 1]) is not UNSET)):
-                                v = _element1(fvars[x1], _load(fvars[x2]), ins[3])
+                                v = _element1(fvars[x1] or frame.var(x1), _load(fvars[x2] or frame.var(x2)), ins[3])
                             x1 = ins[4]
                             a = store[x1]
                             b = ins[5]
@@ -1089,7 +1100,7 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                             elif type(a) is float and type(b) is float:
                                 i = a + b
                             else:
-                                i = _add(a if a is not UNSET else _load(fvars[x1]), b)
+                                i = _add(a if a is not UNSET else _load(fvars[x1] or frame.var(x1)), b)
                             x1 = ins[6]
                             a = store[x1]
                             t = ins[8]
@@ -1098,7 +1109,7 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                 x3 = i
                                 d[x3 - 1] = v
                             else:
-                                _set_element1(fvars[x1], i, v, ins[7])
+                                _set_element1(fvars[x1] or frame.var(x1), i, v, ins[7])
                             ip += 1
                     else:
                         if left > 0 and (not ins[1].cond_stops):

@@ -525,12 +525,12 @@ class VM:
                             if i.__class__ is int and 0 < i <= len(d) and (v := d[(x3 := i) - 1]) is not UNSET:
                                 push(v)
                             else:
-                                push(_element1(fvars[x1], _load(fvars[x2]), ins[3]))
+                                push(_element1((fvars[x1] or frame.var(x1)), _load((fvars[x2] or frame.var(x2))), ins[3]))
                             ip += 1
                         elif op == OP.LOAD_FAST:
                             x1 = ins[1]
                             v = store[x1]
-                            push(v if v is not UNSET else _load(fvars[x1]))
+                            push(v if v is not UNSET else _load((fvars[x1] or frame.var(x1))))
                             ip += 1
                         elif op == OP.JUMP_TICK:
                             if left > 0 and not ins[1].cond_stops:
@@ -580,9 +580,9 @@ class VM:
                             x1 = ins[1]
                             x2 = ins[2]
                             v = store[x1]
-                            push(v if v is not UNSET else _load(fvars[x1]))
+                            push(v if v is not UNSET else _load((fvars[x1] or frame.var(x1))))
                             v = store[x2]
-                            push(v if v is not UNSET else _load(fvars[x2]))
+                            push(v if v is not UNSET else _load((fvars[x2] or frame.var(x2))))
                             ip += 1
                         elif op == OP.ADD:
                             b = pop()
@@ -601,7 +601,7 @@ class VM:
                             if v.__class__ is t and (t is not int or INT_MIN <= v <= INT_MAX):
                                 store[x1] = v
                             else:
-                                _store(fvars[x1], v)
+                                _store((fvars[x1] or frame.var(x1)), v)
                             ip += 1
                         elif op == OP.STORE_ELEM1:
                             i = pop()
@@ -614,7 +614,7 @@ class VM:
                                 x3 = i
                                 d[x3 - 1] = v
                             else:
-                                _set_element1(fvars[x1], i, v, ins[2])
+                                _set_element1((fvars[x1] or frame.var(x1)), i, v, ins[2])
                             ip += 1
                         elif op == OP.SUBC_FAST:
                             x1 = ins[1]
@@ -626,7 +626,7 @@ class VM:
                                 x3 = ins[3]
                                 store[x3] = a - b if ca is float else v
                             else:
-                                _store(fvars[ins[3]], _sub(a if a is not UNSET else _load(fvars[x1]), b))
+                                _store((fvars[ins[3]] or frame.var(ins[3])), _sub(a if a is not UNSET else _load((fvars[x1] or frame.var(x1))), b))
                             ip += 1
                         elif op == OP.IF_NOT_VC:
                             x1 = ins[1]
@@ -636,7 +636,7 @@ class VM:
                             cb = b.__class__
                             f = ins[3]
                             if (f[0](a, b) if (ca is int or ca is float) and (cb is int or cb is float)
-                                    else f[1](a if a is not UNSET else _load(fvars[x1]), b)):
+                                    else f[1](a if a is not UNSET else _load((fvars[x1] or frame.var(x1))), b)):
                                 ip += 1
                             else:
                                 ip = ins[4]
@@ -661,7 +661,7 @@ class VM:
                                 x3 = i
                                 d[x3 - 1] = v
                             else:
-                                _set_element1(fvars[x1], _load(fvars[x2]), v, ins[3])
+                                _set_element1((fvars[x1] or frame.var(x1)), _load((fvars[x2] or frame.var(x2))), v, ins[3])
                             ip += 1
                         elif op == OP.IF_NOT_EV:
                             # LOAD_ELEM1_V, LOAD_FAST, IF_NOT_<o>: their handlers in a row
@@ -671,11 +671,11 @@ class VM:
                             i = store[x2]
                             d = a.data
                             if not (i.__class__ is int and 0 < i <= len(d) and (v := d[(x3 := i) - 1]) is not UNSET):
-                                v = _element1(fvars[x1], _load(fvars[x2]), ins[3])
+                                v = _element1((fvars[x1] or frame.var(x1)), _load((fvars[x2] or frame.var(x2))), ins[3])
                             x1 = ins[4]
                             b = store[x1]
                             if b is UNSET:
-                                b = _load(fvars[x1])
+                                b = _load((fvars[x1] or frame.var(x1)))
                             ca = v.__class__
                             cb = b.__class__
                             f = ins[5]
@@ -691,7 +691,7 @@ class VM:
                             i = store[x2]
                             d = a.data
                             if not (i.__class__ is int and 0 < i <= len(d) and (v := d[(x3 := i) - 1]) is not UNSET):
-                                v = _element1(fvars[x1], _load(fvars[x2]), ins[3])
+                                v = _element1((fvars[x1] or frame.var(x1)), _load((fvars[x2] or frame.var(x2))), ins[3])
                             x1 = ins[4]
                             a = store[x1]
                             b = ins[5]
@@ -700,7 +700,7 @@ class VM:
                             elif a.__class__ is float and b.__class__ is float:
                                 i = a + b
                             else:
-                                i = _add(a if a is not UNSET else _load(fvars[x1]), b)
+                                i = _add(a if a is not UNSET else _load((fvars[x1] or frame.var(x1))), b)
                             x1 = ins[6]
                             a = store[x1]
                             t = ins[8]
@@ -709,7 +709,7 @@ class VM:
                                 x3 = i
                                 d[x3 - 1] = v
                             else:
-                                _set_element1(fvars[x1], i, v, ins[7])
+                                _set_element1((fvars[x1] or frame.var(x1)), i, v, ins[7])
                             ip += 1
                         elif op == OP.FAST_ADD_CONST:
                             x1 = ins[1]
@@ -720,10 +720,10 @@ class VM:
                             elif a.__class__ is float and b.__class__ is float:
                                 push(a + b)
                             else:
-                                push(_add(a if a is not UNSET else _load(fvars[x1]), b))
+                                push(_add(a if a is not UNSET else _load((fvars[x1] or frame.var(x1))), b))
                             ip += 1
                         elif op == OP.REF_LOCAL:
-                            push(fvars[ins[1]])
+                            push((fvars[ins[1]] or frame.var(ins[1])))
                             ip += 1
                         elif op == OP.IF_NOT_VV:
                             x1 = ins[1]
@@ -734,7 +734,7 @@ class VM:
                             cb = b.__class__
                             f = ins[3]
                             if (f[0](a, b) if (ca is int or ca is float) and (cb is int or cb is float)
-                                    else f[1](a if a is not UNSET else _load(fvars[x1]), b if b is not UNSET else _load(fvars[x2]))):
+                                    else f[1](a if a is not UNSET else _load((fvars[x1] or frame.var(x1))), b if b is not UNSET else _load((fvars[x2] or frame.var(x2))))):
                                 ip += 1
                             else:
                                 ip = ins[4]
@@ -758,30 +758,46 @@ class VM:
                                 stack[-1] = _component(base, ins[1][0], ins[2])
                             ip += 1
                         elif op == OP.LOAD_FIELD_L:
+                            # a structure the frame holds itself (a local, an :IN copy) is read from
+                            # its store; a reference parameter's through its Slot
                             x1 = ins[1]
-                            base = fvars[x1]
-                            if base.__class__ is Slot and (x := base.c[base.k]).__class__ is Struct and (
+                            x = store[x1]
+                            if x.__class__ is Struct and (
                                     (x := x.f.get(ins[2][1])).__class__ is float or x.__class__ is int
                                     or x.__class__ is bool):
                                 push(x)
                             else:
-                                push(_component(base, ins[2][0], ins[3]))
+                                base = (fvars[x1] or frame.var(x1))
+                                if base.__class__ is Slot and (x := base.c[base.k]).__class__ is Struct and (
+                                        (x := x.f.get(ins[2][1])).__class__ is float or x.__class__ is int
+                                        or x.__class__ is bool):
+                                    push(x)
+                                else:
+                                    push(_component(base, ins[2][0], ins[3]))
                             ip += 1
                         elif op == OP.STORE_FIELD_L:
                             # set_component's fast path (slots.py): a writable Slot holding a typed
-                            # Struct, a field of type INT/REAL/BOOL, a value of that very type
-                            base = fvars[ins[1]]
+                            # Struct, a field of type INT/REAL/BOOL, a value of that very type; a
+                            # variable the frame holds itself and has no Slot of yet is writable
+                            # (Frame.var: not a CONST, no write hook)
+                            x1 = ins[1]
+                            base = fvars[x1]
                             v = pop()
                             k = ins[2][1]
-                            if base.__class__ is Slot and not base.readonly \
-                                    and (s := base.c[base.k]).__class__ is Struct and s.type is not None \
+                            if base is None:
+                                s = store[x1]
+                            elif base.__class__ is Slot and not base.readonly:
+                                s = base.c[base.k]
+                            else:
+                                s = None
+                            if s.__class__ is Struct and s.type is not None \
                                     and (ft := s.type.fields.get(k)) is not None and k in s.f \
                                     and (((t := ft[1]) is T_REAL and v.__class__ is float)
                                          or (t is T_INT and v.__class__ is int and INT_MIN <= v <= INT_MAX)
                                          or (t is T_BOOL and v.__class__ is bool)):
                                 s.f[k] = v
                             else:
-                                _set_component(base, ins[2][0], v, ins[3])
+                                _set_component(base or frame.var(x1), ins[2][0], v, ins[3])
                             ip += 1
                         elif op == OP.UNOP:
                             a = stack[-1]
@@ -809,7 +825,7 @@ class VM:
                                     and (v := a.data[((y1 := i) - 1) * (y2 := m) + (y3 := j) - 1]) is not UNSET:
                                 stack[-1] = v
                             else:
-                                stack[-1] = _element2(fvars[ins[1]], i, j, ins[2])
+                                stack[-1] = _element2((fvars[ins[1]] or frame.var(ins[1])), i, j, ins[2])
                             ip += 1
                         elif op == OP.LOAD_ELEM2_VV:
                             x1 = ins[1]
@@ -823,7 +839,7 @@ class VM:
                                     and (v := a.data[((y1 := i) - 1) * (y2 := m) + (y3 := j) - 1]) is not UNSET:
                                 push(v)
                             else:
-                                push(_element2(fvars[x1], _load(fvars[x2]), _load(fvars[x3]), ins[4]))
+                                push(_element2((fvars[x1] or frame.var(x1)), _load((fvars[x2] or frame.var(x2))), _load((fvars[x3] or frame.var(x3))), ins[4]))
                             ip += 1
                         elif op == OP.STMT:
                             info = ins[1]
@@ -926,7 +942,7 @@ class VM:
                                 y3 = j
                                 a.data[(y1 - 1) * y2 + y3 - 1] = v
                             else:
-                                _set_element(fvars[ins[1]], [i, j], v, ins[2])
+                                _set_element((fvars[ins[1]] or frame.var(ins[1])), [i, j], v, ins[2])
                             ip += 1
                         elif op == OP.ADDC_FAST:
                             x1 = ins[1]
@@ -938,7 +954,7 @@ class VM:
                                 x3 = ins[3]
                                 store[x3] = a + b if ca is float else v
                             else:
-                                _store(fvars[ins[3]], _add(a if a is not UNSET else _load(fvars[x1]), b))
+                                _store((fvars[ins[3]] or frame.var(ins[3])), _add(a if a is not UNSET else _load((fvars[x1] or frame.var(x1))), b))
                             ip += 1
                         elif op == OP.LOAD_MOD:
                             push(_load(mrefs[ins[1]]))
@@ -980,10 +996,10 @@ class VM:
                         elif op == OP.JUMP:
                             ip = ins[1]
                         elif op == OP.LOAD_LOCAL:
-                            push(_load(fvars[ins[1]]))
+                            push(_load((fvars[ins[1]] or frame.var(ins[1]))))
                             ip += 1
                         elif op == OP.STORE_LOCAL:
-                            _store(fvars[ins[1]], pop())
+                            _store((fvars[ins[1]] or frame.var(ins[1])), pop())
                             ip += 1
                         elif op == OP.FAST_SUB_CONST:
                             a = store[ins[1]]
@@ -993,7 +1009,7 @@ class VM:
                             elif a.__class__ is float and b.__class__ is float:
                                 push(a - b)
                             else:
-                                push(_sub(a if a is not UNSET else _load(fvars[ins[1]]), b))
+                                push(_sub(a if a is not UNSET else _load((fvars[ins[1]] or frame.var(ins[1]))), b))
                             ip += 1
                         elif op == OP.SUB_CONST:
                             b = ins[1]
@@ -1060,14 +1076,14 @@ class VM:
                             if i.__class__ is int and 0 < i <= len(d) and (v := d[(x3 := i) - 1]) is not UNSET:
                                 stack[-1] = v
                             else:
-                                stack[-1] = _element1(fvars[ins[1]], i, ins[2])
+                                stack[-1] = _element1((fvars[ins[1]] or frame.var(ins[1])), i, ins[2])
                             ip += 1
                         elif op == OP.LOAD_ELEM_LL:
-                            push(_element1(fvars[ins[1]], _load(fvars[ins[2]]), ins[3]))
+                            push(_element1((fvars[ins[1]] or frame.var(ins[1])), _load((fvars[ins[2]] or frame.var(ins[2]))), ins[3]))
                             ip += 1
                         elif op == OP.LOAD_LOCAL2:
-                            push(_load(fvars[ins[1]]))
-                            push(_load(fvars[ins[2]]))
+                            push(_load((fvars[ins[1]] or frame.var(ins[1]))))
+                            push(_load((fvars[ins[2]] or frame.var(ins[2]))))
                             ip += 1
                         elif op == OP.FOR_NEXT:
                             t = ins[1]
@@ -1089,7 +1105,7 @@ class VM:
                             else:
                                 ip += 1
                         elif op == OP.LOCAL_ADD_CONST:
-                            push(_add(_load(fvars[ins[1]]), ins[2]))
+                            push(_add(_load((fvars[ins[1]] or frame.var(ins[1]))), ins[2]))
                             ip += 1
                         elif op == OP.STORE_INDEX:
                             n = ins[1]
@@ -1104,13 +1120,13 @@ class VM:
                                 _set_element(base, idx, pop(), ins[2])
                             ip += 1
                         elif op == OP.STORE_ELEM_LL:
-                            _set_element1(fvars[ins[1]], _load(fvars[ins[2]]), pop(), ins[3])
+                            _set_element1((fvars[ins[1]] or frame.var(ins[1])), _load((fvars[ins[2]] or frame.var(ins[2]))), pop(), ins[3])
                             ip += 1
                         elif op == OP.LOCAL_SUB_CONST:
-                            push(_sub(_load(fvars[ins[1]]), ins[2]))
+                            push(_sub(_load((fvars[ins[1]] or frame.var(ins[1]))), ins[2]))
                             ip += 1
                         elif op == OP.LOAD_ELEM2_LLL:
-                            push(_element2(fvars[ins[1]], _load(fvars[ins[2]]), _load(fvars[ins[3]]),
+                            push(_element2((fvars[ins[1]] or frame.var(ins[1])), _load((fvars[ins[2]] or frame.var(ins[2]))), _load((fvars[ins[3]] or frame.var(ins[3]))),
                                           ins[4]))
                             ip += 1
                         elif op == OP.FOR_TEST:
