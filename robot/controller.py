@@ -17,8 +17,9 @@ of that cycle (:class:`MotionEvent`, :class:`TriggerEvent`, :class:`IoEvent`,
 it evaluates them after every step.
 
 Time: the clock is the integer IPO cycle count ``k``; ``time = k · 0.012`` s. Motion timing
-uses a *path time* that equals the clock except while BRAKE ramps the path speed down (the
-robot then stays on its path, because every setpoint is a function of path time).
+uses a *path time* that equals the clock except while BRAKE ramps the path speed down, the
+robot is held, and :meth:`Controller.release` ramps it back up within the axis accelerations
+(the robot stays on its path, because every setpoint is a function of path time).
 """
 
 from __future__ import annotations
@@ -183,6 +184,7 @@ class _Held:
     q: np.ndarray
     tool_T: np.ndarray
     base_T: np.ndarray
+    plan_q: np.ndarray            # end point of the last motion planned before the hold
 
 
 class Controller:
@@ -269,6 +271,7 @@ class Controller:
         self._scale_rate = 0.0
         self._braking = False
         self._brake_T = 0.0
+        self._ramp_up = False      # release(): the path speed ramps up within a_max
         self._held: _Held | None = None
         self._moved_while_held = False
         self._q = q.copy()
@@ -521,7 +524,72 @@ class Controller:
         T = max(self.dt, float(np.max(qd / (f * self.model.a_max))))
         self._brake_T = T
         self._scale_rate = -self._scale / T
+        self._ramp_up = False
         self._braking = True
+
+    def _ramp_scale(self, s_old: float, s_lin: float) -> float:
+        """The path-time step (in IPO cycles) of this cycle while :meth:`release` ramps the
+        path speed back up: the linear ramp's `s_lin` where the setpoint it gives keeps every
+        axis within its machine acceleration, else the largest step in ``[s_old, s_lin]`` that
+        does (found by bisection). A scaled path time ``pt(t)`` gives the axes
+        ``q'·ṡ + q''·s²``: the linear ramp alone adds ``q'·ṡ`` to the profile's own
+        acceleration ``q''`` (up to twice ``a_max`` when the motion was braked while it
+        accelerated); the bisection keeps their sum within ``a_max`` (second differences of
+        the setpoints, as robot/limits.py measures them). ``s_old`` itself adds only
+        ``q''·s²``."""
+        if s_lin <= s_old or self.correction is not None:
+            return s_lin
+        dt = self.dt
+        q, qp = self._q, self._q_prev
+        a_lim = self.model.a_max * (dt * dt)
+        segs = [r.seg for r in self._runs]
+        if self._blend is not None:
+            segs.append(self._blend.prev.seg)
+        saved = [(sg, sg._last_q) for sg in segs if hasattr(sg, "_last_q")]
+
+        def ok(s_new: float) -> bool | None:
+            qn = self._peek(self._pt + dt * s_new)
+            for sg, lq in saved:          # a peek must not move the IK references
+                sg._last_q = lq
+            if qn is None or len(qn) != len(q):
+                return None
+            return bool(np.all(np.abs(qn - 2.0 * q + qp) <= a_lim))
+
+        first = ok(s_lin)
+        if first is None or first:
+            return s_lin
+        lo, hi = s_old, s_lin
+        for _ in range(12):
+            mid = 0.5 * (lo + hi)
+            if ok(mid):
+                lo = mid
+            else:
+                hi = mid
+        if lo >= 1.0 - 1e-6:
+            return 1.0
+        return max(lo, min(s_lin, s_old + 1e-6))
+
+    def _peek(self, pt: float) -> np.ndarray | None:
+        """The setpoint the main run would give at path time `pt` (for :meth:`_ramp_scale`),
+        without its events; None when that would start, blend into or end a motion."""
+        try:
+            b = self._blend
+            if b is not None:
+                if pt < b.pb - EPS:
+                    return self._blend_setpoint(b, pt)
+                return None
+            if not self._runs:
+                return None
+            r = self._runs[0]
+            tau = pt - r.t0
+            if tau >= r.seg.T - EPS:
+                return None
+            if r.seg.req.approx is not None and not r.decided and r.tau_cache is not None \
+                    and r.tau_cache[1] is not None and tau >= r.tau_cache[1] - EPS:
+                return None
+            return np.asarray(r.seg.axes(tau), dtype=float)
+        except RobotError:
+            return None
 
     def is_braking(self) -> bool:
         """True while a BRAKE ramp is running."""
@@ -529,8 +597,11 @@ class Controller:
 
     def release(self) -> None:
         """Return from an interrupt routine without RESUME: the motion suspended by BRAKE
-        continues. If the routine moved the robot, the suspended motions are re-planned from
-        the current position (the braked motion as a PTP/LIN to its end point)."""
+        continues from where the robot stands along its path (the path speed ramps up within
+        the axis accelerations, :meth:`_ramp_scale`), and the advance run plans on from the end
+        point of the last motion planned before the BRAKE. If the routine moved the robot,
+        the suspended motions are re-planned from the current position (the braked motion
+        as a PTP/LIN to its end point)."""
         h = self._held
         if h is None:
             return
@@ -553,6 +624,11 @@ class Controller:
             self._base_inv_T = inv_pos(h.base_T)
             self._scale = 0.0
             self._scale_rate = 1.0 / max(self._brake_T, self.dt)
+            self._ramp_up = True
+            # the interrupt level planned from the standstill point; the advance run plans on
+            # from where the suspended chain ends (else the next motion would start at the
+            # standstill point while the robot stands at the braked motion's end point)
+            self._plan_q = h.plan_q
             return
         # re-plan from where the planning chain ends now
         segs = []
@@ -592,6 +668,7 @@ class Controller:
         self._tracked = []
         self._braking = False
         self._scale, self._scale_rate = 1.0, 0.0
+        self._ramp_up = False
         self._plan_q = self._q.copy()
 
     def _abort(self, runs: list[_Run], blend: _Blend | None) -> None:
@@ -762,11 +839,20 @@ class Controller:
 
         # path time (BRAKE ramps scale the path speed)
         s_old = self._scale
-        if self._scale_rate != 0.0:
-            self._scale = min(1.0, max(0.0, self._scale + self._scale_rate * self.dt))
-            if self._scale in (0.0, 1.0):
-                self._scale_rate = 0.0
-        self._pt += self.dt * 0.5 * (s_old + self._scale)
+        if self._ramp_up:
+            # release(): this cycle's path-time step is dt · scale, the scale chosen within
+            # the axes' accelerations (_ramp_scale)
+            self._scale = self._ramp_scale(s_old, min(1.0, s_old + self._scale_rate * self.dt))
+            self._pt += self.dt * self._scale
+            if self._scale >= 1.0:
+                self._scale, self._scale_rate = 1.0, 0.0
+                self._ramp_up = False
+        else:
+            if self._scale_rate != 0.0:
+                self._scale = min(1.0, max(0.0, self._scale + self._scale_rate * self.dt))
+                if self._scale in (0.0, 1.0):
+                    self._scale_rate = 0.0
+            self._pt += self.dt * 0.5 * (s_old + self._scale)
         self._q_prev = self._q
         try:
             q = self._main_run(self._pt)
@@ -1038,6 +1124,7 @@ class Controller:
         self._held = None
         self._braking = False
         self._scale, self._scale_rate = 1.0, 0.0
+        self._ramp_up = False
         self._plan_q = q.copy()
         return q
 
@@ -1045,10 +1132,11 @@ class Controller:
         """BRAKE finished: suspend the main run (interrupt level starts empty)."""
         self._braking = False
         self._held = _Held(self._runs, self._blend, self._pending, self._tracked, self._pt,
-                           self._q.copy(), self._tool_T, self._base_T)
+                           self._q.copy(), self._tool_T, self._base_T, self._plan_q.copy())
         self._ret_q = self._q.copy()
         self._runs, self._blend, self._pending, self._tracked = [], None, deque(), []
         self._scale, self._scale_rate = 1.0, 0.0
+        self._ramp_up = False
         self._moved_while_held = False
         self._plan_q = self._q.copy()
 

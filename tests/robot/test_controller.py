@@ -182,6 +182,59 @@ def test_brake_then_release_continues_to_the_end():
     assert [e["phase"] for e in tw.events if e["kind"] == "motion" and e["id"] == 2][-1] == "end"
 
 
+def test_release_plans_the_next_motion_from_the_end_of_the_held_chain():
+    """After a release without a motion of the interrupt level, the advance run plans on
+    from the end point of the last motion planned before the BRAKE (not from the standstill
+    point): the next PTP starts where the robot then stands and ends at its target."""
+    ctl, tw = _ctl()
+    P = MotionParams()
+    ctl.enqueue(MotionRequest("PTP", HOME, P))
+    ctl.wait_idle()
+    ctl.enqueue(MotionRequest("PTP", {"A1": 150}, P))
+    ctl.step_until(lambda: ctl.time >= 0.3)
+    ctl.brake()
+    ctl.step_until(lambda: not ctl.is_braking())
+    assert ctl.planned_axes()[0] < 150 - 1.0        # interrupt level: from the standstill point
+    ctl.wait_sec(0.1)
+    ctl.release()
+    assert ctl.planned_axes() == pytest.approx([150, -90, 90, 0, 0, 0], abs=1e-9)
+    ctl.enqueue(MotionRequest("PTP", {"A1": 0}, P))
+    ctl.wait_idle()
+    assert ctl.last_error is None
+    assert ctl.axis_setpoint() == pytest.approx([0, -90, 90, 0, 0, 0], abs=1e-9)
+    assert [e["phase"] for e in tw.events if e["kind"] == "motion" and e["id"] == 2] == ["start", "end"]
+
+
+@pytest.mark.parametrize("fast", [False, True])
+@pytest.mark.parametrize("cycles", [2, 5, 10, 20])
+def test_release_ramps_up_within_the_axis_accelerations(fast, cycles):
+    """The path speed ramps back up after a release without any axis exceeding its machine
+    acceleration (second differences of the setpoints), also when the motion was braked
+    while it accelerated (the ramp's own term adds to the profile's acceleration then)."""
+    ctl, tw = _ctl()
+    P = MotionParams()
+    ctl.enqueue(MotionRequest("PTP", HOME, P))
+    ctl.wait_idle()
+    ctl.enqueue(MotionRequest("PTP", {"A1": 160, "A2": -60}, P))
+    for _ in range(cycles):
+        ctl.step()
+    ctl.brake(fast)
+    ctl.step_until(lambda: not ctl.is_braking())
+    ctl.step()
+    t_rel = ctl.time
+    ctl.release()
+    ctl.wait_idle()
+    assert ctl.axis_setpoint() == pytest.approx([160, -60, 90, 0, 0, 0], abs=1e-9)
+    poses = [(e["t"], e["axes"]) for e in tw.events if e["kind"] == "pose" and e["t"] >= t_rel - 2 * DT - 1e-9]
+    Q = np.array([q for _, q in poses])
+    acc = np.abs(Q[2:] - 2 * Q[1:-1] + Q[:-2]) / DT ** 2
+    a_max = np.asarray(ctl.machine.max_acc_deg_s2, dtype=float)
+    # the trace rounds axes to 1e-6 deg: a second difference is exact to ~0.014 deg/s²
+    assert np.all(acc <= a_max * (1 + 1e-4)), (acc / a_max).max()
+    v = np.abs(np.diff(Q, axis=0)) / DT
+    assert np.all(v <= np.asarray(ctl.machine.max_speed_deg_s) * (1 + 1e-4))
+
+
 def test_brake_then_resume_discards_motions():
     ctl, tw, _, _, stop = _brake_run(True)
     ctl.cancel_pending()
