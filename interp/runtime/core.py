@@ -138,7 +138,8 @@ class Runtime:
         self.random = random.Random(0)
         #: the *state epoch*: bumped by everything that may change a probed system variable
         #: (sysvars.py ``EPOCH_PROBED``: a task resumed after an IPO cycle, RESUME, BRAKE, the
-        #: operating mode, a task's end); an interrupt's poll reads those once per epoch
+        #: end of an interrupt routine of the robot task, the operating mode, a task's end);
+        #: an interrupt's poll reads those once per epoch
         self.state_epoch = 0
         self._mode_op = getattr(controller, "mode_op", "AUT")  # $MODE_OP (robot/limits.py)
         self.msg_handle = 0
