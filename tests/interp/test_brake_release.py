@@ -16,18 +16,12 @@ import pytest
 
 from robot.limits import check_trace
 
+from . import test_interrupt_watch as watch
 from .helpers import run_krl
 
 DT = 0.012
 HOME = "PTP {A1 0, A2 -90, A3 90, A4 0, A5 30, A6 0}"
-DAT = """
-DEFDAT prog
-  DECL INT K = 0
-  DECL INT NB = 0
-  DECL INT NM = 0
-  DECL INT AT[20]
-ENDDAT
-"""
+DAT = watch.BRAKER_DAT           # K, NB, NM and AT[20] in prog.dat
 
 
 def _prog(moves: str, handler: str = "", irq_on: bool = True) -> str:
@@ -197,30 +191,10 @@ def test_interrupt_routine_that_moves_then_returns_replans_the_held_motion(tmp_p
     _no_speed_violation(r)
 
 
-BRAKER = """
-DEF prog()
-  INTERRUPT DECL 5 WHEN $IN[1] DO Stopper()
-  INTERRUPT DECL 6 WHEN $PRO_MOVE==TRUE DO OnMove()
-  INTERRUPT ON 5
-  INTERRUPT ON 6
-  PTP {A1 150, A2 -90, A3 90, A4 0, A5 0, A6 0}
-  LOOP
-    K = K + 1
-    IF (NM >= 2) OR (K > 100000) THEN
-      EXIT
-    ENDIF
-  ENDLOOP
-  PTP {A1 0, A2 -90, A3 90, A4 0, A5 0, A6 0}
-END
-DEF Stopper()
-  BRAKE
-  NB = NB + 1
-END
-DEF OnMove()
-  NM = NM + 1
-  AT[NM] = K
-END
-"""
+#: the report's program: the interrupt test's (a BRAKE routine returning without RESUME, an
+#: interrupt on $PRO_MOVE) with a second PTP after its loop
+BRAKER = watch.BRAKER.replace("  ENDLOOP\nEND", "  ENDLOOP\n  PTP {A1 0, A2 -90, A3 90, A4 0, A5 0, A6 0}\nEND")
+assert BRAKER != watch.BRAKER
 
 
 def test_the_ptp_planned_while_the_released_motion_runs_starts_where_it_ends(tmp_path):

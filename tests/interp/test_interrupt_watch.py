@@ -283,14 +283,7 @@ DEF OnMove()
   AT[NM] = K
 END
 """
-BRAKER_DAT = """
-DEFDAT prog
-  DECL INT K = 0
-  DECL INT NB = 0
-  DECL INT NM = 0
-  DECL INT AT[20]
-ENDDAT
-"""
+BRAKER_DAT = SPS_DAT.replace("plc", "prog").replace("NF", "NB")
 BRAKER_STIMULI = """stimuli:
   - at: 0.1
     set: {"$IN[1]": true}
