@@ -16,7 +16,7 @@ from interp.runtime.values import (Struct, UNSET)
 from krl.semantics.types import (BOOL as T_BOOL, INT as T_INT, REAL as T_REAL)
 
 # sha256 of the vm.py this file was generated from
-VM_SOURCE = 'a2ae269040db2c5b1025e4743a693d7a45d02da4338254384c081363e550ad2f'
+VM_SOURCE = '56727e33d0596f4b7f806352a6966b893ebe3ec0a13428e13685161b501dd853'
 
 # opcode number (interp/vm/opcodes.py) -> this loop's number of the opcode
 DISPATCH = [18, 0, 10, 66, 64, 63, 56, 76, 110, 80, 78, 111, 112, 77, 4, 12, 58, 13, 61, 93, 53, 75, 36, 72, 70, 71, 40, 82, 34, 2, 3, 65, 92, 90, 89, 86, 85, 83, 20, 11, 7, 19, 91, 14, 8, 114, 35, 6, 59, 24, 30, 29, 27, 26, 32, 17, 88, 52, 81, 22, 25, 67, 84, 1, 16, 21, 55, 51, 33, 79, 54, 74, 31, 9, 113, 57, 28, 69, 96, 60, 50, 5, 15, 87, 23, 68, 62, 73, 49, 38, 39, 44, 98, 47, 48, 99, 95, 94, 43, 106, 45, 42, 41, 46, 100, 108, 37, 107, 109, 97, 102, 104, 105, 103, 101]
@@ -53,6 +53,7 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
         :data:`HELPERS` (module names of the generated loop: interp/vm/gen_loop.py)."""
     rt = self.rt
     prog = code.prog
+    ops = code.ops
     mrefs = code.mrefs
     grefs = code.grefs
     store = frame.store
@@ -69,7 +70,7 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
             try:
                 while True:
                     ins = prog[ip]
-                    op = ins[0]
+                    op = ops[ip]
                     if op < 17:
                         if op < 1:
                             info = ins[1]
@@ -165,12 +166,19 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                 ca = type(v)
                                 cb = type(b)
                                 f = ins[5]
-                                if f[0](v, b) if (ca is int or ca is float) and (cb is int or cb is float) else f[1](v, b):
+                                if ca is int and cb is int:
+                                    y1 = v
+                                    y2 = b
+                                    x3 = f[2]
+                                    go = x3 >> (y1 > y2) - (y1 < y2) + 1 & 1
+                                else:
+                                    go = f[0](v, b) if (ca is int or ca is float) and (cb is int or cb is float) else f[1](v, b)
+                                if go:
                                     ip += 1
                                 else:
                                     ip = ins[6]
                             elif op < 11:
-                                if left > 0 and (not ins[1].cond_stops):
+                                if left > 0 and (not ins[2]):
                                     left -= 1
                                     unsaved += 1
                                 else:
@@ -381,7 +389,16 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                 ca = type(a)
                                 cb = type(b)
                                 f = ins[3]
-                                if f[0](a, b) if (ca is int or ca is float) and (cb is int or cb is float) else f[1](a if a is not UNSET else _load(fvars[x1] or frame.var(x1)), b):
+                                if ca is int and cb is int:
+                                    y1 = a
+                                    y2 = b
+                                    x3 = f[2]
+                                    go = x3 >> (y1 > y2) - (y1 < y2) + 1 & 1
+                                elif (ca is int or ca is float) and (cb is int or cb is float):
+                                    go = f[0](a, b)
+                                else:
+                                    go = f[1](a if a is not UNSET else _load(fvars[x1] or frame.var(x1)), b)
+                                if go:
                                     ip += 1
                                 else:
                                     ip = ins[4]
@@ -749,7 +766,16 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                     ca = type(a)
                                     cb = type(b)
                                     f = ins[3]
-                                    if f[0](a, b) if (ca is int or ca is float) and (cb is int or cb is float) else f[1](a if a is not UNSET else _load(fvars[x1] or frame.var(x1)), b if b is not UNSET else _load(fvars[x2] or frame.var(x2))):
+                                    if ca is int and cb is int:
+                                        y1 = a
+                                        y2 = b
+                                        x3 = f[2]
+                                        go = x3 >> (y1 > y2) - (y1 < y2) + 1 & 1
+                                    elif (ca is int or ca is float) and (cb is int or cb is float):
+                                        go = f[0](a, b)
+                                    else:
+                                        go = f[1](a if a is not UNSET else _load(fvars[x1] or frame.var(x1)), b if b is not UNSET else _load(fvars[x2] or frame.var(x2)))
+                                    if go:
                                         ip += 1
                                     else:
                                         ip = ins[4]
@@ -1112,7 +1138,7 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                 _set_element1(fvars[x1] or frame.var(x1), i, v, ins[7])
                             ip += 1
                     else:
-                        if left > 0 and (not ins[1].cond_stops):
+                        if left > 0 and (not ins[3]):
                             left -= 1
                             unsaved += 1
                         else:
