@@ -17,9 +17,9 @@ import cython
                x1=cython.Py_ssize_t, x2=cython.Py_ssize_t, x3=cython.Py_ssize_t,
                y1=cython.Py_ssize_t, y2=cython.Py_ssize_t, y3=cython.Py_ssize_t, proceed=cython.bint, dirty=cython.bint,
                go=cython.bint, d=list, f=tuple, ops=bytes)
-cpdef object run(object self, object code, object frame, list temps, Py_ssize_t ip, list stack, bint thunk=*)
+cpdef object run(object self, object code, object frame, list temps=*, Py_ssize_t ip=*, list stack=*, bint thunk=*)
 
-cdef object UNSET, INT_MIN, INT_MAX, Struct, Slot, ValueRef, T_BOOL, T_INT, T_REAL
+cdef object UNSET, Struct, Slot, ValueRef, T_BOOL, T_INT, T_REAL
 cdef object _load, _store, _element, _element1, _element2, _set_element, _set_element1, _component
 cdef object _set_component, _add, _sub, _mul, _lt, _le, _gt, _ge, _eq, _ne, _for_next, _for_limits
 cdef object _read_value, _array_index

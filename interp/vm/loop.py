@@ -8,7 +8,6 @@ there; vm.py runs the compiled module only when its VM_SOURCE matches vm.py."""
 
 import math
 from interp.runtime.builtins import (ValueRef)
-from interp.runtime.convert import (INT_MAX, INT_MIN)
 from interp.runtime.errors import (KrlRuntimeError)
 from interp.runtime.memory import (Slot)
 from interp.runtime.slots import (add, array_index, component, element, element1, element2, ended_without_return, eq, for_done, for_limits, for_next, function_result, ge, gt, le, load, lt, mul, ne, read_value, return_without_value, set_component, set_element, set_element1, store, sub)
@@ -16,7 +15,7 @@ from interp.runtime.values import (Struct, UNSET)
 from krl.semantics.types import (BOOL as T_BOOL, INT as T_INT, REAL as T_REAL)
 
 # sha256 of the vm.py this file was generated from
-VM_SOURCE = '56727e33d0596f4b7f806352a6966b893ebe3ec0a13428e13685161b501dd853'
+VM_SOURCE = '5d525c309a80ff6d7ac790539217bcac6eae85b08b5f512df70b65521788d5e1'
 
 # opcode number (interp/vm/opcodes.py) -> this loop's number of the opcode
 DISPATCH = [18, 0, 10, 66, 64, 63, 56, 76, 110, 80, 78, 111, 112, 77, 4, 12, 58, 13, 61, 93, 53, 75, 36, 72, 70, 71, 40, 82, 34, 2, 3, 65, 92, 90, 89, 86, 85, 83, 20, 11, 7, 19, 91, 14, 8, 114, 35, 6, 59, 24, 30, 29, 27, 26, 32, 17, 88, 52, 81, 22, 25, 67, 84, 1, 16, 21, 55, 51, 33, 79, 54, 74, 31, 9, 113, 57, 28, 69, 96, 60, 50, 5, 15, 87, 23, 68, 62, 73, 49, 38, 39, 44, 98, 47, 48, 99, 95, 94, 43, 106, 45, 42, 41, 46, 100, 108, 37, 107, 109, 97, 102, 104, 105, 103, 101]
@@ -46,11 +45,18 @@ _read_value = read_value
 _array_index = array_index
 
 
-def run(self, code, frame, temps, ip, stack, thunk=False):
+def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
     """Run ``code`` from ``ip`` in the activation of ``frame`` (its runtime Frame) with
         the temporaries ``temps``; returns the value of RETURN,
-        or of the thunk at END_THUNK. The ``_name`` helpers are the runtime functions of
-        :data:`HELPERS` (module names of the generated loop: interp/vm/gen_loop.py)."""
+        or of the thunk at END_THUNK. ``code`` None: the body of a call (:meth:`exec_routine`,
+        ``VM.body``), the code of the frame's routine from its start. The ``_name`` helpers are
+        the runtime functions of :data:`HELPERS` (module names of the generated loop:
+        interp/vm/gen_loop.py)."""
+    if code is None:
+        routine = frame.routine
+        code = self.codes.get(id(routine)) or self.code_for(routine)
+        temps = [None] * code.ntemps
+        stack = [None, None, None, None, None, None, None, None]
     rt = self.rt
     prog = code.prog
     ops = code.ops
@@ -106,7 +112,7 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                 a = stack[-1]
                                 if type(a) is float and type(b) is float:
                                     stack[-1] = a + b
-                                elif type(a) is int and type(b) is int and (INT_MIN <= (v := (a + b)) <= INT_MAX):
+                                elif type(a) is int and type(b) is int and (-2147483648 <= (v := (a + b)) <= 2147483647):
                                     stack[-1] = v
                                 else:
                                     stack[-1] = _add(a, b)
@@ -117,7 +123,7 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                     a = stack[-1]
                                     if type(a) is float and type(b) is float:
                                         stack[-1] = a - b
-                                    elif type(a) is int and type(b) is int and (INT_MIN <= (v := (a - b)) <= INT_MAX):
+                                    elif type(a) is int and type(b) is int and (-2147483648 <= (v := (a - b)) <= 2147483647):
                                         stack[-1] = v
                                     else:
                                         stack[-1] = _sub(a, b)
@@ -130,7 +136,14 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                     ip += 1
                                 else:
                                     t = ins[1]
-                                    if for_done(temps[t].get(), temps[t + 1], temps[t + 2]):
+                                    ref = temps[t]
+                                    end = temps[t + 1]
+                                    step = temps[t + 2]
+                                    if type(ref) is Slot and type((c := ref.c[ref.k])) is int and (type(end) is int) and (type(step) is int):
+                                        go = c > end if step > 0 else c < end
+                                    else:
+                                        go = for_done(temps[t].get(), end, step)
+                                    if go:
                                         ip = ins[2]
                                     else:
                                         ip += 1
@@ -139,8 +152,10 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                 a = stack[-1]
                                 if type(a) is float and type(b) is float:
                                     stack[-1] = a * b
-                                elif type(a) is int and type(b) is int and (INT_MIN <= (v := (a * b)) <= INT_MAX):
+                                elif type(a) is int and type(b) is int and (-2147483648 <= (v := (a * b)) <= 2147483647):
                                     stack[-1] = v
+                                elif type(a) is int and type(b) is float or (type(a) is float and type(b) is int):
+                                    stack[-1] = a * b
                                 else:
                                     stack[-1] = _mul(a, b)
                                 ip += 1
@@ -242,7 +257,7 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                             v = stack.pop()
                             t = ins[4]
                             d = a.data
-                            if type(i) is int and 0 < i <= len(d) and (type(v) is t) and (t is not int or INT_MIN <= v <= INT_MAX):
+                            if type(i) is int and 0 < i <= len(d) and (type(v) is t) and (t is not int or -2147483648 <= v <= 2147483647):
                                 x3 = i
                                 d[x3 - 1] = v
                             else:
@@ -414,6 +429,9 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                             if type(c) is int and (c := (c + temps[x2 + 2])) <= temps[x2 + 3]:
                                 store[x1] = c
                                 go = True
+                            elif type(c) is int and type((step := temps[x2 + 2])) is int and (type((end := temps[x2 + 1])) is int) and (-2147483648 <= c <= 2147483647):
+                                store[x1] = c
+                                go = c <= end if step > 0 else c >= end
                             else:
                                 go = _for_next(temps[x2], temps[x2 + 1], temps[x2 + 2], ins[3])
                             if go:
@@ -448,7 +466,7 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                 a = stack[-1]
                                 if type(a) is float and type(b) is float:
                                     stack[-1] = a - b
-                                elif type(a) is int and type(b) is int and (INT_MIN <= (v := (a - b)) <= INT_MAX):
+                                elif type(a) is int and type(b) is int and (-2147483648 <= (v := (a - b)) <= 2147483647):
                                     stack[-1] = v
                                 else:
                                     stack[-1] = _sub(a, b)
@@ -590,7 +608,12 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                     ip = cold[op](ins, code, frame, temps, stack, ip)
                                     left = task.quiet - rt.steps if task is not None else 0
                             else:
-                                _store(temps[ins[1]], stack.pop())
+                                ref = temps[ins[1]]
+                                v = stack.pop()
+                                if type(ref) is Slot and ref.type is T_INT and (type(v) is int) and (not ref.readonly) and (ref.on_write is None) and (-2147483648 <= v <= 2147483647):
+                                    ref.c[ref.k] = v
+                                else:
+                                    _store(ref, v)
                                 ip += 1
                         elif op < 52:
                             x1 = ins[1]
@@ -603,7 +626,7 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                 s = base.c[base.k]
                             else:
                                 s = None
-                            if type(s) is Struct and s.type is not None and ((ft := s.type.fields.get(k)) is not None) and (k in s.f) and ((t := ft[1]) is T_REAL and type(v) is float or (t is T_INT and type(v) is int and (INT_MIN <= v <= INT_MAX)) or (t is T_BOOL and type(v) is bool)):
+                            if type(s) is Struct and s.type is not None and ((ft := s.type.fields.get(k)) is not None) and (k in s.f) and ((t := ft[1]) is T_REAL and type(v) is float or (t is T_INT and type(v) is int and (-2147483648 <= v <= 2147483647)) or (t is T_BOOL and type(v) is bool)):
                                 s.f[k] = v
                             else:
                                 _set_component(base or frame.var(x1), ins[2][0], v, ins[3])
@@ -611,7 +634,7 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                         elif op < 53:
                             a = store[ins[1]]
                             b = ins[2]
-                            if type(a) is int and type(b) is int and (INT_MIN <= (v := (a - b)) <= INT_MAX):
+                            if type(a) is int and type(b) is int and (-2147483648 <= (v := (a - b)) <= 2147483647):
                                 stack.append(v)
                             elif type(a) is float and type(b) is float:
                                 stack.append(a - b)
@@ -630,7 +653,7 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                     b = ins[2]
                                     t = ins[4]
                                     ca = type(a)
-                                    if ca is type(b) and ca is t and (ca is float or (ca is int and INT_MIN <= (v := (a - b)) <= INT_MAX)):
+                                    if ca is type(b) and ca is t and (ca is float or (ca is int and -2147483648 <= (v := (a - b)) <= 2147483647)):
                                         x3 = ins[3]
                                         store[x3] = a - b if ca is float else v
                                     else:
@@ -676,8 +699,11 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                     end = stack.pop()
                                     start = stack.pop()
                                     temps[t] = stack.pop()
-                                    temps[t + 1], temps[t + 2] = end, step = _for_limits(end, step)
-                                    temps[t + 3] = min(end, INT_MAX) if type(step) is int and step > 0 else -math.inf
+                                    if not (type(end) is int and type(step) is int and (step != 0)):
+                                        end, step = _for_limits(end, step)
+                                    temps[t + 1] = end
+                                    temps[t + 2] = step
+                                    temps[t + 3] = min(end, 2147483647) if type(step) is int and step > 0 else -math.inf
                                     stack.append(start)
                                     ip += 1
                                 else:
@@ -707,8 +733,10 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                 a = stack[-1]
                                 if type(a) is float and type(b) is float:
                                     stack[-1] = a * b
-                                elif type(a) is int and type(b) is int and (INT_MIN <= (v := (a * b)) <= INT_MAX):
+                                elif type(a) is int and type(b) is int and (-2147483648 <= (v := (a * b)) <= 2147483647):
                                     stack[-1] = v
+                                elif type(a) is int and type(b) is float or (type(a) is float and type(b) is int):
+                                    stack[-1] = a * b
                                 else:
                                     stack[-1] = _mul(a, b)
                                 ip += 1
@@ -722,7 +750,7 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                             a = store[x1]
                             t = ins[3]
                             d = a.data
-                            if type(i) is int and 0 < i <= len(d) and (type(v) is t) and (t is not int or INT_MIN <= v <= INT_MAX):
+                            if type(i) is int and 0 < i <= len(d) and (type(v) is t) and (t is not int or -2147483648 <= v <= 2147483647):
                                 x3 = i
                                 d[x3 - 1] = v
                             else:
@@ -799,7 +827,7 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                     b = ins[2]
                                     t = ins[4]
                                     ca = type(a)
-                                    if ca is type(b) and ca is t and (ca is float or (ca is int and INT_MIN <= (v := (a + b)) <= INT_MAX)):
+                                    if ca is type(b) and ca is t and (ca is float or (ca is int and -2147483648 <= (v := (a + b)) <= 2147483647)):
                                         x3 = ins[3]
                                         store[x3] = a + b if ca is float else v
                                     else:
@@ -812,7 +840,7 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                             v = stack.pop()
                             t = ins[2]
                             x1 = ins[1]
-                            if type(v) is t and (t is not int or INT_MIN <= v <= INT_MAX):
+                            if type(v) is t and (t is not int or -2147483648 <= v <= 2147483647):
                                 store[x1] = v
                             else:
                                 _store(fvars[x1] or frame.var(x1), v)
@@ -825,7 +853,7 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                     if ins[1] == '/' and type(b) is type(a) and (b != 0):
                                         if type(a) is float:
                                             stack[-1] = a / b
-                                        elif type(a) is int and INT_MIN <= (v := (abs(a) // abs(b) if (a >= 0) == (b >= 0) else -(abs(a) // abs(b)))) <= INT_MAX:
+                                        elif type(a) is int and -2147483648 <= (v := (abs(a) // abs(b) if (a >= 0) == (b >= 0) else -(abs(a) // abs(b)))) <= 2147483647:
                                             stack[-1] = v
                                         else:
                                             stack[-1] = rt.binary_op(ins[1], a, b)
@@ -843,7 +871,7 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                 a = store[ins[1]]
                                 n, m = a.dims
                                 t = ins[3]
-                                if type(i) is int and type(j) is int and (0 < i <= n) and (0 < j <= m) and (type(v) is t) and (t is not int or INT_MIN <= v <= INT_MAX):
+                                if type(i) is int and type(j) is int and (0 < i <= n) and (0 < j <= m) and (type(v) is t) and (t is not int or -2147483648 <= v <= 2147483647):
                                     y1 = i
                                     y2 = m
                                     y3 = j
@@ -889,7 +917,7 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                 x1 = ins[1]
                                 a = store[x1]
                                 b = ins[2]
-                                if type(a) is int and type(b) is int and (INT_MIN <= (v := (a + b)) <= INT_MAX):
+                                if type(a) is int and type(b) is int and (-2147483648 <= (v := (a + b)) <= 2147483647):
                                     stack.append(v)
                                 elif type(a) is float and type(b) is float:
                                     stack.append(a + b)
@@ -910,7 +938,7 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                 a = stack[-1]
                                 if type(a) is float and type(b) is float:
                                     stack[-1] = a + b
-                                elif type(a) is int and type(b) is int and (INT_MIN <= (v := (a + b)) <= INT_MAX):
+                                elif type(a) is int and type(b) is int and (-2147483648 <= (v := (a + b)) <= 2147483647):
                                     stack[-1] = v
                                 else:
                                     stack[-1] = _add(a, b)
@@ -1121,7 +1149,7 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                             x1 = ins[4]
                             a = store[x1]
                             b = ins[5]
-                            if type(a) is int and type(b) is int and (INT_MIN <= (i := (a + b)) <= INT_MAX):
+                            if type(a) is int and type(b) is int and (-2147483648 <= (i := (a + b)) <= 2147483647):
                                 pass
                             elif type(a) is float and type(b) is float:
                                 i = a + b
@@ -1131,7 +1159,7 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                             a = store[x1]
                             t = ins[8]
                             d = a.data
-                            if type(i) is int and 0 < i <= len(d) and (type(v) is t) and (t is not int or INT_MIN <= v <= INT_MAX):
+                            if type(i) is int and 0 < i <= len(d) and (type(v) is t) and (t is not int or -2147483648 <= v <= 2147483647):
                                 x3 = i
                                 d[x3 - 1] = v
                             else:

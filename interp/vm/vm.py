@@ -32,6 +32,7 @@ The cold opcodes (motion, interrupts, triggers, analog I/O, waits, ...) are meth
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import importlib.util
 import math
@@ -203,9 +204,12 @@ class VM:
             handler = getattr(self, "_cold_" + o.name, None)
             if handler is not None:
                 self.cold[self.dispatch[o.number]] = handler
+        # the body of a KRL call (exec_routine without its Python frame: the loop itself, which
+        # finds the routine's code when called without one)
+        self.body = functools.partial(self.loop, self, None)
         # the runtime's statement hooks, bound once (the loop takes them at each call)
         self.hooks = (rt.before_statement, rt.loop_tick, rt.take_error_proceed, rt.quiet_limit, rt.run_routine,
-                      self.exec_routine)
+                      self.body)
 
     # ------------------------------------------------------------------ entry points
     def run_program(self, module_name: str | None = None) -> None:
@@ -226,7 +230,7 @@ class VM:
     def invoke(self, target, args: list, caller, catch_resume: bool = True):
         """Run routine ``target`` = (module, Routine) with reference ``args`` (the
         runtime's call protocol, Runtime.run_routine)."""
-        return self.rt.run_routine(target, args, caller, self.exec_routine, catch_resume)
+        return self.rt.run_routine(target, args, caller, self.body, catch_resume)
 
     def exec_routine(self, frame):
         """Run the code of the routine of ``frame`` (compiled on its first call); the value
@@ -468,11 +472,18 @@ class VM:
         return ip + 1
 
     # ------------------------------------------------------------------ the loop
-    def run(self, code, frame, temps: list, ip: int, stack: list, thunk: bool = False):
+    def run(self, code, frame, temps: list | None = None, ip: int = 0, stack: list | None = None, thunk: bool = False):
         """Run ``code`` from ``ip`` in the activation of ``frame`` (its runtime Frame) with
         the temporaries ``temps``; returns the value of RETURN,
-        or of the thunk at END_THUNK. The ``_name`` helpers are the runtime functions of
-        :data:`HELPERS` (module names of the generated loop: interp/vm/gen_loop.py)."""
+        or of the thunk at END_THUNK. ``code`` None: the body of a call (:meth:`exec_routine`,
+        ``VM.body``), the code of the frame's routine from its start. The ``_name`` helpers are
+        the runtime functions of :data:`HELPERS` (module names of the generated loop:
+        interp/vm/gen_loop.py)."""
+        if code is None:
+            routine = frame.routine
+            code = self.codes.get(id(routine)) or self.code_for(routine)
+            temps = [None] * code.ntemps
+            stack = [None, None, None, None, None, None, None, None]      # STACK_BASE
         rt = self.rt
         prog = code.prog
         ops = code.ops               # prog's opcodes, one byte each (C integers when compiled)
@@ -564,6 +575,11 @@ class VM:
                             if c.__class__ is int and (c := c + temps[x2 + 2]) <= temps[x2 + 3]:
                                 store[x1] = c
                                 go = True
+                            elif (c.__class__ is int and (step := temps[x2 + 2]).__class__ is int
+                                  and (end := temps[x2 + 1]).__class__ is int and INT_MIN <= c <= INT_MAX):
+                                # the last step (or a negative STEP): for_next's INT case inline
+                                store[x1] = c
+                                go = c <= end if step > 0 else c >= end
                             else:
                                 go = _for_next(temps[x2], temps[x2 + 1], temps[x2 + 2], ins[3])
                             if go:
@@ -775,6 +791,8 @@ class VM:
                                 stack[-1] = a * b
                             elif a.__class__ is int and b.__class__ is int and INT_MIN <= (v := a * b) <= INT_MAX:
                                 stack[-1] = v
+                            elif (a.__class__ is int and b.__class__ is float) or (a.__class__ is float and b.__class__ is int):
+                                stack[-1] = a * b                   # INT * REAL: REAL (mul)
                             else:
                                 stack[-1] = _mul(a, b)
                             ip += 1
@@ -913,6 +931,8 @@ class VM:
                                 stack[-1] = a * b
                             elif a.__class__ is int and b.__class__ is int and INT_MIN <= (v := a * b) <= INT_MAX:
                                 stack[-1] = v
+                            elif (a.__class__ is int and b.__class__ is float) or (a.__class__ is float and b.__class__ is int):
+                                stack[-1] = a * b                   # INT * REAL: REAL (mul)
                             else:
                                 stack[-1] = _mul(a, b)
                             ip += 1
@@ -1161,7 +1181,15 @@ class VM:
                             ip += 1
                         elif op == OP.FOR_TEST:
                             t = ins[1]
-                            if for_done(temps[t].get(), temps[t + 1], temps[t + 2]):
+                            ref = temps[t]
+                            end = temps[t + 1]
+                            step = temps[t + 2]
+                            if ref.__class__ is Slot and (c := ref.c[ref.k]).__class__ is int and end.__class__ is int \
+                                    and step.__class__ is int:
+                                go = c > end if step > 0 else c < end       # for_done, INTs (STEP is not 0)
+                            else:
+                                go = for_done(temps[t].get(), end, step)
+                            if go:
                                 ip = ins[2]
                             else:
                                 ip += 1
@@ -1272,12 +1300,22 @@ class VM:
                             end = pop()
                             start = pop()
                             temps[t] = pop()
-                            temps[t + 1], temps[t + 2] = end, step = _for_limits(end, step)
+                            if not (end.__class__ is int and step.__class__ is int and step != 0):
+                                end, step = _for_limits(end, step)       # (two INTs: for_limits' result)
+                            temps[t + 1] = end
+                            temps[t + 2] = step
                             temps[t + 3] = min(end, INT_MAX) if step.__class__ is int and step > 0 else -math.inf
                             push(start)
                             ip += 1
                         elif op == OP.FOR_INIT:
-                            _store(temps[ins[1]], pop())
+                            ref = temps[ins[1]]
+                            v = pop()
+                            # store's fast path (slots.py) for an INT counter
+                            if (ref.__class__ is Slot and ref.type is T_INT and v.__class__ is int and not ref.readonly
+                                    and ref.on_write is None and INT_MIN <= v <= INT_MAX):
+                                ref.c[ref.k] = v
+                            else:
+                                _store(ref, v)
                             ip += 1
                         elif (op == OP.AGG or op == OP.JUMP_IF_NONE or op == OP.HALT or op == OP.WAIT_FOR or
                               op == OP.WAIT_SEC or op == OP.CONTINUE or op == OP.ON_ERROR_PROCEED or
