@@ -5,7 +5,8 @@
 # and tuples (indexing without a generic call); x1, x2, x3 hold a handler's slot numbers and
 # in-range element indexes (y1, y2, y3: the row, row length and column of a 2-D element; y1, y2
 # also two INTs compared in C) (list indexing by a C integer); proceed, dirty and go (a jump's
-# condition) are C flags; d is an array's data (values.Arr: always a list), f a comparison's
+# condition) are C flags; d is an array's data (values.Arr: always a list; adata keeps them, agrid
+# the (data, rows, columns) grid of each 2-D array), f a comparison's
 # (operator, runtime function, mask) (vm._COMPARE).
 # The module's names the handlers read (the runtime's constants, classes and functions) are C
 # globals: no dictionary lookup per use.
@@ -16,7 +17,7 @@ import cython
                unsaved=cython.Py_ssize_t,
                x1=cython.Py_ssize_t, x2=cython.Py_ssize_t, x3=cython.Py_ssize_t,
                y1=cython.Py_ssize_t, y2=cython.Py_ssize_t, y3=cython.Py_ssize_t, proceed=cython.bint, dirty=cython.bint,
-               go=cython.bint, d=list, f=tuple, ops=bytes)
+               go=cython.bint, d=list, f=tuple, ops=bytes, adata=list, agrid=list, grid=tuple)
 cpdef object run(object self, object code, object frame, list temps=*, Py_ssize_t ip=*, list stack=*, bint thunk=*)
 
 cdef object UNSET, Struct, Slot, ValueRef, T_BOOL, T_INT, T_REAL

@@ -15,7 +15,7 @@ from interp.runtime.values import (Struct, UNSET)
 from krl.semantics.types import (BOOL as T_BOOL, INT as T_INT, REAL as T_REAL)
 
 # sha256 of the vm.py this file was generated from
-VM_SOURCE = '5d525c309a80ff6d7ac790539217bcac6eae85b08b5f512df70b65521788d5e1'
+VM_SOURCE = 'd796a0b3d3c6f5d9ec99f65dd725e7c4cce9f559416de49fab2a21ea894d5377'
 
 # opcode number (interp/vm/opcodes.py) -> this loop's number of the opcode
 DISPATCH = [18, 0, 10, 66, 64, 63, 56, 76, 110, 80, 78, 111, 112, 77, 4, 12, 58, 13, 61, 93, 53, 75, 36, 72, 70, 71, 40, 82, 34, 2, 3, 65, 92, 90, 89, 86, 85, 83, 20, 11, 7, 19, 91, 14, 8, 114, 35, 6, 59, 24, 30, 29, 27, 26, 32, 17, 88, 52, 81, 22, 25, 67, 84, 1, 16, 21, 55, 51, 33, 79, 54, 74, 31, 9, 113, 57, 28, 69, 96, 60, 50, 5, 15, 87, 23, 68, 62, 73, 49, 38, 39, 44, 98, 47, 48, 99, 95, 94, 43, 106, 45, 42, 41, 46, 100, 108, 37, 107, 109, 97, 102, 104, 105, 103, 101]
@@ -63,6 +63,8 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
     mrefs = code.mrefs
     grefs = code.grefs
     store = frame.store
+    adata = [None] * len(store)
+    agrid = [None] * len(store)
     fvars = frame.vars
     before, tick, take_error_proceed, quiet_limit, run_routine, exec_routine = self.hooks
     cold = self.cold
@@ -98,10 +100,11 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                         elif op < 2:
                             x1 = ins[1]
                             x2 = ins[2]
-                            a = store[x1]
                             i = store[x2]
-                            d = a.data
-                            if type(i) is int and 0 < i <= len(d) and ((v := d[(x3 := i) - 1]) is not UNSET):
+                            d = adata[x1]
+                            if d is None:
+                                d = adata[x1] = store[x1].data
+                            if type(i) is int and 0 < i <= 2147483647 and ((x3 := i) <= len(d)) and ((v := d[x3 - 1]) is not UNSET):
                                 stack.append(v)
                             else:
                                 stack.append(_element1(fvars[x1] or frame.var(x1), _load(fvars[x2] or frame.var(x2)), ins[3]))
@@ -169,10 +172,11 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                             if op < 10:
                                 x1 = ins[1]
                                 x2 = ins[2]
-                                a = store[x1]
                                 i = store[x2]
-                                d = a.data
-                                if not (type(i) is int and 0 < i <= len(d) and ((v := d[(x3 := i) - 1]) is not UNSET)):
+                                d = adata[x1]
+                                if d is None:
+                                    d = adata[x1] = store[x1].data
+                                if not (type(i) is int and 0 < i <= 2147483647 and ((x3 := i) <= len(d)) and ((v := d[x3 - 1]) is not UNSET)):
                                     v = _element1(fvars[x1] or frame.var(x1), _load(fvars[x2] or frame.var(x2)), ins[3])
                                 x1 = ins[4]
                                 b = store[x1]
@@ -252,13 +256,13 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                         else:
                             x1 = ins[1]
                             x2 = ins[2]
-                            a = store[x1]
                             i = store[x2]
                             v = stack.pop()
                             t = ins[4]
-                            d = a.data
-                            if type(i) is int and 0 < i <= len(d) and (type(v) is t) and (t is not int or -2147483648 <= v <= 2147483647):
-                                x3 = i
+                            d = adata[x1]
+                            if d is None:
+                                d = adata[x1] = store[x1].data
+                            if type(i) is int and 0 < i <= 2147483647 and ((x3 := i) <= len(d)) and (type(v) is t) and (t is not int or -2147483648 <= v <= 2147483647):
                                 d[x3 - 1] = v
                             else:
                                 _set_element1(fvars[x1] or frame.var(x1), _load(fvars[x2] or frame.var(x2)), v, ins[3])
@@ -302,20 +306,26 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                                     x1 = ins[1]
                                     x2 = ins[2]
                                     x3 = ins[3]
-                                    a = store[x1]
                                     i = store[x2]
                                     j = store[x3]
-                                    n, m = a.dims
-                                    if type(i) is int and type(j) is int and (0 < i <= n) and (0 < j <= m) and ((v := a.data[((y1 := i) - 1) * (y2 := m) + (y3 := j) - 1]) is not UNSET):
+                                    grid = agrid[x1]
+                                    if grid is None:
+                                        a = store[x1]
+                                        grid = agrid[x1] = (a.data, a.dims[0], a.dims[1])
+                                    n = grid[1]
+                                    m = grid[2]
+                                    if type(i) is int and type(j) is int and (0 < i <= n) and (0 < j <= m) and ((v := grid[0][((y1 := i) - 1) * (y2 := m) + (y3 := j) - 1]) is not UNSET):
                                         stack.append(v)
                                     else:
                                         stack.append(_element2(fvars[x1] or frame.var(x1), _load(fvars[x2] or frame.var(x2)), _load(fvars[x3] or frame.var(x3)), ins[4]))
                                     ip += 1
                                 elif op < 23:
-                                    a = store[ins[1]]
+                                    x1 = ins[1]
                                     i = stack[-1]
-                                    d = a.data
-                                    if type(i) is int and 0 < i <= len(d) and ((v := d[(x3 := i) - 1]) is not UNSET):
+                                    d = adata[x1]
+                                    if d is None:
+                                        d = adata[x1] = store[x1].data
+                                    if type(i) is int and 0 < i <= 2147483647 and ((x3 := i) <= len(d)) and ((v := d[x3 - 1]) is not UNSET):
                                         stack[-1] = v
                                     else:
                                         stack[-1] = _element1(fvars[ins[1]] or frame.var(ins[1]), i, ins[2])
@@ -345,9 +355,14 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                                 elif op < 26:
                                     j = stack.pop()
                                     i = stack[-1]
-                                    a = store[ins[1]]
-                                    n, m = a.dims
-                                    if type(i) is int and type(j) is int and (0 < i <= n) and (0 < j <= m) and ((v := a.data[((y1 := i) - 1) * (y2 := m) + (y3 := j) - 1]) is not UNSET):
+                                    x1 = ins[1]
+                                    grid = agrid[x1]
+                                    if grid is None:
+                                        a = store[x1]
+                                        grid = agrid[x1] = (a.data, a.dims[0], a.dims[1])
+                                    n = grid[1]
+                                    m = grid[2]
+                                    if type(i) is int and type(j) is int and (0 < i <= n) and (0 < j <= m) and ((v := grid[0][((y1 := i) - 1) * (y2 := m) + (y3 := j) - 1]) is not UNSET):
                                         stack[-1] = v
                                     else:
                                         stack[-1] = _element2(fvars[ins[1]] or frame.var(ins[1]), i, j, ins[2])
@@ -747,11 +762,11 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                             i = stack.pop()
                             v = stack.pop()
                             x1 = ins[1]
-                            a = store[x1]
                             t = ins[3]
-                            d = a.data
-                            if type(i) is int and 0 < i <= len(d) and (type(v) is t) and (t is not int or -2147483648 <= v <= 2147483647):
-                                x3 = i
+                            d = adata[x1]
+                            if d is None:
+                                d = adata[x1] = store[x1].data
+                            if type(i) is int and 0 < i <= 2147483647 and ((x3 := i) <= len(d)) and (type(v) is t) and (t is not int or -2147483648 <= v <= 2147483647):
                                 d[x3 - 1] = v
                             else:
                                 _set_element1(fvars[x1] or frame.var(x1), i, v, ins[2])
@@ -868,14 +883,19 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                                 j = stack.pop()
                                 i = stack.pop()
                                 v = stack.pop()
-                                a = store[ins[1]]
-                                n, m = a.dims
+                                x1 = ins[1]
+                                grid = agrid[x1]
+                                if grid is None:
+                                    a = store[x1]
+                                    grid = agrid[x1] = (a.data, a.dims[0], a.dims[1])
+                                n = grid[1]
+                                m = grid[2]
                                 t = ins[3]
                                 if type(i) is int and type(j) is int and (0 < i <= n) and (0 < j <= m) and (type(v) is t) and (t is not int or -2147483648 <= v <= 2147483647):
                                     y1 = i
                                     y2 = m
                                     y3 = j
-                                    a.data[(y1 - 1) * y2 + y3 - 1] = v
+                                    grid[0][(y1 - 1) * y2 + y3 - 1] = v
                                 else:
                                     _set_element(fvars[ins[1]] or frame.var(ins[1]), [i, j], v, ins[2])
                                 ip += 1
@@ -1141,10 +1161,11 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                         else:
                             x1 = ins[1]
                             x2 = ins[2]
-                            a = store[x1]
                             i = store[x2]
-                            d = a.data
-                            if not (type(i) is int and 0 < i <= len(d) and ((v := d[(x3 := i) - 1]) is not UNSET)):
+                            d = adata[x1]
+                            if d is None:
+                                d = adata[x1] = store[x1].data
+                            if not (type(i) is int and 0 < i <= 2147483647 and ((x3 := i) <= len(d)) and ((v := d[x3 - 1]) is not UNSET)):
                                 v = _element1(fvars[x1] or frame.var(x1), _load(fvars[x2] or frame.var(x2)), ins[3])
                             x1 = ins[4]
                             a = store[x1]
@@ -1156,11 +1177,11 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                             else:
                                 i = _add(a if a is not UNSET else _load(fvars[x1] or frame.var(x1)), b)
                             x1 = ins[6]
-                            a = store[x1]
                             t = ins[8]
-                            d = a.data
-                            if type(i) is int and 0 < i <= len(d) and (type(v) is t) and (t is not int or -2147483648 <= v <= 2147483647):
-                                x3 = i
+                            d = adata[x1]
+                            if d is None:
+                                d = adata[x1] = store[x1].data
+                            if type(i) is int and 0 < i <= 2147483647 and ((x3 := i) <= len(d)) and (type(v) is t) and (t is not int or -2147483648 <= v <= 2147483647):
                                 d[x3 - 1] = v
                             else:
                                 _set_element1(fvars[x1] or frame.var(x1), i, v, ins[7])

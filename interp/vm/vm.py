@@ -490,6 +490,10 @@ class VM:
         mrefs = code.mrefs
         grefs = code.grefs
         store = frame.store          # store variables (operand kind v): Frame.store keys
+        # the data list of each store array, read from the store when first used: an array's data
+        # list is never replaced (values.Arr; convert.assign_into fills it in place)
+        adata = [None] * len(store)
+        agrid = [None] * len(store)
         fvars = frame.vars
         push = stack.append
         pop = stack.pop
@@ -537,10 +541,11 @@ class VM:
                         elif op == OP.LOAD_ELEM1_V:
                             x1 = ins[1]             # x1, x2, x3: C integers when compiled (loop.pxd)
                             x2 = ins[2]
-                            a = store[x1]
                             i = store[x2]
-                            d = a.data              # 1-D: len(data) is dims[0] (values.Arr)
-                            if i.__class__ is int and 0 < i <= len(d) and (v := d[(x3 := i) - 1]) is not UNSET:
+                            d = adata[x1]  # 1-D: len(data) is dims[0] (values.Arr)
+                            if d is None:
+                                d = adata[x1] = store[x1].data
+                            if i.__class__ is int and 0 < i <= INT_MAX and (x3 := i) <= len(d) and (v := d[x3 - 1]) is not UNSET:
                                 push(v)
                             else:
                                 push(_element1((fvars[x1] or frame.var(x1)), _load((fvars[x2] or frame.var(x2))), ins[3]))
@@ -630,11 +635,11 @@ class VM:
                             i = pop()
                             v = pop()
                             x1 = ins[1]
-                            a = store[x1]
                             t = ins[3]
-                            d = a.data
-                            if i.__class__ is int and 0 < i <= len(d) and v.__class__ is t and (t is not int or INT_MIN <= v <= INT_MAX):
-                                x3 = i
+                            d = adata[x1]
+                            if d is None:
+                                d = adata[x1] = store[x1].data
+                            if i.__class__ is int and 0 < i <= INT_MAX and (x3 := i) <= len(d) and v.__class__ is t and (t is not int or INT_MIN <= v <= INT_MAX):
                                 d[x3 - 1] = v
                             else:
                                 _set_element1((fvars[x1] or frame.var(x1)), i, v, ins[2])
@@ -683,13 +688,13 @@ class VM:
                         elif op == OP.STORE_ELEM1_V:
                             x1 = ins[1]
                             x2 = ins[2]
-                            a = store[x1]
                             i = store[x2]
                             v = pop()
                             t = ins[4]
-                            d = a.data
-                            if i.__class__ is int and 0 < i <= len(d) and v.__class__ is t and (t is not int or INT_MIN <= v <= INT_MAX):
-                                x3 = i
+                            d = adata[x1]
+                            if d is None:
+                                d = adata[x1] = store[x1].data
+                            if i.__class__ is int and 0 < i <= INT_MAX and (x3 := i) <= len(d) and v.__class__ is t and (t is not int or INT_MIN <= v <= INT_MAX):
                                 d[x3 - 1] = v
                             else:
                                 _set_element1((fvars[x1] or frame.var(x1)), _load((fvars[x2] or frame.var(x2))), v, ins[3])
@@ -698,10 +703,11 @@ class VM:
                             # LOAD_ELEM1_V, LOAD_FAST, IF_NOT_<o>: their handlers in a row
                             x1 = ins[1]
                             x2 = ins[2]
-                            a = store[x1]
                             i = store[x2]
-                            d = a.data
-                            if not (i.__class__ is int and 0 < i <= len(d) and (v := d[(x3 := i) - 1]) is not UNSET):
+                            d = adata[x1]
+                            if d is None:
+                                d = adata[x1] = store[x1].data
+                            if not (i.__class__ is int and 0 < i <= INT_MAX and (x3 := i) <= len(d) and (v := d[x3 - 1]) is not UNSET):
                                 v = _element1((fvars[x1] or frame.var(x1)), _load((fvars[x2] or frame.var(x2))), ins[3])
                             x1 = ins[4]
                             b = store[x1]
@@ -725,10 +731,11 @@ class VM:
                             # LOAD_ELEM1_V, FAST_ADD_CONST, STORE_ELEM1: their handlers in a row
                             x1 = ins[1]
                             x2 = ins[2]
-                            a = store[x1]
                             i = store[x2]
-                            d = a.data
-                            if not (i.__class__ is int and 0 < i <= len(d) and (v := d[(x3 := i) - 1]) is not UNSET):
+                            d = adata[x1]
+                            if d is None:
+                                d = adata[x1] = store[x1].data
+                            if not (i.__class__ is int and 0 < i <= INT_MAX and (x3 := i) <= len(d) and (v := d[x3 - 1]) is not UNSET):
                                 v = _element1((fvars[x1] or frame.var(x1)), _load((fvars[x2] or frame.var(x2))), ins[3])
                             x1 = ins[4]
                             a = store[x1]
@@ -740,11 +747,11 @@ class VM:
                             else:
                                 i = _add(a if a is not UNSET else _load((fvars[x1] or frame.var(x1))), b)
                             x1 = ins[6]
-                            a = store[x1]
                             t = ins[8]
-                            d = a.data
-                            if i.__class__ is int and 0 < i <= len(d) and v.__class__ is t and (t is not int or INT_MIN <= v <= INT_MAX):
-                                x3 = i
+                            d = adata[x1]
+                            if d is None:
+                                d = adata[x1] = store[x1].data
+                            if i.__class__ is int and 0 < i <= INT_MAX and (x3 := i) <= len(d) and v.__class__ is t and (t is not int or INT_MIN <= v <= INT_MAX):
                                 d[x3 - 1] = v
                             else:
                                 _set_element1((fvars[x1] or frame.var(x1)), i, v, ins[7])
@@ -867,10 +874,15 @@ class VM:
                         elif op == OP.LOAD_ELEM2:
                             j = pop()
                             i = stack[-1]
-                            a = store[ins[1]]
-                            n, m = a.dims
+                            x1 = ins[1]
+                            grid = agrid[x1]
+                            if grid is None:               # (data, rows, columns) of a 2-D store array: they never change
+                                a = store[x1]
+                                grid = agrid[x1] = (a.data, a.dims[0], a.dims[1])
+                            n = grid[1]
+                            m = grid[2]
                             if i.__class__ is int and j.__class__ is int and 0 < i <= n and 0 < j <= m \
-                                    and (v := a.data[((y1 := i) - 1) * (y2 := m) + (y3 := j) - 1]) is not UNSET:
+                                    and (v := grid[0][((y1 := i) - 1) * (y2 := m) + (y3 := j) - 1]) is not UNSET:
                                 stack[-1] = v
                             else:
                                 stack[-1] = _element2((fvars[ins[1]] or frame.var(ins[1])), i, j, ins[2])
@@ -879,12 +891,16 @@ class VM:
                             x1 = ins[1]
                             x2 = ins[2]
                             x3 = ins[3]
-                            a = store[x1]
                             i = store[x2]
                             j = store[x3]
-                            n, m = a.dims
+                            grid = agrid[x1]
+                            if grid is None:               # (data, rows, columns) of a 2-D store array: they never change
+                                a = store[x1]
+                                grid = agrid[x1] = (a.data, a.dims[0], a.dims[1])
+                            n = grid[1]
+                            m = grid[2]
                             if i.__class__ is int and j.__class__ is int and 0 < i <= n and 0 < j <= m \
-                                    and (v := a.data[((y1 := i) - 1) * (y2 := m) + (y3 := j) - 1]) is not UNSET:
+                                    and (v := grid[0][((y1 := i) - 1) * (y2 := m) + (y3 := j) - 1]) is not UNSET:
                                 push(v)
                             else:
                                 push(_element2((fvars[x1] or frame.var(x1)), _load((fvars[x2] or frame.var(x2))), _load((fvars[x3] or frame.var(x3))), ins[4]))
@@ -983,14 +999,19 @@ class VM:
                             j = pop()
                             i = pop()
                             v = pop()
-                            a = store[ins[1]]
-                            n, m = a.dims
+                            x1 = ins[1]
+                            grid = agrid[x1]
+                            if grid is None:               # (data, rows, columns) of a 2-D store array: they never change
+                                a = store[x1]
+                                grid = agrid[x1] = (a.data, a.dims[0], a.dims[1])
+                            n = grid[1]
+                            m = grid[2]
                             t = ins[3]
                             if i.__class__ is int and j.__class__ is int and 0 < i <= n and 0 < j <= m and v.__class__ is t and (t is not int or INT_MIN <= v <= INT_MAX):
                                 y1 = i
                                 y2 = m
                                 y3 = j
-                                a.data[(y1 - 1) * y2 + y3 - 1] = v
+                                grid[0][(y1 - 1) * y2 + y3 - 1] = v
                             else:
                                 _set_element((fvars[ins[1]] or frame.var(ins[1])), [i, j], v, ins[2])
                             ip += 1
@@ -1120,10 +1141,12 @@ class VM:
                                 dirty = False
                             return None
                         elif op == OP.LOAD_ELEM1:
-                            a = store[ins[1]]
+                            x1 = ins[1]
                             i = stack[-1]
-                            d = a.data
-                            if i.__class__ is int and 0 < i <= len(d) and (v := d[(x3 := i) - 1]) is not UNSET:
+                            d = adata[x1]
+                            if d is None:
+                                d = adata[x1] = store[x1].data
+                            if i.__class__ is int and 0 < i <= INT_MAX and (x3 := i) <= len(d) and (v := d[x3 - 1]) is not UNSET:
                                 stack[-1] = v
                             else:
                                 stack[-1] = _element1((fvars[ins[1]] or frame.var(ins[1])), i, ins[2])
