@@ -756,6 +756,46 @@ class VM:
                             else:
                                 _set_element1((fvars[x1] or frame.var(x1)), i, v, ins[7])
                             ip += 1
+                        elif op == OP.ADD_FAST:
+                            # LOAD_FAST2, ADD, STORE_FAST: their handlers in a row
+                            x1 = ins[1]
+                            x2 = ins[2]
+                            a = store[x1]
+                            b = store[x2]
+                            t = ins[4]
+                            if a.__class__ is int and b.__class__ is int and t is int and INT_MIN <= (v := a + b) <= INT_MAX:
+                                x3 = ins[3]
+                                store[x3] = v
+                            elif a.__class__ is float and b.__class__ is float and t is float:
+                                x3 = ins[3]
+                                store[x3] = a + b
+                            else:
+                                if a is UNSET:
+                                    a = _load((fvars[x1] or frame.var(x1)))
+                                if b is UNSET:
+                                    b = _load((fvars[x2] or frame.var(x2)))
+                                v = _add(a, b)          # (ADD's inline cases give add's result)
+                                x3 = ins[3]
+                                if v.__class__ is t and (t is not int or INT_MIN <= v <= INT_MAX):
+                                    store[x3] = v
+                                else:
+                                    _store((fvars[x3] or frame.var(x3)), v)
+                            ip += 1
+                        elif op == OP.STORE_ELEM1_VC:
+                            # CONST, STORE_ELEM1_V
+                            x1 = ins[1]
+                            x2 = ins[2]
+                            i = store[x2]
+                            v = ins[5]
+                            t = ins[4]
+                            d = adata[x1]
+                            if d is None:
+                                d = adata[x1] = store[x1].data
+                            if i.__class__ is int and 0 < i <= INT_MAX and (x3 := i) <= len(d) and v.__class__ is t and (t is not int or INT_MIN <= v <= INT_MAX):
+                                d[x3 - 1] = v
+                            else:
+                                _set_element1((fvars[x1] or frame.var(x1)), _load((fvars[x2] or frame.var(x2))), v, ins[3])
+                            ip += 1
                         elif op == OP.FAST_ADD_CONST:
                             x1 = ins[1]
                             a = store[x1]
