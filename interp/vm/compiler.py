@@ -793,6 +793,10 @@ def _fuse(group: list):
         return ("IF_NOT_EV", [*ops[0], ops[1][0], _CMP_SYMBOLS[names[2]], ops[2][0]])
     if len(group) == 3 and names == ["LOAD_ELEM1_V", "FAST_ADD_CONST", "STORE_ELEM1"]:
         return ("MOVE_ELEM1", [*ops[0], *ops[1], *ops[2]])
+    if len(group) == 3 and names == ["LOAD_FAST2", "ADD", "STORE_FAST"]:
+        return ("ADD_FAST", [*ops[0], *ops[2]])
+    if len(group) == 2 and names == ["CONST", "STORE_ELEM1_V"]:
+        return ("STORE_ELEM1_VC", [*ops[1], ops[0][0]])
     if len(group) == 3 and names == ["LOAD_FAST", "LOAD_FAST", "LOAD_ELEM2"]:
         return ("LOAD_ELEM2_VV", [ops[2][0], ops[0][0], ops[1][0], ops[2][1]])
     if len(group) == 2 and names[0] in ("FAST_ADD_CONST", "FAST_SUB_CONST") and names[1] == "STORE_FAST":

@@ -33,7 +33,10 @@ import itertools
 import sys
 from pathlib import Path
 
+from interp.runtime.convert import INT_MAX, INT_MIN
 from interp.vm import opcodes as OP
+
+_LITERALS = {"INT_MIN": INT_MIN, "INT_MAX": INT_MAX}
 
 HERE = Path(__file__).resolve().parent
 SOURCE = HERE / "vm.py"
@@ -133,7 +136,14 @@ def _free_names(func: ast.FunctionDef) -> set[str]:
 class _Plain(ast.NodeTransformer):
     """Spellings that run as fast in CPython and compile to C in Cython: ``x.__class__`` ->
     ``type(x)`` (a pointer comparison when compiled), ``push(v)`` / ``pop()`` (the source's
-    bound-method aliases) -> ``stack.append(v)`` / ``stack.pop()``."""
+    bound-method aliases) -> ``stack.append(v)`` / ``stack.pop()``, the INT range's bounds
+    ``INT_MIN`` / ``INT_MAX`` -> their literal values (Cython compares a Python int with a literal
+    in C)."""
+
+    def visit_Name(self, node):
+        if node.id in _LITERALS and isinstance(node.ctx, ast.Load):
+            return ast.copy_location(ast.Constant(_LITERALS[node.id]), node)
+        return node
 
     def visit_Attribute(self, node):
         self.generic_visit(node)

@@ -8,7 +8,6 @@ there; vm.py runs the compiled module only when its VM_SOURCE matches vm.py."""
 
 import math
 from interp.runtime.builtins import (ValueRef)
-from interp.runtime.convert import (INT_MAX, INT_MIN)
 from interp.runtime.errors import (KrlRuntimeError)
 from interp.runtime.memory import (Slot)
 from interp.runtime.slots import (add, array_index, component, element, element1, element2, ended_without_return, eq, for_done, for_limits, for_next, function_result, ge, gt, le, load, lt, mul, ne, read_value, return_without_value, set_component, set_element, set_element1, store, sub)
@@ -16,10 +15,10 @@ from interp.runtime.values import (Struct, UNSET)
 from krl.semantics.types import (BOOL as T_BOOL, INT as T_INT, REAL as T_REAL)
 
 # sha256 of the vm.py this file was generated from
-VM_SOURCE = 'a2ae269040db2c5b1025e4743a693d7a45d02da4338254384c081363e550ad2f'
+VM_SOURCE = 'd583071419ad1130b997ae2a50fa84e323d8720101cc6930a531c85aa80ad3a9'
 
 # opcode number (interp/vm/opcodes.py) -> this loop's number of the opcode
-DISPATCH = [18, 0, 10, 66, 64, 63, 56, 76, 110, 80, 78, 111, 112, 77, 4, 12, 58, 13, 61, 93, 53, 75, 36, 72, 70, 71, 40, 82, 34, 2, 3, 65, 92, 90, 89, 86, 85, 83, 20, 11, 7, 19, 91, 14, 8, 114, 35, 6, 59, 24, 30, 29, 27, 26, 32, 17, 88, 52, 81, 22, 25, 67, 84, 1, 16, 21, 55, 51, 33, 79, 54, 74, 31, 9, 113, 57, 28, 69, 96, 60, 50, 5, 15, 87, 23, 68, 62, 73, 49, 38, 39, 44, 98, 47, 48, 99, 95, 94, 43, 106, 45, 42, 41, 46, 100, 108, 37, 107, 109, 97, 102, 104, 105, 103, 101]
+DISPATCH = [8, 0, 114, 68, 62, 61, 51, 72, 108, 67, 76, 109, 110, 75, 112, 7, 50, 5, 58, 91, 49, 66, 34, 70, 65, 63, 38, 78, 23, 2, 89, 53, 90, 87, 86, 84, 83, 79, 14, 6, 3, 13, 85, 10, 4, 116, 28, 111, 55, 24, 26, 25, 22, 21, 32, 17, 73, 29, 80, 18, 15, 69, 77, 1, 16, 12, 30, 27, 33, 74, 54, 60, 31, 9, 115, 88, 81, 52, 20, 64, 94, 57, 48, 113, 11, 82, 19, 59, 56, 71, 47, 36, 37, 42, 96, 45, 46, 97, 93, 92, 41, 104, 43, 40, 39, 44, 98, 106, 35, 105, 107, 95, 100, 102, 103, 101, 99]
 
 # the runtime functions of vm.HELPERS under the names the handlers call
 _load = load
@@ -46,16 +45,26 @@ _read_value = read_value
 _array_index = array_index
 
 
-def run(self, code, frame, temps, ip, stack, thunk=False):
+def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
     """Run ``code`` from ``ip`` in the activation of ``frame`` (its runtime Frame) with
         the temporaries ``temps``; returns the value of RETURN,
-        or of the thunk at END_THUNK. The ``_name`` helpers are the runtime functions of
-        :data:`HELPERS` (module names of the generated loop: interp/vm/gen_loop.py)."""
+        or of the thunk at END_THUNK. ``code`` None: the body of a call (:meth:`exec_routine`,
+        ``VM.body``), the code of the frame's routine from its start. The ``_name`` helpers are
+        the runtime functions of :data:`HELPERS` (module names of the generated loop:
+        interp/vm/gen_loop.py)."""
+    if code is None:
+        routine = frame.routine
+        code = self.codes.get(id(routine)) or self.code_for(routine)
+        temps = [None] * code.ntemps
+        stack = [None, None, None, None, None, None, None, None]
     rt = self.rt
     prog = code.prog
+    ops = code.ops
     mrefs = code.mrefs
     grefs = code.grefs
     store = frame.store
+    adata = [None] * len(store)
+    agrid = [None] * len(store)
     fvars = frame.vars
     before, tick, take_error_proceed, quiet_limit, run_routine, exec_routine = self.hooks
     cold = self.cold
@@ -69,7 +78,7 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
             try:
                 while True:
                     ins = prog[ip]
-                    op = ins[0]
+                    op = ops[ip]
                     if op < 17:
                         if op < 1:
                             info = ins[1]
@@ -91,10 +100,11 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                         elif op < 2:
                             x1 = ins[1]
                             x2 = ins[2]
-                            a = store[x1]
                             i = store[x2]
-                            d = a.data
-                            if type(i) is int and 0 < i <= len(d) and ((v := d[(x3 := i) - 1]) is not UNSET):
+                            d = adata[x1]
+                            if d is None:
+                                d = adata[x1] = store[x1].data
+                            if type(i) is int and 0 < i <= 2147483647 and ((x3 := i) <= len(d)) and ((v := d[x3 - 1]) is not UNSET):
                                 stack.append(v)
                             else:
                                 stack.append(_element1(fvars[x1] or frame.var(x1), _load(fvars[x2] or frame.var(x2)), ins[3]))
@@ -105,58 +115,64 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                 a = stack[-1]
                                 if type(a) is float and type(b) is float:
                                     stack[-1] = a + b
-                                elif type(a) is int and type(b) is int and (INT_MIN <= (v := (a + b)) <= INT_MAX):
+                                elif type(a) is int and type(b) is int and (-2147483648 <= (v := (a + b)) <= 2147483647):
                                     stack[-1] = v
                                 else:
                                     stack[-1] = _add(a, b)
                                 ip += 1
                             elif op < 6:
-                                if op < 4:
-                                    b = stack.pop()
-                                    a = stack[-1]
-                                    if type(a) is float and type(b) is float:
-                                        stack[-1] = a - b
-                                    elif type(a) is int and type(b) is int and (INT_MIN <= (v := (a - b)) <= INT_MAX):
-                                        stack[-1] = v
-                                    else:
-                                        stack[-1] = _sub(a, b)
-                                    ip += 1
-                                elif op < 5:
-                                    n = ins[1]
-                                    idx = stack[-n:]
-                                    del stack[-n:]
-                                    stack[-1] = _element(stack[-1], idx, ins[2])
-                                    ip += 1
-                                else:
-                                    t = ins[1]
-                                    if for_done(temps[t].get(), temps[t + 1], temps[t + 2]):
-                                        ip = ins[2]
-                                    else:
+                                if op < 5:
+                                    if op < 4:
+                                        stack.append(_element2(fvars[ins[1]] or frame.var(ins[1]), _load(fvars[ins[2]] or frame.var(ins[2])), _load(fvars[ins[3]] or frame.var(ins[3])), ins[4]))
                                         ip += 1
-                            elif op < 7:
-                                b = ins[1]
-                                a = stack[-1]
-                                if type(a) is float and type(b) is float:
-                                    stack[-1] = a * b
-                                elif type(a) is int and type(b) is int and (INT_MIN <= (v := (a * b)) <= INT_MAX):
-                                    stack[-1] = v
+                                    else:
+                                        stack.append(_sub(_load(fvars[ins[1]] or frame.var(ins[1])), ins[2]))
+                                        ip += 1
                                 else:
-                                    stack[-1] = _mul(a, b)
-                                ip += 1
+                                    base = stack.pop()
+                                    _set_component(base, ins[1][0], stack.pop(), ins[2])
+                                    ip += 1
                             elif op < 8:
-                                stack.append(_element2(fvars[ins[1]] or frame.var(ins[1]), _load(fvars[ins[2]] or frame.var(ins[2])), _load(fvars[ins[3]] or frame.var(ins[3])), ins[4]))
-                                ip += 1
+                                if op < 7:
+                                    _set_element1(fvars[ins[1]] or frame.var(ins[1]), _load(fvars[ins[2]] or frame.var(ins[2])), stack.pop(), ins[3])
+                                    ip += 1
+                                else:
+                                    n = ins[1]
+                                    if n == 1:
+                                        i = stack.pop()
+                                        base = stack.pop()
+                                        _set_element1(base, i, stack.pop(), ins[2])
+                                    else:
+                                        idx = stack[-n:]
+                                        del stack[-n:]
+                                        base = stack.pop()
+                                        _set_element(base, idx, stack.pop(), ins[2])
+                                    ip += 1
                             else:
-                                stack.append(_sub(_load(fvars[ins[1]] or frame.var(ins[1])), ins[2]))
+                                info = ins[1]
+                                dirty = False
+                                if not thunk:
+                                    frame.line = ins[2]
+                                if left > 0 and (not ins[3]):
+                                    left -= 1
+                                    unsaved += 1
+                                    task.at = info
+                                else:
+                                    rt.steps += unsaved
+                                    unsaved = 0
+                                    before(info)
+                                    task.quiet = n = quiet_limit(task)
+                                    left = n - rt.steps
                                 ip += 1
                         elif op < 13:
                             if op < 10:
                                 x1 = ins[1]
                                 x2 = ins[2]
-                                a = store[x1]
                                 i = store[x2]
-                                d = a.data
-                                if not (type(i) is int and 0 < i <= len(d) and ((v := d[(x3 := i) - 1]) is not UNSET)):
+                                d = adata[x1]
+                                if d is None:
+                                    d = adata[x1] = store[x1].data
+                                if not (type(i) is int and 0 < i <= 2147483647 and ((x3 := i) <= len(d)) and ((v := d[x3 - 1]) is not UNSET)):
                                     v = _element1(fvars[x1] or frame.var(x1), _load(fvars[x2] or frame.var(x2)), ins[3])
                                 x1 = ins[4]
                                 b = store[x1]
@@ -165,77 +181,91 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                 ca = type(v)
                                 cb = type(b)
                                 f = ins[5]
-                                if f[0](v, b) if (ca is int or ca is float) and (cb is int or cb is float) else f[1](v, b):
+                                if ca is int and cb is int:
+                                    y1 = v
+                                    y2 = b
+                                    x3 = f[2]
+                                    go = x3 >> (y1 > y2) - (y1 < y2) + 1 & 1
+                                else:
+                                    go = f[0](v, b) if (ca is int or ca is float) and (cb is int or cb is float) else f[1](v, b)
+                                if go:
                                     ip += 1
                                 else:
                                     ip = ins[6]
-                            elif op < 11:
-                                if left > 0 and (not ins[1].cond_stops):
-                                    left -= 1
-                                    unsaved += 1
-                                else:
-                                    if dirty:
-                                        frame.line = info.line
-                                        task.at = info
-                                        dirty = False
-                                    rt.steps += unsaved
-                                    unsaved = 0
-                                    tick(ins[1])
-                                    task.quiet = n = quiet_limit(task)
-                                    left = n - rt.steps
-                                ip += 1
                             elif op < 12:
-                                _set_element1(fvars[ins[1]] or frame.var(ins[1]), _load(fvars[ins[2]] or frame.var(ins[2])), stack.pop(), ins[3])
-                                ip += 1
-                            else:
-                                n = ins[1]
-                                if n == 1:
-                                    i = stack.pop()
-                                    base = stack.pop()
-                                    _set_element1(base, i, stack.pop(), ins[2])
+                                if op < 11:
+                                    stack.append(_add(_load(fvars[ins[1]] or frame.var(ins[1])), ins[2]))
+                                    ip += 1
                                 else:
-                                    idx = stack[-n:]
-                                    del stack[-n:]
-                                    base = stack.pop()
-                                    _set_element(base, idx, stack.pop(), ins[2])
+                                    t = ins[1]
+                                    if _for_next(temps[t], temps[t + 1], temps[t + 2], ins[2]):
+                                        if left > 0 and (not ins[2].cond_stops):
+                                            left -= 1
+                                            unsaved += 1
+                                        else:
+                                            if dirty:
+                                                frame.line = info.line
+                                                task.at = info
+                                                dirty = False
+                                            rt.steps += unsaved
+                                            unsaved = 0
+                                            tick(ins[2])
+                                            task.quiet = n = quiet_limit(task)
+                                            left = n - rt.steps
+                                        ip = ins[3]
+                                    else:
+                                        ip += 1
+                            else:
+                                x1 = ins[1]
+                                x2 = ins[2]
+                                x3 = ins[3]
+                                i = store[x2]
+                                j = store[x3]
+                                grid = agrid[x1]
+                                if grid is None:
+                                    a = store[x1]
+                                    grid = agrid[x1] = (a.data, a.dims[0], a.dims[1])
+                                n = grid[1]
+                                m = grid[2]
+                                if type(i) is int and type(j) is int and (0 < i <= n) and (0 < j <= m) and ((v := grid[0][((y1 := i) - 1) * (y2 := m) + (y3 := j) - 1]) is not UNSET):
+                                    stack.append(v)
+                                else:
+                                    stack.append(_element2(fvars[x1] or frame.var(x1), _load(fvars[x2] or frame.var(x2)), _load(fvars[x3] or frame.var(x3)), ins[4]))
                                 ip += 1
                         elif op < 16:
-                            if op < 14:
-                                base = stack.pop()
-                                _set_component(base, ins[1][0], stack.pop(), ins[2])
-                                ip += 1
-                            elif op < 15:
-                                stack.append(_add(_load(fvars[ins[1]] or frame.var(ins[1])), ins[2]))
-                                ip += 1
-                            else:
-                                t = ins[1]
-                                if _for_next(temps[t], temps[t + 1], temps[t + 2], ins[2]):
-                                    if left > 0 and (not ins[2].cond_stops):
-                                        left -= 1
-                                        unsaved += 1
-                                    else:
-                                        if dirty:
-                                            frame.line = info.line
-                                            task.at = info
-                                            dirty = False
-                                        rt.steps += unsaved
-                                        unsaved = 0
-                                        tick(ins[2])
-                                        task.quiet = n = quiet_limit(task)
-                                        left = n - rt.steps
-                                    ip = ins[3]
-                                else:
+                            if op < 15:
+                                if op < 14:
+                                    stack.append(_load(fvars[ins[1]] or frame.var(ins[1])))
+                                    stack.append(_load(fvars[ins[2]] or frame.var(ins[2])))
                                     ip += 1
+                                else:
+                                    stack.append(_element1(fvars[ins[1]] or frame.var(ins[1]), _load(fvars[ins[2]] or frame.var(ins[2])), ins[3]))
+                                    ip += 1
+                            else:
+                                j = stack.pop()
+                                i = stack[-1]
+                                x1 = ins[1]
+                                grid = agrid[x1]
+                                if grid is None:
+                                    a = store[x1]
+                                    grid = agrid[x1] = (a.data, a.dims[0], a.dims[1])
+                                n = grid[1]
+                                m = grid[2]
+                                if type(i) is int and type(j) is int and (0 < i <= n) and (0 < j <= m) and ((v := grid[0][((y1 := i) - 1) * (y2 := m) + (y3 := j) - 1]) is not UNSET):
+                                    stack[-1] = v
+                                else:
+                                    stack[-1] = _element2(fvars[ins[1]] or frame.var(ins[1]), i, j, ins[2])
+                                ip += 1
                         else:
                             x1 = ins[1]
                             x2 = ins[2]
-                            a = store[x1]
                             i = store[x2]
                             v = stack.pop()
                             t = ins[4]
-                            d = a.data
-                            if type(i) is int and 0 < i <= len(d) and (type(v) is t) and (t is not int or INT_MIN <= v <= INT_MAX):
-                                x3 = i
+                            d = adata[x1]
+                            if d is None:
+                                d = adata[x1] = store[x1].data
+                            if type(i) is int and 0 < i <= 2147483647 and ((x3 := i) <= len(d)) and (type(v) is t) and (t is not int or -2147483648 <= v <= 2147483647):
                                 d[x3 - 1] = v
                             else:
                                 _set_element1(fvars[x1] or frame.var(x1), _load(fvars[x2] or frame.var(x2)), v, ins[3])
@@ -252,63 +282,66 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                     stack.append(v if v is not UNSET else _load(fvars[x2] or frame.var(x2)))
                                     ip += 1
                                 elif op < 21:
-                                    if op < 19:
-                                        info = ins[1]
-                                        dirty = False
-                                        if not thunk:
-                                            frame.line = ins[2]
-                                        if left > 0 and (not ins[3]):
-                                            left -= 1
-                                            unsaved += 1
-                                            task.at = info
+                                    if op < 20:
+                                        if op < 19:
+                                            x1 = ins[1]
+                                            i = stack[-1]
+                                            d = adata[x1]
+                                            if d is None:
+                                                d = adata[x1] = store[x1].data
+                                            if type(i) is int and 0 < i <= 2147483647 and ((x3 := i) <= len(d)) and ((v := d[x3 - 1]) is not UNSET):
+                                                stack[-1] = v
+                                            else:
+                                                stack[-1] = _element1(fvars[ins[1]] or frame.var(ins[1]), i, ins[2])
+                                            ip += 1
                                         else:
-                                            rt.steps += unsaved
-                                            unsaved = 0
-                                            before(info)
-                                            task.quiet = n = quiet_limit(task)
-                                            left = n - rt.steps
-                                        ip += 1
-                                    elif op < 20:
-                                        stack.append(_load(fvars[ins[1]] or frame.var(ins[1])))
-                                        stack.append(_load(fvars[ins[2]] or frame.var(ins[2])))
-                                        ip += 1
+                                            if code.is_function:
+                                                if dirty:
+                                                    frame.line = info.line
+                                                    task.at = info
+                                                    dirty = False
+                                                raise return_without_value(code.routine, frame.line)
+                                            if dirty:
+                                                frame.line = info.line
+                                                task.at = info
+                                                dirty = False
+                                            return None
                                     else:
-                                        stack.append(_element1(fvars[ins[1]] or frame.var(ins[1]), _load(fvars[ins[2]] or frame.var(ins[2])), ins[3]))
-                                        ip += 1
-                                elif op < 22:
-                                    x1 = ins[1]
-                                    x2 = ins[2]
-                                    x3 = ins[3]
-                                    a = store[x1]
-                                    i = store[x2]
-                                    j = store[x3]
-                                    n, m = a.dims
-                                    if type(i) is int and type(j) is int and (0 < i <= n) and (0 < j <= m) and ((v := a.data[((y1 := i) - 1) * (y2 := m) + (y3 := j) - 1]) is not UNSET):
-                                        stack.append(v)
-                                    else:
-                                        stack.append(_element2(fvars[x1] or frame.var(x1), _load(fvars[x2] or frame.var(x2)), _load(fvars[x3] or frame.var(x3)), ins[4]))
-                                    ip += 1
+                                        v = stack.pop()
+                                        if v is True:
+                                            ip += 1
+                                        elif v is False or not rt.to_bool(v):
+                                            ip = ins[1]
+                                        else:
+                                            ip += 1
                                 elif op < 23:
-                                    a = store[ins[1]]
-                                    i = stack[-1]
-                                    d = a.data
-                                    if type(i) is int and 0 < i <= len(d) and ((v := d[(x3 := i) - 1]) is not UNSET):
-                                        stack[-1] = v
+                                    if op < 22:
+                                        b = stack.pop()
+                                        a = stack.pop()
+                                        ca = type(a)
+                                        cb = type(b)
+                                        if a != b if (ca is int or ca is float) and (cb is int or cb is float) else _ne(a, b):
+                                            ip += 1
+                                        else:
+                                            ip = ins[1]
                                     else:
-                                        stack[-1] = _element1(fvars[ins[1]] or frame.var(ins[1]), i, ins[2])
-                                    ip += 1
+                                        b = stack.pop()
+                                        a = stack.pop()
+                                        ca = type(a)
+                                        cb = type(b)
+                                        if a == b if (ca is int or ca is float) and (cb is int or cb is float) else _eq(a, b):
+                                            ip += 1
+                                        else:
+                                            ip = ins[1]
                                 else:
-                                    if code.is_function:
-                                        if dirty:
-                                            frame.line = info.line
-                                            task.at = info
-                                            dirty = False
-                                        raise return_without_value(code.routine, frame.line)
-                                    if dirty:
-                                        frame.line = info.line
-                                        task.at = info
-                                        dirty = False
-                                    return None
+                                    a = stack[-1]
+                                    if (a is True or a is False) and ins[1] == 'NOT':
+                                        stack[-1] = a is False
+                                    elif type(a) is float and ins[1] == '-':
+                                        stack[-1] = -a
+                                    else:
+                                        stack[-1] = rt.unary_op(ins[1], a)
+                                    ip += 1
                             elif op < 28:
                                 if op < 25:
                                     b = stack.pop()
@@ -319,61 +352,75 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                         ip += 1
                                     else:
                                         ip = ins[1]
-                                elif op < 26:
-                                    j = stack.pop()
-                                    i = stack[-1]
-                                    a = store[ins[1]]
-                                    n, m = a.dims
-                                    if type(i) is int and type(j) is int and (0 < i <= n) and (0 < j <= m) and ((v := a.data[((y1 := i) - 1) * (y2 := m) + (y3 := j) - 1]) is not UNSET):
-                                        stack[-1] = v
-                                    else:
-                                        stack[-1] = _element2(fvars[ins[1]] or frame.var(ins[1]), i, j, ins[2])
-                                    ip += 1
                                 elif op < 27:
-                                    b = stack.pop()
-                                    a = stack.pop()
-                                    ca = type(a)
-                                    cb = type(b)
-                                    if a != b if (ca is int or ca is float) and (cb is int or cb is float) else _ne(a, b):
-                                        ip += 1
+                                    if op < 26:
+                                        b = stack.pop()
+                                        a = stack.pop()
+                                        ca = type(a)
+                                        cb = type(b)
+                                        if a >= b if (ca is int or ca is float) and (cb is int or cb is float) else _ge(a, b):
+                                            ip += 1
+                                        else:
+                                            ip = ins[1]
                                     else:
-                                        ip = ins[1]
+                                        b = stack.pop()
+                                        a = stack.pop()
+                                        ca = type(a)
+                                        cb = type(b)
+                                        if a > b if (ca is int or ca is float) and (cb is int or cb is float) else _gt(a, b):
+                                            ip += 1
+                                        else:
+                                            ip = ins[1]
                                 else:
-                                    b = stack.pop()
-                                    a = stack.pop()
-                                    ca = type(a)
-                                    cb = type(b)
-                                    if a == b if (ca is int or ca is float) and (cb is int or cb is float) else _eq(a, b):
-                                        ip += 1
-                                    else:
-                                        ip = ins[1]
-                            elif op < 31:
-                                if op < 29:
+                                    x1 = ins[1]
+                                    base = fvars[x1]
                                     v = stack.pop()
-                                    if v is True:
-                                        ip += 1
-                                    elif v is False or not rt.to_bool(v):
-                                        ip = ins[1]
+                                    k = ins[2][1]
+                                    if base is None:
+                                        s = store[x1]
+                                    elif type(base) is Slot and (not base.readonly):
+                                        s = base.c[base.k]
                                     else:
-                                        ip += 1
-                                elif op < 30:
-                                    b = stack.pop()
-                                    a = stack.pop()
-                                    ca = type(a)
-                                    cb = type(b)
-                                    if a >= b if (ca is int or ca is float) and (cb is int or cb is float) else _ge(a, b):
+                                        s = None
+                                    if type(s) is Struct and s.type is not None and ((ft := s.type.fields.get(k)) is not None) and (k in s.f) and ((t := ft[1]) is T_REAL and type(v) is float or (t is T_INT and type(v) is int and (-2147483648 <= v <= 2147483647)) or (t is T_BOOL and type(v) is bool)):
+                                        s.f[k] = v
+                                    else:
+                                        _set_component(base or frame.var(x1), ins[2][0], v, ins[3])
+                                    ip += 1
+                            elif op < 31:
+                                if op < 30:
+                                    if op < 29:
+                                        b = ins[1]
+                                        a = stack[-1]
+                                        if type(a) is float and type(b) is float:
+                                            stack[-1] = a - b
+                                        elif type(a) is int and type(b) is int and (-2147483648 <= (v := (a - b)) <= 2147483647):
+                                            stack[-1] = v
+                                        else:
+                                            stack[-1] = _sub(a, b)
                                         ip += 1
                                     else:
-                                        ip = ins[1]
+                                        a = store[ins[1]]
+                                        b = ins[2]
+                                        if type(a) is int and type(b) is int and (-2147483648 <= (v := (a - b)) <= 2147483647):
+                                            stack.append(v)
+                                        elif type(a) is float and type(b) is float:
+                                            stack.append(a - b)
+                                        else:
+                                            stack.append(_sub(a if a is not UNSET else _load(fvars[ins[1]] or frame.var(ins[1])), b))
+                                        ip += 1
                                 else:
-                                    b = stack.pop()
-                                    a = stack.pop()
-                                    ca = type(a)
-                                    cb = type(b)
-                                    if a > b if (ca is int or ca is float) and (cb is int or cb is float) else _gt(a, b):
-                                        ip += 1
+                                    x1 = ins[1]
+                                    x = store[x1]
+                                    if type(x) is Struct and (type((x := x.f.get(ins[2][1]))) is float or type(x) is int or type(x) is bool):
+                                        stack.append(x)
                                     else:
-                                        ip = ins[1]
+                                        base = fvars[x1] or frame.var(x1)
+                                        if type(base) is Slot and type((x := base.c[base.k])) is Struct and (type((x := x.f.get(ins[2][1]))) is float or type(x) is int or type(x) is bool):
+                                            stack.append(x)
+                                        else:
+                                            stack.append(_component(base, ins[2][0], ins[3]))
+                                    ip += 1
                             else:
                                 x1 = ins[1]
                                 a = store[x1]
@@ -381,7 +428,16 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                 ca = type(a)
                                 cb = type(b)
                                 f = ins[3]
-                                if f[0](a, b) if (ca is int or ca is float) and (cb is int or cb is float) else f[1](a if a is not UNSET else _load(fvars[x1] or frame.var(x1)), b):
+                                if ca is int and cb is int:
+                                    y1 = a
+                                    y2 = b
+                                    x3 = f[2]
+                                    go = x3 >> (y1 > y2) - (y1 < y2) + 1 & 1
+                                elif (ca is int or ca is float) and (cb is int or cb is float):
+                                    go = f[0](a, b)
+                                else:
+                                    go = f[1](a if a is not UNSET else _load(fvars[x1] or frame.var(x1)), b)
+                                if go:
                                     ip += 1
                                 else:
                                     ip = ins[4]
@@ -397,6 +453,9 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                             if type(c) is int and (c := (c + temps[x2 + 2])) <= temps[x2 + 3]:
                                 store[x1] = c
                                 go = True
+                            elif type(c) is int and type((step := temps[x2 + 2])) is int and (type((end := temps[x2 + 1])) is int) and (-2147483648 <= c <= 2147483647):
+                                store[x1] = c
+                                go = c <= end if step > 0 else c >= end
                             else:
                                 go = _for_next(temps[x2], temps[x2 + 1], temps[x2 + 2], ins[3])
                             if go:
@@ -417,494 +476,25 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                             else:
                                 ip += 1
                         elif op < 51:
-                            if op < 35:
-                                a = stack[-1]
-                                if (a is True or a is False) and ins[1] == 'NOT':
-                                    stack[-1] = a is False
-                                elif type(a) is float and ins[1] == '-':
-                                    stack[-1] = -a
-                                else:
-                                    stack[-1] = rt.unary_op(ins[1], a)
-                                ip += 1
-                            elif op < 36:
-                                b = ins[1]
-                                a = stack[-1]
-                                if type(a) is float and type(b) is float:
-                                    stack[-1] = a - b
-                                elif type(a) is int and type(b) is int and (INT_MIN <= (v := (a - b)) <= INT_MAX):
-                                    stack[-1] = v
-                                else:
-                                    stack[-1] = _sub(a, b)
-                                ip += 1
-                            elif op < 50:
-                                if op < 37:
-                                    g = ins[1]
-                                    ref = grefs[g]
-                                    if ref is None:
-                                        ref = rt.storage_ref(code.gstorage[g], frame)
-                                        grefs[g] = ref
-                                    if op == 110:
-                                        stack.append(_load(ref))
-                                    elif op == 111:
-                                        stack.append(ref)
-                                    else:
-                                        _store(ref, stack.pop())
-                                    ip += 1
-                                elif op < 42:
-                                    if op < 39:
-                                        if op < 38:
-                                            if dirty:
-                                                frame.line = info.line
-                                                task.at = info
-                                                dirty = False
-                                            rt.steps += unsaved
-                                            unsaved = 0
-                                            ip = cold[op](ins, code, frame, temps, stack, ip)
-                                            left = task.quiet - rt.steps if task is not None else 0
-                                        else:
-                                            if dirty:
-                                                frame.line = info.line
-                                                task.at = info
-                                                dirty = False
-                                            rt.steps += unsaved
-                                            unsaved = 0
-                                            ip = cold[op](ins, code, frame, temps, stack, ip)
-                                            left = task.quiet - rt.steps if task is not None else 0
-                                    elif op < 40:
-                                        if dirty:
-                                            frame.line = info.line
-                                            task.at = info
-                                            dirty = False
-                                        rt.steps += unsaved
-                                        unsaved = 0
-                                        ip = cold[op](ins, code, frame, temps, stack, ip)
-                                        left = task.quiet - rt.steps if task is not None else 0
-                                    elif op < 41:
-                                        if dirty:
-                                            frame.line = info.line
-                                            task.at = info
-                                            dirty = False
-                                        rt.steps += unsaved
-                                        unsaved = 0
-                                        ip = cold[op](ins, code, frame, temps, stack, ip)
-                                        left = task.quiet - rt.steps if task is not None else 0
-                                    else:
-                                        if dirty:
-                                            frame.line = info.line
-                                            task.at = info
-                                            dirty = False
-                                        rt.steps += unsaved
-                                        unsaved = 0
-                                        ip = cold[op](ins, code, frame, temps, stack, ip)
-                                        left = task.quiet - rt.steps if task is not None else 0
-                                elif op < 46:
-                                    if op < 44:
-                                        if op < 43:
-                                            if dirty:
-                                                frame.line = info.line
-                                                task.at = info
-                                                dirty = False
-                                            rt.steps += unsaved
-                                            unsaved = 0
-                                            ip = cold[op](ins, code, frame, temps, stack, ip)
-                                            left = task.quiet - rt.steps if task is not None else 0
-                                        else:
-                                            if dirty:
-                                                frame.line = info.line
-                                                task.at = info
-                                                dirty = False
-                                            rt.steps += unsaved
-                                            unsaved = 0
-                                            ip = cold[op](ins, code, frame, temps, stack, ip)
-                                            left = task.quiet - rt.steps if task is not None else 0
-                                    elif op < 45:
-                                        if dirty:
-                                            frame.line = info.line
-                                            task.at = info
-                                            dirty = False
-                                        rt.steps += unsaved
-                                        unsaved = 0
-                                        ip = cold[op](ins, code, frame, temps, stack, ip)
-                                        left = task.quiet - rt.steps if task is not None else 0
-                                    else:
-                                        if dirty:
-                                            frame.line = info.line
-                                            task.at = info
-                                            dirty = False
-                                        rt.steps += unsaved
-                                        unsaved = 0
-                                        ip = cold[op](ins, code, frame, temps, stack, ip)
-                                        left = task.quiet - rt.steps if task is not None else 0
-                                elif op < 48:
-                                    if op < 47:
-                                        if dirty:
-                                            frame.line = info.line
-                                            task.at = info
-                                            dirty = False
-                                        rt.steps += unsaved
-                                        unsaved = 0
-                                        ip = cold[op](ins, code, frame, temps, stack, ip)
-                                        left = task.quiet - rt.steps if task is not None else 0
-                                    else:
-                                        if dirty:
-                                            frame.line = info.line
-                                            task.at = info
-                                            dirty = False
-                                        rt.steps += unsaved
-                                        unsaved = 0
-                                        ip = cold[op](ins, code, frame, temps, stack, ip)
-                                        left = task.quiet - rt.steps if task is not None else 0
-                                elif op < 49:
-                                    if dirty:
-                                        frame.line = info.line
-                                        task.at = info
-                                        dirty = False
-                                    rt.steps += unsaved
-                                    unsaved = 0
-                                    ip = cold[op](ins, code, frame, temps, stack, ip)
-                                    left = task.quiet - rt.steps if task is not None else 0
-                                else:
-                                    if dirty:
-                                        frame.line = info.line
-                                        task.at = info
-                                        dirty = False
-                                    rt.steps += unsaved
-                                    unsaved = 0
-                                    ip = cold[op](ins, code, frame, temps, stack, ip)
-                                    left = task.quiet - rt.steps if task is not None else 0
-                            else:
-                                _store(temps[ins[1]], stack.pop())
-                                ip += 1
-                        elif op < 52:
-                            x1 = ins[1]
-                            base = fvars[x1]
-                            v = stack.pop()
-                            k = ins[2][1]
-                            if base is None:
-                                s = store[x1]
-                            elif type(base) is Slot and (not base.readonly):
-                                s = base.c[base.k]
-                            else:
-                                s = None
-                            if type(s) is Struct and s.type is not None and ((ft := s.type.fields.get(k)) is not None) and (k in s.f) and ((t := ft[1]) is T_REAL and type(v) is float or (t is T_INT and type(v) is int and (INT_MIN <= v <= INT_MAX)) or (t is T_BOOL and type(v) is bool)):
-                                s.f[k] = v
-                            else:
-                                _set_component(base or frame.var(x1), ins[2][0], v, ins[3])
-                            ip += 1
-                        elif op < 53:
-                            a = store[ins[1]]
-                            b = ins[2]
-                            if type(a) is int and type(b) is int and (INT_MIN <= (v := (a - b)) <= INT_MAX):
-                                stack.append(v)
-                            elif type(a) is float and type(b) is float:
-                                stack.append(a - b)
-                            else:
-                                stack.append(_sub(a if a is not UNSET else _load(fvars[ins[1]] or frame.var(ins[1])), b))
-                            ip += 1
-                        else:
-                            _store(fvars[ins[1]] or frame.var(ins[1]), stack.pop())
-                            ip += 1
-                    elif op < 74:
-                        if op < 66:
-                            if op < 58:
-                                if op < 55:
-                                    x1 = ins[1]
-                                    a = store[x1]
-                                    b = ins[2]
-                                    t = ins[4]
-                                    ca = type(a)
-                                    if ca is type(b) and ca is t and (ca is float or (ca is int and INT_MIN <= (v := (a - b)) <= INT_MAX)):
-                                        x3 = ins[3]
-                                        store[x3] = a - b if ca is float else v
-                                    else:
-                                        _store(fvars[ins[3]] or frame.var(ins[3]), _sub(a if a is not UNSET else _load(fvars[x1] or frame.var(x1)), b))
-                                    ip += 1
-                                elif op < 56:
-                                    x1 = ins[1]
-                                    x = store[x1]
-                                    if type(x) is Struct and (type((x := x.f.get(ins[2][1]))) is float or type(x) is int or type(x) is bool):
-                                        stack.append(x)
-                                    else:
-                                        base = fvars[x1] or frame.var(x1)
-                                        if type(base) is Slot and type((x := base.c[base.k])) is Struct and (type((x := x.f.get(ins[2][1]))) is float or type(x) is int or type(x) is bool):
-                                            stack.append(x)
-                                        else:
-                                            stack.append(_component(base, ins[2][0], ins[3]))
-                                    ip += 1
-                                elif op < 57:
-                                    stack.append(_load(fvars[ins[1]] or frame.var(ins[1])))
-                                    ip += 1
-                                else:
-                                    ip = ins[1]
-                            elif op < 62:
-                                if op < 59:
-                                    base = stack[-1]
-                                    if type(base) is Slot and type((x := base.c[base.k])) is Struct and (type((x := x.f.get(ins[1][1]))) is float or type(x) is int or type(x) is bool):
-                                        stack[-1] = x
-                                    else:
-                                        stack[-1] = _component(base, ins[1][0], ins[2])
-                                    ip += 1
-                                elif op < 60:
-                                    b = stack.pop()
-                                    a = stack.pop()
-                                    ca = type(a)
-                                    cb = type(b)
-                                    if a < b if (ca is int or ca is float) and (cb is int or cb is float) else _lt(a, b):
-                                        ip += 1
-                                    else:
-                                        ip = ins[1]
-                                elif op < 61:
-                                    t = ins[1]
-                                    step = stack.pop()
-                                    end = stack.pop()
-                                    start = stack.pop()
-                                    temps[t] = stack.pop()
-                                    temps[t + 1], temps[t + 2] = end, step = _for_limits(end, step)
-                                    temps[t + 3] = min(end, INT_MAX) if type(step) is int and step > 0 else -math.inf
-                                    stack.append(start)
-                                    ip += 1
-                                else:
-                                    stack[-1] = _read_value(stack[-1])
-                                    ip += 1
-                            elif op < 65:
-                                if op < 63:
-                                    if code.is_function:
-                                        if dirty:
-                                            frame.line = info.line
-                                            task.at = info
-                                            dirty = False
-                                        raise ended_without_return(code.routine, frame.line)
-                                    if dirty:
-                                        frame.line = info.line
-                                        task.at = info
-                                        dirty = False
-                                    return None
-                                elif op < 64:
-                                    stack.pop()
-                                    ip += 1
-                                else:
-                                    stack.append(None)
-                                    ip += 1
-                            else:
-                                b = stack.pop()
-                                a = stack[-1]
-                                if type(a) is float and type(b) is float:
-                                    stack[-1] = a * b
-                                elif type(a) is int and type(b) is int and (INT_MIN <= (v := (a * b)) <= INT_MAX):
-                                    stack[-1] = v
-                                else:
-                                    stack[-1] = _mul(a, b)
-                                ip += 1
-                        elif op < 67:
-                            stack.append(ins[1])
-                            ip += 1
-                        elif op < 68:
-                            i = stack.pop()
-                            v = stack.pop()
-                            x1 = ins[1]
-                            a = store[x1]
-                            t = ins[3]
-                            d = a.data
-                            if type(i) is int and 0 < i <= len(d) and (type(v) is t) and (t is not int or INT_MIN <= v <= INT_MAX):
-                                x3 = i
-                                d[x3 - 1] = v
-                            else:
-                                _set_element1(fvars[x1] or frame.var(x1), i, v, ins[2])
-                            ip += 1
-                        elif op < 71:
-                            if op < 69:
-                                v = stack.pop()
-                                if dirty:
-                                    frame.line = info.line
-                                    task.at = info
-                                    dirty = False
-                                return v if code.is_function else None
-                            elif op < 70:
-                                v = stack.pop()
-                                if v is True:
-                                    ip = ins[1]
-                                elif v is False or not rt.to_bool(v):
-                                    ip += 1
-                                else:
-                                    ip = ins[1]
-                            else:
-                                temps[ins[1]] = stack.pop()
-                                ip += 1
-                        elif op < 72:
-                            stack[-1] = ValueRef(stack[-1])
-                            ip += 1
-                        elif op < 73:
-                            stack.append(temps[ins[1]])
-                            ip += 1
-                        else:
-                            return stack[-1] if len(stack) > 8 else None
-                    elif op < 88:
-                        if op < 81:
-                            if op < 77:
-                                if op < 75:
-                                    x1 = ins[1]
-                                    x2 = ins[2]
-                                    a = store[x1]
-                                    b = store[x2]
-                                    ca = type(a)
-                                    cb = type(b)
-                                    f = ins[3]
-                                    if f[0](a, b) if (ca is int or ca is float) and (cb is int or cb is float) else f[1](a if a is not UNSET else _load(fvars[x1] or frame.var(x1)), b if b is not UNSET else _load(fvars[x2] or frame.var(x2))):
-                                        ip += 1
-                                    else:
-                                        ip = ins[4]
-                                elif op < 76:
-                                    _store(mrefs[ins[1]], stack.pop())
-                                    ip += 1
-                                else:
-                                    stack.append(_load(mrefs[ins[1]]))
-                                    ip += 1
-                            elif op < 80:
-                                if op < 79:
-                                    if op < 78:
-                                        stack[-1] = rt.field(stack[-1], ins[1], ins[2])
-                                        ip += 1
-                                    else:
-                                        stack.append(mrefs[ins[1]])
-                                        ip += 1
-                                else:
-                                    x1 = ins[1]
-                                    a = store[x1]
-                                    b = ins[2]
-                                    t = ins[4]
-                                    ca = type(a)
-                                    if ca is type(b) and ca is t and (ca is float or (ca is int and INT_MIN <= (v := (a + b)) <= INT_MAX)):
-                                        x3 = ins[3]
-                                        store[x3] = a + b if ca is float else v
-                                    else:
-                                        _store(fvars[ins[3]] or frame.var(ins[3]), _add(a if a is not UNSET else _load(fvars[x1] or frame.var(x1)), b))
-                                    ip += 1
-                            else:
-                                stack.append(fvars[ins[1]] or frame.var(ins[1]))
-                                ip += 1
-                        elif op < 82:
-                            v = stack.pop()
-                            t = ins[2]
-                            x1 = ins[1]
-                            if type(v) is t and (t is not int or INT_MIN <= v <= INT_MAX):
-                                store[x1] = v
-                            else:
-                                _store(fvars[x1] or frame.var(x1), v)
-                            ip += 1
-                        elif op < 85:
-                            if op < 84:
-                                if op < 83:
-                                    b = stack.pop()
-                                    a = stack[-1]
-                                    if ins[1] == '/' and type(b) is type(a) and (b != 0):
-                                        if type(a) is float:
-                                            stack[-1] = a / b
-                                        elif type(a) is int and INT_MIN <= (v := (abs(a) // abs(b) if (a >= 0) == (b >= 0) else -(abs(a) // abs(b)))) <= INT_MAX:
-                                            stack[-1] = v
-                                        else:
-                                            stack[-1] = rt.binary_op(ins[1], a, b)
-                                    else:
-                                        stack[-1] = rt.binary_op(ins[1], a, b)
-                                    ip += 1
-                                else:
-                                    b = stack.pop()
-                                    stack[-1] = _ne(stack[-1], b)
-                                    ip += 1
-                            else:
-                                j = stack.pop()
-                                i = stack.pop()
-                                v = stack.pop()
-                                a = store[ins[1]]
-                                n, m = a.dims
-                                t = ins[3]
-                                if type(i) is int and type(j) is int and (0 < i <= n) and (0 < j <= m) and (type(v) is t) and (t is not int or INT_MIN <= v <= INT_MAX):
-                                    y1 = i
-                                    y2 = m
-                                    y3 = j
-                                    a.data[(y1 - 1) * y2 + y3 - 1] = v
-                                else:
-                                    _set_element(fvars[ins[1]] or frame.var(ins[1]), [i, j], v, ins[2])
-                                ip += 1
-                        elif op < 87:
-                            if op < 86:
-                                b = stack.pop()
-                                stack[-1] = _eq(stack[-1], b)
-                                ip += 1
-                            else:
-                                b = stack.pop()
-                                stack[-1] = _ge(stack[-1], b)
-                                ip += 1
-                        else:
-                            argc = ins[2]
-                            if argc:
-                                args = stack[-argc:]
-                                del stack[-argc:]
-                            else:
-                                args = []
-                            flags = ins[3]
-                            target = code.callsites.get(ip)
-                            if dirty:
-                                frame.line = info.line
-                                task.at = info
-                                dirty = False
-                            rt.steps += unsaved
-                            unsaved = 0
-                            if target is not None:
-                                v = run_routine(target, args, frame, exec_routine, 'N' not in flags)
-                            else:
-                                v = self.call(code, ip, ins[1], args, frame, flags)
-                            left = task.quiet - rt.steps if task is not None else 0
-                            if flags == 'E':
-                                stack.append(v if v is not None else function_result(ins[1].name, v))
-                            ip += 1
-                    elif op < 114:
-                        if op < 92:
-                            if op < 89:
-                                x1 = ins[1]
-                                a = store[x1]
-                                b = ins[2]
-                                if type(a) is int and type(b) is int and (INT_MIN <= (v := (a + b)) <= INT_MAX):
-                                    stack.append(v)
-                                elif type(a) is float and type(b) is float:
-                                    stack.append(a + b)
-                                else:
-                                    stack.append(_add(a if a is not UNSET else _load(fvars[x1] or frame.var(x1)), b))
-                                ip += 1
-                            elif op < 91:
-                                if op < 90:
-                                    b = stack.pop()
-                                    stack[-1] = _gt(stack[-1], b)
-                                    ip += 1
-                                else:
-                                    b = stack.pop()
-                                    stack[-1] = _le(stack[-1], b)
-                                    ip += 1
-                            else:
-                                b = ins[1]
-                                a = stack[-1]
-                                if type(a) is float and type(b) is float:
-                                    stack[-1] = a + b
-                                elif type(a) is int and type(b) is int and (INT_MIN <= (v := (a + b)) <= INT_MAX):
-                                    stack[-1] = v
-                                else:
-                                    stack[-1] = _add(a, b)
-                                ip += 1
-                        elif op < 113:
-                            if op < 94:
-                                if op < 93:
-                                    b = stack.pop()
-                                    stack[-1] = _lt(stack[-1], b)
-                                    ip += 1
-                                else:
-                                    ref = stack.pop()
-                                    _store(ref, stack.pop())
-                                    ip += 1
-                            elif op < 112:
-                                if op < 110:
-                                    if op < 102:
-                                        if op < 98:
-                                            if op < 96:
-                                                if op < 95:
+                            if op < 50:
+                                if op < 49:
+                                    if op < 48:
+                                        if op < 35:
+                                            g = ins[1]
+                                            ref = grefs[g]
+                                            if ref is None:
+                                                ref = rt.storage_ref(code.gstorage[g], frame)
+                                                grefs[g] = ref
+                                            if op == 108:
+                                                stack.append(_load(ref))
+                                            elif op == 109:
+                                                stack.append(ref)
+                                            else:
+                                                _store(ref, stack.pop())
+                                            ip += 1
+                                        elif op < 40:
+                                            if op < 37:
+                                                if op < 36:
                                                     if dirty:
                                                         frame.line = info.line
                                                         task.at = info
@@ -922,7 +512,16 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                                     unsaved = 0
                                                     ip = cold[op](ins, code, frame, temps, stack, ip)
                                                     left = task.quiet - rt.steps if task is not None else 0
-                                            elif op < 97:
+                                            elif op < 38:
+                                                if dirty:
+                                                    frame.line = info.line
+                                                    task.at = info
+                                                    dirty = False
+                                                rt.steps += unsaved
+                                                unsaved = 0
+                                                ip = cold[op](ins, code, frame, temps, stack, ip)
+                                                left = task.quiet - rt.steps if task is not None else 0
+                                            elif op < 39:
                                                 if dirty:
                                                     frame.line = info.line
                                                     task.at = info
@@ -940,8 +539,27 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                                 unsaved = 0
                                                 ip = cold[op](ins, code, frame, temps, stack, ip)
                                                 left = task.quiet - rt.steps if task is not None else 0
-                                        elif op < 100:
-                                            if op < 99:
+                                        elif op < 44:
+                                            if op < 42:
+                                                if op < 41:
+                                                    if dirty:
+                                                        frame.line = info.line
+                                                        task.at = info
+                                                        dirty = False
+                                                    rt.steps += unsaved
+                                                    unsaved = 0
+                                                    ip = cold[op](ins, code, frame, temps, stack, ip)
+                                                    left = task.quiet - rt.steps if task is not None else 0
+                                                else:
+                                                    if dirty:
+                                                        frame.line = info.line
+                                                        task.at = info
+                                                        dirty = False
+                                                    rt.steps += unsaved
+                                                    unsaved = 0
+                                                    ip = cold[op](ins, code, frame, temps, stack, ip)
+                                                    left = task.quiet - rt.steps if task is not None else 0
+                                            elif op < 43:
                                                 if dirty:
                                                     frame.line = info.line
                                                     task.at = info
@@ -959,7 +577,26 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                                 unsaved = 0
                                                 ip = cold[op](ins, code, frame, temps, stack, ip)
                                                 left = task.quiet - rt.steps if task is not None else 0
-                                        elif op < 101:
+                                        elif op < 46:
+                                            if op < 45:
+                                                if dirty:
+                                                    frame.line = info.line
+                                                    task.at = info
+                                                    dirty = False
+                                                rt.steps += unsaved
+                                                unsaved = 0
+                                                ip = cold[op](ins, code, frame, temps, stack, ip)
+                                                left = task.quiet - rt.steps if task is not None else 0
+                                            else:
+                                                if dirty:
+                                                    frame.line = info.line
+                                                    task.at = info
+                                                    dirty = False
+                                                rt.steps += unsaved
+                                                unsaved = 0
+                                                ip = cold[op](ins, code, frame, temps, stack, ip)
+                                                left = task.quiet - rt.steps if task is not None else 0
+                                        elif op < 47:
                                             if dirty:
                                                 frame.line = info.line
                                                 task.at = info
@@ -977,9 +614,431 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                             unsaved = 0
                                             ip = cold[op](ins, code, frame, temps, stack, ip)
                                             left = task.quiet - rt.steps if task is not None else 0
-                                    elif op < 106:
-                                        if op < 104:
-                                            if op < 103:
+                                    else:
+                                        ref = temps[ins[1]]
+                                        v = stack.pop()
+                                        if type(ref) is Slot and ref.type is T_INT and (type(v) is int) and (not ref.readonly) and (ref.on_write is None) and (-2147483648 <= v <= 2147483647):
+                                            ref.c[ref.k] = v
+                                        else:
+                                            _store(ref, v)
+                                        ip += 1
+                                else:
+                                    _store(fvars[ins[1]] or frame.var(ins[1]), stack.pop())
+                                    ip += 1
+                            else:
+                                base = stack[-1]
+                                if type(base) is Slot and type((x := base.c[base.k])) is Struct and (type((x := x.f.get(ins[1][1]))) is float or type(x) is int or type(x) is bool):
+                                    stack[-1] = x
+                                else:
+                                    stack[-1] = _component(base, ins[1][0], ins[2])
+                                ip += 1
+                        elif op < 53:
+                            if op < 52:
+                                stack.append(_load(fvars[ins[1]] or frame.var(ins[1])))
+                                ip += 1
+                            else:
+                                ip = ins[1]
+                        else:
+                            b = stack.pop()
+                            a = stack[-1]
+                            if type(a) is float and type(b) is float:
+                                stack[-1] = a * b
+                            elif type(a) is int and type(b) is int and (-2147483648 <= (v := (a * b)) <= 2147483647):
+                                stack[-1] = v
+                            elif type(a) is int and type(b) is float or (type(a) is float and type(b) is int):
+                                stack[-1] = a * b
+                            else:
+                                stack[-1] = _mul(a, b)
+                            ip += 1
+                    elif op < 74:
+                        if op < 68:
+                            if op < 60:
+                                if op < 55:
+                                    x1 = ins[1]
+                                    a = store[x1]
+                                    b = ins[2]
+                                    t = ins[4]
+                                    ca = type(a)
+                                    if ca is type(b) and ca is t and (ca is float or (ca is int and -2147483648 <= (v := (a - b)) <= 2147483647)):
+                                        x3 = ins[3]
+                                        store[x3] = a - b if ca is float else v
+                                    else:
+                                        _store(fvars[ins[3]] or frame.var(ins[3]), _sub(a if a is not UNSET else _load(fvars[x1] or frame.var(x1)), b))
+                                    ip += 1
+                                elif op < 57:
+                                    if op < 56:
+                                        b = stack.pop()
+                                        a = stack.pop()
+                                        ca = type(a)
+                                        cb = type(b)
+                                        if a < b if (ca is int or ca is float) and (cb is int or cb is float) else _lt(a, b):
+                                            ip += 1
+                                        else:
+                                            ip = ins[1]
+                                    else:
+                                        if code.is_function:
+                                            if dirty:
+                                                frame.line = info.line
+                                                task.at = info
+                                                dirty = False
+                                            raise ended_without_return(code.routine, frame.line)
+                                        if dirty:
+                                            frame.line = info.line
+                                            task.at = info
+                                            dirty = False
+                                        return None
+                                elif op < 59:
+                                    if op < 58:
+                                        t = ins[1]
+                                        step = stack.pop()
+                                        end = stack.pop()
+                                        start = stack.pop()
+                                        temps[t] = stack.pop()
+                                        if not (type(end) is int and type(step) is int and (step != 0)):
+                                            end, step = _for_limits(end, step)
+                                        temps[t + 1] = end
+                                        temps[t + 2] = step
+                                        temps[t + 3] = min(end, 2147483647) if type(step) is int and step > 0 else -math.inf
+                                        stack.append(start)
+                                        ip += 1
+                                    else:
+                                        stack[-1] = _read_value(stack[-1])
+                                        ip += 1
+                                else:
+                                    v = stack.pop()
+                                    if dirty:
+                                        frame.line = info.line
+                                        task.at = info
+                                        dirty = False
+                                    return v if code.is_function else None
+                            elif op < 64:
+                                if op < 61:
+                                    x1 = ins[1]
+                                    x2 = ins[2]
+                                    a = store[x1]
+                                    b = store[x2]
+                                    ca = type(a)
+                                    cb = type(b)
+                                    f = ins[3]
+                                    if ca is int and cb is int:
+                                        y1 = a
+                                        y2 = b
+                                        x3 = f[2]
+                                        go = x3 >> (y1 > y2) - (y1 < y2) + 1 & 1
+                                    elif (ca is int or ca is float) and (cb is int or cb is float):
+                                        go = f[0](a, b)
+                                    else:
+                                        go = f[1](a if a is not UNSET else _load(fvars[x1] or frame.var(x1)), b if b is not UNSET else _load(fvars[x2] or frame.var(x2)))
+                                    if go:
+                                        ip += 1
+                                    else:
+                                        ip = ins[4]
+                                elif op < 63:
+                                    if op < 62:
+                                        stack.pop()
+                                        ip += 1
+                                    else:
+                                        stack.append(None)
+                                        ip += 1
+                                else:
+                                    stack[-1] = ValueRef(stack[-1])
+                                    ip += 1
+                            elif op < 67:
+                                if op < 66:
+                                    if op < 65:
+                                        v = stack.pop()
+                                        if v is True:
+                                            ip = ins[1]
+                                        elif v is False or not rt.to_bool(v):
+                                            ip += 1
+                                        else:
+                                            ip = ins[1]
+                                    else:
+                                        temps[ins[1]] = stack.pop()
+                                        ip += 1
+                                else:
+                                    _store(mrefs[ins[1]], stack.pop())
+                                    ip += 1
+                            else:
+                                stack.append(fvars[ins[1]] or frame.var(ins[1]))
+                                ip += 1
+                        elif op < 69:
+                            stack.append(ins[1])
+                            ip += 1
+                        elif op < 70:
+                            i = stack.pop()
+                            v = stack.pop()
+                            x1 = ins[1]
+                            t = ins[3]
+                            d = adata[x1]
+                            if d is None:
+                                d = adata[x1] = store[x1].data
+                            if type(i) is int and 0 < i <= 2147483647 and ((x3 := i) <= len(d)) and (type(v) is t) and (t is not int or -2147483648 <= v <= 2147483647):
+                                d[x3 - 1] = v
+                            else:
+                                _set_element1(fvars[x1] or frame.var(x1), i, v, ins[2])
+                            ip += 1
+                        elif op < 73:
+                            if op < 72:
+                                if op < 71:
+                                    stack.append(temps[ins[1]])
+                                    ip += 1
+                                else:
+                                    return stack[-1] if len(stack) > 8 else None
+                            else:
+                                stack.append(_load(mrefs[ins[1]]))
+                                ip += 1
+                        else:
+                            x1 = ins[1]
+                            a = store[x1]
+                            b = ins[2]
+                            if type(a) is int and type(b) is int and (-2147483648 <= (v := (a + b)) <= 2147483647):
+                                stack.append(v)
+                            elif type(a) is float and type(b) is float:
+                                stack.append(a + b)
+                            else:
+                                stack.append(_add(a if a is not UNSET else _load(fvars[x1] or frame.var(x1)), b))
+                            ip += 1
+                    elif op < 89:
+                        if op < 81:
+                            if op < 80:
+                                if op < 77:
+                                    if op < 75:
+                                        x1 = ins[1]
+                                        a = store[x1]
+                                        b = ins[2]
+                                        t = ins[4]
+                                        ca = type(a)
+                                        if ca is type(b) and ca is t and (ca is float or (ca is int and -2147483648 <= (v := (a + b)) <= 2147483647)):
+                                            x3 = ins[3]
+                                            store[x3] = a + b if ca is float else v
+                                        else:
+                                            _store(fvars[ins[3]] or frame.var(ins[3]), _add(a if a is not UNSET else _load(fvars[x1] or frame.var(x1)), b))
+                                        ip += 1
+                                    elif op < 76:
+                                        stack[-1] = rt.field(stack[-1], ins[1], ins[2])
+                                        ip += 1
+                                    else:
+                                        stack.append(mrefs[ins[1]])
+                                        ip += 1
+                                elif op < 78:
+                                    j = stack.pop()
+                                    i = stack.pop()
+                                    v = stack.pop()
+                                    x1 = ins[1]
+                                    grid = agrid[x1]
+                                    if grid is None:
+                                        a = store[x1]
+                                        grid = agrid[x1] = (a.data, a.dims[0], a.dims[1])
+                                    n = grid[1]
+                                    m = grid[2]
+                                    t = ins[3]
+                                    if type(i) is int and type(j) is int and (0 < i <= n) and (0 < j <= m) and (type(v) is t) and (t is not int or -2147483648 <= v <= 2147483647):
+                                        y1 = i
+                                        y2 = m
+                                        y3 = j
+                                        grid[0][(y1 - 1) * y2 + y3 - 1] = v
+                                    else:
+                                        _set_element(fvars[ins[1]] or frame.var(ins[1]), [i, j], v, ins[2])
+                                    ip += 1
+                                elif op < 79:
+                                    b = stack.pop()
+                                    a = stack[-1]
+                                    if ins[1] == '/' and type(b) is type(a) and (b != 0):
+                                        if type(a) is float:
+                                            stack[-1] = a / b
+                                        elif type(a) is int and -2147483648 <= (v := (abs(a) // abs(b) if (a >= 0) == (b >= 0) else -(abs(a) // abs(b)))) <= 2147483647:
+                                            stack[-1] = v
+                                        else:
+                                            stack[-1] = rt.binary_op(ins[1], a, b)
+                                    else:
+                                        stack[-1] = rt.binary_op(ins[1], a, b)
+                                    ip += 1
+                                else:
+                                    b = stack.pop()
+                                    stack[-1] = _ne(stack[-1], b)
+                                    ip += 1
+                            else:
+                                v = stack.pop()
+                                t = ins[2]
+                                x1 = ins[1]
+                                if type(v) is t and (t is not int or -2147483648 <= v <= 2147483647):
+                                    store[x1] = v
+                                else:
+                                    _store(fvars[x1] or frame.var(x1), v)
+                                ip += 1
+                        elif op < 85:
+                            if op < 82:
+                                x1 = ins[1]
+                                x2 = ins[2]
+                                i = store[x2]
+                                v = ins[5]
+                                t = ins[4]
+                                d = adata[x1]
+                                if d is None:
+                                    d = adata[x1] = store[x1].data
+                                if type(i) is int and 0 < i <= 2147483647 and ((x3 := i) <= len(d)) and (type(v) is t) and (t is not int or -2147483648 <= v <= 2147483647):
+                                    d[x3 - 1] = v
+                                else:
+                                    _set_element1(fvars[x1] or frame.var(x1), _load(fvars[x2] or frame.var(x2)), v, ins[3])
+                                ip += 1
+                            elif op < 83:
+                                argc = ins[2]
+                                if argc:
+                                    args = stack[-argc:]
+                                    del stack[-argc:]
+                                else:
+                                    args = []
+                                flags = ins[3]
+                                target = code.callsites.get(ip)
+                                if dirty:
+                                    frame.line = info.line
+                                    task.at = info
+                                    dirty = False
+                                rt.steps += unsaved
+                                unsaved = 0
+                                if target is not None:
+                                    v = run_routine(target, args, frame, exec_routine, 'N' not in flags)
+                                else:
+                                    v = self.call(code, ip, ins[1], args, frame, flags)
+                                left = task.quiet - rt.steps if task is not None else 0
+                                if flags == 'E':
+                                    stack.append(v if v is not None else function_result(ins[1].name, v))
+                                ip += 1
+                            elif op < 84:
+                                b = stack.pop()
+                                stack[-1] = _eq(stack[-1], b)
+                                ip += 1
+                            else:
+                                b = stack.pop()
+                                stack[-1] = _ge(stack[-1], b)
+                                ip += 1
+                        elif op < 88:
+                            if op < 86:
+                                b = ins[1]
+                                a = stack[-1]
+                                if type(a) is float and type(b) is float:
+                                    stack[-1] = a + b
+                                elif type(a) is int and type(b) is int and (-2147483648 <= (v := (a + b)) <= 2147483647):
+                                    stack[-1] = v
+                                else:
+                                    stack[-1] = _add(a, b)
+                                ip += 1
+                            elif op < 87:
+                                b = stack.pop()
+                                stack[-1] = _gt(stack[-1], b)
+                                ip += 1
+                            else:
+                                b = stack.pop()
+                                stack[-1] = _le(stack[-1], b)
+                                ip += 1
+                        else:
+                            x1 = ins[1]
+                            x2 = ins[2]
+                            a = store[x1]
+                            b = store[x2]
+                            t = ins[4]
+                            if type(a) is int and type(b) is int and (t is int) and (-2147483648 <= (v := (a + b)) <= 2147483647):
+                                x3 = ins[3]
+                                store[x3] = v
+                            elif type(a) is float and type(b) is float and (t is float):
+                                x3 = ins[3]
+                                store[x3] = a + b
+                            else:
+                                if a is UNSET:
+                                    a = _load(fvars[x1] or frame.var(x1))
+                                if b is UNSET:
+                                    b = _load(fvars[x2] or frame.var(x2))
+                                v = _add(a, b)
+                                x3 = ins[3]
+                                if type(v) is t and (t is not int or -2147483648 <= v <= 2147483647):
+                                    store[x3] = v
+                                else:
+                                    _store(fvars[x3] or frame.var(x3), v)
+                            ip += 1
+                    elif op < 116:
+                        if op < 112:
+                            if op < 92:
+                                if op < 90:
+                                    b = stack.pop()
+                                    a = stack[-1]
+                                    if type(a) is float and type(b) is float:
+                                        stack[-1] = a - b
+                                    elif type(a) is int and type(b) is int and (-2147483648 <= (v := (a - b)) <= 2147483647):
+                                        stack[-1] = v
+                                    else:
+                                        stack[-1] = _sub(a, b)
+                                    ip += 1
+                                elif op < 91:
+                                    b = stack.pop()
+                                    stack[-1] = _lt(stack[-1], b)
+                                    ip += 1
+                                else:
+                                    ref = stack.pop()
+                                    _store(ref, stack.pop())
+                                    ip += 1
+                            elif op < 111:
+                                if op < 110:
+                                    if op < 108:
+                                        if op < 100:
+                                            if op < 96:
+                                                if op < 94:
+                                                    if op < 93:
+                                                        if dirty:
+                                                            frame.line = info.line
+                                                            task.at = info
+                                                            dirty = False
+                                                        rt.steps += unsaved
+                                                        unsaved = 0
+                                                        ip = cold[op](ins, code, frame, temps, stack, ip)
+                                                        left = task.quiet - rt.steps if task is not None else 0
+                                                    else:
+                                                        if dirty:
+                                                            frame.line = info.line
+                                                            task.at = info
+                                                            dirty = False
+                                                        rt.steps += unsaved
+                                                        unsaved = 0
+                                                        ip = cold[op](ins, code, frame, temps, stack, ip)
+                                                        left = task.quiet - rt.steps if task is not None else 0
+                                                elif op < 95:
+                                                    if dirty:
+                                                        frame.line = info.line
+                                                        task.at = info
+                                                        dirty = False
+                                                    rt.steps += unsaved
+                                                    unsaved = 0
+                                                    ip = cold[op](ins, code, frame, temps, stack, ip)
+                                                    left = task.quiet - rt.steps if task is not None else 0
+                                                else:
+                                                    if dirty:
+                                                        frame.line = info.line
+                                                        task.at = info
+                                                        dirty = False
+                                                    rt.steps += unsaved
+                                                    unsaved = 0
+                                                    ip = cold[op](ins, code, frame, temps, stack, ip)
+                                                    left = task.quiet - rt.steps if task is not None else 0
+                                            elif op < 98:
+                                                if op < 97:
+                                                    if dirty:
+                                                        frame.line = info.line
+                                                        task.at = info
+                                                        dirty = False
+                                                    rt.steps += unsaved
+                                                    unsaved = 0
+                                                    ip = cold[op](ins, code, frame, temps, stack, ip)
+                                                    left = task.quiet - rt.steps if task is not None else 0
+                                                else:
+                                                    if dirty:
+                                                        frame.line = info.line
+                                                        task.at = info
+                                                        dirty = False
+                                                    rt.steps += unsaved
+                                                    unsaved = 0
+                                                    ip = cold[op](ins, code, frame, temps, stack, ip)
+                                                    left = task.quiet - rt.steps if task is not None else 0
+                                            elif op < 99:
                                                 if dirty:
                                                     frame.line = info.line
                                                     task.at = info
@@ -997,26 +1056,64 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                                 unsaved = 0
                                                 ip = cold[op](ins, code, frame, temps, stack, ip)
                                                 left = task.quiet - rt.steps if task is not None else 0
-                                        elif op < 105:
-                                            if dirty:
-                                                frame.line = info.line
-                                                task.at = info
-                                                dirty = False
-                                            rt.steps += unsaved
-                                            unsaved = 0
-                                            ip = cold[op](ins, code, frame, temps, stack, ip)
-                                            left = task.quiet - rt.steps if task is not None else 0
-                                        else:
-                                            if dirty:
-                                                frame.line = info.line
-                                                task.at = info
-                                                dirty = False
-                                            rt.steps += unsaved
-                                            unsaved = 0
-                                            ip = cold[op](ins, code, frame, temps, stack, ip)
-                                            left = task.quiet - rt.steps if task is not None else 0
-                                    elif op < 108:
-                                        if op < 107:
+                                        elif op < 104:
+                                            if op < 102:
+                                                if op < 101:
+                                                    if dirty:
+                                                        frame.line = info.line
+                                                        task.at = info
+                                                        dirty = False
+                                                    rt.steps += unsaved
+                                                    unsaved = 0
+                                                    ip = cold[op](ins, code, frame, temps, stack, ip)
+                                                    left = task.quiet - rt.steps if task is not None else 0
+                                                else:
+                                                    if dirty:
+                                                        frame.line = info.line
+                                                        task.at = info
+                                                        dirty = False
+                                                    rt.steps += unsaved
+                                                    unsaved = 0
+                                                    ip = cold[op](ins, code, frame, temps, stack, ip)
+                                                    left = task.quiet - rt.steps if task is not None else 0
+                                            elif op < 103:
+                                                if dirty:
+                                                    frame.line = info.line
+                                                    task.at = info
+                                                    dirty = False
+                                                rt.steps += unsaved
+                                                unsaved = 0
+                                                ip = cold[op](ins, code, frame, temps, stack, ip)
+                                                left = task.quiet - rt.steps if task is not None else 0
+                                            else:
+                                                if dirty:
+                                                    frame.line = info.line
+                                                    task.at = info
+                                                    dirty = False
+                                                rt.steps += unsaved
+                                                unsaved = 0
+                                                ip = cold[op](ins, code, frame, temps, stack, ip)
+                                                left = task.quiet - rt.steps if task is not None else 0
+                                        elif op < 106:
+                                            if op < 105:
+                                                if dirty:
+                                                    frame.line = info.line
+                                                    task.at = info
+                                                    dirty = False
+                                                rt.steps += unsaved
+                                                unsaved = 0
+                                                ip = cold[op](ins, code, frame, temps, stack, ip)
+                                                left = task.quiet - rt.steps if task is not None else 0
+                                            else:
+                                                if dirty:
+                                                    frame.line = info.line
+                                                    task.at = info
+                                                    dirty = False
+                                                rt.steps += unsaved
+                                                unsaved = 0
+                                                ip = cold[op](ins, code, frame, temps, stack, ip)
+                                                left = task.quiet - rt.steps if task is not None else 0
+                                        elif op < 107:
                                             if dirty:
                                                 frame.line = info.line
                                                 task.at = info
@@ -1035,84 +1132,115 @@ def run(self, code, frame, temps, ip, stack, thunk=False):
                                             ip = cold[op](ins, code, frame, temps, stack, ip)
                                             left = task.quiet - rt.steps if task is not None else 0
                                     elif op < 109:
-                                        if dirty:
-                                            frame.line = info.line
-                                            task.at = info
-                                            dirty = False
-                                        rt.steps += unsaved
-                                        unsaved = 0
-                                        ip = cold[op](ins, code, frame, temps, stack, ip)
-                                        left = task.quiet - rt.steps if task is not None else 0
+                                        g = ins[1]
+                                        ref = grefs[g]
+                                        if ref is None:
+                                            ref = rt.storage_ref(code.gstorage[g], frame)
+                                            grefs[g] = ref
+                                        if op == 108:
+                                            stack.append(_load(ref))
+                                        elif op == 109:
+                                            stack.append(ref)
+                                        else:
+                                            _store(ref, stack.pop())
+                                        ip += 1
                                     else:
-                                        if dirty:
-                                            frame.line = info.line
-                                            task.at = info
-                                            dirty = False
-                                        rt.steps += unsaved
-                                        unsaved = 0
-                                        ip = cold[op](ins, code, frame, temps, stack, ip)
-                                        left = task.quiet - rt.steps if task is not None else 0
-                                elif op < 111:
-                                    g = ins[1]
-                                    ref = grefs[g]
-                                    if ref is None:
-                                        ref = rt.storage_ref(code.gstorage[g], frame)
-                                        grefs[g] = ref
-                                    if op == 110:
-                                        stack.append(_load(ref))
-                                    elif op == 111:
-                                        stack.append(ref)
-                                    else:
-                                        _store(ref, stack.pop())
-                                    ip += 1
+                                        g = ins[1]
+                                        ref = grefs[g]
+                                        if ref is None:
+                                            ref = rt.storage_ref(code.gstorage[g], frame)
+                                            grefs[g] = ref
+                                        if op == 108:
+                                            stack.append(_load(ref))
+                                        elif op == 109:
+                                            stack.append(ref)
+                                        else:
+                                            _store(ref, stack.pop())
+                                        ip += 1
                                 else:
-                                    g = ins[1]
-                                    ref = grefs[g]
-                                    if ref is None:
-                                        ref = rt.storage_ref(code.gstorage[g], frame)
-                                        grefs[g] = ref
-                                    if op == 110:
-                                        stack.append(_load(ref))
-                                    elif op == 111:
-                                        stack.append(ref)
-                                    else:
-                                        _store(ref, stack.pop())
+                                    n = ins[1]
+                                    idx = [None if x is None else _array_index(x) for x in stack[-n:]]
+                                    del stack[-n:]
+                                    stack[-1] = rt.index(stack[-1], idx, ins[2])
                                     ip += 1
                             else:
-                                n = ins[1]
-                                idx = [None if x is None else _array_index(x) for x in stack[-n:]]
-                                del stack[-n:]
-                                stack[-1] = rt.index(stack[-1], idx, ins[2])
+                                b = ins[1]
+                                a = stack[-1]
+                                if type(a) is float and type(b) is float:
+                                    stack[-1] = a * b
+                                elif type(a) is int and type(b) is int and (-2147483648 <= (v := (a * b)) <= 2147483647):
+                                    stack[-1] = v
+                                elif type(a) is int and type(b) is float or (type(a) is float and type(b) is int):
+                                    stack[-1] = a * b
+                                else:
+                                    stack[-1] = _mul(a, b)
+                                ip += 1
+                        elif op < 115:
+                            if op < 114:
+                                if op < 113:
+                                    n = ins[1]
+                                    idx = stack[-n:]
+                                    del stack[-n:]
+                                    stack[-1] = _element(stack[-1], idx, ins[2])
+                                    ip += 1
+                                else:
+                                    t = ins[1]
+                                    ref = temps[t]
+                                    end = temps[t + 1]
+                                    step = temps[t + 2]
+                                    if type(ref) is Slot and type((c := ref.c[ref.k])) is int and (type(end) is int) and (type(step) is int):
+                                        go = c > end if step > 0 else c < end
+                                    else:
+                                        go = for_done(temps[t].get(), end, step)
+                                    if go:
+                                        ip = ins[2]
+                                    else:
+                                        ip += 1
+                            else:
+                                if left > 0 and (not ins[2]):
+                                    left -= 1
+                                    unsaved += 1
+                                else:
+                                    if dirty:
+                                        frame.line = info.line
+                                        task.at = info
+                                        dirty = False
+                                    rt.steps += unsaved
+                                    unsaved = 0
+                                    tick(ins[1])
+                                    task.quiet = n = quiet_limit(task)
+                                    left = n - rt.steps
                                 ip += 1
                         else:
                             x1 = ins[1]
                             x2 = ins[2]
-                            a = store[x1]
                             i = store[x2]
-                            d = a.data
-                            if not (type(i) is int and 0 < i <= len(d) and ((v := d[(x3 := i) - 1]) is not UNSET)):
+                            d = adata[x1]
+                            if d is None:
+                                d = adata[x1] = store[x1].data
+                            if not (type(i) is int and 0 < i <= 2147483647 and ((x3 := i) <= len(d)) and ((v := d[x3 - 1]) is not UNSET)):
                                 v = _element1(fvars[x1] or frame.var(x1), _load(fvars[x2] or frame.var(x2)), ins[3])
                             x1 = ins[4]
                             a = store[x1]
                             b = ins[5]
-                            if type(a) is int and type(b) is int and (INT_MIN <= (i := (a + b)) <= INT_MAX):
+                            if type(a) is int and type(b) is int and (-2147483648 <= (i := (a + b)) <= 2147483647):
                                 pass
                             elif type(a) is float and type(b) is float:
                                 i = a + b
                             else:
                                 i = _add(a if a is not UNSET else _load(fvars[x1] or frame.var(x1)), b)
                             x1 = ins[6]
-                            a = store[x1]
                             t = ins[8]
-                            d = a.data
-                            if type(i) is int and 0 < i <= len(d) and (type(v) is t) and (t is not int or INT_MIN <= v <= INT_MAX):
-                                x3 = i
+                            d = adata[x1]
+                            if d is None:
+                                d = adata[x1] = store[x1].data
+                            if type(i) is int and 0 < i <= 2147483647 and ((x3 := i) <= len(d)) and (type(v) is t) and (t is not int or -2147483648 <= v <= 2147483647):
                                 d[x3 - 1] = v
                             else:
                                 _set_element1(fvars[x1] or frame.var(x1), i, v, ins[7])
                             ip += 1
                     else:
-                        if left > 0 and (not ins[1].cond_stops):
+                        if left > 0 and (not ins[3]):
                             left -= 1
                             unsaved += 1
                         else:

@@ -159,6 +159,8 @@ _TABLE = [
     # chosen by measurement: the commonest triples of the compute benchmark (interp/bench)
     ("IF_NOT_EV",     0,  "vvnvol", "jump to l unless v1 [v2] o v3 (LOAD_ELEM1_V v1 v2 n, LOAD_FAST v3, IF_NOT_<o> l)"),
     ("MOVE_ELEM1",    0,  "vvnvcvny", "v4 [v3 + c] = v1 [v2] (LOAD_ELEM1_V v1 v2 n, FAST_ADD_CONST v3 c, STORE_ELEM1 v4 n y)"),
+    ("ADD_FAST",      0,  "vvvy", "v3 = v1 + v2 (LOAD_FAST2 v1 v2, ADD, STORE_FAST v3 y)"),
+    ("STORE_ELEM1_VC", 0, "vvnyc", "store array v1 [store variable v2] = c (CONST c, STORE_ELEM1_V v1 v2 n y)"),
     # -- jumps
     ("JUMP",          0,  "l",  "jump"),
     ("JUMP_IF_FALSE",-1,  "l",  "pop a condition (Runtime.to_bool); jump if FALSE"),

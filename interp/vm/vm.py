@@ -32,6 +32,7 @@ The cold opcodes (motion, interrupts, triggers, analog I/O, waits, ...) are meth
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import importlib.util
 import math
@@ -79,8 +80,11 @@ STACK_BASE = 8
 
 # the VM's forms of operand kinds y and o (opcodes.py)
 _VALUE_CLASS = {"I": int, "R": float, "B": bool}
-_COMPARE = {"<": (operator.lt, lt), "<=": (operator.le, le), ">": (operator.gt, gt), ">=": (operator.ge, ge),
-            "==": (operator.eq, eq), "<>": (operator.ne, ne)}
+# (the comparison on two numbers, its runtime function, its mask): bit s + 1 of the mask is set when
+# the comparison holds for two INTs whose order is s = (a > b) - (a < b) (-1, 0, 1), so the
+# compiled loop compares two INTs in C without a call
+_COMPARE = {"<": (operator.lt, lt, 0b001), "<=": (operator.le, le, 0b011), ">": (operator.gt, gt, 0b100),
+            ">=": (operator.ge, ge, 0b110), "==": (operator.eq, eq, 0b010), "<>": (operator.ne, ne, 0b101)}
 
 
 class Linked:
@@ -93,7 +97,7 @@ class Linked:
     (the front end's Storage, bound per run by :class:`Bound`); and the error region of
     each instruction. It holds nothing of a run and is kept per routine and loop."""
 
-    __slots__ = ("name", "kind", "file", "prog", "iregions", "lnames", "ntemps",
+    __slots__ = ("name", "kind", "file", "prog", "ops", "iregions", "lnames", "ntemps",
                  "mnames", "mstorage", "gnames", "gstorage", "calls", "is_function")
 
 
@@ -141,6 +145,8 @@ def link(lst, dispatch) -> Linked:
             ins.append(v)
         if name == "STMT_G" or name == "STMT":
             ins += (ins[1].line, ins[1].stops)      # read by every statement: kept in the tuple
+        elif name == "JUMP_TICK" or name == "TICK":
+            ins.append(ins[1].cond_stops)           # read by every iteration: kept in the tuple
         elif ins[0] == call_op and ins[1].kind == ROUTINE:
             out.calls.append(len(prog))
         prog.append(tuple(ins))
@@ -153,6 +159,7 @@ def link(lst, dispatch) -> Linked:
             reg = Region(reg.kind, reg.line, -1)
         regions.append(reg)
     out.prog, out.iregions = prog, regions
+    out.ops = bytes(ins[0] for ins in prog)     # the opcodes alone: the loop dispatches on a C byte
     return out
 
 
@@ -162,13 +169,13 @@ class Bound:
     global slots (``grefs``, bound on first use) and of each call site that runs a routine
     of the program (``callsites``: instruction -> (module, Routine), from its Callee)."""
 
-    __slots__ = ("name", "kind", "is_function", "file", "routine", "prog", "iregions", "ntemps", "gstorage",
+    __slots__ = ("name", "kind", "is_function", "file", "routine", "prog", "ops", "iregions", "ntemps", "gstorage",
                  "mrefs", "grefs", "callsites", "gnames")
 
     def __init__(self, linked: Linked, routine, rt) -> None:
         self.name, self.kind, self.file, self.routine = linked.name, linked.kind, linked.file, routine
         self.is_function = linked.is_function
-        self.prog, self.iregions, self.ntemps = linked.prog, linked.iregions, linked.ntemps
+        self.prog, self.ops, self.iregions, self.ntemps = linked.prog, linked.ops, linked.iregions, linked.ntemps
         self.gstorage, self.gnames = linked.gstorage, linked.gnames
         self.mrefs = [rt.storage_ref(st, None) for st in linked.mstorage]
         self.grefs = [None] * len(linked.gstorage)
@@ -197,9 +204,12 @@ class VM:
             handler = getattr(self, "_cold_" + o.name, None)
             if handler is not None:
                 self.cold[self.dispatch[o.number]] = handler
+        # the body of a KRL call (exec_routine without its Python frame: the loop itself, which
+        # finds the routine's code when called without one)
+        self.body = functools.partial(self.loop, self, None)
         # the runtime's statement hooks, bound once (the loop takes them at each call)
         self.hooks = (rt.before_statement, rt.loop_tick, rt.take_error_proceed, rt.quiet_limit, rt.run_routine,
-                      self.exec_routine)
+                      self.body)
 
     # ------------------------------------------------------------------ entry points
     def run_program(self, module_name: str | None = None) -> None:
@@ -220,7 +230,7 @@ class VM:
     def invoke(self, target, args: list, caller, catch_resume: bool = True):
         """Run routine ``target`` = (module, Routine) with reference ``args`` (the
         runtime's call protocol, Runtime.run_routine)."""
-        return self.rt.run_routine(target, args, caller, self.exec_routine, catch_resume)
+        return self.rt.run_routine(target, args, caller, self.body, catch_resume)
 
     def exec_routine(self, frame):
         """Run the code of the routine of ``frame`` (compiled on its first call); the value
@@ -462,16 +472,28 @@ class VM:
         return ip + 1
 
     # ------------------------------------------------------------------ the loop
-    def run(self, code, frame, temps: list, ip: int, stack: list, thunk: bool = False):
+    def run(self, code, frame, temps: list | None = None, ip: int = 0, stack: list | None = None, thunk: bool = False):
         """Run ``code`` from ``ip`` in the activation of ``frame`` (its runtime Frame) with
         the temporaries ``temps``; returns the value of RETURN,
-        or of the thunk at END_THUNK. The ``_name`` helpers are the runtime functions of
-        :data:`HELPERS` (module names of the generated loop: interp/vm/gen_loop.py)."""
+        or of the thunk at END_THUNK. ``code`` None: the body of a call (:meth:`exec_routine`,
+        ``VM.body``), the code of the frame's routine from its start. The ``_name`` helpers are
+        the runtime functions of :data:`HELPERS` (module names of the generated loop:
+        interp/vm/gen_loop.py)."""
+        if code is None:
+            routine = frame.routine
+            code = self.codes.get(id(routine)) or self.code_for(routine)
+            temps = [None] * code.ntemps
+            stack = [None, None, None, None, None, None, None, None]      # STACK_BASE
         rt = self.rt
         prog = code.prog
+        ops = code.ops               # prog's opcodes, one byte each (C integers when compiled)
         mrefs = code.mrefs
         grefs = code.grefs
         store = frame.store          # store variables (operand kind v): Frame.store keys
+        # the data list of each store array, read from the store when first used: an array's data
+        # list is never replaced (values.Arr; convert.assign_into fills it in place)
+        adata = [None] * len(store)
+        agrid = [None] * len(store)
         fvars = frame.vars
         push = stack.append
         pop = stack.pop
@@ -496,7 +518,7 @@ class VM:
                 try:
                     while True:
                         ins = prog[ip]
-                        op = ins[0]
+                        op = ops[ip]
                         # hottest first (measured on the benchmark): the rank weights the search
                         # tree interp/vm/gen_loop.py makes of this chain
                         if op == OP.STMT_G:
@@ -519,10 +541,11 @@ class VM:
                         elif op == OP.LOAD_ELEM1_V:
                             x1 = ins[1]             # x1, x2, x3: C integers when compiled (loop.pxd)
                             x2 = ins[2]
-                            a = store[x1]
                             i = store[x2]
-                            d = a.data              # 1-D: len(data) is dims[0] (values.Arr)
-                            if i.__class__ is int and 0 < i <= len(d) and (v := d[(x3 := i) - 1]) is not UNSET:
+                            d = adata[x1]  # 1-D: len(data) is dims[0] (values.Arr)
+                            if d is None:
+                                d = adata[x1] = store[x1].data
+                            if i.__class__ is int and 0 < i <= INT_MAX and (x3 := i) <= len(d) and (v := d[x3 - 1]) is not UNSET:
                                 push(v)
                             else:
                                 push(_element1((fvars[x1] or frame.var(x1)), _load((fvars[x2] or frame.var(x2))), ins[3]))
@@ -533,7 +556,7 @@ class VM:
                             push(v if v is not UNSET else _load((fvars[x1] or frame.var(x1))))
                             ip += 1
                         elif op == OP.JUMP_TICK:
-                            if left > 0 and not ins[1].cond_stops:
+                            if left > 0 and not ins[3]:
                                 left -= 1
                                 unsaved += 1
                             else:
@@ -557,6 +580,11 @@ class VM:
                             if c.__class__ is int and (c := c + temps[x2 + 2]) <= temps[x2 + 3]:
                                 store[x1] = c
                                 go = True
+                            elif (c.__class__ is int and (step := temps[x2 + 2]).__class__ is int
+                                  and (end := temps[x2 + 1]).__class__ is int and INT_MIN <= c <= INT_MAX):
+                                # the last step (or a negative STEP): for_next's INT case inline
+                                store[x1] = c
+                                go = c <= end if step > 0 else c >= end
                             else:
                                 go = _for_next(temps[x2], temps[x2 + 1], temps[x2 + 2], ins[3])
                             if go:
@@ -607,11 +635,11 @@ class VM:
                             i = pop()
                             v = pop()
                             x1 = ins[1]
-                            a = store[x1]
                             t = ins[3]
-                            d = a.data
-                            if i.__class__ is int and 0 < i <= len(d) and v.__class__ is t and (t is not int or INT_MIN <= v <= INT_MAX):
-                                x3 = i
+                            d = adata[x1]
+                            if d is None:
+                                d = adata[x1] = store[x1].data
+                            if i.__class__ is int and 0 < i <= INT_MAX and (x3 := i) <= len(d) and v.__class__ is t and (t is not int or INT_MIN <= v <= INT_MAX):
                                 d[x3 - 1] = v
                             else:
                                 _set_element1((fvars[x1] or frame.var(x1)), i, v, ins[2])
@@ -635,8 +663,16 @@ class VM:
                             ca = a.__class__
                             cb = b.__class__
                             f = ins[3]
-                            if (f[0](a, b) if (ca is int or ca is float) and (cb is int or cb is float)
-                                    else f[1](a if a is not UNSET else _load((fvars[x1] or frame.var(x1))), b)):
+                            if ca is int and cb is int:
+                                y1 = a                  # two INTs: compared in C by the mask (_COMPARE)
+                                y2 = b
+                                x3 = f[2]
+                                go = (x3 >> ((y1 > y2) - (y1 < y2) + 1)) & 1
+                            elif (ca is int or ca is float) and (cb is int or cb is float):
+                                go = f[0](a, b)
+                            else:
+                                go = f[1](a if a is not UNSET else _load((fvars[x1] or frame.var(x1))), b)
+                            if go:
                                 ip += 1
                             else:
                                 ip = ins[4]
@@ -652,13 +688,13 @@ class VM:
                         elif op == OP.STORE_ELEM1_V:
                             x1 = ins[1]
                             x2 = ins[2]
-                            a = store[x1]
                             i = store[x2]
                             v = pop()
                             t = ins[4]
-                            d = a.data
-                            if i.__class__ is int and 0 < i <= len(d) and v.__class__ is t and (t is not int or INT_MIN <= v <= INT_MAX):
-                                x3 = i
+                            d = adata[x1]
+                            if d is None:
+                                d = adata[x1] = store[x1].data
+                            if i.__class__ is int and 0 < i <= INT_MAX and (x3 := i) <= len(d) and v.__class__ is t and (t is not int or INT_MIN <= v <= INT_MAX):
                                 d[x3 - 1] = v
                             else:
                                 _set_element1((fvars[x1] or frame.var(x1)), _load((fvars[x2] or frame.var(x2))), v, ins[3])
@@ -667,10 +703,11 @@ class VM:
                             # LOAD_ELEM1_V, LOAD_FAST, IF_NOT_<o>: their handlers in a row
                             x1 = ins[1]
                             x2 = ins[2]
-                            a = store[x1]
                             i = store[x2]
-                            d = a.data
-                            if not (i.__class__ is int and 0 < i <= len(d) and (v := d[(x3 := i) - 1]) is not UNSET):
+                            d = adata[x1]
+                            if d is None:
+                                d = adata[x1] = store[x1].data
+                            if not (i.__class__ is int and 0 < i <= INT_MAX and (x3 := i) <= len(d) and (v := d[x3 - 1]) is not UNSET):
                                 v = _element1((fvars[x1] or frame.var(x1)), _load((fvars[x2] or frame.var(x2))), ins[3])
                             x1 = ins[4]
                             b = store[x1]
@@ -679,7 +716,14 @@ class VM:
                             ca = v.__class__
                             cb = b.__class__
                             f = ins[5]
-                            if (f[0](v, b) if (ca is int or ca is float) and (cb is int or cb is float) else f[1](v, b)):
+                            if ca is int and cb is int:
+                                y1 = v
+                                y2 = b
+                                x3 = f[2]
+                                go = (x3 >> ((y1 > y2) - (y1 < y2) + 1)) & 1
+                            else:
+                                go = f[0](v, b) if (ca is int or ca is float) and (cb is int or cb is float) else f[1](v, b)
+                            if go:
                                 ip += 1
                             else:
                                 ip = ins[6]
@@ -687,10 +731,11 @@ class VM:
                             # LOAD_ELEM1_V, FAST_ADD_CONST, STORE_ELEM1: their handlers in a row
                             x1 = ins[1]
                             x2 = ins[2]
-                            a = store[x1]
                             i = store[x2]
-                            d = a.data
-                            if not (i.__class__ is int and 0 < i <= len(d) and (v := d[(x3 := i) - 1]) is not UNSET):
+                            d = adata[x1]
+                            if d is None:
+                                d = adata[x1] = store[x1].data
+                            if not (i.__class__ is int and 0 < i <= INT_MAX and (x3 := i) <= len(d) and (v := d[x3 - 1]) is not UNSET):
                                 v = _element1((fvars[x1] or frame.var(x1)), _load((fvars[x2] or frame.var(x2))), ins[3])
                             x1 = ins[4]
                             a = store[x1]
@@ -702,14 +747,54 @@ class VM:
                             else:
                                 i = _add(a if a is not UNSET else _load((fvars[x1] or frame.var(x1))), b)
                             x1 = ins[6]
-                            a = store[x1]
                             t = ins[8]
-                            d = a.data
-                            if i.__class__ is int and 0 < i <= len(d) and v.__class__ is t and (t is not int or INT_MIN <= v <= INT_MAX):
-                                x3 = i
+                            d = adata[x1]
+                            if d is None:
+                                d = adata[x1] = store[x1].data
+                            if i.__class__ is int and 0 < i <= INT_MAX and (x3 := i) <= len(d) and v.__class__ is t and (t is not int or INT_MIN <= v <= INT_MAX):
                                 d[x3 - 1] = v
                             else:
                                 _set_element1((fvars[x1] or frame.var(x1)), i, v, ins[7])
+                            ip += 1
+                        elif op == OP.ADD_FAST:
+                            # LOAD_FAST2, ADD, STORE_FAST: their handlers in a row
+                            x1 = ins[1]
+                            x2 = ins[2]
+                            a = store[x1]
+                            b = store[x2]
+                            t = ins[4]
+                            if a.__class__ is int and b.__class__ is int and t is int and INT_MIN <= (v := a + b) <= INT_MAX:
+                                x3 = ins[3]
+                                store[x3] = v
+                            elif a.__class__ is float and b.__class__ is float and t is float:
+                                x3 = ins[3]
+                                store[x3] = a + b
+                            else:
+                                if a is UNSET:
+                                    a = _load((fvars[x1] or frame.var(x1)))
+                                if b is UNSET:
+                                    b = _load((fvars[x2] or frame.var(x2)))
+                                v = _add(a, b)          # (ADD's inline cases give add's result)
+                                x3 = ins[3]
+                                if v.__class__ is t and (t is not int or INT_MIN <= v <= INT_MAX):
+                                    store[x3] = v
+                                else:
+                                    _store((fvars[x3] or frame.var(x3)), v)
+                            ip += 1
+                        elif op == OP.STORE_ELEM1_VC:
+                            # CONST, STORE_ELEM1_V
+                            x1 = ins[1]
+                            x2 = ins[2]
+                            i = store[x2]
+                            v = ins[5]
+                            t = ins[4]
+                            d = adata[x1]
+                            if d is None:
+                                d = adata[x1] = store[x1].data
+                            if i.__class__ is int and 0 < i <= INT_MAX and (x3 := i) <= len(d) and v.__class__ is t and (t is not int or INT_MIN <= v <= INT_MAX):
+                                d[x3 - 1] = v
+                            else:
+                                _set_element1((fvars[x1] or frame.var(x1)), _load((fvars[x2] or frame.var(x2))), v, ins[3])
                             ip += 1
                         elif op == OP.FAST_ADD_CONST:
                             x1 = ins[1]
@@ -733,8 +818,16 @@ class VM:
                             ca = a.__class__
                             cb = b.__class__
                             f = ins[3]
-                            if (f[0](a, b) if (ca is int or ca is float) and (cb is int or cb is float)
-                                    else f[1](a if a is not UNSET else _load((fvars[x1] or frame.var(x1))), b if b is not UNSET else _load((fvars[x2] or frame.var(x2))))):
+                            if ca is int and cb is int:
+                                y1 = a
+                                y2 = b
+                                x3 = f[2]
+                                go = (x3 >> ((y1 > y2) - (y1 < y2) + 1)) & 1
+                            elif (ca is int or ca is float) and (cb is int or cb is float):
+                                go = f[0](a, b)
+                            else:
+                                go = f[1](a if a is not UNSET else _load((fvars[x1] or frame.var(x1))), b if b is not UNSET else _load((fvars[x2] or frame.var(x2))))
+                            if go:
                                 ip += 1
                             else:
                                 ip = ins[4]
@@ -745,6 +838,8 @@ class VM:
                                 stack[-1] = a * b
                             elif a.__class__ is int and b.__class__ is int and INT_MIN <= (v := a * b) <= INT_MAX:
                                 stack[-1] = v
+                            elif (a.__class__ is int and b.__class__ is float) or (a.__class__ is float and b.__class__ is int):
+                                stack[-1] = a * b                   # INT * REAL: REAL (mul)
                             else:
                                 stack[-1] = _mul(a, b)
                             ip += 1
@@ -819,10 +914,15 @@ class VM:
                         elif op == OP.LOAD_ELEM2:
                             j = pop()
                             i = stack[-1]
-                            a = store[ins[1]]
-                            n, m = a.dims
+                            x1 = ins[1]
+                            grid = agrid[x1]
+                            if grid is None:               # (data, rows, columns) of a 2-D store array: they never change
+                                a = store[x1]
+                                grid = agrid[x1] = (a.data, a.dims[0], a.dims[1])
+                            n = grid[1]
+                            m = grid[2]
                             if i.__class__ is int and j.__class__ is int and 0 < i <= n and 0 < j <= m \
-                                    and (v := a.data[((y1 := i) - 1) * (y2 := m) + (y3 := j) - 1]) is not UNSET:
+                                    and (v := grid[0][((y1 := i) - 1) * (y2 := m) + (y3 := j) - 1]) is not UNSET:
                                 stack[-1] = v
                             else:
                                 stack[-1] = _element2((fvars[ins[1]] or frame.var(ins[1])), i, j, ins[2])
@@ -831,12 +931,16 @@ class VM:
                             x1 = ins[1]
                             x2 = ins[2]
                             x3 = ins[3]
-                            a = store[x1]
                             i = store[x2]
                             j = store[x3]
-                            n, m = a.dims
+                            grid = agrid[x1]
+                            if grid is None:               # (data, rows, columns) of a 2-D store array: they never change
+                                a = store[x1]
+                                grid = agrid[x1] = (a.data, a.dims[0], a.dims[1])
+                            n = grid[1]
+                            m = grid[2]
                             if i.__class__ is int and j.__class__ is int and 0 < i <= n and 0 < j <= m \
-                                    and (v := a.data[((y1 := i) - 1) * (y2 := m) + (y3 := j) - 1]) is not UNSET:
+                                    and (v := grid[0][((y1 := i) - 1) * (y2 := m) + (y3 := j) - 1]) is not UNSET:
                                 push(v)
                             else:
                                 push(_element2((fvars[x1] or frame.var(x1)), _load((fvars[x2] or frame.var(x2))), _load((fvars[x3] or frame.var(x3))), ins[4]))
@@ -862,7 +966,7 @@ class VM:
                             _set_component(base, ins[1][0], pop(), ins[2])
                             ip += 1
                         elif op == OP.TICK:
-                            if left > 0 and not ins[1].cond_stops:
+                            if left > 0 and not ins[2]:
                                 left -= 1
                                 unsaved += 1
                             else:
@@ -883,6 +987,8 @@ class VM:
                                 stack[-1] = a * b
                             elif a.__class__ is int and b.__class__ is int and INT_MIN <= (v := a * b) <= INT_MAX:
                                 stack[-1] = v
+                            elif (a.__class__ is int and b.__class__ is float) or (a.__class__ is float and b.__class__ is int):
+                                stack[-1] = a * b                   # INT * REAL: REAL (mul)
                             else:
                                 stack[-1] = _mul(a, b)
                             ip += 1
@@ -933,14 +1039,19 @@ class VM:
                             j = pop()
                             i = pop()
                             v = pop()
-                            a = store[ins[1]]
-                            n, m = a.dims
+                            x1 = ins[1]
+                            grid = agrid[x1]
+                            if grid is None:               # (data, rows, columns) of a 2-D store array: they never change
+                                a = store[x1]
+                                grid = agrid[x1] = (a.data, a.dims[0], a.dims[1])
+                            n = grid[1]
+                            m = grid[2]
                             t = ins[3]
                             if i.__class__ is int and j.__class__ is int and 0 < i <= n and 0 < j <= m and v.__class__ is t and (t is not int or INT_MIN <= v <= INT_MAX):
                                 y1 = i
                                 y2 = m
                                 y3 = j
-                                a.data[(y1 - 1) * y2 + y3 - 1] = v
+                                grid[0][(y1 - 1) * y2 + y3 - 1] = v
                             else:
                                 _set_element((fvars[ins[1]] or frame.var(ins[1])), [i, j], v, ins[2])
                             ip += 1
@@ -1070,10 +1181,12 @@ class VM:
                                 dirty = False
                             return None
                         elif op == OP.LOAD_ELEM1:
-                            a = store[ins[1]]
+                            x1 = ins[1]
                             i = stack[-1]
-                            d = a.data
-                            if i.__class__ is int and 0 < i <= len(d) and (v := d[(x3 := i) - 1]) is not UNSET:
+                            d = adata[x1]
+                            if d is None:
+                                d = adata[x1] = store[x1].data
+                            if i.__class__ is int and 0 < i <= INT_MAX and (x3 := i) <= len(d) and (v := d[x3 - 1]) is not UNSET:
                                 stack[-1] = v
                             else:
                                 stack[-1] = _element1((fvars[ins[1]] or frame.var(ins[1])), i, ins[2])
@@ -1131,7 +1244,15 @@ class VM:
                             ip += 1
                         elif op == OP.FOR_TEST:
                             t = ins[1]
-                            if for_done(temps[t].get(), temps[t + 1], temps[t + 2]):
+                            ref = temps[t]
+                            end = temps[t + 1]
+                            step = temps[t + 2]
+                            if ref.__class__ is Slot and (c := ref.c[ref.k]).__class__ is int and end.__class__ is int \
+                                    and step.__class__ is int:
+                                go = c > end if step > 0 else c < end       # for_done, INTs (STEP is not 0)
+                            else:
+                                go = for_done(temps[t].get(), end, step)
+                            if go:
                                 ip = ins[2]
                             else:
                                 ip += 1
@@ -1242,12 +1363,22 @@ class VM:
                             end = pop()
                             start = pop()
                             temps[t] = pop()
-                            temps[t + 1], temps[t + 2] = end, step = _for_limits(end, step)
+                            if not (end.__class__ is int and step.__class__ is int and step != 0):
+                                end, step = _for_limits(end, step)       # (two INTs: for_limits' result)
+                            temps[t + 1] = end
+                            temps[t + 2] = step
                             temps[t + 3] = min(end, INT_MAX) if step.__class__ is int and step > 0 else -math.inf
                             push(start)
                             ip += 1
                         elif op == OP.FOR_INIT:
-                            _store(temps[ins[1]], pop())
+                            ref = temps[ins[1]]
+                            v = pop()
+                            # store's fast path (slots.py) for an INT counter
+                            if (ref.__class__ is Slot and ref.type is T_INT and v.__class__ is int and not ref.readonly
+                                    and ref.on_write is None and INT_MIN <= v <= INT_MAX):
+                                ref.c[ref.k] = v
+                            else:
+                                _store(ref, v)
                             ip += 1
                         elif (op == OP.AGG or op == OP.JUMP_IF_NONE or op == OP.HALT or op == OP.WAIT_FOR or
                               op == OP.WAIT_SEC or op == OP.CONTINUE or op == OP.ON_ERROR_PROCEED or

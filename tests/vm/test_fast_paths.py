@@ -203,6 +203,10 @@ ERROR_CASES = {
     63: ([_overflow(INT_MAX + 1)], None, 0),        # INT_MIN / -1 (BINOP /)
     64: (["value invalid", "i"], VI, 0),           # INT / unset INT
     65: (["division by zero"], None, 0),            # INT / 0
+    66: (["array index", "a[4]", "1..3"], None, 0),   # past the end (STORE_ELEM1_V)
+    67: (["value invalid", "i"], VI, 0),           # ADD_FAST, unset second operand
+    68: (["cannot assign", "BOOL"], None, 0),       # ADD_FAST, INT into BOOL
+    69: (["cannot assign", "BOOL"], None, 0),       # STORE_ELEM1_VC, INT into a BOOL element
 }
 
 
@@ -340,7 +344,8 @@ def test_on_error_proceed_around_fast_statements(values):
 
 FAST_OPS = {"LOAD_FAST", "LOAD_FAST2", "FAST_ADD_CONST", "FAST_SUB_CONST", "STORE_FAST", "LOAD_ELEM1",
             "LOAD_ELEM2", "STORE_ELEM1", "STORE_ELEM2", "LOAD_ELEM1_V", "STORE_ELEM1_V", "LOAD_ELEM2_VV",
-            "FOR_NEXT_FAST", "ADDC_FAST", "SUBC_FAST", "IF_NOT_VV", "IF_NOT_VC", "IF_NOT_EV", "MOVE_ELEM1"}
+            "FOR_NEXT_FAST", "ADDC_FAST", "SUBC_FAST", "IF_NOT_VV", "IF_NOT_VC", "IF_NOT_EV", "MOVE_ELEM1",
+            "ADD_FAST", "STORE_ELEM1_VC"}
 INLINE_OPS = {"ADD", "SUB", "MUL", "ADD_CONST", "SUB_CONST", "MUL_CONST", "IF_NOT_LT", "IF_NOT_LE",
               "IF_NOT_GT", "IF_NOT_GE", "IF_NOT_EQ", "IF_NOT_NE"}
 
