@@ -5,6 +5,7 @@ semantics (docs/architecture.md, "Interpreters", lists the contracts).
 
 from __future__ import annotations
 
+import gc
 import random
 import sys
 from pathlib import Path
@@ -237,9 +238,18 @@ class Runtime:
                 writer.state_probe = lambda: probe_state(self)
         old = sys.getrecursionlimit()
         sys.setrecursionlimit(max(old, 20000))
+        # the objects of the set-up (make_runtime: the front end's, the runtime's) live as long
+        # as the run: out of the collector's generations while it runs, so its collections
+        # walk only what the run makes (unless the process froze its own already: the
+        # language server's)
+        froze = gc.get_freeze_count() == 0 and gc.isenabled()
+        if froze:
+            gc.freeze()
         try:
             self.scheduler.run()
         finally:
+            if froze:
+                gc.unfreeze()
             sys.setrecursionlimit(old)
             net = getattr(self.controller, "network", None)
             if net is not None:

@@ -57,6 +57,8 @@ from __future__ import annotations
 
 import math
 
+from krl.semantics import types as T
+
 from .values import LEAVES, UNSET, Arr, EnumValue, Struct
 
 #: cycles (12 ms) a run must be quiet before its state is compared (0.384 s)
@@ -72,6 +74,24 @@ _FLAT = LEAVES
 #: values imaged by :func:`freeze` and :func:`_store` so far (fields, elements, slots): the
 #: cost of a state image, counted the same way by both interpreters (:func:`probe_state`)
 _IMAGED = [0]
+#: classes of the declared types whose values are immutable leaves (a simple or an enum type):
+#: an array of such elements, a structure of only such components, holds leaves only
+_LEAF_TYPES = frozenset({T.Simple, T.Enum})
+#: id(structure type) -> (the type, its number of components, whether each is of a leaf type)
+_LEAFY: dict = {}
+
+
+def _leafy(t) -> int:
+    """1 when every component of structure type `t` is of a leaf type (:data:`_LEAF_TYPES`),
+    2 when every component is of a leaf type or a structure type of rank 1, else 0."""
+    c = _LEAFY.get(id(t))
+    if c is None or c[0] is not t or c[1] != len(t.fields):
+        types = [ft for _, ft in t.fields.values()]
+        rank = 1 if all(ft.__class__ in _LEAF_TYPES for ft in types) else \
+            2 if all(ft.__class__ in _LEAF_TYPES or (ft.__class__ is T.Struc and ft is not t and _leafy(ft) == 1)
+                     for ft in types) else 0
+        c = _LEAFY[id(t)] = (t, len(t.fields), rank)
+    return c[2]
 
 
 def freeze(v):
@@ -94,8 +114,38 @@ def freeze(v):
     if c is Arr:
         d = v.data
         _IMAGED[0] += len(d)
-        if _FLAT.issuperset(map(type, d)):
+        t = v.type
+        e = t.elem if t.__class__ is T.Array else None
+        if e.__class__ in _LEAF_TYPES or _FLAT.issuperset(map(type, d)):
+            # (an array of a simple or enum type holds leaves only: no need to look)
             return (2, tuple(d))
+        rank = _leafy(e) if e.__class__ is T.Struc else 0
+        if rank:
+            # an array of structures of leaf components (rank 1) or of leaf components and
+            # structures of leaf components (rank 2): each imaged here as freeze images it
+            out = []
+            add = out.append
+            n = 0
+            for x in d:
+                if x.__class__ is not Struct:
+                    add(x if x.__class__ in _SCALARS else freeze(x))
+                    continue
+                f = x.f
+                n += len(f)
+                if rank == 1:
+                    add((1, tuple(f.items())))
+                    continue
+                items = []
+                for k, y in f.items():
+                    if y.__class__ is Struct:
+                        g = y.f
+                        n += len(g)
+                        items.append((k, (1, tuple(g.items()))))
+                    else:
+                        items.append((k, y if y.__class__ in _SCALARS else freeze(y)))
+                add((1, tuple(items)))
+            _IMAGED[0] += n
+            return (2, tuple(out))
         return (2, tuple([x if x.__class__ in _SCALARS else freeze(x) for x in d]))
     if c is EnumValue:
         return (3, v.name)
