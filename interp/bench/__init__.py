@@ -158,8 +158,8 @@ VM_RUNS_PER_ROUND = 8
 
 def compute(repeat: int = 3, baseline: Baseline | None = None, cpu: bool = False) -> dict:
     """Best-of-``repeat`` times of tree, VM and Python (the VM's best over up to
-    ``VM_RUNS_PER_ROUND`` runs per round, as many as fit in the tree's time of the round) (and, with `baseline`, the tree
-    interpreter and the VM of another revision), interleaved in this run; `cpu`: each time is
+    ``VM_RUNS_PER_ROUND`` runs per round, as many as fit in the tree's time of the round; and,
+    with `baseline`, the tree interpreter and the VM of another revision), interleaved in this run; `cpu`: each time is
     the CPU time of the process that runs it (time.process_time), which a shared machine's
     load disturbs far less than wall time (``clock`` in the result says which); ratios and statement rates,
     and ``vm_loop``: which dispatch loop the VM ran ("compiled": the Cython build of
@@ -173,16 +173,12 @@ def compute(repeat: int = 3, baseline: Baseline | None = None, cpu: bool = False
         # the VM's run is short (tens of ms), so one round times it as often as its time fits
         # in the tree interpreter's run of that round (at most VM_RUNS_PER_ROUND times): both
         # best times are then taken over about the same measured time, as timeit does
-        tree_dt = None
-        for kind in ("tree", "vm"):
-            runs = 1 if kind == "tree" else max(1, min(VM_RUNS_PER_ROUND, int(tree_dt / max(best["vm"] or tree_dt, 1e-9))))
-            for _ in range(runs):
-                dt, n, check = run_krl(kind, clock=clock)
-                steps = n
-                checks[kind] = check
-                best[kind] = dt if best[kind] is None else min(best[kind], dt)
-            if kind == "tree":
-                tree_dt = dt
+        tree_dt, steps, checks["tree"] = run_krl("tree", clock=clock)
+        best["tree"] = tree_dt if best["tree"] is None else min(best["tree"], tree_dt)
+        runs = 1 if best["vm"] is None else max(1, min(VM_RUNS_PER_ROUND, int(tree_dt / max(best["vm"], 1e-9))))
+        for _ in range(runs):
+            dt, steps, checks["vm"] = run_krl("vm", clock=clock)
+            best["vm"] = dt if best["vm"] is None else min(best["vm"], dt)
         dt, check = run_python(clock=clock)
         checks["python"] = check
         best["python"] = dt if best["python"] is None else min(best["python"], dt)

@@ -15,7 +15,7 @@ from interp.runtime.values import (Struct, UNSET)
 from krl.semantics.types import (BOOL as T_BOOL, INT as T_INT, REAL as T_REAL)
 
 # sha256 of the vm.py this file was generated from
-VM_SOURCE = 'd583071419ad1130b997ae2a50fa84e323d8720101cc6930a531c85aa80ad3a9'
+VM_SOURCE = 'bfe0773c19765451577fe7219502e9ccac99910947f9a61986f3f4e81075f163'
 
 # opcode number (interp/vm/opcodes.py) -> this loop's number of the opcode
 DISPATCH = [8, 0, 114, 68, 62, 61, 51, 72, 108, 67, 76, 109, 110, 75, 112, 7, 50, 5, 58, 91, 49, 66, 34, 70, 65, 63, 38, 78, 23, 2, 89, 53, 90, 87, 86, 84, 83, 79, 14, 6, 3, 13, 85, 10, 4, 116, 28, 111, 55, 24, 26, 25, 22, 21, 32, 17, 73, 29, 80, 18, 15, 69, 77, 1, 16, 12, 30, 27, 33, 74, 54, 60, 31, 9, 115, 88, 81, 52, 20, 64, 94, 57, 48, 113, 11, 82, 19, 59, 56, 71, 47, 36, 37, 42, 96, 45, 46, 97, 93, 92, 41, 104, 43, 40, 39, 44, 98, 106, 35, 105, 107, 95, 100, 102, 103, 101, 99]
@@ -48,8 +48,8 @@ _array_index = array_index
 def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
     """Run ``code`` from ``ip`` in the activation of ``frame`` (its runtime Frame) with
         the temporaries ``temps``; returns the value of RETURN,
-        or of the thunk at END_THUNK. ``code`` None: the body of a call (:meth:`exec_routine`,
-        ``VM.body``), the code of the frame's routine from its start. The ``_name`` helpers are
+        or of the thunk at END_THUNK. ``code`` None: the body of a call
+        (``VM.body``), the code of the frame's routine from its start. The ``_name`` helpers are
         the runtime functions of :data:`HELPERS` (module names of the generated loop:
         interp/vm/gen_loop.py)."""
     if code is None:

@@ -204,8 +204,8 @@ class VM:
             handler = getattr(self, "_cold_" + o.name, None)
             if handler is not None:
                 self.cold[self.dispatch[o.number]] = handler
-        # the body of a KRL call (exec_routine without its Python frame: the loop itself, which
-        # finds the routine's code when called without one)
+        # the body of a KRL call: the loop itself, which finds the routine's code when called
+        # without one (no Python frame of its own per call)
         self.body = functools.partial(self.loop, self, None)
         # the runtime's statement hooks, bound once (the loop takes them at each call)
         self.hooks = (rt.before_statement, rt.loop_tick, rt.take_error_proceed, rt.quiet_limit, rt.run_routine,
@@ -231,13 +231,6 @@ class VM:
         """Run routine ``target`` = (module, Routine) with reference ``args`` (the
         runtime's call protocol, Runtime.run_routine)."""
         return self.rt.run_routine(target, args, caller, self.body, catch_resume)
-
-    def exec_routine(self, frame):
-        """Run the code of the routine of ``frame`` (compiled on its first call); the value
-        of its RETURN (None for a DEF)."""
-        routine = frame.routine
-        code = self.codes.get(id(routine)) or self.code_for(routine)
-        return self.loop(self, code, frame, [None] * code.ntemps, 0, [None] * STACK_BASE)
 
     def call(self, code, ip: int, callee, args: list, frame, flags: str):
         """A CALL whose Callee is not a routine of the program (Bound links those): a
@@ -475,8 +468,8 @@ class VM:
     def run(self, code, frame, temps: list | None = None, ip: int = 0, stack: list | None = None, thunk: bool = False):
         """Run ``code`` from ``ip`` in the activation of ``frame`` (its runtime Frame) with
         the temporaries ``temps``; returns the value of RETURN,
-        or of the thunk at END_THUNK. ``code`` None: the body of a call (:meth:`exec_routine`,
-        ``VM.body``), the code of the frame's routine from its start. The ``_name`` helpers are
+        or of the thunk at END_THUNK. ``code`` None: the body of a call
+        (``VM.body``), the code of the frame's routine from its start. The ``_name`` helpers are
         the runtime functions of :data:`HELPERS` (module names of the generated loop:
         interp/vm/gen_loop.py)."""
         if code is None:
