@@ -26,27 +26,34 @@ import xml.etree.ElementTree as ET
 from .ekiconfig import EkiConfig, Element
 from .xmlsafe import XmlFramer, XmlRefused, local, parse
 
-# EKI's own message numbers (Msg_No; the controller shows "EKI000nn"). Confirmed from public
-# sources: 9, 23 and 512; the others follow the manual's list as far as it could be read, and
-# are decisions recorded in docs/network.md.
+# EKI's own message numbers (Msg_No; the controller shows "EKI000nn") with KUKA's texts, from
+# KUKA's EthernetKRL message table (as generated from KUKA's sources into Intrinsic's
+# kss_messages.h; docs/network.md "EthernetKRL", "Decisions"). 25 for a 17th channel is this
+# project's choice: which message KUKA gives there is not public.
 MESSAGES = {
-    3: "Access to the configuration file failed",
-    9: "Channel not available (not initialized)",
-    10: "Ethernet connection is not open",
+    3: "File access failed",
+    9: "Connection not available",
+    10: "Ethernet is disconnected",
+    14: "Ethernet connection to external system failed",
     15: "Access to empty element memory",
-    16: "Element not found in the configuration",
+    16: "Element not found",
     19: "No data to send",
-    20: "Data type mismatch",
-    22: "Error while reading the configuration",
+    20: "Mismatch in type of data",
+    22: "Error while reading the configuration. XML not valid.",
     23: "Initialization already performed",
-    24: "Binding to the internal parameters (IP, port) failed",
+    24: "Link to internal parameters (Port, IP) failed",
     25: "Maximum number of channels reached",
-    512: "Ethernet connection destroyed",
+    512: "Ethernet connection disrupted",
     768: "Ping reports no contact",
     1024: "Error while reading received XML data",
-    1280: "Limit of element memory reached",
+    1280: "Limit of element storage reached",
     1536: "Received string too long",
 }
+
+
+STRUCT_COMPONENTS = frozenset(("X", "Y", "Z", "A", "B", "C", "S", "T") + tuple(f"A{i}" for i in range(1, 7))
+                              + tuple(f"E{i}" for i in range(1, 7)))
+"""The components of a FRAME, POS, AXIS (and E6POS/E6AXIS) as EKI_SetFrame/GetFrame.. write them."""
 
 
 @dataclass
@@ -93,6 +100,7 @@ class Channel:
         self.memory: dict[str, deque] = {}
         self.sendvals: dict[str, str | dict] = {}
         self.locked = False
+        self.connecting = False     # a client's EKI_Open is waiting for its connection
         self.held: list[bytes] = []
         self.async_no = 0
         self.framer = XmlFramer(cfg.buffsize) if cfg.receive_kind != "raw" else None
@@ -109,11 +117,44 @@ class Channel:
         return EkiError(number, f"channel {self.name}" + (f", {detail}" if detail else ""), self.cfg.display)
 
     # ------------------------------------------------------------------ open / close
-    def open(self) -> Status:
-        if not self.opened:
-            self.opened = True
+    def open(self, wait=None) -> tuple[Status, EkiError | None]:
+        """EKI_Open. A server starts listening and returns at once; so does a UDP client (no
+        connection to make). A TCP client connects and, as KUKA's EthernetKRL manual says
+        ("EKI_Open() interrupts the program run until the connection to the external system
+        is active"), returns when its connection is up or TIMEOUT Connect (default 2000 ms)
+        has passed on the controller's clock: then EKI00014, the channel closed again.
+        `wait()` gives one IPO cycle back while the caller is blocked (the runtime's
+        ``block_cycle``: the controller, the main run and the other interpreters go on; the
+        hub polls the socket at the cycle's start). A client opened again after its
+        connection dropped connects again (the manual: "The connection can be re-opened via
+        the EKI_OPEN() function"). docs/network.md "EthernetKRL"."""
+        first = not self.opened
+        self.opened = True
+        if first or self.waits():
             self.hub.eki_opened(self)
-        return self.status()
+        if not self.waits():
+            return self.status(), None
+        ctl = self.hub.ctl
+        timeout_ms = self.cfg.connect_timeout_ms
+        self.connecting = True
+        try:
+            if ctl is not None and wait is not None:
+                deadline = ctl.cycle + max(1, ctl.cycles_for(timeout_ms / 1000.0))
+                while not self.connected and ctl.cycle < deadline:
+                    wait()
+        finally:
+            self.connecting = False
+        if self.connected:
+            return self.status(), None
+        self.hub.eki_closed(self)
+        self.opened = False
+        where = self.hub.eki_target(self)
+        detail = f"no connection{' to ' + where if where else ''} within TIMEOUT Connect {timeout_ms} ms"
+        return self.status(msg_no=14), self.error(14, detail)
+
+    def waits(self) -> bool:
+        """True for a TCP client channel that is not connected: EKI_Open waits for it."""
+        return not self.cfg.server and self.cfg.protocol == "TCP" and not self.connected
 
     def close(self) -> Status:
         if self.opened:
@@ -232,9 +273,14 @@ class Channel:
 
     def get(self, path: str, n: int | None = None) -> tuple[list, Status, EkiError | None]:
         """EKI_Get*: the oldest entry (or up to `n` entries for an array getter) of the element
-        at `path`; (values, status, error)."""
+        at `path`; (values, status, error). An element whose components are configured as
+        attributes (``P/@X`` .. ``P/@C``, no element ``P`` of its own) gives one entry of each
+        component's memory as one structure (:meth:`_components`)."""
         el = self._receive_element(path)
         if el is None:
+            parts = self._components(self.cfg.receive, path) if self.cfg.receive_kind == "xml" else {}
+            if parts:
+                return self._get_struct(parts, n)
             return [], self.status(msg_no=16), self.error(16, f"element {path[:60]}")
         q = self.memory.get(el.tag.upper())
         if not q:
@@ -247,6 +293,38 @@ class Channel:
             vals.append(v)
         return vals, self.status(buff=len(q), read=take, counter=counter), None
 
+    def _get_struct(self, parts: dict[str, Element], n: int | None) -> tuple[list, Status, EkiError | None]:
+        queues = {k: self.memory.get(el.tag.upper()) or deque() for k, el in parts.items()}
+        have = min(len(q) for q in queues.values())
+        if not have:
+            name = next(iter(parts.values())).tag.rsplit("/", 1)[0]
+            return [], self.status(msg_no=15), self.error(15, f"element {name[:60]}")
+        take = 1 if n is None else max(0, min(n, have))
+        vals = []
+        counter = 0
+        for _ in range(take):
+            one = {}
+            for k, q in queues.items():
+                v, c = q.pop() if self.cfg.lifo else q.popleft()
+                one[k] = v
+                counter = counter or c
+            vals.append(one)
+        return vals, self.status(buff=have - take, read=take, counter=counter), None
+
+    @staticmethod
+    def _components(elements: list[Element], path: str) -> dict[str, Element]:
+        """The attributes ``path/@K`` configured for a structure's components K (X, Y, Z, A, B,
+        C, S, T, A1..A6, E1..E6): how a channel XML may describe a FRAME, POS or AXIS element
+        (WeiminZhang's ConfigApp1.xml, used with EKI_SetFrame/EKI_GetFrame on the element;
+        docs/network.md "Decisions")."""
+        prefix = path.strip().strip("/").upper() + "/@"
+        out = {}
+        for e in elements:
+            t = e.tag.upper()
+            if t.startswith(prefix) and t[len(prefix):] in STRUCT_COMPONENTS:
+                out[e.tag[len(prefix):].upper()] = e
+        return out
+
     def clear_buffer(self, path: str) -> tuple[Status, EkiError | None]:
         """EKI_ClearBuffer: empty the memory of `path` and of every element under it (the root
         or ``""``: all)."""
@@ -258,9 +336,14 @@ class Channel:
 
     def set_value(self, path: str, value) -> tuple[Status, EkiError | None]:
         """EKI_Set*: the send structure's value at `path` (text, or a dict for a FRAME)."""
-        if self.cfg.send_kind == "xml":
-            if self.cfg.send_element(path) is None:
+        if self.cfg.send_kind == "xml" and self.cfg.send_element(path) is None:
+            parts = self._components(self.cfg.send, path) if isinstance(value, dict) else {}
+            if not parts:
                 return self.status(msg_no=16), self.error(16, f"send element {path[:60]}")
+            for k, el in parts.items():
+                if k in value:
+                    self.sendvals[el.tag.upper()] = value[k]
+            return self.status(), None
         self.sendvals[path.strip().upper()] = value
         return self.status(), None
 

@@ -36,6 +36,11 @@ from .xmlsafe import XmlRefused
 from .varproxy import VarProxy, replay_request
 
 
+CLIENT_RETRY_CYCLES = 8
+"""IPO cycles (96 ms) between two connection attempts of a client channel whose partner
+refused, while its EKI_Open waits (up to TIMEOUT Connect)."""
+
+
 class Pacer:
     """Wall-clock pacing: :meth:`wait` returns when cycle `k` may start. A run that falls more
     than :data:`REANCHOR_S` behind (a debugger pause, an overloaded machine) is paced again
@@ -226,6 +231,11 @@ class Network:
         for (iface, name), ep in list(self.endpoints.items()):
             for ev in ep.poll():
                 self._event(iface, name, ev)
+            if iface == "eki" and isinstance(ep, transport.TcpClient) and ep.failed:
+                ch = self.channels.get(name)
+                if ch is not None and ch.connecting and ctl.cycle >= ep.retry_cycle:
+                    ep.retry_cycle = ctl.cycle + CLIENT_RETRY_CYCLES
+                    ep.start()      # refused: tried again while EKI_Open waits (docs/network.md)
         if self.varproxy is not None:
             self.varproxy.poll()
         if self.plc is not None:
@@ -323,16 +333,19 @@ class Network:
 
     def eki_opened(self, ch: Channel) -> None:
         """EKI_Open: the channel's socket, when the settings name the channel (else it stays
-        "not connected")."""
+        "not connected"). A client channel opened again (its connection dropped, or its last
+        attempt failed) gets a new connection attempt."""
         key = ch.name.upper()
         s = self.settings
         if s is None or key not in s.eki:
             return
         if not s.live:
             return
+        old = self.endpoints.pop(("eki", key), None)
+        if old is not None:
+            old.close()
         cfg = ch.cfg
-        addr = s.eki[key].address
-        host, port = addr if addr is not None else (LOOPBACK, cfg.port)
+        host, port = self.eki_address(ch)
         try:
             if cfg.protocol == "UDP":
                 ep = transport.Udp(host, port) if cfg.server else transport.Udp(LOOPBACK, 0, (host, port))
@@ -347,6 +360,22 @@ class Network:
             self.published("eki:" + ch.name, ep.address)
         if cfg.protocol == "UDP" and not cfg.server:
             ch.connected_event()
+
+    def eki_address(self, ch: Channel) -> tuple[str, int]:
+        """Where channel `ch` listens (a server) or connects to (a client): the cell file's
+        address, else loopback at the XML's port (docs/network.md "The cell file")."""
+        s = self.settings
+        setting = s.eki.get(ch.name.upper()) if s is not None else None
+        addr = setting.address if setting is not None else None
+        return addr if addr is not None else (LOOPBACK, ch.cfg.port)
+
+    def eki_target(self, ch: Channel) -> str:
+        """``host:port`` a client channel connects to, "" when no socket is opened for it."""
+        ep = self.endpoints.get(("eki", ch.name.upper()))
+        if ep is None and (self.settings is None or ch.name.upper() not in self.settings.eki):
+            return ""
+        host, port = self.eki_address(ch)
+        return f"{host}:{port}"
 
     def eki_closed(self, ch: Channel) -> None:
         ep = self.endpoints.pop(("eki", ch.name.upper()), None)

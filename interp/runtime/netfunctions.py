@@ -78,7 +78,9 @@ def eki_init(rt, a):
 
 @_call
 def eki_open(rt, a):
-    return _status(network(rt).eki_channel(ref_text(a[0], "EKI_Open channel")).open())
+    ch = network(rt).eki_channel(ref_text(a[0], "EKI_Open channel"))
+    task = rt.current_task
+    return _result(*ch.open(lambda: rt.block_cycle(task)))      # a client waits (net/eki.py)
 
 
 @_call
