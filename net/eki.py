@@ -21,9 +21,16 @@ from __future__ import annotations
 
 from collections import deque
 from dataclasses import dataclass
+from pathlib import Path
+import re
 import xml.etree.ElementTree as ET
 
-from .ekiconfig import EkiConfig, Element
+from krl.limits import MAX_EKI_CHANNELS
+
+from . import transport
+from .cellkey import LOOPBACK, SettingsError, channel
+from .ekiconfig import ConfigError, EkiConfig, Element, find_config, load_config
+from .partner import Partner
 from .xmlsafe import XmlFramer, XmlRefused, local, parse
 
 # EKI's own message numbers (Msg_No; the controller shows "EKI000nn") with KUKA's texts, from
@@ -86,11 +93,12 @@ def format_real(v: float) -> str:
 
 
 class Channel:
-    """One EKI channel (see the module docstring). `hub` is the network hub (net/hub.py): it
-    owns the sockets and the trace; `cfg` the configuration."""
+    """One EKI channel (see the module docstring). `hub` is the run's :class:`EkiPartner` (or a
+    network hub, net/hub.py, whose EKI partner is taken): it owns the sockets and the trace;
+    `cfg` the configuration."""
 
     def __init__(self, hub, cfg: EkiConfig) -> None:
-        self.hub = hub
+        self.hub = hub.partner("eki") if hasattr(hub, "partner") else hub
         self.cfg = cfg
         self.name = cfg.name
         self.opened = False
@@ -454,3 +462,241 @@ def _values(root, el: Element) -> list:
         else:
             out.append((n.text or "").strip())
     return out
+
+
+_NAME = re.compile(r"[A-Za-z_$][A-Za-z0-9_$]{0,63}\Z")
+CLIENT_RETRY_CYCLES = 8
+"""IPO cycles (96 ms) between two connection attempts of a client channel whose partner
+refused, while its EKI_Open waits (up to TIMEOUT Connect)."""
+
+
+class EkiPartner(Partner):
+    """EthernetKRL (net/partner.py): the run's EKI channels (``EKI_Init`` creates them, the
+    natives of interp/runtime/netfunctions.py call them) and their sockets, one per channel the
+    cell file names (``network: {eki: {CHANNEL: {config, address}}}``); the others open none
+    and stay "not connected" (docs/network.md "EthernetKRL")."""
+
+    key = "eki"
+    fields = {"eki": {}}
+    docs = "EthernetKRL"
+    opens = ("EKI_INIT", "EKI_LOAD")
+
+    def __init__(self, hub) -> None:
+        super().__init__(hub)
+        self.channels: dict[str, Channel] = {}
+        self.endpoints: dict[str, object] = {}      # CHANNEL (upper) -> net/transport.py endpoint
+
+    # ------------------------------------------------------------------ the protocol
+    @classmethod
+    def parse(cls, doc, base: Path) -> dict:
+        if not isinstance(doc, dict):
+            raise SettingsError("network: eki must map channel names to {config, address}")
+        if len(doc) > MAX_EKI_CHANNELS:
+            raise SettingsError(f"network: eki names {len(doc)} channels, more than {MAX_EKI_CHANNELS}")
+        out = {}
+        for name, ch in doc.items():
+            if not isinstance(name, str) or not _NAME.match(name):
+                raise SettingsError(f"network: eki: {str(name)[:40]!r} is not a channel name")
+            out[name.upper()] = channel(ch, base, f"network: eki: {name}")
+        return {"eki": out}
+
+    def attach(self, ctl, **cell) -> None:
+        """Nothing starts before the program's EKI_Open."""
+
+    @property
+    def attached(self) -> bool:
+        return bool(self.endpoints)
+
+    def sockets(self) -> dict:
+        return dict(self.endpoints)
+
+    def poll(self, ctl, live: bool) -> None:
+        if not live:
+            return
+        for name, ep in list(self.endpoints.items()):
+            for ev in ep.poll():
+                self._event(name, ev)
+            if isinstance(ep, transport.TcpClient) and ep.failed:
+                ch = self.channels.get(name)
+                if ch is not None and ch.connecting and ctl.cycle >= ep.retry_cycle:
+                    ep.retry_cycle = ctl.cycle + CLIENT_RETRY_CYCLES
+                    ep.start()      # refused: tried again while EKI_Open waits (docs/network.md)
+
+    def replay(self, ev: dict) -> None:
+        d, name = ev.get("dir"), ev.get("name")
+        ch = self.channels.get(str(name).upper()) if name else None
+        if ch is None:
+            return
+        if d == "connect":
+            self.trace("eki", "connect", name=ch.name)
+            ch.connected_event()
+        elif d == "disconnect":
+            self.trace("eki", "disconnect", name=ch.name, text=ev.get("text"))
+            ch.disconnected_event(ev.get("text") or "closed by the partner")
+        elif d == "in":
+            self._message(ch, str(ev.get("data", "")).encode("latin-1", "replace"))
+        elif d == "error":
+            number = int(ev.get("number") or 1024)
+            self.trace("eki", "error", name=ch.name, number=number, text=ev.get("text"))
+            ch.async_error(number, str(ev.get("text") or ""))
+
+    def close(self) -> None:
+        for ep in self.endpoints.values():
+            ep.close()
+        self.endpoints.clear()
+
+    @classmethod
+    def starter(cls, opened: list[tuple[str, str]], root: Path) -> list[str]:
+        if not opened:
+            return []
+        out = ["#   eki:"]
+        for name, where in opened:
+            cfg = find_config(name, None, root)
+            note = f"config {cfg.relative_to(root)}" if cfg is not None else \
+                "no Config/User/Common/EthernetKRL/" + name + ".xml in the backup: name one with config:"
+            out.append(f"#     {name}: {{address: 127.0.0.1:54600}}   # opened at {where}; {note}")
+        return out
+
+    # ------------------------------------------------------------------ the hub's services
+    @property
+    def sink(self):
+        return self.hub.sink
+
+    @property
+    def ctl(self):
+        return self.hub.ctl
+
+    def trace(self, iface: str, direction: str, **fields) -> None:
+        self.hub.trace(iface, direction, **fields)
+
+    def net_message(self, text: str, number: int | None = None) -> None:
+        self.hub.net_message(text, number)
+
+    # ------------------------------------------------------------------ events
+    def _event(self, name: str, ev: tuple) -> None:
+        ch = self.channels.get(name)
+        if ch is None:
+            return
+        kind = ev[0]
+        if kind == "connect":
+            self.trace("eki", "connect", name=ch.name)
+            ch.connected_event()
+        elif kind == "refused":
+            self.trace("eki", "refused", name=ch.name, text="a second partner: closed (one client per server)")
+        elif kind == "disconnect":
+            self.trace("eki", "disconnect", name=ch.name, text=ev[1])
+            ch.disconnected_event(ev[1])
+        elif kind == "data":
+            for msg in ch.data_event(ev[1]):
+                self._message(ch, msg)
+
+    def _message(self, ch: Channel, msg) -> None:
+        if isinstance(msg, XmlRefused):
+            number = 1536 if "longer than" in str(msg) else 1024
+            self.trace("eki", "error", name=ch.name, number=number, text=str(msg))
+            ch.async_error(number, str(msg))
+            return
+        self.trace("eki", "in", name=ch.name, data=msg.decode("latin-1"))
+        self.eki_apply(ch, ch.message(msg))
+
+    # ------------------------------------------------------------------ the EKI functions
+    def init(self, name: str) -> Channel:
+        """EKI_Init: the channel `name` from its configuration. Raises :class:`EkiError`."""
+        key = name.strip().upper()
+        if key in self.channels:
+            raise EkiError(23, f"channel {name}", self.channels[key].cfg.display)
+        if len(self.channels) >= MAX_EKI_CHANNELS:
+            raise EkiError(25, f"{MAX_EKI_CHANNELS} channels")
+        settings = self.hub.settings
+        setting = settings.eki.get(key) if settings is not None else None
+        path = setting.config if setting is not None and setting.config is not None else \
+            find_config(name.strip(), self.hub.program, self.hub.backup)
+        if path is None:
+            raise EkiError(3, f"channel {name}: no {name.strip()}.xml in the backup's "
+                              "Config/User/Common/EthernetKRL nor beside the program")
+        try:
+            cfg = load_config(path, name.strip())
+        except ConfigError as exc:
+            raise EkiError(3 if exc.missing else 22, str(exc)) from None
+        ch = Channel(self, cfg)
+        self.channels[key] = ch
+        return ch
+
+    def channel(self, name: str) -> Channel:
+        """The channel `name` (EKI_Open, EKI_Send, ...). Raises EkiError 9 for one never initialized."""
+        ch = self.channels.get(name.strip().upper())
+        if ch is None:
+            raise EkiError(9, f"channel {name.strip()[:40]}")
+        return ch
+
+    def clear(self, name: str) -> None:
+        """EKI_Clear: the channel closed and deleted."""
+        ch = self.channel(name)
+        ch.close()
+        del self.channels[ch.name.upper()]
+
+    def eki_opened(self, ch: Channel) -> None:
+        """EKI_Open: the channel's socket, when the settings name the channel (else it stays
+        "not connected"). A client channel opened again (its connection dropped, or its last
+        attempt failed) gets a new connection attempt."""
+        key = ch.name.upper()
+        s = self.hub.settings
+        if s is None or key not in s.eki:
+            return
+        if not s.live:
+            return
+        old = self.endpoints.pop(key, None)
+        if old is not None:
+            old.close()
+        cfg = ch.cfg
+        host, port = self.address(ch)
+        try:
+            if cfg.protocol == "UDP":
+                ep = transport.Udp(host, port) if cfg.server else transport.Udp(LOOPBACK, 0, (host, port))
+            elif cfg.server:
+                ep = transport.TcpServer(host, port)
+            else:
+                ep = transport.TcpClient(host, port)
+        except OSError as exc:
+            raise EkiError(24, f"channel {ch.name}: {host}:{port}: {exc.strerror or exc}", cfg.display) from None
+        self.endpoints[key] = ep
+        if cfg.server:
+            self.hub.published("eki:" + ch.name, ep.address)
+        if cfg.protocol == "UDP" and not cfg.server:
+            ch.connected_event()
+
+    def address(self, ch: Channel) -> tuple[str, int]:
+        """Where channel `ch` listens (a server) or connects to (a client): the cell file's
+        address, else loopback at the XML's port (docs/network.md "The cell file")."""
+        s = self.hub.settings
+        setting = s.eki.get(ch.name.upper()) if s is not None else None
+        addr = setting.address if setting is not None else None
+        return addr if addr is not None else (LOOPBACK, ch.cfg.port)
+
+    def eki_target(self, ch: Channel) -> str:
+        """``host:port`` a client channel connects to, "" when no socket is opened for it."""
+        s = self.hub.settings
+        if ch.name.upper() not in self.endpoints and (s is None or ch.name.upper() not in s.eki):
+            return ""
+        host, port = self.address(ch)
+        return f"{host}:{port}"
+
+    def eki_closed(self, ch: Channel) -> None:
+        ep = self.endpoints.pop(ch.name.upper(), None)
+        if ep is not None:
+            ep.close()
+
+    def eki_send(self, ch: Channel, payload: bytes) -> None:
+        self.trace("eki", "out", name=ch.name, data=payload.decode("latin-1"))
+        ep = self.endpoints.get(ch.name.upper())
+        if ep is not None and not ep.send(payload):
+            self.trace("eki", "disconnect", name=ch.name, text="send failed")
+            ch.disconnected_event("send failed")
+
+    def eki_apply(self, ch: Channel, sets: list) -> None:
+        for what, n in sets:
+            if what == "flag":
+                self.sink.set_flag(n, True)
+            else:
+                self.sink.set_out(n, True)
+
