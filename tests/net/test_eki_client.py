@@ -188,3 +188,46 @@ def test_a_server_that_starts_late_is_connected_within_the_timeout(interp):
     opened = [e for e in trace.events if e["kind"] == "stmt" and e["line"] == 12]
     assert len(connect) == 1 and 0.2 < connect[0]["t"] - opened[0]["t"] < 1.0
     assert re.match(r"<Ask Val=\"2.5\"\s*/>", net_events(trace, dir="out", name="Client")[0]["data"])
+
+
+def test_a_recorded_client_session_replays_identically_on_tree_and_vm(shared_corpus, tmp_path):
+    """The live session of app1b (tree) is a recording: replayed with no socket, EKI_Open's
+    wait ends at the recorded connection's cycle on both interpreters, and tree and VM give
+    the same trace, whose arriving events are the live ones at the same simulated times."""
+    server = socket.create_server(("127.0.0.1", 0))
+    port = server.getsockname()[1]
+    channel = {"CONFIGAPP1": Channel(CONFIGS / "ConfigApp1.xml", ("127.0.0.1", port))}
+
+    def partner(net, rt):
+        server.settimeout(60)
+        conn, _ = server.accept()
+        for n, _doc in enumerate(_documents(conn, b"Robot", time.monotonic() + 60)):
+            if n == 2:
+                break
+            conn.sendall(b'<Pc><Data><SetPos X="0" Y="5" Z="0" A="0" B="0" C="0"/></Data></Pc>')
+        conn.close()
+        server.close()
+
+    _, live, _ = run_with_partner(shared_corpus / APP1B, NetworkSettings(CONFIGS, eki=channel), partner,
+                                  robot=library_robots()[ROBOT])
+    recording = tmp_path / "app1b.jsonl"
+    recording.write_text(live.text())
+    arrived = [(e["t"], e["dir"], e.get("data")) for e in live.events
+               if e["kind"] == "net" and e["dir"] in ("in", "connect")]
+    assert [d for _, d, _ in arrived][:3] == ["connect", "in", "in"]
+    traces = {}
+    for it in ("tree", "vm"):
+        trace = TraceWriter(keep=True)
+        rt, _ = make_runtime(shared_corpus / APP1B, network=NetworkSettings(CONFIGS, eki=channel, replay=recording),
+                             trace=trace, max_sim_time=arrived[-1][0] + 0.5, mujoco=False, interp=it,
+                             robot=library_robots()[ROBOT])
+        rt.run()
+        assert not rt.controller.network.endpoints
+        traces[it] = trace
+        got = [(e["t"], e["dir"], e.get("data")) for e in trace.events
+               if e["kind"] == "net" and e["dir"] in ("in", "connect")]
+        assert got == arrived
+        opened = [e for e in trace.events if e["kind"] == "stmt" and e["line"] == 43]
+        after = [e for e in trace.events if e["kind"] == "stmt" and e["line"] == 44]
+        assert opened[0]["t"] < after[0]["t"] == arrived[0][0]
+    assert traces["tree"].lines == traces["vm"].lines
