@@ -15,6 +15,11 @@ error of the call itself, an :class:`EkiError`: the runtime stops the program wi
 the channel's ``MESSAGES Display="disabled"`` (then only Msg_No tells). Errors of reception
 (malformed XML, a message too long, a full memory, a dropped connection) are messages of the
 controller: traced, and given as Msg_No of the channel's next call, never a stop.
+
+:class:`EkiPartner` is EthernetKRL as a network partner of the run (net/partner.py): the
+channels, their sockets (one per channel the cell file names), their events at each IPO cycle
+and in a replay. A client channel's ``EKI_Open`` waits for its connection up to TIMEOUT Connect
+(:meth:`Channel.open`, docs/network.md "Which EKI functions wait").
 """
 
 from __future__ import annotations
