@@ -556,10 +556,18 @@ class EkiPartner(Partner):
             return []
         out = ["#   eki:"]
         for name, where in opened:
-            cfg = find_config(name, None, root)
-            note = f"config {cfg.relative_to(root)}" if cfg is not None else \
+            path = find_config(name, None, root)
+            port, role = 54600, ""
+            if path is not None:
+                try:
+                    cfg = load_config(path, name)
+                    port = cfg.port
+                    role = "the robot listens; " if cfg.server else "the robot connects to its partner's server; "
+                except ConfigError:
+                    pass
+            note = f"config {path.relative_to(root)}" if path is not None else \
                 "no Config/User/Common/EthernetKRL/" + name + ".xml in the backup: name one with config:"
-            out.append(f"#     {name}: {{address: 127.0.0.1:54600}}   # opened at {where}; {note}")
+            out.append(f"#     {name}: {{address: 127.0.0.1:{port}}}   # {role}opened at {where}; {note}")
         return out
 
     # ------------------------------------------------------------------ the hub's services

@@ -148,3 +148,18 @@ def test_a_partner_is_added_by_its_class_and_one_registration(monkeypatch, tmp_p
         ctl.cycle = k
         replayed.cycle(ctl)
     assert Echo.log == [("poll", 0, False), ("poll", 1, False), ("replay", "hi"), ("poll", 2, False)]
+
+
+def test_cell_init_lines_name_the_channels_port_and_role(tmp_path):
+    """`krl cell init`'s lines for EKI (EkiPartner.starter): the XML's port and who connects."""
+    from net.eki import EkiPartner
+
+    folder = tmp_path / "Config" / "User" / "Common" / "EthernetKRL"
+    folder.mkdir(parents=True)
+    (folder / "Vision.xml").write_text("<ETHERNETKRL><CONFIGURATION><EXTERNAL><TYPE>Server</TYPE><PORT>7000</PORT>"
+                                       "</EXTERNAL></CONFIGURATION></ETHERNETKRL>")
+    lines = EkiPartner.starter([("Vision", "R1/a.src:3"), ("Other", "R1/a.src:9")], tmp_path)
+    assert lines[0] == "#   eki:"
+    assert lines[1].startswith("#     Vision: {address: 127.0.0.1:7000}   # the robot connects to its partner's server;")
+    assert "config Config/User/Common/EthernetKRL/Vision.xml" in lines[1]
+    assert lines[2].startswith("#     Other: {address: 127.0.0.1:54600}   # opened at R1/a.src:9; no Config")
