@@ -471,8 +471,8 @@ def _values(root, el: Element) -> list:
 
 _NAME = re.compile(r"[A-Za-z_$][A-Za-z0-9_$]{0,63}\Z")
 CLIENT_RETRY_CYCLES = 8
-"""IPO cycles (96 ms) between two connection attempts of a client channel whose partner
-refused, while its EKI_Open waits (up to TIMEOUT Connect)."""
+"""IPO cycles (96 ms) from a refused connection attempt of a client channel to the next one,
+while its EKI_Open waits (up to TIMEOUT Connect)."""
 
 
 class EkiPartner(Partner):
@@ -523,9 +523,13 @@ class EkiPartner(Partner):
                 self._event(name, ev)
             if isinstance(ep, transport.TcpClient) and ep.failed:
                 ch = self.channels.get(name)
-                if ch is not None and ch.connecting and ctl.cycle >= ep.retry_cycle:
-                    ep.retry_cycle = ctl.cycle + CLIENT_RETRY_CYCLES
-                    ep.start()      # refused: tried again while EKI_Open waits (docs/network.md)
+                if ch is None or not ch.connecting:
+                    continue
+                if ep.retry_cycle is None:          # refused: tried again 8 cycles later while
+                    ep.retry_cycle = ctl.cycle + CLIENT_RETRY_CYCLES   # EKI_Open waits (docs/network.md)
+                elif ctl.cycle >= ep.retry_cycle:
+                    ep.retry_cycle = None
+                    ep.start()
 
     def replay(self, ev: dict) -> None:
         d, name = ev.get("dir"), ev.get("name")

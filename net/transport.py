@@ -152,7 +152,7 @@ class TcpClient(Endpoint):
         self.address = self.target
         self.pending: socket.socket | None = None
         self.failed: str | None = None
-        self.retry_cycle = 0        # the hub's next attempt after a refusal (net/hub.py)
+        self.retry_cycle: int | None = None     # the next attempt after a refusal (net/eki.py)
         self.start()
 
     def start(self) -> None:

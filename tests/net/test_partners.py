@@ -14,6 +14,7 @@ from pathlib import Path
 import pytest
 
 import net.partners
+from net.eki import EkiPartner
 from net.hub import Network
 from net.partner import OPERATIONS, Partner
 from net.settings import NetworkSettings, SettingsError, keys, parse_network
@@ -152,8 +153,6 @@ def test_a_partner_is_added_by_its_class_and_one_registration(monkeypatch, tmp_p
 
 def test_cell_init_lines_name_the_channels_port_and_role(tmp_path):
     """`krl cell init`'s lines for EKI (EkiPartner.starter): the XML's port and who connects."""
-    from net.eki import EkiPartner
-
     folder = tmp_path / "Config" / "User" / "Common" / "EthernetKRL"
     folder.mkdir(parents=True)
     (folder / "Vision.xml").write_text("<ETHERNETKRL><CONFIGURATION><EXTERNAL><TYPE>Server</TYPE><PORT>7000</PORT>"
