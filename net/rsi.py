@@ -42,6 +42,7 @@ arrives or leaves is a ``net`` event (iface ``rsi``), so a replay feeds the same
 
 from __future__ import annotations
 
+import re
 import time
 
 import numpy as np
@@ -271,7 +272,7 @@ class Rsi:
         """One datagram of the sensor: its IPOC answers a packet; its values are the ETHERNET
         object's outputs."""
         try:
-            root = parse(data, MAX_RSI_DATAGRAM_BYTES, "RSI answer")
+            root = parse(_digit_names(data), MAX_RSI_DATAGRAM_BYTES, "RSI answer")
         except XmlRefused as exc:
             self.hub.trace("rsi", "error", text=str(exc))
             return                              # unreadable: the packet stays late
@@ -440,9 +441,21 @@ def _f(v: float, dec: int = MIN_DECIMALS) -> str:
     return f"{float(v):.{dec}f}"
 
 
+_DIGIT_ATTR = re.compile(rb"(\s)([0-9][A-Za-z0-9_.-]*\s*=)")
+
+
+def _digit_names(data: bytes) -> bytes:
+    """The answer with attribute names that start with a digit (``<Out 01="1"/>``: RECEIVE tags
+    ``Out.01`` of ROS-Industrial's and ``GPIO.01`` of kroshu's configurations, which RSI writes
+    and reads as they stand) prefixed with ``_`` so that an XML parser reads them."""
+    return _DIGIT_ATTR.sub(rb"\1_\2", data) if len(data) <= MAX_RSI_DATAGRAM_BYTES else data
+
+
 def _value(root, tag: str) -> float | None:
     """The value of RECEIVE tag ``EL.ATTR`` (an attribute) or ``EL`` (an element's text)."""
     el_name, _, attr = tag.partition(".")
+    if attr[:1].isdigit():
+        attr = "_" + attr
     for el in root.iter():
         if local(el.tag).upper() == el_name.upper():
             text = None

@@ -1,0 +1,107 @@
+"""Every RSI program of the corpus with its own published context and configuration (RSI 3 or
+4/5) and a sensor written from that configuration (tests/net/sensor.py), on both interpreters
+(issue 50): datagrams at the program's cycle (12 ms, 4 ms with ``#IPO_FAST``), corrections
+followed (axes for AK, the TCP for RKorr, absolute or relative as the program's RSI_ON says),
+and Stop honoured where the context has a STOP object (RSI_MOVECORR ends, the program goes on
+to its end). Programs whose context has no STOP object never end RSI_MOVECORR themselves; the
+run ends when the sensor has seen the correction.
+
+The contexts are tests/net/configs/published/ (derived from the programs' repositories, origins
+in each file); the programs are read in place from the corpus. The expected values are the
+sensor's own commands, compared with what the robot reports in its datagrams (AIPos, RIst)
+and the trace's poses."""
+
+from __future__ import annotations
+
+import re
+
+import numpy as np
+import pytest
+
+from net.settings import Channel, NetworkSettings
+
+from .helpers import CONFIGS, net_events, run_with_partner
+from .sensor import ConfigSensor, axes_of, tcp_of
+
+PUB = CONFIGS / "published"
+KSS = "kroshu__kuka-external-control-sdk/kuka_external_control_sdk/krc_setup/kss/KRC/R1/Program/RSI/"
+
+# program (corpus), context (published), ETHERNET configuration (None: the context's ConfigFile)
+PROGRAMS = [
+    ("ros-industrial__kuka_experimental/kuka_rsi_hw_interface/krl/KR_C4/ros_rsi.src",
+     "ros_industrial_kr_c4/ros_rsi.rsi.xml", None),
+    ("ros-industrial__kuka_experimental/kuka_rsi_hw_interface/krl/KR_C4/ros_rsi.src",
+     "ros_industrial_kr_c4/ros_rsi.rsix", None),
+    ("fzi-forschungszentrum-informatik__kuka_rsi_driver/kuka_rsi_driver/krl/KR_C4/kuka_rsi_driver.src",
+     "fzi_kr_c4/ros_rsi.rsi.xml", None),
+    ("fzi-forschungszentrum-informatik__kuka_rsi_driver/kuka_rsi_driver/krl/KR_C5/kuka_rsi_driver.src",
+     "fzi_kr_c5/ros_rsi.rsix", None),
+    ("wingljj__Kuka-RSI-real-time-control/krc/PoseTrack.src", "wingljj/PoseTrack.rsix", None),
+    ("wingljj__Kuka-RSI-real-time-control/krc/PoseTrack.src", "wingljj_legacy/PoseTrack.rsi.xml", None),
+    ("AlexeiOvcharov__kuka_rsi3_server/RSI/Painter_RSI.src", "alexeiovcharov/Painter_RSI.xml", None),
+    ("adamleon__kuka/kuka_krl/src/RSI_AxisCorr/RSI_AxisCorr.src", "adamleon/RSIAxisCorrTest.rsi.xml", None),
+    (KSS + "rsi_joint_pos_12ms.src", "kroshu_kss/rsi_joint_pos.rsix", None),
+    (KSS + "rsi_joint_pos_4ms.src", "kroshu_kss/rsi_joint_pos.rsix", None),
+    (KSS + "rsi_gpio_example.src", "kroshu_kss/rsi_gpio_joint_pos.rsix", None),
+]
+AXIS_TARGET = np.array([2.0, -1.5, 1.0, 0.5, 3.0, -2.5])        # deg, within every context's limits
+CART_TARGET = np.array([4.0, -3.0, 5.0, 0.0, 0.0, 0.0])         # mm
+START = "{A1 0, A2 -90, A3 90, A4 0, A5 30, A6 0}"
+
+
+def ethernet_of(context):
+    import xml.etree.ElementTree as ET
+    for el in ET.parse(context).getroot().iter():
+        if el.get("Name") == "ConfigFile":
+            return context.parent / el.get("ParamValue")
+    return context       # an ETHERNET configuration alone
+
+
+@pytest.mark.parametrize("interp", ["tree", "vm"])
+@pytest.mark.parametrize("program,context,ethernet", PROGRAMS, ids=[f"{p[0].split('/')[-1]}-{p[1]}" for p in PROGRAMS])
+def test_corpus_rsi_program(shared_corpus, program, context, ethernet, interp):
+    src = shared_corpus / program
+    text = src.read_text(encoding="latin-1").upper()
+    relative = "#RELATIVE" in text
+    fast = "#IPO_FAST" in text
+    ctx_path = PUB / context
+    sensor = ConfigSensor(ethernet_of(ctx_path))
+    axes = sensor.axis_tag is not None
+    target = AXIS_TARGET if axes else CART_TARGET
+    ramp = 40                                   # answers to reach the target
+    state = {"reached": None}
+
+    def plan(i, rob):
+        now = np.array(axes_of(rob) if axes else tcp_of(rob))
+        state.setdefault("start", now)
+        if state["reached"] is not None:
+            done = i - state["reached"]
+            if done >= 5:
+                return "done" if not sensor.has_stop or done > 60 else ({}, True)
+        elif np.allclose(now - state["start"], target, atol=0.01):
+            state["reached"] = i
+            state["at"] = now
+        if relative:
+            step = target / ramp if i < ramp else np.zeros(6)
+        else:
+            step = target * min(1.0, (i + 1) / ramp)
+        tag = sensor.axis_tag if axes else sensor.cart_tag
+        comps = ("A1", "A2", "A3", "A4", "A5", "A6") if axes else ("X", "Y", "Z", "A", "B", "C")
+        return {(tag, c): float(v) for c, v in zip(comps, step)}, False
+
+    settings = NetworkSettings(ctx_path.parent, rsi=Channel(ctx_path, sensor.address))
+    # the robot stands off the wrist singularity (PoseTrack.src starts with PTP $POS_ACT)
+    result, trace, got = run_with_partner(src, settings, sensor.partner(plan), interp=interp, start=START)
+    assert got, "no datagram"
+    # datagrams at the program's cycle
+    ipocs = [int(r.findtext("IPOC")) for r in got]
+    steps = set(np.diff(ipocs[:30]))
+    assert steps == ({4} if fast else {12}), steps
+    # the correction followed (to 0.01 mm / 0.01 deg), in the datagrams and the trace
+    assert state["reached"] is not None, (result.reason, result.text, len(got))
+    assert np.allclose(state["at"] - state["start"], target, atol=0.01)
+    # Stop honoured: RSI_MOVECORR ends and the program runs to its end
+    if sensor.has_stop:
+        assert result.reason == "completed", (result.reason, result.text)
+    created = net_events(trace, iface="rsi", dir="context")
+    assert created and ("RSI 4/5" in created[0]["text"]) == context.endswith(".rsix")
