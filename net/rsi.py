@@ -50,7 +50,8 @@ import numpy as np
 from krl.limits import MAX_RSI_DATAGRAM_BYTES
 
 from . import transport
-from .rsicontext import AXES, CART, Context, RsiConfigError, RsiObject, find_context, load_context
+from .rsicontext import (AXES, CART, Context, RsiConfigError, RsiObject, find_context, is_ethernet_config,
+                         load_context)
 from .settings import LOOPBACK
 from .xmlsafe import XmlRefused, local, parse
 
@@ -111,8 +112,15 @@ class Rsi:
             self.hub.net_message(f"RSI: context {name[:60]} not found (NAME.rsi.xml or NAME.rsix in "
                                  "Config/User/Common/SensorInterface or beside the program)")
             return RSIINVPARAM
+        ethernet = getattr(chan, "ethernet", None) if chan is not None else None
+        if chan is not None and chan.config is not None and ethernet is None and is_ethernet_config(chan.config):
+            # the cell file names the ETHERNET configuration: the context RSI_CREATE names, where
+            # the controller keeps it or beside that configuration, with it (else one implied)
+            found = find_context(name, self.hub.program, self.hub.backup) or find_context(name, chan.config, None)
+            if found is not None and not is_ethernet_config(found):
+                path, ethernet = found, chan.config
         try:
-            self.ctx = load_context(path, name, getattr(chan, "ethernet", None) if chan is not None else None)
+            self.ctx = load_context(path, name, ethernet, self._folders())
         except RsiConfigError as exc:
             self.hub.net_message(f"RSI: {exc}")
             return RSIINVPARAM
@@ -130,6 +138,17 @@ class Rsi:
                 self.noted.add(key)
                 self.hub.net_message(f"RSI: internal value {el.tag[:40]} is not simulated")
         return RSIOK
+
+    def _folders(self) -> list:
+        """Where else an ETHERNET configuration may be: beside the program, the backup's
+        SensorInterface folders."""
+        out = [self.hub.program.parent] if self.hub.program is not None else []
+        b = self.hub.backup
+        if b is not None:
+            for top in (b, b / "KRC"):
+                out += [top / "Config" / "User" / "Common" / "SensorInterface",
+                        top / "Config" / "RobotSensorInterface" / "Ethernet configuration"]
+        return out
 
     def delete(self) -> int:
         if self.on:

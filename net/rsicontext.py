@@ -169,11 +169,14 @@ def _parse(path: Path, what: str, nodes: int):
         raise RsiConfigError(str(exc)) from None
 
 
-def load_context(path: Path, name: str, ethernet: Path | None = None) -> Context:
+def load_context(path: Path, name: str, ethernet: Path | None = None, folders=()) -> Context:
     """The context in the file `path` (``.rsi.xml``, ``.rsix``, or an ETHERNET configuration
     alone) and its ETHERNET configuration: `ethernet` when given, else the object's
-    ``ConfigFile`` beside the context. Raises :class:`RsiConfigError`."""
+    ``ConfigFile`` found by :func:`find_config` (beside the context, in `folders`, in a folder
+    beside the context's). Raises :class:`RsiConfigError`."""
     path = Path(path)
+    if path.name.lower().endswith(".rsi") and path.with_name(path.name + ".xml").is_file():
+        path = path.with_name(path.name + ".xml")          # NAME.rsi names the context NAME.rsi.xml
     if path.name.lower().endswith(".rsi") or path.name.lower().endswith(".rsi.diagram"):
         raise RsiConfigError(f"RSI context {path.name}: RSI Visual's editor file; the controller reads "
                              f"{path.name.split('.')[0]}.rsi.xml (RSI 3) or .rsix (RSI 4/5)")
@@ -210,7 +213,11 @@ def load_context(path: Path, name: str, ethernet: Path | None = None) -> Context
         cfg_name = eo.params.get(k, "") if k else ""
         if not cfg_name or "/" in cfg_name or "\\" in cfg_name or ".." in cfg_name:
             raise RsiConfigError(f"RSI context {path.name}: ETHERNET {eo.id} ConfigFile {cfg_name[:60]!r} is not a file name")
-        ethernet = _beside(path.parent, cfg_name)
+        ethernet = find_config(cfg_name, path, folders)
+        if ethernet is None:
+            raise RsiConfigError(f"RSI context {path.name}: ETHERNET {eo.id} ConfigFile {cfg_name} not found beside "
+                                 "the context, beside the program, in the backup's SensorInterface folder or in a "
+                                 "folder beside the context's (the cell file's rsi: ethernet: names it)")
     cfg = read_ethernet(ethernet)
     for o in objects.values():
         for i, (src, oi) in o.inputs.items():
@@ -243,6 +250,26 @@ def _object(el, path: Path, base: int, generation: str) -> RsiObject:
                 src = p.get(out_attr) or p.get("OutObjID") or p.get("OutObjId") or ""
                 o.inputs[i] = (str(src), oi)
     return o
+
+
+MAX_SIBLING_FOLDERS = 64
+
+
+def find_config(name: str, context: Path, folders=()) -> Path | None:
+    """Where the ETHERNET object's ``ConfigFile`` `name` is: beside the context, in `folders`
+    (the program's, the backup's SensorInterface), then in a folder beside the context's
+    (published repositories keep it in a sibling: FZI's ``krl/Common``, iiQKA's
+    ``RobotSensorInterface/Ethernet configuration``; at most 64 folders looked at). Names
+    compare without case, as on the controller's file system."""
+    tried = [context.parent, *folders]
+    up = context.parent.parent
+    if up.is_dir():
+        tried += sorted(p for p in up.iterdir() if p.is_dir() and p != context.parent)[:MAX_SIBLING_FOLDERS]
+    for f in tried:
+        p = _beside(f, name)
+        if p.is_file():
+            return p
+    return None
 
 
 def _beside(folder: Path, name: str) -> Path:
@@ -350,6 +377,14 @@ def implied_context(name: str, cfg: EthernetConfig) -> Context:
         if el.indx is not None and el.tag.upper() == "STOP":
             objects["STOP1"] = RsiObject("STOP", "STOP1", inputs={1: (eth.id, el.indx)})
     return Context(name, IMPLIED, cfg.path, objects, eth.id, cfg)
+
+
+def is_ethernet_config(path: Path) -> bool:
+    """True when `path` is an ETHERNET configuration (root ``ROOT``), not a context."""
+    try:
+        return local(_parse(Path(path), "RSI configuration", MAX_RSI_CONTEXT_NODES).tag).upper() == "ROOT"
+    except RsiConfigError:
+        return False
 
 
 def find_context(name: str, program: Path | None, backup: Path | None) -> Path | None:

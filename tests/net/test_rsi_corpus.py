@@ -105,3 +105,28 @@ def test_corpus_rsi_program(shared_corpus, program, context, ethernet, interp):
         assert result.reason == "completed", (result.reason, result.text)
     created = net_events(trace, iface="rsi", dir="context")
     assert created and ("RSI 4/5" in created[0]["text"]) == context.endswith(".rsix")
+
+
+def test_the_cell_file_may_name_the_ethernet_configuration(shared_corpus, tmp_path):
+    """A user who names the ETHERNET configuration in the cell file (``rsi: {config:
+    PoseTrack_ethernet.xml}``) gets the context RSI_CREATE names from beside the program (here
+    the RSI 4/5 PoseTrack.rsix, with its LIMIT objects), not one implied from the tags."""
+    import shutil
+    src = tmp_path / "PoseTrack.src"
+    shutil.copyfile(shared_corpus / "wingljj__Kuka-RSI-real-time-control/krc/PoseTrack.src", src)
+    shutil.copyfile(PUB / "wingljj" / "PoseTrack.rsix", tmp_path / "PoseTrack.rsix")
+    cfg = tmp_path / "cfg" / "PoseTrack_ethernet.xml"
+    cfg.parent.mkdir()
+    shutil.copyfile(PUB / "wingljj" / "PoseTrack_ethernet.xml", cfg)
+    sensor = ConfigSensor(cfg)
+
+    def plan(i, rob):
+        # 50 mm in one answer: the LIMIT objects let 35 through, POSCORR holds the total in 40
+        return "done" if i > 20 else ({(sensor.cart_tag, "X"): 50.0 if i == 0 else 0.0}, False)
+
+    settings = NetworkSettings(tmp_path, rsi=Channel(cfg, sensor.address))
+    result, trace, got = run_with_partner(src, settings, sensor.partner(plan), start=START)
+    created = net_events(trace, iface="rsi", dir="context")
+    assert "RSI 4/5" in created[0]["text"] and "PoseTrack.rsix" in created[0]["text"]
+    x = [tcp_of(r)[0] for r in got]
+    assert x[-1] - x[0] == pytest.approx(35.0, abs=0.01)

@@ -166,3 +166,16 @@ def test_find_context_of_both_generations(tmp_path):
     (sens / "ros_rsi.rsi.xml").write_text("<RSIObjects/>")
     assert find_context("ros_rsi.rsi", None, tmp_path / "backup").name == "ros_rsi.rsi.xml"
     assert find_context("missing", prog, tmp_path / "backup") is None
+
+
+def test_the_ethernet_configuration_in_a_folder_beside(tmp_path):
+    """FZI's repository keeps ros_rsi_ethernet.xml in krl/Common beside krl/KR_C4 and
+    krl/KR_C5; the context finds it there (and says where it looked when it is nowhere)."""
+    for sub in ("KR_C4", "Common"):
+        (tmp_path / sub).mkdir()
+    ctx = tmp_path / "KR_C4" / "ros_rsi.rsi.xml"
+    ctx.write_bytes((PUB / "fzi_kr_c4" / "ros_rsi.rsi.xml").read_bytes())
+    with pytest.raises(RsiConfigError, match="ConfigFile ros_rsi_ethernet.xml not found"):
+        load_context(ctx, "ros_rsi")
+    (tmp_path / "Common" / "ros_rsi_ethernet.xml").write_bytes((PUB / "fzi_kr_c4" / "ros_rsi_ethernet.xml").read_bytes())
+    assert load_context(ctx, "ros_rsi").ethernet.path == tmp_path / "Common" / "ros_rsi_ethernet.xml"
