@@ -398,6 +398,19 @@ class Rsi:
         return self.corr_axes
 
     @property
+    def frame(self) -> str:
+        """The frame of the Cartesian correction: the POSCORR's ``RefCorrSys`` (RSI 3 writes the
+        name, RSI 4/5 the number of its enum: World 0, Base 1, RobRoot 2, Tool 3, TTS 4, as
+        wingljj's published PoseTrack.rsix documents it); BASE when unset. RobRoot is taken as
+        WORLD (the simulated robot stands at the world's origin) and TTS as TOOL."""
+        for obj in self.ctx.of_type("POSCORR") if self.ctx is not None else ():
+            k = obj.param_name("RefCorrSys")
+            v = str(obj.params.get(k, "")).strip().upper() if k else ""
+            return {"0": "WORLD", "WORLD": "WORLD", "2": "WORLD", "ROBROOT": "WORLD",
+                    "3": "TOOL", "TOOL": "TOOL", "4": "TOOL", "TTS": "TOOL"}.get(v, "BASE")
+        return "BASE"
+
+    @property
     def cart(self) -> np.ndarray:
         """The Cartesian correction (X, Y, Z mm, A, B, C deg, in $BASE) the controller superposes."""
         return self.corr_cart

@@ -130,3 +130,37 @@ def test_the_cell_file_may_name_the_ethernet_configuration(shared_corpus, tmp_pa
     assert "RSI 4/5" in created[0]["text"] and "PoseTrack.rsix" in created[0]["text"]
     x = [tcp_of(r)[0] for r in got]
     assert x[-1] - x[0] == pytest.approx(35.0, abs=0.01)
+
+
+def _rot(a, b, c):
+    """KUKA's A, B, C (deg): rotations about Z, then Y, then X."""
+    a, b, c = np.radians([a, b, c])
+    rz = np.array([[np.cos(a), -np.sin(a), 0], [np.sin(a), np.cos(a), 0], [0, 0, 1]])
+    ry = np.array([[np.cos(b), 0, np.sin(b)], [0, 1, 0], [-np.sin(b), 0, np.cos(b)]])
+    rx = np.array([[1, 0, 0], [0, np.cos(c), -np.sin(c)], [0, np.sin(c), np.cos(c)]])
+    return rz @ ry @ rx
+
+
+@pytest.mark.parametrize("refcorrsys", ["Tool", "3", "Base", "1"])
+def test_poscorr_in_the_tool_frame(tmp_path, refcorrsys):
+    """POSCORR's RefCorrSys: Tool (RSI 3 "Tool", RSI 4/5 3) moves the TCP along its own axes,
+    Base (the default, "Base" or 1) along $BASE's."""
+    from .helpers import EXAMPLES
+    text = (EXAMPLES / "rsi_path.rsi.xml").read_text()
+    text = text.replace('<Parameter Name="LowerLimX"', f'<Parameter Name="RefCorrSys" ParamValue="{refcorrsys}"/> '
+                        '<Parameter Name="LowerLimX"', 1)
+    (tmp_path / "rsi_path.rsi.xml").write_text(text)
+    (tmp_path / "rsi_path_ethernet.xml").write_bytes((EXAMPLES / "rsi_path_ethernet.xml").read_bytes())
+    sensor = ConfigSensor(tmp_path / "rsi_path_ethernet.xml")
+    corr = np.array([6.0, -4.0, 3.0])
+
+    def plan(i, rob):
+        return {(sensor.cart_tag, k): float(v) * min(1.0, (i + 1) / 30) for k, v in zip("XYZ", corr)}, i > 60
+
+    settings = NetworkSettings(tmp_path, rsi=Channel(tmp_path / "rsi_path.rsi.xml", sensor.address))
+    result, trace, got = run_with_partner(EXAMPLES / "rsi_path.src", settings, sensor.partner(plan))
+    assert result.reason == "completed", (result.reason, result.text)
+    first, last = np.array(tcp_of(got[0])), np.array(tcp_of(got[-1]))
+    frame = _rot(*first[3:]) if refcorrsys in ("Tool", "3") else np.eye(3)
+    assert np.allclose(last[:3] - first[:3], frame @ corr, atol=0.01), (last[:3] - first[:3], frame @ corr)
+    assert np.allclose(last[3:], first[3:], atol=0.01)
