@@ -15,7 +15,9 @@
   ``UpperLimC``, ``MaxTrans`` mm, ``MaxRotAngle`` deg);
 * ``AXISCORRMON`` / ``POSCORRMON`` (``MaxAn`` / ``MaxTrans``, ``MaxRotAngle``: a total
   correction past them stops the robot; outputs 1..6 the total correction);
-* ``LIMIT`` (input 1 clamped to ``LowerLimit``..``UpperLimit``);
+* the stateless blocks of RSI's toolbox (:data:`BLOCKS`: ``LIMIT`` (input 1 within
+  ``LowerLimit``..``UpperLimit``), ``SUM``, ``SUB``, ``MULTI``, ``Division``, ``ABS``, ``NORM``,
+  ``MinMax``, ``Equal``/``Greater``/``Less``, ``AND``/``OR``/``XOR``/``NOT``, ...);
 * ``STOP`` (input 1 non-zero: ``RSI_MOVECORR`` ends).
 
 Any other object is not simulated: one message says so, and its outputs read 0. RECEIVE's
@@ -42,6 +44,7 @@ arrives or leaves is a ``net`` event (iface ``rsi``), so a replay feeds the same
 
 from __future__ import annotations
 
+import math
 import re
 import time
 
@@ -64,8 +67,42 @@ LATE_NUMBER = 1
 MON_NUMBER = 2
 MIN_DECIMALS = 4        # values are sent with max(Precision, 4) decimals (docs/network.md, Decisions)
 MAX_FLOW_DEPTH = 64     # links followed from an object back to its sources
+def _first(ins: list, k: int = 0) -> float:
+    return ins[k] if len(ins) > k else 0.0
+
+
+def _compared(o, ins: list) -> float:
+    """The second operand of Equal/Greater/Less: input 2 when linked, else ``CompVal``."""
+    return ins[1] if len(ins) > 1 else o.param("CompVal", 0.0)
+
+
+# The stateless blocks of RSI's toolbox (the "Math" and "Logic" subsets of the blueprint
+# collection WorkVisual writes into every .rsix, e.g. FZI's published KR_C5 ros_rsi.rsix: their
+# inputs and parameters): type -> fn(object, the linked inputs in index order, output index).
+# A logic input is TRUE when non-zero; Greater/Less ignore their Hysteresis (no state).
+BLOCKS = {
+    "LIMIT": lambda o, i, k: min(max(_first(i), o.param("LowerLimit", -10.0)), o.param("UpperLimit", 10.0)),
+    "ABS": lambda o, i, k: abs(_first(i)),
+    "CEIL": lambda o, i, k: math.ceil(_first(i)),
+    "FLOOR": lambda o, i, k: math.floor(_first(i)),
+    "ROUND": lambda o, i, k: round(_first(i), int(o.param("nDig", 0))),
+    "POW": lambda o, i, k: _first(i) ** o.param("Exp", 0.0),
+    "NORM": lambda o, i, k: math.sqrt(sum(v * v for v in i)),
+    "MULTI": lambda o, i, k: _first(i) * _first(i, 1),
+    "SUM": lambda o, i, k: sum(i) + o.param("Value", 0.0),
+    "SUB": lambda o, i, k: _first(i) - sum(i[1:]) - o.param("Value", 0.0),
+    "DIVISION": lambda o, i, k: _first(i) / _first(i, 1),
+    "MINMAX": lambda o, i, k: (min(i) if k == 1 else max(i)) if i else 0.0,
+    "EQUAL": lambda o, i, k: float(abs(_first(i) - _compared(o, i)) <= o.param("Tolerance", 0.0)),
+    "GREATER": lambda o, i, k: float(_first(i) > _compared(o, i)),
+    "LESS": lambda o, i, k: float(_first(i) < _compared(o, i)),
+    "AND": lambda o, i, k: float(bool(i) and all(v != 0.0 for v in i)),
+    "OR": lambda o, i, k: float(any(v != 0.0 for v in i)),
+    "XOR": lambda o, i, k: float(sum(v != 0.0 for v in i) % 2 == 1),
+    "NOT": lambda o, i, k: float(_first(i) == 0.0),
+}
 # the objects this module simulates; any other reads 0 on its outputs (one message says so)
-SIMULATED = ("ETHERNET", "AXISCORR", "POSCORR", "AXISCORRMON", "POSCORRMON", "STOP", "LIMIT")
+SIMULATED = ("ETHERNET", "AXISCORR", "POSCORR", "AXISCORRMON", "POSCORRMON", "STOP", *BLOCKS)
 # the controller's internal values a SEND element DEF_... writes: element and its attributes
 INTERNAL_SEND = {
     "DEF_RIST": ("RIst", CART), "DEF_RSOL": ("RSol", CART),
@@ -348,14 +385,19 @@ class Rsi:
         t = o.type
         if t == "ETHERNET":
             return float(self.outputs.get(idx, 0.0))
-        if t == "LIMIT":
-            v = self._input(o, 1, depth)
-            return float(min(max(v, o.param("LowerLimit", -1e9)), o.param("UpperLimit", 1e9)))
         if t == "AXISCORRMON" and 1 <= idx <= 6:
             return float(self.corr_axes[idx - 1])
         if t == "POSCORRMON" and 1 <= idx <= 6:
             return float(self.corr_cart[idx - 1])
-        return 0.0
+        fn = BLOCKS.get(t)
+        if fn is None:
+            return 0.0
+        ins = [self._input(o, i, depth) for i in sorted(o.inputs)]
+        try:
+            v = float(fn(o, ins, idx))
+        except (ValueError, ZeroDivisionError, OverflowError):
+            return 0.0
+        return v if np.isfinite(v) else 0.0
 
     def _apply(self) -> None:
         for obj in self.ctx.of_type("AXISCORR"):

@@ -179,3 +179,52 @@ def test_the_ethernet_configuration_in_a_folder_beside(tmp_path):
         load_context(ctx, "ros_rsi")
     (tmp_path / "Common" / "ros_rsi_ethernet.xml").write_bytes((PUB / "fzi_kr_c4" / "ros_rsi_ethernet.xml").read_bytes())
     assert load_context(ctx, "ros_rsi").ethernet.path == tmp_path / "Common" / "ros_rsi_ethernet.xml"
+
+
+class _Hub:
+    """The little of net/hub.py an Rsi object reads outside a run."""
+    settings = program = backup = ctl = None
+
+    def __init__(self):
+        self.messages = []
+
+    def trace(self, *a, **k):
+        pass
+
+    def net_message(self, text, number=None):
+        self.messages.append(text)
+
+
+def test_toolbox_blocks_in_the_signal_flow(tmp_path):
+    """RSI 4/5 context whose POSCORR X comes through MULTI(ch1, ch2), Y through SUM(ch1, Value
+    0.5), Z through LIMIT(ch3) with the blueprint's default limits (+-10) and A through a
+    SUB of Division(ch1, ch2) and ch2; relative mode adds each answer once."""
+    from net.rsi import Rsi
+
+    (tmp_path / "e.xml").write_text(
+        '<ROOT><CONFIG><PORT>49152</PORT></CONFIG><RECEIVE><ELEMENTS>'
+        '<ELEMENT TAG="P.a" TYPE="DOUBLE" INDX="1"/><ELEMENT TAG="P.b" TYPE="DOUBLE" INDX="2"/>'
+        '<ELEMENT TAG="P.c" TYPE="DOUBLE" INDX="3"/><ELEMENT TAG="DEF_EStr" TYPE="STRING" INDX="INTERNAL"/>'
+        '</ELEMENTS></RECEIVE></ROOT>')
+    (tmp_path / "c.rsix").write_text(
+        '<RsiContext><RsiObjects>'
+        '<RsiObject ObjType="Ethernet" ObjId="E"><Parameters><Parameter Name="ConfigFile" ParamValue="e.xml"/></Parameters></RsiObject>'
+        '<RsiObject ObjType="MULTI" ObjId="M"><Inputs><Input InIdx="0" OutObjId="E" OutIdx="0"/><Input InIdx="1" OutObjId="E" OutIdx="1"/></Inputs></RsiObject>'
+        '<RsiObject ObjType="SUM" ObjId="S"><Inputs><Input InIdx="0" OutObjId="E" OutIdx="0"/></Inputs>'
+        '<Parameters><Parameter Name="Value" ParamValue="0.5"/></Parameters></RsiObject>'
+        '<RsiObject ObjType="Limit" ObjId="L"><Inputs><Input InIdx="0" OutObjId="E" OutIdx="2"/></Inputs></RsiObject>'
+        '<RsiObject ObjType="Division" ObjId="D"><Inputs><Input InIdx="0" OutObjId="E" OutIdx="0"/><Input InIdx="1" OutObjId="E" OutIdx="1"/></Inputs></RsiObject>'
+        '<RsiObject ObjType="SUB" ObjId="B"><Inputs><Input InIdx="0" OutObjId="D" OutIdx="0"/><Input InIdx="1" OutObjId="E" OutIdx="1"/></Inputs></RsiObject>'
+        '<RsiObject ObjType="PosCorr" ObjId="P"><Inputs><Input InIdx="0" OutObjId="M" OutIdx="0"/>'
+        '<Input InIdx="1" OutObjId="S" OutIdx="0"/><Input InIdx="2" OutObjId="L" OutIdx="0"/><Input InIdx="3" OutObjId="B" OutIdx="0"/></Inputs></RsiObject>'
+        '</RsiObjects></RsiContext>')
+    hub = _Hub()
+    rsi = Rsi(hub)
+    rsi.ctx = load_context(tmp_path / "c.rsix", "c")
+    rsi.mode = "RELATIVE"
+    for n, ipoc in enumerate((12, 24)):
+        rsi.expect, rsi.recent = [ipoc], [ipoc]
+        rsi.answer(f'<Sen Type="ImFree"><P a="3" b="2" c="25"/><EStr>step {n}</EStr><IPOC>{ipoc}</IPOC></Sen>'.encode())
+    # two answers: X 2*(3*2), Y 2*(3+0.5), Z 2*10 (limited), A 2*(3/2-2)
+    assert rsi.cart.tolist() == [12.0, 7.0, 20.0, -1.0, 0.0, 0.0]
+    assert hub.messages == ["RSI sensor: step 0", "RSI sensor: step 1"]
