@@ -228,3 +228,15 @@ def test_toolbox_blocks_in_the_signal_flow(tmp_path):
     # two answers: X 2*(3*2), Y 2*(3+0.5), Z 2*10 (limited), A 2*(3/2-2)
     assert rsi.cart.tolist() == [12.0, 7.0, 20.0, -1.0, 0.0, 0.0]
     assert hub.messages == ["RSI sensor: step 0", "RSI sensor: step 1"]
+
+
+def test_cell_file_names_the_ethernet_configuration(tmp_path):
+    from net.settings import SettingsError, parse_network
+
+    s = parse_network({"rsi": {"config": "ctx/ros_rsi.rsix", "ethernet": "Common/ros_rsi_ethernet.xml"}}, tmp_path)
+    assert s.rsi.config == tmp_path / "ctx" / "ros_rsi.rsix"
+    assert s.rsi.ethernet == tmp_path / "Common" / "ros_rsi_ethernet.xml"
+    with pytest.raises(SettingsError, match="without '..'"):
+        parse_network({"rsi": {"ethernet": "../x.xml"}}, tmp_path)
+    with pytest.raises(SettingsError, match="unknown key 'ethernet'"):
+        parse_network({"eki": {"CH": {"config": "a.xml", "ethernet": "b.xml"}}}, tmp_path)
