@@ -14,10 +14,12 @@ import re
 import pytest
 import yaml
 
-from interp.runtime.program import BASIS_DIR, parse_module
-from krl.semantics.data import __path__ as _data_path  # noqa: F401  (the tables' package)
-
 from pathlib import Path
+
+from interp.run import make_runtime
+from interp.runtime.program import BASIS_DIR, parse_module
+from krl.semantics.data import __path__ as _data_path  # the tables' package
+from robot.trace import TraceWriter
 
 TABLE = Path(_data_path[0]) / "functions.yaml"
 # the names of KUKA's system software (functions.yaml lenient: system) that KSS 8's inline
@@ -105,9 +107,6 @@ def test_kss8_inline_forms_run_outside_a_backup(tmp_path, interp):
     """SPTP/SLIN/SCIRC as KSS 8's inline forms write them, with a KR C4 template's PDAT/LDAT
     (GEAR_JERK 50, JERK_FAC 50): the values the BASIS gives (DEF_GEAR_JERK 100 % of a KR C4's
     $config.dat at 50 %, DEF_JERK_STRUC's CP 500 m/s^3 at 50 %)."""
-    from interp.run import make_runtime
-    from robot.trace import TraceWriter
-
     (tmp_path / "sfold.src").write_text(SRC)
     (tmp_path / "sfold.dat").write_text(DAT)
     trace = TraceWriter(keep=True)

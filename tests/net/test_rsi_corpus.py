@@ -14,13 +14,15 @@ and the trace's poses."""
 from __future__ import annotations
 
 import re
+import shutil
+import xml.etree.ElementTree as ET
 
 import numpy as np
 import pytest
 
 from net.settings import Channel, NetworkSettings
 
-from .helpers import CONFIGS, net_events, run_with_partner
+from .helpers import CONFIGS, EXAMPLES, net_events, run_with_partner
 from .sensor import ConfigSensor, axes_of, tcp_of
 
 PUB = CONFIGS / "published"
@@ -50,7 +52,6 @@ START = "{A1 0, A2 -90, A3 90, A4 0, A5 30, A6 0}"
 
 
 def ethernet_of(context):
-    import xml.etree.ElementTree as ET
     for el in ET.parse(context).getroot().iter():
         if el.get("Name") == "ConfigFile":
             return context.parent / el.get("ParamValue")
@@ -111,7 +112,6 @@ def test_the_cell_file_may_name_the_ethernet_configuration(shared_corpus, tmp_pa
     """A user who names the ETHERNET configuration in the cell file (``rsi: {config:
     PoseTrack_ethernet.xml}``) gets the context RSI_CREATE names from beside the program (here
     the RSI 4/5 PoseTrack.rsix, with its LIMIT objects), not one implied from the tags."""
-    import shutil
     src = tmp_path / "PoseTrack.src"
     shutil.copyfile(shared_corpus / "wingljj__Kuka-RSI-real-time-control/krc/PoseTrack.src", src)
     shutil.copyfile(PUB / "wingljj" / "PoseTrack.rsix", tmp_path / "PoseTrack.rsix")
@@ -145,7 +145,6 @@ def _rot(a, b, c):
 def test_poscorr_in_the_tool_frame(tmp_path, refcorrsys):
     """POSCORR's RefCorrSys: Tool (RSI 3 "Tool", RSI 4/5 3) moves the TCP along its own axes,
     Base (the default, "Base" or 1) along $BASE's."""
-    from .helpers import EXAMPLES
     text = (EXAMPLES / "rsi_path.rsi.xml").read_text()
     text = text.replace('<Parameter Name="LowerLimX"', f'<Parameter Name="RefCorrSys" ParamValue="{refcorrsys}"/> '
                         '<Parameter Name="LowerLimX"', 1)

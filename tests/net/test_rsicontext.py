@@ -13,7 +13,9 @@ from pathlib import Path
 
 import pytest
 
+from net.rsi import Rsi
 from net.rsicontext import RSI3, RSI45, IMPLIED, RsiConfigError, find_context, load_context, read_ethernet
+from net.settings import SettingsError, parse_network
 
 from .helpers import CONFIGS
 
@@ -199,7 +201,6 @@ def test_toolbox_blocks_in_the_signal_flow(tmp_path):
     """RSI 4/5 context whose POSCORR X comes through MULTI(ch1, ch2), Y through SUM(ch1, Value
     0.5), Z through LIMIT(ch3) with the blueprint's default limits (+-10) and A through a
     SUB of Division(ch1, ch2) and ch2; relative mode adds each answer once."""
-    from net.rsi import Rsi
 
     (tmp_path / "e.xml").write_text(
         '<ROOT><CONFIG><PORT>49152</PORT></CONFIG><RECEIVE><ELEMENTS>'
@@ -231,7 +232,6 @@ def test_toolbox_blocks_in_the_signal_flow(tmp_path):
 
 
 def test_cell_file_names_the_ethernet_configuration(tmp_path):
-    from net.settings import SettingsError, parse_network
 
     s = parse_network({"rsi": {"config": "ctx/ros_rsi.rsix", "ethernet": "Common/ros_rsi_ethernet.xml"}}, tmp_path)
     assert s.rsi.config == tmp_path / "ctx" / "ros_rsi.rsix"
