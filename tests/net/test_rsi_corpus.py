@@ -163,3 +163,22 @@ def test_poscorr_in_the_tool_frame(tmp_path, refcorrsys):
     frame = _rot(*first[3:]) if refcorrsys in ("Tool", "3") else np.eye(3)
     assert np.allclose(last[:3] - first[:3], frame @ corr, atol=0.01), (last[:3] - first[:3], frame @ corr)
     assert np.allclose(last[3:], first[3:], atol=0.01)
+
+
+def test_onlysend_expects_no_answer(tmp_path):
+    """ONLYSEND TRUE (KUKA's template: "the client don't expect answers"): the robot streams its
+    packets and never counts one late, so a sensor that only listens does not stop it."""
+    text = (EXAMPLES / "rsi_path_ethernet.xml").read_text().replace("<ONLYSEND>FALSE</ONLYSEND>", "<ONLYSEND>TRUE</ONLYSEND>")
+    (tmp_path / "rsi_path_ethernet.xml").write_text(text)
+    shutil.copyfile(EXAMPLES / "rsi_path.rsi.xml", tmp_path / "rsi_path.rsi.xml")
+    sensor = ConfigSensor(tmp_path / "rsi_path_ethernet.xml")
+    assert sensor.onlysend
+
+    def plan(i, rob):
+        return "done" if i >= 200 else ({}, False)        # never sent: the sensor only listens
+
+    settings = NetworkSettings(tmp_path, rsi=Channel(tmp_path / "rsi_path.rsi.xml", sensor.address))
+    result, trace, got = run_with_partner(EXAMPLES / "rsi_path.src", settings, sensor.partner(plan))
+    assert len(got) >= 200 and result.reason != "error", (result.reason, result.text)
+    assert not [e for e in net_events(trace, iface="rsi", dir="error") if e.get("number") == 1]
+    assert all(r.find("Delay").get("D") == "0" for r in got)
