@@ -30,6 +30,7 @@ class Channel:
 
     config: Path | None = None
     address: tuple[str, int] | None = None
+    ethernet: Path | None = None        # RSI only: the ETHERNET configuration (net/rsicontext.py)
 
 
 def parse_address(text, what: str, default_port: int | None = None) -> tuple[str, int]:
@@ -67,11 +68,13 @@ def mapping(doc, keys, what: str) -> dict:
     return doc
 
 
-def channel(doc, base: Path, what: str) -> Channel:
-    """``{config: PATH, address: HOST:PORT}`` (both optional; None: both defaults)."""
+def channel(doc, base: Path, what: str, keys=CHANNEL_KEYS) -> Channel:
+    """``{config: PATH, address: HOST:PORT}`` (optional, None: the defaults), and ``ethernet:
+    PATH`` where `keys` allow it (RSI)."""
     if doc is None:
         return Channel()
-    doc = mapping(doc, CHANNEL_KEYS, what)
+    doc = mapping(doc, keys, what)
     cfg = inside(base, doc["config"], f"{what}: config") if doc.get("config") is not None else None
     addr = parse_address(doc["address"], f"{what}: address") if doc.get("address") is not None else None
-    return Channel(cfg, addr)
+    eth = inside(base, doc["ethernet"], f"{what}: ethernet") if doc.get("ethernet") is not None else None
+    return Channel(cfg, addr, eth)

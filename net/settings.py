@@ -3,7 +3,8 @@
     network:
       eki:
         CHANNEL: {config: PATH.xml, address: 127.0.0.1:54600}  # address overrides the XML's IP and port
-      rsi: {config: PATH, address: 127.0.0.1:49152}
+      rsi: {config: PATH, address: 127.0.0.1:49152, ethernet: PATH.xml}   # ethernet: the ETHERNET
+                             # object's configuration when it is not beside the context
       plc: {modbus: 127.0.0.1:5020, opcua: opc.tcp://127.0.0.1:4840}
       varproxy: 127.0.0.1:7000
       pace: 1.0              # simulated s per wall s while a partner is attached (default 1: real time)
@@ -24,8 +25,8 @@ from pathlib import Path
 
 from krl.limits import MAX_NET_PACE
 
-from . import partners as registry
 from .cellkey import LOOPBACK, Channel, SettingsError, inside, mapping, parse_address
+from . import partners as registry  # noqa: I001  (after .cellkey: net/rsicontext.py imports LOOPBACK from here)
 
 HUB_KEYS = ("pace", "replay")
 
