@@ -21,10 +21,12 @@ def program_assembly(program: Path, workspace: Path | None = None, all_modules: 
     from interp.runtime.program import basis_files, checked_workspace  # noqa: PLC0415
     from interp.vm.compiler import compile_module  # noqa: PLC0415
 
-    main_path = Path(program).resolve()
-    project = project_of(main_path, Path(workspace).resolve() if workspace else None)
+    from krl.files import same_file, spelled, spelled_within  # noqa: PLC0415
+
+    main_path = spelled_within(program, workspace)         # the user's spelling, links kept
+    project = project_of(main_path, spelled(workspace) if workspace else None)
     ws = checked_workspace(project, basis_files(project))
-    units = [u for u in ws.units if any(f is not None and Path(f.path) == main_path for f in (u.src, u.dat))]
+    units = [u for u in ws.units if any(f is not None and same_file(f.path, main_path) for f in (u.src, u.dat))]
     if all_modules:
         units += [u for u in ws.units if u not in units and u.routines]
     out = []

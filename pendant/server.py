@@ -65,7 +65,9 @@ class Pendant:
     def __init__(self, root: Path, *, inputs: str | None = None, mode: str = "T1", realtime: bool = True,
                  trace: str | None = None, program: str | None = None, readonly: bool = False,
                  shown_root: str | None = None) -> None:
-        self.root = root.resolve()
+        from krl.files import spelled  # noqa: PLC0415
+
+        self.root = spelled(root)        # the user's spelling, links kept: the page's paths are the user's
         self.shown_root = shown_root or str(root)
         self.inputs = inputs
         self.mode = mode

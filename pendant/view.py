@@ -22,9 +22,9 @@ def programs(root: Path) -> list[str]:
     from interp.realprograms import programs_of  # noqa: PLC0415
 
     out = []
-    for p in programs_of(root.resolve()):
+    for p in programs_of(root):
         try:
-            out.append(str(p.resolve().relative_to(root.resolve())))
+            out.append(str(Path(p).relative_to(root)))
         except ValueError:
             continue
     return out
@@ -35,7 +35,7 @@ def modules(root: Path) -> list[str]:
     any of them can be selected)."""
     from krl.files import walk  # noqa: PLC0415
 
-    out = [e.rel for e in walk(root.resolve()) if e.kind == "file" and e.rel.lower().endswith(".src")]
+    out = [e.rel for e in walk(root) if e.kind == "file" and e.rel.lower().endswith(".src")]
     return sorted(out, key=str.lower)[:5000]
 
 
@@ -47,7 +47,7 @@ def module_view(path: Path, root: Path) -> dict:
     src = read_source(path, max_bytes=MAX_WEB_FILE_BYTES)
     text = getattr(src, "text", None) or ""
     dat = _data_list_of(path)
-    return {"path": str(path), "label": str(path.relative_to(root.resolve())),
+    return {"path": str(path), "label": str(path.relative_to(root)),
             "lines": text.splitlines(), "points": taught_points(dat, root) if dat is not None else [],
             "dat": str(dat) if dat is not None else None}
 
@@ -102,7 +102,7 @@ def _base_data(root: Path) -> dict[int, tuple]:
     from krl.project import backup_of, system_folder  # noqa: PLC0415
     from robot.datalist import DataListError, read_data_list  # noqa: PLC0415
 
-    base = backup_of(root.resolve()) or root.resolve()
+    base = backup_of(root) or root
     folder = system_folder(base)
     if folder is None:
         return {}
