@@ -19,6 +19,10 @@ kind                      meaning
 
 Order: within a folder, entries sorted by name; the files of a folder come before its
 sub-folders (the order of ``os.walk`` with sorted names).
+
+Also here: :func:`spelled` (a path in the user's spelling, links kept: what every command shows
+and sends), :func:`same_file` (identity by resolved paths), :func:`write_bytes_atomic`, and
+:data:`SHARED_CORPUS`.
 """
 
 from __future__ import annotations
