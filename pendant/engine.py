@@ -274,6 +274,13 @@ class Engine:
             if number is not None:
                 m = _ORIGIN.match(str(text))
                 self.system.add("QUIT", text, number=number, origin=m.group(1) if m else "KSS", time=ctl.time)
+            elif motion_id is not None:
+                # the main run's own message about a motion ("approximation not possible": a
+                # KSS warning, krl-reference §6.8): a notification at the motion's line
+                req = ctl.current_request()
+                at = req if req is not None and getattr(req, "id", None) == motion_id else None
+                self.system.add("NOTIFY", text, path=getattr(at, "file", None), line=getattr(at, "line", None),
+                                time=ctl.time)
             elif not (text.startswith("KRL message: ") or text.startswith("KRL dialog")):
                 self.notes.append({"time": round(ctl.time, 3), "text": str(text)[:300]})
                 del self.notes[:-MAX_KRL_MESSAGES]
