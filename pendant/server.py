@@ -155,6 +155,8 @@ class Pendant:
                      "messages": message_rows(self.engine, None)}
         if s.get("position") is not None:
             self._position = s["position"]
+        if s.get("state") == "ended":                 # the modes the next run starts with
+            s.update({"modeOp": self.mode, "runMode": self.run_mode})
         s.update({"program": self.program, "programLabel": self._label(self.program), "drives": self.drives,
                   "breakpoints": {p: sorted(v) for p, v in self.breakpoints.items()}})
         return s
@@ -284,13 +286,13 @@ class Pendant:
             if value not in RUN_MODES:
                 raise EngineError(f"run mode: one of {', '.join(RUN_MODES)}")
             self.run_mode = value
-            if self.engine.selected:
+            if self._live():
                 await do(lambda core: keys.run_mode(core, value))
         elif op == "modeOp":
             value = str(msg.get("value", "")).upper()
             if value not in MODES_OP:
                 raise EngineError(f"operating mode: one of {', '.join(MODES_OP)}")
-            if self.engine.selected:
+            if self._live():
                 await do(lambda core: keys.mode_op(core, value))
             self.mode = value
             self.drives = False          # turning the mode switch switches the drives off
@@ -351,6 +353,11 @@ class Pendant:
             await self.send_module(ws, str(path))
             return
         await self.push_state(fresh[-1] if fresh and self.watch == watch else None)
+
+    def _live(self) -> bool:
+        """A selected program that has not ended: a mode key goes to its run. After its end
+        the key sets the mode the next selection (Reset, Select) starts with."""
+        return self.engine.selected and self.engine.state in ("running", "stopped")
 
     def _need_drives(self) -> None:
         if not self.drives:

@@ -140,6 +140,13 @@ def test_ended_is_not_drawn_as_an_error(server, pw):
         assert s["outcome"]["reason"] == "completed"
         assert page.locator("#st-state").inner_text() == "ended"
         assert badge_colour(page) != ERR_COLOUR
+        # after the end the mode switch is free again; Reset starts the program in the new mode
+        page.select_option("#mode-op", "T1")
+        wait_state(page, "s.state == 'ended' && s.modeOp == 'T1'")
+        page.click("#reset")
+        s = wait_state(page, "s.state == 'stopped' && s.stop && s.stop.reason == 'entry'")
+        assert s["modeOp"] == "T1"
+        page.click("#cancel")
         assert page.problems == []
 
 
