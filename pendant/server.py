@@ -322,7 +322,7 @@ class Pendant:
             # "Confirm all": the controller's messages and the program's notification and
             # acknowledgement messages (status, wait and dialog messages stay)
             self.engine.system.acknowledge_all()
-            if self.engine.selected and self.engine.state in ("running", "stopped"):
+            if self._live():
                 await do(keys.acknowledge_all)
         elif op == "answer":
             await do(lambda core: keys.message(core, msg.get("handle"), msg.get("key")))
