@@ -7,6 +7,7 @@ from pathlib import Path
 
 import click
 
+from krl.files import same_file, spelled, spelled_within
 from krl.project import project_of
 from krl.terminal import printable
 
@@ -20,8 +21,6 @@ def program_assembly(program: Path, workspace: Path | None = None, all_modules: 
     # registers `asm`)
     from interp.runtime.program import basis_files, checked_workspace  # noqa: PLC0415
     from interp.vm.compiler import compile_module  # noqa: PLC0415
-
-    from krl.files import same_file, spelled, spelled_within  # noqa: PLC0415
 
     main_path = spelled_within(program, workspace)         # the user's spelling, links kept
     project = project_of(main_path, spelled(workspace) if workspace else None)
