@@ -86,13 +86,14 @@ def _rel(path: str, root: str) -> str:
     return Path(path).name
 
 
-_PLACE = re.compile(r":\d+(?::\d+)?\b")
+_NUMBER = re.compile(r"\d+")
 
 
 def _key(f: Finding) -> tuple:
-    """What makes two findings of the two backups the same finding: file, code and message,
-    with line and column numbers left out of the message (lines move when code is edited)."""
-    return f.file.lower(), f.code, _PLACE.sub(":N", f.message)
+    """What makes two findings of the two backups the same finding: the file, the code, the
+    message with its numbers left out (the lines it names move when code is edited; "used 19
+    times" becomes "used 26 times") and the text of the line it is on."""
+    return f.file.lower(), f.code, _NUMBER.sub("N", f.message), f.text.strip()
 
 
 def findings(diagnostics: list, root: str, lines: Callable[[str], list[str]], links: str = "file") -> list[Finding]:

@@ -47,7 +47,8 @@ Selected by an operator:
 
 And ``system`` -- the main routines of KUKA's own files (krl.workspace.is_kuka_file: the
 controller, its inline forms and technology packages call them); ``module`` -- for a folder
-that is not a KRC backup, the main routine of every module (nothing says who starts it).
+that is not a KRC backup, the main routine of every module and every GLOBAL routine (nothing
+says who starts or calls them: code outside the folder may).
 
 Each node has a *reach* (``Node.reach``, :data:`REACH`): ``controller`` when a routine the
 controller starts reaches it along the edges (calls, interrupts, triggers, RUN); ``operator``
@@ -103,6 +104,7 @@ class Node:
     kuka: bool = False
     main: bool = False
     runnable: bool = False         # a module main that is a DEF without parameters: a program of its own
+    is_global: bool = False        # GLOBAL DEF / DEFFCT
     end: int = 0                   # the END/ENDFCT line
     # the data it reads or writes: (declaring file, NAME upper-case) of every name the checker
     # resolved to a variable, constant or signal declared in a file (a data list, $config.dat)
@@ -193,7 +195,8 @@ def build_map(ws: Workspace) -> ProgramMap:
             if nid in pm.nodes:
                 continue                   # a duplicate routine (E102): the first one stands
             pm.nodes[nid] = Node(nid, r.name, u.name, u.src.path, r.span.line, kuka=kuka, main=i == 0,
-                                 runnable=i == 0 and _selectable(r), end=r.end_line or r.span.line)
+                                 runnable=i == 0 and _selectable(r), is_global=r.is_global,
+                                 end=r.end_line or r.span.line)
             pm._by_decl[id(r)] = nid
             if i == 0:
                 mains[u.name.upper()] = nid
@@ -319,6 +322,11 @@ def _entries(pm: ProgramMap, ws: Workspace, mains: dict) -> None:
                 "KUKA system program" if n.kuka else "main routine of a module")
             if not n.kuka:
                 modules.append(nid)
+        elif n.kind == "routine" and n.is_global and not backup and not n.kuka:
+            # a folder that is not a backup is a library as much as a program: code outside it
+            # (the backup it goes into, its sps.sub) may call what its modules export
+            add(nid, "module", "GLOBAL routine of a module")
+            modules.append(nid)
     _reach(pm, out, [nid for nid in modules if not pm.nodes[nid].reach], "module")
     named = _named_in_unparsed(ws)
     _reach(pm, out, [nid for nid, n in pm.nodes.items()

@@ -112,8 +112,14 @@ def to_text(pm: ProgramMap) -> list[str]:
     out = [f"{p(pm.root)}: {len(routines)} routines ({len(own)} of its own, {len(routines) - len(own)} of "
            f"KUKA's system software), {len(pm.edges)} edges"]
     controller = [pm.nodes[i] for i in pm.entries if pm.nodes[i].entry_kind in CONTROLLER_KINDS]
+    modules = [pm.nodes[i] for i in pm.entries if pm.nodes[i].entry_kind == "module"]
+    operator = [pm.nodes[i] for i in pm.entries if pm.nodes[i].entry_kind == "operator"]
+    if modules:
+        out.append(f"a folder, not a KRC backup: {len(modules)} entry points (module mains, GLOBAL routines), "
+                   f"{sum(n.reach == 'module' for n in own)} routines reached")
     reached = sum(n.reach == "controller" for n in own)
-    out.append(f"started by the controller: {len(controller)} entry points, {reached} routines of its own reached")
+    if controller or not modules:
+        out.append(f"started by the controller: {len(controller)} entry points, {reached} routines of its own reached")
     for n in controller:
         kind = n.entry_kind
         if kind == "plc":
@@ -124,11 +130,9 @@ def to_text(pm: ProgramMap) -> list[str]:
         out.append(f"  {kind:<10} {p(n.name)}  {where(n)}{extra}")
     mains = context(pm, None)["operator_mains"]
     only = sum(n.reach == "operator" for n in own)
-    out.append(f"only an operator starts: {len(mains)} modules, {only} routines")
-    out += [f"  {p(n.name)}  {where(n)}" for n in mains]
-    modules = [n for n in own if n.reach == "module"]
-    if modules:
-        out.append(f"reached from a module's main routine (not a backup): {len(modules)} routines")
+    if operator or not modules:
+        out.append(f"only an operator starts: {len(mains)} modules, {only} routines")
+        out += [f"  {p(n.name)}  {where(n)}" for n in mains]
     dead = pm.unreachable
     out.append(f"dead: {len(dead)} routines" + ("" if dead else " (none)"))
     out += [f"  {p(n.module)}:{p(n.name)}  {where(n)}" for n in dead]
