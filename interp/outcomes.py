@@ -160,7 +160,7 @@ def outcome_changes(old: dict | None, new: dict | None) -> list[str]:
     elif old.get("line") != new.get("line") and old["reason"] in ("error", "halt", "deadlock"):
         out.append("ends at another line")
     a, b = old.get("cycle_time"), new.get("cycle_time")
-    if (a is None) != (b is None) or (a is not None and abs(a - b) > CYCLE_TOLERANCE_S):
+    if (a is None) != (b is None) or (a is not None and round(abs(a - b), 6) > CYCLE_TOLERANCE_S):
         out.append("cycle time")
     if old.get("counts", {}) != new.get("counts", {}):
         out.append("motion events")

@@ -110,28 +110,33 @@ def findings(diagnostics: list, root: str, lines: Callable[[str], list[str]], li
 
 def findings_delta(old: list[Finding], new: list[Finding]) -> tuple[list[Finding], list[Finding]]:
     """(introduced, removed): the findings of `new` with no counterpart in `old`, and of `old`
-    with none in `new` (matched by :func:`_key`, one to one, in order)."""
-    pool: dict[tuple, int] = {}
-    for f in old:
-        pool[_key(f)] = pool.get(_key(f), 0) + 1
-    introduced = []
-    for f in new:
-        k = _key(f)
-        if pool.get(k, 0):
-            pool[k] -= 1
-        else:
-            introduced.append(f)
-    pool = {}
-    for f in new:
-        pool[_key(f)] = pool.get(_key(f), 0) + 1
-    removed = []
-    for f in old:
-        k = _key(f)
-        if pool.get(k, 0):
-            pool[k] -= 1
-        else:
-            removed.append(f)
-    return introduced, removed
+    with none in `new`, matched one to one, in order, by :func:`_key`; then what is left is
+    matched by the file's name instead of its path (a folder renamed or moved: the same
+    finding in the same file)."""
+    introduced, removed = _unmatched(old, new, _key)
+    return _unmatched(removed, introduced, _by_name)
+
+
+def _by_name(f: Finding) -> tuple:
+    return (f.file.rsplit("/", 1)[-1].lower(), *_key(f)[1:])
+
+
+def _unmatched(old: list[Finding], new: list[Finding], key) -> tuple[list[Finding], list[Finding]]:
+    """(the findings of `new` no finding of `old` matches by `key`, those of `old` no finding of
+    `new` matches), one to one, in order."""
+    def left(a: list[Finding], b: list[Finding]) -> list[Finding]:
+        pool: dict[tuple, int] = {}
+        for f in b:
+            pool[key(f)] = pool.get(key(f), 0) + 1
+        out = []
+        for f in a:
+            k = key(f)
+            if pool.get(k, 0):
+                pool[k] -= 1
+            else:
+                out.append(f)
+        return out
+    return left(new, old), left(old, new)
 
 
 # ---------------------------------------------------------------------- what the change touches

@@ -12,6 +12,10 @@ import pytest
 
 from tests.docs import transcripts as T
 
+# the README's example runs 44 programs for its report: minutes on a loaded machine (the first
+# test that asks for the documents' run pays for it)
+pytestmark = pytest.mark.timeout(3600)
+
 DOCS = [p for p in T.documents() if T.transcripts(p)]
 
 
