@@ -40,7 +40,7 @@ from krl.render import render_html
 __all__ = ["Finding", "Touched", "findings_delta", "touched_entries", "report_html", "RUN_KINDS",
            "MAX_REPORT_DIAGNOSTICS"]
 
-#: the findings listed in the appendix of all findings (the counts are always complete)
+#: the findings listed in each table (introduced, removed, all of NEW; the counts are always complete)
 MAX_REPORT_DIAGNOSTICS = 500
 #: the entry kinds that are programs of their own (krl/programmap/graph.py), run old against new
 RUN_KINDS = ("cell", "plc", "submit", "selected", "operator", "module")
@@ -257,12 +257,22 @@ def report_html(backup: str, files: int, new_findings: list[Finding], pm: Progra
         "krl.diff", "report.html.j2", title=f"Change report: {backup}", backup=backup, files=files,
         errors=errors, warnings=len(new_findings) - errors, all_findings=new_findings[:MAX_REPORT_DIAGNOSTICS],
         more=max(0, len(new_findings) - MAX_REPORT_DIAGNOSTICS), introduced=introduced, removed=removed,
+        limit=MAX_REPORT_DIAGNOSTICS, by_code=_by_code,
         diff=diff, touched=touched or [], changed_runs=changed_runs, runs=runs, run_rows=rows,
         max_sim_time=max_sim_time,
         reach=reach, map_widget=map_widget(pm, links), format_delta=format_delta,
         map_tables=Markup(render_html("krl.programmap", "_map_body.html.j2", edges=False, **context(pm, None))),
         kind_counts=[(k, KIND_TITLES[k], len(getattr(diff, k))) for k in KINDS] if diff is not None else [],
         **html_helpers(link), **context(pm, None))
+
+
+def _by_code(findings: list[Finding], n: int = 3) -> str:
+    """``E101 5087, W107 30, ...``: the commonest codes of `findings` (a summary of many)."""
+    counts: dict[str, int] = {}
+    for f in findings:
+        counts[f.code] = counts.get(f.code, 0) + 1
+    top = sorted(counts.items(), key=lambda kv: (-kv[1], kv[0]))
+    return ", ".join(f"{c} {k}" for c, k in top[:n]) + (", ..." if len(top) > n else "")
 
 
 def _run_row(t: Touched, link, roots: dict) -> dict:
