@@ -34,7 +34,8 @@ from tests.docs import transcripts as T
 
 # the README's example runs 44 programs for its report: minutes on a loaded machine (the first
 # test that asks for the documents' run pays for it)
-pytestmark = pytest.mark.timeout(3600)
+# and they share that run: one xdist worker takes the whole group (make test: --dist loadgroup)
+pytestmark = [pytest.mark.timeout(3600), pytest.mark.xdist_group("docs")]
 from tests.report.test_report_chromium import CHROMIUM, loaded_page
 
 README = T.REPO / "README.md"

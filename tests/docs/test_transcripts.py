@@ -14,7 +14,8 @@ from tests.docs import transcripts as T
 
 # the README's example runs 44 programs for its report: minutes on a loaded machine (the first
 # test that asks for the documents' run pays for it)
-pytestmark = pytest.mark.timeout(3600)
+# and they share that run: one xdist worker takes the whole group (make test: --dist loadgroup)
+pytestmark = [pytest.mark.timeout(3600), pytest.mark.xdist_group("docs")]
 
 DOCS = [p for p in T.documents() if T.transcripts(p)]
 
