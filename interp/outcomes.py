@@ -13,7 +13,8 @@ the real-programs report's step limit (interp.realprograms.step_limit). It retur
 * ``reason`` (RunResult.reason: completed, halt, error, max_sim_time, max_steps, deadlock, or
   ``internal`` for an error of the simulator), ``ending`` (the words of ``krl run``'s summary,
   interp.summary.ENDINGS), ``cause`` (interp.realprograms.cause_of: completed, intended end,
-  program error, interpreter gap, limit), ``text``, ``file``, ``line`` (where it ended);
+  program error, interpreter gap, limit), ``text``, ``file``, ``line`` (where it ended) and
+  ``statement`` (that line's text);
 * ``sim_time`` (s) and ``cycle_time`` (s): the simulated time from the start to the program's
   own end -- it completed, or stopped at its own HALT -- else None (a cyclic program stopped at
   the time limit has no cycle end; with ``--inputs auto`` every starving wait counts its 0.5 s);
@@ -101,10 +102,22 @@ def run_outcome(path: str, max_sim_time: float | None = None, interp: str = "vm"
     except Exception as exc:  # noqa: BLE001 - the simulator's error is an outcome, never the report's end
         return _outcome(path, "internal", f"{type(exc).__name__}: {exc}", None, None, 0.0, events, "")
     out = _outcome(path, res.reason, res.text or "", res.file, res.line, res.sim_time, events, robot.name)
+    out["statement"] = _statement(res.file, res.line)
     out["ending"] = ENDINGS.get(res.reason, res.reason)
     out["cause"] = cause_of({"program": str(p), "reason": res.reason, "text": res.text, "sim_time": res.sim_time,
                              "cell_answers": 0, "robot_own": _own_machine_data(p, robot.source)})
     return out
+
+
+def _statement(file: str | None, line: int | None) -> str:
+    """The text of the line a run ended at, stripped ("" when unknown): two versions of a
+    program end at the same statement when it moved to another line."""
+    if not file or not line:
+        return ""
+    from krl.source import read_source  # noqa: PLC0415
+
+    lines = (read_source(file).text or "").splitlines()
+    return lines[line - 1].strip() if 0 < line <= len(lines) else ""
 
 
 def _outcome(path: str, reason: str, text: str, file, line, sim_time: float, events: _Events, robot: str) -> dict:
@@ -140,15 +153,25 @@ def run_outcomes(paths: list[str], max_sim_time: float | None = None, jobs: int 
 
 
 def _text(message: str) -> str:
-    """A message without the folders of the file names it holds (the two backups' differ)."""
-    return re.sub(r"[^\s:]*[/\\]", "", message or "")
+    """A message without the folders of the file names it holds (the two backups' differ) and
+    without the line numbers after them (an edit above moves them; the place is compared by
+    its statement)."""
+    text = re.sub(r"[^\s:]*[/\\]", "", message or "")
+    return re.sub(r"(\.(?:src|sub|dat)):\d+", r"\1:N", text, flags=re.I)
+
+
+def _place(o: dict) -> tuple:
+    """Where a run ended: its file's name and statement (the line, when the text is unknown)."""
+    name = Path(o["file"]).name.lower() if o.get("file") else ""
+    return (name, o.get("statement") or o.get("line"))
 
 
 def outcome_changes(old: dict | None, new: dict | None) -> list[str]:
     """What differs between the outcomes `old` and `new` of one entry point, in words ([] when
-    nothing does): how it ends (reason, message, line; two runs both stopped by the time or
-    step limit end alike), the cycle time (beyond :data:`CYCLE_TOLERANCE_S`), the motion events
-    of each kind."""
+    nothing does): how it ends (reason, message, and for an error, HALT or deadlock the file and
+    statement: the same statement moved to another line is the same place; two runs both
+    stopped by the time or step limit end alike), the cycle time (beyond
+    :data:`CYCLE_TOLERANCE_S`), the motion events of each kind."""
     if old is None or new is None:
         return ["only in the old backup" if new is None else "only in the new backup"] if old or new else []
     out = []
@@ -157,8 +180,8 @@ def outcome_changes(old: dict | None, new: dict | None) -> list[str]:
         pass           # both stopped by the run's limit: where each was then says nothing of the change
     elif (old["reason"], _text(old["text"])) != (new["reason"], _text(new["text"])):
         out.append("ends differently")
-    elif old.get("line") != new.get("line") and old["reason"] in ("error", "halt", "deadlock"):
-        out.append("ends at another line")
+    elif old["reason"] in ("error", "halt", "deadlock") and _place(old) != _place(new):
+        out.append("ends at another statement")
     a, b = old.get("cycle_time"), new.get("cycle_time")
     if (a is None) != (b is None) or (a is not None and round(abs(a - b), 6) > CYCLE_TOLERANCE_S):
         out.append("cycle time")

@@ -72,8 +72,9 @@ def test_a_changed_value_touches_the_programs_that_use_it(tmp_path):
     assert "used by plc_step" in touched[0].why
 
 
-def _outcome(reason="completed", text="", line=9, cycle=17.844, counts=None):
-    return {"reason": reason, "text": text, "line": line, "cycle_time": cycle, "counts": counts or {}}
+def _outcome(reason="completed", text="", line=9, cycle=17.844, counts=None, file=None, statement=""):
+    return {"reason": reason, "text": text, "line": line, "cycle_time": cycle, "counts": counts or {}, "file": file,
+            "statement": statement}
 
 
 def test_two_outcomes_differ_in_how_they_end_their_cycle_time_or_their_motion_events():
@@ -91,6 +92,14 @@ def test_two_outcomes_differ_in_how_they_end_their_cycle_time_or_their_motion_ev
     assert outcome_changes(_outcome(), _outcome(**err)) == ["ends differently", "cycle time"]
     assert outcome_changes(_outcome(**err), _outcome(**{**err, "text": "software limit switch -A1 at /b/new/x.src:12"})) == []
     assert outcome_changes(_outcome(counts={"reach": 1}), _outcome()) == ["motion events"]
+    # a deadlock at the same statement, moved from line 40 to 44 by an edit above it: the same
+    # place; at another statement: not
+    wait = dict(reason="deadlock", cycle=None, text="waits: WAIT FOR $IN[5] at /a/old/x.src:40", file="/a/old/x.src",
+                statement="WAIT FOR $IN[5]")
+    assert outcome_changes(_outcome(line=40, **wait), _outcome(
+        line=44, **{**wait, "file": "/b/new/x.src", "text": "waits: WAIT FOR $IN[5] at /b/new/x.src:44"})) == []
+    assert outcome_changes(_outcome(line=40, **wait), _outcome(line=44, **{**wait, "statement": "WAIT FOR $IN[6]"})) == [
+        "ends at another statement"]
     assert outcome_changes(None, _outcome()) == ["only in the new backup"]
 
 
