@@ -18,7 +18,8 @@ the real-programs report's step limit (interp.realprograms.step_limit). It retur
 * ``sim_time`` (s) and ``cycle_time`` (s): the simulated time from the start to the program's
   own end -- it completed, or stopped at its own HALT -- else None (a cyclic program stopped at
   the time limit has no cycle end; with ``--inputs auto`` every starving wait counts its 0.5 s);
-* ``motions``: the motions started; ``events``: every motion error of the run, each ``{t,
+* ``motions``: the motions started; ``events``: every motion error of the run (a target the
+  planner refuses in the advance run, which ends the program, among them), each ``{t,
   kind, text, line}`` with ``kind`` one of :data:`EVENT_KINDS` (from the controller's message:
   ``reach`` a target no axis configuration reaches (workspace error), ``limit`` a software
   limit switch, ``singularity`` a CP path through a wrist singularity, ``speed`` a speed limit
@@ -122,6 +123,10 @@ def _statement(file: str | None, line: int | None) -> str:
 
 def _outcome(path: str, reason: str, text: str, file, line, sim_time: float, events: _Events, robot: str) -> dict:
     errors = [{**e, "kind": event_kind(e["text"])} for e in events.errors]
+    if reason == "error" and event_kind(text) != "motion" and not any(e["text"] in text for e in errors):
+        # a motion the planner refused in the advance run ends the program without a main-run
+        # error event: it is the run's motion event all the same
+        errors.append({"t": round(sim_time, 3), "text": text, "line": line, "kind": event_kind(text)})
     counts = Counter(e["kind"] for e in errors)
     own_end = reason in ("completed", "halt")
     return {"program": path, "reason": reason, "ending": reason, "cause": "interpreter gap" if reason == "internal" else "",

@@ -86,9 +86,9 @@ def diff(old: str, new: str, fmt: str, tolerance: float, timeout: float | None, 
 def load_map(path: str):
     """``(map, diagnostics, files, lines)`` of the backup (folder or .zip) or file at `path`:
     its program map and ``krl check``'s diagnostics with paths shown as the user names them,
-    the number of files, and ``lines(shown path)``: the text lines of a file with a diagnostic
-    (read while an archive is extracted; [] for others). Raises ValueError with the message of
-    ``krl check`` for bad input."""
+    its files (shown paths), and ``lines(shown path)``: the text lines of a file with a
+    diagnostic (read while an archive is extracted; [] for others). Raises ValueError with the
+    message of ``krl check`` for bad input."""
     from dataclasses import replace  # noqa: PLC0415
 
     from krl.archive import ArchiveError, backup_source  # noqa: PLC0415
@@ -121,7 +121,7 @@ def load_map(path: str):
                 n.uses = {(shown(f), name) for f, name in n.uses}
             pm.edges = [replace(e, path=shown(e.path)) for e in pm.edges]
             pm.unresolved = [(s, n, shown(f), ln) for s, n, f, ln in pm.unresolved]
-            return pm, diags, len(ws.files), lambda shown_path: texts.get(shown_path, [])
+            return pm, diags, [shown(f.path) for f in ws.files], lambda shown_path: texts.get(shown_path, [])
     except ArchiveError as exc:
         raise ValueError(f"{path}:1:1: error[E004]: {str(exc).removeprefix(f'{path}: ')}") from None
 
@@ -178,15 +178,15 @@ def report(backup: str, since: str | None, runs: bool, max_sim_time: float | Non
     interactive program map, and every check finding of BACKUP. Prints as a readable PDF."""
     from krl.diff.core import diff_sides  # noqa: PLC0415
     from krl.diff.load import DiffInputError, side  # noqa: PLC0415
-    from krl.diff.report import findings, report_html, touched_entries  # noqa: PLC0415
+    from krl.diff.report import findings, relative, report_html, touched_entries  # noqa: PLC0415
     from krl.programmap.render import GraphTooLarge  # noqa: PLC0415
 
     try:
-        pm, diags, n_files, lines = load_map(backup)
+        pm, diags, files, lines = load_map(backup)
         new_findings = findings(diags, pm.root, lines, links)
         kw: dict = {}
         if since is not None:
-            pm_old, diags_old, _n, lines_old = load_map(since)
+            pm_old, diags_old, files_old, lines_old = load_map(since)
             with side(since) as a, side(backup) as b:
                 d = diff_sides(a, b)
                 touched = touched_entries(d, pm_old, pm)
@@ -197,10 +197,11 @@ def report(backup: str, since: str | None, runs: bool, max_sim_time: float | Non
                 if runs and touched:
                     _run_touched(touched, a, b, max_sim_time, jobs)
                 kw = {"diff": d, "old_findings": findings(diags_old, pm_old.root, lines_old, links),
+                      "file_sets": (relative(files_old, pm_old.root), relative(files, pm.root)),
                       "old_map": pm_old, "touched": touched, "runs": runs, "max_sim_time": max_sim_time,
                       "new_root": None if b.shown_of.archive else str(b.root),
                       "old_root": None if a.shown_of.archive else str(a.root)}
-        text = report_html(backup, n_files, new_findings, pm, links=links, **kw)
+        text = report_html(backup, len(files), new_findings, pm, links=links, **kw)
     except DiffInputError as exc:
         _fail("report", exc)
     except (ValueError, GraphTooLarge) as exc:

@@ -37,7 +37,7 @@ from krl.programmap.graph import ProgramMap
 from krl.programmap.render import LINKS, context, file_href, map_widget
 from krl.render import render_html
 
-__all__ = ["Finding", "Touched", "findings_delta", "touched_entries", "report_html", "RUN_KINDS",
+__all__ = ["Finding", "Touched", "findings_delta", "relative", "touched_entries", "report_html", "RUN_KINDS",
            "MAX_REPORT_DIAGNOSTICS"]
 
 #: the findings listed in each table (introduced, removed, all of NEW; the counts are always complete)
@@ -108,13 +108,28 @@ def findings(diagnostics: list, root: str, lines: Callable[[str], list[str]], li
     return out
 
 
-def findings_delta(old: list[Finding], new: list[Finding]) -> tuple[list[Finding], list[Finding]]:
+def findings_delta(old: list[Finding], new: list[Finding], files: tuple[set[str], set[str]] | None = None
+                   ) -> tuple[list[Finding], list[Finding]]:
     """(introduced, removed): the findings of `new` with no counterpart in `old`, and of `old`
-    with none in `new`, matched one to one, in order, by :func:`_key`; then what is left is
-    matched by the file's name instead of its path (a folder renamed or moved: the same
-    finding in the same file)."""
+    with none in `new`, matched one to one, in order, by :func:`_key`. With `files` (the
+    relative paths of each backup's files, :func:`relative`), what is left in a file only one
+    side has is then matched by the file's name (a folder renamed or moved: the same finding in
+    the same file); a file both sides have keeps its own findings."""
     introduced, removed = _unmatched(old, new, _key)
-    return _unmatched(removed, introduced, _by_name)
+    if files is None:
+        return introduced, removed
+    old_files, new_files = files
+    moved_in = [f for f in introduced if f.file.lower() not in old_files]
+    moved_out = [f for f in removed if f.file.lower() not in new_files]
+    still_in, still_out = _unmatched(moved_out, moved_in, _by_name)
+    keep_in, keep_out = {id(f) for f in still_in}, {id(f) for f in still_out}
+    return ([f for f in introduced if f.file.lower() in old_files or id(f) in keep_in],
+            [f for f in removed if f.file.lower() in new_files or id(f) in keep_out])
+
+
+def relative(paths, root: str) -> set[str]:
+    """The paths relative to `root`, lower-case (the files of a backup, for :func:`findings_delta`)."""
+    return {_rel(p, root).lower() for p in paths}
 
 
 def _by_name(f: Finding) -> tuple:
@@ -234,14 +249,16 @@ def report_html(backup: str, files: int, new_findings: list[Finding], pm: Progra
                 diff: Diff | None = None, old_findings: list[Finding] | None = None,
                 old_map: ProgramMap | None = None, touched: list[Touched] | None = None,
                 runs: bool = False, max_sim_time: float | None = None,
-                new_root: str | None = None, old_root: str | None = None, links: str = "file") -> str:
+                new_root: str | None = None, old_root: str | None = None, links: str = "file",
+                file_sets: tuple[set[str], set[str]] | None = None) -> str:
     """The page (module docstring). `new_findings`: the check findings of NEW (`files` files);
     `pm` NEW's map; with `diff`: OLD's findings and map, the touched entry points (their
-    outcomes filled in when `runs`; `max_sim_time` the runs' limit, s), and the two backups'
-    roots (folders on this machine, else None) for the diff's links."""
+    outcomes filled in when `runs`; `max_sim_time` the runs' limit, s), the two backups'
+    roots (folders on this machine, else None) for the diff's links, and their files
+    (`file_sets`, :func:`relative`, for :func:`findings_delta`)."""
     if links not in LINKS:
         raise ValueError(f"links must be one of {', '.join(LINKS)}")
-    introduced, removed = findings_delta(old_findings or [], new_findings) if diff is not None else ([], [])
+    introduced, removed = findings_delta(old_findings or [], new_findings, file_sets) if diff is not None else ([], [])
     errors = sum(f.severity == "error" for f in new_findings)
     reach = _reach_changes(old_map, pm) if old_map is not None else {"dead": [], "live": []}
 

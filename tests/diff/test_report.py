@@ -7,7 +7,7 @@ from __future__ import annotations
 import shutil
 from pathlib import Path
 
-from interp.outcomes import event_kind, outcome_changes
+from interp.outcomes import _Events, _outcome, event_kind, outcome_changes
 from krl.diff.core import diff_sides
 from krl.diff.load import side
 from krl.diff.report import Finding, findings_delta, touched_entries
@@ -32,9 +32,17 @@ def test_findings_are_matched_by_file_code_message_and_line_text():
            _f("New/c.src", "'m' is not declared"),
            _f("R1/d.src", "'k' is not declared", "k = 3"),
            _f("R1/e.src", "'fresh' is not declared"), _f("R1/e.src", "'fresh' is not declared")]
-    introduced, removed = findings_delta(old, new)
+    files = ({"r1/a.src", "r1/b.src", "old/c.src", "r1/d.src", "src/e.src"},
+             {"r1/a.src", "new/c.src", "r1/d.src", "r1/e.src", "src/e.src"})
+    introduced, removed = findings_delta(old, new, files)
     assert [(f.file, f.text) for f in introduced] == [("R1/d.src", "k = 3"), ("R1/e.src", "x = 1"), ("R1/e.src", "x = 1")]
     assert [(f.file, f.text) for f in removed] == [("R1/b.src", "x = 1"), ("R1/d.src", "k = 2")]
+    # without the files, the renamed folder's finding is new and fixed
+    introduced, removed = findings_delta(old, new)
+    assert ("New/c.src", "Old/c.src") == (introduced[0].file, removed[1].file)
+    # a finding of a file both sides have (src/e.src) never pairs with another file's of that name
+    introduced, removed = findings_delta([_f("src/e.src", "'fresh' is not declared")], new[4:5], files)
+    assert [f.file for f in introduced] == ["R1/e.src"] and [f.file for f in removed] == ["src/e.src"]
 
 
 def _maps(tmp_path: Path, edit) -> tuple:
@@ -109,3 +117,12 @@ def test_motion_events_are_named_by_the_controllers_messages():
     assert event_kind("CP path through a singularity: A4 would turn 170 deg") == "singularity"
     assert event_kind("speed limit exceeded A1: CP path through a singularity") == "singularity"
     assert event_kind("first motion must be PTP") == "motion"
+
+
+def test_a_motion_refused_in_the_advance_run_is_the_runs_motion_event():
+    # kukaKRLmagic's sample_program (history pair 01-53e3f517, old side): the planner refuses
+    # line 81's target before any main-run motion error is written; the run ends with it
+    o = _outcome("p.src", "error", "software limit switch +A3 (the target itself: ...)", "p.src", 81, 0.0, _Events(), "")
+    assert o["counts"] == {"limit": 1} and o["events"][0]["line"] == 81
+    # an error that is no motion's is not a motion event
+    assert _outcome("p.src", "error", "unknown name P_Button", "p.src", 46, 0.0, _Events(), "")["counts"] == {}
