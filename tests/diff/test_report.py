@@ -7,7 +7,8 @@ from __future__ import annotations
 import shutil
 from pathlib import Path
 
-from interp.outcomes import _Events, _outcome, event_kind, outcome_changes
+from interp.outcomes import _Events, event_kind, outcome_changes
+from interp.outcomes import _outcome as outcome_of
 from krl.diff.core import diff_sides
 from krl.diff.load import side
 from krl.diff.report import Finding, findings_delta, touched_entries
@@ -122,7 +123,7 @@ def test_motion_events_are_named_by_the_controllers_messages():
 def test_a_motion_refused_in_the_advance_run_is_the_runs_motion_event():
     # kukaKRLmagic's sample_program (history pair 01-53e3f517, old side): the planner refuses
     # line 81's target before any main-run motion error is written; the run ends with it
-    o = _outcome("p.src", "error", "software limit switch +A3 (the target itself: ...)", "p.src", 81, 0.0, _Events(), "")
+    o = outcome_of("p.src", "error", "software limit switch +A3 (the target itself: ...)", "p.src", 81, 0.0, _Events(), "")
     assert o["counts"] == {"limit": 1} and o["events"][0]["line"] == 81
     # an error that is no motion's is not a motion event
-    assert _outcome("p.src", "error", "unknown name P_Button", "p.src", 46, 0.0, _Events(), "")["counts"] == {}
+    assert outcome_of("p.src", "error", "unknown name P_Button", "p.src", 46, 0.0, _Events(), "")["counts"] == {}
