@@ -48,13 +48,10 @@ from .trace import TraceWriter
 
 def _compiled_module() -> Any:
     """The compiled module robot/simcore.pyx when it is built, current and switched on
-    (robot/kinematics.py ``USE_COMPILED``), else None."""
-    from . import kinematics  # noqa: PLC0415  (the module's one switch and ABI check)
+    (robot/kinematics ``compiled_module``: ``USE_COMPILED``), else None."""
+    from .kinematics import compiled_module  # noqa: PLC0415  (the package's one switch and ABI check)
 
-    sc = kinematics._simcore
-    if sc is None or not kinematics.USE_COMPILED or getattr(sc, "ABI", None) != kinematics.SIMCORE_ABI:
-        return None
-    return sc
+    return compiled_module()
 
 EPS = 1e-9
 _F8 = np.dtype(np.float64)

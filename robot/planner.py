@@ -753,9 +753,8 @@ class CartSegment(Segment):
         axes, ``$ORI_TYPE #JOINT``)."""
         if self._c_path is None:
             self._c_path = False
-            sc = kinematics._simcore
-            if (sc is not None and kinematics.USE_COMPILED and getattr(sc, "ABI", None) == kinematics.SIMCORE_ABI
-                    and len(self.q0) == 6 and not self.joint_ori):
+            sc = kinematics.compiled_module()
+            if sc is not None and len(self.q0) == 6 and self.model.kin.n_axes == 6 and not self.joint_ori:
                 self._c_path = _cart_path(sc, self) or False
         return self._c_path
 
@@ -770,9 +769,9 @@ class CartSegment(Segment):
         """The compiled inverse for :meth:`ik`'s poses as they stand, or False."""
         m = self.model
         if (type(m) is not RobotModel or m.n_ext or not m._robroot_is_null or self._ik_tool is not None
-                or self._ik_base is not None or m.kin._base_inv is not None or m.kin._end_inv is not None):
+                or self._ik_base is not None):
             return False
-        return m.kin._compiled()
+        return m.kin.compiled_core()
 
     def ik_chain(self, poses: list[tuple[np.ndarray, np.ndarray]], ref: np.ndarray) -> np.ndarray | None:
         """:meth:`ik` of each pose with the previous solution as reference (the first: `ref`),

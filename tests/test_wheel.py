@@ -67,7 +67,7 @@ def test_wheel_ships_the_generated_parser_and_the_data(wheel):
     ext = "interp/vm/loop" + sysconfig.get_config_var("EXT_SUFFIX")
     assert ext in names and "interp/vm/loop.py" in names
     # and the simulator's compiled hot path (robot/build.py), beside the Python code it mirrors
-    assert "robot/simcore" + sysconfig.get_config_var("EXT_SUFFIX") in names and "robot/kinematics.py" in names
+    assert "robot/simcore" + sysconfig.get_config_var("EXT_SUFFIX") in names and "robot/kinematics/__init__.py" in names
 
 
 def test_installed_wheel_checks_a_backup_without_java(wheel, tmp_path):

@@ -41,7 +41,7 @@ def test_the_compiled_inverse_is_built_and_used():
     assert kinematics._simcore is not None and kinematics._simcore.ABI == kinematics.SIMCORE_ABI
     k = Kinematics()
     k.inverse(k.forward([10, -80, 100, 20, 30, 40]))
-    assert k._c_opw
+    assert k.impl._c_opw
 
 
 def _answer(k: Kinematics, T, status, turn, ref):
@@ -63,7 +63,7 @@ def _agree(machine, seed: int) -> None:
     if kinematics._simcore is None:
         pytest.skip("not compiled: only the Python inverse runs")
     compiled, python = Kinematics(machine), Kinematics(machine)
-    python._c_opw = False
+    python.impl._c_opw = False
     rng = np.random.default_rng(seed)
     lo, hi = np.maximum(compiled._lo, -185.0), np.minimum(compiled._hi, 185.0)
     solved = failed = 0
@@ -85,7 +85,7 @@ def _agree(machine, seed: int) -> None:
         a, b = _answer(compiled, T, status, turn, ref), _answer(python, T, status, turn, ref)
         assert a == b, (q.tolist(), ref.tolist(), status, turn)
         # the entry of robot/planner.py CartSegment.ik: rotation and position apart
-        rp = compiled._compiled().inverse_rp(T[:3, :3], T[:3, 3], status, turn, ref)
+        rp = compiled.impl.compiled().inverse_rp(T[:3, :3], T[:3, 3], status, turn, ref)
         assert (rp.tobytes() if rp is not None else None) == (a if isinstance(a, bytes) else None)
         solved += isinstance(a, bytes)
         failed += not isinstance(a, bytes)
@@ -335,13 +335,13 @@ def test_the_compiled_forward_is_the_python_forward_bit_for_bit(shared_corpus):
     kins = [Kinematics(load_mada(p)) for p in library_robots().values() if p.suffix == ".dat"]
     kins += [Kinematics(), Kinematics(load_robot(str(shared_corpus / "HugoDanielson__ChinaMilling")))]
     rot = Kinematics()
-    rot._R_origin = Rotation.from_euler("xyz", np.random.default_rng(3).normal(size=(6, 3))).as_matrix()
-    rot._origin_rot = True
+    rot.joints.R_origin = Rotation.from_euler("xyz", np.random.default_rng(3).normal(size=(6, 3))).as_matrix()
+    rot.joints.origin_rot = True
     kins.append(rot)
     rng = np.random.default_rng(47)
     T = np.empty((4, 4))
     for k in kins:
-        c = k._compiled_forward()
+        c = k.joints._compiled()
         assert c, k.machine.name
         for i in range(1500):
             a = rng.uniform(k._lo, k._hi)
@@ -352,8 +352,8 @@ def test_the_compiled_forward_is_the_python_forward_bit_for_bit(shared_corpus):
             if i % 11 == 0:
                 a *= 1e-5                                # the small-angle series of from_rotvec
             c.forward(a, T)
-            assert T.tobytes() == k._forward_py(a).tobytes(), (k.machine.name, a.tolist())
-    assert kins[-1].forward(np.zeros(6)).tobytes() == rot._forward_py(np.zeros(6)).tobytes()
+            assert T.tobytes() == k.joints.forward_py(a).tobytes(), (k.machine.name, a.tolist())
+    assert kins[-1].forward(np.zeros(6)).tobytes() == rot.joints.forward_py(np.zeros(6)).tobytes()
 
 
 def test_the_compiled_palletizer_rows_are_the_pythons():
@@ -370,8 +370,8 @@ def test_the_compiled_palletizer_rows_are_the_pythons():
 
     m = load_mada(ROBOT_LIBRARY / "kr180_r3200_pa.dat")
     compiled, python = Kinematics(m), Kinematics(m)
-    python._c_pal = False
-    assert compiled._c_pal
+    python.impl._c_pal = False
+    assert compiled.impl._c_pal
     home = compiled._home
     rng = np.random.default_rng(48)
     found = empty = 0
@@ -385,10 +385,10 @@ def test_the_compiled_palletizer_rows_are_the_pythons():
         if rng.random() < 0.2:
             T[:3, 3] += rng.normal(size=3) * 300.0
         ref = None if rng.random() < 0.2 else rng.uniform(compiled._lo, compiled._hi)
-        a, b = compiled._palletizer_rows(T, ref), python._palletizer_rows(T, ref)
+        a, b = compiled.impl.solutions(T, ref), python.impl.solutions(T, ref)
         assert len(a) == len(b) and np.array(a).tobytes() == np.array(b).tobytes(), (q.tolist(), ref)
         found += bool(a)
         empty += not a
         for row in a:                                 # the compiled flange test: within 1e-6 mm
-            assert np.abs(compiled._c_pal.flange_position(np.array(row)) - T[:3, 3]).max() < 1e-6
+            assert np.abs(compiled.impl._c_pal.flange_position(np.array(row)) - T[:3, 3]).max() < 1e-6
     assert found > 2000 and empty > 20
