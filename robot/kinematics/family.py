@@ -50,12 +50,16 @@ class KinematicFamily(ABC):
             soft limits, HOME).
         s_free, t_free: the S and T bits that select nothing on this robot (its status has no
             such configuration, or the axis cannot choose its sign).
+        reduced_orientation: True when the robot reaches only part of an orientation (its
+            inverse drops the component it has no axis for: a palletizer's, a SCARA's tilt);
+            robot/blending.py then overlaps the poses the robot reaches.
     """
 
     name: ClassVar[str] = ""
     title: ClassVar[str] = ""
     s_free = 0
     t_free = 0
+    reduced_orientation = False
 
     def __init__(self, kin: Any, found: Any = None) -> None:
         self.kin = kin

@@ -37,6 +37,7 @@ class Palletizer4(KinematicFamily):
     name = "palletizer4"
     title = "analytic (4-axis palletizer: $DEF_A4FIX, A5 led by the parallelogram)"
     s_free = 4
+    reduced_orientation = True
     t_free = 0b11000
 
     def __init__(self, kin: Any, found: Any = None) -> None:

@@ -58,6 +58,7 @@ class Palletizer5(KinematicFamily):
     name = "palletizer5"
     title = "analytic (5-axis palletizer: $DEF_A4FIX)"
     s_free = 4
+    reduced_orientation = True
     t_free = 0b01000
 
     def __init__(self, kin: Any, found: Any = None) -> None:
