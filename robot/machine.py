@@ -252,6 +252,9 @@ class MachineData:
     #: external axes E1..E6 (``$EX_AX_NUM``) and external kinematic systems (``$EX_KIN``)
     external_axes: tuple[ExternalAxis, ...] = ()
     external_kinematics: tuple[ExternalKinematic, ...] = ()
+    #: ``$MAIN_AXIS``: the main axes' kind (``#NR`` articulated arm, ``#CC`` SCARA, ``#SS``
+    #: gantry; KR C2 machine-data handbook §2.1.145); ``#NR`` for the yaml robot
+    main_axis: str = "#NR"
 
     @property
     def n_axes(self) -> int:

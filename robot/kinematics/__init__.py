@@ -36,6 +36,7 @@ import numpy as np
 from ..errors import SoftLimitError
 from ..frames import as_matrix, inv_pos, matrix_to_frame
 from ..machine import MachineData, load_machine
+from ..madavalues import MachineDataError
 from .constants import BOUNDARY_EPS, LIMIT_EPS_DEG, OVERHEAD_SINGULAR_MM, WRIST_SINGULAR_DEG
 
 try:  # the compiled hot path (robot/build.py); absent without a build: the Python code runs
@@ -114,8 +115,6 @@ class Kinematics:
                 self.impl = fam(self, found)
                 self.impl.check(m.provenance.get("$DEF_A4FIX", m.source))
                 return
-        from ..mada import MachineDataError  # noqa: PLC0415  (costs 0.9 s: robot/mada.py loads the KRL front end)
-
         raise MachineDataError(f"{m.source or m.name}: no kinematic family of robot/kinematics/families.py "
                                f"takes this robot ({self.n_axes} axes)")
 

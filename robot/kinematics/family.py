@@ -7,6 +7,9 @@ data's chain (:func:`check_closed_form`).
 A family's operations (mm, deg; 4x4 frames; n = the robot's axis count,
 ``len(machine.joints)``):
 
+* ``geometry(values, source, prov, a4fix, a5link)`` (classmethod): the kinematic chain the
+  machine data's variables describe (:class:`Geometry`), or None when they describe main axes
+  the family does not build; robot/mada.py builds the model's joints from the first answer;
 * ``detect(kin)`` (classmethod): whether the robot of ``kin.machine`` (its machine data) and
   ``kin.joints`` (its joints, robot/kinematics/joints.py) is of this family: None if not, else
   what the family found (handed to its constructor as `found`);
@@ -28,16 +31,38 @@ from __future__ import annotations
 
 import math
 from abc import ABC, abstractmethod
-from typing import Any, ClassVar
+from typing import Any, ClassVar, NamedTuple
 
 import numpy as np
 
 from ..chain import chain_forward
 from ..errors import SoftLimitError, WorkspaceError
+from ..madavalues import MachineDataError
 from .constants import LIMIT_EPS_DEG
 
 #: The operations of the protocol (tests/robot/test_families.py checks each registered family).
-OPERATIONS = ("detect", "forward", "forward_many", "solutions", "status_turn", "inverse", "inverse_many")
+OPERATIONS = ("geometry", "detect", "forward", "forward_many", "solutions", "status_turn", "inverse",
+              "inverse_many")
+
+
+class Geometry(NamedTuple):
+    """A robot's kinematic chain as its machine data define it (a family's ``geometry``; robot/
+    mada.py builds the joints and the rest of the model from it).
+
+    Attributes:
+        chain: robot/chain.py ``Chain``: the fixed frames, joint axes and kinds (n axes).
+        opw: the OPW parameters of the standard arm (robot/machine.py ``OPWParams``), None for a
+            robot without that arm.
+        status_phi_deg: the switching angle of the arm's S bit 1 (deg), 0 without one.
+        reach_mm: the reach to the wrist point (mm).
+        a5link: the palletizer's led A5 (``$DEF_A5LINK``, or ``$NUM_AX=4`` with ``$DEF_A4FIX``).
+    """
+
+    chain: Any
+    opw: Any
+    status_phi_deg: float
+    reach_mm: float
+    a5link: bool = False
 
 
 class KinematicFamily(ABC):
@@ -63,6 +88,15 @@ class KinematicFamily(ABC):
 
     def __init__(self, kin: Any, found: Any = None) -> None:
         self.kin = kin
+
+    @classmethod
+    @abstractmethod
+    def geometry(cls, values: dict[str, Any], source: str, prov: dict[str, str], a4fix: bool,
+                 a5link: bool) -> Geometry | None:
+        """The robot's :class:`Geometry` from its machine data values (robot/datalist.py
+        ``DataValue`` by name; robot/mada.py hands them with the palletizer flags), entering
+        each value's file:line in `prov`; None when the machine data describe main axes this
+        family does not build (``$MAIN_AXIS``). Raises robot.madavalues.MachineDataError."""
 
     @classmethod
     @abstractmethod
@@ -253,8 +287,6 @@ def check_closed_form(kin: Any, rows, where: str, message: str, link=None) -> No
     configurations of the machine-data chain within 1e-6: A4 = 0, and `link(q)` sets the axes
     the arm's linkage leads. Also raises when the chain of the machine data does not close on
     the joints' forward kinematics."""
-    from ..mada import MachineDataError  # noqa: PLC0415  (costs 0.9 s: robot/mada.py loads the KRL front end)
-
     rng = np.random.default_rng(0)
     lo = np.maximum(kin._lo, -170.0)
     hi = np.minimum(kin._hi, 170.0)
@@ -270,4 +302,4 @@ def check_closed_form(kin: Any, rows, where: str, message: str, link=None) -> No
             raise MachineDataError(f"{where}: {message}")
 
 
-__all__ = ["KinematicFamily", "OPERATIONS", "check_closed_form", "inverse_rows", "inverse_rows_many", "select"]
+__all__ = ["Geometry", "KinematicFamily", "OPERATIONS", "check_closed_form", "inverse_rows", "inverse_rows_many", "select"]

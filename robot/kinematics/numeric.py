@@ -122,6 +122,7 @@ class Numeric(KinematicFamily):
     def detect(cls, kin: Any) -> Any:
         return True if six_rotary(kin.machine) else None
 
+    geometry = OPW.geometry
     forward = OPW.forward
     forward_many = OPW.forward_many
     status_turn = OPW.status_turn

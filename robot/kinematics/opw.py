@@ -27,6 +27,7 @@ import numpy as np
 from ..chain import chain_forward, opw_form
 from ..errors import SoftLimitError, WorkspaceError
 from .constants import BOUNDARY_EPS
+from .arm import arm_geometry
 from .family import KinematicFamily, inverse_rows, select
 from .opwsolver import OPWSolver
 
@@ -59,6 +60,12 @@ class OPW(KinematicFamily):
         self.base_inv = found.base_inv
         self.end_inv = found.end_inv
         self._c_opw: Any = None     # robot/simcore.pyx's OPW for this robot; False: not used
+
+    @classmethod
+    def geometry(cls, values: dict[str, Any], source: str, prov: dict[str, str], a4fix: bool,
+                 a5link: bool) -> Any:
+        """The arm's chain (robot/kinematics/arm.py), the one every arm family reads."""
+        return arm_geometry(values, source, prov, a4fix, a5link)
 
     @classmethod
     def detect(cls, kin: Any) -> OpwFound | None:

@@ -70,6 +70,7 @@ class Palletizer4(KinematicFamily):
             f"$DEF_A4FIX=TRUE, A5 led ({led}): this palletizer's arm ($TIRORO, $TX3P3, $DH_4, $DH_5, "
             f"$TFLWP) is not one the 4-axis closed form covers", link=link)
 
+    geometry = OPW.geometry
     forward = OPW.forward
     forward_many = OPW.forward_many
     status_turn = OPW.status_turn

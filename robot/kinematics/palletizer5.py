@@ -79,6 +79,7 @@ class Palletizer5(KinematicFamily):
         m = kin.machine
         return True if m.a4fix and not m.a5link else None
 
+    geometry = OPW.geometry
     forward = OPW.forward
     forward_many = OPW.forward_many
     status_turn = OPW.status_turn
