@@ -126,6 +126,14 @@ def build_mjcf(machine: MachineData | None = None, actuated: bool = False, *,
             lines.append(f'{indent}<geom name="link_{i + 1}_geom" type="capsule" size="{_f(radius)}" fromto="0 0 0 {_vec(nxt)}"/>')
         else:
             lines.append(f'{indent}<geom name="link_{i + 1}_geom" type="sphere" size="{_f(radius)}"/>')
+        if linear:
+            # the moving shaft (a SCARA's quill): from the flange point up along the axis, as long
+            # as the travel (the flange point: the joint origins after this one and the flange)
+            bottom = (np.sum([np.array(jj.origin_mm) for jj in joints[i + 1:]], axis=0) + np.array(m.flange_pos_mm)) / 1000.0
+            ax = np.array(j.joint_axis, dtype=float)
+            top = bottom - ax * ((j.limit_deg[1] - j.limit_deg[0]) / 1000.0 + float(np.linalg.norm(bottom)))
+            lines.append(f'{indent}<geom name="link_{i + 1}_shaft" type="capsule" size="0.02" '
+                         f'fromto="{_vec(bottom)} {_vec(top)}" rgba="0.7 0.7 0.7 1"/>')
     # KUKA flange frame (URDF tool0) on the last link
     fpos = np.array(m.flange_pos_mm) / 1000.0
     lines.append(f'{indent}<site name="tool0" pos="{_vec(fpos)}" quat="{_vec(m.flange_quat_wxyz)}" size="0.01" rgba="0 1 0 1"/>')

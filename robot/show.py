@@ -11,7 +11,7 @@ from .kinematics import Kinematics
 from .machine import MachineData
 
 #: Parameters shown with their source, in this order (those the model has).
-_PARAMS = ("$TRAFONAME", "$KINCLASS", "$NUM_AX", "$TIRORO", "$LENGTH_A", "$LENGTH_B", "$TX3P3", "$DH_4",
+_PARAMS = ("$TRAFONAME", "$KINCLASS", "$MAIN_AXIS", "$NUM_AX", "$AXIS_SEQ", "$TIRORO", "$LENGTH_A", "$LENGTH_B", "$TX3P3", "$DH_4",
            "$DH_5", "$TFLWP", "$AXIS_DIR", "$SOFTN_END", "$SOFTP_END", "$VEL_AXIS_MA", "$RAT_MOT_AX",
            "$RAISE_TIME", "$AXIS_JERK", "$VEL_MA", "$ACC_MA", "$ACC_OV", "$ROBROOT", "$DEF_A4FIX",
            "$DEF_A5LINK", "a5_led", "$AXIS_HOME[1]", "$H_POS", "home_deg", "$MAMES", "$IN_POS_CAR", "$IN_POS_ORI",

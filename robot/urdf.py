@@ -46,7 +46,7 @@ def build_urdf(machine: MachineData) -> str:
     ET.SubElement(el, "parent", link="base_link")
     ET.SubElement(el, "child", link="base")
     ET.SubElement(el, "origin", xyz="0 0 0", rpy="0 0 0")
-    el = ET.SubElement(robot, "joint", name="link_6-tool0", type="fixed")
+    el = ET.SubElement(robot, "joint", name=f"{machine.joints[-1].child}-tool0", type="fixed")
     ET.SubElement(el, "parent", link=machine.joints[-1].child)
     ET.SubElement(el, "child", link="tool0")
     ET.SubElement(el, "origin", xyz=_v(v / 1000.0 for v in machine.flange_pos_mm),

@@ -91,6 +91,11 @@ class Kinematics:
         self._lo_l = [float(v) - LIMIT_EPS_DEG for v in self._lo]
         self._hi_l = [float(v) + LIMIT_EPS_DEG for v in self._hi]
         self._ks_l = [float(v) for v in self._ks]
+        # per axis the ±360° variants select() tries (a linear axis has none: itself) and
+        # the same as (n, 5) rows (inf where a linear axis has no variant)
+        self._ks_axes = [(0.0,) if lin else self._ks_l for lin in self.joints.linear]
+        self._ks_rows = np.where(self.joints.linear[:, None] & (self._ks[None, :] != 0.0), np.inf,
+                                 self._ks[None, :] + np.zeros((self.n_axes, 1)))
         #: FLANGE of recent forward() axes, by their bytes (a robot at rest asks for the same axes
         #: every IPO cycle; a program's cycle plans the same points again); at most FK_MEMO
         self._fk_memo: dict[bytes, np.ndarray] = {}

@@ -189,6 +189,7 @@ def select(fam: KinematicFamily, rows: list[list[float]], status: int | None, tu
     n = kin.n_axes
     ref_l = ref.tolist()
     lo, hi = kin._lo_l, kin._hi_l
+    ks = kin._ks_axes
     t_free = fam.t_free
     if turn is not None:
         turn = int(turn) & ~t_free
@@ -199,7 +200,7 @@ def select(fam: KinematicFamily, rows: list[list[float]], status: int | None, tu
         q: list[float] = []
         for i in range(n):
             best_c, best_d = None, math.inf
-            for kk in kin._ks_l:
+            for kk in ks[i]:
                 c = b[i] + kk
                 if c < lo[i] or c > hi[i]:
                     continue
@@ -233,7 +234,7 @@ def _limit_error(kin: Any, matching: np.ndarray, turn: int | None, t_free: int, 
     best_ok: tuple[float, np.ndarray] | None = None
     best_bad: tuple[float, np.ndarray, int] | None = None
     for b in matching:
-        cands = b[:, None] + kin._ks[None, :]  # (n, 5): the ±360° variants per axis
+        cands = b[:, None] + kin._ks_rows  # (n, 5): the ±360° variants per axis (a linear one: itself)
         ok = np.ones(cands.shape, dtype=bool)
         if turn is not None:
             ok = ((cands < 0) == neg) | (np.abs(cands) < 1e-6) | free
@@ -281,17 +282,20 @@ def inverse_rows_many(self: KinematicFamily, Ts: np.ndarray, status: int | None,
     return inverse_rows(self, Ts, status, turn, refs, range(Ts.shape[0]))
 
 
-def check_closed_form(kin: Any, rows, where: str, message: str, link=None) -> None:
-    """Raise robot.mada.MachineDataError (``"{where}: {message}"``) unless the closed form
+def check_closed_form(kin: Any, rows, where: str, message: str, link=None, sample=None) -> None:
+    """Raise robot.madavalues.MachineDataError (``"{where}: {message}"``) unless the closed form
     ``rows(T, q)`` (a list of axis rows for the flange pose T, 4x4, mm) gives back four random
-    configurations of the machine-data chain within 1e-6: A4 = 0, and `link(q)` sets the axes
-    the arm's linkage leads. Also raises when the chain of the machine data does not close on
-    the joints' forward kinematics."""
+    configurations of the machine-data chain within 1e-6: by default six axes within the soft
+    limits with A4 = 0 (a palletizer's), `sample(kin, rng)` draws them otherwise; `link(q)` sets
+    the axes the arm's linkage leads. Also raises when the chain of the machine data does not
+    close on the joints' forward kinematics."""
     rng = np.random.default_rng(0)
     lo = np.maximum(kin._lo, -170.0)
     hi = np.minimum(kin._hi, 170.0)
-    for q in rng.uniform(lo, hi, size=(4, 6)):
-        q[3] = 0.0
+    draws = [sample(kin, rng) for _ in range(4)] if sample is not None else rng.uniform(lo, hi, size=(4, 6))
+    for q in draws:
+        if sample is None:
+            q[3] = 0.0
         if link is not None:
             link(q)
         T = kin.forward(q)

@@ -333,6 +333,7 @@ def test_the_compiled_forward_is_the_python_forward_bit_for_bit(shared_corpus):
     if not numpy_cblas("dgemm") or not numpy_cblas("dgemv"):
         pytest.skip("numpy without its bundled OpenBLAS: numpy multiplies")
     kins = [Kinematics(load_mada(p)) for p in library_robots().values() if p.suffix == ".dat"]
+    kins = [k for k in kins if k.n_axes == 6]         # the compiled product is of six rotary joints
     kins += [Kinematics(), Kinematics(load_robot(str(shared_corpus / "HugoDanielson__ChinaMilling")))]
     rot = Kinematics()
     rot.joints.R_origin = Rotation.from_euler("xyz", np.random.default_rng(3).normal(size=(6, 3))).as_matrix()
