@@ -17,9 +17,10 @@ from .numeric import Numeric
 from .opw import OPW
 from .palletizer4 import Palletizer4
 from .palletizer5 import Palletizer5
+from .scara import Scara
 
 #: The families, most specific first; the numeric family takes any six-axis arm the others do not.
-FAMILIES = (Palletizer4, Palletizer5, OPW, Numeric)
+FAMILIES = (Palletizer4, Palletizer5, Scara, OPW, Numeric)
 
 
 def machine_geometry(values: dict[str, Any], source: str, prov: dict[str, str], a4fix: bool,
