@@ -78,6 +78,8 @@ class KinematicFamily(ABC):
         reduced_orientation: True when the robot reaches only part of an orientation (its
             inverse drops the component it has no axis for: a palletizer's, a SCARA's tilt);
             robot/blending.py then overlaps the poses the robot reaches.
+        solves_chains: True when :meth:`inverse_chain` solves chains of poses at once (the
+            planner then plans a CP path's samples in numpy, robot/planner.py ``batch_ik``).
     """
 
     name: ClassVar[str] = ""
@@ -85,6 +87,7 @@ class KinematicFamily(ABC):
     s_free = 0
     t_free = 0
     reduced_orientation = False
+    solves_chains = False
 
     def __init__(self, kin: Any, found: Any = None) -> None:
         self.kin = kin

@@ -53,6 +53,7 @@ class OPW(KinematicFamily):
 
     name = "opw"
     title = "analytic (OPW: six axes, spherical wrist)"
+    solves_chains = True
 
     def __init__(self, kin: Any, found: OpwFound) -> None:
         super().__init__(kin, found)
