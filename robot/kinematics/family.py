@@ -38,6 +38,7 @@ import numpy as np
 from ..chain import chain_forward
 from ..errors import SoftLimitError, WorkspaceError
 from ..madavalues import MachineDataError
+from . import fastpath_module
 from .constants import LIMIT_EPS_DEG
 
 #: The operations of the protocol (tests/robot/test_families.py checks each registered family).
@@ -156,6 +157,16 @@ class KinematicFamily(ABC):
         """Lines ``krl robot show`` prints about the solver (after the family's title)."""
         return []
 
+    def chooser(self) -> Any:
+        """robot/kinematics/fastpath.py's ``Chooser`` for this robot's limits and this family's
+        free turn bits (made once)."""
+        c = self.__dict__.get("_chooser")
+        if c is None:
+            k = self.kin
+            c = self._chooser = fastpath_module().Chooser(k.n_axes, k._lo_l, k._hi_l, k._ks_l,
+                                                          [bool(v) for v in k.joints.linear], self.t_free)
+        return c
+
 
 def select(fam: KinematicFamily, rows: list[list[float]], status: int | None, turn: int | None,
            ref: np.ndarray) -> np.ndarray:
@@ -188,41 +199,14 @@ def select(fam: KinematicFamily, rows: list[list[float]], status: int | None, tu
     if not matching_rows:
         raise WorkspaceError(f"workspace error: target not reachable with status S={s_target}")
     # per solution and axis the ±360° variant within the limits (and the turn) nearest to
-    # the reference, then the solution with the least axis motion (the first of equals)
-    n = kin.n_axes
-    ref_l = ref.tolist()
-    lo, hi = kin._lo_l, kin._hi_l
-    ks = kin._ks_axes
+    # the reference, then the solution with the least axis motion (the first of equals):
+    # robot/kinematics/fastpath.py's Chooser (compiled when built)
+    q = fam.chooser().choose(matching_rows, ref.tolist(), turn)
+    if q is not None:
+        return np.array(q)
     t_free = fam.t_free
     if turn is not None:
         turn = int(turn) & ~t_free
-    negs = [(int(turn) >> i) & 1 == 1 for i in range(n)] if turn is not None else None
-    free_t = [(t_free >> i) & 1 == 1 for i in range(n)]
-    best: tuple[float, list[float]] | None = None
-    for b in matching_rows:
-        q: list[float] = []
-        for i in range(n):
-            best_c, best_d = None, math.inf
-            for kk in ks[i]:
-                c = b[i] + kk
-                if c < lo[i] or c > hi[i]:
-                    continue
-                if negs is not None and not ((c < 0) == negs[i] or abs(c) < 1e-6 or free_t[i]):
-                    continue
-                d = abs(c - ref_l[i])
-                if d < best_d:
-                    best_c, best_d = c, d
-            if best_c is None:
-                break
-            q.append(best_c)
-        else:
-            cost = 0.0
-            for i in range(n):
-                cost += abs(q[i] - ref_l[i])
-            if best is None or cost < best[0]:
-                best = (cost, q)
-    if best is not None:
-        return np.array(best[1])
     return _limit_error(kin, np.array(matching_rows), turn, t_free, ref)
 
 

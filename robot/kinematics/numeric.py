@@ -115,7 +115,7 @@ class Numeric(KinematicFamily):
     def __init__(self, kin: Any, found: Any = None) -> None:
         super().__init__(kin, found)
         m = kin.machine
-        self.solver = OPWSolver(replace(m.opw), float(m.status_phi_deg))
+        self.solver = OPWSolver(replace(m.opw), float(m.status_phi_deg), kin, self.s_free, self.t_free)
         self._ik: NumericIK | None = None
 
     @classmethod

@@ -57,10 +57,9 @@ class OPW(KinematicFamily):
 
     def __init__(self, kin: Any, found: OpwFound) -> None:
         super().__init__(kin, found)
-        self.solver = OPWSolver(found.params, found.phi_deg)
+        self.solver = OPWSolver(found.params, found.phi_deg, kin, self.s_free, self.t_free)
         self.base_inv = found.base_inv
         self.end_inv = found.end_inv
-        self._c_opw: Any = None     # robot/simcore.pyx's OPW for this robot; False: not used
 
     @classmethod
     def geometry(cls, values: dict[str, Any], source: str, prov: dict[str, str], a4fix: bool,
@@ -120,7 +119,7 @@ class OPW(KinematicFamily):
         return s, t
 
     def status_row(self, q: list[float]) -> tuple[int, int]:
-        return self.solver.status_row(q, self.s_free)
+        return self.solver.status_row(q)
 
     def wrist_point_x(self, q) -> float:
         return self.solver.wrist_point_x(q)
@@ -144,22 +143,16 @@ class OPW(KinematicFamily):
                 ref: np.ndarray | None) -> np.ndarray:
         if ref is None:
             ref = self.kin._home.copy()
-        c = self._c_opw
-        if c is None:
-            c = self.compiled()
-        if c:
-            # the compiled mirror of solutions + select (robot/simcore.pyx); None: Python decides
-            q = c.inverse(self._in_arm(flange_T), status, turn, ref)
-            if q is not None:
-                return q
+        # robot/kinematics/fastpath.py (compiled when built): the rows, those with the status,
+        # the choice; None where it raises: select() gives the error
+        q = self.solver.c.inverse(self._in_arm(flange_T), status, turn, ref)
+        if q is not None:
+            return q
         return select(self, self.solutions(flange_T, ref), status, turn, ref)
 
     def compiled(self) -> Any:
-        """The compiled OPW inverse of this robot (kept), or False (not built)."""
-        if self._c_opw is None:
-            k = self.kin
-            self._c_opw = self.solver.compiled(k._lo_l, k._hi_l, k._ks_l, self.s_free, self.t_free)
-        return self._c_opw
+        """The compiled fastpath's OPWCore of this robot, or False (not built)."""
+        return self.solver.c if self.solver.compiled else False
 
     def compiled_core(self) -> Any:
         if self.base_inv is not None or self.end_inv is not None:

@@ -1,7 +1,10 @@
 """The OPW closed form of an ortho-parallel arm with a spherical wrist (Brandstötter, Angerer,
 Hofbaur 2014; robot-model.md §4.2) and the arm's status S (robot-model.md §8): the solver the
 six-axis family uses for its inverse, the palletizers for their arm (``c4 = 0``: the A5 point)
-and the numeric family for its seeds and its status.
+and the numeric family for its seeds and its status. One pose at a time it is
+robot/kinematics/fastpath.py (compiled when built); :meth:`OPWSolver.core_many` and
+:meth:`OPWSolver.status_many` are the same formulas over N poses in numpy (the OPW family's
+inverse of many, bit for bit the scalar rows: tests/robot/test_inverse_many.py).
 
 Units: mm and degrees; poses are 4x4 flange frames (mm). The solutions are the KUKA axes
 ``q = wrap180(degrees((th + offset) * sign))`` of OPW's joint angles ``th``.
@@ -15,30 +18,36 @@ from typing import Any
 
 import numpy as np
 
-from . import compiled_module
+from . import _fastpath, fastpath_compiled, fastpath_module
 from .constants import ACOS_TOL, BOUNDARY_EPS, OVERHEAD_SINGULAR_MM, WRIST_SINGULAR_DEG
 
 
 class OPWSolver:
-    """The OPW solution of one arm: :class:`~robot.machine.OPWParams` `o` and the status
-    switching angle `phi_deg` (A3 where the wrist point is on the line A2-A3)."""
+    """The OPW solution of one arm: :class:`~robot.machine.OPWParams` `o`, the status switching
+    angle `phi_deg` (A3 where the wrist point is on the line A2-A3), for the robot of `kin` (its
+    soft limits) with the S and T bits `s_free`, `t_free` that select nothing on it. The scalar
+    work is robot/kinematics/fastpath.py's ``OPWCore`` (:attr:`c`, compiled when it is built)."""
 
-    def __init__(self, o: Any, phi_deg: float) -> None:
+    def __init__(self, o: Any, phi_deg: float, kin: Any, s_free: int = 0, t_free: int = 0) -> None:
         self.phi_deg = float(phi_deg)
-        self.set(o)
-
-    def set(self, o: Any) -> None:
-        """Use the parameters `o` (:class:`~robot.machine.OPWParams`, mm)."""
         self.o = o
         self.sign = np.array(o.sign_corrections, dtype=float)
         self.off = np.radians(np.array(o.offsets_deg, dtype=float))
-        # per-robot constants of the solution and of the status test (hot loop: plain floats)
+        # per-robot constants of the vectorised solution and status (core_many, status_many)
         self.kappa_2 = o.a2 * o.a2 + o.c3 * o.c3
         self.c2_2 = o.c2 * o.c2
         self.k = math.sqrt(self.kappa_2)
         self.at23 = math.atan2(o.a2, o.c3)
         self.sgn = [float(v) for v in self.sign]
         self.offs = [float(v) for v in self.off]
+        #: the scalar solver: robot/kinematics/fastpath.py's OPWCore (compiled when built)
+        self.c = fastpath_module().OPWCore(o, self.phi_deg, self.sgn, self.offs, kin._lo_l, kin._hi_l,
+                                           kin._ks_l, s_free, t_free)
+
+    @property
+    def compiled(self) -> bool:
+        """True when :attr:`c` is the compiled fastpath's."""
+        return fastpath_compiled() and isinstance(self.c, _fastpath.OPWCore)
 
     # ------------------------------------------------------------------ S
     def wrist_point_x(self, axes_deg: Sequence[float]) -> float:
@@ -62,22 +71,16 @@ class OPWSolver:
             s |= 4
         return s
 
-    def status_row(self, q: list[float], s_free: int) -> tuple[int, int]:
-        """S of one axis configuration (list of 6 floats, deg) and the mask of its S bits that
-        sit on their switching point (wrist point on the A1 axis, A3 = phi, A5 = 0), or that
-        select nothing on this robot (`s_free`)."""
-        o = self.o
-        t2 = math.radians(self.sgn[1] * q[1]) - self.offs[1]
-        t23 = t2 + math.radians(self.sgn[2] * q[2]) - self.offs[2]
-        xw = o.a1 + o.c2 * math.sin(t2) + o.c3 * math.sin(t23) + o.a2 * math.cos(t23)
-        phi = self.phi_deg
-        s = int(xw < -BOUNDARY_EPS) | (int(q[2] >= phi - BOUNDARY_EPS) << 1) | (int(q[4] < -BOUNDARY_EPS) << 2)
-        amb = (int(abs(xw) < OVERHEAD_SINGULAR_MM) | (int(abs(q[2] - phi) < 1e-7) << 1)
-               | (int(abs(q[4]) < WRIST_SINGULAR_DEG) << 2) | s_free)
-        return s, amb
+    def status_row(self, q: list[float]) -> tuple[int, int]:
+        """S of one axis configuration (6 floats, deg) and the mask of its S bits that sit on
+        their switching point (wrist point on the A1 axis, A3 = phi, A5 = 0), or that select
+        nothing on this robot (fastpath ``OPWCore.status``)."""
+        c = self.c
+        c.status(q[0], q[1], q[2], q[3], q[4], q[5])
+        return c.s_out, c.amb_out
 
     def status_many(self, Q: np.ndarray, s_free: int) -> tuple[np.ndarray, np.ndarray]:
-        """:meth:`status_row` over the last axis of Q (..., 6): (S, ambiguous bits) arrays."""
+        """:meth:`status_row` over the last axis of Q (..., 6) in numpy: (S, ambiguous bits) arrays."""
         o = self.o
         t2 = np.radians(self.sgn[1] * Q[..., 1]) - self.offs[1]
         t23 = t2 + np.radians(self.sgn[2] * Q[..., 2]) - self.offs[2]
@@ -91,75 +94,11 @@ class OPWSolver:
 
     # ------------------------------------------------------------------ IK
     def core(self, flange_T: np.ndarray, ref_deg: np.ndarray | None) -> list[list[float]]:
-        """OPW closed form: up to 8 lists of KUKA axis values (deg, wrapped to (-180, 180]).
-
-        With ``ref_deg`` the free angle at a singularity is taken from it:
-        A1 when the wrist point is on the A1 axis, A4 when A5 = 0.
-        """
-        o = self.o
-        rows = np.asarray(flange_T, dtype=float).tolist()
-        (r00, r01, r02, px), (r10, r11, r12, py), (r20, r21, r22, pz) = rows[0], rows[1], rows[2]
-        cx, cy, cz = px - o.c4 * r02, py - o.c4 * r12, pz - o.c4 * r22  # wrist point
-        rho2 = cx * cx + cy * cy - o.b * o.b
-        if rho2 < 0.0:
-            return []
-        nx1 = math.sqrt(rho2) - o.a1
-        if math.sqrt(cx * cx + cy * cy) < OVERHEAD_SINGULAR_MM and ref_deg is not None:
-            tmp1 = math.radians(self.sgn[0] * float(ref_deg[0])) - self.offs[0]
-        else:
-            tmp1 = math.atan2(cy, cx)
-        tmp2 = math.atan2(o.b, nx1 + o.a1)
-        th1_i = tmp1 - tmp2
-        th1_ii = tmp1 + tmp2 - math.pi
-        tmp3 = cz - o.c1
-        s1_2 = nx1 * nx1 + tmp3 * tmp3
-        tmp4 = nx1 + 2.0 * o.a1
-        s2_2 = tmp4 * tmp4 + tmp3 * tmp3
-        kappa_2 = self.kappa_2
-        c2_2 = self.c2_2
-        s1 = math.sqrt(s1_2)
-        s2 = math.sqrt(s2_2)
-        k = self.k
-        at23 = self.at23
-
-        arms = []  # (th1, th2, th3)
-        for th1, s_, s_2, base2 in ((th1_i, s1, s1_2, math.atan2(nx1, tmp3)),
-                                    (th1_ii, s2, s2_2, -math.atan2(tmp4, tmp3))):
-            if s_ < 1e-12:
-                continue
-            arg2 = (s_2 + c2_2 - kappa_2) / (2.0 * s_ * o.c2)
-            arg3 = (s_2 - c2_2 - kappa_2) / (2.0 * o.c2 * k)
-            if abs(arg2) > 1.0 + ACOS_TOL or abs(arg3) > 1.0 + ACOS_TOL:
-                continue
-            a2c = math.acos(min(1.0, max(-1.0, arg2)))
-            a3c = math.acos(min(1.0, max(-1.0, arg3)))
-            arms.append((th1, -a2c + base2, a3c - at23))
-            arms.append((th1, a2c + base2, -a3c - at23))
-        if not arms:
-            return []
-
-        sols = []
-        for th1, th2, th3 in arms:
-            sn1, cs1 = math.sin(th1), math.cos(th1)
-            s23, c23 = math.sin(th2 + th3), math.cos(th2 + th3)
-            mm = r02 * s23 * cs1 + r12 * s23 * sn1 + r22 * c23
-            th5 = math.atan2(math.sqrt(max(0.0, 1.0 - mm * mm)), mm)
-            th4 = math.atan2(r12 * cs1 - r02 * sn1,
-                             r02 * c23 * cs1 + r12 * c23 * sn1 - r22 * s23)
-            th6 = math.atan2(r01 * s23 * cs1 + r11 * s23 * sn1 + r21 * c23,
-                             -r00 * s23 * cs1 - r10 * s23 * sn1 - r20 * c23)
-            if ref_deg is not None and abs(math.degrees(th5)) < WRIST_SINGULAR_DEG:
-                # Wrist singularity: only th4 + th6 is defined; keep A4 of the reference.
-                total = th4 + th6
-                th4 = math.radians(self.sgn[3] * float(ref_deg[3])) - self.offs[3]
-                th6 = total - th4
-            sols.append((th1, th2, th3, th4, th5, th6))
-            sols.append((th1, th2, th3, th4 + math.pi, -th5, th6 - math.pi))
-        # q = wrap180(degrees((opw + offset) * sign)), in plain floats (the same operations,
-        # in the same order, as numpy's degrees/remainder: the same values)
-        offs, sgn, deg = self.offs, self.sgn, math.degrees
-        return [[-((-deg((th + offs[i]) * sgn[i]) + 180.0) % 360.0) + 180.0 for i, th in enumerate(sol)]
-                for sol in sols]
+        """OPW closed form: up to 8 lists of KUKA axis values (deg, wrapped to (-180, 180]) of the
+        flange pose (4x4, mm; fastpath ``OPWCore.core``). With ``ref_deg`` the free angle at a
+        singularity is taken from it: A1 when the wrist point is on the A1 axis, A4 when A5 = 0."""
+        return self.c.rows_of(np.asarray(flange_T, dtype=float),
+                              None if ref_deg is None else np.asarray(ref_deg, dtype=float))
 
     def core_many(self, Ts: np.ndarray, refs: np.ndarray) -> tuple[np.ndarray, np.ndarray, bool]:
         """:meth:`core` over N targets: (N, 8, 6) axes (deg, wrapped; NaN where a branch does not
@@ -222,16 +161,5 @@ class OPWSolver:
                     col += 1
         Q[~valid] = np.nan
         return Q, valid, ref_free
-
-    def compiled(self, lo_l: list[float], hi_l: list[float], ks_l: list[float], s_free: int, t_free: int) -> Any:
-        """robot/simcore.pyx's ``OPW`` of this solver with the soft limits `lo_l`/`hi_l` (deg,
-        widened by the limit tolerance), the turn variants `ks_l` and the free S/T bits, or
-        False when the compiled module is not used (not built, stale or switched off)."""
-        sc = compiled_module()
-        if sc is None:
-            return False
-        return sc.OPW(self.o, self.kappa_2, self.c2_2, self.k, self.at23, self.phi_deg, self.sgn,
-                      self.offs, lo_l, hi_l, ks_l, s_free, t_free)
-
 
 __all__ = ["OPWSolver"]

@@ -49,7 +49,7 @@ class Palletizer4(KinematicFamily):
         #: the flange's offset from the A5 axis point in the arm's vertical plane at A1 = 0 (mm),
         #: and the flange rotation at HOME with A1 = A6 = 0
         self.pa = (T[:3, 3] - kin.joints.joint_point(q, 4), T[:3, :3].copy())
-        self.solver = OPWSolver(replace(m.opw, c4=0.0), float(m.status_phi_deg))
+        self.solver = OPWSolver(replace(m.opw, c4=0.0), float(m.status_phi_deg), kin, self.s_free, self.t_free)
         self._c_pal: Any = None     # robot/simcore.pyx's 4-axis palletizer rows; False: not used
 
     @classmethod
@@ -123,12 +123,11 @@ class Palletizer4(KinematicFamily):
     def _compiled(self) -> Any:
         """robot/simcore.pyx's ``Palletizer4`` for this robot, or False (not built, stale, or
         switched off: :meth:`solutions` runs its Python loop)."""
-        k = self.kin
-        c = self.solver.compiled(k._lo_l, k._hi_l, k._ks_l, self.s_free, self.t_free)
-        if not c:
+        sc = compiled_module()
+        if sc is None or not self.solver.compiled:
             return False
-        j = k.joints
-        return compiled_module().Palletizer4(c, j.origins.tolist(), j.axes.tolist(), j.kuka_sign.tolist(),
+        j = self.kin.joints
+        return sc.Palletizer4(self.solver.c, j.origins.tolist(), j.axes.tolist(), j.kuka_sign.tolist(),
                                              j.R_origin.tolist(), j.origin_rot, j.R_flange.tolist(),
                                              j.p_flange.tolist(), self.pa[0].tolist())
 

@@ -65,8 +65,8 @@ class Palletizer5(KinematicFamily):
         super().__init__(kin, found)
         m = kin.machine
         #: the arm's status (and the OPW solver of the arm for the A5 point: c4 = 0)
-        self.solver = OPWSolver(m.opw, float(m.status_phi_deg))
-        self.arm = OPWSolver(replace(m.opw, c4=0.0), float(m.status_phi_deg))
+        self.solver = OPWSolver(m.opw, float(m.status_phi_deg), kin, self.s_free, self.t_free)
+        self.arm = OPWSolver(replace(m.opw, c4=0.0), float(m.status_phi_deg), kin, self.s_free, self.t_free)
         q0 = np.zeros(6)
         pts, dirs, T0 = self.joints(q0)
         R0 = T0[:3, :3]
