@@ -14,7 +14,7 @@ whether the arm has the ortho-parallel form with a spherical wrist that the OPW 
 solves (Brandstötter, Angerer, Hofbaur: "An analytical solution of the inverse kinematics
 problem of industrial serial manipulators with an ortho-parallel basis and a spherical wrist",
 2014), and gives its parameters, axis signs and the fixed frames before and after it. The
-caller verifies the form against :func:`chain_forward` before using it (robot/kinematics.py).
+caller verifies the form against :func:`chain_forward` before using it (robot/kinematics/opw.py).
 """
 
 from __future__ import annotations

@@ -14,9 +14,11 @@ KR C2 and KR C4 machine data use the same names; what a KR C2 file lacks (``$AXI
 is derived by the rules of :data:`RULES` and marked "derived" in
 :attr:`MachineData.provenance` (``krl robot show``).
 
-The chain is robot/chain.py's; it becomes URDF-style joints (translation-only joint origins,
-KUKA's directions in the joint axes, ``q = radians(A_i)``). Reading the machine data never
-builds the inverse kinematics: robot/kinematics.py chooses the closed form the chain has (or
+The chain is the robot's kinematic family's (robot/kinematics/families.py ``machine_geometry``:
+the arm's of robot/kinematics/arm.py for ``$MAIN_AXIS=#NR``, the SCARA's for ``#CC``); it becomes
+URDF-style joints (robot/chain.py: translation-only joint origins, KUKA's directions in the joint
+axes, ``q = radians(A_i)``, a linear axis in mm), n of them. Reading the machine data never
+builds the inverse kinematics: robot/kinematics/ chooses the closed form the chain has (or
 the numeric solver) when a tool moves the robot, so ``krl cell init``, ``krl check``,
 ``krl graph`` and ``krl diff`` never need it. A value the model cannot take is refused with
 :class:`MachineDataError` naming the variable, its value and its file:line.
@@ -290,7 +292,8 @@ def _et_system(machine, source, prov, t: int, sysname: str, n_ext: int, used: se
 def machine_from_values(machine: dict[str, DataValue], robcor: dict[str, DataValue] | None,
                         source: str) -> MachineData:
     """Build the robot model from read machine data (see the module docstring). Builds no
-    inverse kinematics (robot/kinematics.py does, for the tools that move the robot).
+    inverse kinematics (robot/kinematics/ does, for the tools that move the robot). The kinematic
+    chain is the robot's kinematic family's (robot/kinematics/families.py ``machine_geometry``).
 
     Args:
         machine: the values of ``$machine.dat`` (:func:`robot.datalist.read_data_list`).

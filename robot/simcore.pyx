@@ -372,12 +372,12 @@ ctypedef void (*_dgemv_t)(int order, int ta, long long m, long long n, double al
 
 
 cdef class Forward:
-    """``Kinematics.forward`` (robot/kinematics.py) in one call, the same numbers: the joint
+    """``JointChain.forward`` (robot/kinematics/joints.py) in one call, the same numbers: the joint
     rotations of scipy's ``Rotation.from_rotvec(axis * q).as_matrix()`` (its quaternion, then
     its matrix, the same operations in the same order), and every product ``@`` of the Python
     code through numpy's own BLAS as numpy calls it (``cblas_dgemm`` for a 3x3 by 3x3 product,
     ``cblas_dgemv`` for a 3x3 by vector one, at the addresses given). Its users check it against
-    the Python code at set-up (robot/kinematics.py ``_compiled_forward``)."""
+    the Python code at set-up (robot/kinematics/joints.py ``JointChain._compiled``)."""
 
     cdef _dgemm_t gemm
     cdef _dgemv_t gemv

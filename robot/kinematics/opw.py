@@ -12,8 +12,8 @@ family with the yaml's ``opw`` parameters.
 Status S (robot-model.md §8): bit 0 the wrist point behind the A1 axis, bit 1 A3 >= phi, bit 2
 A5 < 0; turn T bit i: A(i+1) < 0.
 
-:meth:`OPW.inverse` runs the compiled mirror of the solver and of the shared selection
-(robot/simcore.pyx ``OPW``: the same axes bit for bit) when it is built; :meth:`OPW.inverse_many`
+:meth:`OPW.inverse` runs robot/kinematics/fastpath.py's ``OPWCore`` (the rows, those with the
+status, the choice; compiled from that file when it is built); :meth:`OPW.inverse_many`
 solves N poses in numpy, bit for bit the scalar rows; :meth:`OPW.inverse_chain` a chain of
 poses each the next one's reference.
 """

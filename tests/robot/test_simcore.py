@@ -486,7 +486,7 @@ def test_the_compiled_forward_is_the_python_forward_bit_for_bit(sc, shared_corpu
 
 def test_the_compiled_palletizer_rows_are_the_pythons(sc):
     """The 4-axis palletizer's solutions (robot/simcore.pyx ``Palletizer4``) against the Python
-    loop of Kinematics._palletizer_rows: the same rows, bit for bit, on linked configurations
+    loop of Palletizer4.solutions: the same rows, bit for bit, on linked configurations
     of the library palletizer, with tilted flanges, targets off the arm's reach and no
     reference (``solutions``); its own flange test tells the rows apart by millimetres."""
     from scipy.spatial.transform import Rotation  # noqa: PLC0415
