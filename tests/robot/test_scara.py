@@ -181,3 +181,39 @@ def test_the_scara_runs_ptp_and_lin_on_both_interpreters_within_its_limits(tmp_p
     zs = sorted({round(p[2], 3) for p in down})
     assert zs[0] == pytest.approx(20.0) and 140.0 < zs[-1] <= 150.0 and len(zs) > 10
     assert all(abs(p[4]) < 1e-6 and abs(abs(p[5]) - 180.0) < 1e-6 for p in down)
+
+
+def test_random_ptp_and_lin_sequences_keep_the_scaras_limits(scara, kin):
+    """Random PTP moves between configurations on one elbow side and LIN moves to poses near
+    them (approximated or exact), on the controller: the trace keeps the axis speeds and
+    accelerations of the machine data, the path speed, and the soft limits."""
+    from robot.bench import run_motions
+    from robot.controller import Controller
+    from robot.limits import check_trace
+    from robot.motion import MotionParams, MotionRequest
+    from robot.trace import TraceWriter
+
+    rng = np.random.default_rng(50)
+    P = MotionParams.initmov(scara)
+    lo, hi = np.array([-110.0, 25.0, 10.0, -300.0]), np.array([110.0, 130.0, 190.0, 300.0])
+    for _ in range(5):
+        tw = TraceWriter(keep=True)
+        ctl = Controller(scara, trace=tw, mujoco=False)
+        reqs = []
+        for _ in range(6):
+            q = rng.uniform(lo, hi)
+            reqs.append(MotionRequest("PTP", dict(zip(("A1", "A2", "A3", "A4"), q.tolist())),
+                                      P.with_(vel_axis=(float(rng.uniform(30.0, 100.0)),) * 6),
+                                      approx=rng.choice([None, "C_PTP"])))
+            q2 = np.clip(q + rng.uniform([-15.0, -15.0, -60.0, -40.0], [15.0, 15.0, 60.0, 40.0]), lo, hi)
+            pose = dict(zip("XYZABC", matrix_to_frame(kin.forward(q2))))
+            reqs.append(MotionRequest("LIN", pose, P.with_(vel_cp=float(rng.uniform(0.2, 2.0))),
+                                      approx=rng.choice([None, "C_DIS"])))
+        run_motions(ctl, reqs)
+        events = tw.events
+        assert not [e for e in events if e["kind"] == "error"]
+        Q = np.array([e["axes"] for e in events if e["kind"] == "pose"])
+        assert len(Q) > 300 and sum(e["kind"] == "motion" and e.get("phase") == "end" for e in events) == 12
+        assert (Q >= np.array(scara.softn_end) - 1e-6).all() and (Q <= np.array(scara.softp_end) + 1e-6).all()
+        report = check_trace(events, scara)
+        assert not report.violations, report.violations[:3]
