@@ -36,7 +36,7 @@ from scipy.spatial.transform import Rotation
 
 from .chain import chain_forward, chain_to_joints
 from .datalist import DataListError, DataValue, read_data_list
-from .frames import frame_to_matrix, matrix_to_frame
+from .frames import matrix_to_frame
 from .madavalues import MachineDataError, krl_value
 from .madavalues import axes as _axes
 from .madavalues import flag as _flag

@@ -66,6 +66,18 @@ def axes(vals: dict[str, DataValue], name: str, where: str, n: int = 6,
     return out, dv
 
 
+def axis_dirs(vals: dict[str, DataValue], where: str, n: int) -> tuple[list[float], DataValue]:
+    """``$AXIS_DIR[1..n]`` as floats, each 1 or -1 (MachineDataError naming the element otherwise)."""
+    dirs = get(vals, "$AXIS_DIR", where)
+    out = []
+    for i in range(1, n + 1):
+        d = dirs.value.get(i) if isinstance(dirs.value, dict) else None
+        if d not in (1, -1) or isinstance(d, bool):
+            raise MachineDataError(f"{dirs.where(i)}: $AXIS_DIR[{i}]={krl_value(d)}: 1 or -1 was expected")
+        out.append(float(d))
+    return out, dirs
+
+
 def frame6(vals: dict[str, DataValue], name: str, where: str) -> tuple[tuple[float, ...], DataValue]:
     dv = get(vals, name, where)
     if not isinstance(dv.value, dict):
@@ -110,4 +122,4 @@ def flag(vals: dict[str, DataValue], name: str) -> tuple[bool, DataValue | None]
     return dv.value, dv
 
 
-__all__ = ["MachineDataError", "axes", "dh", "flag", "frame", "frame6", "get", "krl_value", "num", "rot", "tr"]
+__all__ = ["MachineDataError", "axes", "axis_dirs", "dh", "flag", "frame", "frame6", "get", "krl_value", "num", "rot", "tr"]

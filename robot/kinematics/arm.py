@@ -24,8 +24,9 @@ import numpy as np
 
 from ..chain import Chain, opw_form
 from ..machine import OPWParams
-from ..madavalues import MachineDataError, dh, frame, get, krl_value, num, tr
-from .family import Geometry
+from ..madavalues import MachineDataError, axis_dirs, dh, frame, get, krl_value, num, tr
+from .constants import BOUNDARY_EPS
+from .family import Geometry, KinematicFamily, inverse_rows_many, select_solutions
 
 #: The provenance entries of the derived values (robot/mada.py RULES holds the rest).
 RULES = {
@@ -75,13 +76,7 @@ def arm_geometry(machine: dict[str, Any], source: str, prov: dict[str, str], a4f
     dh4 = get(machine, "$DH_4", source)
     dh5 = get(machine, "$DH_5", source)
     prov["$DH_4"], prov["$DH_5"] = dh4.where(), dh5.where()
-    dirs = get(machine, "$AXIS_DIR", source)
-    axis_dir = []
-    for i in range(1, 7):
-        d = dirs.value.get(i) if isinstance(dirs.value, dict) else None
-        if d not in (1, -1) or isinstance(d, bool):
-            raise MachineDataError(f"{dirs.where(i)}: $AXIS_DIR[{i}]={krl_value(d)}: 1 or -1 was expected")
-        axis_dir.append(float(d))
+    axis_dir, dirs = axis_dirs(machine, source, 6)
     prov["$AXIS_DIR"] = dirs.where(1)
 
     F4, _ = dh(dh4)
@@ -107,4 +102,51 @@ def arm_geometry(machine: dict[str, Any], source: str, prov: dict[str, str], a4f
                     reach_mm=length_a + length_b + math.hypot(tx["X"], tx["Z"]), a5link=a5link)
 
 
-__all__ = ["RULES", "arm_geometry"]
+class ArmFamily(KinematicFamily):
+    """What the arm families (opw.py, palletizer4.py, palletizer5.py, numeric.py) share, declared
+    once: the arm's chain from machine data (:func:`arm_geometry`), the joints' forward
+    kinematics, the OPW arm's status and turn (robot-model.md §8; the family's ``solver``, a
+    robot/kinematics/opwsolver.py ``OPWSolver``), the choice among the family's ``solutions``
+    (robot/kinematics/family.py ``select``), N poses row by row, ``krl robot show``'s line of the
+    machine data's OPW parameters. Each family adds ``detect`` and ``solutions`` (and whatever it
+    does otherwise)."""
+
+    @classmethod
+    def geometry(cls, values: dict[str, Any], source: str, prov: dict[str, str], a4fix: bool,
+                 a5link: bool) -> Geometry | None:
+        return arm_geometry(values, source, prov, a4fix, a5link)
+
+    def forward(self, a: np.ndarray) -> np.ndarray:
+        return self.kin.joints.forward(a)
+
+    def forward_many(self, A: np.ndarray) -> np.ndarray:
+        return self.kin.joints.forward_many(A)
+
+    def status_turn(self, q: np.ndarray) -> tuple[int, int]:
+        s = self.solver.status(q)
+        t = 0
+        for i in range(6):
+            if q[i] < -BOUNDARY_EPS:
+                t |= 1 << i
+        return s, t
+
+    def status_row(self, q: list[float]) -> tuple[int, int]:
+        return self.solver.status_row(q)
+
+    def wrist_point_x(self, q) -> float:
+        return self.solver.wrist_point_x(q)
+
+    inverse = select_solutions
+    inverse_many = inverse_rows_many
+
+    def describe(self) -> list[str]:
+        return [opw_line(self.kin.machine.opw)]
+
+
+def opw_line(o: Any) -> str:
+    """``krl robot show``'s line of the OPW parameters `o` (mm)."""
+    return (f"kinematics OPW a1={o.a1 + 0.0:g} a2={o.a2 + 0.0:g} b={o.b + 0.0:g} c1={o.c1 + 0.0:g} "
+            f"c2={o.c2 + 0.0:g} c3={o.c3 + 0.0:g} c4={o.c4 + 0.0:g} mm")
+
+
+__all__ = ["RULES", "ArmFamily", "arm_geometry", "opw_line"]

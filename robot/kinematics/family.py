@@ -22,14 +22,14 @@ A family's operations (mm, deg; 4x4 frames; n = the robot's axis count,
   `ref`, or :class:`~robot.errors.WorkspaceError` / :class:`~robot.errors.SoftLimitError`;
 * ``inverse_many(Ts, status, turn, refs)``: :meth:`inverse` of N poses, (N, n).
 
-A family with none of its own uses the shared implementations explicitly (``inverse_many =
-inverse_rows_many``), so tests/robot/test_families.py can check that every registered family
+A family with none of its own uses the shared implementations explicitly (``inverse =
+select_solutions``, ``inverse_many = inverse_rows_many``; the arm families inherit robot/kinematics/
+arm.py's ``ArmFamily``), so tests/robot/test_families.py can check that every registered family
 declares every operation.
 """
 
 from __future__ import annotations
 
-import math
 from abc import ABC, abstractmethod
 from typing import Any, ClassVar, NamedTuple
 
@@ -263,6 +263,15 @@ def inverse_rows(fam: KinematicFamily, Ts: np.ndarray, status: int | None, turn:
     return np.array(out, dtype=float).reshape(-1, fam.kin.n_axes)
 
 
+def select_solutions(self: KinematicFamily, flange_T: np.ndarray, status: int | None, turn: int | None,
+                     ref: np.ndarray | None) -> np.ndarray:
+    """The shared ``inverse`` of a family with analytic rows: :func:`select` over its
+    ``solutions`` (the reference HOME when `ref` is None)."""
+    if ref is None:
+        ref = self.kin._home.copy()
+    return select(self, self.solutions(flange_T, ref), status, turn, ref)
+
+
 def inverse_rows_many(self: KinematicFamily, Ts: np.ndarray, status: int | None, turn: int | None,
                       refs: np.ndarray) -> np.ndarray:
     """The shared ``inverse_many`` of a family: its inverse row by row (:func:`inverse_rows`)."""
@@ -293,4 +302,4 @@ def check_closed_form(kin: Any, rows, where: str, message: str, link=None, sampl
             raise MachineDataError(f"{where}: {message}")
 
 
-__all__ = ["Geometry", "KinematicFamily", "OPERATIONS", "check_closed_form", "inverse_rows", "inverse_rows_many", "select"]
+__all__ = ["Geometry", "KinematicFamily", "OPERATIONS", "select_solutions", "check_closed_form", "inverse_rows", "inverse_rows_many", "select"]

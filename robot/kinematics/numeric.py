@@ -29,8 +29,9 @@ from typing import Any
 import numpy as np
 
 from ..errors import SoftLimitError, WorkspaceError
-from .family import KinematicFamily, inverse_rows_many, select
-from .opw import OPW, opw_line, six_rotary
+from .arm import ArmFamily
+from .family import select
+from .opw import six_rotary
 from .opwsolver import OPWSolver
 
 #: Gauss-Newton steps per seed; convergence takes 4-6 from an OPW seed.
@@ -106,7 +107,7 @@ class NumericIK:
         return out
 
 
-class Numeric(KinematicFamily):
+class Numeric(ArmFamily):
     """The numeric family (module docstring): the solver is built on first use."""
 
     name = "numeric"
@@ -122,16 +123,6 @@ class Numeric(KinematicFamily):
     def detect(cls, kin: Any) -> Any:
         return True if six_rotary(kin.machine) else None
 
-    geometry = OPW.geometry
-    forward = OPW.forward
-    forward_many = OPW.forward_many
-    status_turn = OPW.status_turn
-    status_row = OPW.status_row
-    wrist_point_x = OPW.wrist_point_x
-    inverse_many = inverse_rows_many
-
-    def describe(self) -> list[str]:
-        return [opw_line(self.kin.machine.opw)]
 
     @property
     def ik(self) -> NumericIK:

@@ -26,9 +26,8 @@ import numpy as np
 
 from ..chain import chain_forward, opw_form
 from ..errors import SoftLimitError, WorkspaceError
-from .constants import BOUNDARY_EPS
-from .arm import arm_geometry
-from .family import KinematicFamily, inverse_rows, select
+from .arm import ArmFamily, opw_line
+from .family import inverse_rows, select
 from .opwsolver import OPWSolver
 
 
@@ -48,7 +47,7 @@ def six_rotary(machine: Any) -> bool:
             and all(getattr(j, "kind", "rotary") != "linear" for j in machine.joints))
 
 
-class OPW(KinematicFamily):
+class OPW(ArmFamily):
     """The OPW family (module docstring)."""
 
     name = "opw"
@@ -60,12 +59,6 @@ class OPW(KinematicFamily):
         self.solver = OPWSolver(found.params, found.phi_deg, kin, self.s_free, self.t_free)
         self.base_inv = found.base_inv
         self.end_inv = found.end_inv
-
-    @classmethod
-    def geometry(cls, values: dict[str, Any], source: str, prov: dict[str, str], a4fix: bool,
-                 a5link: bool) -> Any:
-        """The arm's chain (robot/kinematics/arm.py), the one every arm family reads."""
-        return arm_geometry(values, source, prov, a4fix, a5link)
 
     @classmethod
     def detect(cls, kin: Any) -> OpwFound | None:
@@ -102,27 +95,6 @@ class OPW(KinematicFamily):
             if not rows or min(np.abs(kin.forward(r) - T).max() for r in rows) > 1e-6:
                 return False
         return True
-
-    # ------------------------------------------------------------------ FK, S/T
-    def forward(self, a: np.ndarray) -> np.ndarray:
-        return self.kin.joints.forward(a)
-
-    def forward_many(self, A: np.ndarray) -> np.ndarray:
-        return self.kin.joints.forward_many(A)
-
-    def status_turn(self, q: np.ndarray) -> tuple[int, int]:
-        s = self.solver.status(q)
-        t = 0
-        for i in range(6):
-            if q[i] < -BOUNDARY_EPS:
-                t |= 1 << i
-        return s, t
-
-    def status_row(self, q: list[float]) -> tuple[int, int]:
-        return self.solver.status_row(q)
-
-    def wrist_point_x(self, q) -> float:
-        return self.solver.wrist_point_x(q)
 
     # ------------------------------------------------------------------ IK
     def _in_arm(self, flange_T: np.ndarray) -> np.ndarray:
@@ -259,10 +231,4 @@ class OPW(KinematicFamily):
         return [opw_line(self.solver.o)]
 
 
-def opw_line(o: Any) -> str:
-    """``krl robot show``'s line of the OPW parameters `o` (mm)."""
-    return (f"kinematics OPW a1={o.a1 + 0.0:g} a2={o.a2 + 0.0:g} b={o.b + 0.0:g} c1={o.c1 + 0.0:g} "
-            f"c2={o.c2 + 0.0:g} c3={o.c3 + 0.0:g} c4={o.c4 + 0.0:g} mm")
-
-
-__all__ = ["OPW", "OpwFound", "opw_line", "six_rotary"]
+__all__ = ["OPW", "OpwFound", "six_rotary"]

@@ -26,12 +26,12 @@ from typing import Any
 import numpy as np
 
 from . import compiled_module
-from .family import KinematicFamily, check_closed_form, inverse_rows_many, select
-from .opw import OPW, opw_line
+from .arm import ArmFamily
+from .family import check_closed_form
 from .opwsolver import OPWSolver
 
 
-class Palletizer4(KinematicFamily):
+class Palletizer4(ArmFamily):
     """The 4-axis palletizer (module docstring)."""
 
     name = "palletizer4"
@@ -70,22 +70,6 @@ class Palletizer4(KinematicFamily):
             f"$DEF_A4FIX=TRUE, A5 led ({led}): this palletizer's arm ($TIRORO, $TX3P3, $DH_4, $DH_5, "
             f"$TFLWP) is not one the 4-axis closed form covers", link=link)
 
-    geometry = OPW.geometry
-    forward = OPW.forward
-    forward_many = OPW.forward_many
-    status_turn = OPW.status_turn
-    status_row = OPW.status_row
-    wrist_point_x = OPW.wrist_point_x
-    inverse_many = inverse_rows_many
-
-    def describe(self) -> list[str]:
-        return [opw_line(self.kin.machine.opw)]
-
-    def inverse(self, flange_T: np.ndarray, status: int | None, turn: int | None,
-                ref: np.ndarray | None) -> np.ndarray:
-        if ref is None:
-            ref = self.kin._home.copy()
-        return select(self, self.solutions(flange_T, ref), status, turn, ref)
 
     def solutions(self, flange_T: np.ndarray, ref_deg: np.ndarray | None) -> list[list[float]]:
         """The rows of a flange pose (module docstring); A4 is 0."""

@@ -31,8 +31,8 @@ from typing import Any
 
 import numpy as np
 
-from .family import KinematicFamily, check_closed_form, inverse_rows_many, select
-from .opw import OPW, opw_line
+from .arm import ArmFamily
+from .family import check_closed_form
 from .opwsolver import OPWSolver
 
 
@@ -52,7 +52,7 @@ def _rotvecs(v: np.ndarray) -> np.ndarray:
     return np.eye(3) + s * K + (1.0 - c) * (K @ K)
 
 
-class Palletizer5(KinematicFamily):
+class Palletizer5(ArmFamily):
     """The 5-axis palletizer (module docstring), for :class:`robot.kinematics.Kinematics` `kin`."""
 
     name = "palletizer5"
@@ -79,22 +79,6 @@ class Palletizer5(KinematicFamily):
         m = kin.machine
         return True if m.a4fix and not m.a5link else None
 
-    geometry = OPW.geometry
-    forward = OPW.forward
-    forward_many = OPW.forward_many
-    status_turn = OPW.status_turn
-    status_row = OPW.status_row
-    wrist_point_x = OPW.wrist_point_x
-    inverse_many = inverse_rows_many
-
-    def describe(self) -> list[str]:
-        return [opw_line(self.kin.machine.opw)]
-
-    def inverse(self, flange_T: np.ndarray, status: int | None, turn: int | None,
-                ref: np.ndarray | None) -> np.ndarray:
-        if ref is None:
-            ref = self.kin._home.copy()
-        return select(self, self.solutions(flange_T, ref), status, turn, ref)
 
     def joints(self, q: np.ndarray) -> tuple[list[np.ndarray], list[np.ndarray], np.ndarray]:
         """Points and unit directions of the six joint axes, and the flange (4x4), at axes `q`

@@ -42,9 +42,9 @@ from typing import Any
 import numpy as np
 
 from ..chain import Chain
-from ..madavalues import MachineDataError, frame, get, krl_value, num, tr
+from ..madavalues import MachineDataError, axis_dirs, frame, get, krl_value, num, tr
 from .constants import ACOS_TOL, BOUNDARY_EPS, OVERHEAD_SINGULAR_MM
-from .family import Geometry, KinematicFamily, check_closed_form, inverse_rows_many, select
+from .family import Geometry, KinematicFamily, check_closed_form, inverse_rows_many, select_solutions
 
 #: The provenance of the derived values.
 RULES = {
@@ -114,13 +114,7 @@ class Scara(KinematicFamily):
         prov["$LENGTH_A"], prov["$LENGTH_B"] = la.where(), lb.where()
         tflwp, dv = frame(values, "$TFLWP", source)
         prov["$TFLWP"] = dv.where()
-        dirs = get(values, "$AXIS_DIR", source)
-        d = []
-        for i in range(1, 5):
-            v = dirs.value.get(i) if isinstance(dirs.value, dict) else None
-            if v not in (1, -1) or isinstance(v, bool):
-                raise MachineDataError(f"{dirs.where(i)}: $AXIS_DIR[{i}]={krl_value(v)}: 1 or -1 was expected")
-            d.append(float(v))
+        d, dirs = axis_dirs(values, source, 4)
         prov["$AXIS_DIR"] = dirs.where(1)
         fixed = [tiroro, tr(x=l1), tr(x=l2), np.eye(4), tflwp]
         local = [np.array([0.0, 0.0, di]) for di in d]
@@ -202,12 +196,7 @@ class Scara(KinematicFamily):
                          _wrap(math.degrees(th4) * self.s[3])])
         return rows
 
-    def inverse(self, flange_T: np.ndarray, status: int | None, turn: int | None,
-                ref: np.ndarray | None) -> np.ndarray:
-        if ref is None:
-            ref = self.kin._home.copy()
-        return select(self, self.solutions(flange_T, ref), status, turn, ref)
-
+    inverse = select_solutions
     inverse_many = inverse_rows_many
 
     def describe(self) -> list[str]:
