@@ -134,11 +134,8 @@ def attach_network(rt: Runtime, program, workspace, settings) -> None:
         old.close()
     root = backup_of(Path(program).resolve(), Path(workspace).resolve() if workspace else None)
     net = Network(settings, program=Path(program).resolve(), backup=root, sink=RuntimeSink(rt))
-    amap = None
-    if settings is not None and (settings.modbus is not None or settings.opcua is not None):
-        amap = plc_map(rt, Path(program).stem)
     try:
-        net.attach(rt.controller, amap)
+        net.attach(rt.controller, plc_map=lambda: plc_map(rt, Path(program).stem))
     except OSError as exc:
         net.close()
         from net.hub import NetError  # noqa: PLC0415
