@@ -75,7 +75,7 @@ bench: $(PARSER) java-parser vm-loop
 	$(BIN)/krl bench
 
 clean:
-	rm -rf $(VENV) $(GEN_DIR) build/java build/cython interp/vm/*.so robot/*.so reports/recovery reports/growth
+	rm -rf $(VENV) $(GEN_DIR) build/java build/cython interp/vm/*.so robot/*.so robot/kinematics/*.so reports/recovery reports/growth
 
 # Conformance suites (issue 8): hand-written cases, differential fuzzing, corpus programs.
 CONF_OUT  ?= reports/conformance
