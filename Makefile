@@ -48,7 +48,8 @@ $(JAVA_STAMP): $(PARSER)
 
 java-parser: $(JAVA_STAMP)
 
-# The compiled VM loop and the simulator's inverse kinematics (robot/build.py: robot/simcore.pyx):
+# The compiled VM loop and the simulator's hot path (robot/build.py: robot/kinematics/fastpath.py with
+# fastpath.pxd, and robot/simcore.pyx):
 # every install builds them (setup.py); this target rebuilds them in place
 # after loop.py was regenerated. Cython compiles the generated interp/vm/loop.py (with loop.pxd)
 # into an extension beside it (interp/vm/build.py). Without Cython or a C compiler it says so and
@@ -74,7 +75,7 @@ bench: $(PARSER) java-parser vm-loop
 	$(BIN)/krl bench
 
 clean:
-	rm -rf $(VENV) $(GEN_DIR) build/java build/cython interp/vm/*.so robot/*.so reports/recovery reports/growth
+	rm -rf $(VENV) $(GEN_DIR) build/java build/cython interp/vm/*.so robot/*.so robot/kinematics/*.so reports/recovery reports/growth
 
 # Conformance suites (issue 8): hand-written cases, differential fuzzing, corpus programs.
 CONF_OUT  ?= reports/conformance
