@@ -141,14 +141,19 @@ class AutoCell:
         self.counts: dict = {}                 # (file, line) -> answers given
         self.rotation: dict = {}               # id(Switch node) -> next CASE index
         self._index: dict | None = None
+        self._resolved: dict = {}               # a statement's file -> its resolved path
 
     # ------------------------------------------------------------------ statements
     def record(self, task, info) -> None:
         """Called for every statement and loop iteration while the cell watches (Runtime)."""
+        self.record_frame(task, info, task.frame)
+
+    def record_frame(self, task, info, frame) -> None:
+        """:meth:`record` of a statement `task` runs in `frame` (a parked spin's statements:
+        interp/runtime/spin.py)."""
         rec = self.recording
         if rec is None or info is None:
             return
-        frame = task.frame
         key = (id(task), info.file, info.line, id(frame))
         if key not in rec:
             rec[key] = (task, info.file, info.line, frame, len(rec))
@@ -173,7 +178,10 @@ class AutoCell:
     def _nodes_at(self, file: str, line: int) -> list:
         if not file:
             return []
-        return self._statements().get((str(Path(file).resolve()), line), [])
+        key = self._resolved.get(file)
+        if key is None:
+            key = self._resolved[file] = str(Path(file).resolve())
+        return self._statements().get((key, line), [])
 
     def pending(self) -> bool:
         """True while an answer has not taken effect yet."""

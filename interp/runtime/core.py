@@ -123,7 +123,7 @@ class Runtime:
                  "noted", "steps", "max_steps", "robot_budget", "sysvars", "memory", "program", "kss",
                  "modules", "scheduler", "robot", "result", "_plans", "_return_types", "_cyclic",
                  "run_mode", "history", "stmt_hook", "step_hook", "error_hook", "cycle_hook",
-                 "autocell", "halt_continues", "start", "halts", "state_epoch")
+                 "autocell", "halt_continues", "start", "halts", "state_epoch", "spin")
 
     def __init__(self, main_path, *, workspace=None, controller=None, trace=None, stimuli=None,
                  max_sim_time: float | None = None, max_steps: int | None = None,
@@ -157,6 +157,7 @@ class Runtime:
         self.kss = SystemSoftware(self)   # stand-ins for KUKA's software the backup lacks
         self.modules = self.program.modules       # by Storage.owner / Callee.owner
         self.scheduler = Scheduler(self, max_sim_time, max_steps)
+        self.spin = self.scheduler.spin   # parked spins (interp/runtime/spin.py)
         self.robot: Task | None = None
         self.result: RunResult | None = None
         self._plans: dict = {}          # id(routine) -> Runtime._frame_plan
@@ -331,10 +332,18 @@ class Runtime:
     # ================================================================== time
     def yield_cycle(self, task: Task) -> None:
         """Give the rest of this IPO cycle back; on return run :meth:`service`."""
+        if self.spin.rec is not None:
+            self.spin.waiting(task)
         self.scheduler.yield_cycle()
         self.service(task)
         if self.cycle_hook is not None:
             self.cycle_hook(task)
+
+    def _proceed(self) -> None:
+        """A task goes on after a wait (or runs a TRIGGER action, an interrupt routine): a
+        parked spin catches up first (interp/runtime/spin.py)."""
+        if self.spin.on:
+            self.spin.proceeding()
 
     def service(self, task: Task) -> None:
         """First act of a resumed task: main-run errors, TRIGGER actions, interrupts."""
@@ -354,6 +363,8 @@ class Runtime:
         the ``stmt`` trace event."""
         task = self.current_task
         task.at = info
+        if self.spin.on:
+            self.spin.event(task, info, False)
         self._count_step(task)
         cont = False
         if task.continue_line is not None:
@@ -381,6 +392,7 @@ class Runtime:
             raise StopRun("max_steps", f"step limit {self.max_steps} reached")
         if self.steps >= task.slice_end:
             self.yield_cycle(task)
+            self._proceed()
         elif task.irqs.armed:
             self.check_interrupts(task)
 
@@ -403,7 +415,8 @@ class Runtime:
                 or task.continue_line is not None \
                 or self.stmt_hook is not None or self.run_mode == "ISTEP" \
                 or any(c.error_proceed for c in task.contexts) \
-                or (self.autocell is not None and self.autocell.recording is not None):
+                or (self.autocell is not None and self.autocell.recording is not None) \
+                or task.watched or task.replay is not None or task.shadow is not None:
             return 0
         lim = task.slice_end - 1
         if self.max_steps is not None and self.max_steps < lim:
@@ -419,7 +432,12 @@ class Runtime:
         """Called once per loop iteration (WHILE/REPEAT/LOOP/FOR): counts a step, may end
         the time slice, applies a loop condition's advance-run stop. No trace event."""
         task = self.current_task
+        spin = self.spin
+        if spin.on:
+            spin.event(task, info, True)
         self._count_step(task)
+        if task.park is not None:
+            spin.park(task)         # a spin: parked until something it reads can change
         if info.cond_stops and task.kind == "robot":
             self.advance_stop(task)
         if self.autocell is not None and self.autocell.recording is not None:
@@ -443,8 +461,10 @@ class Runtime:
     def wait_main_run(self, task: Task) -> None:
         """Advance-run stop: wait until the main run is idle (robot at rest)."""
         ctl = self.controller
-        while not ctl.is_idle():
-            self.yield_cycle(task)
+        if not ctl.is_idle():
+            while not ctl.is_idle():
+                self.yield_cycle(task)
+            self._proceed()
 
     def wait_for(self, cond_fn, text: str = "WAIT FOR") -> None:
         """WAIT FOR: ``cond_fn()`` is evaluated now and once per IPO cycle."""
@@ -456,6 +476,7 @@ class Runtime:
             while True:
                 self.yield_cycle(task)
                 if to_bool(cond_fn(), "WAIT FOR condition"):
+                    self._proceed()
                     return
         finally:
             task.waiting = None
@@ -478,6 +499,7 @@ class Runtime:
             # task.wake_cycle, not a local: a periodic jump of the idle watch moves it
             while ctl.cycle < task.wake_cycle:
                 self.yield_cycle(task)
+            self._proceed()
         finally:
             # an outer WAIT SEC (this one ran in an interrupt routine) moves with the jumps too
             task.wake_cycle = None if outer is None else outer + idle.shifted - shifted
@@ -1077,8 +1099,10 @@ class Runtime:
         ctl = self.controller
         adv = self.sysvars.store.get("$ADVANCE")
         ctl.advance = int(adv) if isinstance(adv, int) else 3
-        while not ctl.can_enqueue():
-            self.yield_cycle(task)
+        if not ctl.can_enqueue():
+            while not ctl.can_enqueue():
+                self.yield_cycle(task)
+            self._proceed()
         try:
             mid = ctl.enqueue(req)
         except RobotError as e:
@@ -1163,6 +1187,7 @@ class Runtime:
                                           delay_ms=float(delay_ms), action=action, prio=prio, line=line))
 
     def run_trigger(self, task: Task, ev) -> None:
+        self._proceed()
         action = ev.trigger.action
         task.contexts.append(Context("trigger", prio=ev.trigger.prio if ev.trigger.prio and ev.trigger.prio > 0 else 129))
         try:
@@ -1218,6 +1243,7 @@ class Runtime:
             self.fire(task, irq)
 
     def fire(self, task: Task, irq: Irq) -> None:
+        self._proceed()
         ctl = self.controller
         ctx = Context("interrupt", prio=irq.number, number=irq.number)
         if task.kind == "robot":
@@ -1274,6 +1300,7 @@ class Runtime:
         while ctl.is_braking():
             self.yield_cycle(task)
         self.yield_cycle(task)
+        self._proceed()
 
     def resume(self) -> None:
         """RESUME: discard the planned motions and unwind to the declaring routine."""

@@ -167,6 +167,13 @@ def _frames(task):
         f = f.caller
 
 
+def frames_of(rt, task) -> tuple:
+    """The image of `task`'s frames (its innermost first): those it stands in, or for a parked
+    spin those it would stand in (interp/runtime/spin.py)."""
+    img = rt.scheduler.spin.frames_image(task) if task.parked is not None else None
+    return img if img is not None else tuple([_store(f.store) for f in _frames(task)])
+
+
 def state_of(rt) -> tuple:
     """The state of the run `rt` that its future depends on, besides the positions of its
     tasks in their loops (see the module docstring): data lists, frames, system variables,
@@ -175,7 +182,7 @@ def state_of(rt) -> tuple:
     mods = tuple([_store(m.store) for m in prog.modules if m.loaded])
     tasks = []
     for t in rt.scheduler.tasks:
-        frames = tuple([_store(f.store) for f in _frames(t)])
+        frames = frames_of(rt, t)
         irqs = tuple((n, i.on, i.enabled, i.last, i.pending, id(i.frame))
                      for n, i in sorted(t.irqs.irqs.items()))
         tasks.append((t.done, t.waiting, len(t.contexts), frames, irqs, t.err_text))
@@ -288,7 +295,7 @@ class IdleWatch:
         start, _, frames = self._robot
         if ctl.cycle - start < WINDOW_CYCLES:
             return
-        now = tuple([_store(f.store) for f in _frames(robot)])
+        now = frames_of(rt, robot)
         if frames is None or frames != now:
             self._robot = (ctl.cycle, marks, now)
             return

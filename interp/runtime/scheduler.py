@@ -59,6 +59,14 @@ class Task:
         self.glet: greenlet | None = None
         self.frame = None               # innermost frame (VARSTATE)
         self.err_text = ""
+        # the spin watch (interp/runtime/spin.py): its statements take the full hook
+        # (``watched``, a recording; ``replay``, a catch-up), the spin it parks at the end of this
+        # loop iteration (``park``), the state of a parked task (``parked``)
+        self.watched = False
+        self.replay = None
+        self.park = None
+        self.parked = None
+        self.shadow = None
 
     @property
     def file(self) -> str | None:
@@ -86,14 +94,19 @@ class Scheduler:
         from .idle import IdleWatch  # noqa: PLC0415
 
         self.idle = IdleWatch(rt)           # fast-forward of idle cycles (interp/runtime/idle.py)
+        from .spin import SpinWatch  # noqa: PLC0415
+
+        self.spin = SpinWatch(rt)           # parked spins (interp/runtime/spin.py)
+        self.return_to = None               # a catch-up's caller (SpinWatch.wake); else main
 
     def add(self, task: Task) -> None:
         task.glet = greenlet(lambda: self.rt.task_main(task), parent=self.main)
         self.tasks.append(task)
 
     def yield_cycle(self) -> None:
-        """Called inside a task: give the IPO cycle back to the scheduler."""
-        self.main.switch()
+        """Called inside a task: give the IPO cycle back to the scheduler (or to whoever made a
+        parked task catch up: interp/runtime/spin.py)."""
+        (self.return_to or self.main).switch()
 
     def _resume(self, task: Task) -> None:
         self.rt.current_task = task
@@ -113,12 +126,17 @@ class Scheduler:
         rt = self.rt
         ctl = rt.controller
         robot = self.tasks[0]
+        spin = self.spin
         while True:
             for task in list(self.tasks):
                 if not task.done and self.stop is None:
+                    if spin.resuming(task):
+                        continue            # parked: this cycle counted, not run
                     self._resume(task)
                     if task.done and task is not robot:
                         rt.submit_finished(task)
+            if spin.shadowed:
+                spin.check_shadows()
             if robot.done or self.stop is not None:
                 break
             if self.max_sim_time is not None and ctl.time >= self.max_sim_time - 1e-9:
@@ -130,6 +148,8 @@ class Scheduler:
                     self.stop = ("deadlock", f"deadlocked {robot.waiting}", robot)
                     break
             self.idle.cycle()
+            if spin.parked or spin.shadowed:
+                spin.before_step()
             events = ctl.step()
             for ev in events:
                 k = ev.kind
