@@ -142,6 +142,7 @@ class AutoCell:
         self.rotation: dict = {}               # id(Switch node) -> next CASE index
         self._index: dict | None = None
         self._resolved: dict = {}               # a statement's file -> its resolved path
+        self._scheduled: list = []              # the stimuli of its answers not yet applied
 
     # ------------------------------------------------------------------ statements
     def record(self, task, info) -> None:
@@ -185,7 +186,7 @@ class AutoCell:
 
     def pending(self) -> bool:
         """True while an answer has not taken effect yet."""
-        return any(st.source == "auto" and not st.fired for st in self.rt.controller.stimuli)
+        return any(not st.fired for st in self._scheduled)
 
     # ------------------------------------------------------------------ answering
     def answer(self, watch) -> str:
@@ -356,8 +357,14 @@ class AutoCell:
                                file=answer.file, line=answer.line, statement=answer.kind,
                                condition=answer.text or None)
 
-        ctl.stimuli.append(Stimulus(set=dict(sets), at=at, source="auto", on_fire=fired,
-                                    where=f"--inputs auto: {Path(span.file).name}:{span.line}"))
+        # the answers that took effect leave the controller's stimuli (it looks at each one
+        # at every IPO cycle); what they did is in self.answers
+        self._scheduled = [st for st in self._scheduled if not st.fired]
+        ctl.stimuli[:] = [st for st in ctl.stimuli if not (st.source == "auto" and st.fired)]
+        st = Stimulus(set=dict(sets), at=at, source="auto", on_fire=fired,
+                      where=f"--inputs auto: {Path(span.file).name}:{span.line}")
+        self._scheduled.append(st)
+        ctl.stimuli.append(st)
 
 
 def program_numbers(rt) -> list[int]:

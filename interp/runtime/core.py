@@ -21,7 +21,7 @@ from krl.semantics.resolve import NATIVE, ROUTINE, Callee, Storage
 from .builtins import NATIVES, ValueRef
 from .netfunctions import RSI_CONSTANTS
 from .contexts import Context, Irq
-from .watch import split_watch
+from .watch import CyclicWatch, settles, split_watch
 from .convert import INT_MAX, INT_MIN, assign_into, binary_op, convert_scalar, to_bool, trunc_int, unary_op
 from .errors import (HaltSignal, KrlRuntimeError, ResumeSignal, StopRun)
 from .idle import probe_state
@@ -123,7 +123,7 @@ class Runtime:
                  "noted", "steps", "max_steps", "robot_budget", "sysvars", "memory", "program", "kss",
                  "modules", "scheduler", "robot", "result", "_plans", "_return_types", "_cyclic",
                  "run_mode", "history", "stmt_hook", "step_hook", "error_hook", "cycle_hook",
-                 "autocell", "halt_continues", "start", "halts", "state_epoch", "spin")
+                 "autocell", "halt_continues", "start", "halts", "state_epoch", "spin", "cyclic_watch")
 
     def __init__(self, main_path, *, workspace=None, controller=None, trace=None, stimuli=None,
                  max_sim_time: float | None = None, max_steps: int | None = None,
@@ -158,6 +158,7 @@ class Runtime:
         self.modules = self.program.modules       # by Storage.owner / Callee.owner
         self.scheduler = Scheduler(self, max_sim_time, max_steps)
         self.spin = self.scheduler.spin   # parked spins (interp/runtime/spin.py)
+        self.cyclic_watch = CyclicWatch(self)   # when a cyclic flag is evaluated again (watch.py)
         self.robot: Task | None = None
         self.result: RunResult | None = None
         self._plans: dict = {}          # id(routine) -> Runtime._frame_plan
@@ -998,8 +999,21 @@ class Runtime:
         run-time error of the robot program at its next resumption."""
         self.cyclic_off(key)
         robot = self.robot
+        # a cyclic flag's expression over variables and I/O is evaluated again only when one of
+        # them may have changed (interp/runtime/watch.py CyclicWatch); every cyclic flag counts
+        # the changes it makes to $CYCFLAG
+        flag = key[0] == "cyclic flag"
+        watch = self.cyclic_watch
+        memo = flag and self._cyclic_settles()
+        cyc = self.sysvars.store.get("$CYCFLAG") if flag else None
+        seen = [None]
 
         def tick(ctl):
+            if memo:
+                k = watch.key()
+                if k is not None and k == seen[0]:
+                    return
+            before = tuple(cyc.data) if cyc is not None else None
             try:
                 fn()
             except KrlRuntimeError as e:
@@ -1008,7 +1022,22 @@ class Runtime:
                     from robot.errors import RobotError  # noqa: PLC0415
 
                     robot.pending_error = RobotError(e.message, e.number)
+                return
+            if before is not None and tuple(cyc.data) != before:
+                watch.version += 1
+            if memo:
+                seen[0] = watch.key()
         self._cyclic[key] = self.controller.add_cyclic(tick)
+
+    def _cyclic_settles(self) -> bool:
+        """The cyclic flag the running statement switches on has an expression that
+        :func:`~.watch.settles`."""
+        task = self.current_task
+        at = task.at if task is not None else None
+        for node in (self.spin.statements(at) or ()) if at is not None else ():
+            if isinstance(node, N.Assign):
+                return settles(node.value)
+        return False
 
     def cyclic_off(self, key) -> None:
         h = self._cyclic.pop(key, None)
@@ -1216,7 +1245,7 @@ class Runtime:
         task = self.current_task
         n = trunc_int(number, "interrupt number") if number is not None else None
         ctl = self.controller
-        task.irqs.control(action.upper(), n, ctl.io.version, ctl.time)
+        task.irqs.control(action.upper(), n, ctl.io.version, ctl.time, self.cyclic_watch.written())
         self._break(task)
         if action.upper() in ("ENABLE", "ON") and task.irqs.armed:
             self.check_interrupts(task)
@@ -1230,7 +1259,7 @@ class Runtime:
         task.in_poll = True
         ctl = self.controller
         try:
-            ready = task.irqs.poll(ctl.io.version, ctl.time, self.state_epoch)
+            ready = task.irqs.poll(ctl.io.version, ctl.time, self.state_epoch, self.cyclic_watch.written())
         finally:
             task.in_poll = False
         if not ready:
@@ -1270,7 +1299,7 @@ class Runtime:
             # (ROS-Industrial's EKI state timer: `$TIMER[1] = -10` in its own handler)
             task.in_poll = True
             try:
-                task.irqs.poll(ctl.io.version, ctl.time, self.state_epoch)
+                task.irqs.poll(ctl.io.version, ctl.time, self.state_epoch, self.cyclic_watch.written())
             finally:
                 task.in_poll = False
         if ok and task.kind == "robot":

@@ -226,6 +226,7 @@ class IdleWatch:
         self._robot: tuple | None = None   # (cycle, marks, frames) of the robot program's quiet window
         self._phases: dict = {}      # phase of the tasks (:meth:`_phase`) -> cycle, while idle in one state
         self.shifted = 0             # cycles of the periodic jumps (each task's WAIT SEC moved with the clock)
+        self._imaged = None          # _state_key() when the state was imaged last
 
     def clock_read(self) -> None:
         """A task read the clock or a random number: its next statements may differ without
@@ -238,6 +239,25 @@ class IdleWatch:
         robot's axes (deg)."""
         ctl = self.rt.controller
         return (len(ctl.io.log), self.clock, ctl._plan_q.tolist(), ctl._q.tolist())
+
+    def _state_key(self):
+        """What :func:`state_of` images can change by: the statements executed and the cyclic
+        flags' changes (interp/runtime/watch.py ``CyclicWatch.written``), the I/O image's
+        version, the message handle, the tasks' waits, contexts and interrupt tables, the step a
+        parked spin stands at (interp/runtime/spin.py). Equal keys: the same state. None: image
+        it (a debugger or an ``ANIN ON`` may write, a network partner is attached)."""
+        rt = self.rt
+        written = rt.cyclic_watch.written()
+        net = getattr(rt.controller, "network", None)
+        if written is None or (net is not None and net.polling):
+            return None
+        tasks = []
+        for t in rt.scheduler.tasks:
+            irqs = tuple([(n, i.on, i.enabled, i.last, i.pending, id(i.frame)) for n, i in t.irqs.irqs.items()])
+            p = t.parked
+            tasks.append((t.done, t.waiting, len(t.contexts), t.err_text, irqs,
+                          None if p is None else (id(p), (p.done - 1) % p.spin.steps)))
+        return (written, rt.controller.io.version, rt.msg_handle, tuple(tasks))
 
     def _quiet(self) -> bool:
         rt = self.rt
@@ -318,7 +338,11 @@ class IdleWatch:
             return 0
         if ctl.cycle - self.start < self.window:
             return 0
-        state = state_of(rt)
+        # the state is imaged again only when something may have changed it since the last
+        # image (:meth:`_state_key`); else it is that image
+        key = self._state_key()
+        state = self.state if key is not None and key == self._imaged else state_of(rt)
+        self._imaged = key
         if self.state is None or state != self.state:
             if self.state is not None:
                 self.window = min(2 * self.window, MAX_WINDOW_CYCLES)

@@ -120,7 +120,7 @@ class _Pass:
     reads ``$CYCFLAG``, which a cyclic flag's expression may set at any step), ``probes`` (the
     state variables it reads)."""
 
-    __slots__ = ("events", "infos", "at", "frames", "images", "io", "motion", "cyclic", "probes")
+    __slots__ = ("events", "infos", "at", "frames", "images", "io", "motion", "cyclic", "probes", "refs")
 
     def __init__(self, events, infos, at, frames, images) -> None:
         self.events = events
@@ -132,6 +132,7 @@ class _Pass:
         self.motion = False
         self.cyclic = False
         self.probes: tuple = ()
+        self.refs = None            # the references of the probes, found when first read
 
     @property
     def steps(self) -> int:
@@ -195,6 +196,7 @@ class SpinWatch:
         self.bad: dict = {}         # id(task) -> loops that did not give a spin (StmtInfo ids)
         self.passes: dict = {}      # signature of a recorded pass -> analysis (None: not a spin)
         self.replaying = 0          # catch-ups under way
+        self._io_at = (None, False)     # (moment, _io_may_change's answer then)
         self._nodes: dict | None = None
         self._targets: dict = {}    # id(statement) -> the names it writes
         self.parks = self.wakes = self.skipped = self.diverged = self.missed = 0
@@ -308,23 +310,28 @@ class SpinWatch:
             self._fail("waits")
 
     # ------------------------------------------------------------------ recording
-    def _node(self, info):
+    def statements(self, info):
         """The statements of the program at `info`'s file and line (the VM has StmtInfos of its
         own: interp/vm/vm.py), as a tuple; None when there is none."""
-        nodes = self._nodes
-        if nodes is None:
-            nodes = self._nodes = {}
+        files = self._nodes
+        if files is None:
+            files = self._nodes = {}
             for unit in self.rt.program.ws.units:
                 src = unit.src
-                if src is None or src.module is None:
-                    continue
-                for node in src.module.walk():
+                if src is not None and src.module is not None:
+                    files.setdefault(str(src.path), []).append(src.module)
+        nodes = files.get(info.file)
+        if isinstance(nodes, list):         # the file's statements, indexed when first asked for
+            modules, nodes = nodes, {}
+            for module in modules:
+                for node in module.walk():
                     ann = node.ann
                     i = getattr(ann, "info", None) if ann is not None else None
                     if i is not None:
                         key = (i.file, i.line)
                         nodes[key] = nodes.get(key, ()) + (node,)
-        return nodes.get((info.file, info.line))
+            files[info.file] = nodes
+        return nodes.get((info.file, info.line)) if nodes is not None else None
 
     def _record(self, rec: _Recording, task, info, tick: bool) -> None:
         frame = task.frame
@@ -349,7 +356,7 @@ class SpinWatch:
                 if rec.looked > MAX_PASS_STEPS:
                     self._fail("looking")
             return
-        nodes = self._node(info)
+        nodes = self.statements(info)
         if not tick:
             if nodes is None or not all(isinstance(n, ALLOWED) for n in nodes):
                 self._fail("statement")
@@ -526,14 +533,17 @@ class SpinWatch:
 
     def _io_may_change(self) -> bool:
         """The controller's next step may change an input (module docstring)."""
-        ctl = self.rt.controller
+        rt = self.rt
+        ctl = rt.controller
+        # the same cycle, no statement run since (a PULSE, an answer of the automatic cell)
+        at = (ctl.cycle, len(ctl.stimuli), rt.steps - self.skipped)
+        if self._io_at[0] == at:
+            return self._io_at[1]
         nxt = ctl.next_event_cycle()
-        if nxt is not None and nxt <= ctl.cycle + 1:
-            return True
-        if ctl.stimuli and ctl.is_moving() and any(
-                not st.fired and st.due is None and st.reached_mm is not None for st in ctl.stimuli):
-            return True
-        return False
+        may = (nxt is not None and nxt <= ctl.cycle + 1) or (ctl.is_moving() and any(
+            not st.fired and st.due is None and st.reached_mm is not None for st in ctl.stimuli))
+        self._io_at = (at, may)
+        return may
 
     # ------------------------------------------------------------------ parked
     def park(self, task) -> None:
@@ -565,8 +575,11 @@ class SpinWatch:
                 and not any(i.pending for i in task.irqs.irqs.values()))
 
     def _probed(self, spin: _Pass) -> tuple:
-        sv = self.rt.sysvars
-        return tuple(freeze(sv.lookup(k).peek()) for k in spin.probes)
+        refs = spin.refs
+        if refs is None:
+            sv = self.rt.sysvars
+            refs = spin.refs = tuple(sv.lookup(k) for k in spin.probes)
+        return tuple([freeze(r.peek()) for r in refs])
 
     def _place(self, task) -> None:
         """The statement the parked task would stand at (``Task.at``)."""
@@ -588,7 +601,7 @@ class SpinWatch:
         if task.irqs.armed:
             # the poll its resume would make (Runtime.service): an interrupt to run wakes it
             ctl = rt.controller
-            if task.irqs.poll(ctl.io.version, ctl.time, rt.state_epoch):
+            if task.irqs.poll(ctl.io.version, ctl.time, rt.state_epoch, rt.cyclic_watch.written()):
                 return False
         auto = rt.autocell
         if auto is not None and auto.recording is not None:
