@@ -12,8 +12,9 @@ written: the figure is what a user waits for when a whole cell runs.
 One worker process per checkout (``PYTHONPATH=CHECKOUT`` on this interpreter: the checkouts must
 share this venv's dependencies and each needs its generated parser and compiled VM loop, as for
 tools/trace_identity.py) runs the entry points one at a time when the driver asks, so imports are
-paid once and the two checkouts alternate program by program (the first to run alternates too):
-both see the same load. Each run measures, in its worker, the CPU time (``time.process_time``)
+paid once (each worker makes one short untimed run first: the process's one-time costs) and the
+two checkouts alternate program by program (the first to run alternates too): both see the same
+load. Each run measures, in its worker, the CPU time (``time.process_time``)
 of making the runtime (reading the backup; ``setup_s``) and of the run (``run_s``); ``cpu_s`` is
 their sum, the figure is ``sim_s / cpu_s``. Each run also gives a digest of every I/O change of
 the run (time, signal, value, source: robot/io.py ``IOImage.log``), the end (reason, simulated
@@ -171,6 +172,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--limit", type=int, default=0)
     ap.add_argument("--json", default=None, help="write the rows and the summary here")
     ap.add_argument("--corpus", default=str(CORPUS))
+    ap.add_argument("--no-warm-up", action="store_true", help="time the first run of each worker too")
     a = ap.parse_args(argv)
     corpus = Path(a.corpus)
     if not corpus.is_dir():
@@ -190,6 +192,11 @@ def main(argv: list[str] | None = None) -> int:
     workers = {name: Worker(co) for name, co in sides}
     rows = []
     try:
+        if programs and not a.no_warm_up:
+            # the first run of a process pays its one-time costs (lazy imports, the first
+            # compile of the VM's code, numpy's first calls): one short untimed run each
+            for w in workers.values():
+                w.run(programs[0], min(1.0, a.sim_time), a.interp)
         names = [n for n, _ in sides]
         head = f"{'entry point':58s} " + " ".join(f"{n + ' cpu s':>10s} {n + ' sim/cpu':>12s}" for n in names)
         if a.baseline:

@@ -72,6 +72,9 @@ class Irq:
     by_epoch: bool = False        # every probe changes only with the runtime's state epoch
     probe_epoch: object = None    # the state epoch at which `probed` was read
     probed: tuple = ()            # the probes' values at `probe_epoch`
+    steady: bool = False          # its value changes only with the I/O image, a statement, a cyclic
+                                  # flag or a task's state, never at a step of the moving robot
+                                  # (interp/runtime/watch.py ``steady``)
 
 
 @dataclass

@@ -21,7 +21,7 @@ from krl.semantics.resolve import NATIVE, ROUTINE, Callee, Storage
 from .builtins import NATIVES, ValueRef
 from .netfunctions import RSI_CONSTANTS
 from .contexts import Context, Irq
-from .watch import CyclicWatch, settles, split_watch
+from .watch import CONSTANT, IO, SETTLES, CyclicWatch, settles, split_watch, stamp_key, steady, watch_of
 from .convert import INT_MAX, INT_MIN, assign_into, binary_op, convert_scalar, to_bool, trunc_int, unary_op
 from .errors import (HaltSignal, KrlRuntimeError, ResumeSignal, StopRun)
 from .idle import probe_state
@@ -30,7 +30,7 @@ from .messages import MessageWindow
 from .motion import frame_of, params_from, request, segment, target_of
 from .program import Program
 from .runmode import STEP_MODES, BackwardRefused, MotionHistory, mode_name
-from .scheduler import Scheduler, Task
+from .scheduler import Scheduler, Task, program_budget
 from .sysvars import EPOCH_PROBED, SysVars, struct_of
 from .values import LEAVES, UNSET, Arr, EnumValue, Struct, copy_value, make_value, maker, value_size
 
@@ -148,7 +148,8 @@ class Runtime:
         self.noted: set[str] = set()    # simulator notes given once per run (builtins)
         self.steps = 0
         self.max_steps = max_steps
-        self.robot_budget = robot_budget
+        # the program's time slice: a .sub selected on its own runs at the submit pace
+        self.robot_budget = robot_budget if robot_budget is not None else program_budget(main_path)
         self.sysvars = SysVars(self)
         self.memory = DataMemory()
         self.program = Program(self, main_path, workspace, submits, check)
@@ -463,9 +464,19 @@ class Runtime:
         """Advance-run stop: wait until the main run is idle (robot at rest)."""
         ctl = self.controller
         if not ctl.is_idle():
-            while not ctl.is_idle():
-                self.yield_cycle(task)
+            self._wait(task, ctl.is_idle)
             self._proceed()
+
+    def _wait(self, task: Task, until) -> None:
+        """Give IPO cycles back until ``until()`` — a test of the controller's state, with no
+        effect — holds. While the task waits so, the scheduler makes the test itself instead of
+        resuming it (interp/runtime/scheduler.py ``Scheduler._waits``)."""
+        outer, task.until = task.until, until
+        try:
+            while not until():
+                self.yield_cycle(task)
+        finally:
+            task.until = outer
 
     def wait_for(self, cond_fn, text: str = "WAIT FOR") -> None:
         """WAIT FOR: ``cond_fn()`` is evaluated now and once per IPO cycle."""
@@ -473,14 +484,41 @@ class Runtime:
         if to_bool(cond_fn(), "WAIT FOR condition"):
             return
         task.waiting = f"{text} at {task.file}:{task.line}" if task.kind == "robot" else None
+        # a condition over inputs and variables (interp/runtime/watch.py) gives the same value
+        # while its watch key stands: the scheduler tests the key instead of resuming the task
+        key = self._wait_key(task) if text == "WAIT FOR" else None
+        outer = task.until
         try:
             while True:
+                if key is not None:
+                    seen = key()
+                    task.until = None if seen is None else (lambda seen=seen: key() != seen)
                 self.yield_cycle(task)
                 if to_bool(cond_fn(), "WAIT FOR condition"):
                     self._proceed()
                     return
         finally:
             task.waiting = None
+            task.until = outer
+
+    def _wait_key(self, task: Task):
+        """The watch key (interp/runtime/watch.py ``stamp_key``) of the condition of the WAIT FOR
+        `task` stands at, as a zero-argument callable; None when its class has none that stands
+        (it reads the clock, calls a routine, ...)."""
+        node = next((n for n in self.spin.statements(task.at) or () if isinstance(n, N.WaitFor)), None)
+        if node is None:
+            return None
+        ann = node.annotate()
+        w = ann.extra.get("watch")
+        if w is None:
+            w = ann.extra["watch"] = watch_of(node.cond)
+        cls, names = split_watch(w)
+        if cls not in (CONSTANT, IO, SETTLES):
+            return None
+        probes = tuple(_reader(self.sysvars.lookup(k)) for k in names)
+        ctl = self.controller
+        written = self.cyclic_watch.written
+        return lambda: stamp_key(cls, ctl.io.version, ctl.time, probes, written())
 
     def wait_sec(self, seconds) -> None:
         """WAIT SEC t: t seconds of simulated time (rounded up to IPO cycles)."""
@@ -498,8 +536,7 @@ class Runtime:
         shifted = idle.shifted
         try:
             # task.wake_cycle, not a local: a periodic jump of the idle watch moves it
-            while ctl.cycle < task.wake_cycle:
-                self.yield_cycle(task)
+            self._wait(task, lambda: ctl.cycle >= task.wake_cycle)
             self._proceed()
         finally:
             # an outer WAIT SEC (this one ran in an interrupt routine) moves with the jumps too
@@ -1129,8 +1166,7 @@ class Runtime:
         adv = self.sysvars.store.get("$ADVANCE")
         ctl.advance = int(adv) if isinstance(adv, int) else 3
         if not ctl.can_enqueue():
-            while not ctl.can_enqueue():
-                self.yield_cycle(task)
+            self._wait(task, ctl.can_enqueue)
             self._proceed()
         try:
             mid = ctl.enqueue(req)
@@ -1235,7 +1271,8 @@ class Runtime:
         # a computed variable's getter is its peek, one call less at each poll
         probes = tuple(_reader(self.sysvars.lookup(k)) for k in names)
         task.irqs.declare(Irq(n, cond_fn, handler_fn, name, frame, is_global, line, watch=cls,
-                              probes=probes, by_epoch=all(k in EPOCH_PROBED for k in names)))
+                              probes=probes, by_epoch=all(k in EPOCH_PROBED for k in names),
+                              steady=steady(watch)))
         if not frame.interrupts:
             frame.interrupts = []
         frame.interrupts.append(n)

@@ -292,6 +292,25 @@ class IdleWatch:
             self.robot_starves()
         return n
 
+    def moved(self) -> None:
+        """:meth:`cycle` of a cycle in which the robot moved while the run is quiet and not
+        idle (interp/runtime/scheduler.py, "Steady cycles"): what it would do then — its marks
+        differ from the last cycle's, so the quiet window starts again here, and so does the
+        robot program's (:meth:`robot_starves`) — without testing what is known."""
+        rt = self.rt
+        ctl = rt.controller
+        self.start, self.marks, self.state, self.since = ctl.cycle, self._marks(), None, None
+        self._phases = {}
+        auto = self.auto
+        if auto is None:
+            return
+        robot = rt.robot
+        if robot is None or robot.done or auto.pending() or robot.wake_cycle is not None:
+            self._robot = None
+        else:
+            self._robot = (ctl.cycle, (self.robot_io, robot.waiting, tuple(ctl._q.tolist()),
+                                       tuple(ctl.planned_axes().tolist())), None)
+
     def robot_starves(self) -> None:
         """The robot program starves while the run is not idle (a submit program blinks a
         lamp on a timer): for a whole window it stood in one WAIT FOR, or it executed

@@ -107,6 +107,19 @@ def watch_of(expr) -> str:
     return worst + (":" + ",".join(probes) if probes else "")
 
 
+#: probed system variables the controller's step changes while the robot moves
+STEP_PROBED = frozenset({"$PRO_MOVE", "$VEL_ACT"})
+
+
+def steady(watch: str) -> bool:
+    """True when a condition of watch string `watch` keeps its value while only the controller
+    steps (the robot moving; nothing runs, the I/O image and the cyclic flags unchanged): class
+    CONSTANT, IO or SETTLES, no probe of :data:`STEP_PROBED` (interp/runtime/scheduler.py,
+    "Steady cycles")."""
+    cls, names = split_watch(watch)
+    return cls in (CONSTANT, IO, SETTLES) and not STEP_PROBED.intersection(names)
+
+
 def split_watch(watch: str) -> tuple[str, tuple[str, ...]]:
     """``(class, probed system variable names)`` of a watch string."""
     cls, _, names = watch.partition(":")

@@ -260,3 +260,17 @@ def test_every_corpus_entry_point_is_the_same_parked_and_shadowed():
         assert (rt.scheduler.spin.diverged, rt.scheduler.spin.missed) == (0, 0), program
         rt, _ = _real(program, "vm", True, 120.0, shadow=True)
         assert rt.scheduler.spin.shadow_errors == 0, (program, rt.scheduler.spin.why)
+
+
+@pytest.mark.parametrize("interp", INTERPS)
+def test_a_submit_program_selected_alone_runs_at_the_submit_pace(tmp_path, interp):
+    """A .sub run as the program (``krl run SPS.SUB``) gets the submit interpreter's time slice,
+    as beside a robot program: 101 slices (cycles 0..100, the run ends when 1.2 s is reached)
+    of SUBMIT_BUDGET steps; its counter changes every pass, so nothing is parked or skipped."""
+    s = write(tmp_path, "alone.sub", "DEF alone()\n  INT n\n  n = 0\n  LOOP\n    n = n + 1\n  ENDLOOP\nEND\n")
+    rt, _ = make_runtime(s, trace=None, max_sim_time=1.2, max_steps=10**7, mujoco=False, check=False,
+                         interp=interp)
+    res = rt.run()
+    assert rt.robot.budget == SUBMIT_BUDGET == 100
+    assert res.steps == 101 * SUBMIT_BUDGET
+    assert rt.scheduler.spin.parks == 0
