@@ -159,22 +159,26 @@ class AutoCell:
         if key not in rec:
             rec[key] = (task, info.file, info.line, frame, len(rec))
 
-    def _statements(self) -> dict:
-        """(resolved file, line) -> the statements of the program's files on that line."""
+    def _statements(self, key_file: str) -> dict:
+        """line -> the statements (IF, WHILE, REPEAT and its UNTIL, WAIT FOR, SWITCH) on that line
+        of the program's file `key_file` (resolved), indexed when first asked for."""
         if self._index is None:
-            idx: dict = {}
+            self._index = {}
             for unit in self.rt.program.ws.units:
                 src = unit.src
-                if src is None or src.module is None:
-                    continue
-                key_file = str(Path(src.path).resolve())
-                for node in src.module.walk():
+                if src is not None and src.module is not None:
+                    self._index.setdefault(str(Path(src.path).resolve()), []).append(src.module)
+        idx = self._index.get(key_file)
+        if isinstance(idx, list):
+            modules, idx = idx, {}
+            for module in modules:
+                for node in module.walk():
                     if isinstance(node, (N.If, N.While, N.Repeat, N.WaitFor, N.Switch)) and node.span is not None:
-                        idx.setdefault((key_file, node.span.line), []).append(node)
+                        idx.setdefault(node.span.line, []).append(node)
                     if isinstance(node, N.Repeat) and node.cond is not None and node.cond.span is not None:
-                        idx.setdefault((key_file, node.cond.span.line), []).append(node)
-            self._index = idx
-        return self._index
+                        idx.setdefault(node.cond.span.line, []).append(node)
+            self._index[key_file] = idx
+        return idx if idx is not None else {}
 
     def _nodes_at(self, file: str, line: int) -> list:
         if not file:
@@ -182,7 +186,7 @@ class AutoCell:
         key = self._resolved.get(file)
         if key is None:
             key = self._resolved[file] = str(Path(file).resolve())
-        return self._statements().get((key, line), [])
+        return self._statements(key).get(line, [])
 
     def pending(self) -> bool:
         """True while an answer has not taken effect yet."""
