@@ -554,6 +554,8 @@ class SpinWatch:
         if rt.steps >= task.slice_end or len(task.contexts) != 1 or not self.parked_ok(task):
             return
         left = task.slice_end - rt.steps        # the rest of this time slice: taken as passes
+        if rt.max_steps is not None and rt.steps + left + 2 * (task.budget + spin.steps) > rt.max_steps:
+            return                              # the step limit is near: it ends at a statement
         if self.shadow:
             task.shadow = _Parked(spin, 0, rt.controller.io.version, self._probed(spin))
             task.shadow.expect = left   # the steps parking would count by the end of this slice

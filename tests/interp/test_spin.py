@@ -84,12 +84,12 @@ ENDDAT
 
 
 def _run(tmp_path, prog: str, sub: str, *, interp: str, enabled: bool = True, shadow: bool = False,
-         stimuli: str | None = None, max_sim_time: float = 30.0):
+         stimuli: str | None = None, max_sim_time: float = 30.0, max_steps: int = 10_000_000):
     p = write(tmp_path, "prog.src", prog)
     write(tmp_path, "prog.dat", DAT)
     s = write(tmp_path, "sps.sub", sub)
     inputs = write(tmp_path, "stimuli.yaml", stimuli) if stimuli else None
-    rt, _ = make_runtime(p, inputs=inputs, trace=None, max_sim_time=max_sim_time, max_steps=10_000_000,
+    rt, _ = make_runtime(p, inputs=inputs, trace=None, max_sim_time=max_sim_time, max_steps=max_steps,
                          mujoco=False, submit=[s], check=False, interp=interp)
     rt.scheduler.spin.enabled = enabled
     rt.scheduler.spin.shadow = shadow
@@ -145,6 +145,17 @@ def test_both_interpreters_park_and_end_alike(tmp_path):
         rt, res = _run(tmp_path, PROG, SPS, interp=interp, stimuli=stim)
         out.append((rt.controller.io.log, res.reason, res.steps, res.sim_time, rt.scheduler.spin.parks))
     assert out[0] == out[1]
+
+
+@pytest.mark.parametrize("interp", INTERPS)
+@pytest.mark.parametrize("limit", [50_000, 50_037])
+def test_the_step_limit_ends_the_run_at_the_same_statement(tmp_path, interp, limit):
+    """The robot moves while the submit program spins: the run ends at the step limit, at the
+    statement and with the steps of the unparked run (a parked task is woken, or not parked,
+    when the limit comes near)."""
+    rt, res = _same_run(tmp_path, MOVING, SPS, interp, max_steps=limit)
+    assert res.reason == "max_steps" and res.steps == limit + 1
+    assert rt.scheduler.spin.parks >= 1
 
 
 @pytest.mark.parametrize("interp", INTERPS)
