@@ -272,12 +272,10 @@ def run_one(path: Path, max_sim_time: float, max_steps: int, cell: Path | None =
         inputs = "auto" if auto else cell
         robot, submit, max_sim_time, limit = report_run(path, cell, max_sim_time, max_steps, auto)
         own = _own_machine_data(path, robot.source)
-        from interp.runtime.scheduler import SUBMIT_BUDGET  # noqa: PLC0415
-
         # --no-check: the report says how each real program runs, also those the checker rejects
+        # (an SPS.SUB entry runs at the submit interpreter's pace: scheduler.program_budget)
         rt, _ = make_runtime(path, trace=None, mujoco=False, max_sim_time=max_sim_time, max_steps=limit,
-                             submit=submit, check=False, inputs=inputs, robot=robot, interp=interp,
-                             robot_budget=SUBMIT_BUDGET if path.suffix.lower() == ".sub" else None)
+                             submit=submit, check=False, inputs=inputs, robot=robot, interp=interp)
         res = rt.run()
         stubs = {name: n for name, _what, n in rt.kss.summary()}
         rules = rt.controller.rules
