@@ -45,8 +45,10 @@ Routines of technology packages absent from the backup are stubbed (a ``message`
 "stub: NAME"), and the report lists the stubs.
 
 Usage: ``python -m interp.realprograms [CORPUS] [--json OUT] [--limit N] [--columns cells,auto]
-[--interp vm|tree] [--jobs N] [--scheduler tcp://HOST:PORT]`` (``--jobs``: worker processes of this machine,
-one per core by default; ``--scheduler``: the runs go to a Dask cluster, :func:`run_rows`; the same report).
+[--interp vm|tree] [--jobs N] [--scheduler tcp://HOST:PORT] [--history new|old|both]`` (``--jobs``: worker
+processes of this machine, one per core by default; ``--scheduler``: the runs go to a Dask cluster,
+:func:`run_rows`; the same report; ``--history``: CORPUS is ../shared/krl-history and the programs are
+those of each pair's side, in backups or not, :func:`history_entries`).
 """
 
 from __future__ import annotations
@@ -190,6 +192,41 @@ def entries_of(root: Path) -> list[Path]:
     progs = programs_of(root)
     sub = boot_submit(progs[0]) if progs else None
     return progs + ([sub] if sub is not None and sub not in progs else [])
+
+
+def loose_programs(folder: Path) -> list[Path]:
+    """The programs of `folder` outside its backups (krl.project.find_backups): every ``.src``
+    file below it, not inside a backup, whose first routine is a DEF without parameters (the
+    programs of a repository that is not a controller backup, as ../shared/krl-history's
+    sides mostly are), in path order."""
+    from interp.runtime.program import parse_module  # noqa: PLC0415
+
+    roots = [b.resolve() for b in find_backups(folder)]
+    out = []
+    for p in sorted(folder.rglob("*")):
+        if p.suffix.lower() != ".src" or not p.is_file():
+            continue
+        rp = p.resolve()
+        if any(rp.is_relative_to(r) for r in roots):
+            continue
+        mod, _errs = parse_module(str(p))
+        if mod.routines and not mod.routines[0].params and mod.routines[0].kind == "DEF":
+            out.append(p)
+    return out
+
+
+def history_entries(history: Path, sides: tuple[str, ...] = ("new",)) -> list[Path]:
+    """The entry points of ../shared/krl-history's pair sides `sides` (``old``, ``new``;
+    layout ``OWNER__NAME/NN-SHA/SIDE``): of each side, the entry points of its backups
+    (:func:`entries_of`), then its programs outside a backup (:func:`loose_programs`)."""
+    out = []
+    for side in sides:
+        for folder in sorted(history.glob(f"*/*/{side}")):
+            if not folder.is_dir():
+                continue
+            out += [p for root in find_backups(folder) for p in entries_of(root)]
+            out += loose_programs(folder)
+    return out
 
 
 def normalise(text: str) -> str:
@@ -404,7 +441,8 @@ def report(rows: list[dict]) -> str:
 
 def run_rows(corpus: Path, max_sim_time: float = REPORT_SIM_TIME_S, max_steps: int = REPORT_STEPS, *,
              cells: bool = True, limit: int = 0, columns: tuple[str, ...] = ("cells",), interp: str = "tree",
-             scheduler: str | None = None, jobs: int = 1, progress=None) -> list[dict]:
+             scheduler: str | None = None, jobs: int = 1, progress=None,
+             history: tuple[str, ...] = ()) -> list[dict]:
     """The report's rows: :func:`run_one` of each entry point of the backups below `corpus`
     (:func:`entries_of`; at most `limit` of them, 0: all), in the corpus's order, once per
     column of `columns` ("cells": with its committed cell file unless `cells` is False;
@@ -414,9 +452,14 @@ def run_rows(corpus: Path, max_sim_time: float = REPORT_SIM_TIME_S, max_steps: i
     `jobs` > 1 runs them in that many worker processes of this machine (krl/pool.py: each run is
     independent, so the rows are the same as one after the other, ``seconds`` aside).
     `progress(column, row)` is called as each row arrives (in completion order when the runs
-    are parallel; the rows returned are always in the corpus's order). Raises
-    krl.cluster.SchedulerError when the scheduler cannot be used."""
-    programs = [p for root in find_backups(corpus) for p in entries_of(root)]
+    are parallel; the rows returned are always in the corpus's order). `history`: `corpus` is
+    ../shared/krl-history, and the programs are those of its pair sides `history`
+    (:func:`history_entries`). Raises krl.cluster.SchedulerError when the scheduler cannot be
+    used."""
+    if history:
+        programs = history_entries(corpus, history)
+    else:
+        programs = [p for root in find_backups(corpus) for p in entries_of(root)]
     if limit:
         programs = programs[:limit]
     tasks = []
@@ -473,8 +516,12 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--scheduler", default=None, metavar="tcp://HOST:PORT",
                     help="make the runs on this Dask distributed scheduler's cluster (its workers "
                          "see the corpus at the same paths); the same report as the local run")
+    ap.add_argument("--history", default=None, choices=("new", "old", "both"),
+                    help="CORPUS is ../shared/krl-history: run the programs of each pair's new "
+                         "(old, both) side, its backups' entry points and its programs outside a backup")
     a = ap.parse_args(argv)
     corpus = Path(a.corpus)
+    history = {"new": ("new",), "old": ("old",), "both": ("old", "new"), None: ()}[a.history]
     cols = [c.strip() for c in a.columns.split(",") if c.strip()]
     if not cols or any(c not in ("cells", "auto") for c in cols):
         ap.error("--columns takes cells, auto or cells,auto")
@@ -497,7 +544,8 @@ def main(argv: list[str] | None = None) -> int:
     try:
         rows = run_rows(corpus, a.max_sim_time, a.max_steps, cells=not a.no_cells, limit=a.limit,
                         columns=tuple(cols), interp=a.interp, scheduler=a.scheduler,
-                        jobs=a.jobs if a.jobs is not None else default_jobs(), progress=progress)
+                        jobs=a.jobs if a.jobs is not None else default_jobs(), progress=progress,
+                        history=history)
     except SchedulerError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2

@@ -530,8 +530,9 @@ class Runtime:
         UNRESOLVED; docs/architecture.md, "One program model"): a ``$`` name is a system
         variable the simulator knows, or one that a system data list or KSS's system files
         declare (``SysVars.lookup``); in a backup, a variable of KUKA's software the backup
-        lacks stands in (interp/runtime/kss.py: its zero value, one note); any other name is
-        the run-time error "unknown name", as on the controller."""
+        lacks stands in (interp/runtime/kss.py: the names the checker classifies outside the
+        program, one note each); any other name is the run-time error "unknown name", as on
+        the controller."""
         key = name.upper()
         if key[:1] == "$":
             r = self.sysvars.lookup(key)
@@ -539,10 +540,9 @@ class Runtime:
                 return r
         elif key in RSI_CONSTANTS:      # RSI's constants (RSIOK, ...): the option declares them
             return ValueRef(RSI_CONSTANTS[key], key)
-        if self.program.backup:
-            r = self.kss.name_ref(name)     # a variable of KUKA's software (interp/runtime/kss.py)
-            if r is not None:
-                return r
+        r = self.kss.name_ref(name)     # a variable of KUKA's software (interp/runtime/kss.py)
+        if r is not None:
+            return r
         raise KrlRuntimeError(f"unknown name {name}")
 
     def index(self, base: Ref, idx: list, name: str) -> Ref:
@@ -610,8 +610,8 @@ class Runtime:
         return NATIVES.get(c.native) if c.kind == NATIVE else None
 
     def stub_call(self, name: str, is_function: bool):
-        """A call of a routine that the program does not contain: in a backup, a routine of
-        KUKA's system software stands in (interp/runtime/kss.py: counted, one note);
+        """A call of a routine that the program does not contain: a routine of KUKA's system
+        software (the checker's classification) stands in (interp/runtime/kss.py: counted, one note);
         anything else is the run-time error "routine NAME not found"."""
         return self.kss.call(name, is_function)
 

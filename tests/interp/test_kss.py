@@ -90,6 +90,83 @@ def test_the_template_names_of_technology_packages_stand_in(tmp_path, interp):
     assert summary["USERSPOT"] == ("procedure", 2)
 
 
+ARC_PROG = """
+DEF weld()
+  ;FOLD INI
+  ;FOLD ARCTECH INI
+  IF ARC_OPTION==#ACTIVE THEN
+    ARC_INIT(#STD, ARC_DEFAULT)
+    $OUT[5] = TRUE
+  ENDIF
+  IF ARC_OPTION<>#ACTIVE THEN
+    $OUT[6] = TRUE
+  ENDIF
+  SWITCH ARC_MODE
+  CASE #PULSE, #STANDARD
+    $OUT[7] = TRUE
+  DEFAULT
+    $OUT[8] = TRUE
+  ENDSWITCH
+  ;ENDFOLD (ARCTECH INI)
+  ;FOLD SPOTTECH INI
+  USERSPOT(SPOT_INI, 3 + SPOT_COUNT)
+  ;ENDFOLD (SPOTTECH INI)
+  ;FOLD USER INI
+  ;ENDFOLD (USER INI)
+  ;ENDFOLD (INI)
+  $OUT[1] = TRUE
+END
+"""
+
+
+@pytest.mark.parametrize("where", ("backup", "folder"))
+def test_an_enum_of_a_package_the_backup_lacks_reads_not_installed(tmp_path, where):
+    """ArcTech's INI fold tests a variable of an ENUM type nothing declares (issue 46):
+    ARC_OPTION gets a stand-in ENUM of the literals its uses compare it with (#ACTIVE) plus
+    #NOT_INSTALLED, so ==#ACTIVE is FALSE and <>#ACTIVE TRUE; ARC_MODE, switched on #PULSE and
+    #STANDARD, takes the DEFAULT branch. USERSPOT's arguments are evaluated (SPOT_INI: no type
+    from its uses, the not-installed value; SPOT_COUNT: INT from 3 + ...) in both interpreters,
+    with one note each. The same in a plain folder: the checker decides the same there."""
+    if where == "backup":
+        prog = _backup(tmp_path, ARC_PROG)
+    else:
+        prog = write(tmp_path, "weld.src", ARC_PROG)
+    runs = [_run(prog, i) for i in INTERPS]
+    assert runs[0][2] == runs[1][2]                 # the same trace, event by event
+    rt, res, events = runs[0]
+    assert res.reason == "completed", res.text
+    io = [(e["signal"], e["value"]) for e in events if e["kind"] == "io"]
+    assert io == [("$OUT[6]", True), ("$OUT[8]", True), ("$OUT[1]", True)]
+    notes = [e["text"] for e in events if e["kind"] == "message"]
+    place = "the backup" if where == "backup" else "the program's files"
+    ini = "the template's INI fold {} uses it (KUKA's template and technology packages write that fold)"
+    assert notes == [
+        f"stub: ARC_OPTION (variable of KUKA's system software not in {place}: {ini.format('ARCTECH INI')}): "
+        "reads #NOT_INSTALLED (the package is not installed: equal to none of #ACTIVE)",
+        f"stub: ARC_MODE (variable of KUKA's system software not in {place}: {ini.format('ARCTECH INI')}): "
+        "reads #NOT_INSTALLED (the package is not installed: equal to none of #PULSE, #STANDARD)",
+        f"stub: SPOT_INI (variable of KUKA's system software not in {place}: {ini.format('SPOTTECH INI')}): "
+        "reads #NOT_INSTALLED (the package is not installed; its uses give it no type)",
+        f"stub: SPOT_COUNT (variable of KUKA's system software not in {place}: {ini.format('SPOTTECH INI')}): "
+        "reads 0",
+        f"stub: USERSPOT (procedure of KUKA's system software not in {place}: {ini.format('SPOTTECH INI')}): "
+        "no effect",
+    ]
+    summary = {name: (what, n) for name, what, n in rt.kss.summary()}
+    assert summary["USERSPOT"] == ("procedure", 1) and summary["ARC_OPTION"] == ("variable", 1)
+    assert "ARC_INIT" not in summary                # never called: the package is not installed
+
+
+def test_the_not_installed_value_is_none_of_the_literals(tmp_path):
+    """A program that compares with #NOT_INSTALLED itself: the stand-in's value differs."""
+    prog = _backup(tmp_path, "DEF weld()\n  ;FOLD INI\n  IF X_OPT==#NOT_INSTALLED THEN\n    $OUT[1] = TRUE\n"
+                             "  ENDIF\n  ;ENDFOLD (INI)\nEND\n")
+    _rt, res, events = _run(prog)
+    assert res.reason == "completed" and not [e for e in events if e["kind"] == "io"]
+    assert [e["text"] for e in events if e["kind"] == "message"][0].endswith(
+        "reads #NOT_INSTALLED_ (the package is not installed: equal to none of #NOT_INSTALLED)")
+
+
 def test_a_name_of_the_program_only_is_its_error(tmp_path):
     prog = _backup(tmp_path, "DEF weld()\n  IF GATE_OPEN THEN\n    $OUT[1] = TRUE\n  ENDIF\nEND\n")
     _rt, res, _ = _run(prog)
