@@ -53,10 +53,26 @@ class RunResult:
     text: str = ""
     sim_time: float = 0.0
     steps: int = 0
+    #: (file, line) of each frame of the robot program's call stack where it stopped, innermost
+    #: first (the run summary says what a wait in a caller waits for: interp/summary.py)
+    stack: tuple = ()
 
     @property
     def exit_code(self) -> int:
         return EXIT_CODES.get(self.reason, 2)
+
+
+def call_stack(task, limit: int = 64) -> tuple:
+    """(file, line) of each frame of `task` (innermost first, at most `limit`): where each
+    routine of its call stack stands."""
+    out = []
+    frame = task.frame
+    while frame is not None and len(out) < limit:
+        span = getattr(frame.routine, "span", None)
+        if span is not None and span.file and frame.line:
+            out.append((span.file, frame.line))
+        frame = frame.caller
+    return tuple(out)
 
 
 def _scalar(t) -> bool:
@@ -269,7 +285,8 @@ class Runtime:
             text = f"{text} while the robot program waits: {robot.waiting}"
         if reason == "completed":
             file, line, ctx = robot.file, robot.line, "main"
-        self.result = RunResult(reason, err, file, line, ctx, text, self.controller.time, self.steps)
+        self.result = RunResult(reason, err, file, line, ctx, text, self.controller.time, self.steps,
+                                call_stack(robot))
         if self.trace is not None and reason == "error" and err is not None and not err.traced:
             # the robot program's run-time error, before the `end` event (robot/trace.py);
             # a submit program's error was written when that task ended (submit_finished)
