@@ -272,14 +272,14 @@ def time_limit(path: Path, cell, default: float) -> float:
 
 
 def report_run(path: Path, cell: Path | None, max_sim_time: float = REPORT_SIM_TIME_S,
-               max_steps: int = REPORT_STEPS, auto: bool = False) -> tuple:
+               max_steps: int = REPORT_STEPS, auto: bool = False, auto_sim_time: float | None = None) -> tuple:
     """``(robot, submit programs, simulated-time limit s, step limit)`` of the report's run of
     `path` with its cell file (a path or a Cell: interp.run.cell_of), or with ``--inputs auto``
     (`auto`; this report and the conformance report's real programs): the cell's robot, else
     the backup's own, else (auto) the library robot that reaches the backup's points, else the
     KR 6 R900 (interp.run.robot_for); the backup's SPS.SUB (none for the SPS.SUB itself: it
     runs as the program, at a submit interpreter's pace); :func:`time_limit` (auto: the longer
-    :data:`AUTO_SIM_TIME_S` for a robot program) and :func:`step_limit`."""
+    `auto_sim_time`, default :data:`AUTO_SIM_TIME_S`, for a robot program) and :func:`step_limit`."""
     from interp.run import cell_of, robot_for  # noqa: PLC0415
 
     cell = None if auto else cell_of(cell)
@@ -287,19 +287,56 @@ def report_run(path: Path, cell: Path | None, max_sim_time: float = REPORT_SIM_T
     submit = submit_of(path)
     sub = path.suffix.lower() == ".sub"
     if auto:
-        t = max_sim_time if sub else max(max_sim_time, AUTO_SIM_TIME_S)
+        t = max_sim_time if sub else max(max_sim_time, AUTO_SIM_TIME_S if auto_sim_time is None else auto_sim_time)
     else:
         t = time_limit(path, cell, max_sim_time)
     return robot, submit, t, step_limit(max_steps, t, len(submit) + sub, robot.ipo_cycle_s)
 
 
+#: the run-time errors of a name nothing of the program declares (interp/runtime/core.py,
+#: interp/runtime/kss.py): the name, and whether it is a routine
+_UNKNOWN = re.compile(r"^(?:unknown name (?P<name>\S+)|routine (?P<routine>\S+) not found)$")
+
+
+def outside_stops(rt) -> list[str]:
+    """The run-time errors of the run `rt` (its robot program's, its submit programs') that
+    stop on a name the checker classifies outside the program (krl/semantics/outside.py
+    ``Unresolved.classify``: W101/W105/W106/W107), as ``NAME at file:line: why``. Issue 46: the
+    run stands in for every such name (interp/runtime/kss.py), so this is always empty unless
+    the checker and the run disagree."""
+    unresolved = rt.program.ws.unresolved()
+    outside = unresolved.classify() if unresolved is not None else {}
+    errors = []
+    if rt.result is not None and rt.result.reason == "error" and rt.result.error is not None:
+        errors.append((rt.result.error, rt.result.file, rt.result.line))
+    for task in rt.scheduler.tasks:
+        reason, err = task.outcome or (None, None)
+        if task.kind == "submit" and reason == "error" and err is not None:
+            errors.append((err, err.file or task.file, err.line or task.line))
+    out = []
+    for err, file, line in errors:
+        m = _UNKNOWN.match(err.message or "")
+        if m is None:
+            continue
+        name = (m.group("name") or m.group("routine")).upper()
+        kinds = ("routine",) if m.group("routine") else ("sysvar",) if name.startswith("$") else ("name",)
+        for kind in kinds:
+            o = outside.get((kind, name))
+            if o is not None:
+                out.append(f"{o.name} at {file}:{line}: {o.why}")
+    return out
+
+
 def run_one(path: Path, max_sim_time: float, max_steps: int, cell: Path | None = None,
-            auto: bool = False, interp: str = "tree") -> dict:
+            auto: bool = False, interp: str = "tree", auto_sim_time: float | None = None) -> dict:
     """One run of the report (module docstring): with the cell file `cell` (a path or a Cell:
     interp.run.cell_of), or with ``--inputs auto`` (`auto`; then `cell` is not used), on the
     interpreter `interp`. The row holds how it ended, its cause, the stand-ins of KUKA's
     software (``stubs``, name -> uses), the cell's answers (``cell_answers``, ``cell_last`` s;
-    ``answers``: the automatic cell's, described) and the idle time skipped."""
+    ``answers``: the automatic cell's, described), the idle time skipped, and the stops on a
+    name the checker classifies outside the program (``outside_stops``, :func:`outside_stops`).
+    `auto_sim_time`: the time limit of an ``--inputs auto`` run of a robot program (default
+    :data:`AUTO_SIM_TIME_S`; a bounded sweep gives less)."""
     from interp.run import cell_of, make_runtime  # noqa: PLC0415
 
     t0 = time.time()
@@ -307,7 +344,8 @@ def run_one(path: Path, max_sim_time: float, max_steps: int, cell: Path | None =
     try:
         cell = None if auto else cell_of(cell)   # the cell file, read once for the robot, the limits and the run
         inputs = "auto" if auto else cell
-        robot, submit, max_sim_time, limit = report_run(path, cell, max_sim_time, max_steps, auto)
+        robot, submit, max_sim_time, limit = report_run(path, cell, max_sim_time, max_steps, auto,
+                                                        auto_sim_time)
         own = _own_machine_data(path, robot.source)
         from interp.runtime.scheduler import SUBMIT_BUDGET  # noqa: PLC0415
 
@@ -317,6 +355,7 @@ def run_one(path: Path, max_sim_time: float, max_steps: int, cell: Path | None =
                              robot_budget=SUBMIT_BUDGET if path.suffix.lower() == ".sub" else None)
         res = rt.run()
         stubs = {name: n for name, _what, n in rt.kss.summary()}
+        stops = outside_stops(rt)
         rules = rt.controller.rules
         fired = [r.last_fired for r in rules if r.last_fired is not None]
         answers = rt.autocell.answers if rt.autocell is not None else []
@@ -338,7 +377,7 @@ def run_one(path: Path, max_sim_time: float, max_steps: int, cell: Path | None =
            "cell_last": round(max(fired), 3) if fired else None,
            "answers": [a.describe() for a in answers],
            "idle_s": round(rt.scheduler.idle.skipped * rt.controller.dt, 3),
-           "robot": robot.name, "robot_own": own}
+           "robot": robot.name, "robot_own": own, "outside_stops": stops}
     row["cause"] = cause_of(row)
     return row
 
@@ -431,6 +470,11 @@ def report(rows: list[dict]) -> str:
         lines.append("")
         lines.append("Stand-ins of KUKA's software the backups lack (uses, in how many runs; "
                      "interp/runtime/kss.py): " + ", ".join(f"{s} ({c} in {runs[s]})" for s, c in stubs.most_common()))
+    stops = [s for r in rows for s in r.get("outside_stops") or ()]
+    lines.append("")
+    lines.append(f"Stops on a name the checker classifies outside the program (issue 46): {len(stops)}"
+                 + (":" if stops else ""))
+    lines += [f"  {s}" for s in stops]
     answers = sum(len(r.get("answers") or ()) for r in rows)
     if any(r.get("mode") == "auto" for r in rows):
         lines.append("")

@@ -268,7 +268,10 @@ class SystemSoftware:
         if why:
             return why
         sym = self._symbol(key)
-        return provided_routine(key, sym.path if sym is not None else "") or None
+        from krl.workspace import is_kuka_file  # noqa: PLC0415
+
+        path = sym.path if sym is not None and sym.path and is_kuka_file(sym.path) else ""
+        return provided_routine(key, path) or None
 
     def _returns(self, key: str):
         """The declared return type of the routine `key`: its EXTFCT in the program's files,

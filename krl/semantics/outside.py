@@ -28,6 +28,7 @@ import re
 from dataclasses import dataclass, field
 
 from krl.diagnostics import DiagnosticSink, Note
+from krl.semantics.builtins import load_builtins
 
 # kind -> (error code, warning code, noun)
 KINDS = {
@@ -41,12 +42,19 @@ _FOLD = re.compile(r"^\s*;\s*FOLD\b(.*)$", re.IGNORECASE)
 _ENDFOLD = re.compile(r"^\s*;\s*ENDFOLD\b", re.IGNORECASE)
 #: the module a KUKA inline form names in its opening comment: ``%MKUKATPBASIS`` (KSS 5 to 8's
 #: form header ``;%{PE}%R 8.3.31,%MKUKATPBASIS,%CMOVE,%VPTP,%P ...``)
-_MODULE = re.compile(r"%M([A-Z][A-Z0-9_]*)", re.IGNORECASE)
+FOLD_MODULE = re.compile(r"%M([A-Z][A-Z0-9_]*)", re.IGNORECASE)
 #: the editor markers of a fold's opening comment: ``%{PE}`` (an inline form), ``%{P}``,
 #: ``%{E}``, ``%{SE}`` (KUKA's folds of older forms and of technology packages; with a module)
 _MARKER = re.compile(r"%\{([A-Z]+)\}", re.IGNORECASE)
 #: KSS 8's forms name their provider in a hidden parameter fold: ``;Params IlfProvider=...``
-_PROVIDER = re.compile(r"^\s*;\s*Params\s+IlfProvider\s*=\s*([A-Za-z0-9_.]+)", re.IGNORECASE)
+FOLD_PROVIDER = re.compile(r"^\s*;\s*Params\s+IlfProvider\s*=\s*([A-Za-z0-9_.]+)", re.IGNORECASE)
+
+
+def fold_opening(line: str) -> str | None:
+    """The opening comment of a ``;FOLD`` line (what follows FOLD: the title, then KUKA's
+    markers after a second ``;``), or None for any other line."""
+    m = _FOLD.match(line) if ";" in line else None
+    return m.group(1) if m else None
 
 
 def template_lines(text: str) -> tuple[dict[int, str], dict[int, str]]:
@@ -69,7 +77,7 @@ def template_lines(text: str) -> tuple[dict[int, str], dict[int, str]]:
         if m:
             rest = m.group(1)
             title = rest.split(";", 1)[0].strip().upper()
-            module = _MODULE.search(rest)
+            module = FOLD_MODULE.search(rest)
             marker = _MARKER.search(rest)
             if title.startswith("USER"):
                 stack.append(["user", ""])
@@ -81,7 +89,7 @@ def template_lines(text: str) -> tuple[dict[int, str], dict[int, str]]:
             else:
                 stack.append(["", ""])
         elif stack and ";" in line:
-            p = _PROVIDER.match(line)
+            p = FOLD_PROVIDER.match(line)
             if p is not None:
                 form = _innermost(stack)
                 if form is not None and form[0] == "inline" and not form[1]:
@@ -115,22 +123,17 @@ def fold_evidence(template, line: int, kind: str) -> str:
     return ""
 
 
-def provided_routine(name: str, declared_in: str = "") -> str:
+def provided_routine(name: str, kuka_file: str = "") -> str:
     """Why KUKA's software provides the routine `name` that the checker resolves but whose body
     no file of the program holds, or "": a routine of the platform tables (krl/semantics/data:
     KSS's system functions, ``IS_KEY_PRESSED`` of ``$operate.dat``), or a routine that an
-    ``EXT`` of a KUKA system file declares (`declared_in`: the file of its declaration; ``EXT
-    P00 (...)`` of ``$config.dat``). An ``EXT`` in the program's own files promises a module
-    the program lacks: "" (its error at run time, "routine NAME not found")."""
-    from krl.semantics.builtins import load_builtins  # noqa: PLC0415
-
+    ``EXT`` of a KUKA system file declares (`kuka_file`: that file, "" when its declaration is
+    in none; ``EXT P00 (...)`` of ``$config.dat``). An ``EXT`` in the program's own files
+    promises a module the program lacks: "" (its error at run time, "routine NAME not found")."""
     if name.upper() in load_builtins().routines:
         return "a routine of the platform tables (krl/semantics/data)"
-    if declared_in:
-        from krl.workspace import is_kuka_file  # noqa: PLC0415
-
-        if is_kuka_file(declared_in):
-            return f"declared by an EXT of KUKA's system file {declared_in.replace(chr(92), '/').rsplit('/', 1)[-1]}"
+    if kuka_file:
+        return f"declared by an EXT of KUKA's system file {kuka_file.replace(chr(92), '/').rsplit('/', 1)[-1]}"
     return ""
 
 
