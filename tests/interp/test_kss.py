@@ -302,3 +302,31 @@ def test_start_places_the_robot_and_on_halt_continue_presses_start(tmp_path):
     cell = write(tmp_path, "cell.yaml", "start: XSTART\n")
     out = runner.invoke(main, ["run", str(prog), "--inputs", str(cell)])
     assert "start      XSTART" in out.output and "$OUT 1" in out.output
+
+
+@pytest.mark.parametrize("interp", INTERPS)
+def test_a_type_follows_the_checker_in_a_backup_or_not(tmp_path, interp):
+    """A type nothing declares (issue 46: one decision). Named by an EXT declaration, the
+    checker's W105 (the software that provides the routine declares it): untyped, one note, in
+    a plain folder too (before, outside a backup, its data list did not load: "unknown name
+    W1"). Named only by the program's own data list, the checker's E105: the program's error,
+    in a backup too (its variable is not declared either: "unknown name W1")."""
+    ext = "DEFDAT weld\n  EXT ArcOn(ARC_DATA_T :IN)\n  DECL ARC_DATA_T W1=#PULSE\nENDDAT\n"
+    mine = "DEFDAT weld\n  DECL GRIPPER_T W1=#PULSE\nENDDAT\n"
+    prog = "DEF weld()\n  $OUT[1] = W1 == #PULSE\nEND\n"
+    for where in ("folder", "backup"):
+        for dat, expected in ((ext, ("completed", "")), (mine, ("error", "unknown name W1"))):
+            # (the data list is loaded when the program first reads W1)
+            folder = tmp_path / f"{where}-{len(dat)}"
+            folder.mkdir()
+            if where == "backup":
+                src = _backup(folder, prog, files={"R1/Program/weld.dat": dat})
+            else:
+                write(folder, "weld.dat", dat)
+                src = write(folder, "weld.src", prog)
+            rt, res, events = _run(src, interp)
+            assert (res.reason, res.text if res.reason == "error" else "") == expected, (where, res.text)
+            if expected[0] == "completed":
+                assert "not simulated: type ARC_DATA_T (undeclared; values are untyped)" in \
+                    [e["text"] for e in events if e["kind"] == "message"]
+                assert ("$OUT[1]", True) in [(e["signal"], e["value"]) for e in events if e["kind"] == "io"]
