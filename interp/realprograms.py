@@ -300,8 +300,9 @@ _UNKNOWN = re.compile(r"^(?:unknown name (?P<name>\S+)|routine (?P<routine>\S+) 
 
 def outside_stops(rt) -> list[str]:
     """The run-time errors of the run `rt` (its robot program's, its submit programs') that
-    stop on a name the checker classifies outside the program (krl/semantics/outside.py
-    ``Unresolved.classify``: W101/W105/W106/W107), as ``NAME at file:line: why``. Issue 46: the
+    stop on a name the checker classifies outside the program and calls KUKA's
+    (krl/semantics/outside.py ``Unresolved.classify``: W101/W105/W106/W107, ``Outside.kuka``),
+    as ``NAME at file:line: why``. Issue 46: the
     run stands in for every such name (interp/runtime/kss.py), so this is always empty unless
     the checker and the run disagree."""
     unresolved = rt.program.ws.unresolved()
@@ -322,7 +323,7 @@ def outside_stops(rt) -> list[str]:
         kinds = ("routine",) if m.group("routine") else ("sysvar",) if name.startswith("$") else ("name",)
         for kind in kinds:
             o = outside.get((kind, name))
-            if o is not None:
+            if o is not None and o.kuka:
                 out.append(f"{o.name} at {file}:{line}: {o.why}")
     return out
 

@@ -15,10 +15,11 @@ one, *never silently*: the first use of each stand-in writes one note (a ``messa
 (kss.yaml ``packages``), a name used on a line KUKA's software wrote (a system file; the
 template's INI fold such as KR C2's ``;FOLD ARCHTECHDIGITAL INI`` with ``IF ARC20==TRUE THEN``;
 for a routine or a type, a KUKA inline form, whose module names the package: ``%MKUKATPGRP``),
-a name a file of the backup that does not parse mentions, a ``$`` name no table lists. No
-second rule: every name the checker classifies stands in, in a backup or not, and a name it
-does not classify stays the program's error ("unknown name X", "routine X not found"), as on
-a controller. Besides, a routine the checker resolves whose body nothing of the program holds
+a ``$`` name no table lists. No second rule: every name the checker calls KUKA's stands in,
+in a backup or not, and any other name stays the program's error ("unknown name X", "routine
+X not found"), as on a controller — also one the checker warns about only because a file of
+the program that does not parse mentions it (``Outside.kuka`` False: perhaps the program's own
+declaration, in a file the controller could not load either). Besides, a routine the checker resolves whose body nothing of the program holds
 stands in when outside.py's :func:`~krl.semantics.outside.provided_routine` says KUKA's software
 provides it (a routine of the platform tables; an ``EXT`` of a KUKA system file such as
 ``EXT P00 (...)`` of ``$config.dat``). The routines of EthernetKRL and RSI (functions.yaml
@@ -186,12 +187,14 @@ class SystemSoftware:
             f"standard {name} runs ({STANDARD[name.upper()].relative_to(STANDARD[name.upper()].parents[3])})"))
     # ------------------------------------------------------------------ evidence
     def outside(self) -> dict:
-        """(kind, UPPER name) -> why, for every name the checker found outside the backup
-        (krl/semantics/outside.py ``Unresolved.classify``: the checker's one decision)."""
+        """(kind, UPPER name) -> why, for every name the checker found outside the backup and
+        calls KUKA's (krl/semantics/outside.py ``Unresolved.classify``, ``Outside.kuka``: the
+        checker's one decision; a name only a file that does not parse mentions may be the
+        program's own, declared there: it stays the program's error)."""
         if self._outside is None:
             unresolved = self.rt.program.ws.unresolved()
             found = unresolved.classify() if unresolved is not None else {}
-            self._outside = {key: o.why for key, o in found.items()}
+            self._outside = {key: o.why for key, o in found.items() if o.kuka}
         return self._outside
 
     def use_types(self) -> dict:

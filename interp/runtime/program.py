@@ -315,7 +315,7 @@ class Program:
 
     def declared_type(self, t, tref) -> T.KrlType:
         """The type the checker gave a declaration; a type nothing declares is untyped and
-        logged once when the checker classifies it outside the program (W105: a type of the
+        logged once when the checker calls it KUKA's (W105, ``Outside.kuka``: a type of the
         controller's system data lists the backup does not hold, e.g. ESYS of $operate.dat; a
         type of a package an EXT names; krl/semantics/outside.py, issue 46: one decision),
         else the run-time error "unknown type NAME" (the program's E105)."""
@@ -324,7 +324,8 @@ class Program:
         name = tref.name if isinstance(tref, N.TypeRef) else str(tref)
         if self._outside_types is None:
             un = self.ws.unresolved()
-            self._outside_types = {k for (kind, k) in (un.classify() if un is not None else {}) if kind == "type"}
+            found = un.classify() if un is not None else {}
+            self._outside_types = {k for (kind, k), o in found.items() if kind == "type" and o.kuka}
         if name.upper() not in self._outside_types:
             raise KrlRuntimeError(f"unknown type {name}")
         if name.upper() not in self.stubs:

@@ -170,6 +170,10 @@ class Use:
     evidence: str = ""       # why this use says "installed software declares it", or ""
 
 
+#: the evidence of rule 4: the only one that does not say KUKA's software declares the name
+UNPARSED = "a file of this backup that does not parse mentions it"
+
+
 @dataclass(slots=True)
 class Outside:
     """One name the checker found outside the backup (a W101/W105/W106/W107): its `kind`
@@ -181,6 +185,10 @@ class Outside:
     name: str
     why: str
     uses: list
+    #: True when the evidence says KUKA's software declares it (rules 1-3 and 5 of the module
+    #: docstring); False when the only evidence is a file of the program that does not parse
+    #: mentioning it (rule 4): the program's own declaration, perhaps, that the check cannot read
+    kuka: bool = True
 
 
 @dataclass
@@ -216,19 +224,20 @@ class Unresolved:
         if kind == "sysvar":
             return "a system variable of the controller that the platform tables do not list"
         if self.maybe_declared is not None and self.maybe_declared(name):
-            return "a file of this backup that does not parse mentions it"
+            return UNPARSED
         return ""
 
     def classify(self) -> dict[tuple[str, str], Outside]:
         """(kind, UPPER name) -> :class:`Outside`, for every recorded name that is outside the
         backup (the module docstring's rule, the one the warnings report); the other names are
         the program's errors. The one decision on what KUKA's software provides: the checker
-        reports it (:meth:`finish`), the run stands in for it (interp/runtime/kss.py)."""
+        reports it (:meth:`finish`), the run stands in for each name whose :attr:`Outside.kuka`
+        says KUKA's software declares it (interp/runtime/kss.py)."""
         out: dict[tuple[str, str], Outside] = {}
         for key, (name, uses) in self.uses.items():
             why = self._why(key[0], name, uses)
             if why:
-                out[key] = Outside(key[0], name, why, uses)
+                out[key] = Outside(key[0], name, why, uses, why != UNPARSED)
         return out
 
     def finish(self, sink: DiagnosticSink) -> None:
