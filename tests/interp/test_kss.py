@@ -344,3 +344,21 @@ def test_a_name_only_a_broken_file_mentions_stays_the_programs_error(tmp_path):
     rt, res, _ = _run(prog)
     assert (res.reason, res.line, res.text) == ("error", 2, "unknown name PART_COUNT")
     assert rt.kss.summary() == []
+
+
+def test_outside_stops_finds_a_run_that_disagrees_with_the_checker(tmp_path, monkeypatch):
+    """interp.realprograms.outside_stops, what tests/interp/test_outside_runs.py asserts empty
+    on every backup of the corpus and the history: with the stand-in of a name taken away (the
+    run and the checker disagree), the stop on it is found and said with the checker's why; the
+    program's own unknown name is not."""
+    from interp import realprograms as rp
+    from interp.runtime.kss import SystemSoftware
+
+    prog = _backup(tmp_path, KRC2_PROG)
+    rt, res, _ = _run(prog)
+    assert res.text == "routine GetJobNr not found" and rp.outside_stops(rt) == []
+    monkeypatch.setattr(SystemSoftware, "name_ref", lambda self, name: None)
+    rt, res, _ = _run(prog)
+    assert res.text == "unknown name ARC20"
+    assert rp.outside_stops(rt) == [f"ARC20 at {prog}:11: the template's INI fold ARCHTECHDIGITAL INI uses it "
+                                    "(KUKA's template and technology packages write that fold)"]
