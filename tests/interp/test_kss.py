@@ -362,3 +362,66 @@ def test_outside_stops_finds_a_run_that_disagrees_with_the_checker(tmp_path, mon
     assert res.text == "unknown name ARC20"
     assert rp.outside_stops(rt) == [f"ARC20 at {prog}:11: the template's INI fold ARCHTECHDIGITAL INI uses it "
                                     "(KUKA's template and technology packages write that fold)"]
+
+
+# ---------------------------------------------------------------------- the operator's path
+CELL_DAT = ("DEFDAT cell\n  DECL E6AXIS XHOME={A1 10.0,A2 -90.0,A3 90.0,A4 0.0,A5 30.0,A6 0.0,E1 0.0,E2 0.0,"
+            "E3 0.0,E4 0.0,E5 0.0,E6 0.0}\nENDDAT\n")
+HANDLER = "&ACCESS RVP\n&COMMENT HANDLER on external automatic\n" + P00_CELL.lstrip("\n")
+
+
+def _cell(tmp: Path, program: str = HANDLER) -> Path:
+    return _backup(tmp, program, P00_CONFIG, name="cell.src", files={"R1/Program/cell.dat": CELL_DAT})
+
+
+def test_a_cell_program_starts_in_automatic_external_at_home(tmp_path):
+    """issue 46: `krl run cell.src` with nothing else: EXT (the header says it is the handler
+    of Automatic External) and XHOME (P00's CHK_HOME wants it there), each said with who chose
+    it; P00's INIT_EXT passes, and the run waits for the PLC's program number: the summary
+    names the input (PGNO_VALID = 42 of $config.dat) and the options that answer it."""
+    prog = _cell(tmp_path)
+    out = CliRunner().invoke(main, ["run", str(prog), "--max-sim-time", "5"])
+    lines = out.output.splitlines()
+    assert "  mode       EXT (cell.src is a cell program (its header &COMMENT HANDLER on external automatic): " \
+           "the controller runs it in Automatic External; --mode to choose another)" in lines, out.output
+    assert "  start      XHOME (the home position: cell.src is a cell program, and P00 #CHK_HOME wants it " \
+           "there; --start to choose another)" in lines
+    waits = [ln for ln in lines if ln.startswith("  waits      ")]
+    assert waits and waits[0].startswith("  waits      in P00_GET (") and waits[0].endswith(
+        "for the PLC's program number (P00's handshake): WAIT FOR $IN[PGNO_VALID] reads $IN[42] (PGNO_VALID) "
+        "of $config.dat"), out.output
+    assert "  answer     --pgno N (a number the cell program's SWITCH PGNO has a CASE for), or the cell " \
+           "file's `pgno: N`, or --inputs auto" in lines
+    # answered: the handshake completes, CASE 2 runs
+    out = CliRunner().invoke(main, ["run", str(prog), "--pgno", "2", "--max-sim-time", "5"])
+    assert "ended      completed" in out.output and "$OUT 3" in out.output, out.output
+
+
+def test_a_cell_program_in_another_mode_says_it_waits_for_automatic_external(tmp_path):
+    """--mode AUT: P00's INIT_EXT waits for $I_O_ACTCONF (the project's standard P00: WAIT FOR);
+    the summary says so and how to answer. A program that calls P00 (#INIT_EXT, ...) without the
+    header is a cell program too."""
+    program = P00_CELL.replace("DEF cell()", "DEF cell()\n  ;FOLD AUTOEXT INI")   # no header
+    prog = _cell(tmp_path, program.replace('  P00 (#INIT_EXT', '  ;ENDFOLD\n  P00 (#INIT_EXT'))
+    out = CliRunner().invoke(main, ["run", str(prog), "--mode", "AUT", "--max-sim-time", "5"])
+    lines = out.output.splitlines()
+    assert "  mode       AUT (--mode)" in lines, out.output
+    assert any(ln.startswith("  waits      in P00_INIT (") and ln.endswith(
+        "for Automatic External ($MODE_OP #EX and $I_O_ACT): WAIT FOR $I_O_ACTCONF") for ln in lines), out.output
+    assert "  answer     --mode EXT, or the cell file's `autoext: true`" in lines
+    out = CliRunner().invoke(main, ["run", str(prog), "--max-sim-time", "5"])
+    assert "it calls P00 (#INIT_EXT, ...) at line" in out.output, out.output
+
+
+def test_chk_home_says_the_robot_is_not_home(tmp_path):
+    """--start elsewhere: the standard P00's CHK_HOME HALTs in Automatic External while $IN_HOME
+    is FALSE; the summary names the loop's condition and --start XHOME."""
+    program = P00_CELL.replace("  P00 (#INIT_EXT", "  P00 (#CHK_HOME,#PGNO_GET,DMY[],0 )\n  P00 (#INIT_EXT")
+    prog = _cell(tmp_path, program)
+    out = CliRunner().invoke(main, ["run", str(prog), "--start", "{A1 40}", "--max-sim-time", "5"])
+    lines = out.output.splitlines()
+    assert "stopped by HALT" in out.output, out.output
+    assert any(ln.startswith("  waits      in P00_HOME (") and ln.endswith(
+        "for the robot in its home position ($H_POS, within $H_POS_TOL): WHILE NOT $IN_HOME") for ln in lines), \
+        out.output
+    assert "  answer     --start XHOME, or the cell file's `start: XHOME`" in lines
