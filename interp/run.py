@@ -36,8 +36,10 @@ def make_runtime(program, *, workspace=None, inputs=None, trace=None, max_sim_ti
     controller's events on their way to `trace`; it is not used with a given `controller`.
     `inputs`: the cell file (a path, or the Cell :func:`cell_of` read; read once per run).
     ``mode``: operating mode T1/T2/AUT/EXT (``$MODE_OP``; default AUT, robot/limits.py);
-    ignored with a given `controller` (it has its own); None: AUT, or EXT when the cell file
-    (`inputs`) has the ``autoext`` preset. ``pgno``: the program number the cell's PLC answers
+    ignored with a given `controller` (it has its own); None: EXT when the cell file (`inputs`)
+    has the ``autoext`` preset, when the program is a cell program (:func:`cell_program`: the
+    controller runs the handler of Automatic External in EXT) or with ``--inputs auto``, else
+    AUT; ``rt.start`` (:class:`RunStart`) says who chose. ``pgno``: the program number the cell's PLC answers
     in P00's handshake (robot/cellpresets.py; overrides the cell file's ``pgno`` preset).
     ``run_mode``: ``$PRO_MODE`` at the start (GO, MSTEP, ISTEP, BSTEP; interp/runtime/runmode.py;
     default GO). ``robot``: the simulated robot (a MachineData or a path for
@@ -47,7 +49,8 @@ def make_runtime(program, *, workspace=None, inputs=None, trace=None, max_sim_ti
     program numbers, the solver; the robot starts at ``XHOME`` when the program has one and
     no `start` is given). ``start``: where the robot stands at the start
     (:func:`start_axes`: an E6AXIS literal or a point name; default the cell file's
-    ``start:``, else ``$AXIS_HOME[1]``). ``halt_continues``: ``--on-halt continue``, the
+    ``start:``, else ``XHOME`` for a cell program or with ``--inputs auto`` when the program has
+    one, else ``$AXIS_HOME[1]``). ``halt_continues``: ``--on-halt continue``, the
     times the operator presses Start again after a HALT (0: a HALT ends the run). ``network``: the partners
     (net.settings.NetworkSettings; default the cell file's ``network:`` key): the run's network
     hub (net/hub.py) is attached to the controller either way; without partners its EKI
