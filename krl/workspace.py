@@ -52,7 +52,7 @@ from krl.project import module_files as project_module_files
 from krl.semantics.builtins import load_builtins
 from krl.semantics.checker import Checker, Declarer, _is_system_datalist
 from krl.diagnostics import Diagnostic, DiagnosticSink
-from krl.semantics.outside import Unresolved, template_lines
+from krl.semantics.outside import Unresolved, fold_evidence, template_lines
 from krl.semantics.resolve import resolve_workspace
 from krl.semantics.symbols import Scope, Symbol, system_scopes
 from krl.syntax.folds import fold_diagnostics
@@ -89,7 +89,7 @@ class LoadedFile:
     unreadable: bool = False
     failed_words: set = field(default_factory=set)
     # (INI-fold lines, inline-form lines) of KUKA's templates (krl/semantics/outside.py)
-    template: tuple = (frozenset(), frozenset())
+    template: tuple = ({}, {})
 
 
 # Below this many bytes a batch of files is parsed by the Python engine: starting the Java
@@ -280,12 +280,7 @@ class Workspace:
     def evidence(self, path: str, line: int, kind: str) -> str:
         """Why a use at path:line says installed software declares the name, or "" (the
         template's INI fold; a KUKA inline form, for routines and types)."""
-        ini, inline = self.template.get(path, (frozenset(), frozenset()))
-        if line in ini:
-            return "the template's INI fold uses it (KUKA's template and technology packages write that fold)"
-        if line in inline and kind in ("routine", "type"):
-            return "a KUKA inline form (;FOLD ... ;%{PE}) uses it"
-        return ""
+        return fold_evidence(self.template.get(path), line, kind)
 
     @property
     def diagnostics(self) -> list[Diagnostic]:
@@ -854,7 +849,7 @@ def _moved_diagnostics(sink: DiagnosticSink, delta: int) -> DiagnosticSink:
 def _same_template(old, new, lines: range, delta: int) -> bool:
     """True when lines `lines` of the old text lie in the same template folds (INI, inline
     form: the evidence of an unresolved use) as those lines moved by `delta` in the new."""
-    return all((n in old[0]) == (n + delta in new[0]) and (n in old[1]) == (n + delta in new[1]) for n in lines)
+    return all(old[0].get(n) == new[0].get(n + delta) and old[1].get(n) == new[1].get(n + delta) for n in lines)
 
 
 @dataclass(slots=True, eq=False)

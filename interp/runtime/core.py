@@ -53,10 +53,26 @@ class RunResult:
     text: str = ""
     sim_time: float = 0.0
     steps: int = 0
+    #: (file, line) of each frame of the robot program's call stack where it stopped, innermost
+    #: first (the run summary says what a wait in a caller waits for: interp/summary.py)
+    stack: tuple = ()
 
     @property
     def exit_code(self) -> int:
         return EXIT_CODES.get(self.reason, 2)
+
+
+def call_stack(task, limit: int = 64) -> tuple:
+    """(file, line) of each frame of `task` (innermost first, at most `limit`): where each
+    routine of its call stack stands."""
+    out = []
+    frame = task.frame
+    while frame is not None and len(out) < limit:
+        span = getattr(frame.routine, "span", None)
+        if span is not None and span.file and frame.line:
+            out.append((span.file, frame.line))
+        frame = frame.caller
+    return tuple(out)
 
 
 def _scalar(t) -> bool:
@@ -272,7 +288,8 @@ class Runtime:
             text = f"{text} while the robot program waits: {robot.waiting}"
         if reason == "completed":
             file, line, ctx = robot.file, robot.line, "main"
-        self.result = RunResult(reason, err, file, line, ctx, text, self.controller.time, self.steps)
+        self.result = RunResult(reason, err, file, line, ctx, text, self.controller.time, self.steps,
+                                call_stack(robot))
         if self.trace is not None and reason == "error" and err is not None and not err.traced:
             # the robot program's run-time error, before the `end` event (robot/trace.py);
             # a submit program's error was written when that task ended (submit_finished)
@@ -616,8 +633,9 @@ class Runtime:
         UNRESOLVED; docs/architecture.md, "One program model"): a ``$`` name is a system
         variable the simulator knows, or one that a system data list or KSS's system files
         declare (``SysVars.lookup``); in a backup, a variable of KUKA's software the backup
-        lacks stands in (interp/runtime/kss.py: its zero value, one note); any other name is
-        the run-time error "unknown name", as on the controller."""
+        lacks stands in (interp/runtime/kss.py: the names the checker classifies outside the
+        program, one note each); any other name is the run-time error "unknown name", as on
+        the controller."""
         key = name.upper()
         if key[:1] == "$":
             r = self.sysvars.lookup(key)
@@ -625,10 +643,9 @@ class Runtime:
                 return r
         elif key in RSI_CONSTANTS:      # RSI's constants (RSIOK, ...): the option declares them
             return ValueRef(RSI_CONSTANTS[key], key)
-        if self.program.backup:
-            r = self.kss.name_ref(name)     # a variable of KUKA's software (interp/runtime/kss.py)
-            if r is not None:
-                return r
+        r = self.kss.name_ref(name)     # a variable of KUKA's software (interp/runtime/kss.py)
+        if r is not None:
+            return r
         raise KrlRuntimeError(f"unknown name {name}")
 
     def index(self, base: Ref, idx: list, name: str) -> Ref:
@@ -696,8 +713,8 @@ class Runtime:
         return NATIVES.get(c.native) if c.kind == NATIVE else None
 
     def stub_call(self, name: str, is_function: bool):
-        """A call of a routine that the program does not contain: in a backup, a routine of
-        KUKA's system software stands in (interp/runtime/kss.py: counted, one note);
+        """A call of a routine that the program does not contain: a routine of KUKA's system
+        software (the checker's classification) stands in (interp/runtime/kss.py: counted, one note);
         anything else is the run-time error "routine NAME not found"."""
         return self.kss.call(name, is_function)
 

@@ -182,6 +182,7 @@ class Program:
                 self.by_path[str(p)] = m
         self.sysrefs: list = [None] * len(ws.system_names)
         self.stubs: set[str] = set()
+        self._outside_types: set[str] | None = None     # the checker's W105 types (declared_type)
         self.fatal: ResourceError | None = None   # a data list past a limit: the program cannot start
         self._initialiser_env = _InitialiserEnv(self)
         self._syntax_errors()
@@ -326,13 +327,19 @@ class Program:
         return self.take_memory_n(self.data_elements(t, vn, decl), vn, decl)
 
     def declared_type(self, t, tref) -> T.KrlType:
-        """The type the checker gave a declaration; a type nothing declares is an error
-        outside a backup and, in a backup (a type of the controller's system data lists it
-        does not hold, e.g. ESYS of $operate.dat), untyped and logged once."""
+        """The type the checker gave a declaration; a type nothing declares is untyped and
+        logged once when the checker calls it KUKA's (W105, ``Outside.kuka``: a type of the
+        controller's system data lists the backup does not hold, e.g. ESYS of $operate.dat; a
+        type of a package an EXT names; krl/semantics/outside.py, issue 46: one decision),
+        else the run-time error "unknown type NAME" (the program's E105)."""
         if t is not None and t is not T.UNKNOWN and not _has_unknown(t):
             return t
         name = tref.name if isinstance(tref, N.TypeRef) else str(tref)
-        if not self.backup:
+        if self._outside_types is None:
+            un = self.ws.unresolved()
+            found = un.classify() if un is not None else {}
+            self._outside_types = {k for (kind, k), o in found.items() if kind == "type" and o.kuka}
+        if name.upper() not in self._outside_types:
             raise KrlRuntimeError(f"unknown type {name}")
         if name.upper() not in self.stubs:
             self.stubs.add(name.upper())

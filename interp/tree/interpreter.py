@@ -441,9 +441,10 @@ class TreeInterpreter:
         if callee.kind == ROUTINE:
             return self.invoke(rt.callee(callee), self.args_for(call, frame), frame, catch_resume)
         native = rt.native(callee)
+        args = self.args_for(call, frame)     # evaluated before a stand-in too, as the VM does
         if native is None:
             return rt.stub_call(callee.name, not statement)
-        return native(rt, self.args_for(call, frame))
+        return native(rt, args)
 
     def invoke(self, target, args: list, caller, catch_resume: bool = True):
         """Run routine ``target`` = (module, Routine) with reference ``args`` (the
