@@ -18,7 +18,7 @@ the program goes on (without a STATE_T variable it is a run-time error). StrToIn
 accept KRL literal syntax only (reference §1.5). CAST_TO/CAST_FROM are in cast.py.
 GETSYSSTATE answers "STOPBITS" (no stop reaction active; :func:`_getsysstate`); INVERSE
 solves the inverse kinematics of the simulated robot (:func:`_inverse`).
-The EthernetKRL and RSI functions (EKI_*, RSI_*) are in netfunctions.py.
+The EthernetKRL and RSI functions (EKI_*, RSI_*) are in natives/eki.py.
 COPEN(:SER_3, HANDLE) finds no device on any channel: HANDLE 0, the channel not connected
 (:func:`_copen`). Unsupported: CREAD/CCLOSE/CIOCTL, GET_SIG_INF, CWRITE channels other than
 $CMD — a clear "not supported" run-time error.
@@ -926,7 +926,7 @@ NATIVES: dict = {
     "GET_SIG_INF": _unsupported("GET_SIG_INF"), "GETSYSSTATE": _getsysstate,
 }
 
-from .netfunctions import NATIVES as _NET_NATIVES  # noqa: E402  (EKI_*, RSI_*: docs/network.md)
+from .natives.eki import NATIVES as _NET_NATIVES  # noqa: E402  (EKI_*, RSI_*: docs/network.md)
 
 NATIVES.update(_NET_NATIVES)
 

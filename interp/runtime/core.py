@@ -19,7 +19,7 @@ from krl.semantics.advance import StmtInfo
 from krl.semantics.resolve import NATIVE, ROUTINE, Callee, Storage
 
 from .builtins import NATIVES, ValueRef
-from .netfunctions import RSI_CONSTANTS
+from .natives.eki import RSI_CONSTANTS
 from .contexts import Context, Irq
 from .watch import split_watch
 from .convert import INT_MAX, INT_MIN, assign_into, binary_op, convert_scalar, to_bool, trunc_int, unary_op

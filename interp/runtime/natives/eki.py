@@ -11,9 +11,9 @@ functions return an RSIERR number as INT (``RSIOK`` = 0, :data:`RSI_CONSTANTS`).
 
 from __future__ import annotations
 
-from .convert import ref_text
-from .errors import KrlRuntimeError, value_invalid
-from .values import UNSET, Arr, EnumValue, Struct, is_char_array
+from ..convert import ref_text
+from ..errors import KrlRuntimeError, value_invalid
+from ..values import UNSET, Arr, EnumValue, Struct, is_char_array
 
 # RSIERR's values as INT constants (types.yaml lists RSIERR; KUKA's numbering is not public:
 # the order of the enum, RSIOK = 0, is the decision recorded in docs/network.md).
@@ -30,7 +30,7 @@ def network(rt):
     if net is None:
         from net.hub import Network  # noqa: PLC0415
 
-        from .netvars import RuntimeSink  # noqa: PLC0415
+        from ..netvars import RuntimeSink  # noqa: PLC0415
 
         net = Network(program=rt.program.main_path, sink=RuntimeSink(rt))
         net.attach(ctl)
@@ -38,7 +38,7 @@ def network(rt):
 
 
 def _status(st) -> Struct:
-    from .sysvars import struct_of  # noqa: PLC0415
+    from ..sysvars import struct_of  # noqa: PLC0415
 
     return struct_of("EKI_STATUS", {"BUFF": st.buff, "READ": st.read, "MSG_NO": st.msg_no,
                                     "CONNECTED": bool(st.connected), "COUNTER": st.counter})
@@ -110,7 +110,7 @@ def eki_send(rt, a):
     data = ref_text(a[1] if len(a) > 1 else None, "EKI_Send data")
     length = None
     if len(a) > 2 and a[2] is not None:
-        from .convert import num  # noqa: PLC0415
+        from ..convert import num  # noqa: PLC0415
 
         length = int(num(a[2].get(), "EKI_Send length"))
     return _result(*ch.send(data, length))
@@ -133,7 +133,7 @@ def _setter(kind: str):
     def native(rt, a):
         from net.eki import format_real  # noqa: PLC0415
 
-        from .convert import num  # noqa: PLC0415
+        from ..convert import num  # noqa: PLC0415
 
         ch = network(rt).eki_channel(ref_text(a[0], f"EKI_Set{kind} channel"))
         path = ref_text(a[1] if len(a) > 1 else None, f"EKI_Set{kind} element")
@@ -236,7 +236,7 @@ def _getter(kind: str, array: bool = False):
             return _result(st, e)
         try:
             if array:
-                from .memory import index_ref  # noqa: PLC0415
+                from ..memory import index_ref  # noqa: PLC0415
 
                 for i, v in enumerate(conv, 1):
                     _store(index_ref(target, [i], name), kind, v, name)
@@ -277,7 +277,7 @@ def rsi_call(hub, rt, method: str, a: list):
     Returns the RSIERR number (INT)."""
     from net.rsi import RSIOK, Rsi  # noqa: PLC0415
 
-    from .convert import num  # noqa: PLC0415
+    from ..convert import num  # noqa: PLC0415
 
     if hub.rsi is None:
         hub.rsi = Rsi(hub)
