@@ -263,6 +263,10 @@ class Workspace:
     # every name (krl/semantics/resolve.py)
     system_names: list = field(default_factory=list)
     resolver: object = None
+    # the implementations of the built-in routines, upper-case name -> fn(rt, args): given by
+    # the runtime for a run (interp/runtime/natives LINKS); the resolver links each call to its
+    # own (Callee.native). None for a check alone.
+    natives: dict | None = None
     # the LoadedFile of each file added from one (path -> LoadedFile): what a full check is
     # made from again when :meth:`replace` cannot re-check a change on its own
     loaded: dict = field(default_factory=dict, repr=False)
