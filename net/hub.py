@@ -14,7 +14,7 @@ The simulated controller calls :meth:`Network.cycle` at the start of every IPO c
    time, so a trace is also a recording: ``network: {replay: trace.jsonl}`` feeds the same
    messages at the same cycles, with no socket, and both interpreters give the same trace.
 
-The runtime talks to the hub through its EKI/RSI built-ins (interp/runtime/netfunctions.py)
+The runtime talks to the hub through its EKI/RSI built-ins (interp/runtime/natives/eki.py, rsi.py)
 and gives it a *sink*: ``set_flag(n, v)``, ``set_out(n, v)``, ``read_var(name) -> text``,
 ``write_var(name, text) -> text`` (interp/runtime/netvars.py).
 """
