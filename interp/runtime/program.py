@@ -32,6 +32,7 @@ from pathlib import Path
 
 from krl.ast import nodes as N
 from krl.diagnostics import SYNTAX_CODES
+from krl.diagnostics.codes import E001, E003, E005
 from krl.limits import PARSE_TIMEOUT_S
 from krl.project import project_of, with_basis   # which files make the program: one rule
 from krl.semantics import types as T
@@ -51,7 +52,7 @@ BASIS_DIR = Path(__file__).resolve().parent.parent / "basis"
 
 # the files a program's own module cannot have for it to start: input errors (E001, E005),
 # syntax errors and constructs the builder cannot build (E003)
-_START_CODES = SYNTAX_CODES | {"E001", "E003", "E005"}
+_START_CODES = SYNTAX_CODES | {E001, E003, E005}
 # files above this size in total are parsed in worker processes (the Java engine when present)
 _BATCH_BYTES = 256 * 1024
 _CACHE: OrderedDict = OrderedDict()
