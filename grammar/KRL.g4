@@ -499,8 +499,12 @@ literal
 // statement's keyword or as `WORD=` inside it, never at a statement's start or between an
 // expression and an operator, so a name spelled alike is never ambiguous, and real backups
 // name parameters and variables so (`DEF SetGripper(ENABLE :IN)`).
+// STEP is a name too (grammar/CHANGES.md, "STEP as a name"): the keyword stands only after
+// FOR's `TO expression`, where no name can follow an expression, and published programs
+// name variables and parameters `step` (`DECL INT step`, `RSI_SETPUBLICPAR(.., step)`).
 name
     : IDENTIFIER
+    | STEP
     | SYSNAME
     | AXIS
     | E3AXIS
@@ -524,14 +528,14 @@ attributeKeyword
 
 // Keywords that KUKA's own data lists use as structure components and enum values
 // (`STRUC DATE INT CSEC,SEC,...`, `ENUM SW_ONOFF ON,OFF`, `P[1].OUT`; IN/OUT are keywords
-// only after ':', 1.6). Accepted only in component and enum-value positions.
+// only after ':', 1.6). Accepted only in component and enum-value positions. (STEP, once
+// here, is a `name`.)
 contextKeyword
     : IN
     | OUT
     | ON
     | OFF
     | PATH
-    | STEP
     | SEC
     | DISTANCE
     ;

@@ -203,6 +203,11 @@ MAX_NET_BYTES_PER_CYCLE = 256 * 1024
 # datagrams read per cycle at most 64 (the rest are dropped by the kernel).
 MAX_RSI_DATAGRAM_BYTES = 8 * 1024
 MAX_RSI_DATAGRAMS_PER_CYCLE = 64
+# An RSI context file (.rsi.xml, .rsix): elements and attributes at most 64 Ki. WorkVisual's
+# .rsix carries the editor's blueprint collection beside the objects (about 120 KB, several
+# thousand nodes: kroshu's SDK, FZI's driver); a context has at most 256 objects.
+MAX_RSI_CONTEXT_NODES = 65536
+MAX_RSI_OBJECTS = 256
 # KukaVarProxy (OpenShowVar protocol): clients at once (KukaVarProxy itself takes 10), requests
 # answered per client per IPO cycle, and the longest variable name and value text (the protocol
 # counts them in 16 bits; real names are under 30 characters, values under 300).

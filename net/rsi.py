@@ -1,22 +1,28 @@
 """KUKA.RobotSensorInterface: the RSI context, its ETHERNET object and the corrections
 (docs/network.md "RobotSensorInterface").
 
-``RSI_CREATE("NAME", CONTID, TRUE)`` reads the context's objects from ``NAME.rsi.xml`` (the
-``RSIObjects`` file RSI Visual writes beside ``NAME.rsi``; the backup's
+``RSI_CREATE("NAME", CONTID, TRUE)`` reads the context (net/rsicontext.py: RSI 3
+``NAME.rsi.xml`` or RSI 4/5 ``NAME.rsix``, in the backup's
 ``Config/User/Common/SensorInterface/``, beside the program, or the cell file's ``rsi:
-{config: ...}``). Simulated objects:
+{config: ...}``) and its ETHERNET configuration. Simulated objects:
 
-* ``ETHERNET`` — ``ConfigFile`` (the XML of the sensor: ``CONFIG/IP_NUMBER``, ``PORT``,
-  ``SEND/ELEMENTS``, ``RECEIVE/ELEMENTS`` with TAG, TYPE, INDX, HOLDON), ``Timeout`` (late
-  packets allowed in a row; past it the robot stops), ``Flag``;
+* ``ETHERNET`` — ``ConfigFile`` (KUKA's ROOT document: ``CONFIG/IP_NUMBER``, ``PORT``,
+  ``SENTYPE``, ``ONLYSEND``; ``SEND`` and ``RECEIVE`` elements with TAG, TYPE, INDX (a channel
+  or INTERNAL), HOLDON), ``Timeout`` (late packets allowed in a row; past it the robot stops),
+  ``Precision`` (decimals sent, at least 4);
 * ``AXISCORR`` (inputs A1..A6; ``LowerLimAn``/``UpperLimAn``: the total correction is held
   within them, deg) and ``POSCORR`` (inputs X, Y, Z, A, B, C in $BASE; ``LowerLimX`` ..
   ``UpperLimC``, ``MaxTrans`` mm, ``MaxRotAngle`` deg);
 * ``AXISCORRMON`` / ``POSCORRMON`` (``MaxAn`` / ``MaxTrans``, ``MaxRotAngle``: a total
-  correction past them stops the robot);
+  correction past them stops the robot; outputs 1..6 the total correction);
+* the stateless blocks of RSI's toolbox (:data:`BLOCKS`: ``LIMIT`` (input 1 within
+  ``LowerLimit``..``UpperLimit``), ``SUM``, ``SUB``, ``MULTI``, ``Division``, ``ABS``, ``NORM``,
+  ``MinMax``, ``Equal``/``Greater``/``Less``, ``AND``/``OR``/``XOR``/``NOT``, ...);
 * ``STOP`` (input 1 non-zero: ``RSI_MOVECORR`` ends).
 
-Any other object is not simulated: one message says so, and its outputs read 0.
+Any other object is not simulated: one message says so, and its outputs read 0. RECEIVE's
+``DEF_EStr`` (INTERNAL) is the sensor's text, shown as a message when it changes; the other
+INTERNAL values of RECEIVE (``DEF_Tech.Tn``) are read and ignored, with one message.
 
 Each sensor cycle (12 ms; ``RSI_ON(mode, #IPO_FAST)``: three of 4 ms in each IPO cycle) the
 controller sends, over UDP to the sensor, KUKA's XML::
@@ -38,15 +44,17 @@ arrives or leaves is a ``net`` event (iface ``rsi``), so a replay feeds the same
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-from pathlib import Path
+import math
+import re
 import time
 
 import numpy as np
 
-from krl.limits import MAX_NET_CONFIG_BYTES, MAX_RSI_DATAGRAM_BYTES
+from krl.limits import MAX_RSI_DATAGRAM_BYTES
 
 from . import transport
+from .rsicontext import (AXES, CART, Context, RsiConfigError, RsiObject, find_context, is_ethernet_config,
+                         load_context)
 from .settings import LOOPBACK
 from .xmlsafe import XmlRefused, local, parse
 
@@ -57,146 +65,53 @@ SENSOR_CYCLE_MS = 12
 FAST_CYCLE_MS = 4
 LATE_NUMBER = 1
 MON_NUMBER = 2
-AXES = ("A1", "A2", "A3", "A4", "A5", "A6")
-CART = ("X", "Y", "Z", "A", "B", "C")
+MIN_DECIMALS = 4        # values are sent with max(Precision, 4) decimals (docs/network.md, Decisions)
+MAX_FLOW_DEPTH = 64     # links followed from an object back to its sources
+def _first(ins: list, k: int = 0) -> float:
+    return ins[k] if len(ins) > k else 0.0
 
 
-class RsiConfigError(ValueError):
-    pass
+def _compared(o, ins: list) -> float:
+    """The second operand of Equal/Greater/Less: input 2 when linked, else ``CompVal``."""
+    return ins[1] if len(ins) > 1 else o.param("CompVal", 0.0)
 
 
-@dataclass
-class RsiObject:
-    type: str
-    id: str
-    params: dict[str, str] = field(default_factory=dict)
-    inputs: dict[int, tuple[str, int]] = field(default_factory=dict)   # InIdx -> (OutObjID, OutIdx)
-
-
-@dataclass
-class RecvElement:
-    tag: str
-    indx: int
-    holdon: bool
-
-
-@dataclass
-class Context:
-    """An RSI context read from its files."""
-
-    name: str
-    objects: dict[str, RsiObject]
-    ip: str
-    port: int
-    send: list[str]
-    receive: list[RecvElement]
-    sentype: str = "ImFree"
-
-    def of_type(self, t: str) -> list[RsiObject]:
-        return [o for o in self.objects.values() if o.type == t]
-
-
-def _read(path: Path, what: str) -> bytes:
-    try:
-        with open(path, "rb") as fh:
-            return fh.read(MAX_NET_CONFIG_BYTES + 1)
-    except OSError as exc:
-        raise RsiConfigError(f"{what}: {path}: {exc.strerror or 'cannot read'}") from None
-
-
-def load_context(path: Path, name: str) -> Context:
-    """The context of ``NAME.rsi.xml`` at `path` and its ETHERNET object's configuration (in
-    the same folder). Raises :class:`RsiConfigError`."""
-    try:
-        root = parse(_read(path, f"RSI context {name}"), MAX_NET_CONFIG_BYTES, f"RSI context {name}")
-    except XmlRefused as exc:
-        raise RsiConfigError(str(exc)) from None
-    objects: dict[str, RsiObject] = {}
-    for el in root.iter():
-        if local(el.tag) != "RSIObject":
-            continue
-        obj = RsiObject(str(el.get("ObjType", "")).upper(), str(el.get("ObjID", "")))
-        for p in el.iter():
-            if local(p.tag) == "Parameter" and p.get("Name"):
-                obj.params[p.get("Name")] = str(p.get("ParamValue", ""))
-            elif local(p.tag) == "Input":
-                try:
-                    obj.inputs[int(p.get("InIdx", "0"))] = (str(p.get("OutObjID", "")), int(p.get("OutIdx", "0")))
-                except ValueError:
-                    raise RsiConfigError(f"RSI context {name}: object {obj.id}: an Input without numbers") from None
-        objects[obj.id] = obj
-    eth = [o for o in objects.values() if o.type == "ETHERNET"]
-    if len(eth) != 1:
-        raise RsiConfigError(f"RSI context {name}: {len(eth)} ETHERNET objects (one is simulated)")
-    cfg_name = eth[0].params.get("ConfigFile", "")
-    if not cfg_name or "/" in cfg_name or "\\" in cfg_name or ".." in cfg_name:
-        raise RsiConfigError(f"RSI context {name}: ETHERNET ConfigFile {cfg_name[:60]!r} is not a file name")
-    cfg_path = _beside(path.parent, cfg_name)
-    try:
-        eroot = parse(_read(cfg_path, "RSI ETHERNET configuration"), MAX_NET_CONFIG_BYTES, f"RSI {cfg_name}")
-    except XmlRefused as exc:
-        raise RsiConfigError(str(exc)) from None
-    conf = _find(eroot, "CONFIG")
-    ip = _text(conf, "IP_NUMBER") or LOOPBACK
-    try:
-        port = int(_text(conf, "PORT") or "")
-    except ValueError:
-        raise RsiConfigError(f"RSI {cfg_name}: CONFIG/PORT is not a number") from None
-    send = [str(e.get("TAG", "")) for e in _elements(eroot, "SEND")]
-    receive = []
-    for e in _elements(eroot, "RECEIVE"):
-        try:
-            receive.append(RecvElement(str(e.get("TAG", "")), int(e.get("INDX", "0")), str(e.get("HOLDON", "0")) == "1"))
-        except ValueError:
-            raise RsiConfigError(f"RSI {cfg_name}: RECEIVE element {e.get('TAG')!r}: INDX is not a number") from None
-    return Context(name, objects, ip, port, send, receive, _text(conf, "SENTYPE") or "ImFree")
-
-
-def _beside(folder: Path, name: str) -> Path:
-    p = folder / name
-    if p.exists():
-        return p
-    for q in folder.iterdir() if folder.is_dir() else ():
-        if q.name.lower() == name.lower():
-            return q
-    return p
-
-
-def _find(el, name):
-    for c in el.iter():
-        if local(c.tag).upper() == name:
-            return c
-    return None
-
-
-def _text(el, name):
-    if el is None:
-        return None
-    c = _find(el, name)
-    return c.text.strip() if c is not None and c.text else None
-
-
-def _elements(root, section):
-    s = _find(root, section)
-    return [e for e in s.iter() if local(e.tag).upper() == "ELEMENT"] if s is not None else []
-
-
-def find_context(name: str, program: Path | None, backup: Path | None) -> Path | None:
-    """Where the controller keeps ``NAME.rsi.xml`` (or ``NAME.xml`` for a name ending in .rsi)."""
-    stem = name[:-4] if name.lower().endswith(".rsi") else name
-    want = {(stem + ".rsi.xml").upper(), (stem + ".xml").upper()} if not name.lower().endswith(".xml") else {name.upper()}
-    folders = []
-    if backup is not None:
-        folders += [backup / "Config" / "User" / "Common" / "SensorInterface",
-                    backup / "KRC" / "Config" / "User" / "Common" / "SensorInterface"]
-    if program is not None:
-        folders.append(program.parent)
-    for f in folders:
-        if f.is_dir():
-            for p in sorted(f.iterdir()):
-                if p.name.upper() in want and p.is_file():
-                    return p
-    return None
+# The stateless blocks of RSI's toolbox (the "Math" and "Logic" subsets of the blueprint
+# collection WorkVisual writes into every .rsix, e.g. FZI's published KR_C5 ros_rsi.rsix: their
+# inputs and parameters): type -> fn(object, the linked inputs in index order, output index).
+# A logic input is TRUE when non-zero; Greater/Less ignore their Hysteresis (no state).
+BLOCKS = {
+    "LIMIT": lambda o, i, k: min(max(_first(i), o.param("LowerLimit", -10.0)), o.param("UpperLimit", 10.0)),
+    "ABS": lambda o, i, k: abs(_first(i)),
+    "CEIL": lambda o, i, k: math.ceil(_first(i)),
+    "FLOOR": lambda o, i, k: math.floor(_first(i)),
+    "ROUND": lambda o, i, k: round(_first(i), int(o.param("nDig", 0))),
+    "POW": lambda o, i, k: _first(i) ** o.param("Exp", 0.0),
+    "NORM": lambda o, i, k: math.sqrt(sum(v * v for v in i)),
+    "MULTI": lambda o, i, k: _first(i) * _first(i, 1),
+    "SUM": lambda o, i, k: sum(i) + o.param("Value", 0.0),
+    "SUB": lambda o, i, k: _first(i) - sum(i[1:]) - o.param("Value", 0.0),
+    "DIVISION": lambda o, i, k: _first(i) / _first(i, 1),
+    "MINMAX": lambda o, i, k: (min(i) if k == 1 else max(i)) if i else 0.0,
+    "EQUAL": lambda o, i, k: float(abs(_first(i) - _compared(o, i)) <= o.param("Tolerance", 0.0)),
+    "GREATER": lambda o, i, k: float(_first(i) > _compared(o, i)),
+    "LESS": lambda o, i, k: float(_first(i) < _compared(o, i)),
+    "AND": lambda o, i, k: float(bool(i) and all(v != 0.0 for v in i)),
+    "OR": lambda o, i, k: float(any(v != 0.0 for v in i)),
+    "XOR": lambda o, i, k: float(sum(v != 0.0 for v in i) % 2 == 1),
+    "NOT": lambda o, i, k: float(_first(i) == 0.0),
+}
+# the objects this module simulates; any other reads 0 on its outputs (one message says so)
+SIMULATED = ("ETHERNET", "AXISCORR", "POSCORR", "AXISCORRMON", "POSCORRMON", "STOP", *BLOCKS)
+# the controller's internal values a SEND element DEF_... writes: element and its attributes
+INTERNAL_SEND = {
+    "DEF_RIST": ("RIst", CART), "DEF_RSOL": ("RSol", CART),
+    "DEF_AIPOS": ("AIPos", AXES), "DEF_ASPOS": ("ASPos", AXES),
+    "DEF_EIPOS": ("EIPos", ("E1", "E2", "E3", "E4", "E5", "E6")),
+    "DEF_ESPOS": ("ESPos", ("E1", "E2", "E3", "E4", "E5", "E6")),
+    "DEF_MACUR": ("MACur", AXES), "DEF_MECUR": ("MECur", ("E1", "E2", "E3", "E4", "E5", "E6")),
+    "DEF_DELAY": ("Delay", ("D",)),
+}
 
 
 class Rsi:
@@ -219,6 +134,7 @@ class Rsi:
         self.stopped = False
         self.failed: str | None = None
         self.noted: set[str] = set()
+        self.estr = ""
         self.q_on: np.ndarray | None = None
 
     # ------------------------------------------------------------------ functions
@@ -226,22 +142,50 @@ class Rsi:
         if self.ctx is not None:
             return RSIOBJUSED
         s = self.hub.settings
-        path = s.rsi.config if s is not None and s.rsi is not None and s.rsi.config is not None else \
+        chan = s.rsi if s is not None else None
+        path = chan.config if chan is not None and chan.config is not None else \
             find_context(name, self.hub.program, self.hub.backup)
         if path is None:
-            self.hub.net_message(f"RSI: context {name[:60]} not found (NAME.rsi.xml in Config/User/Common/SensorInterface or beside the program)")
+            self.hub.net_message(f"RSI: context {name[:60]} not found (NAME.rsi.xml or NAME.rsix in "
+                                 "Config/User/Common/SensorInterface or beside the program)")
             return RSIINVPARAM
+        ethernet = getattr(chan, "ethernet", None) if chan is not None else None
+        if chan is not None and chan.config is not None and ethernet is None and is_ethernet_config(chan.config):
+            # the cell file names the ETHERNET configuration: the context RSI_CREATE names, where
+            # the controller keeps it or beside that configuration, with it (else one implied)
+            found = find_context(name, self.hub.program, self.hub.backup) or find_context(name, chan.config, None)
+            if found is not None and not is_ethernet_config(found):
+                path, ethernet = found, chan.config
         try:
-            self.ctx = load_context(path, name)
+            self.ctx = load_context(path, name, ethernet, self._folders())
         except RsiConfigError as exc:
             self.hub.net_message(f"RSI: {exc}")
             return RSIINVPARAM
+        self.hub.trace("rsi", "context", name=name[:60],
+                       text=f"{self.ctx.generation}: {len(self.ctx.objects)} objects from "
+                            f"{self.ctx.path.name if self.ctx.path else '?'}, ETHERNET configuration "
+                            f"{self.ctx.ethernet.path.name if self.ctx.ethernet.path else '?'}")
         for o in self.ctx.objects.values():
-            if o.type not in ("ETHERNET", "AXISCORR", "POSCORR", "AXISCORRMON", "POSCORRMON", "STOP") \
-                    and o.type not in self.noted:
+            if o.type not in SIMULATED and o.type not in self.noted:
                 self.noted.add(o.type)
                 self.hub.net_message(f"RSI: object {o.type} is not simulated (its outputs read 0)")
+        for el in self.ctx.ethernet.send + self.ctx.ethernet.receive:
+            key = el.tag.upper()
+            if el.internal and key not in INTERNAL_SEND and key != "DEF_ESTR" and key not in self.noted:
+                self.noted.add(key)
+                self.hub.net_message(f"RSI: internal value {el.tag[:40]} is not simulated")
         return RSIOK
+
+    def _folders(self) -> list:
+        """Where else an ETHERNET configuration may be: beside the program, the backup's
+        SensorInterface folders."""
+        out = [self.hub.program.parent] if self.hub.program is not None else []
+        b = self.hub.backup
+        if b is not None:
+            for top in (b, b / "KRC"):
+                out += [top / "Config" / "User" / "Common" / "SensorInterface",
+                        top / "Config" / "RobotSensorInterface" / "Ethernet configuration"]
+        return out
 
     def delete(self) -> int:
         if self.on:
@@ -250,19 +194,26 @@ class Rsi:
         return RSIOK
 
     def set_param(self, obj: str, name: str, value: float) -> int:
+        """RSI_SETPUBLICPAR: object ids and parameter names compare without case."""
         if self.ctx is None:
             return RSIINVOBJID
-        o = self.ctx.objects.get(obj)
+        o = self.ctx.obj(obj)
         if o is None:
             return RSIINVOBJID
-        o.params[name] = repr(float(value))
+        o.params[o.param_name(name) or name] = repr(float(value))
         return RSIOK
 
     def get_param(self, obj: str, name: str) -> tuple[int, float]:
-        if self.ctx is None or obj not in self.ctx.objects:
+        if self.ctx is None:
             return RSIINVOBJID, 0.0
+        o = self.ctx.obj(obj)
+        if o is None:
+            return RSIINVOBJID, 0.0
+        k = o.param_name(name)
+        if k is None:
+            return RSIINVPARAM, 0.0
         try:
-            return RSIOK, float(self.ctx.objects[obj].params.get(name, "0"))
+            return RSIOK, float(o.params[k])
         except ValueError:
             return RSIINVPARAM, 0.0
 
@@ -331,7 +282,8 @@ class Rsi:
             ipoc = base + i * FAST_CYCLE_MS
             msg = self.message(ctl, ipoc)
             self.hub.trace("rsi", "out", data=msg.decode("latin-1"))
-            self.expect.append(ipoc)
+            if not self.ctx.ethernet.onlysend:       # ONLYSEND TRUE: no answer is expected
+                self.expect.append(ipoc)
             self.recent.append(ipoc)
             del self.recent[:-16]
             if live and self.endpoint is not None:
@@ -363,11 +315,7 @@ class Rsi:
             self.fail(ctl, MSG_LATE + f" ({self.late} in a row, Timeout {limit})", LATE_NUMBER)
 
     def _timeout(self) -> int:
-        eth = self.ctx.of_type("ETHERNET")[0]
-        try:
-            return max(0, int(float(eth.params.get("Timeout", "100"))))
-        except ValueError:
-            return 100
+        return max(0, int(self.ctx.eth.param("Timeout", 100)))
 
     def fail(self, ctl, text: str, number: int) -> None:
         """Stop the robot as KSS does: the main run stops with the message, the program with it."""
@@ -380,7 +328,7 @@ class Rsi:
         """One datagram of the sensor: its IPOC answers a packet; its values are the ETHERNET
         object's outputs."""
         try:
-            root = parse(data, MAX_RSI_DATAGRAM_BYTES, "RSI answer")
+            root = parse(_digit_names(data), MAX_RSI_DATAGRAM_BYTES, "RSI answer")
         except XmlRefused as exc:
             self.hub.trace("rsi", "error", text=str(exc))
             return                              # unreadable: the packet stays late
@@ -399,8 +347,12 @@ class Rsi:
             self.hub.trace("rsi", "error", text=f"an answer with IPOC {ipoc} that no packet was sent with")
             return
         # a late answer (its packet already counted late) still carries the sensor's newest values
-        for el in self.ctx.receive:
-            v = _value(root, el.tag)
+        for el in self.ctx.ethernet.receive:
+            if el.internal:
+                if el.tag.upper() == "DEF_ESTR":
+                    self._sensor_text(root)
+                continue
+            v = _value(root, el.tag) if el.type != "STRING" else None
             if v is None:
                 if not el.holdon:
                     self.outputs[el.indx] = 0.0
@@ -408,33 +360,63 @@ class Rsi:
             self.outputs[el.indx] = v
         self._apply()
 
-    def _input(self, obj: RsiObject, idx: int) -> float:
+    def _sensor_text(self, root) -> None:
+        """DEF_EStr: the sensor's text (``<EStr>``) is a message of the controller, once per
+        change (the template: "Notification or error message"; not a stop)."""
+        for el in root:
+            if local(el.tag).upper() == "ESTR":
+                text = (el.text or "").strip()[:200]
+                if text and text != self.estr:
+                    self.hub.net_message(f"RSI sensor: {text}")
+                self.estr = text
+                return
+
+    def _input(self, obj: RsiObject, idx: int, depth: int = 0) -> float:
+        """The value at input `idx` of `obj`: the output its link names (0 unlinked)."""
         src = obj.inputs.get(idx)
-        if src is None:
+        if src is None or depth > MAX_FLOW_DEPTH:
             return 0.0
-        o = self.ctx.objects.get(src[0])
-        if o is None or o.type != "ETHERNET":
+        o = self.ctx.obj(src[0])
+        return self._output(o, src[1], depth + 1) if o is not None else 0.0
+
+    def _output(self, o: RsiObject, idx: int, depth: int) -> float:
+        """Output `idx` of object `o`: ETHERNET its RECEIVE channel, LIMIT its input clamped to
+        LowerLimit..UpperLimit, the monitors the total correction; objects not simulated 0."""
+        t = o.type
+        if t == "ETHERNET":
+            return float(self.outputs.get(idx, 0.0))
+        if t == "AXISCORRMON" and 1 <= idx <= 6:
+            return float(self.corr_axes[idx - 1])
+        if t == "POSCORRMON" and 1 <= idx <= 6:
+            return float(self.corr_cart[idx - 1])
+        fn = BLOCKS.get(t)
+        if fn is None:
             return 0.0
-        return float(self.outputs.get(src[1], 0.0))
+        ins = [self._input(o, i, depth) for i in sorted(o.inputs)]
+        try:
+            v = float(fn(o, ins, idx))
+        except (ValueError, ZeroDivisionError, OverflowError):
+            return 0.0
+        return v if np.isfinite(v) else 0.0
 
     def _apply(self) -> None:
         for obj in self.ctx.of_type("AXISCORR"):
             v = np.array([self._input(obj, i) for i in range(1, 7)])
             total = v if self.mode == "ABSOLUTE" else self.corr_axes + v
-            lo = np.array([_param(obj, f"LowerLimA{i}", -1e9) for i in range(1, 7)])
-            hi = np.array([_param(obj, f"UpperLimA{i}", 1e9) for i in range(1, 7)])
+            lo = np.array([obj.param(f"LowerLimA{i}", -1e9) for i in range(1, 7)])
+            hi = np.array([obj.param(f"UpperLimA{i}", 1e9) for i in range(1, 7)])
             self.corr_axes = np.clip(total, lo, hi)
         for obj in self.ctx.of_type("POSCORR"):
             v = np.array([self._input(obj, i) for i in range(1, 7)])
             total = v if self.mode == "ABSOLUTE" else self.corr_cart + v
-            lo = np.array([_param(obj, f"LowerLim{k}", -1e9) for k in CART])
-            hi = np.array([_param(obj, f"UpperLim{k}", 1e9) for k in CART])
+            lo = np.array([obj.param(f"LowerLim{k}", -1e9) for k in CART])
+            hi = np.array([obj.param(f"UpperLim{k}", 1e9) for k in CART])
             total = np.clip(total, lo, hi)
-            mt = _param(obj, "MaxTrans", 1e9)
+            mt = obj.param("MaxTrans", 1e9)
             n = float(np.linalg.norm(total[:3]))
             if n > mt > 0:
                 total[:3] *= mt / n
-            mr = _param(obj, "MaxRotAngle", 1e9)
+            mr = obj.param("MaxRotAngle", 1e9)
             total[3:] = np.clip(total[3:], -mr, mr)
             self.corr_cart = total
         for obj in self.ctx.of_type("STOP"):
@@ -443,11 +425,11 @@ class Rsi:
         ctl = self.hub.ctl
         for obj in self.ctx.of_type("AXISCORRMON"):
             for i in range(6):
-                if abs(self.corr_axes[i]) > _param(obj, f"MaxA{i + 1}", 1e9):
+                if abs(self.corr_axes[i]) > obj.param(f"MaxA{i + 1}", 1e9):
                     self.fail(ctl, MSG_MON + f" (A{i + 1})", MON_NUMBER)
                     return
         for obj in self.ctx.of_type("POSCORRMON"):
-            if float(np.linalg.norm(self.corr_cart[:3])) > _param(obj, "MaxTrans", 1e9):
+            if float(np.linalg.norm(self.corr_cart[:3])) > obj.param("MaxTrans", 1e9):
                 self.fail(ctl, MSG_MON + " (translation)", MON_NUMBER)
                 return
 
@@ -458,46 +440,96 @@ class Rsi:
         return self.corr_axes
 
     @property
+    def frame(self) -> str:
+        """The frame of the Cartesian correction: the POSCORR's ``RefCorrSys`` (RSI 3 writes the
+        name, RSI 4/5 the number of its enum: World 0, Base 1, RobRoot 2, Tool 3, TTS 4, as
+        wingljj's published PoseTrack.rsix documents it); BASE when unset. RobRoot is taken as
+        WORLD (the simulated robot stands at the world's origin) and TTS as TOOL."""
+        for obj in self.ctx.of_type("POSCORR") if self.ctx is not None else ():
+            k = obj.param_name("RefCorrSys")
+            v = str(obj.params.get(k, "")).strip().upper() if k else ""
+            return {"0": "WORLD", "WORLD": "WORLD", "2": "WORLD", "ROBROOT": "WORLD",
+                    "3": "TOOL", "TOOL": "TOOL", "4": "TOOL", "TTS": "TOOL"}.get(v, "BASE")
+        return "BASE"
+
+    @property
     def cart(self) -> np.ndarray:
         """The Cartesian correction (X, Y, Z mm, A, B, C deg, in $BASE) the controller superposes."""
         return self.corr_cart
 
     def message(self, ctl, ipoc: int) -> bytes:
-        """The robot's packet of one sensor cycle (the elements SEND names, and IPOC)."""
+        """The robot's packet of one sensor cycle: the SEND elements in the configuration's
+        order (internal values, and channels grouped by element: ``Tag.A1``.. as attributes of
+        one ``<Tag>``), then IPOC."""
         q = np.array(ctl.axis_act(), dtype=float)[:6]
+        fr = np.array(ctl.tcp_frame(), dtype=float)
+        eth = self.ctx.eth
+        dec = max(MIN_DECIMALS, min(16, int(eth.param("Precision", MIN_DECIMALS))))
+        groups: dict[str, list[tuple[str, str]]] = {}
+        order: list[str] = []
+        for el in self.ctx.ethernet.send:
+            key = el.tag.upper()
+            if el.internal:
+                if key in INTERNAL_SEND:
+                    name, comps = INTERNAL_SEND[key]
+                    if name == "Delay":
+                        vals = [str(self.late)]
+                    elif name in ("RIst", "RSol"):
+                        vals = [_f(v, dec) for v in fr[:6]]
+                    elif name in ("AIPos", "ASPos"):
+                        vals = [_f(v, dec) for v in q]
+                    else:
+                        vals = [_f(0.0, dec)] * len(comps)
+                    if name not in groups:
+                        order.append(name)
+                        groups[name] = []
+                    groups[name] += list(zip(comps, vals))
+                continue
+            head, _, attr = el.tag.partition(".")
+            v = self._output_of_input(eth, el.indx)
+            text = str(int(v)) if el.type in ("LONG", "BOOL") else ("" if el.type == "STRING" else _f(v, dec))
+            if head not in groups:
+                order.append(head)
+                groups[head] = []
+            groups[head].append((attr, text))
         parts = ['<Rob Type="KUKA">']
-        tags = {t.upper() for t in self.ctx.send}
-        fr = ctl.tcp_frame()
-        if "DEF_RIST" in tags:
-            parts.append("<RIst " + " ".join(f'{k}="{_f(v)}"' for k, v in zip(CART, fr)) + "/>")
-        if "DEF_RSOL" in tags:
-            parts.append("<RSol " + " ".join(f'{k}="{_f(v)}"' for k, v in zip(CART, fr)) + "/>")
-        if "DEF_AIPOS" in tags:
-            parts.append("<AIPos " + " ".join(f'{k}="{_f(v)}"' for k, v in zip(AXES, q)) + "/>")
-        if "DEF_ASPOS" in tags:
-            parts.append("<ASPos " + " ".join(f'{k}="{_f(v)}"' for k, v in zip(AXES, q)) + "/>")
-        if "DEF_EIPOS" in tags:
-            parts.append("<EIPos " + " ".join(f'E{i}="0.0"' for i in range(1, 7)) + "/>")
-        if "DEF_DELAY" in tags:
-            parts.append(f'<Delay D="{self.late}"/>')
+        for name in order:
+            items = groups[name]
+            attrs = [(k, v) for k, v in items if k]
+            texts = [v for k, v in items if not k]
+            if attrs:
+                parts.append(f"<{name} " + " ".join(f'{k}="{v}"' for k, v in attrs) + "/>")
+            if texts:
+                parts.append(f"<{name}>{texts[-1]}</{name}>")
         parts.append(f"<IPOC>{ipoc}</IPOC></Rob>")
         return "".join(parts).encode()
 
+    def _output_of_input(self, eth: RsiObject, indx: int) -> float:
+        try:
+            return self._input(eth, indx)
+        except (TypeError, ValueError):
+            return 0.0
 
-def _f(v: float) -> str:
-    return f"{float(v):.4f}"
+
+def _f(v: float, dec: int = MIN_DECIMALS) -> str:
+    return f"{float(v):.{dec}f}"
 
 
-def _param(obj: RsiObject, name: str, default: float) -> float:
-    try:
-        return float(obj.params.get(name, default))
-    except ValueError:
-        return default
+_DIGIT_ATTR = re.compile(rb"(\s)([0-9][A-Za-z0-9_.-]*\s*=)")
+
+
+def _digit_names(data: bytes) -> bytes:
+    """The answer with attribute names that start with a digit (``<Out 01="1"/>``: RECEIVE tags
+    ``Out.01`` of ROS-Industrial's and ``GPIO.01`` of kroshu's configurations, which RSI writes
+    and reads as they stand) prefixed with ``_`` so that an XML parser reads them."""
+    return _DIGIT_ATTR.sub(rb"\1_\2", data) if len(data) <= MAX_RSI_DATAGRAM_BYTES else data
 
 
 def _value(root, tag: str) -> float | None:
     """The value of RECEIVE tag ``EL.ATTR`` (an attribute) or ``EL`` (an element's text)."""
     el_name, _, attr = tag.partition(".")
+    if attr[:1].isdigit():
+        attr = "_" + attr
     for el in root.iter():
         if local(el.tag).upper() == el_name.upper():
             text = None

@@ -3,7 +3,8 @@
     network:
       eki:
         CHANNEL: {config: PATH.xml, address: 127.0.0.1:54600}  # address overrides the XML's IP and port
-      rsi: {config: PATH, address: 127.0.0.1:49152}
+      rsi: {config: PATH, address: 127.0.0.1:49152, ethernet: PATH.xml}   # ethernet: the ETHERNET
+                             # object's configuration when it is not beside the context
       plc: {modbus: 127.0.0.1:5020, opcua: opc.tcp://127.0.0.1:4840}
       varproxy: 127.0.0.1:7000
       pace: 1.0              # simulated s per wall s while a partner is attached (default 1: real time)
@@ -28,7 +29,7 @@ from krl.limits import MAX_EKI_CHANNELS, MAX_NET_PACE
 LOOPBACK = "127.0.0.1"
 KEYS = ("eki", "rsi", "plc", "varproxy", "pace", "replay")
 EKI_KEYS = ("config", "address")
-RSI_KEYS = ("config", "address")
+RSI_KEYS = ("config", "address", "ethernet")
 PLC_KEYS = ("modbus", "opcua", "map")
 _NAME = re.compile(r"[A-Za-z_$][A-Za-z0-9_$]{0,63}\Z")
 _ADDR = re.compile(r"(?:\[([0-9A-Fa-f:.]+)\]|([A-Za-z0-9.\-]{1,253})):([0-9]{1,5})\Z")
@@ -45,6 +46,7 @@ class Channel:
 
     config: Path | None = None
     address: tuple[str, int] | None = None
+    ethernet: Path | None = None        # RSI only: the ETHERNET configuration (net/rsicontext.py)
 
 
 @dataclass
@@ -98,13 +100,14 @@ def _mapping(doc, keys, what: str) -> dict:
     return doc
 
 
-def _channel(doc, base: Path, what: str) -> Channel:
+def _channel(doc, base: Path, what: str, keys=EKI_KEYS) -> Channel:
     if doc is None:
         return Channel()
-    doc = _mapping(doc, EKI_KEYS, what)
+    doc = _mapping(doc, keys, what)
     cfg = _inside(base, doc["config"], f"{what}: config") if doc.get("config") is not None else None
     addr = parse_address(doc["address"], f"{what}: address") if doc.get("address") is not None else None
-    return Channel(cfg, addr)
+    eth = _inside(base, doc["ethernet"], f"{what}: ethernet") if doc.get("ethernet") is not None else None
+    return Channel(cfg, addr, eth)
 
 
 def parse_network(doc, base: Path) -> NetworkSettings:
@@ -123,7 +126,7 @@ def parse_network(doc, base: Path) -> NetworkSettings:
                 raise SettingsError(f"network: eki: {str(name)[:40]!r} is not a channel name")
             s.eki[name.upper()] = _channel(ch, base, f"network: eki: {name}")
     if doc.get("rsi") is not None:
-        s.rsi = _channel(doc["rsi"], base, "network: rsi")
+        s.rsi = _channel(doc["rsi"], base, "network: rsi", RSI_KEYS)
     if doc.get("plc") is not None:
         plc = _mapping(doc["plc"], PLC_KEYS, "network: plc")
         if plc.get("modbus") is not None:

@@ -23,8 +23,9 @@ class XmlRefused(ValueError):
     """XML that is malformed, too large, too deep or uses DTDs/entities; the message says which."""
 
 
-def parse(data: bytes | str, limit: int, what: str = "XML") -> ET.Element:
-    """The root element of `data` (at most `limit` bytes).
+def parse(data: bytes | str, limit: int, what: str = "XML", max_nodes: int = MAX_NET_XML_NODES) -> ET.Element:
+    """The root element of `data` (at most `limit` bytes, at most `max_nodes` elements and
+    attributes: :data:`~krl.limits.MAX_NET_XML_NODES` unless a reader of larger documents says).
 
     Raises :class:`XmlRefused` for more than `limit` bytes, malformed XML, a DTD, an entity
     declaration or reference to an external resource, or a tree past the depth and node limits."""
@@ -44,8 +45,8 @@ def parse(data: bytes | str, limit: int, what: str = "XML") -> ET.Element:
         if depth > MAX_NET_XML_DEPTH:
             raise XmlRefused(f"{what}: nested deeper than {MAX_NET_XML_DEPTH} levels")
         count += 1 + len(el.attrib)
-        if count > MAX_NET_XML_NODES:
-            raise XmlRefused(f"{what}: more than {MAX_NET_XML_NODES} elements and attributes")
+        if count > max_nodes:
+            raise XmlRefused(f"{what}: more than {max_nodes} elements and attributes")
         stack.extend((c, depth + 1) for c in el)
     return root
 

@@ -303,7 +303,8 @@ class Controller:
         self._ended = False
         self.network = None     # net.hub.Network: the partners, polled at each cycle's start
         # a sensor correction superposed on the setpoint (RSI, net/rsi.py): an object with
-        # `axes` (A1..A6 deg) and `cart` (X, Y, Z mm, A, B, C deg in $BASE); None: none
+        # `axes` (A1..A6 deg) and `cart` (X, Y, Z mm, A, B, C deg in $BASE, or in `frame`:
+        # "TOOL", "WORLD" when it has one); None: none
         self.correction = None
         self._q_raw = self._q.copy()
 
@@ -1051,9 +1052,17 @@ class Controller:
         if np.any(cart):
             T = self.model.tcp(out[:6], self._tool_T, self._base_inv_T)
             C = frame_to_matrix(*cart)
-            target = T.copy()
-            target[:3, 3] = T[:3, 3] + C[:3, 3]
-            target[:3, :3] = C[:3, :3] @ T[:3, :3]
+            frame = getattr(corr, "frame", "BASE")      # RSI's POSCORR RefCorrSys (net/rsi.py)
+            if frame == "WORLD":                        # a correction in $WORLD, seen from $BASE
+                Rb = self._base_T[:3, :3]
+                C[:3, 3] = Rb.T @ C[:3, 3]
+                C[:3, :3] = Rb.T @ C[:3, :3] @ Rb
+            if frame == "TOOL":                         # in the programmed TCP's own frame
+                target = T @ C
+            else:
+                target = T.copy()
+                target[:3, 3] = T[:3, 3] + C[:3, 3]
+                target[:3, :3] = C[:3, :3] @ T[:3, :3]
             out[:6] = self.model.ik(target, np.linalg.inv(self._tool_T), self._base_T, None, None, out[:6])
         return out
 

@@ -78,7 +78,7 @@ SCHEMA: dict[str, list[tuple[str, str]]] = {
     ],
     "net": [
         ("iface", "str: eki | rsi | varproxy | plc (net/, docs/network.md)"),
-        ("dir", "str: in (a message arrived) | out (sent) | connect | disconnect | refused | error"),
+        ("dir", "str: in (a message arrived) | out (sent) | connect | disconnect | refused | error | context (RSI_CREATE read one)"),
         ("name", "optional str: the EKI channel"),
         ("data", "optional str: the message (bytes as Latin-1; the replay feeds them back)"),
         ("number", "optional int: the EKI/RSI message number of an error"),

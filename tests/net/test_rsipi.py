@@ -1,0 +1,237 @@
+"""RSI with a sensor nobody here wrote: RSIPI (PyPI ``rsipi``, a Python library for the sensor
+PC of KUKA RSI; a pinned test dependency) on both interpreters (issue 50):
+
+* the project's example (examples/network/rsi_path.src, absolute RKorr, Stop): connection,
+  the 12 ms cycle, the correction followed to 0.01 mm, ``Stop`` ending RSI_MOVECORR;
+* RSIPI's own shipped context RSIPI_Stop (KUKA's ETHERNET template: DEF_EStr and DEF_Tech in
+  RECEIVE, FREE, DiO, $SEN_PREA channels; a STOP object on MoveStop) with a relative program:
+  each answer's RKorr added once, RSIPI's exit_movecorr() ending RSI_MOVECORR, its EStr text a
+  message;
+* corpus programs with their published configurations: wingljj's PoseTrack (RSI 4/5 .rsix,
+  LIMIT objects, relative RKorr with HOLDON 0) and kroshu's rsi_joint_pos_4ms (RSI 4/5,
+  ``#IPO_FAST``: 4 ms cycle, absolute AK, Stop);
+* a late-answer stop: RSIPI stopped, the robot stops after Timeout + 1 late cycles.
+
+RSIPI binds the configuration's IP and PORT: each test hands it a copy of the published
+configuration with IP 127.0.0.1 and a free port (nothing else changed), and the cell file's
+``rsi: address`` sends the robot's packets there."""
+
+from __future__ import annotations
+
+import re
+import socket
+import time
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import numpy as np
+import pytest
+from RSIPI import RSIAPI, context
+
+from net.settings import Channel, NetworkSettings
+
+from .helpers import CONFIGS, EXAMPLES, PROGRAMS, net_events, run_with_partner
+
+PUB = CONFIGS / "published"
+KSS = "kroshu__kuka-external-control-sdk/kuka_external_control_sdk/krc_setup/kss/KRC/R1/Program/RSI/"
+START = "{A1 0, A2 -90, A3 90, A4 0, A5 30, A6 0}"
+INTERPS = ["tree", "vm"]
+
+
+def local_copy(config: Path, tmp_path: Path) -> tuple[Path, int]:
+    """The ETHERNET configuration with IP 127.0.0.1 and a free UDP port, for RSIPI to bind."""
+    s = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    s.bind(("127.0.0.1", 0))
+    port = s.getsockname()[1]
+    s.close()
+    text = config.read_text(encoding="utf-8-sig")
+    text = re.sub(r"<IP_NUMBER>[^<]*</IP_NUMBER>", "<IP_NUMBER>127.0.0.1</IP_NUMBER>", text)
+    text = re.sub(r"<PORT>[^<]*</PORT>", f"<PORT>{port}</PORT>", text)
+    out = tmp_path / config.name
+    out.write_text(text, encoding="utf-8")
+    return out, port
+
+
+def rsipi(config: Path, script, mode: str = "absolute", cycle: float = 0.012):
+    """A partner for helpers.run_with_partner: RSIPI on `config`, `script(api)` once the robot's
+    first packet arrived; RSIPI stopped after it."""
+    def run(net, rt):
+        api = RSIAPI(str(config), rsi_mode=mode, cycle_time=cycle)
+        api.start()
+        try:
+            assert api.wait_for_connection(60.0), "RSIPI saw no packet of the robot"
+            return script(api)
+        finally:
+            api.stop()
+    return run
+
+
+def until(pred, timeout: float = 30.0) -> bool:
+    end = time.monotonic() + timeout
+    while time.monotonic() < end:
+        if pred():
+            return True
+        time.sleep(0.01)
+    return False
+
+
+def pose(api) -> np.ndarray:
+    p = api.motion.get_current_pose()
+    return np.array([float(p[k]) for k in "XYZABC"])
+
+
+def joints(api) -> np.ndarray:
+    p = api.motion.get_current_joints()
+    return np.array([float(p[f"A{i}"]) for i in range(1, 7)])
+
+
+def robot_packets(trace):
+    return [ET.fromstring(re.sub(r"(\s)([0-9][\w.-]*=)", r"\1_\2", e["data"])) for e in net_events(trace, iface="rsi", dir="out")]
+
+
+def answers(trace):
+    return [ET.fromstring(e["data"]) for e in net_events(trace, iface="rsi", dir="in")]
+
+
+def ipoc_steps(trace) -> set[int]:
+    ipocs = [int(r.findtext("IPOC")) for r in robot_packets(trace)]
+    return set(np.diff(ipocs[:60]).tolist())
+
+
+@pytest.mark.parametrize("interp", INTERPS)
+def test_rsipi_on_the_example(tmp_path, interp):
+    cfg, port = local_copy(EXAMPLES / "rsi_path_ethernet.xml", tmp_path)
+
+    def script(api):
+        z0 = pose(api)
+        api.tools.update_variable("RKorr.Z", 5.0)
+        reached = until(lambda: abs(pose(api)[2] - z0[2] - 5.0) < 0.01)
+        time.sleep(0.3)
+        api.tools.update_variable("Stop", True)
+        time.sleep(0.3)
+        return z0, reached
+
+    settings = NetworkSettings(EXAMPLES, rsi=Channel(EXAMPLES / "rsi_path.rsi.xml", ("127.0.0.1", port)))
+    result, trace, (z0, reached) = run_with_partner(EXAMPLES / "rsi_path.src", settings, rsipi(cfg, script), interp=interp)
+    assert reached
+    assert result.reason == "completed", (result.reason, result.text)        # Stop ended RSI_MOVECORR
+    assert ipoc_steps(trace) == {12}
+    assert len(answers(trace)) >= 40
+    # the TCP followed the 5 mm to 0.01 mm, in the robot's own packets
+    last = robot_packets(trace)[-1].find("RIst")
+    assert float(last.get("Z")) - z0[2] == pytest.approx(5.0, abs=0.01)
+    assert float(last.get("X")) == pytest.approx(z0[0], abs=0.01)
+
+
+@pytest.mark.parametrize("interp", INTERPS)
+def test_rsipi_shipped_context_kuka_template(tmp_path, interp):
+    """RSIPI's own RSIPI_Stop context and its KUKA-template configuration, as RSIPI ships them."""
+    shipped = Path(context("stop"))
+    ctx = shipped.parent / "RSIPI_Stop.rsi.xml"
+    cfg, port = local_copy(shipped, tmp_path)
+
+    def script(api):
+        p0 = pose(api)
+        api.motion.update_cartesian(X=0.1)
+        until(lambda: pose(api)[0] - p0[0] > 3.0)
+        api.motion.update_cartesian(X=0.0)
+        time.sleep(0.3)
+        api.motion.exit_movecorr()
+        time.sleep(0.3)
+        return p0
+
+    settings = NetworkSettings(ctx.parent, rsi=Channel(ctx, ("127.0.0.1", port)))
+    result, trace, p0 = run_with_partner(PROGRAMS / "rsipi_stop.src", settings, rsipi(cfg, script, "relative"),
+                                         interp=interp)
+    assert result.reason == "completed", (result.reason, result.text)
+    assert ipoc_steps(trace) == {12}
+    # relative: every answer's RKorr.X added once (the ones that arrived while RSI was on)
+    sent = sum(float(a.find("RKorr").get("X")) for a in answers(trace))
+    x_end = max(float(r.find("RIst").get("X")) for r in robot_packets(trace))
+    assert sent > 3.0
+    assert x_end - p0[0] == pytest.approx(sent, abs=0.01)
+    # DEF_EStr: RSIPI's text is a message of the controller
+    texts = [e.get("text", "") for e in trace.events if e["kind"] == "message"]
+    assert any("RSIPI: Client started" in t for t in texts), texts[:5]
+
+
+@pytest.mark.parametrize("interp", INTERPS)
+def test_rsipi_on_posetrack_rsix(shared_corpus, tmp_path, interp):
+    """wingljj's PoseTrack.src with its published RSI 4/5 context (LIMIT objects of +-35 per
+    answer, POSCORR within +-40, RELATIVE, HOLDON 0): no STOP object, so the test ends the run."""
+    ctx = PUB / "wingljj" / "PoseTrack.rsix"
+    cfg, port = local_copy(PUB / "wingljj" / "PoseTrack_ethernet.xml", tmp_path)
+
+    def script(api):
+        p0 = pose(api)
+        api.motion.update_cartesian(Y=-0.2, Z=0.1)
+        until(lambda: pose(api)[1] - p0[1] < -4.0)
+        api.motion.update_cartesian(Y=0.0, Z=0.0)
+        time.sleep(0.3)
+        return p0
+
+    settings = NetworkSettings(ctx.parent, rsi=Channel(ctx, ("127.0.0.1", port)))
+    result, trace, p0 = run_with_partner(shared_corpus / "wingljj__Kuka-RSI-real-time-control/krc/PoseTrack.src",
+                                         settings, rsipi(cfg, script, "relative"), interp=interp, start=START)
+    assert ipoc_steps(trace) == {12}
+    ys = sum(float(a.find("RKorr").get("Y")) for a in answers(trace))
+    zs = sum(float(a.find("RKorr").get("Z")) for a in answers(trace))
+    last = robot_packets(trace)[-1].find("RIst")
+    assert ys < -4.0
+    assert float(last.get("Y")) - p0[1] == pytest.approx(ys, abs=0.01)
+    assert float(last.get("Z")) - p0[2] == pytest.approx(zs, abs=0.01)
+
+
+@pytest.mark.parametrize("interp", INTERPS)
+def test_rsipi_ipo_fast_kroshu(shared_corpus, tmp_path, interp):
+    """kroshu's rsi_joint_pos_4ms.src (RSI_ON(#ABSOLUTE, #IPO_FAST)) with its published RSI 4/5
+    context: packets every 4 ms, absolute AK followed, Stop ends RSI_MOVECORR."""
+    ctx = PUB / "kroshu_kss" / "rsi_joint_pos.rsix"
+    cfg, port = local_copy(PUB / "kroshu_kss" / "rsi_ethernet.xml", tmp_path)
+    target = np.array([1.5, -1.0, 0.5, 0.0, 2.0, -2.0])
+
+    def script(api):
+        q0 = joints(api)
+        for i, v in enumerate(target):
+            api.tools.update_variable(f"AK.A{i + 1}", float(v))
+        reached = until(lambda: np.allclose(joints(api) - q0, target, atol=0.01))
+        time.sleep(0.2)
+        api.tools.update_variable("Stop", True)
+        time.sleep(0.3)
+        return q0, reached
+
+    settings = NetworkSettings(ctx.parent, rsi=Channel(ctx, ("127.0.0.1", port)))
+    result, trace, (q0, reached) = run_with_partner(shared_corpus / (KSS + "rsi_joint_pos_4ms.src"), settings,
+                                                    rsipi(cfg, script, cycle=0.004), interp=interp, start=START)
+    assert reached
+    assert result.reason == "completed", (result.reason, result.text)
+    assert ipoc_steps(trace) == {4}
+    pk = [r.find("AIPos") for r in robot_packets(trace)]
+    last = np.array([float(pk[-1].get(f"A{i}")) for i in range(1, 7)])
+    assert np.allclose(last - q0, target, atol=0.01)
+
+
+@pytest.mark.parametrize("interp", INTERPS)
+def test_rsipi_late_answers_stop_the_robot(tmp_path, interp):
+    """RSIPI stops answering: past the ETHERNET object's Timeout (100) late packets in a row
+    the robot stops with RSI's message and the program ends with it."""
+    cfg, port = local_copy(EXAMPLES / "rsi_path_ethernet.xml", tmp_path)
+
+    def script(api):
+        api.tools.update_variable("RKorr.Z", 1.0)
+        time.sleep(0.5)
+        return None                                # RSIPI stopped: no more answers
+
+    settings = NetworkSettings(EXAMPLES, rsi=Channel(EXAMPLES / "rsi_path.rsi.xml", ("127.0.0.1", port)))
+    box = {}
+    partner = rsipi(cfg, script)
+
+    def keep_running(net, rt):
+        partner(net, rt)
+        until(lambda: net.closed, 20.0)          # leave the run going until the robot stops
+    result, trace, _ = run_with_partner(EXAMPLES / "rsi_path.src", settings, keep_running, interp=interp, box=box)
+    assert result.reason == "error"
+    assert "maximum number of late packets exceeded" in result.text
+    errors = [e for e in trace.events if e["kind"] == "error"]
+    last_answer = net_events(trace, iface="rsi", dir="in")[-1]["t"]
+    assert errors[0]["t"] - last_answer == pytest.approx(0.012 * 101, abs=0.012 * 2)
