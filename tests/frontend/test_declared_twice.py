@@ -6,7 +6,7 @@ instead of E102's words. The places below are counted by hand from the texts.
 from __future__ import annotations
 
 from krl.diagnostics.codes import E102
-from krl.workspace import check_texts, load_text
+from krl.workspace import Workspace, check_texts, load_text
 
 SRC = """DEF prog()
   INT i
@@ -61,6 +61,4 @@ def test_a_re_check_after_an_edit_keeps_the_facts_of_a_full_check():
 
 
 def test_no_facts_before_a_check():
-    from krl.workspace import Workspace
-
     assert Workspace("/p").declared_twice() == []

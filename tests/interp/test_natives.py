@@ -52,12 +52,25 @@ def _basis_routines(file: str, basis_dir: Path) -> dict[str, bool]:
     return {r.name.upper(): r.is_function for r in lf.module.routines}
 
 
+def _every_basis_routine(basis_dir: Path) -> dict[str, str]:
+    """UPPER name -> file, of the routines a program may call in the BASIS: GLOBAL ones and each
+    module's main routine."""
+    out = {}
+    for f in sorted(basis_dir.glob("*.src")):
+        routines = load_file(f).module.routines
+        out.update({r.name.upper(): f.name for i, r in enumerate(routines)
+                    if r.is_global or (i == 0 and r.name.upper() == f.stem.upper())})
+    return out
+
+
 def missing_sides(registry: dict, modules: list, basis_dir: Path = BASIS_DIR) -> list[str]:
     """What keeps the registry from being complete: a routine without a way to run (or with
     two), a KRL routine the BASIS does not have (or of the other kind), a function of the calling
-    convention ``(rt, a)`` that no declaration names, a Family that is not registered."""
+    convention ``(rt, a)`` that no declaration names, a Family that is not registered, a
+    stand-in that a BASIS file implements (declare it ``krl``)."""
     problems = []
     basis: dict[str, dict[str, bool]] = {}
+    everywhere = _every_basis_routine(basis_dir)
     for n in registry.values():
         ways = [n.fn is not None, bool(n.krl), bool(n.stand_in.strip())]
         if sum(ways) != 1:
@@ -68,6 +81,8 @@ def missing_sides(registry: dict, modules: list, basis_dir: Path = BASIS_DIR) ->
                 problems.append(f"{n.name}: no routine of that name in the BASIS file {n.krl}")
             elif n.section in (FUNCTIONS, PROCEDURES) and have[n.name] != n.is_function:
                 problems.append(f"{n.name}: the BASIS routine is a {'function' if have[n.name] else 'procedure'}")
+        if n.stand_in and n.name in everywhere:
+            problems.append(f"{n.name}: declared a stand-in, but the BASIS file {everywhere[n.name]} implements it")
     declared = {id(n.fn) for n in registry.values() if n.fn is not None}
     registered = {id(f) for f in FAMILIES}
     for mod in modules:
@@ -86,10 +101,12 @@ def test_every_routine_has_one_way_to_run_and_every_implementation_a_signature()
 
 def test_the_completeness_check_fails_when_a_side_is_missing():
     """A family with a BASIS routine the BASIS lacks, a procedure declared for a BASIS function,
-    and an implementation that no declaration names: each is found."""
+    a stand-in for a routine the BASIS has, and an implementation that no declaration names: each
+    is found."""
     fam = Family("test")
     fam.krl("REAL NOT_IN_BASIS(REAL X :IN)", "bas.src")
     fam.krl("SVEL_JOINT(REAL VEL :IN)", "bas.src")           # bas.src: GLOBAL DEFFCT REAL SVEL_JOINT
+    fam.stand_in("REAL SACC_CP(LDAT L :OUT)", "nothing")      # bas.src: GLOBAL DEFFCT CP SACC_CP
 
     def _forgotten(rt, a):
         return 0
@@ -101,6 +118,7 @@ def test_the_completeness_check_fails_when_a_side_is_missing():
     got = missing_sides(build([fam]), [mod])
     assert got == ["NOT_IN_BASIS: no routine of that name in the BASIS file bas.src",
                    "SVEL_JOINT: the BASIS routine is a function",
+                   "SACC_CP: declared a stand-in, but the BASIS file bas.src implements it",
                    "interp.runtime.natives.fake.FAKE: a family not in FAMILIES",
                    "interp.runtime.natives.fake._forgotten: an implementation without a signature"]
 
@@ -184,20 +202,20 @@ def _run(prog: Path, interp: str):
 
 @pytest.mark.parametrize("interp", INTERPS)
 def test_stand_ins_do_what_their_declarations_say(tmp_path, interp):
-    """In a backup: SGEAR_JERK returns 0.0, STOOL a FRAME of zeros, GET_SINGUL an E6POS of zeros
-    (each noted once), MSGNOTIFY does nothing. EKI_LOAD, a network routine, stops the run in a
-    backup too."""
+    """In a backup: GET_SINGUL returns an E6POS of zeros, EK (an ANY result) the zero of the type
+    its use gives it (REAL: 0.0), MSGNOTIFY does nothing (each noted once); STOOL, a BASIS
+    routine the backup's System folder lacks, stands in too (a FRAME of zeros). EKI_LOAD, a
+    network routine, stops the run in a backup too."""
     prog = _backup(tmp_path, """
 DEF cell()
   DECL REAL r
   DECL FRAME f
   DECL FDAT fd
-  DECL PDAT pd
   DECL E6POS p
   r = 7.0
-  r = SGEAR_JERK(pd)
-  f = STOOL(fd)
+  r = EK(1)
   p = GET_SINGUL(1)
+  f = STOOL(fd)
   MSGNOTIFY("x")
   $OUT[1] = (r == 0.0) AND (f.X == 0.0) AND (f.C == 0.0) AND (p.Y == 0.0)
   EKI_LOAD("x.xml")
@@ -205,17 +223,23 @@ END
 """)
     io, res, notes = _run(prog, interp)
     assert io == [("$OUT[1]", True)]
-    assert [n.split(" (", 1)[0] for n in notes] == ["stub: SGEAR_JERK", "stub: STOOL", "stub: GET_SINGUL",
-                                                      "stub: MSGNOTIFY"]
-    assert (res.reason, res.line, res.text) == ("error", 13, "routine EKI_LOAD not found")
+    assert [n.split(" (", 1)[0] for n in notes] == ["stub: EK", "stub: GET_SINGUL", "stub: STOOL", "stub: MSGNOTIFY"]
+    assert (res.reason, res.line, res.text) == ("error", 12, "routine EKI_LOAD not found")
     assert "routine NAME not found" in REGISTRY["EKI_LOAD"].stand_in
-    assert "0.0" in REGISTRY["SGEAR_JERK"].stand_in and "FRAME of zeros" in REGISTRY["STOOL"].stand_in
+    assert "the zero value of the type its use gives it" in REGISTRY["EK"].stand_in
     assert "E6POS of zeros" in REGISTRY["GET_SINGUL"].stand_in
+    assert REGISTRY["STOOL"].krl == "bas.src" and "does nothing" in REGISTRY["MSGNOTIFY"].stand_in
 
 
 @pytest.mark.parametrize("interp", INTERPS)
-def test_outside_a_backup_a_stand_in_stops_the_run(tmp_path, interp):
-    run = run_krl(tmp_path, "DEF prog()\n  x = SGEAR_JERK(pd)\nEND\n",
-                  "DEFDAT prog\n  DECL REAL x\n  DECL PDAT pd\nENDDAT\n", interp=interp)
-    assert (run.result.reason, run.result.line, run.result.text) == ("error", 2, "routine SGEAR_JERK not found")
-    assert "elsewhere the run stops: routine SGEAR_JERK not found" in REGISTRY["SGEAR_JERK"].stand_in
+def test_outside_a_backup_a_stand_in_stops_the_run_and_a_basis_routine_runs(tmp_path, interp):
+    run = run_krl(tmp_path, "DEF prog()\n  x = GET_SINGUL(1)\nEND\n",
+                  "DEFDAT prog\n  DECL E6POS x\nENDDAT\n", interp=interp)
+    assert (run.result.reason, run.result.line, run.result.text) == ("error", 2, "routine GET_SINGUL not found")
+    assert "elsewhere the run stops: routine GET_SINGUL not found" in REGISTRY["GET_SINGUL"].stand_in
+    # SCIRC_M is KRL of the project's BASIS (bas.src: the LDAT's CB)
+    run = run_krl(tmp_path, "DEF prog()\n  m = SCIRC_M(ld)\nEND\n",
+                  "DEFDAT prog\n  DECL CIRC_MODE m\n  DECL LDAT ld = {CB {AUX_PT {ORI #CONSIDER}}}\nENDDAT\n",
+                  interp=interp)
+    assert run.result.reason == "completed", run.result.text
+    assert run.var("prog", "m").f["AUX_PT"].f["ORI"].name == "CONSIDER"

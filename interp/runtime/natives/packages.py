@@ -30,7 +30,8 @@ _NAME_ONLY = ("in a backup: a procedure does nothing, a function returns the zer
               "gives it (KUKA's software stand-in, noted once); elsewhere the run stops: routine NAME not found")
 
 SYSTEM_MODULES.krl("IR_STOPM", "ir_stopm.src")
-for _name in ("SET_CD_PARAMS", "USE_CD_PARAMS", "USE_CM_PRO_VALUES", "SET_TQ_VALUES", "GET_COLLMON_SET",
+SYSTEM_MODULES.krl("USE_CM_PRO_VALUES", "collmonlib.src")
+for _name in ("SET_CD_PARAMS", "USE_CD_PARAMS", "SET_TQ_VALUES", "GET_COLLMON_SET",
               "EB_ABS", "EO", "TEST_BRAKE", "MSGQUIT", "MSGNOTIFY", "MSGSTATE", "MSGDIALOG", "MSGLOOP",
               "MBX_REC", "ISMESSAGESET", "EMI_RECSTATE"):
     SYSTEM_MODULES.stand_in(_name, _NAME_ONLY)

@@ -12,7 +12,8 @@ and declares each of its routines on it, in one of three ways:
   with ``get()``, :OUT ones written with ``set()``. It raises
   :class:`~interp.runtime.errors.KrlRuntimeError` to stop the program as the controller would.
 * ``FAMILY.krl(signature, "bas.src")``: KRL implements it, a routine of the project's BASIS
-  (interp/basis/FILE; a backup brings its own): a call binds to that routine like any other.
+  (interp/basis/FILE; a backup brings its own): a call binds to that routine like any other
+  (a backup whose own BASIS lacks it: the stand-in policy below).
 * ``FAMILY.stand_in(signature, returns="...")``: nothing implements it in the simulator; a call
   goes to the stand-in policy for KUKA's software (interp/runtime/kss.py), and ``returns`` says,
   in words, what the call gives (its documented value, or that the run stops).
