@@ -68,7 +68,7 @@ validate: $(PARSER) java-parser
 	$(BIN)/krl validate
 
 test: $(PARSER) java-parser vm-loop
-	$(BIN)/python -m pytest -q -n 2 -p no:cacheprovider -r fEsxX
+	$(BIN)/python -m pytest -q -n 2 --dist loadgroup -p no:cacheprovider -r fEsxX
 
 bench: $(PARSER) java-parser vm-loop
 	$(BIN)/krl bench
@@ -104,7 +104,7 @@ nightly: $(PARSER) java-parser
 	$(BIN)/krl bench parse --json > $$d/bench-parse.json 2>> $$d/bench.log; \
 	$(BIN)/python -m robot.limits_bench > $$d/limits.jsonl 2>> $$d/bench.log; \
 	$(BIN)/python -m tests.fuzz.run --seconds $(FUZZ_SECONDS) --out $$d/fuzz; f=$$?; \
-	HYPOTHESIS_PROFILE=nightly $(BIN)/python -m pytest -q -n 2 -p no:cacheprovider -m "slow or not slow" \
+	HYPOTHESIS_PROFILE=nightly $(BIN)/python -m pytest -q -n 2 --dist loadgroup -p no:cacheprovider -m "slow or not slow" \
 	  > $$d/slow-tests.log 2>&1; t=$$?; tail -1 $$d/slow-tests.log; \
 	$(BIN)/python -m conformance.nightly reports/nightly || exit $$?; \
 	echo "nightly reports: $$d (index: reports/nightly/index.html; slow tests: $$d/slow-tests.log)"; \

@@ -260,7 +260,12 @@ def _key(name: str) -> str:
     return name if name.replace("_", "A").isalnum() else json.dumps(name)
 
 
-NETWORK_CALLS = {"EKI_INIT": "eki", "EKI_LOAD": "eki", "RSI_CREATE": "rsi", "RSI_LOAD": "rsi"}
+def _network_calls() -> dict[str, str]:
+    """{KRL function: partner key} of the calls that name what a program opens of a network
+    partner (net/partner.py ``Partner.opens``: ``EKI_Init`` a channel, ``RSI_CREATE`` a context)."""
+    from net.partners import PARTNERS  # noqa: PLC0415  (the network package: only for krl cell init)
+
+    return {call: p.key for p in PARTNERS for call in p.opens}
 
 
 def network_opened(rt, root: Path) -> list[tuple[str, str, str]]:
@@ -272,6 +277,7 @@ def network_opened(rt, root: Path) -> list[tuple[str, str, str]]:
     from interp.runtime.values import Arr  # noqa: PLC0415
 
     found: dict[tuple[str, str], tuple[str, str, str]] = {}
+    calls = _network_calls()
     main = Path(rt.program.main_path).stem
     for m in rt.program.modules:
         src = m.unit.src
@@ -279,7 +285,7 @@ def network_opened(rt, root: Path) -> list[tuple[str, str, str]]:
             continue
         shown = printable(str(Path(src.path).resolve().relative_to(root.resolve())))
         for node in src.module.walk():
-            if not isinstance(node, N.Call) or node.name.upper() not in NETWORK_CALLS or not node.args:
+            if not isinstance(node, N.Call) or node.name.upper() not in calls or not node.args:
                 continue
             arg = node.args[0]
             name = None
@@ -292,7 +298,7 @@ def network_opened(rt, root: Path) -> list[tuple[str, str, str]]:
                     name = v.text() if isinstance(v, Arr) else None
             if not name:
                 continue
-            kind = NETWORK_CALLS[node.name.upper()]
+            kind = calls[node.name.upper()]
             key = (kind, name.upper())
             if key not in found:
                 found[key] = (kind, printable(name)[:64], f"{shown}:{node.span.line}")
@@ -300,27 +306,17 @@ def network_opened(rt, root: Path) -> list[tuple[str, str, str]]:
 
 
 def _network_lines(opened: list[tuple[str, str, str]], root: Path) -> list[str]:
-    """The commented `network:` section of the starter (docs/network.md)."""
-    from net.ekiconfig import find_config  # noqa: PLC0415
-    from net.rsi import find_context  # noqa: PLC0415
+    """The commented `network:` section of the starter (docs/network.md): each partner's lines
+    for what the backup opens of it (net/partner.py ``Partner.starter``)."""
+    from net.partners import PARTNERS  # noqa: PLC0415  (the network package: only for krl cell init)
 
     if not opened:
         return []
     out = ["# network:            # the partners (docs/network.md); without this key every EKI channel",
            "#                     # stays \"not connected\" and the run is not paced to the wall clock"]
-    eki = [o for o in opened if o[0] == "eki"]
-    if eki:
-        out.append("#   eki:")
-        for _, name, where in eki:
-            cfg = find_config(name, None, root)
-            note = f"config {printable(str(cfg.relative_to(root)))}" if cfg is not None else \
-                "no Config/User/Common/EthernetKRL/" + name + ".xml in the backup: name one with config:"
-            out.append(f"#     {name}: {{address: 127.0.0.1:54600}}   # opened at {where}; {note}")
-    for _, name, where in [o for o in opened if o[0] == "rsi"]:
-        ctx = find_context(name, None, root)
-        note = f"context {printable(str(ctx.relative_to(root)))}" if ctx is not None else \
-            "no SensorInterface/" + name + ".rsi.xml in the backup: name one with config:"
-        out.append(f"#   rsi: {{address: 127.0.0.1:49152}}   # the sensor; context {name} created at {where}; {note}")
+    for partner in PARTNERS:
+        mine = [(name, where) for kind, name, where in opened if kind == partner.key]
+        out += [printable(line) for line in partner.starter(mine, root)]
     return out
 
 

@@ -132,13 +132,13 @@ def attach_network(rt: Runtime, program, workspace, settings) -> None:
     old = getattr(rt.controller, "network", None)
     if old is not None:
         old.close()
-    root = backup_of(Path(program).resolve(), Path(workspace).resolve() if workspace else None)
-    net = Network(settings, program=Path(program).resolve(), backup=root, sink=RuntimeSink(rt))
-    amap = None
-    if settings is not None and (settings.modbus is not None or settings.opcua is not None):
-        amap = plc_map(rt, Path(program).stem)
+    from krl.files import spelled, spelled_within  # noqa: PLC0415 - the user's spelling, links kept
+
+    prog = spelled_within(program, workspace)
+    root = backup_of(prog, spelled(workspace) if workspace else None)
+    net = Network(settings, program=prog, backup=root, sink=RuntimeSink(rt))
     try:
-        net.attach(rt.controller, amap)
+        net.attach(rt.controller, plc_map=lambda: plc_map(rt, Path(program).stem))
     except OSError as exc:
         net.close()
         from net.hub import NetError  # noqa: PLC0415
@@ -253,7 +253,9 @@ def robot_for(program, workspace=None, robot=None, inputs=None):
         robot = cell_of(inputs).robot
     if robot is not None:
         return load_robot(robot)
-    root = backup_of(Path(program).resolve(), Path(workspace).resolve() if workspace else None)
+    from krl.files import spelled, spelled_within  # noqa: PLC0415 - the user's spelling, links kept
+
+    root = backup_of(spelled_within(program, workspace), spelled(workspace) if workspace else None)
     found = _backup_robot(root) if root is not None else None
     if found is None and is_auto(inputs):
         from interp.scene import choose_robot  # noqa: PLC0415

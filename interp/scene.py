@@ -92,9 +92,10 @@ _CHOICES: dict = {}
 
 def chosen(program: Path, workspace=None) -> Choice | None:
     """The choice :func:`choose_robot` made for the backup of `program`, if it made one."""
+    from krl.files import spelled, spelled_within  # noqa: PLC0415
     from krl.project import backup_of  # noqa: PLC0415
 
-    root = backup_of(Path(program).resolve(), Path(workspace).resolve() if workspace else None)
+    root = backup_of(spelled_within(program, workspace), spelled(workspace) if workspace else None)
     return _CHOICES.get(root) if root is not None else None
 
 
@@ -185,11 +186,12 @@ def choose_robot(program: Path, probe: Callable[[], tuple], workspace=None) -> C
     value_of)``: the program loaded on the default robot and a reader of its globals. None
     outside a backup, for a backup with its own machine data, or when no robot reaches more
     than the default. One choice per backup and process."""
+    from krl.files import spelled, spelled_within  # noqa: PLC0415
     from krl.project import backup_of, machine_data_file  # noqa: PLC0415
     from robot.machine import library_robots, load_machine  # noqa: PLC0415
     from robot.mada import MachineDataError, load_robot  # noqa: PLC0415
 
-    root = backup_of(Path(program).resolve(), Path(workspace).resolve() if workspace else None)
+    root = backup_of(spelled_within(program, workspace), spelled(workspace) if workspace else None)
     if root is None or machine_data_file(root) is not None:
         return None
     if root in _CHOICES:

@@ -1,10 +1,12 @@
 """The controller on the network (issue 35, docs/network.md): the partners a PLC, a vision PC,
 ROS and service tools connect to, on the simulated controller's one clock.
 
-- :mod:`net.hub` — the run's network hub: polled at every IPO cycle's start, paces the run to
-  the wall clock while a partner is attached, traces every message (``net`` events), replays
-  a recorded trace;
-- :mod:`net.settings` — the cell file's ``network:`` key;
+- :mod:`net.hub` — the run's network hub: polls every partner at each IPO cycle's start, paces
+  the run to the wall clock while a partner is attached, replays a recorded trace;
+- :mod:`net.partner` — the partner protocol (parse, attach, poll, replay, close), and
+  :mod:`net.partners` — the registered partners, one line each;
+- :mod:`net.settings` — the cell file's ``network:`` key, :mod:`net.cellkey` — what a
+  partner's key is made of (addresses, paths, mappings);
 - :mod:`net.xmlsafe` — XML parsed safely (defusedxml, size and depth limits), TCP stream framing;
 - :mod:`net.transport` — non-blocking TCP/UDP endpoints, polled once per cycle;
 - :mod:`net.ekiconfig`, :mod:`net.eki` — EthernetKRL channels and their element memory;

@@ -15,38 +15,57 @@ error of the call itself, an :class:`EkiError`: the runtime stops the program wi
 the channel's ``MESSAGES Display="disabled"`` (then only Msg_No tells). Errors of reception
 (malformed XML, a message too long, a full memory, a dropped connection) are messages of the
 controller: traced, and given as Msg_No of the channel's next call, never a stop.
+
+:class:`EkiPartner` is EthernetKRL as a network partner of the run (net/partner.py): the
+channels, their sockets (one per channel the cell file names), their events at each IPO cycle
+and in a replay. A client channel's ``EKI_Open`` waits for its connection up to TIMEOUT Connect
+(:meth:`Channel.open`, docs/network.md "Which EKI functions wait").
 """
 
 from __future__ import annotations
 
 from collections import deque
 from dataclasses import dataclass
+from pathlib import Path
+import re
 import xml.etree.ElementTree as ET
 
-from .ekiconfig import EkiConfig, Element
+from krl.limits import MAX_EKI_CHANNELS
+
+from . import transport
+from .cellkey import LOOPBACK, SettingsError, channel
+from .ekiconfig import ConfigError, EkiConfig, Element, find_config, load_config
+from .partner import Partner
 from .xmlsafe import XmlFramer, XmlRefused, local, parse
 
-# EKI's own message numbers (Msg_No; the controller shows "EKI000nn"). Confirmed from public
-# sources: 9, 23 and 512; the others follow the manual's list as far as it could be read, and
-# are decisions recorded in docs/network.md.
+# EKI's own message numbers (Msg_No; the controller shows "EKI000nn") with KUKA's texts, from
+# KUKA's EthernetKRL message table (as generated from KUKA's sources into Intrinsic's
+# kss_messages.h; docs/network.md "EthernetKRL", "Decisions"). 25 for a 17th channel is this
+# project's choice: which message KUKA gives there is not public.
 MESSAGES = {
-    3: "Access to the configuration file failed",
-    9: "Channel not available (not initialized)",
-    10: "Ethernet connection is not open",
+    3: "File access failed",
+    9: "Connection not available",
+    10: "Ethernet is disconnected",
+    14: "Ethernet connection to external system failed",
     15: "Access to empty element memory",
-    16: "Element not found in the configuration",
+    16: "Element not found",
     19: "No data to send",
-    20: "Data type mismatch",
-    22: "Error while reading the configuration",
+    20: "Mismatch in type of data",
+    22: "Error while reading the configuration. XML not valid.",
     23: "Initialization already performed",
-    24: "Binding to the internal parameters (IP, port) failed",
+    24: "Link to internal parameters (Port, IP) failed",
     25: "Maximum number of channels reached",
-    512: "Ethernet connection destroyed",
+    512: "Ethernet connection disrupted",
     768: "Ping reports no contact",
     1024: "Error while reading received XML data",
-    1280: "Limit of element memory reached",
+    1280: "Limit of element storage reached",
     1536: "Received string too long",
 }
+
+
+STRUCT_COMPONENTS = frozenset(("X", "Y", "Z", "A", "B", "C", "S", "T") + tuple(f"A{i}" for i in range(1, 7))
+                              + tuple(f"E{i}" for i in range(1, 7)))
+"""The components of a FRAME, POS, AXIS (and E6POS/E6AXIS) as EKI_SetFrame/GetFrame.. write them."""
 
 
 @dataclass
@@ -79,11 +98,12 @@ def format_real(v: float) -> str:
 
 
 class Channel:
-    """One EKI channel (see the module docstring). `hub` is the network hub (net/hub.py): it
-    owns the sockets and the trace; `cfg` the configuration."""
+    """One EKI channel (see the module docstring). `hub` is the run's :class:`EkiPartner` (or a
+    network hub, net/hub.py, whose EKI partner is taken): it owns the sockets and the trace;
+    `cfg` the configuration."""
 
     def __init__(self, hub, cfg: EkiConfig) -> None:
-        self.hub = hub
+        self.hub = hub.partner("eki") if hasattr(hub, "partner") else hub
         self.cfg = cfg
         self.name = cfg.name
         self.opened = False
@@ -93,6 +113,7 @@ class Channel:
         self.memory: dict[str, deque] = {}
         self.sendvals: dict[str, str | dict] = {}
         self.locked = False
+        self.connecting = False     # a client's EKI_Open is waiting for its connection
         self.held: list[bytes] = []
         self.async_no = 0
         self.framer = XmlFramer(cfg.buffsize) if cfg.receive_kind != "raw" else None
@@ -109,11 +130,44 @@ class Channel:
         return EkiError(number, f"channel {self.name}" + (f", {detail}" if detail else ""), self.cfg.display)
 
     # ------------------------------------------------------------------ open / close
-    def open(self) -> Status:
-        if not self.opened:
-            self.opened = True
+    def open(self, wait=None) -> tuple[Status, EkiError | None]:
+        """EKI_Open. A server starts listening and returns at once; so does a UDP client (no
+        connection to make). A TCP client connects and, as KUKA's EthernetKRL manual says
+        ("EKI_Open() interrupts the program run until the connection to the external system
+        is active"), returns when its connection is up or TIMEOUT Connect (default 2000 ms)
+        has passed on the controller's clock: then EKI00014, the channel closed again.
+        `wait()` gives one IPO cycle back while the caller is blocked (the runtime's
+        ``block_cycle``: the controller, the main run and the other interpreters go on; the
+        hub polls the socket at the cycle's start). A client opened again after its
+        connection dropped connects again (the manual: "The connection can be re-opened via
+        the EKI_OPEN() function"). docs/network.md "EthernetKRL"."""
+        first = not self.opened
+        self.opened = True
+        if first or self.waits():
             self.hub.eki_opened(self)
-        return self.status()
+        if not self.waits():
+            return self.status(), None
+        ctl = self.hub.ctl
+        timeout_ms = self.cfg.connect_timeout_ms
+        self.connecting = True
+        try:
+            if ctl is not None and wait is not None:
+                deadline = ctl.cycle + max(1, ctl.cycles_for(timeout_ms / 1000.0))
+                while not self.connected and ctl.cycle < deadline:
+                    wait()
+        finally:
+            self.connecting = False
+        if self.connected:
+            return self.status(), None
+        self.hub.eki_closed(self)
+        self.opened = False
+        where = self.hub.eki_target(self)
+        detail = f"no connection{' to ' + where if where else ''} within TIMEOUT Connect {timeout_ms} ms"
+        return self.status(msg_no=14), self.error(14, detail)
+
+    def waits(self) -> bool:
+        """True for a TCP client channel that is not connected: EKI_Open waits for it."""
+        return not self.cfg.server and self.cfg.protocol == "TCP" and not self.connected
 
     def close(self) -> Status:
         if self.opened:
@@ -232,9 +286,14 @@ class Channel:
 
     def get(self, path: str, n: int | None = None) -> tuple[list, Status, EkiError | None]:
         """EKI_Get*: the oldest entry (or up to `n` entries for an array getter) of the element
-        at `path`; (values, status, error)."""
+        at `path`; (values, status, error). An element whose components are configured as
+        attributes (``P/@X`` .. ``P/@C``, no element ``P`` of its own) gives one entry of each
+        component's memory as one structure (:meth:`_components`)."""
         el = self._receive_element(path)
         if el is None:
+            parts = self._components(self.cfg.receive, path) if self.cfg.receive_kind == "xml" else {}
+            if parts:
+                return self._get_struct(parts, n)
             return [], self.status(msg_no=16), self.error(16, f"element {path[:60]}")
         q = self.memory.get(el.tag.upper())
         if not q:
@@ -247,6 +306,38 @@ class Channel:
             vals.append(v)
         return vals, self.status(buff=len(q), read=take, counter=counter), None
 
+    def _get_struct(self, parts: dict[str, Element], n: int | None) -> tuple[list, Status, EkiError | None]:
+        queues = {k: self.memory.get(el.tag.upper()) or deque() for k, el in parts.items()}
+        have = min(len(q) for q in queues.values())
+        if not have:
+            name = next(iter(parts.values())).tag.rsplit("/", 1)[0]
+            return [], self.status(msg_no=15), self.error(15, f"element {name[:60]}")
+        take = 1 if n is None else max(0, min(n, have))
+        vals = []
+        counter = 0
+        for _ in range(take):
+            one = {}
+            for k, q in queues.items():
+                v, c = q.pop() if self.cfg.lifo else q.popleft()
+                one[k] = v
+                counter = counter or c
+            vals.append(one)
+        return vals, self.status(buff=have - take, read=take, counter=counter), None
+
+    @staticmethod
+    def _components(elements: list[Element], path: str) -> dict[str, Element]:
+        """The attributes ``path/@K`` configured for a structure's components K (X, Y, Z, A, B,
+        C, S, T, A1..A6, E1..E6): how a channel XML may describe a FRAME, POS or AXIS element
+        (WeiminZhang's ConfigApp1.xml, used with EKI_SetFrame/EKI_GetFrame on the element;
+        docs/network.md "Decisions")."""
+        prefix = path.strip().strip("/").upper() + "/@"
+        out = {}
+        for e in elements:
+            t = e.tag.upper()
+            if t.startswith(prefix) and t[len(prefix):] in STRUCT_COMPONENTS:
+                out[e.tag[len(prefix):].upper()] = e
+        return out
+
     def clear_buffer(self, path: str) -> tuple[Status, EkiError | None]:
         """EKI_ClearBuffer: empty the memory of `path` and of every element under it (the root
         or ``""``: all)."""
@@ -258,9 +349,14 @@ class Channel:
 
     def set_value(self, path: str, value) -> tuple[Status, EkiError | None]:
         """EKI_Set*: the send structure's value at `path` (text, or a dict for a FRAME)."""
-        if self.cfg.send_kind == "xml":
-            if self.cfg.send_element(path) is None:
+        if self.cfg.send_kind == "xml" and self.cfg.send_element(path) is None:
+            parts = self._components(self.cfg.send, path) if isinstance(value, dict) else {}
+            if not parts:
                 return self.status(msg_no=16), self.error(16, f"send element {path[:60]}")
+            for k, el in parts.items():
+                if k in value:
+                    self.sendvals[el.tag.upper()] = value[k]
+            return self.status(), None
         self.sendvals[path.strip().upper()] = value
         return self.status(), None
 
@@ -371,3 +467,253 @@ def _values(root, el: Element) -> list:
         else:
             out.append((n.text or "").strip())
     return out
+
+
+_NAME = re.compile(r"[A-Za-z_$][A-Za-z0-9_$]{0,63}\Z")
+CLIENT_RETRY_CYCLES = 8
+"""IPO cycles (96 ms) from a refused connection attempt of a client channel to the next one,
+while its EKI_Open waits (up to TIMEOUT Connect)."""
+
+
+class EkiPartner(Partner):
+    """EthernetKRL (net/partner.py): the run's EKI channels (``EKI_Init`` creates them, the
+    natives of interp/runtime/netfunctions.py call them) and their sockets, one per channel the
+    cell file names (``network: {eki: {CHANNEL: {config, address}}}``); the others open none
+    and stay "not connected" (docs/network.md "EthernetKRL")."""
+
+    key = "eki"
+    fields = {"eki": {}}
+    docs = "EthernetKRL"
+    opens = ("EKI_INIT", "EKI_LOAD")
+
+    def __init__(self, hub) -> None:
+        super().__init__(hub)
+        self.channels: dict[str, Channel] = {}
+        self.endpoints: dict[str, object] = {}      # CHANNEL (upper) -> net/transport.py endpoint
+
+    # ------------------------------------------------------------------ the protocol
+    @classmethod
+    def parse(cls, doc, base: Path) -> dict:
+        if not isinstance(doc, dict):
+            raise SettingsError("network: eki must map channel names to {config, address}")
+        if len(doc) > MAX_EKI_CHANNELS:
+            raise SettingsError(f"network: eki names {len(doc)} channels, more than {MAX_EKI_CHANNELS}")
+        out = {}
+        for name, ch in doc.items():
+            if not isinstance(name, str) or not _NAME.match(name):
+                raise SettingsError(f"network: eki: {str(name)[:40]!r} is not a channel name")
+            out[name.upper()] = channel(ch, base, f"network: eki: {name}")
+        return {"eki": out}
+
+    def attach(self, ctl, **cell) -> None:
+        """Nothing starts before the program's EKI_Open."""
+
+    @property
+    def attached(self) -> bool:
+        return bool(self.endpoints)
+
+    def sockets(self) -> dict:
+        return dict(self.endpoints)
+
+    def poll(self, ctl, live: bool) -> None:
+        if not live:
+            return
+        for name, ep in list(self.endpoints.items()):
+            for ev in ep.poll():
+                self._event(name, ev)
+            if isinstance(ep, transport.TcpClient) and ep.failed:
+                ch = self.channels.get(name)
+                if ch is None or not ch.connecting:
+                    continue
+                if ep.retry_cycle is None:          # refused: tried again 8 cycles later while
+                    ep.retry_cycle = ctl.cycle + CLIENT_RETRY_CYCLES   # EKI_Open waits (docs/network.md)
+                elif ctl.cycle >= ep.retry_cycle:
+                    ep.retry_cycle = None
+                    ep.start()
+
+    def replay(self, ev: dict) -> None:
+        d, name = ev.get("dir"), ev.get("name")
+        ch = self.channels.get(str(name).upper()) if name else None
+        if ch is None:
+            return
+        if d == "connect":
+            self.trace("eki", "connect", name=ch.name)
+            ch.connected_event()
+        elif d == "disconnect":
+            self.trace("eki", "disconnect", name=ch.name, text=ev.get("text"))
+            ch.disconnected_event(ev.get("text") or "closed by the partner")
+        elif d == "in":
+            self._message(ch, str(ev.get("data", "")).encode("latin-1", "replace"))
+        elif d == "error":
+            number = int(ev.get("number") or 1024)
+            self.trace("eki", "error", name=ch.name, number=number, text=ev.get("text"))
+            ch.async_error(number, str(ev.get("text") or ""))
+
+    def close(self) -> None:
+        for ep in self.endpoints.values():
+            ep.close()
+        self.endpoints.clear()
+
+    @classmethod
+    def starter(cls, opened: list[tuple[str, str]], root: Path) -> list[str]:
+        if not opened:
+            return []
+        out = ["#   eki:"]
+        for name, where in opened:
+            path = find_config(name, None, root)
+            port, role = 54600, ""
+            if path is not None:
+                try:
+                    cfg = load_config(path, name)
+                    port = cfg.port
+                    role = "the robot listens; " if cfg.server else "the robot connects to its partner's server; "
+                except ConfigError:
+                    pass
+            note = f"config {path.relative_to(root)}" if path is not None else \
+                "no Config/User/Common/EthernetKRL/" + name + ".xml in the backup: name one with config:"
+            out.append(f"#     {name}: {{address: 127.0.0.1:{port}}}   # {role}opened at {where}; {note}")
+        return out
+
+    # ------------------------------------------------------------------ the hub's services
+    @property
+    def sink(self):
+        return self.hub.sink
+
+    @property
+    def ctl(self):
+        return self.hub.ctl
+
+    def trace(self, iface: str, direction: str, **fields) -> None:
+        self.hub.trace(iface, direction, **fields)
+
+    def net_message(self, text: str, number: int | None = None) -> None:
+        self.hub.net_message(text, number)
+
+    # ------------------------------------------------------------------ events
+    def _event(self, name: str, ev: tuple) -> None:
+        ch = self.channels.get(name)
+        if ch is None:
+            return
+        kind = ev[0]
+        if kind == "connect":
+            self.trace("eki", "connect", name=ch.name)
+            ch.connected_event()
+        elif kind == "refused":
+            self.trace("eki", "refused", name=ch.name, text="a second partner: closed (one client per server)")
+        elif kind == "disconnect":
+            self.trace("eki", "disconnect", name=ch.name, text=ev[1])
+            ch.disconnected_event(ev[1])
+        elif kind == "data":
+            for msg in ch.data_event(ev[1]):
+                self._message(ch, msg)
+
+    def _message(self, ch: Channel, msg) -> None:
+        if isinstance(msg, XmlRefused):
+            number = 1536 if "longer than" in str(msg) else 1024
+            self.trace("eki", "error", name=ch.name, number=number, text=str(msg))
+            ch.async_error(number, str(msg))
+            return
+        self.trace("eki", "in", name=ch.name, data=msg.decode("latin-1"))
+        self.eki_apply(ch, ch.message(msg))
+
+    # ------------------------------------------------------------------ the EKI functions
+    def init(self, name: str) -> Channel:
+        """EKI_Init: the channel `name` from its configuration. Raises :class:`EkiError`."""
+        key = name.strip().upper()
+        if key in self.channels:
+            raise EkiError(23, f"channel {name}", self.channels[key].cfg.display)
+        if len(self.channels) >= MAX_EKI_CHANNELS:
+            raise EkiError(25, f"{MAX_EKI_CHANNELS} channels")
+        settings = self.hub.settings
+        setting = settings.eki.get(key) if settings is not None else None
+        path = setting.config if setting is not None and setting.config is not None else \
+            find_config(name.strip(), self.hub.program, self.hub.backup)
+        if path is None:
+            raise EkiError(3, f"channel {name}: no {name.strip()}.xml in the backup's "
+                              "Config/User/Common/EthernetKRL nor beside the program")
+        try:
+            cfg = load_config(path, name.strip())
+        except ConfigError as exc:
+            raise EkiError(3 if exc.missing else 22, str(exc)) from None
+        ch = Channel(self, cfg)
+        self.channels[key] = ch
+        return ch
+
+    def channel(self, name: str) -> Channel:
+        """The channel `name` (EKI_Open, EKI_Send, ...). Raises EkiError 9 for one never initialized."""
+        ch = self.channels.get(name.strip().upper())
+        if ch is None:
+            raise EkiError(9, f"channel {name.strip()[:40]}")
+        return ch
+
+    def clear(self, name: str) -> None:
+        """EKI_Clear: the channel closed and deleted."""
+        ch = self.channel(name)
+        ch.close()
+        del self.channels[ch.name.upper()]
+
+    def eki_opened(self, ch: Channel) -> None:
+        """EKI_Open: the channel's socket, when the settings name the channel (else it stays
+        "not connected"). A client channel opened again (its connection dropped, or its last
+        attempt failed) gets a new connection attempt."""
+        key = ch.name.upper()
+        s = self.hub.settings
+        if s is None or key not in s.eki:
+            return
+        if not s.live:
+            return
+        old = self.endpoints.pop(key, None)
+        if old is not None:
+            old.close()
+        cfg = ch.cfg
+        host, port = self.address(ch)
+        try:
+            if cfg.protocol == "UDP":
+                ep = transport.Udp(host, port) if cfg.server else transport.Udp(LOOPBACK, 0, (host, port))
+            elif cfg.server:
+                ep = transport.TcpServer(host, port)
+            else:
+                ep = transport.TcpClient(host, port)
+        except OSError as exc:
+            raise EkiError(24, f"channel {ch.name}: {host}:{port}: {exc.strerror or exc}", cfg.display) from None
+        self.endpoints[key] = ep
+        if cfg.server:
+            self.hub.published("eki:" + ch.name, ep.address)
+        if cfg.protocol == "UDP" and not cfg.server:
+            ch.connected_event()
+
+    def address(self, ch: Channel) -> tuple[str, int]:
+        """Where channel `ch` listens (a server) or connects to (a client): the cell file's
+        address, else loopback at the XML's port (docs/network.md "The cell file")."""
+        s = self.hub.settings
+        setting = s.eki.get(ch.name.upper()) if s is not None else None
+        addr = setting.address if setting is not None else None
+        return addr if addr is not None else (LOOPBACK, ch.cfg.port)
+
+    def eki_target(self, ch: Channel) -> str:
+        """``host:port`` a client channel connects to, "" when no socket is opened for it."""
+        s = self.hub.settings
+        if ch.name.upper() not in self.endpoints and (s is None or ch.name.upper() not in s.eki):
+            return ""
+        host, port = self.address(ch)
+        return f"{host}:{port}"
+
+    def eki_closed(self, ch: Channel) -> None:
+        ep = self.endpoints.pop(ch.name.upper(), None)
+        if ep is not None:
+            ep.close()
+
+    def eki_send(self, ch: Channel, payload: bytes) -> None:
+        self.trace("eki", "out", name=ch.name, data=payload.decode("latin-1"))
+        ep = self.endpoints.get(ch.name.upper())
+        if ep is not None and not ep.send(payload):
+            self.trace("eki", "disconnect", name=ch.name, text="send failed")
+            ch.disconnected_event("send failed")
+
+    def eki_apply(self, ch: Channel, sets: list) -> None:
+        for what, n in sets:
+            if what == "flag":
+                self.sink.set_flag(n, True)
+            else:
+                self.sink.set_out(n, True)
+

@@ -210,7 +210,7 @@ def parse_config(data: bytes, name: str) -> EkiConfig:
         cfg.buffsize = lim if lim is not None else cfg.buffsize
     to = _child(internal, "TIMEOUT")
     if to is not None:
-        ms = _int(_attr(to, "Connect"), f"EKI configuration {name}: TIMEOUT Connect", 0, 3_600_000)
+        ms = _int(_attr(to, "Connect"), f"EKI configuration {name}: TIMEOUT Connect", 0, 65_534)  # the manual's range
         cfg.connect_timeout_ms = ms if ms is not None else cfg.connect_timeout_ms
     alive = _child(internal, "ALIVE")
     if alive is not None:

@@ -31,14 +31,17 @@ cell file names another address.
 
 from __future__ import annotations
 
-import asyncio
 import threading
 from dataclasses import dataclass, field
 import logging
+from pathlib import Path
 
 from krl.limits import MAX_PLC_CLIENTS
 
-from .settings import parse_address
+from .cellkey import SettingsError, inside, mapping, parse_address
+from .partner import Partner
+
+PLC_KEYS = ("modbus", "opcua", "map")
 
 N_ANALOG = 32
 SCALE = 32767
@@ -88,7 +91,7 @@ class Plc:
         self.hub = hub
         self.settings = settings
         self.map = amap or AddressMap()
-        self.loop: asyncio.AbstractEventLoop | None = None
+        self.loop = None                    # the servers' asyncio loop
         self.thread: threading.Thread | None = None
         self.modbus = None
         self.device = None
@@ -104,6 +107,8 @@ class Plc:
     # ------------------------------------------------------------------ start / stop
     def start(self) -> None:
         """Start the servers; returns when they listen. Raises OSError (a port in use)."""
+        import asyncio  # noqa: PLC0415  (costs 0.04 s at every krl run: only with a PLC)
+
         ready = threading.Event()
         self.loop = asyncio.new_event_loop()
 
@@ -222,6 +227,8 @@ class Plc:
         return sum(1 << i for i, n in enumerate(range(a, b + 1)) if get(n))
 
     def close(self) -> None:
+        import asyncio  # noqa: PLC0415  (costs 0.04 s at every krl run: only with a PLC)
+
         loop = self.loop
         if loop is None:
             return
@@ -246,6 +253,8 @@ class Plc:
         """Once per IPO cycle (see the module docstring)."""
         if self.loop is None or self.thread is None or not self.thread.is_alive():
             return
+        import asyncio  # noqa: PLC0415  (costs 0.04 s at every krl run: only with a PLC)
+
         writes = asyncio.run_coroutine_threadsafe(self._exchange(), self.loop).result(30)
         while self.traced_refused < self.refused:
             self.traced_refused += 1
@@ -342,3 +351,57 @@ def replay_write(hub, ev: dict) -> None:
     hub.trace("plc", "in", data=text)
     v = True if value == "TRUE" else False if value == "FALSE" else float(value)
     apply_write(hub, signal, v)
+
+
+class PlcPartner(Partner):
+    """The PLC side (net/partner.py): the Modbus TCP and OPC UA servers of ``network: {plc:
+    {modbus, opcua, map}}`` over the I/O image (docs/network.md "The PLC side"). Its address map
+    comes from the cell (``attach``'s ``plc_map``: a callable, interp/run.py)."""
+
+    key = "plc"
+    fields = {"modbus": None, "opcua": None, "plc_map": None}
+    docs = "The PLC side"
+
+    def __init__(self, hub) -> None:
+        super().__init__(hub)
+        self.plc: Plc | None = None
+
+    @classmethod
+    def parse(cls, doc, base: Path) -> dict:
+        plc = mapping(doc, PLC_KEYS, "network: plc")
+        out: dict = {}
+        if plc.get("modbus") is not None:
+            out["modbus"] = parse_address(plc["modbus"], "network: plc: modbus")
+        if plc.get("opcua") is not None:
+            url = plc["opcua"]
+            if not isinstance(url, str) or not url.startswith("opc.tcp://"):
+                raise SettingsError("network: plc: opcua is an opc.tcp://HOST:PORT address")
+            parse_address(url[len("opc.tcp://"):].split("/", 1)[0], "network: plc: opcua")
+            out["opcua"] = url
+        if plc.get("map") is not None:
+            out["plc_map"] = inside(base, plc["map"], "network: plc: map")
+        return out
+
+    def attach(self, ctl, **cell) -> None:
+        s = self.hub.settings
+        if s is None or (s.modbus is None and s.opcua is None):
+            return
+        amap = cell.get("plc_map")
+        self.plc = Plc(self.hub, s, amap() if callable(amap) else amap)
+        self.plc.start()
+
+    @property
+    def attached(self) -> bool:
+        return self.plc is not None
+
+    def poll(self, ctl, live: bool) -> None:
+        if live and self.plc is not None:
+            self.plc.sync()
+
+    def replay(self, ev: dict) -> None:
+        if ev.get("dir") == "in":
+            replay_write(self.hub, ev)
+
+    def close(self) -> None:
+        if self.plc is not None:
+            self.plc.close()

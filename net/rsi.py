@@ -53,9 +53,10 @@ import numpy as np
 from krl.limits import MAX_RSI_DATAGRAM_BYTES
 
 from . import transport
+from .cellkey import LOOPBACK, channel
+from .partner import Partner
 from .rsicontext import (AXES, CART, Context, RsiConfigError, RsiObject, find_context, is_ethernet_config,
                          load_context)
-from .settings import LOOPBACK
 from .xmlsafe import XmlRefused, local, parse
 
 RSIOK, RSIINVOBJID, RSIINVPARAM, RSINOMEM, RSIINVOBJTYPE, RSIINVCONN, RSIALREADYON, RSINOTON, RSIOBJUSED = range(9)
@@ -547,3 +548,70 @@ def _value(root, tag: str) -> float | None:
                 return None
             return v if np.isfinite(v) else None
     return None
+
+
+RSI_KEYS = ("config", "address", "ethernet")
+"""The keys of ``network: {rsi: ...}``: the context, the sensor's address, the ETHERNET object's
+configuration when it is not beside the context (net/rsicontext.py)."""
+
+
+class RsiPartner(Partner):
+    """RobotSensorInterface (net/partner.py): the run's RSI object (:class:`Rsi`, created at the
+    program's first RSI function) and its sensor's address, ``network: {rsi: {config,
+    address}}`` (docs/network.md "RobotSensorInterface")."""
+
+    key = "rsi"
+    fields = {"rsi": None}
+    docs = "RobotSensorInterface"
+    max_pace = 1.0
+    pace_reason = "RSI answers within its cycle in real time"
+    opens = ("RSI_CREATE", "RSI_LOAD")
+
+    def __init__(self, hub) -> None:
+        super().__init__(hub)
+        self.rsi: Rsi | None = None
+
+    def instance(self) -> Rsi:
+        """The run's RSI object, created at the first RSI function."""
+        if self.rsi is None:
+            self.rsi = Rsi(self.hub)
+        return self.rsi
+
+    @classmethod
+    def parse(cls, doc, base: Path) -> dict:
+        return {"rsi": channel(doc, base, "network: rsi", RSI_KEYS)}
+
+    def attach(self, ctl, **cell) -> None:
+        """Nothing starts before the program's RSI_ON (its ETHERNET object's socket)."""
+
+    @property
+    def attached(self) -> bool:
+        return self.rsi is not None and self.rsi.endpoint is not None
+
+    def ticking(self) -> bool:
+        return self.rsi is not None and self.rsi.on
+
+    def poll(self, ctl, live: bool) -> None:
+        if self.rsi is not None:
+            self.rsi.cycle(ctl, live=live)
+
+    def replay(self, ev: dict) -> None:
+        if self.rsi is not None:
+            self.rsi.replayed(ev)
+
+    def close(self) -> None:
+        if self.rsi is not None:
+            self.rsi.close()
+
+    def sockets(self) -> dict:
+        return {"sensor": self.rsi.endpoint} if self.attached else {}
+
+    @classmethod
+    def starter(cls, opened: list[tuple[str, str]], root: Path) -> list[str]:
+        out = []
+        for name, where in opened:
+            ctx = find_context(name, None, root)
+            note = f"context {ctx.relative_to(root)}" if ctx is not None else \
+                "no SensorInterface/" + name + ".rsi.xml in the backup: name one with config:"
+            out.append(f"#   rsi: {{address: 127.0.0.1:49152}}   # the sensor; context {name} created at {where}; {note}")
+        return out

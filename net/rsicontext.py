@@ -44,7 +44,7 @@ from pathlib import Path
 
 from krl.limits import MAX_NET_CONFIG_BYTES, MAX_RSI_CONTEXT_NODES, MAX_RSI_OBJECTS
 
-from .settings import LOOPBACK
+from .cellkey import LOOPBACK
 from .xmlsafe import XmlRefused, local, parse
 
 TYPES = ("BOOL", "STRING", "LONG", "DOUBLE")      # the template's "RSI Data: TYPE=" comment

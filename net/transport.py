@@ -151,9 +151,15 @@ class TcpClient(Endpoint):
         self.target = (host, port)
         self.address = self.target
         self.pending: socket.socket | None = None
+        self.failed: str | None = None
+        self.retry_cycle: int | None = None     # the next attempt after a refusal (net/eki.py)
         self.start()
 
     def start(self) -> None:
+        """A (new) connection attempt; a refusal shows as :attr:`failed`."""
+        if self.pending is not None:
+            self.pending.close()
+            self.pending = None
         s = socket.socket(socket.AF_INET6 if ":" in self.target[0] else socket.AF_INET, socket.SOCK_STREAM)
         s.setblocking(False)
         err = s.connect_ex(self.target)

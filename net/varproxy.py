@@ -23,11 +23,14 @@ closes that client's connection.
 
 from __future__ import annotations
 
+from pathlib import Path
 import struct
 
 from krl.limits import (MAX_VARPROXY_CLIENTS, MAX_VARPROXY_NAME_CHARS, MAX_VARPROXY_REQUESTS_PER_CYCLE,
                         MAX_VARPROXY_VALUE_CHARS)
 
+from .cellkey import parse_address
+from .partner import Partner
 from .transport import Endpoint, listen
 
 OK = b"\x00\x01\x01"
@@ -162,3 +165,42 @@ def replay_request(hub, ev: dict) -> None:
     parts = str(ev.get("data", "")).split(" ", 2)
     if len(parts) >= 2 and parts[0] in ("read", "write"):
         request(hub, 0 if parts[0] == "read" else 1, parts[1], parts[2] if len(parts) > 2 else "")
+
+
+class VarProxyPartner(Partner):
+    """KukaVarProxy (net/partner.py): its server on the cell file's ``network: {varproxy:
+    HOST:PORT}``, requests answered at each IPO cycle's start (docs/network.md "KukaVarProxy")."""
+
+    key = "varproxy"
+    fields = {"varproxy": None}
+    docs = "KukaVarProxy"
+
+    def __init__(self, hub) -> None:
+        super().__init__(hub)
+        self.server: VarProxy | None = None
+
+    @classmethod
+    def parse(cls, doc, base: Path) -> dict:
+        return {"varproxy": parse_address(doc, "network: varproxy")}
+
+    def attach(self, ctl, **cell) -> None:
+        s = self.hub.settings
+        if s is not None and s.varproxy is not None:
+            self.server = VarProxy(self.hub, s.varproxy)
+            self.hub.published("varproxy", self.server.address)
+
+    @property
+    def attached(self) -> bool:
+        return self.server is not None
+
+    def poll(self, ctl, live: bool) -> None:
+        if live and self.server is not None:
+            self.server.poll()
+
+    def replay(self, ev: dict) -> None:
+        if ev.get("dir") == "in":
+            replay_request(self.hub, ev)
+
+    def close(self) -> None:
+        if self.server is not None:
+            self.server.close()

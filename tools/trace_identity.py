@@ -20,6 +20,10 @@ Usage::
     python tools/trace_identity.py record CHECKOUT OUTDIR [--interp tree,vm] [--limit N]
     python tools/trace_identity.py compare DIR_A DIR_B
 
+``--network`` (both forms): instead of the backups' entry points, every code file of the corpus
+that calls an EthernetKRL or RSI function (``EKI_*``, ``RSI_*``), each with its committed cell
+file if it has one (none has today: its channels stay "not connected", docs/network.md).
+
 ``record`` skips what its OUTDIR holds already (a ``.json``) or what another ``record`` process of the
 same OUTDIR has claimed (``NAME.INTERP.claim``; ``--workers N``: N processes per checkout and
 interpreter share the programs; after an interrupted run, delete the claims without a ``.json``
@@ -37,6 +41,7 @@ import gzip
 import hashlib
 import json
 import os
+import re
 import subprocess
 import sys
 import time
@@ -82,10 +87,29 @@ def _claim(path: Path) -> bool:
     return True
 
 
+NETWORK_CALL = re.compile(rb"\b(?:EKI|RSI)_[A-Z_]+\s*\(", re.IGNORECASE)
+
+
+def network_programs(corpus: Path) -> list[Path]:
+    """The corpus's code files (.src/.sub) that call an EthernetKRL or RSI function (``EKI_*``,
+    ``RSI_*``), inside a backup or not: the programs that use the network (``--network``)."""
+    out = []
+    for p in sorted(corpus.rglob("*")):
+        if p.suffix.lower() in (".src", ".sub") and p.is_file() and not p.is_symlink():
+            try:
+                if NETWORK_CALL.search(p.read_bytes()[:1_000_000]):
+                    out.append(p)
+            except OSError:
+                continue
+    return out
+
+
 def record(checkout: Path, out: Path, interps: list[str], limit: int = 0, corpus: Path = CORPUS,
-           reverse: bool = False) -> int:
+           reverse: bool = False, network: bool = False) -> int:
     """Run every entry point of `corpus` on each of `interps` with the code of `checkout` (which
-    must come first on sys.path) and write its trace and summary to `out`."""
+    must come first on sys.path) and write its trace and summary to `out`. `network`: only the
+    programs that use the network (:func:`network_programs`), each with its cell file if it has
+    one, else none (every partner "not connected", docs/network.md)."""
     checkout = checkout.resolve()
     sys.path.insert(0, str(checkout))
     # the checkout's code, importable only once sys.path holds it; loaded only for `record`
@@ -100,7 +124,8 @@ def record(checkout: Path, out: Path, interps: list[str], limit: int = 0, corpus
         print(f"error: interp comes from {interp.__file__}, not {checkout}", file=sys.stderr)
         return 2
     out.mkdir(parents=True, exist_ok=True)
-    programs = [p for root in find_backups(corpus) for p in entries_of(root)]
+    programs = network_programs(corpus) if network else \
+        [p for root in find_backups(corpus) for p in entries_of(root)]
     if limit:
         programs = programs[:limit]
     if reverse:                 # a second worker from the other end: other backups recorded first
@@ -181,8 +206,10 @@ def main(argv: list[str] | None = None) -> int:
         ap.add_argument("--limit", type=int, default=0)
         ap.add_argument("--corpus", default=str(CORPUS))
         ap.add_argument("--reverse", action="store_true", help="the programs in reverse order")
+        ap.add_argument("--network", action="store_true", help="the programs that call EKI_/RSI_ functions")
         a = ap.parse_args(argv)
-        return record(Path(a.checkout), Path(a.out), a.interp.split(","), a.limit, Path(a.corpus), a.reverse)
+        return record(Path(a.checkout), Path(a.out), a.interp.split(","), a.limit, Path(a.corpus), a.reverse,
+                      a.network)
     if argv[:1] == ["compare"]:
         ap.add_argument("cmd")
         ap.add_argument("a")
@@ -198,6 +225,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--workers", type=int, default=1,
                     help="record processes per checkout and interpreter (they share the programs)")
     ap.add_argument("--corpus", default=str(CORPUS))
+    ap.add_argument("--network", action="store_true",
+                    help="instead of the backups' entry points: the programs that call EKI_/RSI_ functions")
     a = ap.parse_args(argv)
     if not Path(a.corpus).is_dir():
         print(f"no corpus at {a.corpus}; nothing to do")
@@ -216,7 +245,7 @@ def main(argv: list[str] | None = None) -> int:
         log = open(dest / f"record.{it}.log", "a", encoding="utf-8")
         running.append(subprocess.Popen(
             [sys.executable, str(Path(__file__).resolve()), "record", str(co), str(dest), "--interp", it,
-             "--limit", str(a.limit), "--corpus", a.corpus], cwd=co, env=env, stdout=log, stderr=subprocess.STDOUT))
+             "--limit", str(a.limit), "--corpus", a.corpus] + (["--network"] if a.network else []), cwd=co, env=env, stdout=log, stderr=subprocess.STDOUT))
     for p in running:
         p.wait()
     return compare(out / "before", out / "after")

@@ -335,6 +335,29 @@ class Runtime:
         if self.cycle_hook is not None:
             self.cycle_hook(task)
 
+    def block_cycle(self, task: Task) -> None:
+        """One IPO cycle of a statement that blocks its interpreter until something outside
+        it happens (a client's EKI_Open waiting for its connection, docs/network.md
+        "EthernetKRL"): the controller's clock, the main run and the other interpreters go on;
+        the task's interrupt conditions are monitored, an event is kept pending and its
+        routine runs when the statement has returned (at the next statement), as the
+        statement is one step of the program run; a main-run error ends the wait."""
+        self.scheduler.yield_cycle()
+        if task.pending_error is not None:
+            e, task.pending_error = task.pending_error, None
+            err = KrlRuntimeError(e.message, e.number)
+            err.traced = True
+            raise err
+        if task.irqs.armed and not task.in_poll:
+            ctl = self.controller
+            task.in_poll = True
+            try:
+                task.irqs.poll(ctl.io.version, ctl.time, self.state_epoch)
+            finally:
+                task.in_poll = False
+        if self.cycle_hook is not None:
+            self.cycle_hook(task)
+
     def service(self, task: Task) -> None:
         """First act of a resumed task: main-run errors, TRIGGER actions, interrupts."""
         if task.pending_error is not None:

@@ -33,6 +33,7 @@ from pathlib import Path
 from krl.ast import nodes as N
 from krl.diagnostics import SYNTAX_CODES
 from krl.diagnostics.codes import E001, E003, E005
+from krl.files import spelled, spelled_within
 from krl.limits import PARSE_TIMEOUT_S
 from krl.project import project_of, with_basis   # which files make the program: one rule
 from krl.semantics import types as T
@@ -160,21 +161,25 @@ class Program:
     def __init__(self, rt, main_path: str | Path, workspace: str | Path | None = None,
                  submits: list = (), check: bool = True) -> None:
         self.rt = rt
-        self.main_path = Path(main_path).resolve()
-        self.project = project_of(self.main_path, Path(workspace).resolve() if workspace else None)
+        # the user's spelling (links kept, krl/files.py spelled): every path the run shows or
+        # traces is the one the user or the editor gave; identity compares resolved paths
+        self.main_path = spelled_within(main_path, workspace)
+        self.project = project_of(self.main_path, spelled(workspace) if workspace else None)
         self.backup = self.project.backup
         self.workspace = self.project.root
         self.system_dir = self.project.system if self.backup and self.project.system else BASIS_DIR
         extra = basis_files(self.project)
         extra += standard_files(self.project)     # KUKA's P00 when the backup lacks it
         own = {f.stem.lower() for f in self.project.files}
-        extra += [Path(s).resolve() for s in submits if Path(s).resolve() not in self.project.files
+        real = {os.path.realpath(f) for f in self.project.files}
+        extra += [spelled(s) for s in submits if os.path.realpath(s) not in real
                   and Path(s).stem.lower() not in own]
         self.ws = ws = checked_workspace(self.project, extra)
         self.check = check
         self.modules: list[ModuleRT] = [ModuleRT(self, i, u) for i, u in enumerate(ws.units)]
         self.by_name: dict[str, ModuleRT] = {}
         self.by_path: dict[str, ModuleRT] = {}
+        self._by_real: dict[str, ModuleRT] | None = None     # by resolved path (module_of), made when asked
         for m in self.modules:
             self.by_name.setdefault(m.name, m)
             for p in m.files.values():
@@ -193,8 +198,16 @@ class Program:
         return self.by_name.get(name.upper())
 
     def module_of(self, path: str | Path) -> ModuleRT | None:
-        """The module of the file `path` (the program's main file, a submit program)."""
-        return self.by_path.get(str(Path(path).resolve())) or self.by_path.get(str(path))
+        """The module of the file `path` (the program's main file, a submit program), in any
+        spelling of its path (links resolved to compare)."""
+        m = self.by_path.get(str(path)) or self.by_path.get(str(spelled(path)))
+        if m is not None:
+            return m
+        if self._by_real is None:
+            self._by_real = {}
+            for p, mod in self.by_path.items():
+                self._by_real.setdefault(os.path.realpath(p), mod)
+        return self._by_real.get(os.path.realpath(path))
 
     def errors_of(self, m: ModuleRT | None) -> list:
         """The checker's errors in module `m`'s files (none when the run does not check); input

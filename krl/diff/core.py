@@ -7,7 +7,7 @@
   a value, matched by file and name: ``delta`` maps a component to new minus old (X Y Z in mm;
   A B C in degrees, wrapped into -180..180; A1..A6 and E1..E6 in degrees or mm), only the
   components that moved; ``status_turn`` when S or T differ; an added or removed point has its
-  ``coordinates``;
+  ``coordinates``; ``line``: where the NEW side gives the value (the OLD side's for a removed one);
 * ``frames`` -- TOOL_DATA, BASE_DATA and LOAD_DATA of ``$config.dat``, as points;
 * ``values`` -- every other value of every data list (``.dat`` files, ``$config.dat``,
   ``$machine.dat``, the other system data lists): scalars, array elements and STRUC
@@ -221,7 +221,7 @@ def _data(d: Diff, show: str, system: str, io: dict[str, DataValue], inn: dict[s
                                  "line": v.line})
             else:
                 entry = {"file": show, "name": v.name, "kind": _point_kind(section, v), "change": change,
-                         "delta": {}, "coordinates": _coordinates(v)}
+                         "delta": {}, "coordinates": _coordinates(v), "line": v.line}
                 if section == "points":
                     entry["status_turn_changed"] = False
                 getattr(d, section).append(entry)
@@ -287,7 +287,8 @@ def _point_change(d: Diff, show: str, section: str, a: DataValue, b: DataValue, 
             other[comp] = [json_value(x) if x else None, json_value(y) if y else None]
     if not (delta or other or st):
         return
-    entry = {"file": show, "name": b.name, "kind": _point_kind(section, b), "change": "changed", "delta": delta}
+    entry = {"file": show, "name": b.name, "kind": _point_kind(section, b), "change": "changed", "delta": delta,
+             "line": b.line}
     if section == "points":
         entry["status_turn_changed"] = bool(st)
         if st:

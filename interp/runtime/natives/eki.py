@@ -38,6 +38,11 @@ def network(rt):
     return net
 
 
+def _eki(rt):
+    """The run's EthernetKRL partner (net/eki.py EkiPartner)."""
+    return network(rt).partner("eki")
+
+
 def _status(st) -> Struct:
     from ..sysvars import struct_of  # noqa: PLC0415
 
@@ -73,41 +78,43 @@ def _call(fn):
 
 @_call
 def eki_init(rt, a):
-    ch = network(rt).eki_init(ref_text(a[0], "EKI_Init channel"))
+    ch = _eki(rt).init(ref_text(a[0], "EKI_Init channel"))
     return _status(ch.status())
 
 
 @_call
 def eki_open(rt, a):
-    return _status(network(rt).eki_channel(ref_text(a[0], "EKI_Open channel")).open())
+    ch = _eki(rt).channel(ref_text(a[0], "EKI_Open channel"))
+    task = rt.current_task
+    return _result(*ch.open(lambda: rt.block_cycle(task)))      # a client waits (net/eki.py)
 
 
 @_call
 def eki_close(rt, a):
-    return _status(network(rt).eki_channel(ref_text(a[0], "EKI_Close channel")).close())
+    return _status(_eki(rt).channel(ref_text(a[0], "EKI_Close channel")).close())
 
 
 @_call
 def eki_clear(rt, a):
     from net.eki import Status  # noqa: PLC0415
 
-    network(rt).eki_clear(ref_text(a[0], "EKI_Clear channel"))
+    _eki(rt).clear(ref_text(a[0], "EKI_Clear channel"))
     return _status(Status())
 
 
 @_call
 def eki_lock(rt, a):
-    return _status(network(rt).eki_channel(ref_text(a[0], "EKI_Lock channel")).lock())
+    return _status(_eki(rt).channel(ref_text(a[0], "EKI_Lock channel")).lock())
 
 
 @_call
 def eki_unlock(rt, a):
-    return _status(network(rt).eki_channel(ref_text(a[0], "EKI_Unlock channel")).unlock())
+    return _status(_eki(rt).channel(ref_text(a[0], "EKI_Unlock channel")).unlock())
 
 
 @_call
 def eki_send(rt, a):
-    ch = network(rt).eki_channel(ref_text(a[0], "EKI_Send channel"))
+    ch = _eki(rt).channel(ref_text(a[0], "EKI_Send channel"))
     data = ref_text(a[1] if len(a) > 1 else None, "EKI_Send data")
     length = None
     if len(a) > 2 and a[2] is not None:
@@ -119,13 +126,13 @@ def eki_send(rt, a):
 
 @_call
 def eki_checkbuffer(rt, a):
-    ch = network(rt).eki_channel(ref_text(a[0], "EKI_CheckBuffer channel"))
+    ch = _eki(rt).channel(ref_text(a[0], "EKI_CheckBuffer channel"))
     return _result(*ch.check(ref_text(a[1] if len(a) > 1 else None, "EKI_CheckBuffer element")))
 
 
 @_call
 def eki_clearbuffer(rt, a):
-    ch = network(rt).eki_channel(ref_text(a[0], "EKI_ClearBuffer channel"))
+    ch = _eki(rt).channel(ref_text(a[0], "EKI_ClearBuffer channel"))
     return _result(*ch.clear_buffer(ref_text(a[1] if len(a) > 1 else None, "EKI_ClearBuffer element")))
 
 
@@ -136,7 +143,7 @@ def _setter(kind: str):
 
         from ..convert import num  # noqa: PLC0415
 
-        ch = network(rt).eki_channel(ref_text(a[0], f"EKI_Set{kind} channel"))
+        ch = _eki(rt).channel(ref_text(a[0], f"EKI_Set{kind} channel"))
         path = ref_text(a[1] if len(a) > 1 else None, f"EKI_Set{kind} element")
         if len(a) < 3 or a[2] is None:
             raise value_invalid(f"EKI_Set{kind} value")
@@ -214,7 +221,7 @@ def _getter(kind: str, array: bool = False):
         from net.eki import EkiError  # noqa: PLC0415
 
         name = f"EKI_Get{kind}{'Array' if array else ''}"
-        ch = network(rt).eki_channel(ref_text(a[0], f"{name} channel"))
+        ch = _eki(rt).channel(ref_text(a[0], f"{name} channel"))
         path = ref_text(a[1] if len(a) > 1 else None, f"{name} element")
         target = a[2] if len(a) > 2 else None
         if target is None:

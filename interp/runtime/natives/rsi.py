@@ -46,13 +46,11 @@ def rsi_call(hub, rt, method: str, a: list):
     PARAM, VALUE :OUT); RSI 5's RSI_LOAD(NAME), RSI_ACTIVATE(NAME), RSI_PROCESS_ON(mode),
     RSI_PROCESS_OFF(), RSI_DEACTIVATE, RSI_UNLOAD as the same. net/rsi.py holds the behaviour.
     Returns the RSIERR number (INT)."""
-    from net.rsi import RSIOK, Rsi  # noqa: PLC0415
+    from net.rsi import RSIOK  # noqa: PLC0415
 
     from ..convert import num  # noqa: PLC0415
 
-    if hub.rsi is None:
-        hub.rsi = Rsi(hub)
-    rsi = hub.rsi
+    rsi = hub.partner("rsi").instance()
     ctl = rt.controller
     if method == "create":
         ret = rsi.create(_arg_text(a, 0))
