@@ -18,8 +18,7 @@ from krl.semantics import types as T
 from krl.semantics.advance import StmtInfo
 from krl.semantics.resolve import NATIVE, ROUTINE, Callee, Storage
 
-from .builtins import NATIVES, ValueRef
-from .netfunctions import RSI_CONSTANTS
+from .natives import RSI_CONSTANTS, ValueRef
 from .contexts import Context, Irq
 from .watch import CONSTANT, IO, SETTLES, CyclicWatch, settles, split_watch, stamp_key, steady, watch_of
 from .convert import INT_MAX, INT_MIN, assign_into, binary_op, convert_scalar, to_bool, trunc_int, unary_op
@@ -706,17 +705,18 @@ class Runtime:
             return None
         return self.modules[c.owner], c.routine
 
-    @staticmethod
-    def native(c: Callee):
-        """The implementation ``fn(rt, args)`` of a built-in callee (NATIVE) the simulator
-        has (interp/runtime/builtins.py), else None (the stub policy: :meth:`stub_call`)."""
-        return NATIVES.get(c.native) if c.kind == NATIVE else None
-
-    def stub_call(self, name: str, is_function: bool):
-        """A call of a routine that the program does not contain: a routine of KUKA's system
-        software (the checker's classification) stands in (interp/runtime/kss.py: counted, one note);
-        anything else is the run-time error "routine NAME not found"."""
-        return self.kss.call(name, is_function)
+    def call_native(self, c: Callee, args: list, is_function: bool):
+        """A call whose callee is not a routine of the program, with reference ``args``
+        (interp/runtime/natives/args.py), for both interpreters: the implementation the
+        resolver linked (``c.native``, interp/runtime/natives) runs; with none (a routine of
+        the tables the simulator does not implement, or one nothing declares) KUKA's system
+        software stands in, in a backup (interp/runtime/kss.py: counted, one note), and
+        anything else is the run-time error "routine NAME not found". ``is_function``: the
+        call's value is used. Returns the call's value (None for a procedure)."""
+        fn = c.native
+        if fn is None:
+            return self.kss.call(c.name, is_function)
+        return fn(self, args)
 
     def enter_routine(self, module, routine: N.Routine, args: list, caller: Frame | None) -> Frame:
         """Create the frame of a call (§2.3): :IN parameters get converted copies, :OUT

@@ -407,7 +407,7 @@ def _param_types(call: N.Call, ws) -> list:
         from krl.semantics.builtins import load_builtins  # noqa: PLC0415
         from .sysvars import sys_type  # noqa: PLC0415
 
-        info = load_builtins().routines.get(c.native or c.name.upper())
+        info = load_builtins().routines.get(c.name.upper())
         if info is None:
             return []
         return [None if p.dims else (sys_type(p.type_name) or getattr(T, p.type_name.upper(), None))

@@ -494,7 +494,7 @@ class SpinWatch:
                     if callee is None:
                         return None
                     if callee.kind == NATIVE:
-                        if callee.native.upper() not in PURE_NATIVES:
+                        if callee.name.upper() not in PURE_NATIVES:
                             return None
                     elif callee.kind != ROUTINE:
                         return None

@@ -29,13 +29,14 @@ from dataclasses import dataclass, field
 
 from krl.diagnostics import DiagnosticSink, Note
 from krl.semantics.builtins import load_builtins
+from krl.diagnostics.codes import E101, E105, E106, W101, W105, W106, W107
 
 # kind -> (error code, warning code, noun)
 KINDS = {
-    "name": ("E101", "W101", "name"),
-    "type": ("E105", "W105", "type"),
-    "routine": ("E106", "W106", "routine"),
-    "sysvar": ("W107", "W107", "system variable"),
+    "name": (E101, W101, "name"),
+    "type": (E105, W105, "type"),
+    "routine": (E106, W106, "routine"),
+    "sysvar": (W107, W107, "system variable"),      # always a warning: _why names the controller
 }
 
 _FOLD = re.compile(r"^\s*;\s*FOLD\b(.*)$", re.IGNORECASE)
@@ -247,14 +248,10 @@ class Unresolved:
             err, warn, noun = KINDS[kind]
             found = outside.get((kind, key))
             why = found.why if found is not None else ""
-            shown = f"'{name}'" if kind != "routine" else f"routine '{name}'"
-            if kind == "type":
-                shown = f"type '{name}'"
             if not why:
                 for u in uses:
-                    msg = (f"unknown type '{name}'" if kind == "type" else f"{shown} is not declared")
                     helps = {"name": "declare it in the routine or in the module's data list (.dat)"}
-                    sink.add(u.path, u.line, u.column, err, msg, help=helps.get(kind, ""))
+                    sink.add(u.path, u.line, u.column, *err(name=name), help=helps.get(kind, ""))
                 continue
             uses = sorted(uses, key=lambda u: (u.path, u.line, u.column))
             first = uses[0]
@@ -268,8 +265,7 @@ class Unresolved:
                 if u.path not in seen_files and len(notes) < 3:
                     seen_files.add(u.path)
                     notes.append(Note(u.path, u.line, u.column, f"also used here"))
-            sink.add(first.path, first.line, first.column, warn,
-                     f"{noun} '{name}' is not declared in this backup ({times}; first here): {why}",
+            sink.add(first.path, first.line, first.column, *warn(noun=noun, name=name, times=times, why=why),
                      notes=notes,
                      help="the controller must have the software that declares it installed; "
                           "if it does not, this is an error")
