@@ -68,7 +68,7 @@ validate: $(PARSER) java-parser
 	$(BIN)/krl validate
 
 test: $(PARSER) java-parser vm-loop
-	$(BIN)/python -m pytest -q -n 2 -p no:cacheprovider -r fEsxX
+	$(BIN)/python -m pytest -q -n 2 --dist loadgroup -p no:cacheprovider -r fEsxX
 
 bench: $(PARSER) java-parser vm-loop
 	$(BIN)/krl bench
@@ -83,7 +83,8 @@ conformance: $(PARSER) java-parser
 	$(BIN)/krl conformance --out $(CONF_OUT) --fuzz $(CONF_FUZZ)
 
 # Long nightly run, in order: recovery over the shared corpus, growth, the 16-copies scaling
-# figures (scale.json), the static check of the corpus backups (check/), conformance, the
+# figures (scale.json), the static check of the corpus backups (check/), the fleet audit of the
+# corpus with every entry point run for krl run's 600 s (audit/: krl audit, docs/audit.md), conformance, the
 # benchmarks (bench.json, bench-parse.json, limits.jsonl), the fuzzers for their nightly budget
 # (fuzz/), the tests marked slow (long sweeps; hypothesis with the nightly profile); dated
 # reports under reports/nightly/<date>/, then the history (reports/nightly/history.sqlite) and
@@ -99,12 +100,13 @@ nightly: $(PARSER) java-parser
 	$(BIN)/krl growth $(SHARED_CORPUS) --out $$d/growth || exit $$?; \
 	$(BIN)/python -m recovery.scale_bench $(SHARED_CORPUS) --json > $$d/scale.json || exit $$?; \
 	$(BIN)/krl check --report $$d/check $(SHARED_CORPUS) > $$d/check.log 2>&1; \
+	$(BIN)/krl audit $(SHARED_CORPUS) --out $$d/audit $(SCHED_OPT) > $$d/audit.log 2>&1; \
 	$(BIN)/krl conformance --out $$d/conformance --fuzz $(NIGHTLY_FUZZ) --fuzz-random $(SCHED_OPT); c=$$?; \
 	$(BIN)/krl bench --json > $$d/bench.json 2> $$d/bench.log; \
 	$(BIN)/krl bench parse --json > $$d/bench-parse.json 2>> $$d/bench.log; \
 	$(BIN)/python -m robot.limits_bench > $$d/limits.jsonl 2>> $$d/bench.log; \
 	$(BIN)/python -m tests.fuzz.run --seconds $(FUZZ_SECONDS) --out $$d/fuzz; f=$$?; \
-	HYPOTHESIS_PROFILE=nightly $(BIN)/python -m pytest -q -n 2 -p no:cacheprovider -m "slow or not slow" \
+	HYPOTHESIS_PROFILE=nightly $(BIN)/python -m pytest -q -n 2 --dist loadgroup -p no:cacheprovider -m "slow or not slow" \
 	  > $$d/slow-tests.log 2>&1; t=$$?; tail -1 $$d/slow-tests.log; \
 	$(BIN)/python -m conformance.nightly reports/nightly || exit $$?; \
 	echo "nightly reports: $$d (index: reports/nightly/index.html; slow tests: $$d/slow-tests.log)"; \
