@@ -7,6 +7,7 @@ from pathlib import Path
 
 import click
 
+from krl.files import same_file, spelled, spelled_within
 from krl.project import project_of
 from krl.terminal import printable
 
@@ -21,10 +22,10 @@ def program_assembly(program: Path, workspace: Path | None = None, all_modules: 
     from interp.runtime.program import basis_files, checked_workspace  # noqa: PLC0415
     from interp.vm.compiler import compile_module  # noqa: PLC0415
 
-    main_path = Path(program).resolve()
-    project = project_of(main_path, Path(workspace).resolve() if workspace else None)
+    main_path = spelled_within(program, workspace)         # the user's spelling, links kept
+    project = project_of(main_path, spelled(workspace) if workspace else None)
     ws = checked_workspace(project, basis_files(project))
-    units = [u for u in ws.units if any(f is not None and Path(f.path) == main_path for f in (u.src, u.dat))]
+    units = [u for u in ws.units if any(f is not None and same_file(f.path, main_path) for f in (u.src, u.dat))]
     if all_modules:
         units += [u for u in ws.units if u not in units and u.routines]
     out = []

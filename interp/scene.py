@@ -50,7 +50,8 @@ def start_axes(controller, value_of: Callable[[str], object], text: str) -> np.n
             if isinstance(v, N.Unary):
                 v = v.operand
             comps[it.name.upper()] = sign * v.value
-    home = np.array(controller.machine.home_deg, dtype=float)
+    # HOME in KRL's order (A1..A6: a robot with fewer axes has 0 for the others)
+    home = controller.model.to_krl(np.array(controller.machine.home_deg, dtype=float))
     if any(k in comps for k in _AXES):
         q = np.array([float(comps.get(k, home[i])) for i, k in enumerate(_AXES)])
     elif all(k in comps for k in _CART):
@@ -92,9 +93,10 @@ _CHOICES: dict = {}
 
 def chosen(program: Path, workspace=None) -> Choice | None:
     """The choice :func:`choose_robot` made for the backup of `program`, if it made one."""
+    from krl.files import spelled, spelled_within  # noqa: PLC0415
     from krl.project import backup_of  # noqa: PLC0415
 
-    root = backup_of(Path(program).resolve(), Path(workspace).resolve() if workspace else None)
+    root = backup_of(spelled_within(program, workspace), spelled(workspace) if workspace else None)
     return _CHOICES.get(root) if root is not None else None
 
 
@@ -185,11 +187,12 @@ def choose_robot(program: Path, probe: Callable[[], tuple], workspace=None) -> C
     value_of)``: the program loaded on the default robot and a reader of its globals. None
     outside a backup, for a backup with its own machine data, or when no robot reaches more
     than the default. One choice per backup and process."""
+    from krl.files import spelled, spelled_within  # noqa: PLC0415
     from krl.project import backup_of, machine_data_file  # noqa: PLC0415
     from robot.machine import library_robots, load_machine  # noqa: PLC0415
     from robot.mada import MachineDataError, load_robot  # noqa: PLC0415
 
-    root = backup_of(Path(program).resolve(), Path(workspace).resolve() if workspace else None)
+    root = backup_of(spelled_within(program, workspace), spelled(workspace) if workspace else None)
     if root is None or machine_data_file(root) is not None:
         return None
     if root in _CHOICES:

@@ -19,6 +19,10 @@ kind                      meaning
 
 Order: within a folder, entries sorted by name; the files of a folder come before its
 sub-folders (the order of ``os.walk`` with sorted names).
+
+Also here: :func:`spelled` (a path in the user's spelling, links kept: what every command shows
+and sends), :func:`same_file` (identity by resolved paths), :func:`write_bytes_atomic`, and
+:data:`SHARED_CORPUS`.
 """
 
 from __future__ import annotations
@@ -61,6 +65,59 @@ class Entry:
                 "unreadable_folder": f"folder cannot be read: {self.detail}",
                 "too_deep": f"folder more than {MAX_FOLDER_DEPTH} levels deep (not entered)",
                 }.get(self.kind, self.detail)
+
+
+def spelled(path: str | Path) -> Path:
+    """``path`` made absolute as the user (or the editor) spelled it: symbolic links kept, not
+    resolved, so that every path a command shows or sends (a run's summary and trace, the
+    debugger's stack frames, the pendant, the reports) is the one the user gave (issue 46).
+
+    A relative path is taken against the working directory as the shell names it (``$PWD``
+    when it is the working directory, else ``os.getcwd()``); ``.`` parts are dropped; a ``..``
+    after a symbolic link goes to the parent of the link's target (what the system opens), any
+    other ``..`` drops the part before it. Identity and containment compare resolved paths
+    (:func:`same_file`, pendant/security.py ``inside``): two spellings of one file are one file.
+    ``spelled("../shared/x.src")`` in /work/main, with /work/shared a link to /data/shared, is
+    ``/work/shared/x.src``. Never raises for a path that does not exist."""
+    p = Path(path)
+    if not p.is_absolute():
+        cwd = os.environ.get("PWD", "")
+        try:
+            ok = bool(cwd) and os.path.isabs(cwd) and os.path.samefile(cwd, os.curdir)
+        except OSError:
+            ok = False
+        p = Path(cwd if ok else os.getcwd()) / p
+    out = Path(p.anchor)
+    for part in p.parts[1:]:
+        if part == ".":
+            continue
+        if part == "..":
+            out = Path(os.path.realpath(out)).parent if out.is_symlink() else out.parent
+        else:
+            out = out / part
+    return out
+
+
+def spelled_within(path: str | Path, within: str | Path | None) -> Path:
+    """:func:`spelled` ``path``, written below the folder ``within`` as spelled there when the
+    file lies in it but was named through another spelling (the workspace an editor opened
+    behind a link, the program named by its resolved path): the workspace's spelling wins."""
+    p = spelled(path)
+    if within is None:
+        return p
+    w = spelled(within)
+    if p == w or w in p.parents:
+        return p
+    try:
+        rel = Path(os.path.realpath(p)).relative_to(os.path.realpath(w))
+    except ValueError:
+        return p
+    return w / rel
+
+
+def same_file(a: str | Path, b: str | Path) -> bool:
+    """True when ``a`` and ``b`` name the same file or folder (links resolved)."""
+    return os.path.realpath(a) == os.path.realpath(b)
 
 
 def display_path(path: str) -> str:

@@ -179,10 +179,10 @@ def boot_submit(program: str | Path, within: str | Path | None = None) -> Path |
     """The submit program that runs beside `program` as the controller starts it at boot:
     the :func:`submit_program` of the KRC backup holding it (:func:`backup_of`); None outside
     a backup, when the backup has none, or when `program` is that submit program itself."""
-    prog = Path(program).resolve()
-    root = backup_of(prog, Path(within).resolve() if within else None)
+    prog = _files.spelled_within(program, within)
+    root = backup_of(prog, _files.spelled(within) if within else None)
     sub = submit_program(root) if root is not None else None
-    return sub if sub is not None and sub.resolve() != prog else None
+    return sub if sub is not None and not _files.same_file(sub, prog) else None
 
 
 def project_of(path: str | Path, within: str | Path | None = None, limit: int | None = None,

@@ -31,6 +31,7 @@ def pendant(target: Path | None, port: int, no_browser: bool, inputs: Path | Non
     program .src: selected at the start; default the current folder) on 127.0.0.1 and open it
     in the browser. The first line printed is the page's URL with the session token."""
     from krl.archive import ArchiveError, backup_source, is_archive  # noqa: PLC0415
+    from krl.files import spelled  # noqa: PLC0415
     from krl.project import backup_of  # noqa: PLC0415
     from krl.terminal import printable  # noqa: PLC0415
 
@@ -53,11 +54,13 @@ def pendant(target: Path | None, port: int, no_browser: bool, inputs: Path | Non
             if target.suffix.lower() != ".src":
                 click.echo(f"error: {printable(target)}: a program is a .src file", err=True)
                 sys.exit(2)
-            root = backup_of(target.resolve()) or target.resolve().parent
-            program = str(target.resolve().relative_to(root.resolve()))
+            # the user's spelling, links kept (krl/files.py spelled): the page shows the paths given
+            where = spelled(target)
+            root = backup_of(where) or where.parent
+            program = str(where.relative_to(root))
             shown = str(root)
         else:
-            root = backup_of(target.resolve()) or target.resolve()
+            root = backup_of(spelled(target)) or spelled(target)
         sys.exit(serve(root, port=port, open_browser=not no_browser, inputs=str(inputs) if inputs else None,
                        mode=mode.upper(), trace=str(trace_path) if trace_path else None, program=program,
                        readonly=readonly, realtime=not no_realtime, shown=shown))

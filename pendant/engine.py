@@ -14,11 +14,18 @@ clock, or until work is posted to the engine (a key, a snapshot: served at the n
 cycle later); a replay is never paced. The message window waits for the operator
 (``rt.messages.interactive``), and the controller's own notes are kept apart from the KRL
 messages.
+
+The controller's own messages of the message window (:class:`SystemMessages`: run-time errors
+with their number, text, module and line, the numbered messages of the controller and its
+options, why a run ended) are kept by the pendant, not by a run: they stay across replays,
+selections and page loads until the operator acknowledges them, as on the smartHMI
+(docs/pendant.md, "The message window").
 """
 
 from __future__ import annotations
 
 import asyncio
+import re
 import threading
 import time
 from pathlib import Path
@@ -42,6 +49,80 @@ class EngineError(Exception):
     """An action the engine refused (its message is the pendant's text)."""
 
 
+#: the message types of the smartHMI's message window, by the kinds of interp/runtime/messages.py
+#: (KUKA "Programming user-defined messages": notification, acknowledgement, status, wait, dialog)
+MESSAGE_TYPES = {"NOTIFY": "notification", "QUIT": "acknowledgement", "STATE": "status", "WAITING": "wait",
+                 "DIALOG": "dialog"}
+#: an originator at the head of a numbered controller message ("EKI00010 ..."), else KSS
+_ORIGIN = re.compile(r"^([A-Z]{2,8})\d{3,6}\b")
+
+
+class SystemMessages:
+    """The controller's own messages in the message window, kept by the pendant for as long as
+    it serves (across runs, replays, selections and page loads) until the operator
+    acknowledges them: each a dict ``handle`` ("S1", "S2", ...: a KRL message's handle is an
+    INT), ``kind`` (QUIT: acknowledgement, NOTIFY: notification), ``origin`` (KSS, EKI, ...),
+    ``number`` (or None), ``text``, ``module`` (the file name), ``path``, ``line``, ``time``
+    (simulated s), ``thread`` (robot program, a submit program). At most MAX_KRL_MESSAGES (the
+    oldest go first). Thread-safe: the engine thread adds, the server's loop acknowledges."""
+
+    def __init__(self) -> None:
+        self._lock = threading.Lock()
+        self._items: list[dict] = []
+        self._next = 1
+
+    def add(self, kind: str, text: str, *, number: int | None = None, origin: str = "KSS",
+            path: str | None = None, line: int | None = None, time: float = 0.0, thread: str | None = None) -> dict:
+        """Show a message; the same message again (a replay reaching it, the end of the run
+        that stopped at it) is not shown twice while the first is shown."""
+        from krl.limits import MAX_KRL_MESSAGES  # noqa: PLC0415
+
+        text = str(text)[:500]
+        row = {"kind": kind, "origin": origin, "number": number, "text": text,
+               "module": Path(path).name if path else "", "path": path, "line": line,
+               "time": round(float(time), 3), "thread": thread}
+        with self._lock:
+            for old in self._items:
+                if all(old[k] == row[k] for k in ("kind", "number", "text", "path", "line", "time")):
+                    return old
+            row["handle"] = f"S{self._next}"
+            self._next += 1
+            self._items.append(row)
+            del self._items[:-MAX_KRL_MESSAGES]
+            return row
+
+    def acknowledge(self, handle: str) -> None:
+        """The operator's OK. Raises :class:`EngineError` for a message not shown."""
+        with self._lock:
+            for i, m in enumerate(self._items):
+                if m["handle"] == handle:
+                    del self._items[i]
+                    return
+        raise EngineError(f"no message {str(handle)[:20]}")
+
+    def acknowledge_all(self) -> int:
+        """"Confirm all": every message shown; how many."""
+        with self._lock:
+            n = len(self._items)
+            self._items.clear()
+            return n
+
+    def rows(self) -> list[dict]:
+        with self._lock:
+            return [dict(m) for m in self._items]
+
+
+def run_time_error(rt, task, err) -> dict:
+    """Where and what a run-time error is, for the message window: number, text, path, line,
+    thread (the innermost statement of ``task`` when the error does not carry its place yet)."""
+    path = err.file or getattr(task, "file", None)
+    line = err.line if err.line is not None else getattr(task, "line", None)
+    kind = getattr(task, "kind", "robot")
+    name = getattr(task, "name", "")
+    return {"number": err.number, "text": err.message, "path": str(path) if path else None, "line": line,
+            "time": rt.controller.time, "thread": f"{'submit' if kind == 'submit' else 'robot'} program {name}".strip()}
+
+
 class Engine:
     """One selected program at a time, run by a debug engine on its own thread.
 
@@ -51,6 +132,8 @@ class Engine:
     def __init__(self, on_event, *, realtime: bool = True) -> None:
         self.on_event = on_event
         self.realtime = realtime
+        self.system = SystemMessages()
+        self._errors_shown: set[int] = set()    # the run-time errors of this run shown (id)
         self.core: RunEngine | None = None
         self.thread = None
         self.live: dict = {}
@@ -70,7 +153,7 @@ class Engine:
         stands on the first line after Select. Raises :class:`EngineError` (the checker's
         errors, a bad cell file)."""
         self.cancel()
-        core = RunEngine(on_event=self.on_event, on_runtime=self._on_runtime)
+        core = RunEngine(on_event=self._event, on_runtime=self._on_runtime)
         self.core, self.signals = core, None
         self.thread = thread_main(core, "krl-pendant-engine")
         options = {"workspace": workspace, "inputs": inputs, "mode": mode, "run_mode": run_mode,
@@ -141,10 +224,42 @@ class Engine:
             raise EngineError("the controller did not answer in time") from None
 
     # ------------------------------------------------------------------ each run
+    def _event(self, name: str, body: dict) -> None:
+        """The engine's event (engine thread): at the end of a run, why it ended goes to the
+        message window (a run-time error once: it was shown where it stopped the program); then
+        handed on."""
+        core = self.core
+        if name == "exited" and core is not None and core.rt is not None:
+            res = getattr(core.rt, "result", None)
+            if res is not None and res.reason == "error" and res.error is not None:
+                err = res.error
+                if id(err) in self._errors_shown:
+                    self.on_event(name, body)          # shown where it stopped the program
+                    return
+                self.system.add("QUIT", err.message, number=err.number, path=res.file, line=res.line,
+                                time=res.sim_time, thread=None if res.context in (None, "main") else res.context)
+            elif res is not None and res.reason != "completed":
+                self.system.add("NOTIFY", f"program ended: {res.reason}" + (f": {res.text}" if res.text else ""),
+                                origin="krl", path=res.file, line=res.line, time=res.sim_time)
+        self.on_event(name, body)
+
     def _on_runtime(self, rt) -> None:
         """A run is built (the first, or a replay): the message window waits for the operator,
-        the simulator's notes are kept, the display and the pacing hook once per IPO cycle."""
+        run-time errors and numbered controller messages go to the message window, the
+        simulator's notes are kept, the display and the pacing hook once per IPO cycle."""
         rt.messages.interactive = True
+        inner_error = rt.error_hook
+
+        self._errors_shown = set()
+
+        def error_hook(task, frame, err):
+            self._errors_shown.add(id(err))
+            e = run_time_error(rt, task, err)
+            self.system.add("QUIT", e["text"], number=e["number"], path=e["path"], line=e["line"], time=e["time"],
+                            thread=e["thread"])
+            if inner_error is not None:
+                inner_error(task, frame, err)
+        rt.error_hook = error_hook
         ctl = rt.controller
         ctl.add_cyclic(self._cycle)
         self._pace0 = None
@@ -156,7 +271,17 @@ class Engine:
         def message(text, motion_id=None, number=None):
             from krl.limits import MAX_KRL_MESSAGES  # noqa: PLC0415
 
-            if not (text.startswith("KRL message: ") or text.startswith("KRL dialog")):
+            if number is not None:
+                m = _ORIGIN.match(str(text))
+                self.system.add("QUIT", text, number=number, origin=m.group(1) if m else "KSS", time=ctl.time)
+            elif motion_id is not None:
+                # the main run's own message about a motion ("approximation not possible": a
+                # KSS warning, krl-reference §6.8): a notification at the motion's line
+                req = ctl.current_request()
+                at = req if req is not None and getattr(req, "id", None) == motion_id else None
+                self.system.add("NOTIFY", text, path=getattr(at, "file", None), line=getattr(at, "line", None),
+                                time=ctl.time)
+            elif not (text.startswith("KRL message: ") or text.startswith("KRL dialog")):
                 self.notes.append({"time": round(ctl.time, 3), "text": str(text)[:300]})
                 del self.notes[:-MAX_KRL_MESSAGES]
             inner(text, motion_id, number)
@@ -291,6 +416,19 @@ def message(core: RunEngine, handle, answer=None) -> None:
     core.edit_now(what, apply)
 
 
+def acknowledge_all(core: RunEngine) -> int:
+    """"Confirm all" for the program's messages: every notification and acknowledgement
+    message shown (status, wait and dialog messages stay: the program clears them, a dialog
+    is answered); how many."""
+    def apply(engine):
+        win = engine.rt.messages
+        handles = [m.handle for m in win.shown if m.kind in ("NOTIFY", "QUIT")]
+        for h in handles:
+            win.acknowledge(h)
+        return len(handles)
+    return core.edit_now("confirm all messages", apply)
+
+
 def jog(core: RunEngine, system: str, axis, step) -> list:
     """One jog increment in T1 with the program stopped: AXIS (``axis`` 1..6, ``step`` deg) or
     WORLD/BASE/TOOL (``axis`` X, Y, Z, A, B, C, ``step`` mm or deg), as a PTP (axis) or a
@@ -359,5 +497,6 @@ def set_watch(core: RunEngine, expr: str, value: str) -> str:
     return core.assign(expr, value)
 
 
-__all__ = ["Engine", "EngineError", "JOG_SYSTEMS", "MODES_OP", "RUN_MODES", "jog", "message", "mode_op",
+__all__ = ["Engine", "EngineError", "JOG_SYSTEMS", "MESSAGE_TYPES", "MODES_OP", "RUN_MODES", "SystemMessages",
+           "acknowledge_all", "jog", "message", "mode_op",
            "override", "run_mode", "set_input", "set_watch", "touch_up"]

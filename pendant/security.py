@@ -40,17 +40,22 @@ def new_token() -> str:
 
 
 def inside(root: Path, path: str | Path, *, suffixes: tuple[str, ...] | None = None) -> Path:
-    """``path`` (absolute, or relative to ``root``) resolved, when it is a regular file inside
-    ``root`` of at most MAX_WEB_FILE_BYTES (and, with ``suffixes``, has one of them, any case).
-    Raises :class:`PathRefused`."""
+    """``path`` (absolute, or relative to ``root``) when it is a regular file inside ``root`` of
+    at most MAX_WEB_FILE_BYTES (and, with ``suffixes``, has one of them, any case): resolved
+    (links followed) to decide, and returned below ``root`` as ``root`` is spelled (the user's
+    spelling, links of ``root`` kept: ``root / `` the resolved path relative to the resolved
+    root). Raises :class:`PathRefused`."""
     text = str(path)
     if not text or "\0" in text or len(text) > 4096:
         raise PathRefused("not a path")
-    root = root.resolve()
+    real_root = root.resolve()
     p = Path(text)
-    p = (p if p.is_absolute() else root / p).resolve()
-    if not p.is_relative_to(root):
+    if not p.is_absolute():
+        p = root / p
+    real = p.resolve()
+    if not real.is_relative_to(real_root):
         raise PathRefused("outside the workspace")
+    p = root / real.relative_to(real_root)
     if not p.is_file():
         raise PathRefused("no such file in the workspace")
     if suffixes is not None and p.suffix.lower() not in suffixes:

@@ -56,7 +56,7 @@ CSP = ("default-src 'none'; script-src 'self'; style-src 'self'; img-src 'self' 
        "connect-src 'self'; font-src 'self'; frame-ancestors 'self' vscode-webview:; base-uri 'none'; "
        "form-action 'none'")
 OPS = ("hello", "select", "cancel", "reset", "start", "stop", "backward", "runMode", "modeOp", "drives",
-       "override", "breakpoint", "input", "ack", "answer", "watch", "setWatch", "jog", "touchup", "open")
+       "override", "breakpoint", "input", "ack", "ackAll", "answer", "watch", "setWatch", "jog", "touchup", "open")
 
 
 class Pendant:
@@ -65,7 +65,9 @@ class Pendant:
     def __init__(self, root: Path, *, inputs: str | None = None, mode: str = "T1", realtime: bool = True,
                  trace: str | None = None, program: str | None = None, readonly: bool = False,
                  shown_root: str | None = None) -> None:
-        self.root = root.resolve()
+        from krl.files import spelled  # noqa: PLC0415
+
+        self.root = spelled(root)        # the user's spelling, links kept: the page's paths are the user's
         self.shown_root = shown_root or str(root)
         self.inputs = inputs
         self.mode = mode
@@ -89,6 +91,7 @@ class Pendant:
         self._shown: dict[WebSocket, dict] = {}     # per page: the state it was last sent
         self._pushing = asyncio.Lock()
         self._modules: dict[str, tuple] = {}
+        self._position = None                       # where the robot stands when no program is selected
 
     # ------------------------------------------------------------------ static data
     def robot(self) -> dict:
@@ -99,7 +102,7 @@ class Pendant:
 
             probe = self.initial or next(iter(self.programs()), None)
             prog = str(self.root / probe) if probe else str(self.root / "none.src")
-            self._robot = robot_view(robot_for(prog, str(self.root), None, self.inputs))
+            self._robot = robot_view(robot_for(prog, str(self.root), None, self.inputs), self.inputs)
         return self._robot
 
     def programs(self) -> list[str]:
@@ -129,10 +132,18 @@ class Pendant:
 
     async def state(self, fresh: dict | None = None) -> dict:
         """The page's state: ``fresh`` (a snapshot the engine took right after a key, in the
-        key's own engine call), else a snapshot asked for now."""
+        key's own engine call), else a snapshot asked for now. Without a selected program: the
+        modes, the message window's system messages (they outlive a run) and where the robot
+        stands (its start pose before the first selection: :meth:`robot`, else where the last
+        run left it)."""
+        from .state import message_rows  # noqa: PLC0415
+
         if not self.engine.selected:
-            return {"state": "none", "program": None, "drives": self.drives, "modeOp": self.mode,
-                    "runMode": self.run_mode}
+            if self._position is None:
+                self._position = self.robot().get("start")
+            return {"state": "none", "program": None, "programLabel": None, "drives": self.drives,
+                    "modeOp": self.mode, "runMode": self.run_mode, "messages": message_rows(self.engine, None),
+                    "position": self._position}
         if fresh is not None:
             s = dict(fresh)
         else:
@@ -140,10 +151,24 @@ class Pendant:
                 eng, watch = self.engine, list(self.watch)
                 s = await eng.do_async(lambda core: snapshot(eng, core, watch), 60.0)
             except EngineError as exc:
-                s = {"state": "ended" if not self.engine.selected else "busy", "note": str(exc)}
-        s.update({"program": self.program, "drives": self.drives, "breakpoints":
-                  {p: sorted(v) for p, v in self.breakpoints.items()}})
+                s = {"state": "ended" if not self.engine.selected else "busy", "note": str(exc),
+                     "messages": message_rows(self.engine, None)}
+        if s.get("position") is not None:
+            self._position = s["position"]
+        if s.get("state") == "ended":                 # the modes the next run starts with
+            s.update({"modeOp": self.mode, "runMode": self.run_mode})
+        s.update({"program": self.program, "programLabel": self._label(self.program), "drives": self.drives,
+                  "breakpoints": {p: sorted(v) for p, v in self.breakpoints.items()}})
         return s
+
+    def _label(self, program: str | None) -> str | None:
+        """``program`` as the programs list names it (relative to the workspace)."""
+        if program is None:
+            return None
+        try:
+            return str(Path(program).relative_to(self.root))
+        except ValueError:
+            return program
 
     async def push_state(self, fresh: dict | None = None) -> None:
         """The state to every page, as what changed since the state that page was sent last
@@ -261,13 +286,13 @@ class Pendant:
             if value not in RUN_MODES:
                 raise EngineError(f"run mode: one of {', '.join(RUN_MODES)}")
             self.run_mode = value
-            if self.engine.selected:
+            if self._live():
                 await do(lambda core: keys.run_mode(core, value))
         elif op == "modeOp":
             value = str(msg.get("value", "")).upper()
             if value not in MODES_OP:
                 raise EngineError(f"operating mode: one of {', '.join(MODES_OP)}")
-            if self.engine.selected:
+            if self._live():
                 await do(lambda core: keys.mode_op(core, value))
             self.mode = value
             self.drives = False          # turning the mode switch switches the drives off
@@ -288,7 +313,17 @@ class Pendant:
         elif op == "input":
             await do(lambda core: keys.set_input(core, msg.get("index"), bool(msg.get("value"))))
         elif op == "ack":
-            await do(lambda core: keys.message(core, msg.get("handle")))
+            handle = msg.get("handle")
+            if isinstance(handle, str):               # the controller's own message (pendant/engine.py)
+                self.engine.system.acknowledge(handle)
+            else:
+                await do(lambda core: keys.message(core, handle))
+        elif op == "ackAll":
+            # "Confirm all": the controller's messages and the program's notification and
+            # acknowledgement messages (status, wait and dialog messages stay)
+            self.engine.system.acknowledge_all()
+            if self._live():
+                await do(keys.acknowledge_all)
         elif op == "answer":
             await do(lambda core: keys.message(core, msg.get("handle"), msg.get("key")))
         elif op == "watch":
@@ -301,6 +336,8 @@ class Pendant:
         elif op == "setWatch":
             await do(lambda core: keys.set_watch(core, str(msg.get("expr", "")), str(msg.get("value", ""))))
         elif op == "jog":
+            if self.mode != "T1":                     # the robot's rule first: jog keys work in T1 only
+                raise EngineError(f"jog: only in T1 (operating mode {self.mode})")
             self._need_drives()
             await do(lambda core: keys.jog(core, str(msg.get("system", "")).upper(), msg.get("axis"), msg.get("step")),
                      900.0)
@@ -316,6 +353,11 @@ class Pendant:
             await self.send_module(ws, str(path))
             return
         await self.push_state(fresh[-1] if fresh and self.watch == watch else None)
+
+    def _live(self) -> bool:
+        """A selected program that has not ended: a mode key goes to its run. After its end
+        the key sets the mode the next selection (Reset, Select) starts with."""
+        return self.engine.selected and self.engine.state in ("running", "stopped")
 
     def _need_drives(self) -> None:
         if not self.drives:

@@ -1,6 +1,8 @@
 """What the pendant page shows, read from the engine on the engine's thread (pendant/engine.py
-``krl/state``): the status line, the pointers, the threads, the message window and the
-simulator's notes, the I/O by number and SIGNAL name, the watch list, the actual position.
+``krl/state``): the status line (with the stop's reason, number, text and place, and how a run
+ended), the pointers, the threads, the message window (the controller's own messages, then the
+program's KRL messages) and the simulator's notes, the I/O by number and SIGNAL name, the watch
+list, the actual position.
 
 Every text here is data for the page (JSON): the page writes it with ``textContent``, never
 as markup (pendant/web/src/main.js).
@@ -21,7 +23,8 @@ def snapshot(eng, core, watch: list) -> dict:
     """The page's state (engine thread): ``eng`` the pendant's :class:`pendant.engine.Engine`
     (notes, signals), ``core`` its run-control engine, ``watch`` the watched expressions."""
     rt = core.rt
-    out = {"state": core.state, "pointers": core.pointers() if rt is not None else {}}
+    out = {"state": core.state, "pointers": core.pointers() if rt is not None else {},
+           "messages": message_rows(eng, rt)}
     if rt is None:
         return out
     if eng.signals is None:
@@ -34,12 +37,9 @@ def snapshot(eng, core, watch: list) -> dict:
         "runMode": rt.run_mode,
         "override": _num(store.get("$OV_PRO")),
         "time": round(ctl.time, 3),
-        "stop": {"reason": body.get("reason"), "description": body.get("description") or body.get("text")}
-        if core.state == "stopped" else None,
+        "stop": _stop(core, body) if core.state == "stopped" else None,
+        "outcome": _outcome(rt) if core.state == "ended" else None,
         "threads": _threads(rt),
-        "messages": [{"handle": m.handle, "kind": m.kind, "text": m.text, "module": m.module,
-                      "number": m.number, "softkeys": m.softkeys, "time": round(m.time, 3)}
-                     for m in rt.messages.shown],
         "notes": list(eng.notes),
         "path": {"run": eng.run_no, "points": len(eng.path)},
         "io": _io(rt, eng.signals),
@@ -47,6 +47,46 @@ def snapshot(eng, core, watch: list) -> dict:
         "watch": _watch(core, watch),
     })
     return out
+
+
+def message_rows(eng, rt) -> list[dict]:
+    """The message window: the controller's own messages (pendant/engine.py
+    :class:`SystemMessages`, kept across runs), then the KRL messages the program shows
+    (interp/runtime/messages.py), each with its ``type`` as the smartHMI names it."""
+    from .engine import MESSAGE_TYPES  # noqa: PLC0415
+
+    rows = [{**m, "type": MESSAGE_TYPES[m["kind"]], "softkeys": []} for m in eng.system.rows()]
+    if rt is not None:
+        rows += [{"handle": m.handle, "kind": m.kind, "type": MESSAGE_TYPES.get(m.kind, m.kind.lower()),
+                  "origin": m.module, "text": m.text, "module": m.module, "number": m.number,
+                  "softkeys": m.softkeys, "time": round(m.time, 3), "krl": True}
+                 for m in rt.messages.shown]
+    return rows
+
+
+def _stop(core, body: dict) -> dict:
+    """Why the program stands: the stop's ``reason`` and ``description`` (the engine's, e.g.
+    "run-time error (1422)"), and for a run-time error its ``text``, ``number``, ``path`` and
+    ``line`` (the statement that failed)."""
+    out = {"reason": body.get("reason"), "description": body.get("description"), "text": body.get("text")}
+    err = core.stop_error
+    if err is not None:
+        from .engine import run_time_error  # noqa: PLC0415
+
+        e = run_time_error(core.rt, core.stop_task, err)
+        out.update({"number": e["number"], "text": e["text"], "path": e["path"], "line": e["line"],
+                    "module": Path(e["path"]).name if e["path"] else ""})
+    return out
+
+
+def _outcome(rt) -> dict | None:
+    """How the run ended (interp/runtime/core.py RunResult): ``reason`` (completed, error,
+    halt, deadlock, max_sim_time, ...), ``text``, ``number``, ``path``, ``line``."""
+    res = getattr(rt, "result", None)
+    if res is None:
+        return None
+    return {"reason": res.reason, "text": res.text or "", "number": res.error.number if res.error is not None else None,
+            "path": str(res.file) if res.file else None, "line": res.line}
 
 
 def _num(v):

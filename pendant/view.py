@@ -22,9 +22,9 @@ def programs(root: Path) -> list[str]:
     from interp.realprograms import programs_of  # noqa: PLC0415
 
     out = []
-    for p in programs_of(root.resolve()):
+    for p in programs_of(root):
         try:
-            out.append(str(p.resolve().relative_to(root.resolve())))
+            out.append(str(Path(p).relative_to(root)))
         except ValueError:
             continue
     return out
@@ -35,7 +35,7 @@ def modules(root: Path) -> list[str]:
     any of them can be selected)."""
     from krl.files import walk  # noqa: PLC0415
 
-    out = [e.rel for e in walk(root.resolve()) if e.kind == "file" and e.rel.lower().endswith(".src")]
+    out = [e.rel for e in walk(root) if e.kind == "file" and e.rel.lower().endswith(".src")]
     return sorted(out, key=str.lower)[:5000]
 
 
@@ -47,7 +47,7 @@ def module_view(path: Path, root: Path) -> dict:
     src = read_source(path, max_bytes=MAX_WEB_FILE_BYTES)
     text = getattr(src, "text", None) or ""
     dat = _data_list_of(path)
-    return {"path": str(path), "label": str(path.relative_to(root.resolve())),
+    return {"path": str(path), "label": str(path.relative_to(root)),
             "lines": text.splitlines(), "points": taught_points(dat, root) if dat is not None else [],
             "dat": str(dat) if dat is not None else None}
 
@@ -102,7 +102,7 @@ def _base_data(root: Path) -> dict[int, tuple]:
     from krl.project import backup_of, system_folder  # noqa: PLC0415
     from robot.datalist import DataListError, read_data_list  # noqa: PLC0415
 
-    base = backup_of(root.resolve()) or root.resolve()
+    base = backup_of(root) or root
     folder = system_folder(base)
     if folder is None:
         return {}
@@ -121,13 +121,45 @@ def _base_data(root: Path) -> dict[int, tuple]:
     return out
 
 
-def robot_view(machine) -> dict:
+def robot_view(machine, inputs: str | None = None) -> dict:
     """The robot the page draws: its URDF (``krl robot export``'s, robot/urdf.py), $ROBROOT
-    (X..C mm/deg) and the joint names in A1..A6 order."""
+    (X..C mm/deg), the joint names in A1..A6 order, and ``start``: where it stands before a
+    program is selected (:func:`start_position`)."""
     from robot.urdf import build_urdf  # noqa: PLC0415
 
     return {"name": machine.name, "urdf": build_urdf(machine), "robroot": list(machine.robroot_frame),
-            "joints": [j.name for j in machine.joints[:6]]}
+            "joints": [j.name for j in machine.joints[:6]], "start": start_position(machine, inputs)}
+
+
+def start_position(machine, inputs: str | None = None) -> dict | None:
+    """The position panel's data before a program is selected: the axes a run starts at
+    (interp/run.py ``make_runtime``: the cell file's ``start:`` when it gives the axes, else
+    ``$AXIS_HOME[1]``, the machine data's home; a start named by a point of the program is known
+    only once the program is selected) and ``$POS_ACT`` there with ``$TOOL`` and ``$BASE`` null,
+    as before the program's BAS sets them: ``{axes, pos, base, tool}`` as pendant/state.py's
+    ``position``. None when the robot cannot be placed (the page then shows no position)."""
+    from robot.controller import Controller  # noqa: PLC0415
+
+    try:
+        from interp.run import cell_of, is_auto  # noqa: PLC0415
+
+        cell = cell_of(inputs) if inputs and not is_auto(inputs) else None
+        ctl = Controller(machine, stimuli=cell, mujoco=False)
+        where = getattr(ctl, "start", None)
+        if where is not None:
+            from krl.ast import nodes as N  # noqa: PLC0415
+            from robot.stimuli import parse_start  # noqa: PLC0415
+
+            if not isinstance(parse_start(where), N.Name):
+                from interp.scene import start_axes  # noqa: PLC0415
+
+                ctl.place(start_axes(ctl, lambda name: None, where))
+        pos = ctl.pos_act()
+    except Exception:  # noqa: BLE001 - a robot the model cannot place shows no start position
+        return None
+    null = dict.fromkeys(("X", "Y", "Z", "A", "B", "C"), 0.0)
+    return {"axes": [round(float(v), 4) for v in ctl.axis_act()],
+            "pos": {k: round(float(v), 3) for k, v in pos.items()}, "base": null, "tool": null}
 
 
 __all__ = ["module_view", "programs", "robot_view", "taught_points"]

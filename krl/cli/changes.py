@@ -84,14 +84,18 @@ def diff(old: str, new: str, fmt: str, tolerance: float, timeout: float | None, 
 
 
 def load_map(path: str):
-    """The program map of the backup (folder or .zip) or file at `path`, with paths shown as
-    the user names them; raises ValueError with the message of ``krl check`` for bad input."""
+    """``(map, diagnostics, files, lines)`` of the backup (folder or .zip) or file at `path`:
+    its program map and ``krl check``'s diagnostics with paths shown as the user names them,
+    its files (shown paths), and ``lines(shown path)``: the text lines of a file with a
+    diagnostic (read while an archive is extracted; [] for others). Raises ValueError with the
+    message of ``krl check`` for bad input."""
     from dataclasses import replace  # noqa: PLC0415
 
     from krl.archive import ArchiveError, backup_source  # noqa: PLC0415
     from krl.limits import PARSE_TIMEOUT_S  # noqa: PLC0415
     from krl.programmap import build_map  # noqa: PLC0415
     from krl.project import folder_groups  # noqa: PLC0415
+    from krl.source import read_source  # noqa: PLC0415
     from krl.workspace import workspaces_for  # noqa: PLC0415
 
     p = Path(path)
@@ -109,20 +113,24 @@ def load_map(path: str):
             ws = wss[0]
             pm = build_map(ws)
             diags = [shown.diagnostic(d) for d in ws.diagnostics]
+            texts = {shown(real): (read_source(real).text or "").splitlines()
+                     for real in {d.path for d in ws.diagnostics} if Path(real).is_file()}
             pm.root = shown(pm.root)
             for n in pm.nodes.values():
                 n.path = shown(n.path) if n.path else n.path
+                n.uses = {(shown(f), name) for f, name in n.uses}
             pm.edges = [replace(e, path=shown(e.path)) for e in pm.edges]
             pm.unresolved = [(s, n, shown(f), ln) for s, n, f, ln in pm.unresolved]
-            return pm, diags, len(ws.files)
+            return pm, diags, [shown(f.path) for f in ws.files], lambda shown_path: texts.get(shown_path, [])
     except ArchiveError as exc:
         raise ValueError(f"{path}:1:1: error[E004]: {str(exc).removeprefix(f'{path}: ')}") from None
 
 
 @click.command()
 @click.argument("backup")
-@click.option("--format", "fmt", type=click.Choice(["dot", "svg", "html", "json"]), default="dot", show_default=True,
-              help="dot: Graphviz source; svg: drawn by Graphviz's dot; html: an interactive page; json: nodes and edges.")
+@click.option("--format", "fmt", type=click.Choice(["dot", "svg", "html", "json", "text"]), default="dot", show_default=True,
+              help="dot: Graphviz source; svg: drawn by Graphviz's dot; html: an interactive page; json: nodes and "
+                   "edges; text: entry points, modules only an operator starts, dead routines.")
 @click.option("--links", type=click.Choice(["file", "vscode", "none"]), default="file", show_default=True,
               help="html: how a routine links to its file:line (file: URL, vscode: URL, or no link).")
 @click.option("-o", "--output", default=None, help="Write to this file instead of standard output.")
@@ -130,16 +138,18 @@ def graph(backup: str, fmt: str, links: str, output: str | None) -> None:
     """The program map of a KRC backup (folder or .zip) or a folder: routines, calls,
     interrupts, triggers, RUN commands and EKI channels, entry points and unreachable routines.
     html: an interactive page (zoom, pan, search, a routine's neighbourhood), offline."""
-    from krl.programmap.render import GraphTooLarge, GraphvizMissing, to_dot, to_html, to_svg  # noqa: PLC0415
+    from krl.programmap.render import GraphTooLarge, GraphvizMissing, to_dot, to_html, to_svg, to_text  # noqa: PLC0415
 
     try:
-        pm, _diags, _n = load_map(backup)
+        pm, _diags, _n, _lines = load_map(backup)
         if fmt == "json":
             text = json.dumps(pm.as_json(), indent=2, ensure_ascii=False)
         elif fmt == "svg":
             text = to_svg(pm)
         elif fmt == "html":
             text = to_html(pm, links)
+        elif fmt == "text":
+            text = "\n".join(to_text(pm))
         else:
             text = to_dot(pm)
     except (ValueError, GraphTooLarge, GraphvizMissing) as exc:
@@ -151,28 +161,47 @@ def graph(backup: str, fmt: str, links: str, output: str | None) -> None:
 
 @click.command()
 @click.argument("backup")
-@click.option("--since", "since", default=None, help="An older backup (folder or .zip): add what changed since it.")
+@click.option("--since", "since", default=None, help="An older backup (folder or .zip): the report says what changed since it.")
+@click.option("--runs/--no-runs", default=True, show_default=True,
+              help="With --since: run the entry points the change touches, old and new (--inputs auto).")
+@click.option("--max-sim-time", type=click.FloatRange(min=0, min_open=True), default=None,
+              help="Simulated seconds each run may take (default 60).")
+@click.option("--jobs", type=click.IntRange(min=1), default=None, help="Worker processes of the runs (default: one per core).")
+@click.option("--links", type=click.Choice(["file", "vscode", "none"]), default="file", show_default=True,
+              help="How each file:line links to its file (file: URL, vscode: URL that opens the line, or no link).")
 @click.option("-o", "--output", default=None, help="Write the HTML page to this file instead of standard output.")
-def report(backup: str, since: str | None, output: str | None) -> None:
-    """One HTML page for a change request: the check summary of BACKUP, its program map and,
-    with --since OLD, the diff from OLD to BACKUP."""
+def report(backup: str, since: str | None, runs: bool, max_sim_time: float | None, jobs: int | None,
+           links: str, output: str | None) -> None:
+    """The change report a customer signs: one HTML page that opens with a summary, then (with
+    --since OLD) the diff from OLD to BACKUP, the check findings the change introduced or
+    removed, the run outcomes of the entry points it touches (old against new), the
+    interactive program map, and every check finding of BACKUP. Prints as a readable PDF."""
     from krl.diff.core import diff_sides  # noqa: PLC0415
     from krl.diff.load import DiffInputError, side  # noqa: PLC0415
-    from krl.diff.report import report_html  # noqa: PLC0415
-    from krl.programmap.render import GraphTooLarge, GraphvizMissing, to_svg  # noqa: PLC0415
+    from krl.diff.report import findings, relative, report_html, touched_entries  # noqa: PLC0415
+    from krl.programmap.render import GraphTooLarge  # noqa: PLC0415
 
     try:
-        pm, diags, n_files = load_map(backup)
-        try:
-            svg = to_svg(pm)
-        except GraphvizMissing as exc:
-            click.echo(f"krl report: {exc}; the page has no drawing", err=True)
-            svg = ""
-        d = None
+        pm, diags, files, lines = load_map(backup)
+        new_findings = findings(diags, pm.root, lines, links)
+        kw: dict = {}
         if since is not None:
+            pm_old, diags_old, files_old, lines_old = load_map(since)
             with side(since) as a, side(backup) as b:
                 d = diff_sides(a, b)
-        text = report_html(backup, n_files, diags, pm, svg, d)
+                touched = touched_entries(d, pm_old, pm)
+                if max_sim_time is None:
+                    from interp.realprograms import REPORT_SIM_TIME_S  # noqa: PLC0415
+
+                    max_sim_time = REPORT_SIM_TIME_S
+                if runs and touched:
+                    _run_touched(touched, a, b, max_sim_time, jobs)
+                kw = {"diff": d, "old_findings": findings(diags_old, pm_old.root, lines_old, links),
+                      "file_sets": (relative(files_old, pm_old.root), relative(files, pm.root)),
+                      "old_map": pm_old, "touched": touched, "runs": runs, "max_sim_time": max_sim_time,
+                      "new_root": None if b.shown_of.archive else str(b.root),
+                      "old_root": None if a.shown_of.archive else str(a.root)}
+        text = report_html(backup, len(files), new_findings, pm, links=links, **kw)
     except DiffInputError as exc:
         _fail("report", exc)
     except (ValueError, GraphTooLarge) as exc:
@@ -180,6 +209,45 @@ def report(backup: str, since: str | None, output: str | None) -> None:
     except Exception as exc:  # noqa: BLE001 - a last line of defence: no traceback
         _fail("report", RuntimeError(f"internal error: {type(exc).__name__}: {exc}"))
     _write(text, output)
+
+
+def _real(s, shown_path: str | None) -> str | None:
+    """The file on this machine of a path shown as the user names it (inside an archive: in
+    the side's extracted folder)."""
+    if shown_path is None:
+        return None
+    archive = s.shown_of.archive if s.shown_of is not None else ""
+    if archive and shown_path.startswith(archive + "/"):
+        return str(Path(s.shown_of.folder) / shown_path[len(archive) + 1:])
+    return shown_path
+
+
+def _run_touched(touched, a, b, max_sim_time, jobs) -> None:
+    """Run the touched entry points on both sides (interp/outcomes.py) and fill in their
+    outcomes and what changed; progress on standard error when it is a terminal."""
+    from interp.outcomes import outcome_changes, run_outcomes  # noqa: PLC0415
+
+    paths = {}
+    for t in touched:
+        for s, p in ((a, t.old), (b, t.new)):
+            real = _real(s, p)
+            if real is not None:
+                paths[real] = (t, "old" if s is a else "new")
+    done = [0]
+    tty = sys.stderr.isatty()
+
+    def progress(path: str, outcome: dict) -> None:
+        done[0] += 1
+        if tty:
+            t, which = paths[path]
+            click.echo(f"\rkrl report: run {done[0]}/{len(paths)}: {printable(t.name)} ({which}) "
+                       f"{outcome['ending']}\033[K", err=True, nl=done[0] == len(paths))
+
+    results = run_outcomes(list(paths), max_sim_time, jobs, progress)
+    for real, (t, which) in paths.items():
+        setattr(t, f"{which}_outcome", results.get(real))
+    for t in touched:
+        t.changes = outcome_changes(t.old_outcome, t.new_outcome)
 
 
 commands = [diff, graph, report]

@@ -7,7 +7,7 @@
   a value, matched by file and name: ``delta`` maps a component to new minus old (X Y Z in mm;
   A B C in degrees, wrapped into -180..180; A1..A6 and E1..E6 in degrees or mm), only the
   components that moved; ``status_turn`` when S or T differ; an added or removed point has its
-  ``coordinates``;
+  ``coordinates``; ``line``: where the NEW side gives the value (the OLD side's for a removed one);
 * ``frames`` -- TOOL_DATA, BASE_DATA and LOAD_DATA of ``$config.dat``, as points;
 * ``values`` -- every other value of every data list (``.dat`` files, ``$config.dat``,
   ``$machine.dat``, the other system data lists): scalars, array elements and STRUC
@@ -221,7 +221,7 @@ def _data(d: Diff, show: str, system: str, io: dict[str, DataValue], inn: dict[s
                                  "line": v.line})
             else:
                 entry = {"file": show, "name": v.name, "kind": _point_kind(section, v), "change": change,
-                         "delta": {}, "coordinates": _coordinates(v)}
+                         "delta": {}, "coordinates": _coordinates(v), "line": v.line}
                 if section == "points":
                     entry["status_turn_changed"] = False
                 getattr(d, section).append(entry)
@@ -287,7 +287,8 @@ def _point_change(d: Diff, show: str, section: str, a: DataValue, b: DataValue, 
             other[comp] = [json_value(x) if x else None, json_value(y) if y else None]
     if not (delta or other or st):
         return
-    entry = {"file": show, "name": b.name, "kind": _point_kind(section, b), "change": "changed", "delta": delta}
+    entry = {"file": show, "name": b.name, "kind": _point_kind(section, b), "change": "changed", "delta": delta,
+             "line": b.line}
     if section == "points":
         entry["status_turn_changed"] = bool(st)
         if st:
@@ -345,12 +346,14 @@ def _declarations(d: Diff, show: str, scope: str, old_items: list, new_items: li
 
 
 def _duplicates(d: Diff, old: Side, new: Side, keys: set[str]) -> None:
-    """The checker's E102 diagnostics in the compared files, of each side."""
+    """The names declared twice in the compared files, of each side (the workspace's facts,
+    krl/semantics/checker.py DeclaredTwice), worded as the checker words E102."""
     for name, s in (("old", old), ("new", new)):
-        for diag, key in s.duplicates:
+        for fact, key in s.duplicates:
             if key in keys:
-                d.duplicates.append({"side": name, "file": s.rel(key), "line": diag.line,
-                                     "code": diag.code, "message": s.relative(diag.message)})
+                code, message = fact.worded(lambda span, s=s: s.relative(str(span)))
+                d.duplicates.append({"side": name, "file": s.rel(key), "line": fact.span.line,
+                                     "code": code, "message": message})
 
 
 # ---------------------------------------------------------------------- routines

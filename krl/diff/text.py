@@ -7,6 +7,8 @@ environment (krl/render.py, template ``diff.html.j2``) in the HTML form.
 
 from __future__ import annotations
 
+from markupsafe import Markup
+
 from krl.diff.core import KIND_TITLES, KINDS, Diff
 from krl.render import render_html
 from krl.terminal import printable
@@ -68,7 +70,8 @@ def diff_text(d: Diff) -> list[str]:
                 "status/turn changed " + ", ".join(f"{c} {a}->{b}" for c, (a, b) in e["status_turn"].items())]
             if e.get("values"):
                 extra.append(_values(e["values"]))
-            out.append(f"  {p(e['file'])} {p(e['name'])} ({e['kind']}): " + "; ".join(x for x in [what, *extra] if x))
+            out.append(f"  {p(e['file'])}:{e['line']} {p(e['name'])} ({e['kind']}): "
+                       + "; ".join(x for x in [what, *extra] if x))
     if d.frames:
         out.append(f"Frames and loads ({len(d.frames)}):")
         for e in d.frames:
@@ -77,7 +80,7 @@ def diff_text(d: Diff) -> list[str]:
                 what += f" {{{format_coordinates(e['coordinates'])}}}"
             if e.get("values"):
                 what = "; ".join(x for x in (what, _values(e["values"])) if x)
-            out.append(f"  {p(e['file'])} {p(e['name'])} ({e['kind']}): {p(what)}")
+            out.append(f"  {p(e['file'])}:{e['line']} {p(e['name'])} ({e['kind']}): {p(what)}")
     if d.values:
         out.append(f"Data values ({len(d.values)}):")
         for e in d.values:
@@ -127,10 +130,18 @@ def diff_text(d: Diff) -> list[str]:
     return out
 
 
-def html_helpers() -> dict:
-    """The template helpers of the diff section (shared with the change report)."""
+def _plain_link(file: str, line: int | None = None, side: str = "new", label: str | None = None) -> Markup:
+    """``file:line`` (or `label`) as code, no link (``krl diff --format html`` names no folder to
+    link into)."""
+    text = label if label is not None else f"{file}:{line}" if line else file
+    return Markup(render_html("krl.diff", "_link.html.j2", text=text, href=""))
+
+
+def html_helpers(link=None) -> dict:
+    """The template helpers of the diff section (shared with the change report); `link(file,
+    line, side, label)` renders a place (default: as code, without a link)."""
     return {"format_coordinates": format_coordinates, "krl_text": krl_text, "kinds": KINDS,
-            "kind_titles": KIND_TITLES, "summary_line": summary_line}
+            "kind_titles": KIND_TITLES, "summary_line": summary_line, "link": link or _plain_link}
 
 
 def diff_html(d: Diff) -> str:

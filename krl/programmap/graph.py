@@ -16,7 +16,10 @@ drawn. Edge kinds:
   node ``EKI name``.
 
 Entry points (``Node.entry`` says why, ``Node.entry_kind`` which of these kinds; the first
-that applies is named):
+that applies is named), in two classes (issue 49): what the controller starts by itself and what
+only an operator can select.
+
+Started by the controller:
 
 * ``cell`` -- the cell program (module ``CELL``, or a main routine ``DEF CELL()``), which
   Automatic External starts;
@@ -25,21 +28,36 @@ that applies is named):
   may have several numbers, the first is named); a routine called in most branches (at least
   three, more than half) is a step of the cell's own sequence (``CellProgramStart()``), not a
   program;
-* ``submit`` -- every submit interpreter (``.sub`` file: ``sps.sub``);
+* ``submit`` -- every submit interpreter (``.sub`` file: ``sps.sub``; reference section 9);
 * ``selected`` -- every program a system data list (``$config.dat``, ``$custom.dat``,
-  ``$option.dat``) names as ``"/R1/NAME()"`` (``$PRO_I_O``, ``$PRO_I_O_PROC_IDn``);
-* ``operator`` -- the main routine of every module under ``R1/Program`` (krl.project
-  .program_folder): the programs an operator can select at the pendant, so a KR C2 backup
-  without cell.src has its user programs as entries;
-* ``interrupt`` -- every interrupt handler (the routine an ``INTERRUPT DECL`` calls): the
-  controller starts it when its condition fires;
-* ``system`` -- the main routines of KUKA's own files (krl.workspace.is_kuka_file: the
-  controller calls them);
-* ``module`` -- for a folder that is not a KRC backup, the main routine of every module.
+  ``$option.dat``) names as ``"/R1/NAME()"`` (``$PRO_I_O``, ``$PRO_I_O_PROC_IDn``: the
+  extended submit interpreters, reference section 9);
+* ``interrupt`` -- an interrupt handler (the routine an ``INTERRUPT DECL`` calls) whose
+  declaring routine runs: the controller starts it when its condition fires (reference 5.16);
+  an interrupt declared only in a routine nothing runs never fires;
+* ``trigger`` -- a routine a ``TRIGGER WHEN ... DO`` of a routine that runs calls (5.18).
 
-A routine of the backup's own that none of these reaches along the edges is *unreachable*
-(``Node.unreachable``); a routine of KUKA's system software that nothing calls is unused
-library (the controller, its inline forms and technology packages call it), never unreachable.
+Selected by an operator:
+
+* ``operator`` -- the main routine of every module under ``R1/Program`` (krl.project
+  .program_folder) that is a ``DEF`` without parameters: the programs an operator can select
+  at the pendant (a selected program starts its main routine with no arguments; the same rule
+  as interp.realprograms.programs_of), so a KR C2 backup without cell.src has its user
+  programs as entries.
+
+And ``system`` -- the main routines of KUKA's own files (krl.workspace.is_kuka_file: the
+controller, its inline forms and technology packages call them); ``module`` -- for a folder
+that is not a KRC backup, the main routine of every module and every GLOBAL routine (nothing
+says who starts or calls them: code outside the folder may).
+
+Each node has a *reach* (``Node.reach``, :data:`REACH`): ``controller`` when a routine the
+controller starts reaches it along the edges (calls, interrupts, triggers, RUN); ``operator``
+when only operator-selectable programs reach it; ``module`` in a folder that is not a backup;
+``dead`` when nothing reaches a routine of the backup's own (``Node.unreachable``); ``unknown``
+for such a routine whose name a file with syntax errors uses (the checker resolves nothing in
+that file, so whether it calls the routine is not known: never called dead), and what it reaches; ``unused`` for a
+routine of KUKA's system software nothing calls (a library: never dead). A module whose
+routines are reached only by operator selection is listed by :attr:`ProgramMap.operator_only`.
 """
 
 from __future__ import annotations
@@ -55,7 +73,12 @@ from krl.ast import printer
 from krl.project import backup_of, program_folder
 from krl.workspace import Workspace, is_kuka_file
 
-__all__ = ["Node", "Edge", "ProgramMap", "build_map", "routine_id"]
+__all__ = ["Node", "Edge", "ProgramMap", "build_map", "routine_id", "REACH", "CONTROLLER_KINDS"]
+
+#: the reach of a node (see the module docstring), in the order the map's tables list them
+REACH = ("controller", "operator", "module", "unknown", "dead", "unused")
+#: the entry kinds the controller starts by itself
+CONTROLLER_KINDS = ("cell", "plc", "submit", "selected", "interrupt", "trigger")
 
 _RUN = re.compile(r"^\s*RUN\s+(?:/R1/)?([A-Za-z_$][A-Za-z0-9_$]*)\s*\(", re.I)
 _SELECTED = re.compile(r"^\s*/R1/([A-Za-z_$][A-Za-z0-9_$]*)\s*\(", re.I)
@@ -65,7 +88,8 @@ _SELECTED = re.compile(r"^\s*/R1/([A-Za-z_$][A-Za-z0-9_$]*)\s*\(", re.I)
 class Node:
     """A routine (kind ``routine``) or an EKI channel (kind ``channel``). ``path``/``line``:
     where it is declared (1-based); ``entry``: why it is an entry point, else ""; ``entry_kind``:
-    which kind of entry point (see the module docstring), else ""; ``kuka``: in KUKA's system
+    which kind of entry point (see the module docstring), else ""; ``reach``: one of
+    :data:`REACH` (``unreachable`` is ``reach == "dead"``); ``kuka``: in KUKA's system
     software (krl.workspace.is_kuka_file)."""
     id: str
     name: str
@@ -76,9 +100,15 @@ class Node:
     entry: str = ""
     entry_kind: str = ""
     unreachable: bool = False
+    reach: str = ""
     kuka: bool = False
     main: bool = False
+    runnable: bool = False         # a module main that is a DEF without parameters: a program of its own
+    is_global: bool = False        # GLOBAL DEF / DEFFCT
     end: int = 0                   # the END/ENDFCT line
+    # the data it reads or writes: (declaring file, NAME upper-case) of every name the checker
+    # resolved to a variable, constant or signal declared in a file (a data list, $config.dat)
+    uses: set[tuple[str, str]] = field(default_factory=set, repr=False)
 
 
 @dataclass(frozen=True)
@@ -114,20 +144,32 @@ class ProgramMap:
 
     @property
     def unreachable(self) -> list[Node]:
+        """The dead routines: of the backup's own, reached by no entry point."""
         return [n for n in self.nodes.values() if n.unreachable]
+
+    @property
+    def operator_only(self) -> list[str]:
+        """The modules of the backup's own that only operator selection reaches: some routine
+        has reach ``operator`` and none ``controller`` (module names, in map order)."""
+        by: dict[str, set[str]] = {}
+        for n in self.nodes.values():
+            if n.kind == "routine" and not n.kuka:
+                by.setdefault(n.module, set()).add(n.reach)
+        return [m for m, r in by.items() if "operator" in r and "controller" not in r]
 
     def as_json(self) -> dict:
         """``{"root", "nodes": [...], "edges": [...], "entries": [...], "unreachable": [...],
-        "unresolved": [...]}`` (docs/diff.md, "krl graph"; docs/schemas/graph.schema.json)."""
+        "operator_only": [...], "unresolved": [...]}`` (docs/diff.md, "krl graph"; docs/schemas/graph.schema.json)."""
         return {
             "root": self.root,
             "nodes": [{"id": n.id, "name": n.name, "module": n.module, "kind": n.kind, "path": n.path,
                        "line": n.line, "system": n.kuka, "entry": n.entry, "entry_kind": n.entry_kind,
-                       "unreachable": n.unreachable} for n in self.nodes.values()],
+                       "unreachable": n.unreachable, "reach": n.reach} for n in self.nodes.values()],
             "edges": [{"source": e.source, "target": e.target, "kind": e.kind, "path": e.path,
                        "line": e.line, "column": e.column} for e in self.edges],
             "entries": list(self.entries),
             "unreachable": [n.id for n in self.unreachable],
+            "operator_only": self.operator_only,
             "unresolved": [{"source": s, "name": n, "path": p, "line": ln} for s, n, p, ln in self.unresolved],
         }
 
@@ -153,6 +195,7 @@ def build_map(ws: Workspace) -> ProgramMap:
             if nid in pm.nodes:
                 continue                   # a duplicate routine (E102): the first one stands
             pm.nodes[nid] = Node(nid, r.name, u.name, u.src.path, r.span.line, kuka=kuka, main=i == 0,
+                                 runnable=i == 0 and _selectable(r), is_global=r.is_global,
                                  end=r.end_line or r.span.line)
             pm._by_decl[id(r)] = nid
             if i == 0:
@@ -165,7 +208,6 @@ def build_map(ws: Workspace) -> ProgramMap:
             if src is not None:
                 _edges(pm, ws, src, r, u.src.path, mains)
     _entries(pm, ws, mains)
-    _mark_unreachable(pm)
     return pm
 
 
@@ -204,6 +246,8 @@ def _edges(pm: ProgramMap, ws: Workspace, src: str, r: N.Routine, path: str, mai
                 target = _target(pm, ws, sym)
                 if target is not None:
                     pm.edges.append(Edge(src, target, "call", path, node.span.line, node.span.column))
+            elif sym is not None and sym.path and sym.kind in ("var", "const", "signal"):
+                pm.nodes[src].uses.add((sym.path, sym.name.upper()))
 
 
 def _builtin(pm: ProgramMap, src: str, call: N.Call, path: str, mains: dict) -> None:
@@ -229,6 +273,9 @@ def _strings(e) -> list[str]:
 
 
 def _entries(pm: ProgramMap, ws: Workspace, mains: dict) -> None:
+    """Entry points and each node's reach (module docstring): the controller's entries first,
+    the handlers of the interrupts and triggers their routines declare, then the programs an
+    operator selects, then KUKA's own main routines and (outside a backup) every module main."""
     def add(nid: str | None, kind: str, why: str) -> None:
         if nid is not None and nid in pm.nodes and not pm.nodes[nid].entry:
             pm.nodes[nid].entry, pm.nodes[nid].entry_kind = why, kind
@@ -257,17 +304,78 @@ def _entries(pm: ProgramMap, ws: Workspace, mains: dict) -> None:
                 m = _SELECTED.match(s)
                 if m is not None:
                     add(mains.get(m.group(1).upper()), "selected", f"selected by {dl.name.lower()}.dat")
-    programs = program_folder(root) if root is not None else None
-    for nid, n in pm.nodes.items():
-        if n.kind == "routine" and n.main and not n.kuka and programs is not None and _inside(n.path, programs):
-            add(nid, "operator", "selectable at the pendant (R1/Program)")
+    out: dict[str, list[Edge]] = {}
     for e in pm.edges:
-        if e.kind == "interrupt":
-            add(e.target, "interrupt", f"interrupt handler (declared by {pm.nodes[e.source].name})")
+        out.setdefault(e.source, []).append(e)
+    _reach(pm, out, list(pm.entries), "controller")
+    programs = program_folder(root) if root is not None else None
+    operator = [nid for nid, n in pm.nodes.items()
+                if n.kind == "routine" and n.runnable and not n.kuka and programs is not None
+                and _inside(n.path, programs)]
+    for nid in operator:
+        add(nid, "operator", "selectable at the pendant (R1/Program)")
+    _reach(pm, out, [nid for nid in operator if not pm.nodes[nid].reach], "operator")
+    modules = []
     for nid, n in pm.nodes.items():
         if n.kind == "routine" and n.main and (n.kuka or not backup):
             add(nid, "system" if n.kuka else "module",
                 "KUKA system program" if n.kuka else "main routine of a module")
+            if not n.kuka:
+                modules.append(nid)
+        elif n.kind == "routine" and n.is_global and not backup and not n.kuka:
+            # a folder that is not a backup is a library as much as a program: code outside it
+            # (the backup it goes into, its sps.sub) may call what its modules export
+            add(nid, "module", "GLOBAL routine of a module")
+            modules.append(nid)
+    _reach(pm, out, [nid for nid in modules if not pm.nodes[nid].reach], "module")
+    named = _named_in_unparsed(ws)
+    _reach(pm, out, [nid for nid, n in pm.nodes.items()
+                     if not n.reach and n.kind == "routine" and not n.kuka and n.name.upper() in named], "unknown")
+    for n in pm.nodes.values():
+        if not n.reach:
+            # KUKA's system software is a library the controller, its inline forms and technology
+            # packages call (bas.src's SVEL_CP, collmonlib.src): what this backup does not call of
+            # it is unused, not dead
+            n.reach = "unused" if n.kuka or n.kind == "channel" else "dead"
+        n.unreachable = n.kind == "routine" and n.reach == "dead"
+
+
+def _reach(pm: ProgramMap, out: dict[str, list[Edge]], roots: list[str], reach: str) -> None:
+    """Give every node `roots` reach along the edges, not reached yet, the reach `reach`; a
+    handler reached through an interrupt or trigger edge becomes an entry of that kind (not from
+    a routine whose reach is ``unknown``: whether it runs is not known)."""
+    todo = deque(nid for nid in roots if not pm.nodes[nid].reach)
+    for nid in todo:
+        pm.nodes[nid].reach = reach
+    while todo:
+        src = todo.popleft()
+        for e in out.get(src, ()):
+            t = pm.nodes[e.target]
+            if e.kind in ("interrupt", "trigger") and not t.entry and reach != "unknown":
+                what = "interrupt handler (declared by" if e.kind == "interrupt" else "trigger routine (TRIGGER in"
+                t.entry, t.entry_kind = f"{what} {pm.nodes[src].name})", e.kind
+                pm.entries.append(t.id)
+            if not t.reach:
+                t.reach = reach
+                todo.append(t.id)
+
+
+def _named_in_unparsed(ws: Workspace) -> set[str]:
+    """The names (upper case) that the ASTs of the workspace's files with syntax errors use as
+    a call or a name: the front end recovers their lines, the checker resolves none of them."""
+    names: set[str] = set()
+    for u in ws.units:
+        if u.src is not None and not u.src.ok:
+            for x in u.src.module.walk():
+                if isinstance(x, (N.Call, N.Name)):
+                    names.add(x.name.upper())
+    return names
+
+
+def _selectable(main: N.Routine | None) -> bool:
+    """True when the module main `main` is a DEF without parameters (a program the pendant can
+    select and start: it passes no arguments)."""
+    return main is not None and main.kind == "DEF" and not main.params
 
 
 def _inside(path: str, folder: Path) -> bool:
@@ -308,21 +416,3 @@ def _case_programs(pm: ProgramMap, ws: Workspace, cell_id: str) -> list[tuple[st
                 step = {t for t, k in seen.items() if k >= 3 and 2 * k > len(branches)}
                 out += [(number, t, line) for number, calls in branches for t, line in calls.items() if t not in step]
     return out
-
-
-def _mark_unreachable(pm: ProgramMap) -> None:
-    out: dict[str, list[str]] = {}
-    for e in pm.edges:
-        out.setdefault(e.source, []).append(e.target)
-    seen = set(pm.entries)
-    todo = deque(pm.entries)
-    while todo:
-        for t in out.get(todo.popleft(), ()):
-            if t not in seen:
-                seen.add(t)
-                todo.append(t)
-    for nid, n in pm.nodes.items():
-        # KUKA's system software is a library the controller, its inline forms and technology
-        # packages call (bas.src's SVEL_CP, collmonlib.src): what this backup does not call of
-        # it is unused, not unreachable
-        n.unreachable = n.kind == "routine" and not n.kuka and nid not in seen

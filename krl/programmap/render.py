@@ -29,10 +29,12 @@ from markupsafe import Markup
 
 from krl.limits import MAX_GRAPH_NODES, MAX_GRAPH_SOURCE_CHARS
 from krl.source import read_source
-from krl.programmap.graph import ProgramMap
+from krl.programmap.graph import CONTROLLER_KINDS, ProgramMap
+from krl.terminal import printable
 from krl.render import render_html
 
-__all__ = ["GraphTooLarge", "GraphvizMissing", "LINKS", "to_dot", "to_svg", "to_html", "page_data"]
+__all__ = ["GraphTooLarge", "GraphvizMissing", "LINKS", "to_dot", "to_svg", "to_html", "to_text", "page_data", "file_href",
+           "map_widget", "context"]
 
 # how a routine links to its file:line: a file: URL (the file opens in the browser), a vscode:
 # URL (the file opens at the line in VS Code), or no link
@@ -66,7 +68,8 @@ def _label(*lines: str) -> str:
 
 
 def digraph(pm: ProgramMap) -> graphviz.Digraph:
-    """The map as a graphviz.Digraph: entry points double-bordered, unreachable routines grey."""
+    """The map as a graphviz.Digraph: entry points double-bordered, routines only operator
+    selection reaches dashed amber, dead routines grey, routines of unknown reach dotted."""
     if len(pm.nodes) > MAX_GRAPH_NODES:
         raise GraphTooLarge(f"the program map has {len(pm.nodes)} nodes (limit MAX_GRAPH_NODES = {MAX_GRAPH_NODES})")
     g = graphviz.Digraph("program_map", graph_attr={"rankdir": "LR", "fontname": "Helvetica"},
@@ -81,6 +84,10 @@ def digraph(pm: ProgramMap) -> graphviz.Digraph:
         attrs = {}
         if n.entry:
             attrs.update(peripheries="2", color="#224466", tooltip=_label(n.entry))
+        if n.reach == "operator" and not n.kuka:
+            attrs.update(color="#b36b00", style="dashed")
+        elif n.reach == "unknown":
+            attrs.update(style="dotted")
         if n.unreachable:
             attrs.update(style="filled", fillcolor="#eeeeee", fontcolor="#777777")
         g.node(names[n.id], _label(n.name, f"{n.module} {_short(n.path, pm.root)}:{n.line}"), **attrs)
@@ -92,6 +99,48 @@ def digraph(pm: ProgramMap) -> graphviz.Digraph:
         seen.add(key)
         g.edge(names[e.source], names[e.target], **_EDGE_STYLE.get(e.kind, {}))
     return g
+
+
+def to_text(pm: ProgramMap) -> list[str]:
+    """The map's reachability as lines for a terminal: the counts, what the controller starts
+    (by kind, with file:line), the modules only an operator starts, the dead routines and those
+    of unknown reach. Text from the backup passes through krl.terminal.printable."""
+    p = printable
+    routines = [n for n in pm.nodes.values() if n.kind == "routine"]
+    own = [n for n in routines if not n.kuka]
+    where = lambda n: f"{p(_short(n.path, pm.root))}:{n.line}"  # noqa: E731
+    out = [f"{p(pm.root)}: {len(routines)} routines ({len(own)} of its own, {len(routines) - len(own)} of "
+           f"KUKA's system software), {len(pm.edges)} edges"]
+    controller = [pm.nodes[i] for i in pm.entries if pm.nodes[i].entry_kind in CONTROLLER_KINDS]
+    modules = [pm.nodes[i] for i in pm.entries if pm.nodes[i].entry_kind == "module"]
+    operator = [pm.nodes[i] for i in pm.entries if pm.nodes[i].entry_kind == "operator"]
+    if modules:
+        out.append(f"a folder, not a KRC backup: {len(modules)} entry points (module mains, GLOBAL routines), "
+                   f"{sum(n.reach == 'module' for n in own)} routines reached")
+    reached = sum(n.reach == "controller" for n in own)
+    if controller or not modules:
+        out.append(f"started by the controller: {len(controller)} entry points, {reached} routines of its own reached")
+    for n in controller:
+        kind = n.entry_kind
+        if kind == "plc":
+            kind = "plc " + n.entry.removeprefix("PLC program number ").split(" (", 1)[0]
+        extra = ""
+        if kind in ("interrupt", "trigger", "selected"):
+            extra = "  (" + p(n.entry.split("(", 1)[1]) if "(" in n.entry else ""
+        out.append(f"  {kind:<10} {p(n.name)}  {where(n)}{extra}")
+    mains = context(pm, None)["operator_mains"]
+    only = sum(n.reach == "operator" for n in own)
+    if operator or not modules:
+        out.append(f"only an operator starts: {len(mains)} modules, {only} routines")
+        out += [f"  {p(n.name)}  {where(n)}" for n in mains]
+    dead = pm.unreachable
+    out.append(f"dead: {len(dead)} routines" + ("" if dead else " (none)"))
+    out += [f"  {p(n.module)}:{p(n.name)}  {where(n)}" for n in dead]
+    unknown = [n for n in own if n.reach == "unknown"]
+    if unknown:
+        out.append(f"unknown reach (named in a file with syntax errors): {len(unknown)} routines")
+        out += [f"  {p(n.module)}:{p(n.name)}  {where(n)}" for n in unknown]
+    return out
 
 
 def to_dot(pm: ProgramMap) -> str:
@@ -111,12 +160,14 @@ def svg_data_uri(svg: str) -> str:
     return "data:image/svg+xml;base64," + base64.b64encode(svg.encode("utf-8")).decode("ascii")
 
 
-def _href(path: str, line: int, links: str) -> str:
-    """The link of a routine at `path`:`line`: "" when `links` is "none" or the file is not on
-    this machine (a map read from an archive names files inside the archive)."""
+def file_href(path: str, line: int, links: str) -> str:
+    """The link of `path`:`line` (a routine, a finding): "" when `links` is "none" or the file
+    is not on this machine (a map read from an archive names files inside the archive); a
+    relative path is taken from the current folder (symbolic links kept, as the user named it)."""
     p = Path(path)
-    if links == "none" or not p.is_absolute() or not p.is_file():
+    if links == "none" or not p.is_file():
         return ""
+    p = p.absolute()
     if links == "vscode":
         return "vscode://file" + quote(p.as_posix()) + f":{line}"
     return p.as_uri()
@@ -124,7 +175,7 @@ def _href(path: str, line: int, links: str) -> str:
 
 def page_data(pm: ProgramMap, links: str = "file") -> dict:
     """The map as the page's JSON: nodes (id, name, module, kind, file shown relative to the
-    root, line, href, system, entry, entry_kind, unreachable, and ``source``: the routine's own
+    root, line, href, system, entry, entry_kind, unreachable, reach, and ``source``: the routine's own
     lines, DEF to END, up to krl.limits.MAX_GRAPH_SOURCE_CHARS in all) and edges (source,
     target, kind, file, line)."""
     texts: dict[str, list[str]] = {}
@@ -141,9 +192,9 @@ def page_data(pm: ProgramMap, links: str = "file") -> dict:
                 source = []
         nodes.append({"id": n.id, "name": n.name, "module": n.module, "kind": n.kind,
                       "file": _short(n.path, pm.root) if n.path else "", "line": n.line,
-                      "href": _href(n.path, n.line, links) if n.path else "", "system": n.kuka,
+                      "href": file_href(n.path, n.line, links) if n.path else "", "system": n.kuka,
                       "entry": n.entry, "entry_kind": n.entry_kind, "unreachable": n.unreachable,
-                      "source": source})
+                      "reach": n.reach, "source": source})
     return {
         "root": pm.root, "links": links, "nodes": nodes,
         "edges": [{"source": e.source, "target": e.target, "kind": e.kind, "file": _short(e.path, pm.root),
@@ -160,17 +211,48 @@ def _script() -> Markup:
     return Markup(text)
 
 
-def to_html(pm: ProgramMap, links: str = "file") -> str:
-    """The interactive page (see the module docstring), with the entry points, the unreachable
-    routines and the edges as tables below the map. `links`: one of :data:`LINKS`."""
+def map_widget(pm: ProgramMap, links: str = "file") -> Markup:
+    """The interactive map as one block of the page (``templates/_map_widget.html.j2``: the
+    tools, the drawing, the details and source panels, the legend, the map's JSON and the
+    script), for the map's own page and the change report. Raises GraphTooLarge."""
     if len(pm.nodes) > MAX_GRAPH_NODES:
         raise GraphTooLarge(f"the program map has {len(pm.nodes)} nodes (limit MAX_GRAPH_NODES = {MAX_GRAPH_NODES})")
+    return Markup(render_html("krl.programmap", "_map_widget.html.j2", data=page_data(pm, links), script=_script()))
+
+
+def to_html(pm: ProgramMap, links: str = "file") -> str:
+    """The interactive page (see the module docstring), with the entry points by class, the
+    modules only an operator starts, the dead routines and the edges as tables below the map.
+    `links`: one of :data:`LINKS`."""
+    widget = map_widget(pm, links)
     return render_html("krl.programmap", "graph.html.j2", title=f"Program map: {pm.root}",
-                       data=page_data(pm, links), script=_script(), **context(pm, None))
+                       widget=widget, **context(pm, None))
+
+
+#: the entry point tables of the map section: title, entry kinds (krl/programmap/graph.py)
+ENTRY_GROUPS = (("Started by the controller", ("cell", "plc", "submit", "selected", "interrupt", "trigger")),
+                ("Selected by an operator (R1/Program)", ("operator",)),
+                ("Main routines of modules (a folder that is not a backup)", ("module",)),
+                ("KUKA's system software", ("system",)))
 
 
 def context(pm: ProgramMap, svg: str | None) -> dict:
-    """The template values of the map section (shared with the change report); `svg` None: no
-    drawing in the section (the interactive page draws it), "" for Graphviz missing."""
+    """The template values of the map section ``_map_body.html.j2`` (shared with the change
+    report): the map, its drawing (`svg` None: none, the interactive page draws it; "" for
+    Graphviz missing), the routines of the backup's own (``own``) by reach (``by_reach``), the
+    entry points by :data:`ENTRY_GROUPS` (``entry_groups``: title and nodes), the main routine
+    of each module only an operator starts (``operator_mains``), ``short(path)``."""
+    own = [n for n in pm.nodes.values() if n.kind == "routine" and not n.kuka]
+    by_reach: dict[str, list] = {}
+    for n in own:
+        by_reach.setdefault(n.reach, []).append(n)
+    entries = [pm.nodes[nid] for nid in pm.entries]
+    groups = [(title, [n for n in entries if n.entry_kind in kinds]) for title, kinds in ENTRY_GROUPS]
+    first: dict[str, object] = {}
+    for n in own:
+        first.setdefault(n.module, n)
     return {"map": pm, "image": None if svg is None else svg_data_uri(svg) if svg else "",
-            "short": lambda p: _short(p, pm.root)}
+            "short": lambda p: _short(p, pm.root), "own": own, "by_reach": by_reach,
+            "kuka_routines": sum(n.kind == "routine" and n.kuka for n in pm.nodes.values()),
+            "entry_groups": [(t, ns) for t, ns in groups if ns],
+            "operator_mains": [first[m] for m in pm.operator_only]}

@@ -93,11 +93,12 @@ def test_retaught_points_report_their_deltas_and_nothing_else(old, base, tmp_pat
     # XC2: C -180.0 -> 179.0 is -1 deg (359 wrapped), status S 2 -> 6
     edit(new, M1_DAT, XC2, XC2.replace("C -180.0", "C 179.0").replace("S 2", "S 6"))
     d = diff_to(old, new)
+    # lines 24 and 27 of caja_g_m1.dat (grep -n 'DECL E6POS XC[12]=')
     assert d.points == [
         {"file": M1_DAT, "name": "XC1", "kind": "E6POS", "change": "changed", "delta": {"X": 1.5, "Z": -2.0},
-         "status_turn_changed": False},
+         "line": 24, "status_turn_changed": False},
         {"file": M1_DAT, "name": "XC2", "kind": "E6POS", "change": "changed", "delta": {"C": -1.0},
-         "status_turn_changed": True, "status_turn": {"S": [2, 6]}},
+         "line": 27, "status_turn_changed": True, "status_turn": {"S": [2, 6]}},
     ]
     assert (d.frames, d.routines, d.declarations, d.motions) == ([], [], [], [])
     # a tolerance of 1.5 mm/deg hides the 1.5 and the 1.0, not the 2.0; the status stays flagged
@@ -112,7 +113,7 @@ def test_changed_tool_data_is_a_frame_delta(old, base, tmp_path):
          "TOOL_DATA[1]={X 0.0,Y 0.0,Z 780.5,A 90.0,B 0.0,C 0.0}")
     d = diff_to(old, new)
     assert d.frames == [{"file": "System/$config.dat", "name": "TOOL_DATA[1]", "kind": "TOOL_DATA",
-                         "change": "changed", "delta": {"A": 90.0, "Z": 5.5}}]
+                         "change": "changed", "delta": {"A": 90.0, "Z": 5.5}, "line": 231}]   # grep -n TOOL_DATA
     assert (d.points, d.routines, d.declarations, d.motions) == ([], [], [], [])
 
 
@@ -195,7 +196,7 @@ def test_cli_json_matches_the_schema_and_exit_status(tmp_path):
     doc = json.loads(r.output)
     validate("diff", doc)
     assert doc["points"] == [{"file": "b.dat", "name": "XHOME", "kind": "E6AXIS", "change": "changed",
-                              "delta": {"A1": 0.5, "A5": -10.0}, "status_turn_changed": False}]
+                              "delta": {"A1": 0.5, "A5": -10.0}, "line": 2, "status_turn_changed": False}]
     r = CliRunner().invoke(main, ["diff", str(a), str(a)])
     assert r.exit_code == 0 and "no change" in r.output
     r = CliRunner().invoke(main, ["diff", str(a), str(tmp_path / "missing")])

@@ -82,3 +82,32 @@ def test_krl_run_answers_for_nobody(shared_corpus, tmp_path):
                          cwd=REPO_ROOT, capture_output=True, text=True, timeout=900, check=False)
     assert run.returncode == 0, run.stdout + run.stderr
     assert '"signal":"$OUT[78]","value":true' in trace.read_text()   # answer 1, as krl run always gave
+
+
+APPROX = """DEF approx()
+  $ADVANCE = 0
+  $APO.CPTP = 50
+  PTP {A1 0, A2 -90, A3 90, A4 0, A5 0, A6 0}
+  PTP {A1 10} C_PTP
+  PTP {A1 20}
+END
+"""
+
+
+def test_the_main_runs_warning_is_a_kss_notification_at_its_motion(tmp_path):
+    """With $ADVANCE = 0 the approximated PTP of line 5 cannot be approximated (krl-reference
+    §6.8: the KSS warns "approximation not possible"): the message window shows a notification
+    of KSS at approx.src line 5, and it stays after the run has ended and is cancelled."""
+    (tmp_path / "approx.src").write_text(APPROX)
+    ended = threading.Event()
+    eng = Engine(lambda name, body: ended.set() if name == "terminated" else None, realtime=False)
+    try:
+        eng.select(str(tmp_path / "approx.src"), workspace=str(tmp_path), inputs=None, mode="T1", run_mode="GO",
+                   trace=None)
+        eng.do(lambda core: core.resume())
+        assert ended.wait(600)
+    finally:
+        eng.cancel()
+    rows = eng.system.rows()
+    assert [(r["kind"], r["origin"], r["text"], r["module"], r["line"]) for r in rows] == [
+        ("NOTIFY", "KSS", "approximation not possible", "approx.src", 5)]

@@ -59,11 +59,15 @@ def test_operator_selectable_programs(krc4_test, shared_corpus):
     for n in operator:
         parts = [p.lower() for p in Path(n.path).parts]
         assert parts[parts.index("r1") + 1] == "program" and n.main and not n.kuka
-    # every module main under R1/Program is an entry of some kind (none is unreachable)
+    # every module main under R1/Program that is a DEF without parameters is an entry of some
+    # kind (none is dead); a main with parameters is an entry only as what calls it
     program = shared_corpus / "khrzysio__KRC4_test" / "R1" / "Program"
     mains = [n for n in krc4_test.nodes.values() if n.main and n.kind == "routine"
              and Path(n.path).is_relative_to(program) and not n.kuka]
-    assert mains and all(n.entry and not n.unreachable for n in mains)
+    assert mains and all(n.entry and not n.unreachable for n in mains if n.runnable)
+    # DrillHole2step(stHole:IN): a parameter, called by nothing -- dead, not selectable
+    drill = next(n for n in mains if n.name == "DrillHole2step")
+    assert not drill.runnable and drill.unreachable and not drill.entry
     # a flat export (Program/ beside System/)
     pm = build_map(workspaces_for(shared_corpus / "ingeniado__KRC4-Robot-Palletizer", timeout=60)[0])
     flat = [n for n in pm.nodes.values() if n.entry_kind == "operator"]

@@ -55,11 +55,21 @@ def test_entry_points_and_unreachable_routines_counted_by_hand(fixture_map):
         "AUX:AUX": ("operator", "selectable at the pendant (R1/Program)"),
         "ORPHAN:ORPHAN": ("operator", "selectable at the pendant (R1/Program)"),
         "PICK:PICK": ("operator", "selectable at the pendant (R1/Program)"),
-        # INTERRUPT DECL 5 ... DO stop_handler() in cell.src
+        # INTERRUPT DECL 5 ... DO stop_handler() in cell.src, which the controller starts
         "CELL:STOP_HANDLER": ("interrupt", "interrupt handler (declared by cell)"),
+        # TRIGGER ... DO gripper_on() in pick, which cell calls
+        "PICK:GRIPPER_ON": ("trigger", "trigger routine (TRIGGER in pick)"),
     }
     # orphan's helper2 is reached from the selectable orphan; only a local routine nobody calls
     assert [n.id for n in fixture_map.unreachable] == ["PICK:UNUSED_LOCAL"]
+    # reach: cell calls pick, which RUNs aux and calls helper_fct; sps and bg the controller
+    # starts; orphan and helper2 only an operator (nothing the controller starts calls them)
+    reach = {nid: n.reach for nid, n in fixture_map.nodes.items() if n.kind == "routine"}
+    assert reach == {"CELL:CELL": "controller", "CELL:STOP_HANDLER": "controller", "PICK:PICK": "controller",
+                     "PICK:HELPER_FCT": "controller", "PICK:GRIPPER_ON": "controller", "AUX:AUX": "controller",
+                     "BG:BG": "controller", "SPS:SPS": "controller", "SPS:PLC_STEP": "controller",
+                     "ORPHAN:ORPHAN": "operator", "ORPHAN:HELPER2": "operator", "PICK:UNUSED_LOCAL": "dead"}
+    assert fixture_map.operator_only == ["orphan"]
     # 12 routines + 1 channel; every routine knows its module and file:line
     assert sum(n.kind == "routine" for n in fixture_map.nodes.values()) == 12
     helper = fixture_map.nodes["PICK:HELPER_FCT"]
@@ -79,7 +89,7 @@ def test_dot_has_one_arrow_per_edge_and_no_port_syntax(fixture_map):
     dot = to_dot(fixture_map)
     arrows = re.findall(r"^\s*(n\d+) -> (n\d+)", dot, re.M)
     assert len(arrows) == 9
-    assert dot.count("peripheries=2") == 7        # the seven entry points
+    assert dot.count("peripheries=2") == 8        # the eight entry points
     assert "EKI ChannelA" in dot
 
 

@@ -71,12 +71,15 @@ def test_change_pages_render_in_headless_chromium(chromium, pages):
     def graph(page):
         assert page.locator("h1").inner_text() == "Program map"
         page.wait_for_function("document.body.dataset.ready === '1'", timeout=120_000)
-        # 13 routines (the 12 of the fixture + odd), 9 edges; the 7 entry points of the fixture
-        # (tests/programmap/test_graph.py) and odd, selectable under R1/Program; unreachable: 1
-        assert page.locator("table.map-entries tr").count() == 1 + 8
+        # 13 routines (the 12 of the fixture + odd), 9 edges; the 8 entry points of the fixture
+        # (tests/programmap/test_graph.py) and odd, selectable under R1/Program; dead: 1
+        assert page.locator("table.map-entries tr[class^=entry-]").count() == 8 + 1
+        assert page.locator("table.map-entries tr.entry-operator").count() == 4      # aux, orphan, pick, odd
         assert page.locator("table.map-unreachable tr").count() == 1 + 1
+        # orphan and odd: modules only an operator starts
+        assert page.locator("table.map-operator-only tr").count() == 1 + 2
         assert page.locator("table.map-edges tr").count() == 1 + 9
-        assert IMG in page.locator("table.map-entries").text_content()   # the module name, as text
+        assert IMG in page.locator("table.map-entries").last.text_content()   # the module name, as text
         assert page.locator("img").count() == 0
         assert page.evaluate("document.querySelector('script[type=\"application/json\"]').id") == "map-data"
 
@@ -98,12 +101,15 @@ def test_change_pages_render_in_headless_chromium(chromium, pages):
         assert page.evaluate("[...document.querySelectorAll('pre')].every(p => p.scrollWidth <= p.clientWidth + 1)")
 
     def report(page):
-        assert page.locator("#check-summary").count() == 1
-        graph_part = page.locator("table.map-edges tr").count()
-        assert graph_part == 1 + 9
+        # the summary first, then the diff; the map is the interactive one (no picture), its
+        # tables without the edge list
+        assert page.locator("#summary-list li").count() == 4
+        assert page.locator("table.map-edges").count() == 0 and page.locator("img").count() == 0
+        page.wait_for_function("document.body.dataset.ready === '1'", timeout=120_000)
+        assert page.locator("table.map-unreachable tr").count() == 1 + 1
         diff(page)
 
     with playwright.sync_playwright() as pw:
         _open(pw, chromium, pages["graph"], graph, scripts=2)
         _open(pw, chromium, pages["diff"], diff)
-        _open(pw, chromium, pages["report"], report)
+        _open(pw, chromium, pages["report"], report, scripts=2)

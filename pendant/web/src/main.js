@@ -77,6 +77,7 @@ function onInit(m) {
   $('workspace').textContent = m.workspace;
   const group = (label, values) => el('optgroup', { label }, ...values.map((v) => el('option', { text: v, value: v })));
   $('programs').replaceChildren(group('entry points', m.programs), group('other modules', m.modules || []));
+  if (P.state && P.state.programLabel) $('programs').value = P.state.programLabel;
   fillSelect($('mode-op'), m.modes);
   fillSelect($('run-mode'), m.runModes);
   $('touchup').disabled = !!m.readonly;
@@ -85,6 +86,7 @@ function onInit(m) {
 }
 
 $('select').onclick = () => act('select', { program: $('programs').value });
+$('ack-all').onclick = () => act('ackAll');
 $('cancel').onclick = () => act('cancel');
 $('reset').onclick = () => act('reset');
 $('start').onclick = () => act('start');
@@ -206,8 +208,13 @@ function setState(s, changed = null) {
   P.lastChange = performance.now();
   const st = s.state || 'none';
   $('st-state').dataset.state = st;
-  $('st-state').textContent = st + (s.stop && s.stop.description ? `: ${s.stop.description}` : '');
+  $('st-state').dataset.outcome = (st === 'ended' && s.outcome && s.outcome.reason) || '';
+  $('st-state').textContent = statusText(s);
   $('st-program').textContent = s.program ? s.program.split('/').slice(-1)[0] : 'no program';
+  // the programs list shows the selected program (after a reload, in a second browser)
+  if (has('programLabel') && s.programLabel && [...$('programs').options].some((o) => o.value === s.programLabel)) {
+    $('programs').value = s.programLabel;
+  }
   if (s.modeOp) $('mode-op').value = s.modeOp;
   if (s.runMode) $('run-mode').value = s.runMode;
   $('drives').setAttribute('aria-pressed', s.drives ? 'true' : 'false');
@@ -225,14 +232,41 @@ function setState(s, changed = null) {
   if (has('position') && s.position) { drawPosition(s.position); setAxes(s.position.axes, s.position.tool, s.position.base); }
 }
 
+// the status line: the state, why the program stands (a run-time error: its number, text and
+// statement) or how the run ended
+const PLACE = (o) => (o && o.module && o.line ? ` \u2014 ${o.module} line ${o.line}` : '');
+function statusText(s) {
+  const st = s.state || 'none';
+  if (st === 'stopped' && s.stop) {
+    const d = s.stop.description ? `: ${s.stop.description}` : '';
+    return `stopped${d}${s.stop.text && s.stop.text !== s.stop.description ? `: ${s.stop.text}` : ''}${PLACE(s.stop)}`;
+  }
+  if (st === 'ended' && s.outcome) {
+    const o = s.outcome;
+    const module = o.path ? o.path.split('/').slice(-1)[0] : '';
+    if (o.reason === 'completed') return 'ended';
+    return `ended: ${o.reason === 'error' ? 'run-time error' : o.reason}${o.number ? ` ${o.number}` : ''}${o.text ? `: ${o.text}` : ''}${PLACE({ module, line: o.line })}`;
+  }
+  return st;
+}
+
+// the message window as the smartHMI shows it: type, time, originator (a program's own messages
+// in angle brackets), number, text, module and line; OK on notification and acknowledgement
+// messages, a dialog's softkeys
 function drawMessages(list) {
   $('msg-count').textContent = list.length ? `(${list.length})` : '';
   $('messages').replaceChildren(...list.map((m) => {
     const buttons = [];
-    if (m.kind === 'QUIT' || m.kind === 'NOTIFY') buttons.push(el('button', { text: 'Ack', 'data-ack': String(m.handle), onclick: () => act('ack', { handle: m.handle }) }));
+    if (m.kind === 'QUIT' || m.kind === 'NOTIFY') buttons.push(el('button', { text: 'OK', 'data-ack': String(m.handle), onclick: () => act('ack', { handle: m.handle }) }));
     if (m.kind === 'DIALOG') m.softkeys.forEach((k, i) => { if (k.trim()) buttons.push(el('button', { text: k, 'data-answer': String(i + 1), onclick: () => act('answer', { handle: m.handle, key: i + 1 }) })); });
-    return el('li', { 'data-kind': m.kind, 'data-handle': String(m.handle) }, el('span', { class: 'kind', text: m.kind }),
-      el('span', { class: 'text', text: m.text }), el('span', { class: 'src', text: `${m.module} ${m.number || ''}` }), ...buttons);
+    const origin = m.krl ? `<${m.origin || ''}>` : (m.origin || '');
+    return el('li', { 'data-kind': m.kind, 'data-handle': String(m.handle), 'data-type': m.type || '' },
+      el('span', { class: 'kind', text: m.type || m.kind }),
+      el('span', { class: 'time', text: `t=${fmt(m.time)} s` }),
+      el('span', { class: 'origin', text: origin }),
+      el('span', { class: 'number', text: m.number || m.number === 0 ? String(m.number) : '' }),
+      el('span', { class: 'text', text: m.text }),
+      el('span', { class: 'src', text: m.line ? `${m.module} line ${m.line}` : (m.krl ? '' : m.module || '') }), ...buttons);
   }));
 }
 

@@ -1,0 +1,129 @@
+"""The pieces of the change report (krl/diff/report.py, interp/outcomes.py, issue 49) on inputs
+whose answers were worked out by hand: which check findings are new or fixed, which entry points
+a change touches, and when two run outcomes differ."""
+
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+from interp.outcomes import _Events, event_kind, outcome_changes
+from interp.outcomes import _outcome as outcome_of
+from krl.diff.core import diff_sides
+from krl.diff.load import side
+from krl.diff.report import Finding, findings_delta, touched_entries
+from krl.programmap import build_map
+from krl.workspace import workspaces_for
+
+FIXTURE = Path(__file__).parents[1] / "programmap" / "fixtures" / "KRC"
+
+
+def _f(file: str, message: str, text: str = "x = 1", code: str = "E101") -> Finding:
+    return Finding(code, "error", message, file, 3, 1, text)
+
+
+def test_findings_are_matched_by_file_code_message_and_line_text():
+    old = [_f("R1/a.src", "'n' is not declared"),
+           _f("R1/a.src", "system variable '$x' (used 19 times in 2 files)"),
+           _f("R1/b.src", "'gone' is not declared"),
+           _f("Old/c.src", "'m' is not declared"),             # its folder renamed: the same finding
+           _f("R1/d.src", "'k' is not declared", "k = 2")]      # its line edited: fixed, and a new one
+    new = [_f("R1/a.src", "'n' is not declared"),
+           _f("R1/a.src", "system variable '$x' (used 26 times in 2 files)"),
+           _f("New/c.src", "'m' is not declared"),
+           _f("R1/d.src", "'k' is not declared", "k = 3"),
+           _f("R1/e.src", "'fresh' is not declared"), _f("R1/e.src", "'fresh' is not declared")]
+    files = ({"r1/a.src", "r1/b.src", "old/c.src", "r1/d.src", "src/e.src"},
+             {"r1/a.src", "new/c.src", "r1/d.src", "r1/e.src", "src/e.src"})
+    introduced, removed = findings_delta(old, new, files)
+    assert [(f.file, f.text) for f in introduced] == [("R1/d.src", "k = 3"), ("R1/e.src", "x = 1"), ("R1/e.src", "x = 1")]
+    assert [(f.file, f.text) for f in removed] == [("R1/b.src", "x = 1"), ("R1/d.src", "k = 2")]
+    # without the files, the renamed folder's finding is new and fixed
+    introduced, removed = findings_delta(old, new)
+    assert ("New/c.src", "Old/c.src") == (introduced[0].file, removed[1].file)
+    # a finding of a file both sides have (src/e.src) never pairs with another file's of that name
+    introduced, removed = findings_delta([_f("src/e.src", "'fresh' is not declared")], new[4:5], files)
+    assert [f.file for f in introduced] == ["R1/e.src"] and [f.file for f in removed] == ["src/e.src"]
+
+
+def _maps(tmp_path: Path, edit) -> tuple:
+    old, new = tmp_path / "old" / "KRC", tmp_path / "new" / "KRC"
+    shutil.copytree(FIXTURE, old)
+    shutil.copytree(FIXTURE, new)
+    edit(new)
+    with side(old) as a, side(new) as b:
+        d = diff_sides(a, b)
+    return d, build_map(workspaces_for(old)[0]), build_map(workspaces_for(new)[0])
+
+
+def test_a_changed_routine_touches_the_programs_that_reach_it(tmp_path):
+    def edit(root: Path):
+        p = root / "R1" / "Program" / "pick.src"
+        p.write_text(p.read_text().replace("  RETURN x\n", "  RETURN x + 1\n"))
+    d, old, new = _maps(tmp_path, edit)
+    assert [(r["name"], r["change"]) for r in d.routines] == [("helper_fct", "changed")]
+    touched = touched_entries(d, old, new)
+    # cell calls pick, which calls helper_fct; pick is an operator's program too. aux (RUN
+    # from pick), orphan, bg and sps do not reach helper_fct
+    assert [(t.id, t.kind) for t in touched] == [("CELL:CELL", "cell"), ("PICK:PICK", "operator")]
+    assert all(t.old and t.new and t.why == "routine helper_fct changed" for t in touched)
+
+
+def test_a_changed_value_touches_the_programs_that_use_it(tmp_path):
+    def edit(root: Path):
+        p = root / "R1" / "System" / "$config.dat"
+        p.write_text(p.read_text().replace("DECL INT shared\n", "DECL INT shared=1\n"))
+    d, old, new = _maps(tmp_path, edit)
+    assert [(e["name"], e["change"]) for e in d.values] == [("shared", "added")]
+    touched = touched_entries(d, old, new)
+    # plc_step (sps.sub) writes shared: the submit program; nothing else uses it
+    assert [(t.id, t.kind) for t in touched] == [("SPS:SPS", "submit")]
+    assert "used by plc_step" in touched[0].why
+
+
+def _outcome(reason="completed", text="", line=9, cycle=17.844, counts=None, file=None, statement=""):
+    return {"reason": reason, "text": text, "line": line, "cycle_time": cycle, "counts": counts or {}, "file": file,
+            "statement": statement}
+
+
+def test_two_outcomes_differ_in_how_they_end_their_cycle_time_or_their_motion_events():
+    assert outcome_changes(_outcome(), _outcome()) == []
+    # one IPO cycle (12 ms) is the same cycle time; two are not
+    assert outcome_changes(_outcome(cycle=17.844), _outcome(cycle=17.832)) == []
+    assert outcome_changes(_outcome(cycle=17.844), _outcome(cycle=17.820)) == ["cycle time"]
+    # both stopped by the time limit, at other lines: alike
+    limit = dict(reason="max_sim_time", cycle=None)
+    assert outcome_changes(_outcome(line=70, text="simulated time limit 60.0 s reached", **limit),
+                           _outcome(line=72, text="simulated time limit 60.0 s reached while the robot program waits",
+                                    **limit)) == []
+    # an error where it completed; an error message naming other folders is the same message
+    err = dict(reason="error", cycle=None, text="software limit switch -A1 at /a/old/x.src:12")
+    assert outcome_changes(_outcome(), _outcome(**err)) == ["ends differently", "cycle time"]
+    assert outcome_changes(_outcome(**err), _outcome(**{**err, "text": "software limit switch -A1 at /b/new/x.src:12"})) == []
+    assert outcome_changes(_outcome(counts={"reach": 1}), _outcome()) == ["motion events"]
+    # a deadlock at the same statement, moved from line 40 to 44 by an edit above it: the same
+    # place; at another statement: not
+    wait = dict(reason="deadlock", cycle=None, text="waits: WAIT FOR $IN[5] at /a/old/x.src:40", file="/a/old/x.src",
+                statement="WAIT FOR $IN[5]")
+    assert outcome_changes(_outcome(line=40, **wait), _outcome(
+        line=44, **{**wait, "file": "/b/new/x.src", "text": "waits: WAIT FOR $IN[5] at /b/new/x.src:44"})) == []
+    assert outcome_changes(_outcome(line=40, **wait), _outcome(line=44, **{**wait, "statement": "WAIT FOR $IN[6]"})) == [
+        "ends at another statement"]
+    assert outcome_changes(None, _outcome()) == ["only in the new backup"]
+
+
+def test_motion_events_are_named_by_the_controllers_messages():
+    assert event_kind("workspace error: target not reachable (XP3)") == "reach"
+    assert event_kind("software limit switch -A3") == "limit"
+    assert event_kind("CP path through a singularity: A4 would turn 170 deg") == "singularity"
+    assert event_kind("speed limit exceeded A1: CP path through a singularity") == "singularity"
+    assert event_kind("first motion must be PTP") == "motion"
+
+
+def test_a_motion_refused_in_the_advance_run_is_the_runs_motion_event():
+    # kukaKRLmagic's sample_program (history pair 01-53e3f517, old side): the planner refuses
+    # line 81's target before any main-run motion error is written; the run ends with it
+    o = outcome_of("p.src", "error", "software limit switch +A3 (the target itself: ...)", "p.src", 81, 0.0, _Events(), "")
+    assert o["counts"] == {"limit": 1} and o["events"][0]["line"] == 81
+    # an error that is no motion's is not a motion event
+    assert outcome_of("p.src", "error", "unknown name P_Button", "p.src", 46, 0.0, _Events(), "")["counts"] == {}

@@ -1,0 +1,183 @@
+"""The change report of the README's example (issue 49), in headless Chromium with Playwright.
+
+The README's transcript makes `out/new-backup` (the Palletizer with XC1 retaught and tool 1
+5.5 mm longer) and writes `out/change.html` with ``krl report``; tests/docs/conftest.py runs it
+once. Here:
+
+* on one screen (1280 x 800), the page opens with its contents, the summary and the whole
+  diff of the example (the point and the tool);
+* every finding and every change links to its file and line: the link is a file: URL of a file
+  of the backup, its text is ``path:line`` of that file, and the line holds what the row says
+  (the finding's source line; the point's or the tool's name);
+* printed by Chromium (``page.pdf``, A4), the PDF is legible: its text (pypdf) holds the summary
+  and the diff on the first page, every run of text is at least 7 pt, no part is a picture, and
+  no file:line is cut.
+
+And on a history pair whose change introduces and removes findings (KnoP-01's krl-for-vim9
+``01-8fae7e9c``: "Fix typo: Name should come without extension" -- the header
+``DEF fahrwege_small.src( )`` fixed, its two syntax errors go, and the parser, now past it, finds
+two further down), the introduced and removed findings link to the new and old backup's lines.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+import subprocess
+from pathlib import Path
+from urllib.parse import unquote, urlparse
+
+import pytest
+
+from tests.apt import apt_install
+from tests.docs import transcripts as T
+
+# the README's example runs 44 programs for its report: minutes on a loaded machine (the first
+# test that asks for the documents' run pays for it)
+# and they share that run: one xdist worker takes the whole group (make test: --dist loadgroup)
+pytestmark = [pytest.mark.timeout(3600), pytest.mark.xdist_group("docs")]
+from tests.report.test_report_chromium import CHROMIUM, loaded_page
+
+README = T.REPO / "README.md"
+SCREEN = {"width": 1280, "height": 800}
+
+
+@pytest.fixture(scope="module")
+def chromium() -> str:
+    if not Path(CHROMIUM).exists() and apt_install("chromium", "chromium") is None:
+        pytest.skip("chromium is not installed and cannot be installed with apt-get")
+    return CHROMIUM
+
+
+@pytest.fixture(scope="module")
+def example(document_runs):
+    """(the folder the README's commands ran in, its change report)."""
+    _results, work = document_runs(README)
+    page = work / "out" / "change.html"
+    assert page.is_file(), "the README's example no longer writes out/change.html (krl report ... -o out/change.html)"
+    return work, page
+
+
+def _file_of(href: str) -> Path:
+    u = urlparse(href)
+    assert u.scheme == "file", href
+    return Path(unquote(u.path))
+
+
+@pytest.mark.may_skip("chromium is missing and cannot be installed (not root, or apt-get has no network)")
+def test_summary_and_diff_on_the_first_screen(chromium, example):
+    import playwright.sync_api as playwright  # noqa: PLC0415 (0.14 s CPU: only the browser tests)
+
+    _work, page_file = example
+    with playwright.sync_playwright() as pw, loaded_page(pw, chromium, page_file) as page:
+        page.set_viewport_size(SCREEN)
+        page.wait_for_function("document.body.dataset.ready === '1'", timeout=180_000)
+        page.evaluate("window.scrollTo(0, 0)")
+        bottom = lambda sel: page.evaluate(f"document.querySelector('{sel}').getBoundingClientRect().bottom")  # noqa: E731
+        for sel in ("#toc", "#summary-list", "#changes", "table.diff-points", "table.diff-frames"):
+            assert bottom(sel) <= SCREEN["height"], (sel, bottom(sel))
+        assert page.locator("table.diff-points").inner_text().count("XC1") == 1
+        assert "ΔX +1.5 mm, ΔZ -2 mm" in page.locator("table.diff-points").inner_text()
+        assert "ΔZ +5.5 mm" in page.locator("table.diff-frames").inner_text()
+        # the summary counts what the sections hold
+        summary = page.locator("#summary-list").inner_text()
+        assert "Points 1, Frames and loads 1" in summary
+        assert f"{page.locator('#introduced-table tr.finding').count()} new" in summary
+        # the map is the interactive one, never a picture
+        assert page.locator("img").count() == 0 and page.locator("#map canvas").count() > 0
+
+
+def _check_links(page, root: Path, findings: str = "table.findings tr.finding") -> int:
+    """Every place of the diff and of the findings (rows `findings`) links to a line of a file
+    below `root` that holds what its row says; returns the number of links checked."""
+    n = 0
+    for row in page.locator(findings).all():
+        link = row.locator("a.where")
+        assert link.count() == 1, row.inner_text()
+        f = _file_of(link.get_attribute("href"))
+        rel, line = link.inner_text().rsplit(":", 1)
+        assert f.resolve() == (root / rel).resolve() and f.is_file()
+        text = f.read_text(encoding="latin-1").splitlines()[int(line) - 1]
+        pre = row.locator("pre")
+        assert pre.inner_text() == f"{line} | {text.rstrip()}"
+        n += 1
+    for row in page.locator("table.diff-points tr, table.diff-frames tr").all()[1:]:
+        if row.locator("th").count():
+            continue
+        link = row.locator("a.where")
+        f = _file_of(link.get_attribute("href"))
+        rel, line = link.inner_text().rsplit(":", 1)
+        assert f.resolve() == (root / rel).resolve()
+        name = row.locator("td").nth(1).inner_text()
+        assert name in f.read_text(encoding="latin-1").splitlines()[int(line) - 1]
+        n += 1
+    return n
+
+
+@pytest.mark.may_skip("chromium is missing and cannot be installed (not root, or apt-get has no network)")
+def test_every_finding_and_change_links_to_its_file_and_line(chromium, example):
+    import playwright.sync_api as playwright  # noqa: PLC0415
+
+    work, page_file = example
+    with playwright.sync_playwright() as pw, loaded_page(pw, chromium, page_file) as page:
+        # the example's new backup has warnings (all listed), the point and the tool
+        assert page.locator("#all-findings-table tr.finding").count() > 0
+        assert _check_links(page, work / "out" / "new-backup") >= 2 + page.locator("#all-findings-table tr.finding").count()
+
+
+@pytest.mark.may_skip("chromium is missing and cannot be installed (not root, or apt-get has no network)")
+def test_findings_introduced_and_removed_link_to_each_side(chromium, shared_history, tmp_path):
+    import playwright.sync_api as playwright  # noqa: PLC0415
+
+    pair = shared_history / "KnoP-01__krl-for-vim9" / "01-8fae7e9c"
+    out = tmp_path / "pair.html"
+    r = subprocess.run([str(T.REPO / ".venv" / "bin" / "krl"), "report", str(pair / "new"), "--since", str(pair / "old"),
+                        "--no-runs", "-o", str(out)], capture_output=True, text=True, timeout=600)
+    assert r.returncode == 0, r.stderr
+    with playwright.sync_playwright() as pw, loaded_page(pw, chromium, out) as page:
+        # read from `diff -r old new` and krl check on each side: lines 104 and 120 of
+        # fahrwege_small.src are new errors, the header's two (lines 5 and 8) are gone
+        new = page.locator("#introduced-table tr.finding")
+        old = page.locator("#removed-table tr.finding")
+        assert [r.locator("a.where").inner_text() for r in new.all()] == [
+            "tests/testdir/resource_Folding/fahrwege_small.src:104", "tests/testdir/resource_Folding/fahrwege_small.src:120"]
+        assert [r.locator("a.where").inner_text() for r in old.all()] == [
+            "tests/testdir/resource_Folding/fahrwege_small.src:5", "tests/testdir/resource_Folding/fahrwege_small.src:8"]
+        assert _check_links(page, pair / "new", "#introduced-table tr.finding, #all-findings-table tr.finding") >= 2
+        assert _check_links(page, pair / "old", "#removed-table tr.finding") >= 2
+
+
+def _pdf_text_sizes(pdf: Path) -> tuple[list[str], list[float], int]:
+    from pypdf import PdfReader  # noqa: PLC0415
+
+    reader = PdfReader(str(pdf))
+    texts, sizes, images = [], [], 0
+    for page in reader.pages:
+        def visit(text, cm, tm, _font, size):
+            if text.strip():
+                sizes.append(size * math.hypot(tm[0], tm[1]) * math.hypot(cm[0], cm[1]))
+        texts.append(page.extract_text(visitor_text=visit))
+        images += len(page.images)
+    return texts, sizes, images
+
+
+@pytest.mark.may_skip("chromium is missing and cannot be installed (not root, or apt-get has no network)")
+def test_the_printed_pdf_is_legible(chromium, example, tmp_path):
+    import playwright.sync_api as playwright  # noqa: PLC0415
+
+    _work, page_file = example
+    pdf = tmp_path / "change.pdf"
+    with playwright.sync_playwright() as pw, loaded_page(pw, chromium, page_file) as page:
+        page.wait_for_function("document.body.dataset.ready === '1'", timeout=180_000)
+        page.pdf(path=str(pdf), format="A4", print_background=True)
+    texts, sizes, images = _pdf_text_sizes(pdf)
+    first = re.sub(r"\s+", " ", texts[0])
+    for words in ("Change report", "Summary", "Changes: Points 1, Frames and loads 1", "Check ﬁndings:",
+                  "Run outcomes:", "Program map:", "Program/CAJA_G/caja_g_m1.dat:24", "XC1", "ΔX +1.5 mm, ΔZ -2 mm",
+                  "System/$conﬁg.dat:231", "TOOL_DATA[1]", "ΔZ +5.5 mm"):
+        assert words.replace("ﬁ", "fi") in first.replace("ﬁ", "fi"), words
+    assert 2 <= len(texts) <= 20
+    assert min(sizes) >= 7.0, sorted(sizes)[:5]          # points: nothing in small print
+    assert images == 0                                    # the map is not printed as a picture
+    whole = re.sub(r"\s+", " ", " ".join(texts))
+    assert "The interactive map" in whole and "Dead routines" in whole

@@ -1,0 +1,80 @@
+"""The interactive map's overview fits a screen (issue 49), in headless Chromium with Playwright.
+
+On every KRC backup of the shared corpus, in a 1600 x 1000 window: the overview (the backup's
+modules grouped by folder, KUKA's system software folded into one node) is drawn whole and with
+readable labels at once; *Expand all* (every folder and module of the backup's own open, KUKA's
+folded) then *Fit* shows every node inside the window at a zoom of at least 0.5 (12 px labels
+drawn at 6 px or more); the check box for KUKA's system software opens KUKA's modules. The
+numbers of nodes are counted here from the map's JSON, not from the page.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from click.testing import CliRunner
+
+from krl.cli import main
+from krl.programmap import build_map
+from krl.project import find_backups
+from krl.workspace import workspaces_for
+from tests.apt import apt_install
+from tests.report.test_report_chromium import CHROMIUM, loaded_page
+
+WINDOW = {"width": 1600, "height": 1000}
+READABLE = 0.5
+
+_INFO = """() => { const cy = window.krlMap.cy; const ext = cy.extent();
+  const leaves = cy.nodes().filter((n) => !n.isParent());
+  const inside = leaves.filter((n) => { const b = n.boundingBox();
+    return b.x1 >= ext.x1 - 1 && b.x2 <= ext.x2 + 1 && b.y1 >= ext.y1 - 1 && b.y2 <= ext.y2 + 1; });
+  return { zoom: cy.zoom(), leaves: leaves.length, inside: inside.length,
+           ids: leaves.map((n) => n.id()) }; }"""
+
+
+@pytest.fixture(scope="module")
+def chromium() -> str:
+    if not Path(CHROMIUM).exists() and apt_install("chromium", "chromium") is None:
+        pytest.skip("chromium is not installed and cannot be installed with apt-get")
+    return CHROMIUM
+
+
+@pytest.mark.may_skip("chromium is missing and cannot be installed (not root, or apt-get has no network)")
+def test_overview_and_expand_all_fit_the_window(chromium, shared_corpus, tmp_path):
+    import playwright.sync_api as playwright  # noqa: PLC0415 (0.14 s CPU: only the browser tests)
+
+    backups = find_backups(shared_corpus)
+    assert len(backups) >= 4
+    with playwright.sync_playwright() as pw:
+        for b in backups:
+            pm = build_map(workspaces_for(b, timeout=60)[0])
+            own = [n for n in pm.nodes.values() if n.kind != "routine" or not n.kuka]
+            kuka = [n for n in pm.nodes.values() if n.kind == "routine" and n.kuka]
+            page_file = tmp_path / f"{b.parent.name}-{b.name}.html"
+            r = CliRunner().invoke(main, ["graph", "--format", "html", str(b), "-o", str(page_file)])
+            assert r.exit_code == 0, r.output
+            with loaded_page(pw, chromium, page_file) as page:
+                page.set_viewport_size(WINDOW)
+                page.wait_for_function("document.body.dataset.ready === '1'", timeout=180_000)
+                page.click("#map-overview")          # laid out again in this window
+                page.wait_for_function("document.body.dataset.ready === '1'", timeout=180_000)
+                info = page.evaluate(_INFO)
+                # folded: a few dozen nodes at most, all in view, readable
+                assert info["leaves"] <= max(30, len(own) // 2), (b, info["leaves"])
+                assert "group:KUKA" in info["ids"] or not kuka
+                assert info["inside"] == info["leaves"] and info["zoom"] >= READABLE, (b, info["zoom"])
+                page.click("#map-expand-all")
+                page.wait_for_function("document.body.dataset.ready === '1'", timeout=180_000)
+                page.click("#map-fit")
+                info = page.evaluate(_INFO)
+                # every routine of the backup's own (and channel) is a node; of KUKA's, those of
+                # a module the controller starts (sps.sub in System/), the rest one node
+                kept = {n.module.upper() for n in kuka if n.entry_kind in ("cell", "plc", "submit", "selected")}
+                shown = [n for n in kuka if n.module.upper() in kept]
+                assert info["leaves"] == len(own) + len(shown) + (len(kuka) > len(shown)), (b, info["leaves"])
+                assert info["inside"] == info["leaves"], (b, info)
+                assert info["zoom"] >= READABLE, (b.name, info["zoom"])
+                page.check("#map-show-kuka")
+                page.wait_for_function("document.body.dataset.ready === '1'", timeout=180_000)
+                assert "group:KUKA" not in page.evaluate(_INFO)["ids"] or not kuka
