@@ -84,7 +84,8 @@ conformance: $(PARSER) java-parser
 	$(BIN)/krl conformance --out $(CONF_OUT) --fuzz $(CONF_FUZZ)
 
 # Long nightly run, in order: recovery over the shared corpus, growth, the 16-copies scaling
-# figures (scale.json), the static check of the corpus backups (check/), conformance, the
+# figures (scale.json), the static check of the corpus backups (check/), the fleet
+# audit of the corpus with every entry point run for krl run's 600 s (audit/: krl audit, docs/audit.md), conformance, the
 # benchmarks (bench.json, bench-parse.json, limits.jsonl, whole-runs.json: every corpus entry
 # point's whole run, tools/whole_run_bench.py), the fuzzers for their nightly budget
 # (fuzz/), the tests marked slow (long sweeps; hypothesis with the nightly profile); dated
@@ -101,6 +102,7 @@ nightly: $(PARSER) java-parser
 	$(BIN)/krl growth $(SHARED_CORPUS) --out $$d/growth || exit $$?; \
 	$(BIN)/python -m recovery.scale_bench $(SHARED_CORPUS) --json > $$d/scale.json || exit $$?; \
 	$(BIN)/krl check --report $$d/check $(SHARED_CORPUS) > $$d/check.log 2>&1; \
+	$(BIN)/krl audit $(SHARED_CORPUS) --out $$d/audit $(SCHED_OPT) > $$d/audit.log 2>&1; \
 	$(BIN)/krl conformance --out $$d/conformance --fuzz $(NIGHTLY_FUZZ) --fuzz-random $(SCHED_OPT); c=$$?; \
 	$(BIN)/krl bench --json > $$d/bench.json 2> $$d/bench.log; \
 	$(BIN)/krl bench parse --json > $$d/bench-parse.json 2>> $$d/bench.log; \

@@ -158,40 +158,60 @@ def cause_of(row: dict) -> str:
     return "limit"
 
 
-def programs_of(root: Path) -> list[Path]:
+def programs_of(root: Path, files: list[Path] | None = None) -> list[Path]:
     """The robot programs of the backup rooted at `root` (krl/project.py): the .src files
     under the robot's folder (R1, or a flat export's root) in a Program folder, named CELL,
-    or at that folder's top, whose first routine is a DEF without parameters."""
-    from interp.runtime.program import parse_module  # noqa: PLC0415
-
+    or at that folder's top, whose first routine is a DEF without parameters. `files`: the
+    files to choose from (a walk of the folder, krl.files.walk, as ``krl audit`` lists them;
+    default every file below the robot's folder, sorted)."""
     system = system_folder(root)
     root = system.parent if system is not None else root
     cands = []
-    for p in sorted(root.rglob("*")):
+    for p in sorted(root.rglob("*")) if files is None else files:
         if p.suffix.lower() != ".src" or not p.is_file():
             continue
-        rel = p.relative_to(root)
+        try:
+            rel = p.relative_to(root)
+        except ValueError:                           # a listed file outside the robot's folder
+            continue
         if system_folder_of(rel) is not None:        # KUKA's system folders (krl/project.py)
             continue
         parts = [x.upper() for x in rel.parts]
         if "PROGRAM" in parts or p.stem.upper() == "CELL" or p.parent == root:
             cands.append(p)
-    out = []
-    for p in cands:
-        mod, errs = parse_module(str(p))
-        if mod.routines and not mod.routines[0].params and mod.routines[0].kind == "DEF":
-            out.append(p)
-    return out
+    return [p for p in cands if is_program(p)]
 
 
-def entries_of(root: Path) -> list[Path]:
-    """The entry points of the backup at `root`: :func:`programs_of`, then its ``SPS.SUB``
-    (krl.project.boot_submit), as a controller starts it at boot."""
+def is_program(path: Path) -> bool:
+    """True when the module `path`'s first routine is a DEF without parameters: a program an
+    operator can select and start (it passes no arguments)."""
+    from interp.runtime.program import parse_module  # noqa: PLC0415
+
+    mod, _errs = parse_module(str(path))
+    return bool(mod.routines) and not mod.routines[0].params and mod.routines[0].kind == "DEF"
+
+
+def entries_of(root: Path, files: list[Path] | None = None) -> list[Path]:
+    """The entry points of the backup at `root`: :func:`programs_of` (of `files`, if given),
+    then its ``SPS.SUB`` (krl.project.boot_submit), as a controller starts it at boot."""
     from krl.project import boot_submit  # noqa: PLC0415
 
-    progs = programs_of(root)
+    progs = programs_of(root, files)
     sub = boot_submit(progs[0]) if progs else None
     return progs + ([sub] if sub is not None and sub not in progs else [])
+
+
+def folder_entries(files: list[Path]) -> list[Path]:
+    """The entry points of a folder of KRL files that is not a KRC backup (``krl audit``):
+    among `files` (a walk of the folder, krl.files.walk), every .src module whose first
+    routine is a DEF without parameters (:func:`is_program`), and every .sub submit program
+    (run alone, as an SPS.SUB entry of a backup is), in the order given."""
+    out = []
+    for p in files:
+        suffix = p.suffix.lower()
+        if (suffix == ".sub" and p.is_file()) or (suffix == ".src" and p.is_file() and is_program(p)):
+            out.append(p)
+    return out
 
 
 def loose_programs(folder: Path) -> list[Path]:
@@ -293,6 +313,84 @@ def report_run(path: Path, cell: Path | None, max_sim_time: float = REPORT_SIM_T
     return robot, submit, t, step_limit(max_steps, t, len(submit) + sub, robot.ipo_cycle_s)
 
 
+#: the kinds of motion event a row counts (:func:`motion_event_kind`), from the controller's
+#: messages (robot/errors.py, robot/kinematics.py, robot/planner.py, robot/controller.py)
+MOTION_EVENT_KINDS = ("reach", "limit", "singularity", "motion")
+_MOTION_EVENT_WORDS = (("reach", ("target not reachable", "workspace error")),
+                       ("limit", ("software limit switch",)),
+                       ("singularity", ("singularity",)))
+#: motion events a row lists (all are counted), and program-number requests it keeps the times of
+MAX_ROW_EVENTS = 100
+MAX_ROW_REQUESTS = 1000
+
+
+def motion_event_kind(text: str) -> str:
+    """The kind (:data:`MOTION_EVENT_KINDS`) of a motion error, from the controller's message:
+    ``reach`` a workspace error (no axis configuration reaches the target, robot/errors.py
+    WorkspaceError), ``limit`` a software limit switch (SoftLimitError), ``singularity`` a CP
+    path through a wrist singularity (robot/planner.py, or an axis past its speed limit on the
+    path, robot/controller.py), ``motion`` any other."""
+    low = (text or "").lower()
+    for kind, words in _MOTION_EVENT_WORDS:
+        if any(w in low for w in words):
+            return kind
+    return "motion"
+
+
+class RunEvents:
+    """The controller's events a row keeps (the part of robot.trace.TraceWriter the controller
+    calls; nothing is written anywhere): the motions started, every motion error (``{t, kind,
+    text, file, line}``: the motion statement's place, from its ``motion`` start event) and the
+    times P00's program-number request output rose (`request`: ``(signal, active value)``, set
+    before the run; KUKA's P00 writes ``$OUT[PGNO_REQ]``, TRUE when PGNO_REQ > 0, FALSE on
+    ``$OUT[-PGNO_REQ]`` when it is negative)."""
+
+    def __init__(self) -> None:
+        self.inner = None
+        self.request: tuple[str, bool] | None = None
+        self.motions = 0
+        self.errors: list[dict] = []
+        self.counts: Counter = Counter()
+        self.requests: list[float] = []
+        self.n_requests = 0
+        self._where: dict[int, tuple] = {}
+        self._out: dict[str, object] = {}
+
+    def write(self, kind: str, t: float, **fields) -> None:
+        if kind == "motion" and fields.get("phase") == "start":
+            self.motions += 1
+            self._where[fields.get("id")] = (fields.get("file"), fields.get("line"))
+        elif kind == "error":
+            self.add(t, str(fields.get("text") or ""), *self._where.get(fields.get("id"), (None, fields.get("line"))))
+        elif kind == "io" and self.request is not None and fields.get("signal") == self.request[0]:
+            value, before = fields.get("value"), self._out.get(self.request[0])
+            self._out[self.request[0]] = value
+            if value == self.request[1] and before != value:
+                self.n_requests += 1
+                if len(self.requests) < MAX_ROW_REQUESTS:
+                    self.requests.append(round(t, 3))
+
+    def write_pose(self, t: float, axes, tcp_T) -> None:
+        pass
+
+    def add(self, t: float, text: str, file, line) -> None:
+        kind = motion_event_kind(text)
+        self.counts[kind] += 1
+        if len(self.errors) < MAX_ROW_EVENTS:
+            self.errors.append({"t": round(t, 3), "kind": kind, "text": text, "file": file, "line": line})
+
+
+def _request_signal(rt, path: Path) -> tuple[str, bool] | None:
+    """P00's program-number request output as the program sees ``PGNO_REQ`` ($config.dat):
+    ``($OUT[n], active value)``, None when it is 0 or not declared."""
+    from interp.run import global_value  # noqa: PLC0415
+
+    req = global_value(rt, path.stem, "PGNO_REQ")
+    if not isinstance(req, int) or isinstance(req, bool) or req == 0:
+        return None
+    return f"$OUT[{abs(req)}]", req > 0
+
+
 #: the run-time errors of a name nothing of the program declares (interp/runtime/core.py,
 #: interp/runtime/kss.py): the name, and whether it is a routine
 _UNKNOWN = re.compile(r"^(?:unknown name (?P<name>\S+)|routine (?P<routine>\S+) not found)$")
@@ -334,14 +432,19 @@ def run_one(path: Path, max_sim_time: float, max_steps: int, cell: Path | None =
     interp.run.cell_of), or with ``--inputs auto`` (`auto`; then `cell` is not used), on the
     interpreter `interp`. The row holds how it ended, its cause, the stand-ins of KUKA's
     software (``stubs``, name -> uses), the cell's answers (``cell_answers``, ``cell_last`` s;
-    ``answers``: the automatic cell's, described), the idle time skipped, and the stops on a
-    name the checker classifies outside the program (``outside_stops``, :func:`outside_stops`).
+    ``answers``: the automatic cell's, described), the idle time skipped, the stops on a
+    name the checker classifies outside the program (``outside_stops``, :func:`outside_stops`),
+    and what the controller saw (:class:`RunEvents`): ``motions`` started, the motion errors
+    (``events``, at most :data:`MAX_ROW_EVENTS`; ``event_counts`` by kind, every one) and the
+    times (s) P00 asked the PLC for a program number (``requests``, at most
+    :data:`MAX_ROW_REQUESTS`; ``requests_total``).
     `auto_sim_time`: the time limit of an ``--inputs auto`` run of a robot program (default
-    :data:`AUTO_SIM_TIME_S`; a bounded sweep gives less)."""
+    :data:`AUTO_SIM_TIME_S`; a bounded sweep gives less, ``krl audit --max-sim-time``)."""
     from interp.run import cell_of, make_runtime  # noqa: PLC0415
 
     t0 = time.time()
     shown = None if auto else cell
+    events = RunEvents()
     try:
         cell = None if auto else cell_of(cell)   # the cell file, read once for the robot, the limits and the run
         inputs = "auto" if auto else cell
@@ -351,7 +454,9 @@ def run_one(path: Path, max_sim_time: float, max_steps: int, cell: Path | None =
         # --no-check: the report says how each real program runs, also those the checker rejects
         # (an SPS.SUB entry runs at the submit interpreter's pace: scheduler.program_budget)
         rt, _ = make_runtime(path, trace=None, mujoco=False, max_sim_time=max_sim_time, max_steps=limit,
-                             submit=submit, check=False, inputs=inputs, robot=robot, interp=interp)
+                             submit=submit, check=False, inputs=inputs, robot=robot, interp=interp,
+                             observer=events)
+        events.request = _request_signal(rt, path)
         res = rt.run()
         stubs = {name: n for name, _what, n in rt.kss.summary()}
         stops = outside_stops(rt)
@@ -377,6 +482,14 @@ def run_one(path: Path, max_sim_time: float, max_steps: int, cell: Path | None =
            "answers": [a.describe() for a in answers],
            "idle_s": round(rt.scheduler.idle.skipped * rt.controller.dt, 3),
            "robot": robot.name, "robot_own": own, "outside_stops": stops}
+    if res.reason == "error" and motion_event_kind(res.text) != "motion" \
+            and not any(e["text"] and e["text"] in (res.text or "") for e in events.errors):
+        # a target the planner refuses in the advance run ends the program without a main-run
+        # error event: it is the run's motion event all the same
+        events.add(res.sim_time, res.text or "", res.file, res.line)
+    row.update(motions=events.motions, events=events.errors,
+               event_counts={k: events.counts[k] for k in MOTION_EVENT_KINDS if events.counts[k]},
+               requests=events.requests, requests_total=events.n_requests)
     row["cause"] = cause_of(row)
     return row
 

@@ -237,3 +237,14 @@ MAX_HALT_CONTINUES = 1000
 # A start position (`krl run --start`, a cell file's `start:`): characters of its text; its
 # tokens are at most MAX_RULE_TOKENS.
 MAX_START_CHARS = 400
+# `krl audit FOLDER...` (audit/, docs/audit.md): the most backups and program folders one audit
+# takes (past it: an error naming the count, nothing runs), the entry points it runs per backup
+# (the first ones in walk order; the rest are listed as not run), the check findings it lists
+# per backup (all are counted), the wall-clock seconds one run may take in its worker process
+# (then it is killed: ends "stopped at the audit's wall-clock limit"), and the source text the
+# report's evidence carries, in characters in all (past it an item keeps its file:line only).
+MAX_AUDIT_BACKUPS = 1000
+MAX_AUDIT_ENTRIES = 200
+MAX_AUDIT_FINDINGS = 500
+AUDIT_RUN_TIMEOUT_S = 900.0
+MAX_AUDIT_EVIDENCE_CHARS = 4_000_000

@@ -32,6 +32,7 @@ SUBCOMMAND_MODULES = (
     "interp.debug.cli",    # debug
     "krl.cli.changes",     # diff, graph, report
     "pendant.cli",         # pendant
+    "audit.cli",           # audit
 )
 
 

@@ -1,0 +1,237 @@
+"""``krl audit FOLDER...``: every KRC backup and program folder of the folders, checked and run,
+in one report (issue 49). The job, from the folders to the report's data; docs/audit.md says
+what each field means.
+
+1. **List** (on the client, :func:`units_of`): the one walk of each folder that ``krl check``
+   makes (krl.project.folder_groups: links never followed, MAX_FOLDER_DEPTH): one *unit* per
+   KRC backup, then one per top-level folder of the files outside every backup (a *program
+   folder*). At most :data:`krl.limits.MAX_AUDIT_BACKUPS` units, else :class:`AuditError`.
+2. **Check** (a task per unit, :func:`check_unit`): the unit loaded and checked as
+   ``krl check`` does (krl.workspace.load_workspaces through the one store, the workspace's
+   ``krl.toml``), its program map (krl.programmap.build_map: the entry kind of each
+   program), the outputs its code writes and their overlaps (audit/outputs.py), and its entry
+   points: in a backup the real-programs report's (interp.realprograms.entries_of: the
+   programs under R1/Program, cell.src, the SPS.SUB), in a program folder every module whose
+   main routine is a DEF without parameters and every .sub (interp.realprograms
+   .folder_entries), both among the files of the walk; at most MAX_AUDIT_ENTRIES per unit.
+3. **Run** (a task per entry point): interp.realprograms.run_one with ``--inputs auto`` (the
+   automatic cell answers every wait, P00's handshake included), on the VM, up to
+   `max_sim_time` simulated seconds (an SPS.SUB entry at most the real-programs report's
+   60 s: a submit program never ends) and `max_steps` statements of the program's own; how
+   it ends (cause, reason, file:line), the motion errors the controller raised and the times
+   P00 asked for a program number.
+4. **Report** (on the client, audit/report.py): the rows in the folders' order, whatever
+   order the tasks finished in, so the report is the same with any number of workers, on this
+   machine (krl.pool: killable worker processes, ``jobs``) or on a Dask cluster (krl.cluster,
+   ``scheduler``).
+
+A unit whose check fails (a worker that dies, a check past its time) is a unit with an
+``error``; a run that fails is a row whose reason says so: the audit never stops on one backup.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+from krl.limits import AUDIT_RUN_TIMEOUT_S, MAX_AUDIT_BACKUPS, MAX_AUDIT_ENTRIES, MAX_AUDIT_FINDINGS, PARSE_TIMEOUT_S
+
+__all__ = ["AuditError", "Unit", "units_of", "check_unit", "run_entry", "run_audit"]
+
+
+class AuditError(Exception):
+    """The folders cannot be audited (not a folder, more units than MAX_AUDIT_BACKUPS, a
+    scheduler that cannot be used): a usage error whose message names the folder or the limit."""
+
+
+@dataclass
+class Unit:
+    """A KRC backup (`backup`) or a program folder: its `root` (as walked from the folder the
+    user named, `folder`), and its entries in the walk (krl.files.Entry)."""
+
+    root: str
+    folder: str
+    entries: list
+    backup: bool
+
+    @property
+    def name(self) -> str:
+        """The unit's path relative to the folder the user named (the folder's own name when it
+        is the unit)."""
+        try:
+            rel = Path(self.root).relative_to(self.folder).as_posix()
+        except ValueError:
+            rel = ""
+        return rel if rel and rel != "." else Path(self.folder).name or self.folder
+
+
+def units_of(folders: list[str]) -> list[Unit]:
+    """The units of `folders` (module docstring, step 1), in the folders' order; a root named
+    twice is audited once. Raises AuditError."""
+    from krl.project import folder_groups, system_folder  # noqa: PLC0415
+    from krl.terminal import printable  # noqa: PLC0415
+
+    out: list[Unit] = []
+    seen: set[str] = set()
+    for folder in folders:
+        groups = folder_groups(Path(folder))
+        if groups is None:
+            raise AuditError(f"{printable(folder)}: not a folder (krl audit takes folders of KRC backups "
+                             f"and KRL programs)")
+        for root, entries in groups:
+            key = str(Path(root).resolve())
+            if key in seen:
+                continue
+            seen.add(key)
+            out.append(Unit(root, folder, entries, system_folder(Path(root)) is not None))
+            if len(out) > MAX_AUDIT_BACKUPS:
+                raise AuditError(f"more than {MAX_AUDIT_BACKUPS} backups and program folders below "
+                                 f"{', '.join(printable(f) for f in folders)} (limit MAX_AUDIT_BACKUPS, "
+                                 f"docs/security.md): audit fewer folders at a time")
+    return out
+
+
+def check_unit(root: str, entries: list, backup: bool) -> dict:
+    """On a worker: the static half of a unit (module docstring, step 2) as a JSON-ready dict:
+    ``files``, ``errors``, ``warnings``, ``codes`` (code -> count), ``findings`` (errors first,
+    at most MAX_AUDIT_FINDINGS: code, severity, message, file relative to `root`, line,
+    column), ``findings_left_out``, ``programs`` (``{path, kind, why}``: each entry point with
+    the program map's entry kind), ``programs_left_out``, ``outputs`` (audit/outputs.py).
+    The files are parsed in this process (a Dask worker may not start the killable pool; the
+    caller's timeout bounds the task)."""
+    from krl.parsecache import through_store  # noqa: PLC0415
+    from krl.programmap import build_map  # noqa: PLC0415
+    from krl.semantics.config import config_for  # noqa: PLC0415
+    from krl.workspace import load_workspaces  # noqa: PLC0415
+
+    from audit.outputs import overlaps  # noqa: PLC0415
+    from audit.report import rel_path as _rel  # noqa: PLC0415
+    from interp.realprograms import entries_of, folder_entries  # noqa: PLC0415
+
+    with through_store():
+        ws = load_workspaces([(root, entries)], None)[0]
+    diags = config_for(ws.root, root).apply(ws.check())
+    errors = [d for d in diags if d.is_error]
+    warnings = [d for d in diags if not d.is_error]
+    codes: dict[str, int] = {}
+    for d in diags:
+        codes[d.code] = codes.get(d.code, 0) + 1
+    shown = (errors + warnings)[:MAX_AUDIT_FINDINGS]
+    pm = build_map(ws)
+    kinds = {str(Path(n.path)): (n.entry_kind, n.entry) for n in pm.nodes.values() if n.main and n.path}
+    files = [e.path for e in entries if e.kind == "file"]
+    progs = entries_of(Path(root), files) if backup else folder_entries(files)
+    rep = overlaps(ws, pm)
+    names = {nid: pm.nodes[nid].name for nid in pm.nodes}
+
+    def write(w) -> dict:
+        return {"file": _rel(w.path, root), "line": w.line, "module": w.module, "name": w.name, "how": w.how,
+                "system": w.kuka, "tasks": rep.tasks.get(w.routine, []),
+                "reached_by": [names[e] for e in rep.reached_by.get(w.routine, [])]}
+
+    return {
+        "files": len(ws.files), "errors": len(errors), "warnings": len(warnings),
+        "codes": dict(sorted(codes.items())),
+        "findings": [{"code": d.code, "severity": d.severity, "message": d.message, "file": _rel(d.path, root),
+                      "line": d.line, "column": d.column} for d in shown],
+        "findings_left_out": len(diags) - len(shown),
+        "programs": [{"path": str(p), "kind": kinds.get(str(Path(p)), ("", ""))[0],
+                      "why": kinds.get(str(Path(p)), ("", ""))[1]} for p in progs[:MAX_AUDIT_ENTRIES]],
+        "programs_left_out": max(0, len(progs) - MAX_AUDIT_ENTRIES),
+        "outputs": {
+            "writes": len(rep.writes), "computed": len(rep.computed), "plc_map": len(rep.plc_map),
+            "overlaps": [{"signal": o.signal, "signals": o.signals, "flags": o.flags, "tasks": o.tasks,
+                          "plc": [{"name": x.name, "signal": x.signal, "file": _rel(x.path, root), "line": x.line}
+                                  for x in o.plc],
+                          "writes": [write(w) for w in o.writes]} for o in rep.overlaps],
+        },
+    }
+
+
+def run_entry(path: str, max_sim_time: float, max_steps: int, interp: str) -> dict:
+    """On a worker: one entry point run with ``--inputs auto`` (interp.realprograms.run_one) up
+    to `max_sim_time` simulated seconds; an SPS.SUB entry at most the real-programs report's
+    REPORT_SIM_TIME_S (a submit program never ends: its cycle is what the report shows)."""
+    from interp.realprograms import REPORT_SIM_TIME_S, run_one  # noqa: PLC0415
+
+    return run_one(Path(path), min(max_sim_time, REPORT_SIM_TIME_S), max_steps, None, True, interp,
+                   auto_sim_time=max_sim_time)
+
+
+def _outcomes(fn: Callable, tasks: list, *, jobs: int | None, scheduler: str | None, timeout: float | None,
+              name: str):
+    """The outcomes (krl.pool.Outcome) of `fn` over `tasks` (``(key, args)``), in completion
+    order: in `jobs` killable worker processes (krl.pool.run_tasks, each task at most
+    `timeout` s of wall time), or on the Dask cluster at `scheduler` (krl.cluster.run_batches,
+    one task per batch). Raises krl.cluster.SchedulerError."""
+    if scheduler is not None:
+        from krl.cluster import run_batches  # noqa: PLC0415
+
+        return run_batches(scheduler, fn, tasks, batch_files=1, timeout=timeout, name=name)
+    from krl.pool import run_tasks  # noqa: PLC0415
+
+    return run_tasks(fn, tasks, jobs=jobs, timeout=timeout)
+
+
+def run_audit(folders: list[str], *, jobs: int | None = None, scheduler: str | None = None,
+              max_sim_time: float | None = None, max_steps: int | None = None, interp: str = "vm",
+              run_timeout: float = AUDIT_RUN_TIMEOUT_S, progress: Callable[[str, int, int, str], None] | None = None
+              ) -> dict:
+    """The audit of `folders` (module docstring) as the report's data (audit/report.py
+    :func:`~audit.report.report_data`). `max_sim_time`: simulated seconds per entry point
+    (default interp.realprograms.AUTO_SIM_TIME_S, ``krl run``'s 600 s); `max_steps`:
+    statements of the program's own (default REPORT_STEPS); `run_timeout`: wall seconds one
+    run may take before its worker is killed. `progress(phase, done, total, label)` is called
+    as the phases ("check", "run") advance. Raises AuditError (also for a scheduler that
+    cannot be used)."""
+    from krl.cluster import SchedulerError  # noqa: PLC0415
+
+    from audit.report import rel_path as _rel  # noqa: PLC0415
+    from audit.report import report_data  # noqa: PLC0415
+    from interp import realprograms as R  # noqa: PLC0415
+
+    max_sim_time = R.AUTO_SIM_TIME_S if max_sim_time is None else max_sim_time
+    max_steps = R.REPORT_STEPS if max_steps is None else max_steps
+    units = units_of(folders)
+    say = progress or (lambda *_a: None)
+    checked: list[dict | None] = [None] * len(units)
+    tasks = [(i, (u.root, u.entries, u.backup)) for i, u in enumerate(units)]
+    # a unit's deadline: the per-file parse limit times its files (as krl check --scheduler)
+    most = max((sum(e.kind == "file" for e in u.entries) for u in units), default=1)
+    try:
+        say("check", 0, len(units), "")
+        from interp import run as _loaded  # noqa: F401, PLC0415  (forked workers start with the runtime imported)
+
+        for k, o in enumerate(_outcomes(check_unit, tasks, jobs=jobs, scheduler=scheduler,
+                                        timeout=PARSE_TIMEOUT_S * max(most, 1), name="krl-audit-check"), 1):
+            if o.status == "done":
+                checked[o.key] = o.value
+            else:
+                why = f"took longer than {PARSE_TIMEOUT_S * max(most, 1):g} s" if o.status == "timeout" else o.detail
+                checked[o.key] = {"error": f"not checked: {why}"}
+            say("check", k, len(units), units[o.key].name)
+        runs = [(i, p["path"]) for i, c in enumerate(checked) for p in c.get("programs", ())]
+        rows: dict[int, dict] = {}
+        say("run", 0, len(runs), "")
+        run_tasks = [(k, (path, max_sim_time, max_steps, interp)) for k, (_i, path) in enumerate(runs)]
+        for k, o in enumerate(_outcomes(run_entry, run_tasks, jobs=jobs, scheduler=scheduler, timeout=run_timeout,
+                                        name="krl-audit-run"), 1):
+            path = runs[o.key][1]
+            if o.status == "done":
+                rows[o.key] = o.value
+            elif o.status == "timeout":
+                rows[o.key] = {"program": path, "reason": "wall_time", "cause": "limit",
+                               "text": f"stopped at the audit's wall-clock limit: the run took more than "
+                                       f"{run_timeout:g} s (AUDIT_RUN_TIMEOUT_S, --run-timeout)"}
+            else:
+                rows[o.key] = {"program": path, "reason": "internal", "cause": "interpreter gap", "text": o.detail}
+            say("run", k, len(runs), _rel(path, units[runs[o.key][0]].root))
+    except SchedulerError as exc:
+        raise AuditError(str(exc)) from None
+    by_unit: list[list[dict]] = [[] for _ in units]
+    for k, (i, _path) in enumerate(runs):
+        by_unit[i].append(rows[k])
+    settings = {"inputs": "auto", "interp": interp, "max_sim_time": max_sim_time, "max_steps": max_steps,
+                "run_timeout": run_timeout}
+    return report_data(folders, units, checked, by_unit, settings)

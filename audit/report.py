@@ -1,0 +1,279 @@
+"""The report of ``krl audit``: its data (JSON, docs/schemas/audit.schema.json), each unit's
+health, and the HTML page (docs/audit.md).
+
+**Health.** Each backup or program folder gets a *status* and the *reasons* for it, each reason
+a sentence with its count and a link to the items behind it; no weighted score (a number
+whose weights nobody can defend explains nothing). The rules, in :func:`health`:
+
+* ``attention`` -- an entry point ends in a program error (a KRL run-time error at its
+  file:line, or a target the backup's own robot cannot take); a run on the backup's own robot
+  (its ``$machine.dat``) raised a motion error (workspace error, software limit switch, a CP
+  path through a singularity, any other motion error of the controller); an output is written
+  by two programs that run at once, or by a program and the PLC's map (audit/outputs.py); the
+  backup could not be checked;
+* ``review`` -- the checker reports errors; an entry point stops at a limit of the audit (it
+  starves for an input the automatic cell cannot set, or loops) or at a gap of the simulator;
+  a run on a stand-in robot (no machine data name the backup's own) raised a motion error;
+  an output is written under two SIGNAL names; entry points past MAX_AUDIT_ENTRIES were not
+  run;
+* ``ok`` -- none of these.
+
+**Evidence.** Every item names its file and line (relative to the unit's root). The HTML page
+carries each place's source lines (two before, two after: read here through krl/source.py,
+at most MAX_AUDIT_EVIDENCE_CHARS in all) in an evidence list at its end; each item links to
+its evidence in the page, and the evidence to the file (a ``file:`` URL). The page is rendered
+in the project's one Jinja environment (krl/render.py, autoescape on); its only script sorts
+the tables (by a cell's ``data-sort`` value, numbers as numbers) and reads nothing else.
+"""
+
+from __future__ import annotations
+
+import json
+from datetime import datetime, timezone
+from pathlib import Path
+
+from krl.limits import MAX_AUDIT_EVIDENCE_CHARS
+
+__all__ = ["AUDIT_FORMAT", "STATUSES", "rel_path", "plural", "report_data", "health", "write_report", "to_html"]
+
+#: the version of the report's JSON (docs/schemas/audit.schema.json)
+AUDIT_FORMAT = 1
+#: the statuses, worst first
+STATUSES = ("attention", "review", "ok")
+#: answers of the automatic cell kept per run (all are counted)
+MAX_ANSWERS_SHOWN = 10
+#: lines of source shown before and after an item's line
+CONTEXT_LINES = 2
+#: characters of one source line shown in the evidence
+MAX_EVIDENCE_LINE = 240
+
+
+def rel_path(path, root: str) -> str | None:
+    """`path` relative to the unit's `root` when inside it (also when one of them is given
+    relative to the current folder and the other resolved: a run reports resolved paths), else
+    as given; None for none."""
+    if not path:
+        return None
+    p, r = Path(path), Path(root)
+    for a, b in ((p, r), (p.absolute(), r.absolute()), (p.resolve(), r.resolve())):
+        try:
+            return a.relative_to(b).as_posix()
+        except ValueError:
+            continue
+    return str(path)
+
+
+
+
+def plural(n: int, word: str) -> str:
+    """``1 entry point``, ``2 entry points``, ``3 check errors``, ``2 bodies``."""
+    return f"{n} {word}" if n == 1 else f"{n} {word}s" if not word.endswith("y") else f"{n} {word[:-1]}ies"
+
+
+def _cycle(requests: list[float], total: int) -> dict | None:
+    """The cell program's cycles from the times P00 asked for a program number: the time from
+    one request to the next (s), their count, mean, shortest and longest; None with fewer than
+    two requests."""
+    if len(requests) < 2:
+        return None
+    cycles = [round(b - a, 3) for a, b in zip(requests, requests[1:])]
+    return {"requests": total, "cycles": len(cycles), "mean": round(sum(cycles) / len(cycles), 3),
+            "min": min(cycles), "max": max(cycles), "first": cycles[:20]}
+
+
+def _entry(row: dict, program: dict, root: str) -> dict:
+    """One entry point of a unit in the report, from its run row (interp.realprograms.run_one)
+    and its listing (audit.fleet.check_unit)."""
+    from interp.realprograms import cause_of  # noqa: PLC0415
+    from interp.summary import ENDINGS  # noqa: PLC0415
+
+    reason = row.get("reason", "internal")
+    own_end = reason in ("completed", "halt")
+    requests = row.get("requests") or []
+    return {
+        "program": rel_path(program["path"], root), "kind": program.get("kind") or "", "why": program.get("why") or "",
+        "cause": row.get("cause") or cause_of(row), "reason": reason,
+        "ending": ENDINGS.get(reason, "stopped at the audit's wall-clock limit" if reason == "wall_time"
+                              else "internal error of the simulator" if reason == "internal" else reason),
+        "text": row.get("text") or "", "file": rel_path(row.get("file"), root), "line": row.get("line"),
+        "sim_time": row.get("sim_time", 0.0), "run_time": row.get("sim_time") if own_end else None,
+        "steps": row.get("steps", 0), "robot": row.get("robot", ""), "robot_own": bool(row.get("robot_own")),
+        "motions": row.get("motions", 0),
+        "event_counts": row.get("event_counts") or {},
+        "events": [{**e, "file": rel_path(e.get("file"), root)} for e in row.get("events") or ()],
+        "cycle": _cycle(requests, row.get("requests_total", len(requests))) if program.get("kind") == "cell" else None,
+        "stubs": row.get("stubs") or {}, "submit_errors": row.get("submit") or [],
+        "answers": len(row.get("answers") or ()), "answers_shown": (row.get("answers") or [])[:MAX_ANSWERS_SHOWN],
+    }
+
+
+def health(unit: dict) -> tuple[str, list[dict]]:
+    """The status of a unit of the report and its reasons (module docstring): ``(status,
+    [{"level", "text", "target"}])``, `target` the id of the report's section behind it."""
+    reasons: list[dict] = []
+
+    def add(level: str, text: str, target: str) -> None:
+        reasons.append({"level": level, "text": text, "target": target})
+
+    if unit.get("error"):
+        add("attention", unit["error"], "check")
+    entries = unit.get("entries", [])
+    by = {}
+    for e in entries:
+        by[e["cause"]] = by.get(e["cause"], 0) + 1
+    n = len(entries)
+    if by.get("program error"):
+        add("attention", f"{by['program error']} of {n} entry points end in a program error", "entries")
+    words = {"reach": "workspace error", "limit": "software limit switch", "singularity": "singularity",
+             "motion": "other motion error"}
+    for own in (True, False):
+        events: dict[str, int] = {}
+        for e in entries:
+            if e["robot_own"] == own:
+                for k, c in e["event_counts"].items():
+                    events[k] = events.get(k, 0) + c
+        if events:
+            detail = ", ".join(plural(c, words.get(k, k)) for k, c in events.items())
+            if own:
+                add("attention", f"{plural(sum(events.values()), 'motion error')} on the backup's own robot "
+                                 f"({detail})", "events")
+            else:
+                add("review", f"{plural(sum(events.values()), 'motion error')} on a stand-in robot (the backup's "
+                              f"machine data do not name this robot: {detail})", "events")
+    ov = unit.get("outputs", {}).get("overlaps", [])
+    two = sum("two programs" in o["flags"] for o in ov)
+    plc = sum("PLC map" in o["flags"] for o in ov)
+    names = sum(o["flags"] == ["two names"] for o in ov)
+    if two:
+        add("attention", f"{plural(two, 'output')} written by two programs that run at once", "outputs")
+    if plc:
+        add("attention", f"{plural(plc, 'output')} of the PLC map written by a program", "outputs")
+    if unit.get("errors"):
+        add("review", f"{plural(unit['errors'], 'check error')}", "check")
+    if by.get("limit"):
+        add("review", f"{by['limit']} of {n} entry points stop at a limit of the audit (starving or looping)",
+            "entries")
+    if by.get("interpreter gap"):
+        add("review", f"{by['interpreter gap']} of {n} entry points stop at a gap of the simulator", "entries")
+    if names:
+        add("review", f"{plural(names, 'output')} written under two SIGNAL names", "outputs")
+    if unit.get("programs_left_out"):
+        add("review", f"{unit['programs_left_out']} entry points not run (MAX_AUDIT_ENTRIES)", "entries")
+    status = next((s for s in STATUSES if any(r["level"] == s for r in reasons)), "ok")
+    return status, reasons
+
+
+def report_data(folders: list[str], units: list, checked: list[dict], runs: list[list[dict]], settings: dict) -> dict:
+    """The report (docs/schemas/audit.schema.json) from the units (audit.fleet.Unit), their
+    static half (audit.fleet.check_unit, or ``{"error"}``) and their run rows, in order."""
+    from krl import __version__  # noqa: PLC0415
+
+    out_units = []
+    for u, c, rows in zip(units, checked, runs):
+        progs = c.get("programs", [])
+        entries = [_entry(r, p, u.root) for r, p in zip(rows, progs)]
+        unit = {
+            "name": u.name, "root": u.root, "kind": "backup" if u.backup else "folder",
+            "error": c.get("error"), "files": c.get("files", 0), "errors": c.get("errors", 0),
+            "warnings": c.get("warnings", 0), "codes": c.get("codes", {}), "findings": c.get("findings", []),
+            "findings_left_out": c.get("findings_left_out", 0),
+            "robot": next((e["robot"] for e in entries if e["robot"]), ""),
+            "entries": entries, "programs_left_out": c.get("programs_left_out", 0),
+            "outputs": c.get("outputs", {"writes": 0, "computed": 0, "plc_map": 0, "overlaps": []}),
+        }
+        cell = next((e for e in entries if e["kind"] == "cell"), None)
+        unit["cell"] = None if cell is None else {"program": cell["program"], "cause": cell["cause"],
+                                                  "cycle": cell["cycle"]}
+        causes = [e["cause"] for e in entries]
+        unit["tally"] = {
+            "entry_points": len(entries),
+            "completed_or_intended": causes.count("completed") + causes.count("intended end"),
+            "program_errors": causes.count("program error"),
+            "limit_or_gap": causes.count("limit") + causes.count("interpreter gap"),
+            "motion_errors": sum(sum(e["event_counts"].values()) for e in entries),
+            "cell_cycle": cell["cycle"]["mean"] if cell is not None and cell["cycle"] else None,
+            "overlaps": len(unit["outputs"]["overlaps"]),
+        }
+        unit["status"], unit["reasons"] = health(unit)
+        out_units.append(unit)
+    causes: dict[str, int] = {}
+    for u in out_units:
+        for e in u["entries"]:
+            causes[e["cause"]] = causes.get(e["cause"], 0) + 1
+    summary = {
+        "backups": sum(u["kind"] == "backup" for u in out_units),
+        "folders": sum(u["kind"] == "folder" for u in out_units),
+        "entry_points": sum(len(u["entries"]) for u in out_units),
+        "causes": causes,
+        "status": {s: sum(u["status"] == s for u in out_units) for s in STATUSES},
+        "check_errors": sum(u["errors"] for u in out_units),
+        "motion_errors": sum(sum(e["event_counts"].values()) for u in out_units for e in u["entries"]),
+        "overlaps": sum(len(u["outputs"]["overlaps"]) for u in out_units),
+    }
+    return {"format": AUDIT_FORMAT, "tool": f"krl-tools {__version__}",
+            "generated": datetime.now(timezone.utc).strftime("%Y-%m-%d %H:%M:%S UTC"),
+            "folders": [str(f) for f in folders], "settings": settings, "summary": summary, "units": out_units}
+
+
+class _Evidence:
+    """The evidence list of the page: one item per (file, line) of a unit, with its source lines
+    (within MAX_AUDIT_EVIDENCE_CHARS in all) and its ``file:`` link."""
+
+    def __init__(self) -> None:
+        self.items: list[dict] = []
+        self._ids: dict[tuple, str] = {}
+        self._texts: dict[str, list[str]] = {}
+        self.budget = MAX_AUDIT_EVIDENCE_CHARS
+
+    def _lines(self, path: Path) -> list[str]:
+        key = str(path)
+        if key not in self._texts:
+            from krl.source import read_source  # noqa: PLC0415
+
+            src = read_source(path, follow_symlinks=False) if path.is_file() else None
+            self._texts[key] = (src.text or "").splitlines() if src is not None else []
+        return self._texts[key]
+
+    def ref(self, root: str, file: str | None, line: int | None) -> str:
+        """The id of the evidence of `file`:`line` (a path relative to the unit's `root`, or
+        absolute), added on first use; "" for no place."""
+        if not file:
+            return ""
+        line = int(line or 1)
+        key = (root, file, line)
+        if key in self._ids:
+            return self._ids[key]
+        path = Path(file) if Path(file).is_absolute() else Path(root) / file
+        lines = self._lines(path)
+        first = max(1, line - CONTEXT_LINES)
+        shown = [(n, lines[n - 1][:MAX_EVIDENCE_LINE]) for n in range(first, min(len(lines), line + CONTEXT_LINES) + 1)]
+        cost = sum(len(t) + 8 for _n, t in shown)
+        if cost > self.budget:
+            shown = []
+        self.budget -= cost if shown else 0
+        ident = f"ev{len(self.items) + 1}"
+        href = path.absolute().as_uri() if path.is_file() else ""
+        self.items.append({"id": ident, "file": file, "line": line, "lines": shown, "href": href})
+        self._ids[key] = ident
+        return ident
+
+
+def to_html(data: dict) -> str:
+    """The report's page (module docstring) from :func:`report_data`'s data."""
+    from krl.render import render_html  # noqa: PLC0415
+
+    ev = _Evidence()
+    return render_html("audit", "audit.html.j2", data=data, ev=ev, statuses=STATUSES)
+
+
+def write_report(data: dict, out: str | Path) -> tuple[Path, Path]:
+    """Write ``audit.json`` and ``audit.html`` into the folder `out` (created), each through
+    a temporary file renamed over the old one (krl.files.write_text_atomic); returns their paths."""
+    from krl.files import write_text_atomic  # noqa: PLC0415
+
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    j, h = out / "audit.json", out / "audit.html"
+    write_text_atomic(j, json.dumps(data, indent=1, ensure_ascii=False) + "\n")
+    write_text_atomic(h, to_html(data))
+    return j, h

@@ -1,0 +1,113 @@
+"""`krl audit` on a small folder of programs written here, and on bad input (issue 49; GUIDE
+"Untrusted input"): how each entry point ends, the report's JSON against its schema, markup
+from a file (its text and its name) inert in the page, and usage errors that name the folder
+or the limit with exit code 2 and no traceback.
+
+Every expected value is read off the files of PROGRAMS (the comments say how)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+from click.testing import CliRunner
+from jsonschema import Draft202012Validator
+
+from krl.cli import main
+
+REPO = Path(__file__).resolve().parents[2]
+PWNED = "<script>window.pwned=1</script>"
+PROGRAMS = {
+    "good.src": "DEF good()\n  DECL INT n\n  n = 1\nEND\n",
+    # line 4 divides by b = 0: a run-time error there
+    "div.src": "DEF div()\n  DECL INT a, b\n  b = 0\n  a = 1 / b\nEND\n",
+    # an endless loop without motion: the step limit ends it
+    "spin.src": "DEF spin()\n  LOOP\n  ENDLOOP\nEND\n",
+    # the IF of line 3 has no ENDIF (E010 at 3:3); markup in a comment
+    "bad.src": f"DEF bad()\n  ; {PWNED}\n  IF x THEN\nEND\n",
+    # markup in a file's name
+    "<i>mark.src": "DEF mark()\n  $OUT[3] = TRUE\nEND\n",
+}
+
+
+def _audit(args: list[str]):
+    return CliRunner().invoke(main, ["audit", *args])
+
+
+@pytest.fixture(scope="module")
+def audited(tmp_path_factory):
+    fleet = tmp_path_factory.mktemp("fleet")
+    for name, text in PROGRAMS.items():
+        (fleet / "cell" / name).parent.mkdir(exist_ok=True)
+        (fleet / "cell" / name).write_text(text.replace("\n", "\r\n"), encoding="latin-1")
+    out = tmp_path_factory.mktemp("out")
+    res = _audit([str(fleet), "--out", str(out), "--max-steps", "10000", "--jobs", "1"])
+    return fleet, out, res, json.loads((out / "audit.json").read_text(encoding="utf-8"))
+
+
+def test_how_each_entry_point_ends(audited):
+    fleet, _out, res, data = audited
+    assert res.exit_code == 1, res.output            # a program error: attention
+    assert "Traceback" not in res.output
+    (u,) = data["units"]
+    assert (u["name"], u["kind"], u["root"]) == (fleet.name, "folder", str(fleet))
+    got = {e["program"]: (e["cause"], e["reason"], e["file"], e["line"]) for e in u["entries"]}
+    # bad.src does not parse: it is no entry point, its error is a finding (below)
+    assert got == {
+        "cell/good.src": ("completed", "completed", "cell/good.src", 3),
+        "cell/<i>mark.src": ("completed", "completed", "cell/<i>mark.src", 2),
+        "cell/div.src": ("program error", "error", "cell/div.src", 4),
+        "cell/spin.src": ("limit", "max_steps", "cell/spin.src", 2),
+    }
+    errors = [(f["code"], f["file"], f["line"], f["column"]) for f in u["findings"] if f["severity"] == "error"]
+    assert errors == [("E010", "cell/bad.src", 3, 3)]
+    assert u["status"] == "attention"
+    assert [(r["level"], r["text"]) for r in u["reasons"]] == [
+        ("attention", "1 of 4 entry points end in a program error"),
+        ("review", "1 check error"),
+        ("review", "1 of 4 entry points stop at a limit of the audit (starving or looping)"),
+    ]
+    # the terminal: one line for the folder, then the totals
+    # (good.src and <i>mark.src complete; div.src, spin.src; bad.src's E010)
+    assert res.output.splitlines()[0] == (
+        f"attention {fleet.name}: 1 check error, 4 entry points (2 completed or intended end, 1 program error, "
+        f"1 limit or gap), 0 motion errors, 0 outputs to review")
+    assert res.output.splitlines()[1] == "0 backups, 1 program folder, 4 entry points: 1 attention, 0 review, 0 ok"
+
+
+def test_the_json_follows_its_schema(audited):
+    _fleet, _out, _res, data = audited
+    schema = json.loads((REPO / "docs" / "schemas" / "audit.schema.json").read_text(encoding="utf-8"))
+    Draft202012Validator(schema).validate(data)
+    with pytest.raises(Exception, match="status"):
+        Draft202012Validator(schema).validate({**data, "units": [{**data["units"][0], "status": "fine"}]})
+
+
+def test_markup_from_the_files_is_inert_in_the_page(audited):
+    _fleet, out, _res, _data = audited
+    page = (out / "audit.html").read_text(encoding="utf-8")
+    assert PWNED not in page and "<i>mark" not in page
+    assert "; &lt;script&gt;window.pwned=1&lt;/script&gt;" in page        # bad.src:2 in the evidence of 3
+    assert "cell/&lt;i&gt;mark.src" in page
+
+
+def test_not_a_folder_is_a_usage_error(tmp_path):
+    res = _audit([str(tmp_path / "missing"), "--out", str(tmp_path / "o")])
+    assert res.exit_code == 2 and isinstance(res.exception, SystemExit)
+    assert f"krl audit: error: {tmp_path / 'missing'}: not a folder" in res.output
+    assert "Traceback" not in res.output and not (tmp_path / "o").exists()
+
+
+def test_more_units_than_the_limit_is_a_usage_error(tmp_path, monkeypatch):
+    import audit.fleet as F  # noqa: PLC0415
+
+    # two KRC backups (each a folder with R1/System/$config.dat): two units
+    for name in ("a", "b"):
+        (tmp_path / name / "R1" / "System").mkdir(parents=True)
+        (tmp_path / name / "R1" / "System" / "$config.dat").write_text("DEFDAT $CONFIG\nENDDAT\n")
+    monkeypatch.setattr(F, "MAX_AUDIT_BACKUPS", 1)
+    res = _audit([str(tmp_path), "--out", str(tmp_path / "o")])
+    assert res.exit_code == 2 and "Traceback" not in res.output
+    assert "more than 1 backups and program folders below" in res.output and "MAX_AUDIT_BACKUPS" in res.output
+    assert not (tmp_path / "o").exists()
