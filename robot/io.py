@@ -143,11 +143,6 @@ class IOImage:
         else:  # pragma: no cover - parse_signal guards this
             raise IOError_(f"unknown signal {name}")
 
-    def get_signal(self, name: str) -> object:
-        base, n = parse_signal(name)
-        return {"$IN": self.get_in, "$OUT": self.get_out, "$ANIN": self.get_anin,
-                "$ANOUT": self.get_anout}[base](n)
-
     # -- timers ----------------------------------------------------------------------------
     def tick_timers(self, dt_ms: int) -> None:
         """Advance every running ``$TIMER`` by ``dt_ms`` (called once per IPO cycle)."""
