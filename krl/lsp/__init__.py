@@ -4,7 +4,7 @@ The server puts the front end in the editor: the parser (krl/syntax), the AST (k
 workspace and its symbol tables (krl/workspace.py, krl/semantics). One module per job:
 
 * :mod:`krl.lsp.text`      -- lines, positions (LSP code units vs characters), tokens of a line;
-* :mod:`krl.lsp.parsing`   -- parsing with a per-routine cache (a change re-parses one routine);
+* :mod:`krl.lsp.parsing`   -- buffers parsed through krl/syntax/pieces.py (a change re-parses one routine);
 * :mod:`krl.lsp.roots`     -- which files form the workspace of an opened file (the backup root);
 * :mod:`krl.lsp.project`   -- open buffers over disk files, one checked :class:`Analysis` per root;
 * :mod:`krl.lsp.analysis`  -- a checked workspace and the look-ups the features share;
