@@ -7,15 +7,15 @@ there; vm.py runs the compiled module only when its VM_SOURCE matches vm.py."""
 # ruff: noqa
 
 import math
-from interp.runtime.builtins import (ValueRef)
 from interp.runtime.errors import (KrlRuntimeError)
 from interp.runtime.memory import (Slot)
+from interp.runtime.natives import (ValueRef)
 from interp.runtime.slots import (add, array_index, component, element, element1, element2, ended_without_return, eq, for_done, for_limits, for_next, function_result, ge, gt, le, load, lt, mul, ne, read_value, return_without_value, set_component, set_element, set_element1, store, sub)
 from interp.runtime.values import (Struct, UNSET)
 from krl.semantics.types import (BOOL as T_BOOL, INT as T_INT, REAL as T_REAL)
 
 # sha256 of the vm.py this file was generated from
-VM_SOURCE = 'bfe0773c19765451577fe7219502e9ccac99910947f9a61986f3f4e81075f163'
+VM_SOURCE = '13b1ce744911bc30da51d9ff09f905ca70cb2e73d0a245391be0efd9a16b74db'
 
 # opcode number (interp/vm/opcodes.py) -> this loop's number of the opcode
 DISPATCH = [8, 0, 114, 68, 62, 61, 51, 72, 108, 67, 76, 109, 110, 75, 112, 7, 50, 5, 58, 91, 49, 66, 34, 70, 65, 63, 38, 78, 23, 2, 89, 53, 90, 87, 86, 84, 83, 79, 14, 6, 3, 13, 85, 10, 4, 116, 28, 111, 55, 24, 26, 25, 22, 21, 32, 17, 73, 29, 80, 18, 15, 69, 77, 1, 16, 12, 30, 27, 33, 74, 54, 60, 31, 9, 115, 88, 81, 52, 20, 64, 94, 57, 48, 113, 11, 82, 19, 59, 56, 71, 47, 36, 37, 42, 96, 45, 46, 97, 93, 92, 41, 104, 43, 40, 39, 44, 98, 106, 35, 105, 107, 95, 100, 102, 103, 101, 99]
@@ -66,7 +66,7 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
     adata = [None] * len(store)
     agrid = [None] * len(store)
     fvars = frame.vars
-    before, tick, take_error_proceed, quiet_limit, run_routine, exec_routine = self.hooks
+    before, tick, take_error_proceed, quiet_limit, run_routine, exec_routine, call_native = self.hooks
     cold = self.cold
     task = rt.current_task
     left = task.quiet - rt.steps if task is not None else 0
@@ -900,7 +900,7 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                                 if target is not None:
                                     v = run_routine(target, args, frame, exec_routine, 'N' not in flags)
                                 else:
-                                    v = self.call(code, ip, ins[1], args, frame, flags)
+                                    v = call_native(ins[1], args, flags == 'E')
                                 left = task.quiet - rt.steps if task is not None else 0
                                 if flags == 'E':
                                     stack.append(v if v is not None else function_result(ins[1].name, v))

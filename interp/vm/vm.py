@@ -22,7 +22,8 @@ Code: the compiler makes a routine's listing from its annotated AST alone (no ru
 `krl asm` prints exactly what runs; kept per checked workspace by :func:`linked_code`, not on
 the AST), and :class:`Bound` binds it to a run's storage and links every call site from its
 Callee (a routine of the program: the (module, Routine) to invoke) when the routine is first
-called; a built-in or a stub is run through the runtime (:meth:`VM.call`). Dispatch: :meth:`VM.run` is the source of
+called; a built-in or a stub is run through the runtime (``Runtime.call_native``, as the tree
+interpreter does: the implementation the resolver linked, else the stand-in policy). Dispatch: :meth:`VM.run` is the source of
 every opcode's handler, a chain in frequency order; interp/vm/loop.py, generated from it by
 interp/vm/gen_loop.py and checked in, is the same loop with a Huffman-shaped binary search
 for the dispatch, and is what runs by default (``VM(rt, loop="source")`` runs the source).
@@ -41,7 +42,7 @@ import sys
 import weakref
 from pathlib import Path
 
-from interp.runtime.builtins import ValueRef
+from interp.runtime.natives import ValueRef
 from interp.runtime.convert import INT_MAX, INT_MIN, num
 from interp.runtime.errors import ExitSignal, KrlRuntimeError
 from interp.runtime.memory import Slot
@@ -209,7 +210,7 @@ class VM:
         self.body = functools.partial(self.loop, self, None)
         # the runtime's statement hooks, bound once (the loop takes them at each call)
         self.hooks = (rt.before_statement, rt.loop_tick, rt.take_error_proceed, rt.quiet_limit, rt.run_routine,
-                      self.body)
+                      self.body, rt.call_native)
 
     # ------------------------------------------------------------------ entry points
     def run_program(self, module_name: str | None = None) -> None:
@@ -231,15 +232,6 @@ class VM:
         """Run routine ``target`` = (module, Routine) with reference ``args`` (the
         runtime's call protocol, Runtime.run_routine)."""
         return self.rt.run_routine(target, args, caller, self.body, catch_resume)
-
-    def call(self, code, ip: int, callee, args: list, frame, flags: str):
-        """A CALL whose Callee is not a routine of the program (Bound links those): a
-        built-in the simulator implements, else the stub policy."""
-        rt = self.rt
-        native = rt.native(callee)
-        if native is None:
-            return rt.stub_call(callee.name, flags == "E")
-        return native(rt, args)
 
     def thunk(self, code, frame, temps: list, ip: int, stack: list | None = None):
         """A callable that runs the thunk at ``ip`` of ``code`` in the activation (``frame``,
@@ -490,7 +482,7 @@ class VM:
         fvars = frame.vars
         push = stack.append
         pop = stack.pop
-        before, tick, take_error_proceed, quiet_limit, run_routine, exec_routine = self.hooks
+        before, tick, take_error_proceed, quiet_limit, run_routine, exec_routine, call_native = self.hooks
         cold = self.cold
         task = rt.current_task
         # Quiet steps (Runtime.quiet_limit) are counted here, in two locals: ``left``, how many
@@ -1022,8 +1014,8 @@ class VM:
                             unsaved = 0
                             if target is not None:       # VM.invoke, without its Python frame
                                 v = run_routine(target, args, frame, exec_routine, "N" not in flags)
-                            else:
-                                v = self.call(code, ip, ins[1], args, frame, flags)
+                            else:                        # a built-in (linked: Callee.native) or the stand-in policy
+                                v = call_native(ins[1], args, flags == "E")
                             left = task.quiet - rt.steps if task is not None else 0
                             if flags == "E":
                                 push(v if v is not None else function_result(ins[1].name, v))
