@@ -164,3 +164,4 @@ $(PROGRAMMAP_WEB)/node_modules/.installed: $(PROGRAMMAP_WEB)/package-lock.json |
 
 programmap-js: $(PROGRAMMAP_WEB)/node_modules/.installed
 	cd $(PROGRAMMAP_WEB) && npm run build
+	$(PYTHON) tests/programmap/test_bundle.py --write

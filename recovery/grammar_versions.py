@@ -128,7 +128,3 @@ def grammar_metrics(text: str) -> dict[str, int]:
                 alts += 1
         alternatives += alts
     return {"parser_rules": parser_rules, "lexer_rules": lexer_rules, "alternatives": alternatives}
-
-
-def short_hash(text: str) -> str:
-    return hashlib.sha256(text.encode()).hexdigest()[:12]

@@ -40,10 +40,6 @@ def load_known_invalid(path: Path = KNOWN_INVALID) -> dict[str, str]:
         return {row["path"]: row["reason"] for row in csv.DictReader(fh) if row.get("path")}
 
 
-def known_invalid_figures(results: list[FileResult]) -> dict | None:
-    return _known_invalid_figures({r.path: r.ok for r in results if r.path in load_known_invalid()})
-
-
 def _known_invalid_figures(present: dict[str, bool]) -> dict | None:
     """Figures of the known-invalid files present: `present` maps their paths to whether they parse."""
     if not present:

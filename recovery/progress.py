@@ -8,7 +8,7 @@ afterwards is the same with or without it.
 from __future__ import annotations
 
 import sys
-from collections.abc import Iterable, Iterator
+from collections.abc import Iterator
 from typing import TypeVar
 
 T = TypeVar("T")
@@ -42,8 +42,3 @@ def steps(items: list[T], what: str, label=str) -> Iterator[T]:
             bar.update(task, description=escape(f"{what}: {label(item)}"))
             yield item
             bar.advance(task)
-
-
-def iterate(items: Iterable[T], what: str, label=str) -> Iterator[T]:
-    """:func:`steps` over any iterable (materialised first to know the total)."""
-    return steps(list(items), what, label)

@@ -82,10 +82,6 @@ class FileResult:
     issues: list[IssueRecord] = field(default_factory=list)
     detail: str = ""          # why a file was not parsed ("a FIFO (never opened)", "killed after 30 s")
 
-    @property
-    def first_error(self) -> IssueRecord | None:
-        return self.issues[0] if self.issues else None
-
     def to_json(self) -> dict:
         return asdict(self)
 

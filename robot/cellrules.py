@@ -126,6 +126,19 @@ def _signal_index(e: N.Index) -> tuple[str, int]:
     return base, n
 
 
+def signal_of(text: str) -> tuple[str, int]:
+    """``("$IN", 3)`` for the text ``$IN[3]`` (any case and spacing): the text is read by the
+    front end (krl/semantics/expression.py) as a KRL expression that must be one of
+    $IN/$OUT/$ANIN/$ANOUT indexed by one constant in range. Raises :class:`ConditionError`."""
+    try:
+        expr = X.parse(text, max_tokens=MAX_RULE_TOKENS, path="<signal>")
+    except X.ExpressionError as exc:
+        raise ConditionError(exc.message, exc.column) from None
+    if not isinstance(expr, N.Index):
+        raise ConditionError("not an indexed signal ($IN[n], $OUT[n], $ANIN[n], $ANOUT[n])", _col(expr))
+    return _signal_index(expr)
+
+
 def names_of(expr: N.Expr) -> list[str]:
     """The signals a condition reads, in order: ``$IN[n]``-style and SIGNAL names (upper case)."""
     out: list[str] = []

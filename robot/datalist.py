@@ -6,8 +6,8 @@ krl/parsecache.py, when a file of the same content was parsed before); every dec
 every array element line (``$SOFTP_END[3]=168.0``) is evaluated from the AST. Only literal
 values are allowed there, as in any data list: numbers, booleans, strings, enumeration
 values (``#STANDARD``), a sign before a number, and aggregates (``{X 0.0, Y 0.0}``), evaluated
-by the front end's evaluator (krl/semantics/expression.py). No text is evaluated and nothing is
-parsed twice.
+by the front end's evaluator (krl/semantics/expression.py). No text is evaluated, and a file is
+parsed once: its syntax errors are the ones that parse gave.
 
 :func:`read_data_list` returns ``name -> DataValue`` (upper-case names). A value is a Python
 scalar, a dict (an aggregate, component names upper-case) or, for an array, a dict
@@ -21,12 +21,10 @@ from pathlib import Path
 from typing import Any
 
 from krl.ast import nodes as N
-from krl.ast.build import build_module
 from krl.limits import MAX_FILE_BYTES
 from krl.parsecache import load_file
 from krl.semantics import expression as X
 from krl.semantics.values import KrlRuntimeError
-from krl.syntax.parse import parse_file
 
 
 class DataListError(ValueError):
@@ -100,19 +98,15 @@ def read_data_list(path: str | Path, shown: str | None = None) -> dict[str, Data
             raise DataListError(f"{name}: larger than {MAX_FILE_BYTES} bytes")
     except OSError as exc:
         raise DataListError(f"{name}: cannot be read ({exc.strerror})") from None
-    cached = load_file(p)        # the parse of this content from the one store (krl/store.py)
-    if cached.ok and cached.module.data is not None:
-        return _values(cached.module, name)
-    result = parse_file(p)
-    if not result.ok:
-        if result.errors:
-            err = result.errors[0]
-            raise DataListError(f"{name}:{err.line}:{err.column + 1}: {err.message}")
-        raise DataListError(f"{name}: not read ({result.status})")
-    module = build_module(result)
-    if module.data is None:
+    loaded = load_file(p)        # the parse of this content from the one store (krl/store.py)
+    if not loaded.ok:
+        err = next((d for d in loaded.diagnostics if d.severity == "error"), None)
+        if err is not None:
+            raise DataListError(f"{name}:{err.line}:{err.column}: {err.message}")
+        raise DataListError(f"{name}: not read ({loaded.status})")
+    if loaded.module.data is None:
         raise DataListError(f"{name}:1:1: not a data list (no DEFDAT)")
-    return _values(module, name)
+    return _values(loaded.module, name)
 
 
 def _values(module: N.Module, name: str) -> dict[str, DataValue]:

@@ -143,11 +143,6 @@ class IOImage:
         else:  # pragma: no cover - parse_signal guards this
             raise IOError_(f"unknown signal {name}")
 
-    def get_signal(self, name: str) -> object:
-        base, n = parse_signal(name)
-        return {"$IN": self.get_in, "$OUT": self.get_out, "$ANIN": self.get_anin,
-                "$ANOUT": self.get_anout}[base](n)
-
     # -- timers ----------------------------------------------------------------------------
     def tick_timers(self, dt_ms: int) -> None:
         """Advance every running ``$TIMER`` by ``dt_ms`` (called once per IPO cycle)."""
@@ -181,8 +176,11 @@ class IOImage:
 
 
 def parse_signal(name: str) -> tuple[str, int]:
-    """``"$IN[3]"`` -> ``("$IN", 3)``; accepts $IN, $OUT, $ANIN, $ANOUT (case-insensitive).
-    Raises IOError_ for anything else."""
+    """``"$IN[3]"`` -> ``("$IN", 3)``: decodes the signal keys the project writes itself (the
+    ``set`` of a stimulus or rule after robot/stimuli.py read the user's text through the front
+    end with :func:`robot.cellrules.signal_of`, robot/cellpresets.py's answers); never given a
+    user's text, which only krl/semantics/expression.py parses. Accepts $IN, $OUT, $ANIN,
+    $ANOUT (case-insensitive); raises IOError_ for anything else."""
     s = name.strip().upper().replace(" ", "")
     if "[" not in s or not s.endswith("]"):
         raise IOError_(f"not a signal: {name!r}")

@@ -356,10 +356,6 @@ class ArmModel:
             q = np.concatenate([q, self.data.qpos[self._eadr] / self._escale])
         return q
 
-    def axes_vel_deg_s(self) -> np.ndarray:
-        """Current axis speeds (deg/s; a linear axis in mm/s) from ``qvel``; shape (n,)."""
-        return self._kuka(self._sign * self.data.qvel[self._dadr])
-
     def flange_pose_world(self) -> np.ndarray:
         """KUKA flange frame (site ``tool0``) in ``$WORLD`` (MuJoCo world), 4x4, mm."""
         xmat, xpos = self._site_views

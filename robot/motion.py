@@ -259,7 +259,3 @@ class MotionRequest:
         """True for an AXIS/E6AXIS target (any of A1..A6 given)."""
         return any(k in self.target for k in AXIS_KEYS)
 
-    @property
-    def is_cartesian(self) -> bool:
-        """True for a Cartesian-path motion (LIN, CIRC, SLIN, SCIRC, SPLINE)."""
-        return self.kind not in ("PTP", "SPTP")

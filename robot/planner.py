@@ -136,12 +136,6 @@ class RobotModel:
             raise RobotError(f"$BASE linked to {system}: no such external kinematic in $EX_KIN")
         return _LinkedBase(self, system)
 
-    def robroot_at(self, q: np.ndarray) -> np.ndarray | None:
-        """``$ROBROOT_C`` for the axis vector `q` (the track's E values), None for the null frame."""
-        if self._ersys:
-            return self.ext.robroot(q[self.n:])           # type: ignore[union-attr]
-        return None if self._robroot_is_null else self.robroot_T
-
     def check_limits(self, q: np.ndarray) -> None:
         """``$SOFTN_END``/``$SOFTP_END`` of A1..An and E1..En (SoftLimitError, reference §8.2)."""
         self.kin.check_soft_limits(q)

@@ -64,8 +64,7 @@ import yaml
 
 from krl.limits import MAX_CELL_RULES, MAX_CELL_SIM_TIME_S, MAX_START_CHARS, MAX_STIMULI, MAX_STIMULI_BYTES
 
-from .cellrules import ConditionError, Rule, compile_condition, parse_condition
-from .io import IOError_, parse_signal
+from .cellrules import ConditionError, Rule, compile_condition, parse_condition, signal_of
 
 PHASES = ("start", "blend_start", "blend_end", "end")
 TOP_KEYS = ("stimuli", "rules", "presets", "robot", "sim_time", "start", "network")
@@ -184,9 +183,9 @@ def _signal_name(name: Any, where: str) -> str:
     s = name.strip().upper().replace(" ", "")
     if "[" in s:
         try:
-            base, n = parse_signal(s)
-        except IOError_:
-            raise StimulusError(f"{where}: not a signal: {name!r}") from None
+            base, n = signal_of(name)
+        except ConditionError as exc:
+            raise StimulusError(f"{where}: not a signal: {name!r} ({exc})") from None
         if base not in ("$IN", "$ANIN"):
             raise StimulusError(f"{where}: only $IN/$ANIN can be stimulated, not {name}")
         return f"{base}[{n}]"

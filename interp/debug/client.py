@@ -125,9 +125,6 @@ class DapClient:
     def stack(self, thread: int = 1) -> list[dict]:
         return self.request("stackTrace", {"threadId": thread})["body"]["stackFrames"]
 
-    def top_line(self, thread: int = 1) -> int:
-        return self.stack(thread)[0]["line"]
-
     def scope_vars(self, frame_id: int, scope: str) -> dict[str, str]:
         """name -> value text of a scope (Locals, Module data, Globals ($config.dat), System
         variables, I/O) of a frame."""

@@ -11,7 +11,11 @@ Meaning comes from the front end's typed facts (krl/semantics/resolve.py), never
 name's spelling: each Name carries its place (a frame slot, a data-list slot, a system
 variable), each Call its Callee (a routine, a built-in, a stub), a GOTO its target Label, an
 assignment whether it sets a cyclic flag, an analog statement its channel, an interrupt
-declaration its BRAKE, each statement its StmtInfo (advance-run stops). Dispatch is the one
+declaration its BRAKE, each statement its StmtInfo (advance-run stops). One exception, by a
+component's spelling: a STRUC component (``x.Y``) and an aggregate's item (``{Y 1}``) are found
+by their upper-cased name in the :class:`~interp.runtime.values.Struct` value
+(interp/runtime/core.py ``field``, ``aggregate``), which the resolver checked exists but does
+not number (the VM does the same: issue 47 makes them resolver facts). Dispatch is the one
 node-dispatch helper (krl/ast/visit.py): one method per statement (``s_Kind``) and expression
 kind (``e_Kind``).
 """

@@ -2,20 +2,45 @@
 ``callHierarchy/outgoingCalls``) read from the program map (krl/programmap), the graph
 ``krl graph`` draws: calls, interrupt handlers, TRIGGER calls and CWRITE RUN commands, all
 resolved by the checker. An item is a routine: its range the DEF..END lines, its selection
-range the name on the DEF line, its ``data`` the map's node id (``MODULE:NAME``).
+range the name on the DEF line, its ``data`` the map's node id (``MODULE:NAME``). The results are
+plain (:class:`CallItem`, :class:`CallPlace`, 1-based); the server's shell (krl/lsp/convert.py)
+makes the protocol's items.
 """
 
 from __future__ import annotations
 
-from lsprotocol import types as L
+from dataclasses import dataclass
 
 from krl.ast import nodes as N
 from krl.lsp.analysis import Analysis
 from krl.lsp.navigate import resolve
-from krl.lsp.text import find_name, to_position, to_range
+from krl.lsp.text import find_name
 from krl.programmap import ProgramMap, build_map
 
-__all__ = ["program_map", "prepare", "incoming", "outgoing"]
+__all__ = ["CallItem", "CallPlace", "program_map", "prepare", "incoming", "outgoing"]
+
+
+@dataclass(frozen=True)
+class CallPlace:
+    """`length` characters at 1-based (line, column) of `path`."""
+    path: str
+    line: int
+    column: int
+    length: int
+
+
+@dataclass(frozen=True)
+class CallItem:
+    """A routine of the call hierarchy: lines `line` .. `end_line` (through `end_column`, the
+    end of its END line), its name at `name_column` of its DEF line, its map node id."""
+    name: str
+    path: str
+    line: int
+    end_line: int
+    end_column: int
+    name_column: int
+    detail: str
+    node_id: str
 
 
 def program_map(an: Analysis) -> ProgramMap:
@@ -37,7 +62,7 @@ def _routine_of(an: Analysis, pm: ProgramMap, path: str, line: int, column: int)
     return None
 
 
-def item(an: Analysis, pm: ProgramMap, node_id: str, uri_of, codec=None) -> L.CallHierarchyItem | None:
+def item(an: Analysis, pm: ProgramMap, node_id: str) -> CallItem | None:
     """The call hierarchy item of a routine node, or None (a channel, or a file not loaded)."""
     n = pm.nodes.get(node_id)
     if n is None or n.kind != "routine" or n.path not in an.files:
@@ -53,22 +78,20 @@ def item(an: Analysis, pm: ProgramMap, node_id: str, uri_of, codec=None) -> L.Ca
     else:
         col = 1
     end_text = lines[end_line - 1] if 0 < end_line <= len(lines) else ""
-    full = L.Range(start=to_position(lines, n.line, 1, codec), end=to_position(lines, end_line, len(end_text) + 1, codec))
-    return L.CallHierarchyItem(name=n.name, kind=L.SymbolKind.Function, uri=uri_of(n.path), range=full,
-                               selection_range=to_range(lines, n.line, col, len(n.name), codec),
-                               detail=f"{n.module}" + (" (never reached)" if n.unreachable else ""), data=n.id)
+    return CallItem(n.name, n.path, n.line, end_line, len(end_text) + 1, col,
+                    f"{n.module}" + (" (never reached)" if n.unreachable else ""), n.id)
 
 
-def prepare(an: Analysis, path: str, line: int, column: int, uri_of, codec=None) -> list[L.CallHierarchyItem]:
+def prepare(an: Analysis, path: str, line: int, column: int) -> list[CallItem]:
     """The routine at 1-based (line, column): a call of it or its DEF line; [] elsewhere."""
     pm = program_map(an)
     r = _routine_of(an, pm, path, line, column)
     n = pm.node_of(r) if r is not None else None
-    it = item(an, pm, n.id, uri_of, codec) if n is not None else None
+    it = item(an, pm, n.id) if n is not None else None
     return [it] if it is not None else []
 
 
-def _ranges(an: Analysis, edges, codec) -> list[L.Range]:
+def _ranges(an: Analysis, edges) -> list[CallPlace]:
     out = []
     for e in edges:
         lines = an.files[e.path].lines if e.path in an.files else []
@@ -78,11 +101,11 @@ def _ranges(an: Analysis, edges, codec) -> list[L.Range]:
             text = lines[e.line - 1][e.column - 1:]
             while length < len(text) and (text[length].isalnum() or text[length] in "_$"):
                 length += 1
-        out.append(to_range(lines, e.line, e.column or 1, length or name_len, codec))
+        out.append(CallPlace(e.path, e.line, e.column or 1, length or name_len))
     return out
 
 
-def _grouped(an: Analysis, edges, other: str, uri_of, codec) -> list[tuple[L.CallHierarchyItem, list[L.Range]]]:
+def _grouped(an: Analysis, edges, other: str) -> list[tuple[CallItem, list[CallPlace]]]:
     """(item of the routine at the `other` end, ranges of the calls) per routine, in edge order."""
     pm = program_map(an)
     by_node: dict[str, list] = {}
@@ -90,19 +113,19 @@ def _grouped(an: Analysis, edges, other: str, uri_of, codec) -> list[tuple[L.Cal
         by_node.setdefault(getattr(e, other), []).append(e)
     out = []
     for nid, group in by_node.items():
-        it = item(an, pm, nid, uri_of, codec)
+        it = item(an, pm, nid)
         if it is not None:
-            out.append((it, _ranges(an, group, codec)))
+            out.append((it, _ranges(an, group)))
     return out
 
 
-def incoming(an: Analysis, node_id: str, uri_of, codec=None) -> list[L.CallHierarchyIncomingCall]:
-    """The routines that call, declare an interrupt handled by, trigger or RUN `node_id`."""
-    return [L.CallHierarchyIncomingCall(from_=it, from_ranges=ranges)
-            for it, ranges in _grouped(an, program_map(an).incoming(node_id), "source", uri_of, codec)]
+def incoming(an: Analysis, node_id: str) -> list[tuple[CallItem, list[CallPlace]]]:
+    """The routines that call, declare an interrupt handled by, trigger or RUN `node_id`, each
+    with the places of those calls (in the caller)."""
+    return _grouped(an, program_map(an).incoming(node_id), "source")
 
 
-def outgoing(an: Analysis, node_id: str, uri_of, codec=None) -> list[L.CallHierarchyOutgoingCall]:
-    """The routines `node_id` calls (and its interrupt handlers, TRIGGER and RUN targets)."""
-    return [L.CallHierarchyOutgoingCall(to=it, from_ranges=ranges)
-            for it, ranges in _grouped(an, program_map(an).outgoing(node_id), "target", uri_of, codec)]
+def outgoing(an: Analysis, node_id: str) -> list[tuple[CallItem, list[CallPlace]]]:
+    """The routines `node_id` calls (and its interrupt handlers, TRIGGER and RUN targets), each
+    with the places of those calls (in `node_id`)."""
+    return _grouped(an, program_map(an).outgoing(node_id), "target")

@@ -5,9 +5,8 @@ scope at the cursor (locals, the module's data list, globals, built-in routines 
 from __future__ import annotations
 
 import re
+from dataclasses import dataclass
 from functools import lru_cache
-
-from lsprotocol import types as L
 
 from krl.limits import MAX_LSP_COMPLETIONS
 from krl.lsp.analysis import Analysis
@@ -17,7 +16,28 @@ from krl.semantics import types as T
 from krl.semantics.symbols import Scope
 
 _WORD_BEFORE = re.compile(r"[\w$]*$")
-CK = L.CompletionItemKind
+
+
+class CK:
+    """Kinds of completion items: names of LSP's ``CompletionItemKind`` (the server's shell,
+    krl/lsp/convert.py, makes the protocol's item)."""
+    Constant = "Constant"
+    Variable = "Variable"
+    Function = "Function"
+    Struct = "Struct"
+    Enum = "Enum"
+    TypeParameter = "TypeParameter"
+    EnumMember = "EnumMember"
+    Field = "Field"
+    Keyword = "Keyword"
+
+
+@dataclass(frozen=True)
+class Completion:
+    """One completion item: the text offered, its kind (a :class:`CK` name), a detail."""
+    label: str
+    kind: str
+    detail: str | None = None
 
 
 @lru_cache(maxsize=1)
@@ -32,8 +52,8 @@ def keywords() -> tuple[str, ...]:
     return tuple(sorted(set(out)))
 
 
-def _scope_names(scope: Scope, dollar: bool) -> list[L.CompletionItem]:
-    out: list[L.CompletionItem] = []
+def _scope_names(scope: Scope, dollar: bool) -> list[Completion]:
+    out: list[Completion] = []
     seen: set[str] = set()
     s: Scope | None = scope
     while s is not None:
@@ -42,25 +62,25 @@ def _scope_names(scope: Scope, dollar: bool) -> list[L.CompletionItem]:
                 continue
             seen.add(key)
             kind = CK.Constant if sym.kind == "const" else CK.Variable
-            out.append(L.CompletionItem(label=sym.name, kind=kind, detail=str(sym.type)))
+            out.append(Completion(label=sym.name, kind=kind, detail=str(sym.type)))
         if not dollar:
             for key, sym in s.routines.items():
                 if key not in seen:
                     seen.add(key)
-                    out.append(L.CompletionItem(label=sym.name, kind=CK.Function,
+                    out.append(Completion(label=sym.name, kind=CK.Function,
                                                 detail="function" if sym.signature and sym.signature.is_function else "procedure"))
             for key, typ in s.types.items():
                 if key not in seen:
                     seen.add(key)
-                    out.append(L.CompletionItem(label=getattr(typ, "name", key), kind=CK.Struct if isinstance(typ, T.Struc)
+                    out.append(Completion(label=getattr(typ, "name", key), kind=CK.Struct if isinstance(typ, T.Struc)
                                                 else CK.Enum if isinstance(typ, T.Enum) else CK.TypeParameter))
         s = s.parent
     return out
 
 
-def _enum_values(scope: Scope, word: str) -> list[L.CompletionItem]:
+def _enum_values(scope: Scope, word: str) -> list[Completion]:
     """ENUM values after ``#``: the values of every ENUM type in scope, inner scopes first."""
-    out: list[L.CompletionItem] = []
+    out: list[Completion] = []
     seen: set[str] = set()
     s: Scope | None = scope
     up = word.upper()
@@ -70,12 +90,12 @@ def _enum_values(scope: Scope, word: str) -> list[L.CompletionItem]:
                 for v in sorted(typ.values):
                     if v.startswith(up) and v not in seen:
                         seen.add(v)
-                        out.append(L.CompletionItem(label=v, kind=CK.EnumMember, detail=typ.name))
+                        out.append(Completion(label=v, kind=CK.EnumMember, detail=typ.name))
         s = s.parent
     return out[:MAX_LSP_COMPLETIONS]
 
 
-def complete(an: Analysis, path: str, line: int, column: int) -> list[L.CompletionItem]:
+def complete(an: Analysis, path: str, line: int, column: int) -> list[Completion]:
     """Completion items at 1-based (line, column) of `path` (the cursor is before `column`)."""
     fi = an.files.get(path)
     if fi is None or not 0 < line <= len(fi.lines):
@@ -94,7 +114,7 @@ def complete(an: Analysis, path: str, line: int, column: int) -> list[L.Completi
             except RecursionError:
                 base = None
             if isinstance(base, T.Struc):
-                return [L.CompletionItem(label=name, kind=CK.Field, detail=str(ct))
+                return [Completion(label=name, kind=CK.Field, detail=str(ct))
                         for name, ct in base.fields.values() if name.upper().startswith(word.upper())]
         return []
     if ";" in prefix:
@@ -106,7 +126,7 @@ def complete(an: Analysis, path: str, line: int, column: int) -> list[L.Completi
         return _enum_values(scope, word)
     items = _scope_names(scope, word.startswith("$"))
     if not word.startswith("$"):
-        items += [L.CompletionItem(label=k, kind=CK.Keyword) for k in keywords()]
+        items += [Completion(label=k, kind=CK.Keyword) for k in keywords()]
     up = word.upper()
     items = [i for i in items if i.label.upper().startswith(up)]
     return items[:MAX_LSP_COMPLETIONS]

@@ -8,7 +8,7 @@ range ends on its ``;ENDFOLD`` line (the section folds away as on the KUKA penda
 
 from __future__ import annotations
 
-from lsprotocol import types as L
+from dataclasses import dataclass
 
 from krl.syntax.blocks import Line, scan
 from krl.syntax.folds import scan_fold_lines
@@ -28,12 +28,21 @@ def block_pairs(lines: list[str]) -> list[tuple[int, int]]:
     return sorted((opener, closer) for closer, opener in res.matched.items())
 
 
-def folding_ranges(lines: list[str]) -> list[L.FoldingRange]:
+@dataclass(frozen=True)
+class FoldRange:
+    """Lines `first` .. `last` (1-based) fold; `region`: a FOLD section (else a block)."""
+    first: int
+    last: int
+    region: bool = False
+
+
+def folding_ranges(lines: list[str]) -> list[FoldRange]:
+    """The FOLD sections (to their ENDFOLD line), then the blocks (to the line before their closer)."""
     out = []
     for start, end, _title in fold_sections(lines):
         if end > start:
-            out.append(L.FoldingRange(start_line=start - 1, end_line=end - 1, kind=L.FoldingRangeKind.Region))
+            out.append(FoldRange(start, end, True))
     for opener, closer in block_pairs(lines):
         if closer - 1 > opener:
-            out.append(L.FoldingRange(start_line=opener - 1, end_line=closer - 2))
+            out.append(FoldRange(opener, closer - 1))
     return out

@@ -5,21 +5,31 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from lsprotocol import types as L
-
 from krl.ast import nodes as N
 from krl.limits import MAX_LSP_SYMBOLS
 from krl.lsp.analysis import Analysis
 from krl.lsp.folding import fold_sections
-from krl.lsp.text import find_name, to_position, to_range
+from krl.lsp.text import find_name
 
-SK = L.SymbolKind
+
+class SK:
+    """Kinds of symbols: names of LSP's ``SymbolKind`` (the server's shell, krl/lsp/convert.py,
+    makes the protocol's symbols)."""
+    Function = "Function"
+    Module = "Module"
+    Namespace = "Namespace"
+    Constant = "Constant"
+    Variable = "Variable"
+    Struct = "Struct"
+    Enum = "Enum"
 
 
 @dataclass
 class Item:
+    """A symbol: its lines (1-based, first and last), its name's place on its line, the
+    symbols inside it."""
     name: str
-    kind: L.SymbolKind
+    kind: str                  # an :class:`SK` name
     start: int                 # 1-based first line
     end: int                   # 1-based last line
     sel_line: int
@@ -83,24 +93,25 @@ def _items(an: Analysis, path: str) -> list[Item]:
     return items
 
 
-def _to_lsp(it: Item, lines: list[str], codec) -> L.DocumentSymbol:
-    end_text = lines[it.end - 1] if 0 < it.end <= len(lines) else ""
-    rng = L.Range(start=to_position(lines, it.start, 1, codec), end=to_position(lines, it.end, len(end_text) + 1, codec))
-    sel = to_range(lines, it.sel_line, it.sel_col, it.sel_len, codec)
-    return L.DocumentSymbol(name=it.name or "?", kind=it.kind, range=rng, selection_range=sel,
-                            detail=it.detail or None, children=[_to_lsp(c, lines, codec) for c in it.children])
+def document_symbols(an: Analysis, path: str) -> list[Item]:
+    """The symbols of `path`, nested (each inside the smallest one whose lines hold it)."""
+    return _nest(_items(an, path))
 
 
-def document_symbols(an: Analysis, path: str, codec=None) -> list[L.DocumentSymbol]:
-    lines = an.files[path].lines
-    return [_to_lsp(i, lines, codec) for i in _nest(_items(an, path))]
+@dataclass(frozen=True)
+class FoundSymbol:
+    """A workspace symbol: the item, its file (and that file's lines), the module that holds it."""
+    item: Item
+    path: str
+    container: str
+    lines: list[str] = field(compare=False, repr=False, default_factory=list)
 
 
-def workspace_symbols(analyses: list[Analysis], query: str, uri_of, codec=None) -> list[L.WorkspaceSymbol]:
+def workspace_symbols(analyses: list[Analysis], query: str) -> list[FoundSymbol]:
     """Routines, data-list declarations and FOLD-free top-level names whose name contains
     `query` (any case); at most MAX_LSP_SYMBOLS."""
     q = query.upper()
-    out: list[L.WorkspaceSymbol] = []
+    out: list[FoundSymbol] = []
     seen: set = set()
     for an in analyses:
         for path, fi in an.files.items():
@@ -111,9 +122,7 @@ def workspace_symbols(analyses: list[Analysis], query: str, uri_of, codec=None) 
                 if key in seen:
                     continue
                 seen.add(key)
-                loc = L.Location(uri=uri_of(path), range=to_range(fi.lines, it.sel_line, it.sel_col, it.sel_len, codec))
-                out.append(L.WorkspaceSymbol(name=it.name, kind=it.kind, location=loc,
-                                             container_name=fi.source.module.name))
+                out.append(FoundSymbol(it, path, fi.source.module.name, fi.lines))
                 if len(out) >= MAX_LSP_SYMBOLS:
                     return out
     return out

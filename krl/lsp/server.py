@@ -49,11 +49,12 @@ from krl.lsp import unused as _unused
 from krl.lsp.occurrences import DECL, WRITE, file_occurrences
 from krl.lsp.analysis import Analysis
 from krl.lsp.bench import generate
-from krl.lsp.convert import lsp_diagnostic
+from krl.lsp import convert as _convert
+from krl.lsp.convert import from_position, lsp_diagnostic, to_range
 from krl.lsp.parsing import Parsed
 from krl.lsp.paths import norm
 from krl.lsp.project import PARALLEL_MIN_JOBS, Project
-from krl.lsp.text import from_position, to_range, token_at, units
+from krl.lsp.text import token_at, units
 from pygls.exceptions import JsonRpcException
 from krl.terminal import printable, printable_path
 
@@ -504,7 +505,10 @@ def create_server() -> KrlLanguageServer:
     @guarded(list)
     async def document_symbol(ls: KrlLanguageServer, params: L.DocumentSymbolParams):
         an, path = await holding(ls, params.text_document)
-        return _outline.document_symbols(an, path, ls.codec()) if an is not None else []
+        if an is None:
+            return []
+        lines, codec = an.files[path].lines, ls.codec()
+        return [_convert.document_symbol(it, lines, codec) for it in _outline.document_symbols(an, path)]
 
     @server.feature(L.WORKSPACE_SYMBOL)
     @guarded(list)
@@ -517,13 +521,15 @@ def create_server() -> KrlLanguageServer:
                 first = list_krl_files(folder, limit=1)
                 if first:
                     await ls.fresh(norm(first[0]))
-        return _outline.workspace_symbols(list(ls.project.analyses.values()), params.query or "", uri_of, ls.codec())
+        codec = ls.codec()
+        return [_convert.workspace_symbol(s, uri_of, codec)
+                for s in _outline.workspace_symbols(list(ls.project.analyses.values()), params.query or "")]
 
     @server.feature(L.TEXT_DOCUMENT_FOLDING_RANGE)
     @guarded(list)
     async def folding_range(ls: KrlLanguageServer, params: L.FoldingRangeParams):
         an, path = await holding(ls, params.text_document)
-        return _folding.folding_ranges(an.files[path].lines) if an is not None else []
+        return [_convert.folding_range(f) for f in _folding.folding_ranges(an.files[path].lines)] if an is not None else []
 
     @server.feature(L.TEXT_DOCUMENT_COMPLETION, L.CompletionOptions(trigger_characters=[".", "$", "#"]))
     @guarded()
@@ -531,7 +537,8 @@ def create_server() -> KrlLanguageServer:
         an, path, line, col = await place(ls, params.text_document, params.position)
         if an is None:
             return None
-        return L.CompletionList(is_incomplete=False, items=_complete.complete(an, path, line, col))
+        return L.CompletionList(is_incomplete=False,
+                                items=[_convert.completion(c) for c in _complete.complete(an, path, line, col)])
 
     _register_calls(server, place, uri_of)
     def refusing(step, an, *args):
@@ -669,7 +676,16 @@ def _register_calls(server: KrlLanguageServer, place, uri_of) -> None:
     @guarded(list)
     async def prepare_call_hierarchy(ls: KrlLanguageServer, params: L.CallHierarchyPrepareParams):
         an, path, line, col = await place(ls, params.text_document, params.position)
-        return _calls.prepare(an, path, line, col, uri_of, ls.codec()) if an is not None else []
+        return [item(an, it, ls.codec()) for it in _calls.prepare(an, path, line, col)] if an is not None else []
+
+    def lines_of(an: Analysis, path: str) -> list[str]:
+        return an.files[path].lines if path in an.files else []
+
+    def item(an: Analysis, it, codec) -> L.CallHierarchyItem:
+        return _convert.call_item(it, lines_of(an, it.path), uri_of, codec)
+
+    def ranges(an: Analysis, places, codec) -> list[L.Range]:
+        return [_convert.call_range(p, lines_of(an, p.path), codec) for p in places]
 
     async def item_analysis(ls: KrlLanguageServer, it: L.CallHierarchyItem):
         an = await ls.fresh(path_of(it.uri))
@@ -679,13 +695,21 @@ def _register_calls(server: KrlLanguageServer, place, uri_of) -> None:
     @guarded(list)
     async def incoming_calls(ls: KrlLanguageServer, params: L.CallHierarchyIncomingCallsParams):
         an, nid = await item_analysis(ls, params.item)
-        return _calls.incoming(an, nid, uri_of, ls.codec()) if an is not None else []
+        if an is None:
+            return []
+        codec = ls.codec()
+        return [L.CallHierarchyIncomingCall(from_=item(an, it, codec), from_ranges=ranges(an, places, codec))
+                for it, places in _calls.incoming(an, nid)]
 
     @server.feature(L.CALL_HIERARCHY_OUTGOING_CALLS)
     @guarded(list)
     async def outgoing_calls(ls: KrlLanguageServer, params: L.CallHierarchyOutgoingCallsParams):
         an, nid = await item_analysis(ls, params.item)
-        return _calls.outgoing(an, nid, uri_of, ls.codec()) if an is not None else []
+        if an is None:
+            return []
+        codec = ls.codec()
+        return [L.CallHierarchyOutgoingCall(to=item(an, it, codec), from_ranges=ranges(an, places, codec))
+                for it, places in _calls.outgoing(an, nid)]
 
 
 def serve(log_file: str | None = None) -> None:

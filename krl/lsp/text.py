@@ -1,9 +1,10 @@
-"""Lines, positions and the tokens of one line.
+"""Lines, code units and the tokens of one line.
 
 KRL spans are 1-based lines and 1-based columns counted in characters (krl/ast/nodes.py); LSP
 positions are 0-based lines and 0-based columns in the negotiated code units (UTF-16 unless the
-client chose another). A ``codec`` is pygls' PositionCodec (``client_num_units``); None means
-characters. KRL is line-oriented and its lexer never carries state from one line to the next, so
+client chose another): the shell converts them (krl/lsp/convert.py ``to_position``). A ``codec``
+is pygls' PositionCodec (``client_num_units``); None means characters (:func:`units`). KRL is
+line-oriented and its lexer never carries state from one line to the next, so
 the tokens of one line are the tokens of the ANTLR lexer on that line alone
 (:func:`line_tokens`, krl/syntax/blocks.py ``Tok``: word, text, 1-based line and column).
 """
@@ -12,8 +13,6 @@ from __future__ import annotations
 
 from functools import lru_cache
 
-from lsprotocol import types as L
-
 from krl.syntax.blocks import Tok, lines_of
 
 NAME_WORDS = ("IDENTIFIER", "SYSNAME")
@@ -21,34 +20,6 @@ NAME_WORDS = ("IDENTIFIER", "SYSNAME")
 
 def units(codec, s: str) -> int:
     return codec.client_num_units(s) if codec is not None else len(s)
-
-
-def to_position(lines: list[str], line: int, column: int, codec=None) -> L.Position:
-    """A 1-based KRL (line, character column) as an LSP Position."""
-    li = max(line - 1, 0)
-    text = lines[li] if li < len(lines) else ""
-    col = min(max(column - 1, 0), len(text))
-    return L.Position(line=li, character=units(codec, text[:col]))
-
-
-def from_position(lines: list[str], pos: L.Position, codec=None) -> tuple[int, int]:
-    """An LSP Position as a 1-based KRL (line, character column)."""
-    li = max(pos.line, 0)
-    text = lines[li] if li < len(lines) else ""
-    if codec is None:
-        return li + 1, min(pos.character, len(text)) + 1
-    n = 0
-    for i, ch in enumerate(text):
-        if n >= pos.character:
-            return li + 1, i + 1
-        n += units(codec, ch)
-    return li + 1, len(text) + 1
-
-
-def to_range(lines: list[str], line: int, column: int, length: int, codec=None) -> L.Range:
-    """The LSP range of `length` characters from a 1-based (line, column)."""
-    return L.Range(start=to_position(lines, line, column, codec),
-                   end=to_position(lines, line, column + max(length, 0), codec))
 
 
 @lru_cache(maxsize=8192)

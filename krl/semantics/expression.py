@@ -2,8 +2,9 @@
 
 The front end's one way to read a KRL expression that a user or a file gives on its own: a
 debugger's watch, condition or set-variable value (interp/debug), the pendant's watch list, the
-condition of a cell rule (robot/cellrules.py), a data-list initialiser (robot/datalist.py,
-interp/runtime/program.py). Nothing else in the project parses or evaluates KRL expressions.
+condition of a cell rule and a stimulus's signal (robot/cellrules.py), a data-list initialiser
+(robot/datalist.py, interp/runtime/program.py). Nothing else in the project parses or evaluates
+KRL expressions.
 
 The API (reference §4 for expressions)::
 

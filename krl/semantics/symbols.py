@@ -75,7 +75,7 @@ class Symbol:
 class Scope:
     """One level of the hierarchy; kind is 'system', 'basis', 'global', 'module' or 'routine'."""
 
-    __slots__ = ("kind", "name", "parent", "values", "types", "routines", "incomplete", "type_symbols")
+    __slots__ = ("kind", "name", "parent", "values", "types", "routines", "type_symbols")
 
     def __init__(self, kind: str, name: str = "", parent: "Scope | None" = None):
         self.kind = kind
@@ -84,7 +84,6 @@ class Scope:
         self.values: dict[str, Symbol] = {}
         self.types: dict[str, T.KrlType] = {}
         self.routines: dict[str, Symbol] = {}
-        self.incomplete = False
         self.type_symbols: dict[str, Symbol] = {}   # UPPER name -> where a declared type was entered
 
     def define(self, table: str, sym: Symbol) -> Symbol | None:
@@ -139,14 +138,6 @@ class Scope:
                 return got
             s = s.parent
         return None
-
-    def is_incomplete(self) -> bool:
-        s: Scope | None = self
-        while s is not None:
-            if s.incomplete:
-                return True
-            s = s.parent
-        return False
 
 
 def make_array(elem: T.KrlType, dims) -> T.KrlType:

@@ -27,7 +27,7 @@ a new line after each LF only, so a lone CR ends a comment but not the line's nu
 
 :func:`scan_folds` is the one recogniser of fold markers outside the lexer: ``krl check``'s
 W021 (:func:`fold_diagnostics`) and the language server's folding ranges and document symbols
-(:func:`fold_pairs`, krl/lsp/folding.py and outline.py) read the same scan.
+(``scan_fold_lines(...).pairs``, krl/lsp/folding.py and outline.py) read the same scan.
 """
 
 from __future__ import annotations
@@ -158,14 +158,6 @@ def scan_fold_lines(lines: list[str]) -> FoldScan:
         routines[current] = (name, first, out.last)
     out.unclosed = [(ln, col, end, ctx) for ln, col, end, ctx, _title in stack]
     return out
-
-
-def fold_pairs(text: str) -> list[Fold]:
-    """The matched ``;FOLD`` ... ``;ENDFOLD`` pairs of `text`, nested ones included, ordered by
-    their ENDFOLD (an inner fold before the one around it). Unbalanced markers pair as the KUKA
-    editor nests them: an ENDFOLD closes the innermost open FOLD, a stray ENDFOLD and a FOLD
-    never closed give no pair (W021 reports them)."""
-    return scan_folds(text).pairs
 
 
 def fold_diagnostics(path: str, text: str) -> list[Diagnostic]:

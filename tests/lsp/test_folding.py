@@ -3,8 +3,14 @@ line before its closer, a FOLD section up to its ;ENDFOLD line)."""
 
 from __future__ import annotations
 
-from krl.lsp.folding import folding_ranges
+from krl.lsp import convert
+from krl.lsp import folding
 from krl.diagnostics.render import split_lines
+
+
+def folding_ranges(lines):
+    """The protocol's folding ranges, as the server sends them (krl/lsp/convert.py)."""
+    return [convert.folding_range(f) for f in folding.folding_ranges(lines)]
 
 PROGRAM = """DEF blocks( )
   DECL INT i
@@ -103,7 +109,7 @@ def test_document_symbols_name_folds_by_their_text(tmp_path):
 
     path = str(tmp_path / "odd.src")
     an = build_analysis(path, [ParseCache().parse(path, MARKERS)])
-    (routine,) = document_symbols(an, path)
+    (routine,) = [convert.document_symbol(it, an.files[path].lines) for it in document_symbols(an, path)]
 
     def tree(sym):
         return (sym.name, sym.range.start.line, sym.range.end.line, [tree(c) for c in sym.children or []])

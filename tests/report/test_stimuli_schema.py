@@ -88,3 +88,14 @@ def test_signal_names_resolve_to_inputs():
         resolve_signals(parse_stimuli([{"at": 0, "set": {"LAMP": True}}]), table.get)
     with pytest.raises(StimulusError, match="0..15"):
         resolve_signals(parse_stimuli([{"at": 0, "set": {"CODE": 16}}]), table.get)
+
+
+def test_a_signal_is_read_by_the_front_end(tmp_path):
+    """`$IN[n]` in a stimulus is a KRL expression read by krl/semantics/expression.py: any case
+    and spacing; a malformed or out-of-range index is an error naming the line."""
+    p = write(tmp_path, "- at: 1\n  set: {'$in[ 3 ]': true}\n")
+    [st] = load_stimuli(p)
+    assert st.set == {"$IN[3]": True}
+    for bad in ("$IN[3", "$IN[-3]", "$IN[1,2]", "$IN[8193]", "$IN[X]"):
+        msg = error_of(write(tmp_path, f"- at: 1\n  set: {{'{bad}': true}}\n"))
+        assert msg.startswith(f"{tmp_path / 'stim.yaml'}:2: not a signal: {bad!r}"), msg

@@ -192,8 +192,8 @@ def test_missing_and_bad_values_name_file_and_line(tmp_path, shared_corpus):
         load_mada(p)
     p2 = _write_mada(tmp_path / "b", shared_corpus,
                      lambda t: t.replace("REAL $LENGTH_A=350.000", "REAL $LENGTH_A=350.0+1"))
-    with pytest.raises(MachineDataError, match=r"\$machine\.dat:522:21: mismatched input '\+'"):
-        load_mada(p2)                      # a syntax error: file:line:col of the parser
+    with pytest.raises(MachineDataError, match=r"\$machine\.dat:522:21: `\+` after the end of the statement"):
+        load_mada(p2)                      # a syntax error: file:line:col and message of krl check
     p2 = _write_mada(tmp_path / "b2", shared_corpus,
                      lambda t: t.replace("REAL $LENGTH_A=350.000", "REAL $LENGTH_A=TRUE"))
     with pytest.raises(MachineDataError, match=r"\$machine\.dat:522: \$LENGTH_A=TRUE: a number was expected"):
