@@ -48,7 +48,8 @@ $(JAVA_STAMP): $(PARSER)
 
 java-parser: $(JAVA_STAMP)
 
-# The compiled VM loop and the simulator's inverse kinematics (robot/build.py: robot/simcore.pyx):
+# The compiled VM loop and the simulator's hot path (robot/build.py: robot/kinematics/fastpath.py with
+# fastpath.pxd, and robot/simcore.pyx):
 # every install builds them (setup.py); this target rebuilds them in place
 # after loop.py was regenerated. Cython compiles the generated interp/vm/loop.py (with loop.pxd)
 # into an extension beside it (interp/vm/build.py). Without Cython or a C compiler it says so and
@@ -74,7 +75,7 @@ bench: $(PARSER) java-parser vm-loop
 	$(BIN)/krl bench
 
 clean:
-	rm -rf $(VENV) $(GEN_DIR) build/java build/cython interp/vm/*.so robot/*.so reports/recovery reports/growth
+	rm -rf $(VENV) $(GEN_DIR) build/java build/cython interp/vm/*.so robot/*.so robot/kinematics/*.so reports/recovery reports/growth
 
 # Conformance suites (issue 8): hand-written cases, differential fuzzing, corpus programs.
 CONF_OUT  ?= reports/conformance
@@ -84,7 +85,8 @@ conformance: $(PARSER) java-parser
 
 # Long nightly run, in order: recovery over the shared corpus, growth, the 16-copies scaling
 # figures (scale.json), the static check of the corpus backups (check/), conformance, the
-# benchmarks (bench.json, bench-parse.json, limits.jsonl), the fuzzers for their nightly budget
+# benchmarks (bench.json, bench-parse.json, limits.jsonl, whole-runs.json: every corpus entry
+# point's whole run, tools/whole_run_bench.py), the fuzzers for their nightly budget
 # (fuzz/), the tests marked slow (long sweeps; hypothesis with the nightly profile); dated
 # reports under reports/nightly/<date>/, then the history (reports/nightly/history.sqlite) and
 # the index with charts and the changes since the night before. Not part of `make test`.
@@ -103,6 +105,7 @@ nightly: $(PARSER) java-parser
 	$(BIN)/krl bench --json > $$d/bench.json 2> $$d/bench.log; \
 	$(BIN)/krl bench parse --json > $$d/bench-parse.json 2>> $$d/bench.log; \
 	$(BIN)/python -m robot.limits_bench > $$d/limits.jsonl 2>> $$d/bench.log; \
+	$(BIN)/python tools/whole_run_bench.py --json $$d/whole-runs.json > $$d/whole-runs.txt 2>> $$d/bench.log; \
 	$(BIN)/python -m tests.fuzz.run --seconds $(FUZZ_SECONDS) --out $$d/fuzz; f=$$?; \
 	HYPOTHESIS_PROFILE=nightly $(BIN)/python -m pytest -q -n 2 --dist loadgroup -p no:cacheprovider -m "slow or not slow" \
 	  > $$d/slow-tests.log 2>&1; t=$$?; tail -1 $$d/slow-tests.log; \

@@ -25,4 +25,4 @@ _cbuild = _load("_krl_cbuild", ROOT / "krl" / "cbuild.py")
 _vm = _load("_krl_vm_build", ROOT / "interp" / "vm" / "build.py")
 _sim = _load("_krl_sim_build", ROOT / "robot" / "build.py")
 
-setup(ext_modules=_cbuild.cythonized([_vm.extension(ROOT), _sim.extension(ROOT)]))
+setup(ext_modules=_cbuild.cythonized([_vm.extension(ROOT), *_sim.extensions(ROOT)]))

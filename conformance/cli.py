@@ -22,8 +22,11 @@ import click
 @click.option("--scheduler", default=None, metavar="tcp://HOST:PORT",
               help="Run the cases and the real programs on this Dask distributed scheduler's cluster "
                    "(its workers see the repository and the corpus at the same paths); the same report.")
+@click.option("--jobs", type=click.IntRange(min=1), default=None, metavar="N",
+              help="Worker processes of this machine for the cases, the fuzzer's programs and the real "
+                   "programs (default: one per core; 1: all in this process); the same report.")
 def conformance(out: Path, fuzz_n: int, no_real: bool, corpus: Path | None, real_limit: int | None,
-                fuzz_random: bool, scheduler: str | None) -> None:
+                fuzz_random: bool, scheduler: str | None, jobs: int | None) -> None:
     """Run the hand-written cases on every available interpreter, the differential fuzzer and
     the corpus programs; write summary.json, report.md and report.html to --out.
 
@@ -33,10 +36,12 @@ def conformance(out: Path, fuzz_n: int, no_real: bool, corpus: Path | None, real
     # modules cost 0.04 s and krl.cluster 0.01 s CPU on top of `krl --help`'s 0.15 s (2026-11-24)
     from conformance.report import DEFAULT_CORPUS, run_all  # noqa: PLC0415
     from krl.cluster import SchedulerError  # noqa: PLC0415
+    from krl.pool import default_jobs  # noqa: PLC0415
 
     try:
         s = run_all(out, fuzz_n=fuzz_n, real=not no_real, corpus=corpus or DEFAULT_CORPUS,
-                    real_limit=real_limit, fuzz_random=fuzz_random, echo=click.echo, scheduler=scheduler)
+                    real_limit=real_limit, fuzz_random=fuzz_random, echo=click.echo, scheduler=scheduler,
+                    jobs=jobs if jobs is not None else default_jobs())
     except SchedulerError as exc:
         click.echo(f"error: {exc}", err=True)
         sys.exit(2)

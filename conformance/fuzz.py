@@ -23,12 +23,13 @@ expectation is "runs cleanly, and tree == vm").
 from __future__ import annotations
 
 import hashlib
+import random
 import tempfile
 from pathlib import Path
 from typing import Any
 
 import yaml
-from hypothesis import HealthCheck, Phase, given, settings
+from hypothesis import HealthCheck, Phase, given, seed, settings
 from hypothesis import strategies as st
 
 from . import harness as H
@@ -322,7 +323,7 @@ def run_text(src: str, stim: str | None, interp: str | list[str], *,
 clean_run_problem = H.clean_run_problem
 
 
-def check_program(src: str, stim: str | None, interps: list[str]) -> str | None:
+def _check_program(src: str, stim: str | None, interps: list[str]) -> str | None:
     """None if the program passes the fuzz property, else a description."""
     runs = run_text(src, stim, list(interps))
     for it, r in runs.items():
@@ -334,6 +335,10 @@ def check_program(src: str, stim: str | None, interps: list[str]) -> str | None:
         if bad:
             return "tree != vm\n" + "\n".join(f"[{c.name}] {c.detail}" for c in bad)
     return None
+
+
+#: the fuzz property's check of one program (run_fuzz's property calls a local of this name)
+check_program = _check_program
 
 
 def save_case(src: str, stim: str | None, problem: str, root: Path = H.CASES_DIR) -> Path:
@@ -359,11 +364,17 @@ def save_case(src: str, stim: str | None, problem: str, root: Path = H.CASES_DIR
 
 
 def run_fuzz(n: int = 200, *, reproducible: bool = True, interps: list[str] | None = None,
-             save_failures: Path | None = None, save_cases: bool = True) -> dict[str, Any]:
+             save_failures: Path | None = None, save_cases: bool = True, jobs: int = 1) -> dict[str, Any]:
     """Run ``n`` generated programs (the same ones every time with ``reproducible``; fresh
     ones otherwise, as in the nightly run). Returns ``{"programs", "mode", "tree_ok", "agree",
     "failures": [...], "saved": [...]}``; ``programs`` counts every run of the property,
-    including hypothesis' shrinking runs after a failure."""
+    including hypothesis' shrinking runs after a failure.
+
+    `jobs` > 1: the programs run in that many worker processes of this machine (krl/pool.py),
+    with the same result as one after the other: hypothesis first draws the ``n`` programs (a
+    property that only records them), the workers check them all, then hypothesis runs the
+    property again over the same draws, taking each verdict from the workers' results; a
+    failure is shrunk as before, in this process (the shrunk programs are new draws)."""
     interps = H.available_interpreters() if interps is None else interps
     mode = "tree == vm" if ("tree" in interps and "vm" in interps) else (
         "tree smoke test (no VM): runs without internal errors" if "tree" in interps else "no interpreter")
@@ -372,6 +383,20 @@ def run_fuzz(n: int = 200, *, reproducible: bool = True, interps: list[str] | No
     if not interps:
         return stats
     last: dict[str, Any] = {}
+    # the property below calls this name, not the module's function: with workers, the first
+    # pass records the draws and the second answers from the workers' verdicts. The property's
+    # source stays as it was, because with `reproducible` hypothesis seeds its draws from it.
+    verdicts: dict[tuple[str, str | None], str | None] = {}
+    drawn: list[tuple[str, str | None]] = []
+    recording = False
+
+    def check_program(src: str, stim: str | None, interps: list[str]) -> str | None:
+        if recording:
+            drawn.append((src, stim))
+            return None
+        if (src, stim) in verdicts:
+            return verdicts[(src, stim)]
+        return _check_program(src, stim, interps)
 
     @settings(max_examples=n, deadline=None, database=None, derandomize=reproducible,
               suppress_health_check=list(HealthCheck),
@@ -391,6 +416,24 @@ def run_fuzz(n: int = 200, *, reproducible: bool = True, interps: list[str] | No
         last["src"], last["stim"], last["problem"] = src, stim, prob
         raise AssertionError(prob)
 
+    if not reproducible:
+        # fresh programs, but the same fresh ones in both passes
+        prop = seed(random.getrandbits(64))(prop)
+    if jobs > 1:
+        recording = True
+        prop()
+        recording = False
+        stats.update(programs=0, tree_ok=0, agree=0 if "vm" in interps else None)
+        # on use: pebble costs 0.85 s to import (krl/pool.py), paid only by a run with workers
+        from krl.pool import run_tasks  # noqa: PLC0415
+
+        order = list(dict.fromkeys(drawn))
+        tasks = ((i, (src, stim, interps)) for i, (src, stim) in enumerate(order))
+        # no pool timeout: each run has its own wall-clock guard (harness.run_program)
+        for o in run_tasks(_check_program, tasks, jobs=jobs, timeout=None):
+            # a worker that died checked nothing: that program is checked again here
+            if o.status == "done":
+                verdicts[order[o.key]] = o.value
     try:
         prop()
     except AssertionError:

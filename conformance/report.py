@@ -72,15 +72,28 @@ def case_outcome(case: H.Case, interps: list[str]) -> CaseOutcome:
     return co
 
 
-def _on_cluster(scheduler: str, fn, tasks: list[tuple[int, tuple]], name: str, progress, failed) -> list:
-    """``fn(*args)`` of each task on the Dask cluster at `scheduler` (krl/cluster.py), in the
-    tasks' order; `progress(result)` as each arrives. A task that fails on the cluster (its
-    worker died: not a failure of the interpreters, which the results hold themselves) is
-    ``failed(*args, detail)``, a result that says so. Raises krl.cluster.SchedulerError."""
+def _elsewhere(fn, tasks: list[tuple[int, tuple]], name: str, progress, failed, *,
+               scheduler: str | None = None, jobs: int = 1) -> list:
+    """``fn(*args)`` of each task in `jobs` worker processes of this machine (krl/pool.py), or,
+    with `scheduler`, on that Dask cluster (krl/cluster.py); the results in the tasks' order,
+    `progress(result)` as each arrives (in completion order). A task whose worker fails (it
+    died, or the cluster lost it: not a failure of the interpreters, which the results hold
+    themselves) is ``failed(*args, detail)``, a result that says so. Each task is independent
+    (a fresh runtime per run), so the results are those of a run one after the other. Raises
+    krl.cluster.SchedulerError."""
 
+    if scheduler is not None:
+        outcomes = run_batches(scheduler, fn, tasks, batch_files=1, name=name)
+        where = "on the Dask cluster"
+    else:
+        from krl.pool import run_tasks  # noqa: PLC0415  (pebble: costs 50 ms; only a run with workers pays it)
+
+        # no pool timeout: each run has its own wall-clock guard (harness.run_program)
+        outcomes = run_tasks(fn, tasks, jobs=jobs, timeout=None)
+        where = "in its worker process"
     got = {}
-    for o in run_batches(scheduler, fn, tasks, batch_files=1, name=name):
-        got[o.key] = o.value if o.status == "done" else failed(*tasks[o.key][1], f"{o.status}: {o.detail}")
+    for o in outcomes:
+        got[o.key] = o.value if o.status == "done" else failed(*tasks[o.key][1], f"{where}: {o.status}: {o.detail}")
         if progress:
             progress(got[o.key])
     return [got[i] for i in range(len(tasks))]
@@ -89,28 +102,29 @@ def _on_cluster(scheduler: str, fn, tasks: list[tuple[int, tuple]], name: str, p
 def _case_failed(case: H.Case, interps: list[str], detail: str) -> CaseOutcome:
     co = CaseOutcome(case)
     for it in interps:
-        co.runs[it] = H.RunResult(it, [], None, crash=f"on the Dask cluster: {detail}")
+        co.runs[it] = H.RunResult(it, [], None, crash=detail)
         co.results[it] = H.check_case(case, co.runs[it])
     return co
 
 
 def _real_failed(prog: Path, corpus: Path, interps: list[str], _t: float, _steps: int, detail: str) -> RealOutcome:
     ro = RealOutcome(str(prog.relative_to(corpus)) if prog.is_relative_to(corpus) else str(prog))
-    ro.crash = {it: f"on the Dask cluster: {detail}"[:300] for it in interps}
+    ro.crash = {it: detail[:300] for it in interps}
     ro.reasons = {it: "crash" for it in interps}
     ro.cause = "interpreter gap"
     return ro
 
 
 def run_cases(cases: list[H.Case] | None = None, interps: list[str] | None = None,
-              *, progress=None, scheduler: str | None = None) -> list[CaseOutcome]:
-    """:func:`case_outcome` of every case (default the whole suite), on this machine or, with
-    `scheduler` (``tcp://HOST:8786``), on that Dask cluster's workers (the same outcomes)."""
+              *, progress=None, scheduler: str | None = None, jobs: int = 1) -> list[CaseOutcome]:
+    """:func:`case_outcome` of every case (default the whole suite), in this process (`jobs`
+    1), in `jobs` worker processes of this machine, or, with `scheduler`
+    (``tcp://HOST:8786``), on that Dask cluster's workers: the same outcomes."""
     cases = H.load_cases() if cases is None else cases
     interps = H.available_interpreters() if interps is None else interps
-    if scheduler is not None:
-        return _on_cluster(scheduler, case_outcome, [(i, (c, interps)) for i, c in enumerate(cases)],
-                           "krl-conformance-cases", progress, _case_failed)
+    if scheduler is not None or jobs > 1:
+        return _elsewhere(case_outcome, [(i, (c, interps)) for i, c in enumerate(cases)],
+                          "krl-conformance-cases", progress, _case_failed, scheduler=scheduler, jobs=jobs)
     out = []
     for case in cases:
         out.append(case_outcome(case, interps))
@@ -152,11 +166,12 @@ def real_programs(corpus: Path = DEFAULT_CORPUS) -> list[tuple[Path, Path]]:
 
 def run_real(corpus: Path = DEFAULT_CORPUS, interps: list[str] | None = None, *, limit: int | None = None,
              max_sim_time: float | None = None, max_steps: int | None = None, progress=None,
-             scheduler: str | None = None) -> list[RealOutcome]:
+             scheduler: str | None = None, jobs: int = 1) -> list[RealOutcome]:
     """Run the corpus programs on every interpreter with the real-programs report's limits
     (interp/realprograms.py: 60 s or the cell's ``sim_time``, the step budget with the
-    submit's), so that the causes shown here are that report's. `scheduler`: run them on that
-    Dask cluster's workers (they see the corpus at the same paths; the same outcomes)."""
+    submit's), so that the causes shown here are that report's. `jobs` > 1: in that many worker
+    processes of this machine; `scheduler`: on that Dask cluster's workers (they see the corpus
+    at the same paths). The same outcomes every way."""
 
     interps = H.available_interpreters() if interps is None else interps
     max_sim_time = R.REPORT_SIM_TIME_S if max_sim_time is None else max_sim_time
@@ -165,8 +180,9 @@ def run_real(corpus: Path = DEFAULT_CORPUS, interps: list[str] | None = None, *,
     if limit is not None:
         progs = progs[:limit]
     tasks = [(i, (prog, corpus, interps, max_sim_time, max_steps)) for i, (prog, _root) in enumerate(progs)]
-    if scheduler is not None:
-        return _on_cluster(scheduler, real_outcome, tasks, "krl-conformance-real", progress, _real_failed)
+    if scheduler is not None or jobs > 1:
+        return _elsewhere(real_outcome, tasks, "krl-conformance-real", progress, _real_failed,
+                          scheduler=scheduler, jobs=jobs)
     out = []
     for _i, args in tasks:
         out.append(real_outcome(*args))
@@ -415,10 +431,12 @@ def _html(s, rows, interps, fuzz, real) -> str:
 
 def run_all(out: Path, *, fuzz_n: int = 200, real: bool = True, corpus: Path = DEFAULT_CORPUS,
             real_limit: int | None = None, fuzz_random: bool = False, echo=print,
-            scheduler: str | None = None, cases: list[H.Case] | None = None) -> dict[str, Any]:
-    """Everything `krl conformance` / `make conformance` does. `scheduler`: the cases and the
-    real programs run on that Dask cluster (the fuzzer's programs run here); `cases`: these
-    instead of the whole suite."""
+            scheduler: str | None = None, cases: list[H.Case] | None = None, jobs: int = 1) -> dict[str, Any]:
+    """Everything `krl conformance` / `make conformance` does. `jobs`: worker processes of this
+    machine for the cases, the fuzzer's programs and the real programs (1: in this process);
+    `scheduler`: the cases and the real programs run on that Dask cluster instead (the
+    fuzzer's programs run on this machine, in `jobs` workers); `cases`: these instead of the
+    whole suite. The same report every way."""
     status = H.interpreter_status()
     for k, v in status.items():
         echo(f"{k}: {'available' if v is None else v}")
@@ -427,17 +445,17 @@ def run_all(out: Path, *, fuzz_n: int = 200, real: bool = True, corpus: Path = D
     def prog(co):
         st = "pass" if co.passed and co.agree is not False else ("pending" if co.ok_or_pending else "FAIL")
         echo(f"  {st:7s} {co.case.name}")
-    outcomes = run_cases(cases, progress=prog, scheduler=scheduler)
+    outcomes = run_cases(cases, progress=prog, scheduler=scheduler, jobs=jobs)
     echo(f"cases: {sum(o.passed for o in outcomes)}/{len(outcomes)} pass ({time.monotonic() - t0:.0f} s)")
     fz = None
     if fuzz_n > 0:
 
-        fz = F.run_fuzz(fuzz_n, reproducible=not fuzz_random, save_failures=out / "fuzz_failures")
+        fz = F.run_fuzz(fuzz_n, reproducible=not fuzz_random, save_failures=out / "fuzz_failures", jobs=jobs)
         echo(f"fuzz: {fz['programs']} programs, mode {fz['mode']}, tree clean {fz['tree_ok']}, agree {fz['agree']}")
     rl = None
     if real:
         if corpus.is_dir():
-            rl = run_real(corpus, limit=real_limit, scheduler=scheduler,
+            rl = run_real(corpus, limit=real_limit, scheduler=scheduler, jobs=jobs,
                           progress=lambda r: echo(f"  real {r.reasons} {r.program}"))
             echo(f"real programs: {len(rl)}")
         else:

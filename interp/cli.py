@@ -34,8 +34,9 @@ from robot.trace import TRACE_REPEATS
 @click.option("--mode", "mode", type=click.Choice(["T1", "T2", "AUT", "EXT"], case_sensitive=False),
               default=None,
               help="Operating mode ($MODE_OP): T1 limits TCP and flange to 250 mm/s and PTP to "
-                   "$RED_T1; AUT is the unattended virtual controller (docs/robot.md). Default AUT, "
-                   "or EXT when the --inputs cell file has the autoext preset.")
+                   "$RED_T1; AUT is the unattended virtual controller (docs/robot.md). Default AUT; EXT "
+                   "for a cell program (&COMMENT HANDLER on external automatic, or a call of P00 (#INIT_EXT, "
+                   "...)), with --inputs auto, or when the --inputs cell file has the autoext preset.")
 @click.option("--run-mode", "run_mode", type=click.Choice(["GO", "MSTEP", "ISTEP", "BSTEP"], case_sensitive=False),
               default="GO", show_default=True,
               help="Program run mode ($PRO_MODE): MSTEP stops after each motion, ISTEP after each "
@@ -55,8 +56,8 @@ from robot.trace import TRACE_REPEATS
                    "R1/Mada/$machine.dat, else the KR 6 R900).")
 @click.option("--start", "start", default=None, metavar="AXIS_OR_POINT",
               help="Where the robot stands at the start: an E6AXIS literal (\"{A1 0, A2 -90, A3 90, A4 0, A5 0, "
-                   "A6 0}\") or a point of the program such as XHOME (default: the cell file's start:, with "
-                   "--inputs auto XHOME, else $AXIS_HOME[1]).")
+                   "A6 0}\") or a point of the program such as XHOME (default: the cell file's start:, for a "
+                   "cell program or with --inputs auto XHOME, else $AXIS_HOME[1]).")
 @click.option("--on-halt", "on_halt", default="stop", show_default=True, metavar="stop|continue[:N]",
               help="After a HALT: stop the run, or `continue`: the operator presses Start again (at most N "
                    "times, default 10; then the HALT ends the run).")

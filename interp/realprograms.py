@@ -45,8 +45,10 @@ Routines of technology packages absent from the backup are stubbed (a ``message`
 "stub: NAME"), and the report lists the stubs.
 
 Usage: ``python -m interp.realprograms [CORPUS] [--json OUT] [--limit N] [--columns cells,auto]
-[--interp vm|tree] [--jobs N] [--scheduler tcp://HOST:PORT]`` (``--jobs``: worker processes of this machine,
-one per core by default; ``--scheduler``: the runs go to a Dask cluster, :func:`run_rows`; the same report).
+[--interp vm|tree] [--jobs N] [--scheduler tcp://HOST:PORT] [--history new|old|both]`` (``--jobs``: worker
+processes of this machine, one per core by default; ``--scheduler``: the runs go to a Dask cluster,
+:func:`run_rows`; the same report; ``--history``: CORPUS is ../shared/krl-history and the programs are
+those of each pair's side, in backups or not, :func:`history_entries`).
 """
 
 from __future__ import annotations
@@ -192,6 +194,41 @@ def entries_of(root: Path) -> list[Path]:
     return progs + ([sub] if sub is not None and sub not in progs else [])
 
 
+def loose_programs(folder: Path) -> list[Path]:
+    """The programs of `folder` outside its backups (krl.project.find_backups): every ``.src``
+    file below it, not inside a backup, whose first routine is a DEF without parameters (the
+    programs of a repository that is not a controller backup, as ../shared/krl-history's
+    sides mostly are), in path order."""
+    from interp.runtime.program import parse_module  # noqa: PLC0415
+
+    roots = [b.resolve() for b in find_backups(folder)]
+    out = []
+    for p in sorted(folder.rglob("*")):
+        if p.suffix.lower() != ".src" or not p.is_file():
+            continue
+        rp = p.resolve()
+        if any(rp.is_relative_to(r) for r in roots):
+            continue
+        mod, _errs = parse_module(str(p))
+        if mod.routines and not mod.routines[0].params and mod.routines[0].kind == "DEF":
+            out.append(p)
+    return out
+
+
+def history_entries(history: Path, sides: tuple[str, ...] = ("new",)) -> list[Path]:
+    """The entry points of ../shared/krl-history's pair sides `sides` (``old``, ``new``;
+    layout ``OWNER__NAME/NN-SHA/SIDE``): of each side, the entry points of its backups
+    (:func:`entries_of`), then its programs outside a backup (:func:`loose_programs`)."""
+    out = []
+    for side in sides:
+        for folder in sorted(history.glob(f"*/*/{side}")):
+            if not folder.is_dir():
+                continue
+            out += [p for root in find_backups(folder) for p in entries_of(root)]
+            out += loose_programs(folder)
+    return out
+
+
 def normalise(text: str) -> str:
     t = re.sub(r"-?\d+(\.\d+)?", "N", text or "")
     t = re.sub(r"/\S+", "PATH", t)
@@ -235,14 +272,14 @@ def time_limit(path: Path, cell, default: float) -> float:
 
 
 def report_run(path: Path, cell: Path | None, max_sim_time: float = REPORT_SIM_TIME_S,
-               max_steps: int = REPORT_STEPS, auto: bool = False) -> tuple:
+               max_steps: int = REPORT_STEPS, auto: bool = False, auto_sim_time: float | None = None) -> tuple:
     """``(robot, submit programs, simulated-time limit s, step limit)`` of the report's run of
     `path` with its cell file (a path or a Cell: interp.run.cell_of), or with ``--inputs auto``
     (`auto`; this report and the conformance report's real programs): the cell's robot, else
     the backup's own, else (auto) the library robot that reaches the backup's points, else the
     KR 6 R900 (interp.run.robot_for); the backup's SPS.SUB (none for the SPS.SUB itself: it
     runs as the program, at a submit interpreter's pace); :func:`time_limit` (auto: the longer
-    :data:`AUTO_SIM_TIME_S` for a robot program) and :func:`step_limit`."""
+    `auto_sim_time`, default :data:`AUTO_SIM_TIME_S`, for a robot program) and :func:`step_limit`."""
     from interp.run import cell_of, robot_for  # noqa: PLC0415
 
     cell = None if auto else cell_of(cell)
@@ -250,19 +287,57 @@ def report_run(path: Path, cell: Path | None, max_sim_time: float = REPORT_SIM_T
     submit = submit_of(path)
     sub = path.suffix.lower() == ".sub"
     if auto:
-        t = max_sim_time if sub else max(max_sim_time, AUTO_SIM_TIME_S)
+        t = max_sim_time if sub else max(max_sim_time, AUTO_SIM_TIME_S if auto_sim_time is None else auto_sim_time)
     else:
         t = time_limit(path, cell, max_sim_time)
     return robot, submit, t, step_limit(max_steps, t, len(submit) + sub, robot.ipo_cycle_s)
 
 
+#: the run-time errors of a name nothing of the program declares (interp/runtime/core.py,
+#: interp/runtime/kss.py): the name, and whether it is a routine
+_UNKNOWN = re.compile(r"^(?:unknown name (?P<name>\S+)|routine (?P<routine>\S+) not found)$")
+
+
+def outside_stops(rt) -> list[str]:
+    """The run-time errors of the run `rt` (its robot program's, its submit programs') that
+    stop on a name the checker classifies outside the program and calls KUKA's
+    (krl/semantics/outside.py ``Unresolved.classify``: W101/W105/W106/W107, ``Outside.kuka``),
+    as ``NAME at file:line: why``. Issue 46: the
+    run stands in for every such name (interp/runtime/kss.py), so this is always empty unless
+    the checker and the run disagree."""
+    unresolved = rt.program.ws.unresolved()
+    outside = unresolved.classify() if unresolved is not None else {}
+    errors = []
+    if rt.result is not None and rt.result.reason == "error" and rt.result.error is not None:
+        errors.append((rt.result.error, rt.result.file, rt.result.line))
+    for task in rt.scheduler.tasks:
+        reason, err = task.outcome or (None, None)
+        if task.kind == "submit" and reason == "error" and err is not None:
+            errors.append((err, err.file or task.file, err.line or task.line))
+    out = []
+    for err, file, line in errors:
+        m = _UNKNOWN.match(err.message or "")
+        if m is None:
+            continue
+        name = (m.group("name") or m.group("routine")).upper()
+        kinds = ("routine",) if m.group("routine") else ("sysvar",) if name.startswith("$") else ("name",)
+        for kind in kinds:
+            o = outside.get((kind, name))
+            if o is not None and o.kuka:
+                out.append(f"{o.name} at {file}:{line}: {o.why}")
+    return out
+
+
 def run_one(path: Path, max_sim_time: float, max_steps: int, cell: Path | None = None,
-            auto: bool = False, interp: str = "tree") -> dict:
+            auto: bool = False, interp: str = "tree", auto_sim_time: float | None = None) -> dict:
     """One run of the report (module docstring): with the cell file `cell` (a path or a Cell:
     interp.run.cell_of), or with ``--inputs auto`` (`auto`; then `cell` is not used), on the
     interpreter `interp`. The row holds how it ended, its cause, the stand-ins of KUKA's
     software (``stubs``, name -> uses), the cell's answers (``cell_answers``, ``cell_last`` s;
-    ``answers``: the automatic cell's, described) and the idle time skipped."""
+    ``answers``: the automatic cell's, described), the idle time skipped, and the stops on a
+    name the checker classifies outside the program (``outside_stops``, :func:`outside_stops`).
+    `auto_sim_time`: the time limit of an ``--inputs auto`` run of a robot program (default
+    :data:`AUTO_SIM_TIME_S`; a bounded sweep gives less)."""
     from interp.run import cell_of, make_runtime  # noqa: PLC0415
 
     t0 = time.time()
@@ -270,16 +345,16 @@ def run_one(path: Path, max_sim_time: float, max_steps: int, cell: Path | None =
     try:
         cell = None if auto else cell_of(cell)   # the cell file, read once for the robot, the limits and the run
         inputs = "auto" if auto else cell
-        robot, submit, max_sim_time, limit = report_run(path, cell, max_sim_time, max_steps, auto)
+        robot, submit, max_sim_time, limit = report_run(path, cell, max_sim_time, max_steps, auto,
+                                                        auto_sim_time)
         own = _own_machine_data(path, robot.source)
-        from interp.runtime.scheduler import SUBMIT_BUDGET  # noqa: PLC0415
-
         # --no-check: the report says how each real program runs, also those the checker rejects
+        # (an SPS.SUB entry runs at the submit interpreter's pace: scheduler.program_budget)
         rt, _ = make_runtime(path, trace=None, mujoco=False, max_sim_time=max_sim_time, max_steps=limit,
-                             submit=submit, check=False, inputs=inputs, robot=robot, interp=interp,
-                             robot_budget=SUBMIT_BUDGET if path.suffix.lower() == ".sub" else None)
+                             submit=submit, check=False, inputs=inputs, robot=robot, interp=interp)
         res = rt.run()
         stubs = {name: n for name, _what, n in rt.kss.summary()}
+        stops = outside_stops(rt)
         rules = rt.controller.rules
         fired = [r.last_fired for r in rules if r.last_fired is not None]
         answers = rt.autocell.answers if rt.autocell is not None else []
@@ -301,7 +376,7 @@ def run_one(path: Path, max_sim_time: float, max_steps: int, cell: Path | None =
            "cell_last": round(max(fired), 3) if fired else None,
            "answers": [a.describe() for a in answers],
            "idle_s": round(rt.scheduler.idle.skipped * rt.controller.dt, 3),
-           "robot": robot.name, "robot_own": own}
+           "robot": robot.name, "robot_own": own, "outside_stops": stops}
     row["cause"] = cause_of(row)
     return row
 
@@ -394,6 +469,11 @@ def report(rows: list[dict]) -> str:
         lines.append("")
         lines.append("Stand-ins of KUKA's software the backups lack (uses, in how many runs; "
                      "interp/runtime/kss.py): " + ", ".join(f"{s} ({c} in {runs[s]})" for s, c in stubs.most_common()))
+    stops = [s for r in rows for s in r.get("outside_stops") or ()]
+    lines.append("")
+    lines.append(f"Stops on a name the checker classifies outside the program (issue 46): {len(stops)}"
+                 + (":" if stops else ""))
+    lines += [f"  {s}" for s in stops]
     answers = sum(len(r.get("answers") or ()) for r in rows)
     if any(r.get("mode") == "auto" for r in rows):
         lines.append("")
@@ -404,7 +484,8 @@ def report(rows: list[dict]) -> str:
 
 def run_rows(corpus: Path, max_sim_time: float = REPORT_SIM_TIME_S, max_steps: int = REPORT_STEPS, *,
              cells: bool = True, limit: int = 0, columns: tuple[str, ...] = ("cells",), interp: str = "tree",
-             scheduler: str | None = None, jobs: int = 1, progress=None) -> list[dict]:
+             scheduler: str | None = None, jobs: int = 1, progress=None,
+             history: tuple[str, ...] = ()) -> list[dict]:
     """The report's rows: :func:`run_one` of each entry point of the backups below `corpus`
     (:func:`entries_of`; at most `limit` of them, 0: all), in the corpus's order, once per
     column of `columns` ("cells": with its committed cell file unless `cells` is False;
@@ -414,9 +495,14 @@ def run_rows(corpus: Path, max_sim_time: float = REPORT_SIM_TIME_S, max_steps: i
     `jobs` > 1 runs them in that many worker processes of this machine (krl/pool.py: each run is
     independent, so the rows are the same as one after the other, ``seconds`` aside).
     `progress(column, row)` is called as each row arrives (in completion order when the runs
-    are parallel; the rows returned are always in the corpus's order). Raises
-    krl.cluster.SchedulerError when the scheduler cannot be used."""
-    programs = [p for root in find_backups(corpus) for p in entries_of(root)]
+    are parallel; the rows returned are always in the corpus's order). `history`: `corpus` is
+    ../shared/krl-history, and the programs are those of its pair sides `history`
+    (:func:`history_entries`). Raises krl.cluster.SchedulerError when the scheduler cannot be
+    used."""
+    if history:
+        programs = history_entries(corpus, history)
+    else:
+        programs = [p for root in find_backups(corpus) for p in entries_of(root)]
     if limit:
         programs = programs[:limit]
     tasks = []
@@ -473,8 +559,12 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--scheduler", default=None, metavar="tcp://HOST:PORT",
                     help="make the runs on this Dask distributed scheduler's cluster (its workers "
                          "see the corpus at the same paths); the same report as the local run")
+    ap.add_argument("--history", default=None, choices=("new", "old", "both"),
+                    help="CORPUS is ../shared/krl-history: run the programs of each pair's new "
+                         "(old, both) side, its backups' entry points and its programs outside a backup")
     a = ap.parse_args(argv)
     corpus = Path(a.corpus)
+    history = {"new": ("new",), "old": ("old",), "both": ("old", "new"), None: ()}[a.history]
     cols = [c.strip() for c in a.columns.split(",") if c.strip()]
     if not cols or any(c not in ("cells", "auto") for c in cols):
         ap.error("--columns takes cells, auto or cells,auto")
@@ -497,7 +587,8 @@ def main(argv: list[str] | None = None) -> int:
     try:
         rows = run_rows(corpus, a.max_sim_time, a.max_steps, cells=not a.no_cells, limit=a.limit,
                         columns=tuple(cols), interp=a.interp, scheduler=a.scheduler,
-                        jobs=a.jobs if a.jobs is not None else default_jobs(), progress=progress)
+                        jobs=a.jobs if a.jobs is not None else default_jobs(), progress=progress,
+                        history=history)
     except SchedulerError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2

@@ -36,8 +36,10 @@ def make_runtime(program, *, workspace=None, inputs=None, trace=None, max_sim_ti
     controller's events on their way to `trace`; it is not used with a given `controller`.
     `inputs`: the cell file (a path, or the Cell :func:`cell_of` read; read once per run).
     ``mode``: operating mode T1/T2/AUT/EXT (``$MODE_OP``; default AUT, robot/limits.py);
-    ignored with a given `controller` (it has its own); None: AUT, or EXT when the cell file
-    (`inputs`) has the ``autoext`` preset. ``pgno``: the program number the cell's PLC answers
+    ignored with a given `controller` (it has its own); None: EXT when the cell file (`inputs`)
+    has the ``autoext`` preset, when the program is a cell program (:func:`cell_program`: the
+    controller runs the handler of Automatic External in EXT) or with ``--inputs auto``, else
+    AUT; ``rt.start`` (:class:`RunStart`) says who chose. ``pgno``: the program number the cell's PLC answers
     in P00's handshake (robot/cellpresets.py; overrides the cell file's ``pgno`` preset).
     ``run_mode``: ``$PRO_MODE`` at the start (GO, MSTEP, ISTEP, BSTEP; interp/runtime/runmode.py;
     default GO). ``robot``: the simulated robot (a MachineData or a path for
@@ -47,7 +49,8 @@ def make_runtime(program, *, workspace=None, inputs=None, trace=None, max_sim_ti
     program numbers, the solver; the robot starts at ``XHOME`` when the program has one and
     no `start` is given). ``start``: where the robot stands at the start
     (:func:`start_axes`: an E6AXIS literal or a point name; default the cell file's
-    ``start:``, else ``$AXIS_HOME[1]``). ``halt_continues``: ``--on-halt continue``, the
+    ``start:``, else ``XHOME`` for a cell program or with ``--inputs auto`` when the program has
+    one, else ``$AXIS_HOME[1]``). ``halt_continues``: ``--on-halt continue``, the
     times the operator presses Start again after a HALT (0: a HALT ends the run). ``network``: the partners
     (net.settings.NetworkSettings; default the cell file's ``network:`` key): the run's network
     hub (net/hub.py) is attached to the controller either way; without partners its EKI
@@ -60,6 +63,7 @@ def make_runtime(program, *, workspace=None, inputs=None, trace=None, max_sim_ti
     auto = is_auto(inputs)
     if auto:
         inputs = None
+    made, cell = controller is None, None
     if controller is None:
         from robot.controller import Controller  # noqa: PLC0415
 
@@ -77,14 +81,26 @@ def make_runtime(program, *, workspace=None, inputs=None, trace=None, max_sim_ti
         rt.set_run_mode(run_mode)
     rt.halt_continues = halt_continues
     main = Path(program).stem
-    where = start if start is not None else getattr(controller, "start", None)
-    if where is None and auto and isinstance(global_value(rt, main, "XHOME"), Struct):
-        where = "XHOME"             # the automatic cell starts at home, as a cell in Automatic External
+    cell_why = cell_program(rt)
+    scene = rt.start = RunStart()
+    if made:
+        scene.mode_why = _mode_origin(rt, program, mode, cell, auto, cell_why)
+    scene.mode = rt.mode_op
+    where, scene.why = start, "--start"
+    if where is None and getattr(controller, "start", None) is not None:
+        where, scene.why = controller.start, "the cell file's start:"
+    if where is None and (auto or cell_why) and isinstance(global_value(rt, main, "XHOME"), Struct):
+        where = "XHOME"             # a cell starts at home, as P00's #CHK_HOME wants it
+        scene.why = (f"the home position: {Path(program).name} is a cell program, and P00 #CHK_HOME wants "
+                     f"it there; --start to choose another" if cell_why else
+                     "the home position: --inputs auto starts a cell there; --start to choose another")
     if where is not None:
         from interp.scene import start_axes  # noqa: PLC0415
 
         controller.place(start_axes(controller, lambda name: global_value(rt, main, name), where))
-        rt.start = where
+        scene.where = where
+    else:
+        scene.why = ""
     if observer is not None:
         # The interpreters trace into the user's trace only: without one the VM keeps its
         # quiet fast path (Runtime.quiet_limit); the observer needs the controller's events.
@@ -119,6 +135,69 @@ def make_runtime(program, *, workspace=None, inputs=None, trace=None, max_sim_ti
         sp = Path(sub).resolve()
         rt.add_task("submit", sp.stem, lambda name=sp: interp.run_program(name))
     return rt, interp
+
+
+@dataclass
+class RunStart:
+    """How a run started (shown in the run summary): the operating mode (``mode``: T1, T2,
+    AUT, EX) and who chose it (``mode_why``; "" for the default AUT), where the robot stood
+    (``where``: an E6AXIS literal or a point name, None for ``$AXIS_HOME[1]``) and why
+    (``why``)."""
+
+    mode: str = "AUT"
+    mode_why: str = ""
+    where: str | None = None
+    why: str = ""
+
+
+def cell_program(rt: Runtime) -> str:
+    """Why the run's program is a cell program, the handler of Automatic External, or "":
+    its module's header ``&COMMENT HANDLER on external automatic`` (KUKA's cell.src), or a
+    call of ``P00 (#INIT_EXT, ...)`` in its module (KUKA's P00 initialises Automatic External
+    for the program that handles it). Read from the program's syntax tree."""
+    from krl.ast import nodes as N  # noqa: PLC0415
+
+    m = rt.program.module_of(rt.program.main_path)
+    src = m.unit.src if m is not None and m.unit is not None else None
+    module = src.module if src is not None else None
+    if module is None:
+        return ""
+    for h in module.headers:
+        if h.upper().startswith("&COMMENT") and "HANDLER ON EXTERNAL AUTOMATIC" in " ".join(h.upper().split()):
+            return f"its header {' '.join(h.split())}"
+    for node in module.walk():
+        if isinstance(node, N.Call) and node.name.upper() == "P00" and node.args \
+                and isinstance(node.args[0], N.EnumLit) and node.args[0].name.upper() == "INIT_EXT":
+            return f"it calls P00 (#INIT_EXT, ...) at line {node.span.line}"
+    return ""
+
+
+def set_mode_op(rt: Runtime, mode: str) -> None:
+    """Select the operating mode `mode` (T1, T2, AUT, EX) before the run starts: ``$MODE_OP``,
+    the controller's and its robot model's (T1's reduced speeds, robot/limits.py)."""
+    from robot.limits import normalise_mode  # noqa: PLC0415
+
+    m = normalise_mode(mode)
+    rt.mode_op = rt.controller.mode_op = rt.controller.model.mode = m
+
+
+def _mode_origin(rt: Runtime, program, mode, cell, auto: bool, cell_why: str) -> str:
+    """Who chose the operating mode of a run whose controller make_runtime built (said in the
+    run summary), selecting Automatic External for a cell program nobody chose a mode for:
+    ``--mode``; the cell file's ``autoext`` preset; the cell program (:func:`cell_program`:
+    the controller runs its handler in Automatic External); ``--inputs auto``; "" for the
+    default AUT."""
+    if mode is not None:
+        return "--mode"
+    if cell is not None and cell.autoext:
+        return "the cell file's autoext preset"
+    if cell_why:
+        set_mode_op(rt, "EX")
+        return (f"{Path(program).name} is a cell program ({cell_why}): the controller runs it in "
+                f"Automatic External; --mode to choose another")
+    if auto:
+        return "--inputs auto: the automatic cell is the PLC of Automatic External; --mode to choose another"
+    return ""
 
 
 def attach_network(rt: Runtime, program, workspace, settings) -> None:

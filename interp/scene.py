@@ -50,7 +50,8 @@ def start_axes(controller, value_of: Callable[[str], object], text: str) -> np.n
             if isinstance(v, N.Unary):
                 v = v.operand
             comps[it.name.upper()] = sign * v.value
-    home = np.array(controller.machine.home_deg, dtype=float)
+    # HOME in KRL's order (A1..A6: a robot with fewer axes has 0 for the others)
+    home = controller.model.to_krl(np.array(controller.machine.home_deg, dtype=float))
     if any(k in comps for k in _AXES):
         q = np.array([float(comps.get(k, home[i])) for i, k in enumerate(_AXES)])
     elif all(k in comps for k in _CART):

@@ -179,8 +179,14 @@ def _run_lines(rt: Any) -> list[str]:
     if rt is None:
         return []
     out = []
-    if getattr(rt, "start", None):
-        out.append(f"  start      {printable(rt.start)}")
+    scene = getattr(rt, "start", None)
+    if scene is not None and scene.mode_why:
+        shown = "EXT" if scene.mode == "EX" else scene.mode
+        out.append(f"  mode       {shown} ({printable(scene.mode_why)})")
+    if scene is not None and scene.where:
+        why = f" ({printable(scene.why)})" if scene.why and scene.why not in ("--start", "the cell file's start:") \
+            else ""
+        out.append(f"  start      {printable(scene.where)}{why}")
     kss = getattr(rt, "kss", None)
     stubs = kss.summary() if kss is not None else []
     if stubs:
@@ -272,10 +278,193 @@ def _inputs_read(rt: Any, main: str, e: Any) -> list[str]:
     return list(dict.fromkeys(n for n in (_input_of(rt, main, node) for node in e.walk()) if n is not None))
 
 
+#: what a condition over a system variable of the controller waits for, and what satisfies it
+#: in a run: variable -> (what, krl run's option, the cell file's key). KSS 8.x "Operating and
+#: Programming Instructions for System Integrators", Automatic External: $I_O_ACTCONF is TRUE
+#: when EXT is selected and $I_O_ACT is TRUE; $IN_HOME is TRUE while the robot stands within
+#: $H_POS_TOL of $H_POS (docs/robot.md, "The operator's path through a cell program").
+ANSWERS = {
+    "$I_O_ACTCONF": ("Automatic External ($MODE_OP #EX and $I_O_ACT)", "--mode EXT", "autoext: true"),
+    "$EXT": ("Automatic External ($MODE_OP #EX)", "--mode EXT", "autoext: true"),
+    "$IN_HOME": ("the robot in its home position ($H_POS, within $H_POS_TOL)", "--start XHOME", "start: XHOME"),
+    "$EXT_START": ("the PLC's external start ($EXT_START: the program number valid with it, PGNO_VALID=0, "
+                   "is not simulated)", "", ""),
+}
+
+#: the P00 parameters of $config.dat whose inputs carry the PLC's program number
+_PGNO_INPUTS = ("PGNO_VALID", "PGNO_PARITY")
+
+
+def _waiting(rt: Any, file: str, line: int, halted: bool):
+    """(routine, kind, condition) the robot task waits on at `file`:`line`: a WAIT FOR on that
+    line; else (a HALT, a statement in a busy loop) the innermost REPEAT ... UNTIL or WHILE
+    around it — kind ``UNTIL``/``WHILE``; None when there is none."""
+    from pathlib import Path  # noqa: PLC0415
+
+    from krl.ast import nodes as N  # noqa: PLC0415
+
+    target = str(Path(file).resolve())
+    for m in rt.program.modules:
+        src = m.unit.src if m.unit is not None else None
+        if src is None or src.module is None or str(Path(src.path).resolve()) != target:
+            continue
+        for routine in src.module.routines:
+            path = _path_to(routine, line)
+            if path is None:
+                continue
+            hit = path[-1]
+            if isinstance(hit, N.WaitFor) and not halted:
+                return routine, "WAIT FOR", hit.cond
+            for node in reversed(path):
+                if isinstance(node, N.Repeat):
+                    return routine, "UNTIL", node.cond
+                if isinstance(node, N.While):
+                    return routine, "WHILE", node.cond
+            return None
+    return None
+
+
+def _path_to(node: Any, line: int) -> list | None:
+    """The nodes from `node` down to the first statement that stands on `line`, or None."""
+    from krl.ast import nodes as N  # noqa: PLC0415
+
+    for child in node.children():
+        if child is None or not isinstance(child, N.Node):
+            continue
+        if isinstance(child, N.Stmt) and child.span.line == line:
+            return [node, child]
+        got = _path_to(child, line)
+        if got is not None:
+            return [node, *got]
+    return None
+
+
+def _index(rt: Any, main: str, e: Any):
+    """The INT value of an index expression of literals, constants and variables of the data
+    lists (``PGNO_VALID*(-1)``), or None."""
+    from krl.ast import nodes as N  # noqa: PLC0415
+    from interp.run import global_value  # noqa: PLC0415
+
+    if isinstance(e, N.IntLit):
+        return e.value
+    if isinstance(e, N.Name):
+        v = global_value(rt, main, e.name)
+        return v if isinstance(v, int) and not isinstance(v, bool) else None
+    if isinstance(e, N.Unary) and e.op in ("-", "+"):
+        v = _index(rt, main, e.operand)
+        return None if v is None else (-v if e.op == "-" else v)
+    if isinstance(e, N.Binary) and e.op in ("+", "-", "*"):
+        a, b = _index(rt, main, e.left), _index(rt, main, e.right)
+        if a is None or b is None:
+            return None
+        return a + b if e.op == "+" else a - b if e.op == "-" else a * b
+    return None
+
+
+def _reads(rt: Any, main: str, cond: Any) -> tuple[list[str], list[int]]:
+    """(system variables, input numbers) the condition `cond` reads, each once, in order."""
+    from krl.ast import nodes as N  # noqa: PLC0415
+    from interp.run import signal_of  # noqa: PLC0415
+
+    names: list[str] = []
+    inputs: list[int] = []
+    for node in cond.walk():
+        if isinstance(node, N.Index) and isinstance(node.base, N.Name) and node.base.name.upper() == "$IN" \
+                and len(node.indices) == 1:
+            n = _index(rt, main, node.indices[0])
+            if n is not None and n != 0 and abs(n) not in inputs:
+                inputs.append(abs(n))
+        elif isinstance(node, N.Name) and node.name.startswith("$") and node.name.upper() not in names:
+            names.append(node.name.upper())
+        elif isinstance(node, N.Name):
+            sig = signal_of(rt, main, node.name)
+            if sig is not None and sig[0] == "$IN" and sig[2] is None and sig[1] not in inputs:
+                inputs.append(sig[1])
+    return names, inputs
+
+
+def _pgno_inputs(rt: Any, main: str) -> dict[int, str]:
+    """Input number -> what it carries in P00's program-number handshake (the ``PGNO_*``
+    parameters of $config.dat): the valid bit, the parity bit, the number's bits."""
+    from interp.run import global_value  # noqa: PLC0415
+
+    out: dict[int, str] = {}
+    for name in _PGNO_INPUTS:
+        v = global_value(rt, main, name)
+        if isinstance(v, int) and not isinstance(v, bool) and v:
+            out[abs(v)] = name
+    fbit, length = global_value(rt, main, "PGNO_FBIT"), global_value(rt, main, "PGNO_LENGTH")
+    if isinstance(fbit, int) and isinstance(length, int) and fbit > 0:
+        for i in range(max(0, min(length, 64))):
+            out.setdefault(fbit + i, f"PGNO_FBIT+{i}")
+    return out
+
+
+def wait_lines(rt: Any) -> list[str]:
+    """When the run ended waiting — at the time or step limit, in a deadlock, or at a HALT
+    inside a loop that waits (P00's #CHK_HOME) — and what it waits on is the controller's
+    state or P00's program-number handshake (KUKA's P00, the project's standard P00, or any
+    program): what it waits for and the option or cell-file key that answers it, as summary
+    lines. Empty otherwise. Names come from the program's files: printable."""
+    res = rt.result
+    task = rt.robot
+    if res is None or task is None or not task.file \
+            or res.reason not in ("max_sim_time", "max_steps", "deadlock", "halt"):
+        return []
+    main = rt.program.main_path.stem
+    pgno = _pgno_inputs(rt, main)
+    halted = res.reason == "halt"
+    for file, line in _stack(rt, task):
+        found = _waiting(rt, file, line, halted)
+        halted = False                  # a caller stands at a call, not at the HALT
+        if found is None:
+            continue
+        routine, kind, cond = found
+        names, inputs = _reads(rt, main, cond)
+        where = f"{routine.name} ({_where(file, line)})"
+        shown = printable(_show(cond))
+        for n in names:
+            if n in ANSWERS:
+                what, option, key = ANSWERS[n]
+                out = [f"  waits      in {where} for {what}: {kind} {shown}"]
+                if option:
+                    out.append(f"  answer     {option}, or the cell file's `{key}`")
+                return out
+        carried = [f"$IN[{i}] ({pgno[i]})" for i in inputs if i in pgno]
+        if carried:
+            return [f"  waits      in {where} for the PLC's program number (P00's handshake): {kind} {shown} "
+                    f"reads {', '.join(carried)} of $config.dat",
+                    "  answer     --pgno N (a number the cell program's SWITCH PGNO has a CASE for), or the "
+                    "cell file's `pgno: N`, or --inputs auto"]
+    return []
+
+
+def _stack(rt: Any, task: Any) -> list[tuple[str, int]]:
+    """(file, line) where the task stopped, then where each caller stands (the run's
+    ``RunResult.stack``), innermost first."""
+    out = [(task.file, task.line)]
+    for file, line in getattr(rt.result, "stack", ())[1:]:
+        out.append((file, line))
+    return out
+
+
+def _show(e: Any) -> str:
+    from krl.ast.printer import expr as printed  # noqa: PLC0415
+
+    try:
+        return printed(e)
+    except Exception:  # noqa: BLE001 - a node the printer does not know
+        return "its condition"
+
+
 def starvation_lines(rt: Any) -> list[str]:
     """When the run ended in a WAIT FOR that nothing released (time or step limit, deadlock):
     the inputs it waits on and a cell rule (robot/cellrules.py) that would release it, as
-    summary lines. Empty otherwise. Names come from the program's files: printable."""
+    summary lines; a wait on the controller's state or P00's handshake is said by
+    :func:`wait_lines`. Empty otherwise. Names come from the program's files: printable."""
+    waits = wait_lines(rt)
+    if waits:
+        return waits
     res = rt.result
     task = rt.robot
     if res is None or task is None or res.reason not in ("max_sim_time", "max_steps", "deadlock") \

@@ -147,7 +147,8 @@ def encode_loaded(lf: LoadedFile) -> bytes | None:
         return None
     try:
         body = [lf.module, lf.ok, lf.status, [_enc_diag(d, False) for d in lf.diagnostics], lf.unreadable,
-                sorted(lf.failed_words), sorted(lf.template[0]), sorted(lf.template[1])]
+                sorted(lf.failed_words), sorted(map(list, lf.template[0].items())),
+                sorted(map(list, lf.template[1].items()))]
         return msgpack.packb(body, use_bin_type=True, strict_types=True, default=_pack_default)
     except (TypeError, ValueError, OverflowError):
         return None
@@ -170,11 +171,12 @@ def decode_loaded(data: bytes, path: str) -> LoadedFile:
             raise CorruptEntry("extra data")
         if not isinstance(module, N.Module) or type(ok) is not bool or type(status) is not str \
                 or type(unreadable) is not bool or not all(type(w) is str for w in words) \
-                or not all(type(x) is int for x in (*ini, *inline)):
+                or not all(type(x) is list and len(x) == 2 and type(x[0]) is int and type(x[1]) is str
+                           for x in (*ini, *inline)):
             raise CorruptEntry("not an entry")
         module.path = path
         return LoadedFile(path, module, ok, status, 0.0, 0.0, [_dec_diag(d, path, path) for d in diags], unreadable,
-                          set(words), (frozenset(ini), frozenset(inline)))
+                          set(words), (dict(map(tuple, ini)), dict(map(tuple, inline))))
     except CorruptEntry:
         raise
     except (ValueError, TypeError, RecursionError, msgpack.exceptions.UnpackException) as exc:

@@ -50,9 +50,10 @@ from krl.project import (ProgramFiles, collect_entries, folder_groups, is_submit
                          modules_of, project_of)
 from krl.project import module_files as project_module_files
 from krl.semantics.builtins import load_builtins
-from krl.semantics.checker import Checker, Declarer, _is_system_datalist
+from krl.semantics.checker import Checker, DeclaredTwice, Declarer, _is_system_datalist
 from krl.diagnostics import Diagnostic, DiagnosticSink
-from krl.semantics.outside import Unresolved, template_lines
+from krl.diagnostics.codes import E001, E005, E901, W002, W108, W111, W201, W202, W205, W206, W210, W501
+from krl.semantics.outside import Unresolved, fold_evidence, template_lines
 from krl.semantics.resolve import resolve_workspace
 from krl.semantics.symbols import Scope, Symbol, system_scopes
 from krl.syntax.folds import fold_diagnostics
@@ -89,7 +90,7 @@ class LoadedFile:
     unreadable: bool = False
     failed_words: set = field(default_factory=set)
     # (INI-fold lines, inline-form lines) of KUKA's templates (krl/semantics/outside.py)
-    template: tuple = (frozenset(), frozenset())
+    template: tuple = ({}, {})
 
 
 # Below this many bytes a batch of files is parsed by the Python engine: starting the Java
@@ -149,8 +150,7 @@ def _loaded(src: SourceText, result: ParseResult, started: float) -> LoadedFile:
     path_s = src.path
     sink = DiagnosticSink()
     if result.status not in ("ok", "syntax_error") and not result.errors:
-        sink.add(path_s, 1, 1, "E001", f"file not checked: {result.status}"
-                 + (f" ({src.detail})" if src.detail else ""))
+        sink.add(path_s, 1, 1, *E001("not_checked", why=result.status + (f" ({src.detail})" if src.detail else "")))
     sink.extend(syntax_diagnostics(result, src.text, tokens=stream_tokens(result.tree) if result.errors else None))
     sink.extend(fold_diagnostics(path_s, src.text))
     t = time.perf_counter()
@@ -263,6 +263,10 @@ class Workspace:
     # every name (krl/semantics/resolve.py)
     system_names: list = field(default_factory=list)
     resolver: object = None
+    # the implementations of the built-in routines, upper-case name -> fn(rt, args): given by
+    # the runtime for a run (interp/runtime/natives LINKS); the resolver links each call to its
+    # own (Callee.native). None for a check alone.
+    natives: dict | None = None
     # the LoadedFile of each file added from one (path -> LoadedFile): what a full check is
     # made from again when :meth:`replace` cannot re-check a change on its own
     loaded: dict = field(default_factory=dict, repr=False)
@@ -280,12 +284,7 @@ class Workspace:
     def evidence(self, path: str, line: int, kind: str) -> str:
         """Why a use at path:line says installed software declares the name, or "" (the
         template's INI fold; a KUKA inline form, for routines and types)."""
-        ini, inline = self.template.get(path, (frozenset(), frozenset()))
-        if line in ini:
-            return "the template's INI fold uses it (KUKA's template and technology packages write that fold)"
-        if line in inline and kind in ("routine", "type"):
-            return "a KUKA inline form (;FOLD ... ;%{PE}) uses it"
-        return ""
+        return fold_evidence(self.template.get(path), line, kind)
 
     @property
     def diagnostics(self) -> list[Diagnostic]:
@@ -363,7 +362,7 @@ class Workspace:
         deep): it may declare what the other files use."""
         for e in entries:
             if e.kind != "file":
-                self.sink.add(str(e.path), 1, 1, "W002", f"not read: {e.message}")
+                self.sink.add(str(e.path), 1, 1, *W002(why=e.message))
                 self.unreadable = self._unread = True
 
     def add_text(self, text: str, path: str = "<string>.src") -> SourceFile:
@@ -419,7 +418,7 @@ class Workspace:
             self._check()
         except Exception as exc:  # noqa: BLE001 - never a traceback for bad input
             self._state = None
-            self.sink.add(self.root, 1, 1, "E901", f"internal checker error: {type(exc).__name__}: {exc}")
+            self.sink.add(self.root, 1, 1, *E901(error=f"{type(exc).__name__}: {exc}"))
         self._by_path = None
         self.check_seconds += time.perf_counter() - t
         return self.diagnostics
@@ -528,7 +527,7 @@ class Workspace:
                 sym = declarer.routine_symbol(r, u.name, u.src.path, u.scope)
                 old = scope.routines.get(r.name.upper())
                 if old is not None and isinstance(old.decl, N.Routine):
-                    declarer.duplicate(r.name, r.span, old)
+                    declarer.duplicate(r.name, r.span, old, "routine")
                 else:
                     scope.routines[r.name.upper()] = sym  # a routine replaces its EXT signature
                 if is_global and scope is glob:
@@ -538,7 +537,7 @@ class Workspace:
             if u.src.module.routines:
                 main = u.src.module.routines[0]
                 if main.name.upper() != u.name.upper() and not is_submit_file(u.src.path):
-                    sink.at(main.span, "W111", f"main routine '{main.name}' differs from the file name '{u.name}'")
+                    sink.at(main.span, *W111(name=main.name, file=u.name))
         st.declarations_done(self)
 
         # routine scopes (parameters and locals), then data-list values, then bodies
@@ -653,6 +652,15 @@ class Workspace:
             for use in uses.items:
                 un.use(*use)
         return un
+
+    def declared_twice(self) -> list[DeclaredTwice]:
+        """The declarations of the last check (or re-check) that repeat a name their scope
+        already holds (krl/semantics/checker.py DeclaredTwice: the facts behind E102), in the
+        order of a check; [] before a check. The language server's rename and the backup diff
+        read these, never the diagnostics' words."""
+        if self._state is None:
+            return []
+        return [f for _diags, uses in self._owners() for f in uses.twice]
 
     def _all_uses(self) -> list[list[tuple]]:
         """Every reported owner's unresolved uses, in the report's order (what :meth:`_report`
@@ -831,16 +839,21 @@ class Workspace:
 # ---------------------------------------------------------------------- what a check leaves
 
 class _Uses:
-    """The unresolved-name uses of one owner (:class:`krl.semantics.outside.Unresolved.use`'s
-    arguments), replayed into the report in the order of a check."""
+    """The name facts of one owner besides its findings: its unresolved-name uses
+    (:class:`krl.semantics.outside.Unresolved.use`'s arguments, replayed into the report in the
+    order of a check) and its declarations made twice (``twice``: DeclaredTwice)."""
 
-    __slots__ = ("items",)
+    __slots__ = ("items", "twice")
 
     def __init__(self) -> None:
         self.items: list[tuple] = []
+        self.twice: list[DeclaredTwice] = []
 
     def use(self, kind: str, name: str, path: str, line: int, column: int, evidence: str = "") -> None:
         self.items.append((kind, name, path, line, column, evidence))
+
+    def declared_twice(self, fact: DeclaredTwice) -> None:
+        self.twice.append(fact)
 
 
 def _moved_diagnostics(sink: DiagnosticSink, delta: int) -> DiagnosticSink:
@@ -854,7 +867,7 @@ def _moved_diagnostics(sink: DiagnosticSink, delta: int) -> DiagnosticSink:
 def _same_template(old, new, lines: range, delta: int) -> bool:
     """True when lines `lines` of the old text lie in the same template folds (INI, inline
     form: the evidence of an unresolved use) as those lines moved by `delta` in the new."""
-    return all((n in old[0]) == (n + delta in new[0]) and (n in old[1]) == (n + delta in new[1]) for n in lines)
+    return all(old[0].get(n) == new[0].get(n + delta) and old[1].get(n) == new[1].get(n + delta) for n in lines)
 
 
 @dataclass(slots=True, eq=False)
@@ -881,6 +894,8 @@ class _RoutineCheck:
         parts = [p for p in (self.scope_diags, self.body_diags) if p is not None]
         if any(path in d.message for p in parts for d in p.items):
             return False
+        if any(p is not None and p.twice for p in (self.scope_uses, self.body_uses)):
+            return False       # a declaration made twice: its facts hold places (checked again)
         uses = [p for p in (self.scope_uses, self.body_uses) if p is not None and p.items]
         if uses and (self.end_line < self.span.line or not _same_template(
                 old_template, new_template, range(self.span.line, self.end_line + 1), delta)):
@@ -919,7 +934,6 @@ class _ValueCheck:
         return True
 
 
-_FIRST_AT = re.compile(r"first declared at (.+):\d+:\d+\)")
 
 
 class _CheckState:
@@ -960,9 +974,7 @@ class _CheckState:
         paths = self.decl_paths
         for d in self.decl_sink.items:
             paths.add(d.path)
-            m = _FIRST_AT.search(d.message)
-            if m:
-                paths.add(m.group(1))
+        paths.update(f.first.file for f in self.decl_uses.twice if f.first is not None)
         paths.update(u[2] for u in self.decl_uses.items)
         for u in ws.units:
             if u.dat is not None and u.dat.path in paths and u.dat.module.data is not None:
@@ -1056,10 +1068,9 @@ def failed_load(path, o, timeout: float) -> LoadedFile:
     may declare anything (unreadable)."""
     sink = DiagnosticSink()
     if o.status == "timeout":
-        sink.add(str(path), 1, 1, "E005", f"file not checked: not parsed within {timeout:g} s "
-                 "(--timeout; the parse was stopped)")
+        sink.add(str(path), 1, 1, *E005("not_checked", timeout=timeout))
     else:
-        sink.add(str(path), 1, 1, "E001", f"file not checked: {o.detail}")
+        sink.add(str(path), 1, 1, *E001("not_checked", why=o.detail))
     module = build_module(ParseResult(str(path), False, "", o.status), DiagnosticSink())
     return LoadedFile(str(path), module, False, o.status, 0.0, 0.0, sink.items, unreadable=True)
 
@@ -1103,7 +1114,7 @@ def loading_files_by(loader: Callable[[list, float | None, int | None], list]):
 
 
 # warnings that advise a change of the code (docs/diagnostics.md): not reported in KUKA's files
-ADVISORY = frozenset({"W108", "W111", "W201", "W202", "W205", "W206", "W210", "W501"})
+ADVISORY = frozenset({W108, W111, W201, W202, W205, W206, W210, W501})
 _WORD = re.compile(r"[A-Za-z_$][A-Za-z0-9_$]*")
 
 
@@ -1191,7 +1202,7 @@ def load_workspace(paths: list[str | Path], root: str = "", timeout: float | Non
     for p in paths:
         p = Path(p)
         if not p.exists() and not p.is_symlink():
-            ws.sink.add(str(p), 1, 1, "E001", "no such file or folder")
+            ws.sink.add(str(p), 1, 1, *E001("missing"))
             continue
         entries += collect_entries(p)
     _add_entries(ws, entries, timeout, jobs)

@@ -477,7 +477,7 @@ while its EKI_Open waits (up to TIMEOUT Connect)."""
 
 class EkiPartner(Partner):
     """EthernetKRL (net/partner.py): the run's EKI channels (``EKI_Init`` creates them, the
-    natives of interp/runtime/netfunctions.py call them) and their sockets, one per channel the
+    natives of interp/runtime/natives/eki.py call them) and their sockets, one per channel the
     cell file names (``network: {eki: {CHANNEL: {config, address}}}``); the others open none
     and stay "not connected" (docs/network.md "EthernetKRL")."""
 

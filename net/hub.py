@@ -15,8 +15,8 @@ The simulated controller calls :meth:`Network.cycle` at the start of every IPO c
    same messages at the same cycles, with no socket, and both interpreters give the same trace.
 
 The runtime talks to the partners through its EKI/RSI built-ins
-(interp/runtime/netfunctions.py: ``hub.partner("eki")``, ``hub.partner("rsi")``) and gives the
-hub a *sink*: ``set_flag(n, v)``, ``set_out(n, v)``, ``read_var(name) -> text``,
+(interp/runtime/natives/eki.py, rsi.py: ``hub.partner("eki")``, ``hub.partner("rsi")``) and gives
+the hub a *sink*: ``set_flag(n, v)``, ``set_out(n, v)``, ``read_var(name) -> text``,
 ``write_var(name, text) -> text`` (interp/runtime/netvars.py).
 """
 

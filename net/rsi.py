@@ -35,7 +35,10 @@ controller sends, over UDP to the sensor, KUKA's XML::
 RECEIVE elements are the ETHERNET object's outputs by INDX. ``#ABSOLUTE``: the correction is
 the total offset from where RSI_ON found the robot; ``#RELATIVE``: each answer adds to it.
 A cycle without its answer is *late*: counted (``Delay``; a late answer still brings the
-sensor's newest values, but only one in time ends the count), and past ``Timeout`` late packets
+sensor's newest values, but only one in time ends the count). In time is in simulated time: a
+live sensor's answer is waited for until the next cycle starts (:data:`ANSWER_WAIT_S` of wall
+time at most; a sensor silent that long is late at once from then on), so neither a slow
+simulator nor a loaded machine makes a packet late. Past ``Timeout`` late packets
 in a row the robot stops with the KSS message "RSI: maximum number of late packets
 exceeded" and the program with it. The corrections superpose on the programmed motion
 (robot/controller.py ``correction``); RSI_OFF keeps the corrected position. Everything that
@@ -46,6 +49,7 @@ from __future__ import annotations
 
 import math
 import re
+import select
 import time
 
 import numpy as np
@@ -66,6 +70,14 @@ SENSOR_CYCLE_MS = 12
 FAST_CYCLE_MS = 4
 LATE_NUMBER = 1
 MON_NUMBER = 2
+#: Wall-clock seconds the simulated controller waits for the live sensor's answer to a packet
+#: before it counts the packet late (docs/network.md, Decisions: "an answer is in time in
+#: simulated time"). The simulator is not a real-time controller: how fast it runs depends on
+#: the machine and its load, so a packet's answer is in time when it is there when the next
+#: sensor cycle starts, however long that took on the wall clock. A sensor that has not
+#: answered for this long is silent: its packets are late from then on, at once, without
+#: waiting, until it answers again (so Timeout + 1 silent cycles still stop the robot).
+ANSWER_WAIT_S = 2.0
 MIN_DECIMALS = 4        # values are sent with max(Precision, 4) decimals (docs/network.md, Decisions)
 MAX_FLOW_DEPTH = 64     # links followed from an object back to its sources
 def _first(ins: list, k: int = 0) -> float:
@@ -132,6 +144,7 @@ class Rsi:
         self.recent: list[int] = []          # the last IPOCs sent (a late answer is still applied)
         self.late = 0
         self.late_total = 0
+        self.silent = False                  # no answer for ANSWER_WAIT_S: late without waiting
         self.stopped = False
         self.failed: str | None = None
         self.noted: set[str] = set()
@@ -229,6 +242,7 @@ class Rsi:
         self.outputs = {}
         self.expect = []
         self.late = 0
+        self.silent = False
         self.stopped = False
         self.failed = None
         self.q_on = np.array(ctl.axis_act(), dtype=float)[:6]
@@ -270,10 +284,8 @@ class Rsi:
         if not self.on or self.failed:
             return
         if live and self.endpoint is not None:
-            for ev in self.endpoint.poll():
-                if ev[0] == "data":
-                    self.hub.trace("rsi", "in", data=ev[1].decode("latin-1"))
-                    self.answer(ev[1])
+            self._await(self.expect)            # the last cycle's packets (ANSWER_WAIT_S)
+            self._receive()
         self._count_late(ctl)
         if self.failed:
             return
@@ -289,13 +301,39 @@ class Rsi:
             del self.recent[:-16]
             if live and self.endpoint is not None:
                 self.endpoint.send(msg)
-                if self.fast and i < n - 1 and self.hub.pacer is not None:
+                if self.fast and i < n - 1:
+                    if self.hub.pacer is not None:      # the sensor sees the 4 ms rhythm
+                        time.sleep(FAST_CYCLE_MS / 1000.0 / self.hub.pacer.pace)
+                    self._await([ipoc])                 # its answer before the next 4 ms packet
+                    self._receive()
 
-                    time.sleep(FAST_CYCLE_MS / 1000.0 / self.hub.pacer.pace)
-                    for ev in self.endpoint.poll():
-                        if ev[0] == "data":
-                            self.hub.trace("rsi", "in", data=ev[1].decode("latin-1"))
-                            self.answer(ev[1])
+    def _receive(self) -> None:
+        """What the sensor sent since the last look: each datagram an answer."""
+        for ev in self.endpoint.poll():
+            if ev[0] == "data":
+                self.hub.trace("rsi", "in", data=ev[1].decode("latin-1"))
+                self.answer(ev[1])
+
+    def _await(self, ipocs: list[int]) -> None:
+        """Live: wait until the packets `ipocs` are answered (each answer applied as it comes),
+        at most :data:`ANSWER_WAIT_S` of wall time; past it the sensor is silent and is not
+        waited for again until it answers."""
+        sock = getattr(self.endpoint, "sock", None)
+        if self.silent or sock is None:
+            return
+        pending = [i for i in ipocs if i in self.expect]
+        end = time.monotonic() + ANSWER_WAIT_S
+        while any(i in self.expect for i in pending):
+            left = end - time.monotonic()
+            if left <= 0:
+                self.silent = True
+                return
+            try:
+                ready, _, _ = select.select([sock], [], [], left)
+            except (OSError, ValueError):       # the socket was closed under us
+                return
+            if ready:
+                self._receive()
 
     def replayed(self, ev: dict) -> None:
         if ev.get("dir") == "in" and self.on and not self.failed:
@@ -347,6 +385,7 @@ class Rsi:
         elif ipoc not in self.recent:
             self.hub.trace("rsi", "error", text=f"an answer with IPOC {ipoc} that no packet was sent with")
             return
+        self.silent = False                     # the sensor answers: waited for again
         # a late answer (its packet already counted late) still carries the sensor's newest values
         for el in self.ctx.ethernet.receive:
             if el.internal:

@@ -6,7 +6,7 @@ with C_PTP/C_DIS approximation, triggers and I/O, and the full per-IPO-cycle JSO
 trace — and reports ``sim_realtime_factor`` = simulated seconds / wall-clock seconds and
 ``sim_cpu_factor`` = simulated seconds / CPU seconds of the process (the figure to compare on a
 loaded machine). The target is >= 20 (60 s of motion in under 3 s); issue 39 asks for 300.
-``krl bench --json`` reports the real-time factor. ``python -m robot.bench --against DIR``
+``krl bench --json`` reports the same figures (:func:`measure`: warm, the same run). ``python -m robot.bench --against DIR``
 measures another checkout side by side (see :func:`main`).
 
 Also holds :func:`run_motions`, a small driver used by the tests and the benchmark.
@@ -102,10 +102,13 @@ def run_bench(min_motion_s: float = 60.0, trace_path: str | None = None, machine
             "cycles": ctl.cycle, "motions": n, "target": TARGET_FACTOR}
 
 
-def _measure(min_motion_s: float, robot: str | None, warm_up: bool) -> dict[str, Any]:
-    """:func:`run_bench` on the robot of path `robot` (None: the KR 6 R900), after a short
-    untimed run when `warm_up` (the process's one-time costs: importing MuJoCo, the first
-    model compile, numpy's and scipy's first calls); adds ``warmup_s`` (its wall time)."""
+def measure(min_motion_s: float = 60.0, robot: str | None = None, warm_up: bool = True) -> dict[str, Any]:
+    """The simulator's figure, as ``python -m robot.bench`` and ``krl bench --json`` both give it
+    (issue 48, "one figure per measure"): :func:`run_bench` on the robot of path `robot` (None:
+    the KR 6 R900), after a short untimed run when `warm_up` (the process's one-time costs:
+    importing MuJoCo, the first model compile, numpy's and scipy's first calls, which a cold
+    figure would add once: 221-256x against 404x on 2026-11-24); adds ``warmup_s`` (its wall
+    time)."""
     machine = None
     if robot:
         from .mada import load_robot  # noqa: PLC0415  (only with --robot: the machine-data reader)
@@ -122,7 +125,7 @@ def _measure(min_motion_s: float, robot: str | None, warm_up: bool) -> dict[str,
 
 def _child_measure(root: str, min_motion_s: float, robot: str | None, warm_up: bool) -> dict[str, Any]:
     """:func:`run_bench` of the checkout in `root` (its own ``robot`` package, a child process
-    of this interpreter), warmed up like :func:`_measure`."""
+    of this interpreter), warmed up like :func:`measure`."""
     import json  # noqa: PLC0415  (only with --against)
     import subprocess  # noqa: PLC0415
     import sys  # noqa: PLC0415
@@ -168,7 +171,7 @@ def main(argv: list[str] | None = None) -> int:  # pragma: no cover - manual ent
     warm = not args.no_warm_up
     robot = os.path.abspath(args.robot) if args.robot else None
     if not args.against:
-        r = _measure(args.min_motion_s, robot, warm)
+        r = measure(args.min_motion_s, robot, warm)
         print(json.dumps(r))
         return 0 if r["sim_realtime_factor"] >= TARGET_FACTOR else 1
     here = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))

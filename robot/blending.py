@@ -258,12 +258,12 @@ _BLEND_SAMPLES = 16
 
 
 def _rates_at(seg: Segment, us: np.ndarray, from_end: bool) -> tuple[np.ndarray, np.ndarray]:
-    """dq/du and d2q/du2 (deg, shape (n, 6)) of a segment at the path parameters ``us``. A PTP
+    """dq/du and d2q/du2 (deg, shape (len(us), w)) of a segment at the path parameters ``us``. A PTP
     is linear in u; a CP motion is sampled with inverse kinematics along its path, from its
     end point's axes (``from_end``) or its start's (the segment's own state is not touched). If the IK cannot follow the window
     (the planner already accepted this path), the planned end rates are used."""
     n = len(us)
-    w = len(seg.q0)                       # A1..A6 and the external axes (robot/planner.py)
+    w = len(seg.q0)                       # A1..An and the external axes (robot/planner.py)
     if not seg.cart:
         return np.broadcast_to(seg.q1 - seg.q0, (n, w)), np.zeros((n, w))
     lo, hi = float(np.min(us)), float(np.max(us))
@@ -276,7 +276,7 @@ def _rates_at(seg: Segment, us: np.ndarray, from_end: bool) -> tuple[np.ndarray,
     try:
         for j in order:
             p, R = seg.pose_u(float(grid[j]))
-            ref = Q[j] = seg.ik(p, R, ref, float(grid[j])) if w > 6 else seg.ik(p, R, ref)
+            ref = Q[j] = seg.ik(p, R, ref, float(grid[j])) if w > seg.model.n else seg.ik(p, R, ref)
     except Exception:  # noqa: BLE001 - keep the planned rates
         d = seg.qd_start if lo <= 0.0 else seg.qd_end
         return np.broadcast_to(d, (n, w)), np.zeros((n, w))
@@ -319,10 +319,11 @@ def superpose_pose(p0: np.ndarray, R0: np.ndarray, p1: np.ndarray, R1: np.ndarra
 
 
 def reduced_orientation(model: Any) -> bool:
-    """Does the robot reach only part of an orientation? True for the palletizers
-    (``$DEF_A4FIX``: A4 stays at 0; docs/robot.md "The palletizers"), whose inverse drops the
-    component of a target's orientation it has no axis for."""
-    return bool(getattr(getattr(model, "machine", None), "a4fix", False))
+    """Does the robot reach only part of an orientation? True for the kinematic families that
+    say so (``reduced_orientation``: the palletizers, whose A4 stays at 0, docs/robot.md "The
+    palletizers"; a SCARA), whose inverse drops the component of a target's orientation they
+    have no axis for."""
+    return bool(model.kin.impl.reduced_orientation)
 
 
 def reached_pose(seg: Segment, p: np.ndarray, R: np.ndarray, ref: np.ndarray,
@@ -335,7 +336,7 @@ def reached_pose(seg: Segment, p: np.ndarray, R: np.ndarray, ref: np.ndarray,
     motion's own (a 5-axis palletizer's A2 jumped to 1.46x a_max at the end of a CIRC
     #CONSTANT -> CIRC blend, whose orientations were 29 deg apart at the point). Raises
     WorkspaceError/SoftLimitError as :meth:`CartSegment.ik`."""
-    q = seg.ik(p, R, ref, u) if len(ref) > 6 else seg.ik(p, R, ref)  # type: ignore[attr-defined]
+    q = seg.ik(p, R, ref, u) if len(ref) > seg.model.n else seg.ik(p, R, ref)  # type: ignore[attr-defined]
     T = seg.model.tcp(q, seg.tool_T, seg.base_inv_T)
     return T[:3, 3], T[:3, :3]
 

@@ -1,21 +1,31 @@
-"""Build the compiled hot path of the simulator: robot/simcore.pyx compiled by Cython
-into an extension module beside it (``simcore.*.so``; gitignored). Issue 39, "Simulator".
+"""Build the compiled hot path of the simulator (issue 39, "Simulator"; issue 47), two Cython
+extensions, each beside its source (``*.so``; gitignored):
 
-One definition (:func:`extension`), two ways in, as for the VM loop (interp/vm/build.py), both
+* ``robot.kinematics.fastpath``: robot/kinematics/fastpath.py itself, compiled with the C types of
+  fastpath.pxd beside it (the kinematics' one source: the OPW form, its status and the choice
+  among solutions; the file runs as Python without a compiler);
+* ``robot.simcore``: robot/simcore.pyx, what needs C's access to MuJoCo's and numpy's BLAS
+  functions and the IPO cycle's own loops (``Forward``, ``ArmCycle``, ``CartPath``, the
+  4-axis palletizer's flange test, ``speed_ok``, ``pose_line``; it calls fastpath's C methods).
+  It carries the sha256 of simcore.pyx it was built from (``SOURCE_SHA``): robot/kinematics
+  uses a build only when that is the current file's (no version number kept by hand).
+
+One definition (:func:`extensions`), two ways in, as for the VM loop (interp/vm/build.py), both
 through krl/cbuild.py:
 
-* the package build: ``setup.py`` loads this file by path and gives :func:`extension`, translated
+* the package build: ``setup.py`` loads this file by path and gives :func:`extensions`, translated
   by Cython, to setuptools, so ``pip install``, ``pip install -e`` (which ``make`` runs) and the
-  wheel carry it;
-* ``python -m robot.build`` (``make vm-loop``): rebuilds it in place after simcore.pyx changed.
+  wheel carry them;
+* ``python -m robot.build`` (``make vm-loop``): rebuilds them in place after a source changed.
 
-Without Cython or a C compiler the build says so and succeeds; robot/kinematics.py then runs
-its pure-Python OPW code, which the extension mirrors bit for bit (``-ffp-contract=off``: no
-fused multiply-add, so C gives the products and sums Python gives).
+Without Cython or a C compiler the build says so and succeeds; the pure-Python code runs then
+(fastpath.py as it stands, robot/kinematics' numpy code for the rest). ``-ffp-contract=off``: no
+fused multiply-add, so C gives the products and sums Python gives.
 """
 
 from __future__ import annotations
 
+import hashlib
 import sys
 import sysconfig
 from pathlib import Path
@@ -24,31 +34,54 @@ HERE = Path(__file__).resolve().parent
 REPO = HERE.parent
 SOURCE = HERE / "simcore.pyx"
 MODULE = "robot.simcore"
+FASTPATH = HERE / "kinematics" / "fastpath.py"
+FASTPATH_PXD = HERE / "kinematics" / "fastpath.pxd"
+FASTPATH_MODULE = "robot.kinematics.fastpath"
 #: C flags: optimised, and no contraction of a * b + c into one rounding (bit-identical results)
 CFLAGS = ["-O2", "-ffp-contract=off", "-fno-fast-math"]
 
 
+def source_sha() -> str:
+    """The sha256 of simcore.pyx (the build embeds it as ``SOURCE_SHA``)."""
+    return hashlib.sha256(SOURCE.read_bytes()).hexdigest()
+
+
 def target() -> Path:
-    """The extension module's path for this interpreter."""
+    """The simcore extension module's path for this interpreter."""
     return HERE / ("simcore" + sysconfig.get_config_var("EXT_SUFFIX"))
 
 
-def extension(root: Path | None = None):
-    """The setuptools ``Extension`` (``optional``: a failed compile leaves the pure-Python
-    code in place), its source absolute or relative to ``root``. Raises ImportError without
-    setuptools."""
+def fastpath_target() -> Path:
+    """The fastpath extension module's path for this interpreter."""
+    return FASTPATH.with_name("fastpath" + sysconfig.get_config_var("EXT_SUFFIX"))
+
+
+def extensions(root: Path | None = None) -> list:
+    """The setuptools ``Extension``s (``optional``: a failed compile leaves the pure-Python code
+    in place), their sources absolute or relative to ``root``; fastpath first (simcore cimports
+    it). Raises ImportError without setuptools."""
     from setuptools import Extension  # noqa: PLC0415  (setuptools loads only for a build)
 
-    src = str(SOURCE) if root is None else SOURCE.relative_to(root).as_posix()
-    return Extension(MODULE, [src], extra_compile_args=CFLAGS, optional=True)
+    def rel(p: Path) -> str:
+        return str(p) if root is None else p.relative_to(root).as_posix()
+
+    sha = source_sha()
+    return [Extension(FASTPATH_MODULE, [rel(FASTPATH)], extra_compile_args=CFLAGS, optional=True),
+            Extension(MODULE, [rel(SOURCE)], extra_compile_args=CFLAGS, optional=True,
+                      define_macros=[("SIMCORE_SOURCE_SHA", f'"{sha}"')])]
 
 
 def build(force: bool = False) -> str:
-    """Compile simcore.pyx in place; the outcome in words. Raises nothing for a missing Cython
-    or compiler (the pure-Python inverse runs then)."""
+    """Compile fastpath.py and simcore.pyx in place; the outcome in words. Raises nothing for a
+    missing Cython or compiler (the pure-Python code runs then)."""
     from krl.cbuild import build_in_place  # noqa: PLC0415  (loads only for a build; setup.py loads this file by path, where krl is not importable)
 
-    return build_in_place(extension(), target(), (SOURCE,), REPO, "the pure-Python inverse kinematics runs", force)
+    fast, sim = extensions()
+    out = [build_in_place(fast, fastpath_target(), (FASTPATH, FASTPATH_PXD), REPO,
+                          "the kinematics run fastpath.py as Python", force)]
+    out.append(build_in_place(sim, target(), (SOURCE, FASTPATH_PXD), REPO,
+                              "the simulator's pure-Python code runs", force))
+    return "\n".join(out)
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -14,7 +14,7 @@ whether the arm has the ortho-parallel form with a spherical wrist that the OPW 
 solves (Brandstötter, Angerer, Hofbaur: "An analytical solution of the inverse kinematics
 problem of industrial serial manipulators with an ortho-parallel basis and a spherical wrist",
 2014), and gives its parameters, axis signs and the fixed frames before and after it. The
-caller verifies the form against :func:`chain_forward` before using it (robot/kinematics.py).
+caller verifies the form against :func:`chain_forward` before using it (robot/kinematics/opw.py).
 """
 
 from __future__ import annotations
@@ -35,15 +35,19 @@ _GEOM_EPS = 1e-9
 
 @dataclass(frozen=True)
 class Chain:
-    """A serial chain ``F0 · Rot(u1, q1) · F1 · ... · Rot(u6, q6) · F6``.
+    """A serial chain ``F0 · J1(q1) · F1 · ... · Jn(qn) · Fn`` (n = 6 for the arms above, 4 for
+    a SCARA), each joint ``Ji`` a rotation about its unit axis ``ui`` by ``qi`` deg or, for a
+    linear axis, a translation along it by ``qi`` mm.
 
     Attributes:
-        fixed: seven 4x4 fixed transforms F0..F6 (mm) as nested tuples.
-        axes: six unit joint axes u1..u6 (the frame after F(i-1)), KUKA's ``$AXIS_DIR`` in them.
+        fixed: n + 1 4x4 fixed transforms F0..Fn (mm) as nested tuples.
+        axes: n unit joint axes u1..un (the frame after F(i-1)), KUKA's ``$AXIS_DIR`` in them.
+        kinds: ``"rotary"`` or ``"linear"`` per axis (empty: all rotary).
     """
 
     fixed: tuple
     axes: tuple
+    kinds: tuple = ()
 
     def frames(self) -> list[np.ndarray]:
         """F0..F6 as 4x4 arrays (mm)."""
@@ -53,48 +57,61 @@ class Chain:
         """u1..u6 as arrays."""
         return [np.array(a, dtype=float) for a in self.axes]
 
+    def linear(self, i: int) -> bool:
+        """True when axis i (0 = A1) is linear."""
+        return bool(self.kinds) and self.kinds[i] == "linear"
+
     @staticmethod
-    def of(fixed: list[np.ndarray], axes: list[np.ndarray]) -> "Chain":
+    def of(fixed: list[np.ndarray], axes: list[np.ndarray], kinds: tuple = ()) -> "Chain":
         return Chain(tuple(tuple(map(tuple, np.asarray(f, dtype=float).tolist())) for f in fixed),
-                     tuple(tuple(float(v) for v in a) for a in axes))
+                     tuple(tuple(float(v) for v in a) for a in axes), tuple(kinds))
 
 
 def chain_forward(chain: Chain, axes_deg) -> np.ndarray:
-    """The flange frame of the chain itself (4x4, mm) for axes A1..A6 in deg."""
+    """The flange frame of the chain itself (4x4, mm) for axes A1..An in deg (a linear axis in mm)."""
     fixed, local = chain.frames(), chain.local_axes()
     T = fixed[0].copy()
-    for i in range(6):
+    for i in range(len(local)):
         J = np.eye(4)
-        J[:3, :3] = Rotation.from_rotvec(local[i] * math.radians(float(axes_deg[i]))).as_matrix()
+        if chain.linear(i):
+            J[:3, 3] = local[i] * float(axes_deg[i])
+        else:
+            J[:3, :3] = Rotation.from_rotvec(local[i] * math.radians(float(axes_deg[i]))).as_matrix()
         T = T @ J @ fixed[i + 1]
     return T
 
 
 def chain_to_joints(fixed: list[np.ndarray], axes_local: list[np.ndarray]
                     ) -> tuple[list[np.ndarray], list[np.ndarray], np.ndarray]:
-    """URDF-style joints of a serial chain ``F0 · Rot(u1, q1) · F1 · ... · Rot(u6, q6) · F6``.
+    """URDF-style joints of a serial chain ``F0 · J1(q1) · F1 · ... · Jn(qn) · Fn`` (:class:`Chain`).
 
     Args:
-        fixed: seven 4x4 fixed transforms F0..F6 (mm).
-        axes_local: six unit joint axes u1..u6 in the frame after F(i-1).
+        fixed: n + 1 4x4 fixed transforms F0..Fn (mm).
+        axes_local: n unit joint axes u1..un in the frame after F(i-1).
     Returns:
         (origins, axes, flange): joint origins (translations in the parent joint's frame,
-        no rotation), joint axes in that frame, and the 4x4 link_6 -> flange transform.
+        no rotation), joint axes in that frame, and the 4x4 last link -> flange transform.
         Each fixed rotation is moved past the joints that follow it
-        (``R · Rot(u, q) = Rot(R u, q) · R``); a translation along a wrist axis (A4, A6) is
-        moved to the joint origin where ROS-Industrial URDFs put it (it commutes with the
-        rotation about that axis).
+        (``R · Rot(u, q) = Rot(R u, q) · R``, and ``R · Trans(u, q) = Trans(R u, q) · R``); on a
+        six-axis arm a translation along a wrist axis (A4, A6) is moved to the joint origin
+        where ROS-Industrial URDFs put it (it commutes with the rotation about that axis).
     """
+    n = len(axes_local)
     R = np.eye(3)
     origins: list[np.ndarray] = []
     axes: list[np.ndarray] = []
-    for i in range(6):
+    for i in range(n):
         origins.append(R @ fixed[i][:3, 3])
         R = R @ fixed[i][:3, :3]
         axes.append(R @ axes_local[i])
     flange = np.eye(4)
-    flange[:3, :3] = R @ fixed[6][:3, :3]
-    flange[:3, 3] = R @ fixed[6][:3, 3]
+    flange[:3, :3] = R @ fixed[n][:3, :3]
+    flange[:3, 3] = R @ fixed[n][:3, 3]
+    if n != 6:
+        clean = [np.round(v, 9) + 0.0 for v in origins]
+        clean_axes = [np.where(np.abs(v) < 1e-12, 0.0, np.round(v, 12)) + 0.0 for v in axes]
+        flange[np.abs(flange) < 1e-12] = 0.0
+        return clean, clean_axes, flange
     # A4: the part of its origin along its own axis goes to A5's origin
     a = axes[3]
     along = float(origins[3] @ a) * a

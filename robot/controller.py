@@ -48,13 +48,10 @@ from .trace import TraceWriter
 
 def _compiled_module() -> Any:
     """The compiled module robot/simcore.pyx when it is built, current and switched on
-    (robot/kinematics.py ``USE_COMPILED``), else None."""
-    from . import kinematics  # noqa: PLC0415  (the module's one switch and ABI check)
+    (robot/kinematics ``compiled_module``: ``USE_COMPILED``), else None."""
+    from .kinematics import compiled_module  # noqa: PLC0415  (the package's one switch and ABI check)
 
-    sc = kinematics._simcore
-    if sc is None or not kinematics.USE_COMPILED or getattr(sc, "ABI", None) != kinematics.SIMCORE_ABI:
-        return None
-    return sc
+    return compiled_module()
 
 EPS = 1e-9
 _F8 = np.dtype(np.float64)
@@ -250,11 +247,13 @@ class Controller:
         self.io = IOImage(on_change=self._on_io)
         self.rules += list(rules or [])
         self.stimuli: list[Stimulus] = list(stimuli or [])
-        q = np.array(self.machine.home_deg if start_axes is None else start_axes, dtype=float)
-        if self.model.n_ext:
-            # A1..A6 then E1..En (robot/planner.py): E from $AXIS_HOME[1] unless given
-            home = np.array(self.machine.home_all, dtype=float)
-            q = np.concatenate([q[:6], q[6:6 + self.model.n_ext], home[6 + len(q[6:]):]])[:6 + self.model.n_ext]
+        #: the robot's axis count: axis vectors are A1..An, then E1..En (robot/planner.py)
+        self.n = self.model.n
+        if start_axes is None:
+            q = np.array(self.machine.home_all, dtype=float)
+        else:
+            # KRL's order (A1..A6, E1..E6); E from $AXIS_HOME[1] unless given
+            q = self.model.from_krl(start_axes)
         self.model.check_limits(q)
         self._arm = None
         self.actuated = actuated
@@ -373,7 +372,7 @@ class Controller:
             return False
         flange = (inv_pos(self.model.robroot_T) @ frame_to_matrix(*p.base)
                   @ frame_to_matrix(*(float(req.target[k]) for k in keys)) @ inv_pos(frame_to_matrix(*p.tool)))
-        limits = [j.limit_deg for j in self.machine.joints[:6]]
+        limits = [j.limit_deg for j in self.machine.joints]
         for q in self.model.kin.solutions(flange):
             if all(any(lo <= v + k <= hi for k in (-720.0, -360.0, 0.0, 360.0, 720.0))
                    for v, (lo, hi) in zip(q, limits)):
@@ -412,13 +411,14 @@ class Controller:
 
     def place(self, axes: Any) -> None:
         """Set the scene (``krl run --start``, a cell file's ``start:``): the robot stands at
-        `axes` (A1..A6, deg) before the first cycle. Raises
+        `axes` (KRL's order: A1..A6, E1..E6, deg; robot/planner.py ``RobotModel.from_krl``) before
+        the first cycle. Raises
         :class:`~robot.errors.SoftLimitError` for axes outside the software limits, ValueError
         once the run has started."""
         if self._k or self._runs or self._pending or self._next_id > 1:
             raise ValueError("the robot can only be placed before the run starts")
-        q = np.array(axes, dtype=float)[:6]
-        self.model.kin.check_soft_limits(q)
+        q = self.model.from_krl(axes)
+        self.model.check_limits(q)
         self._q = q.copy()
         self._q_prev = q.copy()
         self._plan_q = q.copy()
@@ -721,16 +721,21 @@ class Controller:
 
     # ================================================================= read-back
     def axis_act(self) -> np.ndarray:
-        """``$AXIS_ACT``: A1..A6 (deg) read back from the MuJoCo model, shape (6,); then E1..En
-        (mm, deg) on a robot with external axes."""
+        """``$AXIS_ACT`` in KRL's order: A1..A6 (deg) read back from the MuJoCo model, shape (6,)
+        (0 for the axes of a robot with fewer than six, a SCARA's A5 and A6); then E1..En (mm,
+        deg) on a robot with external axes."""
+        return self.model.to_krl(self._axes_act())
+
+    def _axes_act(self) -> np.ndarray:
+        """The axes read back (A1..An, E1..En: the model's order)."""
         arm = self._arm if self._arm_q is None else self._arm_model()
         if arm is not None:
             return arm.axes_deg()
         return self._q.copy()
 
     def axis_setpoint(self) -> np.ndarray:
-        """The current IPO setpoint A1..A6 (deg)."""
-        return self._q.copy()
+        """The current IPO setpoint in KRL's order (as :meth:`axis_act`)."""
+        return self.model.to_krl(self._q.copy())
 
     def pos_act(self, tool: Any = None, base: Any = None, ipo_mode: str = "BASE") -> dict[str, float]:
         """``$POS_ACT`` as an E6POS dict {X, Y, Z, A, B, C, S, T} (mm, deg): the TCP of
@@ -739,7 +744,7 @@ class Controller:
         (external TCP, reference §6.4): ``tool`` is the workpiece on the flange, ``base`` the
         fixed tool in WORLD, and the pose is the fixed tool in the workpiece frame,
         ``INV_POS($ROBROOT : FLANGE(q) : $TOOL) : $BASE`` (robot/external_tcp.py)."""
-        q = self.axis_act()
+        q = self._axes_act()
         tool_T = self._tool_T if tool is None else _as4(tool)
         base_inv = self._base_inv_T if base is None else inv_pos(_as4(base))
         T = self._tcp_read_back(q, tool_T, base_inv)
@@ -748,7 +753,7 @@ class Controller:
         x, y, z, a, b, c = matrix_to_frame(T)
         s, t = self.model.status_turn(q)
         out = {"X": x, "Y": y, "Z": z, "A": a, "B": b, "C": c, "S": s, "T": t}
-        for i, v in enumerate(q[6:]):
+        for i, v in enumerate(q[self.n:]):
             out[f"E{i + 1}"] = float(v)
         return out
 
@@ -890,7 +895,7 @@ class Controller:
                     arm.step_actuated(self._q, self.dt, (self._q - self._q_prev) / self.dt)
                 else:
                     arm.set_axes(self._q)
-            qa = self.axis_act()
+            qa = self._axes_act()
             self._tcp_prev = self._tcp_T[:3, 3].copy()
             self._tcp_T = self._tcp_read_back(qa, self._tool_T, self._base_inv_T)
         if self._cyclic:
@@ -1025,11 +1030,12 @@ class Controller:
                 pc, Rc = blending.reached_pose(b.nxt.seg, pc, Rc, self._q, 0.0)
             p, R = blending.superpose_pose(p0, R0, p1, R1, pc, Rc)
             ref = self._q
-            if len(ref) > 6:
+            n = self.n
+            if len(ref) > n:
                 # the external axes overlap like axes: E_prev(t) + E_next(t) - E at the point
-                e = (_e_at(b.prev.seg, b.prev.seg.u(t_prev)) + _e_at(b.nxt.seg, b.nxt.seg.u(t_next))
-                     - b.nxt.seg.q0[6:])
-                ref = np.concatenate([ref[:6], e])
+                e = (_e_at(b.prev.seg, b.prev.seg.u(t_prev), n) + _e_at(b.nxt.seg, b.nxt.seg.u(t_next), n)
+                     - b.nxt.seg.q0[n:])
+                ref = np.concatenate([ref[:n], e])
             return b.nxt.seg.ik(p, R, ref)  # type: ignore[attr-defined]
         q = b.prev.seg.axes(t_prev) + (b.nxt.seg.axes(t_next) - b.nxt.seg.q0)
         self.model.check_limits(q)
@@ -1045,12 +1051,13 @@ class Controller:
         self._q_raw = np.asarray(q, dtype=float)
         out = self._q_raw.copy()
         corr = self.correction
-        axes = np.asarray(corr.axes, dtype=float)
+        n = self.n
+        axes = np.asarray(corr.axes, dtype=float)        # KRL's A1..A6
         if np.any(axes):
-            out[:6] += axes
+            out[:n] += axes[:n]
         cart = np.asarray(corr.cart, dtype=float)
         if np.any(cart):
-            T = self.model.tcp(out[:6], self._tool_T, self._base_inv_T)
+            T = self.model.tcp(out[:n], self._tool_T, self._base_inv_T)
             C = frame_to_matrix(*cart)
             frame = getattr(corr, "frame", "BASE")      # RSI's POSCORR RefCorrSys (net/rsi.py)
             if frame == "WORLD":                        # a correction in $WORLD, seen from $BASE
@@ -1063,7 +1070,7 @@ class Controller:
                 target = T.copy()
                 target[:3, 3] = T[:3, 3] + C[:3, 3]
                 target[:3, :3] = C[:3, :3] @ T[:3, :3]
-            out[:6] = self.model.ik(target, np.linalg.inv(self._tool_T), self._base_T, None, None, out[:6])
+            out[:n] = self.model.ik(target, np.linalg.inv(self._tool_T), self._base_T, None, None, out[:n])
         return out
 
     def set_correction(self, correction) -> None:
@@ -1207,9 +1214,10 @@ class Controller:
                                 self.io.set_signal(name, v, st.source)
 
 
-def _e_at(seg: Segment, u: float) -> np.ndarray:
-    """The external axes of `seg` at its path parameter `u` (linear from start to end)."""
-    return seg.q0[6:] + u * (seg.q1[6:] - seg.q0[6:])
+def _e_at(seg: Segment, u: float, n: int) -> np.ndarray:
+    """The external axes of `seg` (after its n robot axes) at its path parameter `u` (linear
+    from start to end)."""
+    return seg.q0[n:] + u * (seg.q1[n:] - seg.q0[n:])
 
 
 def _as4(F: Any) -> np.ndarray:

@@ -100,13 +100,14 @@ class MotionLimits:
 
 
 def ptp_axis_speeds(params: Any, machine: Any, mode: str = DEFAULT_MODE) -> np.ndarray:
-    """The programmed axis speeds of a PTP/SPTP motion, deg/s per axis (shape (6,), then the
-    external axes E1..En in mm/s or deg/s):
+    """The programmed axis speeds of a PTP/SPTP motion, deg/s per axis (shape (n,): A1..An, a
+    linear axis in mm/s; then the external axes E1..En in mm/s or deg/s):
     ``v_max_i · $VEL_AXIS[i]% · $OV_PRO%``, ``· $RED_T1%`` in T1 (reference §6.7, robot-model.md
     §10; an external axis at 100 % of ``$VEL_AXIS``). The one formula: the planner plans with
     it, :func:`motion_limits` checks with it."""
     v_max = np.asarray(getattr(machine, "all_max_speed", machine.max_speed_deg_s), dtype=float)
-    vel_axis = list(params.vel_axis)[:6] + [100.0] * (len(v_max) - 6)
+    n = len(machine.joints)
+    vel_axis = list(params.vel_axis)[:n] + [100.0] * (len(v_max) - n)
     axes = v_max * np.asarray(vel_axis, dtype=float) / 100.0 * params.ov_pro / 100.0
     if mode == "T1":
         axes = axes * red_t1_pct(machine) / 100.0
@@ -273,7 +274,7 @@ def check_trace(events: Iterable[dict[str, Any]], machine: Any = None, *,
         from .external import ExternalAxes  # noqa: PLC0415
 
         ext = ExternalAxes(machine)
-        F = np.array([ext.robroot(q[6:]) for q in Q]) @ F     # $ROBROOT_C on a track
+        F = np.array([ext.robroot(q[kin.n_axes:]) for q in Q]) @ F     # $ROBROOT_C on a track
     else:
         robroot = frame_to_matrix(*machine.robroot_frame)
         F = robroot @ F
@@ -326,8 +327,9 @@ def check_trace(events: Iterable[dict[str, Any]], machine: Any = None, *,
                     from .external import ExternalAxes  # noqa: PLC0415
 
                     ext = ExternalAxes(machine)
-                    a = (binv @ inv_pos(ext.chain(ext.base_kins[ml.base_kin], Q[k - 1][6:])) @ F[k - 1] @ tool)[:3, 3]
-                    b = (binv @ inv_pos(ext.chain(ext.base_kins[ml.base_kin], Q[k][6:])) @ F[k] @ tool)[:3, 3]
+                    na = kin.n_axes
+                    a = (binv @ inv_pos(ext.chain(ext.base_kins[ml.base_kin], Q[k - 1][na:])) @ F[k - 1] @ tool)[:3, 3]
+                    b = (binv @ inv_pos(ext.chain(ext.base_kins[ml.base_kin], Q[k][na:])) @ F[k] @ tool)[:3, 3]
                 else:
                     a = (binv @ F[k - 1] @ tool)[:3, 3]
                     b = (binv @ F[k] @ tool)[:3, 3]

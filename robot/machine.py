@@ -56,6 +56,9 @@ class JointData:
         parent, child: URDF link names.
         origin_rpy_rad: URDF joint origin rotation (roll, pitch, yaw), rad.
         kuka_sign: ``q_urdf_rad = kuka_sign * radians(A_i)`` (yaml ``angle_mapping``, +1 here).
+        kind: ``"rotary"`` (deg) or ``"linear"`` (``$AXIS_TYPE`` 1: mm, moving along
+            ``joint_axis``; a SCARA's A3); the limits, speed, acceleration and jerk are then in
+            mm, mm/s, mm/s^2 and mm/s^3.
     """
 
     name: str
@@ -71,6 +74,7 @@ class JointData:
     child: str = ""
     kuka_sign: int = 1
     origin_rpy_rad: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    kind: str = "rotary"
 
     @property
     def softn_end(self) -> float:
@@ -182,7 +186,8 @@ class MachineData:
     Attributes:
         name: robot name, ``"KR 6 R900 sixx"`` (from machine data: ``$TRAFONAME`` without
             its ``#``, robot/mada.py).
-        joints: six :class:`JointData`, A1..A6.
+        joints: the robot's axes A1..An (:class:`JointData`; n = :attr:`n_axes`: six for the arms,
+            four for a SCARA).
         home_deg: ``$AXIS_HOME[1]`` / XHOME, deg.
         mastering_deg: ``$MAMES``, deg.
         opw: :class:`OPWParams` (mm).
@@ -247,6 +252,15 @@ class MachineData:
     #: external axes E1..E6 (``$EX_AX_NUM``) and external kinematic systems (``$EX_KIN``)
     external_axes: tuple[ExternalAxis, ...] = ()
     external_kinematics: tuple[ExternalKinematic, ...] = ()
+    #: ``$MAIN_AXIS``: the main axes' kind (``#NR`` articulated arm, ``#CC`` SCARA, ``#SS``
+    #: gantry; KR C2 machine-data handbook §2.1.145); ``#NR`` for the yaml robot
+    main_axis: str = "#NR"
+
+    @property
+    def n_axes(self) -> int:
+        """The robot's axis count: A1..An (``len(joints)``; six for the arms and palletizers,
+        four for a SCARA); the external axes E1..E6 are not counted."""
+        return len(self.joints)
 
     @property
     def limits_deg(self) -> tuple[tuple[float, float], ...]:
@@ -280,17 +294,18 @@ class MachineData:
 
     @property
     def all_max_speed(self) -> tuple[float, ...]:
-        """Axis speeds of A1..A6 (deg/s) and then E1..En (mm/s or deg/s): the planner's axes."""
+        """Axis speeds of A1..An (deg/s, a linear axis mm/s) and then E1..En (mm/s or deg/s):
+        the planner's axes."""
         return self.max_speed_deg_s + tuple(e.max_speed for e in self.external_axes)
 
     @property
     def all_max_acc(self) -> tuple[float, ...]:
-        """Axis accelerations of A1..A6 and E1..En (deg/s^2, mm/s^2)."""
+        """Axis accelerations of A1..An and E1..En (deg/s^2, mm/s^2)."""
         return self.max_acc_deg_s2 + tuple(e.max_acc for e in self.external_axes)
 
     @property
     def home_all(self) -> tuple[float, ...]:
-        """``$AXIS_HOME[1]``: A1..A6 and E1..En."""
+        """``$AXIS_HOME[1]``: A1..An and E1..En."""
         return tuple(self.home_deg) + tuple(e.home for e in self.external_axes)
 
 

@@ -14,9 +14,11 @@ KR C2 and KR C4 machine data use the same names; what a KR C2 file lacks (``$AXI
 is derived by the rules of :data:`RULES` and marked "derived" in
 :attr:`MachineData.provenance` (``krl robot show``).
 
-The chain is robot/chain.py's; it becomes URDF-style joints (translation-only joint origins,
-KUKA's directions in the joint axes, ``q = radians(A_i)``). Reading the machine data never
-builds the inverse kinematics: robot/kinematics.py chooses the closed form the chain has (or
+The chain is the robot's kinematic family's (robot/kinematics/families.py ``machine_geometry``:
+the arm's of robot/kinematics/arm.py for ``$MAIN_AXIS=#NR``, the SCARA's for ``#CC``); it becomes
+URDF-style joints (robot/chain.py: translation-only joint origins, KUKA's directions in the joint
+axes, ``q = radians(A_i)``, a linear axis in mm), n of them. Reading the machine data never
+builds the inverse kinematics: robot/kinematics/ chooses the closed form the chain has (or
 the numeric solver) when a tool moves the robot, so ``krl cell init``, ``krl check``,
 ``krl graph`` and ``krl diff`` never need it. A value the model cannot take is refused with
 :class:`MachineDataError` naming the variable, its value and its file:line.
@@ -32,13 +34,21 @@ from typing import Any
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from .chain import Chain, chain_forward, chain_to_joints
+from .chain import chain_forward, chain_to_joints
 from .datalist import DataListError, DataValue, read_data_list
-from .frames import frame_to_matrix, matrix_to_frame
-from .machine import (CartLimits, ExternalAxis, ExternalKinematic, JointData, MachineData, OPWParams,
-                      load_machine)
+from .frames import matrix_to_frame
+from .madavalues import MachineDataError, krl_value
+from .madavalues import axes as _axes
+from .madavalues import flag as _flag
+from .madavalues import frame as _frame
+from .madavalues import frame6 as _frame6
+from .madavalues import get as _get
+from .madavalues import num as _num
+from .kinematics.families import machine_geometry
+from .machine import CartLimits, ExternalAxis, ExternalKinematic, JointData, MachineData, load_machine
 
-#: The rules for values that machine data lack (docs/robot.md, "Robots from machine data").
+#: The rules for values that machine data lack (docs/robot.md, "Robots from machine data"); those of
+#: a family's geometry are the family's (robot/kinematics/arm.py RULES).
 RULES = {
     "max_acc_deg_s2": "derived: sqrt(v_max * $AXIS_JERK[i]), the peak acceleration of a jerk-limited "
                       "ramp from rest to full axis speed without a constant-acceleration phase "
@@ -52,10 +62,6 @@ RULES = {
     "ipo_cycle_s": "derived: 12 ms interpolation cycle of the KR C4 (robot-model.md §10)",
     "motion_defaults": "derived: KSS defaults of bas.src/$config.dat (robot/data/kr6_r900.yaml "
                        "motion_defaults)",
-    "status_phi_deg": "derived: atan2($TX3P3.Z, $TX3P3.X), A3 where the arm is stretched (robot-model.md §8)",
-    "reach_wrist_point_mm": "derived: $LENGTH_A + $LENGTH_B + |($TX3P3.X, $TX3P3.Z)|",
-    "opw": "derived: a1=$LENGTH_A, a2=-$TX3P3.Z, b=$TX3P3.Y, c1=$TIRORO.Z, c2=$LENGTH_B, "
-           "c3=$TX3P3.X, c4=$TFLWP.Z (robot-model.md §4.2-4.3); signs from the chain's axes",
     "default_load": "derived: none given ($robcor.dat absent)",
     "external_speed": "derived: $VEL_AXIS_MA / |$RAT_MOT_AX.N / .D| * 6 deg/s (rotary) or * 1000/60 mm/s "
                       "(linear: N/D motor revolutions per 1000 mm, KR C2 machine-data handbook §2.1.10)",
@@ -74,99 +80,9 @@ _EX_SYSTEMS = ("#ERSYS", "#EASYS", "#EBSYS", "#ECSYS", "#EDSYS", "#EESYS", "#EFS
 _FIXED = (0.0, 0.0)
 
 
-class MachineDataError(ValueError):
-    """Machine data that cannot make a robot model; the message names file:line, the variable
-    and the value it cannot take."""
-
-
-def _get(vals: dict[str, DataValue], name: str, where: str) -> DataValue:
-    v = vals.get(name)
-    if v is None or v.value is None or v.value == {}:
-        raise MachineDataError(f"{where}: {name} is not set; cannot build the robot model")
-    return v
-
-
-def krl_value(v: Any) -> str:
-    """A machine-data value as KRL writes it (TRUE, #STANDARD, 12.5, "text", {..})."""
-    if isinstance(v, bool):
-        return "TRUE" if v else "FALSE"
-    if isinstance(v, (int, float)):
-        return f"{v:g}"
-    if isinstance(v, dict):
-        return "{" + ",".join(f"{k} {krl_value(x)}" for k, x in v.items()) + "}"
-    if isinstance(v, str) and not v.startswith("#"):
-        return f'"{v}"'
-    return str(v)
-
-
-def _num(v: Any, where: str, name: str = "") -> float:
-    label = f"{name}={krl_value(v)}: " if name else ""
-    if isinstance(v, bool) or not isinstance(v, (int, float)):
-        raise MachineDataError(f"{where}: {label}a number was expected")
-    if not math.isfinite(float(v)):
-        raise MachineDataError(f"{where}: {label}the value is not finite")
-    return float(v)
-
-
-def _axes(vals: dict[str, DataValue], name: str, where: str, n: int = 6,
-          first: int = 1) -> tuple[list[float], DataValue]:
-    dv = _get(vals, name, where)
-    if not isinstance(dv.value, dict):
-        raise MachineDataError(f"{dv.where()}: {name} is not an array")
-    out = []
-    for i in range(first, first + n):
-        if i not in dv.value:
-            raise MachineDataError(f"{dv.where()}: {name}[{i}] is not set")
-        out.append(_num(dv.value[i], dv.where(i), f"{name}[{i}]"))
-    return out, dv
-
-
-def _frame6(vals: dict[str, DataValue], name: str, where: str) -> tuple[tuple[float, ...], DataValue]:
-    dv = _get(vals, name, where)
-    if not isinstance(dv.value, dict):
-        raise MachineDataError(f"{dv.where()}: {name}={krl_value(dv.value)}: a FRAME was expected")
-    return tuple(_num(dv.value.get(k, 0.0), dv.where(), f"{name}.{k}") for k in "XYZABC"), dv
-
-
-def _frame(vals: dict[str, DataValue], name: str, where: str) -> tuple[np.ndarray, DataValue]:
-    f, dv = _frame6(vals, name, where)
-    return frame_to_matrix(*f), dv
-
-
-def _tr(x: float = 0.0, y: float = 0.0, z: float = 0.0) -> np.ndarray:
-    T = np.eye(4)
-    T[:3, 3] = (x, y, z)
-    return T
-
-
-def _rot(axis: str, deg: float) -> np.ndarray:
-    T = np.eye(4)
-    T[:3, :3] = Rotation.from_euler(axis, deg, degrees=True).as_matrix()
-    return T
-
-
-def _dh(dv: DataValue) -> tuple[np.ndarray, tuple[float, float, float]]:
-    v = dv.value if isinstance(dv.value, dict) else {}
-    try:
-        a = _num(v["DHART_A"], dv.where(), f"{dv.name}.DHART_A")
-        d = _num(v["DHART_D"], dv.where(), f"{dv.name}.DHART_D")
-        alpha = _num(v["DHART_ALPHA"], dv.where(), f"{dv.name}.DHART_ALPHA")
-    except KeyError as exc:
-        raise MachineDataError(f"{dv.where()}: {dv.name} lacks component {exc.args[0]}") from None
-    return _tr(z=d) @ _tr(x=a) @ _rot("x", alpha), (a, d, alpha)
-
-
-def _flag(vals: dict[str, DataValue], name: str) -> tuple[bool, DataValue | None]:
-    dv = vals.get(name)
-    if dv is None or dv.value is None:
-        return False, None
-    if not isinstance(dv.value, bool):
-        raise MachineDataError(f"{dv.where()}: {name}={krl_value(dv.value)}: TRUE or FALSE was expected")
-    return dv.value, dv
-
-
 def _structure(machine: dict[str, DataValue], source: str, prov: dict[str, str]) -> tuple[bool, bool]:
-    """The robot's kinematic class and axis flags; refuses what the model does not build."""
+    """The robot's kinematic class and palletizer flags; refuses what the model does not build
+    (the family's geometry checks ``$NUM_AX``)."""
     kin = machine.get("$KINCLASS")
     if kin is not None and kin.value not in (None, "#STANDARD"):
         raise MachineDataError(f"{kin.where()}: $KINCLASS={kin.value}: only the #STANDARD kinematic class "
@@ -182,37 +98,24 @@ def _structure(machine: dict[str, DataValue], source: str, prov: dict[str, str])
     for key, dv in (("$DEF_A4FIX", dv4), ("$DEF_A5LINK", dv5)):
         if dv is not None:
             prov[key] = dv.where()
-    nax = machine.get("$NUM_AX")
-    if nax is not None and nax.value is not None:
-        n = nax.value
-        least = 4 if a4fix else 6
-        if isinstance(n, bool) or not isinstance(n, int) or not least <= n <= 6:
-            raise MachineDataError(f"{nax.where()}: $NUM_AX={krl_value(n)}: a robot with "
-                                   f"{'$DEF_A4FIX' if a4fix else 'six axes'} has {least}..6 axes")
-        prov["$NUM_AX"] = nax.where()
-        if a4fix and not a5link and n == 4:
-            # A1, A2, A3 and the flange axis A6 are driven: A5 has no drive, so the parallelogram
-            # leads it, whatever $DEF_A5LINK says (KUKA's palletizers keep $DEF_A5LINK FALSE).
-            a5link = True
-            prov["a5_led"] = (f"derived: A5 led by the parallelogram, the flange kept vertical "
-                              f"($NUM_AX=4 with $DEF_A4FIX=TRUE leaves A5 no drive; $DEF_A5LINK=FALSE "
-                              f"at {dv5.where() if dv5 is not None else 'default'})")
     return a4fix, a5link
 
 
 def _joint_limits(machine: dict[str, DataValue], source: str, prov: dict[str, str], a4fix: bool,
-                  flt_ptp: float) -> list[tuple[tuple[float, float], float, float, float]]:
-    """(limits, v_max, a_max, jerk) of A1..A6, with the rules of :data:`RULES` for what is missing."""
-    lo, dv_lo = _axes(machine, "$SOFTN_END", source)
-    hi, dv_hi = _axes(machine, "$SOFTP_END", source)
-    speeds, dv_rpm, ratios = _speeds(machine, source, range(1, 7), [False] * 6)
+                  flt_ptp: float, kinds: tuple[str, ...]) -> list[tuple[tuple[float, float], float, float, float]]:
+    """(limits, v_max, a_max, jerk) of A1..An (a linear axis in mm), with the rules of :data:`RULES`
+    for what is missing."""
+    n = len(kinds)
+    lo, dv_lo = _axes(machine, "$SOFTN_END", source, n)
+    hi, dv_hi = _axes(machine, "$SOFTP_END", source, n)
+    speeds, dv_rpm, ratios = _speeds(machine, source, range(1, n + 1), [k == "linear" for k in kinds])
     jerk = raise_t = None
     if "$AXIS_JERK" in machine and machine["$AXIS_JERK"].value:
-        jerk, dv_jerk = _axes(machine, "$AXIS_JERK", source)
+        jerk, dv_jerk = _axes(machine, "$AXIS_JERK", source, n)
         prov["$AXIS_JERK"] = dv_jerk.where(1)
         prov["max_acc_deg_s2"] = RULES["max_acc_deg_s2"]
     elif "$RAISE_TIME" in machine and machine["$RAISE_TIME"].value:
-        raise_t, dv_rt = _axes(machine, "$RAISE_TIME", source)
+        raise_t, dv_rt = _axes(machine, "$RAISE_TIME", source, n)
         prov["$RAISE_TIME"] = dv_rt.where(1)
         prov["max_acc_deg_s2"] = RULES["max_acc_raise_time"]
         prov["$AXIS_JERK"] = RULES["max_jerk"]
@@ -220,7 +123,7 @@ def _joint_limits(machine: dict[str, DataValue], source: str, prov: dict[str, st
         prov["max_acc_deg_s2"] = RULES["max_acc_default"]
         prov["$AXIS_JERK"] = RULES["max_jerk"]
     out = []
-    for i in range(6):
+    for i in range(n):
         vmax = speeds[i]
         if lo[i] > hi[i]:
             raise MachineDataError(f"{dv_lo.where(i + 1)}: $SOFTN_END[{i + 1}]={lo[i]:g} is above "
@@ -389,7 +292,8 @@ def _et_system(machine, source, prov, t: int, sysname: str, n_ext: int, used: se
 def machine_from_values(machine: dict[str, DataValue], robcor: dict[str, DataValue] | None,
                         source: str) -> MachineData:
     """Build the robot model from read machine data (see the module docstring). Builds no
-    inverse kinematics (robot/kinematics.py does, for the tools that move the robot).
+    inverse kinematics (robot/kinematics/ does, for the tools that move the robot). The kinematic
+    chain is the robot's kinematic family's (robot/kinematics/families.py ``machine_geometry``).
 
     Args:
         machine: the values of ``$machine.dat`` (:func:`robot.datalist.read_data_list`).
@@ -409,42 +313,18 @@ def machine_from_values(machine: dict[str, DataValue], robcor: dict[str, DataVal
         raise MachineDataError(f"{source}: none of the robot's machine data ({', '.join(arm)}) is set: {what}")
     a4fix, a5link = _structure(machine, source, prov)
 
-    tiroro, dv = _frame(machine, "$TIRORO", source)
-    prov["$TIRORO"] = dv.where()
-    la = _get(machine, "$LENGTH_A", source)
-    lb = _get(machine, "$LENGTH_B", source)
-    length_a = _num(la.value, la.where(), "$LENGTH_A")
-    length_b = _num(lb.value, lb.where(), "$LENGTH_B")
-    prov["$LENGTH_A"], prov["$LENGTH_B"] = la.where(), lb.where()
-    tx3p3, dv = _frame(machine, "$TX3P3", source)
-    prov["$TX3P3"] = dv.where()
-    tflwp, dv = _frame(machine, "$TFLWP", source)
-    prov["$TFLWP"] = dv.where()
-    dh4 = _get(machine, "$DH_4", source)
-    dh5 = _get(machine, "$DH_5", source)
-    prov["$DH_4"], prov["$DH_5"] = dh4.where(), dh5.where()
-    dirs = _get(machine, "$AXIS_DIR", source)
-    axis_dir = []
-    for i in range(1, 7):
-        d = dirs.value.get(i) if isinstance(dirs.value, dict) else None
-        if d not in (1, -1) or isinstance(d, bool):
-            raise MachineDataError(f"{dirs.where(i)}: $AXIS_DIR[{i}]={krl_value(d)}: 1 or -1 was expected")
-        axis_dir.append(float(d))
-    prov["$AXIS_DIR"] = dirs.where(1)
-
-    F4, dh4_v = _dh(dh4)
-    F5, dh5_v = _dh(dh5)
-    fixed = [tiroro, _tr(x=length_a), _tr(x=length_b), tx3p3, F4, F5, tflwp]
-    local = [np.array([0.0, 0.0, axis_dir[0]]), np.array([0.0, axis_dir[1], 0.0]),
-             np.array([0.0, axis_dir[2], 0.0]), np.array([0.0, 0.0, axis_dir[3]]),
-             np.array([0.0, 0.0, axis_dir[4]]), np.array([0.0, 0.0, axis_dir[5]])]
-    origins, jaxes, flange = chain_to_joints(fixed, local)
-    chain = Chain.of(fixed, local)
+    # the kinematic chain: the geometry of the robot's kinematic family (robot/kinematics/)
+    geo = machine_geometry(machine, source, prov, a4fix, a5link)
+    a5link = geo.a5link
+    chain = geo.chain
+    n = len(chain.axes)
+    kinds = chain.kinds or ("rotary",) * n
+    origins, jaxes, flange = chain_to_joints(chain.frames(), chain.local_axes())
 
     flt_ptp = _scalar(machine, "$DEF_FLT_PTP", load_machine().def_flt_ptp, prov)
-    lims = _joint_limits(machine, source, prov, a4fix, flt_ptp)
+    lims = _joint_limits(machine, source, prov, a4fix, flt_ptp, kinds)
     joints = []
-    for i in range(6):
+    for i in range(n):
         limit, vmax, acc, jerk = lims[i]
         joints.append(JointData(
             name=f"joint_a{i + 1}", axis=i + 1, limit_deg=limit, max_speed_deg_s=vmax,
@@ -452,21 +332,7 @@ def machine_from_values(machine: dict[str, DataValue], robcor: dict[str, DataVal
             origin_mm=tuple(float(v) for v in origins[i]),       # type: ignore[arg-type]
             joint_axis=tuple(float(v) for v in jaxes[i]),        # type: ignore[arg-type]
             urdf_max_speed_deg_s=vmax, parent="base_link" if i == 0 else f"link_{i}",
-            child=f"link_{i + 1}", kuka_sign=1))
-
-    # OPW parameters of the standard arm (robot-model.md §4.2); robot/kinematics.py checks them
-    # against the chain and finds the form of any other arm from the chain itself (robot/chain.py)
-    tx = {k: _num(machine["$TX3P3"].value.get(k, 0.0), prov["$TX3P3"]) for k in "XYZABC"}
-    ti = {k: _num(machine["$TIRORO"].value.get(k, 0.0), prov["$TIRORO"]) for k in "XYZABC"}
-    fl = {k: _num(machine["$TFLWP"].value.get(k, 0.0), prov["$TFLWP"]) for k in "XYZABC"}
-    from .chain import opw_form  # noqa: PLC0415
-
-    form = opw_form(chain)
-    signs = form.params.sign_corrections if form is not None else (-1, 1, 1, -1, 1, -1)
-    opw = OPWParams(a1=length_a, a2=-tx["Z"], b=tx["Y"], c1=ti["Z"], c2=length_b, c3=tx["X"],
-                    c4=fl["Z"], offsets_deg=(0.0, -90.0, 0.0, 0.0, 0.0, 0.0), sign_corrections=signs)
-    prov["opw"] = RULES["opw"]
-    del dh4_v, dh5_v
+            child=f"link_{i + 1}", kuka_sign=1, kind=kinds[i]))
 
     vel_ma = _cp(machine, "$VEL_MA", source, prov)
     acc_ma = _cp(machine, "$ACC_MA", source, prov)
@@ -475,13 +341,14 @@ def machine_from_values(machine: dict[str, DataValue], robcor: dict[str, DataVal
     robroot = tuple(float(v) for v in matrix_to_frame(robroot_T))
     prov["$ROBROOT"] = dv.where() if dv is not None else "derived: $NULLFRAME ($ROBROOT not set)"
     home, home_ext = _home(machine, prov)
-    mames = (tuple(_axes(machine, "$MAMES", source)[0]) if "$MAMES" in machine else home)
+    home = home[:n]
+    mames = (tuple(_axes(machine, "$MAMES", source, n)[0]) if "$MAMES" in machine else home)
     if "$MAMES" in machine:
         prov["$MAMES"] = machine["$MAMES"].where(1)
 
     base = load_machine()
-    apo = _axes(machine, "$APO_DIS_PTP", source)[0] if "$APO_DIS_PTP" in machine else list(base.apo_dis_ptp_deg)
-    in_pos_ma = _axes(machine, "$IN_POS_MA", source)[0] if "$IN_POS_MA" in machine else list(base.in_pos_ma_deg)
+    apo = _axes(machine, "$APO_DIS_PTP", source, n)[0] if "$APO_DIS_PTP" in machine else list(base.apo_dis_ptp_deg)[:n]
+    in_pos_ma = _axes(machine, "$IN_POS_MA", source, n)[0] if "$IN_POS_MA" in machine else list(base.in_pos_ma_deg)[:n]
     in_car = _scalar(machine, "$IN_POS_CAR", base.in_pos_car_mm, prov)
     in_ori = _scalar(machine, "$IN_POS_ORI", base.in_pos_ori_deg, prov)
     flt_cp = int(_scalar(machine, "$DEF_FLT_CP", base.def_flt_cp, prov))
@@ -491,8 +358,12 @@ def machine_from_values(machine: dict[str, DataValue], robcor: dict[str, DataVal
     if trafo is not None:
         prov["$TRAFONAME"] = trafo.where()
     name = trafoname.lstrip("#").strip() or Path(source).parent.name
-    for key in ("ipo_cycle_s", "motion_defaults", "status_phi_deg", "reach_wrist_point_mm"):
+    for key in ("ipo_cycle_s", "motion_defaults"):
         prov[key] = RULES[key]
+    main = machine.get("$MAIN_AXIS")
+    main_axis = str(main.value) if main is not None and isinstance(main.value, str) else "#NR"
+    if main is not None:
+        prov["$MAIN_AXIS"] = main.where()
     ext_axes, ext_kin = _external(machine, source, prov, flt_ptp, home_ext)
 
     md = dict(base.motion_defaults)
@@ -505,21 +376,21 @@ def machine_from_values(machine: dict[str, DataValue], robcor: dict[str, DataVal
         warnings.simplefilter("ignore", UserWarning)
         rpy = Rotation.from_matrix(R).as_euler("xyz")
     model = MachineData(
-        name=name, joints=tuple(joints), home_deg=tuple(home), mastering_deg=tuple(mames), opw=opw,
+        name=name, joints=tuple(joints), home_deg=tuple(home), mastering_deg=tuple(mames), opw=geo.opw,
         flange_quat_wxyz=(float(w), float(x), float(y), float(z)),
         flange_rpy_rad=tuple(float(v) for v in rpy),                     # type: ignore[arg-type]
         flange_pos_mm=tuple(float(v) for v in flange[:3, 3]),            # type: ignore[arg-type]
         robroot_frame=robroot, default_tool_frame=(0.0,) * 6,
-        status_phi_deg=math.degrees(math.atan2(tx["Z"], tx["X"])),
+        status_phi_deg=geo.status_phi_deg,
         vel_ma=vel_ma, acc_ma=acc_ma, acc_ov=acc_ov, apo_dis_ptp_deg=tuple(apo),
         in_pos_ma_deg=tuple(in_pos_ma), in_pos_car_mm=in_car, in_pos_ori_deg=in_ori,
         def_flt_ptp=int(flt_ptp), def_flt_cp=flt_cp, ipo_cycle_s=base.ipo_cycle_s,
         motion_defaults=md, default_load=load,
-        reach_wrist_point_mm=length_a + length_b + math.hypot(tx["X"], tx["Z"]),
+        reach_wrist_point_mm=geo.reach_mm,
         home_flange_pose=(0.0,) * 6, source=source,
         raw={"machine_data": {k: v.value for k, v in machine.items()}},
         trafoname=trafoname, provenance=prov, a4fix=a4fix, a5link=a5link, chain=chain,
-        external_axes=ext_axes, external_kinematics=ext_kin)
+        external_axes=ext_axes, external_kinematics=ext_kin, main_axis=main_axis)
     home_T = chain_forward(chain, model.home_deg)
     if a5link and abs(home_T[2, 2] + 1.0) > 1e-9:
         label = "$AXIS_HOME[1]" if "$AXIS_HOME[1]" in prov else "$H_POS"

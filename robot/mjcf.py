@@ -4,8 +4,9 @@ kinematics (robot/external.py): a track's joint ``joint_e<n>`` carries ``base_li
 turntable is a body tree of its own ending in the site ``et<n>_flange``.
 
 The body tree mirrors the URDF chain exactly (joint origins, axes, ranges), so
-``qpos = kuka_sign * radians(A_i)`` (= radians(A_i) here, robot-model.md §3) and
-the site ``tool0`` on ``link_6`` is KUKA's flange frame (+Z out of the flange).
+``qpos = kuka_sign * radians(A_i)`` (= radians(A_i) here, robot-model.md §3; a linear axis, a
+SCARA's A3, is a slide joint with ``qpos = kuka_sign * A_i / 1000`` m) and the site ``tool0`` on
+the last link is KUKA's flange frame (+Z out of the flange).
 Geometry is capsules only; masses come from the geometry (density 1000 kg/m^3,
 invented, robot-model.md §11: link masses are not published).
 
@@ -52,10 +53,10 @@ def build_mjcf(machine: MachineData | None = None, actuated: bool = False, *,
                timestep: float = DEFAULT_TIMESTEP_S) -> str:
     """MJCF XML (str) of the arm from the machine data (robot-model.md §2, §11).
 
-    Bodies ``base_link``, ``link_1`` .. ``link_6``; joints named as in the yaml
-    (``joint_a1`` ..); MuJoCo's world frame is ``$WORLD``: ``base_link`` and the
-    site ``robroot`` sit at the machine data's ``$ROBROOT``; site ``tool0`` (KUKA
-    flange) on ``link_6``; keyframe ``home``.
+    Bodies ``base_link``, ``link_1`` .. ``link_n`` (n the robot's axis count); joints named as
+    in the yaml (``joint_a1`` ..), hinges, a linear axis a slide; MuJoCo's world frame is
+    ``$WORLD``: ``base_link`` and the site ``robroot`` sit at the machine data's ``$ROBROOT``;
+    site ``tool0`` (KUKA flange) on ``link_n``; keyframe ``home``.
 
     Args:
         machine: machine data; default :func:`~robot.machine.load_machine`.
@@ -110,12 +111,14 @@ def build_mjcf(machine: MachineData | None = None, actuated: bool = False, *,
         if any(j.origin_rpy_rad):
             x, y, z, w = Rotation.from_euler("xyz", j.origin_rpy_rad).as_quat()
             quat = f' quat="{_vec((w, x, y, z))}"'
-        lo, hi = (math.radians(v) for v in j.limit_deg)
+        linear = j.kind == "linear"
+        lo, hi = ((v / 1000.0 if linear else math.radians(v)) for v in j.limit_deg)
         if j.kuka_sign < 0:
             lo, hi = -hi, -lo
         lines.append(f'{indent}<body name="{j.child or f"link_{i + 1}"}" pos="{_vec(pos)}"{quat}{gravcomp}>')
         indent += "  "
-        lines.append(f'{indent}<joint name="{j.name}" type="hinge" axis="{_vec(j.joint_axis)}" range="{_f(lo)} {_f(hi)}"/>')
+        lines.append(f'{indent}<joint name="{j.name}" type="{"slide" if linear else "hinge"}" '
+                     f'axis="{_vec(j.joint_axis)}" range="{_f(lo)} {_f(hi)}"/>')
         # link geometry: capsule from this joint to the next joint origin (or to the flange)
         nxt = np.array(joints[i + 1].origin_mm) / 1000.0 if i + 1 < len(joints) else None
         radius = 0.06 if i < 3 else 0.045
@@ -123,7 +126,15 @@ def build_mjcf(machine: MachineData | None = None, actuated: bool = False, *,
             lines.append(f'{indent}<geom name="link_{i + 1}_geom" type="capsule" size="{_f(radius)}" fromto="0 0 0 {_vec(nxt)}"/>')
         else:
             lines.append(f'{indent}<geom name="link_{i + 1}_geom" type="sphere" size="{_f(radius)}"/>')
-    # KUKA flange frame (URDF tool0) on link_6
+        if linear:
+            # the moving shaft (a SCARA's quill): from the flange point up along the axis, as long
+            # as the travel (the flange point: the joint origins after this one and the flange)
+            bottom = (np.sum([np.array(jj.origin_mm) for jj in joints[i + 1:]], axis=0) + np.array(m.flange_pos_mm)) / 1000.0
+            ax = np.array(j.joint_axis, dtype=float)
+            top = bottom - ax * ((j.limit_deg[1] - j.limit_deg[0]) / 1000.0 + float(np.linalg.norm(bottom)))
+            lines.append(f'{indent}<geom name="link_{i + 1}_shaft" type="capsule" size="0.02" '
+                         f'fromto="{_vec(bottom)} {_vec(top)}" rgba="0.7 0.7 0.7 1"/>')
+    # KUKA flange frame (URDF tool0) on the last link
     fpos = np.array(m.flange_pos_mm) / 1000.0
     lines.append(f'{indent}<site name="tool0" pos="{_vec(fpos)}" quat="{_vec(m.flange_quat_wxyz)}" size="0.01" rgba="0 1 0 1"/>')
     for _ in joints:
@@ -140,7 +151,7 @@ def build_mjcf(machine: MachineData | None = None, actuated: bool = False, *,
         for i, j in enumerate(joints):
             lines.append(f'    <velocity name="v{i + 1}" joint="{j.name}" kv="{_f(kv)}"/>')
         lines.append("  </actuator>")
-    arm_home = [j.kuka_sign * math.radians(a) for j, a in zip(joints, m.home_deg)]
+    arm_home = [j.kuka_sign * (a / 1000.0 if j.kind == "linear" else math.radians(a)) for j, a in zip(joints, m.home_deg)]
     home = _ext_home(m, arm_home)
     lines.append("  <keyframe>")
     ctrl = ""
@@ -201,7 +212,7 @@ def _arm_cycle(arm: "ArmModel", sc: Any) -> Any:
     :meth:`ArmModel.compiled_cycle`). ``mj_kinematics`` is looked up in the MuJoCo library the
     ``mujoco`` package ships and has loaded (the same library: loading it again gives the
     loaded one)."""
-    if arm.actuated or len(arm._eadr):
+    if arm.actuated or len(arm._eadr) or arm._n != 6 or arm._linear is not None:
         return None
     try:
         import ctypes  # noqa: PLC0415
@@ -272,11 +283,15 @@ class ArmModel:
         self.data = mujoco.MjData(self.model)
         self._qadr = np.array([self.model.joint(j.name).qposadr[0] for j in self.machine.joints])
         self._dadr = np.array([self.model.joint(j.name).dofadr[0] for j in self.machine.joints])
-        # the six joints sit side by side in qpos (they do in build_mjcf's model): a slice
+        # the robot's n joints sit side by side in qpos (they do in build_mjcf's model): a slice
         # instead of a fancy index in the per-cycle replay
+        n = self._n = len(self.machine.joints)
         q0 = int(self._qadr[0])
-        self._qidx = slice(q0, q0 + 6) if list(self._qadr) == list(range(q0, q0 + 6)) else self._qadr
+        self._qidx = slice(q0, q0 + n) if list(self._qadr) == list(range(q0, q0 + n)) else self._qadr
         self._sign = np.array([j.kuka_sign for j in self.machine.joints], dtype=float)
+        #: which joints are linear (mm; a slide in m), None when all turn
+        linear = np.array([j.kind == "linear" for j in self.machine.joints])
+        self._linear = linear if linear.any() else None
         # external axes E1..En (joint_e<n>): qpos in m or rad, set from mm or deg
         ext = self.machine.external_axes
         self._eadr = np.array([self.model.joint(f"joint_e{e.number}").qposadr[0] for e in ext], dtype=int)
@@ -293,15 +308,17 @@ class ArmModel:
     # ------------------------------------------------------------------ replay
     def set_axes(self, axes_deg: Sequence[float], vel_deg_s: Sequence[float] | None = None,
                  full: bool = False) -> None:
-        """Kinematic playback: write ``qpos`` (and ``qvel``) from A1..A6 in deg (deg/s)
-        and run ``mj_kinematics`` (``mj_forward`` with ``full=True``)."""
+        """Kinematic playback: write ``qpos`` (and ``qvel``) from A1..An in deg (deg/s; a linear
+        axis in mm, mm/s), then E1..En, and run ``mj_kinematics`` (``mj_forward`` with
+        ``full=True``)."""
         d = self.data
         a = np.asarray(axes_deg, dtype=float)
-        d.qpos[self._qidx] = self._sign * np.radians(a[:6])
-        if len(self._eadr) and len(a) > 6:
-            d.qpos[self._eadr] = self._escale * a[6:6 + len(self._eadr)]
+        n = self._n
+        d.qpos[self._qidx] = self._sign * self._si(a[:n])
+        if len(self._eadr) and len(a) > n:
+            d.qpos[self._eadr] = self._escale * a[n:n + len(self._eadr)]
         if vel_deg_s is not None:
-            d.qvel[self._dadr] = self._sign * np.radians(np.asarray(vel_deg_s, dtype=float)[:6])
+            d.qvel[self._dadr] = self._sign * self._si(np.asarray(vel_deg_s, dtype=float)[:n])
         if full:
             self._mj.mj_forward(self.model, d)
         else:
@@ -319,17 +336,29 @@ class ArmModel:
             self._cycle = _arm_cycle(self, simcore) or False
         return self._cycle or None
 
+    def _si(self, a: np.ndarray) -> np.ndarray:
+        """Axis values in MuJoCo's units: deg -> rad (a linear axis: mm -> m)."""
+        if self._linear is None:
+            return np.radians(a)
+        return np.where(self._linear, a / 1000.0, np.radians(a))
+
+    def _kuka(self, v: np.ndarray) -> np.ndarray:
+        """MuJoCo's joint values in KUKA's units: rad -> deg (a linear axis: m -> mm)."""
+        if self._linear is None:
+            return np.degrees(v)
+        return np.where(self._linear, v * 1000.0, np.degrees(v))
+
     def axes_deg(self) -> np.ndarray:
-        """Current A1..A6 (deg) read back from ``qpos``, then E1..En (mm, deg) when the robot
-        has external axes; shape (6,) or (6 + n,)."""
-        q = np.degrees(self._sign * self.data.qpos[self._qidx])
+        """Current A1..An (deg; a linear axis in mm) read back from ``qpos``, then E1..En (mm,
+        deg) when the robot has external axes; shape (n,) or (n + n_ext,)."""
+        q = self._kuka(self._sign * self.data.qpos[self._qidx])
         if len(self._eadr):
             q = np.concatenate([q, self.data.qpos[self._eadr] / self._escale])
         return q
 
     def axes_vel_deg_s(self) -> np.ndarray:
-        """Current axis speeds (deg/s) from ``qvel``; shape (6,)."""
-        return np.degrees(self._sign * self.data.qvel[self._dadr])
+        """Current axis speeds (deg/s; a linear axis in mm/s) from ``qvel``; shape (n,)."""
+        return self._kuka(self._sign * self.data.qvel[self._dadr])
 
     def flange_pose_world(self) -> np.ndarray:
         """KUKA flange frame (site ``tool0``) in ``$WORLD`` (MuJoCo world), 4x4, mm."""
@@ -362,11 +391,11 @@ class ArmModel:
             raise RuntimeError("step_actuated needs ArmModel(actuated=True)")
         n = len(self._qadr)
         d = self.data
-        d.ctrl[:n] = self._sign * np.radians(np.asarray(targets_deg, dtype=float)[:6])
+        d.ctrl[:n] = self._sign * self._si(np.asarray(targets_deg, dtype=float)[:n])
         if target_vel_deg_s is None:
             d.ctrl[n:2 * n] = 0.0
         else:
-            d.ctrl[n:2 * n] = self._sign * np.radians(np.asarray(target_vel_deg_s, dtype=float)[:6])
+            d.ctrl[n:2 * n] = self._sign * self._si(np.asarray(target_vel_deg_s, dtype=float)[:n])
         steps = max(1, int(round(dt / self.model.opt.timestep)))
         for _ in range(steps):
             self._mj.mj_step(self.model, d)
@@ -378,5 +407,5 @@ class ArmModel:
         q = self.machine.home_deg if axes_deg is None else axes_deg
         if self.actuated:
             n = len(self._qadr)
-            self.data.ctrl[:n] = self._sign * np.radians(np.asarray(q, dtype=float)[:6])
+            self.data.ctrl[:n] = self._sign * self._si(np.asarray(q, dtype=float)[:n])
         self.set_axes(q, full=True)

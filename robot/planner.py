@@ -7,7 +7,7 @@ machine data, issue 15):
 
 * :class:`JointSegment` (PTP, SPTP): ``q(u) = q0 + u·(q1 - q0)``, synchronised axes.
 
-External axes E1..En (robot/external.py) are the axis vector's entries after A1..A6: a PTP
+External axes E1..En (robot/external.py) are the axis vector's entries after A1..An: a PTP
 moves them synchronised with the robot axes; on a CP path they move linearly in the path
 parameter, ``E(u) = E0 + u·(E1 - E0)``, start and stop with the robot, and the path is slowed
 for their speed and acceleration like for the robot's axes. A track (#ERSYS) moves
@@ -72,17 +72,23 @@ class RobotModel:
     """Adapter between the planner and the kinematics module (mm, deg, 4x4 frames).
 
     ``tcp(q, tool_T, base_T)`` -> TCP 4x4 in ``$BASE``; ``ik(T, tool_T, base_T, status, turn,
-    ref)`` -> axes (6,) raising WorkspaceError/SoftLimitError; ``status_turn(q)``.
+    ref)`` -> axes (n,) raising WorkspaceError/SoftLimitError; ``status_turn(q)``.
+
+    Axis vectors are A1..An, E1..En: n = :attr:`n` the robot's axis count (``machine.n_axes``),
+    then the external axes. :meth:`from_krl` and :meth:`to_krl` convert from and to KRL's
+    E6AXIS order (A1..A6, E1..E6: a robot with fewer axes has no A(n+1)..A6).
     """
 
     def __init__(self, machine: Any, kin: Kinematics | None = None, mode: str = DEFAULT_MODE) -> None:
         self.machine = machine
         self.mode = mode
         self.kin = kin if kin is not None else Kinematics(machine)
+        #: the robot's axis count (A1..An); the external axes follow it in axis vectors
+        self.n = self.kin.n_axes
         self.robroot_T = frame_to_matrix(*machine.robroot_frame)
         self._robroot_is_null = bool(np.allclose(self.robroot_T, np.eye(4)))
         self._robroot_inv_T = inv_pos(self.robroot_T)
-        #: external axes (robot/external.py), None without; axis vectors are A1..A6, E1..En
+        #: external axes (robot/external.py), None without; axis vectors are A1..An, E1..En
         self.n_ext = len(getattr(machine, "external_axes", ()))
         self.ext = None
         self._ersys = False
@@ -94,13 +100,34 @@ class RobotModel:
             self.v_max = np.array(machine.all_max_speed, dtype=float)
             self.a_max = np.array(machine.all_max_acc, dtype=float)
             ext_apo = [90.0] * self.n_ext
-            self.apo_dis_ptp = np.array(list(machine.apo_dis_ptp_deg)[:6] + ext_apo, dtype=float)
+            self.apo_dis_ptp = np.array(list(machine.apo_dis_ptp_deg)[:self.n] + ext_apo, dtype=float)
             self._e_lo = np.array([e.limit[0] for e in machine.external_axes], dtype=float)
             self._e_hi = np.array([e.limit[1] for e in machine.external_axes], dtype=float)
         else:
             self.v_max = np.array(machine.max_speed_deg_s, dtype=float)
             self.a_max = np.array(machine.max_acc_deg_s2, dtype=float)
-            self.apo_dis_ptp = np.array(machine.apo_dis_ptp_deg, dtype=float)
+            self.apo_dis_ptp = np.array(machine.apo_dis_ptp_deg[:self.n], dtype=float)
+
+    def from_krl(self, values: Any) -> np.ndarray:
+        """An axis vector of this model from KRL's order (A1..A6, then E1..En; missing E take
+        ``$AXIS_HOME[1]``'s): A1..An, E1..En. A robot with six axes and none external gets the
+        first six values."""
+        v = np.asarray(values, dtype=float)
+        if not self.n_ext:
+            return v[:self.n]
+        home = np.array(self.machine.home_all, dtype=float)
+        e = v[6:6 + self.n_ext]
+        return np.concatenate([v[:self.n], e, home[self.n + len(e):]])
+
+    def to_krl(self, q: np.ndarray) -> np.ndarray:
+        """The axis vector `q` (A1..An, E1..En) in KRL's order: A1..A6 (0 for the axes a robot
+        with fewer than six does not have), then E1..En; `q` itself for a six-axis robot."""
+        if self.n == 6:
+            return q
+        out = np.zeros(6 + len(q) - self.n)
+        out[:self.n] = q[:self.n]
+        out[6:] = q[self.n:]
+        return out
 
     def linked(self, system: str) -> "RobotModel":
         """This model with ``$BASE`` on the BASE kinematic `system` (robot/external.py):
@@ -112,16 +139,16 @@ class RobotModel:
     def robroot_at(self, q: np.ndarray) -> np.ndarray | None:
         """``$ROBROOT_C`` for the axis vector `q` (the track's E values), None for the null frame."""
         if self._ersys:
-            return self.ext.robroot(q[6:])           # type: ignore[union-attr]
+            return self.ext.robroot(q[self.n:])           # type: ignore[union-attr]
         return None if self._robroot_is_null else self.robroot_T
 
     def check_limits(self, q: np.ndarray) -> None:
-        """``$SOFTN_END``/``$SOFTP_END`` of A1..A6 and E1..En (SoftLimitError, reference §8.2)."""
+        """``$SOFTN_END``/``$SOFTP_END`` of A1..An and E1..En (SoftLimitError, reference §8.2)."""
         self.kin.check_soft_limits(q)
         if self.n_ext:
             from .errors import SoftLimitError  # noqa: PLC0415
 
-            e = np.asarray(q, dtype=float)[6:6 + self.n_ext]
+            e = np.asarray(q, dtype=float)[self.n:self.n + self.n_ext]
             for i in range(self.n_ext):
                 if e[i] < self._e_lo[i] - 1e-9 or e[i] > self._e_hi[i] + 1e-9:
                     pos = bool(e[i] > self._e_hi[i])
@@ -133,7 +160,7 @@ class RobotModel:
         INV_POS($BASE), precomputed; ``$ROBROOT_C(E)`` on a track)."""
         F = self.kin.forward(q)
         if self._ersys:
-            F = self.ext.robroot(q[6:]) @ F          # type: ignore[union-attr]
+            F = self.ext.robroot(q[self.n:]) @ F          # type: ignore[union-attr]
         elif not self._robroot_is_null:
             F = self.robroot_T @ F
         return base_inv_T @ F @ tool_T
@@ -147,12 +174,12 @@ class RobotModel:
             F = F @ tool_inv_T
         if self.n_ext:
             # the external axes are given (ref's E part): the arm solves in $ROBROOT_C(E)
-            e = np.asarray(ref, dtype=float)[6:6 + self.n_ext]
+            e = np.asarray(ref, dtype=float)[self.n:self.n + self.n_ext]
             if self._ersys:
                 F = inv_pos(self.ext.robroot(e)) @ F      # type: ignore[union-attr]
             elif not self._robroot_is_null:
                 F = self._robroot_inv_T @ F
-            q = self.kin.inverse(F, status=status, turn=turn, reference_deg=ref[:6])
+            q = self.kin.inverse(F, status=status, turn=turn, reference_deg=ref[:self.n])
             return np.concatenate([q, e])
         if not self._robroot_is_null:
             F = self._robroot_inv_T @ F
@@ -163,26 +190,26 @@ class RobotModel:
 
     @property
     def batch_ik(self) -> bool:
-        """True when :meth:`ik_chain` solves in numpy (the OPW family, no external axes and
-        no linked $BASE, and no compiled inverse: robot/simcore.pyx solves one pose faster than
-        numpy's passes over a chain, measured); otherwise it returns None and callers solve
-        cycle by cycle."""
-        return (type(self) is RobotModel and not self.n_ext and self.kin.family == "opw"
+        """True when :meth:`ik_chain` solves in numpy (a family that solves chains, the OPW
+        family: ``solves_chains``; no external axes and no linked $BASE, and no compiled inverse:
+        robot/simcore.pyx solves one pose faster than numpy's passes over a chain, measured);
+        otherwise it returns None and callers solve cycle by cycle."""
+        return (type(self) is RobotModel and not self.n_ext and self.kin.impl.solves_chains
                 and not self.kin.compiled_inverse)
 
     def ik_chain(self, poses: list[tuple[np.ndarray, np.ndarray]], tool_inv_T: np.ndarray | None,
                  base_T: np.ndarray | None, status: int | None, ref: np.ndarray) -> np.ndarray | None:
         """:meth:`ik` along a chain of TCP poses ``(p (3,), R (3, 3))`` in $BASE where each
-        solution is the next one's reference (the first one's is `ref`): the (n, 6) axes,
+        solution is the next one's reference (the first one's is `ref`): the (N, n) axes,
         bit for bit those of n calls of :meth:`ik` in turn, or None when the chain must be
         solved call by call (not :attr:`batch_ik`, an error on some pose, no fixed point).
 
         The rows are solved at once by :meth:`Kinematics.inverse_chain` (passes of
         :meth:`Kinematics.inverse_many` until a fixed point). Issue 39, "Simulator"."""
-        n = len(poses)
-        if n < MIN_CHAIN or not self.batch_ik:
+        N = len(poses)
+        if N < MIN_CHAIN or not self.batch_ik:
             return None
-        F = np.empty((n, 4, 4))
+        F = np.empty((N, 4, 4))
         for i, (p, R) in enumerate(poses):
             T = np.empty((4, 4))
             T[:3, :3] = R
@@ -198,10 +225,10 @@ class RobotModel:
         return self.kin.inverse_chain(F, status, ref, IK_CHAIN_PASSES)
 
     def tcp_pos_many(self, Q: np.ndarray, tool_T: np.ndarray, base_inv_T: np.ndarray) -> np.ndarray:
-        """TCP positions (n, 3) in $BASE for axis rows Q (n, 6 + external axes)."""
+        """TCP positions (N, 3) in $BASE for axis rows Q (N, n + external axes)."""
         F = self.kin.forward_many(Q)
         if self._ersys:
-            F = np.array([self.ext.robroot(q[6:]) for q in Q]) @ F      # type: ignore[union-attr]
+            F = np.array([self.ext.robroot(q[self.n:]) for q in Q]) @ F      # type: ignore[union-attr]
         elif not self._robroot_is_null:
             F = self.robroot_T @ F
         T = base_inv_T @ F @ tool_T
@@ -213,7 +240,7 @@ class RobotModel:
         ``wrist`` (deg): Newton iteration on A1..A3 from ``ref`` (``$ORI_TYPE #JOINT``).
         Raises WorkspaceError when it does not converge, SoftLimitError outside the limits."""
         q = np.array(ref, dtype=float)
-        q[3:6] = wrist
+        q[3:self.n] = wrist
         h = 1e-5
         for _ in range(20):
             Q = np.repeat(q[None, :], 4, axis=0)
@@ -245,10 +272,10 @@ class _LinkedBase(RobotModel):
         return self.ext.chain(self._kin_et, e)                   # type: ignore[union-attr]
 
     def tcp(self, q: np.ndarray, tool_T: np.ndarray, base_inv_T: np.ndarray) -> np.ndarray:
-        return RobotModel.tcp(self, q, tool_T, base_inv_T @ inv_pos(self._et(q[6:])))
+        return RobotModel.tcp(self, q, tool_T, base_inv_T @ inv_pos(self._et(q[self.n:])))
 
     def ik(self, T_base, tool_inv_T, base_T, status, turn, ref):
-        E = self._et(np.asarray(ref, dtype=float)[6:])
+        E = self._et(np.asarray(ref, dtype=float)[self.n:])
         return RobotModel.ik(self, T_base, tool_inv_T, E if base_T is None else E @ base_T, status, turn, ref)
 
     def tcp_pos_many(self, Q: np.ndarray, tool_T: np.ndarray, base_inv_T: np.ndarray) -> np.ndarray:
@@ -502,7 +529,7 @@ class Segment:
 
     Attributes:
         req: the request; id: its id.
-        q0, q1: start and end axes (deg), shape (6,).
+        q0, q1: start and end axes (deg), shape (n,) (then the external axes).
         profile: :class:`~robot.profiles.Trapezoid`; T: its duration (s), ``profile.t_total``.
         v_prog: the requested normalised speed (1/s) (for C_VEL).
         tool_T, base_T: the motion's $TOOL and $BASE (4x4); status: start S.
@@ -650,7 +677,7 @@ class CartSegment(Segment):
                  ori: list[str]) -> None:
         super().__init__(req, q0, q1, profile, v_prog, tool_T, base_T, model)
         #: E1..En at the end of the path (they move linearly in u from q0's)
-        self.e1 = np.asarray(q1, dtype=float)[6:].copy()
+        self.e1 = np.asarray(q1, dtype=float)[model.n:].copy()
         self.pieces = pieces
         self.rots = rots
         self.ori = ori
@@ -743,8 +770,9 @@ class CartSegment(Segment):
         T[:3, :3] = R
         T[:3, 3] = p
         T[3] = _BOTTOM_ROW
-        if u is not None and len(ref) > 6:
-            ref = np.concatenate([ref[:6], self.q0[6:] + u * (self.e1 - self.q0[6:])])
+        n = self.model.n
+        if u is not None and len(ref) > n:
+            ref = np.concatenate([ref[:n], self.q0[n:] + u * (self.e1 - self.q0[n:])])
         return self.model.ik(T, self._ik_tool, self._ik_base, self.status, None, ref)
 
     def _compiled_path(self) -> Any:
@@ -753,9 +781,8 @@ class CartSegment(Segment):
         axes, ``$ORI_TYPE #JOINT``)."""
         if self._c_path is None:
             self._c_path = False
-            sc = kinematics._simcore
-            if (sc is not None and kinematics.USE_COMPILED and getattr(sc, "ABI", None) == kinematics.SIMCORE_ABI
-                    and len(self.q0) == 6 and not self.joint_ori):
+            sc = kinematics.compiled_module()
+            if sc is not None and len(self.q0) == 6 and self.model.n == 6 and not self.joint_ori:
                 self._c_path = _cart_path(sc, self) or False
         return self._c_path
 
@@ -770,19 +797,19 @@ class CartSegment(Segment):
         """The compiled inverse for :meth:`ik`'s poses as they stand, or False."""
         m = self.model
         if (type(m) is not RobotModel or m.n_ext or not m._robroot_is_null or self._ik_tool is not None
-                or self._ik_base is not None or m.kin._base_inv is not None or m.kin._end_inv is not None):
+                or self._ik_base is not None):
             return False
-        return m.kin._compiled()
+        return m.kin.compiled_core()
 
     def ik_chain(self, poses: list[tuple[np.ndarray, np.ndarray]], ref: np.ndarray) -> np.ndarray | None:
         """:meth:`ik` of each pose with the previous solution as reference (the first: `ref`),
-        solved at once (:meth:`RobotModel.ik_chain`): (n, 6) axes, or None (solve one by one)."""
+        solved at once (:meth:`RobotModel.ik_chain`): (N, n) axes, or None (solve one by one)."""
         return self.model.ik_chain(poses, self._ik_tool, self._ik_base, self.status, ref)
 
     def ik_chain_compiled(self, poses: list[tuple[np.ndarray, np.ndarray]], ref: np.ndarray) -> np.ndarray | None:
         """:meth:`ik` of each pose with the previous solution as reference (the first: `ref`)
         in one call of the compiled inverse (robot/simcore.pyx ``inverse_chain_rp``, the rows of
-        the calls :meth:`ik` makes, bit for bit): (n, 6) axes, or None where :meth:`ik` does
+        the calls :meth:`ik` makes, bit for bit): (N, 6) axes, or None where :meth:`ik` does
         not run the compiled inverse as it stands or some pose needs the Python code (the
         caller solves pose by pose, which raises the error)."""
         c = self.compiled_inverse()
@@ -815,7 +842,7 @@ class CartSegment(Segment):
                 self._last_q = q
                 return q
             self._ahead = None
-        if self.joint_ori or len(self.q0) > 6 or tau >= self.T or not self.model.batch_ik:
+        if self.joint_ori or len(self.q0) > self.model.n or tau >= self.T or not self.model.batch_ik:
             return self.axes(tau)
         if end - tau < (MIN_CHAIN - 2) * dt:     # the segment's tail: cycle by cycle
             return self.axes(tau)
@@ -844,14 +871,15 @@ class CartSegment(Segment):
             # $ORI_TYPE #JOINT: wrist axes linear in u, TCP on the path (reference §6.7)
             u = self.profile.u(tau)
             p = self.pose_u(u)[0]
-            wrist = self.q0[3:6] + u * (self.q1[3:6] - self.q0[3:6])
+            n = self.model.n
+            wrist = self.q0[3:n] + u * (self.q1[3:n] - self.q0[3:n])
             ref = self._last_q
-            if len(ref) > 6:
-                ref = np.concatenate([ref[:6], self.q0[6:] + u * (self.e1 - self.q0[6:])])
+            if len(ref) > n:
+                ref = np.concatenate([ref[:n], self.q0[n:] + u * (self.e1 - self.q0[n:])])
             q = self.model.solve_position(p, wrist, ref, self.tool_T, self.base_inv_T)
             self._last_q = q
             return q
-        if len(self.q0) > 6:
+        if len(self.q0) > self.model.n:
             u = self.profile.u(tau)
             q = self.ik(*self.pose_u(u), self._last_q, u)
         else:
@@ -1012,24 +1040,24 @@ def _cart_target(req_target: dict[str, float], start_T: np.ndarray, relative: bo
     return frame_to_matrix(*_apply_partial(start6, req_target))
 
 
-def _ext_target(q0: np.ndarray, target: dict[str, float], relative: bool) -> np.ndarray:
-    """``q0`` with its external axes E1..En set from the target's E components (relative:
-    added), the rest kept; ``q0`` itself without external axes."""
-    if len(q0) <= 6:
+def _ext_target(q0: np.ndarray, target: dict[str, float], relative: bool, n: int) -> np.ndarray:
+    """``q0`` (A1..An, E1..En) with its external axes set from the target's E components
+    (relative: added), the rest kept; ``q0`` itself without external axes."""
+    if len(q0) <= n:
         return q0
     out = q0.copy()
-    for i, key in enumerate(EXT_KEYS[:len(q0) - 6]):
+    for i, key in enumerate(EXT_KEYS[:len(q0) - n]):
         if key in target:
-            out[6 + i] = (q0[6 + i] if relative else 0.0) + float(target[key])
+            out[n + i] = (q0[n + i] if relative else 0.0) + float(target[key])
     return out
 
 
-def _check_complete(req: MotionRequest) -> None:
+def _check_complete(req: MotionRequest, n: int) -> None:
     t = req.target
     if req.relative or req.kind in ("CIRC", "SCIRC", "SPLINE"):
         raise RobotError("BCO run: the first motion must be a PTP or LIN to a complete target")
     if req.is_axis_target:
-        ok = all(k in t for k in AXIS_KEYS)
+        ok = all(k in t for k in AXIS_KEYS[:n])
     else:
         ok = all(k in t for k in CART_KEYS)
     if not ok:
@@ -1047,7 +1075,7 @@ def plan(req: MotionRequest, q_start: np.ndarray, model: RobotModel, *,
     """
     p: MotionParams = req.params
     if first:
-        _check_complete(req)
+        _check_complete(req, model.n)
     if p.ipo_mode == "TCP":
         from .external_tcp import external_tcp  # noqa: PLC0415
 
@@ -1074,18 +1102,21 @@ def _plan_joint(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_T:
                 base_T: np.ndarray, model: RobotModel) -> JointSegment:
     p = req.params
     t = req.target
+    n = model.n
     if req.is_axis_target:
+        # the robot's axes A1..An (an A(n+1)..A6 of the target has no axis: ignored), then E
+        keys = AXIS_KEYS[:n] + EXT_KEYS[:len(q0) - n]
         if req.relative:
-            q1 = q0 + np.array([float(t.get(k, 0.0)) for k in AXIS_KEYS + EXT_KEYS[:len(q0) - 6]])
+            q1 = q0 + np.array([float(t.get(k, 0.0)) for k in keys])
         else:
-            q1 = np.array([float(t[k]) if k in t else q0[i] for i, k in enumerate(AXIS_KEYS + EXT_KEYS[:len(q0) - 6])])
+            q1 = np.array([float(t[k]) if k in t else q0[i] for i, k in enumerate(keys)])
         model.check_limits(q1)
     else:
         T1 = _cart_target(t, start_T, req.relative, req.rel_frame)
         s = int(t["S"]) if "S" in t and not req.relative else None
         tt = int(t["T"]) if "T" in t and not req.relative else None
-        q1 = model.ik(T1, inv_pos(tool_T), base_T, s, tt, _ext_target(q0, t, req.relative))
-        if len(q1) > 6:
+        q1 = model.ik(T1, inv_pos(tool_T), base_T, s, tt, _ext_target(q0, t, req.relative, n))
+        if len(q1) > n:
             model.check_limits(q1)
     dq = np.abs(q1 - q0)
     moving = dq > 1e-9
@@ -1095,7 +1126,7 @@ def _plan_joint(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_T:
         V = A = 0.0
     else:
         v_axis = ptp_axis_speeds(p, model.machine, model.mode)     # $RED_T1 in T1 (issue 15)
-        a_axis = model.a_max * np.array(list(p.acc_axis)[:6] + [100.0] * (len(q0) - 6)) / 100.0
+        a_axis = model.a_max * np.array(list(p.acc_axis)[:n] + [100.0] * (len(q0) - n)) / 100.0
         if np.any(v_axis[moving] <= 0) or np.any(a_axis[moving] <= 0):
             raise RobotError("PTP: $VEL_AXIS, $ACC_AXIS and $OV_PRO must be positive")
         V = float(np.min(v_axis[moving] / dq[moving]))
@@ -1159,7 +1190,7 @@ def _plan_cart(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_T: 
     for kind, tgt, aux, ca, prm, _ in items:
         if any(k in tgt for k in AXIS_KEYS):
             # an axis target for a CP motion: its TCP pose
-            qa = np.array([float(tgt[k]) if k in tgt else 0.0 for k in AXIS_KEYS])
+            qa = np.array([float(tgt[k]) if k in tgt else 0.0 for k in AXIS_KEYS[:model.n]])
             if req.relative:
                 raise RobotError("CP _REL motion with an axis target")
             T1 = model.tcp(qa, tool_T, inv_pos(base_T))
@@ -1238,15 +1269,16 @@ def _plan_cart(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_T: 
     c = v_cp0 / v_ori0
     weights = [max(pc.length, th * c) for pc, th in zip(pieces, thetas)]
     W = float(sum(weights))
+    n = model.n
     q_end = _ext_target(q0, req.target if req.kind != "SPLINE" else
-                        (req.segments[-1].target if req.segments else {}), req.relative)
-    if len(q0) > 6:
-        model.check_limits(np.concatenate([q0[:6], q_end[6:]]))
+                        (req.segments[-1].target if req.segments else {}), req.relative, n)
+    if len(q0) > n:
+        model.check_limits(np.concatenate([q0[:n], q_end[n:]]))
     seg = CartSegment(req, q0, q_end, Trapezoid.plan(math.inf, math.inf), math.inf,
                       tool_T, base_T, model, pieces, rots, weights, ori)
     seg.vel_peak = np.zeros(len(q0))
     seg.acc_peak = np.zeros(len(q0))
-    if len(q0) > 6 and W <= 1e-6 and float(np.max(np.abs(q_end[6:] - q0[6:]))) > 1e-9:
+    if len(q0) > n and W <= 1e-6 and float(np.max(np.abs(q_end[n:] - q0[n:]))) > 1e-9:
         raise RobotError(f"{req.kind}: a CP motion that moves only the external axes is not simulated "
                          f"(the TCP stands still); move them with PTP")
     if W <= 1e-6:  # nothing to move (a zero-length LIN): zero duration, never approximated
@@ -1311,9 +1343,9 @@ def _plan_cart(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_T: 
             Q[0] = start
             ref = start
             chain = None
-            if len(q0) == 6 and nk >= MIN_CHAIN and model.batch_ik:
+            if len(q0) == model.n and nk >= MIN_CHAIN and model.batch_ik:
                 chain = seg.ik_chain([seg.pose_u(float(us[j])) for j in range(1, nk + 1)], ref)
-            elif len(q0) == 6 and seg.compiled_inverse():
+            elif len(q0) == model.n and seg.compiled_inverse():
                 # the poses and the compiled inverse along the samples in one call (the same
                 # rows); else the poses here and the inverse in one call
                 cp = seg._compiled_path()
@@ -1331,7 +1363,7 @@ def _plan_cart(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_T: 
                 ref = Q[nk].copy()
             for j in range(1, nk + 1 if chain is None else 1):
                 pu, Ru = seg.pose_u(float(us[j]))
-                q = seg.ik(pu, Ru, ref, float(us[j])) if len(q0) > 6 else seg.ik(pu, Ru, ref)
+                q = seg.ik(pu, Ru, ref, float(us[j])) if len(q0) > model.n else seg.ik(pu, Ru, ref)
                 jump = np.abs(q - ref)
                 if float(jump.max()) > SINGULAR_JUMP_DEG:
                     i = int(np.argmax(jump))
@@ -1392,7 +1424,7 @@ def _plan_cart(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_T: 
         if vnode[k] <= 0.0:
             continue
         uk, du_ = float(ub[k]), 1e-5
-        e_u = (lambda v: v) if len(q0) > 6 else (lambda v: None)
+        e_u = (lambda v: v) if len(q0) > model.n else (lambda v: None)
         qj = seg.ik(*seg.pose_u(uk), junction_q[k], e_u(uk))
         qL = seg.ik(*seg.pose_u(uk - du_), qj, e_u(uk - du_))
         qR = seg.ik(*seg.pose_u(uk + du_), qj, e_u(uk + du_))
@@ -1461,7 +1493,7 @@ def resolved_target(seg: Segment) -> MotionRequest:
     suspended by BRAKE when the interrupt routine moved the robot)."""
     req = seg.req
     if not seg.cart:
-        tgt = {k: float(v) for k, v in zip(AXIS_KEYS, seg.q1)}
+        tgt = {k: float(v) for k, v in zip(AXIS_KEYS[:seg.model.n], seg.q1)}
         kind = "PTP"
     else:
         T = seg.model.tcp(seg.q1, seg.tool_T, seg.base_inv_T)

@@ -11,20 +11,13 @@ from .kinematics import Kinematics
 from .machine import MachineData
 
 #: Parameters shown with their source, in this order (those the model has).
-_PARAMS = ("$TRAFONAME", "$KINCLASS", "$NUM_AX", "$TIRORO", "$LENGTH_A", "$LENGTH_B", "$TX3P3", "$DH_4",
+_PARAMS = ("$TRAFONAME", "$KINCLASS", "$MAIN_AXIS", "$NUM_AX", "$AXIS_SEQ", "$TIRORO", "$LENGTH_A", "$LENGTH_B", "$TX3P3", "$DH_4",
            "$DH_5", "$TFLWP", "$AXIS_DIR", "$SOFTN_END", "$SOFTP_END", "$VEL_AXIS_MA", "$RAT_MOT_AX",
            "$RAISE_TIME", "$AXIS_JERK", "$VEL_MA", "$ACC_MA", "$ACC_OV", "$ROBROOT", "$DEF_A4FIX",
            "$DEF_A5LINK", "a5_led", "$AXIS_HOME[1]", "$H_POS", "home_deg", "$MAMES", "$IN_POS_CAR", "$IN_POS_ORI",
            "$DEF_FLT_PTP", "$DEF_FLT_CP", "$DEF_L_M", "max_speed_deg_s", "max_acc_deg_s2", "opw",
            "status_phi_deg", "reach_wrist_point_mm", "ipo_cycle_s", "motion_defaults", "default_load",
            "$EX_AX_NUM", "$AXIS_TYPE", "E_speed", "$EX_KIN", "$ERSYSROOT")
-
-#: How each family of inverse kinematics is named (robot/kinematics.py ``Kinematics.family``).
-_FAMILIES = {"opw": "analytic (OPW: six axes, spherical wrist)",
-             "palletizer4": "analytic (4-axis palletizer: $DEF_A4FIX, A5 led by the parallelogram)",
-             "palletizer5": "analytic (5-axis palletizer: $DEF_A4FIX)",
-             "numeric": "numeric (mink on the MuJoCo model; no closed form for this arm)"}
-
 
 def _fmt(values, nd: int = 3) -> str:
     return ", ".join(f"{float(v):.{nd}f}".rstrip("0").rstrip(".") for v in values)
@@ -37,11 +30,9 @@ def show_lines(m: MachineData) -> list[str]:
     if m.trafoname:
         out.append(f"$TRAFONAME {printable(m.trafoname)}")
     k = Kinematics(m)
-    o = k._opw if k.family == "opw" else m.opw
-    out.append(f"kinematics OPW a1={o.a1 + 0.0:g} a2={o.a2 + 0.0:g} b={o.b + 0.0:g} c1={o.c1 + 0.0:g} "
-               f"c2={o.c2 + 0.0:g} c3={o.c3 + 0.0:g} c4={o.c4 + 0.0:g} mm")
-    out.append(f"inverse    {_FAMILIES.get(k.family, k.family)}")
-    zero = k.forward([0.0] * 6)[:3, 3]
+    out += k.impl.describe()         # the family's own lines (robot/kinematics/<family>.py)
+    out.append(f"inverse    {k.impl.title}")
+    zero = k.forward([0.0] * k.n_axes)[:3, 3]
     out.append(f"reach      {m.reach_wrist_point_mm:.1f} mm to the wrist point; flange at A=0: "
                f"({_fmt(zero, 1)}) mm")
     out.append(f"home       A = ({_fmt(m.home_deg)}) deg; flange X,Y,Z,A,B,C = ({_fmt(m.home_flange_pose, 1)})")
@@ -57,7 +48,8 @@ def show_lines(m: MachineData) -> list[str]:
     out.append("axes       axis   limits (deg)         v max (deg/s)  a max (deg/s2)  jerk (deg/s3)")
     for j in m.joints:
         out.append(f"           A{j.axis}   {j.limit_deg[0]:8.1f} .. {j.limit_deg[1]:7.1f}   {j.max_speed_deg_s:12.2f}"
-                   f"  {j.max_acc_deg_s2:13.1f}{acc_d}  {j.max_jerk_deg_s3:12.1f}{jerk_d}")
+                   f"  {j.max_acc_deg_s2:13.1f}{acc_d}  {j.max_jerk_deg_s3:12.1f}{jerk_d}"
+                   + ("   linear (mm)" if getattr(j, "kind", "rotary") == "linear" else ""))
     for e in m.external_axes:
         u = "mm" if e.linear else "deg"
         lim = "endless" if e.kind == "endless" else f"{e.limit[0]:8.1f} .. {e.limit[1]:7.1f}"

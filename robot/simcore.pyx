@@ -1,309 +1,61 @@
 # cython: language_level=3, boundscheck=False, wraparound=False, cdivision=True, initializedcheck=False
-"""The simulator's hot path in C (issue 39, "Simulator"), built by robot/build.py:
+"""The simulator's hot path in C that is not kinematics of its own (issue 39, "Simulator";
+issue 47), built by robot/build.py. The kinematics' hot path is robot/kinematics/fastpath.py,
+compiled from that very Python file; this module calls its C methods (``OPWCore``):
 
-* :class:`OPW`: the OPW inverse kinematics of one pose (and along a chain of poses), the
-  compiled form of robot/kinematics.py ``Kinematics._opw_core`` + ``_status_row`` + the
-  selection of ``Kinematics._select`` for the six-axis arm with a spherical wrist;
-* :class:`Palletizer4`: the 4-axis palletizer's solutions (``Kinematics._palletizer_rows``: the
-  same rows; its flange test runs a forward kinematics of its own, see the class);
-* :class:`Forward`: ``Kinematics.forward`` (scipy's rotation matrices, numpy's own BLAS);
+* :class:`Palletizer4`: the 4-axis palletizer's solutions (robot/kinematics/palletizer4.py
+  ``Palletizer4.solutions``: the same rows; its flange test runs a forward kinematics of its
+  own, see the class);
+* :class:`Forward`: the joints' forward kinematics (robot/kinematics/joints.py
+  ``JointChain.forward``: scipy's rotation matrices, numpy's own BLAS through its address);
 * :class:`CartPath`: the poses of a CP segment's lines and arcs (robot/planner.py
-  ``CartSegment.pose_u``) and their axes;
-* :class:`ArmCycle` and :func:`speed_ok`: the IPO cycle's MuJoCo playback with its TCP product,
-  and its axis step check (robot/controller.py ``Controller.step``);
+  ``CartSegment.pose_u``) and their axes (fastpath's ``OPWCore``);
+* :class:`ArmCycle` and :func:`speed_ok`: the IPO cycle's MuJoCo playback (``mj_kinematics``
+  through its address) with its TCP product, and its axis step check (robot/controller.py
+  ``Controller.step``);
 * :func:`pose_line`: the trace's pose line (robot/trace.py).
 
-Bit for bit the pure-Python code it mirrors, which stays the fallback (and the reference:
-tests/robot/test_simcore.py compares the two on random poses): the same operations in the same
-order on C doubles, libm's sin/cos/atan2/acos/sqrt (what Python's ``math`` calls), ``degrees``
-and ``radians`` as CPython's multiplications by 180/pi and pi/180, Python's float ``%`` as
-CPython's ``float_rem``, and no fused multiply-add (compiled with ``-ffp-contract=off``).
-
-:meth:`OPW.inverse` answers the selected axes, or None whenever the Python code would raise or
-takes a path not mirrored here (no solution, no solution with the status, none within the
-limits): the caller then runs the Python code, which gives the error with its message.
+Each is bit for bit the pure-Python code it mirrors, which stays the fallback and the reference:
+tests/robot/test_simcore.py compares the two wherever this module is built, and fails where it
+is expected and missing. The same operations in the same order on C doubles, libm's functions
+(what Python's ``math`` calls), ``degrees`` and ``radians`` as CPython's multiplications by 180/pi
+and pi/180, and no fused multiply-add (compiled with ``-ffp-contract=off``). ``SOURCE_SHA`` is the
+sha256 of the simcore.pyx it was built from (robot/build.py passes it): a stale build is not used.
 """
 
-from libc.math cimport sin, cos, atan2, acos, sqrt, fmod, copysign, fabs, M_PI, INFINITY
+from libc.math cimport sin, cos, atan2, sqrt, fabs, copysign, M_PI
 import numpy as np
 
-#: Bumped whenever the mirrored Python code changes (robot/kinematics.py checks it: a stale
-#: build is not used).
-ABI = 5
+from robot.kinematics.fastpath cimport OPWCore
+
+cdef extern from *:
+    """
+    #ifndef SIMCORE_SOURCE_SHA
+    #define SIMCORE_SOURCE_SHA ""
+    #endif
+    """
+    const char* SIMCORE_SOURCE_SHA
+
+#: The sha256 of the simcore.pyx this module was compiled from (robot/build.py; robot/kinematics
+#: compares it with the file's: a stale build is not used)
+SOURCE_SHA = SIMCORE_SOURCE_SHA.decode("ascii")
 
 cdef double DEG_TO_RAD = M_PI / 180.0
 cdef double RAD_TO_DEG = 180.0 / M_PI
-cdef double BOUNDARY_EPS = 1e-9
-cdef double WRIST_SINGULAR_DEG = 1e-6
-cdef double OVERHEAD_SINGULAR_MM = 1e-6
-cdef double ACOS_TOL = 1e-9
-
-
-cdef inline double _pymod(double vx, double wx) noexcept nogil:
-    """CPython's float ``vx % wx`` (Objects/floatobject.c float_rem), wx != 0."""
-    cdef double mod = fmod(vx, wx)
-    if mod != 0.0:
-        if (wx < 0) != (mod < 0):
-            mod += wx
-    else:
-        mod = copysign(0.0, wx)
-    return mod
-
-
-cdef inline double _wrapdeg(double th, double off, double sg) noexcept nogil:
-    # -((-degrees((th + off) * sg) + 180.0) % 360.0) + 180.0
-    return -_pymod(-((th + off) * sg * RAD_TO_DEG) + 180.0, 360.0) + 180.0
-
-
-cdef class OPW:
-    """The constants of one robot's OPW solution and soft limits (see robot/kinematics.py)."""
-
-    cdef double a1, a2, b, c1, c2, c3, c4, kappa_2, c2_2, k, at23, phi
-    cdef double sgn[6]
-    cdef double offs[6]
-    cdef double lo[6]
-    cdef double hi[6]
-    cdef double ks[5]
-    cdef int s_free, t_free
-
-    def __init__(self, o, double kappa_2, double c2_2, double k, double at23, double phi,
-                 sgn, offs, lo, hi, ks, int s_free, int t_free):
-        cdef int i
-        self.a1, self.a2, self.b = o.a1, o.a2, o.b
-        self.c1, self.c2, self.c3, self.c4 = o.c1, o.c2, o.c3, o.c4
-        self.kappa_2, self.c2_2, self.k, self.at23, self.phi = kappa_2, c2_2, k, at23, phi
-        for i in range(6):
-            self.sgn[i] = sgn[i]
-            self.offs[i] = offs[i]
-            self.lo[i] = lo[i]
-            self.hi[i] = hi[i]
-        for i in range(5):
-            self.ks[i] = ks[i]
-        self.s_free, self.t_free = s_free, t_free
-
-    cdef inline void _status_row(self, const double* q, int* s, int* amb) noexcept nogil:
-        cdef double t2 = (self.sgn[1] * q[1]) * DEG_TO_RAD - self.offs[1]
-        cdef double t23 = t2 + (self.sgn[2] * q[2]) * DEG_TO_RAD - self.offs[2]
-        cdef double xw = self.a1 + self.c2 * sin(t2) + self.c3 * sin(t23) + self.a2 * cos(t23)
-        cdef double phi = self.phi
-        s[0] = (<int>(xw < -BOUNDARY_EPS)) | ((<int>(q[2] >= phi - BOUNDARY_EPS)) << 1) \
-            | ((<int>(q[4] < -BOUNDARY_EPS)) << 2)
-        amb[0] = (<int>(fabs(xw) < OVERHEAD_SINGULAR_MM)) | ((<int>(fabs(q[2] - phi) < 1e-7)) << 1) \
-            | ((<int>(fabs(q[4]) < WRIST_SINGULAR_DEG)) << 2) | self.s_free
-
-    cdef int _core(self, const double* M, const double* ref, double* out) noexcept nogil:
-        """``Kinematics._opw_core(T, ref)`` of the pose M (the first three rows of T, 12
-        values; ref NULL: ``ref_deg`` None): the solutions into out (8 x 6), their number."""
-        cdef double r00 = M[0], r01 = M[1], r02 = M[2], px = M[3]
-        cdef double r10 = M[4], r11 = M[5], r12 = M[6], py = M[7]
-        cdef double r20 = M[8], r21 = M[9], r22 = M[10], pz = M[11]
-        cdef double cx = px - self.c4 * r02
-        cdef double cy = py - self.c4 * r12
-        cdef double cz = pz - self.c4 * r22
-        cdef double rho2 = cx * cx + cy * cy - self.b * self.b
-        cdef double nx1, tmp1, tmp2, th1_i, th1_ii, tmp3, s1_2, tmp4, s2_2, s1, s2
-        cdef double th1, s_, s_2, base2, arg2, arg3, a2c, a3c, v
-        cdef double arm[4][3]
-        cdef int narm = 0, n = 0, j, i
-        cdef double th2, th3, sn1, cs1, s23, c23, mm, th4, th5, th6, total
-        cdef double sol[6]
-        if rho2 < 0.0:
-            return 0
-        nx1 = sqrt(rho2) - self.a1
-        if ref != NULL and sqrt(cx * cx + cy * cy) < OVERHEAD_SINGULAR_MM:
-            tmp1 = (self.sgn[0] * ref[0]) * DEG_TO_RAD - self.offs[0]
-        else:
-            tmp1 = atan2(cy, cx)
-        tmp2 = atan2(self.b, nx1 + self.a1)
-        th1_i = tmp1 - tmp2
-        th1_ii = tmp1 + tmp2 - M_PI
-        tmp3 = cz - self.c1
-        s1_2 = nx1 * nx1 + tmp3 * tmp3
-        tmp4 = nx1 + 2.0 * self.a1
-        s2_2 = tmp4 * tmp4 + tmp3 * tmp3
-        s1 = sqrt(s1_2)
-        s2 = sqrt(s2_2)
-        for j in range(2):
-            if j == 0:
-                th1, s_, s_2, base2 = th1_i, s1, s1_2, atan2(nx1, tmp3)
-            else:
-                th1, s_, s_2, base2 = th1_ii, s2, s2_2, -atan2(tmp4, tmp3)
-            if s_ < 1e-12:
-                continue
-            arg2 = (s_2 + self.c2_2 - self.kappa_2) / (2.0 * s_ * self.c2)
-            arg3 = (s_2 - self.c2_2 - self.kappa_2) / (2.0 * self.c2 * self.k)
-            if fabs(arg2) > 1.0 + ACOS_TOL or fabs(arg3) > 1.0 + ACOS_TOL:
-                continue
-            # math.acos(min(1.0, max(-1.0, arg)))
-            v = arg2 if arg2 > -1.0 else -1.0
-            a2c = acos(v if v < 1.0 else 1.0)
-            v = arg3 if arg3 > -1.0 else -1.0
-            a3c = acos(v if v < 1.0 else 1.0)
-            arm[narm][0], arm[narm][1], arm[narm][2] = th1, -a2c + base2, a3c - self.at23
-            narm += 1
-            arm[narm][0], arm[narm][1], arm[narm][2] = th1, a2c + base2, -a3c - self.at23
-            narm += 1
-        for j in range(narm):
-            th1, th2, th3 = arm[j][0], arm[j][1], arm[j][2]
-            sn1, cs1 = sin(th1), cos(th1)
-            s23, c23 = sin(th2 + th3), cos(th2 + th3)
-            mm = r02 * s23 * cs1 + r12 * s23 * sn1 + r22 * c23
-            v = 1.0 - mm * mm
-            th5 = atan2(sqrt(v if v > 0.0 else 0.0), mm)
-            th4 = atan2(r12 * cs1 - r02 * sn1,
-                        r02 * c23 * cs1 + r12 * c23 * sn1 - r22 * s23)
-            th6 = atan2(r01 * s23 * cs1 + r11 * s23 * sn1 + r21 * c23,
-                        -r00 * s23 * cs1 - r10 * s23 * sn1 - r20 * c23)
-            if ref != NULL and fabs(th5 * RAD_TO_DEG) < WRIST_SINGULAR_DEG:
-                total = th4 + th6
-                th4 = (self.sgn[3] * ref[3]) * DEG_TO_RAD - self.offs[3]
-                th6 = total - th4
-            sol[0], sol[1], sol[2], sol[3], sol[4], sol[5] = th1, th2, th3, th4, th5, th6
-            for i in range(6):
-                out[6 * n + i] = _wrapdeg(sol[i], self.offs[i], self.sgn[i])
-            n += 1
-            sol[3], sol[4], sol[5] = th4 + M_PI, -th5, th6 - M_PI
-            for i in range(6):
-                out[6 * n + i] = _wrapdeg(sol[i], self.offs[i], self.sgn[i])
-            n += 1
-        return n
-
-    def inverse(self, const double[:, :] T, status, turn, const double[:] ref6):
-        """``Kinematics.inverse`` of the flange pose T (4x4, mm, the OPW arm's own frame) for
-        the reference ref6 (6 axes, deg): the axes (6,) as a numpy array, or None where the
-        Python code raises (the caller runs it for the error)."""
-        cdef double M[12]
-        cdef int i, j
-        for i in range(3):
-            for j in range(4):
-                M[4 * i + j] = T[i, j]
-        return self._inverse(M, status, turn, ref6)
-
-    def inverse_rp(self, const double[:, :] R, const double[:] p, status, turn, const double[:] ref6):
-        """:meth:`inverse` of the pose with rotation R (3x3) and position p (3,, mm)."""
-        cdef double M[12]
-        cdef int i, j
-        for i in range(3):
-            for j in range(3):
-                M[4 * i + j] = R[i, j]
-            M[4 * i + 3] = p[i]
-        return self._inverse(M, status, turn, ref6)
-
-    def inverse_chain_rp(self, const double[:, :, :] R, const double[:, :] p, status, turn,
-                         const double[:] ref6):
-        """:meth:`inverse_rp` of each pose (R[j] (3x3), p[j] (3,)) in turn, each solution the
-        next one's reference (the first one's: ref6): the axes (n, 6), the rows those of n
-        calls of :meth:`inverse_rp` bit for bit, or None as soon as one of them would be None
-        (the caller then solves pose by pose for the error). Issue 39: the planner's samples
-        of a CP segment."""
-        cdef Py_ssize_t n = R.shape[0], j
-        cdef double M[12]
-        cdef double ref[6]
-        cdef int i, k
-        if p.shape[0] != n:
-            raise ValueError("R and p hold different numbers of poses")
-        res = np.empty((n, 6))
-        cdef double[:, :] out = res
-        for i in range(6):
-            ref[i] = ref6[i]
-        for j in range(n):
-            for i in range(3):
-                for k in range(3):
-                    M[4 * i + k] = R[j, i, k]
-                M[4 * i + 3] = p[j, i]
-            if not self._solve(M, status, turn, ref, &out[j, 0]):
-                return None
-            for i in range(6):
-                ref[i] = out[j, i]
-        return res
-
-    cdef object _inverse(self, const double* M, status, turn, const double[:] ref6):
-        cdef double ref[6]
-        cdef double[:] rv
-        cdef int i
-        for i in range(6):
-            ref[i] = ref6[i]
-        res = np.empty(6)
-        rv = res
-        if not self._solve(M, status, turn, ref, &rv[0]):
-            return None
-        return res
-
-    cdef int _solve(self, const double* M, status, turn, const double* ref, double* best_q) except -1:
-        """The selected axes of pose M (3x4, row-major) for the reference `ref` into best_q;
-        0 where the Python code raises or takes a path not mirrored here."""
-        cdef double rows[48]
-        cdef double q[6]
-        cdef int i, j, kk, n, s_target, free, keep, s_r, amb, tmask = 0, use_turn = 0
-        cdef int nmatch = 0, have_best = 0, ok
-        cdef double c, d, best_c, best_d, cost, best_cost = 0.0
-        cdef int found
-        cdef const double* b
-        n = self._core(M, ref, rows)
-        if n == 0:
-            return 0
-        if status is not None:
-            s_target = (<int>status) & 7
-            free = 0
-        else:
-            self._status_row(ref, &s_target, &free)
-        keep = ~free
-        if turn is not None:
-            tmask = (<int>turn) & ~self.t_free
-            use_turn = 1
-        for j in range(n):
-            b = &rows[6 * j]
-            self._status_row(b, &s_r, &amb)
-            if ((s_r ^ s_target) & ~amb & keep & 7) != 0:
-                continue
-            nmatch += 1
-            ok = 1
-            for i in range(6):
-                found = 0
-                best_c = 0.0
-                best_d = INFINITY
-                for kk in range(5):
-                    c = b[i] + self.ks[kk]
-                    if c < self.lo[i] or c > self.hi[i]:
-                        continue
-                    if use_turn and not (((c < 0) == (((tmask >> i) & 1) == 1)) or fabs(c) < 1e-6
-                                         or ((self.t_free >> i) & 1) == 1):
-                        continue
-                    d = fabs(c - ref[i])
-                    if d < best_d:
-                        best_c, best_d = c, d
-                        found = 1
-                if not found:
-                    ok = 0
-                    break
-                q[i] = best_c
-            if ok:
-                cost = 0.0
-                for i in range(6):
-                    cost += fabs(q[i] - ref[i])
-                if not have_best or cost < best_cost:
-                    have_best = 1
-                    best_cost = cost
-                    for i in range(6):
-                        best_q[i] = q[i]
-        return have_best
-
-
-
 
 cdef class Palletizer4:
-    """The solutions of a flange pose on the 4-axis palletizer (robot/kinematics.py
-    ``Kinematics._palletizer_rows`` after the vertical rotation ``R_v`` is known): for each arm
+    """The solutions of a flange pose on the 4-axis palletizer (robot/kinematics/palletizer4.py
+    ``Palletizer4.solutions`` after the vertical rotation ``R_v`` is known): for each arm
     plane (towards the flange, and behind the A1 axis) the A5 point the fixed offset back from
-    the flange, :meth:`OPW._core` for it (c4 = 0), A4 at 0 (within 1e-6 deg: set to 0.0; the
+    the flange, fastpath's ``OPWCore.core`` for it (c4 = 0), A4 at 0 (within 1e-6 deg: set to 0.0; the
     flipped wrist, |A4| = 180, dropped), and only the rows whose flange lies within 1e-6 mm of
     the target. The rows are those of the Python code bit for bit; the flange test runs a
     forward kinematics of its own (Rodrigues' formula per joint, the chain of
-    ``Kinematics.forward``), which may differ from numpy's and scipy's in the last bits:
+    ``JointChain.forward``), which may differ from numpy's and scipy's in the last bits:
     it only tells the true solutions (errors about 1e-10 mm) from the wrong arm plane's
     (millimetres), never near 1e-6 (tools/palletizer_rows_check.py shows it on the corpus)."""
 
-    cdef OPW opw
+    cdef OPWCore opw
     cdef double orig[6][3]
     cdef double axis[6][3]
     cdef double sign[6]
@@ -313,7 +65,7 @@ cdef class Palletizer4:
     cdef double pfl[3]
     cdef double off[3]
 
-    def __init__(self, OPW opw, origins, axes, sign, R_origin, origin_rot, R_flange, p_flange, offset):
+    def __init__(self, OPWCore opw, origins, axes, sign, R_origin, origin_rot, R_flange, p_flange, offset):
         cdef int i, j, k
         self.opw = opw
         for i in range(6):
@@ -381,11 +133,10 @@ cdef class Palletizer4:
     def rows(self, const double[:, :] R_v, const double[:] p, ref6):
         """The rows (lists of 6 floats, deg) for the flange position p (3,, mm) with the
         vertical rotation R_v (3x3); ref6 the reference axes (6,, deg) or None."""
-        cdef double M[12]
+        cdef OPWCore opw = self.opw
         cdef double sols[48]
-        cdef double ref[6]
         cdef double pos[3]
-        cdef const double* refp = NULL
+        cdef int has_ref = 0
         cdef double phi, arm, ca, sa, err, e, px = p[0], py = p[1], pz = p[2]
         cdef double* row
         cdef int j, i, k, n
@@ -394,21 +145,23 @@ cdef class Palletizer4:
         if ref6 is not None:
             rv = np.asarray(ref6, dtype=float)
             for i in range(6):
-                ref[i] = rv[i]
-            refp = ref
+                opw.ref[i] = rv[i]
+            has_ref = 1
         for i in range(3):
             for k in range(3):
-                M[4 * i + k] = R_v[i, k]
+                opw.M[4 * i + k] = R_v[i, k]
         phi = atan2(py, px)
         for j in range(2):
             arm = phi if j == 0 else phi + M_PI
             ca = cos(arm)
             sa = sin(arm)
             # w = p - [ca * o0 - sa * o1, sa * o0 + ca * o1, o2]
-            M[3] = px - (ca * self.off[0] - sa * self.off[1])
-            M[7] = py - (sa * self.off[0] + ca * self.off[1])
-            M[11] = pz - self.off[2]
-            n = self.opw._core(M, refp, sols)
+            opw.M[3] = px - (ca * self.off[0] - sa * self.off[1])
+            opw.M[7] = py - (sa * self.off[0] + ca * self.off[1])
+            opw.M[11] = pz - self.off[2]
+            n = opw.core(has_ref)
+            for k in range(6 * n):
+                sols[k] = opw.sol[k]
             for k in range(n):
                 row = &sols[6 * k]
                 if fabs(row[3]) < 1e-6:
@@ -428,8 +181,9 @@ cdef class Palletizer4:
 
 # ----------------------------------------------------------------------------- CP paths
 cdef class CartPath:
-    """The poses of a CP segment's lines and arcs, and their axes (``opw`` None: the poses only) (robot/planner.py
-    ``CartSegment.pose_u`` and ``CartSegment.ik`` with the compiled inverse, the same numbers):
+    """The poses of a CP segment's lines and arcs, and their axes (``opw``: robot/kinematics/fastpath.py's
+    ``OPWCore``; None: the poses only) (robot/planner.py ``CartSegment.pose_u`` and ``CartSegment.ik``
+    with the compiled inverse, the same numbers):
     for path parameter u the piece k and fraction f of ``CartSegment._locate``, the position
     ``LinePiece.pos``/``ArcPiece.pos`` at ``s = f * length`` (libm's cos and sin, as ``math``)
     and the rotation the segment keeps for that piece (at its start, within it and at its end:
@@ -441,7 +195,7 @@ cdef class CartPath:
     ``c`` = e2, ``r``, ``angle``), -1 not mirrored; ``rots`` (n, 3, 3, 3): the rotation at
     f <= 0, within, at f >= 1; ``mid_ok`` 0 where the rotation within is not mirrored."""
 
-    cdef OPW opw
+    cdef OPWCore opw
     cdef int n
     cdef object keep
     cdef const double[::1] ub
@@ -455,7 +209,7 @@ cdef class CartPath:
     cdef const double[:, ::1] c
     cdef const double[:, :, :, ::1] rots
 
-    def __init__(self, OPW opw, ub, kinds, mid_ok, length, r, angle, a, b, c, rots):
+    def __init__(self, OPWCore opw, ub, kinds, mid_ok, length, r, angle, a, b, c, rots):
         self.opw = opw
         self.keep = (ub, kinds, mid_ok, length, r, angle, a, b, c, rots)
         self.ub, self.kinds, self.mid_ok = ub, kinds, mid_ok
@@ -535,6 +289,24 @@ cdef class CartPath:
                 Rv[i, j] = M[4 * i + j]
         return p, R
 
+    cdef int _solve(self, const double* M, status, const double* ref, double* out) except -1:
+        """fastpath's ``OPWCore.solve`` of the pose M (3x4, row-major) for the reference `ref`
+        (turn None) into out (6); 0 where ``CartSegment.ik`` raises."""
+        cdef OPWCore opw = self.opw
+        cdef int i, st = 0, has_status = 0
+        if status is not None:
+            st = <int>status
+            has_status = 1
+        for i in range(12):
+            opw.M[i] = M[i]
+        for i in range(6):
+            opw.ref[i] = ref[i]
+        if not opw.solve(has_status, st, 0, 0):
+            return 0
+        for i in range(6):
+            out[i] = opw.q[i]
+        return 1
+
     def axes_u(self, double u, status, const double[:] ref6):
         """The axes (6,) at u for the reference ref6 (``CartSegment.ik`` of ``pose_u(u)``), or
         None (not mirrored, or the Python inverse decides)."""
@@ -547,7 +319,7 @@ cdef class CartPath:
             ref[i] = ref6[i]
         res = np.empty(6)
         cdef double[::1] rv = res
-        if not self.opw._solve(M, status, None, ref, &rv[0]):
+        if not self._solve(M, status, ref, &rv[0]):
             return None
         return res
 
@@ -567,7 +339,7 @@ cdef class CartPath:
         for j in range(n):
             if not self._pose(us[j], M):
                 return None
-            if not self.opw._solve(M, status, None, ref, &out[j, 0]):
+            if not self._solve(M, status, ref, &out[j, 0]):
                 return None
             for i in range(6):
                 ref[i] = out[j, i]
@@ -600,12 +372,12 @@ ctypedef void (*_dgemv_t)(int order, int ta, long long m, long long n, double al
 
 
 cdef class Forward:
-    """``Kinematics.forward`` (robot/kinematics.py) in one call, the same numbers: the joint
+    """``JointChain.forward`` (robot/kinematics/joints.py) in one call, the same numbers: the joint
     rotations of scipy's ``Rotation.from_rotvec(axis * q).as_matrix()`` (its quaternion, then
     its matrix, the same operations in the same order), and every product ``@`` of the Python
     code through numpy's own BLAS as numpy calls it (``cblas_dgemm`` for a 3x3 by 3x3 product,
     ``cblas_dgemv`` for a 3x3 by vector one, at the addresses given). Its users check it against
-    the Python code at set-up (robot/kinematics.py ``_compiled_forward``)."""
+    the Python code at set-up (robot/kinematics/joints.py ``JointChain._compiled``)."""
 
     cdef _dgemm_t gemm
     cdef _dgemv_t gemv

@@ -47,7 +47,7 @@ SCHEMA: dict[str, list[tuple[str, str]]] = {
         ("source", "optional str: program | trigger | pulse | stimulus | cell (a rule of the cell file; a preset names itself: cell:pgno, cell:autoext) | auto (an answer of --inputs auto)"),
     ],
     "pose": [
-        ("axes", "list[6] float: A1..A6 in deg (setpoint read back from MuJoCo)"),
+        ("axes", "list float: A1..An, the robot's axes (six; four on a SCARA), in deg (a linear axis in mm), then E1..En (mm or deg): the setpoint read back from MuJoCo"),
         ("tcp", "list[6] float: X, Y, Z mm and A, B, C deg of the TCP in $BASE (main-run $TOOL/$BASE)"),
     ],
     "trigger": [
@@ -295,7 +295,7 @@ class TraceWriter:
         return ev
 
     def write_pose(self, t: float, axes: Any, tcp_T: Any) -> None:
-        """Queue a ``pose`` event from axes (6, deg) and a 4x4 TCP matrix (mm). Poses are
+        """Queue a ``pose`` event from axes (A1..An, E1..En; deg, mm) and a 4x4 TCP matrix (mm). Poses are
         converted to X, Y, Z, A, B, C in batches (vectorised, same numbers as
         :func:`robot.frames.matrix_to_frame`) and written before the next other event."""
         self._pose_count += 1
@@ -637,6 +637,7 @@ def validate_event(ev: dict[str, Any]) -> None:
 
 #: the leading words of a field description -> its JSON Schema type
 _JSON_TYPES = (("list[6] float", {"type": "array", "items": {"type": "number"}, "minItems": 6, "maxItems": 6}),
+               ("list float", {"type": "array", "items": {"type": "number"}, "minItems": 1}),
                ("bool or float", {"type": ["boolean", "number"]}), ("str or null", {"type": ["string", "null"]}),
                ("dict", {"type": "object"}), ("int", {"type": "integer"}), ("str", {"type": "string"}),
                ("float", {"type": "number"}), ("bool", {"type": "boolean"}), ("list", {"type": "array"}))

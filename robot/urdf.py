@@ -32,19 +32,21 @@ def build_urdf(machine: MachineData) -> str:
     for name in ("base_link", *(j.child for j in machine.joints), "base", "tool0"):
         ET.SubElement(robot, "link", name=name)
     for j in machine.joints:
-        el = ET.SubElement(robot, "joint", name=j.name, type="revolute")
+        linear = j.kind == "linear"        # a SCARA's A3: prismatic, mm -> m
+        si = (lambda v: v / 1000.0) if linear else math.radians
+        el = ET.SubElement(robot, "joint", name=j.name, type="prismatic" if linear else "revolute")
         ET.SubElement(el, "parent", link=j.parent)
         ET.SubElement(el, "child", link=j.child)
         ET.SubElement(el, "origin", xyz=_v(v / 1000.0 for v in j.origin_mm), rpy=_v(j.origin_rpy_rad))
         ET.SubElement(el, "axis", xyz=_v(j.joint_axis))
-        ET.SubElement(el, "limit", effort="0", lower=_v([math.radians(j.limit_deg[0])]),
-                      upper=_v([math.radians(j.limit_deg[1])]),
-                      velocity=_v([math.radians(j.max_speed_deg_s)]))
+        ET.SubElement(el, "limit", effort="0", lower=_v([si(j.limit_deg[0])]),
+                      upper=_v([si(j.limit_deg[1])]),
+                      velocity=_v([si(j.max_speed_deg_s)]))
     el = ET.SubElement(robot, "joint", name="base_link-base", type="fixed")
     ET.SubElement(el, "parent", link="base_link")
     ET.SubElement(el, "child", link="base")
     ET.SubElement(el, "origin", xyz="0 0 0", rpy="0 0 0")
-    el = ET.SubElement(robot, "joint", name="link_6-tool0", type="fixed")
+    el = ET.SubElement(robot, "joint", name=f"{machine.joints[-1].child}-tool0", type="fixed")
     ET.SubElement(el, "parent", link=machine.joints[-1].child)
     ET.SubElement(el, "child", link="tool0")
     ET.SubElement(el, "origin", xyz=_v(v / 1000.0 for v in machine.flange_pos_mm),

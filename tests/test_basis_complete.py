@@ -1,27 +1,21 @@
-"""The BASIS for programs outside a backup is complete (issue 50): every routine the checker's
-tables declare (krl/semantics/data/functions.yaml: ``functions``, ``procedures``, and the
-names of KUKA's system software the KSS 8 motion inline forms call: ``USE_CM_PRO_VALUES``) has
-either an implementation in the simulator (a native: interp/runtime/builtins.py's NATIVES or
-the natives registry, interp/runtime/natives/, whichever exists) or a GLOBAL routine of
-interp/basis/*.src, read by the front end. A name added to the tables without either fails
-here with its name."""
+"""The BASIS for programs outside a backup is complete (issue 50): the routines KSS 8's motion
+inline forms call in their WITH parts (SPTP/SLIN/SCIRC: the spline helpers of bas.src and
+``USE_CM_PRO_VALUES`` of KUKA's system software) are GLOBAL routines of interp/basis/*.src,
+read by the front end, and they run on both interpreters with the values a KR C4's BASIS gives.
+
+That every routine of the checker's tables (krl/semantics/data/functions.yaml) has an
+implementation, a BASIS routine or a declared stand-in is the natives registry's completeness
+test (tests/interp/test_natives.py, issue 47): the table is generated from the registry, where
+each routine is declared with how it runs."""
 
 from __future__ import annotations
 
-import importlib
-import re
-
 import pytest
-import yaml
-
-from pathlib import Path
 
 from interp.run import make_runtime
-from interp.runtime.program import BASIS_DIR, parse_module
-from krl.semantics.data import __path__ as _data_path  # the tables' package
+from interp.runtime.natives import REGISTRY
 from robot.trace import TraceWriter
 
-TABLE = Path(_data_path[0]) / "functions.yaml"
 # the names of KUKA's system software (functions.yaml lenient: system) that KSS 8's inline
 # forms write into their WITH parts (SPTP/SLIN/SCIRC: $COLLMON_TOL_PRO[1] = USE_CM_PRO_VALUES(0))
 INLINE_FORM_SYSTEM = ("USE_CM_PRO_VALUES",)
@@ -33,73 +27,11 @@ INLINE_FORM_FUNCTIONS = ("SVEL_JOINT", "SVEL_CP", "STOOL", "STOOL2", "SBASE", "S
                          "SACC_CP", "SAPO_PTP", "SAPO", "SORI_TYP", "SCIRC_TYP", "SCIRC_M", "SGEAR_JERK", "SJERK")
 
 
-def table_names() -> set[str]:
-    doc = yaml.safe_load(TABLE.read_text(encoding="utf-8"))
-    names = set()
-    for sig in (doc.get("functions") or []) + (doc.get("procedures") or []):
-        m = re.match(r"\s*(?:[A-Z_0-9$]+\s+)?([A-Z_][A-Z_0-9]*)\s*\(", sig.upper())
-        assert m, sig
-        names.add(m.group(1))
-    return names | set(INLINE_FORM_SYSTEM)
-
-
-def natives() -> set[str]:
-    """The names the simulator implements natively, from whichever registry exists."""
-    names = set()
-    for mod, attrs in (("interp.runtime.builtins", ("NATIVES",)),
-                       ("interp.runtime.natives", ("NATIVES", "REGISTRY", "registry"))):
-        try:
-            m = importlib.import_module(mod)
-        except ImportError:
-            continue
-        for a in attrs:
-            reg = getattr(m, a, None)
-            if callable(reg) and not isinstance(reg, dict):
-                reg = reg()
-            if isinstance(reg, dict):
-                names |= {str(k).upper() for k in reg}
-    return names
-
-
-def basis_routines() -> set[str]:
-    """The routines a program may call in interp/basis/*.src: GLOBAL ones and each module's
-    main routine (``BAS`` of bas.src)."""
-    names = set()
-    for f in sorted(BASIS_DIR.glob("*.src")):
-        module, errors = parse_module(str(f))
-        assert not errors, errors
-        names |= {r.name.upper() for i, r in enumerate(module.routines)
-                  if r.is_global or (i == 0 and r.name.upper() == f.stem.upper())}
-    return names
-
-
-# Routines of the tables that are neither natives nor BASIS routines today: functions of
-# technology packages and of KUKA's system software whose value the tables do not document
-# (result ANY, or a variable argument list). In a backup the run stands each in with a note
-# (interp/runtime/kss.py: "a routine of the platform tables"); outside a backup a call stops
-# with "routine X not found". The natives lane's registry (issue 47) is where they go next;
-# this list may only shrink.
-NOT_YET = {
-    "DIGIN": "REAL DIGIN(...): KR C1's analog-digital input, signature open",
-    "EK": "ANY EK(...): technology package, result type undocumented",
-    "EB": "ANY EB(...): technology package, result type undocumented",
-    "LK": "ANY LK(...): technology package, result type undocumented",
-    "TOOL_ADJ": "ANY TOOL_ADJ(...): technology package, result type undocumented",
-    "SYNC": "ANY SYNC(...): technology package, result type undocumented",
-    "GET_SINGUL": "E6POS GET_SINGUL(...): KSS system function, arguments undocumented",
-}
-
-
-def test_every_table_routine_is_implemented():
-    missing = table_names() - natives() - basis_routines()
-    assert missing <= set(NOT_YET), f"declared in functions.yaml, with neither a native nor a BASIS routine: " \
-                                    f"{sorted(missing - set(NOT_YET))}"
-    assert set(NOT_YET) <= table_names()
-
-
 def test_the_inline_forms_functions_are_basis_routines():
-    assert set(INLINE_FORM_FUNCTIONS) <= table_names()
-    assert not sorted(set(INLINE_FORM_FUNCTIONS + INLINE_FORM_SYSTEM) - basis_routines())
+    """Declared in the natives registry as KRL of the project's BASIS (that the file has each
+    routine, of the declared kind, is tests/interp/test_natives.py's completeness check)."""
+    got = {name: REGISTRY[name].krl for name in INLINE_FORM_FUNCTIONS + INLINE_FORM_SYSTEM}
+    assert got == {**{name: "bas.src" for name in INLINE_FORM_FUNCTIONS}, "USE_CM_PRO_VALUES": "collmonlib.src"}
 
 
 @pytest.mark.parametrize("interp", ["tree", "vm"])

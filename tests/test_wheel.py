@@ -67,7 +67,10 @@ def test_wheel_ships_the_generated_parser_and_the_data(wheel):
     ext = "interp/vm/loop" + sysconfig.get_config_var("EXT_SUFFIX")
     assert ext in names and "interp/vm/loop.py" in names
     # and the simulator's compiled hot path (robot/build.py), beside the Python code it mirrors
-    assert "robot/simcore" + sysconfig.get_config_var("EXT_SUFFIX") in names and "robot/kinematics.py" in names
+    assert "robot/simcore" + sysconfig.get_config_var("EXT_SUFFIX") in names and "robot/kinematics/__init__.py" in names
+    # and the kinematics' fastpath compiled from its own Python file, which it carries too
+    assert "robot/kinematics/fastpath" + sysconfig.get_config_var("EXT_SUFFIX") in names
+    assert "robot/kinematics/fastpath.py" in names
 
 
 def test_installed_wheel_checks_a_backup_without_java(wheel, tmp_path):

@@ -1,6 +1,6 @@
 """The compiled 4-axis palletizer solutions (robot/simcore.pyx ``Palletizer4``) against the Python
-code on the corpus programs (issue 39, "Real programs"): every ``Kinematics._palletizer_rows``
-call of the runs is answered by both, and the rows must be the same bytes.
+code on the corpus programs (issue 39, "Real programs"): every call of robot/kinematics/palletizer4.py
+``Palletizer4.solutions`` in the runs is answered by both, and the rows must be the same bytes.
 
 The compiled code keeps a row when its own forward kinematics (Rodrigues' formula per joint) puts
 the flange within 1e-6 mm of the target; the Python code asks ``Kinematics.forward`` (numpy and
@@ -29,8 +29,9 @@ import numpy as np
 
 from interp import realprograms as rp
 from robot.kinematics import Kinematics
+from robot.kinematics.palletizer4 import Palletizer4
 
-_orig_rows = Kinematics._palletizer_rows
+_orig_rows = Palletizer4.solutions
 _orig_forward = Kinematics.forward
 stats = {"calls": 0, "differ": 0, "accepted": 0, "rejected": 0,
          "acc_err": 0.0, "rej_err": math.inf, "fk_diff": 0.0, "margin": math.inf}
@@ -75,7 +76,7 @@ def _rows(self, flange_T, ref_deg):
 
 def main(argv: list[str]) -> int:
     roots = [Path(a) for a in argv] or [rp.DEFAULT_CORPUS]
-    Kinematics._palletizer_rows = _rows
+    Palletizer4.solutions = _rows
     Kinematics.forward = _forward
     for root in roots:
         corpus = rp.DEFAULT_CORPUS if root.resolve().is_relative_to(rp.DEFAULT_CORPUS.resolve()) else root

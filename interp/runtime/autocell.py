@@ -141,43 +141,56 @@ class AutoCell:
         self.counts: dict = {}                 # (file, line) -> answers given
         self.rotation: dict = {}               # id(Switch node) -> next CASE index
         self._index: dict | None = None
+        self._resolved: dict = {}               # a statement's file -> its resolved path
+        self._scheduled: list = []              # the stimuli of its answers not yet applied
 
     # ------------------------------------------------------------------ statements
     def record(self, task, info) -> None:
         """Called for every statement and loop iteration while the cell watches (Runtime)."""
+        self.record_frame(task, info, task.frame)
+
+    def record_frame(self, task, info, frame) -> None:
+        """:meth:`record` of a statement `task` runs in `frame` (a parked spin's statements:
+        interp/runtime/spin.py)."""
         rec = self.recording
         if rec is None or info is None:
             return
-        frame = task.frame
         key = (id(task), info.file, info.line, id(frame))
         if key not in rec:
             rec[key] = (task, info.file, info.line, frame, len(rec))
 
-    def _statements(self) -> dict:
-        """(resolved file, line) -> the statements of the program's files on that line."""
+    def _statements(self, key_file: str) -> dict:
+        """line -> the statements (IF, WHILE, REPEAT and its UNTIL, WAIT FOR, SWITCH) on that line
+        of the program's file `key_file` (resolved), indexed when first asked for."""
         if self._index is None:
-            idx: dict = {}
+            self._index = {}
             for unit in self.rt.program.ws.units:
                 src = unit.src
-                if src is None or src.module is None:
-                    continue
-                key_file = str(Path(src.path).resolve())
-                for node in src.module.walk():
+                if src is not None and src.module is not None:
+                    self._index.setdefault(str(Path(src.path).resolve()), []).append(src.module)
+        idx = self._index.get(key_file)
+        if isinstance(idx, list):
+            modules, idx = idx, {}
+            for module in modules:
+                for node in module.walk():
                     if isinstance(node, (N.If, N.While, N.Repeat, N.WaitFor, N.Switch)) and node.span is not None:
-                        idx.setdefault((key_file, node.span.line), []).append(node)
+                        idx.setdefault(node.span.line, []).append(node)
                     if isinstance(node, N.Repeat) and node.cond is not None and node.cond.span is not None:
-                        idx.setdefault((key_file, node.cond.span.line), []).append(node)
-            self._index = idx
-        return self._index
+                        idx.setdefault(node.cond.span.line, []).append(node)
+            self._index[key_file] = idx
+        return idx if idx is not None else {}
 
     def _nodes_at(self, file: str, line: int) -> list:
         if not file:
             return []
-        return self._statements().get((str(Path(file).resolve()), line), [])
+        key = self._resolved.get(file)
+        if key is None:
+            key = self._resolved[file] = str(Path(file).resolve())
+        return self._statements(key).get(line, [])
 
     def pending(self) -> bool:
         """True while an answer has not taken effect yet."""
-        return any(st.source == "auto" and not st.fired for st in self.rt.controller.stimuli)
+        return any(not st.fired for st in self._scheduled)
 
     # ------------------------------------------------------------------ answering
     def answer(self, watch) -> str:
@@ -348,8 +361,14 @@ class AutoCell:
                                file=answer.file, line=answer.line, statement=answer.kind,
                                condition=answer.text or None)
 
-        ctl.stimuli.append(Stimulus(set=dict(sets), at=at, source="auto", on_fire=fired,
-                                    where=f"--inputs auto: {Path(span.file).name}:{span.line}"))
+        # the answers that took effect leave the controller's stimuli (it looks at each one
+        # at every IPO cycle); what they did is in self.answers
+        self._scheduled = [st for st in self._scheduled if not st.fired]
+        ctl.stimuli[:] = [st for st in ctl.stimuli if not (st.source == "auto" and st.fired)]
+        st = Stimulus(set=dict(sets), at=at, source="auto", on_fire=fired,
+                      where=f"--inputs auto: {Path(span.file).name}:{span.line}")
+        self._scheduled.append(st)
+        ctl.stimuli.append(st)
 
 
 def program_numbers(rt) -> list[int]:

@@ -33,7 +33,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from .errors import INTERRUPT_NOT_DECLARED, KrlRuntimeError
-from .watch import ALWAYS, CLOCK, CONSTANT, IO, stamp_key
+from .watch import ALWAYS, CLOCK, CONSTANT, IO, SETTLES, stamp_key
 
 MAIN_PRIO = 129
 #: False: every armed condition is evaluated at every poll, whatever its watch (the oracle of
@@ -72,6 +72,9 @@ class Irq:
     by_epoch: bool = False        # every probe changes only with the runtime's state epoch
     probe_epoch: object = None    # the state epoch at which `probed` was read
     probed: tuple = ()            # the probes' values at `probe_epoch`
+    steady: bool = False          # its value changes only with the I/O image, a statement, a cyclic
+                                  # flag or a task's state, never at a step of the moving robot
+                                  # (interp/runtime/watch.py ``steady``)
 
 
 @dataclass
@@ -100,9 +103,11 @@ class InterruptTable:
             raise KrlRuntimeError(f"interrupt {number} not declared", INTERRUPT_NOT_DECLARED)
         return [irq]
 
-    def control(self, action: str, number: int | None, io_version: int = 0, now: float = 0.0) -> None:
+    def control(self, action: str, number: int | None, io_version: int = 0, now: float = 0.0,
+                written=None) -> None:
         """INTERRUPT ON/OFF/ENABLE/DISABLE of `number` (None: all); ON takes the condition's
-        value with the I/O image at `io_version` at simulated time `now` (s) as reference."""
+        value with the I/O image at `io_version` at simulated time `now` (s), with `written`
+        (interp/runtime/watch.py ``CyclicWatch.written``), as reference."""
         self.settled = None
         for irq in self._targets(number):
             if action == "ON":
@@ -111,7 +116,7 @@ class InterruptTable:
                 irq.on = True
                 irq.seen = None
                 irq.last = bool(irq.cond())
-                irq.seen = stamp_key(irq.watch, io_version, now, irq.probes)
+                irq.seen = stamp_key(irq.watch, io_version, now, irq.probes, written)
                 irq.pending = False
             elif action == "OFF":
                 if irq.on:
@@ -125,11 +130,13 @@ class InterruptTable:
             else:
                 raise KrlRuntimeError(f"unknown INTERRUPT action {action}")
 
-    def poll(self, io_version: int = 0, now: float = 0.0, epoch: int | None = None) -> bool:
+    def poll(self, io_version: int = 0, now: float = 0.0, epoch: int | None = None, written=None) -> bool:
         """Evaluate the armed conditions; a rising edge makes the interrupt pending. A
         condition whose watch key (interp/runtime/watch.py :func:`~.watch.stamp_key`, computed
         here inline: this runs before every statement) at `io_version` and simulated time
-        `now` (s) is that of its last evaluation keeps its value: nothing it reads changed.
+        `now` (s) and `written` (what may have written a variable since: watch.py
+        ``CyclicWatch.written``) is that of its last evaluation keeps its value: nothing it
+        reads changed.
         `epoch`: the runtime's state epoch (interp/runtime/core.py ``Runtime.state_epoch``);
         the probes of an interrupt whose probes all change only with it (``by_epoch``) are
         read once per epoch (None: at every poll). Sets :attr:`settled`.
@@ -149,6 +156,9 @@ class InterruptTable:
                 settled = False
             elif w == CLOCK:
                 key = (io_version, now)
+                settled = False
+            elif w == SETTLES and written is not None:
+                key = (io_version, written)
                 settled = False
             else:
                 key = None

@@ -18,10 +18,9 @@ from krl.semantics import types as T
 from krl.semantics.advance import StmtInfo
 from krl.semantics.resolve import NATIVE, ROUTINE, Callee, Storage
 
-from .builtins import NATIVES, ValueRef
-from .netfunctions import RSI_CONSTANTS
+from .natives import RSI_CONSTANTS, ValueRef
 from .contexts import Context, Irq
-from .watch import split_watch
+from .watch import CONSTANT, IO, SETTLES, CyclicWatch, settles, split_watch, stamp_key, steady, watch_of
 from .convert import INT_MAX, INT_MIN, assign_into, binary_op, convert_scalar, to_bool, trunc_int, unary_op
 from .errors import (HaltSignal, KrlRuntimeError, ResumeSignal, StopRun)
 from .idle import probe_state
@@ -30,7 +29,7 @@ from .messages import MessageWindow
 from .motion import frame_of, params_from, request, segment, target_of
 from .program import Program
 from .runmode import STEP_MODES, BackwardRefused, MotionHistory, mode_name
-from .scheduler import Scheduler, Task
+from .scheduler import Scheduler, Task, program_budget
 from .sysvars import EPOCH_PROBED, SysVars, struct_of
 from .values import LEAVES, UNSET, Arr, EnumValue, Struct, copy_value, make_value, maker, value_size
 
@@ -53,10 +52,26 @@ class RunResult:
     text: str = ""
     sim_time: float = 0.0
     steps: int = 0
+    #: (file, line) of each frame of the robot program's call stack where it stopped, innermost
+    #: first (the run summary says what a wait in a caller waits for: interp/summary.py)
+    stack: tuple = ()
 
     @property
     def exit_code(self) -> int:
         return EXIT_CODES.get(self.reason, 2)
+
+
+def call_stack(task, limit: int = 64) -> tuple:
+    """(file, line) of each frame of `task` (innermost first, at most `limit`): where each
+    routine of its call stack stands."""
+    out = []
+    frame = task.frame
+    while frame is not None and len(out) < limit:
+        span = getattr(frame.routine, "span", None)
+        if span is not None and span.file and frame.line:
+            out.append((span.file, frame.line))
+        frame = frame.caller
+    return tuple(out)
 
 
 def _scalar(t) -> bool:
@@ -123,7 +138,7 @@ class Runtime:
                  "noted", "steps", "max_steps", "robot_budget", "sysvars", "memory", "program", "kss",
                  "modules", "scheduler", "robot", "result", "_plans", "_return_types", "_cyclic",
                  "run_mode", "history", "stmt_hook", "step_hook", "error_hook", "cycle_hook",
-                 "autocell", "halt_continues", "start", "halts", "state_epoch")
+                 "autocell", "halt_continues", "start", "halts", "state_epoch", "spin", "cyclic_watch")
 
     def __init__(self, main_path, *, workspace=None, controller=None, trace=None, stimuli=None,
                  max_sim_time: float | None = None, max_steps: int | None = None,
@@ -148,7 +163,8 @@ class Runtime:
         self.noted: set[str] = set()    # simulator notes given once per run (builtins)
         self.steps = 0
         self.max_steps = max_steps
-        self.robot_budget = robot_budget
+        # the program's time slice: a .sub selected on its own runs at the submit pace
+        self.robot_budget = robot_budget if robot_budget is not None else program_budget(main_path)
         self.sysvars = SysVars(self)
         self.memory = DataMemory()
         self.program = Program(self, main_path, workspace, submits, check)
@@ -157,6 +173,8 @@ class Runtime:
         self.kss = SystemSoftware(self)   # stand-ins for KUKA's software the backup lacks
         self.modules = self.program.modules       # by Storage.owner / Callee.owner
         self.scheduler = Scheduler(self, max_sim_time, max_steps)
+        self.spin = self.scheduler.spin   # parked spins (interp/runtime/spin.py)
+        self.cyclic_watch = CyclicWatch(self)   # when a cyclic flag is evaluated again (watch.py)
         self.robot: Task | None = None
         self.result: RunResult | None = None
         self._plans: dict = {}          # id(routine) -> Runtime._frame_plan
@@ -269,7 +287,8 @@ class Runtime:
             text = f"{text} while the robot program waits: {robot.waiting}"
         if reason == "completed":
             file, line, ctx = robot.file, robot.line, "main"
-        self.result = RunResult(reason, err, file, line, ctx, text, self.controller.time, self.steps)
+        self.result = RunResult(reason, err, file, line, ctx, text, self.controller.time, self.steps,
+                                call_stack(robot))
         if self.trace is not None and reason == "error" and err is not None and not err.traced:
             # the robot program's run-time error, before the `end` event (robot/trace.py);
             # a submit program's error was written when that task ended (submit_finished)
@@ -331,6 +350,8 @@ class Runtime:
     # ================================================================== time
     def yield_cycle(self, task: Task) -> None:
         """Give the rest of this IPO cycle back; on return run :meth:`service`."""
+        if self.spin.rec is not None:
+            self.spin.waiting(task)
         self.scheduler.yield_cycle()
         self.service(task)
         if self.cycle_hook is not None:
@@ -343,7 +364,10 @@ class Runtime:
         the task's interrupt conditions are monitored, an event is kept pending and its
         routine runs when the statement has returned (at the next statement), as the
         statement is one step of the program run; a main-run error ends the wait."""
+        if self.spin.rec is not None:
+            self.spin.waiting(task)
         self.scheduler.yield_cycle()
+        self._proceed()
         if task.pending_error is not None:
             e, task.pending_error = task.pending_error, None
             err = KrlRuntimeError(e.message, e.number)
@@ -358,6 +382,12 @@ class Runtime:
                 task.in_poll = False
         if self.cycle_hook is not None:
             self.cycle_hook(task)
+
+    def _proceed(self) -> None:
+        """A task goes on after a wait (or runs a TRIGGER action, an interrupt routine): a
+        parked spin catches up first (interp/runtime/spin.py)."""
+        if self.spin.on:
+            self.spin.proceeding()
 
     def service(self, task: Task) -> None:
         """First act of a resumed task: main-run errors, TRIGGER actions, interrupts."""
@@ -377,6 +407,8 @@ class Runtime:
         the ``stmt`` trace event."""
         task = self.current_task
         task.at = info
+        if self.spin.on:
+            self.spin.event(task, info, False)
         self._count_step(task)
         cont = False
         if task.continue_line is not None:
@@ -404,6 +436,7 @@ class Runtime:
             raise StopRun("max_steps", f"step limit {self.max_steps} reached")
         if self.steps >= task.slice_end:
             self.yield_cycle(task)
+            self._proceed()
         elif task.irqs.armed:
             self.check_interrupts(task)
 
@@ -426,7 +459,8 @@ class Runtime:
                 or task.continue_line is not None \
                 or self.stmt_hook is not None or self.run_mode == "ISTEP" \
                 or any(c.error_proceed for c in task.contexts) \
-                or (self.autocell is not None and self.autocell.recording is not None):
+                or (self.autocell is not None and self.autocell.recording is not None) \
+                or task.watched or task.replay is not None or task.shadow is not None:
             return 0
         lim = task.slice_end - 1
         if self.max_steps is not None and self.max_steps < lim:
@@ -442,7 +476,12 @@ class Runtime:
         """Called once per loop iteration (WHILE/REPEAT/LOOP/FOR): counts a step, may end
         the time slice, applies a loop condition's advance-run stop. No trace event."""
         task = self.current_task
+        spin = self.spin
+        if spin.on:
+            spin.event(task, info, True)
         self._count_step(task)
+        if task.park is not None:
+            spin.park(task)         # a spin: parked until something it reads can change
         if info.cond_stops and task.kind == "robot":
             self.advance_stop(task)
         if self.autocell is not None and self.autocell.recording is not None:
@@ -466,8 +505,20 @@ class Runtime:
     def wait_main_run(self, task: Task) -> None:
         """Advance-run stop: wait until the main run is idle (robot at rest)."""
         ctl = self.controller
-        while not ctl.is_idle():
-            self.yield_cycle(task)
+        if not ctl.is_idle():
+            self._wait(task, ctl.is_idle)
+            self._proceed()
+
+    def _wait(self, task: Task, until) -> None:
+        """Give IPO cycles back until ``until()`` — a test of the controller's state, with no
+        effect — holds. While the task waits so, the scheduler makes the test itself instead of
+        resuming it (interp/runtime/scheduler.py ``Scheduler._waits``)."""
+        outer, task.until = task.until, until
+        try:
+            while not until():
+                self.yield_cycle(task)
+        finally:
+            task.until = outer
 
     def wait_for(self, cond_fn, text: str = "WAIT FOR") -> None:
         """WAIT FOR: ``cond_fn()`` is evaluated now and once per IPO cycle."""
@@ -475,13 +526,41 @@ class Runtime:
         if to_bool(cond_fn(), "WAIT FOR condition"):
             return
         task.waiting = f"{text} at {task.file}:{task.line}" if task.kind == "robot" else None
+        # a condition over inputs and variables (interp/runtime/watch.py) gives the same value
+        # while its watch key stands: the scheduler tests the key instead of resuming the task
+        key = self._wait_key(task) if text == "WAIT FOR" else None
+        outer = task.until
         try:
             while True:
+                if key is not None:
+                    seen = key()
+                    task.until = None if seen is None else (lambda seen=seen: key() != seen)
                 self.yield_cycle(task)
                 if to_bool(cond_fn(), "WAIT FOR condition"):
+                    self._proceed()
                     return
         finally:
             task.waiting = None
+            task.until = outer
+
+    def _wait_key(self, task: Task):
+        """The watch key (interp/runtime/watch.py ``stamp_key``) of the condition of the WAIT FOR
+        `task` stands at, as a zero-argument callable; None when its class has none that stands
+        (it reads the clock, calls a routine, ...)."""
+        node = next((n for n in self.spin.statements(task.at) or () if isinstance(n, N.WaitFor)), None)
+        if node is None:
+            return None
+        ann = node.annotate()
+        w = ann.extra.get("watch")
+        if w is None:
+            w = ann.extra["watch"] = watch_of(node.cond)
+        cls, names = split_watch(w)
+        if cls not in (CONSTANT, IO, SETTLES):
+            return None
+        probes = tuple(_reader(self.sysvars.lookup(k)) for k in names)
+        ctl = self.controller
+        written = self.cyclic_watch.written
+        return lambda: stamp_key(cls, ctl.io.version, ctl.time, probes, written())
 
     def wait_sec(self, seconds) -> None:
         """WAIT SEC t: t seconds of simulated time (rounded up to IPO cycles)."""
@@ -499,8 +578,8 @@ class Runtime:
         shifted = idle.shifted
         try:
             # task.wake_cycle, not a local: a periodic jump of the idle watch moves it
-            while ctl.cycle < task.wake_cycle:
-                self.yield_cycle(task)
+            self._wait(task, lambda: ctl.cycle >= task.wake_cycle)
+            self._proceed()
         finally:
             # an outer WAIT SEC (this one ran in an interrupt routine) moves with the jumps too
             task.wake_cycle = None if outer is None else outer + idle.shifted - shifted
@@ -553,8 +632,9 @@ class Runtime:
         UNRESOLVED; docs/architecture.md, "One program model"): a ``$`` name is a system
         variable the simulator knows, or one that a system data list or KSS's system files
         declare (``SysVars.lookup``); in a backup, a variable of KUKA's software the backup
-        lacks stands in (interp/runtime/kss.py: its zero value, one note); any other name is
-        the run-time error "unknown name", as on the controller."""
+        lacks stands in (interp/runtime/kss.py: the names the checker classifies outside the
+        program, one note each); any other name is the run-time error "unknown name", as on
+        the controller."""
         key = name.upper()
         if key[:1] == "$":
             r = self.sysvars.lookup(key)
@@ -562,10 +642,9 @@ class Runtime:
                 return r
         elif key in RSI_CONSTANTS:      # RSI's constants (RSIOK, ...): the option declares them
             return ValueRef(RSI_CONSTANTS[key], key)
-        if self.program.backup:
-            r = self.kss.name_ref(name)     # a variable of KUKA's software (interp/runtime/kss.py)
-            if r is not None:
-                return r
+        r = self.kss.name_ref(name)     # a variable of KUKA's software (interp/runtime/kss.py)
+        if r is not None:
+            return r
         raise KrlRuntimeError(f"unknown name {name}")
 
     def index(self, base: Ref, idx: list, name: str) -> Ref:
@@ -627,17 +706,18 @@ class Runtime:
             return None
         return self.modules[c.owner], c.routine
 
-    @staticmethod
-    def native(c: Callee):
-        """The implementation ``fn(rt, args)`` of a built-in callee (NATIVE) the simulator
-        has (interp/runtime/builtins.py), else None (the stub policy: :meth:`stub_call`)."""
-        return NATIVES.get(c.native) if c.kind == NATIVE else None
-
-    def stub_call(self, name: str, is_function: bool):
-        """A call of a routine that the program does not contain: in a backup, a routine of
-        KUKA's system software stands in (interp/runtime/kss.py: counted, one note);
-        anything else is the run-time error "routine NAME not found"."""
-        return self.kss.call(name, is_function)
+    def call_native(self, c: Callee, args: list, is_function: bool):
+        """A call whose callee is not a routine of the program, with reference ``args``
+        (interp/runtime/natives/args.py), for both interpreters: the implementation the
+        resolver linked (``c.native``, interp/runtime/natives) runs; with none (a routine of
+        the tables the simulator does not implement, or one nothing declares) KUKA's system
+        software stands in, in a backup (interp/runtime/kss.py: counted, one note), and
+        anything else is the run-time error "routine NAME not found". ``is_function``: the
+        call's value is used. Returns the call's value (None for a procedure)."""
+        fn = c.native
+        if fn is None:
+            return self.kss.call(c.name, is_function)
+        return fn(self, args)
 
     def enter_routine(self, module, routine: N.Routine, args: list, caller: Frame | None) -> Frame:
         """Create the frame of a call (§2.3): :IN parameters get converted copies, :OUT
@@ -1000,8 +1080,21 @@ class Runtime:
         run-time error of the robot program at its next resumption."""
         self.cyclic_off(key)
         robot = self.robot
+        # a cyclic flag's expression over variables and I/O is evaluated again only when one of
+        # them may have changed (interp/runtime/watch.py CyclicWatch); every cyclic flag counts
+        # the changes it makes to $CYCFLAG
+        flag = key[0] == "cyclic flag"
+        watch = self.cyclic_watch
+        memo = flag and self._cyclic_settles()
+        cyc = self.sysvars.store.get("$CYCFLAG") if flag else None
+        seen = [None]
 
         def tick(ctl):
+            if memo:
+                k = watch.key()
+                if k is not None and k == seen[0]:
+                    return
+            before = tuple(cyc.data) if cyc is not None else None
             try:
                 fn()
             except KrlRuntimeError as e:
@@ -1010,7 +1103,22 @@ class Runtime:
                     from robot.errors import RobotError  # noqa: PLC0415
 
                     robot.pending_error = RobotError(e.message, e.number)
+                return
+            if before is not None and tuple(cyc.data) != before:
+                watch.version += 1
+            if memo:
+                seen[0] = watch.key()
         self._cyclic[key] = self.controller.add_cyclic(tick)
+
+    def _cyclic_settles(self) -> bool:
+        """The cyclic flag the running statement switches on has an expression that
+        :func:`~.watch.settles`."""
+        task = self.current_task
+        at = task.at if task is not None else None
+        for node in (self.spin.statements(at) or ()) if at is not None else ():
+            if isinstance(node, N.Assign):
+                return settles(node.value)
+        return False
 
     def cyclic_off(self, key) -> None:
         h = self._cyclic.pop(key, None)
@@ -1101,8 +1209,9 @@ class Runtime:
         ctl = self.controller
         adv = self.sysvars.store.get("$ADVANCE")
         ctl.advance = int(adv) if isinstance(adv, int) else 3
-        while not ctl.can_enqueue():
-            self.yield_cycle(task)
+        if not ctl.can_enqueue():
+            self._wait(task, ctl.can_enqueue)
+            self._proceed()
         try:
             mid = ctl.enqueue(req)
         except RobotError as e:
@@ -1187,6 +1296,7 @@ class Runtime:
                                           delay_ms=float(delay_ms), action=action, prio=prio, line=line))
 
     def run_trigger(self, task: Task, ev) -> None:
+        self._proceed()
         action = ev.trigger.action
         task.contexts.append(Context("trigger", prio=ev.trigger.prio if ev.trigger.prio and ev.trigger.prio > 0 else 129))
         try:
@@ -1205,7 +1315,8 @@ class Runtime:
         # a computed variable's getter is its peek, one call less at each poll
         probes = tuple(_reader(self.sysvars.lookup(k)) for k in names)
         task.irqs.declare(Irq(n, cond_fn, handler_fn, name, frame, is_global, line, watch=cls,
-                              probes=probes, by_epoch=all(k in EPOCH_PROBED for k in names)))
+                              probes=probes, by_epoch=all(k in EPOCH_PROBED for k in names),
+                              steady=steady(watch)))
         if not frame.interrupts:
             frame.interrupts = []
         frame.interrupts.append(n)
@@ -1215,7 +1326,7 @@ class Runtime:
         task = self.current_task
         n = trunc_int(number, "interrupt number") if number is not None else None
         ctl = self.controller
-        task.irqs.control(action.upper(), n, ctl.io.version, ctl.time)
+        task.irqs.control(action.upper(), n, ctl.io.version, ctl.time, self.cyclic_watch.written())
         self._break(task)
         if action.upper() in ("ENABLE", "ON") and task.irqs.armed:
             self.check_interrupts(task)
@@ -1229,7 +1340,7 @@ class Runtime:
         task.in_poll = True
         ctl = self.controller
         try:
-            ready = task.irqs.poll(ctl.io.version, ctl.time, self.state_epoch)
+            ready = task.irqs.poll(ctl.io.version, ctl.time, self.state_epoch, self.cyclic_watch.written())
         finally:
             task.in_poll = False
         if not ready:
@@ -1242,6 +1353,7 @@ class Runtime:
             self.fire(task, irq)
 
     def fire(self, task: Task, irq: Irq) -> None:
+        self._proceed()
         ctl = self.controller
         ctx = Context("interrupt", prio=irq.number, number=irq.number)
         if task.kind == "robot":
@@ -1268,7 +1380,7 @@ class Runtime:
             # (ROS-Industrial's EKI state timer: `$TIMER[1] = -10` in its own handler)
             task.in_poll = True
             try:
-                task.irqs.poll(ctl.io.version, ctl.time, self.state_epoch)
+                task.irqs.poll(ctl.io.version, ctl.time, self.state_epoch, self.cyclic_watch.written())
             finally:
                 task.in_poll = False
         if ok and task.kind == "robot":
@@ -1298,6 +1410,7 @@ class Runtime:
         while ctl.is_braking():
             self.yield_cycle(task)
         self.yield_cycle(task)
+        self._proceed()
 
     def resume(self) -> None:
         """RESUME: discard the planned motions and unwind to the declaring routine."""

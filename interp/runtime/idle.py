@@ -167,6 +167,13 @@ def _frames(task):
         f = f.caller
 
 
+def frames_of(rt, task) -> tuple:
+    """The image of `task`'s frames (its innermost first): those it stands in, or for a parked
+    spin those it would stand in (interp/runtime/spin.py)."""
+    img = rt.scheduler.spin.frames_image(task) if task.parked is not None else None
+    return img if img is not None else tuple([_store(f.store) for f in _frames(task)])
+
+
 def state_of(rt) -> tuple:
     """The state of the run `rt` that its future depends on, besides the positions of its
     tasks in their loops (see the module docstring): data lists, frames, system variables,
@@ -175,7 +182,7 @@ def state_of(rt) -> tuple:
     mods = tuple([_store(m.store) for m in prog.modules if m.loaded])
     tasks = []
     for t in rt.scheduler.tasks:
-        frames = tuple([_store(f.store) for f in _frames(t)])
+        frames = frames_of(rt, t)
         irqs = tuple((n, i.on, i.enabled, i.last, i.pending, id(i.frame))
                      for n, i in sorted(t.irqs.irqs.items()))
         tasks.append((t.done, t.waiting, len(t.contexts), frames, irqs, t.err_text))
@@ -219,6 +226,7 @@ class IdleWatch:
         self._robot: tuple | None = None   # (cycle, marks, frames) of the robot program's quiet window
         self._phases: dict = {}      # phase of the tasks (:meth:`_phase`) -> cycle, while idle in one state
         self.shifted = 0             # cycles of the periodic jumps (each task's WAIT SEC moved with the clock)
+        self._imaged = None          # _state_key() when the state was imaged last
 
     def clock_read(self) -> None:
         """A task read the clock or a random number: its next statements may differ without
@@ -231,6 +239,25 @@ class IdleWatch:
         robot's axes (deg)."""
         ctl = self.rt.controller
         return (len(ctl.io.log), self.clock, ctl._plan_q.tolist(), ctl._q.tolist())
+
+    def _state_key(self):
+        """What :func:`state_of` images can change by: the statements executed and the cyclic
+        flags' changes (interp/runtime/watch.py ``CyclicWatch.written``), the I/O image's
+        version, the message handle, the tasks' waits, contexts and interrupt tables, the step a
+        parked spin stands at (interp/runtime/spin.py). Equal keys: the same state. None: image
+        it (a debugger or an ``ANIN ON`` may write, a network partner is attached)."""
+        rt = self.rt
+        written = rt.cyclic_watch.written()
+        net = getattr(rt.controller, "network", None)
+        if written is None or (net is not None and net.polling):
+            return None
+        tasks = []
+        for t in rt.scheduler.tasks:
+            irqs = tuple([(n, i.on, i.enabled, i.last, i.pending, id(i.frame)) for n, i in t.irqs.irqs.items()])
+            p = t.parked
+            tasks.append((t.done, t.waiting, len(t.contexts), t.err_text, irqs,
+                          None if p is None else (id(p), (p.done - 1) % p.spin.steps)))
+        return (written, rt.controller.io.version, rt.msg_handle, tuple(tasks))
 
     def _quiet(self) -> bool:
         rt = self.rt
@@ -265,6 +292,25 @@ class IdleWatch:
             self.robot_starves()
         return n
 
+    def moved(self) -> None:
+        """:meth:`cycle` of a cycle in which the robot moved while the run is quiet and not
+        idle (interp/runtime/scheduler.py, "Steady cycles"): what it would do then — its marks
+        differ from the last cycle's, so the quiet window starts again here, and so does the
+        robot program's (:meth:`robot_starves`) — without testing what is known."""
+        rt = self.rt
+        ctl = rt.controller
+        self.start, self.marks, self.state, self.since = ctl.cycle, self._marks(), None, None
+        self._phases = {}
+        auto = self.auto
+        if auto is None:
+            return
+        robot = rt.robot
+        if robot is None or robot.done or auto.pending() or robot.wake_cycle is not None:
+            self._robot = None
+        else:
+            self._robot = (ctl.cycle, (self.robot_io, robot.waiting, tuple(ctl._q.tolist()),
+                                       tuple(ctl.planned_axes().tolist())), None)
+
     def robot_starves(self) -> None:
         """The robot program starves while the run is not idle (a submit program blinks a
         lamp on a timer): for a whole window it stood in one WAIT FOR, or it executed
@@ -288,7 +334,7 @@ class IdleWatch:
         start, _, frames = self._robot
         if ctl.cycle - start < WINDOW_CYCLES:
             return
-        now = tuple([_store(f.store) for f in _frames(robot)])
+        now = frames_of(rt, robot)
         if frames is None or frames != now:
             self._robot = (ctl.cycle, marks, now)
             return
@@ -311,7 +357,11 @@ class IdleWatch:
             return 0
         if ctl.cycle - self.start < self.window:
             return 0
-        state = state_of(rt)
+        # the state is imaged again only when something may have changed it since the last
+        # image (:meth:`_state_key`); else it is that image
+        key = self._state_key()
+        state = self.state if key is not None and key == self._imaged else state_of(rt)
+        self._imaged = key
         if self.state is None or state != self.state:
             if self.state is not None:
                 self.window = min(2 * self.window, MAX_WINDOW_CYCLES)

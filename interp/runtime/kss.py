@@ -9,33 +9,43 @@ one, *never silently*: the first use of each stand-in writes one note (a ``messa
 ``stub: ...``), every use is counted, and the run summary names each stand-in with its count
 (:meth:`SystemSoftware.summary`).
 
-**Which names.** Only names with evidence that KUKA's software declares them — the checker's
-decision (krl/semantics/outside.py, docs/diagnostics.md "Names the backup cannot know"; for a
-``$`` name no table lists, only a use on a line KUKA's software wrote, as ``$CP_VEL_MODE = 5``
-in a backup's ``bas.src``: one the program alone uses stays its error, W107): a
-technology package of the platform tables (kss.yaml ``packages``), a line KUKA's software wrote
-(a system file, the template's INI fold such as KR C2's ``;FOLD ARCHTECHDIGITAL INI`` with
-``IF ARC20==TRUE THEN``, an inline form), a routine of the platform tables (functions.yaml,
-kss.yaml: ``EXTFCTP BOOL IS_KEY_PRESSED(INT KEY :IN)`` of ``$operate.dat``), or an ``EXT``
-declaration in a KUKA system file (``EXT P00 (...)`` of ``$config.dat``). A name the program
-uses without such evidence stays the program's error ("unknown name X", "routine X not found"),
-as on a controller. The routines of EthernetKRL and RSI (functions.yaml ``lenient``
-``ethernet_krl``, ``rsi``) are the network partners' (issue 35), not stand-ins here.
+**Which names.** Exactly the names the checker finds outside the backup — its one decision
+(krl/semantics/outside.py ``Unresolved.classify``: W101/W105/W106/W107, docs/diagnostics.md
+"Names the backup cannot know"): a name of a technology package of the platform tables
+(kss.yaml ``packages``), a name used on a line KUKA's software wrote (a system file; the
+template's INI fold such as KR C2's ``;FOLD ARCHTECHDIGITAL INI`` with ``IF ARC20==TRUE THEN``;
+for a routine or a type, a KUKA inline form, whose module names the package: ``%MKUKATPGRP``),
+a ``$`` name no table lists. No second rule: every name the checker calls KUKA's stands in,
+in a backup or not, and any other name stays the program's error ("unknown name X", "routine
+X not found"), as on a controller — also one the checker warns about only because a file of
+the program that does not parse mentions it (``Outside.kuka`` False: perhaps the program's own
+declaration, in a file the controller could not load either). Besides, a routine the checker resolves whose body nothing of the program holds
+stands in when outside.py's :func:`~krl.semantics.outside.provided_routine` says KUKA's software
+provides it (a routine of the platform tables; an ``EXT`` of a KUKA system file such as
+``EXT P00 (...)`` of ``$config.dat``). The routines of EthernetKRL and RSI (functions.yaml
+``lenient`` ``ethernet_krl``, ``rsi``) are the network partners' (issue 35), not stand-ins here.
 
-**Which value.**
+**Which value** (docs/robot.md, "KUKA's software the backup lacks").
 
-* A *variable* of a technology package that is not installed reads the zero value of the type
-  its uses give it (``ARC20==TRUE``: BOOL; ``N > 3``: INT): FALSE, 0, 0.0 — what the
-  templates test for "package not installed" (``IF ARC20==TRUE THEN A20(ARC_INI)``: the
-  ArcTech INI is skipped). A value the program writes is kept. The type comes from the
-  checker's types of the other operand (comparison, arithmetic, assignment) or the statement
-  (an IF/WHILE/UNTIL/WAIT FOR condition, NOT, AND, OR: BOOL); with no such use the name is
-  not stood in (the run stops at it, as before).
-* A *procedure* of the system software runs as a no-op (the package would act on its own
-  hardware: a weld source, a gun, a gripper; nothing of it is simulated).
+* A *variable* reads the zero value of the type its uses give it (``ARC20==TRUE``: BOOL;
+  ``N > 3``: INT; an argument: the parameter's type): FALSE, 0, 0.0 — what the templates test
+  for "package not installed" (``IF ARC20==TRUE THEN A20(ARC_INI)``: the ArcTech INI is
+  skipped). A value the program writes is kept. The type comes from the checker's types of the
+  other operand (comparison, arithmetic, assignment), the statement (an IF/WHILE/UNTIL/WAIT FOR
+  condition, NOT, AND, OR: BOOL) or the parameter it is passed to.
+* A variable of an *ENUM* type — one the backup declares, or one it does not
+  (``IF ARC_OPTION==#ACTIVE THEN``: a stand-in ENUM type made of the literals its uses compare
+  it with, assign to it or switch on) — and a variable whose uses give no type at all (an
+  argument of a stand-in routine) read :data:`NOT_INSTALLED`, a value of that type equal to
+  none of those literals: ``IF ARC_OPTION==#ACTIVE`` is FALSE, as on a controller without the
+  package.
+* A *procedure* runs as a no-op (the package would act on its own hardware: a weld source, a
+  gun, a gripper; nothing of it is simulated); its arguments are evaluated first, in both
+  interpreters.
 * A *function* returns its documented value where there is one (:data:`DOCUMENTED`:
   ``IS_KEY_PRESSED`` is FALSE, no key of the KCP is held in a simulation), else the zero
-  value of its declared return type (or of the type its use gives it).
+  value of its declared return type (or of the type its use gives it; an ENUM or no type:
+  :data:`NOT_INSTALLED`).
 """
 
 from __future__ import annotations
@@ -46,7 +56,8 @@ from pathlib import Path
 
 from krl.ast import nodes as N
 from krl.semantics import types as T
-from krl.semantics.resolve import ROUTINE, UNRESOLVED
+from krl.semantics.outside import provided_routine
+from krl.semantics.resolve import NATIVE, ROUTINE, UNRESOLVED
 
 from .errors import KrlRuntimeError
 from .memory import Slot
@@ -58,6 +69,10 @@ DOCUMENTED: dict[str, tuple[object, str]] = {
                               "($operate.dat EXTFCTP BOOL IS_KEY_PRESSED(INT KEY :IN)); "
                               "nobody presses a key in a simulation"),
 }
+
+#: the value of a stand-in of an ENUM type, or of no type its uses give: the package is not
+#: installed. Its name is not a literal any use compares it with (``NOT_INSTALLED_`` ... then).
+NOT_INSTALLED = "NOT_INSTALLED"
 
 #: the families of routines that the network partners implement (issue 35), never stood in
 NETWORK_FAMILIES = ("ethernet_krl", "rsi")
@@ -92,9 +107,12 @@ class StandIn:
     why: str = ""
 
 
-def _zero(t):
-    """The zero value of type `t`: FALSE, 0, 0.0, a structure or array of zeros; None for
-    any other type (an ENUM has no first value the checker keeps: not stood in)."""
+def _zero(t, absent: str | None = None):
+    """The zero value of type `t`: FALSE, 0, 0.0, a structure or array of zeros; for an ENUM
+    `absent` (the stand-in ENUM's value for "not installed"), else :data:`NOT_INSTALLED` made
+    unequal to its literals; None for any other type."""
+    if isinstance(t, T.Enum):
+        return EnumValue(absent or _not_installed(t.values), t)
     if t is T.BOOL:
         return False
     if t is T.INT:
@@ -109,6 +127,24 @@ def _zero(t):
         except Exception:  # noqa: BLE001 - a type the zero value cannot build
             return make_value(t)
     return None
+
+
+def _not_installed(literals) -> str:
+    """:data:`NOT_INSTALLED`, made unequal to every name of `literals` (UPPER)."""
+    name = NOT_INSTALLED
+    while name in literals:
+        name += "_"
+    return name
+
+
+def standin_enum(name: str, literals) -> tuple[T.Enum, str]:
+    """(type, value) of the stand-in ENUM of the variable `name` whose type the backup does not
+    declare: the literals its uses compare it with, assign or switch on (UPPER), plus the value
+    that says "not installed" (:data:`NOT_INSTALLED`, unequal to every one of them), and that
+    value."""
+    literals = frozenset(x.upper() for x in literals)
+    absent = _not_installed(literals)
+    return T.Enum(f"{name.upper()} (stand-in ENUM)", literals | {absent}), absent
 
 
 def _shown(v) -> str:
@@ -132,6 +168,7 @@ class SystemSoftware:
         self._refs: dict[str, Slot] = {}
         self._outside: dict | None = None
         self._types: dict | None = None
+        self._absent: dict[str, str] = {}       # UPPER name -> "not installed" of its stand-in ENUM
         #: id(main routine) -> name, of the standard programs of :data:`STANDARD` the run loaded
         self.standard: dict[int, str] = {}
         files = {str(f): name for name, f in STANDARD.items()}
@@ -150,32 +187,45 @@ class SystemSoftware:
             f"standard {name} runs ({STANDARD[name.upper()].relative_to(STANDARD[name.upper()].parents[3])})"))
     # ------------------------------------------------------------------ evidence
     def outside(self) -> dict:
-        """(kind, UPPER name) -> why, for every name the checker found outside the backup."""
+        """(kind, UPPER name) -> why, for every name the checker found outside the backup and
+        calls KUKA's (krl/semantics/outside.py ``Unresolved.classify``, ``Outside.kuka``: the
+        checker's one decision; a name only a file that does not parse mentions may be the
+        program's own, declared there: it stays the program's error)."""
         if self._outside is None:
-            out: dict = {}
-            ws = self.rt.program.ws
-            unresolved = ws.unresolved()
-            if unresolved is not None:
-                for (kind, key), (name, uses) in unresolved.uses.items():
-                    if kind == "sysvar" and key not in unresolved.packages and not any(u.evidence for u in uses):
-                        continue    # a $ name only the program uses: its error (docs/diagnostics.md W107)
-                    why = unresolved._why(kind, name, uses)
-                    if why:
-                        out[(kind, key)] = why
-            self._outside = out
+            unresolved = self.rt.program.ws.unresolved()
+            found = unresolved.classify() if unresolved is not None else {}
+            self._outside = {key: o.why for key, o in found.items() if o.kuka}
         return self._outside
 
     def use_types(self) -> dict:
         """UPPER name -> the type its uses give an unresolved name or a call of an untyped
-        routine (see the module docstring), from the checker's types."""
+        routine (see the module docstring), from the checker's types; a name of an ENUM type
+        the backup does not declare gets its stand-in ENUM (:func:`standin_enum`)."""
         if self._types is None:
             types: dict = {}
-            for unit in self.rt.program.ws.units:
+            literals: dict = {}
+            ws = self.rt.program.ws
+            for unit in ws.units:
                 for f in (unit.src, unit.dat):
                     if f is not None and f.module is not None:
-                        _infer(f.module, types)
+                        _infer(f.module, types, literals, ws)
+            for name, lits in literals.items():
+                if name not in types:
+                    types[name], self._absent[name] = standin_enum(name, lits)
             self._types = types
         return self._types
+
+    def _typed_zero(self, key: str, t=None):
+        """(type, value) of the stand-in `key`: the zero value of `t` (the declared type of a
+        function) or of the type its uses give it; else the "not installed" value of a stand-in
+        ENUM of no literal (its uses give no type: an argument of a stand-in routine)."""
+        if t is None or t is T.UNKNOWN:
+            t = self.use_types().get(key)
+        v = _zero(t, self._absent.get(key)) if t is not None else None
+        if v is None:
+            t, absent = standin_enum(key, ())
+            v = _zero(t, absent)
+        return t, v
 
     def _record(self, key: str, standin: StandIn) -> None:
         self.uses[key] += 1
@@ -188,8 +238,9 @@ class SystemSoftware:
                 self.rt.message(f"stub: {standin.name} ({standin.why})")
                 return
             value = f": {standin.value}" if standin.value else ""
+            where = "the backup" if self.rt.program.backup else "the program's files"
             self.rt.message(f"stub: {standin.name} ({standin.what} of KUKA's system software not in "
-                            f"the backup: {standin.why}){value}")
+                            f"{where}: {standin.why}){value}")
 
     # ------------------------------------------------------------------ variables
     def name_ref(self, name: str):
@@ -202,13 +253,15 @@ class SystemSoftware:
         why = self.outside().get(("sysvar" if key[:1] == "$" else "name", key))
         if why is None:
             return None
-        t = self.use_types().get(key)
-        v = _zero(t) if t is not None else None
-        if v is None:
-            return None
+        t, v = self._typed_zero(key)
         ref = self._refs[key] = Slot({"V": v}, "V", t, name)
-        self._record(key, StandIn(name, "system variable" if key[:1] == "$" else "variable",
-                                  f"reads {_shown(v)}", why))
+        shown = f"reads {_shown(v)}"
+        if isinstance(v, EnumValue):
+            others = sorted(x for x in t.values if x != v.name)
+            shown += (" (the package is not installed: equal to none of "
+                      + ", ".join(f"#{x}" for x in others) + ")" if others else
+                      " (the package is not installed; its uses give it no type)")
+        self._record(key, StandIn(name, "system variable" if key[:1] == "$" else "variable", shown, why))
         return ref
 
     # ------------------------------------------------------------------ routines
@@ -217,18 +270,11 @@ class SystemSoftware:
         why = self.outside().get(("routine", key))
         if why:
             return why
-        from krl.semantics.builtins import load_builtins  # noqa: PLC0415
-
-        b = load_builtins()
-        if key in b.routines:
-            return "a routine of the platform tables (krl/semantics/data)"
         sym = self._symbol(key)
-        if sym is not None and sym.path:
-            from krl.workspace import is_kuka_file  # noqa: PLC0415
+        from krl.workspace import is_kuka_file  # noqa: PLC0415
 
-            if is_kuka_file(sym.path):
-                return f"declared by an EXT of KUKA's system file {sym.path.rsplit('/', 1)[-1]}"
-        return None
+        path = sym.path if sym is not None and sym.path and is_kuka_file(sym.path) else ""
+        return provided_routine(key, path) or None
 
     def _returns(self, key: str):
         """The declared return type of the routine `key`: its EXTFCT in the program's files,
@@ -261,14 +307,13 @@ class SystemSoftware:
     def call(self, name: str, is_function: bool):
         """A call of `name`, which no routine of the program implements: the stand-in's value
         (None for a procedure). Raises KrlRuntimeError "routine NAME not found" for a routine
-        without evidence of KUKA's software, a network routine, a function whose value type
-        is unknown, or outside a backup."""
+        without evidence of KUKA's software (the checker's error E106) or a network routine."""
         key = name.upper()
         st = self.standins.get(key)
         if st is not None and key not in DOCUMENTED and st.what != ("function" if is_function else "procedure"):
             st = None
         if st is None:
-            why = self._evidence(key) if self.rt.program.backup else None
+            why = self._evidence(key)
             if why is None or self.network(key):
                 raise KrlRuntimeError(f"routine {name} not found")
             if not is_function:
@@ -278,12 +323,7 @@ class SystemSoftware:
                 v, doc = DOCUMENTED[key]
                 self._record(key, StandIn(name, "function", f"returns {_shown(v)} ({doc})", why))
                 return v
-            t = self._returns(key)
-            if t is None or t is T.UNKNOWN:
-                t = self.use_types().get(key)
-            v = _zero(t) if t is not None else None
-            if v is None:
-                raise KrlRuntimeError(f"routine {name} not found")
+            v = self._value(key)
             self._record(key, StandIn(name, "function", f"returns {_shown(v)}", why))
             return v
         self.uses[key] += 1
@@ -291,7 +331,12 @@ class SystemSoftware:
             return None
         if key in DOCUMENTED:
             return DOCUMENTED[key][0]
-        return _zero(self._returns(key) or self.use_types().get(key))
+        return self._value(key)
+
+    def _value(self, key: str):
+        """What the stand-in function `key` returns: the zero value of its declared type, else
+        of the type its uses give it, else :data:`NOT_INSTALLED` (:meth:`_typed_zero`)."""
+        return self._typed_zero(key, self._returns(key))[1]
 
     def statement(self, what: str) -> None:
         """A statement of reference §5.20 that is recognised and not simulated."""
@@ -338,8 +383,42 @@ def _note(types: dict, name: str | None, t) -> None:
         types[name] = t
 
 
-def _infer(module: N.Module, types: dict) -> None:
-    """Add to `types` what the uses in `module` say of the type of each unresolved name."""
+def _literal(literals: dict, name: str | None, e) -> None:
+    """An ENUM literal `e` compared with, assigned to or switched on by the unresolved `name`
+    (when its type is an ENUM the backup does not declare: :func:`standin_enum`)."""
+    if name is not None and isinstance(e, N.EnumLit):
+        literals.setdefault(name, set()).add(e.name.upper())
+
+
+def _param_types(call: N.Call, ws) -> list:
+    """The declared types of the parameters of `call`'s routine (a routine of the program, or
+    a built-in of the platform tables), None where unknown."""
+    c = call.ann.callee if call.ann is not None else None
+    if c is None:
+        return []
+    if c.kind == ROUTINE and c.routine is not None:
+        scope = ws.routine_scope(c.routine) if ws is not None else None
+        out = []
+        for p in c.routine.params:
+            sym = scope.lookup(p.name) if scope is not None else None
+            out.append(getattr(sym, "type", None) if sym is not None and not p.dims else None)
+        return out
+    if c.kind == NATIVE:
+        from krl.semantics.builtins import load_builtins  # noqa: PLC0415
+        from .sysvars import sys_type  # noqa: PLC0415
+
+        info = load_builtins().routines.get(c.name.upper())
+        if info is None:
+            return []
+        return [None if p.dims else (sys_type(p.type_name) or getattr(T, p.type_name.upper(), None))
+                for p in info.params]
+    return []
+
+
+def _infer(module: N.Module, types: dict, literals: dict | None = None, ws=None) -> None:
+    """Add to `types` what the uses in `module` say of the type of each unresolved name, and
+    to `literals` the ENUM literals each is compared with, assigned or switched on."""
+    literals = {} if literals is None else literals
     stack: list = [module]
     while stack:
         node = stack.pop()
@@ -355,7 +434,23 @@ def _infer(module: N.Module, types: dict) -> None:
             else:
                 _note(types, left, _type_of(node.right))
                 _note(types, right, _type_of(node.left))
+                if node.op in ("==", "<>"):
+                    _literal(literals, left, node.right)
+                    _literal(literals, right, node.left)
         elif isinstance(node, N.Assign):
+            target = _unresolved(node.target)
             _note(types, _unresolved(node.value), _type_of(node.target))
-            _note(types, _unresolved(node.target), _type_of(node.value))
+            _note(types, target, _type_of(node.value))
+            _literal(literals, target, node.value)
+        elif isinstance(node, N.Switch):
+            sel = _unresolved(node.selector)
+            _note(types, sel, _type_of(next((v for c in node.cases for v in c.values), None)))
+            for c in node.cases:
+                for v in c.values:
+                    _literal(literals, sel, v)
+        elif isinstance(node, N.Call) and node.args:
+            params = _param_types(node, ws)
+            for a, t in zip(node.args, params):
+                if a is not None:
+                    _note(types, _unresolved(a), t)
         stack.extend(c for c in node.children() if c is not None)

@@ -10,8 +10,9 @@
   with a folder's own), inside one the backup's own System folder is used;
 * they are loaded, checked and resolved together by the front end
   (:func:`krl.workspace.load_project`, ``Workspace.check``; krl/semantics/resolve.py gives
-  every use its storage class and slot, every call its routine, every statement its
-  advance-run facts), once per process for the same files (:func:`checked_workspace`);
+  every use its storage class and slot, every call its routine or its native's implementation
+  (interp/runtime/natives ``LINKS``), every statement its advance-run facts), once per process
+  for the same files (:func:`checked_workspace`);
 * this module only *allocates* storage for those symbols: one :class:`ModuleRT` per module of
   the workspace (``Workspace.units``, same order: a Storage's ``owner`` is its index) holds
   its data list's references by slot (``refs``), initialised from the DECL values when the
@@ -31,6 +32,7 @@ from pathlib import Path
 
 from krl.ast import nodes as N
 from krl.diagnostics import SYNTAX_CODES
+from krl.diagnostics.codes import E001, E003, E005
 from krl.files import spelled, spelled_within
 from krl.limits import PARSE_TIMEOUT_S
 from krl.project import project_of, with_basis   # which files make the program: one rule
@@ -44,13 +46,14 @@ from .convert import assign_into, convert_scalar
 from .errors import KrlRuntimeError, ResourceError
 from .kss import standard_files
 from .memory import Slot, SignalRef, index_ref
+from .natives import LINKS
 from .values import UNSET, Struct, data_size, make_value
 
 BASIS_DIR = Path(__file__).resolve().parent.parent / "basis"
 
 # the files a program's own module cannot have for it to start: input errors (E001, E005),
 # syntax errors and constructs the builder cannot build (E003)
-_START_CODES = SYNTAX_CODES | {"E001", "E003", "E005"}
+_START_CODES = SYNTAX_CODES | {E001, E003, E005}
 # files above this size in total are parsed in worker processes (the Java engine when present)
 _BATCH_BYTES = 256 * 1024
 _CACHE: OrderedDict = OrderedDict()
@@ -111,6 +114,7 @@ def checked_workspace(project, extra: list[Path] = ()):
     # each file's parse from the one store (krl/store.py, krl/parsecache.py) by content hash
     ws = load_project(project, str(project.root), PARSE_TIMEOUT_S if size > _BATCH_BYTES else None,
                       extra=list(extra))
+    ws.natives = LINKS      # the resolver links each built-in call to its implementation
     ws.check()
     _CACHE[key] = ws
     while len(_CACHE) > _CACHE_SIZE:
@@ -182,6 +186,7 @@ class Program:
                 self.by_path[str(p)] = m
         self.sysrefs: list = [None] * len(ws.system_names)
         self.stubs: set[str] = set()
+        self._outside_types: set[str] | None = None     # the checker's W105 types (declared_type)
         self.fatal: ResourceError | None = None   # a data list past a limit: the program cannot start
         self._initialiser_env = _InitialiserEnv(self)
         self._syntax_errors()
@@ -326,13 +331,19 @@ class Program:
         return self.take_memory_n(self.data_elements(t, vn, decl), vn, decl)
 
     def declared_type(self, t, tref) -> T.KrlType:
-        """The type the checker gave a declaration; a type nothing declares is an error
-        outside a backup and, in a backup (a type of the controller's system data lists it
-        does not hold, e.g. ESYS of $operate.dat), untyped and logged once."""
+        """The type the checker gave a declaration; a type nothing declares is untyped and
+        logged once when the checker calls it KUKA's (W105, ``Outside.kuka``: a type of the
+        controller's system data lists the backup does not hold, e.g. ESYS of $operate.dat; a
+        type of a package an EXT names; krl/semantics/outside.py, issue 46: one decision),
+        else the run-time error "unknown type NAME" (the program's E105)."""
         if t is not None and t is not T.UNKNOWN and not _has_unknown(t):
             return t
         name = tref.name if isinstance(tref, N.TypeRef) else str(tref)
-        if not self.backup:
+        if self._outside_types is None:
+            un = self.ws.unresolved()
+            found = un.classify() if un is not None else {}
+            self._outside_types = {k for (kind, k), o in found.items() if kind == "type" and o.kuka}
+        if name.upper() not in self._outside_types:
             raise KrlRuntimeError(f"unknown type {name}")
         if name.upper() not in self.stubs:
             self.stubs.add(name.upper())

@@ -17,10 +17,25 @@ its own greenlet. Per IPO cycle the scheduler
    nothing can change any more — no motion, no stimulus or pulse pending, no running
    timer, no submit program, no armed interrupt);
 3. lets the idle watch fast-forward a run in which nothing changes to the cycle before its
-   next event (interp/runtime/idle.py);
+   next event (interp/runtime/idle.py), and the spin watch wake a parked task the controller's
+   next step may concern (interp/runtime/spin.py);
 4. runs one ``controller.step()`` and hands its events to the robot task: TRIGGER actions
    and main-run errors are picked up when the robot task resumes (its first act after a
    switch is :meth:`core.Runtime.service`: triggers, then interrupt conditions).
+
+A task that is parked (a spin: interp/runtime/spin.py) or waits on a test of the controller's
+state (``Runtime._wait``: queue space, the main run's end, a WAIT SEC) is not resumed: the cycle
+is counted as its own (:meth:`Scheduler._waits`, ``SpinWatch.resuming``).
+
+**Steady cycles.** While the robot moves and every task is parked or waits so, with nothing to
+do (no TRIGGER, error or interrupt — each armed interrupt's condition ``steady``: it changes only
+with the I/O image, a statement, a cyclic flag or a task's state, interp/runtime/watch.py), the
+I/O image, the cyclic flags and the statements executed unchanged since the first such cycle,
+the controller's next event not due, the run not idle: then each cycle's tasks, idle watch and
+spin watch would only count it. :meth:`Scheduler._steady` knows that from a few tests, and
+:meth:`Scheduler._steady_cycle` counts it as they would (the parked tasks' steps and positions,
+the state epoch, the idle watch's windows: ``IdleWatch.moved``); the controller steps as
+always. A cycle that fails a test is an ordinary one.
 """
 
 from __future__ import annotations
@@ -29,8 +44,19 @@ from greenlet import GreenletExit, greenlet
 
 from .contexts import Context, InterruptTable
 
+#: steps (a statement or a loop iteration) per IPO cycle: the robot interpreter's and the submit
+#: interpreter's time slices (docs/architecture.md, "The submit interpreter's pace": KUKA
+#: describes a time slice of the 12 ms cycle, the submit interpreter's the lower-priority one, and
+#: publishes no statement count; these counts are the simulator's)
 ROBOT_BUDGET = 1000
 SUBMIT_BUDGET = 100
+
+
+def program_budget(path) -> int | None:
+    """The time slice of the program run as the robot task: a submit program (``.sub``) selected
+    on its own runs at the submit interpreter's pace (:data:`SUBMIT_BUDGET`), as it does beside a
+    robot program; None: the robot interpreter's (:data:`ROBOT_BUDGET`)."""
+    return SUBMIT_BUDGET if str(path).lower().endswith(".sub") else None
 
 
 class Task:
@@ -59,6 +85,15 @@ class Task:
         self.glet: greenlet | None = None
         self.frame = None               # innermost frame (VARSTATE)
         self.err_text = ""
+        # the spin watch (interp/runtime/spin.py): its statements take the full hook
+        # (``watched``, a recording; ``replay``, a catch-up), the spin it parks at the end of this
+        # loop iteration (``park``), the state of a parked task (``parked``)
+        self.watched = False
+        self.replay = None
+        self.park = None
+        self.parked = None
+        self.shadow = None
+        self.until = None               # the test that ends its wait (Runtime._wait), while it waits
 
     @property
     def file(self) -> str | None:
@@ -86,14 +121,21 @@ class Scheduler:
         from .idle import IdleWatch  # noqa: PLC0415
 
         self.idle = IdleWatch(rt)           # fast-forward of idle cycles (interp/runtime/idle.py)
+        from .spin import SpinWatch  # noqa: PLC0415
+
+        self.spin = SpinWatch(rt)           # parked spins (interp/runtime/spin.py)
+        self.return_to = None               # a catch-up's caller (SpinWatch.wake); else main
+        self._calm = None                   # what steady cycles found first (_steady)
+        self.steady = 0                     # steady cycles in the run
 
     def add(self, task: Task) -> None:
         task.glet = greenlet(lambda: self.rt.task_main(task), parent=self.main)
         self.tasks.append(task)
 
     def yield_cycle(self) -> None:
-        """Called inside a task: give the IPO cycle back to the scheduler."""
-        self.main.switch()
+        """Called inside a task: give the IPO cycle back to the scheduler (or to whoever made a
+        parked task catch up: interp/runtime/spin.py)."""
+        (self.return_to or self.main).switch()
 
     def _resume(self, task: Task) -> None:
         self.rt.current_task = task
@@ -109,16 +151,127 @@ class Scheduler:
             if task.kind == "robot":
                 self.idle.robot_io += len(log) - before     # the robot program's own I/O changes
 
+    def _waits(self, task: Task) -> bool:
+        """`task` waits (Runtime._wait) and its resume would only find that the wait goes on:
+        its test still fails and there is no TRIGGER action, main-run error or interrupt to run
+        (the interrupt poll its resume makes is made here: interp/runtime/core.py
+        ``Runtime.service``), and no debugger watches the cycle. True: the cycle is counted as
+        the task's, and the task is not resumed."""
+        rt = self.rt
+        if task.pending_triggers or task.pending_error is not None or rt.cycle_hook is not None or task.until():
+            return False
+        rt.state_epoch += 1             # as _resume: the IPO cycle moved the robot
+        if task.irqs.armed and not task.in_poll:
+            ctl = rt.controller
+            if task.irqs.poll(ctl.io.version, ctl.time, rt.state_epoch, rt.cyclic_watch.written()):
+                return False            # an interrupt to run: resumed, its poll finds it pending
+        return True
+
+    def _steady(self) -> bool:
+        """This cycle is a steady one (module docstring)."""
+        rt = self.rt
+        ctl = rt.controller
+        q, q0 = ctl._q, ctl._q_prev
+        if q is q0 or (q == q0).all():
+            self._calm = None               # the robot did not move
+            return False
+        calm = self._calm
+        if calm is None:
+            calm = self._calm = self._calm_now()
+            if calm is None:
+                return False
+        io, cyc, executed, nxt = calm
+        if ctl.io.version != io or rt.cyclic_watch.version != cyc or rt.steps - self.spin.skipped != executed \
+                or (nxt is not None and ctl.cycle + 1 >= nxt) \
+                or (self.max_sim_time is not None and ctl.time >= self.max_sim_time - 1e-9):
+            self._calm = None
+            return False
+        for task in self.tasks:
+            if task.done:
+                continue
+            if task.pending_triggers or task.pending_error is not None:
+                self._calm = None
+                return False
+            if task.parked is not None:
+                if rt.max_steps is not None and \
+                        rt.steps + 2 * (task.budget + task.parked.spin.steps) > rt.max_steps:
+                    self._calm = None
+                    return False
+            elif task.until():
+                self._calm = None
+                return False
+        return True
+
+    def _calm_now(self):
+        """The first of a run of steady cycles: the tests that hold for the whole run of them,
+        and what the later cycles compare with; None when this is not one."""
+        rt = self.rt
+        ctl = rt.controller
+        spin, idle = self.spin, self.idle
+        if not spin.allowed() or spin.shadowed or spin.rec is not None or idle.since is not None \
+                or (idle.auto is not None and idle.auto.recording is not None) or not idle._quiet():
+            return None
+        for task in self.tasks:
+            if task.done:
+                continue
+            p = task.parked
+            if p is None and (task.until is None or task.replay is not None):
+                return None
+            if p is not None and (p.spin.motion or p.spin.cyclic):
+                return None
+            if task.irqs.armed and not all(i.steady and not i.pending
+                                           for i in task.irqs.irqs.values() if i.on):
+                return None
+        if ctl.stimuli and any(not st.fired and st.due is None and st.reached_mm is not None
+                               for st in ctl.stimuli):
+            return None             # an input set on reaching a point: at any step
+        if any(k[0] == "analog output" for k in rt._cyclic):
+            return None             # an output written at any step
+        return (ctl.io.version, rt.cyclic_watch.version, rt.steps - spin.skipped, ctl.next_event_cycle())
+
+    def _steady_cycle(self) -> None:
+        """Count a steady cycle as the tasks, the spin watch and the idle watch would."""
+        rt = self.rt
+        spin = self.spin
+        self.steady += 1
+        for task in self.tasks:
+            if task.done:
+                continue
+            rt.state_epoch += 1             # as its resume, or its parked or waiting count
+            p = task.parked
+            if p is not None:
+                rt.steps += task.budget
+                p.done += task.budget
+                spin.skipped += task.budget
+                spin._place(task)
+        self.idle.moved()
+
     def run(self) -> None:
         rt = self.rt
         ctl = rt.controller
         robot = self.tasks[0]
+        spin = self.spin
         while True:
+            if self._steady():
+                self._steady_cycle()
+                for ev in ctl.step():
+                    k = ev.kind
+                    if k == "trigger":
+                        robot.pending_triggers.append(ev)
+                    elif k == "error":
+                        robot.pending_error = ev.error
+                continue
             for task in list(self.tasks):
                 if not task.done and self.stop is None:
+                    if spin.resuming(task):
+                        continue            # parked: this cycle counted, not run
+                    if task.until is not None and self._waits(task):
+                        continue            # waits on: its resume would only test that
                     self._resume(task)
                     if task.done and task is not robot:
                         rt.submit_finished(task)
+            if spin.shadowed:
+                spin.check_shadows()
             if robot.done or self.stop is not None:
                 break
             if self.max_sim_time is not None and ctl.time >= self.max_sim_time - 1e-9:
@@ -130,6 +283,8 @@ class Scheduler:
                     self.stop = ("deadlock", f"deadlocked {robot.waiting}", robot)
                     break
             self.idle.cycle()
+            if spin.parked or spin.shadowed:
+                spin.before_step()
             events = ctl.step()
             for ev in events:
                 k = ev.kind

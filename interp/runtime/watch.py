@@ -1,5 +1,6 @@
-"""When an interrupt condition must be evaluated again (reference §5.16, "the condition is
-monitored"; issue 39).
+"""When an interrupt condition, or a cyclic flag's expression, must be evaluated again
+(reference §5.16, "the condition is monitored"; issue 39; §5.15 and issue 48 for cyclic flags,
+:class:`CyclicWatch` at the end).
 
 An armed interrupt's condition is polled at every statement boundary and every IPO cycle of
 its task (interp/runtime/core.py ``check_interrupts``); a rising edge makes it pending. Its
@@ -21,6 +22,11 @@ class from the names it reads (the front end's accesses, krl/semantics/advance.p
   the watch string is ``CLASS:NAME,NAME``. Most of them change only with the runtime's state
   epoch (sysvars.py ``EPOCH_PROBED``, interp/runtime/core.py ``Runtime.state_epoch``): a poll
   reads those once per epoch; the others at each poll.
+* :data:`SETTLES` — it reads variables too (a data list's, a global, the declaring frame's,
+  stored system variables such as ``$CYCFLAG``; :func:`settles`): evaluated again when the I/O
+  image changed, a statement ran (the steps executed) or a cyclic flag changed
+  (:meth:`CyclicWatch.written`: nothing else writes a variable; None, and evaluated, while a
+  debugger is attached or an ``ANIN ON`` writes at every cycle).
 * :data:`ALWAYS` — anything else (a variable, a stored or structured system variable such as
   ``$FLAG``, ``$CYCFLAG``, ``$POS_ACT``, a function call, a name the resolver did not place):
   evaluated at every poll, as before.
@@ -37,9 +43,10 @@ from krl.semantics.advance import reads
 from krl.semantics.builtins import load_builtins
 from krl.semantics.resolve import SYSTEM
 
-from .sysvars import CONSTANT_NAMES, PROBED_NAMES
+from .sysvars import _LIVE, CONSTANT_NAMES, PROBED_NAMES
 
 CONSTANT, IO, CLOCK, ALWAYS = "K", "I", "T", ""
+SETTLES = "V"
 _ORDER = {CONSTANT: 0, IO: 1, CLOCK: 2, ALWAYS: 3}
 _IO_ARRAYS = frozenset({"$IN", "$OUT", "$ANIN", "$ANOUT"})
 _CLOCK_ARRAYS = frozenset({"$TIMER", "$TIMER_FLAG", "$TIMER_STOP"})
@@ -88,8 +95,29 @@ def watch_of(expr) -> str:
         if _ORDER[w] > _ORDER[worst]:
             worst = w
             if worst == ALWAYS:
+                break
+    if worst == ALWAYS:
+        # a condition over variables (and I/O, constants, probed state): SETTLES
+        probes = []
+        for mode, node in reads(expr):
+            w = _name_watch(node, probes) if mode == "r" else ALWAYS
+            if w == CLOCK or (w == ALWAYS and not _settles_name(node)):
                 return ALWAYS
+        worst = SETTLES
     return worst + (":" + ",".join(probes) if probes else "")
+
+
+#: probed system variables the controller's step changes while the robot moves
+STEP_PROBED = frozenset({"$PRO_MOVE", "$VEL_ACT"})
+
+
+def steady(watch: str) -> bool:
+    """True when a condition of watch string `watch` keeps its value while only the controller
+    steps (the robot moving; nothing runs, the I/O image and the cyclic flags unchanged): class
+    CONSTANT, IO or SETTLES, no probe of :data:`STEP_PROBED` (interp/runtime/scheduler.py,
+    "Steady cycles")."""
+    cls, names = split_watch(watch)
+    return cls in (CONSTANT, IO, SETTLES) and not STEP_PROBED.intersection(names)
 
 
 def split_watch(watch: str) -> tuple[str, tuple[str, ...]]:
@@ -108,20 +136,82 @@ def watch_of_decl(st) -> str:
     return w
 
 
-def stamp_key(watch: str, io_version: int, now: float, probes=()):
+def stamp_key(watch: str, io_version: int, now: float, probes=(), written=None):
     """The key of a condition of class `watch` (without probes) at a poll that sees the I/O
-    image at `io_version`, the simulated time `now` (s) and the probed system variables'
-    readers `probes` (zero-argument callables); None: evaluate (class ALWAYS).
-    interp/runtime/contexts.py ``InterruptTable.poll`` computes the same key inline (it runs
-    before every statement); tests/interp/test_interrupt_watch.py holds both to it."""
+    image at `io_version`, the simulated time `now` (s), the probed system variables'
+    readers `probes` (zero-argument callables) and what may have written a variable since
+    (`written`: :meth:`CyclicWatch.written`); None: evaluate (class ALWAYS, or SETTLES without
+    `written`). interp/runtime/contexts.py ``InterruptTable.poll`` computes the same key inline
+    (it runs before every statement); tests/interp/test_interrupt_watch.py holds both to it."""
     if watch == CONSTANT:
         key = 0
     elif watch == IO:
         key = io_version
     elif watch == CLOCK:
         key = (io_version, now)
+    elif watch == SETTLES and written is not None:
+        key = (io_version, written)
     else:
         return None
     if probes:
         return (key, tuple(p() for p in probes))
     return key
+
+
+def _settles_name(node) -> bool:
+    """A name whose value changes only when a statement, the I/O image or a cyclic flag writes
+    it (:func:`settles`)."""
+    place = getattr(node.ann, "place", None) if node.ann is not None else None
+    if place is None:
+        return False
+    if place.kind != SYSTEM:
+        sym = place.symbol
+        if sym is not None and sym.kind == "signal":
+            decl = sym.decl
+            start = getattr(decl, "start", None)
+            return isinstance(decl, N.SignalDecl) and start is not None and start.sysvar.upper() in _IO_ARRAYS
+        return not place.name.startswith("$")  # a $ name the resolver did not place: its lookup decides
+    key = place.name.upper()
+    # computed from the run (the robot, the clock, the program's state) unless constant or I/O
+    return not (key in _LIVE and key not in CONSTANT_NAMES and key not in _IO_ARRAYS)
+
+
+def settles(expr) -> bool:
+    """True when expression `expr` reads only what a statement or the I/O image changes:
+    variables (a data list's, a global, a frame's), the I/O arrays ($IN, $OUT, $ANIN, $ANOUT,
+    a SIGNAL over one of them), stored system variables ($CYCFLAG, $FLAG, those a system data
+    list declares) and constants —
+    no call, no timer, no computed system variable (the robot's position, the clock, the
+    program's state). Its value then stays until a statement runs, the I/O image changes or a
+    cyclic flag changes (:class:`CyclicWatch`)."""
+    return all(mode == "r" and _settles_name(node) for mode, node in reads(expr))
+
+
+class CyclicWatch:
+    """When a cyclic flag's expression (``$CYCFLAG[n] = expr``, interp/runtime/core.py
+    ``Runtime.cyclic_on``) must be evaluated again. The controller evaluates each at every IPO
+    cycle; an expression that :func:`settles` gives the same value until a statement runs (the
+    steps executed: ``Runtime.steps`` less the steps a parked spin counted without running them,
+    interp/runtime/spin.py), the I/O image changes (its version) or a cyclic flag changed
+    (:attr:`version`, which the cyclic flags count): :meth:`key` is the same, and the evaluation
+    is left out. Not while an ``ANIN ON`` writes a variable at every cycle."""
+
+    __slots__ = ("rt", "version")
+
+    def __init__(self, rt) -> None:
+        self.rt = rt
+        self.version = 0
+
+    def written(self):
+        """What may have written a variable since: ``(steps executed, cyclic flag changes)``; None
+        when something else may (a debugger, an ``ANIN ON``)."""
+        rt = self.rt
+        if rt.stmt_hook is not None or rt.step_hook is not None or rt.cycle_hook is not None \
+                or any(k[0] == "analog input" for k in rt._cyclic):
+            return None
+        return (rt.steps - rt.spin.skipped, self.version)
+
+    def key(self):
+        """The key of the present moment, or None: evaluate."""
+        w = self.written()
+        return None if w is None else (self.rt.controller.io.version, w)

@@ -24,7 +24,7 @@ from krl.ast import nodes as N
 from krl.ast.visit import EXPRESSIONS, STATEMENTS, handlers
 from krl.semantics.resolve import LOCAL, ROUTINE, SYSTEM
 
-from interp.runtime.builtins import ValueRef
+from interp.runtime.natives import ValueRef
 from interp.runtime.convert import num
 from interp.runtime.errors import ExitSignal, GotoSignal, KrlRuntimeError, ReturnSignal, lvalue_name
 from interp.runtime.slots import (anout_limits, anout_value, array_index, ended_without_return, for_done,
@@ -442,10 +442,8 @@ class TreeInterpreter:
         callee = call.ann.callee
         if callee.kind == ROUTINE:
             return self.invoke(rt.callee(callee), self.args_for(call, frame), frame, catch_resume)
-        native = rt.native(callee)
-        if native is None:
-            return rt.stub_call(callee.name, not statement)
-        return native(rt, self.args_for(call, frame))
+        # the arguments are evaluated before a stand-in too, as the VM does
+        return rt.call_native(callee, self.args_for(call, frame), not statement)
 
     def invoke(self, target, args: list, caller, catch_resume: bool = True):
         """Run routine ``target`` = (module, Routine) with reference ``args`` (the

@@ -39,7 +39,7 @@ from __future__ import annotations
 
 import math
 
-from interp.runtime.builtins import ValueRef
+from interp.runtime.natives import ValueRef
 from interp.runtime.convert import INT_MAX, INT_MIN, num
 from interp.runtime.errors import ExitSignal, KrlRuntimeError
 from interp.runtime.memory import Slot
@@ -122,7 +122,7 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
     adata = [None] * len(store)
     agrid = [None] * len(store)
     fvars = frame.vars
-    before, tick, take_error_proceed, quiet_limit, run_routine, exec_routine = self.hooks
+    before, tick, take_error_proceed, quiet_limit, run_routine, exec_routine, call_native = self.hooks
     cold = COLD
     task = rt.current_task
     # Quiet steps (Runtime.quiet_limit) are counted here, in two locals: ``left``, how many
@@ -750,14 +750,14 @@ def FOR_NEXT_FAST(var: "v", state: "t", stmt: "x", target: "l"):
 # ---------------------------------------------------------------------------- calls
 @inst('args[argc] -- result if flags == "E"', freq=36)
 def CALL(callee: "r", argc: "i", flags: "f"):
-    """call callee (a routine of the program: linked per run, vm.Bound; else VM.call: a built-in or the stub policy); flags: S statement, E expression (pushes the result), N no RESUME catch"""
+    """call callee (a routine of the program: linked per run, vm.Bound; else Runtime.call_native: the implementation the resolver linked, Callee.native, or the stand-in policy); flags: S statement, E expression (pushes the result), N no RESUME catch"""
     target = code.callsites.get(ip)
     FLUSH()
     SYNC_STEPS()
     if target is not None:                  # VM.invoke, without its Python frame
         result = run_routine(target, args, frame, exec_routine, "N" not in flags)
     else:
-        result = self.call(code, ip, callee, args, frame, flags)
+        result = call_native(callee, args, flags == "E")
     left = task.quiet - rt.steps if task is not None else 0
     if result is None and flags == "E":
         result = function_result(callee.name, result)

@@ -8,10 +8,10 @@ its SOURCE is this file's."""
 # ruff: noqa
 
 import math
-from interp.runtime.builtins import (ValueRef)
 from interp.runtime.convert import (num)
 from interp.runtime.errors import (ExitSignal, KrlRuntimeError)
 from interp.runtime.memory import (Slot)
+from interp.runtime.natives import (ValueRef)
 from interp.runtime.slots import (add as _add, array_index as _array_index, component as _component, element as _element, element1 as _element1, element2 as _element2, for_limits as _for_limits, for_next as _for_next, load as _load, mul as _mul, read_value as _read_value, set_component as _set_component, set_element as _set_element, set_element1 as _set_element1, store as _store, sub as _sub, anout_limits, anout_value, ended_without_return, for_done, function_result, label_not_found, return_without_value, trigger_args)
 from interp.runtime.values import (Struct, UNSET)
 from krl.semantics.types import (BOOL as T_BOOL, INT as T_INT, REAL as T_REAL)
@@ -338,7 +338,7 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
     adata = [None] * len(store)
     agrid = [None] * len(store)
     fvars = frame.vars
-    before, tick, take_error_proceed, quiet_limit, run_routine, exec_routine = self.hooks
+    before, tick, take_error_proceed, quiet_limit, run_routine, exec_routine, call_native = self.hooks
     cold = COLD
     task = rt.current_task
     left = task.quiet - rt.steps if task is not None else 0
@@ -425,7 +425,7 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                                             if target is not None:
                                                 result = run_routine(target, args, frame, exec_routine, 'N' not in p2)
                                             else:
-                                                result = self.call(code, ip, p1, args, frame, p2)
+                                                result = call_native(p1, args, p2 == 'E')
                                             left = task.quiet - rt.steps if task is not None else 0
                                             if result is None and p2 == 'E':
                                                 result = function_result(p1.name, result)
@@ -1339,4 +1339,4 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
     finally:
         rt.steps += unsaved
 
-SOURCE = '00b89a638a0d04f7ec1d4ba94479dd4e99b0220ed10d61e2bdde5f0d2ff5010a'
+SOURCE = 'fa4220fb1b3d6e641ea09f33ee8c321af976c362b83aa680eecfb47ccfa266c0'

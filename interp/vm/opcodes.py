@@ -84,7 +84,7 @@ OPS: list[OpInfo] = [
     OpInfo('STMT_G', 0, 'x', ('stmt',), 0, ' -- ', False, (), None, 'statement boundary in a routine: Runtime.before_statement, then take the ON_ERROR_PROCEED flag (every statement takes it)'),
     OpInfo('JUMP_TICK', 1, 'xl', ('stmt', 'target'), 0, ' -- ', False, ('TICK', 'JUMP'), None, 'the back edge of WHILE and LOOP (TICK, JUMP)'),
     OpInfo('STORE_ELEM2', 2, 'vny', ('array', 'name', 'etype'), -3, 'value, i, j --', False, (), None, '2-D store array [i, j] = value (STORE_INDEX 2)'),
-    OpInfo('CALL', 3, 'rif', ('callee', 'argc', 'flags'), _effect_CALL, 'args[argc] -- result if flags == "E"', False, (), None, 'call callee (a routine of the program: linked per run, vm.Bound; else VM.call: a built-in or the stub policy); flags: S statement, E expression (pushes the result), N no RESUME catch'),
+    OpInfo('CALL', 3, 'rif', ('callee', 'argc', 'flags'), _effect_CALL, 'args[argc] -- result if flags == "E"', False, (), None, 'call callee (a routine of the program: linked per run, vm.Bound; else Runtime.call_native: the implementation the resolver linked, Callee.native, or the stand-in policy); flags: S statement, E expression (pushes the result), N no RESUME catch'),
     OpInfo('REF_LOCAL', 4, 's', ('var',), 1, '-- ref', False, (), None, 'push the reference of a frame slot'),
     OpInfo('STORE_MOD', 5, 'm', ('slot',), -1, 'value --', False, (), None, 'pop a value into a module slot'),
     OpInfo('LOAD_ELEM1', 6, 'vn', ('array', 'name'), 0, 'index -- value', False, (), None, "the element of 1-D store array at index (LOAD_INDEX1); name: the array's, for messages"),

@@ -20,7 +20,8 @@ asm` prints exactly what runs; kept per checked workspace by :func:`linked_code`
 AST), each operand as its kind's VM form (:data:`LINK`), and :class:`Bound` binds it to a run's
 storage and links every call site from its Callee (a routine of the program: the (module,
 Routine) to invoke) when the routine is first called; a built-in or a stub is run through the
-runtime (:meth:`VM.call`).
+runtime (``Runtime.call_native``, as the tree interpreter does: the implementation the resolver
+linked, else the stand-in policy).
 """
 
 from __future__ import annotations
@@ -175,7 +176,7 @@ class VM:
         self.body = functools.partial(self.loop, self, None)
         # the runtime's statement hooks, bound once (the loop takes them at each call)
         self.hooks = (rt.before_statement, rt.loop_tick, rt.take_error_proceed, rt.quiet_limit, rt.run_routine,
-                      self.body)
+                      self.body, rt.call_native)
 
     # ------------------------------------------------------------------ entry points
     def run_program(self, module_name: str | None = None) -> None:
@@ -196,15 +197,6 @@ class VM:
         """Run routine ``target`` = (module, Routine) with reference ``args`` (the
         runtime's call protocol, Runtime.run_routine)."""
         return self.rt.run_routine(target, args, caller, self.body, catch_resume)
-
-    def call(self, code, ip: int, callee, args: list, frame, flags: str):
-        """A CALL whose Callee is not a routine of the program (Bound links those): a
-        built-in the simulator implements, else the stub policy."""
-        rt = self.rt
-        native = rt.native(callee)
-        if native is None:
-            return rt.stub_call(callee.name, flags == "E")
-        return native(rt, args)
 
     def thunk(self, code, frame, temps: list, ip: int, stack: list | None = None):
         """A callable that runs the thunk at ``ip`` of ``code`` in the activation (``frame``,

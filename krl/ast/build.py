@@ -20,6 +20,7 @@ from antlr4.tree.Tree import ErrorNode, TerminalNode
 
 from krl.ast import nodes as N
 from krl.diagnostics import DiagnosticSink
+from krl.diagnostics.codes import E003, W003
 
 _RULE_CACHE: dict[type, tuple[str, str]] = {}
 
@@ -130,8 +131,7 @@ class Builder:
     def unknown(self, ctx, what: str) -> None:
         if not self.recovered:
             sp = self.span(ctx)
-            self.sink.add(self.path, sp.line, sp.column, "W003",
-                          f"{what} '{_names(ctx)[0]}' is not mapped to the AST yet")
+            self.sink.add(self.path, sp.line, sp.column, *W003(what=what, name=_names(ctx)[0]))
 
     def guarded(self, fn, ctx, default=None):
         """Run fn(ctx); on a malformed subtree report (unless recovered) and return default."""
@@ -140,13 +140,12 @@ class Builder:
             return fn(ctx)
         except RecursionError:
             sp = self.span(ctx)
-            self.sink.add(self.path, sp.line, sp.column, "E003", "construct nested too deeply to build")
+            self.sink.add(self.path, sp.line, sp.column, *E003("too_deep"))
             return default
         except Exception as exc:  # noqa: BLE001 - the builder must never raise
             if not self.recovered:
                 sp = self.span(ctx)
-                self.sink.add(self.path, sp.line, sp.column, "E003",
-                              f"cannot build '{_names(ctx)[0]}': {exc}")
+                self.sink.add(self.path, sp.line, sp.column, *E003(name=_names(ctx)[0], error=exc))
             return default
 
     # ---------------------------------------------------------------- module level
@@ -1099,7 +1098,7 @@ def build_module(result, sink: DiagnosticSink | None = None) -> N.Module:
         b = Builder(path, sink, symbolic, recovered=not result.ok)
         return b.module(tree)
     except Exception as exc:  # noqa: BLE001 - never raise on any parse tree
-        sink.add(path, 1, 1, "E003", f"AST builder failed: {type(exc).__name__}: {exc}")
+        sink.add(path, 1, 1, *E003("failed", error=f"{type(exc).__name__}: {exc}"))
         return N.Module(path, "src", span=N.Span(path, 1, 1))
 
 

@@ -82,14 +82,15 @@ EMBEDDED_CORPUS = Path(__file__).resolve().parents[2] / "corpus"
 
 def all_figures(repeat: int = 3, sim_seconds: float = 60.0, parse_kb: int = 512) -> dict:
     """Every figure of `krl bench --json`, measured in this process: the compute benchmark
-    on both interpreters and in Python (interp/bench), the simulator's real-time factor
-    (robot.bench) and the parser's warm rate over ``parse_kb`` KB of the shared corpus (the
-    embedded corpus when the shared one is absent)."""
+    on both interpreters and in Python (interp/bench), the simulator's real-time factor and
+    simulated s per CPU s as ``python -m robot.bench`` measures them (robot.bench ``measure``:
+    after its warm-up run, so both commands give one figure) and the parser's warm rate over
+    ``parse_kb`` KB of the shared corpus (the embedded corpus when the shared one is absent)."""
     from interp.bench import compute  # noqa: PLC0415
-    from robot.bench import run_bench  # noqa: PLC0415
+    from robot.bench import measure  # noqa: PLC0415
 
     c = compute(repeat)
-    sim = run_bench(min_motion_s=sim_seconds)
+    sim = measure(min_motion_s=sim_seconds)
     corpus = DEFAULT_CORPUS if DEFAULT_CORPUS.is_dir() else EMBEDDED_CORPUS
     parse = parse_rate(corpus, limit_bytes=parse_kb * 1024)
     return {
@@ -98,6 +99,7 @@ def all_figures(repeat: int = 3, sim_seconds: float = 60.0, parse_kb: int = 512)
         "tree_stmts_per_s": round(c["tree_stmts_per_s"]),
         "vm_stmts_per_s": round(c["vm_stmts_per_s"]),
         "sim_realtime_factor": sim["sim_realtime_factor"],
+        "sim_cpu_factor": sim["sim_cpu_factor"],
         "parse_kb_per_s": parse["warm_kb_per_s"],
         "python_stmts_per_s": round(c["python_stmts_per_s"]),
     }

@@ -75,6 +75,7 @@ def run_check(paths: list[str], as_json: bool = False, no_warnings: bool = False
     from krl.cluster import SchedulerError  # noqa: PLC0415
     from krl.semantics.config import ConfigError, Selection, config_for, parse_codes  # noqa: PLC0415
     from krl.diagnostics import Diagnostic  # noqa: PLC0415
+    from krl.diagnostics.codes import E004  # noqa: PLC0415
     from krl.source import read_source  # noqa: PLC0415
     from krl.diagnostics.render import Renderer  # noqa: PLC0415
     from krl.terminal import printable  # noqa: PLC0415
@@ -126,7 +127,7 @@ def run_check(paths: list[str], as_json: bool = False, no_warnings: bool = False
             except ArchiveError as exc:
                 any_error = True
                 message = str(exc).removeprefix(f"{path}: ")
-                report(str(path), 0, [Diagnostic(str(path), 1, 1, "E004", message)])
+                report(str(path), 0, [Diagnostic(str(path), 1, 1, *E004(detail=message))])
     except ConfigError as exc:
         echo(f"krl check: {printable(exc)}")
         return 2
@@ -221,6 +222,7 @@ def _on_cluster(scheduler: str, groups: list, timeout: float | None) -> list:
     krl.cluster.SchedulerError; a group whose task fails is an E901 diagnostic of its root."""
     from krl.cluster import run_batches  # noqa: PLC0415
     from krl.diagnostics import Diagnostic  # noqa: PLC0415
+    from krl.diagnostics.codes import E901  # noqa: PLC0415
 
     tasks = [(i, (root, entries, timeout)) for i, (root, entries) in enumerate(groups)]
     # a task's deadline: the per-file timeout times its files (krl/cluster.py adds the transfer)
@@ -232,8 +234,7 @@ def _on_cluster(scheduler: str, groups: list, timeout: float | None) -> list:
         if o.status == "done":
             got[o.key] = Checked(*o.value)
         else:
-            got[o.key] = Checked(root, [], [Diagnostic(root, 1, 1, "E901", f"not checked on the Dask cluster: "
-                                                                            f"{o.status}: {o.detail}")])
+            got[o.key] = Checked(root, [], [Diagnostic(root, 1, 1, *E901("cluster", status=o.status, detail=o.detail))])
     return [got[i] for i in range(len(groups))]
 
 

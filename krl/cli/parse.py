@@ -18,6 +18,7 @@ from pathlib import Path
 import click
 
 from krl.diagnostics import Diagnostic
+from krl.diagnostics.codes import E001, E005
 from krl.limits import PARSE_TIMEOUT_S
 from krl.syntax.messages import file_diagnostics
 
@@ -63,10 +64,9 @@ def _jobs_in_order(files, outline: bool, tree: bool, timeout: float | None, jobs
             if o.status == "done":
                 yield path, o.value, None
             elif o.status == "timeout":
-                yield path, None, Diagnostic(str(path), 1, 1, "E005",
-                                             f"file not parsed within {timeout:g} s (--timeout; the parse was stopped)")
+                yield path, None, Diagnostic(str(path), 1, 1, *E005(timeout=timeout))
             else:
-                yield path, None, Diagnostic(str(path), 1, 1, "E001", f"file not parsed: {o.detail}")
+                yield path, None, Diagnostic(str(path), 1, 1, *E001(why=o.detail))
 
 
 def run_parse(files, fmt: str = "text", outline: bool = False, tree: bool = False, echo=print,
@@ -93,7 +93,7 @@ def run_parse(files, fmt: str = "text", outline: bool = False, tree: bool = Fals
             all_diags.append(failure)
             if fmt == "json":
                 obj = {"path": str(path), "ok": False, "encoding": "",
-                       "status": "timeout" if failure.code == "E005" else "internal_error",
+                       "status": "timeout" if failure.code == E005 else "internal_error",
                        "diagnostics": [failure.as_json()]}
                 if antlr_errors:
                     obj["antlr_errors"] = []

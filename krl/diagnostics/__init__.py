@@ -5,8 +5,10 @@ Text form (krl/diagnostics/render.py): ``path:line:col: error[CODE]: message``, 
 and a caret under the span. JSON form: :meth:`Diagnostic.as_json`. Lines and columns are 1-based
 everywhere (columns count characters, a tab is one column).
 
-Codes are stable: tests, reports, ``krl.toml`` and users refer to them, and every code has a
-section in docs/diagnostics.md. Groups:
+Codes are stable: tests, reports, ``krl.toml`` and users refer to them. Each is declared once,
+as a named constant with its severity, kind and message templates, in krl/diagnostics/codes.py
+(``E102(name=...)`` gives the code and its message), and has a section in docs/diagnostics.md.
+Groups:
 E0xx input and syntax, E1xx names and declarations, E2xx types, E3xx calls,
 E4xx control flow, E5xx system variables / write protection, E9xx internal.
 Warnings use the same number with a W prefix where the same rule has a soft form.
@@ -16,79 +18,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-# code -> (severity, short kind name used in reports)
-CODES: dict[str, tuple[str, str]] = {
-    "E001": ("error", "unreadable or binary input"),
-    "W002": ("warning", "entry of a folder not read (symbolic link, FIFO/socket/device, folder unreadable or too deep)"),
-    "E002": ("error", "syntax error"),
-    "W003": ("warning", "construct not understood by the AST builder"),
-    "E003": ("error", "construct that cannot be built (too large or malformed)"),
-    "E004": ("error", "backup archive refused (unsafe entry or past a limit)"),
-    "E005": ("error", "file not parsed within the time limit (--timeout)"),
-    "E010": ("error", "block not closed"),
-    "E011": ("error", "block closer without its opener"),
-    "E012": ("error", "statement missing a keyword or a part"),
-    "E013": ("error", "`==` where an assignment `=` is meant"),
-    "E014": ("error", "declaration after the first statement (syntax)"),
-    "E015": ("error", "bracket or string not closed"),
-    "E016": ("error", "unexpected text after a complete statement"),
-    "E017": ("error", "character that is not KRL"),
-    "E018": ("error", "nesting too deep"),
-    "E019": ("error", "expression too long"),
-    "E020": ("error", "unexpected end of file"),
-    "W021": ("warning", "unbalanced ;FOLD / ;ENDFOLD"),
-    "E101": ("error", "undeclared name"),
-    "W101": ("warning", "name not in the backup, declared by installed software (once per backup)"),
-    "E102": ("error", "duplicate declaration"),
-    "E103": ("error", "identifier longer than 24 characters"),
-    "E104": ("error", "declaration after the first statement"),
-    "E105": ("error", "unknown type"),
-    "W105": ("warning", "type not in the backup, declared by installed software (once per backup)"),
-    "E106": ("error", "undeclared routine"),
-    "W106": ("warning", "routine not in the backup, provided by installed software (once per backup)"),
-    "W107": ("warning", "system variable the platform tables do not list (once per backup)"),
-    "E108": ("error", "unknown structure component"),
-    "W108": ("warning", "component not in the built-in structure table"),
-    "E109": ("error", "not an array / wrong number of indices"),
-    "E110": ("error", "array index out of range"),
-    "W111": ("warning", "main routine name differs from the file name"),
-    "E201": ("error", "incompatible types in assignment"),
-    "W201": ("warning", "aggregate for a built-in type that the tables do not describe as a structure"),
-    "W202": ("warning", "lossy conversion (REAL to INT rounds)"),
-    "E203": ("error", "operator applied to wrong operand types"),
-    "E204": ("error", "condition is not BOOL"),
-    "E205": ("error", "ENUM literal not of the expected type"),
-    "W205": ("warning", "ENUM literal not in the built-in enum table"),
-    "E206": ("error", "unknown aggregate component"),
-    "W206": ("warning", "aggregate component not in the built-in structure table"),
-    "E207": ("error", "invalid SWITCH selector or CASE value"),
-    "E208": ("error", "FOR counter must be an INT variable"),
-    "E209": ("error", "invalid motion target"),
-    "W210": ("warning", "string longer than the CHAR array"),
-    "E211": ("error", "invalid array index type"),
-    "E212": ("error", "FOR STEP is not a non-zero INT constant"),
-    "E301": ("error", "too many arguments"),
-    "E302": ("error", ":OUT argument is not a variable"),
-    "E303": ("error", "argument type mismatch"),
-    "E304": ("error", "procedure used as a function or function as a statement"),
-    "E401": ("error", "GOTO target not found in the routine"),
-    "E402": ("error", "GOTO into a block"),
-    "E403": ("error", "EXIT outside a loop"),
-    "E404": ("error", "RETURN value mismatch"),
-    "E405": ("error", "duplicate label"),
-    "E406": ("error", "motion statement in a submit program"),
-    "E408": ("error", "interrupt priority outside 1..128"),
-    "E409": ("error", "TRIGGER calling a routine without PRIO"),
-    "E501": ("error", "write to a write-protected variable or an input"),
-    "W501": ("warning", "write to a SIGNAL name of an input"),
-    "E502": ("error", "assignment to a constant"),
-    "E503": ("error", "not an assignable variable"),
-    "E901": ("error", "internal checker error"),
-}
-
-# The codes of syntax errors (the file does not parse; krl/syntax/messages.py); E001 and E003 are
-# input and build errors of the same group.
-SYNTAX_CODES = frozenset({"E002", *(f"E0{n}" for n in range(10, 21))})
+from krl.diagnostics.codes import CODES, SYNTAX_CODES, Code  # every code, declared once: codes.py
 
 
 @dataclass(slots=True)
@@ -124,6 +54,8 @@ class Diagnostic:
     help: str = ""
 
     def __post_init__(self) -> None:
+        if type(self.code) is not str:      # a Code constant: stored as its plain text
+            self.code = str(self.code)
         if not self.severity:
             self.severity = CODES.get(self.code, ("error" if self.code.startswith("E") else "warning",))[0]
 

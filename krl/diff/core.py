@@ -346,12 +346,14 @@ def _declarations(d: Diff, show: str, scope: str, old_items: list, new_items: li
 
 
 def _duplicates(d: Diff, old: Side, new: Side, keys: set[str]) -> None:
-    """The checker's E102 diagnostics in the compared files, of each side."""
+    """The names declared twice in the compared files, of each side (the workspace's facts,
+    krl/semantics/checker.py DeclaredTwice), worded as the checker words E102."""
     for name, s in (("old", old), ("new", new)):
-        for diag, key in s.duplicates:
+        for fact, key in s.duplicates:
             if key in keys:
-                d.duplicates.append({"side": name, "file": s.rel(key), "line": diag.line,
-                                     "code": diag.code, "message": s.relative(diag.message)})
+                code, message = fact.worded(lambda span, s=s: s.relative(str(span)))
+                d.duplicates.append({"side": name, "file": s.rel(key), "line": fact.span.line,
+                                     "code": code, "message": message})
 
 
 # ---------------------------------------------------------------------- routines

@@ -6,8 +6,9 @@ limits and the same messages).
 ``/``-separated, lower-case, so a file renamed only in letter case is the same file, as on the
 controller; for a single file, ``""``) to its :class:`krl.workspace.SourceFile`. The workspace
 is checked (krl/semantics): the diff reads the declared types from the checker's annotations,
-and ``s.duplicates`` holds the checker's E102 diagnostics (a name defined twice) with their
-file keys. Of two files whose paths differ only in letter case (impossible on the
+and ``s.duplicates`` holds the workspace's facts of the names declared twice (the checker's
+E102: ``Workspace.declared_twice``, krl/semantics/checker.py ``DeclaredTwice``) with their file
+keys. Of two files whose paths differ only in letter case (impossible on the
 controller), the first in walk order is compared and the other is an E102 there too;
 ``s.shown(key)`` is how the user names it (``backup.zip/R1/Program/a.src``); ``s.errors`` the
 input and syntax errors (:class:`krl.diagnostics.Diagnostic`, paths as shown; ``s.sources`` the
@@ -25,6 +26,7 @@ from pathlib import Path
 
 from krl.archive import ArchiveError, backup_source
 from krl.diagnostics import Diagnostic
+from krl.diagnostics.codes import E001, E004
 from krl.limits import PARSE_TIMEOUT_S
 from krl.project import find_backups
 from krl.source import read_source
@@ -95,9 +97,10 @@ class Side:
         lines = self._file_lines(path)
         return lines[number - 1].strip() if 0 < number <= len(lines) else ""
 
-    def relative(self, message: str) -> str:
-        """`message` with the backup root's path left out of the file names it holds."""
-        return message.replace(str(self.root) + "/", "")
+    def relative(self, path: str) -> str:
+        """`path` (a file's path, or a place ``path:line:col``) relative to the backup root
+        when it lies below it."""
+        return path.replace(str(self.root) + "/", "", 1) if path.startswith(str(self.root) + "/") else path
 
 
 @contextmanager
@@ -108,7 +111,7 @@ def side(path: str | Path, single: bool | None = None, timeout: float | None = N
     p = Path(path)
     timeout = PARSE_TIMEOUT_S if timeout is None else timeout
     if not p.exists() and not p.is_symlink():
-        raise DiffInputError(Diagnostic(str(p), 1, 1, "E001", "no such file or folder"))
+        raise DiffInputError(Diagnostic(str(p), 1, 1, *E001("missing")))
     try:
         with backup_source(p) as (folder, shown):
             is_file = not folder.is_dir() if single is None else single
@@ -127,14 +130,18 @@ def side(path: str | Path, single: bool | None = None, timeout: float | None = N
             ws.check_only = set()     # declarations only (names, types, E102): no routine body is checked
             ws.check()
             keys = {f.path: k for k, f in s.files.items()}
-            s.duplicates = [(d, keys[d.path]) for d in ws.sink.sorted() if d.code == "E102" and d.path in keys]
+            once: dict[tuple, object] = {}     # one entry per line and name, as the checker reports it
+            for f in ws.declared_twice():
+                if f.span.file in keys:
+                    once.setdefault((f.span.file, f.span.line, f.name, f.kind, f.struc, str(f.first)), f)
+            s.duplicates = [(f, keys[f.span.file])
+                            for f in sorted(once.values(), key=lambda f: (f.span.file, f.span.line, f.span.column))]
             for real in {d.path for d in errors} if shown.archive else ():
                 s.sources[shown(real)] = read_source(real).text or ""
             s.errors = [shown.diagnostic(d) for d in errors]
             yield s
     except ArchiveError as exc:
-        raise DiffInputError(Diagnostic(str(path), 1, 1, "E004",
-                                        str(exc).removeprefix(f"{path}: "))) from None
+        raise DiffInputError(Diagnostic(str(path), 1, 1, *E004(detail=str(exc).removeprefix(f"{path}: ")))) from None
 
 
 def _key(path: str, root: Path, folder: Path) -> str:

@@ -35,6 +35,7 @@ from pathlib import Path
 import click
 
 from krl.diagnostics import Diagnostic
+from krl.diagnostics.codes import E001, W002
 from krl.files import Entry, write_bytes_atomic
 from krl.fmt.core import FormatError, FormatOptions, FormatSyntaxError, format_text
 from krl.limits import MAX_FILE_BYTES
@@ -110,7 +111,7 @@ def run_fmt(paths, check: bool = False, diff: bool = False, options: FormatOptio
         path = entry.path
         if entry.kind != "file":
             # never read nor written: a W002 warning as `krl check` gives it
-            renderer.emit([Diagnostic(str(path), 1, 1, "W002", f"not read: {entry.message}")])
+            renderer.emit([Diagnostic(str(path), 1, 1, *W002(why=entry.message))])
             if entry.kind in _UNREADABLE:
                 failed += 1
             else:
@@ -188,11 +189,10 @@ def run_stdin(data: bytes, check: bool = False, diff: bool = False, options: For
     options = options or FormatOptions()
     name = "<stdin>"
     if len(data) > MAX_FILE_BYTES:
-        Renderer(err, colour).emit([Diagnostic(name, 1, 1, "E001", f"file not parsed: too_large "
-                                               f"({len(data)} bytes > {MAX_FILE_BYTES})")])
+        Renderer(err, colour).emit([Diagnostic(name, 1, 1, *E001(why=f"too_large ({len(data)} bytes > {MAX_FILE_BYTES})"))])
         return 2
     if b"\x00" in data:
-        Renderer(err, colour).emit([Diagnostic(name, 1, 1, "E001", "file not parsed: binary (NUL bytes)")])
+        Renderer(err, colour).emit([Diagnostic(name, 1, 1, *E001(why="binary (NUL bytes)"))])
         return 2
     text, encoding = decode_bytes(data)
     try:

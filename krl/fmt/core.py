@@ -46,6 +46,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Literal
 
+from krl.diagnostics.codes import E001, E002
 from krl.syntax.messages import syntax_diagnostics
 from krl.syntax.parse import ParseResult, ParserBundle, default_bundle, keyword_types, parse_text
 from krl.syntax.tokens import DEFAULT_CHANNEL, EOF, is_rule, is_token_node, lex, rule_name
@@ -94,7 +95,7 @@ class SyntaxProblem:
     line: int
     column: int
     message: str
-    code: str = "E002"
+    code: str = E002
 
 
 class FormatSyntaxError(FormatError):
@@ -253,9 +254,10 @@ def _syntax_error(result: ParseResult, text: str) -> FormatSyntaxError:
     diags = syntax_diagnostics(result, text)
     out = [SyntaxProblem(d.line, d.column, d.message, d.code) for d in diags]
     if not out:
-        out = [SyntaxProblem(e.line, e.column + 1, e.message, "E002") for e in result.errors]
+        out = [SyntaxProblem(e.line, e.column + 1, e.message, E002) for e in result.errors]     # the parser's words
     if not out:
-        out.append(SyntaxProblem(1, 1, f"file not parsed: {result.status}", "E001"))
+        code, message = E001(why=result.status)
+        out.append(SyntaxProblem(1, 1, message, code))
     return FormatSyntaxError(out, result, diags)
 
 

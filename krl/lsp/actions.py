@@ -8,18 +8,23 @@
 * E010 ``missing ENDIF for the IF at line n`` (help: add ENDIF before line m / the end of the
   file): the closer on its own line, indented like its opener.
 * E002 ``'INTERRUPT5' is read as one name`` (help: KRL needs a space after INTERRUPT): the space.
+
+A fix is made from the diagnostic's code, place and notes, the source text and the workspace's
+facts (the undeclared name is the workspace's unresolved use at that place), never from the
+words of its message or help.
 """
 
 from __future__ import annotations
 
-import re
 from dataclasses import dataclass
 
 from krl.ast import nodes as N
 from krl.diagnostics import Diagnostic
+from krl.diagnostics.codes import E002, E010, E101
 from krl.lsp.analysis import Analysis
 from krl.lsp.text import line_tokens
 from krl.semantics import types as T
+from krl.syntax.blocks import CLOSER
 from krl.syntax.messages import split_glued
 
 
@@ -43,9 +48,6 @@ class Fix:
     preferred: bool = False
 
 
-_CLOSER = re.compile(r"^add (\w+) before (?:line (\d+)|the end of the file)$")
-_GLUE = re.compile(r"^KRL needs a space after (\w+)$")
-_UNDECLARED = re.compile(r"^'([\w]+)' is not declared$")
 
 
 def _parents(root: N.Node) -> dict[int, N.Node]:
@@ -107,11 +109,20 @@ def _indent(text: str) -> str:
     return text[:len(text) - len(text.lstrip())]
 
 
+def _undeclared_at(an: Analysis, d: Diagnostic) -> str | None:
+    """The name the workspace found undeclared where `d` stands (its unresolved uses,
+    krl/semantics/outside.py), else None (E101 of a parameter: no use)."""
+    un = an.ws.unresolved()
+    for (kind, _key), (name, uses) in (un.uses.items() if un is not None else ()):
+        if kind == "name" and any(u.path == d.path and u.line == d.line and u.column == d.column for u in uses):
+            return name
+    return None
+
+
 def _declare(an: Analysis, d: Diagnostic) -> list[Fix]:
-    m = _UNDECLARED.match(d.message)
-    if m is None:
+    name = _undeclared_at(an, d)
+    if name is None:
         return []
-    name = m.group(1)
     t = infer_type(an, d.path, d.line, d.column, name)
     if t is None:
         return []
@@ -137,14 +148,17 @@ def _declare(an: Analysis, d: Diagnostic) -> list[Fix]:
 
 
 def _close(an: Analysis, d: Diagnostic) -> list[Fix]:
-    m = _CLOSER.match(d.help)
-    if m is None:
-        return []
-    closer, before = m.group(1), m.group(2)
+    """E010 spans the block's opener (krl/syntax/blocks.py); its note, when it has one, is where
+    a closer of an outer block was reached: the missing closer goes before that line, else at
+    the end of the file."""
     lines = an.files[d.path].lines
-    indent = _indent(lines[d.line - 1]) if 0 < d.line <= len(lines) else ""
-    if before is not None:
-        at = int(before)
+    opener = lines[d.line - 1][d.column - 1:d.end_column - 1].upper() if 0 < d.line <= len(lines) else ""
+    closer = CLOSER.get(opener)
+    if closer is None:
+        return []
+    indent = _indent(lines[d.line - 1])
+    if d.notes:
+        at = d.notes[0].line
         edit = Edit(d.path, at, 1, at, 1, f"{indent}{closer}\n")
     else:
         last = len(lines)
@@ -156,9 +170,7 @@ def _close(an: Analysis, d: Diagnostic) -> list[Fix]:
 
 
 def _split(an: Analysis, d: Diagnostic) -> list[Fix]:
-    m = _GLUE.match(d.help)
-    if m is None:
-        return []
+    """An E002 that spans a keyword glued to what follows (``INTERRUPT5``): the space it needs."""
     lines = an.files[d.path].lines
     word = lines[d.line - 1][d.column - 1:d.end_column - 1] if 0 < d.line <= len(lines) else ""
     got = split_glued(word)
@@ -174,10 +186,10 @@ def fixes(an: Analysis, path: str, first_line: int, last_line: int) -> list[Fix]
     for d in an.diagnostics_for(path):
         if not d.help or not first_line <= d.line <= last_line:
             continue
-        if d.code == "E101":
+        if d.code == E101:
             out.extend(_declare(an, d))
-        elif d.code == "E010":
+        elif d.code == E010:
             out.extend(_close(an, d))
-        elif d.code == "E002":
+        elif d.code == E002:
             out.extend(_split(an, d))
     return out

@@ -16,6 +16,7 @@ from dataclasses import dataclass, field
 
 from krl.ast import nodes as N
 from krl.diagnostics import Diagnostic
+from krl.diagnostics.codes import W111
 from krl.diagnostics.render import split_lines
 from krl.lsp.parsing import Parsed
 from krl.lsp.paths import is_uri
@@ -123,7 +124,7 @@ class Analysis:
         """The workspace's diagnostics of one file, with the root's krl.toml applied."""
         diags = self.ws.diagnostics_of(path)
         if is_uri(path):        # an unsaved new buffer has no file name to match its main routine
-            diags = [d for d in diags if d.code != "W111"]
+            diags = [d for d in diags if d.code != W111]
         try:
             return config_for(self.root).apply(diags)     # the workspace root only, as krl check
         except Exception:  # noqa: BLE001 - a bad krl.toml: `krl check` says why; here all are shown

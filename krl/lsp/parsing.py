@@ -42,6 +42,7 @@ from dataclasses import dataclass
 from krl.ast import nodes as N
 from krl.ast.build import build_module
 from krl.diagnostics import Diagnostic, DiagnosticSink
+from krl.diagnostics.codes import E001
 from krl.limits import MAX_FILE_BYTES
 from krl.semantics.outside import template_lines
 from krl.source import SourceText, read_source
@@ -121,7 +122,7 @@ def _not_parsed(path: str, text: str, size: int, status: str, detail: str) -> Pa
     """A buffer that is not parsed (empty, binary, too large): E001 as for a file."""
     sink = DiagnosticSink()
     result = parse_source(SourceText(path, "", "", size, status, detail))
-    sink.add(path, 1, 1, "E001", f"file not checked: {status}" + (f" ({detail})" if detail else ""))
+    sink.add(path, 1, 1, *E001("not_checked", why=status + (f" ({detail})" if detail else "")))
     module = build_module(result, sink)
     lf = LoadedFile(path, module, False, status, 0.0, 0.0, sink.items, status != "empty", set(),
                     (frozenset(), frozenset()))

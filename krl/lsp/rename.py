@@ -7,8 +7,8 @@ KRL words) when:
 
 * the name is a system variable, a built-in, a STRUC/ENUM type or component (not renamed), or a
   routine only declared by EXT (its DEF is outside the backup);
-* the name is ambiguous: declared twice (E102), or named in a file that does not parse (its
-  uses there are not known);
+* the name is ambiguous: declared twice (E102: the workspace's ``declared_twice`` facts), or
+  named in a file that does not parse (its uses there are not known);
 * the new name is not one KRL identifier (a keyword, a ``$`` name, more than 24 characters:
   reference 1.2, E103);
 * the new name is already declared in a scope that sees the declaration: the declaring scope,
@@ -69,10 +69,10 @@ def renamable(an: Analysis, t: Target | None) -> Target:
 
 
 def _ambiguous(an: Analysis, t: Target) -> None:
-    quoted = f"'{t.name.upper()}'"
-    for d in an.ws.diagnostics:
-        if d.code == "E102" and quoted in d.message.upper():
-            raise Refused(f"'{t.name}' is declared more than once ({d.path.rsplit('/', 1)[-1]} line {d.line}): "
+    key = t.name.upper()
+    for f in an.ws.declared_twice():        # the semantic model's facts (E102), never its words
+        if f.kind != "component" and f.name.upper() == key:
+            raise Refused(f"'{t.name}' is declared more than once ({f.span.file.rsplit('/', 1)[-1]} line {f.span.line}): "
                           "which one is meant is ambiguous")
     pat = re.compile(r"(?<![\w$])" + re.escape(t.name) + r"(?![\w$])", re.IGNORECASE)
     for path, fi in an.files.items():

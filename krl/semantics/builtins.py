@@ -1,7 +1,8 @@
 """Built-in types, system variables and routines, loaded from the data tables in
-``krl/semantics/data`` (types.yaml, sysvars.yaml, functions.yaml from the reference; kss.yaml
-derived from KUKA system files by krl/survey/derive_tables.py, each entry with its
-source). Data, not code:
+``krl/semantics/data`` (types.yaml, sysvars.yaml from the reference; functions.yaml generated
+from the simulator's natives registry, interp/runtime/natives, where each routine is declared
+with its signature; kss.yaml derived from KUKA system files by krl/survey/derive_tables.py,
+each entry with its source). Data, not code:
 this module only reads the tables into plain records, once per process.
 
 Reference: 3.7 (predefined structures and enums), 4.5-4.8 (functions and procedures),

@@ -21,12 +21,17 @@ W101/W105/W106/W107 per name) or it is the program's error (E101/E105/E106 at ea
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 from krl.ast import nodes as N
 from krl.ast.visit import EXPRESSIONS, STATEMENTS, handlers
 from krl.ast.printer import expr as printed
 from krl.semantics import types as T
 from krl.semantics.outside import KINDS
 from krl.diagnostics import DiagnosticSink
+from krl.diagnostics.codes import (E101, E102, E103, E104, E108, E109, E110, E201, E203, E204, E205, E206, E207, E208,
+                                   E209, E211, E212, E301, E302, E303, E304, E401, E402, E403, E404, E405, E406, E408,
+                                   E409, E501, E502, E503, E901, W108, W201, W202, W205, W206, W210, W501)
 from krl.semantics.symbols import ParamSig, RoutineSig, Scope, Symbol, make_array
 
 MAX_IDENT = 24
@@ -39,6 +44,30 @@ ORDER = {"<", ">", "<=", ">="}
 
 def _is_system_datalist(name: str) -> bool:
     return name.startswith("$")
+
+
+@dataclass(frozen=True, slots=True)
+class DeclaredTwice:
+    """A declaration of a name that its scope already holds (the fact behind E102): ``name`` as
+    the second declaration writes it, ``kind`` 'value' (a variable, constant, signal or IMPORT,
+    also one data list's GLOBAL and non-GLOBAL declarations of a name), 'routine', 'type' or
+    'component' (of the STRUC ``struc``), ``span`` the second declaration and ``first`` the
+    first one's place (None when nothing of the program declares it: a table's name). The
+    workspace keeps these per owner as it keeps findings (``Workspace.declared_twice``); the
+    language server and the diff read them, never the message."""
+    name: str
+    kind: str
+    span: N.Span
+    first: N.Span | None = None
+    struc: str = ""
+
+    def worded(self, place=str) -> tuple[str, str]:
+        """(code, message) of its E102; `place(span)` shows the first declaration's place
+        (default ``path:line:col``)."""
+        if self.kind == "component":
+            return E102("component", name=self.name, struc=self.struc)
+        where = f" (first declared at {place(self.first)})" if self.first is not None else ""
+        return E102(name=self.name, where=where)
 
 
 class Declarer:
@@ -54,7 +83,9 @@ class Declarer:
         self.soft_types = False
         # set while declaring the types of an EXT/EXTFCT declaration
         self.in_ext = False
-        # the workspace's record of unresolved names (krl/semantics/outside.py); None: report at once
+        # the workspace's record of the current owner's name facts (krl/workspace.py ``_Uses``):
+        # unresolved names (krl/semantics/outside.py decides on them) and declarations made
+        # twice (DeclaredTwice); None: report at once, keep no facts
         self.unresolved = None
         # evidence(path, line, kind) -> why installed software declares a name used there, or ""
         self.evidence = lambda _path, _line, _kind: ""
@@ -75,20 +106,21 @@ class Declarer:
             return
         err, warn, _noun = KINDS[kind]
         soft = evidence or kind == "sysvar" or self.maybe_declared(name)
-        msg = {"type": f"unknown type '{name}'", "routine": f"routine '{name}' is not declared",
-               "sysvar": f"unknown system variable '{name}'"}.get(kind, f"'{name}' is not declared")
-        self.sink.at(span, warn if soft else err, msg)
+        self.sink.at(span, *(warn("soft", name=name) if soft else err(name=name)))
 
     def ident(self, name: str, span: N.Span) -> None:
         if len(name) > MAX_IDENT:
-            self.sink.at(span, "E103", f"identifier '{name}' has {len(name)} characters (at most {MAX_IDENT})")
+            self.sink.at(span, *E103(name=name, length=len(name), limit=MAX_IDENT))
 
-    def duplicate(self, name: str, span: N.Span, old: Symbol | T.KrlType | None) -> None:
-        where = ""
+    def duplicate(self, name: str, span: N.Span, old: Symbol | T.KrlType | None, kind: str = "value") -> None:
+        """E102 for a second declaration of `name` (of `kind`, DeclaredTwice) at `span`;
+        `old` the first one (a Symbol or a declaration holder), when the program declares it."""
         decl = getattr(old, "decl", None)
-        if decl is not None and getattr(decl, "span", None) is not None and decl.span.line:
-            where = f" (first declared at {decl.span})"
-        self.sink.at(span, "E102", f"'{name}' is declared more than once{where}")
+        first = decl.span if decl is not None and getattr(decl, "span", None) is not None and decl.span.line else None
+        fact = DeclaredTwice(name, kind, span, first)
+        self.sink.at(span, *fact.worded())
+        if self.unresolved is not None:
+            self.unresolved.declared_twice(fact)
 
     def resolve_type(self, scope: Scope, tref: N.TypeRef | str, span: N.Span, dims=()) -> T.KrlType:
         """A type by name (E105/W105 and UNKNOWN when it does not exist), with array dims."""
@@ -135,7 +167,7 @@ class Declarer:
             first = scope.type_symbols.get(key)
             first_system = first is None or (id(scope), key) in self._system_types
             if not (system and first_system) and (first is None or first.decl is not d):
-                self.duplicate(d.name, d.span, first)
+                self.duplicate(d.name, d.span, first, "type")
 
     # -- phase 2: structure components
     def fill_types(self, scope: Scope, items: list[N.Decl]) -> None:
@@ -148,7 +180,11 @@ class Declarer:
                     self.ident(c.name, c.span)
                     ct = self.resolve_type(scope, c.type_name, c.span, c.dims)
                     if c.name.upper() in st.fields:
-                        self.sink.at(c.span, "E102", f"component '{c.name}' appears twice in {d.name}")
+                        first = next(x.span for x in d.components if x.name.upper() == c.name.upper())
+                        fact = DeclaredTwice(c.name, "component", c.span, first, d.name)
+                        self.sink.at(c.span, *fact.worded())
+                        if self.unresolved is not None:
+                            self.unresolved.declared_twice(fact)
                     st.fields[c.name.upper()] = (c.name, ct)
 
     # -- phase 3: values and routines
@@ -269,7 +305,7 @@ class Checker:
                 elif isinstance(d, N.ArrayInit):
                     self.check_array_init(d, scope)
         except Exception as exc:  # noqa: BLE001
-            self.sink.at(dl.span, "E901", f"internal checker error in data list: {type(exc).__name__}: {exc}")
+            self.sink.at(dl.span, *E901("datalist", error=f"{type(exc).__name__}: {exc}"))
 
     def check_array_init(self, d: N.ArrayInit, scope: Scope) -> None:
         sym = scope.lookup(d.name)
@@ -279,14 +315,14 @@ class Checker:
         t = sym.type
         if not isinstance(t, T.Array):
             if t is not T.UNKNOWN:
-                self.sink.at(d.span, "E109", f"'{d.name}' is not an array")
+                self.sink.at(d.span, *E109(name=d.name))
             return
         if len(d.indices) != len(t.dims):
-            self.sink.at(d.span, "E109", f"'{d.name}' has {len(t.dims)} dimension(s), {len(d.indices)} given")
+            self.sink.at(d.span, *E109("dims", name=d.name, have=len(t.dims), given=len(d.indices)))
             return
         for i, (idx, size) in enumerate(zip(d.indices, t.dims)):
             if idx is not None and size and not 1 <= idx <= size:
-                self.sink.at(d.span, "E110", f"index {idx} of '{d.name}' is outside 1..{size}")
+                self.sink.at(d.span, *E110("named", index=idx, name=d.name, size=size))
         if d.indices and d.indices[-1] is None:
             elem: T.KrlType = T.Array(t.elem, (t.dims[-1],))
         else:
@@ -299,9 +335,9 @@ class Checker:
             ctx = _Ctx(r, local)
             self._routine(r, ctx)
         except RecursionError:
-            self.sink.at(r.span, "E901", "routine nested too deeply to check")
+            self.sink.at(r.span, *E901("too_deep"))
         except Exception as exc:  # noqa: BLE001
-            self.sink.at(r.span, "E901", f"internal checker error: {type(exc).__name__}: {exc}")
+            self.sink.at(r.span, *E901(error=f"{type(exc).__name__}: {exc}"))
 
     def _routine(self, r: N.Routine, ctx: _Ctx) -> None:
         local = ctx.scope
@@ -313,7 +349,7 @@ class Checker:
         for p in r.params:
             self.decl.ident(p.name, p.span)
             if p.name.upper() not in declared:
-                self.sink.at(p.span, "E101", f"parameter '{p.name}' of {r.name} has no declaration")
+                self.sink.at(p.span, *E101("parameter", name=p.name, routine=r.name))
             else:
                 sym = local.values[p.name.upper()]
                 sym.kind = "param"
@@ -322,11 +358,11 @@ class Checker:
         for g, path in ctx.gotos:
             got = ctx.labels.get(g.label.upper())
             if got is None:
-                self.sink.at(g.span, "E401", f"GOTO target '{g.label}' is not a label of {r.name}")
+                self.sink.at(g.span, *E401(label=g.label, routine=r.name))
                 continue
             _label, lpath = got
             if tuple(path[:len(lpath)]) != lpath:
-                self.sink.at(g.span, "E402", f"GOTO {g.label} jumps into a block")
+                self.sink.at(g.span, *E402(label=g.label))
 
     # ---------------------------------------------------------------- statements
 
@@ -375,7 +411,7 @@ class Checker:
 
     def s_Exit(self, s: N.Exit, ctx: _Ctx) -> None:
         if ctx.loops == 0:
-            self.sink.at(s.span, "E403", "EXIT outside a loop")
+            self.sink.at(s.span, *E403())
 
     def s_Goto(self, s: N.Goto, ctx: _Ctx) -> None:
         ctx.gotos.append((s, tuple(ctx.block_path)))
@@ -384,7 +420,7 @@ class Checker:
         self.decl.ident(s.name, s.span)
         key = s.name.upper()
         if key in ctx.labels:
-            self.sink.at(s.span, "E405", f"label '{s.name}' is defined more than once")
+            self.sink.at(s.span, *E405(label=s.name))
         else:
             ctx.labels[key] = (s, tuple(ctx.block_path))
 
@@ -401,7 +437,7 @@ class Checker:
         sc = ctx.scope
         self.int_expr(s.prio, sc, "interrupt number")
         if isinstance(s.prio, N.IntLit) and not 1 <= s.prio.value <= 128:
-            self.sink.at(s.prio.span, "E408", f"interrupt priority {s.prio.value} is outside 1..128")
+            self.sink.at(s.prio.span, *E408(prio=s.prio.value))
         self.cond(s.when, sc, "WHEN")
         if s.brake is None:
             self.call(s.call, sc, statement=True)
@@ -421,7 +457,7 @@ class Checker:
             self.int_expr(s.prio, sc, "PRIO")
         elif isinstance(s.action, N.CallStmt) and s.action.call.name.upper() != "PULSE":
             # PULSE is a statement of its own, not a subprogram call (5.12, 5.18)
-            self.sink.at(s.span, "E409", "a TRIGGER that calls a routine needs PRIO (-1 lets the system choose)")
+            self.sink.at(s.span, *E409())
         self.stmt(s.action, ctx)
 
     def s_Motion(self, s: N.Motion, ctx: _Ctx) -> None:
@@ -465,7 +501,7 @@ class Checker:
             self.expr(s.value, ctx.scope)
 
     def s_DeclStmt(self, s: N.DeclStmt, ctx: _Ctx) -> None:
-        self.sink.at(s.span, "E104", "declaration after the first statement of the routine")
+        self.sink.at(s.span, *E104())
 
     def s_Brake(self, s: N.Brake, ctx: _Ctx) -> None:
         self.no_motion_in_submit(s, "BRAKE")
@@ -480,7 +516,7 @@ class Checker:
 
     def no_motion_in_submit(self, s: N.Stmt, what: str) -> None:
         if self.submit:
-            self.sink.at(s.span, "E406", f"{what} in a submit program (.sub): the submit interpreter has no motion")
+            self.sink.at(s.span, *E406(what=what))
 
     def loop_body(self, body: list[N.Stmt], ctx: _Ctx) -> None:
         ctx.loops += 1
@@ -497,7 +533,7 @@ class Checker:
         sc = ctx.scope
         st = self.expr(s.selector, sc)
         if not (st in (T.INT, T.CHAR) or isinstance(st, T.Enum) or st is T.UNKNOWN):
-            self.sink.at(s.selector.span, "E207", f"SWITCH selector must be INT, CHAR or ENUM, not {st}")
+            self.sink.at(s.selector.span, *E207(type=st))
             st = T.UNKNOWN
         for c in s.cases:
             for v in c.values:
@@ -506,9 +542,9 @@ class Checker:
                     continue
                 if isinstance(st, T.Enum):
                     if not isinstance(vt, (T.EnumLitType, T.Enum)) or isinstance(vt, T.Enum) and vt != st:
-                        self.sink.at(v.span, "E207", f"CASE value of type {vt} for a {st} selector")
+                        self.sink.at(v.span, *E207("case", type=vt, selector=st))
                 elif not T.assignable(st, vt).ok or isinstance(vt, T.EnumLitType):
-                    self.sink.at(v.span, "E207", f"CASE value of type {vt} for a {st} selector")
+                    self.sink.at(v.span, *E207("case", type=vt, selector=st))
             self.block(c.body, ctx, True)
         if s.default is not None:
             self.block(s.default, ctx, True)
@@ -523,9 +559,9 @@ class Checker:
             s.var.annotate().symbol = sym
             s.var.ann.type = sym.type
             if sym.type not in (T.INT, T.UNKNOWN):
-                self.sink.at(s.var.span, "E208", f"FOR counter '{s.var.name}' is {sym.type}, not INT")
+                self.sink.at(s.var.span, *E208(name=s.var.name, type=sym.type))
             elif sym.kind in ("const", "routine"):
-                self.sink.at(s.var.span, "E208", f"FOR counter '{s.var.name}' is not a variable")
+                self.sink.at(s.var.span, *E208("not_variable", name=s.var.name))
         for e in (s.start, s.end, s.step):
             if e is not None:
                 self.int_expr(e, sc, "FOR bound", lossy_ok=True)
@@ -544,9 +580,9 @@ class Checker:
             return
         if value is None:
             if N.type_of(e) is not T.UNKNOWN:
-                self.sink.at(e.span, "E212", "FOR STEP must be an INT constant (a literal or a CONST)")
+                self.sink.at(e.span, *E212())
         elif value == 0:
-            self.sink.at(e.span, "E212", "FOR STEP must not be 0")
+            self.sink.at(e.span, *E212("zero"))
 
     def return_(self, s: N.Return, ctx: _Ctx) -> None:
         r = ctx.routine
@@ -555,14 +591,14 @@ class Checker:
             return
         if r.kind == "DEFFCT":
             if s.value is None:
-                self.sink.at(s.span, "E404", f"RETURN in function {r.name} needs a value")
+                self.sink.at(s.span, *E404(routine=r.name))
                 return
             sym = sc.lookup_routine(r.name)
             rt = sym.signature.returns if sym is not None and sym.signature else T.UNKNOWN
             self.check_value(rt or T.UNKNOWN, s.value, sc, s.value.span, what="RETURN value")
         elif s.value is not None:
             self.expr(s.value, sc)
-            self.sink.at(s.span, "E404", f"RETURN with a value in procedure {r.name}")
+            self.sink.at(s.span, *E404("procedure", routine=r.name))
 
     def motion(self, m: N.Motion, sc: Scope) -> None:
         for e in (m.aux, m.target):
@@ -584,7 +620,7 @@ class Checker:
                 elif names <= set(axes.fields):
                     target = axes
                 else:
-                    self.sink.at(e.span, "E209", "aggregate target mixes or misses axis and Cartesian components")
+                    self.sink.at(e.span, *E209("mixed"))
                     target = T.UNKNOWN
                 self.check_value(target, e, sc, e.span)
                 return
@@ -592,7 +628,7 @@ class Checker:
         if t is T.UNKNOWN:
             return
         if T.geometric_family(t) is None:
-            self.sink.at(e.span, "E209", f"motion target of type {t}; expected a position or axis type")
+            self.sink.at(e.span, *E209(type=t))
 
     def with_assign(self, w: N.WithAssign, sc: Scope) -> None:
         self.assign(w.target, w.value, sc, w.span)
@@ -607,21 +643,21 @@ class Checker:
         tt = self.expr(target, sc)
         root = N.root_name(target)
         if root is None:
-            self.sink.at(target.span, "E503", "the left side of an assignment must be a variable")
+            self.sink.at(target.span, *E503())
             return T.UNKNOWN
         sym = N.symbol_of(root)
         if isinstance(sym, Symbol):
             if sym.kind == "const":
-                self.sink.at(target.span, "E502", f"'{sym.name}' is a constant")
+                self.sink.at(target.span, *E502(name=sym.name))
             elif sym.kind == "routine":
-                self.sink.at(target.span, "E503", f"'{sym.name}' is a routine, not a variable")
+                self.sink.at(target.span, *E503("routine", name=sym.name))
             elif sym.access == "RO" and sym.name.upper() in ("$IN", "$ANIN"):
-                self.sink.at(target.span, "E501", f"'{sym.name}' is an input; programs cannot write inputs (5.13)")
+                self.sink.at(target.span, *E501("input", name=sym.name))
             elif sym.access == "RO" and sym.kind == "signal":
                 # KUKA's own technology packages write SIGNAL names of inputs (simulated I/O): a warning
-                self.sink.at(target.span, "W501", f"'{sym.name}' is an input; programs can only write simulated inputs")
+                self.sink.at(target.span, *W501(name=sym.name))
             elif sym.access == "RO":
-                self.sink.at(target.span, "E501", f"'{sym.name}' is write-protected")
+                self.sink.at(target.span, *E501(name=sym.name))
         return tt
 
     def check_value(self, target: T.KrlType, value: N.Expr, sc: Scope, span: N.Span,
@@ -635,13 +671,13 @@ class Checker:
             return
         got = T.assignable(target, vt)
         if not got.ok:
-            code = "E205" if isinstance(vt, T.EnumLitType) else "E201"
-            if code == "E205" and getattr(target, "soft", False):
-                code = "W205"
-            self.sink.at(span, code, f"{what}: {got.reason}")
+            code = E205 if isinstance(vt, T.EnumLitType) else E201
+            if code == E205 and getattr(target, "soft", False):
+                code = W205
+            self.sink.at(span, *code("assign", what=what, reason=got.reason))
         elif got.lossy:
-            code = "W210" if isinstance(vt, T.StrType) else "W202"
-            self.sink.at(span, code, f"{what}: {got.reason}")
+            code = W210 if isinstance(vt, T.StrType) else W202
+            self.sink.at(span, *code(what=what, reason=got.reason))
             value.annotate().extra["conversion"] = f"{vt}->{target}"
         elif vt != target and vt is not T.UNKNOWN and target is not T.UNKNOWN:
             value.annotate().extra["conversion"] = f"{vt}->{target}"
@@ -657,28 +693,27 @@ class Checker:
             if expected is not T.UNKNOWN and named is not T.UNKNOWN:
                 got = T.assignable(expected, named)
                 if not got.ok:
-                    self.sink.at(agg.span, "E201", got.reason)
+                    self.sink.at(agg.span, *E201(reason=got.reason))
             target = named
         agg.annotate().type = target
         seen: set[str] = set()
         for item in agg.items:
             key = item.name.upper()
             if key in seen:
-                self.sink.at(item.span, "E206", f"component '{item.name}' given twice")
+                self.sink.at(item.span, *E206("twice", name=item.name))
             seen.add(key)
             if isinstance(target, T.Struc) and target.fields:
                 ft = target.field_type(item.name)
                 if ft is None:
-                    self.sink.at(item.span, "W206" if target.soft else "E206",
-                                 f"{target.name} has no component '{item.name}'")
+                    self.sink.at(item.span, *(W206 if target.soft else E206)(struc=target.name, name=item.name))
                     self.loose(item.value, sc)
                     continue
                 self.check_value(ft, item.value, sc, item.value.span, what=f"component {item.name}")
             elif target is T.UNKNOWN:
                 self.loose(item.value, sc)
             else:
-                self.sink.at(agg.span, "W201" if getattr(target, "soft", False) else "E201",
-                             f"an aggregate cannot be assigned to {target}")
+                soft = getattr(target, "soft", False)
+                self.sink.at(agg.span, *(W201(type=target) if soft else E201("aggregate", type=target)))
                 for rest in agg.items:   # still type every component value
                     self.loose(rest.value, sc)
                 return target
@@ -696,18 +731,18 @@ class Checker:
     def cond(self, e: N.Expr, sc: Scope, what: str) -> None:
         t = self.expr(e, sc, expected=T.BOOL)
         if t not in (T.BOOL, T.UNKNOWN):
-            self.sink.at(e.span, "E204", f"{what} condition is {t}, not BOOL")
+            self.sink.at(e.span, *E204(what=what, type=t))
 
     def numeric(self, e: N.Expr, sc: Scope, what: str) -> None:
         t = self.expr(e, sc)
         if not T.is_numeric(t):
-            self.sink.at(e.span, "E203", f"{what} needs a number, not {t}")
+            self.sink.at(e.span, *E203("number", what=what, type=t))
 
     def int_expr(self, e: N.Expr, sc: Scope, what: str, lossy_ok: bool = False) -> None:
         t = self.expr(e, sc)
         if t in (T.INT, T.UNKNOWN, T.CHAR) or lossy_ok and t == T.REAL:
             return
-        self.sink.at(e.span, "E203", f"{what} must be INT, not {t}")
+        self.sink.at(e.span, *E203("integer", what=what, type=t))
 
     def set_type(self, e: N.Expr, t: T.KrlType) -> T.KrlType:
         (e.ann or e.annotate()).type = t
@@ -737,8 +772,7 @@ class Checker:
     def e_EnumLit(self, e: N.EnumLit, sc: Scope, expected) -> T.KrlType:
         if isinstance(expected, T.Enum):
             if expected.values and e.name.upper() not in expected.values:
-                self.sink.at(e.span, "W205" if expected.soft else "E205",
-                             f"#{e.name} is not a value of {expected.name}")
+                self.sink.at(e.span, *(W205 if expected.soft else E205)(name=e.name, enum=expected.name))
                 return self.set_type(e, T.UNKNOWN)
             return self.set_type(e, expected)
         return self.set_type(e, T.EnumLitType(e.name))
@@ -757,11 +791,10 @@ class Checker:
             ft = bt.field_type(e.name)
             if ft is None:
                 if bt.fields:
-                    self.sink.at(e.span, "W108" if bt.soft else "E108",
-                                 f"{bt.name} has no component '{e.name}'")
+                    self.sink.at(e.span, *(W108 if bt.soft else E108)(struc=bt.name, name=e.name))
                 return self.set_type(e, T.UNKNOWN)
             return self.set_type(e, ft)
-        self.sink.at(e.span, "E108", f"'.{e.name}' applied to {bt}, which is not a structure")
+        self.sink.at(e.span, *E108("not_struc", name=e.name, type=bt))
         return self.set_type(e, T.UNKNOWN)
 
     def e_Call(self, e: N.Call, sc: Scope, expected) -> T.KrlType:
@@ -799,27 +832,27 @@ class Checker:
                 continue
             if it == T.REAL:
                 continue  # converted like an assignment to INT
-            self.sink.at(i.span, "E211", f"array index of type {it}; indices are INT")
+            self.sink.at(i.span, *E211(type=it))
         if bt is T.UNKNOWN:
             return self.set_type(e, T.UNKNOWN)
         if not isinstance(bt, T.Array):
-            self.sink.at(e.span, "E109", f"'{_show(e.base)}' is {bt}, not an array")
+            self.sink.at(e.span, *E109("not_array_type", name=_show(e.base), type=bt))
             return self.set_type(e, T.UNKNOWN)
         n = len(bt.dims)
         if all(i is None for i in e.indices) and (len(e.indices) == n or e.indices == [None]):
             e.annotate().extra["whole_array"] = True
             return self.set_type(e, bt)
         if len(e.indices) != n:
-            self.sink.at(e.span, "E109", f"'{_show(e.base)}' has {n} dimension(s), {len(e.indices)} given")
+            self.sink.at(e.span, *E109("dims", name=_show(e.base), have=n, given=len(e.indices)))
             return self.set_type(e, T.UNKNOWN)
         for i, size in zip(e.indices, bt.dims):
             if isinstance(i, N.IntLit) and size and not 1 <= i.value <= size:
-                self.sink.at(i.span, "E110", f"index {i.value} is outside 1..{size}")
+                self.sink.at(i.span, *E110(index=i.value, size=size))
         if e.indices[-1] is None and all(i is not None for i in e.indices[:-1]):
             e.annotate().extra["row"] = True
             return self.set_type(e, T.Array(bt.elem, (bt.dims[-1],)))
         if any(i is None for i in e.indices):
-            self.sink.at(e.span, "E109", "only the last index may be left out")
+            self.sink.at(e.span, *E109("last_only"))
             return self.set_type(e, T.UNKNOWN)
         return self.set_type(e, bt.elem)
 
@@ -838,7 +871,7 @@ class Checker:
         elif e.op == "B_NOT":
             if t in (T.INT, T.CHAR):
                 return T.INT
-        self.sink.at(e.span, "E203", f"{e.op} cannot be applied to {t}")
+        self.sink.at(e.span, *E203("unary", op=e.op, type=t))
         return T.UNKNOWN
 
     def binary(self, e: N.Binary, sc: Scope) -> T.KrlType:
@@ -858,7 +891,7 @@ class Checker:
             rt = self.geo_operand(e.right, sc)
             for side, t in ((e.left, lt), (e.right, rt)):
                 if t is not T.UNKNOWN and T.geometric_family(t) != "cartesian":
-                    self.sink.at(side.span, "E203", f"':' needs FRAME, POS or E6POS operands, not {t}")
+                    self.sink.at(side.span, *E203("geometric", type=t))
                     return T.UNKNOWN
             return rt
         if op in EQUALITY:
@@ -885,7 +918,7 @@ class Checker:
         elif op in ORDER:
             if lt in num and rt in num or _char_like(lt) and _char_like(rt):
                 return T.BOOL
-        self.sink.at(e.span, "E203", f"'{op}' cannot be applied to {lt} and {rt}")
+        self.sink.at(e.span, *E203(op=op, left=lt, right=rt))
         return T.BOOL if op in EQUALITY | ORDER else T.UNKNOWN
 
     def comparable(self, a: T.KrlType, b: T.KrlType) -> bool:
@@ -928,16 +961,15 @@ class Checker:
         if sig is None:
             return T.UNKNOWN
         if not statement and not sig.is_function:
-            self.sink.at(c.span, "E304", f"procedure '{c.name}' has no value")
+            self.sink.at(c.span, *E304(name=c.name))
         elif (statement and sig.is_function and sig.returns is not T.UNKNOWN
               and isinstance(sym.decl, (N.Routine, N.ExtDecl))):
             # 2.4: a function is called only inside an expression. Only for functions the
             # program declares: KUKA documents built-ins such as CAST_TO as statements, which
             # the tables give a BOOL value
-            self.sink.at(c.span, "E304", f"function '{c.name}' called as a statement; use its value "
-                         f"(x = {c.name}(...))")
+            self.sink.at(c.span, *E304("statement", name=c.name))
         if len(c.args) > len(sig.params) and not sig.varargs:
-            self.sink.at(c.span, "E301", f"'{c.name}' takes {len(sig.params)} argument(s), {len(c.args)} given")
+            self.sink.at(c.span, *E301(name=c.name, params=len(sig.params), given=len(c.args)))
         for i, a in enumerate(c.args):
             if a is None:
                 continue
@@ -948,7 +980,7 @@ class Checker:
             if p.mode == "OUT":
                 if not N.is_lvalue(a):
                     self.expr(a, sc, expected=p.type)
-                    self.sink.at(a.span, "E302", f"argument {i + 1} of '{c.name}' is :OUT and must be a variable")
+                    self.sink.at(a.span, *E302(n=i + 1, name=c.name))
                     continue
             if isinstance(a, N.Aggregate):
                 self.aggregate(a, sc, p.type)
@@ -956,7 +988,7 @@ class Checker:
             at = self.expr(a, sc, expected=p.type)
             got = T.param_compatible(p.type, at, p.mode or "IN")
             if not got.ok:
-                self.sink.at(a.span, "E303", f"argument {i + 1} of '{c.name}': {got.reason}")
+                self.sink.at(a.span, *E303(n=i + 1, name=c.name, reason=got.reason))
         return sig.returns if sig.returns is not None else T.VOID
 
     # ---------------------------------------------------------------- helpers

@@ -28,52 +28,114 @@ import re
 from dataclasses import dataclass, field
 
 from krl.diagnostics import DiagnosticSink, Note
+from krl.semantics.builtins import load_builtins
+from krl.diagnostics.codes import E101, E105, E106, W101, W105, W106, W107
 
 # kind -> (error code, warning code, noun)
 KINDS = {
-    "name": ("E101", "W101", "name"),
-    "type": ("E105", "W105", "type"),
-    "routine": ("E106", "W106", "routine"),
-    "sysvar": ("W107", "W107", "system variable"),
+    "name": (E101, W101, "name"),
+    "type": (E105, W105, "type"),
+    "routine": (E106, W106, "routine"),
+    "sysvar": (W107, W107, "system variable"),      # always a warning: _why names the controller
 }
 
 _FOLD = re.compile(r"^\s*;\s*FOLD\b(.*)$", re.IGNORECASE)
 _ENDFOLD = re.compile(r"^\s*;\s*ENDFOLD\b", re.IGNORECASE)
+#: the module a KUKA inline form names in its opening comment: ``%MKUKATPBASIS`` (KSS 5 to 8's
+#: form header ``;%{PE}%R 8.3.31,%MKUKATPBASIS,%CMOVE,%VPTP,%P ...``)
+FOLD_MODULE = re.compile(r"%M([A-Z][A-Z0-9_]*)", re.IGNORECASE)
+#: the editor markers of a fold's opening comment: ``%{PE}`` (an inline form), ``%{P}``,
+#: ``%{E}``, ``%{SE}`` (KUKA's folds of older forms and of technology packages; with a module)
+_MARKER = re.compile(r"%\{([A-Z]+)\}", re.IGNORECASE)
+#: KSS 8's forms name their provider in a hidden parameter fold: ``;Params IlfProvider=...``
+FOLD_PROVIDER = re.compile(r"^\s*;\s*Params\s+IlfProvider\s*=\s*([A-Za-z0-9_.]+)", re.IGNORECASE)
 
 
-def template_lines(text: str) -> tuple[frozenset[int], frozenset[int]]:
-    """(INI-fold lines, inline-form lines) of a KRL text, 1-based.
+def fold_opening(line: str) -> str | None:
+    """The opening comment of a ``;FOLD`` line (what follows FOLD: the title, then KUKA's
+    markers after a second ``;``), or None for any other line."""
+    m = _FOLD.match(line) if ";" in line else None
+    return m.group(1) if m else None
+
+
+def template_lines(text: str) -> tuple[dict[int, str], dict[int, str]]:
+    """(INI-fold lines, inline-form lines) of a KRL text: line (1-based) -> what wrote it.
 
     INI-fold lines lie inside a fold titled ``INI`` or ``<WORD> INI``/``INIT`` (``BASISTECH
     INI``, ``SPOTTECH INI``, ``AUTOEXT INIT``: the template and the technology packages write
-    them) and not inside a ``USER INI`` fold (the programmer's part). Inline-form lines lie inside
-    a fold whose opening comment carries KUKA's editor marker ``%{PE}`` (an inline form written
-    by a KUKA or package form provider) and outside an INI fold."""
-    ini: set[int] = set()
-    inline: set[int] = set()
-    stack: list[str] = []
+    them) and not inside a ``USER INI`` fold (the programmer's part); each maps to the title of
+    its innermost such fold (``SPOTTECH INI``). Inline-form lines lie inside a fold whose
+    opening comment carries KUKA's editor marker ``%{PE}``, or another marker (``%{P}``,
+    ``%{E}``, ``%{SE}``) with the module of a form provider (``%MKUKATPGRP``), and outside an
+    INI fold; each maps to the module its form names (``KUKATPBASIS``; a KSS 8 form's
+    ``IlfProvider`` in its parameter fold, ``GripperTech.GripperSet``), or "" when it names
+    none."""
+    ini: dict[int, str] = {}
+    inline: dict[int, str] = {}
+    stack: list[list[str]] = []         # [kind, label] of each open fold
     for no, line in enumerate(text.splitlines(), 1):
         m = _FOLD.match(line) if ";" in line else None
         if m:
             rest = m.group(1)
             title = rest.split(";", 1)[0].strip().upper()
+            module = FOLD_MODULE.search(rest)
+            marker = _MARKER.search(rest)
             if title.startswith("USER"):
-                stack.append("user")
+                stack.append(["user", ""])
             elif title == "INI" or title.endswith((" INI", " INIT")) or title == "INIT":
-                stack.append("ini")
-            elif "%{PE}" in rest.upper():
-                stack.append("inline")
+                stack.append(["ini", title])
+            elif marker is not None and (marker.group(1).upper() == "PE" or module is not None) \
+                    and marker.group(1).upper() != "H":
+                stack.append(["inline", module.group(1).upper() if module else ""])
             else:
-                stack.append("")
+                stack.append(["", ""])
+        elif stack and ";" in line:
+            p = FOLD_PROVIDER.match(line)
+            if p is not None:
+                form = _innermost(stack)
+                if form is not None and form[0] == "inline" and not form[1]:
+                    form[1] = p.group(1)
         if stack:
-            where = _innermost(stack)
-            if where == "ini":
-                ini.add(no)
-            elif where == "inline":
-                inline.add(no)
+            form = _innermost(stack)
+            if form is not None and form[0] == "ini":
+                ini[no] = form[1]
+            elif form is not None:
+                inline[no] = form[1]
         if not m and stack and ";" in line and _ENDFOLD.match(line):
             stack.pop()
-    return frozenset(ini), frozenset(inline)
+    return ini, inline
+
+
+def fold_evidence(template, line: int, kind: str) -> str:
+    """Why a use on `line` says installed software declares the name ('name', 'type',
+    'routine', 'sysvar' `kind`), from the file's :func:`template_lines` (None: none): the
+    template's INI fold (any kind), a KUKA inline form (a routine or a type: the points and
+    data sets a form names are the program's), naming the fold or the form's module; else ""."""
+    if template is None:
+        return ""
+    ini, inline = template
+    title = ini.get(line)
+    if title is not None:
+        fold = "INI fold" if title == "INI" else f"INI fold {title}"
+        return f"the template's {fold} uses it (KUKA's template and technology packages write that fold)"
+    module = inline.get(line)
+    if module is not None and kind in ("routine", "type"):
+        return f"a KUKA inline form ({module}) uses it" if module else "a KUKA inline form (;FOLD ... ;%{PE}) uses it"
+    return ""
+
+
+def provided_routine(name: str, kuka_file: str = "") -> str:
+    """Why KUKA's software provides the routine `name` that the checker resolves but whose body
+    no file of the program holds, or "": a routine of the platform tables (krl/semantics/data:
+    KSS's system functions, ``IS_KEY_PRESSED`` of ``$operate.dat``), or a routine that an
+    ``EXT`` of a KUKA system file declares (`kuka_file`: that file, "" when its declaration is
+    in none; ``EXT P00 (...)`` of ``$config.dat``). An ``EXT`` in the program's own files
+    promises a module the program lacks: "" (its error at run time, "routine NAME not found")."""
+    if name.upper() in load_builtins().routines:
+        return "a routine of the platform tables (krl/semantics/data)"
+    if kuka_file:
+        return f"declared by an EXT of KUKA's system file {kuka_file.replace(chr(92), '/').rsplit('/', 1)[-1]}"
+    return ""
 
 
 def user_fold_lines(text: str) -> frozenset[int]:
@@ -92,13 +154,13 @@ def user_fold_lines(text: str) -> frozenset[int]:
     return frozenset(out)
 
 
-def _innermost(stack: list[str]) -> str:
-    for kind in reversed(stack):
-        if kind == "user":
-            return ""
-        if kind in ("ini", "inline"):
-            return kind
-    return ""
+def _innermost(stack: list[list[str]]) -> list[str] | None:
+    for fold in reversed(stack):
+        if fold[0] == "user":
+            return None
+        if fold[0] in ("ini", "inline"):
+            return fold
+    return None
 
 
 @dataclass(slots=True)
@@ -107,6 +169,27 @@ class Use:
     line: int
     column: int
     evidence: str = ""       # why this use says "installed software declares it", or ""
+
+
+#: the evidence of rule 4: the only one that does not say KUKA's software declares the name
+UNPARSED = "a file of this backup that does not parse mentions it"
+
+
+@dataclass(slots=True)
+class Outside:
+    """One name the checker found outside the backup (a W101/W105/W106/W107): its `kind`
+    ('name', 'type', 'routine', 'sysvar'), its spelling at the first use, `why` (the evidence,
+    as the warning says it), and its `uses` in the order they were recorded. The run's
+    stand-ins for KUKA's software (interp/runtime/kss.py) are made for exactly these names."""
+
+    kind: str
+    name: str
+    why: str
+    uses: list
+    #: True when the evidence says KUKA's software declares it (rules 1-3 and 5 of the module
+    #: docstring); False when the only evidence is a file of the program that does not parse
+    #: mentioning it (rule 4): the program's own declaration, perhaps, that the check cannot read
+    kuka: bool = True
 
 
 @dataclass
@@ -142,22 +225,33 @@ class Unresolved:
         if kind == "sysvar":
             return "a system variable of the controller that the platform tables do not list"
         if self.maybe_declared is not None and self.maybe_declared(name):
-            return "a file of this backup that does not parse mentions it"
+            return UNPARSED
         return ""
+
+    def classify(self) -> dict[tuple[str, str], Outside]:
+        """(kind, UPPER name) -> :class:`Outside`, for every recorded name that is outside the
+        backup (the module docstring's rule, the one the warnings report); the other names are
+        the program's errors. The one decision on what KUKA's software provides: the checker
+        reports it (:meth:`finish`), the run stands in for each name whose :attr:`Outside.kuka`
+        says KUKA's software declares it (interp/runtime/kss.py)."""
+        out: dict[tuple[str, str], Outside] = {}
+        for key, (name, uses) in self.uses.items():
+            why = self._why(key[0], name, uses)
+            if why:
+                out[key] = Outside(key[0], name, why, uses, why != UNPARSED)
+        return out
 
     def finish(self, sink: DiagnosticSink) -> None:
         """Report every recorded name: one warning per outside name, else an error per use line."""
-        for (kind, _key), (name, uses) in self.uses.items():
+        outside = self.classify()
+        for (kind, key), (name, uses) in self.uses.items():
             err, warn, noun = KINDS[kind]
-            why = self._why(kind, name, uses)
-            shown = f"'{name}'" if kind != "routine" else f"routine '{name}'"
-            if kind == "type":
-                shown = f"type '{name}'"
+            found = outside.get((kind, key))
+            why = found.why if found is not None else ""
             if not why:
                 for u in uses:
-                    msg = (f"unknown type '{name}'" if kind == "type" else f"{shown} is not declared")
                     helps = {"name": "declare it in the routine or in the module's data list (.dat)"}
-                    sink.add(u.path, u.line, u.column, err, msg, help=helps.get(kind, ""))
+                    sink.add(u.path, u.line, u.column, *err(name=name), help=helps.get(kind, ""))
                 continue
             uses = sorted(uses, key=lambda u: (u.path, u.line, u.column))
             first = uses[0]
@@ -171,8 +265,7 @@ class Unresolved:
                 if u.path not in seen_files and len(notes) < 3:
                     seen_files.add(u.path)
                     notes.append(Note(u.path, u.line, u.column, f"also used here"))
-            sink.add(first.path, first.line, first.column, warn,
-                     f"{noun} '{name}' is not declared in this backup ({times}; first here): {why}",
+            sink.add(first.path, first.line, first.column, *warn(noun=noun, name=name, times=times, why=why),
                      notes=notes,
                      help="the controller must have the software that declares it installed; "
                           "if it does not, this is an error")

@@ -32,9 +32,9 @@ of any run; the interpreters (interp/) allocate storage for them and never look 
   routine whose file does not parse (the checker does not check such bodies) is resolved
   with the same scopes (``Scope.lookup``).
 * every Call gets a :class:`Callee` (``call.ann.callee``): a ROUTINE of the program (the
-  module and Routine it runs), a NATIVE built-in of the tables (``native``: its name there,
-  the key of the runtime's implementation), or a STUB (nothing implements it: the run-time
-  stub policy);
+  module and Routine it runs), a NATIVE built-in of the tables (``native``: its implementation
+  from ``Workspace.natives``, linked once here), or a STUB (nothing implements it: the
+  run-time stand-in policy);
 * every Aggregate with a TYPE prefix gets the STRUC it names (``aggregate.ann.struc``);
 * every GOTO gets its ``target``, the Label it jumps to: the label of that name in the nearest
   block around the GOTO that holds one (the last one in that block), else None (the run-time
@@ -55,6 +55,7 @@ The back ends read these facts and never a name's spelling.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 from krl.ast import nodes as N
@@ -98,15 +99,17 @@ class Storage:
 @dataclass(slots=True, eq=False)
 class Callee:
     """What a call runs. ``kind`` ROUTINE: ``routine`` (a Routine of the program) in module
-    ``owner`` (index in ``Workspace.units``); NATIVE: the built-in routine of the tables named
-    ``native`` (upper case: the key of the runtime's implementation, when it has one); STUB:
-    nothing implements it (a technology package absent from the backup: the run-time stub
-    policy). ``name`` as called (for messages and traces)."""
+    ``owner`` (index in ``Workspace.units``); NATIVE: a built-in routine of the tables, and
+    ``native`` its implementation ``fn(rt, args)``, linked here once from the workspace's
+    ``natives`` (the runtime's registry, interp/runtime/natives, gives it for a run; None when
+    the simulator has none, or for a check alone); STUB: nothing implements it (a technology
+    package absent from the backup). A call whose ``native`` is None goes to the run-time
+    stand-in policy. ``name`` as called (for messages and traces)."""
     name: str
     kind: int = STUB
     owner: int = -1
     routine: N.Routine | None = None
-    native: str = ""
+    native: Callable | None = None
 
     def __repr__(self) -> str:
         return f"Callee({CALLEE_NAMES[self.kind]} {self.name})"
@@ -219,6 +222,7 @@ class Resolver:
         self.system_index: dict[str, int] = {}
         self.unit_of: dict[int, int] = {}                    # id(Routine) -> unit index
         self.native_names = set(self.system.routines)
+        self.natives = ws.natives or {}     # upper-case name -> implementation (a run's workspace)
         tables = load_builtins()
         self.cyclic = frozenset(k for k, info in tables.sysvars.items() if info.cyclic)
 
@@ -370,9 +374,9 @@ class Resolver:
                 callee.owner = self.unit_of.get(id(decl), -1)
         if callee.kind != ROUTINE and c.name.upper() in self.native_names:
             # a built-in of the tables (also behind an EXT declaration nothing implements:
-            # the controller's own routine runs)
+            # the controller's own routine runs), linked to its implementation
             callee.kind = NATIVE
-            callee.native = c.name.upper()
+            callee.native = self.natives.get(c.name.upper())
         c.annotate().callee = callee
 
     def expr(self, e, scope, local, unit: int) -> None:

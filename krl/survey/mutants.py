@@ -49,6 +49,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from krl.ast import nodes as N
+from krl.diagnostics.codes import E101, E102, E106, E201, E203, E204, E208, E301, E303, E304, E401, E403, E404, E501, E502
 from krl.semantics import types as T
 from krl.semantics.builtins import load_builtins
 from krl.semantics.outside import template_lines
@@ -65,14 +66,14 @@ KINDS = ("misspelled_variable", "wrong_argument_count", "real_into_enum", "write
          "exit_outside_loop", "return_value_in_procedure", "operator_type_mismatch",
          "wait_for_not_bool", "function_as_statement", "argument_type_mismatch",
          "for_counter_not_int")
-EXPECTED = {"misspelled_variable": "E101", "wrong_argument_count": "E301", "real_into_enum": "E201",
-            "write_to_input": "E501", "undeclared_routine": "E106", "aggregate_type_mismatch": "E201",
-            "assignment_to_const": "E502", "if_condition_not_bool": "E204",
-            "goto_missing_label": "E401", "duplicate_declaration": "E102",
-            "exit_outside_loop": "E403", "return_value_in_procedure": "E404",
-            "operator_type_mismatch": "E203", "wait_for_not_bool": "E204",
-            "function_as_statement": "E304", "argument_type_mismatch": "E303",
-            "for_counter_not_int": "E208"}
+EXPECTED = {"misspelled_variable": E101, "wrong_argument_count": E301, "real_into_enum": E201,
+            "write_to_input": E501, "undeclared_routine": E106, "aggregate_type_mismatch": E201,
+            "assignment_to_const": E502, "if_condition_not_bool": E204,
+            "goto_missing_label": E401, "duplicate_declaration": E102,
+            "exit_outside_loop": E403, "return_value_in_procedure": E404,
+            "operator_type_mismatch": E203, "wait_for_not_bool": E204,
+            "function_as_statement": E304, "argument_type_mismatch": E303,
+            "for_counter_not_int": E208}
 
 
 @dataclass

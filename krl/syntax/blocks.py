@@ -23,6 +23,7 @@ from dataclasses import dataclass, field
 
 from antlr4 import Token
 
+from krl.diagnostics.codes import E010, E011, E018, E019
 from krl.limits import MAX_EXPRESSION_TERMS, MAX_NESTING
 
 # opener -> its closer; middle keywords of a block
@@ -160,21 +161,20 @@ def _line_limits(line: Line, block_depth: int) -> Finding | None:
             if w in _BINARY:
                 terms += 1
                 if terms > MAX_EXPRESSION_TERMS:
-                    return Finding("E019", f"expression too long: more than {MAX_EXPRESSION_TERMS} "
-                                   "terms in one statement", line.number, line.toks[0].column,
+                    return Finding(*E019(limit=MAX_EXPRESSION_TERMS), line.number, line.toks[0].column,
                                    help="split it with intermediate variables")
         prev = w
     return None
 
 
 def _wrong_closer(kw: str, tok: Tok, top: _Open) -> Finding:
-    return Finding("E011", f"{kw} does not close the {top.keyword} at line {top.line}; use {CLOSER[top.keyword]}",
+    return Finding(*E011("wrong", kw=kw, opener=top.keyword, line=top.line, closer=CLOSER[top.keyword]),
                    tok.line, tok.column, tok.column + len(tok.text),
                    (top.line, top.column, f"the {top.keyword} opened here"), closer_line=tok.line)
 
 
 def _too_deep(t: Tok) -> Finding:
-    return Finding("E018", f"nesting too deep: more than {MAX_NESTING} levels of blocks and brackets",
+    return Finding(*E018(limit=MAX_NESTING),
                    t.line, t.column, t.column + max(len(t.text), 1),
                    help="split the routine or the expression into smaller parts")
 
@@ -197,7 +197,7 @@ def scan(lines: list[Line], limits_only: bool = False) -> BlockScan:
             note = (closer_tok.line, closer_tok.column, f"{closer_tok.text.upper()} reached here "
                                                         f"while the {o.keyword} is open")
             where = f"line {closer_tok.line}"
-        res.blocks.append(Finding("E010", f"missing {closer} for the {o.keyword} at line {o.line}",
+        res.blocks.append(Finding(*E010(closer=closer, opener=o.keyword, line=o.line),
                                   o.line, o.column, o.end_column, note,
                                   f"add {closer} before {where}",
                                   closer_tok.line if closer_tok is not None else -1))
@@ -208,7 +208,7 @@ def scan(lines: list[Line], limits_only: bool = False) -> BlockScan:
         kw_tok = line.toks[1] if first.word == "GLOBAL" and len(line.toks) > 1 else first
         if kw == "END" and len(line.toks) > 1 and "END" + line.toks[1].word in OPENER_OF:
             kw = "END" + line.toks[1].word  # `END IF`: read as the closer it means
-            res.blocks.append(Finding("E011", f"`END {line.toks[1].text}` is written {kw}, in one word",
+            res.blocks.append(Finding(*E011("two_words", word=line.toks[1].text, kw=kw),
                                       line.number, first.column, line.toks[1].column + len(line.toks[1].text),
                                       closer_line=line.number))
         if kw in CLOSER:
@@ -237,20 +237,20 @@ def scan(lines: list[Line], limits_only: bool = False) -> BlockScan:
             elif stack and stack[-1].keyword not in ROUTINES:
                 res.blocks.append(_wrong_closer(kw, kw_tok, stack.pop()))
             else:
-                res.blocks.append(Finding("E011", f"{kw} without an open {opener}", line.number,
+                res.blocks.append(Finding(*E011(kw=kw, opener=opener), line.number,
                                           kw_tok.column, kw_tok.column + len(kw_tok.text),
                                           closer_line=line.number))
         elif kw in MIDDLE:
             opener = MIDDLE[kw]
             inner = next((o for o in reversed(stack) if o.keyword not in ROUTINES), None)
             if inner is None or inner.keyword != opener:
-                res.blocks.append(Finding("E011", f"{kw} outside an {opener} block" if opener == "IF"
-                                          else f"{kw} outside a {opener} block", line.number,
+                res.blocks.append(Finding(*E011("outside", kw=kw, article="an" if opener == "IF" else "a",
+                                                opener=opener), line.number,
                                           kw_tok.column, kw_tok.column + len(kw_tok.text),
                                           closer_line=line.number))
             elif kw == "ELSE":
                 if inner.seen_else:
-                    res.blocks.append(Finding("E011", f"second ELSE in the IF at line {inner.line}",
+                    res.blocks.append(Finding(*E011("second_else", line=inner.line),
                                               line.number, kw_tok.column, kw_tok.column + 4,
                                               (inner.line, inner.column, "the IF opened here"),
                                               closer_line=line.number))

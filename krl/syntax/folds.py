@@ -36,6 +36,7 @@ import re
 from dataclasses import dataclass, field
 
 from krl.diagnostics import Diagnostic, Note
+from krl.diagnostics.codes import W021
 
 _MARKER = re.compile(r";[ \t]*(END)?FOLD(?![A-Za-z0-9_$])", re.I)
 _OPEN = re.compile(r"[ \t\f]*(?:GLOBAL[ \t]+)?(DEF|DEFFCT|DEFDAT)[ \t]+([A-Za-z_$][A-Za-z0-9_$]*)", re.I)
@@ -180,7 +181,7 @@ def fold_diagnostics(path: str, text: str) -> list[Diagnostic]:
         return name, end
 
     for number, col, end_col in found.stray:
-        out.append(Diagnostic(path, number, col, "W021", "`;ENDFOLD` without an open `;FOLD`",
+        out.append(Diagnostic(path, number, col, *W021(),
                               end_line=number, end_column=end_col,
                               help="remove it, or add the `;FOLD` it closes"))
     for fold, o_ctx in found.crossing:
@@ -190,23 +191,23 @@ def fold_diagnostics(path: str, text: str) -> list[Diagnostic]:
         if end is not None:
             what = f"{end[0]} ends here"
             notes.append(Note(path, end[1], 1, what))
-            message = f"`;FOLD` closed by the `;ENDFOLD` at line {c_line}, after the end of {end[0]} (line {end[1]})"
+            warned = W021("after_end", line=c_line, routine=end[0], end=end[1])
         else:
-            message = f"`;FOLD` outside any routine closed by the `;ENDFOLD` at line {c_line}, inside a routine"
+            warned = W021("into_routine", line=c_line)
         notes.append(Note(path, c_line, c_col, "the `;ENDFOLD` that closes it"))
-        out.append(Diagnostic(path, fold.line, fold.column, "W021", message, end_line=fold.line,
+        out.append(Diagnostic(path, fold.line, fold.column, *warned, end_line=fold.line,
                               end_column=fold.marker_end, notes=notes, help="keep each fold inside one routine"))
     for o_line, o_col, o_end, o_ctx in found.unclosed:
         end = routine_end(o_ctx)
         if end is not None:
-            message = f"`;FOLD` never closed (it opens in {end[0]}, which ends at line {end[1]})"
+            warned = W021("unclosed", routine=end[0], end=end[1])
             note = Note(path, end[1], 1, f"{end[0]} ends here")
             help_ = f"add `;ENDFOLD` before line {end[1]}"
         else:
-            message = f"`;FOLD` never closed before the end of the file (line {last})"
+            warned = W021("unclosed_file", line=last)
             note = Note(path, last, 1, "the file ends here")
             help_ = "add the missing `;ENDFOLD`"
-        out.append(Diagnostic(path, o_line, o_col, "W021", message, end_line=o_line, end_column=o_end,
+        out.append(Diagnostic(path, o_line, o_col, *warned, end_line=o_line, end_column=o_end,
                               notes=[note], help=help_))
     out.sort(key=lambda d: (d.line, d.column))
     return out

@@ -28,6 +28,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from krl.diagnostics import Diagnostic, Note
+from krl.diagnostics.codes import E001, E002, E012, E013, E014, E015, E016, E017, E018, E020
 from krl.source import read_source
 from krl.terminal import clip
 from krl.syntax.blocks import CLOSER, OPENER_OF, MIDDLE, BlockScan, lines_of, scan
@@ -168,7 +169,8 @@ def syntax_diagnostics(result, text: str, bundle=None, tokens: list | None = Non
     out: list[Diagnostic] = []
     for e in issues:
         if e.kind == "limit":
-            out.append(Diagnostic(path, e.line, e.column + 1, e.offending_type or "E018", e.message))
+            # a limit the block scan found before parsing (krl/syntax/parse.py): its code and words
+            out.append(Diagnostic(path, e.line, e.column + 1, e.offending_type or E018, e.message))
     if out:
         return out
     try:
@@ -191,7 +193,7 @@ def syntax_diagnostics(result, text: str, bundle=None, tokens: list | None = Non
         try:
             d = _describe(path, e, f)
         except Exception:  # noqa: BLE001
-            d = Diagnostic(path, e.line, e.column + 1, "E002", clip(e.message))
+            d = Diagnostic(path, e.line, e.column + 1, *E002(detail=clip(e.message)))
         out.append(d)
     out.sort(key=lambda d: (d.line, d.column))
     return out
@@ -223,28 +225,27 @@ def _describe(path: str, e, f: _File | None) -> Diagnostic:
             after = e.message.partition("at: '")[2][1:2].upper()
             ch = "'" + after if after in ("H", "B") else ch
         if ch in _LEXER_HINTS:
-            code = "E015" if ch == '"' else "E017"
-            return diag(code, _LEXER_HINTS[ch], end_column=col + 1)
-        return diag("E017", f"{q(ch) if ch.isprintable() and ch.strip() else repr(ch)} is not a KRL character here",
-                    end_column=col + 1)
+            hint = _LEXER_HINTS[ch]
+            return diag(*(E015(detail=hint) if ch == '"' else E017("hint", detail=hint)), end_column=col + 1)
+        return diag(*E017(char=q(ch) if ch.isprintable() and ch.strip() else repr(ch)), end_column=col + 1)
     upper = tok.upper()
     prev = shape[-2] if len(shape) >= 2 else ""
     # `==` / `=` confused
     if tok == "==" and len(shape) >= 2 and kw not in ("IF", "WHILE", "UNTIL", "WAIT"):
-        return diag("E013", "`==` compares; to assign use `=`")
+        return diag(*E013())
     if tok in ("<>", "<", ">", "<=", ">=") and len(shape) == 2 and shape[0] in ("id", "$sys"):
-        return diag("E013", f"{q(tok)} compares; a statement cannot be a comparison (to assign use `=`)")
+        return diag(*E013("comparison", op=q(tok)))
     if tok == "=" and kw in ("IF", "WHILE", "UNTIL", "SWITCH", "CASE") or (
             tok == "=" and shape[:2] == ["WAIT", "FOR"]):
-        return diag("E013", "`=` assigns; to compare use `==`")
+        return diag(*E013("condition"))
     if tok == "=" and prev == ":":
-        return diag("E013", "`:=` is not KRL; to assign use `=`", column=col - 1)
+        return diag(*E013("pascal"), column=col - 1)
     if tok == "+" and len(shape) == 2 and shape[0] in ("id", "$sys"):
-        return diag("E013", "`++` and `+=` are not KRL; write `n = n + 1`")
+        return diag(*E013("increment"))
     # declarations after statements
     if upper in _DECL and len(shape) == 1 and ("a statement" in expected_phrase(e.expected)
                                                 or exp & {"ENDSPLINE", "SPL", "SLIN"}):
-        return diag("E014", "declarations must come before the first statement",
+        return diag(*E014(),
                     help="move the declaration up, above the routine's first statement")
     # unclosed / unbalanced brackets on the line
     if line is not None:
@@ -254,13 +255,13 @@ def _describe(path: str, e, f: _File | None) -> Diagnostic:
                                                end_line=b.line, end_column=b.column + 1)
     # a failed semantic predicate of the grammar: its message is already in KRL words
     if " takes " in e.message and not e.message.startswith(("extraneous", "mismatched", "no viable")):
-        return diag("E012", e.message.split(" ", 2)[2] if e.message.startswith("rule ") else e.message)
+        return diag(*E012(detail=e.message.split(" ", 2)[2] if e.message.startswith("rule ") else e.message))
     # the second word of a statement
     position = len(shape) - 1 - (1 if shape and shape[0] == "GLOBAL" else 0)
     if kw in _SECOND and position == 1 and upper not in _SECOND[kw]:
         words = _SECOND[kw]
         listed = words[0] if len(words) == 1 else ", ".join(words[:-1]) + " or " + words[-1]
-        return diag("E012", f"{kw} needs {listed}, found {_shown_token(e)}")
+        return diag(*E012("second_word", kw=kw, listed=listed, found=_shown_token(e)))
     # a keyword the statement needs
     needs = _NEEDS.get(kw, ())
     missing = [k for k in needs if k in exp and k != upper]
@@ -268,24 +269,25 @@ def _describe(path: str, e, f: _File | None) -> Diagnostic:
         k = missing[0]
         what = _WHAT.get((kw, k), _WHAT.get(k, ""))
         if kw == "WAIT" and set(missing) >= {"FOR", "SEC"}:
-            return diag("E012", "WAIT needs FOR and a condition, or SEC and a time")
+            return diag(*E012("wait"))
         found = "" if tok in ("<EOL>", "") else f", found {_shown_token(e)}"
-        return diag("E012", f"{kw} needs {k if k.isalpha() else q(k)}" + (f" {what}" if what else "") + found)
+        return diag(*E012("keyword", kw=kw, keyword=k if k.isalpha() else q(k), what=f" {what}" if what else "",
+                          found=found))
     if tok == "<EOF>":
         phrase = expected_phrase(e.expected)
-        return diag("E020", "unexpected end of file" + (f"; expected {phrase}" if phrase else ""))
+        return diag(*E020(expected=f"; expected {phrase}" if phrase else ""))
     # text after a complete statement
     if exp <= {"NEWLINE", "<EOF>"} and exp and tok not in ("<EOL>",):
         if kw in _BARE and len(shape) >= 2 and shape[0] == kw:
-            return diag("E016", f"{_shown_token(e)} after {kw}: {kw} stands alone on its line")
-        return diag("E016", f"{_shown_token(e)} after the end of the statement; KRL has one statement per line")
+            return diag(*E016("alone", token=_shown_token(e), kw=kw))
+        return diag(*E016(token=_shown_token(e)))
     # two words written as one: INTERRUPT5, GLOBALSTRUC (the lexer reads one name)
     if line is not None and line.toks and line.toks[0].word == "IDENTIFIER" and e.line == line.toks[0].line:
         glued = _glued(line.toks[0].text)
         if glued is not None:
             t = line.toks[0]
-            return Diagnostic(path, e.line, t.column, "E002",
-                              clip(f"{q(t.text)} is read as one name; write {q(glued[0] + ' ' + glued[1])}"),
+            code, message = E002("glued", text=q(t.text), fix=q(glued[0] + ' ' + glued[1]))
+            return Diagnostic(path, e.line, t.column, code, clip(message),
                               end_line=e.line, end_column=t.column + len(t.text),
                               help=f"KRL needs a space after {glued[0]}")
     # a bare name on its own line: a call without parentheses (withdrawn, grammar/CHANGES.md) or
@@ -293,8 +295,8 @@ def _describe(path: str, e, f: _File | None) -> Diagnostic:
     if (tok == "<EOL>" and line is not None and len(line.toks) == 1 and shape[:1] == ["id"]
             and line.toks[0].word == "IDENTIFIER"):
         t = line.toks[0]
-        return Diagnostic(path, e.line, t.column, "E012",
-                          clip(f"{q(t.text)} alone is not a statement; to call the routine write {q(t.text + '()')}"),
+        code, message = E012("bare_name", name=q(t.text), call=q(t.text + '()'))
+        return Diagnostic(path, e.line, t.column, code, clip(message),
                           end_line=e.line, end_column=t.column + len(t.text),
                           help=f"if it is a note (like TODO), make it a comment: `;{t.text}`")
     # a missing expression
@@ -302,15 +304,14 @@ def _describe(path: str, e, f: _File | None) -> Diagnostic:
     if tok == "<EOL>":
         if phrase == "an expression" or "an expression" in phrase:
             after = q(shape[-2]) if len(shape) >= 2 and shape[-2].isupper() else "here"
-            return diag("E012", f"an expression is missing after {after}" if after != "here"
-                        else "an expression is missing here")
-        return diag("E002", "the line ends too early" + (f"; expected {phrase}" if phrase else ""))
+            return diag(*(E012("expression_after", after=after) if after != "here" else E012("expression")))
+        return diag(*E002("ends_early", expected=f"; expected {phrase}" if phrase else ""))
     if "a statement" in phrase and position > 0:
         phrase = ""  # the parser gave up on the whole line: its list is the line-start set
     after = ""
     if len(shape) >= 2 and shape[-2] not in ("id", "num", "str", "$sys", "#enum") and "…" not in shape[-2]:
         after = f" after {q(shape[-2])}"
-    return diag("E002", f"unexpected {_shown_token(e)}{after}" + (f"; expected {phrase}" if phrase else ""))
+    return diag(*E002("unexpected", token=_shown_token(e), after=after, expected=f"; expected {phrase}" if phrase else ""))
 
 
 _GLUE_KEYWORDS = sorted(_STATEMENT | _DECL | {"DEF", "DEFFCT", "DEFDAT", "DECL"}, key=len, reverse=True)
@@ -348,8 +349,8 @@ def _bracket_problem(line, e) -> Diagnostic | None:
             if stack and stack[-1].word == closing[t.word]:
                 stack.pop()
             elif t.column == limit_col:
-                return Diagnostic("", t.line, t.column, "E015",
-                                  f"{q(t.text)} without an opening {q(closing[t.word])}")
+                return Diagnostic("", t.line, t.column, *E015("no_opening", bracket=q(t.text),
+                                                               opening=q(closing[t.word])))
     unclosed = []
     for t in line.toks:
         if t.word in pairs:
@@ -358,8 +359,8 @@ def _bracket_problem(line, e) -> Diagnostic | None:
             unclosed.pop()
     if unclosed and stack and unclosed[-1] in stack:
         t = unclosed[-1]
-        return Diagnostic("", t.line, t.column, "E015",
-                          f"this {q(t.text)} is not closed; expected {q(pairs[t.word])} before {_shown_token(e)}")
+        return Diagnostic("", t.line, t.column, *E015("not_closed", bracket=q(t.text), closing=q(pairs[t.word]),
+                                                       token=_shown_token(e)))
     return None
 
 
@@ -385,5 +386,5 @@ def source_diagnostics(src, result, worded: list[Diagnostic] | None = None) -> l
     diags = worded if worded is not None else syntax_diagnostics(result, src.text)
     if not result.ok and not diags:
         detail = f" ({src.detail})" if src.detail else ""
-        diags = [Diagnostic(src.path, 1, 1, "E001", f"file not parsed: {result.status}{detail}")]
+        diags = [Diagnostic(src.path, 1, 1, *E001(why=f"{result.status}{detail}"))]
     return diags

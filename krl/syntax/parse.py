@@ -23,6 +23,7 @@ from antlr4.error.ErrorStrategy import BailErrorStrategy
 from antlr4.error.ErrorListener import ErrorListener
 from antlr4.error.Errors import ParseCancellationException
 
+from krl.diagnostics.codes import E018
 from krl.syntax.checks import may_fail, run_checks
 from krl.syntax.blocks import first_past_limit
 from krl.syntax.errors import CollectingErrorListener, LineErrorStrategy, SyntaxIssue
@@ -239,7 +240,7 @@ def result_from_raw(raw: dict, text: str, path: str, encoding: str,
 def _past_limit(path: str, encoding: str, past) -> ParseResult:
     """A file past a limit of krl/limits.py: not parsed; status "too_deep" (nesting) or
     "too_long" (expression size), with one issue (kind "limit") at the place."""
-    status = "too_deep" if past.code == "E018" else "too_long"
+    status = "too_deep" if past.code == E018 else "too_long"
     issue = SyntaxIssue(line=past.line, column=past.column - 1, message=past.message, offending="",
                         expected=[], rule_stack=[], kind="limit", offending_type=past.code)
     return ParseResult(path, False, encoding, status, [issue], None, "limit")

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import hashlib
+import os
 import json
 import shutil
 
@@ -64,3 +66,47 @@ def test_report_files(tmp_path):
     assert "057_lin_c_dis" in md and "999_pending_copy" in html and "a copy marked pending" in md
     assert (tmp_path / "plots" / "057_lin_c_dis.png").stat().st_size > 1000
     assert not (tmp_path / "plots" / "001_assign_arith.png").exists()
+
+
+class RecordingCheck:
+    """A stand-in for the fuzz property's check of one program: appends the program's hash and
+    the checking process's id to `log` and fails the programs that contain `fails_on`. A
+    module-level class, so that the worker processes receive it (pickled by reference)."""
+
+    def __init__(self, log, fails_on=None):
+        self.log, self.fails_on = log, fails_on
+
+    def __call__(self, src, stim, interps):
+        with open(self.log, "a", encoding="utf-8") as fh:
+            fh.write(hashlib.sha1((src + (stim or "")).encode()).hexdigest() + f" {os.getpid()}\n")
+        return f"tree: made to fail ({self.fails_on})" if self.fails_on and self.fails_on in src else None
+
+
+@pytest.mark.parametrize("fails_on", [None, "PULSE"])
+def test_fuzz_in_worker_processes_is_the_run_in_one(monkeypatch, tmp_path, fails_on):
+    """run_fuzz(jobs=2) checks the programs that run_fuzz(jobs=1) checks, in worker processes,
+    and ends with the same stats, failure and shrunk minimal program (the check itself replaced
+    by a recorder, so that this test is about the draws, not the interpreters)."""
+    got = {}
+    for jobs in (1, 2):
+        log = tmp_path / f"checked-{jobs}.txt"
+        monkeypatch.setattr(F, "_check_program", RecordingCheck(log, fails_on))
+        stats = F.run_fuzz(30, interps=["tree", "vm"], save_cases=False, jobs=jobs)
+        got[jobs] = stats, [line.split() for line in log.read_text().splitlines()]
+    (one, checked_one), (two, checked_two) = got[1], got[2]
+    assert one == two
+    assert one["programs"] == 30 if fails_on is None else one["failures"]
+    here = str(os.getpid())
+    assert {pid for _h, pid in checked_one} == {here}
+    if fails_on is None:
+        # the same programs as one after the other (30 draws; hypothesis may draw one text
+        # twice), each checked once, all in the workers
+        assert len(checked_one) == 30
+        assert {h for h, _ in checked_two} == {h for h, _ in checked_one}
+        assert len(checked_two) == len({h for h, _ in checked_two})
+        assert here not in {pid for _h, pid in checked_two}
+    else:
+        assert "PULSE" in one["failures"][0].split("--- minimal program ---")[1]
+        # the draws up to the failure were checked in the workers, the shrinking here, the same way
+        assert {h for h, _ in checked_one} <= {h for h, _ in checked_two}
+        assert here in {pid for _h, pid in checked_two} and len({pid for _h, pid in checked_two}) > 1

@@ -1,6 +1,7 @@
 """Many backups on Dask (issue 39): the real-programs report, `krl conformance` and `krl check` of a
 folder of backups run on a real Dask LocalCluster (two worker processes on loopback) give the
-same report as the local run, and an unreachable scheduler is a clear error, never a traceback.
+same report as the local run (and `krl conformance --jobs 2`, in worker processes of this
+machine, the same again), and an unreachable scheduler is a clear error, never a traceback.
 
 The programs are those of one small corpus backup (rawpython__kukaKRLmagic: two programs under
 R1/Program and its cell.src, whose committed cell file answers it), so the comparison covers a
@@ -67,18 +68,21 @@ def test_the_real_programs_report_on_a_local_cluster_equals_the_local_run(cluste
 def test_krl_conformance_on_a_local_cluster_writes_the_same_report(cluster, one_backup, tmp_path):
     cases = [H.load_case(H.CASES_DIR / name) for name in CASES]
     outs = {}
-    for name, scheduler in (("local", None), ("dask", cluster.scheduler_address)):
+    # in this process, in two worker processes of this machine (krl/pool.py), on the cluster
+    for name, scheduler, jobs in (("local", None, 1), ("workers", None, 2), ("dask", cluster.scheduler_address, 1)):
         # one real program (sample_program.src, 60 s simulated on both interpreters) keeps it short
         s = run_all(tmp_path / name, fuzz_n=0, corpus=SHARED_CORPUS, cases=cases, echo=lambda _m: None,
-                    scheduler=scheduler, real_limit=1)
+                    scheduler=scheduler, real_limit=1, jobs=jobs)
         outs[name] = s
     assert outs["local"]["cases"] == len(CASES) and outs["local"]["real_programs"] == 1
     assert set(outs["local"]["case_status"]) == set(CASES)
     assert list(outs["local"]["real_status"]) == ["rawpython__kukaKRLmagic/R1/Program/sample_program.src"]
     for f in ("summary.json", "report.md", "report.html"):
-        local, dask = ((tmp_path / side / f).read_text() for side in ("local", "dask"))
+        local, workers, dask = ((tmp_path / side / f).read_text() for side in ("local", "workers", "dask"))
         assert _WHEN.sub("WHEN", dask) == _WHEN.sub("WHEN", local), f
+        assert _WHEN.sub("WHEN", workers) == _WHEN.sub("WHEN", local), f
     assert json.loads((tmp_path / "dask" / "summary.json").read_text()) == outs["local"]
+    assert outs["workers"] == outs["local"]
 
 
 def test_krl_check_of_a_folder_of_backups_on_a_local_cluster_prints_the_same(cluster):

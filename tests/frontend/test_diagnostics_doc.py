@@ -1,7 +1,10 @@
 """docs/diagnostics.md documents every diagnostic code, and its examples are true.
 
-The codes are defined once, in krl/diagnostics/__init__.py (CODES). Each has a ``## CODE``
-section in docs/diagnostics.md and the doc has no section for a code that does not exist. The
+The codes are declared once, as named constants in krl/diagnostics/codes.py (severity, kind,
+message templates). Each has a ``## CODE`` section in docs/diagnostics.md and the doc has no
+section for a code that does not exist; no code is spelled as a string anywhere else in the
+project's code (an emit site names the constant), and every declared code is named by some
+emit site. The
 ``krl`` blocks of a section form one small program (the info string names the file); the
 checker run on exactly those files must report the section's code. Codes whose trigger is not
 a small text (a binary file, a generated 101-level nesting, a zip archive) are produced here by
@@ -10,8 +13,10 @@ a generator instead (W002 a symbolic link, E005 a parse that never ends); four c
 
 from __future__ import annotations
 
+import ast
 import json
 import re
+import string
 import time
 import zipfile
 from pathlib import Path
@@ -20,6 +25,7 @@ from unittest import mock
 import pytest
 
 from krl.diagnostics import CODES
+from krl.diagnostics.codes import ALL, E102
 from krl.cli.check import run_check
 from krl.workspace import check_texts, load_workspace
 import krl.workspace as workspace_mod
@@ -99,6 +105,65 @@ def test_every_code_has_a_section_and_every_section_a_code():
     documented = set(sections())
     assert documented - set(CODES) == set(), "sections for codes that do not exist"
     assert set(CODES) - documented == set(), "codes without a section in docs/diagnostics.md"
+
+
+ROOT = Path(__file__).resolve().parents[2]
+SOURCES = ["krl", "interp", "net", "robot", "recovery", "pendant", "conformance", "tools", "examples"]
+CODE_TEXT = re.compile(r"[EW]\d{3}")
+
+
+def _source_files():
+    for top in SOURCES:
+        for p in sorted((ROOT / top).rglob("*.py")):
+            if "generated" not in p.parts and p != ROOT / "krl" / "diagnostics" / "codes.py":
+                yield p
+
+
+def _docstrings(tree) -> set[int]:
+    out = set()
+    for node in ast.walk(tree):
+        if isinstance(node, (ast.Module, ast.ClassDef, ast.FunctionDef, ast.AsyncFunctionDef)) and node.body:
+            first = node.body[0]
+            if isinstance(first, ast.Expr) and isinstance(first.value, ast.Constant):
+                out.add(id(first.value))
+    return out
+
+
+def spelled_codes(path: Path, root: Path = ROOT) -> list[str]:
+    """``file:line CODE`` of each string constant of `path` that is a code (docstrings aside)."""
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    skip = _docstrings(tree)
+    return [f"{path.relative_to(root)}:{n.lineno} {n.value}" for n in ast.walk(tree)
+            if isinstance(n, ast.Constant) and isinstance(n.value, str) and CODE_TEXT.fullmatch(n.value)
+            and id(n) not in skip]
+
+
+def test_no_code_is_spelled_outside_its_declaration():
+    """An emit site names the constant (``E102(...)``), a comparison too (``d.code == E102``)."""
+    assert [hit for p in _source_files() for hit in spelled_codes(p)] == []
+
+
+def test_the_spelling_check_finds_a_bare_code(tmp_path):
+    p = tmp_path / "sample.py"
+    p.write_text('"""E102 in a docstring is prose."""\nsink.add(path, 1, 1, "E102", "x")\n', encoding="utf-8")
+    assert spelled_codes(p, tmp_path) == ["sample.py:2 E102"]
+
+
+def test_every_code_is_named_by_an_emit_site():
+    named = set()
+    for p in _source_files():
+        named |= {n.id for n in ast.walk(ast.parse(p.read_text(encoding="utf-8")))
+                  if isinstance(n, ast.Name) and CODE_TEXT.fullmatch(n.id)}
+    assert sorted(set(CODES) - named) == [], "declared codes that nothing emits"
+
+
+def test_every_template_is_a_format_of_named_fields():
+    for code in ALL:
+        for variant, template in code.messages.items():
+            fields = [f for _lit, f, _spec, _conv in string.Formatter().parse(template) if f is not None]
+            assert all(f.isidentifier() for f in fields), (code, variant, template)
+    assert E102(name="X", where="") == ("E102", "'X' is declared more than once")
+    assert type(E102(name="X", where="")[0]) is str and E102 == "E102"
 
 
 def test_sections_without_example_are_exactly_the_generated_and_untriggerable_ones():

@@ -146,11 +146,31 @@ def test_inline_form_routine_is_outside_but_not_its_points(tmp_path):
     assert [(p, ln, c) for p, ln, c, _m in got] == [("Program/p.src", 3, "W106"), ("Program/p.src", 6, "E101")]
 
 
+def test_the_form_module_names_the_package(tmp_path):
+    """A form of a technology package names its module in the opening comment (%{P}, %{E}:
+    older and package folds carry the module, not %{PE}); a KSS 8 form names its provider in
+    its hidden parameter fold: the warning says which. The template's INI fold is named by its
+    title. A hidden fold (%{H}) is no form."""
+    src = ("DEF p()\n;FOLD INI\n;FOLD SPOTTECH INI\n  USERSPOT(#INIT)\n;ENDFOLD (SPOTTECH INI)\n;ENDFOLD (INI)\n"
+           ";FOLD GRIPPER 1 ;%{P}%MKUKATPVW,%CGRP,%VSET,%P 1:1\n  VW_GRP(1)\n;ENDFOLD\n"
+           ";FOLD Gripper SET [1] ;%{PE}\n;FOLD Parameters ;%{h}\n"
+           ";Params IlfProvider=GripperTech.GripperSet;setgripper=1\n;ENDFOLD\n  GRPg_Set(1, 1)\n;ENDFOLD\n"
+           ";FOLD ;%{H}\n  Hidden_Call()\n;ENDFOLD\nEND\n")
+    root = backup(tmp_path, {"Program/p.src": src})
+    got = diags(root)
+    assert [(ln, c) for _p, ln, c, _m in got] == [(4, "W106"), (8, "W106"), (14, "W106"), (17, "E106")], got
+    assert got[0][3].endswith("the template's INI fold SPOTTECH INI uses it (KUKA's template and technology "
+                              "packages write that fold)")
+    assert got[1][3].endswith("a KUKA inline form (KUKATPVW) uses it")
+    assert got[2][3].endswith("a KUKA inline form (GripperTech.GripperSet) uses it")
+
+
 def test_template_lines():
     text = TEMPLATE.format(name="a", user_ini="    x = 1", body="  y = 2")
     ini, inline = template_lines(text)
     lines = text.splitlines()
     assert {lines[i - 1].strip() for i in ini} >= {"BAS (#INITMOV,0 )", "ArcInit(ARC_DEFAULT)"}
+    assert {lines[i - 1].strip(): title for i, title in ini.items()}["ArcInit(ARC_DEFAULT)"] == "ARCTECH INI"
     assert "x = 1" not in {lines[i - 1].strip() for i in ini}
     assert "y = 2" not in {lines[i - 1].strip() for i in ini | inline}
 

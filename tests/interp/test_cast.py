@@ -1,4 +1,4 @@
-"""CAST_TO / CAST_FROM (reference §4.8): byte layout and round trips (interp/runtime/cast.py)."""
+"""CAST_TO / CAST_FROM (reference §4.8): byte layout and round trips (interp/runtime/natives/cast.py)."""
 
 from __future__ import annotations
 

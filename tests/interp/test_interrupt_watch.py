@@ -88,7 +88,8 @@ def test_each_condition_gets_its_class(tmp_path):
     r = _run(tmp_path, "tree")
     irqs = r.rt.robot.irqs.irqs
     got = {n: (irqs[n].watch, len(irqs[n].probes)) for n in (3, 10, 11, 12, 13, 14)}
-    assert got == {3: ("K", 0), 10: ("I", 0), 11: ("T", 0), 12: ("K", 1), 13: ("", 0), 14: ("I", 0)}
+    # 13 reads a variable: SETTLES (evaluated again after a statement ran)
+    assert got == {3: ("K", 0), 10: ("I", 0), 11: ("T", 0), 12: ("K", 1), 13: ("V", 0), 14: ("I", 0)}
 
 
 @pytest.mark.parametrize("interp", ["tree", "vm"])
@@ -119,6 +120,23 @@ def test_a_constant_condition_is_evaluated_once_per_on():
     for k in range(100):
         t.poll(io_version=k, now=k * 0.012)
     assert len(calls) == 1
+
+
+def test_a_condition_over_variables_is_evaluated_when_something_may_have_written():
+    """SETTLES: the same I/O version and the same ``written`` (steps executed, cyclic flag
+    changes) keep the value; either changing evaluates; no ``written`` (a debugger) evaluates."""
+    t, calls = _table("V")
+    t.control("ON", 7, io_version=1, now=0.0, written=(10, 0))
+    for k in range(50):
+        t.poll(io_version=1, now=k * 0.012, written=(10, 0))
+    assert len(calls) == 1
+    t.poll(io_version=1, written=(11, 0))
+    t.poll(io_version=1, written=(11, 1))
+    t.poll(io_version=2, written=(11, 1))
+    assert len(calls) == 4
+    t.poll(io_version=2, written=None)
+    t.poll(io_version=2, written=None)
+    assert len(calls) == 6
 
 
 def test_an_io_condition_is_evaluated_when_the_image_changed():

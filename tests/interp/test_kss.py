@@ -90,6 +90,83 @@ def test_the_template_names_of_technology_packages_stand_in(tmp_path, interp):
     assert summary["USERSPOT"] == ("procedure", 2)
 
 
+ARC_PROG = """
+DEF weld()
+  ;FOLD INI
+  ;FOLD ARCTECH INI
+  IF ARC_OPTION==#ACTIVE THEN
+    ARC_INIT(#STD, ARC_DEFAULT)
+    $OUT[5] = TRUE
+  ENDIF
+  IF ARC_OPTION<>#ACTIVE THEN
+    $OUT[6] = TRUE
+  ENDIF
+  SWITCH ARC_MODE
+  CASE #PULSE, #STANDARD
+    $OUT[7] = TRUE
+  DEFAULT
+    $OUT[8] = TRUE
+  ENDSWITCH
+  ;ENDFOLD (ARCTECH INI)
+  ;FOLD SPOTTECH INI
+  USERSPOT(SPOT_INI, 3 + SPOT_COUNT)
+  ;ENDFOLD (SPOTTECH INI)
+  ;FOLD USER INI
+  ;ENDFOLD (USER INI)
+  ;ENDFOLD (INI)
+  $OUT[1] = TRUE
+END
+"""
+
+
+@pytest.mark.parametrize("where", ("backup", "folder"))
+def test_an_enum_of_a_package_the_backup_lacks_reads_not_installed(tmp_path, where):
+    """ArcTech's INI fold tests a variable of an ENUM type nothing declares (issue 46):
+    ARC_OPTION gets a stand-in ENUM of the literals its uses compare it with (#ACTIVE) plus
+    #NOT_INSTALLED, so ==#ACTIVE is FALSE and <>#ACTIVE TRUE; ARC_MODE, switched on #PULSE and
+    #STANDARD, takes the DEFAULT branch. USERSPOT's arguments are evaluated (SPOT_INI: no type
+    from its uses, the not-installed value; SPOT_COUNT: INT from 3 + ...) in both interpreters,
+    with one note each. The same in a plain folder: the checker decides the same there."""
+    if where == "backup":
+        prog = _backup(tmp_path, ARC_PROG)
+    else:
+        prog = write(tmp_path, "weld.src", ARC_PROG)
+    runs = [_run(prog, i) for i in INTERPS]
+    assert runs[0][2] == runs[1][2]                 # the same trace, event by event
+    rt, res, events = runs[0]
+    assert res.reason == "completed", res.text
+    io = [(e["signal"], e["value"]) for e in events if e["kind"] == "io"]
+    assert io == [("$OUT[6]", True), ("$OUT[8]", True), ("$OUT[1]", True)]
+    notes = [e["text"] for e in events if e["kind"] == "message"]
+    place = "the backup" if where == "backup" else "the program's files"
+    ini = "the template's INI fold {} uses it (KUKA's template and technology packages write that fold)"
+    assert notes == [
+        f"stub: ARC_OPTION (variable of KUKA's system software not in {place}: {ini.format('ARCTECH INI')}): "
+        "reads #NOT_INSTALLED (the package is not installed: equal to none of #ACTIVE)",
+        f"stub: ARC_MODE (variable of KUKA's system software not in {place}: {ini.format('ARCTECH INI')}): "
+        "reads #NOT_INSTALLED (the package is not installed: equal to none of #PULSE, #STANDARD)",
+        f"stub: SPOT_INI (variable of KUKA's system software not in {place}: {ini.format('SPOTTECH INI')}): "
+        "reads #NOT_INSTALLED (the package is not installed; its uses give it no type)",
+        f"stub: SPOT_COUNT (variable of KUKA's system software not in {place}: {ini.format('SPOTTECH INI')}): "
+        "reads 0",
+        f"stub: USERSPOT (procedure of KUKA's system software not in {place}: {ini.format('SPOTTECH INI')}): "
+        "no effect",
+    ]
+    summary = {name: (what, n) for name, what, n in rt.kss.summary()}
+    assert summary["USERSPOT"] == ("procedure", 1) and summary["ARC_OPTION"] == ("variable", 1)
+    assert "ARC_INIT" not in summary                # never called: the package is not installed
+
+
+def test_the_not_installed_value_is_none_of_the_literals(tmp_path):
+    """A program that compares with #NOT_INSTALLED itself: the stand-in's value differs."""
+    prog = _backup(tmp_path, "DEF weld()\n  ;FOLD INI\n  IF X_OPT==#NOT_INSTALLED THEN\n    $OUT[1] = TRUE\n"
+                             "  ENDIF\n  ;ENDFOLD (INI)\nEND\n")
+    _rt, res, events = _run(prog)
+    assert res.reason == "completed" and not [e for e in events if e["kind"] == "io"]
+    assert [e["text"] for e in events if e["kind"] == "message"][0].endswith(
+        "reads #NOT_INSTALLED_ (the package is not installed: equal to none of #NOT_INSTALLED)")
+
+
 def test_a_name_of_the_program_only_is_its_error(tmp_path):
     prog = _backup(tmp_path, "DEF weld()\n  IF GATE_OPEN THEN\n    $OUT[1] = TRUE\n  ENDIF\nEND\n")
     _rt, res, _ = _run(prog)
@@ -225,3 +302,126 @@ def test_start_places_the_robot_and_on_halt_continue_presses_start(tmp_path):
     cell = write(tmp_path, "cell.yaml", "start: XSTART\n")
     out = runner.invoke(main, ["run", str(prog), "--inputs", str(cell)])
     assert "start      XSTART" in out.output and "$OUT 1" in out.output
+
+
+@pytest.mark.parametrize("interp", INTERPS)
+def test_a_type_follows_the_checker_in_a_backup_or_not(tmp_path, interp):
+    """A type nothing declares (issue 46: one decision). Named by an EXT declaration, the
+    checker's W105 (the software that provides the routine declares it): untyped, one note, in
+    a plain folder too (before, outside a backup, its data list did not load: "unknown name
+    W1"). Named only by the program's own data list, the checker's E105: the program's error,
+    in a backup too (its variable is not declared either: "unknown name W1")."""
+    ext = "DEFDAT weld\n  EXT ArcOn(ARC_DATA_T :IN)\n  DECL ARC_DATA_T W1=#PULSE\nENDDAT\n"
+    mine = "DEFDAT weld\n  DECL GRIPPER_T W1=#PULSE\nENDDAT\n"
+    prog = "DEF weld()\n  $OUT[1] = W1 == #PULSE\nEND\n"
+    for where in ("folder", "backup"):
+        for dat, expected in ((ext, ("completed", "")), (mine, ("error", "unknown name W1"))):
+            # (the data list is loaded when the program first reads W1)
+            folder = tmp_path / f"{where}-{len(dat)}"
+            folder.mkdir()
+            if where == "backup":
+                src = _backup(folder, prog, files={"R1/Program/weld.dat": dat})
+            else:
+                write(folder, "weld.dat", dat)
+                src = write(folder, "weld.src", prog)
+            rt, res, events = _run(src, interp)
+            assert (res.reason, res.text if res.reason == "error" else "") == expected, (where, res.text)
+            if expected[0] == "completed":
+                assert "not simulated: type ARC_DATA_T (undeclared; values are untyped)" in \
+                    [e["text"] for e in events if e["kind"] == "message"]
+                assert ("$OUT[1]", True) in [(e["signal"], e["value"]) for e in events if e["kind"] == "io"]
+
+
+def test_a_name_only_a_broken_file_mentions_stays_the_programs_error(tmp_path):
+    """The checker warns (W101, rule 4: a file that does not parse mentions it: it may declare
+    it) but does not call it KUKA's (Outside.kuka False): perhaps the program's own variable,
+    in a data list the controller could not load either. The run stops on it, as before."""
+    prog = _backup(tmp_path, "DEF weld()\n  IF PART_COUNT > 3 THEN\n    $OUT[1] = TRUE\n  ENDIF\nEND\n",
+                   files={"R1/Program/cnt.dat": "DEFDAT cnt PUBLIC\n  DECL GLOBAL INT PART_COUNT = (\nENDDAT\n"})
+    out = CliRunner().invoke(main, ["check", str(prog.parents[2])])
+    assert "warning[W101]: name 'PART_COUNT' is not declared in this backup (used 1 time; first here): " \
+           "a file of this backup that does not parse mentions it" in out.output, out.output
+    rt, res, _ = _run(prog)
+    assert (res.reason, res.line, res.text) == ("error", 2, "unknown name PART_COUNT")
+    assert rt.kss.summary() == []
+
+
+def test_outside_stops_finds_a_run_that_disagrees_with_the_checker(tmp_path, monkeypatch):
+    """interp.realprograms.outside_stops, what tests/interp/test_outside_runs.py asserts empty
+    on every backup of the corpus and the history: with the stand-in of a name taken away (the
+    run and the checker disagree), the stop on it is found and said with the checker's why; the
+    program's own unknown name is not."""
+    from interp import realprograms as rp
+    from interp.runtime.kss import SystemSoftware
+
+    prog = _backup(tmp_path, KRC2_PROG)
+    rt, res, _ = _run(prog)
+    assert res.text == "routine GetJobNr not found" and rp.outside_stops(rt) == []
+    monkeypatch.setattr(SystemSoftware, "name_ref", lambda self, name: None)
+    rt, res, _ = _run(prog)
+    assert res.text == "unknown name ARC20"
+    assert rp.outside_stops(rt) == [f"ARC20 at {prog}:11: the template's INI fold ARCHTECHDIGITAL INI uses it "
+                                    "(KUKA's template and technology packages write that fold)"]
+
+
+# ---------------------------------------------------------------------- the operator's path
+CELL_DAT = ("DEFDAT cell\n  DECL E6AXIS XHOME={A1 10.0,A2 -90.0,A3 90.0,A4 0.0,A5 30.0,A6 0.0,E1 0.0,E2 0.0,"
+            "E3 0.0,E4 0.0,E5 0.0,E6 0.0}\nENDDAT\n")
+HANDLER = "&ACCESS RVP\n&COMMENT HANDLER on external automatic\n" + P00_CELL.lstrip("\n")
+
+
+def _cell(tmp: Path, program: str = HANDLER) -> Path:
+    return _backup(tmp, program, P00_CONFIG, name="cell.src", files={"R1/Program/cell.dat": CELL_DAT})
+
+
+def test_a_cell_program_starts_in_automatic_external_at_home(tmp_path):
+    """issue 46: `krl run cell.src` with nothing else: EXT (the header says it is the handler
+    of Automatic External) and XHOME (P00's CHK_HOME wants it there), each said with who chose
+    it; P00's INIT_EXT passes, and the run waits for the PLC's program number: the summary
+    names the input (PGNO_VALID = 42 of $config.dat) and the options that answer it."""
+    prog = _cell(tmp_path)
+    out = CliRunner().invoke(main, ["run", str(prog), "--max-sim-time", "5"])
+    lines = out.output.splitlines()
+    assert "  mode       EXT (cell.src is a cell program (its header &COMMENT HANDLER on external automatic): " \
+           "the controller runs it in Automatic External; --mode to choose another)" in lines, out.output
+    assert "  start      XHOME (the home position: cell.src is a cell program, and P00 #CHK_HOME wants it " \
+           "there; --start to choose another)" in lines
+    waits = [ln for ln in lines if ln.startswith("  waits      ")]
+    assert waits and waits[0].startswith("  waits      in P00_GET (") and waits[0].endswith(
+        "for the PLC's program number (P00's handshake): WAIT FOR $IN[PGNO_VALID] reads $IN[42] (PGNO_VALID) "
+        "of $config.dat"), out.output
+    assert "  answer     --pgno N (a number the cell program's SWITCH PGNO has a CASE for), or the cell " \
+           "file's `pgno: N`, or --inputs auto" in lines
+    # answered: the handshake completes, CASE 2 runs
+    out = CliRunner().invoke(main, ["run", str(prog), "--pgno", "2", "--max-sim-time", "5"])
+    assert "ended      completed" in out.output and "$OUT 3" in out.output, out.output
+
+
+def test_a_cell_program_in_another_mode_says_it_waits_for_automatic_external(tmp_path):
+    """--mode AUT: P00's INIT_EXT waits for $I_O_ACTCONF (the project's standard P00: WAIT FOR);
+    the summary says so and how to answer. A program that calls P00 (#INIT_EXT, ...) without the
+    header is a cell program too."""
+    program = P00_CELL.replace("DEF cell()", "DEF cell()\n  ;FOLD AUTOEXT INI")   # no header
+    prog = _cell(tmp_path, program.replace('  P00 (#INIT_EXT', '  ;ENDFOLD\n  P00 (#INIT_EXT'))
+    out = CliRunner().invoke(main, ["run", str(prog), "--mode", "AUT", "--max-sim-time", "5"])
+    lines = out.output.splitlines()
+    assert "  mode       AUT (--mode)" in lines, out.output
+    assert any(ln.startswith("  waits      in P00_INIT (") and ln.endswith(
+        "for Automatic External ($MODE_OP #EX and $I_O_ACT): WAIT FOR $I_O_ACTCONF") for ln in lines), out.output
+    assert "  answer     --mode EXT, or the cell file's `autoext: true`" in lines
+    out = CliRunner().invoke(main, ["run", str(prog), "--max-sim-time", "5"])
+    assert "it calls P00 (#INIT_EXT, ...) at line" in out.output, out.output
+
+
+def test_chk_home_says_the_robot_is_not_home(tmp_path):
+    """--start elsewhere: the standard P00's CHK_HOME HALTs in Automatic External while $IN_HOME
+    is FALSE; the summary names the loop's condition and --start XHOME."""
+    program = P00_CELL.replace("  P00 (#INIT_EXT", "  P00 (#CHK_HOME,#PGNO_GET,DMY[],0 )\n  P00 (#INIT_EXT")
+    prog = _cell(tmp_path, program)
+    out = CliRunner().invoke(main, ["run", str(prog), "--start", "{A1 40}", "--max-sim-time", "5"])
+    lines = out.output.splitlines()
+    assert "stopped by HALT" in out.output, out.output
+    assert any(ln.startswith("  waits      in P00_HOME (") and ln.endswith(
+        "for the robot in its home position ($H_POS, within $H_POS_TOL): WHILE NOT $IN_HOME") for ln in lines), \
+        out.output
+    assert "  answer     --start XHOME, or the cell file's `start: XHOME`" in lines

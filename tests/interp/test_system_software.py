@@ -178,22 +178,30 @@ def test_declared_system_variable_reads_its_declared_value_with_one_note(tmp_pat
             "not simulated: system variable $TORQMON_DEF reads its value declared at R1/Mada/$robcor.dat:3",
             "not simulated: system variable $TORQMON (declared by KSS's system files, not by this "
             "program's): reads 0/FALSE",
+            # a $ name no table lists: the checker's W107 (the controller's: programs cannot declare
+            # $ names); the run follows it (issue 46): INT from `t = ...`, its zero value, one note
+            "stub: $NO_SUCH_VARIABLE (system variable of KUKA's system software not in the backup: "
+            "a system variable of the controller that the platform tables do not list): reads 0",
         ]
-        # an undeclared, unsimulated $ name is the controller's error, not a new variable
-        assert (res.reason, res.line) == ("error", 9)
-        assert res.text == "unknown name $NO_SUCH_VARIABLE"
+        assert (res.reason, rt.controller.io.get_out(1)) == ("completed", True)
     assert out[0] == out[1]
 
 
-def test_undeclared_system_variable_is_an_error_outside_a_backup_too(tmp_path):
+def test_undeclared_system_variable_stands_in_outside_a_backup_too(tmp_path):
+    """The checker's W107 outside a backup too (krl/semantics/outside.py decides the same in
+    any folder): the value written is kept, and read back."""
     src = """
     DEF prog()
-      $NO_SUCH_VARIABLE = 1
+      $NO_SUCH_VARIABLE = 5
+      $OUT[1] = $NO_SUCH_VARIABLE == 5
     END
     """
     for run in both(tmp_path, src):
-        assert (run.result.reason, run.result.line, run.result.text) == \
-            ("error", 2, "unknown name $NO_SUCH_VARIABLE")
+        assert run.result.reason == "completed", run.result.text
+        assert ("$OUT[1]", True) in [(e["signal"], e["value"]) for e in run.kinds("io")]
+        assert messages(run) == ["stub: $NO_SUCH_VARIABLE (system variable of KUKA's system software not in "
+                                 "the program's files: a system variable of the controller that the platform tables do "
+                                 "not list): reads 0"]
 
 
 # ------------------------------------------------------------------ submit errors in the report

@@ -47,7 +47,8 @@ def reference_entry(lf) -> bytes:
     diags = [[d.line, d.column, d.code, d.message, d.severity, d.end_line, d.end_column, d.help,
               [[n.line, n.column, n.message] for n in d.notes]] for d in lf.diagnostics]
     return msgpack.packb([enc(lf.module), lf.ok, lf.status, diags, lf.unreadable, sorted(lf.failed_words),
-                          sorted(lf.template[0]), sorted(lf.template[1])], use_bin_type=True)
+                          sorted(map(list, lf.template[0].items())), sorted(map(list, lf.template[1].items()))],
+                         use_bin_type=True)
 
 
 def test_entries_decode_to_what_was_parsed(shared_corpus: Path):

@@ -25,6 +25,7 @@ import xml.etree.ElementTree as ET
 from pathlib import Path
 
 import numpy as np
+import psutil
 import pytest
 from RSIPI import RSIAPI, context
 
@@ -52,18 +53,45 @@ def local_copy(config: Path, tmp_path: Path) -> tuple[Path, int]:
     return out, port
 
 
-def rsipi(config: Path, script, mode: str = "absolute", cycle: float = 0.012):
-    """A partner for helpers.run_with_partner: RSIPI on `config`, `script(api)` once the robot's
-    first packet arrived; RSIPI stopped after it."""
-    def run(net, rt):
+def udp_bound(port: int) -> bool:
+    """A socket of this machine is bound to UDP `port` (read from the kernel's table, without
+    touching the port)."""
+    return any(c.laddr and c.laddr.port == port for c in psutil.net_connections(kind="udp"))
+
+
+@pytest.fixture
+def rsipi():
+    """A factory of partners for helpers.run_with_partner: ``rsipi(config, script, mode, cycle)``
+    starts RSIPI on `config` at once and returns when it listens on the configuration's port,
+    so that it is there before the robot's RSI_ON, as a sensor PC is (not racing the run); the
+    partner then runs ``script(api, hold)`` once the robot's first packet arrived, and stops
+    RSIPI after it. ``hold(s)`` returns when the controller has run `s` more seconds of
+    simulated time (or the run ended): the script's pauses are the robot's cycles, not the
+    wall clock's, whatever the machine's load. Every RSIPI started is stopped at teardown."""
+    started = []
+
+    def make(config: Path, script, mode: str = "absolute", cycle: float = 0.012):
+        port = int(re.search(r"<PORT>\s*(\d+)\s*</PORT>", config.read_text(encoding="utf-8")).group(1))
         api = RSIAPI(str(config), rsi_mode=mode, cycle_time=cycle)
         api.start()
-        try:
-            assert api.wait_for_connection(60.0), "RSIPI saw no packet of the robot"
-            return script(api)
-        finally:
-            api.stop()
-    return run
+        started.append(api)
+        assert until(lambda: udp_bound(port), 60.0), f"RSIPI did not bind UDP port {port}"
+
+        def run(net, rt):
+            def hold(seconds: float) -> None:
+                t = rt.controller.time + seconds
+                until(lambda: rt.controller.time >= t or net.closed, 60.0)
+
+            try:
+                assert api.wait_for_connection(60.0), "RSIPI saw no packet of the robot"
+                return script(api, hold)
+            finally:
+                api.stop()
+        return run
+
+    yield make
+    for api in started:
+        api.stop()
 
 
 def until(pred, timeout: float = 30.0) -> bool:
@@ -99,16 +127,16 @@ def ipoc_steps(trace) -> set[int]:
 
 
 @pytest.mark.parametrize("interp", INTERPS)
-def test_rsipi_on_the_example(tmp_path, interp):
+def test_rsipi_on_the_example(rsipi, tmp_path, interp):
     cfg, port = local_copy(EXAMPLES / "rsi_path_ethernet.xml", tmp_path)
 
-    def script(api):
+    def script(api, hold):
         z0 = pose(api)
         api.tools.update_variable("RKorr.Z", 5.0)
         reached = until(lambda: abs(pose(api)[2] - z0[2] - 5.0) < 0.01)
-        time.sleep(0.3)
+        hold(0.5)
         api.tools.update_variable("Stop", True)
-        time.sleep(0.3)
+        hold(0.3)
         return z0, reached
 
     settings = NetworkSettings(EXAMPLES, rsi=Channel(EXAMPLES / "rsi_path.rsi.xml", ("127.0.0.1", port)))
@@ -117,6 +145,8 @@ def test_rsipi_on_the_example(tmp_path, interp):
     assert result.reason == "completed", (result.reason, result.text)        # Stop ended RSI_MOVECORR
     assert ipoc_steps(trace) == {12}
     assert len(answers(trace)) >= 40
+    # each packet answered in time: the controller waits for its sensor in simulated time (net/rsi.py)
+    assert not net_events(trace, iface="rsi", dir="error")
     # the TCP followed the 5 mm to 0.01 mm, in the robot's own packets
     last = robot_packets(trace)[-1].find("RIst")
     assert float(last.get("Z")) - z0[2] == pytest.approx(5.0, abs=0.01)
@@ -124,20 +154,20 @@ def test_rsipi_on_the_example(tmp_path, interp):
 
 
 @pytest.mark.parametrize("interp", INTERPS)
-def test_rsipi_shipped_context_kuka_template(tmp_path, interp):
+def test_rsipi_shipped_context_kuka_template(rsipi, tmp_path, interp):
     """RSIPI's own RSIPI_Stop context and its KUKA-template configuration, as RSIPI ships them."""
     shipped = Path(context("stop"))
     ctx = shipped.parent / "RSIPI_Stop.rsi.xml"
     cfg, port = local_copy(shipped, tmp_path)
 
-    def script(api):
+    def script(api, hold):
         p0 = pose(api)
         api.motion.update_cartesian(X=0.1)
         until(lambda: pose(api)[0] - p0[0] > 3.0)
         api.motion.update_cartesian(X=0.0)
-        time.sleep(0.3)
+        hold(0.3)
         api.motion.exit_movecorr()
-        time.sleep(0.3)
+        hold(0.3)
         return p0
 
     settings = NetworkSettings(ctx.parent, rsi=Channel(ctx, ("127.0.0.1", port)))
@@ -156,18 +186,18 @@ def test_rsipi_shipped_context_kuka_template(tmp_path, interp):
 
 
 @pytest.mark.parametrize("interp", INTERPS)
-def test_rsipi_on_posetrack_rsix(shared_corpus, tmp_path, interp):
+def test_rsipi_on_posetrack_rsix(rsipi, shared_corpus, tmp_path, interp):
     """wingljj's PoseTrack.src with its published RSI 4/5 context (LIMIT objects of +-35 per
     answer, POSCORR within +-40, RELATIVE, HOLDON 0): no STOP object, so the test ends the run."""
     ctx = PUB / "wingljj" / "PoseTrack.rsix"
     cfg, port = local_copy(PUB / "wingljj" / "PoseTrack_ethernet.xml", tmp_path)
 
-    def script(api):
+    def script(api, hold):
         p0 = pose(api)
         api.motion.update_cartesian(Y=-0.2, Z=0.1)
         until(lambda: pose(api)[1] - p0[1] < -4.0)
         api.motion.update_cartesian(Y=0.0, Z=0.0)
-        time.sleep(0.3)
+        hold(0.3)
         return p0
 
     settings = NetworkSettings(ctx.parent, rsi=Channel(ctx, ("127.0.0.1", port)))
@@ -183,21 +213,21 @@ def test_rsipi_on_posetrack_rsix(shared_corpus, tmp_path, interp):
 
 
 @pytest.mark.parametrize("interp", INTERPS)
-def test_rsipi_ipo_fast_kroshu(shared_corpus, tmp_path, interp):
+def test_rsipi_ipo_fast_kroshu(rsipi, shared_corpus, tmp_path, interp):
     """kroshu's rsi_joint_pos_4ms.src (RSI_ON(#ABSOLUTE, #IPO_FAST)) with its published RSI 4/5
     context: packets every 4 ms, absolute AK followed, Stop ends RSI_MOVECORR."""
     ctx = PUB / "kroshu_kss" / "rsi_joint_pos.rsix"
     cfg, port = local_copy(PUB / "kroshu_kss" / "rsi_ethernet.xml", tmp_path)
     target = np.array([1.5, -1.0, 0.5, 0.0, 2.0, -2.0])
 
-    def script(api):
+    def script(api, hold):
         q0 = joints(api)
         for i, v in enumerate(target):
             api.tools.update_variable(f"AK.A{i + 1}", float(v))
         reached = until(lambda: np.allclose(joints(api) - q0, target, atol=0.01))
-        time.sleep(0.2)
+        hold(0.2)
         api.tools.update_variable("Stop", True)
-        time.sleep(0.3)
+        hold(0.3)
         return q0, reached
 
     settings = NetworkSettings(ctx.parent, rsi=Channel(ctx, ("127.0.0.1", port)))
@@ -212,14 +242,14 @@ def test_rsipi_ipo_fast_kroshu(shared_corpus, tmp_path, interp):
 
 
 @pytest.mark.parametrize("interp", INTERPS)
-def test_rsipi_late_answers_stop_the_robot(tmp_path, interp):
+def test_rsipi_late_answers_stop_the_robot(rsipi, tmp_path, interp):
     """RSIPI stops answering: past the ETHERNET object's Timeout (100) late packets in a row
     the robot stops with RSI's message and the program ends with it."""
     cfg, port = local_copy(EXAMPLES / "rsi_path_ethernet.xml", tmp_path)
 
-    def script(api):
+    def script(api, hold):
         api.tools.update_variable("RKorr.Z", 1.0)
-        time.sleep(0.5)
+        hold(0.5)
         return None                                # RSIPI stopped: no more answers
 
     settings = NetworkSettings(EXAMPLES, rsi=Channel(EXAMPLES / "rsi_path.rsi.xml", ("127.0.0.1", port)))

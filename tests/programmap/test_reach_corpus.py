@@ -25,6 +25,7 @@ from pathlib import Path
 import pytest
 
 from krl.programmap import build_map
+from krl.project import find_backups
 from krl.workspace import workspaces_for
 
 PALLETIZER = {
@@ -115,8 +116,6 @@ def case(request, shared_corpus):
 
 
 def test_every_corpus_backup_is_covered(shared_corpus):
-    from krl.project import find_backups  # noqa: PLC0415
-
     found = {b.resolve() for b in find_backups(shared_corpus)}
     assert found == {(shared_corpus / b["backup"]).resolve() for b in BACKUPS}
 

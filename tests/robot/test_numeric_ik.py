@@ -1,4 +1,4 @@
-"""Arms without a closed form (robot/ik_numeric.py; issue 34): machine data whose chain is not
+"""Arms without a closed form (robot/kinematics/numeric.py; issue 34): machine data whose chain is not
 ortho-parallel with a spherical wrist get the numeric solver (mink on the robot's MuJoCo model),
 with the status/turn selection and the errors of the analytic forms.
 

@@ -1,11 +1,21 @@
-"""The simulator's compiled hot path (robot/simcore.pyx, built by robot/build.py; `make`
-builds it before the tests) against the pure-Python code it mirrors, the reference: the OPW
-inverse kinematics (the same axes bit for bit, and the same errors, on random poses of the
-KR 6 R900 and of a corpus KR 210) and the trace's pose lines (the same bytes). Issue 39,
-"Simulator": traces byte-identical."""
+"""The simulator's compiled hot path (robot/build.py builds it; `make` and CI build it before the
+tests) against the Python it is compiled from or mirrors, the reference:
+
+* robot/kinematics/fastpath.py compiled against the same file run as Python (the OPW form, its
+  status, the choice among solutions, every entry; the same bytes, the same None where the
+  caller raises), and the kinematics that use it against the kinematics without it (KR 6 R900,
+  a corpus KR 210: the same axes and errors);
+* robot/simcore.pyx (the palletizer's rows, the forward product, CP paths, the IPO cycle, the
+  step check, the pose lines) against the Python code it mirrors.
+
+These tests never skip where the build is expected: with Cython and a C compiler at hand a
+missing or stale build fails here (make vm-loop builds it). Without them there is nothing
+compiled to compare and they skip saying so. Issue 39 ("Simulator": traces byte-identical),
+issue 47 (the compiled core generated from the Python, its comparison always run)."""
 
 from __future__ import annotations
 
+import hashlib
 import random
 import shutil
 import sys
@@ -16,7 +26,7 @@ import pytest
 
 from robot import build, kinematics
 from robot.errors import RobotError
-from robot.kinematics import Kinematics
+from robot.kinematics import Kinematics, constants
 from robot.mada import load_robot
 from robot.trace import _round6, round_time
 
@@ -34,14 +44,144 @@ def _can_compile() -> bool:
     return shutil.which(sysconfig.get_config_var("CC").split()[0]) is not None
 
 
-def test_the_compiled_inverse_is_built_and_used():
-    if not _can_compile():
-        pytest.skip("no Cython or no C compiler: the pure-Python inverse runs (make vm-loop says so)")
-    assert build.target().exists(), "the compiled inverse kinematics is missing: run make vm-loop"
-    assert kinematics._simcore is not None and kinematics._simcore.ABI == kinematics.SIMCORE_ABI
+def _built(what: str) -> None:
+    """Fail when the compiled module `what` is missing although it can be built; skip (saying
+    why) where nothing can be compiled."""
+    if _can_compile():
+        pytest.fail(f"{what} is not built, or is stale, although Cython and a C compiler are here: "
+                    f"run make vm-loop")
+    pytest.skip(f"no Cython or no C compiler: {what} is not compiled, nothing to compare (make vm-loop says so)")
+
+
+@pytest.fixture()
+def sc():
+    """robot/simcore.pyx's module, built and current (else :func:`_built`)."""
+    mod = kinematics.compiled_module()
+    if mod is None:
+        _built("robot/simcore.pyx")
+    return mod
+
+
+@pytest.fixture()
+def fast():
+    """(compiled fastpath module, fastpath.py run as Python)."""
+    if not kinematics.fastpath_compiled():
+        _built("robot/kinematics/fastpath.py")
+    return kinematics.fastpath_module(), kinematics.compiled._python_fastpath()
+
+
+def test_the_compiled_core_is_built_current_and_used(sc, fast):
+    assert build.target().exists() and build.fastpath_target().exists()
+    assert sc.SOURCE_SHA == hashlib.sha256(build.SOURCE.read_bytes()).hexdigest()
+    compiled, python = fast
+    assert compiled.__file__.endswith(sysconfig.get_config_var("EXT_SUFFIX"))
+    assert python.__file__.endswith("fastpath.py")
     k = Kinematics()
-    k.inverse(k.forward([10, -80, 100, 20, 30, 40]))
-    assert k._c_opw
+    assert k.compiled_inverse and isinstance(k.impl.solver.c, compiled.OPWCore)
+    assert k.joints._compiled()                     # the forward product too
+
+
+def test_a_stale_simcore_is_not_used(monkeypatch, sc):
+    monkeypatch.setattr(kinematics.compiled, "_simcore_current", None)
+    monkeypatch.setattr(sc, "SOURCE_SHA", "0" * 64)
+    assert kinematics.compiled_module() is None
+    monkeypatch.setattr(kinematics.compiled, "_simcore_current", None)
+
+
+def test_a_fastpath_that_answers_otherwise_is_not_used(monkeypatch, fast):
+    compiled, python = fast
+
+    class Off:
+        OPWCore = python.OPWCore
+
+        class Wrong(python.OPWCore):
+            def inverse(self, T, status, turn, ref):
+                q = python.OPWCore.inverse(self, T, status, turn, ref)
+                return None if q is None else q + 1e-12
+
+    Off.OPWCore = Off.Wrong
+    assert kinematics.compiled._same_answers(compiled, python) and not kinematics.compiled._same_answers(Off, python)
+
+
+def test_the_fastpath_constants_are_the_kinematics(fast):
+    _, python = fast
+    for name in ("BOUNDARY_EPS", "WRIST_SINGULAR_DEG", "OVERHEAD_SINGULAR_MM", "ACOS_TOL"):
+        assert getattr(python, name) == getattr(constants, name), name
+
+
+def _opw_cores(fast, machine, s_free=0, t_free=0, c4_zero=False):
+    from dataclasses import replace  # noqa: PLC0415
+
+    k = Kinematics(machine)
+    s = k.impl.solver
+    o = replace(s.o, c4=0.0) if c4_zero else s.o
+    args = (o, s.phi_deg, s.sgn, s.offs, k._lo_l, k._hi_l, k._ks_l, s_free, t_free)
+    return k, fast[0].OPWCore(*args), fast[1].OPWCore(*args)
+
+
+@pytest.mark.parametrize("robot", ["kr6", "kr210", "pa4"])
+def test_the_compiled_fastpath_is_fastpath_py_bit_for_bit(fast, robot, shared_corpus):
+    from robot.machine import ROBOT_LIBRARY  # noqa: PLC0415
+    from robot.mada import load_mada  # noqa: PLC0415
+
+    machine = {"kr6": lambda: None, "kr210": lambda: load_robot(str(shared_corpus / "HugoDanielson__ChinaMilling")),
+               "pa4": lambda: load_mada(ROBOT_LIBRARY / "kr180_r3200_pa.dat")}[robot]()
+    k, c, p = _opw_cores(fast, machine, 4 if robot == "pa4" else 0, 0b11000 if robot == "pa4" else 0, robot == "pa4")
+    rng = np.random.default_rng(46)
+    lo, hi = np.maximum(k._lo, -185.0), np.minimum(k._hi, 185.0)
+
+    def same(x, y):
+        return (x is None and y is None) or (x is not None and y is not None and x.tobytes() == y.tobytes())
+    solved = failed = 0
+    for i in range(2500):
+        q = rng.uniform(lo, hi)
+        if i % 10 == 0:
+            q[4] = 0.0
+        elif i % 10 == 1:
+            q[1], q[2] = -90.0, 90.0
+        T = k.forward(q)
+        if i % 17 == 0:
+            T[:3, 3] *= 3.0                                  # out of reach
+        ref = q + rng.normal(0.0, 25.0, 6)
+        status = None if rng.random() < 0.6 else int(rng.integers(0, 8))
+        turn = None if rng.random() < 0.6 else int(rng.integers(0, 64))
+        a, b = c.inverse(T, status, turn, ref), p.inverse(T, status, turn, ref)
+        assert same(a, b), (q.tolist(), status, turn)
+        assert same(c.inverse_rp(T[:3, :3].copy(), T[:3, 3].copy(), status, turn, ref), a)
+        assert c.rows_of(T, ref) == p.rows_of(T, ref) and c.rows_of(T, None) == p.rows_of(T, None)
+        c.status(*ref)
+        p.status(*ref)
+        assert (c.s_out, c.amb_out) == (p.s_out, p.amb_out)
+        solved += a is not None
+        failed += a is None
+    assert solved > 500 and failed > 100
+    if robot == "pa4":
+        return                                   # the chain is the six-axis family's (the planner's)
+    # a chain of poses near HOME, each solution the next one's reference
+    home = k._home
+    Q = np.array([k.forward(q0) for q0 in np.linspace(home, home + np.array([30, 10, -10, 40, 15, 60]), 40)])
+    x = c.inverse_chain_rp(np.ascontiguousarray(Q[:, :3, :3]), np.ascontiguousarray(Q[:, :3, 3]), None, None, home)
+    y = p.inverse_chain_rp(Q[:, :3, :3], Q[:, :3, 3], None, None, home)
+    assert same(x, y) and x is not None
+
+
+def test_the_compiled_chooser_is_fastpath_py_bit_for_bit(fast):
+    rng = np.random.default_rng(45)
+    for n, linear in ((6, [False] * 6), (4, [False, False, True, False])):
+        lo = [-170.0, -190.0, 0.0, -185.0, -120.0, -350.0][:n]
+        hi = [170.0, 45.0, 200.0, 185.0, 120.0, 350.0][:n]
+        ks = [-720.0, -360.0, 0.0, 360.0, 720.0]
+        for t_free in (0, 0b11000):
+            c, p = (m.Chooser(n, lo, hi, ks, linear, t_free) for m in fast)
+            picked = 0
+            for _ in range(1500):
+                rows = [list(rng.uniform(-200.0, 200.0, n)) for _ in range(int(rng.integers(1, 9)))]
+                ref = list(rng.uniform(-200.0, 200.0, n))
+                turn = None if rng.random() < 0.5 else int(rng.integers(0, 64))
+                x, y = c.choose(rows, ref, turn), p.choose(rows, ref, turn)
+                assert x == y
+                picked += x is not None
+            assert picked > 300
 
 
 def _answer(k: Kinematics, T, status, turn, ref):
@@ -51,19 +191,22 @@ def _answer(k: Kinematics, T, status, turn, ref):
         return (type(e).__name__, str(e))
 
 
-def test_compiled_and_python_inverse_agree_bit_for_bit_kr6():
-    _agree(None, 39)
+def test_compiled_and_python_inverse_agree_bit_for_bit_kr6(fast, monkeypatch):
+    _agree(None, 39, monkeypatch)
 
 
-def test_compiled_and_python_inverse_agree_bit_for_bit_on_a_corpus_kr210(shared_corpus):
-    _agree(load_robot(str(shared_corpus / "HugoDanielson__ChinaMilling")), 40)
+def test_compiled_and_python_inverse_agree_bit_for_bit_on_a_corpus_kr210(fast, monkeypatch, shared_corpus):
+    _agree(load_robot(str(shared_corpus / "HugoDanielson__ChinaMilling")), 40, monkeypatch)
 
 
-def _agree(machine, seed: int) -> None:
-    if kinematics._simcore is None:
-        pytest.skip("not compiled: only the Python inverse runs")
-    compiled, python = Kinematics(machine), Kinematics(machine)
-    python._c_opw = False
+def _agree(machine, seed: int, monkeypatch) -> None:
+    """The kinematics with the compiled fastpath against the kinematics with fastpath.py run as
+    Python (USE_COMPILED off): the same axes, the same errors."""
+    compiled = Kinematics(machine)
+    monkeypatch.setattr(kinematics.compiled, "USE_COMPILED", False)
+    python = Kinematics(machine)
+    monkeypatch.setattr(kinematics.compiled, "USE_COMPILED", True)
+    assert compiled.compiled_inverse and not python.compiled_inverse
     rng = np.random.default_rng(seed)
     lo, hi = np.maximum(compiled._lo, -185.0), np.minimum(compiled._hi, 185.0)
     solved = failed = 0
@@ -85,7 +228,7 @@ def _agree(machine, seed: int) -> None:
         a, b = _answer(compiled, T, status, turn, ref), _answer(python, T, status, turn, ref)
         assert a == b, (q.tolist(), ref.tolist(), status, turn)
         # the entry of robot/planner.py CartSegment.ik: rotation and position apart
-        rp = compiled._compiled().inverse_rp(T[:3, :3], T[:3, 3], status, turn, ref)
+        rp = compiled.impl.compiled().inverse_rp(T[:3, :3].copy(), T[:3, 3].copy(), status, turn, ref)
         assert (rp.tobytes() if rp is not None else None) == (a if isinstance(a, bytes) else None)
         solved += isinstance(a, bytes)
         failed += not isinstance(a, bytes)
@@ -104,9 +247,7 @@ def _python_pose_line(t, axes, tcp):
             f'"tcp":[{",".join(map(repr, tc))}]}}')
 
 
-def test_the_compiled_pose_line_is_pythons_bit_for_bit():
-    if simcore is None:
-        pytest.skip("not compiled: only the Python formatting runs")
+def test_the_compiled_pose_line_is_pythons_bit_for_bit(sc):
     rng = random.Random(39)
     tricky = [0.0, -0.0, 5e-7, -5e-7, 4.9999999e-7, 1.5e-6, 1.25e-5, -1.25e-5, 1e-4, 9.9995e-5,
               -1e-4, 1.5e-4, 123.4565, 2.0000005, 99999999.9999995, 1e13, 99999999999999.98, 1e20]
@@ -156,15 +297,11 @@ def _arm_agrees(machine, seed: int) -> None:
     assert a.axes_deg().tobytes() == qa.tobytes()        # the model's own read-back agrees
 
 
-def test_the_compiled_cycle_is_the_arm_models_playback_kr6():
-    if simcore is None:
-        pytest.skip("not compiled: only the Python playback runs")
+def test_the_compiled_cycle_is_the_arm_models_playback_kr6(sc):
     _arm_agrees(None, 41)
 
 
-def test_the_compiled_cycle_is_the_arm_models_playback_on_a_corpus_kr210(shared_corpus):
-    if simcore is None:
-        pytest.skip("not compiled: only the Python playback runs")
+def test_the_compiled_cycle_is_the_arm_models_playback_on_a_corpus_kr210(sc, shared_corpus):
     _arm_agrees(load_robot(str(shared_corpus / "HugoDanielson__ChinaMilling")), 42)
 
 
@@ -175,13 +312,11 @@ def test_the_compiled_cycle_is_off_in_actuated_mode_and_without_the_module(monke
 
     assert ArmModel(actuated=True).compiled_cycle(simcore) is None
     assert ArmModel().compiled_cycle(None) is None
-    monkeypatch.setattr(kinematics, "USE_COMPILED", False)
+    monkeypatch.setattr(kinematics.compiled, "USE_COMPILED", False)
     assert controller._compiled_module() is None
 
 
-def test_the_compiled_step_check_is_the_python_loops():
-    if simcore is None:
-        pytest.skip("not compiled")
+def test_the_compiled_step_check_is_the_python_loops(sc):
     rng = np.random.default_rng(43)
     lim = rng.uniform(0.5, 3.0, 6)
     for _ in range(20_000):
@@ -215,9 +350,7 @@ def _segments(machine, program):
 
 
 @pytest.mark.parametrize("robot", ["kr6", "kr210"])
-def test_the_compiled_cp_path_is_the_segments_poses_and_axes(robot, shared_corpus):
-    if simcore is None:
-        pytest.skip("not compiled: only the Python path runs")
+def test_the_compiled_cp_path_is_the_segments_poses_and_axes(sc, robot, shared_corpus):
     from robot.bench import bench_program  # noqa: PLC0415
     from robot.motion import MotionParams, MotionRequest  # noqa: PLC0415
 
@@ -273,25 +406,21 @@ def test_the_compiled_cp_path_is_the_segments_poses_and_axes(robot, shared_corpu
     assert mirrored > 500 and (compared > 500 or robot == "kr210") and chains > 3
 
 
-def test_the_trace_is_the_same_with_and_without_the_compiled_module(monkeypatch):
+def test_the_trace_is_the_same_with_and_without_the_compiled_module(sc, fast, monkeypatch):
     """The whole compiled path (inverse, CP poses, the IPO cycle, pose lines) against the
     Python code on a random sequence of robot/tracecheck.py: the same bytes."""
-    if simcore is None:
-        pytest.skip("not compiled: only the Python code runs")
     from robot import trace, tracecheck  # noqa: PLC0415
 
     compiled = tracecheck.run_case("random-05")
-    monkeypatch.setattr(kinematics, "USE_COMPILED", False)
+    monkeypatch.setattr(kinematics.compiled, "USE_COMPILED", False)
     monkeypatch.setattr(trace, "_pose_line", None)
     assert tracecheck.run_case("random-05") == compiled
 
 
-def test_the_compiled_tcp_product_is_numpys_matmul():
+def test_the_compiled_tcp_product_is_numpys_matmul(sc):
     """The read-back's INV_POS($BASE) : FLANGE : $TOOL in numpy's own BLAS call: numpy's
     ``@`` bit for bit (a C loop in the textbook order differs in the last bit: numpy's
     OpenBLAS fuses multiply and add)."""
-    if simcore is None:
-        pytest.skip("not compiled")
     from robot.frames import frame_to_matrix, inv_pos  # noqa: PLC0415
     from robot.mjcf import ArmModel, _numpy_dgemm  # noqa: PLC0415
 
@@ -318,12 +447,10 @@ def test_the_compiled_tcp_product_is_numpys_matmul():
     assert cyc.cycle_tcp(np.zeros(6), qa, np.eye(4), np.eye(4), out) is False
 
 
-def test_the_compiled_forward_is_the_python_forward_bit_for_bit(shared_corpus):
+def test_the_compiled_forward_is_the_python_forward_bit_for_bit(sc, shared_corpus):
     """Kinematics.forward through robot/simcore.pyx ``Forward`` (scipy's rotation-vector matrices,
     numpy's own BLAS products) against its numpy/scipy code: the same bytes on random axes of the
     library's robots, of a corpus KR 210 and of a chain with rotated joint origins."""
-    if simcore is None:
-        pytest.skip("not compiled")
     from scipy.spatial.transform import Rotation  # noqa: PLC0415
 
     from robot.blas import numpy_cblas  # noqa: PLC0415
@@ -333,15 +460,16 @@ def test_the_compiled_forward_is_the_python_forward_bit_for_bit(shared_corpus):
     if not numpy_cblas("dgemm") or not numpy_cblas("dgemv"):
         pytest.skip("numpy without its bundled OpenBLAS: numpy multiplies")
     kins = [Kinematics(load_mada(p)) for p in library_robots().values() if p.suffix == ".dat"]
+    kins = [k for k in kins if k.n_axes == 6]         # the compiled product is of six rotary joints
     kins += [Kinematics(), Kinematics(load_robot(str(shared_corpus / "HugoDanielson__ChinaMilling")))]
     rot = Kinematics()
-    rot._R_origin = Rotation.from_euler("xyz", np.random.default_rng(3).normal(size=(6, 3))).as_matrix()
-    rot._origin_rot = True
+    rot.joints.R_origin = Rotation.from_euler("xyz", np.random.default_rng(3).normal(size=(6, 3))).as_matrix()
+    rot.joints.origin_rot = True
     kins.append(rot)
     rng = np.random.default_rng(47)
     T = np.empty((4, 4))
     for k in kins:
-        c = k._compiled_forward()
+        c = k.joints._compiled()
         assert c, k.machine.name
         for i in range(1500):
             a = rng.uniform(k._lo, k._hi)
@@ -352,17 +480,15 @@ def test_the_compiled_forward_is_the_python_forward_bit_for_bit(shared_corpus):
             if i % 11 == 0:
                 a *= 1e-5                                # the small-angle series of from_rotvec
             c.forward(a, T)
-            assert T.tobytes() == k._forward_py(a).tobytes(), (k.machine.name, a.tolist())
-    assert kins[-1].forward(np.zeros(6)).tobytes() == rot._forward_py(np.zeros(6)).tobytes()
+            assert T.tobytes() == k.joints.forward_py(a).tobytes(), (k.machine.name, a.tolist())
+    assert kins[-1].forward(np.zeros(6)).tobytes() == rot.joints.forward_py(np.zeros(6)).tobytes()
 
 
-def test_the_compiled_palletizer_rows_are_the_pythons():
+def test_the_compiled_palletizer_rows_are_the_pythons(sc):
     """The 4-axis palletizer's solutions (robot/simcore.pyx ``Palletizer4``) against the Python
-    loop of Kinematics._palletizer_rows: the same rows, bit for bit, on linked configurations
+    loop of Palletizer4.solutions: the same rows, bit for bit, on linked configurations
     of the library palletizer, with tilted flanges, targets off the arm's reach and no
     reference (``solutions``); its own flange test tells the rows apart by millimetres."""
-    if simcore is None:
-        pytest.skip("not compiled")
     from scipy.spatial.transform import Rotation  # noqa: PLC0415
 
     from robot.machine import ROBOT_LIBRARY  # noqa: PLC0415
@@ -370,8 +496,8 @@ def test_the_compiled_palletizer_rows_are_the_pythons():
 
     m = load_mada(ROBOT_LIBRARY / "kr180_r3200_pa.dat")
     compiled, python = Kinematics(m), Kinematics(m)
-    python._c_pal = False
-    assert compiled._c_pal
+    python.impl._c_pal = False
+    assert compiled.impl._c_pal
     home = compiled._home
     rng = np.random.default_rng(48)
     found = empty = 0
@@ -385,10 +511,10 @@ def test_the_compiled_palletizer_rows_are_the_pythons():
         if rng.random() < 0.2:
             T[:3, 3] += rng.normal(size=3) * 300.0
         ref = None if rng.random() < 0.2 else rng.uniform(compiled._lo, compiled._hi)
-        a, b = compiled._palletizer_rows(T, ref), python._palletizer_rows(T, ref)
+        a, b = compiled.impl.solutions(T, ref), python.impl.solutions(T, ref)
         assert len(a) == len(b) and np.array(a).tobytes() == np.array(b).tobytes(), (q.tolist(), ref)
         found += bool(a)
         empty += not a
         for row in a:                                 # the compiled flange test: within 1e-6 mm
-            assert np.abs(compiled._c_pal.flange_position(np.array(row)) - T[:3, 3]).max() < 1e-6
+            assert np.abs(compiled.impl._c_pal.flange_position(np.array(row)) - T[:3, 3]).max() < 1e-6
     assert found > 2000 and empty > 20

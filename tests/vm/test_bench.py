@@ -10,7 +10,7 @@ from interp.bench import run_krl, run_python
 from interp.vm.vm import COMPILED
 from krl.cli.bench import bench
 
-KEYS = {"vm_vs_tree", "tree_stmts_per_s", "vm_stmts_per_s", "sim_realtime_factor", "parse_kb_per_s"}
+KEYS = {"vm_vs_tree", "tree_stmts_per_s", "vm_stmts_per_s", "sim_realtime_factor", "sim_cpu_factor", "parse_kb_per_s"}
 
 
 def test_benchmark_gives_the_same_result_everywhere():
@@ -31,6 +31,24 @@ def test_bench_json_line():
     assert all(isinstance(data[k], (int, float)) and data[k] > 0 for k in KEYS)
     # make (pip install -e) builds the Cython loop: the benchmark must have run it
     assert data["vm_loop"] == ("compiled" if COMPILED else "python") == "compiled"
+
+
+def test_bench_json_gives_the_simulator_figure_of_robot_bench(monkeypatch):
+    """One figure per measure (issue 48): `krl bench --json` reports the simulator as
+    ``python -m robot.bench`` measures it, warm, by the same function."""
+    import robot.bench as rb
+    from krl.cli.bench import all_figures
+
+    seen = {}
+
+    def measure(min_motion_s=60.0, robot=None, warm_up=True):
+        seen.update(min_motion_s=min_motion_s, warm_up=warm_up)
+        return {"sim_realtime_factor": 123.0, "sim_cpu_factor": 456.0}
+
+    monkeypatch.setattr(rb, "measure", measure)
+    got = all_figures(repeat=1, sim_seconds=2.0, parse_kb=4)
+    assert (got["sim_realtime_factor"], got["sim_cpu_factor"]) == (123.0, 456.0)
+    assert seen == {"min_motion_s": 2.0, "warm_up": True}
 
 
 def test_bench_text():

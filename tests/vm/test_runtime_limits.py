@@ -484,7 +484,7 @@ _VALUES = st.lists(st.one_of(st.integers(-2**31, 2**31 - 1), st.floats(allow_nan
 def test_any_format_is_text_a_format_error_or_a_krl_error(fmt, values, room, src):
     """SWRITE/SREAD on any format and values: a text that fits, a format error, or a KRL
     run-time error (a value that does not suit its conversion), never a Python exception."""
-    from interp.runtime.builtins import sread_values, swrite_text
+    from interp.runtime.natives.swrite import sread_values, swrite_text
     from interp.runtime.errors import KrlRuntimeError
 
     try:

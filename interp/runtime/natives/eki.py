@@ -1,25 +1,26 @@
-"""The EthernetKRL and RobotSensorInterface built-ins (KUKA.EthernetKRL and
-KUKA.RobotSensorInterface manuals; docs/network.md). Each native converts its KRL arguments
-and hands them to the run's network hub (net/hub.py, net/eki.py, net/rsi.py); the behaviour
-lives there, once, for both interpreters.
+"""The EthernetKRL built-ins (KUKA.EthernetKRL manual; docs/network.md). Each native converts
+its KRL arguments and hands them to the run's network hub (net/hub.py, net/eki.py); the
+behaviour lives there, once, for both interpreters. The RSI built-ins are in rsi.py.
 
 EKI functions return EKI_STATUS (Buff, Read, Msg_No, Connected, Counter); an EKI error of the
 call itself stops the program with its message (``EKI000nn ...``, number nn) unless the
-channel's configuration sets ``MESSAGES Display="disabled"``: then only Msg_No tells. RSI
-functions return an RSIERR number as INT (``RSIOK`` = 0, :data:`RSI_CONSTANTS`).
+channel's configuration sets ``MESSAGES Display="disabled"``: then only Msg_No tells.
 """
 
 from __future__ import annotations
 
-from .convert import ref_text
-from .errors import KrlRuntimeError, value_invalid
-from .values import UNSET, Arr, EnumValue, Struct, is_char_array
+from ..convert import ref_text
+from ..errors import KrlRuntimeError, value_invalid
+from ..values import UNSET, Arr, Struct, is_char_array
+from .registry import Family
 
-# RSIERR's values as INT constants (types.yaml lists RSIERR; KUKA's numbering is not public:
-# the order of the enum, RSIOK = 0, is the decision recorded in docs/network.md).
-RSI_CONSTANTS = {name: i for i, name in enumerate(
-    ("RSIOK", "RSIINVOBJID", "RSIINVPARAM", "RSINOMEM", "RSIINVOBJTYPE", "RSIINVCONN",
-     "RSIALREADYON", "RSINOTON", "RSIOBJUSED"))}
+# EthernetKRL's routines are declared on the controller (the option's EXTFCTP lines): known by
+# name only, as functions.yaml's ``lenient: ethernet_krl``
+EKI = Family("EthernetKRL", lenient="ethernet_krl")
+
+NOT_SIMULATED = ("not simulated: the run stops with \"routine NAME not found\" (a network partner's "
+                 "routine is never stood in for: interp/runtime/kss.py)")
+"""What a call of a network routine the simulator does not implement gives."""
 
 
 def network(rt):
@@ -30,7 +31,7 @@ def network(rt):
     if net is None:
         from net.hub import Network  # noqa: PLC0415
 
-        from .netvars import RuntimeSink  # noqa: PLC0415
+        from ..netvars import RuntimeSink  # noqa: PLC0415
 
         net = Network(program=rt.program.main_path, sink=RuntimeSink(rt))
         net.attach(ctl)
@@ -43,7 +44,7 @@ def _eki(rt):
 
 
 def _status(st) -> Struct:
-    from .sysvars import struct_of  # noqa: PLC0415
+    from ..sysvars import struct_of  # noqa: PLC0415
 
     return struct_of("EKI_STATUS", {"BUFF": st.buff, "READ": st.read, "MSG_NO": st.msg_no,
                                     "CONNECTED": bool(st.connected), "COUNTER": st.counter})
@@ -117,7 +118,7 @@ def eki_send(rt, a):
     data = ref_text(a[1] if len(a) > 1 else None, "EKI_Send data")
     length = None
     if len(a) > 2 and a[2] is not None:
-        from .convert import num  # noqa: PLC0415
+        from ..convert import num  # noqa: PLC0415
 
         length = int(num(a[2].get(), "EKI_Send length"))
     return _result(*ch.send(data, length))
@@ -140,7 +141,7 @@ def _setter(kind: str):
     def native(rt, a):
         from net.eki import format_real  # noqa: PLC0415
 
-        from .convert import num  # noqa: PLC0415
+        from ..convert import num  # noqa: PLC0415
 
         ch = _eki(rt).channel(ref_text(a[0], f"EKI_Set{kind} channel"))
         path = ref_text(a[1] if len(a) > 1 else None, f"EKI_Set{kind} element")
@@ -243,7 +244,7 @@ def _getter(kind: str, array: bool = False):
             return _result(st, e)
         try:
             if array:
-                from .memory import index_ref  # noqa: PLC0415
+                from ..memory import index_ref  # noqa: PLC0415
 
                 for i, v in enumerate(conv, 1):
                     _store(index_ref(target, [i], name), kind, v, name)
@@ -257,89 +258,36 @@ def _getter(kind: str, array: bool = False):
     return native
 
 
-# ------------------------------------------------------------------ RSI
+EKI.add("EKI_INIT", eki_init)
+EKI.add("EKI_OPEN", eki_open)
+EKI.add("EKI_CLOSE", eki_close)
+EKI.add("EKI_CLEAR", eki_clear)
+EKI.stand_in("EKI_LOAD", NOT_SIMULATED)
+EKI.stand_in("EKI_UNLOAD", NOT_SIMULATED)
+EKI.add("EKI_SEND", eki_send)
+EKI.add("EKI_LOCK", eki_lock)
+EKI.add("EKI_UNLOCK", eki_unlock)
+EKI.stand_in("EKI_CHECK", NOT_SIMULATED)
+EKI.add("EKI_CHECKBUFFER", eki_checkbuffer)
+EKI.add("EKI_CLEARBUFFER", eki_clearbuffer)
+EKI.stand_in("EKI_READNEXT", NOT_SIMULATED)
+EKI.add("EKI_SETREAL", _setter("Real"))
+EKI.add("EKI_SETINT", _setter("Int"))
+EKI.add("EKI_SETBOOL", _setter("Bool"))
+EKI.add("EKI_SETSTRING", _setter("String"))
+EKI.add("EKI_SETFRAME", _setter("Frame"))
+EKI.add("EKI_SETPOS", _setter("Pos"))
+EKI.add("EKI_SETAXIS", _setter("Axis"))
+EKI.add("EKI_GETREAL", _getter("Real"))
+EKI.add("EKI_GETINT", _getter("Int"))
+EKI.add("EKI_GETBOOL", _getter("Bool"))
+EKI.add("EKI_GETSTRING", _getter("String"))
+EKI.add("EKI_GETFRAME", _getter("Frame"))
+EKI.add("EKI_GETPOS", _getter("Pos"))
+EKI.add("EKI_GETAXIS", _getter("Axis"))
+EKI.add("EKI_GETREALARRAY", _getter("Real", True))
+EKI.add("EKI_GETINTARRAY", _getter("Int", True))
+EKI.add("EKI_GETBOOLARRAY", _getter("Bool", True))
+EKI.add("EKI_GETFRAMEARRAY", _getter("Frame", True))
 
-def _rsi(method: str):
-    def native(rt, a):
-        return rsi_call(network(rt), rt, method, a)
-    return native
-
-
-def _arg_text(a: list, i: int) -> str:
-    v = a[i].get() if len(a) > i and a[i] is not None else ""
-    return v.text() if isinstance(v, Arr) else str(v)
-
-
-def _arg_enum(a: list, i: int, default: str) -> str:
-    v = a[i].get() if len(a) > i and a[i] is not None else None
-    return v.name.upper() if isinstance(v, EnumValue) else default
-
-
-def rsi_call(hub, rt, method: str, a: list):
-    """RSI_CREATE(NAME, CONTID :OUT, BOOL), RSI_DELETE(CONTID), RSI_ON(#ABSOLUTE|#RELATIVE
-    [, #IPO|#IPO_FAST]), RSI_OFF(), RSI_MOVECORR() (waits until the STOP object or an error
-    ends it), RSI_SETPUBLICPAR(CONTID, OBJ, PARAM, VALUE), RSI_GETPUBLICPAR(CONTID, OBJ,
-    PARAM, VALUE :OUT); RSI 5's RSI_LOAD(NAME), RSI_ACTIVATE(NAME), RSI_PROCESS_ON(mode),
-    RSI_PROCESS_OFF(), RSI_DEACTIVATE, RSI_UNLOAD as the same. net/rsi.py holds the behaviour.
-    Returns the RSIERR number (INT)."""
-    from net.rsi import RSIOK  # noqa: PLC0415
-
-    from .convert import num  # noqa: PLC0415
-
-    rsi = hub.partner("rsi").instance()
-    ctl = rt.controller
-    if method == "create":
-        ret = rsi.create(_arg_text(a, 0))
-        if ret == RSIOK and len(a) > 1 and a[1] is not None:
-            a[1].set(1)
-        return ret
-    if method == "delete":
-        return rsi.delete()
-    if method == "activate":
-        return RSIOK if rsi.ctx is not None else RSI_CONSTANTS["RSIINVOBJID"]
-    if method == "on":
-        rt.wait_main_run(rt.current_task)     # RSI_ON stops the advance run: it corrects from the robot at rest
-        return rsi.start(ctl, _arg_enum(a, 0, "RELATIVE"), _arg_enum(a, 1, "IPO") == "IPO_FAST")
-    if method == "off":
-        rt.wait_main_run(rt.current_task)
-        return rsi.off(ctl)
-    if method == "setpar":
-        if len(a) < 4 or a[3] is None:
-            raise value_invalid("RSI_SETPUBLICPAR value")
-        return rsi.set_param(_arg_text(a, 1), _arg_text(a, 2), float(num(a[3].get(), "RSI_SETPUBLICPAR value")))
-    if method == "getpar":
-        ret, v = rsi.get_param(_arg_text(a, 1), _arg_text(a, 2))
-        if len(a) > 3 and a[3] is not None:
-            a[3].set(v)
-        return ret
-    # movecorr: the robot follows the corrections only, until the STOP object or an error
-    if not rsi.on:
-        raise KrlRuntimeError("RSI_MOVECORR without RSI_ON")
-    task = rt.current_task
-    rt.wait_main_run(task)
-    while rsi.on and not rsi.stopped and not rsi.failed:
-        rt.yield_cycle(task)
-    return None
-
-
-NATIVES = {
-    "EKI_INIT": eki_init, "EKI_OPEN": eki_open, "EKI_CLOSE": eki_close, "EKI_CLEAR": eki_clear,
-    "EKI_LOCK": eki_lock, "EKI_UNLOCK": eki_unlock, "EKI_SEND": eki_send,
-    "EKI_CHECKBUFFER": eki_checkbuffer, "EKI_CLEARBUFFER": eki_clearbuffer,
-    "EKI_SETREAL": _setter("Real"), "EKI_SETINT": _setter("Int"), "EKI_SETBOOL": _setter("Bool"),
-    "EKI_SETSTRING": _setter("String"), "EKI_SETFRAME": _setter("Frame"),
-    "EKI_SETPOS": _setter("Pos"), "EKI_SETAXIS": _setter("Axis"),
-    "EKI_GETREAL": _getter("Real"), "EKI_GETINT": _getter("Int"), "EKI_GETBOOL": _getter("Bool"),
-    "EKI_GETSTRING": _getter("String"), "EKI_GETFRAME": _getter("Frame"),
-    "EKI_GETPOS": _getter("Pos"), "EKI_GETAXIS": _getter("Axis"),
-    "EKI_GETREALARRAY": _getter("Real", True), "EKI_GETINTARRAY": _getter("Int", True),
-    "EKI_GETBOOLARRAY": _getter("Bool", True), "EKI_GETFRAMEARRAY": _getter("Frame", True),
-    "RSI_CREATE": _rsi("create"), "RSI_DELETE": _rsi("delete"), "RSI_ON": _rsi("on"),
-    "RSI_OFF": _rsi("off"), "RSI_MOVECORR": _rsi("movecorr"),
-    "RSI_SETPUBLICPAR": _rsi("setpar"), "RSI_GETPUBLICPAR": _rsi("getpar"),
-    # RSI 5 (iiQKA): a context is loaded and activated by name, the process switched on and off
-    "RSI_LOAD": _rsi("create"), "RSI_ACTIVATE": _rsi("activate"), "RSI_DEACTIVATE": _rsi("activate"),
-    "RSI_UNLOAD": _rsi("delete"), "RSI_PROCESS_ON": _rsi("on"), "RSI_PROCESS_OFF": _rsi("off"),
-}
-
-__all__ = ["NATIVES", "RSI_CONSTANTS", "network"]
+__all__ = ["EKI", "NOT_SIMULATED", "network"]

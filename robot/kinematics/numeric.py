@@ -1,6 +1,6 @@
-"""The numeric inverse kinematics of an arm without a closed form (robot/kinematics.py family
-``"numeric"``: e.g. a twisted ``$TX3P3`` or a wrist offset in ``$DH_4``/``$DH_5`` on a six-axis
-arm).
+"""The six-axis arm without a closed form (family ``"numeric"``: e.g. a twisted ``$TX3P3`` or a
+wrist offset in ``$DH_4``/``$DH_5``): every six-axis arm of rotary axes that no other family
+takes (robot/kinematics/families.py registers it last), solved numerically.
 
 The robot's own MuJoCo model (robot/mjcf.py, the same joints as the forward kinematics) is
 solved by the ``mink`` library (differential inverse kinematics on MuJoCo, a quadratic program
@@ -12,7 +12,10 @@ One solve converges from one seed, so the solver starts from several: the refere
 the up to 8 solutions of the nearest OPW arm (robot-model.md §4.2, the standard formulas of
 robot/mada.py) — one per status S — and keeps every distinct converged configuration. The
 selection by status and turn and the errors are then those of the analytic forms
-(:meth:`robot.kinematics.Kinematics.inverse`).
+(robot/kinematics/family.py ``select``). A call with a reference first solves from the
+reference alone (the nearest solution; about 1-2 ms) and falls back to all seeds when that one
+does not fit the requested S/T. Status S and turn T: those of the nearest OPW arm's formulas
+(robot/kinematics/opwsolver.py).
 
 Units: mm and deg at this interface (MuJoCo uses m and rad). About 1.3 ms per seed.
 """
@@ -24,6 +27,12 @@ from dataclasses import replace
 from typing import Any
 
 import numpy as np
+
+from ..errors import SoftLimitError, WorkspaceError
+from .arm import ArmFamily
+from .family import select
+from .opw import six_rotary
+from .opwsolver import OPWSolver
 
 #: Gauss-Newton steps per seed; convergence takes 4-6 from an OPW seed.
 MAX_STEPS = 60
@@ -37,10 +46,11 @@ class NumericIK:
     """Numeric solutions of flange poses for the :class:`robot.kinematics.Kinematics` `kin`."""
 
     def __init__(self, kin: Any) -> None:
+        # costs 0.5 s (mink, MuJoCo, robot/mjcf.py): only a robot of this family loads them
         import mink  # noqa: PLC0415
         import mujoco  # noqa: PLC0415
 
-        from .mjcf import build_mjcf  # noqa: PLC0415
+        from ..mjcf import build_mjcf  # noqa: PLC0415
 
         self.kin = kin
         arm = replace(kin.machine, robroot_frame=(0.0,) * 6, external_axes=(), external_kinematics=())
@@ -53,7 +63,7 @@ class NumericIK:
     def _seeds(self, T: np.ndarray, ref_deg: np.ndarray | None) -> list[np.ndarray]:
         seeds = [np.asarray(ref_deg, dtype=float)[:6]] if ref_deg is not None else []
         seeds.append(np.array(self.kin.machine.home_deg, dtype=float))
-        seeds += [np.array(r, dtype=float) for r in self.kin._opw_core(T, ref_deg)]
+        seeds += [np.array(r, dtype=float) for r in self.kin.impl.solver.core(T, ref_deg)]
         return seeds
 
     def solve(self, T: np.ndarray, seed_deg: np.ndarray) -> np.ndarray | None:
@@ -97,4 +107,45 @@ class NumericIK:
         return out
 
 
-__all__ = ["MAX_STEPS", "NumericIK"]
+class Numeric(ArmFamily):
+    """The numeric family (module docstring): the solver is built on first use."""
+
+    name = "numeric"
+    title = "numeric (mink on the MuJoCo model; no closed form for this arm)"
+
+    def __init__(self, kin: Any, found: Any = None) -> None:
+        super().__init__(kin, found)
+        m = kin.machine
+        self.solver = OPWSolver(replace(m.opw), float(m.status_phi_deg), kin, self.s_free, self.t_free)
+        self._ik: NumericIK | None = None
+
+    @classmethod
+    def detect(cls, kin: Any) -> Any:
+        return True if six_rotary(kin.machine) else None
+
+
+    @property
+    def ik(self) -> NumericIK:
+        if self._ik is None:
+            self._ik = NumericIK(self.kin)
+        return self._ik
+
+    def solutions(self, flange_T: np.ndarray, ref: np.ndarray | None) -> list[list[float]]:
+        return self.ik.rows(flange_T, ref)
+
+    def inverse(self, flange_T: np.ndarray, status: int | None, turn: int | None,
+                ref: np.ndarray | None) -> np.ndarray:
+        if ref is not None:
+            # the solution reached from the reference: the nearest one, when its S and T fit
+            near = self.ik.rows(flange_T, ref, near_only=True)
+            if near:
+                try:
+                    return select(self, near, status, turn, ref)
+                except (WorkspaceError, SoftLimitError):
+                    pass
+        else:
+            ref = self.kin._home.copy()
+        return select(self, self.solutions(flange_T, ref), status, turn, ref)
+
+
+__all__ = ["MAX_STEPS", "Numeric", "NumericIK"]

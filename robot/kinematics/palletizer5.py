@@ -1,4 +1,5 @@
-"""The closed form of the 5-axis palletizer: ``$DEF_A4FIX`` TRUE, ``$DEF_A5LINK`` FALSE.
+"""The 5-axis palletizer: ``$DEF_A4FIX`` TRUE, ``$DEF_A5LINK`` FALSE (and ``$NUM_AX`` 5 or 6),
+and its closed form.
 
 A4 stays at 0 and A5 is a driven axis, so the flange has five degrees of freedom: its
 position, the direction of the A6 axis within the arm's vertical plane (A2 + A3 + A5), and
@@ -16,6 +17,8 @@ at A4 = 0:
 3. A1..A3 from the OPW arm solution for the A5 point (c4 = 0), A5 from the pitch, A6 from
    the rotation left about the A6 axis.
 
+Status: the OPW arm's; S bit 2 and T bit 3 (A4) select nothing.
+
 Units: mm and deg. Raises nothing itself; :meth:`Palletizer5.check` raises
 robot.mada.MachineDataError when the machine data's wrist does not have this form.
 """
@@ -23,9 +26,14 @@ robot.mada.MachineDataError when the machine data's wrist does not have this for
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
+
+from .arm import ArmFamily
+from .family import check_closed_form
+from .opwsolver import OPWSolver
 
 
 def _rot_about(axis: np.ndarray, angle: float) -> np.ndarray:
@@ -44,46 +52,58 @@ def _rotvecs(v: np.ndarray) -> np.ndarray:
     return np.eye(3) + s * K + (1.0 - c) * (K @ K)
 
 
-class Palletizer5:
-    """The inverse of a 5-axis palletizer, for :class:`robot.kinematics.Kinematics` `kin`."""
+class Palletizer5(ArmFamily):
+    """The 5-axis palletizer (module docstring), for :class:`robot.kinematics.Kinematics` `kin`."""
 
-    def __init__(self, kin: Any) -> None:
-        from dataclasses import replace  # noqa: PLC0415
+    name = "palletizer5"
+    title = "analytic (5-axis palletizer: $DEF_A4FIX)"
+    s_free = 4
+    reduced_orientation = True
+    t_free = 0b01000
 
-        self.kin = kin
+    def __init__(self, kin: Any, found: Any = None) -> None:
+        super().__init__(kin, found)
+        m = kin.machine
+        #: the arm's status (and the OPW solver of the arm for the A5 point: c4 = 0)
+        self.solver = OPWSolver(m.opw, float(m.status_phi_deg), kin, self.s_free, self.t_free)
+        self.arm = OPWSolver(replace(m.opw, c4=0.0), float(m.status_phi_deg), kin, self.s_free, self.t_free)
         q0 = np.zeros(6)
         pts, dirs, T0 = self.joints(q0)
         R0 = T0[:3, :3]
         #: the A6 axis in the flange frame (constant: the flange turns with A6 about it)
         self.a6_in_flange = R0.T @ dirs[5]
-        self.arm_opw = replace(kin._opw, c4=0.0)
         self._a1_sign: float | None = None
+
+    @classmethod
+    def detect(cls, kin: Any) -> Any:
+        m = kin.machine
+        return True if m.a4fix and not m.a5link else None
+
 
     def joints(self, q: np.ndarray) -> tuple[list[np.ndarray], list[np.ndarray], np.ndarray]:
         """Points and unit directions of the six joint axes, and the flange (4x4), at axes `q`
         (deg), in ``$ROBROOT``."""
-        k = self.kin
-        qr = k._kuka_sign * np.radians(np.asarray(q, dtype=float)[:6])
-        Rj = _rotvecs(k._axes * qr[:, None])
+        k = self.kin.joints
+        qr = k.kuka_sign * np.radians(np.asarray(q, dtype=float)[:6])
+        Rj = _rotvecs(k.axes * qr[:, None])
         R = np.eye(3)
         p = np.zeros(3)
         pts, dirs = [], []
         for i in range(6):
-            p = p + R @ k._origins[i]
-            if k._origin_rot:
-                R = R @ k._R_origin[i]
+            p = p + R @ k.origins[i]
+            if k.origin_rot:
+                R = R @ k.R_origin[i]
             pts.append(p.copy())
-            dirs.append(R @ k._axes[i])
+            dirs.append(R @ k.axes[i])
             R = R @ Rj[i]
         T = np.eye(4)
-        T[:3, :3] = R @ k._R_flange
-        T[:3, 3] = p + R @ k._p_flange
+        T[:3, :3] = R @ k.R_flange
+        T[:3, 3] = p + R @ k.p_flange
         return pts, dirs, T
 
-    def rows(self, flange_T: np.ndarray, ref_deg: np.ndarray | None) -> list[list[float]]:
+    def solutions(self, flange_T: np.ndarray, ref_deg: np.ndarray | None) -> list[list[float]]:
         """The solutions (lists of A1..A6, deg, wrapped to (-180, 180]) whose flange is at the
         target's position (1e-6 mm) with the A6 axis the target's, projected into the arm plane."""
-        k = self.kin
         T = np.asarray(flange_T, dtype=float)
         p, R = T[:3, 3], T[:3, :3]
         a_des = R @ self.a6_in_flange
@@ -104,12 +124,7 @@ class Palletizer5:
             w = p - v                                           # the A5 point
             Tw = np.eye(4)
             Tw[:3, 3] = w
-            saved = k._opw
-            k._opw = self.arm_opw
-            try:
-                arms = k._opw_core(Tw, ref_deg)
-            finally:
-                k._opw = saved
+            arms = self.arm.core(Tw, ref_deg)
             seen: set[tuple[float, ...]] = set()
             for row in arms:
                 key = tuple(round(v_, 9) for v_ in row[:3])
@@ -157,8 +172,8 @@ class Palletizer5:
         """Raise robot.mada.MachineDataError (at `where`) unless the closed form gives back
         random configurations of the machine-data chain (A4 = 0;
         robot.kinematics.Kinematics.check_closed_form)."""
-        self.kin.check_closed_form(
-            self.rows, where,
+        check_closed_form(
+            self.kin, self.solutions, where,
             "$DEF_A4FIX=TRUE, $DEF_A5LINK=FALSE: the wrist of this 5-axis palletizer "
             "($DH_4, $DH_5, $TFLWP) does not keep the A6 axis in the arm's plane")
 

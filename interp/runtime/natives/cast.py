@@ -19,9 +19,12 @@ import struct
 
 from krl.semantics import types as T
 
-from .convert import num, real_to_int
-from .errors import KrlRuntimeError, value_invalid
-from .values import UNSET, Arr, Struct
+from ..convert import num, real_to_int
+from ..errors import KrlRuntimeError, value_invalid
+from ..values import UNSET, Arr, Struct
+from .registry import Family
+
+CAST = Family("cast")
 
 _SCALAR = {"INT": "<i", "REAL": "<f", "BOOL": "<i"}
 
@@ -110,6 +113,7 @@ def _offset(ref, what: str, buf: Arr) -> int:
     return off
 
 
+@CAST.native("BOOL CAST_TO(CHAR BUFFER[] :OUT, INT OFFSET :OUT, ...)")
 def cast_to(rt, a) -> None:  # noqa: ARG001 - the built-ins' calling convention
     buf = _buffer(a[0], "CAST_TO")
     off = _offset(a[1], "CAST_TO", buf)
@@ -123,6 +127,7 @@ def cast_to(rt, a) -> None:  # noqa: ARG001 - the built-ins' calling convention
         a[1].set(off + len(data))
 
 
+@CAST.native("BOOL CAST_FROM(CHAR BUFFER[] :IN, INT OFFSET :OUT, ...)")
 def cast_from(rt, a) -> None:  # noqa: ARG001
     buf = _buffer(a[0], "CAST_FROM")
     pos = _offset(a[1], "CAST_FROM", buf)

@@ -1,0 +1,99 @@
+"""Positions and the robot's kinematics (reference 4.8; KSS operate.dat): INV_POS, FORWARD,
+INVERSE.
+
+FORWARD and INVERSE work in the current $TOOL and $BASE, as the motions do, on the simulated
+robot's model (robot/kinematics.py through ``rt.controller.model``). INVERSE reports a
+position out of reach in its STATUS (:data:`INVERSE_NOT_REACHABLE`, :data:`INVERSE_SOFT_LIMIT`)
+and returns START_AXIS: the program is expected to test STATUS.
+"""
+
+from __future__ import annotations
+
+from ..convert import frame_tuple, inv_pos, num
+from ..errors import value_invalid
+from ..sysvars import axis_struct, pos_struct
+from ..values import UNSET, Struct
+from .registry import Family
+
+GEOMETRY = Family("geometry")
+
+
+@GEOMETRY.native("E6POS INV_POS(E6POS POS_VALUES :IN)")
+def _inv_pos(rt, a):
+    return inv_pos(a[0].get())
+
+
+@GEOMETRY.native("E6POS FORWARD(E6AXIS AXVAL :IN, INT STATUS :OUT)")
+def _forward(rt, a):
+    """FORWARD(axes, status): the TCP for ``axes`` with the current $TOOL/$BASE (E6POS)."""
+    # robot.frames costs 0.71 s at first import (scipy's rotations): only a run that calls
+    # FORWARD or INVERSE pays it
+    import numpy as np  # noqa: PLC0415
+
+    from robot.frames import frame_to_matrix, inv_pos as _ip, matrix_to_frame  # noqa: PLC0415
+
+    ax = a[0].get()
+    q = np.array([_real_leaf(ax, k) for k in ("A1", "A2", "A3", "A4", "A5", "A6")], dtype=float)
+    ctl = rt.controller
+    store = rt.sysvars.store
+    tool = frame_to_matrix(*frame_tuple(store["$TOOL"]))
+    base = frame_to_matrix(*frame_tuple(store["$BASE"]))
+    x, y, z, aa, bb, cc = matrix_to_frame(ctl.model.tcp(q, tool, _ip(base)))
+    s, t = ctl.model.kin.status_turn(q)
+    if len(a) > 1 and a[1] is not None:
+        a[1].set(0)
+    return pos_struct({"X": x, "Y": y, "Z": z, "A": aa, "B": bb, "C": cc, "S": s, "T": t})
+
+
+INVERSE_NOT_REACHABLE = 3
+"""INVERSE's STATUS for a position the robot cannot reach (KSS reports "3": its value in
+KUKA's field reports; KUKA does not document the codes). 0 is success."""
+INVERSE_SOFT_LIMIT = 2
+"""INVERSE's STATUS for a position reachable only outside the software limit switches
+(a simulated code: KUKA's BASIS treats 2 and 3 alike, bas.src CheckERRStatus)."""
+
+
+@GEOMETRY.native("E6AXIS INVERSE(E6POS TOOLPOS :IN, E6AXIS START_AXIS :IN, INT STATUS :OUT)")
+def _inverse(rt, a):
+    """``E6AXIS INVERSE(E6POS TOOLPOS :IN, E6AXIS START_AXIS :IN, INT STATUS :OUT)``
+    (reference §4.8; KSS operate.dat): the axes that put the TCP at TOOLPOS in the current
+    $TOOL/$BASE (as FORWARD and the motions do), with TOOLPOS's S and T where it has them and
+    otherwise the solution nearest START_AXIS. STATUS 0; a position out of reach: STATUS
+    :data:`INVERSE_NOT_REACHABLE` (outside the software limits: :data:`INVERSE_SOFT_LIMIT`)
+    and the result is START_AXIS (the program is expected to test STATUS)."""
+    # robot.frames costs 0.71 s at first import (scipy's rotations): only a run that calls
+    # FORWARD or INVERSE pays it
+    import numpy as np  # noqa: PLC0415
+
+    from robot.errors import SoftLimitError, WorkspaceError  # noqa: PLC0415
+    from robot.frames import frame_to_matrix  # noqa: PLC0415
+
+    pos = a[0].get()
+    start = a[1].get() if len(a) > 1 and a[1] is not None else None
+    ctl = rt.controller
+    ref = (np.array([_real_leaf(start, k) for k in ("A1", "A2", "A3", "A4", "A5", "A6")], dtype=float)
+           if start is not None else np.array(ctl.axis_act(), dtype=float)[:6])
+    store = rt.sysvars.store
+    tool = frame_to_matrix(*frame_tuple(store["$TOOL"]))
+    base = frame_to_matrix(*frame_tuple(store["$BASE"]))
+    target = frame_to_matrix(*frame_tuple(pos, "INVERSE position"))
+    st = pos.f.get("S", UNSET) if isinstance(pos, Struct) else UNSET
+    tu = pos.f.get("T", UNSET) if isinstance(pos, Struct) else UNSET
+    code = 0
+    try:
+        q = ctl.model.ik(target, np.linalg.inv(tool), base, None if st is UNSET else int(num(st)),
+                         None if tu is UNSET else int(num(tu)), ref)
+    except SoftLimitError:
+        q, code = ref, INVERSE_SOFT_LIMIT
+    except WorkspaceError:
+        q, code = ref, INVERSE_NOT_REACHABLE
+    if len(a) > 2 and a[2] is not None:
+        a[2].set(code)
+    return axis_struct(q)
+
+
+def _real_leaf(s, k):
+    v = s.f.get(k, 0.0) if isinstance(s, Struct) else UNSET
+    if v is UNSET:
+        raise value_invalid(k)
+    return float(num(v))

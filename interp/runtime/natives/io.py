@@ -1,0 +1,67 @@
+"""Inputs, outputs and the controller's channels (reference 5.12, 4.7): PULSE, COPEN, CWRITE,
+CREAD, CCLOSE, CIOCTL, GET_SIG_INF.
+
+PULSE sets an output for a time (``rt.pulse``). COPEN(:SER_3, HANDLE) finds no device on any
+channel: HANDLE 0, the channel not connected (:func:`_copen`). CWRITE writes to the $CMD
+channel only. Unsupported: CREAD, CCLOSE, CIOCTL, GET_SIG_INF and CWRITE channels other than
+$CMD stop the program with a clear "not supported" run-time error.
+"""
+
+from __future__ import annotations
+
+from ..convert import ref_text, to_bool
+from ..errors import KrlRuntimeError
+from ..values import Channel, EnumValue, Struct
+from .args import int_arg, real_arg
+from .registry import Family
+
+IO = Family("I/O")
+
+
+@IO.native("PULSE(BOOL SIGNAL :OUT, BOOL LEVEL :IN, REAL DURATION :IN)")
+def _pulse(rt, a):
+    sig, level, dur = a[0], a[1], a[2]
+    lvl = to_bool(level.get(), "PULSE level")
+    d = real_arg(dur, "PULSE duration")
+    rt.pulse(sig, lvl, d)
+
+
+@IO.native("COPEN(...)")
+def _copen(rt, a):
+    """``COPEN(:SER_3, HANDLE)``: open a channel of the controller. No device answers on any
+    channel in the simulation: the channel is *not connected*, HANDLE is 0 (KUKA: a handle > 0
+    for an open channel, 0 when it could not be opened), and the run notes it once per channel."""
+    if len(a) != 2 or a[0] is None or not isinstance(a[0].peek(), Channel):
+        raise KrlRuntimeError("COPEN needs a channel name and a handle variable: COPEN(:SER_3, HANDLE)")
+    ch = a[0].peek()
+    a[1].set(0)
+    key = f"COPEN {ch.name}"
+    if key not in rt.noted:
+        rt.noted.add(key)
+        rt.message(f"not simulated: channel :{ch.name} is not connected (no device on it): COPEN gives HANDLE 0")
+    return None
+
+
+@IO.native("CWRITE(INT CHANNEL :IN, STATE_T STATE :OUT, MODUS_T MODE :OUT, CHAR FORMAT[] :IN, ...)")
+def _cwrite(rt, a):
+    ch = int_arg(a[0], "channel")
+    cmd = rt.sysvars.store.get("$CMD")
+    fmt = ref_text(a[3], "CWRITE format") if len(a) > 3 else ""
+    if ch != cmd:
+        raise KrlRuntimeError("CWRITE: only the $CMD channel is supported by this simulator")
+    rt.message(f"CWRITE $CMD: {fmt}")
+    st = a[1].peek() if a[1] is not None else None
+    if isinstance(st, Struct) and "RET1" in st.f:
+        st.f["RET1"] = EnumValue("CMD_OK")
+
+
+def _unsupported(name):
+    def fn(rt, a):
+        raise KrlRuntimeError(f"{name} is not supported by this simulator")
+    return fn
+
+
+IO.add("CREAD(INT CHANNEL :IN, STATE_T STATE :OUT, MODUS_T MODE :OUT, ...)", _unsupported("CREAD"))
+IO.add("CCLOSE(...)", _unsupported("CCLOSE"))
+IO.add("CIOCTL(...)", _unsupported("CIOCTL"))
+IO.add("INT GET_SIG_INF(CHAR SIGNAME[] :IN, ...)", _unsupported("GET_SIG_INF"))

@@ -1,0 +1,42 @@
+"""System functions and package routines that the simulator does not implement: they stand in
+for KUKA's software (interp/runtime/kss.py: counted, one note per run, listed in the run
+summary). In a backup a procedure does nothing and a function returns the zero value of its
+result type (of the type its use gives it, for an ANY result); outside a backup, or where no
+such value exists, the run stops with "routine NAME not found", as on a controller without the
+software. Each declaration says what a call gives.
+"""
+
+from __future__ import annotations
+
+from .registry import Family
+
+# with a documented signature (reference 4.8)
+KSS = Family("KUKA system functions")
+
+_ZERO_OF_USE = ("in a backup: the zero value of the type its use gives it (KUKA's software stand-in, noted "
+                "once); with no such use, or elsewhere, the run stops: routine NAME not found")
+
+KSS.stand_in("REAL DIGIN(...)", "in a backup: 0.0 (KUKA's software stand-in, noted once); elsewhere the run "
+                                "stops: routine DIGIN not found")
+KSS.stand_in("E6POS GET_SINGUL(...)", "in a backup: an E6POS of zeros (KUKA's software stand-in, noted once); "
+                                      "elsewhere the run stops: routine GET_SINGUL not found")
+for _sig in ("ANY EK(...)", "ANY EB(...)", "ANY LK(...)", "ANY TOOL_ADJ(...)", "ANY SYNC(...)"):
+    KSS.stand_in(_sig, _ZERO_OF_USE)
+
+# KUKA's system modules, known by name only (functions.yaml ``lenient: system``)
+SYSTEM_MODULES = Family("KUKA system modules", lenient="system")
+
+_NAME_ONLY = ("in a backup: a procedure does nothing, a function returns the zero value of the type its use "
+              "gives it (KUKA's software stand-in, noted once); elsewhere the run stops: routine NAME not found")
+
+SYSTEM_MODULES.krl("IR_STOPM", "ir_stopm.src")
+SYSTEM_MODULES.krl("USE_CM_PRO_VALUES", "collmonlib.src")
+for _name in ("SET_CD_PARAMS", "USE_CD_PARAMS", "SET_TQ_VALUES", "GET_COLLMON_SET",
+              "EB_ABS", "EO", "TEST_BRAKE", "MSGQUIT", "MSGNOTIFY", "MSGSTATE", "MSGDIALOG", "MSGLOOP",
+              "MBX_REC", "ISMESSAGESET", "EMI_RECSTATE"):
+    SYSTEM_MODULES.stand_in(_name, _NAME_ONLY)
+
+# KUKA.FRI (the LBR's Fast Robot Interface), known by name only (``lenient: fri``)
+FRI = Family("FRI", lenient="fri")
+for _name in ("FRIOPEN", "FRICLOSE", "FRISTART", "FRISTOP", "FRISETUP"):
+    FRI.stand_in(_name, _NAME_ONLY)

@@ -1,0 +1,111 @@
+"""The RobotSensorInterface built-ins (KUKA.RobotSensorInterface manual; docs/network.md).
+Each native converts its KRL arguments and hands them to the run's network hub (net/hub.py,
+net/rsi.py); the behaviour lives there, once, for both interpreters.
+
+RSI functions return an RSIERR number as INT (``RSIOK`` = 0, :data:`RSI_CONSTANTS`).
+"""
+
+from __future__ import annotations
+
+from ..errors import KrlRuntimeError, value_invalid
+from ..values import Arr, EnumValue
+from .eki import NOT_SIMULATED, network
+from .registry import Family
+
+# RSI's routines are declared on the controller (the option's EXTFCTP lines): known by name
+# only, as functions.yaml's ``lenient: rsi``
+RSI = Family("RSI", lenient="rsi")
+
+# RSIERR's values as INT constants (types.yaml lists RSIERR; KUKA's numbering is not public:
+# the order of the enum, RSIOK = 0, is the decision recorded in docs/network.md).
+RSI_CONSTANTS = {name: i for i, name in enumerate(
+    ("RSIOK", "RSIINVOBJID", "RSIINVPARAM", "RSINOMEM", "RSIINVOBJTYPE", "RSIINVCONN",
+     "RSIALREADYON", "RSINOTON", "RSIOBJUSED"))}
+
+
+def _rsi(method: str):
+    def native(rt, a):
+        return rsi_call(network(rt), rt, method, a)
+    return native
+
+
+def _arg_text(a: list, i: int) -> str:
+    v = a[i].get() if len(a) > i and a[i] is not None else ""
+    return v.text() if isinstance(v, Arr) else str(v)
+
+
+def _arg_enum(a: list, i: int, default: str) -> str:
+    v = a[i].get() if len(a) > i and a[i] is not None else None
+    return v.name.upper() if isinstance(v, EnumValue) else default
+
+
+def rsi_call(hub, rt, method: str, a: list):
+    """RSI_CREATE(NAME, CONTID :OUT, BOOL), RSI_DELETE(CONTID), RSI_ON(#ABSOLUTE|#RELATIVE
+    [, #IPO|#IPO_FAST]), RSI_OFF(), RSI_MOVECORR() (waits until the STOP object or an error
+    ends it), RSI_SETPUBLICPAR(CONTID, OBJ, PARAM, VALUE), RSI_GETPUBLICPAR(CONTID, OBJ,
+    PARAM, VALUE :OUT); RSI 5's RSI_LOAD(NAME), RSI_ACTIVATE(NAME), RSI_PROCESS_ON(mode),
+    RSI_PROCESS_OFF(), RSI_DEACTIVATE, RSI_UNLOAD as the same. net/rsi.py holds the behaviour.
+    Returns the RSIERR number (INT)."""
+    from net.rsi import RSIOK  # noqa: PLC0415
+
+    from ..convert import num  # noqa: PLC0415
+
+    rsi = hub.partner("rsi").instance()
+    ctl = rt.controller
+    if method == "create":
+        ret = rsi.create(_arg_text(a, 0))
+        if ret == RSIOK and len(a) > 1 and a[1] is not None:
+            a[1].set(1)
+        return ret
+    if method == "delete":
+        return rsi.delete()
+    if method == "activate":
+        return RSIOK if rsi.ctx is not None else RSI_CONSTANTS["RSIINVOBJID"]
+    if method == "on":
+        rt.wait_main_run(rt.current_task)     # RSI_ON stops the advance run: it corrects from the robot at rest
+        return rsi.start(ctl, _arg_enum(a, 0, "RELATIVE"), _arg_enum(a, 1, "IPO") == "IPO_FAST")
+    if method == "off":
+        rt.wait_main_run(rt.current_task)
+        return rsi.off(ctl)
+    if method == "setpar":
+        if len(a) < 4 or a[3] is None:
+            raise value_invalid("RSI_SETPUBLICPAR value")
+        return rsi.set_param(_arg_text(a, 1), _arg_text(a, 2), float(num(a[3].get(), "RSI_SETPUBLICPAR value")))
+    if method == "getpar":
+        ret, v = rsi.get_param(_arg_text(a, 1), _arg_text(a, 2))
+        if len(a) > 3 and a[3] is not None:
+            a[3].set(v)
+        return ret
+    # movecorr: the robot follows the corrections only, until the STOP object or an error
+    if not rsi.on:
+        raise KrlRuntimeError("RSI_MOVECORR without RSI_ON")
+    task = rt.current_task
+    rt.wait_main_run(task)
+    while rsi.on and not rsi.stopped and not rsi.failed:
+        rt.yield_cycle(task)
+    return None
+
+
+RSI.add("RSI_CREATE", _rsi("create"))
+RSI.add("RSI_DELETE", _rsi("delete"))
+RSI.add("RSI_LOAD", _rsi("create"))
+RSI.add("RSI_ACTIVATE", _rsi("activate"))
+RSI.add("RSI_ON", _rsi("on"))
+RSI.add("RSI_OFF", _rsi("off"))
+RSI.add("RSI_MOVECORR", _rsi("movecorr"))
+RSI.add("RSI_SETPUBLICPAR", _rsi("setpar"))
+RSI.add("RSI_GETPUBLICPAR", _rsi("getpar"))
+RSI.stand_in("RSI_SETPARAMETER", NOT_SIMULATED)
+RSI.add("RSI_PROCESS_ON", _rsi("on"))
+RSI.add("RSI_PROCESS_OFF", _rsi("off"))
+RSI.stand_in("RSI_RESET", NOT_SIMULATED)
+RSI.stand_in("RSI_CHECKID", NOT_SIMULATED)
+# RSI 5 (iiQKA): a context is loaded and activated by name, the process switched on and off
+RSI.add("RSI_DEACTIVATE", _rsi("activate"))
+RSI.add("RSI_UNLOAD", _rsi("delete"))
+# the sensor-tech routines of RSI 2 (ST_*): not simulated
+for _name in ("ST_ON", "ST_ON1", "ST_OFF", "ST_SKIPSENS", "ST_SETPARAM", "ST_NEWLINK", "ST_ETHERNET",
+              "ST_AXISCORR", "ST_PATHCORR", "ST_MAP2DIGOUT", "ST_DIGIN", "ST_COROB", "ST_DELOBJ", "ST_RESET"):
+    RSI.stand_in(_name, NOT_SIMULATED)
+
+__all__ = ["RSI", "RSI_CONSTANTS", "rsi_call"]

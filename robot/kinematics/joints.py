@@ -1,0 +1,160 @@
+"""The robot's joints as URDF-style joints, and their forward kinematics: the one forward
+kinematics every kinematic family shares (robot-model.md §2-§3; robot/mada.py builds the joints
+from machine data, robot/machine.py from the yaml).
+
+Each joint ``i`` has an origin (translation, mm, and a rotation, URDF rpy) in the link before
+it and a unit axis; a rotary joint turns about its axis by ``kuka_sign * radians(A_i)``, a
+linear one (``JointData.kind == "linear"``, a SCARA's A3) moves along it by ``A_i`` mm. After
+the last joint the fixed flange frame (``flange_pos_mm``, ``flange_quat_wxyz``) gives KUKA's
+flange frame (+Z out of the flange) in ``$ROBROOT``.
+
+:meth:`JointChain.forward` runs robot/simcore.pyx's ``Forward`` when it is built and gives this
+module's numpy/scipy code bit for bit on 64 random axis sets (checked when it is first needed;
+six rotary joints only: the compiled product has no linear joint).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from ..blas import numpy_cblas
+from .compiled import compiled_module
+
+
+class JointChain:
+    """The joints of one robot (:class:`~robot.machine.MachineData`), n = ``len(machine.joints)``.
+
+    Attributes (numpy, mm): ``origins`` (n, 3), ``axes`` (n, 3) unit vectors, ``kuka_sign`` (n,),
+    ``R_origin`` (n, 3, 3), ``origin_rot`` (any joint origin rotated), ``R_flange`` (3, 3) and
+    ``p_flange`` (3,) the last link to the KUKA flange, ``linear`` (n,) bool.
+    """
+
+    def __init__(self, machine: Any) -> None:
+        m = machine
+        self.n = len(m.joints)
+        self.origins = np.array([j.origin_mm for j in m.joints], dtype=float)  # (n, 3) mm
+        axes = np.array([j.joint_axis for j in m.joints], dtype=float)
+        self.axes = axes / np.linalg.norm(axes, axis=1)[:, None]
+        self.kuka_sign = np.array([j.kuka_sign for j in m.joints], dtype=float)  # q_urdf = sign * A
+        self.R_origin = Rotation.from_euler("xyz", [j.origin_rpy_rad for j in m.joints]).as_matrix()
+        self.origin_rot = any(np.any(r) for r in (j.origin_rpy_rad for j in m.joints))
+        w, x, y, z = m.flange_quat_wxyz
+        self.R_flange = Rotation.from_quat([x, y, z, w]).as_matrix()  # last link -> KUKA flange
+        self.p_flange = np.array(m.flange_pos_mm, dtype=float)
+        self.linear = np.array([getattr(j, "kind", "rotary") == "linear" for j in m.joints], dtype=bool)
+        self.any_linear = bool(self.linear.any())
+        self._c: Any = None          # robot/simcore.pyx's Forward of these joints; False: not used
+
+    def forward(self, a: np.ndarray) -> np.ndarray:
+        """FLANGE(a): the KUKA flange frame (4x4, mm) in ``$ROBROOT`` for the axes `a` ((n,),
+        deg or mm), compiled when robot/simcore.pyx's ``Forward`` reproduces :meth:`forward_py`."""
+        c = self._c
+        if c is None:
+            c = self._c = self._compiled()
+        if c:
+            T = np.empty((4, 4))
+            c.forward(a, T)
+            return T
+        return self.forward_py(a)
+
+    def forward_py(self, a: np.ndarray) -> np.ndarray:
+        """:meth:`forward` in numpy and scipy: the reference the compiled forward (robot/simcore.pyx
+        ``Forward``) reproduces bit for bit."""
+        if self.any_linear:
+            return self._forward_mixed(np.asarray(a, dtype=float)[None, :])[0]
+        q = self.kuka_sign * np.radians(a)
+        Rj = Rotation.from_rotvec(self.axes * q[:, None]).as_matrix()  # (n, 3, 3)
+        R = np.eye(3)
+        p = np.zeros(3)
+        for i in range(self.n):
+            p = p + R @ self.origins[i]
+            if self.origin_rot:
+                R = R @ self.R_origin[i]
+            R = R @ Rj[i]
+        T = np.eye(4)
+        T[:3, :3] = R @ self.R_flange
+        T[:3, 3] = p + R @ self.p_flange
+        return T
+
+    def forward_many(self, axes_deg: np.ndarray) -> np.ndarray:
+        """Vectorised :meth:`forward`: axes (N, n) -> flange frames (N, 4, 4), mm."""
+        A = np.atleast_2d(np.asarray(axes_deg, dtype=float))[:, :self.n]
+        if self.any_linear:
+            return self._forward_mixed(A)
+        Q = self.kuka_sign * np.radians(A)
+        N = Q.shape[0]
+        Rj = Rotation.from_rotvec((self.axes[None, :, :] * Q[:, :, None]).reshape(-1, 3)).as_matrix()
+        Rj = Rj.reshape(N, self.n, 3, 3)
+        R = np.broadcast_to(np.eye(3), (N, 3, 3)).copy()
+        p = np.zeros((N, 3))
+        for i in range(self.n):
+            p = p + R @ self.origins[i]
+            if self.origin_rot:
+                R = R @ self.R_origin[i]
+            R = R @ Rj[:, i]
+        T = np.broadcast_to(np.eye(4), (N, 4, 4)).copy()
+        T[:, :3, :3] = R @ self.R_flange
+        T[:, :3, 3] = p + R @ self.p_flange
+        return T
+
+    def _forward_mixed(self, A: np.ndarray) -> np.ndarray:
+        """:meth:`forward_many` of a chain with linear joints (each moves along its axis by its
+        value in mm; the rotary ones as above)."""
+        N = A.shape[0]
+        R = np.broadcast_to(np.eye(3), (N, 3, 3)).copy()
+        p = np.zeros((N, 3))
+        for i in range(self.n):
+            p = p + R @ self.origins[i]
+            if self.origin_rot:
+                R = R @ self.R_origin[i]
+            if self.linear[i]:
+                p = p + (R @ self.axes[i]) * (self.kuka_sign[i] * A[:, i])[:, None]
+            else:
+                R = R @ Rotation.from_rotvec(self.axes[i][None, :] * np.radians(self.kuka_sign[i] * A[:, i])[:, None]
+                                             ).as_matrix()
+        T = np.broadcast_to(np.eye(4), (N, 4, 4)).copy()
+        T[:, :3, :3] = R @ self.R_flange
+        T[:, :3, 3] = p + R @ self.p_flange
+        return T
+
+    def joint_point(self, axes_deg, index: int) -> np.ndarray:
+        """Position (mm, in ``$ROBROOT``) of the origin of joint `index` (0 = A1), rotary joints."""
+        q = self.kuka_sign * np.radians(np.asarray(axes_deg, dtype=float)[:self.n])
+        R = np.eye(3)
+        p = np.zeros(3)
+        for i in range(index + 1):
+            p = p + R @ self.origins[i]
+            if self.origin_rot:
+                R = R @ self.R_origin[i]
+            R = R @ Rotation.from_rotvec(self.axes[i] * q[i]).as_matrix()
+        return p
+
+    def _compiled(self) -> Any:
+        """robot/simcore.pyx's ``Forward`` of these joints when it is built, numpy's BLAS is at
+        hand (robot/blas.py), the chain is six rotary joints and it gives :meth:`forward_py` bit
+        for bit on 64 random axis sets (wide angles, small ones, zeros and signed zeros); else
+        False."""
+        sc = compiled_module()
+        if sc is None or self.n != 6 or self.any_linear:
+            return False
+        gemm, gemv = numpy_cblas("dgemm"), numpy_cblas("dgemv")
+        if not gemm or not gemv:
+            return False
+        c = sc.Forward(gemm, gemv, self.origins.tolist(), self.axes.tolist(), self.kuka_sign.tolist(),
+                       self.R_origin, self.origin_rot, self.R_flange, self.p_flange.tolist())
+        rng = np.random.default_rng(39)
+        T = np.empty((4, 4))
+        for i in range(64):
+            a = rng.uniform(-360.0, 360.0, 6) * (1e-4 if i % 4 == 1 else 1.0)
+            if i % 3 == 0:
+                a[rng.integers(0, 6)] = -0.0 if i % 2 else 0.0
+            c.forward(a, T)
+            if T.tobytes() != self.forward_py(a).tobytes():
+                return False
+        return c
+
+
+__all__ = ["JointChain"]

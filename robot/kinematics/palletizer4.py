@@ -1,0 +1,120 @@
+"""The 4-axis palletizer (KUKA's KR ... PA: ``$DEF_A4FIX`` and ``$DEF_A5LINK``, or
+``$DEF_A4FIX`` with ``$NUM_AX=4``; docs/robot.md "The palletizers").
+
+A4 stays at 0 and the parallelogram leads A5 so that the flange keeps looking down (A2 + A3 +
+A5 keeps its HOME value): a flange pose has four degrees of freedom, X, Y, Z and the rotation
+about the vertical. The pose's tilt (its B and C against the vertical) is not followed: KUKA's
+4-axis transformation has no axis for it, and the flange keeps the nearest vertical pose (the
+rotation about the vertical closest in the least-squares sense). The arm plane's direction is
+that of the flange seen from the A1 axis; the A5 point lies the fixed offset back from the
+flange in that plane; OPW solves the arm for that point (``c4 = 0``). Only rows that put the
+flange where asked (1e-6 mm) are kept.
+
+The model keeps KUKA's six axis numbers (A4 fixed at 0, A5 led), so the robot has six joints.
+Status: the OPW arm's; S bit 2 and T bits 3, 4 (A4, A5) select nothing (a palletizer cannot
+choose the sign of its led A5: the backup's points carry S 6 / T 18 where the model's A5 is +4°).
+
+The rows run compiled (robot/simcore.pyx ``Palletizer4``: the same rows) when it is built.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+from typing import Any
+
+import numpy as np
+
+from .compiled import compiled_module
+from .arm import ArmFamily
+from .family import check_closed_form
+from .opwsolver import OPWSolver
+
+
+class Palletizer4(ArmFamily):
+    """The 4-axis palletizer (module docstring)."""
+
+    name = "palletizer4"
+    title = "analytic (4-axis palletizer: $DEF_A4FIX, A5 led by the parallelogram)"
+    s_free = 4
+    reduced_orientation = True
+    t_free = 0b11000
+
+    def __init__(self, kin: Any, found: Any = None) -> None:
+        super().__init__(kin, found)
+        m = kin.machine
+        q = np.array(m.home_deg, dtype=float)
+        q[0] = q[3] = q[5] = 0.0
+        T = kin.joints.forward(q)
+        #: the flange's offset from the A5 axis point in the arm's vertical plane at A1 = 0 (mm),
+        #: and the flange rotation at HOME with A1 = A6 = 0
+        self.pa = (T[:3, 3] - kin.joints.joint_point(q, 4), T[:3, :3].copy())
+        self.solver = OPWSolver(replace(m.opw, c4=0.0), float(m.status_phi_deg), kin, self.s_free, self.t_free)
+        self._c_pal: Any = None     # robot/simcore.pyx's 4-axis palletizer rows; False: not used
+
+    @classmethod
+    def detect(cls, kin: Any) -> Any:
+        return True if kin.machine.a5link else None
+
+    def check(self, where: str) -> None:
+        """The 4-axis closed form must give back random linked configurations of the chain
+        (A4 = 0, A2 + A3 + A5 as at HOME); robot.mada.MachineDataError otherwise."""
+        home = self.kin._home
+
+        def link(q):
+            q[4] = home[4] + home[1] + home[2] - q[1] - q[2]
+
+        led = "$NUM_AX=4" if "a5_led" in self.kin.machine.provenance else "$DEF_A5LINK=TRUE"
+        check_closed_form(
+            self.kin, self.solutions, where,
+            f"$DEF_A4FIX=TRUE, A5 led ({led}): this palletizer's arm ($TIRORO, $TX3P3, $DH_4, $DH_5, "
+            f"$TFLWP) is not one the 4-axis closed form covers", link=link)
+
+
+    def solutions(self, flange_T: np.ndarray, ref_deg: np.ndarray | None) -> list[list[float]]:
+        """The rows of a flange pose (module docstring); A4 is 0."""
+        offset, R_ref = self.pa
+        T = np.asarray(flange_T, dtype=float)
+        R_rel = T[:3, :3] @ R_ref.T
+        psi = math.atan2(R_rel[1, 0] - R_rel[0, 1], R_rel[0, 0] + R_rel[1, 1])
+        c, s = math.cos(psi), math.sin(psi)
+        Rz = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+        R_v = Rz @ R_ref
+        p = T[:3, 3]
+        c_pal = self._c_pal
+        if c_pal is None:
+            c_pal = self._c_pal = self._compiled()
+        if c_pal:
+            # the compiled mirror of the loop below (robot/simcore.pyx Palletizer4): the same rows
+            return c_pal.rows(R_v, p, ref_deg)
+        rows: list[list[float]] = []
+        phi = math.atan2(p[1], p[0])
+        for arm in (phi, phi + math.pi):
+            ca, sa = math.cos(arm), math.sin(arm)
+            w = p - np.array([ca * offset[0] - sa * offset[1], sa * offset[0] + ca * offset[1], offset[2]])
+            Tw = np.eye(4)
+            Tw[:3, :3] = R_v
+            Tw[:3, 3] = w
+            for row in self.solver.core(Tw, ref_deg):
+                if abs(row[3]) < 1e-6:
+                    row[3] = 0.0
+                elif abs(abs(row[3]) - 180.0) < 1e-6:
+                    continue                    # the flipped wrist: A4 cannot turn
+                if float(np.abs(self.kin.forward(row)[:3, 3] - p).max()) < 1e-6:
+                    rows.append(row)
+        return rows
+
+    def _compiled(self) -> Any:
+        """robot/simcore.pyx's ``Palletizer4`` for this robot, or False (not built, stale, or
+        switched off: :meth:`solutions` runs its Python loop)."""
+        sc = compiled_module()
+        if sc is None or not self.solver.compiled:
+            return False
+        j = self.kin.joints
+        return sc.Palletizer4(self.solver.c, j.origins.tolist(), j.axes.tolist(), j.kuka_sign.tolist(),
+                                             j.R_origin.tolist(), j.origin_rot, j.R_flange.tolist(),
+                                             j.p_flange.tolist(), self.pa[0].tolist())
+
+
+
+__all__ = ["Palletizer4"]

@@ -1,0 +1,287 @@
+"""A spin costs nothing (issue 48, interp/runtime/spin.py): a task whose loop runs the same
+statements over the same state is parked until something it reads can change, and the run is the
+run it would have been — every I/O change at its time, the end, the step count, the automatic
+cell's answers — identically in both interpreters.
+
+Each test runs a program with the spin watch (``SpinWatch.enabled``) and without it, untraced (a
+traced run executes every statement), and compares what the run did: the I/O log
+(robot/io.py ``IOImage.log``: time, signal, value, source), how it ended, the steps. Expected
+times are IPO cycles of 12 ms worked out by hand (a stimulus ``at: t`` is applied in the first
+cycle k with k * 12 ms >= t; the tasks of that cycle read it; a task's I/O change is logged at the
+time of the cycle's start)."""
+
+from __future__ import annotations
+
+import pytest
+
+from interp.realprograms import REPORT_STEPS, entries_of, find_backups, report_run, step_limit
+from interp.run import make_runtime
+from interp.runtime import spin as S
+from interp.runtime.scheduler import SUBMIT_BUDGET
+from interp.runtime.sysvars import _LIVE, CONSTANT_NAMES
+from krl.files import SHARED_CORPUS
+
+from .helpers import write
+
+INTERPS = ("tree", "vm")
+
+#: the backup's submit program in miniature: polls an input, reflects it on an output; a second
+#: output follows a global flag the robot program sets
+SPS = """
+DEF sps()
+  LOOP
+    IF $IN[5] THEN
+      $OUT[5] = TRUE
+    ELSE
+      $OUT[5] = FALSE
+    ENDIF
+    IF FLAG THEN
+      $OUT[4] = TRUE
+    ENDIF
+    CHECK()
+  ENDLOOP
+END
+
+DEF CHECK()
+  INT n
+  n = 3
+  IF n > 5 THEN
+    $OUT[6] = TRUE
+  ENDIF
+END
+"""
+
+PROG = """
+DEF prog()
+  WAIT SEC 3.0
+  FLAG = TRUE
+  WAIT FOR $OUT[5]
+  $OUT[7] = TRUE
+  WAIT SEC 1.0
+END
+"""
+
+#: a robot program that moves (the idle watch cannot skip its cycles) while the submit program polls
+MOVING = """
+DEF prog()
+  INT i
+  FOR i = 1 TO 8
+    PTP {A1 30, A2 -90, A3 90, A4 0, A5 30, A6 0}
+    PTP {A1 -30, A2 -90, A3 90, A4 0, A5 30, A6 0}
+  ENDFOR
+  FLAG = TRUE
+  WAIT FOR $OUT[5]
+  $OUT[7] = TRUE
+END
+"""
+
+DAT = """
+DEFDAT prog PUBLIC
+  DECL GLOBAL BOOL FLAG = FALSE
+  DECL GLOBAL INT X = 0
+ENDDAT
+"""
+
+
+def _run(tmp_path, prog: str, sub: str, *, interp: str, enabled: bool = True, shadow: bool = False,
+         stimuli: str | None = None, max_sim_time: float = 30.0, max_steps: int = 10_000_000):
+    p = write(tmp_path, "prog.src", prog)
+    write(tmp_path, "prog.dat", DAT)
+    s = write(tmp_path, "sps.sub", sub)
+    inputs = write(tmp_path, "stimuli.yaml", stimuli) if stimuli else None
+    rt, _ = make_runtime(p, inputs=inputs, trace=None, max_sim_time=max_sim_time, max_steps=max_steps,
+                         mujoco=False, submit=[s], check=False, interp=interp)
+    rt.scheduler.spin.enabled = enabled
+    rt.scheduler.spin.shadow = shadow
+    res = rt.run()
+    return rt, res
+
+
+def _same_run(tmp_path, prog: str, sub: str, interp: str, **kw):
+    """Run with and without the spin watch; both runs must agree; return the parked run."""
+    off, r_off = _run(tmp_path, prog, sub, interp=interp, enabled=False, **kw)
+    on, r_on = _run(tmp_path, prog, sub, interp=interp, **kw)
+    assert on.controller.io.log == off.controller.io.log
+    assert (r_on.reason, r_on.file, r_on.line, r_on.sim_time, r_on.steps) == \
+        (r_off.reason, r_off.file, r_off.line, r_off.sim_time, r_off.steps)
+    sw = on.scheduler.spin
+    assert (sw.diverged, sw.missed) == (0, 0), sw.why
+    return on, r_on
+
+
+@pytest.mark.parametrize("interp", INTERPS)
+def test_a_submit_program_is_parked_while_the_robot_moves(tmp_path, interp):
+    """$IN[5] at 5.0 s, while the robot moves: the submit program sets $OUT[5] in that cycle."""
+    stim = "- at: 5.0\n  set: {\"$IN[5]\": true}\n"
+    rt, res = _same_run(tmp_path, MOVING, SPS, interp, stimuli=stim)
+    assert res.reason == "completed"
+    assert (5.004, "$OUT[5]", True) in [(round(t, 3), n, v) for t, n, v, _s in rt.controller.io.log]
+    assert rt.scheduler.idle.skipped == 0              # the robot moved: nothing to fast-forward
+    assert rt.scheduler.spin.skipped > 0.8 * res.steps
+
+
+@pytest.mark.parametrize("interp", INTERPS)
+def test_a_polling_submit_program_is_parked_and_the_run_is_the_same(tmp_path, interp):
+    """The robot program waits 3 s (250 cycles), sets FLAG, waits for $OUT[5], which the submit
+    program sets when the stimulus of 20.0 s sets $IN[5] (cycle 1667, 20.004 s)."""
+    stim = "- at: 20.0\n  set: {\"$IN[5]\": true}\n"
+    rt, res = _same_run(tmp_path, PROG, SPS, interp, stimuli=stim)
+    assert res.reason == "completed"
+    log = [(round(t, 3), name, v) for t, name, v, _src in rt.controller.io.log]
+    assert (20.004, "$IN[5]", True) in log
+    assert (20.004, "$OUT[5]", True) in log     # the submit program reads it in its cycle
+    assert (20.016, "$OUT[7]", True) in log     # the robot program, which runs first, in the next
+    sw = rt.scheduler.spin
+    assert sw.parks >= 2 and sw.wakes >= 2      # woken by FLAG = TRUE and by the stimulus
+    # nearly all the steps the run counts were counted, not run (the idle watch skipped the
+    # cycles in which nothing at all happened: they count no step)
+    assert sw.skipped > 0.9 * res.steps
+
+
+def test_both_interpreters_park_and_end_alike(tmp_path):
+    stim = "- at: 20.0\n  set: {\"$IN[5]\": true}\n"
+    out = []
+    for interp in INTERPS:
+        rt, res = _run(tmp_path, PROG, SPS, interp=interp, stimuli=stim)
+        out.append((rt.controller.io.log, res.reason, res.steps, res.sim_time, rt.scheduler.spin.parks))
+    assert out[0] == out[1]
+
+
+@pytest.mark.parametrize("interp", INTERPS)
+@pytest.mark.parametrize("limit", [50_000, 50_037])
+def test_the_step_limit_ends_the_run_at_the_same_statement(tmp_path, interp, limit):
+    """The robot moves while the submit program spins: the run ends at the step limit, at the
+    statement and with the steps of the unparked run (a parked task is woken, or not parked,
+    when the limit comes near)."""
+    rt, res = _same_run(tmp_path, MOVING, SPS, interp, max_steps=limit)
+    assert res.reason == "max_steps" and res.steps == limit + 1
+    assert rt.scheduler.spin.parks >= 1
+
+
+@pytest.mark.parametrize("interp", INTERPS)
+def test_a_write_undone_within_the_pass_is_not_a_spin(tmp_path, interp):
+    """X = 1 ... X = 0 in each pass: the state is the same at the ends of the pass, but the robot
+    program sees X = 1 whenever a time slice ends between the two: never parked."""
+    sub = SPS.replace("    CHECK()\n", "    X = 1\n    CHECK()\n    X = 0\n")
+    prog = PROG.replace("WAIT FOR $OUT[5]", "WAIT FOR X == 1")
+    rt, _res = _same_run(tmp_path, prog, sub, interp)
+    assert rt.scheduler.spin.parks == 0
+    assert any(k.startswith("wrote X") for k in rt.scheduler.spin.why)
+
+
+@pytest.mark.parametrize("interp", INTERPS)
+def test_a_running_timer_read_each_pass_is_not_a_spin(tmp_path, interp):
+    """IF $TIMER[1] > 5000: the clock moves between passes; the output rises at 5.0 s of the
+    timer, with and without the watch."""
+    sub = SPS.replace("    CHECK()\n", "    IF $TIMER[1] > 5000 THEN\n      $OUT[8] = TRUE\n    ENDIF\n") \
+        .replace("DEF sps()\n", "DEF sps()\n  $TIMER[1] = 0\n  $TIMER_STOP[1] = FALSE\n")
+    rt, _res = _same_run(tmp_path, PROG, sub, interp, max_sim_time=12.0)
+    assert rt.scheduler.spin.parks == 0
+    assert [name for _t, name, v, _s in rt.controller.io.log if name == "$OUT[8]" and v]
+
+
+@pytest.mark.parametrize("interp", INTERPS)
+def test_an_interrupt_of_the_parked_task_runs_where_it_would(tmp_path, interp):
+    """INTERRUPT ON $IN[9] in the submit program; the stimulus at 7.0 s (cycle 584, 7.008 s):
+    its routine runs at the submit program's next resume, and sets $OUT[9] then."""
+    sub = SPS.replace("DEF sps()\n", "DEF sps()\n  INTERRUPT DECL 10 WHEN $IN[9] DO ON9()\n  INTERRUPT ON 10\n") + \
+        "\nDEF ON9()\n  $OUT[9] = TRUE\nEND\n"
+    stim = "- at: 7.0\n  set: {\"$IN[9]\": true}\n- at: 20.0\n  set: {\"$IN[5]\": true}\n"
+    rt, _res = _same_run(tmp_path, PROG, sub, interp, stimuli=stim)
+    log = [(round(t, 3), name) for t, name, v, _src in rt.controller.io.log if v is True]
+    assert (7.008, "$OUT[9]") in log
+    assert rt.scheduler.spin.parks >= 2
+
+
+@pytest.mark.parametrize("interp", INTERPS)
+def test_a_pass_reading_the_robot_position_is_parked_only_at_rest(tmp_path, interp):
+    sub = SPS.replace("    CHECK()\n", "    IF $POS_ACT.X > 100000 THEN\n      $OUT[3] = TRUE\n    ENDIF\n")
+    prog = PROG.replace("  WAIT SEC 3.0\n", "  PTP {A1 20, A2 -90, A3 90, A4 0, A5 30, A6 0}\n  WAIT SEC 3.0\n")
+    stim = "- at: 20.0\n  set: {\"$IN[5]\": true}\n"
+    rt, _res = _same_run(tmp_path, prog, sub, interp, stimuli=stim)
+    assert rt.scheduler.spin.parks >= 1
+
+
+@pytest.mark.parametrize("interp", INTERPS)
+def test_parking_predicts_where_the_task_stands(tmp_path, interp):
+    """Shadow mode: the spin is not parked, the task runs on, and at the end of every cycle the
+    statement and frames parking would report are those it has."""
+    stim = "- at: 5.0\n  set: {\"$IN[5]\": true}\n"
+    rt, _res = _run(tmp_path, MOVING, SPS, interp=interp, stimuli=stim, shadow=True)
+    sw = rt.scheduler.spin
+    assert sw.shadow_checks > 200
+    assert sw.shadow_errors == 0, sw.why
+
+
+def test_every_computed_system_variable_has_a_class():
+    """A new computed system variable (interp/runtime/sysvars.py) must be placed: constant,
+    I/O, the robot's motion, the tasks' state, or the clock (whose reads stop a recording)."""
+    clock = {k for k, make in _LIVE.items() if getattr(make, "clock", False)}
+    placed = CONSTANT_NAMES | S.IO_NAMES | S.MOTION_NAMES | S.STATE_NAMES | clock
+    assert set(_LIVE) - placed == set()
+
+
+# ----------------------------------------------------------------------------- real programs
+#: entry points whose whole runs spend nearly all their steps in the backups' SPS.SUB
+REAL = ("ingeniado__KRC4-Robot-Palletizer/System/sps.sub", "ingeniado__KRC4-Robot-Palletizer/main.src",
+        "ingeniado__KRC4-Robot-Palletizer/Program/SACO_5/saco_5_m2.src",
+        "khrzysio__KRC4_test/R1/System/sps.sub", "khrzysio__KRC4_test/R1/Program/CELL/Frame/Mill_FrameAut3.src",
+        "HugoDanielson__ChinaMilling/KRC/R1/System/sps.sub")
+
+
+def _real(program, interp: str, enabled: bool, seconds: float, shadow: bool = False):
+    sub = program.suffix.lower() == ".sub"
+    robot, submit, _t, _s = report_run(program, None, seconds, REPORT_STEPS, auto=True)
+    steps = step_limit(REPORT_STEPS, seconds, len(submit) + sub, robot.ipo_cycle_s)
+    rt, _ = make_runtime(program, trace=None, mujoco=False, max_sim_time=seconds, max_steps=steps, submit=submit,
+                         check=False, inputs="auto", robot=robot, interp=interp,
+                         robot_budget=SUBMIT_BUDGET if sub else None)
+    rt.scheduler.spin.enabled = enabled
+    rt.scheduler.spin.shadow = shadow
+    res = rt.run()
+    answers = [a.describe() for a in rt.autocell.answers]
+    return rt, (rt.controller.io.log, answers, res.reason, res.file, res.line, res.sim_time, res.steps)
+
+
+@pytest.mark.parametrize("rel", REAL)
+def test_real_whole_runs_are_the_same_parked(rel):
+    """With ``--inputs auto``, 30 s: the same I/O, answers, end and steps with and without the
+    spin watch, on the VM; and the tree interpreter's parked run the VM's."""
+    program = SHARED_CORPUS / rel
+    if not program.is_file():
+        pytest.skip("the shared corpus is not here")
+    _rt, off = _real(program, "vm", False, 30.0)
+    rt, on = _real(program, "vm", True, 30.0)
+    assert on == off
+    assert (rt.scheduler.spin.diverged, rt.scheduler.spin.missed) == (0, 0)
+    _rt, tree = _real(program, "tree", True, 30.0)
+    assert tree == on
+
+
+@pytest.mark.slow
+def test_every_corpus_entry_point_is_the_same_parked_and_shadowed():
+    """The nightly's sweep: every entry point of the corpus, 120 s with ``--inputs auto``, parked
+    and not (the same run), and shadowed (parking predicts where each spin stands)."""
+    if not SHARED_CORPUS.is_dir():
+        pytest.skip("the shared corpus is not here")
+    for program in [p for root in find_backups(SHARED_CORPUS) for p in entries_of(root)]:
+        _rt, off = _real(program, "vm", False, 120.0)
+        rt, on = _real(program, "vm", True, 120.0)
+        assert on == off, program
+        assert (rt.scheduler.spin.diverged, rt.scheduler.spin.missed) == (0, 0), program
+        rt, _ = _real(program, "vm", True, 120.0, shadow=True)
+        assert rt.scheduler.spin.shadow_errors == 0, (program, rt.scheduler.spin.why)
+
+
+@pytest.mark.parametrize("interp", INTERPS)
+def test_a_submit_program_selected_alone_runs_at_the_submit_pace(tmp_path, interp):
+    """A .sub run as the program (``krl run SPS.SUB``) gets the submit interpreter's time slice,
+    as beside a robot program: 101 slices (cycles 0..100, the run ends when 1.2 s is reached)
+    of SUBMIT_BUDGET steps; its counter changes every pass, so nothing is parked or skipped."""
+    s = write(tmp_path, "alone.sub", "DEF alone()\n  INT n\n  n = 0\n  LOOP\n    n = n + 1\n  ENDLOOP\nEND\n")
+    rt, _ = make_runtime(s, trace=None, max_sim_time=1.2, max_steps=10**7, mujoco=False, check=False,
+                         interp=interp)
+    res = rt.run()
+    assert rt.robot.budget == SUBMIT_BUDGET == 100
+    assert res.steps == 101 * SUBMIT_BUDGET
+    assert rt.scheduler.spin.parks == 0

@@ -1,0 +1,47 @@
+"""tools/whole_run_bench.py (issue 48, "whole runs as the unit of speed"): two worker processes
+(this checkout measured against itself as the baseline) run a corpus entry point with
+``--inputs auto``; the rows have both sides, the same I/O and end, and the nightly reads the
+summary into its figures. No timing is asserted (a benchmark prints ratios; it is not tested by
+time)."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from conformance.nightly.figures import read_night
+from krl.files import SHARED_CORPUS
+
+REPO = Path(__file__).resolve().parent.parent
+#: a short whole run: the ChinaMilling backup's SPS.SUB, idle but for its submit program
+ONLY = "HugoDanielson__ChinaMilling/KRC/R1/System/sps.sub"
+
+
+def test_side_by_side_rows_and_the_nightly_figures(tmp_path):
+    if not (SHARED_CORPUS / ONLY).is_file():
+        pytest.skip("the shared corpus is not here")
+    day = tmp_path / "2026-11-25"
+    day.mkdir()
+    out = day / "whole-runs.json"
+    res = subprocess.run([sys.executable, str(REPO / "tools" / "whole_run_bench.py"), "--baseline", str(REPO),
+                          "--only", ONLY, "--sim-time", "5", "--json", str(out)],
+                         capture_output=True, text=True, cwd=REPO, timeout=600, check=False)
+    assert res.returncode == 0, res.stderr[-2000:]
+    data = json.loads(out.read_text())
+    (row,) = data["rows"]
+    assert row["program"] == ONLY
+    for side in ("new", "base"):
+        r = row[side]
+        assert r["reason"] == "max_sim_time" and r["sim_s"] == pytest.approx(5.0, abs=0.012)
+        assert r["cpu_s"] == pytest.approx(r["setup_s"] + r["run_s"], abs=0.002)
+    assert row["same"] is True            # one checkout against itself: the same I/O and end
+    s = data["summary"]
+    assert s["entry_points"] == 1 and s["same"] == 1 and s["new"]["sim_s"] == pytest.approx(5.0, abs=0.012)
+    assert "speedup of the total" in res.stdout and "same I/O and end on 1 of 1" in res.stdout
+    night = read_night(day)
+    assert night.figures["bench.whole_runs_sim_per_cpu"] == s["new"]["sim_per_cpu"] > 0
+    assert night.figures["whole_runs.over_3s"] == s["new"]["over_3s"]

@@ -1,0 +1,256 @@
+"""Whole runs as the unit of speed (issue 48): every entry point of the corpus backups with
+``--inputs auto`` for 600 s of simulated time, simulated seconds per CPU second for each and
+for the total, side by side with a baseline checkout in one run.
+
+Each entry point (interp/realprograms.py ``entries_of``: module mains, cell.src, each backup's
+SPS.SUB) runs as the real-programs report's ``--inputs auto`` column runs it (``report_run``:
+the robot of the backup or the library robot that reaches its points, the backup's SPS.SUB
+beside it, ``--no-check``, the report's step limit for the time), except that every entry point,
+an SPS.SUB too, gets the same simulated time (``--sim-time``, default 600 s). No trace is
+written: the figure is what a user waits for when a whole cell runs.
+
+One worker process per checkout (``PYTHONPATH=CHECKOUT`` on this interpreter: the checkouts must
+share this venv's dependencies and each needs its generated parser and compiled VM loop, as for
+tools/trace_identity.py) runs the entry points one at a time when the driver asks, so imports are
+paid once (each worker makes one short untimed run first: the process's one-time costs) and the
+two checkouts alternate program by program (the first to run alternates too): both see the same
+load. Each run measures, in its worker, the CPU time (``time.process_time``)
+of making the runtime (reading the backup; ``setup_s``) and of the run (``run_s``); ``cpu_s`` is
+their sum, the figure is ``sim_s / cpu_s``. Each run also gives a digest of every I/O change of
+the run (time, signal, value, source: robot/io.py ``IOImage.log``), the end (reason, simulated
+time, steps), the answers of the automatic cell and the idle time skipped, so two checkouts that
+should agree can be seen to.
+
+Usage::
+
+    python tools/whole_run_bench.py [--baseline CHECKOUT] [--sim-time 600] [--interp vm|tree]
+                                    [--only SUBSTRING] [--limit N] [--json OUT] [--corpus DIR]
+
+Prints one row per entry point (CPU s and simulated s per CPU s of each checkout, the ratio,
+whether the I/O digests and ends agree) and the totals; ``--json`` writes the rows and the
+summary (date, commits, load average at the start and the end). ``make nightly`` runs it without
+a baseline (``whole-runs.json``), and the nightly's history keeps the totals
+(conformance/nightly/figures.py). Exit status 0, 2 on bad usage or when a worker dies.
+"""
+
+from __future__ import annotations
+
+import argparse
+import hashlib
+import json
+import os
+import subprocess
+import sys
+import time
+from datetime import datetime, timezone
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent.parent
+CORPUS = HERE.parent / "shared" / "krl-corpus"
+SIM_TIME_S = 600.0
+
+
+# ---------------------------------------------------------------------------- the worker
+def _run_one(program: Path, sim_time: float, interp: str) -> dict:
+    """One whole run of `program` with ``--inputs auto`` (module docstring), measured in this
+    process (the checkout first on sys.path)."""
+    from interp.realprograms import REPORT_STEPS, report_run, step_limit  # noqa: PLC0415  (once sys.path names the checkout measured)
+    from interp.run import make_runtime  # noqa: PLC0415  (once sys.path names the checkout measured)
+    from interp.runtime.scheduler import SUBMIT_BUDGET  # noqa: PLC0415  (once sys.path names the checkout measured)
+
+    sub = program.suffix.lower() == ".sub"
+    row: dict = {"program": str(program), "interp": interp}
+    c0 = time.process_time()
+    try:
+        robot, submit, _t, _steps = report_run(program, None, sim_time, REPORT_STEPS, auto=True)
+        steps = step_limit(REPORT_STEPS, sim_time, len(submit) + sub, robot.ipo_cycle_s)
+        rt, _ = make_runtime(program, trace=None, mujoco=False, max_sim_time=sim_time, max_steps=steps,
+                             submit=submit, check=False, inputs="auto", robot=robot, interp=interp,
+                             robot_budget=SUBMIT_BUDGET if sub else None)
+        c1 = time.process_time()
+        res = rt.run()
+        c2 = time.process_time()
+    except Exception as exc:  # noqa: BLE001 - the row says so; the other programs go on
+        row.update(reason="exception", text=f"{type(exc).__name__}: {exc}",
+                   setup_s=0.0, run_s=round(time.process_time() - c0, 3), cpu_s=round(time.process_time() - c0, 3),
+                   sim_s=0.0, steps=0, io_events=0, io_sha="", answers=0, idle_s=0.0)
+        return row
+    io = rt.controller.io.log
+    digest = hashlib.sha256()
+    for t, name, value, source in io:
+        digest.update(f"{t:.6f} {name} {value!r} {source}\n".encode())
+    row.update(reason=res.reason, sim_s=round(res.sim_time, 6), steps=res.steps,
+               setup_s=round(c1 - c0, 3), run_s=round(c2 - c1, 3), cpu_s=round(c2 - c0, 3),
+               io_events=len(io), io_sha=digest.hexdigest()[:16],
+               answers=len(rt.autocell.answers) if rt.autocell is not None else 0,
+               idle_s=round(rt.scheduler.idle.skipped * rt.controller.dt, 3),
+               end=[res.reason, res.file and Path(str(res.file)).name, res.line])
+    return row
+
+
+def worker(checkout: Path) -> int:
+    """Serve runs for the driver: one JSON request per line on stdin (``{"program", "sim_time",
+    "interp"}``), one JSON row per line on stdout."""
+    checkout = checkout.resolve()
+    sys.path.insert(0, str(checkout))
+    import interp  # noqa: PLC0415  (once sys.path names the checkout measured)
+
+    if Path(interp.__file__).resolve().parent.parent != checkout:
+        print(json.dumps({"fatal": f"interp comes from {interp.__file__}, not {checkout}"}), flush=True)
+        return 2
+    out = sys.stdout
+    sys.stdout = sys.stderr         # anything a run prints must not break the protocol
+    print(json.dumps({"ready": str(checkout)}), file=out, flush=True)
+    for line in sys.stdin:
+        if not line.strip():
+            continue
+        req = json.loads(line)
+        row = _run_one(Path(req["program"]), float(req["sim_time"]), req["interp"])
+        print(json.dumps(row), file=out, flush=True)
+    return 0
+
+
+# ---------------------------------------------------------------------------- the driver
+class Worker:
+    """A worker process of one checkout (module docstring)."""
+
+    def __init__(self, checkout: Path) -> None:
+        self.checkout = checkout.resolve()
+        env = dict(os.environ, PYTHONPATH=str(self.checkout))
+        self.proc = subprocess.Popen([sys.executable, str(Path(__file__).resolve()), "worker", str(self.checkout)],
+                                     cwd=self.checkout, env=env, stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                                     text=True)
+        first = json.loads(self._line())
+        if "ready" not in first:
+            raise SystemExit(f"error: worker of {self.checkout}: {first.get('fatal', first)}")
+
+    def _line(self) -> str:
+        line = self.proc.stdout.readline()
+        if not line:
+            raise SystemExit(f"error: the worker of {self.checkout} ended (exit {self.proc.wait()})")
+        return line
+
+    def run(self, program: Path, sim_time: float, interp: str) -> dict:
+        self.proc.stdin.write(json.dumps({"program": str(program), "sim_time": sim_time, "interp": interp}) + "\n")
+        self.proc.stdin.flush()
+        return json.loads(self._line())
+
+    def close(self) -> None:
+        self.proc.stdin.close()
+        self.proc.wait()
+
+
+def commit_of(checkout: Path) -> str:
+    res = subprocess.run(["git", "-C", str(checkout), "rev-parse", "--short", "HEAD"], capture_output=True,
+                         text=True, check=False)
+    dirty = subprocess.run(["git", "-C", str(checkout), "status", "--porcelain", "--untracked-files=no"],
+                           capture_output=True, text=True, check=False).stdout.strip()
+    return (res.stdout.strip() or "?") + ("+" if dirty else "")
+
+
+def entry_points(corpus: Path) -> list[Path]:
+    """The entry points of every backup under `corpus` (interp/realprograms.py ``entries_of``)."""
+    from interp.realprograms import entries_of, find_backups  # noqa: PLC0415  (once sys.path names the checkout measured)
+
+    return [p for root in find_backups(corpus) for p in entries_of(root)]
+
+
+def factor(sim: float, cpu: float) -> float:
+    return round(sim / cpu, 1) if cpu > 0 else float("inf")
+
+
+def main(argv: list[str] | None = None) -> int:
+    argv = sys.argv[1:] if argv is None else argv
+    if argv[:1] == ["worker"] and len(argv) == 2:
+        return worker(Path(argv[1]))
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--baseline", metavar="CHECKOUT", help="a checkout to measure side by side (e.g. main)")
+    ap.add_argument("--checkout", default=str(HERE), help="the checkout measured (default: this one)")
+    ap.add_argument("--sim-time", type=float, default=SIM_TIME_S, help="simulated seconds of each run")
+    ap.add_argument("--interp", choices=("vm", "tree"), default="vm")
+    ap.add_argument("--only", default=None, help="only entry points whose path contains this")
+    ap.add_argument("--limit", type=int, default=0)
+    ap.add_argument("--json", default=None, help="write the rows and the summary here")
+    ap.add_argument("--corpus", default=str(CORPUS))
+    ap.add_argument("--no-warm-up", action="store_true", help="time the first run of each worker too")
+    a = ap.parse_args(argv)
+    corpus = Path(a.corpus)
+    if not corpus.is_dir():
+        print(f"no corpus at {corpus}; nothing to do")
+        return 0
+    if a.sim_time <= 0:
+        ap.error("--sim-time takes a positive number of seconds")
+    sys.path.insert(0, str(Path(a.checkout).resolve()))
+    programs = entry_points(corpus)
+    if a.only:
+        programs = [p for p in programs if a.only in str(p)]
+    if a.limit:
+        programs = programs[:a.limit]
+    sides = [("new", Path(a.checkout))] + ([("base", Path(a.baseline))] if a.baseline else [])
+    load0 = os.getloadavg()
+    started = datetime.now(timezone.utc)
+    workers = {name: Worker(co) for name, co in sides}
+    rows = []
+    try:
+        if programs and not a.no_warm_up:
+            # the first run of a process pays its one-time costs (lazy imports, the first
+            # compile of the VM's code, numpy's first calls): one short untimed run each
+            for w in workers.values():
+                w.run(programs[0], min(1.0, a.sim_time), a.interp)
+        names = [n for n, _ in sides]
+        head = f"{'entry point':58s} " + " ".join(f"{n + ' cpu s':>10s} {n + ' sim/cpu':>12s}" for n in names)
+        if a.baseline:
+            head += f" {'speedup':>8s}  same I/O+end"
+        print(head, flush=True)
+        for i, p in enumerate(programs):
+            order = names if i % 2 == 0 else names[::-1]
+            got = {n: workers[n].run(p, a.sim_time, a.interp) for n in order}
+            row = {"program": str(p.relative_to(corpus)), **{n: got[n] for n in names}}
+            cells = " ".join(f"{got[n]['cpu_s']:10.2f} {factor(got[n]['sim_s'], got[n]['cpu_s']):12.1f}" for n in names)
+            line = f"{row['program'][-58:]:58s} {cells}"
+            if a.baseline:
+                new, base = got["new"], got["base"]
+                same = new["io_sha"] == base["io_sha"] and new.get("end") == base.get("end") \
+                    and new["sim_s"] == base["sim_s"]
+                row["speedup"] = round(base["cpu_s"] / new["cpu_s"], 2) if new["cpu_s"] > 0 else None
+                row["same"] = same
+                line += f" {row['speedup'] or 0:8.2f}  {'yes' if same else 'NO'}"
+            print(line, flush=True)
+            rows.append(row)
+    finally:
+        for w in workers.values():
+            w.close()
+    load1 = os.getloadavg()
+    summary: dict = {"date": started.strftime("%Y-%m-%d %H:%M UTC"), "sim_time_s": a.sim_time, "interp": a.interp,
+                     "entry_points": len(rows), "load_start": [round(x, 2) for x in load0],
+                     "load_end": [round(x, 2) for x in load1]}
+    for n, co in sides:
+        sim = sum(r[n]["sim_s"] for r in rows)
+        cpu = sum(r[n]["cpu_s"] for r in rows)
+        worst = max(rows, key=lambda r: r[n]["cpu_s"]) if rows else None
+        summary[n] = {"checkout": str(co.resolve()), "commit": commit_of(co), "sim_s": round(sim, 3),
+                      "cpu_s": round(cpu, 3), "sim_per_cpu": factor(sim, cpu),
+                      "worst": worst and {"program": worst["program"], "cpu_s": worst[n]["cpu_s"],
+                                          "sim_per_cpu": factor(worst[n]["sim_s"], worst[n]["cpu_s"])},
+                      "over_3s": sum(1 for r in rows if r[n]["cpu_s"] > 3.0 * a.sim_time / SIM_TIME_S)}
+    if a.baseline:
+        summary["speedup"] = round(summary["base"]["cpu_s"] / summary["new"]["cpu_s"], 2) \
+            if summary["new"]["cpu_s"] > 0 else None
+        summary["same"] = sum(1 for r in rows if r["same"])
+    print()
+    for n, _ in sides:
+        s = summary[n]
+        print(f"{n:5s} {s['commit']:10s} total {s['sim_s']:9.1f} simulated s in {s['cpu_s']:8.2f} CPU s: "
+              f"{s['sim_per_cpu']}x; worst {s['worst']['program'] if s['worst'] else '-'} "
+              f"{s['worst']['cpu_s'] if s['worst'] else 0} s; over {3.0 * a.sim_time / SIM_TIME_S:g} s CPU: {s['over_3s']}")
+    if a.baseline:
+        print(f"speedup of the total {summary['speedup']}x; the same I/O and end on {summary['same']} of {len(rows)}")
+    print(f"load average {summary['load_start'][0]} at the start, {summary['load_end'][0]} at the end "
+          f"({summary['date']})")
+    if a.json:
+        Path(a.json).write_text(json.dumps({"summary": summary, "rows": rows}, indent=1) + "\n", encoding="utf-8")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
