@@ -31,8 +31,8 @@ def make_runtime(program, *, workspace=None, inputs=None, trace=None, max_sim_ti
     (not started yet). Its files (krl.project.project_of, with the `submit` programs) are
     loaded, checked and resolved first; with `check` (``krl run`` without ``--no-check``) a
     program whose own module the checker rejects does not start (its run ends with that
-    error). `vm_loop`: the VM's dispatch loop, "generated" (interp/vm/loop.py) or "source"
-    (VM.run as written; tests compare the two). `observer` (an :class:`interp.summary.RunObserver`) sees the
+    error). `vm_loop`: the VM's dispatch loop, "generated" (interp/vm/loop.py, compiled when
+    built) or "python" (loop.py as plain Python; tests compare the two). `observer` (an :class:`interp.summary.RunObserver`) sees the
     controller's events on their way to `trace`; it is not used with a given `controller`.
     `inputs`: the cell file (a path, or the Cell :func:`cell_of` read; read once per run).
     ``mode``: operating mode T1/T2/AUT/EXT (``$MODE_OP``; default AUT, robot/limits.py);

@@ -650,8 +650,9 @@ class Runtime:
     def index(self, base: Ref, idx: list, name: str) -> Ref:
         return index_ref(base, idx, name)
 
-    def field(self, base: Ref, comp: str, name: str) -> Ref:
-        return field_ref(base, comp, name)
+    def field(self, base: Ref, comp: str, name: str, key: str | None = None) -> Ref:
+        """``base.comp`` (memory.field_ref: `key`, the component's key, the resolver's)."""
+        return field_ref(base, comp, name, key)
 
     def assign(self, ref: Ref, value) -> None:
         """``target = value`` (§5.1, conversions §3.9)."""

@@ -228,9 +228,13 @@ def index_ref(base: Ref, idx: list, name: str) -> Ref:
                 base.readonly if isinstance(base, Slot) else False)
 
 
-def field_ref(base: Ref, comp: str, name: str) -> Ref:
+def field_ref(base: Ref, comp: str, name: str, key: str | None = None) -> Ref:
+    """The reference of component `comp` (as written: messages) of the structure `base` refers
+    to; `key`: the component's key in the structure (the resolver's fact for an interpreter,
+    krl/semantics/resolve.py Component; the upper-case spelling when not given: a tool's text)."""
     v = base.peek()
-    key = comp.upper()
+    if key is None:
+        key = comp.upper()
     if not isinstance(v, Struct):
         if v is UNSET:
             raise value_invalid(base.name)

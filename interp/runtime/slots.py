@@ -157,28 +157,28 @@ def set_element(base, idx: list, v, name: str) -> None:
     index_ref(base, [array_index(i) for i in idx], name).set(v)
 
 
-def component(base, comp: str, name: str):
-    """Value of ``base.comp`` (Runtime.field, then read)."""
+def component(base, comp: str, name: str, key: str):
+    """Value of ``base.comp`` (Runtime.field, then read); `key`: the component's key (the
+    resolver's Component)."""
     if base.__class__ is Slot:
         s = base.c[base.k]
         if s.__class__ is Struct:
-            x = s.f.get(comp.upper())
+            x = s.f.get(key)
             c = x.__class__
             if c is int or c is float or c is bool:
                 return x
-    return read_value(field_ref(base, comp, name))
+    return read_value(field_ref(base, comp, name, key))
 
 
-def set_component(base, comp: str, v, name: str) -> None:
-    """``base.comp = v`` (Runtime.field + Runtime.assign)."""
+def set_component(base, comp: str, v, name: str, key: str) -> None:
+    """``base.comp = v`` (Runtime.field + Runtime.assign); `key` as for :func:`component`."""
     if base.__class__ is Slot and not base.readonly:
         s = base.c[base.k]
         if s.__class__ is Struct and s.type is not None:
-            key = comp.upper()
             ft = s.type.fields.get(key)
             if ft is not None and key in s.f and _store_fast(s.f, key, ft[1], v):
                 return
-    field_ref(base, comp, name).set(v)
+    field_ref(base, comp, name, key).set(v)
 
 
 # ------------------------------------------------------------------ FOR (reference §5.4)

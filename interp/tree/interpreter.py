@@ -9,13 +9,11 @@ continues there.
 
 Meaning comes from the front end's typed facts (krl/semantics/resolve.py), never from a
 name's spelling: each Name carries its place (a frame slot, a data-list slot, a system
-variable), each Call its Callee (a routine, a built-in, a stub), a GOTO its target Label, an
-assignment whether it sets a cyclic flag, an analog statement its channel, an interrupt
-declaration its BRAKE, each statement its StmtInfo (advance-run stops). One exception, by a
-component's spelling: a STRUC component (``x.Y``) and an aggregate's item (``{Y 1}``) are found
-by their upper-cased name in the :class:`~interp.runtime.values.Struct` value
-(interp/runtime/core.py ``field``, ``aggregate``), which the resolver checked exists but does
-not number (the VM does the same: issue 47 makes them resolver facts). Dispatch is the one
+variable), each Call its Callee (a routine, a built-in, a stub), each Field and aggregate item
+its structure Component (the key of the component in the structure's values), a GOTO its
+target Label, an assignment whether it sets a cyclic flag, an analog statement its channel, an
+interrupt declaration its BRAKE, each statement its StmtInfo (advance-run stops). A name's
+spelling is used only in messages. Dispatch is the one
 node-dispatch helper (krl/ast/visit.py): one method per statement (``s_Kind``) and expression
 kind (``e_Kind``).
 """
@@ -492,7 +490,7 @@ class TreeInterpreter:
     def e_Aggregate(self, e, frame):
         items = []
         for it in e.items:
-            items.append((it.name.upper(), self.eval(it.value, frame)))
+            items.append((it.ann.component.key, self.eval(it.value, frame)))
         return self.rt.aggregate(e.ann.struc if e.type_name else None, items)
 
     def e_var(self, e, frame):
@@ -547,6 +545,6 @@ class TreeInterpreter:
             return rt.index(base, idx, lvalue_name(e.base))
         if isinstance(e, N.Field):
             base = self.ref(e.base, frame)
-            return rt.field(base, e.name, lvalue_name(e.base))
+            return rt.field(base, e.name, lvalue_name(e.base), e.ann.component.key)
         raise KrlRuntimeError("not a variable")
 

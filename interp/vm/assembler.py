@@ -5,7 +5,7 @@ The readable assembly is the compiler's output and the VM's debugging view (clox
 
     .routine PROG DEF                       ; name, DEF or DEFFCT
     .file "/path/prog.src"
-    .locals I S R                           ; frame slots (parameters first)
+    .locals I S R                           ; frame slots (parameters first): operands s, v by name
     .temps 3                                ; temporaries (FOR state, SWITCH selector)
         .at -                               ; error region of the following instructions
         ; 4: s = 0                          ; the source line of each statement
@@ -68,6 +68,16 @@ class Code:
     gnames: list = field(default_factory=list)    # global slots
     ntemps: int = 0
     regions: list = field(default_factory=list)   # per word: Region or None
+
+
+# Operand kinds (interp/vm/instructions.py KINDS) by how the text writes them: labels (jump
+# targets, thunk entries), frame slots (by their .locals name), names (a resolved fact: by its
+# name), and the kinds whose encoded word is an index into the constant pool.
+_LABELS = "lh"
+_SLOTS = "sv"
+_NAMES = "nmgyokrap"
+_POOLED = "cnfyokrap"
+assert set(_LABELS + _SLOTS + _NAMES + _POOLED + "ixt") == set(O.OPERAND_KINDS), "an operand kind without a text form"
 
 
 # ---------------------------------------------------------------------------- literals
@@ -172,7 +182,7 @@ def format_listing(lst: Listing) -> str:
     for name, ops, reg in lst.instrs:
         kinds = O.BY_NAME[name].operands
         for k, v in zip(kinds, ops):
-            if k == "l":
+            if k in _LABELS:
                 targets.add(lst.labels[v])
         if reg is not None and reg.kind == "G":
             targets.add(lst.labels[reg.end])
@@ -198,11 +208,13 @@ def format_listing(lst: Listing) -> str:
         info = O.BY_NAME[name]
         parts = []
         for k, v in zip(info.operands, ops):
-            if k == "l":
+            if k in _LABELS:
                 parts.append(lab[v])
             elif k == "c":
                 parts.append(fmt_const(v))
-            elif k in "nsmgvyokrap":
+            elif k in _SLOTS:
+                parts.append(fmt_name(lst.lnames[v]))
+            elif k in _NAMES:
                 parts.append(fmt_name(v))
             elif k == "f":
                 parts.append(fmt_flags(v))
@@ -265,11 +277,16 @@ def parse_listings(text: str) -> list[Listing]:
                 for k, t in zip(info.operands, args):
                     if k == "c":
                         ops.append(parse_const(t))
-                    elif k in "nsmgvyokrap":
+                    elif k in _SLOTS:
+                        slot = {n.upper(): i for i, n in enumerate(cur.lnames)}.get(t.upper())
+                        if slot is None:
+                            raise AsmError(f"{t} is not in .locals")
+                        ops.append(slot)
+                    elif k in _NAMES:
                         ops.append(parse_name(t))
                     elif k == "f":
                         ops.append("" if t == "-" else t)
-                    elif k == "l":
+                    elif k in _LABELS:
                         ops.append(t)
                     elif k == "x":
                         a, _, b = t.partition("/")
@@ -295,7 +312,6 @@ def encode(lst: Listing) -> Code:
     info_ix: dict = {}
     mix: dict = {}
     gix: dict = {}
-    lix = {n.upper(): i for i, n in enumerate(code.lnames)}
 
     def const(v):
         k = const_key(v)
@@ -324,14 +340,10 @@ def encode(lst: Listing) -> Code:
         words.append(info.number)
         regions.append(r)
         for k, v in zip(info.operands, ops):
-            if k in "cnfyokrap":
+            if k in _POOLED:
                 w = const(v)
-            elif k == "l":
+            elif k in _LABELS:
                 w = label(v)
-            elif k == "s" or k == "v":
-                w = lix.get(v.upper())
-                if w is None:
-                    raise AsmError(f"{v} is not in .locals")
             elif k == "m":
                 w = mix.setdefault(v.upper(), len(mix))
                 if w == len(code.mnames):
@@ -369,14 +381,12 @@ def to_listing(code: Code) -> Listing:
         ops = []
         for j, k in enumerate(info.operands):
             w = words[a + 1 + j]
-            if k in "cnfyokrap":
+            if k in _POOLED:
                 ops.append(code.consts[w])
-            elif k == "l":
+            elif k in _LABELS:
                 name = f"@{w}"
                 lst.labels[name] = index_of[w]
                 ops.append(name)
-            elif k == "s" or k == "v":
-                ops.append(code.lnames[w])
             elif k == "m":
                 ops.append(code.mnames[w])
             elif k == "g":

@@ -12,14 +12,17 @@ stepping differs:
 
 * meaning comes from the front end's typed facts (krl/semantics/resolve.py), never from a
   name's spelling: a LOCAL place is a *frame slot* (parameters and locals, in ``.locals``
-  order, the routine's Layout), a MODULE place a *module slot* (the data list of the
-  routine's module), any other place a *global slot* (another data list, a system variable,
-  the ``$``-name fallback; its reference is taken on first use, Runtime.storage_ref); the
-  listing carries each place (operands ``m``/``g``), each call's Callee (``r``), each
-  aggregate's STRUC (``a``) and each analog channel (``p``) for the VM to link;
+  order, the routine's Layout: operands ``s``/``v`` are the slot numbers, ``Storage.slot``), a
+  MODULE place a *module slot* (the data list of the routine's module), any other place a
+  *global slot* (another data list, a system variable, the ``$``-name fallback; its reference
+  is taken on first use, Runtime.storage_ref); the listing carries each place (operands
+  ``m``/``g``), each call's Callee (``r``), each aggregate's STRUC (``a``), each structure
+  component (``k``, its key the resolver's) and each analog channel (``p``) for the VM to link;
 * structured statements become jumps; GOTO jumps to its target Label, in the nearest
   enclosing block that holds it (the tree interpreter's rule), EXIT to the end of the
   innermost loop;
+* a superinstruction (interp/vm/instructions.py ``macro``) replaces the sequence of its parts
+  (:func:`peephole`, from the table interp/vm/opcodes.py ``MACROS``);
 * constant operands are folded with the front end's operators (krl/semantics/values.py, the
   runtime's); an expression whose folding raises is left for run time;
 * conditions that are evaluated later (WAIT FOR, interrupt conditions and handlers,
@@ -42,11 +45,11 @@ from interp.runtime.values import Channel
 from interp.runtime.watch import watch_of_decl
 
 from .assembler import Listing, Region, format_listing
-from .opcodes import BY_NAME as OPS
+from .opcodes import BY_NAME as OPS, MACROS
 
 
-_FAST_BINOPS = {"+": "ADD", "-": "SUB", "*": "MUL", "<": "LT", "<=": "LE", ">": "GT", ">=": "GE",
-                "==": "EQ", "<>": "NE"}
+_FAST_BINOPS = {"+": "ADD", "-": "SUB", "*": "MUL"}
+_COMPARISONS = frozenset(("<", "<=", ">", ">=", "==", "<>"))     # COMPARE (operand kind o)
 _FOLDABLE = (int, float, bool, str, EnumValue)
 
 
@@ -218,7 +221,7 @@ class Compiler:
             for ce in case.values:
                 self.emit("LOAD_TEMP", t)
                 self.expr(ce)
-                self.emit("EQ")
+                self.emit("COMPARE", "==")
                 self.emit("JUMP_IF_TRUE", lab)
         if st.default is not None:
             self.block(st.default)
@@ -495,8 +498,7 @@ class Compiler:
             self.region = Region("A", act.span.line)
             if isinstance(act, N.CallStmt):
                 slow, done = self.new_label(), self.new_label()
-                self.emit("JUMP_IF_NONE", slow)
-                self.emit("TRIG_INVOKE")
+                self.emit("TRIG_INVOKE", slow)
                 self.emit("JUMP", done)
                 self.place(slow)
                 self.call(act.call, "S")
@@ -575,11 +577,12 @@ class Compiler:
         self.emit("CALL", call.ann.callee, len(call.args), flags)
 
     # ------------------------------------------------------------------ names
-    def operand(self, place):
-        """(class, operand) of a place (the front end's Storage): LOCAL and the frame slot's
-        declared name, MOD or GLOBAL and the place itself (the VM links it)."""
+    @staticmethod
+    def operand(place):
+        """(class, operand) of a place (the front end's Storage): LOCAL and the frame slot,
+        MOD or GLOBAL and the place itself (the VM numbers those by the place)."""
         if place.kind == LOCAL:
-            return "LOCAL", self.locals[place.slot]
+            return "LOCAL", place.slot
         return ("MOD" if place.kind == MODULE else "GLOBAL"), place
 
     def ref_place(self, place) -> None:
@@ -604,9 +607,10 @@ class Compiler:
                 return got[0]
         return None
 
-    def local(self, e: N.Name) -> str:
-        """The declared name of the frame slot of a LOCAL name (the ``s``/``v`` operand)."""
-        return self.locals[e.ann.place.slot]
+    @staticmethod
+    def local(e: N.Name) -> int:
+        """The frame slot of a LOCAL name (the ``s``/``v`` operand: the resolver's Storage.slot)."""
+        return e.ann.place.slot
 
     def ref(self, e) -> None:
         if isinstance(e, N.Name):
@@ -617,7 +621,7 @@ class Compiler:
             self.emit("INDEX", len(e.indices), lvalue_name(e.base))
         elif isinstance(e, N.Field):
             self.ref(e.base)
-            self.emit("FIELD", e.name, lvalue_name(e.base))
+            self.emit("FIELD", e.ann.component, lvalue_name(e.base))
         else:
             self.emit("RAISE", "not a variable", 0)
 
@@ -645,10 +649,13 @@ class Compiler:
         elif isinstance(target, N.Index) and None not in target.indices:
             self.ref(target.base)
             self.indices(target)
-            self.emit("STORE_INDEX", len(target.indices), lvalue_name(target.base))
+            if len(target.indices) == 1:
+                self.emit("STORE_INDEX1", lvalue_name(target.base))
+            else:
+                self.emit("STORE_INDEX", len(target.indices), lvalue_name(target.base))
         elif isinstance(target, N.Field):
             self.ref(target.base)
-            self.emit("STORE_FIELD", target.name, lvalue_name(target.base))
+            self.emit("STORE_FIELD", target.ann.component, lvalue_name(target.base))
         else:
             self.ref(target)
             self.emit("ASSIGN")
@@ -728,12 +735,14 @@ class Compiler:
         if None in e.indices:
             self.emit("INDEX", len(e.indices), lvalue_name(e.base))
             self.emit("DEREF")
+        elif len(e.indices) <= 2:
+            self.emit(f"LOAD_INDEX{len(e.indices)}", lvalue_name(e.base))
         else:
             self.emit("LOAD_INDEX", len(e.indices), lvalue_name(e.base))
 
     def e_Field(self, e) -> None:
         self.ref(e.base)
-        self.emit("LOAD_FIELD", e.name, lvalue_name(e.base))
+        self.emit("LOAD_FIELD", e.ann.component, lvalue_name(e.base))
 
     def e_Call(self, e) -> None:
         self.call(e, "E")
@@ -763,6 +772,8 @@ class Compiler:
             fast = _FAST_BINOPS.get(b.op)
             if fast is not None:
                 self.emit(fast)
+            elif b.op in _COMPARISONS:
+                self.emit("COMPARE", b.op)
             else:
                 self.emit("BINOP", b.op)
 
@@ -770,70 +781,18 @@ class Compiler:
         for it in e.items:
             self.expr(it.value)
         struc = e.ann.struc if e.type_name else None
-        self.emit("AGG", struc if struc is not None else e.type_name, ",".join(it.name.upper() for it in e.items))
-
-
-_CMP_JUMPS = {"LT": "IF_NOT_LT", "LE": "IF_NOT_LE", "GT": "IF_NOT_GT", "GE": "IF_NOT_GE",
-              "EQ": "IF_NOT_EQ", "NE": "IF_NOT_NE"}
-_CONST_OPS = {"ADD": "ADD_CONST", "SUB": "SUB_CONST", "MUL": "MUL_CONST"}
-_CMP_SYMBOLS = {"IF_NOT_LT": "<", "IF_NOT_LE": "<=", "IF_NOT_GT": ">", "IF_NOT_GE": ">=", "IF_NOT_EQ": "==",
-                "IF_NOT_NE": "<>"}
-
-
-def _fuse(group: list):
-    """The superinstruction for a group of instructions, or None."""
-    names = [g[0] for g in group]
-    ops = [g[1] for g in group]
-    if len(group) == 3 and names == ["REF_LOCAL", "LOAD_LOCAL2", "LOAD_INDEX"] and ops[2][0] == 2:
-        return ("LOAD_ELEM2_LLL", [ops[0][0], ops[1][0], ops[1][1], ops[2][1]])
-    if len(group) == 3 and names[:2] == ["REF_LOCAL", "LOAD_LOCAL"] and names[2] in ("LOAD_INDEX", "STORE_INDEX") \
-            and ops[2][0] == 1:
-        return ("LOAD_ELEM_LL" if names[2] == "LOAD_INDEX" else "STORE_ELEM_LL", [ops[0][0], ops[1][0], ops[2][1]])
-    if len(group) == 3 and names[:2] == ["LOAD_ELEM1_V", "LOAD_FAST"] and names[2] in _CMP_SYMBOLS:
-        return ("IF_NOT_EV", [*ops[0], ops[1][0], _CMP_SYMBOLS[names[2]], ops[2][0]])
-    if len(group) == 3 and names == ["LOAD_ELEM1_V", "FAST_ADD_CONST", "STORE_ELEM1"]:
-        return ("MOVE_ELEM1", [*ops[0], *ops[1], *ops[2]])
-    if len(group) == 3 and names == ["LOAD_FAST2", "ADD", "STORE_FAST"]:
-        return ("ADD_FAST", [*ops[0], *ops[2]])
-    if len(group) == 2 and names == ["CONST", "STORE_ELEM1_V"]:
-        return ("STORE_ELEM1_VC", [*ops[1], ops[0][0]])
-    if len(group) == 3 and names == ["LOAD_FAST", "LOAD_FAST", "LOAD_ELEM2"]:
-        return ("LOAD_ELEM2_VV", [ops[2][0], ops[0][0], ops[1][0], ops[2][1]])
-    if len(group) == 2 and names[0] in ("FAST_ADD_CONST", "FAST_SUB_CONST") and names[1] == "STORE_FAST":
-        return (names[0][5:8] + "C_FAST", [ops[0][0], ops[0][1], ops[1][0], ops[1][1]])
-    if len(group) == 2 and names[0] == "LOAD_FAST2" and names[1] in _CMP_SYMBOLS:
-        return ("IF_NOT_VV", [ops[0][0], ops[0][1], _CMP_SYMBOLS[names[1]], ops[1][0]])
-    if len(group) == 3 and names[:2] == ["LOAD_FAST", "CONST"] and names[2] in _CMP_SYMBOLS:
-        return ("IF_NOT_VC", [ops[0][0], ops[1][0], _CMP_SYMBOLS[names[2]], ops[2][0]])
-    if len(group) == 2 and names[0] == "REF_LOCAL" and names[1] in ("LOAD_FIELD", "STORE_FIELD"):
-        return (names[1] + "_L", [ops[0][0], ops[1][0], ops[1][1]])
-    if len(group) == 2 and names[0] == "LOAD_FAST":
-        if names[1] == "LOAD_ELEM1":
-            return ("LOAD_ELEM1_V", [ops[1][0], ops[0][0], ops[1][1]])
-        if names[1] == "STORE_ELEM1":
-            return ("STORE_ELEM1_V", [ops[1][0], ops[0][0], ops[1][1], ops[1][2]])
-        if names[1] == "LOAD_FAST":
-            return ("LOAD_FAST2", [ops[0][0], ops[1][0]])
-        if names[1] in ("ADD_CONST", "SUB_CONST"):
-            return ("FAST_" + names[1], [ops[0][0], ops[1][0]])
-    if len(group) == 2:
-        if names[1] == "JUMP_IF_FALSE" and names[0] in _CMP_JUMPS:
-            return (_CMP_JUMPS[names[0]], [ops[1][0]])
-        if names[0] == "CONST" and names[1] in _CONST_OPS:
-            return (_CONST_OPS[names[1]], [ops[0][0]])
-        if names[0] == "LOAD_LOCAL" and names[1] in ("ADD_CONST", "SUB_CONST"):
-            return ("LOCAL_" + names[1], [ops[0][0], ops[1][0]])
-        if names == ["LOAD_LOCAL", "LOAD_LOCAL"]:
-            return ("LOAD_LOCAL2", [ops[0][0], ops[1][0]])
-    return None
+        self.emit("AGG", struc if struc is not None else e.type_name, len(e.items),
+                  ",".join(it.ann.component.key for it in e.items))
 
 
 def peephole(lst: Listing) -> bool:
-    """Replace common instruction sequences by superinstructions (opcodes.py); True if it
-    replaced any (a fused instruction may fuse again in the next pass). A sequence
-    is fused only when no label points inside it and all of it lies in one error region;
-    the fused instruction keeps the region of the sequence's first instruction, except a
-    compare-and-jump, whose only possible error is the comparison's."""
+    """Replace sequences of instructions by the superinstruction whose parts they are
+    (opcodes.MACROS: ``macro`` in interp/vm/instructions.py; its operands are its parts',
+    concatenated); True if it replaced any (a superinstruction may be the part of another one:
+    the next pass fuses it). A sequence is fused only when no label points inside it and all of
+    it lies in one error region, the fused instruction's; a superinstruction with ``errors_from``
+    (only that part can raise) takes that part's region whatever the others'. Three-part
+    sequences go first, and a pair is left alone when its second instruction starts a triple."""
     old = lst.instrs
     targets = set(lst.labels.values())
     new: list = []
@@ -844,13 +803,14 @@ def peephole(lst: Listing) -> bool:
         group = old[i:i + n]
         if len(group) < n or any(i + k in targets for k in range(1, n)):
             return None
-        fused = _fuse(group)
-        if fused is None:
+        name = MACROS.get(tuple(g[0] for g in group))
+        if name is None:
             return None
         regions = [g[2] for g in group]
-        if fused[0] in _CMP_JUMPS.values() or all(r is regions[0] for r in regions):
-            return fused, regions[0]
-        return None
+        only = OPS[name].errors_from
+        if only is None and not all(r is regions[0] for r in regions):
+            return None
+        return (name, [v for g in group for v in g[1]]), regions[0 if only is None else only]
 
     i = 0
     while i < len(old):

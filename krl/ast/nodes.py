@@ -111,6 +111,13 @@ class AssignFacts(Annotation):
 
 
 @dataclass(slots=True)
+class ComponentFacts(Annotation):
+    """A Field or an aggregate's item (AggItem): ``component``, the structure component it names
+    (``Component``: its key and declared type)."""
+    component: "Component | None" = None
+
+
+@dataclass(slots=True)
 class ChannelFacts(Annotation):
     """ANIN ON/OFF, ANOUT ON/OFF: ``channel``, the analog signal's place (``Storage``)."""
     channel: "Storage | None" = None
@@ -714,7 +721,8 @@ class Module(Node):
 FACTS: dict[type, type] = {
     Name: PlaceFacts, ArrayInit: PlaceFacts, Call: CallFacts, Routine: LayoutFacts, DataList: LayoutFacts,
     Aggregate: AggregateFacts, Goto: GotoFacts, Assign: AssignFacts, AninOn: ChannelFacts,
-    AninOff: ChannelFacts, AnoutOn: ChannelFacts, AnoutOff: ChannelFacts,
+    AninOff: ChannelFacts, AnoutOn: ChannelFacts, AnoutOff: ChannelFacts, Field: ComponentFacts,
+    AggItem: ComponentFacts,
 }
 
 

@@ -41,8 +41,13 @@ of any run; the interpreters (interp/) allocate storage for them and never look 
   error "label not found");
 * an assignment to an element of a *cyclic* system variable (``cyclic: true`` in the tables:
   ``$CYCFLAG``, reference §5.15) gets ``assign.ann.cyclic``;
+* every Field and every item of an aggregate gets the structure :class:`Component` it names
+  (``ann.component``): its key (the STRUC declaration's: names are case-insensitive, the key is
+  upper case) and its declared type when the structure's type is known;
 * ANIN ON/OFF and ANOUT ON/OFF get their analog signal's place (``ann.channel``): the name
-  the statement switches, and for ANIN ON the SIGNAL its value expression reads;
+  the statement switches, and for ANIN ON the SIGNAL its value ``factor * signal`` reads
+  (reference §5.14: the signal is declared with SIGNAL), None when it reads no SIGNAL or more
+  than one (its value is then written once, not cyclically: nothing for ANIN OFF to name);
 * every statement gets its :class:`krl.semantics.advance.StmtInfo` (``stmt.ann.info``).
 
 The back ends read these facts and never a name's spelling.
@@ -108,6 +113,18 @@ class Callee:
 
     def __repr__(self) -> str:
         return f"Callee({CALLEE_NAMES[self.kind]} {self.name})"
+
+
+@dataclass(slots=True, frozen=True)
+class Component:
+    """A structure component a Field or an aggregate item names: ``key``, its key in the
+    structure's values (the STRUC declaration's, ``types.Struc.fields``: upper case); ``name``
+    as written (for messages and `krl asm`); ``type`` its declared type when the structure's
+    STRUC is known (None otherwise: the run-time value decides, and the run-time error names a
+    component the value does not have)."""
+    name: str
+    key: str
+    type: T.KrlType | None = None
 
 
 @dataclass(slots=True, eq=False)
@@ -375,11 +392,16 @@ class Resolver:
                 continue
             if isinstance(n, N.Call):
                 self.call(n, scope, unit)
-            elif isinstance(n, N.Aggregate) and n.type_name and scope is not None:
+            elif isinstance(n, N.Field):
+                n.annotate().component = _component(n.name, N.type_of(n.base))
+            elif isinstance(n, N.Aggregate):
                 t = N.type_of(n)
-                if not isinstance(t, T.Struc):
-                    t = scope.lookup_type(n.type_name)
-                n.annotate().struc = t if isinstance(t, T.Struc) else None
+                if n.type_name and scope is not None:
+                    if not isinstance(t, T.Struc):
+                        t = scope.lookup_type(n.type_name)
+                    n.annotate().struc = t if isinstance(t, T.Struc) else None
+                for it in n.items:
+                    it.annotate().component = _component(it.name, t)
             stack.extend(n.children())
 
     # ------------------------------------------------------------------ statements
@@ -430,10 +452,9 @@ class Resolver:
             s.annotate().channel = self.storage(s.name, scope.lookup(s.name), local, unit)
         elif isinstance(s, N.AninOn):
             # the analog input is the SIGNAL the value reads (`ANIN ON v = factor * SIG`)
-            names = [n for n in s.value.walk() if isinstance(n, N.Name)]
-            sig = next((n for n in names if getattr(_symbol_of(n), "kind", None) == "signal"),
-                       names[0] if names else None)
-            s.annotate().channel = sig.ann.place if sig is not None else None
+            signals = {id(_symbol_of(n)): n for n in s.value.walk()
+                       if isinstance(n, N.Name) and getattr(_symbol_of(n), "kind", None) == "signal"}
+            s.annotate().channel = next(iter(signals.values())).ann.place if len(signals) == 1 else None
         elif isinstance(s, N.Assign):
             t = s.target
             place = t.base.ann.place if isinstance(t, N.Index) and isinstance(t.base, N.Name) else None
@@ -444,6 +465,16 @@ class Resolver:
     def exprs(self, es, scope, local, unit) -> None:
         for e in es:
             self.expr(e, scope, local, unit)
+
+
+def _component(name: str, struc) -> Component:
+    """The Component `name` names in a structure of type `struc` (a types.Struc, or None or
+    another type when the checker does not know the structure's STRUC)."""
+    if isinstance(struc, T.Struc):
+        got = struc.fields.get(name.upper())
+        if got is not None:
+            return Component(name, name.upper(), got[1])
+    return Component(name, name.upper())
 
 
 def _label_target(key: str, labels: tuple | None) -> N.Label | None:

@@ -49,7 +49,7 @@ L1:
     CONST 2.5
     CONST NONE
     CONST TRUE
-    IF_NOT_LT L1
+    IF_NOT < L1
 L2:
     END
 .end

@@ -2,9 +2,9 @@
 the C types of loop.pxd; `make` builds it before the tests):
 
 * where Cython and a C compiler are installed, the extension is built from the current
-  vm.py and is the loop the VM runs (``vm.COMPILED``);
+  loop.py and is the loop the VM runs (``vm.COMPILED``);
 * it gives the same traces as the same loop run as plain Python and as the tree interpreter;
-* an extension built from another vm.py is never run, and the build falls back cleanly
+* an extension built from another loop.py is never run, and the build falls back cleanly
   without Cython.
 """
 
@@ -37,7 +37,7 @@ def test_the_compiled_loop_is_built_and_runs():
     if not _can_compile():
         pytest.skip("no Cython or no C compiler: the pure-Python loop runs (make vm-loop says so)")
     assert build.target().exists(), "the compiled loop is missing: run make vm-loop"
-    assert V.COMPILED, "the compiled loop is stale (built from another vm.py): run make vm-loop"
+    assert V.COMPILED, "the compiled loop is stale (built from another loop.py): run make vm-loop"
     assert not V._loop.__file__.endswith(".py")
     rt, vm = make_runtime(PROGRAMS[-1], mujoco=False, interp="vm")
     assert vm.loop is V._loop.run and not inspect.isfunction(vm.loop)     # compiled, not bytecode
@@ -52,8 +52,8 @@ def test_compiled_and_python_loops_give_identical_traces(program):
 
 
 def test_an_extension_of_another_vm_py_is_not_run():
-    assert not V._current(types.SimpleNamespace(VM_SOURCE="0" * 64))
-    assert V._current(V._python_loop())       # loop.py is generated from this vm.py
+    assert not V._current(types.SimpleNamespace(SOURCE="0" * 64))
+    assert V._current(V._python_loop())       # the extension of this very loop.py
 
 
 def test_the_build_falls_back_without_cython(monkeypatch):

@@ -1,11 +1,13 @@
-"""The VM's dispatch loop, interp/vm/loop.py, is generated from VM.run in interp/vm/vm.py
-(interp/vm/gen_loop.py), as CPython generates generated_cases.c.h from bytecodes.c:
+"""The VM's dispatch loop, interp/vm/loop.py, its opcode table interp/vm/opcodes.py and its C
+types interp/vm/loop.pxd are generated from the instruction definitions,
+interp/vm/instructions.py (interp/vm/gen_loop.py), as CPython generates generated_cases.c.h from
+bytecodes.c:
 
-* the checked-in file must be exactly what the generator makes from the current vm.py (a
-  stale file fails here: python -m interp.vm.gen_loop regenerates it);
+* the checked-in files must be exactly what the generator makes from the current definitions
+  (a stale file fails here: python -m interp.vm.gen_loop regenerates them);
 * nothing is compiled from rewritten source when the VM is imported;
-* the source loop (VM.run, the handlers as written) runs too, and gives the same traces as
-  the generated one and as the tree interpreter on programs that reach every opcode family.
+* loop.py run as plain Python gives the same traces as the loop the VM runs (compiled when
+  built) and as the tree interpreter on programs that reach every opcode family.
 """
 
 from __future__ import annotations
@@ -22,16 +24,17 @@ REPO = Path(__file__).resolve().parents[2]
 VM_DIR = REPO / "interp" / "vm"
 
 
-def test_loop_py_is_not_stale():
-    from interp.vm.gen_loop import TARGET, generate
+def test_generated_files_are_not_stale():
+    from interp.vm.gen_loop import LOOP, PXD, TABLE, generate
 
-    assert TARGET.read_text(encoding="utf-8") == generate(), \
-        "interp/vm/loop.py is stale: run python -m interp.vm.gen_loop"
+    out = generate()
+    for path, text in ((LOOP, out.loop), (TABLE, out.table), (PXD, out.pxd)):
+        assert path.read_text(encoding="utf-8") == text, f"{path.name} is stale: run python -m interp.vm.gen_loop"
 
 
 def test_nothing_is_executed_from_rewritten_source():
-    """No exec/compile/eval in the VM's modules (the generator writes a file; it runs nothing)."""
-    for name in ("vm.py", "loop.py", "compiler.py", "assembler.py", "opcodes.py", "gen_loop.py"):
+    """No exec/compile/eval in the VM's modules (the generator writes files; it runs nothing)."""
+    for name in ("vm.py", "loop.py", "compiler.py", "assembler.py", "opcodes.py", "gen_loop.py", "instructions.py"):
         tree = ast.parse((VM_DIR / name).read_text(encoding="utf-8"))
         calls = {n.func.id for n in ast.walk(tree) if isinstance(n, ast.Call) and isinstance(n.func, ast.Name)}
         assert not calls & {"exec", "eval", "compile"}, name
@@ -52,9 +55,9 @@ PROGRAMS = sorted((REPO / "tests" / "vm" / "programs" / "fast").glob("*.src")) +
 
 
 @pytest.mark.parametrize("program", PROGRAMS[::2], ids=lambda p: p.stem)
-def test_source_loop_runs_like_the_generated_one(program):
+def test_python_loop_runs_like_the_generated_one(program):
     gen = _trace(program, "vm")
-    src = _trace(program, "vm", loop="source")
-    assert src == gen
+    py = _trace(program, "vm", loop="python")
+    assert py == gen
     tree = _trace(program, "tree")
     assert tree[0] == gen[0]
