@@ -1,12 +1,14 @@
 """Every RSI program of the corpus with its own published context and configuration (RSI 3 or
 4/5) and a sensor written from that configuration (tests/net/sensor.py), on both interpreters
 (issue 50): datagrams at the program's cycle (12 ms, 4 ms with ``#IPO_FAST``), corrections
-followed (axes for AK, the TCP for RKorr, absolute or relative as the program's RSI_ON says),
+followed (axes for AK, the TCP for RKorr, absolute or relative as the program's RSI_ON, or RSI 2's
+ST_SETPARAM, says),
 and Stop honoured where the context has a STOP object (RSI_MOVECORR ends, the program goes on
 to its end). Programs whose context has no STOP object never end RSI_MOVECORR themselves; the
 run ends when the sensor has seen the correction.
 
-The contexts are tests/net/configs/published/ (derived from the programs' repositories, origins
+RSI 2's program (KR C2) builds its objects itself; its published ETHERNET configuration is the
+one file it needs. The contexts are tests/net/configs/published/ (derived from the programs' repositories, origins
 in each file); the programs are read in place from the corpus. The expected values are the
 sensor's own commands, compared with what the robot reports in its datagrams (AIPos, RIst)
 and the trace's poses."""
@@ -45,6 +47,10 @@ PROGRAMS = [
     (KSS + "rsi_joint_pos_12ms.src", "kroshu_kss/rsi_joint_pos.rsix", None),
     (KSS + "rsi_joint_pos_4ms.src", "kroshu_kss/rsi_joint_pos.rsix", None),
     (KSS + "rsi_gpio_example.src", "kroshu_kss/rsi_gpio_joint_pos.rsix", None),
+    # RSI 2 (KR C2): the program builds its objects with ST_ functions; the ETHERNET configuration
+    # of its ST_ETHERNET is the published file (tests/net/test_rsi2.py for the rest)
+    ("ros-industrial__kuka_experimental/kuka_rsi_hw_interface/krl/KR_C2/ros_rsi.src",
+     "ros_industrial_kr_c2/ros_rsi_ethernet.xml", None),
 ]
 AXIS_TARGET = np.array([2.0, -1.5, 1.0, 0.5, 3.0, -2.5])        # deg, within every context's limits
 CART_TARGET = np.array([4.0, -3.0, 5.0, 0.0, 0.0, 0.0])         # mm
@@ -106,6 +112,7 @@ def test_corpus_rsi_program(shared_corpus, program, context, ethernet, interp):
         assert result.reason == "completed", (result.reason, result.text)
     created = net_events(trace, iface="rsi", dir="context")
     assert created and ("RSI 4/5" in created[0]["text"]) == context.endswith(".rsix")
+    assert ("RSI 2:" in created[0]["text"]) == ("ST_ETHERNET" in text)
 
 
 def test_the_cell_file_may_name_the_ethernet_configuration(shared_corpus, tmp_path):
