@@ -28,11 +28,15 @@ first argument:
   object that ends it); ``ST_OFF()``: the sensor mode off; ``ST_DELOBJ(h)``, ``ST_RESET()``.
 * Any other object (``ST_DIGIN``, ``ST_MAP2DIGOUT``, ``ST_COROB``: the TCP "CoRob" partner of
   Ethernet RSI XML) gets a handle and is reported once as not simulated; its outputs read 0.
+
+A flow holds at most ``MAX_RSI_OBJECTS`` objects (as a context file): one more is RSINOMEM.
 """
 
 from __future__ import annotations
 
 from pathlib import Path
+
+from krl.limits import MAX_RSI_OBJECTS
 
 from .rsicontext import Context, RsiConfigError, RsiObject, read_ethernet
 
@@ -42,7 +46,6 @@ CREATES = {"ST_ETHERNET": "ETHERNET", "ST_AXISCORR": "AXISCORR", "ST_PATHCORR": 
            "ST_DIGIN": "DIGIN", "ST_MAP2DIGOUT": "MAP2DIGOUT", "ST_COROB": "COROB"}
 AXIS_LIMITS = ("A1", "A2", "A3", "A4", "A5", "A6", "E1", "E2", "E3", "E4", "E5", "E6")
 CART_LIMITS = ("X", "Y", "Z", "A", "B", "C")
-MAX_OBJECTS = 256          # objects of one RSI 2 signal flow (docs/security.md)
 MAX_PARAM = 64             # parameter numbers of ST_SETPARAM
 ETHERNET_TIMEOUT = 100     # late packets in a row (docs/network.md, Decisions: RSI 2)
 FRAMES = {"WORLD": "0", "BASE": "Base", "TCP": "Tool", "TOOL": "Tool"}
@@ -123,7 +126,7 @@ class SignalFlow:
         self.next = 1
 
     def create(self, typ: str, **params) -> RsiObject | None:
-        if len(self.ctx.objects) >= MAX_OBJECTS:
+        if len(self.ctx.objects) >= MAX_RSI_OBJECTS:      # as a context file's (docs/security.md)
             return None
         obj = RsiObject(typ, str(self.next), {k: str(v) for k, v in params.items()})
         self.next += 1

@@ -18,6 +18,7 @@ from interp.run import make_runtime
 from net.settings import Channel, NetworkSettings
 from robot.trace import TraceWriter
 
+from ..interp.helpers import run_krl
 from .helpers import CONFIGS, net_events, run_with_partner
 from .sensor import ConfigSensor, axes_of
 
@@ -158,3 +159,33 @@ def test_tcp_protocol_is_refused_clearly(shared_corpus, tmp_path):
     result, trace = _run_alone(shared_corpus / PROGRAM, NetworkSettings(tmp_path, rsi=Channel(cfg, ("127.0.0.1", 9))))
     assert "RSI: PROTOCOL TCP of ros_rsi_ethernet.xml is not simulated (UDP is)" in _texts(trace)
     assert not net_events(trace, iface="rsi", dir="out")
+
+
+@pytest.mark.parametrize("interp", ["tree", "vm"])
+def test_st_functions_without_a_sensor(tmp_path, interp):
+    """The ST_ functions as KRL sees them, no sensor needed: handles from 1, the enum RSIERR
+    returned; a link to an unknown handle is #RSIINVOBJID; ST_ON without an ETHERNET object is
+    not #RSIOK; ST_SKIPSENS before ST_ON stops the program with its line; object 257 of one flow
+    is #RSINOMEM (docs/security.md)."""
+    run = run_krl(tmp_path, """DEF prog()
+  INT i
+  err = ST_AXISCORR(h1, 0)
+  err = ST_PATHCORR(h2, 0)
+  link = ST_NEWLINK(99, 1, h1, 1)
+  started = ST_ON()
+  n = 2
+  FOR i = 3 TO 300
+    err = ST_AXISCORR(h2, 0)
+    IF err == #RSIOK THEN
+      n = n + 1
+    ENDIF
+  ENDFOR
+  ST_SKIPSENS()
+END
+""", "DEFDAT prog\n  DECL RSIERR err, link, started\n  INT h1, h2, n\nENDDAT\n", interp=interp)
+    assert run.result.line == 14, (run.result.reason, run.result.line, run.result.text)
+    assert (run.var("prog", "h1"), run.var("prog", "n")) == (1, 256)
+    assert run.var("prog", "link").name == "RSIINVOBJID"
+    assert run.var("prog", "started").name != "RSIOK"
+    assert run.var("prog", "err").name == "RSINOMEM"
+    assert (run.result.reason, run.result.line, run.result.text) == ("error", 14, "ST_SKIPSENS without ST_ON")

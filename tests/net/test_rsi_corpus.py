@@ -22,7 +22,9 @@ import xml.etree.ElementTree as ET
 import numpy as np
 import pytest
 
+from interp.run import make_runtime
 from net.settings import Channel, NetworkSettings
+from robot.trace import TraceWriter
 
 from .helpers import CONFIGS, EXAMPLES, net_events, run_with_partner
 from .sensor import ConfigSensor, axes_of, tcp_of
@@ -189,3 +191,30 @@ def test_onlysend_expects_no_answer(tmp_path):
     assert len(got) >= 200 and result.reason != "error", (result.reason, result.text)
     assert not [e for e in net_events(trace, iface="rsi", dir="error") if e.get("number") == 1]
     assert all(r.find("Delay").get("D") == "0" for r in got)
+
+
+AXIS_CORRECTION = "adamleon__kuka/kuka_rsi_hw_interface/krl/rsi_axis_correction/rsi_axis_correction.src"
+
+
+@pytest.mark.parametrize("interp", ["tree", "vm"])
+def test_rsi_axis_correction_has_no_published_ethernet_configuration(shared_corpus, tmp_path, interp):
+    """The rsi_axis_correction.src copies are not run: their repository publishes the context as
+    ``rsi_axis_corrrection.rsi.xml`` (three r's: RSI_CREATE("rsi_axis_correction.rsi") does not
+    find it on the controller either) and its ETHERNET object's ConfigFile
+    ``rsi_axis_correction_ethernet_config.xml`` nowhere. The run says so as the controller
+    would: RSI_CREATE returns an error, the program's check HALTs, nothing is sent; with the
+    published context named in the cell file, the message names the missing configuration."""
+    src = tmp_path / "rsi_axis_correction.src"
+    shutil.copyfile(shared_corpus / AXIS_CORRECTION, src)
+    ctx = PUB / "ros_industrial_rsi_axis_correction" / "rsi_axis_corrrection.rsi.xml"
+    shutil.copyfile(ctx, tmp_path / ctx.name)
+    for channel, message in ((Channel(None, ("127.0.0.1", 9)), "RSI: context rsi_axis_correction.rsi not found"),
+                             (Channel(tmp_path / ctx.name, ("127.0.0.1", 9)),
+                              "ConfigFile rsi_axis_correction_ethernet_config.xml not found")):
+        trace = TraceWriter(keep=True)
+        rt, _ = make_runtime(src, network=NetworkSettings(tmp_path, rsi=channel), trace=trace, max_sim_time=3.0,
+                             mujoco=False, interp=interp)
+        rt.run()
+        texts = " ".join(str(e.get("text", "")) for e in trace.events)
+        assert message in texts, texts[-1500:]
+        assert not net_events(trace, iface="rsi", dir="out")
