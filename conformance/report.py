@@ -86,7 +86,7 @@ def _elsewhere(fn, tasks: list[tuple[int, tuple]], name: str, progress, failed, 
         outcomes = run_batches(scheduler, fn, tasks, batch_files=1, name=name)
         where = "on the Dask cluster"
     else:
-        from krl.pool import run_tasks  # noqa: PLC0415  (pebble: only a run with workers pays it)
+        from krl.pool import run_tasks  # noqa: PLC0415  (pebble: costs 50 ms; only a run with workers pays it)
 
         # no pool timeout: each run has its own wall-clock guard (harness.run_program)
         outcomes = run_tasks(fn, tasks, jobs=jobs, timeout=None)

@@ -29,6 +29,7 @@ databases unused for 7 days and the folders earlier versions left. ``KRL_STORE=0
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import logging
 import os
@@ -154,6 +155,22 @@ def check_key(files: list[tuple[str, str]], skipped: list[tuple[str, str]]) -> s
 def enabled() -> bool:
     """False when the user turned the store off (``KRL_STORE=0``, ``KRL_LSP_NO_CACHE``)."""
     return os.environ.get("KRL_STORE", "1") != "0" and not os.environ.get("KRL_LSP_NO_CACHE")
+
+
+@contextlib.contextmanager
+def turned_off():
+    """The store off for the block (``KRL_STORE=0`` while it runs, so worker processes started in
+    it inherit it): a command's ``--no-cache`` never touches the cache folder, not even for the
+    data tables (krl/semantics/builtins.py reads them through the store)."""
+    before = os.environ.get("KRL_STORE")
+    os.environ["KRL_STORE"] = "0"
+    try:
+        yield
+    finally:
+        if before is None:
+            os.environ.pop("KRL_STORE", None)
+        else:
+            os.environ["KRL_STORE"] = before
 
 
 class Store:

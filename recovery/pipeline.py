@@ -8,6 +8,7 @@ import json
 import time
 from pathlib import Path
 
+from krl import store
 from krl.limits import PARSE_TIMEOUT_S
 from recovery.report import ReportStream, Summary, SummaryBuilder
 from recovery.scan import FileResult, cache_dir, grammar_sha, scan, warn
@@ -123,6 +124,14 @@ def run_recovery(corpus: Path, out: Path, jobs: int | None = None, use_cache: bo
     finish and only counts and clusters are kept, so memory stays flat with the corpus size;
     the folder replaces `out` atomically at the end (recovery/report.py). Raises ReportError
     when `out` holds files that are not a report."""
+    if use_cache:
+        return _run_recovery(corpus, out, jobs, use_cache, timeout, label, scheduler)
+    with store.turned_off():       # --no-cache: nothing reads or writes the cache folder
+        return _run_recovery(corpus, out, jobs, use_cache, timeout, label, scheduler)
+
+
+def _run_recovery(corpus: Path, out: Path, jobs: int | None, use_cache: bool, timeout: float,
+                  label: str | None, scheduler: str | None) -> Summary:
     start = time.perf_counter()
     gsha = current_grammar_sha()
     known = load_known_invalid()

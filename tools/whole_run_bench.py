@@ -54,9 +54,9 @@ SIM_TIME_S = 600.0
 def _run_one(program: Path, sim_time: float, interp: str) -> dict:
     """One whole run of `program` with ``--inputs auto`` (module docstring), measured in this
     process (the checkout first on sys.path)."""
-    from interp.realprograms import REPORT_STEPS, report_run, step_limit  # noqa: PLC0415
-    from interp.run import make_runtime  # noqa: PLC0415
-    from interp.runtime.scheduler import SUBMIT_BUDGET  # noqa: PLC0415
+    from interp.realprograms import REPORT_STEPS, report_run, step_limit  # noqa: PLC0415  (once sys.path names the checkout measured)
+    from interp.run import make_runtime  # noqa: PLC0415  (once sys.path names the checkout measured)
+    from interp.runtime.scheduler import SUBMIT_BUDGET  # noqa: PLC0415  (once sys.path names the checkout measured)
 
     sub = program.suffix.lower() == ".sub"
     row: dict = {"program": str(program), "interp": interp}
@@ -93,7 +93,7 @@ def worker(checkout: Path) -> int:
     "interp"}``), one JSON row per line on stdout."""
     checkout = checkout.resolve()
     sys.path.insert(0, str(checkout))
-    import interp  # noqa: PLC0415
+    import interp  # noqa: PLC0415  (once sys.path names the checkout measured)
 
     if Path(interp.__file__).resolve().parent.parent != checkout:
         print(json.dumps({"fatal": f"interp comes from {interp.__file__}, not {checkout}"}), flush=True)
@@ -150,7 +150,7 @@ def commit_of(checkout: Path) -> str:
 
 def entry_points(corpus: Path) -> list[Path]:
     """The entry points of every backup under `corpus` (interp/realprograms.py ``entries_of``)."""
-    from interp.realprograms import entries_of, find_backups  # noqa: PLC0415
+    from interp.realprograms import entries_of, find_backups  # noqa: PLC0415  (once sys.path names the checkout measured)
 
     return [p for root in find_backups(corpus) for p in entries_of(root)]
 

@@ -23,12 +23,11 @@ The package:
   numeric.py (any other six-axis arm); robot/kinematics/families.py registers them.
 
 The OPW family's inverse and the joints' forward run robot/simcore.pyx when it is built
-(:func:`compiled_module`): the same results bit for bit (tests/robot/test_simcore.py).
+(robot/kinematics/compiled.py :func:`compiled_module`): the same results bit for bit (tests/robot/test_simcore.py).
 """
 
 from __future__ import annotations
 
-import sysconfig
 from collections.abc import Sequence
 from typing import Any
 
@@ -40,110 +39,13 @@ from ..machine import MachineData, load_machine
 from ..madavalues import MachineDataError
 from .constants import BOUNDARY_EPS, LIMIT_EPS_DEG, OVERHEAD_SINGULAR_MM, WRIST_SINGULAR_DEG
 
-from . import fastpath as _fastpath  # the compiled extension when it is built, else the .py
-
-try:  # the compiled hot path (robot/build.py); absent without a build: the Python code runs
-    from .. import simcore as _simcore
-except ImportError:
-    _simcore = None
+from . import compiled  # noqa: F401  (the switch: compiled.USE_COMPILED)
+from .compiled import compiled_module, fastpath_compiled, fastpath_module  # noqa: F401
+from .families import FAMILIES
+from .joints import JointChain
 
 #: Results :meth:`Kinematics.forward` keeps (by the axes' bytes; cleared when full).
 FK_MEMO = 256
-#: Use the compiled hot path (robot/kinematics/fastpath.py compiled, robot/simcore.pyx) when it
-#: is built; False: the Python code (the reference: the two agree bit for bit,
-#: tests/robot/test_simcore.py)
-USE_COMPILED = True
-#: robot/kinematics/fastpath.py itself, loaded as Python (None until first needed)
-_fastpath_py: Any = None
-#: Whether the compiled fastpath answers as fastpath.py does (checked once: None until then)
-_fastpath_agrees: bool | None = None
-#: Whether the built simcore is the current simcore.pyx's (checked once: None until then)
-_simcore_current: bool | None = None
-
-
-def compiled_module() -> Any:
-    """robot/simcore.pyx's module when it is built from the current simcore.pyx (its
-    ``SOURCE_SHA``; a wheel ships no .pyx to compare with and is taken as built), the compiled
-    fastpath is in use and :data:`USE_COMPILED` is on; else None."""
-    global _simcore_current
-    if not USE_COMPILED or _simcore is None or not fastpath_compiled():
-        return None
-    if _simcore_current is None:
-        import hashlib  # noqa: PLC0415  (once per process)
-        from pathlib import Path  # noqa: PLC0415
-
-        pyx = Path(__file__).resolve().parents[1] / "simcore.pyx"
-        _simcore_current = (not pyx.is_file()
-                            or getattr(_simcore, "SOURCE_SHA", None) == hashlib.sha256(pyx.read_bytes()).hexdigest())
-    return _simcore if _simcore_current else None
-
-
-def fastpath_compiled() -> bool:
-    """True when robot/kinematics/fastpath.py runs compiled: the extension is built, answers as
-    the Python file does on a fixed set of poses (a stale build does not) and :data:`USE_COMPILED`
-    is on."""
-    global _fastpath_agrees
-    if not USE_COMPILED or not getattr(_fastpath, "__file__", "").endswith(_EXT_SUFFIX):
-        return False
-    if _fastpath_agrees is None:
-        _fastpath_agrees = _same_answers(_fastpath, _python_fastpath())
-    return _fastpath_agrees
-
-
-def fastpath_module() -> Any:
-    """The fastpath module the kinematics use: compiled (:func:`fastpath_compiled`), else
-    robot/kinematics/fastpath.py as Python."""
-    return _fastpath if fastpath_compiled() else _python_fastpath()
-
-
-def _python_fastpath() -> Any:
-    """robot/kinematics/fastpath.py loaded as Python (the compiled module shadows it on import)."""
-    global _fastpath_py
-    if _fastpath_py is None:
-        if not getattr(_fastpath, "__file__", "").endswith(_EXT_SUFFIX):
-            _fastpath_py = _fastpath
-        else:
-            import importlib.util  # noqa: PLC0415  (only beside a built extension)
-            from pathlib import Path  # noqa: PLC0415
-
-            spec = importlib.util.spec_from_file_location(
-                "robot.kinematics._fastpath_source", Path(__file__).with_name("fastpath.py"))
-            _fastpath_py = importlib.util.module_from_spec(spec)
-            spec.loader.exec_module(_fastpath_py)
-    return _fastpath_py
-
-
-def _same_answers(compiled: Any, python: Any) -> bool:
-    """True when the two fastpath modules give the same bytes on the KR 6 R900's OPW form for 32
-    poses (every status, turns, a wrist singularity, a pose out of reach)."""
-    o = load_machine().opw
-    import math  # noqa: PLC0415
-
-    sgn = [float(v) for v in o.sign_corrections]
-    offs = [math.radians(v) for v in o.offsets_deg]
-    lo, hi = [-170.0, -190.0, -120.0, -185.0, -120.0, -350.0], [170.0, 45.0, 156.0, 185.0, 120.0, 350.0]
-    ks = [-720.0, -360.0, 0.0, 360.0, 720.0]
-    a, b = (m.OPWCore(o, 4.764, sgn, offs, lo, hi, ks, 0, 0) for m in (compiled, python))
-    rng = np.random.default_rng(47)
-    for i in range(32):
-        T = np.eye(4)
-        T[:3, :3] = np.linalg.qr(rng.normal(size=(3, 3)))[0] * (1.0 if i % 2 else -1.0)
-        T[:3, 3] = rng.uniform(-700.0, 700.0, 3) * (2.0 if i == 5 else 1.0)
-        ref = rng.uniform(-150.0, 150.0, 6)
-        status, turn = (i % 8, None) if i % 3 else (None, i)
-        x, y = a.inverse(T, status, turn, ref), b.inverse(T, status, turn, ref)
-        if (x is None) != (y is None) or (x is not None and x.tobytes() != y.tobytes()):
-            return False
-        if a.rows_of(T, ref) != b.rows_of(T, ref):
-            return False
-    return True
-
-
-_EXT_SUFFIX = sysconfig.get_config_var("EXT_SUFFIX")
-
-# the family modules read compiled_module() and fastpath_module() above: imported once they are defined
-from .families import FAMILIES  # noqa: E402
-from .joints import JointChain  # noqa: E402
 
 
 class Kinematics:

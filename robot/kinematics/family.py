@@ -38,7 +38,7 @@ import numpy as np
 from ..chain import chain_forward
 from ..errors import SoftLimitError, WorkspaceError
 from ..madavalues import MachineDataError
-from . import fastpath_module
+from .compiled import fastpath_module
 from .constants import LIMIT_EPS_DEG
 
 #: The operations of the protocol (tests/robot/test_families.py checks each registered family).

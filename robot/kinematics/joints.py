@@ -21,7 +21,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from ..blas import numpy_cblas
-from . import compiled_module
+from .compiled import compiled_module
 
 
 class JointChain:

@@ -18,7 +18,7 @@ from typing import Any
 
 import numpy as np
 
-from . import _fastpath, fastpath_compiled, fastpath_module
+from .compiled import _fastpath, fastpath_compiled, fastpath_module
 from .constants import ACOS_TOL, BOUNDARY_EPS, OVERHEAD_SINGULAR_MM, WRIST_SINGULAR_DEG
 
 

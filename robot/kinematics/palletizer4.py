@@ -25,7 +25,7 @@ from typing import Any
 
 import numpy as np
 
-from . import compiled_module
+from .compiled import compiled_module
 from .arm import ArmFamily
 from .family import check_closed_form
 from .opwsolver import OPWSolver

@@ -67,7 +67,7 @@ def fast():
     """(compiled fastpath module, fastpath.py run as Python)."""
     if not kinematics.fastpath_compiled():
         _built("robot/kinematics/fastpath.py")
-    return kinematics.fastpath_module(), kinematics._python_fastpath()
+    return kinematics.fastpath_module(), kinematics.compiled._python_fastpath()
 
 
 def test_the_compiled_core_is_built_current_and_used(sc, fast):
@@ -82,10 +82,10 @@ def test_the_compiled_core_is_built_current_and_used(sc, fast):
 
 
 def test_a_stale_simcore_is_not_used(monkeypatch, sc):
-    monkeypatch.setattr(kinematics, "_simcore_current", None)
+    monkeypatch.setattr(kinematics.compiled, "_simcore_current", None)
     monkeypatch.setattr(sc, "SOURCE_SHA", "0" * 64)
     assert kinematics.compiled_module() is None
-    monkeypatch.setattr(kinematics, "_simcore_current", None)
+    monkeypatch.setattr(kinematics.compiled, "_simcore_current", None)
 
 
 def test_a_fastpath_that_answers_otherwise_is_not_used(monkeypatch, fast):
@@ -100,7 +100,7 @@ def test_a_fastpath_that_answers_otherwise_is_not_used(monkeypatch, fast):
                 return None if q is None else q + 1e-12
 
     Off.OPWCore = Off.Wrong
-    assert kinematics._same_answers(compiled, python) and not kinematics._same_answers(Off, python)
+    assert kinematics.compiled._same_answers(compiled, python) and not kinematics.compiled._same_answers(Off, python)
 
 
 def test_the_fastpath_constants_are_the_kinematics(fast):
@@ -203,9 +203,9 @@ def _agree(machine, seed: int, monkeypatch) -> None:
     """The kinematics with the compiled fastpath against the kinematics with fastpath.py run as
     Python (USE_COMPILED off): the same axes, the same errors."""
     compiled = Kinematics(machine)
-    monkeypatch.setattr(kinematics, "USE_COMPILED", False)
+    monkeypatch.setattr(kinematics.compiled, "USE_COMPILED", False)
     python = Kinematics(machine)
-    monkeypatch.setattr(kinematics, "USE_COMPILED", True)
+    monkeypatch.setattr(kinematics.compiled, "USE_COMPILED", True)
     assert compiled.compiled_inverse and not python.compiled_inverse
     rng = np.random.default_rng(seed)
     lo, hi = np.maximum(compiled._lo, -185.0), np.minimum(compiled._hi, 185.0)
@@ -312,7 +312,7 @@ def test_the_compiled_cycle_is_off_in_actuated_mode_and_without_the_module(monke
 
     assert ArmModel(actuated=True).compiled_cycle(simcore) is None
     assert ArmModel().compiled_cycle(None) is None
-    monkeypatch.setattr(kinematics, "USE_COMPILED", False)
+    monkeypatch.setattr(kinematics.compiled, "USE_COMPILED", False)
     assert controller._compiled_module() is None
 
 
@@ -412,7 +412,7 @@ def test_the_trace_is_the_same_with_and_without_the_compiled_module(sc, fast, mo
     from robot import trace, tracecheck  # noqa: PLC0415
 
     compiled = tracecheck.run_case("random-05")
-    monkeypatch.setattr(kinematics, "USE_COMPILED", False)
+    monkeypatch.setattr(kinematics.compiled, "USE_COMPILED", False)
     monkeypatch.setattr(trace, "_pose_line", None)
     assert tracecheck.run_case("random-05") == compiled
 

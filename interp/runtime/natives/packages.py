@@ -1,9 +1,10 @@
 """System functions and package routines that the simulator does not implement: they stand in
 for KUKA's software (interp/runtime/kss.py: counted, one note per run, listed in the run
-summary). In a backup a procedure does nothing and a function returns the zero value of its
-result type (of the type its use gives it, for an ANY result); outside a backup, or where no
-such value exists, the run stops with "routine NAME not found", as on a controller without the
-software. Each declaration says what a call gives.
+summary). A procedure does nothing and a function returns the zero value of its result type
+(of the type its use gives it, for an ANY result), in a backup or not: the checker's one
+decision (docs/robot.md "KUKA's system software at run time"); where no such value exists, the
+run stops with "routine NAME not found", as on a controller without the software. Each
+declaration says what a call gives.
 """
 
 from __future__ import annotations
@@ -13,21 +14,19 @@ from .registry import Family
 # with a documented signature (reference 4.8)
 KSS = Family("KUKA system functions")
 
-_ZERO_OF_USE = ("in a backup: the zero value of the type its use gives it (KUKA's software stand-in, noted "
-                "once); with no such use, or elsewhere, the run stops: routine NAME not found")
+_ZERO_OF_USE = ("the zero value of the type its use gives it (KUKA's software stand-in, noted once); with no "
+                "such use the run stops: routine NAME not found")
 
-KSS.stand_in("REAL DIGIN(...)", "in a backup: 0.0 (KUKA's software stand-in, noted once); elsewhere the run "
-                                "stops: routine DIGIN not found")
-KSS.stand_in("E6POS GET_SINGUL(...)", "in a backup: an E6POS of zeros (KUKA's software stand-in, noted once); "
-                                      "elsewhere the run stops: routine GET_SINGUL not found")
+KSS.stand_in("REAL DIGIN(...)", "0.0 (KUKA's software stand-in, noted once)")
+KSS.stand_in("E6POS GET_SINGUL(...)", "an E6POS of zeros (KUKA's software stand-in, noted once)")
 for _sig in ("ANY EK(...)", "ANY EB(...)", "ANY LK(...)", "ANY TOOL_ADJ(...)", "ANY SYNC(...)"):
     KSS.stand_in(_sig, _ZERO_OF_USE)
 
 # KUKA's system modules, known by name only (functions.yaml ``lenient: system``)
 SYSTEM_MODULES = Family("KUKA system modules", lenient="system")
 
-_NAME_ONLY = ("in a backup: a procedure does nothing, a function returns the zero value of the type its use "
-              "gives it (KUKA's software stand-in, noted once); elsewhere the run stops: routine NAME not found")
+_NAME_ONLY = ("a procedure does nothing, a function returns the zero value of the type its use gives it "
+              "(KUKA's software stand-in, noted once); with no such use the run stops: routine NAME not found")
 
 SYSTEM_MODULES.krl("IR_STOPM", "ir_stopm.src")
 SYSTEM_MODULES.krl("USE_CM_PRO_VALUES", "collmonlib.src")
