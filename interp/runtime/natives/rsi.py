@@ -2,7 +2,9 @@
 Each native converts its KRL arguments and hands them to the run's network hub (net/hub.py,
 net/rsi.py); the behaviour lives there, once, for both interpreters.
 
-RSI functions return an RSIERR number as INT (``RSIOK`` = 0, :data:`RSI_CONSTANTS`).
+RSI 3/4/5's functions return an RSIERR number as INT (``RSIOK`` = 0, :data:`RSI_CONSTANTS`);
+RSI 2's ``ST_`` functions (KR C2; net/rsi2.py) return the enum RSIERR (``#RSIOK``), as the KR C2
+programs declare their result.
 """
 
 from __future__ import annotations
