@@ -115,6 +115,21 @@ def joints(api) -> np.ndarray:
     return np.array([float(p[f"A{i}"]) for i in range(1, 7)])
 
 
+def follow_axes(api, target) -> tuple[np.ndarray, bool]:
+    """RSIPI sends the absolute AK `target` (deg); (the joints before, whether the robot's
+    joints reached it to 0.01 deg)."""
+    q0 = joints(api)
+    for i, v in enumerate(target):
+        api.tools.update_variable(f"AK.A{i + 1}", float(v))
+    return q0, until(lambda: np.allclose(joints(api) - q0, target, atol=0.01))
+
+
+def last_axes(trace) -> np.ndarray:
+    """A1..A6 of the robot's last packet (AIPos)."""
+    pk = robot_packets(trace)[-1].find("AIPos")
+    return np.array([float(pk.get(f"A{i}")) for i in range(1, 7)])
+
+
 def robot_packets(trace):
     return [ET.fromstring(re.sub(r"(\s)([0-9][\w.-]*=)", r"\1_\2", e["data"])) for e in net_events(trace, iface="rsi", dir="out")]
 
@@ -223,10 +238,7 @@ def test_rsipi_ipo_fast_kroshu(rsipi, shared_corpus, tmp_path, interp):
     target = np.array([1.5, -1.0, 0.5, 0.0, 2.0, -2.0])
 
     def script(api, hold):
-        q0 = joints(api)
-        for i, v in enumerate(target):
-            api.tools.update_variable(f"AK.A{i + 1}", float(v))
-        reached = until(lambda: np.allclose(joints(api) - q0, target, atol=0.01))
+        q0, reached = follow_axes(api, target)
         hold(0.2)
         api.tools.update_variable("Stop", True)
         hold(0.3)
@@ -238,9 +250,7 @@ def test_rsipi_ipo_fast_kroshu(rsipi, shared_corpus, tmp_path, interp):
     assert reached
     assert result.reason == "completed", (result.reason, result.text)
     assert ipoc_steps(trace) == {4}
-    pk = [r.find("AIPos") for r in robot_packets(trace)]
-    last = np.array([float(pk[-1].get(f"A{i}")) for i in range(1, 7)])
-    assert np.allclose(last - q0, target, atol=0.01)
+    assert np.allclose(last_axes(trace) - q0, target, atol=0.01)
 
 
 @pytest.mark.parametrize("interp", INTERPS)
@@ -253,10 +263,7 @@ def test_rsipi_on_the_kr_c2_rsi2_program(rsipi, shared_corpus, tmp_path, interp)
     target = np.array([2.0, -1.5, 1.0, 0.5, 3.0, -2.5])
 
     def script(api, hold):
-        q0 = joints(api)
-        for i, v in enumerate(target):
-            api.tools.update_variable(f"AK.A{i + 1}", float(v))
-        reached = until(lambda: np.allclose(joints(api) - q0, target, atol=0.01))
+        q0, reached = follow_axes(api, target)
         hold(0.2)
         return q0, reached
 
@@ -271,9 +278,7 @@ def test_rsipi_on_the_kr_c2_rsi2_program(rsipi, shared_corpus, tmp_path, interp)
     sent = [int(r.findtext("IPOC")) for r in robot_packets(trace)]
     answered = {int(a.findtext("IPOC")) for a in answers(trace)}
     assert len(answered) >= 15 and all(i > max(answered) for i in set(sent) - answered)
-    pk = [r.find("AIPos") for r in robot_packets(trace)]
-    last = np.array([float(pk[-1].get(f"A{i}")) for i in range(1, 7)])
-    assert np.allclose(last - q0, target, atol=0.01)
+    assert np.allclose(last_axes(trace) - q0, target, atol=0.01)
 
 
 @pytest.mark.parametrize("interp", INTERPS)

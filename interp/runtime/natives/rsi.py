@@ -95,13 +95,7 @@ def st_call(hub, rt, func: str, a: list):
         rt.wait_main_run(rt.current_task)
         return rsi.off(ctl)
     # ST_SKIPSENS: the sensor-guided motion; the program waits here as at RSI_MOVECORR
-    if not rsi.on:
-        raise KrlRuntimeError("ST_SKIPSENS without ST_ON")
-    task = rt.current_task
-    rt.wait_main_run(task)
-    while rsi.on and not rsi.stopped and not rsi.failed:
-        rt.yield_cycle(task)
-    return None
+    return _follow(rt, rsi, "ST_SKIPSENS without ST_ON")
 
 
 def rsi_call(hub, rt, method: str, a: list):
@@ -142,13 +136,19 @@ def rsi_call(hub, rt, method: str, a: list):
             a[3].set(v)
         return ret
     # movecorr: the robot follows the corrections only, until the STOP object or an error
+    return _follow(rt, rsi, "RSI_MOVECORR without RSI_ON")
+
+
+def _follow(rt, rsi, not_on: str) -> None:
+    """RSI_MOVECORR, ST_SKIPSENS: the program waits (the main run done first) while the robot
+    follows the sensor, until the STOP object or an error ends it; `not_on` is the error when
+    the sensor mode is off."""
     if not rsi.on:
-        raise KrlRuntimeError("RSI_MOVECORR without RSI_ON")
+        raise KrlRuntimeError(not_on)
     task = rt.current_task
     rt.wait_main_run(task)
     while rsi.on and not rsi.stopped and not rsi.failed:
         rt.yield_cycle(task)
-    return None
 
 
 RSI.add("RSI_CREATE", _rsi("create"))
