@@ -59,8 +59,9 @@ from krl.limits import MAX_RSI_DATAGRAM_BYTES
 from . import transport
 from .cellkey import LOOPBACK, channel
 from .partner import Partner
-from .rsicontext import (AXES, CART, Context, RsiConfigError, RsiObject, find_context, is_ethernet_config,
-                         load_context)
+from .rsi2 import CREATES, FRAMES, MAX_PARAM, RSI2, SignalFlow, find_ethernet, init_folders, param_name
+from .rsicontext import (AXES, CART, MAX_CHANNELS, Context, RsiConfigError, RsiObject, find_context,
+                         is_ethernet_config, load_context)
 from .xmlsafe import XmlRefused, local, parse
 
 RSIOK, RSIINVOBJID, RSIINVPARAM, RSINOMEM, RSIINVOBJTYPE, RSIINVCONN, RSIALREADYON, RSINOTON, RSIOBJUSED = range(9)
@@ -150,6 +151,7 @@ class Rsi:
         self.noted: set[str] = set()
         self.estr = ""
         self.q_on: np.ndarray | None = None
+        self.flow: SignalFlow | None = None  # RSI 2: the objects the ST_ functions created
 
     # ------------------------------------------------------------------ functions
     def create(self, name: str) -> int:
@@ -201,10 +203,117 @@ class Rsi:
                         top / "Config" / "RobotSensorInterface" / "Ethernet configuration"]
         return out
 
+    # ------------------------------------------------------------------ RSI 2 (ST_ functions)
+    def st_create(self, func: str, config: str = "") -> tuple[int, int]:
+        """An ST_ function that creates an object (net/rsi2.py): (RSIERR, handle)."""
+        if self.ctx is not None and self.flow is None:
+            return RSIOBJUSED, 0                 # an RSI 3+ context is loaded
+        if self.flow is None:
+            self.flow = SignalFlow()
+            self.ctx = self.flow.ctx
+        typ = CREATES[func]
+        if typ == "ETHERNET" and self.flow.ctx.ethernet is not None:
+            return RSIOBJUSED, 0
+        obj = self.flow.create(typ)
+        if obj is None:
+            return RSINOMEM, 0
+        if typ == "ETHERNET":
+            path = self._st_config(config)
+            if path is None:
+                del self.flow.ctx.objects[obj.id]
+                self.hub.net_message(f"RSI: {func}: ETHERNET configuration {config[:60]} not found (Roboter/Init "
+                                     "of the backup, beside the program, or the cell file's rsi: {ethernet: PATH})")
+                return RSIINVPARAM, 0
+            try:
+                self.flow.ethernet(obj, path)
+            except RsiConfigError as exc:
+                del self.flow.ctx.objects[obj.id]
+                self.hub.net_message(f"RSI: {exc}")
+                return RSIINVPARAM, 0
+            self.hub.trace("rsi", "context", name=config[:60],
+                           text=f"{RSI2}: ETHERNET object {obj.id} of {func}, ETHERNET configuration {path.name}")
+            for el in self.ctx.ethernet.send + self.ctx.ethernet.receive:
+                key = el.tag.upper()
+                if el.internal and key not in INTERNAL_SEND and key != "DEF_ESTR" and key not in self.noted:
+                    self.noted.add(key)
+                    self.hub.net_message(f"RSI: internal value {el.tag[:40]} is not simulated")
+        elif typ not in SIMULATED and typ not in self.noted:
+            self.noted.add(typ)
+            self.hub.net_message(f"RSI: object {func} is not simulated (its outputs read 0)")
+        return RSIOK, int(obj.id)
+
+    def _st_config(self, name: str):
+        s = self.hub.settings
+        chan = s.rsi if s is not None else None
+        if chan is not None and getattr(chan, "ethernet", None) is not None:
+            return chan.ethernet
+        if chan is not None and chan.config is not None and is_ethernet_config(chan.config):
+            return chan.config
+        return find_ethernet(name, init_folders(self.hub.program, self.hub.backup))
+
+    def st_link(self, h_out, out_idx: int, h_in, in_idx: int) -> int:
+        """ST_NEWLINK: input `in_idx` of object `h_in` is output `out_idx` of `h_out`."""
+        src = self.flow.obj(h_out) if self.flow is not None else None
+        dst = self.flow.obj(h_in) if self.flow is not None else None
+        if src is None or dst is None:
+            return RSIINVOBJID
+        if not (1 <= out_idx <= MAX_CHANNELS and 1 <= in_idx <= MAX_CHANNELS):
+            return RSIINVPARAM
+        dst.inputs[in_idx] = (src.id, out_idx)
+        return RSIOK
+
+    def st_setparam(self, handle, n: int, value: float) -> int:
+        """ST_SETPARAM: parameter number `n` of the object (net/rsi2.py ``param_name``)."""
+        obj = self.flow.obj(handle) if self.flow is not None else None
+        if obj is None:
+            return RSIINVOBJID
+        if not 1 <= n <= MAX_PARAM:
+            return RSIINVPARAM
+        name = param_name(obj.type, n)
+        if name is None:
+            key = f"{obj.type}.{n}"
+            if key not in self.noted:
+                self.noted.add(key)
+                self.hub.net_message(f"RSI: parameter {n} of {obj.type} is not simulated")
+            name = f"P{n}"
+        obj.params[name] = repr(float(value))
+        return RSIOK
+
+    def st_delete(self, handle) -> int:
+        """ST_DELOBJ: the object and the links from it are gone."""
+        obj = self.flow.obj(handle) if self.flow is not None else None
+        if obj is None or self.on:
+            return RSIINVOBJID if obj is None else RSIALREADYON
+        del self.ctx.objects[obj.id]
+        for o in self.ctx.objects.values():
+            o.inputs = {k: v for k, v in o.inputs.items() if v[0] != obj.id}
+        if obj.id == self.ctx.ethernet_id:
+            self.ctx.ethernet_id, self.ctx.ethernet = "", None
+        return RSIOK
+
+    def st_on(self, ctl, frame: str | None = None) -> int:
+        """ST_ON / ST_ON1: the sensor mode on, in the integration mode of the correction objects'
+        parameter 1 (1 relative, 0 absolute; unset: relative, as RSI_ON's default)."""
+        if self.flow is None or self.ctx.ethernet is None:
+            self.hub.net_message("RSI: ST_ON without an ETHERNET object (ST_ETHERNET) is not simulated")
+            return RSIINVOBJID
+        if self.ctx.ethernet.protocol != "UDP":
+            self.hub.net_message(f"RSI: PROTOCOL {self.ctx.ethernet.protocol} of "
+                                 f"{self.ctx.ethernet.path.name} is not simulated (UDP is)")
+            return RSIINVCONN
+        modes = [o.param("IntegrationMode", 1.0) for o in self.ctx.objects.values()
+                 if o.type in ("AXISCORR", "POSCORR") and o.param_name("IntegrationMode")]
+        mode = "ABSOLUTE" if modes and modes[0] == 0.0 else "RELATIVE"
+        if frame is not None:
+            for o in self.ctx.of_type("POSCORR"):
+                o.params["RefCorrSys"] = FRAMES.get(frame, "Base")
+        return self.start(ctl, mode, False)
+
     def delete(self) -> int:
         if self.on:
             self.off()
         self.ctx = None
+        self.flow = None
         return RSIOK
 
     def set_param(self, obj: str, name: str, value: float) -> int:

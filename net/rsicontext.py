@@ -21,7 +21,7 @@ RSI 3 ``OutIdx="2"`` and RSI 4 ``OutIdx="1"`` both take ``AK.A1`` of ``INDX="2"`
 
 The ETHERNET object's ``ConfigFile`` is KUKA's ``ROOT`` document (the template
 ``RSI_EthernetConfig.xml`` as KUKA ships it): ``CONFIG`` (``IP_NUMBER``, ``PORT``,
-``SENTYPE``, ``ONLYSEND``), ``SEND/ELEMENTS`` and ``RECEIVE/ELEMENTS`` of ``ELEMENT TAG TYPE
+``SENTYPE``, ``ONLYSEND``; RSI 2's also ``PROTOCOL`` UDP or TCP), ``SEND/ELEMENTS`` and ``RECEIVE/ELEMENTS`` of ``ELEMENT TAG TYPE
 INDX [HOLDON]``. The template's own comments are the format's documentation: TYPE is one of
 ``BOOL``, ``STRING``, ``LONG``, ``DOUBLE``; ``INDX="INTERNAL"`` switches on the controller's
 internal values (the ``DEF_`` elements, in SEND and in RECEIVE: ``DEF_EStr``,
@@ -113,6 +113,7 @@ class EthernetConfig:
     onlysend: bool
     send: list[Element]
     receive: list[Element]
+    protocol: str = "UDP"        # RSI 2's CONFIG/PROTOCOL (KR C2 configurations): UDP or TCP
 
 
 @dataclass
@@ -318,10 +319,13 @@ def read_ethernet(path: Path, root=None) -> EthernetConfig:
     only = (_text(conf, "ONLYSEND") or "FALSE").upper()
     if only not in ("TRUE", "FALSE"):
         raise RsiConfigError(f"RSI {name}: CONFIG/ONLYSEND {only[:20]!r} is neither TRUE nor FALSE")
+    protocol = (_text(conf, "PROTOCOL") or "UDP").upper()
+    if protocol not in ("UDP", "TCP"):
+        raise RsiConfigError(f"RSI {name}: CONFIG/PROTOCOL {protocol[:20]!r} is neither UDP nor TCP")
     send = _elements(root, "SEND", name)
     receive = _elements(root, "RECEIVE", name)
     return EthernetConfig(path, _text(conf, "IP_NUMBER") or LOOPBACK, port, _text(conf, "SENTYPE") or "ImFree",
-                          only == "TRUE", send, receive)
+                          only == "TRUE", send, receive, protocol)
 
 
 def _elements(root, section: str, name: str) -> list[Element]:

@@ -1,12 +1,14 @@
 """Every RSI program of the corpus with its own published context and configuration (RSI 3 or
 4/5) and a sensor written from that configuration (tests/net/sensor.py), on both interpreters
 (issue 50): datagrams at the program's cycle (12 ms, 4 ms with ``#IPO_FAST``), corrections
-followed (axes for AK, the TCP for RKorr, absolute or relative as the program's RSI_ON says),
+followed (axes for AK, the TCP for RKorr, absolute or relative as the program's RSI_ON, or RSI 2's
+ST_SETPARAM, says),
 and Stop honoured where the context has a STOP object (RSI_MOVECORR ends, the program goes on
 to its end). Programs whose context has no STOP object never end RSI_MOVECORR themselves; the
 run ends when the sensor has seen the correction.
 
-The contexts are tests/net/configs/published/ (derived from the programs' repositories, origins
+RSI 2's program (KR C2) builds its objects itself; its published ETHERNET configuration is the
+one file it needs. The contexts are tests/net/configs/published/ (derived from the programs' repositories, origins
 in each file); the programs are read in place from the corpus. The expected values are the
 sensor's own commands, compared with what the robot reports in its datagrams (AIPos, RIst)
 and the trace's poses."""
@@ -20,7 +22,9 @@ import xml.etree.ElementTree as ET
 import numpy as np
 import pytest
 
+from interp.run import make_runtime
 from net.settings import Channel, NetworkSettings
+from robot.trace import TraceWriter
 
 from .helpers import CONFIGS, EXAMPLES, net_events, run_with_partner
 from .sensor import ConfigSensor, axes_of, tcp_of
@@ -45,6 +49,10 @@ PROGRAMS = [
     (KSS + "rsi_joint_pos_12ms.src", "kroshu_kss/rsi_joint_pos.rsix", None),
     (KSS + "rsi_joint_pos_4ms.src", "kroshu_kss/rsi_joint_pos.rsix", None),
     (KSS + "rsi_gpio_example.src", "kroshu_kss/rsi_gpio_joint_pos.rsix", None),
+    # RSI 2 (KR C2): the program builds its objects with ST_ functions; the ETHERNET configuration
+    # of its ST_ETHERNET is the published file (tests/net/test_rsi2.py for the rest)
+    ("ros-industrial__kuka_experimental/kuka_rsi_hw_interface/krl/KR_C2/ros_rsi.src",
+     "ros_industrial_kr_c2/ros_rsi_ethernet.xml", None),
 ]
 AXIS_TARGET = np.array([2.0, -1.5, 1.0, 0.5, 3.0, -2.5])        # deg, within every context's limits
 CART_TARGET = np.array([4.0, -3.0, 5.0, 0.0, 0.0, 0.0])         # mm
@@ -106,6 +114,7 @@ def test_corpus_rsi_program(shared_corpus, program, context, ethernet, interp):
         assert result.reason == "completed", (result.reason, result.text)
     created = net_events(trace, iface="rsi", dir="context")
     assert created and ("RSI 4/5" in created[0]["text"]) == context.endswith(".rsix")
+    assert ("RSI 2:" in created[0]["text"]) == ("ST_ETHERNET" in text)
 
 
 def test_the_cell_file_may_name_the_ethernet_configuration(shared_corpus, tmp_path):
@@ -182,3 +191,30 @@ def test_onlysend_expects_no_answer(tmp_path):
     assert len(got) >= 200 and result.reason != "error", (result.reason, result.text)
     assert not [e for e in net_events(trace, iface="rsi", dir="error") if e.get("number") == 1]
     assert all(r.find("Delay").get("D") == "0" for r in got)
+
+
+AXIS_CORRECTION = "adamleon__kuka/kuka_rsi_hw_interface/krl/rsi_axis_correction/rsi_axis_correction.src"
+
+
+@pytest.mark.parametrize("interp", ["tree", "vm"])
+def test_rsi_axis_correction_has_no_published_ethernet_configuration(shared_corpus, tmp_path, interp):
+    """The rsi_axis_correction.src copies are not run: their repository publishes the context as
+    ``rsi_axis_corrrection.rsi.xml`` (three r's: RSI_CREATE("rsi_axis_correction.rsi") does not
+    find it on the controller either) and its ETHERNET object's ConfigFile
+    ``rsi_axis_correction_ethernet_config.xml`` nowhere. The run says so as the controller
+    would: RSI_CREATE returns an error, the program's check HALTs, nothing is sent; with the
+    published context named in the cell file, the message names the missing configuration."""
+    src = tmp_path / "rsi_axis_correction.src"
+    shutil.copyfile(shared_corpus / AXIS_CORRECTION, src)
+    ctx = PUB / "ros_industrial_rsi_axis_correction" / "rsi_axis_corrrection.rsi.xml"
+    shutil.copyfile(ctx, tmp_path / ctx.name)
+    for channel, message in ((Channel(None, ("127.0.0.1", 9)), "RSI: context rsi_axis_correction.rsi not found"),
+                             (Channel(tmp_path / ctx.name, ("127.0.0.1", 9)),
+                              "ConfigFile rsi_axis_correction_ethernet_config.xml not found")):
+        trace = TraceWriter(keep=True)
+        rt, _ = make_runtime(src, network=NetworkSettings(tmp_path, rsi=channel), trace=trace, max_sim_time=3.0,
+                             mujoco=False, interp=interp)
+        rt.run()
+        texts = " ".join(str(e.get("text", "")) for e in trace.events)
+        assert message in texts, texts[-1500:]
+        assert not net_events(trace, iface="rsi", dir="out")

@@ -10,6 +10,8 @@ PC of KUKA RSI; a pinned test dependency) on both interpreters (issue 50):
 * corpus programs with their published configurations: wingljj's PoseTrack (RSI 4/5 .rsix,
   LIMIT objects, relative RKorr with HOLDON 0) and kroshu's rsi_joint_pos_4ms (RSI 4/5,
   ``#IPO_FAST``: 4 ms cycle, absolute AK, Stop);
+* ROS-Industrial's KR_C2 ros_rsi.src (RSI 2, the ST_ functions) with its published
+  ros_rsi_ethernet.xml: 12 ms, absolute AK;
 * a late-answer stop: RSIPI stopped, the robot stops after Timeout + 1 late cycles.
 
 RSIPI binds the configuration's IP and PORT: each test hands it a copy of the published
@@ -111,6 +113,21 @@ def pose(api) -> np.ndarray:
 def joints(api) -> np.ndarray:
     p = api.motion.get_current_joints()
     return np.array([float(p[f"A{i}"]) for i in range(1, 7)])
+
+
+def follow_axes(api, target) -> tuple[np.ndarray, bool]:
+    """RSIPI sends the absolute AK `target` (deg); (the joints before, whether the robot's
+    joints reached it to 0.01 deg)."""
+    q0 = joints(api)
+    for i, v in enumerate(target):
+        api.tools.update_variable(f"AK.A{i + 1}", float(v))
+    return q0, until(lambda: np.allclose(joints(api) - q0, target, atol=0.01))
+
+
+def last_axes(trace) -> np.ndarray:
+    """A1..A6 of the robot's last packet (AIPos)."""
+    pk = robot_packets(trace)[-1].find("AIPos")
+    return np.array([float(pk.get(f"A{i}")) for i in range(1, 7)])
 
 
 def robot_packets(trace):
@@ -221,10 +238,7 @@ def test_rsipi_ipo_fast_kroshu(rsipi, shared_corpus, tmp_path, interp):
     target = np.array([1.5, -1.0, 0.5, 0.0, 2.0, -2.0])
 
     def script(api, hold):
-        q0 = joints(api)
-        for i, v in enumerate(target):
-            api.tools.update_variable(f"AK.A{i + 1}", float(v))
-        reached = until(lambda: np.allclose(joints(api) - q0, target, atol=0.01))
+        q0, reached = follow_axes(api, target)
         hold(0.2)
         api.tools.update_variable("Stop", True)
         hold(0.3)
@@ -236,9 +250,35 @@ def test_rsipi_ipo_fast_kroshu(rsipi, shared_corpus, tmp_path, interp):
     assert reached
     assert result.reason == "completed", (result.reason, result.text)
     assert ipoc_steps(trace) == {4}
-    pk = [r.find("AIPos") for r in robot_packets(trace)]
-    last = np.array([float(pk[-1].get(f"A{i}")) for i in range(1, 7)])
-    assert np.allclose(last - q0, target, atol=0.01)
+    assert np.allclose(last_axes(trace) - q0, target, atol=0.01)
+
+
+@pytest.mark.parametrize("interp", INTERPS)
+def test_rsipi_on_the_kr_c2_rsi2_program(rsipi, shared_corpus, tmp_path, interp):
+    """ROS-Industrial's KR_C2 ros_rsi.src (RSI 2: ST_ETHERNET, ST_AXISCORR absolute by
+    ST_SETPARAM, ST_SKIPSENS) with its published ros_rsi_ethernet.xml (PROTOCOL UDP, UNIT
+    attributes): 12 ms, RSIPI's absolute AK followed to 0.01 deg. No break object: the test
+    ends the run."""
+    cfg, port = local_copy(PUB / "ros_industrial_kr_c2" / "ros_rsi_ethernet.xml", tmp_path)
+    target = np.array([2.0, -1.5, 1.0, 0.5, 3.0, -2.5])
+
+    def script(api, hold):
+        q0, reached = follow_axes(api, target)
+        hold(0.2)
+        return q0, reached
+
+    settings = NetworkSettings(tmp_path, rsi=Channel(cfg, ("127.0.0.1", port)))
+    result, trace, (q0, reached) = run_with_partner(
+        shared_corpus / "ros-industrial__kuka_experimental/kuka_rsi_hw_interface/krl/KR_C2/ros_rsi.src",
+        settings, rsipi(cfg, script), interp=interp)
+    assert reached
+    assert ipoc_steps(trace) == {12}
+    # every packet answered in time until RSIPI was stopped (the run has no Stop: it goes on a
+    # cycle or two after the script, and those packets are late)
+    sent = [int(r.findtext("IPOC")) for r in robot_packets(trace)]
+    answered = {int(a.findtext("IPOC")) for a in answers(trace)}
+    assert len(answered) >= 15 and all(i > max(answered) for i in set(sent) - answered)
+    assert np.allclose(last_axes(trace) - q0, target, atol=0.01)
 
 
 @pytest.mark.parametrize("interp", INTERPS)

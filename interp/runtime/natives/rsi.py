@@ -2,7 +2,9 @@
 Each native converts its KRL arguments and hands them to the run's network hub (net/hub.py,
 net/rsi.py); the behaviour lives there, once, for both interpreters.
 
-RSI functions return an RSIERR number as INT (``RSIOK`` = 0, :data:`RSI_CONSTANTS`).
+RSI 3/4/5's functions return an RSIERR number as INT (``RSIOK`` = 0, :data:`RSI_CONSTANTS`);
+RSI 2's ``ST_`` functions (KR C2; net/rsi2.py) return the enum RSIERR (``#RSIOK``), as the KR C2
+programs declare their result.
 """
 
 from __future__ import annotations
@@ -37,6 +39,63 @@ def _arg_text(a: list, i: int) -> str:
 def _arg_enum(a: list, i: int, default: str) -> str:
     v = a[i].get() if len(a) > i and a[i] is not None else None
     return v.name.upper() if isinstance(v, EnumValue) else default
+
+
+_RSIERR_NAMES = {v: k for k, v in RSI_CONSTANTS.items()}
+
+
+def _st(func: str):
+    def native(rt, a):
+        ret = st_call(network(rt), rt, func, a)
+        # RSI 2's functions return the enum RSIERR (KR C2 programs declare DECL RSIERR err and
+        # compare it with #RSIOK); RSI 3's return its number as INT
+        return None if ret is None else EnumValue(_RSIERR_NAMES[ret])
+    return native
+
+
+def _arg_num(a: list, i: int, what: str) -> float:
+    from ..convert import num  # noqa: PLC0415
+    if len(a) <= i or a[i] is None:
+        raise value_invalid(what)
+    return float(num(a[i].get(), what))
+
+
+def st_call(hub, rt, func: str, a: list):
+    """RSI 2's ST_ functions (KUKA.RobotSensorInterface 2.x; net/rsi2.py holds the model):
+    ST_ETHERNET(h :OUT, container, CONFIG[]), ST_AXISCORR/ST_PATHCORR/ST_DIGIN/ST_MAP2DIGOUT/
+    ST_COROB(h :OUT, container, ...), ST_NEWLINK(hOut, outIdx, hIn, inIdx), ST_SETPARAM(h, n,
+    value), ST_DELOBJ(h), ST_RESET(), ST_ON(), ST_ON1(#frame, n), ST_OFF(), ST_SKIPSENS() (holds
+    the program while the robot follows the sensor, until an error ends it). Returns the RSIERR
+    number (:func:`_st` gives it as the enum RSIERR); ST_SKIPSENS nothing."""
+    from net.rsi import RSIOK  # noqa: PLC0415
+    from net.rsi2 import CREATES  # noqa: PLC0415
+
+    rsi = hub.partner("rsi").instance()
+    ctl = rt.controller
+    if func in CREATES:
+        ret, handle = rsi.st_create(func, _arg_text(a, 2) if func == "ST_ETHERNET" else "")
+        if ret == RSIOK and a and a[0] is not None:
+            a[0].set(handle)
+        return ret
+    if func == "ST_NEWLINK":
+        return rsi.st_link(int(_arg_num(a, 0, "ST_NEWLINK object")), int(_arg_num(a, 1, "ST_NEWLINK output")),
+                           int(_arg_num(a, 2, "ST_NEWLINK object")), int(_arg_num(a, 3, "ST_NEWLINK input")))
+    if func == "ST_SETPARAM":
+        return rsi.st_setparam(int(_arg_num(a, 0, "ST_SETPARAM object")), int(_arg_num(a, 1, "ST_SETPARAM number")),
+                               _arg_num(a, 2, "ST_SETPARAM value"))
+    if func == "ST_DELOBJ":
+        return rsi.st_delete(int(_arg_num(a, 0, "ST_DELOBJ object")))
+    if func == "ST_RESET":
+        rt.wait_main_run(rt.current_task)
+        return rsi.delete()
+    if func in ("ST_ON", "ST_ON1"):
+        rt.wait_main_run(rt.current_task)     # the sensor mode starts from the robot at rest
+        return rsi.st_on(ctl, _arg_enum(a, 0, "BASE") if func == "ST_ON1" else None)
+    if func == "ST_OFF":
+        rt.wait_main_run(rt.current_task)
+        return rsi.off(ctl)
+    # ST_SKIPSENS: the sensor-guided motion; the program waits here as at RSI_MOVECORR
+    return _follow(rt, rsi, "ST_SKIPSENS without ST_ON")
 
 
 def rsi_call(hub, rt, method: str, a: list):
@@ -77,13 +136,19 @@ def rsi_call(hub, rt, method: str, a: list):
             a[3].set(v)
         return ret
     # movecorr: the robot follows the corrections only, until the STOP object or an error
+    return _follow(rt, rsi, "RSI_MOVECORR without RSI_ON")
+
+
+def _follow(rt, rsi, not_on: str) -> None:
+    """RSI_MOVECORR, ST_SKIPSENS: the program waits (the main run done first) while the robot
+    follows the sensor, until the STOP object or an error ends it; `not_on` is the error when
+    the sensor mode is off."""
     if not rsi.on:
-        raise KrlRuntimeError("RSI_MOVECORR without RSI_ON")
+        raise KrlRuntimeError(not_on)
     task = rt.current_task
     rt.wait_main_run(task)
     while rsi.on and not rsi.stopped and not rsi.failed:
         rt.yield_cycle(task)
-    return None
 
 
 RSI.add("RSI_CREATE", _rsi("create"))
@@ -103,9 +168,9 @@ RSI.stand_in("RSI_CHECKID", NOT_SIMULATED)
 # RSI 5 (iiQKA): a context is loaded and activated by name, the process switched on and off
 RSI.add("RSI_DEACTIVATE", _rsi("activate"))
 RSI.add("RSI_UNLOAD", _rsi("delete"))
-# the sensor-tech routines of RSI 2 (ST_*): not simulated
+# RSI 2 (KR C2): the signal flow built object by object by the ST_ functions (net/rsi2.py)
 for _name in ("ST_ON", "ST_ON1", "ST_OFF", "ST_SKIPSENS", "ST_SETPARAM", "ST_NEWLINK", "ST_ETHERNET",
               "ST_AXISCORR", "ST_PATHCORR", "ST_MAP2DIGOUT", "ST_DIGIN", "ST_COROB", "ST_DELOBJ", "ST_RESET"):
-    RSI.stand_in(_name, NOT_SIMULATED)
+    RSI.add(_name, _st(_name))
 
-__all__ = ["RSI", "RSI_CONSTANTS", "rsi_call"]
+__all__ = ["RSI", "RSI_CONSTANTS", "rsi_call", "st_call"]
