@@ -56,6 +56,10 @@ CP_SPEED_LIMIT_FACTOR = 1.5
 #: Largest axis step (deg) between the planning samples of a CP path (axis speed and
 #: acceleration are estimated from them).
 CP_SAMPLE_STEP_DEG = 1.0
+#: Most planning samples of one piece of a CP path (near a wrist singularity A4/A6 turn fast
+#: on a short piece; 256 left steps of several degrees there, and the sampled speed 3 % under
+#: the peak between samples: tests/robot/test_limits_property.py, KR 120 R2700 extra HA).
+CP_MAX_SAMPLES = 1024
 #: Safety factor on the sampled TCP/flange speed of a path in T1 (sampling between points).
 T1_MARGIN = 1.02
 #: Passes of the batched IK chain (:meth:`RobotModel.ik_chain`) before it gives up and the
@@ -1366,11 +1370,11 @@ def _plan_cart(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_T: 
                 Q[j] = q
                 ref = q
             # resolution: at most ~1° of any axis between samples (near a wrist singularity
-            # A4/A6 turn fast on a short piece of path), up to 256 samples per piece
+            # A4/A6 turn fast on a short piece of path), up to CP_MAX_SAMPLES per piece
             step = float(np.max(np.abs(np.diff(Q, axis=0)))) if nk > 0 else 0.0
-            if step <= CP_SAMPLE_STEP_DEG or nk >= 256:
+            if step <= CP_SAMPLE_STEP_DEG or nk >= CP_MAX_SAMPLES:
                 break
-            nk = min(256, int(nk * step / CP_SAMPLE_STEP_DEG) + 1)
+            nk = min(CP_MAX_SAMPLES, int(nk * step / CP_SAMPLE_STEP_DEG) + 1)
         h = float(us[1] - us[0])
         if h <= 0:
             junction_q.append(Q[0].copy())
