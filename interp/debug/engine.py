@@ -394,6 +394,7 @@ class Engine:
         every replay; returns what ``apply`` returned. Raises :class:`Refused`."""
         self.need_stopped()
         result = apply(self)
+        self.rt.changed_outside()
         self.edits.append(Edit(self.stop_where, label, apply))
         return result
 
@@ -407,6 +408,7 @@ class Engine:
         if self.state != "running" or self.rt is None:
             raise Refused("no program is running")
         result = apply(self)
+        self.rt.changed_outside()
         self.edits.append(Edit((self.n, self.sub), label, apply))
         return result
 
@@ -532,6 +534,7 @@ class Engine:
             e = self._pending.pop(0)
             try:
                 e.apply(self)
+                self.rt.changed_outside()
             except Refused as exc:
                 self.output(f"replay: the edit {e.label} could not be made again: {exc}", "stderr")
 

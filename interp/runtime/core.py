@@ -319,6 +319,17 @@ class Runtime:
         if self.current_task is not None:
             self._break(self.current_task)
 
+    def changed_outside(self) -> None:
+        """The operator changed the run's state between two statements or IPO cycles (a front
+        end's edit: interp/debug/engine.py ``Engine.edit``/``edit_now``; a variable, a message
+        acknowledged, the override): every watch key moves (the probes, ``CyclicWatch.version``)
+        and parked spins run again, so that no wait, interrupt or spin misses the change."""
+        self.cyclic_watch.version += 1
+        self.bump_epoch()
+        spin = getattr(self, "spin", None)
+        if spin is not None:
+            spin.outside_change()
+
     def interpreter_active(self, robot: bool) -> bool:
         if robot:
             return self.robot is not None and not self.robot.done

@@ -646,6 +646,14 @@ class SpinWatch:
                 self._unshadow(task)
 
     # ------------------------------------------------------------------ waking
+    def outside_change(self) -> None:
+        """Something outside the tasks changed their state (an operator's edit: a variable set,
+        a message acknowledged, the override; interp/runtime/core.py ``Runtime.changed_outside``):
+        a recording fails, parked and shadowed spins run again."""
+        if self.rec is not None:
+            self._fail("outside")
+        self.wake_all()
+
     def wake_all(self) -> None:
         for task in list(self.parked):
             self.wake(task)
