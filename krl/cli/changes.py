@@ -18,7 +18,7 @@ from pathlib import Path
 
 import click
 
-from krl.limits import PARSE_TIMEOUT_S
+from krl import limits   # limits.PARSE_TIMEOUT_S read at each call (tests lengthen it)
 from krl.project import folder_groups
 from krl.source import read_source
 from krl.terminal import printable
@@ -115,7 +115,7 @@ def load_map(path: str):
                 names = ", ".join(printable(shown(root)) for root, _ in groups)
                 raise ValueError(f"{path} holds {len(groups)} programs (KRC backups or folders): {names}; "
                                  "name one of them")
-            wss = workspaces_for(target, timeout=PARSE_TIMEOUT_S, groups=groups)
+            wss = workspaces_for(target, timeout=limits.PARSE_TIMEOUT_S, groups=groups)
             ws = wss[0]
             pm = build_map(ws)
             diags = [shown.diagnostic(d) for d in ws.diagnostics]
