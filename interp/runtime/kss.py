@@ -59,9 +59,11 @@ from krl.semantics import types as T
 from krl.semantics.builtins import _read, load_builtins
 from krl.semantics.outside import provided_routine
 from krl.semantics.resolve import NATIVE, ROUTINE, UNRESOLVED
+from krl.workspace import is_kuka_file
 
 from .errors import KrlRuntimeError
 from .memory import Slot
+from .sysvars import sys_type
 from .values import EnumValue, make_value, zero_value
 
 #: functions of KSS whose value in a simulation is documented: name -> (value, why)
@@ -270,9 +272,6 @@ class SystemSoftware:
         if why:
             return why
         sym = self._symbol(key)
-        # costs 0.12 s at start-up (python -X importtime, 2026-11-25)
-        from krl.workspace import is_kuka_file  # noqa: PLC0415
-
         path = sym.path if sym is not None and sym.path and is_kuka_file(sym.path) else ""
         return provided_routine(key, path) or None
 
@@ -286,9 +285,6 @@ class SystemSoftware:
         name = getattr(info, "returns", None)
         if not name or name == "ANY":
             return None
-        # costs 0.009 s at start-up (python -X importtime, 2026-11-25)
-        from .sysvars import sys_type  # noqa: PLC0415
-
         return sys_type(name) or getattr(T, name.upper(), None)
 
     def _symbol(self, key: str):
@@ -401,9 +397,6 @@ def _param_types(call: N.Call, ws) -> list:
             out.append(getattr(sym, "type", None) if sym is not None and not p.dims else None)
         return out
     if c.kind == NATIVE:
-        # costs 0.009 s at start-up (python -X importtime, 2026-11-25)
-        from .sysvars import sys_type  # noqa: PLC0415
-
         info = load_builtins().routines.get(c.name.upper())
         if info is None:
             return []
