@@ -13,7 +13,7 @@ import re
 from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[1]
-CHECKED = ["krl", "interp", "robot", "tests/robot", "recovery", "pendant", "tests/pendant", "audit", "tests/audit", "robot", "tests/robot", "recovery", "pendant", "tests/pendant", "robot", "tests/robot", "robot/cellrules.py", "robot/datalist.py",
+CHECKED = ["krl", "interp", "robot", "tests/robot", "recovery", "pendant", "tests/pendant", "audit", "tests/audit", "tests/interp", "tests/vm", "tests/debug", "robot", "tests/robot", "recovery", "pendant", "tests/pendant", "audit", "tests/audit", "robot", "tests/robot", "recovery", "pendant", "tests/pendant", "robot", "tests/robot", "robot/cellrules.py", "robot/datalist.py",
            "conformance", "net", "examples", "tools",
            "tests/frontend", "tests/recovery", "tests/conformance", "tests/syntax", "tests/programmap",
            "tests/report", "tests/fmt", "tests/net", "tests/diff", "tests/editors", "tests/conftest.py",
