@@ -19,6 +19,8 @@ import time
 from collections.abc import Iterable
 from typing import Any
 
+from krl.cbuild import OTHER_CHECKOUT_PRELUDE
+
 from .controller import Controller, Event
 from .motion import MotionParams, MotionRequest, Trigger
 from .trace import TraceWriter
@@ -130,7 +132,8 @@ def _child_measure(root: str, min_motion_s: float, robot: str | None, warm_up: b
     import subprocess  # noqa: PLC0415
     import sys  # noqa: PLC0415
 
-    code = ("import json, sys, time; sys.path.insert(0, sys.argv[1]); from robot.bench import run_bench\n"
+    code = (OTHER_CHECKOUT_PRELUDE +
+            "import json, sys, time; sys.path.insert(0, sys.argv[1]); from robot.bench import run_bench\n"
             "m = None\n"
             "if sys.argv[3]:\n from robot.mada import load_robot; m = load_robot(sys.argv[3])\n"
             "t0 = time.perf_counter()\n"
