@@ -8,7 +8,10 @@ module. Each of those files defines its ``Extension``; this module holds what bo
   translated extensions: ``pip install``, ``pip install -e`` (which ``make`` runs) and the
   wheel all carry them;
 * :func:`build_in_place`: ``make vm-loop`` (``python -m interp.vm.build``, ``python -m
-  robot.build``) after a source changed.
+  robot.build``) after a source changed;
+* :data:`OTHER_CHECKOUT_PRELUDE`: what a benchmark's child process running another checkout
+  (``krl bench vm --baseline``, ``python -m robot.bench --against``, the tools comparing two
+  checkouts through :func:`other_checkout_command`) runs first.
 
 Nothing here raises for missing build tools: without Cython, setuptools or a C compiler the
 outcome says so and the pure-Python module stays the one that runs.
@@ -21,6 +24,29 @@ from pathlib import Path
 
 #: Cython's options for every extension
 DIRECTIVES = {"language_level": 3}
+
+#: Python code a child process that runs another checkout of this repository (a baseline) runs
+#: before its first import of the project, so that it imports only that checkout's files: this
+#: checkout's editable install (``pip install -e``, which ``make`` runs) puts a finder on
+#: ``sys.path`` that maps each module, the compiled extensions too, to this checkout, and an
+#: extension the other checkout has not built would come from here (built against other
+#: sources: "fastpath.Chooser size changed")
+OTHER_CHECKOUT_PRELUDE = """
+import sys
+sys.meta_path[:] = [f for f in sys.meta_path if "__editable__" not in repr(f)]
+sys.path_hooks[:] = [h for h in sys.path_hooks if "__editable__" not in repr(h)]
+sys.path[:] = [p for p in sys.path if "__editable__" not in p]
+sys.path_importer_cache.clear()
+"""
+
+
+def other_checkout_command(python: str, script: str, *args: str) -> list[str]:
+    """The command line that runs `script` (a path) with `args` in a child process of `python`
+    that imports only another checkout's files (:data:`OTHER_CHECKOUT_PRELUDE` first; the
+    checkout itself goes in the child's ``PYTHONPATH``): ``tools/trace_identity.py``,
+    ``tools/whole_run_bench.py``."""
+    run = "import runpy, sys; sys.argv = sys.argv[1:]; runpy.run_path(sys.argv[0], run_name='__main__')"
+    return [python, "-c", OTHER_CHECKOUT_PRELUDE + run, script, *args]
 
 
 def cythonized(extensions: list, build_dir: str = "build/cython", force: bool = False) -> list:

@@ -23,6 +23,8 @@ import time
 from collections.abc import Iterable
 from typing import Any
 
+from krl.cbuild import OTHER_CHECKOUT_PRELUDE
+
 from .controller import Controller, Event
 from .motion import MotionParams, MotionRequest, Trigger
 from .trace import TraceWriter
@@ -131,7 +133,8 @@ def measure(min_motion_s: float = 60.0, robot: str | None = None, warm_up: bool 
 def _child_measure(root: str, min_motion_s: float, robot: str | None, warm_up: bool) -> dict[str, Any]:
     """:func:`run_bench` of the checkout in `root` (its own ``robot`` package, a child process
     of this interpreter), warmed up like :func:`measure`."""
-    code = ("import json, sys, time; sys.path.insert(0, sys.argv[1]); from robot.bench import run_bench\n"
+    code = (OTHER_CHECKOUT_PRELUDE +
+            "import json, sys, time; sys.path.insert(0, sys.argv[1]); from robot.bench import run_bench\n"
             "m = None\n"
             "if sys.argv[3]:\n from robot.mada import load_robot; m = load_robot(sys.argv[3])\n"
             "t0 = time.perf_counter()\n"

@@ -1,4 +1,4 @@
-# cython: language_level=3, boundscheck=False, wraparound=False, cdivision=True, initializedcheck=False
+# cython: language_level=3, boundscheck=False, wraparound=False, cdivision=True, initializedcheck=False, auto_pickle=False
 """The simulator's hot path in C that is not kinematics of its own (issue 39, "Simulator";
 issue 47), built by robot/build.py. The kinematics' hot path is robot/kinematics/fastpath.py,
 compiled from that very Python file; this module calls its C methods (``OPWCore``):
@@ -21,6 +21,8 @@ is expected and missing. The same operations in the same order on C doubles, lib
 (what Python's ``math`` calls), ``degrees`` and ``radians`` as CPython's multiplications by 180/pi
 and pi/180, and no fused multiply-add (compiled with ``-ffp-contract=off``). ``SOURCE_SHA`` is the
 sha256 of the simcore.pyx it was built from (robot/build.py passes it): a stale build is not used.
+Its objects live in one process and are never pickled: ``auto_pickle=False`` (Cython's generated
+unpickling of ``Palletizer4``'s ``double[6][9]`` copied past the array's end).
 """
 
 from libc.math cimport sin, cos, atan2, sqrt, fabs, copysign, M_PI

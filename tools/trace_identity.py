@@ -9,7 +9,8 @@ of each checkout, and writes its full trace (every event: ``TraceWriter(repeats=
 traces of each program and interpreter are compared byte for byte, with the checkout's own root
 written ``<ROOT>`` (a cell or a BASIS file of the repository named in an event).
 
-Each checkout runs in a child process with ``PYTHONPATH=CHECKOUT`` on this interpreter: the
+Each checkout runs in a child process with ``PYTHONPATH=CHECKOUT`` on this interpreter, importing only
+that checkout's files (``krl.cbuild.other_checkout_command``): the
 checkouts must share this venv's dependencies, and each needs its generated parser
 (krl/syntax/generated) and, for the VM at full speed, its compiled loop (``python -m
 interp.vm.build`` run in it). ``KRL_BUILD_DIR`` (the Java parse engine) is passed through.
@@ -46,6 +47,11 @@ import subprocess
 import sys
 import time
 from pathlib import Path
+
+try:
+    from krl.cbuild import other_checkout_command
+except ImportError:  # the record child of a checkout older than it (only the driver calls it)
+    other_checkout_command = None
 
 CORPUS = Path(__file__).resolve().parent.parent.parent / "shared" / "krl-corpus"
 
@@ -244,8 +250,9 @@ def main(argv: list[str] | None = None) -> int:
         env = dict(os.environ, PYTHONPATH=str(co))
         log = open(dest / f"record.{it}.log", "a", encoding="utf-8")
         running.append(subprocess.Popen(
-            [sys.executable, str(Path(__file__).resolve()), "record", str(co), str(dest), "--interp", it,
-             "--limit", str(a.limit), "--corpus", a.corpus] + (["--network"] if a.network else []), cwd=co, env=env, stdout=log, stderr=subprocess.STDOUT))
+            other_checkout_command(sys.executable, str(Path(__file__).resolve()), "record", str(co), str(dest),
+                                   "--interp", it, "--limit", str(a.limit), "--corpus", a.corpus,
+                                   *(["--network"] if a.network else [])), cwd=co, env=env, stdout=log, stderr=subprocess.STDOUT))
     for p in running:
         p.wait()
     return compare(out / "before", out / "after")

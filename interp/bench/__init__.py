@@ -16,6 +16,8 @@ import sys
 import time
 from pathlib import Path
 
+from krl.cbuild import OTHER_CHECKOUT_PRELUDE
+
 from . import bench as py
 
 HERE = Path(__file__).resolve().parent
@@ -63,7 +65,7 @@ BASELINE_REV = "89ac166"
 
 # CPU mode: every revision's run_krl times with time.perf_counter, so this fresh process,
 # which runs only the benchmark, reads the CPU clock there
-_BASELINE_SNIPPET = """
+_BASELINE_SNIPPET = OTHER_CHECKOUT_PRELUDE + """
 import json, sys, time
 if sys.argv[1] == "cpu":
     time.perf_counter = time.process_time
@@ -83,14 +85,17 @@ out["vm_loop"] = "compiled" if COMPILED else "python"
 print(json.dumps(out))
 """
 
-# compiles the revision's own loop where it has one (interp/vm/build.py, since issue 23)
-_BASELINE_BUILD = """
-try:
-    from interp.vm.build import build
-except ImportError:
-    print("no build")
-else:
-    print(build())
+# compiles the revision's own VM loop (interp/vm/build.py, since issue 23) and simulator hot path
+# (robot/build.py, since issue 39) where it has them
+_BASELINE_BUILD = OTHER_CHECKOUT_PRELUDE + """
+out = []
+for name in ("interp.vm.build", "robot.build"):
+    try:
+        module = __import__(name, fromlist=["build"])
+    except ImportError:
+        continue
+    out.append(module.build())
+print("; ".join(out) or "no build")
 """
 
 
