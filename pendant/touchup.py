@@ -35,8 +35,11 @@ def touch_up(dat: Path, name: str, pos: dict, axes: list[float]) -> dict:
     ``axes`` (deg) into the declaration of ``name`` in the data list ``dat``. Returns the new
     components. Raises :class:`TouchUpError` (no such point, not a point, the line does not
     hold the aggregate) and OSError (the file cannot be written)."""
+    # costs 0.04 s at start-up (python -X importtime, 2026-11-25)
     from krl.files import write_bytes_atomic  # noqa: PLC0415
+    # costs 0.03 s at start-up (python -X importtime, 2026-11-25)
     from krl.source import decode_bytes, encode_text  # noqa: PLC0415
+    # costs 0.33 s at start-up (python -X importtime, 2026-11-25)
     from robot.datalist import DataListError, read_data_list  # noqa: PLC0415
 
     try:

@@ -19,6 +19,7 @@ POINT_KEYS = ("X", "Y", "Z")
 def programs(root: Path) -> list[str]:
     """The runnable programs of the workspace (interp/realprograms.py ``programs_of``: a
     backup's entry points; else every .src with a main routine), relative to ``root``."""
+    # costs 0.44 s at start-up (python -X importtime, 2026-11-25)
     from interp.realprograms import programs_of  # noqa: PLC0415
 
     out = []
@@ -33,6 +34,7 @@ def programs(root: Path) -> list[str]:
 def modules(root: Path) -> list[str]:
     """Every program file (.src) of the workspace, relative to ``root`` (the navigator's view:
     any of them can be selected)."""
+    # costs 0.03 s at start-up (python -X importtime, 2026-11-25)
     from krl.files import walk  # noqa: PLC0415
 
     out = [e.rel for e in walk(root) if e.kind == "file" and e.rel.lower().endswith(".src")]
@@ -42,6 +44,7 @@ def modules(root: Path) -> list[str]:
 def module_view(path: Path, root: Path) -> dict:
     """``{path, lines, points}``: the text of ``path`` (lines as str) and the taught points of
     its data list (the .dat beside it, any case)."""
+    # costs 0.02 s at start-up (python -X importtime, 2026-11-25)
     from krl.source import read_source  # noqa: PLC0415
 
     src = read_source(path, max_bytes=MAX_WEB_FILE_BYTES)
@@ -65,7 +68,9 @@ def taught_points(dat: Path, root: Path) -> list[dict]:
     """The Cartesian points of the data list ``dat``: name, X..C (in their base) and the
     position in $WORLD (``world``: mm), using the base their FDAT names (``BASE_DATA[n]`` of the
     backup's $config.dat; $WORLD when none). Axis points are listed with ``axes``."""
+    # costs 0.22 s at start-up (python -X importtime, 2026-11-25)
     from robot.datalist import DataListError, read_data_list  # noqa: PLC0415
+    # costs 0.34 s at start-up (python -X importtime, 2026-11-25)
     from robot.frames import frame_to_matrix  # noqa: PLC0415
 
     try:
@@ -99,7 +104,9 @@ def taught_points(dat: Path, root: Path) -> list[dict]:
 
 def _base_data(root: Path) -> dict[int, tuple]:
     """``BASE_DATA[n]`` of the workspace's $config.dat (n -> X..C), {} when there is none."""
+    # costs 0.04 s at start-up (python -X importtime, 2026-11-25)
     from krl.project import backup_of, system_folder  # noqa: PLC0415
+    # costs 0.22 s at start-up (python -X importtime, 2026-11-25)
     from robot.datalist import DataListError, read_data_list  # noqa: PLC0415
 
     base = backup_of(root) or root
@@ -125,6 +132,7 @@ def robot_view(machine, inputs: str | None = None) -> dict:
     """The robot the page draws: its URDF (``krl robot export``'s, robot/urdf.py), $ROBROOT
     (X..C mm/deg), the joint names in A1..A6 order, and ``start``: where it stands before a
     program is selected (:func:`start_position`)."""
+    # costs 0.36 s at start-up (python -X importtime, 2026-11-25)
     from robot.urdf import build_urdf  # noqa: PLC0415
 
     return {"name": machine.name, "urdf": build_urdf(machine), "robroot": list(machine.robroot_frame),
@@ -138,19 +146,24 @@ def start_position(machine, inputs: str | None = None) -> dict | None:
     only once the program is selected) and ``$POS_ACT`` there with ``$TOOL`` and ``$BASE`` null,
     as before the program's BAS sets them: ``{axes, pos, base, tool}`` as pendant/state.py's
     ``position``. None when the robot cannot be placed (the page then shows no position)."""
+    # costs 0.79 s at start-up (python -X importtime, 2026-11-25)
     from robot.controller import Controller  # noqa: PLC0415
 
     try:
+        # costs 0.38 s at start-up (python -X importtime, 2026-11-25)
         from interp.run import cell_of, is_auto  # noqa: PLC0415
 
         cell = cell_of(inputs) if inputs and not is_auto(inputs) else None
         ctl = Controller(machine, stimuli=cell, mujoco=False)
         where = getattr(ctl, "start", None)
         if where is not None:
+            # costs 0.05 s at start-up (python -X importtime, 2026-11-25)
             from krl.ast import nodes as N  # noqa: PLC0415
+            # costs 0.14 s at start-up (python -X importtime, 2026-11-25)
             from robot.stimuli import parse_start  # noqa: PLC0415
 
             if not isinstance(parse_start(where), N.Name):
+                # costs 0.03 s at start-up (python -X importtime, 2026-11-25)
                 from interp.scene import start_axes  # noqa: PLC0415
 
                 ctl.place(start_axes(ctl, lambda name: None, where))

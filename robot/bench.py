@@ -14,7 +14,11 @@ Also holds :func:`run_motions`, a small driver used by the tests and the benchma
 
 from __future__ import annotations
 
+import argparse
+import json
 import os
+import subprocess
+import sys
 import time
 from collections.abc import Iterable
 from typing import Any
@@ -113,6 +117,7 @@ def measure(min_motion_s: float = 60.0, robot: str | None = None, warm_up: bool 
     time)."""
     machine = None
     if robot:
+        # costs 0.12 s at start-up (python -X importtime, 2026-11-25)
         from .mada import load_robot  # noqa: PLC0415  (only with --robot: the machine-data reader)
 
         machine = load_robot(robot)
@@ -128,10 +133,6 @@ def measure(min_motion_s: float = 60.0, robot: str | None = None, warm_up: bool 
 def _child_measure(root: str, min_motion_s: float, robot: str | None, warm_up: bool) -> dict[str, Any]:
     """:func:`run_bench` of the checkout in `root` (its own ``robot`` package, a child process
     of this interpreter), warmed up like :func:`measure`."""
-    import json  # noqa: PLC0415  (only with --against)
-    import subprocess  # noqa: PLC0415
-    import sys  # noqa: PLC0415
-
     code = (OTHER_CHECKOUT_PRELUDE +
             "import json, sys, time; sys.path.insert(0, sys.argv[1]); from robot.bench import run_bench\n"
             "m = None\n"
@@ -161,9 +162,6 @@ def main(argv: list[str] | None = None) -> int:  # pragma: no cover - manual ent
     benchmark of the checkout in DIR (e.g. a worktree of the baseline) in a child process, in
     alternation with this one for ``--rounds`` rounds, and prints both and their ratio (best
     round of each: the least disturbed by the machine's load)."""
-    import argparse  # noqa: PLC0415  (the command line only)
-    import json  # noqa: PLC0415
-
     ap = argparse.ArgumentParser(prog="python -m robot.bench")
     ap.add_argument("--robot", default=None, help="robot: backup folder/.zip, $machine.dat or robot YAML")
     ap.add_argument("--min-motion-s", type=float, default=60.0, help="simulated seconds of motion")

@@ -8,6 +8,9 @@ from pathlib import Path
 
 import click
 
+from krl.terminal import printable
+from robot.machine import load_machine
+
 
 @click.command("plot")
 @click.argument("trace", type=click.Path(path_type=Path, exists=True, dir_okay=False))
@@ -16,6 +19,7 @@ import click
 def plot(trace: Path, output: Path | None) -> None:
     """Draw the TCP path of a JSON Lines TRACE (3D and top view, programmed points,
     approximation zones, I/O events) as a PNG."""
+    # costs 0.003 s at start-up (python -X importtime, 2026-11-25)
     from robot.plot import plot_trace  # noqa: PLC0415
 
     out = output or trace.with_suffix(".png")
@@ -33,10 +37,8 @@ def robot_group() -> None:
 
 
 def _load(path: Path | None):
-    from robot.machine import load_machine  # noqa: PLC0415
+    # costs 0.16 s at start-up (python -X importtime, 2026-11-25)
     from robot.mada import MachineDataError, load_robot  # noqa: PLC0415
-    from krl.terminal import printable  # noqa: PLC0415
-
     try:
         return load_robot(path) if path is not None else load_machine()
     except MachineDataError as exc:
@@ -50,6 +52,7 @@ def show(robot: Path | None) -> None:
     """Print the robot model of ROBOT (a KRC backup folder or .zip, a $machine.dat or a robot
     YAML; default the KR 6 R900): name, parameters with their source (file:line or the rule
     that derived them), axis limits, speeds, accelerations, reach."""
+    # costs 0.0007 s at krl's start-up (python -X importtime, 2026-11-25)
     from robot.show import show_lines  # noqa: PLC0415
 
     for line in show_lines(_load(robot)):
@@ -64,10 +67,12 @@ def export(robot: Path | None, fmt: str, output: Path) -> None:
     """Write the robot model of ROBOT (as for `krl robot show`) as URDF or MJCF (MuJoCo)."""
     m = _load(robot)
     if fmt == "urdf":
+        # costs 0.01 s at start-up (python -X importtime, 2026-11-25)
         from robot.urdf import build_urdf  # noqa: PLC0415
 
         text = build_urdf(m)
     else:
+        # costs 0.02 s at start-up (python -X importtime, 2026-11-25)
         from robot.mjcf import build_mjcf  # noqa: PLC0415
 
         text = build_mjcf(m)

@@ -27,12 +27,15 @@ the numeric solver) when a tool moves the robot, so ``krl cell init``, ``krl che
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 from scipy.spatial.transform import Rotation
+
+from krl.project import backup_of, find_backups, machine_data_file
 
 from .chain import chain_forward, chain_to_joints
 from .datalist import DataListError, DataValue, read_data_list
@@ -45,7 +48,9 @@ from .madavalues import frame6 as _frame6
 from .madavalues import get as _get
 from .madavalues import num as _num
 from .kinematics.families import machine_geometry
-from .machine import CartLimits, ExternalAxis, ExternalKinematic, JointData, MachineData, load_machine
+from .machine import (
+    CartLimits, ExternalAxis, ExternalKinematic, JointData, MachineData, library_robots, load_machine,
+)
 
 #: The rules for values that machine data lack (docs/robot.md, "Robots from machine data"); those of
 #: a family's geometry are the family's (robot/kinematics/arm.py RULES).
@@ -370,8 +375,6 @@ def machine_from_values(machine: dict[str, DataValue], robcor: dict[str, DataVal
     md["tool_data_1_mm_deg"] = [0.0] * 6
     R = flange[:3, :3]
     x, y, z, w = Rotation.from_matrix(R).as_quat()
-    import warnings  # noqa: PLC0415
-
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", UserWarning)
         rpy = Rotation.from_matrix(R).as_euler("xyz")
@@ -502,8 +505,6 @@ def robot_of_backup(root: str | Path, shown: str | None = None) -> MachineData |
     """The robot of the backup rooted at `root` (krl.project.machine_data_file), or None when
     it has no machine data. ``shown``: the name of `root` in places (an archive's name).
     Raises :class:`MachineDataError` for machine data that cannot make a model."""
-    from krl.project import machine_data_file  # noqa: PLC0415
-
     f = machine_data_file(Path(root))
     if f is None:
         return None
@@ -517,13 +518,10 @@ def load_robot(path: str | Path) -> MachineData:
     ``.zip`` (krl/archive.py checks and extracts it), or the name of a robot of the project's
     library (``kr180_r3200_pa``: robot/machine.py ``library_robots``). Raises :class:`MachineDataError` with a
     clear message for anything else."""
+    # costs 0.008 s at start-up (python -X importtime, 2026-11-25)
     from krl.archive import ArchiveError, backup_source, is_archive  # noqa: PLC0415
-    from krl.project import backup_of, find_backups  # noqa: PLC0415
-
     p = Path(path)
     if not p.exists():
-        from .machine import library_robots  # noqa: PLC0415
-
         lib = library_robots()
         if str(path) in lib:                    # a robot of the project's library, by name
             p = lib[str(path)]

@@ -23,7 +23,10 @@ Units at this interface: degrees and mm (MuJoCo itself uses rad and m).
 
 from __future__ import annotations
 
+import ctypes
+import glob
 import math
+import os
 from collections.abc import Sequence
 from typing import Any
 from xml.sax.saxutils import quoteattr
@@ -31,6 +34,7 @@ from xml.sax.saxutils import quoteattr
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from .blas import numpy_cblas
 from .frames import as_matrix, frame_to_matrix, inv_pos
 from .machine import MachineData, load_machine
 
@@ -215,10 +219,6 @@ def _arm_cycle(arm: "ArmModel", sc: Any) -> Any:
     if arm.actuated or len(arm._eadr) or arm._n != 6 or arm._linear is not None:
         return None
     try:
-        import ctypes  # noqa: PLC0415
-        import glob  # noqa: PLC0415
-        import os  # noqa: PLC0415
-
         libs = sorted(glob.glob(os.path.join(os.path.dirname(arm._mj.__file__), "libmujoco*")))
         if not libs:
             return None
@@ -241,8 +241,6 @@ def _arm_cycle(arm: "ArmModel", sc: Any) -> Any:
 def _numpy_dgemm() -> int:
     """The address of the ILP64 ``cblas_dgemm`` numpy's own BLAS exports (robot/blas.py), 0 when
     there is none at hand."""
-    from .blas import numpy_cblas  # noqa: PLC0415
-
     return numpy_cblas("dgemm")
 
 
@@ -273,6 +271,7 @@ class ArmModel:
     """
 
     def __init__(self, machine: MachineData | None = None, actuated: bool = False, **kw) -> None:
+        # costs 0.20 s at start-up (python -X importtime, 2026-11-25)
         import mujoco
 
         self._mj = mujoco

@@ -39,9 +39,11 @@ from typing import Any
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from .errors import RobotError, WorkspaceError
+from .errors import RobotError, SoftLimitError, WorkspaceError
 from .frames import frame_to_matrix, inv_pos, matrix_to_frame
 from . import kinematics
+from .external import ExternalAxes
+from .external_tcp import external_tcp
 from .kinematics import Kinematics
 from .motion import AXIS_KEYS, CART_KEYS, EXT_KEYS, MotionParams, MotionRequest, Trigger
 from .limits import DEFAULT_MODE, T1_SPEED_MM_S, cp_path_speed, motion_limits, ptp_axis_speeds
@@ -97,8 +99,6 @@ class RobotModel:
         self.ext = None
         self._ersys = False
         if self.n_ext:
-            from .external import ExternalAxes  # noqa: PLC0415
-
             self.ext = ExternalAxes(machine)
             self._ersys = self.ext.robroot_kin is not None
             self.v_max = np.array(machine.all_max_speed, dtype=float)
@@ -144,8 +144,6 @@ class RobotModel:
         """``$SOFTN_END``/``$SOFTP_END`` of A1..An and E1..En (SoftLimitError, reference §8.2)."""
         self.kin.check_soft_limits(q)
         if self.n_ext:
-            from .errors import SoftLimitError  # noqa: PLC0415
-
             e = np.asarray(q, dtype=float)[self.n:self.n + self.n_ext]
             for i in range(self.n_ext):
                 if e[i] < self._e_lo[i] - 1e-9 or e[i] > self._e_hi[i] + 1e-9:
@@ -1075,8 +1073,6 @@ def plan(req: MotionRequest, q_start: np.ndarray, model: RobotModel, *,
     if first:
         _check_complete(req, model.n)
     if p.ipo_mode == "TCP":
-        from .external_tcp import external_tcp  # noqa: PLC0415
-
         model = external_tcp(model)      # the fixed tool in the workpiece frame
     elif p.ipo_mode != "BASE":
         raise RobotError(f"$IPO_MODE=#{p.ipo_mode} is not supported by the simulator")

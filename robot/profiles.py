@@ -28,6 +28,7 @@ Times are in seconds; ``u`` is dimensionless.
 from __future__ import annotations
 
 import math
+from bisect import bisect_right
 from dataclasses import dataclass
 from typing import Any
 
@@ -212,7 +213,6 @@ class PiecewiseProfile:
         self.bounds = [float(b) for b in bounds]
 
     def _phase(self, t: float) -> int:
-        from bisect import bisect_right
         return max(0, bisect_right(self._t0, t) - 1)
 
     def u(self, t: float) -> float:
@@ -232,7 +232,6 @@ class PiecewiseProfile:
         return max(0.0, self._v0[k] + self._acc[k] * tau)
 
     def t_of_u(self, u: float) -> float:
-        from bisect import bisect_right
         if u <= 0.0 or self.t_total == 0.0:
             return 0.0
         if u >= 1.0:

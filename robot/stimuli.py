@@ -62,9 +62,15 @@ from typing import Any
 
 import yaml
 
-from krl.limits import MAX_CELL_RULES, MAX_CELL_SIM_TIME_S, MAX_START_CHARS, MAX_STIMULI, MAX_STIMULI_BYTES
+from krl.ast import nodes as N
+from krl.ast.build import build_expression
+from krl.limits import (
+    MAX_CELL_RULES, MAX_CELL_SIM_TIME_S, MAX_RULE_TOKENS, MAX_START_CHARS, MAX_STIMULI, MAX_STIMULI_BYTES,
+)
+from krl.syntax.parse import default_bundle, parse_expression
 
 from .cellrules import ConditionError, Rule, compile_condition, parse_condition, signal_of
+from .machine import library_robots
 
 PHASES = ("start", "blend_start", "blend_end", "end")
 TOP_KEYS = ("stimuli", "rules", "presets", "robot", "sim_time", "start", "network")
@@ -287,6 +293,7 @@ def parse_cell(doc: Any, default_reach_mm: float = 0.1, source: str = "") -> Cel
         if doc.get("stimuli") is not None:
             cell.stimuli = _parse_stimuli(doc["stimuli"], default_reach_mm, where)
         if doc.get("network") is not None:
+            # costs 0.20 s at start-up (python -X importtime, 2026-11-25)
             from net.settings import SettingsError, parse_network  # noqa: PLC0415
 
             try:
@@ -327,11 +334,6 @@ def parse_start(text: str):
     T 35}``) or the name of a point (``XHOME``), parsed by the project's expression parser
     (one line, at most :data:`~krl.limits.MAX_RULE_TOKENS` tokens). Raises
     :class:`StartError` for anything else."""
-    from krl.ast import nodes as N  # noqa: PLC0415
-    from krl.ast.build import build_expression  # noqa: PLC0415
-    from krl.limits import MAX_RULE_TOKENS  # noqa: PLC0415
-    from krl.syntax.parse import default_bundle, parse_expression  # noqa: PLC0415
-
     if not isinstance(text, str) or not text.strip():
         raise StartError("a start position is an E6AXIS literal or the name of a point, e.g. XHOME")
     if len(text) > MAX_START_CHARS:
@@ -373,8 +375,6 @@ def _start(value: Any, at: str) -> str:
 
 
 def _library_robot(name: Any, at: str) -> Path:
-    from .machine import library_robots  # noqa: PLC0415
-
     robots = library_robots()
     if not isinstance(name, str) or name not in robots:
         raise StimulusError(f"{at}: robot must name a robot of the project's library "

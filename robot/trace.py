@@ -14,10 +14,15 @@ gives the same bytes.
 from __future__ import annotations
 
 import json
+import warnings
 from collections import deque
 from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import IO, Any
+
+import numpy as np
+from .frames import GIMBAL_TOL_DEG, matrix_to_frame
+from scipy.spatial.transform import Rotation
 
 try:  # the compiled pose-line formatter (robot/build.py); absent without a build: Python formats
     from .simcore import pose_line as _pose_line
@@ -574,8 +579,6 @@ class _Pass:
 
 
 def _wrap180(v: Any) -> Any:
-    import numpy as np
-
     w = -((-np.asarray(v, dtype=float) + 180.0) % 360.0) + 180.0
     return np.where(np.abs(w) < 1e-12, 0.0, w)
 
@@ -586,13 +589,6 @@ _GIMBAL_LAST: list[tuple[Any, Any]] = [(None, None)]
 
 def _frames_of(Ts: list[Any]) -> list[list[float]]:
     """Vectorised :func:`robot.frames.matrix_to_frame` for a list of 4x4 matrices."""
-    import warnings
-
-    import numpy as np
-    from scipy.spatial.transform import Rotation
-
-    from .frames import GIMBAL_TOL_DEG, matrix_to_frame
-
     M = np.asarray(Ts, dtype=float)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", UserWarning)

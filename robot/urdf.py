@@ -15,7 +15,11 @@ for a linear axis, revolute for a rotary one, in E's units: m or rad), a BASE ki
 from __future__ import annotations
 
 import math
+import warnings
 import xml.etree.ElementTree as ET
+
+import numpy as np
+from scipy.spatial.transform import Rotation
 
 from .frames import frame_to_matrix
 from .machine import MachineData
@@ -58,10 +62,6 @@ def build_urdf(machine: MachineData) -> str:
 
 
 def _origin(el, T) -> None:
-    import warnings  # noqa: PLC0415
-
-    from scipy.spatial.transform import Rotation  # noqa: PLC0415
-
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", UserWarning)      # B = ±90: any split of the angles is the rotation
         rpy = Rotation.from_matrix(T[:3, :3]).as_euler("xyz")
@@ -77,8 +77,6 @@ def _fixed(robot, name: str, parent: str, child: str, T) -> None:
 
 def _external(robot, machine: MachineData) -> None:
     """The links and joints of the external kinematics (module docstring)."""
-    import numpy as np  # noqa: PLC0415
-
     axes = {e.number: e for e in machine.external_axes}
     ET.SubElement(robot, "link", name="world")
     for kin in machine.external_kinematics:

@@ -20,7 +20,11 @@ from pathlib import Path
 
 import pytest
 
+from interp.debug.client import DapClient
 from krl.files import same_file, spelled, spelled_within
+from pendant.engine import Engine
+from pendant.security import PathRefused, inside
+from pendant.view import module_view, programs
 from tests.conftest import REPO_ROOT, SHARED_CORPUS
 
 MILLING = "HugoDanielson__ChinaMilling/KRC"
@@ -87,8 +91,6 @@ def test_debugger_frames_and_breakpoints_keep_the_editors_path(linked):
     """`krl debug` launched on the program named through the link (as an editor that opened the
     folder behind the link names it): a breakpoint set in Get3Basepoints.src through the link
     is hit at line 21 (its LIN), and the frames carry the link's spelling."""
-    from interp.debug.client import DapClient
-
     root = linked / MILLING
     main, get3 = root / BLOCK, root / GET3
     with DapClient(timeout=900) as c:
@@ -104,10 +106,6 @@ def test_the_pendant_keeps_the_users_paths_and_refuses_links_out(linked, tmp_pat
     """The pendant on the backup named through the link: the programs, a module's path, the
     selected program's pointers are spelled through the link; a path named by its resolved
     spelling is shown in the link's; a link inside the workspace that leaves it is refused."""
-    from pendant.engine import Engine
-    from pendant.security import PathRefused, inside
-    from pendant.view import module_view, programs
-
     root = linked / MILLING
     assert "R1/Program/KukaMiling/Main.src" in programs(root)
     p = inside(root, BLOCK, suffixes=(".src",))

@@ -11,6 +11,7 @@ verifies that the wheel's dependency ranges accept the pinned versions.
 from __future__ import annotations
 
 import json
+import re
 import shutil
 import subprocess
 import sys
@@ -18,6 +19,7 @@ import sysconfig
 import tomllib
 import venv
 import zipfile
+from importlib import metadata
 from pathlib import Path
 
 import pytest
@@ -130,9 +132,6 @@ def test_constraints_pin_installed_versions_and_every_dependency():
     """constraints.txt (which make installs with: `pip install -c constraints.txt`) pins only
     packages that are installed, at their installed versions (a stale pin such as a dropped
     dependency fails here), and pins every direct dependency of krl-tools, dev extras included."""
-    import re
-    from importlib import metadata
-
     def norm(name: str) -> str:
         return re.sub(r"[-_.]+", "-", name).lower()
 

@@ -9,11 +9,16 @@ figure is that count divided by the Python time.
 
 from __future__ import annotations
 
+import json
+import os
 import re
+import sys
 import time
 from pathlib import Path
 
 from krl.cbuild import OTHER_CHECKOUT_PRELUDE
+
+from . import bench as py
 
 HERE = Path(__file__).resolve().parent
 PROGRAM = HERE / "bench.src"
@@ -31,6 +36,7 @@ def run_krl(interp: str, program: Path = PROGRAM, clock=None):
     """One run: (seconds, steps, (CHECK_I, CHECK_R)); seconds of `clock` (default
     time.perf_counter, wall time; time.process_time: this process's CPU time)."""
     clock = clock or time.perf_counter
+    # costs 0.44 s at start-up (python -X importtime, 2026-11-25)
     from interp.run import make_runtime  # noqa: PLC0415
 
     rt, _ = make_runtime(program, mujoco=False, max_steps=10 ** 9, interp=interp)
@@ -47,8 +53,6 @@ def run_python(loops: int = 20, clock=None):
     """The Python version, ``loops`` times (it is too fast to time once): (seconds per
     run, result); seconds of `clock` as in :func:`run_krl`."""
     clock = clock or time.perf_counter
-    from . import bench as py  # noqa: PLC0415
-
     n = rounds()
     t0 = clock()
     for _ in range(loops):
@@ -108,8 +112,11 @@ class Baseline:
         self.dir = None
 
     def __enter__(self) -> "Baseline":
+        # costs 0.004 s at start-up (python -X importtime, 2026-11-25)
         import shutil  # noqa: PLC0415
+        # costs 0.006 s at start-up (python -X importtime, 2026-11-25)
         import subprocess  # noqa: PLC0415
+        # costs 0.007 s at start-up (python -X importtime, 2026-11-25)
         import tempfile  # noqa: PLC0415
 
         repo = HERE.parents[1]
@@ -123,7 +130,9 @@ class Baseline:
         return self
 
     def __exit__(self, *exc) -> None:
+        # costs 0.004 s at start-up (python -X importtime, 2026-11-25)
         import shutil  # noqa: PLC0415
+        # costs 0.006 s at start-up (python -X importtime, 2026-11-25)
         import subprocess  # noqa: PLC0415
 
         repo = HERE.parents[1]
@@ -134,10 +143,8 @@ class Baseline:
     def _python(self, code: str, *args: str) -> str:
         """Run `code` (with `args` in sys.argv[1:]) in a fresh process on that revision; its
         output's last line. Raises RuntimeError when it fails."""
-        import os  # noqa: PLC0415
+        # costs 0.006 s at start-up (python -X importtime, 2026-11-25)
         import subprocess  # noqa: PLC0415
-        import sys  # noqa: PLC0415
-
         env = dict(os.environ, PYTHONPATH=str(self.dir))
         p = subprocess.run([sys.executable, "-c", code, *args], cwd=self.dir, env=env,
                            capture_output=True, text=True, timeout=3600)
@@ -149,8 +156,6 @@ class Baseline:
         """One run of the benchmark on that revision's tree interpreter and VM: ``{"tree":
         (seconds, steps, (CHECK_I, CHECK_R)), "vm": (...), "vm_loop": "compiled" | "python"}``;
         `cpu`: seconds of the process's CPU time instead of wall time."""
-        import json  # noqa: PLC0415
-
         got = json.loads(self._python(_BASELINE_SNIPPET, "cpu" if cpu else "wall"))
         out = {kind: (got[kind][0], got[kind][1], tuple(got[kind][2])) for kind in ("tree", "vm")}
         out["vm_loop"] = got["vm_loop"]
@@ -198,6 +203,7 @@ def compute(repeat: int = 3, baseline: Baseline | None = None, cpu: bool = False
                 best[key] = dt if best[key] is None else min(best[key], dt)
     if len({checks[k] for k in checks}) != 1:
         raise RuntimeError(f"benchmark results differ: {checks}")
+    # costs 0.17 s at start-up (python -X importtime, 2026-11-25)
     from interp.vm.vm import COMPILED  # noqa: PLC0415  (the VM loads only for the benchmark)
 
     out = {

@@ -56,12 +56,15 @@ from pathlib import Path
 
 from krl.ast import nodes as N
 from krl.semantics import types as T
+from krl.semantics.builtins import _read, load_builtins
 from krl.semantics.outside import provided_routine
 from krl.semantics.resolve import NATIVE, ROUTINE, UNRESOLVED
+from krl.workspace import is_kuka_file
 
 from .errors import KrlRuntimeError
 from .memory import Slot
-from .values import EnumValue, make_value
+from .sysvars import sys_type
+from .values import EnumValue, make_value, zero_value
 
 #: functions of KSS whose value in a simulation is documented: name -> (value, why)
 DOCUMENTED: dict[str, tuple[object, str]] = {
@@ -120,8 +123,6 @@ def _zero(t, absent: str | None = None):
     if t is T.REAL:
         return 0.0
     if isinstance(t, (T.Struc, T.Array)):
-        from .values import zero_value  # noqa: PLC0415
-
         try:
             return zero_value(t)
         except Exception:  # noqa: BLE001 - a type the zero value cannot build
@@ -271,8 +272,6 @@ class SystemSoftware:
         if why:
             return why
         sym = self._symbol(key)
-        from krl.workspace import is_kuka_file  # noqa: PLC0415
-
         path = sym.path if sym is not None and sym.path and is_kuka_file(sym.path) else ""
         return provided_routine(key, path) or None
 
@@ -282,14 +281,10 @@ class SystemSoftware:
         t = getattr(getattr(self._symbol(key), "signature", None), "returns", None)
         if t is not None and t is not T.UNKNOWN:
             return t
-        from krl.semantics.builtins import load_builtins  # noqa: PLC0415
-
         info = load_builtins().routines.get(key)
         name = getattr(info, "returns", None)
         if not name or name == "ANY":
             return None
-        from .sysvars import sys_type  # noqa: PLC0415
-
         return sys_type(name) or getattr(T, name.upper(), None)
 
     def _symbol(self, key: str):
@@ -299,8 +294,6 @@ class SystemSoftware:
     @staticmethod
     def network(key: str) -> bool:
         """True for a routine of EthernetKRL or RSI (the network partners', issue 35)."""
-        from krl.semantics.builtins import DATA_DIR, _read  # noqa: PLC0415
-
         lenient = _read("functions.yaml").get("lenient") or {}
         return any(key in {str(n).upper() for n in lenient.get(f, ())} for f in NETWORK_FAMILIES)
 
@@ -404,9 +397,6 @@ def _param_types(call: N.Call, ws) -> list:
             out.append(getattr(sym, "type", None) if sym is not None and not p.dims else None)
         return out
     if c.kind == NATIVE:
-        from krl.semantics.builtins import load_builtins  # noqa: PLC0415
-        from .sysvars import sys_type  # noqa: PLC0415
-
         info = load_builtins().routines.get(c.name.upper())
         if info is None:
             return []

@@ -20,6 +20,7 @@ module it belongs to, its caller, and the interrupts it declared (removed on ret
 
 from __future__ import annotations
 
+from krl.limits import MAX_DATA_ELEMENTS
 from krl.semantics import types as T
 
 from .convert import assign_into, convert_scalar
@@ -313,8 +314,6 @@ class DataMemory:
     __slots__ = ("limit", "used")
 
     def __init__(self, limit: int | None = None) -> None:
-        from krl.limits import MAX_DATA_ELEMENTS  # noqa: PLC0415
-
         self.limit = MAX_DATA_ELEMENTS if limit is None else limit
         self.used = 0
 

@@ -26,6 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from krl.limits import MAX_MOTION_HISTORY
+from robot.motion import MotionRequest
 
 RUN_MODES = ("GO", "MSTEP", "ISTEP", "BSTEP")
 #: modes that run without advance run: every motion ends exactly at its point
@@ -100,8 +101,6 @@ class MotionHistory:
 
         Raises :class:`BackwardRefused`: not in T1/T2; no motion left; a SPLINE block;
         frames changed since the motion (docs/robot.md)."""
-        from robot.motion import MotionRequest  # noqa: PLC0415
-
         if mode_op not in BACKWARD_MODES_OP:
             raise BackwardRefused(f"backward motion is only possible in T1 and T2 (operating mode {mode_op})")
         if not self.records:

@@ -43,6 +43,7 @@ from __future__ import annotations
 from greenlet import GreenletExit, greenlet
 
 from .contexts import Context, InterruptTable
+from .idle import IdleWatch
 
 #: steps (a statement or a loop iteration) per IPO cycle: the robot interpreter's and the submit
 #: interpreter's time slices (docs/architecture.md, "The submit interpreter's pace": KUKA
@@ -118,9 +119,8 @@ class Scheduler:
         self.tasks: list[Task] = []
         self.stop: tuple | None = None      # (reason, text, task)
         self.main = greenlet.getcurrent()
-        from .idle import IdleWatch  # noqa: PLC0415
-
         self.idle = IdleWatch(rt)           # fast-forward of idle cycles (interp/runtime/idle.py)
+        # costs 0.02 s at start-up (python -X importtime, 2026-11-25)
         from .spin import SpinWatch  # noqa: PLC0415
 
         self.spin = SpinWatch(rt)           # parked spins (interp/runtime/spin.py)

@@ -70,7 +70,7 @@ from krl.ast import nodes as N
 from krl.semantics.advance import accesses
 from krl.semantics.resolve import LOCAL, NATIVE, ROUTINE, SYSTEM, UNRESOLVED
 
-from .idle import _store, freeze
+from .idle import _frames, _store, freeze
 from .memory import Slot
 from .sysvars import CONSTANT_NAMES
 
@@ -668,8 +668,6 @@ class SpinWatch:
 
     def check_shadows(self) -> None:
         """The end of an IPO cycle's tasks: each shadowed spin stands where parking says."""
-        from .idle import _frames  # noqa: PLC0415
-
         for task in self.shadowed:
             p = task.shadow
             j = (p.done - 1) % p.spin.steps

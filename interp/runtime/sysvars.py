@@ -21,10 +21,12 @@ this module adds only *where the value lives*:
 from __future__ import annotations
 
 from functools import partial
+from pathlib import Path
 
 from krl.semantics import types as T
 from krl.semantics.builtins import load_builtins
 from krl.semantics.symbols import make_array, system_scopes
+from robot.motion import MotionParams
 
 from .convert import frame_tuple
 from .errors import KrlRuntimeError, value_invalid
@@ -96,8 +98,6 @@ class SysVars:
 
     # ------------------------------------------------------------------ boot values
     def _boot(self) -> None:
-        from robot.motion import MotionParams  # noqa: PLC0415
-
         ctl = self.rt.controller
         p = MotionParams.initmov(ctl.machine)
         m = ctl.machine
@@ -269,8 +269,6 @@ class SysVars:
 def _where(rt, span) -> str:
     """``file:line`` of a declaration, the file relative to the program's workspace when it
     lies inside it (traces do not depend on where the backup is unpacked)."""
-    from pathlib import Path  # noqa: PLC0415
-
     p = Path(span.file)
     root = getattr(getattr(rt, "program", None), "workspace", None)
     if root is not None:

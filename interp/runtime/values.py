@@ -22,8 +22,11 @@ from __future__ import annotations
 
 from functools import partial
 
+from krl.limits import MAX_NESTING
 from krl.semantics import types as T
 from krl.semantics.values import UNSET, EnumValue  # the front end's scalar values
+
+from .errors import KrlRuntimeError
 
 
 class Channel:
@@ -111,10 +114,6 @@ def data_size(t) -> int:
     type 1, a structure 1 plus its components, an array its element count times its
     element. Raises :class:`errors.KrlRuntimeError` for a STRUC that contains itself or
     types nested deeper than krl/limits.py MAX_NESTING (the caller adds the place)."""
-    from krl.limits import MAX_NESTING  # noqa: PLC0415
-
-    from .errors import KrlRuntimeError  # noqa: PLC0415
-
     memo: dict = {}     # id(Struc) -> (elements, levels of STRUC nesting below and with it)
     busy: set = set()
 

@@ -6,6 +6,8 @@ internal error.
 
 from __future__ import annotations
 
+import importlib
+
 import click
 
 from krl import __version__
@@ -37,8 +39,6 @@ SUBCOMMAND_MODULES = (
 
 
 def _register_subcommands() -> None:
-    import importlib  # noqa: PLC0415
-
     for module_name in SUBCOMMAND_MODULES:
         try:
             module = importlib.import_module(module_name)

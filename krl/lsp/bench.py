@@ -162,10 +162,13 @@ class Run:
 async def measure_file(server: Server, root: Path, path: Path, runs: int, errors: int, label: str) -> Run:
     """Open `path` of the workspace `root` in a fresh server, time its first diagnostics, its
     check, then `runs` value edits and `errors` edits that leave a syntax error."""
+    # costs 0.52 s at start-up (python -X importtime, 2026-11-25)
     from lsprotocol import types as L  # noqa: PLC0415 - the benchmark's client only
+    # costs 0.57 s at start-up (python -X importtime, 2026-11-25)
     from pygls.lsp.client import BaseLanguageClient  # noqa: PLC0415
 
     raw = path.read_bytes()
+    # costs 0.006 s at start-up (python -X importtime, 2026-11-25)
     from krl.source import decode_bytes  # noqa: PLC0415
     text = decode_bytes(raw)[0]
     uri = path.as_uri()
@@ -269,6 +272,7 @@ def build_workspace(dst: Path, files: int = 400, corpus: Path | None = None) -> 
     """Copy the corpus backup WORKSPACE_BASE to `dst`/KRC and further corpus KRL files (not
     $-files, not of that backup) into KRC/R1/Program/corpus until it holds `files` KRL files;
     returns (backup root, number of KRL files)."""
+    # costs 0.02 s at start-up (python -X importtime, 2026-11-25)
     from krl.files import SHARED_CORPUS  # noqa: PLC0415
     corpus = corpus or SHARED_CORPUS
     base = corpus / WORKSPACE_BASE
@@ -292,7 +296,9 @@ def build_workspace(dst: Path, files: int = 400, corpus: Path | None = None) -> 
 
 def corpus_backups(corpus: Path | None = None) -> list[tuple[str, Path, Path]]:
     """(name, root, largest KRL file) of each KRC backup of the shared corpus, as it is."""
+    # costs 0.02 s at start-up (python -X importtime, 2026-11-25)
     from krl.files import SHARED_CORPUS  # noqa: PLC0415
+    # costs 0.02 s at start-up (python -X importtime, 2026-11-25)
     from krl.project import find_backups, project_of  # noqa: PLC0415
     corpus = corpus or SHARED_CORPUS
     out = []

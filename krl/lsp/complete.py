@@ -14,6 +14,7 @@ from krl.lsp.navigate import chain_type
 from krl.lsp.text import line_tokens
 from krl.semantics import types as T
 from krl.semantics.symbols import Scope
+from krl.syntax.parse import default_bundle
 
 _WORD_BEFORE = re.compile(r"[\w$]*$")
 
@@ -43,7 +44,6 @@ class Completion:
 @lru_cache(maxsize=1)
 def keywords() -> tuple[str, ...]:
     """The grammar's keywords (the lexer's literal tokens that are words)."""
-    from krl.syntax.parse import default_bundle  # noqa: PLC0415
     out = []
     for lit in default_bundle().literal:
         w = lit.strip("'")

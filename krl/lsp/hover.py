@@ -6,11 +6,13 @@ from __future__ import annotations
 import os
 from functools import lru_cache
 
+import yaml
+
 from krl.ast import nodes as N
 from krl.lsp.analysis import Analysis
 from krl.lsp.navigate import Target, definition
 from krl.semantics import types as T
-from krl.semantics.builtins import load_builtins
+from krl.semantics.builtins import DATA_DIR, load_builtins
 
 _KIND = {"var": "variable", "const": "constant", "param": "parameter", "signal": "signal",
          "sysvar": "system variable", "routine": "routine"}
@@ -61,9 +63,6 @@ def _decl_of(sym) -> str:
 @lru_cache(maxsize=1)
 def meanings() -> dict[str, tuple[str, str]]:
     """UPPER name -> (meaning, reference section) from krl/semantics/data/sysvar_meanings.yaml."""
-    import yaml  # noqa: PLC0415
-
-    from krl.semantics.builtins import DATA_DIR  # noqa: PLC0415
     try:
         data = yaml.safe_load((DATA_DIR / "sysvar_meanings.yaml").read_text(encoding="utf-8")) or {}
     except (OSError, yaml.YAMLError):

@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import re
 
+from krl.ast import nodes as N
 from krl.lsp.analysis import Analysis
 from krl.lsp.navigate import Place, Target
 from krl.lsp.occurrences import DECL, occurrences
@@ -58,7 +59,6 @@ def renamable(an: Analysis, t: Target | None) -> Target:
     if t.kind == "value" and (t.symbol is None or t.symbol.decl is None):
         raise Refused(f"'{t.name}' is built in")
     if t.kind == "routine":
-        from krl.ast import nodes as N  # noqa: PLC0415
         if not isinstance(t.decl, N.Routine):
             raise Refused(f"routine '{t.name}' is {'built in' if t.decl is None else 'only declared by EXT here'}: "
                           "its DEF is not in this backup")
@@ -127,7 +127,6 @@ def _where(sc: Scope) -> str:
 
 def _clash(an: Analysis, t: Target, new: str) -> None:
     if t.kind == "label":
-        from krl.ast import nodes as N  # noqa: PLC0415
         for n in t.owner.walk():
             if isinstance(n, N.Label) and n.name.upper() == new.upper():
                 raise Refused(f"routine {t.owner.name} already has a label '{n.name}'")

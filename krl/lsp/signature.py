@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from krl.ast import nodes as N
 from krl.lsp import navigate as _nav
 from krl.lsp.analysis import Analysis
 from krl.lsp.text import NAME_WORDS, line_tokens
@@ -59,7 +60,6 @@ def signature_at(an: Analysis, path: str, line: int, column: int) -> Signature |
         return None
     sig = t.symbol.signature
     names = [(p.name, p.mode) for p in sig.params]
-    from krl.ast import nodes as N  # noqa: PLC0415
     if isinstance(t.decl, (N.Routine, N.ExtDecl)) and len(t.decl.params) == len(names):
         names = [(p.name or n, p.mode) for p, (n, _m) in zip(t.decl.params, names)]
     head = f"{'DEFFCT ' + str(sig.returns) + ' ' if sig.returns is not None else 'DEF '}{t.name}("

@@ -14,6 +14,8 @@ from __future__ import annotations
 from functools import lru_cache
 
 from krl.syntax.blocks import Tok, lines_of
+from krl.syntax.parse import default_bundle
+from krl.syntax.tokens import lex
 
 NAME_WORDS = ("IDENTIFIER", "SYSNAME")
 
@@ -24,9 +26,6 @@ def units(codec, s: str) -> int:
 
 @lru_cache(maxsize=8192)
 def _lex(line_text: str) -> tuple[Tok, ...]:
-    from krl.syntax.parse import default_bundle  # noqa: PLC0415
-    from krl.syntax.tokens import lex  # noqa: PLC0415
-
     bundle = default_bundle()
     out: list[Tok] = []
     for ln in lines_of(lex(line_text + "\n", bundle), bundle):

@@ -5,7 +5,11 @@ when it is built from the current source: :func:`compiled_module`, :func:`fastpa
 
 from __future__ import annotations
 
+import hashlib
+import importlib.util
+import math
 import sysconfig
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -39,9 +43,6 @@ def compiled_module() -> Any:
     if not USE_COMPILED or _simcore is None or not fastpath_compiled():
         return None
     if _simcore_current is None:
-        import hashlib  # noqa: PLC0415  (once per process)
-        from pathlib import Path  # noqa: PLC0415
-
         pyx = Path(__file__).resolve().parents[1] / "simcore.pyx"
         _simcore_current = (not pyx.is_file()
                             or getattr(_simcore, "SOURCE_SHA", None) == hashlib.sha256(pyx.read_bytes()).hexdigest())
@@ -73,9 +74,6 @@ def _python_fastpath() -> Any:
         if not getattr(_fastpath, "__file__", "").endswith(_EXT_SUFFIX):
             _fastpath_py = _fastpath
         else:
-            import importlib.util  # noqa: PLC0415  (only beside a built extension)
-            from pathlib import Path  # noqa: PLC0415
-
             spec = importlib.util.spec_from_file_location(
                 "robot.kinematics._fastpath_source", Path(__file__).with_name("fastpath.py"))
             _fastpath_py = importlib.util.module_from_spec(spec)
@@ -87,8 +85,6 @@ def _same_answers(compiled: Any, python: Any) -> bool:
     """True when the two fastpath modules give the same bytes on the KR 6 R900's OPW form for 32
     poses (every status, turns, a wrist singularity, a pose out of reach)."""
     o = load_machine().opw
-    import math  # noqa: PLC0415
-
     sgn = [float(v) for v in o.sign_corrections]
     offs = [math.radians(v) for v in o.offsets_deg]
     lo, hi = [-170.0, -190.0, -120.0, -185.0, -120.0, -350.0], [170.0, 45.0, 156.0, 185.0, 120.0, 350.0]

@@ -14,6 +14,8 @@ from pathlib import Path
 import pytest
 from click.testing import CliRunner
 
+from krl.cli import main
+
 #: simulated seconds per entry point in the tests' audit of the corpus
 SIM_TIME = 2.0
 
@@ -21,8 +23,6 @@ SIM_TIME = 2.0
 @pytest.fixture(scope="session")
 def corpus_audit(tmp_path_factory, shared_corpus) -> tuple[dict, Path, object]:
     """(the report's JSON, its HTML file, the CliRunner result) of `krl audit CORPUS`."""
-    from krl.cli import main  # noqa: PLC0415
-
     out = tmp_path_factory.mktemp("audit-corpus")
     res = CliRunner().invoke(main, ["audit", str(shared_corpus), "--out", str(out), "--max-sim-time", str(SIM_TIME),
                                     "--jobs", "2"])

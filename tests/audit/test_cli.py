@@ -14,6 +14,7 @@ import pytest
 from click.testing import CliRunner
 from jsonschema import Draft202012Validator
 
+import audit.fleet as F
 from krl.cli import main
 
 REPO = Path(__file__).resolve().parents[2]
@@ -100,8 +101,6 @@ def test_not_a_folder_is_a_usage_error(tmp_path):
 
 
 def test_more_units_than_the_limit_is_a_usage_error(tmp_path, monkeypatch):
-    import audit.fleet as F  # noqa: PLC0415
-
     # two KRC backups (each a folder with R1/System/$config.dat): two units
     for name in ("a", "b"):
         (tmp_path / name / "R1" / "System").mkdir(parents=True)

@@ -11,6 +11,7 @@ from __future__ import annotations
 import json
 import re
 
+import dask
 import pytest
 from click.testing import CliRunner
 
@@ -53,8 +54,6 @@ def test_the_audit_on_a_local_cluster_equals_the_local_run(cluster, tmp_path):
 def test_an_unreachable_scheduler_is_a_clear_error(tmp_path, monkeypatch, shared_corpus):
     # nothing listens on port 1 of loopback; Dask's connect timeout is shortened for the test
     monkeypatch.setenv("DASK_DISTRIBUTED__COMM__TIMEOUTS__CONNECT", "2s")
-    import dask  # noqa: PLC0415
-
     dask.config.refresh()
     try:
         res = CliRunner().invoke(main, ["audit", str(SMALL), "--out", str(tmp_path / "o"),

@@ -4,6 +4,7 @@ numbers), and every item's link leads to its evidence, whose lines are the file'
 
 from __future__ import annotations
 
+import playwright.sync_api as playwright
 import pytest
 
 from tests.report.test_report_chromium import chromium, loaded_page  # noqa: F401  (fixture)
@@ -18,8 +19,6 @@ def _column(page, table: str, col: int) -> list[str]:
 
 @pytest.mark.may_skip("chromium is missing and cannot be installed (not root, or apt-get has no network)")
 def test_the_fleet_page_sorts_and_links_to_its_evidence(chromium, corpus_audit):  # noqa: F811
-    import playwright.sync_api as playwright  # noqa: PLC0415  (a dev dependency: only the browser tests)
-
     data, html, _res = corpus_audit
     with playwright.sync_playwright() as pw, loaded_page(pw, chromium, html) as page:
         assert page.title() == f"Fleet audit: 4 backups, {data['summary']['folders']} program folders"

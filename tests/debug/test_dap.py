@@ -5,6 +5,7 @@ was first reached."""
 
 from __future__ import annotations
 
+import zipfile
 from pathlib import Path
 
 import pytest
@@ -265,8 +266,6 @@ def test_a_malformed_message_ends_the_session_without_a_traceback():
 
 
 def test_a_krc_backup_zip_as_workspace(tmp_path):
-    import zipfile
-
     backup = tmp_path / "backup.zip"
     with zipfile.ZipFile(backup, "w") as zf:
         zf.writestr("KRC/R1/Program/prog.src", "DEF prog()\n  DECL INT n\n  n = 41\n  n = n + 1\nEND\n")

@@ -8,8 +8,10 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from click.testing import CliRunner
 
 from interp.run import make_runtime
+from krl.cli import main
 from robot.trace import TraceWriter
 
 CASES = Path(__file__).resolve().parents[2] / "conformance" / "cases"
@@ -137,10 +139,6 @@ def test_backward_motion_is_refused_past_changed_frames(tmp_path):
 
 
 def test_krl_run_run_mode_option(tmp_path):
-    from click.testing import CliRunner
-
-    from krl.cli import main
-
     out = tmp_path / "t.jsonl"
     r = CliRunner().invoke(main, ["run", str(CIRC), "--run-mode", "mstep", "--trace", str(out)])
     assert r.exit_code == 0, r.output

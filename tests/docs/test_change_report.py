@@ -27,7 +27,9 @@ import subprocess
 from pathlib import Path
 from urllib.parse import unquote, urlparse
 
+import playwright.sync_api as playwright
 import pytest
+from pypdf import PdfReader
 
 from tests.apt import apt_install
 from tests.docs import transcripts as T
@@ -116,8 +118,6 @@ def _check_links(page, root: Path, findings: str = "table.findings tr.finding") 
 
 @pytest.mark.may_skip("chromium is missing and cannot be installed (not root, or apt-get has no network)")
 def test_every_finding_and_change_links_to_its_file_and_line(chromium, example):
-    import playwright.sync_api as playwright  # noqa: PLC0415
-
     work, page_file = example
     with playwright.sync_playwright() as pw, loaded_page(pw, chromium, page_file) as page:
         # the example's new backup has warnings (all listed), the point and the tool
@@ -127,8 +127,6 @@ def test_every_finding_and_change_links_to_its_file_and_line(chromium, example):
 
 @pytest.mark.may_skip("chromium is missing and cannot be installed (not root, or apt-get has no network)")
 def test_findings_introduced_and_removed_link_to_each_side(chromium, shared_history, tmp_path):
-    import playwright.sync_api as playwright  # noqa: PLC0415
-
     pair = shared_history / "KnoP-01__krl-for-vim9" / "01-8fae7e9c"
     out = tmp_path / "pair.html"
     r = subprocess.run([str(T.REPO / ".venv" / "bin" / "krl"), "report", str(pair / "new"), "--since", str(pair / "old"),
@@ -148,8 +146,6 @@ def test_findings_introduced_and_removed_link_to_each_side(chromium, shared_hist
 
 
 def _pdf_text_sizes(pdf: Path) -> tuple[list[str], list[float], int]:
-    from pypdf import PdfReader  # noqa: PLC0415
-
     reader = PdfReader(str(pdf))
     texts, sizes, images = [], [], 0
     for page in reader.pages:
@@ -163,8 +159,6 @@ def _pdf_text_sizes(pdf: Path) -> tuple[list[str], list[float], int]:
 
 @pytest.mark.may_skip("chromium is missing and cannot be installed (not root, or apt-get has no network)")
 def test_the_printed_pdf_is_legible(chromium, example, tmp_path):
-    import playwright.sync_api as playwright  # noqa: PLC0415
-
     _work, page_file = example
     pdf = tmp_path / "change.pdf"
     with playwright.sync_playwright() as pw, loaded_page(pw, chromium, page_file) as page:

@@ -29,6 +29,7 @@ def main() -> None:
     name = sys.argv.pop(1)
     target = TARGETS[name]
     if name == "interp":
+        # the subject of this test: imported inside instrument_imports, so that atheris instruments them
         with atheris.instrument_imports(include=["interp", "conformance"]):
             import conformance.harness  # noqa: F401
             import interp.run  # noqa: F401

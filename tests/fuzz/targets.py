@@ -20,6 +20,15 @@ from __future__ import annotations
 import tempfile
 from pathlib import Path
 
+from conformance import harness as H
+from krl.ast.build import build_module
+from krl.fmt.core import FormatSafetyError, FormatSyntaxError, format_text
+from krl.lsp.project import Project
+from krl.source import decode_bytes
+from krl.syntax.parse import parse_text
+from krl.workspace import check_texts
+from robot.stimuli import StimulusError, load_stimuli
+
 MAX_INPUT = 4096
 
 
@@ -28,15 +37,11 @@ class Finding(AssertionError):
 
 
 def _text(data: bytes) -> tuple[str, str]:
-    from krl.source import decode_bytes
-
     return decode_bytes(data[:MAX_INPUT])
 
 
 def decode_parse(data: bytes) -> None:
     """decode + parse: any bytes give a ParseResult, never an exception."""
-    from krl.syntax.parse import parse_text
-
     text, _ = _text(data)
     for path in ("f.src", "f.dat"):
         result = parse_text(text, path)
@@ -46,9 +51,6 @@ def decode_parse(data: bytes) -> None:
 
 def ast_build(data: bytes) -> None:
     """The AST builder on every tree the parser accepts: diagnostics, never an exception."""
-    from krl.ast.build import build_module
-    from krl.syntax.parse import parse_text
-
     text, _ = _text(data)
     result = parse_text(text, "f.src")
     if result.ok:
@@ -57,8 +59,6 @@ def ast_build(data: bytes) -> None:
 
 def check(data: bytes) -> None:
     """krl check on a one-file workspace: diagnostics with places inside the file."""
-    from krl.workspace import check_texts
-
     text, _ = _text(data)
     ws = check_texts({"f.src": text})
     lines = text.count("\n") + 2
@@ -69,8 +69,6 @@ def check(data: bytes) -> None:
 
 def fmt(data: bytes) -> None:
     """krl fmt: a file that parses formats to an equal AST, and formatting is idempotent."""
-    from krl.fmt.core import FormatSafetyError, FormatSyntaxError, format_text
-
     text, _ = _text(data)
     try:
         once = format_text(text, path="f.src")
@@ -84,8 +82,6 @@ def fmt(data: bytes) -> None:
 
 def lsp_change(data: bytes) -> None:
     """The language server's didChange: open a document, change it to the input, analyse."""
-    from krl.lsp.project import Project
-
     text, _ = _text(data)
     with tempfile.TemporaryDirectory(prefix="krl-fuzz-lsp-") as tmp:
         path = str(Path(tmp) / "f.src")
@@ -97,8 +93,6 @@ def lsp_change(data: bytes) -> None:
 
 def stimuli(data: bytes) -> None:
     """The stimuli/cell loader: StimulusError (with file:line) or a list of stimuli."""
-    from robot.stimuli import StimulusError, load_stimuli
-
     with tempfile.TemporaryDirectory(prefix="krl-fuzz-stim-") as tmp:
         p = Path(tmp) / "cell.yaml"
         p.write_bytes(data[:MAX_INPUT])
@@ -111,9 +105,6 @@ def stimuli(data: bytes) -> None:
 
 def interp(data: bytes) -> None:
     """Tree interpreter and VM agree on a short run of a program that checks cleanly."""
-    from conformance import harness as H
-    from krl.workspace import check_texts
-
     text, _ = _text(data)
     ws = check_texts({"program.src": text})
     if any(d.is_error for d in ws.diagnostics):

@@ -11,6 +11,8 @@ from __future__ import annotations
 import pytest
 
 from interp.run import make_runtime
+from interp.runtime.idle import freeze
+from interp.runtime.values import UNSET, Arr, EnumValue, Struct
 from robot.trace import TraceWriter
 
 from .helpers import write
@@ -177,8 +179,6 @@ def _elementwise(v):
     """The state image of a value built one element at a time (scalars as they are, an enum
     value by name, UNSET as a marker, a structure or array as its elements' images): what
     :func:`interp.runtime.idle.freeze` must agree with on equality."""
-    from interp.runtime.values import UNSET, Arr, EnumValue, Struct
-
     if isinstance(v, Struct):
         return ("struc", tuple((k, _elementwise(x)) for k, x in v.f.items()))
     if isinstance(v, Arr):
@@ -194,9 +194,6 @@ def test_the_state_image_of_a_value_is_equal_exactly_when_its_elements_are():
     """freeze images a structure or array of leaves by a plain copy (the fast path of the
     idle check): two values' images are equal exactly when their element-wise images are,
     across leaves, enum values, UNSET, nested structures and mixed arrays."""
-    from interp.runtime.idle import freeze
-    from interp.runtime.values import UNSET, Arr, EnumValue, Struct
-
     def arr(*xs):
         return Arr(None, (len(xs),), list(xs))
 

@@ -9,7 +9,9 @@ from pathlib import Path
 import pytest
 from click.testing import CliRunner
 
+from interp import realprograms as rp
 from interp.run import make_runtime
+from interp.runtime.kss import SystemSoftware
 from krl.cli import main
 from robot.trace import TraceWriter
 
@@ -351,9 +353,6 @@ def test_outside_stops_finds_a_run_that_disagrees_with_the_checker(tmp_path, mon
     on every backup of the corpus and the history: with the stand-in of a name taken away (the
     run and the checker disagree), the stop on it is found and said with the checker's why; the
     program's own unknown name is not."""
-    from interp import realprograms as rp
-    from interp.runtime.kss import SystemSoftware
-
     prog = _backup(tmp_path, KRC2_PROG)
     rt, res, _ = _run(prog)
     assert res.text == "routine GetJobNr not found" and rp.outside_stops(rt) == []

@@ -9,6 +9,8 @@ from pathlib import Path
 
 import pytest
 
+from robot.trace import validate_event
+
 from .helpers import run_krl, write
 
 DAT = """
@@ -93,8 +95,6 @@ def test_lin_rel_circ_and_spline(tmp_path):
 
 
 def test_trace_is_deterministic_and_valid(tmp_path):
-    from robot.trace import validate_event
-
     src = """
     DEF prog()
       DECL INT i

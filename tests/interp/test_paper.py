@@ -8,6 +8,7 @@ import pytest
 
 from interp.run import make_runtime
 from interp.runtime.errors import KrlRuntimeError
+from interp.runtime.program import parse_module
 from robot.trace import TraceWriter
 
 PAPER = Path(__file__).resolve().parents[2].parent / "shared" / "examples" / "paper_fig1.src"
@@ -77,8 +78,6 @@ def test_paper_fig1_interrupt_brakes(tmp_path):
 
 
 def test_paper_fig1_as_printed(tmp_path):
-    from interp.runtime.program import parse_module
-
     _, errors = parse_module(str(PAPER))
     assert not errors, errors    # INTERRUPT DECL ... DO BRAKE (grammar/constructs, paper Fig. 1)
     res, ev = run_paper(tmp_path, PAPER)

@@ -2,11 +2,19 @@
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import pytest
+from click.testing import CliRunner
 
 from interp import realprograms as rp
+from interp.realprograms import CELLS, cause_of, cell_of
+from interp.run import make_runtime
+from krl.cli import main
+from robot.limits import check_trace
+from robot.stimuli import load_cell
+from robot.trace import TraceWriter
 
 pytestmark = [pytest.mark.corpus,
               pytest.mark.skipif(not rp.DEFAULT_CORPUS.is_dir(), reason="../shared/krl-corpus absent")]
@@ -35,8 +43,6 @@ def test_all_backup_programs():
 
 def test_every_stop_gets_one_cause():
     """interp/realprograms.py cause_of (issue 22, "Every stop explained")."""
-    from interp.realprograms import cause_of
-
     assert cause_of({"reason": "completed"}) == "completed"
     assert cause_of({"reason": "halt", "file": "p.src", "line": 9}) == "intended end"
     assert cause_of({"reason": "error", "text": "unknown name t_vel"}) == "program error"
@@ -79,12 +85,6 @@ def test_block_calibration_target_is_out_of_its_own_robots_limits(tmp_path):
     assert row["text"] == f"software limit switch -A5 ({rp.TARGET_OUTSIDE_NOTE})"
     assert row["robot_own"] and row["cause"] == "program error"
     # the conformance report's row, from the trace of `krl run`, says the same
-    import json
-
-    from click.testing import CliRunner
-
-    from krl.cli import main
-
     trace = tmp_path / "trace.jsonl"
     CliRunner().invoke(main, ["run", str(p), "--no-check", "--max-sim-time", "5", "--trace", str(trace),
                               "--inputs", str(rp.cell_of(p))])
@@ -94,9 +94,6 @@ def test_block_calibration_target_is_out_of_its_own_robots_limits(tmp_path):
 
 def test_committed_cell_files_load_and_are_found():
     """Every corpus/cells file is a valid cell file; cell_of prefers the program's own file."""
-    from interp.realprograms import CELLS, cell_of
-    from robot.stimuli import load_cell
-
     files = sorted(CELLS.rglob("*.yaml"))
     assert len(files) >= 4
     for f in files:
@@ -115,9 +112,6 @@ def test_the_palletizer_runs_on_the_robot_its_cell_chooses(interp):
     pick XC1 (coge_20.dat:24, in BASE_DATA[1] with TOOL_DATA[1] Z 775) lies 1.5 m from the
     robot, out of the KR 6 R900's 0.9 m. Its BAS calls run the backup's System/bas.src (its
     EXT BAS declaration links to it) and it reports the pick with PULSE SACO_COGIDO."""
-    from interp.run import make_runtime
-    from robot.trace import TraceWriter
-
     p = rp.DEFAULT_CORPUS / "ingeniado__KRC4-Robot-Palletizer/Program/SACO_20/coge_20.src"
     cell = rp.cell_of(p)
     assert cell is not None and cell.name == "ingeniado__KRC4-Robot-Palletizer.yaml"
@@ -137,8 +131,6 @@ def test_the_palletizer_runs_on_the_robot_its_cell_chooses(interp):
     for a in poses:
         assert abs(a[3]) < 1e-6 and abs(a[1] + a[2] + a[4] - 90.0) < 0.01, a
     # and the motion limits of the palletizer's own machine data hold on the whole pick
-    from robot.limits import check_trace
-
     rep = check_trace(tw.events, rt.controller.machine)
     assert rep.ok, rep.summary()
 

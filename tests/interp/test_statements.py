@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import pytest
 
+from interp.runtime.contexts import Context
+
 from .helpers import run_krl
 
 DAT = """
@@ -249,8 +251,6 @@ def test_on_error_proceed_and_err(tmp_path):
 def test_on_error_proceed_flag_belongs_to_the_running_context(tmp_path):
     """An interrupt routine (or TRIGGER action) that runs before the statement after
     ON_ERROR_PROCEED neither takes nor sees the flag: it is the interrupted flow's."""
-    from interp.runtime.contexts import Context
-
     r = run_krl(tmp_path, """
     DEF prog()
     END

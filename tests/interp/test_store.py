@@ -10,6 +10,7 @@ import hashlib
 import json
 import os
 import pickle
+import shutil
 import sqlite3
 import subprocess
 import sys
@@ -20,13 +21,18 @@ import msgpack
 import pytest
 
 import interp.runtime.program as program_mod
+import krl.lsp.project as project_mod
+import krl.parsecache as parsecache
 import krl.store as store
 from interp.debug.client import DapClient
 from interp.run import make_runtime
 from krl.lsp.paths import norm
 from krl.lsp.project import Project
 from krl.parsecache import load_files
+from krl.pool import Outcome
 from krl.project import project_of
+from krl.semantics import builtins as B
+from krl.workspace import load_batch
 from robot.trace import TraceWriter
 
 REPO = Path(__file__).resolve().parents[2]
@@ -106,7 +112,6 @@ def _debug_launch(program: Path, cache: Path) -> None:
 
 def test_a_file_parsed_by_krl_debug_is_a_hit_for_the_language_server(tmp_path, cache):
     root = tmp_path / "KRC"
-    import shutil
     shutil.copytree(BACKUP, root)
     _debug_launch(root / "R1" / "Program" / "main.src", cache)
     before = _rows(_database(cache))
@@ -119,7 +124,6 @@ def test_a_file_parsed_by_krl_debug_is_a_hit_for_the_language_server(tmp_path, c
 
 def test_a_file_parsed_by_the_language_server_is_a_hit_for_krl_debug(tmp_path, cache):
     root = tmp_path / "KRC"
-    import shutil
     shutil.copytree(BACKUP, root)
     s, _diags = _lsp_analysis(root, cache)
     assert s.hits == 0 and s.misses == 5
@@ -225,7 +229,6 @@ def test_the_store_never_unpickles(cache, tmp_path, monkeypatch):
 @pytest.mark.parametrize("data", [msgpack.packb([1, 2]), msgpack.packb({"x": msgpack.ExtType(1, b"x")}),
                                   msgpack.packb({"types": 5, "functions": "x"})])
 def test_a_corrupt_table_entry_is_read_from_the_yaml_again(cache, data):
-    from krl.semantics import builtins as B
     fresh = B._load_builtins(store.Store(enabled=False))
     B._load_builtins()                                  # fills the store
     digest = hashlib.sha256(data).digest()
@@ -295,7 +298,6 @@ def test_a_stored_parse_gives_notes_at_the_files_own_path(tmp_path):
 def _stopped(paths, timeout, jobs=None, threaded=False):
     """load_batch as when each file's worker was stopped: the first past its timeout, the others
     lost with their worker (krl.pool.Outcome)."""
-    from krl.pool import Outcome  # noqa: PLC0415
     return [Outcome(p, "timeout" if i == 0 else "internal_error", None, "the worker process died (SIGKILL)")
             for i, p in enumerate(paths)]
 
@@ -304,10 +306,7 @@ def _stopped(paths, timeout, jobs=None, threaded=False):
 def test_a_stopped_parse_is_never_stored(tmp_path, monkeypatch, way):
     """A parse stopped past its timeout (E005) or lost with its worker (E001) is shown for what
     it is, and never kept: the next load of the same content parses it (docs/security.md)."""
-    import krl.lsp.project as project_mod  # noqa: PLC0415
-    import krl.parsecache as parsecache  # noqa: PLC0415
     root = tmp_path / "KRC"
-    import shutil
     shutil.copytree(BACKUP, root)
     files = sorted(norm(p) for p in root.rglob("*") if p.suffix.lower() in (".src", ".dat", ".sub"))
     assert len(files) >= 2
@@ -426,8 +425,6 @@ def test_a_file_changed_while_it_is_parsed_is_not_kept_under_its_old_hash(tmp_pa
     """load_files hashes the files, and the worker processes read them again by path: when a
     file changes in between, the parse of the new content must not be kept under the old
     content's hash (a later load of the old content would get the new text's AST)."""
-    import krl.parsecache as parsecache  # noqa: PLC0415
-    from krl.workspace import load_batch  # noqa: PLC0415
     src = tmp_path / "a.src"
     old_text = "DEF a()\n  $OUT[1] = TRUE\nEND\n"
     src.write_text(old_text, encoding="utf-8")

@@ -15,7 +15,10 @@ import pytest
 
 from interp import realprograms as rp
 from interp.run import make_runtime
+from interp.runtime.core import TARGET_OUTSIDE_NOTE
 from krl.workspace import workspaces_for
+from robot.frames import matrix_to_frame
+from robot.kinematics import Kinematics
 from robot.trace import TraceWriter
 
 from .helpers import run_krl, write
@@ -413,10 +416,6 @@ def test_a_target_out_of_the_robots_limits_says_so(tmp_path):
     of that pose has |A5| >= 125, tests/robot/test_controller.py) is refused at planning with
     the note that the target itself is out; a PTP to A1 200 (limit 170) is an axis target: the
     plain message."""
-    from interp.runtime.core import TARGET_OUTSIDE_NOTE
-    from robot.frames import matrix_to_frame
-    from robot.kinematics import Kinematics
-
     x, y, z, a, b, c = matrix_to_frame(Kinematics().forward([0, -90, 90, 0, 125, 0]))
     src = f"""
     DEF prog()

@@ -18,7 +18,9 @@ from click.testing import CliRunner
 
 from interp.run import make_runtime
 from krl.cli import main
-from robot.trace import TRACE_REPEATS, TraceWriter, validate_event
+from robot.trace import (
+    PROBE_CREDIT_VALUES, PROBE_VALUES_PER_EVENT, TRACE_REPEATS, TraceWriter, validate_event,
+)
 
 from .helpers import write
 
@@ -214,8 +216,6 @@ def test_the_state_probes_keep_to_their_budget():
     20 events written, 180 counted, and 10 probes: each of the two trackers (every event; the
     events other than poses, here the same) captures at 9, compares at 10 and again after
     passes 20, 40 and 80."""
-    from robot.trace import PROBE_CREDIT_VALUES, PROBE_VALUES_PER_EVENT
-
     assert (PROBE_CREDIT_VALUES, PROBE_VALUES_PER_EVENT) == (1 << 20, 16)
     for values, probes_expected, written_expected in ((2_000_000, 1, 200), (10, 10, 20)):
         tw = TraceWriter(keep=True, repeats=10)
@@ -255,8 +255,6 @@ def test_a_large_state_costs_probes_in_proportion_to_the_events(tmp_path):
     The probes image at most the start credit (2**20) and PROBE_VALUES_PER_EVENT (16) values per
     event, plus one probe's worth, the events written and counted are still the unbounded trace's, and both
     interpreters write the same events."""
-    from robot.trace import PROBE_VALUES_PER_EVENT
-
     assert PROBE_VALUES_PER_EVENT == 16
     prog = write(tmp_path, "bigblink.src", BIG)
     _rt, full_res, full = _run(prog, repeats=None, max_sim_time=2.0, fast=False)

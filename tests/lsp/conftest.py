@@ -8,6 +8,7 @@ import asyncio
 import shutil
 import sys
 from pathlib import Path
+from urllib.parse import unquote, urlparse
 
 import pytest
 import pytest_lsp
@@ -97,7 +98,6 @@ def pos(line: int, character: int) -> L.Position:
 
 def where(loc) -> tuple[str, int, int, int, int]:
     """(file name, start line, start char, end line, end char) of a Location."""
-    from urllib.parse import unquote, urlparse  # noqa: PLC0415
     r = loc.range
     return (Path(unquote(urlparse(loc.uri).path)).name, r.start.line, r.start.character, r.end.line, r.end.character)
 

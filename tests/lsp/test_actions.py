@@ -5,6 +5,7 @@
 from __future__ import annotations
 
 from pathlib import Path
+from urllib.parse import unquote, urlparse
 
 import pytest
 from lsprotocol import types as L
@@ -17,7 +18,6 @@ MAIN_TEXT = (PROGRAM / "main.src").read_text()
 
 
 async def actions(client, path, line):
-    from urllib.parse import unquote, urlparse  # noqa: PLC0415
     got = await client.text_document_code_action_async(L.CodeActionParams(
         text_document=L.TextDocumentIdentifier(uri=path.as_uri()), range=L.Range(start=pos(line, 0), end=pos(line, 0)),
         context=L.CodeActionContext(diagnostics=[])))

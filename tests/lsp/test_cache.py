@@ -5,6 +5,7 @@ trusted."""
 
 from __future__ import annotations
 
+import dataclasses
 import shutil
 from pathlib import Path
 
@@ -12,10 +13,14 @@ import msgpack
 import pytest
 
 import krl.parsecache as C
+from krl.limits import PARSE_TIMEOUT_S
+from krl.lsp.bench import corpus_backups
 from krl.lsp.paths import norm
 from krl.lsp.project import Project
+from krl.source import decode_bytes
 from krl.store import Store
-from krl.workspace import load_file
+from krl.workspace import Workspace, load_batch, load_file
+from tests.conftest import SHARED
 from tests.lsp.conftest import BACKUP
 
 
@@ -31,8 +36,6 @@ def spans(m):
 def reference_entry(lf) -> bytes:
     """The entry's bytes as the cache's schema describes them (krl/parsecache.py), written out
     plainly: the on-disk format must not change with the codec's implementation."""
-    import dataclasses
-
     def enc(v):
         if isinstance(v, C.N.Node):
             fields = [f for f in dataclasses.fields(v) if f.name not in ("span", "ann")]
@@ -189,8 +192,6 @@ def test_deferred_entries_are_written_after_the_check_open_files_encoded_at_once
 
 
 def _backups():
-    from krl.lsp.bench import corpus_backups  # noqa: PLC0415 - the bench's list: each KRC backup as it is
-    from tests.conftest import SHARED  # noqa: PLC0415
     if not (SHARED / "krl-corpus").is_dir():
         return []
     return [pytest.param(root, largest, id=label) for label, root, largest in corpus_backups(SHARED / "krl-corpus")]
@@ -203,10 +204,6 @@ def test_every_corpus_backup_gives_krl_checks_diagnostics_cold_and_from_the_cach
     does): cold (parse entries written after the check), from the cache, and the cached
     diagnostics shown before the check: all exactly those of ``krl check``'s pipeline on the
     same files (krl/workspace.py: each file loaded whole by its loader, then checked)."""
-    from krl.limits import PARSE_TIMEOUT_S  # noqa: PLC0415
-    from krl.source import decode_bytes  # noqa: PLC0415
-    from krl.workspace import Workspace, load_batch  # noqa: PLC0415
-
     store = Store(tmp_path / "cache")
     path = norm(largest)
     text = decode_bytes(largest.read_bytes())[0]

@@ -8,7 +8,7 @@ import asyncio
 import pytest
 import pytest_lsp
 from lsprotocol import types as L
-from pytest_lsp import ClientServerConfig, LanguageClient
+from pytest_lsp import ClientServerConfig, LanguageClient, make_test_lsp_client
 
 from tests.lsp.conftest import BACKUP, init_params, server_config, where
 
@@ -28,8 +28,6 @@ async def test_workspace_symbols_without_open_documents(cold):
 
 
 def watching_client():
-    from pytest_lsp import make_test_lsp_client
-
     client = make_test_lsp_client()
     client.registrations = []
 

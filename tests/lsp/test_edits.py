@@ -10,6 +10,7 @@ of ``krl check``'s own pipeline (each file parsed whole, krl/workspace.py)."""
 from __future__ import annotations
 
 import difflib
+import shutil
 from pathlib import Path
 
 import pytest
@@ -23,6 +24,7 @@ from krl.source import is_krl_file, read_source
 from krl.limits import PARSE_TIMEOUT_S
 from krl.workspace import Workspace, load_batch, load_file, load_text
 from tests.conftest import SHARED
+from tests.lsp.conftest import BACKUP
 
 HISTORY = SHARED / "krl-history"
 
@@ -176,8 +178,6 @@ def test_edits_that_change_what_an_unparsable_file_may_declare_agree_with_a_full
     parsing (its broken line without, then with that name: the name may be declared there, so a
     warning, W101) and back. Each edit re-checks tools.src's routines alone, and the
     unresolved-name report must follow what the unparsable file may declare."""
-    import shutil  # noqa: PLC0415
-    from tests.lsp.conftest import BACKUP  # noqa: PLC0415
     shutil.copytree(BACKUP, tmp_path / "KRC")
     main = norm(tmp_path / "KRC" / "R1" / "Program" / "main.src")
     tools = norm(tmp_path / "KRC" / "R1" / "Program" / "tools.src")

@@ -10,6 +10,8 @@ import json
 import pytest
 from lsprotocol import types as L
 
+from krl.cli.check import run_check
+from krl.fmt import format_text
 from tests.lsp.conftest import (PROGRAM, change_doc, close_doc, open_doc, pos, summary,
                                 wait_diagnostics, where)
 
@@ -36,8 +38,6 @@ async def references(client, path, line, char, decl=True):
 
 def krl_check_json(folder) -> list[dict]:
     """The diagnostics of main.src as `krl check --format json FOLDER` prints them."""
-    from krl.cli.check import run_check
-
     lines: list[str] = []
     run_check([str(folder)], fmt="json", echo=lines.append)
     return [d for ws in map(json.loads, lines) for d in ws["diagnostics"] if d["path"].endswith("main.src")]
@@ -191,7 +191,6 @@ async def test_formatting_offered_exactly_when_krl_fmt_is_installed(client):
     edits = await client.text_document_formatting_async(L.DocumentFormattingParams(
         text_document=td(MAIN), options=L.FormattingOptions(tab_size=2, insert_spaces=True))) if has_fmt else None
     if has_fmt:
-        from krl.fmt import format_text
         expected = format_text(MAIN_TEXT)
         assert (edits or []) == [] if expected == MAIN_TEXT else edits[0].new_text == expected
         # text that does not parse: no edit

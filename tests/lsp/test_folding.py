@@ -6,6 +6,10 @@ from __future__ import annotations
 from krl.lsp import convert
 from krl.lsp import folding
 from krl.diagnostics.render import split_lines
+from krl.lsp.analysis import build_analysis
+from krl.lsp.outline import document_symbols
+from krl.lsp.parsing import ParseCache
+from krl.syntax.folds import fold_diagnostics
 
 
 def folding_ranges(lines):
@@ -75,8 +79,6 @@ MARKERS = ("DEF odd( )\n"                   # 1
 
 
 def test_fold_sections_are_the_checkers_pairs():
-    from krl.syntax.folds import fold_diagnostics
-
     got = sorted((f.start_line, f.end_line, f.kind) for f in folding_ranges(split_lines(MARKERS)))
     assert got == sorted([
         (0, 9, None),             # DEF .. END (line 11)
@@ -88,8 +90,6 @@ def test_fold_sections_are_the_checkers_pairs():
 
 
 def test_unbalanced_folds_fold_what_w021_does_not_report():
-    from krl.syntax.folds import fold_diagnostics
-
     text = ("DEF u( )\n"          # 1
             "  ;ENDFOLD\n"        # 2  stray: W021, no range
             "  ;FOLD a\n"         # 3  never closed: W021, no range
@@ -103,10 +103,6 @@ def test_unbalanced_folds_fold_what_w021_does_not_report():
 
 
 def test_document_symbols_name_folds_by_their_text(tmp_path):
-    from krl.lsp.analysis import build_analysis
-    from krl.lsp.outline import document_symbols
-    from krl.lsp.parsing import ParseCache
-
     path = str(tmp_path / "odd.src")
     an = build_analysis(path, [ParseCache().parse(path, MARKERS)])
     (routine,) = [convert.document_symbol(it, an.files[path].lines) for it in document_symbols(an, path)]

@@ -5,10 +5,10 @@ from __future__ import annotations
 import asyncio
 import logging
 
+from krl.lsp.server import guarded
+
 
 def test_a_handler_that_raises_is_logged_and_answered(caplog):
-    from krl.lsp.server import guarded
-
     class Fake:
         reported: list = []
 

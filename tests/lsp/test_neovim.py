@@ -12,6 +12,7 @@ from pathlib import Path
 
 import pytest
 
+from tests.apt import apt_install
 from tests.lsp.conftest import BACKUP
 
 LUA = r"""
@@ -40,8 +41,6 @@ end })
 
 def neovim() -> str | None:
     """nvim, installed with apt-get when missing (as the test set-up); None if that fails."""
-    from tests.apt import apt_install  # noqa: PLC0415
-
     return apt_install("neovim", "nvim")
 
 

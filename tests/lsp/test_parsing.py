@@ -5,17 +5,20 @@ by the server has exactly the diagnostics `krl check` gives it."""
 
 from __future__ import annotations
 
+import os
 import random
+import shutil
 from pathlib import Path
 
 import pytest
 
 from krl.lsp.bench import generate
-from krl.lsp.parsing import MIN_CHUNKED_LINES, ParseCache
+from krl.lsp.parsing import MIN_CHUNKED_LINES, ParseCache, parse_disk
 from krl.lsp.project import Project, norm
 from krl.source import read_source
 from krl.workspace import Workspace, load_workspace
 from krl.project import find_backups
+from tests.lsp.conftest import BACKUP
 
 
 def same(path: str, text: str, cache: ParseCache) -> None:
@@ -153,7 +156,6 @@ def test_moved_pieces_keep_their_ast():
 
 def test_a_seeded_cache_parses_one_piece_per_edit(shared_corpus: Path):
     path = shared_corpus / "khrzysio__KRC4_test" / "R1" / "System" / "bas.src"
-    from krl.lsp.parsing import parse_disk
     disk = parse_disk(str(path))
     cache = ParseCache()
     assert cache.seed(disk)
@@ -176,11 +178,6 @@ def test_pieces_match_the_whole_file_on_the_corpus(shared_corpus: Path):
 
 
 def test_links_and_fifos_in_a_backup_are_reported_as_krl_check_does(tmp_path: Path):
-    import os
-    import shutil
-
-    from tests.lsp.conftest import BACKUP
-
     b = tmp_path / "KRC"
     shutil.copytree(BACKUP, b)
     (b / "R1" / "Program" / "link.src").symlink_to(b / "R1" / "Program" / "tools.src")

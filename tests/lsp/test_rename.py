@@ -7,6 +7,7 @@ fixture backup: main.src line 8 is ``  counter = 0`` (counter at 2..9), line 10
 from __future__ import annotations
 
 from pathlib import Path
+from urllib.parse import unquote, urlparse
 
 import pytest
 from lsprotocol import types as L
@@ -25,7 +26,6 @@ def td(path) -> L.TextDocumentIdentifier:
 
 
 def edits(got: L.WorkspaceEdit) -> dict[str, list[tuple[int, int, int, int, str]]]:
-    from urllib.parse import unquote, urlparse  # noqa: PLC0415
     out = {}
     for uri, es in (got.changes or {}).items():
         out[Path(unquote(urlparse(uri).path)).name] = sorted(

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from krl.lsp.roots import workspace_of
+from krl.lsp.roots import list_krl_files, workspace_of
 from krl.project import backup_of as backup_root
 from krl.project import find_backups
 
@@ -56,8 +56,6 @@ def test_every_corpus_backup_file_finds_its_backup(shared_corpus: Path):
 
 
 def test_listing_stops_at_its_limits(tmp_path: Path):
-    from krl.lsp.roots import list_krl_files
-
     for i in range(5):
         touch(tmp_path / f"d{i}" / f"f{i}.src")
     assert len(list_krl_files(tmp_path)) == 5

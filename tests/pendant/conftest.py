@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import playwright.sync_api as playwright
 import pytest
 
 
@@ -9,7 +10,5 @@ import pytest
 def pw():
     """The Playwright driver of one test module (its sync API cannot be nested: module scope ends
     it before a test of another module, which may start its own, runs in the same worker)."""
-    import playwright.sync_api as playwright  # noqa: PLC0415 - a dev dependency: missing fails
-
     with playwright.sync_playwright() as p:
         yield p

@@ -14,8 +14,10 @@ from contextlib import contextmanager
 from pathlib import Path
 
 import pytest
+import yaml
 
 from pendant import client
+from tests.apt import apt_install
 from tests.conftest import REPO_ROOT, SHARED_CORPUS
 
 CHROMIUM = "/usr/bin/chromium"
@@ -27,8 +29,6 @@ WAIT_MS = 300_000         # a selection loads and checks a whole backup: minutes
 
 
 def chromium_or_skip() -> str:
-    from tests.apt import apt_install  # noqa: PLC0415
-
     if not Path(CHROMIUM).exists() and apt_install("chromium", "chromium") is None:
         pytest.skip("chromium is not installed and cannot be installed with apt-get "
                     "(not root, no apt-get, or no package source)")
@@ -125,8 +125,6 @@ def pose_at(events: list[dict], t: float) -> list[float]:
 
 def cell_without(cell: Path, signal: str, out: Path) -> Path:
     """The cell file ``cell`` without the rules that set ``signal`` (written to ``out``)."""
-    import yaml  # noqa: PLC0415
-
     doc = yaml.safe_load(cell.read_text())
     doc["rules"] = [r for r in doc.get("rules", []) if signal not in (r.get("set") or {})]
     out.write_text(yaml.safe_dump(doc))

@@ -4,12 +4,16 @@ tests/robot/fixtures/cellbackup (its P00 is KUKA's EXT_PGNO #PGNO_GET, shortened
 
 from __future__ import annotations
 
+import shutil
 from pathlib import Path
 
 from click.testing import CliRunner
 
-from interp.run import make_runtime
+from interp.run import make_runtime, robot_for
 from krl.cli import main
+from krl.project import boot_submit
+from robot.machine import library_robots
+from robot.stimuli import StimulusError, load_cell
 from robot.trace import TraceWriter
 
 BACKUP = Path(__file__).parent / "fixtures" / "cellbackup"
@@ -103,13 +107,10 @@ def test_cell_init_lists_the_inputs_with_their_declarations(tmp_path):
     assert "# $IN[8]\n  #   read at R1/Program/job.src:4 (WAIT FOR)" in text
     assert "CLAMP =" not in text            # an output is not listed
     # the fixture has no machine data: the starter asks for the cell's robot, from the library
-    from robot.machine import library_robots
-
     assert "# robot: NAME       # this backup has no R1/Mada/$machine.dat: name the cell's robot " \
            f"(robot/data: {', '.join(library_robots())})" in text
     assert "kr180_r3200_pa" in library_robots()
     # the starter is a valid cell file (every rule commented out)
-    from robot.stimuli import load_cell
     cell = load_cell(dest)
     assert cell.rules == [] and cell.autoext is False
 
@@ -117,9 +118,6 @@ def test_cell_init_lists_the_inputs_with_their_declarations(tmp_path):
 def test_a_cell_file_names_its_robot_from_the_library(tmp_path):
     """``robot:`` in a cell file (issue 22): a robot of the project's library by name; the run
     simulates it, and ``--robot`` still overrides it. A path or an unknown name is refused."""
-    from interp.run import robot_for
-    from robot.stimuli import StimulusError, load_cell
-
     cell = tmp_path / "cell.yaml"
     cell.write_text("robot: kr180_r3200_pa\nrules: []\n", encoding="utf-8")
     assert load_cell(cell).robot.name == "kr180_r3200_pa.dat"
@@ -142,8 +140,6 @@ def test_a_cell_file_names_its_robot_from_the_library(tmp_path):
 
 
 def test_sim_time_of_a_long_job_is_validated(tmp_path):
-    from robot.stimuli import StimulusError, load_cell
-
     cell = tmp_path / "cell.yaml"
     cell.write_text("sim_time: {Mill_Frame: 180, job: 90.5}\n", encoding="utf-8")
     assert load_cell(cell).sim_time == {"MILL_FRAME": 180.0, "JOB": 90.5}
@@ -162,15 +158,11 @@ def test_krl_run_starts_the_backups_sps_sub_as_at_boot(tmp_path):
     """In a backup `krl run` starts its SPS.SUB beside the program, as the controller does at boot
     (reference §9), and says so; --no-submit runs without; a --submit that is not there is a
     clear error."""
-    import shutil
-
     root = tmp_path / "b"
     shutil.copytree(BACKUP, root)
     (root / "R1" / "SPS.SUB").write_text("DEF SPS()\n  LOOP\n    $OUT[40] = TRUE\n    WAIT SEC 0.1\n  ENDLOOP\nEND\n",
                                          encoding="ascii")
     job = root / "R1" / "Program" / "job.src"
-    from krl.project import boot_submit
-
     assert boot_submit(job) == root / "R1" / "SPS.SUB"
     assert boot_submit(root / "R1" / "SPS.SUB") is None      # the submit program is not booted twice
     assert boot_submit(tmp_path / "elsewhere.src") is None    # outside a backup

@@ -3,6 +3,7 @@ cycles of 12 ms, hostile files refused with file:line."""
 
 from __future__ import annotations
 
+import json
 import textwrap
 from pathlib import Path
 
@@ -101,7 +102,6 @@ def _error(tmp_path, text: str) -> str:
     ("$IN[1] $IN[2]", "cell.yaml:3: not a KRL expression: unexpected '$IN'"),
 ])
 def test_hostile_conditions_are_refused_at_load_with_file_line(tmp_path, when, message):
-    import json
     text = "rules:\n  - set: {\"$IN[1]\": true}\n    when: " + json.dumps(when) + "\n"
     assert _error(tmp_path, text).startswith(message)
 

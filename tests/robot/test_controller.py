@@ -9,7 +9,8 @@ import pytest
 from robot.bench import run_motions
 from robot.controller import Controller, ErrorEvent, TriggerEvent
 from robot.errors import RobotError, WorkspaceError
-from robot.motion import MotionParams, MotionRequest, Trigger
+from robot.frames import matrix_to_frame
+from robot.motion import MotionParams, MotionRequest, SplineSegment, Trigger
 from robot.stimuli import parse_stimuli, load_cell
 from robot.trace import TraceWriter
 
@@ -344,8 +345,6 @@ def test_axis_act_and_pos_act_from_mujoco():
 
 
 def test_triggers_inside_spline_block_refer_to_their_segment():
-    from robot.motion import SplineSegment
-
     P = MotionParams().with_(vel_cp=0.5)
     segs = (SplineSegment("SLIN", {"X": 445, "Y": 100, "Z": 810}),
             SplineSegment("SLIN", {"X": 545, "Y": 100, "Z": 810},
@@ -414,8 +413,6 @@ def test_public_state_queries():
 
 # ------------------------------------------------------------------ a target out of the robot's limits
 def _lin_to_pose_of(ctl, axes):
-    from robot.frames import matrix_to_frame
-
     pose = matrix_to_frame(ctl.model.kin.forward(axes))      # $TOOL = $BASE = $NULLFRAME
     return MotionRequest("LIN", dict(zip("XYZABC", pose)), MotionParams())
 

@@ -10,15 +10,20 @@ it by E1 (KUKA's A: counter-clockwise seen from above)."""
 from __future__ import annotations
 
 import math
+import xml.etree.ElementTree as ET
 
+import mujoco
 import numpy as np
 import pytest
 
+from robot.errors import SoftLimitError
 from robot.external import ExternalAxes
-from robot.frames import frame_to_matrix
+from robot.frames import frame_to_matrix, matrix_to_frame
 from robot.kinematics import Kinematics
 from robot.mada import MachineDataError, load_mada
 from robot.machine import ROBOT_LIBRARY
+from robot.mjcf import build_mjcf
+from robot.urdf import build_urdf
 
 TRACK = ROBOT_LIBRARY / "kr16_2_kl1500.dat"
 TABLE = ROBOT_LIBRARY / "kr16_2_turntable.dat"
@@ -100,10 +105,6 @@ def test_turntable_forward_inverse_round_trip(table):
 
 
 def test_mujoco_model_moves_the_external_axes(track, table):
-    import mujoco
-
-    from robot.mjcf import build_mjcf
-
     for m in (track, table):
         model = mujoco.MjModel.from_xml_string(build_mjcf(m))
         data = mujoco.MjData(model)
@@ -121,10 +122,6 @@ def test_mujoco_model_moves_the_external_axes(track, table):
 
 
 def test_urdf_export_has_the_external_joint(track, table):
-    import xml.etree.ElementTree as ET
-
-    from robot.urdf import build_urdf
-
     for m, jtype in ((track, "prismatic"), (table, "revolute")):
         root = ET.fromstring(build_urdf(m))
         joints = {j.get("name"): j for j in root.findall("joint")}
@@ -186,8 +183,6 @@ def test_a_lin_on_the_track_keeps_the_tcp_on_its_line_in_the_world(track):
     q0 = np.array([0.0, -90.0, 90.0, 0.0, 45.0, 0.0])
     W0 = ext.world_flange(k.forward, q0, [1000.0])
     x0, y0, z0 = W0[:3, 3]
-    from robot.frames import matrix_to_frame
-
     a, b, c = matrix_to_frame(W0)[3:]
     target = {"X": x0 + 900.0, "Y": y0 + 200.0, "Z": z0 - 300.0, "A": a, "B": b, "C": c, "E1": 1800.0}
     ctl, tw, Q, tcp = _run(track, [MotionRequest("PTP", home, P), MotionRequest("LIN", target, P)])
@@ -226,8 +221,6 @@ def test_a_base_on_the_turntable_turns_with_it(table):
 
 
 def test_an_external_axis_outside_its_limits_is_refused(track):
-    from robot.errors import SoftLimitError
-
     ctl = Controller(track, mujoco=False)
     P = MotionParams.initmov(track)
     with pytest.raises(SoftLimitError, match=r"software limit switch \+E1"):

@@ -7,6 +7,7 @@ its forward and inverse agreeing."""
 from __future__ import annotations
 
 import inspect
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -15,7 +16,7 @@ from robot.kinematics import Kinematics
 from robot.kinematics.family import OPERATIONS, KinematicFamily
 from robot.kinematics.families import FAMILIES
 from robot.mada import load_robot
-from robot.machine import load_machine
+from robot.machine import ROBOT_LIBRARY, load_machine
 
 #: A robot of each family: a library robot's name, "yaml" for the KR 6 R900 yaml, or a test's fixture
 EXAMPLES = {"opw": "yaml", "palletizer4": "kr180_r3200_pa", "palletizer5": "kr180_r3200_pa5",
@@ -74,8 +75,6 @@ def test_the_names_are_unique_and_the_registry_the_one_list():
     names = [f.name for f in FAMILIES]
     assert len(names) == len(set(names))
     # no module of robot/ outside the family modules tests a family by its name
-    from pathlib import Path  # noqa: PLC0415
-
     robot = Path(__file__).resolve().parents[2] / "robot"
     for path in robot.rglob("*.py"):
         if path.parent.name == "kinematics":
@@ -89,8 +88,6 @@ def test_the_names_are_unique_and_the_registry_the_one_list():
 def numeric_robot(tmp_path):
     """A six-axis arm no closed form covers: the library's KR 16-2 with a twisted $TX3P3 (as
     tests/robot/test_numeric_ik.py builds it)."""
-    from robot.machine import ROBOT_LIBRARY  # noqa: PLC0415
-
     text = (ROBOT_LIBRARY / "kr16_2_krc2.dat").read_text(encoding="utf-8")
     old = "$TX3P3={X 670.000,Y 0.0,Z -35.0000,A 0.0,B 90.0000"
     assert old in text

@@ -9,9 +9,11 @@ from __future__ import annotations
 
 import itertools
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
+import yaml
 
 from robot.errors import RobotError, SoftLimitError, WorkspaceError
 from robot.frames import frame_to_matrix
@@ -334,10 +336,6 @@ def test_forward_many_and_pos_act(kin):
 
 def test_yaml_copy_matches_shared_file():
     """robot/data/kr6_r900.yaml is the shared machine data plus the two [added] keys."""
-    from pathlib import Path
-
-    import yaml
-
     shared = Path(__file__).resolve().parents[3] / "shared" / "robots" / "kr6_r900.yaml"
     if not shared.exists():
         pytest.skip("../shared/robots/kr6_r900.yaml is not present")

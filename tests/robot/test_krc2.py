@@ -18,7 +18,9 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
+from krl.cli import main
 from robot.errors import SoftLimitError, WorkspaceError
+from robot.frames import frame_to_matrix, matrix_to_frame
 from robot.kinematics import Kinematics
 from robot.mada import MachineDataError, load_mada
 from robot.machine import ROBOT_LIBRARY
@@ -71,8 +73,6 @@ def test_kr_c2_values_the_file_lacks_are_derived(kr16):
 
 
 def test_robot_show_marks_the_derived_values():
-    from krl.cli import main
-
     res = CliRunner().invoke(main, ["robot", "show", str(KR16)])
     assert res.exit_code == 0, res.output
     rows = [ln for ln in res.output.splitlines() if ln.strip().startswith("A1 ")]
@@ -112,8 +112,6 @@ def test_inverse_kinematics_round_trip_every_status(kr16):
 
 def test_errors_are_those_of_every_robot(kr16):
     k = Kinematics(kr16)
-    from robot.frames import frame_to_matrix
-
     with pytest.raises(WorkspaceError, match="workspace error"):
         k.inverse(frame_to_matrix(3000.0, 0.0, 500.0, 0.0, 90.0, 0.0))
     q = np.array([10.0, -60.0, 100.0, 20.0, 40.0, 30.0])
@@ -141,6 +139,4 @@ def test_home_from_h_pos_when_axis_home_is_absent(tmp_path):
     n = text.splitlines().index(line) + 1
     assert m.provenance["$H_POS"] == f"{p}:{n}" and "home_deg" not in m.provenance
     # the HOME flange pose is the forward kinematics of those axes
-    from robot.frames import matrix_to_frame
-
     assert np.allclose(m.home_flange_pose, matrix_to_frame(Kinematics(m).forward(m.home_deg)), atol=1e-9)

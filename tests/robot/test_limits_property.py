@@ -27,6 +27,7 @@ from robot.errors import RobotError
 from robot.frames import matrix_to_frame
 from robot.limits import check_trace
 from robot.machine import load_machine
+from robot.mada import load_robot
 from robot.motion import MotionParams, MotionRequest, SplineSegment
 from robot.trace import TraceWriter
 from tests.budget import examples
@@ -71,8 +72,6 @@ def _load(request, name):
     folder = ROBOTS[name]
     if folder is None:
         return load_machine()
-    from robot.mada import load_robot  # noqa: PLC0415
-
     if folder.startswith("lib:"):
         return load_robot(folder[4:])
     return load_robot(request.getfixturevalue("shared_corpus") / folder)

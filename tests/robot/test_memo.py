@@ -5,6 +5,7 @@ a kept result is never shared with a caller that could change it."""
 from __future__ import annotations
 
 import numpy as np
+from scipy.spatial.transform import Rotation
 
 from robot import planner
 from robot.frames import frame_to_matrix, matrix_to_frame
@@ -49,8 +50,6 @@ def test_the_kept_flange_is_forwards_and_a_copy():
 
 
 def test_the_kept_rotation_is_scipys():
-    from scipy.spatial.transform import Rotation  # noqa: PLC0415
-
     rng = np.random.default_rng(47)
     for _ in range(100):
         R = frame_to_matrix(0, 0, 0, *rng.uniform(-180.0, 180.0, 3))[:3, :3]

@@ -3,6 +3,7 @@ and the optional position+velocity servos follow a joint trajectory."""
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import xml.etree.ElementTree as ET
 
@@ -106,8 +107,6 @@ def test_tcp_pose_read_back_worked_example(arm):
 
 
 def test_robroot_places_the_base():
-    import dataclasses
-
     m = dataclasses.replace(load_machine(), robroot_frame=(1000.0, 200.0, 0.0, 90.0, 0.0, 0.0))
     arm = ArmModel(m)
     kin = Kinematics(m)

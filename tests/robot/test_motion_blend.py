@@ -7,7 +7,10 @@ import pytest
 
 from robot.bench import run_motions
 from robot.controller import MSG_APPROX_IMPOSSIBLE, Controller
-from robot.motion import MotionParams, MotionRequest
+from robot.errors import RobotError
+from robot.frames import frame_to_matrix, rotation_angle_deg
+from robot.limits import check_trace
+from robot.motion import MotionParams, MotionRequest, SplineSegment
 from robot.trace import TraceWriter
 
 DT = 0.012
@@ -143,8 +146,6 @@ def test_c_ptp_blend_with_a_reversing_axis_keeps_the_acceleration_limit():
     """A2 -90->-70 then -70->-110 (A2 reverses): both PTPs accelerate A2 with its maximum
     394.7 deg/s² (A2 leads: 394.7/20 < 1241.4/60), overlapping them would need 2x that, so
     the next motion starts when the approximated one reaches its point (issue 15)."""
-    from robot.limits import check_trace
-
     P = MotionParams().with_(apo_cptp=20.0)
     home = {"A1": 0, "A2": -90, "A3": 90, "A4": 0, "A5": 0, "A6": 0}
     ctl, ev = _run([MotionRequest("PTP", home, P),
@@ -185,8 +186,6 @@ def test_lin_to_ptp_mixed_blend_runs():
 
 def test_c_ori_blend_starts_at_remaining_orientation():
     """C_ORI 10°: the blend starts when the remaining orientation change is 10° or less."""
-    from robot.frames import frame_to_matrix, rotation_angle_deg
-
     P = MotionParams().with_(vel_cp=0.5, apo_cori=10.0)
     goal = (180.0 - 60.0, 0.0, 180.0)  # 60° about Z from the tool-down orientation
     ctl, ev = _run([MotionRequest("PTP", TOOL_DOWN, P),
@@ -220,8 +219,6 @@ def test_blend_overlaps_profiles_without_overspeed():
 def test_no_setpoint_jumps_through_mixed_blends():
     """Blends of every kind, including motions without TCP path: the axes never move more
     per IPO cycle than the axis maximum speed allows (+10 %)."""
-    from robot.motion import SplineSegment
-
     P = MotionParams().with_(vel_cp=0.5, apo_cdis=20.0)
     ctl, ev = _run([MotionRequest("PTP", TOOL_DOWN, P),
                     MotionRequest("LIN", {"A": 150}, P, approx="C_DIS"),
@@ -244,8 +241,6 @@ def test_ptp_c_ptp_into_lin_keeps_the_axis_acceleration_at_the_blend_end():
     """Issue 22: a PTP C_PTP blended into a LIN reached 1.13x the A2 acceleration limit at the
     end of the blend (A2 reverses; the LIN's axis rates grow along its path). Now every
     axis stays within a_max (+10 % finite-difference tolerance of robot/limits.py)."""
-    from robot.limits import check_trace
-
     ax = ("A1", "A2", "A3", "A4", "A5", "A6")
     rows = [([33.9, -83.122, 113.28, 7.754, 34.821, 25.543], [427.081, 351.007, 529.874, -153.625, 9.044, -128.525],
              (64.571, 79.46, 1.481, 54.633)),
@@ -258,8 +253,6 @@ def test_ptp_c_ptp_into_lin_keeps_the_axis_acceleration_at_the_blend_end():
         P = MotionParams().with_(vel_axis=(vax,) * 6, apo_cptp=cptp, vel_cp=vcp, apo_cdis=cdis)
         reqs.append(MotionRequest("PTP", dict(zip(ax, qa)), P, approx="C_PTP"))
         reqs.append(MotionRequest("LIN", dict(zip("XYZABC", lin)), P))
-    from robot.errors import RobotError
-
     tw = TraceWriter(keep=True)
     ctl = Controller(trace=tw, mujoco=False)
     for req in reqs:

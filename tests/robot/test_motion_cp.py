@@ -6,21 +6,20 @@ import math
 
 import numpy as np
 import pytest
-from scipy.spatial.transform import Rotation
+from scipy.spatial.transform import Rotation, Slerp
 
 from robot.bench import run_motions
 from robot.controller import Controller
-from robot.errors import WorkspaceError
-from robot.frames import frame_to_matrix
+from robot.errors import RobotError, WorkspaceError
+from robot.frames import frame_to_matrix, matrix_to_frame
 from robot.motion import MotionParams, MotionRequest, SplineSegment
+from robot.trace import TraceWriter
 
 DT = 0.012
 TOOL_DOWN = {"A1": 0, "A2": -90, "A3": 90, "A4": 0, "A5": 90, "A6": 0}  # flange 445, 0, 810
 
 
 def _run(reqs, **kw):
-    from robot.trace import TraceWriter
-
     tw = TraceWriter(keep=True)
     ctl = Controller(trace=tw, **kw)
     run_motions(ctl, reqs)
@@ -178,8 +177,6 @@ def test_slin_and_sptp_behave_like_lin_and_ptp():
 
 def test_rotation_helper_consistency():
     """The orientation interpolation of a LIN equals scipy's Slerp at mid-path."""
-    from scipy.spatial.transform import Slerp
-
     P = MotionParams().with_(vel_cp=0.5)
     ctl = Controller(mujoco=False)
     ctl.enqueue(MotionRequest("PTP", TOOL_DOWN, P))
@@ -216,9 +213,6 @@ def test_lin_ori_joint_moves_wrist_axes_linearly_on_a_straight_path():
 def test_lin_through_wrist_singularity_is_an_error():
     """A LIN from A5 = +20° to the mirrored pose with A5 = -20° needs a status change
     (wrist flip): a CP motion may not do that (reference §6.5, §8.2)."""
-    from robot.errors import RobotError
-    from robot.frames import matrix_to_frame
-
     P = MotionParams().with_(vel_cp=0.3)
     ctl = Controller(mujoco=False)
     run_motions(ctl, [MotionRequest("PTP", {"A1": 0, "A2": -90, "A3": 90, "A4": 30, "A5": 20,

@@ -11,8 +11,11 @@ import pytest
 
 from robot.bench import run_motions
 from robot.controller import Controller
+from robot.frames import matrix_to_frame
 from robot.limits import check_trace
+from robot.mada import load_robot
 from robot.motion import MotionParams, MotionRequest, SplineSegment
+from robot.planner import CatmullRomPiece, plan
 from robot.trace import TraceWriter
 
 DT = 0.012
@@ -85,8 +88,6 @@ def test_spline_corner_is_slowed_for_acc_cp():
 
 def ctl_seg(segs):
     """The planned SPLINE segment of the corner test (start: the LIN's end point)."""
-    from robot.planner import plan
-
     ctl = Controller(mujoco=False)
     P = MotionParams().with_(vel_cp=1.0)
     ctl.enqueue(MotionRequest("PTP", HOME, P))
@@ -177,9 +178,6 @@ def test_spl_after_a_reversing_slin_keeps_vel_cp_on_the_kr210(shared_corpus):
     the TCP speed measured cycle by cycle after the PTP has ended must stay there (the trace
     rounds positions to 1e-6 mm: ±1.7e-4 mm/s). The arc-length table interpolated linearly ran
     up to 46.18 mm/s (103.8 %) on the SPL piece."""
-    from robot.frames import matrix_to_frame
-    from robot.mada import load_robot
-
     robot = load_robot(shared_corpus / "HugoDanielson__ChinaMilling")
     assert robot.name.startswith("KR210R2700_2")
     tw = TraceWriter(keep=True)
@@ -211,8 +209,6 @@ def test_catmull_rom_piece_is_parametrised_by_exact_arc_length():
     becomes the straight chord with zero end tangents, P(t) = P1 + (3t² - 2t³)·(P2 - P1). On a
     straight piece the arc length is the distance from P1, so pos(s) must lie s mm from P1
     along the chord, including next to the ends where |P'(t)| vanishes."""
-    from robot.planner import CatmullRomPiece
-
     P1, P2 = np.array([100.0, 0.0, 0.0]), np.array([-1900.0, 300.0, 200.0])
     m1 = np.array([1.0, 0.0, 0.0]) * float(np.linalg.norm(P2 - P1))  # the SLIN's direction
     pc = CatmullRomPiece(2 * P1 - P2, P1, P2, 2 * P2 - P1, m1, None)

@@ -14,6 +14,8 @@ import pytest
 
 from robot.bench import run_motions
 from robot.controller import Controller
+from robot.errors import RobotError, SoftLimitError
+from robot.frames import matrix_to_frame
 from robot.motion import MotionParams, MotionRequest
 from robot.trace import TraceWriter
 
@@ -132,8 +134,6 @@ def test_ptp_cartesian_target_reaches_pose():
 
 
 def test_ptp_soft_limit_error_at_planning():
-    from robot.errors import SoftLimitError
-
     ctl = Controller(mujoco=False)
     ctl.enqueue(MotionRequest("PTP", HOME, MotionParams()))
     with pytest.raises(SoftLimitError) as ei:
@@ -143,8 +143,6 @@ def test_ptp_soft_limit_error_at_planning():
 
 
 def test_first_motion_must_be_complete():
-    from robot.errors import RobotError
-
     ctl = Controller(mujoco=False)
     with pytest.raises(RobotError):
         ctl.enqueue(MotionRequest("PTP", {"A1": 10}, MotionParams()))
@@ -166,8 +164,6 @@ def test_ptp_status_and_turn_select_the_configuration():
     """PTP to an E6POS with S/T: the configuration the bits name (reference §6.5)."""
     ctl = Controller(mujoco=False)
     goal = [20.0, -80.0, 100.0, 40.0, -30.0, -120.0]  # A5 < 0: S bit 2; A6 < 0: T bit 5
-    from robot.frames import matrix_to_frame
-
     x, y, z, a, b, c = matrix_to_frame(ctl.model.kin.forward(goal))
     s, t = ctl.model.kin.status_turn(goal)
     assert s & 4 and t & 32

@@ -13,6 +13,8 @@ from pathlib import Path
 import pytest
 from click.testing import CliRunner
 
+import robot.kinematics
+import robot.mada
 from krl.cli import main
 
 BACKUP = "rawpython__kukaKRLmagic"
@@ -34,9 +36,6 @@ def refused(tmp_path, shared_corpus) -> Path:
 @pytest.fixture()
 def no_kinematics(monkeypatch):
     """Building any inverse kinematics, or reading any machine data, fails the test."""
-    import robot.kinematics
-    import robot.mada
-
     def refuse(*_a, **_k):
         raise AssertionError("a tool that does not move the robot built its kinematics")
 

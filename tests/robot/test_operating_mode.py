@@ -11,6 +11,7 @@ import pytest
 from click.testing import CliRunner
 
 from krl.cli import main
+from robot.limits import check_trace
 
 PROG = """
 DEF modes()
@@ -54,8 +55,6 @@ def test_mode_sets_mode_op(tmp_path, args, out):
 
 
 def test_t1_run_keeps_250_mm_s(tmp_path):
-    from robot.limits import check_trace
-
     ev = _run(tmp_path, "--mode", "T1")
     lin = [e for e in ev if e["kind"] == "motion" and e["type"] == "LIN" and e["phase"] == "start"]
     assert lin[-1]["limits"]["path"] == 250.0 and lin[-1]["limits"]["flange"] == 250.0

@@ -12,12 +12,14 @@ import math
 
 import numpy as np
 import pytest
+from scipy.spatial.transform import Rotation
 
 from robot.errors import SoftLimitError, WorkspaceError
 from robot.frames import frame_to_matrix, matrix_to_frame
 from robot.kinematics import Kinematics
 from robot.mada import MachineDataError, load_mada
 from robot.machine import ROBOT_LIBRARY, library_robots
+from robot.show import show_lines
 
 PA = ROBOT_LIBRARY / "kr180_r3200_pa.dat"
 
@@ -176,8 +178,6 @@ def test_5_axis_target_out_of_the_arm_plane_keeps_its_position_and_pitch(pa5):
     axes = [20.0, -60.0, 110.0, 0.0, 30.0, 45.0]
     T = k.forward(axes)
     # tilt the target 5 deg about its own direction 'ahead' x the axis: out of the arm plane
-    from scipy.spatial.transform import Rotation
-
     n = np.array([-math.sin(math.radians(-20.0)), math.cos(math.radians(-20.0)), 0.0])   # plane normal
     ahead = np.cross(n, T[:3, 2])
     R = Rotation.from_rotvec(ahead / np.linalg.norm(ahead) * math.radians(5.0)).as_matrix()
@@ -216,8 +216,6 @@ def test_num_ax_4_with_a5link_false_is_the_4_axis_palletizer(pa4_kuka_flags):
     m = pa4_kuka_flags
     assert m.a4fix and m.a5link and Kinematics(m).family == "palletizer4"
     assert "$NUM_AX=4" in m.provenance["a5_led"] and m.provenance["a5_led"].startswith("derived")
-    from robot.show import show_lines
-
     text = "\n".join(show_lines(m))
     assert "$DEF_A4FIX=TRUE $DEF_A5LINK=FALSE (A5 led: $NUM_AX=4)" in text
     assert "4-axis palletizer" in text

@@ -6,6 +6,7 @@ from __future__ import annotations
 import math
 import xml.etree.ElementTree as ET
 
+import mujoco
 import numpy as np
 import pytest
 from click.testing import CliRunner
@@ -91,12 +92,6 @@ def test_show_a_robot_of_the_library_by_name():
 def test_export_works_for_every_family(tmp_path, name):
     """`krl robot export` (the pendant renders the backup's robot from it) for every family of
     robot/data: the URDF is one tree and the MJCF loads in MuJoCo with a joint per axis."""
-    import xml.etree.ElementTree as ET
-
-    import mujoco
-
-    from robot.mada import load_robot
-
     m = load_robot(name)
     for fmt in ("urdf", "mjcf"):
         out = tmp_path / f"{name}.{fmt}"

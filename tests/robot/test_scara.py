@@ -14,11 +14,17 @@ import pytest
 from click.testing import CliRunner
 
 from krl.cli import main
+from robot.bench import run_motions
+from robot.controller import Controller
 from robot.errors import SoftLimitError, WorkspaceError
 from robot.frames import frame_to_matrix, matrix_to_frame
 from robot.kinematics import Kinematics
+from robot.limits import check_trace
 from robot.mada import MachineDataError, load_robot
 from robot.machine import ROBOT_LIBRARY
+from robot.mjcf import ArmModel, build_mjcf
+from robot.motion import MotionParams, MotionRequest
+from robot.trace import TraceWriter, read_trace
 
 REPO = Path(__file__).resolve().parents[2]
 PROGRAM = REPO / "examples" / "scara" / "pick_place.src"
@@ -111,8 +117,6 @@ def test_errors_out_of_reach_and_past_the_stroke(kin):
 
 
 def test_the_mujoco_model_is_the_kinematics(scara, kin):
-    from robot.mjcf import ArmModel, build_mjcf
-
     xml = build_mjcf(scara)
     assert '<joint name="joint_a3" type="slide"' in xml and xml.count('type="hinge"') == 3
     arm = ArmModel(scara)
@@ -157,9 +161,6 @@ def _run(interp: str, trace: Path):
 
 
 def test_the_scara_runs_ptp_and_lin_on_both_interpreters_within_its_limits(tmp_path, scara):
-    from robot.limits import check_trace
-    from robot.trace import read_trace
-
     tree, vm = tmp_path / "tree.jsonl", tmp_path / "vm.jsonl"
     for interp, path in (("tree", tree), ("vm", vm)):
         res = _run(interp, path)
@@ -187,12 +188,6 @@ def test_random_ptp_and_lin_sequences_keep_the_scaras_limits(scara, kin):
     """Random PTP moves between configurations on one elbow side and LIN moves to poses near
     them (approximated or exact), on the controller: the trace keeps the axis speeds and
     accelerations of the machine data, the path speed, and the soft limits."""
-    from robot.bench import run_motions
-    from robot.controller import Controller
-    from robot.limits import check_trace
-    from robot.motion import MotionParams, MotionRequest
-    from robot.trace import TraceWriter
-
     rng = np.random.default_rng(50)
     P = MotionParams.initmov(scara)
     lo, hi = np.array([-110.0, 25.0, 10.0, -300.0]), np.array([110.0, 130.0, 190.0, 300.0])

@@ -20,14 +20,23 @@ import random
 import shutil
 import sys
 import sysconfig
+from dataclasses import replace
 
 import numpy as np
 import pytest
+from scipy.spatial.transform import Rotation
 
-from robot import build, kinematics
+from robot import build, controller, kinematics, planner, trace, tracecheck
+from robot.bench import bench_program, run_motions
+from robot.blas import numpy_cblas
+from robot.controller import Controller
 from robot.errors import RobotError
+from robot.frames import frame_to_matrix, inv_pos
 from robot.kinematics import Kinematics, constants
-from robot.mada import load_robot
+from robot.machine import ROBOT_LIBRARY, library_robots
+from robot.mada import load_mada, load_robot
+from robot.mjcf import ArmModel, _numpy_dgemm
+from robot.motion import MotionParams, MotionRequest
 from robot.trace import _round6, round_time
 
 try:
@@ -37,7 +46,7 @@ except ImportError:
 
 
 def _can_compile() -> bool:
-    try:
+    try:    # optional: without Cython (a dev dependency) nothing is compiled and loop.py/the Python core run
         import Cython  # noqa: F401, PLC0415
     except ImportError:
         return False
@@ -110,8 +119,6 @@ def test_the_fastpath_constants_are_the_kinematics(fast):
 
 
 def _opw_cores(fast, machine, s_free=0, t_free=0, c4_zero=False):
-    from dataclasses import replace  # noqa: PLC0415
-
     k = Kinematics(machine)
     s = k.impl.solver
     o = replace(s.o, c4=0.0) if c4_zero else s.o
@@ -121,9 +128,6 @@ def _opw_cores(fast, machine, s_free=0, t_free=0, c4_zero=False):
 
 @pytest.mark.parametrize("robot", ["kr6", "kr210", "pa4"])
 def test_the_compiled_fastpath_is_fastpath_py_bit_for_bit(fast, robot, shared_corpus):
-    from robot.machine import ROBOT_LIBRARY  # noqa: PLC0415
-    from robot.mada import load_mada  # noqa: PLC0415
-
     machine = {"kr6": lambda: None, "kr210": lambda: load_robot(str(shared_corpus / "HugoDanielson__ChinaMilling")),
                "pa4": lambda: load_mada(ROBOT_LIBRARY / "kr180_r3200_pa.dat")}[robot]()
     k, c, p = _opw_cores(fast, machine, 4 if robot == "pa4" else 0, 0b11000 if robot == "pa4" else 0, robot == "pa4")
@@ -279,8 +283,6 @@ def test_the_compiled_pose_line_is_pythons_bit_for_bit(sc):
 
 # ----------------------------------------------------------------------------- the IPO cycle
 def _arm_agrees(machine, seed: int) -> None:
-    from robot.mjcf import ArmModel  # noqa: PLC0415  (MuJoCo)
-
     a, b = ArmModel(machine), ArmModel(machine)
     cyc = a.compiled_cycle(simcore)
     assert cyc is not None, "the compiled playback is not used"
@@ -306,10 +308,6 @@ def test_the_compiled_cycle_is_the_arm_models_playback_on_a_corpus_kr210(sc, sha
 
 
 def test_the_compiled_cycle_is_off_in_actuated_mode_and_without_the_module(monkeypatch):
-    from robot.mjcf import ArmModel  # noqa: PLC0415
-
-    from robot import controller  # noqa: PLC0415
-
     assert ArmModel(actuated=True).compiled_cycle(simcore) is None
     assert ArmModel().compiled_cycle(None) is None
     monkeypatch.setattr(kinematics.compiled, "USE_COMPILED", False)
@@ -330,10 +328,6 @@ def test_the_compiled_step_check_is_the_python_loops(sc):
 
 def _segments(machine, program):
     """The CP segments a controller plans for `program` (a list of MotionRequest)."""
-    from robot import planner  # noqa: PLC0415
-    from robot.bench import run_motions  # noqa: PLC0415
-    from robot.controller import Controller  # noqa: PLC0415
-
     segs = []
     orig = planner.CartSegment.__init__
 
@@ -351,9 +345,6 @@ def _segments(machine, program):
 
 @pytest.mark.parametrize("robot", ["kr6", "kr210"])
 def test_the_compiled_cp_path_is_the_segments_poses_and_axes(sc, robot, shared_corpus):
-    from robot.bench import bench_program  # noqa: PLC0415
-    from robot.motion import MotionParams, MotionRequest  # noqa: PLC0415
-
     machine = None if robot == "kr6" else load_robot(str(shared_corpus / "HugoDanielson__ChinaMilling"))
     P = MotionParams.initmov(machine)
     k = machine.reach_wrist_point_mm / 901.456 if machine is not None else 1.0
@@ -409,8 +400,6 @@ def test_the_compiled_cp_path_is_the_segments_poses_and_axes(sc, robot, shared_c
 def test_the_trace_is_the_same_with_and_without_the_compiled_module(sc, fast, monkeypatch):
     """The whole compiled path (inverse, CP poses, the IPO cycle, pose lines) against the
     Python code on a random sequence of robot/tracecheck.py: the same bytes."""
-    from robot import trace, tracecheck  # noqa: PLC0415
-
     compiled = tracecheck.run_case("random-05")
     monkeypatch.setattr(kinematics.compiled, "USE_COMPILED", False)
     monkeypatch.setattr(trace, "_pose_line", None)
@@ -421,9 +410,6 @@ def test_the_compiled_tcp_product_is_numpys_matmul(sc):
     """The read-back's INV_POS($BASE) : FLANGE : $TOOL in numpy's own BLAS call: numpy's
     ``@`` bit for bit (a C loop in the textbook order differs in the last bit: numpy's
     OpenBLAS fuses multiply and add)."""
-    from robot.frames import frame_to_matrix, inv_pos  # noqa: PLC0415
-    from robot.mjcf import ArmModel, _numpy_dgemm  # noqa: PLC0415
-
     if not _numpy_dgemm():
         pytest.skip("numpy without its bundled OpenBLAS: numpy multiplies")
     cyc = ArmModel().compiled_cycle(simcore)
@@ -451,12 +437,6 @@ def test_the_compiled_forward_is_the_python_forward_bit_for_bit(sc, shared_corpu
     """Kinematics.forward through robot/simcore.pyx ``Forward`` (scipy's rotation-vector matrices,
     numpy's own BLAS products) against its numpy/scipy code: the same bytes on random axes of the
     library's robots, of a corpus KR 210 and of a chain with rotated joint origins."""
-    from scipy.spatial.transform import Rotation  # noqa: PLC0415
-
-    from robot.blas import numpy_cblas  # noqa: PLC0415
-    from robot.machine import library_robots  # noqa: PLC0415
-    from robot.mada import load_mada  # noqa: PLC0415
-
     if not numpy_cblas("dgemm") or not numpy_cblas("dgemv"):
         pytest.skip("numpy without its bundled OpenBLAS: numpy multiplies")
     kins = [Kinematics(load_mada(p)) for p in library_robots().values() if p.suffix == ".dat"]
@@ -489,11 +469,6 @@ def test_the_compiled_palletizer_rows_are_the_pythons(sc):
     loop of Palletizer4.solutions: the same rows, bit for bit, on linked configurations
     of the library palletizer, with tilted flanges, targets off the arm's reach and no
     reference (``solutions``); its own flange test tells the rows apart by millimetres."""
-    from scipy.spatial.transform import Rotation  # noqa: PLC0415
-
-    from robot.machine import ROBOT_LIBRARY  # noqa: PLC0415
-    from robot.mada import load_mada  # noqa: PLC0415
-
     m = load_mada(ROBOT_LIBRARY / "kr180_r3200_pa.dat")
     compiled, python = Kinematics(m), Kinematics(m)
     python.impl._c_pal = False

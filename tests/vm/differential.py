@@ -6,6 +6,7 @@ from pathlib import Path
 
 import yaml
 
+from interp.realprograms import DEFAULT_CORPUS, find_backups, programs_of
 from interp.run import make_runtime
 from robot.trace import TraceWriter
 
@@ -29,10 +30,6 @@ def run_trace(program: Path, interp: str, *, inputs=None, submit=(), before=None
 
 def real_programs() -> list:
     """The main programs of the KRC backups in ../shared/krl-corpus ([] when it is absent)."""
-    try:
-        from interp.realprograms import DEFAULT_CORPUS, find_backups, programs_of
-    except ImportError:     # pragma: no cover
-        return []
     if not DEFAULT_CORPUS.is_dir():
         return []
     out = []

@@ -6,7 +6,11 @@ import pytest
 
 from interp.vm.assembler import AsmError, assemble, disassemble, parse_const, fmt_const
 from interp.asm import program_assembly
+from interp.bench import PROGRAM
+from interp.realprograms import DEFAULT_CORPUS, find_backups, programs_of
+from interp.run import make_runtime
 from interp.runtime.values import EnumValue
+from interp.vm.compiler import compile_module
 
 from .differential import CASES, CORPUS
 
@@ -82,10 +86,6 @@ def test_enum_constant():
 
 @pytest.mark.corpus
 def test_every_routine_of_the_shared_corpus_compiles_and_round_trips():
-    from interp.realprograms import DEFAULT_CORPUS, find_backups, programs_of
-    from interp.run import make_runtime
-    from interp.vm.compiler import compile_module
-
     if not DEFAULT_CORPUS.is_dir():
         pytest.skip("../shared/krl-corpus absent")
     n = 0
@@ -107,8 +107,6 @@ def test_every_routine_of_the_shared_corpus_compiles_and_round_trips():
 def test_benchmark_round_trips_with_its_superinstructions():
     """The compute benchmark uses the store-variable and register-style opcodes (operand
     kinds v, y, o, k); its assembly round-trips like any other."""
-    from interp.bench import PROGRAM
-
     text = program_assembly(PROGRAM, all_modules=False)
     codes = assemble(text)
     again = "".join(disassemble(c) for c in codes)

@@ -6,9 +6,10 @@ import json
 
 from click.testing import CliRunner
 
+import robot.bench as rb
 from interp.bench import run_krl, run_python
 from interp.vm.vm import COMPILED
-from krl.cli.bench import bench
+from krl.cli.bench import all_figures, bench
 
 KEYS = {"vm_vs_tree", "tree_stmts_per_s", "vm_stmts_per_s", "sim_realtime_factor", "sim_cpu_factor", "parse_kb_per_s"}
 
@@ -36,9 +37,6 @@ def test_bench_json_line():
 def test_bench_json_gives_the_simulator_figure_of_robot_bench(monkeypatch):
     """One figure per measure (issue 48): `krl bench --json` reports the simulator as
     ``python -m robot.bench`` measures it, warm, by the same function."""
-    import robot.bench as rb
-    from krl.cli.bench import all_figures
-
     seen = {}
 
     def measure(min_motion_s=60.0, robot=None, warm_up=True):

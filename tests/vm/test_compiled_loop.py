@@ -26,7 +26,7 @@ from .test_generated_loop import PROGRAMS, _trace
 
 
 def _can_compile() -> bool:
-    try:
+    try:    # optional: without Cython (a dev dependency) nothing is compiled and loop.py/the Python core run
         import Cython  # noqa: F401, PLC0415
     except ImportError:
         return False

@@ -7,6 +7,9 @@ from pathlib import Path
 
 import pytest
 
+from interp.realprograms import submit_of
+from tests.interp.test_paper import STIMULI, _shift_base, _variant
+
 from .differential import CASES, CORPUS, PAPER, case_options, compare, first_difference, real_programs, run_trace
 
 
@@ -33,8 +36,6 @@ def test_conformance_case(program):
 @pytest.mark.skipif(not PAPER.exists(), reason="../shared/examples absent")
 @pytest.mark.parametrize("brake_at", [None, 1.0])
 def test_paper_example(tmp_path, brake_at):
-    from tests.interp.test_paper import STIMULI, _shift_base, _variant
-
     stim = STIMULI + (f"  - at: {brake_at}\n    set: {{\"$IN[2]\": false}}\n" if brake_at else "")
     inputs = tmp_path / "stimuli.yaml"
     inputs.write_text(stim)
@@ -43,8 +44,6 @@ def test_paper_example(tmp_path, brake_at):
 
 
 def _submit_of(program):
-    from interp.realprograms import submit_of
-
     return submit_of(program)
 
 

@@ -5,9 +5,15 @@ is ``DEF prog()``, the body starts on line 2; EXTRA's routines follow END on lin
 
 from __future__ import annotations
 
+import json
 import re
 
 import pytest
+
+from interp.cli import run
+from robot.controller import Controller
+from robot.errors import RobotError
+from click.testing import CliRunner
 
 from .test_statements import both
 
@@ -93,12 +99,6 @@ def test_same_error(tmp_path, name):
 def test_error_event_trace_files_are_byte_identical(tmp_path):
     """`krl run --trace` of a program stopped by a run-time error: both interpreters write the
     same bytes, the error event (line 4, division by zero) right before the end event."""
-    import json
-
-    from click.testing import CliRunner
-
-    from interp.cli import run
-
     (tmp_path / "prog.src").write_text("DEF prog()\n  INT i, n\n  n = 0\n  i = 1 / n\nEND\n")
     traces = {}
     for kind in ("tree", "vm"):
@@ -116,9 +116,6 @@ def test_a_main_run_fault_is_one_error_event(tmp_path, monkeypatch):
     """A fault of the main run (here forced in the controller's speed check while the LIN of
     line 4 moves) is written once, by the controller, with the motion's id and line; the
     program then stops with that error and the interpreter does not write it a second time."""
-    from robot.controller import Controller
-    from robot.errors import RobotError
-
     real = Controller._check_speed
 
     def check(self, q):

@@ -18,17 +18,24 @@ CONTINUE, §5.16 interrupts, §5.19 ON_ERROR_PROCEED, §8.2 errors), not copied 
 
 from __future__ import annotations
 
+import ast
 import math
+import random
 import re
 import traceback
 from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
+from click.testing import CliRunner
 
-from interp.asm import program_assembly
+from interp.asm import asm, program_assembly
+from interp.realprograms import submit_of
 from interp.run import make_runtime
+from interp.runtime.errors import KrlRuntimeError
 from interp.runtime.values import UNSET, Arr, EnumValue, Struct
+from interp.vm import gen_loop, opcodes as OP
+from interp.vm.compiler import compile_routine
 from robot.trace import TraceWriter
 
 from .differential import CASES, CORPUS, case_options, real_programs
@@ -365,10 +372,6 @@ def test_programs_use_the_fast_opcodes():
 
 
 def test_krl_asm_command_lists_fast_opcodes():
-    from click.testing import CliRunner
-
-    from interp.asm import asm
-
     res = CliRunner().invoke(asm, [str(VALUES)])
     assert res.exit_code == 0, res.output
     assert re.search(r"^\s+ADDC_FAST i 10\.6 k I$", res.output, re.M), "k = i + 10.6"
@@ -402,8 +405,6 @@ def test_quiet_steps_sweep(program, options):
 @pytest.mark.corpus
 @pytest.mark.parametrize("program", real_programs(), ids=lambda p: "/".join(p.parts[-3:]))
 def test_quiet_steps_real_programs(program):
-    from interp.realprograms import submit_of
-
     run_all(program, runs=QUIET_RUNS, max_sim_time=20.0, max_steps=100_000, submit=submit_of(program))
 
 
@@ -497,9 +498,6 @@ def test_step_limit_inside_a_loop(sel, max_steps):
 def test_linked_code_uses_the_loop_numbering():
     """The executed form is the listing, instruction for instruction, each opcode in the
     loop's numbering (what `krl asm` prints is what runs)."""
-    from interp.vm import opcodes as OP
-    from interp.vm.compiler import compile_routine
-
     rt, vm = make_runtime(VALUES, mujoco=False, interp="vm", check=False)
     rt.run()
     seen = set()
@@ -516,10 +514,6 @@ def test_linked_code_uses_the_loop_numbering():
 def _loop_lines():
     """(path of interp/vm/loop.py, first line, last line) of the generated ``run`` (the
     compiled loop's frames name loop.py's lines too: Cython keeps them)."""
-    import ast
-
-    from interp.vm import gen_loop
-
     path = gen_loop.LOOP.resolve()
     tree = ast.parse(path.read_text())
     run = next(n for n in tree.body if isinstance(n, ast.FunctionDef) and n.name == "run")
@@ -529,8 +523,6 @@ def _loop_lines():
 def test_error_traceback_points_into_the_loop():
     """A run-time error raised by a slow path inside the loop: its traceback has a frame
     in interp/vm/loop.py on a line of the generated loop, a real source line."""
-    from interp.runtime.errors import KrlRuntimeError
-
     path, lo, hi = _loop_lines()
     rt, _ = make_runtime(ERRORS, mujoco=False, interp="vm", max_steps=10_000, check=False)
     rt.program.module("fp_errors").data["SEL"].set(6)      # k = big + 1: INT overflow
@@ -602,8 +594,6 @@ _CONSTS = ["0", "1", "2", "-1", "3", "2147483647", "-2147483647", "1.5", "2.5", 
 
 class _Gen:
     def __init__(self, seed: int) -> None:
-        import random
-
         self.r = random.Random(seed)
 
     def scalar(self) -> str:

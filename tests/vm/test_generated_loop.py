@@ -18,6 +18,7 @@ from pathlib import Path
 import pytest
 
 from interp.run import make_runtime
+from interp.vm.gen_loop import LOOP, PXD, TABLE, generate
 from robot.trace import TraceWriter
 
 REPO = Path(__file__).resolve().parents[2]
@@ -25,8 +26,6 @@ VM_DIR = REPO / "interp" / "vm"
 
 
 def test_generated_files_are_not_stale():
-    from interp.vm.gen_loop import LOOP, PXD, TABLE, generate
-
     out = generate()
     for path, text in ((LOOP, out.loop), (TABLE, out.table), (PXD, out.pxd)):
         assert path.read_text(encoding="utf-8") == text, f"{path.name} is stale: run python -m interp.vm.gen_loop"

@@ -12,8 +12,12 @@ from pathlib import Path
 
 import pytest
 
+from interp.asm import program_assembly
 from interp.vm import gen_loop
 from interp.vm import opcodes as O
+
+from .differential import CASES, CORPUS
+from interp.vm.assembler import Listing, parse_listings
 
 COMPILER_SRC = (Path(O.__file__).parent / "compiler.py").read_text()
 
@@ -163,8 +167,6 @@ def ends(name: str) -> bool:
 def check_stack(lst) -> None:
     """Depth never negative, equal on every path into an instruction, statements start at
     depth 0, thunks end with at most one value."""
-    from interp.vm.assembler import Listing  # noqa: F401
-
     n = len(lst.instrs)
     depth: dict = {0: 0}
     entries = [0]
@@ -209,11 +211,6 @@ def check_stack(lst) -> None:
 
 
 def test_stack_effects_of_compiled_programs():
-    from interp.vm.assembler import parse_listings
-    from interp.asm import program_assembly
-
-    from .differential import CASES, CORPUS
-
     here = Path(__file__).parent / "programs"
     for program in CORPUS + CASES + [here / "mixed.src"]:
         for lst in parse_listings(program_assembly(program)):

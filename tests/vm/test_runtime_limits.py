@@ -14,11 +14,16 @@ import re
 from pathlib import Path
 
 import pytest
+from click.testing import CliRunner
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from interp.run import make_runtime
+from interp.runtime.convert import trunc_int
+from interp.runtime.errors import KrlRuntimeError
+from interp.runtime.natives.swrite import sread_values, swrite_text
 from interp.runtime.values import is_char_array
+from krl.cli import main
 from krl.limits import MAX_DATA_ELEMENTS, MAX_EXPRESSION_TERMS, MAX_NESTING
 from robot.trace import TraceWriter
 from tests.budget import examples
@@ -450,10 +455,6 @@ def test_any_lexer_string_through_swrite_and_messages_leaves_tree_equal_vm(tmp_p
 ])
 def test_krl_run_shows_the_limit_with_its_place(tmp_path, interp, case, src, dat, shown):
     """`krl run`: exit 1 (a KRL run-time error), the message with file:line, no internal error."""
-    from click.testing import CliRunner
-
-    from krl.cli import main
-
     (tmp_path / "prog.src").write_text(src)
     if dat is not None:
         (tmp_path / "prog.dat").write_text(dat)
@@ -484,9 +485,6 @@ _VALUES = st.lists(st.one_of(st.integers(-2**31, 2**31 - 1), st.floats(allow_nan
 def test_any_format_is_text_a_format_error_or_a_krl_error(fmt, values, room, src):
     """SWRITE/SREAD on any format and values: a text that fits, a format error, or a KRL
     run-time error (a value that does not suit its conversion), never a Python exception."""
-    from interp.runtime.natives.swrite import sread_values, swrite_text
-    from interp.runtime.errors import KrlRuntimeError
-
     try:
         text, hits, error = swrite_text(fmt, values, room)
     except KrlRuntimeError:
@@ -505,9 +503,6 @@ def test_any_format_is_text_a_format_error_or_a_krl_error(fmt, values, room, src
 def test_a_huge_real_taken_as_an_int_is_int_overflow():
     """trunc_int (interrupt numbers, S/T, TRIGGER DISTANCE/PRIO, %c) checks the INT range
     like every other REAL -> INT conversion: 1E30 is INT overflow, 2147483647.9 truncates."""
-    from interp.runtime.convert import trunc_int
-    from interp.runtime.errors import KrlRuntimeError
-
     with pytest.raises(KrlRuntimeError, match="INT overflow"):
         trunc_int(1e30, "interrupt number")
     with pytest.raises(KrlRuntimeError, match="INT overflow"):

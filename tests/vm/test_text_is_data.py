@@ -15,6 +15,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
+from interp.asm import program_assembly
 from interp.run import make_runtime
 from interp.vm import assembler
 from robot.trace import TraceWriter
@@ -95,8 +96,6 @@ def test_the_vm_never_parses_text(tmp_path, monkeypatch):
 def test_krl_asm_round_trips_and_escapes_source_lines(tmp_path, c):
     """`krl asm`: the source line in a comment is shown escaped, on one line, and the text
     assembles back to the same code."""
-    from interp.asm import program_assembly
-
     prog = tmp_path / "prog.src"
     prog.write_bytes(program(c).encode("utf-8"))
     text = program_assembly(prog)

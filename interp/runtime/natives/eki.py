@@ -9,8 +9,12 @@ channel's configuration sets ``MESSAGES Display="disabled"``: then only Msg_No t
 
 from __future__ import annotations
 
-from ..convert import ref_text
+import math
+
+from ..convert import num, ref_text
 from ..errors import KrlRuntimeError, value_invalid
+from ..memory import index_ref
+from ..sysvars import struct_of
 from ..values import UNSET, Arr, Struct, is_char_array
 from .registry import Family
 
@@ -29,8 +33,10 @@ def network(rt):
     ctl = rt.controller
     net = getattr(ctl, "network", None)
     if net is None:
+        # costs 0.25 s at start-up (python -X importtime, 2026-11-25)
         from net.hub import Network  # noqa: PLC0415
 
+        # costs 0.008 s at start-up (python -X importtime, 2026-11-25)
         from ..netvars import RuntimeSink  # noqa: PLC0415
 
         net = Network(program=rt.program.main_path, sink=RuntimeSink(rt))
@@ -44,8 +50,6 @@ def _eki(rt):
 
 
 def _status(st) -> Struct:
-    from ..sysvars import struct_of  # noqa: PLC0415
-
     return struct_of("EKI_STATUS", {"BUFF": st.buff, "READ": st.read, "MSG_NO": st.msg_no,
                                     "CONNECTED": bool(st.connected), "COUNTER": st.counter})
 
@@ -57,6 +61,7 @@ def _result(st, err) -> Struct:
 
 
 def _eki_error(exc) -> Struct:
+    # costs 0.05 s at start-up (python -X importtime, 2026-11-25)
     from net.eki import Status  # noqa: PLC0415
 
     if exc.stops:
@@ -67,6 +72,7 @@ def _eki_error(exc) -> Struct:
 def _call(fn):
     """A native whose body may raise net.eki.EkiError (an unknown channel, a failed Init)."""
     def native(rt, a):
+        # costs 0.05 s at start-up (python -X importtime, 2026-11-25)
         from net.eki import EkiError  # noqa: PLC0415
 
         try:
@@ -96,6 +102,7 @@ def eki_close(rt, a):
 
 @_call
 def eki_clear(rt, a):
+    # costs 0.05 s at start-up (python -X importtime, 2026-11-25)
     from net.eki import Status  # noqa: PLC0415
 
     _eki(rt).clear(ref_text(a[0], "EKI_Clear channel"))
@@ -118,8 +125,6 @@ def eki_send(rt, a):
     data = ref_text(a[1] if len(a) > 1 else None, "EKI_Send data")
     length = None
     if len(a) > 2 and a[2] is not None:
-        from ..convert import num  # noqa: PLC0415
-
         length = int(num(a[2].get(), "EKI_Send length"))
     return _result(*ch.send(data, length))
 
@@ -139,9 +144,8 @@ def eki_clearbuffer(rt, a):
 def _setter(kind: str):
     @_call
     def native(rt, a):
+        # costs 0.05 s at start-up (python -X importtime, 2026-11-25)
         from net.eki import format_real  # noqa: PLC0415
-
-        from ..convert import num  # noqa: PLC0415
 
         ch = _eki(rt).channel(ref_text(a[0], f"EKI_Set{kind} channel"))
         path = ref_text(a[1] if len(a) > 1 else None, f"EKI_Set{kind} element")
@@ -169,8 +173,6 @@ def _setter(kind: str):
 def _convert(kind: str, text):
     """An element's text as the KRL type `kind`; ValueError when it does not convert."""
     if kind == "Real":
-        import math  # noqa: PLC0415
-
         v = float(text)
         if not math.isfinite(v):
             raise ValueError(text)
@@ -218,6 +220,7 @@ def _store(ref, kind: str, value, what: str) -> None:
 def _getter(kind: str, array: bool = False):
     @_call
     def native(rt, a):
+        # costs 0.05 s at start-up (python -X importtime, 2026-11-25)
         from net.eki import EkiError  # noqa: PLC0415
 
         name = f"EKI_Get{kind}{'Array' if array else ''}"
@@ -244,8 +247,6 @@ def _getter(kind: str, array: bool = False):
             return _result(st, e)
         try:
             if array:
-                from ..memory import index_ref  # noqa: PLC0415
-
                 for i, v in enumerate(conv, 1):
                     _store(index_ref(target, [i], name), kind, v, name)
             elif conv:
