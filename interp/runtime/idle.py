@@ -57,6 +57,7 @@ from __future__ import annotations
 
 import math
 
+from krl.ast import nodes as N
 from krl.semantics import types as T
 
 from .values import LEAVES, UNSET, Arr, EnumValue, Struct
@@ -174,12 +175,53 @@ def frames_of(rt, task) -> tuple:
     return img if img is not None else tuple([_store(f.store) for f in _frames(task)])
 
 
-def state_of(rt) -> tuple:
+def _root_name(e):
+    while isinstance(e, (N.Index, N.Field)):
+        e = e.base
+    return e if isinstance(e, N.Name) else None
+
+
+def written_modules(rt) -> frozenset:
+    """The data lists (module indices, ``Storage.owner``) a statement of the program may write:
+    those an assignment, a FOR, an ``ANIN ON`` or a WITH names as target, or a call takes as an
+    argument (an :OUT parameter may write it; an :IN one is counted too). No other writer
+    changes a data list of a run (the controller writes the I/O image, the cyclic flags, the
+    system variables). A data list outside this set keeps its loaded values: its image is made
+    once (:class:`IdleWatch` keeps it)."""
+    out = set()
+    for unit in rt.program.ws.units:
+        src = unit.src
+        if src is None or src.module is None:
+            continue
+        for node in src.module.walk():
+            c = node.__class__
+            if c is N.Assign or c is N.AninOn or c is N.WithAssign:
+                names = (_root_name(node.target),)
+            elif c is N.For:
+                names = (_root_name(node.var),)
+            elif c is N.Call:
+                names = tuple(_root_name(a) for a in node.args)
+            else:
+                continue
+            for name in names:
+                place = getattr(name.ann, "place", None) if name is not None and name.ann is not None else None
+                if place is not None and place.owner >= 0:
+                    out.add(place.owner)
+                elif name is not None and place is None:
+                    return frozenset(m.index for m in rt.program.modules)   # a name not placed: any
+    return frozenset(out)
+
+
+def state_of(rt, constant: dict | None = None) -> tuple:
     """The state of the run `rt` that its future depends on, besides the positions of its
     tasks in their loops (see the module docstring): data lists, frames, system variables,
-    I/O image, interrupt tables, contexts and waits."""
+    I/O image, interrupt tables, contexts and waits. `constant`: module index -> the image of a
+    data list no statement writes (:func:`written_modules`), made once and used again."""
     prog = rt.program
-    mods = tuple([_store(m.store) for m in prog.modules if m.loaded])
+    if constant is None:
+        mods = tuple([_store(m.store) for m in prog.modules if m.loaded])
+    else:
+        mods = tuple([constant.get(m.index) or _store(m.store) for m in prog.modules if m.loaded])
     tasks = []
     for t in rt.scheduler.tasks:
         frames = frames_of(rt, t)
@@ -227,6 +269,7 @@ class IdleWatch:
         self._phases: dict = {}      # phase of the tasks (:meth:`_phase`) -> cycle, while idle in one state
         self.shifted = 0             # cycles of the periodic jumps (each task's WAIT SEC moved with the clock)
         self._imaged = None          # _state_key() when the state was imaged last
+        self._const = None           # images of the data lists no statement writes (_constant)
 
     def clock_read(self) -> None:
         """A task read the clock or a random number: its next statements may differ without
@@ -239,6 +282,23 @@ class IdleWatch:
         robot's axes (deg)."""
         ctl = self.rt.controller
         return (len(ctl.io.log), self.clock, ctl._plan_q.tolist(), ctl._q.tolist())
+
+    def outside_change(self) -> None:
+        """Something outside the tasks changed the run's state (interp/runtime/core.py
+        ``Runtime.changed_outside``: an operator's edit, a network partner's write): it may
+        have written a data list no statement writes, so its image is made again."""
+        self._const = None
+        self._imaged = None
+
+    def _constant(self) -> dict:
+        """The images of the data lists no statement of the program writes (module index ->
+        image; :func:`written_modules`), made at the first state image of the run."""
+        c = self._const
+        if c is None:
+            written = written_modules(self.rt)
+            c = self._const = {m.index: _store(m.store) for m in self.rt.program.modules
+                               if m.loaded and m.index not in written}
+        return c
 
     def _state_key(self):
         """What :func:`state_of` images can change by: the statements executed and the cyclic
@@ -360,7 +420,7 @@ class IdleWatch:
         # the state is imaged again only when something may have changed it since the last
         # image (:meth:`_state_key`); else it is that image
         key = self._state_key()
-        state = self.state if key is not None and key == self._imaged else state_of(rt)
+        state = self.state if key is not None and key == self._imaged else state_of(rt, self._constant())
         self._imaged = key
         if self.state is None or state != self.state:
             if self.state is not None:

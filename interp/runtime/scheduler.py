@@ -94,6 +94,7 @@ class Task:
         self.parked = None
         self.shadow = None
         self.until = None               # the test that ends its wait (Runtime._wait), while it waits
+        self.clock_reads = 0            # clock reads an evaluation of that wait makes (running timers)
 
     @property
     def file(self) -> str | None:
@@ -165,6 +166,8 @@ class Scheduler:
             ctl = rt.controller
             if task.irqs.poll(ctl.io.version, ctl.time, rt.state_epoch, rt.cyclic_watch.written()):
                 return False            # an interrupt to run: resumed, its poll finds it pending
+        if task.clock_reads:
+            self.idle.clock += task.clock_reads     # the condition's reads of running timers
         return True
 
     def _steady(self) -> bool:
@@ -239,7 +242,10 @@ class Scheduler:
                 continue
             rt.state_epoch += 1             # as its resume, or its parked or waiting count
             p = task.parked
-            if p is not None:
+            if p is None:
+                if task.clock_reads:
+                    self.idle.clock += task.clock_reads     # as _waits
+            else:
                 rt.steps += task.budget
                 p.done += task.budget
                 spin.skipped += task.budget
