@@ -17,7 +17,10 @@ The simulated controller calls :meth:`Network.cycle` at the start of every IPO c
 The runtime talks to the partners through its EKI/RSI built-ins
 (interp/runtime/natives/eki.py, rsi.py: ``hub.partner("eki")``, ``hub.partner("rsi")``) and gives
 the hub a *sink*: ``set_flag(n, v)``, ``set_out(n, v)``, ``read_var(name) -> text``,
-``write_var(name, text) -> text`` (interp/runtime/netvars.py).
+``write_var(name, text) -> text`` (interp/runtime/netvars.py), and ``changed_outside()``, which
+a partner calls at the moment it writes into the run otherwise (a message into an EKI channel's
+memory, a PLC's input, an RSI answer; the sink's own writes call it themselves): the runtime's
+watch keys move and parked spins catch up (interp/runtime/core.py ``Runtime.changed_outside``).
 """
 
 from __future__ import annotations
@@ -68,6 +71,9 @@ class NullSink:
     def __init__(self) -> None:
         self.flags: dict[int, bool] = {}
         self.outs: dict[int, bool] = {}
+
+    def changed_outside(self) -> None:
+        """A partner is about to write (no run to tell)."""
 
     def set_flag(self, n: int, v: bool) -> None:
         self.flags[n] = v

@@ -305,11 +305,11 @@ class IdleWatch:
         flags' changes (interp/runtime/watch.py ``CyclicWatch.written``), the I/O image's
         version, the message handle, the tasks' waits, contexts and interrupt tables, the step a
         parked spin stands at (interp/runtime/spin.py). Equal keys: the same state. None: image
-        it (a debugger or an ``ANIN ON`` may write, a network partner is attached)."""
+        it (a debugger or an ``ANIN ON`` may write; a network partner's write moves the key:
+        ``Runtime.changed_outside``)."""
         rt = self.rt
         written = rt.cyclic_watch.written()
-        net = getattr(rt.controller, "network", None)
-        if written is None or (net is not None and net.polling):
+        if written is None:
             return None
         tasks = []
         for t in rt.scheduler.tasks:

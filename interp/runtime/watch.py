@@ -292,16 +292,15 @@ class CyclicWatch:
         self.version = 0
 
     def written(self):
-        """What may have written a variable since: ``(steps executed, cyclic flag changes)``; None
-        when something else may (a debugger, an ``ANIN ON``, a network partner: an EKI channel
-        sets ``$FLAG`` and writes received values, KukaVarProxy writes any variable: a run with a
-        network configured or replayed, net/hub.py)."""
+        """What may have written a variable since: ``(steps executed, cyclic flag changes and
+        outside changes)``; None when something else may (a debugger, an ``ANIN ON``). A network
+        partner that writes into the run (an EKI channel's ``$FLAG`` or memory, KukaVarProxy's
+        variable, a PLC's input, an RSI answer, live or replayed) announces it first
+        (interp/runtime/core.py ``Runtime.changed_outside``, which moves :attr:`version`; net/hub.py
+        "sink")."""
         rt = self.rt
         if rt.stmt_hook is not None or rt.step_hook is not None or rt.cycle_hook is not None \
                 or any(k[0] == "analog input" for k in rt._cyclic):
-            return None
-        net = getattr(rt.controller, "network", None)
-        if net is not None and (net.polling or net.replay):
             return None
         return (rt.steps - rt.spin.skipped, self.version)
 
