@@ -221,6 +221,7 @@ class Controller:
                  mujoco: bool = True, mode_op: str | None = None) -> None:
         self.machine = machine if machine is not None else load_machine()
         self.rules: list[Rule] = []
+        self._rules_seen = None         # what the rules' conditions last saw (cellrules.step_rules)
         self.pgno: int | None = None      # the cell file's pgno preset (interp/run.py builds its rules)
         self.start: str | None = None     # the cell file's start: position (interp/run.py places the robot)
         self.cell_network = None          # the cell file's `network:` settings (interp/run.py attaches them)
@@ -841,7 +842,7 @@ class Controller:
         if self.stimuli:
             self._apply_stimuli(t)
         if self.rules:
-            step_rules(self.rules, self.io, t, self.dt)
+            self._rules_seen = step_rules(self.rules, self.io, t, self.dt, self._rules_seen)
 
         # path time (BRAKE ramps scale the path speed)
         s_old = self._scale

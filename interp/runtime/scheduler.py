@@ -170,47 +170,59 @@ class Scheduler:
             self.idle.clock += task.clock_reads     # the condition's reads of running timers
         return True
 
-    def _steady(self) -> bool:
-        """This cycle is a steady one (module docstring)."""
+    def _steady(self) -> int:
+        """This cycle is a steady one (module docstring): 1 while the robot moves, 2 while it
+        stands (the idle watch then makes its own cycle, :meth:`run`); 0 when it is not."""
         rt = self.rt
         ctl = rt.controller
         q, q0 = ctl._q, ctl._q_prev
-        if q is q0 or (q == q0).all():
-            self._calm = None               # the robot did not move
-            return False
+        moving = not (q is q0 or (q == q0).all())
         calm = self._calm
+        if calm is not None and calm[4] != moving:
+            calm = None
         if calm is None:
-            calm = self._calm = self._calm_now()
+            calm = self._calm = self._calm_now(moving)
             if calm is None:
-                return False
-        io, cyc, executed, nxt = calm
+                return 0
+        io, cyc, executed, nxt, _m = calm
+        if not moving:
+            # the idle watch's cycle runs in a still one: an answer of the automatic cell may
+            # have scheduled an input, a window be watched or the run be idle since
+            idle = self.idle
+            if idle.since is not None or (idle.auto is not None and idle.auto.recording is not None):
+                self._calm = None
+                return 0
+            nxt = ctl.next_event_cycle()
         if ctl.io.version != io or rt.cyclic_watch.version != cyc or rt.steps - self.spin.skipped != executed \
                 or (nxt is not None and ctl.cycle + 1 >= nxt) \
                 or (self.max_sim_time is not None and ctl.time >= self.max_sim_time - 1e-9):
             self._calm = None
-            return False
+            return 0
         for task in self.tasks:
             if task.done:
                 continue
             if task.pending_triggers or task.pending_error is not None:
                 self._calm = None
-                return False
+                return 0
             if task.parked is not None:
                 if rt.max_steps is not None and \
                         rt.steps + 2 * (task.budget + task.parked.spin.steps) > rt.max_steps:
                     self._calm = None
-                    return False
+                    return 0
             elif task.until():
                 self._calm = None
-                return False
-        return True
+                return 0
+        return 1 if moving else 2
 
-    def _calm_now(self):
+    def _calm_now(self, moving: bool):
         """The first of a run of steady cycles: the tests that hold for the whole run of them,
         and what the later cycles compare with; None when this is not one."""
         rt = self.rt
         ctl = rt.controller
         spin, idle = self.spin, self.idle
+        for task in self.tasks:
+            if not task.done and task.parked is None and task.until is None:
+                return None         # a task runs (the common case: tested first)
         if not spin.allowed() or spin.shadowed or spin.rec is not None or idle.since is not None \
                 or (idle.auto is not None and idle.auto.recording is not None) or not idle._quiet():
             return None
@@ -230,10 +242,10 @@ class Scheduler:
             return None             # an input set on reaching a point: at any step
         if any(k[0] == "analog output" for k in rt._cyclic):
             return None             # an output written at any step
-        return (ctl.io.version, rt.cyclic_watch.version, rt.steps - spin.skipped, ctl.next_event_cycle())
+        return (ctl.io.version, rt.cyclic_watch.version, rt.steps - spin.skipped, ctl.next_event_cycle(), moving)
 
-    def _steady_cycle(self) -> None:
-        """Count a steady cycle as the tasks, the spin watch and the idle watch would."""
+    def _steady_cycle(self, moving: bool = True) -> None:
+        """Count a steady cycle as the tasks, the spin watch and (`moving`) the idle watch would."""
         rt = self.rt
         spin = self.spin
         self.steady += 1
@@ -250,7 +262,8 @@ class Scheduler:
                 p.done += task.budget
                 spin.skipped += task.budget
                 spin._place(task)
-        self.idle.moved()
+        if moving:
+            self.idle.moved()
 
     def run(self) -> None:
         rt = self.rt
@@ -258,7 +271,8 @@ class Scheduler:
         robot = self.tasks[0]
         spin = self.spin
         while True:
-            if self._steady():
+            steady = self._steady()
+            if steady == 1:
                 self._steady_cycle()
                 for ev in ctl.step():
                     k = ev.kind
@@ -267,15 +281,18 @@ class Scheduler:
                     elif k == "error":
                         robot.pending_error = ev.error
                 continue
-            for task in list(self.tasks):
-                if not task.done and self.stop is None:
-                    if spin.resuming(task):
-                        continue            # parked: this cycle counted, not run
-                    if task.until is not None and self._waits(task):
-                        continue            # waits on: its resume would only test that
-                    self._resume(task)
-                    if task.done and task is not robot:
-                        rt.submit_finished(task)
+            if steady == 2:
+                self._steady_cycle(False)   # the robot stands: the rest of the cycle as always
+            else:
+                for task in list(self.tasks):
+                    if not task.done and self.stop is None:
+                        if spin.resuming(task):
+                            continue            # parked: this cycle counted, not run
+                        if task.until is not None and self._waits(task):
+                            continue            # waits on: its resume would only test that
+                        self._resume(task)
+                        if task.done and task is not robot:
+                            rt.submit_finished(task)
             if spin.shadowed:
                 spin.check_shadows()
             if robot.done or self.stop is not None:
