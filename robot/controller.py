@@ -758,6 +758,33 @@ class Controller:
             out[f"E{i + 1}"] = float(v)
         return out
 
+    @property
+    def _tcp_T(self) -> np.ndarray:
+        """The TCP read back this cycle (4x4, in $BASE; :meth:`step` may leave it to be made
+        here, when first asked for)."""
+        T = self._tcp_m
+        if T is None:
+            T = self._tcp_m = self._tcp_read_back(*self._tcp_src)
+            self._tcp_src = None
+        return T
+
+    @_tcp_T.setter
+    def _tcp_T(self, T: np.ndarray) -> None:
+        self._tcp_m, self._tcp_src = T, None
+
+    @property
+    def _tcp_prev(self) -> np.ndarray:
+        """The TCP's position (mm) read back the cycle before (:attr:`_tcp_T`'s)."""
+        p = self._tcp_pp
+        if p is None:
+            p = self._tcp_pp = self._tcp_read_back(*self._tcp_psrc)[:3, 3].copy()
+            self._tcp_psrc = None
+        return p
+
+    @_tcp_prev.setter
+    def _tcp_prev(self, p: np.ndarray) -> None:
+        self._tcp_pp, self._tcp_psrc = p, None
+
     def _tcp_read_back(self, q: np.ndarray, tool_T: np.ndarray, base_inv_T: np.ndarray) -> np.ndarray:
         """TCP in $BASE from the MuJoCo flange site (``INV_POS($BASE) : FLANGE_world : $TOOL``),
         or from the forward kinematics of ``q`` without MuJoCo."""
@@ -897,8 +924,17 @@ class Controller:
                 else:
                     arm.set_axes(self._q)
             qa = self._axes_act()
-            self._tcp_prev = self._tcp_T[:3, 3].copy()
-            self._tcp_T = self._tcp_read_back(qa, self._tool_T, self._base_inv_T)
+            if arm is None:
+                # without MuJoCo the read-back is the forward kinematics of these arrays alone:
+                # made when first asked for ($POS_ACT, $VEL_ACT, the trace's pose), the same numbers
+                if self._tcp_m is not None:
+                    self._tcp_pp, self._tcp_psrc = self._tcp_m[:3, 3].copy(), None
+                else:
+                    self._tcp_pp, self._tcp_psrc = None, self._tcp_src
+                self._tcp_m, self._tcp_src = None, (qa, self._tool_T, self._base_inv_T)
+            else:
+                self._tcp_prev = self._tcp_T[:3, 3].copy()
+                self._tcp_T = self._tcp_read_back(qa, self._tool_T, self._base_inv_T)
         if self._cyclic:
             for fn in list(self._cyclic.values()):
                 fn(self)
