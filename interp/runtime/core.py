@@ -1144,6 +1144,7 @@ class Runtime:
             if memo:
                 seen[0] = watch.key()
         self._cyclic[key] = self.controller.add_cyclic(tick)
+        watch.anin = any(k[0] == "analog input" for k in self._cyclic)
 
     def _cyclic_settles(self) -> bool:
         """The cyclic flag the running statement switches on has an expression that
@@ -1159,6 +1160,7 @@ class Runtime:
         h = self._cyclic.pop(key, None)
         if h is not None:
             self.controller.remove_cyclic(h)
+            self.cyclic_watch.anin = any(k[0] == "analog input" for k in self._cyclic)
 
     def stub_statement(self, what: str) -> None:
         """A statement of §5.20 that is recognised and not simulated (CONFIRM, ASYPTP,

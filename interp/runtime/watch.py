@@ -285,11 +285,12 @@ class CyclicWatch:
     (:attr:`version`, which the cyclic flags count): :meth:`key` is the same, and the evaluation
     is left out. Not while an ``ANIN ON`` writes a variable at every cycle."""
 
-    __slots__ = ("rt", "version")
+    __slots__ = ("rt", "version", "anin")
 
     def __init__(self, rt) -> None:
         self.rt = rt
         self.version = 0
+        self.anin = False       # an ANIN ON is on (interp/runtime/core.py cyclic_on/cyclic_off)
 
     def written(self):
         """What may have written a variable since: ``(steps executed, cyclic flag changes and
@@ -299,8 +300,7 @@ class CyclicWatch:
         (interp/runtime/core.py ``Runtime.changed_outside``, which moves :attr:`version`; net/hub.py
         "sink")."""
         rt = self.rt
-        if rt.stmt_hook is not None or rt.step_hook is not None or rt.cycle_hook is not None \
-                or any(k[0] == "analog input" for k in rt._cyclic):
+        if rt.stmt_hook is not None or rt.step_hook is not None or rt.cycle_hook is not None or self.anin:
             return None
         return (rt.steps - rt.spin.skipped, self.version)
 
