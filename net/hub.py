@@ -113,7 +113,8 @@ class Network:
         self.listen_hook = None     # listen_hook(key, (host, port)) when a server starts (krl run says where)
         self.closed = False
         # the controller calls cycle() only while this is True: partners configured, a replay,
-        # or RSI on; a run without any costs one attribute test per IPO cycle
+        # or RSI on; a run without any costs one attribute test per IPO cycle. False: no partner
+        # is attached (attach starts partners only with settings) or ticks (RSI on sets it)
         self.polling = settings is not None
         if settings is not None and settings.replay is not None:
             self.replay_events = load_replay(settings.replay)
@@ -152,6 +153,8 @@ class Network:
     def may_change(self) -> bool:
         """True when something outside the program can still change its inputs (for the
         deadlock test of WAIT FOR): a partner attached, or a replay not yet over."""
+        if not self.polling:
+            return False            # no partner configured, no replay, no RSI on (:attr:`polling`)
         if self.attached:
             return True
         if self.replay and self.ctl is not None:
@@ -164,6 +167,8 @@ class Network:
         partner is attached (it runs on the wall clock) or ticks (an RSI object on: each cycle
         has its exchange, or its late packet), the next recorded cycle of a replay, None when
         nothing can arrive."""
+        if not self.polling:
+            return None             # no partner configured, no replay, no RSI on (:attr:`polling`)
         if self.attached or any(p.ticking() for p in self.partners.values()):
             return k + 1
         later = [c for c in self.replay if c > k] if self.replay else []
