@@ -269,6 +269,7 @@ class IdleWatch:
         self._phases: dict = {}      # phase of the tasks (:meth:`_phase`) -> cycle, while idle in one state
         self.shifted = 0             # cycles of the periodic jumps (each task's WAIT SEC moved with the clock)
         self._imaged = None          # _state_key() when the state was imaged last
+        self._last = None            # (cycle, clock reads) at the end of the last cycle() call
         self._const = None           # images of the data lists no statement writes (_constant)
 
     def clock_read(self) -> None:
@@ -342,14 +343,27 @@ class IdleWatch:
         self._phases = {}
         self.window = WINDOW_CYCLES
 
-    def cycle(self) -> int:
+    def cycle(self, still: bool = False) -> int:
         """One IPO cycle ended (the tasks ran): check, and fast-forward when the run is idle;
         with the automatic cell, also answer a robot program that starves while a submit
         program keeps changing its own state (:meth:`robot_starves`). Returns the cycles
-        skipped."""
+        skipped.
+
+        `still`: a steady cycle of a robot that stands (interp/runtime/scheduler.py): no
+        statement ran, no I/O, cyclic flag or wait changed since the last cycle. When the last
+        call was the cycle before and no clock was read since, the marks are the ones it left,
+        so while both windows (this one and :meth:`robot_starves`'s) are still counting this
+        cycle would only count too: it returns at once."""
+        ctl = self.rt.controller
+        if still and self._last == (ctl.cycle - 1, self.clock) and self.start is not None \
+                and self.since is None and ctl.cycle - self.start < self.window \
+                and (self.auto is None or (self._robot is not None and ctl.cycle - self._robot[0] < WINDOW_CYCLES)):
+            self._last = (ctl.cycle, self.clock)
+            return 0
         n = self._cycle()
         if n == 0 and self.auto is not None and self.since is None:
             self.robot_starves()
+        self._last = (ctl.cycle, self.clock)
         return n
 
     def moved(self) -> None:

@@ -305,7 +305,7 @@ class Scheduler:
                 if auto is None or (not auto.pending() and auto.answer(self.idle) != "answered"):
                     self.stop = ("deadlock", f"deadlocked {robot.waiting}", robot)
                     break
-            self.idle.cycle()
+            self.idle.cycle(steady == 2)
             if spin.parked or spin.shadowed:
                 spin.before_step()
             events = ctl.step()
