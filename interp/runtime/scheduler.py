@@ -34,8 +34,12 @@ I/O image, the cyclic flags and the statements executed unchanged since the firs
 the controller's next event not due, the run not idle: then each cycle's tasks, idle watch and
 spin watch would only count it. :meth:`Scheduler._steady` knows that from a few tests, and
 :meth:`Scheduler._steady_cycle` counts it as they would (the parked tasks' steps and positions,
-the state epoch, the idle watch's windows: ``IdleWatch.moved``); the controller steps as
-always. A cycle that fails a test is an ordinary one.
+the state epoch, a waiting task's clock reads, the idle watch's windows: ``IdleWatch.moved``);
+the controller steps as always. While the robot stands the same holds for the tasks (issue 48,
+session 2), and the rest of the cycle — the deadlock test, the idle watch (whose windows make the
+automatic cell's answers; ``IdleWatch.cycle(still=True)`` returns at once while they only
+count), the controller's step — runs as in any cycle; the controller's next event is looked up
+each such cycle (an answer schedules one). A cycle that fails a test is an ordinary one.
 """
 
 from __future__ import annotations
