@@ -389,6 +389,7 @@ class Channel:
         self.locked = False
         held, self.held = self.held, []
         for msg in held:
+            self.hub.sink.changed_outside()
             self.hub.eki_apply(self, self.message(msg))
         return self.status()
 
@@ -614,6 +615,7 @@ class EkiPartner(Partner):
             ch.async_error(number, str(msg))
             return
         self.trace("eki", "in", name=ch.name, data=msg.decode("latin-1"))
+        self.sink.changed_outside()     # the channel's memory changes: EKI_CheckBuffer, EKI_Get*
         self.eki_apply(ch, ch.message(msg))
 
     # ------------------------------------------------------------------ the EKI functions

@@ -17,7 +17,10 @@ The simulated controller calls :meth:`Network.cycle` at the start of every IPO c
 The runtime talks to the partners through its EKI/RSI built-ins
 (interp/runtime/natives/eki.py, rsi.py: ``hub.partner("eki")``, ``hub.partner("rsi")``) and gives
 the hub a *sink*: ``set_flag(n, v)``, ``set_out(n, v)``, ``read_var(name) -> text``,
-``write_var(name, text) -> text`` (interp/runtime/netvars.py).
+``write_var(name, text) -> text`` (interp/runtime/netvars.py), and ``changed_outside()``, which
+a partner calls at the moment it writes into the run otherwise (a message into an EKI channel's
+memory, a PLC's input, an RSI answer; the sink's own writes call it themselves): the runtime's
+watch keys move and parked spins catch up (interp/runtime/core.py ``Runtime.changed_outside``).
 """
 
 from __future__ import annotations
@@ -69,6 +72,9 @@ class NullSink:
         self.flags: dict[int, bool] = {}
         self.outs: dict[int, bool] = {}
 
+    def changed_outside(self) -> None:
+        """A partner is about to write (no run to tell)."""
+
     def set_flag(self, n: int, v: bool) -> None:
         self.flags[n] = v
 
@@ -107,7 +113,8 @@ class Network:
         self.listen_hook = None     # listen_hook(key, (host, port)) when a server starts (krl run says where)
         self.closed = False
         # the controller calls cycle() only while this is True: partners configured, a replay,
-        # or RSI on; a run without any costs one attribute test per IPO cycle
+        # or RSI on; a run without any costs one attribute test per IPO cycle. False: no partner
+        # is attached (attach starts partners only with settings) or ticks (RSI on sets it)
         self.polling = settings is not None
         if settings is not None and settings.replay is not None:
             self.replay_events = load_replay(settings.replay)
@@ -146,6 +153,8 @@ class Network:
     def may_change(self) -> bool:
         """True when something outside the program can still change its inputs (for the
         deadlock test of WAIT FOR): a partner attached, or a replay not yet over."""
+        if not self.polling:
+            return False            # no partner configured, no replay, no RSI on (:attr:`polling`)
         if self.attached:
             return True
         if self.replay and self.ctl is not None:
@@ -158,6 +167,8 @@ class Network:
         partner is attached (it runs on the wall clock) or ticks (an RSI object on: each cycle
         has its exchange, or its late packet), the next recorded cycle of a replay, None when
         nothing can arrive."""
+        if not self.polling:
+            return None             # no partner configured, no replay, no RSI on (:attr:`polling`)
         if self.attached or any(p.ticking() for p in self.partners.values()):
             return k + 1
         later = [c for c in self.replay if c > k] if self.replay else []

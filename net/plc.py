@@ -333,6 +333,7 @@ class Plc:
 
 
 def apply_write(hub, signal: str, value) -> None:
+    hub.sink.changed_outside()
     io = hub.ctl.io
     io.now = hub.ctl.time
     n = int(signal[signal.index("[") + 1:-1])

@@ -495,6 +495,7 @@ class Rsi:
             self.hub.trace("rsi", "error", text=f"an answer with IPOC {ipoc} that no packet was sent with")
             return
         self.silent = False                     # the sensor answers: waited for again
+        self.hub.sink.changed_outside()         # the outputs the program reads (RSI_GETPUBLICPAR, ...)
         # a late answer (its packet already counted late) still carries the sensor's newest values
         for el in self.ctx.ethernet.receive:
             if el.internal:

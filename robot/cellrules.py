@@ -266,10 +266,13 @@ class Rule:
         return bool(self.condition(io)) if self.condition is not None else False
 
 
-def step_rules(rules: list[Rule], io: IOImage, t: float, dt: float) -> None:
+def step_rules(rules: list[Rule], io: IOImage, t: float, dt: float, seen=None):
     """One IPO cycle of the cell (Controller.step, after the timed stimuli): first every answer
     that is due at `t` is written, then every condition is evaluated; a rising edge schedules
-    the rule's values for ``max(t + after, t + dt)`` (s)."""
+    the rule's values for ``max(t + after, t + dt)`` (s). A condition reads only the I/O image:
+    `seen`, what the last call returned (the image's version and the number of rules then),
+    equal to that now means no condition can have changed, and none is evaluated. Returns the
+    value to pass as `seen` next time."""
     eps = 1e-9
     for r in rules:
         while r.due and t >= r.due[0] - eps:
@@ -280,11 +283,15 @@ def step_rules(rules: list[Rule], io: IOImage, t: float, dt: float) -> None:
                 io.set_signal(name, v, r.source)
             if r.on_fire is not None:
                 r.on_fire(r, t)
+    key = (io.version, len(rules))
+    if key == seen:
+        return key
     for r in rules:
         now = r.holds(io)
         if now and not r.last:
             r.due.append(t + max(r.after, dt))
         r.last = now
+    return key
 
 
 def rules_may_fire(rules: list[Rule], io: IOImage) -> bool:

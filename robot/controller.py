@@ -220,6 +220,7 @@ class Controller:
                  mujoco: bool = True, mode_op: str | None = None) -> None:
         self.machine = machine if machine is not None else load_machine()
         self.rules: list[Rule] = []
+        self._rules_seen = None         # what the rules' conditions last saw (cellrules.step_rules)
         self.pgno: int | None = None      # the cell file's pgno preset (interp/run.py builds its rules)
         self.start: str | None = None     # the cell file's start: position (interp/run.py places the robot)
         self.cell_network = None          # the cell file's `network:` settings (interp/run.py attaches them)
@@ -757,6 +758,33 @@ class Controller:
             out[f"E{i + 1}"] = float(v)
         return out
 
+    @property
+    def _tcp_T(self) -> np.ndarray:
+        """The TCP read back this cycle (4x4, in $BASE; :meth:`step` may leave it to be made
+        here, when first asked for)."""
+        T = self._tcp_m
+        if T is None:
+            T = self._tcp_m = self._tcp_read_back(*self._tcp_src)
+            self._tcp_src = None
+        return T
+
+    @_tcp_T.setter
+    def _tcp_T(self, T: np.ndarray) -> None:
+        self._tcp_m, self._tcp_src = T, None
+
+    @property
+    def _tcp_prev(self) -> np.ndarray:
+        """The TCP's position (mm) read back the cycle before (:attr:`_tcp_T`'s)."""
+        p = self._tcp_pp
+        if p is None:
+            p = self._tcp_pp = self._tcp_read_back(*self._tcp_psrc)[:3, 3].copy()
+            self._tcp_psrc = None
+        return p
+
+    @_tcp_prev.setter
+    def _tcp_prev(self, p: np.ndarray) -> None:
+        self._tcp_pp, self._tcp_psrc = p, None
+
     def _tcp_read_back(self, q: np.ndarray, tool_T: np.ndarray, base_inv_T: np.ndarray) -> np.ndarray:
         """TCP in $BASE from the MuJoCo flange site (``INV_POS($BASE) : FLANGE_world : $TOOL``),
         or from the forward kinematics of ``q`` without MuJoCo."""
@@ -841,7 +869,7 @@ class Controller:
         if self.stimuli:
             self._apply_stimuli(t)
         if self.rules:
-            step_rules(self.rules, self.io, t, self.dt)
+            self._rules_seen = step_rules(self.rules, self.io, t, self.dt, self._rules_seen)
 
         # path time (BRAKE ramps scale the path speed)
         s_old = self._scale
@@ -896,8 +924,17 @@ class Controller:
                 else:
                     arm.set_axes(self._q)
             qa = self._axes_act()
-            self._tcp_prev = self._tcp_T[:3, 3].copy()
-            self._tcp_T = self._tcp_read_back(qa, self._tool_T, self._base_inv_T)
+            if arm is None:
+                # without MuJoCo the read-back is the forward kinematics of these arrays alone:
+                # made when first asked for ($POS_ACT, $VEL_ACT, the trace's pose), the same numbers
+                if self._tcp_m is not None:
+                    self._tcp_pp, self._tcp_psrc = self._tcp_m[:3, 3].copy(), None
+                else:
+                    self._tcp_pp, self._tcp_psrc = None, self._tcp_src
+                self._tcp_m, self._tcp_src = None, (qa, self._tool_T, self._base_inv_T)
+            else:
+                self._tcp_prev = self._tcp_T[:3, 3].copy()
+                self._tcp_T = self._tcp_read_back(qa, self._tool_T, self._base_inv_T)
         if self._cyclic:
             for fn in list(self._cyclic.values()):
                 fn(self)

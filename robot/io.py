@@ -149,9 +149,13 @@ class IOImage:
         tm, st = self.timer_ms, self.timer_stop
         if False not in st:         # every timer stopped (the common case): nothing to count
             return
-        for i in range(1, N_TIMERS + 1):
-            if not st[i]:
-                tm[i] += dt_ms
+        i = st.index(False, 1)
+        while True:                 # the running ones only (index() runs in C)
+            tm[i] += dt_ms
+            try:
+                i = st.index(False, i + 1)
+            except ValueError:
+                return
 
     def get_timer(self, n: int) -> int:
         """``$TIMER[n]`` in ms."""

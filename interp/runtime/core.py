@@ -22,7 +22,8 @@ from robot.motion import MotionRequest, Trigger
 
 from .natives import RSI_CONSTANTS, ValueRef
 from .contexts import Context, Irq
-from .watch import CONSTANT, IO, SETTLES, CyclicWatch, settles, split_watch, stamp_key, steady, watch_of
+from .watch import (CONSTANT, IO, SETTLES, CyclicWatch, settles, split_watch, stamp_key, steady, timer_due,
+                    timer_reads, timer_watch, watch_of)
 from .convert import (
     INT_MAX, INT_MIN, assign_into, binary_op, convert_scalar, num, to_bool, trunc_int, unary_op,
 )
@@ -332,6 +333,7 @@ class Runtime:
         spin = getattr(self, "spin", None)
         if spin is not None:
             spin.outside_change()
+            self.scheduler.idle.outside_change()
 
     def interpreter_active(self, robot: bool) -> bool:
         if robot:
@@ -542,39 +544,61 @@ class Runtime:
         task.waiting = f"{text} at {task.file}:{task.line}" if task.kind == "robot" else None
         # a condition over inputs and variables (interp/runtime/watch.py) gives the same value
         # while its watch key stands: the scheduler tests the key instead of resuming the task
-        key = self._wait_key(task) if text == "WAIT FOR" else None
-        outer = task.until
+        # (and one that compares running timers with numbers, until a timer reaches its bound:
+        # watch.timer_watch; the scheduler then makes the condition's clock reads itself)
+        key, tests = self._wait_key(task) if text == "WAIT FOR" else (None, ())
+        outer, reads = task.until, task.clock_reads
+        ctl = self.controller
         try:
             while True:
                 if key is not None:
                     seen = key()
-                    task.until = None if seen is None else (lambda seen=seen: key() != seen)
+                    if seen is None:
+                        task.until = None
+                    elif not tests:
+                        task.until = lambda seen=seen: key() != seen
+                    else:
+                        due = timer_due(tests, ctl.io, ctl.cycle, ctl._dt_ms)
+                        task.clock_reads = timer_reads(tests, ctl.io)
+                        task.until = (lambda seen=seen: key() != seen) if due is None else \
+                            (lambda seen=seen, due=due: ctl.cycle >= due or key() != seen)
                 self.yield_cycle(task)
                 if to_bool(cond_fn(), "WAIT FOR condition"):
                     self._proceed()
                     return
         finally:
             task.waiting = None
-            task.until = outer
+            task.until, task.clock_reads = outer, reads
 
     def _wait_key(self, task: Task):
-        """The watch key (interp/runtime/watch.py ``stamp_key``) of the condition of the WAIT FOR
-        `task` stands at, as a zero-argument callable; None when its class has none that stands
-        (it reads the clock, calls a routine, ...)."""
+        """``(key, tests)``: the watch key (interp/runtime/watch.py ``stamp_key``) of the condition
+        of the WAIT FOR `task` stands at, as a zero-argument callable, and the comparisons of
+        running timers with numbers in it (``watch.timer_watch``: the key is the rest's, and the
+        condition stands until a timer reaches its bound, ``watch.timer_due``); ``(None, ())``
+        when its class has no key that stands (it reads the clock otherwise, calls a routine, ...)."""
         node = next((n for n in self.spin.statements(task.at) or () if isinstance(n, N.WaitFor)), None)
         if node is None:
-            return None
+            return None, ()
         ann = node.annotate()
         w = ann.extra.get("watch")
         if w is None:
             w = ann.extra["watch"] = watch_of(node.cond)
         cls, names = split_watch(w)
+        tests = ()
         if cls not in (CONSTANT, IO, SETTLES):
-            return None
+            tw = ann.extra.get("timer_watch", False)
+            if tw is False:
+                tw = ann.extra["timer_watch"] = timer_watch(node.cond)
+            if tw is None:
+                return None, ()
+            w, tests = tw
+            cls, names = split_watch(w)
+            if cls not in (CONSTANT, IO, SETTLES):
+                return None, ()
         probes = tuple(_reader(self.sysvars.lookup(k)) for k in names)
         ctl = self.controller
         written = self.cyclic_watch.written
-        return lambda: stamp_key(cls, ctl.io.version, ctl.time, probes, written())
+        return (lambda: stamp_key(cls, ctl.io.version, ctl.time, probes, written())), tests
 
     def wait_sec(self, seconds) -> None:
         """WAIT SEC t: t seconds of simulated time (rounded up to IPO cycles)."""
@@ -1119,6 +1143,7 @@ class Runtime:
             if memo:
                 seen[0] = watch.key()
         self._cyclic[key] = self.controller.add_cyclic(tick)
+        watch.anin = any(k[0] == "analog input" for k in self._cyclic)
 
     def _cyclic_settles(self) -> bool:
         """The cyclic flag the running statement switches on has an expression that
@@ -1134,6 +1159,7 @@ class Runtime:
         h = self._cyclic.pop(key, None)
         if h is not None:
             self.controller.remove_cyclic(h)
+            self.cyclic_watch.anin = any(k[0] == "analog input" for k in self._cyclic)
 
     def stub_statement(self, what: str) -> None:
         """A statement of §5.20 that is recognised and not simulated (CONFIRM, ASYPTP,

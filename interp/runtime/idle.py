@@ -57,6 +57,7 @@ from __future__ import annotations
 
 import math
 
+from krl.ast import nodes as N
 from krl.semantics import types as T
 
 from .values import LEAVES, UNSET, Arr, EnumValue, Struct
@@ -174,12 +175,53 @@ def frames_of(rt, task) -> tuple:
     return img if img is not None else tuple([_store(f.store) for f in _frames(task)])
 
 
-def state_of(rt) -> tuple:
+def _root_name(e):
+    while isinstance(e, (N.Index, N.Field)):
+        e = e.base
+    return e if isinstance(e, N.Name) else None
+
+
+def written_modules(rt) -> frozenset:
+    """The data lists (module indices, ``Storage.owner``) a statement of the program may write:
+    those an assignment, a FOR, an ``ANIN ON`` or a WITH names as target, or a call takes as an
+    argument (an :OUT parameter may write it; an :IN one is counted too). No other writer
+    changes a data list of a run (the controller writes the I/O image, the cyclic flags, the
+    system variables). A data list outside this set keeps its loaded values: its image is made
+    once (:class:`IdleWatch` keeps it)."""
+    out = set()
+    for unit in rt.program.ws.units:
+        src = unit.src
+        if src is None or src.module is None:
+            continue
+        for node in src.module.walk():
+            c = node.__class__
+            if c is N.Assign or c is N.AninOn or c is N.WithAssign:
+                names = (_root_name(node.target),)
+            elif c is N.For:
+                names = (_root_name(node.var),)
+            elif c is N.Call:
+                names = tuple(_root_name(a) for a in node.args)
+            else:
+                continue
+            for name in names:
+                place = getattr(name.ann, "place", None) if name is not None and name.ann is not None else None
+                if place is not None and place.owner >= 0:
+                    out.add(place.owner)
+                elif name is not None and place is None:
+                    return frozenset(m.index for m in rt.program.modules)   # a name not placed: any
+    return frozenset(out)
+
+
+def state_of(rt, constant: dict | None = None) -> tuple:
     """The state of the run `rt` that its future depends on, besides the positions of its
     tasks in their loops (see the module docstring): data lists, frames, system variables,
-    I/O image, interrupt tables, contexts and waits."""
+    I/O image, interrupt tables, contexts and waits. `constant`: module index -> the image of a
+    data list no statement writes (:func:`written_modules`), made once and used again."""
     prog = rt.program
-    mods = tuple([_store(m.store) for m in prog.modules if m.loaded])
+    if constant is None:
+        mods = tuple([_store(m.store) for m in prog.modules if m.loaded])
+    else:
+        mods = tuple([constant.get(m.index) or _store(m.store) for m in prog.modules if m.loaded])
     tasks = []
     for t in rt.scheduler.tasks:
         frames = frames_of(rt, t)
@@ -227,6 +269,8 @@ class IdleWatch:
         self._phases: dict = {}      # phase of the tasks (:meth:`_phase`) -> cycle, while idle in one state
         self.shifted = 0             # cycles of the periodic jumps (each task's WAIT SEC moved with the clock)
         self._imaged = None          # _state_key() when the state was imaged last
+        self._last = None            # (cycle, clock reads) at the end of the last cycle() call
+        self._const = None           # images of the data lists no statement writes (_constant)
 
     def clock_read(self) -> None:
         """A task read the clock or a random number: its next statements may differ without
@@ -240,16 +284,33 @@ class IdleWatch:
         ctl = self.rt.controller
         return (len(ctl.io.log), self.clock, ctl._plan_q.tolist(), ctl._q.tolist())
 
+    def outside_change(self) -> None:
+        """Something outside the tasks changed the run's state (interp/runtime/core.py
+        ``Runtime.changed_outside``: an operator's edit, a network partner's write): it may
+        have written a data list no statement writes, so its image is made again."""
+        self._const = None
+        self._imaged = None
+
+    def _constant(self) -> dict:
+        """The images of the data lists no statement of the program writes (module index ->
+        image; :func:`written_modules`), made at the first state image of the run."""
+        c = self._const
+        if c is None:
+            written = written_modules(self.rt)
+            c = self._const = {m.index: _store(m.store) for m in self.rt.program.modules
+                               if m.loaded and m.index not in written}
+        return c
+
     def _state_key(self):
         """What :func:`state_of` images can change by: the statements executed and the cyclic
         flags' changes (interp/runtime/watch.py ``CyclicWatch.written``), the I/O image's
         version, the message handle, the tasks' waits, contexts and interrupt tables, the step a
         parked spin stands at (interp/runtime/spin.py). Equal keys: the same state. None: image
-        it (a debugger or an ``ANIN ON`` may write, a network partner is attached)."""
+        it (a debugger or an ``ANIN ON`` may write; a network partner's write moves the key:
+        ``Runtime.changed_outside``)."""
         rt = self.rt
         written = rt.cyclic_watch.written()
-        net = getattr(rt.controller, "network", None)
-        if written is None or (net is not None and net.polling):
+        if written is None:
             return None
         tasks = []
         for t in rt.scheduler.tasks:
@@ -282,14 +343,27 @@ class IdleWatch:
         self._phases = {}
         self.window = WINDOW_CYCLES
 
-    def cycle(self) -> int:
+    def cycle(self, still: bool = False) -> int:
         """One IPO cycle ended (the tasks ran): check, and fast-forward when the run is idle;
         with the automatic cell, also answer a robot program that starves while a submit
         program keeps changing its own state (:meth:`robot_starves`). Returns the cycles
-        skipped."""
+        skipped.
+
+        `still`: a steady cycle of a robot that stands (interp/runtime/scheduler.py): no
+        statement ran, no I/O, cyclic flag or wait changed since the last cycle. When the last
+        call was the cycle before and no clock was read since, the marks are the ones it left,
+        so while both windows (this one and :meth:`robot_starves`'s) are still counting this
+        cycle would only count too: it returns at once."""
+        ctl = self.rt.controller
+        if still and self._last == (ctl.cycle - 1, self.clock) and self.start is not None \
+                and self.since is None and ctl.cycle - self.start < self.window \
+                and (self.auto is None or (self._robot is not None and ctl.cycle - self._robot[0] < WINDOW_CYCLES)):
+            self._last = (ctl.cycle, self.clock)
+            return 0
         n = self._cycle()
         if n == 0 and self.auto is not None and self.since is None:
             self.robot_starves()
+        self._last = (ctl.cycle, self.clock)
         return n
 
     def moved(self) -> None:
@@ -360,7 +434,7 @@ class IdleWatch:
         # the state is imaged again only when something may have changed it since the last
         # image (:meth:`_state_key`); else it is that image
         key = self._state_key()
-        state = self.state if key is not None and key == self._imaged else state_of(rt)
+        state = self.state if key is not None and key == self._imaged else state_of(rt, self._constant())
         self._imaged = key
         if self.state is None or state != self.state:
             if self.state is not None:

@@ -125,14 +125,23 @@ _PATH = re.compile(r"\s*(\$?[A-Za-z_][\w$]*)")
 
 
 class RuntimeSink:
-    """The sink of the network hub for runtime `rt`."""
+    """The sink of the network hub for runtime `rt`. Every write of a partner into the run is
+    announced first (:meth:`changed_outside`, interp/runtime/core.py ``Runtime.changed_outside``):
+    a parked spin catches up over the state it saw, and every watch key moves."""
 
     def __init__(self, rt) -> None:
         self.rt = rt
 
+    def changed_outside(self) -> None:
+        """A partner is about to write into the run (a flag, a variable, an input, a message in
+        an EKI channel's memory, an RSI answer): net/partner.py, docs/network.md."""
+        self.rt.changed_outside()
+
     def set_flag(self, n: int, v: bool) -> None:
         flags = self.rt.sysvars.store.get("$FLAG")
         if isinstance(flags, Arr) and 1 <= n <= len(flags.data):
+            if flags.data[n - 1] != bool(v):
+                self.rt.changed_outside()
             flags.data[n - 1] = bool(v)
 
     def set_out(self, n: int, v: bool) -> None:
@@ -192,6 +201,7 @@ class RuntimeSink:
         v = parse_value(text)
         if isinstance(v, dict):
             v = Struct(None, v)
+        self.rt.changed_outside()
         cur = ref.peek()
         if is_char_array(cur) and isinstance(v, str):
             data = cur.data

@@ -34,8 +34,12 @@ I/O image, the cyclic flags and the statements executed unchanged since the firs
 the controller's next event not due, the run not idle: then each cycle's tasks, idle watch and
 spin watch would only count it. :meth:`Scheduler._steady` knows that from a few tests, and
 :meth:`Scheduler._steady_cycle` counts it as they would (the parked tasks' steps and positions,
-the state epoch, the idle watch's windows: ``IdleWatch.moved``); the controller steps as
-always. A cycle that fails a test is an ordinary one.
+the state epoch, a waiting task's clock reads, the idle watch's windows: ``IdleWatch.moved``);
+the controller steps as always. While the robot stands the same holds for the tasks (issue 48,
+session 2), and the rest of the cycle — the deadlock test, the idle watch (whose windows make the
+automatic cell's answers; ``IdleWatch.cycle(still=True)`` returns at once while they only
+count), the controller's step — runs as in any cycle; the controller's next event is looked up
+each such cycle (an answer schedules one). A cycle that fails a test is an ordinary one.
 """
 
 from __future__ import annotations
@@ -95,6 +99,7 @@ class Task:
         self.parked = None
         self.shadow = None
         self.until = None               # the test that ends its wait (Runtime._wait), while it waits
+        self.clock_reads = 0            # clock reads an evaluation of that wait makes (running timers)
 
     @property
     def file(self) -> str | None:
@@ -165,49 +170,63 @@ class Scheduler:
             ctl = rt.controller
             if task.irqs.poll(ctl.io.version, ctl.time, rt.state_epoch, rt.cyclic_watch.written()):
                 return False            # an interrupt to run: resumed, its poll finds it pending
+        if task.clock_reads:
+            self.idle.clock += task.clock_reads     # the condition's reads of running timers
         return True
 
-    def _steady(self) -> bool:
-        """This cycle is a steady one (module docstring)."""
+    def _steady(self) -> int:
+        """This cycle is a steady one (module docstring): 1 while the robot moves, 2 while it
+        stands (the idle watch then makes its own cycle, :meth:`run`); 0 when it is not."""
         rt = self.rt
         ctl = rt.controller
         q, q0 = ctl._q, ctl._q_prev
-        if q is q0 or (q == q0).all():
-            self._calm = None               # the robot did not move
-            return False
+        moving = not (q is q0 or (q == q0).all())
         calm = self._calm
+        if calm is not None and calm[4] != moving:
+            calm = None
         if calm is None:
-            calm = self._calm = self._calm_now()
+            calm = self._calm = self._calm_now(moving)
             if calm is None:
-                return False
-        io, cyc, executed, nxt = calm
+                return 0
+        io, cyc, executed, nxt, _m = calm
+        if not moving:
+            # the idle watch's cycle runs in a still one: an answer of the automatic cell may
+            # have scheduled an input, a window be watched or the run be idle since
+            idle = self.idle
+            if idle.since is not None or (idle.auto is not None and idle.auto.recording is not None):
+                self._calm = None
+                return 0
+            nxt = ctl.next_event_cycle()
         if ctl.io.version != io or rt.cyclic_watch.version != cyc or rt.steps - self.spin.skipped != executed \
                 or (nxt is not None and ctl.cycle + 1 >= nxt) \
                 or (self.max_sim_time is not None and ctl.time >= self.max_sim_time - 1e-9):
             self._calm = None
-            return False
+            return 0
         for task in self.tasks:
             if task.done:
                 continue
             if task.pending_triggers or task.pending_error is not None:
                 self._calm = None
-                return False
+                return 0
             if task.parked is not None:
                 if rt.max_steps is not None and \
                         rt.steps + 2 * (task.budget + task.parked.spin.steps) > rt.max_steps:
                     self._calm = None
-                    return False
+                    return 0
             elif task.until():
                 self._calm = None
-                return False
-        return True
+                return 0
+        return 1 if moving else 2
 
-    def _calm_now(self):
+    def _calm_now(self, moving: bool):
         """The first of a run of steady cycles: the tests that hold for the whole run of them,
         and what the later cycles compare with; None when this is not one."""
         rt = self.rt
         ctl = rt.controller
         spin, idle = self.spin, self.idle
+        for task in self.tasks:
+            if not task.done and task.parked is None and task.until is None:
+                return None         # a task runs (the common case: tested first)
         if not spin.allowed() or spin.shadowed or spin.rec is not None or idle.since is not None \
                 or (idle.auto is not None and idle.auto.recording is not None) or not idle._quiet():
             return None
@@ -227,10 +246,10 @@ class Scheduler:
             return None             # an input set on reaching a point: at any step
         if any(k[0] == "analog output" for k in rt._cyclic):
             return None             # an output written at any step
-        return (ctl.io.version, rt.cyclic_watch.version, rt.steps - spin.skipped, ctl.next_event_cycle())
+        return (ctl.io.version, rt.cyclic_watch.version, rt.steps - spin.skipped, ctl.next_event_cycle(), moving)
 
-    def _steady_cycle(self) -> None:
-        """Count a steady cycle as the tasks, the spin watch and the idle watch would."""
+    def _steady_cycle(self, moving: bool = True) -> None:
+        """Count a steady cycle as the tasks, the spin watch and (`moving`) the idle watch would."""
         rt = self.rt
         spin = self.spin
         self.steady += 1
@@ -239,12 +258,16 @@ class Scheduler:
                 continue
             rt.state_epoch += 1             # as its resume, or its parked or waiting count
             p = task.parked
-            if p is not None:
+            if p is None:
+                if task.clock_reads:
+                    self.idle.clock += task.clock_reads     # as _waits
+            else:
                 rt.steps += task.budget
                 p.done += task.budget
                 spin.skipped += task.budget
                 spin._place(task)
-        self.idle.moved()
+        if moving:
+            self.idle.moved()
 
     def run(self) -> None:
         rt = self.rt
@@ -252,7 +275,8 @@ class Scheduler:
         robot = self.tasks[0]
         spin = self.spin
         while True:
-            if self._steady():
+            steady = self._steady()
+            if steady == 1:
                 self._steady_cycle()
                 for ev in ctl.step():
                     k = ev.kind
@@ -261,15 +285,18 @@ class Scheduler:
                     elif k == "error":
                         robot.pending_error = ev.error
                 continue
-            for task in list(self.tasks):
-                if not task.done and self.stop is None:
-                    if spin.resuming(task):
-                        continue            # parked: this cycle counted, not run
-                    if task.until is not None and self._waits(task):
-                        continue            # waits on: its resume would only test that
-                    self._resume(task)
-                    if task.done and task is not robot:
-                        rt.submit_finished(task)
+            if steady == 2:
+                self._steady_cycle(False)   # the robot stands: the rest of the cycle as always
+            else:
+                for task in list(self.tasks):
+                    if not task.done and self.stop is None:
+                        if spin.resuming(task):
+                            continue            # parked: this cycle counted, not run
+                        if task.until is not None and self._waits(task):
+                            continue            # waits on: its resume would only test that
+                        self._resume(task)
+                        if task.done and task is not robot:
+                            rt.submit_finished(task)
             if spin.shadowed:
                 spin.check_shadows()
             if robot.done or self.stop is not None:
@@ -282,7 +309,7 @@ class Scheduler:
                 if auto is None or (not auto.pending() and auto.answer(self.idle) != "answered"):
                     self.stop = ("deadlock", f"deadlocked {robot.waiting}", robot)
                     break
-            self.idle.cycle()
+            self.idle.cycle(steady == 2)
             if spin.parked or spin.shadowed:
                 spin.before_step()
             events = ctl.step()

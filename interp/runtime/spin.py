@@ -219,8 +219,7 @@ class SpinWatch:
                 and rt.stmt_hook is None and rt.step_hook is None and rt.cycle_hook is None
                 and rt.run_mode == "GO" and getattr(ctl, "correction", None) is None
                 and not any(k[0] == "analog input" for k in rt._cyclic)
-                and (net is None or not (net.polling or net.attached
-                                        or any(p.ticking() for p in net.partners.values()))))
+                and (net is None or not net.polling))     # (no partner attached or ticking else: net/hub.py)
 
     def _update(self) -> None:
         self.on = self.rec is not None or bool(self.parked) or self.replaying > 0 or bool(self.shadowed)

@@ -86,11 +86,15 @@ def _name_watch(node: N.Name, probes: list) -> str:
     return ALWAYS
 
 
-def watch_of(expr) -> str:
-    """The watch class of condition `expr` (a resolved expression AST; module docstring)."""
+def watch_of(expr, skip: frozenset = frozenset()) -> str:
+    """The watch class of condition `expr` (a resolved expression AST; module docstring);
+    `skip`: the ids of Name nodes left out (the timers of :func:`timer_watch`)."""
     worst = CONSTANT
     probes: list = []
-    for mode, node in reads(expr):
+    acc = reads(expr)
+    if skip:
+        acc = [(mode, node) for mode, node in acc if id(node) not in skip]
+    for mode, node in acc:
         w = ALWAYS if mode != "r" else _name_watch(node, probes)
         if _ORDER[w] > _ORDER[worst]:
             worst = w
@@ -99,12 +103,97 @@ def watch_of(expr) -> str:
     if worst == ALWAYS:
         # a condition over variables (and I/O, constants, probed state): SETTLES
         probes = []
-        for mode, node in reads(expr):
+        for mode, node in acc:
             w = _name_watch(node, probes) if mode == "r" else ALWAYS
             if w == CLOCK or (w == ALWAYS and not _settles_name(node)):
                 return ALWAYS
         worst = SETTLES
     return worst + (":" + ",".join(probes) if probes else "")
+
+
+_RELOPS = frozenset({"<", "<=", ">", ">=", "==", "<>"})
+
+
+def _timer_of(e) -> "tuple[int, N.Name] | None":
+    """``(n, the $TIMER name)`` of ``$TIMER[n]`` with a literal index n, else None."""
+    if e.__class__ is not N.Index or e.base.__class__ is not N.Name or len(e.indices) != 1 \
+            or e.indices[0].__class__ is not N.IntLit:
+        return None
+    place = getattr(e.base.ann, "place", None) if e.base.ann is not None else None
+    if place is None or place.kind != SYSTEM or place.name.upper() != "$TIMER":
+        return None
+    return e.indices[0].value, e.base
+
+
+def _number(e) -> "float | None":
+    """The value of a number literal (``-`` before it allowed), else None."""
+    sign = 1
+    if e.__class__ is N.Unary and e.op in ("-", "+"):
+        sign = -1 if e.op == "-" else 1
+        e = e.operand
+    if e.__class__ is N.IntLit or e.__class__ is N.RealLit:
+        return sign * e.value
+    return None
+
+
+def timer_watch(expr) -> "tuple[str, tuple[tuple[int, float], ...]] | None":
+    """A condition that reads the clock only by comparing running timers with numbers
+    (``WAIT FOR VACOESTATO OR ($TIMER[1] >= 2000)``): ``(watch string of the rest of it,
+    ((n, bound), ...) for each comparison ``$TIMER[n] op bound`` or ``bound op $TIMER[n]``)``,
+    n and bound literals, op one of ``< <= > >= == <>``. None when a timer is read otherwise
+    (an index computed, compared with a variable, in arithmetic) or none is.
+
+    A running timer counts up by the IPO cycle (robot/io.py ``tick_timers``), so such a
+    comparison can change its value only once the timer reaches the bound
+    (:func:`timer_due`): the condition gives the same value until then, or until the rest of
+    it may change (its watch key, :func:`stamp_key`; a timer set, started or stopped changes
+    the I/O image's version). The issue's "a timer reaching a compared value" (issue 48)."""
+    tests = []
+    matched = set()
+    for e in expr.walk():
+        if e.__class__ is not N.Binary or e.op not in _RELOPS:
+            continue
+        for t, b in ((e.left, e.right), (e.right, e.left)):
+            tm = _timer_of(t)
+            bound = _number(b) if tm is not None else None
+            if bound is not None:
+                tests.append((tm[0], float(bound)))
+                matched.add(id(tm[1]))
+                break
+    if not tests:
+        return None
+    for e in expr.walk():
+        if e.__class__ is N.Name and id(e) not in matched and e.name.upper() in _CLOCK_ARRAYS:
+            return None                 # a timer read that is no such comparison
+    return watch_of(expr, frozenset(matched)), tuple(tests)
+
+
+def timer_due(tests, io, cycle: int, dt_ms: float) -> "int | None":
+    """The first IPO cycle, after `cycle`, at which a comparison of `tests` (:func:`timer_watch`)
+    may change its value: the running timer reaches its bound (at most one cycle early; never
+    late). None: none can (every timer of them stopped or past its bound). A timer index out
+    of range gives `cycle` + 1 (evaluate: the read raises there)."""
+    due = None
+    stop, ms = io.timer_stop, io.timer_ms
+    for n, bound in tests:
+        if not 1 <= n < len(stop):
+            return cycle + 1
+        if stop[n]:
+            continue
+        v = ms[n]
+        if v > bound:
+            continue
+        k = cycle + max(1, int((bound - v) // dt_ms))
+        if due is None or k < due:
+            due = k
+    return due
+
+
+def timer_reads(tests, io) -> int:
+    """The reads of a running timer an evaluation of the condition makes (each one a clock
+    read: interp/runtime/sysvars.py ``_timer``; no short circuit)."""
+    stop = io.timer_stop
+    return sum(1 for n, _ in tests if 1 <= n < len(stop) and not stop[n])
 
 
 #: probed system variables the controller's step changes while the robot moves
@@ -196,23 +285,22 @@ class CyclicWatch:
     (:attr:`version`, which the cyclic flags count): :meth:`key` is the same, and the evaluation
     is left out. Not while an ``ANIN ON`` writes a variable at every cycle."""
 
-    __slots__ = ("rt", "version")
+    __slots__ = ("rt", "version", "anin")
 
     def __init__(self, rt) -> None:
         self.rt = rt
         self.version = 0
+        self.anin = False       # an ANIN ON is on (interp/runtime/core.py cyclic_on/cyclic_off)
 
     def written(self):
-        """What may have written a variable since: ``(steps executed, cyclic flag changes)``; None
-        when something else may (a debugger, an ``ANIN ON``, a network partner: an EKI channel
-        sets ``$FLAG`` and writes received values, KukaVarProxy writes any variable: a run with a
-        network configured or replayed, net/hub.py)."""
+        """What may have written a variable since: ``(steps executed, cyclic flag changes and
+        outside changes)``; None when something else may (a debugger, an ``ANIN ON``). A network
+        partner that writes into the run (an EKI channel's ``$FLAG`` or memory, KukaVarProxy's
+        variable, a PLC's input, an RSI answer, live or replayed) announces it first
+        (interp/runtime/core.py ``Runtime.changed_outside``, which moves :attr:`version`; net/hub.py
+        "sink")."""
         rt = self.rt
-        if rt.stmt_hook is not None or rt.step_hook is not None or rt.cycle_hook is not None \
-                or any(k[0] == "analog input" for k in rt._cyclic):
-            return None
-        net = getattr(rt.controller, "network", None)
-        if net is not None and (net.polling or net.replay):
+        if rt.stmt_hook is not None or rt.step_hook is not None or rt.cycle_hook is not None or self.anin:
             return None
         return (rt.steps - rt.spin.skipped, self.version)
 

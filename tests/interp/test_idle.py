@@ -218,3 +218,44 @@ def test_the_state_image_of_a_value_is_equal_exactly_when_its_elements_are():
     for a in allv:
         for b in allv:
             assert (freeze(a) == freeze(b)) == (_elementwise(a) == _elementwise(b)), (_elementwise(a), _elementwise(b))
+
+
+CONST_PROG = """
+DEF cprog()
+  INT i
+  FOR i = 1 TO 3
+    COUNT = COUNT + 1
+  ENDFOR
+  BUMP(OUTV)
+  LOOP
+    IF $IN[3] THEN
+      EXIT
+    ENDIF
+  ENDLOOP
+END
+
+DEF BUMP(v:OUT)
+  INT v
+  v = v + 1
+END
+"""
+
+
+def test_only_data_lists_a_statement_writes_are_imaged_again(tmp_path):
+    """``written_modules``: a data list an assignment, a FOR or an :OUT argument writes is
+    imaged at every state image; one nothing writes (positions, tables) once, and again after
+    an outside change (``Runtime.changed_outside``: an operator's edit, a network partner)."""
+    from interp.runtime.idle import written_modules  # noqa: PLC0415
+
+    prog = write(tmp_path, "cprog.src", CONST_PROG)
+    write(tmp_path, "cprog.dat", "DEFDAT cprog PUBLIC\n  DECL GLOBAL INT COUNT = 0\n  DECL GLOBAL INT OUTV = 0\nENDDAT\n")
+    write(tmp_path, "table.dat", "DEFDAT table PUBLIC\n  DECL GLOBAL INT TAB[3]\n  TAB[1] = 7\nENDDAT\n")
+    rt, res, _tw = _run(prog, max_sim_time=5.0)
+    assert res.reason == "max_sim_time"
+    by_name = {m.name.lower(): m.index for m in rt.program.modules}
+    written = written_modules(rt)
+    assert by_name["cprog"] in written and by_name["table"] not in written
+    idle = rt.scheduler.idle
+    assert by_name["table"] in idle._const and by_name["cprog"] not in idle._const
+    rt.changed_outside()
+    assert idle._const is None

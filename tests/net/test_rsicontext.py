@@ -13,6 +13,7 @@ from pathlib import Path
 
 import pytest
 
+from net.hub import NullSink
 from net.rsi import Rsi
 from net.rsicontext import RSI3, RSI45, IMPLIED, RsiConfigError, find_context, load_context, read_ethernet
 from net.settings import SettingsError, parse_network
@@ -186,6 +187,7 @@ def test_the_ethernet_configuration_in_a_folder_beside(tmp_path):
 class _Hub:
     """The little of net/hub.py an Rsi object reads outside a run."""
     settings = program = backup = ctl = None
+    sink = NullSink()
 
     def __init__(self):
         self.messages = []
