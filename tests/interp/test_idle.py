@@ -11,7 +11,7 @@ from __future__ import annotations
 import pytest
 
 from interp.run import make_runtime
-from interp.runtime.idle import freeze
+from interp.runtime.idle import freeze, written_modules
 from interp.runtime.values import UNSET, Arr, EnumValue, Struct
 from robot.trace import TraceWriter
 
@@ -245,7 +245,6 @@ def test_only_data_lists_a_statement_writes_are_imaged_again(tmp_path):
     """``written_modules``: a data list an assignment, a FOR or an :OUT argument writes is
     imaged at every state image; one nothing writes (positions, tables) once, and again after
     an outside change (``Runtime.changed_outside``: an operator's edit, a network partner)."""
-    from interp.runtime.idle import written_modules  # noqa: PLC0415
 
     prog = write(tmp_path, "cprog.src", CONST_PROG)
     write(tmp_path, "cprog.dat", "DEFDAT cprog PUBLIC\n  DECL GLOBAL INT COUNT = 0\n  DECL GLOBAL INT OUTV = 0\nENDDAT\n")
