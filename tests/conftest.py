@@ -78,6 +78,7 @@ def shared_history() -> Path:
 
 
 def pytest_configure(config: pytest.Config) -> None:
+    config.pluginmanager.register(_XdistGroups(), "krl-xdist-groups")
     config.addinivalue_line("markers", "may_skip(reason): skipping is honest under the named "
                                        "condition even in CI (say which)")
 
@@ -86,6 +87,25 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
     for item in items:
         if CORPUS_FIXTURES & set(getattr(item, "fixturenames", ())):
             item.add_marker(pytest.mark.corpus)
+
+
+class _XdistGroups:
+    """``--dist loadgroup`` (make test): the tests marked ``xdist_group(name)`` go to one worker,
+    so that the session and module fixtures they share are made once. pytest-xdist 3.8 marks
+    them by suffixing ``item._nodeid`` with ``@name``, which pytest 9 no longer reads (a node's
+    id is ``item._id``): without this the groups were spread over both workers and each made
+    the group's fixtures (the corpus audit, the documents' run) again. Same suffix, same rule
+    (the names of all the item's groups, sorted, joined by ``_``)."""
+
+    @pytest.hookimpl(trylast=True)
+    def pytest_collection_modifyitems(self, config: pytest.Config, items: list[pytest.Item]) -> None:
+        if not getattr(config.option, "loadgroup", False):    # xdist sets it in its workers (--dist loadgroup)
+            return
+        for item in items:
+            names = sorted({str(m.args[0] if m.args else m.kwargs.get("name", "default"))
+                            for m in item.iter_markers("xdist_group")})
+            if names and "@" not in item.nodeid and hasattr(item, "_id"):
+                item._id = type(item._id).parse(f"{item.nodeid}@{'_'.join(names)}")
 
 
 @pytest.hookimpl(hookwrapper=True)

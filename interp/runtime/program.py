@@ -39,8 +39,7 @@ from krl.project import project_of, with_basis   # which files make the program:
 from krl.semantics import types as T
 from krl.semantics.expression import Env, evaluate
 from krl.semantics.resolve import GLOBAL, LOCAL, MODULE, SYSTEM, Storage
-from krl.parsecache import load_project
-from krl.workspace import load_file
+from krl.parsecache import load_file, load_project
 
 from .convert import assign_into, convert_scalar
 from .errors import KrlRuntimeError, ResourceError
@@ -81,7 +80,8 @@ def basis_files(project) -> list[Path]:
 
 def parse_module(path: str):
     """(Module AST, syntax error strings) of one file on its own (tools and tests; a run
-    loads its files through :func:`checked_workspace`)."""
+    loads its files through :func:`checked_workspace`); the parse from the one store
+    (krl/store.py) when it holds the file's content."""
     lf = load_file(path)
     errs = [SyntaxProblem(f"{d.path}:{d.line}:{d.column}: {d.message}", d.path, d.line)
             for d in lf.diagnostics if d.is_error and d.code in _START_CODES]

@@ -1,6 +1,7 @@
 """One side of a diff: a backup folder, a backup ``.zip`` or a single file, read the way
 ``krl check`` reads it (krl/archive.py for archives, krl/workspace.py for the files; the same
-limits and the same messages).
+limits and the same messages; each file's parse from the one store, krl/store.py, when it
+holds a file of the same content).
 
 ``with side(path) as s``: ``s.files`` maps a file's key (its path relative to the backup root,
 ``/``-separated, lower-case, so a file renamed only in letter case is the same file, as on the
@@ -28,6 +29,7 @@ from krl.archive import ArchiveError, backup_source
 from krl.diagnostics import Diagnostic
 from krl.diagnostics.codes import E001, E004
 from krl.limits import PARSE_TIMEOUT_S
+from krl.parsecache import through_store
 from krl.project import find_backups
 from krl.source import read_source
 from krl.workspace import SourceFile, Workspace, load_workspace
@@ -115,13 +117,16 @@ def side(path: str | Path, single: bool | None = None, timeout: float | None = N
     try:
         with backup_source(p) as (folder, shown):
             is_file = not folder.is_dir() if single is None else single
-            if is_file:
-                ws = load_workspace([folder], str(folder), timeout=timeout)
-                root = folder.parent
-            else:
-                backups = find_backups(folder)
-                root = backups[0] if len(backups) == 1 else folder
-                ws = load_workspace([folder], str(root), timeout=timeout)
+            # each file's parse from the one store (krl/store.py) when it holds the same content,
+            # as `krl check` reads it: two versions of a backup share most of their files
+            with through_store():
+                if is_file:
+                    ws = load_workspace([folder], str(folder), timeout=timeout)
+                    root = folder.parent
+                else:
+                    backups = find_backups(folder)
+                    root = backups[0] if len(backups) == 1 else folder
+                    ws = load_workspace([folder], str(root), timeout=timeout)
             s = Side(str(path), root, ws, folder=folder, shown_of=shown)
             for f in ws.files:
                 key = "" if is_file else _key(f.path, root, folder)

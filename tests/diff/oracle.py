@@ -1,8 +1,9 @@
 """An independent value comparison of two backup folders, the oracle of tests/diff/test_history.py.
 
 It shares no code with krl/diff: it walks both folders itself, parses every data list with the
-front end (krl.workspace.load_batch: AST only, no checker), and compares every value declared
-with an initial value, by the rules docs/diff.md states for ``krl diff``:
+front end (krl.workspace.load_batch: AST only, no checker; each distinct content once per
+process), and compares every value declared with an initial value, by the rules docs/diff.md
+states for ``krl diff``:
 
 * a file is the same file whatever the letter case of its path;
 * a name given twice in one data list is compared by its first definition;
@@ -17,6 +18,7 @@ folder, ``NAME.PATH`` upper-case (``PPDAT13.APO_DIST``, ``TOOL_DATA[1].X``; a wh
 
 from __future__ import annotations
 
+import hashlib
 import math
 from pathlib import Path
 
@@ -115,14 +117,26 @@ def same_leaf(a: tuple, b: tuple, real: bool, angle: bool) -> bool:
     return (ka, va) == (kb, vb)
 
 
+#: content hash -> module AST (None: did not parse), for the contents parsed before in this
+#: process: two sides of a pair, and consecutive pairs, hold mostly the same files (bounded)
+_PARSED: dict[str, N.Module | None] = {}
+_PARSED_MAX = 4000
+
+
 def parse_all(paths: list[Path]) -> dict[Path, N.Module | None]:
-    """{path: module AST, None when it did not parse}."""
-    outcomes = load_batch(paths, timeout=900.0)
-    out = {}
-    for p, o in zip(paths, outcomes):
+    """{path: module AST, None when it did not parse}; each distinct content is parsed once."""
+    digest = {p: hashlib.sha256(p.read_bytes()).hexdigest() for p in paths}
+    if len(_PARSED) + len(set(digest.values())) > _PARSED_MAX:
+        _PARSED.clear()
+    first: dict[str, Path] = {}
+    for p in paths:
+        if digest[p] not in _PARSED:
+            first.setdefault(digest[p], p)
+    todo = list(first.values())
+    for p, o in zip(todo, load_batch(todo, timeout=900.0)):
         lf = getattr(o, "value", None)
-        out[p] = lf.module if lf is not None and lf.ok else None
-    return out
+        _PARSED[digest[p]] = lf.module if lf is not None and lf.ok else None
+    return {p: _PARSED[digest[p]] for p in paths}
 
 
 def compare(old: Path, new: Path) -> tuple[set[tuple[str, str, str]], set[str]]:

@@ -20,6 +20,10 @@ from krl.workspace import load_workspace
 from krl.project import find_backups
 from krl.ast import nodes as N
 
+# the tests share one load and check of every backup (`checked`): one xdist worker takes them
+# (make test: --dist loadgroup)
+pytestmark = [pytest.mark.xdist_group("frontend-corpus")]
+
 # (path pattern, code, message pattern, why it is a true error, the lines: file name:line)
 TRUE_ERRORS = [
     ('khrzysio__KRC4_test/R1/Program/CELL/', 'E106', "routine 'TODO'",

@@ -15,6 +15,10 @@ import pytest
 
 from krl.survey.mutants import EXPECTED, load_programs, mutants
 
+# the tests share the module's mutants, each checked in its backup (30 s of CPU): one xdist worker
+# takes them (make test: --dist loadgroup)
+pytestmark = [pytest.mark.xdist_group("seeded-errors")]
+
 
 @pytest.fixture(scope="module")
 def programs(shared_corpus):
