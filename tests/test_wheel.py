@@ -24,6 +24,10 @@ from pathlib import Path
 
 import pytest
 
+#: the two tests of the built wheel on one worker of make test (the wheel, a module fixture, is
+#: built once: ~42 s of CPU)
+pytestmark = [pytest.mark.xdist_group("wheel")]
+
 REPO = Path(__file__).resolve().parents[1]
 # the top-level packages the wheel ships: pyproject's package list, one source of truth
 PACKAGES = tuple(p.rstrip("*") for p in tomllib.loads((REPO / "pyproject.toml").read_text())
