@@ -67,7 +67,6 @@ it had not been made.
 from __future__ import annotations
 
 import contextlib
-import gc
 import os
 import queue
 import sys
@@ -77,6 +76,7 @@ from dataclasses import dataclass
 
 from interp.runtime.errors import ControlSignal, KrlRuntimeError
 from interp.runtime.values import type_name_of
+from krl import collector
 from krl.limits import MAX_DAP_BREAKPOINTS, MAX_DAP_REPLAY_STEPS
 from robot.errors import RobotError
 
@@ -294,16 +294,13 @@ class Engine:
         except RunSetupError as exc:
             raise Refused(str(exc)) from None
         self.config = config
-        enabled = gc.isenabled()
-        gc.disable()
-        try:
-            rt, _ = self._build()
-        finally:
-            # the checked program and the tables live as long as the session: out of the
-            # collector's sight (a full collection over them costs as much as loading them)
-            gc.freeze()
-            if enabled:
-                gc.enable()
+        with collector.paused():
+            try:
+                rt, _ = self._build()
+            finally:
+                # the checked program and the tables live as long as the session: out of the
+                # collector's sight (a full collection over them costs as much as loading them)
+                collector.keep()
         errors = rt.program.errors_of(rt.program.module_of(rt.program.main_path))
         if errors:
             rt.scheduler.close()

@@ -5,12 +5,12 @@ semantics (docs/architecture.md, "Interpreters", lists the contracts).
 
 from __future__ import annotations
 
-import gc
 import random
 import sys
 from pathlib import Path
 from dataclasses import dataclass
 
+from krl import collector
 from krl.ast import nodes as N
 from krl.limits import MAX_CALL_DEPTH
 from krl.semantics import expression as X
@@ -264,14 +264,10 @@ class Runtime:
         # as the run: out of the collector's generations while it runs, so its collections
         # walk only what the run makes (unless the process froze its own already: the
         # language server's)
-        froze = gc.get_freeze_count() == 0 and gc.isenabled()
-        if froze:
-            gc.freeze()
         try:
-            self.scheduler.run()
+            with collector.frozen_during():
+                self.scheduler.run()
         finally:
-            if froze:
-                gc.unfreeze()
             sys.setrecursionlimit(old)
             net = getattr(self.controller, "network", None)
             if net is not None:

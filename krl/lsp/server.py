@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import asyncio
 import functools
-import gc
 import importlib.util
 import logging
 import os
@@ -27,7 +26,7 @@ from lsprotocol import types as L
 from pygls.lsp.server import LanguageServer
 from pygls.uris import from_fs_path, to_fs_path
 
-from krl import __version__
+from krl import __version__, collector
 from krl.diagnostics.render import split_lines
 from krl.pool import default_jobs, start_fork_server
 from krl.semantics.config import config_for
@@ -218,8 +217,7 @@ class KrlLanguageServer(LanguageServer):
                 # 400-file bench at load 26, none frozen). What the previous check left is
                 # unfrozen here and collected as usual. (The project froze the check's objects
                 # as it ended already, before the collector ran again: Project(freeze=True).)
-                gc.unfreeze()
-                gc.freeze()
+                collector.keep(renew=True)
             if an.how == "workspace":
                 self.warm_edits({p: t for p, t in docs.items() if p in an.files})
             self.write_cache_later()

@@ -16,13 +16,13 @@ the caller parses the file with the Python engine).
 
 from __future__ import annotations
 
-import gc
-
 from antlr4 import InputStream
 from antlr4.Token import CommonToken
 from antlr4.CommonTokenStream import CommonTokenStream
 from antlr4.error.Errors import RecognitionException
 from antlr4.tree.Tree import ErrorNodeImpl, TerminalNodeImpl
+
+from krl import collector
 
 __all__ = ["TreeDataError", "is_acyclic", "stream_tokens", "tree_from_raw"]
 
@@ -89,17 +89,13 @@ def tree_from_raw(raw: dict, text: str, bundle, parents: bool = True):
     it as soon as it is dropped (:func:`is_acyclic`). Raises TreeDataError."""
     # Millions of new objects and none freed: the cyclic collector's passes over the growing
     # heap would cost more than the building itself, so it waits until the tree is built.
-    enabled = gc.isenabled()
-    gc.disable()
-    try:
-        return _build(raw["tokens"], raw["names"], raw["tree"], raw["labels"], text, bundle, parents)
-    except TreeDataError:
-        raise
-    except (KeyError, IndexError, TypeError, ValueError, AttributeError) as exc:
-        raise TreeDataError(f"malformed tree data: {type(exc).__name__}: {exc}") from None
-    finally:
-        if enabled:
-            gc.enable()
+    with collector.paused():
+        try:
+            return _build(raw["tokens"], raw["names"], raw["tree"], raw["labels"], text, bundle, parents)
+        except TreeDataError:
+            raise
+        except (KeyError, IndexError, TypeError, ValueError, AttributeError) as exc:
+            raise TreeDataError(f"malformed tree data: {type(exc).__name__}: {exc}") from None
 
 
 class RebuiltToken(CommonToken):
