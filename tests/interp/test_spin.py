@@ -229,24 +229,45 @@ REAL = ("ingeniado__KRC4-Robot-Palletizer/System/sps.sub", "ingeniado__KRC4-Robo
         "HugoDanielson__ChinaMilling/KRC/R1/System/sps.sub")
 
 
-def _real(program, interp: str, enabled: bool, seconds: float, shadow: bool = False):
+class _ControllerEvents:
+    """An observer of the controller alone, as ``krl run``'s summary, the change report and the
+    audit attach one (make_runtime ``observer=``): every event and pose the controller writes."""
+
+    inner = None
+
+    def __init__(self) -> None:
+        self.events: list = []
+        self.poses: list = []
+
+    def write(self, kind: str, t: float, **fields) -> None:
+        self.events.append((kind, t, sorted((k, repr(v)) for k, v in fields.items())))
+
+    def write_pose(self, t: float, axes, _tcp_T) -> None:
+        self.poses.append((t, tuple(float(a) for a in axes)))
+
+
+def _real(program, interp: str, enabled: bool, seconds: float, shadow: bool = False, observed: bool = True):
     sub = program.suffix.lower() == ".sub"
     robot, submit, _t, _s = report_run(program, None, seconds, REPORT_STEPS, auto=True)
     steps = step_limit(REPORT_STEPS, seconds, len(submit) + sub, robot.ipo_cycle_s)
+    seen = _ControllerEvents() if observed else None
     rt, _ = make_runtime(program, trace=None, mujoco=False, max_sim_time=seconds, max_steps=steps, submit=submit,
                          check=False, inputs="auto", robot=robot, interp=interp,
-                         robot_budget=SUBMIT_BUDGET if sub else None)
+                         robot_budget=SUBMIT_BUDGET if sub else None, observer=seen)
     rt.scheduler.spin.enabled = enabled
     rt.scheduler.spin.shadow = shadow
     res = rt.run()
     answers = [a.describe() for a in rt.autocell.answers]
-    return rt, (rt.controller.io.log, answers, res.reason, res.file, res.line, res.sim_time, res.steps)
+    return rt, (rt.controller.io.log, answers, res.reason, res.file, res.line, res.sim_time, res.steps,
+                *((seen.events, seen.poses) if seen is not None else ()))
 
 
 @pytest.mark.parametrize("rel", REAL)
 def test_real_whole_runs_are_the_same_parked(rel):
-    """With ``--inputs auto``, 30 s: the same I/O, answers, end and steps with and without the
-    spin watch, on the VM; and the tree interpreter's parked run the VM's."""
+    """With ``--inputs auto``, 30 s, and an observer of the controller (as ``krl run``, the
+    change report and the audit run): the same I/O, answers, end, steps and controller events
+    with and without the spin watch, on the VM, and the spin parked (the observer does not stop
+    the watch); and the tree interpreter's parked run the VM's."""
     program = SHARED_CORPUS / rel
     if not program.is_file():
         pytest.skip("the shared corpus is not here")
@@ -254,6 +275,11 @@ def test_real_whole_runs_are_the_same_parked(rel):
     rt, on = _real(program, "vm", True, 30.0)
     assert on == off
     assert (rt.scheduler.spin.diverged, rt.scheduler.spin.missed) == (0, 0)
+    bare, run = _real(program, "vm", True, 30.0, observed=False)
+    assert run == on[:7]
+    skipped = (rt.scheduler.spin.parks, rt.scheduler.spin.skipped, rt.scheduler.idle.skipped)
+    assert skipped == (bare.scheduler.spin.parks, bare.scheduler.spin.skipped, bare.scheduler.idle.skipped)
+    assert skipped[1] + skipped[2] > 0
     _rt, tree = _real(program, "tree", True, 30.0)
     assert tree == on
 
