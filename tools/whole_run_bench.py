@@ -7,7 +7,10 @@ SPS.SUB) runs as the real-programs report's ``--inputs auto`` column runs it (``
 the robot of the backup or the library robot that reaches its points, the backup's SPS.SUB
 beside it, ``--no-check``, the report's step limit for the time), except that every entry point,
 an SPS.SUB too, gets the same simulated time (``--sim-time``, default 600 s). No trace is
-written: the figure is what a user waits for when a whole cell runs.
+written, and the controller is observed as ``krl run`` observes it for its summary
+(interp/summary.py ``RunObserver``): the figure is what a user waits for when a whole cell runs.
+(Until 2026-11-25 the bench ran without the observer, and the observer stopped the spin watch:
+the bench measured a run no user got; docs/architecture.md, "Spins cost nothing".)
 
 One worker process per checkout (``PYTHONPATH=CHECKOUT`` on this interpreter: the checkouts must
 share this venv's dependencies and each needs its generated parser and compiled VM loop, as for
@@ -57,6 +60,7 @@ def _run_one(program: Path, sim_time: float, interp: str) -> dict:
     from interp.realprograms import REPORT_STEPS, report_run, step_limit  # noqa: PLC0415  (once sys.path names the checkout measured)
     from interp.run import make_runtime  # noqa: PLC0415  (once sys.path names the checkout measured)
     from interp.runtime.scheduler import SUBMIT_BUDGET  # noqa: PLC0415  (once sys.path names the checkout measured)
+    from interp.summary import RunObserver  # noqa: PLC0415  (once sys.path names the checkout measured)
 
     sub = program.suffix.lower() == ".sub"
     row: dict = {"program": str(program), "interp": interp}
@@ -66,7 +70,7 @@ def _run_one(program: Path, sim_time: float, interp: str) -> dict:
         steps = step_limit(REPORT_STEPS, sim_time, len(submit) + sub, robot.ipo_cycle_s)
         rt, _ = make_runtime(program, trace=None, mujoco=False, max_sim_time=sim_time, max_steps=steps,
                              submit=submit, check=False, inputs="auto", robot=robot, interp=interp,
-                             robot_budget=SUBMIT_BUDGET if sub else None)
+                             robot_budget=SUBMIT_BUDGET if sub else None, observer=RunObserver())
         c1 = time.process_time()
         res = rt.run()
         c2 = time.process_time()
