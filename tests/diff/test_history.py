@@ -22,7 +22,17 @@ from tests.conftest import history_pairs
 from tests.diff import oracle
 from tests.test_json_schemas import validate
 
-PAIRS = history_pairs() or ["(absent)"]
+
+
+def _by_repository(pairs: list[str]) -> list:
+    """Each pair with the xdist group of its repository (make test: --dist loadgroup), so a
+    repository's consecutive pairs run on one worker: the oracle parses each content once per
+    process (oracle.parse_all), and the old side of a pair is mostly the new side of the one
+    before (KUKA-Script's four pairs, 1.9 MB a side: 73 s of the module's 128 s when spread)."""
+    return [pytest.param(p, marks=pytest.mark.xdist_group("history-" + p.split("/", 1)[0])) for p in pairs]
+
+
+PAIRS = _by_repository(history_pairs() or ["(absent)"])
 
 
 @pytest.fixture(autouse=True)
@@ -177,7 +187,7 @@ EXPECTED = {
 }
 
 
-@pytest.mark.parametrize("pair", sorted(EXPECTED))
+@pytest.mark.parametrize("pair", _by_repository(sorted(EXPECTED)))
 def test_diff_reports_the_deltas_read_by_hand(shared_history, pair):
     entries, comments, not_compared = EXPECTED[pair]
     code, doc = run_diff(shared_history, pair)
