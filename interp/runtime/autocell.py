@@ -376,8 +376,13 @@ class AutoCell:
 def program_numbers(rt) -> list[int]:
     """The CASE values (INT constants, in source order) of every ``SWITCH PGNO`` of the
     program's files, where PGNO is the variable of ``$config.dat`` (the checker's symbol, not
-    the spelling); empty when there is none."""
-    ws = rt.program.ws
+    the spelling); empty when there is none. Found once per checked workspace
+    (interp/runtime/program.py ``Program.derived``); a new list each call."""
+    return list(rt.program.derived("program_numbers", _program_numbers))
+
+
+def _program_numbers(program) -> tuple[int, ...]:
+    ws = program.ws
     scope = getattr(ws, "global_scope", None)
     sym = scope.values.get("PGNO") if scope is not None else None
     if sym is None:
@@ -397,7 +402,7 @@ def program_numbers(rt) -> list[int]:
                 for v in case.values:
                     if isinstance(v, N.IntLit) and v.value not in out:
                         out.append(v.value)
-    return out
+    return tuple(out)
 
 
 def handshake_rules(rt, main: str, params: dict) -> list:

@@ -182,6 +182,12 @@ def _root_name(e):
 
 
 def written_modules(rt) -> frozenset:
+    """:func:`_written_modules` of the run's program, once per checked workspace
+    (interp/runtime/program.py ``Program.derived``)."""
+    return rt.program.derived("written_modules", _written_modules)
+
+
+def _written_modules(program) -> frozenset:
     """The data lists (module indices, ``Storage.owner``) a statement of the program may write:
     those an assignment, a FOR, an ``ANIN ON`` or a WITH names as target, or a call takes as an
     argument (an :OUT parameter may write it; an :IN one is counted too). No other writer
@@ -189,7 +195,7 @@ def written_modules(rt) -> frozenset:
     system variables). A data list outside this set keeps its loaded values: its image is made
     once (:class:`IdleWatch` keeps it)."""
     out = set()
-    for unit in rt.program.ws.units:
+    for unit in program.ws.units:
         src = unit.src
         if src is None or src.module is None:
             continue
@@ -208,7 +214,7 @@ def written_modules(rt) -> frozenset:
                 if place is not None and place.owner >= 0:
                     out.add(place.owner)
                 elif name is not None and place is None:
-                    return frozenset(m.index for m in rt.program.modules)   # a name not placed: any
+                    return frozenset(m.index for m in program.modules)   # a name not placed: any
     return frozenset(out)
 
 

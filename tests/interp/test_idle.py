@@ -258,3 +258,12 @@ def test_only_data_lists_a_statement_writes_are_imaged_again(tmp_path):
     assert by_name["table"] in idle._const and by_name["cprog"] not in idle._const
     rt.changed_outside()
     assert idle._const is None
+    # found once per checked workspace (Program.derived): a second run of the same files gets
+    # the first run's set; an edit (a new modification time) checks the files again, and the
+    # set is found again from the new ASTs
+    again, _res, _tw = _run(prog, max_sim_time=0.1)
+    assert again.program.ws is rt.program.ws and written_modules(again) is written
+    write(tmp_path, "table.dat", "DEFDAT table PUBLIC\n  DECL GLOBAL INT TAB[3]\n  TAB[1] = 7\nENDDAT\n\n")
+    edited, _res, _tw = _run(prog, max_sim_time=0.1)
+    assert edited.program.ws is not rt.program.ws
+    assert written_modules(edited) == written and written_modules(edited) is not written
