@@ -133,7 +133,7 @@ def side(path: str | Path, single: bool | None = None, timeout: float | None = N
                 s.files.setdefault(key, f)
             errors = [d for d in ws.sink.sorted() if d.is_error]      # input and syntax errors
             ws.check_only = set()     # declarations only (names, types, E102): no routine body is checked
-            ws.check()
+            ws.check(resolve=False)   # and no storage placed: the diff never runs the program
             keys = {f.path: k for k, f in s.files.items()}
             once: dict[tuple, object] = {}     # one entry per line and name, as the checker reports it
             for f in ws.declared_twice():
