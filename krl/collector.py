@@ -56,11 +56,6 @@ def keep(renew: bool = False) -> None:
     _kept = True
 
 
-def keeps_frozen() -> bool:
-    """Whether this process keeps frozen objects (:func:`keep` was called)."""
-    return _kept
-
-
 @contextlib.contextmanager
 def frozen_during() -> Iterator[None]:
     """The objects that exist now are out of the collector's generations while the block runs

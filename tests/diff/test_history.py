@@ -23,7 +23,6 @@ from tests.diff import oracle
 from tests.test_json_schemas import validate
 
 
-
 def _by_repository(pairs: list[str]) -> list:
     """Each pair with the xdist group of its repository (make test: --dist loadgroup), so a
     repository's consecutive pairs run on one worker: the oracle parses each content once per
