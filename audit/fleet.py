@@ -118,7 +118,7 @@ def check_unit(root: str, entries: list, backup: bool) -> dict:
 
     with through_store():
         ws = load_workspaces([(root, entries)], None)[0]
-    diags = config_for(ws.root, root).apply(ws.check())
+    diags = config_for(ws.root, root).apply(ws.check(resolve=False))   # the runs load their own
     errors = [d for d in diags if d.is_error]
     warnings = [d for d in diags if not d.is_error]
     codes: dict[str, int] = {}

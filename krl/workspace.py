@@ -405,6 +405,9 @@ class Workspace:
         (an editor's look-ups), their findings not reported, as ``krl check`` reports only the
         syntax errors of such files."""
         if self.checked:
+            if resolve and not self._options[0]:
+                self.resolve()        # checked for the checker alone before; a run needs the places
+                self._options = (True, self._options[1])
             return self.diagnostics
         t = time.perf_counter()
         self.checked = True

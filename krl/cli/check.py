@@ -125,7 +125,7 @@ def run_check(paths: list[str], as_json: bool = False, no_warnings: bool = False
                         except ConfigError as exc:   # name the krl.toml as the user sees it
                             raise ConfigError(str(exc).replace(str(folder), str(path))
                                               if as_shown.archive else str(exc)) from None
-                        diags = sel.apply(ws.check())
+                        diags = sel.apply(ws.check(resolve=False))   # nothing runs: no storage placed
                         files += len(ws.files)
                         if as_shown.archive:
                             for real in {d.path for d in diags}:
@@ -207,7 +207,8 @@ class Checked:
         self.files = [SimpleNamespace(path=f) for f in files]
         self.diagnostics = diagnostics
 
-    def check(self) -> list:
+    def check(self, resolve: bool = False) -> list:
+        """The diagnostics, as ``Workspace.check(resolve)`` returns them (checked already)."""
         return self.diagnostics
 
 
@@ -220,7 +221,7 @@ def check_group(root: str, entries: list, timeout: float | None) -> tuple[str, l
     from krl.workspace import load_workspaces  # noqa: PLC0415
 
     ws = load_workspaces([(root, entries)], None)[0]
-    diags = ws.check()
+    diags = ws.check(resolve=False)     # nothing runs: no storage placed
     return ws.root, [str(f.path) for f in ws.files], list(diags)
 
 

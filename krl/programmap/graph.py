@@ -183,7 +183,7 @@ def routine_id(module: str, name: str) -> str:
 
 def build_map(ws: Workspace) -> ProgramMap:
     """The program map of `ws` (checked here if it is not yet; see the module docstring)."""
-    ws.check()
+    ws.check(resolve=False)     # the map reads the checker's symbols, never a storage place
     pm = ProgramMap(ws.root)
     mains: dict[str, str] = {}            # MODULE -> node id of its main routine
     for u in ws.units:

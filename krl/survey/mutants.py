@@ -132,7 +132,7 @@ def _programs(corpus: Path) -> list[tuple[Workspace, list[_Program]]]:
     out = []
     for b in find_backups(corpus):
         ws = load_workspace([b], str(b))
-        ws.check()
+        ws.check(resolve=False)
         err_paths = {d.path for d in ws.diagnostics if d.is_error}
         progs = []
         for u in sorted(ws.units, key=lambda u: u.src.path if u.src else ""):
@@ -374,7 +374,7 @@ def judge(m: Mutant, p: _Program) -> None:
     ws.template = dict(base.template)
     ws.add_text(m.text, m.path)
     ws.check_only = {p.src.path} | ({p.dat.path} if p.dat is not None else set())
-    diags = ws.check()
+    diags = ws.check(resolve=False)     # the checker alone: no storage placed
     at = [d for d in diags if d.path == m.path and d.line == m.line]
     m.reported = [f"{d.code} {d.message}" for d in at]
     m.found = any(d.is_error and d.code == m.expected for d in at)

@@ -36,7 +36,7 @@ def check_report(corpus: str | Path, out_dir: str | Path | None = None, top: int
     rows = []
     kinds: Counter = Counter()
     for b, ws in _loaded_backups(backups, timeout, jobs):
-        diags = ws.check()
+        diags = ws.check(resolve=False)
         err_files = {d.path for d in diags if d.is_error}
         codes = Counter(d.code for d in diags)
         kinds.update(codes)
@@ -154,7 +154,7 @@ def measure(corpus: str | Path) -> dict:
            "known_invalid": {"errors": Counter(), "warnings": Counter()}, "valid_errors": []}
     for b in find_backups(corpus):
         out["backups"] += 1
-        for d in load_workspace([b], str(b)).check():
+        for d in load_workspace([b], str(b)).check(resolve=False):
             try:
                 rel = Path(d.path).resolve().relative_to(corpus).as_posix()
             except ValueError:
