@@ -193,9 +193,7 @@ class SystemSoftware:
         checker's one decision; a name only a file that does not parse mentions may be the
         program's own, declared there: it stays the program's error)."""
         if self._outside is None:
-            unresolved = self.rt.program.ws.unresolved()
-            found = unresolved.classify() if unresolved is not None else {}
-            self._outside = {key: o.why for key, o in found.items() if o.kuka}
+            self._outside = self.rt.program.derived("kss.outside", _outside_of)
         return self._outside
 
     def use_types(self) -> dict:
@@ -203,17 +201,7 @@ class SystemSoftware:
         routine (see the module docstring), from the checker's types; a name of an ENUM type
         the backup does not declare gets its stand-in ENUM (:func:`standin_enum`)."""
         if self._types is None:
-            types: dict = {}
-            literals: dict = {}
-            ws = self.rt.program.ws
-            for unit in ws.units:
-                for f in (unit.src, unit.dat):
-                    if f is not None and f.module is not None:
-                        _infer(f.module, types, literals, ws)
-            for name, lits in literals.items():
-                if name not in types:
-                    types[name], self._absent[name] = standin_enum(name, lits)
-            self._types = types
+            self._types, self._absent = self.rt.program.derived("kss.use_types", _use_types_of)
         return self._types
 
     def _typed_zero(self, key: str, t=None):
@@ -403,6 +391,32 @@ def _param_types(call: N.Call, ws) -> list:
         return [None if p.dims else (sys_type(p.type_name) or getattr(T, p.type_name.upper(), None))
                 for p in info.params]
     return []
+
+
+def _outside_of(program) -> dict:
+    """:meth:`SystemSoftware.outside` of `program`'s checked workspace (read-only; made once per
+    workspace, Program.derived)."""
+    unresolved = program.ws.unresolved()
+    found = unresolved.classify() if unresolved is not None else {}
+    return {key: o.why for key, o in found.items() if o.kuka}
+
+
+def _use_types_of(program) -> tuple[dict, dict]:
+    """(UPPER name -> type, UPPER name -> "not installed" literal of its stand-in ENUM) of
+    :meth:`SystemSoftware.use_types`: a walk over every file of `program`'s checked workspace
+    (0.22 s on a KRC backup), made once per workspace (Program.derived); read-only."""
+    types: dict = {}
+    literals: dict = {}
+    absent: dict = {}
+    ws = program.ws
+    for unit in ws.units:
+        for f in (unit.src, unit.dat):
+            if f is not None and f.module is not None:
+                _infer(f.module, types, literals, ws)
+    for name, lits in literals.items():
+        if name not in types:
+            types[name], absent[name] = standin_enum(name, lits)
+    return types, absent
 
 
 def _infer(module: N.Module, types: dict, literals: dict | None = None, ws=None) -> None:

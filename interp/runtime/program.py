@@ -352,9 +352,7 @@ class Program:
             return t
         name = tref.name if isinstance(tref, N.TypeRef) else str(tref)
         if self._outside_types is None:
-            un = self.ws.unresolved()
-            found = un.classify() if un is not None else {}
-            self._outside_types = {k for (kind, k), o in found.items() if kind == "type" and o.kuka}
+            self._outside_types = self.derived("outside_types", _outside_types)
         if name.upper() not in self._outside_types:
             raise KrlRuntimeError(f"unknown type {name}")
         if name.upper() not in self.stubs:
@@ -472,6 +470,14 @@ class Program:
         (krl/semantics/expression.py) reading this program's data lists. `t`: the declared
         type (the caller converts the value to it)."""
         return evaluate(e, self._initialiser_env)
+
+
+def _outside_types(program: Program) -> frozenset:
+    """The types the checker calls KUKA's (W105, ``Outside.kuka``) in `program`'s checked
+    workspace: :meth:`Program.declared_type`'s decision, made once per workspace."""
+    un = program.ws.unresolved()
+    found = un.classify() if un is not None else {}
+    return frozenset(k for (kind, k), o in found.items() if kind == "type" and o.kuka)
 
 
 class _InitialiserEnv(Env):

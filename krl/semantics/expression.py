@@ -160,14 +160,18 @@ class Env:
 
 
 class _Compiler:
-    """The expression walk (one handler per expression kind, krl/ast/visit.py)."""
+    """The expression walk (one handler per expression kind, krl/ast/visit.py; the table is the
+    class's, made once: a run initialises every data-list value through here, 140 000 of them
+    for a KRC backup's 36 entry points, and a table per expression cost 11 µs each)."""
+
+    __slots__ = ("env",)
+    _table: dict = {}
 
     def __init__(self, env: Env) -> None:
         self.env = env
-        self.table = handlers(self, "e_", EXPRESSIONS)
 
     def build(self, e: N.Expr) -> Reader:
-        return self.table[e.__class__](e)
+        return self._table[e.__class__](self, e)
 
     def _literal(self, e) -> Reader:
         v = e.value
@@ -214,6 +218,9 @@ class _Compiler:
                 a = fn(a, right())
             return a
         return chain_value
+
+
+_Compiler._table = handlers(_Compiler, "e_", EXPRESSIONS)
 
 
 def _operator(op: str) -> Callable[[Any, Any], Any]:
