@@ -79,6 +79,8 @@ MON_NUMBER = 2
 #: answered for this long is silent: its packets are late from then on, at once, without
 #: waiting, until it answers again (so Timeout + 1 silent cycles still stop the robot).
 ANSWER_WAIT_S = 2.0
+#: s of wall time between two looks at whether the sensor is known gone while waiting for it
+WAIT_SLICE_S = 0.05
 MIN_DECIMALS = 4        # values are sent with max(Precision, 4) decimals (docs/network.md, Decisions)
 MAX_FLOW_DEPTH = 64     # links followed from an object back to its sources
 def _first(ins: list, k: int = 0) -> float:
@@ -432,17 +434,23 @@ class Rsi:
             return
         pending = [i for i in ipocs if i in self.expect]
         end = time.monotonic() + ANSWER_WAIT_S
-        while any(i in self.expect for i in pending):
+        while any(i in self.expect for i in pending) and not self.silent:
             left = end - time.monotonic()
             if left <= 0:
                 self.silent = True
                 return
-            try:
-                ready, _, _ = select.select([sock], [], [], left)
+            try:     # in slices, so that a sensor known gone (sensor_gone) is not waited for
+                ready, _, _ = select.select([sock], [], [], min(left, WAIT_SLICE_S))
             except (OSError, ValueError):       # the socket was closed under us
                 return
             if ready:
                 self._receive()
+
+    def sensor_gone(self) -> None:
+        """The sensor has ended (its program or thread returned; another thread may say so): it
+        is silent from now on, its packets late at once, and a wait for its answer ends at the
+        next :data:`WAIT_SLICE_S` instead of after :data:`ANSWER_WAIT_S`."""
+        self.silent = True
 
     def replayed(self, ev: dict) -> None:
         if ev.get("dir") == "in" and self.on and not self.failed:

@@ -39,6 +39,7 @@ def run_with_partner(program, settings, partner, *, interp: str = "tree", max_si
             box["error"] = exc
         finally:
             rt.scheduler.max_sim_time = rt.controller.time   # stop at the next cycle
+            _partner_gone(net)
 
     th = threading.Thread(target=body, daemon=True)
     th.start()
@@ -50,6 +51,18 @@ def run_with_partner(program, settings, partner, *, interp: str = "tree", max_si
         raise box["error"]
     box["rt"] = rt
     return result, trace, box.get("value")
+
+
+def _partner_gone(net) -> None:
+    """The partner has returned: nothing answers from now on. The run's RSI sensor is gone
+    (net/rsi.py ``Rsi.sensor_gone``), so the controller does not wait ANSWER_WAIT_S of wall time
+    for an answer to the last cycle's packets before it stops (2 s per test)."""
+    try:
+        rsi = net.partner("rsi").rsi
+    except (KeyError, AttributeError):
+        return
+    if rsi is not None:
+        rsi.sensor_gone()
 
 
 def net_events(trace, **match):
