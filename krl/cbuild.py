@@ -49,15 +49,25 @@ def other_checkout_command(python: str, script: str, *args: str) -> list[str]:
     return [python, "-c", OTHER_CHECKOUT_PRELUDE + run, script, *args]
 
 
-def cythonized(extensions: list, build_dir: str = "build/cython", force: bool = False) -> list:
-    """``extensions`` (setuptools ``Extension``s, ``optional``) translated to C by Cython, or
-    ``[]`` without Cython: then nothing is compiled and the pure-Python modules run."""
+def build_jobs() -> int:
+    """How many extensions a package build translates and compiles at once: one per core this
+    process may run on."""
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except (AttributeError, OSError):
+        return os.cpu_count() or 1
+
+
+def cythonized(extensions: list, build_dir: str = "build/cython", force: bool = False, jobs: int = 1) -> list:
+    """``extensions`` (setuptools ``Extension``s, ``optional``) translated to C by Cython
+    (`jobs` at once), or ``[]`` without Cython: then nothing is compiled and the pure-Python
+    modules run."""
     try:
         from Cython.Build import cythonize  # noqa: PLC0415  (optional; loads only for a build)
     except ImportError:
         return []
     return cythonize(extensions, build_dir=build_dir, quiet=True, force=force,
-                     compiler_directives=DIRECTIVES)
+                     compiler_directives=DIRECTIVES, nthreads=jobs if len(extensions) > 1 else 0)
 
 
 def build_in_place(extension, out: Path, sources, repo: Path, fallback: str, force: bool = False) -> str:
