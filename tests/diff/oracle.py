@@ -1,7 +1,7 @@
 """An independent value comparison of two backup folders, the oracle of tests/diff/test_history.py.
 
 It shares no code with krl/diff: it walks both folders itself, parses every data list with the
-front end (krl.workspace.load_batch: AST only, no checker; each distinct content once per
+front end (krl.parsecache.load_files, through the one store: AST only, no checker; each distinct content once per
 process), and compares every value declared with an initial value, by the rules docs/diff.md
 states for ``krl diff``:
 
@@ -26,7 +26,7 @@ import numpy as np
 
 from krl.ast import nodes as N
 from krl.ast.printer import expr as krl_expr
-from krl.workspace import load_batch
+from krl.parsecache import load_files
 
 _CARTESIAN = {"E6POS", "POS", "FRAME", "E3POS"}
 _ANGLES = {"A", "B", "C"}
@@ -133,8 +133,9 @@ def parse_all(paths: list[Path]) -> dict[Path, N.Module | None]:
         if digest[p] not in _PARSED:
             first.setdefault(digest[p], p)
     todo = list(first.values())
-    for p, o in zip(todo, load_batch(todo, timeout=900.0)):
-        lf = getattr(o, "value", None)
+    # through the one store (krl/store.py): the files `krl diff` parsed a moment before are
+    # not parsed again (the parser is the front end's either way; the comparison is this module's)
+    for p, lf in zip(todo, load_files(todo, timeout=900.0)):
         _PARSED[digest[p]] = lf.module if lf is not None and lf.ok else None
     return {p: _PARSED[digest[p]] for p in paths}
 
