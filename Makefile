@@ -68,8 +68,13 @@ growth: $(PARSER) java-parser
 validate: $(PARSER) java-parser
 	$(BIN)/krl validate
 
+# Three pytest workers on the 2-core machine: a quarter of the workers' time is spent waiting on
+# the processes a test starts (the browser, krl pendant, krl debug, the package build) or on a
+# partner's answer; a third worker runs CPU work meanwhile (15 min 17 s with two workers at the
+# start of 2026-11-25, 11 min 15 s with three; four were slower again: docs/architecture.md, "The test suite")
+PYTEST_WORKERS ?= 3
 test: $(PARSER) java-parser vm-loop
-	$(BIN)/python -m pytest -q -n 2 --dist loadgroup -p no:cacheprovider -r fEsxX
+	$(BIN)/python -m pytest -q -n $(PYTEST_WORKERS) --dist loadgroup -p no:cacheprovider -r fEsxX
 
 bench: $(PARSER) java-parser vm-loop
 	$(BIN)/krl bench
@@ -109,7 +114,7 @@ nightly: $(PARSER) java-parser
 	$(BIN)/python -m robot.limits_bench > $$d/limits.jsonl 2>> $$d/bench.log; \
 	$(BIN)/python tools/whole_run_bench.py --json $$d/whole-runs.json > $$d/whole-runs.txt 2>> $$d/bench.log; \
 	$(BIN)/python -m tests.fuzz.run --seconds $(FUZZ_SECONDS) --out $$d/fuzz; f=$$?; \
-	HYPOTHESIS_PROFILE=nightly $(BIN)/python -m pytest -q -n 2 --dist loadgroup -p no:cacheprovider -m "slow or not slow" \
+	HYPOTHESIS_PROFILE=nightly $(BIN)/python -m pytest -q -n $(PYTEST_WORKERS) --dist loadgroup -p no:cacheprovider -m "slow or not slow" \
 	  > $$d/slow-tests.log 2>&1; t=$$?; tail -1 $$d/slow-tests.log; \
 	$(BIN)/python -m conformance.nightly reports/nightly || exit $$?; \
 	echo "nightly reports: $$d (index: reports/nightly/index.html; slow tests: $$d/slow-tests.log)"; \

@@ -46,7 +46,7 @@ def npm_ci(folder: Path = EXTENSION, env: dict[str, str] | None = None, timeout:
     node_or_fail()
     sha = _lock_sha(folder)
     stamp = folder / "node_modules" / ".installed"
-    # one installer at a time (pytest -n 2 runs the grammar and client tests in two workers)
+    # one installer at a time (make test runs the grammar and client tests in separate pytest workers)
     with open(folder / ".npm-ci.lock", "w") as lock:
         fcntl.flock(lock, fcntl.LOCK_EX)
         if not (stamp.exists() and stamp.read_text().strip() == sha):
