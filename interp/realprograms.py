@@ -56,6 +56,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import multiprocessing
 import re
 import sys
 import time
@@ -64,6 +65,8 @@ from pathlib import Path
 
 from interp.runtime.core import TARGET_OUTSIDE_NOTE
 from interp.runtime.program import parse_module
+from krl import limits
+from krl.parsecache import load_files
 from krl.files import SHARED_CORPUS as DEFAULT_CORPUS
 from krl.project import (
     backup_of, boot_submit, find_backups, machine_data_file, system_folder, system_folder_of,
@@ -180,7 +183,19 @@ def programs_of(root: Path, files: list[Path] | None = None) -> list[Path]:
         parts = [x.upper() for x in rel.parts]
         if "PROGRAM" in parts or p.stem.upper() == "CELL" or p.parent == root:
             cands.append(p)
+    _parse_batch(cands)
     return [p for p in cands if is_program(p)]
+
+
+def _parse_batch(paths: list[Path]) -> None:
+    """Put the parses of `paths` in the one store as one batch (krl.parsecache.load_files: the
+    Java engine parses a batch where there is a JDK, each file within krl.limits.PARSE_TIMEOUT_S), so that
+    :func:`is_program` reads each from the store. One by one, a cold store parsed them in this
+    process with the Python engine: 21 s for the corpus's backups, paid by every pytest worker
+    that listed them at collection. Not in a worker process (``krl audit``'s, a Dask worker's):
+    it may not start the pool of parse workers, and parses one by one as before."""
+    if len(paths) > 1 and not multiprocessing.current_process().daemon:
+        load_files([str(p) for p in paths], timeout=limits.PARSE_TIMEOUT_S)
 
 
 def is_program(path: Path) -> bool:
@@ -204,6 +219,7 @@ def folder_entries(files: list[Path]) -> list[Path]:
     routine is a DEF without parameters (:func:`is_program`), and every .sub submit program
     (run alone, as an SPS.SUB entry of a backup is), in the order given."""
     out = []
+    _parse_batch([p for p in files if p.suffix.lower() == ".src" and p.is_file()])
     for p in files:
         suffix = p.suffix.lower()
         if (suffix == ".sub" and p.is_file()) or (suffix == ".src" and p.is_file() and is_program(p)):
