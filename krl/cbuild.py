@@ -51,7 +51,8 @@ def other_checkout_command(python: str, script: str, *args: str) -> list[str]:
 
 def build_jobs() -> int:
     """How many extensions a package build translates and compiles at once: one per core this
-    process may run on."""
+    process may run on (krl.pool.default_jobs's rule, written again here: this module is loaded
+    by path in the isolated build environment and imports nothing of the project)."""
     try:
         return max(1, len(os.sched_getaffinity(0)))
     except (AttributeError, OSError):

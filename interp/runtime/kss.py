@@ -193,7 +193,7 @@ class SystemSoftware:
         checker's one decision; a name only a file that does not parse mentions may be the
         program's own, declared there: it stays the program's error)."""
         if self._outside is None:
-            self._outside = self.rt.program.derived("kss.outside", _outside_of)
+            self._outside = kuka_names(self.rt.program)
         return self._outside
 
     def use_types(self) -> dict:
@@ -393,12 +393,17 @@ def _param_types(call: N.Call, ws) -> list:
     return []
 
 
-def _outside_of(program) -> dict:
-    """:meth:`SystemSoftware.outside` of `program`'s checked workspace (read-only; made once per
-    workspace, Program.derived)."""
-    unresolved = program.ws.unresolved()
-    found = unresolved.classify() if unresolved is not None else {}
-    return {key: o.why for key, o in found.items() if o.kuka}
+def kuka_names(program) -> dict:
+    """(kind, UPPER name) -> why, for every name the checker found outside the backup and calls
+    KUKA's (krl/semantics/outside.py ``Unresolved.classify``, ``Outside.kuka``: the checker's one
+    decision, issue 46), in `program`'s checked workspace; made once per workspace
+    (interp/runtime/program.py ``Program.derived``) and read by the stand-ins (:meth:`SystemSoftware.outside`) and
+    interp/runtime/program.py ``Program.declared_type``. Read-only."""
+    def make(prog) -> dict:
+        un = prog.ws.unresolved()
+        found = un.classify() if un is not None else {}
+        return {key: o.why for key, o in found.items() if o.kuka}
+    return program.derived("kuka_names", make)
 
 
 def _use_types_of(program) -> tuple[dict, dict]:

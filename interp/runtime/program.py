@@ -43,7 +43,7 @@ from krl.parsecache import load_file, load_project
 
 from .convert import assign_into, convert_scalar
 from .errors import KrlRuntimeError, ResourceError
-from .kss import standard_files
+from .kss import kuka_names, standard_files
 from .memory import Slot, SignalRef, index_ref
 from .natives import LINKS
 from .values import UNSET, Struct, data_size, make_value
@@ -473,11 +473,8 @@ class Program:
 
 
 def _outside_types(program: Program) -> frozenset:
-    """The types the checker calls KUKA's (W105, ``Outside.kuka``) in `program`'s checked
-    workspace: :meth:`Program.declared_type`'s decision, made once per workspace."""
-    un = program.ws.unresolved()
-    found = un.classify() if un is not None else {}
-    return frozenset(k for (kind, k), o in found.items() if kind == "type" and o.kuka)
+    """The types among :func:`kuka_names` (W105): :meth:`Program.declared_type`'s decision."""
+    return frozenset(k for kind, k in kuka_names(program) if kind == "type")
 
 
 class _InitialiserEnv(Env):

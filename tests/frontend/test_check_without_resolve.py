@@ -49,12 +49,19 @@ def test_the_diagnostics_are_a_full_checks(backups):
         assert _diags(light), f"{b}: no diagnostic at all (the comparison would be vacuous)"
 
 
+def _with_facts(ws) -> list:
+    """The top-level statements of the workspace's routines that carry the resolver's advance-run
+    facts (``ann.info``)."""
+    return [n for u in ws.units if u.src is not None for r in u.src.module.routines
+            for n in r.body if getattr(n, "ann", None) is not None and getattr(n.ann, "info", None) is not None]
+
+
 def test_a_later_full_check_places_the_storage(backups):
     ws = _loaded(_smallest(backups, 1)[0])
-    first = _diags(ws) if ws.check(resolve=False) is not None else None
+    ws.check(resolve=False)
+    first = _diags(ws)
+    assert ws.resolver is None and _with_facts(ws) == [], "the checker alone placed storage"
     ws.check()                      # a run's check: the places are made now, the findings stay
     assert ws.resolver is not None
     assert _diags(ws) == first
-    named = [n for u in ws.units if u.src is not None for r in u.src.module.routines
-             for n in r.body if getattr(n, "ann", None) is not None and getattr(n.ann, "info", None) is not None]
-    assert named, "no statement got its advance-run facts from the resolver"
+    assert _with_facts(ws), "no statement got its advance-run facts from the resolver"
