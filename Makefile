@@ -68,7 +68,7 @@ growth: $(PARSER) java-parser
 validate: $(PARSER) java-parser
 	$(BIN)/krl validate
 
-# Three pytest workers on the 2-core machine: a quarter of the workers' time is spent waiting on
+# Three pytest workers on the 2-core machine: a fifth of the workers' time (380 of 1820 s, profiled) is spent waiting on
 # the processes a test starts (the browser, krl pendant, krl debug, the package build) or on a
 # partner's answer; a third worker runs CPU work meanwhile (15 min 17 s with two workers at the
 # start of 2026-11-25, 11 min 15 s with three; four were slower again: docs/architecture.md, "The test suite")
