@@ -138,6 +138,7 @@ class Engine:
         self.core: RunEngine | None = None
         self.thread = None
         self.live: dict = {}
+        self.snapshots = 0                     # state snapshots taken (pendant/state.py snapshot: their seq)
         self.notes: list[dict] = []
         self.signals: list[dict] | None = None
         self.path: list[tuple] = []            # the TCP path of this run: (X, Y, Z mm in $WORLD, blending)

@@ -91,6 +91,7 @@ class Pendant:
         self._path_run, self._path_sent = None, 0
         self._shown: dict[WebSocket, dict] = {}     # per page: the state it was last sent
         self._pushing = asyncio.Lock()
+        self._pushed_seq = 0                        # the newest engine snapshot pushed (pendant/state.py)
         self._modules: dict[str, tuple] = {}
         self._position = None                       # where the robot stands when no program is selected
 
@@ -183,7 +184,16 @@ class Pendant:
             await self._push_state(fresh)
 
     async def _push_state(self, fresh: dict | None) -> None:
+        # A key's snapshot is taken in its engine call, and pushed when the key's coroutine
+        # resumes; meanwhile the run may have gone on and a newer snapshot been pushed (the
+        # program ended right after an acknowledgement: the "exited" event's push came first).
+        # An older snapshot is never pushed over a newer one: the state is asked for anew.
+        if fresh is not None and fresh.get("seq", 0) < self._pushed_seq:
+            fresh = None
         s = await self.state(fresh)
+        seq = s.pop("seq", None)
+        if seq is not None:
+            self._pushed_seq = max(self._pushed_seq, seq)
         texts: dict[tuple, str] = {}                  # one encoding per distinct message
         for ws in list(self.clients):
             last = self._shown.get(ws)

@@ -21,9 +21,13 @@ FRAME_KEYS = ("X", "Y", "Z", "A", "B", "C")
 
 def snapshot(eng, core, watch: list) -> dict:
     """The page's state (engine thread): ``eng`` the pendant's :class:`pendant.engine.Engine`
-    (notes, signals), ``core`` its run-control engine, ``watch`` the watched expressions."""
+    (notes, signals), ``core`` its run-control engine, ``watch`` the watched expressions.
+    ``seq`` numbers the snapshots in the order the engine thread took them
+    (``Engine.snapshots``): the server never pushes one older than a snapshot it pushed
+    already (pendant/server.py ``Pendant._push_state``)."""
     rt = core.rt
-    out = {"state": core.state, "pointers": core.pointers() if rt is not None else {},
+    eng.snapshots += 1
+    out = {"seq": eng.snapshots, "state": core.state, "pointers": core.pointers() if rt is not None else {},
            "messages": message_rows(eng, rt)}
     if rt is None:
         return out
