@@ -66,8 +66,8 @@ class _Events:
         elif kind == "error":
             self.errors.append({"t": round(t, 3), "text": str(fields.get("text") or ""), "line": fields.get("line")})
 
-    def write_pose(self, t: float, axes: Any, tcp_T: Any) -> None:
-        pass
+    #: no pose events (robot/trace.py TraceWriter.takes_poses)
+    takes_poses = False
 
 
 def event_kind(text: str) -> str:

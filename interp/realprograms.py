@@ -381,8 +381,8 @@ class RunEvents:
                 if len(self.requests) < MAX_ROW_REQUESTS:
                     self.requests.append(round(t, 3))
 
-    def write_pose(self, t: float, axes, tcp_T) -> None:
-        pass
+    #: no pose events (robot/trace.py TraceWriter.takes_poses)
+    takes_poses = False
 
     def add(self, t: float, text: str, file, line) -> None:
         kind = motion_event_kind(text)

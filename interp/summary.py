@@ -50,7 +50,8 @@ class RunObserver:
     """A trace writer in front of another (or of none): records the controller's events.
 
     Implements the part of :class:`robot.trace.TraceWriter` the controller uses
-    (``write``, ``write_pose``); every call is forwarded to `inner` first.
+    (``write``, ``write_pose``, ``takes_poses``); every call is forwarded to `inner` first.
+    It takes the poses only for `inner` (a summary has no use for them).
     """
 
     inner: Any = None
@@ -79,9 +80,12 @@ class RunObserver:
             self.notes.append(Note(t, "error", f"{fields.get('text', '')}{num}{where}"))
         return ev
 
+    @property
+    def takes_poses(self) -> bool:
+        return self.inner is not None and self.inner.takes_poses
+
     def write_pose(self, t: float, axes: Any, tcp_T: Any) -> None:
-        if self.inner is not None:
-            self.inner.write_pose(t, axes, tcp_T)
+        self.inner.write_pose(t, axes, tcp_T)
 
 
 def _where(file: str | None, line: int | None) -> str:

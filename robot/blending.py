@@ -122,17 +122,20 @@ def _zone_start_tau(prev: Segment, nxt: Segment | None, keyword: str) -> float |
         return prof.t_total
     if nxt is not None:
         d = min(d, nxt.path_length / 2.0)
+    # the last of the 33 points of the segment's second half still farther than d from its end:
+    # scanned back from the end, each point's distance made when the scan reaches it (the
+    # zone is mostly a few of them; the same distances as made all at once)
     us = np.linspace(0.5, 1.0, 33)
-    dist = [prev.tcp_dist_to_end(float(u)) for u in us]
+    end = prev.end_pose()[0]
     k = len(us) - 1
-    while k > 0 and dist[k - 1] <= d:
+    while k > 0 and prev.tcp_dist_to_end(float(us[k - 1]), end) <= d:
         k -= 1
     if k == 0:
         return prof.t_of_u(0.5)
     lo, hi = float(us[k - 1]), float(us[k])  # dist(lo) > d >= dist(hi)
     for _ in range(30):
         mid = 0.5 * (lo + hi)
-        if prev.tcp_dist_to_end(mid) <= d:
+        if prev.tcp_dist_to_end(mid, end) <= d:
             hi = mid
         else:
             lo = mid

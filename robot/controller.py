@@ -940,8 +940,9 @@ class Controller:
                 fn(self)
         if self.stimuli and self._runs:
             self._reach_stimuli()
-        if self.trace is not None:
-            self.trace.write_pose(t, qa, self._tcp_T)
+        tr = self.trace
+        if tr is not None and tr.takes_poses:
+            tr.write_pose(t, qa, self._tcp_T)
         return self._events
 
     # ----------------------------------------------------------------- main run

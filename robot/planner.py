@@ -652,8 +652,11 @@ class JointSegment(Segment):
             return 0.0
         return float(np.interp(s, ss, us))
 
-    def tcp_dist_to_end(self, u: float) -> float:
-        p_end = self.end_pose()[0]
+    def tcp_dist_to_end(self, u: float, p_end: np.ndarray | None = None) -> float:
+        """:meth:`Segment.tcp_dist_to_end`; `p_end`: the end point's position when the caller
+        has it already (``end_pose()[0]``)."""
+        if p_end is None:
+            p_end = self.end_pose()[0]
         return float(np.linalg.norm(self.pose_u(u)[0] - p_end))
 
 

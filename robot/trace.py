@@ -246,7 +246,14 @@ class TraceWriter:
     (the robot moves) is progress: no event repeats one before it. Before the next written event a ``repeat`` event says how
     many events of each kind were left out, since when, how many whole passes and of how many
     events. None (the default) writes every event.
+
+    ``takes_poses``: the controller passes its per-IPO-cycle pose to :meth:`write_pose` only
+    for a trace whose ``takes_poses`` is true (an observer of the controller's events that has
+    no use for poses says false: the TCP read back is then made only where the run asks for it,
+    robot/controller.py ``Controller._tcp_T``).
     """
+
+    takes_poses = True
 
     def __init__(self, target: str | Path | IO[str] | None = None, *, keep: bool = False,
                  pose_every: int = 1, repeats: int | None = None) -> None:

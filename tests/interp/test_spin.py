@@ -234,6 +234,7 @@ class _ControllerEvents:
     audit attach one (make_runtime ``observer=``): every event and pose the controller writes."""
 
     inner = None
+    takes_poses = True
 
     def __init__(self) -> None:
         self.events: list = []
