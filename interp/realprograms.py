@@ -192,10 +192,12 @@ def _parse_batch(paths: list[Path]) -> None:
     Java engine parses a batch where there is a JDK, each file within krl.limits.PARSE_TIMEOUT_S), so that
     :func:`is_program` reads each from the store. One by one, a cold store parsed them in this
     process with the Python engine: 21 s for the corpus's backups, paid by every pytest worker
-    that listed them at collection. Not in a worker process (``krl audit``'s, a Dask worker's):
-    it may not start the pool of parse workers, and parses one by one as before."""
-    if len(paths) > 1 and not multiprocessing.current_process().daemon:
-        load_files([str(p) for p in paths], timeout=limits.PARSE_TIMEOUT_S)
+    that listed them at collection. In a worker process (``krl audit``'s, a Dask worker's),
+    which may not start the pool of parse workers, the batch is parsed here
+    (krl.workspace.load_here)."""
+    if len(paths) > 1:
+        daemon = multiprocessing.current_process().daemon
+        load_files([str(p) for p in paths], timeout=None if daemon else limits.PARSE_TIMEOUT_S)
 
 
 def is_program(path: Path) -> bool:

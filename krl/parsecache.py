@@ -24,8 +24,8 @@ from krl.ast import nodes as N
 from krl.diagnostics import Diagnostic, Note
 from krl.source import read_source
 from krl.store import Store, parse_key, shared_store
-from krl import workspace
-from krl.workspace import LoadedFile, Workspace, failed_load, load_batch, load_parsed, loading_files_by
+from krl import limits, workspace
+from krl.workspace import LoadedFile, Workspace, failed_load, load_batch, load_here, loading_files_by
 
 
 _CLASSES = sorted((c for c in vars(N).values() if isinstance(c, type) and dataclasses.is_dataclass(c)
@@ -257,7 +257,7 @@ def load_files(paths: list, timeout: float | None = None, store: Store | None = 
     """The LoadedFile of each of `paths`, in order: from the store (`store`, default the
     process's :func:`krl.store.shared_store`) by content hash, the others parsed (in worker
     processes with `timeout` seconds per file and `jobs` workers, as
-    :meth:`krl.workspace.Workspace.add_files`, else here by the Python engine) and put in the
+    :meth:`krl.workspace.Workspace.add_files`, else here: :func:`krl.workspace.load_here`) and put in the
     store (:func:`keep_parses`: not those stopped). Never raises for bad content."""
     store = shared_store() if store is None else store
     sources = [read_source(p) for p in paths]
@@ -270,8 +270,8 @@ def load_files(paths: list, timeout: float | None = None, store: Store | None = 
         return out
     status = {}
     if timeout is None:
-        for i in missing:
-            out[i], status[i] = load_parsed(sources[i]), "done"
+        for i, lf in zip(missing, load_here([sources[i] for i in missing], limits.PARSE_TIMEOUT_S)):
+            out[i], status[i] = lf, "done"
     else:
         for i, o in zip(missing, load_batch([sources[i].path for i in missing], timeout, jobs)):
             out[i] = o.value if o.status == "done" else failed_load(sources[i].path, o, timeout)

@@ -9,6 +9,7 @@ the corpora, is in tests/syntax/test_engines.py.
 from __future__ import annotations
 
 import json
+import os
 import subprocess
 import sys
 import time
@@ -282,3 +283,46 @@ def test_a_loaded_file_leaves_its_parse_tree_to_reference_counting(engine, text)
     assert len(nodes) <= (1 if engine == "python" else 0)
     assert all(isinstance(o, ParserRuleContext) and not o.children for o in nodes)
     assert [r.name.upper() for r in lf.module.routines] == (["A"] * 20 if text != BROKEN else ["B"])
+
+
+def _load_here_in_worker(paths: list[str], engine: str) -> tuple:
+    """In a worker process of krl.pool (as ``krl audit``'s check runs): its pid, the files
+    loaded there (krl.workspace.load_here), how many the Java engine answered."""
+    import os  # noqa: PLC0415
+
+    os.environ["KRL_ENGINE"] = engine
+    answered = []
+    real = workspace_mod.java_answers
+
+    def counting(*a, **kw):
+        for i, src, raw in real(*a, **kw):
+            answered.append(raw is not None)
+            yield i, src, raw
+
+    workspace_mod.java_answers = counting
+    loaded = workspace_mod.load_here([read_source(p) for p in paths], 60.0)
+    return os.getpid(), sum(answered), [(lf.module, lf.diagnostics) for lf in loaded], \
+        [[n.span for n in lf.module.walk()] for lf in loaded]
+
+
+@needs_java
+def test_load_here_parses_a_batch_with_the_java_engine_in_a_worker_process(shared_corpus):
+    """krl.workspace.load_here in a worker process (a Dask worker may not start the pool of
+    parse workers): a batch of at least JAVA_BATCH_BYTES goes to the Java engine's worker (started by
+    that process), with the same ASTs, spans and diagnostics as the Python engine gives; a
+    smaller batch is parsed by the Python engine."""
+    from krl.pool import run_tasks  # noqa: PLC0415
+
+    _java_or_skip()
+    backup = shared_corpus / "rawpython__kukaKRLmagic"
+    paths = [e.path for e in collect_entries(backup) if e.kind == "file"]
+    assert sum(read_source(p).size for p in paths) >= workspace_mod.JAVA_BATCH_BYTES
+    small = [p for p in paths if read_source(p).size < 2000][:3]
+    tasks = [("java", (paths, "auto")), ("python", (paths, "python")), ("small", (small, "auto"))]
+    got = {o.key: o.value for o in run_tasks(_load_here_in_worker, tasks, jobs=2)}
+    pid, answered, loaded_jv, spans_jv = got["java"]
+    assert pid != os.getpid() and answered >= 30              # of 34 files; the rest need a Python-only check
+    _d, answered_py, loaded_py, spans_py = got["python"]
+    assert answered_py == 0
+    assert loaded_jv == loaded_py and spans_jv == spans_py
+    assert got["small"][1] == 0 and len(got["small"][2]) == len(small) > 0
