@@ -168,11 +168,13 @@ def run_entry(path: str, max_sim_time: float, max_steps: int, interp: str) -> di
 
 
 def _outcomes(fn: Callable, tasks: list, *, jobs: int | None, scheduler: str | None, timeout: float | None,
-              name: str):
+              name: str, group: Callable | None = None):
     """The outcomes (krl.pool.Outcome) of `fn` over `tasks` (``(key, args)``), in completion
     order: in `jobs` killable worker processes (krl.pool.run_tasks, each task at most
-    `timeout` s of wall time), or on the Dask cluster at `scheduler` (krl.cluster.run_batches,
-    one task per batch). Raises krl.cluster.SchedulerError."""
+    `timeout` s of wall time; `group`: its ``group``, the unit of a run, so that a worker runs
+    one unit's entry points after the other and loads each unit once), or on the Dask cluster
+    at `scheduler` (krl.cluster.run_batches, one task per batch). Raises
+    krl.cluster.SchedulerError."""
     if scheduler is not None:
         # costs 0.01 s at start-up (python -X importtime, 2026-11-25)
         from krl.cluster import run_batches  # noqa: PLC0415
@@ -181,7 +183,7 @@ def _outcomes(fn: Callable, tasks: list, *, jobs: int | None, scheduler: str | N
     # costs 0.02 s at start-up (python -X importtime, 2026-11-25)
     from krl.pool import run_tasks  # noqa: PLC0415
 
-    return run_tasks(fn, tasks, jobs=jobs, timeout=timeout)
+    return run_tasks(fn, tasks, jobs=jobs, timeout=timeout, group=group)
 
 
 def run_audit(folders: list[str], *, jobs: int | None = None, scheduler: str | None = None,
@@ -230,7 +232,7 @@ def run_audit(folders: list[str], *, jobs: int | None = None, scheduler: str | N
         say("run", 0, len(runs), "")
         run_tasks = [(k, (path, max_sim_time, max_steps, interp)) for k, (_i, path) in enumerate(runs)]
         for k, o in enumerate(_outcomes(run_entry, run_tasks, jobs=jobs, scheduler=scheduler, timeout=run_timeout,
-                                        name="krl-audit-run"), 1):
+                                        name="krl-audit-run", group=lambda key: runs[key][0]), 1):
             path = runs[o.key][1]
             if o.status == "done":
                 rows[o.key] = o.value

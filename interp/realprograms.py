@@ -651,7 +651,9 @@ def run_rows(corpus: Path, max_sim_time: float = REPORT_SIM_TIME_S, max_steps: i
         # costs 0.006 s at start-up (python -X importtime, 2026-11-25)
         from interp import run as _loaded  # noqa: F401, PLC0415  (forked workers start with the runtime imported)
 
-        outcomes = run_tasks(run_one, tasks, jobs=jobs, timeout=None)
+        # a backup's programs in one worker after the other: it loads the backup once
+        outcomes = run_tasks(run_one, tasks, jobs=jobs, timeout=None,
+                             group=lambda k: backup_of(Path(tasks[k][1][0])) or Path(tasks[k][1][0]).parent)
     else:
         # costs 0.005 s at start-up (python -X importtime, 2026-11-25)
         from krl.cluster import run_batches  # noqa: PLC0415

@@ -22,6 +22,7 @@ from antlr4.tree.Tree import TerminalNodeImpl
 
 import krl.syntax.engines as engines_mod
 import krl.workspace as workspace_mod
+from krl.pool import run_tasks
 from krl.syntax.engines import java as java_engine
 from krl.syntax.engines import java_answers, parse_file, result_from_answer
 from krl.syntax.engines.tree import RebuiltToken, TreeDataError, is_acyclic, stream_tokens, tree_from_raw
@@ -288,8 +289,6 @@ def test_a_loaded_file_leaves_its_parse_tree_to_reference_counting(engine, text)
 def _load_here_in_worker(paths: list[str], engine: str) -> tuple:
     """In a worker process of krl.pool (as ``krl audit``'s check runs): its pid, the files
     loaded there (krl.workspace.load_here), how many the Java engine answered."""
-    import os  # noqa: PLC0415
-
     os.environ["KRL_ENGINE"] = engine
     answered = []
     real = workspace_mod.java_answers
@@ -311,8 +310,6 @@ def test_load_here_parses_a_batch_with_the_java_engine_in_a_worker_process(share
     parse workers): a batch of at least JAVA_BATCH_BYTES goes to the Java engine's worker (started by
     that process), with the same ASTs, spans and diagnostics as the Python engine gives; a
     smaller batch is parsed by the Python engine."""
-    from krl.pool import run_tasks  # noqa: PLC0415
-
     _java_or_skip()
     backup = shared_corpus / "rawpython__kukaKRLmagic"
     paths = [e.path for e in collect_entries(backup) if e.kind == "file"]
