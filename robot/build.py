@@ -37,8 +37,9 @@ MODULE = "robot.simcore"
 FASTPATH = HERE / "kinematics" / "fastpath.py"
 FASTPATH_PXD = HERE / "kinematics" / "fastpath.pxd"
 FASTPATH_MODULE = "robot.kinematics.fastpath"
-#: C flags: optimised, and no contraction of a * b + c into one rounding (bit-identical results)
-CFLAGS = ["-O2", "-ffp-contract=off", "-fno-fast-math"]
+#: C flags: optimised, and no contraction of a * b + c into one rounding (bit-identical results);
+#: no debug information (as interp/vm/build.py's CFLAGS: a fifth of the compile)
+CFLAGS = ["-O2", "-g0", "-ffp-contract=off", "-fno-fast-math"]
 
 
 def source_sha() -> str:
