@@ -57,6 +57,7 @@ import argparse
 import json
 import math
 import multiprocessing
+import os
 import re
 import sys
 import time
@@ -183,28 +184,52 @@ def programs_of(root: Path, files: list[Path] | None = None) -> list[Path]:
         parts = [x.upper() for x in rel.parts]
         if "PROGRAM" in parts or p.stem.upper() == "CELL" or p.parent == root:
             cands.append(p)
-    _parse_batch(cands)
-    return [p for p in cands if is_program(p)]
+    return [p for p, yes in zip(cands, _are_programs(cands)) if yes]
 
 
-def _parse_batch(paths: list[Path]) -> None:
-    """Put the parses of `paths` in the one store as one batch (krl.parsecache.load_files: the
-    Java engine parses a batch where there is a JDK, each file within krl.limits.PARSE_TIMEOUT_S), so that
-    :func:`is_program` reads each from the store. One by one, a cold store parsed them in this
-    process with the Python engine: 21 s for the corpus's backups, paid by every pytest worker
-    that listed them at collection. In a worker process (``krl audit``'s, a Dask worker's),
-    which may not start the pool of parse workers, the batch is parsed here
-    (krl.workspace.load_here)."""
-    if len(paths) > 1:
+#: (path, size, modification time) -> whether it is a program (:func:`_are_programs`), this process's
+_PROGRAMS: dict[tuple, bool] = {}
+
+
+def _are_programs(paths: list[Path]) -> list[bool]:
+    """:func:`is_program` of each of `paths`, the files not seen before (their path, size and
+    modification time: :data:`_PROGRAMS`) read as one batch through the one store
+    (krl.parsecache.load_files: the Java engine parses a batch where there is a JDK, each file
+    within krl.limits.PARSE_TIMEOUT_S; in a worker process, ``krl audit``'s or a Dask worker's,
+    which may not start the pool of parse workers, here: krl.workspace.load_here). One by one, a
+    cold store parsed them with the Python engine: 21 s for the corpus's backups; and each
+    listing read every module again (a pytest worker lists the corpus's programs three times
+    at collection)."""
+    keys = []
+    for p in paths:
+        try:
+            st = os.stat(p)
+            keys.append((str(p), st.st_size, st.st_mtime_ns))
+        except OSError:
+            keys.append(None)
+    todo = [i for i, k in enumerate(keys) if k is None or k not in _PROGRAMS]
+    read: dict[int, bool] = {}
+    if todo:
+        if len(_PROGRAMS) > 100_000:
+            _PROGRAMS.clear()
         daemon = multiprocessing.current_process().daemon
-        load_files([str(p) for p in paths], timeout=None if daemon else limits.PARSE_TIMEOUT_S)
+        timeout = None if daemon or len(todo) == 1 else limits.PARSE_TIMEOUT_S
+        for i, lf in zip(todo, load_files([str(paths[i]) for i in todo], timeout=timeout)):
+            read[i] = _program_module(lf.module)
+            if keys[i] is not None:
+                _PROGRAMS[keys[i]] = read[i]
+    return [read[i] if i in read else _PROGRAMS[k] for i, k in enumerate(keys)]
+
+
+def _program_module(mod) -> bool:
+    return bool(mod.routines) and not mod.routines[0].params and mod.routines[0].kind == "DEF"
 
 
 def is_program(path: Path) -> bool:
     """True when the module `path`'s first routine is a DEF without parameters: a program an
     operator can select and start (it passes no arguments)."""
     mod, _errs = parse_module(str(path))
-    return bool(mod.routines) and not mod.routines[0].params and mod.routines[0].kind == "DEF"
+    return _program_module(mod)
 
 
 def entries_of(root: Path, files: list[Path] | None = None) -> list[Path]:
@@ -220,13 +245,9 @@ def folder_entries(files: list[Path]) -> list[Path]:
     among `files` (a walk of the folder, krl.files.walk), every .src module whose first
     routine is a DEF without parameters (:func:`is_program`), and every .sub submit program
     (run alone, as an SPS.SUB entry of a backup is), in the order given."""
-    out = []
-    _parse_batch([p for p in files if p.suffix.lower() == ".src" and p.is_file()])
-    for p in files:
-        suffix = p.suffix.lower()
-        if (suffix == ".sub" and p.is_file()) or (suffix == ".src" and p.is_file() and is_program(p)):
-            out.append(p)
-    return out
+    srcs = [p for p in files if p.suffix.lower() == ".src" and p.is_file()]
+    programs = {p for p, yes in zip(srcs, _are_programs(srcs)) if yes}
+    return [p for p in files if (p.suffix.lower() == ".sub" and p.is_file()) or p in programs]
 
 
 def loose_programs(folder: Path) -> list[Path]:
