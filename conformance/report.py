@@ -73,7 +73,7 @@ def case_outcome(case: H.Case, interps: list[str]) -> CaseOutcome:
 
 
 def _elsewhere(fn, tasks: list[tuple[int, tuple]], name: str, progress, failed, *,
-               scheduler: str | None = None, jobs: int = 1) -> list:
+               scheduler: str | None = None, jobs: int = 1, group=None) -> list:
     """``fn(*args)`` of each task in `jobs` worker processes of this machine (krl/pool.py), or,
     with `scheduler`, on that Dask cluster (krl/cluster.py); the results in the tasks' order,
     `progress(result)` as each arrives (in completion order). A task whose worker fails (it
@@ -89,7 +89,7 @@ def _elsewhere(fn, tasks: list[tuple[int, tuple]], name: str, progress, failed, 
         from krl.pool import run_tasks  # noqa: PLC0415  (pebble: costs 50 ms; only a run with workers pays it)
 
         # no pool timeout: each run has its own wall-clock guard (harness.run_program)
-        outcomes = run_tasks(fn, tasks, jobs=jobs, timeout=None)
+        outcomes = run_tasks(fn, tasks, jobs=jobs, timeout=None, group=group)
         where = "in its worker process"
     got = {}
     for o in outcomes:
@@ -181,8 +181,9 @@ def run_real(corpus: Path = DEFAULT_CORPUS, interps: list[str] | None = None, *,
         progs = progs[:limit]
     tasks = [(i, (prog, corpus, interps, max_sim_time, max_steps)) for i, (prog, _root) in enumerate(progs)]
     if scheduler is not None or jobs > 1:
+        # a backup's programs in one worker after the other: it loads the backup once
         return _elsewhere(real_outcome, tasks, "krl-conformance-real", progress, _real_failed,
-                          scheduler=scheduler, jobs=jobs)
+                          scheduler=scheduler, jobs=jobs, group=lambda i: progs[i][1])
     out = []
     for _i, args in tasks:
         out.append(real_outcome(*args))

@@ -56,6 +56,7 @@ from krl.semantics.outside import template_lines
 from krl.survey.report import known_invalid
 from krl.semantics.symbols import Symbol
 from krl.source import read_source
+from krl.parsecache import through_store
 from krl.workspace import SourceFile, Workspace, load_workspace
 from krl.project import find_backups, is_system_path
 from krl.terminal import printable
@@ -131,7 +132,8 @@ def _programs(corpus: Path) -> list[tuple[Workspace, list[_Program]]]:
     invalid = known_invalid()
     out = []
     for b in find_backups(corpus):
-        ws = load_workspace([b], str(b))
+        with through_store():   # each file's parse from the one store, as krl check reads it
+            ws = load_workspace([b], str(b))
         ws.check(resolve=False)
         err_paths = {d.path for d in ws.diagnostics if d.is_error}
         progs = []
