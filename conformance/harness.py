@@ -53,6 +53,7 @@ import yaml
 import numpy as np
 
 from robot.limits import check_trace
+from robot.trace import load_event
 
 CASES_DIR = Path(__file__).parent / "cases"
 REPO = Path(__file__).resolve().parent.parent
@@ -342,8 +343,8 @@ def run_program(program: Path, interp: str, *, stimuli: Path | None = None,
                     line = line.strip()
                     if line:
                         try:
-                            events.append(json.loads(line))
-                        except json.JSONDecodeError:
+                            events.append(load_event(line))
+                        except ValueError:
                             crash = crash or f"trace line is not JSON: {line[:120]}"
         elif crash is None:
             crash = f"no trace written (exit code {code}): {output.strip()[-500:]}"
@@ -391,12 +392,16 @@ def flow_tokens(events: list[dict[str, Any]], case: Case | None = None, *,
         routines = case.routines() - {"PROGRAM"}   # the run's own top-level call is implied
         sub_routines = case.routines(suffix=".sub")
     pending_handler: str | None = None
+    names: dict[str, str] = {}      # a stmt event's file -> its name in lower case, made once
     for ev in events:
         k = ev.get("kind")
         if k == "stmt":
             pending_handler = None
             ctx = ev.get("context") or "main"
-            fname = Path(str(ev.get("file", ""))).name.lower()
+            file = str(ev.get("file", ""))
+            fname = names.get(file)
+            if fname is None:
+                fname = names[file] = Path(file).name.lower()
             if case is not None:
                 if ctx == "trigger":
                     continue
