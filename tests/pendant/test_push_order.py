@@ -51,12 +51,16 @@ class _Page:
                 self.state[k] = v
 
 
-def test_an_older_snapshot_is_not_pushed_over_a_newer_one(tmp_path):
-    pendant = Pendant(tmp_path)
-    core = _Core()
+def _served(tmp_path) -> tuple[Pendant, _Core, _Page]:
+    """A pendant of an empty folder whose engine is the stand-in, with one page connected."""
+    pendant, core, page = Pendant(tmp_path), _Core(), _Page()
     pendant.engine.core = core
-    page = _Page()
     pendant.clients.add(page)
+    return pendant, core, page
+
+
+def test_an_older_snapshot_is_not_pushed_over_a_newer_one(tmp_path):
+    pendant, core, page = _served(tmp_path)
 
     async def scenario():
         await pendant.push_state()                         # the page's first state: running
@@ -73,11 +77,7 @@ def test_an_older_snapshot_is_not_pushed_over_a_newer_one(tmp_path):
 
 
 def test_a_key_snapshot_newer_than_the_last_push_is_pushed_as_taken(tmp_path):
-    pendant = Pendant(tmp_path)
-    core = _Core()
-    pendant.engine.core = core
-    page = _Page()
-    pendant.clients.add(page)
+    pendant, core, page = _served(tmp_path)
     asked = []
     post = core.post
     core.post = lambda fn, *a: (asked.append(1), post(fn, *a))[1]
