@@ -14,7 +14,6 @@ gives the same bytes.
 from __future__ import annotations
 
 import json
-import re
 import warnings
 from collections import deque
 from collections.abc import Callable, Iterator
@@ -634,23 +633,41 @@ def read_trace(source: str | Path | IO[str]) -> Iterator[dict[str, Any]]:
 
 
 def load_event(line: str | bytes) -> dict[str, Any]:
-    """One line of a trace as data: by orjson (a third of the json module's time: reading the
-    traces back was a tenth of ``krl conformance``'s CPU, 2026-11-25), by the json module where
-    orjson refuses what json reads (NaN and Infinity, which :meth:`TraceWriter.write_event`
-    writes as json.dumps does; a lone surrogate escape) and for a line with a run of 19 digits
-    or more (orjson reads an integer past 64 bits as a float; the json module as it is): the
-    same data. Raises ValueError for a line that is no JSON."""
-    if (_LONG_DIGITS_B if isinstance(line, bytes) else _LONG_DIGITS).search(line) is None:
-        try:
-            return orjson.loads(line)
-        except orjson.JSONDecodeError:
-            pass
-    return json.loads(line)
+    """One line of a trace as data: by orjson (a 110 744-line trace of a palletizer program in
+    0.12 s of CPU against the json module's 0.27 s, 2026-11-25; reading the traces back was a
+    tenth of ``krl conformance``'s CPU), by the json module where orjson refuses what json reads
+    (NaN and Infinity, which :meth:`TraceWriter.write_event` writes as json.dumps does; a lone
+    surrogate escape) or reads otherwise (an integer past 64 bits, which orjson reads as a float:
+    a result holding a float of magnitude 2**63 or more is read again): the same data. Raises
+    ValueError for a line that is no JSON."""
+    try:
+        data = orjson.loads(line)
+    except orjson.JSONDecodeError:
+        return json.loads(line)
+    return json.loads(line) if _past_int64(data) else data
 
 
-#: a run of digits that may be an integer past 64 bits (load_event)
-_LONG_DIGITS = re.compile(r"\d{19}")
-_LONG_DIGITS_B = re.compile(rb"\d{19}")
+#: the smallest magnitude of a float orjson makes of an integer it cannot hold in 64 bits
+_INT64 = float(2 ** 63)
+
+
+def _past_int64(x) -> bool:
+    """True when `x` (parsed JSON) holds a float of magnitude 2**63 or more (:func:`load_event`)."""
+    t = type(x)
+    if t is float:
+        return not -_INT64 < x < _INT64
+    if t is dict:
+        x = x.values()
+    elif t is not list:
+        return False
+    for v in x:
+        tv = type(v)
+        if tv is float:
+            if not -_INT64 < v < _INT64:
+                return True
+        elif (tv is list or tv is dict) and _past_int64(v):
+            return True
+    return False
 
 
 def validate_event(ev: dict[str, Any]) -> None:

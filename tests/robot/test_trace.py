@@ -105,8 +105,8 @@ def test_frames_of_poses_in_gimbal_lock_are_matrix_to_frame_each():
 
 def test_a_trace_line_reads_as_the_json_module_reads_it():
     """robot.trace.load_event (orjson, else the json module): the same data for every line a
-    trace holds, those orjson refuses included (NaN, Infinity, an integer past 64 bits, a lone
-    surrogate escape), and ValueError for a line that is no JSON."""
+    trace holds, those orjson refuses or reads otherwise included (NaN, Infinity, a lone surrogate
+    escape, an integer past 64 bits, nested too), and ValueError for a line that is no JSON."""
     import json as _json  # noqa: PLC0415  (the reference reader: the subject of this test)
 
     from robot.trace import load_event  # noqa: PLC0415  (the subject of this test)
@@ -116,7 +116,8 @@ def test_a_trace_line_reads_as_the_json_module_reads_it():
     tw.write("message", 0.5, text="Ä ü \\u00e9 \u2028 done", number=None)
     lines = [ln for ln in tw.lines if ln.strip()]
     lines += ['{"t":1.5e-07,"kind":"x","v":NaN,"w":-Infinity}', '{"t":0,"kind":"x","n":123456789012345678901234}',
-              '{"t":0,"kind":"x","s":"\\ud800"}', '{"t":0.1,"kind":"pose","axes":[0.0,-90.0,1e+16,-0.0]}']
+              '{"t":0,"kind":"x","s":"\\ud800"}',
+              '{"t":0,"kind":"x","big":[1e+20,{"w":-9223372036854775809}],"u64":18446744073709551615}', '{"t":0.1,"kind":"pose","axes":[0.0,-90.0,1e+16,-0.0]}']
     for line in lines:
         got, want = load_event(line), _json.loads(line)
         assert _json.dumps(got, sort_keys=True) == _json.dumps(want, sort_keys=True), line
