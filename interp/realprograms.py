@@ -221,6 +221,14 @@ def _are_programs(paths: list[Path]) -> list[bool]:
     return [read[i] if i in read else _PROGRAMS[k] for i, k in enumerate(keys)]
 
 
+def loaded_with(program: str | Path) -> Path:
+    """What a run of `program` loads and its worker process keeps (interp/runtime/program.py
+    ``checked_workspace``): its backup (krl.project.backup_of), else its folder. The group of
+    its run among others (krl.pool.run_tasks ``group``)."""
+    p = Path(program)
+    return backup_of(p) or p.parent
+
+
 def _program_module(mod) -> bool:
     return bool(mod.routines) and not mod.routines[0].params and mod.routines[0].kind == "DEF"
 
@@ -673,8 +681,7 @@ def run_rows(corpus: Path, max_sim_time: float = REPORT_SIM_TIME_S, max_steps: i
         from interp import run as _loaded  # noqa: F401, PLC0415  (forked workers start with the runtime imported)
 
         # a backup's programs in one worker after the other: it loads the backup once
-        outcomes = run_tasks(run_one, tasks, jobs=jobs, timeout=None,
-                             group=lambda k: backup_of(Path(tasks[k][1][0])) or Path(tasks[k][1][0]).parent)
+        outcomes = run_tasks(run_one, tasks, jobs=jobs, timeout=None, group=lambda k: loaded_with(tasks[k][1][0]))
     else:
         # costs 0.005 s at start-up (python -X importtime, 2026-11-25)
         from krl.cluster import run_batches  # noqa: PLC0415

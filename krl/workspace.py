@@ -204,10 +204,10 @@ def load_batch(paths: list, timeout: float, jobs: int | None = None, threaded: b
 def load_here(sources: list[SourceText], stall: float) -> list[LoadedFile]:
     """Parse and build `sources` in this process, with no worker processes (krl/parsecache.py
     ``load_files`` without a timeout: ``krl audit``'s check of a unit in its worker, a run's
-    small project; a Dask worker, which is daemonic, may not start them): a batch of at least JAVA_BATCH_BYTES is parsed by the Java engine's worker (a
-    JVM this process starts once and keeps; a file it does not answer within `stall` seconds,
-    and what it cannot parse, go to the Python engine), a smaller one by the Python engine, as
-    :func:`load_batch` decides. The same LoadedFiles, in order; never raises for bad content.
+    small project; a Dask worker, which is daemonic, may not start them): a batch of at least
+    JAVA_BATCH_BYTES is parsed by the Java engine's worker (a JVM this process starts once and
+    keeps; a file it does not answer within `stall` seconds, and what it cannot parse, go to the
+    Python engine), a smaller one by the Python engine, as :func:`load_batch` decides. The same LoadedFiles, in order; never raises for bad content.
     The cold store of ``krl audit``'s check, where each worker parsed its backups' files with
     the Python engine: 32 -> 16 s of CPU for the corpus, the JVMs included (2026-11-25)."""
     try:
