@@ -14,6 +14,7 @@ condition under which skipping is honest. Tests that take the corpus fixtures ar
 from __future__ import annotations
 
 import os
+import shutil
 import tempfile
 from pathlib import Path
 import csv
@@ -27,8 +28,12 @@ SHARED_CORPUS = SHARED / "krl-corpus"
 SHARED_HISTORY = SHARED / "krl-history"
 
 # The caches of what the tests run (the one store of the commands and language servers they start: krl/store.py) go to a
-# temporary folder of the session, never to the user's cache folder.
-os.environ.setdefault("KRL_CACHE_DIR", tempfile.mkdtemp(prefix="krl-test-cache-"))
+# temporary folder of the session, never to the user's cache folder. The process that made it (the
+# controller of make test's workers, which inherit it) removes it at the end (pytest_unconfigure):
+# each session left about 3 MB in /tmp.
+_OWN_CACHE_DIR = None if "KRL_CACHE_DIR" in os.environ else tempfile.mkdtemp(prefix="krl-test-cache-")
+if _OWN_CACHE_DIR is not None:
+    os.environ["KRL_CACHE_DIR"] = _OWN_CACHE_DIR
 
 # CI draws the same examples every run (derandomize: a red run is the code's, never the draw's);
 # the nightly draws new ones, and what it finds becomes a fixed regression test
@@ -81,6 +86,11 @@ def pytest_configure(config: pytest.Config) -> None:
     config.pluginmanager.register(_XdistGroups(), "krl-xdist-groups")
     config.addinivalue_line("markers", "may_skip(reason): skipping is honest under the named "
                                        "condition even in CI (say which)")
+
+
+def pytest_unconfigure(config: pytest.Config) -> None:
+    if _OWN_CACHE_DIR is not None:
+        shutil.rmtree(_OWN_CACHE_DIR, ignore_errors=True)
 
 
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
