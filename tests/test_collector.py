@@ -1,7 +1,10 @@
 """The process's one policy on Python's cyclic collector (krl/collector.py).
 
 * Declared once: no module of the project but krl/collector.py pauses, freezes or unfreezes the
-  collector or asks for the size of its permanent generation (tests may, to measure).
+  collector, sets its thresholds or asks for the size of its permanent generation (tests may, to
+  measure).
+* The thresholds are set in every process that loads KRL: in the `krl` command's and in a
+  worker process of krl.pool, the young threshold is krl.collector.YOUNG_THRESHOLD.
 * A KRL run freezes its set-up while it runs and unfreezes it after, in a process that keeps
   nothing frozen; in one that keeps frozen objects (the language server, a debug session) it
   leaves them frozen. In neither does it ask ``gc.get_freeze_count()``, whose cost grows with
@@ -19,7 +22,7 @@ from pathlib import Path
 from tests.test_imports_inside_functions import _files
 
 REPO = Path(__file__).resolve().parents[1]
-ONLY_HERE = {"disable", "freeze", "unfreeze", "get_freeze_count"}
+ONLY_HERE = {"disable", "freeze", "unfreeze", "get_freeze_count", "set_threshold"}
 PROGRAM = REPO / "tests" / "vm" / "programs" / "fast" / "fp_errors.src"
 
 
@@ -98,3 +101,31 @@ def test_a_run_in_a_process_that_keeps_frozen_objects_leaves_them_frozen():
     assert got["after"] <= got["before"]
     assert got["kept_frozen"] is True
     assert got["enabled"] is True
+
+
+_THRESHOLDS = r"""
+import gc, json, sys
+from krl.cli import main
+from krl import collector
+from krl.pool import run_tasks
+try:
+    main(["check", sys.argv[1]])
+except SystemExit as e:
+    assert e.code == 0, e.code
+command = gc.get_threshold()
+# a worker of a fork server (a fresh interpreter importing its preload) sets it itself
+worker = [o.value for o in run_tasks(gc.get_threshold, [(0, ())], jobs=1, preload=("krl.workspace",))]
+print(json.dumps({"command": command, "worker": worker, "policy": collector.YOUNG_THRESHOLD}))
+"""
+
+
+def test_the_tools_processes_collect_at_the_policys_threshold(tmp_path):
+    (tmp_path / "demo.src").write_text("DEF demo()\nEND\n")
+    out = subprocess.run([sys.executable, "-c", _THRESHOLDS, str(tmp_path / "demo.src")], cwd=tmp_path,
+                         capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0, out.stderr[-2000:]
+    got = json.loads(out.stdout.strip().splitlines()[-1])
+    assert got["policy"] == 100_000
+    assert got["command"][0] == got["policy"] and got["worker"][0][0] == got["policy"]
+    # the older generations keep Python's own thresholds
+    assert got["command"][1:] == got["worker"][0][1:] == [10, 10]
