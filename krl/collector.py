@@ -39,10 +39,11 @@ _kept = False      # the process keeps frozen objects (keep() was called)
 #: that live on (ASTs, the checker's annotations, a run's program and motion queue); with
 #: CPython's 700 each young collection scanned the new objects, which survived, and handed them
 #: on to be scanned again. Measured (CPU, warm store, 2026-11-25): ``krl diff`` of a 1.9 MB
-#: history pair 3.6 -> 1.4 s, a palletizer's whole run (600 s simulated) 4.3 -> 3.3 s; Python's
-#: default cost more as the process's heap grew (the same diff: 6.6 s after three other jobs).
-#: Reference cycles are still collected, after more allocations (100 000 young objects: a few
-#: MB). A threshold the process had already raised is kept; the older generations' are Python's.
+#: history pair 3.6 -> 1.4 s; the whole runs of the corpus's 90 entry points, each in a fresh
+#: process (tools/whole_run_bench.py), 35.3 -> 32.2 s. Python's default costs more as the
+#: process holds more (the same diff: 6.6 s after a check and a whole run in the same process).
+#: Reference cycles are still collected, after more allocations (100 000 young objects: about
+#: 10 MB). A threshold the process had already raised is kept; the older generations' are Python's.
 YOUNG_THRESHOLD = 100_000
 
 
