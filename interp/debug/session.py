@@ -51,6 +51,7 @@ class DebugSession:
         self.rfile = rfile
         self.wfile = wfile
         self.wlock = threading.Lock()
+        self._preparing = threading.Thread(target=_prepare, name="krl-debug-imports", daemon=True)
         self.seq = 0
         self.engine = Engine(on_event=self.event, on_runtime=None)
         self.frames: list = []                  # frame id - 1 -> engine Frame (this stop)
@@ -102,7 +103,7 @@ class DebugSession:
     # ------------------------------------------------------------------ main loop
     def serve(self) -> int:
         """Serve until the client disconnects or the input ends; the exit status (0)."""
-        threading.Thread(target=_prepare, daemon=True).start()
+        self._preparing.start()
         threading.Thread(target=self._reader, daemon=True).start()
         self.engine.serve()
         return 0
@@ -121,6 +122,12 @@ class DebugSession:
         if not isinstance(args, dict):
             self.respond(msg, ok=False, message="arguments must be an object")
             return
+        if cmd != "initialize" and self._preparing.is_alive():
+            # a request after initialize waits for the imports _prepare began: one thread
+            # imports the project's packages, never two at once (robot's modules import each
+            # other, and two threads importing them each found the other's half-made module:
+            # "launch: KeyError: 'robot.kinematics'", one launch in three)
+            self._preparing.join()
         try:
             handler(msg, args)
         except (Restart, Terminate):
