@@ -2,8 +2,9 @@
 pause and every freeze of the project goes through here (tests/test_collector.py holds the
 rest of the code to it).
 
-Its thresholds are set when this module is first imported (every process that loads KRL
-imports it: the `krl` command's, the pool's workers, a Dask worker's task, the tests'):
+Its thresholds are set when this module is first imported. Every process of the tools imports
+it: krl.workspace (what loads KRL: the `krl` command's, the pool's workers, a Dask worker's
+task, the tests') and the robot package (``python -m robot.bench``) import it:
 :data:`YOUNG_THRESHOLD` new container objects before a young collection, not CPython's 700.
 
 Three uses, each measured where it is used:

@@ -5,6 +5,11 @@ kinematics with their external axes, the planner and main run, and the MuJoCo mo
 
 import importlib
 
+# The process's policy on Python's garbage collector (krl/collector.py sets the collector's
+# thresholds when it is imported): a process that runs the simulator alone (``python -m
+# robot.bench``) runs under it as the `krl` command does (`krl bench` gives the same figure).
+from krl import collector as _collector  # noqa: F401
+
 # The names below load their module on first use (PEP 562): `krl` commands that do not move
 # the arm (parse, check, recover) never import numpy and scipy.
 _EXPORTS = {

@@ -3,8 +3,9 @@
 * Declared once: no module of the project but krl/collector.py pauses, freezes or unfreezes the
   collector, sets its thresholds or asks for the size of its permanent generation (tests may, to
   measure).
-* The thresholds are set in every process that loads KRL: in the `krl` command's and in a
-  worker process of krl.pool, the young threshold is krl.collector.YOUNG_THRESHOLD.
+* The thresholds are set in every process of the tools: in the `krl` command's, in a worker
+  process of krl.pool and in the simulator's benchmark alone, the young threshold is
+  krl.collector.YOUNG_THRESHOLD.
 * A KRL run freezes its set-up while it runs and unfreezes it after, in a process that keeps
   nothing frozen; in one that keeps frozen objects (the language server, a debug session) it
   leaves them frozen. In neither does it ask ``gc.get_freeze_count()``, whose cost grows with
@@ -117,6 +118,8 @@ command = gc.get_threshold()
 worker = [o.value for o in run_tasks(gc.get_threshold, [(0, ())], jobs=1, preload=("krl.workspace",))]
 print(json.dumps({"command": command, "worker": worker, "policy": collector.YOUNG_THRESHOLD}))
 """
+# the simulator's benchmark on its own (python -m robot.bench): what it imports sets it too
+_SIMULATOR = "import gc, robot.bench, sys; print(gc.get_threshold()[0], 'krl.workspace' in sys.modules)"
 
 
 def test_the_tools_processes_collect_at_the_policys_threshold(tmp_path):
@@ -129,3 +132,6 @@ def test_the_tools_processes_collect_at_the_policys_threshold(tmp_path):
     assert got["command"][0] == got["policy"] and got["worker"][0][0] == got["policy"]
     # the older generations keep Python's own thresholds
     assert got["command"][1:] == got["worker"][0][1:] == [10, 10]
+    out = subprocess.run([sys.executable, "-c", _SIMULATOR], cwd=tmp_path, capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0, out.stderr[-2000:]
+    assert out.stdout.split() == [str(got["policy"]), "False"]
