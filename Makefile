@@ -29,9 +29,10 @@ check-java:
 # installed beside the project's own editable build, whose C extensions compile meanwhile (gcc on
 # the VM loop alone takes about 20 s). Their bytecode caches (CI sets PYTHONDONTWRITEBYTECODE) are
 # written by compileall, their test folders left out (pip would compile all 10 000 files, one
-# after another; like pip, a file that does not compile is left to its import). pip check then holds the installed set to every package's requirements, as
-# pip's resolver did (tests/test_wheel.py: the pins against pyproject.toml's ranges, dev extras
-# included). The install took 63 s on 2 cores, 36 s so (2026-11-25).
+# after another; like pip, a file that does not compile is left to its import). pip check then
+# holds the installed set to every package's requirements, as pip's resolver did
+# (tests/test_wheel.py: the pins against pyproject.toml's ranges, dev extras included). This
+# recipe took 63 s on 2 cores before, about 36 s so (2026-11-25).
 SITE_PACKAGES = $$($(BIN)/python -c 'import sysconfig; print(sysconfig.get_path("purelib"))')
 $(BIN)/.installed: pyproject.toml setup.py constraints.txt | check-python
 	$(PYTHON) -m venv $(VENV)

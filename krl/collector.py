@@ -67,9 +67,9 @@ _set_thresholds()
 
 def _inherited() -> None:
     """In a forked child, right after the fork: what the child inherited is frozen for its life
-    (the child is a process that keeps frozen objects, :func:`keep`). A child that ends its
-    parent's objects' life (drops a cache it inherited) does not get their memory back; it
-    is shared with the parent until written, and the child's collections leave it alone."""
+    (the child is a process that keeps frozen objects, :func:`keep`). Reference counting still
+    frees an inherited object the child drops; only inherited reference cycles are never
+    collected in the child (their memory is the parent's copy until written)."""
     global _kept
     gc.freeze()
     _kept = True
