@@ -142,7 +142,8 @@ class Runtime:
                  "noted", "steps", "max_steps", "robot_budget", "sysvars", "memory", "program", "kss",
                  "modules", "scheduler", "robot", "result", "_plans", "_return_types", "_cyclic",
                  "run_mode", "history", "stmt_hook", "step_hook", "error_hook", "cycle_hook",
-                 "autocell", "halt_continues", "start", "halts", "state_epoch", "spin", "cyclic_watch")
+                 "autocell", "halt_continues", "start", "halts", "state_epoch", "spin", "cyclic_watch",
+                 "restless")
 
     def __init__(self, main_path, *, workspace=None, controller=None, trace=None, stimuli=None,
                  max_sim_time: float | None = None, max_steps: int | None = None,
@@ -183,6 +184,10 @@ class Runtime:
         self._plans: dict = {}          # id(routine) -> Runtime._frame_plan
         self._return_types: dict = {}   # id(routine) -> the checker's return type, checked once
         self._cyclic: dict = {}
+        #: the cyclic flags whose expression does not settle (watch.py ``settles``: it reads a
+        #: timer, the robot's position, a call...): evaluated at every IPO cycle, they may change
+        #: $CYCFLAG at any cycle, so a spin that reads $CYCFLAG is not parked beside one
+        self.restless: set = set()
         # run modes and debugging (interp/runtime/runmode.py, interp/debug)
         self.run_mode = "GO"            # $PRO_MODE of the robot interpreter
         self.history = MotionHistory()  # executed motions, for backward motion
@@ -1118,6 +1123,8 @@ class Runtime:
         flag = key[0] == "cyclic flag"
         watch = self.cyclic_watch
         memo = flag and self._cyclic_settles()
+        if flag and not memo:
+            self.restless.add(key)
         cyc = self.sysvars.store.get("$CYCFLAG") if flag else None
         seen = [None]
 
@@ -1153,6 +1160,7 @@ class Runtime:
 
     def cyclic_off(self, key) -> None:
         h = self._cyclic.pop(key, None)
+        self.restless.discard(key)
         if h is not None:
             self.controller.remove_cyclic(h)
             self.cyclic_watch.anin = any(k[0] == "analog input" for k in self._cyclic)

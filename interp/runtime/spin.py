@@ -44,7 +44,9 @@ passes read:
 * the controller's next step can change an input it reads (``Controller.next_event_cycle``: a
   stimulus, a cell rule's answer, a PULSE's reset; a stimulus on reaching a point while the robot
   moves), or move the robot while the pass reads the robot's position or motion
-  (:data:`MOTION_NAMES`);
+  (:data:`MOTION_NAMES`); a pass that reads ``$CYCFLAG`` is an input's reader (a cyclic flag
+  whose expression settles changes only after the I/O image did: interp/runtime/watch.py
+  ``CyclicWatch``) and is not parked while a flag's expression does not settle;
 * an interrupt of its own would run at its resume (the poll finds one pending);
 * the step limit comes near.
 
@@ -57,9 +59,13 @@ tests/interp/test_spin.py). Every step of a parked cycle is counted, so the step
 ``RunResult.steps`` are those of the unparked run.
 
 The watch works only where nothing observes statements one by one: no trace of the interpreters
-(a trace has every statement), no debugger hook, run mode GO, no network partner, no cyclic flag or analog hook. A
-failed recording is tried again after twice as many cycles (1 to :data:`MAX_GAP`), at once after a
-wake.
+(a trace has every statement), no debugger hook, run mode GO, no network partner, no ``ANIN ON``
+(it writes a variable at every cycle). A failed recording is tried again after twice as many
+cycles (1 to :data:`MAX_GAP`), at once after a wake; a spin that may not be parked yet (what it
+reads may change at the next step: the robot moves, an input is due) after twice as many cycles
+too, up to :data:`MAX_WAIT_GAP`. Until 2026-11-26 it was recorded again at every cycle: a
+backup's SPS.SUB beside a cyclic flag (which kept it from parking) ran 2-3 times slower for
+recordings that could not end in a park.
 
 An observer of the controller alone (the controller's ``trace`` while the runtime's is None:
 interp/summary.py ``RunObserver`` behind ``krl run``'s summary, interp/outcomes.py and
@@ -117,6 +123,9 @@ ALLOWED = (N.Assign, N.CallStmt, N.If, N.Switch, N.For, N.While, N.Repeat, N.Loo
 MAX_PASS_STEPS = 2048
 #: the longest wait between two recordings, in IPO cycles (after repeated failures)
 MAX_GAP = 256
+#: the longest wait between two recordings of a spin that could not be parked when recorded
+#: (what it reads was about to change), in IPO cycles: parked at most this late once it may be
+MAX_WAIT_GAP = 16
 
 
 class _Pass:
@@ -125,7 +134,8 @@ class _Pass:
     step), ``at`` (the statement the task stands at after each step), ``frames`` (its innermost
     frame at each step) and ``images`` (its frames as the idle watch images them at each step),
     ``io`` (it reads I/O), ``motion`` (it reads the robot's position or motion), ``cyclic`` (it
-    reads ``$CYCFLAG``, which a cyclic flag's expression may set at any step), ``probes`` (the
+    reads ``$CYCFLAG``: a cyclic flag whose expression does not settle may set it at any IPO
+    cycle, one that settles only after an input changed: interp/runtime/watch.py ``settles``), ``probes`` (the
     state variables it reads)."""
 
     __slots__ = ("events", "infos", "at", "frames", "images", "io", "motion", "cyclic", "probes", "refs")
@@ -189,8 +199,8 @@ class _Recording:
 
 
 class SpinWatch:
-    """The spin watch of one run (module docstring). ``parks``, ``wakes`` and ``skipped`` (steps
-    not executed) count what it did; ``diverged`` (a catch-up that left the recorded pass) and
+    """The spin watch of one run (module docstring). ``recordings``, ``parks``, ``wakes`` and
+    ``skipped`` (steps not executed) count what it did; ``diverged`` (a catch-up that left the recorded pass) and
     ``missed`` (a parked task's reads changed without a wake) count what must not happen."""
 
     def __init__(self, rt) -> None:
@@ -208,6 +218,7 @@ class SpinWatch:
         self._nodes: dict | None = None
         self._targets: dict = {}    # id(statement) -> the names it writes
         self.parks = self.wakes = self.skipped = self.diverged = self.missed = 0
+        self.recordings = 0         # recordings started
         self.why: dict = {}         # why recordings failed (a count per reason: tests, tuning)
         #: True: a spin is not parked but *shadowed* — the task runs on, and at the end of each
         #: IPO cycle what parking would have given (the statement it stands at, its frames'
@@ -254,6 +265,7 @@ class SpinWatch:
         return False
 
     def _start(self, task) -> None:
+        self.recordings += 1
         self.rec = _Recording(task)
         task.watched = True
         self.rt._break(task)
@@ -263,7 +275,8 @@ class SpinWatch:
         self.why[why] = self.why.get(why, 0) + 1
         self._stop(False)
 
-    def _stop(self, ok: bool) -> None:
+    def _stop(self, ok: bool, parks: bool = True) -> None:
+        """End the recording: `ok` it found a spin (which `parks` now or not: module docstring)."""
         rec = self.rec
         if rec is None:
             return
@@ -271,7 +284,10 @@ class SpinWatch:
         self.rec = None
         task.watched = False
         key = id(task)
-        gap = 1 if ok else min(MAX_GAP, 2 * self.gap.get(key, 1))
+        if ok:
+            gap = 1 if parks else min(MAX_WAIT_GAP, 2 * self.gap.get(key, 1))
+        else:
+            gap = min(MAX_GAP, 2 * self.gap.get(key, 1))
         self.gap[key] = gap
         self.due[key] = self.rt.controller.cycle + gap
         # the loop of a failed recording is not taken as the boundary by the next one (an inner
@@ -482,7 +498,7 @@ class SpinWatch:
         # of the second pass), and its innermost frame (an automatic cell's recording)
         spin = _copy_with(spin, rec)
         ok = self._may_park(spin) and rt.steps + 1 < task.slice_end
-        self._stop(True)
+        self._stop(True, ok)
         if ok:
             task.park = spin
 
@@ -535,9 +551,12 @@ class SpinWatch:
         rt = self.rt
         if spin.motion and not rt.controller.is_idle():
             return True
-        if spin.cyclic and any(k[0] == "cyclic flag" for k in rt._cyclic):
+        if spin.cyclic and rt.restless:
             return True
-        return spin.io and (self._io_may_change() or any(k[0] == "analog output" for k in rt._cyclic))
+        # a cyclic flag whose expression settles changes only after the I/O image did (a
+        # statement or another task wakes the pass first): $CYCFLAG is read as an input is
+        return (spin.io or spin.cyclic) and \
+            (self._io_may_change() or any(k[0] == "analog output" for k in rt._cyclic))
 
     def _io_may_change(self) -> bool:
         """The controller's next step may change an input (module docstring)."""

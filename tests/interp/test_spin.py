@@ -180,6 +180,45 @@ def test_a_running_timer_read_each_pass_is_not_a_spin(tmp_path, interp):
     assert [name for _t, name, v, _s in rt.controller.io.log if name == "$OUT[8]" and v]
 
 
+#: the submit program switches a cyclic flag on in every pass (as a backup's SPS.SUB does with
+#: ``$CYCFLAG[n] = NOT $ALARM_STOP OR ...``) and reads it
+CYCLIC_SPS = SPS.replace("    IF $IN[5] THEN\n", "    $CYCFLAG[3] = $IN[5] AND FLAG\n    IF $CYCFLAG[3] THEN\n")
+
+
+@pytest.mark.parametrize("interp", INTERPS)
+def test_a_pass_that_switches_and_reads_a_settling_cyclic_flag_is_parked(tmp_path, interp):
+    """$CYCFLAG[3] = $IN[5] AND FLAG: the flag changes only after an input or a variable did
+    (interp/runtime/watch.py ``settles``), so the pass is parked, and woken by FLAG = TRUE (the
+    robot program, 3 s) and by the stimulus (20.0 s: cycle 1667, 20.004 s), in which cycle the
+    submit program's assignment reads $IN[5] and sets $OUT[5]."""
+    stim = "- at: 20.0\n  set: {\"$IN[5]\": true}\n"
+    rt, res = _same_run(tmp_path, PROG, CYCLIC_SPS, interp, stimuli=stim)
+    assert res.reason == "completed"
+    log = [(round(t, 3), name, v) for t, name, v, _src in rt.controller.io.log]
+    assert (20.004, "$OUT[5]", True) in log
+    assert (20.016, "$OUT[7]", True) in log
+    sw = rt.scheduler.spin
+    assert sw.parks >= 2 and sw.wakes >= 2
+    assert sw.skipped > 0.9 * res.steps
+
+
+@pytest.mark.parametrize("interp", INTERPS)
+def test_beside_a_cyclic_flag_over_the_robot_position_a_reader_of_cycflag_is_not_parked(tmp_path, interp):
+    """A second flag over the robot's axis (it does not settle: it may change at any cycle)
+    keeps the pass that reads $CYCFLAG from parking while the robot swings A1 between -30 and
+    30 degrees: $OUT[8] rises as in the unparked run; and the spin that may not park is
+    recorded again at most every MAX_WAIT_GAP cycles, not at every cycle (until 2026-11-26: at
+    every cycle, 516 recordings in this run's 2 500 cycles)."""
+    sub = CYCLIC_SPS.replace("DEF sps()\n", "DEF sps()\n  $CYCFLAG[4] = $AXIS_ACT.A1 > 10\n") \
+        .replace("    CHECK()\n", "    IF $CYCFLAG[4] THEN\n      $OUT[8] = TRUE\n    ENDIF\n")
+    rt, res = _same_run(tmp_path, MOVING, sub, interp, max_sim_time=30.0)
+    sw = rt.scheduler.spin
+    assert sw.parks == 0
+    assert [name for _t, name, v, _s in rt.controller.io.log if name == "$OUT[8]" and v]
+    cycles = res.sim_time / 0.012
+    assert sw.recordings <= cycles / S.MAX_WAIT_GAP + 10
+
+
 @pytest.mark.parametrize("interp", INTERPS)
 def test_an_interrupt_of_the_parked_task_runs_where_it_would(tmp_path, interp):
     """INTERRUPT ON $IN[9] in the submit program; the stimulus at 7.0 s (cycle 584, 7.008 s):
