@@ -470,7 +470,14 @@ class Runtime:
         resets it. Armed interrupts allow quiet steps while their last poll left them settled
         in this state epoch (contexts.py ``InterruptTable.settled``): conditions over
         constants and probed state only, nothing pending, so a poll before these steps would
-        evaluate and fire nothing."""
+        evaluate and fire nothing.
+
+        Sets ``task.calm``: the task's advance-run stops are no-ops during these steps (a
+        submit task's always: :meth:`before_statement`; the robot task's while the main run is
+        idle, which only its own motion statement changes within its time slice:
+        :meth:`_enqueue` breaks), so a statement or loop condition that stops the advance run
+        may be a quiet step too. Until 2026-11-26 every such statement took the full hook: an
+        SPS.SUB writes outputs and reads timers, and 40 % of its steps did."""
         irqs = task.irqs
         if self.trace is not None or (irqs.armed and irqs.settled != self.state_epoch) \
                 or task.continue_line is not None \
@@ -478,7 +485,9 @@ class Runtime:
                 or any(c.error_proceed for c in task.contexts) \
                 or (self.autocell is not None and self.autocell.recording is not None) \
                 or task.watched or task.replay is not None or task.shadow is not None:
+            task.calm = False
             return 0
+        task.calm = task.kind != "robot" or self.controller.is_idle()
         lim = task.slice_end - 1
         if self.max_steps is not None and self.max_steps < lim:
             return self.max_steps
@@ -488,6 +497,7 @@ class Runtime:
     def _break(task: Task) -> None:
         """The next step of ``task`` takes the full hook (see :meth:`quiet_limit`)."""
         task.quiet = 0
+        task.calm = False
 
     def loop_tick(self, info: StmtInfo) -> None:
         """Called once per loop iteration (WHILE/REPEAT/LOOP/FOR): counts a step, may end
@@ -1250,6 +1260,7 @@ class Runtime:
             mid = ctl.enqueue(req)
         except RobotError as e:
             raise KrlRuntimeError(reach_message(ctl, req, e), e.number) from None
+        self._break(task)           # the main run is not idle now: advance-run stops wait
         self.history.record(req, ctl.last_planned())
         if self.run_mode in STEP_MODES:
             # the advance run does not pass the motion: the next statement is read when it ends
@@ -1307,6 +1318,7 @@ class Runtime:
             mid = ctl.enqueue(req)
         except RobotError as e:
             raise KrlRuntimeError(e.message, e.number) from None
+        self._break(task)
         self.wait_main_run(task)
         self.step_stop(task, "BSTEP", motion=mid, at=(rec.file, rec.line))
         return True

@@ -74,6 +74,7 @@ class Task:
         self.budget = budget if budget is not None else (ROBOT_BUDGET if kind == "robot" else SUBMIT_BUDGET)
         self.slice_end = 0              # value of Runtime.steps that ends this IPO cycle's time slice
         self.quiet = 0                  # quiet-step limit (Runtime.quiet_limit)
+        self.calm = False               # its advance-run stops are no-ops (Runtime.quiet_limit)
         self.contexts = [Context("main" if kind == "robot" else "submit")]
         self.irqs = InterruptTable()
         self.err = None                 # $ERR of this interpreter (Struct ERROR_T)

@@ -94,7 +94,7 @@ INT_KINDS = "svtimg"
 #: element index, a 2-D element's row, row length and column, two INTs a comparison compares.
 C_LOCALS = {
     "prog": "list", "ins": "tuple", "op": "Py_ssize_t", "store": "list", "fvars": "list", "mrefs": "list",
-    "grefs": "list", "cold": "list", "left": "Py_ssize_t", "unsaved": "Py_ssize_t", "proceed": "bint",
+    "grefs": "list", "cold": "list", "left": "Py_ssize_t", "unsaved": "Py_ssize_t", "proceed": "bint", "calm": "bint",
     "dirty": "bint", "go": "bint", "d": "list", "ops": "bytes", "adata": "list", "agrid": "list",
     "grid": "tuple", "c1": "Py_ssize_t", "c2": "Py_ssize_t", "c3": "Py_ssize_t",
 }
@@ -130,7 +130,10 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
     # rt.steps (SYNC_STEPS adds them before anything reads or changes rt.steps or task.quiet:
     # the full statement hooks, a call, a cold instruction, an error's $ERR, leaving the loop).
     # (No task: a cyclic flag's or analog output's expression the controller evaluates.)
+    # ``calm``: the task's advance-run stops are no-ops (Runtime.quiet_limit, ``Task.calm``), so
+    # a statement that stops the advance run may be a quiet step too; read with task.quiet.
     left = task.quiet - rt.steps if task is not None else 0
+    calm = task is not None and task.calm
     unsaved = 0
     proceed = False
     # ``dirty``: a quiet STMT_G ran and its line (frame.line) and StmtInfo (task.at) are not
@@ -155,6 +158,7 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                 SYNC_STEPS()
                 rt.record_error(e, frame)
                 left = task.quiet - rt.steps if task is not None else 0
+                calm = task is not None and task.calm
                 del stack[8:]         # STACK_BASE
                 ip = reg.end
     except BaseException:
@@ -185,7 +189,7 @@ def SYNC_STEPS():
 @inline
 def LOOP_TICK(stmt, stops):
     """One loop iteration: a quiet step while one is allowed, else Runtime.loop_tick."""
-    if left > 0 and not stops:
+    if left > 0 and (calm or not stops):
         left -= 1
         unsaved += 1
     else:
@@ -194,6 +198,7 @@ def LOOP_TICK(stmt, stops):
         tick(stmt)
         task.quiet = n = quiet_limit(task)
         left = n - rt.steps
+        calm = task.calm
 
 
 @inline
@@ -205,6 +210,7 @@ def COLD_DISPATCH():
     SYNC_STEPS()
     ip = cold[op](self, ins, code, frame, temps, stack, ip)
     left = task.quiet - rt.steps if task is not None else 0
+    calm = task is not None and task.calm
 
 
 @inline
@@ -266,7 +272,7 @@ def COMPONENT(s, base, comp, name, value):
 def STMT_G(stmt: "x"):
     """statement boundary in a routine: Runtime.before_statement, then take the ON_ERROR_PROCEED flag (every statement takes it)"""
     info = stmt
-    if left > 0 and not stmt.stops:        # a quiet step (Runtime.quiet_limit)
+    if left > 0 and (calm or not stmt.stops):      # a quiet step (Runtime.quiet_limit)
         left -= 1
         unsaved += 1
         dirty = True                        # frame.line, task.at: written by FLUSH
@@ -279,6 +285,7 @@ def STMT_G(stmt: "x"):
         proceed = take_error_proceed()
         task.quiet = n = quiet_limit(task)
         left = n - rt.steps
+        calm = task.calm
 
 
 @inst()
@@ -288,7 +295,7 @@ def STMT(stmt: "x"):
     dirty = False                           # this statement's own line and info follow
     if not thunk:
         frame.line = stmt.line
-    if left > 0 and not stmt.stops:
+    if left > 0 and (calm or not stmt.stops):
         left -= 1
         unsaved += 1
         task.at = stmt
@@ -297,6 +304,7 @@ def STMT(stmt: "x"):
         before(stmt)
         task.quiet = n = quiet_limit(task)
         left = n - rt.steps
+        calm = task.calm
 
 
 @inst(freq=57)
@@ -759,6 +767,7 @@ def CALL(callee: "r", argc: "i", flags: "f"):
     else:
         result = call_native(callee, args, flags == "E")
     left = task.quiet - rt.steps if task is not None else 0
+    calm = task is not None and task.calm
     if result is None and flags == "E":
         result = function_result(callee.name, result)
 

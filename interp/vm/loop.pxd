@@ -4,7 +4,7 @@
 # names the handlers read are C globals (no dictionary lookup per use). Do not edit.
 import cython
 
-@cython.locals(prog=list, ins=tuple, op=cython.Py_ssize_t, store=list, fvars=list, mrefs=list, grefs=list, cold=list, left=cython.Py_ssize_t, unsaved=cython.Py_ssize_t, proceed=cython.bint, dirty=cython.bint, go=cython.bint, d=list, ops=bytes, adata=list, agrid=list, grid=tuple, c1=cython.Py_ssize_t, c2=cython.Py_ssize_t, c3=cython.Py_ssize_t, x1=cython.Py_ssize_t, x2=cython.Py_ssize_t, x3=cython.Py_ssize_t, x4=cython.Py_ssize_t)
+@cython.locals(prog=list, ins=tuple, op=cython.Py_ssize_t, store=list, fvars=list, mrefs=list, grefs=list, cold=list, left=cython.Py_ssize_t, unsaved=cython.Py_ssize_t, proceed=cython.bint, calm=cython.bint, dirty=cython.bint, go=cython.bint, d=list, ops=bytes, adata=list, agrid=list, grid=tuple, c1=cython.Py_ssize_t, c2=cython.Py_ssize_t, c3=cython.Py_ssize_t, x1=cython.Py_ssize_t, x2=cython.Py_ssize_t, x3=cython.Py_ssize_t, x4=cython.Py_ssize_t)
 cpdef object run(object self, object code, object frame, list temps=*, Py_ssize_t ip=*, list stack=*, bint thunk=*)
 
 cdef object COLD, ExitSignal, KrlRuntimeError, Slot, Struct, T_BOOL, T_INT, T_REAL

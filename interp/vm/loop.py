@@ -342,6 +342,7 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
     cold = COLD
     task = rt.current_task
     left = task.quiet - rt.steps if task is not None else 0
+    calm = task is not None and task.calm
     unsaved = 0
     proceed = False
     dirty = False
@@ -355,7 +356,7 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                         if op < 1:
                             p1 = ins[1]
                             info = p1
-                            if left > 0 and (not ins[3]):
+                            if left > 0 and (calm or not ins[3]):
                                 left -= 1
                                 unsaved += 1
                                 dirty = True
@@ -369,10 +370,11 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                                 proceed = take_error_proceed()
                                 task.quiet = n = quiet_limit(task)
                                 left = n - rt.steps
+                                calm = task.calm
                             ip += 1
                         elif op < 20:
                             if op < 2:
-                                if left > 0 and (not ins[4]):
+                                if left > 0 and (calm or not ins[4]):
                                     left -= 1
                                     unsaved += 1
                                 else:
@@ -385,6 +387,7 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                                     tick(ins[1])
                                     task.quiet = n = quiet_limit(task)
                                     left = n - rt.steps
+                                    calm = task.calm
                                 ip = ins[5]
                             elif op < 13:
                                 if op < 5:
@@ -427,6 +430,7 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                                             else:
                                                 result = call_native(p1, args, p2 == 'E')
                                             left = task.quiet - rt.steps if task is not None else 0
+                                            calm = task is not None and task.calm
                                             if result is None and p2 == 'E':
                                                 result = function_result(p1.name, result)
                                             if p2 == 'E':
@@ -849,7 +853,7 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                             else:
                                 go = _for_next(temps[x2], temps[x2 + 1], temps[x2 + 2], p1)
                             if go:
-                                if left > 0 and (not ins[6]):
+                                if left > 0 and (calm or not ins[6]):
                                     left -= 1
                                     unsaved += 1
                                 else:
@@ -862,6 +866,7 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                                     tick(p1)
                                     task.quiet = n = quiet_limit(task)
                                     left = n - rt.steps
+                                    calm = task.calm
                                 ip = ins[7]
                             else:
                                 ip += 1
@@ -894,7 +899,7 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                                 ip += 1
                         elif op < 39:
                             if op < 37:
-                                if left > 0 and (not ins[4]):
+                                if left > 0 and (calm or not ins[4]):
                                     left -= 1
                                     unsaved += 1
                                 else:
@@ -907,6 +912,7 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                                     tick(ins[1])
                                     task.quiet = n = quiet_limit(task)
                                     left = n - rt.steps
+                                    calm = task.calm
                                 ip += 1
                             elif op < 38:
                                 x1 = ins[1]
@@ -949,7 +955,7 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                                         dirty = False
                                         if not thunk:
                                             frame.line = ins[2]
-                                        if left > 0 and (not ins[3]):
+                                        if left > 0 and (calm or not ins[3]):
                                             left -= 1
                                             unsaved += 1
                                             task.at = p1
@@ -959,6 +965,7 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                                             before(p1)
                                             task.quiet = n = quiet_limit(task)
                                             left = n - rt.steps
+                                            calm = task.calm
                                         ip += 1
                                     else:
                                         stack.append(None)
@@ -1149,7 +1156,7 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                                     x1 = ins[1]
                                     p1 = ins[2]
                                     if _for_next(temps[x1], temps[x1 + 1], temps[x1 + 2], p1):
-                                        if left > 0 and (not ins[5]):
+                                        if left > 0 and (calm or not ins[5]):
                                             left -= 1
                                             unsaved += 1
                                         else:
@@ -1162,6 +1169,7 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                                             tick(p1)
                                             task.quiet = n = quiet_limit(task)
                                             left = n - rt.steps
+                                            calm = task.calm
                                         ip = ins[6]
                                     else:
                                         ip += 1
@@ -1312,6 +1320,7 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                         unsaved = 0
                         ip = cold[op](self, ins, code, frame, temps, stack, ip)
                         left = task.quiet - rt.steps if task is not None else 0
+                        calm = task is not None and task.calm
             except KrlRuntimeError as e:
                 if dirty:
                     frame.line = info.line
@@ -1328,6 +1337,7 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                 unsaved = 0
                 rt.record_error(e, frame)
                 left = task.quiet - rt.steps if task is not None else 0
+                calm = task is not None and task.calm
                 del stack[8:]
                 ip = reg.end
     except BaseException:
@@ -1339,4 +1349,4 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
     finally:
         rt.steps += unsaved
 
-SOURCE = 'fa4220fb1b3d6e641ea09f33ee8c321af976c362b83aa680eecfb47ccfa266c0'
+SOURCE = '85b10826f3433ca6b4a03d15783fa3204c31e189e03188be8b1fec5c446840c6'

@@ -773,3 +773,67 @@ def test_unop_conditions_and_fields_errors(case):
     assert Path(out.file).name.lower() == "fp_unop.src"
     assert out.line == marker_line(UNOP, f"E{case}")
     assert out.data["DONE"] == 0
+
+
+# ---------------------------------------------------------------------------- advance-run stops
+CALM_PROG = """
+DEF calm()
+  INT i
+  FOR i = 1 TO 3000
+    $OUT[4] = FALSE
+  ENDFOR
+  PTP {A1 20, A2 -90, A3 90, A4 0, A5 30, A6 0}
+  $OUT[5] = TRUE
+END
+"""
+
+CALM_SPS = """
+DEF calm_sps()
+  LOOP
+    $OUT[6] = FALSE
+  ENDLOOP
+END
+"""
+
+
+def _counted_run(tmp_path, interp: str):
+    prog = tmp_path / "calm.src"
+    prog.write_text(CALM_PROG)
+    sub = tmp_path / "calm_sps.sub"
+    sub.write_text(CALM_SPS)
+    rt, vm = make_runtime(prog, trace=None, mujoco=False, interp=interp, max_sim_time=30.0, check=False,
+                          submit=[sub])
+    calls = [0]
+    if interp == "vm":
+        before, tick, take, quiet, *call_protocol = vm.hooks
+
+        def counted(fn):
+            def hook(*a):
+                calls[0] += 1
+                return fn(*a)
+            return hook
+
+        vm.hooks = (counted(before), counted(tick), take, quiet, *call_protocol)
+    res = rt.run()
+    return rt, res, calls[0]
+
+
+def test_advance_run_stops_that_stop_nothing_are_quiet_steps(tmp_path):
+    """An output write stops the advance run (its StmtInfo ``stops``), in the robot
+    interpreter only, and only while the main run has motions (Runtime.before_statement,
+    wait_main_run). So the submit program's writes, and the robot program's while the robot
+    stands, are quiet steps in the VM (Runtime.quiet_limit, ``Task.calm``): about one full hook
+    per task per IPO cycle, where every such write took one until 2026-11-26. The write after
+    the PTP still waits for the main run: $OUT[5] rises when the motion has ended, at the time
+    the tree interpreter (which takes every hook) gives."""
+    rt, res, hooks = _counted_run(tmp_path, "vm")
+    tree_rt, tree_res, _ = _counted_run(tmp_path, "tree")
+    assert res.reason == tree_res.reason == "completed"
+    assert rt.controller.io.log == tree_rt.controller.io.log
+    assert (res.steps, res.sim_time) == (tree_res.steps, tree_res.sim_time)
+    rises = [t for t, name, v, _s in rt.controller.io.log if name == "$OUT[5]" and v]
+    assert len(rises) == 1
+    # the PTP of 20 degrees of A1 takes many IPO cycles: the write waited for its end
+    assert rises[0] >= 0.1, rises
+    cycles = round(res.sim_time / rt.controller.dt)
+    assert hooks <= 3 * cycles + 20, (hooks, cycles, res.steps)
