@@ -140,7 +140,7 @@ class Runtime:
     # the tree interpreter ran 5-10 % slower with 32). A new attribute is added here too.
     __slots__ = ("controller", "trace", "current_task", "random", "_mode_op", "msg_handle", "messages",
                  "noted", "steps", "max_steps", "robot_budget", "sysvars", "memory", "program", "kss",
-                 "modules", "scheduler", "robot", "result", "_plans", "_return_types", "_cyclic",
+                 "modules", "scheduler", "robot", "result", "_plans", "_return_types", "_settling", "_cyclic",
                  "run_mode", "history", "stmt_hook", "step_hook", "error_hook", "cycle_hook",
                  "autocell", "halt_continues", "start", "halts", "state_epoch", "spin", "cyclic_watch",
                  "restless")
@@ -183,6 +183,7 @@ class Runtime:
         self.result: RunResult | None = None
         self._plans: dict = {}          # id(routine) -> Runtime._frame_plan
         self._return_types: dict = {}   # id(routine) -> the checker's return type, checked once
+        self._settling: dict = {}       # id(assignment) -> its cyclic flag's expression settles
         self._cyclic: dict = {}
         #: the cyclic flags whose expression does not settle (watch.py ``settles``: it reads a
         #: timer, the robot's position, a call...): evaluated at every IPO cycle, they may change
@@ -1160,12 +1161,16 @@ class Runtime:
 
     def _cyclic_settles(self) -> bool:
         """The cyclic flag the running statement switches on has an expression that
-        :func:`~.watch.settles`."""
+        :func:`~.watch.settles`, decided once per statement (an SPS.SUB switches its flags on
+        again in every pass: the analysis cost about 40 µs each time)."""
         task = self.current_task
         at = task.at if task is not None else None
         for node in (self.spin.statements(at) or ()) if at is not None else ():
             if isinstance(node, N.Assign):
-                return settles(node.value)
+                got = self._settling.get(id(node))
+                if got is None:
+                    got = self._settling[id(node)] = settles(node.value)
+                return got
         return False
 
     def cyclic_off(self, key) -> None:
