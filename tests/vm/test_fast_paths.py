@@ -557,14 +557,9 @@ def test_trigger_and_brake_resume_during_a_compute_loop():
     assert d["IRQ_AT"] == d["TRIG_AT"] == d["AFTER_RESUME"] == d["CUR"]
 
 
-@pytest.mark.parametrize("traced", [False, True])
-def test_quiet_path_is_taken_only_without_a_trace(traced):
-    """The sweeps above compare something: untraced, most steps skip the statement hooks
-    (one full hook per time slice here); traced, every step takes them."""
-    tw = TraceWriter(keep=True) if traced else None
-    rt, vm = make_runtime(MAXSTEPS, trace=tw, mujoco=False, interp="vm", max_steps=20_000, max_sim_time=600.0,
-                          check=False)
-    rt.program.module("fp_maxsteps").data["SEL"].set(2)
+def count_hooks(vm) -> list:
+    """Count the VM's calls of the full statement and loop hooks (Runtime.before_statement,
+    loop_tick) from now on: the one-element list returned holds the count."""
     calls = [0]
     before, tick, take, quiet, *call_protocol = vm.hooks    # (run_routine, exec_routine)
 
@@ -575,6 +570,18 @@ def test_quiet_path_is_taken_only_without_a_trace(traced):
         return hook
 
     vm.hooks = (counted(before), counted(tick), take, quiet, *call_protocol)
+    return calls
+
+
+@pytest.mark.parametrize("traced", [False, True])
+def test_quiet_path_is_taken_only_without_a_trace(traced):
+    """The sweeps above compare something: untraced, most steps skip the statement hooks
+    (one full hook per time slice here); traced, every step takes them."""
+    tw = TraceWriter(keep=True) if traced else None
+    rt, vm = make_runtime(MAXSTEPS, trace=tw, mujoco=False, interp="vm", max_steps=20_000, max_sim_time=600.0,
+                          check=False)
+    rt.program.module("fp_maxsteps").data["SEL"].set(2)
+    calls = count_hooks(vm)
     res = rt.run()
     assert res.reason == "max_steps" and res.steps == 20_001
     if traced:
@@ -803,17 +810,7 @@ def _counted_run(tmp_path, interp: str):
     sub.write_text(CALM_SPS)
     rt, vm = make_runtime(prog, trace=None, mujoco=False, interp=interp, max_sim_time=30.0, check=False,
                           submit=[sub])
-    calls = [0]
-    if interp == "vm":
-        before, tick, take, quiet, *call_protocol = vm.hooks
-
-        def counted(fn):
-            def hook(*a):
-                calls[0] += 1
-                return fn(*a)
-            return hook
-
-        vm.hooks = (counted(before), counted(tick), take, quiet, *call_protocol)
+    calls = count_hooks(vm) if interp == "vm" else [0]
     res = rt.run()
     return rt, res, calls[0]
 
