@@ -64,8 +64,8 @@ The watch works only where nothing observes statements one by one: no trace of t
 cycles (1 to :data:`MAX_GAP`), at once after a wake; a spin that may not be parked yet (what it
 reads may change at the next step: the robot moves, an input is due) after twice as many cycles
 too, up to :data:`MAX_WAIT_GAP`. Until 2026-11-26 it was recorded again at every cycle: a
-backup's SPS.SUB beside a cyclic flag (which kept it from parking) ran 2-3 times slower for
-recordings that could not end in a park.
+backup's SPS.SUB beside a cyclic flag (which kept it from parking) took 1.8 times the CPU of a
+run without the watch, for recordings that could not end in a park.
 
 An observer of the controller alone (the controller's ``trace`` while the runtime's is None:
 interp/summary.py ``RunObserver`` behind ``krl run``'s summary, interp/outcomes.py and
