@@ -135,8 +135,8 @@ class _Pass:
     frame at each step) and ``images`` (its frames as the idle watch images them at each step),
     ``io`` (it reads I/O), ``motion`` (it reads the robot's position or motion), ``cyclic`` (it
     reads ``$CYCFLAG``: a cyclic flag whose expression does not settle may set it at any IPO
-    cycle, one that settles only after an input changed: interp/runtime/watch.py ``settles``), ``probes`` (the
-    state variables it reads)."""
+    cycle, one that settles only after an input changed: interp/runtime/watch.py
+    ``settles``), ``probes`` (the state variables it reads)."""
 
     __slots__ = ("events", "infos", "at", "frames", "images", "io", "motion", "cyclic", "probes", "refs")
 
@@ -200,8 +200,9 @@ class _Recording:
 
 class SpinWatch:
     """The spin watch of one run (module docstring). ``recordings``, ``parks``, ``wakes`` and
-    ``skipped`` (steps not executed) count what it did; ``diverged`` (a catch-up that left the recorded pass) and
-    ``missed`` (a parked task's reads changed without a wake) count what must not happen."""
+    ``skipped`` (steps not executed) count what it did; ``diverged`` (a catch-up that left the
+    recorded pass) and ``missed`` (a parked task's reads changed without a wake) count what
+    must not happen."""
 
     def __init__(self, rt) -> None:
         self.rt = rt
