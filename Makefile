@@ -10,6 +10,7 @@ OUT     ?= reports/recovery
 GEN_DIR := krl/syntax/generated
 PARSER  := $(GEN_DIR)/KRLParser.py
 SHARED_CORPUS ?= ../shared/krl-corpus
+SHARED_HISTORY ?= ../shared/krl-history
 
 .PHONY: all recover test validate growth conformance nightly bench parser java-parser clean check-python check-java vsix check-node vm-loop pendant-assets programmap-js
 
@@ -111,7 +112,8 @@ conformance: $(PARSER) java-parser
 # figures (scale.json), the static check of the corpus backups (check/), the fleet
 # audit of the corpus with every entry point run for krl run's 600 s (audit/: krl audit, docs/audit.md), conformance, the
 # benchmarks (bench.json, bench-parse.json, limits.jsonl, whole-runs.json: every corpus entry
-# point's whole run, tools/whole_run_bench.py), the fuzzers for their nightly budget
+# point's whole run, tools/whole_run_bench.py; whole-runs-history.json: the same over the
+# backups of ../shared/krl-history), the fuzzers for their nightly budget
 # (fuzz/), the tests marked slow (long sweeps; hypothesis with the nightly profile); dated
 # reports under reports/nightly/<date>/, then the history (reports/nightly/history.sqlite) and
 # the index with charts and the changes since the night before. Not part of `make test`.
@@ -132,6 +134,8 @@ nightly: $(PARSER) java-parser
 	$(BIN)/krl bench parse --json > $$d/bench-parse.json 2>> $$d/bench.log; \
 	$(BIN)/python -m robot.limits_bench > $$d/limits.jsonl 2>> $$d/bench.log; \
 	$(BIN)/python tools/whole_run_bench.py --json $$d/whole-runs.json > $$d/whole-runs.txt 2>> $$d/bench.log; \
+	$(BIN)/python tools/whole_run_bench.py --corpus $(SHARED_HISTORY) --json $$d/whole-runs-history.json \
+	  > $$d/whole-runs-history.txt 2>> $$d/bench.log; \
 	$(BIN)/python -m tests.fuzz.run --seconds $(FUZZ_SECONDS) --out $$d/fuzz; f=$$?; \
 	HYPOTHESIS_PROFILE=nightly $(BIN)/python -m pytest -q -n $(PYTEST_WORKERS) --dist loadgroup -p no:cacheprovider -m "slow or not slow" \
 	  > $$d/slow-tests.log 2>&1; t=$$?; tail -1 $$d/slow-tests.log; \

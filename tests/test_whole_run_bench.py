@@ -45,3 +45,10 @@ def test_side_by_side_rows_and_the_nightly_figures(tmp_path):
     night = read_night(day)
     assert night.figures["bench.whole_runs_sim_per_cpu"] == s["new"]["sim_per_cpu"] > 0
     assert night.figures["whole_runs.over_3s"] == s["new"]["over_3s"]
+    assert "whole-runs-history.json: not written this night" in night.notes
+    # the nightly's second file, the history backups' whole runs (make nightly), read the same way
+    (day / "whole-runs-history.json").write_text(out.read_text())
+    night = read_night(day)
+    assert night.figures["bench.whole_runs_history_sim_per_cpu"] == s["new"]["sim_per_cpu"]
+    assert night.figures["whole_runs_history.over_3s"] == s["new"]["over_3s"]
+    assert not any(n.startswith("whole-runs") for n in night.notes)

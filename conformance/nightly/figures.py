@@ -16,7 +16,8 @@ that a damaged file is skipped with a note):
 (krl bench --json), ``bench-parse.json`` (krl bench parse --json), ``limits.jsonl``
 (python -m robot.limits_bench), ``lsp-bench.json`` (python -m krl.lsp.bench --json),
 ``fuzz/summary.json`` (python -m tests.fuzz.run), ``whole-runs.json`` (tools/whole_run_bench.py:
-every corpus entry point with ``--inputs auto``, 600 s simulated).
+every corpus entry point with ``--inputs auto``, 600 s simulated) and ``whole-runs-history.json``
+(the same over the backups of ../shared/krl-history).
 """
 
 from __future__ import annotations
@@ -140,14 +141,17 @@ def _bench(day: Path, night: Night) -> None:
     p = _json(day / "bench-parse.json", night)
     if isinstance(p, dict):
         _put(night, "bench.parse_speedup", p.get("speedup"))
-    whole = _json(day / "whole-runs.json", night)
-    if isinstance(whole, dict) and isinstance(whole.get("summary"), dict):
-        new = whole["summary"].get("new") or {}
-        if isinstance(new, dict):
-            # simulated s per CPU s of the whole runs together (a ratio), and how many entry
-            # points took more than 3 s of CPU for 600 s (a count: issue 48's bound)
-            _put(night, "bench.whole_runs_sim_per_cpu", new.get("sim_per_cpu"))
-            _put(night, "whole_runs.over_3s", new.get("over_3s"))
+    # the whole runs of the corpus's entry points, and of the history backups' (material that
+    # is not the corpus: the nearest to a backup nobody here has seen)
+    for name, tag in (("whole-runs.json", "whole_runs"), ("whole-runs-history.json", "whole_runs_history")):
+        whole = _json(day / name, night)
+        if isinstance(whole, dict) and isinstance(whole.get("summary"), dict):
+            new = whole["summary"].get("new") or {}
+            if isinstance(new, dict):
+                # simulated s per CPU s of the whole runs together (a ratio), and how many entry
+                # points took more than 3 s of CPU for 600 s (a count: issue 48's bound)
+                _put(night, f"bench.{tag}_sim_per_cpu", new.get("sim_per_cpu"))
+                _put(night, f"{tag}.over_3s", new.get("over_3s"))
     lsp = _json(day / "lsp-bench.json", night)
     if isinstance(lsp, dict):
         for key in ("change_p50_ms", "change_p95_ms", "first_diagnostics_s"):
