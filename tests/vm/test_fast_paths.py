@@ -790,6 +790,7 @@ DEF calm()
     $OUT[4] = FALSE
   ENDFOR
   PTP {A1 20, A2 -90, A3 90, A4 0, A5 30, A6 0}
+  i = 0
   $OUT[5] = TRUE
 END
 """
@@ -810,6 +811,10 @@ def _counted_run(tmp_path, interp: str):
     sub.write_text(CALM_SPS)
     rt, vm = make_runtime(prog, trace=None, mujoco=False, interp=interp, max_sim_time=30.0, check=False,
                           submit=[sub])
+    # the submit program is a spin: parked, it would be woken (a task switch, the full hook for
+    # the robot program's next statement) by each of the robot program's steps; unparked, the
+    # quiet path alone decides
+    rt.scheduler.spin.enabled = False
     calls = count_hooks(vm) if interp == "vm" else [0]
     res = rt.run()
     return rt, res, calls[0]
@@ -821,8 +826,10 @@ def test_advance_run_stops_that_stop_nothing_are_quiet_steps(tmp_path):
     wait_main_run). So the submit program's writes, and the robot program's while the robot
     stands, are quiet steps in the VM (Runtime.quiet_limit, ``Task.calm``): about one full hook
     per task per IPO cycle, where every such write took one until 2026-11-26. The write after
-    the PTP still waits for the main run: $OUT[5] rises when the motion has ended, at the time
-    the tree interpreter (which takes every hook) gives."""
+    the PTP (and a statement that does not stop, whose full hook sees the main run busy) still
+    waits for the main run: $OUT[5] rises when the motion has ended (0.348 s), at the time the
+    tree interpreter (which takes every hook) gives, not after the loop's 6 000 steps (6 IPO
+    cycles: 0.072 s, where it rises if the queued motion or the busy main run is overlooked)."""
     rt, res, hooks = _counted_run(tmp_path, "vm")
     tree_rt, tree_res, _ = _counted_run(tmp_path, "tree")
     assert res.reason == tree_res.reason == "completed"
@@ -831,6 +838,6 @@ def test_advance_run_stops_that_stop_nothing_are_quiet_steps(tmp_path):
     rises = [t for t, name, v, _s in rt.controller.io.log if name == "$OUT[5]" and v]
     assert len(rises) == 1
     # the PTP of 20 degrees of A1 takes many IPO cycles: the write waited for its end
-    assert rises[0] >= 0.1, rises
+    assert rises[0] > 0.072 + 0.1, rises
     cycles = round(res.sim_time / rt.controller.dt)
     assert hooks <= 3 * cycles + 20, (hooks, cycles, res.steps)
