@@ -237,7 +237,7 @@ class Scheduler:
             p = task.parked
             if p is None and (task.until is None or task.replay is not None):
                 return None
-            if p is not None and (p.spin.motion or (p.spin.cyclic and rt.restless)):
+            if p is not None and (p.spin.motion or spin.reads_restless_flag(p.spin)):
                 return None
             if task.irqs.armed and not all(i.steady and not i.pending
                                            for i in task.irqs.irqs.values() if i.on):

@@ -552,12 +552,18 @@ class SpinWatch:
         rt = self.rt
         if spin.motion and not rt.controller.is_idle():
             return True
-        if spin.cyclic and rt.restless:
+        if self.reads_restless_flag(spin):
             return True
         # a cyclic flag whose expression settles changes only after the I/O image did (a
         # statement or another task wakes the pass first): $CYCFLAG is read as an input is
         return (spin.io or spin.cyclic) and \
             (self._io_may_change() or any(k[0] == "analog output" for k in rt._cyclic))
+
+    def reads_restless_flag(self, spin: _Pass) -> bool:
+        """`spin` reads ``$CYCFLAG`` while a cyclic flag whose expression does not settle is on:
+        the flag may change at any IPO cycle (the one test of it: here and the scheduler's
+        steady cycles)."""
+        return spin.cyclic and bool(self.rt.restless)
 
     def _io_may_change(self) -> bool:
         """The controller's next step may change an input (module docstring)."""
