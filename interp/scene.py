@@ -26,9 +26,9 @@ _AXES = ("A1", "A2", "A3", "A4", "A5", "A6")
 
 
 def start_axes(controller, value_of: Callable[[str], object], text: str) -> np.ndarray:
-    """The axes (deg, A1..A6) the robot starts at for the start position `text`
-    (robot/stimuli.py ``parse_start``): an axis literal as given (missing axes: those of
-    ``$AXIS_HOME[1]``); a point of the program (`value_of(name)`: its data list, then
+    """The axes (KRL's order: A1..A6, E1..Em; deg, mm) the robot starts at for the start position `text`
+    (robot/stimuli.py ``parse_start``): an axis literal as given (missing axes, external ones
+    included: those of ``$AXIS_HOME[1]``); a point of the program (`value_of(name)`: its data list, then
     ``$config.dat``, e.g. ``XHOME``) that is an AXIS/E6AXIS as it is, a POS/E6POS (TCP in the
     world: null ``$TOOL`` and ``$BASE``) through the robot's inverse kinematics with its S and
     T. Raises :class:`robot.stimuli.StartError` for a point the program does not have, a pose
@@ -52,10 +52,13 @@ def start_axes(controller, value_of: Callable[[str], object], text: str) -> np.n
             if isinstance(v, N.Unary):
                 v = v.operand
             comps[it.name.upper()] = sign * v.value
-    # HOME in KRL's order (A1..A6: a robot with fewer axes has 0 for the others)
-    home = controller.model.to_krl(np.array(controller.machine.home_deg, dtype=float))
+    # the model's axes (robot/axismap.py): a component the start does not give takes
+    # $AXIS_HOME[1]'s; the external axes E1..Em the robot has are the start's too (XHOME's E1)
+    amap = controller.model.axes
+    home = np.array(amap.home, dtype=float)
+    ext = {k: comps[k] for k in amap.ext_keys if k in comps}
     if any(k in comps for k in _AXES):
-        q = np.array([float(comps.get(k, home[i])) for i, k in enumerate(_AXES)])
+        q = amap.from_components(comps)
     elif all(k in comps for k in _CART):
         # costs 0.43 s at start-up (python -X importtime, 2026-11-25)
         from robot.frames import frame_to_matrix  # noqa: PLC0415
@@ -63,16 +66,17 @@ def start_axes(controller, value_of: Callable[[str], object], text: str) -> np.n
         T_world = frame_to_matrix(*(float(comps[k]) for k in _CART))
         try:
             q = controller.model.ik(T_world, None, None, int(comps["S"]) if "S" in comps else None,
-                                    int(comps["T"]) if "T" in comps else None, home)
+                                    int(comps["T"]) if "T" in comps else None,
+                                    amap.from_components(ext, fill=home))
         except Exception as exc:  # noqa: BLE001 - a robot error names the reason
             raise StartError(f"start {text}: {getattr(exc, 'message', exc)}") from None
     else:
         raise StartError(f"start {text}: neither the axes A1..A6 nor X, Y, Z, A, B, C")
     try:
-        controller.model.kin.check_soft_limits(q)
+        controller.model.check_limits(q)
     except Exception as exc:  # noqa: BLE001
         raise StartError(f"start {text}: {getattr(exc, 'message', exc)}") from None
-    return np.asarray(q, dtype=float)
+    return amap.to_krl(np.asarray(q, dtype=float))
 
 
 # ---------------------------------------------------------------------- the robot choice

@@ -9,7 +9,8 @@ passes it to :meth:`robot.controller.Controller.enqueue`. A request is plain dat
   E6AXIS target, deg) or ``X``, ``Y``, ``Z`` (mm), ``A``, ``B``, ``C`` (deg), ``S``, ``T``
   (a POS / E6POS / FRAME target in the motion's ``$BASE`` for its ``$TOOL``). Partial
   aggregates are fine: missing components keep the start position's values (§6.3); for
-  ``_REL`` they are 0. External axes ``E1``..``E6`` are accepted and ignored.
+  ``_REL`` they are 0. External axes ``E1``..``E6`` move the robot's external axes
+  (robot/axismap.py); those it does not have are ignored.
 * ``aux`` (CIRC/SCIRC auxiliary point, same form), ``ca`` (circular angle, deg);
 * ``approx``: ``C_PTP``, ``C_DIS``, ``C_VEL``, ``C_ORI``, ``C_SPL`` or None (exact stop);
   ``approx2`` the second keyword of ``PTP P C_PTP C_DIS`` (used for PTP -> CP blends);
@@ -28,9 +29,9 @@ from __future__ import annotations
 from dataclasses import dataclass, field, replace
 from typing import Any
 
-AXIS_KEYS = ("A1", "A2", "A3", "A4", "A5", "A6")
-CART_KEYS = ("X", "Y", "Z", "A", "B", "C")
-EXT_KEYS = ("E1", "E2", "E3", "E4", "E5", "E6")
+from .axismap import CART_KEYS, EXT_KEYS
+from .axismap import ROBOT_KEYS as AXIS_KEYS
+
 KINDS = ("PTP", "LIN", "CIRC", "SPTP", "SLIN", "SCIRC", "SPLINE")
 APPROX = ("C_PTP", "C_DIS", "C_VEL", "C_ORI", "C_SPL")
 Frame6 = tuple[float, float, float, float, float, float]

@@ -42,6 +42,7 @@ from scipy.spatial.transform import Rotation
 from .errors import RobotError, SoftLimitError, WorkspaceError
 from .frames import frame_to_matrix, inv_pos, matrix_to_frame
 from . import kinematics
+from .axismap import AxisMap
 from .external import ExternalAxes
 from .external_tcp import external_tcp
 from .kinematics import Kinematics
@@ -96,6 +97,8 @@ class RobotModel:
         self._robroot_inv_T = inv_pos(self.robroot_T)
         #: external axes (robot/external.py), None without; axis vectors are A1..An, E1..En
         self.n_ext = len(getattr(machine, "external_axes", ()))
+        #: where each axis sits in KRL's E6AXIS (robot/axismap.py): the one mapping
+        self.axes = AxisMap.of(machine)
         self.ext = None
         self._ersys = False
         if self.n_ext:
@@ -113,25 +116,12 @@ class RobotModel:
             self.apo_dis_ptp = np.array(machine.apo_dis_ptp_deg[:self.n], dtype=float)
 
     def from_krl(self, values: Any) -> np.ndarray:
-        """An axis vector of this model from KRL's order (A1..A6, then E1..En; missing E take
-        ``$AXIS_HOME[1]``'s): A1..An, E1..En. A robot with six axes and none external gets the
-        first six values."""
-        v = np.asarray(values, dtype=float)
-        if not self.n_ext:
-            return v[:self.n]
-        home = np.array(self.machine.home_all, dtype=float)
-        e = v[6:6 + self.n_ext]
-        return np.concatenate([v[:self.n], e, home[self.n + len(e):]])
+        """An axis vector of this model from KRL's order (robot/axismap.py ``from_krl``)."""
+        return self.axes.from_krl(values)
 
     def to_krl(self, q: np.ndarray) -> np.ndarray:
-        """The axis vector `q` (A1..An, E1..En) in KRL's order: A1..A6 (0 for the axes a robot
-        with fewer than six does not have), then E1..En; `q` itself for a six-axis robot."""
-        if self.n == 6:
-            return q
-        out = np.zeros(6 + len(q) - self.n)
-        out[:self.n] = q[:self.n]
-        out[6:] = q[self.n:]
-        return out
+        """The axis vector `q` in KRL's order (robot/axismap.py ``to_krl``)."""
+        return self.axes.to_krl(q)
 
     def linked(self, system: str) -> "RobotModel":
         """This model with ``$BASE`` on the BASE kinematic `system` (robot/external.py):

@@ -6,7 +6,10 @@ Two panels: a 3D view and a top view (X-Y) of the TCP path from the ``pose`` eve
   open = approximated),
 * the approximation zones: the TCP where each blend starts and ends, and a circle through
   the blend start around the approximated point (top view),
-* the I/O events, marked at the TCP position of their IPO cycle and labelled.
+* the I/O events, marked at the TCP position of their IPO cycle and labelled;
+
+and, for a robot with external axes (the trace's ``robot`` event names the pose axes,
+robot/axismap.py), a third panel: E1..En over time (mm or deg), the axes the TCP path does not show.
 
 Uses matplotlib with the Agg backend (no display needed).
 """
@@ -29,12 +32,17 @@ def _collect(events: list[dict[str, Any]]) -> dict[str, Any]:
     blend_starts: dict[int, float] = {}
     blend_ends: dict[int, float] = {}
     ios: list[tuple[float, str, Any]] = []
+    names: list[str] = []
+    ext: list[list[float]] = []
     for ev in events:
         k = ev.get("kind")
         if k == "pose":
             x, y, z = ev["tcp"][:3]
             xyz.append((x, y, z))
             times.append(ev["t"])
+            ext.append([v for n, v in zip(names, ev["axes"]) if n.startswith("E")])
+        elif k == "robot":
+            names = list(ev.get("axes") or ())
         elif k == "motion":
             ph = ev.get("phase")
             if ph == "end" and "point" in ev:
@@ -46,7 +54,7 @@ def _collect(events: list[dict[str, Any]]) -> dict[str, Any]:
         elif k == "io":
             ios.append((ev["t"], ev["signal"], ev["value"]))
     return {"xyz": xyz, "times": times, "points": points, "bs": blend_starts,
-            "be": blend_ends, "io": ios}
+            "be": blend_ends, "io": ios, "ext_names": [n for n in names if n.startswith("E")], "ext": ext}
 
 
 def _pose_at(data: dict[str, Any], t: float) -> tuple[float, float, float] | None:
@@ -74,9 +82,20 @@ def plot_trace(trace_path: str | Path, png_path: str | Path, title: str | None =
     if not data["xyz"]:
         raise ValueError(f"{trace_path}: no pose events to plot")
     P = np.array(data["xyz"])
-    fig = plt.figure(figsize=(13, 6))
-    ax3 = fig.add_subplot(1, 2, 1, projection="3d")
-    ax2 = fig.add_subplot(1, 2, 2)
+    panels = 3 if data["ext_names"] else 2
+    fig = plt.figure(figsize=(6.5 * panels, 6))
+    ax3 = fig.add_subplot(1, panels, 1, projection="3d")
+    ax2 = fig.add_subplot(1, panels, 2)
+    if panels == 3:
+        axe = fig.add_subplot(1, 3, 3)
+        E = np.array(data["ext"])
+        for i, name in enumerate(data["ext_names"]):
+            axe.plot(data["times"], E[:, i], lw=1.2, label=name)
+        axe.set_xlabel("t [s]")
+        axe.set_ylabel("external axes [mm or deg]")
+        axe.set_title("external axes")
+        axe.grid(True, lw=0.3)
+        axe.legend(loc="best", fontsize=7)
     ax3.plot(P[:, 0], P[:, 1], P[:, 2], lw=1.2, color="tab:blue", label="TCP path")
     ax2.plot(P[:, 0], P[:, 1], lw=1.2, color="tab:blue", label="TCP path")
 

@@ -94,6 +94,9 @@ SCHEMA: dict[str, list[tuple[str, str]]] = {
         ("name", "str: the simulated robot, e.g. 'KR210R2700_2 C4 FLR' (krl run's trace header, t=0)"),
         ("source", "str: where its data came from: a $machine.dat path or a robot YAML"),
         ("trafoname", "optional str: $TRAFONAME of the machine data"),
+        ("axes", "optional list str: the E6AXIS component of each value of the pose events' axes "
+                 "(robot/axismap.py), e.g. A1..A6, E1; given when they are not A1..A6 (external "
+                 "axes, a SCARA's four)"),
     ],
     # written by the interpreters (same writer)
     "stmt": [

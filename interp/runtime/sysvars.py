@@ -26,6 +26,7 @@ from pathlib import Path
 from krl.semantics import types as T
 from krl.semantics.builtins import load_builtins
 from krl.semantics.symbols import make_array, system_scopes
+from robot.axismap import E6AXIS_KEYS, EXT_KEYS
 from robot.motion import MotionParams
 
 from .convert import frame_tuple
@@ -65,22 +66,22 @@ def struct_of(type_name: str, values: dict) -> Struct:
     return s
 
 
-E6AXIS_KEYS = ("A1", "A2", "A3", "A4", "A5", "A6", "E1", "E2", "E3", "E4", "E5", "E6")
-
-
-def axis_struct(q) -> Struct:
-    vals = {k: 0.0 for k in E6AXIS_KEYS}
-    for i, v in enumerate(list(q)[:6]):
-        vals[E6AXIS_KEYS[i]] = float(v)
+def axis_struct(values) -> Struct:
+    """An E6AXIS of a KRL vector `values` (A1..A6, then E1..; robot/axismap.py ``to_krl``):
+    every component given, 0 for the others."""
+    vals = dict.fromkeys(E6AXIS_KEYS, 0.0)
+    for k, v in zip(E6AXIS_KEYS, values):
+        vals[k] = float(v)
     return struct_of("E6AXIS", vals)
 
 
 def pos_struct(d: dict) -> Struct:
+    """An E6POS of a dict {X, Y, Z, A, B, C, S, T, E1..E6} (the E components it lacks: 0)."""
     vals = {k: float(d[k]) for k in ("X", "Y", "Z", "A", "B", "C")}
     vals["S"] = int(d.get("S", 0))
     vals["T"] = int(d.get("T", 0))
-    for e in ("E1", "E2", "E3", "E4", "E5", "E6"):
-        vals[e] = 0.0
+    for e in EXT_KEYS:
+        vals[e] = float(d.get(e, 0.0))
     return struct_of("E6POS", vals)
 
 
@@ -165,14 +166,15 @@ class SysVars:
         s["$EXT_START"] = False
         s["$CHCK_MOVENA"] = False
         s["$EX_AX_IGNORE"] = 0
-        s["$H_POS"] = axis_struct(m.home_deg)
+        home = ctl.model.axes.to_krl(m.home_all)
+        s["$H_POS"] = axis_struct(home)
         for i in range(5):
-            s["$AXIS_HOME"].data[i] = axis_struct(m.home_deg)
+            s["$AXIS_HOME"].data[i] = axis_struct(home)
         # the home windows: 2 deg per axis, the value of every backup's $machine.dat
         # (shared/docs/robot-model.md "HOME"); a backup's Mada sets its own
-        s["$H_POS_TOL"] = axis_struct([HOME_TOL_DEG] * 6)
+        s["$H_POS_TOL"] = axis_struct([HOME_TOL_DEG] * 12)
         for i in range(5):
-            s["$H_AXIS_TOL"].data[i] = axis_struct([HOME_TOL_DEG] * 6)
+            s["$H_AXIS_TOL"].data[i] = axis_struct([HOME_TOL_DEG] * 12)
         self.robot_values()
 
     #: The system variables that name the simulated robot (issue 22): they always hold the
@@ -181,7 +183,8 @@ class SysVars:
 
     def robot_values(self) -> None:
         """Set :data:`ROBOT_SYSVARS` from the controller's robot (robot/machine.py
-        MachineData): ``$TRAFONAME`` (when the robot has one), the soft limits of A1..A6,
+        MachineData): ``$TRAFONAME`` (when the robot has one), the soft limits of A1..An and of
+        E1..Em (at 7..6+m; an endless axis has none),
         ``$ROBROOT``, ``$VEL_MA`` and ``$ACC_MA``. KRL code and the main run see one robot."""
         m = self.rt.controller.machine
         s = self.store
@@ -191,9 +194,11 @@ class SysVars:
             text = list(name[:len(data)])
             data[:len(text)] = text
             data[len(text):] = [make_value(T.CHAR)] * (len(data) - len(text))
-        for i, j in enumerate(m.joints[:6] if hasattr(m, "joints") else []):
-            s["$SOFTN_END"].data[i] = float(j.limit_deg[0])
-            s["$SOFTP_END"].data[i] = float(j.limit_deg[1])
+        limits = [(i, j.limit_deg) for i, j in enumerate(m.joints)]
+        limits += [(5 + e.number, e.limit) for e in m.external_axes if e.kind != "endless"]
+        for i, (lo, hi) in limits:
+            s["$SOFTN_END"].data[i] = float(lo)
+            s["$SOFTP_END"].data[i] = float(hi)
         for key, values in (("$ROBROOT", dict(zip("XYZABC", (float(x) for x in m.robroot_frame)))),
                             ("$VEL_MA", {"CP": m.vel_ma.cp, "ORI1": m.vel_ma.ori1, "ORI2": m.vel_ma.ori2}),
                             ("$ACC_MA", {"CP": m.acc_ma.cp, "ORI1": m.acc_ma.ori1, "ORI2": m.acc_ma.ori2})):
@@ -406,6 +411,15 @@ def _ro_const(v):
     return value
 
 
+def _machine_const(fn):
+    """A read-only value of the simulated robot's machine data (robot/machine.py), constant
+    for the run: ``$NUM_AX`` (the robot's axes), ``$EX_AX_NUM`` (its external axes E1..Em)."""
+    def value(sv: SysVars):
+        return fn(sv.rt.controller.machine)
+    value.constant = True        # CONSTANT_NAMES
+    return value
+
+
 #: the default window of ``$IN_HOME``/``$IN_HOME1..5`` (``$H_POS_TOL``, ``$H_AXIS_TOL[n]``), deg
 HOME_TOL_DEG = 2.0
 
@@ -415,8 +429,8 @@ def _in_home(n: int):
     A1..A6 stands within the window of the home position — ``|$AXIS_ACT.Ai - $H_POS.Ai| <=
     $H_POS_TOL.Ai`` (deg), for ``$IN_HOMEn`` ``$AXIS_HOME[n]`` and ``$H_AXIS_TOL[n]`` (KUKA
     System Variables, KSS 8.x: "$IN_HOME: robot in the home position, the position window
-    defined by $H_POS and $H_POS_TOL"). The external axes are not simulated and not compared.
-    A home position or window with an unset component gives FALSE."""
+    defined by $H_POS and $H_POS_TOL"), and each external axis E1..Em the robot has within its
+    own window. A home position or window with an unset component gives FALSE."""
     def value(sv: SysVars) -> bool:
         s = sv.store
         if n == 0:
@@ -426,7 +440,7 @@ def _in_home(n: int):
         q = sv.rt.controller.axis_act()
         try:
             return all(abs(float(q[i]) - float(home.f[k])) <= float(tol.f[k])
-                       for i, k in enumerate(E6AXIS_KEYS[:6]))
+                       for i, k in enumerate(E6AXIS_KEYS[:len(q)]))
         except (TypeError, ValueError):     # an UNSET component
             return False
     return value
@@ -473,8 +487,8 @@ _LIVE = {
     "$INTERPRETER": _computed(lambda sv: 1 if sv.rt.current_task_kind() == "robot" else 0),
     "$ERR": _computed(_err),
     "$NULLFRAME": _computed(_nullframe),
-    "$NUM_AX": _computed(_ro_const(6)),
-    "$EX_AX_NUM": _computed(_ro_const(0)),
+    "$NUM_AX": _computed(_machine_const(lambda m: m.n_axes)),
+    "$EX_AX_NUM": _computed(_machine_const(lambda m: m.n_ext)),
     "$PERI_RDY": _computed(_ro_const(True)),
     "$ROB_CAL": _computed(_ro_const(True)),
     "$IN_HOME": _computed(_in_home(0)),

@@ -32,9 +32,8 @@ def _forward(rt, a):
 
     from robot.frames import frame_to_matrix, inv_pos as _ip, matrix_to_frame  # noqa: PLC0415
 
-    ax = a[0].get()
-    q = np.array([_real_leaf(ax, k) for k in ("A1", "A2", "A3", "A4", "A5", "A6")], dtype=float)
     ctl = rt.controller
+    q = _model_axes(ctl, a[0].get())
     store = rt.sysvars.store
     tool = frame_to_matrix(*frame_tuple(store["$TOOL"]))
     base = frame_to_matrix(*frame_tuple(store["$BASE"]))
@@ -42,7 +41,22 @@ def _forward(rt, a):
     s, t = ctl.model.kin.status_turn(q)
     if len(a) > 1 and a[1] is not None:
         a[1].set(0)
-    return pos_struct({"X": x, "Y": y, "Z": z, "A": aa, "B": bb, "C": cc, "S": s, "T": t})
+    return pos_struct({"X": x, "Y": y, "Z": z, "A": aa, "B": bb, "C": cc, "S": s, "T": t,
+                       **ctl.model.axes.external(q)})
+
+
+def _model_axes(ctl, ax, ext_from=None):
+    """The model vector (robot/axismap.py) of the E6AXIS `ax`: its robot axes (each must be
+    set: "value invalid"), its external axes from `ext_from` (an E6POS: INVERSE's TOOLPOS) where
+    it sets them, else from `ax` where set, else the robot's actual ones."""
+    amap = ctl.model.axes
+    comps = {k: _real_leaf(ax, k) for k in amap.model_keys[:amap.n_robot]}
+    for k in amap.ext_keys:
+        for src in (ax, ext_from):
+            v = src.f.get(k, UNSET) if isinstance(src, Struct) else UNSET
+            if v is not UNSET:
+                comps[k] = float(num(v))
+    return amap.from_components(comps, fill=ctl.model.from_krl(ctl.axis_act()))
 
 
 INVERSE_NOT_REACHABLE = 3
@@ -71,8 +85,7 @@ def _inverse(rt, a):
     pos = a[0].get()
     start = a[1].get() if len(a) > 1 and a[1] is not None else None
     ctl = rt.controller
-    ref = (np.array([_real_leaf(start, k) for k in ("A1", "A2", "A3", "A4", "A5", "A6")], dtype=float)
-           if start is not None else np.array(ctl.axis_act(), dtype=float)[:6])
+    ref = _model_axes(ctl, start if start is not None else axis_struct(ctl.axis_act()), ext_from=pos)
     store = rt.sysvars.store
     tool = frame_to_matrix(*frame_tuple(store["$TOOL"]))
     base = frame_to_matrix(*frame_tuple(store["$BASE"]))
@@ -89,7 +102,7 @@ def _inverse(rt, a):
         q, code = ref, INVERSE_NOT_REACHABLE
     if len(a) > 2 and a[2] is not None:
         a[2].set(code)
-    return axis_struct(q)
+    return axis_struct(ctl.model.to_krl(q))
 
 
 def _real_leaf(s, k):
