@@ -49,13 +49,25 @@ def _load(path: Path | None):
 @robot_group.command("show")
 @click.argument("robot", type=click.Path(path_type=Path), required=False)
 def show(robot: Path | None) -> None:
-    """Print the robot model of ROBOT (a KRC backup folder or .zip, a $machine.dat or a robot
-    YAML; default the KR 6 R900): name, parameters with their source (file:line or the rule
+    """Print the robot model of ROBOT (a KRC backup folder or .zip, a $machine.dat, a robot
+    YAML or a KUKA model's name from `krl robot list`; default the KR 6 R900): name, parameters with their source (file:line or the rule
     that derived them), axis limits, speeds, accelerations, reach."""
     # costs 0.0007 s at krl's start-up (python -X importtime, 2026-11-25)
     from robot.show import show_lines  # noqa: PLC0415
 
     for line in show_lines(_load(robot)):
+        click.echo(line)
+
+
+@robot_group.command("list")
+def list_models() -> None:
+    """List the catalogue of KUKA robots by model name (robot/data/catalogue.yaml): each model's
+    $MODEL_NAME spelling, reach, axis limits and speeds, and the public description every value
+    comes from; `--robot NAME` and `krl robot show NAME` take either spelling."""
+    # costs 0.02 s at start-up (python -X importtime, 2026-11-26)
+    from robot.catalogue import catalogue_lines  # noqa: PLC0415
+
+    for line in catalogue_lines():
         click.echo(line)
 
 

@@ -1,0 +1,228 @@
+"""KUKA robots by model name: the catalogue of ``robot/data/catalogue.yaml`` (issue 64).
+
+``--robot "KR 150 R3100-2"``, ``--robot KR150R3100_2`` (KUKA's ``$MODEL_NAME`` spelling, as a
+backup's ``$robcor.dat`` holds it: ``#KR150R3100_2 C4 FLR``) and ``krl robot show`` resolve a model
+here; ``krl robot list`` prints the catalogue with each value's source.
+
+Each entry holds the values of a public robot description (kuka_experimental, kroshu's
+kuka_robot_descriptions; the file's header cites them) in the terms of KUKA's machine data, and
+:func:`machine` builds the model through robot/mada.py ``machine_from_values`` exactly as a
+backup's ``$machine.dat`` is built: the kinematic family (robot/kinematics/families.py), the OPW
+solution, the limits and the derived values follow from the same code. Provenance
+(``MachineData.provenance``) names the description for every value the entry gives, and the rule
+for every value derived.
+
+**Machine data win.** A machine-data file of the project's robot library (robot/data/*.dat) whose
+``$TRAFONAME`` names the same model is that model's robot (issue 60's KR 3 R540 data, for
+instance): :func:`machine` returns it, and ``krl robot list`` says so.
+
+Units: mm and deg (deg/s). Errors: :class:`robot.madavalues.MachineDataError` for a name that is
+no model of the catalogue (the message lists the close ones).
+"""
+
+from __future__ import annotations
+
+import difflib
+import re
+from dataclasses import dataclass, replace
+from functools import cache
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from .datalist import DataValue
+from .machine import MachineData, library_robots
+from .madavalues import MachineDataError
+
+CATALOGUE_FILE = Path(__file__).with_name("data") / "catalogue.yaml"
+
+#: the public descriptions the entries cite: repo id -> (repository, licence)
+REPOSITORIES = {
+    "kuka_experimental": ("ros-industrial/kuka_experimental", "Apache-2.0 (support packages: BSD or Apache)"),
+    "kroshu": ("kroshu/kuka_robot_descriptions", "Apache-2.0"),
+}
+
+#: the values KUKA's standard arm fixes (robot-model.md §4.3): every catalogue model is one
+_STANDARD_ARM = "KUKA's standard arm (robot-model.md section 4.3): $TX3P3.B 90, $DH_4 alpha 90, $DH_5 alpha -90"
+_AXIS_DIR = "KUKA's axis directions of the articulated arm (robot-model.md section 3, every corpus backup)"
+#: path limits: every KR C4 backup of the corpus and ../shared/robots holds these
+_PATH_LIMITS = "derived: the KR C4 path limits every backup of the corpus holds ($VEL_MA CP 3 m/s, ORI 400 deg/s; $ACC_MA CP 10 m/s2, ORI 1000 deg/s2)"
+
+
+@dataclass(frozen=True)
+class Model:
+    """One model of the catalogue.
+
+    Attributes:
+        key: KUKA's ``$MODEL_NAME`` spelling (``KR150R3100_2``).
+        name: the data sheet's name (``KR 150 R3100-2``).
+        series: the product family (``KR QUANTEC``).
+        source: where the values come from: ``repo path@commit``.
+        also: other descriptions of the same model that agree (cited).
+        geometry_mm: ``$TIRORO.Z``, ``$LENGTH_A``, ``$LENGTH_B``, ``$TX3P3.X``, ``$TX3P3.Z``,
+            ``$TFLWP.Z`` (mm).
+        limits_deg: ``($SOFTN_END, $SOFTP_END)`` of A1..A6.
+        speeds_deg_s: axis speeds of A1..A6.
+        note: what the entry says about its source.
+    """
+
+    key: str
+    name: str
+    series: str
+    source: str
+    also: tuple[str, ...]
+    geometry_mm: dict[str, float]
+    limits_deg: tuple[tuple[float, float], ...]
+    speeds_deg_s: tuple[float, ...]
+    note: str = ""
+
+
+def _cite(src: dict[str, Any]) -> str:
+    repo = REPOSITORIES.get(str(src.get("repo")), (str(src.get("repo")), ""))[0]
+    return f"{repo} {src.get('path')}@{str(src.get('commit', ''))[:8]}"
+
+
+@cache
+def models() -> dict[str, Model]:
+    """The catalogue: $MODEL_NAME spelling -> :class:`Model`, in the file's order."""
+    doc = yaml.safe_load(CATALOGUE_FILE.read_text(encoding="utf-8"))
+    out = {}
+    for key, m in doc["models"].items():
+        out[key] = Model(key=key, name=str(m["name"]), series=str(m.get("series", "")),
+                         source=_cite(m["source"]), also=tuple(_cite(a) for a in m.get("also", ())),
+                         geometry_mm={k: float(v) for k, v in m["geometry_mm"].items()},
+                         limits_deg=tuple((float(a), float(b)) for a, b in m["limits_deg"]),
+                         speeds_deg_s=tuple(float(v) for v in m["speeds_deg_s"]), note=str(m.get("note", "")))
+    return out
+
+
+def model_key(text: str) -> str:
+    """The ``$MODEL_NAME`` spelling of a model name: ``"KR 150 R3100-2"``, ``"KR150R3100_2"``,
+    ``"#KR150R3100_2 C4 FLR"`` (a ``$MODEL_NAME``/``$TRAFONAME`` value: its first word) and
+    ``"kr150_r3100_2"`` all give ``KR150R3100_2``."""
+    t = str(text).strip().lstrip("#").upper()
+    if re.match(r"^KR\d", t) and " " in t:          # $TRAFONAME/$MODEL_NAME: the model, then the controller
+        t = t.split()[0]
+    t = re.sub(r"\s+", "", t).replace("-", "_")
+    return re.sub(r"(?<=\d)_(?=R\d)", "", t)        # kroshu's file names: kr150_r3100_2
+
+
+def find(text: str) -> Model | None:
+    """The model named `text` (any spelling :func:`model_key` reads), or None."""
+    return models().get(model_key(text))
+
+
+def lookup(text: str) -> Model:
+    """:func:`find`, raising MachineDataError (with the close names) for an unknown model."""
+    found = find(text)
+    if found is None:
+        close = difflib.get_close_matches(model_key(text), list(models()), n=3, cutoff=0.6)
+        hint = f"; did you mean {', '.join(models()[k].name for k in close)}?" if close else \
+            "; `krl robot list` shows the catalogue"
+        raise MachineDataError(f"{text}: no KUKA model of that name in the catalogue{hint}")
+    return found
+
+
+def library_machine_data(model: Model) -> Path | None:
+    """A machine-data file of the project's robot library (robot/data/*.dat) whose ``$TRAFONAME``
+    names `model` (machine data win over a description), or None."""
+    for path in library_robots().values():
+        if path.suffix.lower() != ".dat":
+            continue
+        head = path.read_text(encoding="latin-1", errors="replace")
+        m = re.search(r'^\s*\$TRAFONAME\[\]\s*=\s*"([^"]*)"', head, re.M | re.I)
+        if m and model_key(m.group(1)) == model.key:
+            return path
+    return None
+
+
+class _Cited(DataValue):
+    """A value of the catalogue: ``where()`` is its source (the description), not a file:line."""
+
+    def __init__(self, name: str, value: Any, source: str) -> None:
+        super().__init__(name, value, source, 0)
+
+    def where(self, index: int | None = None) -> str:
+        return self.file
+
+
+def _values(m: Model) -> dict[str, DataValue]:
+    g = m.geometry_mm
+    src = f"{m.source} (joint origins at A = 0)"
+    lim = f"{m.source} (joint limits)"
+    vel = f"{m.source} (joint velocities)"
+    axes = range(1, 7)
+    vals: dict[str, DataValue] = {
+        "$TRAFONAME": _Cited("$TRAFONAME", f"#{m.key}", f"catalogue: {m.name}"),
+        "$KINCLASS": _Cited("$KINCLASS", "#STANDARD", _STANDARD_ARM),
+        "$NUM_AX": _Cited("$NUM_AX", 6, _STANDARD_ARM),
+        "$TIRORO": _Cited("$TIRORO", dict(X=0.0, Y=0.0, Z=g["TIRORO_Z"], A=0.0, B=0.0, C=0.0), src),
+        "$LENGTH_A": _Cited("$LENGTH_A", g["LENGTH_A"], src),
+        "$LENGTH_B": _Cited("$LENGTH_B", g["LENGTH_B"], src),
+        "$TX3P3": _Cited("$TX3P3", dict(X=g["TX3P3_X"], Y=0.0, Z=g["TX3P3_Z"], A=0.0, B=90.0, C=0.0), src),
+        "$DH_4": _Cited("$DH_4", dict(DHART_A=0.0, DHART_D=0.0, DHART_ALPHA=90.0), _STANDARD_ARM),
+        "$DH_5": _Cited("$DH_5", dict(DHART_A=0.0, DHART_D=0.0, DHART_ALPHA=-90.0), _STANDARD_ARM),
+        "$TFLWP": _Cited("$TFLWP", dict(X=0.0, Y=0.0, Z=g["TFLWP_Z"], A=0.0, B=0.0, C=0.0), src),
+        "$AXIS_DIR": _Cited("$AXIS_DIR", dict(zip(axes, (-1, 1, 1, -1, -1, -1))), _AXIS_DIR),
+        "$SOFTN_END": _Cited("$SOFTN_END", {i: lo for i, (lo, _) in zip(axes, m.limits_deg)}, lim),
+        "$SOFTP_END": _Cited("$SOFTP_END", {i: hi for i, (_, hi) in zip(axes, m.limits_deg)}, lim),
+        # the speeds as machine data carry them (rpm / |N/D| * 6 deg/s), N/D = 6: rpm = deg/s
+        "$VEL_AXIS_MA": _Cited("$VEL_AXIS_MA", dict(zip(axes, m.speeds_deg_s)), vel),
+        "$RAT_MOT_AX": _Cited("$RAT_MOT_AX", {i: {"N": 6, "D": 1} for i in axes}, vel),
+        "$VEL_MA": _Cited("$VEL_MA", {"CP": 3.0, "ORI1": 400.0, "ORI2": 400.0}, _PATH_LIMITS),
+        "$ACC_MA": _Cited("$ACC_MA", {"CP": 10.0, "ORI1": 1000.0, "ORI2": 1000.0}, _PATH_LIMITS),
+    }
+    return vals
+
+
+def machine(model: Model | str) -> MachineData:
+    """The robot model of a catalogue entry (or its name): the machine data of the project's
+    library when they name this model (:func:`library_machine_data`), else the entry's values
+    built by robot/mada.py. Raises MachineDataError for an unknown name."""
+    # costs 0.16 s at start-up (python -X importtime, 2026-11-25: robot.mada, as robot/cli.py says)
+    from .mada import load_mada, machine_from_values  # noqa: PLC0415
+
+    m = lookup(model) if isinstance(model, str) else model
+    lib = library_machine_data(m)
+    if lib is not None:
+        return load_mada(lib)
+    built = machine_from_values(_values(m), None, f"catalogue: {m.name} ({m.source})")
+    prov = dict(built.provenance)
+    for k in ("$VEL_AXIS_MA", "$RAT_MOT_AX"):
+        prov.pop(k, None)
+    prov["max_speed_deg_s"] = f"{m.source} (joint velocities)"
+    return replace(built, name=m.name, provenance=prov)
+
+
+def catalogue_lines() -> list[str]:
+    """The lines of ``krl robot list``: each model, its series, reach, axis limits and speeds,
+    and the source of every value (the description; machine data of the library where they win)."""
+    # costs 0.003 s at start-up (python -X importtime, 2026-11-26)
+    from krl.terminal import printable  # noqa: PLC0415
+
+    out = [f"{len(models())} KUKA robots (robot/data/catalogue.yaml); --robot takes the name or the $MODEL_NAME "
+           f"spelling", ""]
+    for m in models().values():
+        g = m.geometry_mm
+        reach = g["LENGTH_A"] + g["LENGTH_B"] + (g["TX3P3_X"] ** 2 + g["TX3P3_Z"] ** 2) ** 0.5
+        lib = library_machine_data(m)
+        out.append(f"{m.name:<20} {m.key:<16} {m.series}")
+        out.append(f"    reach {reach:.0f} mm to the wrist point; $TIRORO.Z {g['TIRORO_Z']:g}, $LENGTH_A "
+                   f"{g['LENGTH_A']:g}, $LENGTH_B {g['LENGTH_B']:g}, $TX3P3 X {g['TX3P3_X']:g} Z {g['TX3P3_Z']:g}, "
+                   f"$TFLWP.Z {g['TFLWP_Z']:g} mm")
+        out.append("    limits " + ", ".join(f"A{i + 1} {lo:g}..{hi:g}" for i, (lo, hi) in enumerate(m.limits_deg))
+                   + " deg")
+        out.append("    speeds " + ", ".join(f"{v:g}" for v in m.speeds_deg_s) + " deg/s; accelerations derived "
+                   "(v / 0.2 s: no description publishes them)")
+        out.append(f"    source {printable(m.source)} (geometry, limits, speeds)"
+                   + "".join(f"; agrees with {printable(a)}" for a in m.also))
+        if m.note:
+            out.append(f"    note   {printable(m.note)}")
+        if lib is not None:
+            out.append(f"    machine data win: robot/data/{lib.name} ($TRAFONAME names this model)")
+    return out
+
+
+__all__ = ["CATALOGUE_FILE", "Model", "catalogue_lines", "find", "library_machine_data", "lookup", "machine",
+           "model_key", "models"]
