@@ -6,15 +6,15 @@ here; ``krl robot list`` prints the catalogue with each value's source.
 
 Each entry holds the values of a public robot description (kuka_experimental, kroshu's
 kuka_robot_descriptions; the file's header cites them) in the terms of KUKA's machine data, and
-:func:`machine` builds the model through robot/mada.py ``machine_from_values`` exactly as a
-backup's ``$machine.dat`` is built: the kinematic family (robot/kinematics/families.py), the OPW
+:func:`values` gives them to robot/mada.py (``load_robot``, ``catalogue_robot``), which builds the
+model with ``machine_from_values`` exactly as a backup's ``$machine.dat`` is built: the kinematic family (robot/kinematics/families.py), the OPW
 solution, the limits and the derived values follow from the same code. Provenance
 (``MachineData.provenance``) names the description for every value the entry gives, and the rule
 for every value derived.
 
 **Machine data win.** A machine-data file of the project's robot library (robot/data/*.dat) whose
 ``$TRAFONAME`` names the same model is that model's robot (issue 60's KR 3 R540 data, for
-instance): :func:`machine` returns it, and ``krl robot list`` says so.
+instance): robot/mada.py ``catalogue_robot`` returns it, and ``krl robot list`` says so.
 
 Units: mm and deg (deg/s). Errors: :class:`robot.madavalues.MachineDataError` for a name that is
 no model of the catalogue (the message lists the close ones).
@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import difflib
 import re
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from functools import cache
 from pathlib import Path
 from typing import Any
@@ -32,7 +32,7 @@ from typing import Any
 import yaml
 
 from .datalist import DataValue
-from .machine import MachineData, library_robots
+from .machine import library_robots
 from .madavalues import MachineDataError
 
 CATALOGUE_FILE = Path(__file__).with_name("data") / "catalogue.yaml"
@@ -176,23 +176,11 @@ def _values(m: Model) -> dict[str, DataValue]:
     return vals
 
 
-def machine(model: Model | str) -> MachineData:
-    """The robot model of a catalogue entry (or its name): the machine data of the project's
-    library when they name this model (:func:`library_machine_data`), else the entry's values
-    built by robot/mada.py. Raises MachineDataError for an unknown name."""
-    # costs 0.16 s at start-up (python -X importtime, 2026-11-25: robot.mada, as robot/cli.py says)
-    from .mada import load_mada, machine_from_values  # noqa: PLC0415
-
-    m = lookup(model) if isinstance(model, str) else model
-    lib = library_machine_data(m)
-    if lib is not None:
-        return load_mada(lib)
-    built = machine_from_values(_values(m), None, f"catalogue: {m.name} ({m.source})")
-    prov = dict(built.provenance)
-    for k in ("$VEL_AXIS_MA", "$RAT_MOT_AX"):
-        prov.pop(k, None)
-    prov["max_speed_deg_s"] = f"{m.source} (joint velocities)"
-    return replace(built, name=m.name, provenance=prov)
+def values(m: Model) -> tuple[dict[str, DataValue], dict[str, str]]:
+    """The machine-data values of the entry `m` (robot/mada.py ``machine_from_values`` builds the
+    model from them: ``load_robot``), and the provenance entries that replace the build's (the
+    speeds are the description's, carried as ``$VEL_AXIS_MA`` with ``$RAT_MOT_AX`` N/D = 6)."""
+    return _values(m), {"max_speed_deg_s": f"{m.source} (joint velocities)"}
 
 
 def catalogue_lines() -> list[str]:
@@ -224,5 +212,5 @@ def catalogue_lines() -> list[str]:
     return out
 
 
-__all__ = ["CATALOGUE_FILE", "Model", "catalogue_lines", "find", "library_machine_data", "lookup", "machine",
-           "model_key", "models"]
+__all__ = ["CATALOGUE_FILE", "Model", "catalogue_lines", "find", "library_machine_data", "lookup", "model_key",
+           "models", "values"]

@@ -37,6 +37,7 @@ from scipy.spatial.transform import Rotation
 
 from krl.project import backup_of, find_backups, machine_data_file
 
+from . import catalogue
 from .chain import chain_forward, chain_to_joints
 from .datalist import DataListError, DataValue, read_data_list
 from .frames import matrix_to_frame
@@ -512,6 +513,20 @@ def robot_of_backup(root: str | Path, shown: str | None = None) -> MachineData |
     return load_mada(f, name)
 
 
+def catalogue_robot(model: "catalogue.Model | str") -> MachineData:
+    """The robot of a KUKA model of the catalogue (robot/catalogue.py; a Model or its name): the
+    machine data of the project's library when they name the model (machine data win), else the
+    catalogue entry's values built as machine data. Raises MachineDataError for an unknown name."""
+    m = catalogue.lookup(model) if isinstance(model, str) else model
+    lib = catalogue.library_machine_data(m)
+    if lib is not None:
+        return load_mada(lib)
+    vals, cited = catalogue.values(m)
+    built = machine_from_values(vals, None, f"catalogue: {m.name} ({m.source})")
+    prov = {k: v for k, v in built.provenance.items() if k not in ("$VEL_AXIS_MA", "$RAT_MOT_AX")}
+    return replace(built, name=m.name, provenance={**prov, **cited})
+
+
 def load_robot(path: str | Path) -> MachineData:
     """The robot model named by ``krl run --robot`` / ``krl robot show``: a robot YAML (the
     layout of robot/data/kr6_r900.yaml), a ``$machine.dat``, a KRC backup folder or a backup
@@ -527,12 +542,9 @@ def load_robot(path: str | Path) -> MachineData:
         if str(path) in lib:                    # a robot of the project's library, by name
             p = lib[str(path)]
         else:
-            # costs 0.002 s at start-up (python -X importtime, 2026-11-26)
-            from .catalogue import find, machine  # noqa: PLC0415
-
-            model = find(str(path))             # a KUKA model by name (robot/catalogue.py)
+            model = catalogue.find(str(path))   # a KUKA model by name (robot/catalogue.py)
             if model is not None:
-                return machine(model)
+                return catalogue_robot(model)
             raise MachineDataError(f"{p}: no such file or folder, nor a KUKA model of the catalogue (`krl robot "
                                    f"list`), nor a robot of the library ({', '.join(lib)})")
     if p.is_file() and p.suffix.lower() in (".yaml", ".yml"):
@@ -562,5 +574,5 @@ def load_robot(path: str | Path) -> MachineData:
     raise MachineDataError(f"{p}: not a robot YAML, $machine.dat, backup folder or backup .zip")
 
 
-__all__ = ["MachineDataError", "RULES", "chain_forward", "chain_to_joints", "load_mada", "load_robot",
+__all__ = ["MachineDataError", "RULES", "catalogue_robot", "chain_forward", "chain_to_joints", "load_mada", "load_robot",
            "machine_from_values", "robot_of_backup"]

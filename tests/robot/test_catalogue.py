@@ -27,6 +27,7 @@ from scipy.spatial.transform import Rotation
 from krl.cli import main
 from robot import catalogue
 from robot.kinematics import Kinematics
+from robot.mada import catalogue_robot
 from robot.madavalues import MachineDataError
 
 DESCRIPTIONS = Path(__file__).resolve().parents[3] / "shared" / "robots" / "descriptions" / "kuka_experimental"
@@ -166,7 +167,7 @@ def experimental_chain(macro: str, name: str):
 
 
 def _compare(key: str, chain) -> float:
-    m = catalogue.machine(key)
+    m = catalogue_robot(key)
     k = Kinematics(m)
     rng = np.random.default_rng(64)
     lo = np.array([a for a, _ in m.limits_deg])
@@ -202,7 +203,7 @@ def test_forward_kinematics_agrees_with_kuka_experimental(key):
 def test_limits_and_speeds_are_the_descriptions():
     """KR 150 R3100-2 by hand from kuka_experimental kr150r3100_2_macro.xacro: A1 +-185, A2 -140..-5,
     A3 -120..168, A4 +-350, A5 +-125, A6 +-350 deg; 105, 107, 114, 190, 180, 260 deg/s."""
-    m = catalogue.machine("KR 150 R3100-2")
+    m = catalogue_robot("KR 150 R3100-2")
     assert [j.limit_deg for j in m.joints] == [(-185, 185), (-140, -5), (-120, 168), (-350, 350), (-125, 125),
                                                (-350, 350)]
     assert [round(j.max_speed_deg_s, 9) for j in m.joints] == [105, 107, 114, 190, 180, 260]
@@ -257,6 +258,6 @@ def test_machine_data_of_the_library_win_over_the_description(tmp_path, monkeypa
     dat.write_text(src.read_text(encoding="latin-1").replace('"#KR16_2 ZH16_2"', '"#KR3R540 C4SR FLR"'),
                    encoding="latin-1")
     monkeypatch.setattr(catalogue, "library_robots", lambda: {"kr3_r540": dat})
-    m = catalogue.machine("KR 3 R540")
+    m = catalogue_robot("KR 3 R540")
     assert m.source == str(dat) and m.trafoname == "#KR3R540 C4SR FLR"
     assert any("machine data win: robot/data/kr3_r540.dat" in line for line in catalogue.catalogue_lines())
