@@ -162,6 +162,13 @@ MAX_GRAPH_NODES = 5000
 # characters in all; past it the remaining routines show their file:line without the text.
 MAX_GRAPH_SOURCE_CHARS = 8_000_000
 
+# KUKA Trace recordings (`krl trace show|compare`, robot/kukatrace): the largest KRCIpo CSV or
+# PROG.TXT read, in bytes (a recording of the real-traces repository is at most 700 kB: 12 ms
+# samples of 22 columns for 20 s), and the most columns of one CSV row. Past either: an error
+# naming the file (exit 2); nothing is read.
+MAX_RECORDING_BYTES = 64 * 1024 * 1024
+MAX_RECORDING_COLUMNS = 512
+
 # The controller's message window (interp/runtime/messages.py): the most messages shown at once
 # (a real cell shows a handful; past it the oldest notify message is dropped).
 MAX_KRL_MESSAGES = 100

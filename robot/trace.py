@@ -46,6 +46,9 @@ SCHEMA: dict[str, list[tuple[str, str]]] = {
         ("limits", "optional dict on phase start: the limits the motion is planned within "
                    "(robot/limits.py): path (TCP mm/s or null), axes (6 deg/s), flange (mm/s "
                    "or null, T1), tool and base (X..C mm/deg)"),
+        ("reached", "optional float on phase end of an exact stop: s, when the interpolation reached "
+                    "the end point (KUKA Trace's ENDTIME under the program override); the end event, "
+                    "the controller's END signal, follows 24-36 ms later (robot/exactstop.py)"),
     ],
     "io": [
         ("signal", "str: e.g. $OUT[3], $IN[5], $ANOUT[1], $ANIN[2]"),
@@ -89,6 +92,13 @@ SCHEMA: dict[str, list[tuple[str, str]]] = {
         ("data", "optional str: the message (bytes as Latin-1; the replay feeds them back)"),
         ("number", "optional int: the EKI/RSI message number of an error"),
         ("text", "optional str: detail (why a connection ended, what was refused)"),
+    ],
+    "recording": [
+        ("phase", "str: start | stop | trigger: a KUKA Trace recording started, stopped or was "
+                  "triggered ($TRACE.MODE #T_START, #T_STOP, #T_TRIGGER: KUKA's TraceStart and TraceStop "
+                  "of bas.src write it; robot/kukatrace reads a recording into these events too)"),
+        ("name", "optional str: the recording's name ($TRACE.NAME)"),
+        ("config", "optional str: the trace configuration ($TRACE.CONFIG, e.g. an .xml file)"),
     ],
     "robot": [
         ("name", "str: the simulated robot, e.g. 'KR210R2700_2 C4 FLR' (krl run's trace header, t=0)"),

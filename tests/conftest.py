@@ -26,6 +26,7 @@ REPO_ROOT = Path(__file__).resolve().parents[1]
 SHARED = REPO_ROOT.parent / "shared"
 SHARED_CORPUS = SHARED / "krl-corpus"
 SHARED_HISTORY = SHARED / "krl-history"
+SHARED_TRACES = SHARED / "real-traces"
 
 # The caches of what the tests run (the one store of the commands and language servers they start: krl/store.py) go to a
 # temporary folder of the session, never to the user's cache folder. The process that made it (the
@@ -43,7 +44,7 @@ settings.register_profile("nightly", max_examples=2000, deadline=None, print_blo
                           suppress_health_check=[HealthCheck.too_slow])
 settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "ci"))
 
-CORPUS_FIXTURES = {"shared_corpus", "corpus", "shared_history"}
+CORPUS_FIXTURES = {"shared_corpus", "corpus", "shared_history", "real_traces"}
 
 
 def corpus_present() -> bool:
@@ -80,6 +81,15 @@ def shared_history() -> Path:
     if not (SHARED_HISTORY / "MANIFEST.csv").exists():
         pytest.skip("../shared/krl-history is not present")
     return SHARED_HISTORY
+
+
+@pytest.fixture(scope="session")
+def real_traces() -> Path:
+    """The KUKA Trace recordings of a real KR 3 R540 and of OfficeLite (issue 60), read in place.
+    Absent: the test skips (a failure under CI=true)."""
+    if not (SHARED_TRACES / "MAP.csv").exists():
+        pytest.skip("../shared/real-traces is not present")
+    return SHARED_TRACES
 
 
 def pytest_configure(config: pytest.Config) -> None:

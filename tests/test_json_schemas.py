@@ -23,6 +23,7 @@ from krl.cli.bench import all_figures, engine_rates
 from recovery.pipeline import run_recovery
 
 from robot.trace import json_schema, read_trace
+from tests.robot.test_kukatrace import MOTIONS, write_recording
 
 REPO = Path(__file__).resolve().parents[1]
 SCHEMAS = REPO / "docs" / "schemas"
@@ -161,3 +162,13 @@ def test_diff_and_graph_json(tmp_path):
                          check=False)
     assert out.returncode == 0, out.stderr
     validate("graph", json.loads(out.stdout))
+
+
+def test_trace_show_and_compare_json(tmp_path):
+    # a recording written in KUKA Trace's formats (tests/robot/test_kukatrace.py), compared with itself
+    stem = str(write_recording(tmp_path, "demo", MOTIONS))
+    for args, name in ((["trace", "show", stem, "--json"], "trace-show"),
+                       (["trace", "compare", stem, stem, "--json"], "trace-compare")):
+        res = subprocess.run(KRL + args, capture_output=True, text=True, cwd=tmp_path, timeout=120)
+        assert res.returncode == 0, res.stderr
+        validate(name, json.loads(res.stdout))

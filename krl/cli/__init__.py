@@ -22,7 +22,7 @@ SUBCOMMANDS = {
     "parse": "krl.cli.parse",
     "recover": "recovery.cli", "growth": "recovery.cli", "validate": "recovery.cli", "construct": "recovery.cli",
     "check": "krl.cli.check",
-    "plot": "robot.cli", "robot": "robot.cli",
+    "plot": "robot.cli", "robot": "robot.cli", "trace": "robot.cli",
     "run": "interp.cli", "asm": "interp.cli", "cell": "interp.cli",
     "bench": "krl.cli.bench",
     "conformance": "conformance.cli",
