@@ -520,6 +520,74 @@ assert all(k in _LIVE and not getattr(_LIVE[k], "clock", False) for k in PROBED_
 EPOCH_PROBED = PROBED_NAMES - {"$COULD_START_MOTION", "$I_O_ACTCONF"}
 
 
+class _TraceFields(dict):
+    """The components of ``$TRACE`` (STRUC TRACE CHAR NAME[64], CONFIG[64], TRACE_MODE MODE,
+    TRACE_STATE STATE; KSS's $operate.dat). Writing ``MODE`` acts at once, as on a KR C4: ``#T_START``
+    starts a recording named ``NAME`` with the configuration ``CONFIG``, ``#T_STOP`` stops it,
+    ``#T_TRIGGER`` triggers it (a ``recording`` event of the run's trace, robot/trace.py, and the
+    controller's trace segments that ``krl trace compare`` matches with a KUKA Trace recording);
+    ``STATE`` follows: ``#TRIGGERED`` while recording (the configuration's own trigger is not
+    simulated: it records from the start), ``#T_END`` when stopped. KUKA's TraceStart and TraceStop
+    (every KSS 8 bas.src of the corpus; interp/basis/bas.src) write MODE and wait on STATE. A
+    component write goes through this dict in both interpreters (interp/runtime/memory.py
+    ``field_ref``: a Slot of the structure's components)."""
+
+    __slots__ = ("rt",)
+
+    def __setitem__(self, key, value) -> None:
+        super().__setitem__(key, value)
+        if key == "MODE" and isinstance(value, EnumValue):
+            _trace_mode(self.rt, self, value.name.upper())
+
+
+def _text(v) -> str:
+    """A CHAR array's text up to its first NUL (or UNSET)."""
+    data = getattr(v, "data", None)
+    if data is None:
+        return ""
+    out = []
+    for c in data:
+        if not isinstance(c, str) or c == "\0":
+            break
+        out.append(c)
+    return "".join(out).strip()
+
+
+def _trace_mode(rt, fields: dict, mode: str) -> None:
+    phase = {"T_START": "start", "T_STOP": "stop", "T_TRIGGER": "trigger"}.get(mode)
+    if phase is None:
+        return
+    recording = fields.get("STATE") == EnumValue("TRIGGERED")
+    if phase == "stop":
+        dict.__setitem__(fields, "STATE", EnumValue("T_END"))
+        if not recording:
+            return
+    else:
+        if phase == "trigger" and not recording:
+            return
+        dict.__setitem__(fields, "STATE", EnumValue("TRIGGERED"))
+    ctl = rt.controller
+    if ctl.trace is not None:
+        ctl.trace.write("recording", ctl.time, phase=phase, name=_text(fields.get("NAME")) or None,
+                        config=_text(fields.get("CONFIG")) or None)
+
+
+def _trace(sv: SysVars, t, name):
+    """``$TRACE``: a structure whose MODE component acts when written (:class:`_TraceFields`);
+    boots with STATE #T_END (no recording)."""
+    v = make_value(t)
+    fields = _TraceFields(v.f)
+    fields.rt = sv.rt
+    dict.__setitem__(fields, "STATE", EnumValue("T_END"))
+    dict.__setitem__(fields, "MODE", EnumValue("T_STOP"))
+    v.f = fields
+    sv.store[name] = v
+    return Slot(sv.store, name, t, name)
+
+
+_LIVE["$TRACE"] = _trace
+
+
 def _sync_advance(sv: SysVars, ref) -> None:
     """``$ADVANCE = n`` (0..5) goes to the controller's motion queue at once."""
     v = ref.c[ref.k]

@@ -1,4 +1,4 @@
-"""KUKA's BASIS routines that programs call as functions (reference 4.8; KSS bas.src): the
+"""KUKA's BASIS routines that programs call (reference 4.8; KSS bas.src), KUKA Trace's among them: the
 checker knows their signatures even when a backup's BASIS lacks them. KRL implements them:
 the project's BASIS (interp/basis/bas.src, added to a program outside a backup) or the
 backup's own bas.src; a call binds to that routine like any other. A backup whose bas.src
@@ -28,3 +28,8 @@ BASIS.krl("CIRC_MODE SCIRC_M(CIRC_MODE MODE :OUT)", "bas.src")
 BASIS.krl("REAL SGEAR_JERK(PDAT PDAT_ :OUT)", "bas.src")
 BASIS.krl("JERK_STRUC SJERK(LDAT LDAT_ :OUT)", "bas.src")
 BASIS.krl("BAS(BAS_COMMAND COMMAND :IN, REAL VALUE :IN)", "bas.src")
+
+# KUKA Trace (KSS 8 bas.src): start and stop a recording; they write $TRACE (interp/runtime/sysvars.py),
+# which marks the recording in the run's trace (issue 60)
+BASIS.krl("TraceStart(CHAR CONFIG[] :IN, CHAR NAME[] :IN)", "bas.src")
+BASIS.krl("TraceStop()", "bas.src")
