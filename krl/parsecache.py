@@ -147,8 +147,7 @@ def encode_loaded(lf: LoadedFile) -> bytes | None:
         return None
     try:
         body = [lf.module, lf.ok, lf.status, [_enc_diag(d, False) for d in lf.diagnostics], lf.unreadable,
-                sorted(lf.failed_words), sorted(map(list, lf.template[0].items())),
-                sorted(map(list, lf.template[1].items()))]
+                sorted(lf.failed_words), *(sorted(map(list, lines.items())) for lines in lf.template)]
         return msgpack.packb(body, use_bin_type=True, strict_types=True, default=_pack_default)
     except (TypeError, ValueError, OverflowError):
         return None
@@ -161,22 +160,22 @@ def decode_loaded(data: bytes, path: str) -> LoadedFile:
         up = msgpack.Unpacker(None, raw=False, use_list=True, strict_map_key=True, max_buffer_size=max(1, len(data)),
                               object_pairs_hook=_refuse, ext_hook=_refuse, list_hook=_node_hook(path, on))
         up.feed(data)
-        if up.read_array_header() != 8:
+        if up.read_array_header() != 9:
             raise CorruptEntry("not an entry")
         on[0] = True
         module = up.unpack()            # the module's subtree, built by the hook
         on[0] = False
-        ok, status, diags, unreadable, words, ini, inline = [up.unpack() for _ in range(7)]
+        ok, status, diags, unreadable, words, ini, inline, user = [up.unpack() for _ in range(8)]
         if up.tell() != len(data):
             raise CorruptEntry("extra data")
         if not isinstance(module, N.Module) or type(ok) is not bool or type(status) is not str \
                 or type(unreadable) is not bool or not all(type(w) is str for w in words) \
                 or not all(type(x) is list and len(x) == 2 and type(x[0]) is int and type(x[1]) is str
-                           for x in (*ini, *inline)):
+                           for x in (*ini, *inline, *user)):
             raise CorruptEntry("not an entry")
         module.path = path
         return LoadedFile(path, module, ok, status, 0.0, 0.0, [_dec_diag(d, path, path) for d in diags], unreadable,
-                          set(words), (dict(map(tuple, ini)), dict(map(tuple, inline))))
+                          set(words), (dict(map(tuple, ini)), dict(map(tuple, inline)), dict(map(tuple, user))))
     except CorruptEntry:
         raise
     except (ValueError, TypeError, RecursionError, msgpack.exceptions.UnpackException) as exc:

@@ -54,7 +54,7 @@ from krl.semantics.builtins import load_builtins
 from krl.semantics.checker import Checker, DeclaredTwice, Declarer, _is_system_datalist
 from krl.diagnostics import Diagnostic, DiagnosticSink
 from krl.diagnostics.codes import E001, E005, E901, W002, W108, W111, W201, W202, W205, W206, W210, W501
-from krl.semantics.outside import Unresolved, fold_evidence, template_lines
+from krl.semantics.outside import Unresolved, line_evidence, template_lines
 from krl.semantics.resolve import resolve_workspace
 from krl.semantics.symbols import Scope, Symbol, system_scopes
 from krl.syntax.folds import fold_diagnostics
@@ -90,8 +90,9 @@ class LoadedFile:
     diagnostics: list
     unreadable: bool = False
     failed_words: set = field(default_factory=set)
-    # (INI-fold lines, inline-form lines) of KUKA's templates (krl/semantics/outside.py)
-    template: tuple = ({}, {})
+    # (INI-fold lines, inline-form lines, USER-fold lines) of KUKA's templates and files
+    # (krl/semantics/outside.py template_lines)
+    template: tuple = ({}, {}, {})
 
 
 # Below this many bytes a batch of files is parsed by the Python engine: starting the Java
@@ -272,7 +273,8 @@ class Workspace:
     # words of files that did not parse: a name among them may be declared there
     failed_words: set = field(default_factory=set)
     unreadable: bool = False
-    # path -> (INI-fold lines, inline-form lines) of KUKA's templates (krl/semantics/outside.py)
+    # path -> (INI-fold lines, inline-form lines, USER-fold lines) of KUKA's templates and files
+    # (krl/semantics/outside.py template_lines)
     template: dict = field(default_factory=dict)
     # when set: only these paths' routine bodies and data-list values are checked (the other
     # files still declare their names); one file in the context of its backup
@@ -299,10 +301,11 @@ class Workspace:
         """True when a file that could not be parsed (or read) may declare `name`."""
         return self.unreadable or name.upper() in self.failed_words
 
-    def evidence(self, path: str, line: int, kind: str) -> str:
-        """Why a use at path:line says installed software declares the name, or "" (the
-        template's INI fold; a KUKA inline form, for routines and types)."""
-        return fold_evidence(self.template.get(path), line, kind)
+    def evidence(self, path: str, line: int, kind: str, kuka: bool = False) -> str:
+        """Why a use at path:line says installed software declares the name, or "" (a line of a
+        KUKA file, `kuka`, outside its USER folds; the template's INI fold; a KUKA inline form, for
+        routines and types): krl/semantics/outside.py ``line_evidence``."""
+        return line_evidence(self.template.get(path), line, kind, kuka)
 
     @property
     def diagnostics(self) -> list[Diagnostic]:
@@ -870,8 +873,9 @@ class _Uses:
         self.items: list[tuple] = []
         self.twice: list[DeclaredTwice] = []
 
-    def use(self, kind: str, name: str, path: str, line: int, column: int, evidence: str = "") -> None:
-        self.items.append((kind, name, path, line, column, evidence))
+    def use(self, kind: str, name: str, path: str, line: int, column: int, evidence: str = "",
+            declared: str = "") -> None:
+        self.items.append((kind, name, path, line, column, evidence, declared))
 
     def declared_twice(self, fact: DeclaredTwice) -> None:
         self.twice.append(fact)
@@ -888,7 +892,7 @@ def _moved_diagnostics(sink: DiagnosticSink, delta: int) -> DiagnosticSink:
 def _same_template(old, new, lines: range, delta: int) -> bool:
     """True when lines `lines` of the old text lie in the same template folds (INI, inline
     form: the evidence of an unresolved use) as those lines moved by `delta` in the new."""
-    return all(old[0].get(n) == new[0].get(n + delta) and old[1].get(n) == new[1].get(n + delta) for n in lines)
+    return all(all(a.get(n) == b.get(n + delta) for a, b in zip(old, new)) for n in lines)
 
 
 @dataclass(slots=True, eq=False)
@@ -926,7 +930,7 @@ class _RoutineCheck:
             if self.body_diags is not None:
                 self.body_diags = _moved_diagnostics(self.body_diags, delta)
             for p in uses:
-                p.items = [(k, n, f, line + delta, c, e) for k, n, f, line, c, e in p.items]
+                p.items = [(k, n, f, line + delta, c, e, x) for k, n, f, line, c, e, x in p.items]
         self.span, self.end_line = r.span, r.end_line
         return True
 
@@ -950,7 +954,7 @@ class _ValueCheck:
             return False
         if delta:
             self.diags = _moved_diagnostics(self.diags, delta)
-            self.uses.items = [(k, n, f, line + delta, c, e) for k, n, f, line, c, e in self.uses.items]
+            self.uses.items = [(k, n, f, line + delta, c, e, x) for k, n, f, line, c, e, x in self.uses.items]
         self.span = self.item.span
         return True
 

@@ -19,7 +19,7 @@ from krl.semantics.values import INT_MAX, INT_MIN, KrlRuntimeError, UNSET, EnumV
 from krl.semantics.values import binary_op as _binary_op
 from krl.semantics.values import real_to_int, to_bool, trunc_int, unary_op, value_invalid
 
-from .values import Arr, Struct, copy_value, make_value
+from .values import Arr, Struct, copy_value, make_value, value_text
 
 __all__ = ["INT_MAX", "INT_MIN", "assign_chars", "assign_into", "binary_op", "check_int", "compare",
            "convert_scalar", "frame_tuple", "geo_compose", "inv_pos", "num", "real_to_int",
@@ -37,7 +37,7 @@ def convert_scalar(v, t):
             return real_to_int(v)
         if c is str and len(v) == 1:
             return ord(v)
-        raise KrlRuntimeError(f"cannot assign {v!r} to INT")
+        raise KrlRuntimeError(f"cannot assign {value_text(v)} to INT")
     if t is T.REAL:
         c = v.__class__
         if c is float:
@@ -46,11 +46,11 @@ def convert_scalar(v, t):
             return float(v)
         if c is str and len(v) == 1:
             return float(ord(v))
-        raise KrlRuntimeError(f"cannot assign {v!r} to REAL")
+        raise KrlRuntimeError(f"cannot assign {value_text(v)} to REAL")
     if t is T.BOOL:
         if v is True or v is False:
             return v
-        raise KrlRuntimeError(f"cannot assign {v!r} to BOOL")
+        raise KrlRuntimeError(f"cannot assign {value_text(v)} to BOOL")
     if t is T.CHAR:
         if isinstance(v, str) and len(v) == 1:
             return v
@@ -60,13 +60,13 @@ def convert_scalar(v, t):
             return chr(v)
         if isinstance(v, Arr) and v.type.elem == T.CHAR and v.data:
             return v.data[0]
-        raise KrlRuntimeError(f"cannot assign {v!r} to CHAR")
+        raise KrlRuntimeError(f"cannot assign {value_text(v)} to CHAR")
     if isinstance(t, T.Enum):
         if isinstance(v, EnumValue):
             if t.values and v.name not in t.values:
                 raise KrlRuntimeError(f"#{v.name} is not a value of {t.name}")
             return EnumValue(v.name, t)
-        raise KrlRuntimeError(f"cannot assign {v!r} to {t.name}")
+        raise KrlRuntimeError(f"cannot assign {value_text(v)} to {t.name}")
     if isinstance(t, T.Struc):
         dest = make_value(t)
         assign_into(dest, v)
@@ -85,7 +85,7 @@ def assign_chars(dest: Arr, v) -> None:
     elif isinstance(v, str):
         text = v
     else:
-        raise KrlRuntimeError(f"cannot assign {v!r} to a CHAR array")
+        raise KrlRuntimeError(f"cannot assign {value_text(v)} to a CHAR array")
     data = dest.data
     n = len(data)
     text = text[:n]
@@ -102,7 +102,7 @@ def assign_into(dest, v) -> None:
         if not isinstance(v, Struct):
             if v is UNSET:
                 raise value_invalid()
-            raise KrlRuntimeError(f"cannot assign {v!r} to {dest.type.name if dest.type else 'a structure'}")
+            raise KrlRuntimeError(f"cannot assign {value_text(v)} to {dest.type.name if dest.type else 'a structure'}")
         ftypes = dest.type.fields if dest.type is not None else {}
         for k, x in v.f.items():
             if k not in dest.f:
@@ -134,7 +134,7 @@ def assign_into(dest, v) -> None:
                 else:
                     dest.data[i] = x if x is UNSET else convert_scalar(x, dest.type.elem)
             return
-        raise KrlRuntimeError(f"cannot assign {v!r} to {dest.type}")
+        raise KrlRuntimeError(f"cannot assign {value_text(v)} to {dest.type}")
     raise KrlRuntimeError("assignment to a non-aggregate")
 
 
@@ -170,7 +170,7 @@ FRAME_KEYS = ("X", "Y", "Z", "A", "B", "C")
 def frame_tuple(v, what: str = "frame") -> tuple:
     """(X, Y, Z, A, B, C) of a FRAME/POS/E6POS value (missing components 0; set ones only)."""
     if not isinstance(v, Struct):
-        raise KrlRuntimeError(f"{what} is not a FRAME/POS: {v!r}")
+        raise KrlRuntimeError(f"{what} is not a FRAME/POS: {value_text(v)}")
     out = []
     for k in FRAME_KEYS:
         x = v.f.get(k, 0.0)

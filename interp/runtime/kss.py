@@ -21,8 +21,10 @@ X not found"), as on a controller — also one the checker warns about only beca
 the program that does not parse mentions it (``Outside.kuka`` False: perhaps the program's own
 declaration, in a file the controller could not load either). Besides, a routine the checker resolves whose body nothing of the program holds
 stands in when outside.py's :func:`~krl.semantics.outside.provided_routine` says KUKA's software
-provides it (a routine of the platform tables; an ``EXT`` of a KUKA system file such as
-``EXT P00 (...)`` of ``$config.dat``). The routines of EthernetKRL and RSI (functions.yaml
+provides it (a routine of the platform tables); a routine an ``EXT``/``EXTFCT`` declaration names
+and no module defines is one of the checker's classified names (SpotTech's ``USERSPOT`` of every
+module's data list; ``EXT P00 (...)`` of ``$config.dat``), and stands in with its declared
+signature. The routines of EthernetKRL and RSI (functions.yaml
 ``lenient`` ``ethernet_krl``, ``rsi``) are the network partners' (issue 35), not stand-ins here.
 
 **Which value** (docs/robot.md, "KUKA's software the backup lacks").
@@ -59,7 +61,6 @@ from krl.semantics import types as T
 from krl.semantics.builtins import _read, load_builtins
 from krl.semantics.outside import provided_routine
 from krl.semantics.resolve import NATIVE, ROUTINE, UNRESOLVED
-from krl.workspace import is_kuka_file
 
 from .errors import KrlRuntimeError
 from .memory import Slot
@@ -255,13 +256,13 @@ class SystemSoftware:
 
     # ------------------------------------------------------------------ routines
     def _evidence(self, key: str) -> str | None:
-        """Why the routine `key` is KUKA's system software, or None."""
+        """Why the routine `key` is KUKA's system software, or None: the checker's
+        classification (an unresolved name with evidence, a routine an EXT names and no module
+        defines), else a routine of the platform tables the simulator does not implement."""
         why = self.outside().get(("routine", key))
         if why:
             return why
-        sym = self._symbol(key)
-        path = sym.path if sym is not None and sym.path and is_kuka_file(sym.path) else ""
-        return provided_routine(key, path) or None
+        return provided_routine(key) or None
 
     def _returns(self, key: str):
         """The declared return type of the routine `key`: its EXTFCT in the program's files,
@@ -276,8 +277,17 @@ class SystemSoftware:
         return sys_type(name) or getattr(T, name.upper(), None)
 
     def _symbol(self, key: str):
-        scope = getattr(self.rt.program.ws, "global_scope", None)
-        return scope.routines.get(key) if scope is not None else None
+        """The routine symbol of `key`: the global scope's, else an EXT/EXTFCT of a module's
+        data list (its declared signature)."""
+        ws = self.rt.program.ws
+        scope = getattr(ws, "global_scope", None)
+        sym = scope.routines.get(key) if scope is not None else None
+        if sym is None:
+            for unit in getattr(ws, "units", ()):
+                sym = unit.scope.routines.get(key) if unit.scope is not None else None
+                if sym is not None:
+                    break
+        return sym
 
     @staticmethod
     def network(key: str) -> bool:

@@ -19,41 +19,11 @@ from krl.limits import MAX_VARPROXY_NAME_CHARS, MAX_VARPROXY_VALUE_CHARS
 
 from .errors import KrlRuntimeError
 from .memory import field_ref, index_ref
-from .values import UNSET, Arr, EnumValue, Struct, is_char_array
+from .values import UNSET, Arr, EnumValue, Struct, is_char_array, value_text  # noqa: F401 - the text form
 
 
 class ValueTextError(ValueError):
     """A value text that is not a KRL literal (or past the size limits)."""
-
-
-def format_real(v: float) -> str:
-    s = f"{float(v):.6f}".rstrip("0").rstrip(".")
-    return "0" if s in ("-0", "") else s
-
-
-def value_text(v) -> str:
-    """The controller's text of value `v` (see the module docstring)."""
-    if v is UNSET or v is None:
-        return ""
-    if isinstance(v, bool):
-        return "TRUE" if v else "FALSE"
-    if isinstance(v, int):
-        return str(v)
-    if isinstance(v, float):
-        return format_real(v)
-    if isinstance(v, EnumValue):
-        return "#" + v.name
-    if isinstance(v, str):
-        return '"' + v + '"'
-    if is_char_array(v):
-        return '"' + v.text() + '"'
-    if isinstance(v, Struct):
-        parts = [f"{k} {value_text(x)}" for k, x in v.f.items() if x is not UNSET]
-        name = getattr(v.type, "name", None)
-        return "{" + (f"{name}: " if name else "") + ", ".join(parts) + "}"
-    if isinstance(v, Arr):
-        return "{" + ", ".join(value_text(x) for x in v.data[:64]) + "}"
-    return str(v)
 
 
 _TOKEN = re.compile(r'\s*(?:(?P<str>"[^"]*")|(?P<num>[+-]?(?:\d+\.?\d*(?:[Ee][+-]?\d+)?|\.\d+(?:[Ee][+-]?\d+)?))'

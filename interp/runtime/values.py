@@ -323,3 +323,38 @@ def type_name_of(v) -> str:
     if isinstance(v, Arr):
         return str(v.type)
     return "?"
+
+
+def format_real(v: float) -> str:
+    """A REAL in the controller's text: fixed point, at most 6 decimals."""
+    s = f"{float(v):.6f}".rstrip("0").rstrip(".")
+    return "0" if s in ("-0", "") else s
+
+
+def value_text(v) -> str:
+    """The controller's text of value `v`, as KRL writes its literals (reference §2): INT ``42``,
+    REAL ``12.5``, BOOL ``TRUE``/``FALSE``, ENUM ``#T1``, CHAR ``"x"``, a CHAR array ``"text"``, a
+    structure ``{E6POS: X 1.5, ...}``, an array's first 64 elements; "" for an unset value. The
+    one text of a value for KukaVarProxy (interp/runtime/netvars.py) and the run-time errors'
+    messages (no Python literal such as ``False`` in a KRL message)."""
+    if v is UNSET or v is None:
+        return ""
+    if isinstance(v, bool):
+        return "TRUE" if v else "FALSE"
+    if isinstance(v, int):
+        return str(v)
+    if isinstance(v, float):
+        return format_real(v)
+    if isinstance(v, EnumValue):
+        return "#" + v.name
+    if isinstance(v, str):
+        return '"' + v + '"'
+    if is_char_array(v):
+        return '"' + v.text() + '"'
+    if isinstance(v, Struct):
+        parts = [f"{k} {value_text(x)}" for k, x in v.f.items() if x is not UNSET]
+        name = getattr(v.type, "name", None)
+        return "{" + (f"{name}: " if name else "") + ", ".join(parts) + "}"
+    if isinstance(v, Arr):
+        return "{" + ", ".join(value_text(x) for x in v.data[:64]) + "}"
+    return str(v)

@@ -115,7 +115,8 @@ W105 = Code("W105", WARNING, "type not in the backup, declared by installed soft
 E106 = Code("E106", ERROR, "undeclared routine", "routine '{name}' is not declared")
 W106 = Code("W106", WARNING, "routine not in the backup, provided by installed software (once per backup)",
             "{noun} '{name}' is not declared in this backup ({times}; first here): {why}",
-            soft="routine '{name}' is not declared")
+            soft="routine '{name}' is not declared",
+            ext="{noun} '{name}' is declared EXT but not defined in this backup ({times}; first here): {why}")
 W107 = Code("W107", WARNING, "system variable the platform tables do not list (once per backup)",
             "{noun} '{name}' is not declared in this backup ({times}; first here): {why}",
             soft="unknown system variable '{name}'")

@@ -27,7 +27,7 @@ from krl.ast import nodes as N
 from krl.ast.visit import EXPRESSIONS, STATEMENTS, handlers
 from krl.ast.printer import expr as printed
 from krl.semantics import types as T
-from krl.semantics.outside import KINDS
+from krl.semantics.outside import KINDS, ext_evidence, line_evidence
 from krl.diagnostics import DiagnosticSink
 from krl.diagnostics.codes import (E101, E102, E103, E104, E108, E109, E110, E201, E203, E204, E205, E206, E207, E208,
                                    E209, E211, E212, E301, E302, E303, E304, E401, E402, E403, E404, E405, E406, E408,
@@ -87,22 +87,23 @@ class Declarer:
         # unresolved names (krl/semantics/outside.py decides on them) and declarations made
         # twice (DeclaredTwice); None: report at once, keep no facts
         self.unresolved = None
-        # evidence(path, line, kind) -> why installed software declares a name used there, or ""
-        self.evidence = lambda _path, _line, _kind: ""
+        # evidence(path, line, kind, kuka) -> why installed software declares a name used there,
+        # or "" (krl/semantics/outside.py line_evidence; kuka: the file is KUKA's)
+        self.evidence = lambda path, line, kind, kuka=False: line_evidence(None, line, kind, kuka)
         # (id(scope), UPPER name) of the types a system data list declared first (they may repeat)
         self._system_types: set[tuple[int, str]] = set()
 
-    def unknown(self, kind: str, name: str, span: N.Span, evidence: str = "") -> None:
-        """An unresolved name of `kind` ('name', 'type', 'routine', 'sysvar') used at `span`:
-        recorded for the workspace's decision (krl/semantics/outside.py), or reported at once
-        when the declarer works without a workspace."""
+    def unknown(self, kind: str, name: str, span: N.Span, evidence: str = "", kuka: bool | None = None,
+                declared: str = "") -> None:
+        """An unresolved name of `kind` ('name', 'type', 'routine', 'sysvar') used at `span`
+        (or a routine an EXT at `declared`, FILE:LINE, names and nothing defines): recorded for
+        the workspace's decision (krl/semantics/outside.py), or reported at once when the
+        declarer works without a workspace. `kuka`: the file is KUKA's (default: the
+        declarer's ``soft_types``); the line decides with it (outside.py ``line_evidence``)."""
         if not evidence:
-            if self.soft_types:
-                evidence = "KUKA's system files use it"
-            else:
-                evidence = self.evidence(span.file, span.line, kind)
+            evidence = self.evidence(span.file, span.line, kind, self.soft_types if kuka is None else kuka)
         if self.unresolved is not None:
-            self.unresolved.use(kind, name, span.file, span.line, span.column, evidence)
+            self.unresolved.use(kind, name, span.file, span.line, span.column, evidence, declared)
             return
         err, warn, _noun = KINDS[kind]
         soft = evidence or kind == "sysvar" or self.maybe_declared(name)
@@ -957,6 +958,8 @@ class Checker:
             self.unknown("routine", c.name, c.span)
             return T.UNKNOWN
         c.annotate().symbol = sym
+        if isinstance(sym.decl, N.ExtDecl):
+            self._undefined_ext(c, sym, sc)
         sig = sym.signature
         if sig is None:
             return T.UNKNOWN
@@ -995,13 +998,38 @@ class Checker:
 
     def unknown(self, kind: str, name: str, span: N.Span) -> None:
         """Record an unresolved name (krl/semantics/outside.py decides error or warning)."""
-        self.decl.unknown(kind, name, span, "KUKA's system files use it" if self.system_file else "")
+        self.decl.unknown(kind, name, span, kuka=self.system_file)
+
+    def _undefined_ext(self, c: N.Call, sym: Symbol, sc: Scope) -> None:
+        """Record a call of a routine that an EXT/EXTFCT declaration names and no module of the
+        program defines (the link binds a call to the module main or GLOBAL routine of that name,
+        reference 2.6; krl/semantics/resolve.py): the declaration resolves the name, its body is
+        installed software's (krl/semantics/outside.py ``ext_evidence``). A routine of the
+        platform tables behind an EXT is the controller's own: not recorded."""
+        if self.decl.unresolved is None:
+            return
+        key = c.name.upper()
+        s = sc
+        while s is not None:
+            if s.kind in ("global", "basis", "system"):
+                got = s.routines.get(key)
+                if got is not None and not isinstance(got.decl, N.ExtDecl):
+                    return          # a module main or GLOBAL routine, or a built-in
+            s = s.parent
+        span = sym.decl.span
+        place = f"{_file_name(span.file)}:{span.line}" if span is not None else "an EXT declaration"
+        evidence = self.decl.evidence(c.span.file, c.span.line, "routine", self.system_file) or ext_evidence(place)
+        self.decl.unknown("routine", c.name, c.span, evidence, declared=place)
 
     def not_found(self, span: N.Span, name: str, sc: Scope) -> None:
         self.unknown("sysvar" if name.startswith("$") else "name", name, span)
 
     def not_found_type(self, span: N.Span, name: str, sc: Scope) -> None:
         self.unknown("type", name, span)
+
+
+def _file_name(path: str) -> str:
+    return path.replace("\\", "/").rsplit("/", 1)[-1]
 
 
 def _char_like(t: T.KrlType) -> bool:

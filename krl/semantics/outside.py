@@ -5,21 +5,30 @@ The checker does not report an unresolved name at once. It records every use her
 (:meth:`Unresolved.use`), with where the use is, and :meth:`Unresolved.finish` decides once the
 whole workspace has been checked:
 
-* a name is **outside the backup** when there is evidence that installed software declares it:
+* a name is **outside the backup** (installed software: KUKA's system software and its
+  technology packages, installed on the controller whether or not their files were exported)
+  when there is evidence that installed software declares it, whatever resolved it:
   the platform tables name the technology package or KUKA hook program that declares it
   (kss.yaml ``packages``),
   or one of its uses is a line that KUKA's software wrote (a KUKA system file: R1/System,
-  R1/TP, R1/Mada, STEU or a ``$`` file; the template's INI fold of a program, not its
-  USER INI fold; for a routine or a type, a KUKA inline form ``;FOLD ... ;%{PE}``), or it is
-  a type of an ``EXT``/``EXTFCT`` declaration, or a file of the backup that does not parse
-  mentions it, or it is a ``$`` system variable (users cannot declare those);
+  R1/TP, R1/Mada, STEU or a ``$`` file, outside its USER folds; the template's INI fold of a
+  program, not its USER INI fold; for a routine or a type, a KUKA inline form ``;FOLD ...
+  ;%{PE}`` or one naming its module ``%M...``), or it is a routine that an ``EXT``/``EXTFCT``
+  declaration names and no module of the backup defines (:func:`ext_evidence`: the EXT resolves
+  the name, the body is installed), or a type of such a declaration, or a file of the backup
+  that does not parse mentions it, or it is a ``$`` system variable (users cannot declare those);
   it is reported ONCE per (kind, name) per backup as a warning (W101 name, W105 type,
   W106 routine, W107 system variable) at its first use, saying how often and in how many
-  files it is used and, where known, which package declares it where;
+  files it is used and, where known, which package declares it where; an ENUM literal of such a
+  type is one of its values (the run's stand-in ENUM has it, interp/runtime/kss.py);
 * any other unresolved name is the program's error: E101/E105/E106 at every line that uses it.
+  Code in the USER folds of KUKA's files (``USER INIT``, ``USER PLC`` of sps.sub, ``USER GLOBALS``
+  of ``$config.dat``) is the user's: a name only it uses and nothing declares is the program's
+  error there too (:func:`line_evidence`).
 
 Only lines decide, never the spelling of a name: a misspelled variable in user code is an error
-however KUKA-like it looks.
+however KUKA-like it looks. The run stands in for exactly the names classified here
+(interp/runtime/kss.py), with their declared signature where an EXT gives one.
 """
 
 from __future__ import annotations
@@ -58,8 +67,9 @@ def fold_opening(line: str) -> str | None:
     return m.group(1) if m else None
 
 
-def template_lines(text: str) -> tuple[dict[int, str], dict[int, str]]:
-    """(INI-fold lines, inline-form lines) of a KRL text: line (1-based) -> what wrote it.
+def template_lines(text: str) -> tuple[dict[int, str], dict[int, str], dict[int, str]]:
+    """(INI-fold lines, inline-form lines, USER-fold lines) of a KRL text: line (1-based) ->
+    what wrote it.
 
     INI-fold lines lie inside a fold titled ``INI`` or ``<WORD> INI``/``INIT`` (``BASISTECH
     INI``, ``SPOTTECH INI``, ``AUTOEXT INIT``: the template and the technology packages write
@@ -69,9 +79,12 @@ def template_lines(text: str) -> tuple[dict[int, str], dict[int, str]]:
     ``%{E}``, ``%{SE}``) with the module of a form provider (``%MKUKATPGRP``), and outside an
     INI fold; each maps to the module its form names (``KUKATPBASIS``; a KSS 8 form's
     ``IlfProvider`` in its parameter fold, ``GripperTech.GripperSet``), or "" when it names
-    none."""
+    none. USER-fold lines lie inside a fold titled ``USER ...`` (``USER INI``, ``USER PLC``,
+    ``USER GLOBALS``) and in no KUKA fold inside it; each maps to the fold's title: the
+    programmer's part of a template or of a KUKA system file."""
     ini: dict[int, str] = {}
     inline: dict[int, str] = {}
+    user: dict[int, str] = {}
     stack: list[list[str]] = []         # [kind, label] of each open fold
     for no, line in enumerate(text.splitlines(), 1):
         m = _FOLD.match(line) if ";" in line else None
@@ -81,7 +94,7 @@ def template_lines(text: str) -> tuple[dict[int, str], dict[int, str]]:
             module = FOLD_MODULE.search(rest)
             marker = _MARKER.search(rest)
             if title.startswith("USER"):
-                stack.append(["user", ""])
+                stack.append(["user", title])
             elif title == "INI" or title.endswith((" INI", " INIT")) or title == "INIT":
                 stack.append(["ini", title])
             elif marker is not None and (marker.group(1).upper() == "PE" or module is not None) \
@@ -97,13 +110,41 @@ def template_lines(text: str) -> tuple[dict[int, str], dict[int, str]]:
                     form[1] = p.group(1)
         if stack:
             form = _innermost(stack)
-            if form is not None and form[0] == "ini":
+            if form is None:
+                pass
+            elif form[0] == "ini":
                 ini[no] = form[1]
-            elif form is not None:
+            elif form[0] == "inline":
                 inline[no] = form[1]
+            else:
+                user[no] = form[1]
         if not m and stack and ";" in line and _ENDFOLD.match(line):
             stack.pop()
-    return ini, inline
+    return ini, inline, user
+
+
+#: the evidence of a use on a line of a KUKA system file outside its USER folds
+KUKA_FILE = "KUKA's system files use it"
+
+
+def line_evidence(template, line: int, kind: str, kuka: bool) -> str:
+    """Why a use on `line` of a file says installed software declares the name ('name',
+    'type', 'routine', 'sysvar' `kind`), or "": the one rule on lines (module docstring).
+    `template`: the file's :func:`template_lines` (None: none); `kuka`: the file is KUKA's
+    (a system file, a ``$`` data list). A line of a KUKA file is KUKA's, but inside a USER fold,
+    which is the user's code (a KUKA inline form there still names its package); a line of the
+    user's file is KUKA's inside the template's INI fold or (routines, types) an inline form."""
+    if kuka and (template is None or line not in template[2]):
+        return KUKA_FILE
+    return fold_evidence(template, line, kind)
+
+
+def ext_evidence(place: str) -> str:
+    """The evidence of a routine an ``EXT``/``EXTFCT`` declaration at `place` (``FILE:LINE``)
+    names and no module of the backup defines: the declaration resolves the name, the body is
+    installed software's (a technology package's user routine such as SpotTech's USERSPOT)."""
+    return (f"an EXT declaration ({place}) names it and no module of this backup defines it: the "
+            "software that provides it is installed on the controller")
 
 
 def fold_evidence(template, line: int, kind: str) -> str:
@@ -113,7 +154,7 @@ def fold_evidence(template, line: int, kind: str) -> str:
     data sets a form names are the program's), naming the fold or the form's module; else ""."""
     if template is None:
         return ""
-    ini, inline = template
+    ini, inline = template[0], template[1]
     title = ini.get(line)
     if title is not None:
         fold = "INI fold" if title == "INI" else f"INI fold {title}"
@@ -124,17 +165,13 @@ def fold_evidence(template, line: int, kind: str) -> str:
     return ""
 
 
-def provided_routine(name: str, kuka_file: str = "") -> str:
-    """Why KUKA's software provides the routine `name` that the checker resolves but whose body
-    no file of the program holds, or "": a routine of the platform tables (krl/semantics/data:
-    KSS's system functions, ``IS_KEY_PRESSED`` of ``$operate.dat``), or a routine that an
-    ``EXT`` of a KUKA system file declares (`kuka_file`: that file, "" when its declaration is
-    in none; ``EXT P00 (...)`` of ``$config.dat``). An ``EXT`` in the program's own files
-    promises a module the program lacks: "" (its error at run time, "routine NAME not found")."""
+def provided_routine(name: str) -> str:
+    """Why KUKA's software provides the routine `name` of the platform tables that the
+    simulator does not implement (krl/semantics/data: KSS's system functions, ``IS_KEY_PRESSED``
+    of ``$operate.dat``), or "". A routine an EXT declares and no module defines is classified
+    with the other names (:func:`ext_evidence`)."""
     if name.upper() in load_builtins().routines:
         return "a routine of the platform tables (krl/semantics/data)"
-    if kuka_file:
-        return f"declared by an EXT of KUKA's system file {kuka_file.replace(chr(92), '/').rsplit('/', 1)[-1]}"
     return ""
 
 
@@ -155,10 +192,9 @@ def user_fold_lines(text: str) -> frozenset[int]:
 
 
 def _innermost(stack: list[list[str]]) -> list[str] | None:
+    """The innermost open fold that classifies its lines (INI, inline form or USER), or None."""
     for fold in reversed(stack):
-        if fold[0] == "user":
-            return None
-        if fold[0] in ("ini", "inline"):
+        if fold[0] in ("ini", "inline", "user"):
             return fold
     return None
 
@@ -169,10 +205,23 @@ class Use:
     line: int
     column: int
     evidence: str = ""       # why this use says "installed software declares it", or ""
+    declared: str = ""       # FILE:LINE of the EXT declaration that resolves the name, or ""
 
 
 #: the evidence of rule 4: the only one that does not say KUKA's software declares the name
 UNPARSED = "a file of this backup that does not parse mentions it"
+
+#: what `krl run` does with a name classified outside the backup (interp/runtime/kss.py), by
+#: kind: the checker's message says it
+STANDS_IN = {
+    "name": "`krl run` stands in for it: it reads the zero value of the type its uses give it "
+            "(an ENUM: a value meaning \"not installed\"), a value the program writes is kept",
+    "type": "`krl run` gives its values no type (an ENUM: the literals its uses name, and "
+            "\"not installed\")",
+    "routine": "`krl run` stands in for it with its declared signature: a procedure does nothing, "
+               "a function returns its type's zero value (or its documented value)",
+    "sysvar": "`krl run` stands in for it: it reads the zero value of the type its uses give it",
+}
 
 
 @dataclass(slots=True)
@@ -190,6 +239,9 @@ class Outside:
     #: docstring); False when the only evidence is a file of the program that does not parse
     #: mentioning it (rule 4): the program's own declaration, perhaps, that the check cannot read
     kuka: bool = True
+    #: FILE:LINE of the EXT/EXTFCT declaration that resolves the routine ("" for a name nothing
+    #: declares): the run's stand-in follows its signature
+    declared: str = ""
 
 
 @dataclass
@@ -203,13 +255,15 @@ class Unresolved:
     maybe_declared: object = None
     uses: dict = field(default_factory=dict)        # (kind, UPPER name) -> (spelling, [Use])
 
-    def use(self, kind: str, name: str, path: str, line: int, column: int, evidence: str = "") -> None:
-        """Record one use of an unresolved `name` of `kind` ('name', 'type', 'routine', 'sysvar')."""
+    def use(self, kind: str, name: str, path: str, line: int, column: int, evidence: str = "",
+            declared: str = "") -> None:
+        """Record one use of an unresolved `name` of `kind` ('name', 'type', 'routine', 'sysvar'),
+        or of a routine an EXT at `declared` (FILE:LINE) names and no module defines."""
         key = (kind, name.upper())
         entry = self.uses.get(key)
         if entry is None:
             entry = self.uses[key] = (name, [])
-        entry[1].append(Use(path, line, column, evidence))
+        entry[1].append(Use(path, line, column, evidence, declared))
 
     def _why(self, kind: str, name: str, uses: list[Use]) -> str:
         got = self.packages.get(name.upper())
@@ -238,7 +292,8 @@ class Unresolved:
         for key, (name, uses) in self.uses.items():
             why = self._why(key[0], name, uses)
             if why:
-                out[key] = Outside(key[0], name, why, uses, why != UNPARSED)
+                declared = next((u.declared for u in uses if u.declared), "")
+                out[key] = Outside(key[0], name, why, uses, why != UNPARSED, declared)
         return out
 
     def finish(self, sink: DiagnosticSink) -> None:
@@ -265,7 +320,8 @@ class Unresolved:
                 if u.path not in seen_files and len(notes) < 3:
                     seen_files.add(u.path)
                     notes.append(Note(u.path, u.line, u.column, f"also used here"))
-            sink.add(first.path, first.line, first.column, *warn(noun=noun, name=name, times=times, why=why),
-                     notes=notes,
+            form = warn("ext", noun=noun, name=name, times=times, why=why) if found.declared else \
+                warn(noun=noun, name=name, times=times, why=why)
+            sink.add(first.path, first.line, first.column, *form, notes=notes,
                      help="the controller must have the software that declares it installed; "
-                          "if it does not, this is an error")
+                          "if it does not, this is an error" + (". " + STANDS_IN[kind] if found.kuka else ""))

@@ -171,7 +171,7 @@ def _statements(body: list[N.Stmt], depth: int):
 
 def _anchors(p: _Program, top_level: bool = False) -> list[tuple[N.Routine, N.Stmt]]:
     """(routine, statement) pairs where a line may be inserted before the statement."""
-    ini, inline = template_lines(p.text)
+    ini, inline, _user = template_lines(p.text)
     lines = p.text.splitlines()
     out = []
     for r in p.src.module.routines:

@@ -74,6 +74,10 @@ TRUE_ERRORS = [
     ('HugoDanielson__ChinaMilling/KRC/R1/Program/millingcn.src', 'E101', "'t_vel'",
      'declared nowhere (sps.sub mentions t_vel only in comments)',
      ('millingcn.src:24',)),
+    ('rawpython__kukaKRLmagic/R1/System/ir_stopm.src', 'E101', "'(O_START_MARK|O_ENABLE_AIR_KNIFE|O_ENABLE_VORTEX)'",
+     'written in the USER STOP fold of ir_stopm.src, the user\'s part of KUKA\'s file, and declared in no file of '
+     'the backup (issue 59: the user\'s code stays the user\'s); before, "KUKA\'s system files use it" made them W101',
+     ('ir_stopm.src:30', 'ir_stopm.src:31', 'ir_stopm.src:32')),
 ]
 
 

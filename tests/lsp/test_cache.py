@@ -50,7 +50,7 @@ def reference_entry(lf) -> bytes:
     diags = [[d.line, d.column, d.code, d.message, d.severity, d.end_line, d.end_column, d.help,
               [[n.line, n.column, n.message] for n in d.notes]] for d in lf.diagnostics]
     return msgpack.packb([enc(lf.module), lf.ok, lf.status, diags, lf.unreadable, sorted(lf.failed_words),
-                          sorted(map(list, lf.template[0].items())), sorted(map(list, lf.template[1].items()))],
+                          *(sorted(map(list, lines.items())) for lines in lf.template)],
                          use_bin_type=True)
 
 
@@ -73,15 +73,15 @@ def test_entries_decode_to_what_was_parsed(shared_corpus: Path):
 
 @pytest.mark.parametrize("body", [
     [],                                             # too short
-    [[999, 1, 1], True, "ok", [], False, [], [], []],          # no such node class
-    [[C._INDEX[C.N.Module], 1, 1], True, "ok", [], False, [], [], []],     # a node of another shape
-    [None, True, "ok", [], False, [], [], []],       # not a module
-    [[C._INDEX[C.N.Module], 1, 1, [C._LIST], [C._LIST], None, "x"], True, "ok", [[1, 1, "E", "m"]], False, [], [], []],
+    [[999, 1, 1], True, "ok", [], False, [], [], [], []],          # no such node class
+    [[C._INDEX[C.N.Module], 1, 1], True, "ok", [], False, [], [], [], []],     # a node of another shape
+    [None, True, "ok", [], False, [], [], [], []],       # not a module
+    [[C._INDEX[C.N.Module], 1, 1, [C._LIST], [C._LIST], None, "x"], True, "ok", [[1, 1, "E", "m"]], False, [], [], [], []],
     # a valid empty module ([C._INDEX[C.N.Module], 1, 1, "p", "src", [C._LIST], [C._LIST], None]) changed:
-    [[C._INDEX[C.N.Module], 1, 1, "p", b"", [C._LIST], [C._LIST], None], True, "ok", [], False, [], [], []],  # bytes
-    [[C._INDEX[C.N.Module], 1, 1, "p", "src", {}, [C._LIST], None], True, "ok", [], False, [], [], []],     # a map
-    [[C._INDEX[C.N.Module], 1, 1, "p", "src", [C._LIST], [C._LIST, [7]], None], True, "ok", [], False, [], [], []],
-    [[C._INDEX[C.N.Module], 1, 1, "p", "src", [C._LIST], [C._LIST], None], True, "ok", [], False, [], [], [], 0],
+    [[C._INDEX[C.N.Module], 1, 1, "p", b"", [C._LIST], [C._LIST], None], True, "ok", [], False, [], [], [], []],  # bytes
+    [[C._INDEX[C.N.Module], 1, 1, "p", "src", {}, [C._LIST], None], True, "ok", [], False, [], [], [], []],     # a map
+    [[C._INDEX[C.N.Module], 1, 1, "p", "src", [C._LIST], [C._LIST, [7]], None], True, "ok", [], False, [], [], [], []],
+    [[C._INDEX[C.N.Module], 1, 1, "p", "src", [C._LIST], [C._LIST], None], True, "ok", [], False, [], [], [], [], 0],
 ])
 def test_a_hostile_entry_is_refused(body):
     with pytest.raises(C.CorruptEntry):
@@ -89,7 +89,7 @@ def test_a_hostile_entry_is_refused(body):
 
 
 def test_the_valid_entry_the_hostile_ones_change_decodes():
-    body = [[C._INDEX[C.N.Module], 1, 1, "p", "src", [C._LIST], [C._LIST], None], True, "ok", [], False, [], [], []]
+    body = [[C._INDEX[C.N.Module], 1, 1, "p", "src", [C._LIST], [C._LIST], None], True, "ok", [], False, [], [], [], []]
     lf = C.decode_loaded(msgpack.packb(body, use_bin_type=True), "/w/x.src")
     assert lf.module == C.N.Module("/w/x.src", "src", [], [], None) and lf.ok
 
