@@ -28,8 +28,10 @@ from robot.trace import TRACE_REPEATS, read_trace
                    "sets the inputs the program starves for (interp/runtime/autocell.py; docs/robot.md).")
 @click.option("--trace", "trace_path", type=click.Path(path_type=Path), default=None, help="Write the JSONL trace here.")
 @click.option("--max-sim-time", type=float, default=600.0, show_default=True, help="Simulated-time limit (s).")
-@click.option("--max-steps", type=int, default=10_000_000, show_default=True,
-              help="Limit of executed statements and loop iterations.")
+@click.option("--max-steps", type=int, default=None,
+              help="Limit of the robot program's executed statements and loop iterations (its interrupt "
+                   "routines and TRIGGER actions included; a submit program's are not counted). Default: "
+                   "none, the time limit bounds the run (docs/architecture.md, \"The step limit\").")
 @click.option("--submit", "submit", type=click.Path(path_type=Path), multiple=True,
               help="A submit program (.sub) to run beside the robot program (repeatable). Default: "
                    "in a KRC backup, its SPS.SUB, as the controller starts it at boot.")

@@ -8,9 +8,8 @@ the bytecode VM (``--interp tree``: the tree interpreter; the same front end and
 the same cause and reason on every corpus entry point, side by side 2026-11-24) with the
 backup's own System folder (BASIS, ``$config.dat``),
 ``--max-sim-time`` 60 s and 300 000 steps of the program's own, beside its SPS.SUB (an
-SPS.SUB entry runs alone): the steps a submit program may take within the time limit are
-added to the step limit (:func:`step_limit`), so a submit cycling at its budget does not end
-the run before its time.
+SPS.SUB entry runs alone): the step limit counts the robot program's steps only
+(:func:`step_limit`), so a submit cycling at its budget does not end the run before its time.
 
 Each program runs twice (two columns of the report, issue 34): with its committed cell file
 (:func:`cell_of`: ``corpus/cells``; ``--no-cells`` runs this column without), and with
@@ -55,7 +54,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 import multiprocessing
 import os
 import re
@@ -76,7 +74,7 @@ from krl.project import (
 LEGITIMATE = ("deadlock", "halt", "max_sim_time", "max_steps")
 
 #: the report's limits of a run: simulated time (s; a cell file may give a long job more,
-#: :func:`time_limit`) and statements of the robot program (:func:`step_limit` adds the submit's)
+#: :func:`time_limit`) and statements of the robot program (the step limit counts only those)
 REPORT_SIM_TIME_S = 60.0
 REPORT_STEPS = 300_000
 #: the time limit of the --inputs auto column: ``krl run``'s own (s). Nothing hand-written says
@@ -308,16 +306,14 @@ def submit_of(path: Path) -> list[Path]:
 
 
 def step_limit(max_steps: int, max_sim_time: float, n_submits: int, ipo_cycle_s: float) -> int:
-    """The step limit of a run: `max_steps` for the program, plus the statements its
-    `n_submits` submit programs may execute within `max_sim_time` s — each at most
-    ``SUBMIT_BUDGET`` (interp/runtime/scheduler.py) per IPO cycle of `ipo_cycle_s` s. A submit
-    program is an endless cyclic loop by design (reference §9): its steps say nothing of the
-    robot program looping, and counted against `max_steps` they would end a run with an SPS.SUB
-    (100 statements per 12 ms cycle: 300 000 steps in 36 s) before its time limit."""
-    from interp.runtime.scheduler import SUBMIT_BUDGET  # noqa: PLC0415
-
-    cycles = math.ceil(max_sim_time / ipo_cycle_s) + 1
-    return max_steps + n_submits * SUBMIT_BUDGET * cycles
+    """The step limit of a run: `max_steps` of the robot program. Since issue 59 the limit counts
+    the robot interpreter's steps only (docs/architecture.md "The step limit"): a submit program
+    is an endless cyclic loop by design (reference §9), bounded per IPO cycle by its time slice,
+    so its steps are bounded by the time limit. Until then the steps of every task counted and
+    this added what `n_submits` submit programs may execute within `max_sim_time` s (at
+    ``SUBMIT_BUDGET`` per IPO cycle of `ipo_cycle_s` s); the arguments are kept for the callers
+    that measure against an older checkout (tools/whole_run_bench.py)."""
+    return max_steps
 
 
 def time_limit(path: Path, cell, default: float) -> float:
@@ -340,7 +336,8 @@ def report_run(path: Path, cell: Path | None, max_sim_time: float = REPORT_SIM_T
     the backup's own, else (auto) the library robot that reaches the backup's points, else the
     KR 6 R900 (interp.run.robot_for); the backup's SPS.SUB (none for the SPS.SUB itself: it
     runs as the program, at a submit interpreter's pace); :func:`time_limit` (auto: the longer
-    `auto_sim_time`, default :data:`AUTO_SIM_TIME_S`, for a robot program) and :func:`step_limit`."""
+    `auto_sim_time`, default :data:`AUTO_SIM_TIME_S`, for a robot program) and :func:`step_limit`
+    (the robot program's `max_steps`)."""
     # costs 0.006 s at start-up (python -X importtime, 2026-11-25)
     from interp.run import cell_of, robot_for  # noqa: PLC0415
 

@@ -175,8 +175,18 @@ def summary_lines(result: Any, observer: RunObserver, *, program: str, interp: s
     changes = sum(observer.io.values())
     detail = ", ".join(f"{k} {v}" for k, v in sorted(observer.io.items()))
     out.append(f"  I/O        {changes} change(s){f' ({detail})' if changes else ''}")
-    out.append(f"  time       {result.sim_time:.3f} s simulated, {result.steps} steps")
+    out.append(f"  time       {result.sim_time:.3f} s simulated, {result.steps} steps{_by_task(run)}")
     return out
+
+
+def _by_task(run: Any) -> str:
+    """Which task used the steps, when the run had more than one (the robot program and its
+    submit programs): `` (cell 50004000, sps 5000400)``; the step limit counts the robot
+    program's (docs/architecture.md "The step limit")."""
+    by = run.steps_by_task() if run is not None and hasattr(run, "steps_by_task") else []
+    if len(by) < 2:
+        return ""
+    return " (" + ", ".join(f"{printable(name)} {n}" for name, n in by) + ")"
 
 
 def _run_lines(rt: Any) -> list[str]:

@@ -75,6 +75,7 @@ from concurrent.futures import Future
 from dataclasses import dataclass
 
 from interp.runtime.errors import ControlSignal, KrlRuntimeError
+from interp.runtime.scheduler import NO_LIMIT
 from interp.runtime.values import type_name_of
 from krl import collector
 from krl.limits import MAX_DAP_BREAKPOINTS, MAX_DAP_REPLAY_STEPS
@@ -678,11 +679,11 @@ class Engine:
         rt = self.rt
         expr = self._compile(text, frame)
         task = rt.current_task
-        saved = (rt.trace, self.busy, task.slice_end if task else None, rt.max_steps, rt.steps)
+        saved = (rt.trace, self.busy, task.slice_end if task else None, rt.limit_at, rt.steps)
         rt.trace, self.busy = None, True
         if task is not None:
             task.slice_end = sys.maxsize
-        rt.max_steps = None
+        rt.limit_at = NO_LIMIT
         try:
             return self.tree.eval(expr, frame)
         except KrlRuntimeError as exc:
@@ -693,7 +694,7 @@ class Engine:
             rt.trace, self.busy = saved[0], saved[1]
             if task is not None:
                 task.slice_end = saved[2]
-            rt.max_steps, rt.steps = saved[3], saved[4]
+            rt.limit_at, rt.steps = saved[3], saved[4]
 
     # ------------------------------------------------------------------ the run
     def _build(self):

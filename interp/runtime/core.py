@@ -35,7 +35,7 @@ from .messages import MessageWindow
 from .motion import frame_of, params_from, request, segment, target_of
 from .program import Program
 from .runmode import STEP_MODES, BackwardRefused, MotionHistory, mode_name
-from .scheduler import Scheduler, Task, program_budget
+from .scheduler import NO_LIMIT, Scheduler, Task, program_budget
 from .sysvars import EPOCH_PROBED, SysVars, struct_of
 from .values import LEAVES, UNSET, Arr, EnumValue, Struct, copy_value, make_value, maker, value_size
 
@@ -131,7 +131,8 @@ class Runtime:
     Args: main program path; ``workspace`` (folder of the program's modules; default the
     program's folder; a KRC backup is detected automatically); ``controller`` (a
     robot.controller.Controller; default a new one with ``trace``/``stimuli``);
-    ``max_sim_time`` (s), ``max_steps`` (statements + loop iterations, all tasks).
+    ``max_sim_time`` (s), ``max_steps`` (statements + loop iterations of the robot
+    interpreter: :meth:`step_limit_left`; docs/architecture.md "The step limit").
     """
 
     # Every attribute of a run is a slot: the interpreters read them at every statement, and
@@ -143,7 +144,7 @@ class Runtime:
                  "modules", "scheduler", "robot", "result", "_plans", "_return_types", "_settling", "_cyclic",
                  "run_mode", "history", "stmt_hook", "step_hook", "error_hook", "cycle_hook",
                  "autocell", "halt_continues", "start", "halts", "state_epoch", "spin", "cyclic_watch",
-                 "restless")
+                 "restless", "limit_at")
 
     def __init__(self, main_path, *, workspace=None, controller=None, trace=None, stimuli=None,
                  max_sim_time: float | None = None, max_steps: int | None = None,
@@ -169,6 +170,9 @@ class Runtime:
         self.noted: set[str] = set()    # simulator notes given once per run (builtins)
         self.steps = 0
         self.max_steps = max_steps
+        #: the value of ``steps`` past which the running task has used its step limit
+        #: (Scheduler._resume sets it from :meth:`step_limit_left`; NO_LIMIT between resumes)
+        self.limit_at = NO_LIMIT
         # the program's time slice: a .sub selected on its own runs at the submit pace
         self.robot_budget = robot_budget if robot_budget is not None else program_budget(main_path)
         self.sysvars = SysVars(self)
@@ -205,11 +209,28 @@ class Runtime:
     def add_task(self, kind: str, name: str, body) -> Task:
         """Register a task; ``body()`` runs the program (the first task is the robot)."""
         task = Task(kind, name, body, self.robot_budget if kind == "robot" else None)
+        # the step limit stops a runaway robot program, not a submit program (a .sub run as the
+        # program too) cycling at its time slice: docs/architecture.md "The step limit"
+        task.limited = kind == "robot" and program_budget(self.program.main_path) is None
         if kind == "robot":
             self.robot = task
         self.scheduler.add(task)
         self.bump_epoch()           # $PRO_STATE0, $PRO_ACT
         return task
+
+    def step_limit_left(self, task: Task) -> int:
+        """The steps `task` may still take before the step limit (``max_steps``) stops the run:
+        the robot interpreter's (the robot program with its interrupt routines and TRIGGER
+        actions) are counted; a submit program's are not, nor those of a .sub run as the program
+        (NO_LIMIT): docs/architecture.md "The step limit"."""
+        if self.max_steps is None or not task.limited:
+            return NO_LIMIT
+        return self.max_steps - task.steps
+
+    def steps_by_task(self) -> list[tuple[str, int]]:
+        """(task name, steps) of every task of the run, robot first: which task used the steps
+        (the run summary's ``time`` line)."""
+        return [(t.name, t.steps) for t in self.scheduler.tasks]
 
     def task_main(self, task: Task) -> None:
         """Greenlet body of a task: run it and record its outcome."""
@@ -450,7 +471,7 @@ class Runtime:
     def _count_step(self, task: Task) -> None:
         """One step of a task: the step limit, the end of its time slice, interrupts."""
         self.steps += 1
-        if self.max_steps is not None and self.steps > self.max_steps:
+        if self.steps > self.limit_at:
             raise StopRun("max_steps", f"step limit {self.max_steps} reached")
         if self.steps >= task.slice_end:
             self.yield_cycle(task)
@@ -490,9 +511,7 @@ class Runtime:
             return 0
         task.calm = task.kind != "robot" or self.controller.is_idle()
         lim = task.slice_end - 1
-        if self.max_steps is not None and self.max_steps < lim:
-            return self.max_steps
-        return lim
+        return self.limit_at if self.limit_at < lim else lim
 
     @staticmethod
     def _break(task: Task) -> None:

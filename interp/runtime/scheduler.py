@@ -56,6 +56,9 @@ from .idle import IdleWatch
 ROBOT_BUDGET = 1000
 SUBMIT_BUDGET = 100
 
+#: "no step limit" (Runtime.limit_at, Runtime.step_limit_left): an int past any run's steps
+NO_LIMIT = 1 << 62
+
 
 def program_budget(path) -> int | None:
     """The time slice of the program run as the robot task: a submit program (``.sub``) selected
@@ -72,6 +75,8 @@ class Task:
         self.name = name
         self.body = body
         self.budget = budget if budget is not None else (ROBOT_BUDGET if kind == "robot" else SUBMIT_BUDGET)
+        self.steps = 0                  # the steps counted for this task (Runtime.steps_by_task)
+        self.limited = False            # the step limit counts its steps (Runtime.add_task)
         self.slice_end = 0              # value of Runtime.steps that ends this IPO cycle's time slice
         self.quiet = 0                  # quiet-step limit (Runtime.quiet_limit)
         self.calm = False               # its advance-run stops are no-ops (Runtime.quiet_limit)
@@ -144,16 +149,21 @@ class Scheduler:
         (self.return_to or self.main).switch()
 
     def _resume(self, task: Task) -> None:
-        self.rt.current_task = task
-        task.slice_end = self.rt.steps + task.budget
+        rt = self.rt
+        rt.current_task = task
+        steps = rt.steps
+        task.slice_end = steps + task.budget
+        rt.limit_at = steps + rt.step_limit_left(task)
         task.quiet = 0
-        self.rt.state_epoch += 1        # the IPO cycle moved the robot, another task ran
-        log = self.rt.controller.io.log
+        rt.state_epoch += 1             # the IPO cycle moved the robot, another task ran
+        log = rt.controller.io.log
         before = len(log)
         try:
             task.glet.switch()
         finally:
-            self.rt.current_task = None
+            rt.current_task = None
+            rt.limit_at = NO_LIMIT
+            task.steps += rt.steps - steps
             if task.kind == "robot":
                 self.idle.robot_io += len(log) - before     # the robot program's own I/O changes
 
@@ -210,8 +220,7 @@ class Scheduler:
                 self._calm = None
                 return 0
             if task.parked is not None:
-                if rt.max_steps is not None and \
-                        rt.steps + 2 * (task.budget + task.parked.spin.steps) > rt.max_steps:
+                if 2 * (task.budget + task.parked.spin.steps) > rt.step_limit_left(task):
                     self._calm = None
                     return 0
             elif task.until():
@@ -264,6 +273,7 @@ class Scheduler:
                     self.idle.clock += task.clock_reads     # as _waits
             else:
                 rt.steps += task.budget
+                task.steps += task.budget
                 p.done += task.budget
                 spin.skipped += task.budget
                 spin._place(task)
@@ -291,7 +301,9 @@ class Scheduler:
             else:
                 for task in list(self.tasks):
                     if not task.done and self.stop is None:
+                        steps = rt.steps
                         if spin.resuming(task):
+                            task.steps += rt.steps - steps
                             continue            # parked: this cycle counted, not run
                         if task.until is not None and self._waits(task):
                             continue            # waits on: its resume would only test that

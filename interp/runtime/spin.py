@@ -86,6 +86,7 @@ from krl.semantics.resolve import LOCAL, NATIVE, ROUTINE, SYSTEM, UNRESOLVED
 
 from .idle import _frames, _store, freeze
 from .memory import Slot
+from .scheduler import NO_LIMIT
 from .sysvars import CONSTANT_NAMES
 
 #: built-ins whose only effects are on their arguments (the watch checks those as writes): they
@@ -588,7 +589,7 @@ class SpinWatch:
         if rt.steps >= task.slice_end or len(task.contexts) != 1 or not self.parked_ok(task):
             return
         left = task.slice_end - rt.steps        # the rest of this time slice: taken as passes
-        if rt.max_steps is not None and rt.steps + left + 2 * (task.budget + spin.steps) > rt.max_steps:
+        if rt.steps + left + 2 * (task.budget + spin.steps) > rt.limit_at:
             return                              # the step limit is near: it ends at a statement
         if self.shadow:
             task.shadow = _Parked(spin, 0, rt.controller.io.version, self._probed(spin))
@@ -627,7 +628,7 @@ class SpinWatch:
         rt = self.rt
         p = task.parked
         spin = p.spin
-        if rt.max_steps is not None and rt.steps + 2 * (task.budget + spin.steps) > rt.max_steps:
+        if 2 * (task.budget + spin.steps) > rt.step_limit_left(task):
             return False
         if (spin.io and rt.controller.io.version != p.io_version) or \
                 (spin.probes and self._probed(spin) != p.probed):
@@ -725,7 +726,8 @@ class SpinWatch:
         self.skipped -= left
         if left:
             sched = rt.scheduler
-            saved, before = rt.current_task, rt.steps
+            saved, before, limit = rt.current_task, rt.steps, rt.limit_at
+            rt.limit_at = NO_LIMIT          # replayed steps: counted while it was parked
             back = getcurrent()
             rt.current_task = task
             task.slice_end = before + left
@@ -748,6 +750,7 @@ class SpinWatch:
                 task.replay = None
                 self.replaying -= 1
                 rt.steps = before       # these steps were counted while it was parked
+                rt.limit_at = limit
                 rt.current_task = saved
                 rt._break(task)
         self._update()

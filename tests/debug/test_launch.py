@@ -49,7 +49,7 @@ def test_launch_arguments_become_krl_run_options():
                                   "submit": ["x.sub"], "noSubmit": False, "pgno": 3, "stopOnEntry": True})
     assert options["program"] == Path("a.src") and options["mode"] == "T1" and options["run_mode"] == "MSTEP"
     assert options["max_sim_time"] == 12.0 and options["submit"] == (Path("x.sub"),) and options["pgno"] == 3
-    assert options["interp_kind"] == "tree" and options["max_steps"] == 10_000_000   # krl run's defaults
+    assert options["interp_kind"] == "tree" and options["max_steps"] is None   # krl run's defaults
     assert extra == {"stopOnEntry": True}
     # the same names the click command gives its callback
     ctx = run.make_context("run", ["a.src", "--mode", "t1", "--run-mode", "mstep", "--max-sim-time", "12",

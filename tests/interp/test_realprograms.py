@@ -65,12 +65,11 @@ def test_every_stop_gets_one_cause():
     assert cause_of({**own, "text": "LIN through a singularity"}) == "interpreter gap"
 
 
-def test_step_limit_leaves_the_submit_its_cycles():
-    """A submit program runs at most SUBMIT_BUDGET (100) statements per 12 ms IPO cycle:
-    within 60 s, 5000 cycles (+1 for the last partial one) of 100 steps each."""
+def test_step_limit_is_the_robot_programs():
+    """The step limit counts the robot program's steps only (issue 59): a submit program beside
+    it, however many, adds nothing to the limit and uses none of it."""
     assert rp.step_limit(300_000, 60.0, 0, 0.012) == 300_000
-    assert rp.step_limit(300_000, 60.0, 1, 0.012) == 300_000 + 100 * 5001
-    assert rp.step_limit(300_000, 60.0, 2, 0.012) == 300_000 + 2 * 100 * 5001
+    assert rp.step_limit(300_000, 60.0, 2, 0.012) == 300_000
 
 
 def test_block_calibration_target_is_out_of_its_own_robots_limits(tmp_path):
