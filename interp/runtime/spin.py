@@ -86,7 +86,6 @@ from krl.semantics.resolve import LOCAL, NATIVE, ROUTINE, SYSTEM, UNRESOLVED
 
 from .idle import _frames, _store, freeze
 from .memory import Slot
-from .scheduler import NO_LIMIT
 from .sysvars import CONSTANT_NAMES
 
 #: built-ins whose only effects are on their arguments (the watch checks those as writes): they
@@ -727,7 +726,7 @@ class SpinWatch:
         if left:
             sched = rt.scheduler
             saved, before, limit = rt.current_task, rt.steps, rt.limit_at
-            rt.limit_at = NO_LIMIT          # replayed steps: counted while it was parked
+            rt.limit_at = before + left     # replayed steps: counted while it was parked
             back = getcurrent()
             rt.current_task = task
             task.slice_end = before + left
