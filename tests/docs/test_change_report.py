@@ -31,14 +31,14 @@ import playwright.sync_api as playwright
 import pytest
 from pypdf import PdfReader
 
-from tests.apt import apt_install
+from tests.system_tools import require
 from tests.docs import transcripts as T
 
 # the README's example runs 44 programs for its report: minutes on a loaded machine (the first
 # test that asks for the documents' run pays for it)
 # and they share that run: one xdist worker takes the whole group (make test: --dist loadgroup)
 pytestmark = [pytest.mark.timeout(3600), pytest.mark.xdist_group("docs")]
-from tests.report.test_report_chromium import CHROMIUM, loaded_page
+from tests.report.test_report_chromium import loaded_page
 
 README = T.REPO / "README.md"
 SCREEN = {"width": 1280, "height": 800}
@@ -46,9 +46,7 @@ SCREEN = {"width": 1280, "height": 800}
 
 @pytest.fixture(scope="module")
 def chromium() -> str:
-    if not Path(CHROMIUM).exists() and apt_install("chromium", "chromium") is None:
-        pytest.skip("chromium is not installed and cannot be installed with apt-get")
-    return CHROMIUM
+    return require("chromium")
 
 
 @pytest.fixture(scope="module")
@@ -66,7 +64,6 @@ def _file_of(href: str) -> Path:
     return Path(unquote(u.path))
 
 
-@pytest.mark.may_skip("chromium is missing and cannot be installed (not root, or apt-get has no network)")
 def test_summary_and_diff_on_the_first_screen(chromium, example):
     import playwright.sync_api as playwright  # noqa: PLC0415 (0.14 s CPU: only the browser tests)
 
@@ -116,7 +113,6 @@ def _check_links(page, root: Path, findings: str = "table.findings tr.finding") 
     return n
 
 
-@pytest.mark.may_skip("chromium is missing and cannot be installed (not root, or apt-get has no network)")
 def test_every_finding_and_change_links_to_its_file_and_line(chromium, example):
     work, page_file = example
     with playwright.sync_playwright() as pw, loaded_page(pw, chromium, page_file) as page:
@@ -125,7 +121,6 @@ def test_every_finding_and_change_links_to_its_file_and_line(chromium, example):
         assert _check_links(page, work / "out" / "new-backup") >= 2 + page.locator("#all-findings-table tr.finding").count()
 
 
-@pytest.mark.may_skip("chromium is missing and cannot be installed (not root, or apt-get has no network)")
 def test_findings_introduced_and_removed_link_to_each_side(chromium, shared_history, tmp_path):
     pair = shared_history / "KnoP-01__krl-for-vim9" / "01-8fae7e9c"
     out = tmp_path / "pair.html"
@@ -157,7 +152,6 @@ def _pdf_text_sizes(pdf: Path) -> tuple[list[str], list[float], int]:
     return texts, sizes, images
 
 
-@pytest.mark.may_skip("chromium is missing and cannot be installed (not root, or apt-get has no network)")
 def test_the_printed_pdf_is_legible(chromium, example, tmp_path):
     _work, page_file = example
     pdf = tmp_path / "change.pdf"

@@ -35,17 +35,15 @@ from pathlib import Path
 
 import pytest
 
-from tests.apt import apt_install, apt_install_packages
+from tests.system_tools import NIGHTLY_PACKAGES, install_command, missing_packages, require
 from tests.conftest import REPO_ROOT
-from tests.editors.npm import EXTENSION, build_vsix, node_or_fail, npm_ci
+from tests.editors.npm import EXTENSION, build_vsix, node_or_fail, npm_install
 from tests.lsp.conftest import BACKUP
 
 pytestmark = pytest.mark.slow
 
 E2E = EXTENSION / "test" / "e2e"
 CODE_SERVER_NODE_MAJOR = "20"
-BUILD_PACKAGES = ["pkg-config", "g++", "make", "libkrb5-dev", "libx11-dev", "libxkbfile-dev", "libsecret-1-dev",
-                  "ripgrep"]
 # @vscode/ripgrep 1.15.11 (code-server 4.99.4's lib/vscode/npm-shrinkwrap.json): lib/postinstall.js
 # VERSION and the asset name it looks for in its cache folder before any download
 RIPGREP_PACKAGE = "1.15.11"
@@ -84,11 +82,12 @@ def code_server() -> Path:
                            text=True, check=False).stdout.strip()
     if major != CODE_SERVER_NODE_MAJOR:
         _fail_or_skip(f"code-server 4.99.4 installs only with Node.js {CODE_SERVER_NODE_MAJOR} (found {major})")
-    if not apt_install_packages(BUILD_PACKAGES):
-        _fail_or_skip(f"cannot install the Debian packages {BUILD_PACKAGES} (not root, or no package source)")
+    missing = missing_packages(NIGHTLY_PACKAGES)      # make nightly installs them (tests/system_tools.py)
+    if missing:
+        pytest.fail(f"Debian packages missing for code-server's install: {install_command(missing)}", pytrace=False)
     _fill_ripgrep_cache()
     env = dict(os.environ, npm_config_yes="true", npm_config_unsafe_perm="true")
-    npm_ci(E2E, env=env, timeout=INSTALL_TIMEOUT_S)
+    npm_install(E2E, env=env, timeout=INSTALL_TIMEOUT_S)
     binary = E2E / "node_modules" / ".bin" / "code-server"
     assert binary.exists()
     return binary
@@ -96,9 +95,7 @@ def code_server() -> Path:
 
 @pytest.fixture(scope="module")
 def chromium() -> str:
-    if not Path(CHROMIUM).exists() and apt_install("chromium", "chromium") is None:
-        _fail_or_skip("chromium is not installed and cannot be installed with apt-get")
-    return CHROMIUM
+    return require("chromium")
 
 
 def _free_port() -> int:

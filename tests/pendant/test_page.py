@@ -19,7 +19,6 @@ from tests.conftest import REPO_ROOT
 from tests.pendant.harness import (CELLS, KR120, MILLING, browser_page, cell_without, pendant_server, pose_at,
                                    read_trace, select, state, wait_state)
 
-pytestmark = pytest.mark.may_skip("chromium is missing and cannot be installed (not root, or apt-get has no network)")
 
 PREPARE = "R1/Program/CELL/Other/PrepareMillingTools.src"
 HOME = "R1/Program/CELL/Other/GoHomePos.src"

@@ -20,7 +20,6 @@ from tests.conftest import REPO_ROOT
 from tests.pendant.harness import (CELLS, MILLING, PALLETIZER, browser_page, pendant_server, select, wait_drawn,
                                    wait_state)
 
-pytestmark = pytest.mark.may_skip("chromium is missing and cannot be installed (not root, or apt-get has no network)")
 
 DOCS = REPO_ROOT / "docs" / "pendant"
 # name: (backup, cell file, program, MSTEP stops). ChinaMilling's Main calls Home(), whose first

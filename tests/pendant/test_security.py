@@ -154,7 +154,6 @@ def test_bad_and_oversized_messages(server):
     assert asyncio.run(flood()) == 1008
 
 
-@pytest.mark.may_skip("chromium is missing and cannot be installed (not root, or apt-get has no network)")
 def test_krl_text_is_shown_as_text(pw, server):
     with browser_page(pw, server) as page:
         select(page, "prog.src", run_mode="GO", mode="T1")

@@ -71,7 +71,6 @@ def test_touch_up_every_corpus_data_list(shared_corpus, tmp_path):
     assert done >= 20, f"only {done} points touched up in the corpus"
 
 
-@pytest.mark.may_skip("chromium is missing and cannot be installed (not root, or apt-get has no network)")
 def test_touch_up_from_the_page_in_t1(pw, tmp_path):
     ws = tmp_path / "cell"
     ws.mkdir()

@@ -19,7 +19,6 @@ import yaml
 from tests.conftest import REPO_ROOT
 from tests.pendant.harness import CELLS, MILLING, browser_page, pendant_server, select, state, wait_state
 
-pytestmark = pytest.mark.may_skip("chromium is missing and cannot be installed (not root, or apt-get has no network)")
 
 ERROR_PROGRAM = """DEF err1422()
   DECL INT n

@@ -18,7 +18,7 @@ from krl.programmap import build_map
 from krl.programmap.render import to_dot, to_svg
 from krl.project import find_backups
 from krl.workspace import workspaces_for
-from tests.apt import apt_install
+from tests.system_tools import require
 
 FIXTURE = Path(__file__).parent / "fixtures" / "KRC"
 
@@ -145,10 +145,8 @@ def test_corpus_backups_have_an_edge_for_every_call_the_checker_resolves(shared_
                 assert pm.nodes[e.target].name.upper() in text.upper(), (b, e)
 
 
-@pytest.mark.may_skip("graphviz's dot is missing and cannot be installed (not root, or apt-get has no network)")
 def test_svg_drawn_by_graphviz(fixture_map):
-    if apt_install("graphviz", "dot") is None:
-        pytest.skip("graphviz's dot is not installed and cannot be installed with apt-get")
+    require("dot")
     svg = ET.fromstring(to_svg(fixture_map))
     ns = {"s": "http://www.w3.org/2000/svg"}
     groups = svg.findall(".//s:g", ns)

@@ -10,7 +10,6 @@ numbers of nodes are counted here from the map's JSON, not from the page.
 
 from __future__ import annotations
 
-from pathlib import Path
 
 import pytest
 from click.testing import CliRunner
@@ -19,8 +18,8 @@ from krl.cli import main
 from krl.programmap import build_map
 from krl.project import find_backups
 from krl.workspace import workspaces_for
-from tests.apt import apt_install
-from tests.report.test_report_chromium import CHROMIUM, loaded_page
+from tests.system_tools import require
+from tests.report.test_report_chromium import loaded_page
 
 WINDOW = {"width": 1600, "height": 1000}
 READABLE = 0.5
@@ -35,12 +34,9 @@ _INFO = """() => { const cy = window.krlMap.cy; const ext = cy.extent();
 
 @pytest.fixture(scope="module")
 def chromium() -> str:
-    if not Path(CHROMIUM).exists() and apt_install("chromium", "chromium") is None:
-        pytest.skip("chromium is not installed and cannot be installed with apt-get")
-    return CHROMIUM
+    return require("chromium")
 
 
-@pytest.mark.may_skip("chromium is missing and cannot be installed (not root, or apt-get has no network)")
 def test_overview_and_expand_all_fit_the_window(chromium, shared_corpus, tmp_path):
     import playwright.sync_api as playwright  # noqa: PLC0415 (0.14 s CPU: only the browser tests)
 

@@ -20,8 +20,8 @@ from krl.cli import main
 from krl.programmap import build_map
 from krl.project import find_backups
 from krl.workspace import workspaces_for
-from tests.apt import apt_install
-from tests.report.test_report_chromium import CHROMIUM, loaded_page
+from tests.system_tools import require
+from tests.report.test_report_chromium import loaded_page
 
 WEB = Path(__file__).parents[2] / "krl" / "programmap" / "web"
 STATIC = Path(__file__).parents[2] / "krl" / "programmap" / "static" / "programmap.js"
@@ -54,12 +54,9 @@ def largest(shared_corpus):
 
 @pytest.fixture(scope="module")
 def chromium() -> str:
-    if not Path(CHROMIUM).exists() and apt_install("chromium", "chromium") is None:
-        pytest.skip("chromium is not installed and cannot be installed with apt-get")
-    return CHROMIUM
+    return require("chromium")
 
 
-@pytest.mark.may_skip("chromium is missing and cannot be installed (not root, or apt-get has no network)")
 def test_search_neighbourhood_and_source_link_in_chromium(chromium, largest, tmp_path):
     import playwright.sync_api as playwright  # a dev dependency: missing is a failure, not a skip (costs 0.14 s CPU: only the browser tests)
 
@@ -119,7 +116,6 @@ def test_search_neighbourhood_and_source_link_in_chromium(chromium, largest, tmp
         assert page.locator("#source-file").get_attribute("href") == Path(target.path).as_uri()
 
 
-@pytest.mark.may_skip("chromium is missing and cannot be installed (not root, or apt-get has no network)")
 def test_markup_in_names_stays_text(chromium, tmp_path):
     import playwright.sync_api as playwright  # noqa: PLC0415 (costs 0.14 s CPU: only the browser tests)
 

@@ -12,8 +12,8 @@ import pytest
 from click.testing import CliRunner
 
 from krl.cli import main
-from tests.report.test_report_chromium import CHROMIUM, loaded_page
-from tests.apt import apt_install
+from tests.report.test_report_chromium import loaded_page
+from tests.system_tools import require
 
 FIXTURE = Path(__file__).parents[1] / "programmap" / "fixtures" / "KRC"
 IMG = "<img src=x onerror=window.pwned=1>"
@@ -23,11 +23,8 @@ LONG = "a_long_text_without_spaces_" * 12
 
 @pytest.fixture(scope="module")
 def chromium() -> str:
-    if not Path(CHROMIUM).exists() and apt_install("chromium", "chromium") is None:
-        pytest.skip("chromium is not installed and cannot be installed with apt-get")
-    if apt_install("graphviz", "dot") is None:
-        pytest.skip("graphviz's dot is not installed and cannot be installed with apt-get")
-    return CHROMIUM
+    require("dot")
+    return require("chromium")
 
 
 @pytest.fixture(scope="module")
@@ -64,7 +61,6 @@ def _open(pw, chromium, page_path: Path, check, scripts: int = 0):
         check(page)
 
 
-@pytest.mark.may_skip("chromium or graphviz is missing and cannot be installed (not root, or apt-get has no network)")
 def test_change_pages_render_in_headless_chromium(chromium, pages):
     import playwright.sync_api as playwright  # a dev dependency: missing is a failure, not a skip (costs 0.14 s CPU: only the browser tests)
 
