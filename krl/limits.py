@@ -193,6 +193,13 @@ MAX_WEB_FILE_BYTES = 4 * 1024 * 1024
 # maximum); one message at most BUFFSIZE bytes, default 16384 and at most 65534 (the manual's
 # range); a channel's XML configuration at most 256 KiB (real ones are a few KiB).
 MAX_EKI_CHANNELS = 16
+# A server channel takes one partner at a time. The manual monitors a connection by ALIVE's ping,
+# not by its traffic (EthernetKRL 2.2, 2.2.2 "Monitoring a connection"): a partner that only
+# listens is silent by design, and none is dropped for its silence alone. But a partner that
+# has sent nothing for this long, in seconds of the controller's time, gives its place to a new
+# one that connects (it held the only place forever, issue 61); the program sees EKI00512 as for
+# any dropped connection (docs/network.md, Decisions).
+MAX_EKI_IDLE_S = 30.0
 MAX_EKI_BUFFERING = 512
 EKI_BUFFSIZE_DEFAULT = 16384
 MAX_EKI_BUFFSIZE = 65534
@@ -224,6 +231,12 @@ MAX_VARPROXY_NAME_CHARS = 256
 MAX_VARPROXY_VALUE_CHARS = 4096
 # The PLC side (Modbus TCP, OPC UA): clients at once on each server.
 MAX_PLC_CLIENTS = 8
+# What a partner sends, shown anywhere but in the recording of the message itself (the trace's
+# `data`, bounded by each protocol's own limits above so that a replay feeds it again): an error
+# event's text, a controller message, a refusal, a line a protocol library logs on stderr. 200
+# characters show any real name, value or IPOC whole; a 100 KB value a client wrote is cut, ending
+# in "…" (issue 61: one rejected OPC UA write put a 100,158-character line on stderr).
+MAX_NET_LOG_CHARS = 200
 # A recorded message sequence replayed into a run (`network: {replay: trace.jsonl}`): its
 # largest file, in bytes, and its most network events.
 MAX_NET_REPLAY_BYTES = 64 * 1024 * 1024

@@ -32,6 +32,7 @@ from pathlib import Path
 
 from interp.debug.engine import Engine as RunEngine
 from interp.debug.engine import LaunchConfig, Refused, thread_main
+from interp.runtime.writerules import admit
 
 from .touchup import TouchUpError, touch_up as write_point
 from krl.limits import MAX_KRL_MESSAGES, MAX_WEB_EXPRESSION_CHARS
@@ -347,9 +348,13 @@ class Engine:
 # ---------------------------------------------------------------------- the keys (engine thread)
 
 def override(core: RunEngine, value) -> int:
-    """$OV_PRO (0..100 %): applies to the motions planned from then on."""
-    if not isinstance(value, int) or isinstance(value, bool) or not 0 <= value <= 100:
+    """$OV_PRO (0..100 %, the controller's write rules: interp/runtime/writerules.py): applies
+    to the motions planned from then on."""
+    if not isinstance(value, int) or isinstance(value, bool):
         raise Refused("override: an integer 0..100")
+    refusal = admit("$OV_PRO", value, "program")
+    if refusal is not None:
+        raise Refused(f"override: {refusal.message}")
 
     def apply(engine):
         engine.rt.sysvars.store["$OV_PRO"] = value

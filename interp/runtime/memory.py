@@ -26,6 +26,7 @@ from krl.semantics import types as T
 from .convert import assign_into, convert_scalar
 from .errors import KrlRuntimeError, ResourceError, value_invalid
 from .values import UNSET, Arr, Struct, make_value
+from .writerules import protected
 
 
 class Ref:
@@ -74,7 +75,10 @@ class Slot(Ref):
 
     def set(self, v) -> None:
         if self.readonly:
-            raise KrlRuntimeError(f"{self.name} is write-protected")
+            raise protected(self.name)
+        hook = self.on_write            # a system variable's write rules (writerules.WriteHook)
+        if hook is not None:
+            hook.before(self, v)
         cur = self.c[self.k]
         if isinstance(cur, (Struct, Arr)):
             if cur is not v:
@@ -83,8 +87,8 @@ class Slot(Ref):
             self.c[self.k] = convert_scalar(v, self.type)
         else:
             self.c[self.k] = v
-        if self.on_write is not None:
-            self.on_write(self)
+        if hook is not None and hook.after is not None:
+            hook.after(self)
 
 
 class ProxyRef(Ref):
@@ -107,7 +111,7 @@ class ProxyRef(Ref):
 
     def set(self, v) -> None:
         if self.proxy.setter is None:
-            raise KrlRuntimeError(f"{self.name} is write-protected")
+            raise protected(self.name)
         self.proxy.set(self.index, convert_scalar(v, self.type))
 
 
@@ -129,7 +133,7 @@ class ComputedRef(Ref):
 
     def set(self, v) -> None:
         if self.setter is None:
-            raise KrlRuntimeError(f"{self.name} is write-protected")
+            raise protected(self.name)
         self.setter(v)
 
 
@@ -163,7 +167,7 @@ class SignalRef(Ref):
 
     def set(self, v) -> None:
         if self.proxy.setter is None:
-            raise KrlRuntimeError(f"{self.name} is write-protected")
+            raise protected(self.name)
         if self.b is None:
             self.proxy.set(self.a, convert_scalar(v, self.type))
             return
@@ -225,8 +229,9 @@ def index_ref(base: Ref, idx: list, name: str) -> Ref:
         pos = v.flat(idx)
     except IndexError as exc:
         raise KrlRuntimeError(f"array index inadmissible: {name}[{','.join(map(str, idx))}] ({exc})") from None
-    return Slot(v.data, pos, v.type.elem, f"{name}[{','.join(map(str, idx))}]",
-                base.readonly if isinstance(base, Slot) else False)
+    if isinstance(base, Slot):
+        return Slot(v.data, pos, v.type.elem, f"{name}[{','.join(map(str, idx))}]", base.readonly, base.on_write)
+    return Slot(v.data, pos, v.type.elem, f"{name}[{','.join(map(str, idx))}]")
 
 
 def field_ref(base: Ref, comp: str, name: str, key: str | None = None) -> Ref:
@@ -247,7 +252,7 @@ def field_ref(base: Ref, comp: str, name: str, key: str | None = None) -> Ref:
             raise KrlRuntimeError(f"{base.name} has no component {comp}")
     ft = v.type.fields[key][1] if v.type is not None and key in v.type.fields else None
     ro = base.readonly if isinstance(base, (Slot, ComputedRef)) else False
-    return Slot(v.f, key, ft, f"{name}.{comp}", ro)
+    return Slot(v.f, key, ft, f"{name}.{comp}", ro, base.on_write if isinstance(base, Slot) else None)
 
 
 class Frame:

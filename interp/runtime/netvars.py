@@ -20,6 +20,7 @@ from krl.limits import MAX_VARPROXY_NAME_CHARS, MAX_VARPROXY_VALUE_CHARS
 from .errors import KrlRuntimeError
 from .memory import field_ref, index_ref
 from .values import UNSET, Arr, EnumValue, Struct, is_char_array, value_text  # noqa: F401 - the text form
+from .writerules import admit, check, protected
 
 
 class ValueTextError(ValueError):
@@ -107,7 +108,15 @@ class RuntimeSink:
         an EKI channel's memory, an RSI answer): net/partner.py, docs/network.md."""
         self.rt.changed_outside()
 
+    def admit(self, name: str, value, writer: str, scalar: bool | None = True):
+        """The controller's write rules (writerules.py) for a partner's write of `value` into
+        `name` (``$IN[3]``, ``$ANIN[2]``, ...) by `writer` (``opcua``, ``modbus``): None when it
+        is admitted, else the refusal (a KrlRuntimeError with its KSS number and ``rule``). Pure:
+        a partner's server thread may ask (net/plc.py)."""
+        return admit(name, value, writer, scalar)
+
     def set_flag(self, n: int, v: bool) -> None:
+        check(f"$FLAG[{n}]", bool(v), "eki", True)
         flags = self.rt.sysvars.store.get("$FLAG")
         if isinstance(flags, Arr) and 1 <= n <= len(flags.data):
             if flags.data[n - 1] != bool(v):
@@ -115,6 +124,7 @@ class RuntimeSink:
             flags.data[n - 1] = bool(v)
 
     def set_out(self, n: int, v: bool) -> None:
+        check(f"$OUT[{n}]", bool(v), "eki", True)
         self.rt.controller.set_out(n, bool(v), "network")
 
     def ref(self, text: str):
@@ -163,16 +173,19 @@ class RuntimeSink:
         return value_text(self.ref(name).get())
 
     def write_var(self, name: str, text: str) -> str:
-        """Assign the value `text` to a global variable; returns its new text. Raises KeyError,
-        ValueTextError, KrlRuntimeError (a read-only variable, a conversion)."""
+        """Assign the value `text` to a global variable through the controller's write rules
+        (writerules.py: protection, type and shape, range); returns its new text. Raises KeyError,
+        ValueTextError, KrlRuntimeError (KSS 1388 a write-protected variable, 1446 a value refused,
+        a conversion)."""
         ref = self.ref(name)
         if getattr(ref, "readonly", False):
-            raise KrlRuntimeError(f"{name} is read-only")
+            raise protected(name)
         v = parse_value(text)
+        cur = ref.peek()
+        check(name, v, "varproxy", not isinstance(cur, (Struct, Arr)))
         if isinstance(v, dict):
             v = Struct(None, v)
         self.rt.changed_outside()
-        cur = ref.peek()
         if is_char_array(cur) and isinstance(v, str):
             data = cur.data
             for i in range(len(data)):

@@ -82,9 +82,9 @@ def store(ref, v) -> None:
 
 
 def _flat(base, idx):
-    """(array, flat position) for a plain Slot holding an array of scalars and INT
-    indices in range, else None."""
-    if base.__class__ is not Slot:
+    """(array, flat position) for a plain Slot without write hook holding an array of scalars
+    and INT indices in range, else None."""
+    if base.__class__ is not Slot or base.on_write is not None:
         return None
     a = base.c[base.k]
     if a.__class__ is not Arr:
@@ -139,7 +139,7 @@ def element2(base, i, j, name: str):
 
 def set_element1(base, i, v, name: str) -> None:
     """:func:`set_element` with one index."""
-    if base.__class__ is Slot and i.__class__ is int and not base.readonly:
+    if base.__class__ is Slot and i.__class__ is int and not base.readonly and base.on_write is None:
         a = base.c[base.k]
         if a.__class__ is Arr and len(a.dims) == 1 and 1 <= i <= a.dims[0] \
                 and _store_fast(a.data, i - 1, a.type.elem, v):
@@ -172,7 +172,7 @@ def component(base, comp: str, name: str, key: str):
 
 def set_component(base, comp: str, v, name: str, key: str) -> None:
     """``base.comp = v`` (Runtime.field + Runtime.assign); `key` as for :func:`component`."""
-    if base.__class__ is Slot and not base.readonly:
+    if base.__class__ is Slot and not base.readonly and base.on_write is None:
         s = base.c[base.k]
         if s.__class__ is Struct and s.type is not None:
             ft = s.type.fields.get(key)

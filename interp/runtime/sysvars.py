@@ -30,9 +30,10 @@ from robot.axismap import E6AXIS_KEYS, EXT_KEYS
 from robot.motion import MotionParams
 
 from .convert import frame_tuple
-from .errors import KrlRuntimeError, value_invalid
+from .errors import value_invalid
 from .memory import ComputedRef, Slot
 from .values import EnumValue, Struct, make_value, zero_value
+from .writerules import WriteHook
 
 
 class LiveArray:
@@ -222,10 +223,12 @@ class SysVars:
         if live is not None:
             ref = live(self, t, name)
         else:
-            on_write = self._on_write.get(name)
-            if on_write is not None:
-                on_write = partial(on_write, self)
-            ref = Slot(self.store, name, t, name, readonly=info.access == "RO", on_write=on_write)
+            after = self._on_write.get(name)
+            hook = None
+            if after is not None or info.range is not None:
+                # the write rules (writerules.py) for a documented range; a write's effect after it
+                hook = WriteHook(info.range is not None, partial(after, self) if after is not None else None)
+            ref = Slot(self.store, name, t, name, readonly=info.access == "RO", on_write=hook)
         self.refs[name] = ref
         return ref
 
@@ -469,8 +472,14 @@ _LIVE = {
     # $ALARM_STOP_INTERN ;NOT-STOP INTERN): the simulated cell has no EMERGENCY STOP
     "$ALARM_STOP": _computed(_ro_const(True)),
     "$ALARM_STOP_INTERN": _computed(_ro_const(True)),
+    # the other signals of the safety controller (sysvars.yaml ``safety``): the safety gate
+    # closed, the drives enabled, the enabling switch released (a cell in AUT/EXT)
+    "$SAFEGATE_OP": _computed(_ro_const(True)),
+    "$SAFETY_DRIVES_ENABLED": _computed(_ro_const(True)),
+    "$SAFETY_SW": _computed(_ro_const(EnumValue("RELEASED"))),
     # every condition to start a motion holds (drives enabled, motion enable): what a KR C4
-    # in AUT/EXT reads while nothing holds it; $MOVE_ENABLE is the one the program can drop
+    # in AUT/EXT reads while nothing holds it ($MOVE_ENABLE, an input of the safety controller:
+    # write-protected, sysvars.yaml ``safety``)
     "$COULD_START_MOTION": _computed(lambda sv: bool(sv.store.get("$MOVE_ENABLE", True))),
     # a process is active at robot level: a robot program (or its interrupt) is being run
     # (KSS 8.x System Integrators, Automatic External outputs, PRO_ACT)
@@ -588,17 +597,12 @@ def _trace(sv: SysVars, t, name):
 _LIVE["$TRACE"] = _trace
 
 
-def _sync_advance(sv: SysVars, ref) -> None:
-    """``$ADVANCE = n`` (0..5) goes to the controller's motion queue at once."""
-    v = ref.c[ref.k]
-    if not 0 <= v <= 5:
-        raise KrlRuntimeError(f"$ADVANCE {v} outside 0..5")
-
-
 def _pro_mode_written(sv: SysVars, ref) -> None:
     """``$PRO_MODE = #MSTEP`` (any run mode): the next statement takes the full hook, so the
     new mode applies from there in both interpreters (interp/runtime/runmode.py)."""
     sv.rt.run_mode_changed()
 
 
-SysVars._on_write = {"$ADVANCE": _sync_advance, "$PRO_MODE": _pro_mode_written}
+#: what writing a system variable does once the value is stored (its range is checked before,
+#: by the write rules: sysvars.yaml's ``range``, writerules.py)
+SysVars._on_write = {"$PRO_MODE": _pro_mode_written}

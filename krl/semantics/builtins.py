@@ -34,7 +34,10 @@ except AttributeError:  # pragma: no cover
 class SysVarInfo:
     """A system variable: type name, array sizes, access ('RW' or 'RO'), advance-run stops,
     and ``cyclic``: an assignment to one of its elements is re-evaluated every IPO cycle
-    (``$CYCFLAG``, reference §5.15)."""
+    (``$CYCFLAG``, reference §5.15). The write rules (sysvars.yaml's header,
+    interp/runtime/writerules.py): ``range`` (lo, hi) of a scalar or of each element, ``safety``
+    (a signal of the safety controller: write-protected for every writer), ``fieldbus`` (an
+    input the I/O system drives), ``source`` (where the range or protection is documented)."""
     name: str
     type_name: str
     dims: tuple[int, ...] = ()
@@ -42,6 +45,10 @@ class SysVarInfo:
     stop_read: bool = False
     stop_write: bool = False
     cyclic: bool = False
+    range: tuple[float, float] | None = None
+    safety: bool = False
+    fieldbus: bool = False
+    source: str = ""
 
 
 @dataclass(slots=True)
@@ -181,8 +188,13 @@ def _load_builtins(store=None) -> Builtins:
     for key, info in sysv.items():
         name, dims = split_name(key)
         stops = info.get("stop", []) or []
+        rng = info.get("range")
+        if rng is not None and (len(rng) != 2 or not all(isinstance(x, (int, float)) for x in rng) or rng[0] > rng[1]):
+            raise ValueError(f"sysvars.yaml: {key}: range must be [lo, hi]")
         sysvars[name.upper()] = SysVarInfo(name, info["type"], dims, info.get("access", "RW"),
-                                           "read" in stops, "write" in stops, bool(info.get("cyclic")))
+                                           "read" in stops, "write" in stops, bool(info.get("cyclic")),
+                                           tuple(rng) if rng is not None else None, bool(info.get("safety")),
+                                           bool(info.get("fieldbus")), str(info.get("source", "")))
     routines: dict[str, SignatureInfo] = {}
     for text in funcs.get("functions", []):
         sig = parse_signature(text, True)

@@ -31,7 +31,7 @@ CASES = [
     ("unreachable", "PTP {A1 0, A2 -90, A3 90, A4 0, A5 0, A6 0}\n  LIN {X 3000, Y 0, Z 3000}", None, "workspace"),
     ("soft_limit", "PTP {A1 0, A2 -90, A3 90, A4 0, A5 0, A6 0}\n  PTP {A1 200}", None, "software limit"),
     ("pos_int_outside_interrupt", "DECL E6POS p\n  p = $POS_INT", 1422, "value invalid"),
-    ("write_protected", "$POS_ACT.X = 1", None, "write-protected"),
+    ("write_protected", "$POS_ACT.X = 1", 1388, "write-protected"),
 ]
 
 SUBS = """

@@ -43,10 +43,16 @@ END
 DEF NOP()
   N2 = 2
 END
+
+DEF SETOV(v:OUT)
+  DECL INT v
+  v = 250
+END
 """
 # EXTRA's line numbers, counted from its first routine: DIV's RETURN is its line 4, NORET's
-# ENDFCT its line 9, BARE's RETURN its line 12, DEEP's `N1 = ARR[n]` its line 20.
-EXTRA_LINE = {"div_return": 4, "noret_end": 9, "bare_return": 12, "deep_index": 20}
+# ENDFCT its line 9, BARE's RETURN its line 12, DEEP's `N1 = ARR[n]` its line 20, SETOV's
+# `v = 250` its line 30.
+EXTRA_LINE = {"div_return": 4, "noret_end": 9, "bare_return": 12, "deep_index": 20, "setov": 30}
 
 # name -> (program body, message pattern, line within the body (1 = first body line) or
 #          ("extra", key) for a line of EXTRA)
@@ -70,6 +76,17 @@ PROGRAMS = {
                           r"GOTO INSIDE: label not found", 2),
     "return_without_value": ("N1 = BARE()", r"RETURN without a value in function BARE", ("extra", "bare_return")),
     "procedure_in_expression": ("N1 = NOP() + 1", r"NOP does not return a value", 1),
+    # the write rules (interp/runtime/writerules.py, issue 61): $OV_PRO = 1000 was kept, and A1
+    # then moved at 123 % of its maximum speed
+    "override_out_of_range": ("N1 = 5\n  $OV_PRO = N1 * 200",
+                              r"value assignment inadmissible: \$OV_PRO = 1000 out of limits \[0; 100\]", 2),
+    "override_below_range": ("$OV_PRO = -5", r"value assignment inadmissible: \$OV_PRO = -5 out of limits", 1),
+    "advance_out_of_range": ("$ADVANCE = 6", r"value assignment inadmissible: \$ADVANCE = 6 out of limits \[0; 5\]", 1),
+    "override_through_out_parameter": ("SETOV($OV_PRO)", r"value assignment inadmissible: \$OV_PRO = 250",
+                                       ("extra", "setov")),
+    # a signal of the safety controller (the checker's E501 stops such a program before it
+    # starts; unchecked, the statement does)
+    "safety_signal": ("$DRIVES_ON = TRUE", r"\$DRIVES_ON is write-protected \(a signal of the safety controller\)", 1),
 }
 EXTRA_LINE["deep_recursion"] = 18      # DEEP's recursive call `DEEP(n - 1)`
 
@@ -93,6 +110,10 @@ def test_same_error(tmp_path, name):
     assert error["file"].endswith("prog.src")
     if pattern.startswith("value invalid"):
         assert error["number"] == 1422
+    if pattern.startswith("value assignment inadmissible"):
+        assert error["number"] == 1446
+    if "write-protected" in pattern:
+        assert error["number"] == 1388
     assert sum(e["kind"] == "error" for e in ev) == 1
 
 
