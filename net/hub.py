@@ -17,7 +17,9 @@ The simulated controller calls :meth:`Network.cycle` at the start of every IPO c
 The runtime talks to the partners through its EKI/RSI built-ins
 (interp/runtime/natives/eki.py, rsi.py: ``hub.partner("eki")``, ``hub.partner("rsi")``) and gives
 the hub a *sink*: ``set_flag(n, v)``, ``set_out(n, v)``, ``read_var(name) -> text``,
-``write_var(name, text) -> text`` (interp/runtime/netvars.py), and ``changed_outside()``, which
+``write_var(name, text) -> text``, ``admit(name, value, writer) -> refusal or None`` (the
+controller's write rules, interp/runtime/writerules.py; interp/runtime/netvars.py), and
+``changed_outside()``, which
 a partner calls at the moment it writes into the run otherwise (a message into an EKI channel's
 memory, a PLC's input, an RSI answer; the sink's own writes call it themselves): the runtime's
 watch keys move and parked spins catch up (interp/runtime/core.py ``Runtime.changed_outside``).
@@ -33,6 +35,7 @@ import json
 from krl.limits import MAX_NET_REPLAY_BYTES, MAX_NET_REPLAY_EVENTS
 
 from . import partners as registry
+from .netlog import clip
 from .partner import Partner
 from .settings import NetworkSettings
 
@@ -74,6 +77,10 @@ class NullSink:
 
     def changed_outside(self) -> None:
         """A partner is about to write (no run to tell)."""
+
+    def admit(self, name: str, value, writer: str, scalar: bool | None = True):
+        """Every write admitted (no controller to apply its rules: a protocol tested alone)."""
+        return None
 
     def set_flag(self, n: int, v: bool) -> None:
         self.flags[n] = v
@@ -232,14 +239,19 @@ class Network:
 
     # ------------------------------------------------------------------ trace
     def trace(self, iface: str, direction: str, **fields) -> None:
-        """A ``net`` trace event at the current simulated time."""
+        """A ``net`` trace event at the current simulated time. Its ``text`` (an error, a
+        refusal: it may quote what a partner sent) is clipped (net/netlog.py); its ``data`` is
+        the recording of the message, which a replay feeds again."""
         ctl = self.ctl
         if ctl is not None and ctl.trace is not None:
+            if isinstance(fields.get("text"), str):
+                fields["text"] = clip(fields["text"])
             ctl.trace.write("net", ctl.time, iface=iface, dir=direction, **fields)
 
     def net_message(self, text: str, number: int | None = None) -> None:
+        """A controller message of a partner's (clipped: it may quote what the partner sent)."""
         if self.ctl is not None:
-            self.ctl.message(text, number=number)
+            self.ctl.message(clip(text), number=number)
 
 
 def load_replay(path: Path) -> list[tuple[float, dict]]:

@@ -39,6 +39,7 @@ from pathlib import Path
 from krl.limits import MAX_PLC_CLIENTS
 
 from .cellkey import SettingsError, inside, mapping, parse_address
+from .netlog import clip, clip_library_logs
 from .partner import Partner
 
 PLC_KEYS = ("modbus", "opcua", "map")
@@ -101,8 +102,8 @@ class Plc:
         self.seen_anin: list[float] = []
         self.seen_nodes: dict[str, object] = {}
         self.error: BaseException | None = None
-        self.refused = 0            # Modbus clients closed past MAX_PLC_CLIENTS (traced in sync)
-        self.traced_refused = 0
+        self.traced_refused = 0     # Modbus clients closed past MAX_PLC_CLIENTS (net.modbus.Server.refused)
+        self.refusals: list[str] = []   # OPC UA writes the write rules refused (traced in sync)
 
     # ------------------------------------------------------------------ start / stop
     def start(self) -> None:
@@ -144,10 +145,12 @@ class Plc:
         # only with a PLC partner)
         from pymodbus.datastore import (ModbusDeviceContext, ModbusSequentialDataBlock,  # noqa: PLC0415
                                         ModbusServerContext)
-        from pymodbus.server import ModbusTcpServer  # noqa: PLC0415
 
+        # net.modbus imports pymodbus (costs 0.03 s CPU): only when the PLC serves Modbus
+        from .modbus import Server  # noqa: PLC0415
 
         logging.getLogger("pymodbus").setLevel(logging.ERROR)   # its v4 deprecation notes are not the user's
+        clip_library_logs("pymodbus")
         m = self.map
         io = self.hub.ctl.io
         # the blocks start at 1: pymodbus maps the PDU's address a to the block's a+1 (address 0 = $IN[1])
@@ -157,18 +160,9 @@ class Plc:
             hr=ModbusSequentialDataBlock(1, [_to_reg(io.get_anin(n)) for n in range(1, m.analog + 1)]),
             ir=ModbusSequentialDataBlock(1, [_to_reg(io.get_anout(n)) for n in range(1, m.analog + 1)]))
         ctx = ModbusServerContext(devices=self.device, single=True)
-        holder: dict = {}
-
-        def connected(up: bool) -> None:
-            srv = holder.get("server")
-            if up and srv is not None and len(srv.active_connections) > MAX_PLC_CLIENTS:
-                key = list(srv.active_connections)[-1]
-                srv.active_connections[key].close()
-                self.refused += 1
-
         host, port = self.settings.modbus
-        srv = ModbusTcpServer(ctx, address=(host, port), trace_connect=connected)
-        holder["server"] = srv
+        # the map's sizes bound every request's addresses; a client past the limit is closed at accept
+        srv = Server(ctx, (host, port), m.digital, m.analog, MAX_PLC_CLIENTS)
         await srv.listen()
         self.modbus = srv
         socks = getattr(srv.transport, "sockets", None) or ()
@@ -179,6 +173,7 @@ class Plc:
         # asyncua costs 0.43 s CPU (2026-11-24): loaded only when the PLC serves OPC UA
         from asyncua import Server, ua  # noqa: PLC0415
 
+        clip_library_logs("asyncua")        # it logs a refused write with its whole value
         url = self.settings.opcua
         server = Server()
         await server.init()
@@ -208,6 +203,7 @@ class Plc:
             if base == "$IN":
                 await node.set_writable()
             self.nodes["SIGNAL " + name] = node
+        self._guard_writes(server, ua)
         await server.start()
         self.opcua = server
         socks = getattr(getattr(server.bserver, "_server", None), "sockets", None) or ()
@@ -218,6 +214,63 @@ class Plc:
         if socks:
             port = socks[0].getsockname()[1]
         self.hub.published("opcua", (host, port))
+
+    def _guard_writes(self, server, ua) -> None:
+        """A client's write of a node of the map goes through the controller's write rules
+        first (the hub sink's ``admit``, interp/runtime/writerules.py): a value of another
+        type or shape (an array into the scalar ``ANIN[2]``) is BadTypeMismatch, NaN, an
+        infinity or a value outside the variable's range (``$ANIN`` -1.0..1.0) BadOutOfRange, a
+        write-protected one BadNotWritable; nothing of it is taken, and the run gets a ``net``
+        error event. asyncua itself checks only the variant's type (an array of Doubles passed
+        into a Double node, and the run then stopped with "internal error: TypeError")."""
+        expected = {}
+        for key, node in self.nodes.items():
+            if key.startswith(("$IN", "$ANIN", "SIGNAL")):
+                expected[node.nodeid] = key
+        service = server.iserver.attribute_service
+        plain = service.write
+        status = {"shape": ua.StatusCodes.BadTypeMismatch, "protected": ua.StatusCodes.BadNotWritable}
+
+        async def write(params, *args, **kw):
+            results = []
+            for wv in params.NodesToWrite:
+                key = expected.get(wv.NodeId)
+                refusal = None
+                if key is not None and wv.AttributeId == ua.AttributeIds.Value:
+                    refusal = self._refusal(key, wv.Value, ua)
+                if refusal is None:
+                    results += await plain(ua.WriteParameters(NodesToWrite=[wv]), *args, **kw)
+                    continue
+                rule, text = refusal
+                self.refusals.append(text)
+                results.append(ua.StatusCode(status.get(rule, ua.StatusCodes.BadOutOfRange)))
+            return results
+
+        service.write = write
+
+    def _refusal(self, key: str, dv, ua) -> tuple[str, str] | None:
+        """(rule, text) when the write rules refuse the OPC UA value `dv` for node `key`."""
+        variant = dv.Value if dv is not None else None
+        if variant is None or variant.Value is None:
+            return ("shape", f"{key}: an empty value")
+        value = variant.Value
+        want = ua.VariantType.Double if key.startswith("$ANIN") else ua.VariantType.Boolean
+        name = key
+        if key.startswith("SIGNAL "):
+            base, a, b = self.map.signals[key[7:]]
+            want = ua.VariantType.Boolean if a == b else ua.VariantType.Int32
+            name = f"{base}[{a}]"
+            if a != b and isinstance(value, int) and not isinstance(value, bool) and not 0 <= value < 1 << (b - a + 1):
+                return ("range", f"{key}: {clip(value)} outside 0..{(1 << (b - a + 1)) - 1}")
+        if isinstance(value, (list, tuple)) or variant.is_array:
+            refusal = self.hub.sink.admit(name, list(value) if isinstance(value, (list, tuple)) else value, "plc")
+            return (getattr(refusal, "rule", "shape"), str(refusal) if refusal is not None else f"{key}: an array")
+        if variant.VariantType != want:
+            return ("shape", f"{key}: a {variant.VariantType.name}, the node a {want.name}")
+        if key.startswith("SIGNAL ") and want == ua.VariantType.Int32:
+            value = bool(value)         # each bit an input: the protection of the first names them all
+        refusal = self.hub.sink.admit(name, value, "plc")
+        return (refusal.rule, str(refusal)) if refusal is not None else None
 
     def _signal_value(self, base: str, a: int, b: int):
         io = self.hub.ctl.io
@@ -255,16 +308,26 @@ class Plc:
             return
         import asyncio  # noqa: PLC0415  (costs 0.04 s at every krl run: only with a PLC)
 
-        writes = asyncio.run_coroutine_threadsafe(self._exchange(), self.loop).result(30)
-        while self.traced_refused < self.refused:
+        writes, refusals, notes = asyncio.run_coroutine_threadsafe(self._exchange(), self.loop).result(30)
+        refused = self.modbus.refused if self.modbus is not None else 0
+        while self.traced_refused < refused:
             self.traced_refused += 1
-            self.hub.trace("plc", "refused", text=f"more than {MAX_PLC_CLIENTS} Modbus clients")
+            self.hub.trace("plc", "refused", text=f"more than {MAX_PLC_CLIENTS} Modbus clients: closed at accept")
+        for text in refusals:
+            self.hub.trace("plc", "error", text=f"OPC UA write refused: {text}")
+        for text in notes:
+            self.hub.trace("plc", "error", text=f"Modbus: {text}")
         for signal, value in writes:
             self.apply(signal, value)
 
-    async def _exchange(self) -> list:
-        """In the servers' loop: what the PLC wrote, then the robot's image published."""
+    async def _exchange(self) -> tuple[list, list, list]:
+        """In the servers' loop: what the PLC wrote (and the OPC UA writes refused, the Modbus
+        connections closed, since the last cycle), then the robot's image published."""
         io = self.hub.ctl.io
+        refusals, self.refusals = self.refusals, []
+        notes = []
+        if self.modbus is not None:
+            notes, self.modbus.notes = self.modbus.notes, []
         m = self.map
         writes: list = []
         ctx = self.modbus.context if self.modbus is not None else None
@@ -312,7 +375,7 @@ class Plc:
             for n in range(1, m.analog + 1):
                 await self._publish(f"$ANIN[{n}]", anins[n - 1], ua.VariantType.Double)
                 await self._publish(f"$ANOUT[{n}]", io.get_anout(n), ua.VariantType.Double)
-        return writes
+        return writes, refusals, notes
 
     async def _publish(self, key: str, value, vtype) -> None:
         from asyncua import ua  # noqa: PLC0415  (costs 0.43 s: only with an OPC UA server)
@@ -333,6 +396,12 @@ class Plc:
 
 
 def apply_write(hub, signal: str, value) -> None:
+    """The PLC's write of an input, through the controller's write rules (the sink's ``admit``:
+    a refusal is an error event and nothing is written)."""
+    refusal = hub.sink.admit(signal, value, "plc")
+    if refusal is not None:
+        hub.trace("plc", "error", text=f"write refused: {refusal}")
+        return
     hub.sink.changed_outside()
     io = hub.ctl.io
     io.now = hub.ctl.time
