@@ -30,7 +30,7 @@ from pathlib import Path
 import re
 import xml.etree.ElementTree as ET
 
-from krl.limits import MAX_EKI_CHANNELS
+from krl.limits import MAX_EKI_CHANNELS, MAX_EKI_IDLE_S
 
 from . import transport
 from .cellkey import LOOPBACK, SettingsError, channel
@@ -520,7 +520,7 @@ class EkiPartner(Partner):
         if not live:
             return
         for name, ep in list(self.endpoints.items()):
-            for ev in ep.poll():
+            for ev in (ep.poll(ctl.time) if isinstance(ep, transport.TcpServer) else ep.poll()):
                 self._event(name, ev)
             if isinstance(ep, transport.TcpClient) and ep.failed:
                 ch = self.channels.get(name)
@@ -601,6 +601,9 @@ class EkiPartner(Partner):
             ch.connected_event()
         elif kind == "refused":
             self.trace("eki", "refused", name=ch.name, text="a second partner: closed (one client per server)")
+        elif kind == "foreign":
+            self.trace("eki", "error", name=ch.name,
+                       text=f"a datagram from {ev[1][0]}:{ev[1][1]}, not the channel's partner: ignored")
         elif kind == "disconnect":
             self.trace("eki", "disconnect", name=ch.name, text=ev[1])
             ch.disconnected_event(ev[1])
@@ -673,7 +676,7 @@ class EkiPartner(Partner):
             if cfg.protocol == "UDP":
                 ep = transport.Udp(host, port) if cfg.server else transport.Udp(LOOPBACK, 0, (host, port))
             elif cfg.server:
-                ep = transport.TcpServer(host, port)
+                ep = transport.TcpServer(host, port, MAX_EKI_IDLE_S)
             else:
                 ep = transport.TcpClient(host, port)
         except OSError as exc:
@@ -713,9 +716,14 @@ class EkiPartner(Partner):
             ch.disconnected_event("send failed")
 
     def eki_apply(self, ch: Channel, sets: list) -> None:
+        """A message's ``Set_Flag``/``Set_Out``: through the controller's write rules (the sink's
+        set_flag/set_out, interp/runtime/writerules.py); a refusal is an error event."""
         for what, n in sets:
-            if what == "flag":
-                self.sink.set_flag(n, True)
-            else:
-                self.sink.set_out(n, True)
+            try:
+                if what == "flag":
+                    self.sink.set_flag(n, True)
+                else:
+                    self.sink.set_out(n, True)
+            except Exception as exc:  # noqa: BLE001 - the write rules' refusal (a KRL run-time error) of this one write
+                self.trace("eki", "error", name=ch.name, text=f"{'$FLAG' if what == 'flag' else '$OUT'}[{n}]: {exc}")
 

@@ -34,8 +34,11 @@ controller sends, over UDP to the sensor, KUKA's XML::
 <RKorr X=".." ../><Stop>0</Stop><IPOC>same</IPOC></Sen>`` before the next one. The answer's
 RECEIVE elements are the ETHERNET object's outputs by INDX. ``#ABSOLUTE``: the correction is
 the total offset from where RSI_ON found the robot; ``#RELATIVE``: each answer adds to it.
-A cycle without its answer is *late*: counted (``Delay``; a late answer still brings the
-sensor's newest values, but only one in time ends the count). In time is in simulated time: a
+A cycle without its answer is *late*: counted (``Delay``; only an answer in time ends the
+count). The sensor is the configured address and port (a datagram from elsewhere is an error
+event, ignored: transport.Udp ``foreign``), one answer per IPOC: a second answer to a packet or
+an answer to a packet already counted late is a *late answer*, counted (``late_answers``) and
+never applied (docs/network.md, Decisions: "RSI"). In time is in simulated time: a
 live sensor's answer is waited for until the next cycle starts (:data:`ANSWER_WAIT_S` of wall
 time at most; a sensor silent that long is late at once from then on), so neither a slow
 simulator nor a loaded machine makes a packet late. Past ``Timeout`` late packets
@@ -144,9 +147,10 @@ class Rsi:
         self.corr_cart = np.zeros(6)
         self.outputs: dict[int, float] = {}
         self.expect: list[int] = []          # IPOCs sent and not answered yet
-        self.recent: list[int] = []          # the last IPOCs sent (a late answer is still applied)
+        self.recent: list[int] = []          # the last IPOCs sent (an answer to one not expected is late)
         self.late = 0
         self.late_total = 0
+        self.late_answers = 0                # answers not applied: their IPOC already answered or counted late
         self.silent = False                  # no answer for ANSWER_WAIT_S: late without waiting
         self.stopped = False
         self.failed: str | None = None
@@ -419,11 +423,16 @@ class Rsi:
                     self._receive()
 
     def _receive(self) -> None:
-        """What the sensor sent since the last look: each datagram an answer."""
+        """What the sensor sent since the last look: each datagram from the sensor's address an
+        answer; one from anywhere else an error event, ignored (transport.Udp: ``foreign``)."""
         for ev in self.endpoint.poll():
             if ev[0] == "data":
                 self.hub.trace("rsi", "in", data=ev[1].decode("latin-1"))
                 self.answer(ev[1])
+            elif ev[0] == "foreign":
+                sensor = self.endpoint.peer
+                self.hub.trace("rsi", "error", text=f"a datagram from {ev[1][0]}:{ev[1][1]}, not the sensor's "
+                                                    f"address {sensor[0]}:{sensor[1]}: ignored")
 
     def _await(self, ipocs: list[int]) -> None:
         """Live: wait until the packets `ipocs` are answered (each answer applied as it comes),
@@ -499,12 +508,20 @@ class Rsi:
         if ipoc in self.expect:
             self.expect.remove(ipoc)
             self.late = 0                       # in time: the late packets in a row end
-        elif ipoc not in self.recent:
+        elif ipoc in self.recent:
+            # one answer per IPOC: a second answer to a packet, or one to a packet already counted
+            # late, is a late answer: counted, never applied (docs/network.md, Decisions: "RSI")
+            self.late_answers += 1
+            self.silent = False
+            self.hub.trace("rsi", "error", number=LATE_NUMBER,
+                           text=f"a late answer with IPOC {ipoc} (already answered or counted late): not applied, "
+                                f"{self.late_answers} so far")
+            return
+        else:
             self.hub.trace("rsi", "error", text=f"an answer with IPOC {ipoc} that no packet was sent with")
             return
         self.silent = False                     # the sensor answers: waited for again
         self.hub.sink.changed_outside()         # the outputs the program reads (RSI_GETPUBLICPAR, ...)
-        # a late answer (its packet already counted late) still carries the sensor's newest values
         for el in self.ctx.ethernet.receive:
             if el.internal:
                 if el.tag.upper() == "DEF_ESTR":

@@ -8,7 +8,8 @@ what the controller sends is dropped once its send buffer passes its limit.
 
 Events a poll returns: ``("connect", peer)``, ``("data", bytes)``, ``("disconnect", reason)``,
 ``("refused", peer)`` (a second client of a one-client server: closed at once, as EthernetKRL
-does). Servers bind where they are told; net/settings.py makes that loopback unless the cell
+does), ``("foreign", peer)`` (a datagram to a UDP client from another address than its partner's:
+not delivered). Servers bind where they are told; net/settings.py makes that loopback unless the cell
 file names another address.
 """
 
@@ -46,6 +47,7 @@ class Endpoint:
         self.address: tuple[str, int] | None = None
         self.peer: tuple[str, int] | None = None
         self.out = bytearray()
+        self.dropped: str | None = None     # why the connection was dropped last (a send may drop it)
 
     @property
     def connected(self) -> bool:
@@ -59,6 +61,7 @@ class Endpoint:
                 pass
             self.conn = None
             self.out.clear()
+            self.dropped = reason
             events.append(("disconnect", reason))
 
     def _read(self, events: list) -> None:
@@ -113,15 +116,27 @@ class Endpoint:
 
 
 class TcpServer(Endpoint):
-    """Listens on (host, port) and takes one partner at a time."""
+    """Listens on (host, port) and takes one partner at a time. A poll first reads the partner
+    (so that its close is noticed before a new connection is looked at: a partner reconnecting
+    right after a close is taken, not refused), then accepts. `idle_s` (None: never): a partner
+    that has sent nothing for that long, on the clock of the `now` given to :meth:`poll`, gives
+    its place to a new one that connects (``("disconnect", "idle ...")`` then ``connect``); any
+    other second partner is refused."""
 
-    def __init__(self, host: str, port: int) -> None:
+    def __init__(self, host: str, port: int, idle_s: float | None = None) -> None:
         super().__init__()
         self.sock = listen(host, port, 4)
         self.address = self.sock.getsockname()[:2]
+        self.idle_s = idle_s
+        self.heard = 0.0            # when the partner last sent something (or connected)
 
-    def poll(self) -> list:
+    def poll(self, now: float = 0.0) -> list:
         events: list = []
+        self._flush(events)
+        n = len(events)
+        self._read(events)
+        if any(e[0] == "data" for e in events[n:]):
+            self.heard = now
         while self.sock is not None:
             try:
                 c, peer = self.sock.accept()
@@ -131,15 +146,15 @@ class TcpServer(Endpoint):
                 break
             peer = peer[:2]
             if self.conn is not None:
-                c.close()
-                events.append(("refused", peer))
-                continue
+                if self.idle_s is None or now - self.heard < self.idle_s:
+                    c.close()
+                    events.append(("refused", peer))
+                    continue
+                self._drop(events, f"idle for {now - self.heard:.1f} s: a new partner took the channel")
             c.setblocking(False)
             c.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
-            self.conn, self.peer = c, peer
+            self.conn, self.peer, self.heard = c, peer, now
             events.append(("connect", peer))
-        self._flush(events)
-        self._read(events)
         return events
 
 
@@ -203,7 +218,10 @@ class TcpClient(Endpoint):
 
 class Udp(Endpoint):
     """A UDP socket bound to (host, port). As a server its partner is the last sender (the
-    first datagram "connects"); as a client it sends to `target`."""
+    first datagram "connects"); as a client it sends to `target` and takes datagrams from that
+    address only: one from anywhere else is a ``("foreign", peer)`` event, its bytes not
+    delivered (issue 61: an RSI sensor is the configured address and port; three answers sent
+    from another local port moved the robot)."""
 
     def __init__(self, host: str, port: int, target: tuple[str, int] | None = None,
                  limit: int = MAX_RSI_DATAGRAM_BYTES) -> None:
@@ -218,6 +236,11 @@ class Udp(Endpoint):
         self.sock = s
         self.limit = limit
         self.address = s.getsockname()[:2]
+        if target is not None:              # the address datagrams come from: numeric, as recvfrom gives it
+            try:
+                target = socket.getaddrinfo(target[0], target[1], s.family, socket.SOCK_DGRAM)[0][4][:2]
+            except (OSError, UnicodeError):
+                pass                        # sendto will fail as it would have: nothing arrives from it
         self.peer = target
         self.client = target is not None
 
@@ -238,7 +261,10 @@ class Udp(Endpoint):
             if self.peer is None:
                 self.peer = peer
                 events.append(("connect", peer))
-            elif peer != self.peer and not self.client:
+            elif peer != self.peer:
+                if self.client:
+                    events.append(("foreign", peer))
+                    continue
                 self.peer = peer
             events.append(("data", data))
         return events

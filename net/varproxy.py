@@ -17,8 +17,13 @@ is seen by the program's next statement.
 
 Limits (krl/limits.py): :data:`~krl.limits.MAX_VARPROXY_CLIENTS` clients at once (more are
 closed at once), :data:`~krl.limits.MAX_VARPROXY_REQUESTS_PER_CYCLE` requests answered per
-client and cycle (the rest wait), names and values bounded; a request that breaks the format
-closes that client's connection.
+client and cycle; the rest wait: a client's socket is read only while less than
+:data:`BUFFERED` bytes of its requests wait to be answered, so a client sending faster than
+that waits in the kernel's buffer (TCP's own back-pressure), and nothing it sent is dropped
+(5,000 reads sent back to back were answered 16, then the connection dropped, issue 61). Names
+and values are bounded; a request that breaks the format closes that client's connection, and
+so does a client that does not read its answers (``transport.SEND_BUFFER_LIMIT``): each with a
+``net`` error event saying why.
 """
 
 from __future__ import annotations
@@ -35,6 +40,10 @@ from .transport import Endpoint, listen
 
 OK = b"\x00\x01\x01"
 FAILED = b"\x00\x01\x00"
+#: the longest request (its header, a name and a value at their limits)
+MAX_REQUEST = 9 + MAX_VARPROXY_NAME_CHARS + MAX_VARPROXY_VALUE_CHARS
+#: a client's socket is read while fewer bytes than this of its requests wait to be answered
+BUFFERED = 2 * MAX_REQUEST
 
 
 class BadRequest(ValueError):
@@ -107,12 +116,13 @@ class VarProxy:
             self.hub.trace("varproxy", "connect")
         for cl in list(self.clients):
             events: list = []
-            cl._read(events)
+            if len(cl.buf) < BUFFERED:          # else the requests wait in the kernel's buffer
+                cl._read(events)
             for ev in events:
                 if ev[0] == "data":
                     cl.buf += ev[1]
             done = 0
-            while done < MAX_VARPROXY_REQUESTS_PER_CYCLE:
+            while done < MAX_VARPROXY_REQUESTS_PER_CYCLE and cl.conn is not None:
                 try:
                     req = parse_request(cl.buf)
                 except BadRequest as exc:
@@ -123,12 +133,11 @@ class VarProxy:
                     break
                 msg_id, mode, name, value, size = req
                 del cl.buf[:size]
-                cl.send(self.handle(msg_id, mode, name, value))
+                if not cl.send(self.handle(msg_id, mode, name, value)):
+                    self.hub.trace("varproxy", "error", text=f"{cl.dropped}: connection closed")
                 done += 1
-            if len(cl.buf) > 8 + MAX_VARPROXY_NAME_CHARS + MAX_VARPROXY_VALUE_CHARS:
-                cl._drop(events, "request too long")
             if cl.conn is None or any(e[0] == "disconnect" for e in events):
-                self.hub.trace("varproxy", "disconnect")
+                self.hub.trace("varproxy", "disconnect", text=cl.dropped or "closed")
                 cl.close()
                 self.clients.remove(cl)
 
