@@ -19,7 +19,12 @@ cancel, reading files) runs in the loop's executor. Limits
 (krl/limits.py): MAX_WEB_MESSAGE_BYTES per websocket message (uvicorn's ``ws_max_size``: a
 larger one closes the connection, 1009), MAX_WEB_CONNECTIONS websockets at once,
 MAX_WEB_MESSAGES_PER_S per connection, counted as they arrive (past it, or with a second's
-worth of actions not yet carried out: closed, 1008).
+worth of actions not yet carried out: closed, 1008). A binary frame closes the connection with
+1003 (the protocol is JSON text), one connection past the limit is accepted and closed with 1013
+(issue 61: a binary frame raised ``KeyError: 'text'`` and dropped the connection without a close
+frame, a flood logged a traceback although it was closed with 1008, and the ninth connection was
+refused at the handshake, HTTP 403). The actions of a connection stop before it is closed, so
+none of them sends on a closed connection.
 """
 
 from __future__ import annotations
@@ -34,7 +39,7 @@ from starlette.applications import Starlette
 from starlette.responses import FileResponse, PlainTextResponse, Response
 from starlette.routing import Mount, Route, WebSocketRoute
 from starlette.staticfiles import StaticFiles
-from starlette.websockets import WebSocket, WebSocketDisconnect
+from starlette.websockets import WebSocket, WebSocketDisconnect, WebSocketState
 
 from interp.debug.engine import Refused
 
@@ -55,6 +60,8 @@ MODULE_CACHE = 64
 CSP = ("default-src 'none'; script-src 'self'; style-src 'self'; img-src 'self' data: blob:; "
        "connect-src 'self'; font-src 'self'; frame-ancestors 'self' vscode-webview:; base-uri 'none'; "
        "form-action 'none'")
+#: close codes (RFC 6455 7.4.1; 1013 "Try Again Later", IANA's WebSocket Close Code registry)
+CLOSE_POLICY_VIOLATION, CLOSE_UNSUPPORTED_DATA, CLOSE_MESSAGE_TOO_BIG, CLOSE_TRY_AGAIN_LATER = 1008, 1003, 1009, 1013
 OPS = ("hello", "select", "cancel", "reset", "start", "stop", "backward", "runMode", "modeOp", "drives",
        "override", "breakpoint", "input", "ack", "ackAll", "answer", "watch", "setWatch", "jog", "touchup", "open")
 
@@ -427,35 +434,49 @@ class Pendant:
         rate limit holds however slowly the actions are carried out) and queued for
         :meth:`_actions`; a backlog of more than a second's worth of actions is a flood too."""
         if len(self.clients) >= MAX_WEB_CONNECTIONS:
-            await ws.close(code=1013, reason="too many connections")
+            # refused after the handshake, so that the page sees the close code (before it,
+            # Starlette can only answer HTTP 403)
+            await ws.accept()
+            await ws.close(code=CLOSE_TRY_AGAIN_LATER, reason="too many connections")
             return
         await ws.accept()
         self.clients.add(ws)
         queue: asyncio.Queue = asyncio.Queue(maxsize=MAX_WEB_MESSAGES_PER_S)
         worker = asyncio.ensure_future(self._actions(ws, queue))
         window, count = time.monotonic(), 0
+        close = None
         try:
             while not worker.done():
-                text = await ws.receive_text()
+                msg = await ws.receive()
+                if msg["type"] == "websocket.disconnect":
+                    break
+                text = msg.get("text")
+                if text is None:                 # a binary frame: the protocol is JSON text only
+                    close = (CLOSE_UNSUPPORTED_DATA, "binary frames are not accepted")
+                    break
                 now = time.monotonic()
                 if now - window >= 1.0:
                     window, count = now, 0
                 count += 1
                 if count > MAX_WEB_MESSAGES_PER_S or queue.full():
-                    await ws.close(code=1008, reason="too many messages")
-                    return
+                    close = (CLOSE_POLICY_VIOLATION, "too many messages")
+                    break
                 if len(text) > MAX_WEB_MESSAGE_BYTES:
-                    await ws.close(code=1009, reason="message too large")
-                    return
+                    close = (CLOSE_MESSAGE_TOO_BIG, "message too large")
+                    break
                 queue.put_nowait((now, text))
         except WebSocketDisconnect:
             pass
         finally:
+            # the actions stop before the connection closes: none of them sends on a closed one
             worker.cancel()
             with contextlib.suppress(asyncio.CancelledError, WebSocketDisconnect):
                 await worker
             self.clients.discard(ws)
             self._shown.pop(ws, None)
+            if close is not None:
+                with contextlib.suppress(WebSocketDisconnect, RuntimeError):    # the page left meanwhile
+                    await ws.close(code=close[0], reason=close[1])
 
     async def _actions(self, ws: WebSocket, queue: asyncio.Queue) -> None:
         """Carry out the queued messages of one connection in order, each answered with
@@ -466,6 +487,8 @@ class Pendant:
         except (asyncio.CancelledError, WebSocketDisconnect):
             raise
         except Exception:
+            if WebSocketState.DISCONNECTED in (ws.client_state, ws.application_state):
+                return                  # the page left while an answer was being sent: nothing to report
             with contextlib.suppress(Exception):
                 await ws.close(code=1011, reason="server error")
             raise

@@ -32,10 +32,10 @@ def chromium() -> str:
 
 
 @contextmanager
-def pendant_server(target: Path, *args: str):
+def pendant_server(target: Path, *args: str, stderr: Path | None = None):
     """`krl pendant TARGET --no-browser ARGS...` (pendant/client.py): yields the URL it printed
-    first; its stderr is shown on failure."""
-    with client.pendant_server(target, *args, root=REPO_ROOT) as (_proc, url):
+    first; its stderr is shown on failure (and kept in the file `stderr` when given)."""
+    with client.pendant_server(target, *args, root=REPO_ROOT, stderr=stderr) as (_proc, url):
         yield url
 
 

@@ -13,7 +13,7 @@ from urllib.parse import urlsplit
 import pytest
 import websockets
 
-from krl.limits import MAX_WEB_MESSAGE_BYTES, MAX_WEB_MESSAGES_PER_S
+from krl.limits import MAX_WEB_CONNECTIONS, MAX_WEB_MESSAGE_BYTES, MAX_WEB_MESSAGES_PER_S
 from tests.pendant.harness import browser_page, pendant_server, select
 
 PWNED = '<img src=x onerror="window.pwned=1"><script>window.pwned=1</script>'
@@ -32,8 +32,14 @@ def workspace(tmp_path_factory) -> Path:
 
 
 @pytest.fixture(scope="module")
-def server(workspace):
-    with pendant_server(workspace, "--no-realtime") as url:
+def stderr(workspace) -> Path:
+    """The file `krl pendant`'s stderr goes to."""
+    return workspace.parent / "stderr.txt"
+
+
+@pytest.fixture(scope="module")
+def server(workspace, stderr):
+    with pendant_server(workspace, "--no-realtime", stderr=stderr) as url:
         yield url
 
 
@@ -152,6 +158,84 @@ def test_bad_and_oversized_messages(server):
         except websockets.exceptions.ConnectionClosed as exc:
             return exc.rcvd.code if exc.rcvd else None
     assert asyncio.run(flood()) == 1008
+
+
+def _no_traceback(stderr: Path) -> None:
+    text = stderr.read_text()
+    assert "Traceback" not in text and "Cannot call" not in text and "KeyError" not in text, text[-3000:]
+
+
+def test_a_binary_frame_and_a_flood_close_cleanly_with_their_codes(server, stderr):
+    """A binary frame closes the connection with 1003 (it raised ``KeyError: 'text'`` and dropped
+    it without a close frame), a flood with 1008; neither leaves a traceback on stderr (the
+    flood logged "Cannot call send once a close message has been sent")."""
+    host, port, token = _parts(server)
+
+    async def binary():
+        ws = await _ws(server, f"http://{host}:{port}", token)
+        await ws.send(b"\x00\x01binary")
+        try:
+            await asyncio.wait_for(ws.recv(), 60)
+        except websockets.exceptions.ConnectionClosed as exc:
+            return exc.rcvd.code if exc.rcvd else None
+
+    async def flood():
+        ws = await _ws(server, f"http://{host}:{port}", token)
+        try:
+            for i in range(MAX_WEB_MESSAGES_PER_S * 20):
+                await ws.send(json.dumps({"op": "hello", "id": i}))
+            while True:
+                await asyncio.wait_for(ws.recv(), 300)
+        except websockets.exceptions.ConnectionClosed as exc:
+            return exc.rcvd.code if exc.rcvd else None
+
+    assert asyncio.run(binary()) == 1003
+    assert asyncio.run(flood()) == 1008
+    assert not _refused(server, f"http://{host}:{port}", token)         # the server goes on
+    _no_traceback(stderr)
+
+
+def test_one_connection_past_the_limit_is_closed_with_1013(server, stderr):
+    """MAX_WEB_CONNECTIONS websockets are served; the next one is accepted and closed with
+    1013 "try again later", as docs/security.md says (it was refused at the handshake: 403)."""
+    host, port, token = _parts(server)
+
+    async def go():
+        held = [await _ws(server, f"http://{host}:{port}", token) for _ in range(MAX_WEB_CONNECTIONS)]
+        try:
+            extra = await _ws(server, f"http://{host}:{port}", token)
+            try:
+                await asyncio.wait_for(extra.recv(), 60)
+            except websockets.exceptions.ConnectionClosed as exc:
+                return exc.rcvd.code if exc.rcvd else None
+        finally:
+            for ws in held:
+                await ws.close()
+    assert asyncio.run(go()) == 1013
+    _no_traceback(stderr)
+
+
+def test_watch_assignment_and_override_go_through_the_write_rules(server):
+    """The watch list's assignment and the override slider take the controller's write rules
+    (interp/runtime/writerules.py): $OV_PRO 0..100 (the assignment took 1000 while the slider
+    refused it), the safety controller's signals write-protected ($MOVE_ENABLE, $DRIVES_ON,
+    $USER_SAF were set)."""
+    answers = _session(server, [
+        {"op": "select", "id": 1, "program": "prog.src"},
+        {"op": "setWatch", "id": 2, "expr": "$OV_PRO", "value": "1000"},
+        {"op": "setWatch", "id": 3, "expr": "$MOVE_ENABLE", "value": "FALSE"},
+        {"op": "setWatch", "id": 4, "expr": "$DRIVES_ON", "value": "TRUE"},
+        {"op": "setWatch", "id": 5, "expr": "$USER_SAF", "value": "FALSE"},
+        {"op": "override", "id": 6, "value": 1000},
+        {"op": "setWatch", "id": 7, "expr": "$OV_PRO", "value": "55"},
+        {"op": "override", "id": 8, "value": 20},
+    ])
+    types = [a["type"] for a in answers]
+    assert types == ["done", "error", "error", "error", "error", "error", "done", "done"], answers
+    assert "value assignment inadmissible: $OV_PRO = 1000 out of limits [0; 100]" in answers[1]["text"]
+    for a, name in zip(answers[2:5], ("$MOVE_ENABLE", "$DRIVES_ON", "$USER_SAF")):
+        assert f"{name} is write-protected (a signal of the safety controller)" in a["text"], a
+    assert "out of limits" in answers[5]["text"]
 
 
 def test_krl_text_is_shown_as_text(pw, server):
