@@ -12,5 +12,11 @@ ROS and service tools connect to, on the simulated controller's one clock.
 - :mod:`net.ekiconfig`, :mod:`net.eki` — EthernetKRL channels and their element memory;
 - :mod:`net.rsi` — RobotSensorInterface: the RSI context, the ETHERNET object, corrections;
 - :mod:`net.varproxy` — KukaVarProxy's OpenShowVar protocol;
-- :mod:`net.plc` — the PLC side: Modbus TCP (pymodbus) and OPC UA (asyncua) over the I/O image.
+- :mod:`net.plc` — the PLC side: Modbus TCP (pymodbus) and OPC UA (asyncua) over the I/O image;
+  :mod:`net.modbus` — Modbus TCP to the letter (exceptions, pipelined requests, the connection
+  limit at accept) over pymodbus's PDUs;
+- :mod:`net.netlog` — what a partner sent, clipped wherever it is shown but in its recording.
+
+Every value a partner writes into the run goes through the controller's write rules
+(interp/runtime/writerules.py), asked through the hub's sink (net/hub.py).
 """

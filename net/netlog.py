@@ -12,6 +12,7 @@ with its whole value; :func:`clip_library_logs` puts one handler on their logger
 from __future__ import annotations
 
 import logging
+import sys
 
 from krl.limits import MAX_NET_LOG_CHARS
 
@@ -36,7 +37,36 @@ class _Clipped(logging.Formatter):
         return f"{record.name}: {record.levelname.lower()}: {clip(msg)}"
 
 
-_installed: set[str] = set()
+class _ClippedStderr(logging.Handler):
+    """Writes each record, clipped (:class:`_Clipped`), to the process's stderr as it is when the
+    record comes (as Python's last-resort handler does), or to the stream :meth:`setStream` set."""
+
+    def __init__(self, level: int) -> None:
+        super().__init__(level)
+        self.setFormatter(_Clipped())
+        self.stream = None
+
+    def setStream(self, stream):
+        """Write to `stream` from now on (None: stderr again); the stream written to before."""
+        old, self.stream = self.stream, stream
+        return old
+
+    def emit(self, record: logging.LogRecord) -> None:
+        try:
+            stream = self.stream if self.stream is not None else sys.stderr
+            stream.write(self.format(record) + "\n")
+            stream.flush()
+        except Exception:  # noqa: BLE001 - logging's own rule: a handler never raises
+            self.handleError(record)
+
+
+_installed: dict[str, _ClippedStderr] = {}
+
+
+def redirect(stream) -> None:
+    """Every clipping handler writes to `stream` from now on (None: stderr again)."""
+    for handler in _installed.values():
+        handler.setStream(stream)
 
 
 def clip_library_logs(*names: str, level: int = logging.WARNING) -> None:
@@ -47,10 +77,7 @@ def clip_library_logs(*names: str, level: int = logging.WARNING) -> None:
     for name in names:
         if name in _installed:
             continue
-        _installed.add(name)
-        handler = logging.StreamHandler()
-        handler.setFormatter(_Clipped())
-        handler.setLevel(level)
+        handler = _installed[name] = _ClippedStderr(level)
         log = logging.getLogger(name)
         log.addHandler(handler)
         log.propagate = False
@@ -58,4 +85,4 @@ def clip_library_logs(*names: str, level: int = logging.WARNING) -> None:
             log.setLevel(level)
 
 
-__all__ = ["ELLIPSIS", "clip", "clip_library_logs"]
+__all__ = ["ELLIPSIS", "clip", "clip_library_logs", "redirect"]

@@ -14,7 +14,7 @@ import pytest
 
 from krl.limits import MAX_NET_LOG_CHARS
 from net.hub import Network
-from net.netlog import clip, clip_library_logs
+from net.netlog import clip, clip_library_logs, redirect
 from robot.trace import TraceWriter
 
 HUGE = "z" * 100_000
@@ -55,13 +55,12 @@ def test_each_partners_text_is_clipped_and_its_recording_kept(iface, text):
 @pytest.mark.parametrize("library", ["pymodbus", "asyncua"])
 def test_library_log_lines_are_clipped(library):
     clip_library_logs(library)
-    handler = logging.getLogger(library).handlers[0]
     stream = io.StringIO()
-    old = handler.setStream(stream)
+    redirect(stream)
     try:
         logging.getLogger(f"{library}.server").error("request %s refused", HUGE)
     finally:
-        handler.setStream(old)
+        redirect(None)
     line = stream.getvalue().rstrip("\n")
     assert "\n" not in line and line.endswith("…")
     assert len(line) <= MAX_NET_LOG_CHARS + len(f"{library}.server: error: ")

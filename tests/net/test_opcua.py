@@ -20,6 +20,7 @@ import pytest
 from asyncua import Client, ua
 
 from krl.limits import MAX_NET_LOG_CHARS
+from net import netlog
 from net.settings import NetworkSettings
 
 from .helpers import PROGRAMS, run_with_partner
@@ -75,11 +76,13 @@ def opcua_run():
     def partner(net, rt):
         _, port = net.wait_address("opcua")
         # the clipping handler net/netlog.py put on asyncua's logger writes here for this run
-        for h in logging.getLogger("asyncua").handlers:
-            h.setStream(stderr)
+        netlog.redirect(stderr)
         return asyncio.run(_writes(f"opc.tcp://127.0.0.1:{port}", rt))
 
-    result, trace, seen = run_with_partner(PROGRAMS / "plc_watch.src", settings, partner, max_sim_time=600.0)
+    try:
+        result, trace, seen = run_with_partner(PROGRAMS / "plc_watch.src", settings, partner, max_sim_time=600.0)
+    finally:
+        netlog.redirect(None)
     return result, trace, seen, stderr.getvalue()
 
 
@@ -113,7 +116,7 @@ def test_nothing_of_the_client_is_logged_whole(opcua_run):
     assert all(len(line) <= MAX_NET_LOG_CHARS + 40 for line in stderr.splitlines())
     # asyncua's own record of a refused write (it logs the variant whole) goes through the clip
     logging.getLogger("asyncua.server.address_space").warning("Write refused: Variant: %s", "y" * 100_000)
-    handler = logging.getLogger("asyncua").handlers[0]
+    handler = netlog._installed["asyncua"]
     line = handler.format(logging.LogRecord("asyncua.server.address_space", logging.WARNING, __file__, 1,
                                             "Write refused: Variant: %s", ("y" * 100_000,), None))
     assert len(line) <= MAX_NET_LOG_CHARS + 40 and line.endswith("…")
