@@ -27,7 +27,8 @@ from net.modbus import SUPPORTED
 from net.settings import Channel, NetworkSettings
 
 from .helpers import EXAMPLES, PROGRAMS, run_with_partner
-from .test_modbus import answers, request
+from .test_modbus import answers, read_when_served, request
+from .test_rsi_sources import sensor_sockets
 
 pytestmark = pytest.mark.slow
 
@@ -86,20 +87,8 @@ def test_modbus_fuzz(capfd):
             s = socket.create_connection(addr, timeout=30)
             s.sendall(bytes(rng.randrange(256) for _ in range(rng.randrange(1, 2000))))
             s.close()
-        # (the server counts a closed connection out once it has seen the close: until then a new
-        # one past the limit is refused, so the last is tried again for a bounded time)
-        deadline = time.monotonic() + 30
-        served = None
-        while served is None and time.monotonic() < deadline:
-            s = socket.create_connection(addr, timeout=30)
-            try:
-                s.sendall(request(1, 1, struct.pack(">HH", 0, 1)))
-                got = answers(s, 1, timeout=5)
-                served = got[0][1] if got else None
-            except OSError:
-                served = None
-            s.close()
-        assert served is not None and served[0] == 1
+        served = read_when_served(addr, 1)
+        assert served is not None and served[1][0] == 1
         return answered
 
     settings = NetworkSettings(PROGRAMS, modbus=("127.0.0.1", 0))
@@ -155,10 +144,7 @@ def test_rsi_fuzz(capfd, monkeypatch):
     rng = random.Random(63)
     monkeypatch.setattr(rsi_module, "ANSWER_WAIT_S", 0.1)     # a packet the fuzz leaves unanswered is late sooner
     before = _rss_kb()
-    sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
-    sock.bind(("127.0.0.1", 0))
-    rogue = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
-    rogue.bind(("127.0.0.1", 0))
+    sock, rogue = sensor_sockets()
 
     def partner(net, rt):
         sock.settimeout(0.5)

@@ -135,17 +135,24 @@ def partner(net, rt):
     seen["served"] = served
     for c in socks:
         c.close()
-    deadline = time.monotonic() + 20
-    again = None
-    while again is None and time.monotonic() < deadline:
+    seen["after the limit"] = read_when_served(addr, 60)
+    return seen
+
+
+def read_when_served(addr, tid: int, timeout: float = 30.0):
+    """A read of coil 0 on a new connection: (tid, PDU) once the server serves one. The server
+    counts a closed connection out once it has seen the close; until then a new one past the
+    limit is refused, so it is tried again for a bounded time (None when never served)."""
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
         c = socket.create_connection(addr, timeout=20)
         try:
-            again = read_coils(c, 60, 0, 1)
+            return read_coils(c, tid, 0, 1)
         except (OSError, IndexError):
-            again = None
-        c.close()
-    seen["after the limit"] = again
-    return seen
+            pass
+        finally:
+            c.close()
+    return None
 
 
 def closed_unanswered_quick(sock: socket.socket) -> bool:

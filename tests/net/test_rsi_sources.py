@@ -32,11 +32,18 @@ def sen(ipoc: str, z: float, stop: int = 0) -> bytes:
             f"<IPOC>{ipoc}</IPOC></Sen>").encode()
 
 
+def sensor_sockets() -> tuple[socket.socket, socket.socket]:
+    """(the sensor's UDP socket, another one on another local port), both on loopback."""
+    out = []
+    for _ in range(2):
+        s = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+        s.bind(("127.0.0.1", 0))
+        out.append(s)
+    return out[0], out[1]
+
+
 def make_sensor():
-    sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
-    sock.bind(("127.0.0.1", 0))
-    rogue = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
-    rogue.bind(("127.0.0.1", 0))
+    sock, rogue = sensor_sockets()
 
     def partner(net, rt):
         sock.settimeout(0.5)
