@@ -37,8 +37,8 @@ Multiple Registers, 22 Mask Write Register, 23 Read/Write Multiple Registers. Ev
 encapsulated 43, the user-defined ones) is 01. MBAP header (implementation guide 3.1.3): the
 length field frames the stream; a protocol identifier other than 0 is not MODBUS and a frame
 without a function code cannot be answered: both are discarded unanswered (a ``net`` error
-event); a PDU longer than 253 bytes is 03. A connection buffers at most one frame of 64 KiB
-(the length field's largest) beyond what it has answered.
+event); a PDU longer than 253 bytes is 03. A connection holds at most what it read before its
+waiting requests passed :data:`MAX_PENDING` (one read of asyncio's, at most 256 KiB, past them).
 """
 
 from __future__ import annotations

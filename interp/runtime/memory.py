@@ -77,15 +77,17 @@ class Slot(Ref):
         if self.readonly:
             raise protected(self.name)
         hook = self.on_write            # a system variable's write rules (writerules.WriteHook)
-        if hook is not None:
-            hook.before(self, v)
         cur = self.c[self.k]
         if isinstance(cur, (Struct, Arr)):
+            if hook is not None:
+                hook.before(self, v, False)
             if cur is not v:
                 assign_into(cur, v)
-        elif self.type is not None:
-            self.c[self.k] = convert_scalar(v, self.type)
         else:
+            if self.type is not None:
+                v = convert_scalar(v, self.type)
+            if hook is not None:
+                hook.before(self, v, True)
             self.c[self.k] = v
         if hook is not None and hook.after is not None:
             hook.after(self)

@@ -34,8 +34,8 @@ from __future__ import annotations
 import math
 import re
 
-from krl.limits import MAX_NET_LOG_CHARS
 from krl.semantics.builtins import load_builtins
+from net.netlog import clip
 
 from .errors import KrlRuntimeError
 from .values import Arr, Struct
@@ -65,7 +65,7 @@ def info_of(name: str):
 
 
 def shown(value) -> str:
-    """A value as a refusal shows it (clipped: it may come from a partner)."""
+    """A value as a refusal shows it (clipped: it may come from a partner, net/netlog.py)."""
     if isinstance(value, float):
         text = repr(value) if math.isfinite(value) else ("nan" if math.isnan(value) else
                                                          ("inf" if value > 0 else "-inf"))
@@ -73,7 +73,10 @@ def shown(value) -> str:
         text = "TRUE" if value else "FALSE"
     else:
         text = str(value)
-    return text if len(text) <= MAX_NET_LOG_CHARS else text[:MAX_NET_LOG_CHARS - 1] + "…"
+    return clip(text)
+
+
+_SAFETY = " (a signal of the safety controller)"
 
 
 def write_protected(name: str, why: str = "") -> KrlRuntimeError:
@@ -88,9 +91,6 @@ def protected(name: str) -> KrlRuntimeError:
     signal of the safety controller as such."""
     info = info_of(name)
     return write_protected(name, _SAFETY if info is not None and info.safety else "")
-
-
-_SAFETY = " (a signal of the safety controller)"
 
 
 def inadmissible(name: str, value, why: str, rule: str = "range") -> KrlRuntimeError:
@@ -149,10 +149,11 @@ def admit(name: str, value, writer: str, target_is_scalar: bool | None = None) -
 
 class WriteHook:
     """What writing a system variable's slot does besides storing the value (memory.py
-    ``Slot.set``): ``check`` before anything is stored (:func:`check` for the slot's name),
-    ``after`` once it is (``$PRO_MODE``: the new run mode applies from the next statement). The
-    hook of an array or a structure goes with its elements and components (memory.py
-    ``index_ref``, ``field_ref``): each element is checked as a scalar."""
+    ``Slot.set``): :meth:`before` checks the value, converted to the slot's type (a REAL into an
+    INT is checked as the INT it becomes), before anything is stored (:func:`check` for the
+    slot's name); ``after`` runs once it is (``$PRO_MODE``: the new run mode applies from the
+    next statement). The hook of an array or a structure goes with its elements and components
+    (memory.py ``index_ref``, ``field_ref``): each element is checked as a scalar."""
 
     __slots__ = ("checked", "after")
 
@@ -160,9 +161,9 @@ class WriteHook:
         self.checked = checked
         self.after = after
 
-    def before(self, ref, value) -> None:
+    def before(self, ref, value, scalar: bool) -> None:
         if self.checked:
-            check(ref.name, value, "program", not _is_aggregate(ref.peek()))
+            check(ref.name, value, "program", scalar)
 
 
 __all__ = ["FIELDBUS_WRITERS", "VALUE_INADMISSIBLE", "WRITERS", "WRITE_PROTECTED", "WriteHook", "admit", "check",
