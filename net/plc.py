@@ -46,6 +46,8 @@ PLC_KEYS = ("modbus", "opcua", "map")
 
 N_ANALOG = 32
 SCALE = 32767
+#: OPC UA writes refused within one IPO cycle that get an event each (a flood gets these)
+MAX_REFUSALS_TRACED = 64
 
 
 @dataclass
@@ -242,7 +244,8 @@ class Plc:
                     results += await plain(ua.WriteParameters(NodesToWrite=[wv]), *args, **kw)
                     continue
                 rule, text = refusal
-                self.refusals.append(text)
+                if len(self.refusals) < MAX_REFUSALS_TRACED:
+                    self.refusals.append(text)
                 results.append(ua.StatusCode(status.get(rule, ua.StatusCodes.BadOutOfRange)))
             return results
 
