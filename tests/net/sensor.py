@@ -81,6 +81,15 @@ class ConfigSensor:
                     self.sent.append(dict(values))
                     self.sock.sendto(f'<Sen Type="{self.sentype}">{self.body(values, stop)}<IPOC>{ipoc}</IPOC></Sen>'
                                      .encode(), peer)
+                # the run ended: the packets sent before it did are read too (on a loaded machine
+                # the last one could still wait in the socket when the loop saw the end)
+                self.sock.setblocking(False)
+                while True:
+                    try:
+                        data, _peer = self.sock.recvfrom(65536)
+                    except (BlockingIOError, OSError):
+                        break
+                    self.got.append(ET.fromstring(re.sub(rb"(\s)([0-9][\w.-]*=)", rb"\1_\2", data)))
             finally:
                 self.sock.close()
             return self.got
