@@ -63,6 +63,7 @@ from collections import Counter
 from pathlib import Path
 
 from interp.runtime.core import TARGET_OUTSIDE_NOTE
+from interp.runtime.errors import NOT_UNDERSTOOD
 from interp.runtime.program import parse_module
 from krl import limits
 from krl.parsecache import load_files
@@ -88,7 +89,7 @@ CAUSES = ("completed", "intended end", "program error", "interpreter gap", "limi
 #: parts of a run-time error message that make it the simulator's gap, not the program's error
 GAP_MESSAGES = ("target not reachable", "through a singularity", "software limit switch",
                 "not supported", "unsupported", "not simulated",
-                "not implemented", "internal error")
+                "not implemented", "internal error", NOT_UNDERSTOOD)
 
 #: errors of a motion the robot cannot follow: the program's when the robot is the backup's own
 #: and the target itself is out of its limits (:func:`cause_of`)

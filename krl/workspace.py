@@ -46,13 +46,14 @@ from pathlib import Path
 from krl import collector
 from krl.ast import nodes as N
 from krl.ast.build import build_module
+from krl.ast.coverage import lines_not_understood
 from krl.files import Entry
 from krl.project import (ProgramFiles, collect_entries, folder_groups, is_submit_file, is_system_path, module_key,
                          modules_of, project_of)
 from krl.project import module_files as project_module_files
 from krl.semantics.builtins import load_builtins
 from krl.semantics.checker import Checker, DeclaredTwice, Declarer, _is_system_datalist
-from krl.diagnostics import Diagnostic, DiagnosticSink
+from krl.diagnostics import SYNTAX_CODES, Diagnostic, DiagnosticSink
 from krl.diagnostics.codes import E001, E005, E901, W002, W108, W111, W201, W202, W205, W206, W210, W501
 from krl.semantics.outside import Unresolved, line_evidence, template_lines
 from krl.semantics.resolve import resolve_workspace
@@ -130,6 +131,18 @@ def load_parsed(src: SourceText, raw: bytes | None = None) -> LoadedFile:
         result.tree = None
 
 
+def record_unparsed(module: N.Module, text: str, diagnostics) -> set[str]:
+    """For a file with syntax errors: set ``module.unparsed`` and ``module.code_lines`` (the lines
+    its AST lacks: the lines of its syntax diagnostics and the code lines on which no node starts,
+    krl/ast/coverage.py) and return the words of those lines, upper-case: the names the file may
+    declare or use where the checker cannot see them (``Workspace.maybe_declared``). One rule for
+    ``krl check`` and the language server (krl/lsp/parsing.py)."""
+    module.unparsed, module.code_lines = lines_not_understood(
+        module, text, (d.line for d in diagnostics if d.code in SYNTAX_CODES))
+    lines = text.splitlines()
+    return {w.upper() for n in module.unparsed if 0 < n <= len(lines) for w in _WORD.findall(lines[n - 1])}
+
+
 def release_tree(tree) -> None:
     """Break the cycles of a parse tree the AST was built from (each rule node's `children`
     cleared: a child points back through `parentCtx`), so that reference counting frees it at
@@ -156,13 +169,13 @@ def _loaded(src: SourceText, result: ParseResult, started: float) -> LoadedFile:
     sink.extend(syntax_diagnostics(result, src.text, tokens=stream_tokens(result.tree) if result.errors else None))
     sink.extend(fold_diagnostics(path_s, src.text))
     t = time.perf_counter()
-    unreadable, words = False, set()
-    if not result.ok:
-        if result.status in ("binary", "too_large", "unreadable", "not_regular"):
-            unreadable = True
-        elif src.text:
-            words = {w.upper() for w in _WORD.findall(src.text)}
+    unreadable = False
+    if not result.ok and result.status in ("binary", "too_large", "unreadable", "not_regular"):
+        unreadable = True
     module = build_module(result, sink)
+    words = set()
+    if not result.ok and not unreadable and src.text:
+        words = record_unparsed(module, src.text, sink.items)
     return LoadedFile(path_s, module, result.ok, result.status, elapsed, time.perf_counter() - t,
                       sink.items, unreadable, words, template_lines(src.text or ""))
 
@@ -292,7 +305,7 @@ class Workspace:
     loaded: dict = field(default_factory=dict, repr=False)
     # what the last check left for :meth:`replace` (_CheckState), and the check's options
     _state: "_CheckState | None" = field(default=None, repr=False)
-    _options: tuple = field(default=(True, False), repr=False)      # (resolve, partial)
+    _options: tuple = field(default=(True,), repr=False)      # (resolve,)
     _unread: bool = field(default=False, repr=False)                # an entry not read (not a file's)
     _by_path: dict | None = field(default=None, repr=False)
     _inputs: list = field(default_factory=list, repr=False)         # the load's diagnostics, in order
@@ -421,22 +434,22 @@ class Workspace:
         for name, code, dat in modules_of(self.files, lambda f: f.module.kind == "dat"):
             self.units.append(ModuleUnit(name, src=code, dat=dat))
 
-    def check(self, resolve: bool = True, partial: bool = False) -> list[Diagnostic]:
+    def check(self, resolve: bool = True) -> list[Diagnostic]:
         """Link the files into scopes and run the checker; returns the sorted diagnostics.
 
-        `resolve` False: no storage places for the interpreters (krl/semantics/resolve.py; an
-        editor needs only the checker's annotations; :meth:`resolve` places them later).
-        `partial` True: the routines and data lists of files that do not parse are typed too
-        (an editor's look-ups), their findings not reported, as ``krl check`` reports only the
-        syntax errors of such files."""
+        A file with syntax errors is checked from what parsed (issue 63): its declarations,
+        routines and statements, each line not understood an ``Unparsed`` node (no finding of
+        its own beyond the syntax error). `resolve` False: no storage places for the
+        interpreters (krl/semantics/resolve.py; an editor needs only the checker's annotations;
+        :meth:`resolve` places them later)."""
         if self.checked:
             if resolve and not self._options[0]:
                 self.resolve()        # checked for the checker alone before; a run needs the places
-                self._options = (True, self._options[1])
+                self._options = (True,)
             return self.diagnostics
         t = time.perf_counter()
         self.checked = True
-        self._options = (resolve, partial)
+        self._options = (resolve,)
         self._inputs = list(self.sink.items)
         try:
             self._check()
@@ -603,10 +616,9 @@ class Workspace:
             declarer.soft_types = False
 
     def _body_wanted(self, rec: "_RoutineCheck") -> bool:
-        """True when the routine's body is checked: its file parses (a file with syntax errors:
-        its AST may miss tokens; E002 says why) or the check types such files too."""
-        f = rec.unit.src
-        return (f.ok or self._options[1]) and (self.check_only is None or f.path in self.check_only)
+        """True when the routine's body is checked: always, but for a file outside
+        :attr:`check_only` (a file with syntax errors is checked from what parsed)."""
+        return self.check_only is None or rec.unit.src.path in self.check_only
 
     def _check_body(self, rec: "_RoutineCheck") -> None:
         st = self._state
@@ -626,7 +638,7 @@ class Workspace:
         """The initial values of a data list's `items` against the declared types, one record
         per item (`kept`: id(item) -> a record still valid, not checked again)."""
         f = u.dat
-        if not ((f.ok or self._options[1]) and (self.check_only is None or f.path in self.check_only)):
+        if not (self.check_only is None or f.path in self.check_only):
             return []
         st = self._state
         declarer, checker = st.declarer, st.checker
@@ -649,7 +661,7 @@ class Workspace:
         return out
 
     def _reported(self, f: SourceFile) -> bool:
-        return f.ok and (self.check_only is None or f.path in self.check_only)
+        return self.check_only is None or f.path in self.check_only
 
     def _owners(self) -> list[tuple[DiagnosticSink, "_Uses"]]:
         """(findings, unresolved uses) of every owner that is reported, in the order of a check:
@@ -1232,6 +1244,63 @@ def load_workspace(paths: list[str | Path], root: str = "", timeout: float | Non
         entries += collect_entries(p)
     _add_entries(ws, entries, timeout, jobs)
     return ws
+
+
+@dataclass(frozen=True)
+class NotUnderstood:
+    """The lines of one file that its AST does not hold (issue 63): ``lines`` as (line, the
+    parser's message: the file's syntax diagnostic at that line, or for a follow-on line
+    without one, the error it follows), the code lines understood and
+    counted (krl/ast/coverage.py), and what they are (``noun``: declarations of a data list,
+    statements of a module). Every tool names these once, at the top of what it prints."""
+    path: str
+    lines: tuple
+    understood: int
+    total: int
+    noun: str
+
+    def headline(self, verb: str, shown=str) -> str:
+        """``$config.dat:915 not understood: 1,040 of 1,041 declarations compared`` (`verb`: what
+        the tool did with the rest; `shown`: the file as the user names it)."""
+        nums = [str(n) for n, _m in self.lines]
+        where = ", ".join(nums[:8]) + (f" and {len(nums) - 8} more lines" if len(nums) > 8 else "")
+        return (f"{shown(self.path)}:{where} not understood: {self.understood:,} of {self.total:,} "
+                f"{self.noun} {verb}")
+
+    def details(self, shown=str, limit: int = 8) -> list[str]:
+        """One line ``FILE:LINE: message`` per line not understood (at most `limit`, then a count)."""
+        out = [f"{shown(self.path)}:{n}: {m}" for n, m in self.lines[:limit]]
+        if len(self.lines) > limit:
+            out.append(f"... and {len(self.lines) - limit} more lines not understood in {shown(self.path)}")
+        return out
+
+
+def not_understood(ws: Workspace) -> list[NotUnderstood]:
+    """The files of `ws` with lines not understood (a syntax error, or lines its error recovery
+    passed over), in the workspace's file order (with :attr:`Workspace.check_only`, of those
+    files only); [] when every file parsed. Files not read or
+    not parsed at all (E001, E005, past a limit) are not among them: their diagnostics say so."""
+    out = []
+    for f in ws.files:
+        m = f.module
+        if f.ok or not m.unparsed or (ws.check_only is not None and f.path not in ws.check_only):
+            continue
+        msgs: dict[int, str] = {}
+        lf = ws.loaded.get(f.path)
+        for d in (lf.diagnostics if lf is not None else ()):
+            if d.code in SYNTAX_CODES and d.line not in msgs:
+                msgs[d.line] = d.message
+        lines, last = [], None
+        for n in m.unparsed:
+            if n in msgs:
+                last = n
+                lines.append((n, msgs[n]))
+            else:
+                lines.append((n, f"follows the error at line {last}" if last is not None
+                              else "not read by the parser"))
+        noun = "declarations" if m.kind == "dat" and not m.routines else "statements"
+        out.append(NotUnderstood(f.path, tuple(lines), max(0, m.code_lines - len(m.unparsed)), m.code_lines, noun))
+    return out
 
 
 def check_texts(files: dict[str, str]) -> Workspace:

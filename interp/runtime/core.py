@@ -27,7 +27,7 @@ from .watch import (CONSTANT, IO, SETTLES, CyclicWatch, settles, split_watch, st
 from .convert import (
     INT_MAX, INT_MIN, assign_into, binary_op, convert_scalar, num, to_bool, trunc_int, unary_op,
 )
-from .errors import (HaltSignal, KrlRuntimeError, ResumeSignal, StopRun)
+from .errors import (HaltSignal, KrlRuntimeError, ResumeSignal, StopRun, not_entered)
 from .idle import probe_state
 from .kss import SystemSoftware
 from .memory import DataMemory, Frame, ProxyRef, Ref, SignalRef, Slot, field_ref, index_ref
@@ -792,6 +792,8 @@ class Runtime:
         stay declared-but-unset; locals are declared unset. The routine's slots are its
         Layout (krl/semantics/resolve.py), planned once (:class:`FramePlan`); the Slot of a
         variable the frame holds itself is made when first used (``Frame.var``)."""
+        if routine.broken:
+            raise KrlRuntimeError(not_entered(routine), None, routine.span.file, routine.span.line)
         task = self.current_task
         if self.kss.standard and id(routine) in self.kss.standard:
             self.kss.standard_call(routine)

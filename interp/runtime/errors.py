@@ -69,6 +69,26 @@ class StopRun(ControlSignal):
         self.text = text
 
 
+#: the words every stop on a line the grammar does not accept begins with: the simulator's
+#: gap, not the program's error (interp/realprograms.py GAP_MESSAGES)
+NOT_UNDERSTOOD = "line not understood by krl-tools"
+
+
+def not_understood(text: str) -> str:
+    """The message of a run that reaches a line the grammar does not accept (an ``Unparsed``
+    statement, issue 63): the controller runs the line, the simulator cannot say what it does,
+    so the run stops there, in both interpreters alike."""
+    return f"{NOT_UNDERSTOOD} (the controller runs it; the simulation stops here): {' '.join(text.split())[:60]}"
+
+
+def not_entered(routine: N.Routine) -> str:
+    """The message of a call of a routine whose blocks the parser could not close
+    (``Routine.broken``: the line not understood from which its statements may belong
+    elsewhere): the run stops at the call rather than run statements out of their blocks."""
+    return (f"{NOT_UNDERSTOOD}: routine {routine.name} is not entered, its blocks are in doubt from "
+            f"line {routine.broken} on")
+
+
 def lvalue_name(e) -> str:
     """The name of an lvalue expression (krl.ast nodes) as run-time messages show it:
     ``p``, ``a[..]``, ``p.X``."""

@@ -32,7 +32,7 @@ from pathlib import Path
 
 from krl.ast import nodes as N
 from krl.diagnostics import SYNTAX_CODES
-from krl.diagnostics.codes import E001, E003, E005
+from krl.diagnostics.codes import E001, E003, E005, E018, E019
 from krl.files import spelled, spelled_within
 from krl.limits import PARSE_TIMEOUT_S
 from krl.project import project_of, with_basis   # which files make the program: one rule
@@ -50,9 +50,13 @@ from .values import UNSET, Struct, data_size, make_value
 
 BASIS_DIR = Path(__file__).resolve().parent.parent / "basis"
 
-# the files a program's own module cannot have for it to start: input errors (E001, E005),
-# syntax errors and constructs the builder cannot build (E003)
+# the problems of a file reported to the tools as its syntax errors (parse_module)
 _START_CODES = SYNTAX_CODES | {E001, E003, E005}
+# the problems that keep a module from starting: a file not read (E001, E005), not parsed (past a
+# nesting or expression limit: E018, E019) or not built (E003). A line the grammar does not
+# accept does not: the module runs from what parsed, and a run that reaches the line stops
+# there (issue 63; interp/runtime/errors.py ``not_understood``)
+_BLOCKING = frozenset({E001, E003, E005, E018, E019})
 # files above this size in total are parsed in worker processes (the Java engine when present)
 _BATCH_BYTES = 256 * 1024
 _CACHE: OrderedDict = OrderedDict()
@@ -149,7 +153,7 @@ class ModuleRT:
         self.store: list = [UNSET] * n     # slot -> value of a variable
         self.data: dict = {}               # UPPER name -> reference (tools and tests)
         self.errors: list[str] = []        # data-list initialisation problems
-        self.syntax_errors: list[str] = []  # syntax errors of its files (cannot run)
+        self.syntax_errors: list[str] = []  # problems of its files that keep it from starting (_BLOCKING)
         self.loaded = False
         self.loading = False
 
@@ -224,8 +228,9 @@ class Program:
 
     def errors_of(self, m: ModuleRT | None) -> list:
         """The checker's errors in module `m`'s files (none when the run does not check); input
-        and syntax errors are not among them: those keep any run from starting, --no-check or
-        not, and the run says so itself ("the program has syntax errors and cannot start")."""
+        and syntax errors are not among them: a file not read or not parsed keeps any run from
+        starting, --no-check or not, and the run says so itself ("the program has syntax errors
+        and cannot start"); a line not understood stops the run when it is reached."""
         if m is None or not self.check or m.syntax_errors:
             return []
         paths = {str(p) for p in m.files.values()}
@@ -234,11 +239,11 @@ class Program:
     def _syntax_errors(self) -> None:
         by_path: dict[str, list] = {}
         for d in self.ws.sink.sorted():
-            if d.is_error and d.code in _START_CODES:
+            if d.is_error and d.code in _BLOCKING:
                 by_path.setdefault(d.path, []).append(
                     SyntaxProblem(f"{d.path}:{d.line}:{d.column}: {d.message}", d.path, d.line))
         for f in self.ws.files:
-            if not f.ok and f.path not in by_path:
+            if f.status not in ("ok", "syntax_error") and f.path not in by_path:
                 by_path[f.path] = [SyntaxProblem(f"{f.path}: file not read: {f.status}", f.path, 1)]
         for m in self.modules:
             for kind in ("dat", "src", "sub"):

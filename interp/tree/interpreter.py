@@ -26,7 +26,7 @@ from krl.semantics.resolve import LOCAL, ROUTINE, SYSTEM
 
 from interp.runtime.natives import ValueRef
 from interp.runtime.convert import num
-from interp.runtime.errors import ExitSignal, GotoSignal, KrlRuntimeError, ReturnSignal, lvalue_name
+from interp.runtime.errors import ExitSignal, GotoSignal, KrlRuntimeError, ReturnSignal, lvalue_name, not_understood
 from interp.runtime.slots import (anout_limits, anout_value, array_index, ended_without_return, for_done,
                                  for_limits, for_next, label_not_found, return_without_value, trigger_args)
 from interp.runtime.values import Channel, EnumValue, Struct, copy_value
@@ -307,6 +307,9 @@ class TreeInterpreter:
     def s_Unsupported(self, st, frame) -> None:
         raise KrlRuntimeError(f"unsupported statement: {st.text.strip()[:60]}", None,
                               st.span.file, st.span.line)
+
+    def s_Unparsed(self, st, frame) -> None:
+        raise KrlRuntimeError(not_understood(st.text), None, st.span.file, st.span.line)
 
     # interrupts, triggers, brake ------------------------------------------------------
     def s_InterruptDecl(self, st, frame) -> None:

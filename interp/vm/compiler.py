@@ -40,7 +40,7 @@ from krl.semantics import types as T
 from krl.semantics.resolve import LOCAL, MODULE
 from krl.semantics.values import EnumValue, KrlRuntimeError, binary_op, unary_op
 
-from interp.runtime.errors import lvalue_name
+from interp.runtime.errors import lvalue_name, not_understood
 from interp.runtime.values import Channel
 from interp.runtime.watch import watch_of_decl
 
@@ -385,6 +385,10 @@ class Compiler:
     def s_Unsupported(self, st) -> None:
         self.region = None
         self.emit("RAISE", f"unsupported statement: {st.text.strip()[:60]}", st.span.line)
+
+    def s_Unparsed(self, st) -> None:
+        self.region = None
+        self.emit("RAISE", not_understood(st.text), st.span.line)
 
     def _stub(self, st) -> None:
         self.stmt(st)

@@ -9,8 +9,11 @@ shape (expression, operator token, expression), declarations by their modifier t
 
 :func:`build_module` never raises. A parse-tree node it cannot map becomes an
 :class:`~krl.ast.nodes.Unsupported` statement (printed back verbatim) plus a W003
-diagnostic; inside a tree that came from error recovery (the file has syntax errors,
-already reported as E002) broken lines are skipped silently.
+diagnostic. A tree that came from error recovery (the file has syntax errors, already
+reported as E002) is built from what parsed (issue 63): each statement, declaration or
+data-list line with a syntax error becomes an :class:`~krl.ast.nodes.Unparsed` node in its
+place, and a block or routine whose own line parsed but whose closer did not is still built,
+its routine marked ``broken`` at the first line not understood.
 """
 
 from __future__ import annotations
@@ -64,11 +67,16 @@ class BuildError(Exception):
 class Builder:
     """Builds one file's AST. Use :func:`build_module`."""
 
-    def __init__(self, path: str, sink: DiagnosticSink, symbolic: list[str], recovered: bool):
+    def __init__(self, path: str, sink: DiagnosticSink, symbolic: list[str], recovered: bool,
+                 error_lines: dict[int, str] | None = None):
         self.path = path
         self.sink = sink
         self.symbolic = symbolic
         self.recovered = recovered
+        # line -> its text, of each line with a syntax error (a recovered tree only)
+        self.error_lines = error_lines or {}
+        self._placed: set[int] = set()      # error lines already given their Unparsed node
+        self._in_doubt = False              # a rule of the routine in hand recovered past its own line
 
     # ---------------------------------------------------------------- tree helpers
 
@@ -104,6 +112,8 @@ class Builder:
         out = []
         for c in ctx.children or ():
             if isinstance(c, ErrorNode):
+                if self._elsewhere(ctx, c.symbol.line):
+                    continue        # a line of its own inside a block (its Unparsed node says so)
                 raise BuildError("error node")
             if isinstance(c, TerminalNode):
                 out.append((self.sym(c), c.getText(), c))
@@ -126,7 +136,46 @@ class Builder:
 
     def check_ok(self, ctx) -> None:
         if getattr(ctx, "exception", None) is not None:
+            tok = getattr(ctx, "start", None)
+            if tok is not None and self._elsewhere(ctx, None):
+                # a block (or routine, data list) whose own line parsed: the error is on a line
+                # inside it or at its closer; built from what parsed, its routine in doubt
+                self._in_doubt = True
+                return
             raise BuildError("recovered subtree")
+
+    def _elsewhere(self, ctx, line: int | None) -> bool:
+        """In a recovered tree: True when `ctx` starts on a line that parsed and (with `line`)
+        the error at `line` lies on another line."""
+        if not self.recovered:
+            return False
+        tok = getattr(ctx, "start", None)
+        start = tok.line if tok is not None else None
+        return start is not None and start not in self.error_lines and line != start
+
+    def unparsed(self, ctx_or_line) -> N.Unparsed | None:
+        """The Unparsed node of an error line (once per line), or None when the line parsed
+        or was placed already; `ctx_or_line`: a rule context (its first line) or a line."""
+        if isinstance(ctx_or_line, int):
+            line, col = ctx_or_line, 1
+        else:
+            tok = getattr(ctx_or_line, "start", None)
+            if tok is None:
+                return None
+            line, col = tok.line, tok.column + 1
+        if line not in self.error_lines or line in self._placed:
+            return None
+        self._placed.add(line)
+        text = self.error_lines[line]
+        col = len(text) - len(text.lstrip()) + 1 if text.strip() else col
+        return N.Unparsed(text.strip(), span=N.Span(self.path, line, col))
+
+    def _error_line_of(self, ctx) -> int | None:
+        """The line of `ctx` when it is a line with a syntax error (a recovered tree), else None."""
+        if not self.error_lines:
+            return None
+        tok = getattr(ctx, "start", None)
+        return tok.line if tok is not None and tok.line in self.error_lines else None
 
     def unknown(self, ctx, what: str) -> None:
         if not self.recovered:
@@ -179,6 +228,17 @@ class Builder:
             return []
 
     def routine(self, ctx) -> N.Routine:
+        doubt, self._in_doubt = self._in_doubt, False
+        try:
+            r = self._routine(ctx)
+        finally:
+            in_doubt, self._in_doubt = self._in_doubt, doubt
+        if in_doubt:
+            last = r.end_line or max(self.error_lines, default=r.span.line)
+            r.broken = min((ln for ln in self.error_lines if r.span.line <= ln <= last), default=r.span.line)
+        return r
+
+    def _routine(self, ctx) -> N.Routine:
         inner = self.rules(ctx)
         if len(inner) == 1 and _names(inner[0])[1] in ("procedureDefinition", "functionDefinition"):
             ctx = inner[0]
@@ -220,6 +280,11 @@ class Builder:
                 continue
             base = _names(c)[1]
             if base == "declarationLine":
+                if self._error_line_of(c) is not None:
+                    u = self.unparsed(c)
+                    if u is not None:
+                        (body if body else decls).append(u)
+                    continue
                 for d in self.rules(c):
                     decl = self.guarded(self.declaration, d)
                     if decl is None:
@@ -244,6 +309,11 @@ class Builder:
         public = self.has(ctx, "PUBLIC")
         items: list[N.Decl] = []
         for line in self.rules(ctx):
+            if self._error_line_of(line) is not None and not _matches(_names(line)[1], "name"):
+                u = self.unparsed(line)
+                if u is not None:
+                    items.append(u)
+                continue
             for it in self.rules(line) if _names(line)[1].endswith("Line") else [line]:
                 if _matches(_names(it)[1], "name"):
                     continue
@@ -490,8 +560,19 @@ class Builder:
         if ctx is None:
             return out
         for c in ctx.children or ():
+            if isinstance(c, ErrorNode):
+                u = self.unparsed(c.symbol.line)     # tokens skipped between statement lines
+                if u is not None:
+                    out.append(u)
+                continue
             if isinstance(c, ParserRuleContext):
                 base = _names(c)[1]
+                if self._error_line_of(c) is not None and base in ("statementLine", "statement",
+                                                                   "declarationLine", "declaration"):
+                    u = self.unparsed(c)
+                    if u is not None:
+                        out.append(u)
+                    continue
                 if base == "statementLine":
                     out.extend(self.stmt_line(c))
                 elif base == "statement":
@@ -1095,7 +1176,10 @@ def build_module(result, sink: DiagnosticSink | None = None) -> N.Module:
     try:
         parser = getattr(tree, "parser", None)
         symbolic = list(type(parser).symbolicNames) if parser is not None else []
-        b = Builder(path, sink, symbolic, recovered=not result.ok)
+        lines: dict[int, str] = {}
+        for e in getattr(result, "errors", None) or ():
+            lines.setdefault(e.line, e.line_text)
+        b = Builder(path, sink, symbolic, recovered=not result.ok, error_lines=lines)
         return b.module(tree)
     except Exception as exc:  # noqa: BLE001 - never raise on any parse tree
         sink.add(path, 1, 1, *E003("failed", error=f"{type(exc).__name__}: {exc}"))

@@ -47,6 +47,8 @@ def kind_of(node: N.Node) -> str | None:
         return "declaration after statements"
     if isinstance(node, N.Unsupported):
         return f"unsupported {node.rule}"
+    if isinstance(node, N.Unparsed):
+        return "not understood"
     if isinstance(node, N.Routine):
         return node.kind
     if isinstance(node, N.DataList):

@@ -28,7 +28,8 @@ Shapes (reference sections in brackets):
   :class:`AnoutOn`, :class:`AnoutOff`, :class:`Motion`, :class:`SplineBlock`,
   :class:`KeywordStmt` (CONFIRM, ASYPTP, ...), :class:`MoveEmi`,
   :class:`DeclStmt` (a declaration found among statements), :class:`Unsupported`
-  (a construct the builder does not know; carries the source text) [5, 6].
+  (a construct the builder does not know; carries the source text), :class:`Unparsed` (a line
+  the grammar does not accept, in its place; also among a data list's items) [5, 6].
 * expressions: :class:`IntLit`, :class:`RealLit`, :class:`BoolLit`, :class:`StrLit`,
   :class:`EnumLit`, :class:`Aggregate`, :class:`Name`, :class:`Index`, :class:`Field`,
   :class:`Call`, :class:`Unary`, :class:`Binary` (the geometric operator is ``op == ":"``) [1.5, 4].
@@ -652,6 +653,17 @@ class DeclStmt(Stmt):
 
 
 @dataclass(slots=True)
+class Unparsed(Stmt):
+    """A line the grammar does not accept (a syntax error of the file, E002 and its kin), kept
+    in its place among the statements, the declaration section or a data list's items, so
+    that every tool uses what parsed around it (issue 63). ``text`` is the line's source text,
+    stripped; the parser's message is the file's diagnostic at the same line. A run that
+    reaches it stops there (interp/runtime ``not_understood``); ``krl diff`` compares it by its
+    text."""
+    text: str
+
+
+@dataclass(slots=True)
 class Unsupported(Stmt):
     """A parse-tree construct the builder does not map (yet); ``rule`` is the parse-tree
     node name, ``text`` its source text (printed back verbatim)."""
@@ -681,6 +693,10 @@ class Routine(Node):
     return_type: TypeRef | None = None
     is_global: bool = False
     end_line: int = field(default=0, compare=False, repr=False, kw_only=True)   # END/ENDFCT line
+    # the first line not understood that leaves the routine's blocks in doubt (a block's opener
+    # or closer, END itself: the statements after it may belong elsewhere), else 0; a run does
+    # not enter such a routine (interp/runtime ``not_understood``)
+    broken: int = field(default=0, compare=False, repr=False, kw_only=True)
 
     @property
     def is_function(self) -> bool:
@@ -705,6 +721,10 @@ class Module(Node):
     headers: list[str] = field(default_factory=list)
     routines: list[Routine] = field(default_factory=list)
     data: DataList | None = None
+    # a file with syntax errors: the lines its AST does not hold (krl/ast/coverage.py) and the
+    # code lines counted, so that a tool says "N of M understood"; both empty for a file that parses
+    unparsed: list[int] = field(default_factory=list, compare=False, repr=False, kw_only=True)
+    code_lines: int = field(default=0, compare=False, repr=False, kw_only=True)
 
     @property
     def name(self) -> str:

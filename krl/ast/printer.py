@@ -195,6 +195,8 @@ def decl(d: N.Decl) -> str:
         return f"IMPORT {d.type_name} {d.name} IS /{parts[0]}/{parts[1]}..{parts[2]}"
     if isinstance(d, N.ChannelDecl):
         return f"CHANNEL :{d.name} :{d.device} {d.param}"
+    if isinstance(d, N.Unparsed):
+        return d.text
     raise TypeError(f"not a declaration: {type(d).__name__}")
 
 
@@ -377,6 +379,10 @@ def _s_DeclStmt(s, ind: str, level: int):
 
 def _s_Unsupported(s, ind: str, level: int):
     return [ind + line for line in s.text.splitlines()] or [ind]
+
+
+def _s_Unparsed(s, ind: str, level: int):
+    return [ind + s.text]
 
 
 

@@ -89,6 +89,8 @@ def run_check(paths: list[str], as_json: bool = False, no_warnings: bool = False
     from krl.semantics.config import ConfigError, Selection, config_for, parse_codes  # noqa: PLC0415
     # costs 0.003 s at start-up (python -X importtime, 2026-11-25)
     from krl.diagnostics.render import Renderer  # noqa: PLC0415
+    # imported by the check itself (krl.workspace, below): nothing more at start-up
+    from krl.workspace import Workspace, not_understood  # noqa: PLC0415
     fmt = "json" if as_json else fmt
     renderer = Renderer(echo, colour)
     all_shown = []
@@ -96,7 +98,7 @@ def run_check(paths: list[str], as_json: bool = False, no_warnings: bool = False
     any_error = False
     seen: set = set()      # files already checked: `krl check A.src A.dat` checks module A once
 
-    def report(root: str, n_files: int, diags: list) -> None:
+    def report(root: str, n_files: int, diags: list, partial: list = (), named=str) -> None:
         shown = [d for d in diags if d.is_error or not no_warnings]
         if fmt == "json":
             echo(json.dumps({
@@ -104,11 +106,18 @@ def run_check(paths: list[str], as_json: bool = False, no_warnings: bool = False
                 "files": n_files,
                 "errors": sum(d.is_error for d in diags),
                 "warnings": sum(not d.is_error for d in diags),
+                "not_understood": [{"file": named(p.path), "lines": [{"line": n, "message": m} for n, m in p.lines],
+                                    "understood": p.understood, "total": p.total, "noun": p.noun} for p in partial],
                 "diagnostics": [d.as_json() for d in shown],
             }))
         elif fmt == "sarif":
             all_shown.extend(shown)
         else:
+            # the lines not understood first, once each: the rest of each file is checked (issue 63)
+            for p in partial:
+                echo(printable(p.headline("checked", named)))
+                for line in p.details(named):
+                    echo("  " + printable(line))
             renderer.emit(shown)
 
     try:
@@ -132,7 +141,8 @@ def run_check(paths: list[str], as_json: bool = False, no_warnings: bool = False
                                 renderer.sources.add(as_shown(real), read_source(real).text or "")
                             diags = [as_shown.diagnostic(d) for d in diags]
                         any_error |= any(d.is_error for d in diags)
-                        report(as_shown(ws.root), len(ws.files), diags)
+                        partial = not_understood(ws) if isinstance(ws, Workspace) else []
+                        report(as_shown(ws.root), len(ws.files), diags, partial, as_shown)
             except ArchiveError as exc:
                 any_error = True
                 message = str(exc).removeprefix(f"{path}: ")

@@ -24,6 +24,13 @@
   ``WITH`` parameters of the KSS 8 motions (SPTP, SLIN, SCIRC, SPL, spline blocks) and every
   component of the motion data sets (PDAT, LDAT, FDAT records) they name.
 
+A file with syntax errors is compared from what parsed (issue 63): every declaration, value
+and routine it holds; each line not understood (krl.ast.nodes.Unparsed, the file's
+``Module.unparsed``) is compared by its text: ``unparsed`` lists each with its change
+(unchanged, changed, added, removed), and ``partial`` says of each such file how much was
+compared (krl.workspace.NotUnderstood). Only a file that could not be read or parsed at all
+(E001, E005, past a limit) is ``not_compared``, named as its side's file.
+
 A name defined twice (the checker's E102) is compared by its first definition, the one the
 checker keeps; the checker's E102 diagnostics of the compared files are listed in
 ``duplicates``. Names are shown as written (the NEW side's spelling). ``comment_edits`` and
@@ -72,13 +79,18 @@ class Diff:
     comment_edits: int = 0
     fold_edits: int = 0
     files_compared: int = 0
-    unparsed_same: int = 0          # files with syntax errors whose text is the same on both sides
+    unparsed_same: int = 0          # files not read or not parsed whose text is the same on both sides
     not_compared: list[str] = field(default_factory=list)
     left_out: int = 0
+    # the lines not understood of the files compared, by their text (issue 63)
+    unparsed: list[dict] = field(default_factory=list)
+    # of each side's file with lines not understood: {side, file, lines: [{line, message}],
+    # understood, total, noun} (krl.workspace.NotUnderstood)
+    partial: list[dict] = field(default_factory=list)
 
     @property
     def changed(self) -> bool:
-        return any(getattr(self, k) for k in KINDS)
+        return any(getattr(self, k) for k in KINDS) or any(e["change"] != "unchanged" for e in self.unparsed)
 
     def summary(self) -> dict[str, int]:
         """{kind: number of changes} for every kind compared (zeros included)."""
@@ -89,32 +101,40 @@ class Diff:
         out: dict = {"old": self.old, "new": self.new, "changed": self.changed,
                      "summary": {**self.summary(), "files_compared": self.files_compared,
                                  "unparsed_same": self.unparsed_same,
-                                 "not_compared": len(self.not_compared)}}
+                                 "not_compared": len(self.not_compared),
+                                 "not_understood": len(self.unparsed),
+                                 "not_understood_changed": sum(e["change"] != "unchanged" for e in self.unparsed)}}
         for k in KINDS:
             out[k] = getattr(self, k)
         out.update({"duplicates": self.duplicates, "comment_edits": self.comment_edits,
                     "fold_edits": self.fold_edits, "not_compared": self.not_compared,
-                    "left_out": self.left_out})
+                    "left_out": self.left_out, "unparsed": self.unparsed, "not_understood": self.partial})
         return out
 
 
 def diff_sides(old: Side, new: Side, tolerance: float = 0.0) -> Diff:
     """Compare two loaded sides; `tolerance` (mm, deg, or the REAL value's unit) hides smaller
-    differences of REAL values. A file that did not parse on either side is unchanged when
-    its text is the same on both, else listed in ``not_compared`` (its errors are the sides')."""
+    differences of REAL values. A file with syntax errors is compared from what parsed, its
+    lines not understood by their text; a file not read or not parsed at all on either side is
+    unchanged when its text is the same on both, else listed in ``not_compared`` (the side's
+    file that could not be read: its errors are that side's)."""
     d = Diff(old.path, new.path)
     keys = sorted(set(old.files) | set(new.files))
     ok_keys = []
     for k in keys:
         fo, fn = old.files.get(k), new.files.get(k)
-        if (fo is not None and not fo.ok) or (fn is not None and not fn.ok):
+        if not _readable(fo) or not _readable(fn):
             if fo is not None and fn is not None and old.text(k) is not None and old.text(k) == new.text(k):
-                d.unparsed_same += 1    # the same text on both sides: unchanged, though it does not parse
+                d.unparsed_same += 1    # the same text on both sides: unchanged, though it was not parsed
                 continue
-            d.not_compared.append(new.shown(k) if fn is not None else old.shown(k))
+            d.not_compared += [s.shown(k) for s, f in ((old, fo), (new, fn)) if not _readable(f)]
         else:
             ok_keys.append(k)
     d.files_compared = len(ok_keys)
+    for name, s in (("old", old), ("new", new)):
+        d.partial += [{"side": name, "file": s.rel(s.key_of(p.path)), "lines": [{"line": n, "message": m} for n, m in p.lines],
+                       "understood": p.understood, "total": p.total, "noun": p.noun}
+                      for p in s.not_understood if s.key_of(p.path) in ok_keys]
     values_old, values_new = _all_values(old), _all_values(new)
     records_old, records_new = _records(old, values_old), _records(new, values_new)
     for k in ok_keys:
@@ -144,13 +164,48 @@ def diff_sides(old: Side, new: Side, tolerance: float = 0.0) -> Diff:
             mk = _module_key(k)
             _motions(d, show, a, b, (records_old.get(mk, {}), records_old["*"]),
                      (records_new.get(mk, {}), records_new["*"]), tolerance)
+    for k in ok_keys:
+        _unparsed(d, old, new, k)
     _duplicates(d, old, new, set(ok_keys))
-    for name in (*KINDS, "duplicates"):
+    for name in (*KINDS, "duplicates", "unparsed"):
         items = getattr(d, name)
         if len(items) > MAX_DIFF_ENTRIES:
             d.left_out += len(items) - MAX_DIFF_ENTRIES
             del items[MAX_DIFF_ENTRIES:]
     return d
+
+
+def _readable(f) -> bool:
+    """A file of a side that was read and parsed (with or without syntax errors), or absent."""
+    return f is None or f.status in ("ok", "syntax_error")
+
+
+def _unparsed(d: Diff, old: Side, new: Side, k: str) -> None:
+    """The lines not understood of the file `k` on either side, compared by their text (spaces
+    collapsed): the same text in the same order is unchanged, a text replaced by another at its
+    place changed, the rest added or removed."""
+    def lines(s: Side) -> list[tuple[int, str]]:
+        f = s.files.get(k)
+        if f is None or not f.module.unparsed:
+            return []
+        return [(n, s.line(f.path, n)) for n in f.module.unparsed]
+    a, b = lines(old), lines(new)
+    if not a and not b:
+        return
+    show = new.rel(k) if k in new.files else old.rel(k)
+    ka, kb = [" ".join(t.split()).upper() for _, t in a], [" ".join(t.split()).upper() for _, t in b]
+    sm = difflib.SequenceMatcher(None, ka, kb, autojunk=False)
+    for op, i1, i2, j1, j2 in sm.get_opcodes():
+        pairs = list(zip(range(i1, i2), range(j1, j2))) if op in ("equal", "replace") else []
+        for i, j in pairs:
+            d.unparsed.append({"file": show, "line": b[j][0], "old_line": a[i][0], "text": b[j][1],
+                               "old_text": a[i][1], "change": "unchanged" if op == "equal" else "changed"})
+        for i in range(i1 + len(pairs), i2):
+            d.unparsed.append({"file": show, "line": a[i][0], "old_line": a[i][0], "text": None,
+                               "old_text": a[i][1], "change": "removed"})
+        for j in range(j1 + len(pairs), j2):
+            d.unparsed.append({"file": show, "line": b[j][0], "old_line": None, "text": b[j][1],
+                               "old_text": None, "change": "added"})
 
 
 def _routines(m: N.Module | None) -> dict[str, N.Routine]:
@@ -437,9 +492,10 @@ def _routine(d: Diff, old: Side, new: Side, show: str, module: str, a: N.Routine
 # ---------------------------------------------------------------------- motion parameters
 
 def _all_values(s: Side) -> dict[str, list[DataValue]]:
-    """{file key: the values of its data list} of the files that parsed."""
+    """{file key: the values of its data list} of the files read (with or without syntax errors:
+    the values that parsed)."""
     return {k: data_values(f.module.data, s.lines(k)) for k, f in s.files.items()
-            if f.ok and f.module.data is not None}
+            if _readable(f) and f.module.data is not None}
 
 
 def _records(s: Side, values: dict[str, list[DataValue]]) -> dict[str, dict[str, DataValue]]:

@@ -11,7 +11,8 @@ and ``s.duplicates`` holds the workspace's facts of the names declared twice (th
 E102: ``Workspace.declared_twice``, krl/semantics/checker.py ``DeclaredTwice``) with their file
 keys. Of two files whose paths differ only in letter case (impossible on the
 controller), the first in walk order is compared and the other is an E102 there too;
-``s.shown(key)`` is how the user names it (``backup.zip/R1/Program/a.src``); ``s.errors`` the
+``s.shown(key)`` is how the user names it (``backup.zip/R1/Program/a.src``); ``s.not_understood``
+the files with lines not understood (krl.workspace.NotUnderstood, issue 63); ``s.errors`` the
 input and syntax errors (:class:`krl.diagnostics.Diagnostic`, paths as shown; ``s.sources`` the
 text of an archive's files that have errors, by shown path, for the caret lines). An extracted archive is removed
 when the block ends. Raises :class:`DiffInputError` for a path that does not exist or a refused
@@ -32,7 +33,7 @@ from krl.limits import PARSE_TIMEOUT_S
 from krl.parsecache import through_store
 from krl.project import find_backups
 from krl.source import read_source
-from krl.workspace import SourceFile, Workspace, load_workspace
+from krl.workspace import SourceFile, Workspace, load_workspace, not_understood
 
 __all__ = ["DiffInputError", "Side", "side"]
 
@@ -58,7 +59,16 @@ class Side:
     shown_of: object = None
     sources: dict[str, str] = field(default_factory=dict)     # shown path -> text, for the errors
     duplicates: list[tuple[Diagnostic, str]] = field(default_factory=list)
+    # the files with lines not understood (krl.workspace.NotUnderstood), in file order
+    not_understood: list = field(default_factory=list)
     _lines: dict[str, list[str]] = field(default_factory=dict)
+    _keys: dict[str, str] = field(default_factory=dict)
+
+    def key_of(self, path: str) -> str:
+        """The key of the file at `path` (one of :attr:`files`' values)."""
+        if not self._keys:
+            self._keys = {f.path: k for k, f in self.files.items()}
+        return self._keys.get(path, "")
 
     def shown(self, key: str) -> str:
         """The file of `key` as the user names it."""
@@ -132,6 +142,7 @@ def side(path: str | Path, single: bool | None = None, timeout: float | None = N
                 key = "" if is_file else _key(f.path, root, folder)
                 s.files.setdefault(key, f)
             errors = [d for d in ws.sink.sorted() if d.is_error]      # input and syntax errors
+            s.not_understood = not_understood(ws)      # before check_only: of every file
             ws.check_only = set()     # declarations only (names, types, E102): no routine body is checked
             ws.check(resolve=False)   # and no storage placed: the diff never runs the program
             keys = {f.path: k for k, f in s.files.items()}

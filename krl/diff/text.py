@@ -13,7 +13,8 @@ from krl.diff.core import KIND_TITLES, KINDS, Diff
 from krl.render import render_html
 from krl.terminal import printable
 
-__all__ = ["diff_text", "diff_html", "format_delta", "format_coordinates", "html_helpers", "krl_text", "summary_line"]
+__all__ = ["diff_text", "diff_html", "format_delta", "format_coordinates", "html_helpers", "krl_text", "summary_line",
+           "partial_lines"]
 
 _UNITS = {"X": "mm", "Y": "mm", "Z": "mm", "A": "deg", "B": "deg", "C": "deg"}
 
@@ -44,6 +45,28 @@ def format_coordinates(coords: dict) -> str:
     return ", ".join(f"{c} {krl_text(v)}" for c, v in coords.items())
 
 
+def partial_lines(d: Diff) -> list[tuple[str, dict]]:
+    """(which side: "old", "new" or "both", entry of ``d.partial``) of each file with lines not
+    understood; a file whose lines and counts are the same on both sides is named once."""
+    def key(e: dict) -> tuple:
+        return (e["file"].lower(), tuple((x["line"], x["message"]) for x in e["lines"]), e["understood"], e["total"])
+    new = {key(e) for e in d.partial if e["side"] == "new"}
+    old = {key(e) for e in d.partial if e["side"] == "old"}
+    out = []
+    for e in d.partial:
+        if e["side"] == "old" and key(e) in new:
+            continue
+        out.append(("both" if e["side"] == "new" and key(e) in old else e["side"], e))
+    return out
+
+
+def headline(e: dict, verb: str = "compared") -> str:
+    """``FILE:LINE[, LINE...] not understood: N of M declarations compared`` of a ``Diff.partial`` entry."""
+    nums = [str(x["line"]) for x in e["lines"]]
+    where = ", ".join(nums[:8]) + (f" and {len(nums) - 8} more lines" if len(nums) > 8 else "")
+    return f"{e['file']}:{where} not understood: {e['understood']:,} of {e['total']:,} {e['noun']} {verb}"
+
+
 def summary_line(d: Diff) -> str:
     """Every kind compared with its count, then the edits that are not changes and the files
     not compared."""
@@ -51,8 +74,10 @@ def summary_line(d: Diff) -> str:
     out = f"compared {d.files_compared} file(s): {counts}"
     if d.unparsed_same:
         out += f"; {d.unparsed_same} file(s) with syntax errors unchanged (the same text)"
+    if d.unparsed:
+        out += f"; {len(d.unparsed)} line(s) not understood, compared by their text"
     if d.not_compared:
-        out += f"; {len(d.not_compared)} file(s) not compared (syntax errors)"
+        out += f"; {len(d.not_compared)} file(s) not compared (not read or not parsed)"
     return out + f"; {d.comment_edits} comment and {d.fold_edits} fold line(s) edited (not changes)"
 
 
@@ -60,6 +85,12 @@ def diff_text(d: Diff) -> list[str]:
     """The report as lines: one section per non-empty list, in the order of the issue."""
     p = printable
     out: list[str] = []
+    for side, e in partial_lines(d):
+        out.append(f"{side}: {p(headline(e))}")
+        for x in e["lines"][:8]:
+            out.append(f"  {p(e['file'])}:{x['line']}: {p(x['message'])}")
+        if len(e["lines"]) > 8:
+            out.append(f"  ... and {len(e['lines']) - 8} more lines not understood")
     if d.points:
         out.append(f"Points ({len(d.points)}):")
         for e in d.points:
@@ -121,8 +152,16 @@ def diff_text(d: Diff) -> list[str]:
         out.append(f"Duplicate definitions, compared by the first as krl check does ({len(d.duplicates)}):")
         for e in d.duplicates:
             out.append(f"  {e['side']} {p(e['file'])}:{e['line']}: {e['code']} {p(e['message'])}")
+    if d.unparsed:
+        out.append(f"Lines not understood, compared by their text ({len(d.unparsed)}):")
+        for e in d.unparsed:
+            if e["change"] == "changed":
+                what = f"changed {p(e['old_text'])} -> {p(e['text'])}"
+            else:
+                what = f"{e['change']}: {p(e['text'] if e['text'] is not None else e['old_text'])}"
+            out.append(f"  {p(e['file'])}:{e['line']} {what}")
     for f in d.not_compared:
-        out.append(f"not compared (syntax errors): {p(f)}")
+        out.append(f"not compared (not read or not parsed): {p(f)}")
     if d.left_out:
         out.append(f"... {d.left_out} more entries left out (limit MAX_DIFF_ENTRIES)")
     verdict = ("no change" + (" in the files compared" if d.not_compared else "")) if not d.changed else "changed"
@@ -141,7 +180,8 @@ def html_helpers(link=None) -> dict:
     """The template helpers of the diff section (shared with the change report); `link(file,
     line, side, label)` renders a place (default: as code, without a link)."""
     return {"format_coordinates": format_coordinates, "krl_text": krl_text, "kinds": KINDS,
-            "kind_titles": KIND_TITLES, "summary_line": summary_line, "link": link or _plain_link}
+            "kind_titles": KIND_TITLES, "summary_line": summary_line, "link": link or _plain_link,
+            "partial_lines": partial_lines, "headline": headline}
 
 
 def diff_html(d: Diff) -> str:

@@ -3,9 +3,8 @@
 An :class:`Analysis` is a :class:`krl.workspace.Workspace` after ``check()`` plus, per file, its
 text and lines. The scopes are the front end's (krl/semantics/symbols.py): a position's scope is
 the routine scope of the routine around it (``Workspace.routine_scope``), else the module scope
-of its file, else the global scope. Routines of files with syntax errors are not checked by
-``krl check``; here the workspace types them too (``Workspace.check(partial=True)``), their
-findings not reported, so that names in a partial tree still resolve. After an edit,
+of its file, else the global scope. A file with syntax errors is checked from what parsed, as
+``krl check`` checks it (issue 63), so that names in a partial tree resolve. After an edit,
 :func:`updated` hands the new parse to the workspace, which re-checks what the edit can affect
 (``Workspace.replace``); the language server holds no phase of the check itself.
 """
@@ -132,8 +131,8 @@ class Analysis:
 
 
 def build_analysis(root: str, parsed: list[Parsed], skipped=()) -> Analysis:
-    """Link and check parsed files as one workspace (krl/workspace.py ``Workspace.check``, the
-    routines of files that do not parse typed too); `skipped`: the krl.files entries not read
+    """Link and check parsed files as one workspace (krl/workspace.py ``Workspace.check``, files
+    that do not parse checked from what parsed); `skipped`: the krl.files entries not read
     (links, FIFOs, ...), W002 as in ``krl check``."""
     ws = Workspace(root)
     an = Analysis(root, ws)
@@ -141,7 +140,7 @@ def build_analysis(root: str, parsed: list[Parsed], skipped=()) -> Analysis:
         sf = ws.add_loaded(p.loaded, notify=False)
         an.files[p.path] = FileInfo(p.path, p, sf, split_lines(p.text))
     ws.add_unread(skipped)
-    ws.check(resolve=False, partial=True)
+    ws.check(resolve=False)
     return an
 
 

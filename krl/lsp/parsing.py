@@ -15,7 +15,6 @@ layer says only the whole file can word the errors, the whole file is parsed.
 
 from __future__ import annotations
 
-import re
 import time
 from dataclasses import dataclass
 
@@ -31,9 +30,8 @@ from krl.syntax.folds import fold_diagnostics
 from krl.syntax.messages import syntax_diagnostics
 from krl.syntax.parse import parse_source
 from krl.syntax.pieces import MIN_CHUNKED_LINES, PieceCache, cut, parse_whole
-from krl.workspace import LoadedFile, load_file
+from krl.workspace import LoadedFile, load_file, record_unparsed
 
-_WORD = re.compile(r"[A-Za-z_$][A-Za-z0-9_$]*")
 __all__ = ["MIN_CHUNKED_LINES", "ParseCache", "Parsed", "parse_disk"]
 
 
@@ -69,12 +67,12 @@ class Parsed:
         return self.loaded.unreadable
 
 
-def _failed(status: str, ok: bool, text: str) -> tuple[set, bool]:
+def _failed(status: str, ok: bool, text: str, module: N.Module, diags: list) -> tuple[set, bool]:
     if ok:
         return set(), False
     if status in ("binary", "too_large", "unreadable"):
         return set(), True
-    return {w.upper() for w in _WORD.findall(text)}, False
+    return (record_unparsed(module, text, diags) if text else set()), False
 
 
 def parse_disk(path: str) -> Parsed:
@@ -87,7 +85,7 @@ def parse_disk(path: str) -> Parsed:
 
 def _loaded(path: str, text: str, module: N.Module, ok: bool, status: str, diags: list,
             unreadable: bool = False, seconds: float = 0.0) -> LoadedFile:
-    words, gone = _failed(status, ok, text)
+    words, gone = _failed(status, ok, text, module, diags)
     return LoadedFile(path, module, ok, status, seconds, 0.0, diags, unreadable or gone, words,
                       template_lines(text))
 

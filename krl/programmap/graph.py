@@ -54,8 +54,8 @@ Each node has a *reach* (``Node.reach``, :data:`REACH`): ``controller`` when a r
 controller starts reaches it along the edges (calls, interrupts, triggers, RUN); ``operator``
 when only operator-selectable programs reach it; ``module`` in a folder that is not a backup;
 ``dead`` when nothing reaches a routine of the backup's own (``Node.unreachable``); ``unknown``
-for such a routine whose name a file with syntax errors uses (the checker resolves nothing in
-that file, so whether it calls the routine is not known: never called dead), and what it reaches; ``unused`` for a
+for such a routine whose name a line not understood uses (the checker resolves nothing on that
+line, so whether it calls the routine is not known: never called dead), and what it reaches; ``unused`` for a
 routine of KUKA's system software nothing calls (a library: never dead). A module whose
 routines are reached only by operator selection is listed by :attr:`ProgramMap.operator_only`.
 """
@@ -71,7 +71,7 @@ from pathlib import Path
 from krl.ast import nodes as N
 from krl.ast import printer
 from krl.project import backup_of, program_folder
-from krl.workspace import Workspace, is_kuka_file
+from krl.workspace import Workspace, is_kuka_file, not_understood
 
 __all__ = ["Node", "Edge", "ProgramMap", "build_map", "routine_id", "REACH", "CONTROLLER_KINDS"]
 
@@ -131,6 +131,8 @@ class ProgramMap:
     edges: list[Edge] = field(default_factory=list)
     entries: list[str] = field(default_factory=list)
     unresolved: list[tuple[str, str, str, int]] = field(default_factory=list)
+    # the files with lines not understood (krl.workspace.NotUnderstood): named first by every form
+    not_understood: list = field(default_factory=list)
 
     def node_of(self, routine: N.Routine) -> Node | None:
         """The node of a Routine of the workspace."""
@@ -171,6 +173,9 @@ class ProgramMap:
             "unreachable": [n.id for n in self.unreachable],
             "operator_only": self.operator_only,
             "unresolved": [{"source": s, "name": n, "path": p, "line": ln} for s, n, p, ln in self.unresolved],
+            "not_understood": [{"file": p.path, "lines": [{"line": n, "message": m} for n, m in p.lines],
+                                "understood": p.understood, "total": p.total, "noun": p.noun}
+                               for p in self.not_understood],
         }
 
     _by_decl: dict = field(default_factory=dict, repr=False)
@@ -184,7 +189,7 @@ def routine_id(module: str, name: str) -> str:
 def build_map(ws: Workspace) -> ProgramMap:
     """The program map of `ws` (checked here if it is not yet; see the module docstring)."""
     ws.check(resolve=False)     # the map reads the checker's symbols, never a storage place
-    pm = ProgramMap(ws.root)
+    pm = ProgramMap(ws.root, not_understood=not_understood(ws))
     mains: dict[str, str] = {}            # MODULE -> node id of its main routine
     for u in ws.units:
         if u.src is None:
@@ -201,9 +206,9 @@ def build_map(ws: Workspace) -> ProgramMap:
             if i == 0:
                 mains[u.name.upper()] = nid
     for u in ws.units:
-        if u.src is None or not u.src.ok:
+        if u.src is None:
             continue
-        for r in u.src.module.routines:
+        for r in u.src.module.routines:         # a file with syntax errors: what parsed (issue 63)
             src = pm._by_decl.get(id(r))
             if src is not None:
                 _edges(pm, ws, src, r, u.src.path, mains)
@@ -361,15 +366,10 @@ def _reach(pm: ProgramMap, out: dict[str, list[Edge]], roots: list[str], reach: 
 
 
 def _named_in_unparsed(ws: Workspace) -> set[str]:
-    """The names (upper case) that the ASTs of the workspace's files with syntax errors use as
-    a call or a name: the front end recovers their lines, the checker resolves none of them."""
-    names: set[str] = set()
-    for u in ws.units:
-        if u.src is not None and not u.src.ok:
-            for x in u.src.module.walk():
-                if isinstance(x, (N.Call, N.Name)):
-                    names.add(x.name.upper())
-    return names
+    """The words (upper case) of the lines not understood of the workspace's files: a name
+    among them may be called there, and the checker resolves nothing on those lines (the rest
+    of each file is checked and mapped, issue 63)."""
+    return set(ws.failed_words)
 
 
 def _selectable(main: N.Routine | None) -> bool:

@@ -109,8 +109,12 @@ def to_text(pm: ProgramMap) -> list[str]:
     routines = [n for n in pm.nodes.values() if n.kind == "routine"]
     own = [n for n in routines if not n.kuka]
     where = lambda n: f"{p(_short(n.path, pm.root))}:{n.line}"  # noqa: E731
-    out = [f"{p(pm.root)}: {len(routines)} routines ({len(own)} of its own, {len(routines) - len(own)} of "
-           f"KUKA's system software), {len(pm.edges)} edges"]
+    out = []
+    for part in pm.not_understood:          # first, once each: the rest of each file is mapped (issue 63)
+        out.append(p(part.headline("mapped", lambda f: _short(f, pm.root))))
+        out += ["  " + p(line) for line in part.details(lambda f: _short(f, pm.root))]
+    out.append(f"{p(pm.root)}: {len(routines)} routines ({len(own)} of its own, {len(routines) - len(own)} of "
+               f"KUKA's system software), {len(pm.edges)} edges")
     controller = [pm.nodes[i] for i in pm.entries if pm.nodes[i].entry_kind in CONTROLLER_KINDS]
     modules = [pm.nodes[i] for i in pm.entries if pm.nodes[i].entry_kind == "module"]
     operator = [pm.nodes[i] for i in pm.entries if pm.nodes[i].entry_kind == "operator"]
@@ -138,7 +142,7 @@ def to_text(pm: ProgramMap) -> list[str]:
     out += [f"  {p(n.module)}:{p(n.name)}  {where(n)}" for n in dead]
     unknown = [n for n in own if n.reach == "unknown"]
     if unknown:
-        out.append(f"unknown reach (named in a file with syntax errors): {len(unknown)} routines")
+        out.append(f"unknown reach (named on a line not understood): {len(unknown)} routines")
         out += [f"  {p(n.module)}:{p(n.name)}  {where(n)}" for n in unknown]
     return out
 

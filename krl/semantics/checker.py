@@ -513,7 +513,7 @@ class Checker:
     def s_nothing(self, s: N.Stmt, ctx: _Ctx) -> None:
         """HALT, CONTINUE, ON_ERROR_PROCEED, an unsupported construct: nothing to check."""
 
-    s_Halt = s_Continue = s_OnErrorProceed = s_Unsupported = s_nothing
+    s_Halt = s_Continue = s_OnErrorProceed = s_Unsupported = s_Unparsed = s_nothing
 
     def no_motion_in_submit(self, s: N.Stmt, what: str) -> None:
         if self.submit:

@@ -34,10 +34,20 @@ TRUE_ERRORS = [
      ('Mill_FrameHook3.src:35', 'Mill_FrameHook3.src:67', 'Mill_FrameHook5.src:35', 'Mill_FrameHook5.src:67', 'Mill_LeafGlue.src:42', 'Mill_LeafGlue.src:60')),
     ('khrzysio__KRC4_test/R1/Program/', 'E302', "argument 3 of 'ToolMagazine'",
      'ToolMagazine(eCmd:IN, eSpindle:IN, eTool:OUT) gets an enum literal for its :OUT parameter (2.3)',
-     ('TestMillLock.src:16', 'TestPutTool.src:20')),
+     ('TestMillLock.src:16', 'TestPutTool.src:20',
+      # the unfinished CELL programs (their `TODO` line is not understood; the rest is checked, issue 63)
+      'Mill_FrameHook3.src:39', 'Mill_FrameHook3.src:53', 'Mill_FrameHook5.src:39', 'Mill_FrameHook5.src:53',
+      'Mill_LeafAut3.src:110', 'Mill_LeafAut3.src:135', 'Mill_LeafBottom.src:74', 'Mill_LeafBottom.src:90',
+      'Mill_LeafGlue.src:46', 'Mill_LeafHinge.src:71', 'Mill_LeafHook3.src:43', 'Mill_LeafHook3.src:68',
+      'Mill_LeafHook5.src:43', 'Mill_LeafHook5.src:70')),
     ('khrzysio__KRC4_test/R1/Program/', 'E303', "argument 3 of 'Spindle': INT is not assignable to E_Tool",
      'Spindle(eCmd, eSpindle, eTool) declares `DECL E_Tool eSpindle,eTool` but callers pass an INT rpm (17500): the signature changed and the callers were not updated; ENUM <- INT is no conversion (3.9)',
-     ('LeafMillHandle.src:45', 'LeafMillKey.src:49', 'TestCoordinates.src:75', 'Test_Drill2Step.src:18', 'TestMillDrainage.src:19', 'TestMillLock.src:24', 'Mill_FrameHinge_trash.src:133', 'Mill_FrameHinge_trash.src:147', 'Mill_FrameHinge_trash.src:161')),
+     ('LeafMillHandle.src:45', 'LeafMillKey.src:49', 'TestCoordinates.src:75', 'Test_Drill2Step.src:18', 'TestMillDrainage.src:19', 'TestMillLock.src:24', 'Mill_FrameHinge_trash.src:133', 'Mill_FrameHinge_trash.src:147', 'Mill_FrameHinge_trash.src:161',
+      # the unfinished CELL programs, checked from what parsed (issue 63)
+      'Mill_FrameHook3.src:44', 'Mill_FrameHook3.src:58', 'Mill_FrameHook5.src:44', 'Mill_FrameHook5.src:58',
+      'Mill_LeafAut3.src:125', 'Mill_LeafAut3.src:141', 'Mill_LeafBottom.src:80', 'Mill_LeafBottom.src:96',
+      'Mill_LeafGlue.src:51', 'Mill_LeafHinge.src:77', 'Mill_LeafHook3.src:49', 'Mill_LeafHook3.src:58',
+      'Mill_LeafHook3.src:74', 'Mill_LeafHook5.src:49', 'Mill_LeafHook5.src:58', 'Mill_LeafHook5.src:76')),
     ('khrzysio__KRC4_test/R1/Program/CELL/Frame/Mill_FrameHook3.src', 'E101', "'rScrewHoleDepth'",
      'used but declared nowhere',
      ('Mill_FrameHook3.src:121',)),
@@ -71,6 +81,12 @@ TRUE_ERRORS = [
     ('HugoDanielson__ChinaMilling/KRC/R1/Program/KukaMiling/Moves/FromSt1/st1_st4.src', 'E101', "'(xST1_St4_1|FST1_St4_1|xST1_ST4_10)'",
      'inline-form points of module st1_st4, whose st1_st4.dat is missing from the backup',
      ('st1_st4.src:15', 'st1_st4.src:48', 'st1_st4.src:50')),
+    ('HugoDanielson__ChinaMilling/KRC/R1/Program/KukaMiling/Stations/Station1.src', 'E106', "routine 'getJobNr'",
+     'its header is commented out (`;DEFFCT INT getJobNr()`, line 46) while its ENDFCT stays (E011 at line 85)',
+     ('Station1.src:30',)),
+    ('rawpython__kukaKRLmagic/R1/Program/sample_program.src', 'E106', "routine 'str'",
+     "Python's str() in a file half Python, half KRL (corpus/known-invalid.csv)",
+     ('sample_program.src:73',)),
     ('HugoDanielson__ChinaMilling/KRC/R1/Program/millingcn.src', 'E101', "'t_vel'",
      'declared nowhere (sps.sub mentions t_vel only in comments)',
      ('millingcn.src:24',)),
@@ -125,8 +141,8 @@ def test_no_false_errors(checked, corpus):
             else:
                 unexplained.append(f"{rel}:{d.line}: {d.code} {d.message}")
     assert not unexplained, "\n".join(unexplained)
-    # entries may go unused while the grammar grows: a file that stops parsing (E002) is
-    # not type-checked, so its true errors reappear once the grammar accepts it again
+    # entries may go unused while the grammar grows: a line the grammar does not accept is not
+    # checked (the rest of its file is, issue 63), so its true errors reappear once it parses
     assert used, "no documented true error was found at all"
 
 

@@ -89,7 +89,8 @@ def test_a_hostile_entry_is_refused(body):
 
 
 def test_the_valid_entry_the_hostile_ones_change_decodes():
-    body = [[C._INDEX[C.N.Module], 1, 1, "p", "src", [C._LIST], [C._LIST], None], True, "ok", [], False, [], [], [], []]
+    body = [[C._INDEX[C.N.Module], 1, 1, "p", "src", [C._LIST], [C._LIST], None, [C._LIST], 0], True, "ok", [], False,
+            [], [], [], []]
     lf = C.decode_loaded(msgpack.packb(body, use_bin_type=True), "/w/x.src")
     assert lf.module == C.N.Module("/w/x.src", "src", [], [], None) and lf.ok
 
