@@ -2,8 +2,8 @@
 
 It shares no code with krl/diff: it walks both folders itself, parses every data list with the
 front end (krl.parsecache.load_files, through the one store: AST only, no checker; each distinct content once per
-process), and compares every value declared with an initial value, by the rules docs/diff.md
-states for ``krl diff``:
+process; a file with syntax errors gives what parsed), and compares every value declared with an
+initial value, by the rules docs/diff.md states for ``krl diff``:
 
 * a file is the same file whatever the letter case of its path;
 * a name given twice in one data list is compared by its first definition;
@@ -124,7 +124,8 @@ _PARSED_MAX = 4000
 
 
 def parse_all(paths: list[Path]) -> dict[Path, N.Module | None]:
-    """{path: module AST, None when it did not parse}; each distinct content is parsed once."""
+    """{path: module AST (of what parsed), None when it was not read or not parsed}; each distinct
+    content is parsed once."""
     digest = {p: hashlib.sha256(p.read_bytes()).hexdigest() for p in paths}
     if len(_PARSED) + len(set(digest.values())) > _PARSED_MAX:
         _PARSED.clear()
@@ -136,13 +137,16 @@ def parse_all(paths: list[Path]) -> dict[Path, N.Module | None]:
     # through the one store (krl/store.py): the files `krl diff` parsed a moment before are
     # not parsed again (the parser is the front end's either way; the comparison is this module's)
     for p, lf in zip(todo, load_files(todo, timeout=900.0)):
-        _PARSED[digest[p]] = lf.module if lf is not None and lf.ok else None
+        # a file with syntax errors is compared from what parsed (issue 63): its data list's items;
+        # one not read or not parsed at all (E001, E005, past a limit) is skipped
+        _PARSED[digest[p]] = lf.module if lf is not None and lf.status in ("ok", "syntax_error") else None
     return {p: _PARSED[digest[p]] for p in paths}
 
 
 def compare(old: Path, new: Path) -> tuple[set[tuple[str, str, str]], set[str]]:
     """(changes, files skipped): the value changes between the folders `old` and `new` (see the
-    module docstring), and the .dat files not compared because they do not parse on a side."""
+    module docstring), and the .dat files not compared because a side's could not be read or
+    parsed at all (a file with syntax errors is compared from what parsed)."""
     fo, fn = krl_files(old), krl_files(new)
     dats = sorted(k for k in set(fo) | set(fn) if k.endswith(".dat"))
     modules = parse_all([fo[k] for k in dats if k in fo] + [fn[k] for k in dats if k in fn])

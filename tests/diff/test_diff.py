@@ -209,7 +209,11 @@ def test_cli_json_matches_the_schema_and_exit_status(tmp_path):
     assert "Traceback" not in r.output
 
 
-def test_a_file_with_syntax_errors_is_not_compared_and_named(tmp_path):
+def test_a_file_with_syntax_errors_is_compared_from_what_parsed(tmp_path):
+    """Issue 63: a line the grammar does not accept never hides its file. x.src of the archive
+    has one (`y =`, line 2): the file is compared from what parsed (its routine x, changed by a
+    statement), the line is named first, on its side, with the parser's message and the count
+    (the lines DEF x() and y =: one of two), and compared by its text (added)."""
     a, b = tmp_path / "a", tmp_path / "b"
     for d in (a, b):
         d.mkdir()
@@ -221,25 +225,29 @@ def test_a_file_with_syntax_errors_is_not_compared_and_named(tmp_path):
         for p in sorted(b.iterdir()):
             zf.write(p, p.name)
     r = CliRunner().invoke(main, ["diff", str(a), str(archive)])
-    assert r.exit_code == 2, r.output
-    assert f"not compared (syntax errors): {archive}/x.src" in r.output
-    # the syntax error as krl check prints it, with the archive's path, the line and a caret
-    assert f"{archive}/x.src:2:7: error[E012]: an expression is missing here" in r.output
-    assert " 2 |   y =" in r.output and "Traceback" not in r.output
-    assert "no change in the files compared" in r.output
+    assert r.exit_code == 1, r.output
+    lines = r.output.splitlines()
+    assert lines[:2] == ["new: x.src:2 not understood: 1 of 2 statements compared",
+                         "  x.src:2: an expression is missing here"]
+    assert "  x.src:2 added: y =" in lines and "    + 2: y =" in lines
+    assert "not compared" not in r.output and "Traceback" not in r.output
 
 
 def test_corpus_backup_with_unparsed_files_against_itself_is_no_change(shared_corpus):
-    # three of this backup's files do not parse (kuka_internals.src, kuka_internals.dat,
-    # sample_program.src: krl check's E0xx): the same text on both sides is no change
+    # three of this backup's files have lines the grammar does not accept (kuka_internals.src,
+    # kuka_internals.dat, sample_program.src: krl check's E0xx): compared from what parsed, each
+    # line not understood unchanged by its text; no change
     b = shared_corpus / "rawpython__kukaKRLmagic"
     r = CliRunner().invoke(main, ["diff", "--timeout", "900", str(b), str(b)])
     assert r.exit_code == 0, r.output
     assert "not compared" not in r.output and ": no change;" in r.output
-    assert "; 3 file(s) with syntax errors unchanged (the same text);" in r.output
     r = CliRunner().invoke(main, ["diff", "--timeout", "900", "--format", "json", str(b), str(b)])
-    summary = json.loads(r.stdout)["summary"]
-    assert (summary["unparsed_same"], summary["not_compared"]) == (3, 0)
+    doc = json.loads(r.stdout)
+    assert (doc["summary"]["unparsed_same"], doc["summary"]["not_compared"]) == (0, 0)
+    files = {e["file"] for e in doc["unparsed"]}
+    assert {"kuka_internals.src", "kuka_internals.dat", "R1/Program/sample_program.src"} <= files, files
+    assert doc["unparsed"] and all(e["change"] == "unchanged" for e in doc["unparsed"])
+    assert doc["summary"]["not_understood_changed"] == 0
 
 
 # The nine misses issue 37 saw on a real backup's history, each rebuilt on a small backup in
@@ -297,7 +305,8 @@ def test_the_nine_misses_of_issue_37(tmp_path):
                                "line": 2, "changed": {"PPDAT13.APO_DIST": [500.0, 200.0]}}]
     # 3. the summary names every kind compared, zeros included
     assert doc["summary"] == {"points": 0, "frames": 0, "values": 6, "routines": 0, "declarations": 1, "motions": 1,
-                              "files_compared": 5, "unparsed_same": 0, "not_compared": 0}
+                              "files_compared": 5, "unparsed_same": 0, "not_compared": 0, "not_understood": 0,
+                              "not_understood_changed": 0}
     # 4. F_TRIG defined twice: the first compared (no false "retyped"), the checker's E102 named
     assert [d["name"] for d in doc["declarations"]] == ["WEAV_DEF"]
     assert [(d["side"], d["file"], d["line"], d["code"]) for d in doc["duplicates"]] == [
