@@ -134,11 +134,15 @@ def load_parsed(src: SourceText, raw: bytes | None = None) -> LoadedFile:
 def record_unparsed(module: N.Module, text: str, diagnostics) -> set[str]:
     """For a file with syntax errors: set ``module.unparsed`` and ``module.code_lines`` (the lines
     its AST lacks: the lines of its syntax diagnostics and the code lines on which no node starts,
-    krl/ast/coverage.py) and return the words of those lines, upper-case: the names the file may
+    krl/ast/coverage.py), move a routine's ``broken`` line to the first syntax finding in it, and
+    return the words of the lines not understood, upper-case: the names the file may
     declare or use where the checker cannot see them (``Workspace.maybe_declared``). One rule for
     ``krl check`` and the language server (krl/lsp/parsing.py)."""
-    module.unparsed, module.code_lines = lines_not_understood(
-        module, text, (d.line for d in diagnostics if d.code in SYNTAX_CODES))
+    syntax = sorted({d.line for d in diagnostics if d.code in SYNTAX_CODES})
+    module.unparsed, module.code_lines = lines_not_understood(module, text, syntax)
+    for r in module.routines:
+        if r.broken:        # the first syntax finding in it (E010 names the opener the parser closed late)
+            r.broken = min((n for n in syntax if r.span.line <= n <= r.broken), default=r.broken)
     lines = text.splitlines()
     return {w.upper() for n in module.unparsed if 0 < n <= len(lines) for w in _WORD.findall(lines[n - 1])}
 

@@ -793,7 +793,7 @@ class Runtime:
         Layout (krl/semantics/resolve.py), planned once (:class:`FramePlan`); the Slot of a
         variable the frame holds itself is made when first used (``Frame.var``)."""
         if routine.broken:
-            raise KrlRuntimeError(not_entered(routine), None, routine.span.file, routine.span.line)
+            raise KrlRuntimeError(not_entered(routine), None, routine.span.file, routine.broken)
         task = self.current_task
         if self.kss.standard and id(routine) in self.kss.standard:
             self.kss.standard_call(routine)

@@ -54,27 +54,31 @@ def test_how_each_entry_point_ends(audited):
     (u,) = data["units"]
     assert (u["name"], u["kind"], u["root"]) == (fleet.name, "folder", str(fleet))
     got = {e["program"]: (e["cause"], e["reason"], e["file"], e["line"]) for e in u["entries"]}
-    # bad.src does not parse: it is no entry point, its error is a finding (below)
+    # bad.src's DEF line parses, so it is a program (issue 63: what parsed is used); its IF has
+    # no ENDIF, so its blocks are in doubt from line 3 on: the run does not enter it and says so,
+    # a gap of the simulator (the E010 is a finding, below)
     assert got == {
         "cell/good.src": ("completed", "completed", "cell/good.src", 3),
         "cell/<i>mark.src": ("completed", "completed", "cell/<i>mark.src", 2),
         "cell/div.src": ("program error", "error", "cell/div.src", 4),
         "cell/spin.src": ("limit", "max_steps", "cell/spin.src", 2),
+        "cell/bad.src": ("interpreter gap", "error", "cell/bad.src", 3),
     }
     errors = [(f["code"], f["file"], f["line"], f["column"]) for f in u["findings"] if f["severity"] == "error"]
     assert errors == [("E010", "cell/bad.src", 3, 3)]
     assert u["status"] == "attention"
     assert [(r["level"], r["text"]) for r in u["reasons"]] == [
-        ("attention", "1 of 4 entry points end in a program error"),
+        ("attention", "1 of 5 entry points end in a program error"),
         ("review", "1 check error"),
-        ("review", "1 of 4 entry points stop at a limit of the audit (starving or looping)"),
+        ("review", "1 of 5 entry points stop at a limit of the audit (starving or looping)"),
+        ("review", "1 of 5 entry points stop at a gap of the simulator"),
     ]
     # the terminal: one line for the folder, then the totals
-    # (good.src and <i>mark.src complete; div.src, spin.src; bad.src's E010)
+    # (good.src and <i>mark.src complete; div.src; spin.src and bad.src; bad.src's E010)
     assert res.output.splitlines()[0] == (
-        f"attention {fleet.name}: 1 check error, 4 entry points (2 completed or intended end, 1 program error, "
-        f"1 limit or gap), 0 motion errors, 0 outputs to review")
-    assert res.output.splitlines()[1] == "0 backups, 1 program folder, 4 entry points: 1 attention, 0 review, 0 ok"
+        f"attention {fleet.name}: 1 check error, 5 entry points (2 completed or intended end, 1 program error, "
+        f"2 limit or gap), 0 motion errors, 0 outputs to review")
+    assert res.output.splitlines()[1] == "0 backups, 1 program folder, 5 entry points: 1 attention, 0 review, 0 ok"
 
 
 def test_the_json_follows_its_schema(audited):
