@@ -17,8 +17,8 @@ template's INI fold such as KR C2's ``;FOLD ARCHTECHDIGITAL INI`` with ``IF ARC2
 for a routine or a type, a KUKA inline form, whose module names the package: ``%MKUKATPGRP``),
 a ``$`` name no table lists. No second rule: every name the checker calls KUKA's stands in,
 in a backup or not, and any other name stays the program's error ("unknown name X", "routine
-X not found"), as on a controller — also one the checker warns about only because a file of
-the program that does not parse mentions it (``Outside.kuka`` False: perhaps the program's own
+X not found"), as on a controller — also one the checker warns about only because a line of
+the program not understood (a syntax error) mentions it (``Outside.kuka`` False: perhaps the program's own
 declaration, in a file the controller could not load either). Besides, a routine the checker resolves whose body nothing of the program holds
 stands in when outside.py's :func:`~krl.semantics.outside.provided_routine` says KUKA's software
 provides it (a routine of the platform tables); a routine an ``EXT``/``EXTFCT`` declaration names
@@ -191,7 +191,7 @@ class SystemSoftware:
     def outside(self) -> dict:
         """(kind, UPPER name) -> why, for every name the checker found outside the backup and
         calls KUKA's (krl/semantics/outside.py ``Unresolved.classify``, ``Outside.kuka``: the
-        checker's one decision; a name only a file that does not parse mentions may be the
+        checker's one decision; a name only a line not understood mentions may be the
         program's own, declared there: it stays the program's error)."""
         if self._outside is None:
             self._outside = kuka_names(self.rt.program)

@@ -127,6 +127,7 @@ def load_map(path: str):
                 n.uses = {(shown(f), name) for f, name in n.uses}
             pm.edges = [replace(e, path=shown(e.path)) for e in pm.edges]
             pm.unresolved = [(s, n, shown(f), ln) for s, n, f, ln in pm.unresolved]
+            pm.not_understood = [replace(p, path=shown(p.path)) for p in pm.not_understood]
             return pm, diags, [shown(f.path) for f in ws.files], lambda shown_path: texts.get(shown_path, [])
     except ArchiveError as exc:
         raise ValueError(f"{path}:1:1: error[E004]: {str(exc).removeprefix(f'{path}: ')}") from None
@@ -188,7 +189,7 @@ def report(backup: str, since: str | None, runs: bool, max_sim_time: float | Non
     # costs 0.28 s at start-up (python -X importtime, 2026-11-25)
     from krl.diff.load import DiffInputError, side  # noqa: PLC0415
     # costs 0.29 s at start-up (python -X importtime, 2026-11-25)
-    from krl.diff.report import findings, relative, report_html, touched_entries  # noqa: PLC0415
+    from krl.diff.report import findings, relative, report_html, touched_entries, unread_lines  # noqa: PLC0415
     # costs 0.23 s at start-up (python -X importtime, 2026-11-25)
     from krl.programmap.render import GraphTooLarge  # noqa: PLC0415
 
@@ -210,6 +211,7 @@ def report(backup: str, since: str | None, runs: bool, max_sim_time: float | Non
                     _run_touched(touched, a, b, max_sim_time, jobs)
                 kw = {"diff": d, "old_findings": findings(diags_old, pm_old.root, lines_old, links),
                       "file_sets": (relative(files_old, pm_old.root), relative(files, pm.root)),
+                      "unread": (unread_lines(pm_old, lines_old), unread_lines(pm, lines)),
                       "old_map": pm_old, "touched": touched, "runs": runs, "max_sim_time": max_sim_time,
                       "new_root": None if b.shown_of.archive else str(b.root),
                       "old_root": None if a.shown_of.archive else str(a.root)}

@@ -127,6 +127,30 @@ def findings_delta(old: list[Finding], new: list[Finding], files: tuple[set[str]
             [f for f in removed if f.file.lower() in new_files or id(f) in keep_out])
 
 
+def unread_lines(pm: ProgramMap, lines: Callable[[str], list[str]]) -> set[tuple[str, str]]:
+    """(file relative to the map's root, lower-case; the line's text, stripped) of every line
+    not understood of the backup of map `pm` (``ProgramMap.not_understood``, paths as shown;
+    `lines(path)`: a file's text lines): where its check could not look (issue 63)."""
+    out: set[tuple[str, str]] = set()
+    for part in pm.not_understood:
+        text = lines(part.path)
+        rel = _rel(part.path, pm.root).lower()
+        for n, _message in part.lines:
+            if 0 < n <= len(text):
+                out.add((rel, text[n - 1].strip()))
+    return out
+
+
+def apart(found: list[Finding], unread: set[tuple[str, str]]) -> tuple[list[Finding], list[Finding]]:
+    """(the findings of `found` on a line the other backup understood, those on a line whose
+    text the other backup has among its lines not understood): a finding the other side's
+    check could not see is no change of the program (issue 63)."""
+    keep, out = [], []
+    for f in found:
+        (out if (f.file.lower(), f.text.strip()) in unread else keep).append(f)
+    return keep, out
+
+
 def relative(paths, root: str) -> set[str]:
     """The paths relative to `root`, lower-case (the files of a backup, for :func:`findings_delta`)."""
     return {_rel(p, root).lower() for p in paths}
@@ -250,15 +274,21 @@ def report_html(backup: str, files: int, new_findings: list[Finding], pm: Progra
                 old_map: ProgramMap | None = None, touched: list[Touched] | None = None,
                 runs: bool = False, max_sim_time: float | None = None,
                 new_root: str | None = None, old_root: str | None = None, links: str = "file",
-                file_sets: tuple[set[str], set[str]] | None = None) -> str:
+                file_sets: tuple[set[str], set[str]] | None = None,
+                unread: tuple[set, set] = (set(), set())) -> str:
     """The page (module docstring). `new_findings`: the check findings of NEW (`files` files);
     `pm` NEW's map; with `diff`: OLD's findings and map, the touched entry points (their
     outcomes filled in when `runs`; `max_sim_time` the runs' limit, s), the two backups'
-    roots (folders on this machine, else None) for the diff's links, and their files
-    (`file_sets`, :func:`relative`, for :func:`findings_delta`)."""
+    roots (folders on this machine, else None) for the diff's links, their files
+    (`file_sets`, :func:`relative`, for :func:`findings_delta`) and their lines not understood
+    (`unread`: OLD's, NEW's, :func:`unread_lines`; a finding on such a line of the other
+    side is listed apart, not as introduced or fixed)."""
     if links not in LINKS:
         raise ValueError(f"links must be one of {', '.join(LINKS)}")
     introduced, removed = findings_delta(old_findings or [], new_findings, file_sets) if diff is not None else ([], [])
+    # findings on lines the other backup did not understand: its check could not see them
+    introduced, newly_read = apart(introduced, unread[0])
+    removed, now_unread = apart(removed, unread[1])
     errors = sum(f.severity == "error" for f in new_findings)
     reach = _reach_changes(old_map, pm) if old_map is not None else {"dead": [], "live": []}
 
@@ -274,6 +304,7 @@ def report_html(backup: str, files: int, new_findings: list[Finding], pm: Progra
         "krl.diff", "report.html.j2", title=f"Change report: {backup}", backup=backup, files=files,
         errors=errors, warnings=len(new_findings) - errors, all_findings=new_findings[:MAX_REPORT_DIAGNOSTICS],
         more=max(0, len(new_findings) - MAX_REPORT_DIAGNOSTICS), introduced=introduced, removed=removed,
+        newly_read=newly_read, now_unread=now_unread,
         limit=MAX_REPORT_DIAGNOSTICS, by_code=_by_code,
         diff=diff, touched=touched or [], changed_runs=changed_runs, runs=runs, run_rows=rows,
         max_sim_time=max_sim_time,

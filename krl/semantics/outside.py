@@ -209,7 +209,7 @@ class Use:
 
 
 #: the evidence of rule 4: the only one that does not say KUKA's software declares the name
-UNPARSED = "a file of this backup that does not parse mentions it"
+UNPARSED = "a line not understood of this backup mentions it"
 
 #: what `krl run` does with a name classified outside the backup (interp/runtime/kss.py), by
 #: kind: the checker's message says it
@@ -249,7 +249,7 @@ class Unresolved:
     """Collects the uses of unresolved names of one workspace (see the module docstring).
 
     `packages`: UPPER name -> (package, source "path:line") from kss.yaml; `maybe_declared`:
-    name -> True when a file of the backup that does not parse mentions it."""
+    name -> True when a line not understood of the backup mentions it."""
 
     packages: dict = field(default_factory=dict)
     maybe_declared: object = None

@@ -335,14 +335,14 @@ def test_a_type_follows_the_checker_in_a_backup_or_not(tmp_path, interp):
 
 
 def test_a_name_only_a_broken_file_mentions_stays_the_programs_error(tmp_path):
-    """The checker warns (W101, rule 4: a file that does not parse mentions it: it may declare
+    """The checker warns (W101, rule 4: a line not understood mentions it: it may declare
     it) but does not call it KUKA's (Outside.kuka False): perhaps the program's own variable,
     in a data list the controller could not load either. The run stops on it, as before."""
     prog = _backup(tmp_path, "DEF weld()\n  IF PART_COUNT > 3 THEN\n    $OUT[1] = TRUE\n  ENDIF\nEND\n",
                    files={"R1/Program/cnt.dat": "DEFDAT cnt PUBLIC\n  DECL GLOBAL INT PART_COUNT = (\nENDDAT\n"})
     out = CliRunner().invoke(main, ["check", str(prog.parents[2])])
     assert "warning[W101]: name 'PART_COUNT' is not declared in this backup (used 1 time; first here): " \
-           "a file of this backup that does not parse mentions it" in out.output, out.output
+           "a line not understood of this backup mentions it" in out.output, out.output
     rt, res, _ = _run(prog)
     assert (res.reason, res.line, res.text) == ("error", 2, "unknown name PART_COUNT")
     assert rt.kss.summary() == []
