@@ -58,11 +58,20 @@ def test_text_form_line_caret_note_help_and_count(t_src):
 
 
 def test_check_prints_the_same_text(t_src):
+    """krl check prints krl parse's diagnostics, after naming the lines not understood first
+    (issue 63): lines 3 (the IF without ENDIF, E010), 4 and 5, once each; of the 5 code lines
+    (DEF, INT i and those three; ENDFOR and END close blocks) 2 are checked."""
     parsed: list[str] = []
     checked: list[str] = []
     run_parse([t_src], echo=parsed.append)
     assert run_check([str(t_src)], echo=checked.append) == 1
-    assert checked == parsed
+    assert checked[:4] == [
+        "t.src:3, 4, 5 not understood: 2 of 5 statements checked",
+        "  t.src:3: missing ENDIF for the IF at line 3",
+        "  t.src:4: `==` compares; to assign use `=`",
+        "  t.src:5: FOR needs TO before the end value, found `3`",
+    ]
+    assert checked[4:] == parsed
 
 
 def _places(diags):
