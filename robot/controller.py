@@ -306,6 +306,9 @@ class Controller:
         # "TOOL", "WORLD" when it has one); None: none
         self.correction = None
         self._q_raw = self._q.copy()
+        #: KUKA's workspace monitoring (robot/workspace.py ``WorkspaceMonitor``), None while no
+        #: workspace can be active (interp/runtime/sysvars.py installs it)
+        self.workspaces = None
 
     def _arm_model(self):
         """The MuJoCo arm, compiled now (its first use) and reset to the axes it would have
@@ -935,6 +938,8 @@ class Controller:
             else:
                 self._tcp_prev = self._tcp_T[:3, 3].copy()
                 self._tcp_T = self._tcp_read_back(qa, self._tool_T, self._base_inv_T)
+        if self.workspaces is not None:
+            self._watch_workspaces(qa)
         if self._cyclic:
             for fn in list(self._cyclic.values()):
                 fn(self)
@@ -1157,6 +1162,20 @@ class Controller:
                 i = max(range(len(step)), key=lambda j: step[j] / lim[j])
                 name = f"A{i + 1}" if i < 6 else f"E{i - 5}"
                 raise RobotError(f"speed limit exceeded {name}: CP path through a singularity")
+
+    def _watch_workspaces(self, qa: np.ndarray) -> None:
+        """KUKA's workspace monitoring at this IPO cycle (robot/workspace.py): the TCP of the main
+        run's ``$TOOL`` in ``$WORLD`` and the axes read back; each state signal that changes is an
+        I/O event (source ``workspace``); a STOP workspace violated stops the robot here, with
+        its message, as a main-run error (the queue discarded, the program stopped)."""
+        p = (self._base_T @ self._tcp_T)[:3, 3]
+        changes, stop = self.workspaces.cycle(p, self.model.axes.components(qa))
+        for name, value in changes:
+            self._events.append(IoEvent(self.time, name, value, "workspace"))
+            if self.trace is not None:
+                self.trace.write("io", self.time, signal=name, value=value, source="workspace")
+        if stop is not None and (self._runs or self._blend is not None or self._pending):
+            self._fault(RobotError(stop))
 
     def _fault(self, err: RobotError) -> np.ndarray:
         mid = self._runs[0].seg.id if self._runs else None

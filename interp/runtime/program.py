@@ -276,6 +276,7 @@ class Program:
         values (a run with --robot); the Mada data list's own variables follow."""
         sv = self.rt.sysvars
         sv.robot_values()
+        sv.start_workspaces()
         if not self.backup:
             return
         for m in self.modules:

@@ -215,6 +215,8 @@ class SysVars:
         ref = self.refs.get(name)
         if ref is not None:
             return ref
+        if name in WORKSPACE_VARS or name in WORKSTATE_SIGNALS:
+            return self._workspace_ref(name)
         info = self.info.get(name)
         if info is None:
             return self._unsimulated(name)
@@ -267,11 +269,94 @@ class SysVars:
         self.refs[name] = ref
         return ref
 
+    # ------------------------------------------------------------------ workspace monitoring
+    def _workspace_ref(self, name: str):
+        """``$WORKSPACE``/``$AXWORKSPACE`` (simulated: robot/workspace.py): the variable the
+        backup's system data list declares (``$custom.dat``, ``$machine.dat``), else one of KSS's
+        type with zero values (mode #OFF); a program that names one may change it, so the
+        monitor watches from then on. ``$WORKSTATEn``/``$AXWORKSTATEn``: the monitor's signal."""
+        if name in WORKSTATE_SIGNALS:
+            ref = ComputedRef(lambda: self._workstate(name), T.BOOL, name)
+        else:
+            d = self.declared.get(name)
+            if d is not None:
+                ref = d[0]
+            else:
+                kss = load_builtins().kss_variables[name]
+                t = make_array(sys_type(kss.type_name) or T.UNKNOWN, kss.dims)
+                self.store[name] = zero_value(t)
+                ref = Slot(self.store, name, t, name)
+            self.refs[name] = ref
+            self._watch_workspaces()
+        self.refs[name] = ref
+        return ref
+
+    def _workstate(self, name: str) -> bool:
+        mon = self.rt.controller.workspaces
+        return bool(mon is not None and mon.signal(name))
+
+    def start_workspaces(self) -> None:
+        """After the data lists are loaded: watch the workspaces when the backup's own
+        declarations make one active (a mode other than #OFF)."""
+        for name in WORKSPACE_VARS:
+            d = self.declared.get(name)
+            if d is not None and any(e is not None for e in _entries(d[0])):
+                self._workspace_ref(name)
+
+    def _watch_workspaces(self) -> None:
+        ctl = self.rt.controller
+        if ctl.workspaces is not None:
+            return
+        # costs 0.001 s at start-up (python -X importtime, 2026-11-26)
+        from robot.workspace import WorkspaceMonitor  # noqa: PLC0415
+
+        refs = self.refs
+
+        def read():
+            cart = _entries(refs["$WORKSPACE"]) if "$WORKSPACE" in refs else ()
+            axis = _entries(refs["$AXWORKSPACE"]) if "$AXWORKSPACE" in refs else ()
+            return cart, axis
+        def state(i: int, value: bool) -> None:      # $WORKSPACE[n].STATE, $AXWORKSPACE[n].STATE
+            ref = refs.get(WORKSPACE_VARS[i // 8])
+            try:
+                st = ref.peek().data[i % 8] if ref is not None else None
+            except KrlRuntimeError:
+                return
+            if isinstance(getattr(st, "f", None), dict) and "STATE" in st.f:
+                st.f["STATE"] = value
+        ctl.workspaces = WorkspaceMonitor(read, ctl.model.axes.model_keys)
+        ctl.workspaces.on_change = state
+
     # ------------------------------------------------------------------ helpers for motion
     def value(self, name: str):
         return self.store[name]
 
     _on_write: dict = {}
+
+
+#: the workspaces the simulator monitors (robot/workspace.py) and their state signals
+WORKSPACE_VARS = ("$WORKSPACE", "$AXWORKSPACE")
+WORKSTATE_SIGNALS = frozenset([f"$WORKSTATE{n}" for n in range(1, 9)] + [f"$AXWORKSTATE{n}" for n in range(1, 9)])
+
+
+def _entries(ref) -> list:
+    """The 8 workspaces of a ``$WORKSPACE``/``$AXWORKSPACE`` reference as robot/workspace.py reads
+    them: None for one whose mode is #OFF or unset, else (mode, {component: number})."""
+    try:
+        arr = ref.peek()
+    except KrlRuntimeError:
+        return [None] * 8
+    out = []
+    for st in getattr(arr, "data", ())[:8]:
+        f = getattr(st, "f", None)
+        mode = f.get("MODE") if f is not None else None
+        name = getattr(mode, "name", None)
+        if not name or name == "OFF":
+            out.append(None)
+            continue
+        out.append((name, {k: float(v) for k, v in f.items()
+                           if k != "MODE" and isinstance(v, (int, float)) and not isinstance(v, bool)}))
+    return out
 
 
 def _where(rt, span) -> str:
