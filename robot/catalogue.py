@@ -31,7 +31,6 @@ from typing import Any
 
 import yaml
 
-from .datalist import DataValue
 from .machine import library_robots
 from .madavalues import MachineDataError
 
@@ -137,56 +136,47 @@ def library_machine_data(model: Model) -> Path | None:
     return None
 
 
-class _Cited(DataValue):
-    """A value of the catalogue: ``where()`` is its source (the description), not a file:line."""
-
-    def __init__(self, name: str, value: Any, source: str) -> None:
-        super().__init__(name, value, source, 0)
-
-    def where(self, index: int | None = None) -> str:
-        return self.file
-
-
-def _values(m: Model) -> dict[str, DataValue]:
+def _values(m: Model) -> dict[str, tuple[Any, str]]:
     g = m.geometry_mm
     src = f"{m.source} (joint origins at A = 0)"
     lim = f"{m.source} (joint limits)"
     vel = f"{m.source} (joint velocities)"
     axes = range(1, 7)
-    vals: dict[str, DataValue] = {
-        "$TRAFONAME": _Cited("$TRAFONAME", f"#{m.key}", f"catalogue: {m.name}"),
-        "$KINCLASS": _Cited("$KINCLASS", "#STANDARD", _STANDARD_ARM),
-        "$NUM_AX": _Cited("$NUM_AX", 6, _STANDARD_ARM),
-        "$TIRORO": _Cited("$TIRORO", dict(X=0.0, Y=0.0, Z=g["TIRORO_Z"], A=0.0, B=0.0, C=0.0), src),
-        "$LENGTH_A": _Cited("$LENGTH_A", g["LENGTH_A"], src),
-        "$LENGTH_B": _Cited("$LENGTH_B", g["LENGTH_B"], src),
-        "$TX3P3": _Cited("$TX3P3", dict(X=g["TX3P3_X"], Y=0.0, Z=g["TX3P3_Z"], A=0.0, B=90.0, C=0.0), src),
-        "$DH_4": _Cited("$DH_4", dict(DHART_A=0.0, DHART_D=0.0, DHART_ALPHA=90.0), _STANDARD_ARM),
-        "$DH_5": _Cited("$DH_5", dict(DHART_A=0.0, DHART_D=0.0, DHART_ALPHA=-90.0), _STANDARD_ARM),
-        "$TFLWP": _Cited("$TFLWP", dict(X=0.0, Y=0.0, Z=g["TFLWP_Z"], A=0.0, B=0.0, C=0.0), src),
-        "$AXIS_DIR": _Cited("$AXIS_DIR", dict(zip(axes, (-1, 1, 1, -1, -1, -1))), _AXIS_DIR),
-        "$SOFTN_END": _Cited("$SOFTN_END", {i: lo for i, (lo, _) in zip(axes, m.limits_deg)}, lim),
-        "$SOFTP_END": _Cited("$SOFTP_END", {i: hi for i, (_, hi) in zip(axes, m.limits_deg)}, lim),
+    vals: dict[str, tuple[Any, str]] = {
+        "$TRAFONAME": (f"#{m.key}", f"catalogue: {m.name}"),
+        "$KINCLASS": ("#STANDARD", _STANDARD_ARM),
+        "$NUM_AX": (6, _STANDARD_ARM),
+        "$TIRORO": (dict(X=0.0, Y=0.0, Z=g["TIRORO_Z"], A=0.0, B=0.0, C=0.0), src),
+        "$LENGTH_A": (g["LENGTH_A"], src),
+        "$LENGTH_B": (g["LENGTH_B"], src),
+        "$TX3P3": (dict(X=g["TX3P3_X"], Y=0.0, Z=g["TX3P3_Z"], A=0.0, B=90.0, C=0.0), src),
+        "$DH_4": (dict(DHART_A=0.0, DHART_D=0.0, DHART_ALPHA=90.0), _STANDARD_ARM),
+        "$DH_5": (dict(DHART_A=0.0, DHART_D=0.0, DHART_ALPHA=-90.0), _STANDARD_ARM),
+        "$TFLWP": (dict(X=0.0, Y=0.0, Z=g["TFLWP_Z"], A=0.0, B=0.0, C=0.0), src),
+        "$AXIS_DIR": (dict(zip(axes, (-1, 1, 1, -1, -1, -1))), _AXIS_DIR),
+        "$SOFTN_END": ({i: lo for i, (lo, _) in zip(axes, m.limits_deg)}, lim),
+        "$SOFTP_END": ({i: hi for i, (_, hi) in zip(axes, m.limits_deg)}, lim),
         # the speeds as machine data carry them (rpm / |N/D| * 6 deg/s), N/D = 6: rpm = deg/s
-        "$VEL_AXIS_MA": _Cited("$VEL_AXIS_MA", dict(zip(axes, m.speeds_deg_s)), vel),
-        "$RAT_MOT_AX": _Cited("$RAT_MOT_AX", {i: {"N": 6, "D": 1} for i in axes}, vel),
-        "$VEL_MA": _Cited("$VEL_MA", {"CP": 3.0, "ORI1": 400.0, "ORI2": 400.0}, _PATH_LIMITS),
-        "$ACC_MA": _Cited("$ACC_MA", {"CP": 10.0, "ORI1": 1000.0, "ORI2": 1000.0}, _PATH_LIMITS),
+        "$VEL_AXIS_MA": (dict(zip(axes, m.speeds_deg_s)), vel),
+        "$RAT_MOT_AX": ({i: {"N": 6, "D": 1} for i in axes}, vel),
+        "$VEL_MA": ({"CP": 3.0, "ORI1": 400.0, "ORI2": 400.0}, _PATH_LIMITS),
+        "$ACC_MA": ({"CP": 10.0, "ORI1": 1000.0, "ORI2": 1000.0}, _PATH_LIMITS),
     }
     return vals
 
 
-def values(m: Model) -> tuple[dict[str, DataValue], dict[str, str]]:
-    """The machine-data values of the entry `m` (robot/mada.py ``machine_from_values`` builds the
-    model from them: ``load_robot``), and the provenance entries that replace the build's (the
-    speeds are the description's, carried as ``$VEL_AXIS_MA`` with ``$RAT_MOT_AX`` N/D = 6)."""
+def values(m: Model) -> tuple[dict[str, tuple[Any, str]], dict[str, str]]:
+    """The machine-data values of the entry `m`, each with its source: variable -> (value, source)
+    (robot/mada.py ``catalogue_robot`` builds the model from them with ``machine_from_values``),
+    and the provenance entries that replace the build's (the speeds are the description's,
+    carried as ``$VEL_AXIS_MA`` with ``$RAT_MOT_AX`` N/D = 6)."""
     return _values(m), {"max_speed_deg_s": f"{m.source} (joint velocities)"}
 
 
 def catalogue_lines() -> list[str]:
     """The lines of ``krl robot list``: each model, its series, reach, axis limits and speeds,
     and the source of every value (the description; machine data of the library where they win)."""
-    # costs 0.003 s at start-up (python -X importtime, 2026-11-26)
+    # costs 0.006 s at start-up (python -X importtime, 2026-11-26)
     from krl.terminal import printable  # noqa: PLC0415
 
     out = [f"{len(models())} KUKA robots (robot/data/catalogue.yaml); --robot takes the name or the $MODEL_NAME "

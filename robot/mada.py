@@ -513,6 +513,16 @@ def robot_of_backup(root: str | Path, shown: str | None = None) -> MachineData |
     return load_mada(f, name)
 
 
+class _Cited(DataValue):
+    """A value of the catalogue: ``where()`` is its source (the description), not a file:line."""
+
+    def __init__(self, name: str, value: Any, source: str) -> None:
+        super().__init__(name, value, source, 0)
+
+    def where(self, index: int | None = None) -> str:
+        return self.file
+
+
 def catalogue_robot(model: "catalogue.Model | str") -> MachineData:
     """The robot of a KUKA model of the catalogue (robot/catalogue.py; a Model or its name): the
     machine data of the project's library when they name the model (machine data win), else the
@@ -522,7 +532,8 @@ def catalogue_robot(model: "catalogue.Model | str") -> MachineData:
     if lib is not None:
         return load_mada(lib)
     vals, cited = catalogue.values(m)
-    built = machine_from_values(vals, None, f"catalogue: {m.name} ({m.source})")
+    built = machine_from_values({k: _Cited(k, v, src) for k, (v, src) in vals.items()}, None,
+                                f"catalogue: {m.name} ({m.source})")
     prov = {k: v for k, v in built.provenance.items() if k not in ("$VEL_AXIS_MA", "$RAT_MOT_AX")}
     return replace(built, name=m.name, provenance={**prov, **cited})
 

@@ -54,7 +54,8 @@ def _vec(v: Sequence[float]) -> str:
 
 def build_mjcf(machine: MachineData | None = None, actuated: bool = False, *,
                kp: float = DEFAULT_KP, kv: float = DEFAULT_KV,
-               timestep: float = DEFAULT_TIMESTEP_S) -> str:
+               timestep: float = DEFAULT_TIMESTEP_S, cell: Any = None,
+               exclude: Sequence[tuple[str, str]] = ()) -> str:
     """MJCF XML (str) of the arm from the machine data (robot-model.md §2, §11).
 
     Bodies ``base_link``, ``link_1`` .. ``link_n`` (n the robot's axis count); joints named as
@@ -69,20 +70,31 @@ def build_mjcf(machine: MachineData | None = None, actuated: bool = False, *,
             ``v<i>`` (kv) per joint, with ``gravcomp`` on the links.
         kp, kv: servo gains (N·m/rad, N·m·s/rad) for the actuated mode.
         timestep: simulation time step, s.
+        cell: the cell's geometry (robot/collision.py ``CellGeometry``) or None: with it the links
+            take part in contacts, the cell's bodies and the floor are geoms of the world, the tool
+            a body on the last link, and the meshes assets (robot/collision.py ``mesh_assets``).
+        exclude: pairs of bodies whose contacts MuJoCo leaves out (``<contact><exclude>``).
     """
     m = machine if machine is not None else load_machine()
     joints = m.joints
     gravcomp = ' gravcomp="1"' if actuated else ""
+    contacts = 'contype="1" conaffinity="1"' if cell is not None else 'contype="0" conaffinity="0"'
     lines = [
         f"<mujoco model={quoteattr(m.name)}>",
         '  <compiler angle="radian" autolimits="true"/>',
         f'  <option timestep="{_f(timestep)}" integrator="implicitfast"/>',
         "  <default>",
-        '    <geom contype="0" conaffinity="0" rgba="1 0.45 0 1" density="1000"/>',
+        f'    <geom {contacts} rgba="1 0.45 0 1" density="1000"/>',
         '    <joint damping="0" armature="0.01"/>',
         "  </default>",
-        "  <worldbody>",
     ]
+    if cell is not None:
+        assets, _ = cell.mesh_assets()
+        if assets:
+            lines += ["  <asset>", assets, "  </asset>"]
+    lines.append("  <worldbody>")
+    if cell is not None:
+        lines += ["    " + g for g in cell.world_geoms()]
     # $ROBROOT in $WORLD (machine data; $NULLFRAME here): MuJoCo's world frame is $WORLD
     rr = frame_to_matrix(m.robroot_frame)
     rx, ry, rz, rw = Rotation.from_matrix(rr[:3, :3]).as_quat()
@@ -107,7 +119,9 @@ def build_mjcf(machine: MachineData | None = None, actuated: bool = False, *,
     lines.append(f'    {pad}<body name="base_link" {rr_attr}>')
     # base column up to the A1 joint origin
     o1 = np.array(joints[0].origin_mm) / 1000.0
-    lines.append(f'      <geom name="base_geom" type="capsule" size="0.07" fromto="0 0 0 {_vec(o1)}" rgba="0.2 0.2 0.2 1"/>')
+    base_bits = ' contype="8" conaffinity="1"' if cell is not None else ""
+    lines.append(f'      <geom name="base_geom" type="capsule" size="0.07" fromto="0 0 0 {_vec(o1)}" '
+                 f'rgba="0.2 0.2 0.2 1"{base_bits}/>')
     indent = "      "
     for i, j in enumerate(joints):
         pos = np.array(j.origin_mm) / 1000.0
@@ -141,6 +155,8 @@ def build_mjcf(machine: MachineData | None = None, actuated: bool = False, *,
     # KUKA flange frame (URDF tool0) on the last link
     fpos = np.array(m.flange_pos_mm) / 1000.0
     lines.append(f'{indent}<site name="tool0" pos="{_vec(fpos)}" quat="{_vec(m.flange_quat_wxyz)}" size="0.01" rgba="0 1 0 1"/>')
+    if cell is not None:
+        lines += [indent + g for g in cell.tool_geom(_vec(fpos), _vec(m.flange_quat_wxyz))]
     for _ in joints:
         indent = indent[:-2]
         lines.append(f"{indent}</body>")
@@ -157,6 +173,10 @@ def build_mjcf(machine: MachineData | None = None, actuated: bool = False, *,
         lines.append("  </actuator>")
     arm_home = [j.kuka_sign * (a / 1000.0 if j.kind == "linear" else math.radians(a)) for j, a in zip(joints, m.home_deg)]
     home = _ext_home(m, arm_home)
+    if exclude:
+        lines.append("  <contact>")
+        lines += [f'    <exclude body1="{a}" body2="{b}"/>' for a, b in exclude]
+        lines.append("  </contact>")
     lines.append("  <keyframe>")
     ctrl = ""
     if actuated:
@@ -270,15 +290,18 @@ class ArmModel:
         machine, model (``mujoco.MjModel``), data (``mujoco.MjData``), xml, actuated.
     """
 
-    def __init__(self, machine: MachineData | None = None, actuated: bool = False, **kw) -> None:
+    def __init__(self, machine: MachineData | None = None, actuated: bool = False, cell: Any = None, **kw) -> None:
         # costs 0.20 s at start-up (python -X importtime, 2026-11-25)
         import mujoco
 
         self._mj = mujoco
         self.machine = machine if machine is not None else load_machine()
         self.actuated = actuated
-        self.xml = build_mjcf(self.machine, actuated, **kw)
-        self.model = mujoco.MjModel.from_xml_string(self.xml)
+        self.xml = build_mjcf(self.machine, actuated, cell=cell, **kw)
+        if cell is not None:
+            self.model = mujoco.MjModel.from_xml_string(self.xml, assets=cell.mesh_assets()[1])
+        else:
+            self.model = mujoco.MjModel.from_xml_string(self.xml)
         self.data = mujoco.MjData(self.model)
         self._qadr = np.array([self.model.joint(j.name).qposadr[0] for j in self.machine.joints])
         self._dadr = np.array([self.model.joint(j.name).dofadr[0] for j in self.machine.joints])

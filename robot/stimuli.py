@@ -73,7 +73,7 @@ from .cellrules import ConditionError, Rule, compile_condition, parse_condition,
 from .machine import library_robots
 
 PHASES = ("start", "blend_start", "blend_end", "end")
-TOP_KEYS = ("stimuli", "rules", "presets", "robot", "sim_time", "start", "network")
+TOP_KEYS = ("stimuli", "rules", "presets", "robot", "sim_time", "start", "network", "geometry", "tool", "floor")
 PRESET_KEYS = ("pgno", "autoext")
 RULE_KEYS = ("when", "after", "set")
 STIMULUS_KEYS = ("at", "when", "set", "delay")
@@ -228,6 +228,7 @@ class Cell:
     sim_time: dict[str, float] = field(default_factory=dict)   # PROGRAM (upper case) -> s it needs
     start: str | None = None       # where the robot stands at the start (interp/run.py start_axes)
     network: Any = None            # net.settings.NetworkSettings: the partners (`network:`, docs/network.md)
+    geometry: Any = None           # robot/collision.py CellGeometry: `geometry:`, `tool:`, `floor:` (issue 64)
 
 
 def _parse_rules(doc: Any, where: _Where, key_where: str) -> list[Rule]:
@@ -292,6 +293,16 @@ def parse_cell(doc: Any, default_reach_mm: float = 0.1, source: str = "") -> Cel
             cell.start = _start(doc["start"], where(doc, "start"))
         if doc.get("stimuli") is not None:
             cell.stimuli = _parse_stimuli(doc["stimuli"], default_reach_mm, where)
+        if any(doc.get(k) is not None for k in ("geometry", "tool", "floor")):
+            # costs 0.006 s at start-up (python -X importtime, 2026-11-26)
+            from .collision import GeometryError, parse_geometry  # noqa: PLC0415
+
+            try:
+                cell.geometry = parse_geometry(doc.get("geometry"), doc.get("tool"), doc.get("floor"),
+                                               Path(source).parent if source else None)
+            except GeometryError as exc:
+                key = next(k for k in ("geometry", "tool", "floor") if doc.get(k) is not None)
+                raise StimulusError(f"{where(doc, key)}: {exc}") from None
         if doc.get("network") is not None:
             # costs 0.20 s at start-up (python -X importtime, 2026-11-25)
             from net.settings import SettingsError, parse_network  # noqa: PLC0415

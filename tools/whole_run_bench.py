@@ -28,6 +28,11 @@ Usage::
 
     python tools/whole_run_bench.py [--baseline CHECKOUT] [--sim-time 600] [--interp vm|tree]
                                     [--only SUBSTRING] [--limit N] [--json OUT] [--corpus DIR]
+                                    [--collision]
+
+``--collision`` makes the measured side check collisions at every IPO cycle (robot/collision.py: the
+robot's links against each other: MuJoCo's contacts over the same geoms a cell adds to; with
+``--baseline`` naming the same checkout the ratio is the cost of checking (issue 64).
 
 Prints one row per entry point (CPU s and simulated s per CPU s of each checkout, the ratio,
 whether the I/O digests and ends agree) and the totals; ``--json`` writes the rows and the
@@ -54,9 +59,11 @@ SIM_TIME_S = 600.0
 
 
 # ---------------------------------------------------------------------------- the worker
-def _run_one(program: Path, sim_time: float, interp: str) -> dict:
+def _run_one(program: Path, sim_time: float, interp: str, collision: bool = False) -> dict:
     """One whole run of `program` with ``--inputs auto`` (module docstring), measured in this
-    process (the checkout first on sys.path)."""
+    process (the checkout first on sys.path); `collision`: with the robot's collision check
+    against itself (robot/collision.py: a cell file's ``floor: false``; the corpus cells' floors
+    are not known, the palletizer works below its base)."""
     from interp.realprograms import REPORT_STEPS, report_run, step_limit  # noqa: PLC0415  (once sys.path names the checkout measured)
     from interp.run import make_runtime  # noqa: PLC0415  (once sys.path names the checkout measured)
     from interp.runtime.scheduler import SUBMIT_BUDGET  # noqa: PLC0415  (once sys.path names the checkout measured)
@@ -71,6 +78,10 @@ def _run_one(program: Path, sim_time: float, interp: str) -> dict:
         rt, _ = make_runtime(program, trace=None, mujoco=False, max_sim_time=sim_time, max_steps=steps,
                              submit=submit, check=False, inputs="auto", robot=robot, interp=interp,
                              robot_budget=SUBMIT_BUDGET if sub else None, observer=RunObserver())
+        if collision:
+            from robot.collision import CellGeometry, CollisionChecker  # noqa: PLC0415  (once sys.path names the checkout measured)
+
+            rt.controller.collision = CollisionChecker(robot, CellGeometry(floor=None))
         c1 = time.process_time()
         res = rt.run()
         c2 = time.process_time()
@@ -109,7 +120,7 @@ def worker(checkout: Path) -> int:
         if not line.strip():
             continue
         req = json.loads(line)
-        row = _run_one(Path(req["program"]), float(req["sim_time"]), req["interp"])
+        row = _run_one(Path(req["program"]), float(req["sim_time"]), req["interp"], bool(req.get("collision")))
         print(json.dumps(row), file=out, flush=True)
     return 0
 
@@ -118,8 +129,9 @@ def worker(checkout: Path) -> int:
 class Worker:
     """A worker process of one checkout (module docstring)."""
 
-    def __init__(self, checkout: Path) -> None:
+    def __init__(self, checkout: Path, collision: bool = False) -> None:
         self.checkout = checkout.resolve()
+        self.collision = collision
         env = dict(os.environ, PYTHONPATH=str(self.checkout))
         self.proc = subprocess.Popen([sys.executable, str(Path(__file__).resolve()), "worker", str(self.checkout)],
                                      cwd=self.checkout, env=env, stdin=subprocess.PIPE, stdout=subprocess.PIPE,
@@ -135,7 +147,8 @@ class Worker:
         return line
 
     def run(self, program: Path, sim_time: float, interp: str) -> dict:
-        self.proc.stdin.write(json.dumps({"program": str(program), "sim_time": sim_time, "interp": interp}) + "\n")
+        self.proc.stdin.write(json.dumps({"program": str(program), "sim_time": sim_time, "interp": interp,
+                                          "collision": self.collision}) + "\n")
         self.proc.stdin.flush()
         return json.loads(self._line())
 
@@ -177,6 +190,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--json", default=None, help="write the rows and the summary here")
     ap.add_argument("--corpus", default=str(CORPUS))
     ap.add_argument("--no-warm-up", action="store_true", help="time the first run of each worker too")
+    ap.add_argument("--collision", action="store_true",
+                    help="the measured checkout checks collisions (the robot against itself, robot/collision.py): "
+                         "with --baseline the same checkout, the cost of checking")
     a = ap.parse_args(argv)
     corpus = Path(a.corpus)
     if not corpus.is_dir():
@@ -193,7 +209,7 @@ def main(argv: list[str] | None = None) -> int:
     sides = [("new", Path(a.checkout))] + ([("base", Path(a.baseline))] if a.baseline else [])
     load0 = os.getloadavg()
     started = datetime.now(timezone.utc)
-    workers = {name: Worker(co) for name, co in sides}
+    workers = {name: Worker(co, collision=a.collision and name == "new") for name, co in sides}
     rows = []
     try:
         if programs and not a.no_warm_up:
