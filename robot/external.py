@@ -61,10 +61,11 @@ class ExternalAxes:
             return np.array([float(e.get(f"E{i}", 0.0)) for i in range(1, self.n + 1)])
         return np.asarray(e, dtype=float)[: self.n]
 
-    def chain(self, kin: ExternalKinematic, e: Sequence[float]) -> np.ndarray:
-        """``ETn(E)``: the flange of the external kinematic `kin` in ``$WORLD`` (4x4, mm)."""
+    def chain(self, kin: ExternalKinematic, e: Sequence[float], root: Sequence[float] | None = None) -> np.ndarray:
+        """``ETn(E)``: the flange of the external kinematic `kin` in ``$WORLD`` (4x4, mm); `root`
+        (X..C) replaces the kinematic's root (``EK``'s ``MACHINE_DEF[].ROOT``)."""
         ev = self.values(e)
-        T = frame_to_matrix(*kin.root)
+        T = frame_to_matrix(*(kin.root if root is None else root))
         links = (kin.frames[0], kin.frames[1], kin.frames[2])
         for k, num in enumerate(kin.axes):
             ax = self.axes[num]

@@ -88,6 +88,8 @@ class MotionLimits:
     base: tuple[float, ...] = (0.0,) * 6
     #: the BASE kinematic the base is linked to (robot/external.py), None: a fixed base
     base_kin: str | None = None
+    #: its root in $WORLD (EK's; None: the machine data's)
+    base_root: tuple[float, ...] | None = None
 
     def as_trace(self) -> dict[str, Any]:
         """The ``limits`` field of a motion ``start`` trace event."""
@@ -95,13 +97,16 @@ class MotionLimits:
                "tool": list(self.tool), "base": list(self.base)}
         if self.base_kin:
             out["base_kin"] = self.base_kin
+            if self.base_root is not None:
+                out["base_root"] = list(self.base_root)
         return out
 
     @staticmethod
     def from_trace(d: dict[str, Any]) -> "MotionLimits":
         return MotionLimits(d.get("path"), tuple(float(v) for v in d["axes"]), d.get("flange"),
                             tuple(float(v) for v in d.get("tool") or (0.0,) * 6),
-                            tuple(float(v) for v in d.get("base") or (0.0,) * 6), d.get("base_kin"))
+                            tuple(float(v) for v in d.get("base") or (0.0,) * 6), d.get("base_kin"),
+                            tuple(float(v) for v in d["base_root"]) if d.get("base_root") else None)
 
 
 def ptp_axis_speeds(params: Any, machine: Any, mode: str = DEFAULT_MODE) -> np.ndarray:
@@ -144,7 +149,7 @@ def motion_limits(req: Any, machine: Any, mode: str = DEFAULT_MODE) -> MotionLim
     flange = T1_SPEED_MM_S if mode == "T1" else None
     return MotionLimits(path, tuple(float(v) for v in axes), flange,
                         tuple(float(v) for v in p.tool), tuple(float(v) for v in p.base),
-                        getattr(p, "base_kin", None))
+                        getattr(p, "base_kin", None), getattr(p, "base_root", None))
 
 
 # ----------------------------------------------------------------------------- checker
@@ -329,8 +334,9 @@ def check_trace(events: Iterable[dict[str, Any]], machine: Any = None, *,
 
                     ext = ExternalAxes(machine)
                     na = kin.n_axes
-                    a = (binv @ inv_pos(ext.chain(ext.base_kins[ml.base_kin], Q[k - 1][na:])) @ F[k - 1] @ tool)[:3, 3]
-                    b = (binv @ inv_pos(ext.chain(ext.base_kins[ml.base_kin], Q[k][na:])) @ F[k] @ tool)[:3, 3]
+                    et = ext.base_kins[ml.base_kin]
+                    a = (binv @ inv_pos(ext.chain(et, Q[k - 1][na:], ml.base_root)) @ F[k - 1] @ tool)[:3, 3]
+                    b = (binv @ inv_pos(ext.chain(et, Q[k][na:], ml.base_root)) @ F[k] @ tool)[:3, 3]
                 else:
                     a = (binv @ F[k - 1] @ tool)[:3, 3]
                     b = (binv @ F[k] @ tool)[:3, 3]

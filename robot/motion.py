@@ -58,6 +58,8 @@ class MotionParams:
         ipo_mode: ``BASE`` or ``TCP`` (external TCP, robot/external_tcp.py).
         base_kin: the BASE kinematic ``$BASE`` is linked to (``"#EASYS"`` .. ``"#EFSYS"``,
             KSS ``EK``; robot/external.py): the base turns with its external axes; None: fixed.
+        base_root: with `base_kin`, the kinematic's root in ``$WORLD`` (``EK``'s first argument,
+            ``MACHINE_DEF[].ROOT``; None: ``$WORLD``): ``$BASE_C(E) = root : ETn(E) : base``.
     """
 
     vel_cp: float = 2.0
@@ -79,6 +81,7 @@ class MotionParams:
     ov_pro: float = 100.0
     ipo_mode: str = "BASE"
     base_kin: str | None = None
+    base_root: Frame6 | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "ori_type", _enum(self.ori_type))

@@ -123,12 +123,13 @@ class RobotModel:
         """The axis vector `q` in KRL's order (robot/axismap.py ``to_krl``)."""
         return self.axes.to_krl(q)
 
-    def linked(self, system: str) -> "RobotModel":
+    def linked(self, system: str, root: Any = None) -> "RobotModel":
         """This model with ``$BASE`` on the BASE kinematic `system` (robot/external.py):
-        ``$BASE_C(E) = ETn(E) : $BASE`` in :meth:`tcp` and :meth:`ik`."""
+        ``$BASE_C(E) = root : ETn(E) : $BASE`` in :meth:`tcp` and :meth:`ik` (`root`: X..C of
+        the kinematic's root, ``EK``'s; None: the machine data's)."""
         if self.ext is None or system not in self.ext.base_kins:
             raise RobotError(f"$BASE linked to {system}: no such external kinematic in $EX_KIN")
-        return _LinkedBase(self, system)
+        return _LinkedBase(self, system, root)
 
     def check_limits(self, q: np.ndarray) -> None:
         """``$SOFTN_END``/``$SOFTP_END`` of A1..An and E1..En (SoftLimitError, reference §8.2)."""
@@ -250,12 +251,13 @@ class RobotModel:
 class _LinkedBase(RobotModel):
     """A :class:`RobotModel` whose ``$BASE`` turns with a BASE kinematic (a turntable)."""
 
-    def __init__(self, model: RobotModel, system: str) -> None:   # noqa: D107 - a view of `model`
+    def __init__(self, model: RobotModel, system: str, root: Any = None) -> None:   # noqa: D107 - a view of `model`
         self.__dict__.update(model.__dict__)
         self._kin_et = model.ext.base_kins[system]               # type: ignore[union-attr]
+        self._root = root
 
     def _et(self, e: np.ndarray) -> np.ndarray:
-        return self.ext.chain(self._kin_et, e)                   # type: ignore[union-attr]
+        return self.ext.chain(self._kin_et, e, self._root)       # type: ignore[union-attr]
 
     def tcp(self, q: np.ndarray, tool_T: np.ndarray, base_inv_T: np.ndarray) -> np.ndarray:
         return RobotModel.tcp(self, q, tool_T, base_inv_T @ inv_pos(self._et(q[self.n:])))
@@ -1071,7 +1073,7 @@ def plan(req: MotionRequest, q_start: np.ndarray, model: RobotModel, *,
         raise RobotError(f"$IPO_MODE=#{p.ipo_mode} is not supported by the simulator")
     q0 = np.asarray(q_start, dtype=float).copy()
     if getattr(p, "base_kin", None) and model.n_ext:
-        model = model.linked(p.base_kin)      # $BASE on a BASE kinematic (robot/external.py)
+        model = model.linked(p.base_kin, getattr(p, "base_root", None))   # $BASE on a BASE kinematic (robot/external.py)
     tool_T = _matrix_of(p.tool)
     base_T = _matrix_of(p.base)
     base_inv = inv_pos(base_T)

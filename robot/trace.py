@@ -45,7 +45,8 @@ SCHEMA: dict[str, list[tuple[str, str]]] = {
                    "an error or a reset discarded it before its end point)"),
         ("limits", "optional dict on phase start: the limits the motion is planned within "
                    "(robot/limits.py): path (TCP mm/s or null), axes (6 deg/s), flange (mm/s "
-                   "or null, T1), tool and base (X..C mm/deg)"),
+                   "or null, T1), tool and base (X..C mm/deg); base_kin and base_root for a base "
+                   "linked to a BASE kinematic (KSS EK)"),
         ("reached", "optional float on phase end of an exact stop: s, when the interpolation reached "
                     "the end point (KUKA Trace's ENDTIME under the program override); the end event, "
                     "the controller's END signal, follows 24-36 ms later (robot/exactstop.py)"),

@@ -1215,7 +1215,7 @@ class Runtime:
             saved.append((ref, old))
             ref.set(value)
         try:
-            return params_from(store)
+            return params_from(store, self.sysvars.base_link())
         finally:
             for ref, old in reversed(saved):
                 if isinstance(ref, Slot):

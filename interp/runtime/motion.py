@@ -37,8 +37,11 @@ def _frame(s: Struct) -> tuple:
 frame_of = _frame     # a FRAME value as (X, Y, Z, A, B, C) mm/deg ($TOOL, $BASE)
 
 
-def params_from(store: dict) -> MotionParams:
-    """A MotionParams snapshot of the system-variable store (unset values: INITMOV defaults)."""
+def params_from(store: dict, link=None) -> MotionParams:
+    """A MotionParams snapshot of the system-variable store (unset values: INITMOV defaults);
+    `link`: ``(system, root, offset)`` when ``$BASE`` is linked to a BASE kinematic (KSS ``EK``:
+    interp/runtime/sysvars.py ``base_link``): the motion's base is then the offset on the
+    kinematic's flange, which turns with its external axes."""
     d = MotionParams()
     vel, acc, apo = store["$VEL"], store["$ACC"], store["$APO"]
     va, aa = store["$VEL_AXIS"].data, store["$ACC_AXIS"].data
@@ -56,7 +59,14 @@ def params_from(store: dict) -> MotionParams:
         circ_type=_enum_name(store["$CIRC_TYPE"], "BASE"),
         ov_pro=_f(store["$OV_PRO"], 100.0),
         ipo_mode=_enum_name(store["$IPO_MODE"], "BASE"),
-    )
+    ) if link is None else _linked(store, link)
+
+
+def _linked(store: dict, link) -> MotionParams:
+    from dataclasses import replace  # noqa: PLC0415 - only for a linked base (a costs 0 s: stdlib loaded)
+
+    system, root, offset = link
+    return replace(params_from(store), base=offset, base_kin=system, base_root=root)
 
 
 def target_of(v, what: str = "motion target") -> dict:

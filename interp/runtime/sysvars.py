@@ -269,6 +269,26 @@ class SysVars:
         self.refs[name] = ref
         return ref
 
+    # ------------------------------------------------------------------ a base on a BASE kinematic
+    #: the last EK result (KSS ``EK(ROOT, MECH_TYPE, OFFSET)``, interp/runtime/natives/geometry.py):
+    #: (system, root, offset, value); ``$BASE`` is linked while it holds that value
+    ek: tuple | None = None
+
+    def base_link(self) -> tuple | None:
+        """``(system, root, offset)`` while ``$BASE`` is the frame an ``EK`` call returned (KSS's
+        bas.src: ``$BASE = EK(MACHINE_DEF[i].ROOT, MACHINE_DEF[i].MECH_TYPE, BASE_DATA[n])`` for a
+        base that ``MACHINE_FRAME_DAT[n]`` measures on an external kinematic), else None."""
+        ek = self.ek
+        if ek is None:
+            return None
+        try:
+            cur = frame_tuple(self.store["$BASE"], "$BASE")
+        except KrlRuntimeError:
+            return None
+        if all(abs(a - b) <= 1e-9 for a, b in zip(cur, ek[3])):
+            return ek[:3]
+        return None
+
     # ------------------------------------------------------------------ workspace monitoring
     def _workspace_ref(self, name: str):
         """``$WORKSPACE``/``$AXWORKSPACE`` (simulated: robot/workspace.py): the variable the

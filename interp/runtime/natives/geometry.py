@@ -10,8 +10,8 @@ and returns START_AXIS: the program is expected to test STATUS.
 from __future__ import annotations
 
 from ..convert import frame_tuple, inv_pos, num
-from ..errors import value_invalid
-from ..sysvars import axis_struct, pos_struct
+from ..errors import KrlRuntimeError, value_invalid
+from ..sysvars import axis_struct, pos_struct, struct_of
 from ..values import UNSET, Struct
 from .registry import Family
 
@@ -57,6 +57,35 @@ def _model_axes(ctl, ax, ext_from=None):
             if v is not UNSET:
                 comps[k] = float(num(v))
     return amap.from_components(comps, fill=ctl.model.from_krl(ctl.axis_act()))
+
+
+@GEOMETRY.native("FRAME EK(FRAME ROOT :IN, MECH_TYPE TYPE :IN, FRAME OFFSET :IN)")
+def _ek(rt, a):
+    """``EK(ROOT, MECH_TYPE, OFFSET)`` (KSS; the BASIS's bas.src links ``$BASE`` with it to the
+    external kinematic a base is measured on: ``$BASE = EK(MACHINE_DEF[i].ROOT,
+    MACHINE_DEF[i].MECH_TYPE, BASE_DATA[n])``): the frame ``ROOT : ETn(E) : OFFSET`` of the BASE
+    kinematic ``TYPE`` (#EASYS..#EFSYS, robot/external.py) at the external axes' actual values,
+    in ``$WORLD``. ``$BASE`` assigned this value is linked: the motions planned with it take the
+    base on the kinematic's flange, turning with it (robot/planner.py ``RobotModel.linked``).
+    A ``TYPE`` the robot has no BASE kinematic of (#ROBOT, #NONE, a missing ET): the run-time
+    error "EK: no external kinematic TYPE in $EX_KIN"."""
+    import numpy as np  # noqa: PLC0415 - robot.frames costs 0.71 s at first import (as FORWARD)
+
+    from robot.frames import frame_to_matrix, matrix_to_frame  # noqa: PLC0415
+
+    ctl = rt.controller
+    root = frame_tuple(a[0].get(), "EK root")
+    kind = a[1].get()
+    system = "#" + str(getattr(kind, "name", kind)).lstrip("#").upper()
+    offset = frame_tuple(a[2].get(), "EK offset")
+    ext = ctl.model.ext
+    if ext is None or system not in ext.base_kins:
+        raise KrlRuntimeError(f"EK: no external kinematic {system} in $EX_KIN")
+    e = ctl.model.axes.ext_part(ctl.model.from_krl(np.asarray(ctl.axis_act(), dtype=float)))
+    T = ext.chain(ext.base_kins[system], e, root) @ frame_to_matrix(*offset)
+    value = tuple(float(v) for v in matrix_to_frame(T))
+    rt.sysvars.ek = (system, root, offset, value)
+    return struct_of("FRAME", dict(zip("XYZABC", value)))
 
 
 INVERSE_NOT_REACHABLE = 3

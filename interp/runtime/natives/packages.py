@@ -19,7 +19,7 @@ _ZERO_OF_USE = ("the zero value of the type its use gives it (KUKA's software st
 
 KSS.stand_in("REAL DIGIN(...)", "0.0 (KUKA's software stand-in, noted once)")
 KSS.stand_in("E6POS GET_SINGUL(...)", "an E6POS of zeros (KUKA's software stand-in, noted once)")
-for _sig in ("ANY EK(...)", "ANY EB(...)", "ANY LK(...)", "ANY TOOL_ADJ(...)", "ANY SYNC(...)"):
+for _sig in ("ANY EB(...)", "ANY LK(...)", "ANY TOOL_ADJ(...)", "ANY SYNC(...)"):   # EK: natives/geometry.py
     KSS.stand_in(_sig, _ZERO_OF_USE)
 
 # KUKA's system modules, known by name only (functions.yaml ``lenient: system``)
