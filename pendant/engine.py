@@ -438,7 +438,8 @@ def acknowledge_all(core: RunEngine) -> int:
 
 
 def jog(core: RunEngine, system: str, axis, step) -> list:
-    """One jog increment in T1 with the program stopped: AXIS (``axis`` 1..6, ``step`` deg) or
+    """One jog increment in T1 with the program stopped: AXIS (``axis`` 1..6 for A1..A6, 7..12 for
+    E1..E6, ``step`` deg or mm) or
     WORLD/BASE/TOOL (``axis`` X, Y, Z, A, B, C, ``step`` mm or deg), as a PTP (axis) or a
     relative LIN under T1's speed limits (robot/limits.py), made by the engine's ``move``."""
     # costs 0.009 s at start-up (python -X importtime, 2026-11-25)
@@ -456,10 +457,17 @@ def jog(core: RunEngine, system: str, axis, step) -> list:
         raise Refused(f"jog: a step of at most {JOG_MAX_STEP:g} mm or deg")
     params = params_from(rt.sysvars.store).with_(ov_pro=100.0)
     if system == "AXIS":
-        if axis not in (1, 2, 3, 4, 5, 6):
-            raise Refused("jog: axis 1..6")
-        target = {f"A{i + 1}": float(v) for i, v in enumerate(rt.controller.axis_setpoint())}
-        target[f"A{axis}"] += float(step)
+        # the robot's axes A1..An and its external axes E1..Em (robot/axismap.py): 1..6 are A1..A6,
+        # 7..12 E1..E6, as KRL's E6AXIS orders them
+        amap = rt.controller.model.axes
+        keys = [f"A{i}" for i in range(1, 7)] + [f"E{i}" for i in range(1, 7)]
+        if not isinstance(axis, int) or isinstance(axis, bool) or not 1 <= axis <= 12 \
+                or keys[axis - 1] not in amap.model_keys:
+            raise Refused(f"jog: axis 1..{amap.n_robot} (A1..A{amap.n_robot})"
+                          + (f" or 7..{6 + amap.n_ext} (E1..E{amap.n_ext})" if amap.n_ext else ""))
+        target = amap.krl_components(rt.controller.axis_setpoint())
+        target = {k: v for k, v in target.items() if k in amap.model_keys}
+        target[keys[axis - 1]] += float(step)
         req = MotionRequest("PTP", target, params)
     else:
         comp = str(axis).upper()

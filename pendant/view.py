@@ -129,14 +129,53 @@ def _base_data(root: Path) -> dict[int, tuple]:
 
 
 def robot_view(machine, inputs: str | None = None) -> dict:
-    """The robot the page draws: its URDF (``krl robot export``'s, robot/urdf.py), $ROBROOT
-    (X..C mm/deg), the joint names in A1..A6 order, and ``start``: where it stands before a
-    program is selected (:func:`start_position`)."""
+    """The robot the page draws: its URDF (``krl robot export``'s, robot/urdf.py: with external
+    kinematics its root is ``$WORLD``, so ``robroot`` is then null), $ROBROOT (X..C mm/deg), the
+    joint names (A1..An, then ``joint_e<n>`` of E1..Em), for each the index of its value in the
+    position's axes (KRL's order, robot/axismap.py) and its unit (``deg`` or ``mm``), the jog keys'
+    names (``A1``.., ``E1``..), the cell's bodies (:func:`cell_view`), and ``start``: where it stands
+    before a program is selected (:func:`start_position`)."""
     # costs 0.36 s at start-up (python -X importtime, 2026-11-25)
     from robot.urdf import build_urdf  # noqa: PLC0415
+    # costs 0.004 s at start-up (python -X importtime, 2026-11-26)
+    from robot.axismap import AxisMap  # noqa: PLC0415
 
-    return {"name": machine.name, "urdf": build_urdf(machine), "robroot": list(machine.robroot_frame),
-            "joints": [j.name for j in machine.joints[:6]], "start": start_position(machine, inputs)}
+    amap = AxisMap.of(machine)
+    joints = [j.name for j in machine.joints] + [f"joint_e{e.number}" for e in machine.external_axes]
+    krl_index = list(range(amap.n_robot)) + [6 + k for k in range(amap.n_ext)]
+    robroot = [0.0] * 6 if machine.external_kinematics else list(machine.robroot_frame)
+    return {"name": machine.name, "urdf": build_urdf(machine), "robroot": robroot,
+            "joints": joints, "axis_index": krl_index, "units": [amap.unit(k) for k in amap.model_keys],
+            "keys": list(amap.model_keys), "cell": cell_view(inputs),
+            "start": start_position(machine, inputs)}
+
+
+def cell_view(inputs: str | None) -> dict | None:
+    """The cell file's geometry as the page draws it (robot/collision.py): ``bodies`` (name, shape
+    box/cylinder/mesh, size mm, frame X..C in $WORLD, an STL's bytes in base64), ``tool`` (the
+    same, its frame on the flange) and ``floor`` (its Z, or null); None without geometry."""
+    if not inputs:
+        return None
+    # costs 0.38 s at start-up (python -X importtime, 2026-11-25)
+    from interp.run import cell_of, is_auto  # noqa: PLC0415
+
+    if is_auto(inputs):
+        return None
+    try:
+        geo = cell_of(inputs).geometry
+    except Exception:  # noqa: BLE001 - a cell file the run refuses shows no cell (the run says why)
+        return None
+    if geo is None:
+        return None
+    import base64  # noqa: PLC0415 - only with a cell's meshes (costs 0 s: stdlib)
+
+    def body(b) -> dict:
+        out = {"name": b.name, "shape": b.shape, "size": list(b.size), "frame": list(b.frame)}
+        if b.shape == "mesh":
+            out["stl"] = base64.b64encode(b.mesh).decode("ascii")
+        return out
+    return {"bodies": [body(b) for b in geo.bodies], "tool": body(geo.tool) if geo.tool is not None else None,
+            "floor": geo.floor}
 
 
 def start_position(machine, inputs: str | None = None) -> dict | None:

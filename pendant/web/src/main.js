@@ -3,6 +3,7 @@
 // Every text that comes from KRL or the workspace is written with textContent, never as markup.
 import * as THREE from 'three';
 import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
+import { STLLoader } from 'three/examples/jsm/loaders/STLLoader.js';
 import URDFLoader from 'urdf-loader';
 
 const $ = (id) => document.getElementById(id);
@@ -107,11 +108,12 @@ for (const b of document.querySelectorAll('#tabs button')) {
 
 function buildJogKeys() {
   const system = $('jog-system').value;
-  const names = system === 'AXIS' ? ['A1', 'A2', 'A3', 'A4', 'A5', 'A6'] : ['X', 'Y', 'Z', 'A', 'B', 'C'];
+  // the robot's axes and its external axes (the robot view's keys: A1..An, E1..Em); E<n> is axis 6 + n
+  const names = system === 'AXIS' ? (P.jogKeys || ['A1', 'A2', 'A3', 'A4', 'A5', 'A6']) : ['X', 'Y', 'Z', 'A', 'B', 'C'];
   const box = $('jog-keys');
   box.replaceChildren();
-  names.forEach((n, i) => {
-    const axis = system === 'AXIS' ? i + 1 : n;
+  names.forEach((n) => {
+    const axis = system === 'AXIS' ? (n[0] === 'E' ? 6 : 0) + parseInt(n.slice(1), 10) : n;
     const jog = (sign) => act('jog', { system, axis, step: sign * parseFloat($('jog-step').value) });
     box.append(el('span', { text: n }),
       el('button', { text: '\u2212', 'data-jog': `${n}-`, onclick: () => jog(-1) }),
@@ -303,6 +305,11 @@ function drawPosition(p) {
       el('th', { text: keys[i] }), el('td', { 'data-pos': keys[i], text: p.pos ? fmt(p.pos[keys[i]], 2) : '—' })));
   }
   if (p.pos) rows.push(el('tr', {}, el('th', { text: 'S' }), el('td', { text: String(p.pos.S) }), el('th', { text: 'T' }), el('td', { text: String(p.pos.T) })));
+  // the external axes E1..Em: KRL's E6AXIS after A6 (the axes' values), as $POS_ACT carries them
+  for (let k = 0; 6 + k < p.axes.length; k++) {
+    rows.push(el('tr', {}, el('th', { text: `E${k + 1}` }), el('td', { 'data-axis': `E${k + 1}`, text: fmt(p.axes[6 + k], 3) }),
+      el('th', { text: '' }), el('td', { text: '' })));
+  }
   const frame = (f) => (f ? keys.map((k) => fmt(f[k], 1)).join(' ') : '—');
   rows.push(el('tr', {}, el('th', { text: '$BASE' }), el('td', { colspan: '3', text: frame(p.base) })));
   rows.push(el('tr', {}, el('th', { text: '$TOOL' }), el('td', { colspan: '3', text: frame(p.tool) })));
@@ -363,11 +370,54 @@ function limb(from, to, radius) {   // a cylinder from one point to another in a
   return mesh;
 }
 
+// the cell file's bodies (robot/collision.py; pendant/view.py cell_view): boxes, cylinders, STL meshes
+// in $WORLD, the tool on the flange, the floor
+const cellGroup = new THREE.Group();
+world.add(cellGroup);
+const cellMaterial = new THREE.MeshStandardMaterial({ color: 0x5f8f63, metalness: 0.1, roughness: 0.8, transparent: true, opacity: 0.75 });
+const toolMaterial = new THREE.MeshStandardMaterial({ color: 0xc8b43c, metalness: 0.3, roughness: 0.5 });
+let toolMesh = null;
+
+function bodyMesh(b, material) {
+  let g;
+  if (b.shape === 'box') g = new THREE.BoxGeometry(b.size[0] / 1000, b.size[1] / 1000, b.size[2] / 1000);
+  else if (b.shape === 'cylinder') {
+    g = new THREE.CylinderGeometry(b.size[0] / 1000, b.size[0] / 1000, b.size[1] / 1000, 32);
+    g.rotateX(Math.PI / 2);        // three's cylinder stands on Y; the cell's on its frame's Z
+  } else {
+    const bytes = Uint8Array.from(atob(b.stl), (c) => c.charCodeAt(0));
+    g = new STLLoader().parse(bytes.buffer);
+    g.scale(0.001, 0.001, 0.001);  // the STL in mm
+  }
+  const m = new THREE.Mesh(g, material);
+  m.matrixAutoUpdate = false;
+  m.matrix.copy(kukaMatrix(b.frame));
+  m.name = b.name;
+  return m;
+}
+
+function drawCell(cell) {
+  cellGroup.clear();
+  P.cellBodies = 0;
+  if (!cell) return;
+  for (const b of cell.bodies) { cellGroup.add(bodyMesh(b, cellMaterial)); P.cellBodies++; }
+  if (typeof cell.floor === 'number') {
+    const floor = new THREE.Mesh(new THREE.PlaneGeometry(6, 6), new THREE.MeshStandardMaterial({ color: 0x3b4650, transparent: true, opacity: 0.35, side: THREE.DoubleSide }));
+    floor.position.set(0, 0, cell.floor / 1000);
+    cellGroup.add(floor);
+  }
+  if (cell.tool && tool0) { toolMesh = bodyMesh(cell.tool, toolMaterial); tool0.add(toolMesh); P.cellBodies++; }
+}
+
 function loadRobot(r) {
   const loader = new URDFLoader();
   loader.parseVisual = false;
   const robot = loader.parse(r.urdf);
   jointNames = r.joints;
+  P.axisIndex = r.axis_index || jointNames.map((_, i) => i);
+  P.axisScale = (r.units || jointNames.map(() => 'deg')).map((u) => (u === 'mm' ? 0.001 : Math.PI / 180));
+  P.jogKeys = r.keys;
+  buildJogKeys();
   robotRoot.clear();
   robotRoot.matrixAutoUpdate = false;
   robotRoot.matrix.copy(kukaMatrix(r.robroot));
@@ -375,7 +425,7 @@ function loadRobot(r) {
   // the URDF has no meshes (machine data hold none): each link drawn as a limb from its joint
   // to the next joint (or the flange), with a joint drum, scaled to the robot's size
   let reach = 0;
-  for (const name of jointNames) reach += robot.joints[name].position.length();
+  for (const name of jointNames) if (!name.startsWith('joint_e')) reach += robot.joints[name].position.length();
   const radius = Math.max(0.03, reach * 0.035);
   for (const name of jointNames) {
     const j = robot.joints[name];
@@ -389,7 +439,8 @@ function loadRobot(r) {
   }
   const first = robot.joints[jointNames[0]];
   const base = limb([0, 0, 0], first.position.toArray(), radius * 1.6);
-  if (base) robot.add(base);
+  // on the link A1 turns on (base_link, which a track carries), not at the URDF's root
+  if (base) (first.parent || robot).add(base);
   tool0 = robot.links.tool0 || null;
   if (tool0) {
     const link6 = tool0.parent && tool0.parent.parent;
@@ -397,17 +448,28 @@ function loadRobot(r) {
     tool0.add(toolFrame);
   }
   P.robot = robot;
+  drawCell(r.cell);
   requestRender();
   const span = Math.max(1.2, reach * 1.05);
   camera.position.set(span * 1.1, span * 0.9, span * 1.2);
   controls.target.set(0, reach * 0.45, 0);
+  if (P.cellBodies) {
+    // the cell's bodies in view too: aim at the middle of the robot's base and the bodies
+    world.updateMatrixWorld(true);
+    const box = new THREE.Box3().setFromObject(cellGroup.children.length ? cellGroup : robotRoot);
+    box.expandByPoint(new THREE.Vector3(0, reach * 0.45, 0));
+    const c = box.getCenter(new THREE.Vector3());
+    const s = Math.max(span, box.getSize(new THREE.Vector3()).length() * 0.6);
+    controls.target.copy(c);
+    camera.position.set(c.x + s * 1.1, c.y + s * 0.9, c.z + s * 1.2);
+  }
   controls.update();
 }
 
 function setAxes(axes, tool, base) {
   if (!P.robot || !axes) return;
-  const d = Math.PI / 180;
-  jointNames.forEach((n, i) => P.robot.setJointValue(n, axes[i] * d));
+  // each joint's value from KRL's order (A1..A6, E1..Em: the robot view's axis_index), deg -> rad, mm -> m
+  jointNames.forEach((n, i) => { const v = axes[P.axisIndex[i]]; if (v !== undefined) P.robot.setJointValue(n, v * P.axisScale[i]); });
   if (tool) { const f = frameArr(tool); toolFrame.matrixAutoUpdate = false; toolFrame.matrix.copy(kukaMatrix(f)); }
   if (base) { const f = frameArr(base); baseFrame.matrixAutoUpdate = false; baseFrame.matrix.copy(kukaMatrix(f)); }
   P.axesShown = axes.slice();
@@ -415,7 +477,13 @@ function setAxes(axes, tool, base) {
 }
 
 // the rendered joint values (deg), read back from the drawn robot: what the page shows
-P.renderedAxes = () => (P.robot ? jointNames.map((n) => (P.robot.joints[n].angle * 180) / Math.PI) : null);
+P.renderedAxes = () => {
+  if (!P.robot) return null;
+  const out = [];
+  jointNames.forEach((n, i) => { out[P.axisIndex[i]] = P.robot.joints[n].angle / P.axisScale[i]; });
+  for (let i = 0; i < out.length; i++) if (out[i] === undefined) out[i] = 0;   // a SCARA's A5, A6
+  return out;
+};
 
 // TCP path: a trail of the drawn TCP, blue on the path, orange inside an approximation
 const MAX_PATH = 20000;

@@ -1,0 +1,69 @@
+"""The pendant shows the cell and the external axes (issue 64): a KR 16-2 on its KL track
+(robot/data/kr16_2_kl1500.dat, named by the cell file) in a cell with a table, a post and a tool
+(the cell file's geometry:/tool:). In Chromium (Playwright): the 3D view draws the three bodies,
+the jog keys include E1, the position panel shows E1, and after one motion that moves E1 the
+drawn track joint stands where the controller's E1 is; the screenshot of that stop is the page
+as docs/pendant/cell-track.png shows it (KRL_UPDATE_SCREENSHOTS=1 writes it anew)."""
+
+from __future__ import annotations
+
+import io
+import os
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from tests.conftest import REPO_ROOT
+from tests.pendant.harness import browser_page, pendant_server, select, wait_drawn, wait_state
+
+pytestmark = pytest.mark.may_skip("chromium is missing and cannot be installed (not root, or apt-get has no network)")
+
+PROG = """DEF track()
+  PTP {A1 0, A2 -90, A3 90, A4 0, A5 60, A6 0, E1 0}
+  PTP {A1 20, A2 -80, A3 100, A4 0, A5 50, A6 0, E1 1200}
+  PTP {A1 0, A2 -90, A3 90, A4 0, A5 60, A6 0, E1 0}
+END
+"""
+CELL = """robot: kr16_2_kl1500
+geometry:
+  - {name: table, box: [800, 600, 40], frame: [2300, 600, 380, 0, 0, 0]}
+  - {name: post, cylinder: [60, 900], frame: [1600, -700, 450, 0, 0, 0]}
+tool: {box: [60, 60, 250], frame: [0, 0, 125, 0, 0, 0]}
+"""
+SHOT = REPO_ROOT / "docs" / "pendant" / "cell-track.png"
+
+
+def test_the_cell_and_the_track_axis_are_drawn(pw, tmp_path):
+    (tmp_path / "track.src").write_text(PROG, encoding="ascii")
+    cell = tmp_path / "cell.yaml"
+    cell.write_text(CELL, encoding="ascii")
+    with pendant_server(tmp_path, "--no-realtime", "--inputs", str(cell)) as url, \
+            browser_page(pw, url, (1400, 900)) as page:
+        assert page.evaluate("() => window.pendant.cellBodies") == 3       # table, post, tool
+        assert page.locator('#jog-keys button[data-jog="E1+"]').count() == 1
+        select(page, "track.src", run_mode="MSTEP", mode="T1")
+        for _ in range(2):
+            before = page.evaluate("() => window.pendant.state.pointers.cycle")
+            page.click("#start")
+            wait_state(page, f"s.state == 'stopped' && s.stop && s.stop.reason == 'step' && s.pointers.cycle > {before}")
+        s = wait_state(page, "s.position.axes.length == 7 && Math.abs(s.position.axes[6] - 1200) < 1e-6")
+        assert page.locator('#position td[data-axis="E1"]').inner_text() == "1200.000"
+        page.wait_for_function("() => { const s = window.pendant.state; return window.pendant.renderedAxes()"
+                               ".every((v, i) => Math.abs(v - s.position.axes[i]) < 1e-3); }")
+        assert abs(page.evaluate("() => window.pendant.renderedAxes()[6]") - s["position"]["axes"][6]) < 1e-3
+        page.evaluate("() => document.activeElement && document.activeElement.blur()")
+        wait_drawn(page)
+        assert page.problems == []
+        png = page.screenshot()
+    if os.environ.get("KRL_UPDATE_SCREENSHOTS") == "1":
+        SHOT.write_bytes(png)
+    assert SHOT.exists(), f"{SHOT} is missing: KRL_UPDATE_SCREENSHOTS=1 writes it"
+    new = np.asarray(Image.open(io.BytesIO(png)).convert("RGB"), dtype=np.int16)
+    old = np.asarray(Image.open(SHOT).convert("RGB"), dtype=np.int16)
+    assert new.shape == old.shape
+    differ = (np.abs(new - old).max(axis=2) > 48).mean()
+    assert differ <= 0.02, f"{differ:.1%} of the pixels differ from {SHOT}; KRL_UPDATE_SCREENSHOTS=1 updates it"
+    # the cell's green and the tool's yellow are in the picture (the bodies are drawn, not only counted)
+    green = ((np.abs(new[..., 0] - 0x5f) < 40) & (np.abs(new[..., 1] - 0x8f) < 40) & (np.abs(new[..., 2] - 0x63) < 40))
+    assert green.mean() > 0.001
