@@ -6,7 +6,7 @@ here; ``krl robot list`` prints the catalogue with each value's source.
 
 Each entry holds the values of a public robot description (kuka_experimental, kroshu's
 kuka_robot_descriptions; the file's header cites them) in the terms of KUKA's machine data, and
-:func:`values` gives them to robot/mada.py (``load_robot``, ``catalogue_robot``), which builds the
+:func:`arm_values` gives them to robot/mada.py (``load_robot``, ``catalogue_robot``), which builds the
 model with ``machine_from_values`` exactly as a backup's ``$machine.dat`` is built: the kinematic family (robot/kinematics/families.py), the OPW
 solution, the limits and the derived values follow from the same code. Provenance
 (``MachineData.provenance``) names the description for every value the entry gives, and the rule
@@ -136,14 +136,18 @@ def library_machine_data(model: Model) -> Path | None:
     return None
 
 
-def _values(m: Model) -> dict[str, tuple[Any, str]]:
-    g = m.geometry_mm
-    src = f"{m.source} (joint origins at A = 0)"
-    lim = f"{m.source} (joint limits)"
-    vel = f"{m.source} (joint velocities)"
+def arm_values(trafo: str, g: dict[str, float], limits, speeds, source: str, trafo_source: str) -> dict[str, tuple[Any, str]]:
+    """The machine-data values of KUKA's standard arm with the geometry `g` (mm: the keys of
+    :attr:`Model.geometry_mm`), axis `limits` and `speeds` (deg, deg/s) from the description
+    `source`, each with its source: variable -> (value, source). robot/mada.py ``build_cited``
+    builds the model from them (this catalogue's entries, a URDF given to ``--robot``:
+    robot/description.py)."""
+    src = f"{source} (joint origins at A = 0)"
+    lim = f"{source} (joint limits)"
+    vel = f"{source} (joint velocities)"
     axes = range(1, 7)
-    vals: dict[str, tuple[Any, str]] = {
-        "$TRAFONAME": (f"#{m.key}", f"catalogue: {m.name}"),
+    return {
+        "$TRAFONAME": (trafo, trafo_source),
         "$KINCLASS": ("#STANDARD", _STANDARD_ARM),
         "$NUM_AX": (6, _STANDARD_ARM),
         "$TIRORO": (dict(X=0.0, Y=0.0, Z=g["TIRORO_Z"], A=0.0, B=0.0, C=0.0), src),
@@ -154,23 +158,14 @@ def _values(m: Model) -> dict[str, tuple[Any, str]]:
         "$DH_5": (dict(DHART_A=0.0, DHART_D=0.0, DHART_ALPHA=-90.0), _STANDARD_ARM),
         "$TFLWP": (dict(X=0.0, Y=0.0, Z=g["TFLWP_Z"], A=0.0, B=0.0, C=0.0), src),
         "$AXIS_DIR": (dict(zip(axes, (-1, 1, 1, -1, -1, -1))), _AXIS_DIR),
-        "$SOFTN_END": ({i: lo for i, (lo, _) in zip(axes, m.limits_deg)}, lim),
-        "$SOFTP_END": ({i: hi for i, (_, hi) in zip(axes, m.limits_deg)}, lim),
+        "$SOFTN_END": ({i: lo for i, (lo, _) in zip(axes, limits)}, lim),
+        "$SOFTP_END": ({i: hi for i, (_, hi) in zip(axes, limits)}, lim),
         # the speeds as machine data carry them (rpm / |N/D| * 6 deg/s), N/D = 6: rpm = deg/s
-        "$VEL_AXIS_MA": (dict(zip(axes, m.speeds_deg_s)), vel),
+        "$VEL_AXIS_MA": (dict(zip(axes, speeds)), vel),
         "$RAT_MOT_AX": ({i: {"N": 6, "D": 1} for i in axes}, vel),
         "$VEL_MA": ({"CP": 3.0, "ORI1": 400.0, "ORI2": 400.0}, _PATH_LIMITS),
         "$ACC_MA": ({"CP": 10.0, "ORI1": 1000.0, "ORI2": 1000.0}, _PATH_LIMITS),
     }
-    return vals
-
-
-def values(m: Model) -> tuple[dict[str, tuple[Any, str]], dict[str, str]]:
-    """The machine-data values of the entry `m`, each with its source: variable -> (value, source)
-    (robot/mada.py ``catalogue_robot`` builds the model from them with ``machine_from_values``),
-    and the provenance entries that replace the build's (the speeds are the description's,
-    carried as ``$VEL_AXIS_MA`` with ``$RAT_MOT_AX`` N/D = 6)."""
-    return _values(m), {"max_speed_deg_s": f"{m.source} (joint velocities)"}
 
 
 def catalogue_lines() -> list[str]:
@@ -202,5 +197,5 @@ def catalogue_lines() -> list[str]:
     return out
 
 
-__all__ = ["CATALOGUE_FILE", "Model", "catalogue_lines", "find", "library_machine_data", "lookup", "model_key",
-           "models", "values"]
+__all__ = ["CATALOGUE_FILE", "Model", "arm_values", "catalogue_lines", "find", "library_machine_data", "lookup",
+           "model_key", "models"]

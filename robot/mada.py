@@ -531,17 +531,26 @@ def catalogue_robot(model: "catalogue.Model | str") -> MachineData:
     lib = catalogue.library_machine_data(m)
     if lib is not None:
         return load_mada(lib)
-    vals, cited = catalogue.values(m)
-    built = machine_from_values({k: _Cited(k, v, src) for k, (v, src) in vals.items()}, None,
-                                f"catalogue: {m.name} ({m.source})")
+    vals = catalogue.arm_values(f"#{m.key}", m.geometry_mm, m.limits_deg, m.speeds_deg_s, m.source,
+                                f"catalogue: {m.name}")
+    return build_cited(m.name, vals, m.source, f"catalogue: {m.name} ({m.source})")
+
+
+def build_cited(name: str, vals: dict, source: str, shown: str) -> MachineData:
+    """The model of machine-data values that each carry their source (robot/catalogue.py
+    ``arm_values``: a catalogue entry, a URDF description): built by :func:`machine_from_values`,
+    its provenance naming each value's source; the axis speeds are the description's."""
+    built = machine_from_values({k: _Cited(k, v, src) for k, (v, src) in vals.items()}, None, shown)
     prov = {k: v for k, v in built.provenance.items() if k not in ("$VEL_AXIS_MA", "$RAT_MOT_AX")}
-    return replace(built, name=m.name, provenance={**prov, **cited})
+    prov["max_speed_deg_s"] = f"{source} (joint velocities)"
+    return replace(built, name=name, provenance=prov)
 
 
 def load_robot(path: str | Path) -> MachineData:
     """The robot model named by ``krl run --robot`` / ``krl robot show``: a robot YAML (the
     layout of robot/data/kr6_r900.yaml), a ``$machine.dat``, a KRC backup folder or a backup
-    ``.zip`` (krl/archive.py checks and extracts it), the name of a robot of the project's
+    ``.zip`` (krl/archive.py checks and extracts it), a robot description (``.urdf``, ``.xacro``:
+    robot/description.py), the name of a robot of the project's
     library (``kr180_r3200_pa``: robot/machine.py ``library_robots``), or a KUKA model's name
     (``"KR 150 R3100-2"``, ``KR150R3100_2``: robot/catalogue.py). Raises :class:`MachineDataError` with a
     clear message for anything else."""
@@ -565,6 +574,11 @@ def load_robot(path: str | Path) -> MachineData:
             raise MachineDataError(f"{p}: not a robot YAML ({type(exc).__name__}: {exc})") from None
     if p.is_file() and p.suffix.lower() == ".dat":
         return load_mada(p)
+    if p.is_file() and p.suffix.lower() in (".urdf", ".xacro"):
+        # costs 0.003 s at start-up (python -X importtime, 2026-11-26; yourdfpy's 0.2 s when it reads)
+        from .description import load_description  # noqa: PLC0415
+
+        return load_description(p)
     if is_archive(p):
         try:
             with backup_source(p) as (folder, _shown):
@@ -585,5 +599,5 @@ def load_robot(path: str | Path) -> MachineData:
     raise MachineDataError(f"{p}: not a robot YAML, $machine.dat, backup folder or backup .zip")
 
 
-__all__ = ["MachineDataError", "RULES", "catalogue_robot", "chain_forward", "chain_to_joints", "load_mada", "load_robot",
+__all__ = ["MachineDataError", "RULES", "build_cited", "catalogue_robot", "chain_forward", "chain_to_joints", "load_mada", "load_robot",
            "machine_from_values", "robot_of_backup"]

@@ -88,10 +88,14 @@ def build_mjcf(machine: MachineData | None = None, actuated: bool = False, *,
         '    <joint damping="0" armature="0.01"/>',
         "  </default>",
     ]
+    meshes = robot_meshes(m)
+    assets = [f'    <mesh name="mesh_{link}" file="robot_{link}.stl"/>' for link in meshes]
     if cell is not None:
-        assets, _ = cell.mesh_assets()
-        if assets:
-            lines += ["  <asset>", assets, "  </asset>"]
+        cell_assets, _ = cell.mesh_assets()
+        if cell_assets:
+            assets.append(cell_assets)
+    if assets:
+        lines += ["  <asset>", *assets, "  </asset>"]
     lines.append("  <worldbody>")
     if cell is not None:
         lines += ["    " + g for g in cell.world_geoms()]
@@ -120,8 +124,11 @@ def build_mjcf(machine: MachineData | None = None, actuated: bool = False, *,
     # base column up to the A1 joint origin
     o1 = np.array(joints[0].origin_mm) / 1000.0
     base_bits = ' contype="8" conaffinity="1"' if cell is not None else ""
-    lines.append(f'      <geom name="base_geom" type="capsule" size="0.07" fromto="0 0 0 {_vec(o1)}" '
-                 f'rgba="0.2 0.2 0.2 1"{base_bits}/>')
+    if "base_link" in meshes:        # the description's mesh (robot/description.py)
+        lines.append(f'      <geom name="base_geom" type="mesh" mesh="mesh_base_link" rgba="0.2 0.2 0.2 1"{base_bits}/>')
+    else:
+        lines.append(f'      <geom name="base_geom" type="capsule" size="0.07" fromto="0 0 0 {_vec(o1)}" '
+                     f'rgba="0.2 0.2 0.2 1"{base_bits}/>')
     indent = "      "
     for i, j in enumerate(joints):
         pos = np.array(j.origin_mm) / 1000.0
@@ -140,7 +147,10 @@ def build_mjcf(machine: MachineData | None = None, actuated: bool = False, *,
         # link geometry: capsule from this joint to the next joint origin (or to the flange)
         nxt = np.array(joints[i + 1].origin_mm) / 1000.0 if i + 1 < len(joints) else None
         radius = 0.06 if i < 3 else 0.045
-        if nxt is not None and np.linalg.norm(nxt) > 1e-6:
+        body = j.child or f"link_{i + 1}"
+        if body in meshes:
+            lines.append(f'{indent}<geom name="link_{i + 1}_geom" type="mesh" mesh="mesh_{body}"/>')
+        elif nxt is not None and np.linalg.norm(nxt) > 1e-6:
             lines.append(f'{indent}<geom name="link_{i + 1}_geom" type="capsule" size="{_f(radius)}" fromto="0 0 0 {_vec(nxt)}"/>')
         else:
             lines.append(f'{indent}<geom name="link_{i + 1}_geom" type="sphere" size="{_f(radius)}"/>')
@@ -185,6 +195,22 @@ def build_mjcf(machine: MachineData | None = None, actuated: bool = False, *,
     lines.append("  </keyframe>")
     lines.append("</mujoco>")
     return "\n".join(lines) + "\n"
+
+
+def robot_meshes(m: MachineData) -> dict[str, bytes]:
+    """The robot's link meshes a description gave (robot/description.py: link name -> STL bytes in
+    the link's frame, metres), {} for a robot of machine data."""
+    raw = getattr(m, "raw", None) or {}
+    meshes = raw.get("meshes") if isinstance(raw, dict) else None
+    return dict(meshes) if isinstance(meshes, dict) else {}
+
+
+def mjcf_assets(m: MachineData, cell: Any = None) -> dict[str, bytes]:
+    """MuJoCo's assets of :func:`build_mjcf`'s model: the robot's meshes and the cell's."""
+    out = {f"robot_{link}.stl": data for link, data in robot_meshes(m).items()}
+    if cell is not None:
+        out.update(cell.mesh_assets()[1])
+    return out
 
 
 def _ext_bodies(lines: list[str], m: MachineData, kin, indent: str) -> int:
@@ -298,8 +324,9 @@ class ArmModel:
         self.machine = machine if machine is not None else load_machine()
         self.actuated = actuated
         self.xml = build_mjcf(self.machine, actuated, cell=cell, **kw)
-        if cell is not None:
-            self.model = mujoco.MjModel.from_xml_string(self.xml, assets=cell.mesh_assets()[1])
+        assets = mjcf_assets(self.machine, cell)
+        if assets:
+            self.model = mujoco.MjModel.from_xml_string(self.xml, assets=assets)
         else:
             self.model = mujoco.MjModel.from_xml_string(self.xml)
         self.data = mujoco.MjData(self.model)

@@ -1,20 +1,23 @@
-"""The pendant shows the cell and the external axes (issue 64): a KR 16-2 on its KL track
+"""The pendant shows the cell, the external axes and a description's meshes (issue 64): a KR 16-2 on its KL track
 (robot/data/kr16_2_kl1500.dat, named by the cell file) in a cell with a table, a post and a tool
 (the cell file's geometry:/tool:). In Chromium (Playwright): the 3D view draws the three bodies,
 the jog keys include E1, the position panel shows E1, and after one motion that moves E1 the
 drawn track joint stands where the controller's E1 is; the screenshot of that stop is the page
-as docs/pendant/cell-track.png shows it (KRL_UPDATE_SCREENSHOTS=1 writes it anew)."""
+as docs/pendant/cell-track.png shows it (KRL_UPDATE_SCREENSHOTS=1 writes it anew). And a real mesh
+robot: kuka_experimental's KR 150 R3100-2 description with its seven collision meshes, drawn with
+them (docs/pendant/mesh-robot.png)."""
 
 from __future__ import annotations
 
 import io
 import os
+import shutil
 
 import numpy as np
 import pytest
 from PIL import Image
 
-from tests.conftest import REPO_ROOT
+from tests.conftest import REPO_ROOT, SHARED
 from tests.pendant.harness import browser_page, pendant_server, select, wait_drawn, wait_state
 
 pytestmark = pytest.mark.may_skip("chromium is missing and cannot be installed (not root, or apt-get has no network)")
@@ -67,3 +70,43 @@ def test_the_cell_and_the_track_axis_are_drawn(pw, tmp_path):
     # the cell's green and the tool's yellow are in the picture (the bodies are drawn, not only counted)
     green = ((np.abs(new[..., 0] - 0x5f) < 40) & (np.abs(new[..., 1] - 0x8f) < 40) & (np.abs(new[..., 2] - 0x63) < 40))
     assert green.mean() > 0.001
+
+
+MESH_SHOT = REPO_ROOT / "docs" / "pendant" / "mesh-robot.png"
+DESCRIPTIONS = SHARED / "robots" / "descriptions" / "kuka_experimental"
+
+
+def test_a_description_with_meshes_is_drawn_with_them(pw, tmp_path):
+    """The KR 150 R3100-2 of kuka_experimental (its xacro and collision meshes, copied beside the
+    cell file: a cell file names a description of its own folder) is drawn with its seven meshes."""
+    if not DESCRIPTIONS.is_dir():
+        pytest.skip("../shared/robots/descriptions is not present")
+    for pkg in ("kuka_kr150_support", "kuka_resources"):
+        shutil.copytree(DESCRIPTIONS / pkg, tmp_path / pkg)
+    (tmp_path / "reach.src").write_text("DEF reach()\n  PTP {A1 30, A2 -70, A3 80, A4 0, A5 40, A6 0}\n"
+                                        "  PTP {A1 0, A2 -90, A3 90, A4 0, A5 0, A6 0}\nEND\n", encoding="ascii")
+    cell = tmp_path / "cell.yaml"
+    cell.write_text("robot: kuka_kr150_support/urdf/kr150r3100_2.xacro\n"
+                    "geometry:\n  - {name: pallet, box: [1200, 800, 150], frame: [2200, 0, 75, 0, 0, 0]}\n",
+                    encoding="ascii")
+    with pendant_server(tmp_path, "--no-realtime", "--inputs", str(cell)) as url, \
+            browser_page(pw, url, (1400, 900)) as page:
+        assert page.evaluate("() => window.pendant.meshLinks") == 7
+        assert page.evaluate("() => window.pendant.cellBodies") == 1
+        select(page, "reach.src", run_mode="MSTEP", mode="T1")
+        before = page.evaluate("() => window.pendant.state.pointers.cycle")
+        page.click("#start")
+        wait_state(page, f"s.state == 'stopped' && s.stop && s.stop.reason == 'step' && s.pointers.cycle > {before}")
+        page.wait_for_function("() => { const s = window.pendant.state; return window.pendant.renderedAxes()"
+                               ".every((v, i) => Math.abs(v - s.position.axes[i]) < 1e-3); }")
+        page.evaluate("() => document.activeElement && document.activeElement.blur()")
+        wait_drawn(page)
+        assert page.problems == []
+        png = page.screenshot()
+    if os.environ.get("KRL_UPDATE_SCREENSHOTS") == "1":
+        MESH_SHOT.write_bytes(png)
+    new = np.asarray(Image.open(io.BytesIO(png)).convert("RGB"), dtype=np.int16)
+    old = np.asarray(Image.open(MESH_SHOT).convert("RGB"), dtype=np.int16)
+    assert new.shape == old.shape
+    differ = (np.abs(new - old).max(axis=2) > 48).mean()
+    assert differ <= 0.02, f"{differ:.1%} of the pixels differ from {MESH_SHOT}; KRL_UPDATE_SCREENSHOTS=1 updates it"

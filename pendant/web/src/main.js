@@ -427,24 +427,36 @@ function loadRobot(r) {
   let reach = 0;
   for (const name of jointNames) if (!name.startsWith('joint_e')) reach += robot.joints[name].position.length();
   const radius = Math.max(0.03, reach * 0.035);
+  // a description's meshes (robot/description.py), in the links' frames, metres; the links without
+  // one are drawn as limbs
+  const meshes = r.meshes || {};
+  P.meshLinks = 0;
+  for (const [link, b64] of Object.entries(meshes)) {
+    const target = robot.links[link];
+    if (!target) continue;
+    const bytes = Uint8Array.from(atob(b64), (c) => c.charCodeAt(0));
+    target.add(new THREE.Mesh(new STLLoader().parse(bytes.buffer), link === 'base_link' ? jointMaterial : linkMaterial));
+    P.meshLinks++;
+  }
   for (const name of jointNames) {
     const j = robot.joints[name];
     j.ignoreLimits = true;
     const child = j.children.find((c) => c.isURDFLink);
     const next = child && child.children.find((c) => c.isURDFJoint);
+    if (child && meshes[child.name]) continue;
     if (child && next) { const m = limb([0, 0, 0], next.position.toArray(), radius); if (m) child.add(m); }
     const drum = new THREE.Mesh(new THREE.CylinderGeometry(radius * 1.25, radius * 1.25, radius * 2.2, 24), jointMaterial);
     drum.quaternion.setFromUnitVectors(new THREE.Vector3(0, 1, 0), j.axis.clone().normalize());
     j.add(drum);
   }
   const first = robot.joints[jointNames[0]];
-  const base = limb([0, 0, 0], first.position.toArray(), radius * 1.6);
+  const base = meshes.base_link ? null : limb([0, 0, 0], first.position.toArray(), radius * 1.6);
   // on the link A1 turns on (base_link, which a track carries), not at the URDF's root
   if (base) (first.parent || robot).add(base);
   tool0 = robot.links.tool0 || null;
   if (tool0) {
     const link6 = tool0.parent && tool0.parent.parent;
-    if (link6) { const m = limb([0, 0, 0], tool0.parent.position.toArray(), radius * 0.7); if (m) link6.add(m); }
+    if (link6 && !meshes[link6.name]) { const m = limb([0, 0, 0], tool0.parent.position.toArray(), radius * 0.7); if (m) link6.add(m); }
     tool0.add(toolFrame);
   }
   P.robot = robot;
