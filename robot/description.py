@@ -28,11 +28,16 @@ from __future__ import annotations
 
 import io
 import math
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from scipy.spatial.transform import Rotation
+
+from .catalogue import arm_values
+from .kinematics import Kinematics
 from .madavalues import MachineDataError
 
 MAX_DESCRIPTION_BYTES = 4 * 1024 * 1024
@@ -56,7 +61,7 @@ def _urdf_text(path: Path) -> str:
         raise MachineDataError(f"{path}: larger than the limit of {MAX_DESCRIPTION_BYTES} bytes")
     if path.suffix.lower() != ".xacro":
         return path.read_text(encoding="utf-8")
-    # costs 0.02 s at start-up (python -X importtime, 2026-11-26)
+    # costs 0.004 s at start-up (python -X importtime, 2026-11-26)
     import xacro  # noqa: PLC0415 - only for a xacro description
     import xacro.substitution_args as subst  # noqa: PLC0415
 
@@ -112,9 +117,6 @@ def _chain(urdf: Any, where: str) -> tuple[list, np.ndarray, list[str]]:
 
 
 def _forward(joints, tool: np.ndarray, axes_deg) -> np.ndarray:
-    # costs 0.0 s: scipy is loaded with robot.frames
-    from scipy.spatial.transform import Rotation  # noqa: PLC0415
-
     T = np.eye(4)
     frames = []
     for (origin, axis, *_), a in zip(joints, axes_deg):
@@ -149,10 +151,11 @@ def _geometry(joints, tool, where: str) -> dict[str, float]:
 def _meshes(urdf: Any, path: Path, joints, links: list[str], machine, missing: list[str]) -> dict[str, bytes]:
     """The links' meshes as STL (m) in the model's link frames (see the module docstring); a mesh
     file the tree lacks is listed in `missing` (its link keeps its capsule)."""
-    # costs 0.3 s at start-up (python -X importtime, 2026-11-26)
+    # costs 0.0 s once yourdfpy is loaded (it loads trimesh: python -X importtime, 2026-11-26)
     import trimesh  # noqa: PLC0415 - only for a description with meshes
 
-    from .collision import MAX_MESH_BYTES  # noqa: PLC0415 - (costs 0.006 s, robot.collision's limit)
+    # costs 0.006 s at start-up (python -X importtime, 2026-11-26)
+    from .collision import MAX_MESH_BYTES  # noqa: PLC0415
 
     out: dict[str, bytes] = {}
     # the description's link frames at A = 0, and the model's (translation-only joint origins)
@@ -224,17 +227,14 @@ def _mesh_file(fname: str, path: Path) -> Path:
     return f
 
 
-def load_description(path: str | Path) -> Any:
+def load_description(path: str | Path, build: Any) -> Any:
     """The robot model (robot/machine.py ``MachineData``) of a URDF or xacro description (see the
-    module docstring). Raises MachineDataError for a file that cannot be read, a chain that is
-    not KUKA's arm, or a mesh it cannot take."""
-    # costs 0.2 s at start-up (python -X importtime, 2026-11-26: yourdfpy with lxml)
+    module docstring); `build` is robot/mada.py ``build_cited`` (the model of cited machine-data
+    values; passed in, as robot/mada.py reads descriptions through this module). Raises
+    MachineDataError for a file that cannot be read, a chain that is not KUKA's arm, or a mesh it
+    cannot take."""
+    # costs 0.93 s at start-up (python -X importtime, 2026-11-26: yourdfpy with trimesh and lxml)
     import yourdfpy  # noqa: PLC0415 - only for a description
-    # costs 0.16 s at start-up (python -X importtime, 2026-11-25: robot.mada, as robot/cli.py says)
-    from dataclasses import replace  # noqa: PLC0415
-
-    from .catalogue import arm_values  # noqa: PLC0415
-    from .mada import build_cited  # noqa: PLC0415
 
     p = Path(path)
     where = str(p)
@@ -250,11 +250,8 @@ def load_description(path: str | Path) -> Any:
     lims = [(math.degrees(lo), math.degrees(hi)) for _, _, lo, hi, _ in joints]
     speeds = [math.degrees(v) for *_, v in joints]
     name = urdf.robot.name if getattr(urdf, "robot", None) is not None else p.stem
-    machine = build_cited(name, arm_values(f"#{name}", g, lims, speeds, where, where), where, where)
+    machine = build(name, arm_values(f"#{name}", g, lims, speeds, where, where), where, where)
     rng = np.random.default_rng(64)
-    # costs 0.0 s: robot.kinematics is loaded with robot.mada
-    from .kinematics import Kinematics  # noqa: PLC0415
-
     kin = Kinematics(machine)
     lo = np.array([a for a, _ in lims])
     hi = np.array([b for _, b in lims])
