@@ -12,7 +12,10 @@ PC of KUKA RSI; a pinned test dependency) on both interpreters (issue 50):
   ``#IPO_FAST``: 4 ms cycle, absolute AK, Stop);
 * ROS-Industrial's KR_C2 ros_rsi.src (RSI 2, the ST_ functions) with its published
   ros_rsi_ethernet.xml: 12 ms, absolute AK;
-* a late-answer stop: RSIPI stopped, the robot stops after Timeout + 1 late cycles.
+* a late-answer stop: RSIPI stopped, the robot stops after Timeout + 1 late cycles;
+* issue 64's KR 150 cell, rebuilt from its description (points at X 1800-2000, Z 1500-1840): the
+  program runs on ``--robot "KR 150 R3100-2"`` and follows the correction; the KR 6 R900 stops at
+  its first motion.
 
 RSIPI binds the configuration's IP and PORT: each test hands it a copy of the published
 configuration with IP 127.0.0.1 and a free port (nothing else changed), and the cell file's
@@ -21,6 +24,7 @@ configuration with IP 127.0.0.1 and a free port (nothing else changed), and the 
 from __future__ import annotations
 
 import re
+import shutil
 import socket
 import time
 import xml.etree.ElementTree as ET
@@ -32,6 +36,8 @@ import pytest
 from RSIPI import RSIAPI, context
 
 from net.settings import Channel, NetworkSettings
+
+from tests.interp.helpers import run_krl
 
 from .helpers import CONFIGS, EXAMPLES, PROGRAMS, net_events, run_with_partner
 
@@ -305,3 +311,56 @@ def test_rsipi_late_answers_stop_the_robot(rsipi, tmp_path, interp):
     errors = [e for e in trace.events if e["kind"] == "error"]
     last_answer = net_events(trace, iface="rsi", dir="in")[-1]["t"]
     assert errors[0]["t"] - last_answer == pytest.approx(0.012 * 101, abs=0.012 * 2)
+
+
+#: the KR 150 cell of issue 64's unseen RSI programs: points at X 1800-2000 mm, Z 1500-1840 mm.
+#: Rebuilt from that description (the programs are not among ../shared): the project's example
+#: program taken to such a point; on the KR 6 R900 it stops at its first motion ("target not
+#: reachable"), on `--robot "KR 150 R3100-2"` (robot/catalogue.py) it runs and follows the sensor.
+KR150_PROGRAM = """&ACCESS RVP
+DEF rsi_kr150()
+  DECL INT ret
+  DECL INT CONTID
+  BAS(#INITMOV, 0)
+  PTP {X 1900, Y 0, Z 1700, A 180, B 30, C 180, S 2, T 2}
+  ret = RSI_CREATE("rsi_path", CONTID, TRUE)
+  IF ret <> RSIOK THEN
+    HALT
+  ENDIF
+  ret = RSI_ON(#ABSOLUTE)
+  RSI_MOVECORR()
+  ret = RSI_OFF()
+  ret = RSI_DELETE(CONTID)
+  LIN {X 1800, Y 100, Z 1840, A 180, B 30, C 180}
+END
+"""
+
+
+@pytest.mark.parametrize("interp", INTERPS)
+def test_rsipi_on_a_kr150_cell_program_by_model_name(rsipi, tmp_path, interp):
+    shutil.copy(EXAMPLES / "rsi_path.rsi.xml", tmp_path / "rsi_path.rsi.xml")
+    prog = tmp_path / "rsi_kr150.src"
+    prog.write_text(KR150_PROGRAM, encoding="ascii")
+    cfg, port = local_copy(EXAMPLES / "rsi_path_ethernet.xml", tmp_path)
+
+    def script(api, hold):
+        z0 = pose(api)
+        api.tools.update_variable("RKorr.Z", -8.0)
+        reached = until(lambda: abs(pose(api)[2] - z0[2] + 8.0) < 0.01)
+        hold(0.5)
+        api.tools.update_variable("Stop", True)
+        hold(0.3)
+        return z0, reached
+
+    settings = NetworkSettings(tmp_path, rsi=Channel(tmp_path / "rsi_path.rsi.xml", ("127.0.0.1", port)))
+    result, trace, (z0, reached) = run_with_partner(prog, settings, rsipi(cfg, script), interp=interp,
+                                                    robot="KR 150 R3100-2")
+    assert reached
+    assert result.reason == "completed", (result.reason, result.text)
+    assert z0[0] == pytest.approx(1900.0, abs=0.01) and z0[2] == pytest.approx(1700.0, abs=0.01)
+    last = robot_packets(trace)[-1].find("RIst")
+    assert float(last.get("Z")) - z0[2] == pytest.approx(-8.0, abs=0.01)
+    # the stand-in KR 6 R900 cannot reach the cell's first point: the case the issue saw
+    kr6 = run_krl(tmp_path, KR150_PROGRAM.split("  ret = RSI_CREATE")[0].replace("&ACCESS RVP\n", "") + "END\n",
+                  name="rsi_kr150_kr6", interp=interp)
+    assert "target not reachable" in str(kr6.result.error)
