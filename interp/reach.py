@@ -30,13 +30,11 @@ from pathlib import Path
 import numpy as np
 
 from krl.ast import nodes as N
+from robot.axismap import CART_KEYS as _CART
 
-from .runtime.values import Struct
 
 #: poses sampled along each motion
 SAMPLES = 24
-_AXES = ("A1", "A2", "A3", "A4", "A5", "A6")
-_CART = ("X", "Y", "Z", "A", "B", "C")
 
 
 @dataclass
@@ -63,7 +61,7 @@ def reach_check(program: Path, robot=None, inputs=None) -> ReachReport:
 
     # costs 0.66 s at start-up (python -X importtime, 2026-11-26: the runtime)
     from .run import global_value, make_runtime  # noqa: PLC0415
-    from .scene import _frame_at  # noqa: PLC0415
+    from .scene import module_points  # noqa: PLC0415
 
     rt, _ = make_runtime(program, inputs=inputs, robot=robot, mujoco=False, check=False)
     ctl = rt.controller
@@ -96,25 +94,8 @@ def reach_check(program: Path, robot=None, inputs=None) -> ReachReport:
         for d in m.datalist.items:
             for nm in getattr(d, "names", ()) or ():
                 decl.setdefault(str(nm.name).upper(), d.span.line)
-        for name, ref in m.data.items():
-            try:
-                v = ref.peek()
-            except Exception:  # noqa: BLE001 - a value that cannot be read is no point
-                continue
-            if not isinstance(v, Struct):
-                continue
-            f = v.f
-            where = f"{m.files['dat']}:{decl.get(name, 1)}"
-            if all(isinstance(f.get(k), (int, float)) for k in _AXES):
-                points[(m.index, name)] = ("axes", v, None, None, where)
-            elif all(isinstance(f.get(k), (int, float)) for k in _CART) and ("S" in f or "T" in f):
-                fdat = m.data.get("F" + name[1:]) if name.startswith("X") else None
-                fv = fdat.peek() if fdat is not None else None
-                tool = base = None
-                if isinstance(fv, Struct):
-                    tool = _frame_at(tools, fv.f.get("TOOL_NO"))
-                    base = _frame_at(bases, fv.f.get("BASE_NO"))
-                points[(m.index, name)] = ("pose", v, tool, base, where)
+        for name, kind, v, tool, base in module_points(m, tools, bases):
+            points[(m.index, name)] = (kind, v, tool, base, f"{m.files['dat']}:{decl.get(name, 1)}")
 
     def pose_axes(kind, v, tool, base, ref):
         """The axes of a taught point (model vector) from `ref`, or a message why not."""

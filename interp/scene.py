@@ -121,28 +121,35 @@ def taught_points(rt, value_of: Callable[[str], object]) -> list[tuple[str, obje
     for m in rt.program.modules:
         if not m.loaded:
             rt.program.ensure_loaded(m)
-        data = m.data
-        for name, ref in data.items():
-            try:
-                v = ref.peek()
-            except Exception:  # noqa: BLE001 - a value that cannot be read is no point
-                continue
-            if not isinstance(v, Struct):
-                continue
-            f = v.f
-            if all(isinstance(f.get(k), (int, float)) for k in _AXES):
-                out.append(("axes", v, None, None))
-            elif all(isinstance(f.get(k), (int, float)) for k in _CART) and ("S" in f or "T" in f):
-                tool = base = None
-                fdat = data.get("F" + name[1:]) if name.startswith("X") else None
-                fv = fdat.peek() if fdat is not None else None
-                if isinstance(fv, Struct):
-                    tool = _frame_at(tools, fv.f.get("TOOL_NO"))
-                    base = _frame_at(bases, fv.f.get("BASE_NO"))
-                out.append(("pose", v, tool, base))
+        for _name, kind, v, tool, base in module_points(m, tools, bases):
+            out.append((kind, v, tool, base))
             if len(out) >= MAX_CHOICE_POINTS:
                 return out
     return out
+
+
+def module_points(m, tools, bases):
+    """``(name, kind, value, tool, base)`` of each point the data list of the loaded module `m`
+    teaches (see :func:`taught_points`; `tools`/`bases`: ``TOOL_DATA``/``BASE_DATA``)."""
+    data = m.data
+    for name, ref in data.items():
+        try:
+            v = ref.peek()
+        except Exception:  # noqa: BLE001 - a value that cannot be read is no point
+            continue
+        if not isinstance(v, Struct):
+            continue
+        f = v.f
+        if all(isinstance(f.get(k), (int, float)) for k in _AXES):
+            yield name, "axes", v, None, None
+        elif all(isinstance(f.get(k), (int, float)) for k in _CART) and ("S" in f or "T" in f):
+            tool = base = None
+            fdat = data.get("F" + name[1:]) if name.startswith("X") else None
+            fv = fdat.peek() if fdat is not None else None
+            if isinstance(fv, Struct):
+                tool = _frame_at(tools, fv.f.get("TOOL_NO"))
+                base = _frame_at(bases, fv.f.get("BASE_NO"))
+            yield name, "pose", v, tool, base
 
 
 def _frame_at(arr, n):
