@@ -59,9 +59,9 @@ def _model_axes(ctl, ax, ext_from=None):
     return amap.from_components(comps, fill=ctl.model.from_krl(ctl.axis_act()))
 
 
-@GEOMETRY.native("FRAME EK(FRAME ROOT :IN, MECH_TYPE TYPE :IN, FRAME OFFSET :IN)")
+@GEOMETRY.native("FRAME EK(FRAME ROOT :IN, ESYS MECH_TYPE :IN, FRAME OFFSET :IN)")
 def _ek(rt, a):
-    """``EK(ROOT, MECH_TYPE, OFFSET)`` (KSS; the BASIS's bas.src links ``$BASE`` with it to the
+    """``EK(ROOT, MECH_TYPE, OFFSET)`` (KSS, its type ``ESYS`` as operate.dat declares it; the BASIS's bas.src links ``$BASE`` with it to the
     external kinematic a base is measured on: ``$BASE = EK(MACHINE_DEF[i].ROOT,
     MACHINE_DEF[i].MECH_TYPE, BASE_DATA[n])``): the frame ``ROOT : ETn(E) : OFFSET`` of the BASE
     kinematic ``TYPE`` (#EASYS..#EFSYS, robot/external.py) at the external axes' actual values,
