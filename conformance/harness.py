@@ -956,8 +956,55 @@ def _c_standstill(spec, mid, mt, ps):
                          else f"no standstill inside motion {mid} (more than {far} mm from its ends)")
 
 
+def _stands(ps, t0, t1, dt=IPO):
+    """(from, to, position) of each stretch between t0 and t1 in which the TCP stands still:
+    consecutive poses at one position, or a gap in the poses (a bounded trace writes a
+    standstill as repeat events, robot/trace.py): there the TCP stood where the pose before the
+    gap was until a cycle before the next pose."""
+    seg = [(t, p[:3]) for t, p in ps if t0 - 1e-9 <= t <= t1 + 1e-9]
+    spans = []
+    for (ta, pa), (tb, pb) in zip(seg, seg[1:]):
+        if _norm(_sub(pa, pb)) < 1e-6:
+            spans.append((ta, tb, pa))
+        elif tb - ta > 1.5 * dt:
+            spans.append((ta, tb - dt, pa))
+    out: list = []
+    for a, b, p in spans:
+        if out and abs(out[-1][1] - a) < 1e-9 and _norm(_sub(out[-1][2], p)) < 1e-6:
+            out[-1] = (out[-1][0], b, p)
+        else:
+            out.append((a, b, p))
+    return out
+
+
+def _c_stops_at(spec, mid, mt, ps):
+    """A conditional stop (STOP WHEN PATH): during motion ``id`` the TCP stands within
+    ``tol_mm`` of ``point`` for at least ``min_seconds`` (its longest standstill), and stands
+    nowhere else inside the motion (its end point aside); ``point: null``: it stands nowhere
+    inside the motion (the condition did not hold at the braking point)."""
+    d = mt[mid]
+    t0, t1 = d["start"], d.get("end", math.inf)
+    want = spec.get("point")
+    tol = float(spec.get("tol_mm", 1.2))
+    ends = [_start_point(mt, ps, mid), d["point"][:3]]
+    # standing at the motion's own start or end point is no stop of its own, unless it is the one expected
+    stands = [(a, b, p) for a, b, p in _stands(ps, t0, t1)
+              if not any(e is not None and _norm(_sub(p, e)) < 1e-3 for e in ends)
+              or (want is not None and _norm(_sub(p, want)) <= tol)]
+    if want is None:
+        return not stands, ("no standstill inside the motion" if not stands else
+                            f"stands at {[round(float(x), 3) for x in stands[0][2]]} from t={stands[0][0]:.3f} s")
+    elsewhere = [s for s in stands if _norm(_sub(s[2], want)) > tol]
+    here = [s for s in stands if _norm(_sub(s[2], want)) <= tol]
+    longest = max((b - a for a, b, _p in here), default=0.0)
+    ok = not elsewhere and longest >= float(spec.get("min_seconds", 0.0)) - TIME_TOL
+    where = ", ".join(f"{[round(float(x), 3) for x in p]} {a:.3f}..{b:.3f} s" for a, b, p in stands) or "none"
+    return ok, f"standstills: {where}; expected at {want} (±{tol} mm) for at least {spec.get('min_seconds', 0)} s"
+
+
 _MOTION_CHECKS = {
     "standstill": _c_standstill,
+    "stops_at": _c_stops_at,
     "count": _c_count, "straight": _c_straight, "circle": _c_circle, "reaches": _c_reaches,
     "exact_stop": _c_exact, "blend": _c_blend, "duration": _c_duration, "gap": _c_gap,
     "approximation": _c_approx, "point": _c_point, "passes": _c_passes,

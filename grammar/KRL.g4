@@ -300,6 +300,7 @@ statement
     | BRAKE_F                                                       # brakeFStatement
     | RESUME                                                        # resumeStatement
     | triggerStatement                                              # triggerStatementAlt
+    | conditionalStop                                               # conditionalStopStatement
     | ANIN ON variable '=' expression                               # aninOnStatement
     | ANIN OFF name                                                 # aninOffStatement
     | ANOUT ON name '=' expression (DELAY '=' expression)?
@@ -363,6 +364,14 @@ triggerAction
     | call
     ;
 
+// Conditional stop (KSS 8.3 and later; grammar/CHANGES.md, issue 63): the robot stops on the
+// path of the next motion (segment) PATH mm from its end point (its start point with ONSTART)
+// when the condition holds there. STOP is no reserved word (a name anywhere else): the word
+// under the label word= is checked after the parse (krl/syntax/checks.py).
+conditionalStop
+    : word=IDENTIFIER WHEN PATH '=' expression ONSTART? IF expression
+    ;
+
 // ------------------------------------------------------------------ motions (6.1)
 
 // A relative motion may name its reference frame, #BASE (default) or #TOOL (6.1, 6.3); the
@@ -397,7 +406,7 @@ splineBlock
     ;
 
 splineBlockLine
-    : (splineSegment | triggerStatement)? NEWLINE
+    : (splineSegment | triggerStatement | conditionalStop)? NEWLINE
     ;
 
 splineSegment
@@ -407,7 +416,7 @@ splineSegment
     ;
 
 ptpSplineBlockLine
-    : (ptpSplineSegment | triggerStatement)? NEWLINE
+    : (ptpSplineSegment | triggerStatement | conditionalStop)? NEWLINE
     ;
 
 ptpSplineSegment

@@ -39,7 +39,7 @@ from .frames import frame_to_matrix, inv_pos, matrix_to_frame
 from .io import IOImage
 from .limits import normalise_mode
 from .machine import MachineData, load_machine
-from .motion import MotionRequest, Trigger
+from .motion import CondStop, MotionRequest, Trigger
 from .planner import CP_SPEED_LIMIT_FACTOR, RobotModel, Segment, TriggerPlan, plan, resolved_target
 from .cellrules import Rule, rules_may_fire, step_rules
 from .kinematics import compiled_module
@@ -129,6 +129,7 @@ class _Run:
     decided: bool = False               # approximation decided (blend or exact stop)
     fired: set[int] = field(default_factory=set)
     tau_cache: tuple[int | None, float | None] | None = None
+    stops: dict[int, str] = field(default_factory=dict)   # conditional stop index -> braking / stopped
 
     def shift(self, d: float) -> None:
         self.t0 += d
@@ -272,6 +273,7 @@ class Controller:
         self._scale_rate = 0.0
         self._braking = False
         self._brake_T = 0.0
+        self._stop_T = 0.0               # a conditional stop's braking ramp (s), for the ramp up
         self._ramp_up = False      # release(): the path speed ramps up within a_max
         self._held: _Held | None = None
         self._moved_while_held = False
@@ -883,6 +885,8 @@ class Controller:
         if self.rules:
             self._rules_seen = step_rules(self.rules, self.io, t, self.dt, self._rules_seen)
 
+        if self._tracked:
+            self._conditional_stops()
         # path time (BRAKE ramps scale the path speed)
         s_old = self._scale
         if self._ramp_up:
@@ -1238,6 +1242,53 @@ class Controller:
         self._moved_while_held = False
         self._plan_q = self._q.copy()
 
+    # ----------------------------------------------------------------- conditional stops
+    def _conditional_stops(self) -> None:
+        """STOP WHEN PATH (robot.motion.CondStop), each IPO cycle before the path time moves.
+        The stop point is the path time of its planned point (a TRIGGER WHEN PATH's). The
+        braking point is the last cycle from which the robot, braking as BRAKE does at its
+        present axis speeds (:meth:`brake`: half the machine acceleration), still stops before
+        the stop point: there the condition is evaluated. Not met: the robot goes on, even if
+        it is met later. Met: the path speed ramps down linearly so that the robot stands at
+        the stop point; while it brakes or stands the condition is evaluated at every cycle,
+        and once it no longer holds the path speed ramps up again within the axes'
+        accelerations (:meth:`_ramp_scale`, as after a BRAKE). A stop point the robot has passed
+        when it is first looked at (one too close to where a blend began) is braked for as
+        soon as possible. KUKA's manual (KSS 8.3 Operating and Programming Instructions for
+        System Integrators, "Conditional stop"); docs/robot.md, "Conditional stop"."""
+        for run in self._tracked:
+            for tp in run.seg.triggers:
+                st = tp.trigger
+                if not isinstance(st, CondStop) or tp.index in run.fired:
+                    continue
+                state = run.stops.get(tp.index)
+                if state is None:
+                    t_stop = run.t0 + run.seg.profile.t_of_u(tp.u_ref) if tp.u_ref is not None else run.t0
+                    s = self._scale
+                    v = np.abs(self._q - self._q_prev) / self.dt
+                    T = max(self.dt, float(np.max(v / (0.5 * self.model.a_max))))
+                    if self._pt + s * (0.5 * T + self.dt) < t_stop - EPS:
+                        continue            # the braking point lies ahead
+                    if not st.condition():
+                        run.fired.add(tp.index)      # not met at the braking point: it goes on
+                        continue
+                    self._stop_T = T
+                    self._ramp_up = False
+                    left = t_stop - self._pt
+                    if s <= 0.0 or float(np.max(v)) <= 1e-9:
+                        self._scale, self._scale_rate = 0.0, 0.0      # standing: it stays
+                        run.stops[tp.index] = "stopped"
+                    else:
+                        self._scale_rate = -(s * s) / (2.0 * left) if left > EPS else -s / T
+                        run.stops[tp.index] = "braking"
+                elif not st.condition():
+                    run.fired.add(tp.index)          # no longer met: the path speed ramps up
+                    del run.stops[tp.index]
+                    self._scale_rate = 1.0 / max(self._stop_T, self.dt)
+                    self._ramp_up = True
+                elif state == "braking" and self._scale <= 0.0:
+                    run.stops[tp.index] = "stopped"
+
     # ----------------------------------------------------------------- triggers
     def _fire_triggers(self, pt: float) -> None:
         if not self._tracked:
@@ -1246,8 +1297,8 @@ class Controller:
         for run in self._tracked:
             due = []
             for tp in run.seg.triggers:
-                if tp.index in run.fired:
-                    continue
+                if tp.index in run.fired or isinstance(tp.trigger, CondStop):
+                    continue            # a conditional stop is the main run's (_conditional_stops)
                 tf = run.trigger_time(tp)
                 if pt >= tf - EPS:
                     due.append((tf, tp.index, tp))

@@ -198,6 +198,28 @@ class Trigger:
 
 
 @dataclass(frozen=True)
+class CondStop:
+    """A conditional stop, ``STOP WHEN PATH = path_mm [ONSTART] IF condition`` (KSS 8.3 and later;
+    docs/robot.md, "Conditional stop"). It travels among the next motion's (spline segment's)
+    ``triggers``: the planner places its stop point as a TRIGGER WHEN PATH's switching point,
+    `path_mm` from the end point (the start point with `onstart`; negative: before it).
+
+    Attributes:
+        path_mm: the shift of the stop point along the path (mm).
+        onstart: the reference is the start point.
+        condition: opaque to the robot: a zero-argument callable of the interpreter, True when
+            the robot is to stop; the main run calls it at the braking point and, once it
+            brakes or stands, at every IPO cycle.
+        line: source line of the statement.
+    """
+
+    path_mm: float
+    onstart: bool = False
+    condition: Any = None
+    line: int | None = None
+
+
+@dataclass(frozen=True)
 class SplineSegment:
     """One segment of a SPLINE block (reference §6.2): ``kind`` ``SPL``, ``SLIN`` or
     ``SCIRC``; target/aux as in :class:`MotionRequest`; ``params`` overrides the block's

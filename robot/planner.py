@@ -1462,12 +1462,13 @@ def _trigger_plan(seg: Segment, tr: Trigger, index: int, piece: int | None) -> T
         last = piece == len(seg.pieces) - 1
     else:
         u0, u1, s0, s1, last = 0.0, 1.0, 0.0, None, True
-    if tr.distance is not None:
+    if isinstance(tr, Trigger) and tr.distance is not None:
         if tr.distance == 0:
             return TriggerPlan(tr, index, None if piece in (None, 0) else u0, "start")
         return TriggerPlan(tr, index, None if last else u1, "end")
     if seg.req.kind == "PTP":
-        raise RobotError("TRIGGER WHEN PATH is not allowed for a PTP motion (use SPTP or a CP motion)")
+        what = "TRIGGER WHEN PATH" if isinstance(tr, Trigger) else "STOP WHEN PATH"
+        raise RobotError(f"{what} is not allowed for a PTP motion (use SPTP or a CP motion)")
     L = seg.path_length
     if s1 is None:
         s1 = L

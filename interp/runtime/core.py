@@ -18,7 +18,7 @@ from krl.semantics import types as T
 from krl.semantics.advance import StmtInfo
 from krl.semantics.resolve import ROUTINE, Callee, Storage
 from robot.errors import RobotError, SoftLimitError, WorkspaceError
-from robot.motion import MotionRequest, Trigger
+from robot.motion import CondStop, MotionRequest, Trigger
 
 from .natives import RSI_CONSTANTS, ValueRef
 from .contexts import Context, Irq
@@ -1362,6 +1362,14 @@ class Runtime:
         task = self._robot_only("TRIGGER")
         task.next_triggers.append(Trigger(distance=distance, path_mm=path, onstart=onstart,
                                           delay_ms=float(delay_ms), action=action, prio=prio, line=line))
+
+    def conditional_stop(self, path, onstart: bool, condition, line: int | None = None) -> None:
+        """STOP WHEN PATH = path [ONSTART] IF condition (KSS 8.3 and later): the next motion
+        (spline segment) stops `path` mm from its end point (its start point) while
+        ``condition()`` (a zero-argument callable, True: stop) holds there; the main run
+        evaluates it (robot/controller.py ``Controller._conditional_stops``)."""
+        task = self._robot_only("STOP WHEN PATH")
+        task.next_triggers.append(CondStop(float(num(path)), bool(onstart), condition, line))
 
     def run_trigger(self, task: Task, ev) -> None:
         self._proceed()

@@ -379,6 +379,16 @@ class TreeInterpreter:
             rt.trigger(action, line=st.span.line, **trigger_args(st.kind, at, delay, prio, st.onstart))
         self.guarded(do, st, frame)
 
+    def s_ConditionalStop(self, st, frame) -> None:
+        self.begin(st, frame)
+        rt = self.rt
+        cond = st.cond
+
+        def do():
+            rt.conditional_stop(self.eval(st.path, frame), st.onstart,
+                                lambda: rt.to_bool(self.eval(cond, frame), "conditional stop"), st.span.line)
+        self.guarded(do, st, frame)
+
     def exec_trigger_stmt(self, act, frame, fn) -> None:
         self.rt.before_statement(act.ann.info)
         try:
@@ -411,10 +421,10 @@ class TreeInterpreter:
             segs = []
             pending = []
             for s in st.body:
-                if isinstance(s, N.Trigger):
+                if isinstance(s, (N.Trigger, N.ConditionalStop)):
                     saved = task.next_triggers
                     task.next_triggers = []
-                    self.s_Trigger(s, frame)
+                    (self.s_Trigger if isinstance(s, N.Trigger) else self.s_ConditionalStop)(s, frame)
                     pending += task.next_triggers
                     task.next_triggers = saved
                 elif isinstance(s, N.Motion):

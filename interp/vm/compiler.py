@@ -476,6 +476,18 @@ class Compiler:
         self.stmt(st)
         self.emit("RESUME")
 
+    def s_ConditionalStop(self, st) -> None:
+        end = self.guarded(st)
+
+        def cond():
+            self.region = None
+            self.expr(st.cond)
+
+        lc = self.thunk(cond)
+        self.expr(st.path)
+        self.emit("COND_STOP", lc, "O" if st.onstart else "", st.span.line)
+        self.place(end)
+
     def s_Trigger(self, st) -> None:
         end = self.guarded(st)
         act = st.action
@@ -545,9 +557,9 @@ class Compiler:
         t = self.temp()
         self.emit("SPL_BEGIN", t)
         for s in st.body:
-            if isinstance(s, N.Trigger):
+            if isinstance(s, (N.Trigger, N.ConditionalStop)):
                 self.emit("SPL_TRIG_BEGIN", t)
-                self.s_Trigger(s)
+                (self.s_Trigger if isinstance(s, N.Trigger) else self.s_ConditionalStop)(s)
                 self.region = region
                 self.emit("SPL_TRIG_END", t)
             elif isinstance(s, N.Motion):

@@ -944,6 +944,13 @@ def TRIGGER(kind: "n", flags: "f", line: "i", action: "h"):
                **trigger_args(kind, at, delay, prio, "O" in flags))
 
 
+@inst("path --", cold=True)
+def COND_STOP(cond: "h", flags: "f", line: "i"):
+    """Runtime.conditional_stop(path, ONSTART?, condition thunk, line); flags: O onstart"""
+    when = self.thunk(code, frame, temps, cond)
+    rt.conditional_stop(path, flags == "O", lambda c=when: rt.to_bool(c(), "conditional stop"), line)
+
+
 @inst("call --", cold=True)
 def TRIG_INVOKE(slow: "l"):
     """in an action thunk: invoke the packed call; None (no routine target): go on at slow"""

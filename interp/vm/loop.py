@@ -225,6 +225,18 @@ def _cold_TRIGGER(self, ins, code, frame, temps, stack, ip):
     return ip + 1
 
 
+def _cold_COND_STOP(self, ins, code, frame, temps, stack, ip):
+    """Runtime.conditional_stop(path, ONSTART?, condition thunk, line); flags: O onstart"""
+    rt = self.rt
+    cond = ins[1]
+    flags = ins[2]
+    line = ins[3]
+    path = stack.pop()
+    when = self.thunk(code, frame, temps, cond)
+    rt.conditional_stop(path, flags == 'O', lambda c=when: rt.to_bool(c(), 'conditional stop'), line)
+    return ip + 1
+
+
 def _cold_TRIG_INVOKE(self, ins, code, frame, temps, stack, ip):
     """in an action thunk: invoke the packed call; None (no routine target): go on at slow"""
     slow = ins[1]
@@ -317,7 +329,7 @@ def _cold_SPLINE(self, ins, code, frame, temps, stack, ip):
 
 
 # the cold instructions' functions by opcode number (None: a hot one)
-COLD = [None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, _cold_AGG, _cold_HALT, _cold_WAIT_FOR, _cold_WAIT_SEC, _cold_CONTINUE, _cold_ON_ERROR_PROCEED, _cold_EXIT_SIGNAL, _cold_GOTO_FAIL, _cold_RAISE, _cold_INT_DECL, _cold_INT_CTL, _cold_BRAKE, _cold_STUB, _cold_CYCLIC_ASSIGN, _cold_ANOUT_ON, _cold_ANIN_ON, _cold_CYCLIC_OFF, _cold_RESUME, _cold_TRIG_FIND, _cold_TRIG_PACK, _cold_TRIGGER, _cold_TRIG_INVOKE, _cold_MOTION, _cold_SPL_BEGIN, _cold_SPL_TRIG_BEGIN, _cold_SPL_TRIG_END, _cold_SPL_SEG, _cold_SPLINE]
+COLD = [None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, _cold_AGG, _cold_HALT, _cold_WAIT_FOR, _cold_WAIT_SEC, _cold_CONTINUE, _cold_ON_ERROR_PROCEED, _cold_EXIT_SIGNAL, _cold_GOTO_FAIL, _cold_RAISE, _cold_INT_DECL, _cold_INT_CTL, _cold_BRAKE, _cold_STUB, _cold_CYCLIC_ASSIGN, _cold_ANOUT_ON, _cold_ANIN_ON, _cold_CYCLIC_OFF, _cold_RESUME, _cold_TRIG_FIND, _cold_TRIG_PACK, _cold_TRIGGER, _cold_COND_STOP, _cold_TRIG_INVOKE, _cold_MOTION, _cold_SPL_BEGIN, _cold_SPL_TRIG_BEGIN, _cold_SPL_TRIG_END, _cold_SPL_SEG, _cold_SPLINE]
 
 
 def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
@@ -1349,4 +1361,4 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
     finally:
         rt.steps += unsaved
 
-SOURCE = '85b10826f3433ca6b4a03d15783fa3204c31e189e03188be8b1fec5c446840c6'
+SOURCE = '5749343605adfdf5f88c7313fd619ae7b2a4a4e9bbced8cc1d968583786ab09d'

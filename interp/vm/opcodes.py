@@ -183,13 +183,14 @@ OPS: list[OpInfo] = [
     OpInfo('TRIG_FIND', 99, 'rl', ('callee', 'skip'), 1, '-- target', True, (), None, "push the routine target of a TRIGGER action's call (Runtime.callee), or None and jump to skip"),
     OpInfo('TRIG_PACK', 100, 'i', ('argc',), _effect_TRIG_PACK, 'target, args[argc] -- call', True, (), None, 'the packed call (target, args) of a TRIGGER action'),
     OpInfo('TRIGGER', 101, 'nfih', ('kind', 'flags', 'line', 'action'), _effect_TRIGGER, 'call, at, delay, prio if "P" in flags --', True, (), None, 'Runtime.trigger; kind: DISTANCE or PATH, flags: O onstart, P prio given; action: the action thunk (it starts with the packed call)'),
-    OpInfo('TRIG_INVOKE', 102, 'l', ('slow',), -1, 'call --', True, (), None, 'in an action thunk: invoke the packed call; None (no routine target): go on at slow'),
-    OpInfo('MOTION', 103, 'nnnfii', ('kind', 'approx', 'frame_kind', 'flags', 'nwith', 'line'), _effect_MOTION, 'target, aux if "A" in flags, ca if "C" in flags, pairs[2 * nwith] --', True, (), None, 'Runtime.motion; flags: A aux point, C CA given; pairs: the WITH (reference, value) pairs'),
-    OpInfo('SPL_BEGIN', 104, 't', ('spline',), 0, ' -- ', True, (), None, 'start collecting spline segments in temp spline'),
-    OpInfo('SPL_TRIG_BEGIN', 105, 't', ('spline',), 0, ' -- ', True, (), None, 'a TRIGGER inside a SPLINE block: set the trigger list aside'),
-    OpInfo('SPL_TRIG_END', 106, 't', ('spline',), 0, ' -- ', True, (), None, "collect the TRIGGER's entry for the next segment"),
-    OpInfo('SPL_SEG', 107, 'nfiit', ('kind', 'flags', 'nwith', 'line', 'spline'), _effect_SPL_SEG, 'target, aux if "A" in flags, ca if "C" in flags, pairs[2 * nwith] --', True, (), None, 'a segment into temp spline; flags: A aux point, C CA given'),
-    OpInfo('SPLINE', 108, 'nniit', ('kind', 'approx', 'nwith', 'line', 'spline'), _effect_SPLINE, 'pairs[2 * nwith] --', True, (), None, "Runtime.spline with the block's segments and WITH pairs"),
+    OpInfo('COND_STOP', 102, 'hfi', ('cond', 'flags', 'line'), -1, 'path --', True, (), None, 'Runtime.conditional_stop(path, ONSTART?, condition thunk, line); flags: O onstart'),
+    OpInfo('TRIG_INVOKE', 103, 'l', ('slow',), -1, 'call --', True, (), None, 'in an action thunk: invoke the packed call; None (no routine target): go on at slow'),
+    OpInfo('MOTION', 104, 'nnnfii', ('kind', 'approx', 'frame_kind', 'flags', 'nwith', 'line'), _effect_MOTION, 'target, aux if "A" in flags, ca if "C" in flags, pairs[2 * nwith] --', True, (), None, 'Runtime.motion; flags: A aux point, C CA given; pairs: the WITH (reference, value) pairs'),
+    OpInfo('SPL_BEGIN', 105, 't', ('spline',), 0, ' -- ', True, (), None, 'start collecting spline segments in temp spline'),
+    OpInfo('SPL_TRIG_BEGIN', 106, 't', ('spline',), 0, ' -- ', True, (), None, 'a TRIGGER inside a SPLINE block: set the trigger list aside'),
+    OpInfo('SPL_TRIG_END', 107, 't', ('spline',), 0, ' -- ', True, (), None, "collect the TRIGGER's entry for the next segment"),
+    OpInfo('SPL_SEG', 108, 'nfiit', ('kind', 'flags', 'nwith', 'line', 'spline'), _effect_SPL_SEG, 'target, aux if "A" in flags, ca if "C" in flags, pairs[2 * nwith] --', True, (), None, 'a segment into temp spline; flags: A aux point, C CA given'),
+    OpInfo('SPLINE', 109, 'nniit', ('kind', 'approx', 'nwith', 'line', 'spline'), _effect_SPLINE, 'pairs[2 * nwith] --', True, (), None, "Runtime.spline with the block's segments and WITH pairs"),
 ]
 BY_NAME: dict[str, OpInfo] = {o.name: o for o in OPS}
 FIRST_COLD = 81
@@ -329,13 +330,14 @@ RESUME = 98
 TRIG_FIND = 99
 TRIG_PACK = 100
 TRIGGER = 101
-TRIG_INVOKE = 102
-MOTION = 103
-SPL_BEGIN = 104
-SPL_TRIG_BEGIN = 105
-SPL_TRIG_END = 106
-SPL_SEG = 107
-SPLINE = 108
+COND_STOP = 102
+TRIG_INVOKE = 103
+MOTION = 104
+SPL_BEGIN = 105
+SPL_TRIG_BEGIN = 106
+SPL_TRIG_END = 107
+SPL_SEG = 108
+SPLINE = 109
 
 
 def stack_effect(name: str, operands: list) -> int:

@@ -807,6 +807,17 @@ class Builder:
                          self.keyed_expr(kv["PRIO"]) if "PRIO" in kv else None,
                          self.has(ctx, "ONSTART"), span=self.span(ctx))
 
+    def s_cond_stop(self, ctx, sp):
+        return self.cond_stop(self.rule(ctx, "conditionalStop", required=False) or ctx)
+
+    def cond_stop(self, ctx) -> N.ConditionalStop:
+        self.check_ok(ctx)
+        exprs = self.rules(ctx, "expression")
+        if len(exprs) != 2:
+            raise BuildError("conditional stop without its distance or condition")
+        return N.ConditionalStop(self.expr(exprs[0]), self.expr(exprs[1]), self.has(ctx, "ONSTART"),
+                                 span=self.span(ctx))
+
     def s_anin_on(self, ctx, sp):
         return N.AninOn(self.variable(self.rule(ctx, "variable")),
                         self.expr(self.rule(ctx, "expression")), span=sp)
@@ -915,10 +926,12 @@ class Builder:
                 own, b = _names(ch)
                 if b == "withClause" and not body and not seen_end:
                     with_.extend(self.with_clause(ch))
-                elif b in ("motion", "triggerStatement") or own.endswith(("Motion", "Segment")) \
+                elif b in ("motion", "triggerStatement", "conditionalStop") or own.endswith(("Motion", "Segment")) \
                         or b.endswith("Segment"):
                     if b == "triggerStatement":
                         st = self.guarded(self.trigger, ch)
+                    elif b == "conditionalStop":
+                        st = self.guarded(self.cond_stop, ch)
                     else:
                         st = self.guarded(lambda x: self.motion(x, self.span(x)), ch)
                     if st is not None:
@@ -1152,6 +1165,7 @@ _STATEMENTS = {
     "resumeStatement": lambda self, ctx, sp: N.Resume(span=sp),
     "triggerStatementAlt": Builder.s_trigger,
     "triggerStatement": Builder.s_trigger,
+    "conditionalStopStatement": Builder.s_cond_stop,
     "aninOnStatement": Builder.s_anin_on,
     "aninOffStatement": Builder.s_anin_off,
     "anoutOnStatement": Builder.s_anout_on,

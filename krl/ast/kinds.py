@@ -37,6 +37,8 @@ def kind_of(node: N.Node) -> str | None:
         return "BRAKE F" if node.fast else "BRAKE"
     if isinstance(node, N.Trigger):
         return f"TRIGGER WHEN {node.kind}"
+    if isinstance(node, N.ConditionalStop):
+        return "STOP WHEN PATH"
     if isinstance(node, N.Motion):
         return node.kind.upper()
     if isinstance(node, N.SplineBlock):

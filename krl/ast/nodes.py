@@ -24,7 +24,7 @@ Shapes (reference sections in brackets):
   :class:`While`, :class:`Repeat`, :class:`Loop`, :class:`Exit`, :class:`Goto`,
   :class:`Label`, :class:`Halt`, :class:`WaitFor`, :class:`WaitSec`, :class:`Continue`,
   :class:`Return`, :class:`OnErrorProceed`, :class:`InterruptDecl`, :class:`InterruptCtl`,
-  :class:`Brake`, :class:`Resume`, :class:`Trigger`, :class:`AninOn`, :class:`AninOff`,
+  :class:`Brake`, :class:`Resume`, :class:`Trigger`, :class:`ConditionalStop`, :class:`AninOn`, :class:`AninOff`,
   :class:`AnoutOn`, :class:`AnoutOff`, :class:`Motion`, :class:`SplineBlock`,
   :class:`KeywordStmt` (CONFIRM, ASYPTP, ...), :class:`MoveEmi`,
   :class:`DeclStmt` (a declaration found among statements), :class:`Unsupported`
@@ -564,6 +564,17 @@ class Trigger(Stmt):
     delay: Expr
     action: Stmt
     prio: Expr | None = None
+    onstart: bool = False
+
+
+@dataclass(slots=True)
+class ConditionalStop(Stmt):
+    """``STOP WHEN PATH = path [ONSTART] IF cond`` (KSS 8.3 and later, grammar/CHANGES.md): the
+    next motion (or spline segment) stops on its path `path` mm from its end point (from its
+    start point with ONSTART) when `cond` holds at the braking point, and goes on when it no
+    longer holds (robot/controller.py ``Controller._conditional_stops``)."""
+    path: Expr
+    cond: Expr
     onstart: bool = False
 
 

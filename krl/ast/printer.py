@@ -381,6 +381,10 @@ def _s_Unsupported(s, ind: str, level: int):
     return [ind + line for line in s.text.splitlines()] or [ind]
 
 
+def _s_ConditionalStop(s, ind: str, level: int):
+    return [f"{ind}STOP WHEN PATH = {expr(s.path)}{' ONSTART' if s.onstart else ''} IF {expr(s.cond)}"]
+
+
 def _s_Unparsed(s, ind: str, level: int):
     return [ind + s.text]
 

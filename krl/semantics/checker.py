@@ -461,6 +461,11 @@ class Checker:
             self.sink.at(s.span, *E409())
         self.stmt(s.action, ctx)
 
+    def s_ConditionalStop(self, s: N.ConditionalStop, ctx: _Ctx) -> None:
+        self.no_motion_in_submit(s, "STOP WHEN PATH")
+        self.numeric(s.path, ctx.scope, "PATH")
+        self.cond(s.cond, ctx.scope, "STOP WHEN")
+
     def s_Motion(self, s: N.Motion, ctx: _Ctx) -> None:
         self.no_motion_in_submit(s, s.kind)
         self.motion(s, ctx.scope)

@@ -2,7 +2,8 @@
 
 Some restrictions of the reference are on a token's value, not on the token kind:
 `TRIGGER WHEN DISTANCE` takes 0 or 1 (reference 5.18); a relative motion takes the frame
-#BASE or #TOOL (6.1, 6.3). The grammar used to state them as semantic predicates written in
+#BASE or #TOOL (6.1, 6.3); a conditional stop starts with the word STOP, no reserved word
+(KSS 8.3, grammar/CHANGES.md). The grammar used to state them as semantic predicates written in
 Python, which tied it to the Python target. Now the grammar accepts any INTLITERAL /
 ENUMLITERAL there, under a label (`point=`, `frame=`), and this module checks the labelled
 token after the parse, on the parse tree, whatever ANTLR target produced it
@@ -39,20 +40,24 @@ CHECKS: tuple[TokenCheck, ...] = (
     TokenCheck("triggerStatement", "TriggerStatementContext", "point", ("0", "1"), "TRIGGER WHEN DISTANCE takes 0 or 1", "5.18"),
     *(TokenCheck("motion", f"{kind}RelMotionContext", "frame", ("#BASE", "#TOOL"), _REL, "6.1")
       for kind in ("Ptp", "Lin", "Circ", "Sptp", "Slin", "Scirc")),
+    TokenCheck("conditionalStop", "ConditionalStopContext", "word", ("STOP",),
+               "a conditional stop takes STOP before WHEN PATH", "KSS 8.3"),
 )
 
 # A check can fail only on a line that matches: DISTANCE '=' followed by anything but a lone
-# 0 or 1, or a *_REL motion keyword followed on its line by '#' and not #BASE / #TOOL.
+# 0 or 1, a *_REL motion keyword followed on its line by '#' and not #BASE / #TOOL, or a name
+# other than STOP (or TRIGGER) before WHEN PATH.
 _MAY_FAIL = re.compile(
     r"DISTANCE[ \t\f]*=[ \t\f]*(?![01](?![0-9A-Z_]))"
-    r"|(?:PTP|LIN|CIRC|SPTP|SLIN|SCIRC)_REL(?![0-9A-Z_$])[^\r\n]*#(?!(?:BASE|TOOL)(?![0-9A-Z_$]))",
+    r"|(?:PTP|LIN|CIRC|SPTP|SLIN|SCIRC)_REL(?![0-9A-Z_$])[^\r\n]*#(?!(?:BASE|TOOL)(?![0-9A-Z_$]))"
+    r"|(?<![0-9A-Z_$])(?!(?:STOP|TRIGGER)(?![0-9A-Z_$]))[A-Z_$][0-9A-Z_$]*[ \t\f]+WHEN[ \t\f]+PATH(?![0-9A-Z_$])",
     re.IGNORECASE)
 
 
 def may_fail(text: str) -> bool:
     """True when some check could fail on `text` (a superset: False means none can)."""
-    upper = text.upper()  # a cheap pre-test: both patterns need one of these words
-    if "DISTANCE" not in upper and "_REL" not in upper:
+    upper = text.upper()  # a cheap pre-test: each pattern needs one of these words
+    if "DISTANCE" not in upper and "_REL" not in upper and "PATH" not in upper:
         return False
     return _MAY_FAIL.search(text) is not None
 

@@ -184,3 +184,46 @@ def test_tree_vm_comparison_finds_differences():
 def test_expectations_that_check_nothing_fail(tmp_path):
     c = _case(tmp_path, SRC, {"title": "x"})
     assert not H.check_case(c, _run([{"t": 0, "kind": "end", "reason": "completed"}])).passed
+
+
+def _stop_trace(stand_at: float | None, gap: bool):
+    """A LIN from (0,0,0) to (200,0,0), 2 mm a cycle; with `stand_at`, the TCP stands at X
+    `stand_at` for 100 cycles (as consecutive poses, or, with `gap`, as the gap a bounded trace
+    leaves for a standstill: robot/trace.py's repeat events)."""
+    ev = [{"t": 0.0, "kind": "motion", "id": 1, "phase": "start", "point": [0, 0, 0, 0, 0, 0]},
+          {"t": 0.0, "kind": "motion", "id": 1, "phase": "end", "point": [0, 0, 0, 0, 0, 0]},
+          {"t": 0.0, "kind": "motion", "id": 2, "phase": "start", "point": [200, 0, 0, 0, 0, 0]}]
+    t, x, stood = 0.0, 0.0, False
+    while x < 200.0:
+        t += 0.012
+        if stand_at is not None and not stood and x >= stand_at:
+            if not gap:
+                for _ in range(100):
+                    ev.append({"t": t, "kind": "pose", "axes": [0] * 6, "tcp": [x, 0, 0, 0, 0, 0]})
+                    t += 0.012
+            else:
+                ev.append({"t": t, "kind": "pose", "axes": [0] * 6, "tcp": [x, 0, 0, 0, 0, 0]})
+                t += 100 * 0.012
+            stood = True
+        x += 2.0
+        ev.append({"t": t, "kind": "pose", "axes": [0] * 6, "tcp": [min(x, 200.0), 0, 0, 0, 0, 0]})
+    ev.append({"t": t, "kind": "motion", "id": 2, "phase": "end", "point": [200, 0, 0, 0, 0, 0]})
+    return ev
+
+
+def test_stops_at_holds_the_stop_position_and_its_time(tmp_path):
+    """STOP WHEN PATH (case 122): the TCP stands at the expected point long enough, and nowhere
+    else; point null: it stands nowhere inside the motion."""
+    c = _case(tmp_path, SRC, {"motion": [{"check": "stops_at", "id": 2, "point": [150.0, 0.0, 0.0],
+                                          "tol_mm": 1.2, "min_seconds": 1.0}]})
+    for gap in (False, True):
+        assert H.check_case(c, _run(_stop_trace(150.0, gap))).passed, H.check_case(c, _run(_stop_trace(150.0, gap))).diff_text()
+        cr = H.check_case(c, _run(_stop_trace(100.0, gap)))          # stands elsewhere
+        assert not cr.passed and "standstills: [100.0, 0.0, 0.0]" in cr.diff_text()
+    cr = H.check_case(c, _run(_stop_trace(None, False)))              # never stands
+    assert not cr.passed and "standstills: none" in cr.diff_text()
+    (tmp_path / "never").mkdir()
+    never = _case(tmp_path / "never", SRC, {"motion": [{"check": "stops_at", "id": 2, "point": None}]})
+    assert H.check_case(never, _run(_stop_trace(None, False))).passed
+    cr = H.check_case(never, _run(_stop_trace(150.0, True)))
+    assert not cr.passed and "stands at [150.0, 0.0, 0.0]" in cr.diff_text()
