@@ -54,7 +54,9 @@ W002 = Code("W002", WARNING, "entry of a folder not read (symbolic link, FIFO/so
 E002 = Code("E002", ERROR, "syntax error", "{detail}",
             glued="{text} is read as one name; write {fix}",
             ends_early="the line ends too early{expected}",
-            unexpected="unexpected {token}{after}{expected}")
+            unexpected="unexpected {token}{after}{expected}",
+            open_array="{name} has no size ({example}): the controller rejects an open dimension outside a "
+                       "parameter list and does not declare {name} (reference 3.3)")
 W003 = Code("W003", WARNING, "construct not understood by the AST builder", "{what} '{name}' is not mapped to the AST yet")
 E003 = Code("E003", ERROR, "construct that cannot be built (too large or malformed)",
             "cannot build '{name}': {error}", too_deep="construct nested too deeply to build",

@@ -25,6 +25,7 @@ input 'INTERRUPT5'"). Every message is at most :data:`krl.limits.MAX_MESSAGE_CHA
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 from krl.diagnostics import Diagnostic, Note
@@ -36,6 +37,8 @@ from krl.syntax.parse import default_bundle
 from krl.syntax.tokens import lex
 
 MAX_ALTERNATIVES = 6
+# `CHAR sReg_01[` of an open array declared in a data list: (type, name)
+_OPEN_ARRAY = re.compile(r"\b([A-Za-z_$][A-Za-z0-9_$]*)\s+([A-Za-z_$][A-Za-z0-9_$]*)\s*\[\s*\]")
 
 _STATEMENT = {"ANIN", "ANOUT", "ASYPTP", "BRAKE", "BRAKE_F", "CIRC", "CIRC_REL", "CONFIRM", "CONTINUE",
               "EXIT", "FOR", "GOTO", "HALT", "IF", "INTERRUPT", "LIN", "LIN_REL", "LOOP", "MOVE_EMI",
@@ -247,6 +250,14 @@ def _describe(path: str, e, f: _File | None) -> Diagnostic:
                                                 or exp & {"ENDSPLINE", "SPL", "SLIN"}):
         return diag(*E014(),
                     help="move the declaration up, above the routine's first statement")
+    # an array declared in a data list without its size (`CHAR sReg_01[]`): KRL gives a size to
+    # every array but a parameter's (reference 3.3 [D]: "sizes are integer constants"); the
+    # controller's compiler rejects it in .dat files as in .src files (issue 63, grammar/CHANGES.md)
+    if tok == "]" and prev == "[" and "dataList" in e.rule_stack and shape and shape[0] in _DECL:
+        m = _OPEN_ARRAY.search(e.line_text or "")
+        if m is not None:
+            example = f"{m.group(1)} {m.group(2)}[24]" if m.group(1).upper() in _TYPES else f"{m.group(2)}[24]"
+            return diag(*E002("open_array", name=q(m.group(2)), example=q(example)))
     # unclosed / unbalanced brackets on the line
     if line is not None:
         b = _bracket_problem(line, e)
