@@ -5,11 +5,12 @@ The program is loaded as ``krl run`` loads it (interp/run.py ``make_runtime``: i
 lists, the robot — ``--robot``, the cell file's, the backup's own, the KR 6 R900 — and the cell
 file's ``geometry:``/``tool:``/``floor:``), and not run. Then:
 
-* **Points**: every POS/E6POS/AXIS/E6AXIS of the program's data lists (interp/scene.py
+* **Points**: every POS/E6POS/AXIS/E6AXIS of the program's own data list and of ``$config.dat``
+  (XHOME..; a machine-data variable such as ``$H_POS_TOL`` is no point) (interp/scene.py
   ``taught_points``: a pose with the TOOL_DATA and BASE_DATA of its inline form's FDAT) that no
   configuration of the robot reaches within its software limits (any status, turn and ±360°
   variant), each named with its data list's file:line.
-* **Motions**: each routine's PTP/LIN/SPTP/SLIN statements whose target is a taught point, in the
+* **Motions**: each routine of the program's own module: its PTP/LIN/SPTP/SLIN statements whose target is a taught point, in the
   order they stand (control flow is not followed: a loop's motions are checked once, a branch's
   as if taken), from the previous one's end (HOME before the first): a PTP as the axes move it
   (linear in every axis), a LIN as the TCP moves (a straight line, the orientation turned
@@ -83,11 +84,14 @@ def reach_check(program: Path, robot=None, inputs=None) -> ReachReport:
                    for x, (lo, hi) in zip(q, limits))
 
     # the taught points: name -> (kind, value, tool, base, where)
-    points: dict[tuple[int, str], tuple] = {}
+    points: dict[str, tuple] = {}           # by name: the program's own, else $config.dat's
     basis = (Path(__file__).parent / "basis").resolve()
+    own = rt.program.module_of(rt.program.main_path)
     for m in rt.program.modules:
         if not m.files.get("dat") or m.datalist is None or basis in Path(m.files["dat"]).resolve().parents:
             continue                        # the project's stand-in system files teach no point
+        if m is not own and m.datalist.name.upper() != "$CONFIG":
+            continue                        # the program's own data list and $config.dat (XHOME..)
         if not m.loaded:
             rt.program.ensure_loaded(m)
         decl = {}
@@ -95,7 +99,10 @@ def reach_check(program: Path, robot=None, inputs=None) -> ReachReport:
             for nm in getattr(d, "names", ()) or ():
                 decl.setdefault(str(nm.name).upper(), d.span.line)
         for name, kind, v, tool, base in module_points(m, tools, bases):
-            points[(m.index, name)] = (kind, v, tool, base, f"{m.files['dat']}:{decl.get(name, 1)}")
+            if name.startswith("$"):
+                continue                    # machine data ($H_POS_TOL, $AXIS_HOME..) are no taught points
+            if m is own or name not in points:
+                points[name] = (kind, v, tool, base, f"{m.files['dat']}:{decl.get(name, 1)}")
 
     def pose_axes(kind, v, tool, base, ref):
         """The axes of a taught point (model vector) from `ref`, or a message why not."""
@@ -118,15 +125,14 @@ def reach_check(program: Path, robot=None, inputs=None) -> ReachReport:
             return None, f"with its S {s} and T {t}: {exc.message} (another S/T reaches it)"
 
     home = np.array(amap.home, dtype=float)
-    for key, (kind, v, tool, base, where) in points.items():
+    for name, (kind, v, tool, base, where) in points.items():
         report.points += 1
         _q, why = pose_axes(kind, v, tool, base, home)
         if why is not None:
-            name = key[1]
             report.problems.append(f"{where}: unreachable: {name} on {ctl.machine.name}: {why}")
 
     checker = ctl.collision
-    for m in rt.program.modules:
+    for m in [own] if own is not None else []:
         if m.files.get("src") is None:
             continue
         for r in m.routines.values():
@@ -134,9 +140,9 @@ def reach_check(program: Path, robot=None, inputs=None) -> ReachReport:
             for node in r.walk():
                 if not isinstance(node, N.Motion) or node.kind not in ("PTP", "LIN", "SPTP", "SLIN"):
                     continue
-                if not isinstance(node.target, N.Name) or (m.index, node.target.name.upper()) not in points:
+                if not isinstance(node.target, N.Name) or node.target.name.upper() not in points:
                     continue
-                kind, v, tool, base, _ = points[(m.index, node.target.name.upper())]
+                kind, v, tool, base, _ = points[node.target.name.upper()]
                 q1, why = pose_axes(kind, v, tool, base, q_prev)
                 report.motions += 1
                 if q1 is None:
