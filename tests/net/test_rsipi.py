@@ -336,7 +336,7 @@ END
 """
 
 
-@pytest.mark.parametrize("interp", INTERPS)
+@pytest.mark.parametrize("interp", ["vm", pytest.param("tree", marks=pytest.mark.slow)])
 def test_rsipi_on_a_kr150_cell_program_by_model_name(rsipi, tmp_path, interp):
     shutil.copy(EXAMPLES / "rsi_path.rsi.xml", tmp_path / "rsi_path.rsi.xml")
     prog = tmp_path / "rsi_kr150.src"

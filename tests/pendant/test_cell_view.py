@@ -76,6 +76,7 @@ MESH_SHOT = REPO_ROOT / "docs" / "pendant" / "mesh-robot.png"
 DESCRIPTIONS = SHARED / "robots" / "descriptions" / "kuka_experimental"
 
 
+@pytest.mark.slow      # make nightly: a second page in Chromium (about 13 s under load); the first is in make test
 def test_a_description_with_meshes_is_drawn_with_them(pw, tmp_path):
     """The KR 150 R3100-2 of kuka_experimental (its xacro and collision meshes, copied beside the
     cell file: a cell file names a description of its own folder) is drawn with its seven meshes."""
