@@ -37,6 +37,20 @@ tool: {box: [60, 60, 250], frame: [0, 0, 125, 0, 0, 0]}
 SHOT = REPO_ROOT / "docs" / "pendant" / "cell-track.png"
 
 
+def _same_as(png: bytes, path) -> np.ndarray:
+    """The screenshot is the committed one (KRL_UPDATE_SCREENSHOTS=1 writes it): at most 2 % of the
+    pixels differ by more than 48 levels (tests/pendant/test_screenshots.py's rule); its pixels."""
+    if os.environ.get("KRL_UPDATE_SCREENSHOTS") == "1":
+        path.write_bytes(png)
+    assert path.exists(), f"{path} is missing: KRL_UPDATE_SCREENSHOTS=1 writes it"
+    new = np.asarray(Image.open(io.BytesIO(png)).convert("RGB"), dtype=np.int16)
+    old = np.asarray(Image.open(path).convert("RGB"), dtype=np.int16)
+    assert new.shape == old.shape
+    differ = (np.abs(new - old).max(axis=2) > 48).mean()
+    assert differ <= 0.02, f"{differ:.1%} of the pixels differ from {path}; KRL_UPDATE_SCREENSHOTS=1 updates it"
+    return new
+
+
 def test_the_cell_and_the_track_axis_are_drawn(pw, tmp_path):
     (tmp_path / "track.src").write_text(PROG, encoding="ascii")
     cell = tmp_path / "cell.yaml"
@@ -59,14 +73,7 @@ def test_the_cell_and_the_track_axis_are_drawn(pw, tmp_path):
         wait_drawn(page)
         assert page.problems == []
         png = page.screenshot()
-    if os.environ.get("KRL_UPDATE_SCREENSHOTS") == "1":
-        SHOT.write_bytes(png)
-    assert SHOT.exists(), f"{SHOT} is missing: KRL_UPDATE_SCREENSHOTS=1 writes it"
-    new = np.asarray(Image.open(io.BytesIO(png)).convert("RGB"), dtype=np.int16)
-    old = np.asarray(Image.open(SHOT).convert("RGB"), dtype=np.int16)
-    assert new.shape == old.shape
-    differ = (np.abs(new - old).max(axis=2) > 48).mean()
-    assert differ <= 0.02, f"{differ:.1%} of the pixels differ from {SHOT}; KRL_UPDATE_SCREENSHOTS=1 updates it"
+    new = _same_as(png, SHOT)
     # the cell's green and the tool's yellow are in the picture (the bodies are drawn, not only counted)
     green = ((np.abs(new[..., 0] - 0x5f) < 40) & (np.abs(new[..., 1] - 0x8f) < 40) & (np.abs(new[..., 2] - 0x63) < 40))
     assert green.mean() > 0.001
@@ -104,10 +111,4 @@ def test_a_description_with_meshes_is_drawn_with_them(pw, tmp_path):
         wait_drawn(page)
         assert page.problems == []
         png = page.screenshot()
-    if os.environ.get("KRL_UPDATE_SCREENSHOTS") == "1":
-        MESH_SHOT.write_bytes(png)
-    new = np.asarray(Image.open(io.BytesIO(png)).convert("RGB"), dtype=np.int16)
-    old = np.asarray(Image.open(MESH_SHOT).convert("RGB"), dtype=np.int16)
-    assert new.shape == old.shape
-    differ = (np.abs(new - old).max(axis=2) > 48).mean()
-    assert differ <= 0.02, f"{differ:.1%} of the pixels differ from {MESH_SHOT}; KRL_UPDATE_SCREENSHOTS=1 updates it"
+    _same_as(png, MESH_SHOT)
