@@ -111,9 +111,10 @@ IO_NAMES = frozenset({"$IN", "$OUT", "$ANIN", "$ANOUT", "$TIMER", "$TIMER_STOP",
 #: program ends, $MODE_OP, ...) or that never change; the others are stored system variables,
 #: which statements write. tests/interp/test_spin.py holds every computed variable of
 #: interp/runtime/sysvars.py to one of these sets or MOTION_NAMES, IO_NAMES, the clock's.
+#: ``$TRACE`` (KUKA Trace's state) changes only when a statement writes its MODE.
 STATE_NAMES = frozenset({"$PRO_STATE", "$PRO_STATE0", "$PRO_STATE1", "$PRO_ACT", "$MODE_OP", "$T1",
                          "$T2", "$AUT", "$EXT", "$I_O_ACTCONF", "$INTERPRETER", "$COULD_START_MOTION",
-                         "$ERR", "$NULLFRAME", "$POS_INT", "$AXIS_INT"})
+                         "$ERR", "$NULLFRAME", "$POS_INT", "$AXIS_INT", "$TRACE"})
 
 #: the statements a spin may execute (module docstring)
 ALLOWED = (N.Assign, N.CallStmt, N.If, N.Switch, N.For, N.While, N.Repeat, N.Loop, N.Exit, N.Goto,
