@@ -88,7 +88,7 @@ def test_show_a_robot_of_the_library_by_name():
 
 
 @pytest.mark.parametrize("name", ["kr16_2_krc2", "kr180_r3200_pa", "kr180_r3200_pa5", "kr16_2_kl1500",
-                                  "kr16_2_turntable"])
+                                  "kr16_2_turntable", "kr16_2_positioner"])
 def test_export_works_for_every_family(tmp_path, name):
     """`krl robot export` (the pendant renders the backup's robot from it) for every family of
     robot/data: the URDF is one tree and the MJCF loads in MuJoCo with a joint per axis."""
