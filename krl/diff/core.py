@@ -84,13 +84,16 @@ class Diff:
     left_out: int = 0
     # the lines not understood of the files compared, by their text (issue 63)
     unparsed: list[dict] = field(default_factory=list)
+    # files moved to another folder, compared with their old place: {old, new} (issue 63)
+    moved: list[dict] = field(default_factory=list)
     # of each side's file with lines not understood: {side, file, lines: [{line, message}],
     # understood, total, noun} (krl.workspace.NotUnderstood)
     partial: list[dict] = field(default_factory=list)
 
     @property
     def changed(self) -> bool:
-        return any(getattr(self, k) for k in KINDS) or any(e["change"] != "unchanged" for e in self.unparsed)
+        return (any(getattr(self, k) for k in KINDS) or bool(self.moved)
+                or any(e["change"] != "unchanged" for e in self.unparsed))
 
     def summary(self) -> dict[str, int]:
         """{kind: number of changes} for every kind compared (zeros included)."""
@@ -108,7 +111,8 @@ class Diff:
             out[k] = getattr(self, k)
         out.update({"duplicates": self.duplicates, "comment_edits": self.comment_edits,
                     "fold_edits": self.fold_edits, "not_compared": self.not_compared,
-                    "left_out": self.left_out, "unparsed": self.unparsed, "not_understood": self.partial})
+                    "left_out": self.left_out, "unparsed": self.unparsed, "not_understood": self.partial,
+                    "moved": self.moved})
         return out
 
 
@@ -119,34 +123,34 @@ def diff_sides(old: Side, new: Side, tolerance: float = 0.0) -> Diff:
     unchanged when its text is the same on both, else listed in ``not_compared`` (the side's
     file that could not be read: its errors are that side's)."""
     d = Diff(old.path, new.path)
-    keys = sorted(set(old.files) | set(new.files))
-    ok_keys = []
-    for k in keys:
-        fo, fn = old.files.get(k), new.files.get(k)
+    pairs: list[tuple[str | None, str | None]] = []
+    for ko, kn in _pairs(old, new, d):
+        fo, fn = old.files.get(ko) if ko is not None else None, new.files.get(kn) if kn is not None else None
         if not _readable(fo) or not _readable(fn):
-            if fo is not None and fn is not None and old.text(k) is not None and old.text(k) == new.text(k):
+            if fo is not None and fn is not None and old.text(ko) is not None and old.text(ko) == new.text(kn):
                 d.unparsed_same += 1    # the same text on both sides: unchanged, though it was not parsed
                 continue
-            d.not_compared += [s.shown(k) for s, f in ((old, fo), (new, fn)) if not _readable(f)]
+            d.not_compared += [s.shown(k) for s, f, k in ((old, fo, ko), (new, fn, kn)) if not _readable(f)]
         else:
-            ok_keys.append(k)
-    d.files_compared = len(ok_keys)
-    for name, s in (("old", old), ("new", new)):
+            pairs.append((ko, kn))
+    d.files_compared = len(pairs)
+    compared = ({ko for ko, _ in pairs if ko is not None}, {kn for _, kn in pairs if kn is not None})
+    for (name, s), keys in zip((("old", old), ("new", new)), compared):
         d.partial += [{"side": name, "file": s.rel(s.key_of(p.path)), "lines": [{"line": n, "message": m} for n, m in p.lines],
                        "understood": p.understood, "total": p.total, "noun": p.noun}
-                      for p in s.not_understood if s.key_of(p.path) in ok_keys]
+                      for p in s.not_understood if s.key_of(p.path) in keys]
     values_old, values_new = _all_values(old), _all_values(new)
     records_old, records_new = _records(old, values_old), _records(new, values_new)
-    for k in ok_keys:
-        mo = old.files[k].module if k in old.files else None
-        mn = new.files[k].module if k in new.files else None
-        show = new.rel(k) if k in new.files else old.rel(k)
+    for ko, kn in pairs:
+        mo = old.files[ko].module if ko is not None else None
+        mn = new.files[kn].module if kn is not None else None
+        show = new.rel(kn) if kn is not None else old.rel(ko)
         dlo = mo.data if mo is not None else None
         dln = mn.data if mn is not None else None
         if dlo is not None or dln is not None:
             system = (dln or dlo).name.upper()
-            _data(d, show, system, _first(values_old.get(k, [])), _first(values_new.get(k, [])), tolerance)
-            _declarations(d, show, "", dlo.items if dlo else [], dln.items if dln else [], new, k)
+            _data(d, show, system, _first(values_old.get(ko, [])), _first(values_new.get(kn, [])), tolerance)
+            _declarations(d, show, "", dlo.items if dlo else [], dln.items if dln else [])
         ro = _routines(mo)
         rn = _routines(mn)
         module = _module_name(mn or mo, show)
@@ -160,13 +164,12 @@ def diff_sides(old: Side, new: Side, tolerance: float = 0.0) -> Diff:
                                    "comment_edits": 0, "fold_edits": 0})
                 continue
             _routine(d, old, new, show, module, a, b)
-            _declarations(d, show, b.name, a.decls, b.decls, new, k)
-            mk = _module_key(k)
-            _motions(d, show, a, b, (records_old.get(mk, {}), records_old["*"]),
-                     (records_new.get(mk, {}), records_new["*"]), tolerance)
-    for k in ok_keys:
-        _unparsed(d, old, new, k)
-    _duplicates(d, old, new, set(ok_keys))
+            _declarations(d, show, b.name, a.decls, b.decls)
+            _motions(d, show, a, b, (records_old.get(_module_key(ko), {}), records_old["*"]),
+                     (records_new.get(_module_key(kn), {}), records_new["*"]), tolerance)
+    for ko, kn in pairs:
+        _unparsed(d, old, new, ko, kn)
+    _duplicates(d, old, new, *compared)
     for name in (*KINDS, "duplicates", "unparsed"):
         items = getattr(d, name)
         if len(items) > MAX_DIFF_ENTRIES:
@@ -175,24 +178,50 @@ def diff_sides(old: Side, new: Side, tolerance: float = 0.0) -> Diff:
     return d
 
 
+def _pairs(old: Side, new: Side, d: Diff) -> list[tuple[str | None, str | None]]:
+    """(OLD's key, NEW's key) of each file to compare, in the order of the keys: the same key on
+    both sides, or a file of one side alone (None on the other). A file only OLD has and a file
+    only NEW has are one file **moved** when no other file of either side alone has its name
+    (``Program/Service/x.src`` -> ``TP/x.src``; letter case ignored): they are compared with
+    each other, and ``d.moved`` names the move."""
+    only_old = [k for k in old.files if k not in new.files]
+    only_new = [k for k in new.files if k not in old.files]
+    by_name: dict[str, tuple[list, list]] = {}
+    for k in only_old:
+        by_name.setdefault(k.rsplit("/", 1)[-1], ([], []))[0].append(k)
+    for k in only_new:
+        by_name.setdefault(k.rsplit("/", 1)[-1], ([], []))[1].append(k)
+    moved = {ko[0]: kn[0] for ko, kn in by_name.values() if len(ko) == 1 and len(kn) == 1}
+    out: list[tuple[str | None, str | None]] = []
+    for k in sorted(set(old.files) | set(new.files)):
+        if k in moved.values():
+            continue                # compared with its old place
+        if k in moved:
+            out.append((k, moved[k]))
+            d.moved.append({"old": old.rel(k), "new": new.rel(moved[k])})
+        else:
+            out.append((k if k in old.files else None, k if k in new.files else None))
+    return out
+
+
 def _readable(f) -> bool:
     """A file of a side that was read and parsed (with or without syntax errors), or absent."""
     return f is None or f.status in ("ok", "syntax_error")
 
 
-def _unparsed(d: Diff, old: Side, new: Side, k: str) -> None:
+def _unparsed(d: Diff, old: Side, new: Side, ko: str | None, kn: str | None) -> None:
     """The lines not understood of the file `k` on either side, compared by their text (spaces
     collapsed): the same text in the same order is unchanged, a text replaced by another at its
     place changed, the rest added or removed."""
-    def lines(s: Side) -> list[tuple[int, str]]:
-        f = s.files.get(k)
+    def lines(s: Side, k: str | None) -> list[tuple[int, str]]:
+        f = s.files.get(k) if k is not None else None
         if f is None or not f.module.unparsed:
             return []
         return [(n, s.line(f.path, n)) for n in f.module.unparsed]
-    a, b = lines(old), lines(new)
+    a, b = lines(old, ko), lines(new, kn)
     if not a and not b:
         return
-    show = new.rel(k) if k in new.files else old.rel(k)
+    show = new.rel(kn) if kn is not None else old.rel(ko)
     ka, kb = [" ".join(t.split()).upper() for _, t in a], [" ".join(t.split()).upper() for _, t in b]
     sm = difflib.SequenceMatcher(None, ka, kb, autojunk=False)
     for op, i1, i2, j1, j2 in sm.get_opcodes():
@@ -386,7 +415,7 @@ def _declared(items: list) -> dict[str, tuple[str, object, str, N.Node, str]]:
     return out
 
 
-def _declarations(d: Diff, show: str, scope: str, old_items: list, new_items: list, new: Side, k: str) -> None:
+def _declarations(d: Diff, show: str, scope: str, old_items: list, new_items: list) -> None:
     a, b = _declared(old_items), _declared(new_items)
     for name in [n for n in b if n not in a] + [n for n in a if n not in b] + [n for n in b if n in a]:
         x, y = a.get(name), b.get(name)
@@ -400,10 +429,10 @@ def _declarations(d: Diff, show: str, scope: str, old_items: list, new_items: li
                                "line": node.span.line})
 
 
-def _duplicates(d: Diff, old: Side, new: Side, keys: set[str]) -> None:
+def _duplicates(d: Diff, old: Side, new: Side, old_keys: set[str], new_keys: set[str]) -> None:
     """The names declared twice in the compared files, of each side (the workspace's facts,
     krl/semantics/checker.py DeclaredTwice), worded as the checker words E102."""
-    for name, s in (("old", old), ("new", new)):
+    for name, s, keys in (("old", old, old_keys), ("new", new, new_keys)):
         for fact, key in s.duplicates:
             if key in keys:
                 code, message = fact.worded(lambda span, s=s: s.relative(str(span)))

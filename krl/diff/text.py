@@ -72,6 +72,8 @@ def summary_line(d: Diff) -> str:
     not compared."""
     counts = ", ".join(f"{n} {KIND_TITLES[k].lower()}" for k, n in d.summary().items())
     out = f"compared {d.files_compared} file(s): {counts}"
+    if d.moved:
+        out += f"; {len(d.moved)} file(s) moved"
     if d.unparsed_same:
         out += f"; {d.unparsed_same} file(s) with syntax errors unchanged (the same text)"
     if d.unparsed:
@@ -152,6 +154,9 @@ def diff_text(d: Diff) -> list[str]:
         out.append(f"Duplicate definitions, compared by the first as krl check does ({len(d.duplicates)}):")
         for e in d.duplicates:
             out.append(f"  {e['side']} {p(e['file'])}:{e['line']}: {e['code']} {p(e['message'])}")
+    if d.moved:
+        out.append(f"Moved, compared with their old place ({len(d.moved)}):")
+        out += [f"  {p(e['old'])} -> {p(e['new'])}" for e in d.moved]
     if d.unparsed:
         out.append(f"Lines not understood, compared by their text ({len(d.unparsed)}):")
         for e in d.unparsed:

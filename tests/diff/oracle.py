@@ -6,6 +6,9 @@ process; a file with syntax errors gives what parsed), and compares every value 
 initial value, by the rules docs/diff.md states for ``krl diff``:
 
 * a file is the same file whatever the letter case of its path;
+* a file only OLD has and a file only NEW has are one file moved when they have the same name
+  and no other file of either side alone has it (issue 63): compared with each other, its
+  changes named by NEW's path (:func:`moves`);
 * a name given twice in one data list is compared by its first definition;
 * REAL numbers are equal when equal as 32-bit floats (numpy.float32), INT exactly, an angle A,
   B or C of a cartesian point modulo 360 degrees; ENUM values by name in any letter case;
@@ -143,11 +146,28 @@ def parse_all(paths: list[Path]) -> dict[Path, N.Module | None]:
     return {p: _PARSED[digest[p]] for p in paths}
 
 
+def moves(fo: dict[str, Path], fn: dict[str, Path]) -> dict[str, str]:
+    """{OLD's key: NEW's key} of the files moved (module docstring): of the keys only one side
+    has, those whose last part (lower-case) occurs exactly once among OLD's and once among NEW's."""
+    only_old = [k for k in fo if k not in fn]
+    only_new = [k for k in fn if k not in fo]
+    name = lambda k: k.split("/")[-1]  # noqa: E731
+    out = {}
+    for k in only_old:
+        a = [x for x in only_old if name(x) == name(k)]
+        b = [x for x in only_new if name(x) == name(k)]
+        if len(a) == 1 and len(b) == 1:
+            out[k] = b[0]
+    return out
+
+
 def compare(old: Path, new: Path) -> tuple[set[tuple[str, str, str]], set[str]]:
     """(changes, files skipped): the value changes between the folders `old` and `new` (see the
     module docstring), and the .dat files not compared because a side's could not be read or
     parsed at all (a file with syntax errors is compared from what parsed)."""
     fo, fn = krl_files(old), krl_files(new)
+    for a, b in moves(fo, fn).items():            # a moved file: compared under NEW's key
+        fo[b] = fo.pop(a)
     dats = sorted(k for k in set(fo) | set(fn) if k.endswith(".dat"))
     modules = parse_all([fo[k] for k in dats if k in fo] + [fn[k] for k in dats if k in fn])
     changes: set[tuple[str, str, str]] = set()

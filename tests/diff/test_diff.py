@@ -19,6 +19,7 @@ from click.testing import CliRunner
 from krl.cli import main
 from krl.diff.core import diff_sides
 from krl.diff.load import DiffInputError, side
+from krl.diff.text import summary_line
 from tests.test_json_schemas import validate
 
 BACKUP = "ingeniado__KRC4-Robot-Palletizer"
@@ -345,3 +346,26 @@ def test_values_compared_with_their_types(tmp_path):
     assert sorted((e["name"], e["kind"]) for e in doc["values"]) == [("i", "INT"), ("r2", "REAL"), ("s[]", "STRING")]
     doc = json.loads(CliRunner().invoke(main, ["diff", "--format", "json", "--tolerance", "0.001", str(a), str(b)]).stdout)
     assert sorted(e["name"] for e in doc["values"]) == ["i", "s[]"]
+
+
+def test_a_module_moved_to_another_folder_is_a_move_not_removals_and_additions(old, base, tmp_path):
+    # issue 63: Program/CAJA_G/caja_g_m1.src and .dat moved to TP/, XC1 retaught on the way;
+    # two copies of caja_g_m2 (one moved, one new elsewhere): ambiguous, so a removal and two
+    # additions as before
+    new = copy_of(base, tmp_path)
+    edit(new, M1_DAT, XC1, XC1.replace("X 1070.0", "X 1071.5"))
+    (new / "TP").mkdir()
+    for ext in ("src", "dat"):
+        (new / f"Program/CAJA_G/caja_g_m1.{ext}").rename(new / f"TP/caja_g_m1.{ext}")
+    (new / "Program/CAJA_G/caja_g_m2.dat").rename(new / "TP/caja_g_m2.dat")
+    shutil.copy(new / "TP/caja_g_m2.dat", new / "Program/caja_g_m2.dat")
+    d = diff_to(old, new)
+    assert d.moved == [{"old": "Program/CAJA_G/caja_g_m1.dat", "new": "TP/caja_g_m1.dat"},
+                       {"old": "Program/CAJA_G/caja_g_m1.src", "new": "TP/caja_g_m1.src"}]
+    assert d.points[0] == {"file": "TP/caja_g_m1.dat", "name": "XC1", "kind": "E6POS", "change": "changed",
+                           "delta": {"X": 1.5}, "line": 24, "status_turn_changed": False}
+    # nothing of caja_g_m1 is removed or added; caja_g_m2.dat's points are, on each place
+    assert {p["file"] for p in d.points if p["change"] != "changed"} == {
+        "Program/CAJA_G/caja_g_m2.dat", "TP/caja_g_m2.dat", "Program/caja_g_m2.dat"}
+    assert d.routines == [] and d.changed
+    assert "1 file(s) moved" not in summary_line(d) and "2 file(s) moved" in summary_line(d)
