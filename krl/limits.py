@@ -161,6 +161,10 @@ MAX_GRAPH_NODES = 5000
 # The routines' source text the interactive map page carries (krl graph --format html), in
 # characters in all; past it the remaining routines show their file:line without the text.
 MAX_GRAPH_SOURCE_CHARS = 8_000_000
+# The files the change report carries as its own views of the lines it links to (krl report
+# --links source, krl/diff/sources.py), in characters in all; past it a file shows the lines
+# around each line a link names.
+MAX_REPORT_SOURCE_CHARS = 4_000_000
 
 # KUKA Trace recordings (`krl trace show|compare`, robot/kukatrace): the largest KRCIpo CSV or
 # PROG.TXT read, in bytes (a recording of the real-traces repository is at most 700 kB: 12 ms

@@ -1307,6 +1307,34 @@ def not_understood(ws: Workspace) -> list[NotUnderstood]:
     return out
 
 
+_KSS = re.compile(r"KUKA\s*(\d+)(?:\.(\d+))?", re.IGNORECASE)
+#: the controller a KSS major version runs on (KUKA's KSS release notes: KSS 8 on the KR C4,
+#: KSS 5 and 4 on the KR C2)
+_CONTROLLERS = {"8": "KR C4", "5": "KR C2", "4": "KR C2"}
+
+
+def machine_identity(files) -> dict[str, str]:
+    """What the machine data among `files` (:class:`SourceFile`, a backup's) say of the robot
+    and its controller, from what parsed of each ``$machine.dat``: ``robot`` (``$MODEL_NAME[]``,
+    KSS 8.5 and later, else ``$TRAFONAME[]``, without KUKA's ``#``: ``KR30L16_3A C4 FLR ZH16_2``),
+    ``mada`` (``$V_R1MADA[]``: ``V8.3.190/KUKA8.3``), ``kss`` (``KSS 8.3``) and ``controller``
+    (``KR C4``); "" for what they do not name (a backup without machine data names nothing).
+    The one rule of krl report's cover (krl/diff/ident.py) and krl audit's unit names."""
+    values: dict[str, str] = {}
+    for f in files:
+        dl = f.module.data if f.module is not None else None
+        if dl is None or dl.name.upper() != "$MACHINE":
+            continue
+        for item in dl.items:
+            if isinstance(item, N.ArrayInit) and isinstance(item.value, N.StrLit) and item.indices == [None]:
+                values.setdefault(item.name.upper(), item.value.value.strip())
+    robot = (values.get("$MODEL_NAME") or values.get("$TRAFONAME") or "").lstrip("#").strip()
+    mada = values.get("$V_R1MADA", "")
+    m = _KSS.search(mada)
+    kss = (f"KSS {m.group(1)}.{m.group(2)}" if m.group(2) else f"KSS {m.group(1)}") if m else ""
+    return {"robot": robot, "mada": mada, "kss": kss, "controller": _CONTROLLERS.get(m.group(1), "") if m else ""}
+
+
 def check_texts(files: dict[str, str]) -> Workspace:
     """A checked workspace from {path: KRL text}; e.g. ``check_texts({"a.src": "DEF a()..."})``."""
     ws = Workspace(next(iter(files), ""))

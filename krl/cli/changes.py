@@ -175,17 +175,22 @@ def graph(backup: str, fmt: str, links: str, output: str | None) -> None:
 @click.option("--max-sim-time", type=click.FloatRange(min=0, min_open=True), default=None,
               help="Simulated seconds each run may take (default 60).")
 @click.option("--jobs", type=click.IntRange(min=1), default=None, help="Worker processes of the runs (default: one per core).")
-@click.option("--links", type=click.Choice(["file", "vscode", "none"]), default="file", show_default=True,
-              help="How each file:line links to its file (file: URL, vscode: URL that opens the line, or no link).")
+@click.option("--links", type=click.Choice(["source", "file", "vscode", "none"]), default="source", show_default=True,
+              help="How each file:line links to its file: source, the report's own view of the file at that line "
+                   "(in the page, below the report; not printed); file: URL; vscode: URL that opens the line; no link.")
 @click.option("-o", "--output", default=None, help="Write the HTML page to this file instead of standard output.")
 def report(backup: str, since: str | None, runs: bool, max_sim_time: float | None, jobs: int | None,
            links: str, output: str | None) -> None:
-    """The change report a customer signs: one HTML page that opens with a summary, then (with
-    --since OLD) the diff from OLD to BACKUP, the check findings the change introduced or
-    removed, the run outcomes of the entry points it touches (old against new), the
-    interactive program map, and every check finding of BACKUP. Prints as a readable PDF."""
+    """The change report a customer signs: one HTML page that opens with both backups
+    identified (their robot, controller, software, dates and SHA-256) and a signature block,
+    a summary, then (with --since OLD) the diff from OLD to BACKUP, the check findings the change
+    introduced or removed, the run outcomes of the entry points it touches (old against new),
+    what to retest on the robot, the interactive program map, and every check finding of
+    BACKUP. Prints as a PDF to sign: numbered pages, the unchanged context collapsed."""
     # costs 0.22 s at start-up (python -X importtime, 2026-11-25)
     from krl.diff.core import diff_sides  # noqa: PLC0415
+    # costs 0.001 s at start-up (python -X importtime, 2026-11-26)
+    from krl.diff.ident import generator, identify  # noqa: PLC0415
     # costs 0.28 s at start-up (python -X importtime, 2026-11-25)
     from krl.diff.load import DiffInputError, side  # noqa: PLC0415
     # costs 0.29 s at start-up (python -X importtime, 2026-11-25)
@@ -196,8 +201,12 @@ def report(backup: str, since: str | None, runs: bool, max_sim_time: float | Non
     try:
         pm, diags, files, lines = load_map(backup)
         new_findings = findings(diags, pm.root, lines, links)
-        kw: dict = {}
-        if since is not None:
+        if since is None:
+            with side(backup) as b:
+                # the source views are read while an archive is still extracted
+                text = report_html(backup, len(files), new_findings, pm, links=links, idents=[identify(b, "backup")],
+                                   generated=generator(), new_root=_root(b, links))
+        else:
             pm_old, diags_old, files_old, lines_old = load_map(since)
             with side(since) as a, side(backup) as b:
                 d = diff_sides(a, b)
@@ -209,13 +218,14 @@ def report(backup: str, since: str | None, runs: bool, max_sim_time: float | Non
                     max_sim_time = REPORT_SIM_TIME_S
                 if runs and touched:
                     _run_touched(touched, a, b, max_sim_time, jobs)
-                kw = {"diff": d, "old_findings": findings(diags_old, pm_old.root, lines_old, links),
-                      "file_sets": (relative(files_old, pm_old.root), relative(files, pm.root)),
-                      "unread": (unread_lines(pm_old, lines_old), unread_lines(pm, lines)),
-                      "old_map": pm_old, "touched": touched, "runs": runs, "max_sim_time": max_sim_time,
-                      "new_root": None if b.shown_of.archive else str(b.root),
-                      "old_root": None if a.shown_of.archive else str(a.root)}
-        text = report_html(backup, len(files), new_findings, pm, links=links, **kw)
+                text = report_html(
+                    backup, len(files), new_findings, pm, links=links, diff=d,
+                    old_findings=findings(diags_old, pm_old.root, lines_old, links),
+                    file_sets=(relative(files_old, pm_old.root), relative(files, pm.root)),
+                    unread=(unread_lines(pm_old, lines_old), unread_lines(pm, lines)),
+                    old_map=pm_old, touched=touched, runs=runs, max_sim_time=max_sim_time,
+                    new_root=_root(b, links), old_root=_root(a, links),
+                    idents=[identify(a, "old"), identify(b, "new")], generated=generator())
     except DiffInputError as exc:
         _fail("report", exc)
     except (ValueError, GraphTooLarge) as exc:
@@ -223,6 +233,15 @@ def report(backup: str, since: str | None, runs: bool, max_sim_time: float | Non
     except Exception as exc:  # noqa: BLE001 - a last line of defence: no traceback
         _fail("report", RuntimeError(f"internal error: {type(exc).__name__}: {exc}"))
     _write(text, output)
+
+
+def _root(s, links: str) -> str | None:
+    """The folder of side `s` the report's links point into: with ``--links source`` the folder
+    read now (an archive's extracted copy: the report carries what it shows); else a folder
+    that outlives the run (an archive's files have no link)."""
+    if links == "source":
+        return str(s.root)
+    return None if s.shown_of.archive else str(s.root)
 
 
 def _real(s, shown_path: str | None) -> str | None:

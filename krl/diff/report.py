@@ -12,14 +12,23 @@ from ``templates/report.html.j2``, in this order:
 4. **Run outcomes** -- the entry points the change touches (:func:`touched_entries`), old
    against new: how each ends, its cycle time, its motion events (interp/outcomes.py runs
    them; this module only shows the rows it is given).
-5. **Program map** -- the interactive map of NEW (krl/programmap's page, embedded), its entry
+5. **Retest on the robot** -- what to try on the robot before it produces again, derived from
+   the changes (:func:`retest`), each row with boxes to tick and sign.
+6. **Program map** -- the interactive map of NEW (krl/programmap's page, embedded), its entry
    points by class, the modules only an operator starts, the dead routines.
-6. **All check findings** of NEW.
+7. **All check findings** of NEW.
 
-A table of contents opens the page; every finding, change and routine names its file:line as
-a link (``links``: ``file`` a file: URL, ``vscode`` a vscode: URL that opens the line, ``none``;
-a file inside a ``.zip`` has no link). The page prints as a PDF a person reads (its print
-style sheet: A4, the interactive map left out with a note, tables that wrap).
+A cover opens the page (issue 63): both backups identified (krl/diff/ident.py: path, kind,
+controller, robot, KSS version, date of the newest file, KRL files, SHA-256), the generator's
+version and the date, and a signature block (print only: on screen one line names the
+backups). A table of contents follows; every finding, change and routine names its file:line
+as a link (``links``: ``source`` the report's own view of the file at that line,
+krl/diff/sources.py, shown below the report on screen; ``file`` a file: URL, ``vscode`` a
+vscode: URL that opens the line, ``none``; with ``file`` and ``vscode`` a file inside a
+``.zip`` has no link). The page prints as a PDF a person signs (its print style sheet: A4,
+"Page N of M" and the backups' hashes at the foot of each page, the interactive map and the
+source views left out, the unchanged context -- lines not understood that did not change,
+the findings NEW had already -- collapsed to their counts, tables of fixed column widths).
 """
 
 from __future__ import annotations
@@ -32,18 +41,21 @@ from pathlib import Path
 from markupsafe import Markup
 
 from krl.diff.core import KIND_TITLES, KINDS, Diff
+from krl.diff.sources import SourceViews
 from krl.diff.text import format_delta, html_helpers
 from krl.programmap.graph import ProgramMap
 from krl.programmap.render import LINKS, context, file_href, map_widget
 from krl.render import render_html
 
 __all__ = ["Finding", "Touched", "findings_delta", "relative", "touched_entries", "report_html", "RUN_KINDS",
-           "MAX_REPORT_DIAGNOSTICS"]
+           "MAX_REPORT_DIAGNOSTICS", "REPORT_LINKS", "retest", "css_string"]
 
 #: the findings listed in each table (introduced, removed, all of NEW; the counts are always complete)
 MAX_REPORT_DIAGNOSTICS = 500
 #: the entry kinds that are programs of their own (krl/programmap/graph.py), run old against new
 RUN_KINDS = ("cell", "plc", "submit", "selected", "operator", "module")
+#: how the report links a file:line: its own view of the source (the default), or as the map does
+REPORT_LINKS = ("source", *LINKS)
 
 
 @dataclass
@@ -103,8 +115,9 @@ def findings(diagnostics: list, root: str, lines: Callable[[str], list[str]], li
     for d in diagnostics:
         text = lines(d.path)
         src = text[d.line - 1].rstrip() if 0 < d.line <= len(text) else ""
+        href = file_href(d.path, d.line, links) if links in LINKS else ""   # "source": report_html links it
         out.append(Finding(d.code, d.severity, d.message.replace(str(root).rstrip("/") + "/", ""),
-                           _rel(d.path, root), d.line, d.column, src, file_href(d.path, d.line, links)))
+                           _rel(d.path, root), d.line, d.column, src, href))
     return out
 
 
@@ -275,43 +288,203 @@ def report_html(backup: str, files: int, new_findings: list[Finding], pm: Progra
                 runs: bool = False, max_sim_time: float | None = None,
                 new_root: str | None = None, old_root: str | None = None, links: str = "file",
                 file_sets: tuple[set[str], set[str]] | None = None,
-                unread: tuple[set, set] = (set(), set())) -> str:
+                unread: tuple[set, set] = (set(), set()), idents: list[dict] | None = None,
+                generated: str = "") -> str:
     """The page (module docstring). `new_findings`: the check findings of NEW (`files` files);
     `pm` NEW's map; with `diff`: OLD's findings and map, the touched entry points (their
     outcomes filled in when `runs`; `max_sim_time` the runs' limit, s), the two backups'
     roots (folders on this machine, else None) for the diff's links, their files
     (`file_sets`, :func:`relative`, for :func:`findings_delta`) and their lines not understood
     (`unread`: OLD's, NEW's, :func:`unread_lines`; a finding on such a line of the other
-    side is listed apart, not as introduced or fixed)."""
-    if links not in LINKS:
-        raise ValueError(f"links must be one of {', '.join(LINKS)}")
+    side is listed apart, not as introduced or fixed). `idents`: the cover's backups, OLD
+    first (krl/diff/ident.py ``identify``, each with ``role``); `generated`: the generator and
+    the date for the cover. With `links` "source" the roots must be readable while this runs
+    (an archive still extracted): the page carries its views of the files it links to."""
+    if links not in REPORT_LINKS:
+        raise ValueError(f"links must be one of {', '.join(REPORT_LINKS)}")
     introduced, removed = findings_delta(old_findings or [], new_findings, file_sets) if diff is not None else ([], [])
     # findings on lines the other backup did not understand: its check could not see them
     introduced, newly_read = apart(introduced, unread[0])
     removed, now_unread = apart(removed, unread[1])
     errors = sum(f.severity == "error" for f in new_findings)
     reach = _reach_changes(old_map, pm) if old_map is not None else {"dead": [], "live": []}
+    views = SourceViews({"old": old_root, "new": new_root}) if links == "source" else None
+    # a file moved to another folder: the diff names its new place; its old lines are at the old one
+    moved_back = {e["new"]: e["old"] for e in diff.moved} if diff is not None else {}
 
     def link(file: str, line: int | None = None, side: str = "new", label: str | None = None) -> Markup:
         root = new_root if side == "new" else old_root
         text = label if label is not None else f"{file}:{line}" if line else file
-        href = file_href(str(Path(root) / file), line or 1, links) if root else ""
+        place = moved_back.get(file, file) if side == "old" else file
+        if views is not None:
+            href = views.href(side, place, line)
+        else:
+            href = file_href(str(Path(root) / place), line or 1, links) if root else ""
         return Markup(render_html("krl.diff", "_link.html.j2", text=text, href=href))
 
+    shown_new = new_findings[:MAX_REPORT_DIAGNOSTICS]
+    if views is not None:
+        for side, group in (("new", introduced[:MAX_REPORT_DIAGNOSTICS]), ("old", removed[:MAX_REPORT_DIAGNOSTICS]),
+                            ("new", newly_read[:MAX_REPORT_DIAGNOSTICS]), ("old", now_unread[:MAX_REPORT_DIAGNOSTICS]),
+                            ("new", shown_new)):
+            for f in group:
+                f.href = views.href(side, f.file, f.line)
     changed_runs = [t for t in touched or [] if t.changes]
     rows = [_run_row(t, link, {"old": old_root, "new": new_root}) for t in touched or []]
-    return render_html(
-        "krl.diff", "report.html.j2", title=f"Change report: {backup}", backup=backup, files=files,
-        errors=errors, warnings=len(new_findings) - errors, all_findings=new_findings[:MAX_REPORT_DIAGNOSTICS],
+    checks = retest(diff, touched or [], {"new": pm, "old": old_map} if old_map is not None else {"new": pm}) \
+        if diff is not None else []
+    for r in checks:
+        r["where"] = link(r["file"], r["line"], r["side"]) if r.get("file") else ""
+    body = dict(
+        title=f"Change report: {backup}", backup=backup, files=files,
+        errors=errors, warnings=len(new_findings) - errors, all_findings=shown_new,
         more=max(0, len(new_findings) - MAX_REPORT_DIAGNOSTICS), introduced=introduced, removed=removed,
-        newly_read=newly_read, now_unread=now_unread,
+        newly_read=newly_read, now_unread=now_unread, code_groups=code_groups(new_findings),
         limit=MAX_REPORT_DIAGNOSTICS, by_code=_by_code,
         diff=diff, touched=touched or [], changed_runs=changed_runs, runs=runs, run_rows=rows,
-        max_sim_time=max_sim_time,
-        reach=reach, map_widget=map_widget(pm, links), format_delta=format_delta,
+        max_sim_time=max_sim_time, retest=checks, idents=idents or [], generated=generated,
+        footer=css_string(_footer(backup, idents or [])),
+        reach=reach, map_widget=map_widget(pm, links if links in LINKS else "none"), format_delta=format_delta,
         map_tables=Markup(render_html("krl.programmap", "_map_body.html.j2", edges=False, **context(pm, None))),
         kind_counts=[(k, KIND_TITLES[k], len(getattr(diff, k))) for k in KINDS] if diff is not None else [],
         **html_helpers(link), **context(pm, None))
+    # the source views last, once the page's every link has named its file and line (the
+    # template calls link()); the mark cannot come from a backup: its text is escaped
+    page = render_html("krl.diff", "report.html.j2", sources=Markup(_SOURCES_MARK), **body)
+    return page.replace(_SOURCES_MARK, views.render() if views is not None else "", 1)
+
+
+_SOURCES_MARK = "<!-- krl report: the source views -->"
+
+
+def _footer(backup: str, idents: list[dict]) -> str:
+    """The foot of each printed page: the backup(s) by the start of their hash."""
+    if not idents:
+        return f"Change report: {backup}"
+    return "Change report: " + " \u2192 ".join(f"{'/'.join(Path(i['path']).parts[-2:])} ({i['sha256'][:12]})"
+                                                for i in idents)
+
+
+def css_string(text: str) -> Markup:
+    """`text` as a CSS string literal for the page's style sheet (``content: ...`` of the printed
+    page's foot): every character but letters, digits, space and ``._-:()/`` as a CSS escape,
+    so nothing of a file name (a quote, ``</style>``) can end the string or the style element."""
+    out = []
+    for ch in text:
+        out.append(ch if ch.isascii() and (ch.isalnum() or ch in " ._-:()/") else f"\\{ord(ch):06x}")
+    return Markup('"' + "".join(out) + '"')
+
+
+def code_groups(found: list[Finding]) -> list[dict]:
+    """The findings by code, the commonest first: {code, severity, count, message (the first's),
+    files (how many), first (the first's file:line)} -- the printed report's list of the findings
+    NEW had (the whole list is on screen)."""
+    groups: dict[str, dict] = {}
+    for f in found:
+        g = groups.setdefault(f.code, {"code": f.code, "severity": f.severity, "count": 0, "message": f.message,
+                                       "files": set(), "first": f"{f.file}:{f.line}"})
+        g["count"] += 1
+        g["files"].add(f.file.lower())
+    return [dict(g, files=len(g["files"])) for g in sorted(groups.values(), key=lambda g: (-g["count"], g["code"]))]
+
+
+#: the start of the name of a frame of the robot's installation (machine data), not of a tool or base
+_MACHINE_FRAMES = ("$ROBROOT", "$TIRORO", "$ERSYSROOT", "$TFLA_TIRO", "$TX3P3", "$TFLWP", "$ET")
+_FRAME_CHECKS = (("TOOL_DATA", "tool", "measure its TCP on the robot (a fixed point approached in several "
+                  "orientations) before a motion uses it"),
+                 ("BASE_DATA", "base", "touch its reference points on the robot before a motion uses it"),
+                 ("LOAD_DATA", "load", "check the payload's mass and centre of gravity (load data determination)"))
+
+
+def retest(d: Diff, touched: list[Touched], maps: dict[str, ProgramMap] | None = None) -> list[dict]:
+    """What to try on the robot before it produces again, derived from the changes of `d` and
+    the entry points they touch (`maps`: the program map of each side, "old" and "new", for
+    the programs' places and the routines they reach); each row {area, what, why, file, line,
+    side}, `file` relative to its side's root ("" for none):
+
+    * **program** -- each touched program that runs alone: run it in T1, then at its speed;
+      ``why`` names the first change it reaches and how its run outcome changed;
+    * **routine** -- a routine changed or added that none of those programs reaches: run it
+      where it is used;
+    * **tool / base / load** -- each tool, base or load data changed or added ($config.dat's
+      TOOL_DATA, BASE_DATA, LOAD_DATA): measure or check it;
+    * **machine data** -- the values of a system file ($machine.dat, $config.dat: not a tool,
+      base or load) changed, and the frames of the robot's installation ($ROBROOT...): one row
+      per file with their names;
+    * **points** -- the points changed or added, one row per file: approach each in T1;
+    * **motions** -- the motions whose parameters changed (velocity, acceleration,
+      approximation...), one row per routine;
+    * **signal** -- each signal declaration changed or added: check its wiring (an I/O test).
+
+    Removed entries need no retest on their own: what used them is a changed routine."""
+    rows: list[dict] = []
+    maps = maps or {}
+
+    def row(area: str, what: str, why: str, file: str = "", line: int | None = None, side: str = "new") -> None:
+        rows.append({"area": area, "what": what, "why": why, "file": file, "line": line, "side": side})
+
+    covered: set[tuple[str, str]] = set()         # (file, routine) of the routines a touched program reaches
+    for t in touched:
+        side = "new" if t.new is not None else "old"
+        pm = maps.get(side)
+        n = pm.nodes.get(t.id) if pm is not None else None
+        why = t.why + (f"; its run changed: {', '.join(t.changes)}" if t.changes else "")
+        row("program", f"run {t.name} ({t.kind}) in T1, then at its programmed speed", why,
+            _rel(n.path, pm.root) if n is not None and n.path else "", n.line if n is not None else None, side)
+        if pm is not None:
+            for nid in _reach_from(pm, t.id):
+                m = pm.nodes[nid]
+                if m.kind == "routine" and m.path:
+                    covered.add((_rel(m.path, pm.root).lower(), m.name.upper()))
+    for e in d.routines:
+        if e["change"] in ("changed", "added") and (e["file"].lower(), e["name"].upper()) not in covered:
+            row("routine", f"run {e['module']}:{e['name']} where it is used (no program that runs alone was "
+                "found to reach it)", f"routine {e['name']} {e['change']}", e["file"], e["line"])
+    system: dict[str, list[dict]] = {}
+    for e in d.frames:
+        if e["change"] == "removed":
+            continue
+        check = next((c for c in _FRAME_CHECKS if e["name"].upper().startswith(c[0])), None)
+        if check is None:
+            system.setdefault(e["file"], []).append(e)
+            continue
+        row(check[1], f"{e['name']}: {check[2]}", f"{check[1]} data {e['change']}", e["file"], e.get("line"))
+    points: dict[str, list[dict]] = {}
+    for e in d.points:
+        if e["change"] == "removed":
+            continue
+        if e["name"].upper().startswith(_MACHINE_FRAMES) or e["file"].rsplit("/", 1)[-1].startswith("$"):
+            system.setdefault(e["file"], []).append(e)
+        else:
+            points.setdefault(e["file"], []).append(e)
+    for e in d.values:
+        if e["file"].rsplit("/", 1)[-1].startswith("$"):
+            system.setdefault(e["file"], []).append(e)
+    for file, es in system.items():
+        names = _names([e["name"] for e in es])
+        row("machine data", f"check on the robot what depends on {names} (installation, limits, brakes, "
+            "I/O as the names say)", f"{len(es)} value(s) of {file.rsplit('/', 1)[-1]} changed", file, es[0].get("line"))
+    for file, es in points.items():
+        turned = [e["name"] for e in es if e.get("status_turn_changed")]
+        row("points", f"approach {_names([e['name'] for e in es])} in T1 at reduced speed"
+            + (f"; {_names(turned)}: status/turn changed, another arm configuration" if turned else ""),
+            f"{len(es)} point(s) changed or added", file, es[0].get("line"))
+    motions: dict[tuple[str, str], list[dict]] = {}
+    for e in d.motions:
+        motions.setdefault((e["file"], e["routine"]), []).append(e)
+    for (file, routine), es in motions.items():
+        params = sorted({k for e in es for k in e["changed"]})
+        row("motions", f"run the motions of {routine} at line(s) {', '.join(str(e['line']) for e in es[:8])}"
+            f"{', ...' if len(es) > 8 else ''} at their speed", f"changed: {', '.join(params)}", file, es[0]["line"])
+    for e in d.declarations:
+        if e["kind"] == "signal" and e["change"] != "removed":
+            row("signal", f"check the wiring of {e['name']} ({e['after']}): set or read it at the pendant",
+                f"signal {e['change']}", e["file"], e["line"])
+    return rows
+
+
+def _names(names: list[str], n: int = 8) -> str:
+    return ", ".join(names[:n]) + (f" and {len(names) - n} more" if len(names) > n else "")
 
 
 def _by_code(findings: list[Finding], n: int = 3) -> str:

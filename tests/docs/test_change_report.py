@@ -6,12 +6,14 @@ once. Here:
 
 * on one screen (1280 x 800), the page opens with its contents, the summary and the whole
   diff of the example (the point and the tool);
-* every finding and every change links to its file and line: the link is a file: URL of a file
-  of the backup, its text is ``path:line`` of that file, and the line holds what the row says
+* every finding and every change links to its file and line: the link opens the report's own
+  view of a file of the backup at that line (issue 63: in the page, not a file: URL Chromium
+  downloads), its text is ``path:line`` of that file, and the line holds what the row says
   (the finding's source line; the point's or the tool's name);
-* printed by Chromium (``page.pdf``, A4), the PDF is legible: its text (pypdf) holds the summary
-  and the diff on the first page, every run of text is at least 7 pt, no part is a picture, and
-  no file:line is cut.
+* printed by Chromium (``page.pdf``, A4), the PDF is legible: its first page is the cover (the
+  backups identified, the signature block; tests/report/test_signed_report.py checks it on a
+  history pair), its text (pypdf) holds the summary and the diff on the second page, every run
+  of text is at least 7 pt, no part is a picture, and no file:line is cut.
 
 And on a history pair whose change introduces and removes findings (KnoP-01's krl-for-vim9
 ``01-8fae7e9c``: "Fix typo: Name should come without extension" -- the header
@@ -25,7 +27,6 @@ import math
 import re
 import subprocess
 from pathlib import Path
-from urllib.parse import unquote, urlparse
 
 import playwright.sync_api as playwright
 import pytest
@@ -58,10 +59,17 @@ def example(document_runs):
     return work, page
 
 
-def _file_of(href: str) -> Path:
-    u = urlparse(href)
-    assert u.scheme == "file", href
-    return Path(unquote(u.path))
+def _opened(page, link) -> tuple[str, str, int, str]:
+    """(side, file, line, text) of the line `link` opens: the report's view of the file
+    (its section's heading ``side: file``) and the line it marks."""
+    href = link.get_attribute("href")
+    assert href.startswith("#src-"), href
+    side, file = page.evaluate("""id => {
+        const h = document.getElementById(id).closest('section.source').querySelector('h3');
+        return [h.textContent.split(':')[0], h.querySelector('code').textContent]; }""", href[1:])
+    text = page.locator(href).text_content()
+    n, _, line_text = text.partition(" ")
+    return side, file, int(n), line_text
 
 
 def test_summary_and_diff_on_the_first_screen(chromium, example):
@@ -86,17 +94,19 @@ def test_summary_and_diff_on_the_first_screen(chromium, example):
         assert page.locator("img").count() == 0 and page.locator("#map canvas").count() > 0
 
 
-def _check_links(page, root: Path, findings: str = "table.findings tr.finding") -> int:
-    """Every place of the diff and of the findings (rows `findings`) links to a line of a file
-    below `root` that holds what its row says; returns the number of links checked."""
+def _check_links(page, root: Path, findings: str = "table.findings tr.finding", side: str = "new") -> int:
+    """Every place of the diff and of the findings (rows `findings`) opens the report's view of
+    a file below `root` at a line that holds what its row says; returns the number of links
+    checked."""
     n = 0
     for row in page.locator(findings).all():
         link = row.locator("a.where")
         assert link.count() == 1, row.inner_text()
-        f = _file_of(link.get_attribute("href"))
+        opened_side, file, opened, shown = _opened(page, link)
         rel, line = link.inner_text().rsplit(":", 1)
-        assert f.resolve() == (root / rel).resolve() and f.is_file()
-        text = f.read_text(encoding="latin-1").splitlines()[int(line) - 1]
+        assert (opened_side, file, opened) == (side, rel, int(line)) and (root / rel).is_file()
+        text = (root / rel).read_text(encoding="latin-1").splitlines()[int(line) - 1]
+        assert shown.rstrip() == text.rstrip()
         pre = row.locator("pre")
         assert pre.inner_text() == f"{line} | {text.rstrip()}"
         n += 1
@@ -104,11 +114,11 @@ def _check_links(page, root: Path, findings: str = "table.findings tr.finding") 
         if row.locator("th").count():
             continue
         link = row.locator("a.where")
-        f = _file_of(link.get_attribute("href"))
+        _side, file, opened, shown = _opened(page, link)
         rel, line = link.inner_text().rsplit(":", 1)
-        assert f.resolve() == (root / rel).resolve()
+        assert (file, opened) == (rel, int(line))
         name = row.locator("td").nth(1).inner_text()
-        assert name in f.read_text(encoding="latin-1").splitlines()[int(line) - 1]
+        assert name in (root / rel).read_text(encoding="latin-1").splitlines()[int(line) - 1] and name in shown
         n += 1
     return n
 
@@ -143,7 +153,7 @@ def test_findings_introduced_and_removed_link_to_each_side(chromium, shared_hist
         assert {"tests/testdir/resource_Folding/fahrwege_small.src:104",
                 "tests/testdir/resource_Folding/fahrwege_small.src:120"} <= set(where)
         assert _check_links(page, pair / "new", "#newly-read-table tr.finding, #all-findings-table tr.finding") >= 2
-        assert _check_links(page, pair / "old", "#removed-table tr.finding") >= 2
+        assert _check_links(page, pair / "old", "#removed-table tr.finding", side="old") >= 2
 
 
 def _pdf_text_sizes(pdf: Path) -> tuple[list[str], list[float], int]:
@@ -165,7 +175,11 @@ def test_the_printed_pdf_is_legible(chromium, example, tmp_path):
         page.wait_for_function("document.body.dataset.ready === '1'", timeout=180_000)
         page.pdf(path=str(pdf), format="A4", print_background=True)
     texts, sizes, images = _pdf_text_sizes(pdf)
-    first = re.sub(r"\s+", " ", texts[0])
+    cover = re.sub(r"\s+", " ", texts[0])
+    for words in ("Change report", "SHA-256", "Signatures", "Changed by", "Reviewed by", "Accepted by"):
+        assert words in cover, words
+    assert "Summary" not in cover.split("Signatures")[-1]
+    first = re.sub(r"\s+", " ", texts[1])
     for words in ("Change report", "Summary", "Changes: Points 1, Frames and loads 1", "Check ﬁndings:",
                   "Run outcomes:", "Program map:", "Program/CAJA_G/caja_g_m1.dat:24", "XC1", "ΔX +1.5 mm, ΔZ -2 mm",
                   "System/$conﬁg.dat:231", "TOOL_DATA[1]", "ΔZ +5.5 mm"):

@@ -99,7 +99,7 @@ def test_change_pages_render_in_headless_chromium(chromium, pages):
     def report(page):
         # the summary first, then the diff; the map is the interactive one (no picture), its
         # tables without the edge list
-        assert page.locator("#summary-list li").count() == 4
+        assert page.locator("#summary-list li").count() == 5          # changes, findings, runs, retest, map
         assert page.locator("table.map-edges").count() == 0 and page.locator("img").count() == 0
         page.wait_for_function("document.body.dataset.ready === '1'", timeout=120_000)
         assert page.locator("table.map-unreachable tr").count() == 1 + 1
