@@ -63,7 +63,7 @@ def audit(folders: tuple[str, ...], out: Path, jobs: int | None, scheduler: str 
 
 
 def summary_lines(data: dict) -> list[str]:
-    """The terminal's summary of a report: one line per backup (status, name, its counts), then
+    """The terminal's summary of a report: one line per backup (status, name and robot, its counts), then
     the totals."""
     # costs 0.009 s at start-up (python -X importtime, 2026-11-25)
     from audit.report import plural as n  # noqa: PLC0415
@@ -72,7 +72,7 @@ def summary_lines(data: dict) -> list[str]:
     for u in data["units"]:
         t = u["tally"]
         cyc = f", cell cycle {t['cell_cycle']:.3f} s" if t["cell_cycle"] is not None else ""
-        out.append(f"{u['status']:9s} {printable(u['name'])}: {n(u['errors'], 'check error')}, "
+        out.append(f"{u['status']:9s} {printable(u['title'])}: {n(u['errors'], 'check error')}, "
                    f"{n(t['entry_points'], 'entry point')} ({t['completed_or_intended']} completed or intended end, "
                    f"{n(t['program_errors'], 'program error')}, {t['limit_or_gap']} limit or gap), "
                    f"{n(t['motion_errors'], 'motion error')}, {n(t['overlaps'], 'output')} to review{cyc}")

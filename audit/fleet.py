@@ -58,13 +58,18 @@ class Unit:
 
     @property
     def name(self) -> str:
-        """The unit's path relative to the folder the user named (the folder's own name when it
-        is the unit)."""
+        """The unit's path relative to the folder the user named; when the folder named is the
+        unit, its own name with its parent's (``depalletizer/KRC``: a backup's folder is often
+        just ``KRC``, issue 63)."""
         try:
             rel = Path(self.root).relative_to(self.folder).as_posix()
         except ValueError:
             rel = ""
-        return rel if rel and rel != "." else Path(self.folder).name or self.folder
+        if rel and rel != ".":
+            return rel
+        parts = Path(self.folder).absolute().parts
+        parts = Path(*parts).resolve().parts if parts[-1] in (".", "..") else parts
+        return "/".join(p for p in parts[-2:] if p != "/") or self.folder
 
 
 def units_of(folders: list[str]) -> list[Unit]:
@@ -107,7 +112,7 @@ def check_unit(root: str, entries: list, backup: bool) -> dict:
     # costs 0.03 s at start-up (python -X importtime, 2026-11-25)
     from krl.semantics.config import config_for  # noqa: PLC0415
     # costs 0.40 s at start-up (python -X importtime, 2026-11-25)
-    from krl.workspace import load_workspaces  # noqa: PLC0415
+    from krl.workspace import load_workspaces, machine_identity  # noqa: PLC0415
 
     # costs 0.24 s at start-up (python -X importtime, 2026-11-25)
     from audit.outputs import overlaps  # noqa: PLC0415
@@ -128,7 +133,7 @@ def check_unit(root: str, entries: list, backup: bool) -> dict:
     pm = build_map(ws)
     kinds = {str(Path(n.path)): (n.entry_kind, n.entry) for n in pm.nodes.values() if n.main and n.path}
     files = [e.path for e in entries if e.kind == "file"]
-    progs = entries_of(Path(root), files) if backup else folder_entries(files)
+    progs, handlers = _not_handlers(entries_of(Path(root), files) if backup else folder_entries(files), pm, root)
     rep = overlaps(ws, pm)
     names = {nid: pm.nodes[nid].name for nid in pm.nodes}
 
@@ -146,6 +151,11 @@ def check_unit(root: str, entries: list, backup: bool) -> dict:
         "programs": [{"path": str(p), "kind": kinds.get(str(Path(p)), ("", ""))[0],
                       "why": kinds.get(str(Path(p)), ("", ""))[1]} for p in progs[:MAX_AUDIT_ENTRIES]],
         "programs_left_out": max(0, len(progs) - MAX_AUDIT_ENTRIES),
+        "handlers": handlers,
+        # the programs the cell program's SWITCH selects (the map's "plc" entries): its cycle
+        # is a production cycle only when it selects one (issue 63)
+        "cell_selects": sorted({n.name for n in pm.nodes.values() if n.entry_kind == "plc"}, key=str.upper),
+        "machine": machine_identity(ws.files),
         "outputs": {
             "writes": len(rep.writes), "computed": len(rep.computed), "plc_map": len(rep.plc_map),
             "overlaps": [{"signal": o.signal, "signals": o.signals, "flags": o.flags, "tasks": o.tasks,
@@ -154,6 +164,34 @@ def check_unit(root: str, entries: list, backup: bool) -> dict:
                           "writes": [write(w) for w in o.writes]} for o in rep.overlaps],
         },
     }
+
+
+def _not_handlers(progs: list, pm, root: str) -> tuple[list, list[dict]]:
+    """(the programs of `progs` to run, the interrupt and trigger routines among them): a module
+    whose main routine an ``INTERRUPT DECL ... DO`` or a ``TRIGGER ... DO`` of the map `pm`
+    calls is an interrupt routine, run by the program that declares it when its condition
+    fires, never on its own (issue 63: run alone, such routines were counted as program
+    errors); each with ``{path, why}``."""
+    # costs 0.006 s at start-up (python -X importtime, 2026-11-25)
+    from audit.report import rel_path as _rel  # noqa: PLC0415
+
+    called: dict[str, object] = {}
+    for e in pm.edges:
+        if e.kind in ("interrupt", "trigger"):
+            called.setdefault(e.target, e)
+    mains = {str(Path(n.path)): n for n in pm.nodes.values() if n.main and n.path and n.kind == "routine"}
+    keep, handlers = [], []
+    for p in progs:
+        n = mains.get(str(Path(p)))
+        e = called.get(n.id) if n is not None else None
+        if e is None:
+            keep.append(p)
+            continue
+        how = "an interrupt routine" if e.kind == "interrupt" else "a trigger's routine"
+        what = "INTERRUPT DECL ... DO" if e.kind == "interrupt" else "TRIGGER WHEN ... DO"
+        handlers.append({"path": str(p), "why": f"{how}: {pm.nodes[e.source].name} calls it by {what} at "
+                                                f"{_rel(e.path, root)}:{e.line}"})
+    return keep, handlers
 
 
 def run_entry(path: str, max_sim_time: float, max_steps: int, interp: str) -> dict:

@@ -35,7 +35,8 @@ from pathlib import Path
 from krl import __version__
 from krl.limits import MAX_AUDIT_EVIDENCE_CHARS
 
-__all__ = ["AUDIT_FORMAT", "STATUSES", "rel_path", "plural", "report_data", "health", "write_report", "to_html"]
+__all__ = ["AUDIT_FORMAT", "STATUSES", "rel_path", "plural", "report_data", "health", "write_report", "to_html",
+           "causes_of", "motion_causes", "finding_groups"]
 
 #: the version of the report's JSON (docs/schemas/audit.schema.json)
 AUDIT_FORMAT = 1
@@ -104,7 +105,10 @@ def _entry(row: dict, program: dict, root: str) -> dict:
         "motions": row.get("motions", 0),
         "event_counts": row.get("event_counts") or {},
         "events": [{**e, "file": rel_path(e.get("file"), root)} for e in row.get("events") or ()],
-        "cycle": _cycle(requests, row.get("requests_total", len(requests))) if program.get("kind") == "cell" else None,
+        # a cycle time only for a cell program that selects a production program (issue 63):
+        # KUKA's template loop, whose CASE branches call nothing, times P00's handshake alone
+        "cycle": _cycle(requests, row.get("requests_total", len(requests)))
+        if program.get("kind") == "cell" and program.get("selects") else None,
         "stubs": row.get("stubs") or {}, "submit_errors": row.get("submit") or [],
         "answers": len(row.get("answers") or ()), "answers_shown": (row.get("answers") or [])[:MAX_ANSWERS_SHOWN],
     }
@@ -125,8 +129,12 @@ def health(unit: dict) -> tuple[str, list[dict]]:
     for e in entries:
         by[e["cause"]] = by.get(e["cause"], 0) + 1
     n = len(entries)
+    groups: dict[str, int] = {}
+    for c in unit.get("causes", []):
+        groups[c["cause"]] = groups.get(c["cause"], 0) + 1
     if by.get("program error"):
-        add("attention", f"{by['program error']} of {n} entry points end in a program error", "entries")
+        add("attention", f"{by['program error']} of {n} entry points end in a program error "
+                         f"({plural(groups.get('program error', 0), 'cause')})", "causes")
     words = {"reach": "workspace error", "limit": "software limit switch", "singularity": "singularity",
              "motion": "other motion error"}
     for own in (True, False):
@@ -155,9 +163,10 @@ def health(unit: dict) -> tuple[str, list[dict]]:
         add("review", f"{plural(unit['errors'], 'check error')}", "check")
     if by.get("limit"):
         add("review", f"{by['limit']} of {n} entry points stop at a limit of the audit (starving or looping)",
-            "entries")
+            "causes")
     if by.get("interpreter gap"):
-        add("review", f"{by['interpreter gap']} of {n} entry points stop at a gap of the simulator", "entries")
+        add("review", f"{by['interpreter gap']} of {n} entry points stop at a gap of the simulator "
+                      f"({plural(groups.get('interpreter gap', 0), 'cause')})", "causes")
     if names:
         add("review", f"{plural(names, 'output')} written under two SIGNAL names", "outputs")
     if unit.get("programs_left_out"):
@@ -171,20 +180,26 @@ def report_data(folders: list[str], units: list, checked: list[dict], runs: list
     static half (audit.fleet.check_unit, or ``{"error"}``) and their run rows, in order."""
     out_units = []
     for u, c, rows in zip(units, checked, runs):
-        progs = c.get("programs", [])
+        progs = [dict(p, selects=c.get("cell_selects", [])) for p in c.get("programs", [])]
         entries = [_entry(r, p, u.root) for r, p in zip(rows, progs)]
+        machine = c.get("machine") or {"robot": "", "mada": "", "kss": "", "controller": ""}
+        robot = machine["robot"]
         unit = {
-            "name": u.name, "root": u.root, "kind": "backup" if u.backup else "folder",
+            "name": u.name, "title": f"{u.name} ({robot})" if robot else u.name,
+            "root": u.root, "kind": "backup" if u.backup else "folder",
             "error": c.get("error"), "files": c.get("files", 0), "errors": c.get("errors", 0),
             "warnings": c.get("warnings", 0), "codes": c.get("codes", {}), "findings": c.get("findings", []),
+            "finding_groups": finding_groups(c.get("findings", [])),
             "findings_left_out": c.get("findings_left_out", 0),
-            "robot": next((e["robot"] for e in entries if e["robot"]), ""),
-            "entries": entries, "programs_left_out": c.get("programs_left_out", 0),
+            "robot": robot, "machine": machine,
+            "entries": entries, "causes": causes_of(entries), "motion_causes": motion_causes(entries),
+            "programs_left_out": c.get("programs_left_out", 0),
+            "handlers": [{"program": rel_path(h["path"], u.root), "why": h["why"]} for h in c.get("handlers", [])],
             "outputs": c.get("outputs", {"writes": 0, "computed": 0, "plc_map": 0, "overlaps": []}),
         }
         cell = next((e for e in entries if e["kind"] == "cell"), None)
         unit["cell"] = None if cell is None else {"program": cell["program"], "cause": cell["cause"],
-                                                  "cycle": cell["cycle"]}
+                                                  "cycle": cell["cycle"], "selects": c.get("cell_selects", [])}
         causes = [e["cause"] for e in entries]
         unit["tally"] = {
             "entry_points": len(entries),
@@ -214,6 +229,60 @@ def report_data(folders: list[str], units: list, checked: list[dict], runs: list
     return {"format": AUDIT_FORMAT, "tool": f"krl-tools {__version__}",
             "generated": datetime.now(timezone.utc).strftime("%Y-%m-%d %H:%M:%S UTC"),
             "folders": [str(f) for f in folders], "settings": settings, "summary": summary, "units": out_units}
+
+
+#: the sites listed per cause (all are counted)
+MAX_SITES = 50
+
+
+def causes_of(entries: list[dict]) -> list[dict]:
+    """The entry points of a unit by cause (issue 63): those that end alike are one row
+    ``{cause, reason, ending, text, file, line, count, programs}``, the commonest first. A
+    program error, a limit or a gap is the same cause when its message and its file:line are
+    (39 programs stopped by one line of a shared routine: one row, 39 sites); a completed run
+    or an intended end is one cause whatever its line."""
+    rows: dict[tuple, dict] = {}
+    for e in entries:
+        own = e["cause"] in ("completed", "intended end")
+        key = (e["cause"], e["reason"]) if own else (e["cause"], e["reason"], e["text"], e["file"], e["line"])
+        r = rows.get(key)
+        if r is None:
+            r = rows[key] = {"cause": e["cause"], "reason": e["reason"], "ending": e["ending"],
+                             "text": "" if own else e["text"], "file": None if own else e["file"],
+                             "line": None if own else e["line"], "count": 0, "programs": []}
+        r["count"] += 1
+        if len(r["programs"]) < MAX_SITES:
+            r["programs"].append(e["program"])
+    order = {c: i for i, c in enumerate(("program error", "interpreter gap", "limit", "intended end", "completed"))}
+    return sorted(rows.values(), key=lambda r: (order.get(r["cause"], 9), -r["count"]))
+
+
+def motion_causes(entries: list[dict]) -> list[dict]:
+    """The motion errors of a unit's runs by cause: one row per kind, message and motion
+    (file:line) ``{kind, text, file, line, count, programs}``, the commonest first."""
+    rows: dict[tuple, dict] = {}
+    for e in entries:
+        for x in e["events"]:
+            key = (x.get("kind"), x.get("text"), x.get("file"), x.get("line"))
+            r = rows.setdefault(key, {"kind": x.get("kind") or "", "text": x.get("text") or "", "file": x.get("file"),
+                                      "line": x.get("line"), "count": 0, "programs": []})
+            r["count"] += 1
+            if e["program"] not in r["programs"] and len(r["programs"]) < MAX_SITES:
+                r["programs"].append(e["program"])
+    return sorted(rows.values(), key=lambda r: -r["count"])
+
+
+def finding_groups(findings: list[dict]) -> list[dict]:
+    """The check findings listed by cause: one row per code and message ``{code, severity,
+    message, count, sites: [{file, line, column}]}``, errors first, then the commonest."""
+    rows: dict[tuple, dict] = {}
+    for f in findings:
+        r = rows.setdefault((f["code"], f["message"]), {"code": f["code"], "severity": f["severity"],
+                                                        "message": f["message"], "count": 0, "sites": []})
+        r["count"] += 1
+        if len(r["sites"]) < MAX_SITES:
+            r["sites"].append({"file": f["file"], "line": f["line"], "column": f["column"]})
+    return sorted(rows.values(), key=lambda r: (r["severity"] != "error", -r["count"], r["code"]))
 
 
 class _Evidence:

@@ -29,6 +29,12 @@ PROGRAMS = {
     "bad.src": f"DEF bad()\n  ; {PWNED}\n  IF x THEN\nEND\n",
     # markup in a file's name
     "<i>mark.src": "DEF mark()\n  $OUT[3] = TRUE\nEND\n",
+    # issue 63: two programs stopped by one line (div.src:4, through the call): one cause, two
+    # sites; an interrupt routine (good2's INTERRUPT DECL, line 2, calls ir_door) is no entry
+    # point on its own
+    "twice.src": "DEF twice()\n  div()\nEND\n",
+    "good2.src": "DEF good2()\n  INTERRUPT DECL 3 WHEN $IN[1] DO ir_door()\nEND\n",
+    "ir_door.src": "DEF ir_door()\n  DECL INT a, b\n  a = 1 / b\nEND\n",
 }
 
 
@@ -52,7 +58,10 @@ def test_how_each_entry_point_ends(audited):
     assert res.exit_code == 1, res.output            # a program error: attention
     assert "Traceback" not in res.output
     (u,) = data["units"]
-    assert (u["name"], u["kind"], u["root"]) == (fleet.name, "folder", str(fleet))
+    # the folder named is the unit: named with its parent (issue 63: a backup's folder is often
+    # just "KRC"); a program folder names no robot
+    assert (u["name"], u["kind"], u["root"]) == (f"{fleet.parent.name}/{fleet.name}", "folder", str(fleet))
+    assert (u["title"], u["robot"]) == (u["name"], "")
     got = {e["program"]: (e["cause"], e["reason"], e["file"], e["line"]) for e in u["entries"]}
     # bad.src's DEF line parses, so it is a program (issue 63: what parsed is used); its IF has
     # no ENDIF, so its blocks are in doubt from line 3 on: the run does not enter it and says so,
@@ -63,22 +72,36 @@ def test_how_each_entry_point_ends(audited):
         "cell/div.src": ("program error", "error", "cell/div.src", 4),
         "cell/spin.src": ("limit", "max_steps", "cell/spin.src", 2),
         "cell/bad.src": ("interpreter gap", "error", "cell/bad.src", 3),
+        "cell/twice.src": ("program error", "error", "cell/div.src", 4),
+        "cell/good2.src": ("completed", "completed", "cell/good2.src", 2),
     }
+    assert u["handlers"] == [{"program": "cell/ir_door.src",
+                              "why": "an interrupt routine: good2 calls it by INTERRUPT DECL ... DO at cell/good2.src:2"}]
+    # by cause: div.src:4 stops two programs (one row, two sites); the three that complete are
+    # one cause
+    causes = [(c["cause"], c["file"], c["line"], c["count"], c["programs"]) for c in u["causes"]]
+    assert causes == [
+        ("program error", "cell/div.src", 4, 2, ["cell/div.src", "cell/twice.src"]),
+        ("interpreter gap", "cell/bad.src", 3, 1, ["cell/bad.src"]),
+        ("limit", "cell/spin.src", 2, 1, ["cell/spin.src"]),
+        ("completed", None, None, 3, ["cell/<i>mark.src", "cell/good.src", "cell/good2.src"]),
+    ]
     errors = [(f["code"], f["file"], f["line"], f["column"]) for f in u["findings"] if f["severity"] == "error"]
     assert errors == [("E010", "cell/bad.src", 3, 3)]
     assert u["status"] == "attention"
     assert [(r["level"], r["text"]) for r in u["reasons"]] == [
-        ("attention", "1 of 5 entry points end in a program error"),
+        ("attention", "2 of 7 entry points end in a program error (1 cause)"),
         ("review", "1 check error"),
-        ("review", "1 of 5 entry points stop at a limit of the audit (starving or looping)"),
-        ("review", "1 of 5 entry points stop at a gap of the simulator"),
+        ("review", "1 of 7 entry points stop at a limit of the audit (starving or looping)"),
+        ("review", "1 of 7 entry points stop at a gap of the simulator (1 cause)"),
     ]
     # the terminal: one line for the folder, then the totals
-    # (good.src and <i>mark.src complete; div.src; spin.src and bad.src; bad.src's E010)
+    # (good.src, good2.src and <i>mark.src complete; div.src and twice.src; spin.src and
+    # bad.src; bad.src's E010)
     assert res.output.splitlines()[0] == (
-        f"attention {fleet.name}: 1 check error, 5 entry points (2 completed or intended end, 1 program error, "
-        f"2 limit or gap), 0 motion errors, 0 outputs to review")
-    assert res.output.splitlines()[1] == "0 backups, 1 program folder, 5 entry points: 1 attention, 0 review, 0 ok"
+        f"attention {fleet.parent.name}/{fleet.name}: 1 check error, 7 entry points (3 completed or intended end, "
+        f"2 program errors, 2 limit or gap), 0 motion errors, 0 outputs to review")
+    assert res.output.splitlines()[1] == "0 backups, 1 program folder, 7 entry points: 1 attention, 0 review, 0 ok"
 
 
 def test_the_json_follows_its_schema(audited):

@@ -52,4 +52,4 @@ def test_the_fleet_page_sorts_and_links_to_its_evidence(chromium, corpus_audit):
             "rawpython__kukaKRLmagic/R1/Program/sample_program.src")
         # a reason links to the table behind it
         page.locator(f"#unit{u} ul.reasons a", has_text="program error").click()
-        assert page.evaluate("location.hash") == f"#unit{u}-entries"
+        assert page.evaluate("location.hash") == f"#unit{u}-causes"
