@@ -1,6 +1,6 @@
-"""The pieces of the change report (krl/diff/report.py, interp/outcomes.py, issue 49) on inputs
-whose answers were worked out by hand: which check findings are new or fixed, which entry points
-a change touches, and when two run outcomes differ."""
+"""The pieces of the change report (krl/diff/report.py, interp/outcomes.py, issues 49 and 63) on
+inputs whose answers were worked out by hand: which check findings are new or fixed, which entry
+points a change touches, when two run outcomes differ, and what to retest on the robot."""
 
 from __future__ import annotations
 
@@ -9,9 +9,9 @@ from pathlib import Path
 
 from interp.outcomes import _Events, event_kind, outcome_changes
 from interp.outcomes import _outcome as outcome_of
-from krl.diff.core import diff_sides
+from krl.diff.core import Diff, diff_sides
 from krl.diff.load import side
-from krl.diff.report import Finding, findings_delta, touched_entries
+from krl.diff.report import Finding, findings_delta, retest, touched_entries
 from krl.programmap import build_map
 from krl.workspace import workspaces_for
 
@@ -127,3 +127,42 @@ def test_a_motion_refused_in_the_advance_run_is_the_runs_motion_event():
     assert o["counts"] == {"limit": 1} and o["events"][0]["line"] == 81
     # an error that is no motion's is not a motion event
     assert outcome_of("p.src", "error", "unknown name P_Button", "p.src", 46, 0.0, _Events(), "")["counts"] == {}
+
+
+def test_the_retest_list_is_derived_from_the_changes():
+    # issue 63: a diff written by hand; each row below follows from one rule of
+    # krl/diff/report.py retest (no program map: no touched program, every changed routine a row)
+    d = Diff("old", "new")
+    d.frames = [{"file": "R1/System/$config.dat", "name": "TOOL_DATA[1]", "kind": "TOOL_DATA", "change": "changed",
+                 "delta": {"Z": 5.5}, "line": 231},
+                {"file": "R1/System/$config.dat", "name": "BASE_DATA[2]", "kind": "BASE_DATA", "change": "removed",
+                 "delta": {}, "line": 240}]
+    d.points = [{"file": "R1/Program/a.dat", "name": "XP1", "kind": "E6POS", "change": "changed", "delta": {"X": 1.0},
+                 "line": 4, "status_turn_changed": True},
+                {"file": "R1/Program/a.dat", "name": "XP2", "kind": "E6POS", "change": "added", "delta": {}, "line": 5,
+                 "status_turn_changed": False},
+                {"file": "R1/Mada/$machine.dat", "name": "$ROBROOT", "kind": "FRAME", "change": "changed",
+                 "delta": {"A": 90.0}, "line": 97, "status_turn_changed": False}]
+    d.values = [{"file": "R1/Mada/$machine.dat", "name": "$BRK_DEL", "change": "added", "line": 297},
+                {"file": "R1/Program/a.dat", "name": "nCount", "change": "changed", "line": 9}]
+    d.routines = [{"file": "R1/Program/a.src", "module": "a", "name": "pick", "change": "changed", "line": 12},
+                  {"file": "R1/Program/a.src", "module": "a", "name": "old_one", "change": "removed", "line": 40}]
+    d.motions = [{"file": "R1/Program/a.src", "routine": "pick", "motion": "PTP", "point": "XP1", "line": 20,
+                  "changed": {"velocity": [100, 50]}},
+                 {"file": "R1/Program/a.src", "routine": "pick", "motion": "LIN", "point": "XP2", "line": 22,
+                  "changed": {"approximation": ["C_DIS", None]}}]
+    d.declarations = [{"file": "R1/System/$config.dat", "scope": "", "name": "bGripOpen", "kind": "signal",
+                       "change": "retyped", "before": "$IN[3]", "after": "$IN[4]", "line": 700}]
+    rows = [(r["area"], r["file"], r["line"]) for r in retest(d, [])]
+    assert rows == [
+        ("routine", "R1/Program/a.src", 12),            # pick changed; old_one removed: no row
+        ("tool", "R1/System/$config.dat", 231),         # TOOL_DATA[1]; BASE_DATA[2] removed: no row
+        ("machine data", "R1/Mada/$machine.dat", 97),   # $ROBROOT and $BRK_DEL, one row for the file
+        ("points", "R1/Program/a.dat", 4),              # XP1 and XP2, one row for the file
+        ("motions", "R1/Program/a.src", 20),            # both motions of pick, one row
+        ("signal", "R1/System/$config.dat", 700),
+    ]
+    by = {r["area"]: r for r in retest(d, [])}
+    assert "$ROBROOT, $BRK_DEL" in by["machine data"]["what"]
+    assert "approach XP1, XP2 in T1" in by["points"]["what"] and "XP1: status/turn changed" in by["points"]["what"]
+    assert by["motions"]["why"] == "changed: approximation, velocity" and "line(s) 20, 22" in by["motions"]["what"]
