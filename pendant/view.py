@@ -65,9 +65,14 @@ def _data_list_of(path: Path) -> Path | None:
 
 
 def taught_points(dat: Path, root: Path) -> list[dict]:
-    """The Cartesian points of the data list ``dat``: name, X..C (in their base) and the
-    position in $WORLD (``world``: mm), using the base their FDAT names (``BASE_DATA[n]`` of the
-    backup's $config.dat; $WORLD when none). Axis points are listed with ``axes``."""
+    """The points of the data list ``dat`` (at most 5000), each ``{name, line, ext}`` and either
+    ``frame`` (X..C mm/deg in its base), ``base`` (the base number its FDAT names) and ``world``
+    (its position in $WORLD, mm: through ``BASE_DATA[n]`` of the backup's $config.dat; $WORLD when
+    none), for an E6POS/POS/FRAME, or ``axes`` (A1..A6, deg) for an E6AXIS/AXIS. ``ext`` maps each
+    external axis component the point holds (``E1``..``E6`` of an E6POS/E6AXIS, mm or deg) to its
+    value: the page's list of points shows them (issue 64). A base measured on an external
+    kinematic (``MACHINE_FRAME_DAT``) is placed as a fixed ``BASE_DATA[n]``: the point's world
+    position at its E is not computed here."""
     # costs 0.22 s at start-up (python -X importtime, 2026-11-25)
     from robot.datalist import DataListError, read_data_list  # noqa: PLC0415
     # costs 0.34 s at start-up (python -X importtime, 2026-11-25)
@@ -93,13 +98,19 @@ def taught_points(dat: Path, root: Path) -> list[dict]:
             base = bases.get(base_no, (0.0,) * 6)
             T = frame_to_matrix(*base) @ frame_to_matrix(*frame)
             out.append({"name": dv.name, "line": dv.line, "frame": frame, "base": base_no,
-                        "world": [round(float(x), 3) for x in np.asarray(T)[:3, 3]]})
+                        "world": [round(float(x), 3) for x in np.asarray(T)[:3, 3]], "ext": _ext(v)})
         elif all(f"A{i}" in v for i in range(1, 7)):
             out.append({"name": dv.name, "line": dv.line,
-                        "axes": [float(v[f"A{i}"]) for i in range(1, 7)]})
+                        "axes": [float(v[f"A{i}"]) for i in range(1, 7)], "ext": _ext(v)})
         if len(out) >= 5000:
             break
     return out
+
+
+def _ext(v: dict) -> dict[str, float]:
+    """The external axis components E1..E6 a point's value holds (numbers only)."""
+    return {f"E{i}": float(v[f"E{i}"]) for i in range(1, 7)
+            if isinstance(v.get(f"E{i}"), (int, float)) and not isinstance(v.get(f"E{i}"), bool)}
 
 
 def _base_data(root: Path) -> dict[int, tuple]:

@@ -1,7 +1,7 @@
 """The pendant shows the cell, the external axes and a description's meshes (issue 64): a KR 16-2 on its KL track
 (robot/data/kr16_2_kl1500.dat, named by the cell file) in a cell with a table, a post and a tool
 (the cell file's geometry:/tool:). In Chromium (Playwright): the 3D view draws the three bodies,
-the jog keys include E1, the position panel shows E1, and after one motion that moves E1 the
+the jog keys include E1, the list of taught points shows their E1, the position panel shows E1, and after one motion that moves E1 the
 drawn track joint stands where the controller's E1 is; the screenshot of that stop is the page
 as docs/pendant/cell-track.png shows it (KRL_UPDATE_SCREENSHOTS=1 writes it anew). And a real mesh
 robot: kuka_experimental's KR 150 R3100-2 description with its seven collision meshes, drawn with
@@ -28,6 +28,14 @@ PROG = """DEF track()
   PTP {A1 0, A2 -90, A3 90, A4 0, A5 60, A6 0, E1 0}
 END
 """
+#: the program's data list: a Cartesian point and an axis point taught with E1 (the list of points
+#: shows E1, the robot's one external axis, and no E2..E6: they are 0 and the robot has none)
+DAT = """DEFDAT track
+DECL E6POS XP1={X 1500.0,Y 100.0,Z 1200.0,A 0.0,B 90.0,C 0.0,S 2,T 0,E1 1200.5,E2 0.0,E3 0.0,E4 0.0,E5 0.0,E6 0.0}
+DECL E6AXIS XPARK={A1 0.0,A2 -90.0,A3 90.0,A4 0.0,A5 60.0,A6 0.0,E1 250.25,E2 0.0,E3 0.0,E4 0.0,E5 0.0,E6 0.0}
+DECL POS XLOOSE={X 900.0,Y 0.0,Z 1000.0,A 0.0,B 90.0,C 0.0}
+ENDDAT
+"""
 CELL = """robot: kr16_2_kl1500
 geometry:
   - {name: table, box: [800, 600, 40], frame: [2300, 600, 380, 0, 0, 0]}
@@ -53,6 +61,7 @@ def _same_as(png: bytes, path) -> np.ndarray:
 
 def test_the_cell_and_the_track_axis_are_drawn(pw, tmp_path):
     (tmp_path / "track.src").write_text(PROG, encoding="ascii")
+    (tmp_path / "track.dat").write_text(DAT, encoding="ascii")
     cell = tmp_path / "cell.yaml"
     cell.write_text(CELL, encoding="ascii")
     with pendant_server(tmp_path, "--no-realtime", "--inputs", str(cell)) as url, \
@@ -60,6 +69,14 @@ def test_the_cell_and_the_track_axis_are_drawn(pw, tmp_path):
         assert page.evaluate("() => window.pendant.cellBodies") == 3       # table, post, tool
         assert page.locator('#jog-keys button[data-jog="E1+"]').count() == 1
         select(page, "track.src", run_mode="MSTEP", mode="T1")
+        # the list of taught points shows each point's E1 (issue 64): the values of the data list
+        page.click('#tabs button[data-tab="points"]')
+        page.wait_for_selector('#points tr[data-point="XP1"]')
+        assert page.locator("#points tr th").all_inner_texts() == ["point", "line", "base", "position", "E1"]
+        assert page.locator('#points tr[data-point="XP1"] td[data-ext="E1"]').inner_text() == "1200.500"
+        assert page.locator('#points tr[data-point="XPARK"] td[data-ext="E1"]').inner_text() == "250.250"
+        assert page.locator('#points tr[data-point="XLOOSE"] td[data-ext="E1"]').inner_text() == "\u2014"  # a POS has no E
+        page.click('#tabs button[data-tab="messages"]')
         for _ in range(2):
             before = page.evaluate("() => window.pendant.state.pointers.cycle")
             page.click("#start")

@@ -156,6 +156,7 @@ function showModule(m) {
   });
   box.replaceChildren(...rows);
   showPoints(m.points || []);
+  drawPoints(m.points || []);
   if (P.state) drawPointers(P.state.pointers || {}, P.state.breakpoints || {});
 }
 
@@ -292,6 +293,23 @@ function drawWatch(list) {
   }));
 }
 
+// the module's taught points (pendant/view.py taught_points): name, line, base, X..C in that base
+// (an axis point: A1..A6) and the external axes' values, one column per E the robot has and per E
+// any point holds other than 0 (a point taught with E1 on another robot still shows it)
+function drawPoints(points) {
+  const ext = new Set((P.jogKeys || []).filter((k) => /^E[1-6]$/.test(k)));
+  for (const p of points) for (const [k, v] of Object.entries(p.ext || {})) if (v !== 0) ext.add(k);
+  const es = [...ext].sort();
+  const keys = ['X', 'Y', 'Z', 'A', 'B', 'C'];
+  const values = (p) => (p.frame ? p.frame.map((v, i) => `${keys[i]} ${fmt(v, 1)}`) : p.axes.map((v, i) => `A${i + 1} ${fmt(v, 1)}`)).join(' ');
+  $('points-count').textContent = points.length ? `(${points.length})` : '';
+  $('points').replaceChildren(el('tr', {}, el('th', { text: 'point' }), el('th', { text: 'line' }), el('th', { text: 'base' }),
+    el('th', { text: 'position' }), ...es.map((e) => el('th', { text: e }))),
+  ...points.map((p) => el('tr', { 'data-point': p.name }, el('td', { text: p.name }), el('td', { text: String(p.line) }),
+    el('td', { text: p.frame ? (p.base ? `BASE_DATA[${p.base}]` : '$WORLD') : 'axes' }), el('td', { text: values(p) }),
+    ...es.map((e) => el('td', { 'data-ext': e, text: p.ext && e in p.ext ? fmt(p.ext[e], 3) : '—' })))));
+}
+
 function drawThreads(list) {
   $('threads').replaceChildren(el('tr', {}, el('th', { text: 'thread' }), el('th', { text: 'routine' }), el('th', { text: 'line' })),
     ...list.map((t) => el('tr', {}, el('td', { text: t.name }), el('td', { text: t.routine || '' }), el('td', { text: t.line ? String(t.line) : '' }))));
@@ -418,6 +436,7 @@ function loadRobot(r) {
   P.axisScale = (r.units || jointNames.map(() => 'deg')).map((u) => (u === 'mm' ? 0.001 : Math.PI / 180));
   P.jogKeys = r.keys;
   buildJogKeys();
+  if (P.module) drawPoints(P.module.points || []);   // the robot's external axes are the list's columns
   robotRoot.clear();
   robotRoot.matrixAutoUpdate = false;
   robotRoot.matrix.copy(kukaMatrix(r.robroot));
