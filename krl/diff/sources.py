@@ -57,7 +57,8 @@ class SourceViews:
         key = (side, file.lower())
         f = self._files.get(key, False)
         if f is False:
-            src = read_source(Path(root) / file)
+            # a link in the backup is never followed (the walk of krl check follows none either)
+            src = read_source(Path(root) / file, follow_symlinks=False)
             f = self._files[key] = (_File(len(self._files) + 1, side, file, (src.text or "").splitlines())
                                     if src.status == "ok" else None)
         if f is None:

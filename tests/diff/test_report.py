@@ -11,7 +11,7 @@ from interp.outcomes import _Events, event_kind, outcome_changes
 from interp.outcomes import _outcome as outcome_of
 from krl.diff.core import Diff, diff_sides
 from krl.diff.load import side
-from krl.diff.report import Finding, findings_delta, retest, touched_entries
+from krl.diff.report import Finding, css_string, findings_delta, retest, touched_entries
 from krl.programmap import build_map
 from krl.workspace import workspaces_for
 
@@ -166,3 +166,15 @@ def test_the_retest_list_is_derived_from_the_changes():
     assert "$ROBROOT, $BRK_DEL" in by["machine data"]["what"]
     assert "approach XP1, XP2 in T1" in by["points"]["what"] and "XP1: status/turn changed" in by["points"]["what"]
     assert by["motions"]["why"] == "changed: approximation, velocity" and "line(s) 20, 22" in by["motions"]["what"]
+
+
+def test_a_backup_name_in_the_printed_foot_cannot_leave_its_css_string():
+    # the foot of each printed page names the backups inside the page's <style> (a CSS string):
+    # a quote, a backslash, a newline or "</style>" from a folder name is escaped, letters stay
+    text = 'cell "A"\\x\n</style><script>alert(1)</script> Ä'
+    out = str(css_string(text))
+    assert out.startswith('"') and out.endswith('"') and out.count('"') == 2
+    inner = out[1:-1]
+    assert "<" not in inner and ">" not in inner and "\n" not in inner
+    assert inner.startswith("cell \\000022A\\000022\\00005cx\\00000a\\00003c/style\\00003e")
+    assert inner.endswith(" \\0000c4")
