@@ -137,3 +137,24 @@ def test_more_units_than_the_limit_is_a_usage_error(tmp_path, monkeypatch):
     assert res.exit_code == 2 and "Traceback" not in res.output
     assert "more than 1 backups and program folders below" in res.output and "MAX_AUDIT_BACKUPS" in res.output
     assert not (tmp_path / "o").exists()
+
+
+def test_a_backup_folder_named_krc_is_named_by_its_parent_and_robot(tmp_path):
+    # issue 63: the depalletizer's backup was a folder "KRC", and the audit called it "KRC". A
+    # KRC backup (R1/System/$config.dat) whose machine data name the robot (the spelling of
+    # KUKA's $machine.dat: CHAR $TRAFONAME[32], then its value), audited by its own folder
+    krc = tmp_path / "depalletizer" / "KRC"
+    (krc / "R1" / "System").mkdir(parents=True)
+    (krc / "R1" / "Mada").mkdir()
+    (krc / "R1" / "System" / "$config.dat").write_text("DEFDAT $CONFIG\nENDDAT\n")
+    (krc / "R1" / "Mada" / "$machine.dat").write_text(
+        'DEFDAT $MACHINE PUBLIC\nCHAR $V_R1MADA[32]\n$V_R1MADA[]="V42.51.27.12/KUKA8.5"\n'
+        'CHAR $TRAFONAME[32]\n$TRAFONAME[]="#KR210R2700_2 C4 FLR"\nENDDAT\n')
+    out = tmp_path / "out"
+    res = _audit([str(krc), "--out", str(out), "--jobs", "1"])
+    assert "Traceback" not in res.output, res.output
+    (u,) = json.loads((out / "audit.json").read_text(encoding="utf-8"))["units"]
+    assert (u["name"], u["kind"], u["robot"]) == ("depalletizer/KRC", "backup", "KR210R2700_2 C4 FLR")
+    assert u["title"] == "depalletizer/KRC (KR210R2700_2 C4 FLR)"
+    assert (u["machine"]["kss"], u["machine"]["controller"]) == ("KSS 8.5", "KR C4")
+    assert res.output.splitlines()[0].startswith("ok        depalletizer/KRC (KR210R2700_2 C4 FLR): ")

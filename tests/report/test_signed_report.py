@@ -11,7 +11,8 @@ KR 30 L16 on KSS 8.3 replaced by a KR 120 R2700's on KSS 8.6), ``krl report NEW 
   block; every page is numbered "Page N of M";
 * every link of the report opens in the page itself (no file to download) at its line: its
   target is the line of a file of the side it names, whose text is that line of the file on
-  disk; a click scrolls the line into view and marks it.
+  disk; a click scrolls the line into view and marks it;
+* at the printed page's width no code or change cell wraps, nor a place of up to 30 characters.
 
 Nightly (slow): the PDF of paulovictor237's KUKA-Paletizador ``04-72cb25e4`` ("Novo ConfigDat":
 41 modules moved from MainRoutune/ to Main_Program/, the pair with the most files changed) is at
@@ -154,6 +155,30 @@ def test_every_link_opens_in_the_page_at_its_line(chromium, report):
             assert page.evaluate("document.querySelector(':target').id") == href[1:]
             box, height = target.bounding_box(), page.viewport_size["height"]
             assert box is not None and 0 <= box["y"] and box["y"] + box["height"] <= height, (href, box)
+
+
+# the lines a cell's text takes, at the printed page's width
+_LINES = """sel => [...document.querySelectorAll(sel)].filter(e => e.offsetParent !== null).map(e => {
+  const r = document.createRange(); r.selectNodeContents(e);
+  const tops = new Set([...r.getClientRects()].filter(x => x.width > 0).map(x => Math.round(x.top)));
+  return [e.textContent.trim(), tops.size];
+})"""
+
+
+def test_tables_are_readable_at_print_width(chromium, report):
+    # issue 63: the findings table squeezed its code column to one character per line. At the
+    # printed page's width (A4 less the margins: 186 mm, 703 px) with the print style sheet,
+    # every code and change cell is one line, and every place of up to 30 characters too
+    import playwright.sync_api as playwright  # noqa: PLC0415 (0.14 s CPU: only the browser tests)
+
+    _pair, page_file = report
+    with playwright.sync_playwright() as pw, loaded_page(pw, chromium, page_file) as page:
+        page.emulate_media(media="print")
+        page.set_viewport_size({"width": 703, "height": 1000})
+        codes = page.evaluate(_LINES, "table.findings td.code, table.codes td.code, .diff-wrap td.change")
+        assert len(codes) > 10 and all(n == 1 for _t, n in codes), [c for c in codes if c[1] != 1]
+        places = [(t, n) for t, n in page.evaluate(_LINES, ".where") if len(t) <= 30]
+        assert len(places) > 10 and all(n == 1 for _t, n in places), [p for p in places if p[1] != 1]
 
 
 @pytest.mark.slow
