@@ -520,7 +520,7 @@ class EkiPartner(Partner):
         if not live:
             return
         for name, ep in list(self.endpoints.items()):
-            for ev in (ep.poll(ctl.time) if isinstance(ep, transport.TcpServer) else ep.poll()):
+            for ev in ep.poll(ctl.time):
                 self._event(name, ev)
             if isinstance(ep, transport.TcpClient) and ep.failed:
                 ch = self.channels.get(name)

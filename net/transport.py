@@ -6,7 +6,8 @@ this one. A poll reads at most :data:`~krl.limits.MAX_NET_BYTES_PER_CYCLE` bytes
 connection (a flood waits in the kernel's buffer), and a connection whose partner does not read
 what the controller sends is dropped once its send buffer passes its limit.
 
-Events a poll returns: ``("connect", peer)``, ``("data", bytes)``, ``("disconnect", reason)``,
+Each endpoint's ``poll(now)`` (`now`: the controller's time, for a server's idle partner) returns
+events: ``("connect", peer)``, ``("data", bytes)``, ``("disconnect", reason)``,
 ``("refused", peer)`` (a second client of a one-client server: closed at once, as EthernetKRL
 does), ``("foreign", peer)`` (a datagram to a UDP client from another address than its partner's:
 not delivered). Servers bind where they are told; net/settings.py makes that loopback unless the cell
@@ -186,7 +187,7 @@ class TcpClient(Endpoint):
         self.failed = None
         self.pending = s
 
-    def poll(self) -> list:
+    def poll(self, now: float = 0.0) -> list:
         events: list = []
         p = self.pending
         if p is not None:
@@ -248,7 +249,7 @@ class Udp(Endpoint):
     def connected(self) -> bool:
         return self.peer is not None
 
-    def poll(self) -> list:
+    def poll(self, now: float = 0.0) -> list:
         events: list = []
         for _ in range(MAX_RSI_DATAGRAMS_PER_CYCLE):
             try:
