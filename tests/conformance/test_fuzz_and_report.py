@@ -82,7 +82,7 @@ class RecordingCheck:
         return f"tree: made to fail ({self.fails_on})" if self.fails_on and self.fails_on in src else None
 
 
-@pytest.mark.parametrize("fails_on", [None, "PULSE"])
+@pytest.mark.parametrize("fails_on", [None, "B_AND"])
 def test_fuzz_in_worker_processes_is_the_run_in_one(monkeypatch, tmp_path, fails_on):
     """run_fuzz(jobs=2) checks the programs that run_fuzz(jobs=1) checks, in worker processes,
     and ends with the same stats, failure and shrunk minimal program (the check itself replaced
@@ -106,7 +106,7 @@ def test_fuzz_in_worker_processes_is_the_run_in_one(monkeypatch, tmp_path, fails
         assert len(checked_two) == len({h for h, _ in checked_two})
         assert here not in {pid for _h, pid in checked_two}
     else:
-        assert "PULSE" in one["failures"][0].split("--- minimal program ---")[1]
+        assert "B_AND" in one["failures"][0].split("--- minimal program ---")[1]
         # the draws up to the failure were checked in the workers, the shrinking here, the same way
         assert {h for h, _ in checked_one} <= {h for h, _ in checked_two}
         assert here in {pid for _h, pid in checked_two} and len({pid for _h, pid in checked_two}) > 1
