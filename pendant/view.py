@@ -144,12 +144,17 @@ def robot_view(machine, inputs: str | None = None) -> dict:
     kinematics its root is ``$WORLD``, so ``robroot`` is then null), $ROBROOT (X..C mm/deg), the
     joint names (A1..An, then ``joint_e<n>`` of E1..Em), for each the index of its value in the
     position's axes (KRL's order, robot/axismap.py) and its unit (``deg`` or ``mm``), the jog keys'
-    names (``A1``.., ``E1``..), the cell's bodies (:func:`cell_view`), and ``start``: where it stands
-    before a program is selected (:func:`start_position`)."""
+    names (``A1``.., ``E1``..), the cell's bodies (:func:`cell_view`), ``capsules``: the radii (m)
+    of the links' capsules the collision check uses (robot/capsules.py: ``base``, ``arm``,
+    ``wrist``; the page draws the links with them), and ``start``: where it stands before a program
+    is selected (:func:`start_position`)."""
     # costs 0.36 s at start-up (python -X importtime, 2026-11-25)
     from robot.urdf import build_urdf  # noqa: PLC0415
     # costs 0.004 s at start-up (python -X importtime, 2026-11-26)
     from robot.axismap import AxisMap  # noqa: PLC0415
+
+    # costs 0.005 s at start-up (python -X importtime, 2026-11-26, under load: constants and a function)
+    from robot.capsules import capsule_radii  # noqa: PLC0415
 
     amap = AxisMap.of(machine)
     joints = [j.name for j in machine.joints] + [f"joint_e{e.number}" for e in machine.external_axes]
@@ -158,6 +163,7 @@ def robot_view(machine, inputs: str | None = None) -> dict:
     return {"name": machine.name, "urdf": build_urdf(machine), "robroot": robroot,
             "joints": joints, "axis_index": krl_index, "units": [amap.unit(k) for k in amap.model_keys],
             "keys": list(amap.model_keys), "cell": cell_view(inputs), "meshes": _meshes(machine),
+            "capsules": {g: r / 1000.0 for g, r in capsule_radii(machine.reach_wrist_point_mm).items()},
             "start": start_position(machine, inputs)}
 
 

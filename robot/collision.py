@@ -14,8 +14,8 @@ The cell file (robot/stimuli.py) describes the cell in ``$WORLD``, mm and degree
 A box's ``frame`` is its centre (KUKA's X, Y, Z, A, B, C: ``Rz(A)·Ry(B)·Rx(C)``), a cylinder's its
 centre with the axis along its Z, a mesh's the origin of the STL's coordinates (in mm). The tool's
 frame is in the flange frame. The robot's links are the capsules of its MuJoCo model
-(robot/mjcf.py: from joint to joint, radius 60 mm on A1..A3 and 45 mm on the wrist; the base
-column 70 mm).
+(robot/mjcf.py: from joint to joint, their radii from the robot's reach, robot/capsules.py: the KR 6
+R900's 141 mm on A1..A3, 79 mm on the wrist, its base column 199 mm), or a description's meshes.
 
 **Contacts checked** (MuJoCo's ``mj_collision`` after ``mj_kinematics``, a contact whose distance
 is below :data:`CONTACT_MM`): each link and the tool against each cell body and the floor, the base

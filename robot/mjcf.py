@@ -7,7 +7,8 @@ The body tree mirrors the URDF chain exactly (joint origins, axes, ranges), so
 ``qpos = kuka_sign * radians(A_i)`` (= radians(A_i) here, robot-model.md §3; a linear axis, a
 SCARA's A3, is a slide joint with ``qpos = kuka_sign * A_i / 1000`` m) and the site ``tool0`` on
 the last link is KUKA's flange frame (+Z out of the flange).
-Geometry is capsules only; masses come from the geometry (density 1000 kg/m^3,
+Geometry is capsules only, sized from the robot's reach (robot/capsules.py; a description's meshes
+instead where it gave them); masses come from the geometry (density 1000 kg/m^3,
 invented, robot-model.md §11: link masses are not published).
 
 Two modes (argument ``actuated``):
@@ -35,6 +36,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from .blas import numpy_cblas
+from .capsules import capsule_radii, group_of
 from .frames import as_matrix, frame_to_matrix, inv_pos
 from .machine import MachineData, load_machine
 
@@ -124,10 +126,12 @@ def build_mjcf(machine: MachineData | None = None, actuated: bool = False, *,
     # base column up to the A1 joint origin
     o1 = np.array(joints[0].origin_mm) / 1000.0
     base_bits = ' contype="8" conaffinity="1"' if cell is not None else ""
+    # the links' capsules sized from the robot's reach (robot/capsules.py), in metres
+    radii = {g: r / 1000.0 for g, r in capsule_radii(m.reach_wrist_point_mm).items()}
     if "base_link" in meshes:        # the description's mesh (robot/description.py)
         lines.append(f'      <geom name="base_geom" type="mesh" mesh="mesh_base_link" rgba="0.2 0.2 0.2 1"{base_bits}/>')
     else:
-        lines.append(f'      <geom name="base_geom" type="capsule" size="0.07" fromto="0 0 0 {_vec(o1)}" '
+        lines.append(f'      <geom name="base_geom" type="capsule" size="{_f(radii["base"])}" fromto="0 0 0 {_vec(o1)}" '
                      f'rgba="0.2 0.2 0.2 1"{base_bits}/>')
     indent = "      "
     for i, j in enumerate(joints):
@@ -146,7 +150,7 @@ def build_mjcf(machine: MachineData | None = None, actuated: bool = False, *,
                      f'axis="{_vec(j.joint_axis)}" range="{_f(lo)} {_f(hi)}"/>')
         # link geometry: capsule from this joint to the next joint origin (or to the flange)
         nxt = np.array(joints[i + 1].origin_mm) / 1000.0 if i + 1 < len(joints) else None
-        radius = 0.06 if i < 3 else 0.045
+        radius = radii[group_of(i)]
         body = j.child or f"link_{i + 1}"
         if body in meshes:
             lines.append(f'{indent}<geom name="link_{i + 1}_geom" type="mesh" mesh="mesh_{body}"/>')

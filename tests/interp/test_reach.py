@@ -11,6 +11,7 @@ from click.testing import CliRunner
 from krl.cli import main
 from interp.reach import reach_check
 from tests.interp.helpers import write
+from tests.robot.test_collision import R_WRIST
 
 SRC = """DEF reachprog()
   PTP XHOME1
@@ -43,11 +44,11 @@ def test_reach_reports_points_and_motions_at_their_lines(tmp_path):
     assert rep.problems[0].startswith(f"{dat}:6: unreachable: XFAR on KR 6 R900 sixx: no configuration")
     assert rep.problems[1].startswith(f"{dat}:7: unreachable: XWRONG on KR 6 R900 sixx: with its S 2 and T 2: "
                                       f"software limit switch +A1")
-    # the LIN from XP2 down to XP3 meets the table (its top at Z 420; the wrist's capsule, 45 mm
-    # around the flange, first touches it with the flange at Z 465 or a sample below)
+    # the LIN from XP2 down to XP3 meets the table (its top at Z 420; the flange's sphere, R_WRIST
+    # around the flange, first touches it with the flange at Z 420 + R_WRIST or a sample below)
     assert rep.problems[2].startswith(f"{src}:5: collision: LIN XP3: ") and "cell:table" in rep.problems[2]
     z = float(rep.problems[2].split("Z ")[1].split(" mm")[0])
-    assert 420.0 < z <= 465.0
+    assert 420.0 < z <= 420.0 + R_WRIST
     assert len(rep.problems) == 3
     res = CliRunner().invoke(main, ["check", "--reach", str(prog), "--inputs", str(cell)])
     assert res.exit_code == 1 and res.output.splitlines()[-1] == (

@@ -3,10 +3,16 @@
 bodies, the line and the TCP. Hand-built cells: a LIN down through a box, a tool through a fixture,
 A3 folded into the floor, each stopped at the right motion and where the geometry says (worked out
 here from the sizes: the box's top, the tool's length, the flange's capsule radius); a free path
-beside them runs to its end. Both interpreters."""
+beside them runs to its end. Both interpreters.
+
+The flange's capsule radius is robot/capsules.py's rule for the wrist, written out here from its
+documented constants (docs/robot.md, "Collision and reach against the cell"): 85.38 mm times the
+reach in metres to the power 0.7627; the KR 6 R900's reach to the wrist point by hand from its
+machine data (robot-model.md §4: $LENGTH_A 25, $LENGTH_B 455, $TX3P3 X 420 and Z 35): 79 mm."""
 
 from __future__ import annotations
 
+import math
 import struct
 
 import pytest
@@ -27,6 +33,8 @@ DEF cellrun()
   $OUT[3] = TRUE
 END
 """
+#: the radius of the wrist's capsules (link_4..link_6: the flange's sphere) of the KR 6 R900, mm
+R_WRIST = 85.38 * ((25 + 455 + math.hypot(420, 35)) / 1000.0) ** 0.7627
 #: a box whose top is at Z 420 under the second half of the path (Y -150..150)
 BOX = "  - {name: table, box: [300, 300, 40], frame: [650, 0, 400, 0, 0, 0]}\n"
 
@@ -51,23 +59,24 @@ def test_a_lin_through_a_box_stops_at_that_lin(tmp_path, interp):
     assert "collision: " in err["text"] and "cell:table" in err["text"]
     assert "link_5" in err["text"] or "link_6" in err["text"], err["text"]
     assert "at the motion of line 7" in err["text"] and "TCP X 650.0, Y 0.0, Z " in err["text"]
-    # the flange's capsule (radius 45 mm around the flange axis) meets the top (Z 420): the TCP
-    # (the flange, no $TOOL) stops at most one IPO cycle (2 m/s: 24 mm) after Z 465
-    assert _crossing(run, err["t"], 420 + 45)
+    # the flange's sphere (R_WRIST around the flange) meets the top (Z 420): the TCP (the flange,
+    # no $TOOL) stops at the first IPO cycle (2 m/s: 24 mm) at or below Z 420 + R_WRIST (499)
+    assert _crossing(run, err["t"], 420 + R_WRIST)
     assert not run.io("$OUT[3]")
 
 
 @pytest.mark.parametrize("interp", ["tree", "vm"])
 def test_a_tool_through_a_fixture_is_stopped(tmp_path, interp):
     """The tool (a 200 mm box on the flange) meets the fixture where the flange alone would not."""
-    cell = ("geometry:\n  - {name: fixture, cylinder: [30, 100], frame: [650, 250, 380, 0, 0, 0]}\n"
+    cell = ("geometry:\n  - {name: fixture, cylinder: [30, 100], frame: [650, 250, 350, 0, 0, 0]}\n"
             "tool: {box: [40, 40, 200], frame: [0, 0, 100, 0, 0, 0]}\n")
     run = run_krl(tmp_path, PROG, stimuli=cell, interp=interp)
     err = _error(run)
     assert err["line"] == 5 and {"tool", "cell:fixture"} <= set(err["text"].split(" at ")[0].split()), err["text"]
-    # the tool's end (200 mm below the flange) meets the cylinder's top (Z 430)
-    assert _crossing(run, err["t"], 430 + 200)
-    # without the tool the same path passes the fixture (the flange's capsule ends at Z 455, above 430)
+    # the tool's end (200 mm below the flange) meets the cylinder's top (Z 400)
+    assert _crossing(run, err["t"], 400 + 200)
+    # without the tool the same path passes the fixture (the flange's sphere ends at Z 500 - R_WRIST,
+    # 421, above 400)
     free = run_krl(tmp_path, PROG, stimuli=cell.split("tool:")[0], interp=interp)
     assert free.result.reason == "completed", free.result
 
@@ -87,9 +96,9 @@ END
         run = run_krl(tmp_path, src, stimuli=f"floor: {floor}\n", interp=interp)
         err = _error(run)
         assert err["line"] == 4 and "floor" in err["text"], err
-        # the forearm points down: its end, the flange's capsule (radius 45 mm around the flange,
-        # the TCP), is its lowest point, and meets the floor the cycle the TCP reaches it + 45
-        assert _crossing(run, err["t"], z + 45.0)
+        # the forearm points down: its end, the flange's sphere (R_WRIST around the flange, the
+        # TCP), is its lowest point, and meets the floor the cycle the TCP reaches it + R_WRIST
+        assert _crossing(run, err["t"], z + R_WRIST)
         assert not run.io("$OUT[3]")
 
 
@@ -128,4 +137,4 @@ def test_a_mesh_body_collides(tmp_path):
     run = run_krl(tmp_path, PROG, stimuli="geometry:\n  - {name: cube, mesh: cube.stl, frame: [650, 0, 320, 0, 0, 0]}\n")
     err = _error(run)
     assert err["line"] == 7 and "cell:cube" in err["text"]
-    assert _crossing(run, err["t"], 420 + 45)
+    assert _crossing(run, err["t"], 420 + R_WRIST)

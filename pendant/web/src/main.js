@@ -376,13 +376,15 @@ let jointNames = [];
 const linkMaterial = new THREE.MeshStandardMaterial({ color: 0xff5800, metalness: 0.2, roughness: 0.6 });
 const jointMaterial = new THREE.MeshStandardMaterial({ color: 0x30353b, metalness: 0.3, roughness: 0.5 });
 
-function limb(from, to, radius) {   // a cylinder from one point to another in a link's frame
+// a capsule from one point to another in a link's frame (a sphere where they meet): the body the
+// collision check gives the link (robot/mjcf.py, its radius robot/capsules.py's)
+function limb(from, to, radius, material = linkMaterial) {
   const a = new THREE.Vector3(...from);
   const b = new THREE.Vector3(...to);
   const len = a.distanceTo(b);
-  if (len < 1e-4) return null;
-  const g = new THREE.CylinderGeometry(radius, radius, len, 20);
-  const mesh = new THREE.Mesh(g, linkMaterial);
+  if (len < 1e-4) { const m = new THREE.Mesh(new THREE.SphereGeometry(radius, 20, 12), material); m.position.copy(a); return m; }
+  const g = new THREE.CapsuleGeometry(radius, len, 8, 20);
+  const mesh = new THREE.Mesh(g, material);
   mesh.position.copy(a).add(b).multiplyScalar(0.5);
   mesh.quaternion.setFromUnitVectors(new THREE.Vector3(0, 1, 0), b.clone().sub(a).normalize());
   return mesh;
@@ -441,11 +443,12 @@ function loadRobot(r) {
   robotRoot.matrixAutoUpdate = false;
   robotRoot.matrix.copy(kukaMatrix(r.robroot));
   robotRoot.add(robot);
-  // the URDF has no meshes (machine data hold none): each link drawn as a limb from its joint
-  // to the next joint (or the flange), with a joint drum, scaled to the robot's size
+  // the URDF has no meshes (machine data hold none): each link drawn as the capsule the collision
+  // check gives it, from its joint to the next joint (the last link a sphere), the radii of the
+  // robot view's capsules (m: base column, A1..A3, A4..A6; robot/capsules.py)
   let reach = 0;
   for (const name of jointNames) if (!name.startsWith('joint_e')) reach += robot.joints[name].position.length();
-  const radius = Math.max(0.03, reach * 0.035);
+  const caps = r.capsules;
   // a description's meshes (robot/description.py), in the links' frames, metres; the links without
   // one are drawn as limbs
   const meshes = r.meshes || {};
@@ -457,27 +460,23 @@ function loadRobot(r) {
     target.add(new THREE.Mesh(new STLLoader().parse(bytes.buffer), link === 'base_link' ? jointMaterial : linkMaterial));
     P.meshLinks++;
   }
-  for (const name of jointNames) {
+  jointNames.forEach((name, i) => {
     const j = robot.joints[name];
     j.ignoreLimits = true;
+    if (name.startsWith('joint_e')) return;
     const child = j.children.find((c) => c.isURDFLink);
-    const next = child && child.children.find((c) => c.isURDFJoint);
-    if (child && meshes[child.name]) continue;
-    if (child && next) { const m = limb([0, 0, 0], next.position.toArray(), radius); if (m) child.add(m); }
-    const drum = new THREE.Mesh(new THREE.CylinderGeometry(radius * 1.25, radius * 1.25, radius * 2.2, 24), jointMaterial);
-    drum.quaternion.setFromUnitVectors(new THREE.Vector3(0, 1, 0), j.axis.clone().normalize());
-    j.add(drum);
-  }
+    const next = child && child.children.find((c) => c.isURDFJoint && !c.name.startsWith('joint_e'));
+    if (!child || meshes[child.name]) return;
+    // the flange's joint (tool0) is no axis: the last link is a sphere at its origin, as in robot/mjcf.py
+    const to = next && next.name !== 'tool0_joint' && next.jointType !== 'fixed' ? next.position.toArray() : [0, 0, 0];
+    child.add(limb([0, 0, 0], to, i < 3 ? caps.arm : caps.wrist));
+  });
   const first = robot.joints[jointNames[0]];
-  const base = meshes.base_link ? null : limb([0, 0, 0], first.position.toArray(), radius * 1.6);
+  const base = meshes.base_link ? null : limb([0, 0, 0], first.position.toArray(), caps.base, jointMaterial);
   // on the link A1 turns on (base_link, which a track carries), not at the URDF's root
   if (base) (first.parent || robot).add(base);
   tool0 = robot.links.tool0 || null;
-  if (tool0) {
-    const link6 = tool0.parent && tool0.parent.parent;
-    if (link6 && !meshes[link6.name]) { const m = limb([0, 0, 0], tool0.parent.position.toArray(), radius * 0.7); if (m) link6.add(m); }
-    tool0.add(toolFrame);
-  }
+  if (tool0) tool0.add(toolFrame);
   P.robot = robot;
   drawCell(r.cell);
   requestRender();
