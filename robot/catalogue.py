@@ -16,13 +16,18 @@ for every value derived.
 ``$TRAFONAME`` names the same model is that model's robot (issue 60's KR 3 R540 data, for
 instance): robot/mada.py ``catalogue_robot`` returns it, and ``krl robot list`` says so.
 
-Units: mm and deg (deg/s). Errors: :class:`robot.madavalues.MachineDataError` for a name that is
+**Accelerations** are kroshu's joint-limits files' (``max_acceleration``: "calculated from the
+worst-case ramp-up time to reach maximum velocity", its README) where one is published for the model,
+else derived by robot/mada.py's rule (``RULES["max_acc_default"]``).
+
+Units: mm and deg (deg/s, deg/s2). Errors: :class:`robot.madavalues.MachineDataError` for a name that is
 no model of the catalogue (the message lists the close ones).
 """
 
 from __future__ import annotations
 
 import difflib
+import math
 import re
 from dataclasses import dataclass
 from functools import cache
@@ -64,6 +69,9 @@ class Model:
         limits_deg: ``($SOFTN_END, $SOFTP_END)`` of A1..A6.
         speeds_deg_s: axis speeds of A1..A6.
         note: what the entry says about its source.
+        accelerations_deg_s2: the published axis accelerations of A1..A6 (kroshu's joint-limits
+            file, rad/s2 there), or None where no file publishes them (robot/mada.py derives them).
+        acc_source: where the accelerations come from: ``repo path@commit`` ("" without).
     """
 
     key: str
@@ -75,6 +83,8 @@ class Model:
     limits_deg: tuple[tuple[float, float], ...]
     speeds_deg_s: tuple[float, ...]
     note: str = ""
+    accelerations_deg_s2: tuple[float, ...] | None = None
+    acc_source: str = ""
 
 
 def _cite(src: dict[str, Any]) -> str:
@@ -92,7 +102,10 @@ def models() -> dict[str, Model]:
                          source=_cite(m["source"]), also=tuple(_cite(a) for a in m.get("also", ())),
                          geometry_mm={k: float(v) for k, v in m["geometry_mm"].items()},
                          limits_deg=tuple((float(a), float(b)) for a, b in m["limits_deg"]),
-                         speeds_deg_s=tuple(float(v) for v in m["speeds_deg_s"]), note=str(m.get("note", "")))
+                         speeds_deg_s=tuple(float(v) for v in m["speeds_deg_s"]), note=str(m.get("note", "")),
+                         accelerations_deg_s2=(tuple(math.degrees(float(a)) for a in m["accelerations_rad_s2"])
+                                               if "accelerations_rad_s2" in m else None),
+                         acc_source=_cite(m["acc_source"]) if "acc_source" in m else "")
     return out
 
 
@@ -186,8 +199,12 @@ def catalogue_lines() -> list[str]:
                    f"$TFLWP.Z {g['TFLWP_Z']:g} mm")
         out.append("    limits " + ", ".join(f"A{i + 1} {lo:g}..{hi:g}" for i, (lo, hi) in enumerate(m.limits_deg))
                    + " deg")
-        out.append("    speeds " + ", ".join(f"{v:g}" for v in m.speeds_deg_s) + " deg/s; accelerations derived "
-                   "(v / 0.2 s: no description publishes them)")
+        out.append("    speeds " + ", ".join(f"{v:g}" for v in m.speeds_deg_s) + " deg/s")
+        if m.accelerations_deg_s2 is not None:
+            out.append("    accel  " + ", ".join(f"{a:.1f}" for a in m.accelerations_deg_s2)
+                       + f" deg/s2 (worst-case ramp-up), source {printable(m.acc_source)}")
+        else:
+            out.append("    accel  derived: v / 0.2 s (no joint-limits file publishes them)")
         out.append(f"    source {printable(m.source)} (geometry, limits, speeds)"
                    + "".join(f"; agrees with {printable(a)}" for a in m.also))
         if m.note:

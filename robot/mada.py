@@ -107,6 +107,12 @@ def _structure(machine: dict[str, DataValue], source: str, prov: dict[str, str])
     return a4fix, a5link
 
 
+def _jerk(acc: float, flt_ptp: float) -> float:
+    """The jerk of an axis without ``$AXIS_JERK`` (``RULES["max_jerk"]``): the acceleration `acc`
+    spread over the ``$DEF_FLT_PTP`` filter (ms; at least one 12 ms IPO cycle)."""
+    return acc / (max(flt_ptp, 12.0) / 1000.0)
+
+
 def _joint_limits(machine: dict[str, DataValue], source: str, prov: dict[str, str], a4fix: bool,
                   flt_ptp: float, kinds: tuple[str, ...]) -> list[tuple[tuple[float, float], float, float, float]]:
     """(limits, v_max, a_max, jerk) of A1..An (a linear axis in mm), with the rules of :data:`RULES`
@@ -148,7 +154,7 @@ def _joint_limits(machine: dict[str, DataValue], source: str, prov: dict[str, st
             else:
                 ramp = 0.2
             acc = vmax / ramp
-            j = acc / (max(flt_ptp, 12.0) / 1000.0)
+            j = _jerk(acc, flt_ptp)
         limit = (lo[i], hi[i])
         if i == 3 and a4fix:
             limit = _FIXED
@@ -227,7 +233,7 @@ def _external(machine: dict[str, DataValue], source: str, prov: dict[str, str], 
                   if raise_dv is not None and isinstance(raise_dv.value, dict) and 6 + e in raise_dv.value
                   else None)
             acc = speeds[k] / ((rt + flt_ptp / 2.0) / 1000.0 if rt is not None else 0.2)
-            j = acc / (max(flt_ptp, 12.0) / 1000.0)
+            j = _jerk(acc, flt_ptp)
         if lo[k] > hi[k]:
             raise MachineDataError(f"{dv_lo.where(6 + e)}: $SOFTN_END[{6 + e}]={lo[k]:g} is above "
                                    f"$SOFTP_END[{6 + e}]={hi[k]:g}")
@@ -533,7 +539,15 @@ def catalogue_robot(model: "catalogue.Model | str") -> MachineData:
         return load_mada(lib)
     vals = catalogue.arm_values(f"#{m.key}", m.geometry_mm, m.limits_deg, m.speeds_deg_s, m.source,
                                 f"catalogue: {m.name}")
-    return build_cited(m.name, vals, m.source, f"catalogue: {m.name} ({m.source})")
+    built = build_cited(m.name, vals, m.source, f"catalogue: {m.name} ({m.source})")
+    if m.accelerations_deg_s2 is None:
+        return built
+    # the published accelerations replace the rule's; the jerk follows them by the same rule
+    joints = tuple(replace(j, max_acc_deg_s2=a, max_jerk_deg_s3=_jerk(a, built.def_flt_ptp))
+                   for j, a in zip(built.joints, m.accelerations_deg_s2))
+    prov = dict(built.provenance, max_acc_deg_s2=f"{m.acc_source} (max_acceleration, rad/s2 as published: "
+                                                 f"the worst-case ramp-up to full speed)")
+    return replace(built, joints=joints, provenance=prov)
 
 
 def build_cited(name: str, vals: dict, source: str, shown: str) -> MachineData:

@@ -208,10 +208,49 @@ def test_limits_and_speeds_are_the_descriptions():
                                                (-350, 350)]
     assert [round(j.max_speed_deg_s, 9) for j in m.joints] == [105, 107, 114, 190, 180, 260]
     assert m.provenance["max_speed_deg_s"].startswith("ros-industrial/kuka_experimental kuka_kr150_support")
-    assert m.provenance["max_acc_deg_s2"].startswith("derived:")
+    # the accelerations are KUKA's own published ones for the model (kroshu's joint-limits file)
+    assert m.provenance["max_acc_deg_s2"].startswith(
+        "kroshu/kuka_robot_descriptions kuka_quantec_support/config/kr150_r3100_2_joint_limits.yaml@062e13cb")
     # the zero pose by hand: flange at a1 + c2 + x3 + c4 ahead, c1 + z3 high
     np.testing.assert_allclose(Kinematics(m).forward([0] * 6)[:3, 3], [330 + 1350 + 1420 + 215, 0, 645 + 115],
                                atol=1e-9)
+
+
+#: kroshu's joint-limits files (kroshu/kuka_robot_descriptions, the file and the commit read, transcribed
+#: here by hand): max_velocity (rad/s) and max_acceleration (rad/s2) of joint_1..joint_6
+JOINT_LIMITS = {
+    "KR 210 R2700-2": ("kuka_quantec_support/config/kr210_r2700_2_joint_limits.yaml@00525ef0",
+                       [2.0384, 1.9451, 1.95476, 3.12413, 3.00196, 3.83972],
+                       [1.98271, 1.26288, 2.56508, 7.03857, 1.76397, 1.87268]),
+    "KR 6 R900 sixx": ("kuka_agilus_support/config/kr6_r900_sixx_joint_limits.yaml@9825092e",
+                       [6.283185, 5.23599, 6.283185, 6.64970, 6.77188, 10.73377],
+                       [21.666156, 6.889457, 31.415926, 133.055688, 135.557707, 268.382564]),
+    "KR 560 R3100-2": ("kuka_fortec_support/config/kr560_r3100_2_joint_limits.yaml@520102ac",
+                       [1.5708, 1.3962, 1.3090, 1.5708, 1.5708, 2.2689],
+                       [1.1500, 0.9308, 1.5038, 1.5816, 1.6486, 2.1579]),
+}
+
+
+@pytest.mark.parametrize("name", sorted(JOINT_LIMITS))
+def test_accelerations_are_the_published_ones_where_published(name):
+    """The model's axis accelerations are its joint-limits file's (the file's velocities are the
+    model's axis speeds: it is that model's file), the jerk follows them by the machine-data rule."""
+    path, vel, acc = JOINT_LIMITS[name]
+    m = catalogue_robot(name)
+    assert [j.max_speed_deg_s for j in m.joints] == pytest.approx([math.degrees(v) for v in vel], abs=0.01)
+    assert [j.max_acc_deg_s2 for j in m.joints] == pytest.approx([math.degrees(a) for a in acc], rel=1e-12)
+    assert m.provenance["max_acc_deg_s2"].startswith(f"kroshu/kuka_robot_descriptions {path} (max_acceleration")
+    # $AXIS_JERK's rule: a / $DEF_FLT_PTP (the KR 6 R900's 96 ms: no machine data give another)
+    assert [j.max_jerk_deg_s3 for j in m.joints] == pytest.approx([math.degrees(a) / 0.096 for a in acc], rel=1e-12)
+
+
+def test_accelerations_are_derived_where_no_file_publishes_them():
+    """kroshu publishes no joint-limits file of the KR 10 R1420: v / 0.2 s (robot/mada.py's rule), its
+    speeds by hand from kuka_experimental kr10r1420_macro.xacro."""
+    m = catalogue_robot("KR 10 R1420")
+    assert catalogue.lookup("KR 10 R1420").accelerations_deg_s2 is None
+    assert [j.max_acc_deg_s2 for j in m.joints] == pytest.approx([v / 0.2 for v in (220, 210, 270, 381, 311, 492)])
+    assert m.provenance["max_acc_deg_s2"].startswith("derived: v_max / 0.2 s")
 
 
 @pytest.mark.parametrize("spelling", ["KR 150 R3100-2", "KR150R3100_2", "#KR150R3100_2 C4 FLR", "kr150_r3100_2",
@@ -234,7 +273,12 @@ def test_krl_robot_list_shows_every_model_with_its_source():
     assert out[0].startswith(f"{len(catalogue.models())} KUKA robots")
     for m in catalogue.models().values():
         i = next(i for i, line in enumerate(out) if line.startswith(f"{m.name} "))
-        assert out[i + 4].startswith(f"    source {m.source}")
+        acc = out[i + 4]
+        if m.accelerations_deg_s2 is None:
+            assert acc == "    accel  derived: v / 0.2 s (no joint-limits file publishes them)"
+        else:
+            assert acc.startswith("    accel  ") and acc.endswith(f"(worst-case ramp-up), source {m.acc_source}")
+        assert out[i + 5].startswith(f"    source {m.source}")
 
 
 def test_krl_robot_show_and_run_take_a_model_name(tmp_path):
