@@ -481,13 +481,17 @@ def io_events(events: list[dict[str, Any]], signals: list[str] | None = None,
 
 
 def motion_times(events: list[dict[str, Any]]) -> dict[int, dict[str, Any]]:
-    """motion id -> {phase: t, 'point': [...], 'approximation': ..., 'line': ...}."""
+    """motion id -> {phase: t, 'point': [...], 'approximation': ..., 'line': ...}; an exact stop
+    has the phase ``reached`` too: when its interpolation reached the point (the ``end`` event,
+    the controller's END signal, comes 24-36 ms later: robot/exactstop.py)."""
     out: dict[int, dict[str, Any]] = {}
     for ev in events:
         if ev.get("kind") != "motion":
             continue
         d = out.setdefault(int(ev["id"]), {})
         d.setdefault(ev["phase"], ev["t"])
+        if ev.get("reached") is not None:
+            d.setdefault("reached", ev["reached"])
         for k in ("point", "approximation", "line", "type"):
             if k in ev:
                 d[k] = ev[k]
@@ -883,9 +887,11 @@ def _c_blend(spec, mid, mt, ps):
 
 
 def _c_duration(spec, mid, mt, ps):
+    """The time of motion ``id`` from its start to when its interpolation reached the point (an
+    exact stop), else to its end: the planned duration; ``from``/``to`` name other phases."""
     d = mt[mid]
     frm = spec.get("from", "start")
-    to = spec.get("to", "end")
+    to = spec.get("to", "reached" if "reached" in d else "end")
     if frm not in d or to not in d:
         return False, f"phases {frm}/{to} missing: {d}"
     dur = d[to] - d[frm]

@@ -34,6 +34,7 @@ from typing import Any
 import numpy as np
 
 from . import blending
+from .exactstop import DONE_CYCLES, END_DELAY_CYCLES
 from .errors import RobotError
 from .frames import frame_to_matrix, inv_pos, matrix_to_frame
 from .io import IOImage
@@ -184,6 +185,19 @@ class _Held:
     plan_q: np.ndarray            # end point of the last motion planned before the hold
 
 
+@dataclass
+class _Ending:
+    """An exact-stop motion whose interpolation has ended at ``reached`` (s): the main run keeps
+    the robot at its end point, signals the motion's END at cycle ``k_end`` and is done with it
+    at cycle ``k_done`` (robot/exactstop.py)."""
+
+    seg: Segment
+    reached: float
+    k_end: int
+    k_done: int
+    signalled: bool = False
+
+
 class Controller:
     """The simulated controller (main run). See the module docstring for the protocol.
 
@@ -269,6 +283,7 @@ class Controller:
         #: interpreters read it before every statement)
         self.time = self._k * self.dt
         self._pt = 0.0
+        self._pt_step = self.dt       # the path time the last cycle advanced (s)
         self._scale = 1.0
         self._scale_rate = 0.0
         self._braking = False
@@ -282,6 +297,7 @@ class Controller:
         self._plan_q = q.copy()        # end point of the last planned motion
         self._pending: deque[Segment] = deque()
         self._runs: list[_Run] = []
+        self._ending: _Ending | None = None   # an exact stop between its end point and done
         self._blend: _Blend | None = None
         self._tracked: list[_Run] = []  # runs with unfired triggers
         self._next_id = 1
@@ -400,9 +416,14 @@ class Controller:
         return self._pending[-1]
 
     def is_idle(self) -> bool:
-        """True when the main run has caught up: no motion executing or queued, no
-        pending trigger, not braking (the condition an advance-run stop waits for).
-        After BRAKE the suspended motion does not count (interrupt level)."""
+        """True when the main run has caught up: no motion executing, ending (an exact stop
+        until it is done, robot/exactstop.py) or queued, no pending trigger, not braking (the
+        condition an advance-run stop waits for). After BRAKE the suspended motion does not
+        count (interrupt level)."""
+        return self._ending is None and self._main_idle()
+
+    def _main_idle(self) -> bool:
+        """:meth:`is_idle` but for an exact stop that is ending."""
         return (not self._runs and self._blend is None and not self._pending
                 and not self._tracked and not self._braking)
 
@@ -451,7 +472,8 @@ class Controller:
         its start to the same axes without a TRIGGER (``PTP XHOME`` at XHOME, again and
         again), no cell rule about to rise (the condition of :meth:`skip`;
         interp/runtime/idle.py)."""
-        if self._braking or self._held is not None or self._blend is not None or self._tracked:
+        if (self._braking or self._held is not None or self._blend is not None or self._tracked
+                or self._ending is not None):
             return False
         for seg in [r.seg for r in self._runs] + list(self._pending):
             if seg.triggers or not np.array_equal(seg.q0, seg.q1) or not np.array_equal(seg.q0, self._q):
@@ -622,7 +644,7 @@ class Controller:
         if h is None:
             return
         self._held = None
-        if not self._moved_while_held and self.is_idle():
+        if not self._moved_while_held and self._main_idle():
             d = self._pt - h.pt
             objs = list(h.runs) + list(h.tracked)
             if h.blend is not None:
@@ -844,7 +866,8 @@ class Controller:
             self.trace.write("end", self.time, reason=reason, **fields)
         self._ended = True
 
-    def _motion_event(self, seg: Segment, phase: str, reason: str | None = None) -> None:
+    def _motion_event(self, seg: Segment, phase: str, reason: str | None = None,
+                      reached: float | None = None) -> None:
         req = seg.req
         self._events.append(MotionEvent(self.time, req.id, phase, req))
         if self.trace is not None:
@@ -852,7 +875,7 @@ class Controller:
             self.trace.write("motion", self.time, id=req.id, type=req.type_name,
                              target=dict(req.target), approximation=req.approx,
                              phase=phase, point=seg.end_frame, line=req.line, file=req.file,
-                             reason=reason, limits=limits)
+                             reason=reason, limits=limits, reached=reached)
         for st in self.stimuli:
             if (not st.fired and st.due is None and st.phase == phase
                     and st.matches_motion(req.id, req.line)):
@@ -889,6 +912,7 @@ class Controller:
             self._conditional_stops()
         # path time (BRAKE ramps scale the path speed)
         s_old = self._scale
+        pt_old = self._pt
         if self._ramp_up:
             # release(): this cycle's path-time step is dt · scale, the scale chosen within
             # the axes' accelerations (_ramp_scale)
@@ -903,6 +927,7 @@ class Controller:
                 if self._scale in (0.0, 1.0):
                     self._scale_rate = 0.0
             self._pt += self.dt * 0.5 * (s_old + self._scale)
+        self._pt_step = self._pt - pt_old
         self._q_prev = self._q
         try:
             q = self._main_run(self._pt)
@@ -984,6 +1009,8 @@ class Controller:
         return run
 
     def _main_run(self, pt: float) -> np.ndarray:
+        if self._ending is not None and self._exact_stop_ending():
+            return self._q
         if self._blend is not None:
             b = self._blend
             if pt < b.pb - EPS:
@@ -1023,9 +1050,14 @@ class Controller:
                 r.decided = True
                 self.message(MSG_APPROX_IMPOSSIBLE, seg.id)
         if tau >= seg.T - EPS:
+            # an exact stop: the robot stands at the end point; END and done come later
             self._runs = []
             r.decided = True
-            self._motion_event(seg, "end")
+            # the interpolation ended between the last cycle and this one (in clock time)
+            over = (pt - (r.t0 + seg.T)) * self.dt / max(self._pt_step, EPS)
+            reached = self.time - min(max(over, 0.0), self.dt)
+            k_end = int(math.floor(reached / self.dt + 1e-6)) + END_DELAY_CYCLES
+            self._ending = _Ending(seg, reached, k_end, k_end + DONE_CYCLES)
             seg._last_q = seg.q1.copy()
             return seg.q1.copy()
         if self.batch and self._scale == 1.0 and self._scale_rate == 0.0:
@@ -1036,6 +1068,28 @@ class Controller:
                 end = min(end, r.tau_cache[1] - EPS)
             return seg.axes_run(pt, r.t0, self.dt * 0.5 * (1.0 + 1.0), end)
         return seg.axes(tau)
+
+    def _exact_stop_ending(self) -> bool:
+        """The exact stop that is ending (robot/exactstop.py): its END signal (the motion's
+        ``end`` event, with the time its interpolation ended) at its cycle; True while the main
+        run is not done with it (the robot stands; no motion starts), False from the cycle after
+        it is done."""
+        e = self._ending
+        if not e.signalled and self._k >= e.k_end:
+            e.signalled = True
+            self._motion_event(e.seg, "end", reached=e.reached)
+        if self._k >= e.k_done:
+            self._ending = None
+            return self._k == e.k_done
+        return True
+
+    def _end_now(self) -> None:
+        """An ending exact stop gives its END at once (the run stops: an error, a reset)."""
+        e = self._ending
+        if e is not None:
+            self._ending = None
+            if not e.signalled:
+                self._motion_event(e.seg, "end", reached=e.reached)
 
     def _begin_blend(self, r: _Run, pt: float, bp: "blending.BlendPlan") -> np.ndarray:
         nseg = self._pending.popleft()
@@ -1207,6 +1261,7 @@ class Controller:
             self._fault(RobotError(stop))
 
     def _fault(self, err: RobotError) -> np.ndarray:
+        self._end_now()
         mid = self._runs[0].seg.id if self._runs else None
         self.last_error = err
         self._events.append(ErrorEvent(self.time, err, mid))

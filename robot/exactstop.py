@@ -9,8 +9,12 @@ timing").
   ``END = (floor(t_f / cycle) + 3) · cycle``, i.e. 24-36 ms after ``t_f``. It held for every
   motion of every recording (154 real motions, 79 of OfficeLite, no exception).
 * The next motion starts :data:`RESTART_CYCLES` cycles after END (``TIME`` of its START block is
-  exactly END + 60 ms in every recording), also when the program waited in between
-  (``WAIT SEC 2``: START = END + 167 cycles + 5 cycles, Linear_vertical).
+  exactly END + 60 ms in every real recording). When the program waited in between (``WAIT SEC
+  2``, Linear_vertical) START came 167 + 5 cycles after END: the advance run resumed 4 cycles
+  after END (:data:`DONE_CYCLES`), waited its 167 cycles, and the motion started in the next
+  cycle, as a motion starts one cycle after it is queued to an idle main run (the first START of
+  every recording is 2 cycles after the trace started: TraceStart's ``WAIT SEC 0.012``, then one).
+  The simulator's main run does the same (robot/controller.py ``_Ending``).
 
 So the pause between two exact-stop motions, from the end of one interpolation to the start of
 the next, is 84-96 ms (8 cycles less the fraction of the cycle in which the first ended).
@@ -22,8 +26,13 @@ import math
 
 #: IPO cycles from the cycle in which an exact-stop motion's interpolation ends to its END signal
 END_DELAY_CYCLES = 3
-#: IPO cycles from an exact-stop motion's END signal to the start of the next motion
-RESTART_CYCLES = 5
+#: IPO cycles from an exact-stop motion's END signal until the main run is done with it: an
+#: advance-run stop waiting for the motion resumes then, and a motion queued behind it starts in
+#: the next cycle (START = END + 5 cycles = 60 ms; after ``WAIT SEC 2`` the next START comes 167 +
+#: 5 cycles after END: the WAIT began 4 cycles after END)
+DONE_CYCLES = 4
+#: IPO cycles from an exact-stop motion's END signal to the start of a motion queued behind it
+RESTART_CYCLES = DONE_CYCLES + 1
 #: a time within this many seconds below a cycle boundary counts as on it (the recordings' times
 #: are in µs; the planned ends are sums of floats)
 _EPS = 1e-6
@@ -64,4 +73,4 @@ def override_interval(motions, cycle: float) -> tuple[float, float] | None:
     return lo, hi
 
 
-__all__ = ["END_DELAY_CYCLES", "RESTART_CYCLES", "end_signal", "override_interval"]
+__all__ = ["DONE_CYCLES", "END_DELAY_CYCLES", "RESTART_CYCLES", "end_signal", "override_interval"]

@@ -176,6 +176,7 @@ class SysVars:
         s["$H_POS_TOL"] = axis_struct([HOME_TOL_DEG] * 12)
         for i in range(5):
             s["$H_AXIS_TOL"].data[i] = axis_struct([HOME_TOL_DEG] * 12)
+        _boot_trace(self)
         self.robot_values()
 
     #: The system variables that name the simulated robot (issue 22): they always hold the
@@ -686,20 +687,17 @@ def _trace_mode(rt, fields: dict, mode: str) -> None:
                         config=_text(fields.get("CONFIG")) or None)
 
 
-def _trace(sv: SysVars, t, name):
-    """``$TRACE``: a structure whose MODE component acts when written (:class:`_TraceFields`);
-    boots with STATE #T_END (no recording)."""
-    v = make_value(t)
+def _boot_trace(sv: SysVars) -> None:
+    """``$TRACE`` at boot: a structure whose MODE component acts when written
+    (:class:`_TraceFields`), STATE #T_END (no recording)."""
+    v = sv.store.get("$TRACE")
+    if not isinstance(v, Struct):
+        return
     fields = _TraceFields(v.f)
     fields.rt = sv.rt
     dict.__setitem__(fields, "STATE", EnumValue("T_END"))
     dict.__setitem__(fields, "MODE", EnumValue("T_STOP"))
     v.f = fields
-    sv.store[name] = v
-    return Slot(sv.store, name, t, name)
-
-
-_LIVE["$TRACE"] = _trace
 
 
 def _pro_mode_written(sv: SysVars, ref) -> None:

@@ -3,6 +3,8 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 
@@ -25,7 +27,13 @@ def _ctl(**kw):
 
 
 def _phases(events, mid):
-    return {e["phase"]: e["t"] for e in events if e["kind"] == "motion" and e["id"] == mid}
+    """The motion's phase times, and ``reached``: the IPO cycle in which its interpolation
+    ended (an exact stop's END comes 24-36 ms later, robot/exactstop.py)."""
+    ph = {e["phase"]: e["t"] for e in events if e["kind"] == "motion" and e["id"] == mid}
+    for e in events:
+        if e["kind"] == "motion" and e["id"] == mid and e.get("reached") is not None:
+            ph["reached"] = math.ceil(e["reached"] / DT - 1e-6) * DT
+    return ph
 
 
 def _trig_times(events):
@@ -93,8 +101,10 @@ def test_trigger_distance1_at_end_and_negative_delay():
                                 Trigger(distance=1, delay_ms=-100)]))
     ph = _phases(tw.events, 2)
     times = {idx: t for _, idx, t in _trig_times(tw.events)}
-    assert times[0] == pytest.approx(ph["end"], abs=1e-9)
-    assert abs((ph["end"] - times[1]) - 0.100) <= DT + 1e-9
+    # DISTANCE=1 of an exact stop: the cycle the robot reaches the end point, before END
+    assert times[0] == pytest.approx(ph["reached"], abs=1e-9)
+    assert ph["reached"] < ph["end"]
+    assert abs((ph["reached"] - times[1]) - 0.100) <= DT + 1e-9
 
 
 def test_trigger_distance1_in_blend_middle():
@@ -135,7 +145,7 @@ def test_pending_trigger_keeps_controller_busy():
     run_motions(ctl, _lin_with([Trigger(distance=1, delay_ms=200)]))
     ph = _phases(tw.events, 2)
     (_, _, t), = _trig_times(tw.events)
-    assert abs(t - ph["end"] - 0.2) <= DT + 1e-9
+    assert abs(t - ph["reached"] - 0.2) <= DT + 1e-9
 
 
 # ------------------------------------------------------------------ BRAKE

@@ -84,11 +84,13 @@ def test_interpreter_events_through_same_writer():
     tw.write("stmt", ctl.time, file="a.src", line=3)
     ctl.enqueue(MotionRequest("PTP", {"A1": 0, "A2": -90, "A3": 90, "A4": 0, "A5": 0, "A6": 0},
                               MotionParams(), line=3, file="a.src"))
-    ctl.step()
+    for _ in range(4):
+        ctl.step()
     tw.write("call", ctl.time, name="FOO")
     kinds = [e["kind"] for e in tw.events]
-    # a zero-length PTP starts and ends in the same IPO cycle
-    assert kinds == ["stmt", "motion", "motion", "pose", "call"]
+    # a zero-length PTP starts and reaches its end point in the same IPO cycle; its END (an
+    # exact stop's) comes 3 cycles later (robot/exactstop.py)
+    assert kinds == ["stmt", "motion", "pose", "pose", "pose", "motion", "pose", "call"]
 
 
 def test_frames_of_poses_in_gimbal_lock_are_matrix_to_frame_each():
