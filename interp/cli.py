@@ -63,6 +63,9 @@ from robot.trace import TRACE_REPEATS, read_trace
               help="Where the robot stands at the start: an E6AXIS literal (\"{A1 0, A2 -90, A3 90, A4 0, A5 0, "
                    "A6 0}\") or a point of the program such as XHOME (default: the cell file's start:, for a "
                    "cell program or with --inputs auto XHOME, else $AXIS_HOME[1]).")
+@click.option("--override", "override", type=click.IntRange(1, 100), default=None, metavar="PCT",
+              help="The program override $OV_PRO (%) the operator set before the start (default 100): "
+                   "every motion takes its time at 100 % divided by it, as on a KR C4 (docs/robot.md).")
 @click.option("--on-halt", "on_halt", default="stop", show_default=True, metavar="stop|continue[:N]",
               help="After a HALT: stop the run, or `continue`: the operator presses Start again (at most N "
                    "times, default 10; then the HALT ends the run).")

@@ -33,7 +33,7 @@ def make_runtime(program, *, workspace=None, inputs=None, trace=None, max_sim_ti
                  mode: str | None = None, check: bool = True,
                  vm_loop: str = "generated", run_mode: str | None = None,
                  pgno: int | None = None, robot=None, network=None, start: str | None = None,
-                 halt_continues: int = 0) -> tuple[Runtime, object]:
+                 halt_continues: int = 0, override: int | None = None) -> tuple[Runtime, object]:
     """Build the runtime and the interpreter (``interp``: tree or vm) for ``program``
     (not started yet). Its files (krl.project.project_of, with the `submit` programs) are
     loaded, checked and resolved first; with `check` (``krl run`` without ``--no-check``) a
@@ -58,7 +58,9 @@ def make_runtime(program, *, workspace=None, inputs=None, trace=None, max_sim_ti
     (:func:`start_axes`: an E6AXIS literal or a point name; default the cell file's
     ``start:``, else ``XHOME`` for a cell program or with ``--inputs auto`` when the program has
     one, else ``$AXIS_HOME[1]``). ``halt_continues``: ``--on-halt continue``, the
-    times the operator presses Start again after a HALT (0: a HALT ends the run). ``network``: the partners
+    times the operator presses Start again after a HALT (0: a HALT ends the run). ``override``:
+    ``krl run --override``, the program override ``$OV_PRO`` (1..100 %) the operator set before
+    the start (default 100; the program may change it). ``network``: the partners
     (net.settings.NetworkSettings; default the cell file's ``network:`` key): the run's network
     hub (net/hub.py) is attached to the controller either way; without partners its EKI
     channels stay "not connected". Raises
@@ -88,6 +90,8 @@ def make_runtime(program, *, workspace=None, inputs=None, trace=None, max_sim_ti
                  submits=list(submit or ()), check=check)
     if run_mode is not None:
         rt.set_run_mode(run_mode)
+    if override is not None:
+        rt.sysvars.store["$OV_PRO"] = int(override)
     rt.halt_continues = halt_continues
     main = Path(program).stem
     cell_why = cell_program(rt)
@@ -410,7 +414,7 @@ class RunSetup:
     ``booted`` (the backup's SPS.SUB when it was started as at boot, else None), ``machine``
     (the simulated robot, robot.machine.MachineData), ``options`` (the rest of krl run's
     options by their click names: interp_kind, max_sim_time, max_steps, mode, run_mode, pgno,
-    no_check, trace_path, trace_repeats, start, halt_continues), ``shown`` (a path as the
+    no_check, trace_path, trace_repeats, start, halt_continues, override), ``shown`` (a path as the
     user named it: an archive's temporary folder is shown as the archive), ``cell`` (the cell
     file `inputs` read once, robot.stimuli.Cell; ``"auto"`` for the automatic cell; None without one)."""
     program: Path
@@ -462,7 +466,7 @@ class RunSetup:
                   submit=[str(s) for s in self.submit], interp=self.interp, observer=observer,
                   mode=o.get("mode"), check=self.check, run_mode=str(o.get("run_mode") or "GO").upper(),
                   pgno=o.get("pgno"), robot=self.machine, start=o.get("start"),
-                  halt_continues=o.get("halt_continues", 0))
+                  halt_continues=o.get("halt_continues", 0), override=o.get("override"))
         kw.update(override)
         return make_runtime(self.program, **kw)
 

@@ -124,6 +124,41 @@ def ptp_axis_speeds(params: Any, machine: Any, mode: str = DEFAULT_MODE) -> np.n
     return axes
 
 
+def ptp_axis_accelerations(params: Any, machine: Any) -> np.ndarray:
+    """The axis accelerations a PTP/SPTP motion is planned with, deg/s² per axis (as
+    :func:`ptp_axis_speeds`: A1..An, then E1..En), as KSS 8.5 applies ``$ACC_AXIS``, ``$VEL_AXIS``
+    and the program override (identified on the real KR 3 R540's recordings, tools/identify_kr3.py;
+    docs/robot.md "PTP timing"):
+
+    * ``a_max_i · $ACC_AXIS[i]%``: the percentage scales the axis' acceleration;
+    * at most ``v_i² / (2 R_i)`` with ``v_i = v_max_i · $VEL_AXIS[i]%``: at a reduced axis speed the
+      ramp to it covers at least the distance ``R_i`` (deg; machine data ``ptp_ramp_deg``, where
+      identified: a robot without it has no such bound);
+    * ``· ($OV_PRO%)²``: the program override scales the motion's time (``v · ov``, ``a · ov²``), so
+      the motion takes its planned time divided by the override: the END signals of every
+      recording made at 85 % (robot/exactstop.py)."""
+    a_max = np.asarray(getattr(machine, "all_max_acc", machine.max_acc_deg_s2), dtype=float)
+    n = len(machine.joints)
+    acc = np.asarray(list(params.acc_axis)[:n] + [100.0] * (len(a_max) - n), dtype=float)
+    return np.minimum(a_max * acc / 100.0 * (params.ov_pro / 100.0) ** 2, ptp_ramp_accelerations(params, machine))
+
+
+def ptp_ramp_accelerations(params: Any, machine: Any) -> np.ndarray:
+    """The bound of :func:`ptp_axis_accelerations` at a reduced ``$VEL_AXIS``: ``v_i² / (2 R_i) ·
+    ($OV_PRO%)²`` per axis (deg/s²; inf for an axis without ``R_i``)."""
+    v_max = np.asarray(getattr(machine, "all_max_speed", machine.max_speed_deg_s), dtype=float)
+    n = len(machine.joints)
+    vel = np.asarray(list(params.vel_axis)[:n] + [100.0] * (len(v_max) - n), dtype=float)
+    out = np.full(len(v_max), np.inf)
+    ramp = getattr(machine, "ptp_ramp_deg", None)
+    if ramp:
+        r = np.zeros(len(v_max))
+        r[:len(ramp)] = ramp
+        v = v_max * vel / 100.0
+        out = np.where(r > 0, v * v / (2.0 * np.where(r > 0, r, 1.0)), np.inf)
+    return out * (params.ov_pro / 100.0) ** 2
+
+
 def cp_path_speed(params: Any, mode: str = DEFAULT_MODE) -> float:
     """The programmed path speed of a CP motion piece, mm/s: ``$VEL.CP`` (m/s) ``· 1000 ·
     $OV_PRO%``, at most 250 mm/s in T1 (reference §6.7). The one formula, as
@@ -234,12 +269,18 @@ def check_trace(events: Iterable[dict[str, Any]], machine: Any = None, *,
 
     Returns a :class:`LimitReport`. Speeds of a sample (k-1, k] are checked against the
     largest limit of the motions active in it (both motions of an approximation window);
-    accelerations over (k-2, k] against ``a_max_i``, except across a fault stop (an
+    accelerations over (k-2, k] against ``a_max_i`` (``+ c_i·|v_i|`` for an axis with
+    identified friction, machine data ``ptp_friction``), except across a fault stop (an
     ``error`` event or a motion ended with ``reason`` ``abort``)."""
     events = list(events)
     machine = machine if machine is not None else _trace_robot(events) or load_machine()
     v_max = np.asarray(getattr(machine, "all_max_speed", machine.max_speed_deg_s), dtype=float)
     a_max = np.asarray(getattr(machine, "all_max_acc", machine.max_acc_deg_s2), dtype=float)
+    # an axis with identified friction brakes the harder the faster it goes (robot/profiles.py
+    # FrictionProfile): its limit is a_max + c·|v|
+    friction = np.zeros(len(a_max))
+    got = tuple(getattr(machine, "ptp_friction", ()) or ())[:len(a_max)]
+    friction[:len(got)] = got
     lim: dict[int, MotionLimits] = dict(limits or {})
     ts: list[float] = []
     qs: list[list[float]] = []
@@ -353,11 +394,12 @@ def check_trace(events: Iterable[dict[str, Any]], machine: Any = None, *,
             fault = fault_arr.size and bool(np.any((fault_arr > T[k - 2] - 1e-9) & (fault_arr <= t1 + 1e-9)))
             if not fault:
                 acc = (v - prev_v) / (0.5 * (T[k] - T[k - 2]))
-                ra = np.abs(acc) / a_max
+                a_lim = a_max + friction * np.maximum(np.abs(v), np.abs(prev_v))
+                ra = np.abs(acc) / a_lim
                 rep.axis_acc_ratio = max(rep.axis_acc_ratio, float(ra.max()))
                 if ra.max() > 1.0 + tol_acc:
                     i = int(np.argmax(ra))
-                    add(Violation("axis_acc", float(t1), float(abs(acc[i])), float(a_max[i]), i + 1, newest))
+                    add(Violation("axis_acc", float(t1), float(abs(acc[i])), float(a_lim[i]), i + 1, newest))
         prev_v = v
     return rep
 

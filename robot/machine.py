@@ -255,6 +255,24 @@ class MachineData:
     #: ``$MAIN_AXIS``: the main axes' kind (``#NR`` articulated arm, ``#CC`` SCARA, ``#SS``
     #: gantry; KR C2 machine-data handbook §2.1.145); ``#NR`` for the yaml robot
     main_axis: str = "#NR"
+    #: the distance (deg) below which a PTP at reduced ``$VEL_AXIS`` does not ramp to its speed, per
+    #: axis (robot/limits.py ``ptp_axis_accelerations``): identified from a robot's KUKA Trace
+    #: recordings (robot/identified.py); () for a robot without: no such bound
+    ptp_ramp_deg: tuple[float, ...] = ()
+    #: the acceleration (deg/s²) an axis loses per deg/s of its speed while it accelerates in a PTP,
+    #: and gains while it brakes (its friction over its inertia, 1/s; robot/profiles.py
+    #: ``FrictionProfile``): identified from a robot's KUKA Trace recordings (robot/identified.py);
+    #: () for a robot without: the trapezoid
+    ptp_friction: tuple[float, ...] = ()
+    #: the IPO cycles over which the controller's setpoints are averaged (in axis space) before the
+    #: robot's measured axes follow them: the actual-value model ``krl trace compare`` puts a
+    #: simulated run's setpoints through (robot/kukatrace/actual.py); identified from a robot's
+    #: recordings (robot/identified.py), 1 (none) for a robot without
+    actual_filter_cycles: int = 1
+    #: the arm's identified inertia (robot/dynamics.py ``Inertia``: link masses, centres of mass and
+    #: inertias, rotor inertias, acceleration torques), or None: a PTP's accelerations are then the
+    #: axes' own (robot/limits.py)
+    dynamics: dict[str, Any] | None = field(default=None, compare=False, repr=False)
 
     @property
     def n_axes(self) -> int:

@@ -40,6 +40,7 @@ from krl.project import backup_of, find_backups, machine_data_file
 from . import catalogue
 from .chain import chain_forward, chain_to_joints
 from .datalist import DataListError, DataValue, read_data_list
+from .identified import apply_identified, identified_file
 from .frames import matrix_to_frame
 from .madavalues import MachineDataError, krl_value
 from .madavalues import axes as _axes
@@ -505,7 +506,9 @@ def _load_mada(p: Path, name: str) -> MachineData:
         robcor = read_data_list(rob, str(Path(name).parent / rob.name)) if rob is not None else None
     except DataListError as exc:
         raise MachineDataError(str(exc)) from None
-    return machine_from_values(values, robcor, name)
+    machine = machine_from_values(values, robcor, name)
+    ident = identified_file(p)          # a library robot whose recordings were analysed (issue 60)
+    return apply_identified(machine, ident) if ident is not None else machine
 
 
 def robot_of_backup(root: str | Path, shown: str | None = None) -> MachineData | None:

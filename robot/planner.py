@@ -44,11 +44,13 @@ from .frames import frame_to_matrix, inv_pos, matrix_to_frame
 from . import kinematics
 from .axismap import AxisMap
 from .external import ExternalAxes
+from .dynamics import Inertia
 from .external_tcp import external_tcp
 from .kinematics import Kinematics
 from .motion import AXIS_KEYS, CART_KEYS, EXT_KEYS, MotionParams, MotionRequest, Trigger
-from .limits import DEFAULT_MODE, T1_SPEED_MM_S, cp_path_speed, motion_limits, ptp_axis_speeds
-from .profiles import PiecewiseProfile, Trapezoid
+from .limits import (DEFAULT_MODE, T1_SPEED_MM_S, cp_path_speed, motion_limits, ptp_axis_accelerations,
+                     ptp_axis_speeds, ptp_ramp_accelerations)
+from .profiles import FrictionProfile, PiecewiseProfile, Trapezoid
 
 
 #: An axis jump (deg) between neighbouring planning samples of a CP path that means the
@@ -859,15 +861,7 @@ class CartSegment(Segment):
             self._last_q = self.q1.copy()
             return self.q1.copy()
         if self.joint_ori:
-            # $ORI_TYPE #JOINT: wrist axes linear in u, TCP on the path (reference §6.7)
-            u = self.profile.u(tau)
-            p = self.pose_u(u)[0]
-            n = self.model.n
-            wrist = self.q0[3:n] + u * (self.q1[3:n] - self.q0[3:n])
-            ref = self._last_q
-            if len(ref) > n:
-                ref = np.concatenate([ref[:n], self.q0[n:] + u * (self.e1 - self.q0[n:])])
-            q = self.model.solve_position(p, wrist, ref, self.tool_T, self.base_inv_T)
+            q = self.joint_axes_u(self.profile.u(tau), self._last_q)
             self._last_q = q
             return q
         if len(self.q0) > self.model.n:
@@ -890,6 +884,17 @@ class CartSegment(Segment):
             q = self.ik(p, R, self._last_q)
         self._last_q = q
         return q
+
+    def joint_axes_u(self, u: float, ref: np.ndarray) -> np.ndarray:
+        """``$ORI_TYPE #JOINT`` (reference §6.7): the axes at parameter `u`: the wrist axes
+        linear from the start's to the end's (:attr:`q1`: the target's S and T), A1..A3 putting
+        the TCP on the path (Newton from `ref`)."""
+        p = self.pose_u(u)[0]
+        n = self.model.n
+        wrist = self.q0[3:n] + u * (self.q1[3:n] - self.q0[3:n])
+        if len(ref) > n:
+            ref = np.concatenate([ref[:n], self.q0[n:] + u * (self.e1 - self.q0[n:])])
+        return self.model.solve_position(p, wrist, ref, self.tool_T, self.base_inv_T)
 
     def u_of_path(self, s: float) -> float:
         sb = self.s_bounds
@@ -1112,14 +1117,9 @@ def _plan_joint(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_T:
     if not moving.any():
         prof = Trapezoid.plan(math.inf, math.inf)
         v_prog = math.inf
-        V = A = 0.0
+        V = 0.0
     else:
-        v_axis = ptp_axis_speeds(p, model.machine, model.mode)     # $RED_T1 in T1 (issue 15)
-        a_axis = model.a_max * np.array(list(p.acc_axis)[:n] + [100.0] * (len(q0) - n)) / 100.0
-        if np.any(v_axis[moving] <= 0) or np.any(a_axis[moving] <= 0):
-            raise RobotError("PTP: $VEL_AXIS, $ACC_AXIS and $OV_PRO must be positive")
-        V = float(np.min(v_axis[moving] / dq[moving]))
-        A = float(np.min(a_axis[moving] / dq[moving]))
+        V, alpha, fric = _ptp_axis_limits(q1 - q0, p, model.machine, model.mode, q0)
         if model.mode == "T1":
             # TCP and flange <= 250 mm/s (reference §6.7 [C]): the largest |dp/du| on the path
             us = np.linspace(0.0, 1.0, 33)
@@ -1133,12 +1133,103 @@ def _plan_joint(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_T:
             dp *= (len(us) - 1) * T1_MARGIN
             if dp > 0:
                 V = min(V, T1_SPEED_MM_S / dp)
-        prof = Trapezoid.plan(V, A)
+        prof = _ptp_profile(V, alpha, fric, p)
         v_prog = V
     seg = JointSegment(req, q0, q1, prof, v_prog, tool_T, base_T, model)
     seg.vel_peak = dq * prof.v
-    seg.acc_peak = dq * prof.a
+    seg.acc_peak = dq * getattr(prof, "a_peak", prof.a)
     return seg
+
+
+def ptp_limits(dq: np.ndarray, p: MotionParams, machine: Any, mode: str = DEFAULT_MODE,
+               q0: np.ndarray | None = None) -> tuple[float, float]:
+    """(V 1/s, A 1/s²) of a synchronised PTP moving the axes by `dq` (deg; A1..An, E1..En) from
+    `q0`: the normalised speed and acceleration of the leading axis, ``min_i v_i/|dq_i|`` and
+    ``min_i a_i/|dq_i|`` over the moving axes, with :func:`robot.limits.ptp_axis_speeds` and
+    :func:`robot.limits.ptp_axis_accelerations` (reference §6.6; issue 60); for a robot with an
+    identified inertia (``machine.dynamics``) and `q0` given, ``A`` is at most what the arm's
+    inertia allows (robot/dynamics.py, the axes moving together). :func:`ptp_profile` is the
+    motion's time law. Raises RobotError for a non-positive limit."""
+    V, alpha, _ = _ptp_axis_limits(dq, p, machine, mode, q0)
+    return V, float(np.min(alpha))
+
+
+def _ptp_axis_limits(dq: np.ndarray, p: MotionParams, machine: Any, mode: str,
+                     q0: np.ndarray | None) -> tuple[float, np.ndarray, np.ndarray]:
+    """(V, alpha, c) of :func:`ptp_limits` per axis: ``alpha`` (1/s², (n,)) the normalised
+    acceleration each axis allows at rest (inf for an axis that neither moves nor, by the arm's
+    inertia, needs torque), ``c`` (1/s, (n,)) what it loses per unit of normalised speed by its
+    friction at 100 % override (machine data ``ptp_friction``; :func:`ptp_profile`)."""
+    dq = np.asarray(dq, dtype=float)
+    ad = np.abs(dq)
+    moving = ad > 1e-9
+    v_axis = ptp_axis_speeds(p, machine, mode)       # $RED_T1 in T1 (issue 15)
+    a_axis = ptp_axis_accelerations(p, machine)      # as KSS 8.5 (issue 60)
+    if np.any(v_axis[moving] <= 0) or np.any(a_axis[moving] <= 0):
+        raise RobotError("PTP: $VEL_AXIS, $ACC_AXIS and $OV_PRO must be positive")
+    V = float(np.min(v_axis[moving] / ad[moving]))
+    safe = np.where(moving, ad, 1.0)
+    alpha = np.where(moving, a_axis / safe, np.inf)
+    fr = np.zeros(len(dq))
+    got = tuple(getattr(machine, "ptp_friction", ()) or ())[:len(dq)]
+    fr[:len(got)] = got
+    c = np.where(moving, fr, 0.0)
+    dyn = _inertia(machine)
+    if dyn is not None and q0 is not None and len(dq) == dyn.n:
+        # the arm's inertia decides instead of the axes' own accelerations (robot/dynamics.py);
+        # the ramp bound at a reduced $VEL_AXIS stays. An axis' friction torque is that of its
+        # own speed: per unit of normalised speed it costs what the acceleration does at the
+        # pose the axis was identified at, scaled as the inertia scales the acceleration
+        factor = np.asarray(list(p.acc_axis)[:dyn.n], dtype=float) / 100.0 * (p.ov_pro / 100.0) ** 2
+        ramp = np.where(moving, ptp_ramp_accelerations(p, machine) / safe, np.inf)
+        a_dyn = dyn.ptp_accelerations(q0, q0 + dq, factor)
+        a_max = np.asarray(getattr(machine, "all_max_acc", machine.max_acc_deg_s2), dtype=float)[:dyn.n]
+        static = a_max * factor / safe
+        with np.errstate(invalid="ignore"):
+            c = np.where(moving & np.isfinite(a_dyn), c * a_dyn / static, 0.0)
+        alpha = np.minimum(a_dyn, ramp)
+    return V, alpha, c
+
+
+def ptp_profile(dq: np.ndarray, p: MotionParams, machine: Any, mode: str = DEFAULT_MODE,
+                q0: np.ndarray | None = None, V: float | None = None) -> Any:
+    """The time law of a synchronised PTP moving the axes by `dq` from `q0` (:func:`ptp_limits`;
+    at the normalised speed `V` when given, less than its): :class:`~robot.profiles.Trapezoid`
+    with ``V`` and ``A`` of :func:`ptp_limits`; for a robot whose axes lose acceleration with
+    their speed (machine data ``ptp_friction``, 1/s, identified: robot/identified.py) a
+    :class:`~robot.profiles.FrictionProfile`: axis ``i`` allows the normalised acceleration
+    ``alpha_i - c_i·u'`` accelerating and ``alpha_i + c_i·u'`` braking; the motion takes the
+    line through the least of them at rest and at ``V`` (below the least of the lines, so
+    within every axis' own). The override scales the motion's time: ``c_i · $OV_PRO%``."""
+    v_lim, alpha, c = _ptp_axis_limits(dq, p, machine, mode, q0)
+    return _ptp_profile(v_lim if V is None else V, alpha, c, p)
+
+
+def _ptp_profile(V: float, alpha: np.ndarray, c: np.ndarray, p: MotionParams) -> Any:
+    """:func:`ptp_profile` from the axes' limits (:func:`_ptp_axis_limits`)."""
+    A = float(np.min(alpha))
+    if not np.any(c > 0) or not (0 < V < math.inf):
+        return Trapezoid.plan(V, A)
+    c = c * p.ov_pro / 100.0
+    a_end = float(np.min(alpha - c * V))
+    d_end = float(np.min(alpha + c * V))
+    return FrictionProfile(V, A, max(0.0, (A - a_end) / V), max(0.0, (d_end - A) / V))
+
+
+#: robot/dynamics.py Inertia of a machine (by id), kept: a program plans many PTPs on one robot
+_INERTIA: dict[int, Any] = {}
+
+
+def _inertia(machine: Any) -> Any:
+    dyn = getattr(machine, "dynamics", None)
+    if dyn is None:
+        return None
+    got = _INERTIA.get(id(machine))
+    if got is None or got[0] is not machine:
+        if len(_INERTIA) >= 16:
+            _INERTIA.clear()
+        got = _INERTIA[id(machine)] = (machine, Inertia(machine, dyn))
+    return got[1]
 
 
 def _orientation_modes(p: MotionParams, kind: str) -> str:
@@ -1151,11 +1242,14 @@ def _orientation_modes(p: MotionParams, kind: str) -> str:
 
 def _cp_speeds(prm: MotionParams, mode: str) -> tuple[float, float, float, float]:
     """(v_cp mm/s, v_ori deg/s, a_cp mm/s², a_ori deg/s²) of a CP piece: ``$VEL.CP``
-    · ``$OV_PRO``% (T1: at most 250 mm/s), the smaller ORI value (reference §6.7)."""
+    · ``$OV_PRO``% (T1: at most 250 mm/s), the smaller ORI value (reference §6.7); the
+    accelerations · ``($OV_PRO%)²``: the override scales the motion's time, as it does a PTP's
+    (robot/limits.py ``ptp_axis_accelerations``; issue 60)."""
     v_cp = cp_path_speed(prm, mode)
     v_ori = min(prm.vel_ori1, prm.vel_ori2) * prm.ov_pro / 100.0
-    a_cp = prm.acc_cp * 1000.0
-    a_ori = min(prm.acc_ori1, prm.acc_ori2)
+    ov2 = (prm.ov_pro / 100.0) ** 2
+    a_cp = prm.acc_cp * 1000.0 * ov2
+    a_ori = min(prm.acc_ori1, prm.acc_ori2) * ov2
     if min(v_cp, v_ori, a_cp, a_ori) <= 0:
         raise RobotError("CP motion: $VEL, $ACC and $OV_PRO must be positive")
     return v_cp, v_ori, a_cp, a_ori
@@ -1284,8 +1378,11 @@ def _plan_cart(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_T: 
         v_cp, v_ori, a_cp, a_ori = speeds[k]
         lk = L * W / w if w > 0 else 0.0       # mm per unit u
         ok = th * W / w if w > 0 else 0.0      # deg per unit u
-        # curvature: the centripetal acceleration v²/r stays within $ACC.CP
-        v_curve = math.sqrt(a_cp * pieces[k].min_radius) if L > 0 else math.inf
+        # curvature: the centripetal acceleration v²/r stays within $ACC.CP on a spline; a CIRC's
+        # path speed is not limited by it (the real KR C4 plans a 360° CIRC of r 150 mm at
+        # $ACC.CP 2.3 m/s² as the plain triangle 2·sqrt(L/a): 1.280 s, issue 60)
+        curved = L > 0 and req.kind != "CIRC"
+        v_curve = math.sqrt(a_cp * pieces[k].min_radius) if curved else math.inf
         v = min(v_cp / lk if lk > 0 else math.inf, v_ori / ok if ok > 0 else math.inf)
         vprog.append(v)
         v = min(v, v_curve / lk if lk > 0 else math.inf)
@@ -1316,6 +1413,20 @@ def _plan_cart(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_T: 
     # axis speeds/accelerations the path needs (the path is slowed so that the axes stay
     # within machine data: |q'|·du/dt <= v_max, |q''|·(du/dt)² + |q'|·d²u/dt² <= a_max)
     status = model.status_turn(q0)[0]
+    # on a robot whose axis accelerations are those its PTPs were identified with (robot/
+    # identified.py), not limits of its axes, a LIN or CIRC keeps $ACC.CP whatever accelerations
+    # its axes need (the real KR 3 R540 plans the CIRCs of its recordings at 2.3 m/s², although A2
+    # then needs 1.06 x the acceleration it has in a PTP; issue 60); its axis speeds still slow it.
+    # Elsewhere, and for a spline, the path is slowed for both
+    plain = req.kind in ("LIN", "CIRC") and bool(getattr(model.machine, "ptp_ramp_deg", ()))
+    if seg.joint_ori:
+        # $ORI_TYPE #JOINT: the wrist axes move linearly from the start's to the target's, the
+        # target's as its S and T give them (the real KR C4 goes from S 6 to S 2 on such a LIN, A5
+        # through 0: Linear_updated line 38, issue 60); the TCP stays on the path
+        t = req.target
+        s_t = int(t["S"]) if "S" in t and not req.relative else status
+        t_t = int(t["T"]) if "T" in t and not req.relative else None
+        seg.q1 = model.ik(pts_T[-1], inv_pos(tool_T), base_T, s_t, t_t, q0)
     ref = q0.copy()
     ub = seg.u_bounds
     v_ax = model.v_max
@@ -1332,7 +1443,9 @@ def _plan_cart(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_T: 
             Q[0] = start
             ref = start
             chain = None
-            if len(q0) == model.n and nk >= MIN_CHAIN and model.batch_ik:
+            if seg.joint_ori:
+                pass                        # solved sample by sample below (the wrist is given)
+            elif len(q0) == model.n and nk >= MIN_CHAIN and model.batch_ik:
                 chain = seg.ik_chain([seg.pose_u(float(us[j])) for j in range(1, nk + 1)], ref)
             elif len(q0) == model.n and seg.compiled_inverse():
                 # the poses and the compiled inverse along the samples in one call (the same
@@ -1351,8 +1464,11 @@ def _plan_cart(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_T: 
                 Q[1:] = chain
                 ref = Q[nk].copy()
             for j in range(1, nk + 1 if chain is None else 1):
-                pu, Ru = seg.pose_u(float(us[j]))
-                q = seg.ik(pu, Ru, ref, float(us[j])) if len(q0) > model.n else seg.ik(pu, Ru, ref)
+                if seg.joint_ori:
+                    q = seg.joint_axes_u(float(us[j]), ref)
+                else:
+                    pu, Ru = seg.pose_u(float(us[j]))
+                    q = seg.ik(pu, Ru, ref, float(us[j])) if len(q0) > model.n else seg.ik(pu, Ru, ref)
                 jump = np.abs(q - ref)
                 if float(jump.max()) > SINGULAR_JUMP_DEG:
                     i = int(np.argmax(jump))
@@ -1385,7 +1501,8 @@ def _plan_cart(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_T: 
         budget = 0.5 if (kink[k] or kink[k + 1]) else 1.0
         with np.errstate(divide="ignore"):
             V = float(np.min(np.where(qd > 1e-9, v_ax / qd, np.inf)))
-            V = min(V, float(np.min(np.where(qdd > 1e-9, np.sqrt(0.5 * budget * a_ax / qdd), np.inf))))
+            if not plain:
+                V = min(V, float(np.min(np.where(qdd > 1e-9, np.sqrt(0.5 * budget * a_ax / qdd), np.inf))))
         if model.mode == "T1":
             F = model.kin.forward_many(Q)
             dpf = float(np.max(np.linalg.norm(np.diff(F[:, :3, 3], axis=0), axis=1))) / h
@@ -1393,9 +1510,10 @@ def _plan_cart(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_T: 
             if dpf > lk * (1.0 + 1e-6):  # the flange moves faster than the TCP (tool, rotation)
                 V = min(V, T1_SPEED_MM_S / (dpf * T1_MARGIN))
         vmax[k] = min(vmax[k], V)
-        with np.errstate(divide="ignore"):
-            Aax = float(np.min(np.where(qd > 1e-9, (budget * a_ax - qdd * vmax[k] ** 2) / qd, np.inf)))
-        amax[k] = min(amax[k], max(Aax, 1e-9))
+        if not plain:
+            with np.errstate(divide="ignore"):
+                Aax = float(np.min(np.where(qd > 1e-9, (budget * a_ax - qdd * vmax[k] ** 2) / qd, np.inf)))
+            amax[k] = min(amax[k], max(Aax, 1e-9))
         sec_d.append((qd, qdd, budget))
 
     def rebudget(k: int) -> None:
@@ -1437,7 +1555,8 @@ def _plan_cart(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_T: 
         prof = PiecewiseProfile([float(x) for x in ub], vmax, amax, vnode)
     seg.profile = prof
     seg.v_prog = vprog[-1]
-    seg.q1 = ref
+    if not seg.joint_ori:
+        seg.q1 = ref
     seg.status = status
     return seg
 
@@ -1494,5 +1613,5 @@ def resolved_target(seg: Segment) -> MotionRequest:
                          line=req.line, id=req.id)
 
 
-__all__ = ["RobotModel", "Segment", "JointSegment", "CartSegment", "TriggerPlan", "plan",
+__all__ = ["RobotModel", "Segment", "JointSegment", "CartSegment", "TriggerPlan", "plan", "ptp_limits", "ptp_profile",
            "resolved_target", "LinePiece", "ArcPiece", "CatmullRomPiece"]

@@ -128,6 +128,154 @@ class Trapezoid:
         return self.t_total - target / self.a if self.a > 0 else self.t_total
 
 
+def _acc_gain(x: float) -> float:
+    """``-x - log(1 - x)`` (0 <= x < 1), by its series where it would cancel."""
+    if x < 1e-3:
+        return x * x * (0.5 + x * (1.0 / 3.0 + x * (0.25 + x * 0.2)))
+    return -x - math.log1p(-x)
+
+
+def _dec_gain(x: float) -> float:
+    """``x - log(1 + x)`` (x >= 0), by its series where it would cancel."""
+    if x < 1e-3:
+        return x * x * (0.5 + x * (-1.0 / 3.0 + x * (0.25 - x * 0.2)))
+    return x - math.log1p(x)
+
+
+def _acc_path(y: float) -> float:
+    """``y - 1 + exp(-y)`` (y >= 0), by its series where it would cancel."""
+    if y < 1e-3:
+        return y * y * (0.5 + y * (-1.0 / 6.0 + y * (1.0 / 24.0 - y / 120.0)))
+    return y + math.expm1(-y)
+
+
+def _dec_path(z: float) -> float:
+    """``exp(z) - 1 - z`` (z >= 0), by its series where it would cancel."""
+    if z < 1e-3:
+        return z * z * (0.5 + z * (1.0 / 6.0 + z * (1.0 / 24.0 + z / 120.0)))
+    return math.expm1(z) - z
+
+
+class FrictionProfile:
+    """Normalised time law u(t) on [0, T] of an axis whose acceleration depends on its speed
+    (issue 60): a KR C4 plans a PTP with its dynamic model, in which the torque an axis has for
+    accelerating is its acceleration torque less its friction, which grows with the speed. The
+    real KR 3 R540's wrist axes at 10 % ``$ACC_AXIS`` show it plainly: A4 starts at 1 900 °/s²
+    and accelerates at 300 °/s² by 400 °/s, then brakes at 3 500 °/s² (the friction helps):
+    ``a = A - c_a·v`` while accelerating, ``|a| = A + c_d·v`` while braking (KUKA Trace
+    recordings A4/A5/A6_PTP_ACC_10, tools/identify_kr3.py; docs/robot.md "PTP timing").
+
+    Accelerate from rest with ``du'' = A - c_a·du`` to the speed ``V`` (or to the peak speed
+    that leaves room to brake), cruise, brake with ``du'' = -(A + c_d·du)`` to rest at
+    ``u = 1``. With ``c_a = c_d = 0`` this is :class:`Trapezoid`. A speed at or above
+    ``A/c_a`` cannot be reached: ``V`` is held below it (:data:`REACH`). Same interface as
+    :class:`Trapezoid` (``v``: the peak speed, ``a``: ``A``, ``a_peak``: the largest
+    acceleration, the braking's at the peak speed)."""
+
+    #: the fraction of the speed ``A/c_a`` the axis cruises at when ``V`` is not below it
+    REACH = 0.999
+
+    def __init__(self, v_max: float, a_max: float, c_acc: float, c_dec: float) -> None:
+        if not (v_max > 0.0 and a_max > 0.0 and c_acc >= 0.0 and c_dec >= 0.0):
+            raise ValueError(f"profile limits must be positive (v={v_max}, a={a_max}, c={c_acc}, {c_dec})")
+        A, ca, cd = float(a_max), float(c_acc), float(c_dec)
+        V = float(v_max)
+        if ca > 0.0:
+            V = min(V, self.REACH * A / ca)
+        self.a, self.c_acc, self.c_dec = A, ca, cd
+        if self._d_acc(V) + self._d_dec(V) <= 1.0:
+            vp = V
+        else:
+            lo, hi = 0.0, V
+            for _ in range(80):
+                mid = 0.5 * (lo + hi)
+                if self._d_acc(mid) + self._d_dec(mid) < 1.0:
+                    lo = mid
+                else:
+                    hi = mid
+            vp = 0.5 * (lo + hi)
+        self.v = vp
+        self.t_acc = self._t_acc(vp)
+        self.t_brake = self._t_dec(vp)
+        self._u_acc = self._d_acc(vp)
+        self._u_dec = 1.0 - self._d_dec(vp)
+        cruise = max(0.0, self._u_dec - self._u_acc) / vp if vp > 0 else 0.0
+        self.t_dec = self.t_acc + cruise
+        self.t_total = self.t_dec + self.t_brake
+        self.a_start = A
+        self.a_peak = A + cd * vp
+
+    # the phases: time and distance from rest to the speed v (accelerating), from v to rest
+    def _t_acc(self, v: float) -> float:
+        A, ca = self.a, self.c_acc
+        return v / A if ca * v < 1e-12 * A else -math.log1p(-ca * v / A) / ca
+
+    def _t_dec(self, v: float) -> float:
+        A, cd = self.a, self.c_dec
+        return v / A if cd * v < 1e-12 * A else math.log1p(cd * v / A) / cd
+
+    def _d_acc(self, v: float) -> float:
+        A, ca = self.a, self.c_acc
+        return v * v / (2.0 * A) if ca == 0.0 else A / (ca * ca) * _acc_gain(ca * v / A)
+
+    def _d_dec(self, v: float) -> float:
+        A, cd = self.a, self.c_dec
+        return v * v / (2.0 * A) if cd == 0.0 else A / (cd * cd) * _dec_gain(cd * v / A)
+
+    def u(self, t: float) -> float:
+        T = self.t_total
+        if t <= 0.0:
+            return 0.0
+        if t >= T:
+            return 1.0
+        A = self.a
+        if t < self.t_acc:
+            ca = self.c_acc
+            return 0.5 * A * t * t if ca == 0.0 else A / (ca * ca) * _acc_path(ca * t)
+        if t <= self.t_dec:
+            return self._u_acc + self.v * (t - self.t_acc)
+        r = T - t
+        cd = self.c_dec
+        return 1.0 - (0.5 * A * r * r if cd == 0.0 else A / (cd * cd) * _dec_path(cd * r))
+
+    def du(self, t: float) -> float:
+        T = self.t_total
+        if t <= 0.0 or t >= T:
+            return 0.0
+        A = self.a
+        if t < self.t_acc:
+            ca = self.c_acc
+            return A * t if ca == 0.0 else -A / ca * math.expm1(-ca * t)
+        if t <= self.t_dec:
+            return self.v
+        r = T - t
+        cd = self.c_dec
+        return A * r if cd == 0.0 else A / cd * math.expm1(cd * r)
+
+    def t_of_u(self, u: float) -> float:
+        if u <= 0.0 or self.t_total == 0.0:
+            return 0.0
+        if u >= 1.0:
+            return self.t_total
+        if self._u_acc <= u <= self._u_dec and self.v > 0:
+            return self.t_acc + (u - self._u_acc) / self.v
+        lo, hi = (0.0, self.t_acc) if u < self._u_acc else (self.t_dec, self.t_total)
+        for _ in range(60):
+            mid = 0.5 * (lo + hi)
+            if self.u(mid) < u:
+                lo = mid
+            else:
+                hi = mid
+        return 0.5 * (lo + hi)
+
+    def t_of_speed_in_decel(self, fraction_of_v: float, v_ref: float) -> float:
+        """First time in the braking phase at which du/dt <= ``fraction_of_v·v_ref``."""
+        target = fraction_of_v * v_ref
+        if target >= self.v:
+            return self.t_dec
+        return self.t_total - self._t_dec(target)
+
+
 class PiecewiseProfile:
     """Normalised time law u(t) over sections with their own limits (issue 15: spline
     blocks slowed at corners, CP paths slowed for the axes).

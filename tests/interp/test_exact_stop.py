@@ -16,8 +16,11 @@ from __future__ import annotations
 import math
 
 import pytest
+from click.testing import CliRunner
 
+from krl.cli import main
 from robot.exactstop import DONE_CYCLES, END_DELAY_CYCLES, RESTART_CYCLES
+from robot.trace import read_trace
 from tests.interp.helpers import run_krl
 
 DT = 0.012
@@ -75,3 +78,22 @@ def test_end_restart_wait_and_output_as_the_real_controller(tmp_path):
     assert 0.084 - 1e-6 <= pause <= 0.096 + 1e-6
 
 
+
+def test_krl_run_override_scales_every_motions_time(tmp_path):
+    """``krl run --override 50``: $OV_PRO 50 % from the start; a PTP takes its time at 100 %
+    divided by 0.5 (the override scales the time, as the END signals of every recording made at
+    85 % show: docs/robot.md)."""
+    prog = tmp_path / "prog.src"
+    prog.write_text("DEF prog()\n  BAS(#INITMOV, 0)\n  PTP {A1 0, A2 -90, A3 90, A4 0, A5 0, A6 0}\n"
+                    "  PTP {A1 40}\nEND\n", encoding="utf-8")
+    times = {}
+    for pct in (100, 50):
+        out = tmp_path / f"t{pct}.jsonl"
+        res = CliRunner().invoke(main, ["run", str(prog), "--override", str(pct), "--trace", str(out)])
+        assert res.exit_code == 0, res.output
+        ev = [e for e in read_trace(out) if e["kind"] == "motion" and e["id"] == 2]
+        start = next(e["t"] for e in ev if e["phase"] == "start")
+        times[pct] = next(e["reached"] for e in ev if e["phase"] == "end") - start
+    assert times[50] == pytest.approx(times[100] / 0.5, abs=2e-6)
+    res = CliRunner().invoke(main, ["run", str(prog), "--override", "0"])
+    assert res.exit_code == 2 and "--override" in res.output

@@ -112,7 +112,14 @@ def test_ptp_profile_samples_match_hand_formula():
 
 
 def test_ptp_vel_axis_and_override_scale_speed():
+    """The program override scales the motion's time, as KSS does (speeds by ov, accelerations
+    by ov²: the END signals of every _po85 recording fit T/0.85, docs/robot.md)."""
     P = MotionParams().with_(ov_pro=50.0)
+    _, ev = _run([MotionRequest("PTP", HOME, P), MotionRequest("PTP", dict(HOME, A1=90.0), P)])
+    ph = _phase_times(ev, 2)
+    expected = single_axis_time(90.0, A1_V, A1_A) / 0.5
+    assert ph["reached"] - ph["start"] == pytest.approx(expected, abs=1e-6)  # the trace keeps µs
+    P = MotionParams().with_(vel_axis=(50.0,) * 6)
     _, ev = _run([MotionRequest("PTP", HOME, P), MotionRequest("PTP", dict(HOME, A1=90.0), P)])
     ph = _phase_times(ev, 2)
     expected = single_axis_time(90.0, A1_V * 0.5, A1_A)

@@ -1,0 +1,112 @@
+"""Motion parameters identified from a robot's KUKA Trace recordings (issue 60), applied to its model.
+
+A KR C4's machine data hold no axis accelerations: the controller takes them from its dynamic
+model. For a robot of the project's library whose real recordings were analysed,
+``robot/data/identified/<stem>.yaml`` (written by ``python tools/identify_kr3.py --write``, never
+by hand) holds what the recordings show, each value with its method and residual:
+
+* ``ptp.acc_deg_s2``: the axis accelerations a PTP is planned with at 100 % ``$ACC_AXIS``;
+* ``ptp.ramp_deg``: the distances below which a PTP at reduced ``$VEL_AXIS`` does not ramp
+  (robot/limits.py ``ptp_axis_accelerations``);
+* ``ptp.friction_per_s``: the acceleration an axis loses per unit of its speed while it
+  accelerates, and gains while it brakes (robot/profiles.py ``FrictionProfile``);
+* ``actual.filter_cycles``: the IPO cycles over which the setpoints are averaged before the
+  measured axes follow them (robot/kukatrace/actual.py);
+* ``dynamics``: the arm's inertia for a synchronised PTP's accelerations (robot/dynamics.py).
+
+:func:`apply_identified` puts them into the :class:`~robot.machine.MachineData` that machine data
+alone make (robot/mada.py ``load_mada``, for a ``.dat`` of the library with such a file), and
+names the file in ``provenance`` (``krl robot show``). docs/robot.md "The KR 3 R540" lists the
+values with their method and residual.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from .madavalues import MachineDataError
+
+#: the folder of the identified parameters, beside the library's robots
+IDENTIFIED = Path(__file__).with_name("data") / "identified"
+
+
+def identified_file(machine_dat: Path) -> Path | None:
+    """The identified parameters of the library robot `machine_dat` (its stem's yaml in
+    :data:`IDENTIFIED`), or None: none, or a file outside the library."""
+    try:
+        if machine_dat.resolve().parent != IDENTIFIED.parent.resolve():
+            return None
+    except OSError:
+        return None
+    f = IDENTIFIED / f"{machine_dat.stem}.yaml"
+    return f if f.is_file() else None
+
+
+def read_identified(path: Path) -> dict[str, Any]:
+    """The identified parameters of `path`: ``{"acc": (n,), "ramp": (n,), "friction": (n,),
+    "filter": cycles, "dynamics": {...}}`` (deg/s², deg, 1/s, an INT), each missing when the file
+    has none. Raises MachineDataError naming the file and the key."""
+    try:
+        doc = yaml.safe_load(path.read_text(encoding="utf-8")) or {}
+    except (OSError, yaml.YAMLError) as exc:
+        raise MachineDataError(f"{path}: cannot be read as identified parameters ({exc})") from None
+    out: dict[str, Any] = {}
+    n = (doc.get("actual") or {}).get("filter_cycles")
+    if n is not None:
+        if not isinstance(n, int) or not 1 <= n <= 100:
+            raise MachineDataError(f"{path}: actual.filter_cycles: an INT 1..100 was expected")
+        out["filter"] = n
+    dyn = doc.get("dynamics")
+    if dyn is not None:
+        keys = ("link_mass_kg", "link_com_mm", "link_inertia_kg_m2", "rotor_inertia_kg_m2", "torque_nm")
+        missing = [k for k in keys if k not in dyn]
+        if missing:
+            raise MachineDataError(f"{path}: dynamics lacks {', '.join(missing)}")
+        out["dynamics"] = {k: dyn[k] for k in keys}
+    ptp = doc.get("ptp") or {}
+    for key, name in (("acc_deg_s2", "acc"), ("ramp_deg", "ramp"), ("friction_per_s", "friction")):
+        v = ptp.get(key)
+        if v is None:
+            continue
+        low = 0 if name == "friction" else 1e-300
+        if not isinstance(v, list) or not all(isinstance(x, (int, float)) and x >= low for x in v):
+            kind = "non-negative" if name == "friction" else "positive"
+            raise MachineDataError(f"{path}: ptp.{key}: a list of {kind} numbers was expected")
+        out[name] = tuple(float(x) for x in v)
+    return out
+
+
+def apply_identified(machine: Any, path: Path) -> Any:
+    """`machine` with the parameters of `path` (:func:`read_identified`): the joints'
+    ``max_acc_deg_s2``, ``ptp_ramp_deg``, ``ptp_friction``, ``actual_filter_cycles``,
+    ``dynamics``, and their provenance. Raises MachineDataError when the
+    file gives another axis count than the robot's."""
+    got = read_identified(path)
+    n = len(machine.joints)
+    for key, v in got.items():
+        if key not in ("filter", "dynamics") and len(v) != n:
+            raise MachineDataError(f"{path}: {len(v)} values for the {n} axes of {machine.name}")
+    prov = dict(machine.provenance)
+    joints = machine.joints
+    if "acc" in got:
+        joints = tuple(replace(j, max_acc_deg_s2=a) for j, a in zip(joints, got["acc"]))
+        prov["max_acc_deg_s2"] = f"identified: {path.name} (tools/identify_kr3.py, the real KUKA Trace recordings)"
+    if "ramp" in got:
+        prov["ptp_ramp_deg"] = f"identified: {path.name} (tools/identify_kr3.py, the real KUKA Trace recordings)"
+    if "friction" in got:
+        prov["ptp_friction"] = f"identified: {path.name} (tools/identify_kr3.py, the real KUKA Trace recordings)"
+    if "filter" in got:
+        prov["actual_filter_cycles"] = f"identified: {path.name} (tools/identify_kr3.py, the real KUKA Trace recordings)"
+    if "dynamics" in got:
+        prov["dynamics"] = f"identified: {path.name} (tools/identify_kr3.py: link inertias from the collision meshes, rotor inertias and torques from the recordings)"
+    return replace(machine, joints=joints, ptp_ramp_deg=got.get("ramp", machine.ptp_ramp_deg),
+                   ptp_friction=got.get("friction", machine.ptp_friction),
+                   actual_filter_cycles=got.get("filter", machine.actual_filter_cycles),
+                   dynamics=got.get("dynamics", machine.dynamics), provenance=prov)
+
+
+__all__ = ["IDENTIFIED", "apply_identified", "identified_file", "read_identified"]
