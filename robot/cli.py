@@ -144,11 +144,14 @@ def trace_show(rec: Path, override: float | None, as_json: bool, output: Path | 
 @click.option("--override", type=float, default=None, help=_OVERRIDE_HELP + " (REC)")
 @click.option("--run-override", type=float, default=None, help="the same for RUN when it is a recording")
 @click.option("--segment", default=None, help="RUN's segment to compare with REC: its name or number (1-based)")
+@click.option("--setpoints", is_flag=True,
+              help="measure a simulated RUN's path on its setpoints, not on the actual values they give "
+                   "(the robot's identified averaging; docs/trace.md)")
 @click.option("--json", "as_json", is_flag=True, help="Print JSON (docs/schemas/trace-compare.schema.json).")
 @click.option("-o", "--output", type=click.Path(path_type=Path), default=None,
               help="PNG to write: RUN (dashed) over REC per segment.")
 def trace_compare(run: Path, rec: Path, override: float | None, run_override: float | None,
-                  segment: str | None, as_json: bool, output: Path | None) -> None:
+                  segment: str | None, setpoints: bool, as_json: bool, output: Path | None) -> None:
     """Compare RUN (a simulated run's trace, or a recording) with the recording REC, motion by
     motion within each TraceStart..TraceStop segment: motion time (END - START) and its error,
     the exact-stop pause, the path deviation of RUN's TCP from REC's (mm)."""
@@ -158,7 +161,7 @@ def trace_compare(run: Path, rec: Path, override: float | None, run_override: fl
     a = _view(run, run_override)
     b = _view(rec, override)
     try:
-        result = C.compare(a, b, segment)
+        result = C.compare(a, b, segment, actual=not setpoints)
     except C.CompareError as exc:
         click.echo(f"error: {printable(str(exc))}", err=True)
         sys.exit(2)

@@ -10,7 +10,8 @@ segments, by order; ``segment=`` chooses RUN's segment by name or 1-based number
 **Motions.** Within a pair of segments the motions are matched by program line and order: with as
 many motions of the same types on both sides, in order (lines that differ are reported: a PROG.TXT
 counts the lines of the file as it was on the controller); otherwise by the longest common
-sequence of (type, line), the rest left unmatched.
+sequence of (type, line), or of the types alone when that matches more (the lines differ: an
+edited file), the rest left unmatched.
 
 **Per motion:** the start (s from the segment's start) on both sides; the motion time, END -
 START, and its error (RUN - REC, s and % of REC's); the exact-stop pause before it, START - the
@@ -18,7 +19,10 @@ previous motion's end of interpolation (``reached``; a recording's from PROG.TXT
 its program override, robot/kukatrace/model.py); the path deviation, the largest distance (mm) of
 RUN's TCP samples from the START of the motion to the START of the next (or the segment's end) to
 REC's TCP path over the same motion (the polyline of its samples): the measure the issue gives
-OfficeLite's figures in (its CIRC points lie up to 1.48 mm from the real robot's path).
+OfficeLite's figures in (its CIRC points lie up to 1.48 mm from the real robot's path). A
+simulated run's samples are its setpoints: their TCP is taken as the controller's actual-value
+model makes it (robot/kukatrace/actual.py: the setpoints averaged over the cycles identified for
+the robot), as a recording's are measured values; ``actual=False`` takes the setpoints.
 
 **In total**, over the matched exact-stop motions with a time on both sides: the motion time
 |error| median, 90th percentile and maximum (%), the median exact-stop pause of each side (pauses
@@ -34,6 +38,7 @@ from typing import Any
 
 import numpy as np
 
+from .actual import actual_tcp
 from .model import RunView, Segment
 
 #: pauses (s) longer than this between two motions are a program's wait (WAIT SEC, WAIT FOR), not
@@ -69,7 +74,7 @@ class MotionComparison:
 @dataclass
 class SegmentComparison:
     """The comparison of one pair of segments: their names, how the motions were matched
-    (``order`` or ``line``), whether lines differ, the matched motions, the indices left
+    (``order``, ``line`` or ``type``), whether lines differ, the matched motions, the indices left
     unmatched on each side, and :attr:`totals`."""
 
     run_segment: str
@@ -150,15 +155,22 @@ def pair_segments(run: RunView, rec: RunView, segment: str | None = None) -> lis
 
 # ------------------------------------------------------------------------------ motions
 def match_motions(run: Segment, rec: Segment) -> tuple[list[tuple[int, int]], str, bool]:
-    """(index pairs, ``order`` | ``line``, whether matched lines differ) for the motions of two
-    segments (the module's docstring)."""
+    """(index pairs, ``order`` | ``line`` | ``type``, whether matched lines differ) for the motions
+    of two segments (the module's docstring)."""
     a, b = run.motions, rec.motions
     if len(a) == len(b) and all(x.kind == y.kind for x, y in zip(a, b)):
         pairs = list(range(len(a)))
         differ = any(x.line != y.line for x, y in zip(a, b))
         return list(zip(pairs, pairs)), "order", differ
-    ka = [(m.kind, m.line) for m in a]
-    kb = [(m.kind, m.line) for m in b]
+    by_line = _lcs([(m.kind, m.line) for m in a], [(m.kind, m.line) for m in b])
+    by_type = _lcs([m.kind for m in a], [m.kind for m in b])
+    if len(by_type) > len(by_line):
+        return by_type, "type", any(a[i].line != b[j].line for i, j in by_type)
+    return by_line, "line", False
+
+
+def _lcs(ka: list, kb: list) -> list[tuple[int, int]]:
+    """The index pairs of the longest common subsequence of `ka` and `kb` (the earliest)."""
     n, m = len(ka), len(kb)
     L = [[0] * (m + 1) for _ in range(n + 1)]
     for i in range(n - 1, -1, -1):
@@ -175,7 +187,7 @@ def match_motions(run: Segment, rec: Segment) -> tuple[list[tuple[int, int]], st
             i += 1
         else:
             j += 1
-    return out, "line", False
+    return out
 
 
 def _pauses(seg: Segment) -> list[float | None]:
@@ -212,9 +224,11 @@ def path_deviation(points: np.ndarray, path: np.ndarray) -> float | None:
     return float(best.max())
 
 
-def compare_segments(run: Segment, rec: Segment) -> SegmentComparison:
-    """The :class:`SegmentComparison` of two segments."""
+def compare_segments(run: Segment, rec: Segment, run_tcp: np.ndarray | None = None) -> SegmentComparison:
+    """The :class:`SegmentComparison` of two segments; `run_tcp`: RUN's TCP positions (N, 3) to
+    measure the path deviation on (default its samples' own)."""
     pairs, how, differ = match_motions(run, rec)
+    tcp = run.tcp[:, :3] if run_tcp is None else run_tcp
     pr, pc = _pauses(run), _pauses(rec)
     rows = []
     for i, j in pairs:
@@ -225,7 +239,7 @@ def compare_segments(run: Segment, rec: Segment) -> SegmentComparison:
             pct = 100.0 * err / b.duration if b.duration > 0 else None
         ia = run.window(*_span(run, i))
         ib = rec.window(*_span(rec, j))
-        dev = path_deviation(run.tcp[ia, :3], rec.tcp[ib, :3]) if len(run.tcp) and len(rec.tcp) else None
+        dev = path_deviation(tcp[ia], rec.tcp[ib, :3]) if len(run.tcp) and len(rec.tcp) else None
         rows.append(MotionComparison(i, j, a.kind, a.line, b.line, a.start, b.start, a.duration, b.duration,
                                      err, pct, pr[i], pc[j], dev))
     used_a = {i for i, _ in pairs}
@@ -235,9 +249,14 @@ def compare_segments(run: Segment, rec: Segment) -> SegmentComparison:
                              [j for j in range(len(rec.motions)) if j not in used_b])
 
 
-def compare(run: RunView, rec: RunView, segment: str | None = None) -> list[SegmentComparison]:
-    """The comparison of `run` against `rec`, one entry per paired segment. Raises CompareError."""
-    return [compare_segments(a, b) for a, b in pair_segments(run, rec, segment)]
+def compare(run: RunView, rec: RunView, segment: str | None = None, actual: bool = True) -> list[SegmentComparison]:
+    """The comparison of `run` against `rec`, one entry per paired segment; with `actual`, a
+    simulated run's path is that of the actual values its setpoints give (robot/kukatrace/actual.py),
+    else its setpoints'. Raises CompareError."""
+    out = []
+    for a, b in pair_segments(run, rec, segment):
+        out.append(compare_segments(a, b, actual_tcp(run, a) if actual else None))
+    return out
 
 
 # ------------------------------------------------------------------------------ output
@@ -279,7 +298,7 @@ def text_lines(run: RunView, rec: RunView, result: list[SegmentComparison]) -> l
     out = [f"run  {run.source} ({run.kind}{_ov(run)})", f"rec  {rec.source} ({rec.kind}{_ov(rec)})"]
     for s in result:
         out.append("")
-        how = "order" if s.matched_by == "order" else "type and line"
+        how = {"order": "order", "line": "type and line", "type": "type"}[s.matched_by]
         out.append(f"segment {s.run_segment} / {s.rec_segment}: {len(s.motions)} motions matched by {how}"
                    + (" (lines differ)" if s.lines_differ else ""))
         out.append("   #  type  line run/rec   start run/rec (s)   time run/rec (s)   error ms      %"

@@ -42,6 +42,8 @@ class Motion:
     reached: float | None = None
     exact_stop: bool = True
     point: list[float] | None = None
+    tool: tuple[float, ...] | None = None
+    base: tuple[float, ...] | None = None
 
     @property
     def duration(self) -> float | None:
@@ -81,6 +83,7 @@ class RunView:
     segments: list[Segment]
     override: float | None = None
     override_note: str = ""
+    robot_source: str = ""
 
 
 # ------------------------------------------------------------------------------ recordings
@@ -141,7 +144,7 @@ def run_view(events, kind: str = "trace", source: str = "") -> RunView:
     """The :class:`RunView` of trace events (an iterable of dicts): segments between
     ``recording`` start and stop events (a ``recording`` event without a name takes the
     configuration's), or the whole run as one segment named ``run``."""
-    robot = ""
+    robot = robot_source = ""
     segs: list[Segment] = []
     cur: Segment | None = None
     whole = Segment("run", "", 0.0, 0.0)
@@ -162,7 +165,7 @@ def run_view(events, kind: str = "trace", source: str = "") -> RunView:
         t = float(ev.get("t", 0.0))
         last_t = max(last_t, t)
         if k == "robot":
-            robot = str(ev.get("name", ""))
+            robot, robot_source = str(ev.get("name", "")), str(ev.get("source", ""))
         elif k == "recording":
             ph = ev.get("phase")
             if ph == "start":
@@ -184,9 +187,12 @@ def run_view(events, kind: str = "trace", source: str = "") -> RunView:
             mid = int(ev["id"])
             if ph == "start":
                 pt = ev.get("point")
+                lim = ev.get("limits") or {}
                 m = Motion(str(ev.get("type", "")), ev.get("line"), str(ev.get("file") or ""), t - seg.origin,
                            exact_stop=ev.get("approximation") is None,
-                           point=[float(x) for x in pt] if pt else None)
+                           point=[float(x) for x in pt] if pt else None,
+                           tool=tuple(lim["tool"]) if lim.get("tool") else None,
+                           base=tuple(lim["base"]) if lim.get("base") else None)
                 seg.motions.append(m)
                 open_motions[mid] = m
             elif ph == "end":
@@ -206,7 +212,7 @@ def run_view(events, kind: str = "trace", source: str = "") -> RunView:
     if not segs:
         close(whole, whole_samples, last_t)
         segs = [whole]
-    return RunView(kind, source, robot, segs)
+    return RunView(kind, source, robot, segs, robot_source=robot_source)
 
 
 def load_run(path: str | Path, override_pct: float | None = None) -> RunView:

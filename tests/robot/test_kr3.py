@@ -16,9 +16,11 @@ import numpy as np
 import pytest
 
 from robot.frames import frame_to_matrix
+from robot.identified import apply_identified, read_identified
 from robot.kinematics import Kinematics
 from robot.kukatrace.recording import read_recording
 from robot.mada import load_robot
+from robot.madavalues import MachineDataError
 from tests.robot.test_mada import urdf_forward
 
 # kr3r540_macro.xacro: joint origins (m), no rotations, axes -Z, +Y, +Y, -X, +Y, -X; flange at link_6,
@@ -73,3 +75,20 @@ def test_forward_kinematics_gives_the_recorded_tcp(kr3, real_traces):
         errors += np.linalg.norm(F[:, :3, 3] - rec.tcp[rows, :3], axis=1).tolist()
     assert len(errors) > 900              # every 10th sample of 53 recordings
     assert max(errors) < 0.01          # mm: the recording's TCP is the model's to its float precision
+
+
+def test_the_identified_parameters_are_applied(kr3, tmp_path):
+    """robot/data/identified/kr3_r540.yaml (tools/identify_kr3.py) goes into the library robot, each
+    value's provenance naming it; a broken file is refused naming the file and the key."""
+    m, _ = kr3
+    assert len(m.ptp_ramp_deg) == len(m.ptp_friction) == 6 and m.actual_filter_cycles >= 1
+    assert m.dynamics is not None and len(m.dynamics["torque_nm"]) == 6
+    for key in ("max_acc_deg_s2", "ptp_ramp_deg", "ptp_friction", "dynamics", "actual_filter_cycles"):
+        assert "kr3_r540.yaml" in m.provenance[key]
+    bad = tmp_path / "x.yaml"
+    bad.write_text("ptp:\n  friction_per_s: [1, -2, 0, 0, 0, 0]\n", encoding="utf-8")
+    with pytest.raises(MachineDataError, match=r"x\.yaml: ptp\.friction_per_s"):
+        read_identified(bad)
+    bad.write_text("ptp:\n  acc_deg_s2: [1, 2]\n", encoding="utf-8")
+    with pytest.raises(MachineDataError, match="2 values for the 6 axes"):
+        apply_identified(m, bad)

@@ -23,8 +23,13 @@ from click.testing import CliRunner
 from krl.cli import main
 from robot.exactstop import end_signal
 from robot.kukatrace import recording as R
+from robot.frames import frame_to_matrix
+from robot.kinematics import Kinematics
+from robot.kukatrace.actual import actual_tcp
 from robot.kukatrace.compare import compare, path_deviation, totals
-from robot.kukatrace.model import load_run
+from robot.kukatrace.model import load_run, run_view
+from robot.machine import ROBOT_LIBRARY
+from robot.mada import load_robot
 
 CYCLE = 0.012
 
@@ -227,6 +232,46 @@ def test_real_recordings_against_themselves_and_shifted(real_traces, tmp_path):
     assert t["pause_s"]["run"] == pytest.approx(t["pause_s"]["rec"])
 
 
+def test_motions_of_an_edited_program_match_by_type(tmp_path):
+    """Lines that moved (a PROG.TXT counts the controller's file) and an extra motion on one side:
+    neither order nor (type, line) pairs them; the types alone do, and the lines are reported."""
+    (tmp_path / "a").mkdir()
+    (tmp_path / "b").mkdir()
+    a = write_recording(tmp_path / "a", "demo", MOTIONS)
+    edited = [(k, ln + 3, s, e, n, q0, q1) for k, ln, s, e, n, q0, q1 in MOTIONS]
+    edited.append(("PTP", 30, 1.092, 1.5, 1.524, [60, 0, 0, 0, 0, 0], [0] * 6))
+    b = write_recording(tmp_path / "b", "demo", edited)
+    (seg,) = compare(load_run(a), load_run(b))
+    assert seg.matched_by == "type" and seg.lines_differ
+    assert [(m.run_index, m.rec_index, m.run_line, m.rec_line) for m in seg.motions] == [(0, 0, 10, 13), (1, 1, 12, 15)]
+    assert seg.rec_unmatched == [2] and seg.run_unmatched == []
+
+
+def test_the_actual_value_model_averages_the_axes_over_its_cycles():
+    """A simulated run's setpoints through the average of N cycles (robot/kukatrace/actual.py): A1
+    turning at a constant speed lags by (N - 1) / 2 cycles, so each averaged TCP is the forward
+    kinematics of A1 (N - 1) / 2 cycles earlier (N = 1: the setpoints' own TCP)."""
+    robot = ROBOT_LIBRARY / "kr3_r540.dat"
+    kin = Kinematics(load_robot(robot))
+    tool = (0.0, 0.0, 100.0, 0.0, 0.0, 0.0)
+    events = [{"kind": "robot", "t": 0.0, "name": "KR3", "source": str(robot)},
+              {"kind": "motion", "t": 0.0, "id": 1, "type": "PTP", "phase": "start", "line": 3,
+               "limits": {"tool": list(tool), "base": [0.0] * 6}}]
+    axes = [[10.0 + 0.6 * k, -100.0, 100.0, 0.0, 30.0, 0.0] for k in range(40)]
+    for k, q in enumerate(axes):
+        tcp = (kin.forward(np.array(q)) @ frame_to_matrix(*tool))[:3, 3]
+        events.append({"kind": "pose", "t": round(k * CYCLE, 6), "axes": q, "tcp": [*tcp, 0.0, 0.0, 0.0]})
+    events.append({"kind": "motion", "t": 39 * CYCLE, "id": 1, "type": "PTP", "phase": "end", "reached": 39 * CYCLE})
+    view = run_view(events, "trace", "run.jsonl")
+    (seg,) = view.segments
+    for n in (1, 4):
+        got = actual_tcp(view, seg, n)
+        for k in range(n, 40):
+            q = np.array(axes[k]) - [0.6 * (n - 1) / 2, 0, 0, 0, 0, 0]
+            want = (kin.forward(q) @ frame_to_matrix(*tool))[:3, 3]
+            assert got[k] == pytest.approx(want, abs=1e-6)
+
+
 def test_path_deviation_is_the_largest_distance_to_the_polyline():
     path = np.array([[0.0, 0, 0], [100, 0, 0], [100, 100, 0]])
     pts = np.array([[50.0, 3, 0], [104, 50, 0], [100, 100, 0]])
@@ -250,6 +295,9 @@ def test_krl_trace_show_and_compare(tmp_path):
                                     "--json", "--override", "85"])
     data = json.loads(res.output)
     assert data["rec"]["override_pct"] == 85.0 and data["totals"]["time_error_pct"]["max"] == 0.0
+    # a recording's TCP is measured: --setpoints changes nothing for it
+    res = CliRunner().invoke(main, ["trace", "compare", str(stem), str(stem), "--setpoints"])
+    assert res.exit_code == 0 and "time |error| median 0.00 %" in res.output
     res = CliRunner().invoke(main, ["trace", "compare", str(stem), str(stem), "--segment", "other"])
     assert res.exit_code == 2 and "no segment 'other'" in res.output
     bad = tmp_path / "bad_KRCIpo.csv"

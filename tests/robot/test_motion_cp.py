@@ -12,6 +12,8 @@ from robot.bench import run_motions
 from robot.controller import Controller
 from robot.errors import RobotError, WorkspaceError
 from robot.frames import frame_to_matrix, matrix_to_frame
+from robot.kinematics import Kinematics
+from robot.machine import load_machine
 from robot.motion import MotionParams, MotionRequest, SplineSegment
 from robot.trace import TraceWriter
 
@@ -249,3 +251,28 @@ def test_circ_type_path_turns_the_tool_with_the_tangent():
     R0 = frame_to_matrix(*poses[0]["tcp"])[:3, :3]
     R1 = frame_to_matrix(*poses[-1]["tcp"])[:3, :3]
     assert np.degrees(Rotation.from_matrix(R0.T @ R1).magnitude()) == pytest.approx(180.0, abs=1e-6)
+
+
+def test_lin_ori_joint_goes_to_the_targets_status_with_linear_wrist_axes():
+    """$ORI_TYPE #JOINT (reference §6.7; issue 60): the wrist axes move linearly from the start's to
+    the target's as its S and T give them, A5 through 0 (the real KR C4's LIN from S 6 to S 2,
+    Linear_updated line 38), while the TCP stays on the straight line."""
+    k = Kinematics(load_machine())
+    q0 = np.array([0.0, -90.0, 90.0, 30.0, 40.0, 0.0])
+    q1 = np.array([20.0, -80.0, 85.0, -20.0, -35.0, 10.0])
+    f1 = matrix_to_frame(k.forward(q1))
+    s1, t1 = k.status_turn(q1)
+    assert s1 != k.status_turn(q0)[0]                       # the wrist flips: another status
+    P = MotionParams().with_(ori_type="#JOINT", vel_cp=0.3)
+    target = dict(zip("XYZABC", f1), S=s1, T=t1)
+    ctl, ev = _run([MotionRequest("PTP", {f"A{i + 1}": float(v) for i, v in enumerate(q0)}, P),
+                    MotionRequest("LIN", target, P)], mujoco=False)
+    assert ctl.axis_act()[:6] == pytest.approx(q1, abs=1e-6)
+    ph = _phases(ev, 2)
+    start, end = np.array(matrix_to_frame(k.forward(q0))[:3]), np.array(f1[:3])
+    for e in _poses(ev, ph["start"], ph["end"]):
+        q = np.array(e["axes"][:6])
+        u = (q[4] - q0[4]) / (q1[4] - q0[4])
+        assert q[3] == pytest.approx(q0[3] + u * (q1[3] - q0[3]), abs=1e-6)
+        assert q[5] == pytest.approx(q0[5] + u * (q1[5] - q0[5]), abs=1e-6)
+        assert _dist_to_line(e["tcp"][:3], start, end) < 0.01

@@ -1,0 +1,257 @@
+"""The simulator against the real KR 3 R540, beside OfficeLite against it (issue 60):
+``python -m interp.tracebench [--traces DIR] [--interp vm|tree] [--only TEXT] [--json OUT]``.
+
+For every recording of the training half of ../shared/real-traces (its MAP.csv) the program that
+made it runs on the simulator, and ``krl trace compare``'s measures (robot/kukatrace/compare.py)
+compare the run's segment with the real recording; the OfficeLite recording of the same program,
+where there is one, is compared with the real one the same way. The table gives, for both:
+
+* motion time (END - START) |error| median, 90th percentile and maximum over the matched motions;
+* the exact-stop pause (median START - the previous motion's end of interpolation);
+* the largest path deviation of a LIN and of a CIRC (mm);
+
+and, for a like-for-like view, the simulator's figures on the recordings OfficeLite also has.
+
+**The runs.** Each program (``KRL Programs/NAME.src`` and ``.dat``) is copied to a temporary
+folder with what the real controller held and the folder lacks (nothing of it is written into the
+project): a ``$config.dat`` whose ``TOOL_DATA`` and ``LOAD_DATA`` hold the tool and load the
+recordings' PROG.TXT give (the same for every motion of a program), and, in the program's data
+list, the recorded coordinates of each E6POS point a recorded PTP or LIN went to (PROG.TXT's
+``POINT NAME`` and ``POINT COORDINATES``; movement_test_lin.dat was edited after its recordings:
+the README). The robot is robot/data/kr3_r540.dat; the program override ``$OV_PRO`` is the one
+the real recordings' END signals give (85 % for the ``_po85`` programs, robot/kukatrace/model.py).
+The run's trace is kept in memory.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import json
+import re
+import shutil
+import sys
+import tempfile
+import time
+from dataclasses import dataclass, field
+from datetime import datetime, timezone
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from interp.run import make_runtime
+from robot.kukatrace.compare import MotionComparison, compare
+from robot.kukatrace.model import RunView, load_run, recording_override, run_view
+from robot.kukatrace.recording import Recording, read_recording
+from robot.mada import load_robot
+from robot.trace import TraceWriter
+
+TRACES = Path(__file__).resolve().parents[2] / "shared" / "real-traces"
+ROBOT = "kr3_r540"
+REAL_PREFIX = "WINDOWS-V37DJA1 - 8101392_"
+OL_PREFIX = "KukaOL - 0_"
+#: the issue's limits: what OfficeLite reached against the real robot on the held-out half (motion
+#: time |error| %, the pause's distance to the real one in s, path deviations in mm)
+LIMITS = {"time_median_pct": 1.5, "time_p90_pct": 5.0, "time_max_pct": 10.0, "pause_s": 0.012,
+          "lin_mm": 0.28, "circ_mm": 1.48}
+
+
+@dataclass
+class Row:
+    """One recording: its MAP row, the simulator's and OfficeLite's matched motions."""
+
+    program: str
+    name: str
+    sim: list[MotionComparison] = field(default_factory=list)
+    ol: list[MotionComparison] | None = None
+
+
+def map_rows(traces: Path) -> list[dict[str, str]]:
+    with (traces / "MAP.csv").open(newline="", encoding="utf-8") as f:
+        return [r for r in csv.DictReader(f) if r["split"] == "training"]
+
+
+def _config_dat(tool: tuple[float, ...], load: dict[str, Any] | None) -> str:
+    """A ``$config.dat`` with every TOOL_DATA and LOAD_DATA element set to the recorded tool and
+    load (the programs select one tool; which number the recording does not say)."""
+    x = dict(zip("XYZABC", tool))
+    tool_s = "{" + ",".join(f"{k} {v!r}" for k, v in x.items()) + "}"
+    if load:
+        cm = load.get("cm") or {}
+        j = load.get("j") or {}
+        load_s = (f"{{M {load.get('m', -1.0)!r},CM {{" + ",".join(f"{k.upper()} {float(cm.get(k, 0.0))!r}" for k in "xyzabc")
+                  + "},J {" + ",".join(f"{k.upper()} {float(j.get(k, 0.0))!r}" for k in "xyz") + "}}")
+    else:
+        load_s = "{M -1.0,CM {X 0.0,Y 0.0,Z 0.0,A 0.0,B 0.0,C 0.0},J {X 0.0,Y 0.0,Z 0.0}}"
+    lines = ["DEFDAT $CONFIG", "DECL FRAME TOOL_DATA[16]"]
+    lines += [f"TOOL_DATA[{i}]={tool_s}" for i in range(1, 17)]
+    lines += ["DECL LOAD LOAD_DATA[16]"] + [f"LOAD_DATA[{i}]={load_s}" for i in range(1, 17)]
+    return "\n".join(lines + ["ENDDAT", ""])
+
+
+_E6POS = re.compile(r"^(\s*DECL\s+E6POS\s+)(\w+)(\s*=\s*)\{[^}]*\}(.*)$", re.I)
+
+
+def _recorded_points(dat: str, recs: list[Recording]) -> str:
+    """`dat` with each E6POS point a recorded PTP or LIN went to set to the recorded coordinates."""
+    points: dict[str, dict[str, float]] = {}
+    for rec in recs:
+        for m in rec.motions:
+            if m.kind in ("PTP", "LIN") and m.point_name and m.point:
+                points[m.point_name.upper()] = m.point
+    out = []
+    for line in dat.splitlines():
+        mt = _E6POS.match(line)
+        if mt and mt.group(2).upper() in points:
+            p = points[mt.group(2).upper()]
+            val = (",".join(f"{k.upper()} {p[k]!r}" for k in "xyzabc")
+                   + f",S {int(p['s'])},T {int(p['t'])}")
+            line = f"{mt.group(1)}{mt.group(2)}{mt.group(3)}{{{val}}}{mt.group(4)}"
+        out.append(line)
+    return "\n".join(out) + "\n"
+
+
+def prepare(traces: Path, program: str, recs: list[Recording], work: Path) -> Path:
+    """The folder of `program`'s run (the module's docstring): its .src, its data list with the
+    recorded points, a $config.dat with the recorded tool and load. Returns the .src."""
+    folder = work / program
+    folder.mkdir(parents=True, exist_ok=True)
+    src = traces / "KRL Programs" / f"{program}.src"
+    shutil.copyfile(src, folder / src.name)
+    dat = src.with_suffix(".dat")
+    (folder / dat.name).write_text(_recorded_points(dat.read_text(encoding="latin-1"), recs), encoding="latin-1")
+    first = recs[0].motions[0]
+    (folder / "$config.dat").write_text(_config_dat(first.tool, first.load), encoding="latin-1")
+    return folder / src.name
+
+
+def run_program(src: Path, override: float, interp: str = "vm", robot: Any = None) -> RunView:
+    """The run of `src` on the KR 3 R540 (or the MachineData `robot`) at `override` (fraction), as
+    a RunView of its trace."""
+    tw = TraceWriter(keep=True)
+    robot = load_robot(ROBOT) if robot is None else robot
+    # the trace's header, as krl run writes it (interp/run.py RunSetup): the robot and its source
+    tw.write("robot", 0.0, name=robot.name, source=str(robot.source), trafoname=robot.trafoname or None)
+    rt, _ = make_runtime(src, trace=tw, mujoco=False, interp=interp, robot=robot, max_sim_time=1200.0,
+                         check=True, override=round(100 * override))
+    res = rt.run()
+    if res.reason != "completed":
+        raise RuntimeError(f"{src.name}: the run ended with {res.reason}: {getattr(res, 'text', '')}")
+    tw.close()
+    return run_view(tw.events, "trace", str(src))
+
+
+def bench(traces: Path = TRACES, interp: str = "vm", only: str | None = None) -> list[Row]:
+    """Run every program and compare (the module's docstring): one :class:`Row` per recording."""
+    rows = [r for r in map_rows(traces) if only is None or only in r["trace_name"] or only in r["program"]]
+    out: list[Row] = []
+    with tempfile.TemporaryDirectory(prefix="krl-trace-bench-") as tmp:
+        for program in dict.fromkeys(r["program"] for r in rows):
+            mine = [r for r in rows if r["program"] == program]
+            real = {r["trace_name"]: read_recording(traces / r["real_folder"] / f"{REAL_PREFIX}{r['trace_name']}")
+                    for r in mine}
+            src = prepare(traces, program, list(real.values()), Path(tmp))
+            ov, _ = recording_override(next(iter(real.values())))
+            run = run_program(src, ov, interp)
+            for r in mine:
+                rec_view = load_run(real[r["trace_name"]].prog_path)
+                row = Row(program, r["trace_name"], [m for s in compare(run, rec_view) for m in s.motions])
+                if r["officelite_folder"]:
+                    ol = load_run(traces / r["officelite_folder"] / f"{OL_PREFIX}{r['officelite_name']}")
+                    row.ol = [m for s in compare(ol, rec_view) for m in s.motions]
+                out.append(row)
+    return out
+
+
+def summary(motions: list[MotionComparison]) -> dict[str, Any]:
+    """The figures of the table over `motions` (None where there is no data)."""
+    e = np.abs([m.time_error_pct for m in motions if m.time_error_pct is not None])
+    run_p = [m.run_pause for m in motions if m.run_pause is not None and m.run_pause <= 0.5]
+    rec_p = [m.rec_pause for m in motions if m.rec_pause is not None and m.rec_pause <= 0.5]
+
+    def dev(kind: str) -> float | None:
+        d = [m.path_deviation for m in motions if m.kind == kind and m.path_deviation is not None]
+        return max(d) if d else None
+
+    return {"motions": len(e),
+            "time_median_pct": float(np.median(e)) if len(e) else None,
+            "time_p90_pct": float(np.percentile(e, 90)) if len(e) else None,
+            "time_max_pct": float(e.max()) if len(e) else None,
+            "pause_run_s": float(np.median(run_p)) if run_p else None,
+            "pause_real_s": float(np.median(rec_p)) if rec_p else None,
+            "lin_mm": dev("LIN"), "circ_mm": dev("CIRC")}
+
+
+def figures(rows: list[Row]) -> dict[str, dict[str, Any]]:
+    """The simulator's figures on every recording, OfficeLite's on its recordings, and the
+    simulator's on those same recordings."""
+    with_ol = [r for r in rows if r.ol is not None]
+    return {"sim": summary([m for r in rows for m in r.sim]),
+            "officelite": summary([m for r in with_ol for m in r.ol]),
+            "sim_on_officelite_set": summary([m for r in with_ol for m in r.sim])}
+
+
+def worse_than_limits(f: dict[str, Any]) -> list[str]:
+    """The figures of `f` (a :func:`summary`) outside :data:`LIMITS`."""
+    bad = []
+    for key in ("time_median_pct", "time_p90_pct", "time_max_pct", "lin_mm", "circ_mm"):
+        if f[key] is not None and f[key] > LIMITS[key]:
+            bad.append(f"{key} {f[key]:.3f} > {LIMITS[key]}")
+    if f["pause_run_s"] is not None and abs(f["pause_run_s"] - f["pause_real_s"]) > LIMITS["pause_s"]:
+        bad.append(f"pause {1000 * f['pause_run_s']:.0f} ms, real {1000 * f['pause_real_s']:.0f} ms")
+    return bad
+
+
+def table(fig: dict[str, dict[str, Any]]) -> list[str]:
+    """The table of the module's docstring."""
+    def cell(f: dict[str, Any], key: str, scale: float = 1.0, fmt: str = "{:.2f}") -> str:
+        v = f.get(key)
+        return "-" if v is None else fmt.format(v * scale)
+
+    s, o, so = fig["sim"], fig["officelite"], fig["sim_on_officelite_set"]
+    lines = ["figure                              simulated vs real   OfficeLite vs real   simulated (OL's set)   limit",
+             "-" * 110]
+    for label, key, scale, fmt, lim in (
+            ("motion time |error| median (%)", "time_median_pct", 1, "{:.2f}", "1.5"),
+            ("motion time |error| p90 (%)", "time_p90_pct", 1, "{:.2f}", "5.0"),
+            ("motion time |error| max (%)", "time_max_pct", 1, "{:.2f}", "10.0"),
+            ("exact-stop pause (ms)", "pause_run_s", 1000, "{:.0f}", "real +- 12"),
+            ("LIN path deviation max (mm)", "lin_mm", 1, "{:.3f}", "0.28"),
+            ("CIRC path deviation max (mm)", "circ_mm", 1, "{:.3f}", "1.48")):
+        lines.append(f"{label:<36}{cell(s, key, scale, fmt):>18}{cell(o, key, scale, fmt):>21}"
+                     f"{cell(so, key, scale, fmt):>23}   {lim}")
+    lines.append(f"{'real exact-stop pause (ms)':<36}{cell(s, 'pause_real_s', 1000, '{:.0f}'):>18}"
+                 f"{cell(o, 'pause_real_s', 1000, '{:.0f}'):>21}{cell(so, 'pause_real_s', 1000, '{:.0f}'):>23}")
+    lines.append(f"{'motions compared':<36}{s['motions']:>18}{o['motions']:>21}{so['motions']:>23}")
+    return lines
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m interp.tracebench", description=__doc__.split("\n\n")[0])
+    ap.add_argument("--traces", type=Path, default=TRACES, help="the recordings (default ../shared/real-traces)")
+    ap.add_argument("--interp", choices=("vm", "tree"), default="vm")
+    ap.add_argument("--only", default=None, help="only the recordings or programs whose name holds this")
+    ap.add_argument("--json", type=Path, default=None, help="write the rows and the figures here")
+    args = ap.parse_args(argv)
+    if not (args.traces / "MAP.csv").exists():
+        print(f"no recordings at {args.traces} (MAP.csv)", file=sys.stderr)
+        return 2
+    t0 = time.process_time()
+    rows = bench(args.traces, args.interp, args.only)
+    fig = figures(rows)
+    for line in table(fig):
+        print(line)
+    bad = worse_than_limits(fig["sim"])
+    print(f"\n{len(rows)} recordings, {time.process_time() - t0:.1f} s of CPU; "
+          + ("every figure within the issue's limits" if not bad else "outside the limits: " + "; ".join(bad)))
+    if args.json is not None:
+        args.json.write_text(json.dumps({
+            "date": datetime.now(timezone.utc).isoformat(timespec="seconds"), "figures": fig, "limits": LIMITS,
+            "rows": [{"program": r.program, "name": r.name, "sim": summary(r.sim),
+                      "officelite": None if r.ol is None else summary(r.ol)} for r in rows]}, indent=1))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

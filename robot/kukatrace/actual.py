@@ -1,0 +1,79 @@
+"""The actual-value model: what a simulated run's setpoints give as a KUKA Trace's measured
+("Act") TCP (issue 60).
+
+A simulated run's trace holds the interpolator's setpoints (robot/trace.py ``pose``). A KR C4's
+recording holds measured values: the setpoints averaged in axis space over a few IPO cycles by
+the controller, then followed by the drives. Along a straight LIN at 1 m/s the real TCP leaves
+the line by up to 0.6 mm (1.05 mm on the vertical one), growing with the square of the speed, as
+an average in axis space makes it. :func:`actual_tcp` puts a run's axes through that average
+(``MachineData.actual_filter_cycles`` cycles, causal: each sample the mean of its cycle and the
+ones before; identified from the recordings, robot/identified.py) and the forward kinematics with
+each motion's ``$TOOL`` and ``$BASE`` (and the robot's ``$ROBROOT``): the TCP that ``krl trace compare`` measures a simulated
+run's path deviation on. A robot without an identified average (one cycle) keeps its setpoints.
+The lag it adds does not matter there: the path deviation is geometric.
+"""
+
+from __future__ import annotations
+
+from functools import cache
+from pathlib import Path
+
+import numpy as np
+
+from ..frames import frame_to_matrix, inv_pos
+from .model import RunView, Segment
+
+
+@cache
+def _robot(source: str):
+    """(MachineData, Kinematics) of the robot a trace names, or None when it cannot be loaded
+    (the trace made elsewhere)."""
+    # costs 0.5 s at start-up (python -X importtime, 2026-11-26): the machine data and kinematics
+    from ..kinematics import Kinematics  # noqa: PLC0415
+    from ..mada import MachineDataError, load_robot  # noqa: PLC0415
+    if not source or not Path(source).exists():
+        return None
+    try:
+        m = load_robot(source)
+        return m, Kinematics(m)
+    except (MachineDataError, ValueError, OSError):
+        return None
+
+
+def filter_cycles(view: RunView) -> int:
+    """The cycles of the average for `view`'s robot (1: none; a recording is measured already)."""
+    if view.kind != "trace":
+        return 1
+    got = _robot(view.robot_source)
+    return int(got[0].actual_filter_cycles) if got is not None else 1
+
+
+def actual_tcp(view: RunView, seg: Segment, cycles: int | None = None) -> np.ndarray:
+    """The measured TCP positions (N, 3) mm the setpoints of `seg` give (the module's
+    docstring), averaged over `cycles` (default the robot's :func:`filter_cycles`); its own TCP
+    when there is no average to apply."""
+    n = filter_cycles(view) if cycles is None else cycles
+    if n <= 1 or len(seg.t) == 0 or _robot(view.robot_source) is None:
+        return seg.tcp[:, :3]
+    machine, kin = _robot(view.robot_source)
+    q = seg.axes[:, :machine.n_axes]
+    csum = np.cumsum(np.vstack([np.repeat(q[:1], n, axis=0), q]), axis=0)
+    qf = (csum[n:] - csum[:-n]) / n
+    out = seg.tcp[:, :3].copy()
+    starts = [m.start for m in seg.motions]
+    for k, m in enumerate(seg.motions):
+        if m.tool is None:
+            continue
+        t0 = m.start if k else -np.inf
+        t1 = starts[k + 1] if k + 1 < len(starts) else np.inf
+        rows = np.flatnonzero((seg.t >= t0 - 1e-9) & (seg.t < t1 - 1e-9))
+        if len(rows) == 0:
+            continue
+        F = kin.forward_many(qf[rows])
+        T = (inv_pos(frame_to_matrix(*(m.base or (0.0,) * 6))) @ frame_to_matrix(*machine.robroot_frame)
+             @ F @ frame_to_matrix(*m.tool))
+        out[rows] = T[:, :3, 3]
+    return out
+
+
+__all__ = ["actual_tcp", "filter_cycles"]
