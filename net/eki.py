@@ -44,6 +44,7 @@ from .xmlsafe import XmlFramer, XmlRefused, local, parse
 # project's choice: which message KUKA gives there is not public.
 MESSAGES = {
     3: "File access failed",
+    4: "Requested function not implemented",
     9: "Connection not available",
     10: "Ethernet is disconnected",
     14: "Ethernet connection to external system failed",
@@ -360,16 +361,14 @@ class Channel:
         self.sendvals[path.strip().upper()] = value
         return self.status(), None
 
-    def send(self, data: str, length: int | None = None) -> tuple[Status, EkiError | None]:
+    def send(self, data: str, length: int | None = None, raw: bytes | None = None) -> tuple[Status, EkiError | None]:
         """EKI_Send: `data` is a path of the send structure (its part is sent) or, beginning
-        with ``<``, an XML string sent as it is; a RAW channel sends `length` bytes of it."""
+        with ``<``, an XML string sent as it is; a RAW channel sends the record :meth:`record`
+        makes of `raw` (every byte of the CHAR array, NULs included; default `data`'s bytes)."""
         if not self.connected:
             return self.status(msg_no=10), self.error(10, "nothing is connected")
         if self.cfg.send_kind == "raw" or (self.cfg.send_kind is None and self.cfg.receive_kind == "raw"):
-            raw = data.encode("latin-1", "replace")
-            if length is not None:
-                raw = raw[:max(0, length)]
-            payload = raw
+            payload = self.record(raw if raw is not None else data.encode("latin-1", "replace"), length)
         elif data.lstrip().startswith("<"):
             payload = data.encode("utf-8")
         else:
@@ -380,6 +379,24 @@ class Channel:
             return self.status(msg_no=19), self.error(19)
         self.hub.eki_send(self, payload)
         return self.status(), None
+
+    def record(self, data: bytes, length: int | None = None) -> bytes:
+        """The binary record EKI_Send sends of `data` (a CHAR array's bytes) on a RAW channel
+        (KUKA.EthernetKRL 2.2 manual 6.2.4, p. 32-33; 3.x, EKI_Send's LENGTH; docs/network.md
+        "Binary records"): an element of fixed length (``Type="BYTE" Size="N"``) sends N bytes,
+        NULs included, whatever LENGTH says (the array's first N, padded with NULs when it is
+        shorter); an element with an end string (``Type="STREAM" EOS=".."``) sends LENGTH bytes
+        of the array when LENGTH is given (NULs included), else the bytes up to its first NUL,
+        then the end string."""
+        el = (self.cfg.send or self.cfg.receive)[0]
+        if el.eos is None and el.size:
+            return data[:el.size].ljust(el.size, b"\0")
+        if length is not None:
+            body = data[:max(0, length)]
+        else:
+            nul = data.find(b"\0")
+            body = data if nul < 0 else data[:nul]
+        return body + (el.eos or b"") if body else b""
 
     def lock(self) -> Status:
         self.locked = True

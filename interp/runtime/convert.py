@@ -23,7 +23,7 @@ from .values import Arr, Struct, copy_value, make_value, value_text
 
 __all__ = ["INT_MAX", "INT_MIN", "assign_chars", "assign_into", "binary_op", "check_int", "compare",
            "convert_scalar", "frame_tuple", "geo_compose", "inv_pos", "num", "real_to_int",
-           "ref_text", "struct_from_frame", "to_bool", "trunc_int", "unary_op"]
+           "ref_bytes", "ref_text", "struct_from_frame", "to_bool", "trunc_int", "unary_op"]
 
 def convert_scalar(v, t):
     """Convert ``v`` for storage in a leaf of simple/enum type ``t`` (assignment, §3.9)."""
@@ -148,6 +148,20 @@ def ref_text(ref, what: str) -> str:
         return v
     if isinstance(v, Arr) and v.type.elem == T.CHAR:
         return v.text()
+    raise KrlRuntimeError(f"{what} is not a string")
+
+
+def ref_bytes(ref, what: str) -> bytes:
+    """The bytes of a CHAR-array argument of a built-in, every element of it (a NUL, an unset
+    element: 0), or of a string literal (one byte a character): a binary record as
+    ``EKI_Send`` sends it (docs/network.md "Binary records"). Raises as :func:`ref_text`."""
+    if ref is None:
+        raise value_invalid(what)
+    v = ref.get()
+    if isinstance(v, str):
+        return v.encode("latin-1", "replace")
+    if isinstance(v, Arr) and v.type.elem == T.CHAR:
+        return bytes(0 if c is UNSET else ord(c) & 0xFF for c in v.data)
     raise KrlRuntimeError(f"{what} is not a string")
 
 

@@ -34,10 +34,11 @@ def test_cast_round_trip_and_layout(tmp_path):
     END
     """, DAT)
     assert r.result.reason == "completed", r.result
-    # 4 (INT) + 4 (REAL) + 4 (BOOL) + 3 * 4 (INT array) bytes, little-endian
-    assert r.var("prog", "NOFS") == 24 and r.var("prog", "NOFS2") == 24
-    raw = bytes(ord(c) for c in r.var("prog", "BUF").data[:24])
-    assert raw == struct.pack("<ifi3i", -2, 0.1, 1, 1, 2, 300)
+    # 4 (INT) + 4 (REAL) + 1 (BOOL) + 3 * 4 (INT array) bytes, little-endian (KUKA's EthernetKRL
+    # 2.2 manual p. 33: INT, REAL, BOOL, CHAR of its CAST_TO example make a 10-byte record)
+    assert r.var("prog", "NOFS") == 21 and r.var("prog", "NOFS2") == 21
+    raw = bytes(ord(c) for c in r.var("prog", "BUF").data[:21])
+    assert raw == struct.pack("<if?3i", -2, 0.1, True, 1, 2, 300)
     assert r.var("prog", "N2") == -2
     assert r.var("prog", "R2") == struct.unpack("<f", struct.pack("<f", 0.1))[0]  # single precision
     assert r.var("prog", "B2") is True
@@ -62,3 +63,19 @@ def test_cast_struct_and_too_small_buffer(tmp_path):
     # 10 + 24 bytes do not fit into 32: a run-time error on line 8
     assert r.result.reason == "error"
     assert r.result.line == 8 and "too small" in str(r.result.error)
+
+
+def test_the_manuals_cast_to_example(tmp_path):
+    """KUKA's EthernetKRL 2.2 manual, p. 33: ``CHAR Bytes[10]``,
+    ``CAST_TO(Bytes[],OFFSET,91984754,913434.2,TRUE,"X")``, printed as ``"r?{ ? _I X"``."""
+    r = run_krl(tmp_path, """
+    DEF prog()
+      NOFS = 0
+      CAST_TO(BUF[], NOFS, 91984754, 913434.2, TRUE, "X")
+    END
+    """, DAT)
+    assert r.result.reason == "completed", r.result
+    assert r.var("prog", "NOFS") == 10
+    raw = bytes(ord(c) for c in r.var("prog", "BUF").data[:10])
+    shown = "".join(chr(b) if 0x21 <= b < 0x7F else "?" if b >= 0x7F else " " for b in raw)
+    assert shown == "r?{ ? _I X"

@@ -4,13 +4,17 @@
     CAST_FROM(buffer[], offset, var1, var2, ...)   ; reads var1.. back from offset
 
 ``offset`` (INT, in/out) counts the bytes before the first one written or read and advances
-past them. The byte layout is a project decision (the reference gives none): little-endian,
-INT 4 bytes two's complement, REAL 4 bytes IEEE single (so a REAL round trip rounds to
-single precision), BOOL 4 bytes 0/1, CHAR 1 byte; arrays element by element in row-major
-order, structures component by component in declaration order. ENUM values have no
-documented code and are refused. Errors: an offset outside 0..the buffer's length (a
-negative offset never reads from the end of the buffer), a buffer too small, an unset value
-(1422).
+past them. The byte layout: little-endian, INT 4 bytes two's complement, REAL 4 bytes IEEE
+single (so a REAL round trip rounds to single precision), BOOL 1 byte 0/1, CHAR 1 byte. Source:
+KUKA's EthernetKRL 2.2 manual, 6.2.4 (p. 33), whose example writes
+``CAST_TO(Bytes[],OFFSET,91984754,913434.2,TRUE,"X")`` into ``CHAR Bytes[10]`` and sends
+``"r?{ ? _I X"``: 4 + 4 + 1 + 1 bytes, the INT's low byte ``r`` (0x72) first; the CREAD/CWRITE
+manual that page refers to is quoted nowhere public in full (docs/network.md, "Binary
+records"). Until issue 59 BOOL took 4 bytes: the manual's own record came out 13 bytes long.
+Arrays element by element in row-major order, structures component by component in
+declaration order. ENUM values have no documented code and are refused. Errors: an offset
+outside 0..the buffer's length (a negative offset never reads from the end of the buffer), a
+buffer too small, an unset value (1422).
 """
 
 from __future__ import annotations
@@ -26,7 +30,7 @@ from .registry import Family
 
 CAST = Family("cast")
 
-_SCALAR = {"INT": "<i", "REAL": "<f", "BOOL": "<i"}
+_SCALAR = {"INT": "<i", "REAL": "<f", "BOOL": "<?"}
 
 
 def _type_of(ref, value):
@@ -58,7 +62,8 @@ def encode(value, type_) -> bytes:
     if name == "CHAR":
         return bytes([ord(value) & 0xFF])
     if name in _SCALAR:
-        return struct.pack(_SCALAR[name], int(value) if name != "REAL" else float(value))
+        return struct.pack(_SCALAR[name], float(value) if name == "REAL" else bool(value) if name == "BOOL"
+                           else int(value))
     raise KrlRuntimeError(f"CAST: values of type {type_} cannot be copied")
 
 
@@ -81,11 +86,13 @@ def decode(data: bytes, pos: int, type_, old=None):
         _need(data, pos, 1)
         return chr(data[pos]), pos + 1
     if name in _SCALAR:
-        _need(data, pos, 4)
-        (v,) = struct.unpack_from(_SCALAR[name], data, pos)
+        fmt = _SCALAR[name]
+        size = struct.calcsize(fmt)
+        _need(data, pos, size)
+        (v,) = struct.unpack_from(fmt, data, pos)
         if name == "BOOL":
-            v = v != 0
-        return v, pos + 4
+            v = data[pos] != 0              # any byte other than 0 reads TRUE
+        return v, pos + size
     raise KrlRuntimeError(f"CAST: values of type {type_} cannot be copied")
 
 

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import math
 
-from ..convert import num, ref_text
+from ..convert import num, ref_bytes, ref_text
 from ..errors import KrlRuntimeError, value_invalid
 from ..memory import index_ref
 from ..sysvars import struct_of
@@ -121,12 +121,16 @@ def eki_unlock(rt, a):
 
 @_call
 def eki_send(rt, a):
+    """``EKI_Send(CHANNEL[], DATA[] [, LENGTH])``: DATA is a path of the send structure or an XML
+    text (up to its first NUL), or, on a binary channel, the record: every byte of the CHAR array
+    (net/eki.py ``Channel.send``; docs/network.md "Binary records")."""
     ch = _eki(rt).channel(ref_text(a[0], "EKI_Send channel"))
-    data = ref_text(a[1] if len(a) > 1 else None, "EKI_Send data")
+    arg = a[1] if len(a) > 1 else None
+    data = ref_text(arg, "EKI_Send data")
     length = None
     if len(a) > 2 and a[2] is not None:
         length = int(num(a[2].get(), "EKI_Send length"))
-    return _result(*ch.send(data, length))
+    return _result(*ch.send(data, length, ref_bytes(arg, "EKI_Send data")))
 
 
 @_call

@@ -3,8 +3,10 @@ CREAD, CCLOSE, CIOCTL, GET_SIG_INF.
 
 PULSE sets an output for a time (``rt.pulse``). COPEN(:SER_3, HANDLE) finds no device on any
 channel: HANDLE 0, the channel not connected (:func:`_copen`). CWRITE writes to the $CMD
-channel only. Unsupported: CREAD, CCLOSE, CIOCTL, GET_SIG_INF and CWRITE channels other than
-$CMD stop the program with a clear "not supported" run-time error.
+channel (a message) and calls the controller's installed functions on the $FCT_CALL channel
+(fctcall.py: EthernetKRL's kernel behind KUKA's KRL layer). Unsupported: CREAD, CCLOSE, CIOCTL,
+GET_SIG_INF and other CWRITE channels stop the program with a clear "not supported" run-time
+error.
 """
 
 from __future__ import annotations
@@ -13,6 +15,7 @@ from ..convert import ref_text, to_bool
 from ..errors import KrlRuntimeError
 from ..values import Channel, EnumValue, Struct
 from .args import int_arg, real_arg
+from . import fctcall
 from .registry import Family
 
 IO = Family("I/O")
@@ -45,10 +48,12 @@ def _copen(rt, a):
 @IO.native("CWRITE(INT CHANNEL :IN, STATE_T STATE :OUT, MODUS_T MODE :OUT, CHAR FORMAT[] :IN, ...)")
 def _cwrite(rt, a):
     ch = int_arg(a[0], "channel")
-    cmd = rt.sysvars.store.get("$CMD")
+    store = rt.sysvars.store
     fmt = ref_text(a[3], "CWRITE format") if len(a) > 3 else ""
-    if ch != cmd:
-        raise KrlRuntimeError("CWRITE: only the $CMD channel is supported by this simulator")
+    if ch == store.get("$FCT_CALL"):         # the controller's installed functions (fctcall.py)
+        return fctcall.call(rt, fmt, list(a[4:]), a[1].peek() if a[1] is not None else None)
+    if ch != store.get("$CMD"):
+        raise KrlRuntimeError("CWRITE: only the $CMD and $FCT_CALL channels are supported by this simulator")
     rt.message(f"CWRITE $CMD: {fmt}")
     st = a[1].peek() if a[1] is not None else None
     if isinstance(st, Struct) and "RET1" in st.f:
