@@ -432,20 +432,24 @@ def _request_signal(rt, path: Path) -> tuple[str, bool] | None:
     return f"$OUT[{abs(req)}]", req > 0
 
 
-#: the run-time errors of a name nothing of the program declares (interp/runtime/core.py,
-#: interp/runtime/kss.py): the name, and whether it is a routine
-_UNKNOWN = re.compile(r"^(?:unknown name (?P<name>\S+)|routine (?P<routine>\S+) not found)$")
+#: the words of a run-time error's message: the names it mentions
+_WORD = re.compile(r"[A-Za-z_$][A-Za-z0-9_$]*")
 
 
 def outside_stops(rt) -> list[str]:
     """The run-time errors of the run `rt` (its robot program's, its submit programs') that
     stop on a name the checker classifies outside the program and calls KUKA's
     (krl/semantics/outside.py ``Unresolved.classify``: W101/W105/W106/W107, ``Outside.kuka``),
-    as ``NAME at file:line: why``. Issue 46: the
+    as ``NAME at file:line: why``: an error whose message names such a name ("unknown name X",
+    "routine X not found", "X is not an array", "value invalid: X[2]"). Issues 46 and 59: the
     run stands in for every such name (interp/runtime/kss.py), so this is always empty unless
     the checker and the run disagree."""
     unresolved = rt.program.ws.unresolved()
     outside = unresolved.classify() if unresolved is not None else {}
+    by_name: dict = {}
+    for (_kind, key), o in outside.items():
+        if o.kuka:
+            by_name.setdefault(key, o)
     errors = []
     if rt.result is not None and rt.result.reason == "error" and rt.result.error is not None:
         errors.append((rt.result.error, rt.result.file, rt.result.line))
@@ -455,14 +459,9 @@ def outside_stops(rt) -> list[str]:
             errors.append((err, err.file or task.file, err.line or task.line))
     out = []
     for err, file, line in errors:
-        m = _UNKNOWN.match(err.message or "")
-        if m is None:
-            continue
-        name = (m.group("name") or m.group("routine")).upper()
-        kinds = ("routine",) if m.group("routine") else ("sysvar",) if name.startswith("$") else ("name",)
-        for kind in kinds:
-            o = outside.get((kind, name))
-            if o is not None and o.kuka:
+        for word in dict.fromkeys(w.upper() for w in _WORD.findall(err.message or "")):
+            o = by_name.get(word)
+            if o is not None:
                 out.append(f"{o.name} at {file}:{line}: {o.why}")
     return out
 

@@ -21,6 +21,7 @@ from interp.runtime.errors import KrlRuntimeError, ResourceError
 from interp.runtime.memory import SignalRef
 from interp.runtime.values import Struct
 from krl.ast import nodes as N
+from krl.semantics.resolve import UNRESOLVED
 from krl.files import spelled, spelled_within
 from krl.project import backup_of, boot_submit
 from krl.source import is_krl_file
@@ -317,8 +318,11 @@ def global_value(rt: Runtime, main: str, name: str):
     sym = scope.lookup(name) if scope is not None else None
     if sym is None or sym.kind not in ("var", "const"):
         return None
+    storage = prog.ws.resolver.storage(name, sym, None, module.index if module else -1)
+    if storage.kind == UNRESOLVED:
+        return None             # a name of the tables no data list declares: no value (no stand-in made)
     try:
-        return rt.storage_ref(prog.ws.resolver.storage(name, sym, None, module.index if module else -1), None).get()
+        return rt.storage_ref(storage, None).get()
     except KrlRuntimeError:
         return None
 

@@ -672,8 +672,11 @@ class Runtime:
     # ================================================================== memory
     def sysref(self, st: Storage) -> Ref:
         """The reference of a system variable the tables declare (storage class SYSTEM; its
-        storage is allocated on first use and kept)."""
+        storage is allocated on first use and kept). A slot past the program's list is a name the
+        resolver placed while the program runs (VARSTATE's text, ``ref_from_text``)."""
         refs = self.program.sysrefs
+        if st.slot >= len(refs):
+            refs.extend([None] * (st.slot + 1 - len(refs)))
         ref = refs[st.slot]
         if ref is None:
             ref = self.sysvars.lookup(st.name)
@@ -691,7 +694,8 @@ class Runtime:
         if k <= 2:                   # MODULE, GLOBAL
             return self.modules[st.owner].refs[st.slot] or self.program.data_ref(st)
         if k == 3:                   # SYSTEM
-            return self.program.sysrefs[st.slot] or self.sysref(st)
+            refs = self.program.sysrefs
+            return (refs[st.slot] if st.slot < len(refs) else None) or self.sysref(st)
         return self.lookup(st.name)
 
     def lookup(self, name: str) -> Ref:

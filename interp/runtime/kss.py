@@ -64,15 +64,16 @@ from krl.semantics.resolve import NATIVE, ROUTINE, UNRESOLVED
 
 from .errors import KrlRuntimeError
 from .memory import Slot
+from .natives import REGISTRY
+from .natives.registry import NO_VALUE
 from .sysvars import sys_type
-from .values import EnumValue, make_value, zero_value
+from .values import UNSET, Arr, EnumValue, Struct, make_value, zero_value
 
-#: functions of KSS whose value in a simulation is documented: name -> (value, why)
+#: functions of KSS whose value in a simulation is documented: name -> (value, why), the
+#: stand-ins the natives registry declares with a ``value`` (interp/runtime/natives/packages.py)
 DOCUMENTED: dict[str, tuple[object, str]] = {
-    "IS_KEY_PRESSED": (False, "TRUE while the key is held on the KCP/smartPAD "
-                              "($operate.dat EXTFCTP BOOL IS_KEY_PRESSED(INT KEY :IN)); "
-                              "nobody presses a key in a simulation"),
-}
+    name: (native.value, native.stand_in) for name, native in REGISTRY.items()
+    if native.stand_in and native.value is not NO_VALUE}
 
 #: the value of a stand-in of an ENUM type, or of no type its uses give: the package is not
 #: installed. Its name is not a literal any use compares it with (``NOT_INSTALLED_`` ... then).
@@ -125,10 +126,23 @@ def _zero(t, absent: str | None = None):
         return 0.0
     if isinstance(t, (T.Struc, T.Array)):
         try:
-            return zero_value(t)
+            return _enums_not_installed(zero_value(t), t)
         except Exception:  # noqa: BLE001 - a type the zero value cannot build
             return make_value(t)
     return None
+
+
+def _enums_not_installed(v, t):
+    """`v` (a zero value of `t`) with its ENUM leaves, which :func:`zero_value` leaves unset,
+    reading "not installed" (:data:`NOT_INSTALLED`)."""
+    if isinstance(v, Struct):
+        for k, (_, ft) in t.fields.items():
+            v.f[k] = _enums_not_installed(v.f[k], ft)
+    elif isinstance(v, Arr):
+        v.data[:] = [_enums_not_installed(x, t.elem) for x in v.data]
+    elif isinstance(t, T.Enum) and v is UNSET:
+        v = EnumValue(_not_installed(t.values), t)
+    return v
 
 
 def _not_installed(literals) -> str:
@@ -241,9 +255,14 @@ class SystemSoftware:
         if ref is not None:
             return ref          # a variable is counted once: how often an interpreter looks it up is its own
         why = self.outside().get(("sysvar" if key[:1] == "$" else "name", key))
+        declared = None
         if why is None:
-            return None
-        t, v = self._typed_zero(key)
+            declared = self._basis_type(key)
+            if declared is None:
+                return None
+            why = ("KUKA's BASIS declares it in $config.dat (krl/semantics/data/types.yaml basis), which "
+                   "the program's files do not hold")
+        t, v = self._typed_zero(key, declared)
         ref = self._refs[key] = Slot({"V": v}, "V", t, name)
         shown = f"reads {_shown(v)}"
         if isinstance(v, EnumValue):
@@ -253,6 +272,17 @@ class SystemSoftware:
                       " (the package is not installed; its uses give it no type)")
         self._record(key, StandIn(name, "system variable" if key[:1] == "$" else "variable", shown, why))
         return ref
+
+    def _basis_type(self, key: str):
+        """The declared type of `key` when the checker resolved it to KUKA's BASIS tables (the
+        basis scope: a global of KUKA's template ``$config.dat`` such as ``DEF_VEL_FACT``) and no
+        data list of the program declares it (a folder without ``System/$config.dat`` runs on the
+        project's smaller BASIS, interp/basis); else None."""
+        scope = getattr(self.rt.program.ws, "global_scope", None)
+        basis = scope.parent if scope is not None else None
+        sym = basis.values.get(key) if basis is not None and basis.kind == "basis" else None
+        t = getattr(sym, "type", None)
+        return t if t is not None and t is not T.UNKNOWN else None
 
     # ------------------------------------------------------------------ routines
     def _evidence(self, key: str) -> str | None:
@@ -347,17 +377,64 @@ class SystemSoftware:
 
 
 # ---------------------------------------------------------------------- use types
-def _unresolved(e) -> str | None:
-    """The UPPER name of an unresolved Name, or of a call of a routine no program has."""
+#: a dimension of a stand-in array that a use indexes with a value only the run knows (a FOR
+#: counter): the size it gets (its constant indices may ask for more). KRL arrays have the size
+#: their declaration gives, and the declaration is what the backup lacks: a decision (docs/robot.md)
+STANDIN_DIM = 256
+
+
+class _Shape:
+    """What the uses of an unresolved name (or of one of its components or elements) say of its
+    type: ``t`` the type they give it (the other operand's, the statement's, a parameter's),
+    ``literals`` the ENUM literals they compare it with, assign to it or switch on, ``dims`` the
+    largest constant index of each dimension it is indexed with (negative: also indexed by a
+    value only the run knows) and ``elem`` the shape of its elements, ``fields`` the shapes of
+    the components selected from it."""
+
+    __slots__ = ("t", "literals", "dims", "elem", "fields")
+
+    def __init__(self) -> None:
+        self.t = None
+        self.literals: set = set()
+        self.dims: list | None = None
+        self.elem: "_Shape | None" = None
+        self.fields: dict = {}
+
+
+def _shape_of(shapes: dict, e):
+    """The shape of expression `e` when it is an unresolved name, an element or a component of
+    one (``X``, ``X[i]``, ``X.C``, ``X[i].C``), or a call of a routine no program has; else None."""
     if isinstance(e, N.Name):
         st = e.ann.place if e.ann is not None else None
         if st is not None and st.kind == UNRESOLVED:
-            return e.name.upper()
+            return shapes.setdefault(e.name.upper(), _Shape())
         return None
     if isinstance(e, N.Call):
         c = e.ann.callee if e.ann is not None else None
         if c is not None and c.kind != ROUTINE:
-            return e.name.upper()
+            return shapes.setdefault(e.name.upper(), _Shape())
+        return None
+    if isinstance(e, N.Index):
+        base = _shape_of(shapes, e.base)
+        if base is None or base.fields or any(i is None for i in e.indices):
+            return None
+        if base.dims is None:
+            base.dims = [0] * len(e.indices)
+        if len(base.dims) != len(e.indices):
+            return None
+        for k, i in enumerate(e.indices):
+            if isinstance(i, N.IntLit):
+                base.dims[k] = max(abs(base.dims[k]), i.value) * (-1 if base.dims[k] < 0 else 1)
+            elif base.dims[k] >= 0:
+                base.dims[k] = -max(1, base.dims[k])     # a variable index: negative marks it
+        if base.elem is None:
+            base.elem = _Shape()
+        return base.elem
+    if isinstance(e, N.Field):
+        base = _shape_of(shapes, e.base)
+        if base is None or base.dims is not None:
+            return None
+        return base.fields.setdefault(e.name.upper(), _Shape())
     return None
 
 
@@ -366,19 +443,18 @@ def _type_of(e):
     return None if t is None or t is T.UNKNOWN else t
 
 
-def _note(types: dict, name: str | None, t) -> None:
-    if name is None or t is None or not isinstance(t, (T.Simple, T.Enum, T.Struc)):
+def _note(shape, t) -> None:
+    if shape is None or t is None or not isinstance(t, (T.Simple, T.Enum, T.Struc)):
         return
-    old = types.get(name)
-    if old is None or (old is T.INT and t is T.REAL):
-        types[name] = t
+    if shape.t is None or (shape.t is T.INT and t is T.REAL):
+        shape.t = t
 
 
-def _literal(literals: dict, name: str | None, e) -> None:
-    """An ENUM literal `e` compared with, assigned to or switched on by the unresolved `name`
-    (when its type is an ENUM the backup does not declare: :func:`standin_enum`)."""
-    if name is not None and isinstance(e, N.EnumLit):
-        literals.setdefault(name, set()).add(e.name.upper())
+def _literal(shape, e) -> None:
+    """An ENUM literal `e` compared with, assigned to or switched on by an unresolved name (when
+    its type is an ENUM the backup does not declare: :func:`standin_enum`)."""
+    if shape is not None and isinstance(e, N.EnumLit):
+        shape.literals.add(e.name.upper())
 
 
 def _param_types(call: N.Call, ws) -> list:
@@ -419,57 +495,84 @@ def kuka_names(program) -> dict:
 def _use_types_of(program) -> tuple[dict, dict]:
     """(UPPER name -> type, UPPER name -> "not installed" literal of its stand-in ENUM) of
     :meth:`SystemSoftware.use_types`: a walk over every file of `program`'s checked workspace
-    (0.22 s on a KRC backup), made once per workspace (Program.derived); read-only."""
-    types: dict = {}
-    literals: dict = {}
-    absent: dict = {}
+    (0.22 s on a KRC backup), made once per workspace (Program.derived); read-only. A name its
+    uses index is an array, one they select components from a structure (:func:`_typed`)."""
+    shapes: dict = {}
     ws = program.ws
     for unit in ws.units:
         for f in (unit.src, unit.dat):
             if f is not None and f.module is not None:
-                _infer(f.module, types, literals, ws)
-    for name, lits in literals.items():
-        if name not in types:
-            types[name], absent[name] = standin_enum(name, lits)
+                _infer(f.module, shapes, ws)
+    types: dict = {}
+    absent: dict = {}
+    for name, shape in shapes.items():
+        t, none = _typed(name, shape)
+        if t is not None:
+            types[name] = t
+        if none is not None:
+            absent[name] = none
     return types, absent
 
 
-def _infer(module: N.Module, types: dict, literals: dict | None = None, ws=None) -> None:
-    """Add to `types` what the uses in `module` say of the type of each unresolved name, and
-    to `literals` the ENUM literals each is compared with, assigned or switched on."""
-    literals = {} if literals is None else literals
+def _typed(name: str, shape: _Shape) -> tuple:
+    """(type, "not installed" literal or None) of a stand-in from its `shape`: an array of its
+    elements' type (each dimension as large as its largest constant index, at least
+    :data:`STANDIN_DIM` when a value only the run knows indexes it too), a structure of its
+    components' types, else the type its uses give it, else a stand-in ENUM of the literals
+    they name; (None, None) when they say nothing."""
+    if shape.dims is not None:
+        elem = _typed(name, shape.elem)[0] if shape.elem is not None else None
+        dims = tuple(d if d > 0 else max(STANDIN_DIM, -d) for d in shape.dims)
+        return T.Array(elem if elem is not None else T.INT, dims), None
+    if shape.fields:
+        fields = {}
+        for comp, sub in shape.fields.items():
+            ft = _typed(f"{name}.{comp}", sub)[0]
+            fields[comp] = (comp, ft if ft is not None else T.INT)
+        return T.Struc(f"{name} (stand-in STRUC)", fields), None
+    if shape.t is not None:
+        return shape.t, None
+    if shape.literals:
+        return standin_enum(name, shape.literals)
+    return None, None
+
+
+def _infer(module: N.Module, shapes: dict, ws=None) -> None:
+    """Add to `shapes` what the uses in `module` say of each unresolved name (:class:`_Shape`)."""
     stack: list = [module]
     while stack:
         node = stack.pop()
-        if isinstance(node, (N.If, N.While, N.Repeat, N.WaitFor)):
-            _note(types, _unresolved(node.cond), T.BOOL)
+        if isinstance(node, (N.Index, N.Field)):
+            _shape_of(shapes, node)         # an element or a component: its name's shape
+        elif isinstance(node, (N.If, N.While, N.Repeat, N.WaitFor)):
+            _note(_shape_of(shapes, node.cond), T.BOOL)
         elif isinstance(node, N.Unary) and node.op == "NOT":
-            _note(types, _unresolved(node.operand), T.BOOL)
+            _note(_shape_of(shapes, node.operand), T.BOOL)
         elif isinstance(node, N.Binary):
-            left, right = _unresolved(node.left), _unresolved(node.right)
+            left, right = _shape_of(shapes, node.left), _shape_of(shapes, node.right)
             if node.op in _BOOL_OPS:
-                _note(types, left, T.BOOL)
-                _note(types, right, T.BOOL)
+                _note(left, T.BOOL)
+                _note(right, T.BOOL)
             else:
-                _note(types, left, _type_of(node.right))
-                _note(types, right, _type_of(node.left))
+                _note(left, _type_of(node.right))
+                _note(right, _type_of(node.left))
                 if node.op in ("==", "<>"):
-                    _literal(literals, left, node.right)
-                    _literal(literals, right, node.left)
+                    _literal(left, node.right)
+                    _literal(right, node.left)
         elif isinstance(node, N.Assign):
-            target = _unresolved(node.target)
-            _note(types, _unresolved(node.value), _type_of(node.target))
-            _note(types, target, _type_of(node.value))
-            _literal(literals, target, node.value)
+            target = _shape_of(shapes, node.target)
+            _note(_shape_of(shapes, node.value), _type_of(node.target))
+            _note(target, _type_of(node.value))
+            _literal(target, node.value)
         elif isinstance(node, N.Switch):
-            sel = _unresolved(node.selector)
-            _note(types, sel, _type_of(next((v for c in node.cases for v in c.values), None)))
+            sel = _shape_of(shapes, node.selector)
+            _note(sel, _type_of(next((v for c in node.cases for v in c.values), None)))
             for c in node.cases:
                 for v in c.values:
-                    _literal(literals, sel, v)
+                    _literal(sel, v)
         elif isinstance(node, N.Call) and node.args:
             params = _param_types(node, ws)
             for a, t in zip(node.args, params):
                 if a is not None:
-                    _note(types, _unresolved(a), t)
+                    _note(_shape_of(shapes, a), t)
         stack.extend(c for c in node.children() if c is not None)

@@ -86,19 +86,16 @@ from krl.semantics.resolve import LOCAL, NATIVE, ROUTINE, SYSTEM, UNRESOLVED
 
 from .idle import _frames, _store, freeze
 from .memory import Slot
+from .natives import REGISTRY
 from .sysvars import CONSTANT_NAMES
 
-#: built-ins whose only effects are on their arguments (the watch checks those as writes): they
-#: read nothing that changes by itself. Not here, so a pass that calls them is never parked:
+#: built-ins whose only effects are on their arguments (the watch checks those as writes) and
+#: that read nothing that changes by itself: declared ``pure`` in the natives registry
+#: (interp/runtime/natives/registry.py). Not pure, so a pass that calls them is never parked:
 #: FRAND (a random number), the message and dialog routines that write (SET_KRLMSG, CLEAR_KRLMSG,
 #: SET_KRLDLG), CWRITE/COPEN/CREAD (the command channel), PULSE, ERR_RAISE/ERR_CLEAR ($ERR), the
 #: network's (EKI_*, RSI_*), and every stand-in of KUKA's software (counted per call).
-PURE_NATIVES = frozenset({
-    "ABS", "SQRT", "SIN", "COS", "TAN", "ACOS", "ATAN2", "INV_POS", "FORWARD", "INVERSE",
-    "VARSTATE", "VARTYPE", "STRLEN", "STRDECLLEN", "STRCLEAR", "STRADD", "STRCOPY", "STRCOMP",
-    "STRFIND", "STRTOINT", "STRTOREAL", "STRTOBOOL", "STRTOSTRING", "STRTOFRAME", "STRTOPOS",
-    "STRTOE3POS", "STRTOE6POS", "STRTOAXIS", "STRTOE3AXIS", "STRTOE6AXIS", "SWRITE", "SREAD",
-    "CAST_TO", "CAST_FROM", "GETSYSSTATE", "EXISTS_KRLMSG", "EXISTS_KRLDLG"})
+PURE_NATIVES = frozenset(name for name, native in REGISTRY.items() if native.pure)
 
 #: system variables whose value the main run changes as the robot moves (interp/runtime/sysvars.py
 #: ``_LIVE``): a pass that reads one is parked only while the main run is idle

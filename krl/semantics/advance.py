@@ -23,13 +23,16 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from krl.ast import nodes as N
+from krl.semantics.builtins import load_builtins
 
 # INTERRUPT ON/OFF/ENABLE/DISABLE stop it too (reference §6.10 [U]): otherwise the
 # `INTERRUPT OFF` after the interruptible motion of §5.17 would run before the motion.
 STOP_STATEMENTS = {N.WaitFor: "WAIT FOR", N.WaitSec: "WAIT SEC", N.Halt: "HALT",
                    N.AninOn: "analog I/O", N.AninOff: "analog I/O", N.AnoutOn: "analog I/O",
                    N.AnoutOff: "analog I/O", N.InterruptCtl: "INTERRUPT ON/OFF"}
-STOP_ROUTINES = frozenset({"PULSE"})
+#: the routines whose call stops the advance run: declared so in the natives registry
+#: (``stops``, interp/runtime/natives/registry.py), read from the table generated from it
+STOP_ROUTINES = load_builtins().advance_stop
 
 
 @dataclass(slots=True)

@@ -90,6 +90,9 @@ class Builtins:
     sources: dict[str, str] = field(default_factory=dict)      # UPPER name -> "path:line"
     packages: dict[str, tuple[str, str]] = field(default_factory=dict)  # UPPER name -> (package, source)
     programs: dict[str, str] = field(default_factory=dict)    # UPPER file name of a KUKA hook program -> source
+    # functions.yaml (generated from the natives registry): the routines whose call stops the
+    # advance run (reference 6.10; krl/semantics/advance.py)
+    advance_stop: frozenset[str] = frozenset()
 
 
 _NAME_DIMS = re.compile(r"^\s*(\$?[A-Za-z_][\w$]*)\s*(?:\[([\d,\s]*)\])?\s*$")
@@ -253,4 +256,5 @@ def _load_builtins(store=None) -> Builtins:
         sources=sources,
         packages=packages,
         programs=programs,
+        advance_stop=frozenset(str(n).upper() for n in funcs.get("advance_stop") or ()),
     )

@@ -53,6 +53,21 @@ def test_varstate(tmp_path):
     assert r.var("prog", "B1") is True
 
 
+@pytest.mark.parametrize("interp", ["tree", "vm"])
+def test_varstate_of_a_system_variable_the_program_uses_nowhere_else(tmp_path, interp):
+    """VARSTATE's text is placed while the program runs (Runtime.ref_from_text): a system
+    variable no statement of the program names gets a system slot past the program's list. Found
+    by the variants of issue 59 (KUKA's BrakeTestReq.src run without $config.dat): an internal
+    IndexError before."""
+    r = run_krl(tmp_path, """
+    DEF prog()
+      B1 = VARSTATE("$VEL_ACT") == #INITIALIZED
+    END
+    """, DAT, interp=interp)
+    assert r.result.reason == "completed", r.result.text
+    assert r.var("prog", "B1") is True
+
+
 def test_advance_limits_planning(tmp_path):
     src = f"""
     DEF prog()

@@ -3,8 +3,10 @@ with its KRL signature beside its implementation.
 
 * completeness: every routine of the registry has exactly one way to run (a Python
   implementation, a KRL routine of the project's BASIS that exists with the declared kind, or a
-  stand-in that says what a call gives), and every function of the natives' calling convention
-  ``(rt, a)`` in a module of the package is declared (no implementation without a signature);
+  stand-in that says what a call gives), and every function
+  of a module of the package is declared or used by the project's code, whatever its
+  parameters are called (no implementation without a signature); each field of a declaration
+  fits its routine, and its readers take it from there (issue 62);
   every module's Family is registered in ``FAMILIES``; :func:`missing_sides` is shown to fail
   on a family with each side missing;
 * the front end's table krl/semantics/data/functions.yaml is what the registry generates
@@ -17,6 +19,8 @@ Expected values are worked out by hand from the programs below.
 
 from __future__ import annotations
 
+import ast
+import dataclasses
 import importlib
 import inspect
 import pkgutil
@@ -29,9 +33,12 @@ import yaml
 from interp.run import make_runtime
 from interp.runtime import natives
 from interp.runtime.natives import FAMILIES, LINKS, REGISTRY
-from interp.runtime.natives.registry import FUNCTIONS, PROCEDURES, Family, build, functions_yaml
+from interp.runtime.kss import DOCUMENTED
+from interp.runtime.natives.registry import FUNCTIONS, NO_VALUE, PROCEDURES, Family, build, functions_yaml
+from interp.runtime.spin import PURE_NATIVES
 from interp.runtime.program import BASIS_DIR
 from krl.ast import nodes as N
+from krl.semantics.advance import STOP_ROUTINES
 from krl.semantics.builtins import DATA_DIR, parse_signature
 from krl.semantics.resolve import NATIVE
 from krl.workspace import load_file
@@ -63,11 +70,37 @@ def _every_basis_routine(basis_dir: Path) -> dict[str, str]:
     return out
 
 
-def missing_sides(registry: dict, modules: list, basis_dir: Path = BASIS_DIR) -> list[str]:
+#: the project's packages whose code may use a function of the natives package
+PROJECT = Path(__file__).resolve().parents[2]
+PACKAGES = ("interp", "net", "krl", "robot", "pendant", "audit", "conformance", "recovery")
+
+#: the Python type of a documented stand-in value, by the declared result type
+VALUE_TYPES = {"BOOL": bool, "INT": int, "REAL": float}
+
+
+def _used_names() -> set[str]:
+    """Every identifier the project's code reads (a name or an attribute), over its packages."""
+    out: set[str] = set()
+    for pkg in PACKAGES:
+        for f in (PROJECT / pkg).rglob("*.py"):
+            if "generated" in f.parts:
+                continue
+            for node in ast.walk(ast.parse(f.read_text(encoding="utf-8"))):
+                if isinstance(node, ast.Name):
+                    out.add(node.id)
+                elif isinstance(node, ast.Attribute):
+                    out.add(node.attr)
+    return out
+
+
+def missing_sides(registry: dict, modules: list, basis_dir: Path = BASIS_DIR, used: set | None = None) -> list[str]:
     """What keeps the registry from being complete: a routine without a way to run (or with
-    two), a KRL routine the BASIS does not have (or of the other kind), a function of the calling
-    convention ``(rt, a)`` that no declaration names, a Family that is not registered, a
-    stand-in that a BASIS file implements (declare it ``krl``)."""
+    two), a KRL routine the BASIS does not have (or of the other kind), a function of a natives
+    module that no declaration names and no code of the project uses, whatever its parameters
+    are called (a forgotten implementation), a Family that is not registered, a stand-in that a
+    BASIS file implements (declare it ``krl``), and a field that does not fit its routine: a
+    ``pure`` or ``stops`` routine the simulator does not implement, a ``value`` on a routine
+    that is not a stand-in or of another type than the declared result."""
     problems = []
     basis: dict[str, dict[str, bool]] = {}
     everywhere = _every_basis_routine(basis_dir)
@@ -83,15 +116,25 @@ def missing_sides(registry: dict, modules: list, basis_dir: Path = BASIS_DIR) ->
                 problems.append(f"{n.name}: the BASIS routine is a {'function' if have[n.name] else 'procedure'}")
         if n.stand_in and n.name in everywhere:
             problems.append(f"{n.name}: declared a stand-in, but the BASIS file {everywhere[n.name]} implements it")
+        for flag in ("pure", "stops"):
+            if getattr(n, flag) and n.fn is None:
+                problems.append(f"{n.name}: declared {flag}, but the simulator does not implement it")
+        if n.value is not NO_VALUE:
+            result = n.signature.split("(", 1)[0].split()[0] if n.section == FUNCTIONS else ""
+            if not n.stand_in:
+                problems.append(f"{n.name}: a documented value on a routine that is not a stand-in")
+            elif type(n.value) is not VALUE_TYPES.get(result.upper()):
+                problems.append(f"{n.name}: its documented value {n.value!r} is no {result or 'value of a procedure'}")
     declared = {id(n.fn) for n in registry.values() if n.fn is not None}
     registered = {id(f) for f in FAMILIES}
+    used = _used_names() if used is None else used
     for mod in modules:
         for name, obj in vars(mod).items():
             if isinstance(obj, Family) and id(obj) not in registered:
                 problems.append(f"{mod.__name__}.{name}: a family not in FAMILIES")
-            if (inspect.isfunction(obj) and obj.__module__ == mod.__name__
-                    and list(inspect.signature(obj).parameters) == ["rt", "a"] and id(obj) not in declared):
-                problems.append(f"{mod.__name__}.{name}: an implementation without a signature")
+            if inspect.isfunction(obj) and obj.__module__ == mod.__name__ and id(obj) not in declared \
+                    and name not in used:
+                problems.append(f"{mod.__name__}.{name}: an implementation without a signature (nothing uses it)")
     return problems
 
 
@@ -101,26 +144,48 @@ def test_every_routine_has_one_way_to_run_and_every_implementation_a_signature()
 
 def test_the_completeness_check_fails_when_a_side_is_missing():
     """A family with a BASIS routine the BASIS lacks, a procedure declared for a BASIS function,
-    a stand-in for a routine the BASIS has, and an implementation that no declaration names: each
-    is found."""
+    a stand-in for a routine the BASIS has, implementations that no declaration names whatever
+    their parameters are called, and fields that do not fit: each is found."""
     fam = Family("test")
     fam.krl("REAL NOT_IN_BASIS(REAL X :IN)", "bas.src")
     fam.krl("SVEL_JOINT(REAL VEL :IN)", "bas.src")           # bas.src: GLOBAL DEFFCT REAL SVEL_JOINT
     fam.stand_in("REAL SACC_CP(LDAT L :OUT)", "nothing")      # bas.src: GLOBAL DEFFCT CP SACC_CP
+    fam.stand_in("INT ANSWER(INT K :IN)", "a number", value=True)       # a BOOL for an INT
+    fam.stand_in("BOOL CLEAN(INT K :IN)", "FALSE", value=False)         # fits: not reported
+    fam.krl("BAS_FAKE(INT K :IN)", "bas.src")
+    fam.entries[-1] = dataclasses.replace(fam.entries[-1], stops=True)  # stops, but nothing runs it
 
     def _forgotten(rt, a):
         return 0
 
+    def _spelled_otherwise(runtime, argv):
+        return 0
+
     mod = types.ModuleType("interp.runtime.natives.fake")
     mod.FAKE = fam
-    _forgotten.__module__ = mod.__name__
-    mod._forgotten = _forgotten
-    got = missing_sides(build([fam]), [mod])
+    for fn in (_forgotten, _spelled_otherwise):
+        fn.__module__ = mod.__name__
+        setattr(mod, fn.__name__, fn)
+    got = missing_sides(build([fam]), [mod], used=set())
     assert got == ["NOT_IN_BASIS: no routine of that name in the BASIS file bas.src",
                    "SVEL_JOINT: the BASIS routine is a function",
                    "SACC_CP: declared a stand-in, but the BASIS file bas.src implements it",
+                   "ANSWER: its documented value True is no INT",
+                   "BAS_FAKE: no routine of that name in the BASIS file bas.src",
+                   "BAS_FAKE: declared stops, but the simulator does not implement it",
                    "interp.runtime.natives.fake.FAKE: a family not in FAMILIES",
-                   "interp.runtime.natives.fake._forgotten: an implementation without a signature"]
+                   "interp.runtime.natives.fake._forgotten: an implementation without a signature (nothing uses it)",
+                   "interp.runtime.natives.fake._spelled_otherwise: an implementation without a signature "
+                   "(nothing uses it)"]
+
+
+def test_the_readers_take_each_field_from_the_declarations():
+    """The spin watch's pure built-ins, the front end's advance-run stops and the stand-ins'
+    documented values are the registry's fields (issue 62), not lists of their own."""
+    assert PURE_NATIVES == {n for n, x in REGISTRY.items() if x.pure} and "STRLEN" in PURE_NATIVES
+    assert STOP_ROUTINES == {n for n, x in REGISTRY.items() if x.stops} == {"PULSE"}
+    assert DOCUMENTED == {n: (x.value, x.stand_in) for n, x in REGISTRY.items() if x.value is not NO_VALUE}
+    assert DOCUMENTED["IS_KEY_PRESSED"][0] is False
 
 
 def test_a_declaration_needs_its_signature_and_its_behaviour():

@@ -120,7 +120,7 @@ def _offset(ref, what: str, buf: Arr) -> int:
     return off
 
 
-@CAST.native("BOOL CAST_TO(CHAR BUFFER[] :OUT, INT OFFSET :OUT, ...)")
+@CAST.native("BOOL CAST_TO(CHAR BUFFER[] :OUT, INT OFFSET :OUT, ...)", pure=True)
 def cast_to(rt, a) -> None:  # noqa: ARG001 - the built-ins' calling convention
     buf = _buffer(a[0], "CAST_TO")
     off = _offset(a[1], "CAST_TO", buf)
@@ -134,7 +134,7 @@ def cast_to(rt, a) -> None:  # noqa: ARG001 - the built-ins' calling convention
         a[1].set(off + len(data))
 
 
-@CAST.native("BOOL CAST_FROM(CHAR BUFFER[] :IN, INT OFFSET :OUT, ...)")
+@CAST.native("BOOL CAST_FROM(CHAR BUFFER[] :IN, INT OFFSET :OUT, ...)", pure=True)
 def cast_from(rt, a) -> None:  # noqa: ARG001
     buf = _buffer(a[0], "CAST_FROM")
     pos = _offset(a[1], "CAST_FROM", buf)

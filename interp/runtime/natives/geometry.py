@@ -18,12 +18,12 @@ from .registry import Family
 GEOMETRY = Family("geometry")
 
 
-@GEOMETRY.native("E6POS INV_POS(E6POS POS_VALUES :IN)")
+@GEOMETRY.native("E6POS INV_POS(E6POS POS_VALUES :IN)", pure=True)
 def _inv_pos(rt, a):
     return inv_pos(a[0].get())
 
 
-@GEOMETRY.native("E6POS FORWARD(E6AXIS AXVAL :IN, INT STATUS :OUT)")
+@GEOMETRY.native("E6POS FORWARD(E6AXIS AXVAL :IN, INT STATUS :OUT)", pure=True)
 def _forward(rt, a):
     """FORWARD(axes, status): the TCP for ``axes`` with the current $TOOL/$BASE (E6POS)."""
     # robot.frames costs 0.71 s at first import (scipy's rotations): only a run that calls
@@ -96,7 +96,7 @@ INVERSE_SOFT_LIMIT = 2
 (a simulated code: KUKA's BASIS treats 2 and 3 alike, bas.src CheckERRStatus)."""
 
 
-@GEOMETRY.native("E6AXIS INVERSE(E6POS TOOLPOS :IN, E6AXIS START_AXIS :IN, INT STATUS :OUT)")
+@GEOMETRY.native("E6AXIS INVERSE(E6POS TOOLPOS :IN, E6AXIS START_AXIS :IN, INT STATUS :OUT)", pure=True)
 def _inverse(rt, a):
     """``E6AXIS INVERSE(E6POS TOOLPOS :IN, E6AXIS START_AXIS :IN, INT STATUS :OUT)``
     (reference §4.8; KSS operate.dat): the axes that put the TCP at TOOLPOS in the current

@@ -21,7 +21,7 @@ from .registry import Family
 IO = Family("I/O")
 
 
-@IO.native("PULSE(BOOL SIGNAL :OUT, BOOL LEVEL :IN, REAL DURATION :IN)")
+@IO.native("PULSE(BOOL SIGNAL :OUT, BOOL LEVEL :IN, REAL DURATION :IN)", stops=True)
 def _pulse(rt, a):
     sig, level, dur = a[0], a[1], a[2]
     lvl = to_bool(level.get(), "PULSE level")

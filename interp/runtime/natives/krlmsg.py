@@ -67,7 +67,7 @@ def _handle(a) -> int | None:
         return None
 
 
-@MESSAGES.native("BOOL EXISTS_KRLMSG(INT NHANDLE :IN)")
+@MESSAGES.native("BOOL EXISTS_KRLMSG(INT NHANDLE :IN)", pure=True)
 def _exists_krlmsg(rt, a):
     h = _handle(a)
     return h is not None and rt.messages.exists(h)
@@ -99,7 +99,7 @@ def _set_krldlg(rt, a):
     return m.handle
 
 
-@MESSAGES.native("BOOL EXISTS_KRLDLG(INT NHANDLE :IN, INT ANSWER :OUT)")
+@MESSAGES.native("BOOL EXISTS_KRLDLG(INT NHANDLE :IN, INT ANSWER :OUT)", pure=True)
 def _exists_krldlg(rt, a):
     h = _handle(a)
     open_, answer = rt.messages.dialog_answer(h) if h is not None else (False, None)

@@ -16,12 +16,12 @@ from .registry import Family
 MATHS = Family("math")
 
 
-@MATHS.native("REAL ABS(REAL X :IN)")
+@MATHS.native("REAL ABS(REAL X :IN)", pure=True)
 def _abs(rt, a):
     return abs(real_arg(a[0]))
 
 
-@MATHS.native("REAL SQRT(REAL X :IN)")
+@MATHS.native("REAL SQRT(REAL X :IN)", pure=True)
 def _sqrt(rt, a):
     x = real_arg(a[0])
     if x < 0:
@@ -33,11 +33,11 @@ def _trig(fn):
     return lambda rt, a: fn(math.radians(real_arg(a[0])))
 
 
-MATHS.add("REAL SIN(REAL X :IN)", _trig(math.sin))
-MATHS.add("REAL COS(REAL X :IN)", _trig(math.cos))
+MATHS.add("REAL SIN(REAL X :IN)", _trig(math.sin), pure=True)
+MATHS.add("REAL COS(REAL X :IN)", _trig(math.cos), pure=True)
 
 
-@MATHS.native("REAL TAN(REAL X :IN)")
+@MATHS.native("REAL TAN(REAL X :IN)", pure=True)
 def _tan(rt, a):
     x = real_arg(a[0])
     if abs(math.cos(math.radians(x))) < 1e-12:
@@ -45,7 +45,7 @@ def _tan(rt, a):
     return math.tan(math.radians(x))
 
 
-@MATHS.native("REAL ACOS(REAL X :IN)")
+@MATHS.native("REAL ACOS(REAL X :IN)", pure=True)
 def _acos(rt, a):
     x = real_arg(a[0])
     if not -1.0 <= x <= 1.0:
@@ -53,7 +53,7 @@ def _acos(rt, a):
     return math.degrees(math.acos(x))
 
 
-@MATHS.native("REAL ATAN2(REAL Y :IN, REAL X :IN)")
+@MATHS.native("REAL ATAN2(REAL Y :IN, REAL X :IN)", pure=True)
 def _atan2(rt, a):
     y, x = real_arg(a[0]), real_arg(a[1])
     if x == 0 and y == 0:

@@ -18,6 +18,9 @@ _ZERO_OF_USE = ("the zero value of the type its use gives it (KUKA's software st
                 "such use the run stops: routine NAME not found")
 
 KSS.stand_in("REAL DIGIN(...)", "0.0 (KUKA's software stand-in, noted once)")
+KSS.stand_in("BOOL IS_KEY_PRESSED(INT KEY :IN)",
+             "TRUE while the key is held on the KCP/smartPAD ($operate.dat EXTFCTP BOOL "
+             "IS_KEY_PRESSED(INT KEY :IN)); nobody presses a key in a simulation", value=False)
 KSS.stand_in("E6POS GET_SINGUL(...)", "an E6POS of zeros (KUKA's software stand-in, noted once)")
 for _sig in ("ANY EB(...)", "ANY LK(...)", "ANY TOOL_ADJ(...)", "ANY SYNC(...)"):   # EK: natives/geometry.py
     KSS.stand_in(_sig, _ZERO_OF_USE)

@@ -42,13 +42,25 @@ FUNCTIONS = "functions"
 PROCEDURES = "procedures"
 
 
+#: the ``value`` of a stand-in that has no documented value (the zero value of its type)
+NO_VALUE = None
+
+
 @dataclass(frozen=True, slots=True)
 class Native:
     """One system routine of the tables: ``name`` (upper case), ``signature`` (the table's
     text; for a lenient name ``ANY NAME(...)``), ``section`` (FUNCTIONS, PROCEDURES, or the
     lenient key of its package), ``family`` (the declaring module's family name) and how it
     runs: ``fn`` (the simulator's implementation), ``krl`` (the BASIS file whose KRL routine
-    implements it) or ``stand_in`` (what a call gives when nothing implements it)."""
+    implements it) or ``stand_in`` (what a call gives when nothing implements it, in words).
+    The facts each reader of the routine needs, declared here once (issue 62):
+
+    * ``pure``: its only effects are on its arguments and it reads nothing that changes by
+      itself (a spin that calls it may be parked: interp/runtime/spin.py);
+    * ``stops``: a call stops the advance run (reference §6.10: PULSE; the front end's
+      krl/semantics/advance.py reads it from the generated table's ``advance_stop``);
+    * ``value``: a stand-in's documented value (``IS_KEY_PRESSED``: FALSE), :data:`NO_VALUE`
+      for the zero value of its result type (interp/runtime/kss.py)."""
 
     name: str
     signature: str
@@ -57,6 +69,9 @@ class Native:
     fn: Callable | None = None
     krl: str = ""
     stand_in: str = ""
+    pure: bool = False
+    stops: bool = False
+    value: object = NO_VALUE
 
     @property
     def is_function(self) -> bool:
@@ -92,18 +107,19 @@ class Family:
         self.entries.append(entry)
         return entry
 
-    def native(self, signature: str) -> Callable[[Callable], Callable]:
-        """Decorator: the function below implements the routine of `signature`."""
+    def native(self, signature: str, *, pure: bool = False, stops: bool = False) -> Callable[[Callable], Callable]:
+        """Decorator: the function below implements the routine of `signature` (`pure`,
+        `stops`: :class:`Native`)."""
         def register(fn: Callable) -> Callable:
-            self.add(signature, fn)
+            self.add(signature, fn, pure=pure, stops=stops)
             return fn
         return register
 
-    def add(self, signature: str, fn: Callable) -> Callable:
+    def add(self, signature: str, fn: Callable, *, pure: bool = False, stops: bool = False) -> Callable:
         """`fn` implements the routine of `signature` (a factory's function); returns `fn`."""
         if not callable(fn):
             raise ValueError(f"{self.name}: {signature!r}: the implementation is not callable")
-        self._entry(signature, fn=fn)
+        self._entry(signature, fn=fn, pure=pure, stops=stops)
         return fn
 
     def krl(self, signature: str, file: str) -> None:
@@ -111,13 +127,13 @@ class Family:
         (interp/basis; a backup's own BASIS has it too)."""
         self._entry(signature, krl=file)
 
-    def stand_in(self, signature: str, returns: str) -> None:
+    def stand_in(self, signature: str, returns: str, *, value: object = NO_VALUE) -> None:
         """Nothing in the simulator implements the routine of `signature`: a call goes to the
         stand-in policy for KUKA's software (interp/runtime/kss.py); `returns` says what it
-        gives."""
+        gives, `value` is its documented value (default: its result type's zero value)."""
         if not returns.strip():
             raise ValueError(f"{self.name}: {signature!r}: a stand-in says what a call gives")
-        self._entry(signature, stand_in=returns)
+        self._entry(signature, stand_in=returns, value=value)
 
 
 def build(families) -> dict[str, Native]:
@@ -151,6 +167,12 @@ _LENIENT = """
 """
 
 
+_ADVANCE_STOP = """
+# Routines whose call stops the advance run (reference 6.10; the front end's
+# krl/semantics/advance.py): the natives declared with stops=True.
+"""
+
+
 def _quoted(text: str) -> str:
     return '"' + text.replace("\\", "\\\\").replace('"', '\\"') + '"'
 
@@ -168,7 +190,9 @@ def functions_yaml(registry: dict[str, Native]) -> str:
         names = [n.name for n in registry.values() if n.section == key]
         out.append(f"  {key}:\n")
         out += [f"    - {name}\n" for name in names]
+    out += [_ADVANCE_STOP, "advance_stop:\n"]
+    out += [f"  - {n.name}\n" for n in registry.values() if n.stops]
     return "".join(out)
 
 
-__all__ = ["FUNCTIONS", "PROCEDURES", "Family", "Native", "build", "functions_yaml"]
+__all__ = ["FUNCTIONS", "NO_VALUE", "PROCEDURES", "Family", "Native", "build", "functions_yaml"]

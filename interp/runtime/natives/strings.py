@@ -22,12 +22,12 @@ from .registry import Family
 STRINGS = Family("strings")
 
 
-@STRINGS.native("INT STRLEN(CHAR STRVAR[] :IN)")
+@STRINGS.native("INT STRLEN(CHAR STRVAR[] :IN)", pure=True)
 def _strlen(rt, a):
     return len(ref_text(a[0], "STRLEN argument"))
 
 
-@STRINGS.native("INT STRDECLLEN(CHAR STRVAR[] :OUT)")
+@STRINGS.native("INT STRDECLLEN(CHAR STRVAR[] :OUT)", pure=True)
 def _strdecllen(rt, a):
     v = a[0].peek() if a[0] is not None else UNSET
     if isinstance(v, Arr):
@@ -37,19 +37,19 @@ def _strdecllen(rt, a):
     raise KrlRuntimeError("STRDECLLEN needs a CHAR array")
 
 
-@STRINGS.native("BOOL STRCLEAR(CHAR STRVAR[] :OUT)")
+@STRINGS.native("BOOL STRCLEAR(CHAR STRVAR[] :OUT)", pure=True)
 def _strclear(rt, a):
     put_text(char_array(a[0], "STRCLEAR argument"), "")
     return True
 
 
-@STRINGS.native("INT STRADD(CHAR STRDEST[] :OUT, CHAR STRTOADD[] :IN)")
+@STRINGS.native("INT STRADD(CHAR STRDEST[] :OUT, CHAR STRTOADD[] :IN)", pure=True)
 def _stradd(rt, a):
     dest = char_array(a[0], "STRADD destination")
     return put_text(dest, dest.text() + ref_text(a[1], "STRADD argument"))
 
 
-@STRINGS.native("BOOL STRCOPY(CHAR STRDEST[] :OUT, CHAR STRSOURCE[] :IN)")
+@STRINGS.native("BOOL STRCOPY(CHAR STRDEST[] :OUT, CHAR STRSOURCE[] :IN)", pure=True)
 def _strcopy(rt, a):
     dest = char_array(a[0], "STRCOPY destination")
     src = ref_text(a[1], "STRCOPY source")
@@ -57,7 +57,7 @@ def _strcopy(rt, a):
     return len(src) <= len(dest.data)
 
 
-@STRINGS.native("BOOL STRCOMP(CHAR S1[] :IN, CHAR S2[] :IN, CASE_SENSE_T MODE :IN)")
+@STRINGS.native("BOOL STRCOMP(CHAR S1[] :IN, CHAR S2[] :IN, CASE_SENSE_T MODE :IN)", pure=True)
 def _strcomp(rt, a):
     s1, s2 = ref_text(a[0], "STRCOMP argument 1"), ref_text(a[1], "STRCOMP argument 2")
     if not case_sensitive(a[2] if len(a) > 2 else None):
@@ -65,7 +65,7 @@ def _strcomp(rt, a):
     return s1 == s2
 
 
-@STRINGS.native("INT STRFIND(INT STARTAT :IN, CHAR STRVAR[] :IN, CHAR STRFIND[] :IN, CASE_SENSE_T MODE :IN)")
+@STRINGS.native("INT STRFIND(INT STARTAT :IN, CHAR STRVAR[] :IN, CHAR STRFIND[] :IN, CASE_SENSE_T MODE :IN)", pure=True)
 def _strfind(rt, a):
     start = int_arg(a[0])
     s, sub = ref_text(a[1], "STRFIND string"), ref_text(a[2], "STRFIND pattern")
@@ -141,7 +141,7 @@ def _to_bool(s: str) -> bool:
     raise ValueError(s)
 
 
-@STRINGS.native("BOOL STRTOSTRING(CHAR S[] :IN, CHAR RETVAL[] :OUT)")
+@STRINGS.native("BOOL STRTOSTRING(CHAR S[] :IN, CHAR RETVAL[] :OUT)", pure=True)
 def _strtostring(rt, a):
     dest = char_array(a[1], "STRTOSTRING destination")
     put_text(dest, ref_text(a[0], "string"))
@@ -171,13 +171,13 @@ def _strto_struct(tname):
     return fn
 
 
-STRINGS.add("BOOL STRTOINT(CHAR S[] :IN, INT RETVAL :OUT)", _strto(_to_int))
-STRINGS.add("BOOL STRTOREAL(CHAR S[] :IN, REAL RETVAL :OUT)", _strto(_to_real))
-STRINGS.add("BOOL STRTOBOOL(CHAR S[] :IN, BOOL RETVAL :OUT)", _strto(_to_bool))
-STRINGS.add("BOOL STRTOFRAME(CHAR S[] :IN, FRAME RETVAL :OUT)", _strto_struct("FRAME"))
-STRINGS.add("BOOL STRTOPOS(CHAR S[] :IN, POS RETVAL :OUT)", _strto_struct("POS"))
-STRINGS.add("BOOL STRTOE3POS(CHAR S[] :IN, E3POS RETVAL :OUT)", _strto_struct("E3POS"))
-STRINGS.add("BOOL STRTOE6POS(CHAR S[] :IN, E6POS RETVAL :OUT)", _strto_struct("E6POS"))
-STRINGS.add("BOOL STRTOAXIS(CHAR S[] :IN, AXIS RETVAL :OUT)", _strto_struct("AXIS"))
-STRINGS.add("BOOL STRTOE3AXIS(CHAR S[] :IN, E3AXIS RETVAL :OUT)", _strto_struct("E3AXIS"))
-STRINGS.add("BOOL STRTOE6AXIS(CHAR S[] :IN, E6AXIS RETVAL :OUT)", _strto_struct("E6AXIS"))
+STRINGS.add("BOOL STRTOINT(CHAR S[] :IN, INT RETVAL :OUT)", _strto(_to_int), pure=True)
+STRINGS.add("BOOL STRTOREAL(CHAR S[] :IN, REAL RETVAL :OUT)", _strto(_to_real), pure=True)
+STRINGS.add("BOOL STRTOBOOL(CHAR S[] :IN, BOOL RETVAL :OUT)", _strto(_to_bool), pure=True)
+STRINGS.add("BOOL STRTOFRAME(CHAR S[] :IN, FRAME RETVAL :OUT)", _strto_struct("FRAME"), pure=True)
+STRINGS.add("BOOL STRTOPOS(CHAR S[] :IN, POS RETVAL :OUT)", _strto_struct("POS"), pure=True)
+STRINGS.add("BOOL STRTOE3POS(CHAR S[] :IN, E3POS RETVAL :OUT)", _strto_struct("E3POS"), pure=True)
+STRINGS.add("BOOL STRTOE6POS(CHAR S[] :IN, E6POS RETVAL :OUT)", _strto_struct("E6POS"), pure=True)
+STRINGS.add("BOOL STRTOAXIS(CHAR S[] :IN, AXIS RETVAL :OUT)", _strto_struct("AXIS"), pure=True)
+STRINGS.add("BOOL STRTOE3AXIS(CHAR S[] :IN, E3AXIS RETVAL :OUT)", _strto_struct("E3AXIS"), pure=True)
+STRINGS.add("BOOL STRTOE6AXIS(CHAR S[] :IN, E6AXIS RETVAL :OUT)", _strto_struct("E6AXIS"), pure=True)

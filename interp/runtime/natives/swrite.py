@@ -208,7 +208,7 @@ def _format_error(state_ref, error: str) -> None:
         raise KrlRuntimeError(error)
 
 
-@FORMATTED.native("SWRITE(CHAR DEST[] :OUT, STATE_T STATE :OUT, INT OFFSET :OUT, CHAR FORMAT[] :IN, ...)")
+@FORMATTED.native("SWRITE(CHAR DEST[] :OUT, STATE_T STATE :OUT, INT OFFSET :OUT, CHAR FORMAT[] :IN, ...)", pure=True)
 def _swrite(rt, a):
     dest = char_array(a[0], "SWRITE destination")
     off_ref = a[2]
@@ -328,7 +328,7 @@ def sread_values(src: str, fmt: str, start: int = 0, limit: int | None = None) -
     return out, pos, error
 
 
-@FORMATTED.native("SREAD(CHAR SRC[] :IN, STATE_T STATE :OUT, INT OFFSET :OUT, CHAR FORMAT[] :IN, ...)")
+@FORMATTED.native("SREAD(CHAR SRC[] :IN, STATE_T STATE :OUT, INT OFFSET :OUT, CHAR FORMAT[] :IN, ...)", pure=True)
 def _sread(rt, a):
     src = ref_text(a[0], "SREAD source")
     off_ref = a[2]

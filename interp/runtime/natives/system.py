@@ -35,7 +35,7 @@ GETSYSSTATE_COMMANDS = ("STOPBITS",)
 """The GETSYSSTATE commands the simulator answers (the only one the corpus uses)."""
 
 
-@SYSTEM.native("BOOL GETSYSSTATE(...)")
+@SYSTEM.native("BOOL GETSYSSTATE(...)", pure=True)
 def _getsysstate(rt, a):
     """``BOOL GETSYSSTATE(CHAR CMD[64] :IN, INT IPAR :OUT, REAL RPAR :OUT)`` (KSS
     ``$OPERATE`` EXTFCTP, operate.dat; reference §4.8 names it, KUKA does not document it).

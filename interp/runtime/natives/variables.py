@@ -18,7 +18,7 @@ from .registry import Family
 VARIABLES = Family("variables")
 
 
-@VARIABLES.native("VAR_STATE VARSTATE(CHAR VAR_STR[] :IN)")
+@VARIABLES.native("VAR_STATE VARSTATE(CHAR VAR_STR[] :IN)", pure=True)
 def _varstate(rt, a):
     name = ref_text(a[0], "VARSTATE argument")
     try:
@@ -34,7 +34,7 @@ def _varstate(rt, a):
     return EnumValue("INITIALIZED" if is_initialised(v) else "DECLARED")
 
 
-@VARIABLES.native("VAR_TYPE VARTYPE(CHAR VAR_STR[] :IN)")
+@VARIABLES.native("VAR_TYPE VARTYPE(CHAR VAR_STR[] :IN)", pure=True)
 def _vartype(rt, a):
     name = ref_text(a[0], "VARTYPE argument")
     ref = rt.ref_from_text(name)
