@@ -155,6 +155,13 @@ def pytest_terminal_summary(terminalreporter, exitstatus, config) -> None:
     if config.option.collectonly:
         return
     stats = terminalreporter.stats
+    # the figures a test states (``record_property("summary", text)``: the variants of issue 59
+    # count their runs), printed whether the test passed or not, from any xdist worker
+    for key in ("passed", "failed"):
+        for rep in stats.get(key, []):
+            for name, value in getattr(rep, "user_properties", ()):
+                if name == "summary" and getattr(rep, "when", "call") == "call":
+                    terminalreporter.write_line(f"{rep.nodeid}: {value}")
     counts = {k: len(stats.get(k, [])) for k in ("passed", "failed", "error", "skipped", "xfailed", "xpassed")}
     terminalreporter.write_line(
         "test counts: " + ", ".join(f"{v} {k}" for k, v in counts.items()) +

@@ -1,0 +1,328 @@
+"""The backups users actually have, generated from real ones (issue 59): each variant of a backup
+is the backup with one piece of KUKA's software removed, or in another shape, and every entry
+point of every variant runs as a new user runs it (``--inputs auto``, nothing hand-written).
+
+A backup is a partial copy of a controller: KUKA's system software and its technology packages
+are installed whether or not their files were exported. Real backups come without ``TP/``,
+without ``System/`` files, as ``R1/Program`` only, with ``$config.dat``'s user part missing, as
+KR C2 or KR C4 trees, as ``.zip`` files. :func:`variants_of` derives these from a backup, in turn:
+
+* ``whole``: the backup as it is;
+* ``no-TP``: without its ``TP/`` folder; ``no-TP/NAME``: without one technology package folder
+  of it (``TP/GripperSpotTech``); ``no-package-dat FILE``: without one data list of a package
+  (``TP/GripperSpotTech/Spot_Data.dat``, ``TP/p00.dat``);
+* ``no-system FILE``: without one file of its ``System/`` or ``Mada`` folders
+  (``System/bas.src``, ``System/$config.dat``: the folder is then no backup, its programs run
+  as loose programs on the project's BASIS);
+* ``config-user-part-missing``: ``$config.dat`` with the lines of its USER folds deleted (the
+  fold markers kept);
+* ``program-only``: ``R1/Program`` alone;
+* ``tree KRC/R1`` or ``tree flat``: the other of the two layouts KUKA's archives use (a KR C2 or
+  KR C4 archive's ``KRC/R1/...`` with ``KRC/STEU``, or a flat export of R1 with ``System/`` at the
+  top, krl/project.py);
+* ``zip``: the backup as a ``.zip`` archive, read as ``krl run --workspace BACKUP.zip`` reads it
+  (krl/archive.py).
+
+:func:`run_variant` materialises a variant in a temporary folder (removed after) and runs every
+entry point of it (interp.realprograms.entries_of for a backup, else its loose programs) on the
+VM with ``--inputs auto`` for :data:`SIM_TIME_S` simulated seconds (the robot program's steps
+bounded by :data:`STEPS`), reading each run's end against the checker's classification of the
+same workspace (interp.realprograms.outside_stops). A run ends *explained* when its cause
+(interp.realprograms.cause_of) is completed, an intended end, the program's error at its line, a
+limit, or a simulator gap the report names (a target the stand-in robot cannot reach once the
+variant removed the machine data); it *fails* when it stops on a name the checker classifies as
+installed software (an "outside stop") or ends in an internal error.
+
+``python -m interp.variants [FOLDER ...] [--sample N] [--jobs N] [--json OUT]`` (default: the
+backups of ../shared/krl-corpus and ../shared/krl-history) prints the counts of variants and runs,
+the runs by cause and every failing run; exit status 1 when a run fails. ``make nightly`` runs
+all of them (``variants.json``, its counts in the nightly's history: conformance/nightly);
+``make test`` a deterministic sample (tests/interp/test_variants.py).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import shutil
+import sys
+import tempfile
+import zipfile
+from collections import Counter
+from dataclasses import dataclass
+from pathlib import Path
+
+from interp import realprograms as rp
+from krl.archive import backup_source
+from krl.files import SHARED_CORPUS
+from krl.project import find_backups
+from krl.semantics.outside import template_lines
+from krl.source import is_krl_file
+
+__all__ = ["SIM_TIME_S", "STEPS", "Variant", "backups", "run_variant", "sample", "variants_of"]
+
+#: the bound of each run: simulated seconds (a program that starves is fast-forwarded) and steps
+#: of the robot program (the step limit counts no submit program's)
+SIM_TIME_S = 20.0
+STEPS = 100_000
+
+#: ../shared/krl-history beside the corpus
+SHARED_HISTORY = SHARED_CORPUS.parent / "krl-history"
+
+#: the kinds of variant, in the order :func:`variants_of` lists them
+KINDS = ("whole", "no-TP", "no-TP/", "no-package-dat", "no-system", "config-user-part-missing", "program-only",
+         "tree", "zip")
+
+
+@dataclass(frozen=True)
+class Variant:
+    """One variant of the backup at `backup` (its root, krl/project.py): `kind` (:data:`KINDS`)
+    and `detail` (the removed path relative to the backup root, or the tree's shape)."""
+
+    backup: Path
+    kind: str
+    detail: str = ""
+
+    @property
+    def name(self) -> str:
+        return f"{self.kind} {self.detail}".strip()
+
+    def make(self, dest: Path) -> Path:
+        """Write the variant into the empty folder `dest`; returns the path to read it from (a
+        folder, or the ``.zip`` file)."""
+        src = self.backup
+        if self.kind == "zip":
+            return _zip(src, dest / (src.name + ".zip"))
+        if self.kind == "program-only":
+            prog = _robot(src) / _child_name(_robot(src), "program")
+            _copy(prog, dest / "R1" / prog.name)
+            return dest
+        if self.kind == "tree":
+            robot = _robot(src)
+            if self.detail == "flat":
+                _copy(robot, dest)
+                for other in _siblings(src, robot):
+                    _copy(other, dest / other.name)
+            else:
+                _copy(robot, dest / "KRC" / "R1")
+                for other in _siblings(src, robot):
+                    _copy(other, dest / "KRC" / other.name)
+            return dest
+        _copy(src, dest)
+        if self.kind == "whole":
+            return dest
+        if self.kind == "config-user-part-missing":
+            cfg = dest / self.detail
+            cfg.write_bytes(_without_user_folds(cfg.read_bytes()))
+            return dest
+        target = dest / self.detail
+        if target.is_dir():
+            shutil.rmtree(target)
+        elif target.exists():
+            target.unlink()
+        return dest
+
+
+def _robot(root: Path) -> Path:
+    """The robot's folder of a backup root: ``R1`` (``KRC/R1``), else the root (a flat export)."""
+    r1 = _child_name(root, "r1")
+    return root / r1 if r1 else root
+
+
+def _child_name(folder: Path, name: str) -> str:
+    """The name of `folder`'s sub-folder `name` in any letter case, "" when there is none."""
+    for p in sorted(folder.iterdir()) if folder.is_dir() else ():
+        if p.name.lower() == name and p.is_dir() and not p.is_symlink():
+            return p.name
+    return ""
+
+
+def _siblings(root: Path, robot: Path) -> list[Path]:
+    """The folders beside the robot's folder in a ``KRC/R1`` backup (``STEU``), none in a flat one."""
+    if robot == root:
+        return []
+    return [p for p in sorted(root.iterdir()) if p.is_dir() and not p.is_symlink() and p != robot]
+
+
+def _copy(src: Path, dest: Path) -> None:
+    """Copy the regular files of `src` below `dest` (links are never followed nor copied)."""
+    dest.mkdir(parents=True, exist_ok=True)
+    for p in sorted(src.rglob("*")):
+        if p.is_symlink() or not p.is_file():
+            continue
+        q = dest / p.relative_to(src)
+        q.parent.mkdir(parents=True, exist_ok=True)
+        shutil.copyfile(p, q)
+
+
+def _zip(src: Path, archive: Path) -> Path:
+    with zipfile.ZipFile(archive, "w", zipfile.ZIP_DEFLATED) as zf:
+        for p in sorted(src.rglob("*")):
+            if p.is_file() and not p.is_symlink():
+                zf.write(p, (Path(src.name) / p.relative_to(src)).as_posix())
+    return archive
+
+
+def _without_user_folds(data: bytes) -> bytes:
+    """`data` (a ``$config.dat``) with the lines inside its USER folds deleted, the fold lines
+    kept (krl/semantics/outside.py ``template_lines``: the lines the user wrote)."""
+    text = data.decode("latin-1")
+    user = template_lines(text)[2]
+    lines = text.splitlines(keepends=True)
+    keep = [line for no, line in enumerate(lines, 1)
+            if no not in user or line.lstrip().upper().startswith((";FOLD", ";ENDFOLD"))]
+    return "".join(keep).encode("latin-1")
+
+
+def variants_of(backup: Path) -> list[Variant]:
+    """Every variant of the backup rooted at `backup` (module docstring), in :data:`KINDS` order."""
+    out = [Variant(backup, "whole")]
+    robot = _robot(backup)
+    rel = lambda p: p.relative_to(backup).as_posix()      # noqa: E731
+    tp = _child_name(robot, "tp")
+    if tp:
+        out.append(Variant(backup, "no-TP", rel(robot / tp)))
+        out += [Variant(backup, "no-TP/", rel(p)) for p in sorted((robot / tp).iterdir())
+                if p.is_dir() and not p.is_symlink()]
+        out += [Variant(backup, "no-package-dat", rel(p)) for p in sorted((robot / tp).rglob("*"))
+                if p.is_file() and p.suffix.lower() == ".dat"]
+    for folder in ("system", "mada"):
+        name = _child_name(robot, folder)
+        if name:
+            out += [Variant(backup, "no-system", rel(p)) for p in sorted((robot / name).iterdir())
+                    if p.is_file() and is_krl_file(p)]
+    system = _child_name(robot, "system")
+    cfg = next((p for p in sorted((robot / system).iterdir()) if p.name.lower() == "$config.dat"), None) \
+        if system else None
+    if cfg is not None and template_lines(cfg.read_bytes().decode("latin-1"))[2]:
+        out.append(Variant(backup, "config-user-part-missing", rel(cfg)))
+    if _child_name(robot, "program"):
+        out.append(Variant(backup, "program-only"))
+    out.append(Variant(backup, "tree", "flat" if robot != backup else "KRC/R1"))
+    out.append(Variant(backup, "zip"))
+    return out
+
+
+def backups(folders: list[Path]) -> list[Path]:
+    """The backup roots below `folders` (krl/project.py ``find_backups``), in order."""
+    out: list[Path] = []
+    for f in folders:
+        if f.is_dir():
+            out += find_backups(f)
+    return out
+
+
+def sample(variants: list[Variant], n: int) -> list[Variant]:
+    """`n` variants evenly spaced over `variants` (their order: by backup, then kind), always
+    one of each kind present first: a deterministic sample that covers every kind."""
+    if n >= len(variants):
+        return list(variants)
+    first = {}
+    for v in variants:
+        first.setdefault(v.kind, v)
+    chosen = list(first.values())[:n]
+    rest = [v for v in variants if v not in chosen]
+    k = n - len(chosen)
+    if k > 0 and rest:
+        step = len(rest) / k
+        chosen += [rest[int(i * step)] for i in range(k)]
+    return chosen
+
+
+def _entries(folder: Path) -> list[Path]:
+    """The entry points of a materialised variant: of its backups (interp.realprograms
+    ``entries_of``); of a folder that is no backup any more (its ``System/$config.dat`` removed,
+    ``R1/Program`` alone), the programs the same rule finds there (``programs_of``: a Program
+    folder's, KUKA's system folders left out), else every program of the folder."""
+    roots = find_backups(folder)
+    if roots:
+        return [p for r in roots for p in rp.entries_of(r)]
+    progs = rp.programs_of(folder)
+    if progs:
+        return progs
+    files = sorted(p for p in folder.rglob("*") if p.is_file() and not p.is_symlink())
+    return rp.folder_entries(files)
+
+
+def run_variant(variant: Variant, sim_time: float = SIM_TIME_S, steps: int = STEPS, interp: str = "vm") -> dict:
+    """Materialise `variant` and run every entry point of it (module docstring). Returns
+    ``{"variant", "backup", "runs": [{"entry", "cause", "reason", "text", "outside_stops"}]}``;
+    never raises for the material: an error of the simulator is a run with cause "internal"."""
+    runs = []
+    with tempfile.TemporaryDirectory(prefix="krl-variant-") as tmp:
+        made = variant.make(Path(tmp))
+        try:
+            with backup_source(made) as (folder, _shown):
+                for entry in _entries(folder):
+                    row = rp.run_one(entry, sim_time, steps, auto=True, interp=interp, auto_sim_time=sim_time)
+                    internal = row["reason"] == "internal"
+                    runs.append({"entry": entry.relative_to(folder).as_posix(),
+                                 "cause": "internal" if internal else row["cause"],
+                                 "reason": row["reason"], "text": row.get("text") or "",
+                                 "outside_stops": row.get("outside_stops") or []})
+        except Exception as exc:  # noqa: BLE001 - a variant that cannot be read is a finding, not the end
+            runs.append({"entry": "", "cause": "internal", "reason": "internal",
+                         "text": f"{type(exc).__name__}: {exc}", "outside_stops": []})
+    return {"variant": variant.name, "kind": variant.kind, "backup": str(variant.backup), "runs": runs}
+
+
+def _task(backup: str, kind: str, detail: str, sim_time: float, steps: int, interp: str) -> dict:
+    """A worker's task (krl.pool): one variant's runs."""
+    return run_variant(Variant(Path(backup), kind, detail), sim_time, steps, interp)
+
+
+def summarise(results: list[dict]) -> dict:
+    """Counts of `results` (:func:`run_variant`'s): variants, runs, runs by cause, the failing
+    runs (an outside stop or an internal error), as ``{"variants", "runs", "causes", "failures"}``."""
+    causes: Counter = Counter()
+    failures = []
+    for res in results:
+        for run in res["runs"]:
+            causes[run["cause"]] += 1
+            if run["outside_stops"] or run["cause"] == "internal":
+                failures.append({"variant": res["variant"], "backup": res["backup"], "entry": run["entry"],
+                                 "text": run["text"], "outside_stops": run["outside_stops"]})
+    return {"variants": len(results), "runs": sum(causes.values()), "causes": dict(sorted(causes.items())),
+            "outside_stops": sum(len(f["outside_stops"]) for f in failures),
+            "internal": causes.get("internal", 0), "failures": failures}
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m interp.variants", description=__doc__.split("\n\n")[0])
+    ap.add_argument("folders", nargs="*", type=Path, help="folders holding backups (default: the shared corpus "
+                                                          "and history)")
+    ap.add_argument("--sample", type=int, default=0, help="run this many variants (evenly spaced; 0: all)")
+    ap.add_argument("--jobs", type=int, default=None, help="worker processes (default: one per core)")
+    ap.add_argument("--interp", choices=("vm", "tree"), default="vm")
+    ap.add_argument("--json", type=Path, default=None, help="write the results here")
+    args = ap.parse_args(argv)
+    # on use: the worker pool (pebble) costs 0.42 s (python -X importtime, 2026-11-23, krl/workspace.py)
+    from krl.pool import run_tasks  # noqa: PLC0415
+
+    folders = args.folders or [SHARED_CORPUS, SHARED_HISTORY]
+    variants = [v for b in backups(folders) for v in variants_of(b)]
+    if args.sample:
+        variants = sample(variants, args.sample)
+    tasks = [(k, (str(v.backup), v.kind, v.detail, SIM_TIME_S, STEPS, args.interp)) for k, v in enumerate(variants)]
+    results: list = [None] * len(variants)
+    for o in run_tasks(_task, tasks, jobs=args.jobs):
+        v = variants[o.key]
+        results[o.key] = o.value if o.status == "done" else {
+            "variant": v.name, "kind": v.kind, "backup": str(v.backup),
+            "runs": [{"entry": "", "cause": "internal", "reason": "internal", "text": o.detail or o.status,
+                      "outside_stops": []}]}
+    s = summarise(results)
+    print(f"variants {s['variants']} of {len(backups(folders))} backups, runs {s['runs']}: "
+          + ", ".join(f"{k} {n}" for k, n in s["causes"].items()))
+    print(f"stops on a name the checker classifies as installed software: {s['outside_stops']}; "
+          f"internal errors: {s['internal']}")
+    for f in s["failures"]:
+        print(f"  {f['backup']} [{f['variant']}] {f['entry']}: {f['text']} {f['outside_stops']}")
+    if args.json is not None:
+        args.json.write_text(json.dumps({"summary": {k: v for k, v in s.items() if k != "failures"},
+                                         "failures": s["failures"], "results": results}, indent=1))
+    return 1 if s["failures"] else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,133 @@
+"""The backups users actually have, generated from real ones (issue 59, interp/variants.py): the
+generator on a backup written here (what each kind of variant removes or reshapes), and a
+deterministic sample of the variants of every backup of ../shared/krl-corpus and
+../shared/krl-history run as a new user runs them (``--inputs auto``): every run ends explained
+and none stops on a name the checker classifies as installed software. ``make nightly`` runs every
+variant (``python -m interp.variants``, its counts in the nightly's history).
+
+Cost: the sample is :data:`SAMPLE` variants, every kind once first, then evenly spaced; each runs
+every entry point of its variant for :data:`interp.variants.SIM_TIME_S` simulated seconds on the VM
+(0.05 to 1.5 s of CPU a variant, 2026-11-26). Skipped only where ../shared is absent and CI is not
+set (tests/conftest.py)."""
+
+from __future__ import annotations
+
+import zipfile
+from pathlib import Path
+
+import pytest
+
+from interp import variants as V
+from krl.archive import backup_source
+from krl.project import find_backups
+from tests.conftest import SHARED_CORPUS, SHARED_HISTORY
+
+from .helpers import write as _write
+
+
+def write(folder: Path, name: str, text: str) -> Path:
+    (folder / name).parent.mkdir(parents=True, exist_ok=True)
+    return _write(folder, name, text)
+
+#: variants of the sample run in ``make test``
+SAMPLE = 12
+
+
+def _backup(tmp: Path) -> Path:
+    """A KR C4 archive tree: KRC/R1 with System (a $config.dat with a user part), TP with two
+    packages, Mada; KRC/STEU beside it."""
+    root = tmp / "KRC"
+    write(root, "R1/System/$config.dat", "DEFDAT $CONFIG\n;FOLD BASISTECH GLOBALS\nDECL INT K1=1\n"
+                                         ";ENDFOLD (BASISTECH GLOBALS)\n;FOLD USER GLOBALS\nDECL INT U1=2\n"
+                                         "SIGNAL S1 $IN[3]\n;ENDFOLD (USER GLOBALS)\nENDDAT\n")
+    write(root, "R1/System/sps.sub", "DEF sps( )\n  LOOP\n    WAIT SEC 1\n  ENDLOOP\nEND\n")
+    write(root, "R1/TP/Spot/spot.dat", "DEFDAT spot PUBLIC\n  DECL GLOBAL INT SPOTN=0\nENDDAT\n")
+    write(root, "R1/TP/Spot/spot.src", "DEF spot( )\nEND\n")
+    write(root, "R1/TP/Grip/grip.src", "DEF grip( )\nEND\n")
+    write(root, "R1/Mada/$machine.dat", "DEFDAT $MACHINE\nENDDAT\n")
+    write(root, "R1/Program/prog.src", "DEF prog( )\n  $OUT[1] = TRUE\nEND\n")
+    write(root, "STEU/Mada/$custom.dat", "DEFDAT $CUSTOM\nENDDAT\n")
+    assert find_backups(tmp) == [root]
+    return root
+
+
+def test_the_variants_of_a_backup(tmp_path):
+    root = _backup(tmp_path / "src")
+    got = [(v.kind, v.detail) for v in V.variants_of(root)]
+    assert got == [("whole", ""), ("no-TP", "R1/TP"), ("no-TP/", "R1/TP/Grip"), ("no-TP/", "R1/TP/Spot"),
+                   ("no-package-dat", "R1/TP/Spot/spot.dat"), ("no-system", "R1/System/$config.dat"),
+                   ("no-system", "R1/System/sps.sub"), ("no-system", "R1/Mada/$machine.dat"),
+                   ("config-user-part-missing", "R1/System/$config.dat"), ("program-only", ""),
+                   ("tree", "flat"), ("zip", "")]
+
+
+def _made(variant, tmp: Path) -> set[str]:
+    dest = tmp / variant.name.replace("/", "_").replace(" ", "_").replace("$", "")
+    dest.mkdir()
+    out = variant.make(dest)
+    if out.suffix == ".zip":
+        return {n for n in zipfile.ZipFile(out).namelist()}
+    return {p.relative_to(dest).as_posix() for p in dest.rglob("*") if p.is_file()}
+
+
+def test_each_variant_removes_or_reshapes_what_it_says(tmp_path):
+    root = _backup(tmp_path / "src")
+    whole = {p.relative_to(root).as_posix() for p in root.rglob("*") if p.is_file()}
+    by = {(v.kind, v.detail): v for v in V.variants_of(root)}
+    out = tmp_path / "out"
+    out.mkdir()
+    assert _made(by[("whole", "")], out) == whole
+    assert _made(by[("no-TP", "R1/TP")], out) == {f for f in whole if not f.startswith("R1/TP/")}
+    assert _made(by[("no-TP/", "R1/TP/Spot")], out) == whole - {"R1/TP/Spot/spot.dat", "R1/TP/Spot/spot.src"}
+    assert _made(by[("no-package-dat", "R1/TP/Spot/spot.dat")], out) == whole - {"R1/TP/Spot/spot.dat"}
+    assert _made(by[("no-system", "R1/Mada/$machine.dat")], out) == whole - {"R1/Mada/$machine.dat"}
+    assert _made(by[("program-only", "")], out) == {"R1/Program/prog.src"}
+    assert _made(by[("tree", "flat")], out) == {f[3:] if f.startswith("R1/") else f for f in whole}
+    assert _made(by[("zip", "")], out) == {"KRC/" + f for f in whole}
+    v = by[("config-user-part-missing", "R1/System/$config.dat")]
+    dest = out / "user"
+    dest.mkdir()
+    v.make(dest)
+    text = (dest / "R1/System/$config.dat").read_text()
+    assert "K1=1" in text and "U1" not in text and "SIGNAL S1" not in text
+    assert ";FOLD USER GLOBALS" in text and ";ENDFOLD (USER GLOBALS)" in text
+
+
+def test_a_zip_variant_is_read_as_krl_run_reads_a_backup_archive(tmp_path):
+    root = _backup(tmp_path / "src")
+    zipped = next(v for v in V.variants_of(root) if v.kind == "zip")
+    made = zipped.make(tmp_path)
+    with backup_source(made) as (folder, _shown):
+        assert [b.name for b in find_backups(folder)] == ["KRC"]
+
+
+def test_a_flat_export_becomes_an_archive_tree(tmp_path):
+    flat = tmp_path / "flat"
+    write(flat, "System/$config.dat", "DEFDAT $CONFIG\nENDDAT\n")
+    write(flat, "Program/p.src", "DEF p( )\nEND\n")
+    [tree] = [v for v in V.variants_of(flat) if v.kind == "tree"]
+    assert tree.detail == "KRC/R1"
+    assert _made(tree, tmp_path) == {"KRC/R1/System/$config.dat", "KRC/R1/Program/p.src"}
+
+
+def test_the_sample_covers_every_kind_and_is_deterministic(tmp_path):
+    root = _backup(tmp_path / "src")
+    variants = V.variants_of(root) * 3
+    a, b = V.sample(variants, 10), V.sample(variants, 10)
+    assert a == b and len(a) == 10
+    assert {v.kind for v in a} == set(V.KINDS)
+
+
+@pytest.mark.corpus
+@pytest.mark.skipif(not (SHARED_CORPUS / "MANIFEST.csv").exists(), reason="../shared/krl-corpus absent")
+def test_a_sample_of_the_variants_of_every_backup_ends_explained(record_property):
+    variants = [v for b in V.backups([SHARED_CORPUS, SHARED_HISTORY]) for v in V.variants_of(b)]
+    chosen = V.sample(variants, SAMPLE)
+    results = [V.run_variant(v) for v in chosen]
+    s = V.summarise(results)
+    record_property("summary", f"variants {s['variants']} of {len(variants)}, runs {s['runs']}: "
+                               + ", ".join(f"{k} {n}" for k, n in s["causes"].items())
+                               + f"; stops on installed software {s['outside_stops']}, internal {s['internal']}")
+    assert {v.kind for v in chosen} == set(V.KINDS)
+    assert s["runs"] >= SAMPLE
+    assert not s["failures"], s["failures"]
