@@ -114,3 +114,44 @@ def test_records_with_an_end_string_with_and_without_a_length(interp):
     assert (got, rest) == (want, b"")
     data = box["rt"].program.module("streams").data
     assert data["ANSWER"].get().text() == "OK,42" and data["READ"].get() == 1
+
+
+RVS = HERE / "rvs"
+
+
+@pytest.mark.parametrize("interp", ["tree", "vm"])
+def test_a_client_library_of_a_vision_vendors_published_hex_interface(interp):
+    """A client library written from Percipio RVS 2.0's published TCP standard interface in HEX
+    (64-byte commands of little-endian INT32 fields, padded with 0; 101 runs a project; status
+    1102 "Successfully triggered project", 1011 "Project number does not exist": the vendor's
+    status-code list) against a vision system written from the same description: each record is
+    64 bytes both ways. The vendor publishes no answer layout for HEX beyond the status code; the
+    partner answers in the commands' layout (the command, then the status). No vision vendor's
+    KRL with binary records is stored in the search tool's corpora (docs/network.md)."""
+    server = socket.create_server(("127.0.0.1", 0))
+    settings = NetworkSettings(RVS, eki={"RVSHEX": Channel(RVS / "RvsHex.xml", ("127.0.0.1", server.getsockname()[1]))})
+    box: dict = {}
+
+    def vision(net, rt):
+        server.settimeout(60)
+        conn, _ = server.accept()
+        conn.settimeout(60)
+        seen = []
+        for _ in range(2):
+            cmd = _recv_exactly(conn, 64, time.monotonic() + 60)
+            code, project, points, pose_type = struct.unpack_from("<iiii", cmd)
+            seen.append((len(cmd), code, project, points, pose_type, cmd[16:] == bytes(48)))
+            status = 1102 if project == 1 else 1011
+            conn.sendall(struct.pack("<ii", code, status).ljust(64, b"\0"))
+        conn.settimeout(30)
+        seen.append(conn.recv(100))         # the run's end closes the connection
+        conn.close()
+        server.close()
+        return seen
+
+    res, _trace, seen = run_with_partner(RVS / "rvs_client.src", settings, vision, interp=interp, box=box,
+                                         max_sim_time=30)
+    assert res.reason == "completed", res.text
+    assert seen == [(64, 101, 1, 0, 0, True), (64, 101, 99, 0, 0, True), b""]
+    data = box["rt"].program.module("rvs_client").data
+    assert (data["FIRSTSTATUS"].get(), data["SECONDSTATUS"].get()) == (1102, 1011)
