@@ -126,7 +126,8 @@ conformance: $(PARSER) java-parser
 # audit of the corpus with every entry point run for krl run's 600 s (audit/: krl audit, docs/audit.md), conformance, the
 # benchmarks (bench.json, bench-parse.json, limits.jsonl, whole-runs.json: every corpus entry
 # point's whole run, tools/whole_run_bench.py; whole-runs-history.json: the same over the
-# backups of ../shared/krl-history), the fuzzers for their nightly budget
+# backups of ../shared/krl-history; variants.json: every variant of those backups run with --inputs
+# auto, interp/variants.py), the fuzzers for their nightly budget
 # (fuzz/), the tests marked slow (long sweeps; hypothesis with the nightly profile); dated
 # reports under reports/nightly/<date>/, then the history (reports/nightly/history.sqlite) and
 # the index with charts and the changes since the night before. Not part of `make test`.
@@ -153,12 +154,13 @@ nightly:
 	$(BIN)/python tools/whole_run_bench.py --json $$d/whole-runs.json > $$d/whole-runs.txt 2>> $$d/bench.log; \
 	$(BIN)/python tools/whole_run_bench.py --corpus $(SHARED_HISTORY) --json $$d/whole-runs-history.json \
 	  > $$d/whole-runs-history.txt 2>> $$d/bench.log; \
+	$(BIN)/python -m interp.variants --json $$d/variants.json > $$d/variants.txt 2>&1; v=$$?; tail -2 $$d/variants.txt; \
 	$(BIN)/python -m tests.fuzz.run --seconds $(FUZZ_SECONDS) --out $$d/fuzz; f=$$?; \
 	HYPOTHESIS_PROFILE=nightly $(BIN)/python -m pytest -q -n $(PYTEST_WORKERS) --dist loadgroup -p no:cacheprovider -m "slow or not slow" \
 	  > $$d/slow-tests.log 2>&1; t=$$?; tail -1 $$d/slow-tests.log; \
 	$(BIN)/python -m conformance.nightly reports/nightly || exit $$?; \
 	echo "nightly reports: $$d (index: reports/nightly/index.html; slow tests: $$d/slow-tests.log)"; \
-	[ $$c -eq 0 ] || exit $$c; [ $$f -eq 0 ] || exit $$f; exit $$t
+	[ $$c -eq 0 ] || exit $$c; [ $$f -eq 0 ] || exit $$f; [ $$v -eq 0 ] || exit $$v; exit $$t
 
 # The VS Code extension (editors/vscode, issue 25): `make vsix` writes editors/vscode/krl.vsix
 # (install: code --install-extension editors/vscode/krl.vsix). Node.js and npm come from PATH,

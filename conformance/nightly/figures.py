@@ -16,8 +16,9 @@ that a damaged file is skipped with a note):
 (krl bench --json), ``bench-parse.json`` (krl bench parse --json), ``limits.jsonl``
 (python -m robot.limits_bench), ``lsp-bench.json`` (python -m krl.lsp.bench --json),
 ``fuzz/summary.json`` (python -m tests.fuzz.run), ``whole-runs.json`` (tools/whole_run_bench.py:
-every corpus entry point with ``--inputs auto``, 600 s simulated) and ``whole-runs-history.json``
-(the same over the backups of ../shared/krl-history).
+every corpus entry point with ``--inputs auto``, 600 s simulated), ``whole-runs-history.json``
+(the same over the backups of ../shared/krl-history) and ``variants.json`` (python -m
+interp.variants: every generated variant of those backups, issue 59).
 """
 
 from __future__ import annotations
@@ -184,9 +185,26 @@ def _fuzz(day: Path, night: Night) -> None:
         _put(night, "fuzz.runs", s.get("runs"))
 
 
+def _variants(day: Path, night: Night) -> None:
+    """``variants.json`` (python -m interp.variants, issue 59): how many variants of the corpus's
+    and the history's backups ran, how many runs, how many ended by each cause, and the runs that
+    stopped on a name the checker classifies as installed software or failed internally (counts:
+    every change is flagged)."""
+    s = _json(day / "variants.json", night)
+    if not isinstance(s, dict) or not isinstance(s.get("summary"), dict):
+        return
+    summary = s["summary"]
+    for key in ("variants", "runs", "outside_stops", "internal"):
+        _put(night, f"variants.{key}", summary.get(key))
+    causes = summary.get("causes")
+    if isinstance(causes, dict):
+        for cause, n in causes.items():
+            _put(night, f"variants.cause.{str(cause).replace(' ', '_')}", n)
+
+
 def read_night(day: Path) -> Night:
     """The figures and items of the dated folder ``day`` (its name is the date)."""
     night = Night(day.name)
-    for part in (_conformance, _recovery, _check, _bench, _limits, _fuzz):
+    for part in (_conformance, _recovery, _check, _bench, _limits, _fuzz, _variants):
         part(day, night)
     return night

@@ -17,6 +17,7 @@ from pathlib import Path
 
 import pytest
 
+from conformance.nightly.figures import read_night
 from interp import variants as V
 from krl.archive import backup_source
 from krl.project import find_backups
@@ -44,7 +45,7 @@ def _backup(tmp: Path) -> Path:
     write(root, "R1/TP/Spot/spot.dat", "DEFDAT spot PUBLIC\n  DECL GLOBAL INT SPOTN=0\nENDDAT\n")
     write(root, "R1/TP/Spot/spot.src", "DEF spot( )\nEND\n")
     write(root, "R1/TP/Grip/grip.src", "DEF grip( )\nEND\n")
-    write(root, "R1/Mada/$machine.dat", "DEFDAT $MACHINE\nENDDAT\n")
+    write(root, "R1/Mada/$robcor.dat", "DEFDAT $ROBCOR\nENDDAT\n")
     write(root, "R1/Program/prog.src", "DEF prog( )\n  $OUT[1] = TRUE\nEND\n")
     write(root, "STEU/Mada/$custom.dat", "DEFDAT $CUSTOM\nENDDAT\n")
     assert find_backups(tmp) == [root]
@@ -56,7 +57,7 @@ def test_the_variants_of_a_backup(tmp_path):
     got = [(v.kind, v.detail) for v in V.variants_of(root)]
     assert got == [("whole", ""), ("no-TP", "R1/TP"), ("no-TP/", "R1/TP/Grip"), ("no-TP/", "R1/TP/Spot"),
                    ("no-package-dat", "R1/TP/Spot/spot.dat"), ("no-system", "R1/System/$config.dat"),
-                   ("no-system", "R1/System/sps.sub"), ("no-system", "R1/Mada/$machine.dat"),
+                   ("no-system", "R1/System/sps.sub"), ("no-system", "R1/Mada/$robcor.dat"),
                    ("config-user-part-missing", "R1/System/$config.dat"), ("program-only", ""),
                    ("tree", "flat"), ("zip", "")]
 
@@ -80,7 +81,7 @@ def test_each_variant_removes_or_reshapes_what_it_says(tmp_path):
     assert _made(by[("no-TP", "R1/TP")], out) == {f for f in whole if not f.startswith("R1/TP/")}
     assert _made(by[("no-TP/", "R1/TP/Spot")], out) == whole - {"R1/TP/Spot/spot.dat", "R1/TP/Spot/spot.src"}
     assert _made(by[("no-package-dat", "R1/TP/Spot/spot.dat")], out) == whole - {"R1/TP/Spot/spot.dat"}
-    assert _made(by[("no-system", "R1/Mada/$machine.dat")], out) == whole - {"R1/Mada/$machine.dat"}
+    assert _made(by[("no-system", "R1/Mada/$robcor.dat")], out) == whole - {"R1/Mada/$robcor.dat"}
     assert _made(by[("program-only", "")], out) == {"R1/Program/prog.src"}
     assert _made(by[("tree", "flat")], out) == {f[3:] if f.startswith("R1/") else f for f in whole}
     assert _made(by[("zip", "")], out) == {"KRC/" + f for f in whole}
@@ -131,3 +132,19 @@ def test_a_sample_of_the_variants_of_every_backup_ends_explained(record_property
     assert {v.kind for v in chosen} == set(V.KINDS)
     assert s["runs"] >= SAMPLE
     assert not s["failures"], s["failures"]
+
+
+def test_the_nightly_reads_the_counts_of_the_variants(tmp_path):
+    """make nightly writes variants.json (python -m interp.variants --json): its counts are figures
+    of the night, in its history (conformance/nightly)."""
+    day = tmp_path / "2026-11-26"
+    day.mkdir()
+    root = _backup(tmp_path / "src")
+    results = [V.run_variant(v) for v in V.variants_of(root)[:2]]
+    s = V.summarise(results)
+    assert V.main([str(tmp_path / "src"), "--sample", "2", "--jobs", "1", "--json", str(day / "variants.json")]) == 0
+    night = read_night(day)
+    # each variant: prog.src completes, the SPS.SUB cycles to the time limit (an intended end)
+    assert night.figures["variants.variants"] == 2 and night.figures["variants.runs"] == s["runs"] == 4
+    assert night.figures["variants.outside_stops"] == 0 and night.figures["variants.cause.completed"] == 2
+    assert night.figures["variants.cause.intended_end"] == 2
