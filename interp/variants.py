@@ -59,7 +59,7 @@ from krl.project import find_backups
 from krl.semantics.outside import template_lines
 from krl.source import is_krl_file
 
-__all__ = ["SIM_TIME_S", "STEPS", "Variant", "backups", "run_variant", "sample", "variants_of"]
+__all__ = ["SIM_TIME_S", "STEPS", "Variant", "backups", "run_variant", "sample", "some_entries", "variants_of"]
 
 #: the bound of each run: simulated seconds (a program that starves is fast-forwarded) and steps
 #: of the robot program (the step limit counts no submit program's)
@@ -214,19 +214,33 @@ def backups(folders: list[Path]) -> list[Path]:
 
 def sample(variants: list[Variant], n: int) -> list[Variant]:
     """`n` variants evenly spaced over `variants` (their order: by backup, then kind), always
-    one of each kind present first: a deterministic sample that covers every kind."""
+    one of each kind present first, the k-th kind's taken k/len(KINDS) of the way through its
+    variants (so that they come from different backups): a deterministic sample that covers
+    every kind."""
     if n >= len(variants):
         return list(variants)
-    first = {}
+    by_kind: dict = {}
     for v in variants:
-        first.setdefault(v.kind, v)
-    chosen = list(first.values())[:n]
+        by_kind.setdefault(v.kind, []).append(v)
+    chosen = [vs[len(vs) * k // len(KINDS)] for k, kind in enumerate(KINDS)
+              if (vs := by_kind.get(kind))][:n]
     rest = [v for v in variants if v not in chosen]
     k = n - len(chosen)
     if k > 0 and rest:
         step = len(rest) / k
         chosen += [rest[int(i * step)] for i in range(k)]
     return chosen
+
+
+def some_entries(entries: list[Path], n: int) -> list[Path]:
+    """`n` of `entries` (0: all): the submit interpreter's (``sps.sub``: it runs KUKA's folds and
+    the packages' PLC parts, what a variant removes first) and evenly spaced programs."""
+    if not n or n >= len(entries):
+        return entries
+    subs = [e for e in entries if e.suffix.lower() == ".sub"][:n]
+    rest = [e for e in entries if e not in subs]
+    k = n - len(subs)
+    return subs + [rest[int(i * len(rest) / k)] for i in range(k)] if k > 0 and rest else subs
 
 
 def _entries(folder: Path) -> list[Path]:
@@ -244,8 +258,10 @@ def _entries(folder: Path) -> list[Path]:
     return rp.folder_entries(files)
 
 
-def run_variant(variant: Variant, sim_time: float = SIM_TIME_S, steps: int = STEPS, interp: str = "vm") -> dict:
-    """Materialise `variant` and run every entry point of it (module docstring). Returns
+def run_variant(variant: Variant, sim_time: float = SIM_TIME_S, steps: int = STEPS, interp: str = "vm",
+                entries: int = 0) -> dict:
+    """Materialise `variant` and run every entry point of it (module docstring), or `entries` of
+    them (:func:`some_entries`; 0: all). Returns
     ``{"variant", "backup", "runs": [{"entry", "cause", "reason", "text", "outside_stops"}]}``;
     never raises for the material: an error of the simulator is a run with cause "internal"."""
     runs = []
@@ -253,7 +269,7 @@ def run_variant(variant: Variant, sim_time: float = SIM_TIME_S, steps: int = STE
         made = variant.make(Path(tmp))
         try:
             with backup_source(made) as (folder, _shown):
-                for entry in _entries(folder):
+                for entry in some_entries(_entries(folder), entries):
                     row = rp.run_one(entry, sim_time, steps, auto=True, interp=interp, auto_sim_time=sim_time)
                     internal = row["reason"] == "internal"
                     runs.append({"entry": entry.relative_to(folder).as_posix(),

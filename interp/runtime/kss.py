@@ -67,7 +67,7 @@ from .memory import Slot
 from .natives import REGISTRY
 from .natives.registry import NO_VALUE
 from .sysvars import sys_type
-from .values import UNSET, Arr, EnumValue, Struct, make_value, zero_value
+from .values import UNSET, Arr, EnumValue, Struct, copy_value, make_value, zero_value
 
 #: functions of KSS whose value in a simulation is documented: name -> (value, why), the
 #: stand-ins the natives registry declares with a ``value`` (interp/runtime/natives/packages.py)
@@ -112,16 +112,17 @@ class StandIn:
     why: str = ""
 
 
-def _zero(t, absent: str | None = None):
-    """The zero value of type `t`: FALSE, 0, 0.0, a structure or array of zeros; for an ENUM
-    `absent` (the stand-in ENUM's value for "not installed"), else :data:`NOT_INSTALLED` made
-    unequal to its literals; None for any other type."""
+def _zero(t, absent: str | int | None = None):
+    """The value of a stand-in of type `t`: FALSE, 0 (`absent` when it is an INT: an index,
+    :data:`FIRST_INDEX`), 0.0, a structure or array of zeros; for an ENUM `absent` (the stand-in
+    ENUM's value for "not installed"), else :data:`NOT_INSTALLED` made unequal to its literals;
+    None for any other type."""
     if isinstance(t, T.Enum):
         return EnumValue(absent or _not_installed(t.values), t)
     if t is T.BOOL:
         return False
     if t is T.INT:
-        return 0
+        return absent if isinstance(absent, int) else 0
     if t is T.REAL:
         return 0.0
     if isinstance(t, (T.Struc, T.Array)):
@@ -173,6 +174,25 @@ def _shown(v) -> str:
     return "its zero value"
 
 
+class StandInSlot(Slot):
+    """A stand-in variable. Its type is what its uses suggest, not what the missing software
+    declares, so it takes every value the program writes: one its type cannot hold makes it a
+    variable of that value's type (a name the checker classifies as installed software never
+    ends a run, issue 59: ``oFreqconverterCtlw = gsSpindleWord.WaitForCommand`` with the
+    package's data list removed assigns one stand-in's component to another)."""
+
+    __slots__ = ()
+
+    def set(self, v) -> None:
+        try:
+            Slot.set(self, v)
+        except KrlRuntimeError:
+            if v is UNSET:
+                raise                   # an unset value is the program's error, as for any variable
+            self.type = None
+            self.c[self.k] = copy_value(v)
+
+
 class SystemSoftware:
     """The stand-ins of one run (module docstring). ``uses``: name -> uses; ``standins``:
     name -> :class:`StandIn`, in order of first use."""
@@ -184,7 +204,7 @@ class SystemSoftware:
         self._refs: dict[str, Slot] = {}
         self._outside: dict | None = None
         self._types: dict | None = None
-        self._absent: dict[str, str] = {}       # UPPER name -> "not installed" of its stand-in ENUM
+        self._absent: dict[str, str | int] = {}  # UPPER name -> "not installed" of its stand-in ENUM, or 1 (an index)
         #: id(main routine) -> name, of the standard programs of :data:`STANDARD` the run loaded
         self.standard: dict[int, str] = {}
         files = {str(f): name for name, f in STANDARD.items()}
@@ -263,7 +283,7 @@ class SystemSoftware:
             why = ("KUKA's BASIS declares it in $config.dat (krl/semantics/data/types.yaml basis), which "
                    "the program's files do not hold")
         t, v = self._typed_zero(key, declared)
-        ref = self._refs[key] = Slot({"V": v}, "V", t, name)
+        ref = self._refs[key] = StandInSlot({"V": v}, "V", t, name)
         shown = f"reads {_shown(v)}"
         if isinstance(v, EnumValue):
             others = sorted(x for x in t.values if x != v.name)
@@ -377,6 +397,10 @@ class SystemSoftware:
 
 
 # ---------------------------------------------------------------------- use types
+#: the value of a stand-in a use takes as an array index (``$CYCFLAG[cycEmStop]`` with the
+#: package's data list removed): every KRL array begins at 1, 0 is an index of none
+FIRST_INDEX = 1
+
 #: a dimension of a stand-in array that a use indexes with a value only the run knows (a FOR
 #: counter): the size it gets (its constant indices may ask for more). KRL arrays have the size
 #: their declaration gives, and the declaration is what the backup lacks: a decision (docs/robot.md)
@@ -385,16 +409,18 @@ STANDIN_DIM = 256
 
 class _Shape:
     """What the uses of an unresolved name (or of one of its components or elements) say of its
-    type: ``t`` the type they give it (the other operand's, the statement's, a parameter's),
+    type: ``t`` the type they give it (BOOL when one is a condition, INT an index: ``index``;
+    else the first other operand's, assigned value's or parameter's type, REAL over INT),
     ``literals`` the ENUM literals they compare it with, assign to it or switch on, ``dims`` the
     largest constant index of each dimension it is indexed with (negative: also indexed by a
     value only the run knows) and ``elem`` the shape of its elements, ``fields`` the shapes of
     the components selected from it."""
 
-    __slots__ = ("t", "literals", "dims", "elem", "fields")
+    __slots__ = ("t", "index", "literals", "dims", "elem", "fields")
 
     def __init__(self) -> None:
         self.t = None
+        self.index = False
         self.literals: set = set()
         self.dims: list | None = None
         self.elem: "_Shape | None" = None
@@ -450,6 +476,14 @@ def _note(shape, t) -> None:
         shape.t = t
 
 
+def _cond(shape) -> None:
+    """A use as a condition (IF, WHILE, NOT, AND ...): BOOL, whatever other uses say (a
+    condition of another type is an error, an assignment of another type is not:
+    :class:`StandInSlot`)."""
+    if shape is not None:
+        shape.t = T.BOOL
+
+
 def _literal(shape, e) -> None:
     """An ENUM literal `e` compared with, assigned to or switched on by an unresolved name (when
     its type is an ENUM the backup does not declare: :func:`standin_enum`)."""
@@ -493,7 +527,8 @@ def kuka_names(program) -> dict:
 
 
 def _use_types_of(program) -> tuple[dict, dict]:
-    """(UPPER name -> type, UPPER name -> "not installed" literal of its stand-in ENUM) of
+    """(UPPER name -> type, UPPER name -> "not installed" literal of its stand-in ENUM or
+    :data:`FIRST_INDEX` for an index) of
     :meth:`SystemSoftware.use_types`: a walk over every file of `program`'s checked workspace
     (0.22 s on a KRC backup), made once per workspace (Program.derived); read-only. A name its
     uses index is an array, one they select components from a structure (:func:`_typed`)."""
@@ -515,11 +550,12 @@ def _use_types_of(program) -> tuple[dict, dict]:
 
 
 def _typed(name: str, shape: _Shape) -> tuple:
-    """(type, "not installed" literal or None) of a stand-in from its `shape`: an array of its
+    """(type, "not installed" literal, :data:`FIRST_INDEX` or None) of a stand-in from its
+    `shape`: an array of its
     elements' type (each dimension as large as its largest constant index, at least
     :data:`STANDIN_DIM` when a value only the run knows indexes it too), a structure of its
-    components' types, else the type its uses give it, else a stand-in ENUM of the literals
-    they name; (None, None) when they say nothing."""
+    components' types, else the type its uses give it (INT reading 1 for an index), else a
+    stand-in ENUM of the literals they name; (None, None) when they say nothing."""
     if shape.dims is not None:
         elem = _typed(name, shape.elem)[0] if shape.elem is not None else None
         dims = tuple(d if d > 0 else max(STANDIN_DIM, -d) for d in shape.dims)
@@ -531,7 +567,7 @@ def _typed(name: str, shape: _Shape) -> tuple:
             fields[comp] = (comp, ft if ft is not None else T.INT)
         return T.Struc(f"{name} (stand-in STRUC)", fields), None
     if shape.t is not None:
-        return shape.t, None
+        return shape.t, (FIRST_INDEX if shape.index else None)
     if shape.literals:
         return standin_enum(name, shape.literals)
     return None, None
@@ -544,15 +580,19 @@ def _infer(module: N.Module, shapes: dict, ws=None) -> None:
         node = stack.pop()
         if isinstance(node, (N.Index, N.Field)):
             _shape_of(shapes, node)         # an element or a component: its name's shape
+            for i in node.indices if isinstance(node, N.Index) else ():
+                index = _shape_of(shapes, i) if i is not None else None
+                if index is not None:       # an index: INT, whatever other uses say, reading 1
+                    index.t, index.index = T.INT, True
         elif isinstance(node, (N.If, N.While, N.Repeat, N.WaitFor)):
-            _note(_shape_of(shapes, node.cond), T.BOOL)
+            _cond(_shape_of(shapes, node.cond))
         elif isinstance(node, N.Unary) and node.op == "NOT":
-            _note(_shape_of(shapes, node.operand), T.BOOL)
+            _cond(_shape_of(shapes, node.operand))
         elif isinstance(node, N.Binary):
             left, right = _shape_of(shapes, node.left), _shape_of(shapes, node.right)
             if node.op in _BOOL_OPS:
-                _note(left, T.BOOL)
-                _note(right, T.BOOL)
+                _cond(left)
+                _cond(right)
             else:
                 _note(left, _type_of(node.right))
                 _note(right, _type_of(node.left))

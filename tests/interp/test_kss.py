@@ -424,3 +424,32 @@ def test_chk_home_says_the_robot_is_not_home(tmp_path):
         "for the robot in its home position ($H_POS, within $H_POS_TOL): WHILE NOT $IN_HOME") for ln in lines), \
         out.output
     assert "  answer     --start XHOME, or the cell file's `start: XHOME`" in lines
+
+
+@pytest.mark.parametrize("interp", INTERPS)
+def test_a_stand_in_takes_every_value_the_program_writes(tmp_path, interp):
+    """Found by the variants (a history backup of HugoDanielson__ChinaMilling without the Milling
+    package's data list: ``oFreqconverterCtlw = gsSpindleWord.WaitForCommand`` stopped the SPS
+    on "cannot assign 0 to OFREQCONVERTERCTLW (stand-in ENUM)"). A stand-in's type is what its
+    uses suggest, not a declaration: a value it cannot hold makes it that value's variable, and
+    the run goes on (a name the checker classifies as installed software never ends a run)."""
+    prog = _backup(tmp_path, "DEF weld()\n  ;FOLD INI\n  ARC_STATE = ARC_CFG.MODE\n  IF ARC_ON THEN\n"
+                             "    $OUT[2] = TRUE\n  ENDIF\n  ARC_ON = 5\n  ;ENDFOLD (INI)\n"
+                             "  $OUT[1] = TRUE\nEND\n")
+    rt, res, events = _run(prog, interp)
+    assert res.reason == "completed", res.text
+    assert [(e["signal"], e["value"]) for e in events if e["kind"] == "io"] == [("$OUT[1]", True)]
+    assert rt.kss.name_ref("ARC_STATE").get() == 0 and rt.kss.name_ref("ARC_ON").get() == 5
+
+
+@pytest.mark.parametrize("interp", INTERPS)
+def test_a_stand_in_used_as_an_index_reads_the_first_index(tmp_path, interp):
+    """Found by the variants (the same backup: ``$CYCFLAG[cycEmStop] = ...`` in the package's
+    submit routine, its data list removed): an index is INT whatever other uses say, and reads
+    1, the first index of every KRL array (0 is an index of none)."""
+    prog = _backup(tmp_path, "DEF weld()\n  ;FOLD INI\n  $CYCFLAG[CYC_STOP] = NOT $ALARM_STOP\n"
+                             "  CYC_STOP = CYC_OTHER\n  ;ENDFOLD (INI)\n  $OUT[1] = TRUE\nEND\n")
+    rt, res, events = _run(prog, interp)
+    assert res.reason == "completed", res.text
+    notes = [e["text"] for e in events if e["kind"] == "message"]
+    assert any(n.startswith("stub: CYC_STOP (variable") and n.endswith("reads 1") for n in notes), notes
