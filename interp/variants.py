@@ -321,12 +321,15 @@ def main(argv: list[str] | None = None) -> int:
         variants = sample(variants, args.sample)
     tasks = [(k, (str(v.backup), v.kind, v.detail, SIM_TIME_S, STEPS, args.interp)) for k, v in enumerate(variants)]
     results: list = [None] * len(variants)
-    for o in run_tasks(_task, tasks, jobs=args.jobs):
+    for done, o in enumerate(run_tasks(_task, tasks, jobs=args.jobs), 1):
         v = variants[o.key]
         results[o.key] = o.value if o.status == "done" else {
             "variant": v.name, "kind": v.kind, "backup": str(v.backup),
             "runs": [{"entry": "", "cause": "internal", "reason": "internal", "text": o.detail or o.status,
                       "outside_stops": []}]}
+        failing = summarise([results[o.key]])["failures"]
+        print(f"[{done}/{len(tasks)}] {v.backup} [{v.name}]: {len(results[o.key]['runs'])} runs"
+              + (f", {len(failing)} failing" if failing else ""), file=sys.stderr, flush=True)
     s = summarise(results)
     print(f"variants {s['variants']} of {len(backups(folders))} backups, runs {s['runs']}: "
           + ", ".join(f"{k} {n}" for k, n in s["causes"].items()))

@@ -839,6 +839,11 @@ class Controller:
             return T
         return self.model.tcp(q, tool_T, base_inv_T)
 
+    def axis_vel_act(self) -> np.ndarray:
+        """The axes' velocities over the last IPO cycle in KRL's order (A1..A6 deg/s, then
+        E1..En deg/s or mm/s): the source of ``$VEL_AXIS_ACT`` (interp/runtime/sysvars.py)."""
+        return self.model.to_krl((self._q - self._q_prev) / self.dt)
+
     def vel_act(self) -> float:
         """``$VEL_ACT``: TCP speed in m/s over the last IPO cycle."""
         return float(np.linalg.norm(self._tcp_T[:3, 3] - self._tcp_prev)) / self.dt / 1000.0

@@ -285,6 +285,12 @@ class Scheduler:
         ctl = rt.controller
         robot = self.tasks[0]
         spin = self.spin
+        # the first cycle resumes the submit tasks before the robot program: on a controller the
+        # submit interpreter runs from boot (custom.dat), long before the operator starts a
+        # program, so the robot program's first statement finds the submit program's first
+        # statements done (OsmanMarangoz's motion_eki.src reads META_VELOCITY_OVERRIDE, which
+        # its meta_eki.sub sets; docs/architecture.md, "The submit interpreter's pace")
+        order = self.tasks[1:] + self.tasks[:1]
         while True:
             steady = self._steady()
             if steady == 1:
@@ -299,7 +305,7 @@ class Scheduler:
             if steady == 2:
                 self._steady_cycle(False)   # the robot stands: the rest of the cycle as always
             else:
-                for task in list(self.tasks):
+                for task in order or list(self.tasks):
                     if not task.done and self.stop is None:
                         steps = rt.steps
                         if spin.resuming(task):
@@ -310,6 +316,7 @@ class Scheduler:
                         self._resume(task)
                         if task.done and task is not robot:
                             rt.submit_finished(task)
+            order = None
             if spin.shadowed:
                 spin.check_shadows()
             if robot.done or self.stop is not None:

@@ -99,7 +99,7 @@ PURE_NATIVES = frozenset(name for name, native in REGISTRY.items() if native.pur
 
 #: system variables whose value the main run changes as the robot moves (interp/runtime/sysvars.py
 #: ``_LIVE``): a pass that reads one is parked only while the main run is idle
-MOTION_NAMES = frozenset({"$POS_ACT", "$POS_ACT_MES", "$AXIS_ACT", "$AXIS_ACT_MEAS", "$VEL_ACT",
+MOTION_NAMES = frozenset({"$POS_ACT", "$POS_ACT_MES", "$AXIS_ACT", "$AXIS_ACT_MEAS", "$VEL_ACT", "$VEL_AXIS_ACT",
                           "$PRO_MOVE", "$IN_HOME", "$IN_HOME1", "$IN_HOME2", "$IN_HOME3", "$IN_HOME4",
                           "$IN_HOME5"})
 #: the I/O image's system variables: they change between steps only at the controller's events
@@ -111,7 +111,7 @@ IO_NAMES = frozenset({"$IN", "$OUT", "$ANIN", "$ANOUT", "$TIMER", "$TIMER_STOP",
 #: ``$TRACE`` (KUKA Trace's state) changes only when a statement writes its MODE.
 STATE_NAMES = frozenset({"$PRO_STATE", "$PRO_STATE0", "$PRO_STATE1", "$PRO_ACT", "$MODE_OP", "$T1",
                          "$T2", "$AUT", "$EXT", "$I_O_ACTCONF", "$INTERPRETER", "$COULD_START_MOTION",
-                         "$ERR", "$NULLFRAME", "$POS_INT", "$AXIS_INT", "$TRACE"})
+                         "$ERR", "$NULLFRAME", "$POS_INT", "$AXIS_INT", "$TRACE", "$TORQUE_AXIS_ACT"})
 
 #: the statements a spin may execute (module docstring)
 ALLOWED = (N.Assign, N.CallStmt, N.If, N.Switch, N.For, N.While, N.Repeat, N.Loop, N.Exit, N.Goto,

@@ -32,7 +32,7 @@ from robot.motion import MotionParams
 from .convert import frame_tuple
 from .errors import value_invalid
 from .memory import ComputedRef, Slot
-from .values import EnumValue, Struct, make_value, zero_value
+from .values import UNSET, Arr, EnumValue, Struct, make_value, zero_value
 from .writerules import WriteHook
 
 
@@ -209,6 +209,26 @@ class SysVars:
                 for k, x in values.items():
                     if k in v.f:
                         v.f[k] = float(x)
+        self.drive_values()
+
+    def drive_values(self) -> None:
+        """``$VEL_AXIS_MA`` (rated motor speed, rpm) and ``$RAT_MOT_AX`` (gear ratio {N, D}) of
+        each axis from the simulated robot's machine data (robot/data/kr6_r900.yaml
+        ``machine_data_kinematics``, cited from a $machine.dat), where nothing set them: in a
+        backup the Mada data list declares its own (the program reads those); a folder without
+        one read "value invalid" although its robot has them (OsmanMarangoz's motion_eki.src
+        computes its joints' top speed from them, issue 59)."""
+        md = (getattr(self.rt.controller.machine, "raw", None) or {}).get("machine_data_kinematics") or {}
+        rpm, ratios = md.get("vel_axis_ma_rpm") or (), md.get("rat_mot_ax_n_d") or ()
+        vel, rat = self.store.get("$VEL_AXIS_MA"), self.store.get("$RAT_MOT_AX")
+        for i, x in enumerate(rpm):
+            if vel is not None and i < len(vel.data) and vel.data[i] is UNSET:
+                vel.data[i] = float(x)
+        for i, (n, d) in enumerate(ratios):
+            if rat is not None and i < len(rat.data) and isinstance(rat.data[i], Struct):
+                f = rat.data[i].f
+                if f.get("N") is UNSET and f.get("D") is UNSET:
+                    f["N"], f["D"] = int(n), int(d)
 
     # ------------------------------------------------------------------ lookup
     def lookup(self, name: str):
@@ -529,6 +549,43 @@ def _machine_const(fn):
     return value
 
 
+def _vel_axis_act(sv: SysVars) -> Arr:
+    """``$VEL_AXIS_ACT[1..12]``: each axis's velocity over the last IPO cycle in percent of its
+    top speed, which the controller derives from ``$VEL_AXIS_MA`` and ``$RAT_MOT_AX`` (KUKA
+    System Variables: "current axis speeds in %"; robot/machine.py ``max_speed_deg_s``), signed;
+    0 for an axis the robot does not have."""
+    ctl = sv.rt.controller
+    m = ctl.machine
+    top = m.all_max_speed
+    vel = ctl.axis_vel_act()
+    data = [0.0] * 12
+    for i, v in enumerate(vel[:12]):
+        k = i if i < 6 else m.n_axes + (i - 6)     # KRL order: A1..A6, E1..; the model's: A1..An, E1..
+        if k < len(top) and top[k] > 0:
+            data[i] = float(v) / top[k] * 100.0
+    return Arr(T.Array(T.REAL, (12,)), (12,), data)
+
+
+def _torque_axis_act(sv: SysVars) -> Arr:
+    """``$TORQUE_AXIS_ACT[1..12]``: the simulator has no model of the drives, so every axis
+    reads 0.0 (Nm), one "not simulated" note per run saying so (as for a variable only KSS's
+    system files declare: :meth:`SysVars._unsimulated`). A program that streams it to a partner
+    (OsmanMarangoz's motion_eki.src, issue 59) runs on instead of stopping on "value invalid"."""
+    if name_noted(sv, "$TORQUE_AXIS_ACT"):
+        sv.rt.message("not simulated: system variable $TORQUE_AXIS_ACT (the simulator has no drive "
+                      "model): reads 0.0")
+    return Arr(T.Array(T.REAL, (12,)), (12,), [0.0] * 12)
+
+
+def name_noted(sv: SysVars, name: str) -> bool:
+    """True the first time `name` is asked about in the run (its note is due), False after."""
+    noted = sv.__dict__.setdefault("_noted", set())
+    if name in noted:
+        return False
+    noted.add(name)
+    return True
+
+
 #: the default window of ``$IN_HOME``/``$IN_HOME1..5`` (``$H_POS_TOL``, ``$H_AXIS_TOL[n]``), deg
 HOME_TOL_DEG = 2.0
 
@@ -565,6 +622,8 @@ _LIVE = {
     "$POS_INT": _computed(_pos_int),
     "$AXIS_INT": _computed(_axis_int),
     "$VEL_ACT": _computed(lambda sv: float(sv.rt.controller.vel_act())),
+    "$VEL_AXIS_ACT": _computed(lambda sv: _vel_axis_act(sv)),
+    "$TORQUE_AXIS_ACT": _computed(lambda sv: _torque_axis_act(sv)),
     "$DATE": _computed(_clock(_date)),
     "$PRO_STATE": _computed(_pro_state_self),
     "$PRO_STATE0": _computed(_pro_state(False)),
