@@ -623,6 +623,10 @@ _LIVE = {
     "$AXIS_INT": _computed(_axis_int),
     "$VEL_ACT": _computed(lambda sv: float(sv.rt.controller.vel_act())),
     "$VEL_AXIS_ACT": _computed(lambda sv: _vel_axis_act(sv)),
+    # the motions the advance run has planned that the main run has not begun (KUKA System
+    # Variables: "$ACT_ADVANCE: number of motion blocks currently planned in the advance run",
+    # 0..$ADVANCE); shenrq20's kuka_eki_hw_interface streams it to its partner (issue 59)
+    "$ACT_ADVANCE": _computed(lambda sv: int(sv.rt.controller.queue_length())),
     "$TORQUE_AXIS_ACT": _computed(lambda sv: _torque_axis_act(sv)),
     "$DATE": _computed(_clock(_date)),
     "$PRO_STATE": _computed(_pro_state_self),

@@ -131,3 +131,64 @@ def test_tingelst_kuka_eki(shared_corpus, interp):
     assert np.allclose([float(last.get(k)) for k in "XYZABC"], tcp, atol=1e-4)
     assert np.allclose(pos, tcp, atol=1e-4)
     assert len(net_events(trace, iface="eki", dir="connect")) == 2
+
+
+SHENRQ20 = "shenrq20__VisionSoftware/src/device/kuka_eki_hw_interface/krl/kuka_eki_hw_interface.src"
+
+
+@pytest.mark.parametrize("interp", ["tree", "vm"])
+def test_shenrq20_eki_hw_interface(shared_corpus, interp):
+    """shenrq20's VisionSoftware: a modified kuka_eki_hw_interface (issue 59) whose channel XML,
+    kept beside it in its repository (restated in tests/net/configs/shenrq20), takes
+    RobotCommand/@ControlType, @MovingType, @CoordinateType and Pos (X..C or A1..A6) over UDP and
+    streams RobotState (ProMove, MovingStatus, Pos). The partner knows only the XML's elements:
+    a configuration command (ControlType 0: OvPro 50), then an axis target (ControlType 1,
+    MovingType 1, CoordinateType 1: the XML's Pos A1..A6), then a Cartesian LIN (MovingType 0,
+    CoordinateType 0) to the pose the robot reported there, moved 50 mm in Z; it reads the state
+    stream until the robot stands at each. It sends a command after a state has come back: the
+    program takes the newest command and empties the rest (its EKI_ClearBuffer of RobotCommand
+    after each), so the move sent together with the configuration would be lost, as on a
+    controller."""
+    target = [15.0, -85.0, 95.0, 5.0, 35.0, -20.0]
+    conf = CONFIGS / "shenrq20"
+    settings = NetworkSettings(conf, eki={"EKIHWINTERFACE": Channel(conf / "EkiHwInterface.xml", ("127.0.0.1", 0))})
+
+    def partner(net, rt):
+        addr = net.wait_address("eki:EkiHwInterface")
+        u = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+        u.settimeout(10)
+
+        def send(**attrs):
+            cmd = ET.Element("RobotCommand", {k: str(v) for k, v in attrs.items() if k != "pos"})
+            ET.SubElement(cmd, "Pos", {k: str(v) for k, v in attrs.get("pos", {}).items()})
+            u.sendto(ET.tostring(cmd), addr)
+
+        def until(done, deadline):
+            while time.monotonic() < deadline:
+                doc = ET.fromstring(u.recvfrom(65536)[0])
+                if done(doc):
+                    return doc
+            raise TimeoutError
+
+        deadline = time.monotonic() + 60
+        send(ControlType=0, OvPro=50)
+        until(lambda d: True, deadline)     # one command a state: the robot keeps the newest only
+        send(ControlType=1, MovingType=1, CoordinateType=1, pos=dict(zip(AXES, target)))
+        at_axes = until(lambda d: np.allclose([float(d.find("Pos").get(a)) for a in AXES], target, atol=1e-3)
+                        and d.get("ProMove") == "FALSE", deadline)
+        pose = {k: float(at_axes.find("Pos").get(k)) for k in "XYZABC"}
+        goal = dict(pose, Z=pose["Z"] + 50.0)
+        send(ControlType=1, MovingType=0, CoordinateType=0, pos=goal)
+        at_pose = until(lambda d: np.allclose([float(d.find("Pos").get(k)) for k in "XYZ"],
+                                              [goal[k] for k in "XYZ"], atol=1e-3)
+                        and d.get("ProMove") == "FALSE", deadline)
+        u.close()
+        return at_axes, at_pose, goal
+
+    box: dict = {}
+    result, trace, (at_axes, at_pose, goal) = run_with_partner(shared_corpus / SHENRQ20, settings, partner,
+                                                               interp=interp, box=box)
+    assert result.reason == "max_sim_time"
+    assert box["rt"].sysvars.lookup("$OV_PRO").get() == 50
+    assert {k: float(at_pose.find("Pos").get(k)) for k in "XYZABC"} == pytest.approx(goal, abs=1e-3)
+    assert at_axes.get("AdvanceVal") is not None and at_pose.find("Pos").get("A1") is not None
