@@ -27,7 +27,9 @@ class Run:
 
 
 def write(tmp: Path, name: str, text: str) -> Path:
+    """Write `text` (dedented) to ``tmp/name``, making its folders."""
     p = tmp / name
+    p.parent.mkdir(parents=True, exist_ok=True)
     p.write_text(textwrap.dedent(text).lstrip("\n"), encoding="utf-8")
     return p
 

@@ -99,8 +99,6 @@ ENDDAT
 def _spot_backup(tmp: Path) -> Path:
     """A backup without TP/: $config.dat declares nothing of SpotTech; every module's data list
     declares USERSPOT by EXT, and nothing defines it."""
-    for d in ("R1/System", "R1/Program"):
-        (tmp / d).mkdir(parents=True, exist_ok=True)
     write(tmp, "R1/System/$config.dat", "DEFDAT $CONFIG\nENDDAT\n")
     write(tmp, "R1/Program/pick.src", PICK_SRC)
     write(tmp, "R1/Program/pick.dat", PICK_DAT)
@@ -187,8 +185,6 @@ END
 
 
 def _plc_backup(tmp: Path) -> Path:
-    for d in ("R1/System", "R1/Program"):
-        (tmp / d).mkdir(parents=True, exist_ok=True)
     write(tmp, "R1/System/$config.dat", CONFIG_USER)
     write(tmp, "R1/System/sps.sub", SPS_USER_PLC)
     return write(tmp, "R1/Program/prog.src", "DEF prog( )\n  WAIT SEC 0.5\n  $OUT[1] = TRUE\nEND\n")

@@ -49,8 +49,6 @@ END
 
 def _backup(tmp: Path, program: str, config: str = "DEFDAT $CONFIG\nENDDAT\n", name="weld.src",
             files: dict | None = None) -> Path:
-    for d in ("R1/System", "R1/Program"):
-        (tmp / d).mkdir(parents=True, exist_ok=True)
     write(tmp, "R1/System/$config.dat", config)
     for f, text in (files or {}).items():
         write(tmp, f, text)

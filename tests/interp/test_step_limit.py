@@ -59,8 +59,6 @@ END
 
 
 def _counting_cell(tmp: Path) -> Path:
-    for d in ("R1/System", "R1/Program"):
-        (tmp / d).mkdir(parents=True, exist_ok=True)
     write(tmp, "R1/System/$config.dat",
           "DEFDAT $CONFIG\n;FOLD USER GLOBALS\nDECL INT N_PASS = 0\n;ENDFOLD (USER GLOBALS)\nENDDAT\n")
     write(tmp, "R1/System/sps.sub", SPS_COUNTS)

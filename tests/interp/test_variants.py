@@ -25,12 +25,7 @@ from krl.archive import backup_source
 from krl.project import find_backups
 from tests.conftest import SHARED_CORPUS, SHARED_HISTORY
 
-from .helpers import write as _write
-
-
-def write(folder: Path, name: str, text: str) -> Path:
-    (folder / name).parent.mkdir(parents=True, exist_ok=True)
-    return _write(folder, name, text)
+from .helpers import write
 
 #: variants of the sample run in ``make test`` (one of each kind), and entry points of each
 SAMPLE = len(V.KINDS)

@@ -4,7 +4,9 @@ thread over loopback, and stop the run when the partner is done."""
 
 from __future__ import annotations
 
+import socket
 import threading
+import time
 from pathlib import Path
 
 from interp.run import make_runtime
@@ -18,6 +20,27 @@ EXAMPLES = HERE.parents[1] / "examples" / "network"     # the runnable examples 
 
 class PartnerFailed(AssertionError):
     pass
+
+
+def free_port() -> int:
+    """A TCP port of the loopback free now (the channel's place, given before the run)."""
+    s = socket.socket()
+    s.bind(("127.0.0.1", 0))
+    port = s.getsockname()[1]
+    s.close()
+    return port
+
+
+def connect(port: int, deadline: float) -> socket.socket:
+    """A TCP connection to the robot's server on `port` of the loopback, tried until it
+    listens (the program opens its channel when it gets there) or `deadline` (monotonic)."""
+    while True:
+        try:
+            return socket.create_connection(("127.0.0.1", port), timeout=5)
+        except OSError:
+            if time.monotonic() > deadline:
+                raise
+            time.sleep(0.05)
 
 
 def run_with_partner(program, settings, partner, *, interp: str = "tree", max_sim_time: float = 60.0,

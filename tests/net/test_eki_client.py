@@ -28,19 +28,11 @@ from net.settings import Channel, NetworkSettings
 from robot.machine import library_robots
 from robot.trace import TraceWriter
 
-from .helpers import CONFIGS, PROGRAMS, net_events, run_with_partner
+from .helpers import CONFIGS, PROGRAMS, free_port, net_events, run_with_partner
 
 APP1B = "WeiminZhang__Kuka_Robot_Control_through_LAN/Kuka/app1b.src"
 ROBOT = "kr180_r3200_pa"
 DT = 0.012
-
-
-def _free_port() -> int:
-    s = socket.socket()
-    s.bind(("127.0.0.1", 0))
-    port = s.getsockname()[1]
-    s.close()
-    return port
 
 
 def _documents(conn, root: bytes, deadline: float):
@@ -114,7 +106,7 @@ def test_a_client_library_sends_right_after_eki_open(shared_corpus, interp):
 def test_a_client_without_its_server_stops_after_timeout_connect(shared_corpus, interp):
     """app1b with nothing listening: EKI_Open waits TIMEOUT Connect (2000 ms by default) of the
     controller's clock and stops the program with KUKA's EKI00014 at its line."""
-    port = _free_port()
+    port = free_port()
     settings = NetworkSettings(CONFIGS, eki={"CONFIGAPP1": Channel(CONFIGS / "ConfigApp1.xml", ("127.0.0.1", port))})
     trace = TraceWriter(keep=True)
     rt, _ = make_runtime(shared_corpus / APP1B, network=settings, trace=trace, max_sim_time=20.0,
@@ -150,7 +142,7 @@ def test_timeout_with_messages_not_displayed_and_an_interrupt_while_waiting(inte
     """The probe's channel has TIMEOUT Connect 1000 ms and no message display: EKI_Open gives
     Msg_No 14, Connected FALSE, and the program goes on. The timer interrupt that came due
     100 ms into the wait ran after EKI_Open had returned (it saw Msg_No 14)."""
-    port = _free_port()
+    port = free_port()
     settings = NetworkSettings(PROGRAMS, eki={"CLIENT": Channel(PROGRAMS / "Client.xml", ("127.0.0.1", port))})
     result, trace, v = _probe(interp, settings)
     assert result.reason == "completed", result.text
@@ -167,7 +159,7 @@ def test_a_server_that_starts_late_is_connected_within_the_timeout(interp):
     """Nothing listens when EKI_Open starts: its first attempt is refused. The partner starts
     listening then, and the waiting EKI_Open connects at its next attempt, 8 IPO cycles later
     (a refused attempt is tried again while it waits, up to TIMEOUT Connect)."""
-    port = _free_port()
+    port = free_port()
     settings = NetworkSettings(PROGRAMS, eki={"CLIENT": Channel(PROGRAMS / "Client.xml", ("127.0.0.1", port))})
 
     def partner(net, rt):

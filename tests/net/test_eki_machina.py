@@ -10,7 +10,6 @@ speed, a digital output (the driver makes it a TRIGGER on the next motion), two 
 
 from __future__ import annotations
 
-import socket
 import time
 import xml.etree.ElementTree as ET
 
@@ -18,7 +17,7 @@ import pytest
 
 from net.settings import Channel, NetworkSettings
 
-from .helpers import CONFIGS, run_with_partner
+from .helpers import CONFIGS, connect, free_port, run_with_partner
 
 PROGRAM = "RobotExMachina__Machina.NET/src/Machina/Resources/DriverModules/KUKA/machina_kuka_driver.src"
 MACHINA = CONFIGS / "machina"
@@ -42,30 +41,15 @@ def _dt(actions: list) -> bytes:
     return ET.tostring(dt)
 
 
-def _free_port() -> int:
-    probe = socket.socket()
-    probe.bind(("127.0.0.1", 0))
-    port = probe.getsockname()[1]
-    probe.close()
-    return port
-
-
 @pytest.mark.parametrize("interp", ["tree", "vm"])
 def test_the_machina_driver_runs_the_actions_of_a_partner_written_from_its_xml(shared_corpus, interp):
-    port = _free_port()
+    port = free_port()
     settings = NetworkSettings(MACHINA, eki={
         "MACHINA_KUKA_SERVER": Channel(MACHINA / "machina_kuka_server.xml", ("127.0.0.1", port))})
 
     def bridge(net, rt):
         deadline = time.monotonic() + 60
-        while True:
-            try:
-                conn = socket.create_connection(("127.0.0.1", port), timeout=5)
-                break
-            except OSError:
-                if time.monotonic() > deadline:
-                    raise
-                time.sleep(0.05)
+        conn = connect(port, deadline)
         conn.settimeout(60)
         buf = bytearray()
 

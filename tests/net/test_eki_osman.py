@@ -17,7 +17,6 @@ partner waits for the position as well.)"""
 
 from __future__ import annotations
 
-import socket
 import time
 import xml.etree.ElementTree as ET
 
@@ -25,29 +24,11 @@ import pytest
 
 from net.settings import Channel, NetworkSettings
 
-from .helpers import CONFIGS, run_with_partner
+from .helpers import CONFIGS, connect, free_port, run_with_partner
 
 REPO = "OsmanMarangoz__2526ws_BH_KRL2Python/KRL"
 OSMAN = CONFIGS / "osman"
 TARGET = {"A1": 20.0, "A2": -80.0, "A3": 75.0, "A4": 10.0, "A5": 30.0, "A6": -15.0}
-
-
-def _free_port() -> int:
-    probe = socket.socket()
-    probe.bind(("127.0.0.1", 0))
-    port = probe.getsockname()[1]
-    probe.close()
-    return port
-
-
-def _connect(port: int, deadline: float) -> socket.socket:
-    while True:
-        try:
-            return socket.create_connection(("127.0.0.1", port), timeout=5)
-        except OSError:
-            if time.monotonic() > deadline:
-                raise
-            time.sleep(0.05)
 
 
 def _states(conn, deadline: float):
@@ -85,16 +66,16 @@ def _command(**values) -> ET.Element:
 
 @pytest.mark.parametrize("interp", ["tree", "vm"])
 def test_the_motion_and_meta_channels_answer_partners_written_from_their_xml(shared_corpus, interp):
-    motion, meta = _free_port(), _free_port()
+    motion, meta = free_port(), free_port()
     settings = NetworkSettings(OSMAN, eki={
         "MOTION_EKI": Channel(OSMAN / "MOTION_EKI.xml", ("127.0.0.1", motion)),
         "META_EKI": Channel(OSMAN / "META_EKI.xml", ("127.0.0.1", meta))})
 
     def python_side(net, rt):
         deadline = time.monotonic() + 90
-        m = _connect(meta, deadline)
+        m = connect(meta, deadline)
         m.sendall(b'<MetaCommand VelocityOverride="40" AbortCommands="FALSE"/>')
-        conn = _connect(motion, deadline)
+        conn = connect(motion, deadline)
         conn.settimeout(60)
         states = _states(conn, deadline)
         first = next(states)

@@ -16,7 +16,6 @@ does the run (the program's error with its published configuration, as on a cont
 
 from __future__ import annotations
 
-import socket
 import time
 import xml.etree.ElementTree as ET
 
@@ -24,19 +23,9 @@ import pytest
 
 from net.settings import Channel, NetworkSettings
 
-from .helpers import CONFIGS, run_with_partner
+from .helpers import CONFIGS, connect, free_port, run_with_partner
 
 PROGRAM = "LiorSkoury-git__Kuka_EthernetKrl_Python/KRL/ethernetkrl_workshop.src"
-
-
-def _connect(port: int, deadline: float) -> socket.socket:
-    while True:
-        try:
-            return socket.create_connection(("127.0.0.1", port), timeout=5)
-        except OSError:
-            if time.monotonic() > deadline:
-                raise
-            time.sleep(0.05)
 
 
 def _document(conn, buf: bytearray, deadline: float) -> ET.Element:
@@ -52,15 +41,12 @@ def _document(conn, buf: bytearray, deadline: float) -> ET.Element:
 
 @pytest.mark.parametrize("interp", ["tree", "vm"])
 def test_the_workshop_answers_a_partner_written_from_its_xml(shared_corpus, interp):
-    probe = socket.socket()
-    probe.bind(("127.0.0.1", 0))
-    port = probe.getsockname()[1]
-    probe.close()
+    port = free_port()
     settings = NetworkSettings(CONFIGS, eki={"ITECH": Channel(CONFIGS / "ITECH.xml", ("127.0.0.1", port))})
 
     def sensor(net, rt):
         deadline = time.monotonic() + 60
-        conn = _connect(port, deadline)
+        conn = connect(port, deadline)
         conn.settimeout(60)
         # the program empties the channel's memories right after its ALIVE flag rises (its
         # EKI_ClearBuffer of Sensor): a message sent at once would be emptied with them; the
