@@ -560,8 +560,9 @@ def _vel_axis_act(sv: SysVars) -> Arr:
     vel = ctl.axis_vel_act()
     data = [0.0] * 12
     for i, v in enumerate(vel[:12]):
-        k = i if i < 6 else m.n_axes + (i - 6)     # KRL order: A1..A6, E1..; the model's: A1..An, E1..
-        if k < len(top) and top[k] > 0:
+        # KRL order: A1..A6, E1..; the model's: A1..An, E1.. (a SCARA has no A5, A6)
+        k = (i if i < m.n_axes else None) if i < 6 else m.n_axes + (i - 6)
+        if k is not None and k < len(top) and top[k] > 0:
             data[i] = float(v) / top[k] * 100.0
     return Arr(T.Array(T.REAL, (12,)), (12,), data)
 
