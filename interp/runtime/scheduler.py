@@ -289,7 +289,7 @@ class Scheduler:
         # submit interpreter runs from boot (custom.dat), long before the operator starts a
         # program, so the robot program's first statement finds the submit program's first
         # statements done (OsmanMarangoz's motion_eki.src reads META_VELOCITY_OVERRIDE, which
-        # its meta_eki.sub sets; docs/architecture.md, "The submit interpreter's pace")
+        # its meta_eki.sub sets; docs/architecture.md, "Interpreters")
         order = self.tasks[1:] + self.tasks[:1]
         while True:
             steady = self._steady()

@@ -99,9 +99,9 @@ PURE_NATIVES = frozenset(name for name, native in REGISTRY.items() if native.pur
 
 #: system variables whose value the main run changes as the robot moves (interp/runtime/sysvars.py
 #: ``_LIVE``): a pass that reads one is parked only while the main run is idle
-MOTION_NAMES = frozenset({"$POS_ACT", "$POS_ACT_MES", "$AXIS_ACT", "$AXIS_ACT_MEAS", "$VEL_ACT", "$VEL_AXIS_ACT", "$ACT_ADVANCE",
-                          "$PRO_MOVE", "$IN_HOME", "$IN_HOME1", "$IN_HOME2", "$IN_HOME3", "$IN_HOME4",
-                          "$IN_HOME5"})
+MOTION_NAMES = frozenset({"$POS_ACT", "$POS_ACT_MES", "$AXIS_ACT", "$AXIS_ACT_MEAS", "$VEL_ACT",
+                          "$VEL_AXIS_ACT", "$ACT_ADVANCE", "$PRO_MOVE", "$IN_HOME", "$IN_HOME1",
+                          "$IN_HOME2", "$IN_HOME3", "$IN_HOME4", "$IN_HOME5"})
 #: the I/O image's system variables: they change between steps only at the controller's events
 IO_NAMES = frozenset({"$IN", "$OUT", "$ANIN", "$ANOUT", "$TIMER", "$TIMER_STOP", "$TIMER_FLAG"})
 #: system variables the run's tasks change (the program's state: $PRO_STATE1 when the robot
