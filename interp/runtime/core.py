@@ -235,6 +235,7 @@ class Runtime:
     def task_main(self, task: Task) -> None:
         """Greenlet body of a task: run it and record its outcome."""
         self.current_task = task
+        self._proceed()     # a task that starts goes on too: a parked spin catches up first
         try:
             task.body()
             if task.kind == "robot":

@@ -285,12 +285,18 @@ class Scheduler:
         ctl = rt.controller
         robot = self.tasks[0]
         spin = self.spin
-        # the first cycle resumes the submit tasks before the robot program: on a controller the
-        # submit interpreter runs from boot (custom.dat), long before the operator starts a
-        # program, so the robot program's first statement finds the submit program's first
-        # statements done (OsmanMarangoz's motion_eki.src reads META_VELOCITY_OVERRIDE, which
-        # its meta_eki.sub sets; docs/architecture.md, "Interpreters")
-        order = self.tasks[1:] + self.tasks[:1]
+        # boot: each submit task has a time slice before the robot program's first: on a
+        # controller the submit interpreter runs from boot (custom.dat), long before the operator
+        # starts a program, so the robot program's first statement finds the submit program's
+        # first statements done (OsmanMarangoz's motion_eki.src reads META_VELOCITY_OVERRIDE,
+        # which its meta_eki.sub sets; docs/architecture.md, "Interpreters"). Its passes are
+        # checked before the robot runs, as at the end of any cycle (a pass parked with a state
+        # the robot program then changed would not wake: interp/runtime/spin.py)
+        for task in self.tasks[1:]:
+            if not task.done and self.stop is None:
+                self._turn(task, robot)
+        if spin.shadowed:
+            spin.check_shadows()
         while True:
             steady = self._steady()
             if steady == 1:
@@ -305,18 +311,9 @@ class Scheduler:
             if steady == 2:
                 self._steady_cycle(False)   # the robot stands: the rest of the cycle as always
             else:
-                for task in order or list(self.tasks):
+                for task in list(self.tasks):
                     if not task.done and self.stop is None:
-                        steps = rt.steps
-                        if spin.resuming(task):
-                            task.steps += rt.steps - steps
-                            continue            # parked: this cycle counted, not run
-                        if task.until is not None and self._waits(task):
-                            continue            # waits on: its resume would only test that
-                        self._resume(task)
-                        if task.done and task is not robot:
-                            rt.submit_finished(task)
-            order = None
+                        self._turn(task, robot)
             if spin.shadowed:
                 spin.check_shadows()
             if robot.done or self.stop is not None:
@@ -340,6 +337,20 @@ class Scheduler:
                 elif k == "error":
                     robot.pending_error = ev.error
         # tasks still suspended stay so until close()
+
+    def _turn(self, task: Task, robot: Task) -> None:
+        """`task`'s turn in a cycle: counted, not run, while parked or while it waits on a test
+        of the controller's state; else resumed."""
+        rt = self.rt
+        steps = rt.steps
+        if self.spin.resuming(task):
+            task.steps += rt.steps - steps
+            return                  # parked: this cycle counted, not run
+        if task.until is not None and self._waits(task):
+            return                  # waits on: its resume would only test that
+        self._resume(task)
+        if task.done and task is not robot:
+            rt.submit_finished(task)
 
     def close(self) -> None:
         """End the tasks still suspended (the run stopped: a limit, an error, HALT, the
