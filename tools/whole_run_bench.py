@@ -194,7 +194,7 @@ def main(argv: list[str] | None = None) -> int:
                     help="the measured checkout checks collisions (the robot against itself, robot/collision.py): "
                          "with --baseline the same checkout, the cost of checking")
     a = ap.parse_args(argv)
-    corpus = Path(a.corpus)
+    corpus = Path(a.corpus).resolve()
     if not corpus.is_dir():
         print(f"no corpus at {corpus}; nothing to do")
         return 0
