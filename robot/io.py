@@ -10,10 +10,12 @@ Every change of a signal is appended to :attr:`IOImage.log` as ``(t, signal, val
 and reported to the optional ``on_change`` callback (the controller writes it to the trace
 as an ``io`` event). Writing the value a signal already has is not an event.
 
-:attr:`IOImage.version` changes with every change of a signal and every write of a timer or
-its stop flag (not with a running timer's count: that is the clock); it is unique across
-images, so "same version" means "nothing here changed" (the runtime re-evaluates an interrupt
-condition over I/O only then: interp/runtime/watch.py).
+:attr:`IOImage.version` changes with every change of a signal and every write that changes a
+timer or its stop flag (not with a running timer's count: that is the clock; not with a write
+of the value it has, which changes nothing: a submit program that resets a stopped timer in
+every pass is a spin, interp/runtime/spin.py); it is unique across images, so "same version"
+means "nothing here changed" (the runtime re-evaluates an interrupt condition over I/O only
+then: interp/runtime/watch.py).
 """
 
 from __future__ import annotations
@@ -162,17 +164,23 @@ class IOImage:
         return self.timer_ms[self._check(n, N_TIMERS, "$TIMER")]
 
     def set_timer(self, n: int, ms: int) -> None:
-        """Preset ``$TIMER[n]`` (ms)."""
-        self.timer_ms[self._check(n, N_TIMERS, "$TIMER")] = int(ms)
-        self.version = next(_VERSIONS)
+        """Preset ``$TIMER[n]`` (ms). Writing the value it has changes nothing (no new version)."""
+        n = self._check(n, N_TIMERS, "$TIMER")
+        ms = int(ms)
+        if self.timer_ms[n] != ms:
+            self.timer_ms[n] = ms
+            self.version = next(_VERSIONS)
 
     def get_timer_stop(self, n: int) -> bool:
         return self.timer_stop[self._check(n, N_TIMERS, "$TIMER_STOP")]
 
     def set_timer_stop(self, n: int, stopped: bool) -> None:
-        """``$TIMER_STOP[n] = stopped``."""
-        self.timer_stop[self._check(n, N_TIMERS, "$TIMER_STOP")] = bool(stopped)
-        self.version = next(_VERSIONS)
+        """``$TIMER_STOP[n] = stopped``. Writing the value it has changes nothing (no new version)."""
+        n = self._check(n, N_TIMERS, "$TIMER_STOP")
+        stopped = bool(stopped)
+        if self.timer_stop[n] != stopped:
+            self.timer_stop[n] = stopped
+            self.version = next(_VERSIONS)
 
     def get_timer_flag(self, n: int) -> bool:
         """``$TIMER_FLAG[n]`` = ``$TIMER[n] >= 0``."""
