@@ -257,6 +257,8 @@ class Runtime:
         except RecursionError:
             task.outcome = ("error", KrlRuntimeError("stack overflow", None, task.file, task.line))
         finally:
+            if self.spin.on:
+                self.spin.ending(task)      # what a parked task reads of the tasks' state changes
             task.done = True
             self.bump_epoch()       # $PRO_STATE0/1, $PRO_ACT
         reason = task.outcome[0]
@@ -370,6 +372,8 @@ class Runtime:
         sched = getattr(self, "scheduler", None)
         if sched is not None:
             sched.idle.clock_read()
+            if sched.spin.on:
+                sched.spin.clock_read(self.current_task)
 
     def current_task_kind(self) -> str:
         return self.current_task.kind if self.current_task is not None else "robot"
@@ -507,7 +511,7 @@ class Runtime:
                 or self.stmt_hook is not None or self.run_mode == "ISTEP" \
                 or any(c.error_proceed for c in task.contexts) \
                 or (self.autocell is not None and self.autocell.recording is not None) \
-                or task.watched or task.replay is not None or task.shadow is not None:
+                or task.watched or task.replay is not None or task.shadow is not None or self.spin.hooks_all:
             task.calm = False
             return 0
         task.calm = task.kind != "robot" or self.controller.is_idle()

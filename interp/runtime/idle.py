@@ -323,7 +323,7 @@ class IdleWatch:
             irqs = tuple([(n, i.on, i.enabled, i.last, i.pending, id(i.frame)) for n, i in t.irqs.irqs.items()])
             p = t.parked
             tasks.append((t.done, t.waiting, len(t.contexts), t.err_text, irqs,
-                          None if p is None else (id(p), (p.done - 1) % p.spin.steps)))
+                          None if p is None else (id(p), p.step())))
         return (written, rt.controller.io.version, rt.msg_handle, tuple(tasks))
 
     def _quiet(self) -> bool:

@@ -246,8 +246,9 @@ class Scheduler:
             p = task.parked
             if p is None and (task.until is None or task.replay is not None):
                 return None
-            if p is not None and (p.spin.motion or spin.reads_restless_flag(p.spin)):
-                return None
+            if p is not None and (p.spin.motion or spin.reads_restless_flag(p.spin)
+                                  or (p.spin.periodic and not p.spin.still)):
+                return None         # (a period's task changes the state at its cycles)
             if task.irqs.armed and not all(i.steady and not i.pending
                                            for i in task.irqs.irqs.values() if i.on):
                 return None
@@ -327,7 +328,7 @@ class Scheduler:
                     self.stop = ("deadlock", f"deadlocked {robot.waiting}", robot)
                     break
             self.idle.cycle(steady == 2)
-            if spin.parked or spin.shadowed:
+            if spin.on:
                 spin.before_step()
             events = ctl.step()
             for ev in events:

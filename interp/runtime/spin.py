@@ -67,6 +67,14 @@ too, up to :data:`MAX_WAIT_GAP`. Until 2026-11-26 it was recorded again at every
 backup's SPS.SUB beside a cyclic flag (which kept it from parking) took 1.8 times the CPU of a
 run without the watch, for recordings that could not end in a park.
 
+**Periods.** A pass that changes what it writes is recorded again as a possible *period*
+(interp/runtime/period.py: a clock generator toggling a flag every other cycle on a timer): a
+key of the task's state at each iteration of its LOOP that comes again makes a period, parked
+with the state at the end of each cycle's time slice put in place, woken from the last boundary
+before where it stands, and parked again after a wake at the next boundary whose key is one of
+the period's (a *probe*). Another task's step does not end such a recording unless it writes what
+the period reads or writes.
+
 An observer of the controller alone (the controller's ``trace`` while the runtime's is None:
 interp/summary.py ``RunObserver`` behind ``krl run``'s summary, interp/outcomes.py and
 interp/realprograms.py behind the change report, the audit and the real-programs report) does not
@@ -86,39 +94,11 @@ from krl.semantics.resolve import LOCAL, NATIVE, ROUTINE, SYSTEM, UNRESOLVED
 
 from .idle import _frames, _store, freeze
 from .memory import Slot
-from .natives import REGISTRY
+from .passes import (ALLOWED, IO_NAMES, MAX_PASS_STEPS, MOTION_NAMES, PURE_NATIVES, STATE_NAMES, chain,
+                     written)
+from .period import MAX_STATE_CYCLES, Period, PeriodicSpins, set_timers, timers_image
 from .sysvars import CONSTANT_NAMES
 
-#: built-ins whose only effects are on their arguments (the watch checks those as writes) and
-#: that read nothing that changes by itself: declared ``pure`` in the natives registry
-#: (interp/runtime/natives/registry.py). Not pure, so a pass that calls them is never parked:
-#: FRAND (a random number), the message and dialog routines that write (SET_KRLMSG, CLEAR_KRLMSG,
-#: SET_KRLDLG), CWRITE/COPEN/CREAD (the command channel), PULSE, ERR_RAISE/ERR_CLEAR ($ERR), the
-#: network's (EKI_*, RSI_*), and every stand-in of KUKA's software (counted per call).
-PURE_NATIVES = frozenset(name for name, native in REGISTRY.items() if native.pure)
-
-#: system variables whose value the main run changes as the robot moves (interp/runtime/sysvars.py
-#: ``_LIVE``): a pass that reads one is parked only while the main run is idle
-MOTION_NAMES = frozenset({"$POS_ACT", "$POS_ACT_MES", "$AXIS_ACT", "$AXIS_ACT_MEAS", "$VEL_ACT",
-                          "$VEL_AXIS_ACT", "$ACT_ADVANCE", "$PRO_MOVE", "$IN_HOME", "$IN_HOME1",
-                          "$IN_HOME2", "$IN_HOME3", "$IN_HOME4", "$IN_HOME5"})
-#: the I/O image's system variables: they change between steps only at the controller's events
-IO_NAMES = frozenset({"$IN", "$OUT", "$ANIN", "$ANOUT", "$TIMER", "$TIMER_STOP", "$TIMER_FLAG"})
-#: system variables the run's tasks change (the program's state: $PRO_STATE1 when the robot
-#: program ends, $MODE_OP, ...) or that never change; the others are stored system variables,
-#: which statements write. tests/interp/test_spin.py holds every computed variable of
-#: interp/runtime/sysvars.py to one of these sets or MOTION_NAMES, IO_NAMES, the clock's.
-#: ``$TRACE`` (KUKA Trace's state) changes only when a statement writes its MODE.
-STATE_NAMES = frozenset({"$PRO_STATE", "$PRO_STATE0", "$PRO_STATE1", "$PRO_ACT", "$MODE_OP", "$T1",
-                         "$T2", "$AUT", "$EXT", "$I_O_ACTCONF", "$INTERPRETER", "$COULD_START_MOTION",
-                         "$ERR", "$NULLFRAME", "$POS_INT", "$AXIS_INT", "$TRACE", "$TORQUE_AXIS_ACT"})
-
-#: the statements a spin may execute (module docstring)
-ALLOWED = (N.Assign, N.CallStmt, N.If, N.Switch, N.For, N.While, N.Repeat, N.Loop, N.Exit, N.Goto,
-           N.Label, N.WaitFor, N.Continue, N.Return)
-
-#: the longest pass recorded, in steps
-MAX_PASS_STEPS = 2048
 #: the longest wait between two recordings, in IPO cycles (after repeated failures)
 MAX_GAP = 256
 #: the longest wait between two recordings of a spin that could not be parked when recorded
@@ -137,6 +117,7 @@ class _Pass:
     ``settles``), ``probes`` (the state variables it reads)."""
 
     __slots__ = ("events", "infos", "at", "frames", "images", "io", "motion", "cyclic", "probes", "refs")
+    periodic = False
 
     def __init__(self, events, infos, at, frames, images) -> None:
         self.events = events
@@ -156,27 +137,53 @@ class _Pass:
 
 
 class _Parked:
-    """A parked task: its pass, the steps it has taken since the pass's boundary (``done``),
-    the I/O version it saw and the values of the state variables its pass reads."""
+    """A parked task: its pass (or period: interp/runtime/period.py), the step of it the task
+    parked at (``pos0``: 0 for a pass, a boundary of a period), the steps it has taken since
+    (``done``), the I/O version it saw and the values of the state variables its pass reads."""
 
-    __slots__ = ("spin", "done", "io_version", "probed", "expect")
+    __slots__ = ("spin", "done", "io_version", "probed", "expect", "pos0", "seen")
 
-    def __init__(self, spin: _Pass, done: int, io_version: int, probed: tuple) -> None:
+    def __init__(self, spin, done: int, io_version: int, probed: tuple, pos0: int = 0) -> None:
         self.spin = spin
         self.done = done
         self.io_version = io_version
         self.probed = probed
         self.expect = 0
+        self.pos0 = pos0
+        self.seen = -1              # a shadow: the IPO cycle its task was last given
+
+    def step(self) -> int:
+        """The step of the pass (the period) the task stands at: the last one counted."""
+        return (self.pos0 + self.done - 1) % self.spin.steps
 
 
 class _Recording:
     """A recording in progress (module docstring)."""
 
     __slots__ = ("task", "bound", "frame", "depth", "phase", "events", "infos", "at", "frames",
-                 "images", "first", "pending", "world", "contexts", "last_at", "nodes", "looked", "seen")
+                 "images", "first", "pending", "world", "contexts", "last_at", "nodes", "looked", "seen",
+                 "periodic", "probe", "written", "read", "timers", "grew", "keys", "ticks", "ends",
+                 "starts", "clock", "cycle0", "states", "repeats", "foreign", "probed")
 
-    def __init__(self, task) -> None:
+    def __init__(self, task, periodic: bool = False, probe=None) -> None:
         self.task = task
+        # a periodic recording (interp/runtime/period.py) or a probe of a known period
+        self.periodic = periodic
+        self.probe = probe
+        self.written: dict = {}     # place (period.place_of) -> ref: what the statements wrote that outlives a pass
+        self.read: dict = {}        # place -> ref: what they read that outlives a pass
+        self.timers: set = set()    # the timers they name
+        self.grew = False           # the written set or the timers grew since the last boundary
+        self.keys: dict = {}        # key of a boundary -> its step index
+        self.ticks: list = []       # (index, values, timers, own clock reads, key) per boundary
+        self.ends: list = []        # (steps, images, values, timers, frames, at, clock reads) per cycle end
+        self.starts: dict = {}      # index of the step a cycle starts at -> timers
+        self.clock = 0              # the task's own clock reads (running timers)
+        self.cycle0 = 0             # the IPO cycle it started in
+        self.states: set = set()    # the keys seen, where in the time slice left out
+        self.repeats = False        # one of them came again
+        self.foreign: dict = {}     # a place or a timer -> the last step another task wrote it at
+        self.probed: dict = {}      # the state variables the statements read -> their references
         self.bound = None           # (file, line) of the loop whose iteration ends a pass
         self.frame = None           # the frame of that loop
         self.depth = 0
@@ -196,7 +203,7 @@ class _Recording:
         self.seen: set = set()      # loops passed over while looking
 
 
-class SpinWatch:
+class SpinWatch(PeriodicSpins):
     """The spin watch of one run (module docstring). ``recordings``, ``parks``, ``wakes`` and
     ``skipped`` (steps not executed) count what it did; ``diverged`` (a catch-up that left the
     recorded pass) and ``missed`` (a parked task's reads changed without a wake) count what
@@ -206,6 +213,7 @@ class SpinWatch:
         self.rt = rt
         self.enabled = True         # False: never park (tests compare with and without)
         self.on = False             # a recording, a parked task or a catch-up is under way
+        self.hooks_all = False      # a period is parked: every step takes the full hook (_update)
         self.rec: _Recording | None = None
         self.parked: list = []
         self.gap: dict = {}         # id(task) -> cycles between two recordings
@@ -216,6 +224,8 @@ class SpinWatch:
         self._io_at = (None, False)     # (moment, _io_may_change's answer then)
         self._nodes: dict | None = None
         self._targets: dict = {}    # id(statement) -> the names it writes
+        self._reads: dict = {}      # id(statement) -> the names it reads
+        self._foreign_kinds: dict = {}  # id(statement) -> it may run beside a parked period
         self.parks = self.wakes = self.skipped = self.diverged = self.missed = 0
         self.recordings = 0         # recordings started
         self.why: dict = {}         # why recordings failed (a count per reason: tests, tuning)
@@ -225,6 +235,15 @@ class SpinWatch:
         self.shadow = False
         self.shadowed: list = []
         self.shadow_checks = self.shadow_errors = 0
+        # periodic spins (interp/runtime/period.py): the tasks whose next recording looks for a
+        # period (a pass of theirs changed what it wrote), the period of each task found last
+        # (a probe after a wake parks it again at a boundary whose key is one of its own)
+        self.periodic: set = set()
+        self.known: dict = {}       # id(task) -> its Period
+        self.probes: dict = {}      # id(task) -> the Period to probe for at its next boundary
+        self.period_fails: dict = {}    # id(task) -> its periodic recordings that failed
+        self.period_due: dict = {}      # id(task) -> the cycle before which none is tried again
+        self.periods = self.probe_parks = 0
 
     # ------------------------------------------------------------------ when
     def allowed(self) -> bool:
@@ -241,37 +260,67 @@ class SpinWatch:
 
     def _update(self) -> None:
         self.on = self.rec is not None or bool(self.parked) or self.replaying > 0 or bool(self.shadowed)
+        # a parked period lets another task's step run when it writes nothing the period reads
+        # (PeriodicSpins._harmless): every step of the other tasks takes the full hook then
+        self.hooks_all = any(t.parked.spin.periodic for t in self.parked) or \
+            any(t.shadow.spin.periodic for t in self.shadowed)
 
     def resuming(self, task) -> bool:
         """The scheduler is about to give `task` its IPO cycle. True when it stays parked
         (this cycle is counted instead of run: :meth:`_hold`); else a recording may start."""
         if self.shadowed and task in self.shadowed:
             sh = task.shadow
-            if self._step_may_change(sh.spin) or (task.irqs.armed and any(i.pending for i in task.irqs.irqs.values())):
+            if self._step_may_change(sh.spin) or (task.irqs.armed and self._interrupt_due(task)):
                 self._unshadow(task)
             else:
                 sh.expect += task.budget
+                sh.seen = self.rt.controller.cycle
             return False
         if task.parked is not None:
             if self._hold(task):
                 return True
             self.wake(task)
             return False
-        if self.rec is None and task.replay is None and task.shadow is None:
+        rec = self.rec
+        if rec is None and task.replay is None and task.shadow is None and task.until is None:
+            # (a task that waits on a test of the controller's state is not resumed while the
+            # test fails: a recording of it would hold the watch for no step)
+            key = id(task)
+            probe = self.probes.pop(key, None)
+            if probe is not None and self.allowed():
+                self._start(task, probe=probe)
+                return False
             cycle = self.rt.controller.cycle
-            if cycle >= self.due.get(id(task), 0) and self.allowed():
-                self._start(task)
+            if cycle >= self.due.get(key, 0) and self.allowed():
+                self._start(task, periodic=key in self.periodic and cycle >= self.period_due.get(key, 0))
+        elif rec is not None and rec.periodic and rec.task is task and rec.phase:
+            # a cycle starts: the timers as the controller left them, for the step that runs first
+            self.rec.starts[len(rec.events) - 1] = timers_image(self.rt.controller.io, tuple(sorted(rec.timers)))
         return False
 
-    def _start(self, task) -> None:
+    def _start(self, task, periodic: bool = False, probe=None) -> None:
         self.recordings += 1
-        self.rec = _Recording(task)
+        self.rec = _Recording(task, periodic, probe)
+        self.rec.cycle0 = self.rt.controller.cycle
         task.watched = True
         self.rt._break(task)
         self._update()
 
     def _fail(self, why: str) -> None:
         self.why[why] = self.why.get(why, 0) + 1
+        rec = self.rec
+        if rec is not None and rec.probe is None:
+            # a pass that changed what it wrote, or the state beside it, may be periodic: the
+            # next recording looks for a period; a failed periodic one for a pass again
+            key = id(rec.task)
+            if not rec.periodic and (why in ("writes", "second") or why.startswith("wrote ")):
+                self.periodic.add(key)
+            elif rec.periodic:
+                self.periodic.discard(key)
+                if why in ("period: no state repeats", "period: none"):
+                    # a state that does not come back (a counter): looked for ever more rarely
+                    n = self.period_fails[key] = self.period_fails.get(key, 0) + 1
+                    self.period_due[key] = self.rt.controller.cycle + MAX_STATE_CYCLES * 4 ** min(n, 8)
         self._stop(False)
 
     def _stop(self, ok: bool, parks: bool = True) -> None:
@@ -302,14 +351,22 @@ class SpinWatch:
             self._replayed(task, info, tick)
             return
         rec = self.rec
-        if rec is not None and rec.task is task:
-            self._record(rec, task, info, tick)
-            return
+        if rec is not None:
+            if rec.task is task:
+                if rec.probe is not None:
+                    self._probe(rec, task, info, tick)
+                elif rec.periodic:
+                    self._record_period(rec, task, info, tick)
+                else:
+                    self._record(rec, task, info, tick)
+                return
+            if rec.periodic and rec.phase:
+                self._foreign(rec, task, info, tick)
         sh = task.shadow
         if sh is not None:
             # a shadowed spin runs on: it must run the recorded pass, step after step
             n = sh.spin.steps
-            j = sh.done % n
+            j = (sh.pos0 + sh.done) % n
             sh.done += 1
             if sh.spin.events[j][:3] != (info.file, info.line, tick):
                 self.shadow_errors += 1
@@ -317,13 +374,41 @@ class SpinWatch:
                 self._unshadow(task)
             return
         if self.parked or self.shadowed:
-            self.wake_all()
+            for other in list(self.parked):
+                if other.parked.spin.__class__ is not Period or not self._harmless(other.parked.spin, task, info, tick):
+                    self.wake(other)
+            for other in list(self.shadowed):
+                if other.shadow.spin.__class__ is not Period or not self._harmless(other.shadow.spin, task, info, tick):
+                    self._unshadow(other)
 
     def proceeding(self) -> None:
         """A task goes on after a wait, or runs a TRIGGER action or an interrupt routine
-        (Runtime._proceed): the parked tasks catch up first."""
-        if self.parked or self.shadowed:
-            self.wake_all()
+        (Runtime._proceed): the parked tasks catch up first (a shadowed task that goes on after
+        its own time slice ended runs as it did). A period's task stays parked: what the task
+        that goes on does is looked at statement by statement (:meth:`_harmless`)."""
+        for task in list(self.parked):
+            if task.parked.spin.__class__ is not Period:
+                self.wake(task)
+        me = self.rt.current_task
+        for task in list(self.shadowed):
+            if task is not me and task.shadow.spin.__class__ is not Period:
+                self._unshadow(task)
+
+    def ending(self, task) -> None:
+        """`task` ends (Runtime.task_main): the state variables of the tasks ($PRO_STATE1,
+        $PRO_ACT) change now, without a statement; a parked task that reads one catches up first."""
+        for other in list(self.parked):
+            if other is not task and other.parked.spin.probes:
+                self.wake(other)
+        for other in list(self.shadowed):
+            if other is not task and other.shadow.spin.probes:
+                self._unshadow(other)
+
+    def clock_read(self, task) -> None:
+        """`task` read the clock (a running timer: Runtime.clock_read) while the watch is on."""
+        rec = self.rec
+        if rec is not None and rec.task is task:
+            rec.clock += 1
 
     def waiting(self, task) -> None:
         """`task` gives its IPO cycle back before its time slice ended (a wait): a recording of
@@ -369,7 +454,7 @@ class SpinWatch:
             where = (info.file, info.line)
             if tick and (where not in self.bad.get(id(task), ()) or where in rec.seen):
                 rec.bound, rec.frame, rec.depth, rec.phase = where, frame, depth, 1
-                rec.world = self._world(task) + (tuple([_store(f.store) for f in _chain(frame)]),)
+                rec.world = self._world(task) + (tuple([_store(f.store) for f in chain(frame)]),)
             else:
                 if tick:
                     rec.seen.add(where)     # a loop the last recording failed on: the next one, or it
@@ -395,7 +480,7 @@ class SpinWatch:
         rec.at.append(rec.last_at)
         if rec.phase == 2:
             rec.frames.append(frame)
-            rec.images.append(tuple([_store(f.store) for f in _chain(frame)]))
+            rec.images.append(tuple([_store(f.store) for f in chain(frame)]))
         if len(rec.events) > MAX_PASS_STEPS:
             self._fail("long")
             return
@@ -423,7 +508,7 @@ class SpinWatch:
         runs (checked at the next step of the same or a shallower frame)."""
         names = self._targets.get(id(node))
         if names is None:
-            names = self._targets[id(node)] = _written(node)
+            names = self._targets[id(node)] = written(node)
         if not names:
             return
         refs = []
@@ -483,7 +568,7 @@ class SpinWatch:
         first, events = rec.first, rec.events
         rt = self.rt
         if events != first or rec.pending or \
-                self._world(task) + (tuple([_store(f.store) for f in _chain(task.frame)]),) != rec.world:
+                self._world(task) + (tuple([_store(f.store) for f in chain(task.frame)]),) != rec.world:
             self._fail("second")
             return
         key = tuple(events)
@@ -580,8 +665,12 @@ class SpinWatch:
     # ------------------------------------------------------------------ parked
     def park(self, task) -> None:
         """Called by Runtime.loop_tick at the boundary of the second recorded pass of `task`
-        (after its step was counted): the task stops here (module docstring)."""
+        (after its step was counted), or at a boundary of its period (``task.park`` is then the
+        period and the boundary's position): the task stops here (module docstring)."""
         spin, task.park = task.park, None
+        pos0 = 0
+        if spin.__class__ is tuple:
+            spin, pos0 = spin
         rt = self.rt
         if rt.steps >= task.slice_end or len(task.contexts) != 1 or not self.parked_ok(task):
             return
@@ -589,16 +678,21 @@ class SpinWatch:
         if rt.steps + left + 2 * (task.budget + spin.steps) > rt.limit_at:
             return                              # the step limit is near: it ends at a statement
         if self.shadow:
-            task.shadow = _Parked(spin, 0, rt.controller.io.version, self._probed(spin))
+            task.shadow = _Parked(spin, 0, rt.controller.io.version, self._probed(spin), pos0)
             task.shadow.expect = left   # the steps parking would count by the end of this slice
+            task.shadow.seen = rt.controller.cycle
             self.shadowed.append(task)
             self._update()
             return
         rt.steps += left
         self.skipped += left
-        task.parked = _Parked(spin, left, rt.controller.io.version, self._probed(spin))
+        p = task.parked = _Parked(spin, left, rt.controller.io.version, self._probed(spin), pos0)
         self.parked.append(task)
         self.parks += 1
+        if spin.__class__ is Period:
+            # the rest of this slice ran: its end's state, and its clock reads from the boundary
+            tick = next(t for t in spin.ticks if t.pos == pos0)
+            self._put_end(p, spin.end_at(pos0 + left), tick.clock, whole=True)
         self._place(task)
         self._update()
         rt.yield_cycle(task)            # until the scheduler resumes it, or a catch-up
@@ -618,7 +712,7 @@ class SpinWatch:
     def _place(self, task) -> None:
         """The statement the parked task would stand at (``Task.at``)."""
         p = task.parked
-        task.at = p.spin.at[(p.done - 1) % p.spin.steps]
+        task.at = p.spin.at[p.step()]
 
     def _hold(self, task) -> bool:
         """The parked task's IPO cycle: counted, not run, unless it must wake (True: counted)."""
@@ -632,19 +726,25 @@ class SpinWatch:
             self.missed += 1
             return False
         rt.state_epoch += 1             # as Scheduler._resume: another task ran
-        if task.irqs.armed:
-            # the poll its resume would make (Runtime.service): an interrupt to run wakes it
-            ctl = rt.controller
-            if task.irqs.poll(ctl.io.version, ctl.time, rt.state_epoch, rt.cyclic_watch.written()):
-                return False
+        if task.irqs.armed and self._interrupt_due(task):
+            return False                # an interrupt to run wakes it
         auto = rt.autocell
         if auto is not None and auto.recording is not None:
             self._feed(task, auto)
         rt.steps += task.budget
         p.done += task.budget
         self.skipped += task.budget
+        if spin.__class__ is Period:
+            end = spin.end_at(p.pos0 + p.done)
+            self._put_end(p, end, end.clock)
         self._place(task)
         return True
+
+    def _interrupt_due(self, task) -> bool:
+        """The poll of `task`'s interrupts its resume would make (Runtime.service) finds one to run."""
+        rt = self.rt
+        ctl = rt.controller
+        return bool(task.irqs.poll(ctl.io.version, ctl.time, rt.state_epoch, rt.cyclic_watch.written()))
 
     def _feed(self, task, auto) -> None:
         """An automatic cell records what the tasks execute (interp/runtime/autocell.py): the
@@ -656,19 +756,25 @@ class SpinWatch:
         # as run: first the step that ended its last time slice (recorded when it resumes), then
         # the steps of this slice but its last one
         for i in range(min(task.budget, n)):
-            j = (p.done - 1 + i) % n
+            j = (p.pos0 + p.done - 1 + i) % n
             auto.record_frame(task, spin.infos[j], spin.frames[j])
 
     def frames_image(self, task):
-        """The image of a parked task's frames at the step it stands at (None: not parked)."""
+        """The image of a parked task's frames at the step it stands at (None: not parked; a
+        period's task stands at the end of a time slice)."""
         p = task.parked
         if p is None:
             return None
-        return p.spin.images[(p.done - 1) % p.spin.steps]
+        if p.spin.__class__ is Period:
+            return p.spin.end_at(p.pos0 + p.done).frames
+        return p.spin.images[p.step()]
 
     def before_step(self) -> None:
-        """The scheduler is about to step the controller: wake the parked tasks the step may
-        change something for (module docstring)."""
+        """The scheduler is about to step the controller: the end of a periodic recording's
+        time slice; wake the parked tasks the step may change something for (module docstring)."""
+        rec = self.rec
+        if rec is not None and rec.periodic and rec.phase:
+            self._period_end(rec, rec.task)
         for task in list(self.parked):
             if self._step_may_change(task.parked.spin):
                 self.wake(task)
@@ -692,6 +798,8 @@ class SpinWatch:
             self._unshadow(task)
 
     def _unshadow(self, task) -> None:
+        if task.shadow.spin.__class__ is Period:
+            self.probes[id(task)] = task.shadow.spin    # shadowed again at a boundary of its period
         task.shadow = None
         self.shadowed.remove(task)
         self.due[id(task)] = self.rt.controller.cycle
@@ -699,19 +807,31 @@ class SpinWatch:
 
     def check_shadows(self) -> None:
         """The end of an IPO cycle's tasks: each shadowed spin stands where parking says."""
+        cycle = self.rt.controller.cycle
         for task in self.shadowed:
             p = task.shadow
-            j = (p.done - 1) % p.spin.steps
+            if p.seen != cycle:
+                continue                # (not given this cycle: the run stopped before its turn)
+            spin = p.spin
+            j = p.step()
             self.shadow_checks += 1
             real = tuple([_store(f.store) for f in _frames(task)])
-            at = p.spin.at[j]
-            if (at.file, at.line) != (task.at.file, task.at.line) or p.spin.images[j] != real or p.done != p.expect:
+            at = spin.at[j]
+            if spin.__class__ is Period:
+                end = spin.end_at(p.pos0 + p.done)
+                ok = end.frames == real and end.images == tuple([freeze(r.peek()) for r in spin.written]) \
+                    and end.timers == timers_image(self.rt.controller.io, spin.timers)
+            else:
+                ok = spin.images[j] == real
+            if (at.file, at.line) != (task.at.file, task.at.line) or not ok or p.done != p.expect:
                 self.shadow_errors += 1
                 self.why[f"shadow at step {j}: {task.at.file}:{task.at.line}"] = 1
 
     def wake(self, task) -> None:
         """Catch up: `task` runs from the boundary the steps it took after its last whole pass
-        (module docstring), then stands where its last time slice ended."""
+        (module docstring), then stands where its last time slice ended. A period's task runs
+        them from the last boundary before that place, its state and the timers put back to
+        that boundary's (interp/runtime/period.py)."""
         rt = self.rt
         p = task.parked
         task.parked = None
@@ -719,83 +839,62 @@ class SpinWatch:
         self.wakes += 1
         self.due[id(task)] = rt.controller.cycle
         self.bad.pop(id(task), None)
-        left = p.done % p.spin.steps
-        self.skipped -= left
-        if left:
-            sched = rt.scheduler
-            saved, before, limit = rt.current_task, rt.steps, rt.limit_at
-            rt.limit_at = before + left     # replayed steps: counted while it was parked
-            back = getcurrent()
-            rt.current_task = task
-            task.slice_end = before + left
-            task.quiet = 0
-            task.replay = [p.spin, 0]
-            self.replaying += 1
-            task.in_poll = True         # its interrupts were polled where it parked: nothing changed
-            task.glet.parent, parent = back, task.glet.parent
-            sched.return_to, ret = back, sched.return_to
-            self._update()
-            try:
-                task.glet.switch()
-            finally:
-                task.glet.parent = parent
-                sched.return_to = ret
-                task.in_poll = False
-                if task.replay is not None and task.replay[1] != left:
-                    self.diverged += 1
-                    self.why[f"catch-up ran {task.replay[1]} of {left} steps"] = 1
-                task.replay = None
-                self.replaying -= 1
-                rt.steps = before       # these steps were counted while it was parked
-                rt.limit_at = limit
-                rt.current_task = saved
-                rt._break(task)
+        spin = p.spin
+        if spin.__class__ is Period:
+            self._wake_period(task, p)
+        else:
+            left = p.done % spin.steps
+            self.skipped -= left
+            if left:
+                self._catch_up(task, [spin, 0, left], left)
         self._update()
 
+    def _catch_up(self, task, replay: list, left: int) -> None:
+        """Run `task` `left` steps (``replay``: the pass or period, the step it starts at, the
+        step it must end at; :meth:`_replayed` checks each) now, before anything else goes on."""
+        rt = self.rt
+        sched = rt.scheduler
+        saved, before, limit = rt.current_task, rt.steps, rt.limit_at
+        rt.limit_at = before + left     # replayed steps: counted while it was parked
+        back = getcurrent()
+        rt.current_task = task
+        task.slice_end = before + left
+        task.quiet = 0
+        task.replay = replay
+        self.replaying += 1
+        task.in_poll = True         # its interrupts were polled where it parked: nothing changed
+        task.glet.parent, parent = back, task.glet.parent
+        sched.return_to, ret = back, sched.return_to
+        self._update()
+        try:
+            task.glet.switch()
+        finally:
+            task.glet.parent = parent
+            sched.return_to = ret
+            task.in_poll = False
+            if task.replay is not None and task.replay[1] != replay[2]:
+                self.diverged += 1
+                self.why[f"catch-up ran to step {task.replay[1]}, not {replay[2]}"] = 1
+            task.replay = None
+            self.replaying -= 1
+            rt.steps = before       # these steps were counted while it was parked
+            rt.limit_at = limit
+            rt.current_task = saved
+            rt._break(task)
+
     def _replayed(self, task, info, tick: bool) -> None:
-        spin, i = task.replay
-        if i >= len(spin.events) or spin.events[i][:3] != (info.file, info.line, tick):
+        spin, i, end = task.replay
+        if i >= end or spin.events[i][:3] != (info.file, info.line, tick):
             self.diverged += 1
             self.why[f"catch-up left the pass at {i}: {info.file}:{info.line}"] = 1
+        elif spin.__class__ is Period:
+            timers = spin.starts.get(i)
+            if timers is not None:          # this step ran first in a new IPO cycle
+                set_timers(self.rt.controller.io, spin.timers, timers)
         task.replay[1] = i + 1
-
-
-def _chain(frame):
-    while frame is not None:
-        yield frame
-        frame = frame.caller
 
 
 def _copy_with(spin: _Pass, rec: _Recording) -> _Pass:
     out = _Pass(spin.events, rec.infos, rec.at, rec.frames, rec.images)
     out.io, out.motion, out.cyclic, out.probes = spin.io, spin.motion, spin.cyclic, spin.probes
     return out
-
-
-def _root(e):
-    while isinstance(e, (N.Index, N.Field)):
-        e = e.base
-    return e if isinstance(e, N.Name) else None
-
-
-def _written(node) -> tuple:
-    """The names statement `node` writes: its assignment target, a FOR's counter, and every
-    variable passed to a built-in (its :OUT arguments; an :IN one is written by nothing, so
-    counting it only costs a comparison)."""
-    out = []
-    acc, cond = accesses(node)
-    for mode, x in acc + cond:
-        if mode == "w":
-            out.append(x)
-        elif mode == "call":
-            callee = getattr(x.ann, "callee", None) if x.ann is not None else None
-            if callee is not None and callee.kind == NATIVE:
-                for a in x.args:
-                    r = _root(a)
-                    if r is not None:
-                        out.append(r)
-    if isinstance(node, N.For):
-        r = _root(node.var)
-        if r is not None:
-            out.append(r)
-    return tuple(out)

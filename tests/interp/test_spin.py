@@ -179,14 +179,18 @@ def test_the_step_limit_ends_the_run_at_the_same_statement(tmp_path, interp, lim
 
 
 @pytest.mark.parametrize("interp", INTERPS)
-def test_a_write_undone_within_the_pass_is_not_a_spin(tmp_path, interp):
+def test_a_write_undone_within_the_pass_is_parked_as_a_period(tmp_path, interp):
     """X = 1 ... X = 0 in each pass: the state is the same at the ends of the pass, but the robot
-    program sees X = 1 whenever a time slice ends between the two: never parked."""
+    program sees X = 1 whenever a time slice ends between the two: not a plain spin (two equal
+    passes over a state that stands), but a period (interp/runtime/period.py: where the slice
+    ends in the pass is part of the state), parked with the value of X at each cycle's end, so
+    the robot program's WAIT FOR X == 1 sees what it sees without the watch."""
     sub = SPS.replace("    CHECK()\n", "    X = 1\n    CHECK()\n    X = 0\n")
     prog = PROG.replace("WAIT FOR $OUT[5]", "WAIT FOR X == 1")
     rt, _res = _same_run(tmp_path, prog, sub, interp)
-    assert rt.scheduler.spin.parks == 0
-    assert any(k.startswith("wrote X") for k in rt.scheduler.spin.why)
+    sw = rt.scheduler.spin
+    assert any(k.startswith("wrote X") for k in sw.why)     # the plain recording refused it
+    assert sw.periods >= 1 and sw.parks >= 1
 
 
 @pytest.mark.parametrize("interp", INTERPS)
@@ -351,11 +355,13 @@ def test_the_history_backups_submit_programs_are_the_same_parked(shared_history)
     the VM, and the tree interpreter's parked run the VM's. Some switch a cyclic flag on in every
     pass (``$CYCFLAG[n] = NOT $ALARM_STOP OR ...``: a flag over inputs and variables, which
     settles); such a pass is parked (until 2026-11-26 no pass that read $CYCFLAG was, beside any
-    cyclic flag, and it was recorded again at every cycle)."""
+    cyclic flag, and it was recorded again at every cycle). Two run a clock generator (a flag
+    toggled every other cycle on two timers compared with 12 ms, ChinaMilling's PulsGen12ms):
+    parked as periods (interp/runtime/period.py; before issue 62 they ran every statement)."""
     subs = [p for root in find_backups(shared_history) if root.relative_to(shared_history).parts[2] == "new"
             for p in entries_of(root) if p.suffix.lower() == ".sub"]
     assert subs
-    parked_beside_a_flag = 0
+    parked_beside_a_flag = periodic = 0
     for program in subs:
         _rt, off = _real(program, "vm", False, 10.0)
         rt, on = _real(program, "vm", True, 10.0)
@@ -365,7 +371,9 @@ def test_the_history_backups_submit_programs_are_the_same_parked(shared_history)
         assert tree == on, program
         if rt.scheduler.spin.parks and any(k[0] == "cyclic flag" for k in rt._cyclic):
             parked_beside_a_flag += 1
+        periodic += rt.scheduler.spin.periods > 0 and rt.scheduler.spin.skipped > 0
     assert parked_beside_a_flag >= 1
+    assert periodic >= 2
 
 
 @pytest.mark.slow

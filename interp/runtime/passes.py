@@ -1,0 +1,84 @@
+"""What a pass of a task's loop reads and writes: the classes of names and statements that the
+spin watch (interp/runtime/spin.py) and its periods (interp/runtime/period.py) share."""
+
+from __future__ import annotations
+
+from krl.ast import nodes as N
+from krl.semantics.advance import accesses
+from krl.semantics.resolve import NATIVE
+
+from .natives import REGISTRY
+from .sysvars import _LIVE
+
+#: built-ins whose only effects are on their arguments (the watch checks those as writes) and
+#: that read nothing that changes by itself: declared ``pure`` in the natives registry
+#: (interp/runtime/natives/registry.py). Not pure, so a pass that calls them is never parked:
+#: FRAND (a random number), the message and dialog routines that write (SET_KRLMSG, CLEAR_KRLMSG,
+#: SET_KRLDLG), CWRITE/COPEN/CREAD (the command channel), PULSE, ERR_RAISE/ERR_CLEAR ($ERR), the
+#: network's (EKI_*, RSI_*), and every stand-in of KUKA's software (counted per call).
+PURE_NATIVES = frozenset(name for name, native in REGISTRY.items() if native.pure)
+
+#: system variables whose value the main run changes as the robot moves (interp/runtime/sysvars.py
+#: ``_LIVE``): a pass that reads one is parked only while the main run is idle
+MOTION_NAMES = frozenset({"$POS_ACT", "$POS_ACT_MES", "$AXIS_ACT", "$AXIS_ACT_MEAS", "$VEL_ACT",
+                          "$VEL_AXIS_ACT", "$ACT_ADVANCE", "$PRO_MOVE", "$IN_HOME", "$IN_HOME1",
+                          "$IN_HOME2", "$IN_HOME3", "$IN_HOME4", "$IN_HOME5"})
+#: the I/O image's system variables: they change between steps only at the controller's events
+IO_NAMES = frozenset({"$IN", "$OUT", "$ANIN", "$ANOUT", "$TIMER", "$TIMER_STOP", "$TIMER_FLAG"})
+#: system variables the run's tasks change (the program's state: $PRO_STATE1 when the robot
+#: program ends, $MODE_OP, ...) or that never change; the others are stored system variables,
+#: which statements write. tests/interp/test_spin.py holds every computed variable of
+#: interp/runtime/sysvars.py to one of these sets or MOTION_NAMES, IO_NAMES, the clock's.
+#: ``$TRACE`` (KUKA Trace's state) changes only when a statement writes its MODE.
+STATE_NAMES = frozenset({"$PRO_STATE", "$PRO_STATE0", "$PRO_STATE1", "$PRO_ACT", "$MODE_OP", "$T1",
+                         "$T2", "$AUT", "$EXT", "$I_O_ACTCONF", "$INTERPRETER", "$COULD_START_MOTION",
+                         "$ERR", "$NULLFRAME", "$POS_INT", "$AXIS_INT", "$TRACE", "$TORQUE_AXIS_ACT"})
+
+#: system variables whose reads read the clock ($DATE, $ROBRUNTIME, ...: interp/runtime/sysvars.py
+#: ``_clock``); a running timer's read is a clock read too, which a period allows (its timers are
+#: part of its state: interp/runtime/period.py)
+CLOCK_NAMES = frozenset(k for k, make in _LIVE.items() if getattr(make, "clock", False))
+
+#: the statements a spin may execute (module docstring)
+ALLOWED = (N.Assign, N.CallStmt, N.If, N.Switch, N.For, N.While, N.Repeat, N.Loop, N.Exit, N.Goto,
+           N.Label, N.WaitFor, N.Continue, N.Return)
+
+#: the longest pass recorded, in steps
+MAX_PASS_STEPS = 2048
+
+
+def chain(frame):
+    """`frame` and its callers, innermost first."""
+    while frame is not None:
+        yield frame
+        frame = frame.caller
+
+
+def root(e):
+    """The name an index or component expression selects from, or None."""
+    while isinstance(e, (N.Index, N.Field)):
+        e = e.base
+    return e if isinstance(e, N.Name) else None
+
+
+def written(node) -> tuple:
+    """The names statement `node` writes: its assignment target, a FOR's counter, and every
+    variable passed to a built-in (its :OUT arguments; an :IN one is written by nothing, so
+    counting it only costs a comparison)."""
+    out = []
+    acc, cond = accesses(node)
+    for mode, x in acc + cond:
+        if mode == "w":
+            out.append(x)
+        elif mode == "call":
+            callee = getattr(x.ann, "callee", None) if x.ann is not None else None
+            if callee is not None and callee.kind == NATIVE:
+                for a in x.args:
+                    r = root(a)
+                    if r is not None:
+                        out.append(r)
+    if isinstance(node, N.For):
+        r = root(node.var)
+        if r is not None:
+            out.append(r)
+    return tuple(out)

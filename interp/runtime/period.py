@@ -1,0 +1,632 @@
+"""A periodic spin: a task whose loop runs over a state that repeats itself every few IPO cycles
+(issue 62, "Whole cells at 200x"; interp/runtime/spin.py holds the watch that records, parks and
+wakes it, docs/architecture.md "Spins cost nothing").
+
+A *clock generator* is the common case: a submit program toggles a flag every other cycle on two
+timers (``IF $TIMER[30] > 12 THEN $TIMER_STOP[30] = TRUE ... gbClk = TRUE``, ChinaMilling's
+``PulsGen12ms``) and a flip-flop network follows the flag. Its passes are never equal — the flag
+and the timers change — so the plain spin (two equal passes over an unchanged state) never finds
+it, and the task executes every statement of the run (about 8 000 per simulated second). Yet the
+whole state it writes or reads is a function of the IPO cycle modulo a period, and nothing else
+changes while it runs alone.
+
+**Recorded.** A periodic recording takes the boundary of the task's ``LOOP`` (the outermost loop
+it iterates, no FOR: its counter would never repeat) and images, at each iteration of that loop,
+the *key* of the moment (:meth:`Period.key`): where in its time slice the task is, the values of
+everything its statements wrote that outlives a pass (the written set), the timers its statements
+name (value and stop flag), its frames, and what must not change at all (I/O log, messages,
+interrupt tables). When a key is seen again the state is periodic: the statements from the first
+occurrence to the second (``n`` steps, ``P = n / budget`` IPO cycles) repeat for ever, as long as
+nothing else changes — every value a statement reads is a written one (in the key) or one nothing
+writes while the task runs alone (``consts``). At each cycle's end within the period (the end of the
+task's time slice: ``ends``) the recording keeps the written values, the timers, the task's frames
+as the idle watch images them and its clock reads (a running timer read is a clock read:
+interp/runtime/idle.py); at each cycle's start (``starts``) the timers as the controller left them.
+
+**Parked.** The task stands at the loop's boundary; each IPO cycle its time slice is counted and
+the state at the end of that slice is *put* in place (the written values that differ from the
+previous end, the timers, the clock reads), so that whatever reads the run after the task's turn —
+another task's wait, a cyclic flag, the idle watch, the controller — reads what it would have read.
+
+**Woken** (by what wakes a plain spin). The task's greenlet stands at the loop's boundary, which is
+every boundary of the period: the state of the last boundary before the position it would stand at
+is put back (with the timers of that moment) and the statements from there are executed again, the
+timers set to each cycle's values as they cross a cycle's start (:meth:`Period.timers_at`); the
+timers and the clock reads are then those of the present again. After a wake the next boundary's
+key is looked up among the period's (a *probe*): the same key, and the same unwritten values, park
+the task again at once.
+"""
+
+from __future__ import annotations
+
+from krl.ast import nodes as N
+from krl.semantics.advance import accesses
+from krl.semantics.resolve import NATIVE, ROUTINE, SYSTEM, UNRESOLVED
+
+from .convert import assign_into
+from .idle import _frames, _store, freeze
+from .memory import Slot
+from .passes import ALLOWED, CLOCK_NAMES, MAX_PASS_STEPS, PURE_NATIVES, STATE_NAMES, chain, written
+from .sysvars import _LIVE
+from .values import Arr, Struct, copy_value
+from .watch import CONSTANT, IO
+
+#: the longest period recorded, in IPO cycles (where the task is in its time slice is part of the
+#: state: a pass of 44 steps in slices of 100 comes back to its place after 25 passes, so a flag
+#: toggled every other cycle makes a period of 400 cycles, 4.8 s)
+MAX_PERIOD_CYCLES = 1024
+#: a recording ends when no state (its key but where it is in its slice) came again in this many cycles
+MAX_STATE_CYCLES = 64
+#: the timer arrays: a statement that names one of them names a timer of the period's state
+TIMER_ARRAYS = frozenset({"$TIMER", "$TIMER_STOP", "$TIMER_FLAG"})
+#: every timer (a timer named by a computed index)
+ALL_TIMERS = tuple(range(1, 65))
+
+
+def timers_of(node) -> tuple[int, ...] | None:
+    """The timers statement `node`'s own expressions name (``$TIMER[30]``, ``$TIMER_STOP[31]``),
+    :data:`ALL_TIMERS` for one named by a computed index; None when it names none."""
+    found: set[int] = set()
+    for child in node.children():
+        if not isinstance(child, N.Expr):
+            continue
+        for e in child.walk():
+            if e.__class__ is N.Index and e.base.__class__ is N.Name and e.base.name.upper() in TIMER_ARRAYS:
+                if len(e.indices) == 1 and e.indices[0].__class__ is N.IntLit:
+                    found.add(int(e.indices[0].value))
+                else:
+                    return ALL_TIMERS
+    return tuple(sorted(found)) if found else None
+
+
+def timers_image(io, timers: tuple) -> tuple:
+    ms, stop = io.timer_ms, io.timer_stop
+    return tuple([(ms[i], stop[i]) for i in timers])
+
+
+def set_timers(io, timers: tuple, image: tuple) -> None:
+    """Put the timers `timers` to `image` (robot/io.py: a write of the value a timer has is none)."""
+    for i, (ms, stop) in zip(timers, image):
+        io.set_timer(i, ms)
+        io.set_timer_stop(i, stop)
+
+
+def put(ref, value) -> None:
+    """Store `value` (a copy) into the written variable `ref` as the task's statement did: in place
+    for a structure or an array, so that the references others hold stay valid."""
+    cur = ref.c[ref.k]
+    if cur.__class__ is Struct or cur.__class__ is Arr:
+        assign_into(cur, value)
+    else:
+        ref.c[ref.k] = copy_value(value)
+
+
+def place_of(ref) -> tuple:
+    """Where the value of reference `ref` is kept: the same for every reference to it (a data
+    list's slot, a frame's, a structure's component, an element; a live array's element)."""
+    c = ref.__class__
+    if c is Slot:
+        return (id(ref.c), ref.k)
+    proxy = getattr(ref, "proxy", None)
+    if proxy is not None:
+        return (id(proxy), getattr(ref, "index", None), getattr(ref, "a", None))
+    return (id(ref),)
+
+
+def plain(ref) -> bool:
+    """`ref` is a variable :func:`put` may store into: a slot with no write rules of its own."""
+    return ref.__class__ is Slot and ref.on_write is None
+
+
+class End:
+    """The end of the task's time slice in one cycle of the period: the written values (their
+    images and copies), the timers, the task's frames as the idle watch images them, the statement
+    it stands at, and the clock reads of the slice (``clock``)."""
+
+    __slots__ = ("pos", "images", "values", "timers", "frames", "at", "clock", "delta")
+
+    def __init__(self, pos, images, values, timers, frames, at, clock) -> None:
+        self.pos = pos
+        self.images = images
+        self.values = values
+        self.timers = timers
+        self.frames = frames
+        self.at = at
+        self.clock = clock
+        self.delta: tuple = ()      # (index in the written set, value) that differ from the end before
+
+
+class Tick:
+    """A boundary of the loop within the period: its position (``pos``: the period's steps
+    counted through it), the written values and timers then, the clock reads from it to the end of
+    its time slice (``clock``), and its key."""
+
+    __slots__ = ("pos", "values", "timers", "clock", "key")
+
+    def __init__(self, pos, values, timers, clock, key) -> None:
+        self.pos = pos
+        self.values = values
+        self.timers = timers
+        self.clock = clock
+        self.key = key
+
+
+class Period:
+    """A recorded periodic spin (module docstring). Like interp/runtime/spin.py ``_Pass``:
+    ``events``, ``infos``, ``at``, ``frames`` per step, ``steps`` (``n``), ``io``, ``motion``,
+    ``cyclic``, ``probes``; and ``written`` (the written set's references), ``timers``,
+    ``consts`` (the unwritten values read: references and images), ``probed_refs`` (the state
+    variables it reads, in its key), ``ends`` (by position), ``starts`` (timers at each cycle's
+    first step, by step index), ``ticks`` (by position), ``keys`` (tick key -> Tick), ``bound`` and
+    ``frame`` (the loop), ``images`` (None: the frames are the ends')."""
+
+    periodic = True
+    still = False       # no cycle's end puts anything: the state stands (SpinWatch._period_found)
+
+    def __init__(self, events, infos, at, frames) -> None:
+        self.events = events
+        self.infos = infos
+        self.at = at
+        self.frames = frames
+        self.images = None
+        self.io = self.motion = self.cyclic = False
+        self.probes: tuple = ()
+        self.refs = None
+        self.written: tuple = ()
+        self.timers: tuple = ()
+        self.consts: tuple = ()
+        self.touched: frozenset = frozenset()   # where what it reads or writes is (place_of)
+        self.probed_refs: tuple = ()
+        self.ends: dict = {}
+        self.starts: dict = {}
+        self.ticks: list = []
+        self.keys: dict = {}
+        self.bound = None
+        self.frame = None
+
+    @property
+    def steps(self) -> int:
+        return len(self.events)
+
+    def end_at(self, pos: int) -> End:
+        return self.ends[pos % len(self.events)]
+
+    def tick_before(self, pos: int) -> Tick:
+        """The last boundary at or before position `pos` (0 <= pos < n)."""
+        best = self.ticks[0]
+        for t in self.ticks:
+            if t.pos <= pos:
+                best = t
+            else:
+                break
+        return best
+
+    def timers_at(self, index: int):
+        """The timers at step `index` when a cycle starts there (None: it does not)."""
+        return self.starts.get(index)
+
+    def consts_hold(self) -> bool:
+        return all(freeze(r.peek()) == img for r, img in self.consts)
+
+
+class PeriodicSpins:
+    """The periodic part of the spin watch (interp/runtime/spin.py ``SpinWatch``, which this
+    class is a part of: module docstring): recording a period, parking at a boundary of it,
+    putting each cycle's end in place, waking and probing."""
+
+    def _record_period(self, rec, task, info, tick: bool) -> None:
+        """A step of a periodic recording (interp/runtime/period.py): the boundary is a LOOP's
+        iteration; every boundary's key is compared with the earlier ones'."""
+        frame = task.frame
+        depth = frame.depth if frame is not None else 0
+        if len(task.contexts) != rec.contexts or any(i.pending for i in task.irqs.irqs.values()):
+            self._fail("context")
+            return
+        where = (info.file, info.line)
+        nodes = self.statements(info)
+        if rec.phase == 0:
+            if tick and nodes and all(n.__class__ is N.Loop for n in nodes):
+                rec.bound, rec.frame, rec.depth, rec.phase = where, frame, depth, 1
+                rec.world = self._period_world(task)
+                self._period_step(rec, info, frame, tick, depth)
+                self._period_tick(rec, task)
+                return
+            if not tick:
+                rec.last_at = info
+            rec.looked += 1
+            if rec.looked > MAX_PASS_STEPS:
+                self._fail("looking")
+            return
+        if not tick:
+            if nodes is None or not all(isinstance(n, ALLOWED) for n in nodes):
+                self._fail("statement")
+                return
+            rec.last_at = info
+        for n in nodes or ():
+            if id(n) not in rec.nodes:
+                rec.nodes[id(n)] = n
+                named = timers_of(n)
+                if named is not None and not rec.timers.issuperset(named):
+                    rec.timers.update(named)
+                    rec.grew = True
+            if not self._period_names(rec, n, frame, tick):
+                return
+        self._period_step(rec, info, frame, tick, depth)
+        if len(rec.events) > (MAX_PERIOD_CYCLES + 2) * task.budget + MAX_PASS_STEPS:
+            self._fail("long")
+            return
+        if tick and where == rec.bound and frame is rec.frame:
+            self._period_tick(rec, task)
+
+    @staticmethod
+    def _period_step(rec, info, frame, tick: bool, depth: int) -> None:
+        rec.events.append((info.file, info.line, tick, depth - rec.depth))
+        rec.infos.append(info)
+        rec.at.append(rec.last_at)
+        rec.frames.append(frame)
+
+    def _period_names(self, rec, node, frame, tick: bool) -> bool:
+        """Add what statement `node` (run in `frame`) writes and reads that outlives a pass to
+        the recording's sets; False (the recording failed) for a name that cannot be placed."""
+        for ref in self._writes_of(node, frame, rec.depth, tick):
+            if ref is False:
+                self._fail("name")
+                return False
+            k = place_of(ref)
+            if k not in rec.written:
+                rec.written[k] = ref
+                rec.grew = True
+        names = self._reads.get(id(node))
+        if names is None:
+            acc, cond = accesses(node)
+            names = self._reads[id(node)] = tuple(x for mode, x in acc + cond if mode == "r")
+        for name in names:
+            place = getattr(name.ann, "place", None) if name.ann is not None else None
+            if place is not None and place.kind in (SYSTEM, UNRESOLVED):
+                key = place.name.upper()
+                if key in STATE_NAMES:
+                    if key not in rec.probed:
+                        rec.probed[key] = self.rt.sysvars.lookup(key)
+                        rec.grew = True
+                    continue
+                if key in _LIVE:
+                    continue        # computed: the analysis classes it (I/O, motion, clock)
+            ref = self._ref(name, frame, rec.depth)
+            if ref is False:
+                self._fail("name")
+                return False
+            if ref is not None:
+                rec.read[place_of(ref)] = ref
+        return True
+
+    def _writes_of(self, node, frame, base: int, tick: bool):
+        """The references statement `node` (in `frame`) writes that outlive a pass (False for a
+        name that cannot be placed; a loop iteration writes a FOR's counter only)."""
+        if tick and not isinstance(node, N.For):
+            return
+        names = self._targets.get(id(node))
+        if names is None:
+            names = self._targets[id(node)] = written(node)
+        for name in names:
+            ref = self._ref(name, frame, base)
+            if ref is not None:
+                yield ref
+
+    def _foreign(self, rec, task, info, tick: bool) -> None:
+        """Another task's step while a period is recorded: note what it writes (and the timers
+        it names), so that no period is taken across a change it made to what the period
+        reads or writes (:meth:`_period_found`)."""
+        idx = len(rec.events)
+        frame = task.frame
+        for node in self.statements(info) or ():
+            for ref in self._writes_of(node, frame, -1, tick):
+                rec.foreign[place_of(ref) if ref is not False else False] = idx
+            for t in timers_of(node) or ():
+                rec.foreign[("timer", t)] = idx
+
+    def _harmless(self, spin: Period, task, info, tick: bool) -> bool:
+        """Another task's step leaves a parked period as it is: it writes nothing the period
+        reads or writes (``spin.touched``), names none of its timers, writes no I/O and calls no
+        built-in that has an effect (a pure one, a routine of the program: its statements are
+        looked at in their turn). Else the period's task wakes before the step runs."""
+        if not TASK_PROBES.issuperset(spin.probes):
+            return False            # it reads state another task's step may change ($POS_INT, $ERR)
+        nodes = self.statements(info)
+        if nodes is None:
+            return False
+        frame = task.frame
+        kinds = self._foreign_kinds
+        for node in nodes:
+            ok = kinds.get(id(node))
+            if ok is None:
+                ok = kinds[id(node)] = _harmless_kind(node)
+            if not ok:
+                return False
+            for ref in self._writes_of(node, frame, -1, tick):
+                if ref is False or place_of(ref) in spin.touched:
+                    return False
+        return True
+
+    def _period_world(self, task) -> tuple:
+        """What must not change at all while a period runs: the I/O log, the messages, the
+        task's interrupt tables and error text."""
+        rt = self.rt
+        irqs = tuple((n, i.on, i.enabled, i.pending, i.last) for n, i in sorted(task.irqs.irqs.items()))
+        return (len(rt.controller.io.log), rt.msg_handle, len(rt.messages.shown), rt.messages.next_handle,
+                irqs, task.err_text)
+
+    def _period_key(self, written, timers: tuple, probed, task) -> tuple:
+        """The key of `task` at a boundary (interp/runtime/period.py): where in its time slice
+        it is, the written values, the timers, its frames, the state variables it reads, and
+        what must not change."""
+        rt = self.rt
+        return (task.slice_end - rt.steps, tuple([freeze(r.peek()) for r in written]),
+                timers_image(rt.controller.io, timers), tuple([_store(f.store) for f in chain(task.frame)]),
+                tuple([freeze(r.peek()) for r in probed]), self._period_world(task))
+
+    def _period_tick(self, rec, task) -> None:
+        """A boundary of a periodic recording: its key seen before ends the recording."""
+        cycle = self.rt.controller.cycle
+        if cycle == rec.cycle0:
+            return              # (a period starts after a cycle's end: its clock reads are known)
+        if rec.grew:
+            rec.keys, rec.states, rec.grew = {}, set(), False
+        written = tuple(rec.written.values())
+        key = self._period_key(written, tuple(sorted(rec.timers)), tuple(rec.probed.values()), task)
+        if key[5] != rec.world:
+            self._fail("period: I/O, a message or an interrupt")
+            return
+        state = key[1:]
+        if state in rec.states:
+            rec.repeats = True
+        else:
+            rec.states.add(state)
+        if not rec.repeats and cycle - rec.cycle0 > MAX_STATE_CYCLES:
+            self._fail("period: no state repeats")
+            return
+        idx = len(rec.events) - 1
+        seen = rec.keys.get(key)
+        if seen is not None and self._undisturbed(rec, seen):
+            self._period_found(rec, task, seen)
+            return
+        rec.keys[key] = idx
+        rec.ticks.append((idx, tuple([copy_value(r.peek()) for r in written]), key[2], rec.clock, key))
+        if cycle - rec.cycle0 > MAX_PERIOD_CYCLES:
+            self._fail("period: none")
+
+    @staticmethod
+    def _undisturbed(rec, ia: int) -> bool:
+        """No other task wrote what the recorded statements read or write (or a timer they
+        name) since step `ia`."""
+        f = rec.foreign
+        if not f:
+            return True
+        if f.get(False, -1) >= ia:
+            return False            # a write nobody could place
+        return all(f.get(k, -1) < ia for k in rec.read) and all(f.get(k, -1) < ia for k in rec.written) \
+            and all(f.get(("timer", t), -1) < ia for t in rec.timers)
+
+    def _period_end(self, rec, task) -> None:
+        """The tasks of this IPO cycle ran (SpinWatch.before_step): the end of the recorded
+        task's time slice."""
+        written = tuple(rec.written.values())
+        rec.ends.append((len(rec.events), tuple([freeze(r.peek()) for r in written]),
+                         tuple([copy_value(r.peek()) for r in written]),
+                         timers_image(self.rt.controller.io, tuple(sorted(rec.timers))),
+                         tuple([_store(f.store) for f in _frames(task)]), task.at, rec.clock))
+
+    def _period_found(self, rec, task, ia: int) -> None:
+        """The key of boundary `ia` came again at the present boundary: build the Period."""
+        ib = len(rec.events) - 1
+        n = ib - ia
+        budget = task.budget
+        if n <= 0 or n % budget:
+            self._fail("period: steps")
+            return
+        cycles = n // budget
+        spin = Period(tuple(rec.events[ia + 1:ib + 1]), tuple(rec.infos[ia + 1:ib + 1]),
+                      tuple(rec.at[ia + 1:ib + 1]), tuple(rec.frames[ia + 1:ib + 1]))
+        if not self._analyse_into(rec, spin) or not self._period_irqs(task):
+            self._fail("analysis")
+            return
+        written = tuple(rec.written.values())
+        spin.written, spin.timers = written, tuple(sorted(rec.timers))
+        spin.bound, spin.frame = rec.bound, rec.frame
+        # the ends of the time slices: those of the period, and the one before it (clock reads)
+        ends = []
+        prev_clock = None
+        for steps, images, values, timers, frames, at, clock in rec.ends:
+            pos = steps - ia - 1
+            if pos < 0:
+                prev_clock = clock
+            elif pos < n:
+                ends.append(End(pos, images, values, timers, frames, at, clock - prev_clock))
+                prev_clock = clock
+        if len(ends) != cycles or len({e.pos % budget for e in ends}) != 1:
+            self._fail("period: ends")
+            return
+        for j, e in enumerate(ends):
+            before = ends[j - 1]
+            e.delta = tuple((i, v) for i, (v, img, old) in enumerate(zip(e.values, e.images, before.images))
+                            if img != old)
+            spin.ends[e.pos] = e
+        for i, ref in enumerate(written):
+            if not plain(ref) and any(e.images[i] != ends[0].images[i] for e in ends):
+                self._fail("period: writes a system variable")
+                return
+        # nothing to put at any cycle: steady cycles may count it (interp/runtime/scheduler.py)
+        spin.still = all(not e.delta and not e.clock for e in ends) and not spin.timers
+        for idx, timers in rec.starts.items():
+            k = idx - ia - 1
+            if 0 <= k < n:
+                spin.starts[k] = timers
+            elif k == -1:
+                spin.starts[n - 1] = timers     # the first boundary's: the last step's
+        if len(spin.starts) != cycles:
+            self._fail("period: starts")
+            return
+        # the boundaries: their state, and the clock reads from each to the end of its slice
+        # (the reads of that slice less those before the boundary)
+        ticks = []
+        ends_raw = rec.ends
+        for idx, values, timers, clock, key in rec.ticks:
+            pos = idx - ia
+            if not 0 <= pos < n:
+                continue
+            last = max((r for r in ends_raw if r[0] <= idx), key=lambda r: r[0])
+            nxt = spin.end_at(last[0] - ia - 1 + budget)
+            t = Tick(pos, values, timers, nxt.clock - (clock - last[6]), key)
+            ticks.append(t)
+            spin.keys[key] = t
+        ticks.sort(key=lambda t: t.pos)
+        spin.ticks = ticks
+        spin.consts = tuple((r, freeze(r.peek())) for k, r in rec.read.items() if k not in rec.written)
+        spin.touched = frozenset(rec.read) | frozenset(rec.written)
+        spin.probed_refs = tuple(rec.probed.values())
+        self.periods += 1
+        self.known[id(task)] = spin
+        ok = self._may_park(spin) and self.rt.steps + 1 < task.slice_end
+        self._stop(True, ok)
+        if ok:
+            task.park = (spin, 0)
+
+    def _analyse_into(self, rec, spin) -> bool:
+        """The plain analysis (:meth:`_analyse`) on the period's statements, and no clock read
+        but a running timer's (:data:`CLOCK_NAMES`)."""
+        for node in rec.nodes.values():
+            acc, cond = accesses(node)
+            for mode, x in acc + cond:
+                place = getattr(x.ann, "place", None) if mode != "call" and x.ann is not None else None
+                if place is not None and place.kind in (SYSTEM, UNRESOLVED) and place.name.upper() in CLOCK_NAMES:
+                    return False
+                sym = place.symbol if place is not None else None
+                if sym is not None and sym.kind == "signal" and _timer_signal(sym):
+                    return False
+        found = self._analyse(rec)
+        if found is None:
+            return False
+        spin.io, spin.motion, spin.cyclic, spin.probes = found.io, found.motion, found.cyclic, found.probes
+        return True
+
+    @staticmethod
+    def _period_irqs(task) -> bool:
+        """The task's interrupts read nothing a period writes: each one on is over inputs,
+        outputs, constants and the probed state only (interp/runtime/watch.py classes)."""
+        return all(i.watch.split(":")[0] in (CONSTANT, IO) for i in task.irqs.irqs.values() if i.on)
+
+    def _probe(self, rec, task, info, tick: bool) -> None:
+        """After a wake: the task's next boundary parks it again when its key is one of its
+        period's and what the period reads but does not write is unchanged."""
+        spin = rec.probe
+        if len(task.contexts) != rec.contexts:
+            self._fail("probe")
+            return
+        if tick and (info.file, info.line) == spin.bound and task.frame is spin.frame:
+            t = spin.keys.get(self._period_key(spin.written, spin.timers, spin.probed_refs, task))
+            if t is None or not spin.consts_hold() or not self._period_irqs(task):
+                self._fail("probe")
+                return
+            if self._may_park(spin) and self.rt.steps + 1 < task.slice_end:
+                self.probe_parks += 1
+                self._stop(True, True)
+                task.park = (spin, t.pos)
+                return
+        rec.looked += 1
+        if rec.looked > 2 * MAX_PASS_STEPS:
+            self._fail("probe")
+
+    def _put_end(self, p, end, clock: int, whole: bool = False) -> None:
+        """Put the state at the end `end` of a parked period's time slice in place: the written
+        values that differ (`whole`: compared with each; else the end's delta from the end
+        before, which is in place), the timers, `clock` reads of the clock. A value that changed
+        moves the watch keys (interp/runtime/watch.py), as the statements would have."""
+        rt = self.rt
+        spin = p.spin
+        written = spin.written
+        changed = False
+        if whole:
+            for i, ref in enumerate(written):
+                if freeze(ref.peek()) != end.images[i]:
+                    put(ref, end.values[i])
+                    changed = True
+        else:
+            for i, v in end.delta:
+                put(written[i], v)
+                changed = True
+        io = rt.controller.io
+        set_timers(io, spin.timers, end.timers)
+        p.io_version = io.version
+        if clock:
+            rt.scheduler.idle.clock += clock
+        if changed:
+            rt.cyclic_watch.version += 1
+
+    def _wake_period(self, task, p) -> None:
+        rt = self.rt
+        spin = p.spin
+        n = spin.steps
+        target = (p.pos0 + p.done) % n
+        tick = spin.tick_before(target)
+        left = target - tick.pos
+        self.skipped -= left
+        io = rt.controller.io
+        idle = rt.scheduler.idle
+        now, clock = timers_image(io, spin.timers), idle.clock
+        expect = tuple([freeze(r.peek()) for r in spin.written])
+        for ref, v in zip(spin.written, tick.values):
+            if plain(ref):
+                put(ref, v)
+        set_timers(io, spin.timers, tick.timers)
+        first = spin.starts.get((tick.pos - 1) % n)
+        if first is not None:
+            set_timers(io, spin.timers, first)      # the boundary ended a time slice
+        if left:
+            self._catch_up(task, [spin, tick.pos, target], left)
+        set_timers(io, spin.timers, now)
+        idle.clock = clock                          # the reads were counted while it was parked
+        if tuple([freeze(r.peek()) for r in spin.written]) != expect:
+            self.diverged += 1
+            self.why[f"catch-up of a period left another state at step {target}"] = 1
+        self.probes[id(task)] = spin
+
+
+def _timer_signal(sym) -> bool:
+    """`sym` is a SIGNAL over a timer array."""
+    start = getattr(sym.decl, "start", None)
+    return start is not None and getattr(start, "sysvar", "").upper() in TIMER_ARRAYS
+
+
+#: the state variables a parked period may read while another task's steps leave it parked: they
+#: change with a task's end (SpinWatch.ending wakes it first), the operating mode (an operator's
+#: change wakes it) or not at all
+TASK_PROBES = frozenset({"$PRO_STATE", "$PRO_STATE0", "$PRO_STATE1", "$PRO_ACT", "$MODE_OP", "$T1", "$T2",
+                         "$AUT", "$EXT", "$NULLFRAME", "$INTERPRETER"})
+
+#: the statements another task may run beside a parked period without waking it (when they
+#: write nothing it reads or writes: PeriodicSpins._harmless)
+HARMLESS = (N.Assign, N.CallStmt, N.If, N.Switch, N.For, N.While, N.Repeat, N.Loop, N.Exit, N.Goto,
+            N.Label, N.WaitFor, N.Continue, N.Return, N.Motion)
+
+
+def _harmless_kind(node) -> bool:
+    """Statement `node` is of a kind :meth:`PeriodicSpins._harmless` may let run: one of
+    :data:`HARMLESS` that writes no system variable of the I/O image or SIGNAL, names no timer and
+    calls no built-in but a pure one (interp/runtime/passes.py ``PURE_NATIVES``)."""
+    if not isinstance(node, HARMLESS) or timers_of(node) is not None:
+        return False
+    acc, cond = accesses(node)
+    for mode, x in acc + cond:
+        if mode == "call":
+            callee = getattr(x.ann, "callee", None) if x.ann is not None else None
+            if callee is None or callee.kind not in (NATIVE, ROUTINE) or \
+                    (callee.kind == NATIVE and callee.name.upper() not in PURE_NATIVES):
+                return False
+        elif mode == "w":
+            place = getattr(x.ann, "place", None) if x.ann is not None else None
+            if place is None:
+                return False
+            sym = place.symbol
+            if (sym is not None and sym.kind == "signal") or \
+                    (place.kind in (SYSTEM, UNRESOLVED) and place.name.upper() in _LIVE):
+                return False
+    return True
