@@ -164,7 +164,8 @@ def _below(v_of_u: Any, base: Any, u0: float, u1: float) -> bool:
     profile ``base`` on [u0, u1]? Checked on 24 points plus the base's section bounds."""
     if u1 <= u0:
         return True
-    us = list(np.linspace(u0, u1, 26)[1:-1])
+    step = (u1 - u0) / 25          # numpy's linspace(u0, u1, 26)[1:-1], bit for bit, without numpy
+    us = [i * step + u0 for i in range(1, 25)]
     us += [b for b in getattr(base, "bounds", ()) if u0 < b < u1]
     for u in us:
         vb = base.du(base.t_of_u(float(u)))
@@ -344,11 +345,16 @@ def reached_pose(seg: Segment, p: np.ndarray, R: np.ndarray, ref: np.ndarray,
     return T[:3, 3], T[:3, :3]
 
 
+def _close(a: np.ndarray, b: np.ndarray) -> bool:
+    """``np.allclose(a, b)``, at once for the same or equal frames (the motions of a program
+    share their $TOOL and $BASE)."""
+    return a is b or bool((a == b).all()) or bool(np.allclose(a, b))
+
+
 def blend_space(prev: Segment, nxt: Segment) -> str:
     """``"cart"`` when both segments are CP motions (combined in Cartesian space with the
     same $TOOL/$BASE, neither with ``$ORI_TYPE #JOINT``), else ``"joint"``."""
-    if prev.cart and nxt.cart and np.allclose(prev.tool_T, nxt.tool_T) and \
-            np.allclose(prev.base_T, nxt.base_T) and \
+    if prev.cart and nxt.cart and _close(prev.tool_T, nxt.tool_T) and _close(prev.base_T, nxt.base_T) and \
             not getattr(prev, "joint_ori", False) and not getattr(nxt, "joint_ori", False):
         return "cart"
     return "joint"

@@ -37,10 +37,9 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from .errors import RobotError, SoftLimitError, WorkspaceError
-from .frames import frame_to_matrix, inv_pos, matrix_to_frame
+from .frames import frame_to_matrix, inv_pos, matrix_to_frame, rotation_angle_deg, rotvec_of
 from . import kinematics
 from .axismap import AxisMap
 from .external import ExternalAxes
@@ -666,7 +665,7 @@ class CartSegment(Segment):
 
     def __init__(self, req: MotionRequest, q0: np.ndarray, q1: np.ndarray, profile: Trapezoid,
                  v_prog: float, tool_T: np.ndarray, base_T: np.ndarray, model: RobotModel,
-                 pieces: list[_Piece], rots: list[Rotation], weights: list[float],
+                 pieces: list[_Piece], rots: list[np.ndarray], weights: list[float],
                  ori: list[str]) -> None:
         super().__init__(req, q0, q1, profile, v_prog, tool_T, base_T, model)
         #: E1..En at the end of the path (they move linearly in u from q0's)
@@ -683,8 +682,8 @@ class CartSegment(Segment):
         self.lengths = np.array([p.length for p in pieces])
         self.s_bounds = np.concatenate([[0.0], np.cumsum(self.lengths)])
         # orientation of piece k at fraction f: R_k · exp(f · r_k) (= slerp, reference §6.7)
-        self._R = [r.as_matrix() for r in rots]
-        self._rv = [(rots[k].inv() * rots[k + 1]).as_rotvec() for k in range(len(pieces))]
+        self._R = rots
+        self._rv = [rotvec_of(rots[k].T @ rots[k + 1]) for k in range(len(pieces))]
         # a piece without orientation change (a LIN that keeps the start orientation): its
         # R_k · exp(f · 0) once, instead of a product with the identity every cycle
         self._R_still = [self._R[k] @ rotvec_matrix(np.zeros(3)) if float(np.linalg.norm(rv)) < 1e-12
@@ -917,18 +916,16 @@ class CartSegment(Segment):
     def ori_angle_to_end(self, u: float) -> float:
         """Remaining orientation change (deg) from parameter u to the end."""
         R = self.pose_u(u)[1]
-        return float(np.degrees(Rotation.from_matrix(R.T @ self.pose_u(1.0)[1]).magnitude()))
+        return rotation_angle_deg(R, self.pose_u(1.0)[1])
 
     @property
     def ori_angle(self) -> float:
         return self.ori_angle_to_end(0.0)
 
 
-#: Conversions kept by :func:`_frame_of`, :func:`_rotation_of` and :func:`_matrix_of` (each
-#: table cleared when full).
+#: Conversions kept by :func:`_frame_of` and :func:`_matrix_of` (each table cleared when full).
 FRAME_MEMO = 512
 _FRAME_OF: dict[bytes, tuple[float, ...]] = {}
-_ROTATION_OF: dict[bytes, Rotation] = {}
 _MATRIX_OF: dict[bytes, np.ndarray] = {}
 
 
@@ -945,18 +942,9 @@ def _kept(table: dict, key: bytes, make: Callable[[], Any]) -> Any:
 
 def _frame_of(T: np.ndarray) -> tuple[float, ...]:
     """:func:`robot.frames.matrix_to_frame` of T, kept by T's bytes: a program's cycle plans
-    the same points again, and the conversion (scipy's ``Rotation.from_matrix``) costs about
-    0.2 ms. The same tuple as the call."""
+    the same points again. The same tuple as the call."""
     A = np.asarray(T, dtype=float)
     return _kept(_FRAME_OF, A.tobytes() + str(A.shape).encode(), lambda: tuple(matrix_to_frame(A)))
-
-
-def _rotation_of(R: np.ndarray) -> Rotation:
-    """``Rotation.from_matrix(R)`` of a 3x3 rotation, kept by R's bytes (scipy's validation of
-    the matrix costs about 0.15 ms; a program's cycle plans the same orientations again). The
-    same object for the same bytes: scipy's rotations are not changed in place here."""
-    A = np.asarray(R, dtype=float)
-    return _kept(_ROTATION_OF, A.tobytes() + str(A.shape).encode(), lambda: Rotation.from_matrix(A))
 
 
 def _matrix_of(frame: Any) -> np.ndarray:
@@ -1325,7 +1313,7 @@ def _plan_cart(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_T: 
         built[k] = CatmullRomPiece(P0, a, b, P3, m1, m2)
     pieces: list[_Piece] = [pc for pc in built if pc is not None]
 
-    rots: list[Rotation] = [_rotation_of(start_T[:3, :3])]
+    rots: list[np.ndarray] = [start_T[:3, :3].copy()]
     ori: list[str] = []
     thetas: list[float] = []
     speeds: list[tuple[float, float, float, float]] = []
@@ -1337,12 +1325,12 @@ def _plan_cart(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_T: 
             R1 = rots[k]
         elif mode == "PATH":
             assert isinstance(piece, ArcPiece)
-            R1 = Rotation.from_rotvec(piece.n * piece.angle) * rots[k]
+            R1 = rotvec_matrix(piece.n * piece.angle) @ rots[k]
         else:
-            R1 = _rotation_of(pts_T[k + 1][:3, :3])
+            R1 = pts_T[k + 1][:3, :3].copy()
         rots.append(R1)
         ori.append(mode)
-        thetas.append(float(np.degrees((rots[k].inv() * R1).magnitude())))
+        thetas.append(rotation_angle_deg(rots[k], R1))
         speeds.append(_cp_speeds(prm, model.mode))
 
     # parameter u: proportional to max(L_k, θ_k·c) with one scale c (mm/deg) for the block,
