@@ -27,7 +27,7 @@ def replay(program, interp: str) -> TraceWriter:
     settings = NetworkSettings(HERE, eki={"EKIHWINTERFACE": Channel(EXAMPLES / "EkiHwInterface.xml")},
                                replay=RECORDING)
     trace = TraceWriter(keep=True)
-    rt, _ = make_runtime(program, network=settings, trace=trace, max_sim_time=2.4, mujoco=False, interp=interp)
+    rt, _ = make_runtime(program, network=settings, trace=trace, max_sim_time=3.2, mujoco=False, interp=interp)
     rt.run()
     assert rt.controller.network.pacer is None         # a replay is never paced
     assert not rt.controller.network.endpoints         # ... and opens no socket
@@ -44,11 +44,15 @@ def test_tree_equals_vm_on_a_recorded_sequence(shared_corpus):
     arrived = [e for e in events if e["kind"] == "net" and e["dir"] in ("in", "connect")]
     assert [(e["t"], e["dir"], e.get("data")) for e in arrived] == \
         [(e["t"], e["dir"], e.get("data")) for e in recorded]
-    # what the program did with them: the robot reached the second target before the third came
+    # what the program did with them: the robot goes to each target in turn, the third after the
+    # malformed datagram. (Each of the driver's PTPs to the target it holds is an exact stop of
+    # 84-96 ms even when the robot is there: the KR C4's END and restart, issue 60; so the first
+    # target is reached at 1.152 s, after the second came at 0.66 s.)
     poses = [e for e in events if e["kind"] == "pose"]
     at = {round(e["t"], 6): e["axes"] for e in poses}
-    assert np.allclose(at[0.66], [12.5, -75.0, 70.0, 8.0, 25.0, -30.0], atol=1e-6)
-    assert np.allclose(at[1.38], [-10, -95, 100, -5, 40, 10], atol=1e-6)
+    assert np.allclose(at[1.38], [12.5, -75.0, 70.0, 8.0, 25.0, -30.0], atol=1e-6)
+    assert np.allclose(at[2.52], [-10, -95, 100, -5, 40, 10], atol=1e-6)
+    assert np.allclose(at[3.0], [1, -90, 90, 0, 0, 0], atol=1e-6)
     # the malformed datagram is the controller's message EKI01024, not a stop
     msgs = [e for e in events if e["kind"] == "message" and e.get("number") == 1024]
     assert len(msgs) == 1 and msgs[0]["t"] == 1.38
