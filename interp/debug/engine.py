@@ -185,6 +185,10 @@ class Engine:
         self.tree = None
         self._built = None                     # the launch's run, kept for the first run
         self.n = 0                             # statements seen (hook count) in this run
+        # the hook count of the robot program's first statement: the entry stop. The submit
+        # tasks' boot slice runs before it (interp/runtime/scheduler.py), so it need not be 1;
+        # a run replays identically, so it holds for every restart of the launch
+        self.entry_n: int | None = None
         self.sub = 0                           # hook calls inside statement n (cycles, step stops)
         self.target: int | None = None         # replay: stop at this hook count
         self.target_reason = "step"
@@ -773,7 +777,7 @@ class Engine:
             if hit is not None and self.n < self.scan:
                 self.scan_last = self.n
             if self.n >= self.scan - 1:
-                raise Restart(self.scan_last or 1, "breakpoint" if self.scan_last else "entry")
+                raise Restart(self.scan_last or self.entry_n or 1, "breakpoint" if self.scan_last else "entry")
             return
         if self.target is not None:
             if self.n < self.target:
@@ -783,8 +787,10 @@ class Engine:
             return
         self._pump()
         reason, desc = None, None
-        if self.n == 1 and self.config.stop_on_entry:
-            reason = "entry"
+        if self.entry_n is None and task is self.rt.robot:
+            self.entry_n = self.n
+            if self.config.stop_on_entry:
+                reason = "entry"
         elif self.pause_req:
             reason = "pause"
         elif self.stepping is not None and self._step_done(task):
