@@ -313,7 +313,12 @@ class SpinWatch(PeriodicSpins):
             # a pass that changed what it wrote, or the state beside it, may be periodic: the
             # next recording looks for a period; a failed periodic one for a pass again
             key = id(rec.task)
-            if not rec.periodic and (why in ("writes", "second") or why.startswith("wrote ")):
+            # (the submit interpreter's programs only, a .sub run as the program included: the
+            # robot interpreter's loops are no clock generators, and a periodic recording of a
+            # counting loop held every statement's full hook for up to MAX_STATE_CYCLES whole
+            # time slices of the robot program: tests/vm/test_fast_paths.py)
+            if not rec.periodic and not rec.task.limited and \
+                    (why in ("writes", "second") or why.startswith("wrote ")):
                 self.periodic.add(key)
             elif rec.periodic:
                 self.periodic.discard(key)

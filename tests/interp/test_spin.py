@@ -223,7 +223,10 @@ def test_a_pass_that_switches_and_reads_a_settling_cyclic_flag_is_parked(tmp_pat
     assert (20.016, "$OUT[7]", True) in log
     sw = rt.scheduler.spin
     assert sw.parks >= 2 and sw.wakes >= 2
-    assert sw.skipped > 0.9 * res.steps
+    # 0.886 of the steps since the periods (issue 62): the pass's first recording after the wake
+    # at 3 s meets $OUT[4]'s change in its first pass only ("second"), and the next recording
+    # looks for a period, which takes 10 cycles where a pass takes 2 (0.979 before)
+    assert sw.skipped > 0.85 * res.steps
 
 
 @pytest.mark.parametrize("interp", INTERPS)
