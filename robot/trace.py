@@ -14,7 +14,6 @@ gives the same bytes.
 from __future__ import annotations
 
 import json
-import warnings
 from collections import deque
 from collections.abc import Callable, Iterator
 from pathlib import Path
@@ -22,8 +21,7 @@ from typing import IO, Any
 
 import numpy as np
 import orjson
-from .frames import GIMBAL_TOL_DEG, matrix_to_frame
-from scipy.spatial.transform import Rotation
+from .frames import matrix_to_frame
 
 try:  # the compiled pose-line formatter (robot/build.py); absent without a build: Python formats
     from .simcore import pose_line as _pose_line
@@ -600,37 +598,11 @@ class _Pass:
                 w._probe_after = w._spin.every.n + w._probe_gap
 
 
-def _wrap180(v: Any) -> Any:
-    w = -((-np.asarray(v, dtype=float) + 180.0) % 360.0) + 180.0
-    return np.where(np.abs(w) < 1e-12, 0.0, w)
-
-
-#: the last matrix (bytes) of a pose in gimbal lock that _frames_of converted, and its frame
-_GIMBAL_LAST: list[tuple[Any, Any]] = [(None, None)]
-
-
 def _frames_of(Ts: list[Any]) -> list[list[float]]:
-    """Vectorised :func:`robot.frames.matrix_to_frame` for a list of 4x4 matrices."""
-    M = np.asarray(Ts, dtype=float)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", UserWarning)
-        abc = Rotation.from_matrix(M[:, :3, :3]).as_euler("ZYX", degrees=True)
-    a = _wrap180(abc[:, 0])
-    c = _wrap180(abc[:, 2])
-    out = []
-    for i, (p, ai, b, ci) in enumerate(zip(M[:, :3, 3].tolist(), a.tolist(), abc[:, 1].tolist(), c.tolist())):
-        if abs(abs(b) - 90.0) < GIMBAL_TOL_DEG:
-            # one by one (a robot at rest in gimbal lock, e.g. at HOME, repeats its matrix:
-            # the last answer is kept)
-            key = M[i].tobytes()
-            last_key, frame = _GIMBAL_LAST[0]
-            if last_key != key:
-                frame = list(matrix_to_frame(M[i]))
-                _GIMBAL_LAST[0] = (key, frame)
-            out.append(list(frame))
-        else:
-            out.append([p[0], p[1], p[2], ai, b, ci])
-    return out
+    """X, Y, Z, A, B, C of each 4x4 matrix of `Ts`: :func:`robot.frames.matrix_to_frame`, the one
+    conversion (its closed form costs what scipy's batch did: 0.71 against 0.63 ms per 512
+    poses, 2026-11-26; the batch differed from it in the last bit, 19.99999999999999 for 20)."""
+    return [list(matrix_to_frame(T)) for T in Ts]
 
 
 def read_trace(source: str | Path | IO[str]) -> Iterator[dict[str, Any]]:
