@@ -12,6 +12,7 @@ from __future__ import annotations
 import json
 import subprocess
 import sys
+import time
 
 import pytest
 
@@ -91,6 +92,11 @@ def test_step_backward_to_previous_point(kr120):
     page.click("#backward")
     page.wait_for_function(f"() => {{ const a = window.pendant.renderedAxes(); const w = {json.dumps(at_first)};"
                            f" return a && a.every((v, i) => Math.abs(v - w[i]) <= {TOL_DEG}); }}")
+    # the drawing may reach the point before the backward step's stop is in the trace (under
+    # load it was not yet, once: "no backward step"): the trace is read until it is, 60 s at most
+    deadline = time.monotonic() + 60.0
+    while not [e for e in step_stops(page) if e["mode"] == "BSTEP"] and time.monotonic() < deadline:
+        time.sleep(0.1)
     back = [e for e in step_stops(page) if e["mode"] == "BSTEP"]
     assert back, "no backward step in the trace"
     assert all(abs(a - b) <= TOL_DEG for a, b in zip(pose_at(read_trace(page.trace_path), back[-1]["t"]), at_first))
