@@ -372,7 +372,7 @@ def cell_init(root: Path, programs: list[Path], whole: bool = False) -> str:
     """The starter cell file for `programs` of the backup `root` (see the module docstring):
     what each program runs; with `whole` (no program asked), every routine of the backup."""
     # costs 0.26 s at start-up (python -X importtime, 2026-11-25)
-    from interp.run import make_runtime  # noqa: PLC0415
+    from interp.run import make_runtime, run_spec  # noqa: PLC0415
     # costs 0.27 s at start-up (python -X importtime, 2026-11-25)
     from robot.machine import load_machine  # noqa: PLC0415
 
@@ -384,7 +384,7 @@ def cell_init(root: Path, programs: list[Path], whole: bool = False) -> str:
             continue        # its module was loaded with an earlier program's files (one backup)
         # the starter reads inputs and moves no robot: the backup's machine data are not read
         # (a robot the model refuses must not stop it; docs/robot.md), the default robot stands in
-        rt, _ = make_runtime(prog, mujoco=False, check=False, robot=load_machine())
+        rt, _ = make_runtime(run_spec(prog, mujoco=False, check=False, robot=load_machine()))
         covered |= {str(Path(m.unit.src.path).resolve()) for m in rt.program.modules if m.unit.src is not None}
         for u in inputs_read(rt, root, None if whole else prog):
             have = found.setdefault(u.name, u)

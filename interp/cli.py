@@ -11,6 +11,7 @@ from pathlib import Path
 
 import click
 
+from interp.spec import INTERP, INTERPS, RUN_MODE, RUN_MODES, RUN_SIM_TIME_S
 from krl.limits import MAX_HALT_CONTINUES
 from krl.project import backup_of
 from krl.terminal import printable
@@ -19,7 +20,7 @@ from robot.trace import TRACE_REPEATS, read_trace
 
 @click.command("run")
 @click.argument("program", type=click.Path(path_type=Path))
-@click.option("--interp", "interp_kind", type=click.Choice(["tree", "vm"]), default="tree",
+@click.option("--interp", "interp_kind", type=click.Choice(list(INTERPS)), default=INTERP,
               show_default=True, help="Interpreter.")
 @click.option("--workspace", type=click.Path(path_type=Path), default=None,
               help="Folder of the program's modules, or a KRC backup .zip (default: the program's folder; a KRC backup is detected).")
@@ -27,7 +28,7 @@ from robot.trace import TRACE_REPEATS, read_trace
               help="A cell file (stimuli, rules, presets: robot/stimuli.py), or `auto`: the automatic cell "
                    "sets the inputs the program starves for (interp/runtime/autocell.py; docs/robot.md).")
 @click.option("--trace", "trace_path", type=click.Path(path_type=Path), default=None, help="Write the JSONL trace here.")
-@click.option("--max-sim-time", type=float, default=600.0, show_default=True, help="Simulated-time limit (s).")
+@click.option("--max-sim-time", type=float, default=RUN_SIM_TIME_S, show_default=True, help="Simulated-time limit (s).")
 @click.option("--max-steps", type=int, default=None,
               help="Limit of the robot program's executed statements and loop iterations (its interrupt "
                    "routines and TRIGGER actions included; a submit program's are not counted). Default: "
@@ -42,8 +43,8 @@ from robot.trace import TRACE_REPEATS, read_trace
                    "$RED_T1; AUT is the unattended virtual controller (docs/robot.md). Default AUT; EXT "
                    "for a cell program (&COMMENT HANDLER on external automatic, or a call of P00 (#INIT_EXT, "
                    "...)), with --inputs auto, or when the --inputs cell file has the autoext preset.")
-@click.option("--run-mode", "run_mode", type=click.Choice(["GO", "MSTEP", "ISTEP", "BSTEP"], case_sensitive=False),
-              default="GO", show_default=True,
+@click.option("--run-mode", "run_mode", type=click.Choice(list(RUN_MODES), case_sensitive=False),
+              default=RUN_MODE, show_default=True,
               help="Program run mode ($PRO_MODE): MSTEP stops after each motion, ISTEP after each "
                    "statement (no advance run, no approximation); BSTEP runs forward as MSTEP, then "
                    "retraces the motions backward (T1/T2 only). Each stop is a step_stop trace event "

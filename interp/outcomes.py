@@ -86,7 +86,7 @@ def run_outcome(path: str, max_sim_time: float | None = None, interp: str = "vm"
     from interp.realprograms import (REPORT_SIM_TIME_S, REPORT_STEPS, _own_machine_data, cause_of,  # noqa: PLC0415
                                      step_limit, submit_of)
     # costs 0.42 s at start-up (python -X importtime, 2026-11-25)
-    from interp.run import make_runtime, robot_for  # noqa: PLC0415
+    from interp.run import make_runtime, robot_for, run_spec  # noqa: PLC0415
     # costs 0.13 s at start-up (python -X importtime, 2026-11-25)
     from interp.runtime.scheduler import SUBMIT_BUDGET  # noqa: PLC0415
     # costs 0.02 s at start-up (python -X importtime, 2026-11-25)
@@ -100,9 +100,9 @@ def run_outcome(path: str, max_sim_time: float | None = None, interp: str = "vm"
         submit = submit_of(p)
         sub = p.suffix.lower() == ".sub"
         steps = step_limit(REPORT_STEPS, limit_s, len(submit) + sub, robot.ipo_cycle_s)
-        rt, _ = make_runtime(p, trace=None, mujoco=False, max_sim_time=limit_s, max_steps=steps, submit=submit,
-                             check=False, inputs="auto", robot=robot, interp=interp, observer=events,
-                             robot_budget=SUBMIT_BUDGET if sub else None)
+        rt, _ = make_runtime(run_spec(p, mujoco=False, max_sim_time=limit_s, max_steps=steps, submit=submit,
+                                               check=False, inputs="auto", robot=robot, interp=interp, observer=events,
+                                      robot_budget=SUBMIT_BUDGET if sub else None))
         res = rt.run()
     except Exception as exc:  # noqa: BLE001 - the simulator's error is an outcome, never the report's end
         return _outcome(path, "internal", f"{type(exc).__name__}: {exc}", None, None, 0.0, events, "")

@@ -61,10 +61,10 @@ def reach_check(program: Path, robot=None, inputs=None) -> ReachReport:
     from robot.frames import frame_to_matrix, inv_pos  # noqa: PLC0415
 
     # costs 0.66 s at start-up (python -X importtime, 2026-11-26: the runtime)
-    from .run import global_value, make_runtime  # noqa: PLC0415
+    from .run import global_value, make_runtime, run_spec  # noqa: PLC0415
     from .scene import module_points  # noqa: PLC0415
 
-    rt, _ = make_runtime(program, inputs=inputs, robot=robot, mujoco=False, check=False)
+    rt, _ = make_runtime(run_spec(program, inputs=inputs, robot=robot, mujoco=False, check=False))
     ctl = rt.controller
     model = ctl.model
     report = ReachReport(ctl.machine.name)

@@ -481,7 +481,7 @@ def run_one(path: Path, max_sim_time: float, max_steps: int, cell: Path | None =
     `auto_sim_time`: the time limit of an ``--inputs auto`` run of a robot program (default
     :data:`AUTO_SIM_TIME_S`; a bounded sweep gives less, ``krl audit --max-sim-time``)."""
     # costs 0.006 s at start-up (python -X importtime, 2026-11-25)
-    from interp.run import cell_of, make_runtime  # noqa: PLC0415
+    from interp.run import cell_of, make_runtime, run_spec  # noqa: PLC0415
 
     t0 = time.time()
     shown = None if auto else cell
@@ -494,9 +494,9 @@ def run_one(path: Path, max_sim_time: float, max_steps: int, cell: Path | None =
         own = _own_machine_data(path, robot.source)
         # --no-check: the report says how each real program runs, also those the checker rejects
         # (an SPS.SUB entry runs at the submit interpreter's pace: scheduler.program_budget)
-        rt, _ = make_runtime(path, trace=None, mujoco=False, max_sim_time=max_sim_time, max_steps=limit,
-                             submit=submit, check=False, inputs=inputs, robot=robot, interp=interp,
-                             observer=events)
+        rt, _ = make_runtime(run_spec(path, mujoco=False, max_sim_time=max_sim_time, max_steps=limit,
+                                      submit=submit, check=False, inputs=inputs, robot=robot, interp=interp,
+                                      observer=events))
         events.request = _request_signal(rt, path)
         res = rt.run()
         stubs = {name: n for name, _what, n in rt.kss.summary()}

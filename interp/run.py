@@ -1,171 +1,152 @@
-"""One run of a KRL program: controller + runtime + interpreter (used by `krl run`, `krl debug`,
-the tests and the real-programs report).
+"""One run of a KRL program built from its description (interp/spec.py :class:`RunSpec`): the
+runtime, its controller and the interpreter (used by `krl run`, `krl debug`, `krl pendant`, the
+audit, the change report, the tests and the real-programs report).
 
 :func:`run_setup` turns ``krl run``'s options (the parameters of the click command in
-interp/cli.py, by name) into a :class:`RunSetup`: the program found (in a backup archive
-too), the submit programs (the backup's SPS.SUB at boot unless ``no_submit``), the robot. Both
-``krl run`` and ``krl debug``'s launch go through it, so they run the same thing;
-:meth:`RunSetup.make_runtime` builds the run (:func:`make_runtime`).
+interp/cli.py, by name) into a :class:`RunSetup`: the RunSpec with the program found (in a
+backup archive too), the submit programs (the backup's SPS.SUB at boot unless ``no_submit``),
+the cell file read and the robot loaded. ``krl run``, ``krl debug``'s launch and the pendant go
+through it, so they run the same thing; :func:`run_spec` builds a RunSpec from keywords (the
+tools' and the tests' front door); :func:`make_runtime` builds the run of a spec, and
+:func:`plan_cell` what of its controller depends on its program.
 """
 
 from __future__ import annotations
 
 import contextlib
-import re
+import copy
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from interp.runtime.core import RunResult, Runtime
+from interp.runtime.autocell import handshake_rules
+from interp.runtime.core import CellPlan, RunResult, RunStart, Runtime
 from interp.runtime.errors import KrlRuntimeError, ResourceError
 from interp.runtime.memory import SignalRef
 from interp.runtime.values import Struct
+from interp.scene import choose_robot, start_axes
+from interp.spec import INTERP, RUN_MODE, RUN_SIM_TIME_S, RunSpec, SpecError
+from interp.tree import TreeInterpreter
+from interp.vm import VM
+from krl.archive import ArchiveError, backup_source, is_archive
 from krl.ast import nodes as N
 from krl.semantics.resolve import UNRESOLVED
 from krl.files import spelled, spelled_within
 from krl.project import backup_of, boot_submit
 from krl.source import is_krl_file
 from krl.terminal import printable
+from net.plc import cell_map
+from robot.axismap import ROBOT_KEYS, AxisMap
+from robot.cellpresets import PGNO_PARAMETERS, PresetError, pgno_rules
+from robot.limits import normalise_mode
+from robot.machine import MachineData, load_machine
+from robot.mada import MachineDataError, load_robot, robot_of_backup
+from robot.planner import RobotModel
+from robot.stimuli import Cell, StimulusError, load_cell, resolve_signals
+from robot.trace import TRACE_REPEATS, TraceWriter
 
 
-def make_runtime(program, *, workspace=None, inputs=None, trace=None, max_sim_time=None,
-                 max_steps=None, submit=None, mujoco: bool = True, controller=None,
-                 robot_budget=None, interp: str = "tree", observer=None,
-                 mode: str | None = None, check: bool = True,
-                 vm_loop: str = "generated", run_mode: str | None = None,
-                 pgno: int | None = None, robot=None, network=None, start: str | None = None,
-                 halt_continues: int = 0, override: int | None = None) -> tuple[Runtime, object]:
-    """Build the runtime and the interpreter (``interp``: tree or vm) for ``program``
-    (not started yet). Its files (krl.project.project_of, with the `submit` programs) are
-    loaded, checked and resolved first; with `check` (``krl run`` without ``--no-check``) a
-    program whose own module the checker rejects does not start (its run ends with that
-    error). `vm_loop`: the VM's dispatch loop, "generated" (interp/vm/loop.py, compiled when
-    built) or "python" (loop.py as plain Python; tests compare the two). `observer` (an :class:`interp.summary.RunObserver`) sees the
-    controller's events on their way to `trace`; it is not used with a given `controller`.
-    `inputs`: the cell file (a path, or the Cell :func:`cell_of` read; read once per run).
-    ``mode``: operating mode T1/T2/AUT/EXT (``$MODE_OP``; default AUT, robot/limits.py);
-    ignored with a given `controller` (it has its own); None: EXT when the cell file (`inputs`)
-    has the ``autoext`` preset, when the program is a cell program (:func:`cell_program`: the
-    controller runs the handler of Automatic External in EXT) or with ``--inputs auto``, else
-    AUT; ``rt.start`` (:class:`RunStart`) says who chose. ``pgno``: the program number the cell's PLC answers
-    in P00's handshake (robot/cellpresets.py; overrides the cell file's ``pgno`` preset).
-    ``run_mode``: ``$PRO_MODE`` at the start (GO, MSTEP, ISTEP, BSTEP; interp/runtime/runmode.py;
-    default GO). ``robot``: the simulated robot (a MachineData or a path for
-    :func:`robot.mada.load_robot`); default :func:`robot_for` (the cell file's ``robot``, else the
-    backup's own robot, else the KR 6 R900). ``inputs``: a cell file, or ``"auto"`` (the
-    automatic cell, interp/runtime/autocell.py: mode EXT unless `mode` says otherwise, P00's
-    program numbers, the solver; the robot starts at ``XHOME`` when the program has one and
-    no `start` is given). ``start``: where the robot stands at the start
-    (:func:`start_axes`: an E6AXIS literal or a point name; default the cell file's
-    ``start:``, else ``XHOME`` for a cell program or with ``--inputs auto`` when the program has
-    one, else ``$AXIS_HOME[1]``). ``halt_continues``: ``--on-halt continue``, the
-    times the operator presses Start again after a HALT (0: a HALT ends the run). ``override``:
-    ``krl run --override``, the program override ``$OV_PRO`` (1..100 %) the operator set before
-    the start (default 100; the program may change it). ``network``: the partners
-    (net.settings.NetworkSettings; default the cell file's ``network:`` key): the run's network
-    hub (net/hub.py) is attached to the controller either way; without partners its EKI
-    channels stay "not connected". Raises
-    :class:`robot.stimuli.StimulusError` for a bad cell file or a preset the backup's
-    ``$config.dat`` does not allow, :class:`robot.stimuli.StartError` for a start position that cannot
-    place the robot."""
-    # costs 0.01 s at start-up (python -X importtime, 2026-11-25)
-    from interp.tree import TreeInterpreter  # noqa: PLC0415
+def make_runtime(spec: RunSpec) -> tuple[Runtime, object]:
+    """Build the run `spec` describes (interp/spec.py), not started: its robot (``spec.robot``,
+    else :func:`robot_for`), its program's files (krl.project.project_of, with the submit
+    programs) loaded, checked and resolved, a complete controller for the cell :func:`plan_cell`
+    derives from the spec and the program, and the interpreter (tree or VM) on each task.
+    Returns ``(runtime, interpreter)``. With ``spec.check`` (``krl run`` without
+    ``--no-check``) a program whose own module the checker rejects does not start (its run
+    ends with that error). Raises :class:`robot.stimuli.StimulusError` for a preset the
+    backup's ``$config.dat`` does not allow, :class:`robot.stimuli.StartError` for a start that
+    cannot place the robot, :class:`net.hub.NetError` when a network partner cannot start,
+    robot.mada.MachineDataError for machine data that cannot make a model."""
+    if spec.robot is None:
+        spec = spec.with_(robot=robot_for(spec.program, spec.workspace, None, "auto" if spec.auto else spec.cell))
+    if spec.observer is not None:
+        # the interpreters trace into the user's trace only: without one the VM keeps its quiet
+        # fast path (Runtime.quiet_limit); the observer sees the controller's events on their way
+        spec.observer.inner = spec.trace
+    rt = Runtime(spec, cell=plan_cell, interpreter=_interpreter)
+    return rt, rt.interpreter
 
+
+def _fresh(items: list) -> list:
+    """A run's own copies of a cell's stimuli or rules: their signals (which the run resolves)
+    and their run state (a rule's pending answers) its own, the cell of the spec untouched."""
+    out = []
+    for x in items:
+        y = copy.copy(x)
+        y.set = dict(x.set)
+        if isinstance(getattr(x, "due", None), list):
+            y.due = list(x.due)
+        out.append(y)
+    return out
+
+
+def _interpreter(rt: Runtime):
+    """The interpreter of the run `rt` (its spec's ``interp``): the tree interpreter or the VM."""
+    spec = rt.spec
+    if spec.interp == "vm":
+        return VM(rt, loop=spec.vm_loop)
+    return TreeInterpreter(rt)
+
+
+def run_spec(program, *, workspace=None, inputs=None, robot=None, submit=(), **options) -> RunSpec:
+    """The RunSpec of a run given as make_runtime's keywords of old (the tests', the tools'):
+    `inputs` a cell file's path, a read Cell or ``"auto"``; `robot` a MachineData or a path
+    (robot/mada.py ``load_robot``); the others RunSpec's fields by name. Reads the cell file
+    once. Raises robot.stimuli.StimulusError, robot.mada.MachineDataError."""
     auto = is_auto(inputs)
-    if auto:
-        inputs = None
-    made, cell = controller is None, None
-    if controller is None:
-        # costs 0.34 s at start-up (python -X importtime, 2026-11-25)
-        from robot.controller import Controller  # noqa: PLC0415
+    cell = None if auto else cell_of(inputs)
+    machine = None
+    if robot is not None:
+        machine = robot if isinstance(robot, MachineData) else load_robot(robot)
+    return RunSpec(Path(program), workspace=Path(workspace) if workspace is not None else None,
+                   submit=tuple(Path(s) for s in submit or ()), cell=cell, auto=auto, robot=machine, **options)
 
-        if observer is not None:
-            observer.inner = trace
-        cell = cell_of(inputs)       # the cell file, read once for the robot and the controller
-        controller = Controller(robot_for(program, workspace, robot, cell),
-                                trace=observer if observer is not None else trace,
-                                stimuli=cell, mujoco=mujoco,
-                                mode_op=mode if mode is not None or not auto else "EX")
-    rt = Runtime(program, workspace=workspace, controller=controller, trace=trace,
-                 max_sim_time=max_sim_time, max_steps=max_steps, robot_budget=robot_budget,
-                 submits=list(submit or ()), check=check)
-    if run_mode is not None:
-        rt.set_run_mode(run_mode)
-    if override is not None:
-        rt.sysvars.store["$OV_PRO"] = int(override)
-    rt.halt_continues = halt_continues
-    main = Path(program).stem
+
+def plan_cell(rt: Runtime) -> CellPlan:
+    """What of the controller of the run `rt` depends on its program (called by the Runtime once
+    its program is loaded, before it builds its controller): the operating mode and who chose
+    it (:func:`_mode_origin`), where the robot starts and why (:func:`start_axes`), the cell's
+    stimuli and rules with the program's SIGNALs resolved (robot/stimuli.py), the PLC's rules
+    of P00's program-number handshake (``--pgno``, the cell's preset, the automatic cell's), the
+    network partners and the PLC's address map (:func:`plc_map`), the bodies the robot is
+    checked against (the spec's geometry, else the cell's). Each run gets its own copy of
+    the cell's stimuli and rules (they keep run state: fired, due)."""
+    spec = rt.spec
+    main = spec.program.stem
+    cell = spec.cell
+    stimuli = _fresh(cell.stimuli) if cell is not None else []
+    rules = _fresh(cell.rules) if cell is not None else []
     cell_why = cell_program(rt)
-    scene = rt.start = RunStart()
-    if made:
-        scene.mode_why = _mode_origin(rt, program, mode, cell, auto, cell_why)
-    scene.mode = rt.mode_op
-    where, scene.why = start, "--start"
-    if where is None and getattr(controller, "start", None) is not None:
-        where, scene.why = controller.start, "the cell file's start:"
-    if where is None and (auto or cell_why) and isinstance(global_value(rt, main, "XHOME"), Struct):
+    mode, mode_why = _mode_origin(spec, cell, cell_why)
+    scene = RunStart(mode=mode, mode_why=mode_why)
+    where, scene.why = spec.start, "--start"
+    if where is None and cell is not None and cell.start is not None:
+        where, scene.why = cell.start, "the cell file's start:"
+    if where is None and (spec.auto or cell_why) and isinstance(global_value(rt, main, "XHOME"), Struct):
         where = "XHOME"             # a cell starts at home, as P00's #CHK_HOME wants it
-        scene.why = (f"the home position: {Path(program).name} is a cell program, and P00 #CHK_HOME wants "
+        scene.why = (f"the home position: {spec.program.name} is a cell program, and P00 #CHK_HOME wants "
                      f"it there; --start to choose another" if cell_why else
                      "the home position: --inputs auto starts a cell there; --start to choose another")
+    axes = None
     if where is not None:
-        # costs 0.003 s at start-up (python -X importtime, 2026-11-25)
-        from interp.scene import start_axes  # noqa: PLC0415
-
-        controller.place(start_axes(controller, lambda name: global_value(rt, main, name), where))
+        axes = start_axes(RobotModel(spec.robot, mode=mode), lambda name: global_value(rt, main, name), where)
         scene.where = where
     else:
         scene.why = ""
-    if observer is not None:
-        # The interpreters trace into the user's trace only: without one the VM keeps its
-        # quiet fast path (Runtime.quiet_limit); the observer needs the controller's events.
-        rt.trace = trace
-    number = pgno if pgno is not None else getattr(controller, "pgno", None)
+    number = spec.pgno if spec.pgno is not None else (cell.pgno if cell is not None else None)
     if number is not None:
-        controller.rules += _pgno_rules(rt, Path(program).stem, number,
-                                        "--pgno" if pgno is not None else "the cell file's pgno preset")
-    if auto:
-        # costs 0.02 s at start-up (python -X importtime, 2026-11-25)
-        from interp.runtime.autocell import handshake_rules  # noqa: PLC0415
-
-        rt.enable_autocell()
-        if number is None:
-            controller.rules += handshake_rules(rt, Path(program).stem, _pgno_parameters(rt, Path(program).stem))
-    if controller.stimuli or controller.rules:
-        # costs 0.01 s at start-up (python -X importtime, 2026-11-25)
-        from robot.stimuli import resolve_signals  # noqa: PLC0415
-
+        rules += _pgno_rules(rt, main, number, "--pgno" if spec.pgno is not None else "the cell file's pgno preset")
+    elif spec.auto:
+        rules += handshake_rules(rt, main, _pgno_parameters(rt, main))
+    if stimuli or rules:
         try:
-            resolve_signals(controller.stimuli, lambda name: signal_of(rt, Path(program).stem, name),
-                            controller.rules)
+            resolve_signals(stimuli, lambda name: signal_of(rt, main, name), rules)
         except ResourceError:
             pass    # a data list past a limit: the program does not start (Runtime.main_routine says why)
-    attach_network(rt, program, workspace, network if network is not None else getattr(controller, "cell_network", None))
-    if interp == "vm":
-        # costs 0.03 s at start-up (python -X importtime, 2026-11-25)
-        from interp.vm import VM  # noqa: PLC0415
-
-        interp = VM(rt, loop=vm_loop)
-    else:
-        interp = TreeInterpreter(rt)
-    rt.add_task("robot", Path(program).stem, lambda: interp.run_program())
-    for sub in submit or ():
-        sp = Path(sub).resolve()
-        rt.add_task("submit", sp.stem, lambda name=sp: interp.run_program(name))
-    return rt, interp
-
-
-@dataclass
-class RunStart:
-    """How a run started (shown in the run summary): the operating mode (``mode``: T1, T2,
-    AUT, EX) and who chose it (``mode_why``; "" for the default AUT), where the robot stood
-    (``where``: an E6AXIS literal or a point name, None for ``$AXIS_HOME[1]``) and why
-    (``why``)."""
-
-    mode: str = "AUT"
-    mode_why: str = ""
-    where: str | None = None
-    why: str = ""
+    network = spec.network if spec.network is not None else (cell.network if cell is not None else None)
+    geometry = spec.geometry if spec.geometry is not None else (cell.geometry if cell is not None else None)
+    return CellPlan(mode_op=mode, start=scene, start_axes=axes, stimuli=stimuli, rules=rules, network=network,
+                    plc_map=lambda: plc_map(rt, main, stimuli, rules), geometry=geometry)
 
 
 def cell_program(rt: Runtime) -> str:
@@ -188,58 +169,21 @@ def cell_program(rt: Runtime) -> str:
     return ""
 
 
-def set_mode_op(rt: Runtime, mode: str) -> None:
-    """Select the operating mode `mode` (T1, T2, AUT, EX) before the run starts: ``$MODE_OP``,
-    the controller's and its robot model's (T1's reduced speeds, robot/limits.py)."""
-    # costs 0.01 s at start-up (python -X importtime, 2026-11-25)
-    from robot.limits import normalise_mode  # noqa: PLC0415
-
-    m = normalise_mode(mode)
-    rt.mode_op = rt.controller.mode_op = rt.controller.model.mode = m
-
-
-def _mode_origin(rt: Runtime, program, mode, cell, auto: bool, cell_why: str) -> str:
-    """Who chose the operating mode of a run whose controller make_runtime built (said in the
-    run summary), selecting Automatic External for a cell program nobody chose a mode for:
-    ``--mode``; the cell file's ``autoext`` preset; the cell program (:func:`cell_program`:
-    the controller runs its handler in Automatic External); ``--inputs auto``; "" for the
-    default AUT."""
-    if mode is not None:
-        return "--mode"
+def _mode_origin(spec: RunSpec, cell, cell_why: str) -> tuple[str, str]:
+    """The operating mode of the run (T1, T2, AUT, EX: robot/limits.py) and who chose it (said
+    in the run summary): ``--mode``; the cell file's ``autoext`` preset; the cell program
+    (:func:`cell_program`: the controller runs its handler in Automatic External); ``--inputs
+    auto``; "" for the default AUT."""
+    if spec.mode is not None:
+        return normalise_mode(spec.mode), "--mode"
     if cell is not None and cell.autoext:
-        return "the cell file's autoext preset"
+        return "EX", "the cell file's autoext preset"
     if cell_why:
-        set_mode_op(rt, "EX")
-        return (f"{Path(program).name} is a cell program ({cell_why}): the controller runs it in "
-                f"Automatic External; --mode to choose another")
-    if auto:
-        return "--inputs auto: the automatic cell is the PLC of Automatic External; --mode to choose another"
-    return ""
-
-
-def attach_network(rt: Runtime, program, workspace, settings) -> None:
-    """The run's network hub (net/hub.py) on `rt`'s controller, with `settings` (None: no
-    partner). Raises net.hub.NetError when a partner's server cannot start."""
-    # costs 0.06 s at start-up (python -X importtime, 2026-11-25)
-    from net.hub import Network  # noqa: PLC0415
-
-    # costs 0.003 s at start-up (python -X importtime, 2026-11-25)
-    from interp.runtime.netvars import RuntimeSink  # noqa: PLC0415
-
-    old = getattr(rt.controller, "network", None)
-    if old is not None:
-        old.close()
-    prog = spelled_within(program, workspace)
-    root = backup_of(prog, spelled(workspace) if workspace else None)
-    net = Network(settings, program=prog, backup=root, sink=RuntimeSink(rt))
-    try:
-        net.attach(rt.controller, plc_map=lambda: plc_map(rt, Path(program).stem))
-    except OSError as exc:
-        net.close()
-        # costs 0.06 s at start-up (python -X importtime, 2026-11-25)
-        from net.hub import NetError  # noqa: PLC0415
-
-        raise NetError(f"a network partner cannot start: {exc.strerror or exc}") from None
+        return "EX", (f"{spec.program.name} is a cell program ({cell_why}): the controller runs it in "
+                      f"Automatic External; --mode to choose another")
+    if spec.auto:
+        return "EX", "--inputs auto: the automatic cell is the PLC of Automatic External; --mode to choose another"
+    return "AUT", ""
 
 
 def is_auto(inputs) -> bool:
@@ -248,27 +192,19 @@ def is_auto(inputs) -> bool:
     return isinstance(inputs, (str, Path)) and str(inputs) == "auto"
 
 
-def plc_map(rt: Runtime, main: str):
-    """The PLC's address map (net/plc.py) derived from the cell: the inputs and outputs its
-    rules, stimuli and program-number handshake (``PGNO_*`` of $config.dat) use, and the
-    SIGNALs of the global declarations on ``$IN``/``$OUT``."""
-    # costs 0.01 s at start-up (python -X importtime, 2026-11-25)
-    from net.plc import derive_map  # noqa: PLC0415
-    # costs 0.007 s at start-up (python -X importtime, 2026-11-25)
-    from robot.cellpresets import PGNO_PARAMETERS  # noqa: PLC0415
-
-    ctl = rt.controller
-    indices: list[int] = []
+def plc_map(rt: Runtime, main: str, stimuli: list, rules: list):
+    """The PLC's address map (net/plc.py ``cell_map``) of the run `rt`'s cell: the inputs and
+    outputs its `stimuli` and `rules` use (their signals as the front end parsed them), the
+    program-number handshake's (``PGNO_*`` of $config.dat), and the SIGNALs of the global
+    declarations on ``$IN``/``$OUT``."""
+    handshake = []
     for name in PGNO_PARAMETERS:
         v = global_value(rt, main, name)
         if isinstance(v, int) and not isinstance(v, bool) and name != "PGNO_TYPE":
-            indices.append(abs(v))
+            handshake.append(abs(v))
     fbit, length = global_value(rt, main, "PGNO_FBIT"), global_value(rt, main, "PGNO_LENGTH")
     if isinstance(fbit, int) and isinstance(length, int):
-        indices.append(abs(fbit) + max(0, min(length, 64)))
-    texts = [str(st.set) for st in ctl.stimuli] + [f"{r.text} {r.set}" for r in ctl.rules]
-    for text in texts:
-        indices += [int(x) for x in re.findall(r"\$(?:IN|OUT)\[(\d{1,4})\]", text)]
+        handshake.append(abs(fbit) + max(0, min(length, 64)))
     signals = {}
     scope = rt.program.ws.global_scope
     for sym in (scope.values.values() if scope is not None else ()):
@@ -278,14 +214,11 @@ def plc_map(rt: Runtime, main: str):
         if found is not None and found[0] in ("$IN", "$OUT"):
             base, a, b = found
             signals[sym.name.upper()] = (base, a, b if b is not None else a)
-    return derive_map(indices, signals)
+    return cell_map(stimuli, rules, handshake, signals)
 
 
 def _pgno_parameters(rt: Runtime, main: str) -> dict:
     """The ``PGNO_*`` parameters the program `main` sees ($config.dat), those with an INT value."""
-    # costs 0.007 s at start-up (python -X importtime, 2026-11-25)
-    from robot.cellpresets import PGNO_PARAMETERS  # noqa: PLC0415
-
     params = {}
     for name in PGNO_PARAMETERS:
         value = global_value(rt, main, name)
@@ -298,11 +231,6 @@ def _pgno_rules(rt: Runtime, main: str, number: int, origin: str = "--pgno") -> 
     """The PLC's rules of P00's program-number handshake answering `number`, with the
     ``PGNO_*`` parameters the program sees ($config.dat). `origin` names where the number came
     from in the error (``--pgno``, the cell file's preset)."""
-    # costs 0.007 s at start-up (python -X importtime, 2026-11-25)
-    from robot.cellpresets import PresetError, pgno_rules  # noqa: PLC0415
-    # costs 0.01 s at start-up (python -X importtime, 2026-11-25)
-    from robot.stimuli import StimulusError  # noqa: PLC0415
-
     try:
         return pgno_rules(_pgno_parameters(rt, main), number)
     except PresetError as exc:
@@ -332,9 +260,6 @@ def cell_of(inputs):
     itself when it is a Cell already, or None. Raises robot.stimuli.StimulusError."""
     if not inputs:
         return None
-    # costs 0.01 s at start-up (python -X importtime, 2026-11-25)
-    from robot.stimuli import Cell, load_cell  # noqa: PLC0415
-
     return inputs if isinstance(inputs, Cell) else load_cell(inputs)
 
 
@@ -346,11 +271,6 @@ def robot_for(program, workspace=None, robot=None, inputs=None):
     root of krl.project.backup_of, its ``R1/Mada/$machine.dat``); else the KR 6 R900 of
     robot/data/kr6_r900.yaml. Raises robot.mada.MachineDataError for machine data that
     cannot make a model (file:line), robot.stimuli.StimulusError for a bad cell file."""
-    # costs 0.49 s at start-up (python -X importtime, 2026-11-25)
-    from robot.machine import MachineData, load_machine  # noqa: PLC0415
-    # costs 0.53 s at start-up (python -X importtime, 2026-11-25)
-    from robot.mada import load_robot  # noqa: PLC0415
-
     if isinstance(robot, MachineData):
         return robot
     if robot is None and inputs and not is_auto(inputs):
@@ -358,28 +278,18 @@ def robot_for(program, workspace=None, robot=None, inputs=None):
     if robot is not None:
         return load_robot(robot)
     root = backup_of(spelled_within(program, workspace), spelled(workspace) if workspace else None)
-    found = _backup_robot(root) if root is not None else None
+    found = robot_of_backup(root) if root is not None else None
     if found is None and is_auto(inputs):
-        # costs 0.003 s at start-up (python -X importtime, 2026-11-25)
-        from interp.scene import choose_robot  # noqa: PLC0415
 
         def probe():
-            rt, _ = make_runtime(program, workspace=workspace, mujoco=False, check=False, robot=load_machine())
+            rt, _ = make_runtime(RunSpec(Path(program), workspace=Path(workspace) if workspace else None,
+                                         mujoco=False, check=False, robot=load_machine()))
             main = Path(program).stem
             return rt, lambda name: global_value(rt, main, name)
         choice = choose_robot(Path(program), probe, workspace)
         if choice is not None:
             return choice.machine
     return found if found is not None else load_machine()
-
-
-def _backup_robot(root: Path):
-    """robot.mada ``robot_of_backup(root)`` (its data lists' parses come from the one store,
-    robot/datalist.py)."""
-    # costs 0.53 s at start-up (python -X importtime, 2026-11-25)
-    from robot.mada import robot_of_backup  # noqa: PLC0415
-
-    return robot_of_backup(root)
 
 
 def signal_of(rt: Runtime, main: str, name: str) -> tuple[str, int, int | None] | None:
@@ -401,8 +311,9 @@ def signal_of(rt: Runtime, main: str, name: str) -> tuple[str, int, int | None] 
     return ref.proxy.name.upper(), ref.a, ref.b
 
 
-def run_program(program, **kw) -> RunResult:
-    rt, _ = make_runtime(program, **kw)
+def run_program(spec: RunSpec) -> RunResult:
+    """Build the run `spec` describes and run it (:func:`make_runtime`)."""
+    rt, _ = make_runtime(spec)
     return rt.run()
 
 
@@ -411,68 +322,55 @@ class RunSetupError(Exception):
     file."""
 
 
-@dataclass
+@dataclass(frozen=True)
 class RunSetup:
-    """What one run of ``krl run`` runs (:func:`run_setup`): ``program`` (the .src file),
-    ``workspace``, ``inputs`` (cell file), ``submit`` (the submit programs beside it),
-    ``booted`` (the backup's SPS.SUB when it was started as at boot, else None), ``machine``
-    (the simulated robot, robot.machine.MachineData), ``options`` (the rest of krl run's
-    options by their click names: interp_kind, max_sim_time, max_steps, mode, run_mode, pgno,
-    no_check, trace_path, trace_repeats, start, halt_continues, override), ``shown`` (a path as the
-    user named it: an archive's temporary folder is shown as the archive), ``cell`` (the cell
-    file `inputs` read once, robot.stimuli.Cell; ``"auto"`` for the automatic cell; None without one)."""
-    program: Path
-    workspace: Path | None
-    inputs: Path | None
-    submit: list
-    booted: Path | None
-    machine: object
-    options: dict
+    """What ``krl run``, ``krl debug``'s launch and ``krl pendant`` run (:func:`run_setup`): the
+    run's :class:`~interp.spec.RunSpec` (``spec``, validated: its program, robot, cell and
+    submit programs found and read), how a path is shown (``shown``: an archive's temporary
+    folder as the archive), and where its trace goes (``trace_path``, ``trace_repeats``)."""
+    spec: RunSpec
     shown: Callable[[str], str] = field(default=lambda text: text)
-    cell: object = None
+    trace_path: Path | None = None
+    trace_repeats: int = TRACE_REPEATS
+
+    @property
+    def program(self) -> Path:
+        return self.spec.program
+
+    @property
+    def workspace(self) -> Path | None:
+        return self.spec.workspace
+
+    @property
+    def booted(self) -> Path | None:
+        return self.spec.booted
+
+    @property
+    def machine(self):
+        return self.spec.robot
 
     @property
     def interp(self) -> str:
-        return self.options.get("interp_kind") or "tree"
-
-    @property
-    def check(self) -> bool:
-        return not self.options.get("no_check")
+        return self.spec.interp
 
     def trace_writer(self):
-        """The run's trace (robot.trace.TraceWriter) at option ``trace_path``, or None: bounded
-        by ``trace_repeats`` (default robot.trace.TRACE_REPEATS; 0 writes every event), headed by
-        the simulated robot and where its data came from. One rule for krl run, krl debug and
-        krl pendant, so their traces of one run are the same bytes."""
-        # costs 0.25 s at start-up (python -X importtime, 2026-11-25)
-        from robot.trace import TRACE_REPEATS, TraceWriter  # noqa: PLC0415
-
-        path = self.options.get("trace_path")
-        if not path:
+        """The run's trace (robot.trace.TraceWriter) at ``trace_path``, or None: bounded by
+        ``trace_repeats`` (0 writes every event), headed by the simulated robot and where its
+        data came from. One rule for krl run, krl debug and krl pendant, so their traces of one
+        run are the same bytes."""
+        if not self.trace_path:
             return None
-        repeats = self.options.get("trace_repeats", TRACE_REPEATS)
-        trace = TraceWriter(path, repeats=repeats or None)
-        m = self.machine
-        # costs 0.004 s at start-up (python -X importtime, 2026-11-26)
-        from robot.axismap import ROBOT_KEYS, AxisMap  # noqa: PLC0415
-
+        trace = TraceWriter(self.trace_path, repeats=self.trace_repeats or None)
+        m = self.spec.robot
         keys = AxisMap.of(m).model_keys
         trace.write("robot", 0.0, name=m.name, source=self.shown(m.source), trafoname=m.trafoname or None,
                     axes=list(keys) if keys != ROBOT_KEYS else None)
         return trace
 
-    def make_runtime(self, trace=None, observer=None, **override) -> tuple:
-        """(Runtime, interpreter) of this run, not started (:func:`make_runtime`); ``override``:
-        keyword arguments of make_runtime that differ (a debugger's step limit)."""
-        o = self.options
-        kw = dict(workspace=self.workspace, inputs=self.cell if self.cell is not None else self.inputs, trace=trace,
-                  max_sim_time=o.get("max_sim_time", 600.0), max_steps=o.get("max_steps"),
-                  submit=[str(s) for s in self.submit], interp=self.interp, observer=observer,
-                  mode=o.get("mode"), check=self.check, run_mode=str(o.get("run_mode") or "GO").upper(),
-                  pgno=o.get("pgno"), robot=self.machine, start=o.get("start"),
-                  halt_continues=o.get("halt_continues", 0), override=o.get("override"))
-        kw.update(override)
-        return make_runtime(self.program, **kw)
+    def make_runtime(self, trace=None, observer=None, **changes) -> tuple:
+        """(Runtime, interpreter) of this run, not started (:func:`make_runtime`); ``changes``:
+        fields of its spec that differ (a debugger's own step limit)."""
+        return make_runtime(self.spec.with_(trace=trace, observer=observer, **changes))
 
 
 def program_in(folder: Path, program: Path) -> Path | None:
@@ -499,8 +397,6 @@ def run_setup(options: dict) -> Iterator[RunSetup]:
     named by its path or module name in it. Without ``submit`` and ``no_submit``, the backup's
     SPS.SUB runs beside the program, as the controller starts it at boot (krl.project
     ``boot_submit``). Raises :class:`RunSetupError`."""
-    # costs 0.01 s at start-up (python -X importtime, 2026-11-25)
-    from krl.archive import ArchiveError, backup_source, is_archive  # noqa: PLC0415
     program = Path(options["program"])
     workspace = Path(options["workspace"]) if options.get("workspace") is not None else None
     if is_archive(program):
@@ -521,11 +417,9 @@ def run_setup(options: dict) -> Iterator[RunSetup]:
 
 
 def _setup(program: Path, workspace, options: dict, shown=lambda text: text) -> RunSetup:
-    # costs 0.53 s at start-up (python -X importtime, 2026-11-25)
-    from robot.mada import MachineDataError  # noqa: PLC0415
-    # costs 0.01 s at start-up (python -X importtime, 2026-11-25)
-    from robot.stimuli import StimulusError  # noqa: PLC0415
-
+    """The RunSetup of krl run's `options` (their click names) for `program` in `workspace`:
+    every file named found, the cell file read, the robot loaded, the spec made and checked
+    once (interp/spec.py). Raises RunSetupError."""
     if not program.exists():
         # a FIFO, socket or device exists: the reader (krl.source) refuses it with its reason
         raise RunSetupError(f"{shown(printable(program))}: no such file")
@@ -540,11 +434,17 @@ def _setup(program: Path, workspace, options: dict, shown=lambda text: text) -> 
     if not submit and not options.get("no_submit"):
         booted = boot_submit(program, workspace)
         submit = [booted] if booted is not None else []
+    auto = is_auto(inputs)
     try:
-        cell = inputs if is_auto(inputs) else cell_of(inputs)   # the cell file, read once for the robot and the run
-        machine = robot_for(program, workspace, options.get("robot"), cell)
-    except (MachineDataError, StimulusError) as exc:
+        cell = None if auto else cell_of(inputs)    # the cell file, read once for the robot and the run
+        machine = robot_for(program, workspace, options.get("robot"), "auto" if auto else cell)
+        spec = RunSpec(program, workspace=workspace, submit=tuple(submit), booted=booted, cell=cell, auto=auto,
+                       robot=machine, max_sim_time=options.get("max_sim_time", RUN_SIM_TIME_S),
+                       max_steps=options.get("max_steps"), mode=options.get("mode"),
+                       run_mode=options.get("run_mode") or RUN_MODE, halt_continues=options.get("halt_continues", 0),
+                       override=options.get("override"),
+                       pgno=options.get("pgno"), start=options.get("start"),
+                       interp=options.get("interp_kind") or INTERP, check=not options.get("no_check"))
+    except (MachineDataError, StimulusError, SpecError) as exc:
         raise RunSetupError(shown(printable(exc))) from None
-    rest = {k: v for k, v in options.items()
-            if k not in ("program", "workspace", "inputs", "submit", "no_submit", "robot")}
-    return RunSetup(program, workspace, inputs, submit, booted, machine, rest, shown, cell)
+    return RunSetup(spec, shown, options.get("trace_path"), options.get("trace_repeats", TRACE_REPEATS))

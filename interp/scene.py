@@ -25,8 +25,9 @@ _CART = ("X", "Y", "Z", "A", "B", "C")
 _AXES = ("A1", "A2", "A3", "A4", "A5", "A6")
 
 
-def start_axes(controller, value_of: Callable[[str], object], text: str) -> np.ndarray:
-    """The axes (KRL's order: A1..A6, E1..Em; deg, mm) the robot starts at for the start position `text`
+def start_axes(model, value_of: Callable[[str], object], text: str) -> np.ndarray:
+    """The axes (KRL's order: A1..A6, E1..Em; deg, mm) the robot of `model` (robot/planner.py
+    RobotModel) starts at for the start position `text`
     (robot/stimuli.py ``parse_start``): an axis literal as given (missing axes, external ones
     included: those of ``$AXIS_HOME[1]``); a point of the program (`value_of(name)`: its data list, then
     ``$config.dat``, e.g. ``XHOME``) that is an AXIS/E6AXIS as it is, a POS/E6POS (TCP in the
@@ -54,7 +55,7 @@ def start_axes(controller, value_of: Callable[[str], object], text: str) -> np.n
             comps[it.name.upper()] = sign * v.value
     # the model's axes (robot/axismap.py): a component the start does not give takes
     # $AXIS_HOME[1]'s; the external axes E1..Em the robot has are the start's too (XHOME's E1)
-    amap = controller.model.axes
+    amap = model.axes
     home = np.array(amap.home, dtype=float)
     ext = {k: comps[k] for k in amap.ext_keys if k in comps}
     if any(k in comps for k in _AXES):
@@ -65,7 +66,7 @@ def start_axes(controller, value_of: Callable[[str], object], text: str) -> np.n
 
         T_world = frame_to_matrix(*(float(comps[k]) for k in _CART))
         try:
-            q = controller.model.ik(T_world, None, None, int(comps["S"]) if "S" in comps else None,
+            q = model.ik(T_world, None, None, int(comps["S"]) if "S" in comps else None,
                                     int(comps["T"]) if "T" in comps else None,
                                     amap.from_components(ext, fill=home))
         except Exception as exc:  # noqa: BLE001 - a robot error names the reason
@@ -73,7 +74,7 @@ def start_axes(controller, value_of: Callable[[str], object], text: str) -> np.n
     else:
         raise StartError(f"start {text}: neither the axes A1..A6 nor X, Y, Z, A, B, C")
     try:
-        controller.model.check_limits(q)
+        model.check_limits(q)
     except Exception as exc:  # noqa: BLE001
         raise StartError(f"start {text}: {getattr(exc, 'message', exc)}") from None
     return amap.to_krl(np.asarray(q, dtype=float))

@@ -132,11 +132,11 @@ class Network:
 
     # ------------------------------------------------------------------ lifecycle
     def attach(self, ctl, **cell) -> None:
-        """Bind to the controller `ctl` and start the servers the settings name (each partner's
-        ``attach``; `cell`: facts of the cell they may need, ``plc_map``). Raises OSError when
-        one cannot start (a port in use)."""
+        """Bind to the controller `ctl` (which holds this hub: robot/controller.py ``Controller``
+        attaches the hub it is built with) and start the servers the settings name (each
+        partner's ``attach``; `cell`: facts of the cell they may need, ``plc_map``). Raises
+        OSError when one cannot start (a port in use)."""
         self.ctl = ctl
-        ctl.network = self
         if getattr(self, "replay_events", None) is not None:
             self.replay = {}
             for t, ev in self.replay_events:

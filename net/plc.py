@@ -1,7 +1,7 @@
 """The PLC side: the controller's I/O image and the Automatic External handshake as a Modbus
 TCP server (pymodbus) and an OPC UA server (asyncua) (docs/network.md "The PLC side").
 
-The address map (:class:`AddressMap`, derived from the cell file by :func:`derive_map`): the
+The address map (:class:`AddressMap`, derived from the cell by :func:`cell_map`): the
 robot's inputs are what the PLC writes, its outputs what the PLC reads.
 
 =====================  ==================  =======================================
@@ -36,6 +36,7 @@ from dataclasses import dataclass, field
 import logging
 from pathlib import Path
 
+from krl.ast import nodes as N
 from krl.limits import MAX_PLC_CLIENTS
 
 from .cellkey import SettingsError, inside, mapping, parse_address
@@ -76,6 +77,37 @@ def derive_map(indices: list[int], signals: dict[str, tuple[str, int, int]] | No
     top = max([64] + [abs(i) for i in indices] + [b for _, _, b in (signals or {}).values()])
     top = min(8192, (top + 63) // 64 * 64)
     return AddressMap(top, N_ANALOG, dict(signals or {}))
+
+
+def cell_map(stimuli: list, rules: list, handshake: list[int],
+             signals: dict[str, tuple[str, int, int]] | None = None) -> AddressMap:
+    """The map of a run's cell (:func:`derive_map`): the digital inputs and outputs its
+    `stimuli` set (robot/stimuli.py Stimulus ``set``: signal keys such as ``$IN[5]``, SIGNALs
+    resolved), its `rules` set and read (robot/cellrules.py Rule ``set`` and the syntax tree of
+    its condition ``when``: every ``$IN[n]``/``$OUT[n]`` with a literal index), the numbers of
+    P00's program-number handshake (`handshake`: the ``PGNO_*`` bits of $config.dat) and the
+    program's `signals` on ``$IN``/``$OUT``."""
+    indices = list(handshake)
+    for item in list(stimuli) + list(rules):
+        for key in item.set:
+            n = _digital(key)
+            if n is not None:
+                indices.append(n)
+    for rule in rules:
+        for e in rule.when.walk():
+            if e.__class__ is N.Index and e.base.__class__ is N.Name and e.base.name.upper() in ("$IN", "$OUT") \
+                    and len(e.indices) == 1 and e.indices[0].__class__ is N.IntLit:
+                indices.append(int(e.indices[0].value))
+    return derive_map(indices, signals)
+
+
+def _digital(key) -> int | None:
+    """n of a signal key ``$IN[n]``/``$OUT[n]`` (robot/io.py's spelling), else None."""
+    k = str(key).upper().replace(" ", "")
+    for base in ("$IN[", "$OUT["):
+        if k.startswith(base) and k.endswith("]") and k[len(base):-1].isdigit():
+            return int(k[len(base):-1])
+    return None
 
 
 def _to_reg(v: float) -> int:

@@ -262,14 +262,13 @@ class Engine:
                             thread=e["thread"])
             if inner_error is not None:
                 inner_error(task, frame, err)
-        rt.error_hook = error_hook
+        rt.set_hooks(stmt=rt.stmt_hook, step=rt.step_hook, error=error_hook, cycle=rt.cycle_hook)
         ctl = rt.controller
         ctl.add_cyclic(self._cycle)
         self._pace0 = None
         self.notes = []
         self.path = []
         self.run_no += 1
-        inner = ctl.message
 
         def message(text, motion_id=None, number=None):
             if number is not None:
@@ -285,8 +284,7 @@ class Engine:
             elif not (text.startswith("KRL message: ") or text.startswith("KRL dialog")):
                 self.notes.append({"time": round(ctl.time, 3), "text": str(text)[:300]})
                 del self.notes[:-MAX_KRL_MESSAGES]
-            inner(text, motion_id, number)
-        ctl.message = message
+        ctl.watch_messages(message)
 
     def _cycle(self, ctl) -> None:
         """Once per IPO cycle (engine thread): publish the live pose, pace to the wall clock."""
@@ -386,8 +384,7 @@ def mode_op(core: RunEngine, value: str) -> str:
     m = normalise_mode(value)
 
     def apply(engine):
-        rt = engine.rt
-        rt.mode_op = rt.controller.mode_op = rt.controller.model.mode = m
+        engine.rt.select_mode(m)
         return value
     return core.edit(f"$MODE_OP = #{value}", apply)
 

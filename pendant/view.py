@@ -221,7 +221,7 @@ def start_position(machine, inputs: str | None = None) -> dict | None:
 
         cell = cell_of(inputs) if inputs and not is_auto(inputs) else None
         ctl = Controller(machine, stimuli=cell, mujoco=False)
-        where = getattr(ctl, "start", None)
+        where = cell.start if cell is not None else None
         if where is not None:
             # costs 0.05 s at start-up (python -X importtime, 2026-11-25)
             from krl.ast import nodes as N  # noqa: PLC0415
@@ -232,7 +232,7 @@ def start_position(machine, inputs: str | None = None) -> dict | None:
                 # costs 0.03 s at start-up (python -X importtime, 2026-11-25)
                 from interp.scene import start_axes  # noqa: PLC0415
 
-                ctl.place(start_axes(ctl, lambda name: None, where))
+                ctl.place(start_axes(ctl.model, lambda name: None, where))
         pos = ctl.pos_act()
     except Exception:  # noqa: BLE001 - a robot the model cannot place shows no start position
         return None

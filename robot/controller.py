@@ -232,24 +232,30 @@ class Controller:
     def __init__(self, machine: MachineData | None = None, *, trace: TraceWriter | None = None,
                  stimuli: list[Stimulus] | Cell | None = None, rules: list[Rule] | None = None,
                  start_axes: Any = None, actuated: bool = False, strict_bco: bool = True,
-                 mujoco: bool = True, mode_op: str | None = None) -> None:
+                 mujoco: bool = True, mode_op: str | None = None, io: IOImage | None = None,
+                 network: Any = None, cell: dict | None = None, geometry: Any = None,
+                 workspaces: Any = None) -> None:
+        """A complete controller (interp/runtime/core.py ``Runtime`` builds its run's with
+        everything it needs; nothing sets its attributes afterwards): the robot `machine`
+        (default the KR 6 R900), the `trace` it writes, the cell's `stimuli` (or a whole Cell:
+        its stimuli, rules and autoext preset) and `rules`, the `start_axes` (KRL's order; None:
+        $AXIS_HOME[1]), the operating mode `mode_op`, the I/O image `io` (default a new one),
+        the network hub `network` (net/hub.py Network: attached here, with the `cell` facts its
+        partners ask for, ``plc_map``), the cell's `geometry` (robot/collision.py CellGeometry:
+        collisions checked at every IPO cycle; a whole Cell's own by default) and the
+        `workspaces` monitor (robot/workspace.py; None: none yet). Raises SoftLimitError for
+        start axes outside the software limits, OSError when a network partner cannot start."""
         self.machine = machine if machine is not None else load_machine()
         self.rules: list[Rule] = []
-        geometry = None
         self._rules_seen = None         # what the rules' conditions last saw (cellrules.step_rules)
-        self.pgno: int | None = None      # the cell file's pgno preset (interp/run.py builds its rules)
-        self.start: str | None = None     # the cell file's start: position (interp/run.py places the robot)
-        self.cell_network = None          # the cell file's `network:` settings (interp/run.py attaches them)
         if isinstance(stimuli, (str, Path)):
             raise TypeError("a cell file is read by robot.stimuli.load_cell; pass its Cell")
         if isinstance(stimuli, Cell):
-            cell = stimuli
-            stimuli, self.rules, self.pgno = cell.stimuli, list(cell.rules), cell.pgno
-            self.start = cell.start
-            self.cell_network = cell.network
-            geometry = cell.geometry
-            if cell.autoext and mode_op is None:
+            if stimuli.autoext and mode_op is None:
                 mode_op = "EX"            # Automatic External (robot/cellpresets.py)
+            if geometry is None:
+                geometry = stimuli.geometry
+            stimuli, self.rules = stimuli.stimuli, list(stimuli.rules)
         for st in stimuli or ():
             if st.reached_default:        # `reached: true`: this robot's $IN_POS_CAR
                 st.reached_mm = self.machine.in_pos_car_mm
@@ -258,10 +264,11 @@ class Controller:
         self.dt = float(self.machine.ipo_cycle_s)
         self._dt_ms = int(round(self.dt * 1000))
         self.trace = trace
-        self.advance = int(self.machine.motion_defaults.get("def_advance", 3))
+        self.advance = self.machine.def_advance
         self.strict_bco = strict_bco
         self._bco_done = False
-        self.io = IOImage(on_change=self._on_io)
+        self.io = io if io is not None else IOImage()
+        self.io.on_change = self._on_io
         self.rules += list(rules or [])
         self.stimuli: list[Stimulus] = list(stimuli or [])
         #: the robot's axis count: axis vectors are A1..An, then E1..En (robot/planner.py)
@@ -304,6 +311,7 @@ class Controller:
         self._events: list[Event] = []
         self._pulses: list[tuple[float, int, bool]] = []
         self._cyclic: dict[int, Callable[["Controller"], None]] = {}
+        self._message_watchers: list[Callable] = []
         self._cyclic_next = 1
         self._tool_T = np.eye(4)
         self._base_T = np.eye(4)
@@ -320,15 +328,14 @@ class Controller:
         self._speed_ok = getattr(self._simcore, "speed_ok", None)
         self._ret_q: np.ndarray | None = None
         self._ended = False
-        self.network = None     # net.hub.Network: the partners, polled at each cycle's start
         # a sensor correction superposed on the setpoint (RSI, net/rsi.py): an object with
         # `axes` (A1..A6 deg) and `cart` (X, Y, Z mm, A, B, C deg in $BASE, or in `frame`:
         # "TOOL", "WORLD" when it has one); None: none
         self.correction = None
         self._q_raw = self._q.copy()
         #: KUKA's workspace monitoring (robot/workspace.py ``WorkspaceMonitor``), None while no
-        #: workspace can be active (interp/runtime/sysvars.py installs it)
-        self.workspaces = None
+        #: workspace can be active (interp/runtime/sysvars.py makes it: :meth:`watch_workspaces`)
+        self.workspaces = workspaces
         #: the robot against its cell (robot/collision.py), None without a cell file's geometry
         self.collision = None
         if geometry is not None:
@@ -336,6 +343,19 @@ class Controller:
             from .collision import CollisionChecker  # noqa: PLC0415 - only for a cell with geometry
 
             self.collision = CollisionChecker(self.machine, geometry)
+        self.network = network  # net.hub.Network: the partners, polled at each cycle's start
+        if network is not None:
+            network.attach(self, **(cell or {}))
+
+    def select_mode(self, mode: str) -> None:
+        """The operating mode `mode` (T1, T2, AUT, EX; robot/limits.py) selected between two runs
+        of the program (the pendant): the controller's and its robot model's."""
+        self.mode_op = self.model.mode = normalise_mode(mode)
+
+    def watch_workspaces(self, monitor) -> None:
+        """KUKA's workspace monitoring from now on (robot/workspace.py ``WorkspaceMonitor``): a
+        program that names ``$WORKSPACE``/``$AXWORKSPACE`` while it runs (interp/runtime/sysvars.py)."""
+        self.workspaces = monitor
 
     def _arm_model(self):
         """The MuJoCo arm, compiled now (its first use) and reset to the axes it would have
@@ -859,10 +879,20 @@ class Controller:
 
     # ================================================================= trace helpers
     def message(self, text: str, motion_id: int | None = None, number: int | None = None) -> None:
-        """Log a controller message (event + trace)."""
+        """Log a controller message (event + trace), and tell the watchers (:meth:`watch_messages`)."""
         self._events.append(MessageEvent(self.time, text, motion_id))
         if self.trace is not None:
             self.trace.write("message", self.time, text=text, id=motion_id, number=number)
+        for fn in self._message_watchers:
+            fn(text, motion_id, number)
+
+    def watch_messages(self, fn: Callable[[str, int | None, int | None], None]) -> None:
+        """Call ``fn(text, motion_id, number)`` for each message (the pendant's message window)."""
+        self._message_watchers.append(fn)
+
+    def set_advance(self, n: int) -> None:
+        """``$ADVANCE``: how many motions the advance run may plan ahead of the main run."""
+        self.advance = n
 
     def finish(self, reason: str = "program_end", **fields: Any) -> None:
         """Write the ``end`` trace event (once); ``fields`` add where and why (the

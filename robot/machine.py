@@ -306,6 +306,11 @@ class MachineData:
         return tuple(j.max_jerk_deg_s3 for j in self.joints)
 
     @property
+    def def_advance(self) -> int:
+        """``$ADVANCE`` at boot: the machine data's ``def_advance`` (3 when it gives none)."""
+        return int(self.motion_defaults.get("def_advance", 3))
+
+    @property
     def n_ext(self) -> int:
         """The number of external axes E1..En."""
         return len(self.external_axes)

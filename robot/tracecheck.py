@@ -225,7 +225,11 @@ def random_program(seed: int, machine: Any, trace: Any, cell_path: str | None = 
         elif op == "pulse":
             ctl.pulse(rng.randint(5, 6), True, rng.uniform(0.01, 0.3))
         elif op == "advance":
-            ctl.advance = rng.randint(1, 3)
+            n = rng.randint(1, 3)
+            if hasattr(ctl, "set_advance"):
+                ctl.set_advance(n)
+            else:
+                ctl.advance = n         # a checkout before issue 62 (no set_advance)
         elif op == "steps":
             step(rng.randint(1, 60))
         elif ctl.is_moving() or ctl.queue_length():

@@ -49,7 +49,7 @@ def test_only_the_collector_module_pauses_or_freezes_the_collector():
 _CHILD = r"""
 import gc, json, sys
 from krl import collector
-from interp.run import make_runtime
+from interp.run import make_runtime, run_spec
 
 def counted():
     gc.collect()
@@ -64,7 +64,7 @@ def refuse():
     raise AssertionError("gc.get_freeze_count() called during the run")
 gc.get_freeze_count = refuse
 seen = []
-rt, _ = make_runtime(sys.argv[1], mujoco=False, check=False, max_steps=1000, max_sim_time=1.0)
+rt, _ = make_runtime(run_spec(sys.argv[1], mujoco=False, check=False, max_steps=1000, max_sim_time=1.0))
 sched_run = rt.scheduler.run
 def probe():
     seen.append(real())

@@ -122,9 +122,13 @@ def record(checkout: Path, out: Path, interps: list[str], limit: int = 0, corpus
     # (optional for `compare` and the driver, which would pay its 0.3 s for nothing)
     from interp.realprograms import cell_of, entries_of, find_backups, report_run  # noqa: PLC0415
     from interp.run import make_runtime  # noqa: PLC0415
-    from interp.runtime.scheduler import SUBMIT_BUDGET  # noqa: PLC0415
-    from robot.trace import TraceWriter  # noqa: PLC0415
-    import interp  # noqa: PLC0415
+    try:
+        from interp.run import run_spec  # noqa: PLC0415
+    except ImportError:     # a checkout before the run specification (issue 62): keywords
+        run_spec = None
+    from interp.runtime.scheduler import SUBMIT_BUDGET  # noqa: PLC0415  (once sys.path names the checkout)
+    from robot.trace import TraceWriter  # noqa: PLC0415  (once sys.path names the checkout)
+    import interp  # noqa: PLC0415  (once sys.path names the checkout)
 
     if Path(interp.__file__).resolve().parent.parent != checkout:
         print(f"error: interp comes from {interp.__file__}, not {checkout}", file=sys.stderr)
@@ -148,9 +152,10 @@ def record(checkout: Path, out: Path, interps: list[str], limit: int = 0, corpus
                 cell = cell_of(p, corpus)   # a path: make_runtime and report_run read it (any version)
                 robot, submit, t, steps = report_run(p, cell)
                 tw = TraceWriter(sink)
-                rt, _ = make_runtime(p, trace=tw, mujoco=False, max_sim_time=t, max_steps=steps,
-                                     submit=submit, check=False, inputs=cell, robot=robot, interp=it,
-                                     robot_budget=SUBMIT_BUDGET if p.suffix.lower() == ".sub" else None)
+                kw = dict(trace=tw, mujoco=False, max_sim_time=t, max_steps=steps, submit=submit, check=False,
+                          inputs=cell, robot=robot, interp=it,
+                          robot_budget=SUBMIT_BUDGET if p.suffix.lower() == ".sub" else None)
+                rt, _ = make_runtime(run_spec(p, **kw)) if run_spec is not None else make_runtime(p, **kw)
                 res = rt.run()
                 tw.close()
                 summary["end"] = [res.reason, res.text, res.file and str(res.file).replace(str(checkout), "<ROOT>"),

@@ -37,9 +37,9 @@ def run_krl(interp: str, program: Path = PROGRAM, clock=None):
     time.perf_counter, wall time; time.process_time: this process's CPU time)."""
     clock = clock or time.perf_counter
     # costs 0.44 s at start-up (python -X importtime, 2026-11-25)
-    from interp.run import make_runtime  # noqa: PLC0415
+    from interp.run import make_runtime, run_spec  # noqa: PLC0415
 
-    rt, _ = make_runtime(program, mujoco=False, max_steps=10 ** 9, interp=interp)
+    rt, _ = make_runtime(run_spec(program, mujoco=False, max_steps=10 ** 9, interp=interp))
     t0 = clock()
     res = rt.run()
     dt = clock() - t0

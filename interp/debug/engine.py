@@ -725,10 +725,7 @@ class Engine:
                 rt, _ = self._build()
             self.rt = rt
             self.tree = TreeInterpreter(rt)
-            rt.stmt_hook = self.on_statement
-            rt.step_hook = self.on_step_stop
-            rt.error_hook = self.on_error
-            rt.cycle_hook = self.on_cycle
+            rt.set_hooks(stmt=self.on_statement, step=self.on_step_stop, error=self.on_error, cycle=self.on_cycle)
             if self.on_runtime is not None:
                 self.on_runtime(rt)
             self.n = self.sub = 0

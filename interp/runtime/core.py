@@ -7,8 +7,8 @@ from __future__ import annotations
 
 import random
 import sys
+from dataclasses import dataclass, field
 from pathlib import Path
-from dataclasses import dataclass
 
 from krl import collector
 from krl.ast import nodes as N
@@ -17,10 +17,15 @@ from krl.semantics import expression as X
 from krl.semantics import types as T
 from krl.semantics.advance import StmtInfo
 from krl.semantics.resolve import ROUTINE, Callee, Storage
+from net.hub import NetError, Network
+from robot.controller import Controller
 from robot.errors import RobotError, SoftLimitError, WorkspaceError
+from robot.io import IOImage
 from robot.motion import CondStop, MotionRequest, Trigger
 
+from .autocell import AUTO_DELAY_S, AutoCell
 from .natives import RSI_CONSTANTS, ValueRef
+from .netvars import RuntimeSink
 from .contexts import Context, Irq
 from .watch import (CONSTANT, IO, SETTLES, CyclicWatch, settles, split_watch, stamp_key, steady, timer_due,
                     timer_reads, timer_watch, watch_of)
@@ -119,6 +124,38 @@ def reach_message(ctl, req, err) -> str:
 
 
 
+@dataclass
+class RunStart:
+    """How a run started (shown in the run summary): the operating mode (``mode``: T1, T2,
+    AUT, EX) and who chose it (``mode_why``; "" for the default AUT), where the robot stood
+    (``where``: an E6AXIS literal or a point name, None for ``$AXIS_HOME[1]``) and why
+    (``why``)."""
+
+    mode: str = "AUT"
+    mode_why: str = ""
+    where: str | None = None
+    why: str = ""
+
+
+@dataclass
+class CellPlan:
+    """What of a run's controller depends on its program (interp/run.py ``plan_cell``): the
+    operating mode, how the run started (:class:`RunStart`), the start axes (KRL's order; None:
+    ``$AXIS_HOME[1]``), the cell's stimuli and rules (the run's own, SIGNALs resolved), the
+    network partners (net.settings.NetworkSettings or None), the PLC's address map (a
+    zero-argument callable: net/plc.py) and the bodies the robot is checked against
+    (robot/collision.py CellGeometry or None)."""
+
+    mode_op: str = "AUT"
+    start: RunStart = field(default_factory=RunStart)
+    start_axes: object = None
+    stimuli: list = field(default_factory=list)
+    rules: list = field(default_factory=list)
+    network: object = None
+    plc_map: object = None
+    geometry: object = None
+
+
 def _reader(ref):
     """The zero-argument reader of system variable `ref` that an interrupt's watch key probes
     (interp/runtime/watch.py): a computed variable's getter, else its peek."""
@@ -144,19 +181,24 @@ class Runtime:
                  "modules", "scheduler", "robot", "result", "_plans", "_return_types", "_settling", "_cyclic",
                  "run_mode", "history", "stmt_hook", "step_hook", "error_hook", "cycle_hook",
                  "autocell", "halt_continues", "start", "halts", "state_epoch", "spin", "cyclic_watch",
-                 "restless", "limit_at")
+                 "restless", "limit_at", "spec", "machine", "io", "interpreter", "_early_messages")
 
-    def __init__(self, main_path, *, workspace=None, controller=None, trace=None, stimuli=None,
-                 max_sim_time: float | None = None, max_steps: int | None = None,
-                 mujoco: bool = True, robot_budget: int | None = None, submits: list = (),
-                 check: bool = True) -> None:
-        if controller is None:
-            # costs 0.60 s at start-up (python -X importtime, 2026-11-25)
-            from robot.controller import Controller  # noqa: PLC0415
-
-            controller = Controller(trace=trace, stimuli=stimuli, mujoco=mujoco)
-        self.controller = controller
-        self.trace = trace if trace is not None else controller.trace
+    def __init__(self, spec, *, cell=None, interpreter=None) -> None:
+        """The run `spec` (interp/spec.py RunSpec, its robot given) describes, complete: its
+        program loaded and checked (with the machine data and the I/O image, which the data
+        lists' SIGNALs view), its controller built for the cell that `cell(rt)` derives from the
+        spec and the program (interp/run.py ``plan_cell``: a :class:`CellPlan`; None: no cell),
+        its tasks made with the interpreter `interpreter(rt)` makes (the tree interpreter or the
+        VM; None: none, a test adds its own). Nothing sets its attributes afterwards
+        (tests/interp/test_run_spec.py). Raises net.hub.NetError when a partner cannot start."""
+        self.spec = spec
+        self.machine = spec.robot
+        self.io = IOImage()                 # the controller's I/O image (it takes it whole)
+        self.controller = None
+        #: messages given while the program loads, before the controller exists (a type the
+        #: backup does not declare): the controller logs them once it is built
+        self._early_messages: list[str] = []
+        self.trace = spec.trace
         self.current_task: Task | None = None
         self.random = random.Random(0)
         #: the *state epoch*: bumped by everything that may change a probed system variable
@@ -164,23 +206,23 @@ class Runtime:
         #: end of an interrupt routine of the robot task, the operating mode, a task's end);
         #: an interrupt's poll reads those once per epoch
         self.state_epoch = 0
-        self._mode_op = getattr(controller, "mode_op", "AUT")  # $MODE_OP (robot/limits.py)
+        self._mode_op = "AUT"           # $MODE_OP (robot/limits.py): the controller's, once built
         self.msg_handle = 0
         self.messages = MessageWindow()  # the message window (interp/runtime/messages.py)
         self.noted: set[str] = set()    # simulator notes given once per run (builtins)
         self.steps = 0
-        self.max_steps = max_steps
+        self.max_steps = spec.max_steps
         #: the value of ``steps`` past which the running task has used its step limit
         #: (Scheduler._resume sets it from :meth:`step_limit_left`; NO_LIMIT between resumes)
         self.limit_at = NO_LIMIT
         # the program's time slice: a .sub selected on its own runs at the submit pace
-        self.robot_budget = robot_budget if robot_budget is not None else program_budget(main_path)
+        self.robot_budget = spec.robot_budget if spec.robot_budget is not None else program_budget(spec.program)
         self.sysvars = SysVars(self)
         self.memory = DataMemory()
-        self.program = Program(self, main_path, workspace, submits, check)
+        self.program = Program(self, spec.program, spec.workspace, [str(s) for s in spec.submit], spec.check)
         self.kss = SystemSoftware(self)   # stand-ins for KUKA's software the backup lacks
         self.modules = self.program.modules       # by Storage.owner / Callee.owner
-        self.scheduler = Scheduler(self, max_sim_time, max_steps)
+        self.scheduler = Scheduler(self, spec.max_sim_time, spec.max_steps)
         self.spin = self.scheduler.spin   # parked spins (interp/runtime/spin.py)
         self.cyclic_watch = CyclicWatch(self)   # when a cyclic flag is evaluated again (watch.py)
         self.robot: Task | None = None
@@ -200,10 +242,50 @@ class Runtime:
         self.step_hook = None           # debugger: step_hook(task, mode, text) at a step stop
         self.error_hook = None          # debugger: error_hook(task, frame, err) where an error leaves a routine
         self.cycle_hook = None          # debugger: cycle_hook(task) when a waiting task resumes (pause in a WAIT)
-        self.autocell = None            # krl run --inputs auto (interp/runtime/autocell.py)
-        self.halt_continues = 0         # krl run --on-halt continue: Start pressed again at most so often
-        self.start: str | None = None   # krl run --start / the cell's start: (interp/run.py), as given
+        self.halt_continues = spec.halt_continues   # krl run --on-halt continue: Start pressed again at most so often
         self.halts = 0                  # HALTs continued so far
+        plan = cell(self) if cell is not None else CellPlan()
+        self.start = plan.start         # how the run started (mode, place: interp/run.py)
+        self.controller = self._controller(plan)
+        for text in self._early_messages:
+            self.controller.message(text)
+        self._early_messages = []
+        self._mode_op = self.controller.mode_op
+        self.autocell = None            # krl run --inputs auto (interp/runtime/autocell.py)
+        if spec.auto:
+            self.autocell = AutoCell(self, AUTO_DELAY_S)
+            self.scheduler.idle.auto = self.autocell
+        if spec.run_mode != "GO":
+            self.set_run_mode(spec.run_mode)
+        if spec.override is not None:
+            self.sysvars.store["$OV_PRO"] = int(spec.override)   # krl run --override, set before the start
+        self.interpreter = interpreter(self) if interpreter is not None else None
+        if self.interpreter is not None:
+            run = self.interpreter.run_program
+            self.add_task("robot", spec.program.stem, lambda: run())
+            for sub in spec.submit:
+                sp = Path(sub).resolve()
+                self.add_task("submit", sp.stem, lambda name=sp: run(name))
+
+    def _controller(self, plan: "CellPlan"):
+        """The run's controller (robot/controller.py), complete: the spec's robot, its trace (an
+        observer's, which passes the events on to the trace), MuJoCo or not, on the run's I/O
+        image, with the `plan`'s cell (mode, stimuli, rules, start, geometry), the workspace
+        monitor the program's data lists made active (interp/runtime/sysvars.py) and the network hub
+        (net/hub.py: the plan's partners; without any its EKI channels stay "not connected")."""
+        spec = self.spec
+        prog = self.program
+        net = Network(plan.network, program=prog.main_path,
+                      backup=prog.workspace if prog.backup else None, sink=RuntimeSink(self))
+        try:
+            return Controller(spec.robot, trace=spec.observer if spec.observer is not None else spec.trace,
+                              stimuli=plan.stimuli, rules=plan.rules, start_axes=plan.start_axes,
+                              mujoco=spec.mujoco, mode_op=plan.mode_op, io=self.io, network=net,
+                              cell={"plc_map": plan.plc_map}, geometry=plan.geometry,
+                              workspaces=self.sysvars.workspaces)
+        except OSError as exc:
+            net.close()
+            raise NetError(f"a network partner cannot start: {exc.strerror or exc}") from None
 
     # ================================================================== tasks and run
     def add_task(self, kind: str, name: str, body) -> Task:
@@ -272,16 +354,6 @@ class Runtime:
             self.trace.write("error", self.controller.time, text=f"submit {task.name}: {err.message}",
                              number=err.number, line=err.line, file=err.file)
 
-    def enable_autocell(self, delay: float | None = None):
-        """``--inputs auto``: the automatic cell answers what the program starves for
-        (interp/runtime/autocell.py); returns it."""
-        # costs 0.02 s at start-up (python -X importtime, 2026-11-25)
-        from .autocell import AUTO_DELAY_S, AutoCell  # noqa: PLC0415
-
-        self.autocell = AutoCell(self, AUTO_DELAY_S if delay is None else delay)
-        self.scheduler.idle.auto = self.autocell
-        return self.autocell
-
     def run(self) -> RunResult:
         """Run all tasks to the end; writes the ``end`` trace event; returns the result."""
         for writer in (self.trace, getattr(self.controller, "trace", None)):
@@ -337,10 +409,19 @@ class Runtime:
         """``$MODE_OP``'s name (T1, T2, AUT, EX)."""
         return self._mode_op
 
-    @mode_op.setter
-    def mode_op(self, value: str) -> None:
-        self._mode_op = value
+    def select_mode(self, mode: str) -> None:
+        """The operator selects the operating mode `mode` (T1, T2, AUT, EX) between two runs of
+        the program (the pendant's mode selector): ``$MODE_OP``, the controller's and its robot
+        model's (T1's reduced speeds, robot/limits.py)."""
+        self.controller.select_mode(mode)
+        self._mode_op = self.controller.mode_op
         self.bump_epoch()
+
+    def set_hooks(self, *, stmt=None, step=None, error=None, cycle=None) -> None:
+        """A debugger's hooks (docs/architecture.md "Debugger"): `stmt(task, info)` before every
+        statement, `step(task, mode, text)` at a run mode's stop, `error(task, frame, err)` where
+        a run-time error leaves a routine, `cycle(task)` when a waiting task resumes; None: none."""
+        self.stmt_hook, self.step_hook, self.error_hook, self.cycle_hook = stmt, step, error, cycle
 
     def bump_epoch(self) -> None:
         """A probed system variable may have changed (:attr:`state_epoch`): the running task's
@@ -1149,6 +1230,11 @@ class Runtime:
         self.controller.pulse(n, level, duration, self.io_source())
 
     def message(self, text: str) -> None:
+        """A controller message (its message log and the trace); one given while the program
+        loads waits for the controller (:attr:`_early_messages`)."""
+        if self.controller is None:
+            self._early_messages.append(text)
+            return
         self.controller.message(text)
 
     # ================================================================== cyclic evaluation
@@ -1287,7 +1373,7 @@ class Runtime:
     def _enqueue(self, task: Task, req) -> int:
         ctl = self.controller
         adv = self.sysvars.store.get("$ADVANCE")
-        ctl.advance = int(adv) if isinstance(adv, int) else 3
+        ctl.set_advance(int(adv) if isinstance(adv, int) else 3)
         if not ctl.can_enqueue():
             self._wait(task, ctl.can_enqueue)
             self._proceed()

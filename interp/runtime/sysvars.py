@@ -26,7 +26,7 @@ from pathlib import Path
 from krl.semantics import types as T
 from krl.semantics.builtins import load_builtins
 from krl.semantics.symbols import make_array, system_scopes
-from robot.axismap import E6AXIS_KEYS, EXT_KEYS
+from robot.axismap import E6AXIS_KEYS, EXT_KEYS, AxisMap
 from robot.motion import MotionParams
 
 from .convert import frame_tuple
@@ -96,13 +96,15 @@ class SysVars:
         self.store: dict = {}
         self.refs: dict = {}
         self.declared: dict = {}      # UPPER name -> (data-list reference, Span): declare()
+        #: KUKA's workspace monitoring (robot/workspace.py WorkspaceMonitor) once a workspace can
+        #: be active, else None: the controller is built with it or told of it (watch_workspaces)
+        self.workspaces = None
         self._boot()
 
     # ------------------------------------------------------------------ boot values
     def _boot(self) -> None:
-        ctl = self.rt.controller
-        p = MotionParams.initmov(ctl.machine)
-        m = ctl.machine
+        m = self.rt.machine
+        p = MotionParams.initmov(m)
         boot = {
             "$VEL": {"CP": p.vel_cp, "ORI1": p.vel_ori1, "ORI2": p.vel_ori2},
             "$ACC": {"CP": p.acc_cp, "ORI1": p.acc_ori1, "ORI2": p.acc_ori2},
@@ -130,7 +132,7 @@ class SysVars:
         for key in ("$FLAG", "$CYCFLAG"):
             a = s[key]
             a.data[:] = [False] * len(a.data)
-        s["$ADVANCE"] = int(ctl.advance)
+        s["$ADVANCE"] = m.def_advance
         s["$OV_PRO"] = 100
         s["$ORI_TYPE"] = EnumValue("VAR")
         s["$CIRC_TYPE"] = EnumValue("BASE")
@@ -167,7 +169,7 @@ class SysVars:
         s["$EXT_START"] = False
         s["$CHCK_MOVENA"] = False
         s["$EX_AX_IGNORE"] = 0
-        home = ctl.model.axes.to_krl(m.home_all)
+        home = AxisMap.of(m).to_krl(m.home_all)
         s["$H_POS"] = axis_struct(home)
         for i in range(5):
             s["$AXIS_HOME"].data[i] = axis_struct(home)
@@ -188,7 +190,7 @@ class SysVars:
         MachineData): ``$TRAFONAME`` (when the robot has one), the soft limits of A1..An and of
         E1..Em (at 7..6+m; an endless axis has none),
         ``$ROBROOT``, ``$VEL_MA`` and ``$ACC_MA``. KRL code and the main run see one robot."""
-        m = self.rt.controller.machine
+        m = self.rt.machine
         s = self.store
         name = getattr(m, "trafoname", "")
         if name and "$TRAFONAME" in s and hasattr(s["$TRAFONAME"], "data"):
@@ -218,7 +220,7 @@ class SysVars:
         backup the Mada data list declares its own (the program reads those); a folder without
         one read "value invalid" although its robot has them (OsmanMarangoz's motion_eki.src
         computes its joints' top speed from them, issue 59)."""
-        md = (getattr(self.rt.controller.machine, "raw", None) or {}).get("machine_data_kinematics") or {}
+        md = (getattr(self.rt.machine, "raw", None) or {}).get("machine_data_kinematics") or {}
         rpm, ratios = md.get("vel_axis_ma_rpm") or (), md.get("rat_mot_ax_n_d") or ()
         vel, rat = self.store.get("$VEL_AXIS_MA"), self.store.get("$RAT_MOT_AX")
         for i, x in enumerate(rpm):
@@ -333,7 +335,7 @@ class SysVars:
         return ref
 
     def _workstate(self, name: str) -> bool:
-        mon = self.rt.controller.workspaces
+        mon = self.workspaces
         return bool(mon is not None and mon.signal(name))
 
     def start_workspaces(self) -> None:
@@ -345,8 +347,7 @@ class SysVars:
                 self._workspace_ref(name)
 
     def _watch_workspaces(self) -> None:
-        ctl = self.rt.controller
-        if ctl.workspaces is not None:
+        if self.workspaces is not None:
             return
         # costs 0.002 s at start-up (python -X importtime, 2026-11-26; robot.controller loaded)
         from robot.workspace import WorkspaceMonitor  # noqa: PLC0415
@@ -365,8 +366,11 @@ class SysVars:
                 return
             if isinstance(getattr(st, "f", None), dict) and "STATE" in st.f:
                 st.f["STATE"] = value
-        ctl.workspaces = WorkspaceMonitor(read, ctl.model.axes.model_keys)
-        ctl.workspaces.on_change = state
+        mon = WorkspaceMonitor(read, AxisMap.of(self.rt.machine).model_keys)
+        mon.on_change = state
+        self.workspaces = mon
+        if self.rt.controller is not None:      # a program naming one as it runs; else built with it
+            self.rt.controller.watch_workspaces(mon)
 
     # ------------------------------------------------------------------ helpers for motion
     def value(self, name: str):
@@ -417,8 +421,7 @@ def _where(rt, span) -> str:
 
 def _io(kind: str):
     def make(sv: SysVars, t, name):
-        io = sv.rt.controller.io
-        ctl = sv.rt.controller
+        io = sv.rt.io           # the run's I/O image (the controller's, which may not be built yet)
         if kind == "$IN":
             arr = LiveArray(name, 8192, T.BOOL, io.get_in)
         elif kind == "$OUT":
@@ -427,7 +430,7 @@ def _io(kind: str):
                 # (robot/io.py IOImage.set_out): skip the controller's call for it
                 if i.__class__ is int and 1 <= i <= 8192 and io._out[i] == (1 if v else 0):
                     return
-                ctl.set_out(i, v, sv.rt.io_source())
+                sv.rt.controller.set_out(i, v, sv.rt.io_source())
             arr = LiveArray(name, 8192, T.BOOL, io.get_out, set_out)
         elif kind == "$ANIN":
             arr = LiveArray(name, 32, T.REAL, io.get_anin)
@@ -446,7 +449,7 @@ def _io(kind: str):
 
 def _timer(sv: SysVars, get, i: int):
     """``$TIMER[i]``/``$TIMER_FLAG[i]``: a running timer is the clock (interp/runtime/idle.py)."""
-    io = sv.rt.controller.io
+    io = sv.rt.io
     if 1 <= i < len(io.timer_stop) and not io.timer_stop[i]:
         sv.rt.clock_read()
     return get(i)
@@ -544,7 +547,7 @@ def _machine_const(fn):
     """A read-only value of the simulated robot's machine data (robot/machine.py), constant
     for the run: ``$NUM_AX`` (the robot's axes), ``$EX_AX_NUM`` (its external axes E1..Em)."""
     def value(sv: SysVars):
-        return fn(sv.rt.controller.machine)
+        return fn(sv.rt.machine)
     value.constant = True        # CONSTANT_NAMES
     return value
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import textwrap
 from pathlib import Path
 
-from interp.run import make_runtime
+from interp.run import make_runtime, run_spec
 from robot.trace import TraceWriter
 
 
@@ -48,9 +48,9 @@ def run_krl(tmp: Path, src: str, dat: str | None = None, name: str = "prog", *, 
     if stimuli is not None:
         inputs = write(tmp, "stimuli.yaml", stimuli)
     tw = TraceWriter(keep=True) if trace else None
-    rt, _ = make_runtime(prog, inputs=inputs, trace=tw, max_sim_time=max_sim_time, max_steps=max_steps,
+    rt, _ = make_runtime(run_spec(prog, inputs=inputs, trace=tw, max_sim_time=max_sim_time, max_steps=max_steps,
                          mujoco=False, submit=[tmp / s for s in (submit or [])],
-                         check=False, interp=interp)   # run-time semantics, errors included (krl run --no-check)
+                         check=False, interp=interp))   # run-time semantics, errors included (krl run --no-check)
     if before is not None:
         before(rt)
     res = rt.run()

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from interp.run import make_runtime
+from interp.run import make_runtime, run_spec
 from interp.runtime.program import BASIS_DIR, basis_files
 from krl.project import project_of
 
@@ -46,7 +46,7 @@ def test_bas_initmov_runs_on_a_folder_with_its_own_config(tmp_path, interp):
     does not declare (DEF_VEL_PTP, ...): they come from the BASIS $config.dat. The folder's own
     declaration of a BASIS name (DEF_FLW_PTP = 7) wins, as the first declaration of a system
     data list does: 3 + 7 = 10."""
-    rt, _ = make_runtime(_folder(tmp_path, OWN_CONFIG), mujoco=False, interp=interp)
+    rt, _ = make_runtime(run_spec(_folder(tmp_path, OWN_CONFIG), mujoco=False, interp=interp))
     res = rt.run()
     assert res.reason == "completed", res.text
     assert rt.controller.io.get_out(1) is True

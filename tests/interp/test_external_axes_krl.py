@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pytest
 
-from interp.run import make_runtime
+from interp.run import make_runtime, run_spec
 from robot.mada import load_robot
 from robot.trace import TraceWriter
 from tests.interp.helpers import Run, write
@@ -92,8 +92,8 @@ def _run(tmp_path, machine, interp):
     prog = write(tmp_path, "e1prog.src", SRC)
     write(tmp_path, "e1prog.dat", DAT)
     tw = TraceWriter(keep=True)
-    rt, _ = make_runtime(prog, trace=tw, max_sim_time=60.0, mujoco=False, check=False, interp=interp,
-                         robot=machine, start="XHOME")
+    rt, _ = make_runtime(run_spec(prog, trace=tw, max_sim_time=60.0, mujoco=False, check=False, interp=interp,
+                         robot=machine, start="XHOME"))
     return Run(rt, rt.run(), tw)
 
 
@@ -126,8 +126,8 @@ def test_forward_and_inverse_carry_the_external_axes(tmp_path, e1_mada, interp):
     declares both over E6 types: the external axes pass through the robot's kinematics)."""
     prog = write(tmp_path, "fwd.src", FWD_SRC)
     write(tmp_path, "fwd.dat", FWD_DAT)
-    rt, _ = make_runtime(prog, max_sim_time=10.0, mujoco=False, check=False, interp=interp,
-                         robot=load_robot(e1_mada))
+    rt, _ = make_runtime(run_spec(prog, max_sim_time=10.0, mujoco=False, check=False, interp=interp,
+                         robot=load_robot(e1_mada)))
     run = Run(rt, rt.run(), None)
     assert run.result.reason == "completed", run.result
     assert run.var("fwd", "fwd_e1") == 123.5

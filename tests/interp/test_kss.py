@@ -10,7 +10,7 @@ import pytest
 from click.testing import CliRunner
 
 from interp import realprograms as rp
-from interp.run import make_runtime
+from interp.run import make_runtime, run_spec
 from interp.runtime.kss import SystemSoftware
 from krl.cli import main
 from robot.trace import TraceWriter
@@ -57,7 +57,7 @@ def _backup(tmp: Path, program: str, config: str = "DEFDAT $CONFIG\nENDDAT\n", n
 
 def _run(prog, interp="tree", **kw):
     tw = TraceWriter(keep=True)
-    rt, _ = make_runtime(prog, trace=tw, mujoco=False, check=False, interp=interp, **kw)
+    rt, _ = make_runtime(run_spec(prog, trace=tw, mujoco=False, check=False, interp=interp, **kw))
     res = rt.run()
     return rt, res, tw.events
 

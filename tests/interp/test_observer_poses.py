@@ -10,7 +10,7 @@ import math
 
 import pytest
 
-from interp.run import global_value, make_runtime
+from interp.run import global_value, make_runtime, run_spec
 from interp.summary import RunObserver
 from robot.trace import TraceWriter
 
@@ -49,7 +49,7 @@ def _run(tmp_path, trace, observer):
     src = tmp_path / "poses.src"
     src.write_text(PROGRAM)
     (tmp_path / "poses.dat").write_text(DATA)
-    rt, _ = make_runtime(str(src), trace=trace, observer=observer, mujoco=False, max_sim_time=30.0, interp="vm")
+    rt, _ = make_runtime(run_spec(str(src), trace=trace, observer=observer, mujoco=False, max_sim_time=30.0, interp="vm"))
     res = rt.run()
     return (res, list(rt.controller.io.log), global_value(rt, "poses", "x0"), list(global_value(rt, "poses", "ys").data),
             global_value(rt, "poses", "y_end"))

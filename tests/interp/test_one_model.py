@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 
-from interp.run import make_runtime
+from interp.run import make_runtime, run_spec
 from krl.ast import nodes as N
 from krl.lsp.navigate import definition, resolve
 from krl.lsp.project import Project
@@ -45,7 +45,7 @@ def test_global_routine_in_a_subfolder_is_the_same_for_check_run_and_lsp(tmp_pat
     # krl run: the same routine runs (tree and VM)
     for interp in ("tree", "vm"):
         tw = TraceWriter(keep=True)
-        rt, _ = make_runtime(prog, trace=tw, mujoco=False, interp=interp)
+        rt, _ = make_runtime(run_spec(prog, trace=tw, mujoco=False, interp=interp))
         res = rt.run()
         assert res.reason == "completed", (interp, res)
         calls = [e["name"] for e in tw.events if e["kind"] == "call"]
@@ -80,10 +80,10 @@ def test_an_undeclared_name_is_refused_and_a_run_time_error_with_no_check(tmp_pa
     is the run-time error "unknown name" at its line, identically in both interpreters."""
     p = tmp_path / "bad.src"
     p.write_text("DEF bad()\n  $OUT[1] = TRUE\n  $OUT[2] = nothere\nEND\n")
-    rt, _ = make_runtime(p, mujoco=False, interp=interp)
+    rt, _ = make_runtime(run_spec(p, mujoco=False, interp=interp))
     res = rt.run()
     assert res.reason == "error" and "cannot start" in res.text and "E101" in res.text and res.line == 3
-    rt, _ = make_runtime(p, mujoco=False, interp=interp, check=False)
+    rt, _ = make_runtime(run_spec(p, mujoco=False, interp=interp, check=False))
     res = rt.run()
     assert (res.reason, res.text, res.line) == ("error", "unknown name nothere", 3)
     assert rt.controller.io.get_out(1) and not rt.controller.io.get_out(2)
@@ -109,7 +109,7 @@ def test_an_ext_declaration_links_to_the_module_it_names(tmp_path, interp):
     (tmp_path / "caller.src").write_text(EXT_PROG)
     (tmp_path / "callee.src").write_text(EXT_CALLEE)
     tw = TraceWriter(keep=True)
-    rt, _ = make_runtime(tmp_path / "caller.src", trace=tw, mujoco=False, interp=interp)
+    rt, _ = make_runtime(run_spec(tmp_path / "caller.src", trace=tw, mujoco=False, interp=interp))
     res = rt.run()
     assert res.reason == "completed", res
     assert [e["name"] for e in tw.events if e["kind"] == "call"] == ["caller", "callee"]

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import pytest
 
-from interp.run import make_runtime
+from interp.run import make_runtime, run_spec
 
 from .helpers import write
 
@@ -84,8 +84,8 @@ def _run(tmp_path, prog: str, sub: str, *, interp: str, enabled: bool = True, sh
     p = write(tmp_path, "prog.src", prog)
     write(tmp_path, "prog.dat", DAT)
     s = write(tmp_path, "sps.sub", sub)
-    rt, _ = make_runtime(p, trace=None, max_sim_time=max_sim_time, mujoco=False, submit=[s], check=False,
-                         interp=interp)
+    rt, _ = make_runtime(run_spec(p, trace=None, max_sim_time=max_sim_time, mujoco=False, submit=[s], check=False,
+                         interp=interp))
     rt.scheduler.spin.enabled = enabled
     rt.scheduler.spin.shadow = shadow
     return rt, rt.run()

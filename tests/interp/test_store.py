@@ -25,7 +25,7 @@ import krl.lsp.project as project_mod
 import krl.parsecache as parsecache
 import krl.store as store
 from interp.debug.client import DapClient
-from interp.run import make_runtime
+from interp.run import make_runtime, run_spec
 from krl.lsp.paths import norm
 from krl.lsp.project import Project
 from krl.parsecache import load_files
@@ -67,7 +67,7 @@ def _database(cache: Path) -> Path:
 
 def _trace(program: Path, inputs=None) -> str:
     tw = TraceWriter(keep=True)
-    rt, _ = make_runtime(program, trace=tw, mujoco=False, max_sim_time=60, inputs=inputs, max_steps=2_000_000)
+    rt, _ = make_runtime(run_spec(program, trace=tw, mujoco=False, max_sim_time=60, inputs=inputs, max_steps=2_000_000))
     res = rt.run()
     return res.reason + json.dumps(tw.events, default=str)
 

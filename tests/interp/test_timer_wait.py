@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import pytest
 
-from interp.run import make_runtime
+from interp.run import make_runtime, run_spec
 from interp.runtime import core
 
 from .helpers import write
@@ -31,8 +31,8 @@ END
 def _run(tmp_path, cond: str, interp: str, stimuli: str | None = None, timers: bool = True):
     p = write(tmp_path, "prog.src", WAIT.format(cond=cond))
     inputs = write(tmp_path, "stimuli.yaml", stimuli) if stimuli else None
-    rt, _ = make_runtime(p, inputs=inputs, trace=None, max_sim_time=30.0, max_steps=10**7, mujoco=False,
-                         check=False, interp=interp)
+    rt, _ = make_runtime(run_spec(p, inputs=inputs, trace=None, max_sim_time=30.0, max_steps=10**7, mujoco=False,
+                         check=False, interp=interp))
     resumes = [0]
     sched = rt.scheduler
     resume = sched._resume

@@ -43,7 +43,7 @@ def _trig_times(events):
 # ------------------------------------------------------------------ advance run
 def test_queue_blocks_at_advance():
     ctl, _ = _ctl()
-    ctl.advance = 2
+    ctl.set_advance(2)
     P = MotionParams()
     ctl.enqueue(MotionRequest("PTP", HOME, P))
     assert ctl.can_enqueue()
@@ -60,7 +60,7 @@ def test_queue_blocks_at_advance():
 
 def test_advance_zero_only_when_idle():
     ctl, _ = _ctl()
-    ctl.advance = 0
+    ctl.set_advance(0)
     ctl.enqueue(MotionRequest("PTP", HOME, MotionParams()))
     assert not ctl.can_enqueue()
     ctl.wait_idle()

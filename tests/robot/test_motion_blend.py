@@ -23,7 +23,7 @@ def _run(reqs, wait_between=False, advance=None, **kw):
     tw = TraceWriter(keep=True)
     ctl = Controller(trace=tw, mujoco=False, **kw)
     if advance is not None:
-        ctl.advance = advance
+        ctl.set_advance(advance)
     run_motions(ctl, reqs, wait_between=wait_between)
     return ctl, tw.events
 

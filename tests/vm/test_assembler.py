@@ -8,7 +8,7 @@ from interp.vm.assembler import AsmError, assemble, disassemble, parse_const, fm
 from interp.asm import program_assembly
 from interp.bench import PROGRAM
 from interp.realprograms import DEFAULT_CORPUS, find_backups, programs_of
-from interp.run import make_runtime
+from interp.run import make_runtime, run_spec
 from interp.runtime.values import EnumValue
 from interp.vm.compiler import compile_module
 
@@ -93,7 +93,7 @@ def test_every_routine_of_the_shared_corpus_compiles_and_round_trips():
         progs = programs_of(b)
         if not progs:
             continue
-        rt, _ = make_runtime(progs[0], mujoco=False, interp="vm", check=False)
+        rt, _ = make_runtime(run_spec(progs[0], mujoco=False, interp="vm", check=False))
         for m in rt.program.modules:            # every module of the backup, as loaded
             if m.syntax_errors or not m.routines:
                 continue

@@ -18,7 +18,7 @@ import types
 
 import pytest
 
-from interp.run import make_runtime
+from interp.run import make_runtime, run_spec
 from interp.vm import build
 from interp.vm import vm as V
 
@@ -39,7 +39,7 @@ def test_the_compiled_loop_is_built_and_runs():
     assert build.target().exists(), "the compiled loop is missing: run make vm-loop"
     assert V.COMPILED, "the compiled loop is stale (built from another loop.py): run make vm-loop"
     assert not V._loop.__file__.endswith(".py")
-    rt, vm = make_runtime(PROGRAMS[-1], mujoco=False, interp="vm")
+    rt, vm = make_runtime(run_spec(PROGRAMS[-1], mujoco=False, interp="vm"))
     assert vm.loop is V._loop.run and not inspect.isfunction(vm.loop)     # compiled, not bytecode
 
 

@@ -31,7 +31,7 @@ from click.testing import CliRunner
 
 from interp.asm import asm, program_assembly
 from interp.realprograms import submit_of
-from interp.run import make_runtime
+from interp.run import make_runtime, run_spec
 from interp.runtime.errors import KrlRuntimeError
 from interp.runtime.values import UNSET, Arr, EnumValue, Struct
 from interp.vm import gen_loop, opcodes as OP
@@ -82,8 +82,8 @@ class Outcome:
 def run_one(program: Path, interp: str, traced: bool, *, inputs=None, submit=(), max_steps=2_000_000,
             max_sim_time=30.0, set_vars: dict | None = None) -> Outcome:
     tw = TraceWriter(keep=True) if traced else None
-    rt, _ = make_runtime(program, inputs=inputs, trace=tw, max_sim_time=max_sim_time, max_steps=max_steps,
-                         mujoco=False, submit=list(submit), interp=interp, check=False)
+    rt, _ = make_runtime(run_spec(program, inputs=inputs, trace=tw, max_sim_time=max_sim_time, max_steps=max_steps,
+                         mujoco=False, submit=list(submit), interp=interp, check=False))
     mod = rt.program.module(program.stem)
     for name, value in (set_vars or {}).items():
         mod.data[name.upper()].set(value)
@@ -498,7 +498,7 @@ def test_step_limit_inside_a_loop(sel, max_steps):
 def test_linked_code_uses_the_loop_numbering():
     """The executed form is the listing, instruction for instruction, each opcode in the
     loop's numbering (what `krl asm` prints is what runs)."""
-    rt, vm = make_runtime(VALUES, mujoco=False, interp="vm", check=False)
+    rt, vm = make_runtime(run_spec(VALUES, mujoco=False, interp="vm", check=False))
     rt.run()
     seen = set()
     for code in vm.codes.values():
@@ -524,7 +524,7 @@ def test_error_traceback_points_into_the_loop():
     """A run-time error raised by a slow path inside the loop: its traceback has a frame
     in interp/vm/loop.py on a line of the generated loop, a real source line."""
     path, lo, hi = _loop_lines()
-    rt, _ = make_runtime(ERRORS, mujoco=False, interp="vm", max_steps=10_000, check=False)
+    rt, _ = make_runtime(run_spec(ERRORS, mujoco=False, interp="vm", max_steps=10_000, check=False))
     rt.program.module("fp_errors").data["SEL"].set(6)      # k = big + 1: INT overflow
     res = rt.run()
     assert res.reason == "error"
@@ -578,8 +578,8 @@ def test_quiet_path_is_taken_only_without_a_trace(traced):
     """The sweeps above compare something: untraced, most steps skip the statement hooks
     (one full hook per time slice here); traced, every step takes them."""
     tw = TraceWriter(keep=True) if traced else None
-    rt, vm = make_runtime(MAXSTEPS, trace=tw, mujoco=False, interp="vm", max_steps=20_000, max_sim_time=600.0,
-                          check=False)
+    rt, vm = make_runtime(run_spec(MAXSTEPS, trace=tw, mujoco=False, interp="vm", max_steps=20_000, max_sim_time=600.0,
+                          check=False))
     rt.program.module("fp_maxsteps").data["SEL"].set(2)
     calls = count_hooks(vm)
     res = rt.run()
@@ -809,8 +809,8 @@ def _counted_run(tmp_path, interp: str):
     prog.write_text(CALM_PROG)
     sub = tmp_path / "calm_sps.sub"
     sub.write_text(CALM_SPS)
-    rt, vm = make_runtime(prog, trace=None, mujoco=False, interp=interp, max_sim_time=30.0, check=False,
-                          submit=[sub])
+    rt, vm = make_runtime(run_spec(prog, trace=None, mujoco=False, interp=interp, max_sim_time=30.0, check=False,
+                          submit=[sub]))
     # the submit program is a spin: parked, it would be woken (a task switch, the full hook for
     # the robot program's next statement) by each of the robot program's steps; unparked, the
     # quiet path alone decides

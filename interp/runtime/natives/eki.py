@@ -28,20 +28,9 @@ NOT_SIMULATED = ("not simulated: the run stops with \"routine NAME not found\" (
 
 
 def network(rt):
-    """The run's network hub; a run built without one gets a hub with no partner ("not
-    connected": no socket, deterministic)."""
-    ctl = rt.controller
-    net = getattr(ctl, "network", None)
-    if net is None:
-        # costs 0.25 s at start-up (python -X importtime, 2026-11-25)
-        from net.hub import Network  # noqa: PLC0415
-
-        # costs 0.008 s at start-up (python -X importtime, 2026-11-25)
-        from ..netvars import RuntimeSink  # noqa: PLC0415
-
-        net = Network(program=rt.program.main_path, sink=RuntimeSink(rt))
-        net.attach(ctl)
-    return net
+    """The run's network hub (every run's controller has one: interp/runtime/core.py
+    ``Runtime._controller``; without partners its channels stay "not connected")."""
+    return rt.controller.network
 
 
 def _eki(rt):
