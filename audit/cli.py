@@ -1,4 +1,4 @@
-"""`krl audit FOLDER...` (registered by krl/cli/__init__.py): every KRC backup and program folder
+"""`krl audit FOLDER...` (registered by app/__init__.py): every KRC backup and program folder
 of the folders checked and run, one HTML and JSON report (docs/audit.md)."""
 
 from __future__ import annotations

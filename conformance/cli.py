@@ -32,7 +32,7 @@ def conformance(out: Path, fuzz_n: int, no_real: bool, corpus: Path | None, real
 
     Exit code 0 when every case that is not marked pending passes and the interpreters agree,
     1 otherwise."""
-    # this module loads with every `krl` command (krl/cli's subcommand table): the suites'
+    # this module loads with every `krl` command (app's subcommand table): the suites'
     # modules cost 0.04 s and krl.cluster 0.01 s CPU on top of `krl --help`'s 0.15 s (2026-11-24)
     from conformance.report import DEFAULT_CORPUS, run_all  # noqa: PLC0415
     from krl.cluster import SchedulerError  # noqa: PLC0415

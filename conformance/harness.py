@@ -313,7 +313,7 @@ def run_program(program: Path, interp: str, *, stimuli: Path | None = None,
         crash = None
         if subprocess_mode:
             try:
-                p = subprocess.run([sys.executable, "-m", "krl.cli", "run", *args], cwd=REPO,
+                p = subprocess.run([sys.executable, "-m", "app", "run", *args], cwd=REPO,
                                    capture_output=True, text=True, timeout=wall_timeout)
                 code, output = p.returncode, (p.stdout + p.stderr)[-4000:]
             except subprocess.TimeoutExpired:

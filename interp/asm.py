@@ -17,7 +17,7 @@ def program_assembly(program: Path, workspace: Path | None = None, all_modules: 
     program that has routines): the listings the VM links and runs, compiled from the
     checked, resolved program (krl/project.py, krl/semantics/resolve.py) with no runtime."""
     # on use: the runtime and the compiler cost 0.72 s (python -X importtime, 2026-11-23, load
-    # average 22 on the 2 cores) of every krl command's start-up (krl.cli imports interp.cli, which
+    # average 22 on the 2 cores) of every krl command's start-up (app imports interp.cli, which
     # registers `asm`)
     from interp.runtime.program import basis_files, checked_workspace  # noqa: PLC0415
     from interp.vm.compiler import compile_module  # noqa: PLC0415

@@ -43,7 +43,7 @@ def pendant_server(target: Path, *args: str, root: Path = ROOT,
     server once full; ``stderr``: that file, to read it, else a temporary one); the last of it
     is printed when the body fails and is in the error raised (``PendantClientError``) when the
     first line is not the URL."""
-    cmd = [sys.executable, "-m", "krl.cli", "pendant", str(target), "--no-browser", *args]
+    cmd = [sys.executable, "-m", "app", "pendant", str(target), "--no-browser", *args]
     with (open(stderr, "w+") if stderr is not None else tempfile.TemporaryFile("w+")) as err:
         proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=err, text=True, cwd=root,
                                 env={**os.environ, "PYTHONUNBUFFERED": "1"})

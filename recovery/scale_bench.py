@@ -66,7 +66,7 @@ def measure(argv: list[str], interval: float = 0.05) -> dict:
 
 def scale(corpus: Path, copies: int = 16) -> dict:
     """The figures of one copy and of `copies` copies of `corpus` (see the module docstring)."""
-    krl = [sys.executable, "-m", "krl.cli", "recover"]
+    krl = [sys.executable, "-m", "app", "recover"]
     with tempfile.TemporaryDirectory(prefix="krl-scale-") as tmp:
         one, many = Path(tmp) / "one", Path(tmp) / "many"
         _link_tree(corpus, one / "c01")

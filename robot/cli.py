@@ -1,5 +1,5 @@
 """``krl plot``, ``krl robot show|export`` and ``krl trace show|compare``: the robot package's
-subcommands (registered by krl/cli/__init__.py)."""
+subcommands (registered by app/__init__.py)."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""The `krl` subcommands are declared once (krl/cli/__init__.py SUBCOMMANDS: name -> the module that
+"""The `krl` subcommands are declared once (app/__init__.py SUBCOMMANDS: name -> the module that
 defines it) and loaded on first use: the table names every command of every stage's ``commands``
 list and no other, and a command that does not move the arm starts without the simulator."""
 
@@ -13,7 +13,7 @@ from pathlib import Path
 
 from click.testing import CliRunner
 
-from krl.cli import SUBCOMMANDS, main, subcommand
+from app import SUBCOMMANDS, main, subcommand
 
 REPO = Path(__file__).resolve().parents[1]
 #: ``commands = [...]`` or ``commands: list = ...`` at a module's top level (column 0)
@@ -60,7 +60,7 @@ def test_check_does_not_load_the_simulator(tmp_path):
     scipy, are imported (robot/__init__.py's promise; was 0.3 s of CPU at each start)."""
     (tmp_path / "demo.src").write_text("DEF demo()\n  INT i\n  i = 1\nEND\n")
     probe = ("import sys\n"
-             "from krl.cli import main\n"
+             "from app import main\n"
              "try:\n"
              f"    main(['check', {str(tmp_path / 'demo.src')!r}])\n"
              "except SystemExit as e:\n"

@@ -109,7 +109,7 @@ def test_a_run_in_a_process_that_keeps_frozen_objects_leaves_them_frozen():
 
 _THRESHOLDS = r"""
 import gc, json, sys
-from krl.cli import main
+from app import main
 from krl import collector
 from krl.pool import run_tasks
 try:

@@ -18,7 +18,7 @@ from conformance import harness as H
 
 from conformance.report import run_cases, write_report
 
-from krl.cli.bench import all_figures, engine_rates
+from app.bench import all_figures, engine_rates
 
 from recovery.pipeline import run_recovery
 
@@ -27,7 +27,7 @@ from tests.robot.test_kukatrace import MOTIONS, write_recording
 
 REPO = Path(__file__).resolve().parents[1]
 SCHEMAS = REPO / "docs" / "schemas"
-KRL = [sys.executable, "-m", "krl.cli"]
+KRL = [sys.executable, "-m", "app"]
 GOOD = "DEF good()\n  DECL INT n\n  n = 1\nEND\n"
 BAD = "DEF bad()\n  IF x THEN\nEND\n"
 

@@ -29,7 +29,7 @@ from pathlib import Path
 REPO = Path(__file__).resolve().parents[1]
 DOC = REPO / "docs" / "architecture.md"
 CONFIG = REPO / ".importlinter"
-ROOTS = ("krl", "interp", "robot", "recovery", "conformance", "net", "pendant", "audit")
+ROOTS = ("krl", "interp", "robot", "recovery", "conformance", "net", "pendant", "audit", "app")
 #: the generated parser's own fallback import (``from KRLParser import KRLParser`` when the
 #: generated visitor is run as a script): not a package anyone installs
 GENERATED_SELF_IMPORTS = {"KRLParser"}

@@ -71,7 +71,7 @@ def test_krl_run_shows_and_traces_the_users_paths(linked, tmp_path):
     machine data, and every file of the trace, are spelled through the link."""
     root = linked / MILLING
     trace = tmp_path / "run.jsonl"
-    run = subprocess.run([sys.executable, "-m", "krl.cli", "run", str(root / BLOCK), "--inputs", str(CELL),
+    run = subprocess.run([sys.executable, "-m", "app", "run", str(root / BLOCK), "--inputs", str(CELL),
                           "--max-sim-time", "30", "--trace", str(trace)], cwd=REPO_ROOT, capture_output=True,
                          text=True, timeout=900, check=False)
     out = run.stdout

@@ -114,7 +114,7 @@ def test_installed_wheel_checks_a_backup_without_java(wheel, tmp_path):
 
     # the code that ran is the installed wheel's, and nothing of the ANTLR tool was imported
     probe = ("import sys, krl\n"
-             "from krl.cli import main\n"
+             "from app import main\n"
              "try:\n"
              f"    main(['check', {str(backup)!r}], standalone_mode=False)\n"
              "except SystemExit:\n"

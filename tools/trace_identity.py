@@ -123,12 +123,12 @@ def record(checkout: Path, out: Path, interps: list[str], limit: int = 0, corpus
     from interp.realprograms import cell_of, entries_of, find_backups, report_run  # noqa: PLC0415
     from interp.run import make_runtime  # noqa: PLC0415
     try:
-        from interp.run import run_spec  # noqa: PLC0415
+        from interp.run import run_spec  # noqa: PLC0415  (importable only once sys.path holds the checkout)
     except ImportError:     # a checkout before the run specification (issue 62): keywords
         run_spec = None
-    from interp.runtime.scheduler import SUBMIT_BUDGET  # noqa: PLC0415  (once sys.path names the checkout)
-    from robot.trace import TraceWriter  # noqa: PLC0415  (once sys.path names the checkout)
-    import interp  # noqa: PLC0415  (once sys.path names the checkout)
+    from interp.runtime.scheduler import SUBMIT_BUDGET  # noqa: PLC0415  (only once sys.path holds the checkout)
+    from robot.trace import TraceWriter  # noqa: PLC0415  (only once sys.path holds the checkout)
+    import interp  # noqa: PLC0415  (only once sys.path holds the checkout)
 
     if Path(interp.__file__).resolve().parent.parent != checkout:
         print(f"error: interp comes from {interp.__file__}, not {checkout}", file=sys.stderr)

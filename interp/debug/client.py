@@ -34,7 +34,7 @@ class DapClient:
         (default this interpreter); ``env``: variables added to the environment."""
         env = {**os.environ, **(env or {})}
         env["PYTHONPATH"] = str(root) + (os.pathsep + env["PYTHONPATH"] if env.get("PYTHONPATH") else "")
-        self.proc = subprocess.Popen([python or sys.executable, "-m", "krl.cli", "debug"], stdin=subprocess.PIPE,
+        self.proc = subprocess.Popen([python or sys.executable, "-m", "app", "debug"], stdin=subprocess.PIPE,
                                      stdout=subprocess.PIPE, stderr=subprocess.PIPE, env=env, cwd=str(root))
         self.timeout = timeout
         self.seq = 0

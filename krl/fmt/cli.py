@@ -1,5 +1,5 @@
 """`krl fmt [--check] [--diff] [--keyword-case upper|lower|keep] [--indent N|tab] PATHS...`
-(registered by krl/cli/__init__.py).
+(registered by app/__init__.py).
 
 PATHS are KRL files (.src, .dat, .sub) or folders, listed by the project model
 (krl/project.py ``folder_entries``) as ``krl check`` walks them: a symbolic link, FIFO, socket
@@ -97,7 +97,7 @@ def run_fmt(paths, check: bool = False, diff: bool = False, options: FormatOptio
     """The command's body; `out`/`err` are line writers (diffs / diagnostics and the count line).
     Returns the exit status (0, 1 or 2). Never raises for bad input."""
     # on use: krl.diagnostics.render costs 0.12 s (python -X importtime, 2026-11-23, load average 22
-    # on the 2 cores) of every krl command's start-up (krl.cli imports this module to register
+    # on the 2 cores) of every krl command's start-up (app imports this module to register
     # `fmt`)
     from krl.diagnostics.render import Renderer, SourceLines  # noqa: PLC0415
 
@@ -179,7 +179,7 @@ def run_stdin(data: bytes, check: bool = False, diff: bool = False, options: For
     --diff only the diff is printed. Exit status as :func:`run_fmt`; on a syntax error nothing
     is written to `write` (an editor keeps its buffer) and the diagnostics name ``<stdin>``."""
     # on use: krl.diagnostics.render costs 0.12 s (python -X importtime, 2026-11-23, load average 22
-    # on the 2 cores) of every krl command's start-up (krl.cli imports this module to register
+    # on the 2 cores) of every krl command's start-up (app imports this module to register
     # `fmt`)
     from krl.diagnostics.render import Renderer, SourceLines  # noqa: PLC0415
 

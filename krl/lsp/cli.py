@@ -1,4 +1,4 @@
-"""`krl lsp`: the language server on stdio (krl/lsp/server.py); registered by krl/cli/__init__.py."""
+"""`krl lsp`: the language server on stdio (krl/lsp/server.py); registered by app/__init__.py."""
 
 from __future__ import annotations
 

@@ -101,7 +101,7 @@ comment_start = _comment_start      # the public name (the language server's tok
 
 def _lines(text: str) -> list[str]:
     # on first use: krl.diagnostics.render costs 0.12 s (python -X importtime, 2026-11-23, load
-    # average 22 on the 2 cores) of every krl command's start-up (krl.cli imports every subcommand
+    # average 22 on the 2 cores) of every krl command's start-up (app imports every subcommand
     # module, which imports this)
     from krl.diagnostics.render import split_lines  # noqa: PLC0415
 

@@ -14,7 +14,7 @@ from pathlib import Path
 import pytest
 from click.testing import CliRunner
 
-from krl.cli import main
+from app import main
 
 #: simulated seconds per entry point in the tests' audit of the corpus
 SIM_TIME = 2.0

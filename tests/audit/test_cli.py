@@ -15,7 +15,7 @@ from click.testing import CliRunner
 from jsonschema import Draft202012Validator
 
 import audit.fleet as F
-from krl.cli import main
+from app import main
 
 REPO = Path(__file__).resolve().parents[2]
 PWNED = "<script>window.pwned=1</script>"

@@ -15,7 +15,7 @@ import dask
 import pytest
 from click.testing import CliRunner
 
-from krl.cli import main
+from app import main
 from krl.files import SHARED_CORPUS
 
 SMALL = SHARED_CORPUS / "rawpython__kukaKRLmagic"

@@ -21,7 +21,7 @@ from conformance.report import run_all
 from interp import realprograms as R
 from krl.files import SHARED_CORPUS
 from conformance.cli import conformance
-from krl.cli.check import check, run_check
+from app.check import check, run_check
 
 REPO = Path(__file__).resolve().parents[2]
 SMALL = SHARED_CORPUS / "rawpython__kukaKRLmagic"

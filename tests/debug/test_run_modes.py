@@ -11,7 +11,7 @@ import pytest
 from click.testing import CliRunner
 
 from interp.run import make_runtime, run_spec
-from krl.cli import main
+from app import main
 from robot.exactstop import DONE_CYCLES
 from robot.trace import TraceWriter
 

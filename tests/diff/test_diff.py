@@ -16,7 +16,7 @@ from pathlib import Path
 import pytest
 from click.testing import CliRunner
 
-from krl.cli import main
+from app import main
 from krl.diff.core import diff_sides
 from krl.diff.load import DiffInputError, side
 from krl.diff.text import summary_line

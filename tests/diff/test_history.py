@@ -17,7 +17,7 @@ import re
 import pytest
 from click.testing import CliRunner
 
-from krl.cli import main
+from app import main
 from tests.conftest import history_pairs
 from tests.diff import oracle
 from tests.test_json_schemas import validate

@@ -20,7 +20,7 @@ import shutil
 import pytest
 from click.testing import CliRunner
 
-from krl.cli import main
+from app import main
 from tests.conftest import history_pairs
 from tests.diff.oracle import krl_files
 from tests.test_json_schemas import validate

@@ -22,7 +22,7 @@ from pathlib import Path
 import pytest
 from click.testing import CliRunner
 
-from krl.cli import main
+from app import main
 from tests.diff import oracle
 from tests.test_json_schemas import validate
 

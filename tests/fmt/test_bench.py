@@ -6,7 +6,7 @@ import json
 
 from click.testing import CliRunner
 
-from krl.cli.bench import bench
+from app.bench import bench
 
 
 def test_bench_fmt_counts_files_that_parse_and_change(tmp_path):

@@ -8,7 +8,7 @@ import stat
 
 from click.testing import CliRunner
 
-from krl.cli import main
+from app import main
 import krl.fmt.core
 from krl.limits import MAX_FOLDER_DEPTH
 import krl.source

@@ -17,7 +17,7 @@ from click.testing import CliRunner
 
 from krl import limits
 from krl.archive import ArchiveError, backup_source, extract_backup
-from krl.cli.check import run_check
+from app.check import run_check
 from interp.cli import run
 from krl.workspace import on_each_file, workspaces_for
 from recovery.cli import recover

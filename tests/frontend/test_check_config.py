@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from krl.cli.check import run_check
+from app.check import run_check
 
 DEMO = ("DEF demo()\n"
         "  INT i\n"

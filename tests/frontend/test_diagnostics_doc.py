@@ -26,7 +26,7 @@ import pytest
 
 from krl.diagnostics import CODES
 from krl.diagnostics.codes import ALL, E102
-from krl.cli.check import run_check
+from app.check import run_check
 from krl.workspace import check_texts, load_workspace
 import krl.workspace as workspace_mod
 

@@ -9,7 +9,7 @@ from hypothesis import given, settings, strategies as st
 
 from tests.budget import examples
 
-from krl.cli.check import run_check
+from app.check import run_check
 from krl.workspace import check_texts, load_workspace
 from krl.ast import nodes as N
 from krl.ast.printer import print_module

@@ -20,7 +20,7 @@ from krl.ast.build import build_module
 from krl.ast.printer import print_module
 from krl.limits import MAX_CHECK_FRAMES, MAX_EXPRESSION_TERMS, MAX_NESTING
 from krl.semantics import types as T
-from krl.cli.check import run_check
+from app.check import run_check
 from krl.diagnostics import DiagnosticSink
 from krl.syntax.parse import parse_text
 from krl.workspace import check_texts

@@ -16,8 +16,8 @@ import pytest
 
 import krl.files
 from krl.limits import MAX_FOLDER_DEPTH
-from krl.cli import check as cli
-from krl.cli.check import run_check
+from app import check as cli
+from app.check import run_check
 from tests.deep import deep_chain, remove_bottom_up
 
 CONFIG = "DEFDAT $CONFIG\n  INT gCount = 0\nENDDAT\n"

@@ -8,9 +8,9 @@ from __future__ import annotations
 import time
 from pathlib import Path
 
-from krl.cli.check import run_check
-from krl.cli import parse as syntax_cli
-from krl.cli.parse import run_parse
+from app.check import run_check
+from app import parse as syntax_cli
+from app.parse import run_parse
 import krl.workspace as workspace_mod
 
 

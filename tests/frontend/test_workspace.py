@@ -6,7 +6,7 @@ import json
 
 from click.testing import CliRunner
 
-from krl.cli.check import check as check_cmd
+from app.check import check as check_cmd
 from krl.survey.report import check_report
 from krl.workspace import check_texts, workspaces_for
 from krl.project import find_backups, is_system_path

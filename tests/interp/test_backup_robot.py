@@ -10,7 +10,7 @@ from pathlib import Path
 
 from click.testing import CliRunner
 
-from krl.cli import main
+from app import main
 
 BASIS = Path(__file__).resolve().parents[2] / "interp" / "basis"
 KR6 = Path(__file__).resolve().parents[2] / "robot" / "data" / "kr6_r900.yaml"

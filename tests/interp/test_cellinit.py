@@ -6,7 +6,7 @@ from __future__ import annotations
 import yaml
 from click.testing import CliRunner
 
-from krl.cli import main
+from app import main
 from robot.stimuli import parse_cell
 
 from .helpers import write

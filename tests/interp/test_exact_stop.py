@@ -18,7 +18,7 @@ import math
 import pytest
 from click.testing import CliRunner
 
-from krl.cli import main
+from app import main
 from robot.exactstop import DONE_CYCLES, END_DELAY_CYCLES, RESTART_CYCLES
 from robot.trace import read_trace
 from tests.interp.helpers import run_krl

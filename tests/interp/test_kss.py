@@ -12,7 +12,7 @@ from click.testing import CliRunner
 from interp import realprograms as rp
 from interp.run import make_runtime, run_spec
 from interp.runtime.kss import SystemSoftware
-from krl.cli import main
+from app import main
 from robot.trace import TraceWriter
 
 from .helpers import write

@@ -12,7 +12,7 @@ from __future__ import annotations
 import pytest
 from click.testing import CliRunner
 
-from krl.cli import main
+from app import main
 from tests.interp.helpers import run_krl
 
 PROG = """

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from click.testing import CliRunner
 
-from krl.cli import main
+from app import main
 from interp.reach import reach_check
 from tests.interp.helpers import write
 from tests.robot.test_collision import R_WRIST

@@ -11,7 +11,7 @@ from click.testing import CliRunner
 from interp import realprograms as rp
 from interp.realprograms import CELLS, cause_of, cell_of
 from interp.run import make_runtime, run_spec
-from krl.cli import main
+from app import main
 from robot.limits import check_trace
 from robot.stimuli import load_cell
 from robot.trace import TraceWriter

@@ -15,7 +15,7 @@ import pytest
 from click.testing import CliRunner
 
 from interp.run import make_runtime, run_spec
-from krl.cli import main
+from app import main
 from robot.trace import TraceWriter
 
 from .helpers import write

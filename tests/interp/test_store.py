@@ -261,7 +261,7 @@ def test_krl_run_from_the_store_in_another_process_gives_the_same_trace(tmp_path
     env = {**os.environ, "KRL_CACHE_DIR": str(tmp_path / "cache")}
 
     def run(trace: Path, **extra) -> None:
-        subprocess.run([sys.executable, "-m", "krl.cli", "run", str(program), "--max-sim-time", "3",
+        subprocess.run([sys.executable, "-m", "app", "run", str(program), "--max-sim-time", "3",
                         "--trace", str(trace)], env={**env, **extra}, cwd=REPO, capture_output=True,
                        timeout=900, check=False)
 

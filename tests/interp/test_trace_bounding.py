@@ -17,7 +17,7 @@ import pytest
 from click.testing import CliRunner
 
 from interp.run import make_runtime, run_spec
-from krl.cli import main
+from app import main
 from robot.trace import (
     PROBE_CREDIT_VALUES, PROBE_VALUES_PER_EVENT, TRACE_REPEATS, TraceWriter, validate_event,
 )

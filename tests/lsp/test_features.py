@@ -10,7 +10,7 @@ import json
 import pytest
 from lsprotocol import types as L
 
-from krl.cli.check import run_check
+from app.check import run_check
 from krl.fmt import format_text
 from tests.lsp.conftest import (PROGRAM, change_doc, close_doc, open_doc, pos, summary,
                                 wait_diagnostics, where)

@@ -78,7 +78,7 @@ def test_quit_and_dialog_wait_for_the_operator(shared_corpus, tmp_path):
 def test_krl_run_answers_for_nobody(shared_corpus, tmp_path):
     root = _backup(tmp_path)
     trace = tmp_path / "t.jsonl"
-    run = subprocess.run([sys.executable, "-m", "krl.cli", "run", str(root / "R1" / "msgtest.src"), "--trace", str(trace)],
+    run = subprocess.run([sys.executable, "-m", "app", "run", str(root / "R1" / "msgtest.src"), "--trace", str(trace)],
                          cwd=REPO_ROOT, capture_output=True, text=True, timeout=900, check=False)
     assert run.returncode == 0, run.stdout + run.stderr
     assert '"signal":"$OUT[78]","value":true' in trace.read_text()   # answer 1, as krl run always gave

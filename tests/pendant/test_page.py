@@ -210,7 +210,7 @@ def test_the_pendant_run_gives_krl_runs_trace(pw, shared_corpus, tmp_path, pacin
         s = wait_state(page, "s.state == 'ended' || s.state == 'none'", timeout=900_000)
         assert page.problems == []
     ref = tmp_path / "run.jsonl"
-    run = subprocess.run([sys.executable, "-m", "krl.cli", "run", str(KR120 / HOME), "--inputs", str(KR120_CELL),
+    run = subprocess.run([sys.executable, "-m", "app", "run", str(KR120 / HOME), "--inputs", str(KR120_CELL),
                           "--mode", "AUT", "--trace", str(ref)], cwd=REPO_ROOT, capture_output=True, text=True,
                          timeout=900, check=False)
     assert run.returncode == 0, run.stdout + run.stderr

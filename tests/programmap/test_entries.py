@@ -18,7 +18,7 @@ from pathlib import Path
 import pytest
 from click.testing import CliRunner
 
-from krl.cli import main
+from app import main
 from krl.programmap import build_map
 from krl.workspace import workspaces_for
 

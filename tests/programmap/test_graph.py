@@ -13,7 +13,7 @@ import pytest
 from click.testing import CliRunner
 
 from krl.ast import nodes as N
-from krl.cli import main
+from app import main
 from krl.programmap import build_map
 from krl.programmap.render import to_dot, to_svg
 from krl.project import find_backups

@@ -14,7 +14,7 @@ from __future__ import annotations
 import pytest
 from click.testing import CliRunner
 
-from krl.cli import main
+from app import main
 from krl.programmap import build_map
 from krl.project import find_backups
 from krl.workspace import workspaces_for

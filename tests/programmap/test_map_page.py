@@ -16,7 +16,7 @@ from urllib.parse import quote
 import pytest
 from click.testing import CliRunner
 
-from krl.cli import main
+from app import main
 from krl.programmap import build_map
 from krl.project import find_backups
 from krl.workspace import workspaces_for

@@ -97,7 +97,7 @@ def test_parse_json_output_and_exit_codes(tmp_path: Path) -> None:
     good.write_text(VALID)
     bad = tmp_path / "bad.src"
     bad.write_text("DEF t()\n  IF x THEN\nEND\n")
-    krl = [sys.executable, "-m", "krl.cli"]
+    krl = [sys.executable, "-m", "app"]
     ok = subprocess.run([*krl, "parse", str(good)], capture_output=True, text=True)
     assert ok.returncode == 0
     out = subprocess.run([*krl, "parse", "--json", str(good), str(bad)], capture_output=True, text=True)

@@ -31,7 +31,7 @@ def made(tmp_path_factory):
     run_recovery(corpus, report, jobs=1, use_cache=False)
     summary = json.loads((report / "summary.json").read_text())
     (cluster,) = [c for c in summary["clusters"] if c["signature"] == "line-start | END | END"]
-    res = subprocess.run([sys.executable, "-m", "krl.cli", "construct", "new", "end_closes_everything",
+    res = subprocess.run([sys.executable, "-m", "app", "construct", "new", "end_closes_everything",
                           "--from", cluster["id"], "--report", str(report), "--corpus", str(corpus),
                           "--root", str(root)], capture_output=True, text=True, cwd=REPO, check=False)
     return root, report, corpus, cluster, res
@@ -70,7 +70,7 @@ def test_changes_row_and_case_stub(made):
 
 def test_errors_are_clear(made):
     root, report, corpus, cluster, _ = made
-    krl = [sys.executable, "-m", "krl.cli", "construct", "new"]
+    krl = [sys.executable, "-m", "app", "construct", "new"]
     for args, message in ((["x_y", "--from", "Cnope"], "no cluster Cnope"),
                           (["end_closes_everything", "--from", cluster["id"]], "exists already"),
                           (["Bad-Name", "--from", cluster["id"]], "a construct name is"),

@@ -20,10 +20,10 @@ from krl.source import read_source
 from recovery.report import summarise, write_report
 from recovery.scan import scan
 from tests.deep import deep_chain, remove_bottom_up
-from krl.cli.check import run_check
+from app.check import run_check
 
 REPO_ROOT = Path(__file__).resolve().parents[2]
-KRL = [sys.executable, "-m", "krl.cli"]
+KRL = [sys.executable, "-m", "app"]
 VALID = "DEF t()\n  x = 1\nEND\n"
 
 

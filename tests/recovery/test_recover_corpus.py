@@ -12,7 +12,7 @@ import pytest
 
 REPO_ROOT = Path(__file__).resolve().parents[2]
 
-KRL = [sys.executable, "-m", "krl.cli"]
+KRL = [sys.executable, "-m", "app"]
 
 
 def recover(corpus: Path, out: Path) -> tuple[int, dict, list[dict]]:

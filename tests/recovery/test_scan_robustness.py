@@ -27,7 +27,7 @@ from recovery.report import ReportStream, SummaryBuilder, summarise, write_clust
 from recovery.scan import FileResult, scan
 
 REPO_ROOT = Path(__file__).resolve().parents[2]
-KRL = [sys.executable, "-m", "krl.cli"]
+KRL = [sys.executable, "-m", "app"]
 VALID = "DEF t()\n  x = 1\nEND\n"
 BROKEN = "DEF t()\n  IF x THEN\nEND\n"
 

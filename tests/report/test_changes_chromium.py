@@ -11,7 +11,7 @@ from pathlib import Path
 import pytest
 from click.testing import CliRunner
 
-from krl.cli import main
+from app import main
 from tests.report.test_report_chromium import loaded_page
 from tests.system_tools import require
 

@@ -7,7 +7,7 @@ from pathlib import Path
 
 from click.testing import CliRunner
 
-from krl.cli import main
+from app import main
 
 HOME = "{A1 0, A2 -90, A3 90, A4 0, A5 45, A6 0}"
 

@@ -30,7 +30,7 @@ import pytest
 from click.testing import CliRunner
 from pypdf import PdfReader
 
-from krl.cli import main
+from app import main
 from tests.report.test_report_chromium import loaded_page
 from tests.system_tools import require
 

@@ -24,7 +24,7 @@ import xacro.substitution_args
 from click.testing import CliRunner
 from scipy.spatial.transform import Rotation
 
-from krl.cli import main
+from app import main
 from robot import catalogue
 from robot.kinematics import Kinematics
 from robot.mada import catalogue_robot

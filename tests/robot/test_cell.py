@@ -10,7 +10,7 @@ from pathlib import Path
 from click.testing import CliRunner
 
 from interp.run import make_runtime, run_spec, robot_for
-from krl.cli import main
+from app import main
 from krl.project import boot_submit
 from robot.machine import library_robots
 from robot.stimuli import StimulusError, load_cell

@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
-from krl.cli import main
+from app import main
 from robot.errors import SoftLimitError, WorkspaceError
 from robot.frames import frame_to_matrix, matrix_to_frame
 from robot.kinematics import Kinematics

@@ -20,7 +20,7 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
-from krl.cli import main
+from app import main
 from robot.exactstop import end_signal
 from robot.kukatrace import recording as R
 from robot.frames import frame_to_matrix

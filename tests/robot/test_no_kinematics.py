@@ -15,7 +15,7 @@ from click.testing import CliRunner
 
 import robot.kinematics
 import robot.mada
-from krl.cli import main
+from app import main
 
 BACKUP = "rawpython__kukaKRLmagic"
 

@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 from click.testing import CliRunner
 
-from krl.cli import main
+from app import main
 from robot.limits import check_trace
 
 PROG = """

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
-from krl.cli import main
+from app import main
 from robot.kinematics import Kinematics
 from robot.mada import load_robot
 from tests.robot.test_mada import urdf_forward

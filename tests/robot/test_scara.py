@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
-from krl.cli import main
+from app import main
 from robot.bench import run_motions
 from robot.controller import Controller
 from robot.errors import SoftLimitError, WorkspaceError

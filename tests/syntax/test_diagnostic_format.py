@@ -14,9 +14,9 @@ from pathlib import Path
 
 import pytest
 
-from krl.cli.check import run_check
+from app.check import run_check
 from krl.diagnostics.render import count_line, use_colour
-from krl.cli.parse import run_parse
+from app.parse import run_parse
 from krl.workspace import check_texts
 
 REPO = Path(__file__).resolve().parents[2]

@@ -208,7 +208,7 @@ def test_krl_parse_engine_java_without_java_is_a_message_not_a_traceback(tmp_pat
     f = tmp_path / "a.src"
     f.write_text("DEF a()\nEND\n")
     env = dict(os.environ, KRL_NO_JAVA="1")
-    run = subprocess.run([sys.executable, "-m", "krl.cli", "parse", "--engine", "java", str(f)],
+    run = subprocess.run([sys.executable, "-m", "app", "parse", "--engine", "java", str(f)],
                          capture_output=True, text=True, env=env, cwd=REPO, check=False)
     assert run.returncode == 2
     assert "java parse engine is unavailable" in run.stderr

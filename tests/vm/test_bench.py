@@ -9,7 +9,7 @@ from click.testing import CliRunner
 import robot.bench as rb
 from interp.bench import run_krl, run_python
 from interp.vm.vm import COMPILED
-from krl.cli.bench import all_figures, bench
+from app.bench import all_figures, bench
 
 KEYS = {"vm_vs_tree", "tree_stmts_per_s", "vm_stmts_per_s", "sim_realtime_factor", "sim_cpu_factor", "parse_kb_per_s"}
 

@@ -23,7 +23,7 @@ from interp.runtime.convert import trunc_int
 from interp.runtime.errors import KrlRuntimeError
 from interp.runtime.natives.swrite import sread_values, swrite_text
 from interp.runtime.values import is_char_array
-from krl.cli import main
+from app import main
 from krl.limits import MAX_DATA_ELEMENTS, MAX_EXPRESSION_TERMS, MAX_NESTING
 from robot.trace import TraceWriter
 from tests.budget import examples

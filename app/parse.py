@@ -1,4 +1,4 @@
-"""`krl parse FILE...`: syntax-check files and print their syntax errors (registered by krl/cli/__init__.py).
+"""`krl parse FILE...`: syntax-check files and print their syntax errors (registered by app/__init__.py).
 
 Formats (``--format``): ``text`` (compiler style, krl/diagnostics/render.py: location, code, message,
 source line, caret; a closing count line), ``json`` (one object per file: path, ok, encoding,
@@ -132,7 +132,7 @@ def run_parse(files, fmt: str = "text", outline: bool = False, tree: bool = Fals
 
 def main_status(files, fmt, as_json, outline, tree, timeout=None, jobs=None, engine: str | None = None,
                 antlr_errors: bool = False) -> int:
-    """The `parse` command's body (krl/cli/__init__.py keeps only the options)."""
+    """The `parse` command's body (app/__init__.py keeps only the options)."""
     # costs 0.01 s at start-up (python -X importtime, 2026-11-25)
     from krl.syntax.engines import use_engine  # noqa: PLC0415
 

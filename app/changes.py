@@ -1,6 +1,6 @@
 """`krl diff OLD NEW`, `krl graph BACKUP` and `krl report BACKUP [--since OLD]` (issue 26):
 what changed between two backups (krl/diff), the program map (krl/programmap), and one HTML
-page with both and the check summary. Registered by krl/cli/__init__.py.
+page with both and the check summary. Registered by app/__init__.py.
 
 Exit status of ``krl diff``: 0 no change, 1 changes, 2 error (a path that does not exist, a
 refused archive: the messages of ``krl check``, E001 and E004; files with syntax errors are

@@ -77,7 +77,7 @@ def fmt_rate(corpus: Path, limit_bytes: int | None = None) -> dict:
             "fmt_vs_parse": round(fmt_s / parse_s, 2)}
 
 
-EMBEDDED_CORPUS = Path(__file__).resolve().parents[2] / "corpus"
+EMBEDDED_CORPUS = Path(__file__).resolve().parents[1] / "corpus"
 
 
 def all_figures(repeat: int = 3, sim_seconds: float = 60.0, parse_kb: int = 512) -> dict:

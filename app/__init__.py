@@ -1,4 +1,7 @@
-"""The `krl` command line: one subcommand per job of the pipeline.
+"""The `krl` command line, the application on the top floor (issue 62): one subcommand per job
+of the pipeline, each defined by its stage's own module (:data:`SUBCOMMANDS`), and the
+subcommands of no single stage here (parse, check, bench, diff, graph, report). It imports the
+library and the stages; nothing imports it (docs/architecture.md "Packages and layers").
 
 Exit codes follow the compilers' habit: 0 success, 1 the input has errors, 2 usage or
 internal error.
@@ -19,17 +22,17 @@ from krl import __version__
 # subcommands runs, or for `krl --help`: `krl check` or `krl lsp` does not import the simulator
 # (numpy, scipy: 0.3 s of CPU at each start, 2026-11-25).
 SUBCOMMANDS = {
-    "parse": "krl.cli.parse",
+    "parse": "app.parse",
     "recover": "recovery.cli", "growth": "recovery.cli", "validate": "recovery.cli", "construct": "recovery.cli",
-    "check": "krl.cli.check",
+    "check": "app.check",
     "plot": "robot.cli", "robot": "robot.cli", "trace": "robot.cli",
     "run": "interp.cli", "asm": "interp.cli", "cell": "interp.cli",
-    "bench": "krl.cli.bench",
+    "bench": "app.bench",
     "conformance": "conformance.cli",
     "fmt": "krl.fmt.cli",
     "lsp": "krl.lsp.cli",
     "debug": "interp.debug.cli",
-    "diff": "krl.cli.changes", "graph": "krl.cli.changes", "report": "krl.cli.changes",
+    "diff": "app.changes", "graph": "app.changes", "report": "app.changes",
     "pendant": "pendant.cli",
     "audit": "audit.cli",
 }

@@ -1,4 +1,4 @@
-"""`krl check PATH... [--json]`: the front end's command (registered by krl/cli/__init__.py).
+"""`krl check PATH... [--json]`: the front end's command (registered by app/__init__.py).
 
 PATH is a file (checked with the .src/.dat of its module), a KRC backup folder (one
 workspace), a folder holding backups (one workspace per backup) or plain files (one
