@@ -59,11 +59,13 @@ import java.util.concurrent.TimeUnit;
 
 import org.antlr.v4.runtime.BailErrorStrategy;
 import org.antlr.v4.runtime.BaseErrorListener;
+import org.antlr.v4.runtime.CharStream;
 import org.antlr.v4.runtime.CharStreams;
 import org.antlr.v4.runtime.CommonTokenStream;
 import org.antlr.v4.runtime.DefaultErrorStrategy;
 import org.antlr.v4.runtime.InputMismatchException;
 import org.antlr.v4.runtime.Lexer;
+import org.antlr.v4.runtime.LexerNoViableAltException;
 import org.antlr.v4.runtime.Parser;
 import org.antlr.v4.runtime.ParserRuleContext;
 import org.antlr.v4.runtime.RecognitionException;
@@ -163,6 +165,20 @@ public final class KrlWorker {
             out.append(count++ == 0 ? "" : ",").append('[').append(line).append(',').append(col).append(',');
             str(out, msg);
             out.append(']');
+            keepLineEnd((Lexer) r, e);
+        }
+
+        /** krl/syntax/errors.py keep_line_end: the line end a token recognition error stopped at
+         *  stays a token (the lexer's skip takes the last character read instead). */
+        static void keepLineEnd(Lexer lexer, RecognitionException e) {
+            CharStream in = lexer.getInputStream();
+            if (!(e instanceof LexerNoViableAltException) || in == null
+                    || in.index() <= ((LexerNoViableAltException) e).getStartIndex()
+                    || (in.LA(1) != '\n' && in.LA(1) != '\r')) {
+                return;
+            }
+            lexer.setCharPositionInLine(lexer.getCharPositionInLine() - 1);   // the skip counts it again
+            in.seek(in.index() - 1);
         }
     }
 
