@@ -54,6 +54,7 @@ from krl.project import module_files as project_module_files
 from krl.semantics.builtins import load_builtins
 from krl.semantics.checker import Checker, DeclaredTwice, Declarer, _is_system_datalist
 from krl.diagnostics import SYNTAX_CODES, Diagnostic, DiagnosticSink
+from krl.diagnostics.render import split_lines
 from krl.diagnostics.codes import E001, E005, E901, W002, W108, W111, W201, W202, W205, W206, W210, W501
 from krl.semantics.outside import Unresolved, line_evidence, template_lines
 from krl.semantics.resolve import resolve_workspace
@@ -143,7 +144,7 @@ def record_unparsed(module: N.Module, text: str, diagnostics) -> set[str]:
     for r in module.routines:
         if r.broken:        # the first syntax finding in it (E010 names the opener the parser closed late)
             r.broken = min((n for n in syntax if r.span.line <= n <= r.broken), default=r.broken)
-    lines = text.splitlines()
+    lines = split_lines(text)
     return {w.upper() for n in module.unparsed if 0 < n <= len(lines) for w in _WORD.findall(lines[n - 1])}
 
 

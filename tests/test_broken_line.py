@@ -296,3 +296,18 @@ def test_the_mutations_are_the_negative_corpus_s():
     assert _mutate("  nCount = 0\n", next(m for m in MUTATIONS if m[0] == "colon_eq_assign")) == "  nCount := 0\n"
     assert _mutate("  nCount = 0 ; note\n", next(m for m in MUTATIONS if m[0] == "slash_comment")) == \
         "  nCount = 0 // reset the counter ; note\n"
+
+
+def test_lines_are_counted_as_the_lexer_counts_them(tmp_path):
+    """A comment holding a character that Python's str.splitlines takes for a line end (the
+    file separator \\x1c, as in a Paletizador backup) shifted every line after it: the line
+    not understood was taken for the one before it, and its words and the next line's made names
+    declared nowhere "maybe declared" (warnings) instead of errors (the broken-line sweep:
+    setcamada_Prdt_M4207A.src lost its E101 findings)."""
+    f = tmp_path / "p.src"
+    f.write_text("DEF p()\n  ; a separator \x1c here\n  x = 1 ** 2\n  y = 2\nEND\n", encoding="utf-8")
+    ws = load_workspace([f], str(tmp_path))
+    ws.check()
+    assert ws.files[0].module.unparsed == [3]
+    assert ws.failed_words == {"X"}
+    assert sorted((d.line, d.code) for d in ws.diagnostics) == [(3, "E002"), (4, "E101")]

@@ -15,6 +15,7 @@ from __future__ import annotations
 import re
 
 from krl.ast import nodes as N
+from krl.diagnostics.render import split_lines
 
 __all__ = ["lines_not_understood", "code_lines"]
 
@@ -38,7 +39,7 @@ def _code(text: str) -> str:
 def code_lines(text: str) -> list[int]:
     """The 1-based numbers of the lines of `text` that hold code (see the module docstring)."""
     out = []
-    for i, line in enumerate(text.splitlines(), 1):
+    for i, line in enumerate(split_lines(text), 1):
         code = _code(line)
         if not code or code.startswith("&"):
             continue

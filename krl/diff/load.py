@@ -29,6 +29,7 @@ from pathlib import Path
 from krl.archive import ArchiveError, backup_source
 from krl.diagnostics import Diagnostic
 from krl.diagnostics.codes import E001, E004
+from krl.diagnostics.render import split_lines
 from krl.limits import PARSE_TIMEOUT_S
 from krl.parsecache import through_store
 from krl.project import find_backups
@@ -101,7 +102,7 @@ class Side:
     def _file_lines(self, path: str) -> list[str]:
         lines = self._lines.get(path)
         if lines is None:
-            lines = self._lines[path] = (read_source(path).text or "").splitlines()
+            lines = self._lines[path] = split_lines(read_source(path).text or "")
         return lines
 
     def line(self, path: str, number: int) -> str:

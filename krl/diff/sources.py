@@ -19,6 +19,7 @@ from pathlib import Path
 
 from markupsafe import Markup
 
+from krl.diagnostics.render import split_lines
 from krl.limits import MAX_REPORT_SOURCE_CHARS
 from krl.render import render_html
 from krl.source import read_source
@@ -59,7 +60,7 @@ class SourceViews:
         if f is False:
             # a link in the backup is never followed (the walk of krl check follows none either)
             src = read_source(Path(root) / file, follow_symlinks=False)
-            f = self._files[key] = (_File(len(self._files) + 1, side, file, (src.text or "").splitlines())
+            f = self._files[key] = (_File(len(self._files) + 1, side, file, split_lines(src.text or ""))
                                     if src.status == "ok" else None)
         if f is None:
             return ""

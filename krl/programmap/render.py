@@ -27,6 +27,7 @@ from urllib.parse import quote
 import graphviz
 from markupsafe import Markup
 
+from krl.diagnostics.render import split_lines
 from krl.limits import MAX_GRAPH_NODES, MAX_GRAPH_SOURCE_CHARS
 from krl.source import read_source
 from krl.programmap.graph import CONTROLLER_KINDS, ProgramMap
@@ -189,7 +190,7 @@ def page_data(pm: ProgramMap, links: str = "file") -> dict:
         source = []
         if n.path and n.kind == "routine" and budget > 0:
             if n.path not in texts:
-                texts[n.path] = (read_source(n.path).text or "").splitlines() if Path(n.path).is_file() else []
+                texts[n.path] = split_lines(read_source(n.path).text or "") if Path(n.path).is_file() else []
             source = texts[n.path][n.line - 1:max(n.end, n.line)]
             budget -= sum(len(x) + 1 for x in source)
             if budget < 0:

@@ -38,6 +38,7 @@ from dataclasses import dataclass, field
 
 from krl.diagnostics import DiagnosticSink, Note
 from krl.semantics.builtins import load_builtins
+from krl.diagnostics.render import split_lines
 from krl.diagnostics.codes import E101, E105, E106, W101, W105, W106, W107
 
 # kind -> (error code, warning code, noun)
@@ -86,7 +87,7 @@ def template_lines(text: str) -> tuple[dict[int, str], dict[int, str], dict[int,
     inline: dict[int, str] = {}
     user: dict[int, str] = {}
     stack: list[list[str]] = []         # [kind, label] of each open fold
-    for no, line in enumerate(text.splitlines(), 1):
+    for no, line in enumerate(split_lines(text), 1):
         m = _FOLD.match(line) if ";" in line else None
         if m:
             rest = m.group(1)
@@ -180,7 +181,7 @@ def user_fold_lines(text: str) -> frozenset[int]:
     programmer's part of a template or of a KUKA system file such as sps.sub."""
     out: set[int] = set()
     stack: list[bool] = []
-    for no, line in enumerate(text.splitlines(), 1):
+    for no, line in enumerate(split_lines(text), 1):
         m = _FOLD.match(line)
         if m:
             stack.append(m.group(1).split(";", 1)[0].strip().upper().startswith("USER"))

@@ -17,6 +17,8 @@ from antlr4.error.ErrorStrategy import DefaultErrorStrategy
 from antlr4.error.Errors import InputMismatchException
 from antlr4.IntervalSet import IntervalSet
 
+from krl.diagnostics.render import split_lines
+
 
 @dataclass(slots=True)
 class SyntaxIssue:
@@ -183,7 +185,7 @@ class CollectingErrorListener(ErrorListener):
     def finish_lexer(self, text: str) -> list:
         """Turn the collected lexer errors into SyntaxIssue records."""
 
-        lines = text.splitlines()
+        lines = split_lines(text)
         issues = []
         for line, column, msg in self._lexer_raw:
             line_text = lines[line - 1] if 0 < line <= len(lines) else ""
@@ -195,7 +197,7 @@ class CollectingErrorListener(ErrorListener):
 
     def _text_lines(self) -> list[str]:
         if self._lines is None:
-            self._lines = self.text.splitlines()
+            self._lines = split_lines(self.text)
         return self._lines
 
     def _line_text(self, line: int) -> str:
