@@ -198,8 +198,11 @@ def _words(*texts: str) -> set[str]:
     return {w.upper() for t in texts for w in _WORD.findall(t)}
 
 
-def _key(d) -> tuple:
-    return d.line, d.code, re.sub(r"\d+", "N", d.message)
+def _key(d, folder: Path) -> tuple:
+    """A finding as the two files' findings are matched: its line, its code and its message with
+    the file's folder left out (the intact and the broken file lie in two folders, and a message
+    may name the file: E102's "first declared at FILE:LINE:COL") and numbers as N."""
+    return d.line, d.code, re.sub(r"\d+", "N", d.message.replace(str(folder), "<folder>"))
 
 
 def _named(message: str) -> set[str]:
@@ -228,7 +231,8 @@ def check_broken_line(path: Path, got, tmp_path: Path) -> None:
     name = str(tmp_path / "b" / name)       # the file as the broken side names it
 
     # check: every finding kept; a new one is the broken line's
-    da, db = {_key(d): d for d in a.diagnostics}, {_key(d): d for d in b.diagnostics}
+    da = {_key(d, tmp_path / "a"): d for d in a.diagnostics}
+    db = {_key(d, tmp_path / "b"): d for d in b.diagnostics}
     assert not any(d.is_error for d in b.diagnostics if d.code in ("E001", "E005")), where
     lost = [d for k, d in da.items() if k not in db and d.line != n and not (_named(d.message) & on_line)]
     assert not lost, f"{where}: findings of the intact file lost: {[str(d) for d in lost]}"
@@ -311,3 +315,18 @@ def test_lines_are_counted_as_the_lexer_counts_them(tmp_path):
     assert ws.files[0].module.unparsed == [3]
     assert ws.failed_words == {"X"}
     assert sorted((d.line, d.code) for d in ws.diagnostics) == [(3, "E002"), (4, "E101")]
+
+
+def test_a_finding_that_names_its_file_is_matched_across_the_two_folders(tmp_path):
+    """The intact and the broken file lie in two folders; a finding that names its file (E102's
+    "first declared at FILE:LINE:COL") is the same finding on both sides (the sweep called it lost:
+    TMatriz.dat, PlaceCaixaPallet1.dat), and a duplicate that goes away is still a loss."""
+    intact = "DEFDAT d\nDECL INT a = 1\nDECL INT b = 2\nDECL INT a = 3\nENDDAT\n"
+    broken = intact.replace("b = 2", "b = 2 ** 2")
+    path = tmp_path / "src" / "d.dat"
+    (tmp_path / "kept").mkdir()
+    check_broken_line(path, (intact, broken, 3, "star_star_power"), tmp_path / "kept")
+    (tmp_path / "lost").mkdir()
+    with pytest.raises(AssertionError, match="findings of the intact file lost.*'a' is declared more than once"):
+        check_broken_line(path, (intact, broken.replace("INT a = 3", "INT c = 3"), 3, "star_star_power"),
+                          tmp_path / "lost")
