@@ -110,22 +110,27 @@ class LineErrorStrategy(DefaultErrorStrategy):
             recognizer.consume()
 
 
-def keep_line_end(lexer, e) -> None:
-    """Keep the line end a lexer error stopped at out of the error's characters.
+def line_end_lexer(lexer_cls: type) -> type:
+    """`lexer_cls` (a generated KRLLexer) whose error recovery keeps a line end a token.
 
     ANTLR's lexer, after a token recognition error, skips one character past those it read: when
-    the token stopped at a line end (``'B012'`` + ``0'`` then the line end: no character literal
-    holds one), that character is the NEWLINE, and the next line joins the broken one (the
-    parser's line recovery then skips both). Called by the lexer's error listener before that
-    skip: it steps back over the last character read, so that the skip takes it and the line end
-    stays a token. KrlWorker.java's LexerErrors does the same for the Java engine.
+    the token stopped at a line end (``51.'B0120'``: ``'B012``, then ``0'`` cut by the line end,
+    no character literal holds one), that character is the NEWLINE, and the next line joins the
+    broken one (the parser's line recovery then skips both). This lexer steps back over the last
+    character read before that skip, so that the skip takes it and the line end stays a token;
+    the error's message and place are unchanged. KrlWorker.java's ``keepLineEnd`` does the same
+    for the Java engine.
     """
-    stream = getattr(lexer, "_input", None)
-    start = getattr(e, "startIndex", None)
-    if stream is None or start is None or stream.index <= start or stream.LA(1) not in (10, 13):
-        return
-    lexer.column -= 1           # the skip counts the character again
-    stream.seek(stream.index - 1)
+
+    def recover(self, re) -> None:
+        stream = self._input
+        start = getattr(re, "startIndex", None)
+        if start is not None and stream.index > start and stream.LA(1) in (10, 13):
+            self.column -= 1            # the skip counts the character again
+            stream.seek(stream.index - 1)
+        lexer_cls.recover(self, re)
+
+    return type(lexer_cls.__name__, (lexer_cls,), {"recover": recover, "__module__": lexer_cls.__module__})
 
 
 class CollectingErrorListener(ErrorListener):
@@ -144,7 +149,6 @@ class CollectingErrorListener(ErrorListener):
     def syntaxError(self, recognizer, offendingSymbol, line, column, msg, e):  # noqa: N802
         if self.kind == "lexer":
             self._lexer_raw.append((line, column, msg))
-            keep_line_end(recognizer, e)
             return
         try:
             expected_set = recognizer.getExpectedTokens()

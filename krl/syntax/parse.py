@@ -26,7 +26,7 @@ from antlr4.error.Errors import ParseCancellationException
 from krl.diagnostics.codes import E018
 from krl.syntax.checks import may_fail, run_checks
 from krl.syntax.blocks import first_past_limit
-from krl.syntax.errors import CollectingErrorListener, LineErrorStrategy, SyntaxIssue
+from krl.syntax.errors import CollectingErrorListener, LineErrorStrategy, SyntaxIssue, line_end_lexer
 from krl.source import SourceText, read_source
 
 GENERATED_DIR = Path(__file__).parent / "generated"
@@ -53,7 +53,7 @@ class ParserBundle:
 
     def __init__(self, lexer_cls: type, parser_cls: type, directory: Path | None = None):
         self.directory = directory    # the generated code's directory (None: krl/syntax/generated)
-        self.lexer_cls = lexer_cls
+        self.lexer_cls = line_end_lexer(lexer_cls)   # a lexer error never takes a line end
         self.parser_cls = parser_cls
         self.symbolic = list(parser_cls.symbolicNames)
         self.literal = list(parser_cls.literalNames)

@@ -24,6 +24,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from antlr4 import CommonTokenStream, InputStream, ParserRuleContext
 
+from krl.ast import nodes as N
+from krl.ast.build import build_module
 from krl.syntax import blocks
 from krl.syntax.engines import EngineUnavailable, parse_file, parse_sources, resolve
 from krl.syntax.engines import java as java_engine
@@ -269,8 +271,6 @@ def test_a_token_error_at_a_line_end_keeps_the_line_end(engine):
     ProfileHeight.dat, line 11 named not understood with line 10)."""
     if engine == "java":
         _java_or_skip()
-    from krl.ast.build import build_module  # noqa: PLC0415
-    from krl.ast import nodes as N  # noqa: PLC0415
     text = ("DEFDAT d\n"
             "DECL CONST REAL a = 51.'B0120'\n"
             "DECL CONST REAL b = 18.0\n"

@@ -168,7 +168,7 @@ public final class KrlWorker {
             keepLineEnd((Lexer) r, e);
         }
 
-        /** krl/syntax/errors.py keep_line_end: the line end a token recognition error stopped at
+        /** krl/syntax/errors.py line_end_lexer: the line end a token recognition error stopped at
          *  stays a token (the lexer's skip takes the last character read instead). */
         static void keepLineEnd(Lexer lexer, RecognitionException e) {
             CharStream in = lexer.getInputStream();
