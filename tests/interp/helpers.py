@@ -55,3 +55,32 @@ def run_krl(tmp: Path, src: str, dat: str | None = None, name: str = "prog", *, 
         before(rt)
     res = rt.run()
     return Run(rt, res, tw)
+
+
+def run_beside(tmp: Path, prog: str, sub: str, dat: str, *, interp: str, enabled: bool = True,
+               shadow: bool = False, stimuli: str | None = None, max_sim_time: float = 30.0,
+               max_steps: int = 10_000_000):
+    """Run ``prog`` (with the data list `dat`) beside the submit program `sub`, untraced, with the
+    spin watch on or not (`enabled`) or shadowing (`shadow`). Returns ``(runtime, result)``."""
+    p = write(tmp, "prog.src", prog)
+    write(tmp, "prog.dat", dat)
+    s = write(tmp, "sps.sub", sub)
+    inputs = write(tmp, "stimuli.yaml", stimuli) if stimuli else None
+    rt, _ = make_runtime(run_spec(p, inputs=inputs, trace=None, max_sim_time=max_sim_time, max_steps=max_steps,
+                                  mujoco=False, submit=[s], check=False, interp=interp))
+    rt.scheduler.spin.enabled = enabled
+    rt.scheduler.spin.shadow = shadow
+    return rt, rt.run()
+
+
+def same_run(tmp: Path, prog: str, sub: str, dat: str, interp: str, **kw):
+    """:func:`run_beside` with and without the spin watch: the I/O log, the end and the steps must
+    agree and no catch-up diverge; returns the parked run ``(runtime, result)``."""
+    off, r_off = run_beside(tmp, prog, sub, dat, interp=interp, enabled=False, **kw)
+    on, r_on = run_beside(tmp, prog, sub, dat, interp=interp, **kw)
+    assert on.controller.io.log == off.controller.io.log
+    assert (r_on.reason, r_on.file, r_on.line, r_on.sim_time, r_on.steps) == \
+        (r_off.reason, r_off.file, r_off.line, r_off.sim_time, r_off.steps)
+    sw = on.scheduler.spin
+    assert (sw.diverged, sw.missed) == (0, 0), sw.why
+    return on, r_on

@@ -9,9 +9,7 @@ from __future__ import annotations
 
 import pytest
 
-from interp.run import make_runtime, run_spec
-
-from .helpers import write
+from .helpers import run_beside, same_run
 
 INTERPS = ("tree", "vm")
 
@@ -79,27 +77,12 @@ END
 """
 
 
-def _run(tmp_path, prog: str, sub: str, *, interp: str, enabled: bool = True, shadow: bool = False,
-         max_sim_time: float = 3.0):
-    p = write(tmp_path, "prog.src", prog)
-    write(tmp_path, "prog.dat", DAT)
-    s = write(tmp_path, "sps.sub", sub)
-    rt, _ = make_runtime(run_spec(p, trace=None, max_sim_time=max_sim_time, mujoco=False, submit=[s], check=False,
-                         interp=interp))
-    rt.scheduler.spin.enabled = enabled
-    rt.scheduler.spin.shadow = shadow
-    return rt, rt.run()
+def _run(tmp_path, prog: str, sub: str, *, max_sim_time: float = 3.0, **kw):
+    return run_beside(tmp_path, prog, sub, DAT, max_sim_time=max_sim_time, **kw)
 
 
-def _same_run(tmp_path, prog: str, sub: str, interp: str, **kw):
-    off, r_off = _run(tmp_path, prog, sub, interp=interp, enabled=False, **kw)
-    on, r_on = _run(tmp_path, prog, sub, interp=interp, **kw)
-    assert on.controller.io.log == off.controller.io.log
-    assert (r_on.reason, r_on.file, r_on.line, r_on.sim_time, r_on.steps) == \
-        (r_off.reason, r_off.file, r_off.line, r_off.sim_time, r_off.steps)
-    sw = on.scheduler.spin
-    assert (sw.diverged, sw.missed) == (0, 0), sw.why
-    return on, r_on
+def _same_run(tmp_path, prog: str, sub: str, interp: str, *, max_sim_time: float = 3.0, **kw):
+    return same_run(tmp_path, prog, sub, DAT, interp, max_sim_time=max_sim_time, **kw)
 
 
 @pytest.mark.parametrize("interp", INTERPS)

@@ -21,7 +21,7 @@ from interp.runtime.scheduler import SUBMIT_BUDGET
 from interp.runtime.sysvars import _LIVE, CONSTANT_NAMES
 from krl.files import SHARED_CORPUS
 
-from .helpers import write
+from .helpers import run_beside, same_run, write
 
 INTERPS = ("tree", "vm")
 
@@ -83,30 +83,13 @@ ENDDAT
 """
 
 
-def _run(tmp_path, prog: str, sub: str, *, interp: str, enabled: bool = True, shadow: bool = False,
-         stimuli: str | None = None, max_sim_time: float = 30.0, max_steps: int = 10_000_000):
-    p = write(tmp_path, "prog.src", prog)
-    write(tmp_path, "prog.dat", DAT)
-    s = write(tmp_path, "sps.sub", sub)
-    inputs = write(tmp_path, "stimuli.yaml", stimuli) if stimuli else None
-    rt, _ = make_runtime(run_spec(p, inputs=inputs, trace=None, max_sim_time=max_sim_time, max_steps=max_steps,
-                         mujoco=False, submit=[s], check=False, interp=interp))
-    rt.scheduler.spin.enabled = enabled
-    rt.scheduler.spin.shadow = shadow
-    res = rt.run()
-    return rt, res
+def _run(tmp_path, prog: str, sub: str, **kw):
+    return run_beside(tmp_path, prog, sub, DAT, **kw)
 
 
 def _same_run(tmp_path, prog: str, sub: str, interp: str, **kw):
     """Run with and without the spin watch; both runs must agree; return the parked run."""
-    off, r_off = _run(tmp_path, prog, sub, interp=interp, enabled=False, **kw)
-    on, r_on = _run(tmp_path, prog, sub, interp=interp, **kw)
-    assert on.controller.io.log == off.controller.io.log
-    assert (r_on.reason, r_on.file, r_on.line, r_on.sim_time, r_on.steps) == \
-        (r_off.reason, r_off.file, r_off.line, r_off.sim_time, r_off.steps)
-    sw = on.scheduler.spin
-    assert (sw.diverged, sw.missed) == (0, 0), sw.why
-    return on, r_on
+    return same_run(tmp_path, prog, sub, DAT, interp, **kw)
 
 
 @pytest.mark.parametrize("interp", INTERPS)
