@@ -46,7 +46,7 @@ from krl.semantics.resolve import NATIVE, ROUTINE, SYSTEM, UNRESOLVED
 from .convert import assign_into
 from .idle import _frames, _store, freeze
 from .memory import Slot
-from .passes import ALLOWED, CLOCK_NAMES, MAX_PASS_STEPS, PURE_NATIVES, STATE_NAMES, chain, written
+from .passes import ALLOWED, CLOCK_NAMES, MAX_PASS_STEPS, PURE_NATIVES, STATE_NAMES, Pass, chain, written
 from .sysvars import _LIVE
 from .values import Arr, Struct, copy_value
 from .watch import CONSTANT, IO
@@ -151,8 +151,8 @@ class Tick:
         self.key = key
 
 
-class Period:
-    """A recorded periodic spin (module docstring). Like interp/runtime/spin.py ``_Pass``:
+class Period(Pass):
+    """A recorded periodic spin (module docstring). A :class:`~.passes.Pass`:
     ``events``, ``infos``, ``at``, ``frames`` per step, ``steps`` (``n``), ``io``, ``motion``,
     ``cyclic``, ``probes``; and ``written`` (the written set's references), ``timers``,
     ``consts`` (the unwritten values read: references and images), ``probed_refs`` (the state
@@ -164,14 +164,7 @@ class Period:
     still = False       # no cycle's end puts anything: the state stands (SpinWatch._period_found)
 
     def __init__(self, events, infos, at, frames) -> None:
-        self.events = events
-        self.infos = infos
-        self.at = at
-        self.frames = frames
-        self.images = None
-        self.io = self.motion = self.cyclic = False
-        self.probes: tuple = ()
-        self.refs = None
+        super().__init__(events, infos, at, frames, None)
         self.written: tuple = ()
         self.timers: tuple = ()
         self.consts: tuple = ()
@@ -183,10 +176,6 @@ class Period:
         self.keys: dict = {}
         self.bound = None
         self.frame = None
-
-    @property
-    def steps(self) -> int:
-        return len(self.events)
 
     def end_at(self, pos: int) -> End:
         return self.ends[pos % len(self.events)]

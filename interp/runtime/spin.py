@@ -96,6 +96,7 @@ from .idle import _frames, _store, freeze
 from .memory import Slot
 from .passes import (ALLOWED, IO_NAMES, MAX_PASS_STEPS, MOTION_NAMES, PURE_NATIVES, STATE_NAMES, chain,
                      written)
+from .passes import Pass as _Pass
 from .period import MAX_STATE_CYCLES, Period, PeriodicSpins, set_timers, timers_image
 from .sysvars import CONSTANT_NAMES
 
@@ -104,36 +105,6 @@ MAX_GAP = 256
 #: the longest wait between two recordings of a spin that could not be parked when recorded
 #: (what it reads was about to change), in IPO cycles: parked at most this late once it may be
 MAX_WAIT_GAP = 16
-
-
-class _Pass:
-    """A recorded spin: ``events`` ((file, line, loop iteration?, depth below the loop's frame)
-    per step, the loop iteration that ends the pass last), ``infos`` (the StmtInfo of each
-    step), ``at`` (the statement the task stands at after each step), ``frames`` (its innermost
-    frame at each step) and ``images`` (its frames as the idle watch images them at each step),
-    ``io`` (it reads I/O), ``motion`` (it reads the robot's position or motion), ``cyclic`` (it
-    reads ``$CYCFLAG``: a cyclic flag whose expression does not settle may set it at any IPO
-    cycle, one that settles only after an input changed: interp/runtime/watch.py
-    ``settles``), ``probes`` (the state variables it reads)."""
-
-    __slots__ = ("events", "infos", "at", "frames", "images", "io", "motion", "cyclic", "probes", "refs")
-    periodic = False
-
-    def __init__(self, events, infos, at, frames, images) -> None:
-        self.events = events
-        self.infos = infos
-        self.at = at
-        self.frames = frames
-        self.images = images
-        self.io = False
-        self.motion = False
-        self.cyclic = False
-        self.probes: tuple = ()
-        self.refs = None            # the references of the probes, found when first read
-
-    @property
-    def steps(self) -> int:
-        return len(self.events)
 
 
 class _Parked:
