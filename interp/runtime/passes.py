@@ -1,5 +1,6 @@
-"""What a pass of a task's loop reads and writes: the classes of names and statements that the
-spin watch (interp/runtime/spin.py) and its periods (interp/runtime/period.py) share."""
+"""What a pass of a task's loop is and what it reads and writes: the recorded pass (:class:`Pass`,
+which a period extends) and the classes of names and statements that the spin watch
+(interp/runtime/spin.py) and its periods (interp/runtime/period.py) share."""
 
 from __future__ import annotations
 
