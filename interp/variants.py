@@ -33,7 +33,7 @@ limit, or a simulator gap the report names (a target the stand-in robot cannot r
 variant removed the machine data); it *fails* when it stops on a name the checker classifies as
 installed software (an "outside stop") or ends in an internal error.
 
-``python -m interp.variants [FOLDER ...] [--sample N] [--jobs N] [--json OUT]`` (default: the
+``python -m interp.variants [FOLDER ...] [--sample N] [--jobs N] [--json OUT] [--log LOG]`` (default: the
 backups of ../shared/krl-corpus and ../shared/krl-history) prints the counts of variants and runs,
 the runs by cause and every failing run; exit status 1 when a run fails. ``make nightly`` runs
 all of them (``variants.json``, its counts in the nightly's history: conformance/nightly);
@@ -303,6 +303,22 @@ def summarise(results: list[dict]) -> dict:
             "internal": causes.get("internal", 0), "failures": failures}
 
 
+def _logged(log: Path | None, interp: str) -> dict:
+    """The results `log` (``--log``) holds for `interp`, keyed by (backup, variant name); a line
+    cut by a stop mid-write is left out (its variant runs again)."""
+    if log is None or not log.exists():
+        return {}
+    found = {}
+    for line in log.read_text(encoding="utf-8").splitlines():
+        try:
+            res = json.loads(line)
+        except ValueError:
+            continue
+        if isinstance(res, dict) and res.get("interp") == interp and isinstance(res.get("runs"), list):
+            found[(res.get("backup"), res.get("variant"))] = res
+    return found
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(prog="python -m interp.variants", description=__doc__.split("\n\n")[0])
     ap.add_argument("folders", nargs="*", type=Path, help="folders holding backups (default: the shared corpus "
@@ -311,6 +327,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--jobs", type=int, default=None, help="worker processes (default: one per core)")
     ap.add_argument("--interp", choices=("vm", "tree"), default="vm")
     ap.add_argument("--json", type=Path, default=None, help="write the results here")
+    ap.add_argument("--log", type=Path, default=None,
+                    help="append each variant's result to this file as one JSON line as it ends; the variants "
+                         "it already holds are not run again (a stopped sweep resumes)")
     args = ap.parse_args(argv)
     # on use: the worker pool (pebble) costs 0.42 s (python -X importtime, 2026-11-23, krl/workspace.py)
     from krl.pool import run_tasks  # noqa: PLC0415
@@ -319,16 +338,25 @@ def main(argv: list[str] | None = None) -> int:
     variants = [v for b in backups(folders) for v in variants_of(b)]
     if args.sample:
         variants = sample(variants, args.sample)
-    tasks = [(k, (str(v.backup), v.kind, v.detail, SIM_TIME_S, STEPS, args.interp)) for k, v in enumerate(variants)]
     results: list = [None] * len(variants)
-    for done, o in enumerate(run_tasks(_task, tasks, jobs=args.jobs), 1):
+    logged = _logged(args.log, args.interp)
+    for k, v in enumerate(variants):
+        results[k] = logged.get((str(v.backup), v.name))
+    tasks = [(k, (str(v.backup), v.kind, v.detail, SIM_TIME_S, STEPS, args.interp))
+             for k, v in enumerate(variants) if results[k] is None]
+    if logged:
+        print(f"{len(variants) - len(tasks)} variants read from {args.log}", file=sys.stderr, flush=True)
+    for done, o in enumerate(run_tasks(_task, tasks, jobs=args.jobs), len(variants) - len(tasks) + 1):
         v = variants[o.key]
         results[o.key] = o.value if o.status == "done" else {
             "variant": v.name, "kind": v.kind, "backup": str(v.backup),
             "runs": [{"entry": "", "cause": "internal", "reason": "internal", "text": o.detail or o.status,
                       "outside_stops": []}]}
+        if args.log is not None:
+            with args.log.open("a", encoding="utf-8") as log:
+                log.write(json.dumps({**results[o.key], "interp": args.interp}) + "\n")
         failing = summarise([results[o.key]])["failures"]
-        print(f"[{done}/{len(tasks)}] {v.backup} [{v.name}]: {len(results[o.key]['runs'])} runs"
+        print(f"[{done}/{len(variants)}] {v.backup} [{v.name}]: {len(results[o.key]['runs'])} runs"
               + (f", {len(failing)} failing" if failing else ""), file=sys.stderr, flush=True)
     s = summarise(results)
     print(f"variants {s['variants']} of {len(backups(folders))} backups, runs {s['runs']}: "

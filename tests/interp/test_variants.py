@@ -153,3 +153,22 @@ def test_some_entries_takes_the_submit_interpreter_first():
     assert V.some_entries(entries, 0) == entries
     assert V.some_entries(entries, 3) == [Path("R1/System/sps.sub"), Path("R1/Program/p0.src"),
                                           Path("R1/Program/p3.src")]
+
+
+def test_a_stopped_sweep_resumes_from_its_log(tmp_path, capsys):
+    """--log appends each variant's result as it ends; a second sweep with the same log runs only
+    the variants it does not hold (a line cut by a stop mid-write runs again) and counts all."""
+    _backup(tmp_path / "src")
+    log = tmp_path / "sweep.jsonl"
+    args = [str(tmp_path / "src"), "--sample", "3", "--jobs", "1", "--log", str(log)]
+    assert V.main([str(tmp_path / "src"), "--sample", "2", "--jobs", "1", "--log", str(log)]) == 0
+    lines = log.read_text().splitlines()
+    assert len(lines) == 2
+    first = capsys.readouterr()
+    log.write_text(lines[0] + "\n" + lines[1][: len(lines[1]) // 2] + "\n")  # the second cut mid-write
+    assert V.main(args) == 0
+    second = capsys.readouterr()
+    assert "1 variants read from" in second.err
+    assert len([ln for ln in log.read_text().splitlines() if ln.endswith("}")]) == 3
+    assert "variants 3 of 1 backups, runs 6" in second.out
+    assert "variants 2 of 1 backups, runs 4" in first.out
