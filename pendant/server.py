@@ -33,6 +33,7 @@ import asyncio
 import contextlib
 import json
 import time
+from collections.abc import Awaitable, Callable
 from pathlib import Path
 
 from starlette.applications import Starlette
@@ -62,8 +63,51 @@ CSP = ("default-src 'none'; script-src 'self'; style-src 'self'; img-src 'self' 
        "form-action 'none'")
 #: close codes (RFC 6455 7.4.1; 1013 "Try Again Later", IANA's WebSocket Close Code registry)
 CLOSE_POLICY_VIOLATION, CLOSE_UNSUPPORTED_DATA, CLOSE_MESSAGE_TOO_BIG, CLOSE_TRY_AGAIN_LATER = 1008, 1003, 1009, 1013
-OPS = ("hello", "select", "cancel", "reset", "start", "stop", "backward", "runMode", "modeOp", "drives",
-       "override", "breakpoint", "input", "ack", "ackAll", "answer", "watch", "setWatch", "jog", "touchup", "open")
+#: the operator actions a page sends (``{"op": name, ...}``): name -> the :class:`Pendant`
+#: method that carries it out, ``async handler(pendant, action: _Action)``; each handler is
+#: entered by its ``@_operation(name)``, so this table is the one list of the operations
+#: (:data:`OPS` is its keys; tests/pendant/test_protocol.py checks it against the page's)
+OPERATIONS: dict[str, Callable[..., Awaitable[object]]] = {}
+#: a handler's answer when the action changed no state (nothing to push)
+_NO_STATE = object()
+
+
+def _operation(name: str) -> Callable:
+    """The decorator entering a :class:`Pendant` method as the handler of operation `name`
+    (:data:`OPERATIONS`). Raises ValueError for a name entered twice."""
+    def enter(fn: Callable[..., Awaitable[object]]) -> Callable[..., Awaitable[object]]:
+        if name in OPERATIONS:
+            raise ValueError(f"pendant operation {name!r} has two handlers")
+        OPERATIONS[name] = fn
+        return fn
+    return enter
+
+
+class _Action:
+    """One operator action being carried out: the page's socket `ws`, its message `msg`, the
+    watch list when it arrived, and the state snapshots :meth:`do` took (``fresh``)."""
+
+    def __init__(self, pendant: "Pendant", ws: WebSocket, msg: dict) -> None:
+        self.pendant, self.ws, self.msg = pendant, ws, msg
+        self.watch = list(pendant.watch)
+        self.fresh: list = []
+
+    async def do(self, fn, timeout: float = 120.0, *, state: bool = True):
+        """The key ``fn(core)`` and, with ``state``, the state snapshot after it in the same
+        engine call (one round trip to the engine thread: the answer carries what the key
+        changed). Not for Start and Stop: their change comes after the call (the program
+        goes on, stops at its next statement), and the state is asked for afterwards."""
+        eng, watch, fresh = self.pendant.engine, self.watch, self.fresh
+
+        def key_and_state(core):
+            result = fn(core)
+            if state:
+                try:
+                    fresh.append(snapshot(eng, core, watch))
+                except Refused:
+                    pass                           # asked for again by push_state
+            return result
+        return await eng.do_async(key_and_state, timeout)
 
 
 class Pendant:
@@ -251,128 +295,164 @@ class Pendant:
 
     # ------------------------------------------------------------------ operator actions
     async def handle(self, ws: WebSocket, msg: dict) -> None:
+        """Carry out the operator action `msg` (``{"op": name, ...}``) of the page on `ws`: its
+        handler in :data:`OPERATIONS`, then the state it changed pushed to the pages. Raises
+        EngineError for an unknown operation and for a key the controller refuses."""
         op = msg.get("op")
-        if op not in OPS:
+        handler = OPERATIONS.get(op) if isinstance(op, str) else None
+        if handler is None:
             raise EngineError(f"unknown action {str(op)[:40]!r}")
+        action = _Action(self, ws, msg)
+        if await handler(self, action) is _NO_STATE:
+            return
+        fresh = action.fresh
+        await self.push_state(fresh[-1] if fresh and self.watch == action.watch else None)
+
+    @_operation("hello")
+    async def _hello(self, act: "_Action") -> None:
+        # costs 0.15 s at start-up (python -X importtime, 2026-11-25)
+        from .view import modules  # noqa: PLC0415
+
         loop = asyncio.get_running_loop()
-        eng, watch, fresh = self.engine, list(self.watch), []
-
-        async def do(fn, timeout=120.0, *, state=True):
-            """The key ``fn(core)`` and, with ``state``, the state snapshot after it in the same
-            engine call (one round trip to the engine thread: the answer carries what the key
-            changed). Not for Start and Stop: their change comes after the call (the program
-            goes on, stops at its next statement), and the state is asked for afterwards."""
-            def key_and_state(core):
-                result = fn(core)
-                if state:
-                    try:
-                        fresh.append(snapshot(eng, core, watch))
-                    except Refused:
-                        pass                           # asked for again by push_state
-                return result
-            return await eng.do_async(key_and_state, timeout)
-
-        if op == "hello":
-            # costs 0.15 s at start-up (python -X importtime, 2026-11-25)
-            from .view import modules  # noqa: PLC0415
-
-            entries = self.programs()
-            others = [m for m in await loop.run_in_executor(None, modules, self.root) if m not in set(entries)]
-            await ws.send_text(json.dumps({"type": "init", "workspace": self.shown_root, "programs": entries,
+        entries = self.programs()
+        others = [m for m in await loop.run_in_executor(None, modules, self.root) if m not in set(entries)]
+        await act.ws.send_text(json.dumps({"type": "init", "workspace": self.shown_root, "programs": entries,
                                            "modules": others,
                                            "robot": self.robot(), "modes": MODES_OP, "runModes": RUN_MODES,
                                            "readonly": self.readonly}))
-            if self.program is not None:
-                await self.send_module(ws, self.program)
-        elif op == "select":
-            await self.select(str(msg.get("program", "")))
-        elif op == "cancel":
-            await loop.run_in_executor(None, self.engine.cancel)
-            self.program = None
-        elif op == "reset":
-            if self.program is None:
-                raise EngineError("no program is selected")
-            await self.select(self.program)
-        elif op == "start":
-            self._need_drives()
-            await do(lambda core: core.resume(), state=False)
-        elif op == "stop":
-            await do(lambda core: core.pause(), state=False)
-        elif op == "backward":
-            self._need_drives()
-            await do(lambda core: core.backward_motion(), 900.0, state=False)
-        elif op == "runMode":
-            value = str(msg.get("value", "")).upper()
-            if value not in RUN_MODES:
-                raise EngineError(f"run mode: one of {', '.join(RUN_MODES)}")
-            self.run_mode = value
-            if self._live():
-                await do(lambda core: keys.run_mode(core, value))
-        elif op == "modeOp":
-            value = str(msg.get("value", "")).upper()
-            if value not in MODES_OP:
-                raise EngineError(f"operating mode: one of {', '.join(MODES_OP)}")
-            if self._live():
-                await do(lambda core: keys.mode_op(core, value))
-            self.mode = value
-            self.drives = False          # turning the mode switch switches the drives off
-        elif op == "drives":
-            self.drives = bool(msg.get("on"))
-        elif op == "override":
-            await do(lambda core: keys.override(core, msg.get("value")))
-        elif op == "breakpoint":
-            path = str(inside(self.root, str(msg.get("path", "")), suffixes=(".src", ".sub")))
-            line = msg.get("line")
-            if not isinstance(line, int) or isinstance(line, bool) or line < 1:
-                raise EngineError("breakpoint: a line number")
-            lines = self.breakpoints.setdefault(path, set())
-            (lines.add if msg.get("on") else lines.discard)(line)
-            if self.engine.selected:
-                specs = [{"line": n} for n in sorted(lines)]
-                await do(lambda core: core.set_breakpoints(path, specs))
-        elif op == "input":
-            await do(lambda core: keys.set_input(core, msg.get("index"), bool(msg.get("value"))))
-        elif op == "ack":
-            handle = msg.get("handle")
-            if isinstance(handle, str):               # the controller's own message (pendant/engine.py)
-                self.engine.system.acknowledge(handle)
-            else:
-                await do(lambda core: keys.message(core, handle))
-        elif op == "ackAll":
-            # "Confirm all": the controller's messages and the program's notification and
-            # acknowledgement messages (status, wait and dialog messages stay)
-            self.engine.system.acknowledge_all()
-            if self._live():
-                await do(keys.acknowledge_all)
-        elif op == "answer":
-            await do(lambda core: keys.message(core, msg.get("handle"), msg.get("key")))
-        elif op == "watch":
-            exprs = msg.get("exprs")
-            if not isinstance(exprs, list) or len(exprs) > MAX_WEB_WATCHES or \
-                    any(not isinstance(e, str) or len(e) > MAX_WEB_EXPRESSION_CHARS for e in exprs):
-                raise EngineError(f"watch list: at most {MAX_WEB_WATCHES} expressions of "
-                                  f"{MAX_WEB_EXPRESSION_CHARS} characters")
-            self.watch = list(exprs)
-        elif op == "setWatch":
-            await do(lambda core: keys.set_watch(core, str(msg.get("expr", "")), str(msg.get("value", ""))))
-        elif op == "jog":
-            if self.mode != "T1":                     # the robot's rule first: jog keys work in T1 only
-                raise EngineError(f"jog: only in T1 (operating mode {self.mode})")
-            self._need_drives()
-            await do(lambda core: keys.jog(core, str(msg.get("system", "")).upper(), msg.get("axis"), msg.get("step")),
+        if self.program is not None:
+            await self.send_module(act.ws, self.program)
+
+    @_operation("select")
+    async def _select(self, act: "_Action") -> None:
+        await self.select(str(act.msg.get("program", "")))
+
+    @_operation("cancel")
+    async def _cancel(self, act: "_Action") -> None:
+        await asyncio.get_running_loop().run_in_executor(None, self.engine.cancel)
+        self.program = None
+
+    @_operation("reset")
+    async def _reset(self, act: "_Action") -> None:
+        if self.program is None:
+            raise EngineError("no program is selected")
+        await self.select(self.program)
+
+    @_operation("start")
+    async def _start(self, act: "_Action") -> None:
+        self._need_drives()
+        await act.do(lambda core: core.resume(), state=False)
+
+    @_operation("stop")
+    async def _stop(self, act: "_Action") -> None:
+        await act.do(lambda core: core.pause(), state=False)
+
+    @_operation("backward")
+    async def _backward(self, act: "_Action") -> None:
+        self._need_drives()
+        await act.do(lambda core: core.backward_motion(), 900.0, state=False)
+
+    @_operation("runMode")
+    async def _run_mode(self, act: "_Action") -> None:
+        value = str(act.msg.get("value", "")).upper()
+        if value not in RUN_MODES:
+            raise EngineError(f"run mode: one of {', '.join(RUN_MODES)}")
+        self.run_mode = value
+        if self._live():
+            await act.do(lambda core: keys.run_mode(core, value))
+
+    @_operation("modeOp")
+    async def _mode_op(self, act: "_Action") -> None:
+        value = str(act.msg.get("value", "")).upper()
+        if value not in MODES_OP:
+            raise EngineError(f"operating mode: one of {', '.join(MODES_OP)}")
+        if self._live():
+            await act.do(lambda core: keys.mode_op(core, value))
+        self.mode = value
+        self.drives = False          # turning the mode switch switches the drives off
+
+    @_operation("drives")
+    async def _drives(self, act: "_Action") -> None:
+        self.drives = bool(act.msg.get("on"))
+
+    @_operation("override")
+    async def _override(self, act: "_Action") -> None:
+        await act.do(lambda core: keys.override(core, act.msg.get("value")))
+
+    @_operation("breakpoint")
+    async def _breakpoint(self, act: "_Action") -> None:
+        msg = act.msg
+        path = str(inside(self.root, str(msg.get("path", "")), suffixes=(".src", ".sub")))
+        line = msg.get("line")
+        if not isinstance(line, int) or isinstance(line, bool) or line < 1:
+            raise EngineError("breakpoint: a line number")
+        lines = self.breakpoints.setdefault(path, set())
+        (lines.add if msg.get("on") else lines.discard)(line)
+        if self.engine.selected:
+            specs = [{"line": n} for n in sorted(lines)]
+            await act.do(lambda core: core.set_breakpoints(path, specs))
+
+    @_operation("input")
+    async def _input(self, act: "_Action") -> None:
+        await act.do(lambda core: keys.set_input(core, act.msg.get("index"), bool(act.msg.get("value"))))
+
+    @_operation("ack")
+    async def _ack(self, act: "_Action") -> None:
+        handle = act.msg.get("handle")
+        if isinstance(handle, str):               # the controller's own message (pendant/engine.py)
+            self.engine.system.acknowledge(handle)
+        else:
+            await act.do(lambda core: keys.message(core, handle))
+
+    @_operation("ackAll")
+    async def _ack_all(self, act: "_Action") -> None:
+        # "Confirm all": the controller's messages and the program's notification and
+        # acknowledgement messages (status, wait and dialog messages stay)
+        self.engine.system.acknowledge_all()
+        if self._live():
+            await act.do(keys.acknowledge_all)
+
+    @_operation("answer")
+    async def _answer(self, act: "_Action") -> None:
+        await act.do(lambda core: keys.message(core, act.msg.get("handle"), act.msg.get("key")))
+
+    @_operation("watch")
+    async def _watch(self, act: "_Action") -> None:
+        exprs = act.msg.get("exprs")
+        if not isinstance(exprs, list) or len(exprs) > MAX_WEB_WATCHES or \
+                any(not isinstance(e, str) or len(e) > MAX_WEB_EXPRESSION_CHARS for e in exprs):
+            raise EngineError(f"watch list: at most {MAX_WEB_WATCHES} expressions of "
+                              f"{MAX_WEB_EXPRESSION_CHARS} characters")
+        self.watch = list(exprs)
+
+    @_operation("setWatch")
+    async def _set_watch(self, act: "_Action") -> None:
+        msg = act.msg
+        await act.do(lambda core: keys.set_watch(core, str(msg.get("expr", "")), str(msg.get("value", ""))))
+
+    @_operation("jog")
+    async def _jog(self, act: "_Action") -> None:
+        if self.mode != "T1":                     # the robot's rule first: jog keys work in T1 only
+            raise EngineError(f"jog: only in T1 (operating mode {self.mode})")
+        self._need_drives()
+        msg = act.msg
+        await act.do(lambda core: keys.jog(core, str(msg.get("system", "")).upper(), msg.get("axis"), msg.get("step")),
                      900.0)
-        elif op == "touchup":
-            if self.readonly:
-                raise EngineError("touch-up: the workspace is a backup archive (read-only)")
-            dat = inside(self.root, str(msg.get("path", "")), suffixes=(".dat",))
-            await do(lambda core: keys.touch_up(core, str(dat), str(msg.get("name", ""))))
-            if self.program is not None:
-                await self.broadcast_module(self.program)
-        elif op == "open":
-            path = inside(self.root, str(msg.get("path", "")), suffixes=(".src", ".sub", ".dat"))
-            await self.send_module(ws, str(path))
-            return
-        await self.push_state(fresh[-1] if fresh and self.watch == watch else None)
+
+    @_operation("touchup")
+    async def _touchup(self, act: "_Action") -> None:
+        if self.readonly:
+            raise EngineError("touch-up: the workspace is a backup archive (read-only)")
+        dat = inside(self.root, str(act.msg.get("path", "")), suffixes=(".dat",))
+        await act.do(lambda core: keys.touch_up(core, str(dat), str(act.msg.get("name", ""))))
+        if self.program is not None:
+            await self.broadcast_module(self.program)
+
+    @_operation("open")
+    async def _open(self, act: "_Action") -> object:
+        path = inside(self.root, str(act.msg.get("path", "")), suffixes=(".src", ".sub", ".dat"))
+        await self.send_module(act.ws, str(path))
+        return _NO_STATE                           # a view of a file: no state changed
 
     def _live(self) -> bool:
         """A selected program that has not ended: a mode key goes to its run. After its end
@@ -512,6 +592,10 @@ class Pendant:
             except (EngineError, PathRefused) as exc:
                 await ws.send_text(json.dumps({"type": "error", "id": rid, "op": str(msg.get("op"))[:40],
                                                "text": str(exc)[:500]}))
+
+
+#: the operations a page may send: :data:`OPERATIONS`' keys
+OPS = tuple(OPERATIONS)
 
 
 def create_app(pendant: Pendant, token: str, port_of) -> Guard:
