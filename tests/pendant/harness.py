@@ -40,15 +40,20 @@ def pendant_server(target: Path, *args: str, stderr: Path | None = None):
 
 
 @contextmanager
-def browser_page(pw, url: str, viewport=(1400, 900)):
+def browser_page(pw, url: str, viewport=(1400, 900), scale: float = 0.5):
     """A fresh headless Chromium profile with the page loaded and its robot drawn; page errors
-    are collected in ``page.problems``."""
+    are collected in ``page.problems``. ``scale``: the device pixel ratio. The 3D view is
+    software-rendered WebGL (no GPU): at 0.5 its canvas has a quarter of the pixels, with the
+    same CSS layout and scene (the tests read the scene, ``renderedAxes``, the state and the
+    trace; 33.7 -> 20.0 s of Chromium's CPU for test_page's two MSTEP tests, 2026-11-26); the
+    tests that compare pixels (test_screenshots, test_cell_view) draw at 1."""
     with tempfile.TemporaryDirectory() as profile:
         # bypass_csp: Playwright's wait_for_function evaluates its predicate, which the page's
         # Content-Security-Policy (script-src 'self') forbids; the page itself runs under it
         ctx = pw.chromium.launch_persistent_context(profile, executable_path=chromium(), headless=True,
                                                     args=client.CHROMIUM_FLAGS, bypass_csp=True,
-                                                    viewport={"width": viewport[0], "height": viewport[1]})
+                                                    viewport={"width": viewport[0], "height": viewport[1]},
+                                                    device_scale_factor=scale)
         # every Playwright wait and action (a click waits for its element) gets the loaded
         # machine's time limit, not Playwright's 30 s
         ctx.set_default_timeout(WAIT_MS)

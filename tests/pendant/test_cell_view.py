@@ -65,7 +65,7 @@ def test_the_cell_and_the_track_axis_are_drawn(pw, tmp_path):
     cell = tmp_path / "cell.yaml"
     cell.write_text(CELL, encoding="ascii")
     with pendant_server(tmp_path, "--no-realtime", "--inputs", str(cell)) as url, \
-            browser_page(pw, url, (1400, 900)) as page:
+            browser_page(pw, url, (1400, 900), scale=1) as page:
         assert page.evaluate("() => window.pendant.cellBodies") == 3       # table, post, tool
         assert page.locator('#jog-keys button[data-jog="E1+"]').count() == 1
         select(page, "track.src", run_mode="MSTEP", mode="T1")
@@ -115,7 +115,7 @@ def test_a_description_with_meshes_is_drawn_with_them(pw, tmp_path):
                     "geometry:\n  - {name: pallet, box: [1200, 800, 150], frame: [2200, 0, 75, 0, 0, 0]}\n",
                     encoding="ascii")
     with pendant_server(tmp_path, "--no-realtime", "--inputs", str(cell)) as url, \
-            browser_page(pw, url, (1400, 900)) as page:
+            browser_page(pw, url, (1400, 900), scale=1) as page:
         assert page.evaluate("() => window.pendant.meshLinks") == 7
         assert page.evaluate("() => window.pendant.cellBodies") == 1
         select(page, "reach.src", run_mode="MSTEP", mode="T1")

@@ -31,7 +31,7 @@ SHOTS = {
 
 
 def shot(pw, backup, cell, program, stops) -> bytes:
-    with pendant_server(backup, "--no-realtime", "--inputs", str(cell)) as url, browser_page(pw, url, (1400, 900)) as page:
+    with pendant_server(backup, "--no-realtime", "--inputs", str(cell)) as url, browser_page(pw, url, (1400, 900), scale=1) as page:
         select(page, program, run_mode="MSTEP", mode="T1")
         for _ in range(stops):
             before = page.evaluate("() => window.pendant.state.pointers.step")
