@@ -142,7 +142,7 @@ def plan_cell(rt: Runtime) -> CellPlan:
         try:
             resolve_signals(stimuli, lambda name: signal_of(rt, main, name), rules)
         except ResourceError:
-            pass    # a data list past a limit: the program does not start (Runtime.main_routine says why)
+            pass    # a data list past a limit: the program does not start (Calls.main_routine says why)
     network = spec.network if spec.network is not None else (cell.network if cell is not None else None)
     geometry = spec.geometry if spec.geometry is not None else (cell.geometry if cell is not None else None)
     return CellPlan(mode_op=mode, start=scene, start_axes=axes, stimuli=stimuli, rules=rules, network=network,
@@ -250,7 +250,7 @@ def global_value(rt: Runtime, main: str, name: str):
     if storage.kind == UNRESOLVED:
         return None             # a name of the tables no data list declares: no value (no stand-in made)
     try:
-        return rt.storage_ref(storage, None).get()
+        return rt.names.storage_ref(storage, None).get()
     except KrlRuntimeError:
         return None
 
@@ -303,7 +303,7 @@ def signal_of(rt: Runtime, main: str, name: str) -> tuple[str, int, int | None] 
     if sym is None or sym.kind != "signal":
         return None
     try:
-        ref = rt.storage_ref(prog.ws.resolver.storage(name, sym, None, module.index if module else -1), None)
+        ref = rt.names.storage_ref(prog.ws.resolver.storage(name, sym, None, module.index if module else -1), None)
     except (KrlRuntimeError, IndexError):   # IndexError: a system signal ($EXT_START) the table types
         return None
     if not isinstance(ref, SignalRef):

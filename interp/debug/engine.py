@@ -469,7 +469,7 @@ class Engine:
                 if n.upper() == name.upper():
                     target = ref
             if isinstance(target, view.Const) and target.ref is not None:
-                target = engine.rt.index(target.ref, [target.index], name.split("[")[0])
+                target = engine.rt.names.index(target.ref, [target.index], name.split("[")[0])
             if target is None or isinstance(target, view.Const) or not hasattr(target, "peek"):
                 raise Refused(f"{name} cannot be set")
             engine._store(target, engine._eval(value, engine._top()[1]))
@@ -544,7 +544,7 @@ class Engine:
 
     def _store(self, ref, value) -> None:
         try:
-            self.rt.assign(ref, value)
+            self.rt.names.assign(ref, value)
         except KrlRuntimeError as exc:
             raise Refused(exc.message) from None
 

@@ -172,8 +172,8 @@ def child(rt, ref, step, name):
     """The reference of one part (a ``["field", NAME]`` or ``["index", [i, ...]]`` step) of
     ``ref``."""
     if step[0] == "field":
-        return rt.field(ref, step[1], name)
-    return rt.index(ref, step[1], name)
+        return rt.names.field(ref, step[1], name)
+    return rt.names.index(ref, step[1], name)
 
 
 def peek(ref):

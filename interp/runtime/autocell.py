@@ -510,7 +510,7 @@ class _Eval:
             st = e.ann.place if e.ann is not None else None
             if st is None:
                 raise Unsolvable(e.name)
-            return rt.storage_ref(st, self.frame)
+            return rt.names.storage_ref(st, self.frame)
         if isinstance(e, N.Index):
             base = self.ref(e.base, over)
             idx = []
@@ -519,9 +519,9 @@ class _Eval:
                 if v is not None and (not isinstance(v, int) or isinstance(v, bool)):
                     raise Unsolvable("index")
                 idx.append(v)
-            return rt.index(base, idx, getattr(e.base, "name", "?"))
+            return rt.names.index(base, idx, getattr(e.base, "name", "?"))
         if isinstance(e, N.Field):
-            return rt.field(self.ref(e.base, over), e.name, "?")
+            return rt.names.field(self.ref(e.base, over), e.name, "?")
         raise Unsolvable(type(e).__name__)
 
 

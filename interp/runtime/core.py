@@ -12,11 +12,7 @@ from pathlib import Path
 
 from krl import collector
 from krl.ast import nodes as N
-from krl.limits import MAX_CALL_DEPTH
-from krl.semantics import expression as X
-from krl.semantics import types as T
 from krl.semantics.advance import StmtInfo
-from krl.semantics.resolve import ROUTINE, Callee, Storage
 from net.hub import NetError, Network
 from robot.controller import Controller
 from robot.errors import RobotError, SoftLimitError, WorkspaceError
@@ -24,25 +20,24 @@ from robot.io import IOImage
 from robot.motion import CondStop, MotionRequest, Trigger
 
 from .autocell import AUTO_DELAY_S, AutoCell
-from .natives import RSI_CONSTANTS, ValueRef
+from .calls import Calls
 from .netvars import RuntimeSink
 from .contexts import Context, Irq
 from .watch import (CONSTANT, IO, SETTLES, CyclicWatch, settles, split_watch, stamp_key, steady, timer_due,
                     timer_reads, timer_watch, watch_of)
-from .convert import (
-    INT_MAX, INT_MIN, assign_into, binary_op, convert_scalar, num, to_bool, trunc_int, unary_op,
-)
-from .errors import (HaltSignal, KrlRuntimeError, ResumeSignal, StopRun, not_entered)
+from .convert import assign_into, binary_op, num, to_bool, trunc_int, unary_op
+from .errors import HaltSignal, KrlRuntimeError, ResumeSignal, StopRun
 from .idle import probe_state
 from .kss import SystemSoftware
-from .memory import DataMemory, Frame, ProxyRef, Ref, SignalRef, Slot, field_ref, index_ref
+from .memory import DataMemory, Frame, ProxyRef, Ref, SignalRef, Slot
 from .messages import MessageWindow
+from .names import Names
 from .motion import frame_of, params_from, request, segment, target_of
 from .program import Program
 from .runmode import STEP_MODES, BackwardRefused, MotionHistory, mode_name
 from .scheduler import NO_LIMIT, Scheduler, Task, program_budget
 from .sysvars import EPOCH_PROBED, SysVars, struct_of
-from .values import LEAVES, UNSET, Arr, EnumValue, Struct, copy_value, make_value, maker, value_size
+from .values import Arr, EnumValue, Struct, copy_value
 
 
 #: s the operator takes to press Start again after a HALT (``krl run --on-halt continue``; a
@@ -83,30 +78,6 @@ def call_stack(task, limit: int = 64) -> tuple:
             out.append((span.file, frame.line))
         frame = frame.caller
     return tuple(out)
-
-
-def _scalar(t) -> bool:
-    """A type of single values: INT, REAL, BOOL, CHAR or an ENUM (not an array, a STRUC or
-    an unresolved type)."""
-    return isinstance(t, (T.Simple, T.Enum)) and t is not T.UNKNOWN
-
-
-_INT, _REAL = T.INT, T.REAL
-
-
-class FramePlan:
-    """A routine's Layout made ready for its calls (:meth:`Runtime._frame_plan`, once per
-    routine and run): ``layout``; ``n`` slots; ``made`` (slot -> (type, name) of the Slot
-    ``Frame.var`` makes when first used, for a variable the frame holds itself: a plain
-    local, a scalar or structure :IN copy; else None); ``fresh`` ((slot, function making the
-    fresh value) for each local STRUC or array); ``decls`` ((slot, name, type, VarDecl) for
-    each local with an initial value, (slot, name, None, SignalDecl) for each SIGNAL);
-    ``params`` ((slot, name, mode, type or None, scalar?, data elements) for each parameter;
-    *scalar*: a type whose fresh value is UNSET and whose values are converted by
-    convert_scalar: INT, REAL, BOOL, CHAR, ENUM); ``elements``, the data elements of the
-    locals; ``sizes`` ((data elements, VarName, VarDecl) for each local)."""
-
-    __slots__ = ("layout", "n", "made", "fresh", "decls", "params", "elements", "sizes")
 
 
 #: appended to a workspace or software-limit error whose motion target itself is out of the
@@ -178,10 +149,10 @@ class Runtime:
     # the tree interpreter ran 5-10 % slower with 32). A new attribute is added here too.
     __slots__ = ("controller", "trace", "current_task", "random", "_mode_op", "msg_handle", "messages",
                  "noted", "steps", "max_steps", "robot_budget", "sysvars", "memory", "program", "kss",
-                 "modules", "scheduler", "robot", "result", "_plans", "_return_types", "_settling", "_cyclic",
+                 "modules", "scheduler", "robot", "result", "_settling", "_cyclic",
                  "run_mode", "history", "stmt_hook", "step_hook", "error_hook", "cycle_hook",
                  "autocell", "halt_continues", "start", "halts", "state_epoch", "spin", "cyclic_watch",
-                 "restless", "limit_at", "spec", "machine", "io", "interpreter", "_early_messages")
+                 "restless", "limit_at", "spec", "machine", "io", "interpreter", "_early_messages", "calls", "names")
 
     def __init__(self, spec, *, cell=None, interpreter=None) -> None:
         """The run `spec` (interp/spec.py RunSpec, its robot given) describes, complete: its
@@ -222,13 +193,13 @@ class Runtime:
         self.program = Program(self, spec.program, spec.workspace, [str(s) for s in spec.submit], spec.check)
         self.kss = SystemSoftware(self)   # stand-ins for KUKA's software the backup lacks
         self.modules = self.program.modules       # by Storage.owner / Callee.owner
+        self.names = Names(self)          # what a name denotes (interp/runtime/names.py)
+        self.calls = Calls(self)          # routine calls (interp/runtime/calls.py)
         self.scheduler = Scheduler(self, spec.max_sim_time, spec.max_steps)
         self.spin = self.scheduler.spin   # parked spins (interp/runtime/spin.py)
         self.cyclic_watch = CyclicWatch(self)   # when a cyclic flag is evaluated again (watch.py)
         self.robot: Task | None = None
         self.result: RunResult | None = None
-        self._plans: dict = {}          # id(routine) -> Runtime._frame_plan
-        self._return_types: dict = {}   # id(routine) -> the checker's return type, checked once
         self._settling: dict = {}       # id(assignment) -> its cyclic flag's expression settles
         self._cyclic: dict = {}
         #: the cyclic flags whose expression does not settle (watch.py ``settles``: it reads a
@@ -471,6 +442,11 @@ class Runtime:
     def io_source(self) -> str:
         t = self.current_task
         return "trigger" if t is not None and t.context.kind == "trigger" else "program"
+
+    # the operators of expressions (interp/runtime/convert.py), for both interpreters
+    binary_op = staticmethod(binary_op)
+    unary_op = staticmethod(unary_op)
+    to_bool = staticmethod(to_bool)
 
     # ================================================================== time
     def yield_cycle(self, task: Task) -> None:
@@ -754,412 +730,6 @@ class Runtime:
         self.step_stop(task, "HALT", text=text)
         self.message(text)
         self.wait_sec(OPERATOR_DELAY_S)
-
-    # ================================================================== memory
-    def sysref(self, st: Storage) -> Ref:
-        """The reference of a system variable the tables declare (storage class SYSTEM; its
-        storage is allocated on first use and kept). A slot past the program's list is a name the
-        resolver placed while the program runs (VARSTATE's text, ``ref_from_text``)."""
-        refs = self.program.sysrefs
-        if st.slot >= len(refs):
-            refs.extend([None] * (st.slot + 1 - len(refs)))
-        ref = refs[st.slot]
-        if ref is None:
-            ref = self.sysvars.lookup(st.name)
-            if ref is None:
-                ref = self.lookup(st.name)
-            refs[st.slot] = ref
-        return ref
-
-    def storage_ref(self, st: Storage, frame: Frame | None) -> Ref:
-        """The reference a resolved name denotes (krl/semantics/resolve.py): a frame slot, a
-        data-list slot, a system variable, or the fallback for what nothing declares."""
-        k = st.kind
-        if k == 0:                   # LOCAL
-            return frame.vars[st.slot] or frame.var(st.slot)
-        if k <= 2:                   # MODULE, GLOBAL
-            return self.modules[st.owner].refs[st.slot] or self.program.data_ref(st)
-        if k == 3:                   # SYSTEM
-            refs = self.program.sysrefs
-            return (refs[st.slot] if st.slot < len(refs) else None) or self.sysref(st)
-        return self.lookup(st.name)
-
-    def lookup(self, name: str) -> Ref:
-        """The one run-time name lookup, for a name nothing declares (storage class
-        UNRESOLVED; docs/architecture.md, "One program model"): a ``$`` name is a system
-        variable the simulator knows, or one that a system data list or KSS's system files
-        declare (``SysVars.lookup``); in a backup, a variable of KUKA's software the backup
-        lacks stands in (interp/runtime/kss.py: the names the checker classifies outside the
-        program, one note each); any other name is the run-time error "unknown name", as on
-        the controller."""
-        key = name.upper()
-        if key[:1] == "$":
-            r = self.sysvars.lookup(key)
-            if r is not None:
-                return r
-        elif key in RSI_CONSTANTS:      # RSI's constants (RSIOK, ...): the option declares them
-            return ValueRef(RSI_CONSTANTS[key], key)
-        r = self.kss.name_ref(name)     # a variable of KUKA's software (interp/runtime/kss.py)
-        if r is not None:
-            return r
-        raise KrlRuntimeError(f"unknown name {name}")
-
-    def index(self, base: Ref, idx: list, name: str) -> Ref:
-        return index_ref(base, idx, name)
-
-    def field(self, base: Ref, comp: str, name: str, key: str | None = None) -> Ref:
-        """``base.comp`` (memory.field_ref: `key`, the component's key, the resolver's)."""
-        return field_ref(base, comp, name, key)
-
-    def assign(self, ref: Ref, value) -> None:
-        """``target = value`` (§5.1, conversions §3.9)."""
-        ref.set(value)
-
-    def read(self, ref: Ref):
-        return ref.get()
-
-    binary_op = staticmethod(binary_op)
-    unary_op = staticmethod(unary_op)
-    to_bool = staticmethod(to_bool)
-
-    @staticmethod
-    def aggregate(struc, items: list) -> Struct:
-        """Value of ``{[TYPE:] NAME value, ...}``: a partial Struct; ``struc``: the resolved
-        STRUC of the TYPE prefix (the resolver's, ``Aggregate.ann.struc``), else None."""
-        return Struct(struc if isinstance(struc, T.Struc) else None, dict(items))
-
-    # ================================================================== routines
-    def main_routine(self, module_name: str | None = None):
-        """(module, main routine) a robot or submit task starts with (the program's module, or
-        the module of a submit program's file ``module_name``); raises KrlRuntimeError when the
-        module's files have syntax errors, when the checker rejected them (unless the run does
-        not check: ``krl run --no-check``) or when there is no main routine."""
-        prog = self.program
-        if module_name is None:
-            m = prog.module_of(prog.main_path)
-            name = prog.main_path.stem
-        else:
-            m = prog.module_of(module_name) or prog.module(str(module_name))
-            name = module_name
-        if m is not None and m.syntax_errors:
-            first = m.syntax_errors[0]
-            raise KrlRuntimeError("the program has syntax errors and cannot start: " + first, None,
-                                  getattr(first, "file", None) or m.path, getattr(first, "line", None) or 0)
-        errors = prog.errors_of(m)
-        if errors:
-            d = errors[0]
-            more = f" (and {len(errors) - 1} more)" if len(errors) > 1 else ""
-            raise KrlRuntimeError(f"the program has errors and cannot start: {d.path}:{d.line}:{d.column}: "
-                                  f"error[{d.code}]: {d.message}{more}", None, d.path, d.line)
-        if prog.fatal is not None:
-            raise prog.fatal
-        if m is None or m.main is None:
-            raise KrlRuntimeError(f"no main routine in {Path(str(name)).stem}")
-        return m, m.main
-
-    def callee(self, c: Callee):
-        """(module, Routine) of a call whose callee is a routine of the program, else None."""
-        if c.kind != ROUTINE:
-            return None
-        return self.modules[c.owner], c.routine
-
-    def call_native(self, c: Callee, args: list, is_function: bool):
-        """A call whose callee is not a routine of the program, with reference ``args``
-        (interp/runtime/natives/args.py), for both interpreters: the implementation the
-        resolver linked (``c.native``, interp/runtime/natives) runs; with none (a routine of
-        the tables the simulator does not implement, or one nothing declares) KUKA's system
-        software stands in, in a backup (interp/runtime/kss.py: counted, one note), and
-        anything else is the run-time error "routine NAME not found". ``is_function``: the
-        call's value is used. Returns the call's value (None for a procedure)."""
-        fn = c.native
-        if fn is None:
-            return self.kss.call(c.name, is_function)
-        return fn(self, args)
-
-    def enter_routine(self, module, routine: N.Routine, args: list, caller: Frame | None) -> Frame:
-        """Create the frame of a call (§2.3): :IN parameters get converted copies, :OUT
-        (and unmarked) parameters are bound to the caller's reference; omitted arguments
-        stay declared-but-unset; locals are declared unset. The routine's slots are its
-        Layout (krl/semantics/resolve.py), planned once (:class:`FramePlan`); the Slot of a
-        variable the frame holds itself is made when first used (``Frame.var``)."""
-        if routine.broken:
-            raise KrlRuntimeError(not_entered(routine), None, routine.span.file, routine.broken)
-        task = self.current_task
-        if self.kss.standard and id(routine) in self.kss.standard:
-            self.kss.standard_call(routine)
-        if caller is not None and caller.depth >= MAX_CALL_DEPTH:
-            raise KrlRuntimeError(f"stack overflow: more than {MAX_CALL_DEPTH} nested calls")
-        plan = self._plans.get(id(routine))
-        if plan is None:
-            plan = self._plans[id(routine)] = self._frame_plan(module, routine)
-        mem = self.memory
-        n = plan.elements
-        if mem.used + n > mem.limit:
-            self._locals_do_not_fit(plan.sizes)
-        mem.used += n
-        k = plan.n
-        store = [UNSET] * k
-        frame = Frame(routine, module, caller, task, plan.layout, store, [None] * k, plan.made)
-        frame.data = n
-        try:
-            for k, make in plan.fresh:
-                store[k] = make()
-            if plan.decls:
-                self._declare(frame, plan.decls)
-            nargs = len(args)
-            for k, name, mode, t, scalar, size in plan.params:
-                a = args[k] if k < nargs else None
-                if a is None:
-                    self._omitted(frame, k, name, t, size)
-                elif mode == "IN" or a.__class__ is ValueRef:
-                    c = a.__class__
-                    v = a.c[a.k] if c is Slot else a.v if c is ValueRef else a.peek()   # (Ref.peek)
-                    if scalar:          # (the scalar case of _param_copy and _slot_type)
-                        if v is not UNSET:
-                            c = v.__class__
-                            store[k] = v if (c is float and t is _REAL) or (
-                                c is int and t is _INT and INT_MIN <= v <= INT_MAX) else convert_scalar(v, t)
-                    elif v.__class__ is Struct and v.type is t:
-                        # a structure of the parameter's own type: its copy (the same components,
-                        # already of their types: what make_value + assign_into give), its size
-                        if mem.used + size > mem.limit:
-                            mem.take(size, name, what="a copy of :IN parameter")
-                        mem.used += size
-                        frame.data += size
-                        f = v.f
-                        store[k] = Struct(t, f.copy()) if LEAVES.issuperset(map(type, f.values())) \
-                            else copy_value(v)
-                    else:
-                        self._in_copy(frame, k, name, t, size, v)
-                else:
-                    frame.vars[k] = a
-        except BaseException:
-            mem.give(frame.data)
-            raise
-        if self.trace is not None:
-            self.trace.write("call", self.controller.time, name=routine.name,
-                             line=caller.line if caller is not None else None)
-        return frame
-
-    def _locals_do_not_fit(self, local_sizes) -> None:
-        """Raise "data memory exhausted" at the first local DECL that does not fit."""
-        mem = self.memory
-        used = mem.used
-        try:
-            for n, vn, d in local_sizes:
-                self.program.take_memory_n(n, vn, d)
-        finally:
-            mem.used = used
-
-    def _declare(self, frame: Frame, decls) -> None:
-        """The locals of a new frame that are not plain variables: a DECL with an initial
-        value (DECL CONST INT OFFS = 10, KSS 8) and a SIGNAL of the routine."""
-        store = frame.store
-        fvars = frame.vars
-        for k, name, t, d in decls:
-            if t is not None:
-                ref = fvars[k] = Slot(store, k, t, name)
-                v = self.program.literal(d.init, t)
-                cur = store[k]
-                if isinstance(cur, (Struct, Arr)):
-                    assign_into(cur, v)
-                else:
-                    store[k] = convert_scalar(v, t)
-                ref.readonly = d.is_const
-            else:
-                fvars[k] = self.program.signal_ref(d)
-
-    def _omitted(self, frame: Frame, k: int, name: str, t, size: int) -> None:
-        """Parameter ``k`` of a new frame whose argument is omitted: declared, unset."""
-        store = frame.store
-        if isinstance(t, T.Array) and t.elem == T.CHAR and t.dims == (0,):
-            # an omitted string parameter: declared, no characters (KUKA's MsgLib calls
-            # STRLEN on it without ON_ERROR_PROCEED); VARSTATE says #DECLARED
-            store[k] = Arr(t, (0,), [])
-            frame.vars[k] = Slot(store, k, t, name)
-        elif t is None or (isinstance(t, T.Array) and 0 in t.dims):
-            store[k] = UNSET
-            frame.vars[k] = Slot(store, k, None, name)
-        else:
-            frame.data += self.memory.take(size, name, what="parameter")
-            store[k] = make_value(t)
-            frame.vars[k] = Slot(store, k, t, name)
-
-    def _in_copy(self, frame: Frame, k: int, name: str, t, size: int, v) -> None:
-        """An :IN parameter ``k`` of a new frame (or a value given for a reference
-        parameter) that is not a scalar nor a structure of its own type: a converted copy of
-        ``v``, with its data memory."""
-        frame.data += self.memory.take(value_size(v) if isinstance(v, (Struct, Arr)) else size,
-                                       name, what="a copy of :IN parameter")
-        v = frame.store[k] = self._param_copy(v, t, name)
-        frame.vars[k] = Slot(frame.store, k, self._slot_type(t, v), name)
-
-    def _frame_plan(self, module, routine: N.Routine) -> FramePlan:
-        """The routine's Layout made ready for :meth:`enter_routine` (:class:`FramePlan`).
-        Types are the checker's; raises KrlRuntimeError for a type nothing declares (outside
-        a backup), ResourceError for a type that nests too deep (values.data_size)."""
-        layout = routine.ann.layout
-        prog = self.program
-        plan = FramePlan()
-        plan.layout = layout
-        plan.n = len(layout.slots)
-        made = plan.made = [None] * plan.n
-        fresh, decls, params, sizes = [], [], [], []
-        for k, s in enumerate(layout.slots):
-            if k < layout.nparams:
-                if s.var is not None:            # the parameter's declaration (a VarDecl)
-                    t = prog.declared_type(s.type, s.decl.type)
-                    n = prog.data_elements(t, s.var, s.decl)
-                else:                            # no declaration (E101): untyped
-                    t, n = None, 1
-                scalar = _scalar(t)
-                params.append((k, s.name, s.mode, t, scalar, n))
-                if scalar or isinstance(t, T.Struc):
-                    made[k] = (t, s.name)        # the Slot of its copy, made when first used
-            elif isinstance(s.decl, N.VarDecl):
-                t = prog.declared_type(s.type, s.decl.type)
-                n = prog.data_elements(t, s.var, s.decl)
-                sizes.append((n, s.var, s.decl))
-                if isinstance(t, (T.Struc, T.Array)):
-                    fresh.append((k, maker(t)))
-                if s.decl.init is not None:
-                    decls.append((k, s.name, t, s.decl))
-                else:
-                    made[k] = (t, s.name)
-            else:                                # a SIGNAL of the routine
-                decls.append((k, s.name, None, s.decl))
-        plan.fresh, plan.decls, plan.params, plan.sizes = tuple(fresh), tuple(decls), tuple(params), sizes
-        plan.elements = sum(n for n, _, _ in sizes)
-        return plan
-
-    @staticmethod
-    def _slot_type(t, v):
-        if isinstance(t, T.Array) and 0 in t.dims and isinstance(v, Arr):
-            return v.type
-        return t
-
-    def _param_copy(self, v, t, name: str):
-        if v is UNSET:
-            return make_value(t) if t is not None and not (isinstance(t, T.Array) and 0 in t.dims) else UNSET
-        if t is None:
-            return copy_value(v)
-        if isinstance(t, T.Array):
-            if 0 in t.dims:
-                if isinstance(v, str):
-                    arr = make_value(T.Array(T.CHAR, (max(len(v), 1),)))
-                    assign_into(arr, v)
-                    return arr
-                return copy_value(v)
-            dest = make_value(t)
-            assign_into(dest, v)
-            return dest
-        if isinstance(t, T.Struc):
-            dest = make_value(t)
-            assign_into(dest, v)
-            return dest
-        return convert_scalar(v, t)
-
-    def run_routine(self, target, args: list, caller: Frame | None, body, catch_resume: bool = True):
-        """The call protocol of both interpreters (§2.3, §5.17): :meth:`enter_routine`,
-        the task's innermost frame (VARSTATE), ``body(frame)`` — the interpreter runs the
-        routine and returns the value of its RETURN (None for a DEF) —, the value converted
-        to a function's return type (:meth:`return_value`), RESUME caught at the caller
-        that declared the interrupt (unless ``catch_resume`` is False: an interrupt
-        handler's own call), and leaving the routine: its data memory given back, its
-        interrupts removed, a ``return`` event written unless it is abandoned by an error or
-        RESUME (no event then). ``target``: (module, Routine)."""
-        module, routine = target
-        frame = self.enter_routine(module, routine, args, caller)
-        task = self.current_task
-        prev = task.frame
-        task.frame = frame
-        returned = False
-        try:
-            value = body(frame)
-            if routine.kind == "DEFFCT":       # (Routine.is_function)
-                t = self._return_types.get(id(routine))
-                c = value.__class__
-                if not ((c is float and t is _REAL) or (c is int and t is _INT and INT_MIN <= value <= INT_MAX)):
-                    value = self.return_value(routine, value, module)
-            returned = True
-            return value
-        except ResumeSignal as r:
-            if catch_resume and r.frame is caller and caller is not None:
-                return None
-            raise
-        except KrlRuntimeError as e:
-            if self.error_hook is not None and not e.debug_seen:
-                e.debug_seen = True     # the debugger stops once, in the innermost frame
-                self.error_hook(task, frame, e)
-            raise
-        finally:
-            task.frame = prev
-            # leave_routine, inlined: once per call
-            self.memory.used -= frame.data      # DataMemory.give
-            frame.data = 0
-            if frame.interrupts:
-                self.current_task.irqs.remove_frame(frame)
-            if returned and self.trace is not None:
-                self.trace.write("return", self.controller.time, name=frame.name)
-
-    def return_value(self, routine: N.Routine, value, module):
-        """``RETURN expr`` of a function: converted to the return type (§2.4; the checker's,
-        ``Layout.returns``)."""
-        if routine.return_type is None:
-            return value
-        t = self._return_types.get(id(routine))
-        if t is None:
-            t = self._return_types[id(routine)] = self.program.declared_type(routine.ann.layout.returns,
-                                                                              routine.return_type)
-        if isinstance(t, T.Array) and isinstance(value, str):
-            arr = make_value(t)
-            assign_into(arr, value)
-            return arr
-        return convert_scalar(value, t)
-
-    def ref_from_text(self, text: str):
-        """The reference named by a string such as ``"P[2].X"`` (VARSTATE), or None. The text
-        is read by the front end's expression API (krl/semantics/expression.py): a name with
-        constant indices and components, placed by the resolver's rules in the scopes the
-        front end built for the running routine (``Layout.scope``, the checker's). The text
-        is a run-time value, so this is the one name lookup that happens while the program
-        runs, besides the ``$``-name fallback."""
-        task = self.current_task
-        frame = getattr(task, "frame", None)
-        if frame is None or frame.layout is None:
-            return None
-        try:
-            expr = X.parse(text)
-        except X.ExpressionError:
-            return None
-        chain = []
-        e = expr
-        while isinstance(e, (N.Index, N.Field)):
-            chain.append(e)
-            e = e.base
-        if not isinstance(e, N.Name):
-            return None
-        layout = frame.layout
-        resolver = self.program.ws.resolver
-        sym = layout.scope.lookup(e.name) if layout.scope is not None else None
-        try:
-            ref = self.storage_ref(resolver.storage(e.name, sym, resolver.locals_of(layout), layout.owner), frame)
-        except KrlRuntimeError:
-            return None
-        for part in reversed(chain):
-            if isinstance(part, N.Field):
-                ref = field_ref(ref, part.name, e.name)
-                continue
-            idx = []
-            for i in part.indices:
-                if i is None or isinstance(i, N.IntLit):
-                    idx.append(None if i is None else i.value)
-                elif isinstance(i, N.Unary) and i.op == "-" and isinstance(i.operand, N.IntLit):
-                    idx.append(-i.operand.value)
-                else:
-                    return None     # an index that is not an INT literal
-            ref = index_ref(ref, idx, e.name)
-        return ref
 
     # ================================================================== errors ($ERR)
     def current_err(self) -> Struct:

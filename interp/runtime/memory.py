@@ -268,7 +268,7 @@ class Frame:
     removed on return), task (the owning task), line (current line), data (the elements of
     the run's data memory it holds, given back on return), made (frame slot -> (type, name)
     of the Slot :meth:`var` makes for a slot whose ``vars`` entry is None; shared by every
-    activation of the routine: interp/runtime/core.py FramePlan).
+    activation of the routine: interp/runtime/calls.py FramePlan).
     """
 
     __slots__ = ("routine", "module", "vars", "caller", "depth", "interrupts", "task", "line",

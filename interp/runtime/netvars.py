@@ -146,7 +146,7 @@ class RuntimeSink:
             if sym is None or sym.kind not in ("var", "const", "signal"):
                 raise KeyError(name)
             try:
-                ref = rt.storage_ref(prog.ws.resolver.storage(name, sym, None, -1), None)
+                ref = rt.names.storage_ref(prog.ws.resolver.storage(name, sym, None, -1), None)
             except (KrlRuntimeError, IndexError):
                 raise KeyError(name) from None
         rest = text[m.end():].strip()

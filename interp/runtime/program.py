@@ -265,7 +265,7 @@ class Program:
         try:
             for m in sorted(self.modules, key=rank):
                 self.ensure_loaded(m)
-        except ResourceError as exc:     # the program cannot start (Runtime.main_routine)
+        except ResourceError as exc:     # the program cannot start (Calls.main_routine)
             self.fatal = self.fatal or exc
         self._robot_values()
 
@@ -500,7 +500,7 @@ class _InitialiserEnv(Env):
         if isinstance(st, Storage) and st.kind in (MODULE, GLOBAL):
             return lambda: program.data_ref(st).get()
         if isinstance(st, Storage) and st.kind == SYSTEM:
-            return lambda: program.rt.sysref(st).get()
+            return lambda: program.rt.names.sysref(st).get()
         raise KrlRuntimeError(f"unknown name {node.name} in a data list initialisation")
 
     def aggregate(self, node: N.Aggregate, items: list):

@@ -520,7 +520,7 @@ class SpinWatch(PeriodicSpins):
             if key in CONSTANT_NAMES:
                 return None
         try:
-            return self.rt.storage_ref(place, frame)
+            return self.rt.names.storage_ref(place, frame)
         except Exception:  # noqa: BLE001 - a name the run cannot place: not a spin
             return False
 

@@ -39,6 +39,8 @@ _IMMUTABLE = frozenset((int, float, bool, str, EnumValue, type(None)))
 class TreeInterpreter:
     def __init__(self, rt) -> None:
         self.rt = rt
+        self.names = rt.names           # what a name denotes (interp/runtime/names.py)
+        self.calls = rt.calls           # the call protocol (interp/runtime/calls.py)
         self._labels: dict = {}
         self.stmt_dispatch = handlers(self, "s_", STATEMENTS)
         self.expr_dispatch = handlers(self, "e_", EXPRESSIONS)
@@ -46,7 +48,7 @@ class TreeInterpreter:
     # ------------------------------------------------------------------ entry points
     def run_program(self, module_name: str | None = None) -> None:
         """Body of the robot (or a submit) task: call the main routine of the module."""
-        self.invoke(self.rt.main_routine(module_name), [], None)
+        self.invoke(self.calls.main_routine(module_name), [], None)
 
     # ------------------------------------------------------------------ statements
     def exec_block(self, stmts: list, frame) -> None:
@@ -112,10 +114,10 @@ class TreeInterpreter:
         def do():
             value = self.eval(st.value, frame)
             ref = self.ref(st.target, frame)
-            self.rt.assign(ref, value)
+            self.names.assign(ref, value)
             if st.ann.cyclic:
                 # a cyclic flag: re-evaluated every IPO cycle until assigned again (§5.15)
-                self.rt.cyclic_on(("cyclic flag", ref.name), lambda: self.rt.assign(ref, self.eval(st.value, frame)))
+                self.rt.cyclic_on(("cyclic flag", ref.name), lambda: self.names.assign(ref, self.eval(st.value, frame)))
         self.guarded(do, st, frame)
 
     def s_CallStmt(self, st, frame) -> None:
@@ -158,7 +160,7 @@ class TreeInterpreter:
             start = self.eval(st.start, frame)
             end, step = for_limits(self.eval(st.end, frame),
                                    self.eval(st.step, frame) if st.step is not None else 1)
-            rt.assign(ref, start)
+            self.names.assign(ref, start)
             head.extend((ref, end, step))
         if not self.guarded(header, st, frame):
             return
@@ -271,7 +273,7 @@ class TreeInterpreter:
         rt = self.rt
 
         def do():
-            ref = rt.storage_ref(st.ann.channel, frame)
+            ref = rt.names.storage_ref(st.ann.channel, frame)
             lo, hi = anout_limits(self.eval(st.minimum, frame) if st.minimum is not None else None,
                                   self.eval(st.maximum, frame) if st.maximum is not None else None)
 
@@ -294,7 +296,7 @@ class TreeInterpreter:
             ref = self.ref(st.target, frame)
 
             def tick():
-                rt.assign(ref, self.eval(st.value, frame))
+                rt.names.assign(ref, self.eval(st.value, frame))
             tick()
             if channel is not None:
                 rt.cyclic_on(("analog input", channel.key), tick)
@@ -358,7 +360,7 @@ class TreeInterpreter:
         def do():
             if isinstance(act, N.CallStmt):
                 call = act.call
-                target = rt.callee(call.ann.callee)
+                target = rt.calls.callee(call.ann.callee)
                 if target is not None:
                     # the arguments are evaluated now, in the advance run (§5.18)
                     args = [None if a is None else ValueRef(copy_value(self.eval(a, frame)))
@@ -371,7 +373,7 @@ class TreeInterpreter:
                         self.exec_trigger_stmt(act, frame, lambda: self.call(call, frame, statement=True))
             else:
                 def action():
-                    self.exec_trigger_stmt(act, frame, lambda: rt.assign(
+                    self.exec_trigger_stmt(act, frame, lambda: rt.names.assign(
                         self.ref(act.target, frame), self.eval(act.value, frame)))
             at = self.eval(st.at, frame)
             delay = self.eval(st.delay, frame)
@@ -451,17 +453,17 @@ class TreeInterpreter:
         return out
 
     def call(self, call: N.Call, frame, statement: bool = False, catch_resume: bool = True):
-        rt = self.rt
+        calls = self.calls
         callee = call.ann.callee
         if callee.kind == ROUTINE:
-            return self.invoke(rt.callee(callee), self.args_for(call, frame), frame, catch_resume)
+            return self.invoke(calls.callee(callee), self.args_for(call, frame), frame, catch_resume)
         # the arguments are evaluated before a stand-in too, as the VM does
-        return rt.call_native(callee, self.args_for(call, frame), not statement)
+        return calls.call_native(callee, self.args_for(call, frame), not statement)
 
     def invoke(self, target, args: list, caller, catch_resume: bool = True):
         """Run routine ``target`` = (module, Routine) with reference ``args`` (the
-        runtime's call protocol, Runtime.run_routine)."""
-        return self.rt.run_routine(target, args, caller, self.exec_routine, catch_resume)
+        runtime's call protocol, interp/runtime/calls.py ``Calls.run_routine``)."""
+        return self.calls.run_routine(target, args, caller, self.exec_routine, catch_resume)
 
     def exec_routine(self, frame):
         """The body of the routine of ``frame``; the value of its RETURN (None for a DEF).
@@ -504,7 +506,7 @@ class TreeInterpreter:
         items = []
         for it in e.items:
             items.append((it.ann.component.key, self.eval(it.value, frame)))
-        return self.rt.aggregate(e.ann.struc if e.type_name else None, items)
+        return self.names.aggregate(e.ann.struc if e.type_name else None, items)
 
     def e_var(self, e, frame):
         v = self.ref(e, frame).get()
@@ -538,15 +540,15 @@ class TreeInterpreter:
 
     def ref(self, e, frame):
         """The reference of an lvalue expression (Name / Index / Field chain)."""
-        rt = self.rt
+        names = self.names
         if e.__class__ is N.Name:
             st = e.ann.place
             k = st.kind
             if k == LOCAL:
                 return frame.vars[st.slot] or frame.var(st.slot)
             if k < SYSTEM:
-                return rt.modules[st.owner].refs[st.slot] or rt.storage_ref(st, frame)
-            return rt.storage_ref(st, frame)
+                return names.modules[st.owner].refs[st.slot] or names.storage_ref(st, frame)
+            return names.storage_ref(st, frame)
         if isinstance(e, N.Index):
             base = self.ref(e.base, frame)
             idx = []
@@ -555,9 +557,9 @@ class TreeInterpreter:
                     idx.append(None)
                 else:
                     idx.append(array_index(self.eval(i, frame)))
-            return rt.index(base, idx, lvalue_name(e.base))
+            return names.index(base, idx, lvalue_name(e.base))
         if isinstance(e, N.Field):
             base = self.ref(e.base, frame)
-            return rt.field(base, e.name, lvalue_name(e.base), e.ann.component.key)
+            return names.field(base, e.name, lvalue_name(e.base), e.ann.component.key)
         raise KrlRuntimeError("not a variable")
 

@@ -15,7 +15,7 @@ stepping differs:
   order, the routine's Layout: operands ``s``/``v`` are the slot numbers, ``Storage.slot``), a
   MODULE place a *module slot* (the data list of the routine's module), any other place a
   *global slot* (another data list, a system variable, the ``$``-name fallback; its reference
-  is taken on first use, Runtime.storage_ref); the listing carries each place (operands
+  is taken on first use, Names.storage_ref); the listing carries each place (operands
   ``m``/``g``), each call's Callee (``r``), each aggregate's STRUC (``a``), each structure
   component (``k``, its key the resolver's) and each analog channel (``p``) for the VM to link;
 * structured statements become jumps; GOTO jumps to its target Label, in the nearest
@@ -65,7 +65,7 @@ _LETTERS = {T.INT: "I", T.REAL: "R", T.BOOL: "B", T.CHAR: "C"}
 def store_variables(routine: N.Routine) -> dict:
     """The routine's *store variables* (operand kind ``v``, interp/vm/opcodes.py): frame slot
     -> (type letter I/R/B/C, number of array dimensions, 0 for a scalar) for each variable
-    the frame holds in its own store (Runtime.enter_routine: a local, or an :IN parameter)
+    the frame holds in its own store (Calls.enter_routine: a local, or an :IN parameter)
     whose type (the checker's, from the routine's Layout) is INT, REAL, BOOL or CHAR, scalar
     or an array of 1 or 2 fixed dimensions; not CONST, not an :OUT parameter (an alias of
     the caller's variable)."""

@@ -253,7 +253,7 @@ def GLOBAL_REF(slot, ref):
     """``ref``: the reference of global slot ``slot``, taken from its place on first use."""
     ref = grefs[slot]
     if ref is None:
-        ref = grefs[slot] = rt.storage_ref(code.gstorage[slot], frame)
+        ref = grefs[slot] = rt.names.storage_ref(code.gstorage[slot], frame)
 
 
 @inline
@@ -371,13 +371,13 @@ def REF_GLOBAL(slot: "g"):
 @inst("base, idx[count] -- ref")
 def INDEX(count: "i", name: "n"):
     """the element reference of base[idx] (an index may be omitted: None); name: the array's, for messages"""
-    ref = rt.index(base, [None if x is None else _array_index(x) for x in idx], name)
+    ref = rt.names.index(base, [None if x is None else _array_index(x) for x in idx], name)
 
 
 @inst("base -- ref")
 def FIELD(comp: "k", name: "n"):
     """the component reference base.comp; name: the structure's, for messages"""
-    ref = rt.field(base, comp.name, name, comp.key)
+    ref = rt.names.field(base, comp.name, name, comp.key)
 
 
 @inst("base, idx[count] -- value")
@@ -475,7 +475,7 @@ def VALARG():
 @inst("values[count] -- value", cold=True)
 def AGG(struc: "a", count: "i", keys: "n"):
     """an aggregate of count values; struc: its STRUC or -, keys: the components' keys (the resolver's), comma-separated"""
-    value = rt.aggregate(struc, list(zip(keys.split(",") if keys else [], values)))
+    value = rt.names.aggregate(struc, list(zip(keys.split(",") if keys else [], values)))
 
 
 # ---------------------------------------------------------------------------- store variables
@@ -758,7 +758,7 @@ def FOR_NEXT_FAST(var: "v", state: "t", stmt: "x", target: "l"):
 # ---------------------------------------------------------------------------- calls
 @inst('args[argc] -- result if flags == "E"', freq=36)
 def CALL(callee: "r", argc: "i", flags: "f"):
-    """call callee (a routine of the program: linked per run, vm.Bound; else Runtime.call_native: the implementation the resolver linked, Callee.native, or the stand-in policy); flags: S statement, E expression (pushes the result), N no RESUME catch"""
+    """call callee (a routine of the program: linked per run, vm.Bound; else Calls.call_native: the implementation the resolver linked, Callee.native, or the stand-in policy); flags: S statement, E expression (pushes the result), N no RESUME catch"""
     target = code.callsites.get(ip)
     FLUSH()
     SYNC_STEPS()
@@ -885,7 +885,7 @@ def CYCLIC_ASSIGN(thunk_ip: "h"):
     """assign the value, then Runtime.cyclic_on re-assigns the thunk's value every IPO cycle (a cyclic flag)"""
     _store(ref, value)
     value_of = self.thunk(code, frame, temps, thunk_ip)
-    rt.cyclic_on(("cyclic flag", ref.name), lambda r=ref, f=value_of: rt.assign(r, f()))
+    rt.cyclic_on(("cyclic flag", ref.name), lambda r=ref, f=value_of: rt.names.assign(r, f()))
 
 
 @inst('ref, lo if "L" in flags, hi if "H" in flags --', cold=True)
@@ -906,7 +906,7 @@ def ANIN_ON(channel: "p", thunk_ip: "h"):
     value_of = self.thunk(code, frame, temps, thunk_ip)
 
     def anin(ref=ref, value_of=value_of):
-        rt.assign(ref, value_of())
+        rt.names.assign(ref, value_of())
     anin()
     if channel is not None:
         rt.cyclic_on(("analog input", channel.key), anin)
@@ -926,8 +926,8 @@ def RESUME():
 
 @inst("-- target", cold=True)
 def TRIG_FIND(callee: "r", skip: "l"):
-    """push the routine target of a TRIGGER action's call (Runtime.callee), or None and jump to skip"""
-    target = rt.callee(callee)
+    """push the routine target of a TRIGGER action's call (Calls.callee), or None and jump to skip"""
+    target = rt.calls.callee(callee)
     ip = skip if target is None else ip + 1
 
 

@@ -25,7 +25,7 @@ def _cold_AGG(self, ins, code, frame, temps, stack, ip):
     keys = ins[3]
     values = stack[len(stack) - count:]
     del stack[len(stack) - count:]
-    stack.append(rt.aggregate(struc, list(zip(keys.split(',') if keys else [], values))))
+    stack.append(rt.names.aggregate(struc, list(zip(keys.split(',') if keys else [], values))))
     return ip + 1
 
 
@@ -134,7 +134,7 @@ def _cold_CYCLIC_ASSIGN(self, ins, code, frame, temps, stack, ip):
     value = stack.pop()
     _store(ref, value)
     value_of = self.thunk(code, frame, temps, thunk_ip)
-    rt.cyclic_on(('cyclic flag', ref.name), lambda r=ref, f=value_of: rt.assign(r, f()))
+    rt.cyclic_on(('cyclic flag', ref.name), lambda r=ref, f=value_of: rt.names.assign(r, f()))
     return ip + 1
 
 
@@ -166,7 +166,7 @@ def _cold_ANIN_ON(self, ins, code, frame, temps, stack, ip):
     value_of = self.thunk(code, frame, temps, thunk_ip)
 
     def anin(ref=ref, value_of=value_of):
-        rt.assign(ref, value_of())
+        rt.names.assign(ref, value_of())
     anin()
     if channel is not None:
         rt.cyclic_on(('analog input', channel.key), anin)
@@ -190,11 +190,11 @@ def _cold_RESUME(self, ins, code, frame, temps, stack, ip):
 
 
 def _cold_TRIG_FIND(self, ins, code, frame, temps, stack, ip):
-    """push the routine target of a TRIGGER action's call (Runtime.callee), or None and jump to skip"""
+    """push the routine target of a TRIGGER action's call (Calls.callee), or None and jump to skip"""
     rt = self.rt
     callee = ins[1]
     skip = ins[2]
-    target = rt.callee(callee)
+    target = rt.calls.callee(callee)
     ip = skip if target is None else ip + 1
     stack.append(target)
     return ip
@@ -994,7 +994,7 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                                     x1 = ins[1]
                                     ref = grefs[x1]
                                     if ref is None:
-                                        ref = grefs[x1] = rt.storage_ref(code.gstorage[x1], frame)
+                                        ref = grefs[x1] = rt.names.storage_ref(code.gstorage[x1], frame)
                                     stack.append(_load(ref))
                                     ip += 1
                                 else:
@@ -1005,7 +1005,7 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                                 x1 = ins[1]
                                 ref = grefs[x1]
                                 if ref is None:
-                                    ref = grefs[x1] = rt.storage_ref(code.gstorage[x1], frame)
+                                    ref = grefs[x1] = rt.names.storage_ref(code.gstorage[x1], frame)
                                 stack.append(ref)
                                 ip += 1
                             else:
@@ -1013,13 +1013,13 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                                 idx = stack[len(stack) - x1:]
                                 del stack[len(stack) - x1:]
                                 base = stack[-1]
-                                stack[-1] = rt.index(base, [None if x is None else _array_index(x) for x in idx], ins[2])
+                                stack[-1] = rt.names.index(base, [None if x is None else _array_index(x) for x in idx], ins[2])
                                 ip += 1
                         elif op < 51:
                             if op < 49:
                                 if op < 48:
                                     base = stack[-1]
-                                    stack[-1] = rt.field(base, ins[2], ins[4], ins[3])
+                                    stack[-1] = rt.names.field(base, ins[2], ins[4], ins[3])
                                     ip += 1
                                 else:
                                     x1 = ins[1]
@@ -1110,7 +1110,7 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                                     value = stack.pop()
                                     ref = grefs[x1]
                                     if ref is None:
-                                        ref = grefs[x1] = rt.storage_ref(code.gstorage[x1], frame)
+                                        ref = grefs[x1] = rt.names.storage_ref(code.gstorage[x1], frame)
                                     _store(ref, value)
                                     ip += 1
                             elif op < 63:
@@ -1361,4 +1361,4 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
     finally:
         rt.steps += unsaved
 
-SOURCE = '5749343605adfdf5f88c7313fd619ae7b2a4a4e9bbced8cc1d968583786ab09d'
+SOURCE = 'f59ab7dca7e6dedc62601fe2fce20520c43cce477b3a7d7d08618edee322dbd9'

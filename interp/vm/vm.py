@@ -20,7 +20,7 @@ asm` prints exactly what runs; kept per checked workspace by :func:`linked_code`
 AST), each operand as its kind's VM form (:data:`LINK`), and :class:`Bound` binds it to a run's
 storage and links every call site from its Callee (a routine of the program: the (module,
 Routine) to invoke) when the routine is first called; a built-in or a stub is run through the
-runtime (``Runtime.call_native``, as the tree interpreter does: the implementation the resolver
+runtime (``Calls.call_native``, as the tree interpreter does: the implementation the resolver
 linked, else the stand-in policy).
 """
 
@@ -157,10 +157,10 @@ class Bound:
         self.is_function = linked.is_function
         self.prog, self.ops, self.iregions, self.ntemps = linked.prog, linked.ops, linked.iregions, linked.ntemps
         self.gstorage, self.gnames = linked.gstorage, linked.gnames
-        self.mrefs = [rt.storage_ref(st, None) for st in linked.mstorage]
+        self.mrefs = [rt.names.storage_ref(st, None) for st in linked.mstorage]
         self.grefs = [None] * len(linked.gstorage)
         prog = linked.prog
-        self.callsites = {ip: rt.callee(prog[ip][1]) for ip in linked.calls}     # CALL's callee operand
+        self.callsites = {ip: rt.calls.callee(prog[ip][1]) for ip in linked.calls}     # CALL's callee operand
 
 
 class VM:
@@ -175,13 +175,13 @@ class VM:
         # without one (no Python frame of its own per call)
         self.body = functools.partial(self.loop, self, None)
         # the runtime's statement hooks, bound once (the loop takes them at each call)
-        self.hooks = (rt.before_statement, rt.loop_tick, rt.take_error_proceed, rt.quiet_limit, rt.run_routine,
-                      self.body, rt.call_native)
+        self.hooks = (rt.before_statement, rt.loop_tick, rt.take_error_proceed, rt.quiet_limit, rt.calls.run_routine,
+                      self.body, rt.calls.call_native)
 
     # ------------------------------------------------------------------ entry points
     def run_program(self, module_name: str | None = None) -> None:
         """Body of the robot (or a submit) task: call the main routine of the module."""
-        self.invoke(self.rt.main_routine(module_name), [], None)
+        self.invoke(self.rt.calls.main_routine(module_name), [], None)
 
     def code_for(self, routine) -> Bound:
         """This run's code of `routine`: compiled from its annotated AST and linked once per
@@ -195,8 +195,8 @@ class VM:
     # ------------------------------------------------------------------ calls
     def invoke(self, target, args: list, caller, catch_resume: bool = True):
         """Run routine ``target`` = (module, Routine) with reference ``args`` (the
-        runtime's call protocol, Runtime.run_routine)."""
-        return self.rt.run_routine(target, args, caller, self.body, catch_resume)
+        runtime's call protocol, Calls.run_routine)."""
+        return self.rt.calls.run_routine(target, args, caller, self.body, catch_resume)
 
     def thunk(self, code, frame, temps: list, ip: int, stack: list | None = None):
         """A callable that runs the thunk at ``ip`` of ``code`` in the activation (``frame``,

@@ -23,7 +23,7 @@ of any run; the interpreters (interp/) allocate storage for them and never look 
              ``Workspace.system_names``; machine data a backup declares for it (Mada)
              initialises it
   UNRESOLVED nothing declares the name: a ``$`` name goes to the runtime's documented
-             fallback (``Runtime.lookup``: the simulated system variables, and in a backup
+             fallback (``Names.lookup``: the simulated system variables, and in a backup
              an undeclared one that reads 0); any other name is the run-time error
              "unknown name" where it is evaluated
   ========== ============================================================================

@@ -1,4 +1,4 @@
-"""The shared call protocol (interp/runtime/core.py ``run_routine``, ``FramePlan``) keeps its
+"""The shared call protocol (interp/runtime/calls.py ``Calls.run_routine``, ``FramePlan``) keeps its
 meaning on both interpreters: every activation gets fresh locals (a recursive function's local
 array of nested structures is its own), a local passed to an :OUT parameter is changed in place,
 an :IN structure is a copy, a function's value is converted to its return type (§2.4: a REAL

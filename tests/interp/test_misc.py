@@ -55,7 +55,7 @@ def test_varstate(tmp_path):
 
 @pytest.mark.parametrize("interp", ["tree", "vm"])
 def test_varstate_of_a_system_variable_the_program_uses_nowhere_else(tmp_path, interp):
-    """VARSTATE's text is placed while the program runs (Runtime.ref_from_text): a system
+    """VARSTATE's text is placed while the program runs (Names.ref_from_text): a system
     variable no statement of the program names gets a system slot past the program's list. Found
     by the variants of issue 59 (KUKA's BrakeTestReq.src run without $config.dat): an internal
     IndexError before."""

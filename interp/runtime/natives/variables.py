@@ -1,7 +1,7 @@
 """A variable named by text (reference 4.5): VARSTATE and VARTYPE.
 
 The text is resolved the way the program's own names are, in the calling routine's scope
-(``rt.ref_from_text``; no KRL expression is parsed here). VARSTATE answers #UNKNOWN (no such
+(``rt.names.ref_from_text``; no KRL expression is parsed here). VARSTATE answers #UNKNOWN (no such
 variable), #DECLARED (declared, no value) or #INITIALIZED; VARTYPE the variable's type as
 VAR_TYPE (#TYP_INT ... #TYP_E6AXIS, #TYP_ENUM, #TYP_STRUC, #TYP_UNKNOWN).
 """
@@ -22,7 +22,7 @@ VARIABLES = Family("variables")
 def _varstate(rt, a):
     name = ref_text(a[0], "VARSTATE argument")
     try:
-        ref = rt.ref_from_text(name)
+        ref = rt.names.ref_from_text(name)
     except KrlRuntimeError:
         return EnumValue("UNKNOWN")
     if ref is None:
@@ -37,7 +37,7 @@ def _varstate(rt, a):
 @VARIABLES.native("VAR_TYPE VARTYPE(CHAR VAR_STR[] :IN)", pure=True)
 def _vartype(rt, a):
     name = ref_text(a[0], "VARTYPE argument")
-    ref = rt.ref_from_text(name)
+    ref = rt.names.ref_from_text(name)
     if ref is None:
         return EnumValue("TYP_UNKNOWN")
     t = ref.type
