@@ -62,7 +62,7 @@ import time
 from collections import Counter
 from pathlib import Path
 
-from interp.runtime.core import TARGET_OUTSIDE_NOTE
+from interp.runtime.motions import TARGET_OUTSIDE_NOTE
 from interp.runtime.errors import NOT_UNDERSTOOD
 from interp.runtime.program import parse_module
 from krl import limits

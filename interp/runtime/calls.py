@@ -112,7 +112,7 @@ class Calls:
         fn = c.native
         if fn is None:
             return self.kss.call(c.name, is_function)
-        return fn(self, args)
+        return fn(self.rt, args)
 
     def enter_routine(self, module, routine: N.Routine, args: list, caller: Frame | None) -> Frame:
         """Create the frame of a call (§2.3): :IN parameters get converted copies, :OUT

@@ -15,29 +15,32 @@ from krl.ast import nodes as N
 from krl.semantics.advance import StmtInfo
 from net.hub import NetError, Network
 from robot.controller import Controller
-from robot.errors import RobotError, SoftLimitError, WorkspaceError
+from robot.errors import RobotError
 from robot.io import IOImage
-from robot.motion import CondStop, MotionRequest, Trigger
 
 from .autocell import AUTO_DELAY_S, AutoCell
 from .calls import Calls
-from .netvars import RuntimeSink
-from .contexts import Context, Irq
-from .watch import (CONSTANT, IO, SETTLES, CyclicWatch, settles, split_watch, stamp_key, steady, timer_due,
-                    timer_reads, timer_watch, watch_of)
-from .convert import assign_into, binary_op, num, to_bool, trunc_int, unary_op
+from .contexts import Context
+from .convert import binary_op, num, to_bool, unary_op
+from .cyclic import Cyclic
 from .errors import HaltSignal, KrlRuntimeError, ResumeSignal, StopRun
+from .errstate import ErrorState
 from .idle import probe_state
+from .interrupts import Interrupts
 from .kss import SystemSoftware
-from .memory import DataMemory, Frame, ProxyRef, Ref, SignalRef, Slot
+from .memory import DataMemory, ProxyRef, Ref, SignalRef
 from .messages import MessageWindow
+from .motion import frame_of
+from .motions import MotionStatements
 from .names import Names
-from .motion import frame_of, params_from, request, segment, target_of
+from .netvars import RuntimeSink
 from .program import Program
-from .runmode import STEP_MODES, BackwardRefused, MotionHistory, mode_name
+from .runmode import BackwardRefused, MotionHistory, mode_name
 from .scheduler import NO_LIMIT, Scheduler, Task, program_budget
-from .sysvars import EPOCH_PROBED, SysVars, struct_of
-from .values import Arr, EnumValue, Struct, copy_value
+from .sysvars import SysVars
+from .values import EnumValue
+from .watch import (CONSTANT, IO, SETTLES, CyclicWatch, reader, split_watch, stamp_key, timer_due, timer_reads,
+                    timer_watch, watch_of)
 
 
 #: s the operator takes to press Start again after a HALT (``krl run --on-halt continue``; a
@@ -80,21 +83,6 @@ def call_stack(task, limit: int = 64) -> tuple:
     return tuple(out)
 
 
-#: appended to a workspace or software-limit error whose motion target itself is out of the
-#: simulated robot's limits in every configuration (robot/controller.py target_outside_limits)
-TARGET_OUTSIDE_NOTE = "the target itself: no axis configuration of this robot reaches it within its software limits"
-
-
-def reach_message(ctl, req, err) -> str:
-    """The message of a motion `req` the controller `ctl` refused with `err`: a workspace or
-    software-limit error says so when the target itself is out of the robot's limits in
-    every configuration (not only on the way there, or with the program's S/T)."""
-    if isinstance(err, (SoftLimitError, WorkspaceError)) and ctl.target_outside_limits(req):
-        return f"{err.message} ({TARGET_OUTSIDE_NOTE})"
-    return err.message
-
-
-
 @dataclass
 class RunStart:
     """How a run started (shown in the run summary): the operating mode (``mode``: T1, T2,
@@ -127,12 +115,6 @@ class CellPlan:
     geometry: object = None
 
 
-def _reader(ref):
-    """The zero-argument reader of system variable `ref` that an interrupt's watch key probes
-    (interp/runtime/watch.py): a computed variable's getter, else its peek."""
-    getter = getattr(ref, "getter", None)
-    return getter if getter is not None else ref.peek
-
 class Runtime:
     """Shared runtime of one run.
 
@@ -149,10 +131,10 @@ class Runtime:
     # the tree interpreter ran 5-10 % slower with 32). A new attribute is added here too.
     __slots__ = ("controller", "trace", "current_task", "random", "_mode_op", "msg_handle", "messages",
                  "noted", "steps", "max_steps", "robot_budget", "sysvars", "memory", "program", "kss",
-                 "modules", "scheduler", "robot", "result", "_settling", "_cyclic",
+                 "modules", "scheduler", "robot", "result", "cyclic", "interrupts", "motions", "errstate",
                  "run_mode", "history", "stmt_hook", "step_hook", "error_hook", "cycle_hook",
                  "autocell", "halt_continues", "start", "halts", "state_epoch", "spin", "cyclic_watch",
-                 "restless", "limit_at", "spec", "machine", "io", "interpreter", "_early_messages", "calls", "names")
+                 "limit_at", "spec", "machine", "io", "interpreter", "_early_messages", "calls", "names")
 
     def __init__(self, spec, *, cell=None, interpreter=None) -> None:
         """The run `spec` (interp/spec.py RunSpec, its robot given) describes, complete: its
@@ -200,12 +182,10 @@ class Runtime:
         self.cyclic_watch = CyclicWatch(self)   # when a cyclic flag is evaluated again (watch.py)
         self.robot: Task | None = None
         self.result: RunResult | None = None
-        self._settling: dict = {}       # id(assignment) -> its cyclic flag's expression settles
-        self._cyclic: dict = {}
-        #: the cyclic flags whose expression does not settle (watch.py ``settles``: it reads a
-        #: timer, the robot's position, a call...): evaluated at every IPO cycle, they may change
-        #: $CYCFLAG at any cycle, so a spin that reads $CYCFLAG is not parked beside one
-        self.restless: set = set()
+        self.cyclic = Cyclic(self)        # ANIN/ANOUT ON, cyclic flags (interp/runtime/cyclic.py)
+        self.interrupts = Interrupts(self)    # interrupts, BRAKE, RESUME (interp/runtime/interrupts.py)
+        self.motions = MotionStatements(self)    # motion statements (interp/runtime/motions.py)
+        self.errstate = ErrorState(self)  # $ERR, ON_ERROR_PROCEED (interp/runtime/errstate.py)
         # run modes and debugging (interp/runtime/runmode.py, interp/debug)
         self.run_mode = "GO"            # $PRO_MODE of the robot interpreter
         self.history = MotionHistory()  # executed motions, for backward motion
@@ -498,9 +478,9 @@ class Runtime:
             err.traced = True          # robot/controller.py wrote its error event
             raise err
         while task.pending_triggers:
-            self.run_trigger(task, task.pending_triggers.pop(0))
+            self.interrupts.run_trigger(task, task.pending_triggers.pop(0))
         if task.irqs.armed:
-            self.check_interrupts(task)
+            self.interrupts.check(task)
 
     def before_statement(self, info: StmtInfo) -> None:
         """Called by an interpreter before every statement: counts the step (limits,
@@ -539,7 +519,7 @@ class Runtime:
             self.yield_cycle(task)
             self._proceed()
         elif task.irqs.armed:
-            self.check_interrupts(task)
+            self.interrupts.check(task)
 
     def quiet_limit(self, task: Task) -> int:
         """The *quiet-step limit* of ``task`` (the VM's fast path; docs/architecture.md,
@@ -688,7 +668,7 @@ class Runtime:
             cls, names = split_watch(w)
             if cls not in (CONSTANT, IO, SETTLES):
                 return None, ()
-        probes = tuple(_reader(self.sysvars.lookup(k)) for k in names)
+        probes = tuple(reader(self.sysvars.lookup(k)) for k in names)
         ctl = self.controller
         written = self.cyclic_watch.written
         return (lambda: stamp_key(cls, ctl.io.version, ctl.time, probes, written())), tests
@@ -731,63 +711,6 @@ class Runtime:
         self.message(text)
         self.wait_sec(OPERATOR_DELAY_S)
 
-    # ================================================================== errors ($ERR)
-    def current_err(self) -> Struct:
-        task = self.current_task or self.robot
-        if task.err is None:
-            task.err = struct_of("ERROR_T", {})
-            self.clear_err(task.err)
-        return task.err
-
-    def clear_err(self, e: Struct) -> None:
-        for k, v in list(e.f.items()):
-            if isinstance(v, Arr):
-                v.data[:] = ["\0"] * len(v.data)
-            elif k in ("NUMBER", "INT_PRIO", "LINE_NR"):
-                e.f[k] = 0
-        e.f["INTERPRETER"] = EnumValue("R_INT")
-        e.f["INT_TYPE"] = EnumValue("INT_NONE")
-        e.f["TRIGGER_TYPE"] = EnumValue("NONE")
-        if self.current_task is not None:
-            self.current_task.err_text = ""
-
-    def take_error_proceed(self) -> bool:
-        """True (and reset) if ON_ERROR_PROCEED preceded the statement about to run. Every
-        statement takes it, whether or not it can fail (§5.19: it covers the *next*
-        statement only); the flag belongs to the running context, so an interrupt routine
-        or a TRIGGER action that runs before that statement neither takes nor sees it
-        (docs/architecture.md, "Choices on the reference's open points")."""
-        ctx = self.current_task.contexts[-1]
-        p = ctx.error_proceed
-        ctx.error_proceed = False
-        return p
-
-    def on_error_proceed(self) -> None:
-        task = self.current_task
-        task.contexts[-1].error_proceed = True
-        self._break(task)
-
-    def record_error(self, err: KrlRuntimeError, frame: Frame | None) -> None:
-        """A statement under ON_ERROR_PROCEED failed: fill $ERR and go on (§5.19)."""
-        task = self.current_task
-        e = self.current_err()
-        e.f["NUMBER"] = err.number if err.number is not None else 1
-        e.f["LINE_NR"] = err.line or task.line or 0
-        e.f["INTERPRETER"] = EnumValue("R_INT" if task.kind == "robot" else "S_INT")
-        ctx = task.context
-        e.f["INT_TYPE"] = EnumValue("INT_IR" if ctx.kind == "interrupt" else "INT_NONE")
-        e.f["INT_PRIO"] = ctx.number or 0
-        for key, text in (("MODULE", frame.module.name if frame and frame.module else ""),
-                          ("UP_NAME", frame.name if frame else "")):
-            arr = e.f.get(key)
-            if isinstance(arr, Arr):
-                assign_into(arr, text[: len(arr.data)])
-        task.err_text = err.message
-
-    def err_message(self, e: Struct) -> str:
-        task = self.current_task
-        return getattr(task, "err_text", "") or f"error {e.f.get('NUMBER')}"
-
     # ================================================================== I/O, messages
     def pulse(self, ref: Ref, level: bool, duration: float) -> None:
         """PULSE(signal, level, duration) on an output (§5.12)."""
@@ -807,158 +730,10 @@ class Runtime:
             return
         self.controller.message(text)
 
-    # ================================================================== cyclic evaluation
-    def cyclic_on(self, key, fn) -> None:
-        """Evaluate ``fn()`` once per IPO cycle until :meth:`cyclic_off` (``ANOUT ON``,
-        ``ANIN ON``, ``$CYCFLAG[n] = expr``; §5.14, §5.15). An error in ``fn`` becomes a
-        run-time error of the robot program at its next resumption."""
-        self.cyclic_off(key)
-        robot = self.robot
-        # a cyclic flag's expression over variables and I/O is evaluated again only when one of
-        # them may have changed (interp/runtime/watch.py CyclicWatch); every cyclic flag counts
-        # the changes it makes to $CYCFLAG
-        flag = key[0] == "cyclic flag"
-        watch = self.cyclic_watch
-        memo = flag and self._cyclic_settles()
-        if flag and not memo:
-            self.restless.add(key)
-        cyc = self.sysvars.store.get("$CYCFLAG") if flag else None
-        seen = [None]
-
-        def tick(ctl):
-            if memo:
-                k = watch.key()
-                if k is not None and k == seen[0]:
-                    return
-            before = tuple(cyc.data) if cyc is not None else None
-            try:
-                fn()
-            except KrlRuntimeError as e:
-                self.cyclic_off(key)
-                if robot is not None and robot.pending_error is None:
-                    robot.pending_error = RobotError(e.message, e.number)
-                return
-            if before is not None and tuple(cyc.data) != before:
-                watch.version += 1
-            if memo:
-                seen[0] = watch.key()
-        self._cyclic[key] = self.controller.add_cyclic(tick)
-        watch.anin = any(k[0] == "analog input" for k in self._cyclic)
-
-    def _cyclic_settles(self) -> bool:
-        """The cyclic flag the running statement switches on has an expression that
-        :func:`~.watch.settles`, decided once per statement (an SPS.SUB switches its flags on
-        again in every pass: the analysis cost about 40 µs each time)."""
-        task = self.current_task
-        at = task.at if task is not None else None
-        for node in (self.spin.statements(at) or ()) if at is not None else ():
-            if isinstance(node, N.Assign):
-                got = self._settling.get(id(node))
-                if got is None:
-                    got = self._settling[id(node)] = settles(node.value)
-                return got
-        return False
-
-    def cyclic_off(self, key) -> None:
-        h = self._cyclic.pop(key, None)
-        self.restless.discard(key)
-        if h is not None:
-            self.controller.remove_cyclic(h)
-            self.cyclic_watch.anin = any(k[0] == "analog input" for k in self._cyclic)
-
     def stub_statement(self, what: str) -> None:
         """A statement of §5.20 that is recognised and not simulated (CONFIRM, ASYPTP,
         MOVE_EMI, ...): logged once as a ``message`` event, no effect."""
         self.kss.statement(what)
-
-    # ================================================================== motion
-    def _params(self, with_: list):
-        store = self.sysvars.store
-        saved = []
-        for ref, value in with_:
-            old = copy_value(ref.peek())
-            saved.append((ref, old))
-            ref.set(value)
-        try:
-            return params_from(store, self.sysvars.base_link())
-        finally:
-            for ref, old in reversed(saved):
-                if isinstance(ref, Slot):
-                    cur = ref.c[ref.k]
-                    if isinstance(cur, (Struct, Arr)):
-                        assign_into(cur, old)
-                    else:
-                        ref.c[ref.k] = old
-
-    def motion(self, kind: str, target, approx: list, aux=None, ca=None, frame: str | None = None,
-               with_: list = (), file: str | None = None, line: int | None = None) -> int:
-        """Plan a motion statement and queue it (waits while the queue holds $ADVANCE
-        motions). ``target``/``aux`` are evaluated values; ``with_`` (ref, value) pairs of a
-        WITH clause, valid for this motion only. Returns the motion id."""
-        task = self._robot_only(kind)
-        tgt = target_of(target)
-        aux_d = target_of(aux, "auxiliary point") if aux is not None else None
-        params = self._params(list(with_))
-        trig, task.next_triggers = task.next_triggers, []
-        if self.run_mode in STEP_MODES:
-            approx = []     # no advance run: exact positioning (docs/robot.md, run modes)
-        req = request(kind, tgt, params, list(approx), aux_d,
-                      float(num(ca)) if ca is not None else None, frame, trig, file, line)
-        return self._enqueue(task, req)
-
-    def spline(self, kind: str, segments: list, approx: str | None, with_: list = (),
-               file: str | None = None, line: int | None = None) -> int:
-        """A SPLINE / PTP_SPLINE block. ``segments``: list of dicts with kind, target, aux,
-        ca, with_ (ref, value pairs), triggers (robot.motion.Trigger list), line."""
-        task = self._robot_only(kind)
-        if self.run_mode in STEP_MODES:
-            approx = None   # no advance run: the block ends exactly (docs/robot.md, run modes)
-        if kind.upper() == "PTP_SPLINE":
-            last = None
-            for i, s in enumerate(segments):
-                task.next_triggers = list(s.get("triggers", ()))
-                ap = ["C_SPL"] if i < len(segments) - 1 else ([approx] if approx else [])
-                last = self.motion("SPTP", s["target"], ap, with_=list(with_) + list(s.get("with_", ())),
-                                   file=file, line=s.get("line"))
-            return last or 0
-        block_params = self._params(list(with_))
-        segs = []
-        for s in segments:
-            p = self._params(list(with_) + list(s["with_"])) if s.get("with_") else None
-            segs.append(segment(s["kind"], target_of(s["target"]),
-                                target_of(s["aux"], "auxiliary point") if s.get("aux") is not None else None,
-                                s.get("ca"), p, s.get("triggers", ()), s.get("line")))
-        req = MotionRequest("SPLINE", segs[-1].target if segs else {}, block_params,
-                            approx=approx, segments=tuple(segs), file=file, line=line)
-        return self._enqueue(task, req)
-
-    def _robot_only(self, what: str) -> Task:
-        task = self.current_task
-        if task.kind != "robot":
-            raise KrlRuntimeError(f"{what}: motion statements are not allowed in the submit interpreter")
-        if task.context.kind == "trigger":
-            raise KrlRuntimeError(f"{what}: no motion statements in a TRIGGER action")
-        return task
-
-    def _enqueue(self, task: Task, req) -> int:
-        ctl = self.controller
-        adv = self.sysvars.store.get("$ADVANCE")
-        ctl.set_advance(int(adv) if isinstance(adv, int) else 3)
-        if not ctl.can_enqueue():
-            self._wait(task, ctl.can_enqueue)
-            self._proceed()
-        try:
-            mid = ctl.enqueue(req)
-        except RobotError as e:
-            raise KrlRuntimeError(reach_message(ctl, req, e), e.number) from None
-        self._break(task)           # the main run is not idle now: advance-run stops wait
-        self.history.record(req, ctl.last_planned())
-        if self.run_mode in STEP_MODES:
-            # the advance run does not pass the motion: the next statement is read when it ends
-            self.wait_main_run(task)
-            if self.run_mode != "ISTEP":
-                self.step_stop(task, "MSTEP", motion=mid)
-        return mid
 
     # ================================================================== run modes
     def set_run_mode(self, mode) -> None:
@@ -1018,152 +793,3 @@ class Runtime:
         """#BSTEP at the end of the program: backward motions until one is refused."""
         while self.backward_step(task):
             pass
-
-    def trigger(self, action, *, distance: int | None = None, path: float | None = None,
-                onstart: bool = False, delay_ms: float = 0.0, prio: int | None = None,
-                line: int | None = None) -> None:
-        """TRIGGER: ``action`` (a zero-argument callable; call arguments already
-        evaluated) runs when the next motion's switching point is reached."""
-        task = self._robot_only("TRIGGER")
-        task.next_triggers.append(Trigger(distance=distance, path_mm=path, onstart=onstart,
-                                          delay_ms=float(delay_ms), action=action, prio=prio, line=line))
-
-    def conditional_stop(self, path, onstart: bool, condition, line: int | None = None) -> None:
-        """STOP WHEN PATH = path [ONSTART] IF condition (KSS 8.3 and later): the next motion
-        (spline segment) stops `path` mm from its end point (its start point) while
-        ``condition()`` (a zero-argument callable, True: stop) holds there; the main run
-        evaluates it (robot/controller.py ``Controller._conditional_stops``)."""
-        task = self._robot_only("STOP WHEN PATH")
-        task.next_triggers.append(CondStop(float(num(path)), bool(onstart), condition, line))
-
-    def run_trigger(self, task: Task, ev) -> None:
-        self._proceed()
-        action = ev.trigger.action
-        task.contexts.append(Context("trigger", prio=ev.trigger.prio if ev.trigger.prio and ev.trigger.prio > 0 else 129))
-        try:
-            action()
-        finally:
-            task.contexts.pop()
-
-    # ================================================================== interrupts
-    def interrupt_decl(self, number, cond_fn, handler_fn, name: str, frame: Frame,
-                       is_global: bool = False, line: int | None = None, watch: str = "") -> None:
-        """INTERRUPT DECL: `watch` is the condition's watch class (interp/runtime/watch.py
-        ``watch_of``; "" = evaluated at every poll)."""
-        task = self.current_task
-        n = trunc_int(number, "interrupt number")
-        cls, names = split_watch(watch)
-        # a computed variable's getter is its peek, one call less at each poll
-        probes = tuple(_reader(self.sysvars.lookup(k)) for k in names)
-        task.irqs.declare(Irq(n, cond_fn, handler_fn, name, frame, is_global, line, watch=cls,
-                              probes=probes, by_epoch=all(k in EPOCH_PROBED for k in names),
-                              steady=steady(watch)))
-        if not frame.interrupts:
-            frame.interrupts = []
-        frame.interrupts.append(n)
-        self._break(task)
-
-    def interrupt_ctl(self, action: str, number=None) -> None:
-        task = self.current_task
-        n = trunc_int(number, "interrupt number") if number is not None else None
-        ctl = self.controller
-        task.irqs.control(action.upper(), n, ctl.io.version, ctl.time, self.cyclic_watch.written())
-        self._break(task)
-        if action.upper() in ("ENABLE", "ON") and task.irqs.armed:
-            self.check_interrupts(task)
-
-    def check_interrupts(self, task: Task) -> None:
-        """Poll ``task``'s armed interrupts and run those ready, by priority. Nothing to do
-        while the last poll left them settled in this state epoch (contexts.py
-        ``InterruptTable.settled``): a poll would evaluate and fire nothing."""
-        if task.in_poll or task.irqs.settled == self.state_epoch:
-            return
-        task.in_poll = True
-        ctl = self.controller
-        try:
-            ready = task.irqs.poll(ctl.io.version, ctl.time, self.state_epoch, self.cyclic_watch.written())
-        finally:
-            task.in_poll = False
-        if not ready:
-            return          # nothing pending and enabled: next_ready would find nothing
-        while True:
-            irq = task.irqs.next_ready(task.context.prio)
-            if irq is None:
-                return
-            irq.pending = False
-            self.fire(task, irq)
-
-    def fire(self, task: Task, irq: Irq) -> None:
-        self._proceed()
-        ctl = self.controller
-        ctx = Context("interrupt", prio=irq.number, number=irq.number)
-        if task.kind == "robot":
-            ctx.pos_int = ctl.pos_act()
-            ctx.axis_int = ctl.axis_act()
-        ctx.frame = irq.frame
-        ctx.interrupted = task.frame
-        task.contexts.append(ctx)
-        if self.trace is not None:
-            self.trace.write("interrupt", ctl.time, prio=irq.number, name=irq.name, line=task.line,
-                             phase="entry")
-        ok = False
-        try:
-            irq.handler()
-            ok = True
-        finally:
-            task.contexts.pop()
-            if self.trace is not None:
-                self.trace.write("interrupt", ctl.time, prio=irq.number, name=irq.name,
-                                 line=task.line, phase="exit")
-        if ok and task.irqs.armed and not task.in_poll:
-            # the conditions are monitored while the handler runs: what it leaves (a timer it
-            # restarted, a flag it reset) is sampled at its end, so the next rising edge counts
-            # (ROS-Industrial's EKI state timer: `$TIMER[1] = -10` in its own handler)
-            task.in_poll = True
-            try:
-                task.irqs.poll(ctl.io.version, ctl.time, self.state_epoch, self.cyclic_watch.written())
-            finally:
-                task.in_poll = False
-        if ok and task.kind == "robot":
-            ctl.release()
-            self.bump_epoch()       # $PRO_MOVE: the motion suspended by BRAKE runs again
-
-    def brake(self, fast: bool = False) -> None:
-        """BRAKE / BRAKE F: ramp the path speed down and wait until the robot stands (5.17).
-        Only in an interrupt routine (a routine run by an interrupt, at any depth below it):
-        elsewhere it is the run-time error "BRAKE outside an interrupt routine" at its line.
-
-        Standstill is confirmed one IPO cycle after the path speed has reached zero (the
-        controller sees two equal setpoints), so even `DO BRAKE`, whose interrupt ends with
-        the brake, leaves the robot at rest for at least one cycle before it goes on.
-        """
-        task = self.current_task
-        if task.kind != "robot":
-            raise KrlRuntimeError("BRAKE is not allowed in the submit interpreter")
-        if not any(c.kind == "interrupt" for c in task.contexts):
-            # reference §5.17 and §8.2: BRAKE only in interrupt routines; the checker cannot
-            # tell a routine that only ever runs as an interrupt routine, so the run says it
-            raise KrlRuntimeError("BRAKE outside an interrupt routine: BRAKE is allowed only in "
-                                  "interrupt routines (reference 5.17)")
-        ctl = self.controller
-        ctl.brake(fast)
-        self.bump_epoch()           # $PRO_MOVE, $VEL_ACT
-        while ctl.is_braking():
-            self.yield_cycle(task)
-        self.yield_cycle(task)
-        self._proceed()
-
-    def resume(self) -> None:
-        """RESUME: discard the planned motions and unwind to the declaring routine."""
-        task = self.current_task
-        ctx = None
-        for c in reversed(task.contexts):
-            if c.kind == "interrupt":
-                ctx = c
-                break
-        if ctx is None:
-            raise KrlRuntimeError("RESUME outside an interrupt routine")
-        if task.kind == "robot":
-            self.controller.cancel_pending()
-            self.bump_epoch()       # $PRO_MOVE
-        raise ResumeSignal(ctx.frame)

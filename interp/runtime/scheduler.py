@@ -259,7 +259,7 @@ class Scheduler:
         if ctl.stimuli and any(not st.fired and st.due is None and st.reached_mm is not None
                                for st in ctl.stimuli):
             return None             # an input set on reaching a point: at any step
-        if any(k[0] == "analog output" for k in rt._cyclic):
+        if any(k[0] == "analog output" for k in rt.cyclic.handles):
             return None             # an output written at any step
         return (ctl.io.version, rt.cyclic_watch.version, rt.steps - spin.skipped, ctl.next_event_cycle(), moving)
 

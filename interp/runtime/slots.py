@@ -281,7 +281,7 @@ def ne(a, b):
 
 # ------------------------------------------------------------------ TRIGGER arguments
 def trigger_args(kind: str, at, delay, prio, onstart: bool = False) -> dict:
-    """Keyword arguments of Runtime.trigger from the evaluated TRIGGER operands."""
+    """Keyword arguments of MotionStatements.trigger from the evaluated TRIGGER operands."""
     at = num(at)
     delay = num(delay)
     p = trunc_int(prio, "TRIGGER PRIO") if prio is not None else None

@@ -226,7 +226,7 @@ class SpinWatch(PeriodicSpins):
         return (self.enabled and rt.trace is None
                 and rt.stmt_hook is None and rt.step_hook is None and rt.cycle_hook is None
                 and rt.run_mode == "GO" and getattr(ctl, "correction", None) is None
-                and not any(k[0] == "analog input" for k in rt._cyclic)
+                and not any(k[0] == "analog input" for k in rt.cyclic.handles)
                 and (net is None or not net.polling))     # (no partner attached or ticking else: net/hub.py)
 
     def _update(self) -> None:
@@ -616,13 +616,13 @@ class SpinWatch(PeriodicSpins):
         # a cyclic flag whose expression settles changes only after the I/O image did (a
         # statement or another task wakes the pass first): $CYCFLAG is read as an input is
         return (spin.io or spin.cyclic) and \
-            (self._io_may_change() or any(k[0] == "analog output" for k in rt._cyclic))
+            (self._io_may_change() or any(k[0] == "analog output" for k in rt.cyclic.handles))
 
     def reads_restless_flag(self, spin: _Pass) -> bool:
         """`spin` reads ``$CYCFLAG`` while a cyclic flag whose expression does not settle is on:
         the flag may change at any IPO cycle (the one test of it: here and the scheduler's
         steady cycles)."""
-        return spin.cyclic and bool(self.rt.restless)
+        return spin.cyclic and bool(self.rt.cyclic.restless)
 
     def _io_may_change(self) -> bool:
         """The controller's next step may change an input (module docstring)."""

@@ -529,7 +529,7 @@ def _pro_state_self(sv: SysVars):
 
 
 def _err(sv: SysVars):
-    return sv.rt.current_err()
+    return sv.rt.errstate.current_err()
 
 
 def _nullframe(sv: SysVars):

@@ -3,7 +3,7 @@
 :class:`CyclicWatch` at the end).
 
 An armed interrupt's condition is polled at every statement boundary and every IPO cycle of
-its task (interp/runtime/core.py ``check_interrupts``); a rising edge makes it pending. Its
+its task (interp/runtime/interrupts.py ``Interrupts.check``); a rising edge makes it pending. Its
 value can only change when something it reads changes, so each condition gets a *watch*
 class from the names it reads (the front end's accesses, krl/semantics/advance.py
 :func:`~krl.semantics.advance.reads`, and each name's Storage from the resolver):
@@ -278,7 +278,7 @@ def settles(expr) -> bool:
 
 class CyclicWatch:
     """When a cyclic flag's expression (``$CYCFLAG[n] = expr``, interp/runtime/core.py
-    ``Runtime.cyclic_on``) must be evaluated again. The controller evaluates each at every IPO
+    ``Cyclic.on``) must be evaluated again. The controller evaluates each at every IPO
     cycle; an expression that :func:`settles` gives the same value until a statement runs (the
     steps executed: ``Runtime.steps`` less the steps a parked spin counted without running them,
     interp/runtime/spin.py), the I/O image changes (its version) or a cyclic flag changed
@@ -290,7 +290,7 @@ class CyclicWatch:
     def __init__(self, rt) -> None:
         self.rt = rt
         self.version = 0
-        self.anin = False       # an ANIN ON is on (interp/runtime/core.py cyclic_on/cyclic_off)
+        self.anin = False       # an ANIN ON is on (interp/runtime/cyclic.py Cyclic.on/off)
 
     def written(self):
         """What may have written a variable since: ``(steps executed, cyclic flag changes and
@@ -308,3 +308,10 @@ class CyclicWatch:
         """The key of the present moment, or None: evaluate."""
         w = self.written()
         return None if w is None else (self.rt.controller.io.version, w)
+
+
+def reader(ref):
+    """The zero-argument reader of system variable `ref` that an interrupt's or a WAIT FOR's
+    watch key probes: a computed variable's getter, else its peek."""
+    getter = getattr(ref, "getter", None)
+    return getter if getter is not None else ref.peek

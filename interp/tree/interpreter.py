@@ -88,7 +88,7 @@ class TreeInterpreter:
         """Prologue of a statement that ON_ERROR_PROCEED does not cover: it takes the flag
         all the same (§5.19: the flag is for the next statement only)."""
         info = self.begin(st, frame)
-        self.rt.take_error_proceed()
+        self.rt.errstate.take_error_proceed()
         return info
 
     def guarded(self, fn, st, frame, proceed: bool | None = None) -> bool:
@@ -97,14 +97,14 @@ class TreeInterpreter:
         took it already)."""
         rt = self.rt
         if proceed is None:
-            proceed = rt.take_error_proceed()
+            proceed = rt.errstate.take_error_proceed()
         try:
             fn()
         except KrlRuntimeError as e:
             e.at(st.span.file, st.span.line)
             if not proceed:
                 raise
-            rt.record_error(e, frame)
+            rt.errstate.record_error(e, frame)
             return False
         return True
 
@@ -117,7 +117,7 @@ class TreeInterpreter:
             self.names.assign(ref, value)
             if st.ann.cyclic:
                 # a cyclic flag: re-evaluated every IPO cycle until assigned again (§5.15)
-                self.rt.cyclic_on(("cyclic flag", ref.name), lambda: self.names.assign(ref, self.eval(st.value, frame)))
+                self.rt.cyclic.on(("cyclic flag", ref.name), lambda: self.names.assign(ref, self.eval(st.value, frame)))
         self.guarded(do, st, frame)
 
     def s_CallStmt(self, st, frame) -> None:
@@ -179,7 +179,7 @@ class TreeInterpreter:
     def s_While(self, st, frame) -> None:
         info = self.begin(st, frame)
         rt = self.rt
-        proceed = rt.take_error_proceed()
+        proceed = rt.errstate.take_error_proceed()
         first = []
         rt.loop_tick(info)
         # ON_ERROR_PROCEED covers the first evaluation of the condition: an error skips the loop
@@ -254,7 +254,7 @@ class TreeInterpreter:
 
     def s_OnErrorProceed(self, st, frame) -> None:
         self.plain(st, frame)
-        self.rt.on_error_proceed()
+        self.rt.errstate.on_error_proceed()
 
     def s_DeclStmt(self, st, frame) -> None:
         raise KrlRuntimeError("declaration after the first statement", None, st.span.file, st.span.line)
@@ -280,12 +280,12 @@ class TreeInterpreter:
             def tick():
                 ref.set(anout_value(self.eval(st.value, frame), lo, hi))
             tick()
-            rt.cyclic_on(("analog output", st.ann.channel.key), tick)
+            rt.cyclic.on(("analog output", st.ann.channel.key), tick)
         self.guarded(do, st, frame)
 
     def s_AnoutOff(self, st, frame) -> None:
         self.plain(st, frame)
-        self.rt.cyclic_off(("analog output", st.ann.channel.key))
+        self.rt.cyclic.off(("analog output", st.ann.channel.key))
 
     def s_AninOn(self, st, frame) -> None:
         self.begin(st, frame)
@@ -299,12 +299,12 @@ class TreeInterpreter:
                 rt.names.assign(ref, self.eval(st.value, frame))
             tick()
             if channel is not None:
-                rt.cyclic_on(("analog input", channel.key), tick)
+                rt.cyclic.on(("analog input", channel.key), tick)
         self.guarded(do, st, frame)
 
     def s_AninOff(self, st, frame) -> None:
         self.plain(st, frame)
-        self.rt.cyclic_off(("analog input", st.ann.channel.key))
+        self.rt.cyclic.off(("analog input", st.ann.channel.key))
 
     def s_Unsupported(self, st, frame) -> None:
         raise KrlRuntimeError(f"unsupported statement: {st.text.strip()[:60]}", None,
@@ -327,7 +327,7 @@ class TreeInterpreter:
             fast = st.brake.fast
 
             def handler():
-                rt.brake(fast)
+                rt.interrupts.brake(fast)
         else:
             def handler():
                 self.call(call, frame, statement=True, catch_resume=False)
@@ -335,22 +335,22 @@ class TreeInterpreter:
         watch = watch_of_decl(st)
 
         def do():
-            rt.interrupt_decl(self.eval(st.prio, frame), cond, handler, call.name, frame,
+            rt.interrupts.declare(self.eval(st.prio, frame), cond, handler, call.name, frame,
                               st.is_global, st.span.line, watch)
         self.guarded(do, st, frame)
 
     def s_InterruptCtl(self, st, frame) -> None:
         self.begin(st, frame)
-        self.guarded(lambda: self.rt.interrupt_ctl(
+        self.guarded(lambda: self.rt.interrupts.control(
             st.action, self.eval(st.prio, frame) if st.prio is not None else None), st, frame)
 
     def s_Brake(self, st, frame) -> None:
         self.plain(st, frame)
-        self.rt.brake(st.fast)
+        self.rt.interrupts.brake(st.fast)
 
     def s_Resume(self, st, frame) -> None:
         self.plain(st, frame)
-        self.rt.resume()
+        self.rt.interrupts.resume()
 
     def s_Trigger(self, st, frame) -> None:
         self.begin(st, frame)
@@ -378,7 +378,7 @@ class TreeInterpreter:
             at = self.eval(st.at, frame)
             delay = self.eval(st.delay, frame)
             prio = self.eval(st.prio, frame) if st.prio is not None else None
-            rt.trigger(action, line=st.span.line, **trigger_args(st.kind, at, delay, prio, st.onstart))
+            rt.motions.trigger(action, line=st.span.line, **trigger_args(st.kind, at, delay, prio, st.onstart))
         self.guarded(do, st, frame)
 
     def s_ConditionalStop(self, st, frame) -> None:
@@ -387,7 +387,7 @@ class TreeInterpreter:
         cond = st.cond
 
         def do():
-            rt.conditional_stop(self.eval(st.path, frame), st.onstart,
+            rt.motions.conditional_stop(self.eval(st.path, frame), st.onstart,
                                 lambda: rt.to_bool(self.eval(cond, frame), "conditional stop"), st.span.line)
         self.guarded(do, st, frame)
 
@@ -410,7 +410,7 @@ class TreeInterpreter:
             target = self.eval(st.target, frame)
             aux = self.eval(st.aux, frame) if st.aux is not None else None
             ca = self.eval(st.ca, frame) if st.ca is not None else None
-            rt.motion(st.kind, target, st.approx, aux, ca, st.frame, self.with_pairs(st.with_, frame),
+            rt.motions.motion(st.kind, target, st.approx, aux, ca, st.frame, self.with_pairs(st.with_, frame),
                       st.span.file, st.span.line)
         self.guarded(do, st, frame)
 
@@ -436,7 +436,7 @@ class TreeInterpreter:
                                  "with_": self.with_pairs(s.with_, frame), "triggers": pending,
                                  "line": s.span.line})
                     pending = []
-            rt.spline(st.kind, segs, st.approx, self.with_pairs(st.with_, frame), st.span.file, st.span.line)
+            rt.motions.spline(st.kind, segs, st.approx, self.with_pairs(st.with_, frame), st.span.file, st.span.line)
         self.guarded(do, st, frame)
 
     # ------------------------------------------------------------------ calls

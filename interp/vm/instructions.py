@@ -156,7 +156,7 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                     raise
                 proceed = False
                 SYNC_STEPS()
-                rt.record_error(e, frame)
+                rt.errstate.record_error(e, frame)
                 left = task.quiet - rt.steps if task is not None else 0
                 calm = task is not None and task.calm
                 del stack[8:]         # STACK_BASE
@@ -830,8 +830,8 @@ def CONTINUE(stmt: "x"):
 
 @inst(cold=True)
 def ON_ERROR_PROCEED():
-    """Runtime.on_error_proceed"""
-    rt.on_error_proceed()
+    """ErrorState.on_error_proceed"""
+    rt.errstate.on_error_proceed()
 
 
 @inst(cold=True)
@@ -854,24 +854,24 @@ def RAISE(message: "n", line: "i"):
 
 @inst("number --", cold=True)
 def INT_DECL(cond: "h", handler: "h", name: "n", flags: "f", line: "i"):
-    """Runtime.interrupt_decl(cond thunk, handler thunk, name, GLOBAL?, line); flags: G (GLOBAL), then the condition's watch (interp/runtime/watch.py)"""
+    """Interrupts.declare(cond thunk, handler thunk, name, GLOBAL?, line); flags: G (GLOBAL), then the condition's watch (interp/runtime/watch.py)"""
     when = self.thunk(code, frame, temps, cond)
     is_global = flags[:1] == "G"
-    rt.interrupt_decl(number, lambda c=when: rt.to_bool(c(), "interrupt condition"),
+    rt.interrupts.declare(number, lambda c=when: rt.to_bool(c(), "interrupt condition"),
                       self.thunk(code, frame, temps, handler), name, frame,
                       is_global, line, flags[1:] if is_global else flags)
 
 
 @inst('number if flags == "P" --', cold=True)
 def INT_CTL(action: "n", flags: "f"):
-    """Runtime.interrupt_ctl(action[, number]); flags: P if a number is given"""
-    rt.interrupt_ctl(action, number)
+    """Interrupts.control(action[, number]); flags: P if a number is given"""
+    rt.interrupts.control(action, number)
 
 
 @inst(cold=True)
 def BRAKE(flags: "f"):
-    """Runtime.brake (flags: F for BRAKE F)"""
-    rt.brake(flags == "F")
+    """Interrupts.brake (flags: F for BRAKE F)"""
+    rt.interrupts.brake(flags == "F")
 
 
 @inst(cold=True)
@@ -882,46 +882,46 @@ def STUB(words: "n"):
 
 @inst("value, ref --", cold=True)
 def CYCLIC_ASSIGN(thunk_ip: "h"):
-    """assign the value, then Runtime.cyclic_on re-assigns the thunk's value every IPO cycle (a cyclic flag)"""
+    """assign the value, then Cyclic.on re-assigns the thunk's value every IPO cycle (a cyclic flag)"""
     _store(ref, value)
     value_of = self.thunk(code, frame, temps, thunk_ip)
-    rt.cyclic_on(("cyclic flag", ref.name), lambda r=ref, f=value_of: rt.names.assign(r, f()))
+    rt.cyclic.on(("cyclic flag", ref.name), lambda r=ref, f=value_of: rt.names.assign(r, f()))
 
 
 @inst('ref, lo if "L" in flags, hi if "H" in flags --', cold=True)
 def ANOUT_ON(channel: "p", flags: "f", thunk_ip: "h"):
-    """ANOUT ON channel (flags: L minimum, H maximum given), the value thunk, Runtime.cyclic_on"""
+    """ANOUT ON channel (flags: L minimum, H maximum given), the value thunk, Cyclic.on"""
     lo, hi = anout_limits(lo, hi)
     value_of = self.thunk(code, frame, temps, thunk_ip)
 
     def anout(ref=ref, value_of=value_of, lo=lo, hi=hi):
         ref.set(anout_value(value_of(), lo, hi))
     anout()
-    rt.cyclic_on(("analog output", channel.key), anout)
+    rt.cyclic.on(("analog output", channel.key), anout)
 
 
 @inst("ref --", cold=True)
 def ANIN_ON(channel: "p", thunk_ip: "h"):
-    """ANIN ON: the value thunk into the target reference, Runtime.cyclic_on (channel: the input SIGNAL the value reads, or -)"""
+    """ANIN ON: the value thunk into the target reference, Cyclic.on (channel: the input SIGNAL the value reads, or -)"""
     value_of = self.thunk(code, frame, temps, thunk_ip)
 
     def anin(ref=ref, value_of=value_of):
         rt.names.assign(ref, value_of())
     anin()
     if channel is not None:
-        rt.cyclic_on(("analog input", channel.key), anin)
+        rt.cyclic.on(("analog input", channel.key), anin)
 
 
 @inst(cold=True)
 def CYCLIC_OFF(what: "n", channel: "p"):
-    """Runtime.cyclic_off of what `what` switched on for channel (ANOUT OFF, ANIN OFF)"""
-    rt.cyclic_off((what, channel.key))
+    """Cyclic.off of what `what` switched on for channel (ANOUT OFF, ANIN OFF)"""
+    rt.cyclic.off((what, channel.key))
 
 
 @inst(cold=True)
 def RESUME():
-    """Runtime.resume"""
-    rt.resume()
+    """Interrupts.resume"""
+    rt.interrupts.resume()
 
 
 @inst("-- target", cold=True)
@@ -939,16 +939,16 @@ def TRIG_PACK(argc: "i"):
 
 @inst('call, at, delay, prio if "P" in flags --', cold=True)
 def TRIGGER(kind: "n", flags: "f", line: "i", action: "h"):
-    """Runtime.trigger; kind: DISTANCE or PATH, flags: O onstart, P prio given; action: the action thunk (it starts with the packed call)"""
-    rt.trigger(self.thunk(code, frame, temps, action, [call]), line=line,
+    """MotionStatements.trigger; kind: DISTANCE or PATH, flags: O onstart, P prio given; action: the action thunk (it starts with the packed call)"""
+    rt.motions.trigger(self.thunk(code, frame, temps, action, [call]), line=line,
                **trigger_args(kind, at, delay, prio, "O" in flags))
 
 
 @inst("path --", cold=True)
 def COND_STOP(cond: "h", flags: "f", line: "i"):
-    """Runtime.conditional_stop(path, ONSTART?, condition thunk, line); flags: O onstart"""
+    """MotionStatements.conditional_stop(path, ONSTART?, condition thunk, line); flags: O onstart"""
     when = self.thunk(code, frame, temps, cond)
-    rt.conditional_stop(path, flags == "O", lambda c=when: rt.to_bool(c(), "conditional stop"), line)
+    rt.motions.conditional_stop(path, flags == "O", lambda c=when: rt.to_bool(c(), "conditional stop"), line)
 
 
 @inst("call --", cold=True)
@@ -963,8 +963,8 @@ def TRIG_INVOKE(slow: "l"):
 
 @inst('target, aux if "A" in flags, ca if "C" in flags, pairs[2 * nwith] --', cold=True)
 def MOTION(kind: "n", approx: "n", frame_kind: "n", flags: "f", nwith: "i", line: "i"):
-    """Runtime.motion; flags: A aux point, C CA given; pairs: the WITH (reference, value) pairs"""
-    rt.motion(kind, target, approx.split(",") if approx else [], aux, ca,
+    """MotionStatements.motion; flags: A aux point, C CA given; pairs: the WITH (reference, value) pairs"""
+    rt.motions.motion(kind, target, approx.split(",") if approx else [], aux, ca,
               frame_kind, self.pairs(pairs), code.file, line)
 
 
@@ -1003,8 +1003,8 @@ def SPL_SEG(kind: "n", flags: "f", nwith: "i", line: "i", spline: "t"):
 
 @inst("pairs[2 * nwith] --", cold=True)
 def SPLINE(kind: "n", approx: "n", nwith: "i", line: "i", spline: "t"):
-    """Runtime.spline with the block's segments and WITH pairs"""
-    rt.spline(kind, temps[spline][0], approx, self.pairs(pairs), code.file, line)
+    """MotionStatements.spline with the block's segments and WITH pairs"""
+    rt.motions.spline(kind, temps[spline][0], approx, self.pairs(pairs), code.file, line)
 
 
 # ---------------------------------------------------------------------------- superinstructions

@@ -61,9 +61,9 @@ def _cold_CONTINUE(self, ins, code, frame, temps, stack, ip):
 
 
 def _cold_ON_ERROR_PROCEED(self, ins, code, frame, temps, stack, ip):
-    """Runtime.on_error_proceed"""
+    """ErrorState.on_error_proceed"""
     rt = self.rt
-    rt.on_error_proceed()
+    rt.errstate.on_error_proceed()
     return ip + 1
 
 
@@ -86,7 +86,7 @@ def _cold_RAISE(self, ins, code, frame, temps, stack, ip):
 
 
 def _cold_INT_DECL(self, ins, code, frame, temps, stack, ip):
-    """Runtime.interrupt_decl(cond thunk, handler thunk, name, GLOBAL?, line); flags: G (GLOBAL), then the condition's watch (interp/runtime/watch.py)"""
+    """Interrupts.declare(cond thunk, handler thunk, name, GLOBAL?, line); flags: G (GLOBAL), then the condition's watch (interp/runtime/watch.py)"""
     rt = self.rt
     cond = ins[1]
     handler = ins[2]
@@ -96,25 +96,25 @@ def _cold_INT_DECL(self, ins, code, frame, temps, stack, ip):
     number = stack.pop()
     when = self.thunk(code, frame, temps, cond)
     is_global = flags[:1] == 'G'
-    rt.interrupt_decl(number, lambda c=when: rt.to_bool(c(), 'interrupt condition'), self.thunk(code, frame, temps, handler), name, frame, is_global, line, flags[1:] if is_global else flags)
+    rt.interrupts.declare(number, lambda c=when: rt.to_bool(c(), 'interrupt condition'), self.thunk(code, frame, temps, handler), name, frame, is_global, line, flags[1:] if is_global else flags)
     return ip + 1
 
 
 def _cold_INT_CTL(self, ins, code, frame, temps, stack, ip):
-    """Runtime.interrupt_ctl(action[, number]); flags: P if a number is given"""
+    """Interrupts.control(action[, number]); flags: P if a number is given"""
     rt = self.rt
     action = ins[1]
     flags = ins[2]
     number = stack.pop() if flags == 'P' else None
-    rt.interrupt_ctl(action, number)
+    rt.interrupts.control(action, number)
     return ip + 1
 
 
 def _cold_BRAKE(self, ins, code, frame, temps, stack, ip):
-    """Runtime.brake (flags: F for BRAKE F)"""
+    """Interrupts.brake (flags: F for BRAKE F)"""
     rt = self.rt
     flags = ins[1]
-    rt.brake(flags == 'F')
+    rt.interrupts.brake(flags == 'F')
     return ip + 1
 
 
@@ -127,19 +127,19 @@ def _cold_STUB(self, ins, code, frame, temps, stack, ip):
 
 
 def _cold_CYCLIC_ASSIGN(self, ins, code, frame, temps, stack, ip):
-    """assign the value, then Runtime.cyclic_on re-assigns the thunk's value every IPO cycle (a cyclic flag)"""
+    """assign the value, then Cyclic.on re-assigns the thunk's value every IPO cycle (a cyclic flag)"""
     rt = self.rt
     thunk_ip = ins[1]
     ref = stack.pop()
     value = stack.pop()
     _store(ref, value)
     value_of = self.thunk(code, frame, temps, thunk_ip)
-    rt.cyclic_on(('cyclic flag', ref.name), lambda r=ref, f=value_of: rt.names.assign(r, f()))
+    rt.cyclic.on(('cyclic flag', ref.name), lambda r=ref, f=value_of: rt.names.assign(r, f()))
     return ip + 1
 
 
 def _cold_ANOUT_ON(self, ins, code, frame, temps, stack, ip):
-    """ANOUT ON channel (flags: L minimum, H maximum given), the value thunk, Runtime.cyclic_on"""
+    """ANOUT ON channel (flags: L minimum, H maximum given), the value thunk, Cyclic.on"""
     rt = self.rt
     channel = ins[1]
     flags = ins[2]
@@ -153,12 +153,12 @@ def _cold_ANOUT_ON(self, ins, code, frame, temps, stack, ip):
     def anout(ref=ref, value_of=value_of, lo=lo, hi=hi):
         ref.set(anout_value(value_of(), lo, hi))
     anout()
-    rt.cyclic_on(('analog output', channel.key), anout)
+    rt.cyclic.on(('analog output', channel.key), anout)
     return ip + 1
 
 
 def _cold_ANIN_ON(self, ins, code, frame, temps, stack, ip):
-    """ANIN ON: the value thunk into the target reference, Runtime.cyclic_on (channel: the input SIGNAL the value reads, or -)"""
+    """ANIN ON: the value thunk into the target reference, Cyclic.on (channel: the input SIGNAL the value reads, or -)"""
     rt = self.rt
     channel = ins[1]
     thunk_ip = ins[2]
@@ -169,23 +169,23 @@ def _cold_ANIN_ON(self, ins, code, frame, temps, stack, ip):
         rt.names.assign(ref, value_of())
     anin()
     if channel is not None:
-        rt.cyclic_on(('analog input', channel.key), anin)
+        rt.cyclic.on(('analog input', channel.key), anin)
     return ip + 1
 
 
 def _cold_CYCLIC_OFF(self, ins, code, frame, temps, stack, ip):
-    """Runtime.cyclic_off of what `what` switched on for channel (ANOUT OFF, ANIN OFF)"""
+    """Cyclic.off of what `what` switched on for channel (ANOUT OFF, ANIN OFF)"""
     rt = self.rt
     what = ins[1]
     channel = ins[2]
-    rt.cyclic_off((what, channel.key))
+    rt.cyclic.off((what, channel.key))
     return ip + 1
 
 
 def _cold_RESUME(self, ins, code, frame, temps, stack, ip):
-    """Runtime.resume"""
+    """Interrupts.resume"""
     rt = self.rt
-    rt.resume()
+    rt.interrupts.resume()
     return ip + 1
 
 
@@ -211,7 +211,7 @@ def _cold_TRIG_PACK(self, ins, code, frame, temps, stack, ip):
 
 
 def _cold_TRIGGER(self, ins, code, frame, temps, stack, ip):
-    """Runtime.trigger; kind: DISTANCE or PATH, flags: O onstart, P prio given; action: the action thunk (it starts with the packed call)"""
+    """MotionStatements.trigger; kind: DISTANCE or PATH, flags: O onstart, P prio given; action: the action thunk (it starts with the packed call)"""
     rt = self.rt
     kind = ins[1]
     flags = ins[2]
@@ -221,19 +221,19 @@ def _cold_TRIGGER(self, ins, code, frame, temps, stack, ip):
     delay = stack.pop()
     at = stack.pop()
     call = stack.pop()
-    rt.trigger(self.thunk(code, frame, temps, action, [call]), line=line, **trigger_args(kind, at, delay, prio, 'O' in flags))
+    rt.motions.trigger(self.thunk(code, frame, temps, action, [call]), line=line, **trigger_args(kind, at, delay, prio, 'O' in flags))
     return ip + 1
 
 
 def _cold_COND_STOP(self, ins, code, frame, temps, stack, ip):
-    """Runtime.conditional_stop(path, ONSTART?, condition thunk, line); flags: O onstart"""
+    """MotionStatements.conditional_stop(path, ONSTART?, condition thunk, line); flags: O onstart"""
     rt = self.rt
     cond = ins[1]
     flags = ins[2]
     line = ins[3]
     path = stack.pop()
     when = self.thunk(code, frame, temps, cond)
-    rt.conditional_stop(path, flags == 'O', lambda c=when: rt.to_bool(c(), 'conditional stop'), line)
+    rt.motions.conditional_stop(path, flags == 'O', lambda c=when: rt.to_bool(c(), 'conditional stop'), line)
     return ip + 1
 
 
@@ -250,7 +250,7 @@ def _cold_TRIG_INVOKE(self, ins, code, frame, temps, stack, ip):
 
 
 def _cold_MOTION(self, ins, code, frame, temps, stack, ip):
-    """Runtime.motion; flags: A aux point, C CA given; pairs: the WITH (reference, value) pairs"""
+    """MotionStatements.motion; flags: A aux point, C CA given; pairs: the WITH (reference, value) pairs"""
     rt = self.rt
     kind = ins[1]
     approx = ins[2]
@@ -263,7 +263,7 @@ def _cold_MOTION(self, ins, code, frame, temps, stack, ip):
     ca = stack.pop() if 'C' in flags else None
     aux = stack.pop() if 'A' in flags else None
     target = stack.pop()
-    rt.motion(kind, target, approx.split(',') if approx else [], aux, ca, frame_kind, self.pairs(pairs), code.file, line)
+    rt.motions.motion(kind, target, approx.split(',') if approx else [], aux, ca, frame_kind, self.pairs(pairs), code.file, line)
     return ip + 1
 
 
@@ -315,7 +315,7 @@ def _cold_SPL_SEG(self, ins, code, frame, temps, stack, ip):
 
 
 def _cold_SPLINE(self, ins, code, frame, temps, stack, ip):
-    """Runtime.spline with the block's segments and WITH pairs"""
+    """MotionStatements.spline with the block's segments and WITH pairs"""
     rt = self.rt
     kind = ins[1]
     approx = ins[2]
@@ -324,7 +324,7 @@ def _cold_SPLINE(self, ins, code, frame, temps, stack, ip):
     spline = ins[5]
     pairs = stack[len(stack) - 2 * nwith:]
     del stack[len(stack) - 2 * nwith:]
-    rt.spline(kind, temps[spline][0], approx, self.pairs(pairs), code.file, line)
+    rt.motions.spline(kind, temps[spline][0], approx, self.pairs(pairs), code.file, line)
     return ip + 1
 
 
@@ -1347,7 +1347,7 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                 proceed = False
                 rt.steps += unsaved
                 unsaved = 0
-                rt.record_error(e, frame)
+                rt.errstate.record_error(e, frame)
                 left = task.quiet - rt.steps if task is not None else 0
                 calm = task is not None and task.calm
                 del stack[8:]
@@ -1361,4 +1361,4 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
     finally:
         rt.steps += unsaved
 
-SOURCE = 'f59ab7dca7e6dedc62601fe2fce20520c43cce477b3a7d7d08618edee322dbd9'
+SOURCE = '623f54ad3dcc43750d6bdfb767efe248eff59209e256d8554fb67abc87216606'

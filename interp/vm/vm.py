@@ -175,7 +175,7 @@ class VM:
         # without one (no Python frame of its own per call)
         self.body = functools.partial(self.loop, self, None)
         # the runtime's statement hooks, bound once (the loop takes them at each call)
-        self.hooks = (rt.before_statement, rt.loop_tick, rt.take_error_proceed, rt.quiet_limit, rt.calls.run_routine,
+        self.hooks = (rt.before_statement, rt.loop_tick, rt.errstate.take_error_proceed, rt.quiet_limit, rt.calls.run_routine,
                       self.body, rt.calls.call_native)
 
     # ------------------------------------------------------------------ entry points

@@ -355,7 +355,7 @@ def test_the_history_backups_submit_programs_are_the_same_parked(shared_history)
         assert (rt.scheduler.spin.diverged, rt.scheduler.spin.missed) == (0, 0), program
         _rt, tree = _real(program, "tree", True, 10.0)
         assert tree == on, program
-        if rt.scheduler.spin.parks and any(k[0] == "cyclic flag" for k in rt._cyclic):
+        if rt.scheduler.spin.parks and any(k[0] == "cyclic flag" for k in rt.cyclic.handles):
             parked_beside_a_flag += 1
         periodic += rt.scheduler.spin.periods > 0 and rt.scheduler.spin.skipped > 0
     assert parked_beside_a_flag >= 1

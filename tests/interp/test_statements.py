@@ -260,12 +260,12 @@ def test_on_error_proceed_flag_belongs_to_the_running_context(tmp_path):
     rt = r.rt
     task = rt.robot
     rt.current_task = task
-    rt.on_error_proceed()
+    rt.errstate.on_error_proceed()
     task.contexts.append(Context("interrupt", prio=3, number=3))
-    assert rt.take_error_proceed() is False
+    assert rt.errstate.take_error_proceed() is False
     task.contexts.pop()
-    assert rt.take_error_proceed() is True
-    assert rt.take_error_proceed() is False
+    assert rt.errstate.take_error_proceed() is True
+    assert rt.errstate.take_error_proceed() is False
 
 
 def test_swrite_sread_and_string_functions(tmp_path):

@@ -15,7 +15,7 @@ import pytest
 
 from interp import realprograms as rp
 from interp.run import make_runtime, run_spec
-from interp.runtime.core import TARGET_OUTSIDE_NOTE
+from interp.runtime.motions import TARGET_OUTSIDE_NOTE
 from krl.workspace import workspaces_for
 from robot.frames import matrix_to_frame
 from robot.kinematics import Kinematics

@@ -18,7 +18,7 @@ SYSTEM = Family("system state")
 @SYSTEM.native("ERR_CLEAR(ERROR_T PERR :OUT)")
 def _err_clear(rt, a):
     e = a[0].peek()
-    rt.clear_err(e)
+    rt.errstate.clear_err(e)
 
 
 @SYSTEM.native("ERR_RAISE(ERROR_T PERR :OUT)")
@@ -27,7 +27,7 @@ def _err_raise(rt, a):
     n = e.f.get("NUMBER", 0)
     if n in (UNSET, 0):
         return None
-    msg = rt.err_message(e)
+    msg = rt.errstate.err_message(e)
     raise KrlRuntimeError(msg, n)
 
 

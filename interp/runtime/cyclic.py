@@ -1,0 +1,96 @@
+"""Cyclic evaluation of a run (reference §5.14, §5.15): :class:`Cyclic` (``Runtime.cyclic``),
+what ``ANOUT ON``, ``ANIN ON`` and ``$CYCFLAG[n] = expr`` switch on, for both interpreters.
+
+It holds now: ``handles``, the controller's handle (robot/controller.py ``add_cyclic``) of each
+cyclic evaluation by its key (("cyclic flag", name), ("analog output", channel key), ("analog
+input", channel key)); ``restless``, the keys of the cyclic flags whose expression does not
+settle (interp/runtime/watch.py ``settles``); and, by ``id`` of the assignment, whether a
+cyclic flag's expression settles (decided once per statement). Each evaluation runs once per
+IPO cycle; an error in it becomes a run-time error of the robot program at its next
+resumption (``Task.pending_error``).
+"""
+
+from __future__ import annotations
+
+from krl.ast import nodes as N
+from robot.errors import RobotError
+
+from .errors import KrlRuntimeError
+from .watch import settles
+
+
+class Cyclic:
+    """The cyclic evaluations of one run (module docstring)."""
+
+    __slots__ = ("rt", "handles", "restless", "_settling")
+
+    def __init__(self, rt) -> None:
+        self.rt = rt
+        self.handles: dict = {}         # key -> the controller's handle
+        #: the cyclic flags whose expression does not settle (watch.py ``settles``: it reads a
+        #: timer, the robot's position, a call...): evaluated at every IPO cycle, they may change
+        #: $CYCFLAG at any cycle, so a spin that reads $CYCFLAG is not parked beside one
+        self.restless: set = set()
+        self._settling: dict = {}       # id(assignment) -> its cyclic flag's expression settles
+
+    def analog_inputs(self) -> bool:
+        """An ``ANIN ON`` is on."""
+        return any(k[0] == "analog input" for k in self.handles)
+
+    def on(self, key, fn) -> None:
+        """Evaluate ``fn()`` once per IPO cycle until :meth:`off` (``ANOUT ON``,
+        ``ANIN ON``, ``$CYCFLAG[n] = expr``; §5.14, §5.15). An error in ``fn`` becomes a
+        run-time error of the robot program at its next resumption."""
+        self.off(key)
+        robot = self.rt.robot
+        # a cyclic flag's expression over variables and I/O is evaluated again only when one of
+        # them may have changed (interp/runtime/watch.py CyclicWatch); every cyclic flag counts
+        # the changes it makes to $CYCFLAG
+        flag = key[0] == "cyclic flag"
+        watch = self.rt.cyclic_watch
+        memo = flag and self._settles()
+        if flag and not memo:
+            self.restless.add(key)
+        cyc = self.rt.sysvars.store.get("$CYCFLAG") if flag else None
+        seen = [None]
+
+        def tick(ctl):
+            if memo:
+                k = watch.key()
+                if k is not None and k == seen[0]:
+                    return
+            before = tuple(cyc.data) if cyc is not None else None
+            try:
+                fn()
+            except KrlRuntimeError as e:
+                self.off(key)
+                if robot is not None and robot.pending_error is None:
+                    robot.pending_error = RobotError(e.message, e.number)
+                return
+            if before is not None and tuple(cyc.data) != before:
+                watch.version += 1
+            if memo:
+                seen[0] = watch.key()
+        self.handles[key] = self.rt.controller.add_cyclic(tick)
+        watch.anin = self.analog_inputs()
+
+    def _settles(self) -> bool:
+        """The cyclic flag the running statement switches on has an expression that
+        :func:`~.watch.settles`, decided once per statement (an SPS.SUB switches its flags on
+        again in every pass: the analysis cost about 40 µs each time)."""
+        task = self.rt.current_task
+        at = task.at if task is not None else None
+        for node in (self.rt.spin.statements(at) or ()) if at is not None else ():
+            if isinstance(node, N.Assign):
+                got = self._settling.get(id(node))
+                if got is None:
+                    got = self._settling[id(node)] = settles(node.value)
+                return got
+        return False
+
+    def off(self, key) -> None:
+        h = self.handles.pop(key, None)
+        self.restless.discard(key)
+        if h is not None:
+            self.rt.controller.remove_cyclic(h)
+            self.rt.cyclic_watch.anin = self.analog_inputs()

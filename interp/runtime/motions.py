@@ -1,0 +1,152 @@
+"""Motion statements of the robot program (reference §6.1-§6.3, §6.10, TRIGGER §6.11, STOP
+WHEN PATH): :class:`MotionStatements` (``Runtime.motions``), for both interpreters.
+
+It holds nothing of its own now: a statement's evaluated target, approximation and WITH clause
+become a robot.motion.MotionRequest (interp/runtime/motion.py, with the motion system
+variables at planning time: the advance run) queued on the run's controller, which waits
+while the queue holds $ADVANCE motions; a TRIGGER or a conditional stop goes with the next
+motion (``Task.next_triggers``); an executed motion is recorded for backward motion
+(``Runtime.history``). Errors raised: KrlRuntimeError (a motion statement in the submit
+interpreter or a TRIGGER action; a target the controller refuses, with its reason).
+"""
+
+from __future__ import annotations
+
+from robot.errors import RobotError, SoftLimitError, WorkspaceError
+from robot.motion import CondStop, MotionRequest, Trigger
+
+from .convert import assign_into, num
+from .errors import KrlRuntimeError
+from .memory import Slot
+from .motion import params_from, request, segment, target_of
+from .runmode import STEP_MODES
+from .scheduler import Task
+from .values import Arr, Struct, copy_value
+
+
+#: appended to a workspace or software-limit error whose motion target itself is out of the
+#: simulated robot's limits in every configuration (robot/controller.py target_outside_limits)
+TARGET_OUTSIDE_NOTE = "the target itself: no axis configuration of this robot reaches it within its software limits"
+
+
+def reach_message(ctl, req, err) -> str:
+    """The message of a motion `req` the controller `ctl` refused with `err`: a workspace or
+    software-limit error says so when the target itself is out of the robot's limits in
+    every configuration (not only on the way there, or with the program's S/T)."""
+    if isinstance(err, (SoftLimitError, WorkspaceError)) and ctl.target_outside_limits(req):
+        return f"{err.message} ({TARGET_OUTSIDE_NOTE})"
+    return err.message
+
+
+class MotionStatements:
+    """The motion statements of one run's robot program (module docstring)."""
+
+    __slots__ = ("rt",)
+
+    def __init__(self, rt) -> None:
+        self.rt = rt
+
+    def _params(self, with_: list):
+        store = self.rt.sysvars.store
+        saved = []
+        for ref, value in with_:
+            old = copy_value(ref.peek())
+            saved.append((ref, old))
+            ref.set(value)
+        try:
+            return params_from(store, self.rt.sysvars.base_link())
+        finally:
+            for ref, old in reversed(saved):
+                if isinstance(ref, Slot):
+                    cur = ref.c[ref.k]
+                    if isinstance(cur, (Struct, Arr)):
+                        assign_into(cur, old)
+                    else:
+                        ref.c[ref.k] = old
+
+    def motion(self, kind: str, target, approx: list, aux=None, ca=None, frame: str | None = None,
+               with_: list = (), file: str | None = None, line: int | None = None) -> int:
+        """Plan a motion statement and queue it (waits while the queue holds $ADVANCE
+        motions). ``target``/``aux`` are evaluated values; ``with_`` (ref, value) pairs of a
+        WITH clause, valid for this motion only. Returns the motion id."""
+        task = self._robot_only(kind)
+        tgt = target_of(target)
+        aux_d = target_of(aux, "auxiliary point") if aux is not None else None
+        params = self._params(list(with_))
+        trig, task.next_triggers = task.next_triggers, []
+        if self.rt.run_mode in STEP_MODES:
+            approx = []     # no advance run: exact positioning (docs/robot.md, run modes)
+        req = request(kind, tgt, params, list(approx), aux_d,
+                      float(num(ca)) if ca is not None else None, frame, trig, file, line)
+        return self._enqueue(task, req)
+
+    def spline(self, kind: str, segments: list, approx: str | None, with_: list = (),
+               file: str | None = None, line: int | None = None) -> int:
+        """A SPLINE / PTP_SPLINE block. ``segments``: list of dicts with kind, target, aux,
+        ca, with_ (ref, value pairs), triggers (robot.motion.Trigger list), line."""
+        task = self._robot_only(kind)
+        if self.rt.run_mode in STEP_MODES:
+            approx = None   # no advance run: the block ends exactly (docs/robot.md, run modes)
+        if kind.upper() == "PTP_SPLINE":
+            last = None
+            for i, s in enumerate(segments):
+                task.next_triggers = list(s.get("triggers", ()))
+                ap = ["C_SPL"] if i < len(segments) - 1 else ([approx] if approx else [])
+                last = self.motion("SPTP", s["target"], ap, with_=list(with_) + list(s.get("with_", ())),
+                                   file=file, line=s.get("line"))
+            return last or 0
+        block_params = self._params(list(with_))
+        segs = []
+        for s in segments:
+            p = self._params(list(with_) + list(s["with_"])) if s.get("with_") else None
+            segs.append(segment(s["kind"], target_of(s["target"]),
+                                target_of(s["aux"], "auxiliary point") if s.get("aux") is not None else None,
+                                s.get("ca"), p, s.get("triggers", ()), s.get("line")))
+        req = MotionRequest("SPLINE", segs[-1].target if segs else {}, block_params,
+                            approx=approx, segments=tuple(segs), file=file, line=line)
+        return self._enqueue(task, req)
+
+    def _robot_only(self, what: str) -> Task:
+        task = self.rt.current_task
+        if task.kind != "robot":
+            raise KrlRuntimeError(f"{what}: motion statements are not allowed in the submit interpreter")
+        if task.context.kind == "trigger":
+            raise KrlRuntimeError(f"{what}: no motion statements in a TRIGGER action")
+        return task
+
+    def _enqueue(self, task: Task, req) -> int:
+        ctl = self.rt.controller
+        adv = self.rt.sysvars.store.get("$ADVANCE")
+        ctl.set_advance(int(adv) if isinstance(adv, int) else 3)
+        if not ctl.can_enqueue():
+            self.rt._wait(task, ctl.can_enqueue)
+            self.rt._proceed()
+        try:
+            mid = ctl.enqueue(req)
+        except RobotError as e:
+            raise KrlRuntimeError(reach_message(ctl, req, e), e.number) from None
+        self.rt._break(task)           # the main run is not idle now: advance-run stops wait
+        self.rt.history.record(req, ctl.last_planned())
+        if self.rt.run_mode in STEP_MODES:
+            # the advance run does not pass the motion: the next statement is read when it ends
+            self.rt.wait_main_run(task)
+            if self.rt.run_mode != "ISTEP":
+                self.rt.step_stop(task, "MSTEP", motion=mid)
+        return mid
+
+    def trigger(self, action, *, distance: int | None = None, path: float | None = None,
+                onstart: bool = False, delay_ms: float = 0.0, prio: int | None = None,
+                line: int | None = None) -> None:
+        """TRIGGER: ``action`` (a zero-argument callable; call arguments already
+        evaluated) runs when the next motion's switching point is reached."""
+        task = self._robot_only("TRIGGER")
+        task.next_triggers.append(Trigger(distance=distance, path_mm=path, onstart=onstart,
+                                          delay_ms=float(delay_ms), action=action, prio=prio, line=line))
+
+    def conditional_stop(self, path, onstart: bool, condition, line: int | None = None) -> None:
+        """STOP WHEN PATH = path [ONSTART] IF condition (KSS 8.3 and later): the next motion
+        (spline segment) stops `path` mm from its end point (its start point) while
+        ``condition()`` (a zero-argument callable, True: stop) holds there; the main run
+        evaluates it (robot/controller.py ``Controller._conditional_stops``)."""
+        task = self._robot_only("STOP WHEN PATH")
+        task.next_triggers.append(CondStop(float(num(path)), bool(onstart), condition, line))
