@@ -251,7 +251,8 @@ class Engine:
         run-time errors and numbered controller messages go to the message window, the
         simulator's notes are kept, the display and the pacing hook once per IPO cycle."""
         rt.messages.interactive = True
-        inner_error = rt.error_hook
+        hooks = rt.stepping
+        inner_error = hooks.error_hook
 
         self._errors_shown = set()
 
@@ -262,7 +263,7 @@ class Engine:
                             thread=e["thread"])
             if inner_error is not None:
                 inner_error(task, frame, err)
-        rt.set_hooks(stmt=rt.stmt_hook, step=rt.step_hook, error=error_hook, cycle=rt.cycle_hook)
+        hooks.set_hooks(stmt=hooks.stmt_hook, step=hooks.step_hook, error=error_hook, cycle=hooks.cycle_hook)
         ctl = rt.controller
         ctl.add_cyclic(self._cycle)
         self._pace0 = None
@@ -366,7 +367,7 @@ def run_mode(core: RunEngine, value: str) -> str:
         raise Refused(f"run mode {value!r}: one of {', '.join(RUN_MODES)}")
 
     def apply(engine):
-        engine.rt.set_run_mode(value)
+        engine.rt.stepping.set_run_mode(value)
         return value
     return core.edit_now(f"$PRO_MODE = #{value}", apply)
 

@@ -38,7 +38,7 @@ def snapshot(eng, core, watch: list) -> dict:
     body = core.stop_body or {}
     out.update({
         "modeOp": "EXT" if rt.mode_op == "EX" else rt.mode_op,
-        "runMode": rt.run_mode,
+        "runMode": rt.stepping.run_mode,
         "override": _num(store.get("$OV_PRO")),
         "time": round(ctl.time, 3),
         "stop": _stop(core, body) if core.state == "stopped" else None,

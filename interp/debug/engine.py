@@ -518,13 +518,13 @@ class Engine:
 
         def apply(engine: Engine) -> int:
             rt = engine.rt
-            events_before = len(rt.history.records)
+            events_before = len(rt.stepping.history.records)
             with engine._quiet():
-                ok = rt.backward_step(rt.robot)
+                ok = rt.stepping.backward_step(rt.robot)
             engine.flush_trace()
             if not ok:
                 raise Refused(engine.last_refusal or "backward motion not possible")
-            return events_before - len(rt.history.records)
+            return events_before - len(rt.stepping.history.records)
         return self.edit("backward motion", apply)
 
     def _apply_pending(self, task) -> None:
@@ -622,7 +622,7 @@ class Engine:
         req = ctl.current_request()
         main = {"path": req.file, "line": req.line, "motion": req.id} if req is not None and req.line else None
         return {"advanceRun": adv, "mainRun": main, "time": round(ctl.time, 6), "cycle": ctl.cycle,
-                "step": self.n, "runMode": rt.run_mode}
+                "step": self.n, "runMode": rt.stepping.run_mode}
 
     def _view_scope(self, scope: Scope) -> tuple:
         """The view's scope tuple (interp/debug/view.py) of ``scope`` on this run."""
@@ -725,7 +725,7 @@ class Engine:
                 rt, _ = self._build()
             self.rt = rt
             self.tree = TreeInterpreter(rt)
-            rt.set_hooks(stmt=self.on_statement, step=self.on_step_stop, error=self.on_error, cycle=self.on_cycle)
+            rt.stepping.set_hooks(stmt=self.on_statement, step=self.on_step_stop, error=self.on_error, cycle=self.on_cycle)
             if self.on_runtime is not None:
                 self.on_runtime(rt)
             self.n = self.sub = 0

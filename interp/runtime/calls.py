@@ -328,9 +328,9 @@ class Calls:
                 return None
             raise
         except KrlRuntimeError as e:
-            if rt.error_hook is not None and not e.debug_seen:
+            if rt.stepping.error_hook is not None and not e.debug_seen:
                 e.debug_seen = True     # the debugger stops once, in the innermost frame
-                rt.error_hook(task, frame, e)
+                rt.stepping.error_hook(task, frame, e)
             raise
         finally:
             task.frame = prev

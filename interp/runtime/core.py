@@ -15,7 +15,6 @@ from krl.ast import nodes as N
 from krl.semantics.advance import StmtInfo
 from net.hub import NetError, Network
 from robot.controller import Controller
-from robot.errors import RobotError
 from robot.io import IOImage
 
 from .autocell import AUTO_DELAY_S, AutoCell
@@ -30,15 +29,13 @@ from .interrupts import Interrupts
 from .kss import SystemSoftware
 from .memory import DataMemory, ProxyRef, Ref, SignalRef
 from .messages import MessageWindow
-from .motion import frame_of
 from .motions import MotionStatements
 from .names import Names
 from .netvars import RuntimeSink
 from .program import Program
-from .runmode import BackwardRefused, MotionHistory, mode_name
 from .scheduler import NO_LIMIT, Scheduler, Task, program_budget
+from .stepping import Stepping
 from .sysvars import SysVars
-from .values import EnumValue
 from .watch import (CONSTANT, IO, SETTLES, CyclicWatch, reader, split_watch, stamp_key, timer_due, timer_reads,
                     timer_watch, watch_of)
 
@@ -132,7 +129,7 @@ class Runtime:
     __slots__ = ("controller", "trace", "current_task", "random", "_mode_op", "msg_handle", "messages",
                  "noted", "steps", "max_steps", "robot_budget", "sysvars", "memory", "program", "kss",
                  "modules", "scheduler", "robot", "result", "cyclic", "interrupts", "motions", "errstate",
-                 "run_mode", "history", "stmt_hook", "step_hook", "error_hook", "cycle_hook",
+                 "stepping",
                  "autocell", "halt_continues", "start", "halts", "state_epoch", "spin", "cyclic_watch",
                  "limit_at", "spec", "machine", "io", "interpreter", "_early_messages", "calls", "names")
 
@@ -186,13 +183,8 @@ class Runtime:
         self.interrupts = Interrupts(self)    # interrupts, BRAKE, RESUME (interp/runtime/interrupts.py)
         self.motions = MotionStatements(self)    # motion statements (interp/runtime/motions.py)
         self.errstate = ErrorState(self)  # $ERR, ON_ERROR_PROCEED (interp/runtime/errstate.py)
-        # run modes and debugging (interp/runtime/runmode.py, interp/debug)
-        self.run_mode = "GO"            # $PRO_MODE of the robot interpreter
-        self.history = MotionHistory()  # executed motions, for backward motion
-        self.stmt_hook = None           # debugger: stmt_hook(task, info) before every statement
-        self.step_hook = None           # debugger: step_hook(task, mode, text) at a step stop
-        self.error_hook = None          # debugger: error_hook(task, frame, err) where an error leaves a routine
-        self.cycle_hook = None          # debugger: cycle_hook(task) when a waiting task resumes (pause in a WAIT)
+        # the run mode, backward motion and the debugger's hooks (interp/runtime/stepping.py)
+        self.stepping = Stepping(self)
         self.halt_continues = spec.halt_continues   # krl run --on-halt continue: Start pressed again at most so often
         self.halts = 0                  # HALTs continued so far
         plan = cell(self) if cell is not None else CellPlan()
@@ -207,7 +199,7 @@ class Runtime:
             self.autocell = AutoCell(self, AUTO_DELAY_S)
             self.scheduler.idle.auto = self.autocell
         if spec.run_mode != "GO":
-            self.set_run_mode(spec.run_mode)
+            self.stepping.set_run_mode(spec.run_mode)
         if spec.override is not None:
             self.sysvars.store["$OV_PRO"] = int(spec.override)   # krl run --override, set before the start
         self.interpreter = interpreter(self) if interpreter is not None else None
@@ -273,8 +265,8 @@ class Runtime:
             task.body()
             if task.kind == "robot":
                 self.wait_main_run(task)      # END: the main run finishes its motions
-                if self.run_mode == "BSTEP":
-                    self.retrace(task)
+                if self.stepping.run_mode == "BSTEP":
+                    self.stepping.retrace(task)
             task.outcome = ("completed", None)
         except HaltSignal:
             task.outcome = ("halt", None)
@@ -368,12 +360,6 @@ class Runtime:
         self._mode_op = self.controller.mode_op
         self.bump_epoch()
 
-    def set_hooks(self, *, stmt=None, step=None, error=None, cycle=None) -> None:
-        """A debugger's hooks (docs/architecture.md "Debugger"): `stmt(task, info)` before every
-        statement, `step(task, mode, text)` at a run mode's stop, `error(task, frame, err)` where
-        a run-time error leaves a routine, `cycle(task)` when a waiting task resumes; None: none."""
-        self.stmt_hook, self.step_hook, self.error_hook, self.cycle_hook = stmt, step, error, cycle
-
     def bump_epoch(self) -> None:
         """A probed system variable may have changed (:attr:`state_epoch`): the running task's
         next step takes the full hook, whose interrupt poll reads the probes again."""
@@ -435,8 +421,9 @@ class Runtime:
             self.spin.waiting(task)
         self.scheduler.yield_cycle()
         self.service(task)
-        if self.cycle_hook is not None:
-            self.cycle_hook(task)
+        hook = self.stepping.cycle_hook
+        if hook is not None:
+            hook(task)
 
     def block_cycle(self, task: Task) -> None:
         """One IPO cycle of a statement that blocks its interpreter until something outside
@@ -461,8 +448,9 @@ class Runtime:
                 task.irqs.poll(ctl.io.version, ctl.time, self.state_epoch)
             finally:
                 task.in_poll = False
-        if self.cycle_hook is not None:
-            self.cycle_hook(task)
+        hook = self.stepping.cycle_hook
+        if hook is not None:
+            hook(task)
 
     def _proceed(self) -> None:
         """A task goes on after a wait (or runs a TRIGGER action, an interrupt routine): a
@@ -498,17 +486,18 @@ class Runtime:
             task.continue_line = None
         if info.stops and not cont and task.kind == "robot":
             self.advance_stop(task)
-        if self.run_mode == "ISTEP" and task.kind == "robot" and task.context.kind != "trigger":
+        stepping = self.stepping
+        if stepping.run_mode == "ISTEP" and task.kind == "robot" and task.context.kind != "trigger":
             # ISTEP: a stop after each statement, reached with the main run caught up
             self.wait_main_run(task)
-            self.step_stop(task, "ISTEP")
+            stepping.step_stop(task, "ISTEP")
         if self.trace is not None:
             self.trace.write("stmt", self.controller.time, file=info.file, line=info.line,
                              context=task.context.kind)
         if self.autocell is not None and self.autocell.recording is not None:
             self.autocell.record(task, info)
-        if self.stmt_hook is not None:
-            self.stmt_hook(task, info)
+        if stepping.stmt_hook is not None:
+            stepping.stmt_hook(task, info)
 
     def _count_step(self, task: Task) -> None:
         """One step of a task: the step limit, the end of its time slice, interrupts."""
@@ -543,9 +532,10 @@ class Runtime:
         may be a quiet step too. Until 2026-11-26 every such statement took the full hook: an
         SPS.SUB writes outputs and reads timers, and 40 % of its steps did."""
         irqs = task.irqs
+        stepping = self.stepping
         if self.trace is not None or (irqs.armed and irqs.settled != self.state_epoch) \
                 or task.continue_line is not None \
-                or self.stmt_hook is not None or self.run_mode == "ISTEP" \
+                or stepping.stmt_hook is not None or stepping.run_mode == "ISTEP" \
                 or any(c.error_proceed for c in task.contexts) \
                 or (self.autocell is not None and self.autocell.recording is not None) \
                 or task.watched or task.replay is not None or task.shadow is not None or self.spin.hooks_all:
@@ -707,7 +697,7 @@ class Runtime:
         self.wait_main_run(task)
         where = f"{Path(task.file).name}:{task.line}" if task.file else "?"
         text = f"HALT at {where}: Start pressed again ({self.halts} of {self.halt_continues}, --on-halt continue)"
-        self.step_stop(task, "HALT", text=text)
+        self.stepping.step_stop(task, "HALT", text=text)
         self.message(text)
         self.wait_sec(OPERATOR_DELAY_S)
 
@@ -734,62 +724,3 @@ class Runtime:
         """A statement of §5.20 that is recognised and not simulated (CONFIRM, ASYPTP,
         MOVE_EMI, ...): logged once as a ``message`` event, no effect."""
         self.kss.statement(what)
-
-    # ================================================================== run modes
-    def set_run_mode(self, mode) -> None:
-        """``$PRO_MODE`` of the robot interpreter (``#GO``, ``#MSTEP``, ``#ISTEP``,
-        ``#BSTEP``; interp/runtime/runmode.py). ValueError for another mode."""
-        name = mode_name(mode)
-        self.sysvars.store["$PRO_MODE"] = EnumValue(name)
-        self.run_mode_changed()
-
-    def run_mode_changed(self) -> None:
-        """``$PRO_MODE`` was written: the new mode applies from the next statement."""
-        v = self.sysvars.store.get("$PRO_MODE")
-        try:
-            self.run_mode = mode_name(v)
-        except ValueError:
-            self.run_mode = "GO"
-            self.message(f"run mode {getattr(v, 'name', v)} is not simulated: #GO")
-        if self.current_task is not None:
-            self._break(self.current_task)
-
-    def step_stop(self, task: Task, mode: str, motion: int | None = None, text: str | None = None,
-                  at: tuple | None = None) -> None:
-        """A step stop (the operator presses Start again): a ``step_stop`` trace event; the
-        debugger's ``step_hook`` stops there, ``krl run`` goes on at once."""
-        if self.trace is not None:
-            file, line = at if at is not None else (task.file, task.line)
-            self.trace.write("step_stop", self.controller.time, mode=mode, file=file, line=line,
-                             id=motion, text=text)
-        if self.step_hook is not None:
-            self.step_hook(task, mode, text)
-
-    def backward_step(self, task: Task) -> bool:
-        """One backward motion (#BSTEP): the newest executed motion not yet retraced, back
-        to its start point, as exact positioning with its own speed, frames and the
-        operating mode's limits; no statement runs. False (and a ``step_stop`` event whose
-        text is the reason) when it is refused (interp/runtime/runmode.py)."""
-        store = self.sysvars.store
-        try:
-            req, rec = self.history.next_backward(self.mode_op, frame_of(store["$TOOL"]),
-                                                  frame_of(store["$BASE"]))
-        except BackwardRefused as r:
-            self.message(r.reason)
-            self.step_stop(task, "BSTEP", text=r.reason)
-            return False
-        ctl = self.controller
-        self.wait_main_run(task)
-        try:
-            mid = ctl.enqueue(req)
-        except RobotError as e:
-            raise KrlRuntimeError(e.message, e.number) from None
-        self._break(task)
-        self.wait_main_run(task)
-        self.step_stop(task, "BSTEP", motion=mid, at=(rec.file, rec.line))
-        return True
-
-    def retrace(self, task: Task) -> None:
-        """#BSTEP at the end of the program: backward motions until one is refused."""
-        while self.backward_step(task):
-            pass

@@ -328,7 +328,7 @@ class IdleWatch:
 
     def _quiet(self) -> bool:
         rt = self.rt
-        if rt.stmt_hook is not None or rt.step_hook is not None or rt.cycle_hook is not None:
+        if rt.stepping.watched():
             return False
         for t in rt.scheduler.tasks:
             if t.done:

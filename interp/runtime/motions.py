@@ -6,7 +6,7 @@ become a robot.motion.MotionRequest (interp/runtime/motion.py, with the motion s
 variables at planning time: the advance run) queued on the run's controller, which waits
 while the queue holds $ADVANCE motions; a TRIGGER or a conditional stop goes with the next
 motion (``Task.next_triggers``); an executed motion is recorded for backward motion
-(``Runtime.history``). Errors raised: KrlRuntimeError (a motion statement in the submit
+(``Stepping.history``). Errors raised: KrlRuntimeError (a motion statement in the submit
 interpreter or a TRIGGER action; a target the controller refuses, with its reason).
 """
 
@@ -74,7 +74,7 @@ class MotionStatements:
         aux_d = target_of(aux, "auxiliary point") if aux is not None else None
         params = self._params(list(with_))
         trig, task.next_triggers = task.next_triggers, []
-        if self.rt.run_mode in STEP_MODES:
+        if self.rt.stepping.run_mode in STEP_MODES:
             approx = []     # no advance run: exact positioning (docs/robot.md, run modes)
         req = request(kind, tgt, params, list(approx), aux_d,
                       float(num(ca)) if ca is not None else None, frame, trig, file, line)
@@ -85,7 +85,7 @@ class MotionStatements:
         """A SPLINE / PTP_SPLINE block. ``segments``: list of dicts with kind, target, aux,
         ca, with_ (ref, value pairs), triggers (robot.motion.Trigger list), line."""
         task = self._robot_only(kind)
-        if self.rt.run_mode in STEP_MODES:
+        if self.rt.stepping.run_mode in STEP_MODES:
             approx = None   # no advance run: the block ends exactly (docs/robot.md, run modes)
         if kind.upper() == "PTP_SPLINE":
             last = None
@@ -126,12 +126,12 @@ class MotionStatements:
         except RobotError as e:
             raise KrlRuntimeError(reach_message(ctl, req, e), e.number) from None
         self.rt._break(task)           # the main run is not idle now: advance-run stops wait
-        self.rt.history.record(req, ctl.last_planned())
-        if self.rt.run_mode in STEP_MODES:
+        self.rt.stepping.history.record(req, ctl.last_planned())
+        if self.rt.stepping.run_mode in STEP_MODES:
             # the advance run does not pass the motion: the next statement is read when it ends
             self.rt.wait_main_run(task)
-            if self.rt.run_mode != "ISTEP":
-                self.rt.step_stop(task, "MSTEP", motion=mid)
+            if self.rt.stepping.run_mode != "ISTEP":
+                self.rt.stepping.step_stop(task, "MSTEP", motion=mid)
         return mid
 
     def trigger(self, action, *, distance: int | None = None, path: float | None = None,

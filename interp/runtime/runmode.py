@@ -13,7 +13,7 @@ run modes and backward motion", lists every rule with its source).
 A *step stop* is the point where the operator presses Start again. In a non-interactive
 ``krl run`` nobody presses it: the run records a ``step_stop`` trace event and goes on at
 once, so runs complete and the trace shows every stop. ``krl debug`` stops there instead
-(``Runtime.step_hook``).
+(``Stepping.step_hook``).
 
 The submit interpreter is not affected by ``$PRO_MODE`` (it has no motions and its own
 ``$PRO_MODE0``); a TRIGGER action never stops.

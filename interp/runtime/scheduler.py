@@ -174,7 +174,7 @@ class Scheduler:
         ``Runtime.service``), and no debugger watches the cycle. True: the cycle is counted as
         the task's, and the task is not resumed."""
         rt = self.rt
-        if task.pending_triggers or task.pending_error is not None or rt.cycle_hook is not None or task.until():
+        if task.pending_triggers or task.pending_error is not None or rt.stepping.cycle_hook is not None or task.until():
             return False
         rt.state_epoch += 1             # as _resume: the IPO cycle moved the robot
         if task.irqs.armed and not task.in_poll:

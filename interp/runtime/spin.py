@@ -224,8 +224,8 @@ class SpinWatch(PeriodicSpins):
         ctl = rt.controller
         net = getattr(ctl, "network", None)
         return (self.enabled and rt.trace is None
-                and rt.stmt_hook is None and rt.step_hook is None and rt.cycle_hook is None
-                and rt.run_mode == "GO" and getattr(ctl, "correction", None) is None
+                and not rt.stepping.watched()
+                and rt.stepping.run_mode == "GO" and getattr(ctl, "correction", None) is None
                 and not any(k[0] == "analog input" for k in rt.cyclic.handles)
                 and (net is None or not net.polling))     # (no partner attached or ticking else: net/hub.py)
 

@@ -770,7 +770,7 @@ def _boot_trace(sv: SysVars) -> None:
 def _pro_mode_written(sv: SysVars, ref) -> None:
     """``$PRO_MODE = #MSTEP`` (any run mode): the next statement takes the full hook, so the
     new mode applies from there in both interpreters (interp/runtime/runmode.py)."""
-    sv.rt.run_mode_changed()
+    sv.rt.stepping.run_mode_changed()
 
 
 #: what writing a system variable does once the value is stored (its range is checked before,

@@ -300,7 +300,7 @@ class CyclicWatch:
         (interp/runtime/core.py ``Runtime.changed_outside``, which moves :attr:`version`; net/hub.py
         "sink")."""
         rt = self.rt
-        if rt.stmt_hook is not None or rt.step_hook is not None or rt.cycle_hook is not None or self.anin:
+        if rt.stepping.watched() or self.anin:
             return None
         return (rt.steps - rt.spin.skipped, self.version)
 

@@ -41,6 +41,7 @@ class TreeInterpreter:
         self.rt = rt
         self.names = rt.names           # what a name denotes (interp/runtime/names.py)
         self.calls = rt.calls           # the call protocol (interp/runtime/calls.py)
+        self.errstate = rt.errstate     # $ERR, ON_ERROR_PROCEED (interp/runtime/errstate.py)
         self._labels: dict = {}
         self.stmt_dispatch = handlers(self, "s_", STATEMENTS)
         self.expr_dispatch = handlers(self, "e_", EXPRESSIONS)
@@ -88,23 +89,22 @@ class TreeInterpreter:
         """Prologue of a statement that ON_ERROR_PROCEED does not cover: it takes the flag
         all the same (§5.19: the flag is for the next statement only)."""
         info = self.begin(st, frame)
-        self.rt.errstate.take_error_proceed()
+        self.errstate.take_error_proceed()
         return info
 
     def guarded(self, fn, st, frame, proceed: bool | None = None) -> bool:
         """Run a statement body under ON_ERROR_PROCEED semantics and place errors; False
         if it failed and the error was recorded (``proceed``: the flag, if the statement
         took it already)."""
-        rt = self.rt
         if proceed is None:
-            proceed = rt.errstate.take_error_proceed()
+            proceed = self.errstate.take_error_proceed()
         try:
             fn()
         except KrlRuntimeError as e:
             e.at(st.span.file, st.span.line)
             if not proceed:
                 raise
-            rt.errstate.record_error(e, frame)
+            self.errstate.record_error(e, frame)
             return False
         return True
 
@@ -179,7 +179,7 @@ class TreeInterpreter:
     def s_While(self, st, frame) -> None:
         info = self.begin(st, frame)
         rt = self.rt
-        proceed = rt.errstate.take_error_proceed()
+        proceed = self.errstate.take_error_proceed()
         first = []
         rt.loop_tick(info)
         # ON_ERROR_PROCEED covers the first evaluation of the condition: an error skips the loop
@@ -254,7 +254,7 @@ class TreeInterpreter:
 
     def s_OnErrorProceed(self, st, frame) -> None:
         self.plain(st, frame)
-        self.rt.errstate.on_error_proceed()
+        self.errstate.on_error_proceed()
 
     def s_DeclStmt(self, st, frame) -> None:
         raise KrlRuntimeError("declaration after the first statement", None, st.span.file, st.span.line)

@@ -51,7 +51,7 @@ class KrlRuntimeError(Exception):
         # True when the trace already holds this error's `error` event (a main-run fault,
         # written by the controller with its motion id): the run does not write it again
         self.traced = False
-        self.debug_seen = False     # a debugger stopped at it already (Runtime.error_hook)
+        self.debug_seen = False     # a debugger stopped at it already (Stepping.error_hook)
 
     def at(self, file: str | None, line: int | None) -> "KrlRuntimeError":
         """Set the place if it is not set yet (the innermost statement wins); returns self."""

@@ -3,7 +3,8 @@
 from the end of their construction to the start of the run nothing outside their classes sets
 one of their attributes (a method of theirs may change what it holds).
 
-The guard wraps ``Runtime`` and ``Controller`` for the test: their constructors note each
+The guard wraps ``Runtime``, its parts (:data:`PARTS`: interp/runtime/calls.py, names.py, ...) and
+``Controller`` for the test: their constructors note each
 object built (and the Runtime its spec), ``Runtime.run`` notes the run's start, and an attribute
 set on a built object that is not yet running is a violation unless the code setting it is one of
 the class's own (a method, or a function defined in one)."""
@@ -19,7 +20,14 @@ import pytest
 from interp.debug.engine import Engine, LaunchConfig
 from interp.outcomes import run_outcome
 from interp.run import RunSetup, make_runtime, run_setup, run_spec
+from interp.runtime.calls import Calls
 from interp.runtime.core import Runtime
+from interp.runtime.cyclic import Cyclic
+from interp.runtime.errstate import ErrorState
+from interp.runtime.interrupts import Interrupts
+from interp.runtime.motions import MotionStatements
+from interp.runtime.names import Names
+from interp.runtime.stepping import Stepping
 from interp.spec import RUN_SIM_TIME_S, RunSpec, SpecError
 from interp.summary import RunObserver
 from robot.collision import CellGeometry
@@ -47,6 +55,11 @@ start: "{A1 5, A2 -90, A3 90, A4 0, A5 30, A6 0}"
 """
 
 
+#: the runtime's parts (interp/runtime/core.py ``Runtime.__init__``): its attribute -> class
+PARTS = {"calls": Calls, "names": Names, "errstate": ErrorState, "cyclic": Cyclic, "motions": MotionStatements,
+         "interrupts": Interrupts, "stepping": Stepping}
+
+
 class _Guard:
     """Attribute sets on built runtimes and controllers from outside their classes (module
     docstring)."""
@@ -56,13 +69,14 @@ class _Guard:
         self.running: set = set()
         self.specs: list = []
         self.violations: list[str] = []
-        for cls in (Runtime, Controller):
+        for cls in (Runtime, Controller, *PARTS.values()):
             self._wrap(monkeypatch, cls)
         run = Runtime.run
 
         def run_(rt):
             self.running.add(id(rt))
             self.running.add(id(rt.controller))
+            self.running.update(id(getattr(rt, name)) for name in PARTS)
             return run(rt)
         monkeypatch.setattr(Runtime, "run", run_)
 
@@ -95,11 +109,19 @@ def guard(monkeypatch):
 
 
 def test_the_guard_sees_a_set_from_outside(tmp_path, guard):
-    """The test can fail: a runtime attribute and a controller attribute set here are caught."""
+    """The test can fail: a runtime attribute, a controller attribute and an attribute of each of
+    the runtime's parts set here are caught; a part's own method setting its attribute is not."""
     rt, _ = make_runtime(run_spec(write(tmp_path, "prog.src", PROG), mujoco=False, max_sim_time=1.0))
     rt.halt_continues = 3
     rt.controller.advance = 1
-    assert [v.split(" set by ")[0] for v in guard.violations] == ["Runtime.halt_continues", "Controller.advance"]
+    for name, cls in PARTS.items():
+        part = getattr(rt, name)
+        assert type(part) is cls and part.rt is rt
+        part.rt = rt
+    rt.stepping.set_hooks(stmt=lambda task, info: None)
+    assert [v.split(" set by ")[0] for v in guard.violations] == \
+        ["Runtime.halt_continues", "Controller.advance"] + [f"{cls.__name__}.rt" for cls in PARTS.values()]
+    assert rt.stepping.stmt_hook is not None
 
 
 def test_make_runtime_builds_complete_objects(tmp_path, guard):

@@ -1,0 +1,108 @@
+"""The program run mode and the debugger's hooks of a run: :class:`Stepping` (``Runtime.stepping``).
+
+It holds now: ``run_mode``, the robot interpreter's ``$PRO_MODE`` by name (GO, MSTEP, ISTEP,
+BSTEP: interp/runtime/runmode.py; KSS 8.3 SI, program run modes); ``history``, the executed
+motions (runmode.py ``MotionHistory``) that #BSTEP retraces; and the hooks a debugger sets
+(docs/architecture.md "Debugger"; interp/debug/engine.py, the pendant): ``stmt_hook(task, info)``
+before every statement, ``step_hook(task, mode, text)`` at a step stop, ``error_hook(task,
+frame, err)`` where a run-time error leaves a routine, ``cycle_hook(task)`` when a waiting task
+resumes; None: no hook. A step stop is a ``step_stop`` trace event (robot/trace.py) where the
+debugger stops and ``krl run`` goes on at once. Errors raised: ValueError (a run mode that is
+not one of KRL's), KrlRuntimeError (a backward motion the controller refuses).
+"""
+
+from __future__ import annotations
+
+from robot.errors import RobotError
+
+from .errors import KrlRuntimeError
+from .motion import frame_of
+from .runmode import BackwardRefused, MotionHistory, mode_name
+from .scheduler import Task
+from .values import EnumValue
+
+
+class Stepping:
+    """The run mode, step stops, backward motion and debugger hooks of one run (module
+    docstring)."""
+
+    __slots__ = ("rt", "run_mode", "history", "stmt_hook", "step_hook", "error_hook", "cycle_hook")
+
+    def __init__(self, rt) -> None:
+        self.rt = rt
+        self.run_mode = "GO"            # $PRO_MODE of the robot interpreter
+        self.history = MotionHistory()  # executed motions, for backward motion
+        self.stmt_hook = None           # debugger: stmt_hook(task, info) before every statement
+        self.step_hook = None           # debugger: step_hook(task, mode, text) at a step stop
+        self.error_hook = None          # debugger: error_hook(task, frame, err) where an error leaves a routine
+        self.cycle_hook = None          # debugger: cycle_hook(task) when a waiting task resumes (pause in a WAIT)
+
+    def set_hooks(self, *, stmt=None, step=None, error=None, cycle=None) -> None:
+        """A debugger's hooks (docs/architecture.md "Debugger"): `stmt(task, info)` before every
+        statement, `step(task, mode, text)` at a run mode's stop, `error(task, frame, err)` where
+        a run-time error leaves a routine, `cycle(task)` when a waiting task resumes; None: none."""
+        self.stmt_hook, self.step_hook, self.error_hook, self.cycle_hook = stmt, step, error, cycle
+
+    def watched(self) -> bool:
+        """A debugger watches the run between statements or IPO cycles (a statement, step or
+        cycle hook is set): nothing that skips statements or cycles may run (interp/runtime/spin.py,
+        idle.py, watch.py)."""
+        return self.stmt_hook is not None or self.step_hook is not None or self.cycle_hook is not None
+
+    def set_run_mode(self, mode) -> None:
+        """``$PRO_MODE`` of the robot interpreter (``#GO``, ``#MSTEP``, ``#ISTEP``,
+        ``#BSTEP``; interp/runtime/runmode.py). ValueError for another mode."""
+        name = mode_name(mode)
+        self.rt.sysvars.store["$PRO_MODE"] = EnumValue(name)
+        self.run_mode_changed()
+
+    def run_mode_changed(self) -> None:
+        """``$PRO_MODE`` was written: the new mode applies from the next statement."""
+        v = self.rt.sysvars.store.get("$PRO_MODE")
+        try:
+            self.run_mode = mode_name(v)
+        except ValueError:
+            self.run_mode = "GO"
+            self.rt.message(f"run mode {getattr(v, 'name', v)} is not simulated: #GO")
+        if self.rt.current_task is not None:
+            self.rt._break(self.rt.current_task)
+
+    def step_stop(self, task: Task, mode: str, motion: int | None = None, text: str | None = None,
+                  at: tuple | None = None) -> None:
+        """A step stop (the operator presses Start again): a ``step_stop`` trace event; the
+        debugger's ``step_hook`` stops there, ``krl run`` goes on at once."""
+        if self.rt.trace is not None:
+            file, line = at if at is not None else (task.file, task.line)
+            self.rt.trace.write("step_stop", self.rt.controller.time, mode=mode, file=file, line=line,
+                             id=motion, text=text)
+        if self.step_hook is not None:
+            self.step_hook(task, mode, text)
+
+    def backward_step(self, task: Task) -> bool:
+        """One backward motion (#BSTEP): the newest executed motion not yet retraced, back
+        to its start point, as exact positioning with its own speed, frames and the
+        operating mode's limits; no statement runs. False (and a ``step_stop`` event whose
+        text is the reason) when it is refused (interp/runtime/runmode.py)."""
+        store = self.rt.sysvars.store
+        try:
+            req, rec = self.history.next_backward(self.rt.mode_op, frame_of(store["$TOOL"]),
+                                                  frame_of(store["$BASE"]))
+        except BackwardRefused as r:
+            self.rt.message(r.reason)
+            self.step_stop(task, "BSTEP", text=r.reason)
+            return False
+        ctl = self.rt.controller
+        self.rt.wait_main_run(task)
+        try:
+            mid = ctl.enqueue(req)
+        except RobotError as e:
+            raise KrlRuntimeError(e.message, e.number) from None
+        self.rt._break(task)
+        self.rt.wait_main_run(task)
+        self.step_stop(task, "BSTEP", motion=mid, at=(rec.file, rec.line))
+        return True
+
+    def retrace(self, task: Task) -> None:
+        """#BSTEP at the end of the program: backward motions until one is refused."""
+        while self.backward_step(task):
+            pass
