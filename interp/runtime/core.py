@@ -1,6 +1,15 @@
-"""The runtime facade: one :class:`Runtime` per run, used by the tree interpreter and
-(later) the VM. Its methods are the interface an interpreter calls; they hold all the
-semantics (docs/architecture.md, "Interpreters", lists the contracts).
+"""The runtime of one run: :class:`Runtime`, used by the tree interpreter and the VM alike
+(docs/architecture.md, "Runtime API", lists the contracts).
+
+It holds now the run state: the spec, the controller and its I/O image, the tasks and the
+running one (interp/runtime/scheduler.py), the step count and limit, the state epoch, the
+message window; its methods are a task's life (start, end, result), the statement hook
+(``before_statement``, ``loop_tick``, the VM's quiet steps) and the waits (WAIT FOR, WAIT SEC,
+HALT, advance-run stops). The rest of the semantics is in its parts, one class per module, each
+built here once: routine calls (calls.py ``Calls``), run-time names (names.py ``Names``), $ERR
+(errstate.py), cyclic evaluation (cyclic.py), motion statements (motions.py), interrupts
+(interrupts.py) and the run mode with the debugger's hooks (stepping.py). Also here: a run's
+result (:class:`RunResult`) and the cell a run's controller is built for (:class:`CellPlan`).
 """
 
 from __future__ import annotations
@@ -527,9 +536,9 @@ class Runtime:
 
         Sets ``task.calm``: the task's advance-run stops are no-ops during these steps (a
         submit task's always: :meth:`before_statement`; the robot task's while the main run is
-        idle, which only its own motion statement changes within its time slice:
-        :meth:`_enqueue` breaks), so a statement or loop condition that stops the advance run
-        may be a quiet step too. Until 2026-11-26 every such statement took the full hook: an
+        idle, which only its own motion statement changes within its time slice: motions.py
+        ``MotionStatements._enqueue`` breaks), so a statement or loop condition that stops the
+        advance run may be a quiet step too. Until 2026-11-26 every such statement took the full hook: an
         SPS.SUB writes outputs and reads timers, and 40 % of its steps did."""
         irqs = task.irqs
         stepping = self.stepping

@@ -328,7 +328,7 @@ class IdleWatch:
 
     def _quiet(self) -> bool:
         rt = self.rt
-        if rt.stepping.watched():
+        if rt.stepping.watching:
             return False
         for t in rt.scheduler.tasks:
             if t.done:

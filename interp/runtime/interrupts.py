@@ -31,9 +31,12 @@ class Interrupts:
         self.rt = rt
 
     def run_trigger(self, task: Task, ev) -> None:
+        """The action of the TRIGGER whose switching point `ev` the main run reached, in a
+        context of its own (priority 129 unless the TRIGGER gives one)."""
         self.rt._proceed()
         action = ev.trigger.action
-        task.contexts.append(Context("trigger", prio=ev.trigger.prio if ev.trigger.prio and ev.trigger.prio > 0 else 129))
+        prio = ev.trigger.prio if ev.trigger.prio and ev.trigger.prio > 0 else 129
+        task.contexts.append(Context("trigger", prio=prio))
         try:
             action()
         finally:

@@ -224,7 +224,7 @@ class SpinWatch(PeriodicSpins):
         ctl = rt.controller
         net = getattr(ctl, "network", None)
         return (self.enabled and rt.trace is None
-                and not rt.stepping.watched()
+                and not rt.stepping.watching
                 and rt.stepping.run_mode == "GO" and getattr(ctl, "correction", None) is None
                 and not any(k[0] == "analog input" for k in rt.cyclic.handles)
                 and (net is None or not net.polling))     # (no partner attached or ticking else: net/hub.py)

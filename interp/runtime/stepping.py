@@ -26,7 +26,7 @@ class Stepping:
     """The run mode, step stops, backward motion and debugger hooks of one run (module
     docstring)."""
 
-    __slots__ = ("rt", "run_mode", "history", "stmt_hook", "step_hook", "error_hook", "cycle_hook")
+    __slots__ = ("rt", "run_mode", "history", "stmt_hook", "step_hook", "error_hook", "cycle_hook", "watching")
 
     def __init__(self, rt) -> None:
         self.rt = rt
@@ -36,18 +36,17 @@ class Stepping:
         self.step_hook = None           # debugger: step_hook(task, mode, text) at a step stop
         self.error_hook = None          # debugger: error_hook(task, frame, err) where an error leaves a routine
         self.cycle_hook = None          # debugger: cycle_hook(task) when a waiting task resumes (pause in a WAIT)
+        #: a debugger watches the run between statements or IPO cycles (a statement, step or cycle
+        #: hook is set): nothing that skips statements or cycles may run (interp/runtime/spin.py,
+        #: idle.py, watch.py; read at every IPO cycle, so a flag, not a test of the three)
+        self.watching = False
 
     def set_hooks(self, *, stmt=None, step=None, error=None, cycle=None) -> None:
         """A debugger's hooks (docs/architecture.md "Debugger"): `stmt(task, info)` before every
         statement, `step(task, mode, text)` at a run mode's stop, `error(task, frame, err)` where
         a run-time error leaves a routine, `cycle(task)` when a waiting task resumes; None: none."""
         self.stmt_hook, self.step_hook, self.error_hook, self.cycle_hook = stmt, step, error, cycle
-
-    def watched(self) -> bool:
-        """A debugger watches the run between statements or IPO cycles (a statement, step or
-        cycle hook is set): nothing that skips statements or cycles may run (interp/runtime/spin.py,
-        idle.py, watch.py)."""
-        return self.stmt_hook is not None or self.step_hook is not None or self.cycle_hook is not None
+        self.watching = stmt is not None or step is not None or cycle is not None
 
     def set_run_mode(self, mode) -> None:
         """``$PRO_MODE`` of the robot interpreter (``#GO``, ``#MSTEP``, ``#ISTEP``,

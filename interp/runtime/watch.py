@@ -300,7 +300,7 @@ class CyclicWatch:
         (interp/runtime/core.py ``Runtime.changed_outside``, which moves :attr:`version`; net/hub.py
         "sink")."""
         rt = self.rt
-        if rt.stepping.watched() or self.anin:
+        if rt.stepping.watching or self.anin:
             return None
         return (rt.steps - rt.spin.skipped, self.version)
 
