@@ -75,6 +75,16 @@ def history_pairs() -> list[str]:
         return [f"{row['repo'].replace('/', '__')}/{row['pair']}" for row in csv.DictReader(f)]
 
 
+def earlier_pair(pair: str) -> bool:
+    """`pair` (``owner__name/NN-sha``) is older than its repository's newest pair of
+    ../shared/krl-history (the pairs are numbered in commit order; an earlier pair holds earlier
+    versions of the same files). A sweep over every pair keeps each repository's newest pair in
+    ``make test`` (every repository, so every kind of material) and the earlier ones in
+    ``make nightly`` (marked ``slow``: tests/interp/test_outside_runs.py, tests/diff/test_history.py)."""
+    repo, name = pair.split("/", 1)
+    return name != max(p.split("/", 1)[1] for p in history_pairs() if p.split("/", 1)[0] == repo)
+
+
 @pytest.fixture(scope="session")
 def shared_history() -> Path:
     """The real version histories, read in place. Absent: the test skips (a failure under CI=true)."""

@@ -1,7 +1,8 @@
 """krl diff on real history (issue 37): the 40 pairs of consecutive real versions in
 ../shared/krl-history (old/, new/; origins in its MANIFEST.csv), read in place.
 
-* On every pair, ``krl diff --format json`` is compared with an independent comparison of
+* On every pair (``make test``: each repository's newest pair; ``make nightly``: all),
+  ``krl diff --format json`` is compared with an independent comparison of
   every declared value (tests/diff/oracle.py: both sides' data lists parsed and compared
   by the documented rules, no code of krl/diff): no miss, no false change; the JSON validates
   against docs/schemas/diff.schema.json, and nothing of Python's representation is in it.
@@ -18,20 +19,24 @@ import pytest
 from click.testing import CliRunner
 
 from app import main
-from tests.conftest import history_pairs
+from tests.conftest import earlier_pair, history_pairs
 from tests.diff import oracle
 from tests.test_json_schemas import validate
 
 
-def _by_repository(pairs: list[str]) -> list:
+def _by_repository(pairs: list[str], sample: bool = False) -> list:
     """Each pair with the xdist group of its repository (make test: --dist loadgroup), so a
     repository's consecutive pairs run on one worker: the oracle parses each content once per
     process (oracle.parse_all), and the old side of a pair is mostly the new side of the one
-    before (KUKA-Script's four pairs, 1.9 MB a side: 73 s of the module's 128 s when spread)."""
-    return [pytest.param(p, marks=pytest.mark.xdist_group("history-" + p.split("/", 1)[0])) for p in pairs]
+    before (KUKA-Script's four pairs, 1.9 MB a side: 73 s of the module's 128 s when spread).
+    `sample`: a pair older than its repository's newest is marked ``slow`` (tests.conftest
+    earlier_pair: ``make test`` compares each repository's newest pair, ``make nightly`` all)."""
+    return [pytest.param(p, marks=[pytest.mark.xdist_group("history-" + p.split("/", 1)[0])]
+                         + ([pytest.mark.slow] if sample and p != "(absent)" and earlier_pair(p) else []))
+            for p in pairs]
 
 
-PAIRS = _by_repository(history_pairs() or ["(absent)"])
+PAIRS = _by_repository(history_pairs() or ["(absent)"], sample=True)
 
 
 @pytest.fixture(autouse=True)

@@ -22,7 +22,7 @@ from pathlib import Path
 import pytest
 
 from interp import realprograms as rp
-from tests.conftest import SHARED, SHARED_CORPUS, SHARED_HISTORY
+from tests.conftest import SHARED, SHARED_CORPUS, SHARED_HISTORY, earlier_pair
 
 pytestmark = [pytest.mark.corpus,
               pytest.mark.skipif(not (SHARED_CORPUS / "MANIFEST.csv").exists(), reason="../shared/krl-corpus absent")]
@@ -53,8 +53,7 @@ def earlier_version(root: Path) -> bool:
         rel = root.relative_to(SHARED_HISTORY)
     except ValueError:
         return False
-    repo, pair = rel.parts[0], rel.parts[1]
-    return pair != max(p.name for p in (SHARED_HISTORY / repo).iterdir() if p.is_dir())
+    return earlier_pair(f"{rel.parts[0]}/{rel.parts[1]}")
 
 
 def stops_of_backup(root: Path) -> list[tuple[str, str, list[str]]]:
