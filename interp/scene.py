@@ -172,7 +172,7 @@ def reaches(machine, points) -> int:
     from robot.planner import RobotModel  # noqa: PLC0415
 
     model = RobotModel(machine)
-    limits = [j.limit_deg for j in machine.joints[:6]]
+    limits = [j.limit_deg for j in machine.joints]
 
     def within(q) -> bool:
         return all(any(lo - 1e-6 <= float(x) + k <= hi + 1e-6 for k in (-360.0, 0.0, 360.0))

@@ -64,8 +64,8 @@ MESSAGES = {
 }
 
 
-STRUCT_COMPONENTS = frozenset(("X", "Y", "Z", "A", "B", "C", "S", "T") + tuple(f"A{i}" for i in range(1, 7))
-                              + tuple(f"E{i}" for i in range(1, 7)))
+STRUCT_COMPONENTS = frozenset(("X", "Y", "Z", "A", "B", "C", "S", "T", "A1", "A2", "A3", "A4", "A5", "A6",
+                               "E1", "E2", "E3", "E4", "E5", "E6"))
 """The components of a FRAME, POS, AXIS (and E6POS/E6AXIS) as EKI_SetFrame/GetFrame.. write them."""
 
 

@@ -63,6 +63,10 @@ MAX_WRITE_COILS = 1968      # 0x07B0
 MAX_WRITE_REGISTERS = 123   # 0x007B
 MAX_RW_WRITE = 121          # 0x0079 (function 23's write part)
 MBAP = struct.Struct(">HHHB")
+#: the MBAP header's bytes before the ones its length field counts (transaction, protocol, length)
+MBAP_PREFIX = 6
+#: function 22's request body (mask write register: address, AND mask, OR mask)
+MASK_WRITE_BODY = 6
 MAX_PDU = 253               # the largest PDU (Application Protocol 4.1: a 256-byte serial ADU less address and CRC)
 #: requests of one connection waiting to be answered before it stops reading its socket
 MAX_PENDING = 256
@@ -103,7 +107,7 @@ def check_request(pdu: bytes, bits: int, registers: int) -> int | None:
             return ILLEGAL_DATA_VALUE
         return ILLEGAL_DATA_ADDRESS if start + qty > size["bits" if fc == 15 else "registers"] else None
     if fc == 22:
-        if len(body) != 6:
+        if len(body) != MASK_WRITE_BODY:
             return ILLEGAL_DATA_VALUE
         (addr,) = struct.unpack(">H", body[:2])
         return ILLEGAL_DATA_ADDRESS if addr >= registers else None
@@ -143,13 +147,13 @@ class Connection(ServerRequestHandler):
         (an exception in its turn, after the answers of the requests before it)."""
         buf = self.buf
         used = 0
-        while len(buf) - used >= 6:
+        while len(buf) - used >= MBAP_PREFIX:
             tid, pid, length = struct.unpack_from(">HHH", buf, used)
-            if len(buf) - used < 6 + length:
+            if len(buf) - used < MBAP_PREFIX + length:
                 break
-            unit = buf[used + 6] if length else 0
-            pdu = bytes(buf[used + 7:used + 6 + length])
-            used += 6 + length
+            unit = buf[used + MBAP_PREFIX] if length else 0
+            pdu = bytes(buf[used + MBAP_PREFIX + 1:used + MBAP_PREFIX + length])
+            used += MBAP_PREFIX + length
             if pid != 0 or not pdu:
                 # not MODBUS (implementation guide 3.1.3), or no function code to answer: discarded
                 self.server.note(f"a frame of protocol {pid}, {len(pdu)} PDU bytes: discarded unanswered")

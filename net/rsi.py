@@ -143,8 +143,8 @@ class Rsi:
         self.on = False
         self.mode = "ABSOLUTE"
         self.fast = False
-        self.corr_axes = np.zeros(6)
-        self.corr_cart = np.zeros(6)
+        self.corr_axes = np.zeros(len(AXES))        # A1..A6 (KRL's components: robot/axismap.py)
+        self.corr_cart = np.zeros(len(CART))
         self.outputs: dict[int, float] = {}
         self.expect: list[int] = []          # IPOCs sent and not answered yet
         self.recent: list[int] = []          # the last IPOCs sent (an answer to one not expected is late)
@@ -360,7 +360,7 @@ class Rsi:
         self.silent = False
         self.stopped = False
         self.failed = None
-        self.q_on = np.array(ctl.axis_act(), dtype=float)[:6]
+        self.q_on = np.array(ctl.axis_act(), dtype=float)[:len(AXES)]
         s = self.hub.settings
         if s is not None and s.live and s.rsi is not None:
             host, port = s.rsi.address if s.rsi.address is not None else (LOOPBACK, self.ctx.port)
@@ -560,9 +560,9 @@ class Rsi:
         t = o.type
         if t == "ETHERNET":
             return float(self.outputs.get(idx, 0.0))
-        if t == "AXISCORRMON" and 1 <= idx <= 6:
+        if t == "AXISCORRMON" and 1 <= idx <= len(AXES):
             return float(self.corr_axes[idx - 1])
-        if t == "POSCORRMON" and 1 <= idx <= 6:
+        if t == "POSCORRMON" and 1 <= idx <= len(CART):
             return float(self.corr_cart[idx - 1])
         fn = BLOCKS.get(t)
         if fn is None:
@@ -576,13 +576,13 @@ class Rsi:
 
     def _apply(self) -> None:
         for obj in self.ctx.of_type("AXISCORR"):
-            v = np.array([self._input(obj, i) for i in range(1, 7)])
+            v = np.array([self._input(obj, i + 1) for i in range(len(AXES))])
             total = v if self.mode == "ABSOLUTE" else self.corr_axes + v
-            lo = np.array([obj.param(f"LowerLimA{i}", -1e9) for i in range(1, 7)])
-            hi = np.array([obj.param(f"UpperLimA{i}", 1e9) for i in range(1, 7)])
+            lo = np.array([obj.param(f"LowerLim{k}", -1e9) for k in AXES])
+            hi = np.array([obj.param(f"UpperLim{k}", 1e9) for k in AXES])
             self.corr_axes = np.clip(total, lo, hi)
         for obj in self.ctx.of_type("POSCORR"):
-            v = np.array([self._input(obj, i) for i in range(1, 7)])
+            v = np.array([self._input(obj, i + 1) for i in range(len(CART))])
             total = v if self.mode == "ABSOLUTE" else self.corr_cart + v
             lo = np.array([obj.param(f"LowerLim{k}", -1e9) for k in CART])
             hi = np.array([obj.param(f"UpperLim{k}", 1e9) for k in CART])
@@ -599,9 +599,9 @@ class Rsi:
                 self.stopped = True
         ctl = self.hub.ctl
         for obj in self.ctx.of_type("AXISCORRMON"):
-            for i in range(6):
-                if abs(self.corr_axes[i]) > obj.param(f"MaxA{i + 1}", 1e9):
-                    self.fail(ctl, MSG_MON + f" (A{i + 1})", MON_NUMBER)
+            for i, k in enumerate(AXES):
+                if abs(self.corr_axes[i]) > obj.param(f"Max{k}", 1e9):
+                    self.fail(ctl, MSG_MON + f" ({k})", MON_NUMBER)
                     return
         for obj in self.ctx.of_type("POSCORRMON"):
             if float(np.linalg.norm(self.corr_cart[:3])) > obj.param("MaxTrans", 1e9):
@@ -636,7 +636,7 @@ class Rsi:
         """The robot's packet of one sensor cycle: the SEND elements in the configuration's
         order (internal values, and channels grouped by element: ``Tag.A1``.. as attributes of
         one ``<Tag>``), then IPOC."""
-        q = np.array(ctl.axis_act(), dtype=float)[:6]
+        q = np.array(ctl.axis_act(), dtype=float)[:len(AXES)]
         fr = np.array(ctl.tcp_frame(), dtype=float)
         eth = self.ctx.eth
         dec = max(MIN_DECIMALS, min(16, int(eth.param("Precision", MIN_DECIMALS))))
@@ -650,7 +650,7 @@ class Rsi:
                     if name == "Delay":
                         vals = [str(self.late)]
                     elif name in ("RIst", "RSol"):
-                        vals = [_f(v, dec) for v in fr[:6]]
+                        vals = [_f(v, dec) for v in fr[:len(CART)]]
                     elif name in ("AIPos", "ASPos"):
                         vals = [_f(v, dec) for v in q]
                     else:

@@ -62,10 +62,10 @@ def param_name(typ: str, n: int) -> str | None:
         if 14 <= n <= 25:
             return "UpperLim" + AXIS_LIMITS[n - 14]
     if typ == "POSCORR":
-        if 1 <= n <= 6:
+        if 1 <= n <= len(CART_LIMITS):
             return "LowerLim" + CART_LIMITS[n - 1]
-        if 7 <= n <= 12:
-            return "UpperLim" + CART_LIMITS[n - 7]
+        if len(CART_LIMITS) < n <= 2 * len(CART_LIMITS):
+            return "UpperLim" + CART_LIMITS[n - 1 - len(CART_LIMITS)]
     return None
 
 

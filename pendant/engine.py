@@ -33,6 +33,7 @@ from pathlib import Path
 from interp.debug.engine import Engine as RunEngine
 from interp.debug.engine import LaunchConfig, Refused, thread_main
 from interp.runtime.writerules import admit
+from robot.axismap import E6AXIS_KEYS
 
 from .touchup import TouchUpError, touch_up as write_point
 from krl.limits import MAX_KRL_MESSAGES, MAX_WEB_EXPRESSION_CHARS
@@ -455,14 +456,14 @@ def jog(core: RunEngine, system: str, axis, step) -> list:
         raise Refused(f"jog: a step of at most {JOG_MAX_STEP:g} mm or deg")
     params = params_from(rt.sysvars.store).with_(ov_pro=100.0)
     if system == "AXIS":
-        # the robot's axes A1..An and its external axes E1..Em (robot/axismap.py): 1..6 are A1..A6,
-        # 7..12 E1..E6, as KRL's E6AXIS orders them
+        # the robot's axes and its external axes by their E6AXIS component (robot/axismap.py):
+        # 1..6 are A1..A6, 7..12 E1..E6, as KRL's E6AXIS orders them
         amap = rt.controller.model.axes
-        keys = [f"A{i}" for i in range(1, 7)] + [f"E{i}" for i in range(1, 7)]
-        if not isinstance(axis, int) or isinstance(axis, bool) or not 1 <= axis <= 12 \
+        keys = E6AXIS_KEYS
+        if not isinstance(axis, int) or isinstance(axis, bool) or not 1 <= axis <= len(keys) \
                 or keys[axis - 1] not in amap.model_keys:
-            raise Refused(f"jog: axis 1..{amap.n_robot} (A1..A{amap.n_robot})"
-                          + (f" or 7..{6 + amap.n_ext} (E1..E{amap.n_ext})" if amap.n_ext else ""))
+            raise Refused("jog: axis " + ", ".join(f"{i + 1} ({k})" for i, k in enumerate(keys)
+                                                   if k in amap.model_keys))
         target = amap.krl_components(rt.controller.axis_setpoint())
         target = {k: v for k, v in target.items() if k in amap.model_keys}
         target[keys[axis - 1]] += float(step)

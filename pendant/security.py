@@ -104,7 +104,7 @@ class Guard:
         given += qs.get("token", [])[:1]
         auth = headers.get("authorization", "")
         if auth.lower().startswith("token "):
-            given.append(auth[6:].strip())
+            given.append(auth[len("token "):].strip())
         if "cookie" in headers:
             c = SimpleCookie()
             try:

@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from krl.limits import MAX_WEB_FILE_BYTES
+from robot.axismap import CART_KEYS, EXT_KEYS, ROBOT_KEYS
 
 POINT_KEYS = ("X", "Y", "Z")
 
@@ -99,9 +100,9 @@ def taught_points(dat: Path, root: Path) -> list[dict]:
             T = frame_to_matrix(*base) @ frame_to_matrix(*frame)
             out.append({"name": dv.name, "line": dv.line, "frame": frame, "base": base_no,
                         "world": [round(float(x), 3) for x in np.asarray(T)[:3, 3]], "ext": _ext(v)})
-        elif all(f"A{i}" in v for i in range(1, 7)):
+        elif all(k in v for k in ROBOT_KEYS):
             out.append({"name": dv.name, "line": dv.line,
-                        "axes": [float(v[f"A{i}"]) for i in range(1, 7)], "ext": _ext(v)})
+                        "axes": [float(v[k]) for k in ROBOT_KEYS], "ext": _ext(v)})
         if len(out) >= 5000:
             break
     return out
@@ -109,8 +110,7 @@ def taught_points(dat: Path, root: Path) -> list[dict]:
 
 def _ext(v: dict) -> dict[str, float]:
     """The external axis components E1..E6 a point's value holds (numbers only)."""
-    return {f"E{i}": float(v[f"E{i}"]) for i in range(1, 7)
-            if isinstance(v.get(f"E{i}"), (int, float)) and not isinstance(v.get(f"E{i}"), bool)}
+    return {k: float(v[k]) for k in EXT_KEYS if isinstance(v.get(k), (int, float)) and not isinstance(v.get(k), bool)}
 
 
 def _base_data(root: Path) -> dict[int, tuple]:
@@ -158,10 +158,9 @@ def robot_view(machine, inputs: str | None = None) -> dict:
 
     amap = AxisMap.of(machine)
     joints = [j.name for j in machine.joints] + [f"joint_e{e.number}" for e in machine.external_axes]
-    krl_index = list(range(amap.n_robot)) + [6 + k for k in range(amap.n_ext)]
-    robroot = [0.0] * 6 if machine.external_kinematics else list(machine.robroot_frame)
+    robroot = [0.0] * len(CART_KEYS) if machine.external_kinematics else list(machine.robroot_frame)
     return {"name": machine.name, "urdf": build_urdf(machine), "robroot": robroot,
-            "joints": joints, "axis_index": krl_index, "units": [amap.unit(k) for k in amap.model_keys],
+            "joints": joints, "axis_index": list(amap.krl_index), "units": [amap.unit(k) for k in amap.model_keys],
             "keys": list(amap.model_keys), "cell": cell_view(inputs), "meshes": _meshes(machine),
             "capsules": {g: r / 1000.0 for g, r in capsule_radii(machine.reach_wrist_point_mm).items()},
             "start": start_position(machine, inputs)}

@@ -158,7 +158,7 @@ def arm_values(trafo: str, g: dict[str, float], limits, speeds, source: str, tra
     src = f"{source} (joint origins at A = 0)"
     lim = f"{source} (joint limits)"
     vel = f"{source} (joint velocities)"
-    axes = range(1, 7)
+    axes = range(1, len(limits) + 1)
     return {
         "$TRAFONAME": (trafo, trafo_source),
         "$KINCLASS": ("#STANDARD", _STANDARD_ARM),

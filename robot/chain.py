@@ -27,6 +27,10 @@ from scipy.spatial.transform import Rotation
 
 from .machine import OPWParams
 
+#: The standard arm's axis count (robot-model.md §3: A1..A6, the OPW form with a spherical wrist):
+#: the chains of the arm families; a SCARA's or palletizer's chain has fewer
+ARM_AXES = 6
+
 #: OPW's joint offsets for KUKA's zero pose (arm stretched forward; robot-model.md §4.2).
 OPW_OFFSETS_DEG = (0.0, -90.0, 0.0, 0.0, 0.0, 0.0)
 #: Geometry closer than this (mm, or a unit vector's component) counts as exact.
@@ -107,7 +111,7 @@ def chain_to_joints(fixed: list[np.ndarray], axes_local: list[np.ndarray]
     flange = np.eye(4)
     flange[:3, :3] = R @ fixed[n][:3, :3]
     flange[:3, 3] = R @ fixed[n][:3, 3]
-    if n != 6:
+    if n != ARM_AXES:
         clean = [np.round(v, 9) + 0.0 for v in origins]
         clean_axes = [np.where(np.abs(v) < 1e-12, 0.0, np.round(v, 12)) + 0.0 for v in axes]
         flange[np.abs(flange) < 1e-12] = 0.0
@@ -166,7 +170,7 @@ def opw_form(chain: Chain) -> OpwForm | None:
     R = np.eye(3)
     p = np.zeros(3)
     pts, dirs = [], []
-    for i in range(6):
+    for i in range(ARM_AXES):
         if i > 0:
             p = p + R @ F[i][:3, 3]
             R = R @ F[i][:3, :3]

@@ -741,7 +741,7 @@ class Controller:
 
     def axis_ret(self) -> np.ndarray | None:
         """``$AXIS_RET``: the axes where BRAKE (or an error) made the robot leave its path,
-        or None if that never happened (deg, shape (6,))."""
+        or None if that never happened (deg, KRL's order)."""
         return None if self._ret_q is None else self._ret_q.copy()
 
     # ================================================================= I/O
@@ -778,9 +778,9 @@ class Controller:
 
     # ================================================================= read-back
     def axis_act(self) -> np.ndarray:
-        """``$AXIS_ACT`` in KRL's order: A1..A6 (deg) read back from the MuJoCo model, shape (6,)
-        (0 for the axes of a robot with fewer than six, a SCARA's A5 and A6); then E1..En (mm,
-        deg) on a robot with external axes."""
+        """``$AXIS_ACT`` in KRL's order (robot/axismap.py ``to_krl``): A1..A6 (deg) read back from
+        the MuJoCo model (0 for the axes of a robot with fewer than six, a SCARA's A5 and A6); then
+        E1.. (mm, deg) on a robot with external axes or a seven-axis arm's redundancy."""
         return self.model.to_krl(self._axes_act())
 
     def _axes_act(self) -> np.ndarray:
@@ -810,8 +810,7 @@ class Controller:
         x, y, z, a, b, c = matrix_to_frame(T)
         s, t = self.model.status_turn(q)
         out = {"X": x, "Y": y, "Z": z, "A": a, "B": b, "C": c, "S": s, "T": t}
-        for i, v in enumerate(q[self.n:]):
-            out[f"E{i + 1}"] = float(v)
+        out.update(self.model.axes.e_components(q))
         return out
 
     @property
@@ -980,7 +979,7 @@ class Controller:
         cyc = arm.compiled_cycle(self._simcore) if arm is not None and not self.actuated else None
         if cyc is not None:
             # set_axes, axis_act and the flange site in one compiled call (the same numbers)
-            qa, T = np.empty(6), np.empty((4, 4))
+            qa, T = np.empty(self._q.shape[0]), np.empty((4, 4))
             self._tcp_prev = self._tcp_T[:3, 3].copy()
             try:
                 # with _tcp_read_back's product in numpy's own BLAS call (robot/mjcf.py
@@ -1201,7 +1200,7 @@ class Controller:
         n = self.n
         axes = np.asarray(corr.axes, dtype=float)        # KRL's A1..A6
         if np.any(axes):
-            out[:n] += axes[:n]
+            out[:n] += self.model.axes.from_krl(axes, fill=np.zeros(len(out)))[:n]
         cart = np.asarray(corr.cart, dtype=float)
         if np.any(cart):
             T = self.model.tcp(out[:n], self._tool_T, self._base_inv_T)
@@ -1264,7 +1263,7 @@ class Controller:
         for d, m in zip(step, lim):
             if d > m:
                 i = max(range(len(step)), key=lambda j: step[j] / lim[j])
-                name = f"A{i + 1}" if i < 6 else f"E{i - 5}"
+                name = self.model.axes.model_keys[i]
                 raise RobotError(f"speed limit exceeded {name}: CP path through a singularity")
 
     def _watch_collisions(self) -> None:

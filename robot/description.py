@@ -36,7 +36,9 @@ import numpy as np
 
 from scipy.spatial.transform import Rotation
 
+from .axismap import REDUNDANT_SLOTS, ROBOT_KEYS
 from .catalogue import arm_values
+from .frames import matrix_to_frame
 from .kinematics import Kinematics
 from .madavalues import MachineDataError
 
@@ -110,8 +112,9 @@ def _chain(urdf: Any, where: str) -> tuple[list, np.ndarray, list[str]]:
                 fixed = fixed @ origin
         else:
             raise MachineDataError(f"{where}: joint {j.name} is {j.type}: an arm of six revolute joints was expected")
-    if len(joints) != 6:
-        raise MachineDataError(f"{where}: {len(joints)} revolute joints between the root and {tip}: six were expected")
+    if len(joints) not in (len(ROBOT_KEYS), len(REDUNDANT_SLOTS)):
+        raise MachineDataError(f"{where}: {len(joints)} revolute joints between the root and {tip}: six (an arm) "
+                               f"or seven (a redundant arm) were expected")
     first = next(j for j in seq if j.type in ("revolute", "continuous"))
     return joints, fixed, [first.parent] + links
 
@@ -171,7 +174,7 @@ def _meshes(urdf: Any, path: Path, joints, links: list[str], machine, missing: l
         M = np.eye(4)
         M[:3, 3] = acc
         ours.append(M)
-    for k, (link_name, our_name) in enumerate(zip(links, ["base_link"] + [f"link_{i}" for i in range(1, 7)])):
+    for k, (link_name, our_name) in enumerate(zip(links, ["base_link"] + [f"link_{i + 1}" for i in range(len(joints))])):
         link = urdf.link_map.get(link_name)
         if link is None:
             continue
@@ -227,6 +230,59 @@ def _mesh_file(fname: str, path: Path) -> Path:
     return f
 
 
+def _redundant_machine(name: str, joints, tool: np.ndarray, where: str) -> Any:
+    """The model of a seven-axis arm's description (KUKA's LBR iiwa): its joints as the description
+    gives them (origins, axes, limits, speeds; robot/kinematics/redundant.py solves it), its flange
+    the description's ``tool0``. What a description does not give is stated in the provenance: each
+    axis's acceleration and jerk by robot/mada.py's rules for machine data without them, and the
+    Cartesian limits, approximation and in-position values of robot/data/kr6_r900.yaml (J3, the
+    redundancy, takes A3's). HOME is the description's zero (the LBR's upright position); no meshes
+    are read (the links are capsules)."""
+    # costs 0.0 s: robot/mada.py is loaded by every path that reads a description
+    from .mada import RULES, _jerk  # noqa: PLC0415 - robot/mada.py imports this module
+    from .machine import JointData, load_machine  # noqa: PLC0415
+
+    base = load_machine()
+    n = len(joints)
+
+    def per_axis(vals) -> tuple[float, ...]:
+        """A six-axis value per joint: A1..A6's by the joint's E6AXIS component, J3 (E1) A3's."""
+        return tuple(float(vals[ROBOT_KEYS.index(k if k in ROBOT_KEYS else "A3")]) for k in REDUNDANT_SLOTS)
+
+    out = []
+    for i, (origin, axis, lo, hi, vel) in enumerate(joints):
+        vmax = math.degrees(float(vel))
+        acc = vmax / 0.2                                          # RULES["max_acc_default"]
+        rpy = Rotation.from_matrix(origin[:3, :3]).as_euler("xyz")
+        out.append(JointData(
+            name=f"joint_a{i + 1}", axis=i + 1, limit_deg=(math.degrees(lo), math.degrees(hi)),
+            max_speed_deg_s=vmax, max_acc_deg_s2=acc, max_jerk_deg_s3=_jerk(acc, float(base.def_flt_ptp)),
+            origin_mm=tuple(float(v) * 1000.0 for v in origin[:3, 3]),     # type: ignore[arg-type]
+            joint_axis=tuple(float(v) for v in axis),                        # type: ignore[arg-type]
+            urdf_max_speed_deg_s=vmax, parent="base_link" if i == 0 else f"link_{i}", child=f"link_{i + 1}",
+            origin_rpy_rad=tuple(float(v) for v in rpy)))                  # type: ignore[arg-type]
+    x, y, z, w = Rotation.from_matrix(tool[:3, :3]).as_quat()
+    prov = {"joints": f"{where}: origins, axes, limits, velocities",
+            "max_acc_deg_s2": RULES["max_acc_default"], "$AXIS_JERK": RULES["max_jerk"],
+            "family": "robot/kinematics/redundant.py (seven revolute joints; J3 carried as E1)",
+            "cartesian limits, $APO_DIS_PTP, $IN_POS_MA": "robot/data/kr6_r900.yaml (J3 takes A3's)",
+            "home": "derived: the description's zero"}
+    zero = (0.0,) * n
+    probe = replace(base, joints=tuple(out), home_deg=zero, mastering_deg=zero, chain=None,
+                    flange_quat_wxyz=(float(w), float(x), float(y), float(z)),
+                    flange_rpy_rad=tuple(float(v) for v in Rotation.from_matrix(tool[:3, :3]).as_euler("xyz")),
+                    flange_pos_mm=tuple(float(v) * 1000.0 for v in tool[:3, 3]),
+                    robroot_frame=(0.0,) * 6, apo_dis_ptp_deg=per_axis(base.apo_dis_ptp_deg),
+                    in_pos_ma_deg=per_axis(base.in_pos_ma_deg), ptp_ramp_deg=(), ptp_friction=(),
+                    dynamics=None, external_axes=(), external_kinematics=(), name=name, source=where,
+                    trafoname="", raw={"family": "redundant"}, provenance=prov)
+    kin = Kinematics(probe)
+    flange = kin.forward(zero)
+    wrist = kin.joints.joint_point(zero, len(ROBOT_KEYS) - 1)
+    return replace(probe, reach_wrist_point_mm=float(np.linalg.norm(wrist - kin.joints.joint_point(zero, 1))),
+                   home_flange_pose=tuple(float(v) for v in matrix_to_frame(flange)))
+
+
 def load_description(path: str | Path, build: Any) -> Any:
     """The robot model (robot/machine.py ``MachineData``) of a URDF or xacro description (see the
     module docstring); `build` is robot/mada.py ``build_cited`` (the model of cited machine-data
@@ -246,10 +302,12 @@ def load_description(path: str | Path, build: Any) -> Any:
     except Exception as exc:  # noqa: BLE001 - the parser's errors name the problem
         raise MachineDataError(f"{where}: not a URDF robot description ({type(exc).__name__}: {exc})") from None
     joints, tool, links = _chain(urdf, where)
+    name = urdf.robot.name if getattr(urdf, "robot", None) is not None else p.stem
+    if len(joints) == len(REDUNDANT_SLOTS):
+        return _redundant_machine(name, joints, tool, where)
     g = _geometry(joints, tool, where)
     lims = [(math.degrees(lo), math.degrees(hi)) for _, _, lo, hi, _ in joints]
     speeds = [math.degrees(v) for *_, v in joints]
-    name = urdf.robot.name if getattr(urdf, "robot", None) is not None else p.stem
     machine = build(name, arm_values(f"#{name}", g, lims, speeds, where, where), where, where)
     rng = np.random.default_rng(64)
     kin = Kinematics(machine)

@@ -36,6 +36,8 @@ from typing import Any
 
 import numpy as np
 
+from .axismap import CART_KEYS as CART
+
 #: 4x4 identity, i.e. ``$NULLFRAME``.
 I4: np.ndarray = np.eye(4)
 I4.setflags(write=False)
@@ -67,7 +69,7 @@ def _six(f: Any) -> tuple[float, ...]:
         low = {str(k).lower(): v for k, v in f.items()}
         return tuple(float(low.get(k, 0.0)) for k in "xyzabc")
     vals = [float(v) for v in f]
-    if len(vals) != 6:
+    if len(vals) != len(CART):
         raise ValueError(f"a frame needs 6 components (X, Y, Z, A, B, C), got {len(vals)}")
     return tuple(vals)
 
@@ -140,7 +142,7 @@ def as_matrix(F: Any) -> np.ndarray:
     arr = np.asarray(F, dtype=float)
     if arr.shape == (4, 4):
         return arr
-    if arr.shape == (6,):
+    if arr.shape == (len(CART),):
         return frame_to_matrix(arr)
     raise ValueError(f"not a frame: shape {arr.shape}")
 

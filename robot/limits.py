@@ -30,6 +30,7 @@ from typing import Any
 
 import numpy as np
 
+from .axismap import ROBOT_KEYS, robot_slots
 from .frames import frame_to_matrix, inv_pos
 from .kinematics import Kinematics
 from .machine import load_machine
@@ -109,6 +110,17 @@ class MotionLimits:
                             tuple(float(v) for v in d["base_root"]) if d.get("base_root") else None)
 
 
+def axis_percentages(pcts: Any, machine: Any, size: int) -> np.ndarray:
+    """``$VEL_AXIS``/``$ACC_AXIS``'s A1..A6 percentages (`pcts`) per model axis (`size` of them,
+    robot/axismap.py): an axis in an A component takes that component's; an axis in an E component
+    (an external axis, a seven-axis arm's redundancy J3) 100 %."""
+    out = np.full(size, 100.0)
+    for i, k in enumerate(robot_slots(len(machine.joints))):
+        if k in ROBOT_KEYS:
+            out[i] = float(pcts[ROBOT_KEYS.index(k)])
+    return out
+
+
 def ptp_axis_speeds(params: Any, machine: Any, mode: str = DEFAULT_MODE) -> np.ndarray:
     """The programmed axis speeds of a PTP/SPTP motion, deg/s per axis (shape (n,): A1..An, a
     linear axis in mm/s; then the external axes E1..En in mm/s or deg/s):
@@ -116,9 +128,7 @@ def ptp_axis_speeds(params: Any, machine: Any, mode: str = DEFAULT_MODE) -> np.n
     §10; an external axis at 100 % of ``$VEL_AXIS``). The one formula: the planner plans with
     it, :func:`motion_limits` checks with it."""
     v_max = np.asarray(getattr(machine, "all_max_speed", machine.max_speed_deg_s), dtype=float)
-    n = len(machine.joints)
-    vel_axis = list(params.vel_axis)[:n] + [100.0] * (len(v_max) - n)
-    axes = v_max * np.asarray(vel_axis, dtype=float) / 100.0 * params.ov_pro / 100.0
+    axes = v_max * axis_percentages(params.vel_axis, machine, len(v_max)) / 100.0 * params.ov_pro / 100.0
     if mode == "T1":
         axes = axes * red_t1_pct(machine) / 100.0
     return axes
@@ -138,8 +148,7 @@ def ptp_axis_accelerations(params: Any, machine: Any) -> np.ndarray:
       the motion takes its planned time divided by the override: the END signals of every
       recording made at 85 % (robot/exactstop.py)."""
     a_max = np.asarray(getattr(machine, "all_max_acc", machine.max_acc_deg_s2), dtype=float)
-    n = len(machine.joints)
-    acc = np.asarray(list(params.acc_axis)[:n] + [100.0] * (len(a_max) - n), dtype=float)
+    acc = axis_percentages(params.acc_axis, machine, len(a_max))
     return np.minimum(a_max * acc / 100.0 * (params.ov_pro / 100.0) ** 2, ptp_ramp_accelerations(params, machine))
 
 
@@ -147,8 +156,7 @@ def ptp_ramp_accelerations(params: Any, machine: Any) -> np.ndarray:
     """The bound of :func:`ptp_axis_accelerations` at a reduced ``$VEL_AXIS``: ``v_i² / (2 R_i) ·
     ($OV_PRO%)²`` per axis (deg/s²; inf for an axis without ``R_i``)."""
     v_max = np.asarray(getattr(machine, "all_max_speed", machine.max_speed_deg_s), dtype=float)
-    n = len(machine.joints)
-    vel = np.asarray(list(params.vel_axis)[:n] + [100.0] * (len(v_max) - n), dtype=float)
+    vel = axis_percentages(params.vel_axis, machine, len(v_max))
     out = np.full(len(v_max), np.inf)
     ramp = getattr(machine, "ptp_ramp_deg", None)
     if ramp:

@@ -24,6 +24,8 @@ import numpy as np
 import yaml
 from scipy.spatial.transform import Rotation
 
+from .axismap import CART_KEYS
+
 DEFAULT_MACHINE_FILE = Path(__file__).with_name("data") / "kr6_r900.yaml"
 #: The project's robot library: robot YAMLs and machine data (``*.dat``) that a cell file names
 #: by their stem (``robot: kr180_r3200_pa``, robot/stimuli.py).
@@ -415,8 +417,8 @@ def load_machine(path: str | Path | None = None) -> MachineData:
         flange_quat_wxyz=(float(w), float(x), float(y), float(z)),
         flange_rpy_rad=_floats(fl_rpy),  # type: ignore[arg-type]
         flange_pos_mm=_floats(fl_pos),  # type: ignore[arg-type]
-        robroot_frame=_floats(doc.get("robroot_mm_deg", [0.0] * 6)),
-        default_tool_frame=_floats(mdf.get("tool_data_1_mm_deg", [0.0] * 6)),
+        robroot_frame=_floats(doc.get("robroot_mm_deg", [0.0] * len(CART_KEYS))),
+        default_tool_frame=_floats(mdf.get("tool_data_1_mm_deg", [0.0] * len(CART_KEYS))),
         status_phi_deg=float(doc["status_bit1_phi_deg"]),
         vel_ma=_cart(md["vel_ma"]),
         acc_ma=_cart(md["acc_ma"]),

@@ -38,6 +38,10 @@ from scipy.spatial.transform import Rotation
 from krl.project import backup_of, find_backups, machine_data_file
 
 from . import catalogue
+from .axismap import CART_KEYS, EXT_KEYS, ROBOT_KEYS
+
+#: ``$EX_KIN``'s external kinematic systems ET1..ET6 (KSS kinematic systems manual)
+MAX_EXT_KINEMATICS = 6
 from .chain import chain_forward, chain_to_joints
 from .datalist import DataListError, DataValue, read_data_list
 from .identified import apply_identified, identified_file
@@ -199,8 +203,8 @@ def _external(machine: dict[str, DataValue], source: str, prov: dict[str, str], 
     if num is None or not num.value:
         return (), ()
     n = num.value
-    if isinstance(n, bool) or not isinstance(n, int) or not 0 <= n <= 6:
-        raise MachineDataError(f"{num.where()}: $EX_AX_NUM={krl_value(n)}: 0..6 external axes were expected")
+    if isinstance(n, bool) or not isinstance(n, int) or not 0 <= n <= len(EXT_KEYS):
+        raise MachineDataError(f"{num.where()}: $EX_AX_NUM={krl_value(n)}: 0..{len(EXT_KEYS)} external axes were expected")
     prov["$EX_AX_NUM"] = num.where()
     types = machine.get("$AXIS_TYPE")
     kinds = []
@@ -246,7 +250,7 @@ def _external(machine: dict[str, DataValue], source: str, prov: dict[str, str], 
     if ex is not None and isinstance(ex.value, dict):
         prov["$EX_KIN"] = ex.where()
         used: set[int] = set()
-        for t in range(1, 7):
+        for t in range(1, MAX_EXT_KINEMATICS + 1):
             sysname = ex.value.get(f"ET{t}", "#NONE")
             if sysname in (None, "#NONE"):
                 continue
@@ -380,7 +384,7 @@ def machine_from_values(machine: dict[str, DataValue], robcor: dict[str, DataVal
     ext_axes, ext_kin = _external(machine, source, prov, flt_ptp, home_ext)
 
     md = dict(base.motion_defaults)
-    md["tool_data_1_mm_deg"] = [0.0] * 6
+    md["tool_data_1_mm_deg"] = [0.0] * len(CART_KEYS)
     R = flange[:3, :3]
     x, y, z, w = Rotation.from_matrix(R).as_quat()
     with warnings.catch_warnings():
@@ -449,8 +453,8 @@ def _home(vals, prov) -> tuple[tuple[float, ...], dict[str, float]]:
             return (0.0, -90.0, 90.0, 0.0, 0.0, 0.0), {}
         label, where = "$H_POS", dv.where()
     prov[label] = where
-    ext = {f"E{i}": _num(v[f"E{i}"], where, f"{label}.E{i}") for i in range(1, 7) if f"E{i}" in v}
-    return tuple(_num(v.get(f"A{i}", 0.0), where, f"{label}.A{i}") for i in range(1, 7)), ext
+    ext = {k: _num(v[k], where, f"{label}.{k}") for k in EXT_KEYS if k in v}
+    return tuple(_num(v.get(k, 0.0), where, f"{label}.{k}") for k in ROBOT_KEYS), ext
 
 
 def _load(robcor, prov) -> dict[str, Any]:

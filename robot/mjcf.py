@@ -38,6 +38,7 @@ from scipy.spatial.transform import Rotation
 from .blas import numpy_cblas
 from .capsules import capsule_radii, group_of
 from .frames import as_matrix, frame_to_matrix, inv_pos
+from .kinematics.compiled import COMPILED_AXES
 from .machine import MachineData, load_machine
 
 #: Servo gains of the actuated mode (robot-model.md §11: kp 2e4 + kv 400 -> 0.175 deg max error).
@@ -130,8 +131,11 @@ def build_mjcf(machine: MachineData | None = None, actuated: bool = False, *,
     radii = {g: r / 1000.0 for g, r in capsule_radii(m.reach_wrist_point_mm).items()}
     if "base_link" in meshes:        # the description's mesh (robot/description.py)
         lines.append(f'      <geom name="base_geom" type="mesh" mesh="mesh_base_link" rgba="0.2 0.2 0.2 1"{base_bits}/>')
-    else:
+    elif np.linalg.norm(o1) > 1e-6:
         lines.append(f'      <geom name="base_geom" type="capsule" size="{_f(radii["base"])}" fromto="0 0 0 {_vec(o1)}" '
+                     f'rgba="0.2 0.2 0.2 1"{base_bits}/>')
+    else:                            # A1's origin at the base's (an LBR's description): a sphere
+        lines.append(f'      <geom name="base_geom" type="sphere" size="{_f(radii["base"])}" '
                      f'rgba="0.2 0.2 0.2 1"{base_bits}/>')
     indent = "      "
     for i, j in enumerate(joints):
@@ -266,7 +270,7 @@ def _arm_cycle(arm: "ArmModel", sc: Any) -> Any:
     :meth:`ArmModel.compiled_cycle`). ``mj_kinematics`` is looked up in the MuJoCo library the
     ``mujoco`` package ships and has loaded (the same library: loading it again gives the
     loaded one)."""
-    if arm.actuated or len(arm._eadr) or arm._n != 6 or arm._linear is not None:
+    if arm.actuated or len(arm._eadr) or arm._n != COMPILED_AXES or arm._linear is not None:
         return None
     try:
         libs = sorted(glob.glob(os.path.join(os.path.dirname(arm._mj.__file__), "libmujoco*")))

@@ -142,7 +142,7 @@ class MotionParams:
                 m = {str(k).upper(): y for k, y in x.items()}
                 return tuple(float(m[k]) if m.get(k) is not None else old[i]
                              for i, k in enumerate(keys))
-            return tuple(float(y) for y in list(x)[:6])
+            return tuple(float(y) for y in list(x)[:len(keys)])
 
         vel, acc, apo = v.get("VEL"), v.get("ACC"), v.get("APO")
         return MotionParams(

@@ -46,7 +46,8 @@ from .external import ExternalAxes
 from .dynamics import Inertia
 from .external_tcp import external_tcp
 from .kinematics import Kinematics
-from .motion import AXIS_KEYS, CART_KEYS, EXT_KEYS, MotionParams, MotionRequest, Trigger
+from .kinematics.compiled import COMPILED_AXES
+from .motion import AXIS_KEYS, CART_KEYS, MotionParams, MotionRequest, Trigger
 from .limits import (DEFAULT_MODE, T1_SPEED_MM_S, cp_path_speed, motion_limits, ptp_axis_accelerations,
                      ptp_axis_speeds, ptp_ramp_accelerations)
 from .profiles import FrictionProfile, PiecewiseProfile, Trapezoid
@@ -55,6 +56,8 @@ from .profiles import FrictionProfile, PiecewiseProfile, Trapezoid
 #: An axis jump (deg) between neighbouring planning samples of a CP path that means the
 #: path crosses a singularity (the IK had to flip the wrist to keep the status).
 SINGULAR_JUMP_DEG = 90.0
+#: Tries of a spline piece's end tangents: halved up to 4 times, then zero (a straight piece).
+CUSP_ATTEMPTS = 6
 #: Factor on the axis maximum speed above which an interpolated CP setpoint is rejected.
 CP_SPEED_LIMIT_FACTOR = 1.5
 #: Largest axis step (deg) between the planning samples of a CP path (axis speed and
@@ -394,7 +397,7 @@ class CatmullRomPiece(_Piece):
         # no cusp or loop: the curve must keep moving towards P2 (tangent · chord > 0); else
         # the end tangents are shortened (halved up to 4 times, then zero: a straight piece
         # whose junctions are corners)
-        for attempt in range(6):
+        for attempt in range(CUSP_ATTEMPTS):
             c1 = m1
             c2 = 3.0 * chord - 2.0 * m1 - m2
             c3 = -2.0 * chord + m1 + m2
@@ -774,7 +777,7 @@ class CartSegment(Segment):
         if self._c_path is None:
             self._c_path = False
             sc = kinematics.compiled_module()
-            if sc is not None and len(self.q0) == 6 and self.model.n == 6 and not self.joint_ori:
+            if sc is not None and len(self.q0) == self.model.n == COMPILED_AXES and not self.joint_ori:
                 self._c_path = _cart_path(sc, self) or False
         return self._c_path
 
@@ -805,7 +808,7 @@ class CartSegment(Segment):
         not run the compiled inverse as it stands or some pose needs the Python code (the
         caller solves pose by pose, which raises the error)."""
         c = self.compiled_inverse()
-        if not c or not poses or len(ref) != 6:
+        if not c or not poses or len(ref) != COMPILED_AXES:
             return None
         R = np.array([pr[1] for pr in poses], dtype=float)
         p = np.array([pr[0] for pr in poses], dtype=float)
@@ -955,7 +958,7 @@ def _matrix_of(frame: Any) -> np.ndarray:
         v = np.array(frame, dtype=float)
     except (TypeError, ValueError):
         return frame_to_matrix(*frame)
-    if v.shape != (6,):
+    if v.shape != (len(CART_KEYS),):
         return frame_to_matrix(*frame)
     return _kept(_MATRIX_OF, v.tobytes(), lambda: frame_to_matrix(*frame)).copy()
 
@@ -1024,24 +1027,26 @@ def _cart_target(req_target: dict[str, float], start_T: np.ndarray, relative: bo
     return frame_to_matrix(*_apply_partial(start6, req_target))
 
 
-def _ext_target(q0: np.ndarray, target: dict[str, float], relative: bool, n: int) -> np.ndarray:
+def _ext_target(q0: np.ndarray, target: dict[str, float], relative: bool, amap: AxisMap) -> np.ndarray:
     """``q0`` (A1..An, E1..En) with its external axes set from the target's E components
-    (relative: added), the rest kept; ``q0`` itself without external axes."""
+    (relative: added), the rest kept; ``q0`` itself without external axes (`amap`: the model's
+    robot/axismap.py map)."""
+    n = amap.n_robot
     if len(q0) <= n:
         return q0
     out = q0.copy()
-    for i, key in enumerate(EXT_KEYS[:len(q0) - n]):
+    for i, key in enumerate(amap.ext_keys[:len(q0) - n]):
         if key in target:
             out[n + i] = (q0[n + i] if relative else 0.0) + float(target[key])
     return out
 
 
-def _check_complete(req: MotionRequest, n: int) -> None:
+def _check_complete(req: MotionRequest, robot_keys: tuple[str, ...]) -> None:
     t = req.target
     if req.relative or req.kind in ("CIRC", "SCIRC", "SPLINE"):
         raise RobotError("BCO run: the first motion must be a PTP or LIN to a complete target")
     if req.is_axis_target:
-        ok = all(k in t for k in AXIS_KEYS[:n])
+        ok = all(k in t for k in robot_keys)
     else:
         ok = all(k in t for k in CART_KEYS)
     if not ok:
@@ -1059,7 +1064,7 @@ def plan(req: MotionRequest, q_start: np.ndarray, model: RobotModel, *,
     """
     p: MotionParams = req.params
     if first:
-        _check_complete(req, model.n)
+        _check_complete(req, model.axes.robot_keys)
     if p.ipo_mode == "TCP":
         model = external_tcp(model)      # the fixed tool in the workpiece frame
     elif p.ipo_mode != "BASE":
@@ -1087,7 +1092,7 @@ def _plan_joint(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_T:
     n = model.n
     if req.is_axis_target:
         # the robot's axes A1..An (an A(n+1)..A6 of the target has no axis: ignored), then E
-        keys = AXIS_KEYS[:n] + EXT_KEYS[:len(q0) - n]
+        keys = model.axes.model_keys[:len(q0)]
         if req.relative:
             q1 = q0 + np.array([float(t.get(k, 0.0)) for k in keys])
         else:
@@ -1097,7 +1102,7 @@ def _plan_joint(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_T:
         T1 = _cart_target(t, start_T, req.relative, req.rel_frame)
         s = int(t["S"]) if "S" in t and not req.relative else None
         tt = int(t["T"]) if "T" in t and not req.relative else None
-        q1 = model.ik(T1, inv_pos(tool_T), base_T, s, tt, _ext_target(q0, t, req.relative, n))
+        q1 = model.ik(T1, inv_pos(tool_T), base_T, s, tt, _ext_target(q0, t, req.relative, model.axes))
         if len(q1) > n:
             model.check_limits(q1)
     dq = np.abs(q1 - q0)
@@ -1261,7 +1266,7 @@ def _plan_cart(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_T: 
     for kind, tgt, aux, ca, prm, _ in items:
         if any(k in tgt for k in AXIS_KEYS):
             # an axis target for a CP motion: its TCP pose
-            qa = np.array([float(tgt[k]) if k in tgt else 0.0 for k in AXIS_KEYS[:model.n]])
+            qa = np.array([float(tgt[k]) if k in tgt else 0.0 for k in model.axes.robot_keys])
             if req.relative:
                 raise RobotError("CP _REL motion with an axis target")
             T1 = model.tcp(qa, tool_T, inv_pos(base_T))
@@ -1342,7 +1347,7 @@ def _plan_cart(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_T: 
     W = float(sum(weights))
     n = model.n
     q_end = _ext_target(q0, req.target if req.kind != "SPLINE" else
-                        (req.segments[-1].target if req.segments else {}), req.relative, n)
+                        (req.segments[-1].target if req.segments else {}), req.relative, model.axes)
     if len(q0) > n:
         model.check_limits(np.concatenate([q0[:n], q_end[n:]]))
     seg = CartSegment(req, q0, q_end, Trapezoid.plan(math.inf, math.inf), math.inf,
@@ -1590,7 +1595,7 @@ def resolved_target(seg: Segment) -> MotionRequest:
     suspended by BRAKE when the interrupt routine moved the robot)."""
     req = seg.req
     if not seg.cart:
-        tgt = {k: float(v) for k, v in zip(AXIS_KEYS[:seg.model.n], seg.q1)}
+        tgt = {k: float(v) for k, v in zip(seg.model.axes.robot_keys, seg.q1)}
         kind = "PTP"
     else:
         T = seg.model.tcp(seg.q1, seg.tool_T, seg.base_inv_T)

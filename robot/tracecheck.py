@@ -36,6 +36,7 @@ import tempfile
 from pathlib import Path
 from typing import Any
 
+from robot.axismap import ROBOT_KEYS
 from robot.errors import RobotError
 
 #: The corpus backup whose machine data gives the benchmark's KR 210 R2700-2.
@@ -122,8 +123,8 @@ def random_program(seed: int, machine: Any, trace: Any, cell_path: str | None = 
 
     def params() -> MotionParams:
         p = P0.with_(vel_cp=rng.uniform(0.1, 1.2) * k, acc_cp=rng.uniform(0.8, 2.3),
-                     vel_axis=tuple(rng.uniform(20.0, 100.0) for _ in range(6)),
-                     acc_axis=tuple(rng.uniform(40.0, 100.0) for _ in range(6)),
+                     vel_axis=tuple(rng.uniform(20.0, 100.0) for _ in ROBOT_KEYS),
+                     acc_axis=tuple(rng.uniform(40.0, 100.0) for _ in ROBOT_KEYS),
                      apo_cptp=rng.uniform(5.0, 100.0), apo_cdis=rng.uniform(1.0, 60.0) * k,
                      apo_cvel=rng.uniform(20.0, 100.0), apo_cori=rng.uniform(1.0, 20.0),
                      vel_ori1=rng.uniform(50.0, 200.0), ov_pro=rng.choice((100.0, 100.0, 70.0, 35.0)))

@@ -12,6 +12,7 @@
 
 from __future__ import annotations
 
+from robot.axismap import ROBOT_KEYS
 from robot.motion import MotionParams, MotionRequest, SplineSegment
 
 from .convert import num, trunc_int
@@ -50,8 +51,8 @@ def params_from(store: dict, link=None) -> MotionParams:
         vel_ori2=_f(vel.f["ORI2"], d.vel_ori2),
         acc_cp=_f(acc.f["CP"], d.acc_cp), acc_ori1=_f(acc.f["ORI1"], d.acc_ori1),
         acc_ori2=_f(acc.f["ORI2"], d.acc_ori2),
-        vel_axis=tuple(_f(v, 100.0) for v in va[:6]),
-        acc_axis=tuple(_f(v, 100.0) for v in aa[:6]),
+        vel_axis=tuple(_f(v, 100.0) for v in va[:len(ROBOT_KEYS)]),     # A1..A6 (robot/axismap.py)
+        acc_axis=tuple(_f(v, 100.0) for v in aa[:len(ROBOT_KEYS)]),
         apo_cptp=_f(apo.f["CPTP"], d.apo_cptp), apo_cdis=_f(apo.f["CDIS"], d.apo_cdis),
         apo_cvel=_f(apo.f["CVEL"], d.apo_cvel), apo_cori=_f(apo.f["CORI"], d.apo_cori),
         tool=_frame(store["$TOOL"]), base=_frame(store["$BASE"]),

@@ -57,7 +57,7 @@ class BackwardRefused(Exception):
 @dataclass
 class MotionRecord:
     """One executed motion as backward motion needs it: the planned start and end axes
-    (deg, (6,)), the programmed target, the frames ($TOOL, $BASE as X..C mm/deg), the speed
+    (deg, KRL's order: robot/axismap.py), the programmed target, the frames ($TOOL, $BASE as X..C mm/deg), the speed
     parameters (robot.motion.MotionParams) and, for a CIRC, a point in the middle of the
     executed arc (X, Y, Z mm in $BASE) that the backward CIRC passes."""
 

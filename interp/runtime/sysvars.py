@@ -26,7 +26,7 @@ from pathlib import Path
 from krl.semantics import types as T
 from krl.semantics.builtins import load_builtins
 from krl.semantics.symbols import make_array, system_scopes
-from robot.axismap import E6AXIS_KEYS, EXT_KEYS, AxisMap
+from robot.axismap import CART_KEYS, E6AXIS_KEYS, EXT_KEYS, ROBOT_KEYS, AxisMap
 from robot.motion import MotionParams
 
 from .convert import frame_tuple
@@ -78,7 +78,7 @@ def axis_struct(values) -> Struct:
 
 def pos_struct(d: dict) -> Struct:
     """An E6POS of a dict {X, Y, Z, A, B, C, S, T, E1..E6} (the E components it lacks: 0)."""
-    vals = {k: float(d[k]) for k in ("X", "Y", "Z", "A", "B", "C")}
+    vals = {k: float(d[k]) for k in CART_KEYS}
     vals["S"] = int(d.get("S", 0))
     vals["T"] = int(d.get("T", 0))
     for e in EXT_KEYS:
@@ -109,9 +109,9 @@ class SysVars:
             "$VEL": {"CP": p.vel_cp, "ORI1": p.vel_ori1, "ORI2": p.vel_ori2},
             "$ACC": {"CP": p.acc_cp, "ORI1": p.acc_ori1, "ORI2": p.acc_ori2},
             "$APO": {"CPTP": int(p.apo_cptp), "CDIS": p.apo_cdis, "CVEL": int(p.apo_cvel), "CORI": p.apo_cori},
-            "$BASE": dict(zip("XYZABC", [0.0] * 6)),
-            "$TOOL": dict(zip("XYZABC", [0.0] * 6)),
-            "$WORLD": dict(zip("XYZABC", [0.0] * 6)),
+            "$BASE": dict.fromkeys(CART_KEYS, 0.0),
+            "$TOOL": dict.fromkeys(CART_KEYS, 0.0),
+            "$WORLD": dict.fromkeys(CART_KEYS, 0.0),
             "$ROBROOT": dict(zip("XYZABC", [float(x) for x in m.robroot_frame])),
             "$LOAD": {"M": -1.0},
         }
@@ -126,9 +126,9 @@ class SysVars:
                         v.f[k] = x
             self.store[key] = v
         s = self.store
-        for i in range(12):
-            s["$VEL_AXIS"].data[i] = float(p.vel_axis[0]) if i < 6 else 100.0
-            s["$ACC_AXIS"].data[i] = float(p.acc_axis[0]) if i < 6 else 100.0
+        for i, k in enumerate(E6AXIS_KEYS):          # A1..A6 the INITMOV values, E1..E6 100 %
+            s["$VEL_AXIS"].data[i] = float(p.vel_axis[0]) if k in ROBOT_KEYS else 100.0
+            s["$ACC_AXIS"].data[i] = float(p.acc_axis[0]) if k in ROBOT_KEYS else 100.0
         for key in ("$FLAG", "$CYCFLAG"):
             a = s[key]
             a.data[:] = [False] * len(a.data)
@@ -198,8 +198,9 @@ class SysVars:
             text = list(name[:len(data)])
             data[:len(text)] = text
             data[len(text):] = [make_value(T.CHAR)] * (len(data) - len(text))
-        limits = [(i, j.limit_deg) for i, j in enumerate(m.joints)]
-        limits += [(5 + e.number, e.limit) for e in m.external_axes if e.kind != "endless"]
+        index = AxisMap.of(m).krl_index          # each model axis's component (robot/axismap.py)
+        limits = [(index[i], j.limit_deg) for i, j in enumerate(m.joints)]
+        limits += [(index[len(m.joints) + k], e.limit) for k, e in enumerate(m.external_axes) if e.kind != "endless"]
         for i, (lo, hi) in limits:
             s["$SOFTN_END"].data[i] = float(lo)
             s["$SOFTP_END"].data[i] = float(hi)
@@ -533,7 +534,7 @@ def _err(sv: SysVars):
 
 
 def _nullframe(sv: SysVars):
-    return struct_of("FRAME", dict(zip("XYZABC", [0.0] * 6)))
+    return struct_of("FRAME", dict.fromkeys(CART_KEYS, 0.0))
 
 
 def _ro_const(v):
@@ -561,13 +562,13 @@ def _vel_axis_act(sv: SysVars) -> Arr:
     m = ctl.machine
     top = m.all_max_speed
     vel = ctl.axis_vel_act()
-    data = [0.0] * 12
-    for i, v in enumerate(vel[:12]):
-        # KRL order: A1..A6, E1..; the model's: A1..An, E1.. (a SCARA has no A5, A6)
-        k = (i if i < m.n_axes else None) if i < 6 else m.n_axes + (i - 6)
-        if k is not None and k < len(top) and top[k] > 0:
-            data[i] = float(v) / top[k] * 100.0
-    return Arr(T.Array(T.REAL, (12,)), (12,), data)
+    data = [0.0] * len(E6AXIS_KEYS)
+    amap = ctl.model.axes
+    # KRL order: A1..A6, E1..; each model axis at its component (robot/axismap.py)
+    for i, (k, v) in enumerate(zip(amap.krl_index, amap.from_krl(vel))):
+        if i < len(top) and top[i] > 0:
+            data[k] = float(v) / top[i] * 100.0
+    return Arr(T.Array(T.REAL, (len(data),)), (len(data),), data)
 
 
 def _torque_axis_act(sv: SysVars) -> Arr:

@@ -23,6 +23,9 @@ try:  # the compiled hot path (robot/build.py); absent without a build: the Pyth
 except ImportError:
     _simcore = None
 
+#: The axis count of the compiled core's arm (robot/simcore.pyx: six rotary axes, no external
+#: axis): a segment of another model runs the Python code
+COMPILED_AXES = 6
 #: Use the compiled hot path (robot/kinematics/fastpath.py compiled, robot/simcore.pyx) when it
 #: is built; False: the Python code (the reference: the two agree bit for bit,
 #: tests/robot/test_simcore.py)

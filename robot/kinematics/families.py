@@ -17,10 +17,12 @@ from .numeric import Numeric
 from .opw import OPW
 from .palletizer4 import Palletizer4
 from .palletizer5 import Palletizer5
+from .redundant import Redundant
 from .scara import Scara
 
-#: The families, most specific first; the numeric family takes any six-axis arm the others do not.
-FAMILIES = (Palletizer4, Palletizer5, Scara, OPW, Numeric)
+#: The families, most specific first; the numeric family takes any six-axis arm the others do not,
+#: the redundant family a seven-axis arm (from a robot description: robot/description.py).
+FAMILIES = (Palletizer4, Palletizer5, Scara, OPW, Numeric, Redundant)
 
 
 def machine_geometry(values: dict[str, Any], source: str, prov: dict[str, str], a4fix: bool,

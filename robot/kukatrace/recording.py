@@ -40,6 +40,8 @@ import numpy as np
 
 from krl.limits import MAX_RECORDING_BYTES, MAX_RECORDING_COLUMNS
 
+from ..axismap import ROBOT_KEYS
+
 from ..exactstop import override_interval
 
 #: the name suffixes of the two files of a recording (case-insensitive)
@@ -48,7 +50,9 @@ PROG_SUFFIX = "_PROG.TXT"
 #: the IPO cycle of a KR C4 (s): the samples' step
 IPO_CYCLE_S = 0.012
 #: the columns given in degrees (read as radians)
-ANGLE_COLUMNS = ("A_Act", "B_Act", "C_Act") + tuple(f"AxisPos_Act{i}" for i in range(1, 7))
+#: the axis columns: AxisPos_Act1..6 (A1..A6, robot/axismap.py)
+AXIS_COLUMNS = tuple(f"AxisPos_Act{k[1:]}" for k in ROBOT_KEYS)
+ANGLE_COLUMNS = ("A_Act", "B_Act", "C_Act") + AXIS_COLUMNS
 #: PROG.TXT's motion types and the KRL names the project uses for them
 TYPE_NAMES = {"CIR": "CIRC"}
 
@@ -228,7 +232,7 @@ def read_ipo(path: Path) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray
     t = data[:, 0].copy()
     if len(t) and (not np.all(np.isfinite(t)) or np.any(np.diff(t) < 0)):
         raise RecordingError(f"{path}: the time column ({head[0].strip()}) is not finite and ascending")
-    axes = np.degrees(np.column_stack([col[f"AxisPos_Act{i}"] for i in range(1, 7)]))
+    axes = np.degrees(np.column_stack([col[c] for c in AXIS_COLUMNS]))
     tcp = np.column_stack([col["X_Act"], col["Y_Act"], col["Z_Act"],
                            np.degrees(col["A_Act"]), np.degrees(col["B_Act"]), np.degrees(col["C_Act"])])
     speed = col["CartVel_Act"].copy() if "CartVel_Act" in col else np.full(len(t), np.nan)

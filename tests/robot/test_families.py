@@ -20,7 +20,10 @@ from robot.machine import ROBOT_LIBRARY, load_machine
 
 #: A robot of each family: a library robot's name, "yaml" for the KR 6 R900 yaml, or a test's fixture
 EXAMPLES = {"opw": "yaml", "palletizer4": "kr180_r3200_pa", "palletizer5": "kr180_r3200_pa5",
-            "scara": "kr6_r500_z200", "numeric": "numeric_robot"}
+            "scara": "kr6_r500_z200", "numeric": "numeric_robot", "redundant": "iiwa_robot"}
+#: a seven-axis arm's description (read in place: ../shared is test data)
+IIWA = (Path(__file__).resolve().parents[2].parent / "shared" / "robots" / "descriptions" / "kuka_experimental"
+        / "kuka_lbr_iiwa_support" / "urdf" / "lbr_iiwa_14_r820.urdf")
 
 
 def missing_operations(cls: type) -> list[str]:
@@ -96,12 +99,20 @@ def numeric_robot(tmp_path):
     return load_robot(str(p))
 
 
+@pytest.fixture()
+def iiwa_robot():
+    """The seven-axis family's robot: KUKA's LBR iiwa 14 R820 as kuka_experimental describes it."""
+    if not IIWA.exists():
+        pytest.skip("../shared/robots/descriptions (kuka_lbr_iiwa_support) is not present")
+    return load_robot(IIWA)
+
+
 @pytest.mark.parametrize("fam", FAMILIES, ids=lambda f: f.name)
 def test_each_family_is_detected_from_machine_data_and_solves(fam, request):
     example = EXAMPLES[fam.name]
     if example == "yaml":
         machine = load_machine()
-    elif example == "numeric_robot":
+    elif example in ("numeric_robot", "iiwa_robot"):
         machine = request.getfixturevalue(example)
     else:
         machine = load_robot(example)

@@ -50,7 +50,7 @@ def _model_axes(ctl, ax, ext_from=None):
     set: "value invalid"), its external axes from `ext_from` (an E6POS: INVERSE's TOOLPOS) where
     it sets them, else from `ax` where set, else the robot's actual ones."""
     amap = ctl.model.axes
-    comps = {k: _real_leaf(ax, k) for k in amap.model_keys[:amap.n_robot]}
+    comps = {k: _real_leaf(ax, k) for k in amap.robot_keys}
     for k in amap.ext_keys:
         for src in (ax, ext_from):
             v = src.f.get(k, UNSET) if isinstance(src, Struct) else UNSET

@@ -52,6 +52,8 @@ class _Text:
 
 # A rule that recovered from an error carries an exception (the builder and the checks only
 # ask whether there is one); the rebuilt tree marks such rules with this one.
+#: the integers of one token in the Java engine's token data
+TOKEN_FIELDS = 6
 RECOVERED = RecognitionException("a rule recovered from a syntax error (parsed by the Java engine)")
 
 _PARSERS: dict[type, object] = {}
@@ -134,9 +136,9 @@ def _build(tk: list[int], names: list[str], data: list[int], labels: list, text:
            parents_too: bool = True):
     parser = _parser(bundle)
     classes = [_context_class(bundle.parser_cls, n) for n in names]
-    count = len(tk) // 6
-    if count * 6 != len(tk):
-        raise TreeDataError("token data is not a multiple of 6 integers")
+    count = len(tk) // TOKEN_FIELDS
+    if count * TOKEN_FIELDS != len(tk):
+        raise TreeDataError(f"token data is not a multiple of {TOKEN_FIELDS} integers")
     shared = (tk, (None, _Text(text)))
     made: list = [None] * count
 
