@@ -7,6 +7,7 @@ import math
 
 from krl.terminal import printable
 
+from .axismap import AxisMap
 from .kinematics import Kinematics
 from .machine import MachineData
 
@@ -17,7 +18,8 @@ _PARAMS = ("$TRAFONAME", "$KINCLASS", "$MAIN_AXIS", "$NUM_AX", "$AXIS_SEQ", "$TI
            "$DEF_A5LINK", "a5_led", "$AXIS_HOME[1]", "$H_POS", "home_deg", "$MAMES", "$IN_POS_CAR", "$IN_POS_ORI",
            "$DEF_FLT_PTP", "$DEF_FLT_CP", "$DEF_L_M", "max_speed_deg_s", "max_acc_deg_s2", "opw",
            "status_phi_deg", "reach_wrist_point_mm", "ipo_cycle_s", "motion_defaults", "default_load",
-           "$EX_AX_NUM", "$AXIS_TYPE", "E_speed", "$EX_KIN", "$ERSYSROOT", "meshes")
+           "$EX_AX_NUM", "$AXIS_TYPE", "E_speed", "$EX_KIN", "$ERSYSROOT", "meshes", "joints", "family",
+           "cartesian limits, $APO_DIS_PTP, $IN_POS_MA", "home")
 
 def _fmt(values, nd: int = 3) -> str:
     return ", ".join(f"{float(v):.{nd}f}".rstrip("0").rstrip(".") for v in values)
@@ -46,14 +48,15 @@ def show_lines(m: MachineData) -> list[str]:
     acc_d = "*" if m.provenance.get("max_acc_deg_s2", "").startswith("derived") else " "
     jerk_d = "*" if m.provenance.get("$AXIS_JERK", "").startswith("derived") else " "
     out.append("axes       axis   limits (deg)         v max (deg/s)  a max (deg/s2)  jerk (deg/s3)")
-    for j in m.joints:
-        out.append(f"           A{j.axis}   {j.limit_deg[0]:8.1f} .. {j.limit_deg[1]:7.1f}   {j.max_speed_deg_s:12.2f}"
+    amap = AxisMap.of(m)                 # each axis by its E6AXIS component (a seven-axis arm's J3: E1)
+    for key, j in zip(amap.robot_keys, m.joints):
+        out.append(f"           {key}   {j.limit_deg[0]:8.1f} .. {j.limit_deg[1]:7.1f}   {j.max_speed_deg_s:12.2f}"
                    f"  {j.max_acc_deg_s2:13.1f}{acc_d}  {j.max_jerk_deg_s3:12.1f}{jerk_d}"
                    + ("   linear (mm)" if getattr(j, "kind", "rotary") == "linear" else ""))
-    for e in m.external_axes:
+    for key, e in zip(amap.ext_keys, m.external_axes):
         u = "mm" if e.linear else "deg"
         lim = "endless" if e.kind == "endless" else f"{e.limit[0]:8.1f} .. {e.limit[1]:7.1f}"
-        out.append(f"           {e.name}   {lim:<20} {e.max_speed:12.2f}  {e.max_acc:13.1f}   "
+        out.append(f"           {key}   {lim:<20} {e.max_speed:12.2f}  {e.max_acc:13.1f}   "
                    f"{e.max_jerk:12.1f}   {e.kind} ({u})")
     if "*" in acc_d + jerk_d:
         out.append("           * derived by a rule (below), the machine data hold no value")
