@@ -40,6 +40,7 @@ from .axismap import REDUNDANT_SLOTS, ROBOT_KEYS
 from .catalogue import arm_values
 from .frames import matrix_to_frame
 from .kinematics import Kinematics
+from .machine import JointData, load_machine
 from .madavalues import MachineDataError
 
 MAX_DESCRIPTION_BYTES = 4 * 1024 * 1024
@@ -230,7 +231,7 @@ def _mesh_file(fname: str, path: Path) -> Path:
     return f
 
 
-def _redundant_machine(name: str, joints, tool: np.ndarray, where: str) -> Any:
+def _redundant_machine(name: str, joints, tool: np.ndarray, where: str, dynamics: Any) -> Any:
     """The model of a seven-axis arm's description (KUKA's LBR iiwa): its joints as the description
     gives them (origins, axes, limits, speeds; robot/kinematics/redundant.py solves it), its flange
     the description's ``tool0``. What a description does not give is stated in the provenance: each
@@ -238,10 +239,6 @@ def _redundant_machine(name: str, joints, tool: np.ndarray, where: str) -> Any:
     Cartesian limits, approximation and in-position values of robot/data/kr6_r900.yaml (J3, the
     redundancy, takes A3's). HOME is the description's zero (the LBR's upright position); no meshes
     are read (the links are capsules)."""
-    # costs 0.0 s: robot/mada.py is loaded by every path that reads a description
-    from .mada import RULES, _jerk  # noqa: PLC0415 - robot/mada.py imports this module
-    from .machine import JointData, load_machine  # noqa: PLC0415
-
     base = load_machine()
     n = len(joints)
 
@@ -252,18 +249,17 @@ def _redundant_machine(name: str, joints, tool: np.ndarray, where: str) -> Any:
     out = []
     for i, (origin, axis, lo, hi, vel) in enumerate(joints):
         vmax = math.degrees(float(vel))
-        acc = vmax / 0.2                                          # RULES["max_acc_default"]
+        acc, jerk, rules = dynamics(vmax, float(base.def_flt_ptp))
         rpy = Rotation.from_matrix(origin[:3, :3]).as_euler("xyz")
         out.append(JointData(
             name=f"joint_a{i + 1}", axis=i + 1, limit_deg=(math.degrees(lo), math.degrees(hi)),
-            max_speed_deg_s=vmax, max_acc_deg_s2=acc, max_jerk_deg_s3=_jerk(acc, float(base.def_flt_ptp)),
+            max_speed_deg_s=vmax, max_acc_deg_s2=acc, max_jerk_deg_s3=jerk,
             origin_mm=tuple(float(v) * 1000.0 for v in origin[:3, 3]),     # type: ignore[arg-type]
             joint_axis=tuple(float(v) for v in axis),                        # type: ignore[arg-type]
             urdf_max_speed_deg_s=vmax, parent="base_link" if i == 0 else f"link_{i}", child=f"link_{i + 1}",
             origin_rpy_rad=tuple(float(v) for v in rpy)))                  # type: ignore[arg-type]
     x, y, z, w = Rotation.from_matrix(tool[:3, :3]).as_quat()
-    prov = {"joints": f"{where}: origins, axes, limits, velocities",
-            "max_acc_deg_s2": RULES["max_acc_default"], "$AXIS_JERK": RULES["max_jerk"],
+    prov = {"joints": f"{where}: origins, axes, limits, velocities", **rules,
             "family": "robot/kinematics/redundant.py (seven revolute joints; J3 carried as E1)",
             "cartesian limits, $APO_DIS_PTP, $IN_POS_MA": "robot/data/kr6_r900.yaml (J3 takes A3's)",
             "home": "derived: the description's zero"}
@@ -283,12 +279,13 @@ def _redundant_machine(name: str, joints, tool: np.ndarray, where: str) -> Any:
                    home_flange_pose=tuple(float(v) for v in matrix_to_frame(flange)))
 
 
-def load_description(path: str | Path, build: Any) -> Any:
+def load_description(path: str | Path, build: Any, dynamics: Any = None) -> Any:
     """The robot model (robot/machine.py ``MachineData``) of a URDF or xacro description (see the
     module docstring); `build` is robot/mada.py ``build_cited`` (the model of cited machine-data
     values; passed in, as robot/mada.py reads descriptions through this module). Raises
     MachineDataError for a file that cannot be read, a chain that is not KUKA's arm, or a mesh it
-    cannot take."""
+    cannot take. `dynamics` is robot/mada.py ``default_dynamics`` (an axis's acceleration and jerk
+    by the machine-data rules), which a seven-axis arm's joints need."""
     # costs 0.93 s at start-up (python -X importtime, 2026-11-26: yourdfpy with trimesh and lxml)
     import yourdfpy  # noqa: PLC0415 - only for a description
 
@@ -304,7 +301,7 @@ def load_description(path: str | Path, build: Any) -> Any:
     joints, tool, links = _chain(urdf, where)
     name = urdf.robot.name if getattr(urdf, "robot", None) is not None else p.stem
     if len(joints) == len(REDUNDANT_SLOTS):
-        return _redundant_machine(name, joints, tool, where)
+        return _redundant_machine(name, joints, tool, where, dynamics)
     g = _geometry(joints, tool, where)
     lims = [(math.degrees(lo), math.degrees(hi)) for _, _, lo, hi, _ in joints]
     speeds = [math.degrees(v) for *_, v in joints]

@@ -112,6 +112,18 @@ def _structure(machine: dict[str, DataValue], source: str, prov: dict[str, str])
     return a4fix, a5link
 
 
+#: the ramp time (s) of an axis whose machine data give neither ``$AXIS_JERK`` nor ``$RAISE_TIME``
+#: (``RULES["max_acc_default"]``)
+DEFAULT_RAMP_S = 0.2
+
+
+def default_dynamics(vmax: float, flt_ptp: float) -> tuple[float, float, dict[str, str]]:
+    """(a_max, jerk, provenance) of an axis of speed `vmax` whose data give no acceleration (a robot
+    description): :data:`RULES`' ``max_acc_default`` and ``max_jerk`` (`flt_ptp`: ``$DEF_FLT_PTP``, ms)."""
+    acc = vmax / DEFAULT_RAMP_S
+    return acc, _jerk(acc, flt_ptp), {"max_acc_deg_s2": RULES["max_acc_default"], "$AXIS_JERK": RULES["max_jerk"]}
+
+
 def _jerk(acc: float, flt_ptp: float) -> float:
     """The jerk of an axis without ``$AXIS_JERK`` (``RULES["max_jerk"]``): the acceleration `acc`
     spread over the ``$DEF_FLT_PTP`` filter (ms; at least one 12 ms IPO cycle)."""
@@ -157,7 +169,7 @@ def _joint_limits(machine: dict[str, DataValue], source: str, prov: dict[str, st
                     raise MachineDataError(f"{machine['$RAISE_TIME'].where(i + 1)}: $RAISE_TIME[{i + 1}]="
                                            f"{raise_t[i]:g}: a positive time was expected")
             else:
-                ramp = 0.2
+                ramp = DEFAULT_RAMP_S
             acc = vmax / ramp
             j = _jerk(acc, flt_ptp)
         limit = (lo[i], hi[i])
@@ -599,7 +611,7 @@ def load_robot(path: str | Path) -> MachineData:
         # costs 0.015 s at start-up (python -X importtime, 2026-11-26; yourdfpy's 0.93 s when it reads)
         from .description import load_description  # noqa: PLC0415
 
-        return load_description(p, build_cited)
+        return load_description(p, build_cited, default_dynamics)
     if is_archive(p):
         try:
             with backup_source(p) as (folder, _shown):
