@@ -279,7 +279,7 @@ def _redundant_machine(name: str, joints, tool: np.ndarray, where: str, dynamics
                    home_flange_pose=tuple(float(v) for v in matrix_to_frame(flange)))
 
 
-def load_description(path: str | Path, build: Any, dynamics: Any = None) -> Any:
+def load_description(path: str | Path, build: Any, dynamics: Any) -> Any:
     """The robot model (robot/machine.py ``MachineData``) of a URDF or xacro description (see the
     module docstring); `build` is robot/mada.py ``build_cited`` (the model of cited machine-data
     values; passed in, as robot/mada.py reads descriptions through this module). Raises
