@@ -177,7 +177,7 @@ class Calls:
             raise
         if rt.trace is not None:
             rt.trace.write("call", rt.controller.time, name=routine.name,
-                             line=caller.line if caller is not None else None)
+                           line=caller.line if caller is not None else None)
         return frame
 
     def _locals_do_not_fit(self, local_sizes) -> None:

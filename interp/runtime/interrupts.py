@@ -43,7 +43,7 @@ class Interrupts:
             task.contexts.pop()
 
     def declare(self, number, cond_fn, handler_fn, name: str, frame: Frame,
-                       is_global: bool = False, line: int | None = None, watch: str = "") -> None:
+                is_global: bool = False, line: int | None = None, watch: str = "") -> None:
         """INTERRUPT DECL: `watch` is the condition's watch class (interp/runtime/watch.py
         ``watch_of``; "" = evaluated at every poll)."""
         task = self.rt.current_task
@@ -101,7 +101,7 @@ class Interrupts:
         task.contexts.append(ctx)
         if self.rt.trace is not None:
             self.rt.trace.write("interrupt", ctl.time, prio=irq.number, name=irq.name, line=task.line,
-                             phase="entry")
+                                phase="entry")
         ok = False
         try:
             irq.handler()
@@ -110,7 +110,7 @@ class Interrupts:
             task.contexts.pop()
             if self.rt.trace is not None:
                 self.rt.trace.write("interrupt", ctl.time, prio=irq.number, name=irq.name,
-                                 line=task.line, phase="exit")
+                                    line=task.line, phase="exit")
         if ok and task.irqs.armed and not task.in_poll:
             # the conditions are monitored while the handler runs: what it leaves (a timer it
             # restarted, a flag it reset) is sampled at its end, so the next rising edge counts

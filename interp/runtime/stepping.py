@@ -73,7 +73,7 @@ class Stepping:
         if self.rt.trace is not None:
             file, line = at if at is not None else (task.file, task.line)
             self.rt.trace.write("step_stop", self.rt.controller.time, mode=mode, file=file, line=line,
-                             id=motion, text=text)
+                                id=motion, text=text)
         if self.step_hook is not None:
             self.step_hook(task, mode, text)
 
