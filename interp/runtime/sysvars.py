@@ -30,7 +30,7 @@ from robot.axismap import CART_KEYS, E6AXIS_KEYS, EXT_KEYS, ROBOT_KEYS, AxisMap
 from robot.motion import MotionParams
 
 from .convert import frame_tuple
-from .errors import value_invalid
+from .errors import KrlRuntimeError, value_invalid
 from .memory import ComputedRef, Slot
 from .values import UNSET, Arr, EnumValue, Struct, make_value, zero_value
 from .writerules import WriteHook

@@ -46,3 +46,4 @@ def test_each_part_is_its_own_module_and_says_what_it_holds():
     for module in modules:
         assert "holds" in (module.__doc__ or ""), module.__name__
     assert set(PARTS) <= set(core.Runtime.__slots__)
+

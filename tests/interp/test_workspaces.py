@@ -20,6 +20,8 @@ import numpy as np
 import pytest
 
 from interp.run import make_runtime, run_spec
+from interp.runtime.errors import KrlRuntimeError
+from interp.runtime.sysvars import _entries
 from robot.trace import TraceWriter
 from tests.interp.helpers import Run, write
 
@@ -158,3 +160,14 @@ def test_an_inside_stop_workspace_set_at_run_time_stops_the_robot(tmp_path, inte
     assert _transitions(run, "$WORKSTATE3") == [(err["t"], True)]
     assert run.rt.sysvars.lookup("$WORKSPACE").peek().data[2].f["STATE"] is True
     assert not run.io("$OUT[7]")
+
+
+def test_a_workspace_variable_that_cannot_be_read_is_no_workspace():
+    """interp/runtime/sysvars.py catches KrlRuntimeError where a workspace variable's value
+    cannot be read (its name was not imported from 0760e46 on: NameError instead)."""
+
+    class Unreadable:
+        def peek(self):
+            raise KrlRuntimeError("value invalid")
+
+    assert _entries(Unreadable()) == [None] * 8
