@@ -121,7 +121,7 @@ def test_each_family_is_detected_from_machine_data_and_solves(fam, request):
     rng = np.random.default_rng(49)
     home = np.array(machine.home_deg, dtype=float)
     solved = 0
-    for _ in range(6 if fam.name == "numeric" else 40):
+    for _ in range(6 if fam.name in ("numeric", "redundant") else 40):   # the numeric solvers: 6
         q = home + rng.uniform(-15.0, 15.0, kin.n_axes)
         if machine.a4fix:
             q[3] = 0.0
