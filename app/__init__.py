@@ -19,8 +19,8 @@ from krl import __version__
 # Each pipeline stage contributes its subcommands from its own package: the module named here
 # for a subcommand defines it and lists it in its `commands` (tests/test_cli_registry.py checks
 # that this table and the modules' lists are the same). A module is imported when one of its
-# subcommands runs, or for `krl --help`: `krl check` or `krl lsp` does not import the simulator
-# (numpy, scipy: 0.3 s of CPU at each start, 2026-11-25).
+# subcommands runs (`krl --help` lists them from SUMMARIES): `krl check` or `krl lsp` does not
+# import the simulator (numpy, scipy: 0.3 s of CPU at each start, 2026-11-25).
 SUBCOMMANDS = {
     "parse": "app.parse",
     "recover": "recovery.cli", "growth": "recovery.cli", "validate": "recovery.cli", "construct": "recovery.cli",
@@ -35,6 +35,33 @@ SUBCOMMANDS = {
     "diff": "app.changes", "graph": "app.changes", "report": "app.changes",
     "pendant": "pendant.cli",
     "audit": "audit.cli",
+}
+
+#: each subcommand's summary in `krl --help`: the first sentence of its help (tests/test_cli_registry.py
+#: holds the two equal), so that `krl --help` lists the subcommands without importing their modules
+SUMMARIES = {
+    'parse': 'Parse FILES; exit 0 when every file parses.',
+    'recover': 'Parse every KRL file under CORPUS (a folder or a KRC backup .zip), cluster the failures, write the report to --out.',
+    'growth': 'Replay every committed version of grammar/KRL.g4 over CORPUS: growth.csv and growth.png.',
+    'validate': "Run every grammar construct's positive and negative examples (or only NAMES).",
+    'construct': 'Grammar constructs: start a new one from a cluster of the recovery report.',
+    'check': 'Type-check KRL files, KRC backup folders or backup .zip archives; exit 1 when there are errors.',
+    'plot': 'Draw the TCP path of a JSON Lines TRACE (3D and top view, programmed points, approximation zones, I/O events) as a PNG.',
+    'robot': "The simulated robot: its model from a backup's machine data or a robot YAML (issue 22).",
+    'trace': "KUKA Trace recordings (a KR C4's KRCIpo CSV and PROG.TXT) and simulated runs' traces: show one, compare a run with a recording (issue 60; docs/trace.md).",
+    'run': 'Run PROGRAM (.src) on the simulated KR C4; print where and why it ended.',
+    'asm': 'Print the VM assembly of PROGRAM (one instruction per line, source lines as comments).',
+    'cell': "The cell of a backup: the PLC's answers as reactive rules (robot/cellrules.py).",
+    'bench': 'Benchmarks (ratios measured in one run).',
+    'conformance': 'Run the hand-written cases on every available interpreter, the differential fuzzer and the corpus programs; write summary.json, report.md and report.html to --out.',
+    'fmt': 'Format KRL files in place (indentation, keyword case, spacing); comments, folds, inline forms, header lines and line ends are kept.',
+    'lsp': 'Run the KRL language server on stdin/stdout (see docs/editors.md).',
+    'debug': 'Debug a KRL program over the Debug Adapter Protocol on stdin/stdout.',
+    'diff': 'What changed between two KRC backups (folders or .zip) or two files: points, frames and loads, routines, declarations and signals, inline-form motions.',
+    'graph': "The program map of a KRC backup (folder or .zip) or a folder: routines, calls, interrupts, triggers, RUN commands and EKI channels, entry points and unreachable routines. html: an interactive page (zoom, pan, search, a routine's neighbourhood), offline.",
+    'report': 'The change report a customer signs: one HTML page that opens with both backups identified (their robot, controller, software, dates and SHA-256) and a signature block, a summary, then (with --since OLD) the diff from OLD to BACKUP, the check findings the change introduced or removed, the run outcomes of the entry points it touches (old against new), what to retest on the robot, the interactive program map, and every check finding of BACKUP.',
+    'pendant': 'Serve a virtual smartPAD for TARGET (a KRC backup folder or .zip, a folder of KRL, or a program .src: selected at the start; default the current folder) on 127.0.0.1 and open it in the browser.',
+    'audit': "Check every KRC backup and program folder in FOLDERS and run every entry point with --inputs auto; write one report (HTML and JSON) with each backup's health.",
 }
 
 
@@ -61,6 +88,16 @@ class _Subcommands(click.Group):
 
     def get_command(self, ctx: click.Context, cmd_name: str) -> click.Command | None:
         return subcommand(cmd_name)
+
+    def format_commands(self, ctx: click.Context, formatter: click.HelpFormatter) -> None:
+        """The list of `krl --help` from :data:`SUMMARIES`, shortened as click shortens a
+        command's help, without importing a subcommand's module (click's own listing imports
+        every one: 0.58 s of CPU for `krl --help`, tools/startup_bench.py, 2026-11-26)."""
+        names = self.list_commands(ctx)
+        limit = formatter.width - 6 - max(len(n) for n in names)
+        rows = [(n, click.Command(n, help=SUMMARIES[n]).get_short_help_str(limit)) for n in names]
+        with formatter.section("Commands"):
+            formatter.write_dl(rows)
 
 
 @click.group(cls=_Subcommands, context_settings={"help_option_names": ["-h", "--help"]})

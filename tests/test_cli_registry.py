@@ -11,9 +11,10 @@ import sys
 import tomllib
 from pathlib import Path
 
+import click
 from click.testing import CliRunner
 
-from app import SUBCOMMANDS, main, subcommand
+from app import SUBCOMMANDS, SUMMARIES, main, subcommand
 
 REPO = Path(__file__).resolve().parents[1]
 #: ``commands = [...]`` or ``commands: list = ...`` at a module's top level (column 0)
@@ -53,6 +54,33 @@ def test_help_lists_every_subcommand_and_an_unknown_one_is_a_usage_error():
     assert listed == set(SUBCOMMANDS)
     res = CliRunner().invoke(main, ["chek", "x.src"])
     assert res.exit_code == 2 and "No such command 'chek'" in res.output
+
+
+def test_help_lists_each_summary_as_click_would_without_importing_a_subcommand(tmp_path):
+    """SUMMARIES holds each command's first sentence (what click shows of its help); `krl --help`
+    prints what click's own listing prints (it imports every subcommand), at two widths, and
+    imports no module of a subcommand."""
+    assert set(SUMMARIES) == set(SUBCOMMANDS)
+    for name, module_name in SUBCOMMANDS.items():
+        cmd = subcommand(name)
+        assert SUMMARIES[name] == cmd.get_short_help_str(10**6), name
+    for width in (60, 200):
+        eager = click.Group("krl", commands={n: subcommand(n) for n in SUBCOMMANDS})
+        ctx = click.Context(main, info_name="krl", terminal_width=width, max_content_width=width)
+        ours, theirs = ctx.make_formatter(), ctx.make_formatter()
+        main.format_commands(ctx, ours)
+        eager.format_commands(ctx, theirs)
+        assert ours.getvalue() == theirs.getvalue() and "Commands:" in ours.getvalue(), width
+    probe = ("import sys\n"
+             "from app import main, SUBCOMMANDS\n"
+             "try:\n"
+             "    main(['--help'])\n"
+             "except SystemExit as e:\n"
+             "    assert e.code == 0, e.code\n"
+             "print(sorted(set(SUBCOMMANDS.values()) & set(sys.modules)))\n")
+    res = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, cwd=tmp_path, timeout=120)
+    assert res.returncode == 0, res.stderr
+    assert res.stdout.splitlines()[-1] == "[]"
 
 
 def test_check_does_not_load_the_simulator(tmp_path):
