@@ -26,6 +26,13 @@ from krl.limits import PARSE_TIMEOUT_S
 from krl.project import folder_groups
 from krl.source import read_source
 from krl.terminal import printable
+from krl.diagnostics.render import Renderer, use_colour
+from krl.archive import ArchiveError, backup_source
+from krl.cluster import run_batches, SchedulerError
+from krl.semantics.config import ConfigError, Selection, config_for, parse_codes
+from krl.workspace import load_workspaces, not_understood, on_each_file, Workspace, workspaces_for
+from krl.parsecache import through_store
+from krl.diagnostics.sarif import to_sarif
 
 @click.command()
 @click.argument("paths", nargs=-1, required=True)
@@ -57,7 +64,7 @@ def check(paths: tuple[str, ...], fmt: str, as_json: bool, no_warnings: bool, ig
     if reach:
         sys.exit(_reach(paths, robot, inputs))
     if report_dir is not None:
-        # costs 0.15 s at start-up (python -X importtime, 2026-11-25)
+        # deferred: tools/startup_bench.py, krl check +5 ms at the top (2026-11-26)
         from krl.survey.report import check_report  # noqa: PLC0415
         try:
             for path in paths:
@@ -67,8 +74,6 @@ def check(paths: tuple[str, ...], fmt: str, as_json: bool, no_warnings: bool, ig
             click.echo(f"krl check: internal error: {type(exc).__name__}: {exc}")
             sys.exit(2)
         sys.exit(0)
-    # costs 0.003 s at start-up (python -X importtime, 2026-11-25)
-    from krl.diagnostics.render import use_colour  # noqa: PLC0415
 
     fmt = "json" if as_json else fmt
     status = run_check(list(paths), no_warnings=no_warnings, echo=click.echo, fmt=fmt,
@@ -81,16 +86,14 @@ def check(paths: tuple[str, ...], fmt: str, as_json: bool, no_warnings: bool, ig
 def _reach(paths: tuple[str, ...], robot: str | None, inputs: str | None) -> int:
     """``krl check --reach``: interp/reach.py on each program; exit 1 when a point is out of
     reach or a motion collides, 2 when a program cannot be loaded."""
-    # costs 0.22 s at start-up (python -X importtime, 2026-11-26; the runtime when it runs: 0.66 s more)
-    from interp.reach import reach_check  # noqa: PLC0415
-    from robot.mada import MachineDataError  # noqa: PLC0415
-    from robot.stimuli import StimulusError  # noqa: PLC0415
+    # deferred: tools/startup_bench.py, krl check +382 ms at the top (2026-11-26)
+    from interp.reach import REACH_ERRORS, reach_check  # noqa: PLC0415
 
     status = 0
     for path in paths:
         try:
             report = reach_check(Path(path), robot=robot, inputs=inputs)
-        except (MachineDataError, StimulusError, OSError, ValueError) as exc:
+        except REACH_ERRORS as exc:
             click.echo(f"error: {printable(str(exc))}", err=True)
             return 2
         for line in report.lines():
@@ -110,16 +113,6 @@ def run_check(paths: list[str], as_json: bool = False, no_warnings: bool = False
     scheduler whose workers load and check the backups of a folder holding several, one per
     task (:func:`check_group`; the output is the local one). Returns the exit status: 0, 1
     (errors), 2 (bad configuration, internal failure, a scheduler that cannot be used)."""
-    # costs 0.004 s at start-up (python -X importtime, 2026-11-25)
-    from krl.archive import ArchiveError, backup_source  # noqa: PLC0415
-    # costs 0.004 s at start-up (python -X importtime, 2026-11-25)
-    from krl.cluster import SchedulerError  # noqa: PLC0415
-    # costs 0.01 s at start-up (python -X importtime, 2026-11-25)
-    from krl.semantics.config import ConfigError, Selection, config_for, parse_codes  # noqa: PLC0415
-    # costs 0.003 s at start-up (python -X importtime, 2026-11-25)
-    from krl.diagnostics.render import Renderer  # noqa: PLC0415
-    # imported by the check itself (krl.workspace, below): nothing more at start-up
-    from krl.workspace import Workspace, not_understood  # noqa: PLC0415
     fmt = "json" if as_json else fmt
     renderer = Renderer(echo, colour)
     all_shown = []
@@ -186,8 +179,6 @@ def run_check(paths: list[str], as_json: bool = False, no_warnings: bool = False
         echo(f"krl check: internal error: {type(exc).__name__}: {printable(exc)}")
         return 2
     if fmt == "sarif":
-        # costs 0.0005 s at krl's start-up (python -X importtime, 2026-11-25)
-        from krl.diagnostics.sarif import to_sarif  # noqa: PLC0415
         echo(json.dumps(to_sarif(all_shown), indent=2))
     elif fmt == "text":
         echo(renderer.summary(files))
@@ -204,37 +195,22 @@ def _loaded(path, timeout: float | None = None, jobs: int | None = None, schedul
         if groups is not None and (len(groups) > 1 or groups[0][0] != str(path)):
             return _on_cluster(scheduler, groups, timeout)
 
-    # costs 0.19 s at start-up (python -X importtime, 2026-11-25)
-    from krl.parsecache import through_store  # noqa: PLC0415
-
     with through_store():       # each file's parse from the one store (krl/store.py) when it holds it
         return _loaded_here(path, timeout, jobs)
 
 
 def _loaded_here(path, timeout: float | None, jobs: int | None) -> list:
-    # costs 0.14 s at start-up (python -X importtime, 2026-11-25)
-    from krl.workspace import on_each_file, workspaces_for  # noqa: PLC0415
 
     if not _progress_shown():
         return workspaces_for(path, timeout=timeout, jobs=jobs)
-    # costs 0.03 s at start-up (python -X importtime, 2026-11-25)
-    from rich.console import Console  # noqa: PLC0415
-    # costs 0.02 s at start-up (python -X importtime, 2026-11-25)
-    from rich.markup import escape  # noqa: PLC0415
-    # costs 0.04 s at start-up (python -X importtime, 2026-11-25)
-    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn  # noqa: PLC0415
+    # deferred: tools/startup_bench.py, krl check --reach +33 ms at the top (2026-11-26)
+    from recovery.progress import bar  # noqa: PLC0415
 
     p = Path(path)
     groups = folder_groups(p)       # the one walk of the folder; its entries are loaded below
     total = sum(e.kind == "file" for _, entries in groups or () for e in entries) if p.is_dir() else None
-    columns = (TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn())
-    with Progress(*columns, console=Console(stderr=True), transient=True) as bar:
-        task = bar.add_task("parsing", total=total)
-
-        def advance(file: str) -> None:
-            bar.update(task, advance=1, description=escape(f"parsing {Path(file).name}"))
-        with on_each_file(advance):
-            return workspaces_for(path, timeout=timeout, jobs=jobs, groups=groups)
+    with bar("parsing", total) as advance, on_each_file(lambda file: advance(Path(file).name)):
+        return workspaces_for(path, timeout=timeout, jobs=jobs, groups=groups)
 
 
 class Checked:
@@ -256,8 +232,6 @@ def check_group(root: str, entries: list, timeout: float | None) -> tuple[str, l
     entries) group of krl.project.folder_groups, loaded and checked as workspaces_for does
     (the files are parsed in the worker's process: a Dask worker may not start the killable
     pool; the batch's deadline on the cluster bounds it, krl/cluster.py)."""
-    # costs 0.14 s at start-up (python -X importtime, 2026-11-25)
-    from krl.workspace import load_workspaces  # noqa: PLC0415
 
     ws = load_workspaces([(root, entries)], None)[0]
     diags = ws.check(resolve=False)     # nothing runs: no storage placed
@@ -267,8 +241,6 @@ def check_group(root: str, entries: list, timeout: float | None) -> tuple[str, l
 def _on_cluster(scheduler: str, groups: list, timeout: float | None) -> list:
     """The groups checked on the Dask cluster at `scheduler`, in their order. Raises
     krl.cluster.SchedulerError; a group whose task fails is an E901 diagnostic of its root."""
-    # costs 0.004 s at start-up (python -X importtime, 2026-11-25)
-    from krl.cluster import run_batches  # noqa: PLC0415
     tasks = [(i, (root, entries, timeout)) for i, (root, entries) in enumerate(groups)]
     # a task's deadline: the per-file timeout times its files (krl/cluster.py adds the transfer)
     most = max((sum(e.kind == "file" for e in entries) for _r, entries in groups), default=1)

@@ -32,6 +32,13 @@ import numpy as np
 
 from krl.ast import nodes as N
 from robot.axismap import CART_KEYS as _CART
+from robot.collision import motion_contact
+from robot.errors import RobotError
+from robot.frames import frame_to_matrix, inv_pos
+from robot.mada import MachineDataError
+from robot.stimuli import StimulusError
+from .run import global_value, make_runtime, run_spec
+from .scene import module_points
 
 
 #: poses sampled along each motion
@@ -52,17 +59,14 @@ class ReachReport:
                                 f"{self.robot}; {len(self.problems)} problem(s)"]
 
 
+#: what :func:`reach_check` raises for a program it cannot load: its robot's machine data, its cell
+#: file, the files themselves
+REACH_ERRORS = (MachineDataError, StimulusError, OSError, ValueError)
+
+
 def reach_check(program: Path, robot=None, inputs=None) -> ReachReport:
     """The report of `program` (see the module docstring); `robot` and `inputs` as
     ``krl run --robot`` and ``--inputs`` take them (a cell file gives the geometry)."""
-    # costs 0.47 s at start-up (python -X importtime, 2026-11-26: robot.collision with scipy's rotations)
-    from robot.collision import motion_contact  # noqa: PLC0415
-    from robot.errors import RobotError  # noqa: PLC0415
-    from robot.frames import frame_to_matrix, inv_pos  # noqa: PLC0415
-
-    # costs 0.66 s at start-up (python -X importtime, 2026-11-26: the runtime)
-    from .run import global_value, make_runtime, run_spec  # noqa: PLC0415
-    from .scene import module_points  # noqa: PLC0415
 
     rt, _ = make_runtime(run_spec(program, inputs=inputs, robot=robot, mujoco=False, check=False))
     ctl = rt.controller

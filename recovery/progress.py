@@ -7,10 +7,14 @@ afterwards is the same with or without it.
 
 from __future__ import annotations
 
+import contextlib
 import os
 import sys
 from collections.abc import Iterator
 from typing import TypeVar
+from rich.console import Console
+from rich.markup import escape
+from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
 T = TypeVar("T")
 
@@ -25,17 +29,24 @@ def shown(stream=None) -> bool:
     return tty and os.environ.get("TERM", "") != "dumb"
 
 
+@contextlib.contextmanager
+def bar(what: str, total: int | None) -> Iterator:
+    """A transient progress bar on stderr showing `what` (`total` steps, None: unknown); yields
+    ``advance(label)``: one step done, the bar then showing "`what` `label`"."""
+    columns = (TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn())
+    with Progress(*columns, console=Console(stderr=True), transient=True) as shown_bar:
+        task = shown_bar.add_task(escape(what), total=total)
+
+        def advance(label: str) -> None:
+            shown_bar.update(task, advance=1, description=escape(f"{what} {label}"))
+        yield advance
+
+
 def steps(items: list[T], what: str, label=str) -> Iterator[T]:
     """Yield `items`, showing "`what` i/n: label(item)" and a bar on a terminal."""
     if not shown() or not items:
         yield from items
         return
-    # costs 0.05 s at start-up (python -X importtime, 2026-11-25)
-    from rich.console import Console  # noqa: PLC0415
-    # costs 0.03 s at start-up (python -X importtime, 2026-11-25)
-    from rich.markup import escape  # noqa: PLC0415
-    # costs 0.07 s at start-up (python -X importtime, 2026-11-25)
-    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn  # noqa: PLC0415
 
     columns = (TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn())
     with Progress(*columns, console=Console(stderr=True), transient=True) as bar:
