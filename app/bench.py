@@ -21,12 +21,14 @@ from krl.files import SHARED_CORPUS as DEFAULT_CORPUS
 from krl.fmt import format_text
 from krl.source import read_source
 from krl.syntax.parse import parse_source
+from recovery.scan import discover
+from interp.bench import Baseline, compute
+from robot.bench import measure
+from krl.syntax.engines import available, parse_sources, unavailable_reason
 
 
 def parse_rate(corpus: Path, limit_bytes: int | None = None) -> dict:
     """Parse every KRL file under corpus twice in this process; returns KB/s cold and warm."""
-    # costs 0.02 s at start-up (python -X importtime, 2026-11-25)
-    from recovery.scan import discover  # noqa: PLC0415
 
     sources = []
     total = 0
@@ -50,8 +52,6 @@ def parse_rate(corpus: Path, limit_bytes: int | None = None) -> dict:
 def fmt_rate(corpus: Path, limit_bytes: int | None = None) -> dict:
     """Parse, then format, every KRL file under corpus that parses (a warm-up parse first);
     returns KB/s of both and the ratio of the times, all measured in this process."""
-    # costs 0.02 s at start-up (python -X importtime, 2026-11-25)
-    from recovery.scan import discover  # noqa: PLC0415
 
     sources = []
     total = 0
@@ -86,10 +86,6 @@ def all_figures(repeat: int = 3, sim_seconds: float = 60.0, parse_kb: int = 512)
     simulated s per CPU s as ``python -m robot.bench`` measures them (robot.bench ``measure``:
     after its warm-up run, so both commands give one figure) and the parser's warm rate over
     ``parse_kb`` KB of the shared corpus (the embedded corpus when the shared one is absent)."""
-    # costs 0.003 s at start-up (python -X importtime, 2026-11-25)
-    from interp.bench import compute  # noqa: PLC0415
-    # costs 0.17 s at start-up (python -X importtime, 2026-11-25)
-    from robot.bench import measure  # noqa: PLC0415
 
     c = compute(repeat)
     sim = measure(min_motion_s=sim_seconds)
@@ -127,8 +123,6 @@ def bench(ctx: click.Context, as_json: bool, repeat: int, sim_seconds: float, pa
 
 
 def _print_compute(repeat: int, baseline_rev: str | None, as_json: bool = False, cpu: bool = False) -> None:
-    # costs 0.003 s at start-up (python -X importtime, 2026-11-25)
-    from interp.bench import Baseline, compute  # noqa: PLC0415
 
     if baseline_rev:
         with Baseline(baseline_rev) as base:
@@ -174,10 +168,6 @@ def engine_rates(corpus: Path, repeat: int = 3, engines: list[str] | None = None
     """KB/s of each available parse engine (krl/syntax/engines) over the same files, rounds
     interleaved (python, java, python, java, ...), best of `repeat`; one thread each, results
     built in full (the java figure includes the Python side: pre-filters, records, fallbacks)."""
-    # costs 0.01 s at start-up (python -X importtime, 2026-11-25)
-    from krl.syntax.engines import available, parse_sources  # noqa: PLC0415
-    # costs 0.02 s at start-up (python -X importtime, 2026-11-25)
-    from recovery.scan import discover  # noqa: PLC0415
 
     sources = [s for s in (read_source(p) for p in discover(corpus)) if s.status == "ok"]
     kb = sum(s.size for s in sources) / 1024
@@ -203,8 +193,6 @@ def engine_rates(corpus: Path, repeat: int = 3, engines: list[str] | None = None
 def bench_parse(corpus: Path | None, as_json: bool, repeat: int) -> None:
     """Parser speed in KB/s of each available engine over CORPUS (default ../shared/krl-corpus),
     measured side by side in this run: rounds interleaved, best of --repeat, one thread each."""
-    # costs 0.01 s at start-up (python -X importtime, 2026-11-25)
-    from krl.syntax.engines import unavailable_reason  # noqa: PLC0415
 
     corpus = corpus or DEFAULT_CORPUS
     if not corpus.is_dir():

@@ -22,6 +22,18 @@ from krl import limits   # limits.PARSE_TIMEOUT_S read at each call (tests lengt
 from krl.project import folder_groups
 from krl.source import read_source
 from krl.terminal import printable
+from krl.diagnostics.render import Renderer
+from krl.diff.core import diff_sides
+from krl.diff.load import DiffInputError, side
+from krl.diff.text import diff_html, diff_text
+from krl.archive import ArchiveError, backup_source
+from krl.programmap import build_map
+from krl.workspace import workspaces_for
+from krl.programmap.render import GraphTooLarge, GraphvizMissing, to_dot, to_html, to_svg, to_text
+from krl.diff.ident import generator, identify
+from krl.diff.report import findings, relative, report_html, touched_entries, unread_lines
+from interp.outcomes import outcome_changes, run_outcomes
+from interp.realprograms import REPORT_SIM_TIME_S
 
 
 def _fail(command: str, exc: Exception) -> None:
@@ -39,8 +51,6 @@ def _write(text: str, output: str | None) -> None:
 def _echo_errors(sides, paths) -> None:
     """The input and syntax errors of the sides' files `paths` (shown paths), on standard error
     as krl check prints them."""
-    # costs 0.003 s at start-up (python -X importtime, 2026-11-25)
-    from krl.diagnostics.render import Renderer  # noqa: PLC0415
 
     renderer = Renderer(lambda s: click.echo(s, err=True), False)
     for s in sides:
@@ -63,12 +73,6 @@ def diff(old: str, new: str, fmt: str, tolerance: float, timeout: float | None, 
     """What changed between two KRC backups (folders or .zip) or two files: points, frames and
     loads, routines, declarations and signals, inline-form motions. Exit 0 no change, 1
     changes, 2 error."""
-    # costs 0.22 s at start-up (python -X importtime, 2026-11-25)
-    from krl.diff.core import diff_sides  # noqa: PLC0415
-    # costs 0.28 s at start-up (python -X importtime, 2026-11-25)
-    from krl.diff.load import DiffInputError, side  # noqa: PLC0415
-    # costs 0.26 s at start-up (python -X importtime, 2026-11-25)
-    from krl.diff.text import diff_html, diff_text  # noqa: PLC0415
 
     single = Path(old).is_file() and Path(new).is_file() and not any(
         p.lower().endswith(".zip") for p in (old, new))
@@ -97,12 +101,6 @@ def load_map(path: str):
     its files (shown paths), and ``lines(shown path)``: the text lines of a file with a
     diagnostic (read while an archive is extracted; [] for others). Raises ValueError with the
     message of ``krl check`` for bad input."""
-    # costs 0.004 s at start-up (python -X importtime, 2026-11-25)
-    from krl.archive import ArchiveError, backup_source  # noqa: PLC0415
-    # costs 0.22 s at start-up (python -X importtime, 2026-11-25)
-    from krl.programmap import build_map  # noqa: PLC0415
-    # costs 0.14 s at start-up (python -X importtime, 2026-11-25)
-    from krl.workspace import workspaces_for  # noqa: PLC0415
 
     p = Path(path)
     if not p.exists() and not p.is_symlink():
@@ -145,8 +143,6 @@ def graph(backup: str, fmt: str, links: str, output: str | None) -> None:
     """The program map of a KRC backup (folder or .zip) or a folder: routines, calls,
     interrupts, triggers, RUN commands and EKI channels, entry points and unreachable routines.
     html: an interactive page (zoom, pan, search, a routine's neighbourhood), offline."""
-    # costs 0.23 s at start-up (python -X importtime, 2026-11-25)
-    from krl.programmap.render import GraphTooLarge, GraphvizMissing, to_dot, to_html, to_svg, to_text  # noqa: PLC0415
 
     try:
         pm, _diags, _n, _lines = load_map(backup)
@@ -187,16 +183,6 @@ def report(backup: str, since: str | None, runs: bool, max_sim_time: float | Non
     introduced or removed, the run outcomes of the entry points it touches (old against new),
     what to retest on the robot, the interactive program map, and every check finding of
     BACKUP. Prints as a PDF to sign: numbered pages, the unchanged context collapsed."""
-    # costs 0.22 s at start-up (python -X importtime, 2026-11-25)
-    from krl.diff.core import diff_sides  # noqa: PLC0415
-    # costs 0.001 s at start-up (python -X importtime, 2026-11-26)
-    from krl.diff.ident import generator, identify  # noqa: PLC0415
-    # costs 0.28 s at start-up (python -X importtime, 2026-11-25)
-    from krl.diff.load import DiffInputError, side  # noqa: PLC0415
-    # costs 0.29 s at start-up (python -X importtime, 2026-11-25)
-    from krl.diff.report import findings, relative, report_html, touched_entries, unread_lines  # noqa: PLC0415
-    # costs 0.23 s at start-up (python -X importtime, 2026-11-25)
-    from krl.programmap.render import GraphTooLarge  # noqa: PLC0415
 
     try:
         pm, diags, files, lines = load_map(backup)
@@ -212,8 +198,6 @@ def report(backup: str, since: str | None, runs: bool, max_sim_time: float | Non
                 d = diff_sides(a, b)
                 touched = touched_entries(d, pm_old, pm)
                 if max_sim_time is None:
-                    # costs 0.32 s at start-up (python -X importtime, 2026-11-25)
-                    from interp.realprograms import REPORT_SIM_TIME_S  # noqa: PLC0415
 
                     max_sim_time = REPORT_SIM_TIME_S
                 if runs and touched:
@@ -258,8 +242,6 @@ def _real(s, shown_path: str | None) -> str | None:
 def _run_touched(touched, a, b, max_sim_time, jobs) -> None:
     """Run the touched entry points on both sides (interp/outcomes.py) and fill in their
     outcomes and what changed; progress on standard error when it is a terminal."""
-    # costs 0.007 s at start-up (python -X importtime, 2026-11-25)
-    from interp.outcomes import outcome_changes, run_outcomes  # noqa: PLC0415
 
     paths = {}
     for t in touched:

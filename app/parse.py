@@ -23,6 +23,13 @@ from krl.limits import PARSE_TIMEOUT_S
 from krl.syntax.messages import file_diagnostics
 from krl.syntax.parse import default_bundle
 from krl.terminal import printable, printable_path
+from krl.pool import run_tasks
+from krl.diagnostics.render import Renderer, SourceLines, use_colour
+from krl.syntax.engines import use_engine
+from krl.diagnostics.sarif import to_sarif
+from krl.syntax.outline import outline as tree_outline
+from krl.ast.build import build_module
+from krl.ast.outline import symbol_outline
 
 
 def parse_job(path: str, outline: bool, tree: bool):
@@ -32,14 +39,8 @@ def parse_job(path: str, outline: bool, tree: bool):
     entries: list[str] = []
     if result.ok and (outline or tree):
         if tree:
-            # costs 0.0005 s at krl's start-up (python -X importtime, 2026-11-25)
-            from krl.syntax.outline import outline as tree_outline  # noqa: PLC0415
             entries = list(tree_outline(result.tree))
         else:
-            # costs 0.08 s at start-up (python -X importtime, 2026-11-25)
-            from krl.ast.build import build_module  # noqa: PLC0415
-            # costs 0.06 s at start-up (python -X importtime, 2026-11-25)
-            from krl.ast.outline import symbol_outline  # noqa: PLC0415
             entries = list(symbol_outline(build_module(result)))
     result.tree = None
     return result, text, diags, entries
@@ -48,8 +49,6 @@ def parse_job(path: str, outline: bool, tree: bool):
 def _jobs_in_order(files, outline: bool, tree: bool, timeout: float | None, jobs: int | None):
     """(path, job result or None, failure Diagnostic or None) per file, in the order of
     `files`. With `timeout`, each file is parsed in a worker process killed past it."""
-    # costs 0.003 s at start-up (python -X importtime, 2026-11-25)
-    from krl.pool import run_tasks  # noqa: PLC0415
 
     if timeout is None:
         for path in files:
@@ -83,8 +82,6 @@ def run_parse(files, fmt: str = "text", outline: bool = False, tree: bool = Fals
     (None: parse here, without a limit; the command passes krl.limits.PARSE_TIMEOUT_S).
     antlr_errors: with fmt "json", add the parser's raw errors as ``antlr_errors`` (1-based columns).
     """
-    # costs 0.003 s at start-up (python -X importtime, 2026-11-25)
-    from krl.diagnostics.render import Renderer, SourceLines  # noqa: PLC0415
     files = list(files)
     sources = SourceLines()
     renderer = Renderer(echo, colour, sources)
@@ -122,8 +119,6 @@ def run_parse(files, fmt: str = "text", outline: bool = False, tree: bool = Fals
             for entry in entries:
                 echo(f"{printable_path(path)}:{printable(entry)}")
     if fmt == "sarif":
-        # costs 0.0005 s at krl's start-up (python -X importtime, 2026-11-25)
-        from krl.diagnostics.sarif import to_sarif  # noqa: PLC0415
         echo(json.dumps(to_sarif(all_diags), indent=2))
     elif fmt == "text":
         echo(renderer.summary(len(files)))
@@ -133,12 +128,8 @@ def run_parse(files, fmt: str = "text", outline: bool = False, tree: bool = Fals
 def main_status(files, fmt, as_json, outline, tree, timeout=None, jobs=None, engine: str | None = None,
                 antlr_errors: bool = False) -> int:
     """The `parse` command's body (app/__init__.py keeps only the options)."""
-    # costs 0.01 s at start-up (python -X importtime, 2026-11-25)
-    from krl.syntax.engines import use_engine  # noqa: PLC0415
 
     use_engine(engine)
-    # costs 0.003 s at start-up (python -X importtime, 2026-11-25)
-    from krl.diagnostics.render import use_colour  # noqa: PLC0415
 
     fmt = "json" if as_json else fmt
     return run_parse(files, fmt, outline, tree, click.echo, use_colour(sys.stdout) and fmt == "text",
