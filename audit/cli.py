@@ -11,6 +11,12 @@ import click
 
 from krl.limits import AUDIT_RUN_TIMEOUT_S, MAX_CELL_SIM_TIME_S
 from krl.terminal import printable, printable_path
+from audit.fleet import AuditError, run_audit
+from audit.report import plural as n, write_report
+from recovery.progress import shown
+from rich.markup import escape
+from rich.console import Console
+from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
 
 @click.command()
@@ -39,10 +45,6 @@ def audit(folders: tuple[str, ...], out: Path, jobs: int | None, scheduler: str 
     Exit code: 0 when no backup needs attention, 1 when one does (docs/audit.md, "Status"),
     2 on a usage error (not a folder, too many backups, a scheduler that cannot be used).
     """
-    # costs 0.004 s at start-up (python -X importtime, 2026-11-25)
-    from audit.fleet import AuditError, run_audit  # noqa: PLC0415
-    # costs 0.009 s at start-up (python -X importtime, 2026-11-25)
-    from audit.report import write_report  # noqa: PLC0415
 
     start = time.perf_counter()
     try:
@@ -65,8 +67,6 @@ def audit(folders: tuple[str, ...], out: Path, jobs: int | None, scheduler: str 
 def summary_lines(data: dict) -> list[str]:
     """The terminal's summary of a report: one line per backup (status, name and robot, its counts), then
     the totals."""
-    # costs 0.009 s at start-up (python -X importtime, 2026-11-25)
-    from audit.report import plural as n  # noqa: PLC0415
 
     out = []
     for u in data["units"]:
@@ -89,15 +89,9 @@ class _progress:
     the backup or program in hand."""
 
     def __enter__(self):
-        # costs 0.0004 s at krl's start-up (python -X importtime, 2026-11-25)
-        from recovery.progress import shown  # noqa: PLC0415
 
         self.bar = None
         if shown():
-            # costs 0.03 s at start-up (python -X importtime, 2026-11-25)
-            from rich.console import Console  # noqa: PLC0415
-            # costs 0.04 s at start-up (python -X importtime, 2026-11-25)
-            from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn  # noqa: PLC0415
 
             self.bar = Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
                                 TimeElapsedColumn(), console=Console(stderr=True), transient=True)
@@ -108,8 +102,6 @@ class _progress:
     def __call__(self, phase: str, done: int, total: int, label: str) -> None:
         if self.bar is None:
             return
-        # costs 0.02 s at start-up (python -X importtime, 2026-11-25)
-        from rich.markup import escape  # noqa: PLC0415
 
         what = {"check": "checking", "run": "running"}.get(phase, phase)
         if phase not in self.tasks:

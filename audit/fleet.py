@@ -37,6 +37,18 @@ from pathlib import Path
 
 from krl.limits import AUDIT_RUN_TIMEOUT_S, MAX_AUDIT_BACKUPS, MAX_AUDIT_ENTRIES, MAX_AUDIT_FINDINGS, PARSE_TIMEOUT_S
 from krl.terminal import printable
+from krl.project import folder_groups, system_folder
+from krl.parsecache import through_store
+from krl.programmap import build_map
+from krl.semantics.config import config_for
+from krl.workspace import load_workspaces, machine_identity
+from audit.outputs import overlaps
+from audit.report import rel_path as _rel, report_data
+from interp.realprograms import entries_of, folder_entries, REPORT_SIM_TIME_S, run_one
+from krl.pool import run_tasks
+from krl.cluster import run_batches, SchedulerError
+from interp import realprograms as R
+from interp import run as _loaded  # noqa: F401  (forked workers start with the runtime imported)
 
 __all__ = ["AuditError", "Unit", "units_of", "check_unit", "run_entry", "run_audit"]
 
@@ -75,8 +87,6 @@ class Unit:
 def units_of(folders: list[str]) -> list[Unit]:
     """The units of `folders` (module docstring, step 1), in the folders' order; a root named
     twice is audited once. Raises AuditError."""
-    # costs 0.04 s at start-up (python -X importtime, 2026-11-25)
-    from krl.project import folder_groups, system_folder  # noqa: PLC0415
     out: list[Unit] = []
     seen: set[str] = set()
     for folder in folders:
@@ -105,21 +115,6 @@ def check_unit(root: str, entries: list, backup: bool) -> dict:
     the program map's entry kind), ``programs_left_out``, ``outputs`` (audit/outputs.py).
     The files are parsed in this process (a Dask worker may not start the killable pool; the
     caller's timeout bounds the task)."""
-    # costs 0.23 s at start-up (python -X importtime, 2026-11-25)
-    from krl.parsecache import through_store  # noqa: PLC0415
-    # costs 0.28 s at start-up (python -X importtime, 2026-11-25)
-    from krl.programmap import build_map  # noqa: PLC0415
-    # costs 0.03 s at start-up (python -X importtime, 2026-11-25)
-    from krl.semantics.config import config_for  # noqa: PLC0415
-    # costs 0.40 s at start-up (python -X importtime, 2026-11-25)
-    from krl.workspace import load_workspaces, machine_identity  # noqa: PLC0415
-
-    # costs 0.24 s at start-up (python -X importtime, 2026-11-25)
-    from audit.outputs import overlaps  # noqa: PLC0415
-    # costs 0.006 s at start-up (python -X importtime, 2026-11-25)
-    from audit.report import rel_path as _rel  # noqa: PLC0415
-    # costs 0.43 s at start-up (python -X importtime, 2026-11-25)
-    from interp.realprograms import entries_of, folder_entries  # noqa: PLC0415
 
     with through_store():
         ws = load_workspaces([(root, entries)], None)[0]
@@ -172,8 +167,6 @@ def _not_handlers(progs: list, pm, root: str) -> tuple[list, list[dict]]:
     calls is an interrupt routine, run by the program that declares it when its condition
     fires, never on its own (issue 63: run alone, such routines were counted as program
     errors); each with ``{path, why}``."""
-    # costs 0.006 s at start-up (python -X importtime, 2026-11-25)
-    from audit.report import rel_path as _rel  # noqa: PLC0415
 
     called: dict[str, object] = {}
     for e in pm.edges:
@@ -198,8 +191,6 @@ def run_entry(path: str, max_sim_time: float, max_steps: int, interp: str) -> di
     """On a worker: one entry point run with ``--inputs auto`` (interp.realprograms.run_one) up
     to `max_sim_time` simulated seconds; an SPS.SUB entry at most the real-programs report's
     REPORT_SIM_TIME_S (a submit program never ends: its cycle is what the report shows)."""
-    # costs 0.43 s at start-up (python -X importtime, 2026-11-25)
-    from interp.realprograms import REPORT_SIM_TIME_S, run_one  # noqa: PLC0415
 
     return run_one(Path(path), min(max_sim_time, REPORT_SIM_TIME_S), max_steps, None, True, interp,
                    auto_sim_time=max_sim_time)
@@ -214,12 +205,8 @@ def _outcomes(fn: Callable, tasks: list, *, jobs: int | None, scheduler: str | N
     at `scheduler` (krl.cluster.run_batches, one task per batch). Raises
     krl.cluster.SchedulerError."""
     if scheduler is not None:
-        # costs 0.01 s at start-up (python -X importtime, 2026-11-25)
-        from krl.cluster import run_batches  # noqa: PLC0415
 
         return run_batches(scheduler, fn, tasks, batch_files=1, timeout=timeout, name=name)
-    # costs 0.02 s at start-up (python -X importtime, 2026-11-25)
-    from krl.pool import run_tasks  # noqa: PLC0415
 
     return run_tasks(fn, tasks, jobs=jobs, timeout=timeout, group=group)
 
@@ -235,14 +222,6 @@ def run_audit(folders: list[str], *, jobs: int | None = None, scheduler: str | N
     run may take before its worker is killed. `progress(phase, done, total, label)` is called
     as the phases ("check", "run") advance. Raises AuditError (also for a scheduler that
     cannot be used)."""
-    from krl.cluster import SchedulerError  # noqa: PLC0415
-
-    # costs 0.006 s at start-up (python -X importtime, 2026-11-25)
-    from audit.report import rel_path as _rel  # noqa: PLC0415
-    # costs 0.006 s at start-up (python -X importtime, 2026-11-25)
-    from audit.report import report_data  # noqa: PLC0415
-    # costs 0.42 s at start-up (python -X importtime, 2026-11-25)
-    from interp import realprograms as R  # noqa: PLC0415
 
     max_sim_time = R.AUTO_SIM_TIME_S if max_sim_time is None else max_sim_time
     max_steps = R.REPORT_STEPS if max_steps is None else max_steps
@@ -254,9 +233,6 @@ def run_audit(folders: list[str], *, jobs: int | None = None, scheduler: str | N
     most = max((sum(e.kind == "file" for e in u.entries) for u in units), default=1)
     try:
         say("check", 0, len(units), "")
-        # costs 0.42 s at start-up (python -X importtime, 2026-11-25)
-        from interp import run as _loaded  # noqa: F401, PLC0415  (forked workers start with the runtime imported)
-
         for k, o in enumerate(_outcomes(check_unit, tasks, jobs=jobs, scheduler=scheduler,
                                         timeout=PARSE_TIMEOUT_S * max(most, 1), name="krl-audit-check"), 1):
             if o.status == "done":

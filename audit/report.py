@@ -34,6 +34,11 @@ from pathlib import Path
 
 from krl import __version__
 from krl.limits import MAX_AUDIT_EVIDENCE_CHARS
+from interp.realprograms import cause_of
+from interp.summary import ENDINGS
+from krl.render import render_html
+from krl.files import write_text_atomic
+from krl.source import read_source
 
 __all__ = ["AUDIT_FORMAT", "STATUSES", "rel_path", "plural", "report_data", "health", "write_report", "to_html",
            "causes_of", "motion_causes", "finding_groups"]
@@ -86,10 +91,6 @@ def _cycle(requests: list[float], total: int) -> dict | None:
 def _entry(row: dict, program: dict, root: str) -> dict:
     """One entry point of a unit in the report, from its run row (interp.realprograms.run_one)
     and its listing (audit.fleet.check_unit)."""
-    # costs 0.70 s at start-up (python -X importtime, 2026-11-25)
-    from interp.realprograms import cause_of  # noqa: PLC0415
-    # costs 0.04 s at start-up (python -X importtime, 2026-11-25)
-    from interp.summary import ENDINGS  # noqa: PLC0415
 
     reason = row.get("reason", "internal")
     own_end = reason in ("completed", "halt")
@@ -298,8 +299,6 @@ class _Evidence:
     def _lines(self, path: Path) -> list[str]:
         key = str(path)
         if key not in self._texts:
-            # costs 0.02 s at start-up (python -X importtime, 2026-11-25)
-            from krl.source import read_source  # noqa: PLC0415
 
             src = read_source(path, follow_symlinks=False) if path.is_file() else None
             self._texts[key] = (src.text or "").splitlines() if src is not None else []
@@ -331,8 +330,6 @@ class _Evidence:
 
 def to_html(data: dict) -> str:
     """The report's page (module docstring) from :func:`report_data`'s data."""
-    # costs 0.05 s at start-up (python -X importtime, 2026-11-25)
-    from krl.render import render_html  # noqa: PLC0415
 
     ev = _Evidence()
     return render_html("audit", "audit.html.j2", data=data, ev=ev, statuses=STATUSES)
@@ -341,8 +338,6 @@ def to_html(data: dict) -> str:
 def write_report(data: dict, out: str | Path) -> tuple[Path, Path]:
     """Write ``audit.json`` and ``audit.html`` into the folder `out` (created), each through
     a temporary file renamed over the old one (krl.files.write_text_atomic); returns their paths."""
-    # costs 0.05 s at start-up (python -X importtime, 2026-11-25)
-    from krl.files import write_text_atomic  # noqa: PLC0415
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
