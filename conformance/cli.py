@@ -6,6 +6,9 @@ import sys
 from pathlib import Path
 
 import click
+from conformance.report import DEFAULT_CORPUS, run_all
+from krl.cluster import SchedulerError
+from krl.pool import default_jobs
 
 
 @click.command("conformance")
@@ -32,11 +35,6 @@ def conformance(out: Path, fuzz_n: int, no_real: bool, corpus: Path | None, real
 
     Exit code 0 when every case that is not marked pending passes and the interpreters agree,
     1 otherwise."""
-    # this module loads with every `krl` command (app's subcommand table): the suites'
-    # modules cost 0.04 s and krl.cluster 0.01 s CPU on top of `krl --help`'s 0.15 s (2026-11-24)
-    from conformance.report import DEFAULT_CORPUS, run_all  # noqa: PLC0415
-    from krl.cluster import SchedulerError  # noqa: PLC0415
-    from krl.pool import default_jobs  # noqa: PLC0415
 
     try:
         s = run_all(out, fuzz_n=fuzz_n, real=not no_real, corpus=corpus or DEFAULT_CORPUS,

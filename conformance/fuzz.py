@@ -29,10 +29,10 @@ from pathlib import Path
 from typing import Any
 
 import yaml
-from hypothesis import HealthCheck, Phase, given, seed, settings
-from hypothesis import strategies as st
+from hypothesis import given, HealthCheck, Phase, seed, settings, strategies as st
 
 from . import harness as H
+from krl.pool import run_tasks
 
 INT_VARS = ("a", "b", "c")
 REAL_VARS = ("x", "y")
@@ -428,8 +428,6 @@ def run_fuzz(n: int = 200, *, reproducible: bool = True, interps: list[str] | No
         prop()
         recording = False
         stats.update(programs=0, tree_ok=0, agree=0 if "vm" in interps else None)
-        # on use: pebble costs 0.85 s to import (krl/pool.py), paid only by a run with workers
-        from krl.pool import run_tasks  # noqa: PLC0415
 
         order = list(dict.fromkeys(drawn))
         tasks = ((i, (src, stim, interps)) for i, (src, stim) in enumerate(order))

@@ -27,6 +27,10 @@ from krl.cluster import run_batches
 from krl.render import markdown_code as md, render_html
 
 from . import fuzz as F, harness as H
+import matplotlib
+import matplotlib.pyplot as plt
+from matplotlib.patches import Circle
+from krl.pool import run_tasks
 
 REPO = H.REPO
 
@@ -86,7 +90,6 @@ def _elsewhere(fn, tasks: list[tuple[int, tuple]], name: str, progress, failed, 
         outcomes = run_batches(scheduler, fn, tasks, batch_files=1, name=name)
         where = "on the Dask cluster"
     else:
-        from krl.pool import run_tasks  # noqa: PLC0415  (pebble: costs 50 ms; only a run with workers pays it)
 
         # no pool timeout: each run has its own wall-clock guard (harness.run_program)
         outcomes = run_tasks(fn, tasks, jobs=jobs, timeout=None, group=group)
@@ -238,13 +241,8 @@ def plot_case(co: CaseOutcome, png: Path) -> bool:
     runs = {k: r for k, r in co.runs.items() if r.events and any(e.get("kind") == "motion" for e in r.events)}
     if not runs:
         return False
-    # matplotlib costs 0.19 s and pyplot 0.45 s CPU (python -X importtime, 2026-11-24): loaded
-    # only when a chart is drawn
-    import matplotlib  # noqa: PLC0415
 
     matplotlib.use("Agg")
-    import matplotlib.pyplot as plt  # noqa: PLC0415
-    from matplotlib.patches import Circle  # noqa: PLC0415  (part of pyplot's 0.45 s)
 
     first = next(iter(runs.values()))
     mt = H.motion_times(first.events)
