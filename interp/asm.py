@@ -10,17 +10,14 @@ import click
 from krl.files import same_file, spelled, spelled_within
 from krl.project import project_of
 from krl.terminal import printable
+from interp.runtime.program import basis_files, checked_workspace
+from interp.vm.compiler import compile_module
 
 
 def program_assembly(program: Path, workspace: Path | None = None, all_modules: bool = False) -> str:
     """The assembly text of PROGRAM's module (with ``all_modules``: of every module of its
     program that has routines): the listings the VM links and runs, compiled from the
     checked, resolved program (krl/project.py, krl/semantics/resolve.py) with no runtime."""
-    # on use: the runtime and the compiler cost 0.72 s (python -X importtime, 2026-11-23, load
-    # average 22 on the 2 cores) of every krl command's start-up (app imports interp.cli, which
-    # registers `asm`)
-    from interp.runtime.program import basis_files, checked_workspace  # noqa: PLC0415
-    from interp.vm.compiler import compile_module  # noqa: PLC0415
 
     main_path = spelled_within(program, workspace)         # the user's spelling, links kept
     project = project_of(main_path, spelled(workspace) if workspace else None)

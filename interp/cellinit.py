@@ -41,6 +41,10 @@ from krl.project import machine_data_file, system_folder_of
 from krl.semantics.resolve import LOCAL, ROUTINE
 from krl.source import read_source
 from krl.terminal import printable
+from net.partners import PARTNERS
+from interp.run import global_value, make_runtime, run_spec
+from interp.runtime.values import Arr
+from robot.machine import library_robots, load_machine
 
 #: places listed per input; the rest are counted
 MAX_PLACES = 8
@@ -262,8 +266,6 @@ def _key(name: str) -> str:
 def _network_calls() -> dict[str, str]:
     """{KRL function: partner key} of the calls that name what a program opens of a network
     partner (net/partner.py ``Partner.opens``: ``EKI_Init`` a channel, ``RSI_CREATE`` a context)."""
-    # costs 0.12 s at start-up (python -X importtime, 2026-11-25)
-    from net.partners import PARTNERS  # noqa: PLC0415  (the network package: only for krl cell init)
 
     return {call: p.key for p in PARTNERS for call in p.opens}
 
@@ -272,11 +274,6 @@ def network_opened(rt, root: Path) -> list[tuple[str, str, str]]:
     """(kind, name, where) of every EKI channel and RSI context the modules of `rt` in the
     backup `root` open (``EKI_Init("NAME")``, ``RSI_CREATE("NAME", ...)``; a name held in a
     global CHAR array is read from its data list), in order of first use."""
-    # costs 0.26 s at start-up (python -X importtime, 2026-11-25)
-    from interp.run import global_value  # noqa: PLC0415
-
-    # costs 0.005 s at start-up (python -X importtime, 2026-11-25)
-    from interp.runtime.values import Arr  # noqa: PLC0415
 
     found: dict[tuple[str, str], tuple[str, str, str]] = {}
     calls = _network_calls()
@@ -310,8 +307,6 @@ def network_opened(rt, root: Path) -> list[tuple[str, str, str]]:
 def _network_lines(opened: list[tuple[str, str, str]], root: Path) -> list[str]:
     """The commented `network:` section of the starter (docs/network.md): each partner's lines
     for what the backup opens of it (net/partner.py ``Partner.starter``)."""
-    # costs 0.12 s at start-up (python -X importtime, 2026-11-25)
-    from net.partners import PARTNERS  # noqa: PLC0415  (the network package: only for krl cell init)
 
     if not opened:
         return []
@@ -328,8 +323,6 @@ def starter(uses: list[InputUse], programs: list[str], own_robot: bool = True,
     """The text of the starter cell file (YAML; every rule commented out, each valid once
     uncommented). `own_robot`: the backup has machine data of its own (else the file asks for
     the cell's robot). `network`: the commented ``network:`` lines."""
-    # costs 0.27 s at start-up (python -X importtime, 2026-11-25)
-    from robot.machine import library_robots  # noqa: PLC0415
 
     names = ", ".join(library_robots())
     robot = (f"# robot: NAME       # the backup's own robot (its R1/Mada/$machine.dat) runs; a name of "
@@ -371,10 +364,6 @@ def starter(uses: list[InputUse], programs: list[str], own_robot: bool = True,
 def cell_init(root: Path, programs: list[Path], whole: bool = False) -> str:
     """The starter cell file for `programs` of the backup `root` (see the module docstring):
     what each program runs; with `whole` (no program asked), every routine of the backup."""
-    # costs 0.26 s at start-up (python -X importtime, 2026-11-25)
-    from interp.run import make_runtime, run_spec  # noqa: PLC0415
-    # costs 0.27 s at start-up (python -X importtime, 2026-11-25)
-    from robot.machine import load_machine  # noqa: PLC0415
 
     found: dict[str, InputUse] = {}
     opened: dict[tuple[str, str], tuple[str, str, str]] = {}

@@ -16,6 +16,12 @@ from krl.limits import MAX_HALT_CONTINUES
 from krl.project import backup_of
 from krl.terminal import printable
 from robot.trace import TRACE_REPEATS, read_trace
+from interp.run import program_in, run_setup, RunSetupError
+from interp.summary import RunObserver, starvation_lines, summary_lines
+from robot.stimuli import StartError, StimulusError
+from net.hub import NetError
+from interp.scene import chosen
+from interp.cellinit import cell_init, from_run as rules_from_run
 
 
 @click.command("run")
@@ -82,8 +88,6 @@ def run(**options) -> None:
     (KRC/R1/Program/demo.src) or a module name (demo); the archive is checked and extracted
     to a temporary folder (krl/archive.py) that is removed after the run.
     """
-    # costs 0.32 s at start-up (python -X importtime, 2026-11-25)
-    from interp.run import RunSetupError, run_setup  # noqa: PLC0415
 
     options["halt_continues"] = halt_option(options.pop("on_halt"))
     try:
@@ -116,12 +120,6 @@ def halt_option(text: str) -> int:
 
 def _run(setup) -> None:
     """Run `setup` (interp.run.RunSetup) and print the summary; exits with the run's code."""
-    # costs 0.02 s at start-up (python -X importtime, 2026-11-25)
-    from interp.summary import RunObserver, starvation_lines, summary_lines  # noqa: PLC0415
-    # costs 0.11 s at start-up (python -X importtime, 2026-11-25)
-    from robot.stimuli import StartError, StimulusError  # noqa: PLC0415
-    # costs 0.06 s at start-up (python -X importtime, 2026-11-25)
-    from net.hub import NetError  # noqa: PLC0415
 
     shown, machine, program = setup.shown, setup.machine, setup.program
     trace = setup.trace_writer()
@@ -169,8 +167,6 @@ def _run(setup) -> None:
 
 def _chosen(program: Path, workspace) -> str:
     """``; chosen by ...`` when --inputs auto chose the robot (interp/scene.py)."""
-    # costs 0.03 s at start-up (python -X importtime, 2026-11-25)
-    from interp.scene import chosen  # noqa: PLC0415
 
     c = chosen(program, workspace)
     return f"; {c.note}" if c is not None else ""
@@ -210,12 +206,8 @@ def cell_init_cmd(backup: Path | None, program: Path | None, output: Path | None
     """Write a starter cell file for PROGRAM (a path or a module name in BACKUP): each input it
     reads, with a rule to fill in; without PROGRAM for every program of BACKUP. With
     --from-run TRACE, the answers of an automatic cell's run as rules."""
-    # costs 0.10 s at start-up (python -X importtime, 2026-11-25)
-    from interp.cellinit import cell_init, from_run as rules_from_run  # noqa: PLC0415
-    # costs 0.32 s at start-up (python -X importtime, 2026-11-25)
+    # deferred: tools/startup_bench.py, krl run +5 ms at the top (2026-11-26)
     from interp.realprograms import programs_of  # noqa: PLC0415
-    # costs 0.32 s at start-up (python -X importtime, 2026-11-25)
-    from interp.run import program_in  # noqa: PLC0415
     if from_run is not None:
         try:
             text = rules_from_run(read_trace(from_run), str(from_run))

@@ -37,6 +37,13 @@ from collections import Counter
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
+from interp.realprograms import REPORT_SIM_TIME_S, REPORT_STEPS, _own_machine_data, cause_of, step_limit, submit_of
+from interp.run import make_runtime, robot_for, run_spec
+from interp.runtime.scheduler import SUBMIT_BUDGET
+from interp.summary import ENDINGS
+from krl.source import read_source
+from krl.pool import run_tasks
+from interp.realprograms import loaded_with
 
 __all__ = ["EVENT_KINDS", "RUN_TIMEOUT_S", "CYCLE_TOLERANCE_S", "run_outcome", "run_outcomes", "outcome_changes"]
 
@@ -82,15 +89,6 @@ def event_kind(text: str) -> str:
 def run_outcome(path: str, max_sim_time: float | None = None, interp: str = "vm") -> dict:
     """The outcome of one run of the program `path` (see the module docstring). Never raises
     for the program: an error of the simulator is an outcome with reason ``internal``."""
-    # costs 0.42 s at start-up (python -X importtime, 2026-11-25)
-    from interp.realprograms import (REPORT_SIM_TIME_S, REPORT_STEPS, _own_machine_data, cause_of,  # noqa: PLC0415
-                                     step_limit, submit_of)
-    # costs 0.42 s at start-up (python -X importtime, 2026-11-25)
-    from interp.run import make_runtime, robot_for, run_spec  # noqa: PLC0415
-    # costs 0.13 s at start-up (python -X importtime, 2026-11-25)
-    from interp.runtime.scheduler import SUBMIT_BUDGET  # noqa: PLC0415
-    # costs 0.02 s at start-up (python -X importtime, 2026-11-25)
-    from interp.summary import ENDINGS  # noqa: PLC0415
 
     p = Path(path)
     limit_s = REPORT_SIM_TIME_S if max_sim_time is None else max_sim_time
@@ -119,8 +117,6 @@ def _statement(file: str | None, line: int | None) -> str:
     program end at the same statement when it moved to another line."""
     if not file or not line:
         return ""
-    # costs 0.02 s at start-up (python -X importtime, 2026-11-25)
-    from krl.source import read_source  # noqa: PLC0415
 
     lines = (read_source(file).text or "").splitlines()
     return lines[line - 1].strip() if 0 < line <= len(lines) else ""
@@ -145,13 +141,9 @@ def run_outcomes(paths: list[str], max_sim_time: float | None = None, jobs: int 
     """{path: outcome} of every program of `paths` (:func:`run_outcome`), in `jobs` worker
     processes (krl.pool.run_tasks; 1: in this process). `progress(path, outcome)` is called as
     each run ends."""
-    # costs 0.02 s at start-up (python -X importtime, 2026-11-25)
-    from krl.pool import run_tasks  # noqa: PLC0415
 
     out: dict[str, dict] = {}
     tasks = [(p, (p, max_sim_time)) for p in dict.fromkeys(paths)]
-    # costs 0.42 s at start-up (python -X importtime, 2026-11-25), paid by run_outcome anyway
-    from interp.realprograms import loaded_with  # noqa: PLC0415
 
     # a backup's programs in one worker after the other: it loads the backup once
     for o in run_tasks(run_outcome, tasks, jobs=jobs, timeout=RUN_TIMEOUT_S, in_process=jobs == 1,

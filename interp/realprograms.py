@@ -71,6 +71,10 @@ from krl.files import SHARED_CORPUS as DEFAULT_CORPUS
 from krl.project import (
     backup_of, boot_submit, find_backups, machine_data_file, system_folder, system_folder_of,
 )
+from interp.run import cell_of as cell_file, global_value, make_runtime, robot_for, run_spec
+from krl.cluster import run_batches, SchedulerError
+from krl.pool import default_jobs, run_tasks
+from interp import run as _loaded
 
 LEGITIMATE = ("deadlock", "halt", "max_sim_time", "max_steps")
 
@@ -323,10 +327,7 @@ def time_limit(path: Path, cell, default: float) -> float:
     robot/stimuli.py)."""
     if cell is None:
         return default
-    # costs 0.006 s at start-up (python -X importtime, 2026-11-25)
-    from interp.run import cell_of  # noqa: PLC0415
-
-    return max(default, cell_of(cell).sim_time.get(path.stem.upper(), 0.0))
+    return max(default, cell_file(cell).sim_time.get(path.stem.upper(), 0.0))
 
 
 def report_run(path: Path, cell: Path | None, max_sim_time: float = REPORT_SIM_TIME_S,
@@ -339,10 +340,7 @@ def report_run(path: Path, cell: Path | None, max_sim_time: float = REPORT_SIM_T
     runs as the program, at a submit interpreter's pace); :func:`time_limit` (auto: the longer
     `auto_sim_time`, default :data:`AUTO_SIM_TIME_S`, for a robot program) and :func:`step_limit`
     (the robot program's `max_steps`)."""
-    # costs 0.006 s at start-up (python -X importtime, 2026-11-25)
-    from interp.run import cell_of, robot_for  # noqa: PLC0415
-
-    cell = None if auto else cell_of(cell)
+    cell = None if auto else cell_file(cell)
     robot = robot_for(path, inputs="auto" if auto else cell)
     submit = submit_of(path)
     sub = path.suffix.lower() == ".sub"
@@ -423,8 +421,6 @@ class RunEvents:
 def _request_signal(rt, path: Path) -> tuple[str, bool] | None:
     """P00's program-number request output as the program sees ``PGNO_REQ`` ($config.dat):
     ``($OUT[n], active value)``, None when it is 0 or not declared."""
-    # costs 0.006 s at start-up (python -X importtime, 2026-11-25)
-    from interp.run import global_value  # noqa: PLC0415
 
     req = global_value(rt, path.stem, "PGNO_REQ")
     if not isinstance(req, int) or isinstance(req, bool) or req == 0:
@@ -480,14 +476,11 @@ def run_one(path: Path, max_sim_time: float, max_steps: int, cell: Path | None =
     :data:`MAX_ROW_REQUESTS`; ``requests_total``).
     `auto_sim_time`: the time limit of an ``--inputs auto`` run of a robot program (default
     :data:`AUTO_SIM_TIME_S`; a bounded sweep gives less, ``krl audit --max-sim-time``)."""
-    # costs 0.006 s at start-up (python -X importtime, 2026-11-25)
-    from interp.run import cell_of, make_runtime, run_spec  # noqa: PLC0415
-
     t0 = time.time()
     shown = None if auto else cell
     events = RunEvents()
     try:
-        cell = None if auto else cell_of(cell)   # the cell file, read once for the robot, the limits and the run
+        cell = None if auto else cell_file(cell)   # the cell file, read once for the robot, the limits and the run
         inputs = "auto" if auto else cell
         robot, submit, max_sim_time, limit = report_run(path, cell, max_sim_time, max_steps, auto,
                                                         auto_sim_time)
@@ -672,16 +665,10 @@ def run_rows(corpus: Path, max_sim_time: float = REPORT_SIM_TIME_S, max_steps: i
                 progress("auto" if args[4] else "cells", rows[-1])
         return rows
     if scheduler is None:
-        # costs 0.004 s at start-up (python -X importtime, 2026-11-25)
-        from krl.pool import run_tasks  # noqa: PLC0415
-        # costs 0.006 s at start-up (python -X importtime, 2026-11-25)
-        from interp import run as _loaded  # noqa: F401, PLC0415  (forked workers start with the runtime imported)
 
         # a backup's programs in one worker after the other: it loads the backup once
         outcomes = run_tasks(run_one, tasks, jobs=jobs, timeout=None, group=lambda k: loaded_with(tasks[k][1][0]))
     else:
-        # costs 0.005 s at start-up (python -X importtime, 2026-11-25)
-        from krl.cluster import run_batches  # noqa: PLC0415
 
         outcomes = run_batches(scheduler, run_one, tasks, batch_files=1, name="krl-realprograms")
     got: dict[int, dict] = {}
@@ -738,11 +725,6 @@ def main(argv: list[str] | None = None) -> int:
         shown = shown.relative_to(corpus) if shown.is_relative_to(corpus) else shown
         print(f"{col:5s} {r['cause']:15s} {r['reason']:13s} {r.get('seconds', 0):6.1f}s "
               f"{shown}  {r['text'][:80]}{sub}", file=sys.stderr)
-
-    # costs 0.005 s at start-up (python -X importtime, 2026-11-25)
-    from krl.cluster import SchedulerError  # noqa: PLC0415
-    # costs 0.004 s at start-up (python -X importtime, 2026-11-25)
-    from krl.pool import default_jobs  # noqa: PLC0415
 
     try:
         rows = run_rows(corpus, a.max_sim_time, a.max_steps, cells=not a.no_cells, limit=a.limit,

@@ -19,6 +19,14 @@ import numpy as np
 
 from interp.runtime.values import Arr, Struct
 from krl.limits import MAX_CHOICE_POINTS
+from krl.ast import nodes as N
+from robot.stimuli import StartError, parse_start
+from krl.files import spelled, spelled_within
+from krl.project import backup_of, machine_data_file
+from robot.frames import frame_to_matrix, inv_pos
+from robot.planner import RobotModel
+from robot.machine import library_robots, load_machine
+from robot.mada import MachineDataError, load_robot
 
 #: the components of a Cartesian point and of an axis point
 _CART = ("X", "Y", "Z", "A", "B", "C")
@@ -34,10 +42,6 @@ def start_axes(model, value_of: Callable[[str], object], text: str) -> np.ndarra
     world: null ``$TOOL`` and ``$BASE``) through the robot's inverse kinematics with its S and
     T. Raises :class:`robot.stimuli.StartError` for a point the program does not have, a pose
     the robot cannot take, or axes outside its software limits."""
-    # costs 0.05 s at start-up (python -X importtime, 2026-11-25)
-    from krl.ast import nodes as N  # noqa: PLC0415
-    # costs 0.14 s at start-up (python -X importtime, 2026-11-25)
-    from robot.stimuli import StartError, parse_start  # noqa: PLC0415
 
     expr = parse_start(text)
     if isinstance(expr, N.Name):
@@ -61,8 +65,6 @@ def start_axes(model, value_of: Callable[[str], object], text: str) -> np.ndarra
     if any(k in comps for k in _AXES):
         q = amap.from_components(comps)
     elif all(k in comps for k in _CART):
-        # costs 0.43 s at start-up (python -X importtime, 2026-11-25)
-        from robot.frames import frame_to_matrix  # noqa: PLC0415
 
         T_world = frame_to_matrix(*(float(comps[k]) for k in _CART))
         try:
@@ -101,10 +103,6 @@ _CHOICES: dict = {}
 
 def chosen(program: Path, workspace=None) -> Choice | None:
     """The choice :func:`choose_robot` made for the backup of `program`, if it made one."""
-    # costs 0.03 s at start-up (python -X importtime, 2026-11-25)
-    from krl.files import spelled, spelled_within  # noqa: PLC0415
-    # costs 0.03 s at start-up (python -X importtime, 2026-11-25)
-    from krl.project import backup_of  # noqa: PLC0415
 
     root = backup_of(spelled_within(program, workspace), spelled(workspace) if workspace else None)
     return _CHOICES.get(root) if root is not None else None
@@ -166,10 +164,6 @@ def reaches(machine, points) -> int:
     """How many of `points` (:func:`taught_points`) the robot of `machine` can take: an axis
     point within its software limits; a pose for which some configuration of its inverse
     kinematics (any status and turn, ±360° variants) lies within them."""
-    # costs 0.43 s at start-up (python -X importtime, 2026-11-25)
-    from robot.frames import frame_to_matrix, inv_pos  # noqa: PLC0415
-    # costs 0.51 s at start-up (python -X importtime, 2026-11-25)
-    from robot.planner import RobotModel  # noqa: PLC0415
 
     model = RobotModel(machine)
     limits = [j.limit_deg for j in machine.joints]
@@ -206,14 +200,6 @@ def choose_robot(program: Path, probe: Callable[[], tuple], workspace=None) -> C
     value_of)``: the program loaded on the default robot and a reader of its globals. None
     outside a backup, for a backup with its own machine data, or when no robot reaches more
     than the default. One choice per backup and process."""
-    # costs 0.03 s at start-up (python -X importtime, 2026-11-25)
-    from krl.files import spelled, spelled_within  # noqa: PLC0415
-    # costs 0.03 s at start-up (python -X importtime, 2026-11-25)
-    from krl.project import backup_of, machine_data_file  # noqa: PLC0415
-    # costs 0.53 s at start-up (python -X importtime, 2026-11-25)
-    from robot.machine import library_robots, load_machine  # noqa: PLC0415
-    # costs 0.83 s at start-up (python -X importtime, 2026-11-25)
-    from robot.mada import MachineDataError, load_robot  # noqa: PLC0415
 
     root = backup_of(spelled_within(program, workspace), spelled(workspace) if workspace else None)
     if root is None or machine_data_file(root) is not None:

@@ -19,6 +19,9 @@ from pathlib import Path
 from typing import Any
 
 from krl.terminal import clip, printable, printable_path
+from krl.ast import nodes as N
+from interp.run import global_value, signal_of
+from krl.ast.printer import expr as printed
 
 #: messages shown on the console; the rest are counted ("... N more").
 MAX_MESSAGES = 8
@@ -230,8 +233,6 @@ def _run_lines(rt: Any) -> list[str]:
 # ------------------------------------------------------------------ a starving WAIT FOR
 def _wait_node(rt: Any, file: str, line: int):
     """The WAIT FOR statement of the program's files at `file`:`line`, or None."""
-    # costs 0.04 s at start-up (python -X importtime, 2026-11-25)
-    from krl.ast import nodes as N  # noqa: PLC0415
 
     target = str(Path(file).resolve())
     for m in rt.program.modules:
@@ -246,10 +247,6 @@ def _wait_node(rt: Any, file: str, line: int):
 
 def _input_of(rt: Any, main: str, e: Any) -> str | None:
     """``$IN[n]``, or the SIGNAL name on one input, that `e` reads; None for anything else."""
-    # costs 0.04 s at start-up (python -X importtime, 2026-11-25)
-    from krl.ast import nodes as N  # noqa: PLC0415
-    # costs 0.53 s at start-up (python -X importtime, 2026-11-25)
-    from interp.run import global_value, signal_of  # noqa: PLC0415
 
     if isinstance(e, N.Name):
         found = signal_of(rt, main, e.name)
@@ -268,8 +265,6 @@ def _input_of(rt: Any, main: str, e: Any) -> str | None:
 def _release(rt: Any, main: str, e: Any, want: bool) -> dict[str, bool] | None:
     """Input values that make the condition `e` equal `want`: one way, the first operand of
     an OR; None when the condition is not over inputs alone in a way this reads."""
-    # costs 0.04 s at start-up (python -X importtime, 2026-11-25)
-    from krl.ast import nodes as N  # noqa: PLC0415
 
     name = _input_of(rt, main, e)
     if name is not None:
@@ -316,8 +311,6 @@ def _waiting(rt: Any, file: str, line: int, halted: bool):
     """(routine, kind, condition) the robot task waits on at `file`:`line`: a WAIT FOR on that
     line; else (a HALT, a statement in a busy loop) the innermost REPEAT ... UNTIL or WHILE
     around it — kind ``UNTIL``/``WHILE``; None when there is none."""
-    # costs 0.04 s at start-up (python -X importtime, 2026-11-25)
-    from krl.ast import nodes as N  # noqa: PLC0415
 
     target = str(Path(file).resolve())
     for m in rt.program.modules:
@@ -342,8 +335,6 @@ def _waiting(rt: Any, file: str, line: int, halted: bool):
 
 def _path_to(node: Any, line: int) -> list | None:
     """The nodes from `node` down to the first statement that stands on `line`, or None."""
-    # costs 0.04 s at start-up (python -X importtime, 2026-11-25)
-    from krl.ast import nodes as N  # noqa: PLC0415
 
     for child in node.children():
         if child is None or not isinstance(child, N.Node):
@@ -359,10 +350,6 @@ def _path_to(node: Any, line: int) -> list | None:
 def _index(rt: Any, main: str, e: Any):
     """The INT value of an index expression of literals, constants and variables of the data
     lists (``PGNO_VALID*(-1)``), or None."""
-    # costs 0.04 s at start-up (python -X importtime, 2026-11-25)
-    from krl.ast import nodes as N  # noqa: PLC0415
-    # costs 0.53 s at start-up (python -X importtime, 2026-11-25)
-    from interp.run import global_value  # noqa: PLC0415
 
     if isinstance(e, N.IntLit):
         return e.value
@@ -382,10 +369,6 @@ def _index(rt: Any, main: str, e: Any):
 
 def _reads(rt: Any, main: str, cond: Any) -> tuple[list[str], list[int]]:
     """(system variables, input numbers) the condition `cond` reads, each once, in order."""
-    # costs 0.04 s at start-up (python -X importtime, 2026-11-25)
-    from krl.ast import nodes as N  # noqa: PLC0415
-    # costs 0.53 s at start-up (python -X importtime, 2026-11-25)
-    from interp.run import signal_of  # noqa: PLC0415
 
     names: list[str] = []
     inputs: list[int] = []
@@ -407,8 +390,6 @@ def _reads(rt: Any, main: str, cond: Any) -> tuple[list[str], list[int]]:
 def _pgno_inputs(rt: Any, main: str) -> dict[int, str]:
     """Input number -> what it carries in P00's program-number handshake (the ``PGNO_*``
     parameters of $config.dat): the valid bit, the parity bit, the number's bits."""
-    # costs 0.53 s at start-up (python -X importtime, 2026-11-25)
-    from interp.run import global_value  # noqa: PLC0415
 
     out: dict[int, str] = {}
     for name in _PGNO_INPUTS:
@@ -471,8 +452,6 @@ def _stack(rt: Any, task: Any) -> list[tuple[str, int]]:
 
 
 def _show(e: Any) -> str:
-    # costs 0.06 s at start-up (python -X importtime, 2026-11-25)
-    from krl.ast.printer import expr as printed  # noqa: PLC0415
 
     try:
         return printed(e)
@@ -497,8 +476,6 @@ def starvation_lines(rt: Any) -> list[str]:
     if node is None:
         return []
     main = rt.program.main_path.stem
-    # costs 0.53 s at start-up (python -X importtime, 2026-11-25)
-    from interp.run import signal_of  # noqa: PLC0415
 
     names = []
     for n in _inputs_read(rt, main, node.cond):

@@ -58,6 +58,7 @@ from krl.files import SHARED_CORPUS
 from krl.project import find_backups
 from krl.semantics.outside import template_lines
 from krl.source import is_krl_file
+from krl.pool import run_tasks
 
 __all__ = ["SIM_TIME_S", "STEPS", "Variant", "backups", "run_variant", "sample", "some_entries", "variants_of"]
 
@@ -331,8 +332,6 @@ def main(argv: list[str] | None = None) -> int:
                     help="append each variant's result to this file as one JSON line as it ends; the variants "
                          "it already holds are not run again (a stopped sweep resumes)")
     args = ap.parse_args(argv)
-    # on use: the worker pool (pebble) costs 0.42 s (python -X importtime, 2026-11-23, krl/workspace.py)
-    from krl.pool import run_tasks  # noqa: PLC0415
 
     folders = args.folders or [SHARED_CORPUS, SHARED_HISTORY]
     variants = [v for b in backups(folders) for v in variants_of(b)]

@@ -19,6 +19,11 @@ from pathlib import Path
 from krl.cbuild import OTHER_CHECKOUT_PRELUDE
 
 from . import bench as py
+from interp.run import make_runtime, run_spec
+from interp.vm.vm import COMPILED
+import shutil
+import subprocess
+import tempfile
 
 HERE = Path(__file__).resolve().parent
 PROGRAM = HERE / "bench.src"
@@ -36,8 +41,6 @@ def run_krl(interp: str, program: Path = PROGRAM, clock=None):
     """One run: (seconds, steps, (CHECK_I, CHECK_R)); seconds of `clock` (default
     time.perf_counter, wall time; time.process_time: this process's CPU time)."""
     clock = clock or time.perf_counter
-    # costs 0.44 s at start-up (python -X importtime, 2026-11-25)
-    from interp.run import make_runtime, run_spec  # noqa: PLC0415
 
     rt, _ = make_runtime(run_spec(program, mujoco=False, max_steps=10 ** 9, interp=interp))
     t0 = clock()
@@ -112,12 +115,6 @@ class Baseline:
         self.dir = None
 
     def __enter__(self) -> "Baseline":
-        # costs 0.004 s at start-up (python -X importtime, 2026-11-25)
-        import shutil  # noqa: PLC0415
-        # costs 0.006 s at start-up (python -X importtime, 2026-11-25)
-        import subprocess  # noqa: PLC0415
-        # costs 0.007 s at start-up (python -X importtime, 2026-11-25)
-        import tempfile  # noqa: PLC0415
 
         repo = HERE.parents[1]
         self.dir = Path(tempfile.mkdtemp(prefix="krl-baseline-")) / "tree"
@@ -130,10 +127,6 @@ class Baseline:
         return self
 
     def __exit__(self, *exc) -> None:
-        # costs 0.004 s at start-up (python -X importtime, 2026-11-25)
-        import shutil  # noqa: PLC0415
-        # costs 0.006 s at start-up (python -X importtime, 2026-11-25)
-        import subprocess  # noqa: PLC0415
 
         repo = HERE.parents[1]
         subprocess.run(["git", "-C", str(repo), "worktree", "remove", "--force", str(self.dir)],
@@ -143,8 +136,6 @@ class Baseline:
     def _python(self, code: str, *args: str) -> str:
         """Run `code` (with `args` in sys.argv[1:]) in a fresh process on that revision; its
         output's last line. Raises RuntimeError when it fails."""
-        # costs 0.006 s at start-up (python -X importtime, 2026-11-25)
-        import subprocess  # noqa: PLC0415
         env = dict(os.environ, PYTHONPATH=str(self.dir))
         p = subprocess.run([sys.executable, "-c", code, *args], cwd=self.dir, env=env,
                            capture_output=True, text=True, timeout=3600)
@@ -203,8 +194,6 @@ def compute(repeat: int = 3, baseline: Baseline | None = None, cpu: bool = False
                 best[key] = dt if best[key] is None else min(best[key], dt)
     if len({checks[k] for k in checks}) != 1:
         raise RuntimeError(f"benchmark results differ: {checks}")
-    # costs 0.17 s at start-up (python -X importtime, 2026-11-25)
-    from interp.vm.vm import COMPILED  # noqa: PLC0415  (the VM loads only for the benchmark)
 
     out = {
         "steps": steps, "clock": "cpu" if cpu else "wall",

@@ -40,16 +40,14 @@ from pathlib import Path
 from krl.cputime import tree_cpu_s
 
 from .client import ROOT, DapClient
+from krl.files import SHARED_CORPUS
+from krl.project import find_backups
+from krl.source import is_krl_file
+from interp.realprograms import programs_of
 
 
 def largest_backup() -> Path | None:
     """The corpus backup with the most KRL files (None without the shared corpus)."""
-    # costs 0.02 s at start-up (python -X importtime, 2026-11-25)
-    from krl.files import SHARED_CORPUS  # noqa: PLC0415
-    # costs 0.02 s at start-up (python -X importtime, 2026-11-25)
-    from krl.project import find_backups  # noqa: PLC0415
-    # costs 0.02 s at start-up (python -X importtime, 2026-11-25)
-    from krl.source import is_krl_file  # noqa: PLC0415
 
     if not SHARED_CORPUS.is_dir():
         return None
@@ -100,10 +98,6 @@ def main(argv: list[str] | None = None) -> int:
     if backup is None:
         print("no backup: the shared corpus is beside the repository", file=sys.stderr)
         return 2
-    # costs 0.41 s at start-up (python -X importtime, 2026-11-25)
-    from interp.realprograms import programs_of  # noqa: PLC0415
-    # costs 0.02 s at start-up (python -X importtime, 2026-11-25)
-    from krl.source import is_krl_file  # noqa: PLC0415
 
     program = a.program or next(iter(programs_of(backup)), None)
     if program is None:

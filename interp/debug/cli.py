@@ -6,6 +6,8 @@ import os
 import sys
 
 import click
+from interp.debug.session import DebugSession
+from interp.debug.wire import FdReader
 
 
 @click.command("debug")
@@ -19,8 +21,6 @@ def debug() -> None:
     # the simulated arm is never drawn here: MuJoCo's rendering back end (GLFW) is not loaded
     # (0.03-0.05 s CPU of the launch, 2026-11-24); a user's own MUJOCO_GL is kept
     os.environ.setdefault("MUJOCO_GL", "disable")
-    from interp.debug.session import DebugSession  # noqa: PLC0415
-    from interp.debug.wire import FdReader  # noqa: PLC0415
 
     out = sys.stdout.buffer
     sys.stdout = sys.stderr         # a stray print must not corrupt the protocol stream

@@ -86,6 +86,11 @@ from .breakpoints import Breakpoint
 from .errors import Refused
 from .expr import ExpressionError, compile_in_frame, parse_expression
 from .values import has_children, value_text
+from interp.run import RunSetupError, run_setup
+from .launch import run_defaults
+from robot.io import N_DIGITAL
+from interp.tree import TreeInterpreter
+from interp.runtime.convert import to_bool
 
 
 class Terminate(BaseException):
@@ -287,11 +292,6 @@ class Engine:
         """Load, check and build the run of ``config`` (not started yet). Raises
         :class:`Refused` when the checker finds errors in the program's own module (the run
         would not start, as with ``krl run``)."""
-        # costs 0.27 s at start-up (python -X importtime, 2026-11-25)
-        from interp.run import RunSetupError, run_setup  # noqa: PLC0415
-
-        # costs 0.02 s at start-up (python -X importtime, 2026-11-25)
-        from .launch import run_defaults  # noqa: PLC0415
 
         options = {**run_defaults(), **config.options}
         try:
@@ -495,8 +495,6 @@ class Engine:
     def set_input(self, index: int, value: bool) -> bool:
         """``$IN[index]`` set by hand (source ``operator`` in the trace); the cell's rules
         stay active. Returns the input's value."""
-        # costs 0.004 s at start-up (python -X importtime, 2026-11-25)
-        from robot.io import N_DIGITAL  # noqa: PLC0415
 
         if not isinstance(index, int) or isinstance(index, bool) or not 1 <= index <= N_DIGITAL:
             raise Refused(f"input: an index 1..{N_DIGITAL}")
@@ -715,8 +713,6 @@ class Engine:
             self._trace = None
 
     def _run_loop(self) -> None:
-        # costs 0.05 s at start-up (python -X importtime, 2026-11-25)
-        from interp.tree import TreeInterpreter  # noqa: PLC0415
 
         target, reason, scan = None, "step", None
         while True:
@@ -863,8 +859,6 @@ class Engine:
         return None
 
     def _condition(self, bp: Breakpoint, frame) -> bool:
-        # costs 0.003 s at start-up (python -X importtime, 2026-11-25)
-        from interp.runtime.convert import to_bool  # noqa: PLC0415
         v = self._eval(bp.condition, frame)
         try:
             return bool(to_bool(v, "breakpoint condition"))

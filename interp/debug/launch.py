@@ -23,6 +23,7 @@ from pathlib import Path
 import click
 
 from .errors import Refused
+from interp.cli import run
 
 PACKAGE_JSON = Path(__file__).resolve().parents[2] / "editors" / "vscode" / "package.json"
 
@@ -42,8 +43,6 @@ PROGRAM_TEXT = ("The KRL program to run: a .src file (its main routine); with a 
 
 
 def run_command() -> click.Command:
-    # costs 0.55 s at start-up (python -X importtime, 2026-11-25)
-    from interp.cli import run  # noqa: PLC0415
 
     return run
 

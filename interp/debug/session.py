@@ -25,6 +25,7 @@ from krl.terminal import printable
 from .engine import Engine, LaunchConfig, Refused, Restart, Terminate
 from .values import value_text
 from .wire import ProtocolError, read_message, write_message
+from .launch import run_options
 
 
 def _prepare() -> None:
@@ -151,8 +152,6 @@ class DebugSession:
 
     def req_launch(self, req, args) -> None:
         """Every option of ``krl run`` (interp/debug/launch.py), and ``stopOnEntry``."""
-        # costs 0.02 s at start-up (python -X importtime, 2026-11-25)
-        from .launch import run_options  # noqa: PLC0415
 
         options, extra = run_options(args)
         self.engine.launch(LaunchConfig(options, stop_on_entry=extra["stopOnEntry"]))

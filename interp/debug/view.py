@@ -15,6 +15,9 @@ plain value, or a :class:`Const`.
 
 from __future__ import annotations
 
+from .values import children
+from interp.runtime.errors import KrlRuntimeError
+
 ROBOT_THREAD = 1
 SUBMIT_THREAD = 2            # + index among the submit tasks
 INTERRUPT_THREAD = 1000      # + interrupt number (1..128)
@@ -121,8 +124,6 @@ def scopes(frame) -> list[tuple[str, tuple]]:
 
 def entries(rt, scope: tuple) -> list:
     """(name, Ref or value) of the variables under ``scope``."""
-    # costs 0.03 s at start-up (python -X importtime, 2026-11-25)
-    from .values import children  # noqa: PLC0415
 
     kind = scope[0]
     out = []
@@ -179,8 +180,6 @@ def child(rt, ref, step, name):
 def peek(ref):
     """The value under ``ref`` without side effects; :class:`Invalid` when it cannot be
     read."""
-    # costs 0.05 s at start-up (python -X importtime, 2026-11-25)
-    from interp.runtime.errors import KrlRuntimeError  # noqa: PLC0415
 
     if ref is None:
         return None

@@ -58,6 +58,9 @@ from robot.io import ALWAYS_TRUE_INPUT
 from .errors import KrlRuntimeError
 from .memory import ProxyRef, SignalRef
 from .values import EnumValue
+from robot.cellpresets import PresetError, pgno_bits, pgno_rules
+from robot.stimuli import Stimulus
+from krl.source import read_source
 
 #: s between the moment the cell sees the program starve and its answer (a PLC scan, the
 #: sensor and the bus: a stated figure, not a measured one)
@@ -339,8 +342,6 @@ class AutoCell:
     def _schedule(self, c: _Candidate, atoms: list, values: list) -> None:
         rt = self.rt
         ctl = rt.controller
-        # costs 0.15 s at start-up (python -X importtime, 2026-11-25)
-        from robot.stimuli import Stimulus  # noqa: PLC0415
 
         sets: dict[str, bool] = {}
         items = []
@@ -410,8 +411,6 @@ def handshake_rules(rt, main: str, params: dict) -> list:
     automatic cell: the numbers of :func:`program_numbers` in turn (each request gets the
     next one; 1 when the program selects none), or [] when the backup's ``$config.dat`` lacks
     a parameter or does not allow the preset."""
-    # costs 0.12 s at start-up (python -X importtime, 2026-11-25)
-    from robot.cellpresets import PresetError, pgno_bits, pgno_rules  # noqa: PLC0415
 
     numbers = program_numbers(rt) or [1]
     try:
@@ -454,8 +453,6 @@ def _text(e: N.Expr) -> str:
     if span is None or not span.file:
         return ""
     try:
-        # costs 0.008 s at start-up (python -X importtime, 2026-11-25)
-        from krl.source import read_source  # noqa: PLC0415
         lines = read_source(span.file).text.splitlines()
         return printable(lines[span.line - 1].split(";", 1)[0].strip())[:120]
     except Exception:  # noqa: BLE001 - the text is a courtesy

@@ -20,6 +20,7 @@ from krl.semantics.values import binary_op as _binary_op
 from krl.semantics.values import real_to_int, to_bool, trunc_int, unary_op, value_invalid
 
 from .values import Arr, Struct, copy_value, make_value, value_text
+from robot.frames import frame_to_matrix, inv_pos as _inv, matrix_to_frame
 
 __all__ = ["INT_MAX", "INT_MIN", "assign_chars", "assign_into", "binary_op", "check_int", "compare",
            "convert_scalar", "frame_tuple", "geo_compose", "inv_pos", "num", "real_to_int",
@@ -208,8 +209,6 @@ def struct_from_frame(fr, like: Struct | None, type_=None) -> Struct:
 
 
 def geo_compose(a, b) -> Struct:
-    # costs 0.60 s at start-up (python -X importtime, 2026-11-25)
-    from robot.frames import frame_to_matrix, matrix_to_frame  # noqa: PLC0415
 
     Ta = frame_to_matrix(*frame_tuple(a, "left operand of ':'"))
     Tb = frame_to_matrix(*frame_tuple(b, "right operand of ':'"))
@@ -218,8 +217,6 @@ def geo_compose(a, b) -> Struct:
 
 
 def inv_pos(a) -> Struct:
-    # costs 0.60 s at start-up (python -X importtime, 2026-11-25)
-    from robot.frames import frame_to_matrix, inv_pos as _inv, matrix_to_frame  # noqa: PLC0415
 
     fr = matrix_to_frame(_inv(frame_to_matrix(*frame_tuple(a, "INV_POS argument"))))
     return struct_from_frame(fr, a)

@@ -18,6 +18,7 @@ from robot.motion import MotionParams, MotionRequest, SplineSegment
 from .convert import num, trunc_int
 from .errors import KrlRuntimeError, value_invalid
 from .values import UNSET, Struct
+from dataclasses import replace
 
 TARGET_KEYS = ("X", "Y", "Z", "A", "B", "C", "S", "T", "A1", "A2", "A3", "A4", "A5", "A6",
                "E1", "E2", "E3", "E4", "E5", "E6")
@@ -64,7 +65,6 @@ def params_from(store: dict, link=None) -> MotionParams:
 
 
 def _linked(store: dict, link) -> MotionParams:
-    from dataclasses import replace  # noqa: PLC0415 - only for a linked base (a costs 0 s: stdlib loaded)
 
     system, root, offset = link
     return replace(params_from(store), base=offset, base_kin=system, base_root=root)

@@ -48,6 +48,7 @@ from greenlet import GreenletExit, greenlet
 
 from .contexts import Context, InterruptTable
 from .idle import IdleWatch
+from .spin import SpinWatch
 
 #: steps (a statement or a loop iteration) per IPO cycle: the robot interpreter's and the submit
 #: interpreter's time slices (docs/architecture.md, "The submit interpreter's pace": KUKA
@@ -131,8 +132,6 @@ class Scheduler:
         self.stop: tuple | None = None      # (reason, text, task)
         self.main = greenlet.getcurrent()
         self.idle = IdleWatch(rt)           # fast-forward of idle cycles (interp/runtime/idle.py)
-        # costs 0.02 s at start-up (python -X importtime, 2026-11-25)
-        from .spin import SpinWatch  # noqa: PLC0415
 
         self.spin = SpinWatch(rt)           # parked spins (interp/runtime/spin.py)
         self.return_to = None               # a catch-up's caller (SpinWatch.wake); else main

@@ -34,6 +34,7 @@ from .errors import KrlRuntimeError, value_invalid
 from .memory import ComputedRef, Slot
 from .values import UNSET, Arr, EnumValue, Struct, make_value, zero_value
 from .writerules import WriteHook
+from robot.workspace import WorkspaceMonitor
 
 
 class LiveArray:
@@ -350,8 +351,6 @@ class SysVars:
     def _watch_workspaces(self) -> None:
         if self.workspaces is not None:
             return
-        # costs 0.002 s at start-up (python -X importtime, 2026-11-26; robot.controller loaded)
-        from robot.workspace import WorkspaceMonitor  # noqa: PLC0415
 
         refs = self.refs
 

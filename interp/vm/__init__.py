@@ -11,14 +11,6 @@ vm-loop``; loop.py is the pure-Python fallback). The compute benchmark of `krl b
 interp/bench.
 """
 
+from .vm import VM
+
 __all__ = ["VM"]
-
-
-def __getattr__(name: str):
-    # loaded on first use (PEP 562; optional for commands that run nothing): vm.py imports the runtime and the compiled loop, which
-    # `krl` commands that run no program (check, fmt, lsp) do not need
-    if name == "VM":
-        from .vm import VM  # noqa: PLC0415
-
-        return VM
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

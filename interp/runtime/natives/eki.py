@@ -17,6 +17,7 @@ from ..memory import index_ref
 from ..sysvars import struct_of
 from ..values import UNSET, Arr, Struct, is_char_array
 from .registry import Family
+from net.eki import EkiError, format_real, Status
 
 # EthernetKRL's routines are declared on the controller (the option's EXTFCTP lines): known by
 # name only, as functions.yaml's ``lenient: ethernet_krl``
@@ -50,8 +51,6 @@ def _result(st, err) -> Struct:
 
 
 def _eki_error(exc) -> Struct:
-    # costs 0.05 s at start-up (python -X importtime, 2026-11-25)
-    from net.eki import Status  # noqa: PLC0415
 
     if exc.stops:
         raise KrlRuntimeError(str(exc), exc.number)
@@ -61,8 +60,6 @@ def _eki_error(exc) -> Struct:
 def _call(fn):
     """A native whose body may raise net.eki.EkiError (an unknown channel, a failed Init)."""
     def native(rt, a):
-        # costs 0.05 s at start-up (python -X importtime, 2026-11-25)
-        from net.eki import EkiError  # noqa: PLC0415
 
         try:
             return fn(rt, a)
@@ -91,8 +88,6 @@ def eki_close(rt, a):
 
 @_call
 def eki_clear(rt, a):
-    # costs 0.05 s at start-up (python -X importtime, 2026-11-25)
-    from net.eki import Status  # noqa: PLC0415
 
     _eki(rt).clear(ref_text(a[0], "EKI_Clear channel"))
     return _status(Status())
@@ -137,8 +132,6 @@ def eki_clearbuffer(rt, a):
 def _setter(kind: str):
     @_call
     def native(rt, a):
-        # costs 0.05 s at start-up (python -X importtime, 2026-11-25)
-        from net.eki import format_real  # noqa: PLC0415
 
         ch = _eki(rt).channel(ref_text(a[0], f"EKI_Set{kind} channel"))
         path = ref_text(a[1] if len(a) > 1 else None, f"EKI_Set{kind} element")
@@ -213,8 +206,6 @@ def _store(ref, kind: str, value, what: str) -> None:
 def _getter(kind: str, array: bool = False):
     @_call
     def native(rt, a):
-        # costs 0.05 s at start-up (python -X importtime, 2026-11-25)
-        from net.eki import EkiError  # noqa: PLC0415
 
         name = f"EKI_Get{kind}{'Array' if array else ''}"
         ch = _eki(rt).channel(ref_text(a[0], f"{name} channel"))

@@ -31,6 +31,7 @@ from __future__ import annotations
 from ..errors import KrlRuntimeError
 from ..values import EnumValue, Struct
 from .eki import EKI
+from net.eki import EkiError
 
 #: the prefix of EthernetKRL's kernel functions behind its KRL layer
 EKI_KERNEL = "EFC_"
@@ -73,8 +74,6 @@ def _eki_kernel(rt, name: str, function: str, args: list) -> None:
     """The EthernetKRL kernel function behind the layer's ``function`` (``EKI_INIT``)."""
     fn = KERNEL.get(function)
     if fn is None:
-        # costs 0.05 s at start-up (python -X importtime, 2026-11-25)
-        from net.eki import EkiError  # noqa: PLC0415
 
         err = EkiError(4, name[:40])
         raise KrlRuntimeError(str(err), err.number)

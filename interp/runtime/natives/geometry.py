@@ -14,6 +14,9 @@ from ..errors import KrlRuntimeError, value_invalid
 from ..sysvars import axis_struct, pos_struct, struct_of
 from ..values import UNSET, Struct
 from .registry import Family
+import numpy as np
+from robot.frames import frame_to_matrix, inv_pos as _ip, matrix_to_frame
+from robot.errors import SoftLimitError, WorkspaceError
 
 GEOMETRY = Family("geometry")
 
@@ -26,11 +29,6 @@ def _inv_pos(rt, a):
 @GEOMETRY.native("E6POS FORWARD(E6AXIS AXVAL :IN, INT STATUS :OUT)", pure=True)
 def _forward(rt, a):
     """FORWARD(axes, status): the TCP for ``axes`` with the current $TOOL/$BASE (E6POS)."""
-    # robot.frames costs 0.71 s at first import (scipy's rotations): only a run that calls
-    # FORWARD or INVERSE pays it
-    import numpy as np  # noqa: PLC0415
-
-    from robot.frames import frame_to_matrix, inv_pos as _ip, matrix_to_frame  # noqa: PLC0415
 
     ctl = rt.controller
     q = _model_axes(ctl, a[0].get())
@@ -69,9 +67,6 @@ def _ek(rt, a):
     base on the kinematic's flange, turning with it (robot/planner.py ``RobotModel.linked``).
     A ``TYPE`` the robot has no BASE kinematic of (#ROBOT, #NONE, a missing ET): the run-time
     error "EK: no external kinematic TYPE in $EX_KIN"."""
-    import numpy as np  # noqa: PLC0415 - robot.frames costs 0.71 s at first import (as FORWARD)
-
-    from robot.frames import frame_to_matrix, matrix_to_frame  # noqa: PLC0415
 
     ctl = rt.controller
     root = frame_tuple(a[0].get(), "EK root")
@@ -104,12 +99,6 @@ def _inverse(rt, a):
     otherwise the solution nearest START_AXIS. STATUS 0; a position out of reach: STATUS
     :data:`INVERSE_NOT_REACHABLE` (outside the software limits: :data:`INVERSE_SOFT_LIMIT`)
     and the result is START_AXIS (the program is expected to test STATUS)."""
-    # robot.frames costs 0.71 s at first import (scipy's rotations): only a run that calls
-    # FORWARD or INVERSE pays it
-    import numpy as np  # noqa: PLC0415
-
-    from robot.errors import SoftLimitError, WorkspaceError  # noqa: PLC0415
-    from robot.frames import frame_to_matrix  # noqa: PLC0415
 
     pos = a[0].get()
     start = a[1].get() if len(a) > 1 and a[1] is not None else None

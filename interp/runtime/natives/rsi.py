@@ -14,6 +14,8 @@ from ..errors import KrlRuntimeError, value_invalid
 from ..values import Arr, EnumValue
 from .eki import NOT_SIMULATED, network
 from .registry import Family
+from net.rsi import RSIOK
+from net.rsi2 import CREATES
 
 # RSI's routines are declared on the controller (the option's EXTFCTP lines): known by name
 # only, as functions.yaml's ``lenient: rsi``
@@ -67,10 +69,6 @@ def st_call(hub, rt, func: str, a: list):
     value), ST_DELOBJ(h), ST_RESET(), ST_ON(), ST_ON1(#frame, n), ST_OFF(), ST_SKIPSENS() (holds
     the program while the robot follows the sensor, until an error ends it). Returns the RSIERR
     number (:func:`_st` gives it as the enum RSIERR); ST_SKIPSENS nothing."""
-    # costs 0.11 s at start-up (python -X importtime, 2026-11-25)
-    from net.rsi import RSIOK  # noqa: PLC0415
-    # costs 0.03 s at start-up (python -X importtime, 2026-11-25)
-    from net.rsi2 import CREATES  # noqa: PLC0415
 
     rsi = hub.partner("rsi").instance()
     ctl = rt.controller
@@ -107,8 +105,6 @@ def rsi_call(hub, rt, method: str, a: list):
     PARAM, VALUE :OUT); RSI 5's RSI_LOAD(NAME), RSI_ACTIVATE(NAME), RSI_PROCESS_ON(mode),
     RSI_PROCESS_OFF(), RSI_DEACTIVATE, RSI_UNLOAD as the same. net/rsi.py holds the behaviour.
     Returns the RSIERR number (INT)."""
-    # costs 0.11 s at start-up (python -X importtime, 2026-11-25)
-    from net.rsi import RSIOK  # noqa: PLC0415
 
     rsi = hub.partner("rsi").instance()
     ctl = rt.controller
