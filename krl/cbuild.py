@@ -78,7 +78,8 @@ def build_in_place(extension, out: Path, sources, repo: Path, fallback: str, for
     ``not compiled (why): `` + ``fallback``."""
     if not force and out.exists() and all(out.stat().st_mtime >= Path(s).stat().st_mtime for s in sources):
         return f"{out.name} is up to date"
-    try:  # optional build tools, which load only for a build
+    try:
+        # optional build tools, which load only for a build
         from Cython.Build import cythonize  # noqa: PLC0415, F401
         from setuptools import Distribution  # noqa: PLC0415
         from setuptools.command.build_ext import build_ext  # noqa: PLC0415

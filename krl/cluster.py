@@ -82,6 +82,7 @@ def run_batches(address: str, fn: Callable[..., Any], tasks: Iterable[tuple[Hash
     scheduler (None: Dask's ``distributed.comm.timeouts.connect``, 30 s unless configured).
     `name`: the prefix of the tasks' keys on the cluster's dashboard. Raises SchedulerError."""
     try:
+        # deferred: tools/startup_bench.py, krl check +295 ms at the top (2026-11-26)
         from distributed import Client, wait  # noqa: PLC0415
     except ImportError as exc:  # pragma: no cover - dask.distributed is a dependency
         raise SchedulerError(f"dask.distributed is not installed: {exc}") from exc

@@ -10,6 +10,8 @@ difference; it is never used to decide anything.
 
 from __future__ import annotations
 
+import psutil
+
 
 def tree_cpu_s(pid: int | None = None, *, name: str | None = None) -> float:
     """CPU seconds (user + system, ended children included) of process ``pid`` (default: this
@@ -17,8 +19,6 @@ def tree_cpu_s(pid: int | None = None, *, name: str | None = None) -> float:
     (case-insensitive; e.g. ``"chrom"``: Playwright's Chromium among this process's
     descendants). A process that is gone, or cannot be read, counts 0 (never an error): the
     tree changes while it is walked."""
-    # costs 0.03 s at start-up (python -X importtime, 2026-11-25)
-    import psutil  # noqa: PLC0415 - benchmarks only
 
     try:
         root = psutil.Process(pid)

@@ -58,9 +58,9 @@ def _death(exitcode: int | None) -> str:
 def start_fork_server(preload: tuple[str, ...]) -> None:
     """Start the fork server of :func:`run_tasks` ``preload`` now (it takes a second: a fresh
     interpreter importing `preload`), so that the first pool does not wait for it."""
-    # on use: multiprocessing's fork server costs 0.019 s (python -X importtime, 2026-11-24), paid
-    # only by a caller of worker processes
+    # deferred: tools/startup_bench.py, krl check +8 ms at the top (2026-11-26)
     import multiprocessing  # noqa: PLC0415
+    # deferred: tools/startup_bench.py, krl check +10 ms at the top (2026-11-26)
     from multiprocessing import forkserver  # noqa: PLC0415
 
     if "forkserver" in multiprocessing.get_all_start_methods():
@@ -98,12 +98,12 @@ def run_tasks(fn: Callable[..., Any], tasks: Iterable[tuple[Hashable, tuple]], *
             except Exception as exc:  # noqa: BLE001 - one task never stops the others
                 yield Outcome(key, "internal_error", None, f"{type(exc).__name__}: {exc}")
         return
-    # on use: pebble costs 0.85 s and multiprocessing 0.10 s to import (python -X importtime, load 25),
-    # which a single-process run (jobs 1 above) never pays
+    # deferred: tools/startup_bench.py, krl run +32 ms at the top (2026-11-26)
     from pebble import ProcessExpired, ProcessPool  # noqa: PLC0415
 
     jobs = max(1, jobs or default_jobs())
-    import multiprocessing  # noqa: PLC0415  (0.10 s: see pebble above)
+    # deferred: tools/startup_bench.py, krl check +8 ms at the top (2026-11-26)
+    import multiprocessing  # noqa: PLC0415
 
     methods = multiprocessing.get_all_start_methods()
     if preload is not None and "forkserver" in methods:

@@ -20,14 +20,13 @@ from typing import Any
 
 from jinja2 import ChoiceLoader, Environment, PackageLoader, StrictUndefined
 from markupsafe import Markup
+from markdown_it import MarkdownIt
 
 __all__ = ["html_env", "markdown_code", "markdown_html", "render_html"]
 
 
 @lru_cache(maxsize=1)
 def _markdown():
-    # on use: markdown-it costs 1.1 s to import (python -X importtime, load 25); only reports render Markdown
-    from markdown_it import MarkdownIt  # noqa: PLC0415
 
     # CommonMark with tables; "html": False renders raw HTML in the source as text, and
     # markdown-it's link validation refuses javascript:, vbscript:, file: and data: links.

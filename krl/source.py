@@ -99,8 +99,7 @@ def _code_page(body: bytes) -> str:
     letters). When cp1252 gives the same text as the winner (German umlauts are the same bytes
     in cp1250), cp1252 is named.
     """
-    # on use: charset-normalizer costs 0.31 s to import (python -X importtime, load 25); only a
-    # non-UTF-8 file with non-ASCII bytes gets here
+    # deferred: tools/startup_bench.py, krl lsp +12 ms at the top (2026-11-26)
     import charset_normalizer  # noqa: PLC0415
 
     sample = b"\n".join(line for line in body.splitlines() if not line.isascii())[:_DETECT_SAMPLE]

@@ -65,6 +65,7 @@ from krl.syntax.engines import EngineUnavailable, java_answers, parse_source, re
 from krl.syntax.engines.tree import is_acyclic, stream_tokens
 from krl.syntax.parse import ParseResult, default_bundle, parse_text
 from krl.source import SourceText, is_krl_file, read_source
+from krl.pool import default_jobs, run_tasks
 
 
 @dataclass(slots=True)
@@ -197,10 +198,6 @@ def load_batch(paths: list, timeout: float, jobs: int | None = None, threaded: b
     (:func:`_parse_tasks`): the same trees. Progress: the :func:`on_each_file` callback, as
     files finish. `threaded`: the caller runs other threads (the language server), so the
     workers come from a fork server (WORKER_MODULES loaded), not from a fork of this process."""
-    # on use: the worker pool (pebble) costs 0.42 s (python -X importtime, 2026-11-23, load average
-    # 22 on the 2 cores), which single files, `krl run` and the language server, who never start a
-    # pool, do not pay
-    from krl.pool import run_tasks  # noqa: PLC0415
 
     default_bundle()    # imported once here, inherited by the forked workers
     hook = _ON_FILE.get()
@@ -246,7 +243,6 @@ def _parse_tasks(sources: list[SourceText], jobs: int | None, stall: float):
     """(index, (source, raw)) for :func:`load_parsed` in worker processes: one Java worker
     with `jobs` threads parses a batch of at least JAVA_BATCH_BYTES here, with trees, while
     the workers rebuild and build what it has answered (raw None: the Python engine)."""
-    from krl.pool import default_jobs  # noqa: PLC0415 - on use: the pool's 0.42 s (run_tasks above)
 
     try:
         engine = resolve()

@@ -44,6 +44,7 @@ from krl.source import SourceText, decode_bytes, encode_text, read_limited, read
 from krl.syntax.messages import source_diagnostics
 from krl.syntax.parse import parse_source
 from krl.terminal import printable, printable_path
+from krl.diagnostics.render import Renderer, SourceLines, use_colour
 
 _LINE_END = re.compile(r"\r\n|\n|\r")
 
@@ -96,10 +97,6 @@ def run_fmt(paths, check: bool = False, diff: bool = False, options: FormatOptio
             out=None, err=None, colour: bool = False) -> int:
     """The command's body; `out`/`err` are line writers (diffs / diagnostics and the count line).
     Returns the exit status (0, 1 or 2). Never raises for bad input."""
-    # on use: krl.diagnostics.render costs 0.12 s (python -X importtime, 2026-11-23, load average 22
-    # on the 2 cores) of every krl command's start-up (app imports this module to register
-    # `fmt`)
-    from krl.diagnostics.render import Renderer, SourceLines  # noqa: PLC0415
 
     out = out or click.echo
     err = err or (lambda line: click.echo(line, err=True))
@@ -178,10 +175,6 @@ def run_stdin(data: bytes, check: bool = False, diff: bool = False, options: For
     (bytes, in the input's encoding; through ``printable`` when `terminal`); with --check or
     --diff only the diff is printed. Exit status as :func:`run_fmt`; on a syntax error nothing
     is written to `write` (an editor keeps its buffer) and the diagnostics name ``<stdin>``."""
-    # on use: krl.diagnostics.render costs 0.12 s (python -X importtime, 2026-11-23, load average 22
-    # on the 2 cores) of every krl command's start-up (app imports this module to register
-    # `fmt`)
-    from krl.diagnostics.render import Renderer, SourceLines  # noqa: PLC0415
 
     out = out or click.echo
     err = err or (lambda line: click.echo(line, err=True))
@@ -229,8 +222,6 @@ def fmt(paths: tuple[str, ...], check: bool, diff: bool, keyword_case: str, inde
     inline forms, header lines and line ends are kept. Folders are searched; links, FIFOs and
     folders too deep met there are never read (a W002 warning each). Exit 1 with --check when
     a file would change, 2 when a file does not parse or cannot be read."""
-    # on use: krl.diagnostics.render's 0.12 s of krl's start-up (run_fmt above)
-    from krl.diagnostics.render import use_colour  # noqa: PLC0415
 
     if indent.lower() == "tab":
         unit = "\t"

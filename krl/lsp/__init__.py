@@ -12,5 +12,6 @@ workspace and its symbol tables (krl/workspace.py, krl/semantics). One module pe
 * :mod:`krl.lsp.hover`, :mod:`krl.lsp.outline`, :mod:`krl.lsp.folding`, :mod:`krl.lsp.complete`;
 * :mod:`krl.lsp.convert`   -- the shell with the server: plain results and krl diagnostics as LSP types;
 * :mod:`krl.lsp.server`    -- the pygls server and its handlers; :mod:`krl.lsp.cli` the command;
+* :mod:`krl.lsp.sample`    -- a synthetic program of a chosen length (the server's warm-up, the benchmark's);
 * :mod:`krl.lsp.bench`     -- time from didChange to publishDiagnostics (``python -m krl.lsp.bench``).
 """

@@ -26,7 +26,7 @@ machine changes least.
 ``--workspace`` measures a 400-file project instead, built at bench time in a temporary folder
 from the shared corpus (nothing is copied into the repository): the ChinaMilling backup (156
 files) with further corpus files copied into its ``R1/Program/corpus`` until there are 400.
-``--generated`` measures a generated 3,000-line program (:func:`generate`). ``--json`` prints
+``--generated`` measures a generated 3,000-line program (:func:`krl.lsp.sample.generate`). ``--json`` prints
 one JSON document at the end.
 """
 
@@ -46,26 +46,12 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from krl.cputime import tree_cpu_s
-
-
-def generate(lines: int = 3000) -> str:
-    """A valid KRL program of about `lines` lines (CRLF, as on the controller)."""
-    out = ["&ACCESS RVP", "&REL 1", "DEF bench( )", "  DECL INT n", ";FOLD INI;%{PE}", "  BAS(#INITMOV, 0)",
-           ";ENDFOLD (INI)", "  n = 0", "  bench_1( )", "END", ""]
-    k = 1
-    while len(out) < lines:
-        body = [f"DEF bench_{k}( )", "  DECL INT i, j", "  DECL REAL d", "  DECL E6POS p",
-                ";FOLD PTP HOME Vel=100 % DEFAULT;%{PE}", "  PTP {A1 0, A2 -90, A3 90, A4 0, A5 0, A6 0}", ";ENDFOLD"]
-        for s in range(8):
-            body += [f"  ; step {s}", f"  $OUT[{s + 1}] = FALSE", f"  FOR i = 1 TO {s + 3}",
-                     f"    d = i * 2.5 + {s}", "    IF d > 10.0 THEN", f"      $VEL.CP = 0.{s + 1}",
-                     "      LIN {X 100.0, Y 200.0, Z 300.0, A 0.0, B 90.0, C 0.0} C_DIS", "    ELSE",
-                     "      j = i", "    ENDIF", "  ENDFOR", f"  WAIT SEC 0.{s}", "  p = $POS_ACT",
-                     "  p.X = p.X + 10.0", "  SWITCH j", "    CASE 1", "      PTP p", "    DEFAULT",
-                     "      HALT", "  ENDSWITCH"]
-        out += body + ["END", ""]
-        k += 1
-    return "\r\n".join(out) + "\r\n"
+from lsprotocol import types as L
+from pygls.lsp.client import BaseLanguageClient
+from krl.source import decode_bytes
+from krl.files import SHARED_CORPUS
+from krl.project import find_backups, project_of
+from krl.lsp.sample import generate
 
 
 def _pct(values: list[float], p: float) -> float:
@@ -162,14 +148,8 @@ class Run:
 async def measure_file(server: Server, root: Path, path: Path, runs: int, errors: int, label: str) -> Run:
     """Open `path` of the workspace `root` in a fresh server, time its first diagnostics, its
     check, then `runs` value edits and `errors` edits that leave a syntax error."""
-    # costs 0.52 s at start-up (python -X importtime, 2026-11-25)
-    from lsprotocol import types as L  # noqa: PLC0415 - the benchmark's client only
-    # costs 0.57 s at start-up (python -X importtime, 2026-11-25)
-    from pygls.lsp.client import BaseLanguageClient  # noqa: PLC0415
 
     raw = path.read_bytes()
-    # costs 0.006 s at start-up (python -X importtime, 2026-11-25)
-    from krl.source import decode_bytes  # noqa: PLC0415
     text = decode_bytes(raw)[0]
     uri = path.as_uri()
     client = BaseLanguageClient("krl-lsp-bench", "1")
@@ -272,8 +252,6 @@ def build_workspace(dst: Path, files: int = 400, corpus: Path | None = None) -> 
     """Copy the corpus backup WORKSPACE_BASE to `dst`/KRC and further corpus KRL files (not
     $-files, not of that backup) into KRC/R1/Program/corpus until it holds `files` KRL files;
     returns (backup root, number of KRL files)."""
-    # costs 0.02 s at start-up (python -X importtime, 2026-11-25)
-    from krl.files import SHARED_CORPUS  # noqa: PLC0415
     corpus = corpus or SHARED_CORPUS
     base = corpus / WORKSPACE_BASE
     if not base.is_dir():
@@ -296,10 +274,6 @@ def build_workspace(dst: Path, files: int = 400, corpus: Path | None = None) -> 
 
 def corpus_backups(corpus: Path | None = None) -> list[tuple[str, Path, Path]]:
     """(name, root, largest KRL file) of each KRC backup of the shared corpus, as it is."""
-    # costs 0.02 s at start-up (python -X importtime, 2026-11-25)
-    from krl.files import SHARED_CORPUS  # noqa: PLC0415
-    # costs 0.02 s at start-up (python -X importtime, 2026-11-25)
-    from krl.project import find_backups, project_of  # noqa: PLC0415
     corpus = corpus or SHARED_CORPUS
     out = []
     for b in find_backups(corpus):

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import click
+from krl.lsp.server import serve
 
 
 @click.command()
@@ -10,8 +11,6 @@ import click
 @click.option("--log-file", default=None, metavar="FILE", help="Write the server's log to FILE (default: warnings on stderr).")
 def lsp(stdio: bool, log_file: str | None) -> None:
     """Run the KRL language server on stdin/stdout (see docs/editors.md)."""
-    # costs 0.82 s at start-up (python -X importtime, 2026-11-25)
-    from krl.lsp.server import serve  # noqa: PLC0415
     serve(log_file)
 
 

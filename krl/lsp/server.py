@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import asyncio
 import functools
-import importlib.util
 import logging
 import os
 import sys
@@ -27,6 +26,7 @@ from pygls.lsp.server import LanguageServer
 from pygls.uris import from_fs_path, to_fs_path
 
 from krl import __version__, collector
+from krl.fmt import format_text
 from krl.diagnostics.render import split_lines
 from krl.pool import default_jobs, start_fork_server
 from krl.semantics.config import config_for
@@ -49,7 +49,7 @@ from krl.lsp import signature as _signature
 from krl.lsp import unused as _unused
 from krl.lsp.occurrences import DECL, WRITE, file_occurrences
 from krl.lsp.analysis import Analysis
-from krl.lsp.bench import generate
+from krl.lsp.sample import generate
 from krl.lsp import convert as _convert
 from krl.lsp.convert import from_position, lsp_diagnostic, to_range
 from krl.lsp.parsing import Parsed
@@ -84,18 +84,6 @@ def path_of(uri: str) -> str:
 
 def uri_of(path: str) -> str:
     return from_fs_path(path) if os.path.isabs(path) else path
-
-
-def formatter():
-    """krl.fmt.format_text when the formatter is installed, else None (imported lazily)."""
-    try:
-        if importlib.util.find_spec("krl.fmt") is None:
-            return None
-        # costs 0.01 s at start-up (python -X importtime, 2026-11-25)
-        from krl.fmt import format_text  # noqa: PLC0415
-        return format_text
-    except Exception:  # noqa: BLE001 - a formatter that cannot be imported is not offered
-        return None
 
 
 class KrlLanguageServer(LanguageServer):
@@ -391,7 +379,7 @@ def guarded(empty=None):
 
 
 def create_server() -> KrlLanguageServer:
-    """A server with every feature registered (formatting only when krl.fmt is installed)."""
+    """A server with every feature registered."""
     server = KrlLanguageServer()
 
     @server.feature(L.INITIALIZED)
@@ -647,23 +635,21 @@ def create_server() -> KrlLanguageServer:
                                     kind=kinds.get(o.kind, L.DocumentHighlightKind.Read))
                 for o in file_occurrences(an, path) if o.key == t.key]
 
-    fmt = formatter()
-    if fmt is not None:
-        @server.feature(L.TEXT_DOCUMENT_FORMATTING)
-        @guarded()
-        async def formatting(ls: KrlLanguageServer, params: L.DocumentFormattingParams):
-            doc = ls.workspace.get_text_document(params.text_document.uri)
-            text = doc.source
-            try:
-                new = fmt(text)
-            except Exception as exc:  # noqa: BLE001 - unparsable input: no edit, say why
-                ls._report(f"krl lsp: not formatted: {type(exc).__name__}: {printable(exc)}", L.MessageType.Warning)
-                return None
-            if new == text:
-                return []
-            lines = text.split("\n")
-            end = L.Position(line=len(lines) - 1, character=units(ls.codec(), lines[-1]))
-            return [L.TextEdit(range=L.Range(start=L.Position(line=0, character=0), end=end), new_text=new)]
+    @server.feature(L.TEXT_DOCUMENT_FORMATTING)
+    @guarded()
+    async def formatting(ls: KrlLanguageServer, params: L.DocumentFormattingParams):
+        doc = ls.workspace.get_text_document(params.text_document.uri)
+        text = doc.source
+        try:
+            new = format_text(text)
+        except Exception as exc:  # noqa: BLE001 - unparsable input: no edit, say why
+            ls._report(f"krl lsp: not formatted: {type(exc).__name__}: {printable(exc)}", L.MessageType.Warning)
+            return None
+        if new == text:
+            return []
+        lines = text.split("\n")
+        end = L.Position(line=len(lines) - 1, character=units(ls.codec(), lines[-1]))
+        return [L.TextEdit(range=L.Range(start=L.Position(line=0, character=0), end=end), new_text=new)]
 
     return server
 

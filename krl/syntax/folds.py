@@ -37,6 +37,7 @@ from dataclasses import dataclass, field
 
 from krl.diagnostics import Diagnostic, Note
 from krl.diagnostics.codes import W021
+from krl.diagnostics.render import split_lines
 
 _MARKER = re.compile(r";[ \t]*(END)?FOLD(?![A-Za-z0-9_$])", re.I)
 _OPEN = re.compile(r"[ \t\f]*(?:GLOBAL[ \t]+)?(DEF|DEFFCT|DEFDAT)[ \t]+([A-Za-z_$][A-Za-z0-9_$]*)", re.I)
@@ -100,10 +101,6 @@ comment_start = _comment_start      # the public name (the language server's tok
 
 
 def _lines(text: str) -> list[str]:
-    # on first use: krl.diagnostics.render costs 0.12 s (python -X importtime, 2026-11-23, load
-    # average 22 on the 2 cores) of every krl command's start-up (app imports every subcommand
-    # module, which imports this)
-    from krl.diagnostics.render import split_lines  # noqa: PLC0415
 
     return split_lines(text)
 

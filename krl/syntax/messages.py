@@ -35,6 +35,7 @@ from krl.terminal import clip
 from krl.syntax.blocks import CLOSER, OPENER_OF, MIDDLE, BlockScan, lines_of, scan
 from krl.syntax.parse import default_bundle
 from krl.syntax.tokens import lex
+from krl.syntax.engines import parse_source
 
 MAX_ALTERNATIVES = 6
 # `CHAR sReg_01[` of an open array declared in a data list: (type, name)
@@ -379,10 +380,6 @@ def file_diagnostics(path: Path, keep_tree: bool = True):
     """(ParseResult, decoded text, diagnostics) of one file; never raises for bad content.
     The default parse engine (krl/syntax/engines) parses it; with keep_tree the result has its
     parse tree (the java engine's is rebuilt from its data, the same tree)."""
-    # on first use: the parse engines (the Java engine's process machinery) cost 0.10 s (python -X
-    # importtime, 2026-11-23, load average 22 on the 2 cores) of every krl command's start-up, which
-    # imports this module
-    from krl.syntax.engines import parse_source  # noqa: PLC0415
 
     src = read_source(path)
     result = parse_source(src, keep_tree=keep_tree)

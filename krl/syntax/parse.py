@@ -104,10 +104,9 @@ def default_bundle() -> ParserBundle:
         if not (GENERATED_DIR / "KRLParser.py").exists():
             raise RuntimeError("the generated parser is missing: run `make parser` "
                                "(it generates krl/syntax/generated from grammar/KRL.g4)")
-        # on first use: the generated parser exists only after `make parser`, and importing it costs
-        # 0.87 s (python -X importtime, 2026-11-23, load average 22 on the 2 cores), which commands
-        # that parse nothing (krl --help, krl lsp before the first file) do not pay
+        # deferred: tools/startup_bench.py, krl check --reach +8 ms at the top (2026-11-26)
         from krl.syntax.generated.KRLLexer import KRLLexer  # noqa: PLC0415
+        # deferred: tools/startup_bench.py, krl run +14 ms at the top (2026-11-26)
         from krl.syntax.generated.KRLParser import KRLParser  # noqa: PLC0415
         _default_bundle = ParserBundle(KRLLexer, KRLParser)
     return _default_bundle
