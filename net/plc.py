@@ -31,6 +31,7 @@ cell file names another address.
 
 from __future__ import annotations
 
+import functools
 import threading
 from dataclasses import dataclass, field
 import logging
@@ -127,6 +128,8 @@ class Plc:
         self.settings = settings
         self.map = amap or AddressMap()
         self.loop = None                    # the servers' asyncio loop
+        self.submit = None                  # asyncio.run_coroutine_threadsafe on that loop, once started
+        self.ua = None                      # asyncua's `ua` types, once the OPC UA server runs
         self.thread: threading.Thread | None = None
         self.modbus = None
         self.device = None
@@ -142,10 +145,12 @@ class Plc:
     # ------------------------------------------------------------------ start / stop
     def start(self) -> None:
         """Start the servers; returns when they listen. Raises OSError (a port in use)."""
-        import asyncio  # noqa: PLC0415  (costs 0.04 s at every krl run: only with a PLC)
+        # deferred: tools/startup_bench.py, krl check --reach +19 ms at the top (2026-11-26)
+        import asyncio  # noqa: PLC0415
 
         ready = threading.Event()
         self.loop = asyncio.new_event_loop()
+        self.submit = functools.partial(asyncio.run_coroutine_threadsafe, loop=self.loop)
 
         def main():
             asyncio.set_event_loop(self.loop)
@@ -175,12 +180,11 @@ class Plc:
             await self._start_opcua()
 
     async def _start_modbus(self) -> None:
-        # pymodbus costs 0.03 s CPU: loaded only when the PLC serves Modbus (net.plc itself loads
-        # only with a PLC partner)
+        # deferred: tools/startup_bench.py, krl check --reach +33 ms at the top (2026-11-26)
         from pymodbus.datastore import (ModbusDeviceContext, ModbusSequentialDataBlock,  # noqa: PLC0415
                                         ModbusServerContext)
 
-        # net.modbus imports pymodbus (costs 0.03 s CPU): only when the PLC serves Modbus
+        # deferred: tools/startup_bench.py, krl check --reach +36 ms at the top (2026-11-26)
         from .modbus import Server  # noqa: PLC0415
 
         logging.getLogger("pymodbus").setLevel(logging.ERROR)   # its v4 deprecation notes are not the user's
@@ -204,9 +208,10 @@ class Plc:
         self.hub.published("modbus", bound)
 
     async def _start_opcua(self) -> None:
-        # asyncua costs 0.43 s CPU (2026-11-24): loaded only when the PLC serves OPC UA
+        # deferred: tools/startup_bench.py, krl run +282 ms at the top (2026-11-26)
         from asyncua import Server, ua  # noqa: PLC0415
 
+        self.ua = ua
         clip_library_logs("asyncua")        # it logs a refused write with its whole value
         url = self.settings.opcua
         server = Server()
@@ -315,8 +320,6 @@ class Plc:
         return sum(1 << i for i, n in enumerate(range(a, b + 1)) if get(n))
 
     def close(self) -> None:
-        import asyncio  # noqa: PLC0415  (costs 0.04 s at every krl run: only with a PLC)
-
         loop = self.loop
         if loop is None:
             return
@@ -329,7 +332,7 @@ class Plc:
 
         if self.thread is not None and self.thread.is_alive():
             try:
-                asyncio.run_coroutine_threadsafe(stop(), loop).result(30)
+                self.submit(stop()).result(30)
             except Exception:  # noqa: BLE001 - a server that does not stop cleanly is left to the thread's end
                 pass
             loop.call_soon_threadsafe(loop.stop)
@@ -341,9 +344,7 @@ class Plc:
         """Once per IPO cycle (see the module docstring)."""
         if self.loop is None or self.thread is None or not self.thread.is_alive():
             return
-        import asyncio  # noqa: PLC0415  (costs 0.04 s at every krl run: only with a PLC)
-
-        writes, refusals, notes = asyncio.run_coroutine_threadsafe(self._exchange(), self.loop).result(30)
+        writes, refusals, notes = self.submit(self._exchange()).result(30)
         refused = self.modbus.refused if self.modbus is not None else 0
         while self.traced_refused < refused:
             self.traced_refused += 1
@@ -402,8 +403,7 @@ class Plc:
             await ctx.async_setValues(0, 3, 0, [_to_reg(x) for x in anins])
             await ctx.async_setValues(0, 4, 0, [_to_reg(io.get_anout(n)) for n in range(1, m.analog + 1)])
         if self.opcua is not None:
-            from asyncua import ua  # noqa: PLC0415  (costs 0.43 s: only with an OPC UA server)
-
+            ua = self.ua
             for n in range(1, m.digital + 1):
                 await self._publish(f"$IN[{n}]", ins[n - 1], ua.VariantType.Boolean)
                 await self._publish(f"$OUT[{n}]", io.get_out(n), ua.VariantType.Boolean)
@@ -413,8 +413,7 @@ class Plc:
         return writes, refusals, notes
 
     async def _publish(self, key: str, value, vtype) -> None:
-        from asyncua import ua  # noqa: PLC0415  (costs 0.43 s: only with an OPC UA server)
-
+        ua = self.ua
         cache = self.__dict__.setdefault("_published", {})
         if cache.get(key) == value:
             return
