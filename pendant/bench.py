@@ -42,6 +42,7 @@ from pathlib import Path
 from krl.cputime import tree_cpu_s
 
 from .client import CHROMIUM_FLAGS, ROOT, PendantClientError, act_state, connect, pendant_server
+from playwright.sync_api import sync_playwright
 DEFAULT_BACKUP = ROOT.parent / "shared" / "krl-corpus" / "khrzysio__KRC4_test"
 # 142.6 s of simulated time with its cell (corpus/cells/khrzysio__KRC4_test.yaml): long enough
 # for the paced window and the latency toggles on any machine
@@ -122,8 +123,6 @@ def _window(url: str, pid: int, seconds: float, every: float) -> tuple[float, fl
 
 def _with_page(url: str, work):
     """Run ``work(page)`` with the page open in headless Chromium, once it has drawn the robot."""
-    # costs 0.10 s at start-up (python -X importtime, 2026-11-25)
-    from playwright.sync_api import sync_playwright  # noqa: PLC0415
 
     with sync_playwright() as pw, tempfile.TemporaryDirectory() as profile:
         ctx = pw.chromium.launch_persistent_context(profile, executable_path="/usr/bin/chromium", headless=True,

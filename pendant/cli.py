@@ -15,6 +15,11 @@ from krl.files import spelled
 from krl.limits import MAX_WEB_MESSAGE_BYTES
 from krl.project import backup_of
 from krl.terminal import printable
+from krl.archive import ArchiveError, backup_source, is_archive
+import uvicorn
+from .security import new_token
+from .server import Pendant, create_app
+import webbrowser
 
 
 @click.command("pendant")
@@ -36,8 +41,6 @@ def pendant(target: Path | None, port: int, no_browser: bool, inputs: Path | Non
     """Serve a virtual smartPAD for TARGET (a KRC backup folder or .zip, a folder of KRL, or a
     program .src: selected at the start; default the current folder) on 127.0.0.1 and open it
     in the browser. The first line printed is the page's URL with the session token."""
-    # costs 0.004 s at start-up (python -X importtime, 2026-11-25)
-    from krl.archive import ArchiveError, backup_source, is_archive  # noqa: PLC0415
     target = target if target is not None else Path.cwd()
     if not target.exists():
         click.echo(f"error: {printable(target)}: no such file or folder", err=True)
@@ -73,13 +76,6 @@ def serve(root: Path, *, port: int = 0, open_browser: bool = True, inputs: str |
           trace: str | None = None, program: str | None = None, readonly: bool = False, realtime: bool = True,
           shown: str | None = None) -> int:
     """Bind 127.0.0.1:``port``, print the URL with the token, serve until interrupted; 0."""
-    # costs 0.04 s at start-up (python -X importtime, 2026-11-25)
-    import uvicorn  # noqa: PLC0415
-
-    # costs 0.008 s at start-up (python -X importtime, 2026-11-25)
-    from .security import new_token  # noqa: PLC0415
-    # costs 0.18 s at start-up (python -X importtime, 2026-11-25)
-    from .server import Pendant, create_app  # noqa: PLC0415
 
     sock = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
     sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
@@ -103,8 +99,6 @@ def serve(root: Path, *, port: int = 0, open_browser: bool = True, inputs: str |
                             # (py-spy, python -m pendant.bench)
                             ws_per_message_deflate=False)
     if open_browser:
-        # costs 0.002 s at start-up (python -X importtime, 2026-11-25)
-        import webbrowser  # noqa: PLC0415
 
         threading.Timer(0.5, lambda: webbrowser.open(url)).start()
     try:

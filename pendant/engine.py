@@ -30,13 +30,17 @@ import threading
 import time
 from pathlib import Path
 
-from interp.debug.engine import Engine as RunEngine
-from interp.debug.engine import LaunchConfig, Refused, thread_main
+from interp.debug.engine import Engine as RunEngine, LaunchConfig, Refused, thread_main
 from interp.runtime.writerules import admit
 from robot.axismap import E6AXIS_KEYS
 
 from .touchup import TouchUpError, touch_up as write_point
 from krl.limits import MAX_KRL_MESSAGES, MAX_WEB_EXPRESSION_CHARS
+from robot.limits import normalise_mode
+from robot.io import N_DIGITAL
+from interp.runtime.motion import params_from
+from robot.motion import NULLFRAME, MotionRequest
+import numpy as np
 
 #: the operating modes and run modes the keys offer (robot/limits.py, interp/runtime/runmode.py)
 MODES_OP = ("T1", "T2", "AUT", "EXT")
@@ -47,7 +51,6 @@ JOG_MAX_STEP = 100.0
 #: the TCP path drawn: a point each PATH_STEP_MM of TCP motion, at most MAX_PATH_POINTS
 PATH_STEP_MM = 2.0
 MAX_PATH_POINTS = 50_000
-NULLFRAME = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
 
 
 class EngineError(Exception):
@@ -320,14 +323,11 @@ class Engine:
         elif ahead < -0.25:
             self._pace0 = (now, ctl.time)    # fell behind (a stop, a slow cycle): pace from here
 
-
     def _record_path(self, ctl, blending: bool) -> None:
         """The TCP in $WORLD once it has moved PATH_STEP_MM, or when an approximation starts
         or ends (at most MAX_PATH_POINTS points: the oldest are dropped). It is the pose the
         controller computed in this cycle (its TCP in $BASE and that $BASE, the numbers the
         trace's pose events hold), so the path costs the simulation a matrix product a cycle."""
-        # costs 0.07 s at start-up (python -X importtime, 2026-11-25)
-        import numpy as np  # noqa: PLC0415
 
         tcp, base_inv = getattr(ctl, "_tcp_T", None), getattr(ctl, "_base_inv_T", None)
         if tcp is None or base_inv is None:
@@ -376,8 +376,6 @@ def run_mode(core: RunEngine, value: str) -> str:
 def mode_op(core: RunEngine, value: str) -> str:
     """The operating mode, changed while the program stands (on the robot, turning the mode
     selector stops the program and switches the drives off)."""
-    # costs 0.06 s at start-up (python -X importtime, 2026-11-25)
-    from robot.limits import normalise_mode  # noqa: PLC0415
 
     if value not in MODES_OP:
         raise Refused(f"operating mode {value!r}: one of {', '.join(MODES_OP)}")
@@ -394,8 +392,6 @@ def mode_op(core: RunEngine, value: str) -> str:
 def set_input(core: RunEngine, index, value: bool) -> bool:
     """``$IN[index]`` set by hand (source ``operator``), running or stopped; the cell's rules
     stay active."""
-    # costs 0.005 s at start-up (python -X importtime, 2026-11-25)
-    from robot.io import N_DIGITAL  # noqa: PLC0415
 
     if not isinstance(index, int) or isinstance(index, bool) or not 1 <= index <= N_DIGITAL:
         raise Refused(f"input: an index 1..{N_DIGITAL}")
@@ -441,11 +437,6 @@ def jog(core: RunEngine, system: str, axis, step) -> list:
     E1..E6, ``step`` deg or mm) or
     WORLD/BASE/TOOL (``axis`` X, Y, Z, A, B, C, ``step`` mm or deg), as a PTP (axis) or a
     relative LIN under T1's speed limits (robot/limits.py), made by the engine's ``move``."""
-    # costs 0.009 s at start-up (python -X importtime, 2026-11-25)
-    from interp.runtime.motion import params_from  # noqa: PLC0415
-    # costs 0.007 s at start-up (python -X importtime, 2026-11-25)
-    from robot.motion import NULLFRAME, MotionRequest  # noqa: PLC0415
-
     core.need_stopped()
     rt = core.rt
     if rt.mode_op != "T1":

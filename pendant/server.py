@@ -51,6 +51,9 @@ from . import engine as keys
 from .engine import MODES_OP, RUN_MODES, Engine, EngineError
 from .security import COOKIE, Guard, PathRefused, inside
 from .state import message_rows, snapshot
+from krl.files import spelled
+from .view import module_view, modules, programs, robot_view
+from interp.run import robot_for
 
 STATIC = Path(__file__).resolve().parent / "static"
 #: display rate of the live pose (Hz) and of the full state while running
@@ -116,8 +119,6 @@ class Pendant:
     def __init__(self, root: Path, *, inputs: str | None = None, mode: str = "T1", realtime: bool = True,
                  trace: str | None = None, program: str | None = None, readonly: bool = False,
                  shown_root: str | None = None) -> None:
-        # costs 0.008 s at start-up (python -X importtime, 2026-11-25)
-        from krl.files import spelled  # noqa: PLC0415
 
         self.root = spelled(root)        # the user's spelling, links kept: the page's paths are the user's
         self.shown_root = shown_root or str(root)
@@ -149,11 +150,6 @@ class Pendant:
     # ------------------------------------------------------------------ static data
     def robot(self) -> dict:
         if self._robot is None:
-            # costs 0.37 s at start-up (python -X importtime, 2026-11-25)
-            from interp.run import robot_for  # noqa: PLC0415
-
-            # costs 0.15 s at start-up (python -X importtime, 2026-11-25)
-            from .view import robot_view  # noqa: PLC0415
 
             probe = self.initial or next(iter(self.programs()), None)
             prog = str(self.root / probe) if probe else str(self.root / "none.src")
@@ -162,8 +158,6 @@ class Pendant:
 
     def programs(self) -> list[str]:
         if self._programs is None:
-            # costs 0.15 s at start-up (python -X importtime, 2026-11-25)
-            from .view import programs  # noqa: PLC0415
 
             self._programs = programs(self.root)
         return self._programs
@@ -310,8 +304,6 @@ class Pendant:
 
     @_operation("hello")
     async def _hello(self, act: "_Action") -> None:
-        # costs 0.15 s at start-up (python -X importtime, 2026-11-25)
-        from .view import modules  # noqa: PLC0415
 
         loop = asyncio.get_running_loop()
         entries = self.programs()
@@ -480,8 +472,6 @@ class Pendant:
     async def module_text(self, path: str) -> str:
         """The ``module`` message of ``path``, kept while the file and its data list are
         unchanged (the page follows the advance run through modules again and again)."""
-        # costs 0.15 s at start-up (python -X importtime, 2026-11-25)
-        from .view import module_view  # noqa: PLC0415
 
         p = Path(path)
         key = []

@@ -13,6 +13,12 @@ from __future__ import annotations
 from pathlib import Path
 
 from krl.limits import MAX_WEB_EXPRESSION_CHARS, MAX_WEB_WATCHES
+from .engine import MESSAGE_TYPES, run_time_error
+from interp.debug.view import thread_list
+from krl.ast import nodes as N
+from interp.debug.values import value_text
+from interp.runtime.errors import KrlRuntimeError
+from krl.source import decode_bytes
 
 #: I/O shown always (the rest: declared as a SIGNAL, or TRUE)
 IO_ALWAYS = 16
@@ -57,8 +63,6 @@ def message_rows(eng, rt) -> list[dict]:
     """The message window: the controller's own messages (pendant/engine.py
     :class:`SystemMessages`, kept across runs), then the KRL messages the program shows
     (interp/runtime/messages.py), each with its ``type`` as the smartHMI names it."""
-    # costs 0.29 s at start-up (python -X importtime, 2026-11-25)
-    from .engine import MESSAGE_TYPES  # noqa: PLC0415
 
     rows = [{**m, "type": MESSAGE_TYPES[m["kind"]], "softkeys": []} for m in eng.system.rows()]
     if rt is not None:
@@ -76,8 +80,6 @@ def _stop(core, body: dict) -> dict:
     out = {"reason": body.get("reason"), "description": body.get("description"), "text": body.get("text")}
     err = core.stop_error
     if err is not None:
-        # costs 0.29 s at start-up (python -X importtime, 2026-11-25)
-        from .engine import run_time_error  # noqa: PLC0415
 
         e = run_time_error(core.rt, core.stop_task, err)
         out.update({"number": e["number"], "text": e["text"], "path": e["path"], "line": e["line"],
@@ -100,8 +102,6 @@ def _num(v):
 
 
 def _threads(rt) -> list[dict]:
-    # costs 0.002 s at start-up (python -X importtime, 2026-11-25)
-    from interp.debug.view import thread_list  # noqa: PLC0415
 
     out = []
     try:
@@ -121,8 +121,6 @@ def signals_of(rt) -> list[dict]:
     lists), read from the checked AST (nothing is evaluated, so the run is not touched): name,
     I/O (``$IN``/``$OUT``/``$ANIN``/``$ANOUT``), first and last index, and the long text (the
     comment of the declaration line, as KUKA's WorkVisual writes them)."""
-    # costs 0.06 s at start-up (python -X importtime, 2026-11-25)
-    from krl.ast import nodes as N  # noqa: PLC0415
 
     scope = rt.program.ws.global_scope
     out = []
@@ -146,9 +144,6 @@ def _long_text(sym, cache: dict) -> str:
     if lines is None:
         try:
             data = Path(span.file).read_bytes()[:4 * 1024 * 1024]
-            # costs 0.03 s at start-up (python -X importtime, 2026-11-25)
-            from krl.source import decode_bytes  # noqa: PLC0415
-
             lines = decode_bytes(data)[0].splitlines()
         except Exception:  # noqa: BLE001 - a long text is optional
             lines = []
@@ -209,10 +204,6 @@ def _position(eng, rt) -> dict:
 
 
 def _watch(core, exprs: list) -> list[dict]:
-    # costs 0.04 s at start-up (python -X importtime, 2026-11-25)
-    from interp.debug.values import value_text  # noqa: PLC0415
-    # costs 0.07 s at start-up (python -X importtime, 2026-11-25)
-    from interp.runtime.errors import KrlRuntimeError  # noqa: PLC0415
 
     out = []
     for text in exprs[:MAX_WEB_WATCHES]:

@@ -15,6 +15,9 @@ import re
 from pathlib import Path
 
 from krl.limits import MAX_WEB_FILE_BYTES
+from krl.files import write_bytes_atomic
+from krl.source import decode_bytes, encode_text
+from robot.datalist import DataListError, read_data_list
 
 CARTESIAN = ("X", "Y", "Z", "A", "B", "C")
 STATUS_TURN = ("S", "T")
@@ -35,12 +38,6 @@ def touch_up(dat: Path, name: str, pos: dict, axes: list[float]) -> dict:
     ``axes`` (deg) into the declaration of ``name`` in the data list ``dat``. Returns the new
     components. Raises :class:`TouchUpError` (no such point, not a point, the line does not
     hold the aggregate) and OSError (the file cannot be written)."""
-    # costs 0.04 s at start-up (python -X importtime, 2026-11-25)
-    from krl.files import write_bytes_atomic  # noqa: PLC0415
-    # costs 0.03 s at start-up (python -X importtime, 2026-11-25)
-    from krl.source import decode_bytes, encode_text  # noqa: PLC0415
-    # costs 0.33 s at start-up (python -X importtime, 2026-11-25)
-    from robot.datalist import DataListError, read_data_list  # noqa: PLC0415
 
     try:
         if dat.stat().st_size > MAX_WEB_FILE_BYTES:

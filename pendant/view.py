@@ -12,7 +12,22 @@ from pathlib import Path
 import numpy as np
 
 from krl.limits import MAX_WEB_FILE_BYTES
-from robot.axismap import CART_KEYS, EXT_KEYS, ROBOT_KEYS
+from robot.axismap import AxisMap, CART_KEYS, EXT_KEYS, ROBOT_KEYS
+from interp.realprograms import programs_of
+from krl.files import walk
+from krl.source import read_source
+from robot.datalist import DataListError, read_data_list
+from robot.frames import frame_to_matrix
+from krl.project import backup_of, system_folder
+from robot.urdf import build_urdf
+from robot.capsules import capsule_radii
+from robot.mjcf import robot_meshes
+import base64
+from interp.run import cell_of, is_auto
+from robot.controller import Controller
+from krl.ast import nodes as N
+from robot.stimuli import parse_start
+from interp.scene import start_axes
 
 POINT_KEYS = ("X", "Y", "Z")
 
@@ -20,8 +35,6 @@ POINT_KEYS = ("X", "Y", "Z")
 def programs(root: Path) -> list[str]:
     """The runnable programs of the workspace (interp/realprograms.py ``programs_of``: a
     backup's entry points; else every .src with a main routine), relative to ``root``."""
-    # costs 0.44 s at start-up (python -X importtime, 2026-11-25)
-    from interp.realprograms import programs_of  # noqa: PLC0415
 
     out = []
     for p in programs_of(root):
@@ -35,8 +48,6 @@ def programs(root: Path) -> list[str]:
 def modules(root: Path) -> list[str]:
     """Every program file (.src) of the workspace, relative to ``root`` (the navigator's view:
     any of them can be selected)."""
-    # costs 0.03 s at start-up (python -X importtime, 2026-11-25)
-    from krl.files import walk  # noqa: PLC0415
 
     out = [e.rel for e in walk(root) if e.kind == "file" and e.rel.lower().endswith(".src")]
     return sorted(out, key=str.lower)[:5000]
@@ -45,8 +56,6 @@ def modules(root: Path) -> list[str]:
 def module_view(path: Path, root: Path) -> dict:
     """``{path, lines, points}``: the text of ``path`` (lines as str) and the taught points of
     its data list (the .dat beside it, any case)."""
-    # costs 0.02 s at start-up (python -X importtime, 2026-11-25)
-    from krl.source import read_source  # noqa: PLC0415
 
     src = read_source(path, max_bytes=MAX_WEB_FILE_BYTES)
     text = getattr(src, "text", None) or ""
@@ -74,10 +83,6 @@ def taught_points(dat: Path, root: Path) -> list[dict]:
     value: the page's list of points shows them (issue 64). A base measured on an external
     kinematic (``MACHINE_FRAME_DAT``) is placed as a fixed ``BASE_DATA[n]``: the point's world
     position at its E is not computed here."""
-    # costs 0.22 s at start-up (python -X importtime, 2026-11-25)
-    from robot.datalist import DataListError, read_data_list  # noqa: PLC0415
-    # costs 0.34 s at start-up (python -X importtime, 2026-11-25)
-    from robot.frames import frame_to_matrix  # noqa: PLC0415
 
     try:
         values = read_data_list(dat)
@@ -115,10 +120,6 @@ def _ext(v: dict) -> dict[str, float]:
 
 def _base_data(root: Path) -> dict[int, tuple]:
     """``BASE_DATA[n]`` of the workspace's $config.dat (n -> X..C), {} when there is none."""
-    # costs 0.04 s at start-up (python -X importtime, 2026-11-25)
-    from krl.project import backup_of, system_folder  # noqa: PLC0415
-    # costs 0.22 s at start-up (python -X importtime, 2026-11-25)
-    from robot.datalist import DataListError, read_data_list  # noqa: PLC0415
 
     base = backup_of(root) or root
     folder = system_folder(base)
@@ -148,13 +149,6 @@ def robot_view(machine, inputs: str | None = None) -> dict:
     of the links' capsules the collision check uses (robot/capsules.py: ``base``, ``arm``,
     ``wrist``; the page draws the links with them), and ``start``: where it stands before a program
     is selected (:func:`start_position`)."""
-    # costs 0.36 s at start-up (python -X importtime, 2026-11-25)
-    from robot.urdf import build_urdf  # noqa: PLC0415
-    # costs 0.004 s at start-up (python -X importtime, 2026-11-26)
-    from robot.axismap import AxisMap  # noqa: PLC0415
-
-    # costs 0.005 s at start-up (python -X importtime, 2026-11-26, under load: constants and a function)
-    from robot.capsules import capsule_radii  # noqa: PLC0415
 
     amap = AxisMap.of(machine)
     joints = [j.name for j in machine.joints] + [f"joint_e{e.number}" for e in machine.external_axes]
@@ -169,9 +163,6 @@ def robot_view(machine, inputs: str | None = None) -> dict:
 def _meshes(machine) -> dict[str, str]:
     """The robot's link meshes (a description's, robot/description.py): link -> STL (metres, in
     the link's frame of the URDF the page draws) in base64; {} for a robot of machine data."""
-    # costs 0.03 s at start-up (python -X importtime, 2026-11-26: robot.mjcf once the controller is loaded)
-    from robot.mjcf import robot_meshes  # noqa: PLC0415
-    import base64  # noqa: PLC0415 - (stdlib: costs 0.001 s)
 
     return {link: base64.b64encode(data).decode("ascii") for link, data in robot_meshes(machine).items()}
 
@@ -182,8 +173,6 @@ def cell_view(inputs: str | None) -> dict | None:
     same, its frame on the flange) and ``floor`` (its Z, or null); None without geometry."""
     if not inputs:
         return None
-    # costs 0.38 s at start-up (python -X importtime, 2026-11-25)
-    from interp.run import cell_of, is_auto  # noqa: PLC0415
 
     if is_auto(inputs):
         return None
@@ -193,7 +182,6 @@ def cell_view(inputs: str | None) -> dict | None:
         return None
     if geo is None:
         return None
-    import base64  # noqa: PLC0415 - only with a cell's meshes (costs 0 s: stdlib)
 
     def body(b) -> dict:
         out = {"name": b.name, "shape": b.shape, "size": list(b.size), "frame": list(b.frame)}
@@ -211,25 +199,14 @@ def start_position(machine, inputs: str | None = None) -> dict | None:
     only once the program is selected) and ``$POS_ACT`` there with ``$TOOL`` and ``$BASE`` null,
     as before the program's BAS sets them: ``{axes, pos, base, tool}`` as pendant/state.py's
     ``position``. None when the robot cannot be placed (the page then shows no position)."""
-    # costs 0.79 s at start-up (python -X importtime, 2026-11-25)
-    from robot.controller import Controller  # noqa: PLC0415
 
     try:
-        # costs 0.38 s at start-up (python -X importtime, 2026-11-25)
-        from interp.run import cell_of, is_auto  # noqa: PLC0415
-
         cell = cell_of(inputs) if inputs and not is_auto(inputs) else None
         ctl = Controller(machine, stimuli=cell, mujoco=False)
         where = cell.start if cell is not None else None
         if where is not None:
-            # costs 0.05 s at start-up (python -X importtime, 2026-11-25)
-            from krl.ast import nodes as N  # noqa: PLC0415
-            # costs 0.14 s at start-up (python -X importtime, 2026-11-25)
-            from robot.stimuli import parse_start  # noqa: PLC0415
 
             if not isinstance(parse_start(where), N.Name):
-                # costs 0.03 s at start-up (python -X importtime, 2026-11-25)
-                from interp.scene import start_axes  # noqa: PLC0415
 
                 ctl.place(start_axes(ctl.model, lambda name: None, where))
         pos = ctl.pos_act()
