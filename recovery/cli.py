@@ -10,6 +10,15 @@ import click
 
 from krl.limits import PARSE_TIMEOUT_S
 from krl.terminal import printable, printable_path
+from krl.archive import ArchiveError, backup_source, is_archive
+from recovery.pipeline import run_recovery
+from krl.syntax.engines import use_engine
+from krl.cluster import SchedulerError
+from recovery.report import ReportError
+from recovery.grammar_versions import GrammarToolError
+from recovery.growth import growth_rows, write_growth
+from recovery.validate import DEFAULT_CORPUS, print_validation, validate_constructs
+from recovery.construct import REPO_ROOT, ConstructError, new_construct
 
 
 @click.command()
@@ -34,16 +43,6 @@ def recover(corpus: Path, out: Path, jobs: int | None, no_cache: bool, timeout: 
     Exit code: 0 when every file parses, 1 when some do not, 2 on a usage or internal error
     (or an archive refused by the limits of krl/limits.py).
     """
-    # costs 0.004 s at start-up (python -X importtime, 2026-11-25)
-    from krl.archive import ArchiveError, backup_source, is_archive  # noqa: PLC0415
-    # costs 0.05 s at start-up (python -X importtime, 2026-11-25)
-    from recovery.pipeline import run_recovery  # noqa: PLC0415
-    # costs 0.01 s at start-up (python -X importtime, 2026-11-25)
-    from krl.syntax.engines import use_engine  # noqa: PLC0415
-    # costs 0.004 s at start-up (python -X importtime, 2026-11-25)
-    from krl.cluster import SchedulerError  # noqa: PLC0415
-    # costs 0.05 s at start-up (python -X importtime, 2026-11-25)
-    from recovery.report import ReportError  # noqa: PLC0415
 
     use_engine(engine)
     if not corpus.is_dir() and not is_archive(corpus):
@@ -75,12 +74,6 @@ def recover(corpus: Path, out: Path, jobs: int | None, no_cache: bool, timeout: 
               help="Parse engine (java: fast, needs a JDK; python: the reference; default: $KRL_ENGINE, else auto).")
 def growth(corpus: Path, out: Path, jobs: int | None, no_cache: bool, engine: str | None) -> None:
     """Replay every committed version of grammar/KRL.g4 over CORPUS: growth.csv and growth.png."""
-    # costs 0.01 s at start-up (python -X importtime, 2026-11-25)
-    from krl.syntax.engines import use_engine  # noqa: PLC0415
-    # costs 0.02 s at start-up (python -X importtime, 2026-11-25)
-    from recovery.grammar_versions import GrammarToolError  # noqa: PLC0415
-    # costs 0.03 s at start-up (python -X importtime, 2026-11-25)
-    from recovery.growth import growth_rows, write_growth  # noqa: PLC0415
 
     use_engine(engine)
     if not corpus.is_dir():
@@ -111,12 +104,6 @@ def growth(corpus: Path, out: Path, jobs: int | None, no_cache: bool, engine: st
 def validate(names: tuple[str, ...], corpus: Path | None, no_corpus: bool, jobs: int | None,
              engine: str | None) -> None:
     """Run every grammar construct's positive and negative examples (or only NAMES)."""
-    # costs 0.01 s at start-up (python -X importtime, 2026-11-25)
-    from krl.syntax.engines import use_engine  # noqa: PLC0415
-    # costs 0.02 s at start-up (python -X importtime, 2026-11-25)
-    from recovery.grammar_versions import GrammarToolError  # noqa: PLC0415
-    # costs 0.03 s at start-up (python -X importtime, 2026-11-25)
-    from recovery.validate import DEFAULT_CORPUS, print_validation, validate_constructs  # noqa: PLC0415
 
     use_engine(engine)
     if corpus is None and not no_corpus and DEFAULT_CORPUS.is_dir():
@@ -148,8 +135,6 @@ def construct_new(name: str, cluster_id: str, report: Path, corpus: Path | None,
     """Create grammar/constructs/NAME/ from CLUSTER: positive examples cut from the corpus (the
     smallest module that still shows the construct, each with its origin), a negative-example
     template, the grammar/CHANGES.md row and a conformance-case stub."""
-    # costs 0.03 s at start-up (python -X importtime, 2026-11-25)
-    from recovery.construct import REPO_ROOT, ConstructError, new_construct  # noqa: PLC0415
 
     base = root or REPO_ROOT
     try:

@@ -18,6 +18,11 @@ from recovery.cluster import cluster_results
 from recovery.grammar_versions import committed_versions, grammar_metrics, parser_dir_for, python_target
 from recovery.progress import steps
 from recovery.scan import grammar_sha, scan
+from krl.syntax.engines.java import build_many, close_all, java_target
+from krl.syntax.engines import resolve
+from concurrent.futures import ProcessPoolExecutor
+import matplotlib
+import matplotlib.pyplot as plt
 
 COLUMNS = ["commit", "date", "subject", "parser_rules", "lexer_rules", "alternatives",
            "files_ok", "bytes_ok", "clusters", "files", "bytes"]
@@ -33,8 +38,6 @@ def _summary(results) -> dict:
 def _scan_version(args: tuple[str, str, str, bool]) -> dict:
     """Scan the corpus with one grammar version in this process (a pool worker); its Java
     worker (if any) is stopped afterwards, so that versions do not pile up JVMs."""
-    # costs 0.09 s at start-up (python -X importtime, 2026-11-25)
-    from krl.syntax.engines.java import close_all  # noqa: PLC0415
 
     corpus, sha, pdir, use_cache = args
     try:
@@ -48,10 +51,6 @@ def build_parsers(texts: list[str], jobs: int) -> list[Path]:
     """The Python parser directory of each grammar text, and its Java parser when the Java
     engine can run, generated once per sha: all missing ones in `jobs` JVMs (KrlBuild), so the
     JVM start and warm-up are paid once, not per version."""
-    # costs 0.06 s at start-up (python -X importtime, 2026-11-25)
-    from krl.syntax.engines import resolve  # noqa: PLC0415
-    # costs 0.09 s at start-up (python -X importtime, 2026-11-25)
-    from krl.syntax.engines.java import build_many, java_target  # noqa: PLC0415
     tasks = [("python", t, python_target(t)) for t in texts]
     if resolve() == "java":
         tasks += [("java", t, java_target(t)) for t in texts]
@@ -64,8 +63,6 @@ def scan_versions(corpus: Path, texts: list[str], jobs: int | None = None, use_c
     """Scan `corpus` with each grammar text, `jobs` versions at a time (one process and one
     parse engine worker each); returns each version's summary (files_ok, bytes_ok, clusters,
     files, bytes), in order. Per-file results land in the result cache (recovery/scan.py)."""
-    # costs 0.02 s at start-up (python -X importtime, 2026-11-25)
-    from concurrent.futures import ProcessPoolExecutor  # noqa: PLC0415
 
     jobs = jobs or os.cpu_count() or 1
     pdirs = build_parsers(texts, jobs)
@@ -111,12 +108,8 @@ def write_growth(out: Path, rows: list[dict]) -> None:
 
 
 def plot_growth(path: Path, rows: list[dict]) -> None:
-    # costs 0.30 s at start-up (python -X importtime, 2026-11-25)
-    import matplotlib  # noqa: PLC0415
 
     matplotlib.use("Agg")
-    # costs 0.69 s at start-up (python -X importtime, 2026-11-25)
-    import matplotlib.pyplot as plt  # noqa: PLC0415
 
     xs = list(range(len(rows)))
     files_pct = [100.0 * r["files_ok"] / r["files"] if r["files"] else 0 for r in rows]

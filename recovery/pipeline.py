@@ -13,6 +13,8 @@ from krl.files import write_text_atomic
 from krl.limits import PARSE_TIMEOUT_S
 from recovery.report import ReportStream, Summary, SummaryBuilder
 from recovery.scan import FileResult, cache_dir, grammar_sha, scan, warn
+from krl.project import find_backups
+from krl.survey.report import check_report
 
 REPO_ROOT = Path(__file__).resolve().parents[1]
 GRAMMAR = REPO_ROOT / "grammar" / "KRL.g4"
@@ -66,8 +68,6 @@ def static_check_figures(corpus: Path, fingerprints: list[str], gsha: str,
     grammar, the front end's code and the corpus files (`fingerprints`: "path:sha" of every
     scanned file). Files are parsed and built in `jobs`
     worker processes (the scan's pool, krl/pool.py), each stopped past `timeout` seconds."""
-    # costs 0.009 s at start-up (python -X importtime, 2026-11-25)
-    from krl.project import find_backups  # noqa: PLC0415
 
     if not find_backups(corpus):
         return None
@@ -87,8 +87,6 @@ def static_check_figures(corpus: Path, fingerprints: list[str], gsha: str,
         except (OSError, ValueError, RecursionError):
             pass
         warn(f"cache file {path} is corrupt; ignored and rebuilt")
-    # costs 0.28 s at start-up (python -X importtime, 2026-11-25)
-    from krl.survey.report import check_report  # noqa: PLC0415
 
     data, markdown = check_report(corpus, timeout=timeout, jobs=jobs)
     figures = {"files": data["total"]["files"], "files_clean": data["total"]["files_clean"],

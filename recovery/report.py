@@ -28,10 +28,14 @@ from urllib.parse import quote
 
 from jinja2 import Environment, PackageLoader
 
-from krl.render import markdown_code as md_code
-from krl.render import render_html
+from krl.render import markdown_code as md_code, render_html
 from recovery.cluster import Cluster, ClusterBuilder, clusters_of_file
 from recovery.scan import FileResult
+import matplotlib
+import matplotlib.pyplot as plt
+from matplotlib.ticker import MaxNLocator
+from krl.syntax.messages import expected_phrase
+import ctypes
 
 TOP_CHART = 20
 TOP_REPORT = 40
@@ -186,12 +190,8 @@ def write_chart(path: Path, clusters: list[Cluster]) -> bool:
     Returns False (and writes nothing) when there is no cluster."""
     if not clusters:
         return False
-    # costs 0.31 s at start-up (python -X importtime, 2026-11-25)
-    import matplotlib  # noqa: PLC0415
 
     matplotlib.use("Agg")
-    # costs 0.71 s at start-up (python -X importtime, 2026-11-25)
-    import matplotlib.pyplot as plt  # noqa: PLC0415
 
     top = clusters[:TOP_CHART]
     fig, ax = plt.subplots(figsize=(11, 0.42 * len(top) + 1.4))
@@ -201,8 +201,6 @@ def write_chart(path: Path, clusters: list[Cluster]) -> bool:
     for i, c in enumerate(top):
         ax.annotate(str(c.files), (c.files, i), xytext=(3, 0), textcoords="offset points",
                     va="center", fontsize=8)
-    # costs 0.30 s at start-up (python -X importtime, 2026-11-25)
-    from matplotlib.ticker import MaxNLocator  # noqa: PLC0415
 
     ax.xaxis.set_major_locator(MaxNLocator(integer=True))
     ax.set_xlabel("files affected")
@@ -232,8 +230,6 @@ def source_link(corpus: str, path: str, out: Path) -> str:
 def _expected_words(expected: list[str]) -> str:
     """The tokens expected at a cluster's error in KRL words: at most six grouped alternatives
     ("a statement, ELSE, ENDIF or end of line"), as in the compiler-style messages."""
-    # costs 0.07 s at start-up (python -X importtime, 2026-11-25)
-    from krl.syntax.messages import expected_phrase  # noqa: PLC0415
 
     return expected_phrase(list(expected)).replace("`", "")
 
@@ -269,8 +265,6 @@ def _new_report_folder(out: Path) -> Path:
 def _exchange(a: Path, b: Path) -> bool:
     """Swap the folders `a` and `b` in one atomic step (Linux renameat2 RENAME_EXCHANGE);
     False when the system or the file system cannot (then nothing has changed)."""
-    # costs 0.007 s at start-up (python -X importtime, 2026-11-25)
-    import ctypes  # noqa: PLC0415
     if not sys.platform.startswith("linux"):
         return False
     try:

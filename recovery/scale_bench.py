@@ -24,6 +24,8 @@ import time
 from pathlib import Path
 
 import click
+import psutil
+from krl.files import SHARED_CORPUS as DEFAULT_CORPUS
 
 def _link_tree(src: Path, dst: Path) -> None:
     try:
@@ -37,8 +39,6 @@ def measure(argv: list[str], interval: float = 0.05) -> dict:
     """Run argv; wall time (s), exit status and peak resident memory (MB): of the whole process
     tree at any one moment (`total`) and of the largest process of each kind (`main`, `worker`,
     `java`)."""
-    # costs 0.02 s at start-up (python -X importtime, 2026-11-25)
-    import psutil  # noqa: PLC0415
 
     start = time.perf_counter()
     proc = subprocess.Popen(argv, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
@@ -89,8 +89,6 @@ def scale(corpus: Path, copies: int = 16) -> dict:
 @click.option("--copies", type=click.IntRange(2, 64), default=16, show_default=True)
 @click.option("--json", "as_json", is_flag=True, help="One JSON object.")
 def main(corpus: Path | None, copies: int, as_json: bool) -> None:
-    # costs 0.02 s at start-up (python -X importtime, 2026-11-25)
-    from krl.files import SHARED_CORPUS as DEFAULT_CORPUS  # noqa: PLC0415
 
     if corpus is None and not DEFAULT_CORPUS.is_dir():
         raise click.UsageError(f"no corpus at {DEFAULT_CORPUS}; name one")

@@ -39,6 +39,10 @@ from krl.limits import PARSE_TIMEOUT_S
 from krl.pool import default_jobs, run_tasks
 from krl.source import read_limited, source_from_bytes
 from krl.terminal import printable
+from krl.syntax.parse import ParserBundle, default_bundle
+from krl.syntax.engines import parse_source
+from rich.progress import Progress
+from krl.cluster import run_batches
 
 CACHE_VERSION = "3"
 CACHE_SCHEMA = "krl-scan-results"
@@ -151,8 +155,6 @@ def _init_worker(parser_dir: str | None) -> None:
     global _BUNDLE, _BUNDLE_DIR
     if _BUNDLE_DIR == (parser_dir,):
         return
-    # costs 0.07 s at start-up (python -X importtime, 2026-11-25)
-    from krl.syntax.parse import ParserBundle, default_bundle  # noqa: PLC0415
 
     _BUNDLE = ParserBundle.from_directory(parser_dir, tag="scan") if parser_dir else default_bundle()
     _BUNDLE_DIR = (parser_dir,)
@@ -160,8 +162,6 @@ def _init_worker(parser_dir: str | None) -> None:
 
 def parse_row(rel_path: str, data: bytes, sha: str) -> FileResult:
     """Decode and parse the bytes of one file: the scan's one call into the parser."""
-    # costs 0.04 s at start-up (python -X importtime, 2026-11-25)
-    from krl.syntax.engines import parse_source  # noqa: PLC0415  (KRL_ENGINE: python, java, auto)
 
     source = source_from_bytes(rel_path, data, sha)
     row = FileResult(rel_path, source.size, sha, source.encoding, source.status, detail=source.detail)
@@ -369,8 +369,6 @@ def scan(corpus: Path, gsha: str, parser_dir: str | None = None, jobs: int | Non
     (krl/cluster.py; raises SchedulerError when it cannot be reached). Never raises
     for what it finds in the corpus.
     """
-    # costs 0.06 s at start-up (python -X importtime, 2026-11-25)
-    from rich.progress import Progress  # noqa: PLC0415
 
     corpus = Path(corpus)
     _init_worker(parser_dir)      # here first: a missing parser fails once, with its own message
@@ -416,8 +414,6 @@ def scan(corpus: Path, gsha: str, parser_dir: str | None = None, jobs: int | Non
 
     with bar:
         if scheduler is not None:
-            # costs 0.005 s at start-up (python -X importtime, 2026-11-25)
-            from krl.cluster import run_batches  # noqa: PLC0415
 
             outcomes = run_batches(scheduler, scan_bytes, tasks(), timeout=timeout,
                                    initializer=_init_worker, initargs=(parser_dir,), name="krl-scan")

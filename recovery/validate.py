@@ -30,6 +30,10 @@ from recovery.cluster import cluster_results
 from recovery.grammar_versions import GrammarToolError, _git, parser_dir_for
 from recovery.progress import shown, steps
 from recovery.scan import grammar_sha, scan
+from krl.ast.build import build_module
+from krl.ast.kinds import statement_kinds
+from recovery.growth import scan_versions
+from krl.syntax.engines import parse_source
 
 REPO_ROOT = Path(__file__).resolve().parents[1]
 CONSTRUCTS = REPO_ROOT / "grammar" / "constructs"
@@ -75,10 +79,6 @@ def expected_kinds(expect_file: Path) -> list[tuple[int, str]] | None:
 
 def built_kinds(result) -> list[tuple[int, str]]:
     """(line, kind) of the module the AST builder makes of a parse result."""
-    # costs 0.08 s at start-up (python -X importtime, 2026-11-25)
-    from krl.ast.build import build_module  # noqa: PLC0415
-    # costs 0.05 s at start-up (python -X importtime, 2026-11-25)
-    from krl.ast.kinds import statement_kinds  # noqa: PLC0415
     return statement_kinds(build_module(result, DiagnosticSink()))
 
 
@@ -87,8 +87,6 @@ def check_example(path: Path) -> ExampleResult:
     if kind == "ok":   # the statement kinds need the tree: the Python engine
         result = parse_file(path, keep_tree=True)
     else:
-        # costs 0.02 s at start-up (python -X importtime, 2026-11-25)
-        from krl.syntax.engines import parse_source  # noqa: PLC0415
 
         result = parse_source(read_source(path))
     rel = path.relative_to(REPO_ROOT).as_posix()
@@ -175,8 +173,6 @@ def validate_constructs(names: list[str], corpus: Path | None = None,
         if unknown:
             raise click.UsageError(f"unknown construct(s): {', '.join(sorted(unknown))}")
         dirs = [d for d in dirs if d.name in names]
-    # costs 0.006 s at start-up (python -X importtime, 2026-11-25)
-    from recovery.growth import scan_versions  # noqa: PLC0415
     reports = [ConstructReport(d.name) for d in dirs]
     pairs = [_grammar_change(rep, d) if corpus is not None else None for rep, d in zip(reports, dirs)]
     if corpus is not None:
