@@ -28,6 +28,7 @@ from krl.cbuild import OTHER_CHECKOUT_PRELUDE
 from .controller import Controller, Event
 from .motion import MotionParams, MotionRequest, Trigger
 from .trace import TraceWriter
+from .mada import load_robot
 
 TARGET_FACTOR = 20.0
 
@@ -117,8 +118,6 @@ def measure(min_motion_s: float = 60.0, robot: str | None = None, warm_up: bool 
     time)."""
     machine = None
     if robot:
-        # costs 0.12 s at start-up (python -X importtime, 2026-11-25)
-        from .mada import load_robot  # noqa: PLC0415  (only with --robot: the machine-data reader)
 
         machine = load_robot(robot)
     t0 = time.perf_counter()

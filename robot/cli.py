@@ -11,6 +11,16 @@ import click
 
 from krl.terminal import printable
 from robot.machine import load_machine
+from robot.plot import plot_trace
+from robot.mada import MachineDataError, load_robot
+from robot.show import show_lines
+from robot.catalogue import catalogue_lines
+from robot.kukatrace.model import load_run
+from robot.kukatrace.recording import RecordingError
+from robot.kukatrace import compare as C, show as S
+from robot.urdf import build_urdf
+from robot.mjcf import build_mjcf
+from robot.kukatrace.show import plot_compare
 
 
 @click.command("plot")
@@ -20,8 +30,6 @@ from robot.machine import load_machine
 def plot(trace: Path, output: Path | None) -> None:
     """Draw the TCP path of a JSON Lines TRACE (3D and top view, programmed points,
     approximation zones, I/O events) as a PNG."""
-    # costs 0.003 s at start-up (python -X importtime, 2026-11-25)
-    from robot.plot import plot_trace  # noqa: PLC0415
 
     out = output or trace.with_suffix(".png")
     try:
@@ -38,8 +46,6 @@ def robot_group() -> None:
 
 
 def _load(path: Path | None):
-    # costs 0.16 s at start-up (python -X importtime, 2026-11-25)
-    from robot.mada import MachineDataError, load_robot  # noqa: PLC0415
     try:
         return load_robot(path) if path is not None else load_machine()
     except MachineDataError as exc:
@@ -53,8 +59,6 @@ def show(robot: Path | None) -> None:
     """Print the robot model of ROBOT (a KRC backup folder or .zip, a $machine.dat, a robot
     YAML or a KUKA model's name from `krl robot list`; default the KR 6 R900): name, parameters with their source (file:line or the rule
     that derived them), axis limits, speeds, accelerations, reach."""
-    # costs 0.0007 s at krl's start-up (python -X importtime, 2026-11-25)
-    from robot.show import show_lines  # noqa: PLC0415
 
     for line in show_lines(_load(robot)):
         click.echo(line)
@@ -65,8 +69,6 @@ def list_models() -> None:
     """List the catalogue of KUKA robots by model name (robot/data/catalogue.yaml): each model's
     $MODEL_NAME spelling, reach, axis limits and speeds, and the public description every value
     comes from; `--robot NAME` and `krl robot show NAME` take either spelling."""
-    # costs 0.005 s at start-up (python -X importtime, 2026-11-26)
-    from robot.catalogue import catalogue_lines  # noqa: PLC0415
 
     for line in catalogue_lines():
         click.echo(line)
@@ -80,13 +82,9 @@ def export(robot: Path | None, fmt: str, output: Path) -> None:
     """Write the robot model of ROBOT (as for `krl robot show`) as URDF or MJCF (MuJoCo)."""
     m = _load(robot)
     if fmt == "urdf":
-        # costs 0.01 s at start-up (python -X importtime, 2026-11-25)
-        from robot.urdf import build_urdf  # noqa: PLC0415
 
         text = build_urdf(m)
     else:
-        # costs 0.02 s at start-up (python -X importtime, 2026-11-25)
-        from robot.mjcf import build_mjcf  # noqa: PLC0415
 
         text = build_mjcf(m)
     output.write_text(text, encoding="utf-8")
@@ -100,9 +98,6 @@ def trace_group() -> None:
 
 
 def _view(path: Path, override: float | None):
-    # costs 0.01 s at start-up (python -X importtime, 2026-11-26)
-    from robot.kukatrace.model import load_run  # noqa: PLC0415
-    from robot.kukatrace.recording import RecordingError  # noqa: PLC0415
     try:
         return load_run(path, override)
     except (RecordingError, ValueError, OSError) as exc:
@@ -124,8 +119,6 @@ def trace_show(rec: Path, override: float | None, as_json: bool, output: Path | 
     """Show REC: a KUKA Trace recording (its _KRCIpo.csv or _PROG.TXT, or their common stem) or a
     run's JSON Lines trace (krl run --trace): its segments, motions (START, END, time, pause
     before, type, line, point) and samples."""
-    # costs 0.01 s at start-up (python -X importtime, 2026-11-26)
-    from robot.kukatrace import show as S  # noqa: PLC0415
 
     view = _view(rec, override)
     if as_json:
@@ -155,8 +148,6 @@ def trace_compare(run: Path, rec: Path, override: float | None, run_override: fl
     """Compare RUN (a simulated run's trace, or a recording) with the recording REC, motion by
     motion within each TraceStart..TraceStop segment: motion time (END - START) and its error,
     the exact-stop pause, the path deviation of RUN's TCP from REC's (mm)."""
-    # costs 0.01 s at start-up (python -X importtime, 2026-11-26)
-    from robot.kukatrace import compare as C  # noqa: PLC0415
 
     a = _view(run, run_override)
     b = _view(rec, override)
@@ -171,8 +162,6 @@ def trace_compare(run: Path, rec: Path, override: float | None, run_override: fl
         for line in C.text_lines(a, b, result):
             click.echo(printable(line))
     if output is not None:
-        # costs 0.2 s at start-up (python -X importtime, 2026-11-26)
-        from robot.kukatrace.show import plot_compare  # noqa: PLC0415
 
         plot_compare(a, b, result, output)
         click.echo(str(output), err=as_json)

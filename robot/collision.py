@@ -249,8 +249,8 @@ class CollisionChecker:
     excluded: set = field(default_factory=set)
 
     def __post_init__(self) -> None:
-        # costs 0.20 s at start-up (python -X importtime, 2026-11-25: MuJoCo, robot/mjcf.py's)
-        from .mjcf import ArmModel  # noqa: PLC0415 - MuJoCo only for a cell with geometry
+        # deferred: tools/startup_bench.py, krl check --reach +91 ms at the top (2026-11-26)
+        from .mjcf import ArmModel  # noqa: PLC0415
 
         self.arm = ArmModel(self.machine, cell=self.cell)
         self._names = [self._body_label(self.arm.model, g) for g in range(self.arm.model.ngeom)]

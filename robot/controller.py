@@ -339,8 +339,8 @@ class Controller:
         #: the robot against its cell (robot/collision.py), None without a cell file's geometry
         self.collision = None
         if geometry is not None:
-            # costs 0.006 s at start-up (python -X importtime, 2026-11-26; MuJoCo's own 0.2 s aside)
-            from .collision import CollisionChecker  # noqa: PLC0415 - only for a cell with geometry
+            # deferred: tools/startup_bench.py, krl run +4 ms at the top (2026-11-26)
+            from .collision import CollisionChecker  # noqa: PLC0415
 
             self.collision = CollisionChecker(self.machine, geometry)
         self.network = network  # net.hub.Network: the partners, polled at each cycle's start
@@ -361,8 +361,8 @@ class Controller:
         """The MuJoCo arm, compiled now (its first use) and reset to the axes it would have
         been reset to when built at once (the start axes, or :meth:`place`'s): the same state."""
         if self._arm_q is not None:
-            # costs 0.04 s at start-up (python -X importtime, 2026-11-25)
-            from .mjcf import ArmModel  # noqa: PLC0415 - MuJoCo at the arm's first use (issue 37)
+            # deferred: tools/startup_bench.py, krl run +93 ms at the top (2026-11-26)
+            from .mjcf import ArmModel  # noqa: PLC0415
 
             arm = ArmModel(self.machine, actuated=self.actuated)
             arm.reset(self._arm_q)

@@ -42,6 +42,11 @@ from .frames import matrix_to_frame
 from .kinematics import Kinematics
 from .machine import JointData, load_machine
 from .madavalues import MachineDataError
+import xacro
+import xacro.substitution_args as subst
+import trimesh
+from .collision import MAX_MESH_BYTES
+import yourdfpy
 
 MAX_DESCRIPTION_BYTES = 4 * 1024 * 1024
 MAX_MESH_FACES = 400_000
@@ -64,9 +69,6 @@ def _urdf_text(path: Path) -> str:
         raise MachineDataError(f"{path}: larger than the limit of {MAX_DESCRIPTION_BYTES} bytes")
     if path.suffix.lower() != ".xacro":
         return path.read_text(encoding="utf-8")
-    # costs 0.004 s at start-up (python -X importtime, 2026-11-26)
-    import xacro  # noqa: PLC0415 - only for a xacro description
-    import xacro.substitution_args as subst  # noqa: PLC0415
 
     def find(pkg: str) -> str:
         found = _tree_root(path, pkg)
@@ -155,11 +157,6 @@ def _geometry(joints, tool, where: str) -> dict[str, float]:
 def _meshes(urdf: Any, path: Path, joints, links: list[str], machine, missing: list[str]) -> dict[str, bytes]:
     """The links' meshes as STL (m) in the model's link frames (see the module docstring); a mesh
     file the tree lacks is listed in `missing` (its link keeps its capsule)."""
-    # costs 0.0 s once yourdfpy is loaded (it loads trimesh: python -X importtime, 2026-11-26)
-    import trimesh  # noqa: PLC0415 - only for a description with meshes
-
-    # costs 0.006 s at start-up (python -X importtime, 2026-11-26)
-    from .collision import MAX_MESH_BYTES  # noqa: PLC0415
 
     out: dict[str, bytes] = {}
     # the description's link frames at A = 0, and the model's (translation-only joint origins)
@@ -286,8 +283,6 @@ def load_description(path: str | Path, build: Any, dynamics: Any) -> Any:
     MachineDataError for a file that cannot be read, a chain that is not KUKA's arm, or a mesh it
     cannot take. `dynamics` is robot/mada.py ``default_dynamics`` (an axis's acceleration and jerk
     by the machine-data rules), which a seven-axis arm's joints need."""
-    # costs 0.93 s at start-up (python -X importtime, 2026-11-26: yourdfpy with trimesh and lxml)
-    import yourdfpy  # noqa: PLC0415 - only for a description
 
     p = Path(path)
     where = str(p)

@@ -34,6 +34,8 @@ from .axismap import ROBOT_KEYS, robot_slots
 from .frames import frame_to_matrix, inv_pos
 from .kinematics import Kinematics
 from .machine import load_machine
+from .mada import load_robot
+from .external import ExternalAxes
 
 #: T1 speed limit of the TCP and the flange (reference §6.7 [C], §7.5), mm/s.
 T1_SPEED_MM_S = 250.0
@@ -248,8 +250,6 @@ def _frame(f: Iterable[float]) -> np.ndarray:
 def _trace_robot(events: list[dict[str, Any]]) -> Any:
     """The robot named by the trace's ``robot`` header (krl run, issue 22), or None when the
     trace has none or its source is no longer there (a backup archive's temporary folder)."""
-    # costs 0.82 s at start-up (python -X importtime, 2026-11-25)
-    from .mada import load_robot  # noqa: PLC0415
 
     for ev in events[:4]:
         if ev.get("kind") == "robot":
@@ -324,8 +324,6 @@ def check_trace(events: Iterable[dict[str, Any]], machine: Any = None, *,
     kin = Kinematics(machine)
     F = kin.forward_many(Q)
     if any(k.robroot for k in getattr(machine, "external_kinematics", ())):
-        # costs 0.002 s at start-up (python -X importtime, 2026-11-25)
-        from .external import ExternalAxes  # noqa: PLC0415
 
         ext = ExternalAxes(machine)
         F = np.array([ext.robroot(q[kin.n_axes:]) for q in Q]) @ F     # $ROBROOT_C on a track
@@ -378,9 +376,6 @@ def check_trace(events: Iterable[dict[str, Any]], machine: Any = None, *,
                 ml = lim.get(newest)
                 if ml is not None and ml.base_kin:
                     # a base on a turntable: the path is measured in the turning base
-                    # costs 0.002 s at start-up (python -X importtime, 2026-11-25)
-                    from .external import ExternalAxes  # noqa: PLC0415
-
                     ext = ExternalAxes(machine)
                     na = kin.n_axes
                     et = ext.base_kins[ml.base_kin]

@@ -46,10 +46,7 @@ from .chain import chain_forward, chain_to_joints
 from .datalist import DataListError, DataValue, read_data_list
 from .identified import apply_identified, identified_file
 from .frames import matrix_to_frame
-from .madavalues import MachineDataError, krl_value
-from .madavalues import axes as _axes
-from .madavalues import flag as _flag
-from .madavalues import frame as _frame
+from .madavalues import axes as _axes, flag as _flag, frame as _frame, krl_value, MachineDataError
 from .madavalues import frame6 as _frame6
 from .madavalues import get as _get
 from .madavalues import num as _num
@@ -57,6 +54,7 @@ from .kinematics.families import machine_geometry
 from .machine import (
     CartLimits, ExternalAxis, ExternalKinematic, JointData, MachineData, library_robots, load_machine,
 )
+from krl.archive import ArchiveError, backup_source, is_archive
 
 #: The rules for values that machine data lack (docs/robot.md, "Robots from machine data"); those of
 #: a family's geometry are the family's (robot/kinematics/arm.py RULES).
@@ -587,8 +585,6 @@ def load_robot(path: str | Path) -> MachineData:
     library (``kr180_r3200_pa``: robot/machine.py ``library_robots``), or a KUKA model's name
     (``"KR 150 R3100-2"``, ``KR150R3100_2``: robot/catalogue.py). Raises :class:`MachineDataError` with a
     clear message for anything else."""
-    # costs 0.008 s at start-up (python -X importtime, 2026-11-25)
-    from krl.archive import ArchiveError, backup_source, is_archive  # noqa: PLC0415
     p = Path(path)
     if not p.exists():
         lib = library_robots()
@@ -608,7 +604,7 @@ def load_robot(path: str | Path) -> MachineData:
     if p.is_file() and p.suffix.lower() == ".dat":
         return load_mada(p)
     if p.is_file() and p.suffix.lower() in (".urdf", ".xacro"):
-        # costs 0.015 s at start-up (python -X importtime, 2026-11-26; yourdfpy's 0.93 s when it reads)
+        # deferred: tools/startup_bench.py, krl run +306 ms at the top (2026-11-26)
         from .description import load_description  # noqa: PLC0415
 
         return load_description(p, build_cited, default_dynamics)

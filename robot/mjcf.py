@@ -40,6 +40,7 @@ from .capsules import capsule_radii, group_of
 from .frames import as_matrix, frame_to_matrix, inv_pos
 from .kinematics.compiled import COMPILED_AXES
 from .machine import MachineData, load_machine
+import mujoco
 
 #: Servo gains of the actuated mode (robot-model.md §11: kp 2e4 + kv 400 -> 0.175 deg max error).
 DEFAULT_KP = 20000.0
@@ -325,8 +326,6 @@ class ArmModel:
     """
 
     def __init__(self, machine: MachineData | None = None, actuated: bool = False, cell: Any = None, **kw) -> None:
-        # costs 0.20 s at start-up (python -X importtime, 2026-11-25)
-        import mujoco
 
         self._mj = mujoco
         self.machine = machine if machine is not None else load_machine()

@@ -23,6 +23,8 @@ from typing import Any
 import numpy as np
 
 from .trace import read_trace
+import matplotlib
+import matplotlib.pyplot as plt
 
 
 def _collect(events: list[dict[str, Any]]) -> dict[str, Any]:
@@ -71,12 +73,8 @@ def plot_trace(trace_path: str | Path, png_path: str | Path, title: str | None =
 
     Raises FileNotFoundError if the trace does not exist, ValueError if it has no pose events.
     """
-    # costs 0.13 s at start-up (python -X importtime, 2026-11-25)
-    import matplotlib
 
     matplotlib.use("Agg")
-    # costs 0.38 s at start-up (python -X importtime, 2026-11-25)
-    import matplotlib.pyplot as plt
     events = list(read_trace(trace_path))
     data = _collect(events)
     if not data["xyz"]:

@@ -71,6 +71,8 @@ from krl.syntax.parse import default_bundle, parse_expression
 
 from .cellrules import ConditionError, Rule, compile_condition, parse_condition, signal_of
 from .machine import library_robots
+from .catalogue import find
+from net.settings import SettingsError, parse_network
 
 PHASES = ("start", "blend_start", "blend_end", "end")
 TOP_KEYS = ("stimuli", "rules", "presets", "robot", "sim_time", "start", "network", "geometry", "tool", "floor")
@@ -294,7 +296,7 @@ def parse_cell(doc: Any, default_reach_mm: float = 0.1, source: str = "") -> Cel
         if doc.get("stimuli") is not None:
             cell.stimuli = _parse_stimuli(doc["stimuli"], default_reach_mm, where)
         if any(doc.get(k) is not None for k in ("geometry", "tool", "floor")):
-            # costs 0.006 s at start-up (python -X importtime, 2026-11-26)
+            # deferred: tools/startup_bench.py, krl run +4 ms at the top (2026-11-26)
             from .collision import GeometryError, parse_geometry  # noqa: PLC0415
 
             try:
@@ -304,8 +306,6 @@ def parse_cell(doc: Any, default_reach_mm: float = 0.1, source: str = "") -> Cel
                 key = next(k for k in ("geometry", "tool", "floor") if doc.get(k) is not None)
                 raise StimulusError(f"{where(doc, key)}: {exc}") from None
         if doc.get("network") is not None:
-            # costs 0.20 s at start-up (python -X importtime, 2026-11-25)
-            from net.settings import SettingsError, parse_network  # noqa: PLC0415
 
             try:
                 cell.network = parse_network(doc["network"], Path(source).parent if source else Path("."))
@@ -393,8 +393,6 @@ def _library_robot(name: Any, at: str, folder: Path | None = None) -> Path:
     robots = library_robots()
     if isinstance(name, str) and name in robots:
         return robots[name]
-    # costs 0.005 s at start-up (python -X importtime, 2026-11-26)
-    from .catalogue import find  # noqa: PLC0415
 
     if isinstance(name, str) and find(name) is not None:
         return Path(name)

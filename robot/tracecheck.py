@@ -38,6 +38,13 @@ from typing import Any
 
 from robot.axismap import ROBOT_KEYS
 from robot.errors import RobotError
+from robot.mada import load_robot
+from robot.controller import Controller
+from robot.motion import MotionParams, MotionRequest, SplineSegment, Trigger
+from robot.trace import TraceWriter
+import argparse
+from robot.bench import run_bench
+from robot.stimuli import load_cell
 
 #: The corpus backup whose machine data gives the benchmark's KR 210 R2700-2.
 KR210_BACKUP = "HugoDanielson__ChinaMilling"
@@ -61,8 +68,6 @@ def _kr210() -> Any:
     c = _corpus()
     if c is None:
         return None
-    # costs 0.51 s at start-up (python -X importtime, 2026-11-25)
-    from robot.mada import load_robot
 
     return load_robot(str(c / KR210_BACKUP))
 
@@ -89,19 +94,12 @@ def random_program(seed: int, machine: Any, trace: Any, cell_path: str | None = 
     """Run the random sequence ``seed`` on a new Controller for ``machine`` (None: the KR 6
     R900) writing to the TraceWriter ``trace``; returns the controller. Deterministic: the
     same seed gives the same operations on any checkout."""
-    # costs 0.60 s at start-up (python -X importtime, 2026-11-25)
-    from robot.controller import Controller
-    # costs 0.01 s at start-up (python -X importtime, 2026-11-25)
-    from robot.motion import MotionParams, MotionRequest, SplineSegment, Trigger
 
     rng = random.Random(seed)
     mode = "T1" if seed % 8 == 5 else None
     try:
         ctl = Controller(machine, trace=trace, stimuli=cell_path, mode_op=mode)
     except TypeError:      # this checkout's Controller takes the Cell of the one loader, not a path
-        # costs 0.15 s at start-up (python -X importtime, 2026-11-25)
-        from robot.stimuli import load_cell
-
         ctl = Controller(machine, trace=trace, stimuli=load_cell(cell_path), mode_op=mode)
     mach = ctl.machine
     k = mach.reach_wrist_point_mm / 901.456
@@ -258,13 +256,9 @@ def cases() -> list[str]:
 
 def run_case(name: str) -> bytes:
     """The trace (bytes) of case `name`."""
-    # costs 0.52 s at start-up (python -X importtime, 2026-11-25)
-    from robot.trace import TraceWriter
 
     buf = io.StringIO()
     if name.startswith("bench-"):
-        # costs 0.83 s at start-up (python -X importtime, 2026-11-25)
-        from robot.bench import run_bench
 
         machine = _kr210() if name == "bench-kr210" else None
         with tempfile.TemporaryDirectory() as d:
@@ -289,8 +283,6 @@ def run_case(name: str) -> bytes:
 def _emit(out: str | None, per_cycle: bool) -> dict[str, str]:
     """Run every case here; returns name -> sha256 (and writes the traces to `out`)."""
     if per_cycle:
-        # costs 0.60 s at start-up (python -X importtime, 2026-11-25)
-        from robot.controller import Controller
 
         Controller.batch = False
     digests = {}
@@ -319,8 +311,6 @@ def _child(root: str, out: str | None, per_cycle: bool = False) -> dict[str, str
 
 
 def main(argv: list[str] | None = None) -> int:  # pragma: no cover - developer entry point
-    # costs 0.007 s at start-up (python -X importtime, 2026-11-25)
-    import argparse
 
     ap = argparse.ArgumentParser(prog="python -m robot.tracecheck", description=__doc__.split("\n\n")[0])
     ap.add_argument("--against", metavar="DIR", help="another checkout (e.g. a worktree of 8175047)")

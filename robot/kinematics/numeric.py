@@ -46,10 +46,12 @@ class NumericIK:
     """Numeric solutions of flange poses for the :class:`robot.kinematics.Kinematics` `kin`."""
 
     def __init__(self, kin: Any) -> None:
-        # costs 0.5 s (mink, MuJoCo, robot/mjcf.py): only a robot of this family loads them
+        # deferred: tools/startup_bench.py, krl run +120 ms at the top (2026-11-26)
         import mink  # noqa: PLC0415
+        # deferred: tools/startup_bench.py, krl run +75 ms at the top (2026-11-26)
         import mujoco  # noqa: PLC0415
 
+        # deferred: tools/startup_bench.py, krl run +93 ms at the top (2026-11-26)
         from ..mjcf import build_mjcf  # noqa: PLC0415
 
         self.kin = kin

@@ -22,15 +22,14 @@ import numpy as np
 
 from ..frames import frame_to_matrix, inv_pos
 from .model import RunView, Segment
+from ..kinematics import Kinematics
+from ..mada import MachineDataError, load_robot
 
 
 @cache
 def _robot(source: str):
     """(MachineData, Kinematics) of the robot a trace names, or None when it cannot be loaded
     (the trace made elsewhere)."""
-    # costs 0.5 s at start-up (python -X importtime, 2026-11-26): the machine data and kinematics
-    from ..kinematics import Kinematics  # noqa: PLC0415
-    from ..mada import MachineDataError, load_robot  # noqa: PLC0415
     if not source or not Path(source).exists():
         return None
     try:

@@ -17,6 +17,8 @@ import numpy as np
 
 from .compare import SegmentComparison
 from .model import RunView, Segment
+import matplotlib
+import matplotlib.pyplot as plt
 
 
 def show_lines(view: RunView) -> list[str]:
@@ -81,10 +83,8 @@ def _panels(axs, seg: Segment, style: str, label: str) -> None:
 
 
 def _figure(n: int):
-    import matplotlib  # noqa: PLC0415 - only a plot needs matplotlib (0.2 s)
 
     matplotlib.use("Agg")
-    import matplotlib.pyplot as plt  # noqa: PLC0415
 
     fig, axs = plt.subplots(n, 4, figsize=(20, 4.2 * n), squeeze=False)
     return plt, fig, axs
