@@ -23,6 +23,7 @@ list (or the next one under 48 KB that has a line to break: corpus and history f
 
 from __future__ import annotations
 
+import importlib.util
 import hashlib
 import re
 import sys
@@ -41,6 +42,16 @@ from krl.workspace import load_workspace
 from tests.conftest import SHARED_CORPUS, SHARED_HISTORY
 
 NEGATIVE = Path(__file__).resolve().parent / "negative"
+
+
+def _generator():
+    """tests/negative/generate.py, loaded from its path (it is no module of a package)."""
+    spec = importlib.util.spec_from_file_location("negative_generate", NEGATIVE / "generate.py")
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = module          # its dataclasses look their module up there
+    spec.loader.exec_module(module)
+    return module
+
 SAMPLE_EVERY = 90
 SAMPLE_MAX_BYTES = 48 * 1024        # make test's sample: smaller files (a 250 KB data list takes 30 s)
 _WORD = re.compile(r"[A-Za-z_$][A-Za-z0-9_$]*")
@@ -53,11 +64,7 @@ def _mutations() -> list[tuple[str, str, str, bool]]:
     one line into one line: the text between the two lines' common prefix and suffix, widened
     to the token next to an insertion (``=`` -> ``:=``, ``=`` -> ``==``); `appended`: it adds
     text at the end of the line (``// reset the counter``)."""
-    sys.path.insert(0, str(NEGATIVE))
-    try:
-        import generate  # noqa: PLC0415  (importable only while sys.path holds its folder)
-    finally:
-        sys.path.pop(0)
+    generate = _generator()
     out = []
     for m in generate.MUTATIONS:
         if len(m.edits) != 1:

@@ -25,6 +25,8 @@ import re
 import subprocess
 import sys
 from pathlib import Path
+import grimp
+from importlinter.contracts.protected import ProtectedContract
 
 REPO = Path(__file__).resolve().parents[1]
 DOC = REPO / "docs" / "architecture.md"
@@ -114,7 +116,6 @@ def generate() -> str:
 
 
 def _graph():
-    import grimp  # noqa: PLC0415 - only these tests build the graph (costs 0.05 s)
 
     return grimp.build_graph(*ROOTS, include_external_packages=True, cache_dir=None)
 
@@ -209,7 +210,6 @@ def test_each_row_is_what_its_package_imports():
 def test_antlr4_only_in_syntax_and_ast():
     """ANTLR is contained: only krl.syntax and krl.ast import antlr4, and the protected
     contract generated for it fails when any other module imports it."""
-    from importlinter.contracts.protected import ProtectedContract  # noqa: PLC0415  (costs 0.09 s)
 
     graph = _graph()
     importers = {m for m in graph.find_modules_that_directly_import("antlr4")}

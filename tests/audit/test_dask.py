@@ -17,6 +17,7 @@ from click.testing import CliRunner
 
 from app import main
 from krl.files import SHARED_CORPUS
+from distributed import LocalCluster
 
 SMALL = SHARED_CORPUS / "rawpython__kukaKRLmagic"
 #: the one line of the reports that says when they were written
@@ -27,7 +28,6 @@ pytestmark = [pytest.mark.corpus, pytest.mark.timeout(900)]
 
 @pytest.fixture(scope="module")
 def cluster(shared_corpus):
-    from distributed import LocalCluster  # noqa: PLC0415  (costs 0.58 s CPU: only these tests)
 
     with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
                       dashboard_address=":0", silence_logs=50) as c:

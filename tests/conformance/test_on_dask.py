@@ -22,6 +22,8 @@ from interp import realprograms as R
 from krl.files import SHARED_CORPUS
 from conformance.cli import conformance
 from app.check import check, run_check
+from distributed import LocalCluster
+import dask
 
 REPO = Path(__file__).resolve().parents[2]
 SMALL = SHARED_CORPUS / "rawpython__kukaKRLmagic"
@@ -35,7 +37,6 @@ pytestmark = pytest.mark.skipif(not SMALL.is_dir(), reason="the shared corpus is
 
 @pytest.fixture(scope="module")
 def cluster():
-    from distributed import LocalCluster  # noqa: PLC0415  (costs 0.58 s CPU: only these tests)
 
     with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
                       dashboard_address=":0", silence_logs=50) as c:
@@ -106,7 +107,6 @@ def test_krl_check_of_a_folder_of_backups_on_a_local_cluster_prints_the_same(clu
 def test_an_unreachable_scheduler_is_a_clear_error(tmp_path, monkeypatch, capsys):
     # nothing listens on port 1 of loopback; Dask's connect timeout is shortened for the test
     monkeypatch.setenv("DASK_DISTRIBUTED__COMM__TIMEOUTS__CONNECT", "2s")
-    import dask  # noqa: PLC0415  (costs 0.15 s CPU: only this test)
 
     dask.config.refresh()
     try:
@@ -117,7 +117,6 @@ def test_an_unreachable_scheduler_is_a_clear_error(tmp_path, monkeypatch, capsys
     err = capsys.readouterr().err
     assert "error: cannot reach the Dask scheduler at tcp://127.0.0.1:1" in err and "Traceback" not in err
     # krl conformance and krl check, as the user runs them (the interpreters' probe is skipped)
-
 
     monkeypatch.setattr(H, "_STATUS", {"tree": None, "vm": None})
     monkeypatch.setenv("DASK_DISTRIBUTED__COMM__TIMEOUTS__CONNECT", "2s")

@@ -73,7 +73,6 @@ def _opened(page, link) -> tuple[str, str, int, str]:
 
 
 def test_summary_and_diff_on_the_first_screen(chromium, example):
-    import playwright.sync_api as playwright  # noqa: PLC0415 (0.14 s CPU: only the browser tests)
 
     _work, page_file = example
     with playwright.sync_playwright() as pw, loaded_page(pw, chromium, page_file) as page:

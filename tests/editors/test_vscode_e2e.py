@@ -39,6 +39,7 @@ from tests.system_tools import NIGHTLY_PACKAGES, install_command, missing_packag
 from tests.conftest import REPO_ROOT
 from tests.editors.npm import EXTENSION, build_vsix, node_or_fail, npm_install
 from tests.lsp.conftest import BACKUP
+import playwright.sync_api as playwright
 
 pytestmark = pytest.mark.slow
 
@@ -126,7 +127,6 @@ def _open(page, name: str) -> None:
 
 
 def test_the_extension_in_code_server(code_server: Path, chromium: str, tmp_path: Path):
-    import playwright.sync_api as playwright  # a dev dependency: missing is a failure (costs 0.14 s CPU: only the browser tests)
 
     root, _main, _upper = _workspace(tmp_path)
     vsix = build_vsix(tmp_path / "krl.vsix")

@@ -29,8 +29,8 @@ def main() -> None:
     name = sys.argv.pop(1)
     target = TARGETS[name]
     if name == "interp":
-        # the subject of this test: imported inside instrument_imports, so that atheris instruments them
         with atheris.instrument_imports(include=["interp", "conformance"]):
+            # the subject of this test: imported inside instrument_imports, so that atheris instruments them
             import conformance.harness  # noqa: F401
             import interp.run  # noqa: F401
     atheris.Setup(sys.argv, target)

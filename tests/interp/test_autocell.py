@@ -20,6 +20,8 @@ from app import main
 from robot.trace import TraceWriter
 
 from .helpers import write
+from robot.stimuli import parse_cell
+import yaml
 
 INTERPS = ("tree", "vm")
 CELLBACKUP = Path(__file__).resolve().parents[1] / "robot" / "fixtures" / "cellbackup"
@@ -157,8 +159,6 @@ def test_krl_run_inputs_auto_lists_the_answers(tmp_path):
     assert "#   set: {PROG_NR: 3}" in rules.output
     # CLAMP = TRUE (the program's output) was switched on 0.504 s before the answer at 1.008 s
     assert '# - when: "$OUT[6]"\n  #   after: 0.504\n  #   set: {CLAMPED: true, "$IN[8]": true}' in rules.output
-    from robot.stimuli import parse_cell
-    import yaml
 
     text = uncomment_rules(rules.output)
     doc = yaml.safe_load(text)

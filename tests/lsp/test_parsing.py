@@ -12,7 +12,7 @@ from pathlib import Path
 
 import pytest
 
-from krl.lsp.bench import generate
+from krl.lsp.sample import generate
 from krl.lsp.parsing import MIN_CHUNKED_LINES, ParseCache, parse_disk
 from krl.lsp.project import Project, norm
 from krl.source import read_source

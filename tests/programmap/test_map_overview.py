@@ -20,6 +20,7 @@ from krl.project import find_backups
 from krl.workspace import workspaces_for
 from tests.system_tools import require
 from tests.report.test_report_chromium import loaded_page
+import playwright.sync_api as playwright
 
 WINDOW = {"width": 1600, "height": 1000}
 READABLE = 0.5
@@ -38,7 +39,6 @@ def chromium() -> str:
 
 
 def test_overview_and_expand_all_fit_the_window(chromium, shared_corpus, tmp_path):
-    import playwright.sync_api as playwright  # noqa: PLC0415 (0.14 s CPU: only the browser tests)
 
     backups = find_backups(shared_corpus)
     assert len(backups) >= 4

@@ -22,6 +22,7 @@ from krl.project import find_backups
 from krl.workspace import workspaces_for
 from tests.system_tools import require
 from tests.report.test_report_chromium import loaded_page
+import playwright.sync_api as playwright
 
 WEB = Path(__file__).parents[2] / "krl" / "programmap" / "web"
 STATIC = Path(__file__).parents[2] / "krl" / "programmap" / "static" / "programmap.js"
@@ -58,8 +59,6 @@ def chromium() -> str:
 
 
 def test_search_neighbourhood_and_source_link_in_chromium(chromium, largest, tmp_path):
-    import playwright.sync_api as playwright  # a dev dependency: missing is a failure, not a skip (costs 0.14 s CPU: only the browser tests)
-
 
     root, pm = largest
     page_file = tmp_path / "map.html"
@@ -117,8 +116,6 @@ def test_search_neighbourhood_and_source_link_in_chromium(chromium, largest, tmp
 
 
 def test_markup_in_names_stays_text(chromium, tmp_path):
-    import playwright.sync_api as playwright  # noqa: PLC0415 (costs 0.14 s CPU: only the browser tests)
-
 
     evil = "<img src=x onerror=window.pwned=1>"
     (tmp_path / f"{evil}.src").write_text("DEF odd()\n  helper()\nEND\nDEF helper()\nEND\n")

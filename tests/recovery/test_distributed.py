@@ -14,6 +14,7 @@ import pytest
 
 from krl import cluster as distributed
 from recovery.pipeline import run_recovery
+from distributed import LocalCluster
 
 REPO = Path(__file__).resolve().parents[2]
 EMBEDDED = REPO / "corpus"
@@ -33,7 +34,6 @@ def _report(out: Path) -> dict[str, str]:
 
 @pytest.fixture(scope="module")
 def cluster():
-    from distributed import LocalCluster  # noqa: PLC0415  (costs 0.58 s CPU: only these tests)
 
     with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
                       dashboard_address=":0", silence_logs=50) as c:

@@ -14,6 +14,7 @@ from click.testing import CliRunner
 from app import main
 from tests.report.test_report_chromium import loaded_page
 from tests.system_tools import require
+import playwright.sync_api as playwright
 
 FIXTURE = Path(__file__).parents[1] / "programmap" / "fixtures" / "KRC"
 IMG = "<img src=x onerror=window.pwned=1>"
@@ -62,7 +63,6 @@ def _open(pw, chromium, page_path: Path, check, scripts: int = 0):
 
 
 def test_change_pages_render_in_headless_chromium(chromium, pages):
-    import playwright.sync_api as playwright  # a dev dependency: missing is a failure, not a skip (costs 0.14 s CPU: only the browser tests)
 
     def graph(page):
         assert page.locator("h1").inner_text() == "Program map"

@@ -12,6 +12,7 @@ import pytest
 from recovery.report import summarise, write_report
 from tests.report.test_recovery_report import corpus_results
 from tests.system_tools import require
+import playwright.sync_api as playwright
 
 CHROMIUM = "/usr/bin/chromium"
 FLAGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
@@ -60,7 +61,6 @@ def loaded_page(pw, chromium: str, path: Path):
 
 
 def test_report_renders_in_headless_chromium(chromium, report):
-    import playwright.sync_api as playwright  # a dev dependency: missing is a failure, not a skip (costs 0.14 s CPU: only the browser tests)
     with playwright.sync_playwright() as pw, loaded_page(pw, chromium, report) as page:
         assert page.title() == "KRL grammar recovery report"
         assert page.locator("h1").inner_text() == "Grammar recovery report"

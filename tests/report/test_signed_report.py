@@ -33,6 +33,7 @@ from pypdf import PdfReader
 from app import main
 from tests.report.test_report_chromium import loaded_page
 from tests.system_tools import require
+import playwright.sync_api as playwright
 
 PAIR = "rawpython__kukaKRLmagic/01-53e3f517"
 MOVED = "paulovictor237__KUKA-Paletizador/04-72cb25e4"
@@ -89,7 +90,6 @@ def _print(pw, chromium: str, page_file: Path, pdf: Path) -> list[str]:
 
 
 def test_the_first_printed_page_identifies_both_backups_and_carries_the_signatures(chromium, report, tmp_path):
-    import playwright.sync_api as playwright  # noqa: PLC0415 (0.14 s CPU: only the browser tests)
 
     pair, page_file = report
     with playwright.sync_playwright() as pw:
@@ -123,7 +123,6 @@ _TARGETS = """() => [...document.querySelectorAll('a[href]')].filter(a => !a.clo
 
 
 def test_every_link_opens_in_the_page_at_its_line(chromium, report):
-    import playwright.sync_api as playwright  # noqa: PLC0415 (0.14 s CPU: only the browser tests)
 
     pair, page_file = report
     with playwright.sync_playwright() as pw, loaded_page(pw, chromium, page_file) as page:
@@ -169,7 +168,6 @@ def test_tables_are_readable_at_print_width(chromium, report):
     # issue 63: the findings table squeezed its code column to one character per line. At the
     # printed page's width (A4 less the margins: 186 mm, 703 px) with the print style sheet,
     # every code and change cell is one line, and every place of up to 30 characters too
-    import playwright.sync_api as playwright  # noqa: PLC0415 (0.14 s CPU: only the browser tests)
 
     _pair, page_file = report
     with playwright.sync_playwright() as pw, loaded_page(pw, chromium, page_file) as page:
@@ -183,7 +181,6 @@ def test_tables_are_readable_at_print_width(chromium, report):
 
 @pytest.mark.slow
 def test_the_pdf_of_a_pair_with_moved_modules_is_a_third_of_what_it_was(chromium, shared_history, tmp_path):
-    import playwright.sync_api as playwright  # noqa: PLC0415 (0.14 s CPU: only the browser tests)
 
     pair = shared_history / MOVED
     page_file = _report(pair, tmp_path / "moved.html")

@@ -15,6 +15,7 @@ issue 47 (the compiled core generated from the Python, its comparison always run
 
 from __future__ import annotations
 
+import importlib.util
 import hashlib
 import random
 import shutil
@@ -46,9 +47,8 @@ except ImportError:
 
 
 def _can_compile() -> bool:
-    try:    # optional: without Cython (a dev dependency) nothing is compiled and loop.py/the Python core run
-        import Cython  # noqa: F401, PLC0415
-    except ImportError:
+    # without Cython (a dev dependency) nothing is compiled and loop.py/the Python core run
+    if importlib.util.find_spec("Cython") is None:
         return False
     return shutil.which(sysconfig.get_config_var("CC").split()[0]) is not None
 

@@ -13,6 +13,8 @@ from robot.frames import frame_to_matrix, matrix_to_frame
 from robot.motion import MotionParams, MotionRequest, Trigger
 from robot.stimuli import parse_stimuli
 from robot.trace import KINDS, SCHEMA, TraceWriter, _frames_of, make_event, read_trace, validate_event
+import json as _json
+from robot.trace import load_event
 
 
 def test_schema_has_the_issue_kinds():
@@ -109,9 +111,6 @@ def test_a_trace_line_reads_as_the_json_module_reads_it():
     """robot.trace.load_event (orjson, else the json module): the same data for every line a
     trace holds, those orjson refuses or reads otherwise included (NaN, Infinity, a lone surrogate
     escape, an integer past 64 bits, nested too), and ValueError for a line that is no JSON."""
-    import json as _json  # noqa: PLC0415  (the reference reader: the subject of this test)
-
-    from robot.trace import load_event  # noqa: PLC0415  (the subject of this test)
 
     tw = TraceWriter(keep=True)
     tw.write("io", 0.012, signal="$OUT[3]", value=True, source="program")

@@ -10,6 +10,7 @@ the C types of loop.pxd; `make` builds it before the tests):
 
 from __future__ import annotations
 
+import importlib.util
 import inspect
 import shutil
 import sys
@@ -19,16 +20,14 @@ import types
 import pytest
 
 from interp.run import make_runtime, run_spec
-from interp.vm import build
-from interp.vm import vm as V
+from interp.vm import build, vm as V
 
 from .test_generated_loop import PROGRAMS, _trace
 
 
 def _can_compile() -> bool:
-    try:    # optional: without Cython (a dev dependency) nothing is compiled and loop.py/the Python core run
-        import Cython  # noqa: F401, PLC0415
-    except ImportError:
+    # without Cython (a dev dependency) nothing is compiled and loop.py/the Python core run
+    if importlib.util.find_spec("Cython") is None:
         return False
     return shutil.which(sysconfig.get_config_var("CC").split()[0]) is not None
 
