@@ -15,6 +15,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import yourdfpy
+from scipy.spatial.transform import Rotation
 
 from interp.run import make_runtime, run_spec
 from robot.mada import load_robot
@@ -59,10 +61,6 @@ def iiwa():
 @pytest.fixture(scope="module")
 def description_flange():
     """The flange (tool0 in base_link, mm) of joints J1..J7 (deg) by the description's own chain."""
-    # costs 0.9 s (yourdfpy with trimesh): only for the description's own chain
-    import yourdfpy
-    from scipy.spatial.transform import Rotation  # noqa: PLC0415 - costs 0 s: loaded by the run already
-
     urdf = yourdfpy.URDF.load(str(IIWA), build_scene_graph=False, load_meshes=False)
     chain = [urdf.joint_map[f"joint_a{i}"] for i in range(1, 8)]
     tool = np.asarray(urdf.joint_map["joint_a7-tool0"].origin, dtype=float)
