@@ -32,7 +32,7 @@ figures from one run.
 
 Usage::
 
-    python tools/startup_bench.py [--repeat 3] [--min-ms 3] [--against REF] [--sites] [--json OUT]
+    python tools/startup_bench.py [--repeat 3] [--min-ms 3] [--against REF] [--sites] [--commands-only] [--json OUT]
 
 Exit status 0; 2 when a command fails to start. Run from a checkout with its ``.venv`` (the
 commands run as ``python -m app`` with the checkout first on ``sys.path``).
@@ -237,6 +237,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--min-ms", type=float, default=3.0, help="a site that saves less is listed as saving nothing")
     ap.add_argument("--against", default=None, help="a git revision to measure the commands on as well")
     ap.add_argument("--sites", action="store_true", help="list every site with what it saves")
+    ap.add_argument("--commands-only", action="store_true", help="time the commands, measure no site")
     ap.add_argument("--json", default=None, help="write the figures to this file")
     a = ap.parse_args(argv)
     with tempfile.TemporaryDirectory() as td:
@@ -270,6 +271,8 @@ def main(argv: list[str] | None = None) -> int:
                 base = cpu[a.against, name]
                 line += f"   {a.against} {base:6.3f} s   this/{a.against} {cpu['this', name] / base:5.2f}"
             print(line)
+        if a.commands_only:
+            return 0
         found = sites()
         saves: dict[str, dict[str, float]] = {s["site"]: {} for s in found}
         for name, mods in loaded.items():
