@@ -23,10 +23,8 @@ list (or the next one under 48 KB that has a line to break: corpus and history f
 
 from __future__ import annotations
 
-import importlib.util
 import hashlib
 import re
-import sys
 from pathlib import Path
 
 import pytest
@@ -40,17 +38,7 @@ from krl.programmap import build_map
 from krl.syntax.engines import parse_file
 from krl.workspace import load_workspace
 from tests.conftest import SHARED_CORPUS, SHARED_HISTORY
-
-NEGATIVE = Path(__file__).resolve().parent / "negative"
-
-
-def _generator():
-    """tests/negative/generate.py, loaded from its path (it is no module of a package)."""
-    spec = importlib.util.spec_from_file_location("negative_generate", NEGATIVE / "generate.py")
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = module          # its dataclasses look their module up there
-    spec.loader.exec_module(module)
-    return module
+from tests.test_negative_corpus import generator
 
 SAMPLE_EVERY = 90
 SAMPLE_MAX_BYTES = 48 * 1024        # make test's sample: smaller files (a 250 KB data list takes 30 s)
@@ -64,7 +52,7 @@ def _mutations() -> list[tuple[str, str, str, bool]]:
     one line into one line: the text between the two lines' common prefix and suffix, widened
     to the token next to an insertion (``=`` -> ``:=``, ``=`` -> ``==``); `appended`: it adds
     text at the end of the line (``// reset the counter``)."""
-    generate = _generator()
+    generate = generator()
     out = []
     for m in generate.MUTATIONS:
         if len(m.edits) != 1:

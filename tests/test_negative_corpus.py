@@ -17,7 +17,7 @@ from krl.syntax.parse import parse_file
 NEGATIVE_DIR = Path(__file__).resolve().parent / "negative"
 
 
-def _generator():
+def generator():
     """tests/negative/generate.py, loaded from its path (it is no module of a package)."""
     spec = importlib.util.spec_from_file_location("negative_generate", NEGATIVE_DIR / "generate.py")
     module = importlib.util.module_from_spec(spec)
@@ -39,7 +39,7 @@ def test_every_file_names_its_mutation():
 
 
 def test_generated_files_are_up_to_date():
-    generate = _generator()
+    generate = generator()
     expected = generate.generate()
     assert sorted(expected) == [p.name for p in NEGATIVE_FILES]
     for name, text in expected.items():
