@@ -135,7 +135,7 @@ def reach_check(program: Path, robot=None, inputs=None) -> ReachReport:
         if why is not None:
             report.problems.append(f"{where}: unreachable: {name} on {ctl.machine.name}: {why}")
 
-    checker = ctl.collision
+    checker = ctl.monitor.collision
     for m in [own] if own is not None else []:
         if m.files.get("src") is None:
             continue

@@ -251,7 +251,7 @@ class Network:
     def net_message(self, text: str, number: int | None = None) -> None:
         """A controller message of a partner's (clipped: it may quote what the partner sent)."""
         if self.ctl is not None:
-            self.ctl.message(clip(text), number=number)
+            self.ctl.log.message(clip(text), number=number)
 
 
 def load_replay(path: Path) -> list[tuple[float, dict]]:

@@ -360,7 +360,7 @@ class Rsi:
         self.silent = False
         self.stopped = False
         self.failed = None
-        self.q_on = np.array(ctl.axis_act(), dtype=float)[:len(AXES)]
+        self.q_on = np.array(ctl.actual.axis_act(), dtype=float)[:len(AXES)]
         s = self.hub.settings
         if s is not None and s.live and s.rsi is not None:
             host, port = s.rsi.address if s.rsi.address is not None else (LOOPBACK, self.ctx.port)
@@ -636,8 +636,8 @@ class Rsi:
         """The robot's packet of one sensor cycle: the SEND elements in the configuration's
         order (internal values, and channels grouped by element: ``Tag.A1``.. as attributes of
         one ``<Tag>``), then IPOC."""
-        q = np.array(ctl.axis_act(), dtype=float)[:len(AXES)]
-        fr = np.array(ctl.tcp_frame(), dtype=float)
+        q = np.array(ctl.actual.axis_act(), dtype=float)[:len(AXES)]
+        fr = np.array(ctl.actual.tcp_frame(), dtype=float)
         eth = self.ctx.eth
         dec = max(MIN_DECIMALS, min(16, int(eth.param("Precision", MIN_DECIMALS))))
         groups: dict[str, list[tuple[str, str]]] = {}

@@ -269,7 +269,7 @@ class Engine:
                 inner_error(task, frame, err)
         hooks.set_hooks(stmt=hooks.stmt_hook, step=hooks.step_hook, error=error_hook, cycle=hooks.cycle_hook)
         ctl = rt.controller
-        ctl.add_cyclic(self._cycle)
+        ctl.signals.add_cyclic(self._cycle)
         self._pace0 = None
         self.notes = []
         self.path = []
@@ -289,7 +289,7 @@ class Engine:
             elif not (text.startswith("KRL message: ") or text.startswith("KRL dialog")):
                 self.notes.append({"time": round(ctl.time, 3), "text": str(text)[:300]})
                 del self.notes[:-MAX_KRL_MESSAGES]
-        ctl.watch_messages(message)
+        ctl.log.watch_messages(message)
 
     def _cycle(self, ctl) -> None:
         """Once per IPO cycle (engine thread): publish the live pose, pace to the wall clock."""
@@ -301,7 +301,7 @@ class Engine:
         blending = getattr(ctl, "_blend", None) is not None
         self._record_path(ctl, blending)
         self.live = {
-            "time": round(ctl.time, 6), "axes": [float(v) for v in ctl.axis_act()],
+            "time": round(ctl.time, 6), "axes": [float(v) for v in ctl.actual.axis_act()],
             "blending": blending, "run": self.run_no,
             "pointers": {"advanceRun": {"path": robot.file, "line": robot.line}
                          if robot is not None and robot.at is not None else None,
@@ -329,9 +329,8 @@ class Engine:
         controller computed in this cycle (its TCP in $BASE and that $BASE, the numbers the
         trace's pose events hold), so the path costs the simulation a matrix product a cycle."""
 
-        tcp, base_inv = getattr(ctl, "_tcp_T", None), getattr(ctl, "_base_inv_T", None)
-        if tcp is None or base_inv is None:
-            return
+        actual = ctl.actual
+        tcp, base_inv = actual.tcp, actual.base_inv_T
         if base_inv is not self._base_inv:
             self._base_inv, self._base_T = base_inv, np.linalg.inv(base_inv)
         w = self._base_T[:3, :3] @ tcp[:3, 3] + self._base_T[:3, 3]
@@ -400,7 +399,7 @@ def set_input(core: RunEngine, index, value: bool) -> bool:
         ctl = engine.rt.controller
         ctl.io.now = ctl.time
         ctl.io.set_in(index, bool(value), "operator")
-        return ctl.get_in(index)
+        return ctl.io.get_in(index)
     return core.edit_now(f"$IN[{index}] = {'TRUE' if value else 'FALSE'}", apply)
 
 
@@ -455,7 +454,7 @@ def jog(core: RunEngine, system: str, axis, step) -> list:
                 or keys[axis - 1] not in amap.model_keys:
             raise Refused("jog: axis " + ", ".join(f"{i + 1} ({k})" for i, k in enumerate(keys)
                                                    if k in amap.model_keys))
-        target = amap.krl_components(rt.controller.axis_setpoint())
+        target = amap.krl_components(rt.controller.actual.axis_setpoint())
         target = {k: v for k, v in target.items() if k in amap.model_keys}
         target[keys[axis - 1]] += float(step)
         req = MotionRequest("PTP", target, params)
@@ -481,7 +480,7 @@ def touch_up(core: RunEngine, path: str, name: str) -> dict:
     if not name or len(name) > 24 or not name.replace("_", "").replace("$", "").isalnum():
         raise Refused("touch-up: a point name")
     try:
-        new = write_point(Path(path), name, rt.controller.pos_act(), [float(v) for v in rt.controller.axis_act()])
+        new = write_point(Path(path), name, rt.controller.actual.pos_act(), [float(v) for v in rt.controller.actual.axis_act()])
     except TouchUpError as exc:
         raise Refused(str(exc)) from None
     except OSError as exc:

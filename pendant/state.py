@@ -188,17 +188,17 @@ def _frame(v) -> dict | None:
 def _position(eng, rt) -> dict:
     ctl = rt.controller
     store = rt.sysvars.store
-    key = (ctl.cycle, ctl.time, tuple(float(v) for v in ctl.axis_act()))
+    key = (ctl.cycle, ctl.time, tuple(float(v) for v in ctl.actual.axis_act()))
     cached = getattr(eng, "pos_cache", None)        # $POS_ACT is the same until the robot moves
     if cached is not None and cached[0] == key:
         pos = cached[1]
     else:
         try:
-            pos = ctl.pos_act()
+            pos = ctl.actual.pos_act()
         except Exception:  # noqa: BLE001 - a pose outside the model shows as unknown
             pos = None
         eng.pos_cache = (key, pos)
-    return {"axes": [round(float(v), 4) for v in ctl.axis_act()],
+    return {"axes": [round(float(v), 4) for v in ctl.actual.axis_act()],
             "pos": {k: round(float(v), 3) for k, v in pos.items()} if pos else None,
             "base": _frame(store.get("$BASE")), "tool": _frame(store.get("$TOOL"))}
 

@@ -209,11 +209,11 @@ def start_position(machine, inputs: str | None = None) -> dict | None:
             if not isinstance(parse_start(where), N.Name):
 
                 ctl.place(start_axes(ctl.model, lambda name: None, where))
-        pos = ctl.pos_act()
+        pos = ctl.actual.pos_act()
     except Exception:  # noqa: BLE001 - a robot the model cannot place shows no start position
         return None
     null = dict.fromkeys(("X", "Y", "Z", "A", "B", "C"), 0.0)
-    return {"axes": [round(float(v), 4) for v in ctl.axis_act()],
+    return {"axes": [round(float(v), 4) for v in ctl.actual.axis_act()],
             "pos": {k: round(float(v), 3) for k, v in pos.items()}, "base": null, "tool": null}
 
 

@@ -20,7 +20,7 @@ import os
 import subprocess
 import sys
 import time
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from typing import Any
 
 from krl.cbuild import OTHER_CHECKOUT_PRELUDE
@@ -42,10 +42,35 @@ def run_motions(ctl: Controller, requests: Iterable[MotionRequest], *,
     for req in requests:
         while not ctl.can_enqueue():
             out.extend(ctl.step())
-        ctl.enqueue(req)
+        ctl.queue.enqueue(req)
         if wait_between:
-            out.extend(ctl.wait_idle())
-    out.extend(ctl.wait_idle())
+            out.extend(wait_idle(ctl))
+    out.extend(wait_idle(ctl))
+    return out
+
+
+def step_until(ctl: Controller, predicate: Callable[[], bool], max_cycles: int = 10_000_000) -> list[Event]:
+    """Step `ctl` until ``predicate()`` is true (checked before each cycle), at most
+    `max_cycles` cycles; returns all events. Interpreters that evaluate interrupts step
+    themselves."""
+    out: list[Event] = []
+    n = 0
+    while not predicate() and n < max_cycles:
+        out.extend(ctl.step())
+        n += 1
+    return out
+
+
+def wait_idle(ctl: Controller) -> list[Event]:
+    """Step `ctl` until it is idle (``Controller.is_idle``); returns all events."""
+    return step_until(ctl, ctl.is_idle)
+
+
+def wait_sec(ctl: Controller, seconds: float) -> list[Event]:
+    """Step `ctl` for ``WAIT SEC seconds`` (``Controller.cycles_for``); returns all events."""
+    out: list[Event] = []
+    for _ in range(ctl.cycles_for(seconds)):
+        out.extend(ctl.step())
     return out
 
 
@@ -95,11 +120,11 @@ def run_bench(min_motion_s: float = 60.0, trace_path: str | None = None, machine
                 while not ctl.can_enqueue():
                     for ev in ctl.step():
                         if ev.kind == "trigger":
-                            ctl.set_out(1, not ctl.io.get_out(1), "trigger")
-                ctl.enqueue(req)
+                            ctl.io.set_out(1, not ctl.io.get_out(1), "trigger")
+                ctl.queue.enqueue(req)
                 n += 1
-        ctl.wait_idle()
-        ctl.finish("program_end")
+        wait_idle(ctl)
+        ctl.log.finish("program_end")
         wall = time.perf_counter() - t0
         cpu = time.process_time() - c0
     sim = ctl.time

@@ -360,5 +360,50 @@ def blend_space(prev: Segment, nxt: Segment) -> str:
     return "joint"
 
 
-__all__ = ["effective_keyword", "blend_start_tau", "blend_end_tau", "blend_space", "superpose_pose",
+def blend_window(seg: Segment, nxt: Segment, keyword: str, tau_a: float) -> float:
+    """Length (s) of the blend that starts at local time `tau_a` of `seg` (it ends when `seg`
+    reaches its point)."""
+    bp = plan_blend(seg, nxt, keyword, tau_a) or plan_blend(seg, nxt, keyword, seg.T)
+    assert bp is not None
+    return bp.window
+
+
+def blend_setpoint(prev: Segment, t_prev: float, nxt: Segment, t_next: float, space: str, model: Any,
+                   q: np.ndarray) -> np.ndarray:
+    """The setpoint of the blend from `prev` (at its local time `t_prev`, s) into `nxt` (at
+    `t_next`): the overlap of the two velocity profiles, in Cartesian space (``space`` "cart":
+    the poses superposed, solved near the setpoint `q`; the external axes overlap like axes) or
+    in axis space (``prev(t) + nxt(t) - nxt's start``, within the software limits: raises
+    SoftLimitError). Axes in the model's order (deg, mm)."""
+    if space == "cart":
+        p0, R0 = prev.pose(t_prev)
+        p1, R1 = nxt.pose(t_next)
+        pc, Rc = nxt.pose(0.0)
+        if reduced_orientation(model):
+            # a palletizer: overlap the poses it reaches, not the paths' own orientations
+            # (reached_pose)
+            u0, u1 = prev.u(t_prev), nxt.u(t_next)
+            p0, R0 = reached_pose(prev, p0, R0, q, u0)
+            p1, R1 = reached_pose(nxt, p1, R1, q, u1)
+            pc, Rc = reached_pose(nxt, pc, Rc, q, 0.0)
+        p, R = superpose_pose(p0, R0, p1, R1, pc, Rc)
+        ref = q
+        n = model.n
+        if len(ref) > n:
+            # the external axes overlap like axes: E_prev(t) + E_next(t) - E at the point
+            e = _e_at(prev, prev.u(t_prev), n) + _e_at(nxt, nxt.u(t_next), n) - nxt.q0[n:]
+            ref = np.concatenate([ref[:n], e])
+        return nxt.ik(p, R, ref)  # type: ignore[attr-defined]
+    out = prev.axes(t_prev) + (nxt.axes(t_next) - nxt.q0)
+    model.check_limits(out)
+    return out
+
+
+def _e_at(seg: Segment, u: float, n: int) -> np.ndarray:
+    """The external axes of `seg` (after its n robot axes) at its path parameter `u` (linear
+    from start to end)."""
+    return seg.q0[n:] + u * (seg.q1[n:] - seg.q0[n:])
+
+
+__all__ = ["effective_keyword", "blend_start_tau", "blend_window", "blend_setpoint", "blend_end_tau", "blend_space", "superpose_pose",
            "plan_blend", "BlendPlan", "reduced_orientation", "reached_pose"]

@@ -1,5 +1,6 @@
-"""The simulated KR C4 main run: motion queue, 12 ms IPO cycle, triggers, BRAKE, I/O
-(reference §5.8, §5.12-§5.18, §6, §7; issue 5).
+"""The simulated KR C4 main run: the 12 ms IPO cycle, motion execution (start, approximation,
+exact stop, triggers, conditional stops), BRAKE and RESUME (reference §5.8, §5.12-§5.18, §6, §7;
+issue 5).
 
 The interpreters are the advance run; they drive a :class:`Controller` through a small
 protocol (docs/architecture.md, "Robot interface")::
@@ -7,14 +8,22 @@ protocol (docs/architecture.md, "Robot interface")::
     ctl = Controller(trace=TraceWriter("run.jsonl"))
     while not ctl.can_enqueue():          # $ADVANCE: a full queue blocks the advance run
         handle(ctl.step())
-    ctl.enqueue(MotionRequest("LIN", {"X": 500}, params, approx="C_DIS", triggers=...))
+    ctl.queue.enqueue(MotionRequest("LIN", {"X": 500}, params, approx="C_DIS", triggers=...))
     while not ctl.is_idle():              # an advance-run stop (WAIT, $OUT write, ...)
         handle(ctl.step())
 
 :meth:`Controller.step` runs one IPO cycle (12 ms of simulated time) and returns the events
-of that cycle (:class:`MotionEvent`, :class:`TriggerEvent`, :class:`IoEvent`,
+of that cycle (robot/events.py: :class:`MotionEvent`, :class:`TriggerEvent`, :class:`IoEvent`,
 :class:`MessageEvent`, :class:`ErrorEvent`). Interrupt conditions are the interpreter's:
 it evaluates them after every step.
+
+The controller's parts (issue 62), each its own module, reached as attributes: ``queue`` the
+motions planned and not started and ``$ADVANCE`` (robot/motionqueue.py), ``io`` the I/O image
+(robot/io.py), ``signals`` what changes the I/O without the program: PULSE, cyclic hooks, the
+cell's stimuli and rules (robot/signals.py), ``actual`` the robot read back: ``$AXIS_ACT``,
+``$POS_ACT``, the MuJoCo arm (robot/readback.py), ``monitor`` the checks of each cycle: axis
+speed, collisions, workspaces (robot/monitor.py), ``log`` the events and the trace
+(robot/events.py). This class keeps the clock and the main run that ties them.
 
 Time: the clock is the integer IPO cycle count ``k``; ``time = k · 0.012`` s. Motion timing
 uses a *path time* that equals the clock except while BRAKE ramps the path speed down, the
@@ -26,7 +35,6 @@ from __future__ import annotations
 
 import math
 from collections import deque
-from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -36,14 +44,19 @@ import numpy as np
 from . import blending
 from .exactstop import DONE_CYCLES, END_DELAY_CYCLES
 from .errors import RobotError
-from .frames import frame_to_matrix, inv_pos, matrix_to_frame
+from .events import ErrorEvent, Event, EventLog, IoEvent, MessageEvent, MotionEvent, TriggerEvent
+from .frames import frame_to_matrix, inv_pos
 from .io import IOImage
 from .limits import normalise_mode
 from .machine import MachineData, load_machine
-from .motion import CondStop, MotionRequest, Trigger
-from .planner import CP_SPEED_LIMIT_FACTOR, RobotModel, Segment, TriggerPlan, plan, resolved_target
-from .cellrules import Rule, rules_may_fire, step_rules
+from .motion import CondStop, MotionRequest
+from .monitor import Monitor
+from .motionqueue import MotionQueue
+from .planner import RobotModel, Segment, TriggerPlan, resolved_target
+from .cellrules import Rule
 from .kinematics import compiled_module
+from .readback import ReadBack
+from .signals import Signals
 from .stimuli import Cell, Stimulus
 from .trace import TraceWriter
 
@@ -54,68 +67,7 @@ def _compiled_module() -> Any:
     return compiled_module()
 
 EPS = 1e-9
-_F8 = np.dtype(np.float64)
 MSG_APPROX_IMPOSSIBLE = "approximation not possible"
-
-
-# ----------------------------------------------------------------------------- events
-@dataclass(frozen=True)
-class MotionEvent:
-    """A motion reached a phase: ``start``, ``blend_start``, ``blend_end`` or ``end``."""
-
-    t: float
-    id: int
-    phase: str
-    request: MotionRequest = field(repr=False, compare=False)
-    kind: str = "motion"
-
-
-@dataclass(frozen=True)
-class TriggerEvent:
-    """A TRIGGER's switching point was reached: the interpreter runs ``trigger.action``
-    now, as a short interrupt-like context (no motion statements)."""
-
-    t: float
-    id: int
-    index: int
-    trigger: Trigger
-    kind: str = "trigger"
-
-
-@dataclass(frozen=True)
-class IoEvent:
-    """A signal changed (``source``: program, trigger, pulse, stimulus)."""
-
-    t: float
-    signal: str
-    value: Any
-    source: str
-    kind: str = "io"
-
-
-@dataclass(frozen=True)
-class MessageEvent:
-    """A controller message (e.g. "approximation not possible")."""
-
-    t: float
-    text: str
-    id: int | None = None
-    kind: str = "message"
-
-
-@dataclass(frozen=True)
-class ErrorEvent:
-    """A motion error in the main run (workspace error, software limit switch, ...): the
-    robot stopped, the motion queue was discarded. The interpreter raises ``error``."""
-
-    t: float
-    error: RobotError
-    id: int | None = None
-    kind: str = "error"
-
-
-Event = MotionEvent | TriggerEvent | IoEvent | MessageEvent | ErrorEvent
-
 
 # ----------------------------------------------------------------------------- main run
 @dataclass
@@ -183,6 +135,7 @@ class _Held:
     tool_T: np.ndarray
     base_T: np.ndarray
     plan_q: np.ndarray            # end point of the last motion planned before the hold
+    next_id: int                  # the queue's next motion id at the hold (a motion planned since: re-plan)
 
 
 @dataclass
@@ -212,13 +165,18 @@ class Controller:
         start_axes: initial axes A1..A6 (deg), default HOME.
         actuated: drive MuJoCo with position/velocity actuators instead of qpos replay.
         strict_bco: the first motion needs a complete PTP/LIN target (reference §6.3).
-        mujoco: False to skip MuJoCo entirely (axis_act then returns the setpoint).
+        mujoco: False to skip MuJoCo entirely (``actual.axis_act`` then returns the setpoint).
         mode_op: operating mode ``T1``, ``T2``, ``AUT`` or ``EX`` (``EXT``); default AUT
             (reference §7.5; T1 limits TCP and flange to 250 mm/s, PTP to ``$RED_T1``).
 
     Attributes:
-        advance: ``$ADVANCE`` (0..5), set by the interpreter; default 3.
+        queue: the :class:`~robot.motionqueue.MotionQueue` (``$ADVANCE``: ``queue.advance``).
         io: the :class:`~robot.io.IOImage`.
+        signals: the :class:`~robot.signals.Signals` (PULSE, cyclic hooks, stimuli, rules).
+        actual: the :class:`~robot.readback.ReadBack` (``$AXIS_ACT``, ``$POS_ACT``, ``$VEL_ACT``).
+        monitor: the :class:`~robot.monitor.Monitor` (speed, collisions, workspaces).
+        log: the :class:`~robot.events.EventLog` (this cycle's events, the trace, messages).
+        time: simulated time in s; ``cycle``: IPO cycles run.
         dt: IPO cycle in s (0.012).
         last_error: the last :class:`RobotError` of the main run, or None.
         batch: class switch (default True): a CP segment at full path speed solves its
@@ -246,8 +204,7 @@ class Controller:
         `workspaces` monitor (robot/workspace.py; None: none yet). Raises SoftLimitError for
         start axes outside the software limits, OSError when a network partner cannot start."""
         self.machine = machine if machine is not None else load_machine()
-        self.rules: list[Rule] = []
-        self._rules_seen = None         # what the rules' conditions last saw (cellrules.step_rules)
+        rules_all: list[Rule] = []
         if isinstance(stimuli, (str, Path)):
             raise TypeError("a cell file is read by robot.stimuli.load_cell; pass its Cell")
         if isinstance(stimuli, Cell):
@@ -255,7 +212,7 @@ class Controller:
                 mode_op = "EX"            # Automatic External (robot/cellpresets.py)
             if geometry is None:
                 geometry = stimuli.geometry
-            stimuli, self.rules = stimuli.stimuli, list(stimuli.rules)
+            stimuli, rules_all = stimuli.stimuli, list(stimuli.rules)
         for st in stimuli or ():
             if st.reached_default:        # `reached: true`: this robot's $IN_POS_CAR
                 st.reached_mm = self.machine.in_pos_car_mm
@@ -264,13 +221,12 @@ class Controller:
         self.dt = float(self.machine.ipo_cycle_s)
         self._dt_ms = int(round(self.dt * 1000))
         self.trace = trace
-        self.advance = self.machine.def_advance
-        self.strict_bco = strict_bco
-        self._bco_done = False
+        #: this cycle's events, the trace's, the messages' watchers (robot/events.py)
+        self.log = EventLog(trace, lambda: self.time)
         self.io = io if io is not None else IOImage()
-        self.io.on_change = self._on_io
-        self.rules += list(rules or [])
-        self.stimuli: list[Stimulus] = list(stimuli or [])
+        self.io.on_change = self.log.io
+        #: the I/O side of each cycle: PULSE, cyclic hooks, the cell's stimuli and rules (robot/signals.py)
+        self.signals = Signals(self.io, list(stimuli or []), rules_all + list(rules or []), network, self.dt)
         #: the robot's axis count: axis vectors are A1..An, then E1..En (robot/planner.py)
         self.n = self.model.n
         if start_axes is None:
@@ -279,16 +235,18 @@ class Controller:
             # KRL's order (A1..A6, E1..E6); E from $AXIS_HOME[1] unless given
             q = self.model.from_krl(start_axes)
         self.model.check_limits(q)
-        self._arm = None
-        self.actuated = actuated
-        # the MuJoCo arm (robot/mjcf.py ArmModel) is compiled at its first use (_arm_model), reset
-        # to the axes it stands at then: a debugger's launch and first stop do not wait for
-        # MuJoCo's import and compile (issue 37); None: built, or no MuJoCo
-        self._arm_q: np.ndarray | None = q.copy() if mujoco else None
+        #: the motions planned and not yet started, $ADVANCE (robot/motionqueue.py)
+        self.queue = MotionQueue(self.model, q, self.machine.def_advance, strict_bco)
+        self._pending = self.queue.pending      # the one deque of the queue (the main run's cached reference)
+        #: robot/simcore.pyx (None: the Python code alone) and its per-cycle step check
+        self._simcore = _compiled_module()
+        #: the robot read back: $AXIS_ACT, $POS_ACT, the MuJoCo arm (robot/readback.py)
+        self.actual = ReadBack(self.model, q, actuated=actuated, mujoco=mujoco, simcore=self._simcore, dt=self.dt)
         self._k = 0
         #: simulated time in s (IPO cycles · the IPO cycle): ``_k * dt``, kept with ``_k`` (the
         #: interpreters read it before every statement)
         self.time = self._k * self.dt
+        self.io.now = self.time          # the I/O image's clock (robot/io.py): the controller's
         self._pt = 0.0
         self._pt_step = self.dt       # the path time the last cycle advanced (s)
         self._scale = 1.0
@@ -298,51 +256,36 @@ class Controller:
         self._stop_T = 0.0               # a conditional stop's braking ramp (s), for the ramp up
         self._ramp_up = False      # release(): the path speed ramps up within a_max
         self._held: _Held | None = None
-        self._moved_while_held = False
         self._q = q.copy()
         self._q_prev = q.copy()
-        self._plan_q = q.copy()        # end point of the last planned motion
-        self._pending: deque[Segment] = deque()
         self._runs: list[_Run] = []
         self._ending: _Ending | None = None   # an exact stop between its end point and done
         self._blend: _Blend | None = None
         self._tracked: list[_Run] = []  # runs with unfired triggers
-        self._next_id = 1
-        self._events: list[Event] = []
-        self._pulses: list[tuple[float, int, bool]] = []
-        self._cyclic: dict[int, Callable[["Controller"], None]] = {}
-        self._message_watchers: list[Callable] = []
-        self._cyclic_next = 1
-        self._tool_T = np.eye(4)
-        self._base_T = np.eye(4)
-        self._base_inv_T = np.eye(4)
-        self._tcp_T = self.model.tcp(self._q, self._tool_T, self._base_inv_T)
-        self._tcp_prev = self._tcp_T[:3, 3].copy()
-        #: the last forward kinematics of _tcp_read_back: (q, tool, INV_POS(base) as bytes), TCP
-        self._tcp_last: tuple | None = None
         self.last_error: RobotError | None = None
-        self._step_lim: list[float] | None = None   # largest axis step per cycle (_check_speed)
-        self._step_lim_a: np.ndarray | None = None  # the same as an array (the compiled check)
-        #: robot/simcore.pyx (None: the Python code alone) and its per-cycle step check
-        self._simcore = _compiled_module()
-        self._speed_ok = getattr(self._simcore, "speed_ok", None)
         self._ret_q: np.ndarray | None = None
-        self._ended = False
         # a sensor correction superposed on the setpoint (RSI, net/rsi.py): an object with
         # `axes` (A1..A6 deg) and `cart` (X, Y, Z mm, A, B, C deg in $BASE, or in `frame`:
         # "TOOL", "WORLD" when it has one); None: none
         self.correction = None
         self._q_raw = self._q.copy()
-        #: KUKA's workspace monitoring (robot/workspace.py ``WorkspaceMonitor``), None while no
-        #: workspace can be active (interp/runtime/sysvars.py makes it: :meth:`watch_workspaces`)
-        self.workspaces = workspaces
-        #: the robot against its cell (robot/collision.py), None without a cell file's geometry
-        self.collision = None
+        collision = None
         if geometry is not None:
             # deferred: tools/startup_bench.py, krl run +4 ms at the top (2026-11-26)
             from .collision import CollisionChecker  # noqa: PLC0415
 
-            self.collision = CollisionChecker(self.machine, geometry)
+            collision = CollisionChecker(self.machine, geometry)
+        #: the checks of each cycle: axis speed, the robot against its cell (None without a cell
+        #: file's geometry), KUKA's workspace monitoring (None while no workspace can be active;
+        #: interp/runtime/sysvars.py makes it) (robot/monitor.py)
+        self.monitor = Monitor(self.model, self.dt, self._simcore, collision, workspaces)
+        # what step() calls or reads every IPO cycle, cached (the components keep these objects for
+        # the controller's life: the hook table and the stimulus list change only in place)
+        self._before_motion = self.signals.before_motion
+        self._check_speed = self.monitor.check_speed
+        self._read_back = self.actual.cycle
+        self._cyclic = self.signals.cyclic
+        self._stimuli = self.signals.stimuli
         self.network = network  # net.hub.Network: the partners, polled at each cycle's start
         if network is not None:
             network.attach(self, **(cell or {}))
@@ -351,23 +294,6 @@ class Controller:
         """The operating mode `mode` (T1, T2, AUT, EX; robot/limits.py) selected between two runs
         of the program (the pendant): the controller's and its robot model's."""
         self.mode_op = self.model.mode = normalise_mode(mode)
-
-    def watch_workspaces(self, monitor) -> None:
-        """KUKA's workspace monitoring from now on (robot/workspace.py ``WorkspaceMonitor``): a
-        program that names ``$WORKSPACE``/``$AXWORKSPACE`` while it runs (interp/runtime/sysvars.py)."""
-        self.workspaces = monitor
-
-    def _arm_model(self):
-        """The MuJoCo arm, compiled now (its first use) and reset to the axes it would have
-        been reset to when built at once (the start axes, or :meth:`place`'s): the same state."""
-        if self._arm_q is not None:
-            # deferred: tools/startup_bench.py, krl run +93 ms at the top (2026-11-26)
-            from .mjcf import ArmModel  # noqa: PLC0415
-
-            arm = ArmModel(self.machine, actuated=self.actuated)
-            arm.reset(self._arm_q)
-            self._arm, self._arm_q = arm, None
-        return self._arm
 
     # ================================================================= clock
     @property
@@ -386,54 +312,10 @@ class Controller:
     def can_enqueue(self) -> bool:
         """True if the advance run may plan another motion now: fewer than ``$ADVANCE``
         motions wait in the queue (with ``$ADVANCE = 0``: only when the robot is idle)."""
-        if self.advance <= 0:
+        advance = self.queue.advance
+        if advance <= 0:
             return self.is_idle()
-        return len(self._pending) < self.advance
-
-    def enqueue(self, req: MotionRequest) -> int:
-        """Plan ``req`` from the end point of the previously planned motion and queue it.
-
-        Returns the motion id (1, 2, ... in enqueue order). Raises
-        :class:`~robot.errors.RobotError` (WorkspaceError, SoftLimitError, BCO errors) when
-        the motion cannot be planned; nothing is queued then. It does not wait for queue
-        space: check :meth:`can_enqueue` first.
-        """
-        req.id = self._next_id
-        seg = plan(req, self._plan_q, self.model, first=self.strict_bco and not self._bco_done)
-        self._next_id += 1
-        self._bco_done = True
-        self._pending.append(seg)
-        self._plan_q = seg.q1.copy()
-        if self._held is not None:
-            self._moved_while_held = True
-        return req.id
-
-    def target_outside_limits(self, req: MotionRequest) -> bool:
-        """True when the target of `req` is itself out of this robot's reach: an absolute
-        Cartesian target with X, Y, Z, A, B, C in ``$BASE``/``$TOOL`` (``$IPO_MODE #BASE``) for
-        which no axis configuration — any of the analytic solutions, any status and turn,
-        each axis with its ±360° variants — lies within ``$SOFTN_END``/``$SOFTP_END``. Then no
-        path and no S/T of the program reaches it: the robot of this machine data cannot take
-        that pose. False for any other request (an axis target, a relative or partial one,
-        ``#TCP``), or when some configuration is within the limits."""
-        p = req.params
-        keys = ("X", "Y", "Z", "A", "B", "C")
-        if req.relative or req.is_axis_target or p.ipo_mode != "BASE" or \
-                not all(k in req.target for k in keys):
-            return False
-        flange = (inv_pos(self.model.robroot_T) @ frame_to_matrix(*p.base)
-                  @ frame_to_matrix(*(float(req.target[k]) for k in keys)) @ inv_pos(frame_to_matrix(*p.tool)))
-        limits = [j.limit_deg for j in self.machine.joints]
-        for q in self.model.kin.solutions(flange):
-            if all(any(lo <= v + k <= hi for k in (-720.0, -360.0, 0.0, 360.0, 720.0))
-                   for v, (lo, hi) in zip(q, limits)):
-                return False
-        return True
-
-    def last_planned(self):
-        """The Segment (robot.planner) that :meth:`enqueue` planned last (for the motion
-        history of backward motion, interp/runtime/runmode.py)."""
-        return self._pending[-1]
+        return len(self._pending) < advance
 
     def is_idle(self) -> bool:
         """True when the main run has caught up: no motion executing, ending (an exact stop
@@ -452,15 +334,6 @@ class Controller:
         :meth:`cancel_pending`)."""
         return self._held is not None
 
-    def io_may_change(self) -> bool:
-        """True if an input or output can still change without the program doing anything:
-        a stimulus not yet applied, a PULSE not yet reset, a cyclic hook, a running timer, a
-        cell rule with an answer pending or about to fire (for deadlock detection of WAIT FOR)."""
-        return (any(not st.fired for st in self.stimuli) or bool(self._pulses)
-                or bool(self._cyclic) or not all(self.io.timer_stop[1:])
-                or (bool(self.rules) and rules_may_fire(self.rules, self.io))
-                or (self.network is not None and self.network.may_change()))
-
     def is_moving(self) -> bool:
         """True while a motion is being executed."""
         return bool(self._runs) or self._blend is not None
@@ -471,19 +344,14 @@ class Controller:
         the first cycle. Raises
         :class:`~robot.errors.SoftLimitError` for axes outside the software limits, ValueError
         once the run has started."""
-        if self._k or self._runs or self._pending or self._next_id > 1:
+        if self._k or self._runs or self._pending or self.queue.next_id > 1:
             raise ValueError("the robot can only be placed before the run starts")
         q = self.model.from_krl(axes)
         self.model.check_limits(q)
         self._q = q.copy()
         self._q_prev = q.copy()
-        self._plan_q = q.copy()
-        if self._arm_q is not None:
-            self._arm_q = q.copy()
-        elif self._arm is not None:
-            self._arm.reset(q)
-        self._tcp_T = self.model.tcp(self._q, self._tool_T, self._base_inv_T)
-        self._tcp_prev = self._tcp_T[:3, 3].copy()
+        self.queue.plan_from(q)
+        self.actual.place(q)
 
     # ================================================================= idle fast-forward
     def at_rest(self) -> bool:
@@ -498,23 +366,8 @@ class Controller:
         for seg in [r.seg for r in self._runs] + list(self._pending):
             if seg.triggers or not np.array_equal(seg.q0, seg.q1) or not np.array_equal(seg.q0, self._q):
                 return False
-        return not (self.rules and any(not r.last and r.holds(self.io) for r in self.rules))
-
-    def next_event_cycle(self) -> int | None:
-        """The first IPO cycle at which the controller changes something by itself while the
-        program does nothing: a timed stimulus, a stimulus delay that runs, a cell rule's
-        pending answer, a PULSE's reset, the network's next message (net.hub.Network: any
-        cycle while a partner is attached, the next recorded one of a replay). None when
-        there is none. (A cycle ``k`` is the one whose :meth:`step` makes ``time = k · dt``.)"""
-        times = [st.at if st.at is not None else st.due for st in self.stimuli
-                 if not st.fired and (st.at is not None or st.due is not None)]
-        times += [r.due[0] for r in self.rules if r.due]
-        times += [te for te, _, _ in self._pulses]
-        net = self.network.next_event_cycle(self._k) if self.network is not None else None
-        if not times:
-            return net
-        k = max(self._k + 1, int(math.ceil(min(times) / self.dt - EPS)))
-        return k if net is None else min(k, net)
+        rules = self.signals.rules
+        return not (rules and any(not r.last and r.holds(self.io) for r in rules))
 
     def skip(self, cycles: int) -> None:
         """Fast-forward `cycles` IPO cycles in which nothing happens (interp/runtime/idle.py
@@ -523,10 +376,10 @@ class Controller:
         pose or cyclic hook runs (the robot stands: the pose is the one of the last cycle; a
         motion that does not move it, executing or queued, goes on after the jump).
         Raises ValueError when the main run is not :meth:`at_rest` or a skipped cycle would
-        reach :meth:`next_event_cycle`."""
+        reach the next event (robot/signals.py ``Signals.next_event_cycle``)."""
         if cycles <= 0:
             return
-        nxt = self.next_event_cycle()
+        nxt = self.signals.next_event_cycle(self._k)
         if not self.at_rest() or (nxt is not None and self._k + cycles >= nxt):
             raise ValueError("the controller cannot skip these cycles: something happens in them")
         self._k += cycles
@@ -537,31 +390,6 @@ class Controller:
             if not st[i]:
                 tm[i] += cycles * self._dt_ms
         self.io.now = self.time
-
-    def queue_length(self) -> int:
-        """Motions planned but not yet started by the main run."""
-        return len(self._pending)
-
-    def step_until(self, predicate: Callable[[], bool], max_cycles: int = 10_000_000) -> list[Event]:
-        """Step until ``predicate()`` is true (checked before each cycle); returns all
-        events. Interpreters that evaluate interrupts should call :meth:`step` themselves."""
-        out: list[Event] = []
-        n = 0
-        while not predicate() and n < max_cycles:
-            out.extend(self.step())
-            n += 1
-        return out
-
-    def wait_idle(self) -> list[Event]:
-        """Step until :meth:`is_idle`."""
-        return self.step_until(self.is_idle)
-
-    def wait_sec(self, seconds: float) -> list[Event]:
-        """Step for ``WAIT SEC seconds`` (see :meth:`cycles_for`)."""
-        out: list[Event] = []
-        for _ in range(self.cycles_for(seconds)):
-            out.extend(self.step())
-        return out
 
     # ================================================================= BRAKE / RESUME
     def brake(self, fast: bool = False) -> None:
@@ -664,7 +492,8 @@ class Controller:
         if h is None:
             return
         self._held = None
-        if not self._moved_while_held and self._main_idle():
+        # the interrupt routine planned no motion: the suspended chain goes on
+        if self.queue.next_id == h.next_id and self._main_idle():
             d = self._pt - h.pt
             objs = list(h.runs) + list(h.tracked)
             if h.blend is not None:
@@ -676,17 +505,17 @@ class Controller:
                 if id(r) not in seen:
                     seen.add(id(r))
                     r.shift(d)
-            self._runs, self._blend, self._pending = h.runs, h.blend, h.pending
+            self._runs, self._blend = h.runs, h.blend
+            self._pending.extend(h.pending)           # empty here (_main_idle)
             self._tracked = list(dict.fromkeys(h.tracked))
-            self._tool_T, self._base_T = h.tool_T, h.base_T
-            self._base_inv_T = inv_pos(h.base_T)
+            self.actual.set_frames(h.tool_T, h.base_T, inv_pos(h.base_T))
             self._scale = 0.0
             self._scale_rate = 1.0 / max(self._brake_T, self.dt)
             self._ramp_up = True
             # the interrupt level planned from the standstill point; the advance run plans on
             # from where the suspended chain ends (else the next motion would start at the
             # standstill point while the robot stands at the braked motion's end point)
-            self._plan_q = h.plan_q
+            self.queue.plan_from(h.plan_q)
             return
         # re-plan from where the planning chain ends now
         segs = []
@@ -699,10 +528,7 @@ class Controller:
             segs.append(req)
         segs.extend(s.req for s in h.pending)
         for req in segs:
-            seg = plan(req, self._plan_q, self.model)
-            self._pending.append(seg)
-            self._plan_q = seg.q1.copy()
-        self._moved_while_held = False
+            self.queue.replan(req)
 
     def cancel_pending(self) -> None:
         """``RESUME``: discard the motions suspended by BRAKE (the braked one and everything
@@ -714,11 +540,9 @@ class Controller:
             h = self._held
             self._abort(h.runs, h.blend)
             self._held = None
-            self._moved_while_held = False
             if not self.is_moving() and not self._pending:
-                self._plan_q = self._q.copy()
+                self.queue.plan_from(self._q)
             return
-        self._moved_while_held = False
         self._abort(self._runs, self._blend)
         self._pending.clear()
         self._runs = []
@@ -727,7 +551,7 @@ class Controller:
         self._braking = False
         self._scale, self._scale_rate = 1.0, 0.0
         self._ramp_up = False
-        self._plan_q = self._q.copy()
+        self.queue.plan_from(self._q)
 
     def _abort(self, runs: list[_Run], blend: _Blend | None) -> None:
         """Log ``end`` with ``reason: abort`` for started motions that are abandoned before
@@ -745,175 +569,25 @@ class Controller:
         return None if self._ret_q is None else self._ret_q.copy()
 
     # ================================================================= I/O
-    def _on_io(self, t: float, name: str, value: Any, source: str) -> None:
-        self._events.append(IoEvent(t, name, value, source))
-        if self.trace is not None:
-            self.trace.write("io", t, signal=name, value=value, source=source)
-
-    def set_out(self, n: int, value: bool, source: str = "program") -> None:
-        """``$OUT[n] = value`` (logged as an io event)."""
-        self.io.now = self.time
-        self.io.set_out(n, value, source)
-
-    def get_in(self, n: int) -> bool:
-        """``$IN[n]``."""
-        return self.io.get_in(n)
-
-    def pulse(self, n: int, level: bool, duration_s: float, source: str = "program") -> None:
-        """``PULSE($OUT[n], level, duration)``: set now, set to ``NOT level`` after
-        ``duration_s`` (at the first IPO cycle at or after it; reference §5.12)."""
-        self.set_out(n, level, source)
-        self._pulses.append((self.time + float(duration_s), int(n), not level))
-
-    def add_cyclic(self, fn: Callable[["Controller"], None]) -> int:
-        """Call ``fn(controller)`` once per IPO cycle after the setpoint is computed
-        (ANOUT ON, ANIN ON, $CYCFLAG). Returns a handle for :meth:`remove_cyclic`."""
-        h = self._cyclic_next
-        self._cyclic_next += 1
-        self._cyclic[h] = fn
-        return h
-
-    def remove_cyclic(self, handle: int) -> None:
-        self._cyclic.pop(handle, None)
-
     # ================================================================= read-back
-    def axis_act(self) -> np.ndarray:
-        """``$AXIS_ACT`` in KRL's order (robot/axismap.py ``to_krl``): A1..A6 (deg) read back from
-        the MuJoCo model (0 for the axes of a robot with fewer than six, a SCARA's A5 and A6); then
-        E1.. (mm, deg) on a robot with external axes or a seven-axis arm's redundancy."""
-        return self.model.to_krl(self._axes_act())
-
-    def _axes_act(self) -> np.ndarray:
-        """The axes read back (A1..An, E1..En: the model's order)."""
-        arm = self._arm if self._arm_q is None else self._arm_model()
-        if arm is not None:
-            return arm.axes_deg()
-        return self._q.copy()
-
-    def axis_setpoint(self) -> np.ndarray:
-        """The current IPO setpoint in KRL's order (as :meth:`axis_act`)."""
-        return self.model.to_krl(self._q.copy())
-
-    def pos_act(self, tool: Any = None, base: Any = None, ipo_mode: str = "BASE") -> dict[str, float]:
-        """``$POS_ACT`` as an E6POS dict {X, Y, Z, A, B, C, S, T} (mm, deg): the TCP of
-        :meth:`axis_act` in ``base`` for ``tool`` (6-tuples or 4x4; default: the $BASE/$TOOL
-        of the motion the main run executes, ``$BASE_C``/``$TOOL_C``). ``ipo_mode`` "TCP"
-        (external TCP, reference §6.4): ``tool`` is the workpiece on the flange, ``base`` the
-        fixed tool in WORLD, and the pose is the fixed tool in the workpiece frame,
-        ``INV_POS($ROBROOT : FLANGE(q) : $TOOL) : $BASE`` (robot/external_tcp.py)."""
-        q = self._axes_act()
-        tool_T = self._tool_T if tool is None else _as4(tool)
-        base_inv = self._base_inv_T if base is None else inv_pos(_as4(base))
-        T = self._tcp_read_back(q, tool_T, base_inv)
-        if ipo_mode == "TCP":
-            T = inv_pos(T)
-        x, y, z, a, b, c = matrix_to_frame(T)
-        s, t = self.model.status_turn(q)
-        out = {"X": x, "Y": y, "Z": z, "A": a, "B": b, "C": c, "S": s, "T": t}
-        out.update(self.model.axes.e_components(q))
-        return out
-
-    @property
-    def _tcp_T(self) -> np.ndarray:
-        """The TCP read back this cycle (4x4, in $BASE; :meth:`step` may leave it to be made
-        here, when first asked for)."""
-        T = self._tcp_m
-        if T is None:
-            T = self._tcp_m = self._tcp_read_back(*self._tcp_src)
-            self._tcp_src = None
-        return T
-
-    @_tcp_T.setter
-    def _tcp_T(self, T: np.ndarray) -> None:
-        self._tcp_m, self._tcp_src = T, None
-
-    @property
-    def _tcp_prev(self) -> np.ndarray:
-        """The TCP's position (mm) read back the cycle before (:attr:`_tcp_T`'s)."""
-        p = self._tcp_pp
-        if p is None:
-            p = self._tcp_pp = self._tcp_read_back(*self._tcp_psrc)[:3, 3].copy()
-            self._tcp_psrc = None
-        return p
-
-    @_tcp_prev.setter
-    def _tcp_prev(self, p: np.ndarray) -> None:
-        self._tcp_pp, self._tcp_psrc = p, None
-
-    def _tcp_read_back(self, q: np.ndarray, tool_T: np.ndarray, base_inv_T: np.ndarray) -> np.ndarray:
-        """TCP in $BASE from the MuJoCo flange site (``INV_POS($BASE) : FLANGE_world : $TOOL``),
-        or from the forward kinematics of ``q`` without MuJoCo."""
-        arm = self._arm if self._arm_q is None else self._arm_model()
-        if arm is not None:
-            return base_inv_T @ arm.flange_pose_world() @ tool_T
-        if q.dtype is _F8 and tool_T.dtype is _F8 and base_inv_T.dtype is _F8:
-            # a robot at rest reads back the same pose every cycle: the model's forward
-            # kinematics is a function of these three arrays alone, so equal bytes give it again
-            key = (q.tobytes(), tool_T.tobytes(), base_inv_T.tobytes())
-            last = self._tcp_last
-            if last is not None and last[0] == key:
-                return last[1].copy()
-            T = self.model.tcp(q, tool_T, base_inv_T)
-            self._tcp_last = (key, T.copy())
-            return T
-        return self.model.tcp(q, tool_T, base_inv_T)
-
-    def axis_vel_act(self) -> np.ndarray:
-        """The axes' velocities over the last IPO cycle in KRL's order (A1..A6 deg/s, then
-        E1..En deg/s or mm/s): the source of ``$VEL_AXIS_ACT`` (interp/runtime/sysvars.py)."""
-        return self.model.to_krl((self._q - self._q_prev) / self.dt)
-
-    def vel_act(self) -> float:
-        """``$VEL_ACT``: TCP speed in m/s over the last IPO cycle."""
-        return float(np.linalg.norm(self._tcp_T[:3, 3] - self._tcp_prev)) / self.dt / 1000.0
-
     def current_request(self) -> MotionRequest | None:
         """The motion the main run executes now (the newer one during a blend), or None:
         the source of the ``_C`` variables (``$VEL_C``, ``$TOOL_C``, ...) and ``$POS_FOR``."""
         return self._runs[-1].seg.req if self._runs else None
 
-    def planned_axes(self) -> np.ndarray:
-        """End point (deg) of the last planned motion (the start of the next one)."""
-        return self._plan_q.copy()
-
     # ================================================================= trace helpers
-    def message(self, text: str, motion_id: int | None = None, number: int | None = None) -> None:
-        """Log a controller message (event + trace), and tell the watchers (:meth:`watch_messages`)."""
-        self._events.append(MessageEvent(self.time, text, motion_id))
-        if self.trace is not None:
-            self.trace.write("message", self.time, text=text, id=motion_id, number=number)
-        for fn in self._message_watchers:
-            fn(text, motion_id, number)
-
-    def watch_messages(self, fn: Callable[[str, int | None, int | None], None]) -> None:
-        """Call ``fn(text, motion_id, number)`` for each message (the pendant's message window)."""
-        self._message_watchers.append(fn)
-
-    def set_advance(self, n: int) -> None:
-        """``$ADVANCE``: how many motions the advance run may plan ahead of the main run."""
-        self.advance = n
-
-    def finish(self, reason: str = "program_end", **fields: Any) -> None:
-        """Write the ``end`` trace event (once); ``fields`` add where and why (the
-        interpreters pass text, number, file, line and context)."""
-        if not self._ended and self.trace is not None:
-            self.trace.write("end", self.time, reason=reason, **fields)
-        self._ended = True
-
     def _motion_event(self, seg: Segment, phase: str, reason: str | None = None,
                       reached: float | None = None) -> None:
         req = seg.req
-        self._events.append(MotionEvent(self.time, req.id, phase, req))
+        self.log.events.append(MotionEvent(self.time, req.id, phase, req))
         if self.trace is not None:
             limits = seg.limits.as_trace() if phase == "start" else None
             self.trace.write("motion", self.time, id=req.id, type=req.type_name,
                              target=dict(req.target), approximation=req.approx,
                              phase=phase, point=seg.end_frame, line=req.line, file=req.file,
                              reason=reason, limits=limits, reached=reached)
-        for st in self.stimuli:
-            if (not st.fired and st.due is None and st.phase == phase
-                    and st.matches_motion(req.id, req.line)):
-                st.due = self.time + st.delay
+        if self.signals.stimuli:
+            self.signals.motion_phase(req.id, req.line, phase, self.time)
 
     # ================================================================= the IPO cycle
     def step(self) -> list[Event]:
@@ -922,25 +596,14 @@ class Controller:
 
         Returns the events of this cycle, in order.
         """
-        self._events = []
+        log = self.log
+        log.events = []
         self._k += 1
         t = self.time = self._k * self.dt
         self.io.now = t
         if self.network is not None and self.network.polling:
             self.network.cycle(self)
-        self.io.tick_timers(self._dt_ms)
-        if self._pulses:
-            keep = []
-            for (te, n, lvl) in self._pulses:
-                if t >= te - EPS:
-                    self.io.set_out(n, lvl, "pulse")
-                else:
-                    keep.append((te, n, lvl))
-            self._pulses = keep
-        if self.stimuli:
-            self._apply_stimuli(t)
-        if self.rules:
-            self._rules_seen = step_rules(self.rules, self.io, t, self.dt, self._rules_seen)
+        self._before_motion(t)
 
         if self._tracked:
             self._conditional_stops()
@@ -967,7 +630,7 @@ class Controller:
             q = self._main_run(self._pt)
             if self.correction is not None:
                 q = self._corrected(q)
-            self._check_speed(q)
+            self._check_speed(q, self._q_prev)
         except RobotError as err:
             q = self._fault(err)
         self._q = np.asarray(q, dtype=float)
@@ -975,60 +638,36 @@ class Controller:
             self._hold()
         if self._tracked:
             self._fire_triggers(self._pt)
-        arm = self._arm if self._arm_q is None else self._arm_model()
-        cyc = arm.compiled_cycle(self._simcore) if arm is not None and not self.actuated else None
-        if cyc is not None:
-            # set_axes, axis_act and the flange site in one compiled call (the same numbers)
-            qa, T = np.empty(self._q.shape[0]), np.empty((4, 4))
-            self._tcp_prev = self._tcp_T[:3, 3].copy()
-            try:
-                # with _tcp_read_back's product in numpy's own BLAS call (robot/mjcf.py
-                # _same_products)
-                done = cyc.cycle_tcp(self._q, qa, self._base_inv_T, self._tool_T, T)
-            except (TypeError, ValueError):      # a frame not C-contiguous float64: numpy's @
-                done = False
-            if not done:
-                F = np.empty((4, 4))
-                cyc.cycle(self._q, qa, F)
-                T = self._base_inv_T @ F @ self._tool_T
-            self._tcp_T = T
-        else:
-            if arm is not None:
-                if self.actuated:
-                    arm.step_actuated(self._q, self.dt, (self._q - self._q_prev) / self.dt)
-                else:
-                    arm.set_axes(self._q)
-            qa = self._axes_act()
-            if arm is None:
-                # without MuJoCo the read-back is the forward kinematics of these arrays alone:
-                # made when first asked for ($POS_ACT, $VEL_ACT, the trace's pose), the same numbers
-                if self._tcp_m is not None:
-                    self._tcp_pp, self._tcp_psrc = self._tcp_m[:3, 3].copy(), None
-                else:
-                    self._tcp_pp, self._tcp_psrc = None, self._tcp_src
-                self._tcp_m, self._tcp_src = None, (qa, self._tool_T, self._base_inv_T)
-            else:
-                self._tcp_prev = self._tcp_T[:3, 3].copy()
-                self._tcp_T = self._tcp_read_back(qa, self._tool_T, self._base_inv_T)
-        if self.collision is not None and (self._runs or self._blend is not None):
-            self._watch_collisions()
-        if self.workspaces is not None:
-            self._watch_workspaces(qa)
+        qa = self._read_back(self._q, self._q_prev)
+        actual, mon = self.actual, self.monitor
+        if mon.collision is not None and (self._runs or self._blend is not None):
+            req = self._runs[0].seg.req if self._runs else None
+            err = mon.collision_error(self._q, (actual.base_T @ actual.tcp)[:3, 3], req.line if req is not None else None)
+            if err is not None:
+                self._fault(err)
+        if mon.workspaces is not None:
+            changes, stop = mon.workspaces_cycle((actual.base_T @ actual.tcp)[:3, 3], qa)
+            for name, value in changes:
+                log.io(self.time, name, value, "workspace")
+            if stop is not None and (self._runs or self._blend is not None or self._pending):
+                self._fault(RobotError(stop))
         if self._cyclic:
             for fn in list(self._cyclic.values()):
                 fn(self)
-        if self.stimuli and self._runs:
-            self._reach_stimuli()
+        if self._stimuli and self._runs:
+            active = [r.seg for r in self._runs]
+            if self._blend is not None:
+                active.append(self._blend.prev.seg)
+            self.signals.reach(active, self._q, self.time)
         tr = self.trace
         if tr is not None and tr.takes_poses:
-            tr.write_pose(t, qa, self._tcp_T)
-        return self._events
+            tr.write_pose(t, qa, actual.tcp)
+        return log.events
 
     # ----------------------------------------------------------------- main run
     def _start(self, seg: Segment, pt: float) -> _Run:
         run = _Run(seg, pt)
-        self._tool_T, self._base_T = seg.tool_T, seg.base_T
-        self._base_inv_T = seg.base_inv_T
+        self.actual.set_frames(seg.tool_T, seg.base_T, seg.base_inv_T)
         self._motion_event(seg, "start")
         if seg.triggers:
             self._tracked.append(run)
@@ -1038,7 +677,7 @@ class Controller:
             kw = blending.effective_keyword(seg, nxt)
             ta = blending.blend_start_tau(seg, nxt, kw) if kw else None
             if ta is not None:
-                te = self._blend_window(seg, nxt, kw, ta)
+                te = blending.blend_window(seg, nxt, kw, ta)
                 run.planned_mid = pt + ta + 0.5 * te
         return run
 
@@ -1082,7 +721,7 @@ class Controller:
                     r.decided = True
                     return self._begin_blend(r, pt, bp)
                 r.decided = True
-                self.message(MSG_APPROX_IMPOSSIBLE, seg.id)
+                self.log.message(MSG_APPROX_IMPOSSIBLE, seg.id)
         if tau >= seg.T - EPS:
             # an exact stop: the robot stands at the end point; END and done come later
             self._runs = []
@@ -1145,13 +784,6 @@ class Controller:
             return nr.seg.axes(pt - nr.t0)
         return self._blend_setpoint(b, pt)
 
-    def _blend_window(self, seg: Segment, nxt: Segment, kw: str, tau_a: float) -> float:
-        """Length (s) of the blend that starts at local time ``tau_a`` of ``seg`` (it ends
-        when ``seg`` reaches its point)."""
-        bp = blending.plan_blend(seg, nxt, kw, tau_a) or blending.plan_blend(seg, nxt, kw, seg.T)
-        assert bp is not None
-        return bp.window
-
     def _end_blend(self, b: _Blend) -> None:
         self._blend = None
         self._motion_event(b.prev.seg, "blend_end")
@@ -1159,33 +791,9 @@ class Controller:
         b.nxt.seg._last_q = self._q.copy()
 
     def _blend_setpoint(self, b: _Blend, pt: float) -> np.ndarray:
-        """The blend's setpoint: the overlap of the two velocity profiles (robot/blending.py),
-        in Cartesian space or in axis space."""
-        t_prev = min(pt - b.prev.t0, b.prev.seg.T)
-        t_next = pt - b.nxt.t0
-        if b.space == "cart":
-            p0, R0 = b.prev.seg.pose(t_prev)
-            p1, R1 = b.nxt.seg.pose(t_next)
-            pc, Rc = b.nxt.seg.pose(0.0)
-            if blending.reduced_orientation(self.model):
-                # a palletizer: overlap the poses it reaches, not the paths' own orientations
-                # (robot/blending.py reached_pose)
-                u0, u1 = b.prev.seg.u(t_prev), b.nxt.seg.u(t_next)
-                p0, R0 = blending.reached_pose(b.prev.seg, p0, R0, self._q, u0)
-                p1, R1 = blending.reached_pose(b.nxt.seg, p1, R1, self._q, u1)
-                pc, Rc = blending.reached_pose(b.nxt.seg, pc, Rc, self._q, 0.0)
-            p, R = blending.superpose_pose(p0, R0, p1, R1, pc, Rc)
-            ref = self._q
-            n = self.n
-            if len(ref) > n:
-                # the external axes overlap like axes: E_prev(t) + E_next(t) - E at the point
-                e = (_e_at(b.prev.seg, b.prev.seg.u(t_prev), n) + _e_at(b.nxt.seg, b.nxt.seg.u(t_next), n)
-                     - b.nxt.seg.q0[n:])
-                ref = np.concatenate([ref[:n], e])
-            return b.nxt.seg.ik(p, R, ref)  # type: ignore[attr-defined]
-        q = b.prev.seg.axes(t_prev) + (b.nxt.seg.axes(t_next) - b.nxt.seg.q0)
-        self.model.check_limits(q)
-        return q
+        """The blend's setpoint at path time `pt` (robot/blending.py ``blend_setpoint``)."""
+        return blending.blend_setpoint(b.prev.seg, min(pt - b.prev.t0, b.prev.seg.T), b.nxt.seg, pt - b.nxt.t0,
+                                       b.space, self.model, self._q)
 
     def _corrected(self, q: np.ndarray) -> np.ndarray:
         """The setpoint `q` with the sensor correction superposed: the axis correction added,
@@ -1203,11 +811,12 @@ class Controller:
             out[:n] += self.model.axes.from_krl(axes, fill=np.zeros(len(out)))[:n]
         cart = np.asarray(corr.cart, dtype=float)
         if np.any(cart):
-            T = self.model.tcp(out[:n], self._tool_T, self._base_inv_T)
+            actual = self.actual
+            T = self.model.tcp(out[:n], actual.tool_T, actual.base_inv_T)
             C = frame_to_matrix(*cart)
             frame = getattr(corr, "frame", "BASE")      # RSI's POSCORR RefCorrSys (net/rsi.py)
             if frame == "WORLD":                        # a correction in $WORLD, seen from $BASE
-                Rb = self._base_T[:3, :3]
+                Rb = actual.base_T[:3, :3]
                 C[:3, 3] = Rb.T @ C[:3, 3]
                 C[:3, :3] = Rb.T @ C[:3, :3] @ Rb
             if frame == "TOOL":                         # in the programmed TCP's own frame
@@ -1216,7 +825,7 @@ class Controller:
                 target = T.copy()
                 target[:3, 3] = T[:3, 3] + C[:3, 3]
                 target[:3, :3] = C[:3, :3] @ T[:3, :3]
-            out[:n] = self.model.ik(target, np.linalg.inv(self._tool_T), self._base_T, None, None, out[:n])
+            out[:n] = self.model.ik(target, np.linalg.inv(actual.tool_T), actual.base_T, None, None, out[:n])
         return out
 
     def set_correction(self, correction) -> None:
@@ -1230,7 +839,7 @@ class Controller:
         self.correction = None
         self._q_raw = self._q.copy()
         if self.is_idle():
-            self._plan_q = self._q.copy()
+            self.queue.plan_from(self._q)
 
     def stop_with(self, text: str, number: int | None = None) -> None:
         """Stop the robot now with the message `text` (a sensor's error, as KSS stops on
@@ -1239,66 +848,11 @@ class Controller:
         self._q = q
         self.correction = None
 
-    def tcp_frame(self) -> tuple:
-        """The TCP (X, Y, Z mm, A, B, C deg) in $BASE read back this cycle (``$POS_ACT``'s frame)."""
-        return matrix_to_frame(self._tcp_T)
-
-    def _check_speed(self, q: np.ndarray) -> None:
-        """Reject a setpoint that would move an axis faster than
-        ``CP_SPEED_LIMIT_FACTOR`` x its maximum speed (a CP path through a singularity)."""
-        if q is self._q_prev:        # at rest: the main run kept the last setpoint
-            return
-        lim = self._step_lim
-        if lim is None:
-            lim = self._step_lim = (CP_SPEED_LIMIT_FACTOR * self.model.v_max * self.dt + 1e-9).tolist()
-            self._step_lim_a = np.array(lim, dtype=float)
-        if self._speed_ok is not None and type(q) is np.ndarray:
-            try:
-                if self._speed_ok(q, self._q_prev, self._step_lim_a):
-                    return
-            except (TypeError, ValueError):      # not float64: the loop below takes it
-                pass
-        step = [abs(a - b) for a, b in zip(q.tolist() if type(q) is np.ndarray else np.asarray(q).tolist(),
-                                           self._q_prev.tolist())]
-        for d, m in zip(step, lim):
-            if d > m:
-                i = max(range(len(step)), key=lambda j: step[j] / lim[j])
-                name = self.model.axes.model_keys[i]
-                raise RobotError(f"speed limit exceeded {name}: CP path through a singularity")
-
-    def _watch_collisions(self) -> None:
-        """The robot against its cell at this IPO cycle's setpoint (robot/collision.py: MuJoCo's
-        contacts of the links, the tool, the cell's bodies and the floor): a contact stops the
-        robot here, a main-run error naming both bodies, the motion's line and the TCP in
-        ``$WORLD``."""
-        c = self.collision.check(self._q)
-        if c is None:
-            return
-        p = (self._base_T @ self._tcp_T)[:3, 3]
-        req = self._runs[0].seg.req if self._runs else None
-        line = f" at the motion of line {req.line}" if req is not None and req.line is not None else ""
-        self._fault(RobotError(f"collision: {c.a} touches {c.b}{line}; TCP X {p[0]:.1f}, Y {p[1]:.1f}, "
-                               f"Z {p[2]:.1f} mm in $WORLD"))
-
-    def _watch_workspaces(self, qa: np.ndarray) -> None:
-        """KUKA's workspace monitoring at this IPO cycle (robot/workspace.py): the TCP of the main
-        run's ``$TOOL`` in ``$WORLD`` and the axes read back; each state signal that changes is an
-        I/O event (source ``workspace``); a STOP workspace violated stops the robot here, with
-        its message, as a main-run error (the queue discarded, the program stopped)."""
-        p = (self._base_T @ self._tcp_T)[:3, 3]
-        changes, stop = self.workspaces.cycle(p, self.model.axes.components(qa))
-        for name, value in changes:
-            self._events.append(IoEvent(self.time, name, value, "workspace"))
-            if self.trace is not None:
-                self.trace.write("io", self.time, signal=name, value=value, source="workspace")
-        if stop is not None and (self._runs or self._blend is not None or self._pending):
-            self._fault(RobotError(stop))
-
     def _fault(self, err: RobotError) -> np.ndarray:
         self._end_now()
         mid = self._runs[0].seg.id if self._runs else None
         self.last_error = err
-        self._events.append(ErrorEvent(self.time, err, mid))
+        self.log.events.append(ErrorEvent(self.time, err, mid))
         if self.trace is not None:
             line = self._runs[0].seg.req.line if self._runs else None
             self.trace.write("error", self.time, text=err.message, number=err.number,
@@ -1316,20 +870,22 @@ class Controller:
         self._braking = False
         self._scale, self._scale_rate = 1.0, 0.0
         self._ramp_up = False
-        self._plan_q = q.copy()
+        self.queue.plan_from(q)
         return q
 
     def _hold(self) -> None:
         """BRAKE finished: suspend the main run (interrupt level starts empty)."""
         self._braking = False
-        self._held = _Held(self._runs, self._blend, self._pending, self._tracked, self._pt,
-                           self._q.copy(), self._tool_T, self._base_T, self._plan_q.copy())
+        actual = self.actual
+        self._held = _Held(self._runs, self._blend, deque(self._pending), self._tracked, self._pt,
+                           self._q.copy(), actual.tool_T, actual.base_T, self.queue.planned_axes(),
+                           self.queue.next_id)
         self._ret_q = self._q.copy()
-        self._runs, self._blend, self._pending, self._tracked = [], None, deque(), []
+        self._runs, self._blend, self._tracked = [], None, []
+        self._pending.clear()
         self._scale, self._scale_rate = 1.0, 0.0
         self._ramp_up = False
-        self._moved_while_held = False
-        self._plan_q = self._q.copy()
+        self.queue.plan_from(self._q)
 
     # ----------------------------------------------------------------- conditional stops
     def _conditional_stops(self) -> None:
@@ -1394,59 +950,13 @@ class Controller:
             for _, _, tp in sorted(due, key=lambda x: (x[0], x[1])):
                 run.fired.add(tp.index)
                 ev = TriggerEvent(self.time, run.seg.id, tp.index, tp.trigger)
-                self._events.append(ev)
+                self.log.events.append(ev)
                 if self.trace is not None:
                     self.trace.write("trigger", self.time, id=run.seg.id, index=tp.index,
                                      line=tp.trigger.line)
             if run.pending_triggers:
                 still.append(run)
         self._tracked = still
-
-    # ----------------------------------------------------------------- stimuli
-    def _apply_stimuli(self, t: float) -> None:
-        for st in self.stimuli:
-            if st.fired:
-                continue
-            due = st.at if st.at is not None else st.due
-            if due is not None and t >= due - EPS:
-                st.fired = True
-                for name, v in st.set.items():
-                    self.io.set_signal(name, v, st.source)
-                if st.on_fire is not None:
-                    st.on_fire(t)
-
-    def _reach_stimuli(self) -> None:
-        if not self.stimuli or not self._runs:
-            return
-        active = [r.seg for r in self._runs]
-        if self._blend is not None:
-            active.append(self._blend.prev.seg)
-        for st in self.stimuli:
-            if st.fired or st.due is not None or st.reached_mm is None:
-                continue
-            for seg in active:
-                if st.matches_motion(seg.id, seg.req.line):
-                    p_end = seg.model.tcp(seg.q1, seg.tool_T, seg.base_inv_T)[:3, 3]
-                    here = seg.model.tcp(self._q, seg.tool_T, seg.base_inv_T)[:3, 3]
-                    if float(np.linalg.norm(here - p_end)) <= st.reached_mm + 1e-9:
-                        st.due = self.time + st.delay
-                        if st.delay <= 0:
-                            st.fired = True
-                            for name, v in st.set.items():
-                                self.io.set_signal(name, v, st.source)
-
-
-def _e_at(seg: Segment, u: float, n: int) -> np.ndarray:
-    """The external axes of `seg` (after its n robot axes) at its path parameter `u` (linear
-    from start to end)."""
-    return seg.q0[n:] + u * (seg.q1[n:] - seg.q0[n:])
-
-
-def _as4(F: Any) -> np.ndarray:
-    arr = np.asarray(F, dtype=float)
-    if arr.shape == (4, 4):
-        return arr
-    return frame_to_matrix(*arr)
 
 
 __all__ = ["Controller", "MotionEvent", "TriggerEvent", "IoEvent", "MessageEvent",

@@ -263,7 +263,7 @@ class TraceWriter:
     ``takes_poses``: the controller passes its per-IPO-cycle pose to :meth:`write_pose` only
     for a trace whose ``takes_poses`` is true (an observer of the controller's events that has
     no use for poses says false: the TCP read back is then made only where the run asks for it,
-    robot/controller.py ``Controller._tcp_T``).
+    robot/readback.py ``ReadBack.tcp``).
     """
 
     takes_poses = True

@@ -8,9 +8,9 @@ vectorised segment sampling off (:attr:`robot.controller.Controller.batch`), the
 path; ``--out DIR`` keeps the traces. Exit status 1 when a trace differs.
 
 The cases drive a :class:`~robot.controller.Controller` directly (no interpreter) through the
-API every checkout since 8175047 has (``enqueue``, ``step``, ``wait_idle``, ``wait_sec``,
-``brake``, ``release``, ``cancel_pending``, ``set_out``, ``pulse``, ``advance``), so an old
-checkout runs them unchanged:
+API every checkout since 8175047 has (``enqueue``, ``step``, ``brake``, ``release``,
+``cancel_pending``, ``set_out``, ``pulse``, ``advance``; since issue 62 on the controller's
+``queue``, ``signals``, ``io`` and ``log``), so an old checkout runs them unchanged:
 
 * ``bench-kr6``, ``bench-kr210``: :func:`robot.bench.run_bench` (20 s of motion) on the
   KR 6 R900 and on the KR 210 R2700-2 of the corpus backup ``HugoDanielson__ChinaMilling``
@@ -102,6 +102,12 @@ def random_program(seed: int, machine: Any, trace: Any, cell_path: str | None = 
     except TypeError:      # this checkout's Controller takes the Cell of the one loader, not a path
         ctl = Controller(machine, trace=trace, stimuli=load_cell(cell_path), mode_op=mode)
     mach = ctl.machine
+    # the API of this checkout (issue 62: the controller's queue, I/O side and event log are
+    # components) or of one before it (the same calls on the controller itself)
+    queue = getattr(ctl, "queue", ctl)
+    signals = getattr(ctl, "signals", ctl)
+    log = getattr(ctl, "log", ctl)
+    set_out = ctl.set_out if hasattr(ctl, "set_out") else ctl.io.set_out
     k = mach.reach_wrist_point_mm / 901.456
     P0 = MotionParams.initmov(mach)
     budget = [MAX_CYCLES]
@@ -113,7 +119,7 @@ def random_program(seed: int, machine: Any, trace: Any, cell_path: str | None = 
             budget[0] -= 1
             for ev in ctl.step():
                 if ev.kind == "trigger":
-                    ctl.set_out(1, not ctl.io.get_out(1), "trigger")
+                    set_out(1, not ctl.io.get_out(1), "trigger")
 
     def until(pred: Any) -> None:
         while not pred() and budget[0] > 0:
@@ -204,7 +210,7 @@ def random_program(seed: int, machine: Any, trace: Any, cell_path: str | None = 
         if budget[0] <= 0:
             return
         try:
-            ctl.enqueue(req)
+            queue.enqueue(req)
         except RobotError as err:
             trace.write("message", ctl.time, text=f"enqueue: {err}")
 
@@ -220,18 +226,18 @@ def random_program(seed: int, machine: Any, trace: Any, cell_path: str | None = 
         elif op == "wait_sec":
             step(ctl.cycles_for(rng.uniform(0.0, 0.4)))
         elif op == "out":
-            ctl.set_out(rng.randint(2, 4), rng.random() < 0.5)
+            set_out(rng.randint(2, 4), rng.random() < 0.5)
         elif op == "pulse":
-            ctl.pulse(rng.randint(5, 6), True, rng.uniform(0.01, 0.3))
+            signals.pulse(rng.randint(5, 6), True, rng.uniform(0.01, 0.3))
         elif op == "advance":
             n = rng.randint(1, 3)
-            if hasattr(ctl, "set_advance"):
-                ctl.set_advance(n)
+            if hasattr(queue, "set_advance"):
+                queue.set_advance(n)
             else:
                 ctl.advance = n         # a checkout before issue 62 (no set_advance)
         elif op == "steps":
             step(rng.randint(1, 60))
-        elif ctl.is_moving() or ctl.queue_length():
+        elif ctl.is_moving() or (len(queue) if queue is not ctl else ctl.queue_length()):
             until(ctl.is_moving)
             step(rng.randint(0, 40))
             ctl.brake(fast=rng.random() < 0.5)
@@ -244,7 +250,7 @@ def random_program(seed: int, machine: Any, trace: Any, cell_path: str | None = 
             else:
                 ctl.cancel_pending()
     until(ctl.is_idle)
-    ctl.finish("program_end")
+    log.finish("program_end")
     return ctl
 
 

@@ -33,7 +33,7 @@ it must only hand the event on):
 * ``exited`` — ``{"exitCode"}`` (krl run's exit code); ``terminated`` — ``{}``.
 
 and, through ``on_runtime(rt)``, of each run it builds (the first one, and each replay), to
-hook its own display (``rt.controller.add_cyclic``) or message window on it.
+hook its own display (``rt.controller.signals.add_cyclic``) or message window on it.
 
 The engine's methods (to be called on the engine thread):
 
@@ -432,12 +432,12 @@ class Engine:
             with engine._quiet():
                 rt.wait_main_run(rt.robot)
                 try:
-                    rt.controller.enqueue(request)
+                    rt.controller.queue.enqueue(request)
                 except RobotError as e:
                     raise Refused(e.message) from None
                 rt.wait_main_run(rt.robot)
             engine.flush_trace()
-            return [float(v) for v in rt.controller.axis_act()]
+            return [float(v) for v in rt.controller.actual.axis_act()]
         return self.edit(getattr(request, "kind", "motion"), apply)
 
     def evaluate_now(self, text: str):
@@ -503,7 +503,7 @@ class Engine:
             ctl = engine.rt.controller
             ctl.io.now = ctl.time
             ctl.io.set_in(index, bool(value), "operator")
-            return ctl.get_in(index)
+            return ctl.io.get_in(index)
         return self.edit(f"$IN[{index}] = {'TRUE' if value else 'FALSE'}", apply)
 
     def backward_motion(self) -> int:

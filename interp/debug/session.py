@@ -31,7 +31,7 @@ from .launch import run_options
 def _prepare() -> None:
     """Import what a launch needs (the simulated controller, the interpreters) while the
     client starts the session: the launch request then finds them loaded. Not MuJoCo: the
-    controller compiles the arm at its first use (robot/controller.py ``_arm_model``), after
+    controller compiles the arm at its first use (robot/readback.py ``ReadBack.arm``), after
     the launch."""
     for name in ("interp.run", "robot.controller", "interp.tree", "interp.debug.launch"):
         try:

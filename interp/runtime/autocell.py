@@ -367,11 +367,11 @@ class AutoCell:
         # the answers that took effect leave the controller's stimuli (it looks at each one
         # at every IPO cycle); what they did is in self.answers
         self._scheduled = [st for st in self._scheduled if not st.fired]
-        ctl.stimuli[:] = [st for st in ctl.stimuli if not (st.source == "auto" and st.fired)]
+        ctl.signals.stimuli[:] = [st for st in ctl.signals.stimuli if not (st.source == "auto" and st.fired)]
         st = Stimulus(set=dict(sets), at=at, source="auto", on_fire=fired,
                       where=f"--inputs auto: {Path(span.file).name}:{span.line}")
         self._scheduled.append(st)
-        ctl.stimuli.append(st)
+        ctl.signals.stimuli.append(st)
 
 
 def program_numbers(rt) -> list[int]:

@@ -200,7 +200,7 @@ class Runtime:
         self.start = plan.start         # how the run started (mode, place: interp/run.py)
         self.controller = self._controller(plan)
         for text in self._early_messages:
-            self.controller.message(text)
+            self.controller.log.message(text)
         self._early_messages = []
         self._mode_op = self.controller.mode_op
         self.autocell = None            # krl run --inputs auto (interp/runtime/autocell.py)
@@ -349,7 +349,7 @@ class Runtime:
             self.trace.write("error", self.controller.time, text=err.message, number=err.number,
                              line=line, file=file)
         if self.trace is not None:
-            self.controller.finish(reason, text=text or None,
+            self.controller.log.finish(reason, text=text or None,
                                    number=err.number if err is not None else None,
                                    file=file, line=line, context=ctx)
         self.trace = None       # the suspended tasks unwind now: nothing more is traced
@@ -719,7 +719,7 @@ class Runtime:
             n = ref.a
         else:
             raise KrlRuntimeError("PULSE needs an output ($OUT[n] or an output SIGNAL)")
-        self.controller.pulse(n, level, duration, self.io_source())
+        self.controller.signals.pulse(n, level, duration, self.io_source())
 
     def message(self, text: str) -> None:
         """A controller message (its message log and the trace); one given while the program
@@ -727,7 +727,7 @@ class Runtime:
         if self.controller is None:
             self._early_messages.append(text)
             return
-        self.controller.message(text)
+        self.controller.log.message(text)
 
     def stub_statement(self, what: str) -> None:
         """A statement of §5.20 that is recognised and not simulated (CONFIRM, ASYPTP,

@@ -71,7 +71,7 @@ class Cyclic:
                 watch.version += 1
             if memo:
                 seen[0] = watch.key()
-        self.handles[key] = self.rt.controller.add_cyclic(tick)
+        self.handles[key] = self.rt.controller.signals.add_cyclic(tick)
         watch.anin = self.analog_inputs()
 
     def _settles(self) -> bool:
@@ -92,5 +92,5 @@ class Cyclic:
         h = self.handles.pop(key, None)
         self.restless.discard(key)
         if h is not None:
-            self.rt.controller.remove_cyclic(h)
+            self.rt.controller.signals.remove_cyclic(h)
             self.rt.cyclic_watch.anin = self.analog_inputs()

@@ -288,7 +288,7 @@ class IdleWatch:
         I/O changes and of clock reads, the end point of the last planned motion and the
         robot's axes (deg)."""
         ctl = self.rt.controller
-        return (len(ctl.io.log), self.clock, ctl._plan_q.tolist(), ctl._q.tolist())
+        return (len(ctl.io.log), self.clock, ctl.queue.plan_q.tolist(), ctl._q.tolist())
 
     def outside_change(self) -> None:
         """Something outside the tasks changed the run's state (interp/runtime/core.py
@@ -389,7 +389,7 @@ class IdleWatch:
             self._robot = None
         else:
             self._robot = (ctl.cycle, (self.robot_io, robot.waiting, tuple(ctl._q.tolist()),
-                                       tuple(ctl.planned_axes().tolist())), None)
+                                       tuple(ctl.queue.planned_axes().tolist())), None)
 
     def robot_starves(self) -> None:
         """The robot program starves while the run is not idle (a submit program blinks a
@@ -407,7 +407,7 @@ class IdleWatch:
         if robot.wake_cycle is not None:
             self._robot = None          # WAIT SEC: time is what it waits for
             return
-        marks = (self.robot_io, robot.waiting, tuple(ctl._q.tolist()), tuple(ctl.planned_axes().tolist()))
+        marks = (self.robot_io, robot.waiting, tuple(ctl._q.tolist()), tuple(ctl.queue.planned_axes().tolist()))
         if self._robot is None or self._robot[1] != marks:
             self._robot = (ctl.cycle, marks, None)
             return
@@ -468,7 +468,7 @@ class IdleWatch:
         rt = self.rt
         ctl = rt.controller
         cands = []
-        nxt = ctl.next_event_cycle()
+        nxt = ctl.signals.next_event_cycle(ctl.cycle)
         if nxt is not None:
             cands.append(nxt)
         if wakes:

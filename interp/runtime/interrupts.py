@@ -94,8 +94,8 @@ class Interrupts:
         ctl = self.rt.controller
         ctx = Context("interrupt", prio=irq.number, number=irq.number)
         if task.kind == "robot":
-            ctx.pos_int = ctl.pos_act()
-            ctx.axis_int = ctl.axis_act()
+            ctx.pos_int = ctl.actual.pos_act()
+            ctx.axis_int = ctl.actual.axis_act()
         ctx.frame = irq.frame
         ctx.interrupted = task.frame
         task.contexts.append(ctx)

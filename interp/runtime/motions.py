@@ -33,7 +33,7 @@ def reach_message(ctl, req, err) -> str:
     """The message of a motion `req` the controller `ctl` refused with `err`: a workspace or
     software-limit error says so when the target itself is out of the robot's limits in
     every configuration (not only on the way there, or with the program's S/T)."""
-    if isinstance(err, (SoftLimitError, WorkspaceError)) and ctl.target_outside_limits(req):
+    if isinstance(err, (SoftLimitError, WorkspaceError)) and ctl.queue.target_outside_limits(req):
         return f"{err.message} ({TARGET_OUTSIDE_NOTE})"
     return err.message
 
@@ -117,16 +117,16 @@ class MotionStatements:
     def _enqueue(self, task: Task, req) -> int:
         ctl = self.rt.controller
         adv = self.rt.sysvars.store.get("$ADVANCE")
-        ctl.set_advance(int(adv) if isinstance(adv, int) else 3)
+        ctl.queue.set_advance(int(adv) if isinstance(adv, int) else 3)
         if not ctl.can_enqueue():
             self.rt._wait(task, ctl.can_enqueue)
             self.rt._proceed()
         try:
-            mid = ctl.enqueue(req)
+            mid = ctl.queue.enqueue(req)
         except RobotError as e:
             raise KrlRuntimeError(reach_message(ctl, req, e), e.number) from None
         self.rt._break(task)           # the main run is not idle now: advance-run stops wait
-        self.rt.stepping.history.record(req, ctl.last_planned())
+        self.rt.stepping.history.record(req, ctl.queue.last_planned())
         if self.rt.stepping.run_mode in STEP_MODES:
             # the advance run does not pass the motion: the next statement is read when it ends
             self.rt.wait_main_run(task)

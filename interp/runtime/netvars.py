@@ -125,7 +125,7 @@ class RuntimeSink:
 
     def set_out(self, n: int, v: bool) -> None:
         check(f"$OUT[{n}]", bool(v), "eki", True)
-        self.rt.controller.set_out(n, bool(v), "network")
+        self.rt.controller.io.set_out(n, bool(v), "network")
 
     def ref(self, text: str):
         """The reference a global name with indices and components denotes. Raises KeyError."""

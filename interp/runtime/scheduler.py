@@ -206,7 +206,7 @@ class Scheduler:
             if idle.since is not None or (idle.auto is not None and idle.auto.recording is not None):
                 self._calm = None
                 return 0
-            nxt = ctl.next_event_cycle()
+            nxt = ctl.signals.next_event_cycle(ctl.cycle)
         if ctl.io.version != io or rt.cyclic_watch.version != cyc or rt.steps - self.spin.skipped != executed \
                 or (nxt is not None and ctl.cycle + 1 >= nxt) \
                 or (self.max_sim_time is not None and ctl.time >= self.max_sim_time - 1e-9):
@@ -255,12 +255,12 @@ class Scheduler:
                 # whose recording used to make the cycle unsteady missed conformance 096's
                 # interrupt without this)
                 return None
-        if ctl.stimuli and any(not st.fired and st.due is None and st.reached_mm is not None
-                               for st in ctl.stimuli):
+        if ctl.signals.stimuli and any(not st.fired and st.due is None and st.reached_mm is not None
+                               for st in ctl.signals.stimuli):
             return None             # an input set on reaching a point: at any step
         if any(k[0] == "analog output" for k in rt.cyclic.handles):
             return None             # an output written at any step
-        return (ctl.io.version, rt.cyclic_watch.version, rt.steps - spin.skipped, ctl.next_event_cycle(), moving)
+        return (ctl.io.version, rt.cyclic_watch.version, rt.steps - spin.skipped, ctl.signals.next_event_cycle(ctl.cycle), moving)
 
     def _steady_cycle(self, moving: bool = True) -> None:
         """Count a steady cycle as the tasks, the spin watch and (`moving`) the idle watch would."""
@@ -378,7 +378,7 @@ class Scheduler:
             return False
         if any(not t.done for t in self.tasks[1:]):
             return False
-        if ctl.io_may_change():   # a stimulus, a PULSE, a cyclic hook or a running timer
+        if ctl.signals.may_change():   # a stimulus, a PULSE, a cyclic hook or a running timer
             return False
         robot = self.tasks[0]
         if robot.irqs.armed or robot.pending_triggers:

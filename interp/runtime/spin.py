@@ -629,12 +629,12 @@ class SpinWatch(PeriodicSpins):
         rt = self.rt
         ctl = rt.controller
         # the same cycle, no statement run since (a PULSE, an answer of the automatic cell)
-        at = (ctl.cycle, len(ctl.stimuli), rt.steps - self.skipped)
+        at = (ctl.cycle, len(ctl.signals.stimuli), rt.steps - self.skipped)
         if self._io_at[0] == at:
             return self._io_at[1]
-        nxt = ctl.next_event_cycle()
+        nxt = ctl.signals.next_event_cycle(ctl.cycle)
         may = (nxt is not None and nxt <= ctl.cycle + 1) or (ctl.is_moving() and any(
-            not st.fired and st.due is None and st.reached_mm is not None for st in ctl.stimuli))
+            not st.fired and st.due is None and st.reached_mm is not None for st in ctl.signals.stimuli))
         self._io_at = (at, may)
         return may
 

@@ -93,7 +93,7 @@ class Stepping:
         ctl = self.rt.controller
         self.rt.wait_main_run(task)
         try:
-            mid = ctl.enqueue(req)
+            mid = ctl.queue.enqueue(req)
         except RobotError as e:
             raise KrlRuntimeError(e.message, e.number) from None
         self.rt._break(task)

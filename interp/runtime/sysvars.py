@@ -370,7 +370,7 @@ class SysVars:
         mon.on_change = state
         self.workspaces = mon
         if self.rt.controller is not None:      # a program naming one as it runs; else built with it
-            self.rt.controller.watch_workspaces(mon)
+            self.rt.controller.monitor.watch_workspaces(mon)
 
     # ------------------------------------------------------------------ helpers for motion
     def value(self, name: str):
@@ -430,7 +430,7 @@ def _io(kind: str):
                 # (robot/io.py IOImage.set_out): skip the controller's call for it
                 if i.__class__ is int and 1 <= i <= 8192 and io._out[i] == (1 if v else 0):
                     return
-                sv.rt.controller.set_out(i, v, sv.rt.io_source())
+                sv.rt.controller.io.set_out(i, v, sv.rt.io_source())
             arr = LiveArray(name, 8192, T.BOOL, io.get_out, set_out)
         elif kind == "$ANIN":
             arr = LiveArray(name, 32, T.REAL, io.get_anin)
@@ -486,7 +486,7 @@ def _pos_act(sv: SysVars):
     the workpiece frame (robot/external_tcp.py)."""
     s = sv.store
     mode = s["$IPO_MODE"]
-    return pos_struct(sv.rt.controller.pos_act(frame_tuple(s["$TOOL"], "$TOOL"), frame_tuple(s["$BASE"], "$BASE"),
+    return pos_struct(sv.rt.controller.actual.pos_act(frame_tuple(s["$TOOL"], "$TOOL"), frame_tuple(s["$BASE"], "$BASE"),
                                                ipo_mode=mode.name if isinstance(mode, EnumValue) else "BASE"))
 
 
@@ -560,7 +560,7 @@ def _vel_axis_act(sv: SysVars) -> Arr:
     ctl = sv.rt.controller
     m = ctl.machine
     top = m.all_max_speed
-    vel = ctl.axis_vel_act()
+    vel = ctl.actual.axis_vel_act()
     data = [0.0] * len(E6AXIS_KEYS)
     amap = ctl.model.axes
     # KRL order: A1..A6, E1..; each model axis at its component (robot/axismap.py)
@@ -607,7 +607,7 @@ def _in_home(n: int):
             home, tol = s["$H_POS"], s["$H_POS_TOL"]
         else:
             home, tol = s["$AXIS_HOME"].data[n - 1], s["$H_AXIS_TOL"].data[n - 1]
-        q = sv.rt.controller.axis_act()
+        q = sv.rt.controller.actual.axis_act()
         try:
             return all(abs(float(q[i]) - float(home.f[k])) <= float(tol.f[k])
                        for i, k in enumerate(E6AXIS_KEYS[:len(q)]))
@@ -621,16 +621,16 @@ _LIVE = {
     "$TIMER": _io("$TIMER"), "$TIMER_STOP": _io("$TIMER_STOP"), "$TIMER_FLAG": _io("$TIMER_FLAG"),
     "$POS_ACT": _computed(lambda sv: _pos_act(sv)),
     "$POS_ACT_MES": _computed(lambda sv: _pos_act(sv)),
-    "$AXIS_ACT": _computed(lambda sv: axis_struct(sv.rt.controller.axis_act())),
-    "$AXIS_ACT_MEAS": _computed(lambda sv: axis_struct(sv.rt.controller.axis_act())),
+    "$AXIS_ACT": _computed(lambda sv: axis_struct(sv.rt.controller.actual.axis_act())),
+    "$AXIS_ACT_MEAS": _computed(lambda sv: axis_struct(sv.rt.controller.actual.axis_act())),
     "$POS_INT": _computed(_pos_int),
     "$AXIS_INT": _computed(_axis_int),
-    "$VEL_ACT": _computed(lambda sv: float(sv.rt.controller.vel_act())),
+    "$VEL_ACT": _computed(lambda sv: float(sv.rt.controller.actual.vel_act())),
     "$VEL_AXIS_ACT": _computed(lambda sv: _vel_axis_act(sv)),
     # the motions the advance run has planned that the main run has not begun (KUKA System
     # Variables: "$ACT_ADVANCE: number of motion blocks currently planned in the advance run",
     # 0..$ADVANCE); shenrq20's kuka_eki_hw_interface streams it to its partner (issue 59)
-    "$ACT_ADVANCE": _computed(lambda sv: int(sv.rt.controller.queue_length())),
+    "$ACT_ADVANCE": _computed(lambda sv: len(sv.rt.controller.queue)),
     "$TORQUE_AXIS_ACT": _computed(lambda sv: _torque_axis_act(sv)),
     "$DATE": _computed(_clock(_date)),
     "$PRO_STATE": _computed(_pro_state_self),

@@ -52,4 +52,4 @@ def test_the_controller_reads_no_cell_file(tmp_path):
     assert cell.stimuli[0].reached_default
     ctl = Controller(mujoco=False, stimuli=cell)
     # `reached: true` is the robot's own in-position distance, set by the controller of the run
-    assert ctl.stimuli[0].reached_mm == ctl.machine.in_pos_car_mm
+    assert ctl.signals.stimuli[0].reached_mm == ctl.machine.in_pos_car_mm

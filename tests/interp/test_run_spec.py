@@ -3,8 +3,9 @@
 from the end of their construction to the start of the run nothing outside their classes sets
 one of their attributes (a method of theirs may change what it holds).
 
-The guard wraps ``Runtime``, its parts (:data:`PARTS`: interp/runtime/calls.py, names.py, ...) and
-``Controller`` for the test: their constructors note each
+The guard wraps ``Runtime``, its parts (:data:`PARTS`: interp/runtime/calls.py, names.py, ...),
+``Controller`` and the controller's components (:data:`COMPONENTS`: robot/motionqueue.py,
+signals.py, readback.py, monitor.py, events.py) for the test: their constructors note each
 object built (and the Runtime its spec), ``Runtime.run`` notes the run's start, and an attribute
 set on a built object that is not yet running is a violation unless the code setting it is one of
 the class's own (a method, or a function defined in one)."""
@@ -32,6 +33,11 @@ from interp.spec import RUN_SIM_TIME_S, RunSpec, SpecError
 from interp.summary import RunObserver
 from robot.collision import CellGeometry
 from robot.controller import Controller
+from robot.events import EventLog
+from robot.monitor import Monitor
+from robot.motionqueue import MotionQueue
+from robot.readback import ReadBack
+from robot.signals import Signals
 from robot.trace import TraceWriter
 
 from .helpers import write
@@ -58,6 +64,8 @@ start: "{A1 5, A2 -90, A3 90, A4 0, A5 30, A6 0}"
 #: the runtime's parts (interp/runtime/core.py ``Runtime.__init__``): its attribute -> class
 PARTS = {"calls": Calls, "names": Names, "errstate": ErrorState, "cyclic": Cyclic, "motions": MotionStatements,
          "interrupts": Interrupts, "stepping": Stepping}
+#: the controller's components (robot/controller.py ``Controller.__init__``): its attribute -> class
+COMPONENTS = {"queue": MotionQueue, "signals": Signals, "actual": ReadBack, "monitor": Monitor, "log": EventLog}
 
 
 class _Guard:
@@ -69,14 +77,16 @@ class _Guard:
         self.running: set = set()
         self.specs: list = []
         self.violations: list[str] = []
-        for cls in (Runtime, Controller, *PARTS.values()):
+        for cls in (Runtime, Controller, *PARTS.values(), *COMPONENTS.values()):
             self._wrap(monkeypatch, cls)
         run = Runtime.run
 
         def run_(rt):
+            ctl = rt.controller
             self.running.add(id(rt))
-            self.running.add(id(rt.controller))
+            self.running.add(id(ctl))
             self.running.update(id(getattr(rt, name)) for name in PARTS)
+            self.running.update(id(getattr(ctl, name)) for name in COMPONENTS)
             return run(rt)
         monkeypatch.setattr(Runtime, "run", run_)
 
@@ -110,18 +120,29 @@ def guard(monkeypatch):
 
 def test_the_guard_sees_a_set_from_outside(tmp_path, guard):
     """The test can fail: a runtime attribute, a controller attribute and an attribute of each of
-    the runtime's parts set here are caught; a part's own method setting its attribute is not."""
+    the runtime's parts and of the controller's components set here are caught; a part's own
+    method setting its attribute is not."""
     rt, _ = make_runtime(run_spec(write(tmp_path, "prog.src", PROG), mujoco=False, max_sim_time=1.0))
     rt.halt_continues = 3
-    rt.controller.advance = 1
+    ctl = rt.controller
+    ctl.time = 1.0
     for name, cls in PARTS.items():
         part = getattr(rt, name)
         assert type(part) is cls and part.rt is rt
         part.rt = rt
     rt.stepping.set_hooks(stmt=lambda task, info: None)
+    for name, cls in COMPONENTS.items():
+        assert type(getattr(ctl, name)) is cls
+    ctl.queue.advance = 1
+    ctl.signals.pulses = []
+    ctl.actual.tool_T = ctl.actual.tool_T
+    ctl.monitor.workspaces = None
+    ctl.log.trace = None
+    ctl.queue.set_advance(2)                    # a component's own method
     assert [v.split(" set by ")[0] for v in guard.violations] == \
-        ["Runtime.halt_continues", "Controller.advance"] + [f"{cls.__name__}.rt" for cls in PARTS.values()]
-    assert rt.stepping.stmt_hook is not None
+        ["Runtime.halt_continues", "Controller.time"] + [f"{cls.__name__}.rt" for cls in PARTS.values()] + \
+        ["MotionQueue.advance", "Signals.pulses", "ReadBack.tool_T", "Monitor.workspaces", "EventLog.trace"]
+    assert rt.stepping.stmt_hook is not None and ctl.queue.advance == 2
 
 
 def test_make_runtime_builds_complete_objects(tmp_path, guard):
@@ -184,10 +205,10 @@ def test_the_spec_carries_the_collision_geometry(tmp_path, guard):
     either no collision check is built."""
     p = write(tmp_path, "prog.src", PROG)
     rt, _ = make_runtime(run_spec(p, mujoco=False, max_sim_time=1.0))
-    assert rt.controller.collision is None
+    assert rt.controller.monitor.collision is None
     rt, _ = make_runtime(run_spec(p, mujoco=False, max_sim_time=1.0, geometry=CellGeometry(floor=None)))
-    assert rt.controller.collision is not None
+    assert rt.controller.monitor.collision is not None
     cell = write(tmp_path, "cell.yaml", "floor: 0\n")
     rt, _ = make_runtime(run_spec(p, mujoco=False, max_sim_time=1.0, inputs=cell))
-    assert rt.controller.collision is not None
+    assert rt.controller.monitor.collision is not None
     assert guard.violations == []

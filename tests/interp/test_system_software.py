@@ -287,7 +287,7 @@ def test_external_tcp_pose_and_linear_motion(tmp_path):
         assert _pose(run.var("prog", "r"))[3:] == pytest.approx([90.0, 0.0, 180.0], abs=1e-4)
         # FLANGE = $BASE : INV_POS(P2) : INV_POS($TOOL): (500,0,0) + Rz(90)(0, 55, 535) = (445, 0, 535),
         # then 225 mm up along -z of diag(-1, 1, -1): the flange at (445, 0, 760), 50 mm lower
-        q = run.rt.controller.axis_act()
+        q = run.rt.controller.actual.axis_act()
         F = run.rt.controller.model.tcp(q, np.eye(4), np.eye(4))
         assert F[:3, 3] == pytest.approx([445.0, 0.0, 760.0], abs=1e-4)
         assert F[:3, :3] == pytest.approx(np.diag([-1.0, 1.0, -1.0]), abs=1e-6)

@@ -67,7 +67,7 @@ def test_the_machina_driver_runs_the_actions_of_a_partner_written_from_its_xml(s
         answers = [document(b"/>") for _ in range(4)]
         # the driver answers a motion when its advance run has passed it: the test ends once the
         # robot stands (the driver then waits for the next DT, WAIT FOR $FLAG[2])
-        while rt.controller.is_moving() or rt.controller.queue_length():
+        while rt.controller.is_moving() or rt.len(controller.queue):
             if time.monotonic() > deadline:
                 raise TimeoutError("the robot did not come to rest")
             time.sleep(0.05)
@@ -84,5 +84,5 @@ def test_the_machina_driver_runs_the_actions_of_a_partner_written_from_its_xml(s
     io = [(e["signal"], e["value"]) for e in trace.events if e["kind"] == "io"]
     assert ("$OUT[5]", True) in io                          # the TRIGGER of action 2, on action 3's motion
     # the first axis move is approximated (C_PTP) into the second, where the robot comes to rest
-    assert list(box["rt"].controller.axis_act()[:6]) == pytest.approx(LAST, abs=1e-3)
+    assert list(box["rt"].controller.actual.axis_act()[:6]) == pytest.approx(LAST, abs=1e-3)
     assert res.reason == "max_sim_time"

@@ -167,7 +167,7 @@ def test_a_ptp_moves_the_track_synchronised_with_the_arm(track):
     end = dict(zip(AX, (40.0, -70.0, 80.0, 10.0, 60.0, 30.0)), E1=2500.0)
     ctl, tw, Q, _ = _run(track, [MotionRequest("PTP", start, P), MotionRequest("PTP", end, P)])
     assert Q.shape[1] == 7
-    assert ctl.axis_act()[6] == pytest.approx(2500.0, abs=1e-6)
+    assert ctl.actual.axis_act()[6] == pytest.approx(2500.0, abs=1e-6)
     # synchronised: every axis covers the same fraction of its way in every cycle
     moving = Q[(Q[:, 6] > 1000.0 + 1e-6) & (Q[:, 6] < 2500.0 - 1e-6)]
     frac_e = (moving[:, 6] - 1000.0) / 1500.0
@@ -193,7 +193,7 @@ def test_a_lin_on_the_track_keeps_the_tcp_on_its_line_in_the_world(track):
     off = (p - [x0, y0, z0]) - frac[:, None] * d
     assert np.abs(off).max() < 0.01                              # straight in $WORLD (= $BASE)
     np.testing.assert_allclose((Q[on, 6] - 1000.0) / 800.0, frac, atol=1e-4)   # E1 linear in the path
-    assert ctl.axis_act()[6] == pytest.approx(1800.0, abs=1e-6)
+    assert ctl.actual.axis_act()[6] == pytest.approx(1800.0, abs=1e-6)
     rep = check_trace(tw.events, track)
     assert rep.ok, rep.summary()
 
@@ -207,7 +207,7 @@ def test_a_base_on_the_turntable_turns_with_it(table):
     p2 = {"X": -250.0, "Y": 150.0, "Z": 250.0, "A": 0.0, "B": 180.0, "C": 0.0, "E1": 40.0}
     ctl, tw, Q, tcp = _run(table, [MotionRequest("PTP", home, P.with_(base_kin=None)),
                                     MotionRequest("PTP", p1, P), MotionRequest("LIN", p2, P)])
-    assert ctl.axis_act()[6] == pytest.approx(40.0, abs=1e-6)
+    assert ctl.actual.axis_act()[6] == pytest.approx(40.0, abs=1e-6)
     on = Q[:, 6] > 1e-6
     assert on.sum() > 20
     a, b = np.array([-350.0, -100.0, 200.0]), np.array([-250.0, 150.0, 250.0])
@@ -224,4 +224,4 @@ def test_an_external_axis_outside_its_limits_is_refused(track):
     ctl = Controller(track, mujoco=False)
     P = MotionParams.initmov(track)
     with pytest.raises(SoftLimitError, match=r"software limit switch \+E1"):
-        ctl.enqueue(MotionRequest("PTP", dict(zip(AX, (0.0, -90.0, 90.0, 0.0, 45.0, 0.0)), E1=5000.0), P))
+        ctl.queue.enqueue(MotionRequest("PTP", dict(zip(AX, (0.0, -90.0, 90.0, 0.0, 45.0, 0.0)), E1=5000.0), P))

@@ -22,6 +22,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from pathlib import Path
 
+from robot.bench import step_until
 from robot.controller import Controller
 from robot.errors import RobotError
 from robot.frames import matrix_to_frame
@@ -200,13 +201,13 @@ def _keeps_the_limits(robot, steps, mode):
         while not ctl.can_enqueue():
             ctl.step()
         try:
-            ctl.enqueue(req)
+            ctl.queue.enqueue(req)
             planned += 1
         except RobotError:
             continue  # the advance run would stop at this motion
         if ctl.time > 120.0:
             break
-    ctl.step_until(ctl.is_idle, max_cycles=200_000)
+    step_until(ctl, ctl.is_idle, max_cycles=200_000)
     rep = check_trace(tw.events, robot)
     assert rep.ok, f"{rep.summary()}\n" + "\n".join(str(v) for v in rep.violations[:10])
 
@@ -229,10 +230,10 @@ def test_a_fixed_sequence_moves_every_library_robot(library_robot):
     for req in reqs:
         while not ctl.can_enqueue():
             ctl.step()
-        ctl.enqueue(req)                   # every motion plans
-    ctl.step_until(ctl.is_idle, max_cycles=200_000)
+        ctl.queue.enqueue(req)                   # every motion plans
+    step_until(ctl, ctl.is_idle, max_cycles=200_000)
     assert ctl.last_error is None
-    assert np.abs(ctl.axis_act()[:3] - np.array(q1[:3])).max() < 1e-6 or library_robot.a5link
+    assert np.abs(ctl.actual.axis_act()[:3] - np.array(q1[:3])).max() < 1e-6 or library_robot.a5link
     rep = check_trace(tw.events, library_robot)
     assert rep.ok, rep.summary()
 
@@ -261,8 +262,8 @@ def test_a_blend_from_an_orientation_the_palletizer_cannot_take(approx):
     for req in reqs:
         while not ctl.can_enqueue():
             ctl.step()
-        ctl.enqueue(req)                   # every motion plans
-    ctl.step_until(ctl.is_idle, max_cycles=200_000)
+        ctl.queue.enqueue(req)                   # every motion plans
+    step_until(ctl, ctl.is_idle, max_cycles=200_000)
     phases = [(ev["id"], ev["phase"]) for ev in tw.events if ev.get("kind") == "motion"]
     assert (3, "blend_start") in phases    # the CIRC #CONSTANT is approximated
     assert ctl.last_error is None

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from robot.bench import run_motions
+from robot.bench import run_motions, step_until
 from robot.controller import MSG_APPROX_IMPOSSIBLE, Controller
 from robot.errors import RobotError
 from robot.frames import frame_to_matrix, rotation_angle_deg
@@ -23,7 +23,7 @@ def _run(reqs, wait_between=False, advance=None, **kw):
     tw = TraceWriter(keep=True)
     ctl = Controller(trace=tw, mujoco=False, **kw)
     if advance is not None:
-        ctl.set_advance(advance)
+        ctl.queue.set_advance(advance)
     run_motions(ctl, reqs, wait_between=wait_between)
     return ctl, tw.events
 
@@ -181,7 +181,7 @@ def test_lin_to_ptp_mixed_blend_runs():
     for mid in (2, 3):
         assert {"start", "blend_start", "blend_end", "end"} <= set(_phases(ev, mid))
     assert not [e for e in ev if e["kind"] in ("message", "error")]
-    assert ctl.pos_act()["X"] == pytest.approx(400, abs=1e-6)
+    assert ctl.actual.pos_act()["X"] == pytest.approx(400, abs=1e-6)
 
 
 def test_c_ori_blend_starts_at_remaining_orientation():
@@ -259,10 +259,10 @@ def test_ptp_c_ptp_into_lin_keeps_the_axis_acceleration_at_the_blend_end():
         while not ctl.can_enqueue():
             ctl.step()
         try:
-            ctl.enqueue(req)
+            ctl.queue.enqueue(req)
         except RobotError:
             continue        # one LIN target is outside A5's limits: the advance run would stop there
-    ctl.step_until(ctl.is_idle, max_cycles=100_000)
+    step_until(ctl, ctl.is_idle, max_cycles=100_000)
     rep = check_trace(tw.events, ctl.machine)
     assert rep.ok, rep.summary()
     assert sum(1 for e in tw.events if e["kind"] == "motion" and e["phase"] == "blend_start") >= 1

@@ -98,12 +98,12 @@ def test_lin_partial_and_relative():
     ctl, ev = _run([MotionRequest("PTP", TOOL_DOWN, P),
                     MotionRequest("LIN", {"Z": 700}, P),
                     MotionRequest("LIN_REL", {"X": 20, "Y": -10}, P)])
-    pos = ctl.pos_act()
+    pos = ctl.actual.pos_act()
     assert (pos["X"], pos["Y"], pos["Z"]) == pytest.approx((465, -10, 700), abs=1e-6)
     # LIN_REL #TOOL: tool-down flange has +Z pointing down, so Z+50 in the tool frame lowers
     ctl2, _ = _run([MotionRequest("PTP", TOOL_DOWN, P),
                     MotionRequest("LIN_REL", {"Z": 50}, P, rel_frame="#TOOL")])
-    assert ctl2.pos_act()["Z"] == pytest.approx(760, abs=1e-6)
+    assert ctl2.actual.pos_act()["Z"] == pytest.approx(760, abs=1e-6)
 
 
 def test_lin_with_tool_and_base():
@@ -113,11 +113,11 @@ def test_lin_with_tool_and_base():
     P = MotionParams().with_(tool=tool, base=base)
     ctl, ev = _run([MotionRequest("PTP", TOOL_DOWN, P),
                     MotionRequest("LIN", {"X": 10, "Y": 20, "Z": 500}, P)])
-    pos = ctl.pos_act()
+    pos = ctl.actual.pos_act()
     assert (pos["X"], pos["Y"], pos["Z"]) == pytest.approx((10, 20, 500), abs=1e-6)
     # cross-check through the world: TCP_world = BASE : POS
     T_world = frame_to_matrix(*base) @ frame_to_matrix(pos["X"], pos["Y"], pos["Z"], pos["A"], pos["B"], pos["C"])
-    flange = ctl.model.kin.forward(ctl.axis_act()) @ frame_to_matrix(*tool)
+    flange = ctl.model.kin.forward(ctl.actual.axis_act()) @ frame_to_matrix(*tool)
     assert np.allclose(T_world, flange, atol=1e-6)
 
 
@@ -144,15 +144,15 @@ def test_circ_ca_sets_the_angle():
                    MotionRequest("LIN", {"X": 500, "Y": 100, "Z": 600}, P),
                    MotionRequest("CIRC", {"X": 500, "Y": -100, "Z": 600}, P,
                                  aux={"X": 600, "Y": 0, "Z": 600}, ca=270.0)])
-    pos = ctl.pos_act()
+    pos = ctl.actual.pos_act()
     assert (pos["X"], pos["Y"]) == pytest.approx((400.0, 0.0), abs=1e-6)
 
 
 def test_lin_workspace_error_at_planning():
     ctl = Controller(mujoco=False)
-    ctl.enqueue(MotionRequest("PTP", TOOL_DOWN, MotionParams()))
+    ctl.queue.enqueue(MotionRequest("PTP", TOOL_DOWN, MotionParams()))
     with pytest.raises(WorkspaceError):
-        ctl.enqueue(MotionRequest("LIN", {"X": 2000}, MotionParams()))
+        ctl.queue.enqueue(MotionRequest("LIN", {"X": 2000}, MotionParams()))
 
 
 def test_spline_block_passes_through_spl_points():
@@ -186,9 +186,9 @@ def test_rotation_helper_consistency():
     """The orientation interpolation of a LIN equals scipy's Slerp at mid-path."""
     P = MotionParams().with_(vel_cp=0.5)
     ctl = Controller(mujoco=False)
-    ctl.enqueue(MotionRequest("PTP", TOOL_DOWN, P))
-    ctl.enqueue(MotionRequest("LIN", {"X": 500, "A": 120, "B": 20, "C": 160}, P))
-    seg = ctl._pending[1]
+    ctl.queue.enqueue(MotionRequest("PTP", TOOL_DOWN, P))
+    ctl.queue.enqueue(MotionRequest("LIN", {"X": 500, "A": 120, "B": 20, "C": 160}, P))
+    seg = ctl.queue.pending[1]
     R0 = Rotation.from_matrix(frame_to_matrix(0, 0, 0, 180, 0, 180)[:3, :3])
     R1 = Rotation.from_matrix(frame_to_matrix(0, 0, 0, 120, 20, 160)[:3, :3])
     mid = Slerp([0, 1], Rotation.concatenate([R0, R1]))([0.5])[0].as_matrix()
@@ -226,7 +226,7 @@ def test_lin_through_wrist_singularity_is_an_error():
                                             "A6": 0}, P)])
     f = matrix_to_frame(ctl.model.kin.forward([0, -90, 90, 30, -20, 0]))
     with pytest.raises(RobotError, match="singularity"):
-        ctl.enqueue(MotionRequest("LIN", dict(zip("XYZABC", f)), P))
+        ctl.queue.enqueue(MotionRequest("LIN", dict(zip("XYZABC", f)), P))
 
 
 def test_circ_type_path_turns_the_tool_with_the_tangent():
@@ -267,7 +267,7 @@ def test_lin_ori_joint_goes_to_the_targets_status_with_linear_wrist_axes():
     target = dict(zip("XYZABC", f1), S=s1, T=t1)
     ctl, ev = _run([MotionRequest("PTP", {f"A{i + 1}": float(v) for i, v in enumerate(q0)}, P),
                     MotionRequest("LIN", target, P)], mujoco=False)
-    assert ctl.axis_act()[:6] == pytest.approx(q1, abs=1e-6)
+    assert ctl.actual.axis_act()[:6] == pytest.approx(q1, abs=1e-6)
     ph = _phases(ev, 2)
     start, end = np.array(matrix_to_frame(k.forward(q0))[:3]), np.array(f1[:3])
     for e in _poses(ev, ph["start"], ph["end"]):

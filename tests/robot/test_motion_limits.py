@@ -9,7 +9,7 @@ import math
 import numpy as np
 import pytest
 
-from robot.bench import run_motions
+from robot.bench import run_motions, wait_idle
 from robot.controller import Controller
 from robot.frames import matrix_to_frame
 from robot.limits import check_trace
@@ -90,9 +90,9 @@ def ctl_seg(segs):
     """The planned SPLINE segment of the corner test (start: the LIN's end point)."""
     ctl = Controller(mujoco=False)
     P = MotionParams().with_(vel_cp=1.0)
-    ctl.enqueue(MotionRequest("PTP", HOME, P))
-    ctl.enqueue(MotionRequest("LIN", _xyz(450, -150, 700), P))
-    return plan(MotionRequest("SPLINE", {}, P, segments=segs), ctl.planned_axes(), ctl.model)
+    ctl.queue.enqueue(MotionRequest("PTP", HOME, P))
+    ctl.queue.enqueue(MotionRequest("LIN", _xyz(450, -150, 700), P))
+    return plan(MotionRequest("SPLINE", {}, P, segments=segs), ctl.queue.planned_axes(), ctl.model)
 
 
 def test_t1_limits_tcp_to_250_and_ptp_to_red_t1():
@@ -145,14 +145,14 @@ def test_resume_logs_an_abort_end_for_the_abandoned_motion():
     ctl = Controller(trace=tw, mujoco=False)
     P = MotionParams().with_(vel_cp=0.2)
     run_motions(ctl, [MotionRequest("PTP", HOME, P)])
-    ctl.enqueue(MotionRequest("LIN", _xyz(450, -200, 600), P))
+    ctl.queue.enqueue(MotionRequest("LIN", _xyz(450, -200, 600), P))
     for _ in range(20):
         ctl.step()
     ctl.brake()
     while ctl.is_braking():
         ctl.step()
     ctl.cancel_pending()  # RESUME
-    ctl.wait_idle()
+    wait_idle(ctl)
     ends = [e for e in tw.events if e["kind"] == "motion" and e["id"] == 2 and e["phase"] == "end"]
     assert len(ends) == 1 and ends[0]["reason"] == "abort"
     rep = check_trace(tw.events, ctl.machine)

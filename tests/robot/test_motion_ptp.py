@@ -130,7 +130,7 @@ def test_ptp_partial_and_relative_targets():
     P = MotionParams()
     ctl, ev = _run([MotionRequest("PTP", HOME, P), MotionRequest("PTP", {"A1": 20}, P),
                     MotionRequest("PTP_REL", {"A3": -10, "A1": 5}, P)])
-    q = ctl.axis_act()
+    q = ctl.actual.axis_act()
     assert list(q) == pytest.approx([25, -90, 80, 0, 0, 0], abs=1e-9)
 
 
@@ -139,24 +139,24 @@ def test_ptp_cartesian_target_reaches_pose():
     tool_down = dict(HOME, A5=90)
     ctl, _ = _run([MotionRequest("PTP", tool_down, P),
                    MotionRequest("PTP", {"X": 500, "Y": 100, "Z": 600}, P)])
-    pos = ctl.pos_act()
+    pos = ctl.actual.pos_act()
     assert (pos["X"], pos["Y"], pos["Z"]) == pytest.approx((500, 100, 600), abs=1e-6)
     assert pos["S"] == 2
 
 
 def test_ptp_soft_limit_error_at_planning():
     ctl = Controller(mujoco=False)
-    ctl.enqueue(MotionRequest("PTP", HOME, MotionParams()))
+    ctl.queue.enqueue(MotionRequest("PTP", HOME, MotionParams()))
     with pytest.raises(SoftLimitError) as ei:
-        ctl.enqueue(MotionRequest("PTP", {"A1": 175}, MotionParams()))
+        ctl.queue.enqueue(MotionRequest("PTP", {"A1": 175}, MotionParams()))
     assert ei.value.message == "software limit switch +A1"
-    assert ctl.queue_length() == 1  # nothing queued for the failing statement
+    assert len(ctl.queue) == 1  # nothing queued for the failing statement
 
 
 def test_first_motion_must_be_complete():
     ctl = Controller(mujoco=False)
     with pytest.raises(RobotError):
-        ctl.enqueue(MotionRequest("PTP", {"A1": 10}, MotionParams()))
+        ctl.queue.enqueue(MotionRequest("PTP", {"A1": 10}, MotionParams()))
 
 
 def test_motion_params_from_sysvars():
@@ -181,4 +181,4 @@ def test_ptp_status_and_turn_select_the_configuration():
     run_motions(ctl, [MotionRequest("PTP", dict(HOME, A5=30), MotionParams()),
                       MotionRequest("PTP", {"X": x, "Y": y, "Z": z, "A": a, "B": b, "C": c,
                                             "S": s, "T": t}, MotionParams())])
-    assert list(ctl.axis_act()) == pytest.approx(goal, abs=1e-6)
+    assert list(ctl.actual.axis_act()) == pytest.approx(goal, abs=1e-6)

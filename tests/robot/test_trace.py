@@ -46,8 +46,8 @@ def _program_trace(path=None):
     reqs[1].triggers = (Trigger(distance=0, delay_ms=20),)
     for ev in run_motions(ctl, reqs):
         if ev.kind == "trigger":
-            ctl.set_out(5, True, "trigger")
-    ctl.finish()
+            ctl.io.set_out(5, True, "trigger")
+    ctl.log.finish()
     tw.close()
     return tw
 
@@ -84,7 +84,7 @@ def test_interpreter_events_through_same_writer():
     tw = TraceWriter(keep=True)
     ctl = Controller(trace=tw, mujoco=False)
     tw.write("stmt", ctl.time, file="a.src", line=3)
-    ctl.enqueue(MotionRequest("PTP", {"A1": 0, "A2": -90, "A3": 90, "A4": 0, "A5": 0, "A6": 0},
+    ctl.queue.enqueue(MotionRequest("PTP", {"A1": 0, "A2": -90, "A3": 90, "A4": 0, "A5": 0, "A6": 0},
                               MotionParams(), line=3, file="a.src"))
     for _ in range(4):
         ctl.step()

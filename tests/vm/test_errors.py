@@ -7,12 +7,13 @@ from __future__ import annotations
 
 import json
 import re
+import weakref
 
 import pytest
 
 from interp.cli import run
-from robot.controller import Controller
 from robot.errors import RobotError
+from robot.monitor import Monitor
 from click.testing import CliRunner
 
 from .test_statements import both
@@ -137,14 +138,16 @@ def test_a_main_run_fault_is_one_error_event(tmp_path, monkeypatch):
     """A fault of the main run (here forced in the controller's speed check while the LIN of
     line 4 moves) is written once, by the controller, with the motion's id and line; the
     program then stops with that error and the interpreter does not write it a second time."""
-    real = Controller._check_speed
+    real = Monitor.check_speed
+    cycles: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
-    def check(self, q):
-        if self.time > 0.5:
+    def check(self, q, q_prev):
+        k = cycles[self] = cycles.get(self, 0) + 1             # the IPO cycle of this run
+        if k > 42:                                              # 0.504 s
             raise RobotError("forced main-run fault")
-        return real(self, q)
+        return real(self, q, q_prev)
 
-    monkeypatch.setattr(Controller, "_check_speed", check)
+    monkeypatch.setattr(Monitor, "check_speed", check)
     body = ("PTP {A1 0, A2 -90, A3 90, A4 0, A5 45, A6 0}\n"
             "LIN_REL {Z -100}\n"
             "LIN_REL {Y 100}\n"

@@ -54,7 +54,7 @@ def _model_axes(ctl, ax, ext_from=None):
             v = src.f.get(k, UNSET) if isinstance(src, Struct) else UNSET
             if v is not UNSET:
                 comps[k] = float(num(v))
-    return amap.from_components(comps, fill=ctl.model.from_krl(ctl.axis_act()))
+    return amap.from_components(comps, fill=ctl.model.from_krl(ctl.actual.axis_act()))
 
 
 @GEOMETRY.native("FRAME EK(FRAME ROOT :IN, ESYS MECH_TYPE :IN, FRAME OFFSET :IN)")
@@ -76,7 +76,7 @@ def _ek(rt, a):
     ext = ctl.model.ext
     if ext is None or system not in ext.base_kins:
         raise KrlRuntimeError(f"EK: no external kinematic {system} in $EX_KIN")
-    e = ctl.model.axes.ext_part(ctl.model.from_krl(np.asarray(ctl.axis_act(), dtype=float)))
+    e = ctl.model.axes.ext_part(ctl.model.from_krl(np.asarray(ctl.actual.axis_act(), dtype=float)))
     T = ext.chain(ext.base_kins[system], e, root) @ frame_to_matrix(*offset)
     value = tuple(float(v) for v in matrix_to_frame(T))
     rt.sysvars.ek = (system, root, offset, value)
@@ -103,7 +103,7 @@ def _inverse(rt, a):
     pos = a[0].get()
     start = a[1].get() if len(a) > 1 and a[1] is not None else None
     ctl = rt.controller
-    ref = _model_axes(ctl, start if start is not None else axis_struct(ctl.axis_act()), ext_from=pos)
+    ref = _model_axes(ctl, start if start is not None else axis_struct(ctl.actual.axis_act()), ext_from=pos)
     store = rt.sysvars.store
     tool = frame_to_matrix(*frame_tuple(store["$TOOL"]))
     base = frame_to_matrix(*frame_tuple(store["$BASE"]))

@@ -53,7 +53,7 @@ def _krlmsg(a_msg, a_par) -> tuple[str, str, int, list[str]]:
 def _set_krlmsg(rt, a):
     kind = str(getattr(a[0].peek(), "name", a[0].peek()) if a and a[0] is not None else "NOTIFY").lstrip("#").upper()
     text, module, number, params = _krlmsg(a[1] if len(a) > 1 else None, a[2] if len(a) > 2 else None)
-    rt.controller.message(f"KRL message: {text}")
+    rt.controller.log.message(f"KRL message: {text}")
     m = rt.messages.add(kind, format_text(text, params), module, number, time=rt.controller.time)
     rt.msg_handle = m.handle
     return m.handle
@@ -91,9 +91,9 @@ def _set_krldlg(rt, a):
     while keys and not keys[-1].strip():
         keys.pop()
     if rt.messages.interactive:
-        rt.controller.message(f"KRL dialog: {text}")
+        rt.controller.log.message(f"KRL dialog: {text}")
     else:
-        rt.controller.message("KRL dialog (answered with the first softkey)")
+        rt.controller.log.message("KRL dialog (answered with the first softkey)")
     m = rt.messages.add("DIALOG", format_text(text, params), module, number, keys or ["OK"], rt.controller.time)
     rt.msg_handle = m.handle
     return m.handle

@@ -1,0 +1,227 @@
+"""The robot as the simulated controller reads it back each IPO cycle: ``$AXIS_ACT``,
+``$POS_ACT``, ``$VEL_ACT`` (reference §7.1; robot/controller.py's ``Controller.actual``).
+
+:class:`ReadBack` holds the MuJoCo arm (robot/mjcf.py ``ArmModel``, compiled at its first use:
+a debugger's launch does not wait for MuJoCo, issue 37; None without MuJoCo, then the read-back
+is the forward kinematics of the setpoint), the frames of the motion the main run executes
+(``tool_T``, ``base_T``, ``base_inv_T``: 4x4, mm; ``$TOOL_C``, ``$BASE_C``) and the TCP read back
+this cycle and the cycle before (4x4 in ``$BASE``, made when first asked for where MuJoCo is not
+used). Axis vectors are in the model's order (A1..An deg, then E1..En deg or mm); what callers
+get is in KRL's order (robot/planner.py ``RobotModel.to_krl``).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from .frames import frame_to_matrix, inv_pos, matrix_to_frame
+from .planner import RobotModel
+
+_F8 = np.dtype(np.float64)
+
+
+class ReadBack:
+    """The robot read back (module docstring).
+
+    Args:
+        model: the robot model.
+        q: the axes it stands at (model order).
+        actuated: MuJoCo driven by position/velocity actuators instead of qpos replay.
+        mujoco: False: no MuJoCo arm (the read-back is the setpoint's forward kinematics).
+        simcore: robot/simcore.pyx's module or None (one compiled call per cycle).
+        dt: the IPO cycle (s).
+    """
+
+    def __init__(self, model: RobotModel, q: np.ndarray, *, actuated: bool, mujoco: bool, simcore: Any,
+                 dt: float) -> None:
+        self.model = model
+        self.dt = dt
+        self.actuated = actuated
+        self._simcore = simcore
+        self._arm = None
+        # the axes the arm is reset to when it is compiled (its first use); None: built, or no MuJoCo
+        self._arm_q: np.ndarray | None = q.copy() if mujoco else None
+        self._q = q                      # the setpoint of the last cycle (without MuJoCo: the axes)
+        self._q_prev = q                 # the setpoint of the cycle before
+        self.tool_T = np.eye(4)
+        self.base_T = np.eye(4)
+        self.base_inv_T = np.eye(4)
+        #: the last forward kinematics of tcp_of: (q, tool, INV_POS(base) as bytes), TCP
+        self._tcp_last: tuple | None = None
+        self.tcp = self.model.tcp(q, self.tool_T, self.base_inv_T)
+        self.tcp_prev = self.tcp[:3, 3].copy()
+
+    def arm(self):
+        """The MuJoCo arm, compiled now (its first use) and reset to the axes it would have
+        been reset to when built at once (the start axes, or :meth:`place`'s): the same state."""
+        if self._arm_q is not None:
+            # deferred: tools/startup_bench.py, krl run +93 ms at the top (2026-11-26)
+            from .mjcf import ArmModel  # noqa: PLC0415
+
+            arm = ArmModel(self.model.machine, actuated=self.actuated)
+            arm.reset(self._arm_q)
+            self._arm, self._arm_q = arm, None
+        return self._arm
+
+    def place(self, q: np.ndarray) -> None:
+        """The robot stands at `q` (model order) before the first cycle."""
+        self._q = self._q_prev = q.copy()
+        if self._arm_q is not None:
+            self._arm_q = q.copy()
+        elif self._arm is not None:
+            self._arm.reset(q)
+        self.tcp = self.model.tcp(q, self.tool_T, self.base_inv_T)
+        self.tcp_prev = self.tcp[:3, 3].copy()
+
+    def set_frames(self, tool_T: np.ndarray, base_T: np.ndarray, base_inv_T: np.ndarray) -> None:
+        """The ``$TOOL``/``$BASE`` (4x4) of the motion the main run executes from now on."""
+        self.tool_T, self.base_T, self.base_inv_T = tool_T, base_T, base_inv_T
+
+    # ------------------------------------------------------------------ the TCP, lazily
+    @property
+    def tcp(self) -> np.ndarray:
+        """The TCP read back this cycle (4x4, in $BASE; :meth:`cycle` may leave it to be made
+        here, when first asked for)."""
+        T = self._tcp_m
+        if T is None:
+            T = self._tcp_m = self.tcp_of(*self._tcp_src)
+            self._tcp_src = None
+        return T
+
+    @tcp.setter
+    def tcp(self, T: np.ndarray) -> None:
+        self._tcp_m, self._tcp_src = T, None
+
+    @property
+    def tcp_prev(self) -> np.ndarray:
+        """The TCP's position (mm) read back the cycle before (:attr:`tcp`'s)."""
+        p = self._tcp_pp
+        if p is None:
+            p = self._tcp_pp = self.tcp_of(*self._tcp_psrc)[:3, 3].copy()
+            self._tcp_psrc = None
+        return p
+
+    @tcp_prev.setter
+    def tcp_prev(self, p: np.ndarray) -> None:
+        self._tcp_pp, self._tcp_psrc = p, None
+
+    def tcp_of(self, q: np.ndarray, tool_T: np.ndarray, base_inv_T: np.ndarray) -> np.ndarray:
+        """TCP in $BASE from the MuJoCo flange site (``INV_POS($BASE) : FLANGE_world : $TOOL``),
+        or from the forward kinematics of ``q`` without MuJoCo."""
+        arm = self._arm if self._arm_q is None else self.arm()
+        if arm is not None:
+            return base_inv_T @ arm.flange_pose_world() @ tool_T
+        if q.dtype is _F8 and tool_T.dtype is _F8 and base_inv_T.dtype is _F8:
+            # a robot at rest reads back the same pose every cycle: the model's forward
+            # kinematics is a function of these three arrays alone, so equal bytes give it again
+            key = (q.tobytes(), tool_T.tobytes(), base_inv_T.tobytes())
+            last = self._tcp_last
+            if last is not None and last[0] == key:
+                return last[1].copy()
+            T = self.model.tcp(q, tool_T, base_inv_T)
+            self._tcp_last = (key, T.copy())
+            return T
+        return self.model.tcp(q, tool_T, base_inv_T)
+
+    # ------------------------------------------------------------------ each IPO cycle
+    def cycle(self, q: np.ndarray, q_prev: np.ndarray) -> np.ndarray:
+        """The IPO cycle's setpoint `q` (the cycle before: `q_prev`) sent to the arm and read
+        back: returns the axes read back (model order); the TCP follows (:attr:`tcp`)."""
+        self._q, self._q_prev = q, q_prev
+        arm = self._arm if self._arm_q is None else self.arm()
+        cyc = arm.compiled_cycle(self._simcore) if arm is not None and not self.actuated else None
+        if cyc is not None:
+            # set_axes, axis_act and the flange site in one compiled call (the same numbers)
+            qa, T = np.empty(q.shape[0]), np.empty((4, 4))
+            self.tcp_prev = self.tcp[:3, 3].copy()
+            try:
+                # with tcp_of's product in numpy's own BLAS call (robot/mjcf.py _same_products)
+                done = cyc.cycle_tcp(q, qa, self.base_inv_T, self.tool_T, T)
+            except (TypeError, ValueError):      # a frame not C-contiguous float64: numpy's @
+                done = False
+            if not done:
+                F = np.empty((4, 4))
+                cyc.cycle(q, qa, F)
+                T = self.base_inv_T @ F @ self.tool_T
+            self.tcp = T
+            return qa
+        if arm is not None:
+            if self.actuated:
+                arm.step_actuated(q, self.dt, (q - q_prev) / self.dt)
+            else:
+                arm.set_axes(q)
+            qa = arm.axes_deg()
+            self.tcp_prev = self.tcp[:3, 3].copy()
+            self.tcp = self.tcp_of(qa, self.tool_T, self.base_inv_T)
+            return qa
+        # without MuJoCo the read-back is the forward kinematics of these arrays alone:
+        # made when first asked for ($POS_ACT, $VEL_ACT, the trace's pose), the same numbers
+        qa = q.copy()
+        if self._tcp_m is not None:
+            self._tcp_pp, self._tcp_psrc = self._tcp_m[:3, 3].copy(), None
+        else:
+            self._tcp_pp, self._tcp_psrc = None, self._tcp_src
+        self._tcp_m, self._tcp_src = None, (qa, self.tool_T, self.base_inv_T)
+        return qa
+
+    # ------------------------------------------------------------------ what the program reads
+    def axes(self) -> np.ndarray:
+        """The axes read back (A1..An, E1..En: the model's order)."""
+        arm = self._arm if self._arm_q is None else self.arm()
+        if arm is not None:
+            return arm.axes_deg()
+        return self._q.copy()
+
+    def axis_act(self) -> np.ndarray:
+        """``$AXIS_ACT`` in KRL's order (robot/axismap.py ``to_krl``): A1..A6 (deg) read back from
+        the MuJoCo model (0 for the axes of a robot with fewer than six, a SCARA's A5 and A6); then
+        E1.. (mm, deg) on a robot with external axes or a seven-axis arm's redundancy."""
+        return self.model.to_krl(self.axes())
+
+    def axis_setpoint(self) -> np.ndarray:
+        """The IPO setpoint of the last cycle in KRL's order (as :meth:`axis_act`)."""
+        return self.model.to_krl(self._q.copy())
+
+    def axis_vel_act(self) -> np.ndarray:
+        """The axes' velocities over the last IPO cycle in KRL's order (A1..A6 deg/s, then
+        E1..En deg/s or mm/s): the source of ``$VEL_AXIS_ACT`` (interp/runtime/sysvars.py)."""
+        return self.model.to_krl((self._q - self._q_prev) / self.dt)
+
+    def pos_act(self, tool: Any = None, base: Any = None, ipo_mode: str = "BASE") -> dict[str, float]:
+        """``$POS_ACT`` as an E6POS dict {X, Y, Z, A, B, C, S, T} (mm, deg): the TCP of
+        :meth:`axis_act` in ``base`` for ``tool`` (6-tuples or 4x4; default: the $BASE/$TOOL
+        of the motion the main run executes, ``$BASE_C``/``$TOOL_C``). ``ipo_mode`` "TCP"
+        (external TCP, reference §6.4): ``tool`` is the workpiece on the flange, ``base`` the
+        fixed tool in WORLD, and the pose is the fixed tool in the workpiece frame,
+        ``INV_POS($ROBROOT : FLANGE(q) : $TOOL) : $BASE`` (robot/external_tcp.py)."""
+        q = self.axes()
+        tool_T = self.tool_T if tool is None else _as4(tool)
+        base_inv = self.base_inv_T if base is None else inv_pos(_as4(base))
+        T = self.tcp_of(q, tool_T, base_inv)
+        if ipo_mode == "TCP":
+            T = inv_pos(T)
+        x, y, z, a, b, c = matrix_to_frame(T)
+        s, t = self.model.status_turn(q)
+        out = {"X": x, "Y": y, "Z": z, "A": a, "B": b, "C": c, "S": s, "T": t}
+        out.update(self.model.axes.e_components(q))
+        return out
+
+    def vel_act(self) -> float:
+        """``$VEL_ACT``: TCP speed in m/s over the last IPO cycle."""
+        return float(np.linalg.norm(self.tcp[:3, 3] - self.tcp_prev)) / self.dt / 1000.0
+
+    def tcp_frame(self) -> tuple:
+        """The TCP (X, Y, Z mm, A, B, C deg) in $BASE read back this cycle (``$POS_ACT``'s frame)."""
+        return matrix_to_frame(self.tcp)
+
+
+def _as4(F: Any) -> np.ndarray:
+    arr = np.asarray(F, dtype=float)
+    if arr.shape == (4, 4):
+        return arr
+    return frame_to_matrix(*arr)
+
+
+__all__ = ["ReadBack"]
