@@ -67,7 +67,7 @@ def test_the_machina_driver_runs_the_actions_of_a_partner_written_from_its_xml(s
         answers = [document(b"/>") for _ in range(4)]
         # the driver answers a motion when its advance run has passed it: the test ends once the
         # robot stands (the driver then waits for the next DT, WAIT FOR $FLAG[2])
-        while rt.controller.is_moving() or rt.len(controller.queue):
+        while rt.controller.is_moving() or len(rt.controller.queue):
             if time.monotonic() > deadline:
                 raise TimeoutError("the robot did not come to rest")
             time.sleep(0.05)

@@ -21,12 +21,14 @@ HUGE = "z" * 100_000
 
 
 class _Ctl:
-    """The controller as the hub sees it: a trace, a clock, a message window."""
+    """The controller as the hub sees it: a trace, a clock, a message window (its event log's
+    ``message``, robot/events.py)."""
 
     def __init__(self) -> None:
         self.trace = TraceWriter(keep=True)
         self.time = 0.0
         self.messages: list[str] = []
+        self.log = self
 
     def message(self, text: str, number=None) -> None:
         self.messages.append(text)

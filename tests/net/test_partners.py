@@ -123,6 +123,11 @@ class _Ctl:
     def message(self, text, number=None):
         pass
 
+    @property
+    def log(self):
+        """The message window (the controller's event log, robot/events.py)."""
+        return self
+
 
 def test_a_partner_is_added_by_its_class_and_one_registration(monkeypatch, tmp_path):
     monkeypatch.setattr(net.partners, "PARTNERS", net.partners.PARTNERS + (Echo,))
