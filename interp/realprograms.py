@@ -436,8 +436,9 @@ def outside_stops(rt) -> list[str]:
     """The run-time errors of the run `rt` (its robot program's, its submit programs') that
     stop on a name the checker classifies outside the program and calls KUKA's
     (krl/semantics/outside.py ``Unresolved.classify``: W101/W105/W106/W107, ``Outside.kuka``),
-    as ``NAME at file:line: why``: an error whose message names such a name ("unknown name X",
-    "routine X not found", "X is not an array", "value invalid: X[2]"). Issues 46 and 59: the
+    as ``NAME at file:line: why``: an error about such a name (its ``name``: "unknown name X",
+    "routine X not found", "X is not an array"), or, for an error that carries no name ("value
+    invalid: X[2]"), whose message holds it as a word. Issues 46 and 59: the
     run stands in for every such name (interp/runtime/kss.py), so this is always empty unless
     the checker and the run disagree."""
     unresolved = rt.program.ws.unresolved()
@@ -455,7 +456,8 @@ def outside_stops(rt) -> list[str]:
             errors.append((err, err.file or task.file, err.line or task.line))
     out = []
     for err, file, line in errors:
-        for word in dict.fromkeys(w.upper() for w in _WORD.findall(err.message or "")):
+        words = [err.name] if getattr(err, "name", None) else _WORD.findall(err.message or "")
+        for word in dict.fromkeys(w.upper() for w in words):
             o = by_name.get(word)
             if o is not None:
                 out.append(f"{o.name} at {file}:{line}: {o.why}")

@@ -356,7 +356,7 @@ class SystemSoftware:
         if st is None:
             why = self._evidence(key)
             if why is None or self.network(key):
-                raise KrlRuntimeError(f"routine {name} not found")
+                raise KrlRuntimeError(f"routine {name} not found", name=name)
             if not is_function:
                 self._record(key, StandIn(name, "procedure", "no effect", why))
                 return None

@@ -224,7 +224,7 @@ def index_ref(base: Ref, idx: list, name: str) -> Ref:
     if not isinstance(v, Arr):
         if v is UNSET:
             raise value_invalid(base.name)
-        raise KrlRuntimeError(f"{base.name} is not an array")
+        raise KrlRuntimeError(f"{base.name} is not an array", name=base.name)
     if idx[-1] is None and len(idx) == 2 and len(v.dims) == 2:
         return RowRef(v, idx[0], f"{name}[{idx[0]},]")
     try:

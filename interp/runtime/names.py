@@ -83,7 +83,7 @@ class Names:
         r = self.kss.name_ref(name)     # a variable of KUKA's software (interp/runtime/kss.py)
         if r is not None:
             return r
-        raise KrlRuntimeError(f"unknown name {name}")
+        raise KrlRuntimeError(f"unknown name {name}", name=name)
 
     def index(self, base: Ref, idx: list, name: str) -> Ref:
         return index_ref(base, idx, name)

@@ -467,7 +467,7 @@ class Program:
             self.ensure_loaded(m)
             ref = m.refs[st.slot]
         if ref is None:
-            raise KrlRuntimeError(f"unknown name {st.name}")
+            raise KrlRuntimeError(f"unknown name {st.name}", name=st.name)
         return ref
 
     def literal(self, e, t=None):

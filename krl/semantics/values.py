@@ -36,15 +36,18 @@ INT_MAX = 2 ** 31 - 1
 
 
 class KrlRuntimeError(Exception):
-    """A KRL run-time error: ``message``, ``number`` (or None), ``file``, ``line``.
+    """A KRL run-time error: ``message``, ``number`` (or None), ``file``, ``line``, and ``name``:
+    the KRL name an error about one is about ("unknown name X", "routine X not found", "X is not
+    an array"; None for the others), so that a reader of the error needs no parse of its text.
 
     Raised by the operators here, by the front end's evaluator and by the interpreters'
     runtime (interp/runtime/errors.py re-exports it with the unwinding signals)."""
 
     def __init__(self, message: str, number: int | None = None, file: str | None = None,
-                 line: int | None = None) -> None:
+                 line: int | None = None, name: str | None = None) -> None:
         super().__init__(message)
         self.message = message
+        self.name = name
         self.number = number
         self.file = file
         self.line = line

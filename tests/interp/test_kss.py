@@ -361,6 +361,24 @@ def test_outside_stops_finds_a_run_that_disagrees_with_the_checker(tmp_path, mon
                                     "(KUKA's template and technology packages write that fold)"]
 
 
+
+def test_an_installed_name_that_is_a_word_of_the_message_is_no_outside_stop(tmp_path):
+    """The variants sweep (issue 59, ChinaMilling 04 without TP/p00.dat): KUKA's P00 uses FOUND,
+    which no file of the backup declares (W101, KUKA's system files use it), and the user's
+    cell program calls its own routine that the backup lacks. The run stops on that routine,
+    the program's error (E106): "routine millingcn not found" names MILLINGCN, not FOUND, the
+    word of the message."""
+    prog = _backup(tmp_path, "DEF cell()\n  millingcn()\nEND\n", name="cell.src",
+                   files={"R1/TP/p00.src": "DEF p00()\nEND\nDEF helper()\n  BOOL ok\n  FOUND=FALSE\n"
+                                           "  ok = FOUND\nEND\n"})
+    out = CliRunner().invoke(main, ["check", str(prog.parents[2])])
+    assert "name 'FOUND' is not declared in this backup" in out.output and "KUKA's system files use it" in out.output
+    assert "routine 'millingcn' is not declared" in out.output, out.output
+    for interp in INTERPS:
+        rt, res, _ = _run(prog, interp=interp)
+        assert (res.reason, res.line, res.text) == ("error", 2, "routine millingcn not found")
+        assert rp.outside_stops(rt) == []
+
 # ---------------------------------------------------------------------- the operator's path
 CELL_DAT = ("DEFDAT cell\n  DECL E6AXIS XHOME={A1 10.0,A2 -90.0,A3 90.0,A4 0.0,A5 30.0,A6 0.0,E1 0.0,E2 0.0,"
             "E3 0.0,E4 0.0,E5 0.0,E6 0.0}\nENDDAT\n")
