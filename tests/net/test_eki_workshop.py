@@ -49,9 +49,13 @@ def test_the_workshop_answers_a_partner_written_from_its_xml(shared_corpus, inte
         conn = connect(port, deadline)
         conn.settimeout(60)
         # the program empties the channel's memories right after its ALIVE flag rises (its
-        # EKI_ClearBuffer of Sensor): a message sent at once would be emptied with them; the
-        # workshop's operator sends from Grasshopper well after connecting
-        time.sleep(1.0)
+        # EKI_ClearBuffer of Sensor and Robot, lines 33-34): a message sent before would be
+        # emptied with them; the workshop's operator sends from Grasshopper well after
+        # connecting. The partner waits until the robot program has passed them, whatever the
+        # machine's load (a fixed second of wall time was not enough at load 20)
+        robot = next(t for t in rt.scheduler.tasks if t.kind == "robot")
+        while (robot.line or 0) <= 34 and time.monotonic() < deadline:
+            time.sleep(0.01)
         buf = bytearray()
         docs = []
         message = b"<Sensor><Action>2</Action><WaitForResponse>FALSE</WaitForResponse></Sensor>"
