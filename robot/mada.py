@@ -35,26 +35,29 @@ from typing import Any
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from krl.archive import ArchiveError, backup_source, is_archive
 from krl.project import backup_of, find_backups, machine_data_file
 
 from . import catalogue
 from .axismap import CART_KEYS, EXT_KEYS, ROBOT_KEYS
-
-#: ``$EX_KIN``'s external kinematic systems ET1..ET6 (KSS kinematic systems manual)
-MAX_EXT_KINEMATICS = 6
 from .chain import chain_forward, chain_to_joints
 from .datalist import DataListError, DataValue, read_data_list
-from .identified import apply_identified, identified_file
 from .frames import matrix_to_frame
-from .madavalues import axes as _axes, flag as _flag, frame as _frame, krl_value, MachineDataError
-from .madavalues import frame6 as _frame6
-from .madavalues import get as _get
-from .madavalues import num as _num
+from .identified import apply_identified, identified_file
 from .kinematics.families import machine_geometry
 from .machine import (
     CartLimits, ExternalAxis, ExternalKinematic, JointData, MachineData, library_robots, load_machine,
 )
-from krl.archive import ArchiveError, backup_source, is_archive
+from .madavalues import MachineDataError, krl_value
+from .madavalues import axes as _axes
+from .madavalues import flag as _flag
+from .madavalues import frame as _frame
+from .madavalues import frame6 as _frame6
+from .madavalues import get as _get
+from .madavalues import num as _num
+
+#: ``$EX_KIN``'s external kinematic systems ET1..ET6 (KSS kinematic systems manual)
+MAX_EXT_KINEMATICS = 6
 
 #: The rules for values that machine data lack (docs/robot.md, "Robots from machine data"); those of
 #: a family's geometry are the family's (robot/kinematics/arm.py RULES).
