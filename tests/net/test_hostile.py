@@ -14,6 +14,7 @@ import time
 
 import pytest
 
+from krl.semantics.values import KrlRuntimeError
 from net.settings import Channel, NetworkSettings
 
 from .helpers import PROGRAMS, run_with_partner
@@ -44,10 +45,18 @@ def wait_for(predicate, what: str, timeout: float = 90.0) -> None:
 
 
 def seen(net) -> set[int]:
-    """The Msg_No values the program has recorded (MSGS[1..min(NMSG, 16)])."""
+    """The Msg_No values the program has recorded (MSGS[1..min(NMSG, 16)]). The program counts
+    NMSG one statement before it writes MSGS[NMSG]: read between the two (this thread runs beside
+    the run), that element is still unset ("value invalid"), not seen yet."""
     sink = net.sink
     n = int(sink.read_var("NMSG"))
-    return {int(sink.read_var(f"MSGS[{i}]")) for i in range(1, min(n, 16) + 1)}
+    out = set()
+    for i in range(1, min(n, 16) + 1):
+        try:
+            out.add(int(sink.read_var(f"MSGS[{i}]")))
+        except KrlRuntimeError:
+            pass
+    return out
 
 
 def saw(net, msg_no: int) -> None:
@@ -146,10 +155,9 @@ def test_hostile_partner(case):
     assert elapsed < 60, f"{case} took {elapsed:.1f} s"
     assert result.reason == "max_sim_time", (result.reason, result.text)   # never an error or a hang
     sink = box["rt"].controller.network.sink
-    nmsg = int(sink.read_var("NMSG"))
-    seen = {int(sink.read_var(f"MSGS[{i}]")) for i in range(1, min(nmsg, 16) + 1)}
-    assert expected <= seen, (case, seen)
-    assert seen <= {512, 1024, 1280, 1536}, seen
+    got = seen(box["rt"].controller.network)     # the run may end between NMSG's count and MSGS's write
+    assert expected <= got, (case, got)
+    assert got <= {512, 1024, 1280, 1536}, got
     assert float(sink.read_var("LASTVAL")) == 7.5
     assert int(sink.read_var("MAXBUFF")) < 16                    # BUFFERING Limit
     for v in never:
