@@ -50,6 +50,7 @@ from pathlib import Path
 
 from krl.ast import nodes as N
 from krl.diagnostics.codes import E101, E102, E106, E201, E203, E204, E208, E301, E303, E304, E401, E403, E404, E501, E502
+from krl.diagnostics.render import split_lines
 from krl.semantics import types as T
 from krl.semantics.builtins import load_builtins
 from krl.semantics.outside import template_lines
@@ -172,7 +173,7 @@ def _statements(body: list[N.Stmt], depth: int):
 def _anchors(p: _Program, top_level: bool = False) -> list[tuple[N.Routine, N.Stmt]]:
     """(routine, statement) pairs where a line may be inserted before the statement."""
     ini, inline, _user = template_lines(p.text)
-    lines = p.text.splitlines()
+    lines = split_lines(p.text)
     out = []
     for r in p.src.module.routines:
         for s, depth in _statements(r.body, 0):
@@ -308,13 +309,13 @@ def _dat_mutant(p: _Program, rng: random.Random) -> tuple[int, str, str] | None:
     if p.dat is None or p.dat.module.data is None:
         return None
     names = [v.name for d in p.dat.module.data.items if isinstance(d, N.VarDecl) for v in d.names]
-    lines = p.dat_text.splitlines()
+    lines = split_lines(p.dat_text)
     end = [i for i, ln in enumerate(lines) if ln.strip().upper().startswith("ENDDAT")]
     if not names or not end:
         return None
     line = f"DECL INT {rng.choice(sorted(names))}"
     i = end[-1]
-    return i + 1, line, "\n".join(lines[:i] + [line] + lines[i:]) + "\n"
+    return i + 1, line, "\n".join(lines[:i] + [line] + lines[i:])   # the last LF is the last line's (split_lines)
 
 
 def load_programs(corpus: str | Path) -> list[_Program]:
@@ -354,9 +355,9 @@ def mutants(corpus: str | Path, per_kind: int = 6, seed: int = 14, programs: lis
                 new = _statement(kind, p, r, rng)
                 if new is None:
                     continue
-                lines = p.text.splitlines()
+                lines = split_lines(p.text)
                 at = s.span.line - 1
-                text = "\n".join(lines[:at] + new + lines[at:]) + "\n"
+                text = "\n".join(lines[:at] + new + lines[at:])   # as the file ends (split_lines keeps its last LF)
                 m = Mutant(kind, p.src.path, s.span.line, new[0], text, EXPECTED[kind], p.backup.root)
             if check:
                 judge(m, p)
