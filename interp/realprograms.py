@@ -27,8 +27,8 @@ Every stop gets one *cause* (:func:`cause_of`, issue 22 "Every stop explained"):
   whose target the backup's own robot cannot take (the run simulates the robot of the
   backup's ``$machine.dat``, and no axis configuration of the target — any status, turn,
   ±360° variant — lies within that machine data's software limits,
-  ``Controller.target_outside_limits``; the error says so, interp/runtime/core.py
-  ``TARGET_OUTSIDE_NOTE``): the real controller of that robot refuses it too;
+  robot/motionqueue.py ``MotionQueue.target_outside_limits``; the error says so,
+  interp/runtime/motions.py ``TARGET_OUTSIDE_NOTE``): the real controller of that robot refuses it too;
 * ``interpreter gap``: an error that is the simulator's (:data:`GAP_MESSAGES`: a feature not
   simulated; a target, a CP path or an axis range the simulated robot cannot follow when it is
   not the backup's own — the KR 6 R900 of a backup without machine data — or when only the

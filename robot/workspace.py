@@ -31,7 +31,7 @@ stops the robot after it entered). Decisions, each marked in docs/robot.md "Work
   itk-thrivaldi kuka_kvp_hw_interface toolchanger.src:26) holds the signal's value.
 
 Units: mm and deg. This module reads numbers only: the runtime hands it the workspaces' current
-values each cycle (interp/runtime/sysvars.py ``workspace_reader``), so a program that changes
+values each cycle (interp/runtime/sysvars.py ``start_workspaces``), so a program that changes
 ``$WORKSPACE[n]`` takes effect at the next IPO cycle.
 """
 

@@ -1,7 +1,7 @@
 """Cyclic evaluation of a run (reference §5.14, §5.15): :class:`Cyclic` (``Runtime.cyclic``),
 what ``ANOUT ON``, ``ANIN ON`` and ``$CYCFLAG[n] = expr`` switch on, for both interpreters.
 
-It holds now: ``handles``, the controller's handle (robot/controller.py ``add_cyclic``) of each
+It holds now: ``handles``, the controller's handle (robot/signals.py ``Signals.add_cyclic``) of each
 cyclic evaluation by its key (("cyclic flag", name), ("analog output", channel key), ("analog
 input", channel key)); ``restless``, the keys of the cyclic flags whose expression does not
 settle (interp/runtime/watch.py ``settles``); and, by ``id`` of the assignment, whether a

@@ -856,7 +856,7 @@ def peephole(lst: Listing) -> bool:
 def compile_routine(routine: N.Routine) -> Listing:
     """The instruction listing of ``routine``, from its annotated AST alone (the front end's
     facts, krl/semantics/resolve.py; no runtime): for vm.link (the VM's executed form, kept
-    per workspace by the VM, interp/vm/vm.py ``code_cache``) and assembler.format_listing
+    per workspace by the VM, interp/vm/vm.py ``linked_code``) and assembler.format_listing
     (`krl asm`)."""
     return Compiler(routine).compile()
 
