@@ -59,14 +59,32 @@ def build_jobs() -> int:
         return os.cpu_count() or 1
 
 
+def optimisation_from_environment(extensions: list, environ=os.environ) -> list:
+    """``extensions`` (setuptools ``Extension``s), each without its own ``-O`` flags when the
+    environment's ``CFLAGS`` names an optimisation level (``-O0``, ``-O3``, ``-Os``...): that
+    level then compiles them. setuptools puts the environment's ``CFLAGS`` after Python's own
+    flags but before an extension's ``extra_compile_args``, where the build files' ``-O2``
+    (interp/vm/build.py, robot/build.py) would win; without an ``-O`` in ``CFLAGS`` (a plain
+    ``pip install``) they keep it. tests/test_wheel.py builds its wheel at ``-O0``: it checks
+    that the wheel carries and runs the extensions, not their speed (gcc 40 -> 4 s of CPU for
+    the three, 2026-11-26). The other flags (``-g0``, robot/build.py's floating-point ones)
+    stay. Returns the same list, changed in place."""
+    if any(flag.startswith("-O") for flag in environ.get("CFLAGS", "").split()):
+        for ext in extensions:
+            ext.extra_compile_args = [a for a in ext.extra_compile_args if not a.startswith("-O")]
+    return extensions
+
+
 def cythonized(extensions: list, build_dir: str = "build/cython", force: bool = False, jobs: int = 1) -> list:
     """``extensions`` (setuptools ``Extension``s, ``optional``) translated to C by Cython
-    (`jobs` at once), or ``[]`` without Cython: then nothing is compiled and the pure-Python
-    modules run."""
+    (`jobs` at once), their optimisation level the environment's where it names one
+    (:func:`optimisation_from_environment`), or ``[]`` without Cython: then nothing is
+    compiled and the pure-Python modules run."""
     try:
         from Cython.Build import cythonize  # noqa: PLC0415  (optional; loads only for a build)
     except ImportError:
         return []
+    optimisation_from_environment(extensions)
     return cythonize(extensions, build_dir=build_dir, quiet=True, force=force,
                      compiler_directives=DIRECTIVES, nthreads=jobs if len(extensions) > 1 else 0)
 
