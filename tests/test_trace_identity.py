@@ -56,3 +56,25 @@ def test_the_same_trace_with_another_end_is_a_difference(tmp_path):
     out = io.StringIO()
     assert TI.compare(tmp_path / "a", tmp_path / "b", out) == 1
     assert "first at line 2:" in out.getvalue()      # past the end of both traces: equal text
+
+
+def test_last_place_counts_a_tie_rounded_apart_and_the_cut_at_180_degrees(tmp_path):
+    """--last-place: one unit of the 6th decimal (a tie rounded apart) and C 180 vs -180 (the
+    same rotation) make an equivalent trace; two units, or 180 vs -180 in a position, do not."""
+    pose = '{"t":0.012,"kind":"pose","tcp":[%s,0.0,5.0,0.0,0.0,%s]}'
+    _record(tmp_path / "a", "p", [pose % ("1208.898992", "-180.0")], "/x")
+    _record(tmp_path / "b", "p", [pose % ("1208.898993", "180.0")], "/y")
+    _record(tmp_path / "a", "q", [pose % ("1208.898992", "0.0")], "/x")
+    _record(tmp_path / "b", "q", [pose % ("1208.898994", "0.0")], "/y")
+    _record(tmp_path / "a", "r", [pose % ("180.0", "0.0")], "/x")
+    _record(tmp_path / "b", "r", [pose % ("-180.0", "0.0")], "/y")
+    _record(tmp_path / "a", "s", ['{"kind":"motion","target":{"C":-180.0,"X":1.0}}'], "/x")
+    _record(tmp_path / "b", "s", ['{"kind":"motion","target":{"C":180.0,"X":1.0}}'], "/y")
+    out = io.StringIO()
+    assert TI.compare(tmp_path / "a", tmp_path / "b", out, last_place=True) == 1
+    text = out.getvalue()
+    assert "DIFF q.tree" in text and "DIFF r.tree" in text and "DIFF p.tree" not in text and "DIFF s.tree" not in text
+    assert text.strip().endswith("identical 0, equivalent 2 (last place 1 numbers, +-180 2 angles), different 2, missing 0")
+    out = io.StringIO()
+    assert TI.compare(tmp_path / "a", tmp_path / "b", out) == 1     # byte for byte: all four differ
+    assert out.getvalue().strip().endswith("identical 0, different 4, missing 0")
