@@ -39,7 +39,7 @@ from typing import Any
 
 import numpy as np
 
-from .planner import CartSegment, JointSegment, Segment
+from .planner import CartSegment, JointSegment, Segment, gradient_rows
 from .profiles import BrakeProfile, RampProfile
 
 
@@ -285,8 +285,8 @@ def _rates_at(seg: Segment, us: np.ndarray, from_end: bool) -> tuple[np.ndarray,
         d = seg.qd_start if lo <= 0.0 else seg.qd_end
         return np.broadcast_to(d, (n, w)), np.zeros((n, w))
     h = float(grid[1] - grid[0])
-    d1 = np.gradient(Q, h, axis=0, edge_order=2)
-    d2 = np.gradient(d1, h, axis=0, edge_order=2)
+    d1 = gradient_rows(Q, h)
+    d2 = gradient_rows(d1, h)
     return (np.stack([np.interp(us, grid, d1[:, i]) for i in range(w)], axis=1),
             np.stack([np.interp(us, grid, d2[:, i]) for i in range(w)], axis=1))
 

@@ -42,6 +42,7 @@ from .errors import RobotError, SoftLimitError, WorkspaceError
 from .frames import frame_to_matrix, inv_pos, matrix_to_frame, rotation_angle_deg, rotvec_of
 from . import kinematics
 from .axismap import AxisMap
+from .blas import numpy_cblas
 from .external import ExternalAxes
 from .dynamics import Inertia
 from .external_tcp import external_tcp
@@ -540,14 +541,16 @@ class Segment:
         self.v_prog = v_prog
         self.tool_T = tool_T
         self.base_T = base_T
-        self.tool_inv_T = inv_pos(tool_T)
-        self.base_inv_T = inv_pos(base_T)
+        tool_inv, _, tool_null = _inverse_of(tool_T)
+        base_inv, base_null, _ = _inverse_of(base_T)
+        self.tool_inv_T = tool_inv.copy()
+        self.base_inv_T = base_inv.copy()
         # the frames the IK multiplies with, None for a null frame (RobotModel.ik skips them)
-        eye = np.eye(4)
-        self._ik_tool = None if np.array_equal(self.tool_inv_T, eye) else self.tool_inv_T
-        self._ik_base = None if np.array_equal(base_T, eye) else base_T
+        self._ik_tool = None if tool_null else self.tool_inv_T
+        self._ik_base = None if base_null else base_T
         self._c_ik: Any = None      # CartSegment.ik's compiled inverse (robot/simcore.pyx), False: none
         self._c_path: Any = None    # CartSegment's compiled poses (robot/simcore.pyx CartPath), False: none
+        self._c_framed = False      # the compiled path solves through $BASE and $TOOL (CartPath.use_frames)
         self.model = model
         self.status = model.status_turn(q0)[0]
         self.triggers: list[TriggerPlan] = []
@@ -691,6 +694,7 @@ class CartSegment(Segment):
         # R_k · exp(f · 0) once, instead of a product with the identity every cycle
         self._R_still = [self._R[k] @ rotvec_matrix(np.zeros(3)) if float(np.linalg.norm(rv)) < 1e-12
                          else None for k, rv in enumerate(self._rv)]
+        self._path_end: np.ndarray | None = None      # tcp_dist_to_end's end point, once
 
     @property
     def path_length(self) -> float:
@@ -761,6 +765,19 @@ class CartSegment(Segment):
                 q = None
             if q is not None:
                 return q
+        else:
+            cp = self._c_path
+            if cp is None:
+                cp = self._compiled_path()
+            if cp and self._c_framed:
+                # $BASE and $TOOL multiplied as below, numpy's BLAS in C (robot/simcore.pyx
+                # CartPath.use_frames), then the compiled inverse; None: the code below decides
+                try:
+                    q = cp.solve_rp(R, p, self.status, ref)
+                except (TypeError, ValueError):
+                    q = None
+                if q is not None:
+                    return q
         T = np.empty((4, 4))
         T[:3, :3] = R
         T[:3, 3] = p
@@ -780,6 +797,11 @@ class CartSegment(Segment):
             if sc is not None and len(self.q0) == self.model.n == COMPILED_AXES and not self.joint_ori:
                 self._c_path = _cart_path(sc, self) or False
         return self._c_path
+
+    def compiled_solver(self) -> bool:
+        """Does :meth:`ik` run compiled code: the compiled inverse on the poses as they stand, or
+        the compiled path's through $BASE and $TOOL (:func:`_cart_path`)?"""
+        return bool(self.compiled_inverse()) or (bool(self._compiled_path()) and self._c_framed)
 
     def compiled_inverse(self) -> Any:
         """The compiled inverse :meth:`ik` runs on its poses as they stand (kept), or False."""
@@ -914,7 +936,10 @@ class CartSegment(Segment):
         return float(self.s_bounds[k] + f * self.lengths[k])
 
     def tcp_dist_to_end(self, u: float) -> float:
-        return float(np.linalg.norm(self.pose_u(u)[0] - self.pieces[-1].pos(self.pieces[-1].length)))
+        end = self._path_end
+        if end is None:             # the last piece's end point (its pieces do not change)
+            end = self._path_end = self.pieces[-1].pos(self.pieces[-1].length)
+        return float(np.linalg.norm(self.pose_u(u)[0] - end))
 
     def ori_angle_to_end(self, u: float) -> float:
         """Remaining orientation change (deg) from parameter u to the end."""
@@ -924,6 +949,18 @@ class CartSegment(Segment):
     @property
     def ori_angle(self) -> float:
         return self.ori_angle_to_end(0.0)
+
+
+def gradient_rows(f: np.ndarray, h: float) -> np.ndarray:
+    """``np.gradient(f, h, axis=0, edge_order=2)`` of the rows of `f` (at least 3, spacing `h`, a
+    Python float), the same operations in the same order as numpy 2's (central differences
+    inside, the second-order one-sided ones at the ends): the same numbers, without its
+    argument handling (a planned CP motion takes two)."""
+    out = np.empty_like(f)
+    out[1:-1] = (f[2:] - f[:-2]) / (2. * h)
+    out[0] = (-1.5 / h) * f[0] + (2. / h) * f[1] + (-0.5 / h) * f[2]
+    out[-1] = (0.5 / h) * f[-3] + (-2. / h) * f[-2] + (1.5 / h) * f[-1]
+    return out
 
 
 #: Conversions kept by :func:`_frame_of` and :func:`_matrix_of` (each table cleared when full).
@@ -941,6 +978,24 @@ def _kept(table: dict, key: bytes, make: Callable[[], Any]) -> Any:
             table.clear()
         got = table[key] = make()
     return got
+
+
+_INVERSE_OF: dict[bytes, tuple[np.ndarray, bool, bool]] = {}
+_EYE4 = np.eye(4)
+
+
+def _inverse_of(T: np.ndarray) -> tuple[np.ndarray, bool, bool]:
+    """(:func:`robot.frames.inv_pos` of the 4x4 T, is T the identity, is its inverse), kept by
+    T's float64 bytes: the motions of a program share their $TOOL and $BASE. The inverse is the
+    kept array (read-only): copy it to keep it."""
+    A = np.asarray(T, dtype=float)
+
+    def make() -> tuple[np.ndarray, bool, bool]:
+        inv = inv_pos(A)
+        inv.setflags(write=False)
+        return inv, bool(np.array_equal(A, _EYE4)), bool(np.array_equal(inv, _EYE4))
+
+    return _kept(_INVERSE_OF, A.tobytes() + str(A.shape).encode(), make)
 
 
 def _frame_of(T: np.ndarray) -> tuple[float, ...]:
@@ -994,7 +1049,50 @@ def _cart_path(sc: Any, seg: "CartSegment") -> Any:
     if not (kinds >= 0).any():
         return None
     opw = seg.compiled_inverse() or None
-    return sc.CartPath(opw, np.asarray(seg._ub, dtype=float), kinds, mid_ok, length, r, angle, a, b, c, rots)
+    gemm = 0
+    if opw is None:
+        m = seg.model
+        if type(m) is RobotModel and not m.n_ext and m._robroot_is_null:
+            opw = m.kin.compiled_core() or None
+            gemm = _frames_gemm(sc) if opw is not None else 0
+            if not gemm:
+                opw = None
+    cp = sc.CartPath(opw, np.asarray(seg._ub, dtype=float), kinds, mid_ok, length, r, angle, a, b, c, rots)
+    if gemm:
+        cp.use_frames(gemm, seg._ik_base, seg._ik_tool)
+        seg._c_framed = True
+    return cp
+
+
+#: [address] of numpy's cblas_dgemm once CartPath.use_frames was seen to multiply as numpy does
+#: (robot/blas.py), [0] when not: :func:`_frames_gemm`
+_FRAMES_GEMM: list[int] = []
+
+
+def _frames_gemm(sc: Any) -> int:
+    """The ``cblas_dgemm`` address for robot/simcore.pyx ``CartPath.use_frames`` (0: none, or its
+    products are not numpy's ``@`` bit for bit on a probe of drawn frames and poses: the
+    compiled path then solves only poses without $BASE and $TOOL), checked once a process."""
+    if not _FRAMES_GEMM:
+        gemm = numpy_cblas("dgemm")
+        if gemm:
+            rng = np.random.default_rng(62)
+            z1, z3 = np.zeros(1), np.zeros((1, 3))
+            probe = sc.CartPath(None, np.array([0.0, 1.0]), np.zeros(1, dtype=np.intc),
+                                np.ones(1, dtype=np.intc), z1, np.ones(1), z1, z3, z3, z3, np.zeros((1, 3, 3, 3)))
+            for i in range(32):
+                base = frame_to_matrix(*rng.uniform(-500.0, 500.0, 6))
+                tool = inv_pos(frame_to_matrix(*rng.uniform(-200.0, 200.0, 6)))
+                T = frame_to_matrix(*rng.uniform(-900.0, 900.0, 6))
+                pre, post = (base, tool) if i % 3 == 0 else (None, tool) if i % 3 == 1 else (base, None)
+                probe.use_frames(gemm, pre, post)
+                want = T if pre is None else pre @ T
+                want = want if post is None else want @ post
+                if probe.flange_rp(T[:3, :3], T[:3, 3])[:3].tobytes() != want[:3].tobytes():
+                    gemm = 0
+                    break
+        _FRAMES_GEMM.append(gemm)
+    return _FRAMES_GEMM[0]
 
 
 # ------------------------------------------------------------------------- planning
@@ -1074,7 +1172,7 @@ def plan(req: MotionRequest, q_start: np.ndarray, model: RobotModel, *,
         model = model.linked(p.base_kin, getattr(p, "base_root", None))   # $BASE on a BASE kinematic (robot/external.py)
     tool_T = _matrix_of(p.tool)
     base_T = _matrix_of(p.base)
-    base_inv = inv_pos(base_T)
+    base_inv = _inverse_of(base_T)[0]
     start_T = model.tcp(q0, tool_T, base_inv)
     if req.kind in ("PTP", "SPTP"):
         seg = _plan_joint(req, q0, start_T, tool_T, base_T, model)
@@ -1405,7 +1503,7 @@ def _plan_cart(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_T: 
     # walk the path per piece: IK (start status S, continuous turn), singularities, and the
     # axis speeds/accelerations the path needs (the path is slowed so that the axes stay
     # within machine data: |q'|·du/dt <= v_max, |q''|·(du/dt)² + |q'|·d²u/dt² <= a_max)
-    status = model.status_turn(q0)[0]
+    status = seg.status             # model.status_turn(q0)[0], made by the segment
     # on a robot whose axis accelerations are those its PTPs were identified with (robot/
     # identified.py), not limits of its axes, a LIN or CIRC keeps $ACC.CP whatever accelerations
     # its axes need (the real KR 3 R540 plans the CIRCs of its recordings at 2.3 m/s², although A2
@@ -1440,7 +1538,7 @@ def _plan_cart(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_T: 
                 pass                        # solved sample by sample below (the wrist is given)
             elif len(q0) == model.n and nk >= MIN_CHAIN and model.batch_ik:
                 chain = seg.ik_chain([seg.pose_u(float(us[j])) for j in range(1, nk + 1)], ref)
-            elif len(q0) == model.n and seg.compiled_inverse():
+            elif len(q0) == model.n and seg.compiled_solver():
                 # the poses and the compiled inverse along the samples in one call (the same
                 # rows); else the poses here and the inverse in one call
                 cp = seg._compiled_path()
@@ -1480,8 +1578,8 @@ def _plan_cart(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_T: 
             junction_q.append(Q[0].copy())
             sec_d.append((np.zeros(len(q0)), np.zeros(len(q0)), 1.0))
             continue
-        d1 = np.gradient(Q, h, axis=0, edge_order=2)
-        d2 = np.gradient(d1, h, axis=0, edge_order=2)
+        d1 = gradient_rows(Q, h)
+        d2 = gradient_rows(d1, h)
         qd = np.max(np.abs(d1), axis=0)
         qdd = np.max(np.abs(d2), axis=0)
         junction_q.append(Q[0].copy())

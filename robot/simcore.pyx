@@ -9,7 +9,8 @@ compiled from that very Python file; this module calls its C methods (``OPWCore`
 * :class:`Forward`: the joints' forward kinematics (robot/kinematics/joints.py
   ``JointChain.forward``: scipy's rotation matrices, numpy's own BLAS through its address);
 * :class:`CartPath`: the poses of a CP segment's lines and arcs (robot/planner.py
-  ``CartSegment.pose_u``) and their axes (fastpath's ``OPWCore``);
+  ``CartSegment.pose_u``) and their axes (fastpath's ``OPWCore``), through the motion's ``$BASE``
+  and ``$TOOL`` where it has them (``RobotModel.ik``'s two products, numpy's BLAS at its address);
 * :class:`ArmCycle` and :func:`speed_ok`: the IPO cycle's MuJoCo playback (``mj_kinematics``
   through its address) with its TCP product, and its axis step check (robot/controller.py
   ``Controller.step``);
@@ -182,6 +183,13 @@ cdef class Palletizer4:
 
 
 # ----------------------------------------------------------------------------- CP paths
+#: cblas_dgemm of an ILP64 BLAS (numpy's own: the product numpy's ``@`` computes for two
+#: C-contiguous float64 4x4 matrices is this call, row-major, no transposes, alpha 1, beta 0)
+ctypedef void (*_dgemm_t)(int order, int ta, int tb, long long m, long long n, long long k,
+                          double alpha, const double* a, long long lda, const double* b,
+                          long long ldb, double beta, double* c, long long ldc) noexcept nogil
+
+
 cdef class CartPath:
     """The poses of a CP segment's lines and arcs, and their axes (``opw``: robot/kinematics/fastpath.py's
     ``OPWCore``; None: the poses only) (robot/planner.py ``CartSegment.pose_u`` and ``CartSegment.ik``
@@ -210,6 +218,9 @@ cdef class CartPath:
     cdef const double[:, ::1] b
     cdef const double[:, ::1] c
     cdef const double[:, :, :, ::1] rots
+    cdef _dgemm_t gemm
+    cdef int has_pre, has_post
+    cdef double[:, ::1] frames     # (12, 4): pre (base), post (tool), scratch T, F; numpy-allocated
 
     def __init__(self, OPWCore opw, ub, kinds, mid_ok, length, r, angle, a, b, c, rots):
         self.opw = opw
@@ -299,8 +310,11 @@ cdef class CartPath:
         if status is not None:
             st = <int>status
             has_status = 1
-        for i in range(12):
-            opw.M[i] = M[i]
+        if self.has_pre or self.has_post:
+            self._flange(M, &opw.M[0])
+        else:
+            for i in range(12):
+                opw.M[i] = M[i]
         for i in range(6):
             opw.ref[i] = ref[i]
         if not opw.solve(has_status, st, 0, 0):
@@ -348,6 +362,90 @@ cdef class CartPath:
         return res
 
 
+    def use_frames(self, size_t gemm, pre, post):
+        """Solve ``(pre @ T) @ post`` instead of the pose T (4x4 of the pose's R and p) as it
+        stands: robot/planner.py ``RobotModel.ik``'s ``$BASE @ T @ INV_POS($TOOL)``, each
+        product numpy's ``@`` through the BLAS ``cblas_dgemm`` at address `gemm` (numpy's own,
+        robot/blas.py; row-major, no transposes, alpha 1, beta 0, into numpy-allocated 4x4s);
+        `pre` or `post` None: that product is skipped, as there for a null frame."""
+        if gemm == 0:
+            raise ValueError("CartPath.use_frames: no BLAS")
+        frames = np.zeros((16, 4))
+        if pre is not None:
+            frames[0:4] = np.asarray(pre, dtype=float).reshape(4, 4)
+        if post is not None:
+            frames[4:8] = np.asarray(post, dtype=float).reshape(4, 4)
+        self.gemm = <_dgemm_t>gemm
+        self.frames = frames
+        self.has_pre = 0 if pre is None else 1
+        self.has_post = 0 if post is None else 1
+
+    cdef void _flange(self, const double* M, double* out) noexcept:
+        """The flange pose (3x4 into out) the solver is given for the pose M (3x4, row-major)."""
+        cdef double* T = &self.frames[8, 0]
+        cdef double* F = &self.frames[12, 0]
+        cdef double* src
+        cdef int i
+        for i in range(12):
+            T[i] = M[i]
+        T[12] = 0.0
+        T[13] = 0.0
+        T[14] = 0.0
+        T[15] = 1.0
+        src = T
+        if self.has_pre:
+            self.gemm(101, 111, 111, 4, 4, 4, 1.0, &self.frames[0, 0], 4, T, 4, 0.0, F, 4)
+            src = F
+        if self.has_post:
+            self.gemm(101, 111, 111, 4, 4, 4, 1.0, src, 4, &self.frames[4, 0], 4, 0.0,
+                      T if src == F else F, 4)
+            src = T if src == F else F
+        for i in range(12):
+            out[i] = src[i]
+
+    def flange_rp(self, const double[:, :] R, const double[:] p):
+        """The flange pose (4x4) :meth:`solve_rp` solves for the pose (R (3, 3), p (3,))."""
+        cdef double M[12]
+        cdef double out[12]
+        cdef int i, j
+        for i in range(3):
+            for j in range(3):
+                M[4 * i + j] = R[i, j]
+            M[4 * i + 3] = p[i]
+        if self.has_pre or self.has_post:
+            self._flange(M, out)
+        else:
+            for i in range(12):
+                out[i] = M[i]
+        res = np.zeros((4, 4))
+        cdef double[:, ::1] rv = res
+        for i in range(3):
+            for j in range(4):
+                rv[i, j] = out[4 * i + j]
+        rv[3, 3] = 1.0
+        return res
+
+    def solve_rp(self, const double[:, :] R, const double[:] p, status, const double[:] ref6):
+        """The axes (6,) of the pose (R (3, 3), p (3,)) for the reference ref6 (``CartSegment.ik``;
+        turn None), or None (no inverse here, or the Python inverse decides)."""
+        cdef double M[12]
+        cdef double ref[6]
+        cdef int i, j
+        if self.opw is None or ref6.shape[0] != 6 or R.shape[0] != 3 or R.shape[1] != 3 or p.shape[0] != 3:
+            return None
+        for i in range(3):
+            for j in range(3):
+                M[4 * i + j] = R[i, j]
+            M[4 * i + 3] = p[i]
+        for i in range(6):
+            ref[i] = ref6[i]
+        res = np.empty(6)
+        cdef double[::1] rv = res
+        if not self._solve(M, status, ref, &rv[0]):
+            return None
+        return res
+
+
 # ----------------------------------------------------------------------------- the IPO cycle
 def speed_ok(const double[:] q, const double[:] q_prev, const double[:] lim):
     """True when no axis moves more than its limit in one cycle: ``abs(q[i] - q_prev[i]) <=
@@ -361,11 +459,6 @@ def speed_ok(const double[:] q, const double[:] q_prev, const double[:] lim):
 
 
 ctypedef void (*_mj_kinematics_t)(const void* m, void* d) noexcept nogil
-#: cblas_dgemm of an ILP64 BLAS (numpy's own: the product numpy's ``@`` computes for two
-#: C-contiguous float64 4x4 matrices is this call, row-major, no transposes, alpha 1, beta 0)
-ctypedef void (*_dgemm_t)(int order, int ta, int tb, long long m, long long n, long long k,
-                          double alpha, const double* a, long long lda, const double* b,
-                          long long ldb, double beta, double* c, long long ldc) noexcept nogil
 
 
 ctypedef void (*_dgemv_t)(int order, int ta, long long m, long long n, double alpha, const double* a,

@@ -16,6 +16,7 @@ issue 47 (the compiled core generated from the Python, its comparison always run
 from __future__ import annotations
 
 import importlib.util
+import math
 import hashlib
 import random
 import shutil
@@ -32,7 +33,7 @@ from robot.bench import bench_program, run_motions
 from robot.blas import numpy_cblas
 from robot.controller import Controller
 from robot.errors import RobotError
-from robot.frames import frame_to_matrix, inv_pos
+from robot.frames import NULLFRAME, frame_to_matrix, inv_pos, matrix_to_frame
 from robot.kinematics import Kinematics, constants
 from robot.machine import ROBOT_LIBRARY, library_robots
 from robot.mada import load_mada, load_robot
@@ -395,6 +396,63 @@ def test_the_compiled_cp_path_is_the_segments_poses_and_axes(sc, robot, shared_c
             else:                  # a pose the Python code computes (a slerp): the caller's
                 assert chain is None
     assert mirrored > 500 and (compared > 500 or robot == "kr210") and chains > 3
+
+
+@pytest.mark.parametrize("frames", ["tool", "base", "both"])
+def test_the_compiled_cp_path_solves_through_base_and_tool_as_the_python_code(sc, frames):
+    """A CP motion with $TOOL and $BASE (a milling program's LINs: issue 62, the CAM-like
+    program) solves its poses in C through ``$BASE @ T @ INV_POS($TOOL)`` (CartPath.use_frames,
+    numpy's BLAS at its address): the same axes, bit for bit, and the same None where the Python
+    code raises, as ``RobotModel.ik``; the planning walk's chains as pose-by-pose solutions."""
+    if not numpy_cblas("dgemm"):
+        pytest.skip("numpy without its bundled OpenBLAS: the compiled path solves only poses as they stand")
+    tool = (10.0, -20.0, 150.0, 270.0, 0.0, 0.0) if frames != "base" else NULLFRAME
+    base = (600.0, -50.0, 300.0, 15.0, 0.0, 180.0) if frames != "tool" else NULLFRAME
+    P = MotionParams.initmov(None).with_(tool=tool, base=base)
+    q = [10.0, -80.0, 100.0, 10.0, 40.0, 20.0]
+    T0 = inv_pos(frame_to_matrix(*base)) @ Kinematics().forward(q) @ frame_to_matrix(*tool)
+    start = dict(zip("XYZABC", matrix_to_frame(T0)))
+    program = [MotionRequest("PTP", {f"A{i + 1}": v for i, v in enumerate(q)}, P)]
+    for i in range(12):       # a circle of short LINs, C_VEL, as the CAM-like program's
+        a = math.radians(30.0 * i)
+        program.append(MotionRequest("LIN", {**start, "X": start["X"] + 40.0 * math.cos(a) - 40.0,
+                                              "Y": start["Y"] + 40.0 * math.sin(a), "A": start["A"] + (5.0 if i >= 9 else 0.0)},
+                                     P, approx="C_VEL"))
+    segs = _segments(None, program)
+    rng = np.random.default_rng(62)
+    compared = raised = chains = 0
+    for seg in segs:
+        if seg.path_length <= 0:
+            continue
+        assert seg.compiled_solver() and not seg.compiled_inverse() and seg._c_framed
+        cp = seg._compiled_path()
+        for u in rng.uniform(0.0, 1.0, 60).tolist():
+            p, R = seg.pose_u(u)
+            ref = seg.q0 + rng.normal(0.0, 2.0, 6)
+            if compared % 7 == 0:
+                p = p + rng.normal(0.0, 5000.0 if compared % 14 == 0 else 1.0, 3)   # some out of reach
+            got = cp.solve_rp(R, p, seg.status, ref)
+            seg._c_path = False
+            try:
+                want = seg.ik(p, R, ref).tobytes()
+            except RobotError:
+                want = None
+                raised += 1
+            seg._c_path = cp
+            assert (got.tobytes() if got is not None else None) == want
+            compared += 1
+        ups = np.sort(rng.uniform(0.0, 1.0, 20))
+        chain = cp.chain_u(ups, seg.status, seg.q0)
+        seg._c_path = False
+        ref, rows = seg.q0, []
+        for u in ups.tolist():
+            ref = seg.ik(*seg.pose_u(u), ref)
+            rows.append(ref)
+        seg._c_path = cp
+        if chain is not None:
+            assert chain.tobytes() == np.array(rows).tobytes()
+            chains += 1
+    assert compared > 500 and raised > 10 and chains > 5
 
 
 def test_the_trace_is_the_same_with_and_without_the_compiled_module(sc, fast, monkeypatch):
