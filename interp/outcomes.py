@@ -73,8 +73,9 @@ class _Events:
         elif kind == "error":
             self.errors.append({"t": round(t, 3), "text": str(fields.get("text") or ""), "line": fields.get("line")})
 
-    #: no pose events (robot/trace.py TraceWriter.takes_poses)
+    #: no pose events, no motion end points (robot/trace.py TraceWriter.takes_poses, takes_motion_points)
     takes_poses = False
+    takes_motion_points = False
 
 
 def event_kind(text: str) -> str:

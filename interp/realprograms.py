@@ -408,8 +408,9 @@ class RunEvents:
                 if len(self.requests) < MAX_ROW_REQUESTS:
                     self.requests.append(round(t, 3))
 
-    #: no pose events (robot/trace.py TraceWriter.takes_poses)
+    #: no pose events, no motion end points (robot/trace.py TraceWriter.takes_poses, takes_motion_points)
     takes_poses = False
+    takes_motion_points = False
 
     def add(self, t: float, text: str, file, line) -> None:
         kind = motion_event_kind(text)

@@ -87,6 +87,11 @@ class RunObserver:
     def takes_poses(self) -> bool:
         return self.inner is not None and self.inner.takes_poses
 
+    @property
+    def takes_motion_points(self) -> bool:
+        """The motion events' end points and limits only for `inner` (robot/trace.py)."""
+        return self.inner is not None and getattr(self.inner, "takes_motion_points", True)
+
     def write_pose(self, t: float, axes: Any, tcp_T: Any) -> None:
         self.inner.write_pose(t, axes, tcp_T)
 

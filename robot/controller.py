@@ -580,12 +580,17 @@ class Controller:
                       reached: float | None = None) -> None:
         req = seg.req
         self.log.events.append(MotionEvent(self.time, req.id, phase, req))
-        if self.trace is not None:
-            limits = seg.limits.as_trace() if phase == "start" else None
-            self.trace.write("motion", self.time, id=req.id, type=req.type_name,
-                             target=dict(req.target), approximation=req.approx,
-                             phase=phase, point=seg.end_frame, line=req.line, file=req.file,
-                             reason=reason, limits=limits, reached=reached)
+        tr = self.trace
+        if tr is not None:
+            if getattr(tr, "takes_motion_points", True):
+                limits = seg.limits.as_trace() if phase == "start" else None
+                tr.write("motion", self.time, id=req.id, type=req.type_name,
+                         target=dict(req.target), approximation=req.approx,
+                         phase=phase, point=seg.end_frame, line=req.line, file=req.file,
+                         reason=reason, limits=limits, reached=reached)
+            else:       # an observer without use for the target, the end point and the limits
+                tr.write("motion", self.time, id=req.id, type=req.type_name, approximation=req.approx,
+                         phase=phase, line=req.line, file=req.file, reason=reason, reached=reached)
         if self.signals.stimuli:
             self.signals.motion_phase(req.id, req.line, phase, self.time)
 

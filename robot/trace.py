@@ -263,10 +263,13 @@ class TraceWriter:
     ``takes_poses``: the controller passes its per-IPO-cycle pose to :meth:`write_pose` only
     for a trace whose ``takes_poses`` is true (an observer of the controller's events that has
     no use for poses says false: the TCP read back is then made only where the run asks for it,
-    robot/readback.py ``ReadBack.tcp``).
+    robot/readback.py ``ReadBack.tcp``). ``takes_motion_points``: likewise for the motion
+    events' ``target``, ``point`` (the programmed end point, made by a forward kinematics) and
+    ``limits``: an observer that says false gets the motion events without them.
     """
 
     takes_poses = True
+    takes_motion_points = True
 
     def __init__(self, target: str | Path | IO[str] | None = None, *, keep: bool = False,
                  pose_every: int = 1, repeats: int | None = None) -> None:

@@ -74,3 +74,34 @@ def test_an_observer_without_poses_gets_none_and_the_run_is_the_same(tmp_path):
     writer.flush()
     assert sum('"kind":"pose"' in line for line in writer.lines) >= int(res_a.sim_time / 0.012) - 1
     assert RunObserver(inner=writer).takes_poses
+
+
+class _Fields(RunObserver):
+    """A RunObserver that keeps the fields of each motion event it is handed."""
+
+    def __init__(self, inner=None):
+        super().__init__(inner=inner)
+        self.seen = []
+
+    def write(self, kind, t, **fields):
+        if kind == "motion":
+            self.seen.append(fields)
+        return super().write(kind, t, **fields)
+
+
+def test_an_observer_without_a_trace_gets_the_motion_events_without_their_end_points(tmp_path):
+    """The controller makes a motion event's programmed end point (a forward kinematics), target
+    and limits only for an observer that takes them (robot/trace.py ``takes_motion_points``):
+    RunObserver alone does not; in front of a trace it does, and the trace has them. The run,
+    and what the observer records of the motions, are the same."""
+    bare, traced, writer = _Fields(), _Fields(), TraceWriter()
+    assert not bare.takes_motion_points and TraceWriter.takes_motion_points
+    a, b = _run(tmp_path, None, bare), _run(tmp_path, writer, traced)      # make_runtime puts the trace behind it
+    assert traced.inner is writer and traced.takes_motion_points
+    assert a == b
+    assert len(bare.seen) == len(traced.seen) >= 4 and bare.motion_types == traced.motion_types == {1: "PTP", 2: "PTP"}
+    assert all("point" not in f and "limits" not in f and "target" not in f for f in bare.seen)
+    assert [(f["id"], f["phase"], f["line"]) for f in bare.seen] == [(f["id"], f["phase"], f["line"]) for f in traced.seen]
+    assert all(len(f["point"]) == 6 for f in traced.seen)
+    writer.flush()
+    assert sum('"kind":"motion"' in line and '"point"' in line for line in writer.lines) == len(traced.seen)
