@@ -167,8 +167,9 @@ def _below(v_of_u: Any, base: Any, u0: float, u1: float) -> bool:
     step = (u1 - u0) / 25          # numpy's linspace(u0, u1, 26)[1:-1], bit for bit, without numpy
     us = [i * step + u0 for i in range(1, 25)]
     us += [b for b in getattr(base, "bounds", ()) if u0 < b < u1]
+    du, t_of_u = base.du, base.t_of_u
     for u in us:
-        vb = base.du(base.t_of_u(float(u)))
+        vb = du(t_of_u(float(u)))
         if v_of_u(float(u)) > vb * (1.0 + 1e-6) + 1e-12:
             # at a section bound the planned speed is the junction speed: compare with the
             # smaller of the speeds just before and after
@@ -248,9 +249,10 @@ def plan_blend(prev: Segment, nxt: Segment, keyword: str, tau_a: float) -> Blend
                 hi = mid
         rp = RampProfile(base, lo, max(0.0, tau_p - ramp_time(lo)))
     rev = (prev.qd_end * nxt.qd_start) < 0
-    a_sum = np.abs(prev.qd_end) * bp.a_b + np.abs(nxt.qd_start) * rp.a_r
-    if np.any(rev & (a_sum > prev.model.a_max * (1.0 + 1e-6))):
-        return None
+    if rev.any():                       # only an axis that reverses can add up both accelerations
+        a_sum = np.abs(prev.qd_end) * bp.a_b + np.abs(nxt.qd_start) * rp.a_r
+        if np.any(rev & (a_sum > prev.model.a_max * (1.0 + 1e-6))):
+            return None
     if blend_space(prev, nxt) == "joint" and tau_p > 0.0 and \
             _joint_blend_acc_ratio(prev, bp, nxt, rp, tau_p) > 1.0 + 1e-6:
         return None

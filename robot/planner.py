@@ -687,6 +687,7 @@ class CartSegment(Segment):
         self._ub = self.u_bounds.tolist()
         self.lengths = np.array([p.length for p in pieces])
         self.s_bounds = np.concatenate([[0.0], np.cumsum(self.lengths)])
+        self._sb, self._lens = self.s_bounds.tolist(), self.lengths.tolist()     # for u_of_path
         # orientation of piece k at fraction f: R_k · exp(f · r_k) (= slerp, reference §6.7)
         self._R = rots
         self._rv = [rotvec_of(rots[k].T @ rots[k + 1]) for k in range(len(pieces))]
@@ -921,15 +922,15 @@ class CartSegment(Segment):
         return self.model.solve_position(p, wrist, ref, self.tool_T, self.base_inv_T)
 
     def u_of_path(self, s: float) -> float:
-        sb = self.s_bounds
+        sb, ub = self._sb, self._ub         # s_bounds and u_bounds as floats (the same numbers)
         if sb[-1] <= 0:
             return 0.0
         s = min(max(s, 0.0), sb[-1])
-        k = int(np.searchsorted(sb, s, side="right")) - 1
+        k = bisect_right(sb, s) - 1         # np.searchsorted(s_bounds, s, side="right") - 1
         k = min(max(k, 0), len(self.pieces) - 1)
-        L = self.lengths[k]
+        L = self._lens[k]
         f = (s - sb[k]) / L if L > 0 else 1.0
-        return float(self.u_bounds[k] + f * (self.u_bounds[k + 1] - self.u_bounds[k]))
+        return float(ub[k] + f * (ub[k + 1] - ub[k]))
 
     def s_of_u(self, u: float) -> float:
         k, f = self._locate(u)
