@@ -32,7 +32,8 @@ from __future__ import annotations
 
 import math
 from bisect import bisect_right
-from collections.abc import Callable
+from itertools import accumulate
+from collections.abc import Callable, Hashable
 from dataclasses import dataclass
 from typing import Any
 
@@ -682,18 +683,19 @@ class CartSegment(Segment):
         W = float(sum(weights))
         self.W = W
         self.joint_ori = req.params.ori_type == "JOINT" and req.kind != "SPLINE"
-        cw = np.concatenate([[0.0], np.cumsum(weights)])
+        cw = np.array([0.0, *accumulate(weights)])     # np.cumsum's sums, in its order
         self.u_bounds = cw / W if W > 0 else np.linspace(0.0, 1.0, len(pieces) + 1)
         self._ub = self.u_bounds.tolist()
-        self.lengths = np.array([p.length for p in pieces])
-        self.s_bounds = np.concatenate([[0.0], np.cumsum(self.lengths)])
-        self._sb, self._lens = self.s_bounds.tolist(), self.lengths.tolist()     # for u_of_path
+        self._lens = [float(p.length) for p in pieces]
+        self.lengths = np.array(self._lens)
+        self._sb = [0.0, *accumulate(self._lens)]     # s_bounds as floats, for u_of_path
+        self.s_bounds = np.array(self._sb)
         # orientation of piece k at fraction f: R_k · exp(f · r_k) (= slerp, reference §6.7)
         self._R = rots
         self._rv = [rotvec_of(rots[k].T @ rots[k + 1]) for k in range(len(pieces))]
         # a piece without orientation change (a LIN that keeps the start orientation): its
         # R_k · exp(f · 0) once, instead of a product with the identity every cycle
-        self._R_still = [self._R[k] @ rotvec_matrix(np.zeros(3)) if float(np.linalg.norm(rv)) < 1e-12
+        self._R_still = [self._R[k] @ _EYE3 if float(np.linalg.norm(rv)) < 1e-12     # rotvec_matrix(0)
                          else None for k, rv in enumerate(self._rv)]
         self._path_end: np.ndarray | None = None      # tcp_dist_to_end's end point, once
 
@@ -952,6 +954,20 @@ class CartSegment(Segment):
         return self.ori_angle_to_end(0.0)
 
 
+_SAMPLES: dict[tuple[float, float, int], np.ndarray] = {}
+
+
+def _samples(a: float, b: float, n: int) -> np.ndarray:
+    """``np.linspace(a, b, n)``, kept (read-only) by its arguments: the planning walk samples
+    most pieces on the same parameters (a single LIN: 0 to 1)."""
+    return _kept(_SAMPLES, (a, b, n), lambda: _readonly(np.linspace(a, b, n)))
+
+
+def _readonly(A: np.ndarray) -> np.ndarray:
+    A.setflags(write=False)
+    return A
+
+
 def gradient_rows(f: np.ndarray, h: float) -> np.ndarray:
     """``np.gradient(f, h, axis=0, edge_order=2)`` of the rows of `f` (at least 3, spacing `h`, a
     Python float), the same operations in the same order as numpy 2's (central differences
@@ -970,7 +986,7 @@ _FRAME_OF: dict[bytes, tuple[float, ...]] = {}
 _MATRIX_OF: dict[bytes, np.ndarray] = {}
 
 
-def _kept(table: dict, key: bytes, make: Callable[[], Any]) -> Any:
+def _kept(table: dict, key: Hashable, make: Callable[[], Any]) -> Any:
     """``table[key]``, made by `make()` the first time (the table is cleared when it holds
     :data:`FRAME_MEMO` entries): the one bounded memo of the planner's conversions."""
     got = table.get(key)
@@ -983,6 +999,7 @@ def _kept(table: dict, key: bytes, make: Callable[[], Any]) -> Any:
 
 _INVERSE_OF: dict[bytes, tuple[np.ndarray, bool, bool]] = {}
 _EYE4 = np.eye(4)
+_EYE3 = np.eye(3)
 
 
 def _inverse_of(T: np.ndarray) -> tuple[np.ndarray, bool, bool]:
@@ -1530,7 +1547,7 @@ def _plan_cart(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_T: 
         nk = max(4, min(48, int(L / 50.0) + int(th / 10.0) + 4))
         start = ref
         while True:
-            us = np.linspace(float(ub[k]), float(ub[k + 1]), nk + 1)
+            us = _samples(float(ub[k]), float(ub[k + 1]), nk + 1)
             Q = np.empty((nk + 1, len(q0)))
             Q[0] = start
             ref = start
@@ -1546,14 +1563,15 @@ def _plan_cart(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_T: 
                 chain = cp.chain_u(us[1:], seg.status, ref) if cp else None
                 if chain is None:
                     chain = seg.ik_chain_compiled([seg.pose_u(float(us[j])) for j in range(1, nk + 1)], ref)
+            jumps = None
             if chain is not None:
                 # the same rows as the loop below; its singularity check, in its order
-                jumps = np.abs(np.diff(np.concatenate([Q[:1], chain]), axis=0))
+                Q[1:] = chain
+                jumps = np.abs(np.diff(Q, axis=0))
                 for j in np.flatnonzero(jumps.max(axis=1) > SINGULAR_JUMP_DEG)[:1].tolist():
                     i = int(np.argmax(jumps[j]))
                     raise RobotError(f"CP path through a singularity: A{i + 1} would turn "
                                      f"{jumps[j][i]:.0f} deg at once (keep the status on CP paths)")
-                Q[1:] = chain
                 ref = Q[nk].copy()
             for j in range(1, nk + 1 if chain is None else 1):
                 if seg.joint_ori:
@@ -1570,7 +1588,10 @@ def _plan_cart(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_T: 
                 ref = q
             # resolution: at most ~1° of any axis between samples (near a wrist singularity
             # A4/A6 turn fast on a short piece of path), up to CP_MAX_SAMPLES per piece
-            step = float(np.max(np.abs(np.diff(Q, axis=0)))) if nk > 0 else 0.0
+            if nk <= 0:
+                step = 0.0
+            else:
+                step = float((jumps if jumps is not None else np.abs(np.diff(Q, axis=0))).max())
             if step <= CP_SAMPLE_STEP_DEG or nk >= CP_MAX_SAMPLES:
                 break
             nk = min(CP_MAX_SAMPLES, int(nk * step / CP_SAMPLE_STEP_DEG) + 1)
@@ -1591,10 +1612,12 @@ def _plan_cart(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_T: 
         # next to a corner the axis velocity turns within one IPO cycle (up to half of a_max,
         # junction rule below) while the path brakes: the piece keeps the other half
         budget = 0.5 if (kink[k] or kink[k + 1]) else 1.0
-        with np.errstate(divide="ignore"):
-            V = float(np.min(np.where(qd > 1e-9, v_ax / qd, np.inf)))
-            if not plain:
-                V = min(V, float(np.min(np.where(qdd > 1e-9, np.sqrt(0.5 * budget * a_ax / qdd), np.inf))))
+        # v/x where x > 1e-9, else inf (x: 1.0 where not taken, so that nothing divides by 0)
+        moves, turns = qd > 1e-9, qdd > 1e-9
+        qd_safe, qdd_safe = np.where(moves, qd, 1.0), np.where(turns, qdd, 1.0)
+        V = float(np.where(moves, v_ax / qd_safe, np.inf).min())
+        if not plain:
+            V = min(V, float(np.where(turns, np.sqrt(0.5 * budget * a_ax / qdd_safe), np.inf).min()))
         if model.mode == "T1":
             F = model.kin.forward_many(Q)
             dpf = float(np.max(np.linalg.norm(np.diff(F[:, :3, 3], axis=0), axis=1))) / h
@@ -1603,8 +1626,7 @@ def _plan_cart(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_T: 
                 V = min(V, T1_SPEED_MM_S / (dpf * T1_MARGIN))
         vmax[k] = min(vmax[k], V)
         if not plain:
-            with np.errstate(divide="ignore"):
-                Aax = float(np.min(np.where(qd > 1e-9, (budget * a_ax - qdd * vmax[k] ** 2) / qd, np.inf)))
+            Aax = float(np.where(moves, (budget * a_ax - qdd * vmax[k] ** 2) / qd_safe, np.inf).min())
             amax[k] = min(amax[k], max(Aax, 1e-9))
         sec_d.append((qd, qdd, budget))
 
