@@ -39,12 +39,16 @@ def _frame(s: Struct) -> tuple:
 frame_of = _frame     # a FRAME value as (X, Y, Z, A, B, C) mm/deg ($TOOL, $BASE)
 
 
+#: the defaults of an unset value (a frozen MotionParams, made once)
+_INITMOV = MotionParams()
+
+
 def params_from(store: dict, link=None) -> MotionParams:
     """A MotionParams snapshot of the system-variable store (unset values: INITMOV defaults);
     `link`: ``(system, root, offset)`` when ``$BASE`` is linked to a BASE kinematic (KSS ``EK``:
     interp/runtime/sysvars.py ``base_link``): the motion's base is then the offset on the
     kinematic's flange, which turns with its external axes."""
-    d = MotionParams()
+    d = _INITMOV
     vel, acc, apo = store["$VEL"], store["$ACC"], store["$APO"]
     va, aa = store["$VEL_AXIS"].data, store["$ACC_AXIS"].data
     return MotionParams(
