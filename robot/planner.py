@@ -1000,6 +1000,7 @@ def _kept(table: dict, key: Hashable, make: Callable[[], Any]) -> Any:
 _INVERSE_OF: dict[bytes, tuple[np.ndarray, bool, bool]] = {}
 _EYE4 = np.eye(4)
 _EYE3 = np.eye(3)
+_Z3, _Z33, _Z333 = np.zeros(3), np.zeros((3, 3)), np.zeros((3, 3, 3))   # _cart_path's empty entries
 
 
 def _inverse_of(T: np.ndarray) -> tuple[np.ndarray, bool, bool]:
@@ -1041,31 +1042,36 @@ def _cart_path(sc: Any, seg: "CartSegment") -> Any:
     lines and arcs with the rotations ``CartSegment.pose_u`` holds, other pieces (splines, a
     ``#PATH`` orientation) marked for the Python code; None when no piece is mirrored."""
     n = len(seg.pieces)
-    kinds = np.full(n, -1, dtype=np.intc)
-    mid_ok = np.zeros(n, dtype=np.intc)
-    length, r, angle = np.zeros(n), np.ones(n), np.zeros(n)
-    a, b, c = np.zeros((n, 3)), np.zeros((n, 3)), np.zeros((n, 3))
-    rots = np.zeros((n, 3, 3, 3))
+    # the tables as lists first, each made an array once (a line: a = p0, b = dir; an arc: a = centre,
+    # b = e1, c = e2, r, angle; rots: the rotations at f <= 0, within, at f >= 1)
+    kinds, mid_ok = [-1] * n, [0] * n
+    length, r, angle = [0.0] * n, [1.0] * n, [0.0] * n
+    a, b, c = [_Z3] * n, [_Z3] * n, [_Z3] * n
+    rots: list[Any] = [_Z333] * n
     for k, pc in enumerate(seg.pieces):
         mode = seg.ori[k]
+        if type(pc) is LinePiece:
+            kind, pa, pb, pcc, pr, pang = 0, pc.p0, pc.dir, _Z3, 1.0, 0.0
+        elif type(pc) is ArcPiece:
+            kind, pa, pb, pcc, pr, pang = 1, pc.c, pc.e1, pc.e2, pc.r, pc.angle
+        else:
+            continue
         if mode == "VAR":
-            rots[k, 0], rots[k, 2] = seg._R[k], seg._R[k + 1]
-            if seg._R_still[k] is not None:
-                rots[k, 1], mid_ok[k] = seg._R_still[k], 1
+            still = seg._R_still[k]
+            rots[k] = (seg._R[k], _Z33 if still is None else still, seg._R[k + 1])
+            mid_ok[k] = 0 if still is None else 1
         elif mode == "CONSTANT":
-            rots[k, 0] = rots[k, 1] = rots[k, 2] = seg._R[k]
+            rots[k] = (seg._R[k],) * 3
             mid_ok[k] = 1
         else:
             continue
-        if type(pc) is LinePiece:
-            kinds[k], a[k], b[k] = 0, pc.p0, pc.dir
-        elif type(pc) is ArcPiece:
-            kinds[k], a[k], b[k], c[k], r[k], angle[k] = 1, pc.c, pc.e1, pc.e2, pc.r, pc.angle
-        else:
-            continue
-        length[k] = pc.length
-    if not (kinds >= 0).any():
+        kinds[k], a[k], b[k], c[k], r[k], angle[k], length[k] = kind, pa, pb, pcc, pr, pang, pc.length
+    if max(kinds) < 0:
         return None
+    kinds_a, mid_a = np.array(kinds, dtype=np.intc), np.array(mid_ok, dtype=np.intc)
+    length_a, r_a, angle_a = np.array(length, dtype=float), np.array(r, dtype=float), np.array(angle, dtype=float)
+    a_a, b_a, c_a = np.array(a, dtype=float), np.array(b, dtype=float), np.array(c, dtype=float)
+    rots_a = np.array(rots, dtype=float)
     opw = seg.compiled_inverse() or None
     gemm = 0
     if opw is None:
@@ -1075,7 +1081,8 @@ def _cart_path(sc: Any, seg: "CartSegment") -> Any:
             gemm = _frames_gemm(sc) if opw is not None else 0
             if not gemm:
                 opw = None
-    cp = sc.CartPath(opw, np.asarray(seg._ub, dtype=float), kinds, mid_ok, length, r, angle, a, b, c, rots)
+    cp = sc.CartPath(opw, np.asarray(seg._ub, dtype=float), kinds_a, mid_a, length_a, r_a, angle_a, a_a, b_a, c_a,
+                     rots_a)
     if gemm:
         cp.use_frames(gemm, seg._ik_base, seg._ik_tool)
         seg._c_framed = True
