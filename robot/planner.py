@@ -1137,6 +1137,8 @@ def _cart_target(req_target: dict[str, float], start_T: np.ndarray, relative: bo
         out[:3, :3] = D[:3, :3] @ start_T[:3, :3]
         out[:3, 3] = start_T[:3, 3] + D[:3, 3]
         return out
+    if all(k in req_target for k in CART_KEYS):     # complete: nothing from the start pose
+        return frame_to_matrix(*[float(req_target[k]) for k in CART_KEYS])
     start6 = _frame_of(start_T)
     if all(k in req_target for k in ("A", "B", "C")):
         return frame_to_matrix(*_apply_partial(start6, req_target))
