@@ -73,7 +73,8 @@ key of the task's state at each iteration of its LOOP that comes again makes a p
 with the state at the end of each cycle's time slice put in place, woken from the last boundary
 before where it stands, and parked again after a wake at the next boundary whose key is one of
 the period's (a *probe*). Another task's step does not end such a recording unless it writes what
-the period reads or writes.
+the period reads or writes. After a failed probe, passes are looked for first again
+(:data:`PASSES_AFTER_PROBE`: a task that settles after its input changed is a plain spin).
 
 An observer of the controller alone (the controller's ``trace`` while the runtime's is None:
 interp/summary.py ``RunObserver`` behind ``krl run``'s summary, interp/outcomes.py and
@@ -105,6 +106,15 @@ MAX_GAP = 256
 #: the longest wait between two recordings of a spin that could not be parked when recorded
 #: (what it reads was about to change), in IPO cycles: parked at most this late once it may be
 MAX_WAIT_GAP = 16
+#: pass recordings in a row that changed what they wrote before the next recording of a task looks
+#: for a period again (interp/runtime/period.py) once a wake found its state none of its period's
+#: (a failed probe). Until then one such pass is enough: a clock generator is found at once. After a
+#: changed input a task often settles into a plain spin instead (the palletizer's SPS.SUB: two
+#: passes that write something new, then the same pass for ever), which a pass recording parks in
+#: two passes where a periodic one takes ~1 400 steps (the slice offset comes back only after dozens
+#: of passes): with 1 here, each of the automatic cell's answers cost it a periodic recording,
+#: 600 s in 6.9 s of CPU instead of 1.3 s (2026-11-26, tools/whole_run_bench.py).
+PASSES_AFTER_PROBE = 3
 
 
 class _Parked:
@@ -214,6 +224,8 @@ class SpinWatch(PeriodicSpins):
         self.probes: dict = {}      # id(task) -> the Period to probe for at its next boundary
         self.period_fails: dict = {}    # id(task) -> its periodic recordings that failed
         self.period_due: dict = {}      # id(task) -> the cycle before which none is tried again
+        self.changed: dict = {}     # id(task) -> its pass recordings in a row that changed what they wrote
+        self.needed: dict = {}      # id(task) -> how many before a period is looked for (1 if absent)
         self.periods = self.probe_parks = 0
 
     # ------------------------------------------------------------------ when
@@ -280,9 +292,16 @@ class SpinWatch(PeriodicSpins):
     def _fail(self, why: str) -> None:
         self.why[why] = self.why.get(why, 0) + 1
         rec = self.rec
-        if rec is not None and rec.probe is None:
-            # a pass that changed what it wrote, or the state beside it, may be periodic: the
-            # next recording looks for a period; a failed periodic one for a pass again
+        if rec is not None and rec.probe is not None:
+            # the state after a wake is none of the period's: passes are looked for first again
+            # (the task may settle into a plain spin, far cheaper to record: PASSES_AFTER_PROBE)
+            self.periodic.discard(id(rec.task))
+            self.changed.pop(id(rec.task), None)
+            self.needed[id(rec.task)] = PASSES_AFTER_PROBE
+        elif rec is not None:
+            # a pass that changed what it wrote, or the state beside it (PASSES_AFTER_PROBE in a
+            # row after a failed probe), may be periodic: the next recording looks for a period;
+            # a failed periodic one for a pass again
             key = id(rec.task)
             # (the submit interpreter's programs only, a .sub run as the program included: the
             # robot interpreter's loops are no clock generators, and a periodic recording of a
@@ -290,7 +309,9 @@ class SpinWatch(PeriodicSpins):
             # time slices of the robot program: tests/vm/test_fast_paths.py)
             if not rec.periodic and not rec.task.limited and \
                     (why in ("writes", "second") or why.startswith("wrote ")):
-                self.periodic.add(key)
+                n = self.changed[key] = self.changed.get(key, 0) + 1
+                if n >= self.needed.get(key, 1):
+                    self.periodic.add(key)
             elif rec.periodic:
                 self.periodic.discard(key)
                 if why in ("period: no state repeats", "period: none"):
@@ -309,6 +330,7 @@ class SpinWatch(PeriodicSpins):
         task.watched = False
         key = id(task)
         if ok:
+            self.changed.pop(key, None)
             gap = 1 if parks else min(MAX_WAIT_GAP, 2 * self.gap.get(key, 1))
         else:
             gap = min(MAX_GAP, 2 * self.gap.get(key, 1))

@@ -153,3 +153,49 @@ def test_a_counter_is_no_period(tmp_path, interp):
     sw = rt.scheduler.spin
     assert sw.periods == 0
     assert sw.why.get("period: no state repeats", 0) >= 1
+
+
+#: a pass that settles in two passes after its input changes: A follows $IN[5], B follows A
+SETTLING_SPS = """
+DEF sps()
+  LOOP
+    B = A
+    A = $IN[5]
+    IF B THEN
+      $OUT[5] = TRUE
+    ELSE
+      $OUT[5] = FALSE
+    ENDIF
+  ENDLOOP
+END
+"""
+
+SETTLING_DAT = """
+DEFDAT prog PUBLIC
+  DECL GLOBAL BOOL A = TRUE
+  DECL GLOBAL BOOL B = FALSE
+ENDDAT
+"""
+
+#: $IN[5] on at 1 s, off at 2 s, ... (each change wakes the parked task)
+TOGGLES = "".join(f"- at: {t}.0\n  set: {{\"$IN[5]\": {'true' if t % 2 else 'false'}}}\n" for t in range(1, 5))
+
+
+@pytest.mark.parametrize("interp", INTERPS)
+def test_a_task_that_settles_after_its_input_changed_is_parked_as_a_pass(tmp_path, interp):
+    """Its first passes write A and B anew: the first recording looks for a period and finds
+    one (the settled state, where the slice ends in the pass being part of its key). Each input
+    change then wakes it into a state none of that period's (the probe fails), and it settles
+    again in two passes: a plain pass is looked for first (spin.PASSES_AFTER_PROBE), which
+    parks it after those two, not another periodic recording of dozens of passes (the
+    palletizer's SPS.SUB at each answer of the automatic cell). $OUT[5] follows $IN[5] two
+    passes late, in the cycle of the change: at 1.008, 2.004, 3.000 and 4.008 s."""
+    rt, res = same_run(tmp_path, "DEF prog()\n  WAIT SEC 5.0\nEND\n", SETTLING_SPS, SETTLING_DAT, interp,
+                       max_sim_time=6.0, stimuli=TOGGLES)
+    assert res.reason == "completed"
+    assert [(round(t, 3), n, v) for t, n, v, _s in rt.controller.io.log if n == "$OUT[5]"] == \
+        [(0.0, "$OUT[5]", True), (0.0, "$OUT[5]", False), (1.008, "$OUT[5]", True), (2.004, "$OUT[5]", False),
+         (3.0, "$OUT[5]", True), (4.008, "$OUT[5]", False)]
+    sw = rt.scheduler.spin
+    assert sw.periods == 1 and sw.wakes >= 4 and sw.parks >= 5      # (5 periods with one pass enough)
+    assert sw.skipped > 0.9 * res.steps
