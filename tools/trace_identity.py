@@ -167,7 +167,8 @@ def record(checkout: Path, out: Path, interps: list[str], limit: int = 0, corpus
                 rt, _ = make_runtime(run_spec(p, **kw)) if run_spec is not None else make_runtime(p, **kw)
                 res = rt.run()
                 tw.close()
-                summary["end"] = [res.reason, res.text, res.file and str(res.file).replace(str(checkout), "<ROOT>"),
+                summary["end"] = [res.reason, (res.text or "").replace(str(checkout), "<ROOT>"),
+                                  res.file and str(res.file).replace(str(checkout), "<ROOT>"),
                                   res.line, round(res.sim_time, 6), res.steps]
             except Exception as exc:  # noqa: BLE001 - recorded: an internal error is a difference too
                 summary["end"] = ["exception", f"{type(exc).__name__}: {exc}".replace(str(checkout), "<ROOT>")]
