@@ -388,8 +388,14 @@ class SystemSoftware:
     def summary(self) -> list[tuple[str, str, int]]:
         """(name, what, uses) of every stand-in of the run, most used first: the calls of a
         routine, the statements of a statement; a variable and a type count once (how often an
-        interpreter looks a variable up is its own business: the two interpreters differ)."""
-        out = [(st.name, st.what, self.uses[k]) for k, st in self.standins.items()]
+        interpreter looks a variable up is its own business: the two interpreters differ). A
+        procedure's calls include those of the steps the spin watch counted without running
+        them (interp/runtime/passes.py ``stub_uses``): the count of a run without the watch."""
+        uses = Counter(self.uses)
+        sched = getattr(self.rt, "scheduler", None)
+        if sched is not None:       # the calls of the steps a parked task was counted (spin.py)
+            sched.spin.parked_stub_uses(uses)
+        out = [(st.name, st.what, uses[k]) for k, st in self.standins.items()]
         for name in sorted(self.rt.program.stubs):
             if name.upper() not in self.standins and not name.startswith("STMT "):
                 out.append((name, "type", 1))

@@ -16,7 +16,10 @@ from .sysvars import _LIVE
 #: (interp/runtime/natives/registry.py). Not pure, so a pass that calls them is never parked:
 #: FRAND (a random number), the message and dialog routines that write (SET_KRLMSG, CLEAR_KRLMSG,
 #: SET_KRLDLG), CWRITE/COPEN/CREAD (the command channel), PULSE, ERR_RAISE/ERR_CLEAR ($ERR), the
-#: network's (EKI_*, RSI_*), and every stand-in of KUKA's software (counted per call).
+#: network's (EKI_*, RSI_*). A stand-in procedure of KUKA's software (interp/runtime/kss.py: no
+#: effect, its uses counted) called as a statement of its own line is allowed: the pass keeps
+#: which steps call one (``stub_lines``), and the uses of the steps parking skips are counted
+#: (:func:`stub_uses`); a stand-in function is not (its value is not known to be constant).
 PURE_NATIVES = frozenset(name for name, native in REGISTRY.items() if native.pure)
 
 #: system variables whose value the main run changes as the robot moves (interp/runtime/sysvars.py
@@ -58,7 +61,8 @@ class Pass:
     cycle, one that settles only after an input changed: interp/runtime/watch.py
     ``settles``), ``probes`` (the state variables it reads)."""
 
-    __slots__ = ("events", "infos", "at", "frames", "images", "io", "motion", "cyclic", "probes", "refs")
+    __slots__ = ("events", "infos", "at", "frames", "images", "io", "motion", "cyclic", "probes", "refs",
+                 "stub_lines", "stubs")
     periodic = False
 
     def __init__(self, events, infos, at, frames, images) -> None:
@@ -72,10 +76,34 @@ class Pass:
         self.cyclic = False
         self.probes: tuple = ()
         self.refs = None            # the references of the probes, found when first read
+        self.stub_lines: dict = {}  # (file, line) -> UPPER name of the stand-in procedure it calls
+        self.stubs = None           # per step: that name or None (from stub_lines, when first asked)
 
     @property
     def steps(self) -> int:
         return len(self.events)
+
+
+def stub_uses(spin: Pass, start: int, count: int, into) -> None:
+    """Add to the counter `into` (interp/runtime/kss.py ``SystemSoftware.uses``) the stand-in
+    calls of the `count` steps of `spin` from step `start` on (cyclically: the pass or period
+    repeats), which parking counted and did not run."""
+    if not spin.stub_lines or count <= 0:
+        return
+    steps = spin.stubs
+    if steps is None:
+        lines = spin.stub_lines
+        steps = spin.stubs = tuple([None if tick else lines.get((f, line)) for f, line, tick, _d in spin.events])
+    n = len(steps)
+    whole, rest = divmod(count, n)
+    if whole:
+        for name in steps:
+            if name is not None:
+                into[name] += whole
+    for i in range(start, start + rest):
+        name = steps[i % n]
+        if name is not None:
+            into[name] += 1
 
 
 def chain(frame):

@@ -46,7 +46,7 @@ from krl.semantics.resolve import NATIVE, ROUTINE, SYSTEM, UNRESOLVED
 from .convert import assign_into
 from .idle import _frames, _store, freeze
 from .memory import Slot
-from .passes import ALLOWED, CLOCK_NAMES, MAX_PASS_STEPS, PURE_NATIVES, STATE_NAMES, Pass, chain, written
+from .passes import ALLOWED, CLOCK_NAMES, MAX_PASS_STEPS, PURE_NATIVES, STATE_NAMES, Pass, chain, stub_uses, written
 from .sysvars import _LIVE
 from .values import Arr, Struct, copy_value
 from .watch import CONSTANT, IO
@@ -495,6 +495,7 @@ class PeriodicSpins:
         if found is None:
             return False
         spin.io, spin.motion, spin.cyclic, spin.probes = found.io, found.motion, found.cyclic, found.probes
+        spin.stub_lines = found.stub_lines
         return True
 
     @staticmethod
@@ -558,6 +559,7 @@ class PeriodicSpins:
         tick = spin.tick_before(target)
         left = target - tick.pos
         self.skipped -= left
+        stub_uses(spin, p.pos0, p.done - left, self.rt.kss.uses)     # the steps it skipped
         io = rt.controller.io
         idle = rt.scheduler.idle
         now, clock = timers_image(io, spin.timers), idle.clock

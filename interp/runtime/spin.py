@@ -91,13 +91,14 @@ from greenlet import getcurrent
 
 from krl.ast import nodes as N
 from krl.semantics.advance import accesses
-from krl.semantics.resolve import LOCAL, NATIVE, ROUTINE, SYSTEM, UNRESOLVED
+from krl.semantics.resolve import LOCAL, NATIVE, ROUTINE, STUB, SYSTEM, UNRESOLVED
 
 from .idle import _frames, _store, freeze
 from .memory import Slot
 from .passes import (ALLOWED, IO_NAMES, MAX_PASS_STEPS, MOTION_NAMES, PURE_NATIVES, STATE_NAMES, chain,
                      written)
 from .passes import Pass as _Pass
+from .passes import stub_uses
 from .period import MAX_STATE_CYCLES, Period, PeriodicSpins, set_timers, timers_image
 from .sysvars import CONSTANT_NAMES
 
@@ -588,6 +589,7 @@ class SpinWatch(PeriodicSpins):
         """What the recorded pass reads (module docstring), or None when it is not a spin."""
         io = motion = cyclic = False
         probes = []
+        stub_lines = {}
         for node in rec.nodes.values():
             if node is None:
                 continue
@@ -599,6 +601,15 @@ class SpinWatch(PeriodicSpins):
                     callee = getattr(x.ann, "callee", None) if x.ann is not None else None
                     if callee is None:
                         return None
+                    if callee.kind == STUB or (callee.kind == NATIVE and callee.native is None):
+                        # a stand-in (interp/runtime/kss.py): a procedure statement alone on its
+                        # line (its step is known by file and line), not yet any function
+                        info = getattr(node.ann, "info", None) if node.ann is not None else None
+                        if node.__class__ is not N.CallStmt or x is not node.call or info is None or \
+                                len(self.statements(info) or ()) != 1:
+                            return None
+                        stub_lines[(info.file, info.line)] = callee.name.upper()
+                        continue
                     if callee.kind == NATIVE:
                         if callee.name.upper() not in PURE_NATIVES:
                             return None
@@ -623,6 +634,7 @@ class SpinWatch(PeriodicSpins):
                     probes.append(key)
         spin = _Pass(tuple(rec.events), None, None, None, None)
         spin.io, spin.motion, spin.cyclic, spin.probes = io, motion, cyclic, tuple(probes)
+        spin.stub_lines = stub_lines
         return spin
 
     def _may_park(self, spin: _Pass) -> bool:
@@ -694,6 +706,15 @@ class SpinWatch(PeriodicSpins):
         self._place(task)
         self._update()
         rt.yield_cycle(task)            # until the scheduler resumes it, or a catch-up
+
+    def parked_stub_uses(self, into) -> None:
+        """Add to the counter `into` the stand-in calls (interp/runtime/passes.py ``stub_uses``)
+        of the steps the parked tasks have been counted since they parked but the last (a step
+        is counted before it runs: the last one of a time slice runs when the task resumes):
+        what their runs would have called by now (a wake counts them into the run's own counter)."""
+        for task in self.parked:
+            p = task.parked
+            stub_uses(p.spin, p.pos0, p.done - 1, into)
 
     def parked_ok(self, task) -> bool:
         """Nothing pending for `task` (an interrupt, a TRIGGER, an error) and parking still allowed."""
@@ -843,6 +864,7 @@ class SpinWatch(PeriodicSpins):
         else:
             left = p.done % spin.steps
             self.skipped -= left
+            stub_uses(spin, 0, p.done - left, self.rt.kss.uses)     # the whole passes it skipped
             if left:
                 self._catch_up(task, [spin, 0, left], left)
         self._update()
@@ -895,4 +917,5 @@ class SpinWatch(PeriodicSpins):
 def _copy_with(spin: _Pass, rec: _Recording) -> _Pass:
     out = _Pass(spin.events, rec.infos, rec.at, rec.frames, rec.images)
     out.io, out.motion, out.cyclic, out.probes = spin.io, spin.motion, spin.cyclic, spin.probes
+    out.stub_lines = spin.stub_lines
     return out

@@ -391,3 +391,26 @@ def test_a_submit_program_selected_alone_runs_at_the_submit_pace(tmp_path, inter
     assert res.steps == 101 * SUBMIT_BUDGET
     assert rt.scheduler.spin.parks == 0
 
+
+
+#: the submit program calls a routine nothing of the program defines, declared EXT (installed
+#: software: interp/runtime/kss.py stands in for it, no effect, each call counted)
+STANDIN_SPS = SPS.replace("DEF sps()\n", "DEF sps()\n  EXT PULSGEN()\n").replace("    CHECK()\n", "    PULSGEN()\n    CHECK()\n")
+
+
+@pytest.mark.parametrize("interp", INTERPS)
+def test_a_pass_that_calls_a_stand_in_procedure_is_parked_and_its_calls_are_counted(tmp_path, interp):
+    """A stand-in procedure has no effect but its count (the run summary's uses): the pass is
+    parked, and the uses of the steps parking counted without running them are added, so the
+    summary's count is the unparked run's — at the end of the run (still parked) and after each
+    wake (FLAG at 3 s, $IN[5] at 20 s). History 04 old's SPS.SUB calls two such routines
+    (PulsGen12ms, Pdetection: not in its backup) in its loop: 600 s took 20 s of CPU, 1.8 s now."""
+    stim = "- at: 20.0\n  set: {\"$IN[5]\": true}\n"
+    off, r_off = _run(tmp_path, PROG.replace("WAIT SEC 1.0", "WAIT SEC 8.0"), STANDIN_SPS, interp=interp,
+                      enabled=False, stimuli=stim)
+    on, r_on = _same_run(tmp_path, PROG.replace("WAIT SEC 1.0", "WAIT SEC 8.0"), STANDIN_SPS, interp, stimuli=stim)
+    uses = dict((name, n) for name, _what, n in off.kss.summary())
+    assert uses["PULSGEN"] > 1000
+    assert on.kss.summary() == off.kss.summary()
+    sw = on.scheduler.spin
+    assert sw.parks >= 2 and sw.wakes >= 2 and sw.skipped > 0.9 * r_on.steps
