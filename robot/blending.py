@@ -350,7 +350,9 @@ def reached_pose(seg: Segment, p: np.ndarray, R: np.ndarray, ref: np.ndarray,
 def _close(a: np.ndarray, b: np.ndarray) -> bool:
     """``np.allclose(a, b)``, at once for the same or equal frames (the motions of a program
     share their $TOOL and $BASE)."""
-    return a is b or bool((a == b).all()) or bool(np.allclose(a, b))
+    # a.tolist() == b.tolist(): (a == b).all() of two 4x4 frames (float ==: -0.0 equals 0.0, a NaN
+    # nothing: each tolist makes new floats), without numpy's reduction per call
+    return a is b or a.tolist() == b.tolist() or bool(np.allclose(a, b))
 
 
 def blend_space(prev: Segment, nxt: Segment) -> str:
