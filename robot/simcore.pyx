@@ -323,14 +323,10 @@ cdef class CartPath:
             out[i] = opw.q[i]
         return 1
 
-    def axes_u(self, double u, status, const double[:] ref6):
-        """The axes (6,) at u for the reference ref6 (``CartSegment.ik`` of ``pose_u(u)``), or
-        None (not mirrored, or the Python inverse decides)."""
-        cdef double M[12]
+    cdef object _axes(self, const double* M, status, const double[:] ref6):
+        """The axes (6,) of the pose M (3x4) for the reference ref6 (a new array), or None."""
         cdef double ref[6]
         cdef int i
-        if self.opw is None or ref6.shape[0] != 6 or not self._pose(u, M):
-            return None
         for i in range(6):
             ref[i] = ref6[i]
         res = np.empty(6)
@@ -338,6 +334,14 @@ cdef class CartPath:
         if not self._solve(M, status, ref, &rv[0]):
             return None
         return res
+
+    def axes_u(self, double u, status, const double[:] ref6):
+        """The axes (6,) at u for the reference ref6 (``CartSegment.ik`` of ``pose_u(u)``), or
+        None (not mirrored, or the Python inverse decides)."""
+        cdef double M[12]
+        if self.opw is None or ref6.shape[0] != 6 or not self._pose(u, M):
+            return None
+        return self._axes(M, status, ref6)
 
     def chain_u(self, const double[:] us, status, const double[:] ref6):
         """:meth:`axes_u` at each u of us in turn, each solution the next one's reference (the
@@ -403,15 +407,24 @@ cdef class CartPath:
         for i in range(12):
             out[i] = src[i]
 
+    @staticmethod
+    cdef int _pose_rp(const double[:, :] R, const double[:] p, double* M) except -1:
+        """The pose (R (3, 3), p (3,)) into M (3x4, row-major); ValueError for other shapes."""
+        cdef int i, j
+        if R.shape[0] != 3 or R.shape[1] != 3 or p.shape[0] != 3:
+            raise ValueError("CartPath: R (3, 3), p (3,)")
+        for i in range(3):
+            for j in range(3):
+                M[4 * i + j] = R[i, j]
+            M[4 * i + 3] = p[i]
+        return 0
+
     def flange_rp(self, const double[:, :] R, const double[:] p):
         """The flange pose (4x4) :meth:`solve_rp` solves for the pose (R (3, 3), p (3,))."""
         cdef double M[12]
         cdef double out[12]
         cdef int i, j
-        for i in range(3):
-            for j in range(3):
-                M[4 * i + j] = R[i, j]
-            M[4 * i + 3] = p[i]
+        CartPath._pose_rp(R, p, M)
         if self.has_pre or self.has_post:
             self._flange(M, out)
         else:
@@ -429,21 +442,10 @@ cdef class CartPath:
         """The axes (6,) of the pose (R (3, 3), p (3,)) for the reference ref6 (``CartSegment.ik``;
         turn None), or None (no inverse here, or the Python inverse decides)."""
         cdef double M[12]
-        cdef double ref[6]
-        cdef int i, j
-        if self.opw is None or ref6.shape[0] != 6 or R.shape[0] != 3 or R.shape[1] != 3 or p.shape[0] != 3:
+        if self.opw is None or ref6.shape[0] != 6:
             return None
-        for i in range(3):
-            for j in range(3):
-                M[4 * i + j] = R[i, j]
-            M[4 * i + 3] = p[i]
-        for i in range(6):
-            ref[i] = ref6[i]
-        res = np.empty(6)
-        cdef double[::1] rv = res
-        if not self._solve(M, status, ref, &rv[0]):
-            return None
-        return res
+        CartPath._pose_rp(R, p, M)
+        return self._axes(M, status, ref6)
 
 
 # ----------------------------------------------------------------------------- the IPO cycle
