@@ -308,14 +308,15 @@ def _real(program, interp: str, enabled: bool, seconds: float, shadow: bool = Fa
     rt.scheduler.spin.shadow = shadow
     res = rt.run()
     answers = [a.describe() for a in rt.autocell.answers]
+    # (the stand-ins' counts: a parked pass's calls of one are counted without running: kss.summary)
     return rt, (rt.controller.io.log, answers, res.reason, res.file, res.line, res.sim_time, res.steps,
-                *((seen.events, seen.poses) if seen is not None else ()))
+                rt.kss.summary(), *((seen.events, seen.poses) if seen is not None else ()))
 
 
 @pytest.mark.parametrize("rel", REAL)
 def test_real_whole_runs_are_the_same_parked(rel):
     """With ``--inputs auto``, 30 s, and an observer of the controller (as ``krl run``, the
-    change report and the audit run): the same I/O, answers, end, steps and controller events
+    change report and the audit run): the same I/O, answers, end, steps, stand-in counts and controller events
     with and without the spin watch, on the VM, and the spin parked (the observer does not stop
     the watch); and the tree interpreter's parked run the VM's."""
     program = SHARED_CORPUS / rel
@@ -326,7 +327,7 @@ def test_real_whole_runs_are_the_same_parked(rel):
     assert on == off
     assert (rt.scheduler.spin.diverged, rt.scheduler.spin.missed) == (0, 0)
     bare, run = _real(program, "vm", True, 30.0, observed=False)
-    assert run == on[:7]
+    assert run == on[:8]
     skipped = (rt.scheduler.spin.parks, rt.scheduler.spin.skipped, rt.scheduler.idle.skipped)
     assert skipped == (bare.scheduler.spin.parks, bare.scheduler.spin.skipped, bare.scheduler.idle.skipped)
     assert skipped[1] + skipped[2] > 0
@@ -337,7 +338,7 @@ def test_real_whole_runs_are_the_same_parked(rel):
 def test_the_history_backups_submit_programs_are_the_same_parked(shared_history):
     """Material nobody here wrote: the SPS.SUB of every backup in ../shared/krl-history (the
     new side of each pair; its entry points that are submit programs), 10 s with ``--inputs auto``:
-    the same I/O, answers, end, steps and controller events with the spin watch as without, on
+    the same I/O, answers, end, steps, stand-in counts and controller events with the spin watch as without, on
     the VM, and the tree interpreter's parked run the VM's. Some switch a cyclic flag on in every
     pass (``$CYCFLAG[n] = NOT $ALARM_STOP OR ...``: a flag over inputs and variables, which
     settles); such a pass is parked (until 2026-11-26 no pass that read $CYCFLAG was, beside any
