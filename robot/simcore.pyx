@@ -451,7 +451,7 @@ cdef class CartPath:
 # ----------------------------------------------------------------------------- the IPO cycle
 def speed_ok(const double[:] q, const double[:] q_prev, const double[:] lim):
     """True when no axis moves more than its limit in one cycle: ``abs(q[i] - q_prev[i]) <=
-    lim[i]`` over the shortest of the three (robot/controller.py ``_check_speed``, which gives
+    lim[i]`` over the shortest of the three (robot/monitor.py ``Monitor.check_speed``, which gives
     the error on False; a NaN step passes, as there)."""
     cdef Py_ssize_t n = min(q.shape[0], q_prev.shape[0], lim.shape[0]), i
     for i in range(n):
