@@ -29,13 +29,16 @@ def _compile_commands(tmp_path, monkeypatch, cflags: str | None) -> list[list[st
 
     class Recording(build_ext):
         def build_extensions(self):
-            real_spawn = self.compiler.spawn
+            # setuptools runs the compiler through Compiler.call (its own distutils, 80 on),
+            # earlier through Compiler.spawn; the one it has is recorded
+            name = "call" if hasattr(self.compiler, "call") else "spawn"
+            real = getattr(self.compiler, name)
 
-            def spawn(cmd, **kw):
+            def record(cmd, **kw):
                 ran.append(list(cmd))
-                return real_spawn(cmd, **kw)
+                return real(cmd, **kw)
 
-            self.compiler.spawn = spawn
+            setattr(self.compiler, name, record)
             super().build_extensions()
 
     cmd = Recording(Distribution({"name": "probe", "ext_modules": [ext]}))
