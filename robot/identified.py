@@ -12,6 +12,9 @@ by hand) holds what the recordings show, each value with its method and residual
   accelerates, and gains while it brakes (robot/profiles.py ``FrictionProfile``);
 * ``actual.filter_cycles``: the IPO cycles over which the setpoints are averaged before the
   measured axes follow them (robot/kukatrace/actual.py);
+* ``actual.following_error``: the drives' following error behind those averaged setpoints, per
+  axis ``inertia_s2``, ``coulomb_deg``, ``viscous_s`` and one ``coulomb_speed_deg_s``
+  (robot/kukatrace/actual.py ``following_error``);
 * ``dynamics``: the arm's inertia for a synchronised PTP's accelerations (robot/dynamics.py).
 
 :func:`apply_identified` puts them into the :class:`~robot.machine.MachineData` that machine data
@@ -48,8 +51,9 @@ def identified_file(machine_dat: Path) -> Path | None:
 
 def read_identified(path: Path) -> dict[str, Any]:
     """The identified parameters of `path`: ``{"acc": (n,), "ramp": (n,), "friction": (n,),
-    "filter": cycles, "dynamics": {...}}`` (deg/s², deg, 1/s, an INT), each missing when the file
-    has none. Raises MachineDataError naming the file and the key."""
+    "filter": cycles, "following": {...}, "dynamics": {...}}`` (deg/s², deg, 1/s, an INT, the
+    following error's keys), each missing when the file has none. Raises MachineDataError naming
+    the file and the key."""
     try:
         doc = yaml.safe_load(path.read_text(encoding="utf-8")) or {}
     except (OSError, yaml.YAMLError) as exc:
@@ -60,6 +64,9 @@ def read_identified(path: Path) -> dict[str, Any]:
         if not isinstance(n, int) or not 1 <= n <= 100:
             raise MachineDataError(f"{path}: actual.filter_cycles: an INT 1..100 was expected")
         out["filter"] = n
+    fe = (doc.get("actual") or {}).get("following_error")
+    if fe is not None:
+        out["following"] = _following(path, fe)
     dyn = doc.get("dynamics")
     if dyn is not None:
         keys = ("link_mass_kg", "link_com_mm", "link_inertia_kg_m2", "rotor_inertia_kg_m2", "torque_nm")
@@ -80,15 +87,37 @@ def read_identified(path: Path) -> dict[str, Any]:
     return out
 
 
+def _following(path: Path, fe: Any) -> dict[str, Any]:
+    """The ``actual.following_error`` mapping of `path`, checked: lists of numbers (``inertia_s2``
+    and ``coulomb_deg`` non-negative, ``viscous_s`` any sign) and a positive ``coulomb_speed_deg_s``."""
+    if not isinstance(fe, dict):
+        raise MachineDataError(f"{path}: actual.following_error: a mapping was expected")
+    out: dict[str, Any] = {}
+    for key, low in (("inertia_s2", 0.0), ("coulomb_deg", 0.0), ("viscous_s", -float("inf"))):
+        v = fe.get(key)
+        if not isinstance(v, list) or not all(isinstance(x, (int, float)) and x >= low for x in v):
+            raise MachineDataError(f"{path}: actual.following_error.{key}: a list of numbers was expected"
+                                   + (" (none negative)" if low == 0.0 else ""))
+        out[key] = tuple(float(x) for x in v)
+    v0 = fe.get("coulomb_speed_deg_s")
+    if not isinstance(v0, (int, float)) or not v0 > 0:
+        raise MachineDataError(f"{path}: actual.following_error.coulomb_speed_deg_s: a positive number was expected")
+    out["coulomb_speed_deg_s"] = float(v0)
+    return out
+
+
 def apply_identified(machine: Any, path: Path) -> Any:
     """`machine` with the parameters of `path` (:func:`read_identified`): the joints'
     ``max_acc_deg_s2``, ``ptp_ramp_deg``, ``ptp_friction``, ``actual_filter_cycles``,
-    ``dynamics``, and their provenance. Raises MachineDataError when the
+    ``actual_following``, ``dynamics``, and their provenance. Raises MachineDataError when the
     file gives another axis count than the robot's."""
     got = read_identified(path)
     n = len(machine.joints)
     for key, v in got.items():
-        if key not in ("filter", "dynamics") and len(v) != n:
+        if key == "following":
+            if any(len(v[k]) != n for k in ("inertia_s2", "coulomb_deg", "viscous_s")):
+                raise MachineDataError(f"{path}: actual.following_error: not {n} values per key for the axes of {machine.name}")
+        elif key not in ("filter", "dynamics") and len(v) != n:
             raise MachineDataError(f"{path}: {len(v)} values for the {n} axes of {machine.name}")
     prov = dict(machine.provenance)
     joints = machine.joints
@@ -101,11 +130,14 @@ def apply_identified(machine: Any, path: Path) -> Any:
         prov["ptp_friction"] = f"identified: {path.name} (tools/identify_kr3.py, the real KUKA Trace recordings)"
     if "filter" in got:
         prov["actual_filter_cycles"] = f"identified: {path.name} (tools/identify_kr3.py, the real KUKA Trace recordings)"
+    if "following" in got:
+        prov["actual_following"] = f"identified: {path.name} (tools/identify_kr3.py, the real KUKA Trace recordings)"
     if "dynamics" in got:
         prov["dynamics"] = f"identified: {path.name} (tools/identify_kr3.py: link inertias from the collision meshes, rotor inertias and torques from the recordings)"
     return replace(machine, joints=joints, ptp_ramp_deg=got.get("ramp", machine.ptp_ramp_deg),
                    ptp_friction=got.get("friction", machine.ptp_friction),
                    actual_filter_cycles=got.get("filter", machine.actual_filter_cycles),
+                   actual_following=got.get("following", machine.actual_following),
                    dynamics=got.get("dynamics", machine.dynamics), provenance=prov)
 
 

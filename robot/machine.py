@@ -271,6 +271,10 @@ class MachineData:
     #: simulated run's setpoints through (robot/kukatrace/actual.py); identified from a robot's
     #: recordings (robot/identified.py), 1 (none) for a robot without
     actual_filter_cycles: int = 1
+    #: the drives' following error behind the averaged setpoints (robot/kukatrace/actual.py
+    #: ``following_error``: ``inertia_s2``, ``coulomb_deg``, ``viscous_s`` per axis and
+    #: ``coulomb_speed_deg_s``), identified from a robot's recordings (robot/identified.py), or None
+    actual_following: dict[str, Any] | None = field(default=None, compare=False, repr=False)
     #: the arm's identified inertia (robot/dynamics.py ``Inertia``: link masses, centres of mass and
     #: inertias, rotor inertias, acceleration torques), or None: a PTP's accelerations are then the
     #: axes' own (robot/limits.py)

@@ -37,6 +37,13 @@ allow (robot/kukatrace/model.py ``recording_override``: 85 % for every ``_po85``
 4. *CP*: each LIN's and CIRC's planned duration against ``d/v + v/a`` (``2 sqrt(d/a)`` when the
    speed is not reached) with ``$VEL.CP`` and ``$ACC.CP`` of PROG.TXT; a LIN's length from its
    points, a CIRC's (CA 360: it ends where it starts) from the measured TCP path.
+5. *Actual-value average* (robot/kukatrace/actual.py): the LIN and CIRC programs run on the robot
+   identified above; N cycles of the average the one whose largest LIN path deviation is least.
+6. *Following error* (robot/kukatrace/actual.py ``following_error``): per axis ``m q'' + c
+   tanh(q'/v0) + k q'`` behind the averaged setpoints, least squares in axis space of the measured
+   axes less the averaged setpoints (shifted by each motion's best lag) over the 3 CIRCs and the 5
+   LINs; cross-validated by leaving out each LIN recording and each LIN (printed, and written with
+   the parameters).
 """
 
 from __future__ import annotations
@@ -53,7 +60,7 @@ from pathlib import Path
 
 import numpy as np
 import trimesh
-from scipy.optimize import least_squares
+from scipy.optimize import least_squares, lsq_linear
 
 HERE = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(HERE))
@@ -62,7 +69,7 @@ from interp import tracebench as B  # noqa: E402
 from robot.dynamics import Inertia  # noqa: E402
 from robot.exactstop import END_DELAY_CYCLES, RESTART_CYCLES, end_signal  # noqa: E402
 from robot.identified import IDENTIFIED  # noqa: E402
-from robot.kukatrace.actual import actual_tcp  # noqa: E402
+from robot.kukatrace.actual import actual_tcp, average  # noqa: E402
 from robot.kukatrace.compare import compare_segments, pair_segments  # noqa: E402
 from robot.kukatrace.model import load_run, recording_override  # noqa: E402
 from robot.kukatrace.recording import IPO_CYCLE_S, read_recording  # noqa: E402
@@ -253,13 +260,10 @@ def friction_slopes(recs) -> dict[int, list[float]]:
     return out
 
 
-def fit_filter(traces: Path, machine) -> tuple[int, list[dict]]:
-    """The cycles of the actual-value average (robot/kukatrace/actual.py): the simulator runs the
-    LIN and CIRC programs on `machine` (the robot with the parameters identified above;
-    interp/tracebench.py, every recorded point as recorded), and the
-    average of N = 1..10 cycles puts the setpoints through; N is the one whose largest LIN path
-    deviation from the real robot's path is least (fitted on the 5 LINs), checked on the 3 CIRCs
-    (not fitted). Returns (N, residuals)."""
+def simulate_cp(traces: Path, machine) -> list[tuple[str, object, object, object]]:
+    """The LIN and CIRC programs run on `machine` (the robot with the parameters identified above;
+    interp/tracebench.py, every recorded point as recorded): (recording name, run, run's segment,
+    recording's segment) of each paired segment."""
     rows = B.map_rows(traces)
     pairs = []
     with tempfile.TemporaryDirectory(prefix="krl-identify-") as tmp:
@@ -270,27 +274,147 @@ def fit_filter(traces: Path, machine) -> tuple[int, list[dict]]:
             src = B.prepare(traces, program, list(real.values()), Path(tmp))
             run = B.run_program(src, recording_override(next(iter(real.values())))[0], robot=machine)
             for r in mine:
-                pairs += [(run, a, b) for a, b in pair_segments(run, load_run(real[r["trace_name"]].prog_path))]
+                pairs += [(r["trace_name"], run, a, b)
+                          for a, b in pair_segments(run, load_run(real[r["trace_name"]].prog_path))]
+    return pairs
 
-    def worst(n: int) -> dict[str, float]:
-        out: dict[str, float] = {}
-        for run, a, b in pairs:
-            for m in compare_segments(a, b, actual_tcp(run, a, n)).motions:
-                if m.kind in ("LIN", "CIRC") and m.path_deviation is not None:
-                    out[m.kind] = max(out.get(m.kind, 0.0), m.path_deviation)
-        return out
 
-    table = {n: worst(n) for n in range(1, 11)}
-    best = min(table, key=lambda n: table[n]["LIN"])
+def path_figures(pairs, n: int, following: dict) -> dict[tuple[str, str, int], float]:
+    """The path deviation (mm) of each LIN and CIRC, keyed (kind, recording, motion index), of the
+    runs' setpoints averaged over `n` cycles less the `following` error (``{}``: none)."""
+    out: dict[tuple[str, str, int], float] = {}
+    for name, run, a, b in pairs:
+        for k, m in enumerate(compare_segments(a, b, actual_tcp(run, a, n, following=following)).motions):
+            if m.kind in ("LIN", "CIRC") and m.path_deviation is not None:
+                out[(m.kind, name, k)] = m.path_deviation
+    return out
+
+
+def worst(fig: dict, kind: str) -> float:
+    return max(v for key, v in fig.items() if key[0] == kind)
+
+
+def fit_filter(pairs) -> tuple[int, list[dict]]:
+    """The cycles of the actual-value average (robot/kukatrace/actual.py): the average of N = 1..10
+    cycles puts the runs' setpoints (:func:`simulate_cp`) through, without the following error; N is
+    the one whose largest LIN path deviation from the real robot's path is least (fitted on the 5
+    LINs), checked on the 3 CIRCs (not fitted). Returns (N, residuals)."""
+    table = {n: path_figures(pairs, n, {}) for n in range(1, 11)}
+    best = min(table, key=lambda n: worst(table[n], "LIN"))
     print("\n5. actual-value model: the setpoints averaged over N cycles, the largest path deviation (mm)")
-    for n, w in table.items():
+    for n, fig in table.items():
         mark = "  <- fitted on the LINs" if n == best else ""
-        print(f"   N {n:2}: LIN {w['LIN']:.3f}, CIRC {w['CIRC']:.3f} (not fitted){mark}")
-    res = [{"set": "fit: the 5 LINs", "largest_path_deviation_mm": round(table[best]["LIN"], 3),
-            "setpoints_alone_mm": round(table[1]["LIN"], 3)},
-           {"set": "check: the 3 CIRCs", "largest_path_deviation_mm": round(table[best]["CIRC"], 3),
-            "setpoints_alone_mm": round(table[1]["CIRC"], 3)}]
+        print(f"   N {n:2}: LIN {worst(fig, 'LIN'):.3f}, CIRC {worst(fig, 'CIRC'):.3f} (not fitted){mark}")
+    res = [{"set": "fit: the 5 LINs", "largest_path_deviation_mm": round(worst(table[best], "LIN"), 3),
+            "setpoints_alone_mm": round(worst(table[1], "LIN"), 3)},
+           {"set": "check: the 3 CIRCs", "largest_path_deviation_mm": round(worst(table[best], "CIRC"), 3),
+            "setpoints_alone_mm": round(worst(table[1], "CIRC"), 3)}]
     return best, res
+
+
+#: the grid of the Coulomb term's smoothing speed v0 (deg/s), chosen by the fit's own residual
+COULOMB_SPEEDS = (0.5, 1.0, 2.0, 5.0, 10.0)
+#: the shifts (s) tried between a run's motion and the recording's (the measured axes lag START)
+LAGS = np.arange(0.0, 0.08, 0.001)
+
+
+def motion_residuals(pairs, n: int) -> list[dict]:
+    """Per LIN and CIRC motion: the measured axes less the runs' setpoints averaged over `n` cycles,
+    on the recording's samples from START to the next START, the setpoints shifted by the lag
+    (``LAGS``) whose rms over the motion (50 ms off either end) is least; with the averaged
+    setpoints' speed and acceleration there (deg, deg/s, deg/s²). Keys: recording, index, kind,
+    r, v, a (each (N, 6))."""
+    out = []
+    for name, _run, a, b in pairs:
+        qa = average(a.axes[:, :6], n)
+        va = np.gradient(qa, CYCLE, axis=0)
+        for k, (ma, mb) in enumerate(zip(a.motions, b.motions)):
+            if ma.kind not in ("LIN", "CIRC") or mb.kind != ma.kind:
+                continue
+            ia, ib = a.window(*_span(a, k)), b.window(*_span(b, k))
+            ta, tb = a.t[ia] - ma.start, b.t[ib] - mb.start
+            best = None
+            for lag in LAGS:
+                r = np.stack([b.axes[ib, i] - np.interp(tb - lag, ta, qa[ia, i]) for i in range(6)], 1)
+                on = (tb - lag > 0.05) & (tb - lag < ta[-1] - 0.05)
+                e = float(np.sqrt(np.mean(r[on] ** 2)))
+                if best is None or e < best[0]:
+                    best = (e, lag, r)
+            _e, lag, r = best
+            v = np.stack([np.interp(tb - lag, ta, va[ia, i]) for i in range(6)], 1)
+            out.append({"recording": name, "index": k, "kind": ma.kind, "r": r, "v": v,
+                        "a": np.gradient(v, CYCLE, axis=0)})
+    return out
+
+
+def _span(seg, k: int) -> tuple[float, float]:
+    t0 = seg.motions[k].start
+    return t0, seg.motions[k + 1].start if k + 1 < len(seg.motions) else seg.length
+
+
+def fit_following(samples: list[dict]) -> tuple[dict, float]:
+    """The following error (robot/kukatrace/actual.py ``following_error``) that explains the
+    residuals of `samples` (:func:`motion_residuals`) best: per axis, bounded least squares
+    (m, c >= 0; k either sign: relative to the lag already shifted out) of ``r = -(m a + c
+    tanh(v/v0) + k v)``, v0 from :data:`COULOMB_SPEEDS` by the summed squared residual.
+    Returns (parameters, that residual in deg²)."""
+    best = None
+    for v0 in COULOMB_SPEEDS:
+        p, cost = np.zeros((6, 3)), 0.0
+        for i in range(6):
+            X = np.vstack([np.stack([-s["a"][:, i], -np.tanh(s["v"][:, i] / v0), -s["v"][:, i]], 1) for s in samples])
+            y = np.concatenate([s["r"][:, i] for s in samples])
+            got = lsq_linear(X, y, bounds=([0, 0, -np.inf], [np.inf] * 3))
+            p[i], cost = got.x, cost + 2 * got.cost
+        if best is None or cost < best[1]:
+            best = ({"inertia_s2": [float(f"{x:.4g}") for x in p[:, 0]],
+                     "coulomb_deg": [round(float(x), 5) for x in p[:, 1]],
+                     "viscous_s": [float(f"{x:.4g}") for x in p[:, 2]],
+                     "coulomb_speed_deg_s": v0}, cost)
+    return best
+
+
+def identify_following(pairs, n: int) -> tuple[dict, list[dict]]:
+    """6. The drives' following error, identified on the 3 CIRCs and the 5 LINs
+    (:func:`fit_following`), then cross-validated: leaving out each LIN recording, and each LIN,
+    the left-out LINs measured with the parameters of the rest. Returns (parameters, residuals)."""
+    samples = motion_residuals(pairs, n)
+    lins = [(s["recording"], s["index"]) for s in samples if s["kind"] == "LIN"]
+    before = path_figures(pairs, n, {})
+    params, _cost = fit_following(samples)
+    full = path_figures(pairs, n, params)
+    print("\n6. the drives' following error m q'' + c tanh(q'/v0) + k q' behind the averaged setpoints,")
+    print(f"   fitted in axis space on the 3 CIRCs and the 5 LINs: v0 {params['coulomb_speed_deg_s']} deg/s")
+    for i in range(6):
+        print(f"   A{i + 1}: m {params['inertia_s2'][i]:.3g} s2, c {params['coulomb_deg'][i]:.4f} deg, "
+              f"k {1000 * params['viscous_s'][i]:.3f} ms")
+
+    def row(fig):
+        return ", ".join(f"{fig[('LIN', *key)]:.3f}" for key in lins)
+
+    print(f"   LINs {row(before)} -> {row(full)}: largest {worst(before, 'LIN'):.3f} -> {worst(full, 'LIN'):.3f} mm; "
+          f"CIRC {worst(before, 'CIRC'):.3f} -> {worst(full, 'CIRC'):.3f} mm")
+    res = [{"set": "fit: the 3 CIRCs and the 5 LINs", "largest_lin_mm": round(worst(full, "LIN"), 3),
+            "largest_circ_mm": round(worst(full, "CIRC"), 3), "without_mm": [round(worst(before, "LIN"), 3),
+                                                                              round(worst(before, "CIRC"), 3)]}]
+    folds = [(f"leave out {name}", [key for key in lins if key[0] == name]) for name in dict.fromkeys(k[0] for k in lins)]
+    folds += [(f"leave out {name} LIN {k}", [(name, k)]) for name, k in lins]
+    print("   cross-validation: fitted without the left-out LINs, measured on them (mm; without the model)")
+    for label, out in folds:
+        p, _ = fit_following([s for s in samples if (s["recording"], s["index"]) not in out])
+        fig = path_figures(pairs, n, p)
+        got = [round(fig[("LIN", *key)], 3) for key in out]
+        was = [round(before[("LIN", *key)], 3) for key in out]
+        print(f"   {label}: {', '.join(map(str, got))} ({', '.join(map(str, was))}); CIRC {worst(fig, 'CIRC'):.3f}")
+        res.append({"set": f"check: {label}", "left_out_lin_mm": got, "without_mm": was,
+                    "largest_circ_mm": round(worst(fig, "CIRC"), 3)})
+    return params, res
+
+
+def _decimal(x: float) -> str:
+    """`x` in fixed point (YAML 1.1 reads an exponent without a point, "5e-05", as a string)."""
+    text = f"{x:.9f}".rstrip("0")
+    return text + "0" if text.endswith(".") else text
 
 
 def main(argv=None) -> int:
@@ -401,8 +525,10 @@ def main(argv=None) -> int:
                       f"model {t:.4f} s ({1000 * (t - (m.endtime - m.start)):+.1f} ms)")
             prev = m.point
 
-    # 5. the actual-value model
-    cycles, path_res = fit_filter(args.traces, fitted)
+    # 5. the actual-value model, 6. the following error
+    pairs = simulate_cp(args.traces, fitted)
+    cycles, path_res = fit_filter(pairs)
+    following, follow_res = identify_following(pairs, cycles)
 
     if args.write:
         out = IDENTIFIED / "kr3_r540.yaml"
@@ -428,6 +554,12 @@ def main(argv=None) -> int:
                   "  # measured axes follow them (robot/kukatrace/actual.py)", f"  filter_cycles: {cycles}",
                   "  residuals:"]
         lines += ["    - " + json.dumps(r) for r in path_res]
+        lines += ["  # the drives' following error behind the averaged setpoints, per axis deg:",
+                  "  # m q'' + c tanh(q'/v0) + k q' (robot/kukatrace/actual.py following_error)",
+                  "  following_error:"]
+        lines += [f"    {k}: [{', '.join(map(_decimal, v))}]" if isinstance(v, list) else f"    {k}: {v}"
+                  for k, v in following.items()]
+        lines += ["    residuals:"] + ["      - " + json.dumps(r) for r in follow_res]
         out.write_text("\n".join(lines) + "\n", encoding="utf-8")
         print(f"\nwrote {out.relative_to(HERE)}")
     return 0

@@ -11,6 +11,12 @@ ones before; identified from the recordings, robot/identified.py) and the forwar
 each motion's ``$TOOL`` and ``$BASE`` (and the robot's ``$ROBROOT``): the TCP that ``krl trace compare`` measures a simulated
 run's path deviation on. A robot without an identified average (one cycle) keeps its setpoints.
 The lag it adds does not matter there: the path deviation is geometric.
+
+Behind the averaged setpoints the drives follow with an error (:func:`following_error`, a robot's
+``MachineData.actual_following``, identified from its recordings): the torque an axis needs over
+its loop's stiffness, ``m_i·q̈ + c_i·tanh(q̇/v0) + k_i·q̇`` (inertia, Coulomb and viscous
+friction; a position loop without torque feed-forward). On the KR 3 R540 it is what makes a LIN's
+wrist axes fall 0.05-0.1° behind as they leave rest (docs/robot.md "The drives' following error").
 """
 
 from __future__ import annotations
@@ -22,6 +28,7 @@ import numpy as np
 
 from ..frames import frame_to_matrix, inv_pos
 from .model import RunView, Segment
+from .recording import IPO_CYCLE_S
 from ..kinematics import Kinematics
 from ..mada import MachineDataError, load_robot
 
@@ -47,17 +54,42 @@ def filter_cycles(view: RunView) -> int:
     return int(got[0].actual_filter_cycles) if got is not None else 1
 
 
-def actual_tcp(view: RunView, seg: Segment, cycles: int | None = None) -> np.ndarray:
+def average(q: np.ndarray, n: int) -> np.ndarray:
+    """Setpoints `q` (N, n_axes) averaged over `n` cycles, causal: each row the mean of its own and
+    the `n` - 1 before (the first row repeated before the start)."""
+    csum = np.cumsum(np.vstack([np.repeat(q[:1], n, axis=0), q]), axis=0)
+    return (csum[n:] - csum[:-n]) / n
+
+
+def following_error(q: np.ndarray, params: dict, dt: float = IPO_CYCLE_S) -> np.ndarray:
+    """The drives' following error (N, n_axes) deg behind averaged setpoints `q` (N, n_axes) deg,
+    one row per IPO cycle of `dt` s (a gap in a trace is a rest, where both sides agree):
+    ``m_i·q̈_i + c_i·tanh(q̇_i/v0) + k_i·q̇_i``, q̇ and q̈ central differences (deg/s, deg/s²).
+    `params`: ``inertia_s2`` m (n_axes,) s², ``coulomb_deg`` c (n_axes,) deg, ``viscous_s`` k
+    (n_axes,) s, ``coulomb_speed_deg_s`` v0 deg/s (robot/identified.py reads them; docs/robot.md
+    "The drives' following error" gives their identification). Fewer than 3 rows: zeros."""
+    if len(q) < 3:
+        return np.zeros_like(q)
+    v = np.gradient(q, dt, axis=0)
+    a = np.gradient(v, dt, axis=0)
+    m, c, k = (np.asarray(params[key], dtype=float) for key in ("inertia_s2", "coulomb_deg", "viscous_s"))
+    return m * a + c * np.tanh(v / float(params["coulomb_speed_deg_s"])) + k * v
+
+
+def actual_tcp(view: RunView, seg: Segment, cycles: int | None = None,
+               following: dict | None = None) -> np.ndarray:
     """The measured TCP positions (N, 3) mm the setpoints of `seg` give (the module's
-    docstring), averaged over `cycles` (default the robot's :func:`filter_cycles`); its own TCP
-    when there is no average to apply."""
+    docstring): averaged over `cycles` (default the robot's :func:`filter_cycles`), less the
+    :func:`following_error` of `following` (default the robot's ``actual_following``; ``{}``:
+    none); its own TCP when there is no average to apply."""
     n = filter_cycles(view) if cycles is None else cycles
     if n <= 1 or len(seg.t) == 0 or _robot(view.robot_source) is None:
         return seg.tcp[:, :3]
     machine, kin = _robot(view.robot_source)
-    q = seg.axes[:, :machine.n_axes]
-    csum = np.cumsum(np.vstack([np.repeat(q[:1], n, axis=0), q]), axis=0)
-    qf = (csum[n:] - csum[:-n]) / n
+    qf = average(seg.axes[:, :machine.n_axes], n)
+    follow = machine.actual_following if following is None else following
+    if follow:
+        qf = qf - following_error(qf, follow)
     out = seg.tcp[:, :3].copy()
     starts = [m.start for m in seg.motions]
     for k, m in enumerate(seg.motions):
@@ -75,4 +107,4 @@ def actual_tcp(view: RunView, seg: Segment, cycles: int | None = None) -> np.nda
     return out
 
 
-__all__ = ["actual_tcp", "filter_cycles"]
+__all__ = ["actual_tcp", "average", "filter_cycles", "following_error"]

@@ -57,8 +57,5 @@ def test_circ_path_within_the_limit_and_no_worse_than_officelite(fig):
     assert so["lin_mm"] <= ol["lin_mm"]
 
 
-@pytest.mark.xfail(strict=True, reason="issue 60: the largest LIN path deviation is 0.316 mm (Linear_updated, "
-                                       "line 36: mid-LIN the real robot leaves the line by 0.45 mm in z, which the "
-                                       "actual-value model does not make), over the issue's 0.28 mm")
 def test_lin_path_within_the_issues_limit(fig):
     assert fig["sim"]["lin_mm"] <= LIMITS["lin_mm"]

@@ -83,7 +83,9 @@ def test_the_identified_parameters_are_applied(kr3, tmp_path):
     m, _ = kr3
     assert len(m.ptp_ramp_deg) == len(m.ptp_friction) == 6 and m.actual_filter_cycles >= 1
     assert m.dynamics is not None and len(m.dynamics["torque_nm"]) == 6
-    for key in ("max_acc_deg_s2", "ptp_ramp_deg", "ptp_friction", "dynamics", "actual_filter_cycles"):
+    assert all(len(m.actual_following[k]) == 6 for k in ("inertia_s2", "coulomb_deg", "viscous_s"))
+    for key in ("max_acc_deg_s2", "ptp_ramp_deg", "ptp_friction", "dynamics", "actual_filter_cycles",
+                "actual_following"):
         assert "kr3_r540.yaml" in m.provenance[key]
     bad = tmp_path / "x.yaml"
     bad.write_text("ptp:\n  friction_per_s: [1, -2, 0, 0, 0, 0]\n", encoding="utf-8")
@@ -91,4 +93,15 @@ def test_the_identified_parameters_are_applied(kr3, tmp_path):
         read_identified(bad)
     bad.write_text("ptp:\n  acc_deg_s2: [1, 2]\n", encoding="utf-8")
     with pytest.raises(MachineDataError, match="2 values for the 6 axes"):
+        apply_identified(m, bad)
+    follow = "actual:\n  following_error:\n    inertia_s2: [{}]\n    coulomb_deg: [0, 0]\n    viscous_s: [0, 0]\n" \
+             "    coulomb_speed_deg_s: {}\n"
+    bad.write_text(follow.format("0.00001, -0.00001", 2), encoding="utf-8")
+    with pytest.raises(MachineDataError, match=r"x\.yaml: actual\.following_error\.inertia_s2"):
+        read_identified(bad)
+    bad.write_text(follow.format("0.00001, 0.00001", 0), encoding="utf-8")
+    with pytest.raises(MachineDataError, match=r"following_error\.coulomb_speed_deg_s"):
+        read_identified(bad)
+    bad.write_text(follow.format("0.00001, 0.00001", 2), encoding="utf-8")
+    with pytest.raises(MachineDataError, match="not 6 values per key"):
         apply_identified(m, bad)

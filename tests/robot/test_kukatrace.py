@@ -25,7 +25,7 @@ from robot.exactstop import end_signal
 from robot.kukatrace import recording as R
 from robot.frames import frame_to_matrix
 from robot.kinematics import Kinematics
-from robot.kukatrace.actual import actual_tcp
+from robot.kukatrace.actual import actual_tcp, following_error
 from robot.kukatrace.compare import compare, path_deviation, totals
 from robot.kukatrace.model import load_run, run_view
 from robot.machine import ROBOT_LIBRARY
@@ -265,11 +265,29 @@ def test_the_actual_value_model_averages_the_axes_over_its_cycles():
     view = run_view(events, "trace", "run.jsonl")
     (seg,) = view.segments
     for n in (1, 4):
-        got = actual_tcp(view, seg, n)
+        got = actual_tcp(view, seg, n, following={})
         for k in range(n, 40):
             q = np.array(axes[k]) - [0.6 * (n - 1) / 2, 0, 0, 0, 0, 0]
             want = (kin.forward(q) @ frame_to_matrix(*tool))[:3, 3]
             assert got[k] == pytest.approx(want, abs=1e-6)
+
+
+def test_the_following_error_is_inertia_coulomb_and_viscous():
+    """robot/kukatrace/actual.py following_error: an axis accelerating uniformly from rest (q = α t²/2,
+    whose central differences are exact: q̇ = α t, q̈ = α) lags by m α + c tanh(α t / v0) + k α t;
+    an axis at rest not at all; an axis moving backwards lags the other way (c and k odd in q̇)."""
+    alpha, dt = 600.0, 0.012
+    t = np.arange(20) * dt
+    q = np.zeros((20, 3))
+    q[:, 0] = 0.5 * alpha * t ** 2
+    q[:, 2] = -q[:, 0]
+    params = {"inertia_s2": [5e-5, 1.0, 5e-5], "coulomb_deg": [0.01, 1.0, 0.01], "viscous_s": [2e-4, 1.0, 2e-4],
+              "coulomb_speed_deg_s": 2.0}
+    got = following_error(q, params, dt)
+    want = 5e-5 * alpha + 0.01 * np.tanh(alpha * t / 2.0) + 2e-4 * alpha * t
+    assert got[2:-2, 0] == pytest.approx(want[2:-2], abs=1e-12)
+    assert np.all(got[:, 1] == 0.0)
+    assert got[2:-2, 2] == pytest.approx(-want[2:-2], abs=1e-12)
 
 
 def test_path_deviation_is_the_largest_distance_to_the_polyline():
