@@ -139,7 +139,7 @@ def trace_show(rec: Path, override: float | None, as_json: bool, output: Path | 
 @click.option("--segment", default=None, help="RUN's segment to compare with REC: its name or number (1-based)")
 @click.option("--setpoints", is_flag=True,
               help="measure a simulated RUN's path on its setpoints, not on the actual values they give "
-                   "(the robot's identified averaging; docs/trace.md)")
+                   "(the robot's identified averaging and following error; docs/trace.md)")
 @click.option("--json", "as_json", is_flag=True, help="Print JSON (docs/schemas/trace-compare.schema.json).")
 @click.option("-o", "--output", type=click.Path(path_type=Path), default=None,
               help="PNG to write: RUN (dashed) over REC per segment.")

@@ -22,7 +22,8 @@ REC's TCP path over the same motion (the polyline of its samples): the measure t
 OfficeLite's figures in (its CIRC points lie up to 1.48 mm from the real robot's path). A
 simulated run's samples are its setpoints: their TCP is taken as the controller's actual-value
 model makes it (robot/kukatrace/actual.py: the setpoints averaged over the cycles identified for
-the robot), as a recording's are measured values; ``actual=False`` takes the setpoints.
+the robot, less its drives' identified following error), as a recording's are measured values;
+``actual=False`` takes the setpoints.
 
 **In total**, over the matched exact-stop motions with a time on both sides: the motion time
 |error| median, 90th percentile and maximum (%), the median exact-stop pause of each side (pauses
