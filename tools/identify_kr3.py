@@ -70,7 +70,7 @@ from robot.dynamics import Inertia  # noqa: E402
 from robot.exactstop import END_DELAY_CYCLES, RESTART_CYCLES, end_signal  # noqa: E402
 from robot.identified import IDENTIFIED  # noqa: E402
 from robot.kukatrace.actual import actual_tcp, average  # noqa: E402
-from robot.kukatrace.compare import compare_segments, pair_segments  # noqa: E402
+from robot.kukatrace.compare import compare_segments, match_motions, motion_span, pair_segments  # noqa: E402
 from robot.kukatrace.model import load_run, recording_override  # noqa: E402
 from robot.kukatrace.recording import IPO_CYCLE_S, read_recording  # noqa: E402
 from robot.mada import load_mada  # noqa: E402
@@ -284,13 +284,14 @@ def path_figures(pairs, n: int, following: dict) -> dict[tuple[str, str, int], f
     runs' setpoints averaged over `n` cycles less the `following` error (``{}``: none)."""
     out: dict[tuple[str, str, int], float] = {}
     for name, run, a, b in pairs:
-        for k, m in enumerate(compare_segments(a, b, actual_tcp(run, a, n, following=following)).motions):
+        for m in compare_segments(a, b, actual_tcp(run, a, n, following=following)).motions:
             if m.kind in ("LIN", "CIRC") and m.path_deviation is not None:
-                out[(m.kind, name, k)] = m.path_deviation
+                out[(m.kind, name, m.run_index)] = m.path_deviation
     return out
 
 
 def worst(fig: dict, kind: str) -> float:
+    """The largest path deviation (mm) of the motions of `kind` in `fig` (:func:`path_figures`)."""
     return max(v for key, v in fig.items() if key[0] == kind)
 
 
@@ -328,10 +329,11 @@ def motion_residuals(pairs, n: int) -> list[dict]:
     for name, _run, a, b in pairs:
         qa = average(a.axes[:, :6], n)
         va = np.gradient(qa, CYCLE, axis=0)
-        for k, (ma, mb) in enumerate(zip(a.motions, b.motions)):
-            if ma.kind not in ("LIN", "CIRC") or mb.kind != ma.kind:
+        for k, j in match_motions(a, b)[0]:
+            ma, mb = a.motions[k], b.motions[j]
+            if ma.kind not in ("LIN", "CIRC"):
                 continue
-            ia, ib = a.window(*_span(a, k)), b.window(*_span(b, k))
+            ia, ib = a.window(*motion_span(a, k)), b.window(*motion_span(b, j))
             ta, tb = a.t[ia] - ma.start, b.t[ib] - mb.start
             best = None
             for lag in LAGS:
@@ -345,11 +347,6 @@ def motion_residuals(pairs, n: int) -> list[dict]:
             out.append({"recording": name, "index": k, "kind": ma.kind, "r": r, "v": v,
                         "a": np.gradient(v, CYCLE, axis=0)})
     return out
-
-
-def _span(seg, k: int) -> tuple[float, float]:
-    t0 = seg.motions[k].start
-    return t0, seg.motions[k + 1].start if k + 1 < len(seg.motions) else seg.length
 
 
 def fit_following(samples: list[dict]) -> tuple[dict, float]:

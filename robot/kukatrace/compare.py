@@ -198,7 +198,7 @@ def _pauses(seg: Segment) -> list[float | None]:
     return out
 
 
-def _span(seg: Segment, k: int) -> tuple[float, float]:
+def motion_span(seg: Segment, k: int) -> tuple[float, float]:
     """The time span (s) of motion k's samples: its START to the next START (or the end)."""
     t0 = seg.motions[k].start
     t1 = seg.motions[k + 1].start if k + 1 < len(seg.motions) else seg.length
@@ -238,8 +238,8 @@ def compare_segments(run: Segment, rec: Segment, run_tcp: np.ndarray | None = No
         if a.duration is not None and b.duration is not None:
             err = a.duration - b.duration
             pct = 100.0 * err / b.duration if b.duration > 0 else None
-        ia = run.window(*_span(run, i))
-        ib = rec.window(*_span(rec, j))
+        ia = run.window(*motion_span(run, i))
+        ib = rec.window(*motion_span(rec, j))
         dev = path_deviation(tcp[ia], rec.tcp[ib, :3]) if len(run.tcp) and len(rec.tcp) else None
         rows.append(MotionComparison(i, j, a.kind, a.line, b.line, a.start, b.start, a.duration, b.duration,
                                      err, pct, pr[i], pc[j], dev))
@@ -333,4 +333,5 @@ def total_line(t: dict[str, Any]) -> str:
 
 
 __all__ = ["CompareError", "MotionComparison", "PAUSE_MAX_S", "SegmentComparison", "as_json", "compare",
-           "compare_segments", "match_motions", "pair_segments", "path_deviation", "text_lines", "totals"]
+           "compare_segments", "match_motions", "motion_span", "pair_segments", "path_deviation", "text_lines",
+           "totals"]
