@@ -1551,9 +1551,30 @@ def _plan_cart(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_T: 
     a_ax = model.a_max
     junction_q: list[np.ndarray] = []
     sec_d: list[tuple[np.ndarray, np.ndarray, float]] = []
+    # the pieces whose axes the compiled path solves in a chain (below) are walked in C, the
+    # same numbers (robot/simcore.pyx ``CartPath.walk``); None there: the code below
+    walker = _compiled_walker(seg) if model.mode != "T1" else None
+    chain_from = MIN_CHAIN if model.batch_ik else CP_MAX_SAMPLES + 1
     for k in range(m):
         L, th = pieces[k].length, thetas[k]
         nk = max(4, min(48, int(L / 50.0) + int(th / 10.0) + 4))
+        # next to a corner the axis velocity turns within one IPO cycle (up to half of a_max,
+        # junction rule below) while the path brakes: the piece keeps the other half
+        budget = 0.5 if (kink[k] or kink[k + 1]) else 1.0
+        walked = None if walker is None else walker(
+            float(ub[k]), float(ub[k + 1]), nk, status, ref, chain_from, budget, plain, v_ax, a_ax,
+            vmax[k], SINGULAR_JUMP_DEG, CP_SAMPLE_STEP_DEG, CP_MAX_SAMPLES)
+        if walked is not None:
+            junction_q.append(ref.copy())
+            ref, d1_first, d1_last, qd, qdd, vmax[k], Aax = walked
+            if k == 0:
+                seg.qd_start = d1_first
+            if k == m - 1:
+                seg.qd_end = d1_last
+            if not plain:
+                amax[k] = min(amax[k], max(Aax, 1e-9))
+            sec_d.append((qd, qdd, budget))
+            continue
         start = ref
         while True:
             us = _samples(float(ub[k]), float(ub[k + 1]), nk + 1)
@@ -1618,9 +1639,6 @@ def _plan_cart(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_T: 
             seg.qd_start = d1[0].copy()
         if k == m - 1:
             seg.qd_end = d1[-1].copy()
-        # next to a corner the axis velocity turns within one IPO cycle (up to half of a_max,
-        # junction rule below) while the path brakes: the piece keeps the other half
-        budget = 0.5 if (kink[k] or kink[k + 1]) else 1.0
         # v/x where x > 1e-9, else inf (x: 1.0 where not taken, so that nothing divides by 0)
         moves, turns = qd > 1e-9, qdd > 1e-9
         qd_safe, qdd_safe = np.where(moves, qd, 1.0), np.where(turns, qdd, 1.0)
@@ -1682,6 +1700,15 @@ def _plan_cart(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_T: 
         seg.q1 = ref
     seg.status = status
     return seg
+
+
+def _compiled_walker(seg: CartSegment) -> Callable[..., Any] | None:
+    """The compiled walk of the planning walk's pieces (robot/simcore.pyx ``CartPath.walk``)
+    where the walk solves each piece's samples with ``CartPath.chain_u``, else None."""
+    if seg.joint_ori or len(seg.q0) != seg.model.n or not seg.compiled_solver():
+        return None
+    cp = seg._compiled_path()
+    return cp.walk if cp else None
 
 
 def _plan_triggers(seg: Segment) -> None:

@@ -10,7 +10,8 @@ compiled from that very Python file; this module calls its C methods (``OPWCore`
   ``JointChain.forward``: scipy's rotation matrices, numpy's own BLAS through its address);
 * :class:`CartPath`: the poses of a CP segment's lines and arcs (robot/planner.py
   ``CartSegment.pose_u``) and their axes (fastpath's ``OPWCore``), through the motion's ``$BASE``
-  and ``$TOOL`` where it has them (``RobotModel.ik``'s two products, numpy's BLAS at its address);
+  and ``$TOOL`` where it has them (``RobotModel.ik``'s two products, numpy's BLAS at its address),
+  and the planning walk of a piece (robot/planner.py ``_walk_piece``);
 * :class:`ArmCycle` and :func:`speed_ok`: the IPO cycle's MuJoCo playback (``mj_kinematics``
   through its address) with its TCP product, and its axis step check (robot/controller.py
   ``Controller.step``);
@@ -26,7 +27,8 @@ Its objects live in one process and are never pickled: ``auto_pickle=False`` (Cy
 unpickling of ``Palletizer4``'s ``double[6][9]`` copied past the array's end).
 """
 
-from libc.math cimport sin, cos, atan2, sqrt, fabs, copysign, M_PI
+from libc.math cimport sin, cos, atan2, sqrt, fabs, copysign, M_PI, INFINITY
+from cpython.mem cimport PyMem_Malloc, PyMem_Free
 import numpy as np
 
 from robot.kinematics.fastpath cimport OPWCore
@@ -38,6 +40,16 @@ cdef extern from *:
     #endif
     """
     const char* SIMCORE_SOURCE_SHA
+
+cdef extern from *:
+    """
+    #include <math.h>
+    /* libm's pow called as CPython's float ** calls it: through a pointer the compiler cannot
+       see through, so that pow(x, 2.0) is not folded into x * x (glibc's pow is not
+       correctly rounded everywhere: the two may differ in the last bit) */
+    static double (* volatile simcore_libm_pow)(double, double) = pow;
+    """
+    double simcore_libm_pow(double x, double y) noexcept nogil
 
 #: The sha256 of the simcore.pyx this module was compiled from (robot/build.py; robot/kinematics
 #: compares it with the file's: a stale build is not used)
@@ -364,6 +376,125 @@ cdef class CartPath:
             for i in range(6):
                 ref[i] = out[j, i]
         return res
+
+
+    def walk(self, double u0, double u1, int nk, status, const double[:] start6, int chain_from,
+             double budget, bint plain, const double[:] v_ax, const double[:] a_ax, double vmax_k,
+             double max_jump, double step_deg, int max_samples):
+        """robot/planner.py ``_walk_piece`` for a piece from u0 to u1 whose axes :meth:`chain_u`
+        solves (the same numbers, the same operations in the same order): ``np.linspace(u0, u1,
+        nk + 1)``'s samples solved in a chain from start6, more samples while an axis turns more
+        than `step_deg` between two (up to `max_samples`), ``gradient_rows`` twice, the largest
+        |q'| and |q''| of each axis and the piece's speed and acceleration limits from `v_ax` and
+        `a_ax` (deg/s, deg/s^2, (6,)), `budget` and `vmax_k` (Python's ``min``, ``float ** 2`` as
+        libm's pow). Returns (end axes (6,), q' at the start (6,), q' at the end (6,), |q'| max
+        (6,), |q''| max (6,), the piece's speed limit, its axis acceleration limit or None when
+        `plain`), or None where the Python code decides: a pose :meth:`chain_u` does not solve, an
+        axis turning more than `max_jump` between samples (the Python code raises), `nk` reaching
+        `chain_from` (the Python code solves in numpy), a step of 0, a NaN."""
+        cdef double M[12]
+        cdef double ref[6]
+        cdef double qd[6]
+        cdef double qdd[6]
+        cdef double d1a[6]
+        cdef double d1b[6]
+        cdef double* Q
+        cdef double* D1
+        cdef double* D2
+        cdef double step, h, c2h, x, V, W, t, vk2, Aax, biggest
+        cdef double ca, cb, cc
+        cdef int j, i, N, bad = 0
+        if (self.opw is None or start6.shape[0] != 6 or v_ax.shape[0] != 6 or a_ax.shape[0] != 6
+                or nk < 2 or max_samples < nk):
+            return None
+        Q = <double*>PyMem_Malloc(3 * (max_samples + 1) * 6 * sizeof(double))
+        if Q == NULL:
+            raise MemoryError()
+        D1 = Q + (max_samples + 1) * 6
+        D2 = D1 + (max_samples + 1) * 6
+        try:
+            while True:
+                if nk >= chain_from:
+                    return None
+                step = (u1 - u0) / <double>nk           # np.linspace: i * step + start, stop last
+                if step == 0:
+                    return None
+                for i in range(6):
+                    Q[i] = start6[i]
+                    ref[i] = start6[i]
+                for j in range(1, nk + 1):
+                    if not self._pose((<double>j) * step + u0 if j < nk else u1, M):
+                        return None
+                    if not self._solve(M, status, ref, &Q[6 * j]):
+                        return None
+                    for i in range(6):
+                        ref[i] = Q[6 * j + i]
+                biggest = 0.0
+                for j in range(nk):
+                    for i in range(6):
+                        x = fabs(Q[6 * (j + 1) + i] - Q[6 * j + i])
+                        if x != x or x > max_jump:
+                            return None
+                        if x > biggest:
+                            biggest = x
+                if biggest <= step_deg or nk >= max_samples:
+                    break
+                nk = <int>(<double>nk * biggest / step_deg) + 1
+                if nk > max_samples:
+                    nk = max_samples
+            h = ((<double>1) * step + u0) - u0
+            if not h > 0:
+                return None
+            N = nk + 1
+            _gradient_rows(Q, D1, N, h)
+            _gradient_rows(D1, D2, N, h)
+            for i in range(6):
+                d1a[i] = D1[i]
+                d1b[i] = D1[6 * (N - 1) + i]
+                qd[i] = fabs(D1[i])
+                qdd[i] = fabs(D2[i])
+                for j in range(1, N):
+                    x = fabs(D1[6 * j + i])
+                    if x > qd[i]:
+                        qd[i] = x
+                    bad |= x != x
+                    x = fabs(D2[6 * j + i])
+                    if x > qdd[i]:
+                        qdd[i] = x
+                    bad |= x != x
+                bad |= (qd[i] != qd[i]) | (qdd[i] != qdd[i])
+            if bad:
+                return None
+            V = INFINITY
+            for i in range(6):
+                if qd[i] > 1e-9:
+                    x = v_ax[i] / qd[i]
+                    if x < V:
+                        V = x
+            if not plain:
+                W = INFINITY
+                t = 0.5 * budget
+                for i in range(6):
+                    if qdd[i] > 1e-9:
+                        x = sqrt(t * a_ax[i] / qdd[i])
+                        if x < W:
+                            W = x
+                if W < V:
+                    V = W
+            if V < vmax_k:
+                vmax_k = V
+            Aax = INFINITY
+            if not plain:
+                vk2 = simcore_libm_pow(vmax_k, 2.0)
+                for i in range(6):
+                    if qd[i] > 1e-9:
+                        x = (budget * a_ax[i] - qdd[i] * vk2) / qd[i]
+                        if x < Aax:
+                            Aax = x
+            return (_array6(ref), _array6(d1a), _array6(d1b), _array6(qd), _array6(qdd), vmax_k,
+                    None if plain else Aax)
+        finally:
+            PyMem_Free(Q)
 
 
     def use_frames(self, size_t gemm, pre, post):
@@ -816,3 +947,27 @@ def pose_line(double t, axes, tcp):
             n += _put_r6(seq[i], buf + n)
     n += _put(b']}', buf + n)
     return buf[:n].decode('ascii')
+
+
+cdef void _gradient_rows(const double* f, double* out, int n, double h) noexcept:
+    """robot/planner.py ``gradient_rows`` of the n rows (n >= 3) of 6 in f into out."""
+    cdef int r, i
+    cdef double c2h = 2. * h
+    cdef double a0 = -1.5 / h, a1 = 2. / h, a2 = -0.5 / h
+    cdef double b0 = 0.5 / h, b1 = -2. / h, b2 = 1.5 / h
+    for r in range(1, n - 1):
+        for i in range(6):
+            out[6 * r + i] = (f[6 * (r + 1) + i] - f[6 * (r - 1) + i]) / c2h
+    for i in range(6):
+        out[i] = a0 * f[i] + a1 * f[6 + i] + a2 * f[12 + i]
+        out[6 * (n - 1) + i] = b0 * f[6 * (n - 3) + i] + b1 * f[6 * (n - 2) + i] + b2 * f[6 * (n - 1) + i]
+
+
+cdef object _array6(const double* v):
+    """A new float64 array (6,) of v."""
+    res = np.empty(6)
+    cdef double[::1] rv = res
+    cdef int i
+    for i in range(6):
+        rv[i] = v[i]
+    return res

@@ -455,6 +455,94 @@ def test_the_compiled_cp_path_solves_through_base_and_tool_as_the_python_code(sc
     assert compared > 500 and raised > 10 and chains > 5
 
 
+def _plan_bytes(req, q, model):
+    """What a plan decides, as bytes (or the error it raises)."""
+    try:
+        seg = planner.plan(req, q, model)
+    except RobotError as exc:
+        return f"{type(exc).__name__}: {exc}"
+    prof = seg.profile
+    taus = np.linspace(0.0, prof.t_total, 9) if math.isfinite(prof.t_total) else []
+    return b"".join(np.asarray(x, dtype=float).tobytes() for x in (
+        seg.q1, seg.vel_peak, seg.acc_peak, seg.qd_start, seg.qd_end, [prof.t_total, seg.v_prog],
+        [prof.u(t) for t in taus], [prof.du(t) for t in taus]))
+
+
+def _drawn_cp_motions(rng, n, model):
+    """(request, start axes) of drawn CP motions: LINs from 0.05 mm (a CAM program's) to 600 mm,
+    with and without a turn of the orientation, CIRCs, SLIN splines (corners), $TOOL and $BASE
+    or not, $VEL.CP and $ACC.CP drawn; some out of reach."""
+    out = []
+    reach = float(np.linalg.norm(model.kin.forward(np.zeros(6))[:3, 3])) / 1000.0   # m
+    for i in range(n):
+        tool = (10.0, -20.0, 150.0, 270.0, 0.0, 0.0) if i % 4 in (1, 3) else NULLFRAME
+        base = (600.0, -50.0, 300.0, 15.0, 0.0, 180.0) if i % 4 in (2, 3) else NULLFRAME
+        P = MotionParams.initmov(None).with_(tool=tool, base=base)
+        P = P.with_(vel_cp=float(rng.choice([0.02, 0.2, 2.0])), acc_cp=float(rng.choice([0.5, 2.3, 10.0])))
+        q = np.array([rng.uniform(-120, 120), rng.uniform(-110, -50), rng.uniform(60, 130),
+                      rng.uniform(-60, 60), rng.uniform(-100, 100) if i % 9 else rng.uniform(-3, 3),
+                      rng.uniform(-150, 150)])
+        T0 = inv_pos(frame_to_matrix(*base)) @ model.kin.forward(q) @ frame_to_matrix(*tool)
+        start = dict(zip("XYZABC", matrix_to_frame(T0)))
+
+        def moved(scale):
+            d = rng.normal(0.0, 1.0, 3)
+            d *= scale / np.linalg.norm(d)
+            t = {**start, "X": start["X"] + d[0], "Y": start["Y"] + d[1], "Z": start["Z"] + d[2]}
+            if rng.uniform() < 0.4:
+                t[str(rng.choice(["A", "B", "C"]))] += float(rng.normal(0.0, 40.0))
+            return t
+
+        scale = float(rng.choice([0.05, 0.7, 20.0, 150.0, 600.0])) * reach
+        kind = ("LIN", "LIN", "CIRC", "SPLINE")[i % 4 if i % 3 else 0]
+        if kind == "LIN":
+            req = MotionRequest("LIN", moved(scale), P, approx="C_VEL" if i % 2 else None)
+        elif kind == "CIRC":
+            req = MotionRequest("CIRC", moved(scale), P, aux=moved(scale / 2))
+        else:
+            segs = [MotionRequest("SLIN", moved(scale * (k + 1)), P) for k in range(3)]
+            req = MotionRequest("SPLINE", {}, P, segments=segs)
+        out.append((req, q))
+    return out
+
+
+@pytest.mark.parametrize("robot", ["kr6", "kr3_r540"])
+def test_the_compiled_planning_walk_is_the_python_walk_bit_for_bit(sc, monkeypatch, robot):
+    """The planning walk of a CP motion's pieces in C (robot/simcore.pyx ``CartPath.walk``: the
+    samples, the chain of axes, the finer resolution, the derivatives and the speed and
+    acceleration limits; issue 62, the CAM-like program) plans what the Python walk plans, bit
+    for bit, on drawn motions (the KR 3 R540 keeps $ACC.CP: its axis accelerations were
+    identified, robot/identified.py), and raises the same errors."""
+    model = Controller(None if robot == "kr6" else load_robot(robot), mujoco=False).model
+    motions = _drawn_cp_motions(np.random.default_rng(6202), 60, model)
+    walker, samples = planner._compiled_walker, planner._samples
+    walked, sampled = [], []
+
+    def counting(seg):
+        w = walker(seg)
+        return None if w is None else (lambda *a: walked.append(w(*a)) or walked[-1])
+
+    monkeypatch.setattr(planner, "_compiled_walker", counting)
+    compiled, in_c = [], []
+    for req, q in motions:
+        n = len(walked)
+        compiled.append(_plan_bytes(req, q, model))
+        in_c.append(any(w is not None for w in walked[n:]))
+    monkeypatch.setattr(planner, "_compiled_walker", lambda seg: None)
+    monkeypatch.setattr(planner, "_samples", lambda a, b, n: sampled.append(n) or samples(a, b, n))
+    python, finer = [], []
+    for req, q in motions:
+        del sampled[:]
+        python.append(_plan_bytes(req, q, model))
+        finer.append(any(b > a for a, b in zip(sampled, sampled[1:])))
+    assert compiled == python
+    done = [w for w in walked if w is not None]
+    # walked in C: short and long pieces, some at a finer resolution; errors raised alike
+    assert len(done) > 30 and sum(c and f for c, f in zip(in_c, finer)) > 8
+    assert sum(isinstance(b, str) for b in python) >= 5
+    assert any(w[-1] is None for w in done) == (robot == "kr3_r540")
+
+
 def test_the_trace_is_the_same_with_and_without_the_compiled_module(sc, fast, monkeypatch):
     """The whole compiled path (inverse, CP poses, the IPO cycle, pose lines) against the
     Python code on a random sequence of robot/tracecheck.py: the same bytes."""
