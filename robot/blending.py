@@ -39,8 +39,9 @@ from typing import Any
 
 import numpy as np
 
+from .kinematics import compiled_module
 from .planner import CartSegment, JointSegment, Segment, gradient_rows
-from .profiles import BrakeProfile, RampProfile
+from .profiles import BrakeProfile, RampProfile, Trapezoid
 
 
 def effective_keyword(prev: Segment, nxt: Segment | None) -> str | None:
@@ -177,6 +178,47 @@ def _below(v_of_u: Any, base: Any, u0: float, u1: float) -> bool:
     return True
 
 
+#: the speed laws of a blend that :func:`_below_law` checks: the uniform braking of the
+#: approximated motion, the uniform ramp of the next one
+BRAKE_LAW, RAMP_LAW = 0, 1
+
+
+def _below_law(law: int, p0: float, p1: float, p2: float, base: Any, u0: float, u1: float) -> bool:
+    """:func:`_below` of a blend's speed law: :data:`BRAKE_LAW` ``sqrt(max(0, v_a² - 2·a_b·(u - u_a)))``
+    (p0, p1, p2 = v_a, a_b, u_a of a ``BrakeProfile``) or :data:`RAMP_LAW` ``sqrt(2·a_r·u)`` (p0 =
+    a_r of a ``RampProfile``); in C where robot/simcore.pyx ``below`` mirrors the time law `base`
+    (the same operations in the same order: the same answer)."""
+    sc = compiled_module()
+    if sc is not None:
+        table = profile_table(base)
+        if table is not None:
+            got = sc.below(law, p0, p1, p2, table, getattr(base, "bounds", ()), u0, u1)
+            if got is not None:
+                return got
+    if law == BRAKE_LAW:
+        return _below(lambda u: math.sqrt(max(0.0, p0 ** 2 - 2.0 * p1 * (u - p2))), base, u0, u1)
+    return _below(lambda u: math.sqrt(2.0 * p0 * u), base, u0, u1)
+
+
+def profile_table(prof: Any) -> np.ndarray | None:
+    """The time law `prof` and its bases as the records of robot/simcore.pyx ``below``
+    (``PROFILE_FIELDS`` floats each: a ``Trapezoid`` at the bottom, ``RampProfile`` and
+    ``BrakeProfile`` above it), or None for another time law (a spline block's, a friction PTP's)."""
+    rows: list[tuple[float, ...]] = []
+    while True:
+        kind = type(prof)
+        if kind is Trapezoid:
+            rows.append((0.0, prof.t_total, prof.t_acc, prof.a, prof.v, 0.0, 0.0))
+            return np.array(rows, dtype=float).ravel()
+        if kind is RampProfile:
+            rows.append((1.0, prof.delay, prof.tau, prof.u_e, prof.a_r, prof.shift, 0.0))
+        elif kind is BrakeProfile:
+            rows.append((2.0, prof.tau, prof.t_a, prof.u_a, prof.v_a, prof.a_b, prof.t_total))
+        else:
+            return None
+        prof = prof.base
+
+
 @dataclass
 class BlendPlan:
     """How a blend runs (issue 15), from :func:`plan_blend`: the new time laws of the two
@@ -211,8 +253,7 @@ def plan_blend(prev: Segment, nxt: Segment, keyword: str, tau_a: float) -> Blend
         return BlendPlan(bp, RampProfile(nxt.profile, 0.0), 0.0)
     # the uniform braking must stay below the planned speed everywhere (a spline block's
     # corners and curves have lower speeds than the blend start): else no blend before the point
-    if not _below(lambda u: math.sqrt(max(0.0, bp.v_a ** 2 - 2.0 * bp.a_b * (u - bp.u_a))),
-                  prev.profile, bp.u_a, 1.0):
+    if not _below_law(BRAKE_LAW, bp.v_a, bp.a_b, bp.u_a, prev.profile, bp.u_a, 1.0):
         return None
     base = nxt.profile
     u_max = base.u(blend_end_tau(prev, nxt, keyword, tau_a))
@@ -237,13 +278,13 @@ def plan_blend(prev: Segment, nxt: Segment, keyword: str, tau_a: float) -> Blend
             else:
                 hi = mid
         rp = RampProfile(base, lo, tau_p - ramp_time(lo))
-    if rp.tau > 0 and not _below(lambda u: math.sqrt(2.0 * rp.a_r * u), base, 0.0, rp.u_e):
+    if rp.tau > 0 and not _below_law(RAMP_LAW, rp.a_r, 0.0, 0.0, base, 0.0, rp.u_e):
         lo, hi = 0.0, rp.u_e  # a shorter ramp (at its shortest it is the planned acceleration)
         for _ in range(30):
             mid = 0.5 * (lo + hi)
             t_m = ramp_time(mid)
             cand = RampProfile(base, mid, max(0.0, tau_p - t_m))
-            if cand.tau <= 0 or _below(lambda u, c=cand: math.sqrt(2.0 * c.a_r * u), base, 0.0, mid):
+            if cand.tau <= 0 or _below_law(RAMP_LAW, cand.a_r, 0.0, 0.0, base, 0.0, mid):
                 lo = mid
             else:
                 hi = mid

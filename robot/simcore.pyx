@@ -11,7 +11,9 @@ compiled from that very Python file; this module calls its C methods (``OPWCore`
 * :class:`CartPath`: the poses of a CP segment's lines and arcs (robot/planner.py
   ``CartSegment.pose_u``) and their axes (fastpath's ``OPWCore``), through the motion's ``$BASE``
   and ``$TOOL`` where it has them (``RobotModel.ik``'s two products, numpy's BLAS at its address),
-  and the planning walk of a piece (robot/planner.py ``_walk_piece``);
+  and the planning walk of a piece (robot/planner.py ``_plan_cart``);
+* :func:`below`: a blend's check of its speed law against a planned time law (robot/blending.py
+  ``_below``) for the time laws of robot/profiles.py it mirrors;
 * :class:`ArmCycle` and :func:`speed_ok`: the IPO cycle's MuJoCo playback (``mj_kinematics``
   through its address) with its TCP product, and its axis step check (robot/controller.py
   ``Controller.step``);
@@ -381,7 +383,7 @@ cdef class CartPath:
     def walk(self, double u0, double u1, int nk, status, const double[:] start6, int chain_from,
              double budget, bint plain, const double[:] v_ax, const double[:] a_ax, double vmax_k,
              double max_jump, double step_deg, int max_samples):
-        """robot/planner.py ``_walk_piece`` for a piece from u0 to u1 whose axes :meth:`chain_u`
+        """robot/planner.py ``_plan_cart``'s walk of a piece from u0 to u1 whose axes :meth:`chain_u`
         solves (the same numbers, the same operations in the same order): ``np.linspace(u0, u1,
         nk + 1)``'s samples solved in a chain from start6, more samples while an axis turns more
         than `step_deg` between two (up to `max_samples`), ``gradient_rows`` twice, the largest
@@ -971,3 +973,107 @@ cdef object _array6(const double* v):
     for i in range(6):
         rv[i] = v[i]
     return res
+
+
+#: the time laws :func:`below` mirrors (robot/profiles.py), one record of PROFILE_FIELDS floats each,
+#: a law's base after it: ``Trapezoid`` (0, t_total, t_acc, a, v), ``RampProfile`` (1, delay,
+#: tau, u_e, a_r, shift), ``BrakeProfile`` (2, tau, t_a, u_a, v_a, a_b, t_total)
+cdef enum:
+    _PF = 7
+PROFILE_FIELDS = _PF
+
+
+cdef double _t_of_u(const double* r, int left, double u) noexcept:
+    """``t_of_u(u)`` of the time law whose record starts at r (`left` records from r on)."""
+    cdef double T, ta, a, v, u_acc, d, den, x
+    if r[0] == 0:
+        T, ta, a, v = r[1], r[2], r[3], r[4]
+        if u <= 0.0 or T == 0.0:
+            return 0.0
+        if u >= 1.0:
+            return T
+        u_acc = 0.5 * a * ta * ta
+        if u <= u_acc:
+            return sqrt(2.0 * u / a)
+        if u <= 1.0 - u_acc:
+            return ta + (u - u_acc) / v
+        return T - sqrt(2.0 * (1.0 - u) / a)
+    if r[0] == 1:
+        if u <= 0.0:
+            return 0.0
+        if r[2] > 0 and u < r[3]:
+            return r[1] + sqrt(2.0 * u / r[4])
+        return _t_of_u(r + _PF, left - 1, u) + r[5]
+    # brake
+    if r[1] <= 0 or u <= r[3]:
+        return _t_of_u(r + _PF, left - 1, u)
+    if u >= 1.0:
+        return r[6]
+    d = u - r[3]
+    x = r[4] * r[4] - 2.0 * r[5] * d
+    den = r[4] + sqrt(x if x > 0.0 else 0.0)
+    return r[2] + (2.0 * d / den if den > 0 else r[1])
+
+
+cdef double _du(const double* r, int left, double t) noexcept:
+    """``du(t)`` of the time law whose record starts at r."""
+    cdef double T, x
+    if r[0] == 0:
+        T = r[1]
+        if t <= 0.0 or t >= T:
+            return 0.0
+        if t < r[2]:
+            return r[3] * t
+        if t <= T - r[2]:
+            return r[4]
+        return r[3] * (T - t)
+    if r[0] == 1:
+        if t <= r[1]:
+            return 0.0
+        if r[2] > 0 and t < r[1] + r[2]:
+            return r[4] * (t - r[1])
+        return _du(r + _PF, left - 1, t - r[5])
+    if r[1] <= 0 or t <= r[2]:
+        return _du(r + _PF, left - 1, t)
+    if t >= r[6]:
+        return 0.0
+    x = r[4] - r[5] * (t - r[2])
+    return x if x > 0.0 else 0.0
+
+
+def below(int law, double p0, double p1, double p2, const double[::1] table, bounds, double u0, double u1):
+    """robot/blending.py ``_below`` (the same operations in the same order) of the speed law `law`
+    against the time law `table` (records of :data:`PROFILE_FIELDS`, robot/blending.py
+    ``profile_table``) with its section bounds `bounds`: law 0 the uniform braking
+    ``sqrt(max(0, p0 ** 2 - 2 * p1 * (u - p2)))`` (p0 = v_a, p1 = a_b, p2 = u_a; ``**`` as
+    libm's pow), law 1 the uniform ramp ``sqrt(2 * p0 * u)`` (p0 = a_r). True, False, or None for
+    a table it does not read (the Python code decides)."""
+    cdef int n = table.shape[0] // _PF, i
+    cdef const double* r
+    cdef double step, u, vb, v, x, va2 = 0.0
+    if n < 1 or table.shape[0] != n * _PF or law < 0 or law > 1:
+        return None
+    r = &table[0]
+    for i in range(n):
+        if not (r[_PF * i] == 0 or r[_PF * i] == 1 or r[_PF * i] == 2):
+            return None
+        if (r[_PF * i] == 0) != (i == n - 1):      # one trapezoid, at the bottom
+            return None
+    if u1 <= u0:
+        return True
+    if law == 0:
+        va2 = simcore_libm_pow(p0, 2.0)
+    step = (u1 - u0) / 25
+    us = [(<double>i) * step + u0 for i in range(1, 25)]
+    us += [b for b in bounds if u0 < b < u1]
+    for ub in us:
+        u = <double>ub
+        vb = _du(r, n, _t_of_u(r, n, u))
+        if law == 0:
+            x = va2 - 2.0 * p1 * (u - p2)
+            v = sqrt(x if x > 0.0 else 0.0)
+        else:
+            v = sqrt(2.0 * p0 * u)
+        if v > vb * (1.0 + 1e-6) + 1e-12:
+            return False
+    return True

@@ -28,7 +28,7 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from robot import build, controller, kinematics, planner, trace, tracecheck
+from robot import blending, build, controller, kinematics, planner, trace, tracecheck
 from robot.bench import bench_program, run_motions
 from robot.blas import numpy_cblas
 from robot.controller import Controller
@@ -39,6 +39,7 @@ from robot.machine import ROBOT_LIBRARY, library_robots
 from robot.mada import load_mada, load_robot
 from robot.mjcf import ArmModel, _numpy_dgemm
 from robot.motion import MotionParams, MotionRequest
+from robot.profiles import BrakeProfile, RampProfile, Trapezoid
 from robot.trace import _round6, round_time
 
 try:
@@ -541,6 +542,53 @@ def test_the_compiled_planning_walk_is_the_python_walk_bit_for_bit(sc, monkeypat
     assert len(done) > 30 and sum(c and f for c, f in zip(in_c, finer)) > 8
     assert sum(isinstance(b, str) for b in python) >= 5
     assert any(w[-1] is None for w in done) == (robot == "kr3_r540")
+
+
+def _drawn_time_laws(rng, n):
+    """Drawn time laws of blends (robot/profiles.py): trapezoids and triangles, ramps onto them
+    (with and without a delay, a ramp of length 0), braking from them, braking from a ramp."""
+    laws = []
+    for i in range(n):
+        trap = Trapezoid.plan(float(rng.uniform(0.05, 30.0)), float(rng.uniform(0.5, 400.0)))
+        ramp = RampProfile(trap, float(rng.choice([0.0, rng.uniform(0.0, 0.6)])),
+                           float(rng.choice([0.0, rng.uniform(0.0, 0.2)])))
+        laws.append((trap, ramp, BrakeProfile(trap, float(rng.uniform(0.0, trap.t_total))),
+                     BrakeProfile(ramp, float(rng.uniform(0.0, ramp.t_total))))[i % 4])
+    return laws
+
+
+def test_the_compiled_blend_speed_check_is_the_pythons(sc):
+    """A blend's check of its braking and its ramp against a planned time law (robot/blending.py
+    ``_below``) in C (robot/simcore.pyx ``below``; issue 62, the CAM-like program): the same
+    answers on drawn time laws with speed laws set within a few bits of the limit at a sample,
+    both ways (the time law's speeds must be the same bits for the answers to agree)."""
+    rng = np.random.default_rng(6203)
+    answers = []
+    for base in _drawn_time_laws(rng, 400):
+        table = blending.profile_table(base)
+        assert table is not None
+        u0 = float(rng.choice([0.0, rng.uniform(0.0, 0.9)]))
+        u1 = float(rng.choice([1.0, rng.uniform(u0, 1.0)]))
+        points = [i * ((u1 - u0) / 25) + u0 for i in range(1, 25)]
+        limits = [base.du(base.t_of_u(x)) * (1.0 + 1e-6) + 1e-12 for x in points]
+        # the speed laws that touch the limit at one sample: a constant speed (a braking of 0)
+        # at the lowest limit, the ramp whose a_r the samples allow
+        v_min = min(limits)
+        a_min = min(lim * lim / (2.0 * x) for lim, x in zip(limits, points))
+        for bits in (-2, -1, 0, 1, 2):
+            v, a_r = v_min, a_min
+            for _ in range(abs(bits)):
+                v = math.nextafter(v, math.inf if bits > 0 else -math.inf)
+                a_r = math.nextafter(a_r, math.inf if bits > 0 else -math.inf)
+            for law, p in ((blending.RAMP_LAW, (a_r, 0.0, 0.0)), (blending.BRAKE_LAW, (v, 0.0, 0.0)),
+                           (blending.BRAKE_LAW, (v, 0.3 * v * v, 0.5 * (u0 + u1)))):
+                python = blending._below(
+                    (lambda x, p=p: math.sqrt(2.0 * p[0] * x)) if law == blending.RAMP_LAW else
+                    (lambda x, p=p: math.sqrt(max(0.0, p[0] ** 2 - 2.0 * p[1] * (x - p[2])))), base, u0, u1)
+                assert sc.below(law, *p, table, getattr(base, "bounds", ()), u0, u1) is python
+                answers.append(python)
+    assert 0.2 < sum(answers) / len(answers) < 0.8
+    assert blending.profile_table(object()) is None
 
 
 def test_the_trace_is_the_same_with_and_without_the_compiled_module(sc, fast, monkeypatch):
