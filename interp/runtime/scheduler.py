@@ -219,7 +219,7 @@ class Scheduler:
                 self._calm = None
                 return 0
             if task.parked is not None:
-                if 2 * (task.budget + task.parked.spin.steps) > rt.step_limit_left(task):
+                if self.spin.limit_near(task, task.parked.spin):
                     self._calm = None
                     return 0
             elif task.until():

@@ -254,7 +254,11 @@ class SpinWatch(PeriodicSpins):
         (this cycle is counted instead of run: :meth:`_hold`); else a recording may start."""
         if self.shadowed and task in self.shadowed:
             sh = task.shadow
-            if self._step_may_change(sh.spin) or (task.irqs.armed and self._interrupt_due(task)):
+            # (woken where a parked task would be: :meth:`_hold`. Without the step limit's
+            # wake the shadow expected a whole time slice in the cycle the limit stopped the
+            # run in: rawpython's R1/cell.src, 116 of 1000 steps in its last cycle)
+            if self.limit_near(task, sh.spin) or self._step_may_change(sh.spin) or \
+                    (task.irqs.armed and self._interrupt_due(task)):
                 self._unshadow(task)
             else:
                 sh.expect += task.budget
@@ -738,7 +742,7 @@ class SpinWatch(PeriodicSpins):
         rt = self.rt
         p = task.parked
         spin = p.spin
-        if 2 * (task.budget + spin.steps) > rt.step_limit_left(task):
+        if self.limit_near(task, spin):
             return False
         if (spin.io and rt.controller.io.version != p.io_version) or \
                 (spin.probes and self._probed(spin) != p.probed):
@@ -758,6 +762,13 @@ class SpinWatch(PeriodicSpins):
             self._put_end(p, end, end.clock)
         self._place(task)
         return True
+
+    def limit_near(self, task, spin) -> bool:
+        """The step limit comes near for `task`, parked (or shadowed) at `spin`: fewer steps
+        are left than two time slices and a pass, and the task is woken to end at a statement,
+        as unparked (module docstring; :meth:`_hold`, :meth:`resuming`, the scheduler's steady
+        cycles)."""
+        return 2 * (task.budget + spin.steps) > self.rt.step_limit_left(task)
 
     def _interrupt_due(self, task) -> bool:
         """The poll of `task`'s interrupts its resume would make (Runtime.service) finds one to run."""

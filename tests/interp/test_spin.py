@@ -21,7 +21,7 @@ from interp.runtime.scheduler import SUBMIT_BUDGET
 from interp.runtime.sysvars import _LIVE, CONSTANT_NAMES
 from krl.files import SHARED_CORPUS
 
-from .helpers import run_beside, same_run, write
+from .helpers import run_beside, run_krl, same_run, write
 
 INTERPS = ("tree", "vm")
 
@@ -159,6 +159,48 @@ def test_the_step_limit_ends_the_run_at_the_same_statement(tmp_path, interp, lim
     assert res.reason == "max_steps" and by["prog"] == limit + 1
     assert res.steps == by["prog"] + by["sps"] and by["sps"] > 0
     assert rt.scheduler.spin.parks >= 1
+
+
+#: a robot program alone whose loop spins from its first statement: a pass of 2 steps (the
+#: LOOP's iteration, the IF), parked (or shadowed) in the first cycle
+SPINNING = """
+DEF prog()
+  LOOP
+    IF $IN[9] THEN
+      $OUT[9] = TRUE
+    ENDIF
+  ENDLOOP
+END
+"""
+
+
+@pytest.mark.parametrize("interp", INTERPS)
+@pytest.mark.parametrize(("limit", "checked"), [(20_000, 18), (20_037, 19)])
+def test_a_shadowed_spin_is_woken_where_the_step_limit_wakes_a_parked_one(tmp_path, interp, limit, checked):
+    """The nightly's shadowed sweep on rawpython's R1/cell.src (P00's REPEAT loop, the robot task
+    alone): the run ends at the step limit (300 000) in the middle of a time slice, 116 of its
+    1000 steps, where the shadow expected a whole one (expected 6994, done 6110). A parked task
+    is woken when fewer steps are left than two time slices and a pass (2 * (1000 + 2) = 2004
+    here), and a shadowed one must be too. The robot task takes 1000 steps a cycle, so at the
+    resume of cycle k it has taken 1000 k: 20 000 - 1000 k < 2004 first at k = 18 (20 037: at
+    k = 19), and the shadow is checked at the ends of cycles 0..17 (0..18); the run ends in
+    cycle 20 (0.24 s) at step limit + 1, the same parked, unparked and shadowed."""
+    def mode(enabled, shadow):
+        def set_up(rt):
+            rt.scheduler.spin.enabled = enabled
+            rt.scheduler.spin.shadow = shadow
+        return set_up
+
+    runs = [run_krl(tmp_path, SPINNING, interp=interp, max_steps=limit, trace=False, before=mode(*m))
+            for m in ((False, False), (True, False), (True, True))]
+    ends = [(r.result.reason, r.result.line, r.result.steps, r.result.sim_time, r.rt.controller.io.log)
+            for r in runs]
+    # (at the IF, line 3, the only statement: a loop iteration is a step, not a statement)
+    assert ends[0] == ends[1] == ends[2] == ("max_steps", 3, limit + 1, pytest.approx(0.24), [])
+    parked, shadowed = runs[1].rt.scheduler.spin, runs[2].rt.scheduler.spin
+    assert (parked.parks, parked.wakes, parked.diverged, parked.missed) == (1, 1, 0, 0)
+    assert shadowed.shadow_errors == 0, shadowed.why
+    assert shadowed.shadow_checks == checked
 
 
 @pytest.mark.parametrize("interp", INTERPS)
