@@ -161,17 +161,10 @@ def test_the_step_limit_ends_the_run_at_the_same_statement(tmp_path, interp, lim
     assert rt.scheduler.spin.parks >= 1
 
 
-#: a robot program alone whose loop spins from its first statement: a pass of 2 steps (the
-#: LOOP's iteration, the IF), parked (or shadowed) in the first cycle
-SPINNING = """
-DEF prog()
-  LOOP
-    IF $IN[9] THEN
-      $OUT[9] = TRUE
-    ENDIF
-  ENDLOOP
-END
-"""
+#: POLLING without its motions: a robot program alone whose loop spins from its first statement
+#: (LOOP at line 2, the IF at line 3), a pass of 2 steps (the LOOP's iteration, the IF), parked
+#: (or shadowed) in the first cycle
+SPINNING = "DEF prog()\n" + POLLING.split("  ENDFOR\n")[1]
 
 
 @pytest.mark.parametrize("interp", INTERPS)
