@@ -27,6 +27,11 @@ KR120_CELL = CELLS / "khrzysio__KRC4_test.yaml"
 TOL_DEG = 0.01
 
 
+#: the tests on the `kr120` page carry one xdist group: one worker makes the module's server and
+#: page once (spread over three workers, each made its own: 5.3 s of wall each at load 7)
+ON_KR120 = pytest.mark.xdist_group("pendant-kr120")
+
+
 @pytest.fixture(scope="module")
 def kr120(pw, shared_corpus, tmp_path_factory):
     """One server on the KR 120 backup (khrzysio__KRC4_test) with its cell, and one page."""
@@ -59,14 +64,18 @@ def assert_drawn_as_traced(page, t: float) -> None:
     assert all(abs(g - w) <= TOL_DEG for g, w in zip(got, want)), (got, want)
 
 
-def test_mstep_pointer_and_pose_advance(kr120):
+@ON_KR120
+def test_mstep_pointer_and_pose_advance_and_step_backward(kr120):
+    """Two MSTEP steps: the advance-run pointer and the drawn robot follow the trace; then a
+    backward step returns the robot to the first step's point (one run: the backward step
+    starts where the two steps stopped, as an operator's would)."""
     page = kr120
     s0 = select(page, PREPARE)
     entry = (s0["pointers"]["advanceRun"]["path"], s0["pointers"]["advanceRun"]["line"])
     assert entry[0].endswith("PrepareMillingTools.src")
     # the program view shows the advance-run pointer on its line
     page.wait_for_selector(f'#program-view .ln.advance[data-line="{entry[1]}"]')
-    previous, poses = entry, []
+    previous, poses, stops = entry, [], []
     for _ in range(2):
         s = start_to_step(page, state(page)["pointers"]["step"])
         here = (s["pointers"]["advanceRun"]["path"], s["pointers"]["advanceRun"]["line"])
@@ -76,17 +85,10 @@ def test_mstep_pointer_and_pose_advance(kr120):
         assert_drawn_as_traced(page, stop["t"])
         page.wait_for_selector(f'#program-view .ln.advance[data-line="{here[1]}"]')
         poses.append(rendered(page))
+        stops.append(stop)
         previous = here
     assert max(abs(a - b) for a, b in zip(*poses)) > 1.0, "the robot did not move between the two stops"
-
-
-def test_step_backward_to_previous_point(kr120):
-    page = kr120
-    select(page, PREPARE)
-    start_to_step(page, state(page)["pointers"]["step"])
-    first = step_stops(page)[-1]
-    start_to_step(page, state(page)["pointers"]["step"])
-    second = step_stops(page)[-1]
+    first, second = stops
     at_first = pose_at(read_trace(page.trace_path), first["t"])
     assert max(abs(a - b) for a, b in zip(at_first, pose_at(read_trace(page.trace_path), second["t"]))) > 1.0
     page.click("#backward")
@@ -102,6 +104,7 @@ def test_step_backward_to_previous_point(kr120):
     assert all(abs(a - b) <= TOL_DEG for a, b in zip(pose_at(read_trace(page.trace_path), back[-1]["t"]), at_first))
 
 
+@ON_KR120
 def test_jog_an_axis_in_t1(kr120):
     page = kr120
     s = select(page, PREPARE, mode="T1")
@@ -131,6 +134,7 @@ def motion_time(events: list[dict], motion_id: int = 1) -> float:
     return t["end"] - t["start"]
 
 
+@ON_KR120
 def test_override_changes_the_motion_time(kr120):
     page = kr120
     times = {}
@@ -218,6 +222,7 @@ def test_the_pendant_run_gives_krl_runs_trace(pw, shared_corpus, tmp_path, pacin
     assert trace.read_text() == ref.read_text()
 
 
+@ON_KR120
 def test_breakpoint_from_the_program_view(kr120):
     """A breakpoint set by clicking a line number stops the run there (GO), as the engine's
     breakpoints do for `krl debug`."""
