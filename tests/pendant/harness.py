@@ -9,7 +9,6 @@ loaded machine; no assertion depends on how long anything took.
 from __future__ import annotations
 
 import json
-import tempfile
 from contextlib import contextmanager
 from pathlib import Path
 
@@ -39,34 +38,45 @@ def pendant_server(target: Path, *args: str, stderr: Path | None = None):
         yield url
 
 
+def _browser(pw):
+    """The headless Chromium of the Playwright driver ``pw`` (tests/pendant/conftest.py: one
+    driver per test module), launched at its first page with pendant/client.py's flags and
+    ended with the driver. Each page gets a context of its own (:func:`browser_page`): cookies,
+    storage and cache are not shared between pages, as with a fresh profile; launching Chromium
+    once per module instead of once per page saves about a second of CPU a page."""
+    browser = getattr(pw, "krl_browser", None)
+    if browser is None or not browser.is_connected():
+        browser = pw.krl_browser = pw.chromium.launch(executable_path=chromium(), headless=True,
+                                                      args=client.CHROMIUM_FLAGS)
+    return browser
+
+
 @contextmanager
 def browser_page(pw, url: str, viewport=(1400, 900), scale: float = 0.5):
-    """A fresh headless Chromium profile with the page loaded and its robot drawn; page errors
-    are collected in ``page.problems``. ``scale``: the device pixel ratio. The 3D view is
-    software-rendered WebGL (no GPU): at 0.5 its canvas has a quarter of the pixels, with the
-    same CSS layout and scene (the tests read the scene, ``renderedAxes``, the state and the
-    trace; 33.7 -> 20.0 s of Chromium's CPU for test_page's two MSTEP tests, 2026-11-26); the
-    tests that compare pixels (test_screenshots, test_cell_view) draw at 1."""
-    with tempfile.TemporaryDirectory() as profile:
-        # bypass_csp: Playwright's wait_for_function evaluates its predicate, which the page's
-        # Content-Security-Policy (script-src 'self') forbids; the page itself runs under it
-        ctx = pw.chromium.launch_persistent_context(profile, executable_path=chromium(), headless=True,
-                                                    args=client.CHROMIUM_FLAGS, bypass_csp=True,
-                                                    viewport={"width": viewport[0], "height": viewport[1]},
-                                                    device_scale_factor=scale)
-        # every Playwright wait and action (a click waits for its element) gets the loaded
-        # machine's time limit, not Playwright's 30 s
-        ctx.set_default_timeout(WAIT_MS)
-        try:
-            page = ctx.new_page()
-            page.problems = []
-            page.on("pageerror", lambda e: page.problems.append(f"page error: {e}"))
-            page.on("console", lambda m: page.problems.append(f"console: {m.text}") if m.type == "error" else None)
-            page.goto(url)
-            page.wait_for_function("() => window.pendant && window.pendant.robot", timeout=WAIT_MS)
-            yield page
-        finally:
-            ctx.close()
+    """A page in a fresh browser context (no cookie, storage or cache of another page) with the
+    page loaded and its robot drawn; page errors are collected in ``page.problems``.
+    ``scale``: the device pixel ratio. The 3D view is software-rendered WebGL (no GPU): at 0.5
+    its canvas has a quarter of the pixels, with the same CSS layout and scene (the tests read
+    the scene, ``renderedAxes``, the state and the trace; 33.7 -> 20.0 s of Chromium's CPU for
+    test_page's two MSTEP runs, 2026-11-26); the tests that compare pixels (test_screenshots,
+    test_cell_view) draw at 1."""
+    # bypass_csp: Playwright's wait_for_function evaluates its predicate, which the page's
+    # Content-Security-Policy (script-src 'self') forbids; the page itself runs under it
+    ctx = _browser(pw).new_context(bypass_csp=True, viewport={"width": viewport[0], "height": viewport[1]},
+                                   device_scale_factor=scale)
+    # every Playwright wait and action (a click waits for its element) gets the loaded
+    # machine's time limit, not Playwright's 30 s
+    ctx.set_default_timeout(WAIT_MS)
+    try:
+        page = ctx.new_page()
+        page.problems = []
+        page.on("pageerror", lambda e: page.problems.append(f"page error: {e}"))
+        page.on("console", lambda m: page.problems.append(f"console: {m.text}") if m.type == "error" else None)
+        page.goto(url)
+        page.wait_for_function("() => window.pendant && window.pendant.robot", timeout=WAIT_MS)
+        yield page
+    finally:
+        ctx.close()
 
 
 def state(page) -> dict:
