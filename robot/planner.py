@@ -306,7 +306,7 @@ class LinePiece(_Piece):
         self.p0 = np.asarray(p0, dtype=float)
         self.p1 = np.asarray(p1, dtype=float)
         d = self.p1 - self.p0
-        self.length = float(np.linalg.norm(d))
+        self.length = norm3(d)
         self.dir = d / self.length if self.length > 0 else np.zeros(3)
 
     def pos(self, s: float) -> np.ndarray:
@@ -657,7 +657,7 @@ class JointSegment(Segment):
         has it already (``end_pose()[0]``)."""
         if p_end is None:
             p_end = self.end_pose()[0]
-        return float(np.linalg.norm(self.pose_u(u)[0] - p_end))
+        return norm3(self.pose_u(u)[0] - p_end)
 
 
 class CartSegment(Segment):
@@ -695,7 +695,7 @@ class CartSegment(Segment):
         self._rv = [rotvec_of(rots[k].T @ rots[k + 1]) for k in range(len(pieces))]
         # a piece without orientation change (a LIN that keeps the start orientation): its
         # R_k · exp(f · 0) once, instead of a product with the identity every cycle
-        self._R_still = [self._R[k] @ _EYE3 if float(np.linalg.norm(rv)) < 1e-12     # rotvec_matrix(0)
+        self._R_still = [self._R[k] @ _EYE3 if norm3(rv) < 1e-12     # rotvec_matrix(0)
                          else None for k, rv in enumerate(self._rv)]
         self._path_end: np.ndarray | None = None      # tcp_dist_to_end's end point, once
 
@@ -942,7 +942,7 @@ class CartSegment(Segment):
         end = self._path_end
         if end is None:             # the last piece's end point (its pieces do not change)
             end = self._path_end = self.pieces[-1].pos(self.pieces[-1].length)
-        return float(np.linalg.norm(self.pose_u(u)[0] - end))
+        return norm3(self.pose_u(u)[0] - end)
 
     def ori_angle_to_end(self, u: float) -> float:
         """Remaining orientation change (deg) from parameter u to the end."""
@@ -966,6 +966,13 @@ def _samples(a: float, b: float, n: int) -> np.ndarray:
 def _readonly(A: np.ndarray) -> np.ndarray:
     A.setflags(write=False)
     return A
+
+
+def norm3(v: np.ndarray) -> float:
+    """``float(np.linalg.norm(v))`` of a float64 vector, the same number (numpy's norm is
+    ``sqrt(v.dot(v))``: the same dot product, and both square roots correctly rounded) without
+    its argument handling (a planned CP motion and a blend's distances take several)."""
+    return math.sqrt(v.dot(v))
 
 
 def gradient_rows(f: np.ndarray, h: float) -> np.ndarray:
