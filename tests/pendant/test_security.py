@@ -16,6 +16,10 @@ import websockets
 from krl.limits import MAX_WEB_CONNECTIONS, MAX_WEB_MESSAGE_BYTES, MAX_WEB_MESSAGES_PER_S
 from tests.pendant.harness import browser_page, pendant_server, select
 
+# the module's tests share its pendant server (a module fixture): one xdist group, so that one
+# worker starts it once (spread over the three workers, each started its own)
+pytestmark = [pytest.mark.xdist_group("pendant-security")]
+
 PWNED = '<img src=x onerror="window.pwned=1"><script>window.pwned=1</script>'
 
 

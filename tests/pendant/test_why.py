@@ -20,6 +20,10 @@ from tests.conftest import REPO_ROOT
 from tests.pendant.harness import CELLS, MILLING, browser_page, pendant_server, select, state, wait_state
 
 
+# the module's tests share its pendant server (a module fixture): one xdist group, so that one
+# worker starts it once (spread over the three workers, each started its own)
+pytestmark = [pytest.mark.xdist_group("pendant-why")]
+
 ERROR_PROGRAM = """DEF err1422()
   DECL INT n
   $OUT[5] = TRUE
