@@ -3,7 +3,6 @@ elements are there, and markup from the corpus stays inert (issue 12)."""
 
 from __future__ import annotations
 
-import tempfile
 from contextlib import contextmanager
 from pathlib import Path
 
@@ -41,23 +40,27 @@ def report(tmp_path_factory) -> Path:
 
 @contextmanager
 def loaded_page(pw, chromium: str, path: Path):
-    """A page of a fresh headless Chromium profile with `path` loaded, after checking that
-    loading it logged no console error or warning, no page error and no failed request."""
-    with tempfile.TemporaryDirectory() as profile:
-        ctx = pw.chromium.launch_persistent_context(profile, executable_path=chromium, headless=True,
-                                                    args=FLAGS[1:])
-        try:
-            page = ctx.new_page()
-            problems: list[str] = []
-            page.on("console", lambda m: problems.append(f"{m.type}: {m.text}") if m.type in ("error", "warning") else None)
-            page.on("pageerror", lambda e: problems.append(f"page error: {e}"))
-            page.on("requestfailed", lambda r: problems.append(f"request failed: {r.url}"))
-            page.goto(path.as_uri())
-            page.wait_for_load_state("load")
-            assert problems == []
-            yield page
-        finally:
-            ctx.close()
+    """A page of a fresh browser context (no cookie, storage or cache of another page) with
+    `path` loaded, after checking that loading it logged no console error or warning, no page
+    error and no failed request. One headless Chromium per Playwright driver ``pw``, launched
+    at its first page and ended with the driver (a launch is about a second of CPU: a test
+    that loads several pages launches it once)."""
+    browser = getattr(pw, "krl_browser", None)
+    if browser is None or not browser.is_connected():
+        browser = pw.krl_browser = pw.chromium.launch(executable_path=chromium, headless=True, args=FLAGS[1:])
+    ctx = browser.new_context()
+    try:
+        page = ctx.new_page()
+        problems: list[str] = []
+        page.on("console", lambda m: problems.append(f"{m.type}: {m.text}") if m.type in ("error", "warning") else None)
+        page.on("pageerror", lambda e: problems.append(f"page error: {e}"))
+        page.on("requestfailed", lambda r: problems.append(f"request failed: {r.url}"))
+        page.goto(path.as_uri())
+        page.wait_for_load_state("load")
+        assert problems == []
+        yield page
+    finally:
+        ctx.close()
 
 
 def test_report_renders_in_headless_chromium(chromium, report):
