@@ -15,7 +15,7 @@ from pathlib import Path
 import yaml
 
 from pendant import client
-from tests.system_tools import require
+from tests.chromium import shared_browser
 from tests.conftest import REPO_ROOT, SHARED_CORPUS
 
 KR120 = SHARED_CORPUS / "khrzysio__KRC4_test"
@@ -25,30 +25,12 @@ CELLS = REPO_ROOT / "corpus" / "cells"
 WAIT_MS = 300_000         # a selection loads and checks a whole backup: minutes on a loaded machine
 
 
-def chromium() -> str:
-    """Debian's chromium (make test installs it; missing: a failure naming the command)."""
-    return require("chromium")
-
-
 @contextmanager
 def pendant_server(target: Path, *args: str, stderr: Path | None = None):
     """`krl pendant TARGET --no-browser ARGS...` (pendant/client.py): yields the URL it printed
     first; its stderr is shown on failure (and kept in the file `stderr` when given)."""
     with client.pendant_server(target, *args, root=REPO_ROOT, stderr=stderr) as (_proc, url):
         yield url
-
-
-def _browser(pw):
-    """The headless Chromium of the Playwright driver ``pw`` (tests/pendant/conftest.py: one
-    driver per test module), launched at its first page with pendant/client.py's flags and
-    ended with the driver. Each page gets a context of its own (:func:`browser_page`): cookies,
-    storage and cache are not shared between pages, as with a fresh profile; launching Chromium
-    once per module instead of once per page saves about a second of CPU a page."""
-    browser = getattr(pw, "krl_browser", None)
-    if browser is None or not browser.is_connected():
-        browser = pw.krl_browser = pw.chromium.launch(executable_path=chromium(), headless=True,
-                                                      args=client.CHROMIUM_FLAGS)
-    return browser
 
 
 @contextmanager
@@ -62,7 +44,7 @@ def browser_page(pw, url: str, viewport=(1400, 900), scale: float = 0.5):
     test_cell_view) draw at 1."""
     # bypass_csp: Playwright's wait_for_function evaluates its predicate, which the page's
     # Content-Security-Policy (script-src 'self') forbids; the page itself runs under it
-    ctx = _browser(pw).new_context(bypass_csp=True, viewport={"width": viewport[0], "height": viewport[1]},
+    ctx = shared_browser(pw).new_context(bypass_csp=True, viewport={"width": viewport[0], "height": viewport[1]},
                                    device_scale_factor=scale)
     # every Playwright wait and action (a click waits for its element) gets the loaded
     # machine's time limit, not Playwright's 30 s

@@ -10,12 +10,11 @@ import pytest
 
 from recovery.report import summarise, write_report
 from tests.report.test_recovery_report import corpus_results
+from tests.chromium import shared_browser
 from tests.system_tools import require
 import playwright.sync_api as playwright
 
 CHROMIUM = "/usr/bin/chromium"
-FLAGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-         "--disable-background-networking", "--disable-component-update", "--disable-sync"]
 PWNED = "<script>window.pwned=1</script>"
 
 
@@ -42,13 +41,8 @@ def report(tmp_path_factory) -> Path:
 def loaded_page(pw, chromium: str, path: Path):
     """A page of a fresh browser context (no cookie, storage or cache of another page) with
     `path` loaded, after checking that loading it logged no console error or warning, no page
-    error and no failed request. One headless Chromium per Playwright driver ``pw``, launched
-    at its first page and ended with the driver (a launch is about a second of CPU: a test
-    that loads several pages launches it once)."""
-    browser = getattr(pw, "krl_browser", None)
-    if browser is None or not browser.is_connected():
-        browser = pw.krl_browser = pw.chromium.launch(executable_path=chromium, headless=True, args=FLAGS[1:])
-    ctx = browser.new_context()
+    error and no failed request; the browser is the driver's one (tests/chromium.py)."""
+    ctx = shared_browser(pw, chromium).new_context()
     try:
         page = ctx.new_page()
         problems: list[str] = []
