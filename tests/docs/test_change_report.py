@@ -28,7 +28,6 @@ import re
 import subprocess
 from pathlib import Path
 
-import playwright.sync_api as playwright
 import pytest
 from pypdf import PdfReader
 
@@ -40,6 +39,7 @@ from tests.docs import transcripts as T
 # and they share that run: one xdist worker takes the whole group (make test: --dist loadgroup)
 pytestmark = [pytest.mark.timeout(3600), pytest.mark.xdist_group("docs")]
 from tests.report.test_report_chromium import loaded_page
+from tests.chromium import pw  # noqa: F401  (fixture: the module's Playwright driver)
 
 README = T.REPO / "README.md"
 SCREEN = {"width": 1280, "height": 800}
@@ -72,10 +72,10 @@ def _opened(page, link) -> tuple[str, str, int, str]:
     return side, file, int(n), line_text
 
 
-def test_summary_and_diff_on_the_first_screen(chromium, example):
+def test_summary_and_diff_on_the_first_screen(chromium, example, pw):
 
     _work, page_file = example
-    with playwright.sync_playwright() as pw, loaded_page(pw, chromium, page_file) as page:
+    with loaded_page(pw, chromium, page_file) as page:
         page.set_viewport_size(SCREEN)
         page.wait_for_function("document.body.dataset.ready === '1'", timeout=180_000)
         page.evaluate("window.scrollTo(0, 0)")
@@ -122,21 +122,21 @@ def _check_links(page, root: Path, findings: str = "table.findings tr.finding", 
     return n
 
 
-def test_every_finding_and_change_links_to_its_file_and_line(chromium, example):
+def test_every_finding_and_change_links_to_its_file_and_line(chromium, example, pw):
     work, page_file = example
-    with playwright.sync_playwright() as pw, loaded_page(pw, chromium, page_file) as page:
+    with loaded_page(pw, chromium, page_file) as page:
         # the example's new backup has warnings (all listed), the point and the tool
         assert page.locator("#all-findings-table tr.finding").count() > 0
         assert _check_links(page, work / "out" / "new-backup") >= 2 + page.locator("#all-findings-table tr.finding").count()
 
 
-def test_findings_introduced_and_removed_link_to_each_side(chromium, shared_history, tmp_path):
+def test_findings_introduced_and_removed_link_to_each_side(chromium, shared_history, tmp_path, pw):
     pair = shared_history / "KnoP-01__krl-for-vim9" / "01-8fae7e9c"
     out = tmp_path / "pair.html"
     r = subprocess.run([str(T.REPO / ".venv" / "bin" / "krl"), "report", str(pair / "new"), "--since", str(pair / "old"),
                         "--no-runs", "-o", str(out)], capture_output=True, text=True, timeout=600)
     assert r.returncode == 0, r.stderr
-    with playwright.sync_playwright() as pw, loaded_page(pw, chromium, out) as page:
+    with loaded_page(pw, chromium, out) as page:
         # read from `diff -r old new` and krl check on each side: the header's two errors
         # (lines 5 and 8) are gone; the old header failed, so the old check understood none of
         # the file's 106 code lines (issue 63): what the new check finds on them (the syntax
@@ -167,10 +167,10 @@ def _pdf_text_sizes(pdf: Path) -> tuple[list[str], list[float], int]:
     return texts, sizes, images
 
 
-def test_the_printed_pdf_is_legible(chromium, example, tmp_path):
+def test_the_printed_pdf_is_legible(chromium, example, tmp_path, pw):
     _work, page_file = example
     pdf = tmp_path / "change.pdf"
-    with playwright.sync_playwright() as pw, loaded_page(pw, chromium, page_file) as page:
+    with loaded_page(pw, chromium, page_file) as page:
         page.wait_for_function("document.body.dataset.ready === '1'", timeout=180_000)
         page.pdf(path=str(pdf), format="A4", print_background=True)
     texts, sizes, images = _pdf_text_sizes(pdf)

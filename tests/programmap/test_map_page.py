@@ -22,7 +22,7 @@ from krl.project import find_backups
 from krl.workspace import workspaces_for
 from tests.system_tools import require
 from tests.report.test_report_chromium import loaded_page
-import playwright.sync_api as playwright
+from tests.chromium import pw  # noqa: F401  (fixture: the module's Playwright driver)
 
 WEB = Path(__file__).parents[2] / "krl" / "programmap" / "web"
 STATIC = Path(__file__).parents[2] / "krl" / "programmap" / "static" / "programmap.js"
@@ -58,7 +58,7 @@ def chromium() -> str:
     return require("chromium")
 
 
-def test_search_neighbourhood_and_source_link_in_chromium(chromium, largest, tmp_path):
+def test_search_neighbourhood_and_source_link_in_chromium(chromium, largest, tmp_path, pw):
 
     root, pm = largest
     page_file = tmp_path / "map.html"
@@ -72,7 +72,7 @@ def test_search_neighbourhood_and_source_link_in_chromium(chromium, largest, tmp
                   if n.kind == "routine" and not n.kuka and n.id in out and n.id in inc and not n.main)
     callers = sorted({pm.nodes[e.source].name for e in pm.edges if e.target == target.id})
     callees = sorted({pm.nodes[e.target].name for e in pm.edges if e.source == target.id})
-    with playwright.sync_playwright() as pw, loaded_page(pw, chromium, page_file) as page:
+    with loaded_page(pw, chromium, page_file) as page:
         page.wait_for_function("document.body.dataset.ready === '1'", timeout=180_000)
         assert page.evaluate("document.body.dataset.view") == "overview"
         shown = page.evaluate("window.krlMap.cy.nodes().filter(n => !n.isParent()).length")
@@ -115,7 +115,7 @@ def test_search_neighbourhood_and_source_link_in_chromium(chromium, largest, tmp
         assert page.locator("#source-file").get_attribute("href") == Path(target.path).as_uri()
 
 
-def test_markup_in_names_stays_text(chromium, tmp_path):
+def test_markup_in_names_stays_text(chromium, tmp_path, pw):
 
     evil = "<img src=x onerror=window.pwned=1>"
     (tmp_path / f"{evil}.src").write_text("DEF odd()\n  helper()\nEND\nDEF helper()\nEND\n")
@@ -123,7 +123,7 @@ def test_markup_in_names_stays_text(chromium, tmp_path):
     r = CliRunner().invoke(main, ["graph", "--format", "html", str(tmp_path), "-o", str(page_file)])
     assert r.exit_code == 0, r.output
     assert evil not in page_file.read_text(encoding="utf-8")           # escaped in the page's JSON
-    with playwright.sync_playwright() as pw, loaded_page(pw, chromium, page_file) as page:
+    with loaded_page(pw, chromium, page_file) as page:
         page.wait_for_function("document.body.dataset.ready === '1'", timeout=60_000)
         page.fill("#map-search", "helper")
         page.keyboard.press("Enter")

@@ -32,8 +32,8 @@ from pypdf import PdfReader
 
 from app import main
 from tests.report.test_report_chromium import loaded_page
+from tests.chromium import pw  # noqa: F401  (fixture: the module's Playwright driver)
 from tests.system_tools import require
-import playwright.sync_api as playwright
 
 PAIR = "rawpython__kukaKRLmagic/01-53e3f517"
 MOVED = "paulovictor237__KUKA-Paletizador/04-72cb25e4"
@@ -89,11 +89,10 @@ def _print(pw, chromium: str, page_file: Path, pdf: Path) -> list[str]:
     return [p.extract_text().replace("\ufb01", "fi").replace("\ufb02", "fl") for p in PdfReader(str(pdf)).pages]
 
 
-def test_the_first_printed_page_identifies_both_backups_and_carries_the_signatures(chromium, report, tmp_path):
+def test_the_first_printed_page_identifies_both_backups_and_carries_the_signatures(chromium, report, tmp_path, pw):
 
     pair, page_file = report
-    with playwright.sync_playwright() as pw:
-        texts = _print(pw, chromium, page_file, tmp_path / "report.pdf")
+    texts = _print(pw, chromium, page_file, tmp_path / "report.pdf")
     first = re.sub(r"\s+", "", texts[0])            # a path or a hash wraps across lines
     assert "Changereport" in first
     for side in ("old", "new"):
@@ -122,10 +121,10 @@ _TARGETS = """() => [...document.querySelectorAll('a[href]')].filter(a => !a.clo
 })"""
 
 
-def test_every_link_opens_in_the_page_at_its_line(chromium, report):
+def test_every_link_opens_in_the_page_at_its_line(chromium, report, pw):
 
     pair, page_file = report
-    with playwright.sync_playwright() as pw, loaded_page(pw, chromium, page_file) as page:
+    with loaded_page(pw, chromium, page_file) as page:
         links = page.evaluate(_TARGETS)
         places = [x for x in links if x["where"]]
         # read from `diff -r old new` and krl check on each side: 6 points, 105 values, 9
@@ -164,13 +163,13 @@ _LINES = """sel => [...document.querySelectorAll(sel)].filter(e => e.offsetParen
 })"""
 
 
-def test_tables_are_readable_at_print_width(chromium, report):
+def test_tables_are_readable_at_print_width(chromium, report, pw):
     # issue 63: the findings table squeezed its code column to one character per line. At the
     # printed page's width (A4 less the margins: 186 mm, 703 px) with the print style sheet,
     # every code and change cell is one line, and every place of up to 30 characters too
 
     _pair, page_file = report
-    with playwright.sync_playwright() as pw, loaded_page(pw, chromium, page_file) as page:
+    with loaded_page(pw, chromium, page_file) as page:
         page.emulate_media(media="print")
         page.set_viewport_size({"width": 703, "height": 1000})
         codes = page.evaluate(_LINES, "table.findings td.code, table.codes td.code, .diff-wrap td.change")
@@ -180,12 +179,11 @@ def test_tables_are_readable_at_print_width(chromium, report):
 
 
 @pytest.mark.slow
-def test_the_pdf_of_a_pair_with_moved_modules_is_a_third_of_what_it_was(chromium, shared_history, tmp_path):
+def test_the_pdf_of_a_pair_with_moved_modules_is_a_third_of_what_it_was(chromium, shared_history, tmp_path, pw):
 
     pair = shared_history / MOVED
     page_file = _report(pair, tmp_path / "moved.html")
-    with playwright.sync_playwright() as pw:
-        texts = _print(pw, chromium, page_file, tmp_path / "moved.pdf")
+    texts = _print(pw, chromium, page_file, tmp_path / "moved.pdf")
     assert len(texts) <= PAGES_BEFORE // 3, len(texts)
     whole = re.sub(r"\s+", " ", " ".join(texts))
     # the 41 modules moved (counted from the two folders' file lists) are moves, not removals
