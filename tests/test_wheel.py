@@ -154,7 +154,11 @@ def test_constraints_pin_installed_versions_and_every_dependency():
         if line:
             name, _, version = line.partition("==")
             pins[norm(name)] = version
-    installed = {norm(d.metadata["Name"]): d.version for d in metadata.distributions() if d.metadata["Name"]}
+    # the environment's own packages: setuptools (from 71 on) puts its vendored copies of zipp,
+    # packaging, ... on sys.path once imported, and their metadata would answer for the real ones
+    site = sorted({sysconfig.get_path("purelib"), sysconfig.get_path("platlib")})
+    installed = {norm(d.metadata["Name"]): d.version for d in metadata.distributions(path=site)
+                 if d.metadata["Name"]}
     assert {n: installed.get(n) for n in pins} == pins
     requires = [Requirement(r) for r in metadata.requires("krl-tools") or []]
     assert {norm(r.name) for r in requires} - set(pins) == set()
