@@ -1,5 +1,7 @@
-"""A short run of every fuzz target (a few seconds each), so that the harness cannot rot:
-each target starts under atheris, runs its seeds and some mutations, and finds nothing."""
+"""A short run of the fuzz targets (a few seconds each), so that the harness cannot rot: a target
+starts under atheris, runs its seeds and some mutations, and finds nothing. make test runs two
+targets so (:data:`UNDER_ATHERIS`) and every target's function on its seeds in this process;
+make nightly runs every target under atheris (here, marked slow, and at length: tests.fuzz.run)."""
 
 from __future__ import annotations
 
@@ -13,9 +15,21 @@ from tests.fuzz.targets import TARGETS
 from tests.test_json_schemas import validate
 
 
-@pytest.mark.parametrize("target", sorted(TARGETS))
+#: the targets make test starts under atheris: ``interp``, whose subject atheris_main instruments
+#: apart (its own ``instrument_imports``), and ``decode_parse``, the first step of every other
+#: target. Each start costs 4-8 s of CPU (atheris instruments the project's modules as they
+#: import); the other five targets' functions run on their seeds below, uninstrumented.
+UNDER_ATHERIS = ("decode_parse", "interp")
+
+
+def _seeds_and_runs(target: str) -> tuple[int, int]:
+    return (3, 6) if target == "interp" else (8, 40)
+
+
+@pytest.mark.parametrize("target", [pytest.param(t, marks=() if t in UNDER_ATHERIS else pytest.mark.slow)
+                                    for t in sorted(TARGETS)])
 def test_short_fuzz_run(target, tmp_path):
-    seeds, runs = (3, 6) if target == "interp" else (8, 40)
+    seeds, runs = _seeds_and_runs(target)
     res = subprocess.run([sys.executable, "-m", "tests.fuzz.run", target, "--seconds", "3", "--seeds", str(seeds),
                           "--runs", str(runs), "--out", str(tmp_path)], cwd=REPO, capture_output=True, text=True,
                          timeout=600, check=False)
@@ -27,6 +41,19 @@ def test_short_fuzz_run(target, tmp_path):
     assert entry["findings"] == 0
     assert entry["runs"] >= seeds, log[-3000:]     # every seed ran at least once
     assert "INITED" in log or "DONE" in log
+
+
+def test_every_target_holds_on_its_seeds():
+    """Every target's function on the seeds its short run starts from, in this process: the
+    property holds for each (a target or a seed folder that rots fails here, fuzzed or not)."""
+    failed = []
+    for name, target in sorted(TARGETS.items()):
+        for path in seed_files(name, _seeds_and_runs(name)[0]):
+            try:
+                target(path.read_bytes())
+            except Exception as exc:  # noqa: BLE001 - each seed is reported by name
+                failed.append(f"{name}: {path.name}: {type(exc).__name__}: {exc}")
+    assert failed == []
 
 
 def test_seeds_come_from_the_corpora():
