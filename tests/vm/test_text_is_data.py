@@ -20,6 +20,11 @@ from interp.run import make_runtime, run_spec
 from interp.vm import assembler
 from robot.trace import TraceWriter
 
+#: one xdist group: xdist sends groups before single tests (larger first), so the property test
+#: below (~20 s on a loaded worker) no longer starts among the suite's last tests and ends
+#: alone (a whole run of 2026-11-26 16:31-16:56: the other workers had ended 19 s earlier)
+pytestmark = pytest.mark.xdist_group("text-is-data")
+
 # the characters str.splitlines breaks at that the KRL lexer keeps inside a comment/string
 SPLITLINES_ONLY = ["\f", "\v", "\x1c", "\x1d", "\x1e", "\x85", "\u2028", "\u2029"]
 # other odd characters a KRL file may hold (NUL makes the file "binary": not run at all)
