@@ -123,15 +123,11 @@ def apply_identified(machine: Any, path: Path) -> Any:
     joints = machine.joints
     if "acc" in got:
         joints = tuple(replace(j, max_acc_deg_s2=a) for j, a in zip(joints, got["acc"]))
-        prov["max_acc_deg_s2"] = f"identified: {path.name} (tools/identify_kr3.py, the real KUKA Trace recordings)"
-    if "ramp" in got:
-        prov["ptp_ramp_deg"] = f"identified: {path.name} (tools/identify_kr3.py, the real KUKA Trace recordings)"
-    if "friction" in got:
-        prov["ptp_friction"] = f"identified: {path.name} (tools/identify_kr3.py, the real KUKA Trace recordings)"
-    if "filter" in got:
-        prov["actual_filter_cycles"] = f"identified: {path.name} (tools/identify_kr3.py, the real KUKA Trace recordings)"
-    if "following" in got:
-        prov["actual_following"] = f"identified: {path.name} (tools/identify_kr3.py, the real KUKA Trace recordings)"
+    from_recordings = f"identified: {path.name} (tools/identify_kr3.py, the real KUKA Trace recordings)"
+    for key, field in (("acc", "max_acc_deg_s2"), ("ramp", "ptp_ramp_deg"), ("friction", "ptp_friction"),
+                       ("filter", "actual_filter_cycles"), ("following", "actual_following")):
+        if key in got:
+            prov[field] = from_recordings
     if "dynamics" in got:
         prov["dynamics"] = f"identified: {path.name} (tools/identify_kr3.py: link inertias from the collision meshes, rotor inertias and torques from the recordings)"
     return replace(machine, joints=joints, ptp_ramp_deg=got.get("ramp", machine.ptp_ramp_deg),
