@@ -17,8 +17,9 @@ from tests.test_json_schemas import validate
 
 #: the targets make test starts under atheris: ``interp``, whose subject atheris_main instruments
 #: apart (its own ``instrument_imports``), and ``decode_parse``, the first step of every other
-#: target. Each start costs 4-8 s of CPU (atheris instruments the project's modules as they
-#: import); the other five targets' functions run on their seeds below, uninstrumented.
+#: target. Each start took 4.3-8.6 s in a fresh clone's run (2026-11-26; mostly the atheris
+#: process, which instruments the project's modules as they import); the other five targets'
+#: functions run on their seeds below, uninstrumented.
 UNDER_ATHERIS = ("decode_parse", "interp")
 
 
