@@ -74,11 +74,16 @@ class StopRun(ControlSignal):
 NOT_UNDERSTOOD = "line not understood by krl-tools"
 
 
-def not_understood(text: str) -> str:
+def not_understood(st: N.Unparsed) -> str:
     """The message of a run that reaches a line the grammar does not accept (an ``Unparsed``
-    statement, issue 63): the controller runs the line, the simulator cannot say what it does,
-    so the run stops there, in both interpreters alike."""
-    return f"{NOT_UNDERSTOOD} (the controller runs it; the simulation stops here): {' '.join(text.split())[:60]}"
+    statement, issue 63), in both interpreters alike. A line whose form KRL rejects (its
+    ``error``: krl/diagnostics ``PROGRAM_SYNTAX_CODES``, a compile error of the reference, 8.1)
+    is the program's error, in the checker's words: ``syntax error E012: ...``. Any other line
+    may be a construct the recovered grammar lacks: the controller runs it, the simulator
+    cannot say what it does, so the run stops there as the simulator's gap."""
+    if st.error:
+        return f"syntax error {st.error}"
+    return f"{NOT_UNDERSTOOD} (the controller runs it; the simulation stops here): {' '.join(st.text.split())[:60]}"
 
 
 def not_entered(routine: N.Routine) -> str:

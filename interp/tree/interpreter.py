@@ -311,7 +311,7 @@ class TreeInterpreter:
                               st.span.file, st.span.line)
 
     def s_Unparsed(self, st, frame) -> None:
-        raise KrlRuntimeError(not_understood(st.text), None, st.span.file, st.span.line)
+        raise KrlRuntimeError(not_understood(st), None, st.span.file, st.span.line)
 
     # interrupts, triggers, brake ------------------------------------------------------
     def s_InterruptDecl(self, st, frame) -> None:

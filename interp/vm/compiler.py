@@ -388,7 +388,7 @@ class Compiler:
 
     def s_Unparsed(self, st) -> None:
         self.region = None
-        self.emit("RAISE", not_understood(st.text), st.span.line)
+        self.emit("RAISE", not_understood(st), st.span.line)
 
     def _stub(self, st) -> None:
         self.stmt(st)

@@ -23,7 +23,7 @@ from antlr4.tree.Tree import ErrorNode, TerminalNode
 
 from krl.ast import nodes as N
 from krl.diagnostics import DiagnosticSink
-from krl.diagnostics.codes import E003, W003
+from krl.diagnostics.codes import E003, PROGRAM_SYNTAX_CODES, W003
 
 _RULE_CACHE: dict[type, tuple[str, str]] = {}
 
@@ -68,13 +68,15 @@ class Builder:
     """Builds one file's AST. Use :func:`build_module`."""
 
     def __init__(self, path: str, sink: DiagnosticSink, symbolic: list[str], recovered: bool,
-                 error_lines: dict[int, str] | None = None):
+                 error_lines: dict[int, str] | None = None, line_errors: dict[int, str] | None = None):
         self.path = path
         self.sink = sink
         self.symbolic = symbolic
         self.recovered = recovered
         # line -> its text, of each line with a syntax error (a recovered tree only)
         self.error_lines = error_lines or {}
+        # line -> "CODE: message" of the error lines whose form KRL rejects (Unparsed.error)
+        self.line_errors = line_errors or {}
         self._placed: set[int] = set()      # error lines already given their Unparsed node
         self._in_doubt = False              # a rule of the routine in hand recovered past its own line
 
@@ -168,7 +170,7 @@ class Builder:
         self._placed.add(line)
         text = self.error_lines[line]
         col = len(text) - len(text.lstrip()) + 1 if text.strip() else col
-        return N.Unparsed(text.strip(), span=N.Span(self.path, line, col))
+        return N.Unparsed(text.strip(), self.line_errors.get(line, ""), span=N.Span(self.path, line, col))
 
     def _error_line_of(self, ctx) -> int | None:
         """The line of `ctx` when it is a line with a syntax error (a recovered tree), else None."""
@@ -1177,7 +1179,9 @@ _STATEMENTS = {
 def build_module(result, sink: DiagnosticSink | None = None) -> N.Module:
     """Build the AST of one parsed file.
 
-    `result` is a krl.syntax.parse.ParseResult (its `.tree` must be kept). Returns a
+    `result` is a krl.syntax.parse.ParseResult (its `.tree` must be kept); `sink` holds the
+    file's syntax findings when the caller made them first (krl/workspace.py): a line whose
+    finding is one of ``PROGRAM_SYNTAX_CODES`` gets it as its ``Unparsed.error``. Returns a
     Module (possibly empty, for a file that was not parsed or lost its tree). Never raises;
     a construct that cannot be built is an E003 error (the program does not start), one the
     builder does not map yet a W003 warning (it is kept as an Unsupported statement). Reference: sections 2-6 for the shapes.
@@ -1193,7 +1197,9 @@ def build_module(result, sink: DiagnosticSink | None = None) -> N.Module:
         lines: dict[int, str] = {}
         for e in getattr(result, "errors", None) or ():
             lines.setdefault(e.line, e.line_text)
-        b = Builder(path, sink, symbolic, recovered=not result.ok, error_lines=lines)
+        rejected = {d.line: f"{d.code}: {d.message}" for d in reversed(sink.items)
+                    if d.code in PROGRAM_SYNTAX_CODES and d.path == path and d.line in lines}
+        b = Builder(path, sink, symbolic, recovered=not result.ok, error_lines=lines, line_errors=rejected)
         return b.module(tree)
     except Exception as exc:  # noqa: BLE001 - never raise on any parse tree
         sink.add(path, 1, 1, *E003("failed", error=f"{type(exc).__name__}: {exc}"))

@@ -670,8 +670,12 @@ class Unparsed(Stmt):
     that every tool uses what parsed around it (issue 63). ``text`` is the line's source text,
     stripped; the parser's message is the file's diagnostic at the same line. A run that
     reaches it stops there (interp/runtime ``not_understood``); ``krl diff`` compares it by its
-    text."""
+    text. ``error``: the checker's finding on the line when KRL rejects its form whatever the
+    controller's grammar holds (``"E012: `TODO` alone is not a statement; ..."``,
+    krl/diagnostics ``PROGRAM_SYNTAX_CODES``): the run stops on the program's error; "" when the
+    line may be a construct the grammar lacks (the simulator's gap)."""
     text: str
+    error: str = ""
 
 
 @dataclass(slots=True)

@@ -18,7 +18,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from krl.diagnostics.codes import CODES, SYNTAX_CODES, Code  # every code, declared once: codes.py
+from krl.diagnostics.codes import CODES, PROGRAM_SYNTAX_CODES, SYNTAX_CODES, Code  # every code, declared once: codes.py
 
 
 @dataclass(slots=True)

@@ -207,4 +207,14 @@ CODES: dict[str, tuple[str, str]] = {str(c): (c.severity, c.kind) for c in ALL}
 #: are input and build errors of the same group
 SYNTAX_CODES = frozenset({E002, E010, E011, E012, E013, E014, E015, E016, E017, E018, E019, E020})
 
-__all__ = ["ALL", "CODES", "Code", "ERROR", "SYNTAX_CODES", "WARNING", *(str(c) for c in ALL)]
+#: the syntax findings that are the program's error whatever the controller's full grammar holds:
+#: a closer without its opener, a statement missing its keyword or part (a name alone on its
+#: line: calls need parentheses, grammar/CHANGES.md), `==` for `=`, a declaration after the
+#: first statement, a bracket or string not closed, a character that is not KRL: the compile
+#: errors of the reference, 8.1. A run that reaches such a line stops on the program's error
+#: (interp/runtime/errors.py ``not_understood``). The others (E002, E016: a construct the
+#: recovered grammar may lack; E010: the routine is not entered; E018-E020: the tool's limits,
+#: a file cut short) stay the simulator's gap.
+PROGRAM_SYNTAX_CODES = frozenset({E011, E012, E013, E014, E015, E017})
+
+__all__ = ["ALL", "CODES", "Code", "ERROR", "PROGRAM_SYNTAX_CODES", "SYNTAX_CODES", "WARNING", *(str(c) for c in ALL)]
