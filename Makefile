@@ -54,7 +54,7 @@ parser: $(PARSER) java-parser
 # The Java parse engine (krl/syntax/engines/java.py): the Java parser generated from
 # grammar/KRL.g4 and compiled, cached by the grammar's sha under build/java/ (not committed).
 # Without a JDK it says so and the Python engine is used.
-JAVA_STAMP := build/java/.built-$(shell sha256sum grammar/KRL.g4 krl/syntax/engines/worker/KrlWorker.java 2>/dev/null | sha256sum | cut -c1-16)
+JAVA_STAMP := build/java/.built-$(shell sha256sum grammar/KRL.g4 krl/syntax/engines/worker/KrlWorker.java krl/syntax/engines/java.py 2>/dev/null | sha256sum | cut -c1-16)
 $(JAVA_STAMP): $(PARSER)
 	@$(BIN)/python -c 'import sys; from krl.syntax.engines.java import main; sys.exit(main(["build"]))'
 	@mkdir -p build/java && touch $@
