@@ -18,7 +18,7 @@ from robot.motion import CondStop, MotionRequest, Trigger
 from .convert import assign_into, num
 from .errors import KrlRuntimeError
 from .memory import Slot
-from .motion import params_from, request, segment, target_of
+from .motion import ParamsMemo, params_from, request, segment, target_of
 from .runmode import STEP_MODES
 from .scheduler import Task
 from .values import Arr, Struct, copy_value
@@ -41,10 +41,11 @@ def reach_message(ctl, req, err) -> str:
 class MotionStatements:
     """The motion statements of one run's robot program (module docstring)."""
 
-    __slots__ = ("rt",)
+    __slots__ = ("rt", "memo")
 
     def __init__(self, rt) -> None:
         self.rt = rt
+        self.memo = ParamsMemo()        # the last motion's snapshot (motion.py params_from)
 
     def _params(self, with_: list):
         store = self.rt.sysvars.store
@@ -54,7 +55,7 @@ class MotionStatements:
             saved.append((ref, old))
             ref.set(value)
         try:
-            return params_from(store, self.rt.sysvars.base_link())
+            return params_from(store, self.rt.sysvars.base_link(), self.memo)
         finally:
             for ref, old in reversed(saved):
                 if isinstance(ref, Slot):
