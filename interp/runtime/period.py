@@ -317,24 +317,54 @@ class PeriodicSpins:
         """Another task's step leaves a parked period as it is: it writes nothing the period
         reads or writes (``spin.touched``), names none of its timers, writes no I/O and calls no
         built-in that has an effect (a pure one, a routine of the program: its statements are
-        looked at in their turn). Else the period's task wakes before the step runs."""
+        looked at in their turn). Else the period's task wakes before the step runs.
+
+        What a statement is (its nodes' kinds, the names each writes) is looked at once per
+        line and kind of step (:meth:`_step_plan`); the places those names denote in `task`'s
+        frame are looked at each time, node by node in order as before."""
         if not TASK_PROBES.issuperset(spin.probes):
             return False            # it reads state another task's step may change ($POS_INT, $ERR)
-        nodes = self.statements(info)
-        if nodes is None:
+        plan = self._step_plans.get((info.file, info.line, tick))
+        if plan is None:
+            plan = self._step_plan(info, tick)
+        if plan is False:
             return False
         frame = task.frame
-        kinds = self._foreign_kinds
-        for node in nodes:
-            ok = kinds.get(id(node))
-            if ok is None:
-                ok = kinds[id(node)] = _harmless_kind(node)
+        ref_of = self._ref
+        touched = spin.touched
+        for ok, names in plan:
             if not ok:
                 return False
-            for ref in self._writes_of(node, frame, -1, tick):
-                if ref is False or place_of(ref) in spin.touched:
+            for name in names:
+                ref = ref_of(name, frame, -1)
+                if ref is not None and (ref is False or place_of(ref) in touched):
                     return False
         return True
+
+    def _step_plan(self, info, tick: bool):
+        """For :meth:`_harmless`: the statements at `info`'s line as ``(kind ok, names a step
+        of them writes)`` per node (:meth:`_writes_of`'s names: a loop iteration writes a
+        FOR's counter only), False when there is no statement there; kept per (file, line,
+        tick)."""
+        nodes = self.statements(info)
+        if nodes is None:
+            plan = False
+        else:
+            kinds = self._foreign_kinds
+            plan = []
+            for node in nodes:
+                ok = kinds.get(id(node))
+                if ok is None:
+                    ok = kinds[id(node)] = _harmless_kind(node)
+                names = ()
+                if ok and (not tick or isinstance(node, N.For)):
+                    names = self._targets.get(id(node))
+                    if names is None:
+                        names = self._targets[id(node)] = written(node)
+                plan.append((ok, tuple(names)))
+            plan = tuple(plan)
+        self._step_plans[(info.file, info.line, tick)] = plan
+        return plan
 
     def _period_world(self, task) -> tuple:
         """What must not change at all while a period runs: the I/O log, the messages, the

@@ -208,6 +208,7 @@ class SpinWatch(PeriodicSpins):
         self._targets: dict = {}    # id(statement) -> the names it writes
         self._reads: dict = {}      # id(statement) -> the names it reads
         self._foreign_kinds: dict = {}  # id(statement) -> it may run beside a parked period
+        self._step_plans: dict = {}     # (file, line, tick) -> PeriodicSpins._step_plan
         self.parks = self.wakes = self.skipped = self.diverged = self.missed = 0
         self.recordings = 0         # recordings started
         self.why: dict = {}         # why recordings failed (a count per reason: tests, tuning)
