@@ -16,7 +16,7 @@ from krl.ast import nodes as N
 from robot.errors import RobotError
 
 from .errors import KrlRuntimeError
-from .watch import settles
+from .watch import CONSTANT, IO, SETTLES, settles, split_watch, watch_of
 
 
 class Cyclic:
@@ -31,7 +31,7 @@ class Cyclic:
         #: timer, the robot's position, a call...): evaluated at every IPO cycle, they may change
         #: $CYCFLAG at any cycle, so a spin that reads $CYCFLAG is not parked beside one
         self.restless: set = set()
-        self._settling: dict = {}       # id(assignment) -> its cyclic flag's expression settles
+        self._settling: dict = {}       # id(assignment) -> how its cyclic flag is evaluated again (_settles)
 
     def analog_inputs(self) -> bool:
         """An ``ANIN ON`` is on."""
@@ -48,15 +48,23 @@ class Cyclic:
         # the changes it makes to $CYCFLAG
         flag = key[0] == "cyclic flag"
         watch = self.rt.cyclic_watch
-        memo = flag and self._settles()
+        kind = self._settles() if flag else None
+        memo = kind is not None
+        io_only = kind == IO
         if flag and not memo:
             self.restless.add(key)
         cyc = self.rt.sysvars.store.get("$CYCFLAG") if flag else None
         seen = [None]
 
+        def moment():
+            # the key of the present moment (None: evaluate); an expression over the I/O image and
+            # constants only: the I/O image's version and the flags as the last evaluation left them
+            k = watch.key()
+            return (k[0], tuple(cyc.data)) if io_only and k is not None else k
+
         def tick(ctl):
             if memo:
-                k = watch.key()
+                k = moment()
                 if k is not None and k == seen[0]:
                     return
             before = tuple(cyc.data) if cyc is not None else None
@@ -70,23 +78,30 @@ class Cyclic:
             if before is not None and tuple(cyc.data) != before:
                 watch.version += 1
             if memo:
-                seen[0] = watch.key()
+                seen[0] = moment()
         self.handles[key] = self.rt.controller.signals.add_cyclic(tick)
         watch.anin = self.analog_inputs()
 
-    def _settles(self) -> bool:
-        """The cyclic flag the running statement switches on has an expression that
-        :func:`~.watch.settles`, decided once per statement (an SPS.SUB switches its flags on
-        again in every pass: the analysis cost about 40 µs each time)."""
+    def _settles(self) -> str | None:
+        """How the cyclic flag the running statement switches on is evaluated again, decided once
+        per statement (an SPS.SUB switches its flags on again in every pass: the analysis cost
+        about 40 µs each time): None, at every IPO cycle; :data:`~.watch.IO`, its expression
+        reads the I/O image and constants only (:func:`~.watch.watch_of`: no probed state), so
+        its value changes with the I/O image's version alone; :data:`~.watch.SETTLES`, it
+        :func:`~.watch.settles` (a statement, the I/O image or a cyclic flag changes it)."""
         task = self.rt.current_task
         at = task.at if task is not None else None
         for node in (self.rt.spin.statements(at) or ()) if at is not None else ():
             if isinstance(node, N.Assign):
-                got = self._settling.get(id(node))
-                if got is None:
-                    got = self._settling[id(node)] = settles(node.value)
+                got = self._settling.get(id(node), False)
+                if got is False:
+                    got = None
+                    if settles(node.value):
+                        cls, probes = split_watch(watch_of(node.value))
+                        got = IO if cls in (CONSTANT, IO) and not probes else SETTLES
+                    self._settling[id(node)] = got
                 return got
-        return False
+        return None
 
     def off(self, key) -> None:
         h = self.handles.pop(key, None)
