@@ -542,12 +542,12 @@ class Runtime:
         SPS.SUB writes outputs and reads timers, and 40 % of its steps did."""
         irqs = task.irqs
         stepping = self.stepping
-        if self.trace is not None or (irqs.armed and irqs.settled != self.state_epoch) \
+        if self.spin.hooks_all or self.trace is not None or (irqs.armed and irqs.settled != self.state_epoch) \
                 or task.continue_line is not None \
                 or stepping.stmt_hook is not None or stepping.run_mode == "ISTEP" \
                 or any(c.error_proceed for c in task.contexts) \
                 or (self.autocell is not None and self.autocell.recording is not None) \
-                or task.watched or task.replay is not None or task.shadow is not None or self.spin.hooks_all:
+                or task.watched or task.replay is not None or task.shadow is not None:
             task.calm = False
             return 0
         task.calm = task.kind != "robot" or self.controller.is_idle()
