@@ -34,7 +34,25 @@ def _scalar(t) -> bool:
     return isinstance(t, (T.Simple, T.Enum)) and t is not T.UNKNOWN
 
 
-_INT, _REAL = T.INT, T.REAL
+_INT, _REAL, _BOOL = T.INT, T.REAL, T.BOOL
+
+
+def typed_copy(v: Struct, t) -> Struct | None:
+    """The value :func:`~.convert.convert_scalar` makes of structure `v` for its own type `t` (a
+    fresh value of `t` with `v` assigned into it), made as one copy of `v`'s components when each
+    is already what the assignment would store: every component of `t` in its order, each unset,
+    a REAL's float, an INT's int in range or a BOOL's bool; else None (the general conversion).
+    A function's FRAME value returns so (getCircFrame of the CAM-like program, per point)."""
+    fields = t.fields
+    f = v.f
+    if len(f) != len(fields):
+        return None
+    for (k, x), (fk, (_, ft)) in zip(f.items(), fields.items()):
+        c = x.__class__
+        if k != fk or not (x is UNSET or (c is float and ft is _REAL) or (c is bool and ft is _BOOL)
+                           or (c is int and ft is _INT and INT_MIN <= x <= INT_MAX)):
+            return None
+    return Struct(t, f.copy())
 
 
 class FramePlan:
@@ -355,4 +373,8 @@ class Calls:
             arr = make_value(t)
             assign_into(arr, value)
             return arr
+        if value.__class__ is Struct and value.type is t:
+            got = typed_copy(value, t)
+            if got is not None:
+                return got
         return convert_scalar(value, t)
