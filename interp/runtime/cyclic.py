@@ -4,8 +4,10 @@ what ``ANOUT ON``, ``ANIN ON`` and ``$CYCFLAG[n] = expr`` switch on, for both in
 It holds now: ``handles``, the controller's handle (robot/signals.py ``Signals.add_cyclic``) of each
 cyclic evaluation by its key (("cyclic flag", name), ("analog output", channel key), ("analog
 input", channel key)); ``restless``, the keys of the cyclic flags whose expression does not
-settle (interp/runtime/watch.py ``settles``); and, by ``id`` of the assignment, whether a
-cyclic flag's expression settles (decided once per statement). Each evaluation runs once per
+settle (interp/runtime/watch.py ``settles``); and, by ``id`` of the assignment, how a cyclic
+flag's expression is evaluated again (decided once per statement: at every IPO cycle, when a
+statement ran or the I/O image or a flag changed, or, over the I/O image and constants only, when
+the I/O image or the flags changed). Each evaluation runs once per
 IPO cycle; an error in it becomes a run-time error of the robot program at its next
 resumption (``Task.pending_error``).
 """
