@@ -6,8 +6,8 @@ cyclic evaluation by its key (("cyclic flag", name), ("analog output", channel k
 input", channel key)); ``restless``, the keys of the cyclic flags whose expression does not
 settle (interp/runtime/watch.py ``settles``); and, by ``id`` of the assignment, how a cyclic
 flag's expression is evaluated again (decided once per statement: at every IPO cycle, when a
-statement ran or the I/O image or a flag changed, or, over the I/O image and constants only, when
-the I/O image or the flags changed). Each evaluation runs once per
+statement ran or the I/O image or a flag changed, or, over the signals and constants only, when
+a signal or the flags changed). Each evaluation runs once per
 IPO cycle; an error in it becomes a run-time error of the robot program at its next
 resumption (``Task.pending_error``).
 """
@@ -56,13 +56,16 @@ class Cyclic:
         if flag and not memo:
             self.restless.add(key)
         cyc = self.rt.sysvars.store.get("$CYCFLAG") if flag else None
+        ctl = self.rt.controller
         seen = [None]
 
         def moment():
-            # the key of the present moment (None: evaluate); an expression over the I/O image and
-            # constants only: the I/O image's version and the flags as the last evaluation left them
+            # the key of the present moment (None: evaluate); an expression over the signals and
+            # constants only: the signals' changes (each one is logged: robot/io.py; a timer's
+            # write moves the I/O image's version, not the log) and the flags as the last
+            # evaluation left them
             k = watch.key()
-            return (k[0], tuple(cyc.data)) if io_only and k is not None else k
+            return (len(ctl.io.log), tuple(cyc.data)) if io_only and k is not None else k
 
         def tick(ctl):
             if memo:
@@ -88,8 +91,9 @@ class Cyclic:
         """How the cyclic flag the running statement switches on is evaluated again, decided once
         per statement (an SPS.SUB switches its flags on again in every pass: the analysis cost
         about 40 µs each time): None, at every IPO cycle; :data:`~.watch.IO`, its expression
-        reads the I/O image and constants only (:func:`~.watch.watch_of`: no probed state), so
-        its value changes with the I/O image's version alone; :data:`~.watch.SETTLES`, it
+        reads the signals ($IN, $OUT, $ANIN, $ANOUT, a SIGNAL over them) and constants only
+        (:func:`~.watch.watch_of`: no probed state), so its value changes only when a signal
+        changes (the I/O log grows: a submit program's timers do not count); :data:`~.watch.SETTLES`, it
         :func:`~.watch.settles` (a statement, the I/O image or a cyclic flag changes it)."""
         task = self.rt.current_task
         at = task.at if task is not None else None

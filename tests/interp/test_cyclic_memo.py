@@ -1,7 +1,8 @@
-"""A cyclic flag whose expression reads the I/O image and constants only is evaluated again when the
-I/O image's version or the flags changed (interp/runtime/cyclic.py ``Cyclic._settles``: IO), not
-after every statement: the same run as evaluating it at every IPO cycle (the general path), on
-drawn input changes, both interpreters, with a program that runs statements every cycle."""
+"""A cyclic flag whose expression reads the signals and constants only is evaluated again when a
+signal or the flags changed (interp/runtime/cyclic.py ``Cyclic._settles``: IO), not after every
+statement: the same run as evaluating it at every IPO cycle (the general path), on drawn input
+changes, both interpreters, with a program that runs statements and presets a timer every cycle
+(which moves the I/O image's version, not its signals)."""
 
 from __future__ import annotations
 
@@ -26,6 +27,7 @@ DEF prog()
     n = n + 1
     $OUT[1] = $CYCFLAG[2]
     $OUT[2] = $CYCFLAG[3] AND $CYCFLAG[2]
+    $TIMER[2] = n
     WAIT SEC 0.012
   ENDWHILE
 END
