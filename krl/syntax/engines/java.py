@@ -166,9 +166,12 @@ def write_class_archive(classes: Path, worker: Path, texts: Iterable[str]) -> Pa
     tmp = target.with_name(f"{target.stem}.{os.getpid()}.tmp")
     payload = b"".join(b"%d %d\n%s" % (k, len(data), data)
                        for k, data in enumerate((t.encode("utf-8", "surrogatepass") for t in texts), 1))
-    run = subprocess.run(["java", *JAVA_OPTS, f"-XX:ArchiveClassesAtExit={tmp}",
-                          "-cp", cp, "KrlWorker", "1"], input=payload + b"0 -1\n", capture_output=True, check=False)
-    if run.returncode != 0 or not tmp.is_file():
+    try:
+        run = subprocess.run(["java", *JAVA_OPTS, f"-XX:ArchiveClassesAtExit={tmp}", "-cp", cp, "KrlWorker", "1"],
+                             input=payload + b"0 -1\n", capture_output=True, check=False, timeout=600)
+    except subprocess.TimeoutExpired:
+        run = None
+    if run is None or run.returncode != 0 or not tmp.is_file():
         tmp.unlink(missing_ok=True)
         return None
     os.replace(tmp, target)
@@ -499,13 +502,16 @@ def main(argv: list[str]) -> int:
     except EngineUnavailable as exc:
         print(f"Java parse engine not built: {exc}; the Python engine will be used", file=sys.stderr)
         return 0
-    for built in (classes, worker):       # built before the classes were packed
-        if not (built / CLASSES_JAR).is_file():
-            _pack(built)
-    if not class_archive(class_path(classes, worker)).is_file():
-        # the classes a parse loads: the conformance cases' modules and data lists
-        write_class_archive(classes, worker, (f.read_bytes().decode("utf-8", "replace")
-                                              for f in sorted([*SAMPLE.glob("*/*.src"), *SAMPLE.glob("*/*.dat")])))
+    try:
+        for built in (classes, worker):       # built before the classes were packed
+            if not (built / CLASSES_JAR).is_file():
+                _pack(built)
+        if not class_archive(class_path(classes, worker)).is_file():
+            # the classes a parse loads: the conformance cases' modules and data lists
+            write_class_archive(classes, worker, (f.read_bytes().decode("utf-8", "replace")
+                                                  for f in sorted([*SAMPLE.glob("*/*.src"), *SAMPLE.glob("*/*.dat")])))
+    except OSError as exc:      # a build folder not writable: the workers start without the archive
+        print(f"Java parse engine: no class-data archive ({exc})", file=sys.stderr)
     print(f"Java parse engine: {classes} (worker {worker.name})")
     return 0
 
