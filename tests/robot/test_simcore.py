@@ -28,7 +28,7 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from robot import blending, build, controller, kinematics, planner, trace, tracecheck
+from robot import blending, build, controller, kinematics, motionqueue, planner, trace, tracecheck
 from robot.bench import bench_program, run_motions
 from robot.blas import numpy_cblas
 from robot.controller import Controller
@@ -331,17 +331,19 @@ def test_the_compiled_step_check_is_the_python_loops(sc):
 def _segments(machine, program):
     """The CP segments a controller plans for `program` (a list of MotionRequest)."""
     segs = []
-    orig = planner.CartSegment.__init__
+    orig = motionqueue.plan
 
-    def keep(self, *a, **kw):
-        orig(self, *a, **kw)
-        segs.append(self)
+    def keep(*a, **kw):
+        seg = orig(*a, **kw)
+        if isinstance(seg, planner.CartSegment):
+            segs.append(seg)
+        return seg
 
-    planner.CartSegment.__init__ = keep
+    motionqueue.plan = keep
     try:
         run_motions(Controller(machine, mujoco=False), program)
     finally:
-        planner.CartSegment.__init__ = orig
+        motionqueue.plan = orig
     return segs
 
 
@@ -518,6 +520,7 @@ def test_the_compiled_planning_walk_is_the_python_walk_bit_for_bit(sc, monkeypat
     motions = _drawn_cp_motions(np.random.default_rng(6202), 60, model)
     walker, samples = planner._compiled_walker, planner._samples
     walked, sampled = [], []
+    monkeypatch.setattr(planner, "_planned_line", lambda *a: None)    # every LIN through _plan_cart's walk
 
     def counting(seg):
         w = walker(seg)
@@ -542,6 +545,87 @@ def test_the_compiled_planning_walk_is_the_python_walk_bit_for_bit(sc, monkeypat
     assert len(done) > 30 and sum(c and f for c, f in zip(in_c, finer)) > 8
     assert sum(isinstance(b, str) for b in python) >= 5
     assert any(w[-1] is None for w in done) == (robot == "kr3_r540")
+
+
+def _same(a, b) -> bool:
+    """Are a and b the same values bit for bit (arrays: dtype, shape and bytes; floats: their bits;
+    lists, tuples, dicts and plain objects: element by element and attribute by attribute)?"""
+    if isinstance(a, np.ndarray) or isinstance(b, np.ndarray):
+        return (type(a) is type(b) and a.dtype == b.dtype and a.shape == b.shape
+                and a.tobytes() == b.tobytes() and a.flags.writeable == b.flags.writeable)
+    if isinstance(a, float) or isinstance(b, float):
+        return type(a) is type(b) and a.hex() == b.hex()
+    if isinstance(a, (list, tuple)):
+        return type(a) is type(b) and len(a) == len(b) and all(_same(x, y) for x, y in zip(a, b))
+    if isinstance(a, dict):
+        return type(a) is type(b) and a.keys() == b.keys() and all(_same(a[k], b[k]) for k in a)
+    if isinstance(a, (planner.LinePiece, Trapezoid)):
+        return type(a) is type(b) and _same(vars(a), vars(b))
+    return a is b or a == b
+
+
+def _drawn_lines(rng, n, model):
+    """(request, start axes) of drawn single LINs to complete targets: a CAM program's (0.01 to
+    2 mm, the orientation kept) to 600 mm, some turning the orientation (a slerp: the Python
+    plan), some of zero length or out of reach, with $TOOL and $BASE or not, #VAR and
+    #CONSTANT, $VEL.CP, $ACC.CP and $OV_PRO drawn."""
+    out = []
+    reach = float(np.linalg.norm(model.kin.forward(np.zeros(6))[:3, 3]))
+    for i in range(n):
+        tool = (10.0, -20.0, 150.0, 270.0, 0.0, 0.0) if i % 4 in (1, 3) else NULLFRAME
+        base = (600.0, -50.0, 300.0, 15.0, 0.0, 180.0) if i % 4 in (2, 3) else NULLFRAME
+        P = MotionParams.initmov(None).with_(
+            tool=tool, base=base, vel_cp=float(rng.choice([0.02, 0.2, 2.0])), acc_cp=float(rng.choice([0.5, 2.3, 10.0])),
+            ov_pro=float(rng.choice([100.0, 100.0, 37.0])), ori_type="CONSTANT" if i % 17 == 5 else "VAR")
+        q = np.array([rng.uniform(-120, 120), rng.uniform(-110, -50), rng.uniform(60, 130),
+                      rng.uniform(-60, 60), rng.uniform(-100, 100) if i % 9 else rng.uniform(-3, 3),
+                      rng.uniform(-150, 150)])
+        T0 = inv_pos(frame_to_matrix(*base)) @ model.kin.forward(q) @ frame_to_matrix(*tool)
+        t = dict(zip("XYZABC", matrix_to_frame(T0)))
+        d = rng.normal(0.0, 1.0, 3)
+        d *= float(rng.choice([0.0, 0.01, 0.3, 2.0, 50.0, 0.3 * reach, 0.8 * reach])) / np.linalg.norm(d)
+        t.update(X=t["X"] + d[0], Y=t["Y"] + d[1], Z=t["Z"] + d[2])
+        if i % 5 == 4:
+            t[str(rng.choice(["A", "B", "C"]))] += float(rng.choice([1e-9, 0.5, 40.0]))
+        out.append((MotionRequest("LIN", t, P, approx="C_VEL" if i % 2 else None), q))
+    return out
+
+
+@pytest.mark.parametrize("robot", ["kr6", "kr3_r540"])
+def test_the_compiled_line_plan_is_the_python_plan_bit_for_bit(sc, monkeypatch, robot):
+    """A single LIN planned in C (robot/planner.py ``_planned_line``, robot/simcore.pyx
+    ``plan_line``: the set-up of its segment, its tables, its compiled path and its walk; issue 62,
+    the CAM-like program) is the segment the Python code plans, attribute by attribute, bit for bit
+    (its compiled path gives the same poses and axes), on drawn LINs; those it leaves to the Python
+    code (an orientation that turns, #CONSTANT, a zero length) and the errors are the Python code's."""
+    model = Controller(None if robot == "kr6" else load_robot(robot), mujoco=False).model
+    motions = _drawn_lines(np.random.default_rng(6206), 80, model)
+    line, planned = planner._planned_line, []
+    monkeypatch.setattr(planner, "_planned_line", lambda *a: planned.append(line(*a)) or planned[-1])
+
+    def planned_or_error(req, q):
+        try:
+            return planner.plan(req, q, model)
+        except RobotError as exc:
+            return f"{type(exc).__name__}: {exc}"
+
+    compiled = [planned_or_error(req, q) for req, q in motions]
+    in_c = [p is not None for p in planned]
+    monkeypatch.setattr(planner, "_planned_line", lambda *a: None)
+    python = [planned_or_error(req, q) for req, q in motions]
+    for c, p in zip(compiled, python):
+        if isinstance(p, str):
+            assert c == p
+            continue
+        cp, pp = vars(c).pop("_c_path"), vars(p).pop("_c_path")
+        assert _same(vars(c), vars(p))
+        assert c._R is c.rots and (c._ik_tool is None or c._ik_tool is c.tool_inv_T)
+        assert (cp is None) == (pp is None) and (cp is False) == (pp is False)
+        for u in np.linspace(0.0, 1.0, 7).tolist() if cp else ():     # the same poses and axes
+            a, b = cp.pose_u(u), pp.pose_u(u)
+            assert _same(a, b) and _same(cp.axes_u(u, c.status, c.q0), pp.axes_u(u, p.status, p.q0))
+    assert 30 < sum(in_c) < len(motions) - 10
+    assert sum(isinstance(p, str) for p in python) >= 3
 
 
 def _drawn_time_laws(rng, n):
