@@ -258,6 +258,31 @@ def plan_blend(prev: Segment, nxt: Segment, keyword: str, tau_a: float) -> Blend
     base = nxt.profile
     u_max = base.u(blend_end_tau(prev, nxt, keyword, tau_a))
     u_max = min(u_max, base.u(max(0.0, base.t_total - getattr(base, "t_brake", base.t_acc))))
+    rp = _ramp(base, u_max, tau_p)
+    rev = (prev.qd_end * nxt.qd_start) < 0
+    if rev.any():                       # only an axis that reverses can add up both accelerations
+        a_sum = np.abs(prev.qd_end) * bp.a_b + np.abs(nxt.qd_start) * rp.a_r
+        if np.any(rev & (a_sum > prev.model.a_max * (1.0 + 1e-6))):
+            return None
+    if blend_space(prev, nxt) == "joint" and tau_p > 0.0 and \
+            _joint_blend_acc_ratio(prev, bp, nxt, rp, tau_p) > 1.0 + 1e-6:
+        return None
+    return BlendPlan(bp, rp, tau_p)
+
+
+def _ramp(base: Any, u_max: float, tau_p: float) -> RampProfile:
+    """:func:`plan_blend`'s ramp of the next motion onto its time law `base` up to the blend end
+    ``u_max`` within the window ``tau_p`` (s): as long as the window where the ramp can take that
+    long (bisected where it cannot), shorter where it would exceed the planned speed (bisected);
+    found in C where robot/simcore.pyx ``ramp_args`` mirrors `base` (the same bisections, the
+    same operations in the same order: the same ramp)."""
+    sc = compiled_module()
+    if sc is not None:
+        table = profile_table(base)
+        if table is not None:
+            got = sc.ramp_args(table, getattr(base, "bounds", ()), u_max, tau_p)
+            if got is not None:
+                return RampProfile(base, got[0], got[1])
 
     def ramp_time(u: float) -> float:
         if u <= 0:
@@ -289,15 +314,7 @@ def plan_blend(prev: Segment, nxt: Segment, keyword: str, tau_a: float) -> Blend
             else:
                 hi = mid
         rp = RampProfile(base, lo, max(0.0, tau_p - ramp_time(lo)))
-    rev = (prev.qd_end * nxt.qd_start) < 0
-    if rev.any():                       # only an axis that reverses can add up both accelerations
-        a_sum = np.abs(prev.qd_end) * bp.a_b + np.abs(nxt.qd_start) * rp.a_r
-        if np.any(rev & (a_sum > prev.model.a_max * (1.0 + 1e-6))):
-            return None
-    if blend_space(prev, nxt) == "joint" and tau_p > 0.0 and \
-            _joint_blend_acc_ratio(prev, bp, nxt, rp, tau_p) > 1.0 + 1e-6:
-        return None
-    return BlendPlan(bp, rp, tau_p)
+    return rp
 
 
 #: Samples of a blend window, and of a CP motion's path, for :func:`_joint_blend_acc_ratio`.

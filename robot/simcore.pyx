@@ -1255,33 +1255,37 @@ cdef double _du(const double* r, int left, double t) noexcept:
     return x if x > 0.0 else 0.0
 
 
-def below(int law, double p0, double p1, double p2, const double[::1] table, bounds, double u0, double u1):
-    """robot/blending.py ``_below`` (the same operations in the same order) of the speed law `law`
-    against the time law `table` (records of :data:`PROFILE_FIELDS`, robot/blending.py
-    ``profile_table``) with its section bounds `bounds`: law 0 the uniform braking
-    ``sqrt(max(0, p0 ** 2 - 2 * p1 * (u - p2)))`` (p0 = v_a, p1 = a_b, p2 = u_a; ``**`` as
-    libm's pow), law 1 the uniform ramp ``sqrt(2 * p0 * u)`` (p0 = a_r). True, False, or None for
-    a table it does not read (the Python code decides)."""
+cdef int _table_rows(const double[::1] table) except -2:
+    """The records of a time-law table :func:`below` reads (one trapezoid, at the bottom), or -1."""
     cdef int n = table.shape[0] // _PF, i
-    cdef const double* r
-    cdef double step, u, vb, v, x, va2 = 0.0
-    if n < 1 or table.shape[0] != n * _PF or law < 0 or law > 1:
-        return None
-    r = &table[0]
+    if n < 1 or table.shape[0] != n * _PF:
+        return -1
     for i in range(n):
-        if not (r[_PF * i] == 0 or r[_PF * i] == 1 or r[_PF * i] == 2):
-            return None
-        if (r[_PF * i] == 0) != (i == n - 1):      # one trapezoid, at the bottom
-            return None
+        if not (table[_PF * i] == 0 or table[_PF * i] == 1 or table[_PF * i] == 2):
+            return -1
+        if (table[_PF * i] == 0) != (i == n - 1):      # one trapezoid, at the bottom
+            return -1
+    return n
+
+
+cdef int _below(int law, double p0, double p1, double p2, const double* r, int n, bounds, double u0,
+                double u1) except -1:
+    """robot/blending.py ``_below`` of the speed law `law` (:func:`below`) against the time law of the
+    n records at r with its section bounds `bounds` (a sequence of floats): 1 or 0."""
+    cdef double step, u, vb, v, x, va2 = 0.0
+    cdef int i
     if u1 <= u0:
-        return True
+        return 1
     if law == 0:
         va2 = simcore_libm_pow(p0, 2.0)
     step = (u1 - u0) / 25
-    us = [(<double>i) * step + u0 for i in range(1, 25)]
-    us += [b for b in bounds if u0 < b < u1]
-    for ub in us:
-        u = <double>ub
+    for i in range(1, 25 + len(bounds)):
+        if i < 25:
+            u = (<double>i) * step + u0
+        else:
+            u = <double>bounds[i - 25]
+            if not (u0 < u < u1):
+                continue
         vb = _du(r, n, _t_of_u(r, n, u))
         if law == 0:
             x = va2 - 2.0 * p1 * (u - p2)
@@ -1289,5 +1293,87 @@ def below(int law, double p0, double p1, double p2, const double[::1] table, bou
         else:
             v = sqrt(2.0 * p0 * u)
         if v > vb * (1.0 + 1e-6) + 1e-12:
-            return False
-    return True
+            return 0
+    return 1
+
+
+def below(int law, double p0, double p1, double p2, const double[::1] table, bounds, double u0, double u1):
+    """robot/blending.py ``_below`` (the same operations in the same order) of the speed law `law`
+    against the time law `table` (records of :data:`PROFILE_FIELDS`, robot/blending.py
+    ``profile_table``) with its section bounds `bounds`: law 0 the uniform braking
+    ``sqrt(max(0, p0 ** 2 - 2 * p1 * (u - p2)))`` (p0 = v_a, p1 = a_b, p2 = u_a; ``**`` as
+    libm's pow), law 1 the uniform ramp ``sqrt(2 * p0 * u)`` (p0 = a_r). True, False, or None for
+    a table it does not read (the Python code decides)."""
+    cdef int n = _table_rows(table)
+    if n < 0 or law < 0 or law > 1:
+        return None
+    return _below(law, p0, p1, p2, &table[0], n, bounds, u0, u1) == 1
+
+
+cdef double _ramp_time(const double* r, int n, double u) noexcept:
+    """robot/blending.py ``plan_blend``'s ``ramp_time(u)`` against the time law at r."""
+    cdef double v
+    if u <= 0:
+        return 0.0
+    v = _du(r, n, _t_of_u(r, n, u))
+    return 2.0 * u / v if v > 0 else INFINITY
+
+
+cdef double _ramp_rate(const double* r, int n, double u_e) noexcept:
+    """``RampProfile(base, u_e).a_r`` of the time law ``base`` at r (0 where its ``tau`` is 0)."""
+    cdef double t_b = _t_of_u(r, n, u_e) if u_e > 0 else 0.0
+    cdef double v_b = _du(r, n, t_b) if u_e > 0 else 0.0
+    cdef double tau
+    if u_e <= 1e-12 or v_b <= 1e-12:
+        return 0.0
+    tau = 2.0 * u_e / v_b
+    return v_b / tau
+
+
+cdef double _ramp_tau(const double* r, int n, double u_e) noexcept:
+    """``RampProfile(base, u_e).tau`` of the time law ``base`` at r."""
+    cdef double t_b = _t_of_u(r, n, u_e) if u_e > 0 else 0.0
+    cdef double v_b = _du(r, n, t_b) if u_e > 0 else 0.0
+    if u_e <= 1e-12 or v_b <= 1e-12:
+        return 0.0
+    return 2.0 * u_e / v_b
+
+
+def ramp_args(const double[::1] table, bounds, double u_max, double tau_p):
+    """robot/blending.py ``plan_blend``'s choice of the next motion's ramp onto the time law
+    `table` (:func:`below`'s records; `bounds` its section bounds) for the blend end ``u_max`` and
+    the window ``tau_p`` (s): the arguments (u_e, delay) of the ``RampProfile(base, u_e, delay)``
+    it makes, found by the same bisections with the same operations in the same order (the
+    ramp's time law and ``_below`` as :func:`below`), or None for a table it does not read."""
+    cdef int n = _table_rows(table), k
+    cdef const double* r
+    cdef double rt, lo, hi, mid, d, u_e, delay
+    if n < 0:
+        return None
+    r = &table[0]
+    if u_max <= 0.0:
+        u_e, delay = 0.0, tau_p
+    else:
+        rt = _ramp_time(r, n, u_max)
+        if rt <= tau_p:
+            u_e, delay = u_max, tau_p - rt
+        else:
+            lo, hi = 0.0, u_max
+            for k in range(40):
+                mid = 0.5 * (lo + hi)
+                if _ramp_time(r, n, mid) <= tau_p:
+                    lo = mid
+                else:
+                    hi = mid
+            u_e, delay = lo, tau_p - _ramp_time(r, n, lo)
+    if _ramp_tau(r, n, u_e) > 0 and not _below(1, _ramp_rate(r, n, u_e), 0.0, 0.0, r, n, bounds, 0.0, u_e):
+        lo, hi = 0.0, u_e
+        for k in range(30):
+            mid = 0.5 * (lo + hi)
+            if _ramp_tau(r, n, mid) <= 0 or _below(1, _ramp_rate(r, n, mid), 0.0, 0.0, r, n, bounds, 0.0, mid):
+                lo = mid
+            else:
+                hi = mid
+        d = tau_p - _ramp_time(r, n, lo)
+        u_e, delay = lo, (d if d > 0.0 else 0.0)
+    return u_e, delay

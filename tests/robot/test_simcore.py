@@ -675,6 +675,28 @@ def test_the_compiled_blend_speed_check_is_the_pythons(sc):
     assert blending.profile_table(object()) is None
 
 
+def test_the_compiled_ramp_of_a_blend_is_the_pythons(sc, monkeypatch):
+    """The next motion's ramp of a blend (robot/blending.py ``_ramp``: the bisection of its length
+    within the window, then of a shorter ramp where it would exceed the planned speed) in C
+    (robot/simcore.pyx ``ramp_args``; issue 62, the CAM-like program) is the Python ramp bit for
+    bit on drawn time laws, blend ends and windows, every branch taken."""
+    rng = np.random.default_rng(6207)
+    cases = []
+    for base in _drawn_time_laws(rng, 600):
+        u_max = float(rng.choice([0.0, -0.1, 1.0, rng.uniform(0.0, 1.0), rng.uniform(0.0, 0.05)]))
+        tau_p = float(rng.choice([0.0, rng.uniform(0.0, 0.2), rng.uniform(0.0, 2.0)]) * base.t_total)
+        cases.append((base, u_max, tau_p))
+    compiled = [vars(blending._ramp(*c)) for c in cases]
+    monkeypatch.setattr(blending, "compiled_module", lambda: None)
+    python = [vars(blending._ramp(*c)) for c in cases]
+    assert all(_same(a, b) for a, b in zip(compiled, python))
+    # the branches: no ramp, the whole window, a shorter ramp bisected, a ramp the speed check shortened
+    rt = [2.0 * u / b.du(b.t_of_u(u)) if u > 0 and b.du(b.t_of_u(u)) > 0 else 0.0 for b, u, _ in cases]
+    kinds = [0 if u <= 0 else 1 if r <= t else 2 for (_, u, t), r in zip(cases, rt)]
+    shortened = [p["u_e"] < u and k == 1 for p, (_, u, _), k in zip(python, cases, kinds)]
+    assert min(kinds.count(0), kinds.count(1), kinds.count(2), sum(shortened)) >= 10
+
+
 def test_norm3_is_numpys_norm_bit_for_bit():
     """robot/planner.py ``norm3`` (a CP segment's lengths and distances) is ``np.linalg.norm``
     on drawn float64 vectors from 1e-160 to 1e150 (squares underflowing to subnormals), and zero."""
