@@ -39,6 +39,8 @@ from typing import Any
 
 import numpy as np
 
+from .blas import numpy_cblas
+from .frames import frame_to_matrix
 from .kinematics import compiled_module
 from .planner import CartSegment, JointSegment, Segment, gradient_rows
 from .profiles import BrakeProfile, RampProfile, Trapezoid
@@ -438,6 +440,9 @@ def blend_setpoint(prev: Segment, t_prev: float, nxt: Segment, t_next: float, sp
     in axis space (``prev(t) + nxt(t) - nxt's start``, within the software limits: raises
     SoftLimitError). Axes in the model's order (deg, mm)."""
     if space == "cart":
+        q_c = _superposed(prev, t_prev, nxt, t_next, model, q)
+        if q_c is not None:
+            return q_c
         p0, R0 = prev.pose(t_prev)
         p1, R1 = nxt.pose(t_next)
         pc, Rc = nxt.pose(0.0)
@@ -459,6 +464,50 @@ def blend_setpoint(prev: Segment, t_prev: float, nxt: Segment, t_next: float, sp
     out = prev.axes(t_prev) + (nxt.axes(t_next) - nxt.q0)
     model.check_limits(out)
     return out
+
+
+def _superposed(prev: Segment, t_prev: float, nxt: Segment, t_next: float, model: Any, q: np.ndarray) -> np.ndarray | None:
+    """:func:`blend_setpoint` of a Cartesian blend in C (robot/simcore.pyx ``CartPath.superposed``:
+    the three poses, their overlap with numpy's products through its BLAS, checked once a process
+    by :func:`_superpose_gemm`, and the next motion's compiled inverse): the same axes bit for bit,
+    or None where it does not run (no compiled paths or inverse, external axes, a robot of
+    :func:`reduced_orientation`) or leaves the setpoint to the Python code."""
+    if not (prev.cart and nxt.cart) or len(q) != model.n:
+        return None
+    sc = compiled_module()
+    if sc is None or reduced_orientation(model):
+        return None
+    cp, cq = prev._compiled_path(), nxt._compiled_path()      # type: ignore[attr-defined]
+    if not (cp and cq and (nxt._c_framed or nxt.compiled_inverse())):   # type: ignore[attr-defined]
+        return None
+    gemm = _superpose_gemm(sc)
+    if not gemm:
+        return None
+    try:
+        return cq.superposed(cp, prev.u(t_prev), nxt.u(t_next), nxt.u(0.0), nxt.status, q, gemm)
+    except (TypeError, ValueError):     # not float64 axes: the Python code takes them
+        return None
+
+
+#: [address] of numpy's cblas_dgemm once robot/simcore.pyx ``CartPath.superpose_products`` was seen to
+#: compute ``(A @ B.T) @ C`` as numpy does, [0] when not: :func:`_superpose_gemm`
+_SUPERPOSE_GEMM: list[int] = []
+
+
+def _superpose_gemm(sc: Any) -> int:
+    """The ``cblas_dgemm`` address for robot/simcore.pyx ``CartPath.superposed`` (0: none, or its
+    products are not numpy's bit for bit on a probe of drawn rotations), checked once a process."""
+    if not _SUPERPOSE_GEMM:
+        gemm = numpy_cblas("dgemm")
+        rng = np.random.default_rng(6208)
+        for i in range(48 if gemm else 0):
+            A, B, C = (frame_to_matrix(*rng.uniform(-500.0, 500.0, 6))[:3, :3].copy() for _ in range(3))
+            if i % 3 == 0:
+                B = A + rng.normal(0.0, 1e-15, (3, 3))
+            if sc.CartPath.superpose_products(gemm, A, B, C).tobytes() != ((A @ B.T) @ C).tobytes():
+                gemm = 0
+        _SUPERPOSE_GEMM.append(gemm)
+    return _SUPERPOSE_GEMM[0]
 
 
 def _e_at(seg: Segment, u: float, n: int) -> np.ndarray:

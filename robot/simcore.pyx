@@ -499,6 +499,54 @@ cdef class CartPath:
             PyMem_Free(Q)
 
 
+    def superposed(self, CartPath prev, double u_prev, double u, double u_start, status, ref6, size_t gemm):
+        """robot/blending.py ``blend_setpoint`` in Cartesian space with this path the next motion's:
+        the poses of `prev` at `u_prev` and of this path at `u` and at `u_start` (:meth:`pose_u`),
+        overlapped as ``superpose_pose`` does (``p0 + (p1 - pc)``, ``(R1 @ Rc.T) @ R0``: numpy's
+        two products through its ``cblas_dgemm`` at address `gemm`, as numpy calls it, into
+        numpy-allocated 3x3s) and solved as ``CartSegment.ik`` solves (:meth:`solve_rp`) for the
+        reference ref6 (6,): the axes (6,), or None (a pose not mirrored, no inverse here, or the
+        Python code decides)."""
+        cdef double M0[12]
+        cdef double M1[12]
+        cdef double Mc[12]
+        cdef double M[12]
+        cdef int i, j
+        if self.opw is None or gemm == 0 or len(ref6) != 6:
+            return None
+        if not prev._pose(u_prev, M0) or not self._pose(u, M1) or not self._pose(u_start, Mc):
+            return None
+        buf = np.empty((4, 3, 3))
+        cdef double[:, :, ::1] b = buf
+        for i in range(3):
+            for j in range(3):
+                b[0, i, j] = M1[4 * i + j]
+                b[1, i, j] = Mc[4 * i + j]
+                b[2, i, j] = M0[4 * i + j]
+        (<_dgemm_t>gemm)(101, 111, 112, 3, 3, 3, 1.0, &b[0, 0, 0], 3, &b[1, 0, 0], 3, 0.0, &b[3, 0, 0], 3)
+        (<_dgemm_t>gemm)(101, 111, 111, 3, 3, 3, 1.0, &b[3, 0, 0], 3, &b[2, 0, 0], 3, 0.0, &b[0, 0, 0], 3)
+        for i in range(3):
+            for j in range(3):
+                M[4 * i + j] = b[0, i, j]
+            M[4 * i + 3] = M0[4 * i + 3] + (M1[4 * i + 3] - Mc[4 * i + 3])
+        return self._axes(M, status, ref6)
+
+    @staticmethod
+    def superpose_products(size_t gemm, const double[:, ::1] A, const double[:, ::1] B, const double[:, ::1] C):
+        """``(A @ B.T) @ C`` of three 3x3s as :meth:`superposed` computes it, for robot/blending.py's
+        check at set-up that it is numpy's bit for bit."""
+        if gemm == 0 or A.shape[0] != 3 or A.shape[1] != 3 or B.shape[0] != 3 or B.shape[1] != 3 \
+                or C.shape[0] != 3 or C.shape[1] != 3:
+            raise ValueError("superpose_products: a BLAS address, three (3, 3)")
+        buf = np.empty((4, 3, 3))
+        cdef double[:, :, ::1] b = buf
+        b[0, :, :] = A
+        b[1, :, :] = B
+        b[2, :, :] = C
+        (<_dgemm_t>gemm)(101, 111, 112, 3, 3, 3, 1.0, &b[0, 0, 0], 3, &b[1, 0, 0], 3, 0.0, &b[3, 0, 0], 3)
+        (<_dgemm_t>gemm)(101, 111, 111, 3, 3, 3, 1.0, &b[3, 0, 0], 3, &b[2, 0, 0], 3, 0.0, &b[0, 0, 0], 3)
+        return buf[0].copy()
+
     def use_frames(self, size_t gemm, pre, post):
         """Solve ``(pre @ T) @ post`` instead of the pose T (4x4 of the pose's R and p) as it
         stands: robot/planner.py ``RobotModel.ik``'s ``$BASE @ T @ INV_POS($TOOL)``, each

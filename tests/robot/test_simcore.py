@@ -628,6 +628,41 @@ def test_the_compiled_line_plan_is_the_python_plan_bit_for_bit(sc, monkeypatch, 
     assert sum(isinstance(p, str) for p in python) >= 3
 
 
+def test_the_compiled_blend_setpoint_is_the_pythons(sc, monkeypatch):
+    """A Cartesian blend's setpoint in C (robot/blending.py ``_superposed``, robot/simcore.pyx
+    ``CartPath.superposed``: the three poses, their overlap with numpy's products, the next
+    motion's inverse; issue 62, the CAM-like program) is ``blend_setpoint``'s Python one bit for
+    bit, on drawn pairs of LINs at drawn times of both, with $TOOL and $BASE or not."""
+    model = Controller(None, mujoco=False).model
+    rng = np.random.default_rng(6209)
+    pairs = []
+    for req, q in _drawn_lines(rng, 120, model):
+        try:
+            a = planner.plan(req, q, model)
+            back = {k: v - 3.0 * rng.uniform() if k in "XY" else v for k, v in dict(
+                zip("XYZABC", matrix_to_frame(a.model.tcp(a.q1, a.tool_T, a.base_inv_T)))).items()}
+            b = planner.plan(replace(req, target=back), a.q1, model)
+        except RobotError:
+            continue
+        if a.T > 0 and b.T > 0 and blending.blend_space(a, b) == "cart":
+            pairs.append((a, b))
+    compiled, python, in_c = [], [], 0
+    for a, b in pairs:
+        for _ in range(6):
+            t_a, t_b = float(rng.uniform(0.0, a.T)), float(rng.uniform(0.0, b.T))
+            ref = a.q1 + rng.normal(0.0, 1.0, 6)
+            in_c += blending._superposed(a, t_a, b, t_b, model, ref) is not None
+            for out, off in ((compiled, False), (python, True)):
+                if off:
+                    monkeypatch.setattr(blending, "_superposed", lambda *x: None)
+                try:
+                    out.append(blending.blend_setpoint(a, t_a, b, t_b, "cart", model, ref).tobytes())
+                except RobotError as exc:
+                    out.append(str(exc))
+                monkeypatch.undo()
+    assert compiled == python and in_c > 100 and len(pairs) > 30
+
+
 def _drawn_time_laws(rng, n):
     """Drawn time laws of blends (robot/profiles.py): trapezoids and triangles, ramps onto them
     (with and without a delay, a ramp of length 0), braking from them, braking from a ramp."""
