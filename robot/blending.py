@@ -230,6 +230,8 @@ class BlendPlan:
     prev_profile: Any
     next_profile: Any
     window: float
+    #: :func:`blend_space` of the two motions, when plan_blend made it (else None)
+    space: str | None = None
 
 
 def plan_blend(prev: Segment, nxt: Segment, keyword: str, tau_a: float) -> BlendPlan | None:
@@ -261,15 +263,15 @@ def plan_blend(prev: Segment, nxt: Segment, keyword: str, tau_a: float) -> Blend
     u_max = base.u(blend_end_tau(prev, nxt, keyword, tau_a))
     u_max = min(u_max, base.u(max(0.0, base.t_total - getattr(base, "t_brake", base.t_acc))))
     rp = _ramp(base, u_max, tau_p)
-    rev = (prev.qd_end * nxt.qd_start) < 0
-    if rev.any():                       # only an axis that reverses can add up both accelerations
-        a_sum = np.abs(prev.qd_end) * bp.a_b + np.abs(nxt.qd_start) * rp.a_r
-        if np.any(rev & (a_sum > prev.model.a_max * (1.0 + 1e-6))):
+    # only an axis that reverses can add up both accelerations (numpy's elementwise operations
+    # on the floats, one axis at a time)
+    for e, s, a in zip(prev.qd_end.tolist(), nxt.qd_start.tolist(), prev.model.a_max.tolist()):
+        if e * s < 0 and abs(e) * bp.a_b + abs(s) * rp.a_r > a * (1.0 + 1e-6):
             return None
-    if blend_space(prev, nxt) == "joint" and tau_p > 0.0 and \
-            _joint_blend_acc_ratio(prev, bp, nxt, rp, tau_p) > 1.0 + 1e-6:
+    space = blend_space(prev, nxt)
+    if space == "joint" and tau_p > 0.0 and _joint_blend_acc_ratio(prev, bp, nxt, rp, tau_p) > 1.0 + 1e-6:
         return None
-    return BlendPlan(bp, rp, tau_p)
+    return BlendPlan(bp, rp, tau_p, space)
 
 
 def _ramp(base: Any, u_max: float, tau_p: float) -> RampProfile:

@@ -781,7 +781,7 @@ class Controller:
         nr = self._start(nseg, pt)
         nr.blend_in_end = pt + tau_e
         r.blend_mid = pt + 0.5 * tau_e
-        b = _Blend(r, nr, pt, pt + tau_e, blending.blend_space(r.seg, nseg), kw)
+        b = _Blend(r, nr, pt, pt + tau_e, bp.space or blending.blend_space(r.seg, nseg), kw)
         self._runs = [nr]
         self._blend = b
         if tau_e <= EPS:

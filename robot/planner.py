@@ -942,6 +942,15 @@ class CartSegment(Segment):
         end = self._path_end
         if end is None:             # the last piece's end point (its pieces do not change)
             end = self._path_end = self.pieces[-1].pos(self.pieces[-1].length)
+        cp = self._c_path
+        if cp is None:
+            cp = self._compiled_path()
+        if cp:
+            # the same distance in C (robot/simcore.pyx CartPath.dist_to: numpy's dot product)
+            blas = _line_blas(kinematics.compiled_module())
+            d = cp.dist_to(u, end, blas[1]) if blas is not None else None
+            if d is not None:
+                return d
         return norm3(self.pose_u(u)[0] - end)
 
     def ori_angle_to_end(self, u: float) -> float:

@@ -203,6 +203,16 @@ ctypedef void (*_dgemm_t)(int order, int ta, int tb, long long m, long long n, l
                           double alpha, const double* a, long long lda, const double* b,
                           long long ldb, double beta, double* c, long long ldc) noexcept nogil
 
+ctypedef double (*_ddot_t)(long long n, const double* x, long long incx, const double* y,
+                           long long incy) noexcept nogil
+
+
+cdef double _dot3(_ddot_t ddot, const double* v) noexcept:
+    """``v.dot(v)`` of a float64 (3,) as numpy computes it: ``0. + cblas_ddot(3, v, 1, v, 1)``."""
+    cdef double s = 0.
+    s += ddot(3, v, 1, v, 1)
+    return s
+
 
 cdef class CartPath:
     """The poses of a CP segment's lines and arcs, and their axes (``opw``: robot/kinematics/fastpath.py's
@@ -499,6 +509,18 @@ cdef class CartPath:
             PyMem_Free(Q)
 
 
+    def dist_to(self, double u, const double[:] end, size_t ddot):
+        """robot/planner.py ``CartSegment.tcp_dist_to_end``: ``norm3(pose_u(u)[0] - end)`` (numpy's
+        dot product through its ``cblas_ddot`` at address `ddot`), or None (a pose not mirrored)."""
+        cdef double M[12]
+        cdef double d[3]
+        cdef int i
+        if ddot == 0 or end.shape[0] != 3 or not self._pose(u, M):
+            return None
+        for i in range(3):
+            d[i] = M[4 * i + 3] - end[i]
+        return sqrt(_dot3(<_ddot_t>ddot, d))
+
     def superposed(self, CartPath prev, double u_prev, double u, double u_start, status, ref6, size_t gemm):
         """robot/blending.py ``blend_setpoint`` in Cartesian space with this path the next motion's:
         the poses of `prev` at `u_prev` and of this path at `u` and at `u_start` (:meth:`pose_u`),
@@ -630,8 +652,6 @@ cdef class CartPath:
 
 
 # ----------------------------------------------------------------------------- a single LIN's plan
-ctypedef double (*_ddot_t)(long long n, const double* x, long long incx, const double* y,
-                           long long incy) noexcept nogil
 
 #: the identity numpy's ``R @ _EYE3`` multiplies with (robot/planner.py), numpy-allocated
 _EYE3 = np.eye(3)
@@ -640,13 +660,6 @@ _LINE_KIND, _LINE_MID, _LINE_R, _LINE_ANGLE, _LINE_C = (
     np.zeros(1, dtype=np.intc), np.ones(1, dtype=np.intc), np.ones(1), np.zeros(1), np.zeros((1, 3)))
 for _a in (_LINE_KIND, _LINE_MID, _LINE_R, _LINE_ANGLE, _LINE_C):
     _a.setflags(write=False)
-
-
-cdef double _dot3(_ddot_t ddot, const double* v) noexcept:
-    """``v.dot(v)`` of a float64 (3,) as numpy computes it: ``0. + cblas_ddot(3, v, 1, v, 1)``."""
-    cdef double s = 0.
-    s += ddot(3, v, 1, v, 1)
-    return s
 
 
 cdef void _tmul(_dgemm_t gemm, const double* A, const double* B, double* out) noexcept:
