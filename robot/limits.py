@@ -188,12 +188,14 @@ def motion_limits(req: Any, machine: Any, mode: str = DEFAULT_MODE) -> MotionLim
         axes = ptp_axis_speeds(p, machine, mode)
         path: float | None = T1_SPEED_MM_S if mode == "T1" else None
     else:
-        pieces = [p] + [s.params for s in getattr(req, "segments", ()) if s.params]
-        path = max(cp_path_speed(q, mode) for q in pieces)
-        axes = np.asarray(getattr(machine, "all_max_speed", machine.max_speed_deg_s), dtype=float)
+        segments = getattr(req, "segments", ())
+        path = cp_path_speed(p, mode) if not segments else \
+            max(cp_path_speed(q, mode) for q in [p] + [s.params for s in segments if s.params])
+        axes = getattr(machine, "all_max_speed", None)
+        if axes is None:
+            axes = machine.max_speed_deg_s
     flange = T1_SPEED_MM_S if mode == "T1" else None
-    return MotionLimits(path, tuple(float(v) for v in axes), flange,
-                        tuple(float(v) for v in p.tool), tuple(float(v) for v in p.base),
+    return MotionLimits(path, tuple(map(float, axes)), flange, tuple(map(float, p.tool)), tuple(map(float, p.base)),
                         getattr(p, "base_kin", None), getattr(p, "base_root", None))
 
 
