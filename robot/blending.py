@@ -206,16 +206,16 @@ def profile_table(prof: Any) -> np.ndarray | None:
     """The time law `prof` and its bases as the records of robot/simcore.pyx ``below``
     (``PROFILE_FIELDS`` floats each: a ``Trapezoid`` at the bottom, ``RampProfile`` and
     ``BrakeProfile`` above it), or None for another time law (a spline block's, a friction PTP's)."""
-    rows: list[tuple[float, ...]] = []
+    rows: list[float] = []
     while True:
         kind = type(prof)
         if kind is Trapezoid:
-            rows.append((0.0, prof.t_total, prof.t_acc, prof.a, prof.v, 0.0, 0.0))
-            return np.array(rows, dtype=float).ravel()
+            rows += (0.0, prof.t_total, prof.t_acc, prof.a, prof.v, 0.0, 0.0)
+            return np.array(rows, dtype=float)
         if kind is RampProfile:
-            rows.append((1.0, prof.delay, prof.tau, prof.u_e, prof.a_r, prof.shift, 0.0))
+            rows += (1.0, prof.delay, prof.tau, prof.u_e, prof.a_r, prof.shift, 0.0)
         elif kind is BrakeProfile:
-            rows.append((2.0, prof.tau, prof.t_a, prof.u_a, prof.v_a, prof.a_b, prof.t_total))
+            rows += (2.0, prof.tau, prof.t_a, prof.u_a, prof.v_a, prof.a_b, prof.t_total)
         else:
             return None
         prof = prof.base
