@@ -1734,8 +1734,7 @@ def _planned_line(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_
     t = req.target
     if (req.relative or p.ori_type != "VAR" or model.mode == "T1" or type(model) is not RobotModel
             or model.n_ext or not model._robroot_is_null or len(q0) != COMPILED_AXES
-            or model.n != COMPILED_AXES or any(k in t for k in AXIS_KEYS)
-            or not all(k in t for k in CART_KEYS)):
+            or model.n != COMPILED_AXES or not t.keys() >= _CART_SET or not t.keys().isdisjoint(AXIS_KEYS)):
         return None
     sc = kinematics.compiled_module()
     opw = model.kin.compiled_core() if sc is not None else None
@@ -1779,6 +1778,7 @@ def _planned_line(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_
     return seg
 
 
+_CART_SET = frozenset(CART_KEYS)
 #: [(cblas_dgemm, cblas_ddot) addresses] once robot/simcore.pyx ``line_products`` was seen to
 #: compute numpy's products and dot products bit for bit, [None] when not: :func:`_line_blas`
 _LINE_BLAS: list[tuple[int, int] | None] = []
