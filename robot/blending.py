@@ -42,7 +42,7 @@ import numpy as np
 from .blas import numpy_cblas
 from .frames import frame_to_matrix
 from .kinematics import compiled_module
-from .planner import CartSegment, JointSegment, Segment, gradient_rows
+from .planner import CartSegment, JointSegment, Segment, _line_blas, gradient_rows
 from .profiles import BrakeProfile, RampProfile, Trapezoid
 
 
@@ -255,14 +255,20 @@ def plan_blend(prev: Segment, nxt: Segment, keyword: str, tau_a: float) -> Blend
     tau_p = bp.t_total - tau_a if bp.tau > 0 else 0.0
     if tau_p <= 0.0 or nxt.T <= 0.0:
         return BlendPlan(bp, RampProfile(nxt.profile, 0.0), 0.0)
-    # the uniform braking must stay below the planned speed everywhere (a spline block's
-    # corners and curves have lower speeds than the blend start): else no blend before the point
-    if not _below_law(BRAKE_LAW, bp.v_a, bp.a_b, bp.u_a, prev.profile, bp.u_a, 1.0):
-        return None
     base = nxt.profile
-    u_max = base.u(blend_end_tau(prev, nxt, keyword, tau_a))
-    u_max = min(u_max, base.u(max(0.0, base.t_total - getattr(base, "t_brake", base.t_acc))))
-    rp = _ramp(base, u_max, tau_p)
+    got = _cart_blend(prev, nxt, bp, tau_p)
+    if got is False:
+        return None
+    if got is not None:
+        rp = RampProfile(base, got[0], got[1])
+    else:
+        # the uniform braking must stay below the planned speed everywhere (a spline block's
+        # corners and curves have lower speeds than the blend start): else no blend before the point
+        if not _below_law(BRAKE_LAW, bp.v_a, bp.a_b, bp.u_a, prev.profile, bp.u_a, 1.0):
+            return None
+        u_max = base.u(blend_end_tau(prev, nxt, keyword, tau_a))
+        u_max = min(u_max, base.u(max(0.0, base.t_total - getattr(base, "t_brake", base.t_acc))))
+        rp = _ramp(base, u_max, tau_p)
     # only an axis that reverses can add up both accelerations (numpy's elementwise operations
     # on the floats, one axis at a time)
     for e, s, a in zip(prev.qd_end.tolist(), nxt.qd_start.tolist(), prev.model.a_max.tolist()):
@@ -272,6 +278,31 @@ def plan_blend(prev: Segment, nxt: Segment, keyword: str, tau_a: float) -> Blend
     if space == "joint" and tau_p > 0.0 and _joint_blend_acc_ratio(prev, bp, nxt, rp, tau_p) > 1.0 + 1e-6:
         return None
     return BlendPlan(bp, rp, tau_p, space)
+
+
+def _cart_blend(prev: Segment, nxt: Segment, bp: BrakeProfile, tau_p: float) -> Any:
+    """:func:`plan_blend` from its braking `bp` on, for two CP motions whose paths and time laws
+    robot/simcore.pyx mirrors, in C (``blend_args``: the braking's check, ``blend_end_tau``, the
+    blend end and :func:`_ramp`, the same operations in the same order): (u_e, delay) of the next
+    motion's ramp, False for no blend before the point, None where the Python code decides."""
+    if not (prev.cart and nxt.cart):
+        return None
+    sc = compiled_module()
+    if sc is None:
+        return None
+    cp, cq = prev._compiled_path(), nxt._compiled_path()      # type: ignore[attr-defined]
+    blas = _line_blas(sc) if cp and cq else None
+    if blas is None:
+        return None
+    pt, nt = profile_table(prev.profile), profile_table(nxt.profile)
+    if pt is None or nt is None:
+        return None
+    base = nxt.profile
+    end = prev._path_end                                       # type: ignore[attr-defined]
+    if end is None:
+        end = prev._path_end = prev.pieces[-1].pos(prev.pieces[-1].length)    # type: ignore[attr-defined]
+    return sc.blend_args(pt, getattr(prev.profile, "bounds", ()), bp.v_a, bp.a_b, bp.u_a, tau_p, cp, end, blas[1],
+                         cq, nt, getattr(base, "bounds", ()), getattr(base, "t_brake", base.t_acc))
 
 
 def _ramp(base: Any, u_max: float, tau_p: float) -> RampProfile:

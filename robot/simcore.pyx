@@ -1358,6 +1358,49 @@ cdef int _below(int law, double p0, double p1, double p2, const double* r, int n
     return 1
 
 
+cdef double _t_total(const double* r) noexcept:
+    """``t_total`` of the time law whose record starts at r (a ramp's: its base's plus its shift)."""
+    if r[0] == 0:
+        return r[1]
+    if r[0] == 1:
+        return _t_total(r + _PF) + r[5]
+    return r[6]
+
+
+cdef double _u(const double* r, double t) noexcept:
+    """``u(t)`` of the time law whose record starts at r (robot/profiles.py, the same operations)."""
+    cdef double T, ta, a, v, x, s
+    if r[0] == 0:
+        T = r[1]
+        if T == 0.0:
+            return 1.0
+        if t <= 0.0:
+            return 0.0
+        if t >= T:
+            return 1.0
+        ta, a, v = r[2], r[3], r[4]
+        if t < ta:
+            return 0.5 * a * t * t
+        if t <= T - ta:
+            return 0.5 * a * ta * ta + v * (t - ta)
+        x = T - t
+        return 1.0 - 0.5 * a * x * x
+    if r[0] == 1:
+        if t <= r[1]:
+            return 0.0 if _t_total(r) > 0 else 1.0
+        if r[2] > 0 and t < r[1] + r[2]:
+            s = t - r[1]
+            return 0.5 * r[4] * s * s
+        return _u(r + _PF, t - r[5])
+    if r[1] <= 0 or t <= r[2]:
+        return _u(r + _PF, t)
+    if t >= r[6]:
+        return 1.0
+    s = t - r[2]
+    x = r[3] + r[4] * s - 0.5 * r[5] * s * s
+    return x if x < 1.0 else 1.0
+
+
 def below(int law, double p0, double p1, double p2, const double[::1] table, bounds, double u0, double u1):
     """robot/blending.py ``_below`` (the same operations in the same order) of the speed law `law`
     against the time law `table` (records of :data:`PROFILE_FIELDS`, robot/blending.py
@@ -1400,18 +1443,10 @@ cdef double _ramp_tau(const double* r, int n, double u_e) noexcept:
     return 2.0 * u_e / v_b
 
 
-def ramp_args(const double[::1] table, bounds, double u_max, double tau_p):
-    """robot/blending.py ``plan_blend``'s choice of the next motion's ramp onto the time law
-    `table` (:func:`below`'s records; `bounds` its section bounds) for the blend end ``u_max`` and
-    the window ``tau_p`` (s): the arguments (u_e, delay) of the ``RampProfile(base, u_e, delay)``
-    it makes, found by the same bisections with the same operations in the same order (the
-    ramp's time law and ``_below`` as :func:`below`), or None for a table it does not read."""
-    cdef int n = _table_rows(table), k
-    cdef const double* r
+cdef int _ramp_args(const double* r, int n, bounds, double u_max, double tau_p, double* out) except -1:
+    """:func:`ramp_args` of the n records at r into out (u_e, delay)."""
+    cdef int k
     cdef double rt, lo, hi, mid, d, u_e, delay
-    if n < 0:
-        return None
-    r = &table[0]
     if u_max <= 0.0:
         u_e, delay = 0.0, tau_p
     else:
@@ -1437,4 +1472,92 @@ def ramp_args(const double[::1] table, bounds, double u_max, double tau_p):
                 hi = mid
         d = tau_p - _ramp_time(r, n, lo)
         u_e, delay = lo, (d if d > 0.0 else 0.0)
-    return u_e, delay
+    out[0] = u_e
+    out[1] = delay
+    return 0
+
+
+def ramp_args(const double[::1] table, bounds, double u_max, double tau_p):
+    """robot/blending.py ``plan_blend``'s choice of the next motion's ramp onto the time law
+    `table` (:func:`below`'s records; `bounds` its section bounds) for the blend end ``u_max`` and
+    the window ``tau_p`` (s): the arguments (u_e, delay) of the ``RampProfile(base, u_e, delay)``
+    it makes, found by the same bisections with the same operations in the same order (the
+    ramp's time law and ``_below`` as :func:`below`), or None for a table it does not read."""
+    cdef int n = _table_rows(table)
+    cdef double out[2]
+    if n < 0:
+        return None
+    _ramp_args(&table[0], n, bounds, u_max, tau_p, out)
+    return out[0], out[1]
+
+
+def blend_args(const double[::1] prev_table, prev_bounds, double v_a, double a_b, double u_a, double tau_p,
+               CartPath prev_path, const double[:] prev_end, size_t ddot, CartPath next_path,
+               const double[::1] next_table, next_bounds, double t_brake):
+    """robot/blending.py ``plan_blend`` of a blend between two CP motions from its braking
+    (``BrakeProfile``'s ``v_a``, ``a_b``, ``u_a`` on the approximated motion's time law
+    `prev_table`, the window ``tau_p``) on: ``_below`` of the braking, ``blend_end_tau`` (the
+    distance from ``u_a`` to `prev_end` on `prev_path` (:meth:`CartPath.dist_to`), the next
+    motion's path length and ``u_of_path`` on `next_path`'s pieces, its time law `next_table`),
+    the blend end ``u_max`` (with `t_brake`, the next law's ``t_brake``) and :func:`ramp_args`:
+    the same operations in the same order. Returns (u_e, delay) of the next motion's
+    ``RampProfile``, False where the braking exceeds the planned speed (no blend before the
+    point), or None where it does not mirror the two (the Python code decides)."""
+    cdef int n_p = _table_rows(prev_table), n_n = _table_rows(next_table), k, lo, hi, mid, m
+    cdef double d_start, L, t_end, s, f, Lk, u, u_max, u2, t2, sk, sk1
+    cdef double out[2]
+    cdef const double* rn
+    if n_p < 0 or n_n < 0:
+        return None
+    if not _below(0, v_a, a_b, u_a, &prev_table[0], n_p, prev_bounds, u_a, 1.0):
+        return False
+    got = prev_path.dist_to(u_a, prev_end, ddot)
+    if got is None:
+        return None
+    d_start = got
+    m = next_path.n
+    for k in range(m):
+        if next_path.kinds[k] < 0:
+            return None                 # a piece whose length the path does not hold
+    L = 0.0                             # path_length: [0, *accumulate(lengths)][-1]
+    for k in range(m):
+        L = next_path.length[k] if k == 0 else L + next_path.length[k]
+    rn = &next_table[0]
+    if L <= 1e-9 or (d_start <= 1e-9 and u_a < 1.0):
+        t_end = _t_of_u(rn, n_n, 0.5 if 0.5 < 1.0 - u_a else 1.0 - u_a)
+    else:
+        # u_of_path(min(d_start, L / 2))
+        s = L / 2.0 if L / 2.0 < d_start else d_start
+        if 0.0 > s:
+            s = 0.0
+        if L < s:
+            s = L
+        lo, hi, sk = 0, m + 1, 0.0      # bisect_right over the s bounds [0, l0, l0 + l1, ...]
+        while lo < hi:
+            mid = (lo + hi) // 2
+            sk = 0.0
+            for k in range(mid):
+                sk = next_path.length[k] if k == 0 else sk + next_path.length[k]
+            if s < sk:
+                hi = mid
+            else:
+                lo = mid + 1
+        k = lo - 1
+        if k < 0:
+            k = 0
+        if k > m - 1:
+            k = m - 1
+        sk = 0.0
+        for mid in range(k):
+            sk = next_path.length[mid] if mid == 0 else sk + next_path.length[mid]
+        Lk = next_path.length[k]
+        f = (s - sk) / Lk if Lk > 0 else 1.0
+        u = next_path.ub[k] + f * (next_path.ub[k + 1] - next_path.ub[k])
+        t_end = _t_of_u(rn, n_n, u)
+    u_max = _u(rn, t_end)
+    t2 = _t_total(rn) - t_brake
+    u2 = _u(rn, t2 if t2 > 0.0 else 0.0)
+    if u2 < u_max:
+        u_max = u2
+    _ramp_args(rn, n_n, next_bounds, u_max, tau_p, out)
+    return out[0], out[1]

@@ -666,6 +666,46 @@ def test_the_compiled_blend_setpoint_is_the_pythons(sc, monkeypatch):
     assert compiled == python and in_c > 100 and len(pairs) > 30
 
 
+def test_the_compiled_blend_plan_is_the_pythons(sc, monkeypatch):
+    """A blend between two CP motions planned in C from its braking on (robot/blending.py
+    ``_cart_blend``, robot/simcore.pyx ``blend_args``: the braking's check, the blend end, the
+    ramp; issue 62, the CAM-like program) is ``plan_blend``'s Python plan bit for bit (the time
+    laws attribute by attribute, the window), on drawn pairs of CP motions (LINs, CIRCs; the
+    approximated one ramped in from a blend before it or not) at drawn blend starts."""
+    model = Controller(None, mujoco=False).model
+    rng = np.random.default_rng(6210)
+    pairs = []
+    for req, q in _drawn_cp_motions(rng, 160, model):
+        if req.kind == "SPLINE":
+            continue
+        try:
+            a = planner.plan(req, q, model)
+            back = {k: v - 5.0 * rng.uniform() if k in "XY" else v for k, v in dict(
+                zip("XYZABC", matrix_to_frame(a.model.tcp(a.q1, a.tool_T, a.base_inv_T)))).items()}
+            b = planner.plan(replace(req, kind="LIN", target=back, aux=None), a.q1, model)
+        except RobotError:
+            continue
+        if a.T > 0 and b.T > 0:
+            if rng.uniform() < 0.5:         # ramped in from a blend before it
+                a.profile = RampProfile(a.profile, float(rng.uniform(0.0, 0.3)), float(rng.choice([0.0, 0.01])))
+            pairs.append((a, b))
+    plans, in_c, none = {True: [], False: []}, 0, 0
+    for a, b in pairs:
+        for tau in rng.uniform(0.0, a.T, 5).tolist():
+            got = blending._cart_blend(a, b, BrakeProfile(a.profile, tau), 1.0)
+            in_c += got is not None
+            for compiled in (True, False):
+                if not compiled:
+                    monkeypatch.setattr(blending, "_cart_blend", lambda *x: None)
+                bp = blending.plan_blend(a, b, "C_DIS", tau)
+                monkeypatch.undo()
+                none += bp is None
+                plans[compiled].append(None if bp is None else (
+                    bp.window, bp.space, vars(bp.prev_profile), vars(bp.next_profile)))
+    assert all(_same(x, y) for x, y in zip(plans[True], plans[False]))
+    assert in_c > 200 and len(pairs) > 40 and none > 0
+
+
 def _drawn_time_laws(rng, n):
     """Drawn time laws of blends (robot/profiles.py): trapezoids and triangles, ramps onto them
     (with and without a delay, a ramp of length 0), braking from them, braking from a ramp."""
