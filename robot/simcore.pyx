@@ -214,6 +214,24 @@ cdef double _dot3(_ddot_t ddot, const double* v) noexcept:
     return s
 
 
+cdef int _piece_of(const double* bounds, int n, double x) noexcept:
+    """``bisect_right(bounds, x) - 1`` over the n + 1 bounds of n pieces, clamped to 0 .. n - 1: the
+    piece whose bounds hold x (robot/planner.py ``CartSegment._locate`` and ``u_of_path``)."""
+    cdef int lo = 0, hi = n + 1, mid
+    while lo < hi:
+        mid = (lo + hi) // 2
+        if x < bounds[mid]:
+            hi = mid
+        else:
+            lo = mid + 1
+    lo -= 1
+    if lo < 0:
+        lo = 0
+    if lo > n - 1:
+        lo = n - 1
+    return lo
+
+
 cdef class CartPath:
     """The poses of a CP segment's lines and arcs, and their axes (``opw``: robot/kinematics/fastpath.py's
     ``OPWCore``; None: the poses only) (robot/planner.py ``CartSegment.pose_u`` and ``CartSegment.ik``
@@ -270,19 +288,7 @@ cdef class CartPath:
         elif u >= 1.0:
             k, f = n - 1, 1.0
         else:
-            # bisect_right(ub, u) - 1
-            lo, hi = 0, n + 1
-            while lo < hi:
-                mid = (lo + hi) // 2
-                if u < self.ub[mid]:
-                    hi = mid
-                else:
-                    lo = mid + 1
-            k = lo - 1
-            if k < 0:
-                k = 0
-            if k > n - 1:
-                k = n - 1
+            k = _piece_of(&self.ub[0], n, u)
             du = self.ub[k + 1] - self.ub[k]
             f = (u - self.ub[k]) / du if du > 0 else 1.0
         if self.kinds[k] < 0:
@@ -1503,10 +1509,9 @@ def blend_args(const double[::1] prev_table, prev_bounds, double v_a, double a_b
     the same operations in the same order. Returns (u_e, delay) of the next motion's
     ``RampProfile``, False where the braking exceeds the planned speed (no blend before the
     point), or None where it does not mirror the two (the Python code decides)."""
-    cdef int n_p = _table_rows(prev_table), n_n = _table_rows(next_table), k, lo, hi, mid, m
-    cdef double d_start, L, t_end, s, f, Lk, u, u_max, u2, t2, sk, sk1
-    cdef double out[2]
-    cdef const double* rn
+    cdef int n_p = _table_rows(prev_table), n_n = _table_rows(next_table), k, m
+    cdef double d_start
+    cdef double* sb
     if n_p < 0 or n_n < 0:
         return None
     if not _below(0, v_a, a_b, u_a, &prev_table[0], n_p, prev_bounds, u_a, 1.0):
@@ -1519,10 +1524,25 @@ def blend_args(const double[::1] prev_table, prev_bounds, double v_a, double a_b
     for k in range(m):
         if next_path.kinds[k] < 0:
             return None                 # a piece whose length the path does not hold
-    L = 0.0                             # path_length: [0, *accumulate(lengths)][-1]
-    for k in range(m):
-        L = next_path.length[k] if k == 0 else L + next_path.length[k]
-    rn = &next_table[0]
+    sb = <double*>PyMem_Malloc((m + 1) * sizeof(double))
+    if sb == NULL:
+        raise MemoryError()
+    try:
+        sb[0] = 0.0                     # s_bounds: [0, *accumulate(lengths)]
+        for k in range(m):
+            sb[k + 1] = next_path.length[k] if k == 0 else sb[k] + next_path.length[k]
+        return _blend_end_ramp(sb, m, next_path, d_start, u_a, next_table, n_n, next_bounds, t_brake, tau_p)
+    finally:
+        PyMem_Free(sb)
+
+
+cdef object _blend_end_ramp(const double* sb, int m, CartPath next_path, double d_start, double u_a,
+                            const double[::1] next_table, int n_n, next_bounds, double t_brake, double tau_p):
+    """:func:`blend_args` from the distance `d_start` on (`sb`: the next path's m + 1 s bounds)."""
+    cdef double L = sb[m], t_end, s, f, Lk, u, u_max, u2, t2
+    cdef double out[2]
+    cdef int k
+    cdef const double* rn = &next_table[0]
     if L <= 1e-9 or (d_start <= 1e-9 and u_a < 1.0):
         t_end = _t_of_u(rn, n_n, 0.5 if 0.5 < 1.0 - u_a else 1.0 - u_a)
     else:
@@ -1532,26 +1552,9 @@ def blend_args(const double[::1] prev_table, prev_bounds, double v_a, double a_b
             s = 0.0
         if L < s:
             s = L
-        lo, hi, sk = 0, m + 1, 0.0      # bisect_right over the s bounds [0, l0, l0 + l1, ...]
-        while lo < hi:
-            mid = (lo + hi) // 2
-            sk = 0.0
-            for k in range(mid):
-                sk = next_path.length[k] if k == 0 else sk + next_path.length[k]
-            if s < sk:
-                hi = mid
-            else:
-                lo = mid + 1
-        k = lo - 1
-        if k < 0:
-            k = 0
-        if k > m - 1:
-            k = m - 1
-        sk = 0.0
-        for mid in range(k):
-            sk = next_path.length[mid] if mid == 0 else sk + next_path.length[mid]
+        k = _piece_of(sb, m, s)
         Lk = next_path.length[k]
-        f = (s - sk) / Lk if Lk > 0 else 1.0
+        f = (s - sb[k]) / Lk if Lk > 0 else 1.0
         u = next_path.ub[k] + f * (next_path.ub[k + 1] - next_path.ub[k])
         t_end = _t_of_u(rn, n_n, u)
     u_max = _u(rn, t_end)
