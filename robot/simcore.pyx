@@ -11,9 +11,15 @@ compiled from that very Python file; this module calls its C methods (``OPWCore`
 * :class:`CartPath`: the poses of a CP segment's lines and arcs (robot/planner.py
   ``CartSegment.pose_u``) and their axes (fastpath's ``OPWCore``), through the motion's ``$BASE``
   and ``$TOOL`` where it has them (``RobotModel.ik``'s two products, numpy's BLAS at its address),
-  and the planning walk of a piece (robot/planner.py ``_plan_cart``);
-* :func:`below`: a blend's check of its speed law against a planned time law (robot/blending.py
-  ``_below``) for the time laws of robot/profiles.py it mirrors;
+  the planning walk of a piece (robot/planner.py ``_plan_cart``), the distance to the path's end
+  (``CartSegment.tcp_dist_to_end``) and a Cartesian blend's setpoint (robot/blending.py
+  ``blend_setpoint``);
+* :func:`plan_line`: the plan of a single LIN (robot/planner.py ``_plan_cart`` of one line, for
+  ``_planned_line``, which makes the segment);
+* :func:`below`, :func:`ramp_args`, :func:`blend_args`: a blend's check of its speed law against
+  a planned time law (robot/blending.py ``_below``), the next motion's ramp (``_ramp``) and the
+  plan of a blend between two CP motions from its braking on (``plan_blend``), for the time laws
+  of robot/profiles.py it mirrors;
 * :class:`ArmCycle` and :func:`speed_ok`: the IPO cycle's MuJoCo playback (``mj_kinematics``
   through its address) with its TCP product, and its axis step check (robot/controller.py
   ``Controller.step``);
