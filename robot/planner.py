@@ -947,7 +947,8 @@ class CartSegment(Segment):
             cp = self._compiled_path()
         if cp:
             # the same distance in C (robot/simcore.pyx CartPath.dist_to: numpy's dot product)
-            blas = _line_blas(kinematics.compiled_module())
+            sc = kinematics.compiled_module()
+            blas = _line_blas(sc) if sc is not None else None
             d = cp.dist_to(u, end, blas[1]) if blas is not None else None
             if d is not None:
                 return d
