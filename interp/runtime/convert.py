@@ -14,6 +14,8 @@ module adds what needs the runtime's structures and arrays:
 
 from __future__ import annotations
 
+from operator import is_
+
 from krl.semantics import types as T
 from krl.semantics.values import INT_MAX, INT_MIN, KrlRuntimeError, UNSET, EnumValue, check_int, compare, num
 from krl.semantics.values import binary_op as _binary_op
@@ -184,6 +186,11 @@ FRAME_KEYS = ("X", "Y", "Z", "A", "B", "C")
 
 def frame_tuple(v, what: str = "frame") -> tuple:
     """(X, Y, Z, A, B, C) of a FRAME/POS/E6POS value (missing components 0; set ones only)."""
+    if v.__class__ is Struct:
+        f = v.f
+        out = tuple([f.get(k, 0.0) for k in FRAME_KEYS])
+        if all(x.__class__ is float for x in out):
+            return out          # (float(num(x)) of a float is x itself)
     if not isinstance(v, Struct):
         raise KrlRuntimeError(f"{what} is not a FRAME/POS: {value_text(v)}")
     out = []
@@ -208,9 +215,22 @@ def struct_from_frame(fr, like: Struct | None, type_=None) -> Struct:
     return out
 
 
-def geo_compose(a, b) -> Struct:
+#: the left operand of the last ``:`` and its matrix (:func:`geo_compose`)
+_last_left: tuple = ((), None)
 
-    Ta = frame_to_matrix(*frame_tuple(a, "left operand of ':'"))
+
+def geo_compose(a, b) -> Struct:
+    """``a : b`` (§4.3). The matrix of the left operand is the last one's when its six values
+    are the very objects the last was made of (``is``: the same floats, -0.0 not 0.0; a read-only
+    array held here): a program that composes one base frame with many points (the CAM-like
+    program's ``lfStartPoint:lfPoint``) makes it once."""
+    global _last_left
+    fa = frame_tuple(a, "left operand of ':'")
+    last, Ta = _last_left
+    if len(last) != 6 or not all(map(is_, fa, last)):
+        Ta = frame_to_matrix(*fa)
+        Ta.flags.writeable = False
+        _last_left = (fa, Ta)
     Tb = frame_to_matrix(*frame_tuple(b, "right operand of ':'"))
     fr = matrix_to_frame(Ta @ Tb)
     return struct_from_frame(fr, b)
