@@ -189,14 +189,28 @@ def motion_limits(req: Any, machine: Any, mode: str = DEFAULT_MODE) -> MotionLim
         path: float | None = T1_SPEED_MM_S if mode == "T1" else None
     else:
         segments = getattr(req, "segments", ())
-        path = cp_path_speed(p, mode) if not segments else \
-            max(cp_path_speed(q, mode) for q in [p] + [s.params for s in segments if s.params])
         axes = getattr(machine, "all_max_speed", None)
         if axes is None:
             axes = machine.max_speed_deg_s
+        last = _LAST_CP
+        if (not segments and last and last[0] is p and last[1] is machine and last[2] == mode
+                and last[3] == axes and 0.0 not in axes):
+            # the same MotionParams (interp/runtime/motion.py hands the same snapshot again while
+            # nothing changed; frozen) and the same axis speeds (no zero: == is their bits): the
+            # same (frozen) limits
+            return last[4]
+        path = cp_path_speed(p, mode) if not segments else \
+            max(cp_path_speed(q, mode) for q in [p] + [s.params for s in segments if s.params])
     flange = T1_SPEED_MM_S if mode == "T1" else None
-    return MotionLimits(path, tuple(map(float, axes)), flange, tuple(map(float, p.tool)), tuple(map(float, p.base)),
-                        getattr(p, "base_kin", None), getattr(p, "base_root", None))
+    out = MotionLimits(path, tuple(map(float, axes)), flange, tuple(map(float, p.tool)), tuple(map(float, p.base)),
+                       getattr(p, "base_kin", None), getattr(p, "base_root", None))
+    if path is not None and not getattr(req, "segments", ()) and req.kind not in ("PTP", "SPTP"):
+        _LAST_CP[:] = [p, machine, mode, axes, out]
+    return out
+
+
+#: the last CP motion's (MotionParams, machine, mode, axis speeds, MotionLimits): motion_limits
+_LAST_CP: list[Any] = []
 
 
 # ----------------------------------------------------------------------------- checker

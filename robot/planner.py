@@ -1044,14 +1044,28 @@ def _frame_of(T: np.ndarray) -> tuple[float, ...]:
 def _matrix_of(frame: Any) -> np.ndarray:
     """:func:`robot.frames.frame_to_matrix` of six numbers (X, Y, Z, A, B, C), kept by their
     float64 bytes (so -0.0 is not 0.0): the motions of a program share their $TOOL and $BASE.
-    A new array each call, as the function gives."""
+    A new array each call, as the function gives. A frame that is the very tuple of the last call
+    (a MotionParams' $TOOL or $BASE: interp/runtime/motion.py hands the same snapshot again while
+    nothing changed) takes the matrix it got then: the same numbers, without the bytes."""
+    last = _LAST_MATRIX.get(id(frame))
+    if last is not None and last[0] is frame:
+        return last[1].copy()
     try:
         v = np.array(frame, dtype=float)
     except (TypeError, ValueError):
         return frame_to_matrix(*frame)
     if v.shape != (len(CART_KEYS),):
         return frame_to_matrix(*frame)
-    return _kept(_MATRIX_OF, v.tobytes(), lambda: frame_to_matrix(*frame)).copy()
+    kept = _kept(_MATRIX_OF, v.tobytes(), lambda: frame_to_matrix(*frame))
+    if type(frame) is tuple and all(type(x) is float for x in frame):     # immutable all through
+        if len(_LAST_MATRIX) >= 8:
+            _LAST_MATRIX.clear()
+        _LAST_MATRIX[id(frame)] = (frame, kept)
+    return kept.copy()
+
+
+#: _matrix_of's last frames by identity (a tuple of floats, kept alive here) and their matrices
+_LAST_MATRIX: dict[int, tuple[tuple, np.ndarray]] = {}
 
 
 def _cart_path(sc: Any, seg: "CartSegment") -> Any:
