@@ -25,7 +25,7 @@ from .values import Arr, Struct, copy_value, make_value, value_text
 from robot.frames import frame_to_matrix, inv_pos as _inv, matrix_to_frame
 
 __all__ = ["INT_MAX", "INT_MIN", "assign_chars", "assign_into", "binary_op", "check_int", "compare",
-           "convert_scalar", "frame_tuple", "geo_compose", "inv_pos", "num", "real_to_int",
+           "convert_scalar", "frame_tuple", "frame_values", "geo_compose", "inv_pos", "num", "real_to_int",
            "ref_bytes", "ref_text", "struct_from_frame", "to_bool", "trunc_int", "unary_op"]
 
 def convert_scalar(v, t):
@@ -191,6 +191,12 @@ def frame_tuple(v, what: str = "frame") -> tuple:
         out = tuple([f.get(k, 0.0) for k in FRAME_KEYS])
         if all(x.__class__ is float for x in out):
             return out          # (float(num(x)) of a float is x itself)
+    return frame_values(v, what)
+
+
+def frame_values(v, what: str = "frame") -> tuple:
+    """:func:`frame_tuple` for any value: each component through ``num`` and ``float``; raises
+    KrlRuntimeError for a value that is not a structure or an unset component."""
     if not isinstance(v, Struct):
         raise KrlRuntimeError(f"{what} is not a FRAME/POS: {value_text(v)}")
     out = []

@@ -1,7 +1,7 @@
 """The geometric operator's fast paths (interp/runtime/convert.py ``geo_compose``: the left
 operand's matrix kept while its six values are the very same floats; ``frame_tuple`` of six floats
-without conversions) give the bytes of the general computation (each operand's components through
-``num`` and ``float``, both matrices made afresh), on drawn sequences of operands: a pool of left
+without conversions) give the bytes of the general computation (``frame_values``: each operand's
+components through ``num`` and ``float``; both matrices made afresh), on drawn sequences of operands: a pool of left
 operands that repeat (equal values as other objects, -0.0 for 0.0, INT components, NaN, a missing
 or unset component) and right ones drawn each time."""
 
@@ -13,27 +13,16 @@ import struct
 import pytest
 
 from interp.runtime import convert
-from interp.runtime.convert import FRAME_KEYS, geo_compose, struct_from_frame
+from interp.runtime.convert import FRAME_KEYS, frame_values, geo_compose, struct_from_frame
 from interp.runtime.errors import KrlRuntimeError
 from interp.runtime.sysvars import struct_of
 from interp.runtime.values import UNSET
-from krl.semantics.values import num, value_invalid
 from robot.frames import frame_to_matrix, matrix_to_frame
 
 
-def _general_tuple(v, what):
-    out = []
-    for k in FRAME_KEYS:
-        x = v.f.get(k, 0.0)
-        if x is UNSET:
-            raise value_invalid(f"{what}.{k}")
-        out.append(float(num(x)))
-    return tuple(out)
-
-
 def _general(a, b):
-    Ta = frame_to_matrix(*_general_tuple(a, "left operand of ':'"))
-    Tb = frame_to_matrix(*_general_tuple(b, "right operand of ':'"))
+    Ta = frame_to_matrix(*frame_values(a, "left operand of ':'"))
+    Tb = frame_to_matrix(*frame_values(b, "right operand of ':'"))
     return struct_from_frame(matrix_to_frame(Ta @ Tb), b)
 
 
