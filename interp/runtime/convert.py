@@ -233,7 +233,7 @@ def geo_compose(a, b) -> Struct:
     global _last_left
     fa = frame_tuple(a, "left operand of ':'")
     last, Ta = _last_left
-    if len(last) != 6 or not all(map(is_, fa, last)):
+    if len(last) != len(fa) or not all(map(is_, fa, last)):
         Ta = frame_to_matrix(*fa)
         Ta.flags.writeable = False
         _last_left = (fa, Ta)
