@@ -57,7 +57,8 @@ class ParamsMemo:
 
 def _read(store: dict) -> tuple:
     """Every value :func:`params_from` reads from `store` (without `link`), in one tuple: the
-    value objects themselves, as the store holds them."""
+    value objects themselves, as the store holds them (:func:`_snapshot` makes the MotionParams
+    of it: one list of what is read, for the snapshot and for its memo's key)."""
     n = len(ROBOT_KEYS)
     vel, acc, apo = store["$VEL"].f, store["$ACC"].f, store["$APO"].f
     tool, base = store["$TOOL"].f, store["$BASE"].f
@@ -66,6 +67,28 @@ def _read(store: dict) -> tuple:
             *store["$VEL_AXIS"].data[:n], None, *store["$ACC_AXIS"].data[:n], None,
             *[tool.get(k, 0.0) for k in FRAME_KEYS], *[base.get(k, 0.0) for k in FRAME_KEYS],
             store["$ORI_TYPE"], store["$CIRC_TYPE"], store["$OV_PRO"], store["$IPO_MODE"])
+
+
+def _snapshot(raw: tuple) -> MotionParams:
+    """The MotionParams of :func:`_read`'s tuple (unset values: the INITMOV defaults)."""
+    d = _INITMOV
+    vcp, vo1, vo2, acp, ao1, ao2, cptp, cdis, cvel, cori = raw[:10]
+    i = raw.index(None, 10)                     # the end of $VEL_AXIS's A1..A6 (robot/axismap.py)
+    j = raw.index(None, i + 1)                  # the end of $ACC_AXIS's
+    va, aa = raw[10:i], raw[i + 1:j]
+    k = len(FRAME_KEYS)
+    tool, base = raw[j + 1:j + 1 + k], raw[j + 1 + k:j + 1 + 2 * k]
+    ori, circ, ov, ipo = raw[j + 1 + 2 * k:]
+    return MotionParams(
+        vel_cp=_f(vcp, d.vel_cp), vel_ori1=_f(vo1, d.vel_ori1), vel_ori2=_f(vo2, d.vel_ori2),
+        acc_cp=_f(acp, d.acc_cp), acc_ori1=_f(ao1, d.acc_ori1), acc_ori2=_f(ao2, d.acc_ori2),
+        vel_axis=tuple(_f(v, 100.0) for v in va), acc_axis=tuple(_f(v, 100.0) for v in aa),
+        apo_cptp=_f(cptp, d.apo_cptp), apo_cdis=_f(cdis, d.apo_cdis),
+        apo_cvel=_f(cvel, d.apo_cvel), apo_cori=_f(cori, d.apo_cori),
+        tool=tuple(_f(v, 0.0) for v in tool), base=tuple(_f(v, 0.0) for v in base),
+        ori_type=_enum_name(ori, "VAR"), circ_type=_enum_name(circ, "BASE"),
+        ov_pro=_f(ov, 100.0), ipo_mode=_enum_name(ipo, "BASE"),
+    )
 
 
 def params_from(store: dict, link=None, memo: ParamsMemo | None = None) -> MotionParams:
@@ -79,33 +102,18 @@ def params_from(store: dict, link=None, memo: ParamsMemo | None = None) -> Motio
     reused), that snapshot is the answer (MotionParams is frozen); a program that sets no motion
     variable between its motions reads about 40 values instead of converting them and making a
     MotionParams (TopSquare's store: 24 -> 4 us a motion, 2026-11-26). Identity, not equality:
-    -0.0 == 0.0."""
-    if memo is not None and link is None:
-        raw = _read(store)
-        last = memo.raw
-        if len(raw) == len(last) and all(map(is_, raw, last)):
-            return memo.params
-        memo.params = params = params_from(store)
-        memo.raw = raw
-        return params
-    d = _INITMOV
-    vel, acc, apo = store["$VEL"], store["$ACC"], store["$APO"]
-    va, aa = store["$VEL_AXIS"].data, store["$ACC_AXIS"].data
-    return MotionParams(
-        vel_cp=_f(vel.f["CP"], d.vel_cp), vel_ori1=_f(vel.f["ORI1"], d.vel_ori1),
-        vel_ori2=_f(vel.f["ORI2"], d.vel_ori2),
-        acc_cp=_f(acc.f["CP"], d.acc_cp), acc_ori1=_f(acc.f["ORI1"], d.acc_ori1),
-        acc_ori2=_f(acc.f["ORI2"], d.acc_ori2),
-        vel_axis=tuple(_f(v, 100.0) for v in va[:len(ROBOT_KEYS)]),     # A1..A6 (robot/axismap.py)
-        acc_axis=tuple(_f(v, 100.0) for v in aa[:len(ROBOT_KEYS)]),
-        apo_cptp=_f(apo.f["CPTP"], d.apo_cptp), apo_cdis=_f(apo.f["CDIS"], d.apo_cdis),
-        apo_cvel=_f(apo.f["CVEL"], d.apo_cvel), apo_cori=_f(apo.f["CORI"], d.apo_cori),
-        tool=_frame(store["$TOOL"]), base=_frame(store["$BASE"]),
-        ori_type=_enum_name(store["$ORI_TYPE"], "VAR"),
-        circ_type=_enum_name(store["$CIRC_TYPE"], "BASE"),
-        ov_pro=_f(store["$OV_PRO"], 100.0),
-        ipo_mode=_enum_name(store["$IPO_MODE"], "BASE"),
-    ) if link is None else _linked(store, link)
+    -0.0 == 0.0. The snapshot and the memo's key are made of the same reads (:func:`_read`)."""
+    if link is not None:
+        return _linked(store, link)
+    raw = _read(store)
+    if memo is None:
+        return _snapshot(raw)
+    last = memo.raw
+    if len(raw) == len(last) and all(map(is_, raw, last)):
+        return memo.params
+    memo.params = params = _snapshot(raw)
+    memo.raw = raw
+    return params
 
 
 def _linked(store: dict, link) -> MotionParams:
