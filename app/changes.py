@@ -18,6 +18,7 @@ from pathlib import Path
 
 import click
 
+from krl.durable import write_text
 from krl import limits   # limits.PARSE_TIMEOUT_S read at each call (tests lengthen it)
 from krl.project import folder_groups
 from krl.source import read_source
@@ -45,7 +46,7 @@ def _write(text: str, output: str | None) -> None:
     if output is None:
         click.echo(text)
     else:
-        Path(output).write_text(text + ("" if text.endswith("\n") else "\n"), encoding="utf-8")
+        write_text(Path(output), text + ("" if text.endswith("\n") else "\n"))
 
 
 def _echo_errors(sides, paths) -> None:

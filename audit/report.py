@@ -37,7 +37,7 @@ from krl.limits import MAX_AUDIT_EVIDENCE_CHARS
 from interp.realprograms import cause_of
 from interp.summary import ENDINGS
 from krl.render import render_html
-from krl.files import write_text_atomic
+from krl.durable import write_text
 from krl.source import read_source
 
 __all__ = ["AUDIT_FORMAT", "STATUSES", "rel_path", "plural", "report_data", "health", "write_report", "to_html",
@@ -337,11 +337,11 @@ def to_html(data: dict) -> str:
 
 def write_report(data: dict, out: str | Path) -> tuple[Path, Path]:
     """Write ``audit.json`` and ``audit.html`` into the folder `out` (created), each through
-    a temporary file renamed over the old one (krl.files.write_text_atomic); returns their paths."""
+    a temporary file renamed over the old one (krl/durable.py write_text); returns their paths."""
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     j, h = out / "audit.json", out / "audit.html"
-    write_text_atomic(j, json.dumps(data, indent=1, ensure_ascii=False) + "\n")
-    write_text_atomic(h, to_html(data))
+    write_text(j, json.dumps(data, indent=1, ensure_ascii=False) + "\n")
+    write_text(h, to_html(data))
     return j, h

@@ -21,6 +21,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from krl.durable import write_text
 from krl.files import SHARED_CORPUS as DEFAULT_CORPUS
 from interp import realprograms as R
 from krl.cluster import run_batches
@@ -352,11 +353,11 @@ def write_report(out: Path, outcomes: list[CaseOutcome], fuzz: dict[str, Any] | 
                 o.plot = None
                 print(f"plot {o.case.name}: {exc}")
     s = summary(outcomes, fuzz, real, status)
-    (out / "summary.json").write_text(json.dumps(s, indent=2) + "\n", encoding="utf-8")
+    write_text(out / "summary.json", json.dumps(s, indent=2) + "\n")
     rows = [_row(o) for o in outcomes]
     interps = sorted({k for o in outcomes for k in o.results})
-    (out / "report.md").write_text(_markdown(s, rows, interps, fuzz, real), encoding="utf-8")
-    (out / "report.html").write_text(_html(s, rows, interps, fuzz, real), encoding="utf-8")
+    write_text(out / "report.md", _markdown(s, rows, interps, fuzz, real))
+    write_text(out / "report.html", _html(s, rows, interps, fuzz, real))
     return s
 
 

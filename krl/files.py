@@ -21,15 +21,13 @@ Order: within a folder, entries sorted by name; the files of a folder come befor
 sub-folders (the order of ``os.walk`` with sorted names).
 
 Also here: :func:`spelled` (a path in the user's spelling, links kept: what every command shows
-and sends), :func:`same_file` (identity by resolved paths), :func:`write_bytes_atomic`, and
-:data:`SHARED_CORPUS`.
+and sends), :func:`same_file` (identity by resolved paths) and :data:`SHARED_CORPUS`. Writing a file: krl/durable.py.
 """
 
 from __future__ import annotations
 
 import os
 import stat
-import tempfile
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
@@ -181,31 +179,3 @@ def _links_to_folder(e: os.DirEntry) -> bool:
         return e.is_dir(follow_symlinks=True)
     except OSError:
         return False
-
-
-def write_bytes_atomic(path: str | Path, data: bytes, mode: int | None = 0o644) -> None:
-    """Write `data` to `path` atomically: into a temporary file in the same folder, flushed to
-    disk, then renamed over `path`, so a reader (or a crash) never sees half a file.
-    mode: the new file's permission bits (None: keep those of the existing file). Raises OSError."""
-    path = Path(path)
-    if mode is None:
-        mode = path.stat().st_mode & 0o7777
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(data)
-            fh.flush()
-            os.fsync(fh.fileno())
-        os.chmod(tmp, mode)
-        os.replace(tmp, path)
-    except BaseException:
-        try:
-            os.unlink(tmp)
-        except OSError:
-            pass
-        raise
-
-
-def write_text_atomic(path: str | Path, text: str) -> None:
-    """:func:`write_bytes_atomic` of `text` in UTF-8, mode 0644."""
-    write_bytes_atomic(path, text.encode("utf-8"))

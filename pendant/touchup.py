@@ -5,7 +5,8 @@ parameters: touching up a point").
 The data list is read through the front end (robot/datalist.py: the declaration's line and its
 components); only the numbers of that one aggregate are replaced, component by component, so
 the line keeps its spelling, spacing, comments and the components the point did not have.
-The file is written atomically (krl/files.py ``write_bytes_atomic``) in its own encoding
+The file is written durably (krl/durable.py ``write_bytes``: owner, group and mode kept, a
+read-only file refused, an edit saved meanwhile kept) in its own encoding
 (krl/source.py ``decode_bytes``/``encode_text``: a cp1252 file stays cp1252, CRLF stays CRLF).
 """
 
@@ -15,7 +16,7 @@ import re
 from pathlib import Path
 
 from krl.limits import MAX_WEB_FILE_BYTES
-from krl.files import write_bytes_atomic
+from krl.durable import write_bytes
 from krl.source import decode_bytes, encode_text
 from robot.datalist import DataListError, read_data_list
 
@@ -78,7 +79,7 @@ def touch_up(dat: Path, name: str, pos: dict, axes: list[float]) -> dict:
         if n != 1:
             raise TouchUpError(f"{dat.name}:{dv.line}: component {key} of {name} not found")
     lines[i] = line[:start] + body + line[end:]
-    write_bytes_atomic(dat, encode_text("".join(lines), encoding), mode=None)
+    write_bytes(dat, encode_text("".join(lines), encoding), mode=None, expect=data)
     return new
 
 

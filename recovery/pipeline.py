@@ -9,7 +9,7 @@ import time
 from pathlib import Path
 
 from krl import store
-from krl.files import write_text_atomic
+from krl.durable import write_text
 from krl.limits import PARSE_TIMEOUT_S
 from recovery.report import ReportStream, Summary, SummaryBuilder
 from recovery.scan import FileResult, cache_dir, grammar_sha, scan, warn
@@ -95,7 +95,7 @@ def static_check_figures(corpus: Path, fingerprints: list[str], gsha: str,
     if path is not None:
         try:
             path.parent.mkdir(parents=True, exist_ok=True)
-            write_text_atomic(path, json.dumps(figures))
+            write_text(path, json.dumps(figures))
         except OSError as exc:
             warn(f"cache file {path} not written ({exc.strerror or exc})")
     return figures

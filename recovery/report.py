@@ -18,9 +18,7 @@ from __future__ import annotations
 import csv
 import json
 import os
-import shutil
 import sys
-import tempfile
 from collections.abc import Collection
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -28,6 +26,7 @@ from urllib.parse import quote
 
 from jinja2 import Environment, PackageLoader
 
+from krl.durable import TempFolder, replace_folder
 from krl.render import markdown_code as md_code, render_html
 from recovery.cluster import Cluster, ClusterBuilder, clusters_of_file
 from recovery.scan import FileResult
@@ -35,7 +34,6 @@ import matplotlib
 import matplotlib.pyplot as plt
 from matplotlib.ticker import MaxNLocator
 from krl.syntax.messages import expected_phrase
-import ctypes
 
 TOP_CHART = 20
 TOP_REPORT = 40
@@ -253,44 +251,21 @@ def _replaceable(out: Path) -> bool:
     return ".krl-report" in names or names <= REPORT_FILES
 
 
-def _new_report_folder(out: Path) -> Path:
-    """A temporary folder next to `out`, after checking that `out` may be replaced."""
+def _new_report_folder(out: Path) -> TempFolder:
+    """A locked temporary folder next to `out` (krl/durable.py ``TempFolder``; the stale ones
+    of killed runs removed first), after checking that `out` may be replaced."""
     if not _replaceable(out):
         raise ReportError(f"{out} holds files that are not a recovery report; choose an empty or "
                           "new folder for --out")
-    out.parent.mkdir(parents=True, exist_ok=True)
-    return Path(tempfile.mkdtemp(prefix=f".{out.name}.new-", dir=out.parent))
-
-
-def _exchange(a: Path, b: Path) -> bool:
-    """Swap the folders `a` and `b` in one atomic step (Linux renameat2 RENAME_EXCHANGE);
-    False when the system or the file system cannot (then nothing has changed)."""
-    if not sys.platform.startswith("linux"):
-        return False
-    try:
-        libc = ctypes.CDLL(None, use_errno=True)
-        renameat2 = libc.renameat2
-    except (OSError, AttributeError):
-        return False
-    at_fdcwd, rename_exchange = -100, 2
-    return renameat2(at_fdcwd, os.fsencode(a), at_fdcwd, os.fsencode(b), rename_exchange) == 0
+    return TempFolder(out)
 
 
 def _put_in_place(tmp: Path, out: Path) -> None:
-    """Replace the folder `out` by the finished folder `tmp`: one atomic exchange where the
-    system has it (a reader sees the old report or the new one, never none); else two renames
-    (the old report stays whole until the first, the new one is whole from the second)."""
+    """Replace the folder `out` by the finished folder `tmp`, durably (krl/durable.py
+    ``replace_folder``: every file fsynced, one atomic exchange where the system has it, the
+    parent folder fsynced): a reader sees the old report or the new one, never none."""
     (tmp / ".krl-report").write_text("a krl recover report; replaced as a whole by the next run\n")
-    os.chmod(tmp, 0o755)   # mkdtemp makes it private
-    if not out.exists():
-        os.replace(tmp, out)
-    elif _exchange(tmp, out):
-        shutil.rmtree(tmp, ignore_errors=True)      # now holds the old report
-    else:
-        old = Path(tempfile.mkdtemp(prefix=f".{out.name}.old-", dir=out.parent))
-        os.replace(out, old / out.name)
-        os.replace(tmp, out)
-        shutil.rmtree(old, ignore_errors=True)
+    replace_folder(tmp, out)
 
 
 def write_report(out: Path, summary: Summary, results: list[FileResult]) -> None:
@@ -318,7 +293,8 @@ class ReportStream:
         (krl/source.py), ``detail`` says why a file was not parsed; every text cell
         through :func:`csv_cell`."""
         self.out = Path(out)
-        self.tmp = _new_report_folder(self.out)
+        self._folder = _new_report_folder(self.out)
+        self.tmp = self._folder.path
         self._fh = (self.tmp / "files.csv").open("w", newline="", encoding="utf-8")
         self._csv = csv.writer(self._fh)
         self._csv.writerow(FILES_CSV_HEADER)
@@ -337,6 +313,7 @@ class ReportStream:
         self._fh.close()
         render_report(self.tmp, summary, bad_input, link_from=self.out)
         _put_in_place(self.tmp, self.out)
+        self._folder.close()
 
     def __enter__(self) -> "ReportStream":
         return self
@@ -344,7 +321,7 @@ class ReportStream:
     def __exit__(self, exc_type, exc, tb) -> None:
         if exc_type is not None:
             self._fh.close()
-            shutil.rmtree(self.tmp, ignore_errors=True)
+            self._folder.close(remove=True)
 
 
 def render_report(out: Path, summary: Summary, bad_input: list[FileResult], link_from: Path | None = None) -> None:

@@ -9,6 +9,7 @@ from pathlib import Path
 
 import click
 
+from krl.durable import write_text
 from krl.terminal import printable
 from robot.machine import load_machine
 from robot.plot import plot_trace
@@ -87,7 +88,7 @@ def export(robot: Path | None, fmt: str, output: Path) -> None:
     else:
 
         text = build_mjcf(m)
-    output.write_text(text, encoding="utf-8")
+    write_text(output, text)
     click.echo(str(output))
 
 

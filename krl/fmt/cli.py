@@ -8,8 +8,10 @@ never read nor written; each is reported
 on stderr as a W002 warning naming it (``path:1:1: warning[W002]: not read: a symbolic link
 (never followed)``), as is a folder that cannot be listed. ``-`` alone formats standard input
 to standard output (for editors and hooks). By default each file that would change is
-rewritten in place, atomically (a temporary file in the same folder, then a rename), in the
-encoding it was read in (krl/source.py: UTF-8 with or without BOM, or Windows-1252,
+rewritten in place, durably (krl/durable.py: a temporary file in the same folder, fsynced,
+exchanged in by one rename, the folder fsynced; owner, group and mode kept; a read-only file
+or one on a read-only file system refused, exit 2; a file another program saved while it was
+formatted kept as that program saved it, exit 2), in the encoding it was read in (krl/source.py: UTF-8 with or without BOM, or Windows-1252,
 byte for byte outside the changed whitespace and keyword case). ``--check`` and ``--diff``
 write nothing: they print a unified diff of each file that would change (KRL text shown
 through krl/terminal.py ``printable``); ``--check`` also exits 1 when any file would change.
@@ -36,7 +38,8 @@ import click
 
 from krl.diagnostics import Diagnostic
 from krl.diagnostics.codes import E001, W002
-from krl.files import Entry, write_bytes_atomic
+from krl.durable import write_bytes
+from krl.files import Entry
 from krl.fmt.core import FormatError, FormatOptions, FormatSyntaxError, format_text
 from krl.limits import MAX_FILE_BYTES
 from krl.project import folder_entries
@@ -84,13 +87,14 @@ def unified_diff(path: str, before: str, after: str) -> list[str]:
     return [printable(line) for line in diff]
 
 
-def write_atomically(path: Path, data: bytes, follow_symlinks: bool = True) -> None:
-    """Replace the file's content atomically (krl/files.py), keeping its mode. A named file
-    (`follow_symlinks`): the target of a symbolic link is replaced, the link kept; a file found
-    in a folder: the path itself is replaced (a link swapped in meanwhile is replaced, its
-    target never written). Raises OSError."""
+def write_atomically(path: Path, data: bytes, follow_symlinks: bool = True, expect: bytes | None = None) -> None:
+    """Replace the file's content durably (krl/durable.py ``write_bytes``), keeping its mode,
+    owner and group. A named file (`follow_symlinks`): the target of a symbolic link is
+    replaced, the link kept; a file found in a folder: the path itself is replaced (a link
+    swapped in meanwhile is replaced, its target never written). `expect`: the bytes read
+    (an edit saved meanwhile is kept: krl.durable.ChangedMeanwhile). Raises OSError."""
 
-    write_bytes_atomic(Path(os.path.realpath(path)) if follow_symlinks else Path(path), data, mode=None)
+    write_bytes(Path(os.path.realpath(path)) if follow_symlinks else Path(path), data, mode=None, expect=expect)
 
 
 def run_fmt(paths, check: bool = False, diff: bool = False, options: FormatOptions | None = None,
@@ -152,7 +156,7 @@ def run_fmt(paths, check: bool = False, diff: bool = False, options: FormatOptio
                 raise OSError(f"the file changed while it was formatted ({status}{': ' + detail if detail else ''})")
             if original != now:
                 raise OSError("the file changed while it was formatted, or its bytes do not round-trip")
-            write_atomically(Path(path), data, follow_symlinks=named)
+            write_atomically(Path(path), data, follow_symlinks=named, expect=original)
         except (OSError, UnicodeError) as exc:
             err(f"{printable_path(path)}: not written: {printable(exc)}")
             changed -= 1

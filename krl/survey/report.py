@@ -18,7 +18,7 @@ import ctypes
 import sys
 
 from krl.diagnostics import CODES
-from krl.files import write_text_atomic
+from krl.durable import write_text
 from krl.project import collect_entries, find_backups
 from krl.terminal import printable
 from krl.workspace import load_workspace, load_workspaces
@@ -64,8 +64,8 @@ def check_report(corpus: str | Path, out_dir: str | Path | None = None, top: int
 
         out = Path(out_dir)
         out.mkdir(parents=True, exist_ok=True)
-        write_text_atomic(out / "check_report.json", json.dumps(data, indent=2))
-        write_text_atomic(out / "check_report.md", md)
+        write_text(out / "check_report.json", json.dumps(data, indent=2))
+        write_text(out / "check_report.md", md)
     return data, md
 
 

@@ -20,6 +20,7 @@ import random
 
 import pytest
 
+from krl import durable
 from recovery import pipeline, report as report_mod
 from recovery import scan as scan_mod
 from recovery.cluster import Cluster
@@ -246,7 +247,7 @@ def test_report_is_replaced_atomically(tmp_path: Path, monkeypatch) -> None:
 def test_report_replacement_by_exchange_or_renames(tmp_path: Path, monkeypatch, exchange: str) -> None:
     # Both ways of putting the new report in place give the new report and leave nothing behind.
     if exchange == "two renames":
-        monkeypatch.setattr(report_mod, "_exchange", lambda a, b: False)
+        monkeypatch.setattr(durable, "exchange", lambda a, b: False)
     (tmp_path / "a.src").write_text(BROKEN)
     out = tmp_path / "reports" / "recovery"
     results = _results(tmp_path)
