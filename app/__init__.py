@@ -4,16 +4,19 @@ subcommands of no single stage here (parse, check, bench, diff, graph, report). 
 library and the stages; nothing imports it (docs/architecture.md "Packages and layers").
 
 Exit codes follow the compilers' habit: 0 success, 1 the input has errors, 2 usage or
-internal error.
+internal error; every command ends on SIGINT with 130 and on SIGTERM with 143, printing
+``interrupted`` (krl/signals.py; docs/security.md "Faults").
 """
 
 from __future__ import annotations
 
 import importlib
+import sys
 
 import click
 
 from krl import __version__
+from krl import signals
 
 
 # Each pipeline stage contributes its subcommands from its own package: the module named here
@@ -83,6 +86,20 @@ def subcommand(name: str) -> click.Command | None:
 class _Subcommands(click.Group):
     """The `krl` group: its subcommands come from :data:`SUBCOMMANDS`, each loaded on first use."""
 
+    def main(self, *args, **kwargs):
+        """click's main, with SIGTERM raising like SIGINT while a command runs (krl/signals.py)."""
+        with signals.handling():
+            return super().main(*args, **kwargs)
+
+    def invoke(self, ctx: click.Context):
+        """Run the subcommand; every command ends the same way on a signal: ``interrupted`` on
+        stderr, exit 130 (SIGINT) or 143 (SIGTERM); never click's "Aborted!" with exit 1, the
+        code of "the input has errors"."""
+        try:
+            return super().invoke(ctx)
+        except KeyboardInterrupt as exc:
+            _interrupted(exc)
+
     def list_commands(self, ctx: click.Context) -> list[str]:
         return sorted(SUBCOMMANDS)
 
@@ -98,6 +115,11 @@ class _Subcommands(click.Group):
         rows = [(n, click.Command(n, help=SUMMARIES[n]).get_short_help_str(limit)) for n in names]
         with formatter.section("Commands"):
             formatter.write_dl(rows)
+
+
+def _interrupted(exc: BaseException) -> None:
+    click.echo(signals.MESSAGE, err=True)
+    sys.exit(signals.exit_code(exc))
 
 
 @click.group(cls=_Subcommands, context_settings={"help_option_names": ["-h", "--help"]})

@@ -1,7 +1,9 @@
 """`krl run`: run a KRL program on the simulated controller (issue 6).
 
 Exit codes: 0 completed; 3 stopped (HALT, --max-steps, --max-sim-time, deadlocked WAIT);
-1 KRL run-time error; 2 usage or internal error.
+1 KRL run-time error; 2 usage or internal error (a --trace that cannot be written: a missing
+folder, a read-only or full file system); 130 Ctrl-C (SIGINT), 143 SIGTERM: the trace then ends
+with an ``end`` event of reason ``interrupted`` (krl/signals.py; docs/security.md "Faults").
 """
 
 from __future__ import annotations
@@ -15,7 +17,9 @@ from interp.spec import INTERP, INTERPS, RUN_MODE, RUN_MODES, RUN_SIM_TIME_S
 from krl.limits import MAX_HALT_CONTINUES
 from krl.project import backup_of
 from krl.terminal import printable
-from robot.trace import TRACE_REPEATS, read_trace
+from krl import signals
+from krl.durable import write_text
+from robot.trace import TRACE_REPEATS, TraceWriteError, read_trace
 from interp.run import program_in, run_setup, RunSetupError
 from interp.summary import RunObserver, starvation_lines, summary_lines
 from robot.stimuli import StartError, StimulusError
@@ -122,8 +126,14 @@ def _run(setup) -> None:
     """Run `setup` (interp.run.RunSetup) and print the summary; exits with the run's code."""
 
     shown, machine, program = setup.shown, setup.machine, setup.program
-    trace = setup.trace_writer()
+    try:
+        trace = setup.trace_writer()
+    except OSError as exc:
+        click.echo(f"error: the trace {shown(printable(setup.trace_path))} cannot be written: "
+                   f"{printable(exc.strerror or exc)}", err=True)
+        sys.exit(2)
     observer = RunObserver()
+    rt = None
     try:
         rt, _ = setup.make_runtime(trace=trace, observer=observer)
         _announce_partners(rt)
@@ -138,15 +148,22 @@ def _run(setup) -> None:
     except (StimulusError, StartError, NetError) as exc:
         click.echo(f"error: {shown(printable(exc))}", err=True)
         sys.exit(2)
-    except KeyboardInterrupt:
-        click.echo("interrupted", err=True)
-        sys.exit(130)
+    except KeyboardInterrupt as exc:
+        if rt is not None:       # the trace says how the run ended (the controller's one end event)
+            rt.controller.log.finish("interrupted", text=signals.name(exc))
+        elif trace is not None:  # stopped while the run was being set up
+            trace.write("end", 0.0, reason="interrupted", text=signals.name(exc))
+        click.echo(signals.MESSAGE, err=True)
+        sys.exit(signals.exit_code(exc))
+    except TraceWriteError as exc:
+        click.echo(f"error: {shown(printable(exc))}", err=True)
+        sys.exit(2)
     except Exception as exc:  # noqa: BLE001
         click.echo(f"internal error: {type(exc).__name__}: {shown(printable(exc))}", err=True)
         sys.exit(2)
     finally:
         if trace is not None:
-            trace.close()
+            _close(trace, shown)
     prog = rt.program
     ws_note = None
     if prog.backup:
@@ -163,6 +180,15 @@ def _run(setup) -> None:
         if booted is not None and line.startswith("  workspace"):
             click.echo(shown(f"  submit     {booted} (the backup's, started as at boot; --no-submit: without)"))
     sys.exit(res.exit_code)
+
+
+def _close(trace, shown) -> None:
+    """Close the trace; a trace that cannot be written to its end (a full disk) is exit 2."""
+    try:
+        trace.close()
+    except TraceWriteError as exc:
+        click.echo(f"error: {shown(printable(exc))}", err=True)
+        sys.exit(2)
 
 
 def _chosen(program: Path, workspace) -> str:
@@ -238,7 +264,7 @@ def cell_init_cmd(backup: Path | None, program: Path | None, output: Path | None
     if output is None:
         click.echo(text, nl=False)
     else:
-        output.write_text(text, encoding="utf-8")
+        write_text(output, text)
         click.echo(f"wrote {printable(output)}")
 
 

@@ -41,7 +41,8 @@ def recover(corpus: Path, out: Path, jobs: int | None, no_cache: bool, timeout: 
     write the report to --out.
 
     Exit code: 0 when every file parses, 1 when some do not, 2 on a usage or internal error
-    (or an archive refused by the limits of krl/limits.py).
+    (or an archive refused by the limits of krl/limits.py, or a report that cannot be
+    written: a full disk, a read-only --out), 130 on Ctrl-C, 143 on SIGTERM.
     """
 
     use_engine(engine)
@@ -55,6 +56,10 @@ def recover(corpus: Path, out: Path, jobs: int | None, no_cache: bool, timeout: 
                                    label=str(corpus) if shown.archive else None, scheduler=scheduler)
     except (ArchiveError, ReportError, SchedulerError) as exc:
         click.echo(f"error: {printable_path(exc)}", err=True)
+        sys.exit(2)
+    except OSError as exc:      # the report cannot be written: a full disk, a read-only --out
+        click.echo(f"error: the report could not be written to {printable_path(out)}: "
+                   f"{printable(exc.strerror or exc)} (the previous report, if any, is kept)", err=True)
         sys.exit(2)
     click.echo(f"{summary.files_ok}/{summary.files} files parse "
                f"({summary.bytes_ok}/{summary.bytes} bytes), {len(summary.clusters)} clusters, "

@@ -22,7 +22,7 @@ from typing import Any
 
 import numpy as np
 
-from .trace import read_trace
+from .trace import how_it_ended, read_trace, unfinished
 import matplotlib
 import matplotlib.pyplot as plt
 
@@ -68,14 +68,16 @@ def _pose_at(data: dict[str, Any], t: float) -> tuple[float, float, float] | Non
     return data["xyz"][i]
 
 
-def plot_trace(trace_path: str | Path, png_path: str | Path, title: str | None = None) -> Path:
-    """Read a JSON Lines trace and write the PNG; returns the PNG path.
+def plot_trace(trace_path: str | Path, png_path: str | Path, title: str | None = None, warn=None) -> Path:
+    """Read a JSON Lines trace and write the PNG; returns the PNG path. A run that did not end
+    by itself (no end event, or interrupted) says so in the title (robot/trace.py
+    ``how_it_ended``); a cut last line is dropped with a warning through `warn`.
 
     Raises FileNotFoundError if the trace does not exist, ValueError if it has no pose events.
     """
 
     matplotlib.use("Agg")
-    events = list(read_trace(trace_path))
+    events = list(read_trace(trace_path, warn))
     data = _collect(events)
     if not data["xyz"]:
         raise ValueError(f"{trace_path}: no pose events to plot")
@@ -143,7 +145,8 @@ def plot_trace(trace_path: str | Path, png_path: str | Path, title: str | None =
     ax2.set_title("top view")
     ax2.grid(True, lw=0.3)
     ax2.legend(loc="best", fontsize=7)
-    fig.suptitle(title or Path(trace_path).name)
+    ended = how_it_ended(events)
+    fig.suptitle((title or Path(trace_path).name) + (f": {ended}" if unfinished(ended) else ""))
     fig.tight_layout()
     out = Path(png_path)
     fig.savefig(out, dpi=110)

@@ -14,8 +14,9 @@ gives the same bytes.
 from __future__ import annotations
 
 import json
+import sys
 from collections import deque
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from pathlib import Path
 from typing import IO, Any
 
@@ -77,7 +78,8 @@ SCHEMA: dict[str, list[tuple[str, str]]] = {
     ],
     "end": [
         ("reason", "str: e.g. program_end, error, reset, max_time; interpreters: completed, "
-                   "halt, error, deadlock, max_steps, max_sim_time"),
+                   "halt, error, deadlock, max_steps, max_sim_time; interrupted (SIGINT or SIGTERM "
+                   "stopped `krl run`: text names the signal)"),
         ("text", "optional str: detail (error message, the condition waited for)"),
         ("number", "optional int: KSS message number of an error"),
         ("file", "optional str: source file where the run ended"),
@@ -230,6 +232,17 @@ def make_event(kind: str, t: float, **fields: Any) -> dict[str, Any]:
     return ev
 
 
+class TraceWriteError(OSError):
+    """The trace file could not be written (a full disk, a file system gone read-only): the
+    lines written before stay whole, the last may be cut (:func:`trace_lines` drops it)."""
+
+    def __init__(self, name: str, exc: OSError):
+        super().__init__(exc.errno, f"the trace {name} could not be written: {exc.strerror or exc}")
+
+    def __str__(self) -> str:
+        return self.strerror
+
+
 class TraceWriter:
     """Writes trace events as JSON Lines.
 
@@ -281,6 +294,7 @@ class TraceWriter:
             self._own = True
         else:
             self._fh = target
+        self._name = str(target) if isinstance(target, (str, Path)) else "the trace"
         self.keep = keep
         self._events: list[dict[str, Any]] = []
         self._lines: list[str] = []
@@ -423,8 +437,10 @@ class TraceWriter:
         if self._memory:
             self._lines.append(line)
         elif self._fh is not None:
-            self._fh.write(line)
-            self._fh.write("\n")
+            try:
+                self._fh.write(line + "\n")     # one call: a signal never falls between line and end
+            except OSError as exc:
+                raise TraceWriteError(self._name, exc) from None
 
     def _probe(self) -> Any:
         """The state image of :attr:`state_probe`, or None while the probes are over their
@@ -441,10 +457,15 @@ class TraceWriter:
         return "".join(line + "\n" for line in self.lines)
 
     def close(self) -> None:
+        """Write what is queued and close the file. Raises :class:`TraceWriteError`."""
         self._write_left()
         self.flush()
         if self._own and self._fh is not None and not self.closed:
-            self._fh.close()
+            self.closed = True
+            try:
+                self._fh.close()
+            except OSError as exc:
+                raise TraceWriteError(self._name, exc) from None
         self.closed = True
 
     def __enter__(self) -> "TraceWriter":
@@ -608,17 +629,71 @@ def _frames_of(Ts: list[Any]) -> list[list[float]]:
     return [list(matrix_to_frame(T)) for T in Ts]
 
 
-def read_trace(source: str | Path | IO[str]) -> Iterator[dict[str, Any]]:
-    """Yield the events of a JSON Lines trace (a path, or a text stream). Raises ValueError
-    for a line that is no JSON."""
+def read_trace(source: str | Path | IO[str], warn: Callable[[str], None] | None = None) -> Iterator[dict[str, Any]]:
+    """Yield the events of a JSON Lines trace (a path, or a text stream; :func:`trace_lines`:
+    a cut last line is dropped with a warning through `warn`, default: on stderr). Raises
+    ValueError for a line that is no JSON."""
     if isinstance(source, (str, Path)):
         with open(source, encoding="utf-8") as fh:
-            yield from read_trace(fh)
+            for _n, ev in trace_lines(fh, str(source), warn):
+                yield ev
         return
-    for line in source:
-        line = line.strip()
-        if line:
-            yield load_event(line)
+    for _n, ev in trace_lines(source, getattr(source, "name", "<trace>"), warn):
+        yield ev
+
+
+def trace_lines(lines: Iterable[str], name: str,
+                warn: Callable[[str], None] | None = None) -> Iterator[tuple[int, dict[str, Any]]]:
+    """(line number, event) of each non-blank line. A last line cut short (no line end, no
+    JSON: a full disk, a run killed while it wrote) is dropped, with a warning naming it through
+    `warn` (default: printed on stderr): every whole line before it is kept (issue 74). Raises
+    ValueError ``NAME:N: not a trace event (...)`` for any other line that is no JSON."""
+    for n, line in enumerate(lines, 1):
+        text = line.strip()
+        if not text:
+            continue
+        try:
+            ev = load_event(text)
+        except ValueError as exc:
+            if not line.endswith("\n"):
+                (warn or _warn_stderr)(f"{name}:{n}: warning: the last line is cut short (a full disk, or "
+                                        f"the run was killed while writing it): dropped")
+                return
+            raise ValueError(f"{name}:{n}: not a trace event ({exc})") from None
+        yield n, ev
+
+
+def _warn_stderr(text: str) -> None:
+    print(text, file=sys.stderr)
+
+
+def how_it_ended(events: Iterable[dict[str, Any]]) -> str:
+    """How the run of a trace ended, in words: the last ``end`` event's reason (with its text,
+    such as the signal of an ``interrupted`` run), or ``incomplete (no end event: the run was
+    killed, or its trace cut)``."""
+    last = None
+    for ev in events:
+        if ev.get("kind") == "end":
+            last = ev
+    return ending_words(last)
+
+
+def ending_words(end: dict[str, Any] | None) -> str:
+    """:func:`how_it_ended` of the last ``end`` event `end` (None: there was none)."""
+    if end is None:
+        return INCOMPLETE
+    text = end.get("text")
+    return f"{end.get('reason')}" + (f" ({text})" if text else "")
+
+
+def unfinished(ended: str) -> bool:
+    """True for a run that did not end by itself (:func:`how_it_ended`: no end event, or
+    interrupted by a signal): ``krl trace show`` and the plots say so."""
+    return ended.startswith(("incomplete", "interrupted"))
+
+
+#: what :func:`how_it_ended` says of a trace without an ``end`` event
+INCOMPLETE = "incomplete (no end event: the run was killed, or its trace cut)"
 
 
 def load_event(line: str | bytes) -> dict[str, Any]:
@@ -699,7 +774,8 @@ def json_schema() -> dict[str, Any]:
             "oneOf": branches}
 
 
-__all__ = ["SCHEMA", "KINDS", "TraceWriter", "json_schema", "make_event", "read_trace", "validate_event",
+__all__ = ["SCHEMA", "KINDS", "TraceWriter", "json_schema", "make_event", "read_trace", "trace_lines",
+           "how_it_ended", "ending_words", "unfinished", "INCOMPLETE", "TraceWriteError", "validate_event",
            "round_time"]
 
 

@@ -18,7 +18,7 @@ from typing import Any
 
 import numpy as np
 
-from ..trace import make_event, read_trace
+from ..trace import ending_words, make_event, trace_lines
 from .recording import Recording, RecordingError, is_recording, read_recording
 
 #: overrides (fractions) a recording is taken to have run at when its END signals allow them
@@ -84,6 +84,9 @@ class RunView:
     override: float | None = None
     override_note: str = ""
     robot_source: str = ""
+    #: how a simulated run's trace ended (robot/trace.py ``how_it_ended``: the end event's
+    #: reason, or "incomplete ..." without one); "" for a recording
+    ended: str = ""
 
 
 # ------------------------------------------------------------------------------ recordings
@@ -152,6 +155,7 @@ def run_view(events, kind: str = "trace", source: str = "") -> RunView:
     samples: list[tuple[float, list[float], list[float]]] = []
     whole_samples: list[tuple[float, list[float], list[float]]] = []
     last_t = 0.0
+    end_ev = None
 
     def close(seg: Segment, smp: list, t_end: float) -> None:
         seg.length = max(0.0, t_end - seg.origin)
@@ -201,6 +205,8 @@ def run_view(events, kind: str = "trace", source: str = "") -> RunView:
                     m.end = t - seg.origin
                     if ev.get("reached") is not None:
                         m.reached = float(ev["reached"]) - seg.origin
+        elif k == "end":
+            end_ev = ev
         elif k == "pose":
             smp = (t, ev["axes"], ev["tcp"])
             if cur is not None:
@@ -212,14 +218,16 @@ def run_view(events, kind: str = "trace", source: str = "") -> RunView:
     if not segs:
         close(whole, whole_samples, last_t)
         segs = [whole]
-    return RunView(kind, source, robot, segs, robot_source=robot_source)
+    return RunView(kind, source, robot, segs, robot_source=robot_source,
+                   ended=ending_words(end_ev) if kind == "trace" else "")
 
 
-def load_run(path: str | Path, override_pct: float | None = None) -> RunView:
+def load_run(path: str | Path, override_pct: float | None = None, warn=None) -> RunView:
     """The :class:`RunView` of `path`: a KUKA Trace recording (either of its files or their stem;
     read with :func:`recording_override`) or a simulated run's JSON Lines trace. Raises
     RecordingError for a recording that cannot be read, ValueError (file:line) for a trace line
-    that is no JSON, OSError for a file that cannot be opened."""
+    that is no JSON (a cut last line is dropped, with a warning through `warn`: robot/trace.py
+    ``trace_lines``), OSError for a file that cannot be opened."""
     p = Path(path)
     if is_recording(p) and not p.suffix.lower() in (".jsonl", ".json"):
         rec = read_recording(p)
@@ -227,17 +235,15 @@ def load_run(path: str | Path, override_pct: float | None = None) -> RunView:
         view = run_view(recording_events(rec, ov), "recording", str(p))
         view.override, view.override_note = ov, note
         return view
-    return run_view(_trace_events(p), "trace", str(p))
+    return run_view(_trace_events(p, warn), "trace", str(p))
 
 
-def _trace_events(p: Path):
+def _trace_events(p: Path, warn=None):
+    """The events of the trace `p` (robot/trace.py ``trace_lines``: a cut last line dropped
+    with a warning through `warn`)."""
     with open(p, encoding="utf-8") as fh:
-        for n, line in enumerate(fh, 1):
-            if line.strip():
-                try:
-                    yield from read_trace([line])
-                except ValueError as exc:
-                    raise ValueError(f"{p}:{n}: not a trace event ({exc})") from None
+        for _n, ev in trace_lines(fh, str(p), warn):
+            yield ev
 
 
 __all__ = ["Motion", "RunView", "Segment", "load_run", "recording_events", "recording_override", "run_view"]

@@ -17,6 +17,7 @@ import numpy as np
 
 from .compare import SegmentComparison
 from .model import RunView, Segment
+from ..trace import unfinished
 import matplotlib
 import matplotlib.pyplot as plt
 
@@ -26,6 +27,8 @@ def show_lines(view: RunView) -> list[str]:
     out = [f"{view.kind:<9} {view.source}", f"robot     {view.robot or '-'}"]
     if view.override_note:
         out.append(f"override  {view.override_note}")
+    if view.ended:
+        out.append(f"ended     {view.ended}")
     for s in view.segments:
         out.append("")
         out.append(f"segment {s.name}" + (f" ({s.config})" if s.config else "")
@@ -48,6 +51,7 @@ def as_json(view: RunView) -> dict[str, Any]:
         "kind": view.kind, "source": view.source, "robot": view.robot,
         "override_pct": None if view.override is None else round(100 * view.override, 3),
         "override_note": view.override_note or None,
+        "ended": view.ended or None,
         "segments": [{"name": s.name, "config": s.config or None, "length_s": round(s.length, 6),
                       "samples": int(len(s.t)),
                       "motions": [{"kind": m.kind, "line": m.line, "file": m.file or None,
@@ -114,6 +118,8 @@ def plot_view(view: RunView, out: Path) -> None:
     for row, seg in zip(axs, view.segments):
         _panels(row, seg, "-", view.kind)
         row[0].set_title(f"{seg.name}: axes")
+    if unfinished(view.ended):
+        fig.suptitle(f"{Path(view.source).name}: {view.ended}", color="tab:red")
     _finish(plt, fig, axs, out)
 
 
