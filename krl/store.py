@@ -16,9 +16,12 @@ and an old one is never read). A row is (kind, key, SHA-256 of the data, data, l
 This module stores and returns bytes only; it never unpickles or evaluates anything it reads.
 The data of a row is returned only when its SHA-256 matches; what a codec cannot decode is a
 corrupt entry, and the caller makes the result anew (a silent recompute, counted in
-:attr:`Store.corrupt`). A database that cannot be opened, read or written (a file that is not
-SQLite, a full disk, a read-only folder) turns the store off for the process (said once in the
-``krl.store`` log): commands then parse and check as without a cache, and never fail for it.
+:attr:`Store.corrupt`). A damaged database (a truncated file, garbage, a malformed page:
+SQLite's SQLITE_CORRUPT or SQLITE_NOTADB, when it is opened or at any query) is removed and made
+anew, once per process, with one warning on stderr (issue 74: before, it turned the cache off for
+good). A database that cannot be opened, read or written otherwise (a full disk, a read-only
+folder, or damaged again) turns the store off for the process (said once in the ``krl.store``
+log): commands then parse and check as without a cache, and never fail for it.
 The database is kept within :data:`krl.limits.MAX_CACHE_BYTES` (past it the least recently used
 quarter of the rows goes), an entry larger than :data:`krl.limits.MAX_CACHE_ENTRY_BYTES` is not
 kept (nor read: such a row is corrupt). The cache root (:func:`cache_dir`) and its
@@ -35,6 +38,7 @@ import logging
 import os
 import shutil
 import sqlite3
+import sys
 import threading
 import time
 from pathlib import Path
@@ -173,6 +177,24 @@ def turned_off():
             os.environ["KRL_STORE"] = before
 
 
+#: SQLite's result codes of a damaged database file: SQLITE_CORRUPT, SQLITE_NOTADB
+_DAMAGED = (11, 26)
+_WARNED: set[str] = set()
+
+
+def damaged(exc: sqlite3.Error) -> bool:
+    """True when `exc` says the database file is damaged (not a locked or full database)."""
+    return (getattr(exc, "sqlite_errorcode", None) or 0) & 0xFF in _DAMAGED
+
+
+def _warn_once(text: str) -> None:
+    """Print `text` on stderr once per process (and to the ``krl.store`` log)."""
+    log.warning("%s", text)
+    if text not in _WARNED:
+        _WARNED.add(text)
+        print(text, file=sys.stderr)
+
+
 class Store:
     """The database (see the module docstring): bytes by (kind, key); thread-safe; never
     raises. `folder`: the cache folder (default :func:`cache_dir`)."""
@@ -182,6 +204,7 @@ class Store:
         self.lock = threading.Lock()
         self.path: Path | None = None
         self.hits = self.misses = self.corrupt = 0
+        self.rebuilt = False
         if not enabled or not globals()["enabled"]():
             return
         try:
@@ -191,13 +214,51 @@ class Store:
             folder.mkdir(parents=True, exist_ok=True, mode=0o700)
             self.path = folder / f"{front_end_version()[:24]}.sqlite"
             tidy(root, self.path.name)
-            db = sqlite3.connect(self.path, timeout=LOCK_WAIT_S, check_same_thread=False)
-            db.execute("CREATE TABLE IF NOT EXISTS entries (kind TEXT, key TEXT, digest BLOB, data BLOB, "
-                       "used REAL, PRIMARY KEY (kind, key))")
-            db.commit()
-            self.db = db
+            try:
+                self.db = self._open()
+            except sqlite3.DatabaseError as exc:
+                if not damaged(exc):
+                    raise
+                self._rebuild(exc)
         except (OSError, sqlite3.Error) as exc:
             self._off(f"the cache is not used: {exc}")
+
+    def _open(self) -> sqlite3.Connection:
+        db = sqlite3.connect(self.path, timeout=LOCK_WAIT_S, check_same_thread=False)
+        try:
+            db.execute("CREATE TABLE IF NOT EXISTS entries (kind TEXT, key TEXT, digest BLOB, data BLOB, "
+                       "used REAL, PRIMARY KEY (kind, key))")
+            db.execute("SELECT COUNT(*) FROM entries").fetchone()   # reads the table's pages: a cut file fails here
+            db.commit()
+        except sqlite3.Error:
+            db.close()
+            raise
+        return db
+
+    def _rebuild(self, exc: sqlite3.Error) -> None:
+        """The database is damaged (truncated, garbage, malformed): it is removed and made anew,
+        once per process, with one warning on stderr. A second failure turns the store off."""
+        self._close()
+        if self.rebuilt:
+            self._off(f"the cache is not used: {exc}")
+            return
+        self.rebuilt = True
+        _warn_once(f"krl: warning: the parse cache {self.path} was damaged ({exc}); it is rebuilt")
+        for suffix in ("", "-journal", "-wal", "-shm"):
+            with contextlib.suppress(FileNotFoundError):
+                os.unlink(f"{self.path}{suffix}")
+        self.db = self._open()
+
+    def _failed(self, exc: sqlite3.Error, what: str) -> None:
+        """A query failed: a damaged database is rebuilt (:meth:`_rebuild`), anything else (a
+        full disk, a lock held too long) turns the store off for the process."""
+        if damaged(exc):
+            try:
+                self._rebuild(exc)
+                return
+            except (OSError, sqlite3.Error) as again:
+                exc = again
+        self._off(f"{what}: {exc}")
 
     def _off(self, why: str) -> None:
         log.warning("%s", why)
@@ -244,7 +305,7 @@ class Store:
                                         [(now, kind, k) for k in touch])
                     self.db.commit()
             except sqlite3.Error as exc:
-                self._off(f"the cache is not used: {exc}")
+                self._failed(exc, "the cache is not used")
         self.hits += len(out)
         self.misses += len(keys) - len(out)
         return out
@@ -262,7 +323,7 @@ class Store:
                 self.db.commit()
                 self._trim()
             except sqlite3.Error as exc:
-                self._off(f"the cache is not written: {exc}")
+                self._failed(exc, "the cache is not written")
 
     def _trim(self) -> None:
         """Keep the database within MAX_CACHE_BYTES: the least recently used quarter goes

@@ -184,17 +184,47 @@ def test_a_corrupt_entry_is_parsed_again_not_a_crash(cache, data, good_digest):
     assert _trace(case) == fresh and s.hits > hits      # the entries were made anew
 
 
-def test_a_database_that_is_not_sqlite_means_no_store_not_a_crash(cache, caplog):
+def test_a_database_that_is_not_sqlite_is_rebuilt_not_a_crash(cache, capsys):
+    # issue 74, case 8: before, a garbage database switched the cache off for good (every
+    # later command ran cold); now it is removed and made anew, said once on stderr
     case = CASES[0] / "program.src"
     fresh = _trace(case)
     db = _database(cache)
     store._SHARED.clear()
     db.write_bytes(b"this is not a database" * 100)
     program_mod._CACHE.clear()
+    capsys.readouterr()
     assert _trace(case) == fresh
-    assert store.shared_store().db is None            # off for this process, said in the log
-    assert "cache is not" in caplog.text
+    s = store.shared_store()
+    assert s.db is not None and s.rebuilt and s.hits == 0 and s.misses > 0
+    assert capsys.readouterr().err.count("was damaged") == 1
     store._SHARED.clear()
+
+
+@pytest.mark.parametrize("damage", ["garbage", "truncated"])
+def test_a_damaged_database_is_rebuilt_once_with_one_warning(tmp_path, capsys, damage):
+    # issue 74, case 8, at the store: the next store of the folder is warm and says nothing
+    s = store.Store(tmp_path)
+    s.put("parse", {f"k{i}": os.urandom(3000) for i in range(40)})
+    s.close()
+    db = s.path
+    if damage == "garbage":
+        db.write_bytes(b"this is not a database" * 100)
+    else:                     # cut by a full disk or a crash: the header kept, the pages lost
+        with open(db, "r+b") as fh:
+            fh.truncate(db.stat().st_size // 3)
+    capsys.readouterr()
+    healed = store.Store(tmp_path)
+    assert healed.db is not None and healed.rebuilt
+    assert healed.get("parse", ["k1"]) == {}                 # the damaged entries are gone
+    healed.put("parse", {"k1": b"anew"})
+    healed.close()
+    err = capsys.readouterr().err
+    assert err.count("was damaged") == 1 and "it is rebuilt" in err
+    warm = store.Store(tmp_path)
+    assert warm.get("parse", ["k1"]) == {"k1": b"anew"} and not warm.rebuilt
+    warm.close()
+    assert capsys.readouterr().err == ""
 
 
 def test_the_store_never_unpickles(cache, tmp_path, monkeypatch):
