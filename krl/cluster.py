@@ -20,15 +20,20 @@ repository at the same paths as the client (one machine, or a shared file system
 Dask is imported only when a scheduler address is given.
 
 Errors: :class:`SchedulerError` when the scheduler cannot be reached (within Dask's connect
-timeout, 30 s by default) or the address is malformed: a clear message naming the address,
-never a traceback from the command.
+timeout, 30 s by default) or the address is malformed, and when it is lost in the middle of a
+job (killed, its machine gone: Dask cancels the futures in flight; issue 74): a clear message
+naming the address, never a traceback from the command. A lost worker is Dask's to handle (its
+tasks are run again on the others).
 """
 
 from __future__ import annotations
 
+import contextlib
 import uuid
 from collections.abc import Callable, Hashable, Iterable, Iterator
 from typing import Any
+
+from concurrent.futures import CancelledError
 
 from krl.pool import Outcome
 
@@ -40,6 +45,8 @@ DEFAULT_BATCH_FILES = 16
 IN_FLIGHT_PER_THREAD = 4
 #: Seconds added to each batch's deadline for transfer and scheduling.
 TRANSFER_ALLOWANCE_S = 60.0
+#: Seconds the client may take to close (a lost scheduler: it does not wait for it longer).
+CLOSE_S = 5.0
 
 
 class SchedulerError(RuntimeError):
@@ -93,57 +100,74 @@ def run_batches(address: str, fn: Callable[..., Any], tasks: Iterable[tuple[Hash
         client = Client(address, set_as_default=False, **kw)
     except (OSError, TimeoutError, ValueError) as exc:
         raise SchedulerError(f"cannot reach the Dask scheduler at {address}: {exc}") from exc
-    run = uuid.uuid4().hex[:12]
     try:
-        threads = sum(client.nthreads().values())
-        if threads == 0:
-            raise SchedulerError(f"the Dask cluster at {address} has no workers")
-        limit = max(2, threads * IN_FLIGHT_PER_THREAD)
-        in_flight: dict[Any, list[tuple[Hashable, tuple]]] = {}
-        source = _batches(tasks, batch_files)
-        n = 0
+        yield from _run_on(client, address, fn, tasks, timeout, initializer, initargs, batch_files, name, wait)
+    except SchedulerError:
+        raise
+    except Exception as exc:  # noqa: BLE001 - a lost scheduler surfaces as many exception types
+        if client.status == "running" and not isinstance(exc, (OSError, CancelledError)):
+            raise
+        raise SchedulerError(f"lost the Dask scheduler at {address} in the middle of the job "
+                             f"({type(exc).__name__}); the results received so far were given, run "
+                             "the command again (or without --scheduler)") from None
+    finally:
+        with contextlib.suppress(Exception):
+            client.close(timeout=CLOSE_S)
 
-        def submit() -> bool:
-            nonlocal n
-            batch = next(source, None)
-            if batch is None:
-                return False
-            fut = client.submit(_run_batch, fn, batch, initializer, initargs, pure=False,
-                                key=f"{name}-{run}-{n}")
-            n += 1
-            in_flight[fut] = batch
-            return True
 
-        while len(in_flight) < limit and submit():
-            pass
-        while in_flight:
-            deadline = None if timeout is None else timeout * batch_files + TRANSFER_ALLOWANCE_S
-            try:
-                with client.as_current():
-                    done, _ = wait(list(in_flight), timeout=deadline, return_when="FIRST_COMPLETED")
-            except TimeoutError:
-                done = set()
-            if not done:   # nothing finished within a whole batch's deadline: give up on them
-                for fut, batch in in_flight.items():
-                    fut.cancel()
-                    for key, _args in batch:
-                        yield Outcome(key, "timeout", detail=f"the batch on the Dask cluster took longer "
-                                                             f"than {deadline:g} s")
-                in_flight.clear()
-                while len(in_flight) < limit and submit():
-                    pass
-                continue
-            for fut in done:
-                batch = in_flight.pop(fut)
-                if fut.status == "finished":
-                    for key, status, value, detail in fut.result():
-                        yield Outcome(key, status, value, detail)
-                else:
-                    detail = f"the Dask worker failed: {fut.exception()!r}" if fut.status == "error" \
-                        else f"the Dask task ended as {fut.status}"
-                    for key, _args in batch:
-                        yield Outcome(key, "internal_error", detail=detail)
+def _run_on(client, address: str, fn, tasks, timeout, initializer, initargs, batch_files: int, name: str,
+            wait) -> Iterator[Outcome]:
+    """The body of :func:`run_batches` on a connected client."""
+    run = uuid.uuid4().hex[:12]
+    threads = sum(client.nthreads().values())
+    if threads == 0:
+        raise SchedulerError(f"the Dask cluster at {address} has no workers")
+    limit = max(2, threads * IN_FLIGHT_PER_THREAD)
+    in_flight: dict[Any, list[tuple[Hashable, tuple]]] = {}
+    source = _batches(tasks, batch_files)
+    n = 0
+
+    def submit() -> bool:
+        nonlocal n
+        batch = next(source, None)
+        if batch is None:
+            return False
+        fut = client.submit(_run_batch, fn, batch, initializer, initargs, pure=False,
+                            key=f"{name}-{run}-{n}")
+        n += 1
+        in_flight[fut] = batch
+        return True
+
+    while len(in_flight) < limit and submit():
+        pass
+    while in_flight:
+        deadline = None if timeout is None else timeout * batch_files + TRANSFER_ALLOWANCE_S
+        try:
+            with client.as_current():
+                done, _ = wait(list(in_flight), timeout=deadline, return_when="FIRST_COMPLETED")
+        except TimeoutError:
+            done = set()
+        if not done:   # nothing finished within a whole batch's deadline: give up on them
+            for fut, batch in in_flight.items():
+                fut.cancel()
+                for key, _args in batch:
+                    yield Outcome(key, "timeout", detail=f"the batch on the Dask cluster took longer "
+                                                         f"than {deadline:g} s")
+            in_flight.clear()
             while len(in_flight) < limit and submit():
                 pass
-    finally:
-        client.close()
+            continue
+        for fut in done:
+            batch = in_flight.pop(fut)
+            if fut.status == "cancelled" and client.status != "running":
+                raise CancelledError(f"batch {fut.key} cancelled: the client lost its scheduler")
+            if fut.status == "finished":
+                for key, status, value, detail in fut.result():
+                    yield Outcome(key, status, value, detail)
+            else:
+                detail = f"the Dask worker failed: {fut.exception()!r}" if fut.status == "error" \
+                    else f"the Dask task ended as {fut.status}"
+                for key, _args in batch:
+                    yield Outcome(key, "internal_error", detail=detail)
+        while len(in_flight) < limit and submit():
+            pass

@@ -1,0 +1,78 @@
+"""Issue 74, case 7: a Dask scheduler lost in the middle of a job is a clear error
+(krl.cluster.SchedulerError, which every command prints as ``error: ...`` with exit 2), never a
+traceback. A real scheduler and worker on loopback, each its own process; the scheduler is
+killed (SIGKILL) while batches are in flight."""
+
+from __future__ import annotations
+
+import os
+import re
+import signal
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import pytest
+
+from krl import cluster
+
+BIN = Path(sys.executable).parent
+
+
+def _start(args: list[str], log: Path) -> subprocess.Popen:
+    return subprocess.Popen([str(BIN / "dask"), *args], stdout=subprocess.DEVNULL, stderr=open(log, "w"),
+                            start_new_session=True)
+
+
+def _address(log: Path, deadline: float) -> str:
+    while time.monotonic() < deadline:
+        m = re.search(r"Scheduler at:\s+(tcp://[\d.]+:\d+)", log.read_text())
+        if m:
+            return m.group(1)
+        time.sleep(0.1)
+    pytest.fail(f"the scheduler did not start:\n{log.read_text()}")
+
+
+@pytest.mark.slow
+def test_a_scheduler_killed_mid_job_is_a_clear_error(tmp_path: Path) -> None:
+    sched = _start(["scheduler", "--host", "127.0.0.1", "--port", "0", "--no-dashboard"], tmp_path / "s.log")
+    worker = None
+    try:
+        address = _address(tmp_path / "s.log", time.monotonic() + 60)
+        worker = _start(["worker", address, "--nthreads", "1", "--no-dashboard"], tmp_path / "w.log")
+        deadline = time.monotonic() + 60
+        while "Registered to" not in (tmp_path / "w.log").read_text() and time.monotonic() < deadline:
+            time.sleep(0.1)
+        got: list = []
+        outcome: dict = {}
+
+        def job():
+            try:
+                for o in cluster.run_batches(address, time.sleep, ((i, (0.3,)) for i in range(60)),
+                                             batch_files=1, connect_s=30):
+                    got.append(o)
+            except BaseException as exc:       # what a command would meet
+                outcome["exc"] = exc
+            else:
+                outcome["done"] = True
+
+        t = threading.Thread(target=job, daemon=True)
+        t.start()
+        deadline = time.monotonic() + 90
+        while len(got) < 3 and time.monotonic() < deadline and t.is_alive():
+            time.sleep(0.05)
+        assert len(got) >= 3, f"the job never ran on the cluster: {outcome}"
+        os.killpg(sched.pid, signal.SIGKILL)
+        sched.wait()
+        t.join(120)
+        assert not t.is_alive(), "the job hung after the scheduler was lost"
+        exc = outcome.get("exc")
+        assert isinstance(exc, cluster.SchedulerError), repr(exc)
+        assert address in str(exc) and "lost" in str(exc)
+    finally:
+        for p in (sched, worker):
+            if p is not None and p.poll() is None:
+                os.killpg(p.pid, signal.SIGKILL)
+                p.wait()
