@@ -13,7 +13,9 @@ from __future__ import annotations
 import fcntl
 import os
 import signal
+import shutil
 import stat
+import tempfile
 from pathlib import Path
 
 import pytest
@@ -42,10 +44,12 @@ def test_the_formatted_form_is_what_these_tests_expect(tmp_path: Path) -> None:
     assert f.read_bytes() == FORMATTED
 
 
-@pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGINT])
+@pytest.mark.parametrize("sig", [signal.SIGTERM, pytest.param(signal.SIGINT, marks=pytest.mark.slow)])
 def test_a_signal_inside_the_write_of_krl_fmt_leaves_the_file_whole_and_nothing_beside_it(tmp_path, sig):
     # case 1 (SIGTERM, what `timeout` and a CI cancel send) and case 5 (the same end for every
-    # signal): exit 128 + signal, "interrupted", the file as it was, no temporary file
+    # signal): exit 128 + signal, "interrupted", the file as it was, no temporary file (SIGINT
+    # in a separate process is nightly's: the default suite sends it in-process,
+    # tests/faults/test_signals_and_exit_codes.py)
     work = tmp_path / "work"
     work.mkdir()
     f = work / "bas.src"
@@ -139,6 +143,39 @@ def test_the_pendants_touch_up_keeps_another_users_owner(tmp_path: Path) -> None
     st = dat.stat()
     assert (st.st_uid, st.st_gid, stat.S_IMODE(st.st_mode)) == (4242, 4343, 0o664)
     assert b"XP1={A1 10,A2 -80,A3 85,A4 0,A5 5,A6 0}" in dat.read_bytes()
+
+
+@pytest.mark.skipif(os.geteuid() != 0, reason="only root can act as two other users")
+@pytest.mark.may_skip("the suite runs as root in CI and on the project's machine")
+def test_a_user_who_cannot_keep_the_owner_is_refused() -> None:
+    # a shared folder, a file of user 4343 that user 4242 may write: a rename would hand the
+    # file to 4242, so the durable write refuses (the owner is what `ls -l` promised)
+    folder = Path(tempfile.mkdtemp(prefix="krl-owner-"))      # /tmp: reachable by any user
+    try:
+        folder.chmod(0o777)
+        f = folder / "bas.src"
+        f.write_bytes(UGLY)
+        os.chown(f, 4343, 4343)
+        f.chmod(0o666)
+        pid = os.fork()
+        if pid == 0:                               # the child becomes user 4242
+            code = 1
+            try:
+                os.setgid(4242)
+                os.setuid(4242)
+                try:
+                    durable.write_bytes(f, FORMATTED, mode=None)
+                    code = 2
+                except durable.WriteRefused as exc:
+                    code = 0 if "owned by user 4343" in str(exc) else 3
+            finally:
+                os._exit(code)
+        _pid, status = os.waitpid(pid, 0)
+        assert os.waitstatus_to_exitcode(status) == 0
+        assert f.read_bytes() == UGLY and f.stat().st_uid == 4343
+        assert sorted(p.name for p in folder.iterdir()) == ["bas.src"]
+    finally:
+        shutil.rmtree(folder)
 
 
 def _editor_saves_at_first_fsync(monkeypatch, path: Path, text: bytes, in_place: bool) -> None:
