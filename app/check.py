@@ -31,6 +31,7 @@ from krl.archive import ArchiveError, backup_source
 from krl.cluster import run_batches, SchedulerError
 from krl.semantics.config import ConfigError, Selection, config_for, parse_codes
 from krl.workspace import load_workspaces, not_understood, on_each_file, Workspace, workspaces_for
+from krl import store
 from krl.parsecache import through_store
 from krl.diagnostics.sarif import to_sarif
 
@@ -46,6 +47,8 @@ from krl.diagnostics.sarif import to_sarif
               help="Instead: write check_report.md/.json for the KRC backups below PATH into this folder.")
 @click.option("--timeout", type=click.FloatRange(min=0, min_open=True), default=PARSE_TIMEOUT_S,
               show_default=True, help="Seconds one file may parse; past it the parse is stopped (error E005).")
+@click.option("--no-cache", "no_cache", is_flag=True,
+              help="Parse every file again: parses are neither read from nor kept in the store (krl/store.py).")
 @click.option("--jobs", type=click.IntRange(min=1), default=None,
               help="Worker processes that parse the files (default: the number of cores).")
 @click.option("--scheduler", default=None, metavar="tcp://HOST:PORT",
@@ -58,9 +61,12 @@ from krl.diagnostics.sarif import to_sarif
 @click.option("--inputs", default=None, help="With --reach: the cell file (its geometry:, tool:, floor:).")
 def check(paths: tuple[str, ...], fmt: str, as_json: bool, no_warnings: bool, ignore: tuple[str, ...],
           report_dir: str | None, timeout: float, jobs: int | None, scheduler: str | None,
-          reach: bool = False, robot: str | None = None, inputs: str | None = None) -> None:
+          reach: bool = False, robot: str | None = None, inputs: str | None = None,
+          no_cache: bool = False) -> None:
     """Type-check KRL files, KRC backup folders or backup .zip archives; exit 1 when there are
     errors. Every code is explained in docs/diagnostics.md."""
+    if no_cache:       # for the whole command and the workers it starts (krl/store.py turned_off)
+        click.get_current_context().with_resource(store.turned_off())
     if reach:
         sys.exit(_reach(paths, robot, inputs))
     if report_dir is not None:

@@ -19,11 +19,13 @@ from pathlib import Path
 
 import msgpack
 import pytest
+from click.testing import CliRunner
 
 import interp.runtime.program as program_mod
 import krl.lsp.project as project_mod
 import krl.parsecache as parsecache
 import krl.store as store
+from app import main as app_main
 from interp.debug.client import DapClient
 from interp.run import make_runtime, run_spec
 from krl.lsp.paths import norm
@@ -225,6 +227,26 @@ def test_a_damaged_database_is_rebuilt_once_with_one_warning(tmp_path, capsys, d
     assert warm.get("parse", ["k1"]) == {"k1": b"anew"} and not warm.rebuilt
     warm.close()
     assert capsys.readouterr().err == ""
+
+
+def test_krl_check_no_cache_neither_reads_nor_keeps_parses(cache, tmp_path):
+    # issue 74, case 8: a way around the store for one command (as krl recover --no-cache)
+    prog = tmp_path / "nocache.src"
+    prog.write_text("DEF nocache()\n  $OUT[1] = TRUE\nEND\n")
+    store._SHARED.clear()
+    res = CliRunner().invoke(app_main, ["check", "--no-cache", "--jobs", "1", str(prog)])
+    assert res.exit_code == 0, res.output
+    db = cache / "front-end"
+    rows = 0
+    for f in db.glob("*.sqlite"):
+        with sqlite3.connect(f) as con:
+            rows += con.execute("SELECT COUNT(*) FROM entries WHERE kind = 'parse'").fetchone()[0]
+    assert rows == 0
+    store._SHARED.clear()
+    assert CliRunner().invoke(app_main, ["check", "--jobs", "1", str(prog)]).exit_code == 0
+    with sqlite3.connect(_database(cache)) as con:
+        assert con.execute("SELECT COUNT(*) FROM entries WHERE kind = 'parse'").fetchone()[0] == 1
+    store._SHARED.clear()
 
 
 def test_the_store_never_unpickles(cache, tmp_path, monkeypatch):
