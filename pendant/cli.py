@@ -75,7 +75,8 @@ def pendant(target: Path | None, port: int, no_browser: bool, inputs: Path | Non
 def serve(root: Path, *, port: int = 0, open_browser: bool = True, inputs: str | None = None, mode: str = "T1",
           trace: str | None = None, program: str | None = None, readonly: bool = False, realtime: bool = True,
           shown: str | None = None) -> int:
-    """Bind 127.0.0.1:``port``, print the URL with the token, serve until interrupted; 0."""
+    """Bind 127.0.0.1:``port``, print the URL with the token, serve until interrupted (SIGINT
+    or SIGTERM: the command exits 130 / 143, krl/signals.py); 2 when it cannot listen."""
 
     sock = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
     sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
@@ -101,10 +102,9 @@ def serve(root: Path, *, port: int = 0, open_browser: bool = True, inputs: str |
     if open_browser:
 
         threading.Timer(0.5, lambda: webbrowser.open(url)).start()
-    try:
-        uvicorn.Server(config).run(sockets=[sock])
-    except KeyboardInterrupt:
-        pass
+    # Ctrl-C / SIGTERM: uvicorn shuts down gracefully, then raises the signal again; it ends
+    # the command as every command ends on a signal (app/__init__.py: exit 130 / 143)
+    uvicorn.Server(config).run(sockets=[sock])
     return 0
 
 

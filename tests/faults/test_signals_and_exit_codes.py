@@ -20,6 +20,7 @@ import pytest
 from click.testing import CliRunner
 
 from app import main
+from pendant.client import pendant_server
 from recovery import pipeline
 from robot.trace import TraceWriter
 
@@ -172,3 +173,15 @@ def test_krl_run_whose_trace_fills_the_disk_is_a_clear_error_exit_2(tmp_path, sm
     assert res.exit_code == 2
     assert "could not be written" in res.stderr and "No space left on device" in res.stderr
     assert (small_fs / "t.jsonl").stat().st_size > 32 * 1024
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM])
+def test_krl_pendant_ends_on_a_signal_as_every_command(tmp_path, sig) -> None:
+    # case 5: the server's own graceful stop, then exit 128 + signal (before: exit 0)
+    prog = tmp_path / "main.src"
+    prog.write_text(VALID)
+    with pendant_server(prog, stderr=tmp_path / "err.txt") as (proc, _url):
+        proc.send_signal(sig)
+        assert proc.wait(60) == 128 + sig
+    assert "interrupted" in (tmp_path / "err.txt").read_text()
