@@ -90,6 +90,12 @@ MAX_ARCHIVE_DEPTH = 32
 # home folder must not make the server read the whole disk. Past it: the first files (sorted)
 # are read, the rest are not part of the workspace (their names stay unresolved).
 MAX_LSP_WORKSPACE_FILES = 5000
+# The largest file of a workspace `krl lsp` reads while it is not open in the editor, in bytes:
+# a larger one is not indexed (a W002 warning names it; what it declares stays unresolved in the
+# other files, as for any file not read) until the editor opens it. The corpus's largest KRL file
+# is 626 kB (My_Job.src); a 9.8 MB file beside the one opened made the first answer wait 96 s,
+# 86 s of CPU and 2.9 GB (issue 74, case 10).
+MAX_LSP_INDEX_FILE_BYTES = 2 * 1024 * 1024
 # The most directory entries (files and folders) `krl lsp` looks at while listing one workspace
 # folder, in entries: a backup has a few thousand; a home folder opened by mistake may have
 # millions. Past it the listing stops there (as for MAX_LSP_WORKSPACE_FILES).

@@ -38,7 +38,7 @@ from krl.limits import PARSE_TIMEOUT_S
 from krl.lsp.analysis import Analysis, build_analysis, updated
 from krl.lsp.parsing import MIN_CHUNKED_LINES, ParseCache, Parsed
 from krl.lsp.paths import is_uri, norm
-from krl.lsp.roots import workspace_of
+from krl.lsp.roots import NOT_INDEXED, workspace_of
 from krl.parsecache import (CorruptEntry, decode_diagnostics, encode_diagnostics, keep_parses, parse_entries,
                             read_parses)
 from krl.pool import default_jobs
@@ -179,11 +179,13 @@ class Project:
             self._roots[p] = got
         root, files = got[1], list(dict.fromkeys(got[2]))
         seen = set(files)
-        for d in (docs if docs is not None else self.docs):      # open buffers not (yet) on disk that belong to this workspace
+        docs = docs if docs is not None else self.docs
+        for d in docs:      # open buffers not (yet) on disk, or not indexed when closed, of this workspace
             if d not in seen and (d == root or d.startswith(root.rstrip(os.sep) + os.sep)) and \
                     Path(root).is_dir() and d.lower().endswith((".src", ".dat", ".sub")):
                 files.append(d)
-        return root, files, got[3]
+        skipped = [e for e in got[3] if e.kind != NOT_INDEXED or norm(str(e.path)) not in docs]
+        return root, files, skipped
 
     @staticmethod
     def _stamp(path: str) -> tuple:

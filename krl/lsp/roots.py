@@ -10,7 +10,10 @@ model's one rule (krl/project.py ``project_of``), the editor's folder taking the
 
 A walk stops after :data:`krl.limits.MAX_LSP_WORKSPACE_FILES` KRL files or
 :data:`krl.limits.MAX_LSP_SCAN_ENTRIES` entries looked at (an editor opened on a home folder
-must not make the server read the whole disk).
+must not make the server read the whole disk). A file larger than
+:data:`krl.limits.MAX_LSP_INDEX_FILE_BYTES` is left out as an entry of kind
+:data:`NOT_INDEXED` (a W002 warning) unless it is the file opened: the open document first, and
+memory bounded (issue 74); krl/lsp/project.py reads it once the editor opens it.
 """
 
 from __future__ import annotations
@@ -18,8 +21,11 @@ from __future__ import annotations
 from pathlib import Path
 
 from krl.files import Entry
-from krl.limits import MAX_LSP_SCAN_ENTRIES, MAX_LSP_WORKSPACE_FILES
+from krl.limits import MAX_LSP_INDEX_FILE_BYTES, MAX_LSP_SCAN_ENTRIES, MAX_LSP_WORKSPACE_FILES
 from krl.project import list_entries, project_of
+
+#: the kind of a walk entry (krl.files.Entry) for a file too large to index while it is closed
+NOT_INDEXED = "not_indexed"
 
 
 def list_krl_files(folder: Path, limit: int = MAX_LSP_WORKSPACE_FILES,
@@ -34,4 +40,12 @@ def workspace_of(path: Path, folders: list[Path]) -> tuple[Path, list[Path], lis
     disk, an unsaved new buffer)."""
     folder = next((f for f in folders if f in path.parents), None)
     project = project_of(path, within=folder, limit=MAX_LSP_WORKSPACE_FILES, max_entries=MAX_LSP_SCAN_ENTRIES)
-    return project.root, project.files, [e for e in project.entries if e.kind != "file"]
+    unread = [e for e in project.entries if e.kind != "file"]
+    large = {e.path for e in project.entries
+             if e.kind == "file" and e.size > MAX_LSP_INDEX_FILE_BYTES and e.path != path}
+    if not large:
+        return project.root, project.files, unread
+    unread += [Entry(e.path, e.rel, NOT_INDEXED, f"{e.size} bytes, more than {MAX_LSP_INDEX_FILE_BYTES}: not "
+                     "indexed by the language server until it is opened", e.size)
+               for e in project.entries if e.path in large]
+    return project.root, [f for f in project.files if f not in large], unread
