@@ -29,6 +29,7 @@ tasks are run again on the others).
 from __future__ import annotations
 
 import contextlib
+import logging
 import uuid
 from collections.abc import Callable, Hashable, Iterable, Iterator
 from typing import Any
@@ -100,6 +101,10 @@ def run_batches(address: str, fn: Callable[..., Any], tasks: Iterable[tuple[Hash
         client = Client(address, set_as_default=False, **kw)
     except (OSError, TimeoutError, ValueError) as exc:
         raise SchedulerError(f"cannot reach the Dask scheduler at {address}: {exc}") from exc
+    quiet = _NoTracebacks()
+    handlers = logging.getLogger("distributed").handlers
+    for h in handlers:
+        h.addFilter(quiet)
     try:
         yield from _run_on(client, address, fn, tasks, timeout, initializer, initargs, batch_files, name, wait)
     except SchedulerError:
@@ -113,6 +118,20 @@ def run_batches(address: str, fn: Callable[..., Any], tasks: Iterable[tuple[Hash
     finally:
         with contextlib.suppress(Exception):
             client.close(timeout=CLOSE_S)
+        for h in handlers:
+            h.removeFilter(quiet)
+
+
+class _NoTracebacks(logging.Filter):
+    """Dask's own log lines on stderr keep their message but lose their traceback while a job
+    runs (a lost scheduler: Dask logs each failed reconnection with one); the command says what
+    happened in one line (SchedulerError)."""
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        record.exc_info = None
+        record.exc_text = None
+        record.stack_info = None
+        return True
 
 
 def _run_on(client, address: str, fn, tasks, timeout, initializer, initargs, batch_files: int, name: str,

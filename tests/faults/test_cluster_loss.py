@@ -17,6 +17,7 @@ from pathlib import Path
 import pytest
 
 from krl import cluster
+from krl.lsp.sample import generate
 
 BIN = Path(sys.executable).parent
 
@@ -76,3 +77,41 @@ def test_a_scheduler_killed_mid_job_is_a_clear_error(tmp_path: Path) -> None:
             if p is not None and p.poll() is None:
                 os.killpg(p.pid, signal.SIGKILL)
                 p.wait()
+
+
+@pytest.mark.slow
+def test_krl_recover_whose_scheduler_dies_is_a_clear_error_exit_2(tmp_path: Path) -> None:
+    # the probe's case 7 as the user meets it: before, an 80-line FuturesCancelledError
+    # traceback from krl/cluster.py and exit 1
+    corpus = tmp_path / "corpus"
+    corpus.mkdir()
+    unit = generate(3000)
+    for i in range(24):          # about 3 s of the Python engine's parse each, on one worker
+        (corpus / f"p{i:02}.src").write_text(unit.replace("DEF bench", f"DEF p{i:02}", 1) * 2, newline="")
+    sched = _start(["scheduler", "--host", "127.0.0.1", "--port", "0", "--no-dashboard"], tmp_path / "s.log")
+    worker = recover = None
+    try:
+        address = _address(tmp_path / "s.log", time.monotonic() + 60)
+        worker = subprocess.Popen([str(BIN / "dask"), "worker", address, "--nthreads", "1", "--no-dashboard"],
+                                  stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True,
+                                  env={**os.environ, "KRL_ENGINE": "python"})
+        recover = subprocess.Popen([str(BIN / "krl"), "recover", str(corpus), "--out", str(tmp_path / "out"),
+                                    "--no-cache", "--engine", "python", "--scheduler", address],
+                                   stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        time.sleep(8)                # imported, connected, batches on the worker
+        assert recover.poll() is None, recover.communicate()
+        os.killpg(sched.pid, signal.SIGKILL)
+        sched.wait()
+        out, err = recover.communicate(timeout=120)
+        assert recover.returncode == 2, out + err
+        assert f"error: lost the Dask scheduler at {address}" in err
+        assert "Traceback" not in err
+        assert not (tmp_path / "out").exists() and [p.name for p in tmp_path.iterdir() if p.name.startswith(".")] == []
+    finally:
+        for p in (sched, worker):
+            if p is not None and p.poll() is None:
+                os.killpg(p.pid, signal.SIGKILL)
+                p.wait()
+        if recover is not None and recover.poll() is None:
+            recover.kill()
+            recover.wait()
