@@ -63,6 +63,7 @@ from collections import Counter
 from pathlib import Path
 
 from interp.runtime.motions import TARGET_OUTSIDE_NOTE
+from krl.durable import write_text
 from interp.runtime.errors import NOT_UNDERSTOOD
 from interp.runtime.program import parse_module
 from krl import limits
@@ -738,9 +739,7 @@ def main(argv: list[str] | None = None) -> int:
         print(f"error: {exc}", file=sys.stderr)
         return 2
     if a.json:
-        with open(a.json, "w", encoding="utf-8") as fh:
-            for r in rows:
-                fh.write(json.dumps(r) + "\n")
+        write_text(a.json, "".join(json.dumps(r) + "\n" for r in rows))
     if len(cols) > 1:
         print(report_columns(rows))
         print()

@@ -53,6 +53,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from interp import realprograms as rp
+from krl.durable import write_text
 from krl.archive import backup_source
 from krl.files import SHARED_CORPUS
 from krl.project import find_backups
@@ -365,8 +366,8 @@ def main(argv: list[str] | None = None) -> int:
     for f in s["failures"]:
         print(f"  {f['backup']} [{f['variant']}] {f['entry']}: {f['text']} {f['outside_stops']}")
     if args.json is not None:
-        args.json.write_text(json.dumps({"summary": {k: v for k, v in s.items() if k != "failures"},
-                                         "failures": s["failures"], "results": results}, indent=1))
+        write_text(args.json, json.dumps({"summary": {k: v for k, v in s.items() if k != "failures"},
+                                          "failures": s["failures"], "results": results}, indent=1))
     return 1 if s["failures"] else 0
 
 

@@ -47,6 +47,7 @@ from __future__ import annotations
 import ctypes
 import errno
 import fcntl
+import io
 import os
 import shutil
 import stat
@@ -87,6 +88,14 @@ class ChangedMeanwhile(OSError):
 def write_text(path: str | Path, text: str, mode: int | None = 0o644) -> None:
     """:func:`write_bytes` of `text` in UTF-8."""
     write_bytes(path, text.encode("utf-8"), mode=mode)
+
+
+def write_with(path: str | Path, render: Callable[[io.BytesIO], object], mode: int | None = 0o644) -> None:
+    """:func:`write_bytes` of what `render(stream)` writes into a bytes stream (a matplotlib
+    figure's ``savefig``, a CSV writer over a text wrapper)."""
+    buf = io.BytesIO()
+    render(buf)
+    write_bytes(path, buf.getvalue(), mode=mode)
 
 
 def write_bytes(path: str | Path, data: bytes, mode: int | None = 0o644,

@@ -31,6 +31,7 @@ import re
 from dataclasses import dataclass
 from pathlib import Path
 
+from krl.durable import write_bytes
 from krl.source import read_source
 from recovery.cluster import clusters_of_file
 from recovery.scan import _init_worker, parse_row
@@ -155,9 +156,10 @@ def new_construct(name: str, cluster_id: str, report: Path, corpus: Path | None 
     row = (f"| {name}: (describe the construct, the rule added or changed) | (reference section) | {cluster_id} "
            f"({cluster.get('files', '?')} files: `{cluster.get('signature', '')}`) | {data.get('files_ok', '?')} -> "
            f"(measure with krl recover) | grammar: {name.replace('_', ' ')} |\n")
-    text = changes.read_text(encoding="utf-8") if changes.exists() else "# Grammar changes\n"
+    old = changes.read_bytes() if changes.exists() else None
+    text = old.decode("utf-8") if old is not None else "# Grammar changes\n"
     changes.parent.mkdir(parents=True, exist_ok=True)
-    changes.write_text(text.rstrip("\n") + "\n" + row, encoding="utf-8")
+    write_bytes(changes, (text.rstrip("\n") + "\n" + row).encode("utf-8"), mode=None, expect=old)
     written.append(changes)
     cases = root / "conformance" / "cases"
     case = cases / f"{_next_case(cases):03d}_{name}"

@@ -11,9 +11,11 @@ changed.
 from __future__ import annotations
 
 import csv
+import io
 import os
 from pathlib import Path
 
+from krl.durable import write_text, write_with
 from recovery.cluster import cluster_results
 from recovery.grammar_versions import committed_versions, grammar_metrics, parser_dir_for, python_target
 from recovery.progress import steps
@@ -100,10 +102,11 @@ def growth_rows(corpus: Path, jobs: int | None = None, use_cache: bool = True,
 
 def write_growth(out: Path, rows: list[dict]) -> None:
     out.mkdir(parents=True, exist_ok=True)
-    with (out / "growth.csv").open("w", newline="", encoding="utf-8") as fh:
-        w = csv.DictWriter(fh, fieldnames=COLUMNS)
-        w.writeheader()
-        w.writerows(rows)
+    text = io.StringIO(newline="")
+    w = csv.DictWriter(text, fieldnames=COLUMNS)
+    w.writeheader()
+    w.writerows(rows)
+    write_text(out / "growth.csv", text.getvalue())
     plot_growth(out / "growth.png", rows)
 
 
@@ -126,5 +129,5 @@ def plot_growth(path: Path, rows: list[dict]) -> None:
     ax.legend(loc="lower right")
     ax.set_title("Grammar growth over the corpus")
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    write_with(path, lambda fh: fig.savefig(fh, dpi=110, format="png"))
     plt.close(fig)

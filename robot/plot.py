@@ -23,6 +23,7 @@ from typing import Any
 import numpy as np
 
 from .trace import how_it_ended, read_trace, unfinished
+from krl.durable import write_with
 import matplotlib
 import matplotlib.pyplot as plt
 
@@ -149,6 +150,6 @@ def plot_trace(trace_path: str | Path, png_path: str | Path, title: str | None =
     fig.suptitle((title or Path(trace_path).name) + (f": {ended}" if unfinished(ended) else ""))
     fig.tight_layout()
     out = Path(png_path)
-    fig.savefig(out, dpi=110)
+    write_with(out, lambda fh: fig.savefig(fh, dpi=110, format="png"))
     plt.close(fig)
     return out

@@ -16,6 +16,7 @@ from krl.render import render_html
 
 from . import flags as F, history as H
 from .figures import CORE, kind_of, read_night
+from krl.durable import write_text
 import matplotlib
 import matplotlib.pyplot as plt
 
@@ -112,11 +113,11 @@ def write_index(root: Path, charts: bool = True) -> Path:
     html = render_html("conformance", "nightly.html.j2", days=rows, flags=flag_list, charts=chart_rows,
                        last=dates[-1] if dates else None, prev=dates[-2] if len(dates) > 1 else None,
                        nights=len(dates))
-    (root / "index.html").write_text(html, encoding="utf-8")
+    write_text(root / "index.html", html)
     md = ["# Nightly reports", ""]
     if flag_list:
         md += [f"## Changes since {dates[-2]}", ""] + [f"- **{f.severity}** [{f.text}]({f.link})" for f in flag_list] + [""]
     md += ["| date | reports | conformance |", "|---|---|---|"]
     md += [f"| {r['name']} | " + " ".join(f"[{t}]({h})" for t, h in r["links"]) + f" | {r['summary']} |" for r in rows]
-    (root / "index.md").write_text("\n".join(md) + "\n", encoding="utf-8")
+    write_text(root / "index.md", "\n".join(md) + "\n")
     return root / "index.html"

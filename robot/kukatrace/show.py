@@ -18,6 +18,7 @@ import numpy as np
 from .compare import SegmentComparison
 from .model import RunView, Segment
 from ..trace import unfinished
+from krl.durable import write_with
 import matplotlib
 import matplotlib.pyplot as plt
 
@@ -108,7 +109,7 @@ def _finish(plt, fig, axs, out: Path) -> None:
             ax.set_aspect("equal", adjustable="datalim")
         row[1].legend(fontsize=7)
     fig.tight_layout()
-    fig.savefig(out, dpi=80)
+    write_with(out, lambda fh: fig.savefig(fh, dpi=80, format="png"))
     plt.close(fig)
 
 
