@@ -33,7 +33,7 @@ limit, or a simulator gap the report names (a target the stand-in robot cannot r
 variant removed the machine data); it *fails* when it stops on a name the checker classifies as
 installed software (an "outside stop") or ends in an internal error.
 
-``python -m interp.variants [FOLDER ...] [--sample N] [--jobs N] [--json OUT] [--log LOG]`` (default: the
+``python -m interp.variants [FOLDER ...] [--sample N] [--jobs N | --scheduler tcp://HOST:PORT] [--json OUT] [--log LOG]`` (default: the
 backups of ../shared/krl-corpus and ../shared/krl-history) prints the counts of variants and runs,
 the runs by cause and every failing run; exit status 1 when a run fails. ``make nightly`` runs
 all of them (``variants.json``, its counts in the nightly's history: conformance/nightly);
@@ -59,6 +59,7 @@ from krl.files import SHARED_CORPUS
 from krl.project import find_backups
 from krl.semantics.outside import template_lines
 from krl.source import is_krl_file
+from krl.cluster import SchedulerError, run_batches
 from krl.pool import run_tasks
 
 __all__ = ["SIM_TIME_S", "STEPS", "Variant", "backups", "run_variant", "sample", "some_entries", "variants_of"]
@@ -321,6 +322,31 @@ def _logged(log: Path | None, interp: str) -> dict:
     return found
 
 
+def _outcomes(args, tasks):
+    """The sweep's outcomes: on the cluster at ``--scheduler`` (one variant per task) or in
+    local worker processes (krl.pool)."""
+    if args.scheduler:
+        return run_batches(args.scheduler, _task, tasks, batch_files=1, name="krl-variants")
+    return run_tasks(_task, tasks, jobs=args.jobs)
+
+
+def _sweep(args, variants: list, tasks: list, results: list) -> None:
+    """Run `tasks`, putting each variant's result in `results`, its line in ``--log``.
+    Raises SchedulerError (krl.cluster)."""
+    for done, o in enumerate(_outcomes(args, tasks), len(variants) - len(tasks) + 1):
+        v = variants[o.key]
+        results[o.key] = o.value if o.status == "done" else {
+            "variant": v.name, "kind": v.kind, "backup": str(v.backup),
+            "runs": [{"entry": "", "cause": "internal", "reason": "internal", "text": o.detail or o.status,
+                      "outside_stops": []}]}
+        if args.log is not None:
+            with args.log.open("a", encoding="utf-8") as log:
+                log.write(json.dumps({**results[o.key], "interp": args.interp}) + "\n")
+        failing = summarise([results[o.key]])["failures"]
+        print(f"[{done}/{len(variants)}] {v.backup} [{v.name}]: {len(results[o.key]['runs'])} runs"
+              + (f", {len(failing)} failing" if failing else ""), file=sys.stderr, flush=True)
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(prog="python -m interp.variants", description=__doc__.split("\n\n")[0])
     ap.add_argument("folders", nargs="*", type=Path, help="folders holding backups (default: the shared corpus "
@@ -332,6 +358,11 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--log", type=Path, default=None,
                     help="append each variant's result to this file as one JSON line as it ends; the variants "
                          "it already holds are not run again (a stopped sweep resumes)")
+    ap.add_argument("--scheduler", default=None, metavar="tcp://HOST:PORT",
+                    help="run the variants on this Dask distributed scheduler's cluster, one variant per task "
+                         "(its workers see the backups at the same paths); a lost worker's variants run again "
+                         "on the others; a lost scheduler ends the sweep (exit 2): run it again with the same "
+                         "--log and it resumes")
     args = ap.parse_args(argv)
 
     folders = args.folders or [SHARED_CORPUS, SHARED_HISTORY]
@@ -346,18 +377,12 @@ def main(argv: list[str] | None = None) -> int:
              for k, v in enumerate(variants) if results[k] is None]
     if logged:
         print(f"{len(variants) - len(tasks)} variants read from {args.log}", file=sys.stderr, flush=True)
-    for done, o in enumerate(run_tasks(_task, tasks, jobs=args.jobs), len(variants) - len(tasks) + 1):
-        v = variants[o.key]
-        results[o.key] = o.value if o.status == "done" else {
-            "variant": v.name, "kind": v.kind, "backup": str(v.backup),
-            "runs": [{"entry": "", "cause": "internal", "reason": "internal", "text": o.detail or o.status,
-                      "outside_stops": []}]}
-        if args.log is not None:
-            with args.log.open("a", encoding="utf-8") as log:
-                log.write(json.dumps({**results[o.key], "interp": args.interp}) + "\n")
-        failing = summarise([results[o.key]])["failures"]
-        print(f"[{done}/{len(variants)}] {v.backup} [{v.name}]: {len(results[o.key]['runs'])} runs"
-              + (f", {len(failing)} failing" if failing else ""), file=sys.stderr, flush=True)
+    try:
+        _sweep(args, variants, tasks, results)
+    except SchedulerError as exc:
+        print(f"error: {exc}" + (f" (resume: run again with --log {args.log})" if args.log else ""),
+              file=sys.stderr)
+        return 2
     s = summarise(results)
     print(f"variants {s['variants']} of {len(backups(folders))} backups, runs {s['runs']}: "
           + ", ".join(f"{k} {n}" for k, n in s["causes"].items()))

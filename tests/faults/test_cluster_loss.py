@@ -5,6 +5,7 @@ killed (SIGKILL) while batches are in flight."""
 
 from __future__ import annotations
 
+import json
 import os
 import re
 import signal
@@ -16,8 +17,10 @@ from pathlib import Path
 
 import pytest
 
+from interp import variants as V
 from krl import cluster
 from krl.lsp.sample import generate
+from tests.interp.test_variants import _backup
 
 BIN = Path(sys.executable).parent
 
@@ -115,3 +118,70 @@ def test_krl_recover_whose_scheduler_dies_is_a_clear_error_exit_2(tmp_path: Path
         if recover is not None and recover.poll() is None:
             recover.kill()
             recover.wait()
+
+
+def _registered(*logs: Path) -> None:
+    deadline = time.monotonic() + 60
+    while not all("Registered to" in log.read_text() for log in logs):
+        if time.monotonic() > deadline:
+            pytest.fail("a worker did not register with the scheduler")
+        time.sleep(0.1)
+
+
+def _lines(log: Path) -> int:
+    return len(log.read_text().splitlines()) if log.exists() else 0
+
+
+@pytest.mark.slow
+def test_the_variants_sweep_survives_a_lost_worker_and_resumes_after_a_lost_scheduler(tmp_path: Path) -> None:
+    # issue 74's long sweeps: python -m interp.variants --scheduler on a real cluster of two
+    # workers; one worker killed mid-way (Dask runs its variants again on the other), then the
+    # scheduler killed (exit 2, a clear error) and started again: the sweep resumes from its
+    # --log and its counts are those of the local sweep of the same variants
+    for i in range(4):           # 48 variants (the issue: a sample of at least 40 in the nightly)
+        _backup(tmp_path / "src" / f"cell{i}")
+    src = str(tmp_path / "src")
+    assert V.main([src, "--jobs", "2", "--json", str(tmp_path / "local.json")]) == 0
+    local = json.loads((tmp_path / "local.json").read_text())["summary"]
+    assert local["variants"] == 48
+
+    log = tmp_path / "sweep.jsonl"
+    procs: list[subprocess.Popen] = []
+    try:
+        sched = _start(["scheduler", "--host", "127.0.0.1", "--port", "0", "--no-dashboard"], tmp_path / "s1.log")
+        procs.append(sched)
+        address = _address(tmp_path / "s1.log", time.monotonic() + 60)
+        workers = [_start(["worker", address, "--nthreads", "1", "--no-dashboard"], tmp_path / f"w{i}.log")
+                   for i in range(2)]
+        procs += workers
+        _registered(tmp_path / "w0.log", tmp_path / "w1.log")
+        outcome: dict = {}
+        t = threading.Thread(target=lambda: outcome.setdefault(
+            "code", V.main([src, "--scheduler", address, "--log", str(log)])), daemon=True)
+        t.start()
+        deadline = time.monotonic() + 300
+        while _lines(log) < 3 and time.monotonic() < deadline and t.is_alive():
+            time.sleep(0.1)
+        os.killpg(workers[0].pid, signal.SIGKILL)        # a worker lost mid-way
+        while _lines(log) < 20 and time.monotonic() < deadline and t.is_alive():
+            time.sleep(0.1)
+        assert t.is_alive() and _lines(log) < 48, f"the sweep ended first: {outcome}, {_lines(log)} lines"
+        os.killpg(sched.pid, signal.SIGKILL)             # then the scheduler
+        t.join(120)
+        assert outcome.get("code") == 2
+        done_before = _lines(log)
+
+        sched2 = _start(["scheduler", "--host", "127.0.0.1", "--port", "0", "--no-dashboard"], tmp_path / "s2.log")
+        procs.append(sched2)
+        address2 = _address(tmp_path / "s2.log", time.monotonic() + 60)
+        procs.append(_start(["worker", address2, "--nthreads", "1", "--no-dashboard"], tmp_path / "w3.log"))
+        _registered(tmp_path / "w3.log")
+        assert V.main([src, "--scheduler", address2, "--log", str(log), "--json", str(tmp_path / "dask.json")]) == 0
+        resumed = json.loads((tmp_path / "dask.json").read_text())["summary"]
+        assert resumed == local
+        assert _lines(log) == 48 and done_before >= 20
+    finally:
+        for p in procs:
+            if p.poll() is None:
+                os.killpg(p.pid, signal.SIGKILL)
+                p.wait()
