@@ -131,7 +131,8 @@ conformance: $(PARSER) java-parser
 # (fuzz/), the tests marked slow (long sweeps; hypothesis with the nightly profile); dated
 # reports under reports/nightly/<date>/, then the history (reports/nightly/history.sqlite) and
 # the index with charts and the changes since the night before. Not part of `make test`.
-# SCHEDULER=tcp://HOST:PORT: recovery and conformance run on that Dask cluster (same reports)
+# SCHEDULER=tcp://HOST:PORT: recovery, the audit, conformance and the variants sweep run on that Dask
+# cluster (same reports); the sweep keeps variants.jsonl, so a night run again resumes it (issue 74)
 SCHEDULER ?=
 SCHED_OPT = $(if $(SCHEDULER),--scheduler $(SCHEDULER),)
 NIGHTLY_FUZZ ?= 2000
@@ -154,7 +155,7 @@ nightly:
 	$(BIN)/python tools/whole_run_bench.py --json $$d/whole-runs.json > $$d/whole-runs.txt 2>> $$d/bench.log; \
 	$(BIN)/python tools/whole_run_bench.py --corpus $(SHARED_HISTORY) --json $$d/whole-runs-history.json \
 	  > $$d/whole-runs-history.txt 2>> $$d/bench.log; \
-	$(BIN)/python -m interp.variants --json $$d/variants.json > $$d/variants.txt 2>&1; v=$$?; tail -2 $$d/variants.txt; \
+	$(BIN)/python -m interp.variants --json $$d/variants.json --log $$d/variants.jsonl $(SCHED_OPT) > $$d/variants.txt 2>&1; v=$$?; tail -2 $$d/variants.txt; \
 	$(BIN)/python -m tests.fuzz.run --seconds $(FUZZ_SECONDS) --out $$d/fuzz; f=$$?; \
 	HYPOTHESIS_PROFILE=nightly $(BIN)/python -m pytest -q -n $(PYTEST_WORKERS) --dist loadgroup -p no:cacheprovider -m "slow or not slow" \
 	  > $$d/slow-tests.log 2>&1; t=$$?; tail -1 $$d/slow-tests.log; \
