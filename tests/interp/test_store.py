@@ -249,6 +249,22 @@ def test_krl_check_no_cache_neither_reads_nor_keeps_parses(cache, tmp_path):
     store._SHARED.clear()
 
 
+def test_krl_cache_clear_removes_the_store_and_nothing_else(cache, tmp_path):
+    s = store.Store(cache)
+    s.put("parse", {"k": b"data"})
+    s.close()
+    elsewhere = tmp_path / "keep.sqlite"
+    elsewhere.write_bytes(b"not ours")
+    (cache / "front-end" / "link.sqlite").symlink_to(elsewhere)
+    (cache / "front-end" / "notes.txt").write_text("kept")
+    res = CliRunner().invoke(app_main, ["cache", "clear"])
+    assert res.exit_code == 0, res.output
+    assert sorted(p.name for p in (cache / "front-end").iterdir()) == ["link.sqlite", "notes.txt"]
+    assert elsewhere.read_bytes() == b"not ours"
+    assert res.output.startswith("removed 1 file(s)")
+    assert CliRunner().invoke(app_main, ["cache", "path"]).output.strip() == str(cache)
+
+
 def test_the_store_never_unpickles(cache, tmp_path, monkeypatch):
     """A pickle planted in an entry (with a matching digest) is a corrupt entry: it never
     runs, and no part of loading a program from the store calls the pickle module."""
