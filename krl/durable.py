@@ -1,10 +1,12 @@
 """Durable writes: the one way a command replaces a user's file or writes a report (issue 74).
 
 Every file a command writes for the user (``krl fmt``'s formatted file, the pendant's touch-up
-of a data list, the reports of ``krl recover``, ``krl check --report``, ``krl audit``,
-``krl conformance``, the outputs of ``krl diff``/``graph``/``report``/``robot export``/
-``cell init``) goes through :func:`write_bytes` (one file) or :class:`TempFolder` +
-:func:`replace_folder` (a report folder). The discipline, as SQLite's and PostgreSQL's crash
+of a data list, ``krl construct new``'s row of grammar/CHANGES.md, the reports of
+``krl recover``, ``krl growth``, ``krl check --report``, ``krl audit``, ``krl conformance`` and
+the nightly's index, the ``-o`` files of ``krl diff``/``graph``/``report``/``plot``/``trace
+show``/``robot export``/``cell init``, the ``--json`` of the variants and real-programs sweeps)
+goes through :func:`write_bytes` (one file; :func:`write_text`, :func:`write_with` for a
+streaming writer) or :class:`TempFolder` + :func:`replace_folder` (a report folder). The discipline, as SQLite's and PostgreSQL's crash
 rules have it:
 
 1. the new content goes into a temporary file in the target's own folder
@@ -16,15 +18,16 @@ rules have it:
 4. the folder is ``fsync``\\ ed, so the rename itself survives a power loss.
 
 A reader, a crash or a signal never sees half a file: the target holds the old content or
-the new one. A signal (SIGINT, SIGTERM) removes the temporary file on the way out; SIGKILL
+the new one. A signal (SIGINT; SIGTERM under the ``krl`` command, krl/signals.py) removes the
+temporary file on the way out; SIGKILL
 cannot, so every write first removes the *stale* temporaries of its folder (:func:`sweep`):
 those of this naming scheme whose lock no process holds (a lock dies with its process, even
 one killed by SIGKILL). An empty temporary younger than :data:`STALE_GRACE_S` is left alone
 (a writer between creating and locking it).
 
 Refusals (:class:`WriteRefused`, an OSError; nothing is written): a target whose mode has no
-write bit or that this user may not write (``chmod 0444`` is the owner's "do not touch", as
-black, gofmt and prettier honour it, root included); a target on a read-only file system; a
+write bit or that this user may not write (``chmod 0444`` is the owner's "do not touch": black,
+gofmt, prettier and clang-format refuse such a file; here root does too); a target on a read-only file system; a
 target owned by another user whose owner this process cannot keep (not root).
 
 Lost edits (``expect``): a caller that read the file and computed the new content from it
@@ -35,11 +38,8 @@ it was read, the exchange is undone at once (the other writer's content back in 
 Where the exchange is not available (another system, a file system without it) the comparison
 is made just before a plain rename (a window of one system call).
 
-Test hooks (for the fault tests only, tests/test_faults_write.py): the environment variable
-``KRL_TEST_WRITE_DELAY`` (seconds, a float) makes every write sleep after its temporary file is
-fsynced and before it is put in place (so a test can signal a process inside its write, or save
-over the file as an editor would); :data:`before_commit`, when set, is called with the target
-path at the same point.
+The fault tests (tests/faults/) stop a real process inside its write by slowing its first
+``os.fsync`` from outside (tests/faults/slow_fsync.py); this module has no test hook.
 """
 
 from __future__ import annotations
@@ -63,10 +63,6 @@ TEMP_MARK = "krl-"
 TEMP_SUFFIX = ".tmp"
 #: an empty temporary (file or folder) younger than this is a writer's that has not locked it yet
 STALE_GRACE_S = 2.0
-#: test hook: seconds slept between fsync and rename (module docstring)
-DELAY_ENV = "KRL_TEST_WRITE_DELAY"
-#: test hook: called with the target path between fsync and rename (module docstring)
-before_commit: Callable[[Path], None] | None = None
 
 
 class WriteRefused(OSError):
@@ -125,7 +121,6 @@ def write_bytes(path: str | Path, data: bytes, mode: int | None = 0o644,
             _keep_owner(fd, old)
         os.fchmod(fd, 0o644 if mode is None else mode)     # after fchown, which clears set-id bits
         os.fsync(fd)
-        _test_hooks(path)
         _commit(Path(tmp), path, expect)
         fsync_folder(folder)
     except BaseException:
@@ -176,14 +171,6 @@ def _keep_owner(fd: int, st: os.stat_result) -> None:
     except PermissionError:
         raise WriteRefused(errno.EPERM, f"owned by user {st.st_uid}, group {st.st_gid}: a rewrite would change "
                                         "its owner; not written (run as its owner)") from None
-
-
-def _test_hooks(path: Path) -> None:
-    delay = os.environ.get(DELAY_ENV)
-    if delay:
-        time.sleep(float(delay))
-    if before_commit is not None:
-        before_commit(path)
 
 
 def _commit(tmp: Path, path: Path, expect: bytes | None) -> None:
@@ -284,7 +271,6 @@ def replace_folder(tmp: Path, out: Path) -> None:
     fsynced last."""
     os.chmod(tmp, 0o755)   # mkdtemp makes it private
     fsync_tree(tmp)
-    _test_hooks(out)
     if not out.exists():
         os.replace(tmp, out)
     elif exchange(tmp, out):
