@@ -212,3 +212,38 @@ def test_an_editors_save_during_krl_fmts_write_is_never_lost(tmp_path, monkeypat
     assert status == 2
     assert any("changed while it was formatted" in line for line in lines), lines
     assert sorted(p.name for p in tmp_path.iterdir()) == ["bas.src"]
+
+
+def _fsynced(monkeypatch) -> list[str]:
+    """The paths fsync is called on from now (what each fd names, /proc/self/fd)."""
+    real, seen = os.fsync, []
+
+    def fsync(fd):
+        seen.append(os.readlink(f"/proc/self/fd/{fd}"))
+        real(fd)
+
+    monkeypatch.setattr(os, "fsync", fsync)
+    return seen
+
+
+def test_a_durable_write_fsyncs_the_file_then_its_folder(tmp_path: Path, monkeypatch) -> None:
+    # case 11: "no folder is fsynced after a rename"
+    seen = _fsynced(monkeypatch)
+    durable.write_bytes(tmp_path / "out.txt", b"new")
+    assert len(seen) == 2
+    assert Path(seen[0]).parent == tmp_path and Path(seen[0]).name.startswith(".out.txt.krl-")
+    assert seen[1] == str(tmp_path)
+
+
+def test_every_file_of_a_report_folder_is_fsynced_before_it_is_put_in_place(tmp_path: Path, monkeypatch) -> None:
+    # case 11: "the report's files are never fsynced"
+    folder = durable.TempFolder(tmp_path / "report")
+    for name in ("summary.json", "report.md"):
+        (folder.path / name).write_text(name)
+    seen = _fsynced(monkeypatch)
+    durable.replace_folder(folder.path, tmp_path / "report")
+    folder.close()
+    names = [Path(p).name for p in seen]
+    assert sorted(names[:2]) == ["report.md", "summary.json"]          # the files, then their folder
+    assert Path(seen[2]).name.startswith(".report.new-krl-") and seen[-1] == str(tmp_path)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["report"]
