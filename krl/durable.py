@@ -113,7 +113,12 @@ def write_bytes(path: str | Path, data: bytes, mode: int | None = 0o644,
     elif expect is not None:
         raise ChangedMeanwhile(errno.ENOENT, "the file was removed or renamed while it was formatted")
     sweep(folder)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.{TEMP_MARK}", suffix=TEMP_SUFFIX, dir=folder)
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.{TEMP_MARK}", suffix=TEMP_SUFFIX, dir=folder)
+    except (PermissionError, OSError) as exc:
+        if exc.errno not in (errno.EACCES, errno.EPERM, errno.EROFS):
+            raise
+        raise WriteRefused(exc.errno, f"its folder cannot be written ({exc.strerror}): not written") from None
     try:
         fcntl.flock(fd, fcntl.LOCK_EX)
         _write_all(fd, data)

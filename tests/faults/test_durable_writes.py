@@ -145,37 +145,61 @@ def test_the_pendants_touch_up_keeps_another_users_owner(tmp_path: Path) -> None
     assert b"XP1={A1 10,A2 -80,A3 85,A4 0,A5 5,A6 0}" in dat.read_bytes()
 
 
+def _as_user(uid: int, fn) -> int:
+    """Run `fn()` in a forked child that became user `uid`; its exit status (fn's int)."""
+    pid = os.fork()
+    if pid == 0:
+        code = 1
+        try:
+            os.setgid(uid)
+            os.setuid(uid)
+            code = fn()
+        finally:
+            os._exit(code)
+    return os.waitstatus_to_exitcode(os.waitpid(pid, 0)[1])
+
+
+def _refused_with(path: Path, words: str) -> int:
+    try:
+        durable.write_bytes(path, FORMATTED, mode=None)
+    except durable.WriteRefused as exc:
+        return 0 if words in str(exc) else 3
+    return 2
+
+
+@pytest.fixture
+def shared_folder():
+    folder = Path(tempfile.mkdtemp(prefix="krl-owner-"))      # in /tmp: reachable by any user
+    yield folder
+    shutil.rmtree(folder)
+
+
 @pytest.mark.skipif(os.geteuid() != 0, reason="only root can act as two other users")
 @pytest.mark.may_skip("the suite runs as root in CI and on the project's machine")
-def test_a_user_who_cannot_keep_the_owner_is_refused() -> None:
+def test_a_user_who_cannot_keep_the_owner_is_refused(shared_folder: Path) -> None:
     # a shared folder, a file of user 4343 that user 4242 may write: a rename would hand the
     # file to 4242, so the durable write refuses (the owner is what `ls -l` promised)
-    folder = Path(tempfile.mkdtemp(prefix="krl-owner-"))      # /tmp: reachable by any user
-    try:
-        folder.chmod(0o777)
-        f = folder / "bas.src"
-        f.write_bytes(UGLY)
-        os.chown(f, 4343, 4343)
-        f.chmod(0o666)
-        pid = os.fork()
-        if pid == 0:                               # the child becomes user 4242
-            code = 1
-            try:
-                os.setgid(4242)
-                os.setuid(4242)
-                try:
-                    durable.write_bytes(f, FORMATTED, mode=None)
-                    code = 2
-                except durable.WriteRefused as exc:
-                    code = 0 if "owned by user 4343" in str(exc) else 3
-            finally:
-                os._exit(code)
-        _pid, status = os.waitpid(pid, 0)
-        assert os.waitstatus_to_exitcode(status) == 0
-        assert f.read_bytes() == UGLY and f.stat().st_uid == 4343
-        assert sorted(p.name for p in folder.iterdir()) == ["bas.src"]
-    finally:
-        shutil.rmtree(folder)
+    shared_folder.chmod(0o777)
+    f = shared_folder / "bas.src"
+    f.write_bytes(UGLY)
+    os.chown(f, 4343, 4343)
+    f.chmod(0o666)
+    assert _as_user(4242, lambda: _refused_with(f, "owned by user 4343")) == 0
+    assert f.read_bytes() == UGLY and f.stat().st_uid == 4343
+    assert sorted(p.name for p in shared_folder.iterdir()) == ["bas.src"]
+
+
+@pytest.mark.skipif(os.geteuid() != 0, reason="only root can act as another user")
+@pytest.mark.may_skip("the suite runs as root in CI and on the project's machine")
+def test_a_file_in_a_folder_its_user_cannot_write_is_refused_clearly(shared_folder: Path) -> None:
+    f = shared_folder / "bas.src"
+    f.write_bytes(UGLY)
+    os.chown(f, 4242, 4242)
+    os.chown(shared_folder, 4242, 4242)
+    shared_folder.chmod(0o555)
+    assert _as_user(4242, lambda: _refused_with(f, "its folder cannot be written (Permission denied)")) == 0
+    assert f.read_bytes() == UGLY
+    shared_folder.chmod(0o755)
 
 
 def _editor_saves_at_first_fsync(monkeypatch, path: Path, text: bytes, in_place: bool) -> None:
