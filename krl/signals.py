@@ -59,10 +59,12 @@ def handling() -> Iterator[None]:
 
     old_term = signal.signal(signal.SIGTERM, on_term)
     old_int = signal.getsignal(signal.SIGINT)
-    if old_int is not signal.SIG_IGN:      # `nohup`/a background job's ignored SIGINT stays ignored
+    if old_int not in (signal.SIG_IGN, None):  # a background job's ignored SIGINT stays ignored
         signal.signal(signal.SIGINT, signal.default_int_handler)
     try:
         yield
     finally:
-        signal.signal(signal.SIGTERM, old_term)
-        signal.signal(signal.SIGINT, old_int)
+        # (None: a handler not installed from Python, which cannot be put back from here)
+        signal.signal(signal.SIGTERM, old_term if old_term is not None else signal.SIG_DFL)
+        if old_int is not None:
+            signal.signal(signal.SIGINT, old_int)
