@@ -14,12 +14,14 @@ from __future__ import annotations
 
 import os
 import signal
+import time
 from pathlib import Path
 
 import pytest
 from click.testing import CliRunner
 
 from app import main
+from krl import signals
 from pendant.client import pendant_server
 from recovery import pipeline
 from robot.trace import TraceWriter
@@ -185,3 +187,18 @@ def test_krl_pendant_ends_on_a_signal_as_every_command(tmp_path, sig) -> None:
         proc.send_signal(sig)
         assert proc.wait(60) == 128 + sig
     assert "interrupted" in (tmp_path / "err.txt").read_text()
+
+
+def test_a_forked_worker_keeps_sigterms_default_action() -> None:
+    # a pool worker forked while a command runs dies of SIGTERM (the pool stops its workers so),
+    # never raising Terminated into the worker's own loop
+    with signals.handling():
+        pid = os.fork()
+        if pid == 0:
+            try:
+                os.kill(os.getpid(), signal.SIGTERM)
+                time.sleep(5)
+            finally:
+                os._exit(7)         # reached only if SIGTERM raised instead of ending the process
+        _pid, status = os.waitpid(pid, 0)
+    assert os.WIFSIGNALED(status) and os.WTERMSIG(status) == signal.SIGTERM
