@@ -167,7 +167,7 @@ def read_events(path: str | Path, shown: str | None = None) -> Iterator[Event]:
     shown = shown or str(path)
     size = _check_file(path, shown)
     renderer = _Renderer()
-    last = "before its first record"
+    last = "its start"
     try:
         log = Evtx(str(path)).__enter__()
     except (OSError, ValueError) as exc:
@@ -198,6 +198,8 @@ def read_events(path: str | Path, shown: str | None = None) -> Iterator[Event]:
         if seen < count:
             raise LogError(f"{shown}: truncated: the header names {count} chunks of records, the file ({size} "
                            f"bytes) holds {seen}; the records after {last} are missing")
+    except LogError:
+        raise
     except _DAMAGE as exc:
         raise LogError(f"{shown}: damaged after {last} ({type(exc).__name__}: {exc})") from None
     finally:

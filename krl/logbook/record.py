@@ -181,7 +181,10 @@ class Logbook:
 
 
 def _wanted(rec: LogRecord, since, until, module: str | None, number: int | None) -> bool:
-    return ((since is None or rec.time >= since) and (until is None or rec.time <= until)
+    """The filters of :func:`read_logbook`; times compare to the millisecond, as they are shown
+    (a record shown at ``...31.901Z`` passes ``--until ...31.901Z``)."""
+    shown = rec.time.replace(microsecond=rec.time.microsecond // 1000 * 1000)
+    return ((since is None or shown >= since) and (until is None or shown <= until)
             and (module is None or rec.module.lower() == module.lower())
             and (number is None or rec.number == number))
 
