@@ -1,0 +1,107 @@
+"""A controller archive as KUKA writes it is one thing every command accepts (issue 72 item 8,
+issue 75 item 4): its KRC folder is the backup (also when its $config.dat is in KRC/STEU and
+R1/System has none), its machine data found in KRC/R1/Mada, its am.ini and ArchiveInfo.xml shown
+by `krl robot show` and the report's cover, folder or .zip. The archive is tests/logbook/archive.py's;
+the expected values are the texts written there, and for the shared archive's manifest the
+values of its am.ini and ArchiveInfo.xml as ../shared/event-logs/README.md describes them."""
+
+from __future__ import annotations
+
+import html
+import re
+import shutil
+from pathlib import Path
+
+import pytest
+from click.testing import CliRunner
+
+from app import main
+from krl.kssarchive import archive_root, log_files, parse_am_ini, parse_archive_info, read_info
+from tests.logbook.archive import build_archive, zip_folder
+
+
+@pytest.fixture(scope="module")
+def archive(tmp_path_factory) -> Path:
+    return build_archive(tmp_path_factory.mktemp("kss") / "archive", None)
+
+
+@pytest.fixture(scope="module")
+def steu_only(tmp_path_factory) -> Path:
+    """The archive with its $config.dat in KRC/STEU and none in KRC/R1/System."""
+    root = build_archive(tmp_path_factory.mktemp("steu") / "archive", None)
+    shutil.move(root / "KRC" / "R1" / "System" / "$config.dat", root / "KRC" / "STEU" / "$config.dat")
+    return root
+
+
+def krl(*args: str):
+    return CliRunner().invoke(main, list(args))
+
+
+def test_an_archive_whose_config_is_in_steu_is_a_backup(steu_only):
+    """Failed before krl/project.py knew the layout: `krl robot show` said "no R1/Mada/$machine.dat
+    in this folder" and `krl graph` "a folder, not a KRC backup"."""
+    res = krl("robot", "show", str(steu_only))
+    assert res.exit_code == 0, res.output
+    assert res.output.splitlines()[1] == f"source     {steu_only / 'KRC' / 'R1' / 'Mada' / '$machine.dat'}"
+    res = krl("graph", str(steu_only), "--format", "text")
+    assert res.exit_code == 0, res.output
+    assert "a folder, not a KRC backup" not in res.output
+    assert re.search(r"^  cell +CELL +R1/cell\.src:1$", res.output, re.M), res.output
+
+
+@pytest.mark.parametrize("zipped", [False, True])
+def test_robot_show_names_the_archive(archive, tmp_path, zipped):
+    path = zip_folder(archive, tmp_path / "archive.zip") if zipped else archive
+    res = krl("robot", "show", str(path))
+    assert res.exit_code == 0, res.output
+    lines = res.output.splitlines()
+    assert lines[1] == f"source     {path / 'KRC' / 'R1' / 'Mada' / '$machine.dat'}"
+    assert "named      Test_Cell_75, serial 750075" in lines
+    assert "type       #KR180R3200PA C4 FLR (ArchiveInfo.xml)" in lines
+    assert "software   KSS 8.7.8 build 671" in lines
+    assert "packages   KUKA.PROFINET MS 6.0.8, KUKA.UpdateService 1.1.24" in lines
+
+
+def test_the_report_cover_names_the_archive(archive, tmp_path):
+    out = tmp_path / "report.html"
+    res = krl("report", str(zip_folder(archive, tmp_path / "archive.zip")), "--no-runs", "-o", str(out))
+    assert res.exit_code == 0, res.output
+    row = re.search(r'<tr id="cover-archive">(.*?)</tr>', out.read_text(encoding="utf-8"), re.S).group(1)
+    text = html.unescape(re.sub(r"<[^>]+>", " ", row))
+    assert "Test_Cell_75, serial 750075, #KR180R3200PA C4 FLR, KSS 8.7.8 build 671" in " ".join(text.split())
+    assert "technology packages: KUKA.PROFINET MS 6.0.8, KUKA.UpdateService 1.1.24" in " ".join(text.split())
+
+
+def test_the_archive_is_found_from_inside_and_its_logs_listed(archive, tmp_path):
+    assert archive_root(archive / "KRC" / "R1" / "Program" / "Parca_Birakma" / "B3_Parca_Birakma.src") == archive
+    assert archive_root(tmp_path) is None
+    (archive / "Log Files" / "KrcLogU.evt").write_bytes(b"")
+    (archive / "Log Files" / "KrcLog.evt").write_bytes(b"")
+    (archive / "Log Files" / "notes.txt").write_text("")
+    assert [p.name for p in log_files(archive)] == ["KrcLog.evt", "KrcLogU.evt"]
+
+
+def test_the_shared_archive_manifest(event_logs):
+    """The values of ../shared/event-logs' am.ini and ArchiveInfo.xml (README: a KR 470 PA-2 on KSS
+    V8.7.8; the files' own lines)."""
+    ini = parse_am_ini((event_logs / "am.ini").read_text(encoding="utf-8"))
+    assert (ini["robot_name"], ini["serial"], ini["kss"]) == ("Ambalajli_Paletleme_Robotu", "996627", "V8.7.8")
+    assert len(ini["techpacks"]) == 9
+    assert ini["techpacks"][0] == ("DiagnosisSafety", "3.2.4")
+    assert ("KUKA.DeviceConnector pre-installed", "2.1.13") in ini["techpacks"]
+    xml = parse_archive_info((event_logs / "ArchiveInfo.xml").read_bytes())
+    assert (xml["robot_type"], xml["build"], xml["kss"]) == ("#KR470PA_2 S C4 FLR", "671", "V8.7.8")
+    assert xml["logs"] == ["KrcLog", "KrcLogI", "KrcLogU", "KrcLogS", "KrcLogP", "KrcLogB", "KrcLogC"]
+    assert ("KUKA.PROFINET MS", "6.0.8") in xml["techpacks"]
+    info = read_info(event_logs)
+    assert (info.robot_name, info.robot_type, info.techpacks[0]) == \
+        ("Ambalajli_Paletleme_Robotu", "#KR470PA_2 S C4 FLR", ("DiagnosisSafety", "3.2.4"))
+
+
+def test_a_bad_manifest_is_a_note_never_an_error(tmp_path):
+    (tmp_path / "am.ini").write_text("this is no ini file\n[")
+    (tmp_path / "ArchiveInfo.xml").write_text('<!DOCTYPE x [<!ENTITY a "b">]><ArchiveInformation>&a;</ArchiveInformation>')
+    info = read_info(tmp_path)
+    assert info.robot_name == "" and len(info.notes) == 2
+    assert "am.ini: not an INI file" in info.notes[0]
+    assert "ArchiveInfo.xml: not readable XML" in info.notes[1]
