@@ -21,15 +21,25 @@ from pathlib import Path
 
 import pytest
 from click.testing import CliRunner
+from jsonschema import Draft202012Validator
 from Evtx.Evtx import Evtx
 from Evtx.Views import evtx_template_readable_view
 
 from app.log import log_group
+from interp.runtime.kssmessages import KNOWN_MESSAGES
+from krl.logbook.record import LogRecord
+from krl.logbook.summary import messages, timeline
 from tests.logbook.archive import LINES, MODULES, build_archive
 
 LOGS = ("KrcLogB.evt", "KrcLogI.evt", "KrcLogU.evt")
+SCHEMAS = Path(__file__).resolve().parents[2] / "docs" / "schemas"
 NS = "{http://schemas.microsoft.com/win/2004/08/events/event}"
 SAMPLE = 20
+
+
+def validate(name: str, obj) -> None:
+    """`obj` against docs/schemas/<name>.schema.json (tests/test_json_schemas.py checks the schemas)."""
+    Draft202012Validator(json.loads((SCHEMAS / f"{name}.schema.json").read_text())).validate(obj)
 
 
 def _ms(text: str) -> str:
@@ -87,7 +97,10 @@ def shown(archive) -> list[dict]:
     """`krl log show --format json` of the archive: every record of its three logs."""
     res = CliRunner().invoke(log_group, ["show", "--format", "json", str(archive)])
     assert res.exit_code == 0, res.output
-    return [json.loads(line) for line in res.output.splitlines()]
+    objs = [json.loads(line) for line in res.output.splitlines()]
+    for o in objs[::50] + [o for o in objs if "file" in o][:20]:
+        validate("log-record", o)
+    return objs
 
 
 @pytest.fixture(scope="module")
@@ -204,3 +217,59 @@ def test_every_record_of_krclogu_against_record_xml(event_logs, shown):
         g = got[e["record"]]
         assert (g["time"], g["module"], g["number"], g["key"], g["params"]) == \
             (e["time"], e["module"], e["number"], e["key"], e["params"])
+
+
+def test_summary_of_krclogb_by_number_and_module(archive, expected):
+    res = CliRunner().invoke(log_group, ["summary", "--format", "json", str(archive / "Log Files" / "KrcLogB.evt")])
+    assert res.exit_code == 0, res.output
+    got = json.loads(res.output)
+    validate("log-summary", got)
+    b = [e for e in expected if e["log"] == "KrcLogB.evt"]
+    groups: dict = {}
+    for e in b:
+        g = groups.setdefault((e["module"], e["number"]), [0, e["time"], e["time"]])
+        g[0] += 1
+        g[2] = e["time"]
+    assert {(m["module"], m["number"]): [m["count"], m["first"], m["last"]] for m in got["messages"]} == groups
+    assert (got["records"], got["first"], got["last"]) == (len(b), b[0]["time"], b[-1]["time"])
+    # KrcLogB's CrossMeld numbers (5005, 1008) are not messages the simulated controller raises
+    assert {m["text"] for m in got["messages"] if m["module"] == "CrossMeld"} == {"text not in the archive"}
+
+
+def _records(objs: list[dict]) -> list[LogRecord]:
+    return [LogRecord(dt.datetime.fromisoformat(o["time"].replace("Z", "+00:00")), o["log"], o["record"], o["channel"],
+                      o["level"], o["source"], o["module"], o["number"], o["key"], o["short"], tuple(o["params"]),
+                      tuple(o["param_kinds"]), file=o.get("file", ""), line=o.get("line"), names=o.get("names", ""))
+            for o in objs]
+
+
+def test_the_operator_timeline(shown, expected):
+    actions = timeline(_records(shown))
+    assert [a.record.time for a in actions] == sorted(a.record.time for a in actions)
+    overrides = [r for r in shown if r["module"] == "Jogging" and r["key"] == "ProgramOverrideChanged"]
+    assert sum(a.count for a in actions if a.kind == "override") == len(overrides) > 1000
+    variables = [a for a in actions if a.kind == "variable"]
+    want = [e for e in expected if e.get("module") == "Varkor"]      # the sampled ones, read independently
+    assert want
+    for e in want:
+        (a,) = [a for a in variables if a.record.record == e["record"]]
+        assert a.text == f"set {e['params'][0]}: {e['params'][1]} -> {e['params'][2]}"
+        var = e["params"][0].rsplit("/", 1)[1]
+        if var in LINES:
+            assert a.place == f"{LINES[var][0]}:{LINES[var][1]}"
+
+
+def test_override_changes_in_a_row_are_one_action_and_known_numbers_have_texts():
+    t = dt.datetime(2026, 1, 27, 10, 0, tzinfo=dt.timezone.utc)
+    recs = [LogRecord(t, "u", 1, "KrcLogU", 4, "JOG", "Jogging", 3, "ProgramOverrideChanged", params=("100", "97")),
+            LogRecord(t, "u", 2, "KrcLogU", 4, "JOG", "Jogging", 3, "ProgramOverrideChanged", params=("97", "50")),
+            LogRecord(t, "u", 3, "KrcLogU", 4, "KcpKeys", "HardKey", 1, "LogStartPlus"),
+            LogRecord(t, "u", 4, "KrcLogU", 4, "JOG", "Jogging", 3, "ProgramOverrideChanged", params=("50", "10")),
+            LogRecord(t, "u", 5, "KrcLog", 2, "System", "CrossMeld", 1422, "M_1422"),
+            LogRecord(t, "u", 6, "KrcLog", 2, "System", "CrossMeld", 1008, "M_1008")]
+    assert [(a.kind, a.text, a.count) for a in timeline(recs)] == [
+        ("override", "override 100 -> 50 %", 2), ("start", "start key (forward)", 1), ("override", "override 50 -> 10 %", 1)]
+    texts = {g.number: g.text for g in messages(recs, KNOWN_MESSAGES)}
+    # reference §8.2: 1422 "value invalid"; a number the project does not raise has no text
+    assert (texts[1422], texts[1008]) == ("value invalid", "text not in the archive")
+    assert KNOWN_MESSAGES[1430][0] == "interrupt not declared"
