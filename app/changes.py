@@ -34,6 +34,7 @@ from krl.diff.ident import generator, identify
 from krl.diff.report import findings, relative, report_html, touched_entries, unread_lines
 from interp.outcomes import outcome_changes, run_outcomes
 from interp.realprograms import REPORT_SIM_TIME_S
+from app.reportlog import report_logbooks
 
 
 def _fail(command: str, exc: Exception) -> None:
@@ -191,7 +192,8 @@ def report(backup: str, since: str | None, runs: bool, max_sim_time: float | Non
             with side(backup) as b:
                 # the source views are read while an archive is still extracted
                 text = report_html(backup, len(files), new_findings, pm, links=links, idents=[identify(b, "backup")],
-                                   generated=generator(), new_root=_root(b, links))
+                                   generated=generator(), new_root=_root(b, links),
+                                   logbooks=report_logbooks((backup, b.root)))
         else:
             pm_old, diags_old, files_old, lines_old = load_map(since)
             with side(since) as a, side(backup) as b:
@@ -209,7 +211,8 @@ def report(backup: str, since: str | None, runs: bool, max_sim_time: float | Non
                     unread=(unread_lines(pm_old, lines_old), unread_lines(pm, lines)),
                     old_map=pm_old, touched=touched, runs=runs, max_sim_time=max_sim_time,
                     new_root=_root(b, links), old_root=_root(a, links),
-                    idents=[identify(a, "old"), identify(b, "new")], generated=generator())
+                    idents=[identify(a, "old"), identify(b, "new")], generated=generator(),
+                    logbooks=report_logbooks((backup, b.root), (since, a.root)))
     except DiffInputError as exc:
         _fail("report", exc)
     except (ValueError, GraphTooLarge) as exc:

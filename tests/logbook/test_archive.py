@@ -10,19 +10,23 @@ from __future__ import annotations
 import html
 import re
 import shutil
+import xml.etree.ElementTree as ET
 from pathlib import Path
 
 import pytest
 from click.testing import CliRunner
+from Evtx.Evtx import Evtx
 
 from app import main
 from krl.kssarchive import archive_root, log_files, parse_am_ini, parse_archive_info, read_info
 from tests.logbook.archive import build_archive, zip_folder
 
+NS = "{http://schemas.microsoft.com/win/2004/08/events/event}"
+
 
 @pytest.fixture(scope="module")
-def archive(tmp_path_factory) -> Path:
-    return build_archive(tmp_path_factory.mktemp("kss") / "archive", None)
+def archive(tmp_path_factory, event_logs) -> Path:
+    return build_archive(tmp_path_factory.mktemp("kss") / "archive", event_logs, ("KrcLogI.evt",))
 
 
 @pytest.fixture(scope="module")
@@ -62,19 +66,33 @@ def test_robot_show_names_the_archive(archive, tmp_path, zipped):
     assert "packages   KUKA.PROFINET MS 6.0.8, KUKA.UpdateService 1.1.24" in lines
 
 
-def test_the_report_cover_names_the_archive(archive, tmp_path):
+def test_the_report_cover_names_the_archive_and_its_logbook(archive, tmp_path, event_logs):
     out = tmp_path / "report.html"
     res = krl("report", str(zip_folder(archive, tmp_path / "archive.zip")), "--no-runs", "-o", str(out))
     assert res.exit_code == 0, res.output
-    row = re.search(r'<tr id="cover-archive">(.*?)</tr>', out.read_text(encoding="utf-8"), re.S).group(1)
+    page = out.read_text(encoding="utf-8")
+    row = re.search(r'<tr id="cover-archive">(.*?)</tr>', page, re.S).group(1)
     text = html.unescape(re.sub(r"<[^>]+>", " ", row))
     assert "Test_Cell_75, serial 750075, #KR180R3200PA C4 FLR, KSS 8.7.8 build 671" in " ".join(text.split())
     assert "technology packages: KUKA.PROFINET MS 6.0.8, KUKA.UpdateService 1.1.24" in " ".join(text.split())
+    # the logbook section: KrcLogI's 26 records, by module and number as python-evtx reads them
+    section = re.search(r'<section class="logbook" id="logbook-backup">(.*?)</section>', page, re.S).group(1)
+    assert "26 of 26 records" in section
+    counts: dict = {}
+    with Evtx(str(event_logs / "KrcLogI.evt")) as log:
+        for rec in log.records():
+            ls = ET.fromstring(next(d.text for d in ET.fromstring(rec.xml()).iter(NS + "Data")))
+            key = (ls.findtext("M"), ls.findtext("N"))
+            counts[key] = counts.get(key, 0) + 1
+    rows = re.findall(r'<tr><td class="num">(\d+)</td><td>(\w+)</td><td class="num">(\d*)</td>', section)
+    assert {(m, n): int(c) for c, m, n in rows} == counts
 
 
-def test_the_archive_is_found_from_inside_and_its_logs_listed(archive, tmp_path):
+def test_the_archive_is_found_from_inside_and_its_logs_listed(tmp_path):
+    archive = build_archive(tmp_path / "archive", None)
     assert archive_root(archive / "KRC" / "R1" / "Program" / "Parca_Birakma" / "B3_Parca_Birakma.src") == archive
-    assert archive_root(tmp_path) is None
+    (tmp_path / "other").mkdir()
+    assert archive_root(tmp_path / "other") is None
     (archive / "Log Files" / "KrcLogU.evt").write_bytes(b"")
     (archive / "Log Files" / "KrcLog.evt").write_bytes(b"")
     (archive / "Log Files" / "notes.txt").write_text("")
