@@ -34,7 +34,7 @@ from krl.diff.ident import generator, identify
 from krl.diff.report import findings, relative, report_html, touched_entries, unread_lines
 from interp.outcomes import outcome_changes, run_outcomes
 from interp.realprograms import REPORT_SIM_TIME_S
-from app.reportlog import report_logbooks
+from app.reportlog import graph_marks, report_logbooks
 
 
 def _fail(command: str, exc: Exception) -> None:
@@ -143,7 +143,8 @@ def load_map(path: str):
 def graph(backup: str, fmt: str, links: str, output: str | None) -> None:
     """The program map of a KRC backup (folder or .zip) or a folder: routines, calls,
     interrupts, triggers, RUN commands and EKI channels, entry points and unreachable routines.
-    html: an interactive page (zoom, pan, search, a routine's neighbourhood), offline."""
+    html: an interactive page (zoom, pan, search, a routine's neighbourhood), offline; in a
+    controller archive the routines its logbook names are marked."""
 
     try:
         pm, _diags, _n, _lines = load_map(backup)
@@ -152,7 +153,7 @@ def graph(backup: str, fmt: str, links: str, output: str | None) -> None:
         elif fmt == "svg":
             text = to_svg(pm)
         elif fmt == "html":
-            text = to_html(pm, links)
+            text = to_html(pm, links, graph_marks(pm, backup))
         elif fmt == "text":
             text = "\n".join(to_text(pm))
         else:

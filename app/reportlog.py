@@ -18,9 +18,11 @@ from krl.archive import ArchiveError
 from krl.logbook.links import link_all
 from krl.logbook.record import LogRecord, log_sources, read_logbook
 from krl.logbook.summary import summary_json, timeline
+from krl.programmap.graph import ProgramMap
+from krl.programmap.render import logbook_marks
 from interp.runtime.kssmessages import KNOWN_MESSAGES
 
-__all__ = ["side_logbook", "report_logbooks"]
+__all__ = ["graph_marks", "side_logbook", "report_logbooks"]
 
 #: the operator's actions and message groups the report lists per side (the rest are counted)
 MAX_REPORT_ACTIONS = 200
@@ -93,3 +95,14 @@ def report_logbooks(new: tuple[str, Path | None], old: tuple[str, Path | None] |
     out = [side_logbook("old", old[0], old[1], records=old_recs) if old_recs else None,
            side_logbook("new", new[0], new[1], since, records=new_recs) if new_recs else None]
     return [x for x in out if x is not None]
+
+
+def graph_marks(pm: ProgramMap, path: str) -> dict[str, str]:
+    """The program map's marks (krl/programmap/render.py ``logbook_marks``) of the archive at
+    `path`: the modules and variables its logbook names; {} without event logs."""
+    got = _records(path)
+    named: dict[str, int] = {}
+    for r in got[0] if got is not None else []:
+        if r.names:
+            named[r.names] = named.get(r.names, 0) + 1
+    return logbook_marks(pm, named) if named else {}

@@ -44,7 +44,7 @@ from krl.diff.core import KIND_TITLES, KINDS, Diff
 from krl.diff.sources import SourceViews
 from krl.diff.text import format_delta, html_helpers
 from krl.programmap.graph import ProgramMap
-from krl.programmap.render import LINKS, context, file_href, map_widget
+from krl.programmap.render import LINKS, context, file_href, logbook_marks, map_widget
 from krl.render import render_html
 
 __all__ = ["Finding", "Touched", "findings_delta", "relative", "touched_entries", "report_html", "RUN_KINDS",
@@ -352,7 +352,8 @@ def report_html(backup: str, files: int, new_findings: list[Finding], pm: Progra
         max_sim_time=max_sim_time, retest=checks, idents=idents or [], generated=generated,
         logbooks=logbooks or [],
         footer=css_string(_footer(backup, idents or [])),
-        reach=reach, map_widget=map_widget(pm, links if links in LINKS else "none"), format_delta=format_delta,
+        reach=reach, map_widget=map_widget(pm, links if links in LINKS else "none", _marks(pm, logbooks)),
+        format_delta=format_delta,
         map_tables=Markup(render_html("krl.programmap", "_map_body.html.j2", edges=False, **context(pm, None))),
         kind_counts=[(k, KIND_TITLES[k], len(getattr(diff, k))) for k in KINDS] if diff is not None else [],
         **html_helpers(link), **context(pm, None))
@@ -363,6 +364,15 @@ def report_html(backup: str, files: int, new_findings: list[Finding], pm: Progra
 
 
 _SOURCES_MARK = "<!-- krl report: the source views -->"
+
+
+def _marks(pm: ProgramMap, logbooks: list[dict] | None) -> dict[str, str]:
+    """The map's marks (krl/programmap/render.py ``logbook_marks``) from the newer side's
+    logbook: the modules and variables its records name."""
+    lb = next((b for b in reversed(logbooks or []) if b["role"] != "old"), None)
+    if lb is None:
+        return {}
+    return logbook_marks(pm, {p["names"]: p["count"] for p in lb["summary"]["programs"]})
 
 
 def _footer(backup: str, idents: list[dict]) -> str:

@@ -18,6 +18,8 @@ from click.testing import CliRunner
 from Evtx.Evtx import Evtx
 
 from app import main
+from app.changes import load_map
+from krl.programmap.render import logbook_marks, page_data
 from krl.kssarchive import archive_root, log_files, parse_am_ini, parse_archive_info, read_info
 from tests.logbook.archive import build_archive, zip_folder
 
@@ -123,3 +125,16 @@ def test_a_bad_manifest_is_a_note_never_an_error(tmp_path):
     assert info.robot_name == "" and len(info.notes) == 2
     assert "am.ini: not an INI file" in info.notes[0]
     assert "ArchiveInfo.xml: not readable XML" in info.notes[1]
+
+
+def test_the_map_marks_what_the_logbook_names(archive):
+    """The main routine of each module a logbook record names gets a mark (krl graph, krl report);
+    a module the archive does not hold, none."""
+    pm = load_map(str(archive))[0]
+    marks = logbook_marks(pm, {"B3_PARCA_BIRAKMA.b3_parcasirasi": 5, "CELL": 2, "B3_PARCA_BIRAKMA": 1,
+                               "B4_PARCA_BIRAKMA": 3})
+    by_name = {pm.nodes[nid].name.upper(): text for nid, text in marks.items()}
+    assert by_name == {"B3_PARCA_BIRAKMA": "B3_PARCA_BIRAKMA.b3_parcasirasi (5 records), B3_PARCA_BIRAKMA (1 record)",
+                       "CELL": "CELL (2 records)"}
+    data = page_data(pm, "none", marks)
+    assert {n["name"].upper() for n in data["nodes"] if n["logbook"]} == {"B3_PARCA_BIRAKMA", "CELL"}

@@ -65,3 +65,8 @@ def test_the_report_shows_the_logbook_since_the_older_archive(event_logs, tmp_pa
             assert var in shown
             checked += 1
         assert checked > 0
+        # the map marks the modules the new side's records name (B1 and CELL by the logs) with a
+        # red halo: drawn folded, the module cell and the folder of B1 and B3 carry it
+        page.wait_for_function("document.body.dataset.ready === '1'", timeout=180_000)
+        marked = [x.split("\n")[0] for x in page.evaluate("window.krlMap.cy.nodes('.logbook').map(n => n.data('label'))")]
+        assert sorted(marked) == ["R1/Program/Parca_Birakma", "cell"]
