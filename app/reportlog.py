@@ -16,7 +16,7 @@ from pathlib import Path
 
 from krl.archive import ArchiveError
 from krl.logbook.links import link_all
-from krl.logbook.record import LogRecord, log_sources, read_logbook
+from krl.logbook.record import LogRecord, has_event_logs, log_sources, read_logbook
 from krl.logbook.summary import summary_json, timeline
 from krl.programmap.graph import ProgramMap
 from krl.programmap.render import logbook_marks
@@ -30,6 +30,8 @@ MAX_REPORT_MESSAGES = 100
 
 
 def _records(path: str) -> tuple[list[LogRecord], list[str], Path | None] | None:
+    if not has_event_logs(path):           # a backup that is no archive: nothing extracted again
+        return None
     try:
         with log_sources(path) as src:
             if not src.logs:

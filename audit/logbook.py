@@ -10,7 +10,7 @@ main process (event logs are read in about 0.5 ms a record), after the runs.
 from __future__ import annotations
 
 from krl.kssarchive import archive_root
-from krl.logbook.record import log_sources, read_logbook
+from krl.logbook.record import has_event_logs, log_sources, read_logbook
 from krl.logbook.summary import messages
 
 __all__ = ["MAX_AUDIT_LOG_GROUPS", "fleet_logbook", "unit_logbook"]
@@ -23,7 +23,7 @@ def unit_logbook(root: str) -> dict | None:
     """{records, errors, messages: [{module, number, key, count, first, last}], left_out} of the
     archive holding the unit's `root`; None when it is no archive or has no event log."""
     arch = archive_root(root)
-    if arch is None:
+    if arch is None or not has_event_logs(arch):
         return None
     with log_sources(arch) as src:
         if not src.logs:

@@ -2,8 +2,9 @@
 
 `krl check`, `krl recover` and `krl run --workspace` accept a backup archive as they accept a
 folder: :func:`backup_source` inspects every entry, extracts the KRL files (``.src``, ``.dat``,
-``.sub``, any case) and a ``krl.toml`` into a fresh temporary folder, yields that folder, and
-removes it afterwards whatever happens. The archive is untrusted (docs/security.md); it is
+``.sub``, any case), a ``krl.toml`` and, when the caller asks (``also``: ``krl log`` asks for a
+controller archive's event logs and manifest), more files by name into a fresh temporary
+folder, yields that folder, and removes it afterwards whatever happens. The archive is untrusted (docs/security.md); it is
 refused whole, with an :class:`ArchiveError` naming the archive and the entry, when
 
 * an entry's path is absolute (``/x``, ``\\x``, ``C:x``), has a ``..`` component or a NUL, or is

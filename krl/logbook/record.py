@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import datetime as dt
 import os
+import zipfile
 from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field
@@ -37,7 +38,7 @@ from krl.limits import MAX_LOG_RECORD_CHARS, MAX_LOG_RECORDS
 
 from .evtx import Event, LogError, read_events
 
-__all__ = ["ARCHIVE_FILES", "LogRecord", "Logbook", "Sources", "log_sources", "parse_time", "read_logbook",
+__all__ = ["ARCHIVE_FILES", "LogRecord", "Logbook", "Sources", "has_event_logs", "log_sources", "parse_time", "read_logbook",
            "record_of"]
 
 #: what krl log extracts of a zipped archive besides its KRL files
@@ -151,6 +152,21 @@ def _found(path: Path, shown: Shown) -> Sources:
     else:
         files = _evts(path) or log_files(root if root is not None else path)
     return Sources([(f, shown(str(f))) for f in files], root, shown)
+
+
+def has_event_logs(path: str | Path) -> bool:
+    """True when :func:`log_sources` would find an event log for `path`, found cheaply: a zip's
+    entry names (nothing extracted), else the folders :func:`log_sources` looks in."""
+    p = Path(path)
+    if is_archive(p):
+        try:
+            with zipfile.ZipFile(p) as zf:
+                return any(n.lower().endswith(".evt") for n in zf.namelist())
+        except (zipfile.BadZipFile, OSError, ValueError):
+            return False
+    if not p.exists():
+        return False
+    return bool(_found(p, Shown()).logs)
 
 
 @contextmanager

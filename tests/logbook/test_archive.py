@@ -8,6 +8,7 @@ values of its am.ini and ArchiveInfo.xml as ../shared/event-logs/README.md descr
 from __future__ import annotations
 
 import html
+import json
 import re
 import shutil
 import xml.etree.ElementTree as ET
@@ -138,3 +139,11 @@ def test_the_map_marks_what_the_logbook_names(archive):
                        "CELL": "CELL (2 records)"}
     data = page_data(pm, "none", marks)
     assert {n["name"].upper() for n in data["nodes"] if n["logbook"]} == {"B3_PARCA_BIRAKMA", "CELL"}
+
+
+def test_log_show_reads_a_zipped_archive(archive, tmp_path):
+    path = zip_folder(archive, tmp_path / "archive.zip")
+    res = krl("log", "show", "--format", "json", str(path))
+    assert res.exit_code == 0, res.output
+    objs = [json.loads(line) for line in res.output.splitlines()]
+    assert len(objs) == 26 and {o["log"] for o in objs} == {f"{path}/Log Files/KrcLogI.evt"}
