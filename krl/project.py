@@ -56,7 +56,7 @@ from krl.files import Entry
 from krl.limits import MAX_FOLDER_DEPTH
 from krl.source import is_krl_file
 
-__all__ = ["ProgramFiles", "SYSTEM_DIRS", "backup_of", "collect_entries", "collect_files", "find_backups",
+__all__ = ["ProgramFiles", "SYSTEM_DIRS", "backup_of", "cell_program", "collect_entries", "collect_files", "find_backups",
            "folder_entries", "folder_groups", "is_submit_file", "is_system_path", "machine_data_file", "module_key",
            "modules_of", "program_folder", "project_of", "system_folder", "system_folder_of", "with_basis"]
 
@@ -171,6 +171,18 @@ def machine_data_file(root: Path) -> Path | None:
         if f is not None and not f.is_symlink() and f.is_file():
             return f
     return None
+
+
+def cell_program(root: Path) -> Path | None:
+    """The backup's cell program, which the controller selects in Automatic External (KUKA System
+    Software 8: the external PLC starts ``CELL.SRC``): ``R1/cell.src`` (or ``cell.src`` at a flat
+    export's top), beside its System folder; any letter case, links never followed; None when the
+    backup has none."""
+    sysdir = system_folder(root)
+    r1 = _child(root, "r1")
+    base = sysdir.parent if sysdir is not None else r1 if r1 is not None else root
+    f = _child(base, "cell.src")
+    return f if f is not None and not f.is_symlink() and f.is_file() else None
 
 
 def submit_program(root: Path) -> Path | None:

@@ -147,3 +147,20 @@ def test_log_show_reads_a_zipped_archive(archive, tmp_path):
     assert res.exit_code == 0, res.output
     objs = [json.loads(line) for line in res.output.splitlines()]
     assert len(objs) == 26 and {o["log"] for o in objs} == {f"{path}/Log Files/KrcLogI.evt"}
+
+
+@pytest.mark.parametrize("interp,zipped", [("tree", False), ("vm", True)])
+def test_krl_run_of_an_archive_runs_its_cell_program(steu_only, tmp_path, interp, zipped):
+    """An archive given whole runs KRC/R1/cell.src (CELL calls B1 and B3, which complete), folder
+    (tree interpreter) or zip (VM); a folder without a backup is a usage error naming the way to
+    name a program. Before, a folder stopped at once ("no main routine in archive") and a zip was
+    refused ("name the program to run in it")."""
+    path = zip_folder(steu_only, tmp_path / "archive.zip") if zipped else steu_only
+    res = krl("run", str(path), "--interp", interp, "--max-sim-time", "1")
+    lines = res.output.splitlines()
+    assert lines[0] == f"run {path / 'KRC' / 'R1' / 'cell.src'} ({interp} interpreter)", res.output
+    assert lines[2].split() == ["ended", "completed", "at", "t=0.000", "s"], res.output
+    assert res.exit_code == 0
+    (tmp_path / "empty").mkdir()
+    res = krl("run", str(tmp_path / "empty"))
+    assert res.exit_code == 2 and "holds no KRC backup with a cell program (R1/cell.src)" in res.output
