@@ -186,12 +186,12 @@ def summary_lines(records: list[LogRecord], texts: dict[int, tuple[str, str]] | 
         progs = f"  programs: {', '.join(m['programs'])}" if m["programs"] else ""
         out.append(printable(f"  {m['count']:>5}  {m['module']} {num} {m['key']}  {m['first']} .. {m['last']}"
                              + text + progs))
-    out += ["", "programs named:"]
-    for p in s["programs"] or [{"names": "(none)", "file": "", "line": None, "count": 0}]:
+    out += ["", "programs named:" + ("" if s["programs"] else " none (or no archive's code to tie them to)")]
+    for p in s["programs"]:
         place = p["file"] + (f":{p['line']}" if p["line"] else "")
-        out.append(printable(f"  {p['names']}  {place}" + (f"  ({p['count']} records)" if p["count"] else "")))
-    out += ["", "operator actions:"]
-    for a in s["actions"] or [{"time": "", "kind": "", "text": "(none)", "count": 1}]:
+        out.append(printable(f"  {p['names']}  {place}  ({p['count']} records)"))
+    out += ["", "operator actions:" + ("" if s["actions"] else " none")]
+    for a in s["actions"]:
         times = f"  ({a['count']} changes)" if a["count"] > 1 else ""
         place = f"  -> {a['place']}" if a.get("place") else ""
         out.append(printable(f"  {a['time']}  {a['kind']:<9} {a['text']}{times}{place}"))
