@@ -26,6 +26,9 @@ from tests.logbook.archive import build_archive, zip_folder
 
 NS = "{http://schemas.microsoft.com/win/2004/08/events/event}"
 
+# one worker takes the module (make test: --dist loadgroup), so its module fixtures build each archive once
+pytestmark = [pytest.mark.xdist_group("logbook")]
+
 
 @pytest.fixture(scope="module")
 def archive(tmp_path_factory, event_logs) -> Path:

@@ -36,6 +36,9 @@ SCHEMAS = Path(__file__).resolve().parents[2] / "docs" / "schemas"
 NS = "{http://schemas.microsoft.com/win/2004/08/events/event}"
 SAMPLE = 20
 
+# one worker takes the module (make test: --dist loadgroup), so its module fixtures read each log once
+pytestmark = [pytest.mark.xdist_group("logbook")]
+
 
 def validate(name: str, obj) -> None:
     """`obj` against docs/schemas/<name>.schema.json (tests/test_json_schemas.py checks the schemas)."""
