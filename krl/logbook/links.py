@@ -39,13 +39,14 @@ _ORDER = {".src": 0, ".sub": 1, ".dat": 2}
 
 def module_reference(param: str) -> tuple[str, str, str] | None:
     """(kind, what, variable) of a parameter naming a module: ``("module", NAME, var)`` for
-    ``/R1/NAME.SRC[/var]``, ``("file", "R1/x/name.src", "")`` for ``KRC:\\R1\\x\\name.src``
-    (the extension may be absent); None for any other parameter. ``var`` is the variable's name
-    without indices or components ("" when none)."""
+    ``/R1/NAME.SRC[/var]`` (``/R1/NAME.SRC/ROUTINE/var``: a routine's local), ``("file",
+    "R1/x/name.src", "")`` for ``KRC:\\R1\\x\\name.src`` (the extension may be absent); None for
+    any other parameter. ``var`` is the variable's name without indices or components ("" when none)."""
     s = param.strip()
     m = _MODULE_PATH.match(s)
     if m:
-        var = _NAME.match(m.group(3) or "")
+        # /R1/MOD.SRC/var, /R1/MOD.SRC/var[2].x, or a local of a routine: /R1/MOD.SRC/ROUTINE/var
+        var = _NAME.match((m.group(3) or "").rsplit("/", 1)[-1])
         return "module", m.group(1), var.group(0) if var else ""
     m = _KRC_PATH.match(s)
     if m:

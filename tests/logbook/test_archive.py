@@ -21,6 +21,7 @@ from Evtx.Evtx import Evtx
 from app import main
 from app.changes import load_map
 from krl.programmap.render import logbook_marks, page_data
+from krl.logbook.links import module_reference
 from krl.kssarchive import archive_root, log_files, parse_am_ini, parse_archive_info, read_info
 from tests.logbook.archive import build_archive, zip_folder
 
@@ -167,3 +168,17 @@ def test_krl_run_of_an_archive_runs_its_cell_program(steu_only, tmp_path, interp
     (tmp_path / "empty").mkdir()
     res = krl("run", str(tmp_path / "empty"))
     assert res.exit_code == 2 and "holds no KRC backup with a cell program (R1/cell.src)" in res.output
+
+
+def test_module_references():
+    """The forms the shared logs and their README show (docs/log.md), and near misses."""
+    assert module_reference("/R1/B3_PARCA_BIRAKMA.SRC/b3_parcasirasi") == ("module", "B3_PARCA_BIRAKMA", "b3_parcasirasi")
+    assert module_reference("/R1/CELL.SRC") == ("module", "CELL", "")
+    assert module_reference("/R1/B4_PARCA_BIRAKMA.SRC/p") == ("module", "B4_PARCA_BIRAKMA", "p")
+    assert module_reference("/R1/X.SRC/arr[3].pos") == ("module", "X", "arr")
+    assert module_reference("/R1/X.SRC/MAIN/i") == ("module", "X", "i")
+    assert module_reference("KRC:\\R1\\Program\\Parca_Birakma\\B3_Parca_Birakma") == \
+        ("file", "R1/Program/Parca_Birakma/B3_Parca_Birakma", "")
+    assert module_reference("krc:\\R1\\cell.src") == ("file", "R1/cell.src", "")
+    for other in ("$OUT[235]", "RobotData.xml", "/R1", "KrcSecurity#Operator", "R1/CELL.SRC"):
+        assert module_reference(other) is None, other
