@@ -15,7 +15,9 @@ EventRecordID, Channel, Level, EventID, Provider, Computer) and the ``LS`` docum
 (docs/security.md): larger than ``MAX_LOG_BYTES`` it is not read; a file whose header is not an
 EVTX header, a chunk past the file's end (a truncated copy), a chunk whose checksum fails, or a
 record python-evtx cannot parse gives a :class:`LogError` naming the file and the record (the
-last one read before it, and the byte offset), and the records before it stand.
+last one read before it, and the byte offset), and the records before it stand. A *dirty*
+header (the log was open when it was copied: its chunk count may lag) lets the chunks after
+the counted ones be read as long as they verify.
 """
 
 from __future__ import annotations
@@ -177,8 +179,13 @@ def read_events(path: str | Path, shown: str | None = None) -> Iterator[Event]:
         if not header.check_magic():
             raise LogError(f"{shown}: not an EVTX event log (no 'ElfFile' header)")
         count = header.chunk_count()
+        dirty = header.is_dirty()
         seen = 0
-        for chunk in header.chunks():      # python-evtx stops at the file's end: counted below
+        # python-evtx stops at the file's end (counted below); a dirty header (the log was open
+        # when copied) may lag behind chunks already written: those that verify are read too
+        for chunk in header.chunks(include_inactive=dirty):
+            if seen >= count and not (chunk.check_magic() and chunk.verify()):
+                break
             seen += 1
             if not chunk.check_magic() or not chunk.verify():
                 raise LogError(f"{shown}: chunk {seen} (byte {chunk.offset()}) is damaged (its checksum "
