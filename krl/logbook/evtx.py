@@ -23,6 +23,7 @@ the counted ones be read as long as they verify.
 from __future__ import annotations
 
 import datetime as dt
+import logging
 import struct
 from collections.abc import Iterator
 from dataclasses import dataclass
@@ -39,6 +40,11 @@ from Evtx.Evtx import Evtx
 from krl.limits import MAX_LOG_BYTES
 
 __all__ = ["Event", "LogError", "read_events"]
+
+# python-evtx logs a damaged template's "Unexpected token encountered" as a warning; without a
+# handler Python prints it bare on standard error. What the damage costs is this module's
+# LogError, naming the file and the record; the library's own line is not shown.
+logging.getLogger("Evtx").addHandler(logging.NullHandler())
 
 _EVENT_NS = "{http://schemas.microsoft.com/win/2004/08/events/event}"
 #: what python-evtx raises on bytes that are not what the format says (its own exceptions, and
