@@ -39,6 +39,7 @@ SUBCOMMANDS = {
     "diff": "app.changes", "graph": "app.changes", "report": "app.changes",
     "pendant": "pendant.cli",
     "audit": "audit.cli",
+    "log": "app.log",
 }
 
 #: each subcommand's summary in `krl --help`: the first sentence of its help (tests/test_cli_registry.py
@@ -63,9 +64,10 @@ SUMMARIES = {
     'lsp': 'Run the KRL language server on stdin/stdout (see docs/editors.md).',
     'debug': 'Debug a KRL program over the Debug Adapter Protocol on stdin/stdout.',
     'diff': 'What changed between two KRC backups (folders or .zip) or two files: points, frames and loads, routines, declarations and signals, inline-form motions.',
-    'graph': "The program map of a KRC backup (folder or .zip) or a folder: routines, calls, interrupts, triggers, RUN commands and EKI channels, entry points and unreachable routines. html: an interactive page (zoom, pan, search, a routine's neighbourhood), offline.",
+    'graph': "The program map of a KRC backup (folder or .zip) or a folder: routines, calls, interrupts, triggers, RUN commands and EKI channels, entry points and unreachable routines. html: an interactive page (zoom, pan, search, a routine's neighbourhood), offline; in a controller archive the routines its logbook names are marked.",
     'report': 'The change report a customer signs: one HTML page that opens with both backups identified (their robot, controller, software, dates and SHA-256) and a signature block, a summary, then (with --since OLD) the diff from OLD to BACKUP, the check findings the change introduced or removed, the run outcomes of the entry points it touches (old against new), what to retest on the robot, the interactive program map, and every check finding of BACKUP.',
     'pendant': 'Serve a virtual smartPAD for TARGET (a KRC backup folder or .zip, a folder of KRL, or a program .src: selected at the start; default the current folder) on 127.0.0.1 and open it in the browser.',
+    'log': 'The controller\'s logbook: the event logs (Log Files/KrcLog*.evt) of a KUKA archive, tied to its code (docs/log.md).',
     'audit': "Check every KRC backup and program folder in FOLDERS and run every entry point with --inputs auto; write one report (HTML and JSON) with each backup's health.",
 }
 

@@ -35,6 +35,7 @@ from krl.diff.ident import generator, identify
 from krl.diff.report import findings, relative, report_html, touched_entries, unread_lines
 from interp.outcomes import outcome_changes, run_outcomes
 from interp.realprograms import REPORT_SIM_TIME_S
+from app.reportlog import graph_marks, report_logbooks
 
 
 def _fail(command: str, exc: Exception) -> None:
@@ -143,7 +144,8 @@ def load_map(path: str):
 def graph(backup: str, fmt: str, links: str, output: str | None) -> None:
     """The program map of a KRC backup (folder or .zip) or a folder: routines, calls,
     interrupts, triggers, RUN commands and EKI channels, entry points and unreachable routines.
-    html: an interactive page (zoom, pan, search, a routine's neighbourhood), offline."""
+    html: an interactive page (zoom, pan, search, a routine's neighbourhood), offline; in a
+    controller archive the routines its logbook names are marked."""
 
     try:
         pm, _diags, _n, _lines = load_map(backup)
@@ -152,7 +154,7 @@ def graph(backup: str, fmt: str, links: str, output: str | None) -> None:
         elif fmt == "svg":
             text = to_svg(pm)
         elif fmt == "html":
-            text = to_html(pm, links)
+            text = to_html(pm, links, graph_marks(pm, backup))
         elif fmt == "text":
             text = "\n".join(to_text(pm))
         else:
@@ -192,7 +194,8 @@ def report(backup: str, since: str | None, runs: bool, max_sim_time: float | Non
             with side(backup) as b:
                 # the source views are read while an archive is still extracted
                 text = report_html(backup, len(files), new_findings, pm, links=links, idents=[identify(b, "backup")],
-                                   generated=generator(), new_root=_root(b, links))
+                                   generated=generator(), new_root=_root(b, links),
+                                   logbooks=report_logbooks((backup, b.root)))
         else:
             pm_old, diags_old, files_old, lines_old = load_map(since)
             with side(since) as a, side(backup) as b:
@@ -210,7 +213,8 @@ def report(backup: str, since: str | None, runs: bool, max_sim_time: float | Non
                     unread=(unread_lines(pm_old, lines_old), unread_lines(pm, lines)),
                     old_map=pm_old, touched=touched, runs=runs, max_sim_time=max_sim_time,
                     new_root=_root(b, links), old_root=_root(a, links),
-                    idents=[identify(a, "old"), identify(b, "new")], generated=generator())
+                    idents=[identify(a, "old"), identify(b, "new")], generated=generator(),
+                    logbooks=report_logbooks((backup, b.root), (since, a.root)))
     except DiffInputError as exc:
         _fail("report", exc)
     except (ValueError, GraphTooLarge) as exc:

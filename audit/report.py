@@ -40,6 +40,8 @@ from krl.render import render_html
 from krl.durable import write_text
 from krl.source import read_source
 
+from audit.logbook import fleet_logbook, unit_logbook
+
 __all__ = ["AUDIT_FORMAT", "STATUSES", "rel_path", "plural", "report_data", "health", "write_report", "to_html",
            "causes_of", "motion_causes", "finding_groups"]
 
@@ -212,6 +214,7 @@ def report_data(folders: list[str], units: list, checked: list[dict], runs: list
             "overlaps": len(unit["outputs"]["overlaps"]),
         }
         unit["status"], unit["reasons"] = health(unit)
+        unit["logbook"] = unit_logbook(u.root)
         out_units.append(unit)
     causes: dict[str, int] = {}
     for u in out_units:
@@ -226,6 +229,7 @@ def report_data(folders: list[str], units: list, checked: list[dict], runs: list
         "check_errors": sum(u["errors"] for u in out_units),
         "motion_errors": sum(sum(e["event_counts"].values()) for u in out_units for e in u["entries"]),
         "overlaps": sum(len(u["outputs"]["overlaps"]) for u in out_units),
+        "logbook": fleet_logbook(out_units),
     }
     return {"format": AUDIT_FORMAT, "tool": f"krl-tools {__version__}",
             "generated": datetime.now(timezone.utc).strftime("%Y-%m-%d %H:%M:%S UTC"),

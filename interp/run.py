@@ -32,7 +32,8 @@ from krl.archive import ArchiveError, backup_source, is_archive
 from krl.ast import nodes as N
 from krl.semantics.resolve import UNRESOLVED
 from krl.files import spelled, spelled_within
-from krl.project import backup_of, boot_submit
+from krl.project import backup_of, boot_submit, find_backups
+from krl.project import cell_program as backup_cell_program
 from krl.source import is_krl_file
 from krl.terminal import printable
 from net.plc import cell_map
@@ -373,6 +374,18 @@ class RunSetup:
         return make_runtime(self.spec.with_(trace=trace, observer=observer, **changes))
 
 
+def _cell_of_folder(folder: Path) -> Path | None:
+    """The cell program (krl.project ``cell_program``) of the one KRC backup at or below `folder`."""
+    root = backup_of(folder, folder)
+    roots = [root] if root is not None else find_backups(folder)
+    return backup_cell_program(roots[0]) if len(roots) == 1 else None
+
+
+def _no_cell(path: Path) -> str:
+    return (f"{printable(path)} holds no KRC backup with a cell program (R1/cell.src); name the program to "
+            f"run in it: krl run --workspace {printable(path)} PROGRAM")
+
+
 def program_in(folder: Path, program: Path) -> Path | None:
     """PROGRAM inside an extracted archive: its relative path (any letter case of the file
     name), else the .src (then .sub) file whose stem is its name; None when there is none."""
@@ -394,18 +407,27 @@ def run_setup(options: dict) -> Iterator[RunSetup]:
     interp/cli.py ``run``: program, workspace, inputs, submit, no_submit, robot, ...; the others
     are kept in :attr:`RunSetup.options`). A ``workspace`` that is a KRC backup archive is
     checked and extracted for the duration of the ``with`` block (krl/archive.py), the program
-    named by its path or module name in it. Without ``submit`` and ``no_submit``, the backup's
+    named by its path or module name in it. A ``program`` that is a backup folder or archive
+    (without ``workspace``) runs its cell program (krl.project ``cell_program``: ``R1/cell.src``)
+    as the controller selects it in Automatic External. Without ``submit`` and ``no_submit``, the backup's
     SPS.SUB runs beside the program, as the controller starts it at boot (krl.project
     ``boot_submit``). Raises :class:`RunSetupError`."""
     program = Path(options["program"])
     workspace = Path(options["workspace"]) if options.get("workspace") is not None else None
-    if is_archive(program):
-        raise RunSetupError(f"{printable(program)} is a backup archive; name the program to run in it: "
-                            f"krl run --workspace {printable(program)} PROGRAM")
+    whole = workspace is None and (is_archive(program) or program.is_dir())
+    if whole:
+        # a backup or controller archive given whole: its cell program, as the controller selects it
+        workspace = program
+        if not is_archive(workspace):
+            program = _cell_of_folder(workspace)
+            if program is None:
+                raise RunSetupError(_no_cell(workspace))
     if workspace is not None and is_archive(workspace):
         try:
             with backup_source(workspace) as (folder, _shown):
-                found = program_in(folder, program)
+                found = _cell_of_folder(folder) if whole else program_in(folder, program)
+                if found is None and whole:
+                    raise RunSetupError(_no_cell(workspace))
                 if found is None:
                     raise RunSetupError(f"no program {printable(program)} in {printable(workspace)}")
                 yield _setup(found, folder, options,

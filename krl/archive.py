@@ -2,8 +2,9 @@
 
 `krl check`, `krl recover` and `krl run --workspace` accept a backup archive as they accept a
 folder: :func:`backup_source` inspects every entry, extracts the KRL files (``.src``, ``.dat``,
-``.sub``, any case) and a ``krl.toml`` into a fresh temporary folder, yields that folder, and
-removes it afterwards whatever happens. The archive is untrusted (docs/security.md); it is
+``.sub``, any case), a ``krl.toml`` and, when the caller asks (``also``: ``krl log`` asks for a
+controller archive's event logs and manifest), more files by name into a fresh temporary
+folder, yields that folder, and removes it afterwards whatever happens. The archive is untrusted (docs/security.md); it is
 refused whole, with an :class:`ArchiveError` naming the archive and the entry, when
 
 * an entry's path is absolute (``/x``, ``\\x``, ``C:x``), has a ``..`` component or a NUL, or is
@@ -82,13 +83,15 @@ def _check_kind(archive: str, info: zipfile.ZipInfo) -> None:
         raise ArchiveError(f"{archive}: entry '{info.filename}' is a symbolic link (reparse point)")
 
 
-def _wanted(parts: list[str]) -> bool:
+def _wanted(parts: list[str], also: tuple[str, ...] = ()) -> bool:
     name = parts[-1].lower()
-    return name.endswith(_KEEP_SUFFIXES) or name == "krl.toml"
+    return name.endswith(_KEEP_SUFFIXES + also) or name == "krl.toml"
 
 
-def inspect(zf: zipfile.ZipFile, archive: str) -> list[tuple[zipfile.ZipInfo, list[str]]]:
-    """Check every entry against the limits; returns the (entry, path parts) to extract."""
+def inspect(zf: zipfile.ZipFile, archive: str,
+            also: tuple[str, ...] = ()) -> list[tuple[zipfile.ZipInfo, list[str]]]:
+    """Check every entry against the limits; returns the (entry, path parts) to extract: the KRL
+    files, ``krl.toml``, and the files whose lower-case name ends in one of `also`."""
     infos = zf.infolist()
     if len(infos) > limits.MAX_ARCHIVE_ENTRIES:
         raise ArchiveError(f"{archive}: {len(infos)} entries (limit MAX_ARCHIVE_ENTRIES = "
@@ -107,14 +110,15 @@ def inspect(zf: zipfile.ZipFile, archive: str) -> list[tuple[zipfile.ZipInfo, li
             if ratio > limits.MAX_ARCHIVE_RATIO:
                 raise ArchiveError(f"{archive}: entry '{info.filename}' expands {ratio:.0f} times "
                                    f"(limit MAX_ARCHIVE_RATIO = {limits.MAX_ARCHIVE_RATIO}): a zip bomb?")
-        if parts and not info.is_dir() and _wanted(parts):
+        if parts and not info.is_dir() and _wanted(parts, also):
             keep.append((info, parts))
     return keep
 
 
-def extract_backup(archive: str | Path, dest: str | Path) -> int:
-    """Extract the KRL files (and krl.toml) of `archive` into the existing empty folder `dest`
-    after checking every entry; returns the number of files written. Raises ArchiveError."""
+def extract_backup(archive: str | Path, dest: str | Path, also: tuple[str, ...] = ()) -> int:
+    """Extract the KRL files (and krl.toml, and the files whose lower-case name ends in one of
+    `also`) of `archive` into the existing empty folder `dest` after checking every entry;
+    returns the number of files written. Raises ArchiveError."""
     archive_s = str(archive)
     dest = Path(dest)
     try:
@@ -124,7 +128,7 @@ def extract_backup(archive: str | Path, dest: str | Path) -> int:
     written = 0
     count = 0
     with zf:
-        keep = inspect(zf, archive_s)
+        keep = inspect(zf, archive_s, also)
         for info, parts in keep:
             target = dest.joinpath(*parts)
             try:
@@ -172,17 +176,19 @@ class Shown:
 
 
 @contextmanager
-def backup_source(path: str | Path) -> Iterator[tuple[Path, Shown]]:
+def backup_source(path: str | Path, also: tuple[str, ...] = ()) -> Iterator[tuple[Path, Shown]]:
     """``with backup_source(p) as (folder, shown)``: for a .zip, the checked and extracted
     temporary folder (removed on exit) and the path mapping; otherwise `p` itself and the
-    identity. Raises ArchiveError for a refused archive (before yielding)."""
+    identity. `also`: lower-case name endings of more files to extract than the KRL files
+    (``krl log``: ``(".evt", "am.ini", "archiveinfo.xml")``). Raises ArchiveError for a refused
+    archive (before yielding)."""
     p = Path(path)
     if not is_archive(p):
         yield p, Shown()
         return
     tmp = tempfile.mkdtemp(prefix="krl-backup-")
     try:
-        extract_backup(p, tmp)
+        extract_backup(p, tmp, also)
         yield Path(tmp), Shown(tmp, str(path))
     finally:
         shutil.rmtree(tmp, ignore_errors=True)

@@ -278,3 +278,16 @@ MAX_AUDIT_ENTRIES = 200
 MAX_AUDIT_FINDINGS = 500
 AUDIT_RUN_TIMEOUT_S = 900.0
 MAX_AUDIT_EVIDENCE_CHARS = 4_000_000
+
+# A controller archive as KUKA writes it (krl/kssarchive.py): its am.ini and ArchiveInfo.xml, in
+# bytes (the real KSS 8.7.8 archive's are 750 and 7,010 bytes); past it the file is not read and
+# the archive is described without it (a note names the file).
+MAX_ARCHIVE_INFO_BYTES = 1024 * 1024
+# The controller's logbook (`krl log`, krl/logbook): the largest event log read, in bytes (a KSS
+# event log is 64 KiB to a few MiB: the archive's KrcLogU.evt is 1.1 MB with 1,761 records), the
+# most records read from all the logs of one command (past it the rest of the logs is not read and
+# a note says so), and the characters of one record's LS document (a record is a few hundred
+# characters). Past the file size: an error naming the file; the other logs are still read.
+MAX_LOG_BYTES = 64 * 1024 * 1024
+MAX_LOG_RECORDS = 1_000_000
+MAX_LOG_RECORD_CHARS = 64 * 1024

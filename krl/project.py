@@ -4,9 +4,13 @@ One rule, used by ``krl check``, ``krl run``, ``krl asm``, ``krl lsp``, ``krl fm
 static check of ``krl recover`` (docs/architecture.md, "Project model"):
 
 1. **A backup.** A folder *B* is the *base* of a KRC backup when ``B/System/$config.dat`` is a
-   regular file (folder and file names in any letter case; links are never followed). The
-   backup's *root* is the folder holding *B* when *B* is named ``R1`` (``KRC/R1/System``: the
-   root is ``KRC``, so ``KRC/STEU`` belongs to it), else *B* itself (a flat export of R1).
+   regular file (folder and file names in any letter case; links are never followed), or when
+   *B* is named ``R1``, holds a ``Program``, ``System`` or ``Mada`` folder and its parent holds
+   ``STEU`` (the ``KRC`` folder of a controller archive as KUKA writes it: ``KRC/R1/{Program,
+   System,TP,Mada}`` beside ``KRC/STEU/{Mada,$config.dat}``, ../shared/event-logs/README.md;
+   krl/kssarchive.py reads the rest of such an archive). The backup's *root* is the folder
+   holding *B* when *B* is named ``R1`` (``KRC/R1/System``: the root is ``KRC``, so ``KRC/STEU``
+   belongs to it), else *B* itself (a flat export of R1).
 2. **The backup of a path** is the *outermost* backup root among the path's folders: a backup
    inside another one is part of it. With ``within`` (``krl run --workspace DIR``), only folders
    inside ``DIR`` (``DIR`` included) count, so a folder above it is never adopted.
@@ -52,7 +56,7 @@ from krl.files import Entry
 from krl.limits import MAX_FOLDER_DEPTH
 from krl.source import is_krl_file
 
-__all__ = ["ProgramFiles", "SYSTEM_DIRS", "backup_of", "collect_entries", "collect_files", "find_backups",
+__all__ = ["ProgramFiles", "SYSTEM_DIRS", "backup_of", "cell_program", "collect_entries", "collect_files", "find_backups",
            "folder_entries", "folder_groups", "is_submit_file", "is_system_path", "machine_data_file", "module_key",
            "modules_of", "program_folder", "project_of", "system_folder", "system_folder_of", "with_basis"]
 
@@ -88,13 +92,21 @@ def _child(folder: Path, name: str) -> Path | None:
     return None
 
 
+def _is_dir(p: Path | None) -> bool:
+    return p is not None and not p.is_symlink() and p.is_dir()
+
+
 def _is_base(folder: Path) -> bool:
-    """Rule 1: `folder` holds ``System/$config.dat`` (any case, no links)."""
+    """Rule 1: `folder` holds ``System/$config.dat``, or is the ``R1`` of an archive's ``KRC``
+    folder (beside ``STEU``, holding ``Program``, ``System`` or ``Mada``); any case, no links."""
     system = _child(folder, "system")
-    if system is None or system.is_symlink() or not system.is_dir():
+    if _is_dir(system):
+        config = _child(system, "$config.dat")
+        if config is not None and not config.is_symlink() and config.is_file():
+            return True
+    if folder.name.lower() != "r1" or not _is_dir(_child(folder.parent, "steu")):
         return False
-    config = _child(system, "$config.dat")
-    return config is not None and not config.is_symlink() and config.is_file()
+    return any(_is_dir(_child(folder, n)) for n in ("program", "system", "mada"))
 
 
 def _root_of_base(base: Path) -> Path:
@@ -159,6 +171,18 @@ def machine_data_file(root: Path) -> Path | None:
         if f is not None and not f.is_symlink() and f.is_file():
             return f
     return None
+
+
+def cell_program(root: Path) -> Path | None:
+    """The backup's cell program, which the controller selects in Automatic External (KUKA System
+    Software 8: the external PLC starts ``CELL.SRC``): ``R1/cell.src`` (or ``cell.src`` at a flat
+    export's top), beside its System folder; any letter case, links never followed; None when the
+    backup has none."""
+    sysdir = system_folder(root)
+    r1 = _child(root, "r1")
+    base = sysdir.parent if sysdir is not None else r1 if r1 is not None else root
+    f = _child(base, "cell.src")
+    return f if f is not None and not f.is_symlink() and f.is_file() else None
 
 
 def submit_program(root: Path) -> Path | None:
@@ -334,12 +358,18 @@ def find_backups(root: str | Path) -> list[Path]:
 
 def _backups_in(entries) -> list[Path]:
     """:func:`find_backups` from the entries of a walk (krl.files.walk) of the folder: its
-    regular files named $config.dat in folders at most MAX_FOLDER_DEPTH levels deep."""
+    regular files named $config.dat in folders at most MAX_FOLDER_DEPTH levels deep: in a
+    ``System`` folder, or in the ``STEU`` folder beside an archive's ``R1`` (rule 1)."""
     found: set[Path] = set()
     for e in entries:
         if e.kind != "file" or e.path.name.lower() != "$config.dat" or _levels(e.rel) - 1 > MAX_FOLDER_DEPTH:
             continue
         system = e.path.parent
+        if system.name.lower() == "steu":
+            r1 = _child(system.parent, "r1")
+            if r1 is not None and _is_base(r1):
+                found.add(system.parent)
+            continue
         if system.name.lower() != "system":
             continue
         found.add(_root_of_base(system.parent))

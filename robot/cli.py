@@ -9,7 +9,9 @@ from pathlib import Path
 
 import click
 
+from krl.archive import ArchiveError, is_archive
 from krl.durable import write_text
+from krl.kssarchive import info_lines, read_info
 from krl.terminal import printable
 from robot.machine import load_machine
 from robot.plot import plot_trace
@@ -59,10 +61,20 @@ def _load(path: Path | None):
 def show(robot: Path | None) -> None:
     """Print the robot model of ROBOT (a KRC backup folder or .zip, a $machine.dat, a robot
     YAML or a KUKA model's name from `krl robot list`; default the KR 6 R900): name, parameters with their source (file:line or the rule
-    that derived them), axis limits, speeds, accelerations, reach."""
+    that derived them), axis limits, speeds, accelerations, reach. A controller archive (a folder
+    or .zip with am.ini or ArchiveInfo.xml) adds what it says of itself: the robot's name and
+    serial, its type, the KSS version and the installed technology packages (krl/kssarchive.py)."""
 
     for line in show_lines(_load(robot)):
         click.echo(line)
+    info = None
+    if robot is not None and (robot.is_dir() or is_archive(robot)):
+        try:
+            info = read_info(robot)
+        except ArchiveError:
+            info = None                   # an archive _load read can still be refused here: not shown
+    for line in info_lines(info) if info is not None else []:
+        click.echo(printable(line))
 
 
 @robot_group.command("list")

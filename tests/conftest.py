@@ -27,6 +27,7 @@ SHARED = REPO_ROOT.parent / "shared"
 SHARED_CORPUS = SHARED / "krl-corpus"
 SHARED_HISTORY = SHARED / "krl-history"
 SHARED_TRACES = SHARED / "real-traces"
+SHARED_EVENT_LOGS = SHARED / "event-logs"
 
 # The caches of what the tests run (the one store of the commands and language servers they start: krl/store.py) go to a
 # temporary folder of the session, never to the user's cache folder. The process that made it (the
@@ -44,7 +45,7 @@ settings.register_profile("nightly", max_examples=2000, deadline=None, print_blo
                           suppress_health_check=[HealthCheck.too_slow])
 settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "ci"))
 
-CORPUS_FIXTURES = {"shared_corpus", "corpus", "shared_history", "real_traces"}
+CORPUS_FIXTURES = {"shared_corpus", "corpus", "shared_history", "real_traces", "event_logs"}
 
 
 def corpus_present() -> bool:
@@ -100,6 +101,15 @@ def real_traces() -> Path:
     if not (SHARED_TRACES / "MAP.csv").exists():
         pytest.skip("../shared/real-traces is not present")
     return SHARED_TRACES
+
+
+@pytest.fixture(scope="session")
+def event_logs() -> Path:
+    """Three event logs of a real KSS 8.7.8 archive with its am.ini and ArchiveInfo.xml (issue 75),
+    read in place. Absent: the test skips (a failure under CI=true)."""
+    if not (SHARED_EVENT_LOGS / "MANIFEST.csv").exists():
+        pytest.skip("../shared/event-logs is not present")
+    return SHARED_EVENT_LOGS
 
 
 def pytest_configure(config: pytest.Config) -> None:

@@ -19,6 +19,8 @@ from conformance import harness as H
 from conformance.report import run_cases, write_report
 
 from app.bench import all_figures, engine_rates
+from app.log import log_group
+from click.testing import CliRunner
 
 from recovery.pipeline import run_recovery
 
@@ -172,3 +174,16 @@ def test_trace_show_and_compare_json(tmp_path):
         res = subprocess.run(KRL + args, capture_output=True, text=True, cwd=tmp_path, timeout=120)
         assert res.returncode == 0, res.stderr
         validate(name, json.loads(res.stdout))
+
+
+def test_log_show_and_summary_json(event_logs):
+    """krl log show / summary --format json on the shared archive's smallest log (26 records)."""
+    res = CliRunner().invoke(log_group, ["show", "--format", "json", str(event_logs / "KrcLogI.evt")])
+    assert res.exit_code == 0, res.output
+    objs = [json.loads(line) for line in res.output.splitlines()]
+    assert len(objs) == 26
+    for obj in objs:
+        validate("log-record", obj)
+    res = CliRunner().invoke(log_group, ["summary", "--format", "json", str(event_logs / "KrcLogI.evt")])
+    assert res.exit_code == 0, res.output
+    validate("log-summary", json.loads(res.output))

@@ -2,7 +2,9 @@
 
 :func:`identify` reads one loaded side (krl/diff/load.py ``Side``): the path as the user named
 it, whether it is a folder, a ``.zip`` or a file, its KRL files (count), the date of its newest
-KRL file, a SHA-256 of its KRL files, and what its machine data names
+KRL file, a SHA-256 of its KRL files, what a controller archive says of itself (its am.ini and
+ArchiveInfo.xml, krl/kssarchive.py: the robot's name and serial, its type, the KSS version, the
+installed technology packages: :func:`archive_identity`), and what its machine data names
 (krl.workspace.machine_identity, the rule krl audit names its units by): the robot
 (``$MODEL_NAME[]``, else ``$TRAFONAME[]``), the machine data's version (``$V_R1MADA[]``, whose
 ``KUKA8.6`` is the KSS version) and so the controller (KSS 8 runs on a KR C4, KSS 5 on a KR C2;
@@ -22,11 +24,13 @@ import zipfile
 from pathlib import Path
 
 from krl import __version__
+from krl.archive import ArchiveError
 from krl.diff.load import Side
+from krl.kssarchive import read_info
 from krl.limits import MAX_FILE_BYTES
 from krl.workspace import machine_identity
 
-__all__ = ["identify", "backup_hash", "generator"]
+__all__ = ["archive_identity", "identify", "backup_hash", "generator"]
 
 
 
@@ -74,13 +78,30 @@ def generator(now: dt.datetime | None = None) -> str:
     return f"krl-tools {__version__} (krl report), {now.strftime('%Y-%m-%d %H:%M UTC')}"
 
 
+def archive_identity(path: str) -> dict | None:
+    """What the controller archive at `path` (a folder inside one, or a ``.zip``) says of itself:
+    {name, serial, type, kss, build, date, packages} ("" where it does not say it; packages as
+    ``NAME VERSION, ...``); None when `path` is no such archive or cannot be read."""
+    try:
+        info = read_info(path)
+    except (ArchiveError, OSError):
+        return None
+    if info is None:
+        return None
+    return {"name": info.robot_name, "serial": info.serial, "type": info.robot_type, "kss": info.kss.lstrip("Vv"),
+            "build": info.build, "date": info.date,
+            "packages": ", ".join(f"{n} {v}".strip() for n, v in info.techpacks)}
+
+
 def identify(side: Side, role: str = "") -> dict:
-    """{role, path, kind, files, date, sha256, robot, mada, kss, controller} of one loaded side
-    (`role`: how the report names it, "old", "new"); "" for what the backup does not name."""
+    """{role, path, kind, files, date, sha256, robot, mada, kss, controller, archive} of one loaded
+    side (`role`: how the report names it, "old", "new"); "" for what the backup does not name;
+    ``archive``: :func:`archive_identity` of its path (None for a backup that is no archive)."""
     md = machine_identity(side.files.values())
     archive = side.shown_of.archive if side.shown_of is not None else ""
     kind = "archive (.zip)" if archive else ("folder" if side.folder is not None and side.folder.is_dir() else "file")
     return {"role": role, "path": side.path, "kind": kind, "files": len(side.files), "date": _date(side),
             "sha256": backup_hash(side),
             "robot": md["robot"],
-            "mada": md["mada"], "kss": md["kss"], "controller": md["controller"]}
+            "mada": md["mada"], "kss": md["kss"], "controller": md["controller"],
+            "archive": archive_identity(side.path) if kind != "file" else None}

@@ -44,7 +44,7 @@ from krl.diff.core import KIND_TITLES, KINDS, Diff
 from krl.diff.sources import SourceViews
 from krl.diff.text import format_delta, html_helpers
 from krl.programmap.graph import ProgramMap
-from krl.programmap.render import LINKS, context, file_href, map_widget
+from krl.programmap.render import LINKS, context, file_href, logbook_marks, map_widget
 from krl.render import render_html
 
 __all__ = ["Finding", "Touched", "findings_delta", "relative", "touched_entries", "report_html", "RUN_KINDS",
@@ -289,7 +289,7 @@ def report_html(backup: str, files: int, new_findings: list[Finding], pm: Progra
                 new_root: str | None = None, old_root: str | None = None, links: str = "file",
                 file_sets: tuple[set[str], set[str]] | None = None,
                 unread: tuple[set, set] = (set(), set()), idents: list[dict] | None = None,
-                generated: str = "") -> str:
+                generated: str = "", logbooks: list[dict] | None = None) -> str:
     """The page (module docstring). `new_findings`: the check findings of NEW (`files` files);
     `pm` NEW's map; with `diff`: OLD's findings and map, the touched entry points (their
     outcomes filled in when `runs`; `max_sim_time` the runs' limit, s), the two backups'
@@ -298,7 +298,9 @@ def report_html(backup: str, files: int, new_findings: list[Finding], pm: Progra
     (`unread`: OLD's, NEW's, :func:`unread_lines`; a finding on such a line of the other
     side is listed apart, not as introduced or fixed). `idents`: the cover's backups, OLD
     first (krl/diff/ident.py ``identify``, each with ``role``); `generated`: the generator and
-    the date for the cover. With `links` "source" the roots must be readable while this runs
+    the date for the cover. `logbooks`: each side's controller logbook (app/reportlog.py
+    ``report_logbooks``; a place ``where`` = (file relative to its side's root, line) is linked
+    here). With `links` "source" the roots must be readable while this runs
     (an archive still extracted): the page carries its views of the files it links to."""
     if links not in REPORT_LINKS:
         raise ValueError(f"links must be one of {', '.join(REPORT_LINKS)}")
@@ -335,6 +337,11 @@ def report_html(backup: str, files: int, new_findings: list[Finding], pm: Progra
         if diff is not None else []
     for r in checks:
         r["where"] = link(r["file"], r["line"], r["side"]) if r.get("file") else ""
+    for lb in logbooks or []:
+        side = "old" if lb["role"] == "old" else "new"
+        for item in lb["summary"]["programs"] + lb["summary"]["actions"]:
+            w = item.get("where")
+            item["link"] = link(w[0], w[1], side) if w and w[0] else ""
     body = dict(
         title=f"Change report: {backup}", backup=backup, files=files,
         errors=errors, warnings=len(new_findings) - errors, all_findings=shown_new,
@@ -343,8 +350,10 @@ def report_html(backup: str, files: int, new_findings: list[Finding], pm: Progra
         limit=MAX_REPORT_DIAGNOSTICS, by_code=_by_code,
         diff=diff, touched=touched or [], changed_runs=changed_runs, runs=runs, run_rows=rows,
         max_sim_time=max_sim_time, retest=checks, idents=idents or [], generated=generated,
+        logbooks=logbooks or [],
         footer=css_string(_footer(backup, idents or [])),
-        reach=reach, map_widget=map_widget(pm, links if links in LINKS else "none"), format_delta=format_delta,
+        reach=reach, map_widget=map_widget(pm, links if links in LINKS else "none", _marks(pm, logbooks)),
+        format_delta=format_delta,
         map_tables=Markup(render_html("krl.programmap", "_map_body.html.j2", edges=False, **context(pm, None))),
         kind_counts=[(k, KIND_TITLES[k], len(getattr(diff, k))) for k in KINDS] if diff is not None else [],
         **html_helpers(link), **context(pm, None))
@@ -355,6 +364,15 @@ def report_html(backup: str, files: int, new_findings: list[Finding], pm: Progra
 
 
 _SOURCES_MARK = "<!-- krl report: the source views -->"
+
+
+def _marks(pm: ProgramMap, logbooks: list[dict] | None) -> dict[str, str]:
+    """The map's marks (krl/programmap/render.py ``logbook_marks``) from the newer side's
+    logbook: the modules and variables its records name."""
+    lb = next((b for b in reversed(logbooks or []) if b["role"] != "old"), None)
+    if lb is None:
+        return {}
+    return logbook_marks(pm, {p["names"]: p["count"] for p in lb["summary"]["programs"]})
 
 
 def _footer(backup: str, idents: list[dict]) -> str:

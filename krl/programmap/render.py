@@ -34,8 +34,8 @@ from krl.programmap.graph import CONTROLLER_KINDS, ProgramMap
 from krl.terminal import printable
 from krl.render import render_html
 
-__all__ = ["GraphTooLarge", "GraphvizMissing", "LINKS", "to_dot", "to_svg", "to_html", "to_text", "page_data", "file_href",
-           "map_widget", "context"]
+__all__ = ["GraphTooLarge", "GraphvizMissing", "LINKS", "to_dot", "to_svg", "to_html", "to_text", "page_data",
+           "logbook_marks", "file_href", "map_widget", "context"]
 
 # how a routine links to its file:line: a file: URL (the file opens in the browser), a vscode:
 # URL (the file opens at the line in VS Code), or no link
@@ -178,11 +178,12 @@ def file_href(path: str, line: int, links: str) -> str:
     return p.as_uri()
 
 
-def page_data(pm: ProgramMap, links: str = "file") -> dict:
+def page_data(pm: ProgramMap, links: str = "file", marks: dict[str, str] | None = None) -> dict:
     """The map as the page's JSON: nodes (id, name, module, kind, file shown relative to the
     root, line, href, system, entry, entry_kind, unreachable, reach, and ``source``: the routine's own
-    lines, DEF to END, up to krl.limits.MAX_GRAPH_SOURCE_CHARS in all) and edges (source,
-    target, kind, file, line)."""
+    lines, DEF to END, up to krl.limits.MAX_GRAPH_SOURCE_CHARS in all; ``logbook``: what the
+    controller's logbook says of it, from `marks`, node id -> text, "" for none) and edges
+    (source, target, kind, file, line)."""
     texts: dict[str, list[str]] = {}
     budget = MAX_GRAPH_SOURCE_CHARS
     nodes = []
@@ -199,7 +200,7 @@ def page_data(pm: ProgramMap, links: str = "file") -> dict:
                       "file": _short(n.path, pm.root) if n.path else "", "line": n.line,
                       "href": file_href(n.path, n.line, links) if n.path else "", "system": n.kuka,
                       "entry": n.entry, "entry_kind": n.entry_kind, "unreachable": n.unreachable,
-                      "reach": n.reach, "source": source})
+                      "reach": n.reach, "source": source, "logbook": (marks or {}).get(n.id, "")})
     return {
         "root": pm.root, "links": links, "nodes": nodes,
         "edges": [{"source": e.source, "target": e.target, "kind": e.kind, "file": _short(e.path, pm.root),
@@ -216,20 +217,36 @@ def _script() -> Markup:
     return Markup(text)
 
 
-def map_widget(pm: ProgramMap, links: str = "file") -> Markup:
+def map_widget(pm: ProgramMap, links: str = "file", marks: dict[str, str] | None = None) -> Markup:
     """The interactive map as one block of the page (``templates/_map_widget.html.j2``: the
     tools, the drawing, the details and source panels, the legend, the map's JSON and the
-    script), for the map's own page and the change report. Raises GraphTooLarge."""
+    script), for the map's own page and the change report. `marks`: node id -> what the
+    controller's logbook says of the routine (:func:`logbook_marks`; drawn with a red halo, the
+    text in its details). Raises GraphTooLarge."""
     if len(pm.nodes) > MAX_GRAPH_NODES:
         raise GraphTooLarge(f"the program map has {len(pm.nodes)} nodes (limit MAX_GRAPH_NODES = {MAX_GRAPH_NODES})")
-    return Markup(render_html("krl.programmap", "_map_widget.html.j2", data=page_data(pm, links), script=_script()))
+    return Markup(render_html("krl.programmap", "_map_widget.html.j2", data=page_data(pm, links, marks),
+                              script=_script(), marked=bool(marks)))
 
 
-def to_html(pm: ProgramMap, links: str = "file") -> str:
+def logbook_marks(pm: ProgramMap, named: dict[str, int]) -> dict[str, str]:
+    """Node id -> text for the main routine of each module the logbook names: `named` maps
+    ``MODULE`` or ``MODULE.variable`` (krl/logbook/links.py ``names``) to its records' count;
+    the text lists them (``logbook: B3.b3_parcasirasi (5 records), B3 (2 records)``)."""
+    mains = {n.module.upper(): n.id for n in pm.nodes.values() if n.kind == "routine" and n.main and not n.kuka}
+    out: dict[str, list[str]] = {}
+    for names, count in sorted(named.items(), key=lambda x: (-x[1], x[0])):
+        nid = mains.get(names.split(".", 1)[0].upper())
+        if nid is not None:
+            out.setdefault(nid, []).append(f"{names} ({count} record{'s' if count != 1 else ''})")
+    return {nid: ", ".join(items) for nid, items in out.items()}
+
+
+def to_html(pm: ProgramMap, links: str = "file", marks: dict[str, str] | None = None) -> str:
     """The interactive page (see the module docstring), with the entry points by class, the
     modules only an operator starts, the dead routines and the edges as tables below the map.
-    `links`: one of :data:`LINKS`."""
-    widget = map_widget(pm, links)
+    `links`: one of :data:`LINKS`; `marks`: see :func:`map_widget`."""
+    widget = map_widget(pm, links, marks)
     return render_html("krl.programmap", "graph.html.j2", title=f"Program map: {pm.root}",
                        widget=widget, **context(pm, None))
 

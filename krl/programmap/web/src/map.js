@@ -142,7 +142,8 @@ function view() {
     // what the controller starts is an entry; a group nothing the controller starts reaches, but
     // operator selection does, is operator-only
     return { entry: rs.some((r) => KEEP.has(r.entry_kind)), dead: rs.length > 0 && rs.every((r) => r.unreachable),
-      operator: rs.some((r) => r.reach === 'operator') && !rs.some((r) => r.reach === 'controller') };
+      operator: rs.some((r) => r.reach === 'operator') && !rs.some((r) => r.reach === 'controller'),
+      logbook: rs.some((r) => r.logbook) };
   };
   for (const id of shown) {
     const v = visibleOf(id);
@@ -273,6 +274,7 @@ const cy = cytoscape({
       'text-valign': 'top', 'text-halign': 'center', 'background-color': '#f6f8fb', 'background-opacity': 0.6,
       'border-color': '#b8c2d0', 'font-weight': 'bold', padding: 6 } },
     { selector: ':parent.system', style: { 'background-color': '#fff8ee' } },
+    { selector: 'node.logbook', style: { 'underlay-color': '#c0392b', 'underlay-opacity': 0.25, 'underlay-padding': 5 } },
     { selector: 'node.match', style: { 'overlay-color': '#ffd000', 'overlay-opacity': 0.35, 'overlay-padding': 4 } },
     { selector: 'node:selected', style: { 'border-width': 3, 'border-color': '#e36209' } },
     { selector: 'node.focus', style: { 'border-width': 4, 'border-color': '#e36209' } },
@@ -313,6 +315,7 @@ function render() {
       if (info.unreachable || n.dead) classes.push('unreachable');
       else if ((info.reach === 'operator' && !info.system) || n.operator) classes.push('operator');
       else if (info.reach === 'unknown') classes.push('unknown');
+      if (info.logbook || n.logbook) classes.push('logbook');
       if (n.id === state.focus) classes.push('focus');
       els.push({ group: 'nodes', data: { id: n.id, label: n.label, parent: n.parent || undefined,
         w: width(n.label), h: height(n.label) }, classes: classes.join(' ') });
@@ -416,6 +419,7 @@ function showDetails(id) {
       box.append(p);
       if (n.entry) box.append(el('p', 'entry point: ' + n.entry, { class: 'entry-why' }));
       if (n.unreachable) box.append(el('p', 'unreachable: no entry point starts it', { class: 'bad' }));
+      if (n.logbook) box.append(el('p', 'logbook: ' + n.logbook, { class: 'logbook-why' }));
     }
     const nb = el('button', 'Show its neighbourhood', { type: 'button', id: 'show-neighbourhood' });
     nb.addEventListener('click', () => focus(id));

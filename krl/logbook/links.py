@@ -1,0 +1,168 @@
+"""Logbook parameters that name a program module or one of its variables, tied to the archive's code.
+
+The controller names a module two ways in its logbook (the shared archive's records):
+
+* its module path, ``/R1/B3_PARCA_BIRAKMA.SRC`` (XEdit's ``logOpenFile``) and a variable of it,
+  ``/R1/B3_PARCA_BIRAKMA.SRC/b3_parcasirasi`` (Varkor's ``logSetVar``: a variable set from the
+  pendant; CrossMeld messages that name a program: ``/R1/B4_PARCA_BIRAKMA.SRC/p``): the robot's
+  module namespace, where a module is known by its name whatever its folder;
+* its file, ``KRC:\\R1\\cell.src`` (XEdit's ``logCancelProgram``, OnlineServices' file
+  operations) or, without the extension, ``KRC:\\R1\\Program\\Parca_Birakma\\B3_Parca_Birakma``
+  (Navigator's ``LogSelect``): a path below the archive's ``KRC`` folder.
+
+:class:`Linker` resolves them against the archive's KRL backup (krl/project.py finds it): the
+module's file (``.src``, else ``.sub``, else ``.dat``; any letter case) as its path in the
+archive, and for a variable the line of its declaration, found by the front end (krl/workspace.py
+loads and checks the backup once, on the first variable asked for): the module's scope (its data
+list, then the global names: ``$config.dat``), else a local of one of its routines. A name that
+does not resolve keeps the module's file and no line. The first parameter that names a module
+gives the record its ``file``, ``line`` and ``names``.
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+from krl.project import collect_files, find_backups, project_of
+from krl.workspace import Workspace, load_project
+
+from .record import LogRecord
+
+__all__ = ["Linker", "link_all", "module_reference"]
+
+_MODULE_PATH = re.compile(r"^/R\d+/(?:[^/]+/)*?([A-Za-z_$][\w$]*)\.(SRC|SUB|DAT)(?:/(.*))?$", re.I)
+_KRC_PATH = re.compile(r"^KRC:\\(.+)$", re.I)
+_NAME = re.compile(r"[A-Za-z_$][\w$]*")
+_ORDER = {".src": 0, ".sub": 1, ".dat": 2}
+
+
+def module_reference(param: str) -> tuple[str, str, str] | None:
+    """(kind, what, variable) of a parameter naming a module: ``("module", NAME, var)`` for
+    ``/R1/NAME.SRC[/var]`` (``/R1/NAME.SRC/ROUTINE/var``: a routine's local), ``("file",
+    "R1/x/name.src", "")`` for ``KRC:\\R1\\x\\name.src`` (the extension may be absent); None for
+    any other parameter. ``var`` is the variable's name without indices or components ("" when none)."""
+    s = param.strip()
+    m = _MODULE_PATH.match(s)
+    if m:
+        # /R1/MOD.SRC/var, /R1/MOD.SRC/var[2].x, or a local of a routine: /R1/MOD.SRC/ROUTINE/var
+        var = _NAME.match((m.group(3) or "").rsplit("/", 1)[-1])
+        return "module", m.group(1), var.group(0) if var else ""
+    m = _KRC_PATH.match(s)
+    if m:
+        return "file", m.group(1).replace("\\", "/").strip("/"), ""
+    return None
+
+
+class Linker:
+    """Resolves module references against the KRL backup of the archive at `root` (a folder;
+    paths are given relative to it, ``/``-separated, as the user sees them in the archive)."""
+
+    def __init__(self, root: Path) -> None:
+        self.root = root
+        backups = find_backups(root)
+        self.backup = backups[0] if backups else None
+        self._files: dict[str, list[Path]] | None = None
+        self._ws: Workspace | None = None
+        self._tried = False
+
+    def _by_name(self) -> dict[str, list[Path]]:
+        if self._files is None:
+            self._files = {}
+            for f in collect_files(self.backup) if self.backup is not None else []:
+                self._files.setdefault(f.stem.upper(), []).append(f)
+            for fs in self._files.values():
+                fs.sort(key=lambda f: _ORDER.get(f.suffix.lower(), 3))
+        return self._files
+
+    def _rel(self, f: Path) -> str:
+        try:
+            return f.relative_to(self.root).as_posix()
+        except ValueError:
+            return f.as_posix()
+
+    def module_file(self, name: str) -> Path | None:
+        """The file of the module `name` (any case): its ``.src``, else ``.sub``, else ``.dat``."""
+        got = self._by_name().get(name.upper())
+        return got[0] if got else None
+
+    def krc_file(self, rel: str) -> Path | None:
+        """The file of ``KRC:\\<rel>``: below the backup's root, any letter case; a path without
+        extension is its module's code file."""
+        if self.backup is None:
+            return None
+        want = rel.lower()
+        for f in self._by_name().get(Path(rel).stem.upper(), []):
+            got = f.relative_to(self.backup).as_posix().lower()
+            if got == want or got.rsplit(".", 1)[0] == want:
+                return f
+        return None
+
+    def _workspace(self) -> Workspace | None:
+        if not self._tried and self.backup is not None:
+            self._tried = True
+            files = self._by_name()
+            first = next((fs[0] for fs in files.values()), None)
+            if first is not None:
+                ws = load_project(project_of(first))
+                ws.check(resolve=False)
+                self._ws = ws
+        return self._ws
+
+    def declaration(self, module: str, variable: str) -> int | None:
+        """The line of the declaration of `variable` as module `module` sees it (module scope,
+        then global), else as a local of one of the module's routines; None when it does not
+        resolve. The line is in the file of the symbol (a data list, ``$config.dat``, the module)."""
+        return (self.declared(module, variable) or (None, None))[1]
+
+    def declared(self, module: str, variable: str) -> tuple[Path, int] | None:
+        """(file, line) of the declaration of `variable` seen from `module` (:meth:`declaration`)."""
+        ws = self._workspace()
+        unit = ws.modules.get(module.upper()) if ws is not None else None
+        if unit is None:
+            return None
+        sym = unit.scope.lookup(variable) if unit.scope is not None else None
+        if sym is None:
+            for r in unit.routines:
+                scope = ws.routine_scope(r)
+                sym = scope.values.get(variable.upper()) if scope is not None else None
+                if sym is not None:
+                    break
+        span = getattr(getattr(sym, "decl", None), "span", None)
+        if span is None or not span.line:
+            return None
+        return Path(span.file or sym.path), span.line
+
+    def link(self, rec: LogRecord) -> None:
+        """Fill `rec`'s ``file``, ``line`` and ``names`` from its first parameter that names a
+        module of the archive (see the module docstring); leaves it alone otherwise."""
+        for p in rec.params:
+            ref = module_reference(p)
+            if ref is None:
+                continue
+            kind, what, var = ref
+            f = self.module_file(what) if kind == "module" else self.krc_file(what)
+            if f is None:
+                continue
+            rec.file = self._rel(f)
+            rec.names = f.stem.upper() if kind == "file" else what.upper()
+            if var:
+                rec.names += "." + var
+                got = self.declared(f.stem, var)
+                if got is not None:
+                    rec.file, rec.line = self._rel(got[0]), got[1]
+            return
+
+
+def link_all(records: list[LogRecord], root: Path | None) -> int:
+    """Fill ``file``/``line``/``names`` of every record of `records` whose parameters name a
+    module of the archive at `root` (None: no archive, nothing to link); returns how many."""
+    if root is None:
+        return 0
+    linker = Linker(root)
+    if linker.backup is None:
+        return 0
+    for r in records:
+        if r.params:
+            linker.link(r)
+    return sum(1 for r in records if r.file)
