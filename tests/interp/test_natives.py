@@ -280,7 +280,7 @@ DEF cell()
   r = 7.0
   r = EB(1)
   p = GET_SINGUL(1)
-  f = STOOL(fd)
+  f = STOOL(fd.TOOL_NO)
   MSGNOTIFY("x")
   $OUT[1] = (r == 0.0) AND (f.X == 0.0) AND (f.C == 0.0) AND (p.Y == 0.0)
   EKI_LOAD("x.xml")
