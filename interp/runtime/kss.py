@@ -241,7 +241,9 @@ class SystemSoftware:
         #: id(main routine) -> name, of the standard programs of :data:`STANDARD` the run loaded
         self.standard: dict[int, str] = {}
         files = {str(s.file): name for name, s in STANDARD.items()}
-        for m in rt.program.modules:
+        # only a backup runs them in place of its own (standard_files); outside one the project's
+        # BASIS is the program's System folder (krl/project.py rule 4), no stand-in
+        for m in rt.program.modules if rt.program.backup else ():
             src = m.files.get("src")
             if src is not None and str(src) in files and m.main is not None:
                 self.standard[id(m.main)] = m.main.name

@@ -125,3 +125,17 @@ def test_the_palletizer_without_bas_src_runs_on(tmp_path, interp, shared_corpus)
     rt, _ = make_runtime(run_spec(dst / "main.src", mujoco=False, interp=interp, inputs="auto", max_sim_time=10.0))
     res = rt.run()
     assert (res.reason, res.text) == ("max_sim_time", "simulated time limit 10.0 s reached")
+
+
+@pytest.mark.parametrize("interp", INTERPS)
+def test_outside_a_backup_the_basis_is_the_programs_own_not_a_stand_in(tmp_path, interp):
+    """Outside a backup the project's BASIS is the program's System folder (krl/project.py rule
+    4): BAS runs there without a note or a count (the model's note is for a backup only)."""
+    prog = write(tmp_path, "prog.src", "DEF prog()\n  BAS(#INITMOV, 0)\n  $OUT[1] = $ACT_TOOL == 1\nEND\n")
+    tw = TraceWriter(keep=True)
+    rt, _ = make_runtime(run_spec(prog, trace=tw, mujoco=False, interp=interp))
+    res = rt.run()
+    assert res.reason == "completed", (res.reason, res.text)
+    assert [e["text"] for e in tw.events if e["kind"] == "message"] == []
+    assert "BAS" not in {n for n, _w, _c in rt.kss.summary()}
+    assert [(e["signal"], e["value"]) for e in tw.events if e["kind"] == "io"] == [("$OUT[1]", True)]
