@@ -94,3 +94,14 @@ def test_a_name_that_is_no_kuka_model_names_no_robot(tmp_path, name):
     assert res.exit_code == 2
     assert "no R1/Mada/$machine.dat" in res.output
     assert robot_for(b / "R1" / "Program" / "cell.src").name == "KR 6 R900 sixx"
+
+
+def test_the_history_backup_without_machine_data_drives_the_robot_it_names(shared_history):
+    """The one backup of ../shared that has no R1/Mada but a model in MACHINE_DEF[1]:
+    rawpython__kukaKRLmagic 03-e616379d/new ($config.dat:402, "KR 120 R2700-2", as the backup's
+    older versions' $machine.dat name it); --inputs auto chose the 4-axis KR 180 palletizer by
+    reach before. The catalogue has the KR 120 R2700-2."""
+    b = shared_history / "rawpython__kukaKRLmagic" / "03-e616379d" / "new"
+    machine = robot_for(b / "R1" / "cell.src", inputs="auto")
+    assert machine.name == "KR 120 R2700-2"
+    assert machine.named == f"KR 120 R2700-2, the robot the backup names ({b / 'R1' / 'System' / '$config.dat'}:402 MACHINE_DEF[1])"
