@@ -34,6 +34,8 @@ from krl.programmap.render import GraphTooLarge, GraphvizMissing, to_dot, to_htm
 from krl.diff.ident import generator, identify
 from krl.diff.report import findings, relative, report_html, touched_entries, unread_lines
 from interp.outcomes import outcome_changes, run_outcomes
+from robot.machine import load_machine
+from robot.named import Named
 from interp.realprograms import REPORT_SIM_TIME_S
 from app.reportlog import graph_marks, report_logbooks
 
@@ -193,7 +195,7 @@ def report(backup: str, since: str | None, runs: bool, max_sim_time: float | Non
         if since is None:
             with side(backup) as b:
                 # the source views are read while an archive is still extracted
-                text = report_html(backup, len(files), new_findings, pm, links=links, idents=[identify(b, "backup")],
+                text = report_html(backup, len(files), new_findings, pm, links=links, idents=[_identify(b, "backup")],
                                    generated=generator(), new_root=_root(b, links),
                                    logbooks=report_logbooks((backup, b.root)))
         else:
@@ -213,7 +215,7 @@ def report(backup: str, since: str | None, runs: bool, max_sim_time: float | Non
                     unread=(unread_lines(pm_old, lines_old), unread_lines(pm, lines)),
                     old_map=pm_old, touched=touched, runs=runs, max_sim_time=max_sim_time,
                     new_root=_root(b, links), old_root=_root(a, links),
-                    idents=[identify(a, "old"), identify(b, "new")], generated=generator(),
+                    idents=[_identify(a, "old", touched), _identify(b, "new", touched)], generated=generator(),
                     logbooks=report_logbooks((backup, b.root), (since, a.root)))
     except DiffInputError as exc:
         _fail("report", exc)
@@ -242,6 +244,21 @@ def _real(s, shown_path: str | None) -> str | None:
     if archive and shown_path.startswith(archive + "/"):
         return str(Path(s.shown_of.folder) / shown_path[len(archive) + 1:])
     return shown_path
+
+
+def _identify(s, role: str, touched=()) -> dict:
+    """krl/diff/ident.py ``identify`` of side `s`, with ``robot_note`` for a robot its
+    ``$config.dat`` names (no machine data; robot/named.py): whether the catalogue or the robot
+    library has it, and if not, which robot the runs of side `role` drove in its place (the
+    robots of its run outcomes among `touched`; without runs the one ``krl run`` drives, the
+    KR 6 R900)."""
+    ident = identify(s, role)
+    if ident.get("robot_from") == "$config.dat MACHINE_DEF[1]":
+        side_of = "old" if role == "old" else "new"
+        ran = sorted({o["robot"] for t in touched for o in [getattr(t, f"{side_of}_outcome", None)]
+                      if isinstance(o, dict) and o.get("robot")})
+        ident["robot_note"] = Named.of(ident["robot"], "$config.dat").cover(", ".join(ran) or load_machine().name)
+    return ident
 
 
 def _run_touched(touched, a, b, max_sim_time, jobs) -> None:

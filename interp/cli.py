@@ -174,7 +174,8 @@ def _run(setup) -> None:
     for line in summary_lines(res, observer, program=str(program), interp=setup.interp,
                               submits=[t for t in rt.scheduler.tasks if t.kind == "submit"],
                               workspace=ws_note, starving=starvation_lines(rt),
-                              robot=f"{machine.name} ({machine.source}{_chosen(program, setup.workspace)})",
+                              robot=f"{machine.name} ({machine.source}{_chosen(program, setup.workspace)})"
+                              + (f"; {machine.named}" if machine.named else ""),
                               run=rt):
         click.echo(shown(line))
         if booted is not None and line.startswith("  workspace"):

@@ -41,7 +41,8 @@ from robot.axismap import ROBOT_KEYS, AxisMap
 from robot.cellpresets import PGNO_PARAMETERS, PresetError, pgno_rules
 from robot.limits import normalise_mode
 from robot.machine import MachineData, load_machine
-from robot.mada import MachineDataError, load_robot, robot_of_backup
+from robot.mada import MachineDataError, load_robot, named_machine, robot_of_backup
+from robot.named import named_robot
 from robot.planner import RobotModel
 from robot.stimuli import Cell, StimulusError, load_cell, resolve_signals
 from robot.trace import TRACE_REPEATS, TraceWriter
@@ -269,8 +270,10 @@ def robot_for(program, workspace=None, robot=None, inputs=None):
     or a path: robot YAML, ``$machine.dat``, backup folder or .zip, robot/mada.py
     ``load_robot``); else the robot the cell file `inputs` names (``robot:``, one of the
     project's robot library); else the robot of the KRC backup holding the program (the backup
-    root of krl.project.backup_of, its ``R1/Mada/$machine.dat``); else the KR 6 R900 of
-    robot/data/kr6_r900.yaml. Raises robot.mada.MachineDataError for machine data that
+    root of krl.project.backup_of, its ``R1/Mada/$machine.dat``; without one, the robot its
+    ``$config.dat`` names in ``MACHINE_DEF[1]`` when the catalogue or the library has it,
+    robot/named.py); else the KR 6 R900 of robot/data/kr6_r900.yaml (or the robot --inputs auto
+    chooses), which says so when it stands in for a robot the backup names (``named``). Raises robot.mada.MachineDataError for machine data that
     cannot make a model (file:line), robot.stimuli.StimulusError for a bad cell file."""
     if isinstance(robot, MachineData):
         return robot
@@ -280,6 +283,11 @@ def robot_for(program, workspace=None, robot=None, inputs=None):
         return load_robot(robot)
     root = backup_of(spelled_within(program, workspace), spelled(workspace) if workspace else None)
     found = robot_of_backup(root) if root is not None else None
+    # no machine data: the robot the backup's $config.dat names (MACHINE_DEF[1]; robot/named.py),
+    # driven when the catalogue or the library has it, else said to be missing where it stands in
+    named = named_robot(root) if root is not None and found is None else None
+    if named is not None and named.known:
+        return named_machine(named)
     if found is None and is_auto(inputs):
 
         def probe():
@@ -289,8 +297,10 @@ def robot_for(program, workspace=None, robot=None, inputs=None):
             return rt, lambda name: global_value(rt, main, name)
         choice = choose_robot(Path(program), probe, workspace)
         if choice is not None:
-            return choice.machine
-    return found if found is not None else load_machine()
+            return choice.machine if named is None else named_machine(named, choice.machine)
+    if found is not None:
+        return found
+    return load_machine() if named is None else named_machine(named)
 
 
 def signal_of(rt: Runtime, main: str, name: str) -> tuple[str, int, int | None] | None:

@@ -1310,13 +1310,43 @@ _KSS = re.compile(r"KUKA\s*(\d+)(?:\.(\d+))?", re.IGNORECASE)
 _CONTROLLERS = {"8": "KR C4", "5": "KR C2", "4": "KR C2"}
 
 
+#: a name of a KUKA robot model (``KR 10 R1440-2``, ``KR6 R900 sixx``, ``LBR iiwa 14 R820``), as
+#: opposed to the user's own name of a machine (``MACHINE_DEF[1]={NAME[] "Robot",...}``)
+_KUKA_MODEL = re.compile(r"^(KR\s*\d|LBR\s)", re.IGNORECASE)
+
+
+def config_robot(files) -> tuple[str, str, int] | None:
+    """``(name, path, line)`` of the robot that the ``$config.dat`` among `files`
+    (:class:`SourceFile`, a backup's) names in ``MACHINE_DEF[1].NAME[]`` (KUKA's ``MACHINE_DEF_T``
+    of a KR C4: the cell's first machine, its robot) when the name reads as a KUKA model
+    (:data:`_KUKA_MODEL`: ``KR 10 R1440-2``; not the user's ``"Robot"``), else None. The
+    robot's identity where no ``$machine.dat`` names it (issue 72)."""
+    for f in files:
+        dl = f.module.data if f.module is not None else None
+        if dl is None or dl.name.upper() != "$CONFIG":
+            continue
+        for item in dl.items:
+            if not (isinstance(item, N.ArrayInit) and item.name.upper() == "MACHINE_DEF" and item.indices == [1]
+                    and isinstance(item.value, N.Aggregate)):
+                continue
+            for comp in item.value.items:
+                if comp.name.upper() == "NAME" and isinstance(comp.value, N.StrLit):
+                    name = comp.value.value.strip()
+                    if _KUKA_MODEL.match(name):
+                        return name, str(f.path), item.span.line
+    return None
+
+
 def machine_identity(files) -> dict[str, str]:
     """What the machine data among `files` (:class:`SourceFile`, a backup's) say of the robot
     and its controller, from what parsed of each ``$machine.dat``: ``robot`` (``$MODEL_NAME[]``,
-    KSS 8.5 and later, else ``$TRAFONAME[]``, without KUKA's ``#``: ``KR30L16_3A C4 FLR ZH16_2``),
-    ``mada`` (``$V_R1MADA[]``: ``V8.3.190/KUKA8.3``), ``kss`` (``KSS 8.3``) and ``controller``
-    (``KR C4``); "" for what they do not name (a backup without machine data names nothing).
+    KSS 8.5 and later, else ``$TRAFONAME[]``, without KUKA's ``#``: ``KR30L16_3A C4 FLR ZH16_2``;
+    where no ``$machine.dat`` names it, the model ``$config.dat`` names in ``MACHINE_DEF[1]``:
+    :func:`config_robot`), ``robot_from`` (``$machine.dat``, ``$config.dat MACHINE_DEF[1]`` or
+    ""), ``mada`` (``$V_R1MADA[]``: ``V8.3.190/KUKA8.3``), ``kss`` (``KSS 8.3``) and ``controller``
+    (``KR C4``); "" for what they do not name (a backup without machine data names nothing else).
     The one rule of krl report's cover (krl/diff/ident.py) and krl audit's unit names."""
+    files = list(files)
     values: dict[str, str] = {}
     for f in files:
         dl = f.module.data if f.module is not None else None
@@ -1326,10 +1356,15 @@ def machine_identity(files) -> dict[str, str]:
             if isinstance(item, N.ArrayInit) and isinstance(item.value, N.StrLit) and item.indices == [None]:
                 values.setdefault(item.name.upper(), item.value.value.strip())
     robot = (values.get("$MODEL_NAME") or values.get("$TRAFONAME") or "").lstrip("#").strip()
+    robot_from = "$machine.dat" if robot else ""
+    if not robot:
+        named = config_robot(files)
+        robot, robot_from = (named[0], "$config.dat MACHINE_DEF[1]") if named else ("", "")
     mada = values.get("$V_R1MADA", "")
     m = _KSS.search(mada)
     kss = (f"KSS {m.group(1)}.{m.group(2)}" if m.group(2) else f"KSS {m.group(1)}") if m else ""
-    return {"robot": robot, "mada": mada, "kss": kss, "controller": _CONTROLLERS.get(m.group(1), "") if m else ""}
+    return {"robot": robot, "robot_from": robot_from, "mada": mada, "kss": kss,
+            "controller": _CONTROLLERS.get(m.group(1), "") if m else ""}
 
 
 def check_texts(files: dict[str, str]) -> Workspace:

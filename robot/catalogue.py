@@ -140,12 +140,18 @@ def lookup(text: str) -> Model:
 def library_machine_data(model: Model) -> Path | None:
     """A machine-data file of the project's robot library (robot/data/*.dat) whose ``$TRAFONAME``
     names `model` (machine data win over a description), or None."""
+    return library_file(model.key)
+
+
+def library_file(key: str) -> Path | None:
+    """A machine-data file of the project's robot library (robot/data/*.dat) whose ``$TRAFONAME``
+    names the model of ``$MODEL_NAME`` spelling `key` (:func:`model_key`), or None."""
     for path in library_robots().values():
         if path.suffix.lower() != ".dat":
             continue
         head = path.read_text(encoding="latin-1", errors="replace")
         m = re.search(r'^\s*\$TRAFONAME\[\]\s*=\s*"([^"]*)"', head, re.M | re.I)
-        if m and model_key(m.group(1)) == model.key:
+        if m and model_key(m.group(1)) == key:
             return path
     return None
 

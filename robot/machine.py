@@ -242,6 +242,9 @@ class MachineData:
     raw: dict[str, Any] = field(default_factory=dict, repr=False, compare=False)
     #: ``$TRAFONAME`` of the machine data ("" for the yaml robot).
     trafoname: str = ""
+    #: for a backup without machine data that names its robot in ``$config.dat``
+    #: (robot/named.py): the robot it names, where, and whether this one stands in for it; else ""
+    named: str = field(default="", compare=False)
     #: parameter name -> where its value came from: ``"file:line"`` or ``"derived: rule"``
     #: (robot/mada.py; empty for the yaml robot, whose sources are the yaml's comments).
     provenance: dict[str, str] = field(default_factory=dict, repr=False, compare=False)

@@ -49,6 +49,7 @@ from .machine import (
     CartLimits, ExternalAxis, ExternalKinematic, JointData, MachineData, library_robots, load_machine,
 )
 from .madavalues import MachineDataError, krl_value
+from .named import Named, named_robot
 from .madavalues import axes as _axes
 from .madavalues import flag as _flag
 from .madavalues import frame as _frame
@@ -580,10 +581,39 @@ def build_cited(name: str, vals: dict, source: str, shown: str) -> MachineData:
     return replace(built, name=name, provenance=prov)
 
 
+def named_machine(named: Named, stand_in: MachineData | None = None) -> MachineData:
+    """The robot driven for a backup without machine data that names `named` in its
+    ``$config.dat`` (robot/named.py): the robot library's machine data of it, else the
+    catalogue's model, else `stand_in` (default the KR 6 R900 of robot/machine.py
+    ``load_machine``); its ``named`` says which robot the backup names, where, and whether this
+    one stands in for it (issue 72). Raises MachineDataError as :func:`load_mada` does."""
+    if named.library is not None:
+        m = load_mada(named.library)
+    elif named.model is not None:
+        m = catalogue_robot(named.model)
+    else:
+        m = stand_in if stand_in is not None else load_machine()
+    return replace(m, named=named.note(m.name))
+
+
+def _named_in(roots, shown=None) -> MachineData | None:
+    """The robot the first of the backup `roots` that names one in its ``$config.dat`` names
+    (:func:`named_machine`), else None; `shown` (folder, name) maps a temporary folder's path
+    back to the archive's name in the note."""
+    for root in roots:
+        named = named_robot(root)
+        if named is not None:
+            if shown is not None:
+                named = replace(named, where=named.where.replace(str(shown[0]), str(shown[1]), 1))
+            return named_machine(named)
+    return None
+
+
 def load_robot(path: str | Path) -> MachineData:
     """The robot model named by ``krl run --robot`` / ``krl robot show``: a robot YAML (the
     layout of robot/data/kr6_r900.yaml), a ``$machine.dat``, a KRC backup folder or a backup
-    ``.zip`` (krl/archive.py checks and extracts it), a robot description (``.urdf``, ``.xacro``:
+    ``.zip`` (krl/archive.py checks and extracts it; a backup without machine data gives the
+    robot its ``$config.dat`` names, :func:`named_machine`), a robot description (``.urdf``, ``.xacro``:
     robot/description.py), the name of a robot of the project's
     library (``kr180_r3200_pa``: robot/machine.py ``library_robots``), or a KUKA model's name
     (``"KR 150 R3100-2"``, ``KR150R3100_2``: robot/catalogue.py). Raises :class:`MachineDataError` with a
@@ -619,17 +649,24 @@ def load_robot(path: str | Path) -> MachineData:
                     found = robot_of_backup(root, str(p / root.relative_to(folder)))
                     if found is not None:
                         return found
+                found = _named_in(roots or [folder], (folder, p))
+                if found is not None:
+                    return found
         except ArchiveError as exc:
             raise MachineDataError(str(exc)) from None
         raise MachineDataError(f"{p}: the backup holds no R1/Mada/$machine.dat")
     if p.is_dir():
-        for root in [backup_of(p) or p, *find_backups(p)]:
+        roots = [backup_of(p) or p, *find_backups(p)]
+        for root in roots:
             found = robot_of_backup(root)
             if found is not None:
                 return found
+        found = _named_in(roots)       # no machine data: the robot its $config.dat names (issue 72)
+        if found is not None:
+            return found
         raise MachineDataError(f"{p}: no R1/Mada/$machine.dat in this folder")
     raise MachineDataError(f"{p}: not a robot YAML, $machine.dat, backup folder or backup .zip")
 
 
 __all__ = ["MachineDataError", "RULES", "build_cited", "catalogue_robot", "chain_forward", "chain_to_joints", "load_mada", "load_robot",
-           "machine_from_values", "robot_of_backup"]
+           "machine_from_values", "named_machine", "robot_of_backup"]

@@ -29,6 +29,8 @@ def show_lines(m: MachineData) -> list[str]:
     """The lines printed by ``krl robot show`` for the model ``m`` (mm, deg, s)."""
     out = [f"robot      {printable(m.name)}",
            f"source     {printable(m.source)}"]
+    if m.named:                      # a backup without machine data that names its robot (robot/named.py)
+        out.append(f"named      {printable(m.named)}")
     if m.trafoname:
         out.append(f"$TRAFONAME {printable(m.trafoname)}")
     k = Kinematics(m)

@@ -82,20 +82,53 @@ NOT_INSTALLED = "NOT_INSTALLED"
 #: the families of routines that the network partners implement (issue 35), never stood in
 NETWORK_FAMILIES = ("ethernet_krl", "rsi")
 
-#: KUKA's standard programs the project writes itself, used by a backup that lacks its own:
-#: module name -> file (interp/basis/kuka)
-STANDARD = {"P00": Path(__file__).resolve().parent.parent / "basis" / "kuka" / "p00.src"}
+_BASIS = Path(__file__).resolve().parent.parent / "basis"
+
+
+@dataclass(frozen=True)
+class Standard:
+    """A program of KUKA's software the project writes itself: ``file`` (interp/basis), where
+    KUKA keeps it on the controller (``kuka``), what it is (``what``, the run summary's word
+    for it) and the run's note's name for it (``called``)."""
+
+    file: Path
+    kuka: str
+    what: str
+    called: str
+
+
+#: KUKA's programs the project writes itself, used by a backup that lacks its own (a module of
+#: that name): module name -> :class:`Standard`. P00, KUKA's standard program of the PLC
+#: handshake; BAS, the BASIS package (issue 72): interp/basis/bas.src models the BAS commands
+#: (BAS(#INITMOV), #TOOL, #BASE, #PTP_PARAMS, #CP_PARAMS, ...) over the ``$config.dat`` data
+#: every KUKA ``$config.dat`` declares (TOOL_DATA, BASE_DATA, LOAD_DATA, DEF_VEL_PTP, PDAT_ACT,
+#: ...; interp/basis/README.md), as the reference describes them (6.9 "What BAS(...) does to
+#: system variables": "A simulator should ship a bas.src-compatible BASIS (it is plain KRL) plus
+#: $config.dat defaults, rather than hard-coding these effects"; 6.4 for #TOOL and #BASE)
+STANDARD = {
+    "P00": Standard(_BASIS / "kuka" / "p00.src", "R1/TP/p00.src", "standard program", "standard P00"),
+    "BAS": Standard(_BASIS / "bas.src", "R1/System/bas.src", "BASIS model", "model of KUKA's BASIS"),
+}
+
+#: the BASIS data list that comes with the BASIS model: merged after the backup's own
+#: ``$config.dat`` as outside a backup (krl/project.py rule 4): the backup's declarations hold,
+#: this one's fill in what the model reads and the backup lacks (DEF_ADAP_ACC, DEF_LOAD_DATA)
+BASIS_CONFIG = _BASIS / "$config.dat"
 
 
 def standard_files(project) -> list[Path]:
     """The files of :data:`STANDARD` a run of `project` (krl.project.Project) adds: in a KRC
     backup, each standard program whose module the backup does not have (no file of that
-    name; KUKA's ``P00`` lives in ``R1/TP/p00.src``). Outside a backup none: the project's
-    BASIS holds what such a program may call."""
+    name; KUKA's ``P00`` lives in ``R1/TP/p00.src``, ``BAS`` in ``R1/System/bas.src``), and with
+    the BASIS model the BASIS ``$config.dat`` (:data:`BASIS_CONFIG`) first. Outside a backup
+    none: the project's BASIS holds what such a program may call (krl/project.py rule 4)."""
     if not project.backup:
         return []
     have = {Path(f).stem.upper() for f in project.files}
-    return [f for name, f in STANDARD.items() if name not in have]
+    missing = [s.file for name, s in STANDARD.items() if name not in have]
+    if STANDARD["BAS"].file in missing:
+        missing.insert(0, BASIS_CONFIG)
+    return missing
 
 _BOOL_OPS = ("AND", "OR", "EXOR", "NOT")
 _CMP = ("==", "<>", "<", ">", "<=", ">=")
@@ -207,8 +240,10 @@ class SystemSoftware:
         self._absent: dict[str, str | int] = {}  # UPPER name -> "not installed" of its stand-in ENUM, or 1 (an index)
         #: id(main routine) -> name, of the standard programs of :data:`STANDARD` the run loaded
         self.standard: dict[int, str] = {}
-        files = {str(f): name for name, f in STANDARD.items()}
-        for m in rt.program.modules:
+        files = {str(s.file): name for name, s in STANDARD.items()}
+        # only a backup runs them in place of its own (standard_files); outside one the project's
+        # BASIS is the program's System folder (krl/project.py rule 4), no stand-in
+        for m in rt.program.modules if rt.program.backup else ():
             src = m.files.get("src")
             if src is not None and str(src) in files and m.main is not None:
                 self.standard[id(m.main)] = m.main.name
@@ -217,10 +252,11 @@ class SystemSoftware:
         """A standard program of the project runs in place of the backup's own (counted; one
         note at the first call)."""
         name = routine.name
+        std = STANDARD[name.upper()]
         self._record(name.upper(), StandIn(
-            name, "standard program", "",
-            f"the backup has no {name} of its own (KUKA's R1/TP/{name.lower()}.src); the project's "
-            f"standard {name} runs ({STANDARD[name.upper()].relative_to(STANDARD[name.upper()].parents[3])})"))
+            name, std.what, "",
+            f"the backup has no {name} of its own (KUKA's {std.kuka}); the project's "
+            f"{std.called} runs ({std.file.relative_to(_BASIS.parent.parent)})"))
     # ------------------------------------------------------------------ evidence
     def outside(self) -> dict:
         """(kind, UPPER name) -> why, for every name the checker found outside the backup and
@@ -258,7 +294,7 @@ class SystemSoftware:
             if standin.what == "statement":
                 self.rt.message(f"stub: {standin.name} (statement not simulated)")
                 return
-            if standin.what == "standard program":
+            if standin.what in {s.what for s in STANDARD.values()}:
                 self.rt.message(f"stub: {standin.name} ({standin.why})")
                 return
             value = f": {standin.value}" if standin.value else ""

@@ -8,7 +8,8 @@ installed technology packages: :func:`archive_identity`), and what its machine d
 (krl.workspace.machine_identity, the rule krl audit names its units by): the robot
 (``$MODEL_NAME[]``, else ``$TRAFONAME[]``), the machine data's version (``$V_R1MADA[]``, whose
 ``KUKA8.6`` is the KSS version) and so the controller (KSS 8 runs on a KR C4, KSS 5 on a KR C2;
-KUKA's KSS release notes). A backup without machine data names no robot, and the cover says so.
+KUKA's KSS release notes). A backup without machine data names the robot its ``$config.dat``
+names in ``MACHINE_DEF[1]`` (a KUKA model's name), else none, and the cover says so.
 
 **The SHA-256** is of the backup's KRL files as the diff compares them: for each file, sorted by
 its key (its path below the backup root, ``/``-separated, lower-case), the line
@@ -94,14 +95,17 @@ def archive_identity(path: str) -> dict | None:
 
 
 def identify(side: Side, role: str = "") -> dict:
-    """{role, path, kind, files, date, sha256, robot, mada, kss, controller, archive} of one loaded
-    side (`role`: how the report names it, "old", "new"); "" for what the backup does not name;
+    """{role, path, kind, files, date, sha256, robot, robot_from, robot_note, mada, kss,
+    controller, archive} of one loaded side (`role`: how the report names it, "old", "new"); ""
+    for what the backup does not name. ``robot_from`` says where the robot is named
+    (``$machine.dat``, ``$config.dat MACHINE_DEF[1]``); ``robot_note`` is left to the caller that
+    knows the robots (app/changes.py: whether the catalogue has a robot named in ``$config.dat``);
     ``archive``: :func:`archive_identity` of its path (None for a backup that is no archive)."""
     md = machine_identity(side.files.values())
     archive = side.shown_of.archive if side.shown_of is not None else ""
     kind = "archive (.zip)" if archive else ("folder" if side.folder is not None and side.folder.is_dir() else "file")
     return {"role": role, "path": side.path, "kind": kind, "files": len(side.files), "date": _date(side),
             "sha256": backup_hash(side),
-            "robot": md["robot"],
+            "robot": md["robot"], "robot_from": md["robot_from"], "robot_note": "",
             "mada": md["mada"], "kss": md["kss"], "controller": md["controller"],
             "archive": archive_identity(side.path) if kind != "file" else None}

@@ -17,7 +17,16 @@ at A4 = 0:
 3. A1..A3 from the OPW arm solution for the A5 point (c4 = 0), A5 from the pitch, A6 from
    the rotation left about the A6 axis.
 
-Status: the OPW arm's; S bit 2 and T bit 3 (A4) select nothing.
+Status: the OPW arm's; S bit 2 and T bits 3 and 4 (the signs of A4 and A5) select nothing. A4
+is fixed, and A5 is not chosen: for a given arm (A1..A3, chosen by S bits 0 and 1) and the
+target's A6 axis in the arm plane, A5 has one value (within its range, no ±360° variant); in
+palletizing mode KUKA's controller computes it from A2 and A3 so that the flange stays parallel
+to the floor ("$PAL_MODE", 5-axis palletizers KR300PA_2 S C4 FLR and the like: "A5 drives to its
+calculated position"; industrialmonitordirect.com knowledge base, "KUKA 5-Axis Palletizer A5
+Gripper Parallelism Fix"). A taught point's T bit 4 records the sign of A5 on the robot that
+taught it; on a model whose A5 comes out with the other sign it selected the -360° variant
+and refused the point ("software limit switch -A5", issue 72: a KR 470 PA-2's first pick,
+T 26), as T bit 4 is also free on the 4-axis palletizer.
 
 Units: mm and deg. Raises nothing itself; :meth:`Palletizer5.check` raises
 robot.mada.MachineDataError when the machine data's wrist does not have this form.
@@ -59,7 +68,8 @@ class Palletizer5(ArmFamily):
     title = "analytic (5-axis palletizer: $DEF_A4FIX)"
     s_free = 4
     reduced_orientation = True
-    t_free = 0b01000
+    #: A4's and A5's turn bits select nothing (module docstring, "Status")
+    t_free = 0b11000
 
     def __init__(self, kin: Any, found: Any = None) -> None:
         super().__init__(kin, found)

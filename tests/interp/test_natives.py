@@ -269,8 +269,10 @@ def _run(prog: Path, interp: str):
 def test_stand_ins_do_what_their_declarations_say(tmp_path, interp):
     """In a backup: GET_SINGUL returns an E6POS of zeros, EB (an ANY result) the zero of the type
     its use gives it (REAL: 0.0), MSGNOTIFY does nothing (each noted once); STOOL, a BASIS
-    routine the backup's System folder lacks, stands in too (a FRAME of zeros). EKI_LOAD, a
-    network routine, stops the run in a backup too."""
+    routine the backup's own bas.src lacks (an older BASIS: BAS alone), stands in too (a FRAME
+    of zeros). EKI_LOAD, a network routine, stops the run in a backup too."""
+    write(tmp_path, "R1/System/bas.src", "DEF BAS(COMMAND :IN, VALUE :IN)\n  DECL BAS_COMMAND COMMAND\n"
+          "  DECL REAL VALUE\nEND\n")
     prog = _backup(tmp_path, """
 DEF cell()
   DECL REAL r
@@ -280,7 +282,7 @@ DEF cell()
   r = 7.0
   r = EB(1)
   p = GET_SINGUL(1)
-  f = STOOL(fd)
+  f = STOOL(1)
   MSGNOTIFY("x")
   $OUT[1] = (r == 0.0) AND (f.X == 0.0) AND (f.C == 0.0) AND (p.Y == 0.0)
   EKI_LOAD("x.xml")

@@ -238,3 +238,28 @@ def test_num_ax_below_4_is_refused_naming_it(tmp_path):
                    encoding="utf-8")
     with pytest.raises(MachineDataError, match=r"\$machine.dat:21: \$NUM_AX=3: a robot with \$DEF_A4FIX has 4..6"):
         load_mada(bad)
+
+
+def test_5_axis_first_pick_of_the_issue_is_not_refused_for_the_sign_of_a5(pa5):
+    """Issue 72 item 2, rebuilt from its numbers on the library's 5-axis palletizer (the KR 470
+    PA-2 of the issue is neither in the catalogue nor in ../shared/robots): from XHOME {A1 2.57,
+    A2 -60.81, A3 139.58, A4 0, A5 11.23, A6 92.35} (A2 + A3 + A5 = 90: the flange straight down),
+    XPre_Pick_Point {X 1612.745, Y -69.344, Z -185.774, A 0, B 0, C 0, S 6, T 26} with TOOL_DATA[1]
+    {Z 1025, A -90, B 0, C 180}, BASE 0, was refused at once, "software limit switch -A5": T 26
+    asks A5 < 0 (bit 4) and A4 < 0 (bit 3), and this arm's A5 there is positive. In palletizing
+    mode KUKA computes A5 from A2 and A3 (the flange kept parallel to the floor), so A5's sign,
+    like A4's, selects nothing. Expected by hand: the TCP's Z axis is the world's, the tool's
+    turns the flange's Z down, so the flange is 1025 mm above the TCP, pointing down: A1 =
+    atan2(69.344, 1612.745) (A1 > 0 turns clockwise: $AXIS_DIR[1] = -1), A4 = 0 and A2 + A3 + A5
+    = 90; the flange at (1612.745, -69.344, -185.774 + 1025)."""
+    k = Kinematics(pa5)
+    home = [2.57, -60.81, 139.58, 0.0, 11.23, 92.35]
+    tcp = frame_to_matrix(1612.745, -69.344, -185.774, 0.0, 0.0, 0.0)
+    tool = frame_to_matrix(0.0, 0.0, 1025.0, -90.0, 0.0, 180.0)
+    flange = tcp @ np.linalg.inv(tool)
+    q = k.inverse(flange, 6, 26, home)
+    assert q[0] == pytest.approx(math.degrees(math.atan2(69.344, 1612.745)), abs=1e-9)
+    assert q[3] == 0.0
+    assert q[1] + q[2] + q[4] == pytest.approx(90.0, abs=1e-9)
+    assert np.allclose(k.forward(q)[:3, 3], [1612.745, -69.344, -185.774 + 1025.0], atol=1e-6)
+    assert np.allclose(k.inverse(flange, 2, 2, home), q, atol=1e-9)      # the same with S 2, T 2

@@ -1,0 +1,84 @@
+"""The robot a KRC backup without machine data names in its ``$config.dat`` (issue 72).
+
+A KR C4 backup exported without ``R1/Mada`` still names its robot where WorkVisual writes the
+cell's machines: ``MACHINE_DEF[1]={NAME[] "KR 10 R1440-2",...}`` (KUKA's ``MACHINE_DEF_T``;
+krl.workspace ``config_robot`` reads it, the one rule of ``krl report``'s cover too).
+:func:`named_robot` gives that name, where it is written and the catalogue's model of it
+(robot/catalogue.py: the public descriptions of ../shared/robots) and the project's robot
+library's machine data of it (robot/data/*.dat whose ``$TRAFONAME`` names it: they win), or
+neither; robot/mada.py ``named_machine`` makes the robot driven: the named model, else the
+stand-in, saying which.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+from krl.parsecache import load_file
+from krl.project import system_folder
+from krl.workspace import config_robot
+
+from . import catalogue
+
+
+@dataclass(frozen=True)
+class Named:
+    """The robot a backup names: ``name`` as written (``KR 10 R1440-2``), ``where`` it is written
+    (``.../R1/System/$config.dat:415 MACHINE_DEF[1]``), ``model``, the catalogue's model of that
+    name, and ``library``, the robot library's machine data of it (each None when absent)."""
+
+    name: str
+    where: str
+    model: catalogue.Model | None
+    library: Path | None = None
+
+    @property
+    def known(self) -> bool:
+        """True when the catalogue or the robot library has the named robot."""
+        return self.model is not None or self.library is not None
+
+    def note(self, driven: str) -> str:
+        """What the run, ``krl robot show`` and the report say of it, given the name of the robot
+        `driven`: the named model itself, or the stand-in in its place."""
+        head = f"{self.name}, the robot the backup names ({self.where})"
+        if self.known:
+            return head
+        return (f"{head}, is neither in the catalogue (krl robot list) nor in the robot library: "
+                f"the {driven} stands in")
+
+
+    def cover(self, driven: str) -> str:
+        """What ``krl report``'s cover says after the robot's name, given the robot(s) the runs
+        drive in its place (`driven`)."""
+        head = "named by $config.dat MACHINE_DEF[1]"
+        if self.known:
+            return head
+        return f"{head}; neither in the catalogue nor in the robot library: the runs drive the {driven} in its place"
+
+    @classmethod
+    def of(cls, name: str, where: str) -> "Named":
+        """The robot named `name` (written at `where`), with the catalogue's and the robot
+        library's model of it."""
+        return cls(name, where, catalogue.find(name), catalogue.library_file(catalogue.model_key(name)))
+
+
+def named_robot(root: str | Path) -> Named | None:
+    """The robot the ``$config.dat`` of the backup rooted at `root` names in ``MACHINE_DEF[1]``
+    (krl.workspace ``config_robot``: a KUKA model's name), or None (no System folder, no
+    ``$config.dat``, no model named there). Never raises for bad input: a file that does not
+    parse names nothing."""
+    folder = system_folder(Path(root))
+    if folder is None:
+        return None
+    cfg = next((c for c in sorted(folder.iterdir()) if c.name.lower() == "$config.dat" and c.is_file()), None)
+    if cfg is None:
+        return None
+    found = config_robot([load_file(cfg)])
+    if found is None:
+        return None
+    name, path, line = found
+    return Named.of(name, f"{path}:{line} MACHINE_DEF[1]")
+
+
+__all__ = ["Named", "named_robot"]
