@@ -122,6 +122,7 @@ class ProgramControl:
         return self._change(m.group(1).upper(), int(m.group(2)), text.strip())
 
     def _run(self, path: str) -> str:
+        path = path[:80]                # the program's text, shown in messages: clipped
         name = Path(path.replace("\\", "/")).name
         n = 0 if name.lower().endswith(".sub") else 1
         if self.writer() == n:
