@@ -33,7 +33,7 @@ from krl.workspace import workspaces_for
 from krl.programmap.render import GraphTooLarge, GraphvizMissing, to_dot, to_html, to_svg, to_text
 from krl.diff.ident import generator, identify
 from krl.diff.report import findings, relative, report_html, touched_entries, unread_lines
-from interp.outcomes import outcome_changes, run_outcomes
+from interp.outcomes import ends_alike, outcome_changes, run_outcomes
 from robot.machine import load_machine
 from robot.named import Named
 from interp.realprograms import REPORT_SIM_TIME_S
@@ -191,7 +191,7 @@ def report(backup: str, since: str | None, runs: bool, max_sim_time: float | Non
 
     try:
         pm, diags, files, lines = load_map(backup)
-        new_findings = findings(diags, pm.root, lines, links)
+        new_findings = findings(diags, pm.root, lines, links, pm)
         if since is None:
             with side(backup) as b:
                 # the source views are read while an archive is still extracted
@@ -210,7 +210,7 @@ def report(backup: str, since: str | None, runs: bool, max_sim_time: float | Non
                     _run_touched(touched, a, b, max_sim_time, jobs)
                 text = report_html(
                     backup, len(files), new_findings, pm, links=links, diff=d,
-                    old_findings=findings(diags_old, pm_old.root, lines_old, links),
+                    old_findings=findings(diags_old, pm_old.root, lines_old, links, pm_old),
                     file_sets=(relative(files_old, pm_old.root), relative(files, pm.root)),
                     unread=(unread_lines(pm_old, lines_old), unread_lines(pm, lines)),
                     old_map=pm_old, touched=touched, runs=runs, max_sim_time=max_sim_time,
@@ -286,6 +286,7 @@ def _run_touched(touched, a, b, max_sim_time, jobs) -> None:
         setattr(t, f"{which}_outcome", results.get(real))
     for t in touched:
         t.changes = outcome_changes(t.old_outcome, t.new_outcome)
+        t.ends_alike = ends_alike(t.old_outcome, t.new_outcome)
 
 
 commands = [diff, graph, report]

@@ -27,7 +27,8 @@ the real-programs report's step limit (interp.realprograms.step_limit). It retur
 
 :func:`run_outcomes` runs several in worker processes (krl.pool: a run that crashes the
 interpreter or passes :data:`RUN_TIMEOUT_S` of wall time is an ``internal`` outcome of its
-own). :func:`outcome_changes` says what differs between two outcomes of one entry point.
+own). :func:`outcome_changes` says what differs between two outcomes of one entry point, and
+:func:`ends_alike` whether they end the same way (the same reason, cause, message and statement).
 """
 
 from __future__ import annotations
@@ -45,7 +46,8 @@ from krl.source import read_source
 from krl.pool import run_tasks
 from interp.realprograms import loaded_with
 
-__all__ = ["EVENT_KINDS", "RUN_TIMEOUT_S", "CYCLE_TOLERANCE_S", "run_outcome", "run_outcomes", "outcome_changes"]
+__all__ = ["EVENT_KINDS", "RUN_TIMEOUT_S", "CYCLE_TOLERANCE_S", "END_CHANGES", "run_outcome", "run_outcomes",
+           "outcome_changes", "ends_alike"]
 
 #: the kinds of motion event a run outcome counts (see the module docstring)
 EVENT_KINDS = ("reach", "limit", "singularity", "speed", "motion")
@@ -175,25 +177,37 @@ def _place(o: dict) -> tuple:
     return (name, o.get("statement") or o.get("line"))
 
 
+#: the words of :func:`outcome_changes` that say two runs of an entry point end differently
+#: (:func:`ends_alike`)
+END_CHANGES = ("ends differently", "ends at another statement")
+
+
 def outcome_changes(old: dict | None, new: dict | None) -> list[str]:
     """What differs between the outcomes `old` and `new` of one entry point, in words ([] when
-    nothing does): how it ends (reason, message, and for an error, HALT or deadlock the file and
-    statement: the same statement moved to another line is the same place; two runs both
-    stopped by the time or step limit end alike), the cycle time (beyond
-    :data:`CYCLE_TOLERANCE_S`), the motion events of each kind."""
+    nothing does): how it ends -- its reason and cause and its message ("ends differently"),
+    then, unless both completed, the file and statement it ended at ("ends at another
+    statement"; the same statement moved to another line is the same place) -- the cycle time
+    (beyond :data:`CYCLE_TOLERANCE_S`), the motion events of each kind. Two runs stopped by the
+    run's limits end alike only at the same limit, statement and message: a run stopped by the
+    step limit in a loop and one that waits in a WAIT FOR until the time limit do not (issue 72)."""
     if old is None or new is None:
         return ["only in the old backup" if new is None else "only in the new backup"] if old or new else []
     out = []
-    limit = ("max_sim_time", "max_steps")
-    if old["reason"] in limit and new["reason"] in limit:
-        pass           # both stopped by the run's limit: where each was then says nothing of the change
-    elif (old["reason"], _text(old["text"])) != (new["reason"], _text(new["text"])):
-        out.append("ends differently")
-    elif old["reason"] in ("error", "halt", "deadlock") and _place(old) != _place(new):
-        out.append("ends at another statement")
+    if (old["reason"], old.get("cause", ""), _text(old["text"])) != (new["reason"], new.get("cause", ""), _text(new["text"])):
+        out.append(END_CHANGES[0])
+    elif old["reason"] != "completed" and _place(old) != _place(new):
+        out.append(END_CHANGES[1])
     a, b = old.get("cycle_time"), new.get("cycle_time")
     if (a is None) != (b is None) or (a is not None and round(abs(a - b), 6) > CYCLE_TOLERANCE_S):
         out.append("cycle time")
     if old.get("counts", {}) != new.get("counts", {}):
         out.append("motion events")
     return out
+
+
+def ends_alike(old: dict | None, new: dict | None) -> bool:
+    """Both outcomes exist and end the same way (:func:`outcome_changes` finds no change of
+    :data:`END_CHANGES`): what the change report shows as "the same"."""
+    if old is None or new is None:
+        return False
+    return not any(c in END_CHANGES for c in outcome_changes(old, new))

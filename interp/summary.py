@@ -267,9 +267,23 @@ def _input_of(rt: Any, main: str, e: Any) -> str | None:
     return None
 
 
-def _release(rt: Any, main: str, e: Any, want: bool) -> dict[str, bool] | None:
+def _group_of(rt: Any, main: str, e: Any) -> tuple[str, int, int] | None:
+    """``(NAME, first, last)`` of the group SIGNAL on inputs (``SIGNAL X $IN[513] TO $IN[544]``:
+    an INT, bit 0 on the first) that `e` names; None for anything else."""
+
+    if not isinstance(e, N.Name):
+        return None
+    found = signal_of(rt, main, e.name)
+    if found is None or found[0] != "$IN" or found[2] is None:
+        return None
+    return e.name.upper(), found[1], found[2]
+
+
+def _release(rt: Any, main: str, e: Any, want: bool) -> dict[str, bool | int] | None:
     """Input values that make the condition `e` equal `want`: one way, the first operand of
-    an OR; None when the condition is not over inputs alone in a way this reads."""
+    an OR; a group SIGNAL compared for equality with an INT literal takes that INT (a cell
+    file sets a group by name with an INT: robot/stimuli.py); None when the condition is not
+    over inputs alone in a way this reads."""
 
     name = _input_of(rt, main, e)
     if name is not None:
@@ -281,6 +295,10 @@ def _release(rt: Any, main: str, e: Any, want: bool) -> dict[str, bool] | None:
             for side, lit in ((e.left, e.right), (e.right, e.left)):
                 if isinstance(lit, N.BoolLit):
                     return _release(rt, main, side, (lit.value == want) == (e.op == "=="))
+                group = _group_of(rt, main, side)
+                if group is not None and isinstance(lit, N.IntLit) and want == (e.op == "==") \
+                        and 0 <= lit.value < (1 << (group[2] - group[1] + 1)):
+                    return {group[0]: lit.value}
             return None
         if (e.op == "AND" and want) or (e.op == "OR" and not want):
             a, b = _release(rt, main, e.left, want), _release(rt, main, e.right, want)
@@ -291,8 +309,17 @@ def _release(rt: Any, main: str, e: Any, want: bool) -> dict[str, bool] | None:
 
 
 def _inputs_read(rt: Any, main: str, e: Any) -> list[str]:
-    """The inputs (``$IN[n]``, SIGNAL names on one input) the condition `e` reads, in order."""
-    return list(dict.fromkeys(n for n in (_input_of(rt, main, node) for node in e.walk()) if n is not None))
+    """The inputs the condition `e` reads, in order: ``$IN[n]``, SIGNAL names on one input, and
+    group SIGNALs on inputs shown with their range (``PartCode ($IN[513..544])``)."""
+    out = []
+    for node in e.walk():
+        n = _input_of(rt, main, node)
+        if n is None:
+            group = _group_of(rt, main, node)
+            n = f"{group[0]} ($IN[{group[1]}..{group[2]}])" if group is not None else None
+        if n is not None:
+            out.append(n)
+    return list(dict.fromkeys(out))
 
 
 #: what a condition over a system variable of the controller waits for, and what satisfies it
@@ -484,7 +511,7 @@ def starvation_lines(rt: Any) -> list[str]:
 
     names = []
     for n in _inputs_read(rt, main, node.cond):
-        sig = None if n.startswith("$") else signal_of(rt, main, n)
+        sig = None if n.startswith("$") or "(" in n else signal_of(rt, main, n)
         names.append(f"{n} ($IN[{sig[1]}])" if sig else n)
     release = _release(rt, main, node.cond, True)
     where = _where(task.file, task.line)

@@ -13,9 +13,14 @@ KR C2 or KR C4 trees, as ``.zip`` files. :func:`variants_of` derives these from 
   (``TP/GripperSpotTech/Spot_Data.dat``, ``TP/p00.dat``);
 * ``no-system FILE``: without one file of its ``System/`` or ``Mada`` folders
   (``System/bas.src``, ``System/$config.dat``: the folder is then no backup, its programs run
-  as loose programs on the project's BASIS);
+  as loose programs on the project's BASIS; ``Mada/$machine.dat``: a KR C4 backup then names
+  its robot only in ``$config.dat``'s ``MACHINE_DEF``, issue 72);
 * ``config-user-part-missing``: ``$config.dat`` with the lines of its USER folds deleted (the
   fold markers kept);
+* ``busy-submit FILE``: its SPS.SUB's loop made busy, a counter counting every pass
+  (:func:`busy_submit`): a submit interpreter that never rests while the robot program waits,
+  so the run is never idle and the automatic cell must see the robot program starve on its own
+  (issue 72: a KR C2 cell whose SPS.SUB runs 2.49 million statements in 300 s);
 * ``program-only``: ``R1/Program`` alone;
 * ``tree KRC/R1`` or ``tree flat``: the other of the two layouts KUKA's archives use (a KR C2 or
   KR C4 archive's ``KRC/R1/...`` with ``KRC/STEU``, or a flat export of R1 with ``System/`` at the
@@ -44,6 +49,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import re
 import shutil
 import sys
 import tempfile
@@ -62,7 +68,8 @@ from krl.source import is_krl_file
 from krl.cluster import SchedulerError, run_batches
 from krl.pool import run_tasks
 
-__all__ = ["SIM_TIME_S", "STEPS", "Variant", "backups", "run_variant", "sample", "some_entries", "variants_of"]
+__all__ = ["SIM_TIME_S", "STEPS", "Variant", "backups", "busy_submit", "run_variant", "sample", "some_entries",
+           "variants_of"]
 
 #: the bound of each run: simulated seconds (a program that starves is fast-forwarded) and steps
 #: of the robot program (the step limit counts no submit program's)
@@ -73,8 +80,14 @@ STEPS = 100_000
 SHARED_HISTORY = SHARED_CORPUS.parent / "krl-history"
 
 #: the kinds of variant, in the order :func:`variants_of` lists them
-KINDS = ("whole", "no-TP", "no-TP/", "no-package-dat", "no-system", "config-user-part-missing", "program-only",
-         "tree", "zip")
+KINDS = ("whole", "no-TP", "no-TP/", "no-package-dat", "no-system", "config-user-part-missing", "busy-submit",
+         "program-only", "tree", "zip")
+
+#: the counter :func:`busy_submit` adds to an SPS.SUB's main routine (a name no backup uses)
+BUSY_NAME = "KRL_VARIANT_BUSY"
+_DEF = re.compile(r"^\s*(?:GLOBAL\s+)?DEF\s+[A-Za-z_$][A-Za-z0-9_$]*\s*\(", re.I)
+_LOOP = re.compile(r"^\s*LOOP\s*(?:;.*)?$", re.I)
+_END = re.compile(r"^\s*END\s*(?:;.*)?$", re.I)
 
 
 @dataclass(frozen=True)
@@ -117,6 +130,10 @@ class Variant:
         if self.kind == "config-user-part-missing":
             cfg = dest / self.detail
             cfg.write_bytes(_without_user_folds(cfg.read_bytes()))
+            return dest
+        if self.kind == "busy-submit":
+            sub = dest / self.detail
+            sub.write_bytes(busy_submit(sub.read_bytes()) or b"")
             return dest
         target = dest / self.detail
         if target.is_dir():
@@ -177,6 +194,39 @@ def _without_user_folds(data: bytes) -> bytes:
     return "".join(keep).encode("latin-1")
 
 
+def busy_submit(data: bytes) -> bytes | None:
+    """`data` (a submit program) with its main routine's first ``LOOP`` made busy: the counter
+    :data:`BUSY_NAME` declared first in the routine, set to 0 before the loop and counted up at
+    the start of every pass (a pass that changes the state is never parked nor idle:
+    interp/runtime/spin.py, idle.py); None when the first routine has no ``LOOP`` of its own
+    before its ``END``. Line ends and the other lines are kept."""
+    text = data.decode("latin-1")
+    lines = text.splitlines(keepends=True)
+    nl = "\r\n" if "\r\n" in text else "\n"
+    start = next((i for i, line in enumerate(lines) if _DEF.match(line)), None)
+    if start is None:
+        return None
+    for i in range(start + 1, len(lines)):
+        if _END.match(lines[i]):
+            return None
+        if _LOOP.match(lines[i]):
+            indent = lines[i][: len(lines[i]) - len(lines[i].lstrip())]
+            out = lines[: start + 1] + [f"DECL INT {BUSY_NAME}{nl}"] + lines[start + 1: i] \
+                + [f"{indent}{BUSY_NAME} = 0{nl}", lines[i], f"{indent}  {BUSY_NAME} = {BUSY_NAME} + 1{nl}"] \
+                + lines[i + 1:]
+            return "".join(out).encode("latin-1")
+    return None
+
+
+def _submit_file(robot: Path) -> Path | None:
+    """The SPS.SUB of the robot folder's ``System`` folder (any letter case), or None."""
+    system = _child_name(robot, "system")
+    if not system:
+        return None
+    return next((p for p in sorted((robot / system).iterdir())
+                 if p.name.lower() == "sps.sub" and p.is_file() and not p.is_symlink()), None)
+
+
 def variants_of(backup: Path) -> list[Variant]:
     """Every variant of the backup rooted at `backup` (module docstring), in :data:`KINDS` order."""
     out = [Variant(backup, "whole")]
@@ -199,6 +249,9 @@ def variants_of(backup: Path) -> list[Variant]:
         if system else None
     if cfg is not None and template_lines(cfg.read_bytes().decode("latin-1"))[2]:
         out.append(Variant(backup, "config-user-part-missing", rel(cfg)))
+    sub = _submit_file(robot)
+    if sub is not None and busy_submit(sub.read_bytes()) is not None:
+        out.append(Variant(backup, "busy-submit", rel(sub)))
     if _child_name(robot, "program"):
         out.append(Variant(backup, "program-only"))
     out.append(Variant(backup, "tree", "flat" if robot != backup else "KRC/R1"))

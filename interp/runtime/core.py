@@ -389,9 +389,17 @@ class Runtime:
             self.scheduler.idle.outside_change()
 
     def interpreter_active(self, robot: bool) -> bool:
-        if robot:
-            return self.robot is not None and not self.robot.done
-        return any(not t.done for t in self.scheduler.tasks[1:])
+        """The robot interpreter's (`robot`) or the submit interpreter's program runs
+        (#P_ACTIVE: interp/runtime/cmdchannel.py, the run's tasks and the $CMD commands)."""
+        return self.scheduler.programs.state(robot) == "P_ACTIVE"
+
+    def tasks_state_changed(self) -> None:
+        """An interpreter's program state changed without a task's end (a $CMD command:
+        interp/runtime/cmdchannel.py): as at a task's end, the probed state variables
+        ($PRO_STATE0/1, $PRO_ACT) are read again and a parked task that reads one catches up."""
+        if self.spin.on:
+            self.spin.ending(self.current_task)
+        self.bump_epoch()
 
     def clock_read(self) -> None:
         """A task read the clock ($DATE, a running $TIMER) or drew a random number: the run

@@ -11,7 +11,8 @@ interpreters) sees it and moves the clock to the next cycle in which something c
 
 * the robot has not moved (its axes and the end point of the last planned motion are those
   of the window's start: a loop of ``PTP XHOME`` at XHOME plans motions that do not move),
-  no task has a trigger, an error or an interrupt pending, no input or output changed, and no
+  no task has a trigger, an error or an interrupt pending (a TRIGGER that waits for the task's
+  next motion is not pending: it is state), no input or output changed, and no
   task read the clock (``$DATE``, ``$ROBRUNTIME``, a running ``$TIMER``:
   :meth:`IdleWatch.clock_read`) or drew a random number, since the cycle the window began;
 * for a *window* of :data:`WINDOW_CYCLES` such cycles, and then the *state* of the run is the
@@ -233,7 +234,7 @@ def state_of(rt, constant: dict | None = None) -> tuple:
         frames = frames_of(rt, t)
         irqs = tuple((n, i.on, i.enabled, i.last, i.pending, id(i.frame))
                      for n, i in sorted(t.irqs.irqs.items()))
-        tasks.append((t.done, t.waiting, len(t.contexts), frames, irqs, t.err_text))
+        tasks.append((t.done, t.waiting, len(t.contexts), frames, irqs, t.err_text, len(t.next_triggers)))
     sv = rt.sysvars.store
     sysvars = tuple([(k, v if v.__class__ in _SCALARS else freeze(v)) for k, v in sv.items()])
     io = rt.controller.io
@@ -322,7 +323,7 @@ class IdleWatch:
         for t in rt.scheduler.tasks:
             irqs = tuple([(n, i.on, i.enabled, i.last, i.pending, id(i.frame)) for n, i in t.irqs.irqs.items()])
             p = t.parked
-            tasks.append((t.done, t.waiting, len(t.contexts), t.err_text, irqs,
+            tasks.append((t.done, t.waiting, len(t.contexts), t.err_text, irqs, len(t.next_triggers),
                           None if p is None else (id(p), p.step())))
         return (written, rt.controller.io.version, rt.msg_handle, tuple(tasks))
 
@@ -333,7 +334,9 @@ class IdleWatch:
         for t in rt.scheduler.tasks:
             if t.done:
                 continue
-            if t.pending_triggers or t.pending_error is not None or t.next_triggers:
+            # (a TRIGGER waiting for the task's next motion is not an event: it cannot fire
+            # before the task plans that motion; it is part of the state, state_of)
+            if t.pending_triggers or t.pending_error is not None:
                 return False
             if any(i.pending for i in t.irqs.irqs.values()):
                 return False
@@ -389,7 +392,7 @@ class IdleWatch:
             self._robot = None
         else:
             self._robot = (ctl.cycle, (self.robot_io, robot.waiting, tuple(ctl._q.tolist()),
-                                       tuple(ctl.queue.planned_axes().tolist())), None)
+                                       tuple(ctl.queue.planned_axes().tolist()), len(robot.next_triggers)), None)
 
     def robot_starves(self) -> None:
         """The robot program starves while the run is not idle (a submit program blinks a
@@ -407,7 +410,8 @@ class IdleWatch:
         if robot.wake_cycle is not None:
             self._robot = None          # WAIT SEC: time is what it waits for
             return
-        marks = (self.robot_io, robot.waiting, tuple(ctl._q.tolist()), tuple(ctl.queue.planned_axes().tolist()))
+        marks = (self.robot_io, robot.waiting, tuple(ctl._q.tolist()), tuple(ctl.queue.planned_axes().tolist()),
+                 len(robot.next_triggers))
         if self._robot is None or self._robot[1] != marks:
             self._robot = (ctl.cycle, marks, None)
             return

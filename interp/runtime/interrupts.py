@@ -37,10 +37,12 @@ class Interrupts:
         action = ev.trigger.action
         prio = ev.trigger.prio if ev.trigger.prio and ev.trigger.prio > 0 else 129
         task.contexts.append(Context("trigger", prio=prio))
+        at = task.at
         try:
             action()
         finally:
             task.contexts.pop()
+            task.at = at            # where the interrupted context stands (:meth:`fire`)
 
     def declare(self, number, cond_fn, handler_fn, name: str, frame: Frame,
                 is_global: bool = False, line: int | None = None, watch: str = "") -> None:
@@ -103,6 +105,7 @@ class Interrupts:
             self.rt.trace.write("interrupt", ctl.time, prio=irq.number, name=irq.name, line=task.line,
                                 phase="entry")
         ok = False
+        at = task.at
         try:
             irq.handler()
             ok = True
@@ -111,6 +114,11 @@ class Interrupts:
             if self.rt.trace is not None:
                 self.rt.trace.write("interrupt", ctl.time, prio=irq.number, name=irq.name,
                                     line=task.line, phase="exit")
+            # the task stands again at the statement the routine interrupted (a WAIT FOR, the
+            # advance-run stop of one): its file and line are that statement's, not the
+            # routine's last one, for what it waits on (the automatic cell's starving WAIT FOR,
+            # the run summary) and for an error the statement raises next (issue 72)
+            task.at = at
         if ok and task.irqs.armed and not task.in_poll:
             # the conditions are monitored while the handler runs: what it leaves (a timer it
             # restarted, a flag it reset) is sampled at its end, so the next rising edge counts

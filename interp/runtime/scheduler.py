@@ -46,6 +46,7 @@ from __future__ import annotations
 
 from greenlet import GreenletExit, greenlet
 
+from .cmdchannel import ProgramControl
 from .contexts import Context, InterruptTable
 from .idle import IdleWatch
 from .spin import SpinWatch
@@ -144,6 +145,8 @@ class Scheduler:
         self.return_to = None               # a catch-up's caller (SpinWatch.wake); else main
         self._calm = None                   # what steady cycles found first (_steady)
         self.steady = 0                     # steady cycles in the run
+        #: the interpreters' program states, as the $CMD commands set them (interp/runtime/cmdchannel.py)
+        self.programs = ProgramControl(rt)
 
     def add(self, task: Task) -> None:
         task.glet = greenlet(lambda: self.rt.task_main(task), parent=self.main)

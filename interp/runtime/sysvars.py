@@ -29,6 +29,7 @@ from krl.semantics.symbols import make_array, system_scopes
 from robot.axismap import CART_KEYS, E6AXIS_KEYS, EXT_KEYS, ROBOT_KEYS, AxisMap
 from robot.motion import MotionParams
 
+from .cmdchannel import STATE_VALUES
 from .convert import frame_tuple
 from .errors import KrlRuntimeError, value_invalid
 from .memory import ComputedRef, Slot
@@ -512,15 +513,17 @@ def _date(sv: SysVars):
                               "HOUR": (s // 3600) % 24, "DAY": 1, "MONTH": 1, "YEAR": 2026})
 
 
-#: the values of $PRO_STATE*, made once: an enum value is an immutable leaf
-#: (interp/runtime/idle.py _FLAT), and an interrupt's watch key (watch.py) compares the same
-#: object at each poll by identity
-_P_ACTIVE, _P_FREE = EnumValue("P_ACTIVE"), EnumValue("P_FREE")
+#: the values of $PRO_STATE*, made once (interp/runtime/cmdchannel.py): an enum value is an
+#: immutable leaf (interp/runtime/idle.py _FLAT), and an interrupt's watch key (watch.py)
+#: compares the same object at each poll by identity
+_P_ACTIVE = STATE_VALUES["P_ACTIVE"]
 
 
 def _pro_state(robot: bool):
+    """``$PRO_STATE1`` (`robot`) or ``$PRO_STATE0``: the interpreter's program state, as the
+    run's tasks and the $CMD channel's commands set it (interp/runtime/cmdchannel.py)."""
     def fn(sv: SysVars):
-        return _P_ACTIVE if sv.rt.interpreter_active(robot) else _P_FREE
+        return sv.rt.scheduler.programs.value(robot)
     return fn
 
 

@@ -61,7 +61,10 @@ REPORT_LINKS = ("source", *LINKS)
 @dataclass
 class Finding:
     """One check finding as the report shows it: `file` relative to its backup's root, the
-    source `text` of its line ("" when not readable), `href` its link ("" for none)."""
+    source `text` of its line ("" when not readable), `href` its link ("" for none), the
+    `symbol` it is about (the name at its column, else the first name its message quotes; "")
+    and the `routine` it stands in (by the program map's routine spans; "" outside a routine
+    or without a map)."""
     code: str
     severity: str
     message: str
@@ -70,6 +73,8 @@ class Finding:
     column: int
     text: str = ""
     href: str = ""
+    symbol: str = ""
+    routine: str = ""
 
 
 @dataclass
@@ -87,6 +92,9 @@ class Touched:
     old_outcome: dict | None = None
     new_outcome: dict | None = None
     changes: list[str] = field(default_factory=list)
+    #: both runs end the same way (interp.outcomes ``ends_alike``: reason, cause, message and
+    #: statement), set with `changes`: the report's "the same"
+    ends_alike: bool = False
 
 
 def _rel(path: str, root: str) -> str:
@@ -103,21 +111,53 @@ _NUMBER = re.compile(r"\d+")
 
 def _key(f: Finding) -> tuple:
     """What makes two findings of the two backups the same finding: the file, the code, the
-    message with its numbers left out (the lines it names move when code is edited; "used 19
-    times" becomes "used 26 times") and the text of the line it is on."""
-    return f.file.lower(), f.code, _NUMBER.sub("N", f.message), f.text.strip()
+    symbol, the routine and the message with its numbers left out (the lines it names move when
+    code is edited; "used 19 times" becomes "used 26 times"). Not the line nor its text: an edit
+    above moves the line, an edit of the call changes its text, and the finding stays the same
+    (issue 72: the same two missing routines were "8 new" and "7 fixed")."""
+    return f.file.lower(), f.code, f.symbol.upper(), f.routine.upper(), _NUMBER.sub("N", f.message)
 
 
-def findings(diagnostics: list, root: str, lines: Callable[[str], list[str]], links: str = "file") -> list[Finding]:
+_NAME = re.compile(r"[A-Za-z_$][A-Za-z0-9_$]*")
+_QUOTED = re.compile(r"'([A-Za-z_$][A-Za-z0-9_$]*)")
+
+
+def _symbol(src: str, column: int, message: str) -> str:
+    """The name a finding is about: the identifier at its (1-based) `column` of the line `src`,
+    else the first name its message quotes, else ""."""
+    m = _NAME.match(src, column - 1) if 0 < column <= len(src) else None
+    if m is not None and (column == 1 or not (src[column - 2].isalnum() or src[column - 2] in "_$")):
+        return m.group(0)
+    q = _QUOTED.search(message)
+    return q.group(1) if q else ""
+
+
+def _routines(pm: ProgramMap | None) -> dict[str, list[tuple[int, int, str]]]:
+    """Resolved file path -> (first line, END line, name) of each routine of the map `pm`."""
+    out: dict[str, list[tuple[int, int, str]]] = {}
+    if pm is None:
+        return out
+    for n in pm.nodes.values():
+        if n.kind == "routine" and n.path and n.line:
+            out.setdefault(str(Path(n.path).resolve()), []).append((n.line, n.end or n.line, n.name))
+    return out
+
+
+def findings(diagnostics: list, root: str, lines: Callable[[str], list[str]], links: str = "file",
+             pm: ProgramMap | None = None) -> list[Finding]:
     """The diagnostics (krl.diagnostics.Diagnostic, paths as shown) as :class:`Finding`, files
-    relative to `root`; `lines(path)` gives a file's text lines ([] if unknown)."""
+    relative to `root`; `lines(path)` gives a file's text lines ([] if unknown); `pm` the
+    backup's program map, whose routines name the routine of each finding."""
     out = []
+    spans = _routines(pm)
     for d in diagnostics:
         text = lines(d.path)
         src = text[d.line - 1].rstrip() if 0 < d.line <= len(text) else ""
         href = file_href(d.path, d.line, links) if links in LINKS else ""   # "source": report_html links it
+        routine = next((name for first, end, name in spans.get(str(Path(d.path).resolve()), ())
+                        if first <= d.line <= end), "")
         out.append(Finding(d.code, d.severity, d.message.replace(str(root).rstrip("/") + "/", ""),
-                           _rel(d.path, root), d.line, d.column, src, href))
+                           _rel(d.path, root), d.line, d.column, src, href, _symbol(src, d.column, d.message), routine))
     return out
 
 
@@ -536,8 +576,7 @@ def _run_row(t: Touched, link, roots: dict) -> dict:
                        "motions": o.get("motions", 0), "counts": o.get("counts", {}),
                        "first_event": o["events"][0] if o.get("events") else None}
     a, b = sides["old"], sides["new"]
-    same_end = bool(a["ending"] and b["ending"]) and "ends differently" not in t.changes \
-        and "ends at another line" not in t.changes
+    same_end = bool(a["ending"] and b["ending"]) and t.ends_alike
     cycle = "—"
     if a.get("cycle_time") is not None or b.get("cycle_time") is not None:
         ca, cb = a.get("cycle_time"), b.get("cycle_time")

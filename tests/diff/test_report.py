@@ -7,27 +7,44 @@ from __future__ import annotations
 import shutil
 from pathlib import Path
 
-from interp.outcomes import _Events, event_kind, outcome_changes
+from interp.outcomes import _Events, ends_alike, event_kind, outcome_changes
 from interp.outcomes import _outcome as outcome_of
 from krl.diff.core import Diff, diff_sides
 from krl.diff.load import side
-from krl.diff.report import Finding, css_string, findings_delta, retest, touched_entries
+from krl.diff.report import Finding, Touched, _run_row, css_string, findings, findings_delta, retest, touched_entries
 from krl.programmap import build_map
 from krl.workspace import workspaces_for
 
 FIXTURE = Path(__file__).parents[1] / "programmap" / "fixtures" / "KRC"
 
 
-def _f(file: str, message: str, text: str = "x = 1", code: str = "E101") -> Finding:
-    return Finding(code, "error", message, file, 3, 1, text)
+def _f(file: str, message: str, text: str = "x = 1", code: str = "E101", routine: str = "main", line: int = 3) -> Finding:
+    symbol = message.split("'")[1] if "'" in message else ""
+    return Finding(code, "error", message, file, line, 1, text, symbol=symbol, routine=routine)
 
 
-def test_findings_are_matched_by_file_code_message_and_line_text():
+def test_the_same_missing_routines_are_neither_new_nor_fixed():
+    """Issue 72, item 7: two versions of a Main.src call the same two routines the backup lacks
+    (E1xx "unknown routine"), 7 calls in the old, 8 in the new, on lines that moved and whose
+    arguments changed: the findings of one routine, code and symbol are the same findings (the
+    one more call is one new finding), not "8 new" and "7 fixed"."""
+    def calls(n: int, shift: int, arg: str) -> list:
+        return [_f("R1/Main.src", f"unknown routine '{name}'", f"{name}({arg}{i})", code="E102", line=10 + shift + 5 * i)
+                for i in range(n) for name in (("GRIP",) if i % 2 else ("UNGRIP",))]
+    old, new = calls(7, 0, "a"), calls(8, 3, "b")
+    files = ({"r1/main.src"}, {"r1/main.src"})
+    introduced, removed = findings_delta(old, new, files)
+    assert [(f.symbol, f.line) for f in introduced] == [("GRIP", 13 + 35)]
+    assert removed == []
+
+
+def test_findings_are_matched_by_file_code_symbol_routine_and_message():
     old = [_f("R1/a.src", "'n' is not declared"),
            _f("R1/a.src", "system variable '$x' (used 19 times in 2 files)"),
            _f("R1/b.src", "'gone' is not declared"),
            _f("Old/c.src", "'m' is not declared"),             # its folder renamed: the same finding
-           _f("R1/d.src", "'k' is not declared", "k = 2")]      # its line edited: fixed, and a new one
+           _f("R1/d.src", "'k' is not declared", "k = 2"),      # its line edited: the same finding
+           _f("R1/d.src", "'k' is not declared", "k = 2", routine="other")]   # in another routine: fixed
     new = [_f("R1/a.src", "'n' is not declared"),
            _f("R1/a.src", "system variable '$x' (used 26 times in 2 files)"),
            _f("New/c.src", "'m' is not declared"),
@@ -36,8 +53,8 @@ def test_findings_are_matched_by_file_code_message_and_line_text():
     files = ({"r1/a.src", "r1/b.src", "old/c.src", "r1/d.src", "src/e.src"},
              {"r1/a.src", "new/c.src", "r1/d.src", "r1/e.src", "src/e.src"})
     introduced, removed = findings_delta(old, new, files)
-    assert [(f.file, f.text) for f in introduced] == [("R1/d.src", "k = 3"), ("R1/e.src", "x = 1"), ("R1/e.src", "x = 1")]
-    assert [(f.file, f.text) for f in removed] == [("R1/b.src", "x = 1"), ("R1/d.src", "k = 2")]
+    assert [(f.file, f.text) for f in introduced] == [("R1/e.src", "x = 1"), ("R1/e.src", "x = 1")]
+    assert [(f.file, f.text, f.routine) for f in removed] == [("R1/b.src", "x = 1", "main"), ("R1/d.src", "k = 2", "other")]
     # without the files, the renamed folder's finding is new and fixed
     introduced, removed = findings_delta(old, new)
     assert ("New/c.src", "Old/c.src") == (introduced[0].file, removed[1].file)
@@ -91,11 +108,14 @@ def test_two_outcomes_differ_in_how_they_end_their_cycle_time_or_their_motion_ev
     # one IPO cycle (12 ms) is the same cycle time; two are not
     assert outcome_changes(_outcome(cycle=17.844), _outcome(cycle=17.832)) == []
     assert outcome_changes(_outcome(cycle=17.844), _outcome(cycle=17.820)) == ["cycle time"]
-    # both stopped by the time limit, at other lines: alike
-    limit = dict(reason="max_sim_time", cycle=None)
+    # both stopped by the time limit at the same statement (moved by an edit above it): alike;
+    # one running there and the other waiting: not the same message (issue 72)
+    limit = dict(reason="max_sim_time", cycle=None, file="/a/x.src", statement="LOOP")
+    assert outcome_changes(_outcome(line=70, text="simulated time limit 60.0 s reached", **limit),
+                           _outcome(line=72, text="simulated time limit 60.0 s reached", **limit)) == []
     assert outcome_changes(_outcome(line=70, text="simulated time limit 60.0 s reached", **limit),
                            _outcome(line=72, text="simulated time limit 60.0 s reached while the robot program waits",
-                                    **limit)) == []
+                                    **limit)) == ["ends differently"]
     # an error where it completed; an error message naming other folders is the same message
     err = dict(reason="error", cycle=None, text="software limit switch -A1 at /a/old/x.src:12")
     assert outcome_changes(_outcome(), _outcome(**err)) == ["ends differently", "cycle time"]
@@ -110,6 +130,30 @@ def test_two_outcomes_differ_in_how_they_end_their_cycle_time_or_their_motion_ev
     assert outcome_changes(_outcome(line=40, **wait), _outcome(line=44, **{**wait, "statement": "WAIT FOR $IN[6]"})) == [
         "ends at another statement"]
     assert outcome_changes(None, _outcome()) == ["only in the new backup"]
+
+
+def test_ends_alike_only_with_the_same_cause_statement_and_message():
+    """Issue 72, item 7: the old Main.src stops at the step limit at line 52 (t = 3.684 s), the
+    new one waits at line 129 until the time limit: the report must not say "the same"."""
+    old = {**_outcome(reason="max_steps", text="step limit 300000 reached", line=52, cycle=None, file="/a/Main.src",
+                      statement="nCount = nCount + 1"), "cause": "limit", "ending": "stopped at the step limit",
+           "sim_time": 3.684}
+    new = {**_outcome(reason="max_sim_time", line=129, cycle=None, file="/b/Main.src", statement="WAIT FOR $IN[7]",
+                      text="simulated time limit 60.0 s reached while the robot program waits: WAIT FOR at "
+                           "/b/Main.src:129"), "cause": "limit", "ending": "stopped at the time limit",
+           "sim_time": 60.0}
+    assert outcome_changes(old, new) == ["ends differently"]
+    assert not ends_alike(old, new)
+    # the same wait in both, moved from line 125 to 129: alike; another WAIT FOR: not
+    moved = {**new, "line": 125, "file": "/a/Main.src", "text": new["text"].replace("/b/Main.src:129", "/a/Main.src:125")}
+    assert outcome_changes(moved, new) == [] and ends_alike(moved, new)
+    other = {**moved, "statement": "WAIT FOR $IN[8]"}
+    assert outcome_changes(other, new) == ["ends at another statement"] and not ends_alike(other, new)
+    # the report's row says "the same" exactly when the ends are alike
+    for a, b in ((old, new), (other, new), (moved, new)):
+        t = Touched("MAIN:MAIN", "Main", "Main", "program", "/a/Main.src", "/b/Main.src", "changed",
+                    old_outcome=a, new_outcome=b, changes=outcome_changes(a, b), ends_alike=ends_alike(a, b))
+        assert _run_row(t, lambda *x: "", {})["same_end"] is ends_alike(a, b)
 
 
 def test_motion_events_are_named_by_the_controllers_messages():

@@ -9,7 +9,7 @@ Cost: the sample is :data:`SAMPLE` variants, every kind once first, then evenly 
 :data:`ENTRIES` of its variant's entry points (its sps.sub first) for
 :data:`interp.variants.SIM_TIME_S` simulated seconds on the VM. Every entry point of 12 variants was
 309 runs, 52 s of CPU (2026-11-26): too much for make test; the nightly runs them all. The sample:
-9 variants of 9 backups, 18 runs. Skipped only where ../shared is absent and CI is not
+10 variants (9 before issue 72's busy-submit), 20 runs. Skipped only where ../shared is absent and CI is not
 set (tests/conftest.py)."""
 
 from __future__ import annotations
@@ -56,8 +56,8 @@ def test_the_variants_of_a_backup(tmp_path):
     assert got == [("whole", ""), ("no-TP", "R1/TP"), ("no-TP/", "R1/TP/Grip"), ("no-TP/", "R1/TP/Spot"),
                    ("no-package-dat", "R1/TP/Spot/spot.dat"), ("no-system", "R1/System/$config.dat"),
                    ("no-system", "R1/System/sps.sub"), ("no-system", "R1/Mada/$robcor.dat"),
-                   ("config-user-part-missing", "R1/System/$config.dat"), ("program-only", ""),
-                   ("tree", "flat"), ("zip", "")]
+                   ("config-user-part-missing", "R1/System/$config.dat"), ("busy-submit", "R1/System/sps.sub"),
+                   ("program-only", ""), ("tree", "flat"), ("zip", "")]
 
 
 def _made(variant, tmp: Path) -> set[str]:
@@ -83,6 +83,14 @@ def test_each_variant_removes_or_reshapes_what_it_says(tmp_path):
     assert _made(by[("program-only", "")], out) == {"R1/Program/prog.src"}
     assert _made(by[("tree", "flat")], out) == {f[3:] if f.startswith("R1/") else f for f in whole}
     assert _made(by[("zip", "")], out) == {"KRC/" + f for f in whole}
+    busy = by[("busy-submit", "R1/System/sps.sub")]
+    assert _made(busy, out) == whole
+    dest = out / "busy"
+    dest.mkdir()
+    busy.make(dest)
+    assert (dest / "R1/System/sps.sub").read_text() == (
+        "DEF sps( )\nDECL INT KRL_VARIANT_BUSY\n  KRL_VARIANT_BUSY = 0\n  LOOP\n    KRL_VARIANT_BUSY = KRL_VARIANT_BUSY + 1\n"
+        "    WAIT SEC 1\n  ENDLOOP\nEND\n")
     v = by[("config-user-part-missing", "R1/System/$config.dat")]
     dest = out / "user"
     dest.mkdir()
@@ -90,6 +98,32 @@ def test_each_variant_removes_or_reshapes_what_it_says(tmp_path):
     text = (dest / "R1/System/$config.dat").read_text()
     assert "K1=1" in text and "U1" not in text and "SIGNAL S1" not in text
     assert ";FOLD USER GLOBALS" in text and ";ENDFOLD (USER GLOBALS)" in text
+
+
+def test_a_busy_submit_needs_a_loop_of_its_main_routine():
+    """busy_submit makes the first routine's own LOOP busy, keeps CRLF line ends, and gives None
+    for a submit program without one (a LOOP only in a later routine is not its cycle)."""
+    crlf = b"&ACCESS RVP\r\nDEF  SPS ( )\r\n  ;FOLD INI\r\n  X = 1\r\n  ;ENDFOLD\r\n  LOOP ; cycle\r\n    X = 2\r\n  ENDLOOP\r\nEND\r\n"
+    got = V.busy_submit(crlf).decode()
+    assert got.splitlines(keepends=True)[2] == "DECL INT KRL_VARIANT_BUSY\r\n"
+    assert "  KRL_VARIANT_BUSY = 0\r\n  LOOP ; cycle\r\n    KRL_VARIANT_BUSY = KRL_VARIANT_BUSY + 1\r\n" in got
+    assert V.busy_submit(b"DEF sps( )\n  WAIT SEC 1\nEND\nDEF other( )\n  LOOP\n  ENDLOOP\nEND\n") is None
+    assert V.busy_submit(b"DEFDAT sps\nENDDAT\n") is None
+
+
+def test_the_conditions_of_issue_72_are_variants(tmp_path):
+    """A KR C4 backup whose $config.dat names its robot in MACHINE_DEF: no $machine.dat and no
+    bas.src are variants of it (no-system), as is its submit interpreter kept busy."""
+    root = tmp_path / "KRC"
+    write(root, "R1/System/$config.dat", "DEFDAT $CONFIG\nDECL MACHINE_DEF_T MACHINE_DEF[1]\n"
+                                         'MACHINE_DEF[1]={NAME[] "KR 10 R1440-2",MECH_TYPE #ROBOT}\nENDDAT\n')
+    write(root, "R1/System/bas.src", "DEF bas( )\nEND\n")
+    write(root, "R1/System/sps.sub", "DEF sps( )\n  LOOP\n  ENDLOOP\nEND\n")
+    write(root, "R1/Mada/$machine.dat", "DEFDAT $MACHINE\nENDDAT\n")
+    write(root, "R1/Program/prog.src", "DEF prog( )\nEND\n")
+    got = {(v.kind, v.detail) for v in V.variants_of(root)}
+    assert {("no-system", "R1/System/bas.src"), ("no-system", "R1/Mada/$machine.dat"),
+            ("busy-submit", "R1/System/sps.sub")} <= got
 
 
 def test_a_zip_variant_is_read_as_krl_run_reads_a_backup_archive(tmp_path):

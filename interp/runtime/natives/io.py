@@ -3,7 +3,8 @@ CREAD, CCLOSE, CIOCTL, GET_SIG_INF.
 
 PULSE sets an output for a time (``rt.pulse``). COPEN(:SER_3, HANDLE) finds no device on any
 channel: HANDLE 0, the channel not connected (:func:`_copen`). CWRITE writes to the $CMD
-channel (a message) and calls the controller's installed functions on the $FCT_CALL channel
+channel (a message; its commands RUN, STOP, RESET and CANCEL change the interpreters'
+program states: interp/runtime/cmdchannel.py) and calls the controller's installed functions on the $FCT_CALL channel
 (fctcall.py: EthernetKRL's kernel behind KUKA's KRL layer). Unsupported: CREAD, CCLOSE, CIOCTL,
 GET_SIG_INF and other CWRITE channels stop the program with a clear "not supported" run-time
 error.
@@ -55,9 +56,10 @@ def _cwrite(rt, a):
     if ch != store.get("$CMD"):
         raise KrlRuntimeError("CWRITE: only the $CMD and $FCT_CALL channels are supported by this simulator")
     rt.message(f"CWRITE $CMD: {fmt}")
+    ret = rt.scheduler.programs.command(fmt)     # RUN, STOP n, RESET n, CANCEL n (cmdchannel.py)
     st = a[1].peek() if a[1] is not None else None
     if isinstance(st, Struct) and "RET1" in st.f:
-        st.f["RET1"] = EnumValue("CMD_OK")
+        st.f["RET1"] = EnumValue(ret)
 
 
 def _unsupported(name):
