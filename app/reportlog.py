@@ -4,8 +4,8 @@ report's "Logbook" section (krl/diff/templates/_logbook.html.j2).
 For a side that is a controller archive with event logs (krl/logbook: folder or .zip), its
 records summed up as ``krl log summary`` sums them (messages by module and number, the programs
 named, the operator's actions); with an older side, the newer side's records since the older
-archive (after its last logbook record, else after the newest record both share: the logs of one
-controller overlap) -- what happened on the robot between the two archives. A side without event
+archive (after the older archive's last logbook record: the logs of one controller overlap) --
+what happened on the robot between the two archives. A side without event
 logs has no logbook (None); a log not read whole is listed with its error.
 """
 
