@@ -89,6 +89,8 @@ class Builtins:
     kss_enums: dict[str, list[str]] = field(default_factory=dict)
     sources: dict[str, str] = field(default_factory=dict)      # UPPER name -> "path:line"
     packages: dict[str, tuple[str, str]] = field(default_factory=dict)  # UPPER name -> (package, source)
+    # UPPER routine name -> (package, source): a package's routines, installed where an archive lists it
+    package_routines: dict[str, tuple[str, str]] = field(default_factory=dict)
     programs: dict[str, str] = field(default_factory=dict)    # UPPER file name of a KUKA hook program -> source
     # functions.yaml (generated from the natives registry): the routines whose call stops the
     # advance run (reference 6.10; krl/semantics/advance.py)
@@ -231,6 +233,7 @@ def _load_builtins(store=None) -> Builtins:
             routines[key] = parse_signature(info["signature"], bool(info["function"]))
             sources.setdefault(key, info["source"])
     packages = {k: (v["package"], v["source"]) for k, v in (kss.get("packages") or {}).items()}
+    package_routines = {k: (v["package"], v["source"]) for k, v in (kss.get("package_routines") or {}).items()}
     programs = {k: v["source"] for k, v in (kss.get("programs") or {}).items()}
     options = types.get("options", {}) or {}
     bvars = {}
@@ -255,6 +258,7 @@ def _load_builtins(store=None) -> Builtins:
         kss_enums=kss_enums,
         sources=sources,
         packages=packages,
+        package_routines=package_routines,
         programs=programs,
         advance_stop=frozenset(str(n).upper() for n in funcs.get("advance_stop") or ()),
     )
