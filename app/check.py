@@ -28,6 +28,7 @@ from krl.source import read_source
 from krl.terminal import printable
 from krl.diagnostics.render import Renderer, use_colour
 from krl.archive import ArchiveError, backup_source
+from krl.kssarchive import ARCHIVE_MANIFESTS, packages_text
 from krl.cluster import run_batches, SchedulerError
 from krl.semantics.config import ConfigError, Selection, config_for, parse_codes
 from krl.workspace import load_workspaces, not_understood, on_each_file, Workspace, workspaces_for
@@ -126,11 +127,12 @@ def run_check(paths: list[str], as_json: bool = False, no_warnings: bool = False
     any_error = False
     seen: set = set()      # files already checked: `krl check A.src A.dat` checks module A once
 
-    def report(root: str, n_files: int, diags: list, partial: list = (), named=str) -> None:
+    def report(root: str, n_files: int, diags: list, partial: list = (), named=str, packages=()) -> None:
         shown = [d for d in diags if d.is_error or not no_warnings]
         if fmt == "json":
             echo(json.dumps({
                 "workspace": root,
+                **({"installed_packages": [{"name": n, "version": v} for n, v in packages]} if packages else {}),
                 "files": n_files,
                 "errors": sum(d.is_error for d in diags),
                 "warnings": sum(not d.is_error for d in diags),
@@ -141,6 +143,9 @@ def run_check(paths: list[str], as_json: bool = False, no_warnings: bool = False
         elif fmt == "sarif":
             all_shown.extend(shown)
         else:
+            if packages:      # what the check took as installed software (krl/semantics/outside.py)
+                echo(printable(f"{root}: the archive's am.ini lists these technology packages as installed: "
+                               f"{packages_text(packages)}"))
             # the lines not understood first, once each: the rest of each file is checked (issue 63)
             for p in partial:
                 echo(printable(p.headline("checked", named)))
@@ -154,7 +159,7 @@ def run_check(paths: list[str], as_json: bool = False, no_warnings: bool = False
             if _resolved(path) in seen:
                 continue
             try:
-                with backup_source(path) as (folder, as_shown):
+                with backup_source(path, ARCHIVE_MANIFESTS) as (folder, as_shown):
                     for ws in _loaded(folder if as_shown.archive else path, timeout, jobs, scheduler):
                         seen.update(_resolved(f.path) for f in ws.files)
                         try:
@@ -170,7 +175,8 @@ def run_check(paths: list[str], as_json: bool = False, no_warnings: bool = False
                             diags = [as_shown.diagnostic(d) for d in diags]
                         any_error |= any(d.is_error for d in diags)
                         partial = not_understood(ws) if isinstance(ws, Workspace) else []
-                        report(as_shown(ws.root), len(ws.files), diags, partial, as_shown)
+                        report(as_shown(ws.root), len(ws.files), diags, partial, as_shown,
+                               getattr(ws, "installed_packages", ()))
             except ArchiveError as exc:
                 any_error = True
                 message = str(exc).removeprefix(f"{path}: ")

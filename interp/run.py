@@ -29,6 +29,7 @@ from interp.spec import INTERP, RUN_MODE, RUN_SIM_TIME_S, RunSpec, SpecError
 from interp.tree import TreeInterpreter
 from interp.vm import VM
 from krl.archive import ArchiveError, backup_source, is_archive
+from krl.kssarchive import ARCHIVE_MANIFESTS
 from krl.ast import nodes as N
 from krl.semantics.resolve import UNRESOLVED
 from krl.files import spelled, spelled_within
@@ -434,7 +435,7 @@ def run_setup(options: dict) -> Iterator[RunSetup]:
                 raise RunSetupError(_no_cell(workspace))
     if workspace is not None and is_archive(workspace):
         try:
-            with backup_source(workspace) as (folder, _shown):
+            with backup_source(workspace, ARCHIVE_MANIFESTS) as (folder, _shown):
                 found = _cell_of_folder(folder) if whole else program_in(folder, program)
                 if found is None and whole:
                     raise RunSetupError(_no_cell(workspace))

@@ -18,6 +18,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from krl.kssarchive import packages_text
 from krl.terminal import clip, printable, printable_path
 from krl.ast import nodes as N
 from interp.run import global_value, signal_of
@@ -218,6 +219,10 @@ def _run_lines(rt: Any) -> list[str]:
                           for name, what, n in stubs[:12])
         more = f", ... {len(stubs) - 12} more" if len(stubs) > 12 else ""
         out.append(f"  stubs      {len(stubs)}: {shown}{more}")
+    ws = getattr(getattr(rt, "program", None), "ws", None)
+    packages = getattr(ws, "installed_packages", ())
+    if packages:
+        out.append(f"  packages   {printable(packages_text(packages))} (installed: the archive's am.ini)")
     auto = getattr(rt, "autocell", None)
     if auto is not None:
         answers = auto.answers

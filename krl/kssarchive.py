@@ -43,11 +43,14 @@ from xml.etree.ElementTree import ParseError
 from krl.archive import ArchiveError, inspect, is_archive
 from krl.limits import MAX_ARCHIVE_INFO_BYTES
 
-__all__ = ["ArchiveInfo", "archive_root", "info_lines", "log_files", "parse_am_ini", "parse_archive_info",
-           "read_info"]
+__all__ = ["ARCHIVE_MANIFESTS", "ArchiveInfo", "archive_root", "info_lines", "log_files", "packages_text",
+           "parse_am_ini", "parse_archive_info", "read_info"]
 
 _NS = "{KUKARoboter.Contracts.Archive}"
 _MANIFESTS = ("am.ini", "archiveinfo.xml")
+#: the name endings krl/archive.py backup_source extracts of a zipped archive besides its KRL
+#: files so that the manifest is read (krl check, krl run: the installed packages)
+ARCHIVE_MANIFESTS = _MANIFESTS
 LOG_FOLDER = "log files"
 
 
@@ -241,6 +244,12 @@ def read_info(path: str | Path) -> ArchiveInfo | None:
     return _merge(str(root), _read_folder(root)) if root is not None else None
 
 
+def packages_text(techpacks) -> str:
+    """``KUKA.PROFINET MS 6.0.8, KUKA.UpdateService 1.1.24``: (name, version) pairs as one text
+    (from the archive, unescaped)."""
+    return ", ".join(f"{n} {v}".strip() for n, v in techpacks)
+
+
 def info_lines(info: ArchiveInfo) -> list[str]:
     """The lines ``krl robot show`` prints for an archive (text from the archive, unescaped:
     the caller passes each through krl.terminal.printable)."""
@@ -252,7 +261,7 @@ def info_lines(info: ArchiveInfo) -> list[str]:
     if info.kss:
         out.append(f"software   KSS {info.kss.lstrip('Vv')}" + (f" build {info.build}" if info.build else ""))
     if info.techpacks:
-        out.append("packages   " + ", ".join(f"{n} {v}".strip() for n, v in info.techpacks))
+        out.append("packages   " + packages_text(info.techpacks))
     for note in info.notes:
         out.append(f"note       {note}")
     return out

@@ -48,6 +48,7 @@ from krl.ast import nodes as N
 from krl.ast.build import build_module
 from krl.ast.coverage import lines_not_understood
 from krl.files import Entry
+from krl.kssarchive import archive_root, read_info
 from krl.project import (ProgramFiles, collect_entries, folder_groups, is_submit_file, is_system_path, module_key,
                          modules_of, project_of)
 from krl.project import module_files as project_module_files
@@ -56,7 +57,7 @@ from krl.semantics.checker import Checker, DeclaredTwice, Declarer, _is_system_d
 from krl.diagnostics import SYNTAX_CODES, Diagnostic, DiagnosticSink
 from krl.diagnostics.render import split_lines
 from krl.diagnostics.codes import E001, E005, E901, W002, W108, W111, W201, W202, W205, W206, W210, W501
-from krl.semantics.outside import Unresolved, line_evidence, template_lines
+from krl.semantics.outside import Unresolved, line_evidence, package_installed, template_lines
 from krl.semantics.resolve import resolve_workspace
 from krl.semantics.symbols import Scope, Symbol, system_scopes
 from krl.syntax.folds import fold_diagnostics
@@ -307,9 +308,25 @@ class Workspace:
     # what the last check left for :meth:`replace` (_CheckState), and the check's options
     _state: "_CheckState | None" = field(default=None, repr=False)
     _options: tuple = field(default=(True,), repr=False)      # (resolve,)
+    _installed: tuple | None = field(default=None, repr=False)      # installed_packages, once read
     _unread: bool = field(default=False, repr=False)                # an entry not read (not a file's)
     _by_path: dict | None = field(default=None, repr=False)
     _inputs: list = field(default_factory=list, repr=False)         # the load's diagnostics, in order
+
+    @property
+    def installed_packages(self) -> tuple[tuple[str, str], ...]:
+        """The technology packages (name, version) that the controller archive holding this
+        backup lists as installed (its am.ini ``[TechPacks]``, else ArchiveInfo.xml's
+        ``OptionData``: krl/kssarchive.py); () outside an archive. Read once."""
+        if self._installed is None:
+            self._installed = ()
+            if self.root and archive_root(self.root) is not None:
+                try:
+                    info = read_info(self.root)
+                except (ValueError, OSError):
+                    info = None
+                self._installed = info.techpacks if info is not None else ()
+        return self._installed
 
     def maybe_declared(self, name: str) -> bool:
         """True when a file that could not be parsed (or read) may declare `name`."""
@@ -684,7 +701,12 @@ class Workspace:
         check. The run's stand-ins for KUKA's system software read it (interp/runtime/kss.py)."""
         if self._state is None:
             return None
-        un = Unresolved(load_builtins().packages, self.maybe_declared)
+        tables, installed = load_builtins(), self.installed_packages
+        packages = tables.packages
+        if installed:       # a routine of a package the archive lists is installed software's
+            packages = {**{k: v for k, v in tables.package_routines.items() if package_installed(v[0], installed)},
+                        **packages}
+        un = Unresolved(packages, self.maybe_declared, installed=installed)
         for _diags, uses in self._owners():
             for use in uses.items:
                 un.use(*use)

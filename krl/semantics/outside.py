@@ -9,7 +9,10 @@ whole workspace has been checked:
   technology packages, installed on the controller whether or not their files were exported)
   when there is evidence that installed software declares it, whatever resolved it:
   the platform tables name the technology package or KUKA hook program that declares it
-  (kss.yaml ``packages``),
+  (kss.yaml ``packages``: the GLOBAL names of each package's data lists in the corpus; in a
+  controller archive whose ``am.ini`` lists its installed technology packages, also the routines
+  of the packages it lists, kss.yaml ``package_routines``: :func:`package_installed`; the
+  warning says whether the archive lists the package),
   or one of its uses is a line that KUKA's software wrote (a KUKA system file: R1/System,
   R1/TP, R1/Mada, STEU or a ``$`` file, outside its USER folds; the template's INI fold of a
   program, not its USER INI fold; for a routine or a type, a KUKA inline form ``;FOLD ...
@@ -200,6 +203,34 @@ def _innermost(stack: list[list[str]]) -> list[str] | None:
     return None
 
 
+def _package_key(name: str) -> str:
+    """A technology package's name as am.ini and the backup's ``R1/TP`` folder both spell it:
+    the product name without KUKA's ``KUKA.`` prefix, letters and digits only, any case
+    (am.ini ``KUKA.GripperSpotTech`` and the folder ``TP/GripperSpotTech``)."""
+    low = name.strip().lower()
+    low = low[5:] if low.startswith("kuka.") else low
+    return "".join(ch for ch in low if ch.isalnum())
+
+
+def package_installed(package: str, installed) -> tuple[str, str] | None:
+    """The (name, version) of `installed` (an archive's ``am.ini`` ``[TechPacks]``: (name,
+    version) pairs, krl/kssarchive.py) that is the technology package `package` (its ``R1/TP``
+    folder's name, kss.yaml ``packages``), or None."""
+    want = _package_key(package)
+    return next(((n, v) for n, v in installed if _package_key(n) == want), None) if want else None
+
+
+def installed_clause(package: str, installed) -> str:
+    """What an archive's am.ini says of `package`: '' without a package list, else that it
+    lists the package as installed (with its version) or that it does not."""
+    if not installed:
+        return ""
+    got = package_installed(package, installed)
+    if got is None:
+        return "; the archive's am.ini does not list it among its installed technology packages"
+    return f"; the archive's am.ini lists it as installed ({f'{got[0]} {got[1]}'.strip()})"
+
+
 @dataclass(slots=True)
 class Use:
     path: str
@@ -250,10 +281,13 @@ class Unresolved:
     """Collects the uses of unresolved names of one workspace (see the module docstring).
 
     `packages`: UPPER name -> (package, source "path:line") from kss.yaml; `maybe_declared`:
-    name -> True when a line not understood of the backup mentions it."""
+    name -> True when a line not understood of the backup mentions it; `installed`: the
+    technology packages a controller archive's am.ini lists, (name, version) pairs (empty
+    outside an archive or without a list)."""
 
     packages: dict = field(default_factory=dict)
     maybe_declared: object = None
+    installed: tuple = ()
     uses: dict = field(default_factory=dict)        # (kind, UPPER name) -> (spelling, [Use])
 
     def use(self, kind: str, name: str, path: str, line: int, column: int, evidence: str = "",
@@ -273,7 +307,8 @@ class Unresolved:
             if package.startswith("KSS hook program "):
                 return (f"declared by KUKA's hook program {package[17:]} ({source}), which KUKA's system "
                         f"files call and this backup does not contain")
-            return f"declared by technology package {package} ({source}), which this backup does not contain"
+            return (f"declared by technology package {package} ({source}), which this backup does not contain"
+                    + installed_clause(package, self.installed))
         for u in uses:
             if u.evidence:
                 return u.evidence
