@@ -290,4 +290,7 @@ MAX_ARCHIVE_INFO_BYTES = 1024 * 1024
 # characters). Past the file size: an error naming the file; the other logs are still read.
 MAX_LOG_BYTES = 64 * 1024 * 1024
 MAX_LOG_RECORDS = 1_000_000
+#: the logbook records `krl pendant` sends its page (pendant/logbook.py): the newest are kept,
+#: the page says how many were left out (a whole archive's seven logs hold tens of thousands)
+MAX_PENDANT_LOG_RECORDS = 5_000
 MAX_LOG_RECORD_CHARS = 64 * 1024

@@ -16,6 +16,7 @@ from krl.limits import MAX_WEB_MESSAGE_BYTES
 from krl.project import backup_of
 from krl.terminal import printable
 from krl.archive import ArchiveError, backup_source, is_archive
+from krl.logbook.record import ARCHIVE_FILES
 import uvicorn
 from .security import new_token
 from .server import Pendant, create_app
@@ -51,7 +52,8 @@ def pendant(target: Path | None, port: int, no_browser: bool, inputs: Path | Non
         shown = str(target)
         if is_archive(target):
             try:
-                folder, _ = stack.enter_context(backup_source(target))
+                # its event logs and manifest too: the Logbook tab (pendant/logbook.py)
+                folder, _ = stack.enter_context(backup_source(target, ARCHIVE_FILES))
             except ArchiveError as exc:
                 click.echo(f"error: {printable(exc)}", err=True)
                 sys.exit(2)

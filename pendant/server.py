@@ -4,7 +4,8 @@
 Routes: ``/`` the page, ``/static/...`` its bundle (built from pendant/web, committed), ``/ws``
 the one websocket. On the websocket the page sends operator actions as JSON objects
 ``{"op": ..., ...}`` (:data:`OPS`) and receives ``{"type": ...}`` objects: ``init`` (workspace,
-programs, robot), ``module`` (a file's text and taught points), ``state`` (pendant/state.py: the
+programs, robot), ``module`` (a file's text and taught points), ``logbook`` (a controller
+archive's logbook records with the file and line each names: pendant/logbook.py), ``state`` (pendant/state.py: the
 whole state first, ``"full": true``, then only the top-level keys that changed, a key gone as
 null), ``live`` (time, axes, the TCP path's new points and, when they changed, the pointers, at
 display rate while the program runs), ``done`` (an action carried out: its id and op, and ``ms``
@@ -53,6 +54,7 @@ from .security import COOKIE, Guard, PathRefused, inside
 from .state import message_rows, snapshot
 from krl.files import spelled
 from .view import module_view, modules, programs, robot_view
+from .logbook import logbook_view
 from interp.run import robot_for
 
 STATIC = Path(__file__).resolve().parent / "static"
@@ -146,6 +148,7 @@ class Pendant:
         self._pushed_seq = 0                        # the newest engine snapshot pushed (pendant/state.py)
         self._modules: dict[str, tuple] = {}
         self._position = None                       # where the robot stands when no program is selected
+        self._logbook: dict | None = None           # the archive's logbook, once read (pendant/logbook.py)
 
     # ------------------------------------------------------------------ static data
     def robot(self) -> dict:
@@ -439,6 +442,14 @@ class Pendant:
         await act.do(lambda core: keys.touch_up(core, str(dat), str(act.msg.get("name", ""))))
         if self.program is not None:
             await self.broadcast_module(self.program)
+
+    @_operation("logbook")
+    async def _logbook(self, act: "_Action") -> object:
+        """The archive's logbook (pendant/logbook.py), read once, for the page's Logbook tab."""
+        if self._logbook is None:
+            self._logbook = await asyncio.get_running_loop().run_in_executor(None, logbook_view, self.root)
+        await act.ws.send_text(json.dumps({"type": "logbook", **self._logbook}))
+        return _NO_STATE
 
     @_operation("open")
     async def _open(self, act: "_Action") -> object:

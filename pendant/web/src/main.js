@@ -56,6 +56,7 @@ function onMessage(m) {
   switch (m.type) {
     case 'init': onInit(m); break;
     case 'module': onModule(m); break;
+    case 'logbook': onLogbook(m); break;
     case 'state': onState(m); break;
     case 'live': onLive(m); break;
     case 'event': P.events.push(m); if (P.events.length > 200) P.events.shift(); break;
@@ -84,6 +85,7 @@ function onInit(m) {
   $('touchup').disabled = !!m.readonly;
   $('robot-name').textContent = m.robot.name;
   loadRobot(m.robot);
+  if (!P.logbook) send('logbook').catch(showError);
 }
 
 $('select').onclick = () => act('select', { program: $('programs').value });
@@ -158,6 +160,7 @@ function showModule(m) {
   showPoints(m.points || []);
   drawPoints(m.points || []);
   if (P.state) drawPointers(P.state.pointers || {}, P.state.breakpoints || {});
+  markLogged();
 }
 
 function samePath(a, b) { return a && b && a === b; }
@@ -190,6 +193,55 @@ function drawPointers(ptr, bps) {
     else if (P.opening !== want) { P.opening = want; send('open', { path: want }).catch(() => {}); }
   }
 }
+
+// ------------------------------------------------------------------ the logbook (pendant/logbook.py)
+// the controller archive's logbook beside the program: stepping through its records moves the
+// program view to the file and line a record names (a variable set from the pendant: its
+// declaration; a program: its first line)
+function onLogbook(m) {
+  P.logbook = m;
+  P.logIndex = -1;
+  $('log-count').textContent = m.records.length ? `(${m.records.length})` : '';
+  const notes = [...m.errors];
+  if (m.omitted) notes.push(`${m.omitted} older records not shown`);
+  if (!m.records.length && !m.errors.length) notes.push('no logbook: the workspace is no controller archive with event logs');
+  $('log-note').textContent = notes.join('; ');
+  $('logbook').replaceChildren(...m.records.map((r, i) => el('li', { 'data-index': String(i), 'data-linked': r.path ? 'true' : 'false', onclick: () => stepLog(i) },
+    el('span', { class: 'time', text: r.time.replace('T', ' ').replace('Z', '') }),
+    el('span', { class: 'origin', text: r.module }),
+    el('span', { class: 'number', text: r.number === null ? '' : String(r.number) }),
+    el('span', { class: 'text', text: [r.key, ...r.params].filter((x) => x).join('  ') }),
+    el('span', { class: 'src', text: r.path ? `${r.path.split('/').slice(-1)[0]}${r.line ? ` line ${r.line}` : ''}` : '' }))));
+}
+
+function stepLog(i) {
+  const recs = P.logbook ? P.logbook.records : [];
+  if (!recs.length) return;
+  P.logIndex = Math.max(0, Math.min(recs.length - 1, i));
+  for (const li of $('logbook').querySelectorAll('li.current')) li.classList.remove('current');
+  const li = $('logbook').querySelector(`li[data-index="${P.logIndex}"]`);
+  li.classList.add('current');
+  li.scrollIntoView({ block: 'nearest' });
+  const r = recs[P.logIndex];
+  $('log-pos').textContent = `${P.logIndex + 1} / ${recs.length}`;
+  if (!r.path) return;
+  P.logTarget = { path: r.path, line: r.line || 1 };
+  if (P.module && samePath(P.module.path, r.path)) markLogged();
+  else if (moduleCache.get(r.path)) showModule(moduleCache.get(r.path));
+  else send('open', { path: r.path }).catch(showError);
+}
+
+// the line the current record names, marked in the program view when it shows that file
+function markLogged() {
+  const box = $('program-view');
+  for (const r of box.querySelectorAll('.logged')) r.classList.remove('logged');
+  const t = P.logTarget;
+  if (!t || !P.module || !samePath(P.module.path, t.path)) return;
+  const row = box.querySelector(`[data-line="${t.line}"]`);
+  if (row) { row.classList.add('logged'); row.scrollIntoView({ block: 'center' }); }
+}
+$('log-prev').onclick = () => stepLog(P.logIndex - 1);
+$('log-next').onclick = () => stepLog(P.logIndex + 1);
 
 // ------------------------------------------------------------------ state
 const fmt = (v, d = 3) => (typeof v === 'number' ? v.toFixed(d) : '—');
