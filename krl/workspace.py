@@ -702,11 +702,12 @@ class Workspace:
         if self._state is None:
             return None
         tables, installed = load_builtins(), self.installed_packages
-        packages = tables.packages
+        packages, unlisted = tables.packages, {}
         if installed:       # a routine of a package the archive lists is installed software's
-            packages = {**{k: v for k, v in tables.package_routines.items() if package_installed(v[0], installed)},
-                        **packages}
-        un = Unresolved(packages, self.maybe_declared, installed=installed)
+            listed = {k: v for k, v in tables.package_routines.items() if package_installed(v[0], installed)}
+            unlisted = {k: v for k, v in tables.package_routines.items() if k not in listed}
+            packages = {**listed, **packages}
+        un = Unresolved(packages, self.maybe_declared, installed=installed, unlisted=unlisted)
         for _diags, uses in self._owners():
             for use in uses.items:
                 un.use(*use)

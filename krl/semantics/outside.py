@@ -283,11 +283,15 @@ class Unresolved:
     `packages`: UPPER name -> (package, source "path:line") from kss.yaml; `maybe_declared`:
     name -> True when a line not understood of the backup mentions it; `installed`: the
     technology packages a controller archive's am.ini lists, (name, version) pairs (empty
-    outside an archive or without a list)."""
+    outside an archive or without a list); `unlisted`: UPPER routine name -> (package, source)
+    of the packages' routines (kss.yaml ``package_routines``) whose package the archive does not
+    list: an EXT or a KUKA line still says installed software declares such a routine, and the
+    warning adds that the archive does not list its package."""
 
     packages: dict = field(default_factory=dict)
     maybe_declared: object = None
     installed: tuple = ()
+    unlisted: dict = field(default_factory=dict)
     uses: dict = field(default_factory=dict)        # (kind, UPPER name) -> (spelling, [Use])
 
     def use(self, kind: str, name: str, path: str, line: int, column: int, evidence: str = "",
@@ -311,7 +315,11 @@ class Unresolved:
                     + installed_clause(package, self.installed))
         for u in uses:
             if u.evidence:
-                return u.evidence
+                unlisted = self.unlisted.get(name.upper()) if kind == "routine" else None
+                if unlisted is None:
+                    return u.evidence
+                return (f"{u.evidence}; it is a routine of technology package {unlisted[0]} ({unlisted[1]})"
+                        + installed_clause(unlisted[0], self.installed))
         if kind == "sysvar":
             return "a system variable of the controller that the platform tables do not list"
         if self.maybe_declared is not None and self.maybe_declared(name):

@@ -103,7 +103,8 @@ def test_a_package_the_archive_lists_is_installed_software(tmp_path, zipped):
 def test_a_package_the_archive_does_not_list_is_said_so(tmp_path):
     """am.ini lists EthernetKRL only: GripperSpotTech's routine called without EXT is the
     program's error (nothing declares it and the archive says the package is not installed),
-    its EXT-declared routine stays installed software by its EXT, and its data-list variable
+    its EXT-declared routine stays installed software by its EXT, the warning adding that the
+    archive does not list its package, and its data-list variable
     (a name the tables give the package whatever the archive says) is named as not listed."""
     root = _archive(tmp_path / "archive", "KUKA.EthernetKRL")
     res = krl("check", str(root))
@@ -112,6 +113,8 @@ def test_a_package_the_archive_does_not_list_is_said_so(tmp_path):
     assert any("error[E106]: routine 'GRPg_Check' is not declared" in x for x in out), res.output
     ext = next(x for x in out if "routine 'GRPg_SetState'" in x)
     assert "warning[W106]" in ext and "an EXT declaration (pick.src:2) names it" in ext, ext
+    assert ext.endswith(f"; it is a routine of technology package GripperSpotTech ({GRP_FUNC}:71); the archive's "
+                        "am.ini does not list it among its installed technology packages"), ext
     var = next(x for x in out if "'GRPg_MaxGrp'" in x)
     assert var.endswith(f"declared by technology package GripperSpotTech ({GRP_DATA}:19), which this backup does "
                         "not contain; the archive's am.ini does not list it among its installed technology "
