@@ -20,11 +20,12 @@ residuals of each step. What each step takes from the recordings:
 2. *PTP accelerations* ``A_i``, *ramp distances* ``R_i``, *friction* ``c_i``: least squares (soft
    L1) of log(planned duration) over the single-axis PTPs (the velocity runs, and the acceleration
    runs at 10 % and 100 % ``$ACC_AXIS``), planned as the simulator plans with the dynamic model
-   on (:func:`fit_axes`). For an axis without a torque channel (A1, A4..A6) the torque is then
+   on (:func:`fit_axes`; a ramp distance is fitted only with a PTP at a reduced ``$VEL_AXIS``, a
+   friction only with one at a reduced ``$ACC_AXIS``). For an axis without a torque channel (A1, A4..A6) the torque is then
    the one that gives ``A_i`` at the poses it was identified at (its acceleration is the torque's,
    at any pose and load); A2 and A3 keep their measured torque limits and ``A_i`` caps them.
-3. *Rotor inertias*: one value for A1 (the main axes' rotors of A2 and A3 likewise), one for the
-   wrist, the best of a grid over the multi-axis PTPs (:func:`fit_rotors`).
+3. *Rotor inertias*: one value for the main axes A1..A3, one for the wrist, the best of a grid
+   over the multi-axis PTPs (:func:`fit_rotors`).
 4. *Actual-value average* and *following error* (robot/kukatrace/actual.py) on the LINs and
    CIRCs of the set (:func:`fit_filter`, :func:`fit_following`).
 
@@ -191,33 +192,54 @@ def fit_axes(base, train, hook: Callable[[int, float], None] | None = None) -> t
     """(A_i, R_i, c_i) fitted axis by axis (a single-axis PTP depends on its axis' three
     parameters only): the best point of a grid (A 1 000..200 000 deg/s², R 0.1..30 deg,
     log-spaced; c 0, 2, 5, 10 1/s), then least squares (soft L1, scale 2 %) of log(planned
-    duration) from there, c within 0..30 1/s. An axis without a PTP in `train` keeps 10 000
-    deg/s², 2 deg, 0. `hook(i, A_i)` is called before each evaluation (the dynamic model's torque
-    of an axis without a measured limit follows its acceleration)."""
+    duration) from there, c within 0..30 1/s. A parameter the axis' PTPs cannot show is not fitted
+    (:func:`_shown`): R_i 0 (no ramp bound) without a PTP at a reduced ``$VEL_AXIS``, c_i 0
+    without one at a reduced ``$ACC_AXIS``. An axis without a PTP in `train` keeps 10 000 deg/s²,
+    2 deg, 0. `hook(i, A_i)` is called before each evaluation (the dynamic model's torque of an
+    axis without a measured limit follows its acceleration)."""
     acc, ramp, fric = np.full(AXES, 10000.0), np.full(AXES, 2.0), np.zeros(AXES)
     dyn = getattr(base, "dynamics", None)
+    lo, hi = np.array([math.log(500.0), math.log(0.01), 0.0]), np.array([math.log(5e5), math.log(100.0), 30.0])
     for i in range(AXES):
         mine = [m for m in train if main_axis(m) == i]
         if not mine:
             continue
+        free = _shown(mine, i)
+
+        def full(x, free=free):
+            y = np.array([0.0, -np.inf, 0.0])
+            y[free] = x
+            return y
 
         def res(x, i=i, mine=mine):
             a, r, c = acc.copy(), ramp.copy(), fric.copy()
-            a[i], r[i], c[i] = math.exp(x[0]), math.exp(x[1]), x[2]
+            y = full(x)
+            a[i], r[i], c[i] = math.exp(y[0]), math.exp(y[1]), y[2]
             if hook is not None:
                 hook(i, a[i])
             mach = with_params(base, a, r, c, dyn)
             return [math.log(planned(mach, m) / m["plan"]) for m in mine]
 
-        grid = [(la, lr, c) for la in np.linspace(math.log(1e3), math.log(2e5), 24)
-                for lr in np.linspace(math.log(0.1), math.log(30.0), 16) for c in (0.0, 2.0, 5.0, 10.0)]
+        grid = [np.array((la, lr, c))[free] for la in np.linspace(math.log(1e3), math.log(2e5), 24)
+                for lr in (np.linspace(math.log(0.1), math.log(30.0), 16) if free[1] else (0.0,))
+                for c in ((0.0, 2.0, 5.0, 10.0) if free[2] else (0.0,))]
         x0 = min(grid, key=lambda x: float(np.sum(np.abs(res(x)))))
-        sol = least_squares(res, x0, loss="soft_l1", f_scale=0.02,
-                            bounds=([math.log(500.0), math.log(0.01), 0.0], [math.log(5e5), math.log(100.0), 30.0]))
-        acc[i], ramp[i], fric[i] = math.exp(sol.x[0]), math.exp(sol.x[1]), sol.x[2]
+        sol = least_squares(res, x0, loss="soft_l1", f_scale=0.02, bounds=(lo[free], hi[free]))
+        y = full(sol.x)
+        acc[i], ramp[i], fric[i] = math.exp(y[0]), math.exp(y[1]), y[2]
         if hook is not None:
             hook(i, acc[i])
     return acc, ramp, fric
+
+
+def _shown(mine: list[dict], i: int) -> np.ndarray:
+    """Which of (A_i, R_i, c_i) axis i's single-axis PTPs `mine` can show: A always; R (the ramp
+    at a reduced speed) only with a PTP below 100 % ``$VEL_AXIS``; c (the friction, which takes a
+    share of the acceleration that grows as the acceleration falls) only with a PTP below 100 %
+    ``$ACC_AXIS``. Otherwise the parameter trades against A_i on the data it has and predicts
+    nothing (``--cross``: with PTP_vel_test left out, A5's R went to 10.6 deg and its 10 % runs
+    took 2.5 times as long)."""
+    return np.array([True, any(m["vel"][i] < 100.0 for m in mine), any(m["acc"][i] < 100.0 for m in mine)])
 
 
 def scaled_links(links: dict[str, list], scales: np.ndarray) -> dict[str, list]:
